@@ -1,0 +1,149 @@
+//! The `semo` command. Exit codes: 0 no errors, 1 errors found, 2 usage or I/O
+//! problem.
+
+mod render;
+
+use crate::workspace;
+use clap::{Parser, Subcommand, ValueEnum};
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "semo",
+    version,
+    about = "SeMo: mission scripts for teams of cooperating robots",
+    long_about = "SeMo checks mission scripts (*.mission) against a robot catalog (the built-in \
+                  one plus any *.robot.xml files), and will refine them into per-robot task \
+                  graphs and C code.\n\nExit status: 0 when no errors were found, 1 when \
+                  errors were found, 2 for a usage or I/O problem."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Check mission scripts and robot catalogs, and report problems.
+    #[command(
+        long_about = "Check mission scripts and robot catalogs, and report problems.\n\n\
+        Each PATH is a file or a folder; a folder stands for every *.mission and *.robot.xml \
+        file under it. All catalog files found form one catalog (on top of the built-in \
+        one), and every mission is checked against it. With no PATH, the current folder \
+        is checked."
+    )]
+    Check {
+        /// Files or folders to check.
+        paths: Vec<PathBuf>,
+        /// How to print diagnostics: `human` (source snippets) or `json` (one
+        /// object per line: code, severity, file, start/end line and column,
+        /// message, suggestion).
+        #[arg(long, value_enum, default_value_t = Format::Human)]
+        format: Format,
+        /// Colour the human output: `auto` colours it when writing to a terminal.
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
+    },
+    /// Explain a diagnostic code (e.g. `semo explain E019`), or list them all.
+    Explain {
+        /// A code such as E019; all codes when omitted.
+        code: Option<String>,
+    },
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+enum Format {
+    Human,
+    Json,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+enum ColorChoice {
+    Auto,
+    Always,
+    Never,
+}
+
+/// Runs the command line and gives the process exit code.
+pub fn main() -> i32 {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() { 2 } else { 0 };
+        }
+    };
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    let code = match cli.command {
+        Command::Check {
+            paths,
+            format,
+            color,
+        } => {
+            let color = match color {
+                ColorChoice::Always => true,
+                ColorChoice::Never => false,
+                ColorChoice::Auto => {
+                    std::io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none()
+                }
+            };
+            check(paths, format, color, &mut out)
+        }
+        Command::Explain { code } => explain(code.as_deref(), &mut out),
+    };
+    let _ = out.flush();
+    code
+}
+
+fn check(paths: Vec<PathBuf>, format: Format, color: bool, out: &mut impl Write) -> i32 {
+    let paths = if paths.is_empty() {
+        vec![PathBuf::from(".")]
+    } else {
+        paths
+    };
+    let run = match workspace::check_paths(&paths) {
+        Ok(run) => run,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let written = match format {
+        Format::Human => render::human(&run, color, out),
+        Format::Json => render::json(&run, out),
+    };
+    if let Err(e) = written {
+        eprintln!("error: cannot write the report: {e}");
+        return 2;
+    }
+    if run.error_count() > 0 {
+        1
+    } else {
+        0
+    }
+}
+
+fn explain(code: Option<&str>, out: &mut impl Write) -> i32 {
+    use crate::diag::Code;
+    let codes: Vec<Code> = match code {
+        None => Code::ALL.to_vec(),
+        Some(c) => match Code::from_code(&c.to_ascii_uppercase()) {
+            Some(code) => vec![code],
+            None => {
+                eprintln!("error: unknown diagnostic code `{c}` (run `semo explain` to list them)");
+                return 2;
+            }
+        },
+    };
+    for code in codes {
+        let _ = writeln!(
+            out,
+            "{code} ({}): {}",
+            code.default_severity(),
+            code.summary()
+        );
+    }
+    0
+}

@@ -1,0 +1,138 @@
+//! Rendering diagnostics for people (ariadne snippets) and for programs (JSON
+//! lines). Positions become 1-based lines and columns here, columns counted in
+//! characters.
+
+use crate::diag::{Diagnostic, Severity};
+use crate::text::ColumnUnit;
+use crate::workspace::{CheckRun, Files};
+use ariadne::{Color, Config, IndexType, Label, Report, ReportKind};
+use std::io::{self, Write};
+
+fn kind(severity: Severity) -> ReportKind<'static> {
+    match severity {
+        Severity::Error => ReportKind::Error,
+        Severity::Warning => ReportKind::Warning,
+        Severity::Hint => ReportKind::Advice,
+    }
+}
+
+fn color(severity: Severity) -> Color {
+    match severity {
+        Severity::Error => Color::Red,
+        Severity::Warning => Color::Yellow,
+        Severity::Hint => Color::Cyan,
+    }
+}
+
+fn path_of(files: &Files, d: &Diagnostic) -> String {
+    files.get(d.file).path.display().to_string()
+}
+
+/// Clamps a span to the text and to character boundaries, so that a bad span
+/// can never make the renderer fail.
+fn safe_range(text: &str, span: crate::span::Span) -> std::ops::Range<usize> {
+    let fix = |mut i: usize| {
+        i = i.min(text.len());
+        while !text.is_char_boundary(i) {
+            i -= 1;
+        }
+        i
+    };
+    let (start, end) = (fix(span.start), fix(span.end));
+    start..end.max(start)
+}
+
+pub fn human(run: &CheckRun, colored: bool, out: &mut impl Write) -> io::Result<()> {
+    let config = Config::default()
+        .with_color(colored)
+        .with_index_type(IndexType::Byte);
+    let mut sources = Vec::new();
+    for f in run.files.iter() {
+        sources.push((f.path.display().to_string(), f.text.clone()));
+    }
+    let builtin = run.files.get(crate::catalog::BUILTIN_FILE);
+    sources.push((builtin.path.display().to_string(), builtin.text.clone()));
+    let mut cache = ariadne::sources(sources);
+
+    for d in &run.diagnostics {
+        let path = path_of(&run.files, d);
+        let range = safe_range(&run.files.get(d.file).text, d.span);
+        let mut report = Report::build(kind(d.severity), (path.clone(), range.clone()))
+            .with_config(config)
+            .with_code(d.code.as_str())
+            .with_message(&d.message)
+            .with_label(
+                Label::new((path, range))
+                    .with_message(d.code.summary())
+                    .with_color(color(d.severity)),
+            );
+        for related in &d.related {
+            let file = run.files.get(related.file);
+            report = report.with_label(
+                Label::new((
+                    file.path.display().to_string(),
+                    safe_range(&file.text, related.span),
+                ))
+                .with_message(&related.message)
+                .with_color(Color::Blue),
+            );
+        }
+        if let Some(s) = &d.suggestion {
+            report = report.with_help(format!("did you mean `{s}`?"));
+        }
+        report.finish().write(&mut cache, &mut *out)?;
+    }
+    let count = |s: Severity| run.diagnostics.iter().filter(|d| d.severity == s).count();
+    let plural = |n: usize, word: &str| format!("{n} {word}{}", if n == 1 { "" } else { "s" });
+    let missions = run
+        .files
+        .iter()
+        .filter(|f| f.kind == crate::workspace::FileKind::Mission)
+        .count();
+    let catalogs = run.files.iter().count() - missions;
+    writeln!(
+        out,
+        "checked {} and {}: {}, {}, {}",
+        plural(missions, "mission"),
+        plural(catalogs, "catalog file"),
+        plural(count(Severity::Error), "error"),
+        plural(count(Severity::Warning), "warning"),
+        plural(count(Severity::Hint), "hint"),
+    )
+}
+
+pub fn json(run: &CheckRun, out: &mut impl Write) -> io::Result<()> {
+    for d in &run.diagnostics {
+        let file = run.files.get(d.file);
+        let position = |offset: usize| {
+            let lc = file.lines.line_col(&file.text, offset, ColumnUnit::Char);
+            serde_json::json!({ "line": lc.line + 1, "column": lc.col + 1 })
+        };
+        let related: Vec<serde_json::Value> = d
+            .related
+            .iter()
+            .map(|r| {
+                let rf = run.files.get(r.file);
+                let lc = rf.lines.line_col(&rf.text, r.span.start, ColumnUnit::Char);
+                serde_json::json!({
+                    "file": rf.path.display().to_string(),
+                    "line": lc.line + 1,
+                    "column": lc.col + 1,
+                    "message": r.message,
+                })
+            })
+            .collect();
+        let value = serde_json::json!({
+            "code": d.code.as_str(),
+            "severity": d.severity.as_str(),
+            "file": file.path.display().to_string(),
+            "start": position(d.span.start),
+            "end": position(d.span.end),
+            "message": d.message,
+            "suggestion": d.suggestion,
+            "related": related,
+        });
+        writeln!(out, "{value}")?;
+    }
+    Ok(())
+}

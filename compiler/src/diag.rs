@@ -1,0 +1,200 @@
+//! Diagnostics as data: one type used by every layer. Each code is listed once in
+//! [`codes!`] with its stable name, default severity and a one-line summary; the CLI
+//! (ariadne, JSON) and the language server render the same values.
+
+use crate::span::Span;
+use std::fmt;
+
+/// Which file a diagnostic points into. The caller that loads files assigns them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+pub struct FileId(pub u32);
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Severity {
+    Error,
+    Warning,
+    Hint,
+}
+
+impl Severity {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+            Severity::Hint => "hint",
+        }
+    }
+}
+
+impl fmt::Display for Severity {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+macro_rules! codes {
+    ($($variant:ident = $code:literal, $severity:ident, $summary:literal;)*) => {
+        /// Every diagnostic the toolchain can report. The string code is stable.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub enum Code {
+            $($variant,)*
+        }
+
+        impl Code {
+            pub const ALL: &'static [Code] = &[$(Code::$variant,)*];
+
+            /// The stable code, e.g. `E010`.
+            pub fn as_str(self) -> &'static str {
+                match self { $(Code::$variant => $code,)* }
+            }
+
+            pub fn default_severity(self) -> Severity {
+                match self { $(Code::$variant => Severity::$severity,)* }
+            }
+
+            /// What the code means, in one line (for `--explain`-style listings).
+            pub fn summary(self) -> &'static str {
+                match self { $(Code::$variant => $summary,)* }
+            }
+
+            pub fn from_code(code: &str) -> Option<Code> {
+                match code { $($code => Some(Code::$variant),)* _ => None }
+            }
+        }
+    };
+}
+
+codes! {
+    // Syntax (mission scripts).
+    InvalidCharacter = "E001", Error, "a character that the language does not use";
+    UnterminatedString = "E002", Error, "a string without its closing quote";
+    SyntaxError = "E003", Error, "the text does not follow the grammar";
+    // Names and structure.
+    UnknownRobotType = "E010", Error, "a robot type that the catalog does not have";
+    DuplicateTeam = "E011", Error, "a team declared twice";
+    DuplicateRobot = "E012", Error, "a robot name used twice";
+    DuplicateService = "E013", Error, "a composite service defined twice for the same team and plan";
+    DuplicateMode = "E014", Error, "a mode defined twice for the same team";
+    UnknownTeam = "E015", Error, "a service, mode or main of a team that is not declared";
+    ServiceNotInPlan = "E016", Error, "`set` names a service that the plan does not have";
+    UnknownMode = "E017", Error, "`case`, `catch` or `mode =` names a mode that is not defined";
+    MissingDefault = "E018", Error, "a main block without `default: mode = ...`";
+    ServiceNotProvided = "E019", Error, "a built-in service that some robot running the statement lacks";
+    UnsatisfiableGroup = "E020", Error, "a group condition that no robot of the team meets";
+    UnknownCommTeam = "E021", Error, "an unknown team in send, receive, publish or subscribe";
+    WrongArgumentCount = "E022", Error, "a built-in service called with too many or too few arguments";
+    WrongArgumentType = "E023", Error, "an argument whose type the service does not accept";
+    UnknownService = "E024", Error, "a call to a service or function that does not exist";
+    DuplicateFunction = "E025", Error, "a function defined twice";
+    DuplicateMain = "E026", Error, "two main blocks for the same team";
+    ReservedName = "E027", Error, "a reserved word used as a name";
+    EmptyRobotGroup = "E028", Error, "`name[N]` with N less than one";
+    RecursiveFunction = "E029", Error, "a function that calls itself (functions are inlined)";
+    PlanSetTwice = "E030", Error, "a mode that sets the same plan twice";
+    DuplicateCase = "E031", Error, "a main block with two cases for the same mode";
+    DuplicateCatch = "E032", Error, "a case that catches the same event twice";
+    ValueNotProvided = "E033", Error, "a robot value that some robot reading it lacks";
+    InvalidPeriod = "E034", Error, "a period or timeout that is not positive";
+    // Catalog files (*.robot.xml).
+    CatalogXml = "E050", Error, "a catalog file that is not well-formed XML";
+    CatalogUnknownElement = "E051", Error, "an element that the catalog format does not have";
+    CatalogMissingAttribute = "E052", Error, "a required attribute is missing";
+    CatalogDuplicateType = "E053", Error, "a robot type (or alias) defined twice";
+    CatalogUnknownValueType = "E054", Error, "a value or parameter type that does not exist";
+    CatalogMissingGraph = "E055", Error, "a `graph=` file that does not exist";
+    CatalogBadAttribute = "E056", Error, "an attribute value of the wrong form";
+    CatalogUnknownAttribute = "W050", Warning, "an attribute that the catalog format does not have";
+    // Warnings (mission scripts).
+    EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
+    UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";
+    ServiceNeverSet = "W003", Warning, "a composite service that no mode sets";
+    ReceiveWithoutSend = "W004", Warning, "a receive or subscribe that no send or publish feeds";
+    SendWithoutReceive = "W005", Warning, "a send or publish that nobody receives";
+    AmbiguousGroup = "W006", Warning, "robots that meet several group conditions";
+    UnknownAttribute = "W007", Warning, "an attribute that is neither a robot value nor a team variable";
+    ConstantOutsideDomain = "W008", Warning, "a constant outside the value's domain";
+    CatchNeverThrown = "W009", Hint, "a catch of an event that no service of the mode throws";
+    FunctionNeverCalled = "W010", Warning, "a function that is never called";
+    TeamWithoutMain = "W011", Warning, "a team without a main block: its robots do nothing";
+    EmptyOthers = "W012", Warning, "an `others` block that no robot is left to run";
+}
+
+impl fmt::Display for Code {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// A secondary location that explains a diagnostic ("first defined here").
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Related {
+    pub file: FileId,
+    pub span: Span,
+    pub message: String,
+}
+
+/// One finding, positioned by byte range in `file`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Diagnostic {
+    pub code: Code,
+    pub severity: Severity,
+    pub file: FileId,
+    pub span: Span,
+    pub message: String,
+    /// The replacement the user most likely meant (did-you-mean), if any.
+    pub suggestion: Option<String>,
+    pub related: Vec<Related>,
+}
+
+impl Diagnostic {
+    pub fn new(code: Code, file: FileId, span: Span, message: impl Into<String>) -> Self {
+        Diagnostic {
+            code,
+            severity: code.default_severity(),
+            file,
+            span,
+            message: message.into(),
+            suggestion: None,
+            related: Vec::new(),
+        }
+    }
+
+    /// Adds a did-you-mean: the message gains "(did you mean `x`?)".
+    pub fn suggest(&mut self, suggestion: Option<String>) -> &mut Self {
+        if let Some(s) = &suggestion {
+            self.message = format!("{} (did you mean `{s}`?)", self.message);
+        }
+        self.suggestion = suggestion;
+        self
+    }
+
+    /// Adds a secondary location, such as "first defined here".
+    pub fn relate(&mut self, span: Span, message: impl Into<String>) -> &mut Self {
+        self.related.push(Related {
+            file: self.file,
+            span,
+            message: message.into(),
+        });
+        self
+    }
+
+    pub fn with_severity(mut self, severity: Severity) -> Self {
+        self.severity = severity;
+        self
+    }
+
+    pub fn is_error(&self) -> bool {
+        self.severity == Severity::Error
+    }
+}
+
+/// Sort diagnostics by file and position, and drop exact repeats (a function body
+/// checked at several call sites reports the same finding once).
+pub fn sort_and_dedup(diags: &mut Vec<Diagnostic>) {
+    diags.sort_by(|a, b| {
+        (a.file, a.span.start, a.span.end, a.code).cmp(&(b.file, b.span.start, b.span.end, b.code))
+    });
+    diags.dedup_by(|a, b| {
+        a.file == b.file && a.span == b.span && a.code == b.code && a.message == b.message
+    });
+}

@@ -1,0 +1,372 @@
+//! Phase 3: modes and main blocks. `set` must name a service of that plan;
+//! `case`/`catch`/`mode =` must name modes; every mode should be reachable from
+//! the default, every thrown event caught, every service set somewhere.
+
+use super::ir::*;
+use super::{suggestion, Checker};
+use crate::diag::{Code, Severity};
+use crate::syntax::ast::{self, Item, SetTarget};
+use std::collections::HashSet;
+
+impl<'a> Checker<'a> {
+    pub(super) fn check_behaviour(&mut self, source: &'a ast::SourceFile) {
+        for item in &source.items {
+            match item {
+                Item::Mode(m) => self.mode_sets(m),
+                Item::Main(m) => self.main(m),
+                _ => {}
+            }
+        }
+        for t in 0..self.mission.teams.len() {
+            let team = TeamId(t as u32);
+            self.uncaught_events(team);
+            self.catches_never_thrown(team);
+            self.unreachable_modes(team);
+            self.services_never_set(team);
+        }
+        for f in 0..self.mission.functions.len() {
+            let function = &self.mission.functions[f];
+            if !function.called {
+                let (span, name) = (function.name_span, function.name.clone());
+                self.report(
+                    Code::FunctionNeverCalled,
+                    span,
+                    format!("the function `{name}` is never called"),
+                );
+            }
+        }
+    }
+
+    /// The team and mode index of a mode definition, unless it was rejected.
+    fn declared_mode(&self, m: &ast::ModeDef) -> Option<(TeamId, Index)> {
+        let team = self.team_id(&m.team.name)?;
+        let mode = self.team(team).mode_by_name(&m.name.name)?;
+        (self.team(team).modes[mode as usize].span == m.span).then_some((team, mode))
+    }
+
+    fn mode_sets(&mut self, m: &ast::ModeDef) {
+        let Some((team, mode)) = self.declared_mode(m) else {
+            return;
+        };
+        let mut sets: Vec<ModeSet> = Vec::new();
+        for set in &m.sets {
+            if let Some(p) = &set.timeout {
+                self.period(p);
+            }
+            let plan = self.team(team).plan_by_name(&set.plan.name);
+            match plan {
+                Some(plan) => self.occurrence(set.plan.span, Symbol::Plan { team, plan }, false),
+                None => {
+                    let t = self.team(team);
+                    let plans: Vec<&str> = t.plans.iter().map(|p| p.name.as_str()).collect();
+                    let guess = suggestion(&set.plan.name, plans.iter().copied());
+                    let message = format!(
+                        "team {} has no plan `{}` (its plans: {})",
+                        t.name,
+                        set.plan.name,
+                        if plans.is_empty() {
+                            "none".to_string()
+                        } else {
+                            plans.join(", ")
+                        }
+                    );
+                    self.report(Code::ServiceNotInPlan, set.plan.span, message)
+                        .suggest(guess);
+                }
+            }
+            if let Some(first) = sets.iter().find(|s| plan.is_some() && s.plan == plan) {
+                let first = first.span;
+                self.report(
+                    Code::PlanSetTwice,
+                    set.plan.span,
+                    format!("this mode already sets the plan `{}`", set.plan.name),
+                )
+                .relate(first, "first set here");
+            }
+            let service = match (&set.service, plan) {
+                (SetTarget::Off(_), _) => None,
+                (SetTarget::Service(name), Some(plan)) => self.set_target(team, plan, name),
+                (SetTarget::Service(_), None) => None,
+            };
+            sets.push(ModeSet {
+                plan,
+                service,
+                timeout_ms: set.timeout.as_ref().and_then(|p| p.millis()),
+                span: set.span,
+            });
+        }
+        self.team_mut(team).modes[mode as usize].sets = sets;
+    }
+
+    fn set_target(&mut self, team: TeamId, plan: Index, name: &ast::Ident) -> Option<Index> {
+        let t = self.team(team);
+        if let Some(service) = t.service_in_plan(plan, &name.name) {
+            self.occurrence(name.span, Symbol::Service { team, service }, false);
+            return Some(service);
+        }
+        let plan_name = &t.plans[plan as usize].name;
+        let elsewhere = t
+            .services
+            .iter()
+            .find(|s| s.name == name.name)
+            .map(|s| t.plans[s.plan as usize].name.clone());
+        let in_plan: Vec<&str> = t
+            .services
+            .iter()
+            .filter(|s| s.plan == plan)
+            .map(|s| s.name.as_str())
+            .collect();
+        let guess = suggestion(&name.name, in_plan);
+        let message = match elsewhere {
+            Some(other) => format!(
+                "plan {plan_name} of team {} has no service `{}`; `{}` belongs to plan {other}",
+                t.name, name.name, name.name
+            ),
+            None => format!(
+                "plan {plan_name} of team {} has no service `{}`",
+                t.name, name.name
+            ),
+        };
+        self.report(Code::ServiceNotInPlan, name.span, message)
+            .suggest(guess);
+        None
+    }
+
+    /// Resolves a mode name in a main block, reporting it if undefined.
+    fn mode_ref(&mut self, team: TeamId, name: &ast::Ident) -> Option<Index> {
+        match self.team(team).mode_by_name(&name.name) {
+            Some(mode) => {
+                self.occurrence(name.span, Symbol::Mode { team, mode }, false);
+                Some(mode)
+            }
+            None => {
+                let t = self.team(team);
+                let guess = suggestion(&name.name, t.modes.iter().map(|m| m.name.as_str()));
+                let message = format!("team {} has no mode `{}`", t.name, name.name);
+                self.report(Code::UnknownMode, name.span, message)
+                    .suggest(guess);
+                None
+            }
+        }
+    }
+
+    fn main(&mut self, m: &ast::MainDef) {
+        let Some(team) = self.header_team(&m.team, "a main block") else {
+            return;
+        };
+        if let Some(first) = &self.team(team).main {
+            let first = first.span;
+            self.report(
+                Code::DuplicateMain,
+                m.main_span,
+                format!("team {} already has a main block", m.team.name),
+            )
+            .relate(first, "first main block here");
+            return;
+        }
+        let default = match &m.default {
+            Some(name) => self.mode_ref(team, name),
+            None => {
+                self.report(
+                    Code::MissingDefault,
+                    m.team.span.cover(m.main_span),
+                    format!(
+                        "the main block of {} has no `default: mode = ...`, so its robots would not know which mode to start in",
+                        m.team.name
+                    ),
+                );
+                None
+            }
+        };
+        let mut transitions = Vec::new();
+        let mut cased: Vec<(Index, crate::span::Span)> = Vec::new();
+        for case in &m.cases {
+            let from = self.mode_ref(team, &case.mode);
+            if let Some(from) = from {
+                if let Some(&(_, first)) = cased.iter().find(|(f, _)| *f == from) {
+                    self.report(
+                        Code::DuplicateCase,
+                        case.mode.span,
+                        format!("there is already a case for the mode `{}`", case.mode.name),
+                    )
+                    .relate(first, "first case here");
+                } else {
+                    cased.push((from, case.mode.span));
+                }
+            }
+            let mut caught: Vec<&ast::Ident> = Vec::new();
+            for catch in &case.catches {
+                self.caught(team, &catch.event);
+                if let Some(first) = caught.iter().find(|e| e.name == catch.event.name) {
+                    let first = first.span;
+                    self.report(
+                        Code::DuplicateCatch,
+                        catch.event.span,
+                        format!("this case already catches `{}`", catch.event.name),
+                    )
+                    .relate(first, "first caught here");
+                } else {
+                    caught.push(&catch.event);
+                }
+                let to = self.mode_ref(team, &catch.target);
+                if let (Some(from), Some(to)) = (from, to) {
+                    transitions.push(Transition {
+                        from,
+                        event: catch.event.name.clone(),
+                        event_span: catch.event.span,
+                        to,
+                        span: catch.span,
+                    });
+                }
+            }
+        }
+        self.team_mut(team).main = Some(Main {
+            span: m.span,
+            default,
+            transitions,
+        });
+    }
+
+    fn caught(&mut self, team: TeamId, event: &ast::Ident) {
+        self.occurrence(
+            event.span,
+            Symbol::Event {
+                team,
+                name: event.name.clone(),
+            },
+            false,
+        );
+        let events = &mut self.team_mut(team).events;
+        match events.iter_mut().find(|e| e.name == event.name) {
+            Some(e) => e.caught_at.push(event.span),
+            None => events.push(Event {
+                name: event.name.clone(),
+                thrown_at: Vec::new(),
+                caught_at: vec![event.span],
+            }),
+        }
+    }
+
+    fn uncaught_events(&mut self, team: TeamId) {
+        let t = self.team(team);
+        if t.main.is_none() {
+            let span = t.name_span;
+            let message = format!(
+                "team {} has no main block, so its robots do nothing",
+                t.name
+            );
+            self.report(Code::TeamWithoutMain, span, message);
+            return;
+        }
+        let caught: Vec<String> = t
+            .events
+            .iter()
+            .filter(|e| !e.caught_at.is_empty())
+            .map(|e| e.name.clone())
+            .collect();
+        let uncaught: Vec<(String, Vec<crate::span::Span>)> = t
+            .events
+            .iter()
+            .filter(|e| e.caught_at.is_empty())
+            .map(|e| (e.name.clone(), e.thrown_at.clone()))
+            .collect();
+        let team_name = t.name.clone();
+        for (name, spans) in uncaught {
+            let guess = suggestion(&name, caught.iter().map(String::as_str));
+            for span in spans {
+                self.report(
+                    Code::EventNeverCaught,
+                    span,
+                    format!(
+                        "the event `{name}` is thrown, but no mode of team {team_name} catches it"
+                    ),
+                )
+                .suggest(guess.clone());
+            }
+        }
+    }
+
+    fn catches_never_thrown(&mut self, team: TeamId) {
+        let Some(main) = &self.team(team).main else {
+            return;
+        };
+        let t = self.team(team);
+        let mut findings = Vec::new();
+        for tr in &main.transitions {
+            let mode = &t.modes[tr.from as usize];
+            let thrown = mode
+                .sets
+                .iter()
+                .filter_map(|s| s.service)
+                .any(|s| t.services[s as usize].throws.contains(&tr.event));
+            if !thrown {
+                findings.push((
+                    tr.event_span,
+                    format!(
+                        "no service that mode {} runs throws `{}`, so this catch never fires there",
+                        mode.name, tr.event
+                    ),
+                ));
+            }
+        }
+        for (span, message) in findings {
+            self.report(Code::CatchNeverThrown, span, message).severity = Severity::Hint;
+        }
+    }
+
+    fn unreachable_modes(&mut self, team: TeamId) {
+        let t = self.team(team);
+        let Some(Main {
+            default: Some(start),
+            transitions,
+            ..
+        }) = &t.main
+        else {
+            return;
+        };
+        let mut reached = HashSet::from([*start]);
+        let mut queue = vec![*start];
+        while let Some(mode) = queue.pop() {
+            for tr in transitions.iter().filter(|tr| tr.from == mode) {
+                if reached.insert(tr.to) {
+                    queue.push(tr.to);
+                }
+            }
+        }
+        let default_name = t.modes[*start as usize].name.clone();
+        let unreachable: Vec<(crate::span::Span, String)> = t
+            .modes
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !reached.contains(&(*i as Index)))
+            .map(|(_, m)| (m.name_span, m.name.clone()))
+            .collect();
+        for (span, name) in unreachable {
+            self.report(
+                Code::UnreachableMode,
+                span,
+                format!("the mode `{name}` can never be entered: no catch leads to it from the default mode {default_name}"),
+            );
+        }
+    }
+
+    fn services_never_set(&mut self, team: TeamId) {
+        let t = self.team(team);
+        let set: HashSet<Index> = t
+            .modes
+            .iter()
+            .flat_map(|m| m.sets.iter().filter_map(|s| s.service))
+            .collect();
+        let unused: Vec<(crate::span::Span, String)> = (0..t.services.len() as Index)
+            .filter(|s| !set.contains(s))
+            .map(|s| (t.services[s as usize].name_span, t.service_path(s)))
+            .collect();
+        for (span, path) in unused {
+            self.report(
+                Code::ServiceNeverSet,
+                span,
+                format!("`{path}` is never set in any mode, so it never runs"),
+            );
+        }
+    }
+}

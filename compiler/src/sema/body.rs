@@ -1,0 +1,930 @@
+//! Phase 2: statement bodies. Each statement is checked against the robots that
+//! run it: all robots of the team, narrowed inside `group`/`leader` to those
+//! meeting the condition and inside `others` to the rest. Functions are inlined:
+//! their body is checked at every call, with the caller's robots.
+
+use super::ir::*;
+use super::{is_user, suggestion, Checker};
+use crate::catalog::{RobotTypeId, ServiceDef, ValueType};
+use crate::diag::Code;
+use crate::span::Span;
+use crate::syntax::ast::{self, Arg, ArmKind, CondKind, Expr, ExprKind, StmtKind};
+
+/// Who runs the statements being checked.
+#[derive(Clone, Debug)]
+pub(super) struct Scope {
+    /// `None` inside a function that no service calls: robots are unknown.
+    team: Option<TeamId>,
+    service: Option<Index>,
+    /// Indices into the team's robots that run the statement.
+    robots: Vec<Index>,
+    /// Functions being inlined, innermost last, to catch recursion.
+    inlining: Vec<FunctionId>,
+}
+
+/// What an attribute (`X`, `T.X`, `USER.X`) refers to, before reporting.
+#[derive(Clone, Debug)]
+enum Resolution {
+    Value {
+        owner: Option<TeamId>,
+        name: String,
+        ty: ValueType,
+    },
+    /// A value that only some of the robots concerned have.
+    PartialValue {
+        name: String,
+        lacking: String,
+    },
+    Variable {
+        team: Option<TeamId>,
+        name: String,
+    },
+    /// `T.X` where `T` is a team (or `USER`) without such a value or variable.
+    NotInTeam {
+        team: String,
+        name: String,
+        known: Vec<String>,
+    },
+    NotATeam {
+        team: String,
+    },
+    TooLong,
+    /// A single name that is neither: a symbolic constant where one is allowed.
+    Bare(String),
+    /// Nothing can be said (no robot runs the statement).
+    Unchecked,
+}
+
+/// The type of an expression, as far as the checker can tell.
+#[derive(Clone, Debug, PartialEq)]
+enum Type {
+    Text,
+    Int,
+    Float,
+    Bool,
+    Period,
+    Value(ValueType),
+    Constant(String),
+    Unknown,
+}
+
+impl Type {
+    fn describe(&self) -> String {
+        match self {
+            Type::Text => "a string".into(),
+            Type::Int => "a whole number".into(),
+            Type::Float => "a number".into(),
+            Type::Bool => "true or false".into(),
+            Type::Period => "a period".into(),
+            Type::Value(t) => format!("a value of type {t}"),
+            Type::Constant(c) => format!("the constant `{c}`"),
+            Type::Unknown => "a value".into(),
+        }
+    }
+
+    /// Whether an argument of this type fits a parameter of type `param`.
+    fn fits(&self, param: &ValueType) -> bool {
+        use ValueType as V;
+        match (self, param) {
+            (Type::Unknown, _) => true,
+            (Type::Value(v), p) => match (v, p) {
+                (a, b) if a.name() == b.name() => true,
+                (V::Int, V::Float) => true,
+                (V::String | V::Enum(_), V::String | V::Location | V::Enum(_)) => true,
+                _ => false,
+            },
+            (Type::Int, V::Int | V::Float) | (Type::Float, V::Float) => true,
+            (Type::Bool, V::Bool) => true,
+            (Type::Text, V::String | V::Location) => true,
+            (Type::Text | Type::Constant(_), V::Enum(domain)) => match self {
+                Type::Constant(c) => domain.contains(c),
+                _ => true,
+            },
+            (Type::Constant(_), V::String | V::Location) => true,
+            _ => false,
+        }
+    }
+}
+
+impl<'a> Checker<'a> {
+    pub(super) fn check_bodies(&mut self) {
+        for t in 0..self.mission.teams.len() {
+            let team = TeamId(t as u32);
+            let all: Vec<Index> = (0..self.team(team).robots.len() as Index).collect();
+            for s in 0..self.service_syntax[t].len() {
+                let syntax = self.service_syntax[t][s];
+                let scope = Scope {
+                    team: Some(team),
+                    service: Some(s as Index),
+                    robots: all.clone(),
+                    inlining: Vec::new(),
+                };
+                self.block(&syntax.body, &scope);
+                if let Some(repeat) = &syntax.repeat {
+                    if let Some(p) = &repeat.period {
+                        self.period(p);
+                    }
+                    if let Some(c) = &repeat.condition {
+                        self.condition(c, &scope);
+                    }
+                }
+            }
+        }
+        // Functions nobody calls are still checked, as far as possible without robots.
+        for f in 0..self.function_syntax.len() {
+            if !self.mission.functions[f].called {
+                let scope = Scope {
+                    team: None,
+                    service: None,
+                    robots: Vec::new(),
+                    inlining: vec![FunctionId(f as u32)],
+                };
+                self.block(&self.function_syntax[f].body, &scope);
+            }
+        }
+    }
+
+    fn block(&mut self, block: &'a ast::Block, scope: &Scope) {
+        for stmt in &block.stmts {
+            self.stmt(stmt, scope);
+        }
+    }
+
+    fn stmt(&mut self, stmt: &'a ast::Stmt, scope: &Scope) {
+        match &stmt.kind {
+            StmtKind::If(i) => {
+                self.condition(&i.condition, scope);
+                self.block(&i.then_block, scope);
+                match i.else_branch.as_deref() {
+                    Some(ast::Else::If(s)) => self.stmt(s, scope),
+                    Some(ast::Else::Block(b)) => self.block(b, scope),
+                    None => {}
+                }
+            }
+            StmtKind::Loop(l) => {
+                if let Some(p) = &l.period {
+                    self.period(p);
+                }
+                if let Some(c) = &l.condition {
+                    self.condition(c, scope);
+                }
+                self.block(&l.body, scope);
+            }
+            StmtKind::Group(g) => self.group(g, scope),
+            StmtKind::Comm(c) => self.comm(c, scope),
+            StmtKind::Throw(event) => self.throw(event, scope),
+            StmtKind::Call(c) => self.call(c, scope),
+            StmtKind::Error => {}
+        }
+    }
+
+    pub(super) fn period(&mut self, period: &ast::Period) {
+        if !period.millis().is_some_and(|ms| ms > 0.0) {
+            self.report(
+                Code::InvalidPeriod,
+                period.span,
+                "a period or timeout must be more than zero",
+            );
+        }
+    }
+
+    fn throw(&mut self, event: &ast::Ident, scope: &Scope) {
+        let Some(team) = scope.team else { return };
+        self.occurrence(
+            event.span,
+            Symbol::Event {
+                team,
+                name: event.name.clone(),
+            },
+            false,
+        );
+        let t = self.team_mut(team);
+        match t.events.iter_mut().find(|e| e.name == event.name) {
+            Some(e) => e.thrown_at.push(event.span),
+            None => t.events.push(Event {
+                name: event.name.clone(),
+                thrown_at: vec![event.span],
+                caught_at: Vec::new(),
+            }),
+        }
+        if let Some(service) = scope.service {
+            let throws = &mut t.services[service as usize].throws;
+            if !throws.contains(&event.name) {
+                throws.push(event.name.clone());
+            }
+        }
+    }
+
+    // ----- calls -----
+
+    fn call(&mut self, call: &'a ast::Call, scope: &Scope) {
+        if let Some(p) = &call.timeout {
+            self.period(p);
+        }
+        if let Some(&function) = self.functions_by_name.get(&call.name.name) {
+            self.occurrence(call.name.span, Symbol::Function(function), false);
+            if !call.args.is_empty() {
+                self.report(
+                    Code::WrongArgumentCount,
+                    call.args_span,
+                    format!("the function `{}` takes no arguments", call.name.name),
+                );
+            }
+            if scope.inlining.contains(&function) {
+                self.report(
+                    Code::RecursiveFunction,
+                    call.name.span,
+                    format!(
+                        "`{}` calls itself: functions are copied where they are called, so this would never end",
+                        call.name.name
+                    ),
+                );
+                return;
+            }
+            if scope.team.is_some() {
+                self.mission.functions[function.0 as usize].called = true;
+            }
+            let mut inner = scope.clone();
+            inner.inlining.push(function);
+            let body = &self.function_syntax[function.0 as usize].body;
+            self.block(body, &inner);
+            return;
+        }
+        self.builtin_call(call, scope);
+    }
+
+    /// The known robot types among `robots` of `team`, each with its robots' names.
+    fn types_of(&self, team: TeamId, robots: &[Index]) -> Vec<(RobotTypeId, Vec<String>)> {
+        let mut types: Vec<(RobotTypeId, Vec<String>)> = Vec::new();
+        let t = self.team(team);
+        for &r in robots {
+            let robot = &t.robots[r as usize];
+            let Some(ty) = robot.robot_type else { continue };
+            match types.iter_mut().find(|(id, _)| *id == ty) {
+                Some((_, names)) => names.push(robot.name.clone()),
+                None => types.push((ty, vec![robot.name.clone()])),
+            }
+        }
+        types
+    }
+
+    fn describe_types(&self, types: &[(RobotTypeId, Vec<String>)]) -> String {
+        let parts: Vec<String> = types
+            .iter()
+            .map(|(ty, names)| format!("{} ({})", self.catalog.get(*ty).name, names.join(", ")))
+            .collect();
+        parts.join(", ")
+    }
+
+    fn builtin_call(&mut self, call: &ast::Call, scope: &Scope) {
+        let name = &call.name.name;
+        let catalog = self.catalog;
+        let anywhere = catalog.types().find_map(|(_, r)| r.service(name));
+        let types = scope
+            .team
+            .map(|team| self.types_of(team, &scope.robots))
+            .unwrap_or_default();
+        let providers: Vec<&ServiceDef> = types
+            .iter()
+            .filter_map(|(ty, _)| catalog.get(*ty).service(name))
+            .collect();
+        let Some(any_def) = anywhere else {
+            let mut candidates: Vec<&str> =
+                self.functions_by_name.keys().map(String::as_str).collect();
+            if types.is_empty() {
+                candidates.extend(
+                    catalog
+                        .types()
+                        .flat_map(|(_, r)| r.services.iter().map(|s| s.name.as_str())),
+                );
+            } else {
+                candidates.extend(
+                    types.iter().flat_map(|(ty, _)| {
+                        catalog.get(*ty).services.iter().map(|s| s.name.as_str())
+                    }),
+                );
+            }
+            let guess = suggestion(name, candidates);
+            self.report(
+                Code::UnknownService,
+                call.name.span,
+                format!("`{name}` is neither a robot service nor a function"),
+            )
+            .suggest(guess);
+            return;
+        };
+        let def = providers.first().copied().unwrap_or(any_def);
+        self.occurrence(
+            call.name.span,
+            Symbol::BuiltinService(def.name.clone()),
+            false,
+        );
+        if providers.len() < types.len() {
+            let lacking: Vec<(RobotTypeId, Vec<String>)> = types
+                .iter()
+                .filter(|(ty, _)| catalog.get(*ty).service(name).is_none())
+                .cloned()
+                .collect();
+            let having: Vec<&str> = catalog
+                .types()
+                .filter(|(_, r)| r.service(name).is_some())
+                .map(|(_, r)| r.name.as_str())
+                .collect();
+            let team = scope
+                .team
+                .map(|t| self.team(t).name.clone())
+                .unwrap_or_default();
+            let advice = if providers.is_empty() {
+                format!("only {} provide it", having.join(", "))
+            } else {
+                let types: Vec<&str> = types
+                    .iter()
+                    .filter(|(ty, _)| catalog.get(*ty).service(name).is_some())
+                    .map(|(ty, _)| catalog.get(*ty).name.as_str())
+                    .collect();
+                format!(
+                    "put the call inside `group(instance of {})`",
+                    types.join(", ")
+                )
+            };
+            let message = format!(
+                "`{name}` is not a service of {} in team {team}; {advice}",
+                self.describe_types(&lacking)
+            );
+            self.report(Code::ServiceNotProvided, call.name.span, message);
+        }
+        self.arguments(call, def, scope);
+    }
+
+    fn arguments(&mut self, call: &ast::Call, def: &ServiceDef, scope: &Scope) {
+        let given = call.args.len();
+        let (min, max) = (def.required_params(), def.params.len());
+        if given < min || given > max {
+            let expected = match (min, max) {
+                (0, 0) => "no arguments".to_string(),
+                (a, b) if a == b => format!("{a} argument{}", if a == 1 { "" } else { "s" }),
+                (a, b) => format!("{a} to {b} arguments"),
+            };
+            self.report(
+                Code::WrongArgumentCount,
+                call.args_span,
+                format!(
+                    "`{}` takes {expected}, but {given} {} given: {}",
+                    call.name.name,
+                    if given == 1 { "is" } else { "are" },
+                    def.signature()
+                ),
+            );
+        }
+        for (arg, param) in call.args.iter().zip(&def.params) {
+            let ty = match arg {
+                Arg::Words { .. } => Type::Text,
+                Arg::Expr(e) => self.expr(e, scope, true),
+            };
+            if !ty.fits(&param.ty) {
+                self.report(
+                    Code::WrongArgumentType,
+                    arg.span(),
+                    format!(
+                        "`{}` expects {} for `{}`, but this is {}",
+                        call.name.name,
+                        describe_param(&param.ty),
+                        param.name,
+                        ty.describe()
+                    ),
+                );
+            }
+        }
+        // Extra arguments are still resolved, so their names are checked.
+        for arg in call.args.iter().skip(def.params.len()) {
+            if let Arg::Expr(e) = arg {
+                self.expr(e, scope, true);
+            }
+        }
+    }
+
+    // ----- expressions and attributes -----
+
+    fn condition(&mut self, e: &Expr, scope: &Scope) {
+        self.expr(e, scope, false);
+    }
+
+    /// Checks an expression and gives its type. `bare_is_constant`: a single
+    /// unknown name is a symbolic constant here (arguments, right of `==`).
+    fn expr(&mut self, e: &Expr, scope: &Scope, bare_is_constant: bool) -> Type {
+        match &e.kind {
+            ExprKind::Or(a, b) | ExprKind::And(a, b) => {
+                self.condition(a, scope);
+                self.condition(b, scope);
+                Type::Bool
+            }
+            ExprKind::Not(a) => {
+                self.condition(a, scope);
+                Type::Bool
+            }
+            ExprKind::Compare(lhs, _, rhs) => {
+                self.compare(lhs, rhs, scope);
+                Type::Bool
+            }
+            ExprKind::Str(_) => Type::Text,
+            ExprKind::Number(n) if n.contains('.') => Type::Float,
+            ExprKind::Number(_) => Type::Int,
+            ExprKind::Period(p) => {
+                self.period(p);
+                Type::Period
+            }
+            ExprKind::Bool(_) => Type::Bool,
+            ExprKind::Attr(attr) => {
+                let resolution = self.resolve_attr(attr, scope);
+                self.record_attr(attr, resolution, bare_is_constant)
+            }
+            ExprKind::Error => Type::Unknown,
+        }
+    }
+
+    fn compare(&mut self, lhs: &Expr, rhs: &Expr, scope: &Scope) {
+        // A bare unknown name is a constant on the right, and on the left when the
+        // right is a known value (`DARK == Guards.Alarm`).
+        let rhs_known = match &rhs.kind {
+            ExprKind::Attr(a) => !matches!(self.resolve_attr(a, scope), Resolution::Bare(_)),
+            _ => true,
+        };
+        let lt = self.expr(lhs, scope, rhs_known);
+        let rt = self.expr(rhs, scope, true);
+        for (value, other, other_span) in [(&lt, &rt, rhs.span), (&rt, &lt, lhs.span)] {
+            let Type::Value(ValueType::Enum(domain)) = value else {
+                continue;
+            };
+            let written = match (other, other_side_text(other_span, lhs, rhs)) {
+                (Type::Constant(c), _) => Some(c.clone()),
+                (Type::Text, Some(s)) => Some(s),
+                _ => None,
+            };
+            if let Some(c) = written.filter(|c| !domain.contains(c)) {
+                let guess = suggestion(&c, domain.iter().map(String::as_str));
+                self.report(
+                    Code::ConstantOutsideDomain,
+                    other_span,
+                    format!(
+                        "`{c}` is not one of the possible values: {}",
+                        domain.join(", ")
+                    ),
+                )
+                .suggest(guess);
+            }
+        }
+    }
+
+    /// The robots whose values `T.X` (or bare `X`) reads.
+    fn robots_for(&self, team: TeamId, scope: &Scope) -> Vec<Index> {
+        if scope.team == Some(team) {
+            scope.robots.clone()
+        } else {
+            (0..self.team(team).robots.len() as Index).collect()
+        }
+    }
+
+    fn resolve_attr(&self, attr: &ast::Attr, scope: &Scope) -> Resolution {
+        match attr.segments.as_slice() {
+            [name] => match scope.team {
+                Some(team) => self.resolve_in_team(team, &name.name, scope, true),
+                None => {
+                    let is_value = self
+                        .catalog
+                        .types()
+                        .any(|(_, r)| r.value(&name.name).is_some());
+                    let is_variable = self.variables.iter().any(|(_, v)| v == &name.name);
+                    if is_value || is_variable {
+                        Resolution::Unchecked
+                    } else {
+                        Resolution::Bare(name.name.clone())
+                    }
+                }
+            },
+            [team, name] if is_user(&team.name) => {
+                match self.catalog.user().and_then(|u| u.value(&name.name)) {
+                    Some(v) => Resolution::Value {
+                        owner: None,
+                        name: v.name.clone(),
+                        ty: v.ty.clone(),
+                    },
+                    None => Resolution::NotInTeam {
+                        team: "USER".into(),
+                        name: name.name.clone(),
+                        known: self
+                            .catalog
+                            .user()
+                            .map(|u| u.values.iter().map(|v| v.name.clone()).collect())
+                            .unwrap_or_default(),
+                    },
+                }
+            }
+            [team, name] => match self.team_id(&team.name) {
+                Some(t) => self.resolve_in_team(t, &name.name, scope, false),
+                None => Resolution::NotATeam {
+                    team: team.name.clone(),
+                },
+            },
+            _ => Resolution::TooLong,
+        }
+    }
+
+    fn resolve_in_team(&self, team: TeamId, name: &str, scope: &Scope, bare: bool) -> Resolution {
+        let robots = self.robots_for(team, scope);
+        let types = self.types_of(team, &robots);
+        let catalog = self.catalog;
+        let defs: Vec<_> = types
+            .iter()
+            .filter_map(|(ty, _)| catalog.get(*ty).value(name))
+            .collect();
+        if let Some(def) = defs.first() {
+            if defs.len() < types.len() {
+                let lacking: Vec<_> = types
+                    .iter()
+                    .filter(|(ty, _)| catalog.get(*ty).value(name).is_none())
+                    .cloned()
+                    .collect();
+                return Resolution::PartialValue {
+                    name: def.name.clone(),
+                    lacking: self.describe_types(&lacking),
+                };
+            }
+            return Resolution::Value {
+                owner: Some(team),
+                name: def.name.clone(),
+                ty: def.ty.clone(),
+            };
+        }
+        if self.variables.contains(&(Some(team), name.to_string()))
+            || self.variables.contains(&(None, name.to_string()))
+        {
+            return Resolution::Variable {
+                team: Some(team),
+                name: name.to_string(),
+            };
+        }
+        if types.is_empty() {
+            return Resolution::Unchecked;
+        }
+        if bare {
+            return Resolution::Bare(name.to_string());
+        }
+        let mut known: Vec<String> = types
+            .iter()
+            .flat_map(|(ty, _)| catalog.get(*ty).values.iter().map(|v| v.name.clone()))
+            .collect();
+        known.extend(self.team(team).variables.iter().cloned());
+        Resolution::NotInTeam {
+            team: self.team(team).name.clone(),
+            name: name.to_string(),
+            known,
+        }
+    }
+
+    /// Reports what a resolution says is wrong, records the occurrence, and gives
+    /// the attribute's type.
+    fn record_attr(
+        &mut self,
+        attr: &ast::Attr,
+        resolution: Resolution,
+        bare_is_constant: bool,
+    ) -> Type {
+        let last = attr.last().span;
+        if let [team, _] = attr.segments.as_slice() {
+            if is_user(&team.name) {
+                self.occurrence(team.span, Symbol::User, false);
+            } else if let Some(t) = self.team_id(&team.name) {
+                self.occurrence(team.span, Symbol::Team(t), false);
+            }
+        }
+        match resolution {
+            Resolution::Value { owner, name, ty } => {
+                self.occurrence(last, Symbol::Value { owner, name }, false);
+                Type::Value(ty)
+            }
+            Resolution::Variable { team, name } => {
+                self.occurrence(last, Symbol::TeamVariable { team, name }, false);
+                Type::Unknown
+            }
+            Resolution::PartialValue { name, lacking } => {
+                self.report(
+                    Code::ValueNotProvided,
+                    attr.span,
+                    format!(
+                        "`{name}` is not a value of {lacking}, which run this statement; read it inside a `group` of the robots that have it"
+                    ),
+                );
+                Type::Unknown
+            }
+            Resolution::NotInTeam { team, name, known } => {
+                let guess = suggestion(&name, known.iter().map(String::as_str));
+                self.report(
+                    Code::UnknownAttribute,
+                    attr.span,
+                    format!(
+                        "`{team}.{name}` is neither a value of {team}'s robots nor a team variable that is sent, published or received"
+                    ),
+                )
+                .suggest(guess.map(|g| format!("{team}.{g}")));
+                Type::Unknown
+            }
+            Resolution::NotATeam { team } => {
+                let guess = suggestion(&team, self.team_names().iter().map(String::as_str));
+                self.report(
+                    Code::UnknownAttribute,
+                    attr.span,
+                    format!("`{}`: `{team}` is not a team", attr.dotted()),
+                )
+                .suggest(guess);
+                Type::Unknown
+            }
+            Resolution::TooLong => {
+                self.report(
+                    Code::UnknownAttribute,
+                    attr.span,
+                    format!(
+                        "`{}` is not a value: write `Team.VALUE` or `VALUE`",
+                        attr.dotted()
+                    ),
+                );
+                Type::Unknown
+            }
+            Resolution::Bare(name) if bare_is_constant => {
+                self.occurrence(last, Symbol::Constant(name.clone()), false);
+                Type::Constant(name)
+            }
+            Resolution::Bare(name) => {
+                self.report(
+                    Code::UnknownAttribute,
+                    attr.span,
+                    format!(
+                        "`{name}` is neither a value of the robots running this statement nor a team variable"
+                    ),
+                );
+                Type::Unknown
+            }
+            Resolution::Unchecked => Type::Unknown,
+        }
+    }
+
+    // ----- groups -----
+
+    /// The robots of `scope` that meet a group condition.
+    fn group_members(&mut self, cond: &ast::GroupCond, scope: &Scope) -> Vec<Index> {
+        let catalog = self.catalog;
+        let mut types = Vec::new();
+        for name in &cond.names {
+            match cond.kind {
+                CondKind::InstanceOf => {
+                    if let Some(ty) = self.resolve_robot_type(name) {
+                        types.push(ty);
+                    }
+                }
+                CondKind::CapableOf => {
+                    let known = catalog.types().any(|(_, r)| r.has_capability(&name.name));
+                    if known {
+                        self.occurrence(name.span, Symbol::Capability(name.name.clone()), false);
+                    } else {
+                        let all: Vec<&str> = catalog
+                            .types()
+                            .flat_map(|(_, r)| r.capabilities.iter().map(String::as_str))
+                            .collect();
+                        let guess = suggestion(&name.name, all);
+                        self.report(
+                            Code::UnsatisfiableGroup,
+                            name.span,
+                            format!("no robot type has the capability `{}`", name.name),
+                        )
+                        .suggest(guess);
+                    }
+                }
+            }
+        }
+        let Some(team) = scope.team else {
+            return Vec::new();
+        };
+        let t = self.team(team);
+        scope
+            .robots
+            .iter()
+            .copied()
+            .filter(|&r| {
+                let Some(ty) = t.robots[r as usize].robot_type else {
+                    return false;
+                };
+                match cond.kind {
+                    CondKind::InstanceOf => types.contains(&ty),
+                    CondKind::CapableOf => cond
+                        .names
+                        .iter()
+                        .all(|c| catalog.get(ty).has_capability(&c.name)),
+                }
+            })
+            .collect()
+    }
+
+    fn group(&mut self, g: &'a ast::GroupStmt, scope: &Scope) {
+        let mut taken: Vec<Index> = Vec::new();
+        let checkable = scope.team.is_some() && !scope.robots.is_empty();
+        for arm in &g.arms {
+            let members = self.group_members(&arm.condition, scope);
+            if checkable && members.is_empty() {
+                let team = scope
+                    .team
+                    .map(|t| self.team(t).name.clone())
+                    .unwrap_or_default();
+                let what = match arm.condition.kind {
+                    CondKind::InstanceOf => "is an instance of",
+                    CondKind::CapableOf => "is capable of",
+                };
+                let names: Vec<&str> = arm.condition.names.iter().map(|n| n.as_str()).collect();
+                self.report(
+                    Code::UnsatisfiableGroup,
+                    arm.condition.span,
+                    format!(
+                        "no robot of team {team} that runs this statement {what} {}",
+                        names.join(", ")
+                    ),
+                );
+            }
+            let overlap: Vec<Index> = members
+                .iter()
+                .copied()
+                .filter(|r| taken.contains(r))
+                .collect();
+            if arm.kind == ArmKind::Group && !overlap.is_empty() {
+                let names = self.robot_names(scope, &overlap);
+                self.report(
+                    Code::AmbiguousGroup,
+                    arm.condition.span,
+                    format!(
+                        "{names} also meet{} an earlier group's condition and will join that group only",
+                        if overlap.len() == 1 { "s" } else { "" }
+                    ),
+                );
+            }
+            let runners: Vec<Index> = match arm.kind {
+                ArmKind::Group => members
+                    .iter()
+                    .copied()
+                    .filter(|r| !taken.contains(r))
+                    .collect(),
+                ArmKind::Leader => members.clone(),
+            };
+            let inner = Scope {
+                robots: if runners.is_empty() {
+                    members.clone()
+                } else {
+                    runners
+                },
+                ..scope.clone()
+            };
+            self.block(&arm.body, &inner);
+            // A leader is one robot among the members: the others may still run
+            // `others`, unless the leader is the only candidate.
+            if arm.kind == ArmKind::Group || members.len() == 1 {
+                taken.extend(members);
+            }
+        }
+        if let Some(others) = &g.others {
+            let rest: Vec<Index> = scope
+                .robots
+                .iter()
+                .copied()
+                .filter(|r| !taken.contains(r))
+                .collect();
+            if checkable && rest.is_empty() {
+                self.report(
+                    Code::EmptyOthers,
+                    others.keyword_span,
+                    "every robot already belongs to a group above: no robot runs `others`",
+                );
+            }
+            let inner = Scope {
+                robots: rest,
+                ..scope.clone()
+            };
+            self.block(&others.body, &inner);
+        }
+    }
+
+    fn robot_names(&self, scope: &Scope, robots: &[Index]) -> String {
+        let Some(team) = scope.team else {
+            return String::new();
+        };
+        let t = self.team(team);
+        let names: Vec<&str> = robots
+            .iter()
+            .map(|&r| t.robots[r as usize].name.as_str())
+            .collect();
+        names.join(", ")
+    }
+
+    // ----- communication -----
+
+    fn comm(&mut self, comm: &ast::Comm, scope: &Scope) {
+        if let Some(p) = &comm.timeout {
+            self.period(p);
+        }
+        let peer = if is_user(&comm.team.name) {
+            self.occurrence(comm.team.span, Symbol::User, false);
+            Some(Peer::User)
+        } else if let Some(t) = self.team_id(&comm.team.name) {
+            self.occurrence(comm.team.span, Symbol::Team(t), false);
+            Some(Peer::Team(t))
+        } else {
+            let mut names = self.team_names();
+            names.push("USER".into());
+            let guess = suggestion(&comm.team.name, names.iter().map(String::as_str));
+            self.report(
+                Code::UnknownCommTeam,
+                comm.team.span,
+                format!(
+                    "`{}` is not a team: `{}` needs a declared team or USER",
+                    comm.team.name,
+                    comm.kind.as_str()
+                ),
+            )
+            .suggest(guess);
+            None
+        };
+        for item in &comm.items {
+            if let Some(value) = &item.value {
+                self.expr(value, scope, true);
+            }
+            let resolution = self.resolve_attr(&item.attr, scope);
+            let key = self.attr_key(&item.attr, &resolution, scope);
+            if comm.kind.is_outgoing() && item.value.is_some() {
+                // `T.X = e` declares the team variable here.
+                let team = match item.attr.segments.as_slice() {
+                    [t, _] => self.team_id(&t.name),
+                    _ => scope.team,
+                };
+                if let [t, _] = item.attr.segments.as_slice() {
+                    if let Some(id) = team {
+                        self.occurrence(t.span, Symbol::Team(id), false);
+                    }
+                }
+                let name = item.attr.last().name.clone();
+                self.occurrence(
+                    item.attr.last().span,
+                    Symbol::TeamVariable { team, name },
+                    true,
+                );
+            } else {
+                self.record_attr(&item.attr, resolution, false);
+            }
+            if let (Some(team), Some(service), Some(peer), Some(value)) =
+                (scope.team, scope.service, peer, key)
+            {
+                self.mission.messages.push(Message {
+                    kind: comm.kind,
+                    team,
+                    service,
+                    peer,
+                    value,
+                    span: item.attr.span,
+                });
+            }
+        }
+    }
+
+    /// `COLOR` written in SlaveTeam and `SlaveTeam.COLOR` are the same value.
+    fn attr_key(
+        &self,
+        attr: &ast::Attr,
+        resolution: &Resolution,
+        scope: &Scope,
+    ) -> Option<AttrKey> {
+        let name = match resolution {
+            Resolution::Value { name, .. } | Resolution::PartialValue { name, .. } => name.clone(),
+            _ => attr.last().name.clone(),
+        };
+        let owner = match attr.segments.as_slice() {
+            [_] => self.team(scope.team?).name.clone(),
+            [team, _] if is_user(&team.name) => "USER".to_string(),
+            [team, _] => team.name.clone(),
+            _ => return None,
+        };
+        Some(AttrKey { owner, name })
+    }
+}
+
+fn describe_param(ty: &ValueType) -> String {
+    match ty {
+        ValueType::Enum(domain) => format!("one of {}", domain.join(", ")),
+        ValueType::Location => "a location such as \"5,5\"".into(),
+        other => format!("a {}", other.name()),
+    }
+}
+
+/// The text of a string literal on the other side of a comparison.
+fn other_side_text(span: Span, lhs: &Expr, rhs: &Expr) -> Option<String> {
+    [lhs, rhs]
+        .into_iter()
+        .find(|e| e.span == span)
+        .and_then(|e| match &e.kind {
+            ExprKind::Str(s) => Some(s.clone()),
+            _ => None,
+        })
+}

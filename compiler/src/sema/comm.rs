@@ -1,0 +1,67 @@
+//! Phase 4: communication matching. `receive(T, v)` in team X needs a
+//! `send(X, v)` in team T, `subscribe(T, v)` a `publish(X, v)`, and the reverse.
+//! The operator console (`USER`) sends and receives anything.
+
+use super::ir::*;
+use super::Checker;
+use crate::diag::Code;
+use crate::syntax::ast::CommKind;
+use std::collections::HashSet;
+
+/// The statement that would feed (or drain) `kind`.
+fn counterpart(kind: CommKind) -> CommKind {
+    match kind {
+        CommKind::Send => CommKind::Receive,
+        CommKind::Receive => CommKind::Send,
+        CommKind::Publish => CommKind::Subscribe,
+        CommKind::Subscribe => CommKind::Publish,
+    }
+}
+
+impl Checker<'_> {
+    pub(super) fn check_communication(&mut self) {
+        // (kind, running team, other team, value)
+        let present: HashSet<(CommKind, TeamId, TeamId, &AttrKey)> = self
+            .mission
+            .messages
+            .iter()
+            .filter_map(|m| match m.peer {
+                Peer::Team(other) => Some((m.kind, m.team, other, &m.value)),
+                Peer::User => None,
+            })
+            .collect();
+        let mut findings = Vec::new();
+        for m in &self.mission.messages {
+            let Peer::Team(other) = m.peer else { continue };
+            if present.contains(&(counterpart(m.kind), other, m.team, &m.value)) {
+                continue;
+            }
+            let team = self.team(m.team);
+            let path = team.service_path(m.service);
+            let (me, them) = (&team.name, &self.team(other).name);
+            let value = &m.value;
+            let (code, message) = match m.kind {
+                CommKind::Receive => (
+                    Code::ReceiveWithoutSend,
+                    format!("`{path}` receives `{value}` from {them}, but no service of {them} sends it to {me}"),
+                ),
+                CommKind::Subscribe => (
+                    Code::ReceiveWithoutSend,
+                    format!("`{path}` subscribes to `{value}` from {them}, but no service of {them} publishes it to {me}"),
+                ),
+                CommKind::Send => (
+                    Code::SendWithoutReceive,
+                    format!("`{path}` sends `{value}` to {them}, but no service of {them} receives it from {me}"),
+                ),
+                CommKind::Publish => (
+                    Code::SendWithoutReceive,
+                    format!("`{path}` publishes `{value}` to {them}, but no service of {them} subscribes to it from {me}"),
+                ),
+            };
+            findings.push((code, m.span, message));
+        }
+        for (code, span, message) in findings {
+            self.report(code, span, message);
+        }
+    }
+}

@@ -1,0 +1,314 @@
+//! Phase 1: the declarations of a mission: teams and robots (formation), plans
+//! and composite services, modes, functions, and the team variables that
+//! communication statements introduce.
+
+use super::ir::*;
+use super::{is_user, suggestion, Checker};
+use crate::diag::Code;
+use crate::span::Span;
+use crate::syntax::ast::{self, Item};
+use std::collections::HashMap;
+
+impl<'a> Checker<'a> {
+    pub(super) fn declare(&mut self, source: &'a ast::SourceFile) {
+        let mut robot_names = HashMap::new();
+        for item in &source.items {
+            if let Item::Formation(formation) = item {
+                for decl in &formation.teams {
+                    self.declare_team(decl, &mut robot_names);
+                }
+            }
+        }
+        for item in &source.items {
+            match item {
+                Item::Function(f) => self.declare_function(f),
+                Item::Service(s) => self.declare_service(s),
+                _ => {}
+            }
+        }
+        for item in &source.items {
+            if let Item::Mode(m) = item {
+                self.declare_mode(m);
+            }
+        }
+        self.collect_variables();
+    }
+
+    fn declare_team(&mut self, decl: &ast::TeamDecl, robot_names: &mut HashMap<String, Span>) {
+        let name = &decl.name;
+        if is_user(&name.name) {
+            self.report(
+                Code::ReservedName,
+                name.span,
+                format!(
+                    "`{}` is the operator's console; choose another team name",
+                    name.name
+                ),
+            );
+            return;
+        }
+        if let Some(existing) = self.team_id(&name.name) {
+            let first = self.team(existing).name_span;
+            self.report(
+                Code::DuplicateTeam,
+                name.span,
+                format!("the team `{}` is already declared", name.name),
+            )
+            .relate(first, "first declared here");
+            return;
+        }
+        let id = TeamId(self.mission.teams.len() as u32);
+        self.teams_by_name.insert(name.name.clone(), id);
+        self.occurrence(name.span, Symbol::Team(id), true);
+        let mut robots = Vec::new();
+        for robot in &decl.robots {
+            let robot_type = self.resolve_robot_type(&robot.robot_type);
+            let names: Vec<String> = match robot.count {
+                None => vec![robot.name.name.clone()],
+                Some(ast::Count { value: Some(n), .. }) if n >= 1 => {
+                    (0..n).map(|i| format!("{}_{i}", robot.name.name)).collect()
+                }
+                Some(count) => {
+                    self.report(
+                        Code::EmptyRobotGroup,
+                        count.span,
+                        "the number of robots must be a whole number of at least 1",
+                    );
+                    Vec::new()
+                }
+            };
+            for robot_name in names {
+                if let Some(&first) = robot_names.get(&robot_name) {
+                    self.report(
+                        Code::DuplicateRobot,
+                        robot.name.span,
+                        format!("a robot named `{robot_name}` is already declared"),
+                    )
+                    .relate(first, "first declared here");
+                    continue;
+                }
+                robot_names.insert(robot_name.clone(), robot.name.span);
+                self.occurrence(
+                    robot.name.span,
+                    Symbol::Robot {
+                        team: id,
+                        robot: robots.len() as Index,
+                    },
+                    true,
+                );
+                robots.push(Robot {
+                    name: robot_name,
+                    name_span: robot.name.span,
+                    type_name: robot_type
+                        .map(|t| self.catalog.get(t).name.clone())
+                        .unwrap_or_else(|| robot.robot_type.name.clone()),
+                    robot_type,
+                });
+            }
+        }
+        self.service_syntax.push(Vec::new());
+        self.mission.teams.push(Team {
+            name: name.name.clone(),
+            name_span: name.span,
+            robots,
+            plans: Vec::new(),
+            services: Vec::new(),
+            modes: Vec::new(),
+            main: None,
+            events: Vec::new(),
+            variables: Vec::new(),
+        });
+    }
+
+    /// Looks a robot type (or alias) up in the catalog, reporting it if unknown.
+    pub(super) fn resolve_robot_type(
+        &mut self,
+        name: &ast::Ident,
+    ) -> Option<crate::catalog::RobotTypeId> {
+        match self.catalog.lookup(&name.name) {
+            Some(id) => {
+                let canonical = self.catalog.get(id).name.clone();
+                self.occurrence(name.span, Symbol::RobotType(canonical), false);
+                Some(id)
+            }
+            None => {
+                let guess = suggestion(&name.name, self.catalog.names());
+                let message = match guess {
+                    Some(_) => format!("unknown robot type `{}`", name.name),
+                    None => {
+                        let known: Vec<&str> =
+                            self.catalog.types().map(|(_, r)| r.name.as_str()).collect();
+                        format!(
+                            "unknown robot type `{}`; the catalog has {}",
+                            name.name,
+                            known.join(", ")
+                        )
+                    }
+                };
+                self.report(Code::UnknownRobotType, name.span, message)
+                    .suggest(guess);
+                None
+            }
+        }
+    }
+
+    /// The team a header names, or an "undeclared team" error.
+    pub(super) fn header_team(&mut self, team: &ast::Ident, what: &str) -> Option<TeamId> {
+        if let Some(id) = self.team_id(&team.name) {
+            self.occurrence(team.span, Symbol::Team(id), false);
+            return Some(id);
+        }
+        let guess = suggestion(&team.name, self.team_names().iter().map(String::as_str));
+        self.report(
+            Code::UnknownTeam,
+            team.span,
+            format!("{what} of `{}`, which is not a declared team", team.name),
+        )
+        .suggest(guess);
+        None
+    }
+
+    fn declare_function(&mut self, f: &'a ast::Function) {
+        if let Some(&existing) = self.functions_by_name.get(&f.name.name) {
+            let first = self.mission.functions[existing.0 as usize].name_span;
+            self.report(
+                Code::DuplicateFunction,
+                f.name.span,
+                format!("the function `{}` is already defined", f.name.name),
+            )
+            .relate(first, "first defined here");
+            return;
+        }
+        let id = FunctionId(self.mission.functions.len() as u32);
+        self.functions_by_name.insert(f.name.name.clone(), id);
+        self.function_syntax.push(f);
+        self.occurrence(f.name.span, Symbol::Function(id), true);
+        self.mission.functions.push(FunctionInfo {
+            name: f.name.name.clone(),
+            name_span: f.name.span,
+            body: f.body.clone(),
+            called: false,
+        });
+    }
+
+    fn declare_service(&mut self, s: &'a ast::CompositeService) {
+        let Some(team) = self.header_team(&s.team, "a composite service") else {
+            return;
+        };
+        let plan = match self.team(team).plan_by_name(&s.plan.name) {
+            Some(plan) => {
+                self.occurrence(s.plan.span, Symbol::Plan { team, plan }, false);
+                plan
+            }
+            None => {
+                let t = self.team_mut(team);
+                t.plans.push(Plan {
+                    name: s.plan.name.clone(),
+                    span: s.plan.span,
+                });
+                let plan = t.plans.len() as Index - 1;
+                self.occurrence(s.plan.span, Symbol::Plan { team, plan }, true);
+                plan
+            }
+        };
+        if let Some(existing) = self.team(team).service_in_plan(plan, &s.name.name) {
+            let first = self.team(team).services[existing as usize].name_span;
+            self.report(
+                Code::DuplicateService,
+                s.name.span,
+                format!(
+                    "`{}.{}.{}` is already defined",
+                    s.team.name, s.plan.name, s.name.name
+                ),
+            )
+            .relate(first, "first defined here");
+            return;
+        }
+        self.service_syntax[team.0 as usize].push(s);
+        let t = self.team_mut(team);
+        t.services.push(Service {
+            name: s.name.name.clone(),
+            name_span: s.name.span,
+            plan,
+            span: s.span,
+            body: s.body.clone(),
+            repeat: s.repeat.clone(),
+            throws: Vec::new(),
+        });
+        let service = t.services.len() as Index - 1;
+        self.occurrence(s.name.span, Symbol::Service { team, service }, true);
+    }
+
+    fn declare_mode(&mut self, m: &ast::ModeDef) {
+        let Some(team) = self.header_team(&m.team, "a mode") else {
+            return;
+        };
+        if let Some(existing) = self.team(team).mode_by_name(&m.name.name) {
+            let first = self.team(team).modes[existing as usize].name_span;
+            self.report(
+                Code::DuplicateMode,
+                m.name.span,
+                format!(
+                    "the mode `{}.{}` is already defined",
+                    m.team.name, m.name.name
+                ),
+            )
+            .relate(first, "first defined here");
+            return;
+        }
+        let t = self.team_mut(team);
+        t.modes.push(Mode {
+            name: m.name.name.clone(),
+            name_span: m.name.span,
+            span: m.span,
+            sets: Vec::new(),
+        });
+        let mode = t.modes.len() as Index - 1;
+        self.occurrence(m.name.span, Symbol::Mode { team, mode }, true);
+    }
+
+    /// Team variables are declared by `send/publish(T, T.X = e)` and by receiving
+    /// `T.X`, anywhere in the file: collect them all before checking bodies.
+    fn collect_variables(&mut self) {
+        let mut found = Vec::new();
+        let mut visit =
+            |owner: Option<TeamId>, block: &ast::Block, teams: &HashMap<String, TeamId>| {
+                block.walk(&mut |stmt| {
+                    let ast::StmtKind::Comm(comm) = &stmt.kind else {
+                        return;
+                    };
+                    for item in &comm.items {
+                        if comm.kind.is_outgoing() && item.value.is_none() {
+                            continue;
+                        }
+                        match item.attr.segments.as_slice() {
+                            [name] => found.push((owner, name.name.clone())),
+                            [team, name] => {
+                                if let Some(&t) = teams.get(&team.name) {
+                                    found.push((Some(t), name.name.clone()));
+                                }
+                            }
+                            _ => {}
+                        }
+                    }
+                });
+            };
+        for (i, team) in self.mission.teams.iter().enumerate() {
+            for service in &team.services {
+                visit(Some(TeamId(i as u32)), &service.body, &self.teams_by_name);
+            }
+        }
+        for function in &self.mission.functions {
+            visit(None, &function.body, &self.teams_by_name);
+        }
+        for (team, name) in found {
+            if let Some(t) = team {
+                let vars = &mut self.mission.teams[t.0 as usize].variables;
+                if !vars.contains(&name) {
+                    vars.push(name.clone());
+                }
+            }
+            self.variables.insert((team, name));
+        }
+    }
+}

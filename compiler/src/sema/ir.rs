@@ -1,0 +1,267 @@
+//! The Mission IR: a mission with every name resolved. This is the one contract
+//! that the language server, the strategy checker and the code generator read.
+//! Statement bodies stay as syntax trees; what each name in them refers to is in
+//! [`Mission::occurrences`], keyed by the name's byte range.
+
+use crate::catalog::RobotTypeId;
+use crate::diag::FileId;
+use crate::span::Span;
+use crate::syntax::ast;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct TeamId(pub u32);
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct FunctionId(pub u32);
+
+/// Index of a plan, service, mode or robot inside its team.
+pub type Index = u32;
+
+#[derive(Clone, Debug, Default)]
+pub struct Mission {
+    pub file: FileId,
+    pub teams: Vec<Team>,
+    pub functions: Vec<FunctionInfo>,
+    /// Every communication statement, with the service that runs it.
+    pub messages: Vec<Message>,
+    /// Every name written in the file and what it refers to, sorted by position.
+    pub occurrences: Vec<Occurrence>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Team {
+    pub name: String,
+    pub name_span: Span,
+    pub robots: Vec<Robot>,
+    pub plans: Vec<Plan>,
+    pub services: Vec<Service>,
+    pub modes: Vec<Mode>,
+    pub main: Option<Main>,
+    /// Events its services throw or its main catches.
+    pub events: Vec<Event>,
+    /// Team variables (`T.X` assigned in send/publish, or received).
+    pub variables: Vec<String>,
+}
+
+/// One robot. `name[N]` declares N robots `name_0` .. `name_{N-1}`.
+#[derive(Clone, Debug)]
+pub struct Robot {
+    pub name: String,
+    /// The range of the declaration's name (shared by the N robots of `name[N]`).
+    pub name_span: Span,
+    pub type_name: String,
+    /// `None` when the type is not in the catalog (already reported).
+    pub robot_type: Option<RobotTypeId>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Plan {
+    pub name: String,
+    /// Where the plan is first named in a service header.
+    pub span: Span,
+}
+
+#[derive(Clone, Debug)]
+pub struct Service {
+    pub name: String,
+    pub name_span: Span,
+    pub plan: Index,
+    pub span: Span,
+    pub body: ast::Block,
+    pub repeat: Option<ast::Repeat>,
+    /// Events this service can throw, directly or through functions it calls.
+    pub throws: Vec<String>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Mode {
+    pub name: String,
+    pub name_span: Span,
+    pub span: Span,
+    pub sets: Vec<ModeSet>,
+}
+
+#[derive(Clone, Debug)]
+pub struct ModeSet {
+    pub plan: Option<Index>,
+    /// `None` for `OFF` (or a service that does not exist, already reported).
+    pub service: Option<Index>,
+    pub timeout_ms: Option<f64>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug)]
+pub struct Main {
+    pub span: Span,
+    pub default: Option<Index>,
+    pub transitions: Vec<Transition>,
+}
+
+/// `case (from): catch (event): mode = to`.
+#[derive(Clone, Debug)]
+pub struct Transition {
+    pub from: Index,
+    pub event: String,
+    pub event_span: Span,
+    pub to: Index,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Event {
+    pub name: String,
+    pub thrown_at: Vec<Span>,
+    pub caught_at: Vec<Span>,
+}
+
+#[derive(Clone, Debug)]
+pub struct FunctionInfo {
+    pub name: String,
+    pub name_span: Span,
+    pub body: ast::Block,
+    pub called: bool,
+}
+
+/// Who is at the other end of a communication statement.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Peer {
+    Team(TeamId),
+    /// The operator console.
+    User,
+}
+
+/// A communicated value, normalised: `COLOR` in SlaveTeam is `SlaveTeam.COLOR`.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct AttrKey {
+    /// The team the value belongs to, or `USER`.
+    pub owner: String,
+    pub name: String,
+}
+
+impl std::fmt::Display for AttrKey {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}.{}", self.owner, self.name)
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Message {
+    pub kind: ast::CommKind,
+    /// The team whose service runs the statement.
+    pub team: TeamId,
+    pub service: Index,
+    pub peer: Peer,
+    pub value: AttrKey,
+    pub span: Span,
+}
+
+/// What a name refers to.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Symbol {
+    Team(TeamId),
+    User,
+    Robot {
+        team: TeamId,
+        robot: Index,
+    },
+    RobotType(String),
+    Capability(String),
+    Plan {
+        team: TeamId,
+        plan: Index,
+    },
+    Service {
+        team: TeamId,
+        service: Index,
+    },
+    Mode {
+        team: TeamId,
+        mode: Index,
+    },
+    Event {
+        team: TeamId,
+        name: String,
+    },
+    Function(FunctionId),
+    /// A catalog service such as `move`.
+    BuiltinService(String),
+    /// A catalog value of a team's robots (or of `USER`).
+    Value {
+        owner: Option<TeamId>,
+        name: String,
+    },
+    TeamVariable {
+        team: Option<TeamId>,
+        name: String,
+    },
+    /// A symbolic constant such as `colored_paper`.
+    Constant(String),
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Occurrence {
+    pub span: Span,
+    pub symbol: Symbol,
+    pub is_definition: bool,
+}
+
+impl Mission {
+    pub fn team(&self, id: TeamId) -> &Team {
+        &self.teams[id.0 as usize]
+    }
+
+    pub fn team_by_name(&self, name: &str) -> Option<TeamId> {
+        self.teams
+            .iter()
+            .position(|t| t.name == name)
+            .map(|i| TeamId(i as u32))
+    }
+
+    /// The innermost occurrence at a byte offset (for hover, go-to-definition).
+    pub fn occurrence_at(&self, offset: usize) -> Option<&Occurrence> {
+        self.occurrences
+            .iter()
+            .filter(|o| o.span.touches(offset))
+            .min_by_key(|o| o.span.len())
+    }
+
+    /// Every occurrence of a symbol (definitions and uses).
+    pub fn occurrences_of<'a>(
+        &'a self,
+        symbol: &'a Symbol,
+    ) -> impl Iterator<Item = &'a Occurrence> {
+        self.occurrences.iter().filter(move |o| &o.symbol == symbol)
+    }
+}
+
+impl Team {
+    pub fn plan_by_name(&self, name: &str) -> Option<Index> {
+        self.plans
+            .iter()
+            .position(|p| p.name == name)
+            .map(|i| i as Index)
+    }
+
+    pub fn mode_by_name(&self, name: &str) -> Option<Index> {
+        self.modes
+            .iter()
+            .position(|m| m.name == name)
+            .map(|i| i as Index)
+    }
+
+    pub fn service_in_plan(&self, plan: Index, name: &str) -> Option<Index> {
+        self.services
+            .iter()
+            .position(|s| s.plan == plan && s.name == name)
+            .map(|i| i as Index)
+    }
+
+    /// `Team.Plan.Service`, for messages.
+    pub fn service_path(&self, service: Index) -> String {
+        let s = &self.services[service as usize];
+        format!(
+            "{}.{}.{}",
+            self.name, self.plans[s.plan as usize].name, s.name
+        )
+    }
+}

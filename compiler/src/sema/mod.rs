@@ -1,0 +1,156 @@
+//! Semantic analysis: resolves the names of a parsed mission against the robot
+//! catalog, reports every check of spec section 5, and builds the [`Mission`] IR.
+//!
+//! Phases, each in its own module:
+//! 1. [`declare`]: teams, robots, plans, services, modes, mains and functions.
+//! 2. [`body`]: statement bodies, walked with the set of robots that run them
+//!    (narrowed by `group`/`leader`/`others`): calls, arguments, values, events,
+//!    communication.
+//! 3. [`behaviour`]: modes and main blocks: `set` targets, transitions,
+//!    reachability, uncaught events, unused services and functions.
+//! 4. [`comm`]: every receive/subscribe matched with a send/publish, and back.
+//!
+//! Sema never reads files and never panics.
+
+mod behaviour;
+mod body;
+mod comm;
+mod declare;
+pub mod ir;
+
+pub use ir::*;
+
+use crate::catalog::Catalog;
+use crate::diag::{self, Code, Diagnostic, FileId};
+use crate::span::Span;
+use crate::syntax::{self, ast};
+use std::collections::{HashMap, HashSet};
+
+/// Everything known about one mission file after checking.
+#[derive(Clone, Debug)]
+pub struct Analysis {
+    pub syntax: ast::SourceFile,
+    pub mission: Mission,
+    /// Syntax and semantic diagnostics, sorted by position.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl Analysis {
+    pub fn has_errors(&self) -> bool {
+        self.diagnostics.iter().any(Diagnostic::is_error)
+    }
+}
+
+/// Parses and checks one mission script.
+pub fn check_source(file: FileId, text: &str, catalog: &Catalog) -> Analysis {
+    let parse = syntax::parse(file, text);
+    let (mission, mut diagnostics) = check(file, &parse.file, catalog);
+    diagnostics.extend(parse.diagnostics);
+    diag::sort_and_dedup(&mut diagnostics);
+    Analysis {
+        syntax: parse.file,
+        mission,
+        diagnostics,
+    }
+}
+
+/// Checks a parsed mission script.
+pub fn check<'a>(
+    file: FileId,
+    source: &'a ast::SourceFile,
+    catalog: &'a Catalog,
+) -> (Mission, Vec<Diagnostic>) {
+    let mut checker = Checker::new(file, catalog);
+    checker.declare(source);
+    checker.check_bodies();
+    checker.check_behaviour(source);
+    checker.check_communication();
+    checker.finish()
+}
+
+/// The name written for the operator console.
+pub(crate) fn is_user(name: &str) -> bool {
+    name == "USER" || name == "user"
+}
+
+pub(crate) struct Checker<'a> {
+    file: FileId,
+    /// The syntax of each team's services, parallel to `Team::services`, and of
+    /// each function: bodies are walked from the tree, not from the IR copy.
+    service_syntax: Vec<Vec<&'a ast::CompositeService>>,
+    function_syntax: Vec<&'a ast::Function>,
+    catalog: &'a Catalog,
+    mission: Mission,
+    diagnostics: Vec<Diagnostic>,
+    teams_by_name: HashMap<String, TeamId>,
+    functions_by_name: HashMap<String, FunctionId>,
+    /// Team variables declared anywhere by `T.X = ...` or received: (team or
+    /// `None` when written bare inside a function, name).
+    variables: HashSet<(Option<TeamId>, String)>,
+}
+
+impl<'a> Checker<'a> {
+    fn new(file: FileId, catalog: &'a Catalog) -> Self {
+        Checker {
+            file,
+            service_syntax: Vec::new(),
+            function_syntax: Vec::new(),
+            catalog,
+            mission: Mission {
+                file,
+                ..Mission::default()
+            },
+            diagnostics: Vec::new(),
+            teams_by_name: HashMap::new(),
+            functions_by_name: HashMap::new(),
+            variables: HashSet::new(),
+        }
+    }
+
+    fn report(&mut self, code: Code, span: Span, message: impl Into<String>) -> &mut Diagnostic {
+        self.diagnostics
+            .push(Diagnostic::new(code, self.file, span, message));
+        self.diagnostics
+            .last_mut()
+            .unwrap_or_else(|| unreachable!())
+    }
+
+    fn occurrence(&mut self, span: Span, symbol: Symbol, is_definition: bool) {
+        self.mission.occurrences.push(Occurrence {
+            span,
+            symbol,
+            is_definition,
+        });
+    }
+
+    fn team_id(&self, name: &str) -> Option<TeamId> {
+        self.teams_by_name.get(name).copied()
+    }
+
+    fn team(&self, id: TeamId) -> &Team {
+        &self.mission.teams[id.0 as usize]
+    }
+
+    fn team_mut(&mut self, id: TeamId) -> &mut Team {
+        &mut self.mission.teams[id.0 as usize]
+    }
+
+    fn team_names(&self) -> Vec<String> {
+        self.mission.teams.iter().map(|t| t.name.clone()).collect()
+    }
+
+    fn finish(mut self) -> (Mission, Vec<Diagnostic>) {
+        let occurrences = &mut self.mission.occurrences;
+        occurrences.sort_by(|a, b| (a.span, a.is_definition).cmp(&(b.span, b.is_definition)));
+        occurrences.dedup();
+        (self.mission, self.diagnostics)
+    }
+}
+
+/// Resolves `name` in `candidates`, or reports `code` with a did-you-mean.
+pub(crate) fn suggestion<'s>(
+    name: &str,
+    candidates: impl IntoIterator<Item = &'s str>,
+) -> Option<String> {
+    crate::suggest::did_you_mean(name, candidates)
+}

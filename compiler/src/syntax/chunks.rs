@@ -1,0 +1,112 @@
+//! Cutting the token stream into independent top-level chunks, so that a syntax
+//! error in one item (even an unbalanced brace) cannot swallow the items after it.
+//!
+//! A chunk starts at every item header. `T.P.S {`, `T.M {`, `T.main {` and
+//! `def f {` can never occur inside a statement, so they start a chunk wherever
+//! they appear; `{` and `T:` start one only at brace depth zero (they also occur
+//! inside a braced team formation). A `}` with no matching `{` is a chunk of its own.
+
+use super::token::{Kw, Token};
+use chumsky::span::SimpleSpan;
+
+type Tok<'s> = (Token<'s>, SimpleSpan);
+
+/// If an item header starts at token `i`, the index of its opening brace.
+fn header_brace(tokens: &[Tok<'_>], i: usize) -> Option<usize> {
+    let at = |k: usize| tokens.get(i + k).map(|t| t.0);
+    let ident = |k: usize| matches!(at(k), Some(Token::Ident(_)));
+    let brace = |k: usize| (at(k) == Some(Token::LBrace)).then_some(i + k);
+    match at(0)? {
+        Token::Kw(Kw::Def) if ident(1) => brace(2),
+        Token::Ident(_) if at(1) == Some(Token::Dot) => match at(2)? {
+            Token::Kw(Kw::Main) => brace(3),
+            Token::Ident(_) if at(3) == Some(Token::Dot) && ident(4) => brace(5),
+            Token::Ident(_) => brace(3),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// Token index ranges of the chunks, in order, covering every token.
+pub fn split(tokens: &[Tok<'_>]) -> Vec<std::ops::Range<usize>> {
+    let mut chunks = Vec::new();
+    let mut start = 0;
+    let mut depth: usize = 0;
+    let cut = |chunks: &mut Vec<std::ops::Range<usize>>, start: &mut usize, at: usize| {
+        if at > *start {
+            chunks.push(*start..at);
+        }
+        *start = at;
+    };
+    // The brace that opens the body of the header seen last: not a new chunk.
+    let mut body_brace = None;
+    for i in 0..tokens.len() {
+        let token = tokens[i].0;
+        let at_top = depth == 0;
+        // Inside `A.P.S {`, `P.S {` looks like a mode header: not a new item.
+        let in_header = body_brace.is_some_and(|b| i <= b);
+        let header = header_brace(tokens, i).filter(|_| !in_header);
+        if header.is_some()
+            || (at_top && token == Token::LBrace && body_brace != Some(i))
+            || (at_top
+                && matches!(token, Token::Ident(_))
+                && tokens.get(i + 1).map(|t| t.0) == Some(Token::Colon))
+        {
+            cut(&mut chunks, &mut start, i);
+            depth = 0;
+        }
+        if header.is_some() {
+            body_brace = header;
+        }
+        match token {
+            Token::LBrace => depth += 1,
+            Token::RBrace if depth == 0 => {
+                cut(&mut chunks, &mut start, i);
+                cut(&mut chunks, &mut start, i + 1);
+            }
+            Token::RBrace => depth -= 1,
+            _ => {}
+        }
+    }
+    cut(&mut chunks, &mut start, tokens.len());
+    chunks
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::syntax::token::lex;
+
+    fn chunk_texts(text: &str) -> Vec<String> {
+        let tokens = lex(text);
+        split(&tokens)
+            .into_iter()
+            .map(|r| text[tokens[r.start].1.start..tokens[r.end - 1].1.end].to_string())
+            .collect()
+    }
+
+    #[test]
+    fn cuts_at_headers_even_when_a_brace_is_missing() {
+        let text =
+            "{ A: x a\n B: y b }\nA.P.S { move() \nA.M { set(P, S) }\nA.main { default: mode = M }";
+        assert_eq!(
+            chunk_texts(text),
+            vec![
+                "{ A: x a\n B: y b }",
+                "A.P.S { move()",
+                "A.M { set(P, S) }",
+                "A.main { default: mode = M }"
+            ]
+        );
+    }
+
+    #[test]
+    fn bare_team_declarations_and_stray_braces() {
+        let text = "A: x a\nB: y b[2]\n} def f { stop() }";
+        assert_eq!(
+            chunk_texts(text),
+            vec!["A: x a", "B: y b[2]", "}", "def f { stop() }"]
+        );
+    }
+}

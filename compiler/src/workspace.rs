@@ -1,0 +1,213 @@
+//! Loading a check's files from disk: the one place (besides the CLI) that reads
+//! files. A folder stands for every `.mission` and `.robot.xml` under it; all
+//! catalog files found form one catalog that every mission is checked against.
+
+use crate::catalog::{
+    load_catalog, Catalog, CatalogSource, BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE,
+};
+use crate::diag::{self, Diagnostic, FileId};
+use crate::sema::{check_source, Analysis};
+use crate::text::LineIndex;
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileKind {
+    Mission,
+    Catalog,
+}
+
+impl FileKind {
+    pub fn of(path: &Path) -> Option<FileKind> {
+        let name = path.file_name()?.to_str()?;
+        if name.ends_with(".robot.xml") {
+            Some(FileKind::Catalog)
+        } else if name.ends_with(".mission") {
+            Some(FileKind::Mission)
+        } else {
+            None
+        }
+    }
+}
+
+/// A loaded source file.
+#[derive(Clone, Debug)]
+pub struct SourceFile {
+    pub id: FileId,
+    pub path: PathBuf,
+    pub kind: FileKind,
+    pub text: String,
+    pub lines: LineIndex,
+}
+
+/// The files of one check, addressable by [`FileId`]. The built-in catalog is
+/// always there, so diagnostics that point into it can be shown.
+#[derive(Clone, Debug)]
+pub struct Files {
+    files: Vec<SourceFile>,
+    builtin: SourceFile,
+}
+
+impl Default for Files {
+    fn default() -> Self {
+        Files {
+            files: Vec::new(),
+            builtin: SourceFile {
+                id: BUILTIN_FILE,
+                path: PathBuf::from(format!("<built-in>/{BUILTIN_NAME}")),
+                kind: FileKind::Catalog,
+                text: BUILTIN_SOURCE.to_string(),
+                lines: LineIndex::new(BUILTIN_SOURCE),
+            },
+        }
+    }
+}
+
+impl Files {
+    pub fn add(&mut self, path: PathBuf, kind: FileKind, text: String) -> FileId {
+        let id = FileId(self.files.len() as u32);
+        let lines = LineIndex::new(&text);
+        self.files.push(SourceFile {
+            id,
+            path,
+            kind,
+            text,
+            lines,
+        });
+        id
+    }
+
+    pub fn get(&self, id: FileId) -> &SourceFile {
+        if id == BUILTIN_FILE {
+            return &self.builtin;
+        }
+        &self.files[id.0 as usize]
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = &SourceFile> {
+        self.files.iter()
+    }
+}
+
+/// A problem reading the paths given (reported with exit code 2).
+#[derive(Debug)]
+pub struct LoadError {
+    pub path: PathBuf,
+    pub message: String,
+}
+
+impl std::fmt::Display for LoadError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.path.display(), self.message)
+    }
+}
+
+/// Expands the paths given on the command line: files as they are (whatever
+/// their extension, a file named explicitly is a mission unless it is
+/// `*.robot.xml`), folders recursively, sorted for stable output.
+pub fn collect(paths: &[PathBuf]) -> Result<Vec<(PathBuf, FileKind)>, LoadError> {
+    let mut found = Vec::new();
+    for path in paths {
+        let meta = std::fs::metadata(path).map_err(|e| LoadError {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        if meta.is_dir() {
+            walk(path, &mut found)?;
+        } else {
+            found.push((
+                path.clone(),
+                FileKind::of(path).unwrap_or(FileKind::Mission),
+            ));
+        }
+    }
+    Ok(found)
+}
+
+fn walk(dir: &Path, found: &mut Vec<(PathBuf, FileKind)>) -> Result<(), LoadError> {
+    let err = |e: std::io::Error| LoadError {
+        path: dir.to_path_buf(),
+        message: e.to_string(),
+    };
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(err)?
+        .map(|e| e.map(|e| e.path()))
+        .collect::<Result<_, _>>()
+        .map_err(err)?;
+    entries.sort();
+    for path in entries {
+        let hidden = path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .is_some_and(|n| n.starts_with('.') || n == "target" || n == "node_modules");
+        if hidden {
+            continue;
+        }
+        if path.is_dir() {
+            walk(&path, found)?;
+        } else if let Some(kind) = FileKind::of(&path) {
+            found.push((path, kind));
+        }
+    }
+    Ok(())
+}
+
+/// The outcome of checking a set of files.
+pub struct CheckRun {
+    pub files: Files,
+    pub catalog: Catalog,
+    pub analyses: Vec<(FileId, Analysis)>,
+    /// Every diagnostic, catalog files first, sorted by file and position.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl CheckRun {
+    pub fn error_count(&self) -> usize {
+        self.diagnostics.iter().filter(|d| d.is_error()).count()
+    }
+}
+
+/// Reads and checks the given files and folders.
+pub fn check_paths(paths: &[PathBuf]) -> Result<CheckRun, LoadError> {
+    let mut files = Files::default();
+    for (path, kind) in collect(paths)? {
+        let bytes = std::fs::read(&path).map_err(|e| LoadError {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        // Invalid UTF-8 is replaced rather than refused, so the rest is still checked.
+        let text = String::from_utf8(bytes)
+            .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned());
+        files.add(path, kind, text);
+    }
+    Ok(check_files(files))
+}
+
+/// Checks files already loaded: the catalog files form the catalog, then each
+/// mission is checked against it.
+pub fn check_files(files: Files) -> CheckRun {
+    let sources: Vec<CatalogSource<'_>> = files
+        .iter()
+        .filter(|f| f.kind == FileKind::Catalog)
+        .map(|f| CatalogSource {
+            file: f.id,
+            text: &f.text,
+            base_dir: f.path.parent(),
+        })
+        .collect();
+    let (catalog, mut diagnostics) = load_catalog(&sources);
+    let analyses: Vec<(FileId, Analysis)> = files
+        .iter()
+        .filter(|f| f.kind == FileKind::Mission)
+        .map(|f| (f.id, check_source(f.id, &f.text, &catalog)))
+        .collect();
+    for (_, analysis) in &analyses {
+        diagnostics.extend(analysis.diagnostics.iter().cloned());
+    }
+    diag::sort_and_dedup(&mut diagnostics);
+    CheckRun {
+        files,
+        catalog,
+        analyses,
+        diagnostics,
+    }
+}
