@@ -18,4 +18,4 @@ pub mod syntax;
 pub mod text;
 pub mod workspace;
 
-pub use sema::{check_source, Analysis};
+pub use sema::{Analysis, check_source};

@@ -109,7 +109,7 @@ mod tests {
         );
         assert_eq!(
             idx.line_col(text, x, ColumnUnit::Utf8),
-            LineCol { line: 1, col: 12 }
+            LineCol { line: 1, col: 13 }
         );
         for unit in [ColumnUnit::Char, ColumnUnit::Utf16, ColumnUnit::Utf8] {
             let lc = idx.line_col(text, x, unit);

@@ -3,10 +3,10 @@
 //! catalog files found form one catalog that every mission is checked against.
 
 use crate::catalog::{
-    load_catalog, Catalog, CatalogSource, BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE,
+    BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE, Catalog, CatalogSource, load_catalog,
 };
 use crate::diag::{self, Diagnostic, FileId};
-use crate::sema::{check_source, Analysis};
+use crate::sema::{Analysis, check_source};
 use crate::text::LineIndex;
 use std::path::{Path, PathBuf};
 

@@ -1,8 +1,8 @@
 //! The built-in catalog: the robots of the seed's experiments, embedded as a
 //! catalog file (`builtin.robot.xml`) so that `semo check` works on a bare mission.
 
-use super::xml::parse_catalog;
 use super::Catalog;
+use super::xml::parse_catalog;
 use crate::diag::FileId;
 use std::sync::OnceLock;
 

@@ -6,8 +6,8 @@
 mod builtin;
 mod xml;
 
-pub use builtin::{builtin_catalog, BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE};
-pub use xml::{parse_catalog, parse_catalog_file, ParsedCatalog, ParsedRobot};
+pub use builtin::{BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE, builtin_catalog};
+pub use xml::{ParsedCatalog, ParsedRobot, parse_catalog, parse_catalog_file};
 
 use crate::diag::{Code, Diagnostic, FileId, Related};
 use crate::span::Span;

@@ -12,10 +12,10 @@ use super::{
 use crate::diag::{Code, Diagnostic, FileId};
 use crate::span::Span;
 use crate::suggest::{did_you_mean, edit_distance};
+use quick_xml::Reader;
 use quick_xml::encoding::Decoder;
 use quick_xml::events::attributes::AttrError;
 use quick_xml::events::{BytesEnd, BytesStart, Event};
-use quick_xml::Reader;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -495,8 +495,8 @@ impl Parser<'_, '_> {
     }
 
     fn xml_error(&mut self, err: &quick_xml::Error, pos: usize) {
-        use quick_xml::errors::{IllFormedError, SyntaxError};
         use quick_xml::Error as E;
+        use quick_xml::errors::{IllFormedError, SyntaxError};
         let message = match err {
             E::Syntax(SyntaxError::UnclosedTag) => {
                 "this tag is never closed: a `>` is missing".to_string()

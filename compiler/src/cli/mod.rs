@@ -118,11 +118,7 @@ fn check(paths: Vec<PathBuf>, format: Format, color: bool, out: &mut impl Write)
         eprintln!("error: cannot write the report: {e}");
         return 2;
     }
-    if run.error_count() > 0 {
-        1
-    } else {
-        0
-    }
+    if run.error_count() > 0 { 1 } else { 0 }
 }
 
 fn explain(code: Option<&str>, out: &mut impl Write) -> i32 {

@@ -3,7 +3,7 @@
 //! the default, every thrown event caught, every service set somewhere.
 
 use super::ir::*;
-use super::{suggestion, Checker};
+use super::{Checker, suggestion};
 use crate::diag::{Code, Severity};
 use crate::syntax::ast::{self, Item, SetTarget};
 use std::collections::HashSet;
@@ -45,9 +45,12 @@ impl<'a> Checker<'a> {
     }
 
     fn mode_sets(&mut self, m: &ast::ModeDef) {
-        let Some((team, mode)) = self.declared_mode(m) else {
+        let Some(team) = self.team_id(&m.team.name) else {
             return;
         };
+        // `None` for a second definition of the mode (already reported): its sets
+        // are still checked.
+        let mode = self.declared_mode(m).map(|(_, mode)| mode);
         let mut sets: Vec<ModeSet> = Vec::new();
         for set in &m.sets {
             if let Some(p) = &set.timeout {
@@ -95,7 +98,12 @@ impl<'a> Checker<'a> {
                 span: set.span,
             });
         }
-        self.team_mut(team).modes[mode as usize].sets = sets;
+        match mode {
+            Some(mode) => self.team_mut(team).modes[mode as usize].sets = sets,
+            None => self
+                .set_by_duplicate_modes
+                .extend(sets.iter().filter_map(|s| s.service).map(|s| (team, s))),
+        }
     }
 
     fn set_target(&mut self, team: TeamId, plan: Index, name: &ast::Ident) -> Option<Index> {
@@ -134,6 +142,14 @@ impl<'a> Checker<'a> {
 
     /// Resolves a mode name in a main block, reporting it if undefined.
     fn mode_ref(&mut self, team: TeamId, name: &ast::Ident) -> Option<Index> {
+        let mode = self.lookup_mode_ref(team, name);
+        if mode.is_none() {
+            self.mains_with_unknown_modes.insert(team);
+        }
+        mode
+    }
+
+    fn lookup_mode_ref(&mut self, team: TeamId, name: &ast::Ident) -> Option<Index> {
         match self.team(team).mode_by_name(&name.name) {
             Some(mode) => {
                 self.occurrence(name.span, Symbol::Mode { team, mode }, false);
@@ -315,6 +331,11 @@ impl<'a> Checker<'a> {
     }
 
     fn unreachable_modes(&mut self, team: TeamId) {
+        // A catch or case naming an undefined mode is likely a typo of a mode
+        // that would otherwise look unreachable.
+        if self.mains_with_unknown_modes.contains(&team) {
+            return;
+        }
         let t = self.team(team);
         let Some(Main {
             default: Some(start),
@@ -358,7 +379,7 @@ impl<'a> Checker<'a> {
             .flat_map(|m| m.sets.iter().filter_map(|s| s.service))
             .collect();
         let unused: Vec<(crate::span::Span, String)> = (0..t.services.len() as Index)
-            .filter(|s| !set.contains(s))
+            .filter(|s| !set.contains(s) && !self.set_by_duplicate_modes.contains(&(team, *s)))
             .map(|s| (t.services[s as usize].name_span, t.service_path(s)))
             .collect();
         for (span, path) in unused {

@@ -4,11 +4,15 @@
 //! their body is checked at every call, with the caller's robots.
 
 use super::ir::*;
-use super::{is_user, suggestion, Checker};
+use super::{Checker, is_user, suggestion};
 use crate::catalog::{RobotTypeId, ServiceDef, ValueType};
 use crate::diag::Code;
 use crate::span::Span;
 use crate::syntax::ast::{self, Arg, ArmKind, CondKind, Expr, ExprKind, StmtKind};
+
+/// Deeper chains of function calls are refused: they are surely a mistake, and
+/// the checker's recursion must stay bounded.
+const MAX_INLINING_DEPTH: usize = 64;
 
 /// Who runs the statements being checked.
 #[derive(Clone, Debug)]
@@ -30,10 +34,14 @@ enum Resolution {
         name: String,
         ty: ValueType,
     },
-    /// A value that only some of the robots concerned have.
+    /// A catalog value that some of the robots running the statement lack, or
+    /// all of them (`none`).
     PartialValue {
         name: String,
+        team: String,
         lacking: String,
+        advice: String,
+        none: bool,
     },
     Variable {
         team: Option<TeamId>,
@@ -50,7 +58,11 @@ enum Resolution {
     },
     TooLong,
     /// A single name that is neither: a symbolic constant where one is allowed.
-    Bare(String),
+    /// `known`: the values and variables it may be a typo of.
+    Bare {
+        name: String,
+        known: Vec<String>,
+    },
     /// Nothing can be said (no robot runs the statement).
     Unchecked,
 }
@@ -241,8 +253,22 @@ impl<'a> Checker<'a> {
                 );
                 return;
             }
+            if scope.inlining.len() >= MAX_INLINING_DEPTH {
+                self.report(
+                    Code::RecursiveFunction,
+                    call.name.span,
+                    format!(
+                        "functions call each other more than {MAX_INLINING_DEPTH} levels deep here"
+                    ),
+                );
+                return;
+            }
             if scope.team.is_some() {
                 self.mission.functions[function.0 as usize].called = true;
+            }
+            let key = (function, scope.team, scope.service, scope.robots.clone());
+            if !self.inlined.insert(key) {
+                return;
             }
             let mut inner = scope.clone();
             inner.inlining.push(function);
@@ -335,7 +361,15 @@ impl<'a> Checker<'a> {
                 .map(|t| self.team(t).name.clone())
                 .unwrap_or_default();
             let advice = if providers.is_empty() {
-                format!("only {} provide it", having.join(", "))
+                format!(
+                    "only {} {} it",
+                    having.join(", "),
+                    if having.len() == 1 {
+                        "provides"
+                    } else {
+                        "provide"
+                    }
+                )
             } else {
                 let types: Vec<&str> = types
                     .iter()
@@ -363,6 +397,7 @@ impl<'a> Checker<'a> {
             let expected = match (min, max) {
                 (0, 0) => "no arguments".to_string(),
                 (a, b) if a == b => format!("{a} argument{}", if a == 1 { "" } else { "s" }),
+                (0, b) => format!("at most {b} argument{}", if b == 1 { "" } else { "s" }),
                 (a, b) => format!("{a} to {b} arguments"),
             };
             self.report(
@@ -444,16 +479,26 @@ impl<'a> Checker<'a> {
 
     fn compare(&mut self, lhs: &Expr, rhs: &Expr, scope: &Scope) {
         // A bare unknown name is a constant on the right, and on the left when the
-        // right is a known value (`DARK == Guards.Alarm`).
+        // right is a known value (`DARK == Guards.Alarm`); against a literal it is
+        // a misspelt value (`LIGHTNES < 200`).
         let rhs_known = match &rhs.kind {
-            ExprKind::Attr(a) => !matches!(self.resolve_attr(a, scope), Resolution::Bare(_)),
-            _ => true,
+            ExprKind::Attr(a) => !matches!(
+                self.resolve_attr(a, scope),
+                Resolution::Bare { .. } | Resolution::PartialValue { none: true, .. }
+            ),
+            _ => false,
         };
         let lt = self.expr(lhs, scope, rhs_known);
         let rt = self.expr(rhs, scope, true);
-        for (value, other, other_span) in [(&lt, &rt, rhs.span), (&rt, &lt, lhs.span)] {
+        for (value, value_expr, other, other_span) in
+            [(&lt, lhs, &rt, rhs.span), (&rt, rhs, &lt, lhs.span)]
+        {
             let Type::Value(ValueType::Enum(domain)) = value else {
                 continue;
+            };
+            let what = match &value_expr.kind {
+                ExprKind::Attr(a) => format!("`{}`", a.dotted()),
+                _ => "this value".to_string(),
             };
             let written = match (other, other_side_text(other_span, lhs, rhs)) {
                 (Type::Constant(c), _) => Some(c.clone()),
@@ -466,7 +511,7 @@ impl<'a> Checker<'a> {
                     Code::ConstantOutsideDomain,
                     other_span,
                     format!(
-                        "`{c}` is not one of the possible values: {}",
+                        "`{c}` is not a possible value of {what}, which is one of {}",
                         domain.join(", ")
                     ),
                 )
@@ -497,7 +542,15 @@ impl<'a> Checker<'a> {
                     if is_value || is_variable {
                         Resolution::Unchecked
                     } else {
-                        Resolution::Bare(name.name.clone())
+                        let values = self.catalog.types().flat_map(|(_, r)| &r.values);
+                        let known = values
+                            .map(|v| v.name.clone())
+                            .chain(self.variables.iter().map(|(_, v)| v.clone()))
+                            .collect();
+                        Resolution::Bare {
+                            name: name.name.clone(),
+                            known,
+                        }
                     }
                 }
             },
@@ -537,17 +590,23 @@ impl<'a> Checker<'a> {
             .iter()
             .filter_map(|(ty, _)| catalog.get(*ty).value(name))
             .collect();
+        // Robots read their own values; another team's value is what its robots
+        // that have it send or publish, so only its own team must all have it.
+        let own = scope.team == Some(team);
         if let Some(def) = defs.first() {
-            if defs.len() < types.len() {
-                let lacking: Vec<_> = types
+            if own && defs.len() < types.len() {
+                let having: Vec<&str> = types
                     .iter()
-                    .filter(|(ty, _)| catalog.get(*ty).value(name).is_none())
-                    .cloned()
+                    .filter(|(ty, _)| catalog.get(*ty).value(name).is_some())
+                    .map(|(ty, _)| catalog.get(*ty).name.as_str())
                     .collect();
-                return Resolution::PartialValue {
-                    name: def.name.clone(),
-                    lacking: self.describe_types(&lacking),
-                };
+                return self.partial_value(
+                    team,
+                    &def.name,
+                    &types,
+                    format!("read it inside `group(instance of {})`", having.join(", ")),
+                    false,
+                );
             }
             return Resolution::Value {
                 owner: Some(team),
@@ -566,18 +625,64 @@ impl<'a> Checker<'a> {
         if types.is_empty() {
             return Resolution::Unchecked;
         }
-        if bare {
-            return Resolution::Bare(name.to_string());
+        let having: Vec<(&str, &str)> = catalog
+            .types()
+            .filter_map(|(_, r)| r.value(name).map(|v| (r.name.as_str(), v.name.as_str())))
+            .collect();
+        if own {
+            if let Some(&(_, value)) = having.first() {
+                let types_having: Vec<&str> = having.iter().map(|(t, _)| *t).collect();
+                let advice = format!(
+                    "only {} {} it",
+                    types_having.join(", "),
+                    if types_having.len() == 1 {
+                        "has"
+                    } else {
+                        "have"
+                    }
+                );
+                return self.partial_value(team, value, &types, advice, true);
+            }
         }
         let mut known: Vec<String> = types
             .iter()
             .flat_map(|(ty, _)| catalog.get(*ty).values.iter().map(|v| v.name.clone()))
             .collect();
         known.extend(self.team(team).variables.iter().cloned());
+        if bare {
+            return Resolution::Bare {
+                name: name.to_string(),
+                known,
+            };
+        }
         Resolution::NotInTeam {
             team: self.team(team).name.clone(),
             name: name.to_string(),
             known,
+        }
+    }
+
+    /// A value that the robots `lacking` (among those running the statement) do
+    /// not have.
+    fn partial_value(
+        &self,
+        team: TeamId,
+        name: &str,
+        types: &[(RobotTypeId, Vec<String>)],
+        advice: String,
+        none: bool,
+    ) -> Resolution {
+        let lacking: Vec<_> = types
+            .iter()
+            .filter(|(ty, _)| self.catalog.get(*ty).value(name).is_none())
+            .cloned()
+            .collect();
+        Resolution::PartialValue {
+            name: name.to_string(),
+            team: self.team(team).name.clone(),
+            lacking: self.describe_types(&lacking),
+            advice,
+            none,
         }
     }
 
@@ -606,26 +711,46 @@ impl<'a> Checker<'a> {
                 self.occurrence(last, Symbol::TeamVariable { team, name }, false);
                 Type::Unknown
             }
-            Resolution::PartialValue { name, lacking } => {
+            // A name that no robot running the statement has, where a constant
+            // may stand: the constant (`follow(obstacle)` for a camera robot).
+            Resolution::PartialValue { none: true, .. }
+                if bare_is_constant && attr.segments.len() == 1 =>
+            {
+                let name = attr.last().name.clone();
+                self.occurrence(last, Symbol::Constant(name.clone()), false);
+                Type::Constant(name)
+            }
+            Resolution::PartialValue {
+                name,
+                team,
+                lacking,
+                advice,
+                ..
+            } => {
                 self.report(
                     Code::ValueNotProvided,
                     attr.span,
-                    format!(
-                        "`{name}` is not a value of {lacking}, which run this statement; read it inside a `group` of the robots that have it"
-                    ),
+                    format!("`{name}` is not a value of {lacking} in team {team}; {advice}"),
                 );
                 Type::Unknown
             }
             Resolution::NotInTeam { team, name, known } => {
                 let guess = suggestion(&name, known.iter().map(String::as_str));
-                self.report(
-                    Code::UnknownAttribute,
-                    attr.span,
+                let message = if is_user(&team) {
+                    let has = match known.is_empty() {
+                        true => "no values".to_string(),
+                        false => known.join(", "),
+                    };
                     format!(
-                        "`{team}.{name}` is neither a value of {team}'s robots nor a team variable that is sent, published or received"
-                    ),
-                )
-                .suggest(guess.map(|g| format!("{team}.{g}")));
+                        "`{team}.{name}` is not a value of the operator's console, which has {has}"
+                    )
+                } else {
+                    format!(
+                        "`{team}.{name}` is neither a value of the robots of team {team} nor a team variable that is sent, published or received"
+                    )
+                };
+                self.report(Code::UnknownAttribute, attr.span, message)
+                    .suggest(guess.map(|g| format!("{team}.{g}")));
                 Type::Unknown
             }
             Resolution::NotATeam { team } => {
@@ -649,18 +774,20 @@ impl<'a> Checker<'a> {
                 );
                 Type::Unknown
             }
-            Resolution::Bare(name) if bare_is_constant => {
+            Resolution::Bare { name, .. } if bare_is_constant => {
                 self.occurrence(last, Symbol::Constant(name.clone()), false);
                 Type::Constant(name)
             }
-            Resolution::Bare(name) => {
+            Resolution::Bare { name, known } => {
+                let guess = suggestion(&name, known.iter().map(String::as_str));
                 self.report(
                     Code::UnknownAttribute,
                     attr.span,
                     format!(
                         "`{name}` is neither a value of the robots running this statement nor a team variable"
                     ),
-                );
+                )
+                .suggest(guess);
                 Type::Unknown
             }
             Resolution::Unchecked => Type::Unknown,
@@ -669,22 +796,24 @@ impl<'a> Checker<'a> {
 
     // ----- groups -----
 
-    /// The robots of `scope` that meet a group condition.
-    fn group_members(&mut self, cond: &ast::GroupCond, scope: &Scope) -> Vec<Index> {
+    /// The robots of `scope` that meet a group condition, and whether every name
+    /// in the condition is known (an unknown one is reported here).
+    fn group_members(&mut self, cond: &ast::GroupCond, scope: &Scope) -> (Vec<Index>, bool) {
         let catalog = self.catalog;
         let mut types = Vec::new();
+        let mut all_known = true;
         for name in &cond.names {
             match cond.kind {
-                CondKind::InstanceOf => {
-                    if let Some(ty) = self.resolve_robot_type(name) {
-                        types.push(ty);
-                    }
-                }
+                CondKind::InstanceOf => match self.resolve_robot_type(name) {
+                    Some(ty) => types.push(ty),
+                    None => all_known = false,
+                },
                 CondKind::CapableOf => {
                     let known = catalog.types().any(|(_, r)| r.has_capability(&name.name));
                     if known {
                         self.occurrence(name.span, Symbol::Capability(name.name.clone()), false);
                     } else {
+                        all_known = false;
                         let all: Vec<&str> = catalog
                             .types()
                             .flat_map(|(_, r)| r.capabilities.iter().map(String::as_str))
@@ -701,10 +830,10 @@ impl<'a> Checker<'a> {
             }
         }
         let Some(team) = scope.team else {
-            return Vec::new();
+            return (Vec::new(), all_known);
         };
         let t = self.team(team);
-        scope
+        let members = scope
             .robots
             .iter()
             .copied()
@@ -720,15 +849,17 @@ impl<'a> Checker<'a> {
                         .all(|c| catalog.get(ty).has_capability(&c.name)),
                 }
             })
-            .collect()
+            .collect();
+        (members, all_known)
     }
 
     fn group(&mut self, g: &'a ast::GroupStmt, scope: &Scope) {
         let mut taken: Vec<Index> = Vec::new();
         let checkable = scope.team.is_some() && !scope.robots.is_empty();
         for arm in &g.arms {
-            let members = self.group_members(&arm.condition, scope);
-            if checkable && members.is_empty() {
+            let (members, all_known) = self.group_members(&arm.condition, scope);
+            // An unknown type or capability is reported on its own name.
+            if checkable && all_known && members.is_empty() {
                 let team = scope
                     .team
                     .map(|t| self.team(t).name.clone())
@@ -874,17 +1005,21 @@ impl<'a> Checker<'a> {
             } else {
                 self.record_attr(&item.attr, resolution, false);
             }
-            if let (Some(team), Some(service), Some(peer), Some(value)) =
-                (scope.team, scope.service, peer, key)
-            {
-                self.mission.messages.push(Message {
-                    kind: comm.kind,
-                    team,
-                    service,
-                    peer,
-                    value,
-                    span: item.attr.span,
-                });
+            match (scope.team, scope.service, peer, key) {
+                (Some(team), Some(service), Some(peer), Some(value)) => {
+                    self.mission.messages.push(Message {
+                        kind: comm.kind,
+                        team,
+                        service,
+                        peer,
+                        value,
+                        span: item.attr.span,
+                    });
+                }
+                (Some(team), _, None, Some(value)) => {
+                    self.comms_with_unknown_team.push((comm.kind, team, value));
+                }
+                _ => {}
             }
         }
     }

@@ -1,9 +1,10 @@
 //! Phase 4: communication matching. `receive(T, v)` in team X needs a
 //! `send(X, v)` in team T, `subscribe(T, v)` a `publish(X, v)`, and the reverse.
-//! The operator console (`USER`) sends and receives anything.
+//! The operator console (`USER`) sends and receives anything. A statement naming
+//! an unknown team (already reported) may be the counterpart of any team's.
 
-use super::ir::*;
 use super::Checker;
+use super::ir::*;
 use crate::diag::Code;
 use crate::syntax::ast::CommKind;
 use std::collections::HashSet;
@@ -36,6 +37,16 @@ impl Checker<'_> {
             if present.contains(&(counterpart(m.kind), other, m.team, &m.value)) {
                 continue;
             }
+            // A counterpart naming a misspelt team is already reported (E021).
+            let misaddressed = self
+                .comms_with_unknown_team
+                .iter()
+                .any(|(kind, team, value)| {
+                    *kind == counterpart(m.kind) && *team == other && *value == m.value
+                });
+            if misaddressed {
+                continue;
+            }
             let team = self.team(m.team);
             let path = team.service_path(m.service);
             let (me, them) = (&team.name, &self.team(other).name);
@@ -43,19 +54,27 @@ impl Checker<'_> {
             let (code, message) = match m.kind {
                 CommKind::Receive => (
                     Code::ReceiveWithoutSend,
-                    format!("`{path}` receives `{value}` from {them}, but no service of {them} sends it to {me}"),
+                    format!(
+                        "`{path}` receives `{value}` from {them}, but no service of {them} sends it to {me}"
+                    ),
                 ),
                 CommKind::Subscribe => (
                     Code::ReceiveWithoutSend,
-                    format!("`{path}` subscribes to `{value}` from {them}, but no service of {them} publishes it to {me}"),
+                    format!(
+                        "`{path}` subscribes to `{value}` from {them}, but no service of {them} publishes it to {me}"
+                    ),
                 ),
                 CommKind::Send => (
                     Code::SendWithoutReceive,
-                    format!("`{path}` sends `{value}` to {them}, but no service of {them} receives it from {me}"),
+                    format!(
+                        "`{path}` sends `{value}` to {them}, but no service of {them} receives it from {me}"
+                    ),
                 ),
                 CommKind::Publish => (
                     Code::SendWithoutReceive,
-                    format!("`{path}` publishes `{value}` to {them}, but no service of {them} subscribes to it from {me}"),
+                    format!(
+                        "`{path}` publishes `{value}` to {them}, but no service of {them} subscribes to it from {me}"
+                    ),
                 ),
             };
             findings.push((code, m.span, message));

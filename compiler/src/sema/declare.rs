@@ -3,7 +3,7 @@
 //! communication statements introduce.
 
 use super::ir::*;
-use super::{is_user, suggestion, Checker};
+use super::{Checker, is_user, suggestion};
 use crate::diag::Code;
 use crate::span::Span;
 use crate::syntax::ast::{self, Item};

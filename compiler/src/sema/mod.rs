@@ -73,6 +73,9 @@ pub(crate) fn is_user(name: &str) -> bool {
     name == "USER" || name == "user"
 }
 
+/// A function body checked for a (function, team, service, robots running it).
+type InlinedBody = (FunctionId, Option<TeamId>, Option<Index>, Vec<Index>);
+
 pub(crate) struct Checker<'a> {
     file: FileId,
     /// The syntax of each team's services, parallel to `Team::services`, and of
@@ -87,6 +90,18 @@ pub(crate) struct Checker<'a> {
     /// Team variables declared anywhere by `T.X = ...` or received: (team or
     /// `None` when written bare inside a function, name).
     variables: HashSet<(Option<TeamId>, String)>,
+    /// Services named by the `set`s of a mode defined twice (already reported):
+    /// they are not "never set".
+    set_by_duplicate_modes: HashSet<(TeamId, Index)>,
+    /// Teams whose main block names an undefined mode (already reported): which
+    /// modes it can reach is unknown.
+    mains_with_unknown_modes: HashSet<TeamId>,
+    /// Communication statements naming an unknown team (already reported), as
+    /// (kind, running team, value): they may be the counterpart of another.
+    comms_with_unknown_team: Vec<(ast::CommKind, TeamId, AttrKey)>,
+    /// Function bodies already checked for a (function, team, service, robots):
+    /// checking again would find the same, and nested calls would be exponential.
+    inlined: HashSet<InlinedBody>,
 }
 
 impl<'a> Checker<'a> {
@@ -104,6 +119,10 @@ impl<'a> Checker<'a> {
             teams_by_name: HashMap::new(),
             functions_by_name: HashMap::new(),
             variables: HashSet::new(),
+            set_by_duplicate_modes: HashSet::new(),
+            mains_with_unknown_modes: HashSet::new(),
+            comms_with_unknown_team: Vec::new(),
+            inlined: HashSet::new(),
         }
     }
 
@@ -141,7 +160,7 @@ impl<'a> Checker<'a> {
 
     fn finish(mut self) -> (Mission, Vec<Diagnostic>) {
         let occurrences = &mut self.mission.occurrences;
-        occurrences.sort_by(|a, b| (a.span, a.is_definition).cmp(&(b.span, b.is_definition)));
+        occurrences.sort_by_key(|o| (o.span, o.is_definition));
         occurrences.dedup();
         (self.mission, self.diagnostics)
     }

@@ -4,6 +4,7 @@
 
 pub mod ast;
 mod chunks;
+mod delimiters;
 mod parser;
 pub mod token;
 
@@ -53,17 +54,27 @@ pub fn parse(file: FileId, text: &str) -> Parse {
         _ => true,
     });
 
-    let parser = parser::items();
+    let chunks: Vec<_> = chunks::split(&tokens)
+        .into_iter()
+        .map(|range| delimiters::balance(text, &tokens[range], file, &mut diagnostics))
+        .collect();
+    let fast = parser::items::<_, chumsky::error::EmptyErr>();
+    let rich = parser::items::<_, parser::RichError<'_, '_>>();
     let mut items = Vec::new();
-    for range in chunks::split(&tokens) {
-        let chunk = &tokens[range];
+    for chunk in &chunks {
         let (Some(first), Some(last)) = (chunk.first(), chunk.last()) else {
             continue;
         };
         let chunk_span = Span::new(first.1.start, last.1.end);
         let eoi = SimpleSpan::from(last.1.end..last.1.end);
-        let input: parser::TokenInput<'_, '_> = chunk.map(eoi, |(t, s)| (t, s));
-        let (output, errors) = parser.parse(input).into_output_errors();
+        let input = || -> parser::TokenInput<'_, '_> { chunk.as_slice().map(eoi, |(t, s)| (t, s)) };
+        if let (Some(parsed), errors) = fast.parse(input()).into_output_errors()
+            && errors.is_empty()
+        {
+            items.extend(parsed);
+            continue;
+        }
+        let (output, errors) = rich.parse(input()).into_output_errors();
         for error in &errors {
             diagnostics.push(syntax_diagnostic(file, error));
         }
@@ -109,11 +120,40 @@ fn describe_pattern(pattern: &RichPattern<'_, Token<'_>>) -> String {
     }
 }
 
+/// An operator (or "anything else") that would merely continue what was parsed.
+fn is_continuation(pattern: &RichPattern<'_, Token<'_>>) -> bool {
+    use token::Kw;
+    match pattern {
+        RichPattern::Token(t) => matches!(
+            **t,
+            Token::AndAnd
+                | Token::OrOr
+                | Token::Kw(Kw::And | Kw::Or)
+                | Token::EqEq
+                | Token::NotEq
+                | Token::Lt
+                | Token::Le
+                | Token::Gt
+                | Token::Ge
+        ),
+        RichPattern::SomethingElse => true,
+        _ => false,
+    }
+}
+
 fn syntax_diagnostic(file: FileId, error: &Rich<'_, Token<'_>>) -> Diagnostic {
     let span = Span::new(error.span().start, error.span().end);
     let message = match error.reason() {
         RichReason::ExpectedFound { expected, found } => {
-            let mut wanted: Vec<String> = expected.iter().map(describe_pattern).collect();
+            // An operator that could continue the expression is rarely what is
+            // missing: `move("1,1"` lacks its `)`, not an `and`.
+            let likely: Vec<_> = expected.iter().filter(|p| !is_continuation(p)).collect();
+            let shown = if likely.is_empty() {
+                expected.iter().collect()
+            } else {
+                likely
+            };
+            let mut wanted: Vec<String> = shown.into_iter().map(describe_pattern).collect();
             wanted.sort();
             wanted.dedup();
             let found = describe_found(found.as_deref());

@@ -7,7 +7,7 @@
 //! resume, so several errors in one block are each reported.
 
 use super::ast::*;
-use super::token::{unescape, Kw, Token};
+use super::token::{Kw, Token, unescape};
 use crate::span::Span;
 use chumsky::input::{MappedInput, ValueInput};
 use chumsky::prelude::*;
@@ -20,23 +20,38 @@ pub type TokenInput<'t, 's> = MappedInput<
     fn(&'t (Token<'s>, SimpleSpan)) -> (&'t Token<'s>, &'t SimpleSpan),
 >;
 
-pub type ParseError<'t, 's> = Rich<'t, Token<'s>, SimpleSpan>;
-type Extra<'t, 's> = extra::Err<ParseError<'t, 's>>;
+/// The detailed error, used to report a chunk that failed the fast parse.
+pub type RichError<'t, 's> = Rich<'t, Token<'s>, SimpleSpan>;
+
+/// What the grammar needs of its error type. The same grammar runs with
+/// chumsky's zero-cost `EmptyErr` first (most chunks are valid), and again with
+/// [`RichError`] only for the chunks that failed, to explain what went wrong.
+pub trait ParseErr<'t, I: chumsky::input::Input<'t>>:
+    chumsky::error::Error<'t, I> + chumsky::label::LabelError<'t, I, &'static str>
+{
+}
+
+impl<'t, I: chumsky::input::Input<'t>, T> ParseErr<'t, I> for T where
+    T: chumsky::error::Error<'t, I> + chumsky::label::LabelError<'t, I, &'static str>
+{
+}
 
 fn sp(s: SimpleSpan) -> Span {
     Span::new(s.start, s.end)
 }
 
-fn kw<'t, 's: 't, I>(k: Kw) -> impl Parser<'t, I, SimpleSpan, Extra<'t, 's>> + Clone
+fn kw<'t, 's: 't, I, E>(k: Kw) -> impl Parser<'t, I, SimpleSpan, extra::Err<E>> + Clone
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
 {
     just(Token::Kw(k)).map_with(|_, e| e.span())
 }
 
-fn tok<'t, 's: 't, I>(t: Token<'s>) -> impl Parser<'t, I, Token<'s>, Extra<'t, 's>> + Clone
+fn tok<'t, 's: 't, I, E>(t: Token<'s>) -> impl Parser<'t, I, Token<'s>, extra::Err<E>> + Clone
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
 {
     just(t)
 }
@@ -45,12 +60,13 @@ where
 /// so that a line that does not parse is reported and skipped: first by skipping
 /// tokens until a later line parses, else by taking everything up to the closing
 /// bracket as one bad line. Either way the enclosing item survives.
-fn recovering<'t, 's: 't, I, O: 't>(
-    line: impl Parser<'t, I, O, Extra<'t, 's>> + Clone + 't,
+fn recovering<'t, 's: 't, I, E, O: 't>(
+    line: impl Parser<'t, I, O, extra::Err<E>> + Clone + 't,
     bad_line: impl Fn(Span) -> O + Clone + 't,
-) -> impl Parser<'t, I, O, Extra<'t, 's>> + Clone
+) -> impl Parser<'t, I, O, extra::Err<E>> + Clone
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
 {
     let bracketed = nested_delimiters(
         Token::LBrace,
@@ -76,22 +92,26 @@ where
 }
 
 /// A non-reserved identifier.
-fn name<'t, 's: 't, I>() -> impl Parser<'t, I, Ident, Extra<'t, 's>> + Clone
+fn name<'t, 's: 't, I, E>() -> impl Parser<'t, I, Ident, extra::Err<E>> + Clone
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
 {
     select! { Token::Ident(s) = e => Ident::new(s, sp(e.span())) }.labelled("a name")
 }
 
 /// `2 SEC`, `500 msec`.
-fn period<'t, 's: 't, I>() -> impl Parser<'t, I, Period, Extra<'t, 's>> + Clone
+fn period<'t, 's: 't, I, E>() -> impl Parser<'t, I, Period, extra::Err<E>> + Clone
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
 {
     select! { Token::Number(n) => n }
-        .then(select! { Token::Ident(w) => w }.try_map(|w, span| {
-            TimeUnit::parse(w).ok_or_else(|| Rich::custom(span, "expected a time unit"))
-        }))
+        .then(
+            select! { Token::Ident(w) if TimeUnit::parse(w).is_some() => TimeUnit::parse(w) }
+                .map(|unit| unit.unwrap_or(TimeUnit::Sec))
+                .labelled("a time unit"),
+        )
         .map_with(|(amount, unit), e| Period {
             amount: amount.to_string(),
             unit,
@@ -100,18 +120,20 @@ where
         .labelled("a period such as `2 SEC`")
 }
 
-fn timeout<'t, 's: 't, I>() -> impl Parser<'t, I, Period, Extra<'t, 's>> + Clone
+fn timeout<'t, 's: 't, I, E>() -> impl Parser<'t, I, Period, extra::Err<E>> + Clone
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
 {
     kw(Kw::Timeout)
         .ignore_then(tok(Token::Assign))
         .ignore_then(period())
 }
 
-fn attr<'t, 's: 't, I>() -> impl Parser<'t, I, Attr, Extra<'t, 's>> + Clone
+fn attr<'t, 's: 't, I, E>() -> impl Parser<'t, I, Attr, extra::Err<E>> + Clone
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
 {
     name()
         .separated_by(tok(Token::Dot))
@@ -124,9 +146,10 @@ where
         .labelled("a value name")
 }
 
-pub fn expr<'t, 's: 't, I>() -> impl Parser<'t, I, Expr, Extra<'t, 's>> + Clone
+pub fn expr<'t, 's: 't, I, E>() -> impl Parser<'t, I, Expr, extra::Err<E>> + Clone
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
 {
     recursive(|expr| {
         let literal = select! {
@@ -213,10 +236,11 @@ where
 }
 
 /// `(P)`, `(expr)`, `(P, expr)`, and for `repeat` also `()`.
-fn period_and_condition<'t, 's: 't, I>(
-) -> impl Parser<'t, I, (Option<Period>, Option<Expr>), Extra<'t, 's>> + Clone
+fn period_and_condition<'t, 's: 't, I, E>()
+-> impl Parser<'t, I, (Option<Period>, Option<Expr>), extra::Err<E>> + Clone
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
 {
     period()
         .then(tok(Token::Comma).ignore_then(expr()).or_not())
@@ -224,9 +248,10 @@ where
         .or(expr().map(|c| (None, Some(c))))
 }
 
-fn statement<'t, 's: 't, I>() -> impl Parser<'t, I, Stmt, Extra<'t, 's>> + Clone
+fn statement<'t, 's: 't, I, E>() -> impl Parser<'t, I, Stmt, extra::Err<E>> + Clone
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
 {
     recursive(|stmt| {
         let recovering_stmt = recovering(stmt.clone(), |span| Stmt {
@@ -410,9 +435,10 @@ fn else_of(block: Block) -> Else {
     }
 }
 
-fn braced_block<'t, 's: 't, I>() -> impl Parser<'t, I, Block, Extra<'t, 's>> + Clone
+fn braced_block<'t, 's: 't, I, E>() -> impl Parser<'t, I, Block, extra::Err<E>> + Clone
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
 {
     recovering(statement(), |span| Stmt {
         kind: StmtKind::Error,
@@ -428,9 +454,10 @@ where
 }
 
 /// Parses the items of one chunk.
-pub fn items<'t, 's: 't, I>() -> impl Parser<'t, I, Vec<Item>, Extra<'t, 's>>
+pub fn items<'t, 's: 't, I, E>() -> impl Parser<'t, I, Vec<Item>, extra::Err<E>>
 where
     I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
 {
     let semis = tok(Token::Semi).repeated();
 

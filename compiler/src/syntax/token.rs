@@ -107,8 +107,40 @@ impl Kw {
         }
     }
 
+    /// The keyword spelled `word`, if any (a `match` is much faster than a search).
     pub fn from_word(word: &str) -> Option<Kw> {
-        Kw::ALL.iter().copied().find(|k| k.as_str() == word)
+        Some(match word {
+            "if" => Kw::If,
+            "else" => Kw::Else,
+            "loop" => Kw::Loop,
+            "repeat" => Kw::Repeat,
+            "throw" => Kw::Throw,
+            "send" => Kw::Send,
+            "receive" => Kw::Receive,
+            "publish" => Kw::Publish,
+            "subscribe" => Kw::Subscribe,
+            "set" => Kw::Set,
+            "OFF" => Kw::Off,
+            "def" => Kw::Def,
+            "main" => Kw::Main,
+            "case" => Kw::Case,
+            "catch" => Kw::Catch,
+            "default" => Kw::Default,
+            "mode" => Kw::Mode,
+            "group" => Kw::Group,
+            "leader" => Kw::Leader,
+            "others" => Kw::Others,
+            "instance" => Kw::Instance,
+            "of" => Kw::Of,
+            "capable" => Kw::Capable,
+            "timeout" => Kw::Timeout,
+            "true" => Kw::True,
+            "false" => Kw::False,
+            "and" => Kw::And,
+            "or" => Kw::Or,
+            "not" => Kw::Not,
+            _ => return None,
+        })
     }
 }
 
@@ -187,34 +219,21 @@ impl fmt::Display for Token<'_> {
 pub type Spanned<'src> = (Token<'src>, SimpleSpan);
 
 fn lexer<'src>() -> impl Parser<'src, &'src str, Vec<Spanned<'src>>, extra::Default> {
-    let ident = any()
-        .filter(|c: &char| c.is_ascii_alphabetic() || *c == '_')
-        .then(
-            any()
-                .filter(|c: &char| c.is_ascii_alphanumeric() || *c == '_')
-                .repeated(),
-        )
-        .to_slice()
-        .map(|word: &str| match Kw::from_word(word) {
-            Some(kw) => Token::Kw(kw),
-            None => Token::Ident(word),
-        });
+    let word = text::ascii::ident().map(|word: &str| match Kw::from_word(word) {
+        Some(kw) => Token::Kw(kw),
+        None => Token::Ident(word),
+    });
 
-    let digits = any()
-        .filter(|c: &char| c.is_ascii_digit())
-        .repeated()
-        .at_least(1);
     let number = just('-')
         .or_not()
-        .then(digits)
-        .then(just('.').then(digits).or_not())
+        .then(text::digits(10))
+        .then(just('.').then(text::digits(10)).or_not())
         .to_slice()
         .map(Token::Number);
 
-    let escape = just('\\').then(any().filter(|c: &char| *c != '\n'));
-    let string_body = escape.ignored().or(none_of("\"\\\n").ignored()).repeated();
+    let escape = just('\\').then(none_of('\n'));
     let string = just('"')
-        .ignore_then(string_body)
+        .ignore_then(escape.ignored().or(none_of("\"\\\n").ignored()).repeated())
         .ignore_then(just('"').or_not())
         .map_with(|close, e| {
             let raw: &str = e.slice();
@@ -224,7 +243,7 @@ fn lexer<'src>() -> impl Parser<'src, &'src str, Vec<Spanned<'src>>, extra::Defa
             }
         });
 
-    let punct = choice((
+    let two_chars = choice((
         just("[[").to(Token::GroupOpen),
         just("]]").to(Token::GroupClose),
         just("==").to(Token::EqEq),
@@ -233,43 +252,108 @@ fn lexer<'src>() -> impl Parser<'src, &'src str, Vec<Spanned<'src>>, extra::Defa
         just(">=").to(Token::Ge),
         just("&&").to(Token::AndAnd),
         just("||").to(Token::OrOr),
-        just('{').to(Token::LBrace),
-        just('}').to(Token::RBrace),
-        just('(').to(Token::LParen),
-        just(')').to(Token::RParen),
-        just('[').to(Token::LBracket),
-        just(']').to(Token::RBracket),
-        just(':').to(Token::Colon),
-        just(';').to(Token::Semi),
-        just(',').to(Token::Comma),
-        just('.').to(Token::Dot),
-        just('=').to(Token::Assign),
-        just('<').to(Token::Lt),
-        just('>').to(Token::Gt),
-        just('!').to(Token::Bang),
+    ));
+    // Punctuation that never starts a two-character operator, matched first.
+    let single = select! {
+        '{' => Token::LBrace,
+        '}' => Token::RBrace,
+        '(' => Token::LParen,
+        ')' => Token::RParen,
+        ':' => Token::Colon,
+        ';' => Token::Semi,
+        ',' => Token::Comma,
+        '.' => Token::Dot,
+    };
+    let prefix_of_two = select! {
+        '[' => Token::LBracket,
+        ']' => Token::RBracket,
+        '=' => Token::Assign,
+        '<' => Token::Lt,
+        '>' => Token::Gt,
+        '!' => Token::Bang,
+    };
+
+    let token = choice((
+        word,
+        single,
+        string,
+        number,
+        two_chars,
+        prefix_of_two,
+        any().map(Token::Error),
     ));
 
-    let token = choice((ident, number, string, punct, any().map(Token::Error)));
+    // Whitespace and `#` comments, skipped in one tight loop: trivia is most of
+    // the characters of a script, and combinators per character cost far more.
+    let trivia = custom::<_, &'src str, (), extra::Default>(|inp| {
+        while let Some(c) = inp.peek() {
+            if c == '#' {
+                while inp.peek().is_some_and(|c| c != '\n') {
+                    inp.skip();
+                }
+            } else if c.is_whitespace() {
+                inp.skip();
+            } else {
+                break;
+            }
+        }
+        Ok(())
+    });
 
-    let comment = just('#').then(none_of('\n').repeated()).ignored();
-    let trivia = choice((
-        any().filter(|c: &char| c.is_whitespace()).ignored(),
-        comment,
-    ))
-    .repeated();
-
-    token
-        .map_with(|tok, e| (tok, e.span()))
-        .padded_by(trivia)
+    trivia
+        .ignore_then(token.map_with(|tok, e| (tok, e.span())))
         .repeated()
         .collect()
-        .padded_by(trivia)
+        .then_ignore(trivia)
 }
 
 /// Splits `text` into tokens. Never fails: unknown characters and unterminated
 /// strings become tokens that the parser reports.
 pub fn lex(text: &str) -> Vec<Spanned<'_>> {
-    lexer().parse(text).into_output().unwrap_or_default()
+    let tokens = lexer().parse(text).into_output().unwrap_or_default();
+    let mut out = Vec::with_capacity(tokens.len());
+    for (tok, span) in tokens {
+        match tok {
+            Token::Unterminated(raw) => match missing_quote_before(raw) {
+                Some(cut) => {
+                    let end = span.start + cut;
+                    out.push((
+                        Token::Unterminated(&raw[..cut]),
+                        SimpleSpan::from(span.start..end),
+                    ));
+                    let rest = lexer().parse(&text[end..span.end]).into_output();
+                    out.extend(
+                        rest.unwrap_or_default()
+                            .into_iter()
+                            .map(|(t, s)| (t, SimpleSpan::from(s.start + end..s.end + end))),
+                    );
+                }
+                None => out.push((tok, span)),
+            },
+            _ => out.push((tok, span)),
+        }
+    }
+    out
+}
+
+/// Where an unterminated string most likely lacks its closing quote: before a
+/// `)` that it does not open itself, as in `move("5,5)`. The rest of the line is
+/// then read as code, so the statement still parses. `None` when there is no such
+/// `)`, or when the rest holds a quote or backslash (it would not lex as code).
+fn missing_quote_before(raw: &str) -> Option<usize> {
+    let mut depth = 0usize;
+    for (i, c) in raw.char_indices() {
+        match c {
+            '(' => depth += 1,
+            ')' if depth > 0 => depth -= 1,
+            ')' => {
+                let rest = &raw[i..];
+                return (!rest.contains(['"', '\\'])).then_some(i);
+            }
+            _ => {}
+        }
+    }
+    None
 }
 
 /// The value of a string literal token (quotes removed, escapes applied).
@@ -332,6 +416,35 @@ mod tests {
         assert_eq!(toks[2], Token::Str(r#""a\"b😀""#));
         assert_eq!(unescape(r#""a\"b😀""#), "a\"b😀");
         assert_eq!(toks.last(), Some(&Token::Unterminated("\"open")));
+    }
+
+    #[test]
+    fn unterminated_strings_end_before_an_unopened_paren() {
+        let toks = kinds("move(\"5,5) stop()\nsay(\"a (b) c");
+        assert_eq!(
+            toks,
+            vec![
+                Token::Ident("move"),
+                Token::LParen,
+                Token::Unterminated("\"5,5"),
+                Token::RParen,
+                Token::Ident("stop"),
+                Token::LParen,
+                Token::RParen,
+                Token::Ident("say"),
+                Token::LParen,
+                Token::Unterminated("\"a (b) c"),
+            ]
+        );
+        assert_eq!(lex("move(\"5,5)")[3].1, SimpleSpan::from(9..10));
+    }
+
+    #[test]
+    fn every_keyword_round_trips() {
+        for &kw in Kw::ALL {
+            assert_eq!(Kw::from_word(kw.as_str()), Some(kw));
+        }
+        assert_eq!(Kw::from_word("If"), None);
     }
 
     #[test]

@@ -335,7 +335,9 @@ fn duplicates() {
     assert_eq!(robot.services.len(), 2);
     assert!(robot.services[1].aliases.is_empty());
 
-    let text = wrap("<Service name=\"s\"><Param name=\"p\" type=\"int\"/><Param name=\"p\" type=\"int\"/></Service>");
+    let text = wrap(
+        "<Service name=\"s\"><Param name=\"p\" type=\"int\"/><Param name=\"p\" type=\"int\"/></Service>",
+    );
     assert_eq!(codes(&text), ["E053"]);
     let text = wrap("<Platform os=\"a\"/><Platform os=\"b\"/>");
     assert_eq!(codes(&text), ["E053"]);
@@ -391,7 +393,10 @@ fn bad_attribute_values() {
         ("<Value name=\"C\" type=\"enum\" domain=\"A 2B\"/>", "2B"),
         ("<Value name=\"my value\" type=\"int\"/>", "my value"),
         ("<Value name=\"\" type=\"int\"/>", ""),
-        ("<Value name=\"V\" type=\"int\" task=\"t\" graph=\"g\"/>", "g"),
+        (
+            "<Value name=\"V\" type=\"int\" task=\"t\" graph=\"g\"/>",
+            "g",
+        ),
         ("<Service name=\"s\" aliases=\"ok 9bad\"/>", "9bad"),
         (
             "<Service name=\"s\"><Param name=\"p\" type=\"int\" optional=\"yes\"/></Service>",
@@ -418,9 +423,11 @@ fn unknown_attributes() {
     let parsed = parse(&text);
     let diags = &parsed.diagnostics;
     assert_eq!(diags.len(), 2);
-    assert!(diags
-        .iter()
-        .all(|d| d.code == Code::CatalogUnknownAttribute));
+    assert!(
+        diags
+            .iter()
+            .all(|d| d.code == Code::CatalogUnknownAttribute)
+    );
     assert!(diags.iter().all(|d| d.severity == Severity::Warning));
     assert_eq!(&text[diags[0].span.range()], "colour");
     assert_eq!(diags[1].suggestion.as_deref(), Some("doc"));

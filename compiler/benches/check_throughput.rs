@@ -1,0 +1,160 @@
+//! Check throughput on a large generated mission (200 teams, 10k+ lines):
+//! parse alone and parse+check, in MB/s and lines/s. Run with `cargo bench`.
+//! The target is at least 30 MB/s for parse+check on a 2-core machine.
+
+use semo::catalog::builtin_catalog;
+use semo::diag::FileId;
+use std::fmt::Write;
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+/// A realistic mission: mixed teams with groups, communication between
+/// neighbouring teams, modes with transitions, functions, comments.
+fn generate(teams: usize) -> String {
+    let mut m = String::from("# Generated benchmark mission\n{\n");
+    for t in 0..teams {
+        writeln!(
+            m,
+            "  Team{t}: Turtlebot3_Burger tb{t}[3], Ev3_Robot ev{t}[2], iRobotCreate cr{t}"
+        )
+        .unwrap();
+    }
+    m.push_str("}\n\ndef report_home {\n  move(\"0,0\")\n  standby()\n}\n\n");
+    for t in 0..teams {
+        let next = (t + 1) % teams;
+        let prev = (t + teams - 1) % teams;
+        write!(
+            m,
+            r#"# ----- Team{t} -----
+Team{t}.Listen.Hear{{
+  receive(Team{prev}, Team{prev}.Status)
+  subscribe(Team{t}, Team{t}.Alarm)
+  if(Team{t}.Alarm == DARK) throw hide
+  else if(Team{prev}.Status == "done") throw finish
+  else throw resume
+}} repeat(500 MSEC)
+
+Team{t}.Report.Tell{{
+  send(Team{next}, Team{t}.Status = "working")
+  send(USER, Team{t}.LOCATION)
+  [[
+    leader(instance of Turtlebot3_Burger){{
+      light_on()
+      publish(Team{t}, Team{t}.Alarm = BRIGHT)
+    }}
+  ]]
+}} repeat(1 SEC)
+
+Team{t}.Action.Patrol{{
+  [[
+    group(instance of Turtlebot3_Burger){{
+      loop(2 SEC){{
+        if(Team{t}.LIGHTNESS < 200 and BATTERY > 20)
+          publish(Team{t}, Team{t}.Alarm = DARK)
+      }}
+    }}
+    group(capable of color_sensor){{
+      search(colored_paper)
+      scatter()
+    }}
+    others{{
+      move("3,3"), timeout = 10 SEC
+      move("0,3")
+    }}
+  ]]
+}} repeat()
+
+Team{t}.Action.Hide{{
+  if(DISTANCE > 30){{
+    go_forward()
+  }} else {{
+    turn_left()
+  }}
+  stop()
+}} repeat(LOCATION != "0,0")
+
+Team{t}.Action.Return{{
+  report_home()
+}}
+
+Team{t}.PATROL{{ set(Listen, Hear); set(Report, Tell); set(Action, Patrol) }}
+Team{t}.HIDE{{ set(Listen, Hear); set(Report, OFF); set(Action, Hide, timeout = 30 SEC) }}
+Team{t}.HOME{{ set(Listen, OFF); set(Report, OFF); set(Action, Return) }}
+Team{t}.main{{
+  case (PATROL):
+    catch (hide): mode = HIDE
+    catch (finish): mode = HOME
+  case (HIDE):
+    catch (resume): mode = PATROL
+  default: mode = PATROL
+}}
+
+"#
+        )
+        .unwrap();
+    }
+    m
+}
+
+/// Runs `f` repeatedly for about `budget`, and gives the fastest run.
+fn fastest(budget: Duration, mut f: impl FnMut()) -> Duration {
+    let start = Instant::now();
+    let mut best = Duration::MAX;
+    let mut runs = 0;
+    while runs < 3 || start.elapsed() < budget {
+        let t = Instant::now();
+        f();
+        best = best.min(t.elapsed());
+        runs += 1;
+    }
+    best
+}
+
+fn main() {
+    // `cargo bench` passes `--bench`; a filter argument is accepted and ignored.
+    let teams: usize = std::env::var("SEMO_BENCH_TEAMS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(200);
+    let text = generate(teams);
+    if let Ok(path) = std::env::var("SEMO_BENCH_DUMP") {
+        std::fs::write(&path, &text).expect("write the generated mission");
+    }
+    let catalog = builtin_catalog();
+    let lines = text.lines().count();
+    let mb = text.len() as f64 / 1e6;
+
+    let analysis = semo::check_source(FileId(0), &text, &catalog);
+    let errors: Vec<_> = analysis
+        .diagnostics
+        .iter()
+        .filter(|d| d.is_error())
+        .collect();
+    assert!(
+        errors.is_empty(),
+        "the generated mission must be valid: {:#?}",
+        &errors[..errors.len().min(5)]
+    );
+
+    println!(
+        "mission: {teams} teams, {lines} lines, {:.2} MB, {} diagnostics (warnings/hints)",
+        mb,
+        analysis.diagnostics.len()
+    );
+    let budget = Duration::from_secs(3);
+    let parse = fastest(budget, || {
+        black_box(semo::syntax::parse(FileId(0), black_box(&text)));
+    });
+    let check = fastest(budget, || {
+        black_box(semo::check_source(FileId(0), black_box(&text), &catalog));
+    });
+    for (what, d) in [("parse", parse), ("parse+check", check)] {
+        let s = d.as_secs_f64();
+        println!(
+            "{what:>12}: {:>8.2} ms  {:>7.1} MB/s  {:>10.0} lines/s",
+            s * 1e3,
+            mb / s,
+            lines as f64 / s
+        );
+    }
+}

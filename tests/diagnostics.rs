@@ -1,0 +1,47 @@
+//! One fixture per diagnostic code, checked through `semo check --format json`.
+//!
+//! A fixture is `tests/fixtures/diagnostics/<CODE>_<what>.mission`, or a folder
+//! `<CODE>_<what>/` (a mission with its own `*.robot.xml`). Its expected
+//! diagnostics are the insta snapshot `tests/snapshots/diagnostics__<name>.snap`;
+//! besides, the fixture must produce at least one diagnostic with its code.
+
+mod support;
+
+use semo::diag::Code;
+use std::path::Path;
+
+fn fixture_code(path: &Path) -> String {
+    let name = path.file_name().unwrap().to_str().unwrap();
+    name.split('_').next().unwrap().to_string()
+}
+
+#[test]
+fn every_fixture_produces_its_code() {
+    insta::glob!("fixtures/diagnostics/*", |path| {
+        let dir = path.parent().unwrap();
+        let name = path.file_name().unwrap().to_str().unwrap();
+        let (_, diags) = support::check_json_in(dir, &[name]);
+        let code = fixture_code(path);
+        assert!(
+            diags.iter().any(|d| d.code == code),
+            "fixture {name} should report {code}, got:\n{}",
+            support::listing(&diags)
+        );
+        insta::assert_snapshot!(support::listing(&diags));
+    });
+}
+
+#[test]
+fn every_code_has_a_fixture() {
+    let dir = support::repo_root().join("tests/fixtures/diagnostics");
+    let codes: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| fixture_code(&e.unwrap().path()))
+        .collect();
+    let missing: Vec<&str> = Code::ALL
+        .iter()
+        .map(|c| c.as_str())
+        .filter(|c| !codes.iter().any(|f| f == c))
+        .collect();
+    assert!(missing.is_empty(), "codes without a fixture: {missing:?}");
+}

@@ -1,0 +1,284 @@
+//! The parser and checker never panic, whatever the input: random bytes, random
+//! token soups, and random line mutations (delete, duplicate, swap) of the
+//! reference examples. Thousands of cases run in the normal test run; the
+//! `#[ignore]`d variant runs many more (`cargo test --test robustness -- --ignored`,
+//! with `SEMO_FUZZ_CASES` to choose how many). A libFuzzer target lives in
+//! `compiler/fuzz/`.
+
+mod support;
+
+use proptest::prelude::*;
+use semo::catalog::{Catalog, builtin_catalog};
+use semo::diag::FileId;
+use std::sync::OnceLock;
+
+fn catalog() -> &'static Catalog {
+    static CATALOG: OnceLock<Catalog> = OnceLock::new();
+    CATALOG.get_or_init(builtin_catalog)
+}
+
+fn examples() -> &'static Vec<String> {
+    static EXAMPLES: OnceLock<Vec<String>> = OnceLock::new();
+    EXAMPLES.get_or_init(|| {
+        let root = support::shared().join("examples");
+        [
+            "scouting/scouting.mission",
+            "follow/follow.mission",
+            "swarm/march.mission",
+            "swarm/patrol_groups.mission",
+        ]
+        .iter()
+        .map(|p| std::fs::read_to_string(root.join(p)).expect("shared example"))
+        .collect()
+    })
+}
+
+/// Parses and checks `text`, and checks the invariants of the result: every
+/// range lies inside the text on character boundaries.
+fn check_never_panics(text: &str) {
+    let analysis = semo::check_source(FileId(0), text, catalog());
+    for d in &analysis.diagnostics {
+        assert!(
+            d.span.start <= d.span.end && d.span.end <= text.len(),
+            "{d:?}"
+        );
+        assert!(
+            text.is_char_boundary(d.span.start) && text.is_char_boundary(d.span.end),
+            "{d:?}"
+        );
+        assert!(!d.message.is_empty());
+    }
+    for o in &analysis.mission.occurrences {
+        assert!(o.span.end <= text.len(), "{o:?}");
+    }
+}
+
+const SOUP: &[&str] = &[
+    "{",
+    "}",
+    "(",
+    ")",
+    "[",
+    "]",
+    "[[",
+    "]]",
+    ":",
+    ";",
+    ",",
+    ".",
+    "=",
+    "==",
+    "!=",
+    "<",
+    "<=",
+    ">",
+    ">=",
+    "&&",
+    "||",
+    "!",
+    "if",
+    "else",
+    "loop",
+    "repeat",
+    "throw",
+    "send",
+    "receive",
+    "publish",
+    "subscribe",
+    "set",
+    "OFF",
+    "def",
+    "main",
+    "case",
+    "catch",
+    "default",
+    "mode",
+    "group",
+    "leader",
+    "others",
+    "instance",
+    "of",
+    "capable",
+    "timeout",
+    "true",
+    "false",
+    "and",
+    "or",
+    "not",
+    "SEC",
+    "MSEC",
+    "2",
+    "-4",
+    "3.5",
+    "0",
+    "\"5,5\"",
+    "\"😀 한국\"",
+    "\"open",
+    "T",
+    "Team",
+    "USER",
+    "iRobotCreate",
+    "TIEvalbot",
+    "Turtlebot3_Burger",
+    "move",
+    "light_on",
+    "LOCATION",
+    "COLOR",
+    "Action",
+    "Listen",
+    "M",
+    "E",
+    "# comment\n",
+    "\n",
+    " ",
+    "@",
+    "한",
+];
+
+fn token_soup() -> impl Strategy<Value = String> {
+    prop::collection::vec(prop::sample::select(SOUP), 0..200).prop_map(|toks| toks.join(" "))
+}
+
+#[derive(Clone, Debug)]
+enum Mutation {
+    Delete(usize),
+    Duplicate(usize),
+    Swap(usize, usize),
+}
+
+fn mutated_example() -> impl Strategy<Value = String> {
+    let mutation = prop_oneof![
+        any::<usize>().prop_map(Mutation::Delete),
+        any::<usize>().prop_map(Mutation::Duplicate),
+        (any::<usize>(), any::<usize>()).prop_map(|(a, b)| Mutation::Swap(a, b)),
+    ];
+    (0..examples().len(), prop::collection::vec(mutation, 1..8)).prop_map(|(which, mutations)| {
+        let mut lines: Vec<String> = examples()[which].lines().map(str::to_string).collect();
+        for m in mutations {
+            let n = lines.len();
+            if n == 0 {
+                break;
+            }
+            match m {
+                Mutation::Delete(i) => {
+                    lines.remove(i % n);
+                }
+                Mutation::Duplicate(i) => {
+                    let line = lines[i % n].clone();
+                    lines.insert(i % n, line);
+                }
+                Mutation::Swap(a, b) => lines.swap(a % n, b % n),
+            }
+        }
+        lines.join("\n")
+    })
+}
+
+/// Byte-level damage inside an example: truncation or a character cut in half
+/// is impossible for `&str`, so damage is done on characters.
+fn damaged_example() -> impl Strategy<Value = String> {
+    (
+        0..examples().len(),
+        any::<usize>(),
+        any::<usize>(),
+        any::<char>(),
+    )
+        .prop_map(|(which, at, len, c)| {
+            let chars: Vec<char> = examples()[which].chars().collect();
+            let at = at % (chars.len() + 1);
+            let end = (at + len % 16).min(chars.len());
+            let mut out: String = chars[..at].iter().collect();
+            out.push(c);
+            out.extend(&chars[end..]);
+            out
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 1500, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_bytes(bytes in prop::collection::vec(any::<u8>(), 0..400)) {
+        check_never_panics(&String::from_utf8_lossy(&bytes));
+    }
+
+    #[test]
+    fn token_soups(text in token_soup()) {
+        check_never_panics(&text);
+    }
+
+    #[test]
+    fn line_mutations_of_the_examples(text in mutated_example()) {
+        check_never_panics(&text);
+    }
+
+    #[test]
+    fn character_damage_in_the_examples(text in damaged_example()) {
+        check_never_panics(&text);
+    }
+}
+
+#[test]
+#[ignore = "long-running: many more random cases"]
+fn long_running_fuzz() {
+    let cases: u32 = std::env::var("SEMO_FUZZ_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(100_000);
+    let mut runner = proptest::test_runner::TestRunner::new(ProptestConfig {
+        cases,
+        ..ProptestConfig::default()
+    });
+    let strategy = prop_oneof![
+        prop::collection::vec(any::<u8>(), 0..2000)
+            .prop_map(|b| String::from_utf8_lossy(&b).into_owned()),
+        token_soup(),
+        mutated_example(),
+        damaged_example(),
+    ];
+    runner
+        .run(&strategy, |text| {
+            check_never_panics(&text);
+            Ok(())
+        })
+        .unwrap();
+}
+
+#[test]
+fn deeply_nested_input_does_not_overflow_the_stack() {
+    let mut text = String::from("{ T: iRobotCreate a }\nT.Action.Go {\n");
+    for _ in 0..2000 {
+        text.push_str("if (LOCATION == \"0,0\") {\n");
+    }
+    check_never_panics(&text);
+    let parens = format!(
+        "T.Action.Go {{ if ({}x{}) stop() }}",
+        "(".repeat(5000),
+        ")".repeat(5000)
+    );
+    check_never_panics(&parens);
+}
+
+#[test]
+fn function_call_chains_are_neither_exponential_nor_unbounded() {
+    // f0 calls f1 twice, f1 calls f2 twice, ...: 2^200 inlinings if done naively.
+    let mut text = String::from(
+        "{ T: iRobotCreate a }\nT.Action.Go { f0() } repeat()\nT.GO { set(Action, Go) }\nT.main { default: mode = GO }\n",
+    );
+    for i in 0..200 {
+        text.push_str(&format!(
+            "def f{i} {{ f{}() f{}() stop() }}\n",
+            i + 1,
+            i + 1
+        ));
+    }
+    text.push_str("def f200 { stop() }\n");
+    let analysis = semo::check_source(FileId(0), &text, catalog());
+    assert!(
+        analysis
+            .diagnostics
+            .iter()
+            .any(|d| d.code == semo::diag::Code::RecursiveFunction),
+        "a 200-deep chain is reported"
+    );
+}

@@ -1,0 +1,106 @@
+//! Helpers shared by the end-to-end tests: running the real `semo` binary.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The repository root (the parent of `compiler/`).
+pub fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("compiler/ has a parent")
+        .to_path_buf()
+}
+
+/// `../shared` beside the checkout: the reference examples.
+pub fn shared() -> PathBuf {
+    repo_root().join("../shared")
+}
+
+pub struct Output {
+    pub code: i32,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+/// Runs `semo ARGS` in `dir`.
+pub fn semo_in(dir: &Path, args: &[&str]) -> Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_semo"))
+        .args(args)
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("the semo binary runs");
+    Output {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+pub fn semo(args: &[&str]) -> Output {
+    semo_in(&repo_root(), args)
+}
+
+/// One diagnostic of `semo check --format json`.
+#[derive(Debug, Clone)]
+pub struct Diag {
+    pub code: String,
+    pub severity: String,
+    pub file: String,
+    pub start: (u64, u64),
+    pub end: (u64, u64),
+    pub message: String,
+    pub suggestion: Option<String>,
+}
+
+pub fn parse_json_lines(stdout: &str) -> Vec<Diag> {
+    stdout
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|line| {
+            let v: serde_json::Value = serde_json::from_str(line).expect("each line is JSON");
+            let pos = |key: &str| {
+                (
+                    v[key]["line"].as_u64().expect("line"),
+                    v[key]["column"].as_u64().expect("column"),
+                )
+            };
+            Diag {
+                code: v["code"].as_str().expect("code").to_string(),
+                severity: v["severity"].as_str().expect("severity").to_string(),
+                file: v["file"].as_str().expect("file").to_string(),
+                start: pos("start"),
+                end: pos("end"),
+                message: v["message"].as_str().expect("message").to_string(),
+                suggestion: v["suggestion"].as_str().map(str::to_string),
+            }
+        })
+        .collect()
+}
+
+/// `semo check --format json ARGS` in `dir`, parsed.
+pub fn check_json_in(dir: &Path, paths: &[&str]) -> (i32, Vec<Diag>) {
+    let mut args = vec!["check", "--format", "json"];
+    args.extend_from_slice(paths);
+    let out = semo_in(dir, &args);
+    assert!(
+        out.code == 0 || out.code == 1,
+        "exit {}: {}",
+        out.code,
+        out.stderr
+    );
+    (out.code, parse_json_lines(&out.stdout))
+}
+
+/// A compact, readable listing for snapshots: `file:line:col-line:col CODE severity: message`.
+pub fn listing(diags: &[Diag]) -> String {
+    let mut s = String::new();
+    for d in diags {
+        s.push_str(&format!(
+            "{}:{}:{}-{}:{} {} {}: {}\n",
+            d.file, d.start.0, d.start.1, d.end.0, d.end.1, d.code, d.severity, d.message
+        ));
+    }
+    s
+}
