@@ -9,10 +9,14 @@ use crate::catalog::{RobotTypeId, ServiceDef, ValueType};
 use crate::diag::Code;
 use crate::span::Span;
 use crate::syntax::ast::{self, Arg, ArmKind, CondKind, Expr, ExprKind, StmtKind};
+use std::rc::Rc;
 
 /// Deeper chains of function calls are refused: they are surely a mistake, and
 /// the checker's recursion must stay bounded.
 const MAX_INLINING_DEPTH: usize = 64;
+
+/// Robot types, each with the names of the robots of that type.
+pub(super) type TypeList = Rc<[(RobotTypeId, Vec<String>)]>;
 
 /// Who runs the statements being checked.
 #[derive(Clone, Debug)]
@@ -22,6 +26,9 @@ pub(super) struct Scope {
     service: Option<Index>,
     /// Indices into the team's robots that run the statement.
     robots: Vec<Index>,
+    /// The known robot types among `robots`, with those robots' names: computed
+    /// once per scope, read by every call and value in it.
+    types: TypeList,
     /// Functions being inlined, innermost last, to catch recursion.
     inlining: Vec<FunctionId>,
 }
@@ -58,13 +65,23 @@ enum Resolution {
     },
     TooLong,
     /// A single name that is neither: a symbolic constant where one is allowed.
-    /// `known`: the values and variables it may be a typo of.
+    /// `known`: where to look for the value or variable it may be a typo of
+    /// (gathered only if it is reported: most bare names are fine constants).
     Bare {
         name: String,
-        known: Vec<String>,
+        known: Candidates,
     },
     /// Nothing can be said (no robot runs the statement).
     Unchecked,
+}
+
+/// Where did-you-mean candidates for a bare name come from.
+#[derive(Clone, Debug)]
+enum Candidates {
+    /// Every value of the catalog and every team variable.
+    Everywhere,
+    /// The values of these robot types and the variables of the team.
+    Team(TeamId, TypeList),
 }
 
 /// The type of an expression, as far as the checker can tell.
@@ -120,6 +137,13 @@ impl Type {
 
 impl<'a> Checker<'a> {
     pub(super) fn check_bodies(&mut self) {
+        self.team_types = (0..self.mission.teams.len())
+            .map(|t| {
+                let team = TeamId(t as u32);
+                let all: Vec<Index> = (0..self.team(team).robots.len() as Index).collect();
+                self.types_of(team, &all)
+            })
+            .collect();
         for t in 0..self.mission.teams.len() {
             let team = TeamId(t as u32);
             let all: Vec<Index> = (0..self.team(team).robots.len() as Index).collect();
@@ -129,6 +153,7 @@ impl<'a> Checker<'a> {
                     team: Some(team),
                     service: Some(s as Index),
                     robots: all.clone(),
+                    types: self.team_types[t].clone(),
                     inlining: Vec::new(),
                 };
                 self.block(&syntax.body, &scope);
@@ -149,6 +174,7 @@ impl<'a> Checker<'a> {
                     team: None,
                     service: None,
                     robots: Vec::new(),
+                    types: Rc::new([]),
                     inlining: vec![FunctionId(f as u32)],
                 };
                 self.block(&self.function_syntax[f].body, &scope);
@@ -279,8 +305,21 @@ impl<'a> Checker<'a> {
         self.builtin_call(call, scope);
     }
 
+    /// The same scope, run by fewer robots (inside a group).
+    fn narrowed(&self, scope: &Scope, robots: Vec<Index>) -> Scope {
+        let types = match scope.team {
+            Some(team) => self.types_of(team, &robots),
+            None => Rc::new([]),
+        };
+        Scope {
+            robots,
+            types,
+            ..scope.clone()
+        }
+    }
+
     /// The known robot types among `robots` of `team`, each with its robots' names.
-    fn types_of(&self, team: TeamId, robots: &[Index]) -> Vec<(RobotTypeId, Vec<String>)> {
+    fn types_of(&self, team: TeamId, robots: &[Index]) -> TypeList {
         let mut types: Vec<(RobotTypeId, Vec<String>)> = Vec::new();
         let t = self.team(team);
         for &r in robots {
@@ -291,7 +330,7 @@ impl<'a> Checker<'a> {
                 None => types.push((ty, vec![robot.name.clone()])),
             }
         }
-        types
+        types.into()
     }
 
     fn describe_types(&self, types: &[(RobotTypeId, Vec<String>)]) -> String {
@@ -306,10 +345,7 @@ impl<'a> Checker<'a> {
         let name = &call.name.name;
         let catalog = self.catalog;
         let anywhere = catalog.types().find_map(|(_, r)| r.service(name));
-        let types = scope
-            .team
-            .map(|team| self.types_of(team, &scope.robots))
-            .unwrap_or_default();
+        let types = scope.types.clone();
         let providers: Vec<&ServiceDef> = types
             .iter()
             .filter_map(|(ty, _)| catalog.get(*ty).service(name))
@@ -520,12 +556,13 @@ impl<'a> Checker<'a> {
         }
     }
 
-    /// The robots whose values `T.X` (or bare `X`) reads.
-    fn robots_for(&self, team: TeamId, scope: &Scope) -> Vec<Index> {
+    /// The robot types whose values `T.X` (or bare `X`) reads: those running
+    /// the statement for its own team, all of the team's otherwise.
+    fn types_for(&self, team: TeamId, scope: &Scope) -> TypeList {
         if scope.team == Some(team) {
-            scope.robots.clone()
+            scope.types.clone()
         } else {
-            (0..self.team(team).robots.len() as Index).collect()
+            self.team_types[team.0 as usize].clone()
         }
     }
 
@@ -538,18 +575,13 @@ impl<'a> Checker<'a> {
                         .catalog
                         .types()
                         .any(|(_, r)| r.value(&name.name).is_some());
-                    let is_variable = self.variables.iter().any(|(_, v)| v == &name.name);
+                    let is_variable = self.variables.contains_key(&name.name);
                     if is_value || is_variable {
                         Resolution::Unchecked
                     } else {
-                        let values = self.catalog.types().flat_map(|(_, r)| &r.values);
-                        let known = values
-                            .map(|v| v.name.clone())
-                            .chain(self.variables.iter().map(|(_, v)| v.clone()))
-                            .collect();
                         Resolution::Bare {
                             name: name.name.clone(),
-                            known,
+                            known: Candidates::Everywhere,
                         }
                     }
                 }
@@ -583,8 +615,7 @@ impl<'a> Checker<'a> {
     }
 
     fn resolve_in_team(&self, team: TeamId, name: &str, scope: &Scope, bare: bool) -> Resolution {
-        let robots = self.robots_for(team, scope);
-        let types = self.types_of(team, &robots);
+        let types = self.types_for(team, scope);
         let catalog = self.catalog;
         let defs: Vec<_> = types
             .iter()
@@ -614,9 +645,7 @@ impl<'a> Checker<'a> {
                 ty: def.ty.clone(),
             };
         }
-        if self.variables.contains(&(Some(team), name.to_string()))
-            || self.variables.contains(&(None, name.to_string()))
-        {
+        if self.is_variable(team, name) {
             return Resolution::Variable {
                 team: Some(team),
                 name: name.to_string(),
@@ -644,21 +673,32 @@ impl<'a> Checker<'a> {
                 return self.partial_value(team, value, &types, advice, true);
             }
         }
-        let mut known: Vec<String> = types
-            .iter()
-            .flat_map(|(ty, _)| catalog.get(*ty).values.iter().map(|v| v.name.clone()))
-            .collect();
-        known.extend(self.team(team).variables.iter().cloned());
         if bare {
             return Resolution::Bare {
                 name: name.to_string(),
-                known,
+                known: Candidates::Team(team, types),
             };
         }
         Resolution::NotInTeam {
             team: self.team(team).name.clone(),
             name: name.to_string(),
-            known,
+            known: self.candidate_names(&Candidates::Team(team, types)),
+        }
+    }
+
+    fn candidate_names(&self, candidates: &Candidates) -> Vec<String> {
+        let catalog = self.catalog;
+        match candidates {
+            Candidates::Everywhere => catalog
+                .types()
+                .flat_map(|(_, r)| r.values.iter().map(|v| v.name.clone()))
+                .chain(self.variables.keys().cloned())
+                .collect(),
+            Candidates::Team(team, types) => types
+                .iter()
+                .flat_map(|(ty, _)| catalog.get(*ty).values.iter().map(|v| v.name.clone()))
+                .chain(self.team(*team).variables.iter().cloned())
+                .collect(),
         }
     }
 
@@ -779,6 +819,7 @@ impl<'a> Checker<'a> {
                 Type::Constant(name)
             }
             Resolution::Bare { name, known } => {
+                let known = self.candidate_names(&known);
                 let guess = suggestion(&name, known.iter().map(String::as_str));
                 self.report(
                     Code::UnknownAttribute,
@@ -902,14 +943,12 @@ impl<'a> Checker<'a> {
                     .collect(),
                 ArmKind::Leader => members.clone(),
             };
-            let inner = Scope {
-                robots: if runners.is_empty() {
-                    members.clone()
-                } else {
-                    runners
-                },
-                ..scope.clone()
+            let runners = if runners.is_empty() {
+                members.clone()
+            } else {
+                runners
             };
+            let inner = self.narrowed(scope, runners);
             self.block(&arm.body, &inner);
             // A leader is one robot among the members: the others may still run
             // `others`, unless the leader is the only candidate.
@@ -931,10 +970,7 @@ impl<'a> Checker<'a> {
                     "every robot already belongs to a group above: no robot runs `others`",
                 );
             }
-            let inner = Scope {
-                robots: rest,
-                ..scope.clone()
-            };
+            let inner = self.narrowed(scope, rest);
             self.block(&others.body, &inner);
         }
     }

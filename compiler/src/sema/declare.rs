@@ -19,10 +19,10 @@ impl<'a> Checker<'a> {
                 }
             }
         }
-        for item in &source.items {
+        for (index, item) in source.items.iter().enumerate() {
             match item {
-                Item::Function(f) => self.declare_function(f),
-                Item::Service(s) => self.declare_service(s),
+                Item::Function(f) => self.declare_function(f, index),
+                Item::Service(s) => self.declare_service(s, index),
                 _ => {}
             }
         }
@@ -168,7 +168,7 @@ impl<'a> Checker<'a> {
         None
     }
 
-    fn declare_function(&mut self, f: &'a ast::Function) {
+    fn declare_function(&mut self, f: &'a ast::Function, item: usize) {
         if let Some(&existing) = self.functions_by_name.get(&f.name.name) {
             let first = self.mission.functions[existing.0 as usize].name_span;
             self.report(
@@ -186,12 +186,12 @@ impl<'a> Checker<'a> {
         self.mission.functions.push(FunctionInfo {
             name: f.name.name.clone(),
             name_span: f.name.span,
-            body: f.body.clone(),
+            item,
             called: false,
         });
     }
 
-    fn declare_service(&mut self, s: &'a ast::CompositeService) {
+    fn declare_service(&mut self, s: &'a ast::CompositeService, item: usize) {
         let Some(team) = self.header_team(&s.team, "a composite service") else {
             return;
         };
@@ -231,8 +231,7 @@ impl<'a> Checker<'a> {
             name_span: s.name.span,
             plan,
             span: s.span,
-            body: s.body.clone(),
-            repeat: s.repeat.clone(),
+            item,
             throws: Vec::new(),
         });
         let service = t.services.len() as Index - 1;
@@ -293,12 +292,12 @@ impl<'a> Checker<'a> {
                     }
                 });
             };
-        for (i, team) in self.mission.teams.iter().enumerate() {
-            for service in &team.services {
+        for (i, services) in self.service_syntax.iter().enumerate() {
+            for service in services {
                 visit(Some(TeamId(i as u32)), &service.body, &self.teams_by_name);
             }
         }
-        for function in &self.mission.functions {
+        for function in &self.function_syntax {
             visit(None, &function.body, &self.teams_by_name);
         }
         for (team, name) in found {
@@ -308,7 +307,10 @@ impl<'a> Checker<'a> {
                     vars.push(name.clone());
                 }
             }
-            self.variables.insert((team, name));
+            let teams = self.variables.entry(name).or_default();
+            if !teams.contains(&team) {
+                teams.push(team);
+            }
         }
     }
 }

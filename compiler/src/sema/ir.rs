@@ -67,8 +67,9 @@ pub struct Service {
     pub name_span: Span,
     pub plan: Index,
     pub span: Span,
-    pub body: ast::Block,
-    pub repeat: Option<ast::Repeat>,
+    /// Index of the service's item in the file's syntax tree: its body and
+    /// `repeat` are read from there ([`crate::Analysis::service_syntax`]).
+    pub item: usize,
     /// Events this service can throw, directly or through functions it calls.
     pub throws: Vec<String>,
 }
@@ -118,7 +119,8 @@ pub struct Event {
 pub struct FunctionInfo {
     pub name: String,
     pub name_span: Span,
-    pub body: ast::Block,
+    /// Index of the function's item in the file's syntax tree.
+    pub item: usize,
     pub called: bool,
 }
 

@@ -39,6 +39,22 @@ impl Analysis {
     pub fn has_errors(&self) -> bool {
         self.diagnostics.iter().any(Diagnostic::is_error)
     }
+
+    /// The syntax (body, `repeat`) of a composite service of the IR.
+    pub fn service_syntax(&self, service: &Service) -> Option<&ast::CompositeService> {
+        match self.syntax.items.get(service.item) {
+            Some(ast::Item::Service(s)) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// The syntax (body) of a function of the IR.
+    pub fn function_syntax(&self, function: &FunctionInfo) -> Option<&ast::Function> {
+        match self.syntax.items.get(function.item) {
+            Some(ast::Item::Function(f)) => Some(f),
+            _ => None,
+        }
+    }
 }
 
 /// Parses and checks one mission script.
@@ -87,9 +103,9 @@ pub(crate) struct Checker<'a> {
     diagnostics: Vec<Diagnostic>,
     teams_by_name: HashMap<String, TeamId>,
     functions_by_name: HashMap<String, FunctionId>,
-    /// Team variables declared anywhere by `T.X = ...` or received: (team or
-    /// `None` when written bare inside a function, name).
-    variables: HashSet<(Option<TeamId>, String)>,
+    /// Team variables declared anywhere by `T.X = ...` or received, by name:
+    /// the teams declaring them (`None` when written bare inside a function).
+    variables: HashMap<String, Vec<Option<TeamId>>>,
     /// Services named by the `set`s of a mode defined twice (already reported):
     /// they are not "never set".
     set_by_duplicate_modes: HashSet<(TeamId, Index)>,
@@ -102,6 +118,8 @@ pub(crate) struct Checker<'a> {
     /// Function bodies already checked for a (function, team, service, robots):
     /// checking again would find the same, and nested calls would be exponential.
     inlined: HashSet<InlinedBody>,
+    /// Each team's robot types (all its robots), for values read across teams.
+    team_types: Vec<body::TypeList>,
 }
 
 impl<'a> Checker<'a> {
@@ -118,11 +136,12 @@ impl<'a> Checker<'a> {
             diagnostics: Vec::new(),
             teams_by_name: HashMap::new(),
             functions_by_name: HashMap::new(),
-            variables: HashSet::new(),
+            variables: HashMap::new(),
             set_by_duplicate_modes: HashSet::new(),
             mains_with_unknown_modes: HashSet::new(),
             comms_with_unknown_team: Vec::new(),
             inlined: HashSet::new(),
+            team_types: Vec::new(),
         }
     }
 
@@ -154,16 +173,47 @@ impl<'a> Checker<'a> {
         &mut self.mission.teams[id.0 as usize]
     }
 
+    /// Whether `name` is a team variable of `team` (or written bare in a function).
+    fn is_variable(&self, team: TeamId, name: &str) -> bool {
+        self.variables
+            .get(name)
+            .is_some_and(|teams| teams.iter().any(|t| t.is_none_or(|t| t == team)))
+    }
+
     fn team_names(&self) -> Vec<String> {
         self.mission.teams.iter().map(|t| t.name.clone()).collect()
     }
 
     fn finish(mut self) -> (Mission, Vec<Diagnostic>) {
-        let occurrences = &mut self.mission.occurrences;
-        occurrences.sort_by_key(|o| (o.span, o.is_definition));
-        occurrences.dedup();
+        self.mission.occurrences =
+            sorted_occurrences(std::mem::take(&mut self.mission.occurrences));
         (self.mission, self.diagnostics)
     }
+}
+
+/// Occurrences sorted by position, without the repeats that checking a
+/// function body at several call sites leaves. Occurrences are large, so
+/// compact keys are sorted and the occurrences moved once.
+fn sorted_occurrences(occurrences: Vec<Occurrence>) -> Vec<Occurrence> {
+    let key = |o: &Occurrence| {
+        ((o.span.start as u64) << 33) | ((o.span.end as u64) << 1) | u64::from(o.is_definition)
+    };
+    let mut order: Vec<(u64, u32)> = occurrences
+        .iter()
+        .enumerate()
+        .map(|(i, o)| (key(o), i as u32))
+        .collect();
+    order.sort_unstable();
+    let mut slots: Vec<Option<Occurrence>> = occurrences.into_iter().map(Some).collect();
+    let mut sorted: Vec<Occurrence> = Vec::with_capacity(slots.len());
+    for (_, i) in order {
+        if let Some(o) = slots[i as usize].take() {
+            if sorted.last() != Some(&o) {
+                sorted.push(o);
+            }
+        }
+    }
+    sorted
 }
 
 /// Resolves `name` in `candidates`, or reports `code` with a did-you-mean.

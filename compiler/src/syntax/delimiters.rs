@@ -13,6 +13,7 @@ use super::token::{Kw, Token};
 use crate::diag::{Code, Diagnostic, FileId};
 use crate::span::Span;
 use chumsky::span::SimpleSpan;
+use std::borrow::Cow;
 
 type Tok<'s> = (Token<'s>, SimpleSpan);
 
@@ -50,17 +51,56 @@ struct Open<'s> {
     else_ifs: usize,
 }
 
+/// Whether the chunk needs no repair: brackets balanced, nesting within bounds.
+/// Most chunks are like this; checking needs no allocation.
+fn already_balanced(chunk: &[Tok<'_>]) -> bool {
+    let mut closers = [Token::RBrace; MAX_DEPTH];
+    let mut else_ifs = [0usize; MAX_DEPTH];
+    let (mut open, mut depth) = (0, 0);
+    for (i, &(token, _)) in chunk.iter().enumerate() {
+        if let Some(closer) = closer_of(token) {
+            if depth >= MAX_DEPTH {
+                return false;
+            }
+            closers[open] = closer;
+            else_ifs[open] = 0;
+            open += 1;
+            depth += 1;
+        } else if is_closer(token) {
+            if open == 0 || closers[open - 1] != token {
+                return false;
+            }
+            open -= 1;
+            depth -= 1 + else_ifs[open];
+        } else if token == Token::Kw(Kw::Else)
+            && chunk.get(i + 1).map(|t| t.0) == Some(Token::Kw(Kw::If))
+        {
+            if depth >= MAX_DEPTH {
+                return false;
+            }
+            depth += 1;
+            if open > 0 {
+                else_ifs[open - 1] += 1;
+            }
+        }
+    }
+    open == 0
+}
+
 /// Returns the chunk with balanced brackets, reporting every repair.
 ///
 /// An unclosed `(` or `[` is closed at the end of its own line (conditions and
 /// argument lists are written on one line: `move("1,1"` then `stop()` below is
 /// one mistake, not two); an unclosed `{` or `[[` where its parent closes.
-pub fn balance<'s>(
+pub fn balance<'c, 's>(
     text: &str,
-    chunk: &[Tok<'s>],
+    chunk: &'c [Tok<'s>],
     file: FileId,
     diagnostics: &mut Vec<Diagnostic>,
-) -> Vec<Tok<'s>> {
+) -> Cow<'c, [Tok<'s>]> {
+    if already_balanced(chunk) {
+        return Cow::Borrowed(chunk);
+    }
     let n = chunk.len();
     let mut report = |span: SimpleSpan, message: String| {
         diagnostics.push(Diagnostic::new(
@@ -182,7 +222,7 @@ pub fn balance<'s>(
             out.push(chunk[i]);
         }
     }
-    out
+    Cow::Owned(out)
 }
 
 #[cfg(test)]
@@ -192,7 +232,8 @@ mod tests {
 
     fn balanced(text: &str) -> (String, Vec<String>) {
         let mut diags = Vec::new();
-        let toks = balance(text, &lex(text), FileId(0), &mut diags);
+        let tokens = lex(text);
+        let toks = balance(text, &tokens, FileId(0), &mut diags);
         let s: Vec<String> = toks.iter().map(|t| t.0.to_string()).collect();
         (s.join(" "), diags.into_iter().map(|d| d.message).collect())
     }
@@ -228,6 +269,17 @@ mod tests {
                 "this `{` is never closed"
             ]
         );
+    }
+
+    #[test]
+    fn balanced_chunks_are_borrowed_unchanged() {
+        let tokens = lex("T.A.S { if (a) { b() } else if (c) d() } repeat(1 SEC)");
+        let mut diags = Vec::new();
+        assert!(matches!(
+            balance("", &tokens, FileId(0), &mut diags),
+            Cow::Borrowed(_)
+        ));
+        assert!(diags.is_empty());
     }
 
     #[test]

@@ -21,13 +21,82 @@ pub struct Parse {
     pub diagnostics: Vec<Diagnostic>,
 }
 
-/// Parses a mission script.
-pub fn parse(file: FileId, text: &str) -> Parse {
-    let mut diagnostics = Vec::new();
-    let mut tokens = token::lex(text);
+/// Files at least this large are lexed and parsed on two threads.
+const PARALLEL_MIN_BYTES: usize = 64 * 1024;
 
-    // Lexical problems are reported here, and the tokens repaired so the parser
-    // sees the rest of the statement.
+fn parallel(text: &str) -> bool {
+    text.len() >= PARALLEL_MIN_BYTES
+        && std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
+}
+
+/// Runs `a` here and `b` on another thread; a panic in `b` is passed on.
+fn join<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B + Send) -> (A, B) {
+    std::thread::scope(|scope| {
+        let other = scope.spawn(b);
+        let a = a();
+        match other.join() {
+            Ok(b) => (a, b),
+            Err(panic) => std::panic::resume_unwind(panic),
+        }
+    })
+}
+
+/// Parses a mission script. Large files use two threads: no token spans a
+/// newline, so the two halves of the text lex independently, and chunks parse
+/// independently; the result is the same as on one thread.
+pub fn parse(file: FileId, text: &str) -> Parse {
+    parse_with(file, text, parallel(text))
+}
+
+fn parse_with(file: FileId, text: &str, two_threads: bool) -> Parse {
+    let mut diagnostics = Vec::new();
+    let mut tokens = lex(text, two_threads);
+    report_lexical_errors(file, &mut tokens, &mut diagnostics);
+    let ranges = chunks::split(&tokens);
+    let half = tokens.len() / 2;
+    let cut = ranges.partition_point(|r| r.start < half);
+    let (items, chunk_diagnostics) = if two_threads && cut > 0 && cut < ranges.len() {
+        let (first, second) = ranges.split_at(cut);
+        let ((mut items, mut diags), (more_items, more_diags)) = join(
+            || parse_chunks(file, text, &tokens, first),
+            || parse_chunks(file, text, &tokens, second),
+        );
+        items.extend(more_items);
+        diags.extend(more_diags);
+        (items, diags)
+    } else {
+        parse_chunks(file, text, &tokens, &ranges)
+    };
+    diagnostics.extend(chunk_diagnostics);
+    diagnostics.sort_by_key(|d| (d.span.start, d.span.end));
+    Parse {
+        file: ast::SourceFile { items },
+        diagnostics,
+    }
+}
+
+/// Lexes `text`, in two halves cut at a newline when it is large.
+fn lex(text: &str, two_threads: bool) -> Vec<token::Spanned<'_>> {
+    let middle = text.len() / 2;
+    let cut = match text.as_bytes()[middle..].iter().position(|&b| b == b'\n') {
+        Some(i) if two_threads => middle + i + 1,
+        _ => return token::lex(text),
+    };
+    let (mut tokens, rest) = join(|| token::lex(&text[..cut]), || token::lex(&text[cut..]));
+    tokens.extend(
+        rest.into_iter()
+            .map(|(t, s)| (t, SimpleSpan::from(s.start + cut..s.end + cut))),
+    );
+    tokens
+}
+
+/// Reports characters the language does not use and unterminated strings, and
+/// repairs the tokens so that the parser sees the rest of the statement.
+fn report_lexical_errors(
+    file: FileId,
+    tokens: &mut Vec<token::Spanned<'_>>,
+    diagnostics: &mut Vec<Diagnostic>,
+) {
     tokens.retain_mut(|(tok, span)| match *tok {
         Token::Error(c) => {
             diagnostics.push(Diagnostic::new(
@@ -53,10 +122,19 @@ pub fn parse(file: FileId, text: &str) -> Parse {
         }
         _ => true,
     });
+}
 
-    let chunks: Vec<_> = chunks::split(&tokens)
-        .into_iter()
-        .map(|range| delimiters::balance(text, &tokens[range], file, &mut diagnostics))
+/// Balances and parses the chunks `ranges` of `tokens`.
+fn parse_chunks(
+    file: FileId,
+    text: &str,
+    tokens: &[token::Spanned<'_>],
+    ranges: &[std::ops::Range<usize>],
+) -> (Vec<ast::Item>, Vec<Diagnostic>) {
+    let mut diagnostics = Vec::new();
+    let chunks: Vec<_> = ranges
+        .iter()
+        .map(|range| delimiters::balance(text, &tokens[range.clone()], file, &mut diagnostics))
         .collect();
     let fast = parser::items::<_, chumsky::error::EmptyErr>();
     let rich = parser::items::<_, parser::RichError<'_, '_>>();
@@ -67,7 +145,7 @@ pub fn parse(file: FileId, text: &str) -> Parse {
         };
         let chunk_span = Span::new(first.1.start, last.1.end);
         let eoi = SimpleSpan::from(last.1.end..last.1.end);
-        let input = || -> parser::TokenInput<'_, '_> { chunk.as_slice().map(eoi, |(t, s)| (t, s)) };
+        let input = || -> parser::TokenInput<'_, '_> { chunk.as_ref().map(eoi, |(t, s)| (t, s)) };
         if let (Some(parsed), errors) = fast.parse(input()).into_output_errors()
             && errors.is_empty()
         {
@@ -93,10 +171,7 @@ pub fn parse(file: FileId, text: &str) -> Parse {
             }
         }
     }
-    Parse {
-        file: ast::SourceFile { items },
-        diagnostics,
-    }
+    (items, diagnostics)
 }
 
 fn describe_found(found: Option<&Token<'_>>) -> String {
@@ -171,4 +246,20 @@ fn syntax_diagnostic(file: FileId, error: &Rich<'_, Token<'_>>) -> Diagnostic {
         RichReason::Custom(msg) => msg.to_string(),
     };
     Diagnostic::new(Code::SyntaxError, file, span, message)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn two_threads_give_the_same_result_as_one() {
+        let unit = "T.Action.Go { move(\"1,1\" \n stop() @ } repeat(2 SEC)\n# 한국어 😀\nT.M { set(Action Go) }\n";
+        let text = unit.repeat(PARALLEL_MIN_BYTES / unit.len() + 10);
+        let one = parse_with(FileId(0), &text, false);
+        let two = parse_with(FileId(0), &text, true);
+        assert!(two.diagnostics.len() > 100);
+        assert_eq!(one.file, two.file);
+        assert_eq!(one.diagnostics, two.diagnostics);
+    }
 }
