@@ -209,3 +209,58 @@ fn tempdir() -> std::path::PathBuf {
     std::fs::create_dir_all(&dir).unwrap();
     dir
 }
+
+#[test]
+fn three_unrelated_syntax_errors_are_each_reported_and_the_rest_is_checked() {
+    let dir = support::repo_root().join("tests/fixtures/recovery");
+    let (code, diags) = check_json_in(&dir, &["three_syntax_errors.mission"]);
+    assert_eq!(code, 1);
+    let syntax: Vec<_> = diags
+        .iter()
+        .filter(|d| ["E001", "E002", "E003"].contains(&d.code.as_str()))
+        .map(|d| (d.start.0, d.message.as_str()))
+        .collect();
+    assert_eq!(
+        syntax,
+        vec![
+            (5, "this `(` is never closed"),
+            (13, "expected `,`, found `Go`"),
+            (18, "expected `:`, found `mode`"),
+        ]
+    );
+    // The valid parts around them are still checked.
+    let codes: Vec<&str> = diags.iter().map(|d| d.code.as_str()).collect();
+    assert!(
+        codes.contains(&"E021"),
+        "unknown team in receive: {codes:?}"
+    );
+    assert!(
+        codes.contains(&"E019"),
+        "spin on an iRobotCreate: {codes:?}"
+    );
+}
+
+#[test]
+fn rejected_definitions_are_still_checked() {
+    let dir = tempdir();
+    std::fs::write(
+        dir.join("dup.mission"),
+        "{ T: iRobotCreate a }\nT.Action.Go { move(\"1,1\") } repeat()\nT.Action.Go { mvoe(\"1,1\") }\n\
+         U.Action.X { stopp() }\nT.GO { set(Action, Go) }\nT.main { default: mode = GO }\n",
+    )
+    .unwrap();
+    let (_, diags) = check_json_in(&dir, &["dup.mission"]);
+    let found: Vec<(&str, u64, Option<&str>)> = diags
+        .iter()
+        .map(|d| (d.code.as_str(), d.start.0, d.suggestion.as_deref()))
+        .collect();
+    assert_eq!(
+        found,
+        vec![
+            ("E013", 3, None),
+            ("E024", 3, Some("move")),
+            ("E015", 4, None),
+            ("E024", 4, Some("stop")),
+        ]
+    );
+}

@@ -1,37 +1,52 @@
 //! Did-you-mean: the closest known name by edit distance.
 
-/// Levenshtein distance over characters, ASCII case differences costing nothing
-/// extra beyond one edit (so `move` vs `Move` is 1).
+/// Edit distance counting insertions, deletions, substitutions and swaps of
+/// two neighbouring characters (optimal string alignment): `mvoe` is one edit
+/// from `move`, as a typist would see it.
 pub fn edit_distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
     let b: Vec<char> = b.chars().collect();
+    // Three rows: two back (for swaps), previous, current.
+    let mut before: Vec<usize> = vec![0; b.len() + 1];
     let mut prev: Vec<usize> = (0..=b.len()).collect();
     let mut cur = vec![0; b.len() + 1];
-    for (i, ca) in a.chars().enumerate() {
+    for i in 0..a.len() {
         cur[0] = i + 1;
-        for (j, &cb) in b.iter().enumerate() {
-            let cost = usize::from(ca != cb);
-            cur[j + 1] = (prev[j] + cost).min(prev[j + 1] + 1).min(cur[j] + 1);
+        for j in 0..b.len() {
+            let cost = usize::from(a[i] != b[j]);
+            let mut d = (prev[j] + cost).min(prev[j + 1] + 1).min(cur[j] + 1);
+            if i > 0 && j > 0 && a[i] == b[j - 1] && a[i - 1] == b[j] {
+                d = d.min(before[j - 1] + 1);
+            }
+            cur[j + 1] = d;
         }
+        std::mem::swap(&mut before, &mut prev);
         std::mem::swap(&mut prev, &mut cur);
     }
     prev[b.len()]
 }
 
 /// The candidate closest to `name`, if it is close enough to be a likely typo:
-/// a case-insensitive match, or at most a third of the name's length in edits.
+/// a case-insensitive match, a prefix of at least three characters (`RETURN` for
+/// `RETURN_MODE`), or at most a third of the name's length in edits. Names of
+/// one or two characters only match up to case.
 pub fn did_you_mean<'a, I>(name: &str, candidates: I) -> Option<String>
 where
     I: IntoIterator<Item = &'a str>,
 {
-    let limit = (name.chars().count() / 3).max(1);
+    let length = name.chars().count();
+    let limit = if length < 3 { 0 } else { (length / 3).max(1) };
     let lower = name.to_lowercase();
     let mut best: Option<(usize, &str)> = None;
     for cand in candidates {
         if cand == name {
             continue;
         }
-        let d = if cand.to_lowercase() == lower {
+        let cand_lower = cand.to_lowercase();
+        let d = if cand_lower == lower {
             0
+        } else if length >= 3 && cand_lower.starts_with(&lower) {
+            1
         } else {
             edit_distance(name, cand)
         };
@@ -48,7 +63,8 @@ mod tests {
 
     #[test]
     fn distances() {
-        assert_eq!(edit_distance("move", "mvoe"), 2);
+        assert_eq!(edit_distance("move", "mvoe"), 1);
+        assert_eq!(edit_distance("abc", "ca"), 3);
         assert_eq!(edit_distance("", "abc"), 3);
         assert_eq!(edit_distance("kitten", "sitting"), 3);
     }
@@ -65,5 +81,15 @@ mod tests {
             Some("AUTO_MODE")
         );
         assert_eq!(did_you_mean("XYZ", names), None);
+        assert_eq!(
+            did_you_mean("SEARCH", names).as_deref(),
+            Some("SEARCH_MODE")
+        );
+        assert_eq!(
+            did_you_mean("Master", ["MasterTeam", "SlaveTeam"]).as_deref(),
+            Some("MasterTeam")
+        );
+        assert_eq!(did_you_mean("x", ["y", "X"]).as_deref(), Some("X"));
+        assert_eq!(did_you_mean("x", ["y", "ab"]), None);
     }
 }

@@ -114,9 +114,14 @@ fn check(paths: Vec<PathBuf>, format: Format, color: bool, out: &mut impl Write)
         Format::Human => render::human(&run, color, out),
         Format::Json => render::json(&run, out),
     };
-    if let Err(e) = written {
-        eprintln!("error: cannot write the report: {e}");
-        return 2;
+    match written {
+        // The reader went away (`semo check | head`): not a problem to report.
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+        Err(e) => {
+            eprintln!("error: cannot write the report: {e}");
+            return 2;
+        }
+        Ok(()) => {}
     }
     if run.error_count() > 0 { 1 } else { 0 }
 }

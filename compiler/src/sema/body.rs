@@ -167,6 +167,22 @@ impl<'a> Checker<'a> {
                 }
             }
         }
+        // Rejected definitions: checked with their team's robots, but belonging
+        // to no service (they send, receive and run nothing).
+        for (team, body) in std::mem::take(&mut self.rejected_bodies) {
+            let robots: Vec<Index> = match team {
+                Some(t) => (0..self.team(t).robots.len() as Index).collect(),
+                None => Vec::new(),
+            };
+            let scope = Scope {
+                team,
+                service: None,
+                types: team.map_or_else(|| Rc::from([]), |t| self.team_types[t.0 as usize].clone()),
+                robots,
+                inlining: Vec::new(),
+            };
+            self.block(body, &scope);
+        }
         // Functions nobody calls are still checked, as far as possible without robots.
         for f in 0..self.function_syntax.len() {
             if !self.mission.functions[f].called {

@@ -177,6 +177,7 @@ impl<'a> Checker<'a> {
                 format!("the function `{}` is already defined", f.name.name),
             )
             .relate(first, "first defined here");
+            self.rejected_bodies.push((None, &f.body));
             return;
         }
         let id = FunctionId(self.mission.functions.len() as u32);
@@ -193,6 +194,7 @@ impl<'a> Checker<'a> {
 
     fn declare_service(&mut self, s: &'a ast::CompositeService, item: usize) {
         let Some(team) = self.header_team(&s.team, "a composite service") else {
+            self.rejected_bodies.push((None, &s.body));
             return;
         };
         let plan = match self.team(team).plan_by_name(&s.plan.name) {
@@ -222,6 +224,7 @@ impl<'a> Checker<'a> {
                 ),
             )
             .relate(first, "first defined here");
+            self.rejected_bodies.push((Some(team), &s.body));
             return;
         }
         self.service_syntax[team.0 as usize].push(s);

@@ -118,6 +118,9 @@ pub(crate) struct Checker<'a> {
     /// Function bodies already checked for a (function, team, service, robots):
     /// checking again would find the same, and nested calls would be exponential.
     inlined: HashSet<InlinedBody>,
+    /// Bodies of duplicate definitions and of services of undeclared teams:
+    /// not part of the IR, but still checked so that their mistakes show now.
+    rejected_bodies: Vec<(Option<TeamId>, &'a ast::Block)>,
     /// Each team's robot types (all its robots), for values read across teams.
     team_types: Vec<body::TypeList>,
 }
@@ -142,6 +145,7 @@ impl<'a> Checker<'a> {
             comms_with_unknown_team: Vec::new(),
             inlined: HashSet::new(),
             team_types: Vec::new(),
+            rejected_bodies: Vec::new(),
         }
     }
 
