@@ -244,23 +244,11 @@ impl<'a> Checker<'a> {
     }
 
     fn caught(&mut self, team: TeamId, event: &ast::Ident) {
-        self.occurrence(
-            event.span,
-            Symbol::Event {
-                team,
-                name: event.name.clone(),
-            },
-            false,
-        );
-        let events = &mut self.team_mut(team).events;
-        match events.iter_mut().find(|e| e.name == event.name) {
-            Some(e) => e.caught_at.push(event.span),
-            None => events.push(Event {
-                name: event.name.clone(),
-                thrown_at: Vec::new(),
-                caught_at: vec![event.span],
-            }),
-        }
+        self.event_occurrence(team, event);
+        self.team_mut(team)
+            .event_mut(&event.name)
+            .caught_at
+            .push(event.span);
     }
 
     fn uncaught_events(&mut self, team: TeamId) {

@@ -244,23 +244,9 @@ impl<'a> Checker<'a> {
 
     fn throw(&mut self, event: &ast::Ident, scope: &Scope) {
         let Some(team) = scope.team else { return };
-        self.occurrence(
-            event.span,
-            Symbol::Event {
-                team,
-                name: event.name.clone(),
-            },
-            false,
-        );
+        self.event_occurrence(team, event);
         let t = self.team_mut(team);
-        match t.events.iter_mut().find(|e| e.name == event.name) {
-            Some(e) => e.thrown_at.push(event.span),
-            None => t.events.push(Event {
-                name: event.name.clone(),
-                thrown_at: vec![event.span],
-                caught_at: Vec::new(),
-            }),
-        }
+        t.event_mut(&event.name).thrown_at.push(event.span);
         if let Some(service) = scope.service {
             let throws = &mut t.services[service as usize].throws;
             if !throws.contains(&event.name) {

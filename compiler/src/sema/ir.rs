@@ -237,6 +237,21 @@ impl Mission {
 }
 
 impl Team {
+    /// The event named `name`, added (neither thrown nor caught yet) if new.
+    pub fn event_mut(&mut self, name: &str) -> &mut Event {
+        let index = match self.events.iter().position(|e| e.name == name) {
+            Some(i) => i,
+            None => {
+                self.events.push(Event {
+                    name: name.to_string(),
+                    ..Event::default()
+                });
+                self.events.len() - 1
+            }
+        };
+        &mut self.events[index]
+    }
+
     pub fn plan_by_name(&self, name: &str) -> Option<Index> {
         self.plans
             .iter()

@@ -165,6 +165,15 @@ impl<'a> Checker<'a> {
         });
     }
 
+    /// Records that `event`, written here, is an event of `team`.
+    fn event_occurrence(&mut self, team: TeamId, event: &ast::Ident) {
+        let symbol = Symbol::Event {
+            team,
+            name: event.name.clone(),
+        };
+        self.occurrence(event.span, symbol, false);
+    }
+
     fn team_id(&self, name: &str) -> Option<TeamId> {
         self.teams_by_name.get(name).copied()
     }
