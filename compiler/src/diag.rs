@@ -104,6 +104,18 @@ codes! {
     CatalogMissingGraph = "E055", Error, "a `graph=` file that does not exist";
     CatalogBadAttribute = "E056", Error, "an attribute value of the wrong form";
     CatalogUnknownAttribute = "W050", Warning, "an attribute that the catalog format does not have";
+    // Task graphs (*.taskgraph.xml, SDF3 files).
+    GraphXml = "E060", Error, "a task-graph file that is not well-formed XML";
+    GraphUnknownElement = "E061", Error, "an element that the task-graph format does not have";
+    GraphMissingAttribute = "E062", Error, "a required task-graph attribute is missing";
+    GraphDuplicateName = "E063", Error, "a task, port, loop or library named twice";
+    GraphUnknownEndpoint = "E064", Error, "a channel end that names no task or port";
+    GraphBadAttribute = "E065", Error, "a task-graph attribute value of the wrong form";
+    GraphPortDirection = "E066", Error, "a channel from an input port or into an output port";
+    GraphUnknownAttribute = "W060", Warning, "an attribute that the task-graph format does not have";
+    InconsistentRates = "E070", Error, "sample rates that no repetition vector satisfies";
+    Deadlock = "E071", Error, "a cycle without enough initial samples: one iteration cannot complete";
+    RateOverflow = "E072", Error, "rates whose repetition vector does not fit in 64 bits";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

@@ -15,7 +15,10 @@ pub mod sema;
 pub mod span;
 pub mod suggest;
 pub mod syntax;
+pub mod taskgraph;
 pub mod text;
 pub mod workspace;
+/// Byte positions of XML elements and attributes, shared by the XML loaders.
+mod xmlpos;
 
 pub use sema::{Analysis, check_source};

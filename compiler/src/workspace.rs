@@ -14,6 +14,8 @@ use std::path::{Path, PathBuf};
 pub enum FileKind {
     Mission,
     Catalog,
+    /// `*.taskgraph.xml`, or an SDF3 graph named explicitly.
+    TaskGraph,
 }
 
 impl FileKind {
@@ -21,6 +23,8 @@ impl FileKind {
         let name = path.file_name()?.to_str()?;
         if name.ends_with(".robot.xml") {
             Some(FileKind::Catalog)
+        } else if name.ends_with(".taskgraph.xml") {
+            Some(FileKind::TaskGraph)
         } else if name.ends_with(".mission") {
             Some(FileKind::Mission)
         } else {
@@ -183,7 +187,7 @@ pub fn check_paths(paths: &[PathBuf]) -> Result<CheckRun, LoadError> {
 }
 
 /// Checks files already loaded: the catalog files form the catalog, then each
-/// mission is checked against it.
+/// mission is checked against it; task graphs are loaded and analysed.
 pub fn check_files(files: Files) -> CheckRun {
     let sources: Vec<CatalogSource<'_>> = files
         .iter()
@@ -203,11 +207,41 @@ pub fn check_files(files: Files) -> CheckRun {
     for (_, analysis) in &analyses {
         diagnostics.extend(analysis.diagnostics.iter().cloned());
     }
+    for f in files.iter().filter(|f| f.kind == FileKind::TaskGraph) {
+        diagnostics.extend(analyze_graph(f).diagnostics);
+    }
     diag::sort_and_dedup(&mut diagnostics);
     CheckRun {
         files,
         catalog,
         analyses,
+        diagnostics,
+    }
+}
+
+/// A task graph file loaded and analysed.
+pub struct GraphRun {
+    /// `None` when the file could not be read as a task graph at all.
+    pub graph: Option<crate::taskgraph::TaskGraph>,
+    pub report: crate::taskgraph::analysis::GraphReport,
+    /// Loading and analysis diagnostics, sorted.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Loads a task graph (ours or SDF3) and runs its analyses; a graph that did
+/// not load cleanly is not analysed, so that its problems are not reported twice.
+pub fn analyze_graph(file: &SourceFile) -> GraphRun {
+    let (graph, mut diagnostics) = crate::taskgraph::load_task_graph(file.id, &file.text);
+    let loaded_cleanly = !diagnostics.iter().any(Diagnostic::is_error);
+    let report = match &graph {
+        Some(g) if loaded_cleanly => crate::taskgraph::analysis::analyze(g),
+        _ => crate::taskgraph::analysis::GraphReport::default(),
+    };
+    diagnostics.extend(report.diagnostics.iter().cloned());
+    diag::sort_and_dedup(&mut diagnostics);
+    GraphRun {
+        graph,
+        report,
         diagnostics,
     }
 }

@@ -11,10 +11,12 @@ use super::{
 };
 use crate::diag::{Code, Diagnostic, FileId};
 use crate::span::Span;
-use crate::suggest::{did_you_mean, edit_distance};
+use crate::xmlpos::{
+    self, Attr, get, is_ident, is_namespace_attribute, read_attributes, resolve_reference, suggest,
+    trim_span, xml_error_message,
+};
 use quick_xml::Reader;
 use quick_xml::encoding::Decoder;
-use quick_xml::events::attributes::AttrError;
 use quick_xml::events::{BytesEnd, BytesStart, Event};
 use std::collections::HashMap;
 use std::path::Path;
@@ -230,69 +232,6 @@ impl Sink {
     }
 }
 
-/// One attribute as written.
-struct Attr {
-    key: String,
-    key_span: Span,
-    /// The value with entities replaced.
-    value: String,
-    /// The byte range of the value (between the quotes).
-    span: Span,
-    /// Whether `value` is byte-for-byte the text at `span` (no entities), so that
-    /// positions inside the value can be computed.
-    exact: bool,
-}
-
-impl Attr {
-    /// The whitespace- or comma-separated words of the value, each with its range.
-    fn words(&self) -> Vec<(String, Span)> {
-        let mut out = Vec::new();
-        let mut start: Option<usize> = None;
-        let is_sep = |c: char| c.is_whitespace() || c == ',';
-        for (i, c) in self.value.char_indices().chain([(self.value.len(), ' ')]) {
-            match (start, is_sep(c)) {
-                (None, false) => start = Some(i),
-                (Some(s), true) => {
-                    let span = if self.exact {
-                        Span::new(self.span.start + s, self.span.start + i)
-                    } else {
-                        self.span
-                    };
-                    out.push((self.value[s..i].to_string(), span));
-                    start = None;
-                }
-                _ => {}
-            }
-        }
-        out
-    }
-
-    fn trimmed(&self) -> &str {
-        self.value.trim()
-    }
-}
-
-/// Did-you-mean over the format's few element, attribute and type names: the
-/// shared rule, plus swapped letters (`Valeu`, `dco`) and two edits on longer names.
-fn suggest(name: &str, candidates: &[&str]) -> Option<String> {
-    did_you_mean(name, candidates.iter().copied()).or_else(|| {
-        let sorted = |s: &str| {
-            let mut v: Vec<char> = s.to_lowercase().chars().collect();
-            v.sort_unstable();
-            v
-        };
-        let key = sorted(name);
-        let lower = name.to_lowercase();
-        candidates
-            .iter()
-            .find(|c| {
-                sorted(c) == key
-                    || (name.chars().count() >= 5 && edit_distance(&lower, &c.to_lowercase()) <= 2)
-            })
-            .map(|c| c.to_string())
-    })
-}
-
 /// Did-you-mean for a value type, knowing the usual names from other languages.
 fn suggest_type(name: &str) -> Option<String> {
     let usual = match name.to_lowercase().as_str() {
@@ -306,16 +245,6 @@ fn suggest_type(name: &str) -> Option<String> {
         _ => return suggest(name, TYPE_NAMES),
     };
     Some(usual.to_string())
-}
-
-fn get<'a>(attrs: &'a [Attr], key: &str) -> Option<&'a Attr> {
-    attrs.iter().find(|a| a.key == key)
-}
-
-fn is_ident(s: &str) -> bool {
-    let mut chars = s.chars();
-    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
-        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
 /// Collapses runs of whitespace (a `<Doc>` may span lines) into single spaces.
@@ -427,22 +356,10 @@ impl Parser<'_, '_> {
                     }
                 }
                 Ok(Event::GeneralRef(r)) => {
-                    let inner = self.slice_span(&r).unwrap_or(Span::new(end, end));
-                    let span = Span::new(inner.start.saturating_sub(1), end.max(inner.end));
-                    let name = String::from_utf8_lossy(&r).into_owned();
-                    let resolved = if r.is_char_ref() {
-                        r.resolve_char_ref().ok().flatten().map(String::from)
-                    } else {
-                        quick_xml::escape::resolve_predefined_entity(&name).map(str::to_string)
-                    };
+                    let (span, resolved) = resolve_reference(self.text, &r, end);
                     match resolved {
-                        Some(s) => self.text_content(&s, span),
-                        None => self.malformed(
-                            span,
-                            format!(
-                                "`&{name};` is not a known character: write `&amp;` for a plain `&`"
-                            ),
-                        ),
+                        Ok(s) => self.text_content(&s, span),
+                        Err(message) => self.malformed(span, message),
                     }
                 }
                 Ok(Event::Comment(_) | Event::Decl(_) | Event::PI(_) | Event::DocType(_)) => Ok(()),
@@ -455,33 +372,12 @@ impl Parser<'_, '_> {
 
     /// The byte range of `slice` if it borrows from the text.
     fn slice_span(&self, slice: &[u8]) -> Option<Span> {
-        let base = self.text.as_ptr() as usize;
-        let ptr = slice.as_ptr() as usize;
-        if ptr >= base && ptr + slice.len() <= base + self.text.len() {
-            Some(Span::new(ptr - base, ptr - base + slice.len()))
-        } else {
-            None
-        }
+        xmlpos::slice_span(self.text, slice)
     }
 
     /// A short range at `pos` for an error position: the word starting there.
     fn word_at(&self, pos: usize) -> Span {
-        let text = self.text;
-        let mut pos = pos.min(text.len());
-        while !text.is_char_boundary(pos) {
-            pos -= 1;
-        }
-        let mut end = pos;
-        for (i, c) in text[pos..].char_indices() {
-            if i > 0 && (c.is_whitespace() || c == '<' || i >= 40) {
-                break;
-            }
-            end = pos + i + c.len_utf8();
-            if c == '>' {
-                break;
-            }
-        }
-        Span::new(pos, end)
+        xmlpos::word_at(self.text, pos)
     }
 
     /// E050: reports malformed XML; reading stops.
@@ -495,43 +391,9 @@ impl Parser<'_, '_> {
     }
 
     fn xml_error(&mut self, err: &quick_xml::Error, pos: usize) {
-        use quick_xml::Error as E;
-        use quick_xml::errors::{IllFormedError, SyntaxError};
-        let message = match err {
-            E::Syntax(SyntaxError::UnclosedTag) => {
-                "this tag is never closed: a `>` is missing".to_string()
-            }
-            E::Syntax(SyntaxError::UnclosedComment) => {
-                "this comment is never closed: `-->` is missing".to_string()
-            }
-            E::Syntax(SyntaxError::UnclosedCData) => {
-                "this CDATA section is never closed: `]]>` is missing".to_string()
-            }
-            E::Syntax(SyntaxError::UnclosedDoctype) => {
-                "this DOCTYPE is never closed: a `>` is missing".to_string()
-            }
-            E::Syntax(SyntaxError::UnclosedPIOrXmlDecl) => {
-                "this `<?...` declaration is never closed: `?>` is missing".to_string()
-            }
-            E::Syntax(SyntaxError::InvalidBangMarkup) => {
-                "`<!` must start a comment `<!-- ... -->`".to_string()
-            }
-            E::IllFormed(IllFormedError::UnclosedReference) => {
-                "a `&` must start an entity such as `&amp;`, ended by `;`".to_string()
-            }
-            E::IllFormed(IllFormedError::DoubleHyphenInComment) => {
-                "a comment cannot contain `--`".to_string()
-            }
-            E::IllFormed(IllFormedError::MismatchedEndTag { expected, found }) => {
-                format!("`</{found}>` does not close `<{expected}>`")
-            }
-            E::IllFormed(IllFormedError::UnmatchedEndTag(found)) => {
-                format!("`</{found}>` closes an element that was never opened")
-            }
-            other => format!("the file is not well-formed XML: {other}"),
-        };
         let span = self.word_at(pos);
-        self.sink.report(Code::CatalogXml, span, message);
+        self.sink
+            .report(Code::CatalogXml, span, xml_error_message(err));
     }
 
     fn eof(&mut self) {
@@ -563,13 +425,7 @@ impl Parser<'_, '_> {
         if s.trim().is_empty() {
             return Ok(());
         }
-        let lead = s.len() - s.trim_start().len();
-        let trail = s.len() - s.trim_end().len();
-        let span = if span.len() == s.len() {
-            Span::new(span.start + lead, span.end - trail)
-        } else {
-            span
-        };
+        let span = trim_span(s, span);
         match top {
             None => self.malformed(
                 span,
@@ -596,76 +452,8 @@ impl Parser<'_, '_> {
         tag: Span,
         decoder: Decoder,
     ) -> Result<Vec<Attr>, Stop> {
-        let mut out = Vec::new();
-        // Attribute error positions count from the byte after `<`.
-        let content_start = tag.start + 1;
-        for attr in e.attributes() {
-            let attr = match attr {
-                Ok(a) => a,
-                Err(err) => {
-                    let (pos, message) = match err {
-                        AttrError::ExpectedEq(p) => (
-                            p,
-                            "an attribute name must be followed by `=` and a value in quotes"
-                                .to_string(),
-                        ),
-                        AttrError::ExpectedValue(p) => {
-                            (p, "`=` must be followed by a value in quotes".to_string())
-                        }
-                        AttrError::UnquotedValue(p) => (
-                            p,
-                            "an attribute value must be in quotes, like name=\"value\"".to_string(),
-                        ),
-                        AttrError::ExpectedQuote(p, q) => (
-                            p,
-                            format!(
-                                "this attribute value is never closed: a `{}` is missing",
-                                q as char
-                            ),
-                        ),
-                        AttrError::Duplicated(p, _) => (
-                            p,
-                            "this attribute is given twice on the same element".to_string(),
-                        ),
-                    };
-                    let span = self.word_at(content_start + pos);
-                    return Err(self.fail(span, message));
-                }
-            };
-            let key = String::from_utf8_lossy(attr.key.as_ref()).into_owned();
-            let key_span = self.slice_span(attr.key.as_ref()).unwrap_or(tag);
-            let raw: &[u8] = &attr.value;
-            let span = self.slice_span(raw).unwrap_or(tag);
-            if let Some(p) = raw.iter().position(|&b| b == b'<') {
-                let at = span.start + p;
-                let span = if self.text.len() > at {
-                    Span::new(at, at + 1)
-                } else {
-                    span
-                };
-                return Err(self.fail(
-                    span,
-                    "a `<` inside an attribute value: is a closing quote missing? (write `&lt;` for a plain `<`)",
-                ));
-            }
-            let value =
-                match attr.decode_and_unescape_value(decoder) {
-                    Ok(v) => v.into_owned(),
-                    Err(_) => return Err(self.fail(
-                        span,
-                        "this value has an unknown `&...;` entity: write `&amp;` for a plain `&`",
-                    )),
-                };
-            let exact = value.as_bytes() == raw;
-            out.push(Attr {
-                key,
-                key_span,
-                value,
-                span,
-                exact,
-            });
-        }
-        Ok(out)
+        read_attributes(self.text, e, tag, decoder)
+            .map_err(|(span, message)| self.fail(span, message))
     }
 
     /// W050 for attributes that `kind` does not have.
@@ -673,7 +461,7 @@ impl Parser<'_, '_> {
         let allowed = kind.attributes();
         for a in attrs {
             // Namespace declarations and prefixed attributes (xsi:...) are allowed.
-            if a.key == "xmlns" || a.key.contains(':') || allowed.contains(&a.key.as_str()) {
+            if is_namespace_attribute(&a.key) || allowed.contains(&a.key.as_str()) {
                 continue;
             }
             self.sink.report_suggest(

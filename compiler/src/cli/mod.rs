@@ -1,6 +1,7 @@
 //! The `semo` command. Exit codes: 0 no errors, 1 errors found, 2 usage or I/O
 //! problem.
 
+mod graph;
 mod render;
 
 use crate::workspace;
@@ -45,10 +46,28 @@ enum Command {
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
     },
+    /// Analyse task graphs (`*.taskgraph.xml` or SDF3 files).
+    #[command(subcommand)]
+    Graph(GraphCommand),
     /// Explain a diagnostic code (e.g. `semo explain E019`), or list them all.
     Explain {
         /// A code such as E019; all codes when omitted.
         code: Option<String>,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum GraphCommand {
+    /// Consistency (repetition vector per level) and deadlock freedom of a
+    /// task graph, with diagnostics on the channel concerned.
+    Analyze {
+        /// A `*.taskgraph.xml` file or an SDF3 graph (`<sdf3 type="sdf">`).
+        file: PathBuf,
+        /// `human` or `json` (one object: levels and diagnostics).
+        #[arg(long, value_enum, default_value_t = Format::Human)]
+        format: Format,
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
     },
 }
 
@@ -81,20 +100,26 @@ pub fn main() -> i32 {
             paths,
             format,
             color,
-        } => {
-            let color = match color {
-                ColorChoice::Always => true,
-                ColorChoice::Never => false,
-                ColorChoice::Auto => {
-                    std::io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none()
-                }
-            };
-            check(paths, format, color, &mut out)
-        }
+        } => check(paths, format, use_color(color), &mut out),
+        Command::Graph(GraphCommand::Analyze {
+            file,
+            format,
+            color,
+        }) => graph::analyze(&file, format == Format::Json, use_color(color), &mut out),
         Command::Explain { code } => explain(code.as_deref(), &mut out),
     };
     let _ = out.flush();
     code
+}
+
+fn use_color(choice: ColorChoice) -> bool {
+    match choice {
+        ColorChoice::Always => true,
+        ColorChoice::Never => false,
+        ColorChoice::Auto => {
+            std::io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none()
+        }
+    }
 }
 
 fn check(paths: Vec<PathBuf>, format: Format, color: bool, out: &mut impl Write) -> i32 {

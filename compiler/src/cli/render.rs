@@ -42,21 +42,27 @@ fn safe_range(text: &str, span: crate::span::Span) -> std::ops::Range<usize> {
     start..end.max(start)
 }
 
-pub fn human(run: &CheckRun, colored: bool, out: &mut impl Write) -> io::Result<()> {
+/// Source snippets for people: one ariadne report per diagnostic.
+pub fn diagnostics(
+    files: &Files,
+    diagnostics: &[Diagnostic],
+    colored: bool,
+    out: &mut impl Write,
+) -> io::Result<()> {
     let config = Config::default()
         .with_color(colored)
         .with_index_type(IndexType::Byte);
     let mut sources = Vec::new();
-    for f in run.files.iter() {
+    for f in files.iter() {
         sources.push((f.path.display().to_string(), f.text.clone()));
     }
-    let builtin = run.files.get(crate::catalog::BUILTIN_FILE);
+    let builtin = files.get(crate::catalog::BUILTIN_FILE);
     sources.push((builtin.path.display().to_string(), builtin.text.clone()));
     let mut cache = ariadne::sources(sources);
 
-    for d in &run.diagnostics {
-        let path = path_of(&run.files, d);
-        let range = safe_range(&run.files.get(d.file).text, d.span);
+    for d in diagnostics {
+        let path = path_of(files, d);
+        let range = safe_range(&files.get(d.file).text, d.span);
         let mut report = Report::build(kind(d.severity), (path.clone(), range.clone()))
             .with_config(config)
             .with_code(d.code.as_str())
@@ -67,7 +73,7 @@ pub fn human(run: &CheckRun, colored: bool, out: &mut impl Write) -> io::Result<
                     .with_color(color(d.severity)),
             );
         for related in &d.related {
-            let file = run.files.get(related.file);
+            let file = files.get(related.file);
             report = report.with_label(
                 Label::new((
                     file.path.display().to_string(),
@@ -82,56 +88,68 @@ pub fn human(run: &CheckRun, colored: bool, out: &mut impl Write) -> io::Result<
         }
         report.finish().write(&mut cache, &mut *out)?;
     }
+    Ok(())
+}
+
+/// `semo check`'s report: the diagnostics, then a one-line summary.
+pub fn human(run: &CheckRun, colored: bool, out: &mut impl Write) -> io::Result<()> {
+    diagnostics(&run.files, &run.diagnostics, colored, out)?;
     let count = |s: Severity| run.diagnostics.iter().filter(|d| d.severity == s).count();
     let plural = |n: usize, word: &str| format!("{n} {word}{}", if n == 1 { "" } else { "s" });
-    let missions = run
-        .files
-        .iter()
-        .filter(|f| f.kind == crate::workspace::FileKind::Mission)
-        .count();
-    let catalogs = run.files.iter().count() - missions;
+    let of_kind = |kind| run.files.iter().filter(|f| f.kind == kind).count();
+    let graphs = of_kind(crate::workspace::FileKind::TaskGraph);
+    let graphs = if graphs > 0 {
+        format!(", {}", plural(graphs, "task graph"))
+    } else {
+        String::new()
+    };
     writeln!(
         out,
-        "checked {} and {}: {}, {}, {}",
-        plural(missions, "mission"),
-        plural(catalogs, "catalog file"),
+        "checked {} and {}{graphs}: {}, {}, {}",
+        plural(of_kind(crate::workspace::FileKind::Mission), "mission"),
+        plural(of_kind(crate::workspace::FileKind::Catalog), "catalog file"),
         plural(count(Severity::Error), "error"),
         plural(count(Severity::Warning), "warning"),
         plural(count(Severity::Hint), "hint"),
     )
 }
 
+/// One diagnostic as a JSON object (the `--format json` line).
+pub fn json_value(files: &Files, d: &Diagnostic) -> serde_json::Value {
+    let file = files.get(d.file);
+    let position = |offset: usize| {
+        let lc = file.lines.line_col(&file.text, offset, ColumnUnit::Char);
+        serde_json::json!({ "line": lc.line + 1, "column": lc.col + 1 })
+    };
+    let related: Vec<serde_json::Value> = d
+        .related
+        .iter()
+        .map(|r| {
+            let rf = files.get(r.file);
+            let lc = rf.lines.line_col(&rf.text, r.span.start, ColumnUnit::Char);
+            serde_json::json!({
+                "file": rf.path.display().to_string(),
+                "line": lc.line + 1,
+                "column": lc.col + 1,
+                "message": r.message,
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "code": d.code.as_str(),
+        "severity": d.severity.as_str(),
+        "file": file.path.display().to_string(),
+        "start": position(d.span.start),
+        "end": position(d.span.end),
+        "message": d.message,
+        "suggestion": d.suggestion,
+        "related": related,
+    })
+}
+
 pub fn json(run: &CheckRun, out: &mut impl Write) -> io::Result<()> {
     for d in &run.diagnostics {
-        let file = run.files.get(d.file);
-        let position = |offset: usize| {
-            let lc = file.lines.line_col(&file.text, offset, ColumnUnit::Char);
-            serde_json::json!({ "line": lc.line + 1, "column": lc.col + 1 })
-        };
-        let related: Vec<serde_json::Value> = d
-            .related
-            .iter()
-            .map(|r| {
-                let rf = run.files.get(r.file);
-                let lc = rf.lines.line_col(&rf.text, r.span.start, ColumnUnit::Char);
-                serde_json::json!({
-                    "file": rf.path.display().to_string(),
-                    "line": lc.line + 1,
-                    "column": lc.col + 1,
-                    "message": r.message,
-                })
-            })
-            .collect();
-        let value = serde_json::json!({
-            "code": d.code.as_str(),
-            "severity": d.severity.as_str(),
-            "file": file.path.display().to_string(),
-            "start": position(d.span.start),
-            "end": position(d.span.end),
-            "message": d.message,
-            "suggestion": d.suggestion,
-            "related": related,
-        });
+        let value = json_value(&run.files, d);
         writeln!(out, "{value}")?;
     }
     Ok(())

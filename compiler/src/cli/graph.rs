@@ -1,0 +1,112 @@
+//! `semo graph analyze`: a task graph's repetition vectors and deadlock
+//! freedom, level by level, with its diagnostics.
+
+use super::render;
+use crate::diag::Diagnostic;
+use crate::workspace::{FileKind, Files, analyze_graph};
+use std::io::Write;
+use std::path::Path;
+
+pub fn analyze(path: &Path, json: bool, color: bool, out: &mut impl Write) -> i32 {
+    let text = match std::fs::read(path) {
+        Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
+        Err(e) => {
+            eprintln!("error: {}: {e}", path.display());
+            return 2;
+        }
+    };
+    let mut files = Files::default();
+    let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
+    let run = analyze_graph(files.get(id));
+    let written = if json {
+        write_json(&files, &run, out)
+    } else {
+        write_human(&files, &run, color, out)
+    };
+    if let Err(e) = written
+        && e.kind() != std::io::ErrorKind::BrokenPipe
+    {
+        eprintln!("error: cannot write the report: {e}");
+        return 2;
+    }
+    if run.diagnostics.iter().any(Diagnostic::is_error) {
+        1
+    } else {
+        0
+    }
+}
+
+fn write_human(
+    files: &Files,
+    run: &crate::workspace::GraphRun,
+    color: bool,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
+    render::diagnostics(files, &run.diagnostics, color, out)?;
+    for level in &run.report.levels {
+        let state = match (&level.repetition, level.deadlock_free) {
+            (None, _) => "inconsistent".to_string(),
+            (Some(_), Some(false)) => "consistent, deadlocks".to_string(),
+            (Some(_), _) => "consistent, deadlock-free".to_string(),
+        };
+        let per = if level.path.contains('/') {
+            " (per iteration)"
+        } else {
+            ""
+        };
+        writeln!(out, "{}{per}: {state}", level.path)?;
+        if let Some(counts) = &level.repetition {
+            let pairs: Vec<String> = level
+                .nodes
+                .iter()
+                .zip(counts)
+                .filter(|(name, _)| !name.ends_with(')'))
+                .map(|(name, n)| format!("{name}={n}"))
+                .collect();
+            writeln!(out, "  repetition vector: {}", pairs.join(" "))?;
+        }
+    }
+    if run.report.levels.is_empty() {
+        writeln!(out, "not analysed: the file has errors")?;
+    }
+    Ok(())
+}
+
+fn write_json(
+    files: &Files,
+    run: &crate::workspace::GraphRun,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
+    let levels: Vec<serde_json::Value> = run
+        .report
+        .levels
+        .iter()
+        .map(|level| {
+            let repetition = level.repetition.as_ref().map(|counts| {
+                level
+                    .nodes
+                    .iter()
+                    .zip(counts)
+                    .map(|(name, n)| (name.clone(), serde_json::json!(n)))
+                    .collect::<serde_json::Map<_, _>>()
+            });
+            serde_json::json!({
+                "path": level.path,
+                "consistent": level.repetition.is_some(),
+                "deadlock_free": level.deadlock_free,
+                "repetition": repetition,
+            })
+        })
+        .collect();
+    let diagnostics: Vec<serde_json::Value> = run
+        .diagnostics
+        .iter()
+        .map(|d| render::json_value(files, d))
+        .collect();
+    let value = serde_json::json!({
+        "graph": run.graph.as_ref().map(|g| g.name.clone()),
+        "levels": levels,
+        "diagnostics": diagnostics,
+    });
+    writeln!(out, "{value}")
+}

@@ -1,0 +1,206 @@
+//! Task graphs end to end: `semo graph analyze` on the reference examples, and
+//! every SDF3 benchmark graph loaded, consistent and deadlock-free, with the
+//! repetition vector checked against the balance equations independently.
+
+mod support;
+
+use semo::diag::FileId;
+use semo::taskgraph::{Direction, TaskGraph, analysis, load_task_graph};
+use support::{semo_in, shared};
+
+fn analyze_json(dir: &std::path::Path, file: &str) -> (i32, serde_json::Value) {
+    let out = semo_in(dir, &["graph", "analyze", "--format", "json", file]);
+    assert!(
+        out.code == 0 || out.code == 1,
+        "exit {}: {}",
+        out.code,
+        out.stderr
+    );
+    (
+        out.code,
+        serde_json::from_str(&out.stdout).expect("one JSON object"),
+    )
+}
+
+fn repetition(level: &serde_json::Value, node: &str) -> u64 {
+    level["repetition"][node]
+        .as_u64()
+        .unwrap_or_else(|| panic!("{node} in {level}"))
+}
+
+#[test]
+fn consistent_example_has_its_repetition_vector() {
+    let (code, v) = analyze_json(
+        &shared().join("examples/taskgraphs"),
+        "consistent.taskgraph.xml",
+    );
+    assert_eq!(code, 0, "{v}");
+    assert_eq!(v["levels"][0]["consistent"], true);
+    assert_eq!(v["levels"][0]["deadlock_free"], true);
+    assert_eq!(v["diagnostics"], serde_json::json!([]));
+}
+
+#[test]
+fn inconsistent_example_names_the_channel_and_ratios() {
+    let (code, v) = analyze_json(
+        &shared().join("examples/taskgraphs"),
+        "inconsistent.taskgraph.xml",
+    );
+    assert_eq!(code, 1);
+    let d = &v["diagnostics"][0];
+    assert_eq!(d["code"], "E070");
+    let message = d["message"].as_str().unwrap();
+    assert!(message.contains("C.o → D.i2"), "{message}");
+    assert!(message.contains("fire once per firing of C"), "{message}");
+    assert!(message.contains("fire 2 times"), "{message}");
+}
+
+#[test]
+fn deadlock_example_names_the_cycle_and_the_fix() {
+    let dir = shared().join("examples/taskgraphs");
+    let (code, v) = analyze_json(&dir, "deadlock.taskgraph.xml");
+    assert_eq!(code, 1);
+    let d = &v["diagnostics"][0];
+    assert_eq!(d["code"], "E071");
+    let message = d["message"].as_str().unwrap();
+    assert!(message.contains("X → Y → X"), "{message}");
+    assert!(
+        message.contains("1 more initial sample on channel Y.back → X.fb"),
+        "{message}"
+    );
+    // The range is the feedback channel's element.
+    let text = std::fs::read_to_string(dir.join("deadlock.taskgraph.xml")).unwrap();
+    let line = text.lines().position(|l| l.contains("Y.back")).unwrap() as u64 + 1;
+    assert_eq!(d["start"]["line"], line);
+}
+
+#[test]
+fn data_loop_body_fires_once_per_iteration() {
+    let (code, v) = analyze_json(
+        &shared().join("examples/taskgraphs"),
+        "data_loop.taskgraph.xml",
+    );
+    assert_eq!(code, 0, "{v}");
+    let top = &v["levels"][0];
+    assert_eq!(
+        (
+            repetition(top, "A"),
+            repetition(top, "L"),
+            repetition(top, "D")
+        ),
+        (1, 1, 1)
+    );
+    let body = &v["levels"][1];
+    assert_eq!(body["path"], "data_loop/L");
+    assert_eq!((repetition(body, "B"), repetition(body, "C")), (1, 1));
+}
+
+#[test]
+fn human_report_lists_levels() {
+    let out = semo_in(
+        &shared().join("examples/taskgraphs"),
+        &["graph", "analyze", "kmeans.taskgraph.xml"],
+    );
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout.contains("kmeans: consistent, deadlock-free"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stdout
+            .contains("kmeans/Converge/Assign (per iteration)"),
+        "{}",
+        out.stdout
+    );
+}
+
+#[test]
+fn every_reference_example_loads() {
+    let dir = shared().join("examples/taskgraphs");
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let (graph, diags) = load_task_graph(FileId(0), &text);
+        assert!(graph.is_some(), "{}", path.display());
+        let load_errors: Vec<_> = diags.iter().filter(|d| d.is_error()).collect();
+        assert!(
+            load_errors.is_empty(),
+            "{}: {load_errors:#?}",
+            path.display()
+        );
+    }
+}
+
+/// γ(src)·produce = γ(dst)·consume on every channel, and the vector is the
+/// smallest such (its entries share no factor) — checked from the model, not
+/// from the analysis.
+fn assert_balanced(graph: &TaskGraph, counts: &[u64]) {
+    for c in &graph.channels {
+        let (s, d) = (
+            graph.task_index(&c.src.task).unwrap(),
+            graph.task_index(&c.dst.task).unwrap(),
+        );
+        let produce = graph.tasks[s].port(&c.src.port).unwrap();
+        let consume = graph.tasks[d].port(&c.dst.port).unwrap();
+        assert_eq!(produce.dir, Direction::Out);
+        assert_eq!(
+            counts[s] * produce.rate,
+            counts[d] * consume.rate,
+            "{}: channel {}.{} → {}.{}",
+            graph.name,
+            c.src.task,
+            c.src.port,
+            c.dst.task,
+            c.dst.port
+        );
+    }
+    let divisor = counts.iter().fold(0, |g, &n| gcd(g, n));
+    assert_eq!(divisor, 1, "{}: {counts:?} is not the smallest", graph.name);
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 { a } else { gcd(b, a % b) }
+}
+
+#[test]
+fn every_sdf3_benchmark_is_consistent_and_deadlock_free() {
+    let dir = shared().join("data/sdf3");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("xml") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        let (graph, diags) = load_task_graph(FileId(0), &text);
+        assert!(diags.is_empty(), "{}: {diags:#?}", path.display());
+        let graph = graph.unwrap();
+        let report = analysis::analyze(&graph);
+        assert!(
+            report.diagnostics.is_empty(),
+            "{}: {:#?}",
+            path.display(),
+            report.diagnostics
+        );
+        assert!(
+            report.is_consistent() && report.is_deadlock_free(),
+            "{}",
+            path.display()
+        );
+        assert_balanced(&graph, report.levels[0].repetition.as_ref().unwrap());
+        checked += 1;
+    }
+    assert_eq!(checked, 11);
+}
+
+#[test]
+fn check_reports_task_graph_problems_in_folders() {
+    let (code, diags) = support::check_json_in(&shared().join("examples"), &["taskgraphs"]);
+    assert_eq!(code, 1);
+    let codes: Vec<&str> = diags.iter().map(|d| d.code.as_str()).collect();
+    assert!(
+        codes.contains(&"E070") && codes.contains(&"E071"),
+        "{codes:?}"
+    );
+}
