@@ -204,3 +204,34 @@ fn check_reports_task_graph_problems_in_folders() {
         "{codes:?}"
     );
 }
+
+#[test]
+fn dot_draws_the_graph_and_refuses_a_broken_file() {
+    let out = semo_in(
+        &shared().join("examples/taskgraphs"),
+        &["graph", "dot", "data_loop.taskgraph.xml"],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        out.stdout.starts_with("digraph \"data_loop\" {"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stdout.contains("subgraph \"cluster_L\""),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stdout.contains("\"A\" -> \"L/L.in\" [taillabel=\"10\""),
+        "{}",
+        out.stdout
+    );
+    let broken = semo_in(
+        &support::repo_root().join("tests/fixtures/diagnostics/E064_graph_unknown_endpoint"),
+        &["graph", "dot", "graph.taskgraph.xml"],
+    );
+    assert_eq!(broken.code, 1);
+    assert!(broken.stdout.is_empty());
+    assert!(broken.stderr.contains("E064"), "{}", broken.stderr);
+}

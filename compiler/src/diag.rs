@@ -116,6 +116,13 @@ codes! {
     InconsistentRates = "E070", Error, "sample rates that no repetition vector satisfies";
     Deadlock = "E071", Error, "a cycle without enough initial samples: one iteration cannot complete";
     RateOverflow = "E072", Error, "rates whose repetition vector does not fit in 64 bits";
+    LoopBoundaryRate = "E073", Error, "a loop port whose outer and inner rates do not match the loop";
+    DistributingOnConvergentLoop = "E074", Error, "a distributing input port on a C-type (convergent) loop";
+    ExitTaskNotInLoop = "E075", Error, "a loop's exitTask that is not a task of its body";
+    UnknownLibrary = "E076", Error, "a library port naming a library that is not declared";
+    UnknownLibraryFunction = "E077", Error, "a call through a library port to a function the library lacks";
+    MulticastWithoutReader = "W062", Warning, "a multicast group that tasks write but none reads";
+    MulticastWithoutWriter = "W063", Warning, "a multicast group that tasks read but none writes";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

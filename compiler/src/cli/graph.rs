@@ -7,14 +7,40 @@ use crate::workspace::{FileKind, Files, analyze_graph};
 use std::io::Write;
 use std::path::Path;
 
-pub fn analyze(path: &Path, json: bool, color: bool, out: &mut impl Write) -> i32 {
-    let text = match std::fs::read(path) {
-        Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
+fn read(path: &Path) -> Option<String> {
+    match std::fs::read(path) {
+        Ok(bytes) => Some(String::from_utf8_lossy(&bytes).into_owned()),
         Err(e) => {
             eprintln!("error: {}: {e}", path.display());
-            return 2;
+            None
         }
-    };
+    }
+}
+
+/// `semo graph dot`: the DOT text, or the loading errors (exit 1).
+pub fn dot(path: &Path, out: &mut impl Write) -> i32 {
+    let Some(text) = read(path) else { return 2 };
+    let mut files = Files::default();
+    let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
+    let (graph, diagnostics) = crate::taskgraph::load_task_graph(id, &files.get(id).text);
+    let errors: Vec<Diagnostic> = diagnostics
+        .into_iter()
+        .filter(Diagnostic::is_error)
+        .collect();
+    match graph {
+        Some(g) if errors.is_empty() => {
+            let _ = out.write_all(crate::taskgraph::dot::to_dot(&g).as_bytes());
+            0
+        }
+        _ => {
+            let _ = render::diagnostics(&files, &errors, false, &mut std::io::stderr());
+            1
+        }
+    }
+}
+
+pub fn analyze(path: &Path, json: bool, color: bool, out: &mut impl Write) -> i32 {
+    let Some(text) = read(path) else { return 2 };
     let mut files = Files::default();
     let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
     let run = analyze_graph(files.get(id));

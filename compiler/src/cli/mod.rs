@@ -69,6 +69,12 @@ enum GraphCommand {
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
     },
+    /// Print the graph in Graphviz DOT: tasks, loop nodes as clusters, rates
+    /// and initial samples on channels (`semo graph dot g.taskgraph.xml | dot -Tsvg`).
+    Dot {
+        /// A `*.taskgraph.xml` file or an SDF3 graph.
+        file: PathBuf,
+    },
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
@@ -106,6 +112,7 @@ pub fn main() -> i32 {
             format,
             color,
         }) => graph::analyze(&file, format == Format::Json, use_color(color), &mut out),
+        Command::Graph(GraphCommand::Dot { file }) => graph::dot(&file, &mut out),
         Command::Explain { code } => explain(code.as_deref(), &mut out),
     };
     let _ = out.flush();

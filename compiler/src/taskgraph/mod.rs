@@ -1,6 +1,7 @@
 //! Task graphs (extended SDF, SDF/L): the model, its loaders, and its analyses.
 
 pub mod analysis;
+pub mod dot;
 pub mod model;
 mod xml;
 

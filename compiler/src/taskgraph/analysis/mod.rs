@@ -6,6 +6,7 @@ pub mod consistency;
 pub mod deadlock;
 pub mod level;
 pub mod ratio;
+pub mod rules;
 
 use crate::diag::{Code, Diagnostic};
 use crate::taskgraph::model::TaskGraph;
@@ -44,7 +45,10 @@ impl GraphReport {
 
 /// Runs the analyses on every level of `graph`.
 pub fn analyze(graph: &TaskGraph) -> GraphReport {
-    let mut report = GraphReport::default();
+    let mut report = GraphReport {
+        diagnostics: rules::check(graph),
+        ..GraphReport::default()
+    };
     for level in Level::all(graph) {
         let nodes = level.nodes.iter().map(|n| n.name.clone()).collect();
         let (repetition, deadlock_free) = match repetition_vector(&level) {
