@@ -235,3 +235,54 @@ fn dot_draws_the_graph_and_refuses_a_broken_file() {
     assert!(broken.stdout.is_empty());
     assert!(broken.stderr.contains("E064"), "{}", broken.stderr);
 }
+
+#[test]
+fn data_loop_has_the_looped_single_appearance_schedule() {
+    let dir = shared().join("examples/taskgraphs");
+    let out = semo_in(&dir, &["graph", "schedule", "data_loop.taskgraph.xml"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert_eq!(out.stdout, "A 10(B C) D\n");
+    let (_, v) = analyze_json(&dir, "data_loop.taskgraph.xml");
+    assert_eq!(v["looped_schedule"], "A 10(B C) D");
+    assert_eq!(v["levels"][0]["buffers"]["A.o → L.in"], 10);
+}
+
+#[test]
+fn multicore_schedule_lists_each_core() {
+    let dir = shared().join("examples/taskgraphs");
+    let out = semo_in(
+        &dir,
+        &[
+            "graph",
+            "schedule",
+            "--cores",
+            "2",
+            "consistent.taskgraph.xml",
+        ],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        out.stdout.contains("on 2 cores:\n  core 0: "),
+        "{}",
+        out.stdout
+    );
+    assert!(out.stdout.contains("\n  core 1: "), "{}", out.stdout);
+}
+
+#[test]
+fn throughput_names_the_period_and_critical_cycle() {
+    let (code, v) = analyze_json(&shared().join("data/sdf3"), "h263encoder.xml");
+    assert_eq!(code, 0, "{v}");
+    let t = &v["levels"][0]["throughput"];
+    // Verified by an independent self-timed simulation in the unit tests.
+    assert_eq!(t["period"], "1232530");
+    assert_eq!(
+        t["critical_cycle"],
+        serde_json::json!([
+            "motion_estimation",
+            "mb_encoding",
+            "mb_decoding",
+            "motion_compensation"
+        ])
+    );
+}

@@ -113,6 +113,7 @@ codes! {
     GraphBadAttribute = "E065", Error, "a task-graph attribute value of the wrong form";
     GraphPortDirection = "E066", Error, "a channel from an input port or into an output port";
     GraphUnknownAttribute = "W060", Warning, "an attribute that the task-graph format does not have";
+    BufferTooSmall = "W061", Warning, "a channel whose declared capacity is smaller than the schedule needs";
     InconsistentRates = "E070", Error, "sample rates that no repetition vector satisfies";
     Deadlock = "E071", Error, "a cycle without enough initial samples: one iteration cannot complete";
     RateOverflow = "E072", Error, "rates whose repetition vector does not fit in 64 bits";

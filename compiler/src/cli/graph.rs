@@ -91,6 +91,27 @@ fn write_human(
                 .collect();
             writeln!(out, "  repetition vector: {}", pairs.join(" "))?;
         }
+        if let Some(schedule) = &level.schedule {
+            writeln!(out, "  schedule: {schedule}")?;
+        }
+        if let Some(t) = &level.throughput {
+            let cycle = match t.critical_cycle.as_slice() {
+                [one] => format!("{one} alone"),
+                many => format!("{} → {}", many.join(" → "), many[0]),
+            };
+            writeln!(out, "  iteration period: {} (bounded by {cycle})", t.period)?;
+        }
+        if !level.buffers.is_empty() {
+            let bounds: Vec<String> = level
+                .buffers
+                .iter()
+                .map(|b| format!("{}: {}", b.channel, b.samples))
+                .collect();
+            writeln!(out, "  buffers: {}", bounds.join(", "))?;
+        }
+    }
+    if let Some(looped) = &run.report.looped_schedule {
+        writeln!(out, "looped schedule: {looped}")?;
     }
     if run.report.levels.is_empty() {
         writeln!(out, "not analysed: the file has errors")?;
@@ -116,11 +137,22 @@ fn write_json(
                     .map(|(name, n)| (name.clone(), serde_json::json!(n)))
                     .collect::<serde_json::Map<_, _>>()
             });
+            let buffers: serde_json::Map<String, serde_json::Value> = level
+                .buffers
+                .iter()
+                .map(|b| (b.channel.clone(), serde_json::json!(b.samples)))
+                .collect();
             serde_json::json!({
                 "path": level.path,
                 "consistent": level.repetition.is_some(),
                 "deadlock_free": level.deadlock_free,
                 "repetition": repetition,
+                "schedule": level.schedule,
+                "buffers": buffers,
+                "throughput": level.throughput.as_ref().map(|t| serde_json::json!({
+                    "period": t.period.to_string(),
+                    "critical_cycle": t.critical_cycle,
+                })),
             })
         })
         .collect();
@@ -131,8 +163,67 @@ fn write_json(
         .collect();
     let value = serde_json::json!({
         "graph": run.graph.as_ref().map(|g| g.name.clone()),
+        "looped_schedule": run.report.looped_schedule,
         "levels": levels,
         "diagnostics": diagnostics,
     });
     writeln!(out, "{value}")
+}
+
+/// `semo graph schedule`: the looped schedule of the whole graph, and with
+/// `cores` a list schedule of each level's iteration onto that many cores.
+pub fn schedule(path: &Path, cores: Option<usize>, out: &mut impl Write) -> i32 {
+    use crate::taskgraph::analysis::{consistency, deadlock, level::Level, schedule};
+    let Some(text) = read(path) else { return 2 };
+    let mut files = Files::default();
+    let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
+    let run = analyze_graph(files.get(id));
+    let Some(graph) = run
+        .graph
+        .as_ref()
+        .filter(|_| !run.diagnostics.iter().any(Diagnostic::is_error))
+    else {
+        let _ = render::diagnostics(&files, &run.diagnostics, false, &mut std::io::stderr());
+        return 1;
+    };
+    let mut text = String::new();
+    match &run.report.looped_schedule {
+        Some(looped) => text.push_str(&format!("{looped}\n")),
+        None => {
+            for level in &run.report.levels {
+                let s = level.schedule.as_deref().unwrap_or("(none)");
+                text.push_str(&format!("{}: {s}\n", level.path));
+            }
+        }
+    }
+    if let Some(cores) = cores {
+        for level in Level::all(graph) {
+            let Ok(counts) = consistency::repetition_vector(&level) else {
+                continue;
+            };
+            if deadlock::find_deadlock(&level, &counts).is_some() {
+                continue;
+            }
+            let Some(plan) = schedule::multicore(&level, &counts, cores) else {
+                text.push_str(&format!("{}: no schedule on {cores} cores\n", level.path));
+                continue;
+            };
+            text.push_str(&format!(
+                "{} on {cores} core{}:\n",
+                level.path,
+                if cores == 1 { "" } else { "s" }
+            ));
+            for (core, firings) in plan.iter().enumerate() {
+                // Loop boundary nodes take no time and run no code: not shown.
+                let items: Vec<String> = firings
+                    .iter()
+                    .filter(|&&(node, _)| level.nodes[node].task.is_some())
+                    .map(|&(node, start)| format!("{}@{start}", level.nodes[node].name))
+                    .collect();
+                text.push_str(&format!("  core {core}: {}\n", items.join(" ")));
+            }
+        }
+    }
+    let _ = out.write_all(text.as_bytes());
+    0
 }

@@ -69,6 +69,16 @@ enum GraphCommand {
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
     },
+    /// A static schedule: the looped single-appearance schedule of the whole
+    /// graph (`A 10(B C) D`), and with `--cores N` each level's iteration
+    /// scheduled onto N cores (task@start time).
+    Schedule {
+        /// A `*.taskgraph.xml` file or an SDF3 graph.
+        file: PathBuf,
+        /// Also schedule each level onto this many cores.
+        #[arg(long)]
+        cores: Option<usize>,
+    },
     /// Print the graph in Graphviz DOT: tasks, loop nodes as clusters, rates
     /// and initial samples on channels (`semo graph dot g.taskgraph.xml | dot -Tsvg`).
     Dot {
@@ -113,6 +123,9 @@ pub fn main() -> i32 {
             color,
         }) => graph::analyze(&file, format == Format::Json, use_color(color), &mut out),
         Command::Graph(GraphCommand::Dot { file }) => graph::dot(&file, &mut out),
+        Command::Graph(GraphCommand::Schedule { file, cores }) => {
+            graph::schedule(&file, cores, &mut out)
+        }
         Command::Explain { code } => explain(code.as_deref(), &mut out),
     };
     let _ = out.flush();

@@ -1,12 +1,16 @@
 //! Analyses of a task graph, level by level (the top graph and every loop
-//! body): consistency and repetition vectors, deadlock. Results are data; the
-//! problems found are also diagnostics on the channel concerned.
+//! body): consistency and repetition vectors, deadlock, schedules and buffer
+//! bounds; plus the structural SDF/L rules. Results are data; the problems
+//! found are also diagnostics on the channel or task concerned.
 
+pub mod buffers;
 pub mod consistency;
 pub mod deadlock;
 pub mod level;
 pub mod ratio;
 pub mod rules;
+pub mod schedule;
+pub mod throughput;
 
 use crate::diag::{Code, Diagnostic};
 use crate::taskgraph::model::TaskGraph;
@@ -25,11 +29,39 @@ pub struct LevelReport {
     pub repetition: Option<Vec<u64>>,
     /// Whether one iteration completes (`None` when inconsistent).
     pub deadlock_free: Option<bool>,
+    /// A looped single-appearance schedule (`3A 2B`), else a flat one, when
+    /// the level is consistent and deadlock-free.
+    pub schedule: Option<String>,
+    /// Per edge of the level: the most samples it holds under that schedule.
+    pub buffers: Vec<BufferBound>,
+    /// The self-timed iteration period, when execution times are known.
+    pub throughput: Option<ThroughputReport>,
+}
+
+/// The iteration period of the self-timed execution and the cycle bounding it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ThroughputReport {
+    /// Time units per iteration, exact (`16`, `11/2`).
+    pub period: ratio::Ratio,
+    /// Node names around the critical cycle, in flow order (one name: that
+    /// task alone, which cannot overlap with itself, bounds the period).
+    pub critical_cycle: Vec<String>,
+}
+
+/// The most samples a channel holds while one iteration runs.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BufferBound {
+    /// `A.o → B.i`
+    pub channel: String,
+    pub samples: u64,
 }
 
 #[derive(Clone, Debug, Default)]
 pub struct GraphReport {
     pub levels: Vec<LevelReport>,
+    /// The whole hierarchy as one looped schedule (`A 10(B C) D`), where every
+    /// level has a single-appearance schedule.
+    pub looped_schedule: Option<String>,
     pub diagnostics: Vec<Diagnostic>,
 }
 
@@ -51,27 +83,83 @@ pub fn analyze(graph: &TaskGraph) -> GraphReport {
     };
     for level in Level::all(graph) {
         let nodes = level.nodes.iter().map(|n| n.name.clone()).collect();
-        let (repetition, deadlock_free) = match repetition_vector(&level) {
-            Ok(counts) => {
-                let blocked = find_deadlock(&level, &counts);
-                if let Some(b) = &blocked {
-                    report.diagnostics.push(deadlock_diagnostic(&level, b));
-                }
-                (Some(counts), Some(blocked.is_none()))
-            }
-            Err(problem) => {
-                report.diagnostics.push(rate_diagnostic(&level, &problem));
-                (None, None)
-            }
-        };
-        report.levels.push(LevelReport {
+        let mut level_report = LevelReport {
             path: level.path.clone(),
             nodes,
-            repetition,
-            deadlock_free,
-        });
+            repetition: None,
+            deadlock_free: None,
+            schedule: None,
+            buffers: Vec::new(),
+            throughput: None,
+        };
+        match repetition_vector(&level) {
+            Ok(counts) => {
+                let blocked = find_deadlock(&level, &counts);
+                match &blocked {
+                    Some(b) => report.diagnostics.push(deadlock_diagnostic(&level, b)),
+                    None => {
+                        schedule_level(&level, &counts, &mut level_report, &mut report.diagnostics)
+                    }
+                }
+                level_report.deadlock_free = Some(blocked.is_none());
+                level_report.repetition = Some(counts);
+            }
+            Err(problem) => report.diagnostics.push(rate_diagnostic(&level, &problem)),
+        }
+        report.levels.push(level_report);
+    }
+    if report.is_consistent() && report.is_deadlock_free() {
+        report.looped_schedule = schedule::render_hierarchy(graph);
     }
     report
+}
+
+/// The schedule of a live level, its buffer bounds, capacity warnings, and
+/// its throughput when some task has an execution time.
+fn schedule_level(
+    level: &Level<'_>,
+    counts: &[u64],
+    report: &mut LevelReport,
+    diagnostics: &mut Vec<Diagnostic>,
+) {
+    let timed = level.nodes.iter().any(|n| {
+        n.task
+            .is_some_and(|t| level.graph.tasks[t].wcet.is_some_and(|w| w > 0))
+    });
+    if timed {
+        report.throughput = throughput::throughput(level, counts).map(|t| ThroughputReport {
+            period: t.period,
+            critical_cycle: t
+                .critical_cycle
+                .iter()
+                .map(|&n| level.nodes[n].name.clone())
+                .collect(),
+        });
+    }
+    report.schedule = match schedule::single_appearance(level, counts) {
+        Some(s) => Some(schedule::render(level, &s)),
+        None => schedule::flat_schedule(level, counts).map(|firings| {
+            let names: Vec<&str> = firings
+                .iter()
+                .map(|&n| level.nodes[n].name.as_str())
+                .collect();
+            names.join(" ")
+        }),
+    };
+    // Buffer bounds under the flat (sample-frugal) schedule.
+    if let Some(firings) = schedule::flat_schedule(level, counts) {
+        let bounds = buffers::buffer_bounds(level, &firings);
+        diagnostics.extend(buffers::capacity_warnings(level, &bounds));
+        report.buffers = level
+            .edges
+            .iter()
+            .zip(bounds)
+            .map(|(e, samples)| BufferBound {
+                channel: e.label.clone(),
+                samples,
+            })
+            .collect();
+    }
 }
 
 fn times(r: impl std::fmt::Display) -> String {

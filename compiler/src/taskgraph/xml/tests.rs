@@ -1060,7 +1060,9 @@ fn diagnostic_fixtures_produce_only_their_code() {
         let name = dir.file_name().unwrap().to_string_lossy().into_owned();
         let path = dir.join("graph.taskgraph.xml");
         // The loader's own codes; the analyses' fixtures are checked elsewhere.
-        let loader_codes = ["E060", "E061", "E062", "E063", "E064", "E065", "E066", "W060"];
+        let loader_codes = [
+            "E060", "E061", "E062", "E063", "E064", "E065", "E066", "W060",
+        ];
         if !loader_codes.iter().any(|c| name.starts_with(c)) || !path.is_file() {
             continue;
         }
