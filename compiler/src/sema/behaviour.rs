@@ -5,6 +5,7 @@
 use super::ir::*;
 use super::{Checker, suggestion};
 use crate::diag::{Code, Severity};
+use crate::syntax::ast::Name;
 use crate::syntax::ast::{self, Item, SetTarget};
 use std::collections::HashSet;
 
@@ -262,13 +263,13 @@ impl<'a> Checker<'a> {
             self.report(Code::TeamWithoutMain, span, message);
             return;
         }
-        let caught: Vec<String> = t
+        let caught: Vec<Name> = t
             .events
             .iter()
             .filter(|e| !e.caught_at.is_empty())
             .map(|e| e.name.clone())
             .collect();
-        let uncaught: Vec<(String, Vec<crate::span::Span>)> = t
+        let uncaught: Vec<(Name, Vec<crate::span::Span>)> = t
             .events
             .iter()
             .filter(|e| e.caught_at.is_empty())
@@ -276,7 +277,7 @@ impl<'a> Checker<'a> {
             .collect();
         let team_name = t.name.clone();
         for (name, spans) in uncaught {
-            let guess = suggestion(&name, caught.iter().map(String::as_str));
+            let guess = suggestion(&name, caught.iter().map(Name::as_str));
             for span in spans {
                 self.report(
                     Code::EventNeverCaught,
@@ -343,7 +344,7 @@ impl<'a> Checker<'a> {
             }
         }
         let default_name = t.modes[*start as usize].name.clone();
-        let unreachable: Vec<(crate::span::Span, String)> = t
+        let unreachable: Vec<(crate::span::Span, Name)> = t
             .modes
             .iter()
             .enumerate()

@@ -8,7 +8,7 @@ use super::{Checker, is_user, suggestion};
 use crate::catalog::{RobotTypeId, ServiceDef, ValueType};
 use crate::diag::Code;
 use crate::span::Span;
-use crate::syntax::ast::{self, Arg, ArmKind, CondKind, Expr, ExprKind, StmtKind};
+use crate::syntax::ast::{self, Arg, ArmKind, CondKind, Expr, ExprKind, Name, StmtKind};
 use std::rc::Rc;
 
 /// Deeper chains of function calls are refused: they are surely a mistake, and
@@ -16,7 +16,7 @@ use std::rc::Rc;
 const MAX_INLINING_DEPTH: usize = 64;
 
 /// Robot types, each with the names of the robots of that type.
-pub(super) type TypeList = Rc<[(RobotTypeId, Vec<String>)]>;
+pub(super) type TypeList = Rc<[(RobotTypeId, Vec<Name>)]>;
 
 /// Who runs the statements being checked.
 #[derive(Clone, Debug)]
@@ -38,37 +38,37 @@ pub(super) struct Scope {
 enum Resolution {
     Value {
         owner: Option<TeamId>,
-        name: String,
+        name: Name,
         ty: ValueType,
     },
     /// A catalog value that some of the robots running the statement lack, or
     /// all of them (`none`).
     PartialValue {
-        name: String,
-        team: String,
+        name: Name,
+        team: Name,
         lacking: String,
         advice: String,
         none: bool,
     },
     Variable {
         team: Option<TeamId>,
-        name: String,
+        name: Name,
     },
     /// `T.X` where `T` is a team (or `USER`) without such a value or variable.
     NotInTeam {
-        team: String,
-        name: String,
+        team: Name,
+        name: Name,
         known: Vec<String>,
     },
     NotATeam {
-        team: String,
+        team: Name,
     },
     TooLong,
     /// A single name that is neither: a symbolic constant where one is allowed.
     /// `known`: where to look for the value or variable it may be a typo of
     /// (gathered only if it is reported: most bare names are fine constants).
     Bare {
-        name: String,
+        name: Name,
         known: Candidates,
     },
     /// Nothing can be said (no robot runs the statement).
@@ -93,7 +93,7 @@ enum Type {
     Bool,
     Period,
     Value(ValueType),
-    Constant(String),
+    Constant(Name),
     Unknown,
 }
 
@@ -126,7 +126,7 @@ impl Type {
             (Type::Bool, V::Bool) => true,
             (Type::Text, V::String | V::Location) => true,
             (Type::Text | Type::Constant(_), V::Enum(domain)) => match self {
-                Type::Constant(c) => domain.contains(c),
+                Type::Constant(c) => domain.iter().any(|d| d == c),
                 _ => true,
             },
             (Type::Constant(_), V::String | V::Location) => true,
@@ -322,7 +322,7 @@ impl<'a> Checker<'a> {
 
     /// The known robot types among `robots` of `team`, each with its robots' names.
     fn types_of(&self, team: TeamId, robots: &[Index]) -> TypeList {
-        let mut types: Vec<(RobotTypeId, Vec<String>)> = Vec::new();
+        let mut types: Vec<(RobotTypeId, Vec<Name>)> = Vec::new();
         let t = self.team(team);
         for &r in robots {
             let robot = &t.robots[r as usize];
@@ -335,7 +335,7 @@ impl<'a> Checker<'a> {
         types.into()
     }
 
-    fn describe_types(&self, types: &[(RobotTypeId, Vec<String>)]) -> String {
+    fn describe_types(&self, types: &[(RobotTypeId, Vec<Name>)]) -> String {
         let parts: Vec<String> = types
             .iter()
             .map(|(ty, names)| format!("{} ({})", self.catalog.get(*ty).name, names.join(", ")))
@@ -354,7 +354,7 @@ impl<'a> Checker<'a> {
             .collect();
         let Some(any_def) = anywhere else {
             let mut candidates: Vec<&str> =
-                self.functions_by_name.keys().map(String::as_str).collect();
+                self.functions_by_name.keys().map(Name::as_str).collect();
             if types.is_empty() {
                 candidates.extend(
                     catalog
@@ -380,11 +380,11 @@ impl<'a> Checker<'a> {
         let def = providers.first().copied().unwrap_or(any_def);
         self.occurrence(
             call.name.span,
-            Symbol::BuiltinService(def.name.clone()),
+            Symbol::BuiltinService(Name::new(&def.name)),
             false,
         );
         if providers.len() < types.len() {
-            let lacking: Vec<(RobotTypeId, Vec<String>)> = types
+            let lacking: Vec<(RobotTypeId, Vec<Name>)> = types
                 .iter()
                 .filter(|(ty, _)| catalog.get(*ty).service(name).is_none())
                 .cloned()
@@ -539,7 +539,7 @@ impl<'a> Checker<'a> {
                 _ => "this value".to_string(),
             };
             let written = match (other, other_side_text(other_span, lhs, rhs)) {
-                (Type::Constant(c), _) => Some(c.clone()),
+                (Type::Constant(c), _) => Some(c.to_string()),
                 (Type::Text, Some(s)) => Some(s),
                 _ => None,
             };
@@ -592,7 +592,7 @@ impl<'a> Checker<'a> {
                 match self.catalog.user().and_then(|u| u.value(&name.name)) {
                     Some(v) => Resolution::Value {
                         owner: None,
-                        name: v.name.clone(),
+                        name: Name::new(&v.name),
                         ty: v.ty.clone(),
                     },
                     None => Resolution::NotInTeam {
@@ -643,14 +643,14 @@ impl<'a> Checker<'a> {
             }
             return Resolution::Value {
                 owner: Some(team),
-                name: def.name.clone(),
+                name: Name::new(&def.name),
                 ty: def.ty.clone(),
             };
         }
         if self.is_variable(team, name) {
             return Resolution::Variable {
                 team: Some(team),
-                name: name.to_string(),
+                name: Name::new(name),
             };
         }
         if types.is_empty() {
@@ -677,13 +677,13 @@ impl<'a> Checker<'a> {
         }
         if bare {
             return Resolution::Bare {
-                name: name.to_string(),
+                name: Name::new(name),
                 known: Candidates::Team(team, types),
             };
         }
         Resolution::NotInTeam {
             team: self.team(team).name.clone(),
-            name: name.to_string(),
+            name: Name::new(name),
             known: self.candidate_names(&Candidates::Team(team, types)),
         }
     }
@@ -694,12 +694,12 @@ impl<'a> Checker<'a> {
             Candidates::Everywhere => catalog
                 .types()
                 .flat_map(|(_, r)| r.values.iter().map(|v| v.name.clone()))
-                .chain(self.variables.keys().cloned())
+                .chain(self.variables.keys().map(Name::to_string))
                 .collect(),
             Candidates::Team(team, types) => types
                 .iter()
                 .flat_map(|(ty, _)| catalog.get(*ty).values.iter().map(|v| v.name.clone()))
-                .chain(self.team(*team).variables.iter().cloned())
+                .chain(self.team(*team).variables.iter().map(Name::to_string))
                 .collect(),
         }
     }
@@ -710,7 +710,7 @@ impl<'a> Checker<'a> {
         &self,
         team: TeamId,
         name: &str,
-        types: &[(RobotTypeId, Vec<String>)],
+        types: &[(RobotTypeId, Vec<Name>)],
         advice: String,
         none: bool,
     ) -> Resolution {
@@ -720,7 +720,7 @@ impl<'a> Checker<'a> {
             .cloned()
             .collect();
         Resolution::PartialValue {
-            name: name.to_string(),
+            name: Name::new(name),
             team: self.team(team).name.clone(),
             lacking: self.describe_types(&lacking),
             advice,
@@ -1075,7 +1075,7 @@ impl<'a> Checker<'a> {
         };
         let owner = match attr.segments.as_slice() {
             [_] => self.team(scope.team?).name.clone(),
-            [team, _] if is_user(&team.name) => "USER".to_string(),
+            [team, _] if is_user(&team.name) => Name::new_static("USER"),
             [team, _] => team.name.clone(),
             _ => return None,
         };

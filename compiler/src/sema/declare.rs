@@ -6,7 +6,7 @@ use super::ir::*;
 use super::{Checker, is_user, suggestion};
 use crate::diag::Code;
 use crate::span::Span;
-use crate::syntax::ast::{self, Item};
+use crate::syntax::ast::{self, Item, Name};
 use std::collections::HashMap;
 
 impl<'a> Checker<'a> {
@@ -34,7 +34,7 @@ impl<'a> Checker<'a> {
         self.collect_variables();
     }
 
-    fn declare_team(&mut self, decl: &ast::TeamDecl, robot_names: &mut HashMap<String, Span>) {
+    fn declare_team(&mut self, decl: &ast::TeamDecl, robot_names: &mut HashMap<Name, Span>) {
         let name = &decl.name;
         if is_user(&name.name) {
             self.report(
@@ -63,11 +63,11 @@ impl<'a> Checker<'a> {
         let mut robots = Vec::new();
         for robot in &decl.robots {
             let robot_type = self.resolve_robot_type(&robot.robot_type);
-            let names: Vec<String> = match robot.count {
+            let names: Vec<Name> = match robot.count {
                 None => vec![robot.name.name.clone()],
-                Some(ast::Count { value: Some(n), .. }) if n >= 1 => {
-                    (0..n).map(|i| format!("{}_{i}", robot.name.name)).collect()
-                }
+                Some(ast::Count { value: Some(n), .. }) if n >= 1 => (0..n)
+                    .map(|i| Name::new(format!("{}_{i}", robot.name.name)))
+                    .collect(),
                 Some(count) => {
                     self.report(
                         Code::EmptyRobotGroup,
@@ -101,7 +101,7 @@ impl<'a> Checker<'a> {
                     name_span: robot.name.span,
                     type_name: robot_type
                         .map(|t| self.catalog.get(t).name.clone())
-                        .unwrap_or_else(|| robot.robot_type.name.clone()),
+                        .unwrap_or_else(|| robot.robot_type.name.to_string()),
                     robot_type,
                 });
             }
@@ -128,7 +128,7 @@ impl<'a> Checker<'a> {
         match self.catalog.lookup(&name.name) {
             Some(id) => {
                 let canonical = self.catalog.get(id).name.clone();
-                self.occurrence(name.span, Symbol::RobotType(canonical), false);
+                self.occurrence(name.span, Symbol::RobotType(Name::new(canonical)), false);
                 Some(id)
             }
             None => {
@@ -274,7 +274,7 @@ impl<'a> Checker<'a> {
     fn collect_variables(&mut self) {
         let mut found = Vec::new();
         let mut visit =
-            |owner: Option<TeamId>, block: &ast::Block, teams: &HashMap<String, TeamId>| {
+            |owner: Option<TeamId>, block: &ast::Block, teams: &HashMap<Name, TeamId>| {
                 block.walk(&mut |stmt| {
                     let ast::StmtKind::Comm(comm) = &stmt.kind else {
                         return;

@@ -6,7 +6,7 @@
 use crate::catalog::RobotTypeId;
 use crate::diag::FileId;
 use crate::span::Span;
-use crate::syntax::ast;
+use crate::syntax::ast::{self, Name};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct TeamId(pub u32);
@@ -30,7 +30,7 @@ pub struct Mission {
 
 #[derive(Clone, Debug)]
 pub struct Team {
-    pub name: String,
+    pub name: Name,
     pub name_span: Span,
     pub robots: Vec<Robot>,
     pub plans: Vec<Plan>,
@@ -40,13 +40,13 @@ pub struct Team {
     /// Events its services throw or its main catches.
     pub events: Vec<Event>,
     /// Team variables (`T.X` assigned in send/publish, or received).
-    pub variables: Vec<String>,
+    pub variables: Vec<Name>,
 }
 
 /// One robot. `name[N]` declares N robots `name_0` .. `name_{N-1}`.
 #[derive(Clone, Debug)]
 pub struct Robot {
-    pub name: String,
+    pub name: Name,
     /// The range of the declaration's name (shared by the N robots of `name[N]`).
     pub name_span: Span,
     pub type_name: String,
@@ -56,14 +56,14 @@ pub struct Robot {
 
 #[derive(Clone, Debug)]
 pub struct Plan {
-    pub name: String,
+    pub name: Name,
     /// Where the plan is first named in a service header.
     pub span: Span,
 }
 
 #[derive(Clone, Debug)]
 pub struct Service {
-    pub name: String,
+    pub name: Name,
     pub name_span: Span,
     pub plan: Index,
     pub span: Span,
@@ -71,12 +71,12 @@ pub struct Service {
     /// `repeat` are read from there ([`crate::Analysis::service_syntax`]).
     pub item: usize,
     /// Events this service can throw, directly or through functions it calls.
-    pub throws: Vec<String>,
+    pub throws: Vec<Name>,
 }
 
 #[derive(Clone, Debug)]
 pub struct Mode {
-    pub name: String,
+    pub name: Name,
     pub name_span: Span,
     pub span: Span,
     pub sets: Vec<ModeSet>,
@@ -102,7 +102,7 @@ pub struct Main {
 #[derive(Clone, Debug)]
 pub struct Transition {
     pub from: Index,
-    pub event: String,
+    pub event: Name,
     pub event_span: Span,
     pub to: Index,
     pub span: Span,
@@ -110,14 +110,14 @@ pub struct Transition {
 
 #[derive(Clone, Debug, Default)]
 pub struct Event {
-    pub name: String,
+    pub name: Name,
     pub thrown_at: Vec<Span>,
     pub caught_at: Vec<Span>,
 }
 
 #[derive(Clone, Debug)]
 pub struct FunctionInfo {
-    pub name: String,
+    pub name: Name,
     pub name_span: Span,
     /// Index of the function's item in the file's syntax tree.
     pub item: usize,
@@ -136,8 +136,8 @@ pub enum Peer {
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct AttrKey {
     /// The team the value belongs to, or `USER`.
-    pub owner: String,
-    pub name: String,
+    pub owner: Name,
+    pub name: Name,
 }
 
 impl std::fmt::Display for AttrKey {
@@ -166,8 +166,8 @@ pub enum Symbol {
         team: TeamId,
         robot: Index,
     },
-    RobotType(String),
-    Capability(String),
+    RobotType(Name),
+    Capability(Name),
     Plan {
         team: TeamId,
         plan: Index,
@@ -182,22 +182,22 @@ pub enum Symbol {
     },
     Event {
         team: TeamId,
-        name: String,
+        name: Name,
     },
     Function(FunctionId),
     /// A catalog service such as `move`.
-    BuiltinService(String),
+    BuiltinService(Name),
     /// A catalog value of a team's robots (or of `USER`).
     Value {
         owner: Option<TeamId>,
-        name: String,
+        name: Name,
     },
     TeamVariable {
         team: Option<TeamId>,
-        name: String,
+        name: Name,
     },
     /// A symbolic constant such as `colored_paper`.
-    Constant(String),
+    Constant(Name),
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -243,7 +243,7 @@ impl Team {
             Some(i) => i,
             None => {
                 self.events.push(Event {
-                    name: name.to_string(),
+                    name: Name::new(name),
                     ..Event::default()
                 });
                 self.events.len() - 1

@@ -23,7 +23,7 @@ pub use ir::*;
 use crate::catalog::Catalog;
 use crate::diag::{self, Code, Diagnostic, FileId};
 use crate::span::Span;
-use crate::syntax::{self, ast};
+use crate::syntax::{self, ast, ast::Name};
 use std::collections::{HashMap, HashSet};
 
 /// Everything known about one mission file after checking.
@@ -101,11 +101,11 @@ pub(crate) struct Checker<'a> {
     catalog: &'a Catalog,
     mission: Mission,
     diagnostics: Vec<Diagnostic>,
-    teams_by_name: HashMap<String, TeamId>,
-    functions_by_name: HashMap<String, FunctionId>,
+    teams_by_name: HashMap<Name, TeamId>,
+    functions_by_name: HashMap<Name, FunctionId>,
     /// Team variables declared anywhere by `T.X = ...` or received, by name:
     /// the teams declaring them (`None` when written bare inside a function).
-    variables: HashMap<String, Vec<Option<TeamId>>>,
+    variables: HashMap<Name, Vec<Option<TeamId>>>,
     /// Services named by the `set`s of a mode defined twice (already reported):
     /// they are not "never set".
     set_by_duplicate_modes: HashSet<(TeamId, Index)>,
@@ -194,7 +194,11 @@ impl<'a> Checker<'a> {
     }
 
     fn team_names(&self) -> Vec<String> {
-        self.mission.teams.iter().map(|t| t.name.clone()).collect()
+        self.mission
+            .teams
+            .iter()
+            .map(|t| t.name.to_string())
+            .collect()
     }
 
     fn finish(mut self) -> (Mission, Vec<Diagnostic>) {

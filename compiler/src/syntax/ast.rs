@@ -5,17 +5,21 @@
 
 use crate::span::Span;
 
+/// A name as stored everywhere in the tree and the IR: short names (nearly all
+/// of them) live inline, so parsing allocates nothing per identifier.
+pub type Name = smol_str::SmolStr;
+
 /// A name as written, with its range.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Ident {
-    pub name: String,
+    pub name: Name,
     pub span: Span,
 }
 
 impl Ident {
-    pub fn new(name: impl Into<String>, span: Span) -> Self {
+    pub fn new(name: &str, span: Span) -> Self {
         Ident {
-            name: name.into(),
+            name: Name::new(name),
             span,
         }
     }
