@@ -65,7 +65,7 @@ pub fn capacity_warnings(level: &Level<'_>, bounds: &[u64]) -> Vec<Diagnostic> {
 #[cfg(test)]
 mod tests {
     use super::super::schedule::flat_schedule;
-    use super::super::schedule::tests::{channel, graph, task};
+    use super::super::testing::{channel, graph, task};
     use super::*;
     use crate::span::Span;
 

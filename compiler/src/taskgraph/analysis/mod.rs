@@ -264,4 +264,6 @@ fn deadlock_diagnostic(level: &Level<'_>, blocked: &deadlock::Blocked) -> Diagno
 }
 
 #[cfg(test)]
+mod testing;
+#[cfg(test)]
 mod tests;

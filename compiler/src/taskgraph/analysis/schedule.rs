@@ -757,86 +757,12 @@ pub fn multicore(
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::super::consistency::repetition_vector;
+    use super::super::testing::*;
     use super::*;
     use crate::diag::FileId;
-    use crate::span::Span;
     use crate::taskgraph::model::*;
-
-    fn named(name: &str) -> Named {
-        Named {
-            name: name.to_string(),
-            span: Span::default(),
-        }
-    }
-
-    fn port(spec: &str) -> Port {
-        // "o>2": output o, rate 2; "i<3": input i, rate 3.
-        let (name, dir, rate) = match spec.split_once('>') {
-            Some((n, r)) => (n, Direction::Out, r),
-            None => {
-                let (n, r) = spec.split_once('<').unwrap();
-                (n, Direction::In, r)
-            }
-        };
-        Port {
-            name: named(name),
-            span: Span::default(),
-            dir,
-            rate: rate.parse().unwrap(),
-            rate_span: None,
-            sample_type: None,
-            size: None,
-            kind: None,
-            inner_rate: None,
-        }
-    }
-
-    pub(crate) fn task(name: &str, ports: &[&str]) -> Task {
-        Task {
-            name: named(name),
-            span: Span::default(),
-            kind: TaskKind::Computational,
-            trigger: Trigger::Data,
-            wcet: None,
-            source: None,
-            subgraph: None,
-            ports: ports.iter().map(|p| port(p)).collect(),
-            library_ports: Vec::new(),
-            multicast_ports: Vec::new(),
-            loop_node: None,
-        }
-    }
-
-    pub(crate) fn channel(src: &str, dst: &str, tokens: u64, at: usize) -> Channel {
-        let end = |s: &str| {
-            let (task, port) = s.split_once('.').unwrap();
-            Endpoint {
-                task: task.into(),
-                port: port.into(),
-                span: Span::default(),
-            }
-        };
-        Channel {
-            src: end(src),
-            dst: end(dst),
-            initial_tokens: tokens,
-            capacity: None,
-            span: Span::new(at, at + 1),
-        }
-    }
-
-    pub(crate) fn graph(name: &str, tasks: Vec<Task>, channels: Vec<Channel>) -> TaskGraph {
-        TaskGraph {
-            name: name.into(),
-            file: FileId(0),
-            span: Span::default(),
-            tasks,
-            channels,
-            libraries: Vec::new(),
-        }
-    }
 
     fn top(g: &TaskGraph) -> (Level<'_>, Vec<u64>) {
         let level = Level::build(g, None, g.name.clone());

@@ -367,84 +367,26 @@ fn level_cycle(mut walk: Vec<usize>) -> Vec<usize> {
 mod tests {
     use super::*;
     use crate::diag::FileId;
-    use crate::span::Span;
     use crate::taskgraph::analysis::consistency::repetition_vector;
     use crate::taskgraph::analysis::deadlock::find_deadlock;
     use crate::taskgraph::model::*;
     use std::collections::HashMap;
 
-    fn named(name: &str) -> Named {
-        Named {
-            name: name.to_string(),
-            span: Span::default(),
-        }
-    }
-
-    fn port(spec: &str) -> Port {
-        // "o>2": output o, rate 2; "i<3": input i, rate 3.
-        let (name, dir, rate) = match spec.split_once('>') {
-            Some((n, r)) => (n, Direction::Out, r),
-            None => {
-                let (n, r) = spec.split_once('<').unwrap();
-                (n, Direction::In, r)
-            }
-        };
-        Port {
-            name: named(name),
-            span: Span::default(),
-            dir,
-            rate: rate.parse().unwrap(),
-            rate_span: None,
-            sample_type: None,
-            size: None,
-            kind: None,
-            inner_rate: None,
-        }
-    }
+    use crate::taskgraph::analysis::testing::{self, port};
 
     fn task(name: &str, wcet: u64, ports: &[&str]) -> Task {
         Task {
-            name: named(name),
-            span: Span::default(),
-            kind: TaskKind::Computational,
-            trigger: Trigger::Data,
             wcet: Some(wcet),
-            source: None,
-            subgraph: None,
-            ports: ports.iter().map(|p| port(p)).collect(),
-            library_ports: Vec::new(),
-            multicast_ports: Vec::new(),
-            loop_node: None,
+            ..testing::task(name, ports)
         }
     }
 
     fn channel(src: &str, dst: &str, tokens: u64) -> Channel {
-        let end = |s: &str| {
-            let (task, port) = s.split_once('.').unwrap();
-            Endpoint {
-                task: task.into(),
-                port: port.into(),
-                span: Span::default(),
-            }
-        };
-        Channel {
-            src: end(src),
-            dst: end(dst),
-            initial_tokens: tokens,
-            capacity: None,
-            span: Span::default(),
-        }
+        testing::channel(src, dst, tokens, 0)
     }
 
     fn graph(tasks: Vec<Task>, channels: Vec<Channel>) -> TaskGraph {
-        TaskGraph {
-            name: "g".into(),
-            file: FileId(0),
-            span: Span::default(),
-            tasks,
-            channels,
-            libraries: Vec::new(),
-        }
+        testing::graph("g", tasks, channels)
     }
 
     fn ratio(num: u64, den: u64) -> Ratio {
