@@ -48,7 +48,7 @@ pub const MAX_FIRINGS: u64 = 1 << 20;
 
 /// Above this many components in one frame, loops are factored by the gcd of
 /// the whole frame only (DPPO is cubic).
-const DPPO_LIMIT: usize = 256;
+const DPPO_LIMIT: usize = 64;
 
 /// A term of a looped schedule.
 #[derive(Clone, Debug, PartialEq, Eq)]
