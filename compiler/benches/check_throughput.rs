@@ -2,11 +2,14 @@
 //! parse alone and parse+check, in MB/s and lines/s. Run with `cargo bench`.
 //! The target is at least 30 MB/s for parse+check on a 2-core machine.
 
+mod common;
+use common::fastest;
+
 use semo::catalog::builtin_catalog;
 use semo::diag::FileId;
 use std::fmt::Write;
 use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// A realistic mission: mixed teams with groups, communication between
 /// neighbouring teams, modes with transitions, functions, comments.
@@ -94,20 +97,6 @@ Team{t}.main{{
         .unwrap();
     }
     m
-}
-
-/// Runs `f` repeatedly for about `budget`, and gives the fastest run.
-fn fastest(budget: Duration, mut f: impl FnMut()) -> Duration {
-    let start = Instant::now();
-    let mut best = Duration::MAX;
-    let mut runs = 0;
-    while runs < 3 || start.elapsed() < budget {
-        let t = Instant::now();
-        f();
-        best = best.min(t.elapsed());
-        runs += 1;
-    }
-    best
 }
 
 fn main() {

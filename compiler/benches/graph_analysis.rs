@@ -4,25 +4,15 @@
 //! analysis of each SDF3 benchmark under 10 ms ("analyse" below: consistency,
 //! deadlock, schedules, buffers, throughput and the SDF/L rules).
 
+mod common;
+use common::fastest;
+
 use semo::diag::FileId;
 use semo::taskgraph::analysis::{self, consistency, deadlock, level::Level, throughput};
 use semo::taskgraph::load_task_graph;
 use std::fmt::Write;
 use std::hint::black_box;
-use std::time::{Duration, Instant};
-
-fn fastest(budget: Duration, mut f: impl FnMut()) -> Duration {
-    let start = Instant::now();
-    let mut best = Duration::MAX;
-    let mut runs = 0;
-    while runs < 3 || start.elapsed() < budget {
-        let t = Instant::now();
-        f();
-        best = best.min(t.elapsed());
-        runs += 1;
-    }
-    best
-}
+use std::time::Duration;
 
 /// A chain of `n` tasks with alternating rates (2 out, 1 in; then 1 out, 2 in)
 /// so the repetition vector alternates 1, 2, plus side branches and a feedback

@@ -77,3 +77,31 @@ pub(crate) fn graph(name: &str, tasks: Vec<Task>, channels: Vec<Channel>) -> Tas
         libraries: Vec::new(),
     }
 }
+
+/// `shared/examples/taskgraphs/data_loop`: A 10→ L (D-loop × 10 over B, C) 10→ D.
+pub(crate) fn data_loop() -> TaskGraph {
+    let mut l = task("L", &["in<10", "out>10"]);
+    l.kind = TaskKind::Loop;
+    for p in &mut l.ports {
+        p.inner_rate = Some(1);
+    }
+    l.loop_node = Some(Box::new(LoopNode {
+        loop_type: LoopType::D,
+        loop_count: 10,
+        exit_task: None,
+        body: graph(
+            "L_body",
+            vec![task("B", &["i<1", "o>1"]), task("C", &["i<1", "o>1"])],
+            vec![
+                channel("L.in", "B.i", 0, 1),
+                channel("B.o", "C.i", 0, 2),
+                channel("C.o", "L.out", 0, 3),
+            ],
+        ),
+    }));
+    graph(
+        "data_loop",
+        vec![task("A", &["o>10"]), l, task("D", &["i<10"])],
+        vec![channel("A.o", "L.in", 0, 4), channel("L.out", "D.i", 0, 5)],
+    )
+}

@@ -1,7 +1,6 @@
 use super::testing::*;
 use super::*;
 use crate::span::Span;
-use crate::taskgraph::model::*;
 
 #[test]
 fn multirate_chain_has_the_smallest_repetition_vector() {
@@ -124,30 +123,7 @@ fn self_loops_need_a_sample_to_fire() {
 
 #[test]
 fn loop_bodies_are_levels_with_a_boundary_firing_once() {
-    let mut l = task("L", &["in<10", "out>10"]);
-    l.kind = TaskKind::Loop;
-    for p in &mut l.ports {
-        p.inner_rate = Some(1);
-    }
-    l.loop_node = Some(Box::new(LoopNode {
-        loop_type: LoopType::D,
-        loop_count: 10,
-        exit_task: None,
-        body: graph(
-            "L_body",
-            vec![task("B", &["i<1", "o>1"]), task("C", &["i<1", "o>1"])],
-            vec![
-                channel("L.in", "B.i", 0, 1),
-                channel("B.o", "C.i", 0, 2),
-                channel("C.o", "L.out", 0, 3),
-            ],
-        ),
-    }));
-    let g = graph(
-        "data_loop",
-        vec![task("A", &["o>10"]), l, task("D", &["i<10"])],
-        vec![channel("A.o", "L.in", 0, 4), channel("L.out", "D.i", 0, 5)],
-    );
+    let g = data_loop();
     let report = analyze(&g);
     assert!(report.diagnostics.is_empty(), "{:?}", report.diagnostics);
     assert_eq!(report.levels.len(), 2);
