@@ -33,6 +33,18 @@ impl FileKind {
     }
 }
 
+impl FileKind {
+    /// The kind of a file the user named: as [`FileKind::of`], else any other
+    /// `.xml` file is a task graph (an SDF3 benchmark, say) and anything else a
+    /// mission, whatever its extension.
+    pub fn named_explicitly(path: &Path) -> FileKind {
+        FileKind::of(path).unwrap_or_else(|| match path.extension().and_then(|e| e.to_str()) {
+            Some(ext) if ext.eq_ignore_ascii_case("xml") => FileKind::TaskGraph,
+            _ => FileKind::Mission,
+        })
+    }
+}
+
 /// A loaded source file.
 #[derive(Clone, Debug)]
 pub struct SourceFile {
@@ -105,9 +117,9 @@ impl std::fmt::Display for LoadError {
     }
 }
 
-/// Expands the paths given on the command line: files as they are (whatever
-/// their extension, a file named explicitly is a mission unless it is
-/// `*.robot.xml`), folders recursively, sorted for stable output.
+/// Expands the paths given on the command line: files as they are (see
+/// [`FileKind::named_explicitly`]), folders recursively (their `.mission`,
+/// `.robot.xml` and `.taskgraph.xml` files), sorted for stable output.
 pub fn collect(paths: &[PathBuf]) -> Result<Vec<(PathBuf, FileKind)>, LoadError> {
     let mut found = Vec::new();
     for path in paths {
@@ -118,10 +130,7 @@ pub fn collect(paths: &[PathBuf]) -> Result<Vec<(PathBuf, FileKind)>, LoadError>
         if meta.is_dir() {
             walk(path, &mut found)?;
         } else {
-            found.push((
-                path.clone(),
-                FileKind::of(path).unwrap_or(FileKind::Mission),
-            ));
+            found.push((path.clone(), FileKind::named_explicitly(path)));
         }
     }
     Ok(found)

@@ -173,7 +173,7 @@ fn write_json(
 /// `semo graph schedule`: the looped schedule of the whole graph, and with
 /// `cores` a list schedule of each level's iteration onto that many cores.
 pub fn schedule(path: &Path, cores: Option<usize>, out: &mut impl Write) -> i32 {
-    use crate::taskgraph::analysis::{consistency, deadlock, level::Level, schedule};
+    use crate::taskgraph::analysis::{level::Level, schedule};
     let Some(text) = read(path) else { return 2 };
     let mut files = Files::default();
     let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
@@ -197,14 +197,12 @@ pub fn schedule(path: &Path, cores: Option<usize>, out: &mut impl Write) -> i32 
         }
     }
     if let Some(cores) = cores {
-        for level in Level::all(graph) {
-            let Ok(counts) = consistency::repetition_vector(&level) else {
+        // The report's levels are `Level::all`'s, in the same order.
+        for (level, report) in Level::all(graph).iter().zip(&run.report.levels) {
+            let (Some(counts), Some(true)) = (&report.repetition, report.deadlock_free) else {
                 continue;
             };
-            if deadlock::find_deadlock(&level, &counts).is_some() {
-                continue;
-            }
-            let Some(plan) = schedule::multicore(&level, &counts, cores) else {
+            let Some(plan) = schedule::multicore(level, counts, cores) else {
                 text.push_str(&format!("{}: no schedule on {cores} cores\n", level.path));
                 continue;
             };

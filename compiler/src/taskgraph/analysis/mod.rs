@@ -81,7 +81,11 @@ pub fn analyze(graph: &TaskGraph) -> GraphReport {
         diagnostics: rules::check(graph),
         ..GraphReport::default()
     };
-    for level in Level::all(graph) {
+    let levels = Level::all(graph);
+    // Each level's single-appearance schedule, kept to write the whole
+    // hierarchy's looped schedule at the end.
+    let mut single_appearance = Vec::with_capacity(levels.len());
+    for level in &levels {
         let nodes = level.nodes.iter().map(|n| n.name.clone()).collect();
         let mut level_report = LevelReport {
             path: level.path.clone(),
@@ -92,36 +96,42 @@ pub fn analyze(graph: &TaskGraph) -> GraphReport {
             buffers: Vec::new(),
             throughput: None,
         };
-        match repetition_vector(&level) {
+        let mut sas = None;
+        match repetition_vector(level) {
             Ok(counts) => {
-                let blocked = find_deadlock(&level, &counts);
+                let blocked = find_deadlock(level, &counts);
                 match &blocked {
-                    Some(b) => report.diagnostics.push(deadlock_diagnostic(&level, b)),
+                    Some(b) => report.diagnostics.push(deadlock_diagnostic(level, b)),
                     None => {
-                        schedule_level(&level, &counts, &mut level_report, &mut report.diagnostics)
+                        sas = schedule_level(
+                            level,
+                            &counts,
+                            &mut level_report,
+                            &mut report.diagnostics,
+                        )
                     }
                 }
                 level_report.deadlock_free = Some(blocked.is_none());
                 level_report.repetition = Some(counts);
             }
-            Err(problem) => report.diagnostics.push(rate_diagnostic(&level, &problem)),
+            Err(problem) => report.diagnostics.push(rate_diagnostic(level, &problem)),
         }
+        single_appearance.push(sas);
         report.levels.push(level_report);
     }
-    if report.is_consistent() && report.is_deadlock_free() {
-        report.looped_schedule = schedule::render_hierarchy(graph);
-    }
+    report.looped_schedule = schedule::render_hierarchy(&levels, &single_appearance);
     report
 }
 
 /// The schedule of a live level, its buffer bounds, capacity warnings, and
-/// its throughput when some task has an execution time.
+/// its throughput when some task has an execution time. Gives the level's
+/// single-appearance schedule, if it has one.
 fn schedule_level(
     level: &Level<'_>,
     counts: &[u64],
     report: &mut LevelReport,
     diagnostics: &mut Vec<Diagnostic>,
-) {
+) -> Option<Vec<schedule::Schedule>> {
     let timed = level.nodes.iter().any(|n| {
         n.task
             .is_some_and(|t| level.graph.tasks[t].wcet.is_some_and(|w| w > 0))
@@ -136,19 +146,23 @@ fn schedule_level(
                 .collect(),
         });
     }
-    report.schedule = match schedule::single_appearance(level, counts) {
-        Some(s) => Some(schedule::render(level, &s)),
-        None => schedule::flat_schedule(level, counts).map(|firings| {
+    let single_appearance = schedule::single_appearance(level, counts);
+    // The flat (sample-frugal) schedule: the buffer bounds are measured under
+    // it, and it is the level's schedule where no single-appearance one exists.
+    let flat = schedule::flat_schedule(level, counts);
+    report.schedule = match (&single_appearance, &flat) {
+        (Some(s), _) => Some(schedule::render(level, s)),
+        (None, Some(firings)) => {
             let names: Vec<&str> = firings
                 .iter()
                 .map(|&n| level.nodes[n].name.as_str())
                 .collect();
-            names.join(" ")
-        }),
+            Some(names.join(" "))
+        }
+        (None, None) => None,
     };
-    // Buffer bounds under the flat (sample-frugal) schedule.
-    if let Some(firings) = schedule::flat_schedule(level, counts) {
-        let bounds = buffers::buffer_bounds(level, &firings);
+    if let Some(firings) = &flat {
+        let bounds = buffers::buffer_bounds(level, firings);
         diagnostics.extend(buffers::capacity_warnings(level, &bounds));
         report.buffers = level
             .edges
@@ -160,6 +174,7 @@ fn schedule_level(
             })
             .collect();
     }
+    single_appearance
 }
 
 fn times(r: impl std::fmt::Display) -> String {

@@ -111,28 +111,47 @@ fn render_with(
     terms.join(" ")
 }
 
-/// The looped single-appearance schedule of `graph` with every loop node
-/// written as its body's schedule repeated `loopCount` times (for a C-type
-/// loop: at most that many): `A 10(B C) D`. `None` when some level is
-/// inconsistent or has no single-appearance schedule.
-pub fn render_hierarchy(graph: &crate::taskgraph::model::TaskGraph) -> Option<String> {
-    render_level(Level::build(graph, None, graph.name.clone()))
+/// The looped single-appearance schedule of a whole graph, with every loop
+/// node written as its body's schedule repeated `loopCount` times (for a C-type
+/// loop: at most that many): `A 10(B C) D`. `levels` are as [`Level::all`]
+/// gives them (outermost first) and `schedules` their single-appearance
+/// schedules; `None` when some level has none.
+pub fn render_hierarchy(
+    levels: &[Level<'_>],
+    schedules: &[Option<Vec<Schedule>>],
+) -> Option<String> {
+    render_at(levels, schedules, 0)
 }
 
-fn render_level(level: Level<'_>) -> Option<String> {
-    let counts = super::consistency::repetition_vector(&level).ok()?;
-    let schedule = single_appearance(&level, &counts)?;
+/// [`render_hierarchy`] computing every level's schedule itself.
+pub fn looped_schedule(graph: &crate::taskgraph::model::TaskGraph) -> Option<String> {
+    let levels = Level::all(graph);
+    let schedules: Vec<Option<Vec<Schedule>>> = levels
+        .iter()
+        .map(|level| {
+            let counts = super::consistency::repetition_vector(level).ok()?;
+            single_appearance(level, &counts)
+        })
+        .collect();
+    render_hierarchy(&levels, &schedules)
+}
+
+fn render_at(
+    levels: &[Level<'_>],
+    schedules: &[Option<Vec<Schedule>>],
+    at: usize,
+) -> Option<String> {
+    let level = levels.get(at)?;
+    let schedule = schedules.get(at)?.as_ref()?;
     let mut bodies: Vec<Option<String>> = vec![None; level.nodes.len()];
     for (v, node) in level.nodes.iter().enumerate() {
         let Some(task) = node.task.and_then(|t| level.graph.tasks.get(t)) else {
             continue;
         };
         if let Some(l) = &task.loop_node {
-            let body = render_level(Level::build(
-                &l.body,
-                Some(task),
-                format!("{}/{}", level.path, task.name.name),
-            ))?;
+            let path = format!("{}/{}", level.path, task.name.name);
+            let inner = levels.iter().position(|other| other.path == path)?;
+            let body = render_at(levels, schedules, inner)?;
             bodies[v] = Some(if l.loop_count == 1 {
                 body
             } else {
@@ -140,7 +159,7 @@ fn render_level(level: Level<'_>) -> Option<String> {
             });
         }
     }
-    Some(render_with(&level, &schedule, &|v| {
+    Some(render_with(level, schedule, &|v| {
         bodies.get(v).cloned().flatten()
     }))
 }
@@ -815,7 +834,7 @@ mod tests {
             single_appearance(&levels[1], &body).unwrap(),
             [2, 0, 1, 3].map(|node| Schedule::Fire { node, count: 1 })
         );
-        assert_eq!(render_hierarchy(&g).unwrap(), "A 10(B C) D");
+        assert_eq!(looped_schedule(&g).unwrap(), "A 10(B C) D");
         assert_eq!(check_flat(&levels[0], &counts), [0, 1, 2]);
     }
 
@@ -830,13 +849,13 @@ mod tests {
             env!("CARGO_MANIFEST_DIR"),
             "/../../shared/examples/taskgraphs/data_loop.taskgraph.xml"
         )));
-        assert_eq!(render_hierarchy(&data_loop).unwrap(), "A 10(B C) D");
+        assert_eq!(looped_schedule(&data_loop).unwrap(), "A 10(B C) D");
         let kmeans = load(include_str!(concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../../shared/examples/taskgraphs/kmeans.taskgraph.xml"
         )));
         assert_eq!(
-            render_hierarchy(&kmeans).unwrap(),
+            looped_schedule(&kmeans).unwrap(),
             "ReadPoints InitCenters 500(Select 16(Nearest) ReplaceCenter) Output"
         );
     }
