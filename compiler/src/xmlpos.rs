@@ -78,6 +78,30 @@ pub(crate) fn is_namespace_attribute(key: &str) -> bool {
 }
 
 /// The byte range of `slice` if it borrows from `text`.
+/// The range of an end tag `</name>`: `name` is the tag's name (a slice of
+/// `text`) and `tag_end` where the tag ends.
+pub(crate) fn end_tag_span(text: &str, name: &[u8], tag_end: usize) -> Span {
+    let name_span = slice_span(text, name).unwrap_or(Span::new(tag_end, tag_end));
+    Span::new(
+        name_span.start.saturating_sub(2),
+        tag_end.max(name_span.end),
+    )
+}
+
+/// The message for `</name>` with no element open.
+pub(crate) fn unopened_close(name: &str) -> String {
+    format!("`</{name}>` closes an element that was never opened")
+}
+
+/// The message for `</name>` while `<open>` is the element open, and the
+/// label for where `<open>` was opened.
+pub(crate) fn mismatched_close(name: &str, open: &str) -> (String, String) {
+    (
+        format!("`</{name}>` does not match the open `<{open}>`: close it first with `</{open}>`"),
+        format!("`<{open}>` opened here"),
+    )
+}
+
 pub(crate) fn slice_span(text: &str, slice: &[u8]) -> Option<Span> {
     let base = text.as_ptr() as usize;
     let ptr = slice.as_ptr() as usize;

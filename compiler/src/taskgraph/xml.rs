@@ -347,24 +347,12 @@ impl<'t, 's> TreeBuilder<'t, 's> {
 
     fn end(&mut self, e: &BytesEnd<'_>, tag_end: usize) -> Flow {
         let name = e.name();
-        let name_span =
-            xmlpos::slice_span(self.text, name.as_ref()).unwrap_or(Span::new(tag_end, tag_end));
-        let span = Span::new(
-            name_span.start.saturating_sub(2),
-            tag_end.max(name_span.end),
-        );
+        let span = xmlpos::end_tag_span(self.text, name.as_ref(), tag_end);
         let name = String::from_utf8_lossy(name.as_ref()).into_owned();
         match self.stack.pop() {
-            None => self.malformed(
-                span,
-                format!("`</{name}>` closes an element that was never opened"),
-            ),
+            None => self.malformed(span, xmlpos::unopened_close(&name)),
             Some(open) if open.qname != name => {
-                let message = format!(
-                    "`</{name}>` does not match the open `<{0}>`: close it first with `</{0}>`",
-                    open.qname
-                );
-                let opened = format!("`<{}>` opened here", open.qname);
+                let (message, opened) = xmlpos::mismatched_close(&name, &open.qname);
                 self.sink
                     .report(Code::GraphXml, span, message)
                     .relate(open.tag, opened);
