@@ -1,3 +1,4 @@
+//! The `semo` binary: the compiler's command line.
 fn main() {
     std::process::exit(semo::cli::main());
 }
