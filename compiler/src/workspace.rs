@@ -240,7 +240,12 @@ pub struct GraphRun {
 /// Loads a task graph (ours or SDF3) and runs its analyses; a graph that did
 /// not load cleanly is not analysed, so that its problems are not reported twice.
 pub fn analyze_graph(file: &SourceFile) -> GraphRun {
-    let (graph, mut diagnostics) = crate::taskgraph::load_task_graph(file.id, &file.text);
+    analyze_graph_text(file.id, &file.text)
+}
+
+/// [`analyze_graph`] for text held elsewhere (the language server's documents).
+pub fn analyze_graph_text(file: FileId, text: &str) -> GraphRun {
+    let (graph, mut diagnostics) = crate::taskgraph::load_task_graph(file, text);
     let loaded_cleanly = !diagnostics.iter().any(Diagnostic::is_error);
     let report = match &graph {
         Some(g) if loaded_cleanly => crate::taskgraph::analysis::analyze(g),

@@ -1,3 +1,67 @@
-//! The SeMo language server (grows in the language-server issue). This crate
-//! also builds the `semo` binary, since the server depends on the compiler
-//! library and the binary serves both.
+//! The SeMo language server. It also builds the `semo` binary, since the
+//! server depends on the compiler library and one binary serves both the CLI
+//! and editors (`semo lsp`).
+//!
+//! - [`world`]: files, documents and snapshots (the state, under one std lock).
+//! - [`diagnostics`]: the queue and task that publish diagnostics.
+//! - [`server`]: the `LanguageServer` implementation, one line per method,
+//!   delegating to [`handlers`] (one file per request).
+//! - [`encoding`], [`document`]: positions and incremental edits at the door.
+//! - [`harness`]: an in-memory client, for tests and benchmarks.
+
+pub mod diagnostics;
+pub mod document;
+pub mod encoding;
+pub mod handlers;
+pub mod harness;
+pub mod server;
+pub mod world;
+
+use std::sync::{Mutex, MutexGuard};
+use tokio::io::{AsyncRead, AsyncWrite};
+use tower_lsp_server::{LspService, Server};
+
+/// State shared by the handlers and the diagnostics task.
+#[derive(Default)]
+pub struct State {
+    world: Mutex<world::World>,
+    pub queue: diagnostics::Queue,
+}
+
+impl State {
+    /// The world, locked. A handler that panicked while holding the lock
+    /// leaves it poisoned; the state is still consistent (every mutation is
+    /// one assignment), so later handlers carry on.
+    pub fn world(&self) -> MutexGuard<'_, world::World> {
+        self.world.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// Serves the protocol on the given streams until the client exits.
+pub async fn serve<I, O>(input: I, output: O)
+where
+    I: AsyncRead + Unpin,
+    O: AsyncWrite,
+{
+    let (service, socket) = LspService::build(server::Backend::new)
+        .custom_method("semo/catalog", server::Backend::catalog)
+        .custom_method("semo/viewFileText", server::Backend::view_file_text)
+        .finish();
+    Server::new(input, output, socket).serve(service).await;
+}
+
+/// `semo lsp`: serves on stdin/stdout; gives the process exit code.
+pub fn run_stdio() -> i32 {
+    let runtime = match tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+    {
+        Ok(rt) => rt,
+        Err(e) => {
+            eprintln!("error: cannot start the language server: {e}");
+            return 2;
+        }
+    };
+    runtime.block_on(serve(tokio::io::stdin(), tokio::io::stdout()));
+    0
+}

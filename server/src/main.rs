@@ -1,4 +1,5 @@
-//! The `semo` binary: the compiler's command line.
+//! The `semo` binary: the compiler's command line, with `semo lsp` served by
+//! this crate.
 fn main() {
-    std::process::exit(semo::cli::main());
+    std::process::exit(semo::cli::main(semo_server::run_stdio));
 }

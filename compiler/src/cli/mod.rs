@@ -49,6 +49,12 @@ enum Command {
     /// Analyse task graphs (`*.taskgraph.xml` or SDF3 files).
     #[command(subcommand)]
     Graph(GraphCommand),
+    /// Run the language server on stdin/stdout (for editors).
+    Lsp {
+        /// Accepted because editors pass it; stdio is the only transport.
+        #[arg(long)]
+        stdio: bool,
+    },
     /// Explain a diagnostic code (e.g. `semo explain E019`), or list them all.
     Explain {
         /// A code such as E019; all codes when omitted.
@@ -100,8 +106,9 @@ enum ColorChoice {
     Never,
 }
 
-/// Runs the command line and gives the process exit code.
-pub fn main() -> i32 {
+/// Runs the command line and gives the process exit code. The language server
+/// lives in a crate above this library, so the binary hands it in as `lsp`.
+pub fn main(lsp: fn() -> i32) -> i32 {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
@@ -127,6 +134,11 @@ pub fn main() -> i32 {
             graph::schedule(&file, cores, &mut out)
         }
         Command::Explain { code } => explain(code.as_deref(), &mut out),
+        Command::Lsp { stdio: _ } => {
+            // The protocol owns stdout from here on.
+            drop(out);
+            return lsp();
+        }
     };
     let _ = out.flush();
     code

@@ -1,0 +1,167 @@
+//! Publishing diagnostics. Changes only queue their file; one task drains the
+//! queue, analysing the *newest* snapshot of each file, so a burst of edits is
+//! coalesced into one analysis without any fixed delay. A result whose
+//! snapshot was replaced meanwhile is dropped: its file is queued again.
+
+use crate::State;
+use crate::encoding::LineMap;
+use crate::world::{FileAnalysis, Snapshot};
+use semo::catalog::BUILTIN_FILE;
+use semo::diag::{Code, FileId, Severity};
+use semo::text::LineIndex;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+use tokio::sync::Notify;
+use tower_lsp_server::Client;
+use tower_lsp_server::ls_types::{
+    self as lsp, DiagnosticRelatedInformation, DiagnosticTag, Location, NumberOrString, Uri,
+};
+
+#[derive(Default)]
+pub struct Queue {
+    files: Mutex<Vec<Uri>>,
+    wake: Notify,
+}
+
+impl Queue {
+    /// Queues files for (re-)analysis; a file already queued keeps its place.
+    pub fn push(&self, uris: impl IntoIterator<Item = Uri>) {
+        let mut files = self.files.lock().unwrap_or_else(|e| e.into_inner());
+        for uri in uris {
+            if !files.contains(&uri) {
+                files.push(uri);
+            }
+        }
+        drop(files);
+        self.wake.notify_one();
+    }
+
+    fn pop(&self) -> Option<Uri> {
+        let mut files = self.files.lock().unwrap_or_else(|e| e.into_inner());
+        (!files.is_empty()).then(|| files.remove(0))
+    }
+}
+
+/// Runs for the life of the server.
+pub async fn publish_loop(state: Arc<State>, client: Client) {
+    loop {
+        state.queue.wake.notified().await;
+        while let Some(uri) = state.queue.pop() {
+            publish(&state, &client, uri).await;
+        }
+    }
+}
+
+async fn publish(state: &State, client: &Client, uri: Uri) {
+    let Some(snapshot) = state.world().snapshot(&uri) else {
+        // Forgotten (closed and not in the workspace, or deleted): clear.
+        client.publish_diagnostics(uri, Vec::new(), None).await;
+        return;
+    };
+    let analysed = snapshot.clone();
+    let Ok(analysis) = tokio::task::spawn_blocking(move || analysed.analysis()).await else {
+        return;
+    };
+    let others = {
+        let world = state.world();
+        if !world.is_current(&snapshot) {
+            return; // stale: the newer snapshot is queued
+        }
+        related_files(&analysis, |id| world.uri_of(id).cloned())
+    };
+    let diagnostics = to_lsp(&snapshot, &analysis, &others);
+    client
+        .publish_diagnostics(uri, diagnostics, snapshot.version)
+        .await;
+}
+
+/// The URIs of the other files that related information points into.
+fn related_files(
+    analysis: &FileAnalysis,
+    uri_of: impl Fn(FileId) -> Option<Uri>,
+) -> HashMap<FileId, Uri> {
+    let mut out = HashMap::new();
+    for d in &analysis.diagnostics {
+        for r in &d.related {
+            if r.file != d.file && r.file != BUILTIN_FILE {
+                if let Some(uri) = uri_of(r.file) {
+                    out.insert(r.file, uri);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The library's diagnostics of a snapshot, as the protocol has them.
+pub fn to_lsp(
+    snapshot: &Snapshot,
+    analysis: &FileAnalysis,
+    others: &HashMap<FileId, Uri>,
+) -> Vec<lsp::Diagnostic> {
+    let here = snapshot.line_map(analysis);
+    // Line indexes of other (catalog) files, built once each.
+    let mut other_lines: HashMap<FileId, LineIndex> = HashMap::new();
+    analysis
+        .diagnostics
+        .iter()
+        .map(|d| {
+            let related = d
+                .related
+                .iter()
+                .filter_map(|r| {
+                    let (uri, range) = if r.file == snapshot.id {
+                        (snapshot.uri.clone(), here.range(r.span))
+                    } else {
+                        let uri = others.get(&r.file)?;
+                        let text = snapshot.catalog.text_of(r.file)?;
+                        let index = other_lines
+                            .entry(r.file)
+                            .or_insert_with(|| LineIndex::new(text));
+                        let map = LineMap {
+                            text,
+                            index,
+                            encoding: snapshot.encoding,
+                        };
+                        (uri.clone(), map.range(r.span))
+                    };
+                    Some(DiagnosticRelatedInformation {
+                        location: Location::new(uri, range),
+                        message: r.message.clone(),
+                    })
+                })
+                .collect::<Vec<_>>();
+            lsp::Diagnostic {
+                range: here.range(d.span),
+                severity: Some(severity(d.severity)),
+                code: Some(NumberOrString::String(d.code.as_str().to_string())),
+                source: Some("semo".to_string()),
+                message: d.message.clone(),
+                related_information: (!related.is_empty()).then_some(related),
+                tags: is_unnecessary(d.code).then(|| vec![DiagnosticTag::UNNECESSARY]),
+                // The did-you-mean travels with the diagnostic, for quick fixes.
+                data: d
+                    .suggestion
+                    .as_ref()
+                    .map(|s| serde_json::json!({ "suggestion": s })),
+                code_description: None,
+            }
+        })
+        .collect()
+}
+
+fn severity(s: Severity) -> lsp::DiagnosticSeverity {
+    match s {
+        Severity::Error => lsp::DiagnosticSeverity::ERROR,
+        Severity::Warning => lsp::DiagnosticSeverity::WARNING,
+        Severity::Hint => lsp::DiagnosticSeverity::HINT,
+    }
+}
+
+/// Code that is never used: editors grey it out.
+fn is_unnecessary(code: Code) -> bool {
+    matches!(
+        code,
+        Code::ServiceNeverSet | Code::FunctionNeverCalled | Code::UnreachableMode
+    )
+}

@@ -1,0 +1,23 @@
+//! One module per request: each translates protocol types to library calls on
+//! a [`Snapshot`](crate::world::Snapshot) and back.
+
+pub mod catalog;
+
+use crate::encoding::Encoding;
+use tower_lsp_server::ls_types::*;
+
+/// What this server can do, announced at `initialize`.
+pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
+    ServerCapabilities {
+        position_encoding: Some(encoding.kind()),
+        text_document_sync: Some(TextDocumentSyncCapability::Options(
+            TextDocumentSyncOptions {
+                open_close: Some(true),
+                change: Some(TextDocumentSyncKind::INCREMENTAL),
+                save: Some(TextDocumentSyncSaveOptions::Supported(true)),
+                ..Default::default()
+            },
+        )),
+        ..Default::default()
+    }
+}

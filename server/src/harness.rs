@@ -1,0 +1,184 @@
+//! An in-memory LSP client: the real server on one end of an in-process pipe,
+//! JSON-RPC framing on the other. Tests and benchmarks drive the server through
+//! it exactly as an editor would, without a process or a socket.
+
+use serde_json::{Value, json};
+use std::collections::VecDeque;
+use tokio::io::{AsyncBufReadExt, AsyncReadExt, AsyncWriteExt, BufReader, DuplexStream};
+use tokio::task::JoinHandle;
+
+pub struct TestClient {
+    to_server: tokio::io::WriteHalf<DuplexStream>,
+    from_server: BufReader<tokio::io::ReadHalf<DuplexStream>>,
+    next_id: i64,
+    /// Notifications read while waiting for something else, oldest first.
+    pending: VecDeque<Value>,
+    server: JoinHandle<()>,
+}
+
+impl TestClient {
+    /// Starts a server in this runtime (not yet initialized).
+    pub fn start() -> TestClient {
+        let (client_end, server_end) = tokio::io::duplex(1 << 16);
+        let (server_in, server_out) = tokio::io::split(server_end);
+        let server = tokio::spawn(crate::serve(server_in, server_out));
+        let (from_server, to_server) = tokio::io::split(client_end);
+        TestClient {
+            to_server,
+            from_server: BufReader::new(from_server),
+            next_id: 0,
+            pending: VecDeque::new(),
+            server,
+        }
+    }
+
+    /// `initialize` + `initialized`. `encodings` are the position encodings
+    /// the client offers (e.g. `["utf-8", "utf-16"]`); `root` a workspace folder.
+    pub async fn initialize(&mut self, encodings: &[&str], root: Option<&str>) -> Value {
+        let folders = root.map(|r| json!([{ "uri": r, "name": "workspace" }]));
+        let result = self
+            .request(
+                "initialize",
+                json!({
+                    "processId": null,
+                    "rootUri": root,
+                    "workspaceFolders": folders,
+                    "capabilities": {
+                        "general": { "positionEncodings": encodings },
+                        "workspace": {
+                            "didChangeWatchedFiles": { "dynamicRegistration": true }
+                        },
+                        "textDocument": {
+                            "completion": { "completionItem": { "snippetSupport": true } }
+                        }
+                    }
+                }),
+            )
+            .await
+            .expect("initialize succeeds");
+        self.notify("initialized", json!({})).await;
+        result
+    }
+
+    /// Sends a request and waits for its response: `Ok(result)` or `Err(error)`.
+    pub async fn request(&mut self, method: &str, params: Value) -> Result<Value, Value> {
+        self.next_id += 1;
+        let id = self.next_id;
+        self.send(&json!({ "jsonrpc": "2.0", "id": id, "method": method, "params": params }))
+            .await;
+        loop {
+            let msg = self.read_message().await.expect("the server answers");
+            if msg.get("id") == Some(&json!(id)) && msg.get("method").is_none() {
+                return match msg.get("error") {
+                    Some(e) => Err(e.clone()),
+                    None => Ok(msg.get("result").cloned().unwrap_or(Value::Null)),
+                };
+            }
+            self.keep(msg).await;
+        }
+    }
+
+    pub async fn notify(&mut self, method: &str, params: Value) {
+        self.send(&json!({ "jsonrpc": "2.0", "method": method, "params": params }))
+            .await;
+    }
+
+    pub async fn open(&mut self, uri: &str, text: &str) {
+        self.notify(
+            "textDocument/didOpen",
+            json!({ "textDocument": {
+                "uri": uri, "languageId": "mission", "version": 1, "text": text
+            }}),
+        )
+        .await;
+    }
+
+    /// Waits for the diagnostics of `uri` published for `version` (any
+    /// version when `None`), skipping older publications.
+    pub async fn diagnostics(&mut self, uri: &str, version: Option<i64>) -> Vec<Value> {
+        let msg = self
+            .notification("textDocument/publishDiagnostics", |p| {
+                p["uri"] == uri && (version.is_none() || p["version"] == json!(version))
+            })
+            .await;
+        msg["diagnostics"].as_array().cloned().unwrap_or_default()
+    }
+
+    /// Waits for a notification whose params satisfy `wanted`; the ones
+    /// skipped are dropped.
+    pub async fn notification(&mut self, method: &str, wanted: impl Fn(&Value) -> bool) -> Value {
+        loop {
+            let msg = match self.pending.pop_front() {
+                Some(m) => m,
+                None => self.read_message().await.expect("the server is alive"),
+            };
+            if msg.get("id").is_some() && msg.get("method").is_some() {
+                self.answer(&msg).await;
+                continue;
+            }
+            if msg["method"] == method && wanted(&msg["params"]) {
+                return msg["params"].clone();
+            }
+        }
+    }
+
+    /// Bytes as they are, for robustness tests (malformed frames and JSON).
+    pub async fn send_raw(&mut self, bytes: &[u8]) {
+        self.to_server.write_all(bytes).await.expect("pipe open");
+        self.to_server.flush().await.expect("pipe open");
+    }
+
+    /// `shutdown` + `exit`; the server task ends.
+    pub async fn shutdown(mut self) {
+        let _ = self.request("shutdown", Value::Null).await;
+        self.notify("exit", Value::Null).await;
+        let _ = self.server.await;
+    }
+
+    pub fn server_is_running(&self) -> bool {
+        !self.server.is_finished()
+    }
+
+    async fn send(&mut self, msg: &Value) {
+        let body = msg.to_string();
+        let frame = format!("Content-Length: {}\r\n\r\n{body}", body.len());
+        self.send_raw(frame.as_bytes()).await;
+    }
+
+    /// A message that is not the awaited response: server requests are
+    /// answered at once, notifications kept for later.
+    async fn keep(&mut self, msg: Value) {
+        if msg.get("id").is_some() && msg.get("method").is_some() {
+            self.answer(&msg).await;
+        } else {
+            self.pending.push_back(msg);
+        }
+    }
+
+    /// Answers a request from the server (registrations, progress tokens) with
+    /// success, as an accommodating editor would.
+    async fn answer(&mut self, request: &Value) {
+        let reply = json!({ "jsonrpc": "2.0", "id": request["id"], "result": null });
+        self.send(&reply).await;
+    }
+
+    async fn read_message(&mut self) -> Option<Value> {
+        let mut length = None;
+        loop {
+            let mut line = String::new();
+            if self.from_server.read_line(&mut line).await.ok()? == 0 {
+                return None;
+            }
+            let line = line.trim_end();
+            if line.is_empty() {
+                break;
+            }
+            if let Some(n) = line.strip_prefix("Content-Length: ") {
+                length = n.parse::<usize>().ok();
+            }
+        }
+        let mut body = vec![0; length?];
+        self.from_server.read_exact(&mut body).await.ok()?;
+        serde_json::from_slice(&body).ok()
+    }
+}

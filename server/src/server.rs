@@ -1,0 +1,204 @@
+//! The `LanguageServer` implementation: each method is a thin translation to
+//! the [`World`](crate::world::World) (notifications) or to a handler in
+//! [`crate::handlers`] (requests), which work on immutable snapshots.
+
+use crate::encoding::Encoding;
+use crate::handlers;
+use crate::world::{self, Snapshot};
+use crate::{State, diagnostics};
+use std::sync::Arc;
+use tower_lsp_server::jsonrpc::{Error, Result};
+use tower_lsp_server::ls_types::*;
+use tower_lsp_server::{Client, LanguageServer};
+
+pub struct Backend {
+    client: Client,
+    state: Arc<State>,
+}
+
+impl Backend {
+    /// Starts the diagnostics task; called by `LspService` inside the runtime.
+    pub fn new(client: Client) -> Backend {
+        let state = Arc::new(State::default());
+        tokio::spawn(diagnostics::publish_loop(state.clone(), client.clone()));
+        Backend { client, state }
+    }
+
+    /// The current snapshot of a document, or an error for files never opened
+    /// nor found in the workspace.
+    fn snapshot(&self, uri: &Uri) -> Result<Arc<Snapshot>> {
+        self.state.world().snapshot(uri).ok_or_else(|| Error {
+            code: tower_lsp_server::jsonrpc::ErrorCode::InvalidParams,
+            message: format!("unknown document {}", uri.as_str()).into(),
+            data: None,
+        })
+    }
+
+    /// Runs `f` on a snapshot off the async threads.
+    #[allow(dead_code)] // the request handlers arrive in the next commits A panic inside a handler
+    /// becomes an internal error for this request only.
+    async fn on_snapshot<T: Send + 'static>(
+        &self,
+        uri: &Uri,
+        f: impl FnOnce(&Snapshot) -> T + Send + 'static,
+    ) -> Result<T> {
+        let snapshot = self.snapshot(uri)?;
+        tokio::task::spawn_blocking(move || f(&snapshot))
+            .await
+            .map_err(|e| Error {
+                code: tower_lsp_server::jsonrpc::ErrorCode::InternalError,
+                message: format!("the request failed: {e}").into(),
+                data: None,
+            })
+    }
+
+    /// `semo/catalog`: the robot types the workspace sees (for the robot panel).
+    pub async fn catalog(
+        &self,
+        params: handlers::catalog::CatalogParams,
+    ) -> Result<serde_json::Value> {
+        let catalog = match params
+            .uri
+            .as_ref()
+            .and_then(|u| self.state.world().snapshot(u))
+        {
+            Some(snapshot) => snapshot.catalog.clone(),
+            None => self.state.world().catalog(),
+        };
+        tokio::task::spawn_blocking(move || handlers::catalog::catalog(catalog.catalog()))
+            .await
+            .map_err(|_| Error::internal_error())
+    }
+
+    /// `semo/viewFileText`: the server's text of a document, to debug
+    /// synchronisation (as rust-analyzer's `viewFileText`).
+    pub async fn view_file_text(&self, params: TextDocumentIdentifier) -> Result<String> {
+        Ok(self.snapshot(&params.uri)?.text.to_string())
+    }
+
+    async fn register_watchers(&self) {
+        let watchers = ["**/*.mission", "**/*.robot.xml", "**/*.taskgraph.xml"]
+            .into_iter()
+            .map(|glob| FileSystemWatcher {
+                glob_pattern: GlobPattern::String(glob.to_string()),
+                kind: None,
+            })
+            .collect();
+        let registration = Registration {
+            id: "semo-files".to_string(),
+            method: "workspace/didChangeWatchedFiles".to_string(),
+            register_options: serde_json::to_value(DidChangeWatchedFilesRegistrationOptions {
+                watchers,
+            })
+            .ok(),
+        };
+        // Clients without dynamic registration simply do not watch for us.
+        let _ = self.client.register_capability(vec![registration]).await;
+    }
+
+    async fn index_workspace(&self) {
+        let roots = self.state.world().roots.clone();
+        let Ok(found) = tokio::task::spawn_blocking(move || world::read_roots(&roots)).await else {
+            return;
+        };
+        let mut world = self.state.world();
+        let mut changed = Vec::new();
+        for (uri, text) in found {
+            changed.extend(world.disk_changed(&uri, text).files);
+        }
+        drop(world);
+        self.state.queue.push(changed);
+    }
+}
+
+fn roots(params: &InitializeParams) -> Vec<std::path::PathBuf> {
+    let folders = params.workspace_folders.iter().flatten().map(|f| &f.uri);
+    #[allow(deprecated)] // rootUri is what older clients send
+    let root = params.root_uri.iter();
+    folders
+        .chain(root)
+        .filter_map(|uri| uri.to_file_path().map(|p| p.into_owned()))
+        .collect()
+}
+
+impl LanguageServer for Backend {
+    async fn initialize(&self, params: InitializeParams) -> Result<InitializeResult> {
+        let encoding = Encoding::negotiate(&params.capabilities);
+        {
+            let mut world = self.state.world();
+            world.encoding = encoding;
+            world.roots = roots(&params);
+            world.roots.dedup();
+        }
+        Ok(InitializeResult {
+            server_info: Some(ServerInfo {
+                name: "semo".to_string(),
+                version: Some(env!("CARGO_PKG_VERSION").to_string()),
+            }),
+            capabilities: handlers::capabilities(encoding),
+            offset_encoding: None,
+        })
+    }
+
+    async fn initialized(&self, _: InitializedParams) {
+        self.register_watchers().await;
+        self.index_workspace().await;
+    }
+
+    async fn shutdown(&self) -> Result<()> {
+        Ok(())
+    }
+
+    // Notifications change the world synchronously, before any `.await`, so
+    // they apply in the order the client sent them.
+
+    async fn did_open(&self, p: DidOpenTextDocumentParams) {
+        let d = p.text_document;
+        let changed = self
+            .state
+            .world()
+            .open(d.uri, &d.language_id, &d.text, d.version);
+        self.state.queue.push(changed.files);
+    }
+
+    async fn did_change(&self, p: DidChangeTextDocumentParams) {
+        let d = p.text_document;
+        let changed = self
+            .state
+            .world()
+            .change(&d.uri, d.version, p.content_changes);
+        self.state.queue.push(changed.files);
+    }
+
+    async fn did_save(&self, p: DidSaveTextDocumentParams) {
+        // The text is already current; re-publishing confirms the saved state.
+        self.state.queue.push([p.text_document.uri]);
+    }
+
+    async fn did_close(&self, p: DidCloseTextDocumentParams) {
+        let changed = self.state.world().close(&p.text_document.uri);
+        self.state.queue.push(changed.files);
+    }
+
+    async fn did_change_watched_files(&self, p: DidChangeWatchedFilesParams) {
+        let mut changed = Vec::new();
+        for event in p.changes {
+            let text = if event.typ == FileChangeType::DELETED {
+                None
+            } else {
+                event
+                    .uri
+                    .to_file_path()
+                    .and_then(|path| world::read_text(&path))
+            };
+            let mut world = self.state.world();
+            changed.extend(match text {
+                None if event.typ == FileChangeType::DELETED => {
+                    world.disk_deleted(&event.uri).files
+                }
+                text => world.disk_changed(&event.uri, text).files,
+            });
+        }
+        self.state.queue.push(changed);
+    }
+}

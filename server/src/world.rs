@@ -1,0 +1,443 @@
+//! The server's state: every file it knows (open documents and files indexed
+//! from the workspace folders), the workspace catalog, and immutable
+//! [`Snapshot`]s that handlers analyse without holding the lock.
+//!
+//! Invariant: the [`World`] is only touched under its `std::sync::Mutex`, and
+//! every notification applies its change synchronously, before its handler's
+//! first `.await`, so changes are applied in the order the client sent them.
+//! A snapshot is replaced (never mutated) when its text or the catalog changes;
+//! a result computed for a snapshot that is no longer current is stale.
+
+use crate::document::Document;
+use crate::encoding::{Encoding, LineMap};
+use semo::catalog::{Catalog, CatalogSource, load_catalog};
+use semo::diag::{self, Diagnostic, FileId};
+use semo::sema::Analysis;
+use semo::text::LineIndex;
+use semo::workspace::{FileKind, GraphRun, analyze_graph_text};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
+use tower_lsp_server::ls_types::{TextDocumentContentChangeEvent, Uri};
+
+/// The catalog files of the workspace and, built on first use, the catalog they
+/// form with the built-in one.
+pub struct CatalogState {
+    pub files: Vec<CatalogFile>,
+    built: OnceLock<(Catalog, Vec<Diagnostic>)>,
+}
+
+pub struct CatalogFile {
+    pub id: FileId,
+    pub path: Option<PathBuf>,
+    pub text: Arc<str>,
+}
+
+impl CatalogState {
+    fn new(files: Vec<CatalogFile>) -> CatalogState {
+        CatalogState {
+            files,
+            built: OnceLock::new(),
+        }
+    }
+
+    fn built(&self) -> &(Catalog, Vec<Diagnostic>) {
+        self.built.get_or_init(|| {
+            let sources: Vec<CatalogSource<'_>> = self
+                .files
+                .iter()
+                .map(|f| CatalogSource {
+                    file: f.id,
+                    text: &f.text,
+                    base_dir: f.path.as_deref().and_then(Path::parent),
+                })
+                .collect();
+            load_catalog(&sources)
+        })
+    }
+
+    pub fn catalog(&self) -> &Catalog {
+        &self.built().0
+    }
+
+    /// The catalog diagnostics of one catalog file.
+    pub fn diagnostics_of(&self, file: FileId) -> impl Iterator<Item = &Diagnostic> {
+        self.built().1.iter().filter(move |d| d.file == file)
+    }
+
+    pub fn text_of(&self, file: FileId) -> Option<&str> {
+        self.files.iter().find(|f| f.id == file).map(|f| &*f.text)
+    }
+}
+
+/// One version of one file, with the catalog it is checked against.
+pub struct Snapshot {
+    pub uri: Uri,
+    pub id: FileId,
+    pub kind: FileKind,
+    /// The client's version for open documents; `None` for files read from disk.
+    pub version: Option<i32>,
+    pub text: Arc<str>,
+    pub catalog: Arc<CatalogState>,
+    pub encoding: Encoding,
+    analysis: OnceLock<Arc<FileAnalysis>>,
+}
+
+/// What is known about a snapshot once analysed.
+pub struct FileAnalysis {
+    pub lines: LineIndex,
+    /// Diagnostics of this file, sorted.
+    pub diagnostics: Vec<Diagnostic>,
+    pub mission: Option<Analysis>,
+    pub graph: Option<GraphRun>,
+}
+
+impl Snapshot {
+    /// Analyses the snapshot once; concurrent callers wait for the first.
+    pub fn analysis(&self) -> Arc<FileAnalysis> {
+        self.analysis
+            .get_or_init(|| Arc::new(self.analyse()))
+            .clone()
+    }
+
+    fn analyse(&self) -> FileAnalysis {
+        let lines = LineIndex::new(&self.text);
+        match self.kind {
+            FileKind::Mission => {
+                let analysis = semo::check_source(self.id, &self.text, self.catalog.catalog());
+                FileAnalysis {
+                    lines,
+                    diagnostics: analysis.diagnostics.clone(),
+                    mission: Some(analysis),
+                    graph: None,
+                }
+            }
+            FileKind::Catalog => {
+                let mut diagnostics: Vec<Diagnostic> =
+                    self.catalog.diagnostics_of(self.id).cloned().collect();
+                diag::sort_and_dedup(&mut diagnostics);
+                FileAnalysis {
+                    lines,
+                    diagnostics,
+                    mission: None,
+                    graph: None,
+                }
+            }
+            FileKind::TaskGraph => {
+                let run = analyze_graph_text(self.id, &self.text);
+                FileAnalysis {
+                    lines,
+                    diagnostics: run.diagnostics.clone(),
+                    mission: None,
+                    graph: Some(run),
+                }
+            }
+        }
+    }
+
+    /// Converts positions of this snapshot's text.
+    pub fn line_map<'a>(&'a self, analysis: &'a FileAnalysis) -> LineMap<'a> {
+        LineMap {
+            text: &self.text,
+            index: &analysis.lines,
+            encoding: self.encoding,
+        }
+    }
+}
+
+struct FileEntry {
+    kind: FileKind,
+    /// Set while the client has the file open.
+    document: Option<Document>,
+    /// Where the file is on disk, if it is a `file:` URI.
+    path: Option<PathBuf>,
+    snapshot: Arc<Snapshot>,
+}
+
+#[derive(Default)]
+pub struct World {
+    pub encoding: Encoding,
+    pub roots: Vec<PathBuf>,
+    files: HashMap<Uri, FileEntry>,
+    /// `FileId(i)` is `uris[i]`; ids are never reused within a session.
+    uris: Vec<Uri>,
+    ids: HashMap<Uri, FileId>,
+    catalog: Option<Arc<CatalogState>>,
+}
+
+/// What a change did, so the caller knows which files to re-check.
+#[derive(Debug, Default, PartialEq, Eq)]
+pub struct Changed {
+    pub files: Vec<Uri>,
+}
+
+impl World {
+    /// The kind of file a URI names, from its file name, else (for unsaved
+    /// buffers) from the client's language id.
+    pub fn kind_of(uri: &Uri, language_id: Option<&str>) -> Option<FileKind> {
+        let path = uri.path().as_str();
+        let name = path.rsplit('/').next().unwrap_or(path);
+        FileKind::of(Path::new(name)).or(match language_id {
+            Some("mission" | "semo") => Some(FileKind::Mission),
+            _ => None,
+        })
+    }
+
+    pub fn file_id(&mut self, uri: &Uri) -> FileId {
+        if let Some(&id) = self.ids.get(uri) {
+            return id;
+        }
+        let id = FileId(self.uris.len() as u32);
+        self.uris.push(uri.clone());
+        self.ids.insert(uri.clone(), id);
+        id
+    }
+
+    pub fn uri_of(&self, id: FileId) -> Option<&Uri> {
+        self.uris.get(id.0 as usize)
+    }
+
+    pub fn snapshot(&self, uri: &Uri) -> Option<Arc<Snapshot>> {
+        self.files.get(uri).map(|f| f.snapshot.clone())
+    }
+
+    /// Whether `snapshot` is still the newest of its file (else its results are stale).
+    pub fn is_current(&self, snapshot: &Arc<Snapshot>) -> bool {
+        self.files
+            .get(&snapshot.uri)
+            .is_some_and(|f| Arc::ptr_eq(&f.snapshot, snapshot))
+    }
+
+    pub fn is_open(&self, uri: &Uri) -> bool {
+        self.files.get(uri).is_some_and(|f| f.document.is_some())
+    }
+
+    pub fn uris(&self) -> impl Iterator<Item = &Uri> {
+        self.files.keys()
+    }
+
+    pub fn catalog(&mut self) -> Arc<CatalogState> {
+        if let Some(c) = &self.catalog {
+            return c.clone();
+        }
+        let mut files: Vec<CatalogFile> = self
+            .files
+            .iter()
+            .filter(|(_, f)| f.kind == FileKind::Catalog)
+            .map(|(uri, f)| CatalogFile {
+                id: self.ids[uri],
+                path: f.path.clone(),
+                text: f.snapshot.text.clone(),
+            })
+            .collect();
+        // A stable order, so "defined in another catalog file" always names the same one.
+        files.sort_by(|a, b| a.path.cmp(&b.path).then(a.id.0.cmp(&b.id.0)));
+        let state = Arc::new(CatalogState::new(files));
+        self.catalog = Some(state.clone());
+        state
+    }
+
+    /// The client opened a document.
+    pub fn open(&mut self, uri: Uri, language_id: &str, text: &str, version: i32) -> Changed {
+        let Some(kind) = World::kind_of(&uri, Some(language_id)) else {
+            return Changed::default();
+        };
+        let document = Document::new(text, version);
+        let path = uri.to_file_path().map(|p| p.into_owned());
+        self.set_text(uri, kind, path, Some(document), text.into())
+    }
+
+    /// The client changed an open document. Changes to unknown documents are
+    /// ignored (the client will open them first).
+    pub fn change(
+        &mut self,
+        uri: &Uri,
+        version: i32,
+        changes: Vec<TextDocumentContentChangeEvent>,
+    ) -> Changed {
+        let encoding = self.encoding;
+        let Some(entry) = self.files.get_mut(uri) else {
+            return Changed::default();
+        };
+        let Some(document) = entry.document.as_mut() else {
+            return Changed::default();
+        };
+        document.apply(changes, version, encoding);
+        let text: Arc<str> = document.rope.to_string().into();
+        let (kind, path, document) = (entry.kind, entry.path.clone(), entry.document.take());
+        self.set_text(uri.clone(), kind, path, document, text)
+    }
+
+    /// The client closed a document: it falls back to its text on disk if it
+    /// is in the workspace, else it is forgotten.
+    pub fn close(&mut self, uri: &Uri) -> Changed {
+        let Some(entry) = self.files.get(uri) else {
+            return Changed::default();
+        };
+        let (kind, path) = (entry.kind, entry.path.clone());
+        let on_disk = path
+            .as_ref()
+            .filter(|p| self.in_workspace(p))
+            .and_then(|p| read_text(p));
+        match on_disk {
+            Some(text) => self.set_text(uri.clone(), kind, path, None, text.into()),
+            None => self.remove(uri),
+        }
+    }
+
+    /// A file of the workspace was created or changed on disk (`text`, read
+    /// by the caller outside the lock; `None` if it could not be read). Open
+    /// documents keep the client's text.
+    pub fn disk_changed(&mut self, uri: &Uri, text: Option<String>) -> Changed {
+        if self.is_open(uri) {
+            return Changed::default();
+        }
+        let path = uri.to_file_path().map(|p| p.into_owned());
+        let kind = World::kind_of(uri, None);
+        match (path, kind, text) {
+            (Some(path), Some(kind), Some(text)) => {
+                self.set_text(uri.clone(), kind, Some(path), None, text.into())
+            }
+            _ => self.remove(uri),
+        }
+    }
+
+    /// A file was deleted on disk. An open document stays as the client has it.
+    pub fn disk_deleted(&mut self, uri: &Uri) -> Changed {
+        if self.is_open(uri) {
+            return Changed::default();
+        }
+        self.remove(uri)
+    }
+
+    fn in_workspace(&self, path: &Path) -> bool {
+        self.roots.iter().any(|r| path.starts_with(r))
+    }
+
+    fn remove(&mut self, uri: &Uri) -> Changed {
+        let Some(entry) = self.files.remove(uri) else {
+            return Changed::default();
+        };
+        let mut changed = if entry.kind == FileKind::Catalog {
+            self.catalog_changed()
+        } else {
+            Changed::default()
+        };
+        changed.files.push(uri.clone());
+        changed
+    }
+
+    fn set_text(
+        &mut self,
+        uri: Uri,
+        kind: FileKind,
+        path: Option<PathBuf>,
+        document: Option<Document>,
+        text: Arc<str>,
+    ) -> Changed {
+        let id = self.file_id(&uri);
+        let version = document.as_ref().map(|d| d.version);
+        let is_catalog = kind == FileKind::Catalog;
+        // A catalog file gets its snapshot on the new catalog just below.
+        let catalog = if is_catalog {
+            Arc::new(CatalogState::new(Vec::new()))
+        } else {
+            self.catalog()
+        };
+        let snapshot = Arc::new(self.new_snapshot(&uri, id, kind, version, text, catalog));
+        self.files.insert(
+            uri.clone(),
+            FileEntry {
+                kind,
+                document,
+                path,
+                snapshot,
+            },
+        );
+        let mut changed = if is_catalog {
+            self.catalog_changed()
+        } else {
+            Changed::default()
+        };
+        if !changed.files.contains(&uri) {
+            changed.files.push(uri);
+        }
+        changed
+    }
+
+    fn new_snapshot(
+        &self,
+        uri: &Uri,
+        id: FileId,
+        kind: FileKind,
+        version: Option<i32>,
+        text: Arc<str>,
+        catalog: Arc<CatalogState>,
+    ) -> Snapshot {
+        Snapshot {
+            uri: uri.clone(),
+            id,
+            kind,
+            version,
+            text,
+            catalog,
+            encoding: self.encoding,
+            analysis: OnceLock::new(),
+        }
+    }
+
+    /// Every file gets a new snapshot on the new catalog (missions are
+    /// re-checked against it, catalog files get their new diagnostics).
+    fn catalog_changed(&mut self) -> Changed {
+        self.catalog = None;
+        let catalog = self.catalog();
+        let mut changed = Changed::default();
+        let uris: Vec<Uri> = self
+            .files
+            .iter()
+            .filter(|(_, f)| f.kind != FileKind::TaskGraph)
+            .map(|(u, _)| u.clone())
+            .collect();
+        for uri in uris {
+            let old = self.files[&uri].snapshot.clone();
+            let fresh = Arc::new(self.new_snapshot(
+                &uri,
+                old.id,
+                old.kind,
+                old.version,
+                old.text.clone(),
+                catalog.clone(),
+            ));
+            self.files.get_mut(&uri).expect("listed above").snapshot = fresh;
+            changed.files.push(uri);
+        }
+        changed
+    }
+}
+
+/// Every mission, catalog and task graph under the given roots, with its text
+/// (read without holding any lock).
+pub fn read_roots(roots: &[PathBuf]) -> Vec<(Uri, Option<String>)> {
+    let mut found = Vec::new();
+    for root in roots {
+        // A root that cannot be listed has nothing to index.
+        let Ok(files) = semo::workspace::collect(std::slice::from_ref(root)) else {
+            continue;
+        };
+        for (path, _) in files {
+            if let Some(uri) = Uri::from_file_path(&path) {
+                found.push((uri, read_text(&path)));
+            }
+        }
+    }
+    found
+}
+
+/// A file's text, with invalid UTF-8 replaced (so the rest is still checked).
+pub fn read_text(path: &Path) -> Option<String> {
+    let bytes = std::fs::read(path).ok()?;
+    Some(
+        String::from_utf8(bytes)
+            .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()),
+    )
+}
