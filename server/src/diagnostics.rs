@@ -69,7 +69,8 @@ async fn publish(state: &State, client: &Client, uri: Uri) {
         }
         related_files(&analysis, |id| world.uri_of(id).cloned())
     };
-    let diagnostics = to_lsp(&snapshot, &analysis, &others);
+    let mut diagnostics = to_lsp(&snapshot, &analysis, &others);
+    cap(&mut diagnostics);
     client
         .publish_diagnostics(uri, diagnostics, snapshot.version)
         .await;
@@ -148,6 +149,29 @@ pub fn to_lsp(
             }
         })
         .collect()
+}
+
+/// Editors slow to a crawl on files with many thousands of problems (a pasted
+/// binary, say): the first [`MAX_PUBLISHED`] are published, then one note.
+pub const MAX_PUBLISHED: usize = 1000;
+
+fn cap(diagnostics: &mut Vec<lsp::Diagnostic>) {
+    if diagnostics.len() <= MAX_PUBLISHED {
+        return;
+    }
+    let hidden = diagnostics.len() - MAX_PUBLISHED;
+    diagnostics.truncate(MAX_PUBLISHED);
+    let range = diagnostics[MAX_PUBLISHED - 1].range;
+    diagnostics.push(lsp::Diagnostic {
+        range,
+        severity: Some(lsp::DiagnosticSeverity::INFORMATION),
+        source: Some("semo".to_string()),
+        message: format!(
+            "{hidden} more problems in this file are not shown (the first {MAX_PUBLISHED} are); \
+             `semo check` lists them all"
+        ),
+        ..Default::default()
+    });
 }
 
 fn severity(s: Severity) -> lsp::DiagnosticSeverity {

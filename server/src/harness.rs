@@ -21,7 +21,7 @@ impl TestClient {
     pub fn start() -> TestClient {
         let (client_end, server_end) = tokio::io::duplex(1 << 16);
         let (server_in, server_out) = tokio::io::split(server_end);
-        let server = tokio::spawn(crate::serve(server_in, server_out));
+        let server = tokio::spawn(crate::transport::serve_guarded(server_in, server_out));
         let (from_server, to_server) = tokio::io::split(client_end);
         TestClient {
             to_server,
@@ -133,6 +133,12 @@ impl TestClient {
         let _ = self.request("shutdown", Value::Null).await;
         self.notify("exit", Value::Null).await;
         let _ = self.server.await;
+    }
+
+    /// The messages read but not yet consumed (notifications, and responses
+    /// to no request such as parse errors), oldest first.
+    pub fn take_unclaimed(&mut self) -> Vec<Value> {
+        self.pending.drain(..).collect()
     }
 
     pub fn server_is_running(&self) -> bool {

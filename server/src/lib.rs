@@ -7,6 +7,7 @@
 //! - [`server`]: the `LanguageServer` implementation, one line per method,
 //!   delegating to [`handlers`] (one file per request).
 //! - [`encoding`], [`document`]: positions and incremental edits at the door.
+//! - [`transport`]: a guard that keeps malformed frames away from tower-lsp.
 //! - [`harness`]: an in-memory client, for tests and benchmarks.
 
 pub mod diagnostics;
@@ -15,6 +16,7 @@ pub mod encoding;
 pub mod handlers;
 pub mod harness;
 pub mod server;
+pub mod transport;
 pub mod world;
 
 use std::sync::{Mutex, MutexGuard};
@@ -37,7 +39,8 @@ impl State {
     }
 }
 
-/// Serves the protocol on the given streams until the client exits.
+/// Serves the protocol on the given streams until the client exits. Editors
+/// and tests use [`transport::serve_guarded`], which puts a guard in front.
 pub async fn serve<I, O>(input: I, output: O)
 where
     I: AsyncRead + Unpin,
@@ -62,6 +65,9 @@ pub fn run_stdio() -> i32 {
             return 2;
         }
     };
-    runtime.block_on(serve(tokio::io::stdin(), tokio::io::stdout()));
+    runtime.block_on(transport::serve_guarded(
+        tokio::io::stdin(),
+        tokio::io::stdout(),
+    ));
     0
 }

@@ -1,5 +1,8 @@
 //! Shared by the benches.
 
+#[allow(dead_code)] // not every bench generates a mission
+pub mod mission;
+
 use std::time::{Duration, Instant};
 
 /// Runs `f` at least three times and for about `budget`; gives the fastest run.

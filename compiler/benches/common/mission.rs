@@ -1,0 +1,92 @@
+//! The generated benchmark mission, shared by the compiler's and the language
+//! server's benches.
+
+use std::fmt::Write;
+
+/// A realistic mission: mixed teams with groups, communication between
+/// neighbouring teams, modes with transitions, functions, comments.
+pub fn generate(teams: usize) -> String {
+    let mut m = String::from("# Generated benchmark mission\n{\n");
+    for t in 0..teams {
+        writeln!(
+            m,
+            "  Team{t}: Turtlebot3_Burger tb{t}[3], Ev3_Robot ev{t}[2], iRobotCreate cr{t}"
+        )
+        .unwrap();
+    }
+    m.push_str("}\n\ndef report_home {\n  move(\"0,0\")\n  standby()\n}\n\n");
+    for t in 0..teams {
+        let next = (t + 1) % teams;
+        let prev = (t + teams - 1) % teams;
+        write!(
+            m,
+            r#"# ----- Team{t} -----
+Team{t}.Listen.Hear{{
+  receive(Team{prev}, Team{prev}.Status)
+  subscribe(Team{t}, Team{t}.Alarm)
+  if(Team{t}.Alarm == DARK) throw hide
+  else if(Team{prev}.Status == "done") throw finish
+  else throw resume
+}} repeat(500 MSEC)
+
+Team{t}.Report.Tell{{
+  send(Team{next}, Team{t}.Status = "working")
+  send(USER, Team{t}.LOCATION)
+  [[
+    leader(instance of Turtlebot3_Burger){{
+      light_on()
+      publish(Team{t}, Team{t}.Alarm = BRIGHT)
+    }}
+  ]]
+}} repeat(1 SEC)
+
+Team{t}.Action.Patrol{{
+  [[
+    group(instance of Turtlebot3_Burger){{
+      loop(2 SEC){{
+        if(Team{t}.LIGHTNESS < 200 and BATTERY > 20)
+          publish(Team{t}, Team{t}.Alarm = DARK)
+      }}
+    }}
+    group(capable of color_sensor){{
+      search(colored_paper)
+      scatter()
+    }}
+    others{{
+      move("3,3"), timeout = 10 SEC
+      move("0,3")
+    }}
+  ]]
+}} repeat()
+
+Team{t}.Action.Hide{{
+  if(DISTANCE > 30){{
+    go_forward()
+  }} else {{
+    turn_left()
+  }}
+  stop()
+}} repeat(LOCATION != "0,0")
+
+Team{t}.Action.Return{{
+  report_home()
+}}
+
+Team{t}.PATROL{{ set(Listen, Hear); set(Report, Tell); set(Action, Patrol) }}
+Team{t}.HIDE{{ set(Listen, Hear); set(Report, OFF); set(Action, Hide, timeout = 30 SEC) }}
+Team{t}.HOME{{ set(Listen, OFF); set(Report, OFF); set(Action, Return) }}
+Team{t}.main{{
+  case (PATROL):
+    catch (hide): mode = HIDE
+    catch (finish): mode = HOME
+  case (HIDE):
+    catch (resume): mode = PATROL
+  default: mode = PATROL
+}}
+
+"#
+        )
+        .unwrap();
+    }
+    m
+}

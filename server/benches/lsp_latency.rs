@@ -1,0 +1,92 @@
+//! The language server driven in-process on a 10k-line mission: time from a
+//! one-character `didChange` to its `publishDiagnostics` (p50/p99 over 1,000
+//! edits), and the resident memory at the end. Run with
+//! `cargo bench -p semo-server --bench lsp_latency`.
+//! Targets on a 2-core machine: p99 edit-to-diagnostics ≤ 10 ms, RSS ≤ 60 MB.
+
+#[path = "../../compiler/benches/common/mission.rs"]
+mod mission;
+
+use semo_server::harness::TestClient;
+use serde_json::json;
+use std::time::{Duration, Instant};
+
+const URI: &str = "file:///bench/big.mission";
+
+fn main() {
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .expect("a runtime");
+    runtime.block_on(run());
+}
+
+async fn run() {
+    // 154 teams of the generated mission make about 10k lines.
+    let text = mission::generate(154);
+    let lines = text.lines().count();
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], None).await;
+    client.open(URI, &text).await;
+    let first = client.diagnostics(URI, Some(1)).await;
+    println!(
+        "mission: {lines} lines, {:.2} MB, {} diagnostics",
+        text.len() as f64 / 1e6,
+        first.len()
+    );
+
+    // Type a character at the end of the first line (a comment), then delete
+    // it: every version is a real edit that must be re-checked.
+    let line0_len = text.lines().next().unwrap().encode_utf16().count() as u32;
+    let mut latencies = Vec::with_capacity(1000);
+    for i in 0..1000u32 {
+        let version = i as i64 + 2;
+        let (range, new_text) = if i % 2 == 0 {
+            ((line0_len, line0_len), "x")
+        } else {
+            ((line0_len, line0_len + 1), "")
+        };
+        let change = json!({
+            "textDocument": { "uri": URI, "version": version },
+            "contentChanges": [{
+                "range": {
+                    "start": { "line": 0, "character": range.0 },
+                    "end": { "line": 0, "character": range.1 }
+                },
+                "text": new_text
+            }]
+        });
+        let start = Instant::now();
+        client.notify("textDocument/didChange", change).await;
+        client.diagnostics(URI, Some(version)).await;
+        latencies.push(start.elapsed());
+    }
+    report("edit → diagnostics", &mut latencies);
+    println!("peak RSS: {:.1} MB", peak_rss_kb() as f64 / 1024.0);
+    client.shutdown().await;
+}
+
+fn report(what: &str, samples: &mut [Duration]) {
+    samples.sort();
+    let at = |q: f64| samples[((samples.len() - 1) as f64 * q).round() as usize];
+    println!(
+        "{what}: p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms ({} samples)",
+        at(0.50).as_secs_f64() * 1e3,
+        at(0.99).as_secs_f64() * 1e3,
+        samples[samples.len() - 1].as_secs_f64() * 1e3,
+        samples.len()
+    );
+}
+
+/// The process's peak resident set (VmHWM), in kB; 0 where /proc is absent.
+fn peak_rss_kb() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse().ok())
+        })
+        .unwrap_or(0)
+}
