@@ -20,5 +20,7 @@ pub mod text;
 pub mod workspace;
 /// Byte positions of XML elements and attributes, shared by the XML loaders.
 mod xmlpos;
+/// The positioned XML element tree read by the task-graph and strategy loaders.
+mod xmltree;
 
 pub use sema::{Analysis, check_source};
