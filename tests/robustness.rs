@@ -257,6 +257,17 @@ fn deeply_nested_input_does_not_overflow_the_stack() {
         ")".repeat(5000)
     );
     check_never_panics(&parens);
+    // `a and a and ...` is a tree as deep as the chain, and so is `not not ...`.
+    let ands = format!(
+        "{{ T: iRobotCreate a }}\nT.Action.Go {{ if (a{}) stop() }}",
+        " and a".repeat(20_000)
+    );
+    check_never_panics(&ands);
+    let nots = format!(
+        "{{ T: iRobotCreate a }}\nT.Action.Go {{ if ({}a) stop() }}",
+        "not !".repeat(10_000)
+    );
+    check_never_panics(&nots);
 }
 
 #[test]
