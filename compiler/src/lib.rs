@@ -5,6 +5,8 @@
 //! - [`syntax`]: lexer and parser (chumsky) from text to a positioned AST; never panics.
 //! - [`catalog`]: robot types from the built-in catalog and `*.robot.xml` files.
 //! - [`sema`]: name resolution and checks, producing the [`sema::Mission`] IR.
+//! - [`strategy`]: strategy files (`*.strategy.xml`), checked on their own and
+//!   against the catalog and the Mission IR.
 //! - [`workspace`]: loading files and folders from disk for the CLI.
 //! - [`cli`]: the `semo` command (rendering with ariadne or JSON).
 
@@ -13,6 +15,7 @@ pub mod cli;
 pub mod diag;
 pub mod sema;
 pub mod span;
+pub mod strategy;
 pub mod suggest;
 pub mod syntax;
 pub mod taskgraph;
