@@ -470,10 +470,12 @@ impl Cross<'_> {
             .filter_map(|m| m.mission().team_by_name(&team_name.name).map(|t| (m, t)))
             .collect();
         if teams.is_empty() {
-            let names: Vec<&str> = missions
-                .iter()
-                .flat_map(|m| m.mission().teams.iter().map(|t| t.name.as_str()))
-                .collect();
+            let mut names: Vec<&str> = Vec::new();
+            for team in missions.iter().flat_map(|m| m.mission().teams.iter()) {
+                if !names.contains(&team.name.as_str()) {
+                    names.push(&team.name);
+                }
+            }
             let guess = did_you_mean(&team_name.name, names.iter().copied());
             let message = format!(
                 "no mission of this check declares a team `{}` (the teams are {})",
@@ -512,7 +514,9 @@ impl Cross<'_> {
         // Target robots: robot types of the team.
         let team_types: Vec<RobotTypeId> =
             team.robots.iter().filter_map(|r| r.robot_type).collect();
-        for target in all_targets(strategy) {
+        // A robot of an unknown type (reported in the mission) may be the one meant.
+        let all_known = team.robots.iter().all(|r| r.robot_type.is_some());
+        for target in all_targets(strategy).filter(|_| all_known) {
             let Some(id) = catalog.lookup(&target.name) else {
                 continue; // E010, reported against the catalog
             };

@@ -340,3 +340,22 @@ fn an_entry_refined_in_two_files_of_a_team_is_a_duplicate() {
     // Both entries refine the call.
     assert_eq!(links.calls().len(), 2);
 }
+
+#[test]
+fn a_team_with_a_robot_of_unknown_type_is_not_blamed_for_its_targets() {
+    let catalog = builtin_catalog();
+    let text = SMALL.replace("iRobotCreate a", "iRobotCreat a");
+    let analysis = crate::check_source(MISSION, &text, &catalog);
+    let strategy = r#"<Strategy name="T"><ValueInfo><Value name="DISTANCE"><TargetRobot name="iRobotCreate"/>
+</Value></ValueInfo></Strategy>"#;
+    let (s, _) = load(strategy);
+    let (_, diags) = cross(&[&s], &[&analysis]);
+    assert!(diags.is_empty(), "{diags:#?}");
+    // With the type known, another type is not of the team.
+    let analysis = mission(MISSION, SMALL, &catalog);
+    let (s, _) = load(&strategy.replace("iRobotCreate", "TIEvalbot"));
+    let (_, diags) = cross(&[&s], &[&analysis]);
+    assert_eq!(codes(&diags), ["E090"], "{diags:#?}");
+    assert_eq!(diags[0].related[0].file, MISSION);
+    assert_eq!(at(SMALL, diags[0].related[0].span), "T");
+}
