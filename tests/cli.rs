@@ -264,3 +264,87 @@ fn rejected_definitions_are_still_checked() {
         ]
     );
 }
+
+#[test]
+fn strategy_files_are_checked_against_their_missions() {
+    let out = semo_in(&shared().join("examples"), &["check", "scouting"]);
+    assert_eq!(out.code, 0, "{}", out.stdout);
+    assert!(
+        out.stdout
+            .contains("checked 1 mission and 0 catalog files, 1 strategy file: 0 errors"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        semo(&["check", "--help"]).stdout.contains("*.strategy.xml"),
+        "check --help names strategy files"
+    );
+
+    // A target robot outside the team: shown in the strategy file, with the
+    // team's declaration in the mission beside it.
+    let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
+    let out = semo_in(&fixtures, &["check", "E090_strategy_robot_not_in_team"]);
+    assert_eq!(out.code, 1, "{}", out.stdout);
+    assert!(out.stdout.contains("[E090] Error"), "{}", out.stdout);
+    assert!(
+        out.stdout.contains("Scouts.strategy.xml:5:26"),
+        "{}",
+        out.stdout
+    );
+    assert!(out.stdout.contains("scouts.mission:3:3"), "{}", out.stdout);
+    assert!(
+        out.stdout.contains("team Scouts is declared here"),
+        "{}",
+        out.stdout
+    );
+    let json = semo_in(
+        &fixtures,
+        &[
+            "check",
+            "--format",
+            "json",
+            "E090_strategy_robot_not_in_team",
+        ],
+    );
+    let v: serde_json::Value = serde_json::from_str(json.stdout.lines().next().unwrap()).unwrap();
+    let related = &v["related"][0];
+    assert!(
+        related["file"]
+            .as_str()
+            .unwrap()
+            .ends_with("scouts.mission"),
+        "{v}"
+    );
+    assert_eq!(
+        (related["line"].as_u64(), related["column"].as_u64()),
+        (Some(3), Some(3))
+    );
+
+    // Named alone, a strategy file is checked against the catalog only.
+    let (code, diags) = check_json_in(
+        &fixtures,
+        &["E090_strategy_robot_not_in_team/Scouts.strategy.xml"],
+    );
+    assert_eq!((code, diags.len()), (0, 0), "{diags:#?}");
+}
+
+#[test]
+fn a_plain_lt_in_a_condition_points_at_the_lt_with_the_fix() {
+    let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
+    let out = semo_in(&fixtures, &["check", "E081_strategy_plain_lt"]);
+    assert_eq!(out.code, 1, "{}", out.stdout);
+    assert!(
+        out.stdout.contains("Scouts.strategy.xml:25:40"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stdout.contains("did you mean `&lt;`?"),
+        "{}",
+        out.stdout
+    );
+    let (_, diags) = check_json_in(&fixtures, &["E081_strategy_plain_lt"]);
+    assert!(diags.iter().all(|d| d.code == "E081"), "{diags:#?}");
+    assert_eq!(diags[0].suggestion.as_deref(), Some("&lt;"));
+    assert_eq!((diags[0].start, diags[0].end), ((25, 40), (25, 41)));
+}

@@ -1,7 +1,8 @@
 //! One fixture per diagnostic code, checked through `semo check --format json`.
 //!
 //! A fixture is `tests/fixtures/diagnostics/<CODE>_<what>.mission`, or a folder
-//! `<CODE>_<what>/` (a mission with its own `*.robot.xml`). Its expected
+//! `<CODE>_<what>/` (a mission with its own `*.robot.xml` or `*.strategy.xml`,
+//! or a task graph). Its expected
 //! diagnostics are the insta snapshot `tests/snapshots/diagnostics__<name>.snap`;
 //! besides, the fixture must produce at least one diagnostic with its code.
 

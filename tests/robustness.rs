@@ -1,6 +1,7 @@
 //! The parser and checker never panic, whatever the input: random bytes, random
 //! token soups, and random line mutations (delete, duplicate, swap) of the
-//! reference examples. Thousands of cases run in the normal test run; the
+//! reference examples; nor does the strategy loader and cross checker on
+//! damaged strategy XML. Thousands of cases run in the normal test run; the
 //! `#[ignore]`d variant runs many more (`cargo test --test robustness -- --ignored`,
 //! with `SEMO_FUZZ_CASES` to choose how many). A libFuzzer target lives in
 //! `compiler/fuzz/`.
@@ -10,6 +11,7 @@ mod support;
 use proptest::prelude::*;
 use semo::catalog::{Catalog, builtin_catalog};
 use semo::diag::FileId;
+use semo::strategy::{cross_check, load_strategy};
 use std::sync::OnceLock;
 
 fn catalog() -> &'static Catalog {
@@ -218,6 +220,225 @@ proptest! {
     }
 }
 
+// --- strategy files ----------------------------------------------------------
+
+const STRATEGY_FILE: FileId = FileId(2);
+
+fn strategy_examples() -> &'static Vec<String> {
+    static EXAMPLES: OnceLock<Vec<String>> = OnceLock::new();
+    EXAMPLES.get_or_init(|| {
+        let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
+        [
+            support::shared().join("examples/scouting/MasterTeam.strategy.xml"),
+            // Every element of the format, and conditions with a plain `<`.
+            fixtures.join("E081_strategy_plain_lt/Scouts.strategy.xml"),
+        ]
+        .iter()
+        .map(|p| std::fs::read_to_string(p).expect("strategy example"))
+        .collect()
+    })
+}
+
+/// The missions the strategies are cross-checked against (their teams are
+/// MasterTeam and Scouts).
+fn strategy_missions() -> &'static Vec<(String, semo::Analysis)> {
+    static MISSIONS: OnceLock<Vec<(String, semo::Analysis)>> = OnceLock::new();
+    MISSIONS.get_or_init(|| {
+        let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
+        [
+            support::shared().join("examples/scouting/scouting.mission"),
+            fixtures.join("E081_strategy_plain_lt/scouts.mission"),
+        ]
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let text = std::fs::read_to_string(p).expect("mission");
+            let analysis = semo::check_source(FileId(10 + i as u32), &text, catalog());
+            (text, analysis)
+        })
+        .collect()
+    })
+}
+
+fn assert_in(text: &str, span: semo::span::Span, what: &dyn std::fmt::Debug) {
+    assert!(span.start <= span.end && span.end <= text.len(), "{what:?}");
+    assert!(
+        text.is_char_boundary(span.start) && text.is_char_boundary(span.end),
+        "{what:?}"
+    );
+}
+
+/// Loads and cross-checks `text` as a strategy file: no panic, and every range
+/// lies inside the file it points into, on character boundaries.
+fn check_strategy_never_panics(text: &str) {
+    let missions = strategy_missions();
+    let (strategy, mut diags) = load_strategy(STRATEGY_FILE, text);
+    let strategies: Vec<_> = strategy.iter().collect();
+    let analyses: Vec<_> = missions.iter().map(|(_, a)| a).collect();
+    let (links, more) = cross_check(&strategies, &analyses, catalog());
+    diags.extend(more);
+    let text_of = |file: FileId| -> &str {
+        if file == STRATEGY_FILE {
+            return text;
+        }
+        &missions[(file.0 - 10) as usize].0
+    };
+    for d in &diags {
+        assert_eq!(d.file, STRATEGY_FILE, "{d:?}");
+        assert_in(text, d.span, d);
+        assert!(!d.message.is_empty() && !d.message.contains('\n'), "{d:?}");
+        for r in &d.related {
+            assert_in(text_of(r.file), r.span, d);
+        }
+    }
+    for link in links.calls() {
+        assert_in(text_of(link.mission), link.call, link);
+        assert!(link.entry.index < strategies[0].services.len());
+    }
+}
+
+fn damaged_strategy() -> impl Strategy<Value = String> {
+    (
+        0..strategy_examples().len(),
+        any::<usize>(),
+        any::<usize>(),
+        prop::sample::select(vec![
+            '<', '>', '"', '\'', '&', ';', '/', '=', '!', '?', ' ', '\n', 'x', '0', '한', '😀',
+        ]),
+        any::<char>(),
+        any::<bool>(),
+    )
+        .prop_map(|(which, at, len, xml_char, any_char, xml)| {
+            let chars: Vec<char> = strategy_examples()[which].chars().collect();
+            let at = at % (chars.len() + 1);
+            let end = (at + len % 24).min(chars.len());
+            let mut out: String = chars[..at].iter().collect();
+            out.push(if xml { xml_char } else { any_char });
+            out.extend(&chars[end..]);
+            out
+        })
+}
+
+fn mutated_strategy() -> impl Strategy<Value = String> {
+    let mutation = prop_oneof![
+        any::<usize>().prop_map(Mutation::Delete),
+        any::<usize>().prop_map(Mutation::Duplicate),
+        (any::<usize>(), any::<usize>()).prop_map(|(a, b)| Mutation::Swap(a, b)),
+    ];
+    (
+        0..strategy_examples().len(),
+        prop::collection::vec(mutation, 1..8),
+    )
+        .prop_map(|(which, mutations)| {
+            let mut lines: Vec<String> = strategy_examples()[which]
+                .lines()
+                .map(str::to_string)
+                .collect();
+            for m in mutations {
+                let n = lines.len();
+                if n == 0 {
+                    break;
+                }
+                match m {
+                    Mutation::Delete(i) => {
+                        lines.remove(i % n);
+                    }
+                    Mutation::Duplicate(i) => {
+                        let line = lines[i % n].clone();
+                        lines.insert(i % n, line);
+                    }
+                    Mutation::Swap(a, b) => lines.swap(a % n, b % n),
+                }
+            }
+            lines.join("\n")
+        })
+}
+
+const XML_SOUP: &[&str] = &[
+    "<Strategy name=\"MasterTeam\">",
+    "</Strategy>",
+    "<ServiceInfo>",
+    "</ServiceInfo>",
+    "<Service plan_name=\"Action\" name=\"move\">",
+    "</Service>",
+    "<TargetRobot name=\"iRobotCreate\"/>",
+    "<ActionInfo>",
+    "</ActionInfo>",
+    "<Action name=\"A\" actionId=\"0\" initial=\"Yes\">",
+    "<Action name=\"B\" actionId=\"1\" final=\"Yes\"/>",
+    "</Action>",
+    "<TransitionInfo>",
+    "<Transition srcId=\"0\" dstId=\"1\">",
+    "</Transition>",
+    "<Condition cond=\"d<2 and (e\"/>",
+    "<Condition cond=\"d &gt;= 2\">",
+    "</Condition>",
+    "<Parameter name=\"d\" type=\"int\" dataCharacteristic=\"channel\" srcTask=\"vicon\"/>",
+    "<ValueInfo><Value name=\"DISTANCE\">",
+    "</Value></ValueInfo>",
+    "<GroupingInfo><LeaderSelectionInfo algorithm=\"bully\" plan_name=\"Action\" cs_name=\"Wait\"/>",
+    "<GroupSync timeout=\"5 SEC\"/></GroupingInfo>",
+    "<NonFunctionalInfo><BatteryRequirement>",
+    "<Sensor name=\"Camera\" periodLevel=\"2\"/>",
+    "<",
+    ">",
+    "\"",
+    "&lt;",
+    "&bogus;",
+    "<!--",
+    "-->",
+    "<![CDATA[x",
+    "text",
+    "\n",
+    "😀",
+];
+
+fn xml_soup() -> impl Strategy<Value = String> {
+    prop::collection::vec(prop::sample::select(XML_SOUP), 0..60).prop_map(|parts| parts.concat())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 1000, ..ProptestConfig::default() })]
+
+    #[test]
+    fn damaged_strategy_files(text in damaged_strategy()) {
+        check_strategy_never_panics(&text);
+    }
+
+    #[test]
+    fn line_mutations_of_strategy_files(text in mutated_strategy()) {
+        check_strategy_never_panics(&text);
+    }
+
+    #[test]
+    fn strategy_xml_soups(text in xml_soup()) {
+        check_strategy_never_panics(&text);
+    }
+
+    #[test]
+    fn random_bytes_as_a_strategy_file(bytes in prop::collection::vec(any::<u8>(), 0..400)) {
+        check_strategy_never_panics(&String::from_utf8_lossy(&bytes));
+    }
+}
+
+#[test]
+fn the_strategy_examples_load_cleanly() {
+    // The damage above starts from valid files.
+    for text in strategy_examples() {
+        let (strategy, diags) = load_strategy(STRATEGY_FILE, text);
+        assert!(strategy.is_some());
+        assert!(
+            diags.iter().all(|d| d.code.as_str() == "E081"),
+            "{diags:#?}"
+        );
+    }
+    let long = format!(
+        "<Strategy name=\"T\"><NonFunctionalInfo><BatteryRequirement><Condition cond=\"Battery{}\"/></BatteryRequirement></NonFunctionalInfo></Strategy>",
+        " and Battery".repeat(20_000)
+    );
+    check_strategy_never_panics(&long);
+}
+
 #[test]
 #[ignore = "long-running: many more random cases"]
 fn long_running_fuzz() {
@@ -242,6 +463,19 @@ fn long_running_fuzz() {
             Ok(())
         })
         .unwrap();
+    let strategy_files = prop_oneof![
+        prop::collection::vec(any::<u8>(), 0..2000)
+            .prop_map(|b| String::from_utf8_lossy(&b).into_owned()),
+        xml_soup(),
+        mutated_strategy(),
+        damaged_strategy(),
+    ];
+    runner
+        .run(&strategy_files, |text| {
+            check_strategy_never_panics(&text);
+            Ok(())
+        })
+        .unwrap();
 }
 
 #[test]
@@ -257,6 +491,17 @@ fn deeply_nested_input_does_not_overflow_the_stack() {
         ")".repeat(5000)
     );
     check_never_panics(&parens);
+    // `a and a and ...` is a tree as deep as the chain, and so is `not not ...`.
+    let ands = format!(
+        "{{ T: iRobotCreate a }}\nT.Action.Go {{ if (a{}) stop() }}",
+        " and a".repeat(20_000)
+    );
+    check_never_panics(&ands);
+    let nots = format!(
+        "{{ T: iRobotCreate a }}\nT.Action.Go {{ if ({}a) stop() }}",
+        "not !".repeat(10_000)
+    );
+    check_never_panics(&nots);
 }
 
 #[test]

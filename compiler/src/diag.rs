@@ -124,6 +124,26 @@ codes! {
     UnknownLibraryFunction = "E077", Error, "a call through a library port to a function the library lacks";
     MulticastWithoutReader = "W062", Warning, "a multicast group that tasks write but none reads";
     MulticastWithoutWriter = "W063", Warning, "a multicast group that tasks read but none writes";
+    // Strategy files (*.strategy.xml).
+    StrategyXml = "E080", Error, "a strategy file that is not well-formed XML";
+    StrategyRawLt = "E081", Error, "a plain `<` inside an attribute value, where XML needs `&lt;`";
+    StrategyUnknownElement = "E082", Error, "an element that the strategy format does not have there";
+    StrategyMissingAttribute = "E083", Error, "a required strategy attribute or element is missing";
+    StrategyBadAttribute = "E084", Error, "a strategy attribute value of the wrong form";
+    StrategyDuplicate = "E085", Error, "an actionId, parameter or strategy entry given twice";
+    StrategyBadTransition = "E086", Error, "a transition that does not leave its own action, or goes to no action";
+    StrategyInitialAction = "E087", Error, "an action machine without exactly one initial action";
+    StrategyUnknownParameter = "E088", Error, "a condition naming a parameter that the service does not declare";
+    StrategyUnknownTeam = "E089", Error, "a strategy for a team that the missions do not declare";
+    StrategyRobotNotInTeam = "E090", Error, "a `TargetRobot` that is not a robot type of the strategy's team";
+    StrategyServiceNotCalled = "E091", Error, "a strategy `Service` that the team does not call in that plan";
+    StrategyUnknownCompositeService = "E092", Error, "a leader selection naming a composite service that the team lacks or that elects no leader";
+    StrategyUnknownValue = "E093", Error, "a `Value` that the target robot type does not have";
+    StrategyUnknownTask = "E094", Error, "a `srcTask` or `dstTask` that is not a task of the target robot type";
+    StrategyServiceNotProvided = "E095", Error, "a strategy `Service` that the target robot type does not provide";
+    StrategyUnknownAttribute = "W080", Warning, "an attribute that the strategy format does not have";
+    UnreachableAction = "W081", Warning, "an action that cannot be reached from the initial action";
+    NoFinalAction = "W082", Warning, "an action machine in which no final action can be reached: the service never ends";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

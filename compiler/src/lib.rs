@@ -5,6 +5,8 @@
 //! - [`syntax`]: lexer and parser (chumsky) from text to a positioned AST; never panics.
 //! - [`catalog`]: robot types from the built-in catalog and `*.robot.xml` files.
 //! - [`sema`]: name resolution and checks, producing the [`sema::Mission`] IR.
+//! - [`strategy`]: strategy files (`*.strategy.xml`), checked on their own and
+//!   against the catalog and the Mission IR.
 //! - [`workspace`]: loading files and folders from disk for the CLI.
 //! - [`cli`]: the `semo` command (rendering with ariadne or JSON).
 
@@ -13,6 +15,7 @@ pub mod cli;
 pub mod diag;
 pub mod sema;
 pub mod span;
+pub mod strategy;
 pub mod suggest;
 pub mod syntax;
 pub mod taskgraph;
@@ -20,5 +23,7 @@ pub mod text;
 pub mod workspace;
 /// Byte positions of XML elements and attributes, shared by the XML loaders.
 mod xmlpos;
+/// The positioned XML element tree read by the task-graph and strategy loaders.
+mod xmltree;
 
 pub use sema::{Analysis, check_source};

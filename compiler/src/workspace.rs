@@ -1,12 +1,15 @@
 //! Loading a check's files from disk: the one place (besides the CLI) that reads
-//! files. A folder stands for every `.mission` and `.robot.xml` under it; all
-//! catalog files found form one catalog that every mission is checked against.
+//! files. A folder stands for every `.mission`, `.robot.xml`, `.strategy.xml`
+//! and `.taskgraph.xml` under it; all catalog files found form one catalog that
+//! every mission is checked against, and every strategy file is checked against
+//! the catalog and the missions.
 
 use crate::catalog::{
     BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE, Catalog, CatalogSource, load_catalog,
 };
 use crate::diag::{self, Diagnostic, FileId};
 use crate::sema::{Analysis, check_source};
+use crate::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
 use crate::text::LineIndex;
 use std::path::{Path, PathBuf};
 
@@ -16,6 +19,8 @@ pub enum FileKind {
     Catalog,
     /// `*.taskgraph.xml`, or an SDF3 graph named explicitly.
     TaskGraph,
+    /// `*.strategy.xml`.
+    Strategy,
 }
 
 impl FileKind {
@@ -25,6 +30,8 @@ impl FileKind {
             Some(FileKind::Catalog)
         } else if name.ends_with(".taskgraph.xml") {
             Some(FileKind::TaskGraph)
+        } else if name.ends_with(".strategy.xml") {
+            Some(FileKind::Strategy)
         } else if name.ends_with(".mission") {
             Some(FileKind::Mission)
         } else {
@@ -119,7 +126,8 @@ impl std::fmt::Display for LoadError {
 
 /// Expands the paths given on the command line: files as they are (see
 /// [`FileKind::named_explicitly`]), folders recursively (their `.mission`,
-/// `.robot.xml` and `.taskgraph.xml` files), sorted for stable output.
+/// `.robot.xml`, `.strategy.xml` and `.taskgraph.xml` files), sorted for
+/// stable output.
 pub fn collect(paths: &[PathBuf]) -> Result<Vec<(PathBuf, FileKind)>, LoadError> {
     let mut found = Vec::new();
     for path in paths {
@@ -169,6 +177,11 @@ pub struct CheckRun {
     pub files: Files,
     pub catalog: Catalog,
     pub analyses: Vec<(FileId, Analysis)>,
+    /// The strategy files that could be read (a file without a `<Strategy>`
+    /// element is left out; its diagnostics say why).
+    pub strategies: Vec<Strategy>,
+    /// The missions' built-in calls linked to the strategy entries refining them.
+    pub strategy_links: StrategyLinks,
     /// Every diagnostic, catalog files first, sorted by file and position.
     pub diagnostics: Vec<Diagnostic>,
 }
@@ -196,7 +209,8 @@ pub fn check_paths(paths: &[PathBuf]) -> Result<CheckRun, LoadError> {
 }
 
 /// Checks files already loaded: the catalog files form the catalog, then each
-/// mission is checked against it; task graphs are loaded and analysed.
+/// mission is checked against it; strategy files are checked on their own, then
+/// against the catalog and the missions; task graphs are loaded and analysed.
 pub fn check_files(files: Files) -> CheckRun {
     let sources: Vec<CatalogSource<'_>> = files
         .iter()
@@ -216,6 +230,18 @@ pub fn check_files(files: Files) -> CheckRun {
     for (_, analysis) in &analyses {
         diagnostics.extend(analysis.diagnostics.iter().cloned());
     }
+    let mut strategies = Vec::new();
+    for f in files.iter().filter(|f| f.kind == FileKind::Strategy) {
+        let (strategy, found) = load_strategy(f.id, &f.text);
+        diagnostics.extend(found);
+        strategies.extend(strategy);
+    }
+    let (strategy_links, found) = cross_check(
+        &strategies.iter().collect::<Vec<_>>(),
+        &analyses.iter().map(|(_, a)| a).collect::<Vec<_>>(),
+        &catalog,
+    );
+    diagnostics.extend(found);
     for f in files.iter().filter(|f| f.kind == FileKind::TaskGraph) {
         diagnostics.extend(analyze_graph(f).diagnostics);
     }
@@ -224,6 +250,8 @@ pub fn check_files(files: Files) -> CheckRun {
         files,
         catalog,
         analyses,
+        strategies,
+        strategy_links,
         diagnostics,
     }
 }

@@ -196,15 +196,70 @@ pub(crate) fn start_tag_spans(text: &str, e: &BytesStart<'_>, tag_end: usize) ->
     (name_span, tag)
 }
 
+/// What is said of a `<` inside an attribute value when reading stops there:
+/// most often a closing quote is missing and the value ran into the next tag.
+pub(crate) const LT_IN_VALUE: &str =
+    "a `<` inside an attribute value: is a closing quote missing? (write `&lt;` for a plain `<`)";
+
+/// For a tag that quick-xml found never closed (it starts at `tag_start`): the
+/// range of the first `<` inside one of its quoted values, if any. That is
+/// where a value whose closing quote is missing ran into the next tag.
+pub(crate) fn lt_in_unclosed_tag(text: &str, tag_start: usize) -> Option<Span> {
+    let bytes = text.as_bytes().get(tag_start..)?;
+    let mut quote: Option<u8> = None;
+    for (i, &b) in bytes.iter().enumerate().skip(1) {
+        match (quote, b) {
+            (None, b'"' | b'\'') => quote = Some(b),
+            (Some(q), _) if b == q => quote = None,
+            (Some(_), b'<') => return Some(Span::new(tag_start + i, tag_start + i + 1)),
+            _ => {}
+        }
+    }
+    None
+}
+
+/// The range of the `<` at byte `at` (or `fallback` past the end).
+fn lt_span(text: &str, at: usize, fallback: Span) -> Span {
+    if text.len() > at {
+        Span::new(at, at + 1)
+    } else {
+        fallback
+    }
+}
+
 /// The attributes of a start tag (`tag` is its range), with their ranges. A
-/// malformed attribute list gives the range and message of the first error.
+/// malformed attribute list gives the range and message of the first error; a
+/// `<` inside a value is such an error.
 pub(crate) fn read_attributes(
     text: &str,
     e: &BytesStart<'_>,
     tag: Span,
     decoder: Decoder,
 ) -> Result<Vec<Attr>, (Span, String)> {
+    let (attrs, raw_lt) = read_attributes_keeping_lt(text, e, tag, decoder)?;
+    match raw_lt.first() {
+        Some(&at) => Err((lt_span(text, at, tag), LT_IN_VALUE.to_string())),
+        None => Ok(attrs),
+    }
+}
+
+/// As [`read_attributes`], except that a `<` inside a value (which quick-xml
+/// reads as part of the value, and XML forbids) is kept: the byte position of
+/// every such `<` is returned with the attributes, for formats that report it
+/// and read on. When the attribute list is malformed after such a `<`, the
+/// error is the `<` (a closing quote is likely missing there).
+pub(crate) fn read_attributes_keeping_lt(
+    text: &str,
+    e: &BytesStart<'_>,
+    tag: Span,
+    decoder: Decoder,
+) -> Result<(Vec<Attr>, Vec<usize>), (Span, String)> {
     let mut out = Vec::new();
+    let mut raw_lt: Vec<usize> = Vec::new();
+    let fail = |raw_lt: &[usize], span: Span, message: String| match raw_lt.first() {
+        Some(&at) => (lt_span(text, at, tag), LT_IN_VALUE.to_string()),
+        None => (span, message),
+    };
     // Attribute error positions count from the byte after `<`.
     let content_start = tag.start + 1;
     for attr in e.attributes() {
@@ -236,34 +291,25 @@ pub(crate) fn read_attributes(
                         "this attribute is given twice on the same element".to_string(),
                     ),
                 };
-                return Err((word_at(text, content_start + pos), message));
+                return Err(fail(&raw_lt, word_at(text, content_start + pos), message));
             }
         };
         let key = String::from_utf8_lossy(attr.key.as_ref()).into_owned();
         let key_span = slice_span(text, attr.key.as_ref()).unwrap_or(tag);
         let raw: &[u8] = &attr.value;
         let span = slice_span(text, raw).unwrap_or(tag);
-        if let Some(p) = raw.iter().position(|&b| b == b'<') {
-            let at = span.start + p;
-            let span = if text.len() > at {
-                Span::new(at, at + 1)
-            } else {
-                span
-            };
-            return Err((
-                span,
-                "a `<` inside an attribute value: is a closing quote missing? (write `&lt;` for a plain `<`)"
-                    .to_string(),
-            ));
-        }
+        raw_lt.extend(
+            raw.iter()
+                .enumerate()
+                .filter(|&(_, &b)| b == b'<')
+                .map(|(i, _)| span.start + i),
+        );
         let value = match attr.decode_and_unescape_value(decoder) {
             Ok(v) => v.into_owned(),
             Err(_) => {
-                return Err((
-                    span,
-                    "this value has an unknown `&...;` entity: write `&amp;` for a plain `&`"
-                        .to_string(),
-                ));
+                let message =
+                    "this value has an unknown `&...;` entity: write `&amp;` for a plain `&`";
+                return Err(fail(&raw_lt, span, message.to_string()));
             }
         };
         let exact = value.as_bytes() == raw;
@@ -275,7 +321,57 @@ pub(crate) fn read_attributes(
             exact,
         });
     }
-    Ok(out)
+    Ok((out, raw_lt))
+}
+
+/// For each byte offset of `attr.value` (and one past its end), the byte
+/// offset in `text` where it was written: entities (`&lt;`) make the value
+/// shorter than its text, and every byte of what an entity stands for maps to
+/// the entity's `&`. Offsets stay inside the value's range whatever happens.
+pub(crate) fn value_offsets(text: &str, attr: &Attr) -> Vec<usize> {
+    let span = attr.span;
+    if attr.exact
+        || span.end > text.len()
+        || !text.is_char_boundary(span.start)
+        || !text.is_char_boundary(span.end)
+    {
+        return (0..=attr.value.len())
+            .map(|i| (span.start + i).min(span.end))
+            .collect();
+    }
+    let raw = &text[span.range()];
+    let mut out = Vec::with_capacity(attr.value.len() + 1);
+    let mut i = 0;
+    while i < raw.len() {
+        let rest = &raw[i..];
+        if rest.starts_with('&') {
+            if let Some(semi) = rest.find(';') {
+                let name = &rest[1..semi];
+                let decoded = if let Some(num) = name.strip_prefix('#') {
+                    let n = match num.strip_prefix('x') {
+                        Some(hex) => u32::from_str_radix(hex, 16).ok(),
+                        None => num.parse::<u32>().ok(),
+                    };
+                    n.and_then(char::from_u32).map(|c| c.len_utf8())
+                } else {
+                    quick_xml::escape::resolve_predefined_entity(name).map(str::len)
+                };
+                if let Some(len) = decoded {
+                    out.extend(std::iter::repeat_n(span.start + i, len));
+                    i += semi + 1;
+                    continue;
+                }
+            }
+        }
+        let c_len = rest.chars().next().map_or(1, char::len_utf8);
+        out.extend((0..c_len).map(|k| span.start + i + k));
+        i += c_len;
+    }
+    out.push(span.end);
+    // Should the decoding differ from quick-xml's, keep every offset in range
+    // and the table as long as the value.
+    out.resize(attr.value.len() + 1, span.end);
+    out
 }
 
 /// A `&name;` or `&#N;` reference in text: the character(s) it stands for, or
@@ -377,6 +473,41 @@ mod tests {
         assert_eq!(word_at(text, 5).start, 4);
         assert_eq!(word_at(text, 7), Span::new(7, 8));
         assert_eq!(word_at(text, 100), Span::new(text.len(), text.len()));
+    }
+
+    #[test]
+    fn value_offsets_map_entities_to_their_ampersand() {
+        let text = r#"<C cond="a&lt;=b&#x3E;é"/>"#;
+        let start = text.find('a').unwrap();
+        let end = text.rfind('"').unwrap();
+        let a = Attr {
+            key: "cond".into(),
+            key_span: Span::new(3, 7),
+            value: "a<=b>é".into(),
+            span: Span::new(start, end),
+            exact: false,
+        };
+        let offsets = value_offsets(text, &a);
+        assert_eq!(offsets.len(), a.value.len() + 1);
+        let at = |i: usize| &text[offsets[i]..];
+        assert!(at(0).starts_with("a&lt;"));
+        assert!(at(1).starts_with("&lt;"));
+        assert!(at(2).starts_with("=b"));
+        assert!(at(4).starts_with("&#x3E;"));
+        assert!(at(5).starts_with('é'));
+        assert_eq!(offsets[a.value.len()], end);
+        // Exact values map one to one.
+        let exact = attr("xy", 4);
+        assert_eq!(value_offsets("0123xy\"", &exact), vec![4, 5, 6]);
+    }
+
+    #[test]
+    fn lt_in_unclosed_tag_finds_the_lt_inside_quotes() {
+        let text = "<B a='1' cond=\"x<2/>\n<C k=\"1\"/>";
+        let lt = lt_in_unclosed_tag(text, 0).unwrap();
+        assert_eq!(lt.start, text.find("x<").unwrap() + 1);
+        assert_eq!(lt_in_unclosed_tag("<B a=\"1\"", 0), None);
+        assert_eq!(lt_in_unclosed_tag("<B", 9), None);
     }
 
     #[test]

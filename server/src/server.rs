@@ -77,13 +77,18 @@ impl Backend {
     }
 
     async fn register_watchers(&self) {
-        let watchers = ["**/*.mission", "**/*.robot.xml", "**/*.taskgraph.xml"]
-            .into_iter()
-            .map(|glob| FileSystemWatcher {
-                glob_pattern: GlobPattern::String(glob.to_string()),
-                kind: None,
-            })
-            .collect();
+        let watchers = [
+            "**/*.mission",
+            "**/*.robot.xml",
+            "**/*.strategy.xml",
+            "**/*.taskgraph.xml",
+        ]
+        .into_iter()
+        .map(|glob| FileSystemWatcher {
+            glob_pattern: GlobPattern::String(glob.to_string()),
+            kind: None,
+        })
+        .collect();
         let registration = Registration {
             id: "semo-files".to_string(),
             method: "workspace/didChangeWatchedFiles".to_string(),

@@ -13,6 +13,7 @@ use crate::encoding::{Encoding, LineMap};
 use semo::catalog::{Catalog, CatalogSource, load_catalog};
 use semo::diag::{self, Diagnostic, FileId};
 use semo::sema::Analysis;
+use semo::strategy::{Strategy, cross_check, load_strategy};
 use semo::text::LineIndex;
 use semo::workspace::{FileKind, GraphRun, analyze_graph_text};
 use std::collections::HashMap;
@@ -80,6 +81,8 @@ pub struct Snapshot {
     pub text: Arc<str>,
     pub catalog: Arc<CatalogState>,
     pub encoding: Encoding,
+    /// For a strategy file: the missions it is cross-checked against.
+    pub missions: Vec<Arc<Snapshot>>,
     analysis: OnceLock<Arc<FileAnalysis>>,
 }
 
@@ -90,6 +93,7 @@ pub struct FileAnalysis {
     pub diagnostics: Vec<Diagnostic>,
     pub mission: Option<Analysis>,
     pub graph: Option<GraphRun>,
+    pub strategy: Option<Strategy>,
 }
 
 impl Snapshot {
@@ -110,6 +114,7 @@ impl Snapshot {
                     diagnostics: analysis.diagnostics.clone(),
                     mission: Some(analysis),
                     graph: None,
+                    strategy: None,
                 }
             }
             FileKind::Catalog => {
@@ -121,6 +126,7 @@ impl Snapshot {
                     diagnostics,
                     mission: None,
                     graph: None,
+                    strategy: None,
                 }
             }
             FileKind::TaskGraph => {
@@ -130,6 +136,26 @@ impl Snapshot {
                     diagnostics: run.diagnostics.clone(),
                     mission: None,
                     graph: Some(run),
+                    strategy: None,
+                }
+            }
+            FileKind::Strategy => {
+                let (strategy, mut diagnostics) = load_strategy(self.id, &self.text);
+                if let Some(strategy) = &strategy {
+                    let analyses: Vec<Arc<FileAnalysis>> =
+                        self.missions.iter().map(|m| m.analysis()).collect();
+                    let missions: Vec<&Analysis> =
+                        analyses.iter().filter_map(|a| a.mission.as_ref()).collect();
+                    let (_, cross) = cross_check(&[strategy], &missions, self.catalog.catalog());
+                    diagnostics.extend(cross.into_iter().filter(|d| d.file == self.id));
+                    diag::sort_and_dedup(&mut diagnostics);
+                }
+                FileAnalysis {
+                    lines,
+                    diagnostics,
+                    mission: None,
+                    graph: None,
+                    strategy,
                 }
             }
         }
@@ -318,10 +344,10 @@ impl World {
         let Some(entry) = self.files.remove(uri) else {
             return Changed::default();
         };
-        let mut changed = if entry.kind == FileKind::Catalog {
-            self.catalog_changed()
-        } else {
-            Changed::default()
+        let mut changed = match entry.kind {
+            FileKind::Catalog => self.catalog_changed(),
+            FileKind::Mission => self.missions_changed(),
+            _ => Changed::default(),
         };
         changed.files.push(uri.clone());
         changed
@@ -356,6 +382,8 @@ impl World {
         );
         let mut changed = if is_catalog {
             self.catalog_changed()
+        } else if kind == FileKind::Mission {
+            self.missions_changed()
         } else {
             Changed::default()
         };
@@ -374,6 +402,15 @@ impl World {
         text: Arc<str>,
         catalog: Arc<CatalogState>,
     ) -> Snapshot {
+        let missions = if kind == FileKind::Strategy {
+            self.files
+                .values()
+                .filter(|f| f.kind == FileKind::Mission)
+                .map(|f| f.snapshot.clone())
+                .collect()
+        } else {
+            Vec::new()
+        };
         Snapshot {
             uri: uri.clone(),
             id,
@@ -382,8 +419,34 @@ impl World {
             text,
             catalog,
             encoding: self.encoding,
+            missions,
             analysis: OnceLock::new(),
         }
+    }
+
+    /// Strategy files are cross-checked against the missions: they get new
+    /// snapshots on the current missions.
+    fn missions_changed(&mut self) -> Changed {
+        let catalog = self.catalog();
+        let strategies: Vec<Uri> = self
+            .files
+            .iter()
+            .filter(|(_, f)| f.kind == FileKind::Strategy)
+            .map(|(u, _)| u.clone())
+            .collect();
+        for uri in &strategies {
+            let old = self.files[uri].snapshot.clone();
+            let fresh = Arc::new(self.new_snapshot(
+                uri,
+                old.id,
+                old.kind,
+                old.version,
+                old.text.clone(),
+                catalog.clone(),
+            ));
+            self.files.get_mut(uri).expect("listed above").snapshot = fresh;
+        }
+        Changed { files: strategies }
     }
 
     /// Every file gets a new snapshot on the new catalog (missions are
@@ -395,7 +458,7 @@ impl World {
         let uris: Vec<Uri> = self
             .files
             .iter()
-            .filter(|(_, f)| f.kind != FileKind::TaskGraph)
+            .filter(|(_, f)| matches!(f.kind, FileKind::Mission | FileKind::Catalog))
             .map(|(u, _)| u.clone())
             .collect();
         for uri in uris {
@@ -411,6 +474,8 @@ impl World {
             self.files.get_mut(&uri).expect("listed above").snapshot = fresh;
             changed.files.push(uri);
         }
+        // Strategies last, on the missions' new snapshots.
+        changed.files.extend(self.missions_changed().files);
         changed
     }
 }

@@ -26,13 +26,15 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Check mission scripts and robot catalogs, and report problems.
+    /// Check mission scripts, robot catalogs, strategy files and task graphs.
     #[command(
-        long_about = "Check mission scripts and robot catalogs, and report problems.\n\n\
-        Each PATH is a file or a folder; a folder stands for every *.mission and *.robot.xml \
-        file under it. All catalog files found form one catalog (on top of the built-in \
-        one), and every mission is checked against it. With no PATH, the current folder \
-        is checked."
+        long_about = "Check mission scripts, robot catalogs, strategy files and task graphs, \
+        and report problems.\n\n\
+        Each PATH is a file or a folder; a folder stands for every *.mission, *.robot.xml, \
+        *.strategy.xml and *.taskgraph.xml file under it. All catalog files found form one \
+        catalog (on top of the built-in one), every mission is checked against it, and \
+        every strategy file against the catalog and the missions. With no PATH, the \
+        current folder is checked."
     )]
     Check {
         /// Files or folders to check.

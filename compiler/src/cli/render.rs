@@ -103,9 +103,15 @@ pub fn human(run: &CheckRun, colored: bool, out: &mut impl Write) -> io::Result<
     } else {
         String::new()
     };
+    let strategies = of_kind(crate::workspace::FileKind::Strategy);
+    let strategies = if strategies > 0 {
+        format!(", {}", plural(strategies, "strategy file"))
+    } else {
+        String::new()
+    };
     writeln!(
         out,
-        "checked {} and {}{graphs}: {}, {}, {}",
+        "checked {} and {}{graphs}{strategies}: {}, {}, {}",
         plural(of_kind(crate::workspace::FileKind::Mission), "mission"),
         plural(of_kind(crate::workspace::FileKind::Catalog), "catalog file"),
         plural(count(Severity::Error), "error"),

@@ -5,9 +5,10 @@
 //! So brackets are balanced first, in one linear pass: an unclosed `{`, `(`,
 //! `[[` or `[` is reported and closed where its parent closes (or at the end of
 //! the chunk); a closer without an opener is reported and dropped. Nesting deeper
-//! than [`MAX_DEPTH`] (counting `else if` chains, which nest too) is reported and
-//! the rest of the chunk dropped, so that parser and checker recursion stays
-//! bounded whatever the input.
+//! than [`MAX_DEPTH`] (counting `else if` chains and `and`/`or`/`not` chains,
+//! which nest too: each link is one level of the tree) is reported and the rest
+//! of the chunk dropped, so that parser and checker recursion (and dropping the
+//! tree) stays bounded whatever the input.
 
 use super::token::{Kw, Token};
 use crate::diag::{Code, Diagnostic, FileId};
@@ -39,15 +40,27 @@ fn is_closer(t: Token<'_>) -> bool {
 
 fn too_deep() -> String {
     format!(
-        "blocks, brackets and `else if` chains are nested too deeply here (more than {MAX_DEPTH} levels)"
+        "blocks, brackets, `else if` chains and `and`/`or`/`not` chains are nested too deeply here (more than {MAX_DEPTH} levels)"
     )
+}
+
+/// A token that nests the rest of its bracket one level deeper: an `else if`
+/// link, or a logical operator (`a and b and c` is a tree as deep as its
+/// chain).
+fn nests(chunk: &[Tok<'_>], i: usize) -> bool {
+    match chunk[i].0 {
+        Token::Kw(Kw::Else) => chunk.get(i + 1).map(|t| t.0) == Some(Token::Kw(Kw::If)),
+        Token::Kw(Kw::And | Kw::Or | Kw::Not) | Token::AndAnd | Token::OrOr | Token::Bang => true,
+        _ => false,
+    }
 }
 
 struct Open<'s> {
     token: Token<'s>,
     /// Index of the opener in the chunk.
     index: usize,
-    /// `else if` links seen directly in this bracket: each nests one level.
+    /// `else if` links and logical operators seen directly in this bracket:
+    /// each nests one level.
     else_ifs: usize,
 }
 
@@ -72,9 +85,7 @@ fn already_balanced(chunk: &[Tok<'_>]) -> bool {
             }
             open -= 1;
             depth -= 1 + else_ifs[open];
-        } else if token == Token::Kw(Kw::Else)
-            && chunk.get(i + 1).map(|t| t.0) == Some(Token::Kw(Kw::If))
-        {
+        } else if nests(chunk, i) {
             if depth >= MAX_DEPTH {
                 return false;
             }
@@ -188,9 +199,7 @@ pub fn balance<'c, 's>(
             let open = stack.pop().unwrap_or_else(|| unreachable!());
             matched[open.index] = Some(i);
             depth -= 1 + open.else_ifs;
-        } else if token == Token::Kw(Kw::Else)
-            && chunk.get(i + 1).map(|t| t.0) == Some(Token::Kw(Kw::If))
-        {
+        } else if nests(chunk, i) {
             depth += 1;
             if let Some(open) = stack.last_mut() {
                 open.else_ifs += 1;
@@ -292,6 +301,22 @@ mod tests {
             "else if (x) a() ".repeat(MAX_DEPTH + 1)
         );
         let (_, diags) = balanced(&chain);
+        assert!(diags[0].contains("nested too deeply"), "{diags:?}");
+    }
+
+    #[test]
+    fn limits_and_or_not_chains_per_bracket() {
+        let long =
+            |op: &str, n: usize| format!("T.A.S {{ if (x{}) a() }}", format!(" {op} x").repeat(n));
+        for op in ["and", "or", "&&", "||"] {
+            let (_, diags) = balanced(&long(op, MAX_DEPTH + 1));
+            assert!(diags[0].contains("nested too deeply"), "{op}: {diags:?}");
+            // Each condition's chain ends with its bracket.
+            let (_, diags) = balanced(&long(op, MAX_DEPTH - 4).repeat(3));
+            assert!(diags.is_empty(), "{op}: {diags:?}");
+        }
+        let nots = format!("T.A.S {{ if ({}x) a() }}", "not ! ".repeat(MAX_DEPTH));
+        let (_, diags) = balanced(&nots);
         assert!(diags[0].contains("nested too deeply"), "{diags:?}");
     }
 }

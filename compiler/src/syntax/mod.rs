@@ -174,6 +174,68 @@ fn parse_chunks(
     (items, diagnostics)
 }
 
+/// A standalone expression parsed with the mission grammar (spec section 2,
+/// `Expr`): a condition written outside a mission, such as a strategy file's
+/// `cond="distance > 20"`.
+#[derive(Clone, Debug, Default)]
+pub struct ExprParse {
+    /// `None` when the text is blank or did not parse (the diagnostics say why).
+    pub expr: Option<ast::Expr>,
+    /// Syntax diagnostics (E001–E003), positioned in the file the text came from.
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Parses `text` as one expression. Every position is `base` plus the offset
+/// in `text`, so that ranges are right in the file `text` was taken from.
+pub fn parse_expr(file: FileId, text: &str, base: usize) -> ExprParse {
+    parse_expr_mapped(file, text, |offset| base + offset)
+}
+
+/// As [`parse_expr`], with each byte offset of `text` (and the offset of its
+/// end) mapped to a file position by `position`, which must not decrease: for
+/// text that was unescaped from the file (an XML attribute written with
+/// `&lt;` is shorter once read).
+pub fn parse_expr_mapped(file: FileId, text: &str, position: impl Fn(usize) -> usize) -> ExprParse {
+    let mut diagnostics = Vec::new();
+    let mut tokens = token::lex(text);
+    report_lexical_errors(file, &mut tokens, &mut diagnostics);
+    // Brackets balanced and nesting bounded, as in a mission.
+    let tokens = delimiters::balance(text, &tokens, file, &mut diagnostics);
+    let map =
+        |s: SimpleSpan| SimpleSpan::from(position(s.start)..position(s.end).max(position(s.start)));
+    let tokens: Vec<token::Spanned<'_>> = tokens.iter().map(|&(t, s)| (t, map(s))).collect();
+    for d in &mut diagnostics {
+        let mapped = map(SimpleSpan::from(d.span.start..d.span.end));
+        d.span = Span::new(mapped.start, mapped.end);
+    }
+    let text_end = position(text.len());
+    let expr = if tokens.is_empty() {
+        if diagnostics.is_empty() {
+            diagnostics.push(Diagnostic::new(
+                Code::SyntaxError,
+                file,
+                Span::new(text_end, text_end),
+                "expected a condition, found nothing",
+            ));
+        }
+        None
+    } else {
+        let eoi = SimpleSpan::from(text_end..text_end);
+        let input: parser::TokenInput<'_, '_> = tokens.as_slice().map(eoi, |(t, s)| (t, s));
+        let (output, errors) = parser::expr::<_, parser::RichError<'_, '_>>()
+            .then_ignore(end())
+            .parse(input)
+            .into_output_errors();
+        for error in &errors {
+            diagnostics.push(syntax_diagnostic(file, error));
+        }
+        // A tree with recovered errors inside is kept: its names can still be checked.
+        output
+    };
+    diagnostics.sort_by_key(|d| (d.span.start, d.span.end));
+    ExprParse { expr, diagnostics }
+}
+
 fn describe_found(found: Option<&Token<'_>>) -> String {
     match found {
         None => "the end of this part".to_string(),
@@ -251,6 +313,59 @@ fn syntax_diagnostic(file: FileId, error: &Rich<'_, Token<'_>>) -> Diagnostic {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_standalone_expression_is_positioned_from_its_base() {
+        let p = parse_expr(FileId(2), "distance > 20 and not stop", 100);
+        assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);
+        let expr = p.expr.unwrap();
+        assert_eq!(expr.span, Span::new(100, 126));
+        let ast::ExprKind::And(lhs, _) = &expr.kind else {
+            panic!("{expr:?}")
+        };
+        let ast::ExprKind::Compare(name, ast::CmpOp::Gt, _) = &lhs.kind else {
+            panic!("{lhs:?}")
+        };
+        assert_eq!(name.span, Span::new(100, 108));
+    }
+
+    #[test]
+    fn standalone_expression_errors_are_positioned_and_never_empty() {
+        let p = parse_expr(FileId(0), "a == ", 10);
+        assert!(p.expr.is_none());
+        assert_eq!(p.diagnostics.len(), 1, "{:?}", p.diagnostics);
+        assert_eq!(p.diagnostics[0].code, Code::SyntaxError);
+        assert_eq!(p.diagnostics[0].span, Span::new(15, 15));
+        let p = parse_expr(FileId(0), "a @ b", 0);
+        assert_eq!(p.diagnostics[0].code, Code::InvalidCharacter);
+        assert_eq!(p.diagnostics[0].span, Span::new(2, 3));
+        let p = parse_expr(FileId(0), "(a", 0);
+        assert!(
+            p.diagnostics.iter().any(|d| d.message.contains("`(`")),
+            "{:?}",
+            p.diagnostics
+        );
+        let p = parse_expr(FileId(0), "  ", 7);
+        assert!(p.expr.is_none());
+        assert_eq!(p.diagnostics[0].span, Span::new(9, 9));
+        let deep = format!("{}a{}", "(".repeat(5000), ")".repeat(5000));
+        assert!(!parse_expr(FileId(0), &deep, 0).diagnostics.is_empty());
+        let long = format!("a{}", " and a".repeat(20_000));
+        assert!(!parse_expr(FileId(0), &long, 0).diagnostics.is_empty());
+    }
+
+    #[test]
+    fn mapped_positions_follow_the_map() {
+        // `a<b` written as `a&lt;b` at offset 50: `<` is 4 bytes longer in the file.
+        let map = |i: usize| 50 + if i <= 1 { i } else { i + 3 };
+        let p = parse_expr_mapped(FileId(0), "a<b", map);
+        let expr = p.expr.unwrap();
+        assert_eq!(expr.span, Span::new(50, 56));
+        let ast::ExprKind::Compare(_, ast::CmpOp::Lt, rhs) = &expr.kind else {
+            panic!("{expr:?}")
+        };
+        assert_eq!(rhs.span, Span::new(55, 56));
+    }
 
     #[test]
     fn two_threads_give_the_same_result_as_one() {

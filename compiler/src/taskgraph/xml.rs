@@ -3,8 +3,8 @@
 //! W060). See `shared/spec/taskgraph.md` for both formats.
 //!
 //! Reading happens in two steps: the XML is read into a small positioned
-//! element tree (every element, attribute and attribute value keeps its byte
-//! range), then the tree is read as a graph. Malformed XML (E060) stops the
+//! element tree ([`crate::xmltree`]: every element, attribute and attribute
+//! value keeps its byte range), then the tree is read as a graph. Malformed XML (E060) stops the
 //! first step; what was read before the error is still read as a graph, and
 //! channel ends are not checked in a graph level that was cut short.
 //!
@@ -44,13 +44,10 @@ use crate::diag::{Code, Diagnostic, FileId, sort_and_dedup};
 use crate::span::Span;
 use crate::suggest::did_you_mean;
 use crate::syntax::ast::TimeUnit;
-use crate::xmlpos::{
-    self, Attr, get, is_ident, is_namespace_attribute, read_attributes, resolve_reference, shown,
-    start_tag_spans, suggest, trim_span, xml_error_message,
-};
+use crate::xmlpos::{Attr, get, is_ident, is_namespace_attribute, shown, suggest};
+use crate::xmltree::{Elem, TreeFormat, one_line_diagnostic, read_tree};
 use quick_xml::Reader;
-use quick_xml::encoding::Decoder;
-use quick_xml::events::{BytesEnd, BytesStart, Event};
+use quick_xml::events::Event;
 use std::collections::{HashMap, HashSet};
 
 /// The two file formats a task graph can be read from.
@@ -71,7 +68,16 @@ pub fn load_task_graph(file: FileId, text: &str) -> (Option<TaskGraph>, Vec<Diag
         file,
         list: Vec::new(),
     };
-    let root = TreeBuilder::read(text, &mut sink);
+    let (root, xml_diagnostics) = read_tree(
+        text,
+        TreeFormat {
+            file,
+            xml_code: Code::GraphXml,
+            empty_message: "this file is empty: a task graph needs a `<TaskGraph>` element",
+            raw_lt: None,
+        },
+    );
+    sink.list.extend(xml_diagnostics);
     let graph = root.and_then(|root| {
         let mut loader = Loader {
             file,
@@ -125,253 +131,14 @@ struct Sink {
 
 impl Sink {
     fn report(&mut self, code: Code, span: Span, message: impl Into<String>) -> &mut Diagnostic {
-        // One line, whatever text the message quotes.
-        let message: String = message
-            .into()
-            .chars()
-            .map(|c| if c.is_control() { ' ' } else { c })
-            .collect();
         self.list
-            .push(Diagnostic::new(code, self.file, span, message));
+            .push(one_line_diagnostic(code, self.file, span, message));
         self.list.last_mut().expect("just pushed")
     }
 }
 
 // ---------------------------------------------------------------------------
-// Step 1: the positioned element tree.
-
-/// One element as written.
-#[derive(Debug)]
-struct Elem {
-    qname: String,
-    /// The name without a namespace prefix.
-    local: String,
-    name_span: Span,
-    /// The start tag, `<` to `>`.
-    tag: Span,
-    /// The whole element, to the end of its end tag (or to where reading stopped).
-    span: Span,
-    attrs: Vec<Attr>,
-    children: Vec<Elem>,
-    /// Non-blank text directly inside, trimmed.
-    texts: Vec<Span>,
-    /// Closed by its end tag or `/>`; false when malformed XML stopped reading
-    /// inside it.
-    complete: bool,
-}
-
-/// Malformed XML: stop reading the file.
-struct Stop;
-
-type Flow = Result<(), Stop>;
-
-struct TreeBuilder<'t, 's> {
-    text: &'t str,
-    sink: &'s mut Sink,
-    stack: Vec<Elem>,
-    root: Option<Elem>,
-}
-
-impl<'t, 's> TreeBuilder<'t, 's> {
-    /// The root element (with everything read before any XML error).
-    fn read(text: &'t str, sink: &'s mut Sink) -> Option<Elem> {
-        let mut builder = TreeBuilder {
-            text,
-            sink,
-            stack: Vec::new(),
-            root: None,
-        };
-        let stopped_at = builder.run();
-        // Elements left open by an error: keep them, marked incomplete.
-        while let Some(mut open) = builder.stack.pop() {
-            open.span = Span::new(open.tag.start, stopped_at.max(open.tag.end));
-            open.complete = false;
-            builder.attach(open);
-        }
-        builder.root
-    }
-
-    /// Reads events until the end or an error; returns where reading stopped.
-    fn run(&mut self) -> usize {
-        let text = self.text;
-        let mut reader = Reader::from_str(text);
-        {
-            let config = reader.config_mut();
-            // End tags are matched here, to report them with both positions.
-            config.check_end_names = false;
-            config.allow_unmatched_ends = true;
-            config.trim_text(false);
-        }
-        let decoder = reader.decoder();
-        loop {
-            let before = (reader.buffer_position() as usize).min(text.len());
-            let event = reader.read_event();
-            let end = (reader.buffer_position() as usize).min(text.len());
-            let flow = match event {
-                Err(err) => {
-                    let pos = (reader.error_position() as usize).min(text.len());
-                    let span = xmlpos::word_at(text, pos);
-                    self.sink
-                        .report(Code::GraphXml, span, xml_error_message(&err));
-                    return pos.max(before);
-                }
-                Ok(Event::Eof) => {
-                    self.eof();
-                    return text.len();
-                }
-                Ok(Event::Start(e)) => self.start(&e, end, false, decoder),
-                Ok(Event::Empty(e)) => self.start(&e, end, true, decoder),
-                Ok(Event::End(e)) => self.end(&e, end),
-                Ok(Event::Text(t)) => {
-                    let span = xmlpos::slice_span(text, &t).unwrap_or(Span::new(end, end));
-                    match t.decode() {
-                        Ok(s) => self.text_content(&s, span),
-                        Err(_) => self.malformed(span, "this text is not valid UTF-8"),
-                    }
-                }
-                Ok(Event::CData(t)) => {
-                    let span = xmlpos::slice_span(text, &t).unwrap_or(Span::new(end, end));
-                    match t.decode() {
-                        Ok(s) => self.text_content(&s, span),
-                        Err(_) => self.malformed(span, "this text is not valid UTF-8"),
-                    }
-                }
-                Ok(Event::GeneralRef(r)) => {
-                    let (span, resolved) = resolve_reference(text, &r, end);
-                    match resolved {
-                        Ok(s) => self.text_content(&s, span),
-                        Err(message) => self.malformed(span, message),
-                    }
-                }
-                Ok(Event::Comment(_) | Event::Decl(_) | Event::PI(_) | Event::DocType(_)) => Ok(()),
-            };
-            if flow.is_err() {
-                return end.max(before);
-            }
-        }
-    }
-
-    fn malformed(&mut self, span: Span, message: impl Into<String>) -> Flow {
-        self.sink.report(Code::GraphXml, span, message);
-        Err(Stop)
-    }
-
-    fn attach(&mut self, elem: Elem) {
-        match self.stack.last_mut() {
-            Some(parent) => parent.children.push(elem),
-            None => {
-                if self.root.is_none() {
-                    self.root = Some(elem);
-                }
-            }
-        }
-    }
-
-    fn eof(&mut self) {
-        if let Some(open) = self.stack.last() {
-            let message = format!("`<{0}>` is never closed: add `</{0}>`", open.qname);
-            let tag = open.tag;
-            self.sink.report(Code::GraphXml, tag, message);
-        } else if self.root.is_none() {
-            let end = self.text.len();
-            self.sink.report(
-                Code::GraphXml,
-                Span::new(end, end),
-                "this file is empty: a task graph needs a `<TaskGraph>` element",
-            );
-        }
-    }
-
-    fn text_content(&mut self, s: &str, span: Span) -> Flow {
-        // A byte-order mark counts as blank.
-        if s.trim_matches(|c: char| c.is_whitespace() || c == '\u{feff}')
-            .is_empty()
-        {
-            return Ok(());
-        }
-        let span = trim_span(s, span);
-        match self.stack.last_mut() {
-            Some(top) => {
-                top.texts.push(span);
-                Ok(())
-            }
-            None => self.malformed(
-                span,
-                "text outside the root element: only comments may go there",
-            ),
-        }
-    }
-
-    fn start(&mut self, e: &BytesStart<'_>, tag_end: usize, empty: bool, decoder: Decoder) -> Flow {
-        let (name_span, tag) = start_tag_spans(self.text, e, tag_end);
-        let qname = String::from_utf8_lossy(e.name().as_ref()).into_owned();
-        let local = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
-        if local.is_empty() {
-            let span = xmlpos::word_at(self.text, tag.start);
-            return self.malformed(
-                span,
-                "a `<` must be followed by an element name: write `&lt;` for a plain `<`",
-            );
-        }
-        let attrs = match read_attributes(self.text, e, tag, decoder) {
-            Ok(a) => a,
-            Err((span, message)) => return self.malformed(span, message),
-        };
-        if self.stack.is_empty() {
-            if let Some(root) = &self.root {
-                let message = format!(
-                    "`<{qname}>` comes after the end of `<{}>`: a file has a single root element",
-                    root.qname
-                );
-                return self.malformed(name_span, message);
-            }
-        }
-        let elem = Elem {
-            qname,
-            local,
-            name_span,
-            tag,
-            span: tag,
-            attrs,
-            children: Vec::new(),
-            texts: Vec::new(),
-            complete: empty,
-        };
-        if empty {
-            self.attach(elem);
-        } else {
-            self.stack.push(elem);
-        }
-        Ok(())
-    }
-
-    fn end(&mut self, e: &BytesEnd<'_>, tag_end: usize) -> Flow {
-        let name = e.name();
-        let span = xmlpos::end_tag_span(self.text, name.as_ref(), tag_end);
-        let name = String::from_utf8_lossy(name.as_ref()).into_owned();
-        match self.stack.pop() {
-            None => self.malformed(span, xmlpos::unopened_close(&name)),
-            Some(open) if open.qname != name => {
-                let (message, opened) = xmlpos::mismatched_close(&name, &open.qname);
-                self.sink
-                    .report(Code::GraphXml, span, message)
-                    .relate(open.tag, opened);
-                // Left open: the caller closes it as incomplete.
-                self.stack.push(open);
-                Err(Stop)
-            }
-            Some(mut open) => {
-                open.span = Span::new(open.tag.start, span.end);
-                open.complete = true;
-                self.attach(open);
-                Ok(())
-            }
-        }
-    }
-}
-
-// ---------------------------------------------------------------------------
-// Step 2: reading the tree as a graph.
+// Reading the tree as a graph.
 
 /// Elements of our format, with where each belongs (for "not allowed here").
 const SEMO_ELEMENTS: &[(&str, &str)] = &[

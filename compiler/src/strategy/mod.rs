@@ -1,0 +1,41 @@
+//! Strategy files (`*.strategy.xml`): how a team's robots perform the services
+//! of a mission (see `shared/spec/strategy.md`).
+//!
+//! - [`model`]: the typed model, every entry with its byte ranges.
+//! - `xml`: the quick-xml loader (well-formedness, elements, attributes, value
+//!   forms; conditions parsed with the mission expression grammar).
+//! - `check`: per-file checks (duplicates, names read by conditions).
+//! - `machine`: each service's actions checked as a graph (petgraph).
+//! - [`cross`]: checks against the catalog and the missions of the same check,
+//!   and the link from mission calls to strategy entries ([`StrategyLinks`]).
+//!
+//! Like sema, this module never reads files: [`crate::workspace`] does.
+
+mod check;
+pub mod cross;
+mod machine;
+pub mod model;
+mod xml;
+
+pub use cross::{CONTROL_TASK, CallLink, ServiceEntryRef, StrategyLinks, cross_check};
+pub use model::*;
+
+use crate::diag::{self, Diagnostic, FileId};
+
+/// Reads one strategy file and checks it on its own (everything that needs
+/// neither the catalog nor a mission): the strategy (`None` when the file has
+/// no `<Strategy>` element) and its diagnostics, sorted.
+pub fn load_strategy(file: FileId, text: &str) -> (Option<Strategy>, Vec<Diagnostic>) {
+    let (strategy, mut diagnostics) = xml::read_strategy(file, text);
+    if let Some(strategy) = &strategy {
+        check::check_strategy(strategy, &mut diagnostics);
+        for service in &strategy.services {
+            machine::check_machine(file, service, &mut diagnostics);
+        }
+    }
+    diag::sort_and_dedup(&mut diagnostics);
+    (strategy, diagnostics)
+}
+
+#[cfg(test)]
+mod tests;

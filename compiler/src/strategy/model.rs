@@ -1,0 +1,334 @@
+//! The strategy model: how one team performs the services of a mission (see
+//! `shared/spec/strategy.md`). Every entry keeps the byte ranges it was read
+//! from, so that checks (and the language server) can point into the file.
+//!
+//! Entries are kept even when an attribute is missing or malformed (that is
+//! reported by the loader): the field is then `None`, and the rest of the entry
+//! is still checked.
+
+use crate::diag::FileId;
+use crate::span::Span;
+use crate::syntax::ast;
+
+/// A name or word as written in an attribute, trimmed, with its range.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Named {
+    pub name: String,
+    pub span: Span,
+}
+
+/// One `*.strategy.xml` file: `<Strategy name="Team">`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Strategy {
+    pub file: FileId,
+    /// The team the strategy is for (`name`).
+    pub team: Option<Named>,
+    /// The `<Strategy>` start tag.
+    pub tag: Span,
+    /// `<ValueInfo>`: where mission values come from.
+    pub values: Vec<ValueEntry>,
+    /// `<ServiceInfo>`: services refined into action machines.
+    pub services: Vec<ServiceEntry>,
+    /// `<GroupingInfo>`.
+    pub grouping: Option<Grouping>,
+    /// `<NonFunctionalInfo>`: each `<Condition>` of each `<BatteryRequirement>`.
+    pub battery_rules: Vec<BatteryRule>,
+}
+
+/// `<TargetRobot name="iRobotCreate" nickName="irobot" ea="1"/>`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TargetRobot {
+    /// The robot type.
+    pub name: Option<Named>,
+    pub nick_name: Option<Named>,
+    /// `ea`, kept as written (the thesis's files carry it; its meaning is not
+    /// specified).
+    pub ea: Option<Named>,
+    pub span: Span,
+}
+
+/// `<Value name="DISTANCE">`: binds a mission value to sensor or algorithm
+/// tasks on the target robot types.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ValueEntry {
+    pub name: Option<Named>,
+    pub targets: Vec<TargetRobot>,
+    pub tasks: Vec<TaskUse>,
+    /// The whole element.
+    pub span: Span,
+    /// The start tag.
+    pub tag: Span,
+}
+
+/// Which kind of task an action (or value) uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TaskUseKind {
+    /// `<CheckSensor>`: read a sensor task.
+    CheckSensor,
+    /// `<ExecuteActuator>`: drive an actuator task.
+    ExecuteActuator,
+    /// `<ExecuteAlgorithm>`: run an algorithm task.
+    ExecuteAlgorithm,
+}
+
+impl TaskUseKind {
+    pub fn tag(self) -> &'static str {
+        match self {
+            TaskUseKind::CheckSensor => "CheckSensor",
+            TaskUseKind::ExecuteActuator => "ExecuteActuator",
+            TaskUseKind::ExecuteAlgorithm => "ExecuteAlgorithm",
+        }
+    }
+}
+
+/// `<CheckSensor name="Vicon">` (or actuator, algorithm) with its parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TaskUse {
+    pub kind: TaskUseKind,
+    pub name: Option<Named>,
+    pub parameters: Vec<Parameter>,
+    pub span: Span,
+}
+
+/// `dataCharacteristic`: how a parameter's data moves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum DataCharacteristic {
+    /// A FIFO channel from or to a task (`srcTask` → `dstTask`).
+    Channel,
+    /// A variable local to the control task.
+    Variable,
+    /// A task parameter set through the runtime, then the task is called.
+    SysRequest,
+}
+
+impl DataCharacteristic {
+    pub const ALL: [(&'static str, DataCharacteristic); 3] = [
+        ("channel", DataCharacteristic::Channel),
+        ("variable", DataCharacteristic::Variable),
+        ("sysRequest", DataCharacteristic::SysRequest),
+    ];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            DataCharacteristic::Channel => "channel",
+            DataCharacteristic::Variable => "variable",
+            DataCharacteristic::SysRequest => "sysRequest",
+        }
+    }
+}
+
+/// `<Parameter name="distance" type="integer" dataCharacteristic="channel"
+/// size="1" srcTask="ultrasonic" dstTask="ControlTask"/>`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Parameter {
+    pub name: Option<Named>,
+    /// The data type as written (`integer`, `viconInfo`): a C-level type of
+    /// the task code, not a mission value type.
+    pub ty: Option<Named>,
+    pub data: Option<DataCharacteristic>,
+    pub size: Option<u64>,
+    /// `value`: the initial value or the request sent, as written.
+    pub value: Option<Named>,
+    pub src_task: Option<Named>,
+    pub dst_task: Option<Named>,
+    pub span: Span,
+}
+
+/// `<Service plan_name="Action" name="move">`: a built-in service of one plan,
+/// for the listed robot types, refined into a state machine of actions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ServiceEntry {
+    pub plan: Option<Named>,
+    /// `name` (or its alias `service_name`): the built-in service.
+    pub name: Option<Named>,
+    pub targets: Vec<TargetRobot>,
+    /// The actions of `<ActionInfo>`, in file order.
+    pub actions: Vec<Action>,
+    pub span: Span,
+    pub tag: Span,
+    /// False when malformed XML cut the entry short: its action machine is
+    /// not checked as a whole.
+    pub complete: bool,
+}
+
+impl ServiceEntry {
+    /// Every parameter the service declares (in any action, directly or in a
+    /// task use), action by action: the names its conditions may read.
+    pub fn parameters(&self) -> impl Iterator<Item = &Parameter> {
+        self.actions.iter().flat_map(Action::parameters)
+    }
+
+    /// The action whose `actionId` is `id` (the first one, if given twice).
+    pub fn action_by_id(&self, id: u64) -> Option<&Action> {
+        self.actions
+            .iter()
+            .find(|a| a.id.as_ref().is_some_and(|i| i.value == id))
+    }
+}
+
+/// An `actionId`, `srcId` or `dstId` with its range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ActionId {
+    pub value: u64,
+    pub span: Span,
+}
+
+/// `<Action name="CheckGoal" initial="Yes" actionId="0">`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Action {
+    pub name: Option<Named>,
+    pub id: Option<ActionId>,
+    /// `initial`: the action the service starts with.
+    pub initial: YesNo,
+    /// `final`: the service ends when this action is done.
+    pub is_final: YesNo,
+    pub tasks: Vec<TaskUse>,
+    /// `<Parameter>`s directly inside the action (variables).
+    pub parameters: Vec<Parameter>,
+    pub transitions: Vec<Transition>,
+    pub span: Span,
+    pub tag: Span,
+}
+
+impl Action {
+    /// The action's own parameters, then those of its task uses.
+    pub fn parameters(&self) -> impl Iterator<Item = &Parameter> {
+        self.parameters
+            .iter()
+            .chain(self.tasks.iter().flat_map(|t| t.parameters.iter()))
+    }
+
+    /// `name (actionId)` for messages.
+    pub fn describe(&self) -> String {
+        match (&self.name, &self.id) {
+            (Some(n), Some(id)) => format!("`{}` ({})", n.name, id.value),
+            (Some(n), None) => format!("`{}`", n.name),
+            (None, Some(id)) => format!("action {}", id.value),
+            (None, None) => "this action".to_string(),
+        }
+    }
+}
+
+/// An `initial` or `final` attribute.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum YesNo {
+    /// `No`, or not given.
+    No,
+    /// `Yes`, with the value's range.
+    Yes(Span),
+    /// Neither `Yes` nor `No` (reported): checks that depend on it say nothing.
+    Malformed(Span),
+}
+
+impl YesNo {
+    pub fn is_yes(self) -> bool {
+        matches!(self, YesNo::Yes(_))
+    }
+
+    pub fn is_malformed(self) -> bool {
+        matches!(self, YesNo::Malformed(_))
+    }
+
+    /// The value's range when given as `Yes` (or malformed).
+    pub fn span(self) -> Option<Span> {
+        match self {
+            YesNo::No => None,
+            YesNo::Yes(span) | YesNo::Malformed(span) => Some(span),
+        }
+    }
+}
+
+/// `<Transition srcId="0" dstId="4"><Condition cond="..."/></Transition>`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Transition {
+    pub src: Option<ActionId>,
+    pub dst: Option<ActionId>,
+    /// `None`: always taken.
+    pub condition: Option<Condition>,
+    pub span: Span,
+}
+
+/// A `cond="..."` attribute, parsed with the mission expression grammar.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Condition {
+    /// The condition with entities replaced (`distance<=20`).
+    pub text: String,
+    /// The range of the attribute value.
+    pub span: Span,
+    /// `None` when it did not parse (reported).
+    pub expr: Option<ast::Expr>,
+}
+
+/// `<GroupingInfo>`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Grouping {
+    pub leader_selection: Option<LeaderSelection>,
+    /// `<GroupSync timeout="5 SEC"/>`: how long the robots of a group wait for
+    /// each other at the start of a group statement.
+    pub sync_timeout: Option<Duration>,
+    pub span: Span,
+}
+
+/// The leader-selection algorithms.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LeaderAlgorithm {
+    LowestId,
+    HighestBattery,
+    Bully,
+}
+
+impl LeaderAlgorithm {
+    pub const ALL: [(&'static str, LeaderAlgorithm); 3] = [
+        ("lowest_id", LeaderAlgorithm::LowestId),
+        ("highest_battery", LeaderAlgorithm::HighestBattery),
+        ("bully", LeaderAlgorithm::Bully),
+    ];
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            LeaderAlgorithm::LowestId => "lowest_id",
+            LeaderAlgorithm::HighestBattery => "highest_battery",
+            LeaderAlgorithm::Bully => "bully",
+        }
+    }
+}
+
+/// `<LeaderSelectionInfo algorithm="lowest_id" heartbeatPeriod="1 SEC"
+/// plan_name="Resolve" cs_name="Decide"/>`. With `plan_name` and `cs_name`, it
+/// applies to the leader elections of that composite service.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LeaderSelection {
+    pub algorithm: Option<LeaderAlgorithm>,
+    pub heartbeat: Option<Duration>,
+    pub plan: Option<Named>,
+    /// `cs_name`: the composite service.
+    pub service: Option<Named>,
+    pub span: Span,
+}
+
+/// A period such as `1 SEC`, in milliseconds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Duration {
+    pub millis: f64,
+    pub span: Span,
+}
+
+/// One `<Condition cond="Battery&lt;30">` of a `<BatteryRequirement>`: while
+/// it holds, the listed sensors and actuators run at the given levels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BatteryRule {
+    pub condition: Option<Condition>,
+    /// `<Sensor name="Camera" periodLevel="2"/>`.
+    pub sensors: Vec<LevelSetting>,
+    /// `<Actuator name="Move" speedLevel="2"/>`.
+    pub actuators: Vec<LevelSetting>,
+    pub span: Span,
+}
+
+/// A sensor's `periodLevel` or an actuator's `speedLevel`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LevelSetting {
+    pub name: Option<Named>,
+    pub level: Option<u64>,
+    pub span: Span,
+}

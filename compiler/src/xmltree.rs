@@ -1,0 +1,397 @@
+//! A positioned XML element tree, read with quick-xml: every element, attribute
+//! and attribute value keeps its byte range. The task-graph and strategy loaders
+//! read a file into this tree first, then read the tree as their model.
+//!
+//! Malformed XML is reported with the format's own code and stops reading; what
+//! was read before the error is kept, the elements left open marked incomplete.
+
+use crate::diag::{Code, Diagnostic, FileId};
+use crate::span::Span;
+use crate::xmlpos::{
+    self, Attr, read_attributes, read_attributes_keeping_lt, resolve_reference, start_tag_spans,
+    trim_span, xml_error_message,
+};
+use quick_xml::Reader;
+use quick_xml::encoding::Decoder;
+use quick_xml::errors::SyntaxError;
+use quick_xml::events::{BytesEnd, BytesStart, Event};
+
+/// One element as written.
+#[derive(Debug)]
+pub(crate) struct Elem {
+    pub qname: String,
+    /// The name without a namespace prefix.
+    pub local: String,
+    pub name_span: Span,
+    /// The start tag, `<` to `>`.
+    pub tag: Span,
+    /// The whole element, to the end of its end tag (or to where reading stopped).
+    pub span: Span,
+    pub attrs: Vec<Attr>,
+    pub children: Vec<Elem>,
+    /// Non-blank text directly inside, trimmed.
+    pub texts: Vec<Span>,
+    /// Closed by its end tag or `/>`; false when malformed XML stopped reading
+    /// inside it.
+    pub complete: bool,
+}
+
+/// How one format reports what the tree reader finds.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TreeFormat<'a> {
+    pub file: FileId,
+    /// The code of "not well-formed XML".
+    pub xml_code: Code,
+    /// The message for a file with no element at all.
+    pub empty_message: &'a str,
+    /// `Some(code)`: a `<` written inside an attribute value (quick-xml reads
+    /// it; XML forbids it) is reported with this code, pointing at the `<`,
+    /// and reading goes on. `None`: it is malformed XML and reading stops.
+    pub raw_lt: Option<Code>,
+}
+
+/// Reads `text` into its root element (with everything read before any XML
+/// error) and the diagnostics of malformed XML.
+pub(crate) fn read_tree(text: &str, format: TreeFormat<'_>) -> (Option<Elem>, Vec<Diagnostic>) {
+    let mut builder = TreeBuilder {
+        text,
+        format,
+        diagnostics: Vec::new(),
+        stack: Vec::new(),
+        root: None,
+    };
+    let stopped_at = builder.run();
+    // Elements left open by an error: keep them, marked incomplete.
+    while let Some(mut open) = builder.stack.pop() {
+        open.span = Span::new(open.tag.start, stopped_at.max(open.tag.end));
+        open.complete = false;
+        builder.attach(open);
+    }
+    (builder.root, builder.diagnostics)
+}
+
+/// A diagnostic whose message is one line, whatever text it quotes.
+pub(crate) fn one_line_diagnostic(
+    code: Code,
+    file: FileId,
+    span: Span,
+    message: impl Into<String>,
+) -> Diagnostic {
+    let message: String = message
+        .into()
+        .chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect();
+    Diagnostic::new(code, file, span, message)
+}
+
+/// Malformed XML: stop reading the file.
+struct Stop;
+
+type Flow = Result<(), Stop>;
+
+struct TreeBuilder<'t, 'f> {
+    text: &'t str,
+    format: TreeFormat<'f>,
+    diagnostics: Vec<Diagnostic>,
+    stack: Vec<Elem>,
+    root: Option<Elem>,
+}
+
+impl TreeBuilder<'_, '_> {
+    fn report(&mut self, code: Code, span: Span, message: impl Into<String>) -> &mut Diagnostic {
+        self.diagnostics
+            .push(one_line_diagnostic(code, self.format.file, span, message));
+        self.diagnostics
+            .last_mut()
+            .unwrap_or_else(|| unreachable!())
+    }
+
+    /// Reads events until the end or an error; returns where reading stopped.
+    fn run(&mut self) -> usize {
+        let text = self.text;
+        let mut reader = Reader::from_str(text);
+        {
+            let config = reader.config_mut();
+            // End tags are matched here, to report them with both positions.
+            config.check_end_names = false;
+            config.allow_unmatched_ends = true;
+            config.trim_text(false);
+        }
+        let decoder = reader.decoder();
+        loop {
+            let before = (reader.buffer_position() as usize).min(text.len());
+            let event = reader.read_event();
+            let end = (reader.buffer_position() as usize).min(text.len());
+            let flow = match event {
+                Err(err) => {
+                    let pos = (reader.error_position() as usize).min(text.len());
+                    let unclosed =
+                        matches!(err, quick_xml::Error::Syntax(SyntaxError::UnclosedTag));
+                    let (span, message) = match xmlpos::lt_in_unclosed_tag(text, pos) {
+                        Some(lt) if unclosed => (lt, xmlpos::LT_IN_VALUE.to_string()),
+                        _ => (xmlpos::word_at(text, pos), xml_error_message(&err)),
+                    };
+                    self.report(self.format.xml_code, span, message);
+                    return pos.max(before);
+                }
+                Ok(Event::Eof) => {
+                    self.eof();
+                    return text.len();
+                }
+                Ok(Event::Start(e)) => self.start(&e, end, false, decoder),
+                Ok(Event::Empty(e)) => self.start(&e, end, true, decoder),
+                Ok(Event::End(e)) => self.end(&e, end),
+                Ok(Event::Text(t)) => {
+                    let span = xmlpos::slice_span(text, &t).unwrap_or(Span::new(end, end));
+                    match t.decode() {
+                        Ok(s) => self.text_content(&s, span),
+                        Err(_) => self.malformed(span, "this text is not valid UTF-8"),
+                    }
+                }
+                Ok(Event::CData(t)) => {
+                    let span = xmlpos::slice_span(text, &t).unwrap_or(Span::new(end, end));
+                    match t.decode() {
+                        Ok(s) => self.text_content(&s, span),
+                        Err(_) => self.malformed(span, "this text is not valid UTF-8"),
+                    }
+                }
+                Ok(Event::GeneralRef(r)) => {
+                    let (span, resolved) = resolve_reference(text, &r, end);
+                    match resolved {
+                        Ok(s) => self.text_content(&s, span),
+                        Err(message) => self.malformed(span, message),
+                    }
+                }
+                Ok(Event::Comment(_) | Event::Decl(_) | Event::PI(_) | Event::DocType(_)) => Ok(()),
+            };
+            if flow.is_err() {
+                return end.max(before);
+            }
+        }
+    }
+
+    fn malformed(&mut self, span: Span, message: impl Into<String>) -> Flow {
+        self.report(self.format.xml_code, span, message);
+        Err(Stop)
+    }
+
+    fn attach(&mut self, elem: Elem) {
+        match self.stack.last_mut() {
+            Some(parent) => parent.children.push(elem),
+            None => {
+                if self.root.is_none() {
+                    self.root = Some(elem);
+                }
+            }
+        }
+    }
+
+    fn eof(&mut self) {
+        if let Some(open) = self.stack.last() {
+            let message = format!("`<{0}>` is never closed: add `</{0}>`", open.qname);
+            let tag = open.tag;
+            self.report(self.format.xml_code, tag, message);
+        } else if self.root.is_none() {
+            let end = self.text.len();
+            self.report(
+                self.format.xml_code,
+                Span::new(end, end),
+                self.format.empty_message,
+            );
+        }
+    }
+
+    fn text_content(&mut self, s: &str, span: Span) -> Flow {
+        // A byte-order mark counts as blank.
+        if s.trim_matches(|c: char| c.is_whitespace() || c == '\u{feff}')
+            .is_empty()
+        {
+            return Ok(());
+        }
+        let span = trim_span(s, span);
+        match self.stack.last_mut() {
+            Some(top) => {
+                top.texts.push(span);
+                Ok(())
+            }
+            None => self.malformed(
+                span,
+                "text outside the root element: only comments may go there",
+            ),
+        }
+    }
+
+    fn attributes(
+        &mut self,
+        e: &BytesStart<'_>,
+        tag: Span,
+        decoder: Decoder,
+    ) -> Result<Vec<Attr>, Stop> {
+        let Some(code) = self.format.raw_lt else {
+            return read_attributes(self.text, e, tag, decoder)
+                .map_err(|(span, message)| self.report_stop(span, message));
+        };
+        let (attrs, raw_lt) = read_attributes_keeping_lt(self.text, e, tag, decoder)
+            .map_err(|(span, message)| self.report_stop(span, message))?;
+        for at in raw_lt {
+            let value = attrs
+                .iter()
+                .find(|a| a.span.start <= at && at < a.span.end)
+                .map(|a| {
+                    let mut fixed = String::from(&self.text[a.span.start..at]);
+                    fixed.push_str("&lt;");
+                    fixed.push_str(&self.text[at + 1..a.span.end]);
+                    format!(" ({}=\"{}\")", a.key, xmlpos::shown(&fixed))
+                })
+                .unwrap_or_default();
+            self.report(
+                code,
+                Span::new(at, at + 1),
+                format!("XML does not allow a plain `<` inside an attribute value: write `&lt;` instead{value}"),
+            )
+            .suggestion = Some("&lt;".to_string());
+        }
+        Ok(attrs)
+    }
+
+    fn report_stop(&mut self, span: Span, message: String) -> Stop {
+        self.report(self.format.xml_code, span, message);
+        Stop
+    }
+
+    fn start(&mut self, e: &BytesStart<'_>, tag_end: usize, empty: bool, decoder: Decoder) -> Flow {
+        let (name_span, tag) = start_tag_spans(self.text, e, tag_end);
+        let qname = String::from_utf8_lossy(e.name().as_ref()).into_owned();
+        let local = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
+        if local.is_empty() {
+            let span = xmlpos::word_at(self.text, tag.start);
+            return self.malformed(
+                span,
+                "a `<` must be followed by an element name: write `&lt;` for a plain `<`",
+            );
+        }
+        let attrs = self.attributes(e, tag, decoder)?;
+        if self.stack.is_empty() {
+            if let Some(root) = &self.root {
+                let message = format!(
+                    "`<{qname}>` comes after the end of `<{}>`: a file has a single root element",
+                    root.qname
+                );
+                return self.malformed(name_span, message);
+            }
+        }
+        let elem = Elem {
+            qname,
+            local,
+            name_span,
+            tag,
+            span: tag,
+            attrs,
+            children: Vec::new(),
+            texts: Vec::new(),
+            complete: empty,
+        };
+        if empty {
+            self.attach(elem);
+        } else {
+            self.stack.push(elem);
+        }
+        Ok(())
+    }
+
+    fn end(&mut self, e: &BytesEnd<'_>, tag_end: usize) -> Flow {
+        let name = e.name();
+        let span = xmlpos::end_tag_span(self.text, name.as_ref(), tag_end);
+        let name = String::from_utf8_lossy(name.as_ref()).into_owned();
+        match self.stack.pop() {
+            None => self.malformed(span, xmlpos::unopened_close(&name)),
+            Some(open) if open.qname != name => {
+                let (message, opened) = xmlpos::mismatched_close(&name, &open.qname);
+                let code = self.format.xml_code;
+                self.report(code, span, message).relate(open.tag, opened);
+                // Left open: the caller closes it as incomplete.
+                self.stack.push(open);
+                Err(Stop)
+            }
+            Some(mut open) => {
+                open.span = Span::new(open.tag.start, span.end);
+                open.complete = true;
+                self.attach(open);
+                Ok(())
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn format(raw_lt: Option<Code>) -> TreeFormat<'static> {
+        TreeFormat {
+            file: FileId(1),
+            xml_code: Code::GraphXml,
+            empty_message: "empty",
+            raw_lt,
+        }
+    }
+
+    #[test]
+    fn a_raw_lt_in_a_value_stops_reading_or_is_reported_and_kept() {
+        let text = r#"<A><B cond="x<2" k="y &lt; 3"/><C/></A>"#;
+        let (root, diags) = read_tree(text, format(None));
+        assert_eq!(diags.len(), 1);
+        assert_eq!(diags[0].code, Code::GraphXml);
+        assert_eq!(&text[diags[0].span.range()], "<");
+        assert_eq!(diags[0].span.start, text.find("x<").unwrap() + 1);
+        assert!(root.unwrap().children.is_empty());
+
+        let (root, diags) = read_tree(text, format(Some(Code::GraphBadAttribute)));
+        assert_eq!(diags.len(), 1, "{diags:#?}");
+        assert_eq!(diags[0].code, Code::GraphBadAttribute);
+        assert_eq!(diags[0].span.start, text.find("x<").unwrap() + 1);
+        assert_eq!(diags[0].suggestion.as_deref(), Some("&lt;"));
+        assert!(
+            diags[0].message.contains("cond=\"x&lt;2\""),
+            "{}",
+            diags[0].message
+        );
+        let root = root.unwrap();
+        assert_eq!(root.children.len(), 2);
+        assert_eq!(root.children[0].attrs[0].value, "x<2");
+        assert_eq!(root.children[0].attrs[1].value, "y < 3");
+    }
+
+    #[test]
+    fn a_raw_lt_before_a_broken_tag_is_a_missing_quote() {
+        // The value runs into the next tag, and the tag never closes.
+        let unclosed = "<A><B cond=\"x<2/>\n<C k=\"1\"/></A>";
+        // The value runs into the next tag, and its attributes are malformed.
+        let malformed = "<A><B cond=\"x<2/>\n<C k=\"1\" j=\"2\"/></A>";
+        for text in [unclosed, malformed] {
+            for raw_lt in [None, Some(Code::GraphBadAttribute)] {
+                let (_, diags) = read_tree(text, format(raw_lt));
+                assert_eq!(diags.len(), 1, "{diags:#?}");
+                assert_eq!(diags[0].code, Code::GraphXml);
+                assert!(diags[0].message.contains("closing quote"), "{diags:#?}");
+                assert_eq!(diags[0].span.start, text.find("x<").unwrap() + 1);
+            }
+        }
+    }
+
+    #[test]
+    fn unclosed_elements_are_kept_incomplete() {
+        let text = "<A><B/><C>";
+        let (root, diags) = read_tree(text, format(None));
+        assert_eq!(diags.len(), 1);
+        assert!(diags[0].message.contains("`<C>` is never closed"));
+        let root = root.unwrap();
+        assert!(!root.complete);
+        assert!(root.children[0].complete);
+        assert!(!root.children[1].complete);
+        let (root, diags) = read_tree("  ", format(None));
+        assert!(root.is_none());
+        assert_eq!(diags[0].message, "empty");
+    }
+}

@@ -1,0 +1,124 @@
+//! Files that depend on each other: strategies are cross-checked against the
+//! open missions, missions against the workspace catalog; workspace folders
+//! are indexed at start and kept current through watched-file events.
+
+mod support;
+
+use semo_server::harness::TestClient;
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+
+fn scouting(name: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/examples/scouting")
+        .join(name);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+fn codes(diags: &[Value]) -> Vec<String> {
+    diags
+        .iter()
+        .map(|d| d["code"].as_str().unwrap_or("").to_string())
+        .collect()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_strategy_is_rechecked_when_its_mission_changes() {
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], None).await;
+    let mission_uri = "file:///w/scouting.mission";
+    let strategy_uri = "file:///w/MasterTeam.strategy.xml";
+    let mission = scouting("scouting.mission");
+    client.open(mission_uri, &mission).await;
+    client
+        .open(strategy_uri, &scouting("MasterTeam.strategy.xml"))
+        .await;
+    let clean = client.diagnostics(strategy_uri, Some(1)).await;
+    assert_eq!(clean, Vec::<Value>::new());
+
+    // Renaming the team in the mission leaves the strategy naming no team.
+    let renamed = mission.replace("MasterTeam", "ChiefTeam");
+    client
+        .notify(
+            "textDocument/didChange",
+            json!({
+                "textDocument": { "uri": mission_uri, "version": 2 },
+                "contentChanges": [{ "text": renamed }]
+            }),
+        )
+        .await;
+    let after = client.diagnostics(strategy_uri, Some(1)).await;
+    assert!(codes(&after).contains(&"E089".to_string()), "{after:#?}");
+    client.shutdown().await;
+}
+
+fn temp_workspace(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("semo-lsp-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn uri(path: &Path) -> String {
+    format!("file://{}", path.display())
+}
+
+const CATALOG: &str = r#"<?xml version="1.0"?>
+<Catalog xmlns="urn:semo:catalog:1">
+  <Robot type="Rover">
+    <Service name="dig" task="dig_task"/>
+  </Robot>
+</Catalog>
+"#;
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn workspace_files_are_indexed_and_catalog_changes_recheck_missions() {
+    let dir = temp_workspace("index");
+    let mission_path = dir.join("dig.mission");
+    let catalog_path = dir.join("rover.robot.xml");
+    std::fs::write(
+        &mission_path,
+        "{\n  T: Rover r\n}\nT.P.S{\n  dig()\n} repeat()\nT.M{ set(P, S) }\nT.main{ default: mode = M }\n",
+    )
+    .unwrap();
+    std::fs::write(&catalog_path, CATALOG).unwrap();
+
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], Some(&uri(&dir))).await;
+    // Indexed from disk, unopened: published without a version, and clean
+    // because the workspace catalog defines Rover and dig.
+    let first = client.diagnostics(&uri(&mission_path), None).await;
+    assert_eq!(first, Vec::<Value>::new());
+
+    // The catalog loses `dig` on disk; the watcher event re-checks the mission.
+    std::fs::write(&catalog_path, CATALOG.replace("dig", "drill")).unwrap();
+    client
+        .notify(
+            "workspace/didChangeWatchedFiles",
+            json!({ "changes": [{ "uri": uri(&catalog_path), "type": 2 }] }),
+        )
+        .await;
+    let after = client
+        .notification("textDocument/publishDiagnostics", |p| {
+            p["uri"] == uri(&mission_path) && !p["diagnostics"].as_array().unwrap().is_empty()
+        })
+        .await;
+    let message = after["diagnostics"][0]["message"].as_str().unwrap();
+    assert!(message.contains("dig"), "{after:#}");
+
+    // Deleting the mission clears its diagnostics.
+    std::fs::remove_file(&mission_path).unwrap();
+    client
+        .notify(
+            "workspace/didChangeWatchedFiles",
+            json!({ "changes": [{ "uri": uri(&mission_path), "type": 3 }] }),
+        )
+        .await;
+    client
+        .notification("textDocument/publishDiagnostics", |p| {
+            p["uri"] == uri(&mission_path) && p["diagnostics"] == json!([])
+        })
+        .await;
+    client.shutdown().await;
+    let _ = std::fs::remove_dir_all(&dir);
+}
