@@ -408,34 +408,82 @@ impl Bounds {
     }
 }
 
-/// A coordinate with at most one decimal (no `-0`, no exponent).
-fn num(v: f64) -> String {
-    let r = (v * 10.0).round() / 10.0;
-    if !r.is_finite() || r == 0.0 {
-        return "0".to_string();
-    }
-    if r.fract() == 0.0 && r.abs() < 1e15 {
-        format!("{}", r as i64)
-    } else {
-        format!("{r:.1}")
+/// A coordinate with at most one decimal (no `-0`, no exponent), written
+/// without an intermediate string.
+#[derive(Clone, Copy)]
+struct Num(f64);
+
+fn num(v: f64) -> Num {
+    Num(v)
+}
+
+impl std::fmt::Display for Num {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let tenths = (self.0 * 10.0).round();
+        // Far beyond any drawing; keeps the integer conversion exact.
+        if !tenths.is_finite() || tenths.abs() > 1e17 {
+            return f.write_str("0");
+        }
+        let tenths = tenths as i64;
+        let sign = if tenths < 0 { "-" } else { "" };
+        let (whole, tenth) = (tenths.abs() / 10, tenths.abs() % 10);
+        match tenth {
+            0 if whole == 0 => f.write_str("0"),
+            0 => write!(f, "{sign}{whole}"),
+            _ => write!(f, "{sign}{whole}.{tenth}"),
+        }
     }
 }
 
 /// Text for XML content or a quoted attribute: special characters escaped,
 /// characters XML 1.0 does not allow replaced by U+FFFD.
-fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            '\t' | '\n' | '\r' => out.push(c),
-            c if (c as u32) < 0x20 || c == '\u{FFFE}' || c == '\u{FFFF}' => out.push('\u{FFFD}'),
-            c => out.push(c),
+#[derive(Clone, Copy)]
+struct Escaped<'s>(&'s str);
+
+fn escape(s: &str) -> Escaped<'_> {
+    Escaped(s)
+}
+
+impl std::fmt::Display for Escaped<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut plain = 0;
+        for (i, c) in self.0.char_indices() {
+            let replacement = match c {
+                '&' => "&amp;",
+                '<' => "&lt;",
+                '>' => "&gt;",
+                '"' => "&quot;",
+                '\'' => "&apos;",
+                '\t' | '\n' | '\r' => continue,
+                c if (c as u32) < 0x20 || c == '\u{FFFE}' || c == '\u{FFFF}' => "\u{FFFD}",
+                _ => continue,
+            };
+            f.write_str(&self.0[plain..i])?;
+            f.write_str(replacement)?;
+            plain = i + c.len_utf8();
         }
+        f.write_str(&self.0[plain..])
     }
-    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{escape, num};
+
+    #[test]
+    fn numbers_have_one_decimal_at_most() {
+        let shown: Vec<String> = [0.0, -0.04, 1.0, 2.25, -3.96, 130.85, 1e20, f64::NAN]
+            .iter()
+            .map(|&v| num(v).to_string())
+            .collect();
+        assert_eq!(shown, ["0", "0", "1", "2.3", "-4", "130.9", "0", "0"]);
+    }
+
+    #[test]
+    fn special_characters_are_escaped() {
+        assert_eq!(
+            escape("a<b>&\"c'\u{1}d\u{FFFF}é").to_string(),
+            "a&lt;b&gt;&amp;&quot;c&apos;\u{FFFD}d\u{FFFD}é"
+        );
+    }
 }
