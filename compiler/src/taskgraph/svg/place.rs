@@ -101,12 +101,19 @@ impl Route {
         self.segs.last().map_or(self.start, Seg::end)
     }
 
-    /// Every point of the path, control points included.
-    pub fn points(&self) -> impl Iterator<Item = P> + '_ {
-        std::iter::once(self.start).chain(self.segs.iter().flat_map(|s| match *s {
-            Seg::Line(e) => vec![e],
-            Seg::Cubic(a, b, e) => vec![a, b, e],
-        }))
+    /// Calls `f` with every point of the path, control points included.
+    pub fn each_point(&self, mut f: impl FnMut(P)) {
+        f(self.start);
+        for seg in &self.segs {
+            match *seg {
+                Seg::Line(e) => f(e),
+                Seg::Cubic(a, b, e) => {
+                    f(a);
+                    f(b);
+                    f(e);
+                }
+            }
+        }
     }
 }
 

@@ -389,10 +389,10 @@ impl Bounds {
             }
         }
         for route in &placed.routes {
-            for q in route.points() {
+            route.each_point(|q| {
                 self.add(ox + q.x - 4.0, oy + q.y - 4.0);
                 self.add(ox + q.x + 4.0, oy + q.y + 4.0);
-            }
+            });
             for label in [&route.tail, &route.head, &route.mid].into_iter().flatten() {
                 let w = text_width(&label.text, LABEL_FONT) + 3.0;
                 let x = ox + label.at.x;

@@ -101,7 +101,7 @@ enum Ext {
 
 /// The picture's top level.
 pub(super) fn build(graph: &TaskGraph) -> Level {
-    let mut b = Builder::new(String::new(), None);
+    let mut b = Builder::new(String::new());
     b.fill(graph);
     b.level
 }
@@ -127,11 +127,11 @@ struct Builder {
 }
 
 impl Builder {
-    fn new(prefix: String, enclosing: Option<Enclosing>) -> Builder {
+    fn new(prefix: String) -> Builder {
         Builder {
             prefix,
             level: Level::default(),
-            enclosing,
+            enclosing: None,
             tasks: HashMap::new(),
             cluster_ports: HashMap::new(),
             missing: HashMap::new(),
@@ -317,7 +317,7 @@ impl Builder {
                 ports.push((port.to_string(), side, None));
             }
         }
-        let mut inner = Builder::new(format!("{path}/"), None);
+        let mut inner = Builder::new(format!("{path}/"));
         let mut by_name = HashMap::new();
         let mut from_inside = HashMap::new();
         for (port, side, declared) in ports {
@@ -418,11 +418,8 @@ impl Builder {
             return End { node, port: None };
         }
         let top = self.enclosing.is_none();
-        // At the top level a group is one node for both directions.
-        let key = match (&ext, top) {
-            (Ext::Group(_), true) | (Ext::Library(_), true) => (ext.clone(), Side::Left),
-            _ => (ext.clone(), side),
-        };
+        // At the top level one node serves both directions.
+        let key = (ext.clone(), if top { Side::Left } else { side });
         if let Some(&node) = self.externals.get(&key) {
             return End { node, port: None };
         }
