@@ -491,7 +491,7 @@ impl<'a> Geometry<'a> {
             let links = chain.nodes.len() - 1;
             let mid = (links - 1) / 2;
             for i in 0..links {
-                let mut need = 24.0;
+                let mut need = 30.0;
                 if i == 0 {
                     need += text_width(low, LABEL_FONT);
                     if self.attach[e][0].lane.is_some() {
@@ -858,16 +858,17 @@ fn label_ends(route: &mut Route, edge: &Edge) {
         Some(Seg::Cubic(_, c, _)) => *c,
         None => end,
     };
-    let place = |at: P, toward: P| {
+    // `away`: how far from the end along the line (clear of an arrowhead).
+    let place = |at: P, toward: P, away: f64| {
         if toward.x >= at.x {
-            (p(at.x + 4.0, at.y - 4.0), Anchor::Start)
+            (p(at.x + away, at.y - 4.0), Anchor::Start)
         } else {
-            (p(at.x - 4.0, at.y - 4.0), Anchor::End)
+            (p(at.x - away, at.y - 4.0), Anchor::End)
         }
     };
-    let (at, anchor) = place(start, next);
+    let (at, anchor) = place(start, next, 4.0);
     route.tail = end_label(&edge.tail, at, anchor);
-    let (at, anchor) = place(end, before);
+    let (at, anchor) = place(end, before, 9.0);
     route.head = end_label(&edge.head, at, anchor);
 }
 
