@@ -237,6 +237,56 @@ fn dot_draws_the_graph_and_refuses_a_broken_file() {
 }
 
 #[test]
+fn svg_draws_the_graph_to_stdout_or_a_file_and_refuses_a_broken_file() {
+    let dir = shared().join("examples/taskgraphs");
+    let out = semo_in(&dir, &["graph", "svg", "kmeans.taskgraph.xml"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        out.stdout
+            .starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\""),
+        "{}",
+        out.stdout
+    );
+    assert!(out.stdout.trim_end().ends_with("</svg>"), "{}", out.stdout);
+    assert!(
+        out.stdout
+            .contains("<g class=\"cluster\" data-path=\"Converge/Assign\">"),
+        "{}",
+        out.stdout
+    );
+    assert!(out.stdout.contains(">Assign (D-loop × 16)</text>"));
+    // The same picture into a file with -o.
+    let target = std::env::temp_dir().join(format!("semo-svg-{}.svg", std::process::id()));
+    let target_arg = target.to_string_lossy().into_owned();
+    let written = semo_in(
+        &dir,
+        &["graph", "svg", "kmeans.taskgraph.xml", "-o", &target_arg],
+    );
+    assert_eq!(written.code, 0, "{}", written.stderr);
+    assert!(written.stdout.is_empty(), "{}", written.stdout);
+    let file = std::fs::read_to_string(&target).expect("the SVG file is written");
+    let _ = std::fs::remove_file(&target);
+    assert_eq!(file, out.stdout);
+    // An SDF3 benchmark.
+    let sdf3 = semo_in(&shared().join("data/sdf3"), &["graph", "svg", "modem.xml"]);
+    assert_eq!(sdf3.code, 0, "{}", sdf3.stderr);
+    assert!(
+        sdf3.stdout.contains("data-path=\"deci\""),
+        "{}",
+        sdf3.stdout
+    );
+    let broken = semo_in(
+        &support::repo_root().join("tests/fixtures/diagnostics/E064_graph_unknown_endpoint"),
+        &["graph", "svg", "graph.taskgraph.xml"],
+    );
+    assert_eq!(broken.code, 1);
+    assert!(broken.stdout.is_empty());
+    assert!(broken.stderr.contains("E064"), "{}", broken.stderr);
+    let missing = semo_in(&dir, &["graph", "svg", "no_such.taskgraph.xml"]);
+    assert_eq!(missing.code, 2, "{}", missing.stderr);
+}
+
+#[test]
 fn data_loop_has_the_looped_single_appearance_schedule() {
     let dir = shared().join("examples/taskgraphs");
     let out = semo_in(&dir, &["graph", "schedule", "data_loop.taskgraph.xml"]);

@@ -2,14 +2,16 @@
 //! multirate graphs of 1k, 10k and 100k tasks. Run with `cargo bench`.
 //! Targets: repetition vector linear in size (100k tasks under 100 ms), the full
 //! analysis of each SDF3 benchmark under 10 ms ("analyse" below: consistency,
-//! deadlock, schedules, buffers, throughput and the SDF/L rules).
+//! deadlock, schedules, buffers, throughput and the SDF/L rules). "svg" is the
+//! picture (`semo graph svg`: layout and SVG text), for the SDF3 graphs and the
+//! generated 1k and 10k graphs.
 
 mod common;
 use common::fastest;
 
 use semo::diag::FileId;
 use semo::taskgraph::analysis::{self, consistency, deadlock, level::Level, throughput};
-use semo::taskgraph::load_task_graph;
+use semo::taskgraph::{load_task_graph, to_svg};
 use std::fmt::Write;
 use std::hint::black_box;
 use std::time::Duration;
@@ -50,8 +52,8 @@ fn main() {
     let budget = Duration::from_millis(700);
     let sdf3 = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/sdf3");
     println!(
-        "{:<40} {:>8} {:>10} {:>12}",
-        "SDF3 graph", "tasks", "load", "analyse"
+        "{:<40} {:>8} {:>10} {:>12} {:>12}",
+        "SDF3 graph", "tasks", "load", "analyse", "svg"
     );
     let mut paths: Vec<_> = std::fs::read_dir(sdf3)
         .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
@@ -70,18 +72,22 @@ fn main() {
         let analyse = fastest(budget, || {
             black_box(analysis::analyze(black_box(&graph)));
         });
+        let svg = fastest(budget, || {
+            black_box(to_svg(black_box(&graph)));
+        });
         println!(
-            "{:<40} {:>8} {:>8.3}ms {:>10.3}ms",
+            "{:<40} {:>8} {:>8.3}ms {:>10.3}ms {:>10.3}ms",
             path.file_name().unwrap().to_string_lossy(),
             graph.tasks.len(),
             load.as_secs_f64() * 1e3,
-            analyse.as_secs_f64() * 1e3
+            analyse.as_secs_f64() * 1e3,
+            svg.as_secs_f64() * 1e3
         );
     }
     println!();
     println!(
-        "{:<12} {:>12} {:>16} {:>12}",
-        "generated", "load", "repetition", "deadlock"
+        "{:<12} {:>12} {:>16} {:>12} {:>12} {:>12}",
+        "generated", "load", "repetition", "deadlock", "throughput", "svg"
     );
     for n in [1_000, 10_000, 100_000] {
         let text = generate(n);
@@ -103,13 +109,21 @@ fn main() {
         let period = fastest(budget, || {
             black_box(throughput::throughput(black_box(&level), &counts));
         });
+        // The picture of 100k tasks is a few tens of megabytes: not timed.
+        let svg = (n <= 10_000).then(|| {
+            let t = fastest(budget, || {
+                black_box(to_svg(black_box(&graph)));
+            });
+            format!("{:.2}ms", t.as_secs_f64() * 1e3)
+        });
         println!(
-            "{:<12} {:>10.2}ms {:>14.2}ms {:>10.2}ms {:>10.2}ms",
+            "{:<12} {:>10.2}ms {:>14.2}ms {:>10.2}ms {:>10.2}ms {:>12}",
             format!("{n} tasks"),
             load.as_secs_f64() * 1e3,
             repetition.as_secs_f64() * 1e3,
             dead.as_secs_f64() * 1e3,
-            period.as_secs_f64() * 1e3
+            period.as_secs_f64() * 1e3,
+            svg.unwrap_or_else(|| "-".to_string())
         );
     }
 }

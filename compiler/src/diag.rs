@@ -186,6 +186,15 @@ pub struct Diagnostic {
     pub related: Vec<Related>,
 }
 
+/// Messages are one line (renderers and editors rely on it), but they quote
+/// names the user wrote, which may hold line breaks (an XML attribute value).
+fn one_line(message: String) -> String {
+    if !message.contains(['\n', '\r']) {
+        return message;
+    }
+    message.replace('\r', "\\r").replace('\n', "\\n")
+}
+
 impl Diagnostic {
     pub fn new(code: Code, file: FileId, span: Span, message: impl Into<String>) -> Self {
         Diagnostic {
@@ -193,7 +202,7 @@ impl Diagnostic {
             severity: code.default_severity(),
             file,
             span,
-            message: message.into(),
+            message: one_line(message.into()),
             suggestion: None,
             related: Vec::new(),
         }

@@ -1,5 +1,6 @@
-//! `semo graph analyze`: a task graph's repetition vectors and deadlock
-//! freedom, level by level, with its diagnostics.
+//! `semo graph analyze|schedule|dot|svg`: a task graph's repetition vectors
+//! and deadlock freedom level by level with its diagnostics, its schedules,
+//! and pictures of it.
 
 use super::render;
 use crate::diag::Diagnostic;
@@ -17,9 +18,12 @@ fn read(path: &Path) -> Option<String> {
     }
 }
 
-/// `semo graph dot`: the DOT text, or the loading errors (exit 1).
-pub fn dot(path: &Path, out: &mut impl Write) -> i32 {
-    let Some(text) = read(path) else { return 2 };
+/// The graph in `path` when it loads without errors; otherwise the errors
+/// are printed and the exit code given.
+fn load_clean(path: &Path) -> Result<crate::taskgraph::TaskGraph, i32> {
+    let Some(text) = read(path) else {
+        return Err(2);
+    };
     let mut files = Files::default();
     let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
     let (graph, diagnostics) = crate::taskgraph::load_task_graph(id, &files.get(id).text);
@@ -28,13 +32,44 @@ pub fn dot(path: &Path, out: &mut impl Write) -> i32 {
         .filter(Diagnostic::is_error)
         .collect();
     match graph {
-        Some(g) if errors.is_empty() => {
+        Some(g) if errors.is_empty() => Ok(g),
+        _ => {
+            let _ = render::diagnostics(&files, &errors, false, &mut std::io::stderr());
+            Err(1)
+        }
+    }
+}
+
+/// `semo graph dot`: the DOT text, or the loading errors (exit 1).
+pub fn dot(path: &Path, out: &mut impl Write) -> i32 {
+    match load_clean(path) {
+        Ok(g) => {
             let _ = out.write_all(crate::taskgraph::dot::to_dot(&g).as_bytes());
             0
         }
-        _ => {
-            let _ = render::diagnostics(&files, &errors, false, &mut std::io::stderr());
-            1
+        Err(code) => code,
+    }
+}
+
+/// `semo graph svg`: the SVG picture on `out` or in `output`, or the loading
+/// errors (exit 1).
+pub fn svg(path: &Path, output: Option<&Path>, out: &mut impl Write) -> i32 {
+    let graph = match load_clean(path) {
+        Ok(g) => g,
+        Err(code) => return code,
+    };
+    let picture = crate::taskgraph::to_svg(&graph);
+    match output {
+        Some(file) => match std::fs::write(file, picture) {
+            Ok(()) => 0,
+            Err(e) => {
+                eprintln!("error: {}: {e}", file.display());
+                2
+            }
+        },
+        None => {
+            let _ = out.write_all(picture.as_bytes());
+            0
         }
     }
 }

@@ -93,6 +93,15 @@ enum GraphCommand {
         /// A `*.taskgraph.xml` file or an SDF3 graph.
         file: PathBuf,
     },
+    /// Draw the graph as SVG, without Graphviz: tasks, loop nodes as
+    /// clusters, rates and initial samples on channels.
+    Svg {
+        /// A `*.taskgraph.xml` file or an SDF3 graph.
+        file: PathBuf,
+        /// Write the SVG to this file instead of standard output.
+        #[arg(short, long, value_name = "FILE")]
+        output: Option<PathBuf>,
+    },
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
@@ -132,6 +141,9 @@ pub fn main(lsp: fn() -> i32) -> i32 {
             color,
         }) => graph::analyze(&file, format == Format::Json, use_color(color), &mut out),
         Command::Graph(GraphCommand::Dot { file }) => graph::dot(&file, &mut out),
+        Command::Graph(GraphCommand::Svg { file, output }) => {
+            graph::svg(&file, output.as_deref(), &mut out)
+        }
         Command::Graph(GraphCommand::Schedule { file, cores }) => {
             graph::schedule(&file, cores, &mut out)
         }

@@ -3,7 +3,9 @@
 pub mod analysis;
 pub mod dot;
 pub mod model;
+pub mod svg;
 mod xml;
 
 pub use model::*;
+pub use svg::to_svg;
 pub use xml::{GraphFormat, detect_format, load_task_graph};
