@@ -69,5 +69,8 @@ pub fn run_stdio() -> i32 {
         tokio::io::stdin(),
         tokio::io::stdout(),
     ));
+    // tokio reads stdin on a blocking thread that would hold a normal shutdown
+    // until the client writes again: after `exit`, do not wait for it.
+    runtime.shutdown_background();
     0
 }

@@ -14,6 +14,8 @@ use tower_lsp_server::{Client, LanguageServer};
 pub struct Backend {
     client: Client,
     state: Arc<State>,
+    /// Whether the client lets us register file watchers at run time.
+    can_watch: std::sync::atomic::AtomicBool,
 }
 
 impl Backend {
@@ -21,7 +23,11 @@ impl Backend {
     pub fn new(client: Client) -> Backend {
         let state = Arc::new(State::default());
         tokio::spawn(diagnostics::publish_loop(state.clone(), client.clone()));
-        Backend { client, state }
+        Backend {
+            client,
+            state,
+            can_watch: Default::default(),
+        }
     }
 
     /// The current snapshot of a document, or an error for files never opened
@@ -77,6 +83,9 @@ impl Backend {
     }
 
     async fn register_watchers(&self) {
+        if !self.can_watch.load(std::sync::atomic::Ordering::Relaxed) {
+            return;
+        }
         let watchers = [
             "**/*.mission",
             "**/*.robot.xml",
@@ -97,7 +106,6 @@ impl Backend {
             })
             .ok(),
         };
-        // Clients without dynamic registration simply do not watch for us.
         let _ = self.client.register_capability(vec![registration]).await;
     }
 
@@ -129,6 +137,15 @@ fn roots(params: &InitializeParams) -> Vec<std::path::PathBuf> {
 impl LanguageServer for Backend {
     async fn initialize(&self, params: InitializeParams) -> Result<InitializeResult> {
         let encoding = Encoding::negotiate(&params.capabilities);
+        let can_watch = params
+            .capabilities
+            .workspace
+            .as_ref()
+            .and_then(|w| w.did_change_watched_files.as_ref())
+            .and_then(|w| w.dynamic_registration)
+            .unwrap_or(false);
+        self.can_watch
+            .store(can_watch, std::sync::atomic::Ordering::Relaxed);
         {
             let mut world = self.state.world();
             world.encoding = encoding;
