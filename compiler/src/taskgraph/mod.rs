@@ -2,6 +2,7 @@
 
 pub mod analysis;
 pub mod dot;
+pub mod ide;
 pub mod model;
 pub mod svg;
 mod xml;
