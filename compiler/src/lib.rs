@@ -5,12 +5,15 @@
 //! - [`syntax`]: lexer and parser (chumsky) from text to a positioned AST; never panics.
 //! - [`catalog`]: robot types from the built-in catalog and `*.robot.xml` files.
 //! - [`sema`]: name resolution and checks, producing the [`sema::Mission`] IR.
+//! - [`format`]: the canonical layout of mission scripts (`semo fmt`), from the
+//!   tokens and the syntax tree.
 //! - [`workspace`]: loading files and folders from disk for the CLI.
 //! - [`cli`]: the `semo` command (rendering with ariadne or JSON).
 
 pub mod catalog;
 pub mod cli;
 pub mod diag;
+pub mod format;
 pub mod sema;
 pub mod span;
 pub mod suggest;
