@@ -60,6 +60,11 @@ impl<'s, 't> Emitter<'s, 't> {
         self.tokens.get(self.next).map(|t| t.0)
     }
 
+    /// The token `k` places after the next one, and where it starts.
+    pub fn peek_nth(&self, k: usize) -> Option<(Token<'s>, usize)> {
+        self.tokens.get(self.next + k).map(|t| (t.0, t.1.start))
+    }
+
     /// Where the next token starts (the end of the text when there is none).
     pub fn peek_start(&self) -> usize {
         self.tokens

@@ -73,6 +73,10 @@ fn braced(
     empty: bool,
     inside: impl FnOnce(&mut Emitter<'_, '_>) -> Result,
 ) -> Result {
+    // After a comment, `{` starts a line at the level of its header.
+    if e.has_comments_before_next() {
+        e.boundary(Sep::Line, false);
+    }
     e.token();
     if empty && e.at(Token::RBrace) && !e.has_comments_before_next() {
         e.token();
@@ -289,47 +293,77 @@ fn stmt(e: &mut Emitter<'_, '_>, s: &ast::Stmt, depth: usize) -> Result {
     Ok(())
 }
 
+/// Whether a break is allowed before this token inside the outermost
+/// parentheses: `and`, `or`, `&&`, `||`, except inside bare words (`move(salt
+/// and pepper)`).
+fn breaks_before(token: Token<'_>, at: usize, words: &[Span]) -> bool {
+    matches!(
+        token,
+        Token::Kw(Kw::And | Kw::Or) | Token::AndAnd | Token::OrOr
+    ) && !words.iter().any(|w| w.contains(at))
+}
+
+/// Whether the parentheses opening at the next token hold more than one part
+/// or a part with `and`/`or`: else breaking them would gain nothing.
+fn breakable_parens(e: &Emitter<'_, '_>, words: &[Span]) -> bool {
+    let mut depth = 0usize;
+    let mut k = 0;
+    while let Some((token, at)) = e.peek_nth(k) {
+        match token {
+            Token::LParen => depth += 1,
+            Token::RParen if depth <= 1 => return false,
+            Token::RParen => depth -= 1,
+            Token::Comma if depth == 1 => return true,
+            _ if depth == 1 && breaks_before(token, at, words) => return true,
+            _ => {}
+        }
+        k += 1;
+    }
+    false
+}
+
 /// Places the tokens before `end` on one line, the outermost parentheses
 /// forming a group: when the line is too long, each comma-separated part goes
 /// on its own line, and a part still too long breaks before each `and`/`or`
-/// outside nested parentheses (but not inside bare words, `move(salt and
-/// pepper)`).
+/// outside nested parentheses.
 fn inline(e: &mut Emitter<'_, '_>, end: usize, words: &[Span]) {
     let mut depth = 0usize;
+    // Whether the outermost parentheses open now form a group.
+    let mut grouped = false;
     while e.peek().is_some() && e.peek_start() < end {
         let Some(token) = e.peek() else { break };
         match token {
+            Token::LParen if depth == 0 && !breakable_parens(e, words) => {
+                // `()`, `(x)`: nothing worth breaking.
+                depth = 1;
+                grouped = false;
+                e.token();
+            }
             Token::LParen if depth == 0 => {
                 e.push(Item::GroupStart);
                 e.token();
-                if e.at(Token::RParen) {
-                    // `()`: nothing to break.
-                    e.token();
-                    e.push(Item::GroupEnd);
-                    continue;
-                }
                 depth = 1;
+                grouped = true;
                 e.push(Item::IndentStart);
                 e.push(Item::Line(""));
                 e.push(Item::GroupStart);
             }
-            Token::RParen if depth == 1 => {
+            Token::RParen if depth == 1 && grouped => {
                 e.push(Item::GroupEnd);
                 e.push(Item::IndentEnd);
                 e.push(Item::Line(""));
                 e.token();
                 e.push(Item::GroupEnd);
                 depth = 0;
+                grouped = false;
             }
-            Token::Comma if depth == 1 => {
+            Token::Comma if depth == 1 && grouped => {
                 e.token();
                 e.push(Item::GroupEnd);
                 e.push(Item::Line(" "));
                 e.push(Item::GroupStart);
             }
-            Token::Kw(Kw::And | Kw::Or) | Token::AndAnd | Token::OrOr
-                if depth == 1 && !words.iter().any(|w| w.contains(e.peek_start())) =>
-            {
+            _ if depth == 1 && grouped && breaks_before(token, e.peek_start(), words) => {
                 e.push(Item::Line(" "));
                 e.token();
             }
@@ -344,7 +378,7 @@ fn inline(e: &mut Emitter<'_, '_>, end: usize, words: &[Span]) {
             _ => e.token(),
         }
     }
-    if depth > 0 {
+    if depth > 0 && grouped {
         e.push(Item::GroupEnd);
         e.push(Item::IndentEnd);
         e.push(Item::GroupEnd);
