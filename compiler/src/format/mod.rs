@@ -79,7 +79,7 @@ mod tests;
 
 use crate::diag::{Diagnostic, FileId};
 use crate::span::Span;
-use crate::syntax::{self, token};
+use crate::syntax;
 use std::fmt;
 
 /// The width lines are kept within where the layout allows a break.
@@ -139,11 +139,10 @@ impl std::error::Error for FormatRefusal {}
 /// documentation). Returns the whole new text, or why the text must be left
 /// as it is.
 pub fn format_source(text: &str) -> Result<String, FormatRefusal> {
-    let parsed = syntax::parse(FileId(0), text);
+    let (parsed, tokens) = syntax::parse_with_tokens(FileId(0), text);
     if !parsed.diagnostics.is_empty() {
         return Err(FormatRefusal::SyntaxErrors(parsed.diagnostics));
     }
-    let tokens = token::lex(text);
     let trivia = trivia::scan(text, &tokens)
         .map_err(|at| FormatRefusal::Unfaithful(format!("unexpected text at byte {}", at.0)))?;
     let mut emitter = emit::Emitter::new(text, &tokens, &trivia);

@@ -108,25 +108,36 @@ fn scan_gap<'s>(
 ) -> Result<Gap, Unexpected> {
     let first = comments.len() as u32;
     let gap = text.get(start..end).ok_or(Unexpected(start))?;
+    let bytes = gap.as_bytes();
     let mut newlines = 0;
-    let mut rest = gap;
-    while let Some(c) = rest.chars().next() {
-        let at = start + (gap.len() - rest.len());
-        if c == '#' {
-            let line_end = rest.find('\n').unwrap_or(rest.len());
-            let comment = rest[..line_end].trim_end();
-            comments.push(Comment {
-                text: comment,
-                span: Span::new(at, at + comment.len()),
-                newlines_before: newlines,
-            });
-            newlines = 0;
-            rest = &rest[line_end..];
-        } else if c.is_whitespace() {
-            newlines += u32::from(c == '\n');
-            rest = &rest[c.len_utf8()..];
-        } else {
-            return Err(Unexpected(at));
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'#' => {
+                let line_end = gap[i..].find('\n').map_or(gap.len(), |n| i + n);
+                let comment = gap[i..line_end].trim_end();
+                comments.push(Comment {
+                    text: comment,
+                    span: Span::new(start + i, start + i + comment.len()),
+                    newlines_before: newlines,
+                });
+                newlines = 0;
+                i = line_end;
+            }
+            b'\n' => {
+                newlines += 1;
+                i += 1;
+            }
+            b if b.is_ascii_whitespace() || b == 0x0b => i += 1,
+            b if b.is_ascii() => return Err(Unexpected(start + i)),
+            _ => {
+                // Other whitespace the lexer skips: no-break spaces, em spaces...
+                let c = gap[i..].chars().next().ok_or(Unexpected(start + i))?;
+                if !c.is_whitespace() {
+                    return Err(Unexpected(start + i));
+                }
+                i += c.len_utf8();
+            }
         }
     }
     Ok(Gap {
@@ -172,6 +183,18 @@ mod tests {
         assert_eq!(c.text, "#  Korean 한국어 😀");
         assert_eq!(&text[c.span.range()], c.text);
         assert_eq!(trivia.gaps[1].newlines_after, 1);
+    }
+
+    #[test]
+    fn every_whitespace_the_lexer_skips_is_skipped_and_anything_else_reported() {
+        let text = "a\t\u{b}\u{c}\r\u{85}\u{a0}\u{3000}\u{2028}b";
+        let tokens = lex(text);
+        assert_eq!(tokens.len(), 2);
+        assert!(scan(text, &tokens).is_ok());
+        // Between tokens that do not cover the text, something is left over.
+        let partial = &tokens[..1];
+        assert_eq!(scan("a @", partial).err(), Some(Unexpected(2)));
+        assert_eq!(scan("a 한", partial).err(), Some(Unexpected(2)));
     }
 
     #[test]
