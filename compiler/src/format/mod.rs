@@ -9,7 +9,7 @@
 //!   every `#` comment stays between the same two tokens, at the end of a line
 //!   of code or on a line of its own as it was (trailing whitespace in a
 //!   comment is removed). The output is checked against the input before it is
-//!   returned ([`verify`]); if it differs, the text is refused, not returned.
+//!   returned (`verify.rs`); if it differs, the text is refused, not returned.
 //! - **Broken text is refused.** A file with any syntax error is not touched:
 //!   what the parser did not understand cannot be laid out safely.
 //! - **Idempotent**: formatting formatted text changes nothing.
@@ -57,15 +57,22 @@
 //!   statement that would be longer breaks its outermost parentheses: each
 //!   comma-separated part on its own line one level in, `)` back at the
 //!   statement's level; a part still too long breaks before each `and`/`or`
-//!   outside nested parentheses. Names and strings are never split, so a line
-//!   can still be longer.
+//!   outside nested parentheses. Parentheses holding a single part without
+//!   `and`/`or` (`say("...")`) are not broken, and names and strings are
+//!   never split, so a line can still be longer.
 //! - Comments: a comment that ends a line of code stays there, after one
-//!   space. A comment on its own line stays on its own line, indented like the
-//!   code after it (before a closing `}`, like the statements of the block).
-//!   An empty line before or after a comment between statements is kept as
-//!   above. A comment inside a statement where the layout has no line break
-//!   (`T.Plan # why` / `.Service {`) ends its line, and the statement goes on
-//!   in the next line, one level deeper.
+//!   space (it does not count against the width). A comment on its own line
+//!   stays on its own line, indented like the code after it (before a
+//!   closing `}`, like the statements of the block). Comments before the
+//!   first token of an item belong to that item: the empty line between items
+//!   goes before them. An empty line before or after a comment between
+//!   statements is kept as above.
+//! - A comment where the layout has no line break ends its line all the
+//!   same. Inside parentheses, they break as if too long. Before `else` or
+//!   `repeat`, an own-line comment puts them on a line of their own; after a
+//!   comment, a block's `{` starts a line at its header's level. Elsewhere
+//!   (`T.Plan # why` / `.Service {`) the statement goes on in the next line,
+//!   one level deeper.
 
 mod doc;
 mod emit;
@@ -82,6 +89,8 @@ use crate::span::Span;
 use crate::syntax;
 use std::fmt;
 
+pub use layout::MAX_NESTING;
+
 /// The width lines are kept within where the layout allows a break.
 pub const MAX_WIDTH: usize = 100;
 
@@ -91,7 +100,7 @@ pub enum FormatRefusal {
     /// The text has syntax errors (at least one; the parser's diagnostics, for
     /// [`FileId`]`(0)`, sorted by position).
     SyntaxErrors(Vec<Diagnostic>),
-    /// Statements nested more deeply than [`MAX_NESTING`](layout::MAX_NESTING)
+    /// Statements nested more deeply than [`MAX_NESTING`]
     /// levels, at this statement.
     TooDeep(Span),
     /// The formatter's own check of its output failed (a formatter bug): the
@@ -122,8 +131,7 @@ impl fmt::Display for FormatRefusal {
             }
             FormatRefusal::TooDeep(_) => write!(
                 f,
-                "statements are nested more than {} levels deep",
-                layout::MAX_NESTING
+                "statements are nested more than {MAX_NESTING} levels deep"
             ),
             FormatRefusal::Unfaithful(what) => write!(
                 f,
