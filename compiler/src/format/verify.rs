@@ -5,11 +5,11 @@
 //! or a comment of the user's.
 
 use super::trivia::{self, Trivia};
-use crate::syntax::token::Spanned;
+use crate::syntax::token::{Spanned, lex};
 
 /// What differs between the original and the formatted text, if anything.
 pub fn faithful(tokens: &[Spanned<'_>], trivia: &Trivia<'_>, output: &str) -> Result<(), String> {
-    let formatted = crate::syntax::tokens(output);
+    let formatted = lex(output);
     if formatted.len() != tokens.len() {
         return Err(format!(
             "the output has {} tokens instead of {}",
@@ -48,7 +48,6 @@ fn texts<'s>(comments: &[trivia::Comment<'s>]) -> Vec<&'s str> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::syntax::token::lex;
 
     fn check(original: &str, output: &str) -> Result<(), String> {
         let tokens = lex(original);

@@ -56,11 +56,6 @@ pub fn parse_with_tokens(file: FileId, text: &str) -> (Parse, Vec<token::Spanned
     parse_with(file, text, parallel(text))
 }
 
-/// The tokens of `text` (as [`token::lex`], on two threads when it is large).
-pub fn tokens(text: &str) -> Vec<token::Spanned<'_>> {
-    lex(text, parallel(text))
-}
-
 fn parse_with(file: FileId, text: &str, two_threads: bool) -> (Parse, Vec<token::Spanned<'_>>) {
     let mut diagnostics = Vec::new();
     let mut tokens = lex(text, two_threads);
