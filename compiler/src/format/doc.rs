@@ -17,8 +17,8 @@ pub const INDENT: usize = 2;
 pub enum Item<'s> {
     /// Text without line breaks.
     Text(&'s str),
-    /// One space, unless at the start of a line.
-    Space,
+    /// One space (unless at the start of a line), then the text.
+    SpacedText(&'s str),
     /// A possible line break: prints `flat` (`""` or `" "`) when its group is
     /// flat, else breaks the line.
     Line(&'static str),
@@ -92,7 +92,7 @@ fn fits(items: &[Item<'_>], start: usize, room: usize) -> Option<usize> {
                 }
             }
             Item::Text(s) => room -= width(s) as isize,
-            Item::Space => room -= 1,
+            Item::SpacedText(s) => room -= 1 + width(s) as isize,
             Item::Line(flat) if end.is_none() => room -= flat.len() as isize,
             // After the group: the rest of the line ends at the next break.
             Item::Line(_) => return end,
@@ -106,10 +106,10 @@ fn fits(items: &[Item<'_>], start: usize, room: usize) -> Option<usize> {
     end
 }
 
-/// Prints `items` in `max_width` columns. The text ends with one line break
-/// unless it is empty.
-pub fn print(items: &[Item<'_>], max_width: usize) -> String {
-    let mut out = String::with_capacity(items.len() * 4);
+/// Prints `items` in `max_width` columns, in a text of about `size_hint`
+/// bytes. The text ends with one line break unless it is empty.
+pub fn print(items: &[Item<'_>], max_width: usize, size_hint: usize) -> String {
+    let mut out = String::with_capacity(size_hint);
     let mut level = 0usize;
     let mut col = 0usize;
     let mut pending: Option<Pending> = None;
@@ -144,16 +144,14 @@ pub fn print(items: &[Item<'_>], max_width: usize) -> String {
     for (i, item) in items.iter().enumerate() {
         let flat = i < flat_until;
         match *item {
-            Item::Text(s) => {
-                flush(&mut out, &mut pending, &mut col, &mut continued, level);
-                out.push_str(s);
-                col += width(s);
-            }
-            Item::Space => {
-                if pending.is_none() && !out.is_empty() {
+            Item::SpacedText(s) | Item::Text(s) => {
+                if matches!(item, Item::SpacedText(_)) && pending.is_none() && !out.is_empty() {
                     out.push(' ');
                     col += 1;
                 }
+                flush(&mut out, &mut pending, &mut col, &mut continued, level);
+                out.push_str(s);
+                col += width(s);
             }
             Item::Line(flat_text) if flat => {
                 if pending.is_none() && !out.is_empty() {
@@ -247,13 +245,13 @@ mod tests {
 
     #[test]
     fn a_group_that_fits_stays_on_one_line() {
-        assert_eq!(print(&call(&["a", "b"]), 20), "move(a, b)\n");
+        assert_eq!(print(&call(&["a", "b"]), 20, 0), "move(a, b)\n");
     }
 
     #[test]
     fn a_group_too_wide_breaks_every_line_of_it() {
         assert_eq!(
-            print(&call(&["alpha", "beta", "gamma"]), 15),
+            print(&call(&["alpha", "beta", "gamma"]), 15, 0),
             "move(\n  alpha,\n  beta,\n  gamma\n)\n"
         );
     }
@@ -261,9 +259,9 @@ mod tests {
     #[test]
     fn what_follows_a_group_on_its_line_counts() {
         let mut items = call(&["a", "b"]);
-        items.extend([Text(","), Space, Text("timeout")]);
-        assert_eq!(print(&items, 18), "move(\n  a,\n  b\n), timeout\n");
-        assert_eq!(print(&items, 19), "move(a, b), timeout\n");
+        items.extend([Text(","), SpacedText("timeout")]);
+        assert_eq!(print(&items, 18, 0), "move(\n  a,\n  b\n), timeout\n");
+        assert_eq!(print(&items, 19, 0), "move(a, b), timeout\n");
     }
 
     #[test]
@@ -271,7 +269,7 @@ mod tests {
         let mut items = vec![Text("move"), GroupStart, Text("("), IndentStart, Line("")];
         items.extend([Text("a"), Text(","), TrailingComment("# first"), Line(" ")]);
         items.extend([Text("b"), IndentEnd, Line(""), Text(")"), GroupEnd]);
-        assert_eq!(print(&items, 80), "move(\n  a, # first\n  b\n)\n");
+        assert_eq!(print(&items, 80, 0), "move(\n  a, # first\n  b\n)\n");
     }
 
     #[test]
@@ -285,7 +283,7 @@ mod tests {
             Hard,
             Text("d"),
         ];
-        assert_eq!(print(&items, 80), "a # one\n  b\n  # two\n  c\nd\n");
+        assert_eq!(print(&items, 80, 0), "a # one\n  b\n  # two\n  c\nd\n");
     }
 
     #[test]
@@ -300,7 +298,7 @@ mod tests {
             Text("b"),
             Hard,
         ];
-        assert_eq!(print(&items, 80), "a\n\n  b\n");
-        assert_eq!(print(&[], 80), "");
+        assert_eq!(print(&items, 80, 0), "a\n\n  b\n");
+        assert_eq!(print(&[], 80, 0), "");
     }
 }

@@ -44,7 +44,7 @@ impl<'s, 't> Emitter<'s, 't> {
             tokens,
             trivia,
             next: 0,
-            items: Vec::with_capacity(tokens.len() * 2),
+            items: Vec::with_capacity(tokens.len() * 3),
             prev: None,
             at_break: true,
             comments_placed: false,
@@ -91,17 +91,13 @@ impl<'s, 't> Emitter<'s, 't> {
             self.at_break = true;
         }
         match item {
-            Item::Text(_) => self.at_break = false,
+            Item::Text(_) | Item::SpacedText(_) => self.at_break = false,
             Item::Line(_)
             | Item::Hard
             | Item::Blank
             | Item::TrailingComment(_)
             | Item::OwnLineComment(_) => self.at_break = true,
-            Item::Space
-            | Item::GroupStart
-            | Item::GroupEnd
-            | Item::IndentStart
-            | Item::IndentEnd => {}
+            Item::GroupStart | Item::GroupEnd | Item::IndentStart | Item::IndentEnd => {}
         }
         self.items.push(item);
     }
@@ -127,10 +123,12 @@ impl<'s, 't> Emitter<'s, 't> {
                 self.push(Item::OwnLineComment(c.text));
             }
         }
+        let text = &self.text[span.start..span.end];
         if !self.at_break && self.prev.is_some_and(|p| space_between(p, token)) {
-            self.push(Item::Space);
+            self.push(Item::SpacedText(text));
+        } else {
+            self.push(Item::Text(text));
         }
-        self.push(Item::Text(&self.text[span.start..span.end]));
         self.prev = Some(token);
         self.next += 1;
         self.comments_placed = false;

@@ -164,7 +164,7 @@ pub fn format_source(text: &str) -> Result<String, FormatRefusal> {
     let items = emitter.finish().map_err(|at| {
         FormatRefusal::Unfaithful(format!("the token at byte {at} was not placed"))
     })?;
-    let mut out = doc::print(&items, MAX_WIDTH);
+    let mut out = doc::print(&items, MAX_WIDTH, text.len() + text.len() / 4);
     if uses_crlf(text) {
         out = out.replace('\n', "\r\n");
     }
