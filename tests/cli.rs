@@ -435,6 +435,26 @@ fn fmt_through_a_symbolic_link_rewrites_the_file_and_keeps_the_link() {
     assert_eq!(names(&dir.join("real")), ["a.mission"]);
 }
 
+#[test]
+fn fmt_does_not_replace_a_read_only_file() {
+    let dir = tempdir();
+    let path = dir.join("locked.mission");
+    std::fs::write(&path, UNFORMATTED).unwrap();
+    let mut permissions = std::fs::metadata(&path).unwrap().permissions();
+    permissions.set_readonly(true);
+    std::fs::set_permissions(&path, permissions).unwrap();
+    let out = semo_in(&dir, &["fmt", "locked.mission"]);
+    assert_eq!(out.code, 2);
+    assert!(
+        out.stderr
+            .contains("locked.mission: cannot write the formatted text: the file is read-only"),
+        "{}",
+        out.stderr
+    );
+    assert_eq!(read(&path), UNFORMATTED);
+    assert_eq!(names(&dir), ["locked.mission"]);
+}
+
 fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
     std::fs::create_dir_all(to).unwrap();
     for entry in std::fs::read_dir(from).unwrap() {
@@ -444,6 +464,11 @@ fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
             copy_dir(&path, &target);
         } else {
             std::fs::copy(&path, &target).unwrap();
+            // The shared examples are read-only; their copies are ours to change.
+            let mut permissions = std::fs::metadata(&target).unwrap().permissions();
+            #[allow(clippy::permissions_set_readonly_false)]
+            permissions.set_readonly(false);
+            std::fs::set_permissions(&target, permissions).unwrap();
         }
     }
 }

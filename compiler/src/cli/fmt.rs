@@ -153,10 +153,16 @@ fn describe(name: &str, text: &str, refusal: &FormatRefusal) -> String {
 /// Replaces the file at `path` (the file a symbolic link points to, not the
 /// link) by `text`: a temporary file in the same folder, with the original's
 /// permissions, renamed over it. Either the old text stays or the new one is
-/// there whole.
+/// there whole. A read-only file is not replaced.
 fn write_replacing(path: &Path, text: &str) -> io::Result<()> {
     let target = std::fs::canonicalize(path)?;
     let permissions = std::fs::metadata(&target)?.permissions();
+    if permissions.readonly() {
+        return Err(io::Error::new(
+            io::ErrorKind::PermissionDenied,
+            "the file is read-only",
+        ));
+    }
     let folder = target.parent().unwrap_or(Path::new("."));
     let name = target
         .file_name()
