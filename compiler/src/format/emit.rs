@@ -123,7 +123,9 @@ impl<'s, 't> Emitter<'s, 't> {
                 self.push(Item::OwnLineComment(c.text));
             }
         }
-        let text = &self.text[span.start..span.end];
+        // The lexer's spans lie on character boundaries; were one not to, the
+        // token would be missing and the output refused by the final check.
+        let text = self.text.get(span.start..span.end).unwrap_or_default();
         if !self.at_break && self.prev.is_some_and(|p| space_between(p, token)) {
             self.push(Item::SpacedText(text));
         } else {
