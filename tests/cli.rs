@@ -3,7 +3,7 @@
 
 mod support;
 
-use support::{check_json_in, semo, semo_in, shared};
+use support::{check_json_in, semo, semo_in, semo_with_stdin, shared};
 
 #[test]
 fn every_shared_example_checks_without_errors() {
@@ -128,6 +128,10 @@ fn help_explains_the_commands() {
     assert_eq!(check.code, 0);
     assert!(check.stdout.contains("--format"), "{}", check.stdout);
     assert!(check.stdout.contains("*.robot.xml"), "{}", check.stdout);
+    let fmt = semo(&["fmt", "--help"]);
+    assert_eq!(fmt.code, 0);
+    assert!(fmt.stdout.contains("--check"), "{}", fmt.stdout);
+    assert!(fmt.stdout.contains("standard input"), "{}", fmt.stdout);
 }
 
 #[test]
@@ -263,6 +267,233 @@ fn rejected_definitions_are_still_checked() {
             ("E024", 4, Some("stop")),
         ]
     );
+}
+
+// ---- semo fmt ----
+
+const UNFORMATTED: &str = "{ T: iRobotCreate a }\nT.Action.Go{move(\"1,1\") # go\n}repeat()\n\
+                           T.GO{set(Action,Go)}\nT.main{default:mode=GO}\n";
+const FORMATTED: &str = "{\n  T: iRobotCreate a\n}\n\nT.Action.Go {\n  move(\"1,1\") # go\n} repeat()\n\n\
+                         T.GO {\n  set(Action, Go)\n}\n\nT.main {\n  default: mode = GO\n}\n";
+
+fn read(path: &std::path::Path) -> String {
+    std::fs::read_to_string(path).unwrap()
+}
+
+/// The names in `dir`, sorted.
+fn names(dir: &std::path::Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+#[test]
+fn fmt_rewrites_only_the_missions_that_change_and_lists_them() {
+    let dir = tempdir();
+    std::fs::create_dir(dir.join("sub")).unwrap();
+    std::fs::write(dir.join("a.mission"), UNFORMATTED).unwrap();
+    std::fs::write(dir.join("sub/b.mission"), UNFORMATTED).unwrap();
+    std::fs::write(dir.join("c.mission"), FORMATTED).unwrap();
+    std::fs::write(dir.join("robots.robot.xml"), "<robots>  </robots>").unwrap();
+    std::fs::write(dir.join("notes.txt"), "T.A.S{x()}").unwrap();
+    let out = semo_in(&dir, &["fmt", "."]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert_eq!(
+        out.stdout,
+        "formatted ./a.mission\nformatted ./sub/b.mission\n"
+    );
+    for file in ["a.mission", "sub/b.mission", "c.mission"] {
+        assert_eq!(read(&dir.join(file)), FORMATTED, "{file}");
+    }
+    assert_eq!(read(&dir.join("robots.robot.xml")), "<robots>  </robots>");
+    assert_eq!(read(&dir.join("notes.txt")), "T.A.S{x()}");
+    // No temporary file is left behind.
+    assert_eq!(
+        names(&dir),
+        [
+            "a.mission",
+            "c.mission",
+            "notes.txt",
+            "robots.robot.xml",
+            "sub"
+        ]
+    );
+    assert_eq!(names(&dir.join("sub")), ["b.mission"]);
+    // Without a path, the current folder; nothing is left to change.
+    let again = semo_in(&dir, &["fmt"]);
+    assert_eq!((again.code, again.stdout.as_str()), (0, ""));
+}
+
+#[test]
+fn fmt_check_lists_the_files_that_would_change_and_writes_nothing() {
+    let dir = tempdir();
+    std::fs::write(dir.join("a.mission"), UNFORMATTED).unwrap();
+    std::fs::write(dir.join("c.mission"), FORMATTED).unwrap();
+    let out = semo_in(&dir, &["fmt", "--check", "a.mission", "c.mission"]);
+    assert_eq!((out.code, out.stdout.as_str()), (1, "a.mission\n"));
+    assert_eq!(read(&dir.join("a.mission")), UNFORMATTED);
+    assert_eq!(names(&dir), ["a.mission", "c.mission"]);
+    let out = semo_in(&dir, &["fmt", "--check", "c.mission"]);
+    assert_eq!((out.code, out.stdout.as_str()), (0, ""));
+}
+
+#[test]
+fn fmt_leaves_a_file_with_syntax_errors_as_it_is_and_says_where() {
+    let dir = tempdir();
+    let broken = "T.Action.Go {\n  move(\"1,1\"\n  stop()\n}\n  # keep   this\n";
+    std::fs::write(dir.join("broken.mission"), broken).unwrap();
+    std::fs::write(dir.join("fine.mission"), UNFORMATTED).unwrap();
+    let out = semo_in(&dir, &["fmt", "broken.mission", "fine.mission"]);
+    assert_eq!(out.code, 1, "{}", out.stderr);
+    assert!(
+        out.stderr.contains(
+            "error: broken.mission:2:7: syntax error: this `(` is never closed; not formatted"
+        ),
+        "{}",
+        out.stderr
+    );
+    assert_eq!(read(&dir.join("broken.mission")), broken);
+    // The other files are formatted all the same.
+    assert_eq!(out.stdout, "formatted fine.mission\n");
+    assert_eq!(read(&dir.join("fine.mission")), FORMATTED);
+}
+
+#[test]
+fn fmt_leaves_a_file_that_is_not_utf8_as_it_is() {
+    let dir = tempdir();
+    let bytes = b"# caf\xe9\n{ T: iRobotCreate a }\n";
+    std::fs::write(dir.join("latin1.mission"), bytes).unwrap();
+    let out = semo_in(&dir, &["fmt", "latin1.mission"]);
+    assert_eq!(out.code, 1);
+    assert!(
+        out.stderr.contains("latin1.mission: not UTF-8 text"),
+        "{}",
+        out.stderr
+    );
+    assert_eq!(std::fs::read(dir.join("latin1.mission")).unwrap(), bytes);
+}
+
+#[test]
+fn fmt_reads_standard_input_and_can_print_instead_of_writing() {
+    let dir = tempdir();
+    let out = semo_with_stdin(&dir, &["fmt", "-"], UNFORMATTED);
+    assert_eq!(
+        (out.code, out.stdout.as_str()),
+        (0, FORMATTED),
+        "{}",
+        out.stderr
+    );
+    let out = semo_with_stdin(&dir, &["fmt", "--check", "-"], UNFORMATTED);
+    assert_eq!((out.code, out.stdout.as_str()), (1, "<stdin>\n"));
+    let out = semo_with_stdin(&dir, &["fmt", "-"], "T.A.S { move( }");
+    assert_eq!((out.code, out.stdout.as_str()), (1, ""));
+    assert!(out.stderr.contains("<stdin>:1:13:"), "{}", out.stderr);
+
+    std::fs::write(dir.join("a.mission"), UNFORMATTED).unwrap();
+    let out = semo_in(&dir, &["fmt", "--stdout", "a.mission"]);
+    assert_eq!((out.code, out.stdout.as_str()), (0, FORMATTED));
+    assert_eq!(read(&dir.join("a.mission")), UNFORMATTED);
+}
+
+#[test]
+fn fmt_path_and_usage_problems_exit_with_2() {
+    let dir = tempdir();
+    std::fs::write(dir.join("robots.robot.xml"), "<robots/>").unwrap();
+    let out = semo_in(&dir, &["fmt", "missing.mission"]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("missing.mission"), "{}", out.stderr);
+    let out = semo_in(&dir, &["fmt", "robots.robot.xml"]);
+    assert_eq!(out.code, 2);
+    assert!(
+        out.stderr.contains("not a mission script"),
+        "{}",
+        out.stderr
+    );
+    let out = semo_in(&dir, &["fmt", "--check", "--stdout", "."]);
+    assert_eq!(out.code, 2);
+}
+
+#[cfg(unix)]
+#[test]
+fn fmt_through_a_symbolic_link_rewrites_the_file_and_keeps_the_link() {
+    let dir = tempdir();
+    std::fs::create_dir(dir.join("real")).unwrap();
+    std::fs::write(dir.join("real/a.mission"), UNFORMATTED).unwrap();
+    std::os::unix::fs::symlink("real/a.mission", dir.join("link.mission")).unwrap();
+    let out = semo_in(&dir, &["fmt", "link.mission"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        std::fs::symlink_metadata(dir.join("link.mission"))
+            .unwrap()
+            .file_type()
+            .is_symlink()
+    );
+    assert_eq!(read(&dir.join("real/a.mission")), FORMATTED);
+    assert_eq!(names(&dir.join("real")), ["a.mission"]);
+}
+
+#[test]
+fn fmt_does_not_replace_a_read_only_file() {
+    let dir = tempdir();
+    let path = dir.join("locked.mission");
+    std::fs::write(&path, UNFORMATTED).unwrap();
+    let mut permissions = std::fs::metadata(&path).unwrap().permissions();
+    permissions.set_readonly(true);
+    std::fs::set_permissions(&path, permissions).unwrap();
+    let out = semo_in(&dir, &["fmt", "locked.mission"]);
+    assert_eq!(out.code, 2);
+    assert!(
+        out.stderr
+            .contains("locked.mission: cannot write the formatted text: the file is read-only"),
+        "{}",
+        out.stderr
+    );
+    assert_eq!(read(&path), UNFORMATTED);
+    assert_eq!(names(&dir), ["locked.mission"]);
+}
+
+fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let path = entry.unwrap().path();
+        let target = to.join(path.file_name().unwrap());
+        if path.is_dir() {
+            copy_dir(&path, &target);
+        } else {
+            std::fs::copy(&path, &target).unwrap();
+            // The shared examples are read-only; their copies are ours to change.
+            let mut permissions = std::fs::metadata(&target).unwrap().permissions();
+            #[allow(clippy::permissions_set_readonly_false)]
+            permissions.set_readonly(false);
+            std::fs::set_permissions(&target, permissions).unwrap();
+        }
+    }
+}
+
+#[test]
+fn formatting_the_examples_changes_nothing_that_semo_check_finds() {
+    let dir = tempdir();
+    copy_dir(&shared().join("examples"), &dir.join("shared"));
+    copy_dir(&support::repo_root().join("examples"), &dir.join("ours"));
+    let findings = || {
+        let (code, diags) = check_json_in(&dir, &["."]);
+        let found: Vec<(String, String, String)> = diags
+            .into_iter()
+            .map(|d| (d.file, d.code, d.message))
+            .collect();
+        (code, found)
+    };
+    let before = findings();
+    assert!(!before.1.is_empty());
+    let out = semo_in(&dir, &["fmt", "."]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(out.stdout.contains("scouting.mission"), "{}", out.stdout);
+    assert_eq!(findings(), before);
+    let check = semo_in(&dir, &["fmt", "--check", "."]);
+    assert_eq!((check.code, check.stdout.as_str()), (0, ""));
 }
 
 #[test]

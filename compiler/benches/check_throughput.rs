@@ -1,6 +1,8 @@
 //! Check throughput on a large generated mission (200 teams, 10k+ lines):
-//! parse alone and parse+check, in MB/s and lines/s. Run with `cargo bench`.
-//! The target is at least 30 MB/s for parse+check on a 2-core machine.
+//! parse alone, parse+check, and `semo fmt`'s formatting (parse, layout and
+//! the check of its own output), in MB/s and lines/s. Run with `cargo bench`.
+//! The target is at least 30 MB/s for parse+check on a 2-core machine, and a
+//! few milliseconds per 10k lines for formatting.
 
 mod common;
 use common::fastest;
@@ -42,6 +44,13 @@ fn main() {
         mb,
         analysis.diagnostics.len()
     );
+    let formatted = semo::format::format_source(&text).expect("the generated mission formats");
+    assert_eq!(
+        semo::format::format_source(&formatted).as_ref(),
+        Ok(&formatted),
+        "formatting is stable"
+    );
+
     let budget = Duration::from_secs(3);
     let parse = fastest(budget, || {
         black_box(semo::syntax::parse(FileId(0), black_box(&text)));
@@ -49,7 +58,10 @@ fn main() {
     let check = fastest(budget, || {
         black_box(semo::check_source(FileId(0), black_box(&text), &catalog));
     });
-    for (what, d) in [("parse", parse), ("parse+check", check)] {
+    let format = fastest(budget, || {
+        black_box(semo::format::format_source(black_box(&text)).ok());
+    });
+    for (what, d) in [("parse", parse), ("parse+check", check), ("format", format)] {
         let s = d.as_secs_f64();
         println!(
             "{what:>12}: {:>8.2} ms  {:>7.1} MB/s  {:>10.0} lines/s",

@@ -7,12 +7,15 @@
 //! - [`sema`]: name resolution and checks, producing the [`sema::Mission`] IR.
 //! - [`strategy`]: strategy files (`*.strategy.xml`), checked on their own and
 //!   against the catalog and the Mission IR.
+//! - [`format`]: the canonical layout of mission scripts (`semo fmt`), from the
+//!   tokens and the syntax tree.
 //! - [`workspace`]: loading files and folders from disk for the CLI.
 //! - [`cli`]: the `semo` command (rendering with ariadne or JSON).
 
 pub mod catalog;
 pub mod cli;
 pub mod diag;
+pub mod format;
 pub mod sema;
 pub mod span;
 pub mod strategy;

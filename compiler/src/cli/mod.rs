@@ -1,6 +1,7 @@
 //! The `semo` command. Exit codes: 0 no errors, 1 errors found, 2 usage or I/O
 //! problem.
 
+mod fmt;
 mod graph;
 mod render;
 
@@ -15,8 +16,8 @@ use std::path::PathBuf;
     version,
     about = "SeMo: mission scripts for teams of cooperating robots",
     long_about = "SeMo checks mission scripts (*.mission) against a robot catalog (the built-in \
-                  one plus any *.robot.xml files), and will refine them into per-robot task \
-                  graphs and C code.\n\nExit status: 0 when no errors were found, 1 when \
+                  one plus any *.robot.xml files), lays them out canonically (`semo fmt`), and \
+                  will refine them into per-robot task graphs and C code.\n\nExit status: 0 when no errors were found, 1 when \
                   errors were found, 2 for a usage or I/O problem."
 )]
 struct Cli {
@@ -47,6 +48,29 @@ enum Command {
         /// Colour the human output: `auto` colours it when writing to a terminal.
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
+    },
+    /// Rewrite mission scripts in the canonical layout.
+    #[command(
+        long_about = "Rewrite mission scripts in the canonical layout (two-space indents, one \
+        statement per line, one empty line between items); only spaces and line breaks \
+        change, every comment is kept.\n\n\
+        Each PATH is a file or a folder; a folder stands for every *.mission file under it, \
+        and `-` reads standard input and writes the result to standard output. With no \
+        PATH, the current folder. A file is rewritten only when its layout changes; a file \
+        with syntax errors is left as it is and reported.\n\n\
+        Exit status: 0 when all is formatted, 1 when a file was refused or (with --check) \
+        is not formatted, 2 for a path or I/O problem."
+    )]
+    Fmt {
+        /// Files or folders to format (`-` for standard input).
+        paths: Vec<PathBuf>,
+        /// Write nothing; list the files whose layout would change, and exit
+        /// with 1 if there are any.
+        #[arg(long)]
+        check: bool,
+        /// Print the formatted text instead of rewriting the files.
+        #[arg(long, conflicts_with = "check")]
+        stdout: bool,
     },
     /// Analyse task graphs (`*.taskgraph.xml` or SDF3 files).
     #[command(subcommand)]
@@ -135,6 +159,18 @@ pub fn main(lsp: fn() -> i32) -> i32 {
             format,
             color,
         } => check(paths, format, use_color(color), &mut out),
+        Command::Fmt {
+            paths,
+            check,
+            stdout,
+        } => {
+            let mode = match (check, stdout) {
+                (true, _) => fmt::Mode::Check,
+                (false, true) => fmt::Mode::Stdout,
+                (false, false) => fmt::Mode::InPlace,
+            };
+            fmt::run(paths, mode, &mut out)
+        }
         Command::Graph(GraphCommand::Analyze {
             file,
             format,

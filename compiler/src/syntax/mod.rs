@@ -45,10 +45,18 @@ fn join<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B + 
 /// newline, so the two halves of the text lex independently, and chunks parse
 /// independently; the result is the same as on one thread.
 pub fn parse(file: FileId, text: &str) -> Parse {
+    parse_with(file, text, parallel(text)).0
+}
+
+/// [`parse`], also giving the tokens the tree was parsed from, for tools that
+/// need both (the formatter). Where there are lexical errors, the tokens are
+/// as repaired for the parser: unknown characters dropped, unterminated
+/// strings taken as strings.
+pub fn parse_with_tokens(file: FileId, text: &str) -> (Parse, Vec<token::Spanned<'_>>) {
     parse_with(file, text, parallel(text))
 }
 
-fn parse_with(file: FileId, text: &str, two_threads: bool) -> Parse {
+fn parse_with(file: FileId, text: &str, two_threads: bool) -> (Parse, Vec<token::Spanned<'_>>) {
     let mut diagnostics = Vec::new();
     let mut tokens = lex(text, two_threads);
     report_lexical_errors(file, &mut tokens, &mut diagnostics);
@@ -69,10 +77,11 @@ fn parse_with(file: FileId, text: &str, two_threads: bool) -> Parse {
     };
     diagnostics.extend(chunk_diagnostics);
     diagnostics.sort_by_key(|d| (d.span.start, d.span.end));
-    Parse {
+    let parse = Parse {
         file: ast::SourceFile { items },
         diagnostics,
-    }
+    };
+    (parse, tokens)
 }
 
 /// Lexes `text`, in two halves cut at a newline when it is large.
@@ -371,8 +380,9 @@ mod tests {
     fn two_threads_give_the_same_result_as_one() {
         let unit = "T.Action.Go { move(\"1,1\" \n stop() @ } repeat(2 SEC)\n# 한국어 😀\nT.M { set(Action Go) }\n";
         let text = unit.repeat(PARALLEL_MIN_BYTES / unit.len() + 10);
-        let one = parse_with(FileId(0), &text, false);
-        let two = parse_with(FileId(0), &text, true);
+        let (one, one_tokens) = parse_with(FileId(0), &text, false);
+        let (two, two_tokens) = parse_with(FileId(0), &text, true);
+        assert_eq!(one_tokens, two_tokens);
         assert!(two.diagnostics.len() > 100);
         assert_eq!(one.file, two.file);
         assert_eq!(one.diagnostics, two.diagnostics);
