@@ -6,7 +6,9 @@ use crate::encoding::Encoding;
 use crate::handlers;
 use crate::world::{self, Snapshot};
 use crate::{State, diagnostics};
+use semo::ide::completion::CompletionConfig;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use tower_lsp_server::jsonrpc::{Error, Result};
 use tower_lsp_server::ls_types::*;
 use tower_lsp_server::{Client, LanguageServer};
@@ -14,6 +16,8 @@ use tower_lsp_server::{Client, LanguageServer};
 pub struct Backend {
     client: Client,
     state: Arc<State>,
+    /// Whether the client takes snippets in completion items (from `initialize`).
+    snippets: AtomicBool,
 }
 
 impl Backend {
@@ -21,7 +25,11 @@ impl Backend {
     pub fn new(client: Client) -> Backend {
         let state = Arc::new(State::default());
         tokio::spawn(diagnostics::publish_loop(state.clone(), client.clone()));
-        Backend { client, state }
+        Backend {
+            client,
+            state,
+            snippets: AtomicBool::new(false),
+        }
     }
 
     /// The current snapshot of a document, or an error for files never opened
@@ -34,8 +42,7 @@ impl Backend {
         })
     }
 
-    /// Runs `f` on a snapshot off the async threads.
-    #[allow(dead_code)] // the request handlers arrive in the next commits A panic inside a handler
+    /// Runs `f` on a snapshot off the async threads. A panic inside a handler
     /// becomes an internal error for this request only.
     async fn on_snapshot<T: Send + 'static>(
         &self,
@@ -124,6 +131,8 @@ fn roots(params: &InitializeParams) -> Vec<std::path::PathBuf> {
 impl LanguageServer for Backend {
     async fn initialize(&self, params: InitializeParams) -> Result<InitializeResult> {
         let encoding = Encoding::negotiate(&params.capabilities);
+        let snippets = handlers::completion::snippet_support(&params.capabilities);
+        self.snippets.store(snippets, Ordering::Relaxed);
         {
             let mut world = self.state.world();
             world.encoding = encoding;
@@ -200,5 +209,18 @@ impl LanguageServer for Backend {
             });
         }
         self.state.queue.push(changed);
+    }
+
+    // Requests: a snapshot, and a handler off the async threads.
+
+    async fn completion(&self, p: CompletionParams) -> Result<Option<CompletionResponse>> {
+        let position = p.text_document_position.position;
+        let config = CompletionConfig {
+            snippets: self.snippets.load(Ordering::Relaxed),
+        };
+        self.on_snapshot(&p.text_document_position.text_document.uri, move |s| {
+            handlers::completion::completion(s, position, config)
+        })
+        .await
     }
 }

@@ -2,6 +2,7 @@
 //! a [`Snapshot`](crate::world::Snapshot) and back.
 
 pub mod catalog;
+pub mod completion;
 
 use crate::encoding::Encoding;
 use tower_lsp_server::ls_types::*;
@@ -18,6 +19,10 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
                 ..Default::default()
             },
         )),
+        completion_provider: Some(CompletionOptions {
+            trigger_characters: Some([".", "(", "=", ",", ":", "["].map(String::from).to_vec()),
+            ..Default::default()
+        }),
         ..Default::default()
     }
 }
