@@ -223,4 +223,13 @@ impl LanguageServer for Backend {
         })
         .await
     }
+
+    async fn hover(&self, p: HoverParams) -> Result<Option<Hover>> {
+        let position = p.text_document_position_params.position;
+        self.on_snapshot(
+            &p.text_document_position_params.text_document.uri,
+            move |s| handlers::hover::hover(s, position),
+        )
+        .await
+    }
 }

@@ -3,6 +3,7 @@
 
 pub mod catalog;
 pub mod completion;
+pub mod hover;
 
 use crate::encoding::Encoding;
 use tower_lsp_server::ls_types::*;
@@ -23,6 +24,7 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
             trigger_characters: Some([".", "(", "=", ",", ":", "["].map(String::from).to_vec()),
             ..Default::default()
         }),
+        hover_provider: Some(HoverProviderCapability::Simple(true)),
         ..Default::default()
     }
 }
