@@ -232,4 +232,13 @@ impl LanguageServer for Backend {
         )
         .await
     }
+
+    async fn signature_help(&self, p: SignatureHelpParams) -> Result<Option<SignatureHelp>> {
+        let position = p.text_document_position_params.position;
+        self.on_snapshot(
+            &p.text_document_position_params.text_document.uri,
+            move |s| handlers::signature_help::signature_help(s, position),
+        )
+        .await
+    }
 }

@@ -4,6 +4,7 @@
 pub mod catalog;
 pub mod completion;
 pub mod hover;
+pub mod signature_help;
 
 use crate::encoding::Encoding;
 use tower_lsp_server::ls_types::*;
@@ -25,6 +26,10 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
             ..Default::default()
         }),
         hover_provider: Some(HoverProviderCapability::Simple(true)),
+        signature_help_provider: Some(SignatureHelpOptions {
+            trigger_characters: Some(["(", ","].map(String::from).to_vec()),
+            ..Default::default()
+        }),
         ..Default::default()
     }
 }
