@@ -241,4 +241,12 @@ impl LanguageServer for Backend {
         )
         .await
     }
+
+    async fn inlay_hint(&self, p: InlayHintParams) -> Result<Option<Vec<InlayHint>>> {
+        let range = p.range;
+        self.on_snapshot(&p.text_document.uri, move |s| {
+            handlers::inlay_hints::inlay_hints(s, range)
+        })
+        .await
+    }
 }

@@ -4,6 +4,7 @@
 pub mod catalog;
 pub mod completion;
 pub mod hover;
+pub mod inlay_hints;
 pub mod signature_help;
 
 use crate::encoding::Encoding;
@@ -30,6 +31,7 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
             trigger_characters: Some(["(", ","].map(String::from).to_vec()),
             ..Default::default()
         }),
+        inlay_hint_provider: Some(OneOf::Left(true)),
         ..Default::default()
     }
 }
