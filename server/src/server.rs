@@ -249,4 +249,10 @@ impl LanguageServer for Backend {
         })
         .await
     }
+
+    async fn code_action(&self, p: CodeActionParams) -> Result<Option<CodeActionResponse>> {
+        let uri = p.text_document.uri.clone();
+        self.on_snapshot(&uri, move |s| handlers::code_actions::code_actions(s, &p))
+            .await
+    }
 }

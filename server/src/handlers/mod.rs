@@ -2,6 +2,7 @@
 //! a [`Snapshot`](crate::world::Snapshot) and back.
 
 pub mod catalog;
+pub mod code_actions;
 pub mod completion;
 pub mod hover;
 pub mod inlay_hints;
@@ -32,6 +33,10 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
             ..Default::default()
         }),
         inlay_hint_provider: Some(OneOf::Left(true)),
+        code_action_provider: Some(CodeActionProviderCapability::Options(CodeActionOptions {
+            code_action_kinds: Some(vec![CodeActionKind::QUICKFIX]),
+            ..Default::default()
+        })),
         ..Default::default()
     }
 }
