@@ -56,7 +56,6 @@ pub(crate) enum Paren {
     /// The arguments of a built-in service or function call.
     Call {
         name: Name,
-        span: Span,
     },
     /// Anything else: a parenthesised expression.
     Expr,
@@ -233,7 +232,7 @@ fn paren_of(level: &[Lt<'_>]) -> Paren {
             _ => Paren::Expr,
         },
         // `T.x(` is not a call: only a plain name is.
-        Some(Lt::Tok(Token::Ident(name), span))
+        Some(Lt::Tok(Token::Ident(name), _))
             if !matches!(
                 level.len().checked_sub(2).and_then(|i| level[i].token()),
                 Some(Token::Dot)
@@ -241,7 +240,6 @@ fn paren_of(level: &[Lt<'_>]) -> Paren {
         {
             Paren::Call {
                 name: Name::new(name),
-                span: *span,
             }
         }
         _ => Paren::Expr,
