@@ -216,6 +216,7 @@ impl<'a> Completions<'a> {
             Place::Nothing => {}
             Place::Item => self.item_start(),
             Place::ItemAfterTeam { team } => self.after_team(team),
+            Place::ItemAfterPlan { team, plan } => self.after_plan(team, plan),
             Place::TeamDecl => self.team_decl(),
             Place::RobotType => self.robot_types(),
             Place::Statement => self.statement(),
@@ -374,7 +375,7 @@ impl<'a> Completions<'a> {
             return;
         };
         for (i, p) in t.plans.iter().enumerate() {
-            let doc = docs::plan(t, i as Index);
+            let doc = docs::plan(self.text, t, i as Index);
             self.add(
                 EXACT,
                 CompletionKind::Plan,
@@ -419,6 +420,44 @@ impl<'a> Completions<'a> {
             Some(format!("a mode of {}", t.name)),
             None,
         );
+    }
+
+    /// `Team.Plan.` between items: the services that a `set` of the team
+    /// names for that plan but no definition has.
+    fn after_plan(&mut self, team: &Name, plan: &Name) {
+        let Some((_, t)) = self.team(team) else {
+            return;
+        };
+        let defined = |name: &str| {
+            t.plan_by_name(plan)
+                .is_some_and(|p| t.service_in_plan(p, name).is_some())
+        };
+        let mut missing: Vec<(&Name, &Name)> = Vec::new();
+        for item in &self.analysis.syntax.items {
+            let ast::Item::Mode(m) = item else { continue };
+            if m.team.name != *team {
+                continue;
+            }
+            for set in &m.sets {
+                if let ast::SetTarget::Service(s) = &set.service
+                    && set.plan.name == *plan
+                    && !defined(&s.name)
+                    && !missing.iter().any(|(n, _)| **n == s.name)
+                {
+                    missing.push((&s.name, &m.name.name));
+                }
+            }
+        }
+        for (name, mode) in missing {
+            self.add_snippet(
+                EXACT,
+                CompletionKind::Service,
+                name.as_str(),
+                &format!("{}{{\n\t$0\n}} repeat($1)", snippets::escape(name)),
+                Some(format!("set in mode {mode}, not yet defined")),
+                None,
+            );
+        }
     }
 
     /// Modes named in the team's main block that no definition has.
@@ -921,7 +960,7 @@ impl<'a> Completions<'a> {
                 CompletionKind::Plan,
                 p.name.as_str(),
                 Some(format!("plan of {}", t.name)),
-                Some(docs::plan(t, i as Index)),
+                Some(docs::plan(self.text, t, i as Index)),
             );
         }
     }
@@ -980,7 +1019,7 @@ impl<'a> Completions<'a> {
                 CompletionKind::Mode,
                 m.name.as_str(),
                 Some(format!("mode of {}", t.name)),
-                Some(docs::mode(t, i as Index)),
+                Some(docs::mode(self.text, t, i as Index)),
             );
         }
     }
@@ -995,7 +1034,7 @@ impl<'a> Completions<'a> {
                 CompletionKind::Mode,
                 m.name.as_str(),
                 Some(format!("mode of {}", t.name)),
-                Some(docs::mode(t, i as Index)),
+                Some(docs::mode(self.text, t, i as Index)),
             );
         }
     }

@@ -444,6 +444,9 @@ pub(crate) enum Place {
     Item,
     /// `Team.` at the start of an item: its plans, `main`, its modes.
     ItemAfterTeam { team: Name },
+    /// `Team.Plan.` at the start of an item: the services that modes set for
+    /// that plan but nobody defined yet.
+    ItemAfterPlan { team: Name, plan: Name },
     /// The start of a team declaration in the formation block.
     TeamDecl,
     /// `Team: |` or `Type a, |`: a robot type.
@@ -648,6 +651,17 @@ fn top_level(top: &[Lt<'_>]) -> Place {
         (Some(Token::Dot), Some(Token::Ident(team)), third) if third != Some(Token::Dot) => {
             Place::ItemAfterTeam {
                 team: Name::new(team),
+            }
+        }
+        (Some(Token::Dot), Some(Token::Ident(plan)), Some(Token::Dot)) => {
+            match (last(4), last(5)) {
+                (Some(Token::Ident(team)), fifth) if fifth != Some(Token::Dot) => {
+                    Place::ItemAfterPlan {
+                        team: Name::new(team),
+                        plan: Name::new(plan),
+                    }
+                }
+                _ => Place::Nothing,
             }
         }
         // After a complete bare team declaration, a new item may start.

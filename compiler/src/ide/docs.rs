@@ -1,7 +1,7 @@
 //! Markdown descriptions of what names mean, shared by hover and completion.
 
 use crate::catalog::{Catalog, RobotType, RobotTypeId, ServiceDef, ValueDef};
-use crate::sema::{Analysis, Index, Mission, Team, TeamId};
+use crate::sema::{Analysis, Index, Mission, ModeSet, Team, TeamId};
 use crate::syntax::ast;
 use std::fmt::Write;
 
@@ -292,7 +292,7 @@ fn plural(n: usize) -> &'static str {
 }
 
 /// A plan: the services it can run, and which one each mode runs.
-pub(crate) fn plan(t: &Team, plan: Index) -> String {
+pub(crate) fn plan(text: &str, t: &Team, plan: Index) -> String {
     let Some(p) = t.plans.get(plan as usize) else {
         return String::new();
     };
@@ -307,9 +307,11 @@ pub(crate) fn plan(t: &Team, plan: Index) -> String {
     let mut runs = Vec::new();
     for m in &t.modes {
         let set = m.sets.iter().find(|s| s.plan == Some(plan));
-        let what = match set.map(|s| s.service) {
-            Some(Some(s)) => format!("`{}`", t.services[s as usize].name),
-            Some(None) => "`OFF`".to_string(),
+        let what = match set {
+            Some(ModeSet {
+                service: Some(s), ..
+            }) => format!("`{}`", t.services[*s as usize].name),
+            Some(set) => unset(text, set),
             None => "nothing".to_string(),
         };
         runs.push(format!("- `{}`: {what}", m.name));
@@ -321,7 +323,7 @@ pub(crate) fn plan(t: &Team, plan: Index) -> String {
 }
 
 /// A mode: what each plan runs, and where its events lead.
-pub(crate) fn mode(t: &Team, mode: Index) -> String {
+pub(crate) fn mode(text: &str, t: &Team, mode: Index) -> String {
     let Some(m) = t.modes.get(mode as usize) else {
         return String::new();
     };
@@ -338,7 +340,10 @@ pub(crate) fn mode(t: &Team, mode: Index) -> String {
                     }
                     l
                 }
-                None => format!("- `{}` is `OFF`", p.name),
+                None => match unset(text, s).as_str() {
+                    "`OFF`" => format!("- `{}` is `OFF`", p.name),
+                    other => format!("- `{}` runs {other}", p.name),
+                },
             },
             None => format!("- `{}` does not run", p.name),
         };
@@ -364,6 +369,20 @@ pub(crate) fn mode(t: &Team, mode: Index) -> String {
         }
     }
     out
+}
+
+/// What a `set` without a service names: `OFF`, or a service that does not
+/// exist (already reported).
+fn unset(text: &str, set: &ModeSet) -> String {
+    let written = text
+        .get(set.span.range())
+        .and_then(|s| s.split(',').nth(1))
+        .map(|s| s.trim().trim_end_matches(')').trim())
+        .unwrap_or("");
+    match written {
+        "OFF" | "" => "`OFF`".to_string(),
+        name => format!("`{name}`, which is not defined"),
+    }
 }
 
 fn millis_text(ms: f64) -> String {

@@ -63,11 +63,11 @@ pub fn hover(
         }
         Symbol::RobotType(name) => docs::robot_type(catalog.robot(name)?),
         Symbol::Capability(name) => capability(analysis, catalog, name, offset),
-        Symbol::Plan { team, plan } => docs::plan(mission.team(*team), *plan),
+        Symbol::Plan { team, plan } => docs::plan(text, mission.team(*team), *plan),
         Symbol::Service { team, service } => {
             docs::composite_service(analysis, text, *team, *service)
         }
-        Symbol::Mode { team, mode } => docs::mode(mission.team(*team), *mode),
+        Symbol::Mode { team, mode } => docs::mode(text, mission.team(*team), *mode),
         Symbol::Event { team, name } => docs::event(mission.team(*team), name),
         Symbol::Function(f) => {
             let info = mission.functions.get(f.0 as usize)?;

@@ -207,7 +207,14 @@ fn places_in_half_typed_text() {
         ("T.main{ case(A): $0", Place::MainArm { in_case: true }),
         ("$0", Place::Item),
         ("T.$0", Place::ItemAfterTeam { team: "T".into() }),
-        ("T.P.$0", Place::Nothing),
+        (
+            "T.P.$0",
+            Place::ItemAfterPlan {
+                team: "T".into(),
+                plan: "P".into(),
+            },
+        ),
+        ("T.P.S.$0", Place::Nothing),
         (
             "T.P.S{ x() } repeat()\nT.$0",
             Place::ItemAfterTeam { team: "T".into() },
