@@ -225,3 +225,38 @@ fn completions_while_typing() {
     assert!(expectations.is_empty());
     session.shutdown();
 }
+
+/// The replaced range counts columns as negotiated: after a Korean string,
+/// UTF-8 columns are bytes, UTF-16 ones code units.
+#[test]
+fn replaced_ranges_in_both_encodings() {
+    let text = "{ T: iRobotCreate r }\nT.Action.Go{\n  send(USER, \"한국어\") sto\n} repeat()\nT.M{ set(Action, Go) }\nT.main{ default: mode = M }\n";
+    let line = text.lines().nth(2).unwrap();
+    let end_bytes = line.len();
+    let end_units = line.encode_utf16().count();
+    for (encoding, end) in [("utf-8", end_bytes), ("utf-16", end_units)] {
+        let caps = json!({
+            "general": { "positionEncodings": [encoding] },
+            "textDocument": { "completion": { "completionItem": { "snippetSupport": true } } }
+        });
+        let mut session = Session::with_capabilities(Some(caps));
+        let doc = session.open("enc.mission", text);
+        let position = json!({ "line": 2, "character": end });
+        let result = session.at("textDocument/completion", &doc, &position);
+        let stop = result["items"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|i| i["label"] == "stop")
+            .expect("stop is offered");
+        assert_eq!(
+            stop["textEdit"]["range"],
+            json!({
+                "start": { "line": 2, "character": end - 3 },
+                "end": { "line": 2, "character": end }
+            }),
+            "{encoding}"
+        );
+        session.shutdown();
+    }
+}
