@@ -9,6 +9,7 @@
 //!   against the catalog and the Mission IR.
 //! - [`format`]: the canonical layout of mission scripts (`semo fmt`), from the
 //!   tokens and the syntax tree.
+//! - [`ide`]: editor features over an analysis (completion, hover, ...), as plain data.
 //! - [`workspace`]: loading files and folders from disk for the CLI.
 //! - [`cli`]: the `semo` command (rendering with ariadne or JSON).
 
@@ -16,6 +17,7 @@ pub mod catalog;
 pub mod cli;
 pub mod diag;
 pub mod format;
+pub mod ide;
 pub mod sema;
 pub mod span;
 pub mod strategy;

@@ -34,7 +34,22 @@ impl TestClient {
 
     /// `initialize` + `initialized`. `encodings` are the position encodings
     /// the client offers (e.g. `["utf-8", "utf-16"]`); `root` a workspace folder.
+    /// The client takes snippets in completion items.
     pub async fn initialize(&mut self, encodings: &[&str], root: Option<&str>) -> Value {
+        let capabilities = json!({
+            "general": { "positionEncodings": encodings },
+            "workspace": {
+                "didChangeWatchedFiles": { "dynamicRegistration": true }
+            },
+            "textDocument": {
+                "completion": { "completionItem": { "snippetSupport": true } }
+            }
+        });
+        self.initialize_with(capabilities, root).await
+    }
+
+    /// `initialize` + `initialized` with the given client capabilities.
+    pub async fn initialize_with(&mut self, capabilities: Value, root: Option<&str>) -> Value {
         let folders = root.map(|r| json!([{ "uri": r, "name": "workspace" }]));
         let result = self
             .request(
@@ -43,15 +58,7 @@ impl TestClient {
                     "processId": null,
                     "rootUri": root,
                     "workspaceFolders": folders,
-                    "capabilities": {
-                        "general": { "positionEncodings": encodings },
-                        "workspace": {
-                            "didChangeWatchedFiles": { "dynamicRegistration": true }
-                        },
-                        "textDocument": {
-                            "completion": { "completionItem": { "snippetSupport": true } }
-                        }
-                    }
+                    "capabilities": capabilities,
                 }),
             )
             .await

@@ -6,7 +6,9 @@ use crate::encoding::Encoding;
 use crate::handlers;
 use crate::world::{self, Snapshot};
 use crate::{State, diagnostics};
+use semo::ide::completion::CompletionConfig;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use tower_lsp_server::jsonrpc::{Error, Result};
 use tower_lsp_server::ls_types::*;
 use tower_lsp_server::{Client, LanguageServer};
@@ -16,6 +18,8 @@ pub struct Backend {
     state: Arc<State>,
     /// Whether the client lets us register file watchers at run time.
     can_watch: std::sync::atomic::AtomicBool,
+    /// Whether the client takes snippets in completion items (from `initialize`).
+    snippets: AtomicBool,
 }
 
 impl Backend {
@@ -27,6 +31,7 @@ impl Backend {
             client,
             state,
             can_watch: Default::default(),
+            snippets: AtomicBool::new(false),
         }
     }
 
@@ -40,8 +45,7 @@ impl Backend {
         })
     }
 
-    /// Runs `f` on a snapshot off the async threads.
-    #[allow(dead_code)] // the request handlers arrive in the next commits A panic inside a handler
+    /// Runs `f` on a snapshot off the async threads. A panic inside a handler
     /// becomes an internal error for this request only.
     async fn on_snapshot<T: Send + 'static>(
         &self,
@@ -146,6 +150,8 @@ impl LanguageServer for Backend {
             .unwrap_or(false);
         self.can_watch
             .store(can_watch, std::sync::atomic::Ordering::Relaxed);
+        let snippets = handlers::completion::snippet_support(&params.capabilities);
+        self.snippets.store(snippets, Ordering::Relaxed);
         {
             let mut world = self.state.world();
             world.encoding = encoding;
@@ -222,5 +228,50 @@ impl LanguageServer for Backend {
             });
         }
         self.state.queue.push(changed);
+    }
+
+    // Requests: a snapshot, and a handler off the async threads.
+
+    async fn completion(&self, p: CompletionParams) -> Result<Option<CompletionResponse>> {
+        let position = p.text_document_position.position;
+        let config = CompletionConfig {
+            snippets: self.snippets.load(Ordering::Relaxed),
+        };
+        self.on_snapshot(&p.text_document_position.text_document.uri, move |s| {
+            handlers::completion::completion(s, position, config)
+        })
+        .await
+    }
+
+    async fn hover(&self, p: HoverParams) -> Result<Option<Hover>> {
+        let position = p.text_document_position_params.position;
+        self.on_snapshot(
+            &p.text_document_position_params.text_document.uri,
+            move |s| handlers::hover::hover(s, position),
+        )
+        .await
+    }
+
+    async fn signature_help(&self, p: SignatureHelpParams) -> Result<Option<SignatureHelp>> {
+        let position = p.text_document_position_params.position;
+        self.on_snapshot(
+            &p.text_document_position_params.text_document.uri,
+            move |s| handlers::signature_help::signature_help(s, position),
+        )
+        .await
+    }
+
+    async fn inlay_hint(&self, p: InlayHintParams) -> Result<Option<Vec<InlayHint>>> {
+        let range = p.range;
+        self.on_snapshot(&p.text_document.uri, move |s| {
+            handlers::inlay_hints::inlay_hints(s, range)
+        })
+        .await
+    }
+
+    async fn code_action(&self, p: CodeActionParams) -> Result<Option<CodeActionResponse>> {
+        let uri = p.text_document.uri.clone();
+        self.on_snapshot(&uri, move |s| handlers::code_actions::code_actions(s, &p))
+            .await
     }
 }

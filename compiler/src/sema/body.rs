@@ -156,6 +156,11 @@ impl<'a> Checker<'a> {
                     types: self.team_types[t].clone(),
                     inlining: Vec::new(),
                 };
+                let kind = ScopeKind::Service {
+                    team,
+                    service: s as Index,
+                };
+                self.record_scope(syntax.span, kind, &scope);
                 self.block(&syntax.body, &scope);
                 if let Some(repeat) = &syntax.repeat {
                     if let Some(p) = &repeat.period {
@@ -181,6 +186,7 @@ impl<'a> Checker<'a> {
                 robots,
                 inlining: Vec::new(),
             };
+            self.record_scope(body.span, ScopeKind::Rejected, &scope);
             self.block(body, &scope);
         }
         // Functions nobody calls are still checked, as far as possible without robots.
@@ -193,9 +199,20 @@ impl<'a> Checker<'a> {
                     types: Rc::new([]),
                     inlining: vec![FunctionId(f as u32)],
                 };
+                let span = self.function_syntax[f].span;
+                self.record_scope(span, ScopeKind::Function(FunctionId(f as u32)), &scope);
                 self.block(&self.function_syntax[f].body, &scope);
             }
         }
+    }
+
+    /// Records who runs the statements of `span` (for the IDE).
+    fn record_scope(&mut self, span: Span, kind: ScopeKind, scope: &Scope) {
+        let runners = Runners {
+            team: scope.team,
+            robots: scope.robots.clone(),
+        };
+        self.scope(span, kind, runners);
     }
 
     fn block(&mut self, block: &'a ast::Block, scope: &Scope) {
@@ -300,8 +317,9 @@ impl<'a> Checker<'a> {
             }
             let mut inner = scope.clone();
             inner.inlining.push(function);
-            let body = &self.function_syntax[function.0 as usize].body;
-            self.block(body, &inner);
+            let syntax = self.function_syntax[function.0 as usize];
+            self.record_scope(syntax.span, ScopeKind::Function(function), &inner);
+            self.block(&syntax.body, &inner);
             return;
         }
         self.builtin_call(call, scope);
@@ -951,6 +969,11 @@ impl<'a> Checker<'a> {
                 runners
             };
             let inner = self.narrowed(scope, runners);
+            let kind = ScopeKind::Arm {
+                kind: arm.kind,
+                condition: arm.condition.span,
+            };
+            self.record_scope(arm.body.span, kind, &inner);
             self.block(&arm.body, &inner);
             // A leader is one robot among the members: the others may still run
             // `others`, unless the leader is the only candidate.
@@ -973,6 +996,10 @@ impl<'a> Checker<'a> {
                 );
             }
             let inner = self.narrowed(scope, rest);
+            let kind = ScopeKind::Others {
+                keyword: others.keyword_span,
+            };
+            self.record_scope(others.body.span, kind, &inner);
             self.block(&others.body, &inner);
         }
     }

@@ -26,6 +26,9 @@ pub struct Mission {
     pub messages: Vec<Message>,
     /// Every name written in the file and what it refers to, sorted by position.
     pub occurrences: Vec<Occurrence>,
+    /// The parts of the file whose statements robots run (service and function
+    /// bodies, group arms), outer before inner: see [`Mission::scope_at`].
+    pub scopes: Vec<RobotScope>,
 }
 
 #[derive(Clone, Debug)]
@@ -200,6 +203,51 @@ pub enum Symbol {
     Constant(Name),
 }
 
+/// A part of the file whose statements some robots run, as the checker saw it:
+/// a composite service (header to `repeat`), a function, or the body of a
+/// `group`/`leader` arm or of `others` (run by fewer robots than around it).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RobotScope {
+    pub span: Span,
+    pub kind: ScopeKind,
+    /// Who runs it: one entry per team and set of robots (a function called
+    /// from several places has several; a function nobody calls has one,
+    /// with no team).
+    pub runs: Vec<Runners>,
+    /// The smallest scope around this one (an index into [`Mission::scopes`]).
+    pub parent: Option<u32>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ScopeKind {
+    Service {
+        team: TeamId,
+        service: Index,
+    },
+    Function(FunctionId),
+    /// The body of `group(cond)` or `leader(cond)`; `condition` is `cond`'s range.
+    Arm {
+        kind: ast::ArmKind,
+        condition: Span,
+    },
+    /// The body of `others`; `keyword` is the range of the word.
+    Others {
+        keyword: Span,
+    },
+    /// The body of a definition that was rejected (a duplicate, or of an
+    /// undeclared team): checked, but part of nothing.
+    Rejected,
+}
+
+/// Robots that run a scope: `team` is `None` where they are unknown (a
+/// function that no service calls).
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Runners {
+    pub team: Option<TeamId>,
+    /// Indices into the team's robots.
+    pub robots: Vec<Index>,
+}
+
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Occurrence {
     pub span: Span,
@@ -225,6 +273,20 @@ impl Mission {
             .iter()
             .filter(|o| o.span.touches(offset))
             .min_by_key(|o| o.span.len())
+    }
+
+    /// The innermost scope strictly inside which `offset` lies (after its
+    /// first byte, before its end): O(log n + nesting depth).
+    pub fn scope_at(&self, offset: usize) -> Option<&RobotScope> {
+        let after = self.scopes.partition_point(|s| s.span.start < offset);
+        let mut candidate = after.checked_sub(1)?;
+        loop {
+            let scope = &self.scopes[candidate];
+            if offset < scope.span.end {
+                return Some(scope);
+            }
+            candidate = scope.parent? as usize;
+        }
     }
 
     /// Every occurrence of a symbol (definitions and uses).

@@ -123,6 +123,9 @@ pub(crate) struct Checker<'a> {
     rejected_bodies: Vec<(Option<TeamId>, &'a ast::Block)>,
     /// Each team's robot types (all its robots), for values read across teams.
     team_types: Vec<body::TypeList>,
+    /// Where each scope of `mission.scopes` is, by its range: a function body
+    /// walked for several callers is one scope with several runners.
+    scope_index: HashMap<Span, usize>,
 }
 
 impl<'a> Checker<'a> {
@@ -146,6 +149,7 @@ impl<'a> Checker<'a> {
             inlined: HashSet::new(),
             team_types: Vec::new(),
             rejected_bodies: Vec::new(),
+            scope_index: HashMap::new(),
         }
     }
 
@@ -201,10 +205,48 @@ impl<'a> Checker<'a> {
             .collect()
     }
 
+    /// Records that `runners` run the statements of `span`.
+    fn scope(&mut self, span: Span, kind: ScopeKind, runners: Runners) {
+        let scopes = &mut self.mission.scopes;
+        let index = *self.scope_index.entry(span).or_insert_with(|| {
+            scopes.push(RobotScope {
+                span,
+                kind,
+                runs: Vec::new(),
+                parent: None,
+            });
+            scopes.len() - 1
+        });
+        let runs = &mut scopes[index].runs;
+        if !runs.contains(&runners) {
+            runs.push(runners);
+        }
+    }
+
     fn finish(mut self) -> (Mission, Vec<Diagnostic>) {
         self.mission.occurrences =
             sorted_occurrences(std::mem::take(&mut self.mission.occurrences));
+        nest_scopes(&mut self.mission.scopes);
         (self.mission, self.diagnostics)
+    }
+}
+
+/// Sorts scopes outer before inner (by start, then longest first) and links
+/// each to the smallest scope containing it.
+fn nest_scopes(scopes: &mut [RobotScope]) {
+    scopes.sort_by_key(|s| (s.span.start, std::cmp::Reverse(s.span.end)));
+    let mut open: Vec<usize> = Vec::new();
+    for i in 0..scopes.len() {
+        let span = scopes[i].span;
+        while let Some(&top) = open.last() {
+            let outer = scopes[top].span;
+            if outer.start <= span.start && span.end <= outer.end {
+                break;
+            }
+            open.pop();
+        }
+        scopes[i].parent = open.last().map(|&p| p as u32);
+        open.push(i);
     }
 }
 

@@ -387,4 +387,23 @@ mod tests {
         assert_eq!(one.file, two.file);
         assert_eq!(one.diagnostics, two.diagnostics);
     }
+
+    #[test]
+    fn a_header_being_typed_after_an_item_keeps_the_item() {
+        let text = "T.Action.Go { stop() } repeat()\nT.\nT.main { default: mode = M }";
+        let parse = parse(FileId(0), text);
+        assert_eq!(parse.diagnostics.len(), 1, "{:#?}", parse.diagnostics);
+        let kinds: Vec<&str> = parse
+            .file
+            .items
+            .iter()
+            .map(|i| match i {
+                ast::Item::Service(_) => "service",
+                ast::Item::Error(span) => &text[span.range()],
+                ast::Item::Main(_) => "main",
+                _ => "other",
+            })
+            .collect();
+        assert_eq!(kinds, ["service", "T.", "main"]);
+    }
 }

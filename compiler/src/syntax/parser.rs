@@ -652,9 +652,16 @@ where
             })
         });
 
+    // Text that starts no item, after the items of a chunk (a header being
+    // typed: `Team.`), is one bad item: the items before it are kept.
+    let rest = any()
+        .repeated()
+        .at_least(1)
+        .map_with(|_, e| Item::Error(sp(e.span())));
     choice((formation_block, service, main, mode, function, bare_team))
         .then_ignore(semis)
         .labelled("a team, service, mode, main or function")
+        .recover_with(via_parser(rest))
         .repeated()
         .collect::<Vec<_>>()
 }

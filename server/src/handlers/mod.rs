@@ -2,6 +2,11 @@
 //! a [`Snapshot`](crate::world::Snapshot) and back.
 
 pub mod catalog;
+pub mod code_actions;
+pub mod completion;
+pub mod hover;
+pub mod inlay_hints;
+pub mod signature_help;
 
 use crate::encoding::Encoding;
 use tower_lsp_server::ls_types::*;
@@ -18,6 +23,20 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
                 ..Default::default()
             },
         )),
+        completion_provider: Some(CompletionOptions {
+            trigger_characters: Some([".", "(", "=", ",", ":", "["].map(String::from).to_vec()),
+            ..Default::default()
+        }),
+        hover_provider: Some(HoverProviderCapability::Simple(true)),
+        signature_help_provider: Some(SignatureHelpOptions {
+            trigger_characters: Some(["(", ","].map(String::from).to_vec()),
+            ..Default::default()
+        }),
+        inlay_hint_provider: Some(OneOf::Left(true)),
+        code_action_provider: Some(CodeActionProviderCapability::Options(CodeActionOptions {
+            code_action_kinds: Some(vec![CodeActionKind::QUICKFIX]),
+            ..Default::default()
+        })),
         ..Default::default()
     }
 }

@@ -59,3 +59,5 @@ pub async fn client_with(uri: &str, text: &str) -> TestClient {
     client.diagnostics(uri, Some(1)).await;
     client
 }
+
+pub mod ide;

@@ -1,0 +1,66 @@
+//! `textDocument/codeAction`: the quick fixes of [`semo::ide::code_actions`],
+//! each attached to the diagnostic it fixes.
+//!
+//! Fixes are computed from the snapshot's own diagnostics (so that their
+//! edits match the text the server has); each is attached to the client's
+//! copy of its diagnostic when the request carries it (same code and range),
+//! else to the diagnostic as the server publishes it.
+
+use crate::diagnostics;
+use crate::world::Snapshot;
+use std::collections::HashMap;
+use tower_lsp_server::ls_types::*;
+
+pub fn code_actions(snapshot: &Snapshot, params: &CodeActionParams) -> Option<CodeActionResponse> {
+    if let Some(only) = &params.context.only
+        && !only
+            .iter()
+            .any(|k| *k == CodeActionKind::QUICKFIX || k.as_str().is_empty())
+    {
+        return Some(Vec::new());
+    }
+    let analysis = snapshot.analysis();
+    let mission = analysis.mission.as_ref()?;
+    let lines = snapshot.line_map(&analysis);
+    let span = lines.span(params.range);
+    let catalog = snapshot.catalog.catalog();
+    let actions = semo::ide::code_actions::code_actions(mission, catalog, &snapshot.text, span);
+    if actions.is_empty() {
+        return Some(Vec::new());
+    }
+    let published = diagnostics::to_lsp(snapshot, &analysis, &HashMap::new());
+    let response = actions
+        .into_iter()
+        .filter_map(|action| {
+            let ours = published.get(action.diagnostic)?;
+            let diagnostic = params
+                .context
+                .diagnostics
+                .iter()
+                .find(|d| d.range == ours.range && d.code == ours.code)
+                .unwrap_or(ours)
+                .clone();
+            let edits = action
+                .edits
+                .into_iter()
+                .map(|e| TextEdit {
+                    range: lines.range(e.span),
+                    new_text: e.new_text,
+                })
+                .collect();
+            let edit = WorkspaceEdit {
+                changes: Some(HashMap::from([(snapshot.uri.clone(), edits)])),
+                ..WorkspaceEdit::default()
+            };
+            Some(CodeActionOrCommand::CodeAction(CodeAction {
+                title: action.title,
+                kind: Some(CodeActionKind::QUICKFIX),
+                diagnostics: Some(vec![diagnostic]),
+                edit: Some(edit),
+                is_preferred: Some(action.preferred),
+                ..CodeAction::default()
+            }))
+        })
+        .collect();
+    Some(response)
+}

@@ -1,0 +1,57 @@
+//! Hover through the protocol. Each fixture in `fixtures/hover/` holds a
+//! mission with `$0` cursors; the snapshot shows, for each, the hovered range
+//! and the markdown, or that there is nothing to show.
+
+mod support;
+
+use serde_json::json;
+use support::ide::{Session, positions_past_the_end, show_position};
+use support::text_at;
+
+fn render(session: &mut Session, doc: &support::ide::Doc) -> String {
+    let mut out = String::new();
+    for position in doc.cursors.clone() {
+        let result = session.at("textDocument/hover", doc, &position);
+        out.push_str(&show_position(&doc.text, &position));
+        out.push('\n');
+        if result.is_null() {
+            out.push_str("(nothing)\n\n");
+            continue;
+        }
+        let range = text_at(&doc.text, &result["range"]);
+        assert_eq!(result["contents"]["kind"], "markdown");
+        let markdown = result["contents"]["value"].as_str().unwrap();
+        out.push_str(&format!("hovering `{range}`:\n    "));
+        out.push_str(&markdown.replace('\n', "\n    "));
+        out.push_str("\n\n");
+    }
+    out
+}
+
+#[test]
+fn hover_fixtures() {
+    let mut session = Session::new();
+    insta::glob!("fixtures/hover/*.mission", |path| {
+        let doc = session.open_fixture(path);
+        assert!(!doc.cursors.is_empty(), "a fixture needs a $0 cursor");
+        insta::assert_snapshot!(render(&mut session, &doc));
+    });
+    session.shutdown();
+}
+
+/// Past the end of the text, in an empty file and on blank space: no hover,
+/// and no error.
+#[test]
+fn nothing_to_hover() {
+    let mut session = Session::new();
+    for text in ["", "{ T: iRobotCreate r }\n\n", "T.Action.Go{ mvoe( }"] {
+        let doc = session.open("empty.mission", text);
+        let mut positions = positions_past_the_end(&doc.text).to_vec();
+        positions.push(json!({ "line": 1, "character": 0 }));
+        for position in positions {
+            let result = session.at("textDocument/hover", &doc, &position);
+            assert!(result.is_null(), "{text:?} at {position}: {result}");
+        }
+    }
+    session.shutdown();
+}
