@@ -10,6 +10,9 @@ pub fn completion(
     config: CompletionConfig,
 ) -> Option<CompletionResponse> {
     let analysis = snapshot.analysis();
+    if analysis.graph.is_some() {
+        return super::taskgraph::completion(snapshot, &analysis, position);
+    }
     let mission = analysis.mission.as_ref()?;
     let lines = snapshot.line_map(&analysis);
     let offset = lines.offset(position);

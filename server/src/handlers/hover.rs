@@ -5,6 +5,9 @@ use tower_lsp_server::ls_types::*;
 
 pub fn hover(snapshot: &Snapshot, position: Position) -> Option<Hover> {
     let analysis = snapshot.analysis();
+    if analysis.graph.is_some() {
+        return super::taskgraph::hover(snapshot, &analysis, position);
+    }
     let mission = analysis.mission.as_ref()?;
     let lines = snapshot.line_map(&analysis);
     let offset = lines.offset(position);

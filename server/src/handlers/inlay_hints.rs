@@ -6,6 +6,9 @@ use tower_lsp_server::ls_types::*;
 
 pub fn inlay_hints(snapshot: &Snapshot, range: Range) -> Option<Vec<InlayHint>> {
     let analysis = snapshot.analysis();
+    if analysis.graph.is_some() {
+        return Some(super::taskgraph::inlay_hints(snapshot, &analysis, range));
+    }
     let mission = analysis.mission.as_ref()?;
     let lines = snapshot.line_map(&analysis);
     let span = lines.span(range);

@@ -7,6 +7,7 @@ pub mod completion;
 pub mod hover;
 pub mod inlay_hints;
 pub mod signature_help;
+pub mod taskgraph;
 
 use crate::encoding::Encoding;
 use tower_lsp_server::ls_types::*;
@@ -24,7 +25,12 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
             },
         )),
         completion_provider: Some(CompletionOptions {
-            trigger_characters: Some([".", "(", "=", ",", ":", "["].map(String::from).to_vec()),
+            // `"` opens a value in task-graph files (`src="`).
+            trigger_characters: Some(
+                [".", "(", "=", ",", ":", "[", "\""]
+                    .map(String::from)
+                    .to_vec(),
+            ),
             ..Default::default()
         }),
         hover_provider: Some(HoverProviderCapability::Simple(true)),
