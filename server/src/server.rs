@@ -243,6 +243,11 @@ impl LanguageServer for Backend {
         .await
     }
 
+    async fn formatting(&self, p: DocumentFormattingParams) -> Result<Option<Vec<TextEdit>>> {
+        self.on_snapshot(&p.text_document.uri, handlers::formatting::formatting)
+            .await?
+    }
+
     async fn hover(&self, p: HoverParams) -> Result<Option<Hover>> {
         let position = p.text_document_position_params.position;
         self.on_snapshot(

@@ -4,6 +4,7 @@
 pub mod catalog;
 pub mod code_actions;
 pub mod completion;
+pub mod formatting;
 pub mod hover;
 pub mod inlay_hints;
 pub mod signature_help;
@@ -16,6 +17,7 @@ use tower_lsp_server::ls_types::*;
 pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
     ServerCapabilities {
         position_encoding: Some(encoding.kind()),
+        document_formatting_provider: Some(OneOf::Left(true)),
         text_document_sync: Some(TextDocumentSyncCapability::Options(
             TextDocumentSyncOptions {
                 open_close: Some(true),
