@@ -31,7 +31,10 @@ async def client(lsp_client: LanguageClient):
                 ),
                 text_document=types.TextDocumentClientCapabilities(
                     completion=types.CompletionClientCapabilities(
-                        completion_item=types.ClientCompletionItemOptions(snippet_support=True)
+                        completion_item=types.ClientCompletionItemOptions(
+                            snippet_support=True,
+                            documentation_format=[types.MarkupKind.Markdown],
+                        )
                     )
                 ),
             )
@@ -84,3 +87,22 @@ async def test_a_mission_with_an_error_gets_its_diagnostic_then_a_fix_clears_it(
         )
     )
     assert list(await diagnostics_for_version(client, 2)) == []
+
+
+async def test_completion_offers_the_services_the_robots_have(client: LanguageClient):
+    text = MISSION.replace('mvoe("1,1")', "mo")
+    open_mission(client, text)
+    await diagnostics_for_version(client, 1)
+    result = await client.text_document_completion_async(
+        types.CompletionParams(
+            text_document=types.TextDocumentIdentifier(uri=URI),
+            position=types.Position(line=4, character=4),
+        )
+    )
+    items = result.items if isinstance(result, types.CompletionList) else result
+    labels = [item.label for item in items]
+    assert "move" in labels
+    move = next(item for item in items if item.label == "move")
+    # Snippets were offered by this client: the parameters are placeholders.
+    assert move.insert_text_format == types.InsertTextFormat.Snippet
+    assert move.text_edit.new_text.startswith("move($1")
