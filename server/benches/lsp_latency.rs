@@ -1,8 +1,10 @@
 //! The language server driven in-process on a 10k-line mission: time from a
 //! one-character `didChange` to its `publishDiagnostics` (p50/p99 over 1,000
-//! edits), and the resident memory at the end. Run with
+//! edits), completion latency (p50/p99 over 1,000 requests), and the
+//! resident memory at the end. Run with
 //! `cargo bench -p semo-server --bench lsp_latency`.
-//! Targets on a 2-core machine: p99 edit-to-diagnostics ≤ 10 ms, RSS ≤ 60 MB.
+//! Targets on a 2-core machine: p99 edit-to-diagnostics ≤ 10 ms, completion
+//! p99 ≤ 5 ms, RSS ≤ 60 MB.
 
 #[path = "../../compiler/benches/common/mission.rs"]
 mod mission;
@@ -63,6 +65,36 @@ async fn run() {
         latencies.push(start.elapsed());
     }
     report("edit → diagnostics", &mut latencies);
+
+    // Completion inside statements all over the file (the analysis exists).
+    let spots: Vec<(usize, usize)> = text
+        .lines()
+        .enumerate()
+        .filter_map(|(i, line)| {
+            let indent = line.len() - line.trim_start().len();
+            let t = line.trim_start();
+            (t.starts_with("move(") || t.starts_with("stop()") || t.starts_with("light_on()"))
+                .then_some((i, indent + 2))
+        })
+        .collect();
+    let mut completions = Vec::with_capacity(1000);
+    for i in 0..1000 {
+        let (line, character) = spots[(i * 7919) % spots.len()];
+        let start = Instant::now();
+        let items = client
+            .request(
+                "textDocument/completion",
+                json!({
+                    "textDocument": { "uri": URI },
+                    "position": { "line": line, "character": character }
+                }),
+            )
+            .await
+            .expect("completion answers");
+        completions.push(start.elapsed());
+        assert!(!items["items"].as_array().expect("a list").is_empty());
+    }
+    report("completion", &mut completions);
     println!("peak RSS: {:.1} MB", peak_rss_kb() as f64 / 1024.0);
     client.shutdown().await;
 }

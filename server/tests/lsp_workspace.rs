@@ -122,3 +122,55 @@ async fn workspace_files_are_indexed_and_catalog_changes_recheck_missions() {
     client.shutdown().await;
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_catalog_request_lists_builtin_and_workspace_robot_types_and_follows_changes() {
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], None).await;
+    let names = |catalog: &Value| -> Vec<String> {
+        catalog["robots"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r["name"].as_str().unwrap().to_string())
+            .collect()
+    };
+    let builtin = client.request("semo/catalog", json!({})).await.unwrap();
+    assert!(names(&builtin).contains(&"iRobotCreate".to_string()));
+    assert!(!names(&builtin).contains(&"Rover".to_string()));
+    let create = builtin["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["name"] == "iRobotCreate")
+        .unwrap();
+    let mv = create["services"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == "move")
+        .unwrap();
+    assert!(
+        mv["signature"].as_str().unwrap().starts_with("move("),
+        "{mv}"
+    );
+    assert!(!create["values"].as_array().unwrap().is_empty());
+    assert_eq!(builtin["user"]["name"], "USER");
+
+    // A catalog file opened in the editor adds its type at once.
+    client
+        .notify(
+            "textDocument/didOpen",
+            json!({ "textDocument": { "uri": "file:///w/rover.robot.xml", "languageId": "xml", "version": 1, "text": CATALOG } }),
+        )
+        .await;
+    let with_rover = client.request("semo/catalog", json!({})).await.unwrap();
+    let rover = with_rover["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["name"] == "Rover");
+    let rover = rover.unwrap_or_else(|| panic!("{:?}", names(&with_rover)));
+    assert_eq!(rover["services"][0]["name"], "dig");
+    client.shutdown().await;
+}
