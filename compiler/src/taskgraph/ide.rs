@@ -6,45 +6,10 @@
 
 use crate::span::Span;
 use crate::taskgraph::analysis::{GraphReport, LevelReport};
-use crate::taskgraph::model::{Channel, Direction, LoopType, Task, TaskGraph, TaskKind, Trigger};
+use crate::taskgraph::model::{
+    Channel, Direction, LevelRef, LoopType, Task, TaskGraph, TaskKind, Trigger,
+};
 use std::fmt::Write;
-
-/// One level of the hierarchy: its graph, its path (as in the report) and the
-/// loop node whose body it is.
-struct LevelRef<'g> {
-    path: String,
-    graph: &'g TaskGraph,
-    enclosing: Option<&'g Task>,
-}
-
-/// Every level, outermost first, in the order of `GraphReport::levels`.
-fn levels(graph: &TaskGraph) -> Vec<LevelRef<'_>> {
-    fn collect<'g>(
-        graph: &'g TaskGraph,
-        enclosing: Option<&'g Task>,
-        path: String,
-        out: &mut Vec<LevelRef<'g>>,
-    ) {
-        out.push(LevelRef {
-            path: path.clone(),
-            graph,
-            enclosing,
-        });
-        for task in &graph.tasks {
-            if let Some(l) = &task.loop_node {
-                collect(
-                    &l.body,
-                    Some(task),
-                    format!("{path}/{}", task.name.name),
-                    out,
-                );
-            }
-        }
-    }
-    let mut out = Vec::new();
-    collect(graph, None, graph.name.clone(), &mut out);
-    out
-}
 
 fn level_report<'r>(report: &'r GraphReport, path: &str) -> Option<&'r LevelReport> {
     report.levels.iter().find(|l| l.path == path)
@@ -67,7 +32,7 @@ pub struct Hover {
 /// What is under `offset`: a channel endpoint, a port, or a task (by its name
 /// or anywhere in its element outside ports and inner graphs).
 pub fn hover(graph: &TaskGraph, report: &GraphReport, offset: usize) -> Option<Hover> {
-    let levels = levels(graph);
+    let levels = graph.levels();
     // Innermost level first: a body's elements lie inside its loop's element.
     for level in levels.iter().rev() {
         for channel in &level.graph.channels {
@@ -235,7 +200,7 @@ pub struct InlayHint {
 /// `×N` after the name of every task of a consistent level.
 pub fn inlay_hints(graph: &TaskGraph, report: &GraphReport) -> Vec<InlayHint> {
     let mut hints = Vec::new();
-    for level in levels(graph) {
+    for level in graph.levels() {
         for task in &level.graph.tasks {
             if let Some(n) = repetition(report, &level.path, &task.name.name) {
                 hints.push(InlayHint {
@@ -274,7 +239,7 @@ pub fn complete_endpoint(
         Direction::In
     };
     // The innermost level whose element holds the cursor.
-    let all = levels(graph);
+    let all = graph.levels();
     let level = all
         .iter()
         .rev()

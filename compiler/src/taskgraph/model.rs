@@ -29,6 +29,45 @@ impl TaskGraph {
     pub fn task_index(&self, name: &str) -> Option<usize> {
         self.tasks.iter().position(|t| t.name.name == name)
     }
+
+    /// This graph and every loop body nested in it, outermost first (the
+    /// order of the analyses' levels), each with its path (`kmeans/Converge`).
+    pub fn levels(&self) -> Vec<LevelRef<'_>> {
+        fn collect<'g>(
+            graph: &'g TaskGraph,
+            enclosing: Option<&'g Task>,
+            path: String,
+            out: &mut Vec<LevelRef<'g>>,
+        ) {
+            out.push(LevelRef {
+                path: path.clone(),
+                graph,
+                enclosing,
+            });
+            for task in &graph.tasks {
+                if let Some(l) = &task.loop_node {
+                    collect(
+                        &l.body,
+                        Some(task),
+                        format!("{path}/{}", task.name.name),
+                        out,
+                    );
+                }
+            }
+        }
+        let mut out = Vec::new();
+        collect(self, None, self.name.clone(), &mut out);
+        out
+    }
+}
+
+/// One level of a graph's hierarchy: its tasks and channels, its path, and
+/// the loop node whose body it is.
+#[derive(Clone, Debug)]
+pub struct LevelRef<'g> {
+    pub path: String,
+    pub graph: &'g TaskGraph,
+    pub enclosing: Option<&'g Task>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

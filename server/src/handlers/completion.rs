@@ -30,25 +30,39 @@ pub fn completion(
                     value,
                 })
             }),
-            // The library's order, most specific first.
-            sort_text: Some(format!("{i:05}")),
-            filter_text: Some(item.label.clone()),
             insert_text_format: Some(match item.snippet {
                 true => InsertTextFormat::SNIPPET,
                 false => InsertTextFormat::PLAIN_TEXT,
             }),
-            text_edit: Some(CompletionTextEdit::Edit(TextEdit {
-                range: lines.range(item.replace),
-                new_text: item.insert,
-            })),
-            label: item.label,
-            ..CompletionItem::default()
+            ..in_order(i, item.label, lines.range(item.replace), item.insert)
         })
         .collect();
-    Some(CompletionResponse::List(CompletionList {
+    Some(list(items))
+}
+
+/// An item that replaces `range` by `new_text`, kept in the library's order
+/// (most specific first) rather than the editor's alphabetical one.
+pub(super) fn in_order(
+    index: usize,
+    label: String,
+    range: Range,
+    new_text: String,
+) -> CompletionItem {
+    CompletionItem {
+        sort_text: Some(format!("{index:05}")),
+        filter_text: Some(label.clone()),
+        text_edit: Some(CompletionTextEdit::Edit(TextEdit { range, new_text })),
+        label,
+        ..CompletionItem::default()
+    }
+}
+
+/// A complete list: the server sends every candidate, the editor filters.
+pub(super) fn list(items: Vec<CompletionItem>) -> CompletionResponse {
+    CompletionResponse::List(CompletionList {
         is_incomplete: false,
         items,
-    }))
+    })
 }
 
 fn kind(kind: CompletionKind) -> CompletionItemKind {

@@ -45,20 +45,10 @@ pub fn completion(
         .map(|(i, item)| CompletionItem {
             kind: Some(CompletionItemKind::FIELD),
             detail: Some(item.detail),
-            sort_text: Some(format!("{i:05}")),
-            filter_text: Some(item.label.clone()),
-            text_edit: Some(CompletionTextEdit::Edit(TextEdit {
-                range,
-                new_text: item.label.clone(),
-            })),
-            label: item.label,
-            ..CompletionItem::default()
+            ..super::completion::in_order(i, item.label.clone(), range, item.label)
         })
         .collect();
-    Some(CompletionResponse::List(CompletionList {
-        is_incomplete: false,
-        items,
-    }))
+    Some(super::completion::list(items))
 }
 
 pub fn inlay_hints(snapshot: &Snapshot, analysis: &FileAnalysis, range: Range) -> Vec<InlayHint> {

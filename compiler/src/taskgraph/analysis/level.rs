@@ -129,27 +129,10 @@ impl<'g> Level<'g> {
 
     /// This level and every level nested in its loop nodes, outermost first.
     pub fn all(graph: &'g TaskGraph) -> Vec<Level<'g>> {
-        let mut levels = Vec::new();
-        collect(graph, None, graph.name.clone(), &mut levels);
-        levels
-    }
-}
-
-fn collect<'g>(
-    graph: &'g TaskGraph,
-    enclosing: Option<&'g Task>,
-    path: String,
-    out: &mut Vec<Level<'g>>,
-) {
-    out.push(Level::build(graph, enclosing, path.clone()));
-    for task in &graph.tasks {
-        if let Some(l) = &task.loop_node {
-            collect(
-                &l.body,
-                Some(task),
-                format!("{path}/{}", task.name.name),
-                out,
-            );
-        }
+        graph
+            .levels()
+            .into_iter()
+            .map(|l| Level::build(l.graph, l.enclosing, l.path))
+            .collect()
     }
 }
