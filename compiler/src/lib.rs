@@ -5,12 +5,15 @@
 //! - [`syntax`]: lexer and parser (chumsky) from text to a positioned AST; never panics.
 //! - [`catalog`]: robot types from the built-in catalog and `*.robot.xml` files.
 //! - [`sema`]: name resolution and checks, producing the [`sema::Mission`] IR.
+//! - [`ide`]: editor features over an analysis (navigation, rename, outline,
+//!   highlighting, folding, selection), in byte ranges, for the language server.
 //! - [`workspace`]: loading files and folders from disk for the CLI.
 //! - [`cli`]: the `semo` command (rendering with ariadne or JSON).
 
 pub mod catalog;
 pub mod cli;
 pub mod diag;
+pub mod ide;
 pub mod sema;
 pub mod span;
 pub mod suggest;
