@@ -15,6 +15,8 @@ pub mod selection;
 pub mod semantic_tokens;
 pub mod symbols;
 
+#[cfg(test)]
+mod latency;
 mod lookup;
 #[cfg(test)]
 mod testing;
