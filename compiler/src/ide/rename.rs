@@ -5,7 +5,9 @@
 //!
 //! A mission is self-contained: a team `Base` in another mission is another
 //! team, so a rename changes one file, every name in it that means the
-//! renamed symbol. When one of those names also means another symbol (a
+//! renamed symbol. (Strategy files, `<Team>.strategy.xml`, also name teams,
+//! plans and robots; the server does not read them yet, so they are not
+//! renamed.) When one of those names also means another symbol (a
 //! function called by two teams raises an event of each with one `throw`),
 //! that symbol is renamed too, so the file keeps its meaning; if it cannot be
 //! renamed, neither can the first.
