@@ -112,8 +112,8 @@ pub fn references(analysis: &Analysis, offset: usize) -> Vec<Reference> {
         for span in uses.chain(definitions.iter().copied()) {
             refs.push(Reference {
                 span,
-                is_definition: definitions.contains(&span),
-                access: if writes.contains(&span) {
+                is_definition: definitions.binary_search(&span).is_ok(),
+                access: if writes.binary_search(&span).is_ok() {
                     Access::Write
                 } else {
                     Access::Read
@@ -155,8 +155,8 @@ pub(crate) fn definition_spans(analysis: &Analysis, symbol: &Symbol) -> Vec<Span
     spans
 }
 
-/// The spans where `symbol` is given a value: its definitions, and for a team
-/// variable also where it is received.
+/// The spans where `symbol` is given a value, sorted: its definitions, and
+/// for a team variable also where it is received.
 fn write_spans(analysis: &Analysis, symbol: &Symbol, definitions: &[Span]) -> Vec<Span> {
     let mut writes = definitions.to_vec();
     if matches!(symbol, Symbol::TeamVariable { .. }) {
@@ -168,6 +168,7 @@ fn write_spans(analysis: &Analysis, symbol: &Symbol, definitions: &[Span]) -> Ve
                 .map(|o| o.span)
                 .filter(|s| incoming.binary_search(s).is_ok()),
         );
+        writes.sort();
     }
     writes
 }

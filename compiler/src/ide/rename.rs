@@ -76,20 +76,23 @@ pub fn rename(
     let mission = &analysis.mission;
     // The symbols to rename: those of the name, and those sharing a name with
     // one of them (closure), each checked.
+    let first = name.symbols.len();
     let mut symbols = name.symbols;
     let mut spans: Vec<Span> = Vec::new();
     let mut next = 0;
     while let Some(symbol) = symbols.get(next).cloned() {
         next += 1;
-        renamable(&symbol)?;
+        renamable(&symbol).map_err(|e| match next > first {
+            true => RenameError(format!(
+                "{e} (a function body here is shared with another team, for which this name means that)"
+            )),
+            false => e,
+        })?;
         if let Some(clash) = clash(analysis, catalog, text, &symbol, new_name) {
             return refuse(clash);
         }
         let uses = mission.occurrences_of(&symbol).map(|o| o.span);
         for span in uses.chain(navigation::definition_spans(analysis, &symbol)) {
-            if spans.contains(&span) {
-                continue;
-            }
             spans.push(span);
             for o in lookup::with_span(mission, span) {
                 if !symbols.contains(&o.symbol) {
@@ -99,6 +102,7 @@ pub fn rename(
         }
     }
     spans.sort();
+    spans.dedup();
     Ok(spans)
 }
 
@@ -446,6 +450,25 @@ Guards.main { case (GO): catch (alarm): mode = GO catch (home): mode = GO defaul
                 (_, Err(e)) => assert!(e.contains(message), "{marker} -> {new}: {e}"),
             }
         }
+    }
+
+    #[test]
+    fn refuses_a_name_that_a_shared_function_gives_another_meaning() {
+        // In `f`, `COLOR` is team A's variable but team B's robot value.
+        let f = Fixture::new(
+            r#"{ A: iRobotCreate a  B: NXTLego b }
+def f { if (COLOR == "red") stop() }
+A.P.S { publish(A, A.COLOR = "red") f() } repeat()
+B.P.S { f() } repeat()
+A.M { set(P, S) }
+B.M { set(P, S) }
+A.main { default: mode = M }
+B.main { default: mode = M }
+"#,
+        );
+        let error = renamed(&f, "COLOR = ", "SHADE").unwrap_err();
+        assert!(error.contains("`COLOR` is a robot value"), "{error}");
+        assert!(error.contains("shared with another team"), "{error}");
     }
 
     #[test]
