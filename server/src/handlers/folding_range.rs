@@ -3,14 +3,21 @@
 
 use crate::world::Snapshot;
 use semo::ide::folding::{self, FoldKind};
+use semo::text::ColumnUnit;
 use tower_lsp_server::ls_types::{FoldingRange, FoldingRangeKind};
 
 pub fn folding_range(snapshot: &Snapshot) -> Option<Vec<FoldingRange>> {
     super::with_mission(snapshot, |analysis, lines| {
+        // Whole lines: no column to count in the client's encoding.
+        let line = |offset| {
+            lines
+                .index
+                .line_col(lines.text, offset, ColumnUnit::Utf8)
+                .line
+        };
         let mut ranges: Vec<FoldingRange> = Vec::new();
         for fold in folding::folding_ranges(analysis, &snapshot.text) {
-            let start_line = lines.position(fold.span.start).line;
-            let end_line = lines.position(fold.span.end).line;
+            let (start_line, end_line) = (line(fold.span.start), line(fold.span.end));
             let duplicate = ranges
                 .iter()
                 .rev()
