@@ -1,4 +1,4 @@
-//! The parser and checker never panic, whatever the input: random bytes, random
+//! The parser, the checker and the editor features never panic, whatever the input: random bytes, random
 //! token soups, and random line mutations (delete, duplicate, swap) of the
 //! reference examples; nor does the strategy loader and cross checker on
 //! damaged strategy XML. Thousands of cases run in the normal test run; the
@@ -52,6 +52,48 @@ fn check_never_panics(text: &str) {
     }
     for o in &analysis.mission.occurrences {
         assert!(o.span.end <= text.len(), "{o:?}");
+    }
+    ide_never_panics(text, &analysis);
+}
+
+/// The editor features on the analysis, at a spread of offsets (past the end
+/// too): no panic, and their ranges lie inside the text, sorted or nested.
+fn ide_never_panics(text: &str, analysis: &semo::Analysis) {
+    use semo::ide::*;
+    let inside = |s: semo::span::Span| s.start <= s.end && s.end <= text.len();
+    let tokens = semantic_tokens::semantic_tokens(analysis, None);
+    assert!(tokens.iter().all(|t| inside(t.span)));
+    assert!(tokens.windows(2).all(|w| w[0].span.end <= w[1].span.start));
+    assert!(
+        folding::folding_ranges(analysis, text)
+            .iter()
+            .all(|f| inside(f.span))
+    );
+    let outline = symbols::document_symbols(analysis, text);
+    assert!(
+        outline
+            .iter()
+            .all(|s| inside(s.span) && inside(s.name_span))
+    );
+    symbols::workspace_symbols(analysis, "a");
+    let step = text.len() / 7 + 1;
+    for offset in (0..text.len() + 2).step_by(step) {
+        navigation::definition(analysis, catalog(), offset);
+        assert!(
+            navigation::references(analysis, offset)
+                .iter()
+                .all(|r| inside(r.span))
+        );
+        let _ = rename::prepare_rename(analysis, text, offset);
+        if let Ok(spans) = rename::rename(analysis, catalog(), text, offset, "renamed") {
+            assert!(spans.iter().all(|s| inside(*s)));
+        }
+        let chain = selection::selection_ranges(analysis, text, offset);
+        assert!(
+            chain
+                .windows(2)
+                .all(|w| w[1].start <= w[0].start && w[0].end <= w[1].end)
+        );
     }
 }
 

@@ -9,7 +9,8 @@
 //!   against the catalog and the Mission IR.
 //! - [`format`]: the canonical layout of mission scripts (`semo fmt`), from the
 //!   tokens and the syntax tree.
-//! - [`ide`]: editor features over an analysis (completion, hover, ...), as plain data.
+//! - [`ide`]: editor features over an analysis (completion, hover, navigation, rename,
+//!   outline, highlighting, folding, selection), as plain data in byte ranges.
 //! - [`workspace`]: loading files and folders from disk for the CLI.
 //! - [`cli`]: the `semo` command (rendering with ariadne or JSON).
 

@@ -279,4 +279,117 @@ impl LanguageServer for Backend {
         self.on_snapshot(&uri, move |s| handlers::code_actions::code_actions(s, &p))
             .await
     }
+
+    // Navigation and structure.
+
+    async fn goto_definition(
+        &self,
+        p: GotoDefinitionParams,
+    ) -> Result<Option<GotoDefinitionResponse>> {
+        let at = p.text_document_position_params;
+        let found = self
+            .on_snapshot(&at.text_document.uri, move |s| {
+                handlers::definition::definition(s, at.position)
+            })
+            .await?;
+        let world = self.state.world();
+        Ok(handlers::definition::response(found, |id| {
+            world.uri_of(id).cloned()
+        }))
+    }
+
+    async fn references(&self, p: ReferenceParams) -> Result<Option<Vec<Location>>> {
+        let uri = p.text_document_position.text_document.uri.clone();
+        self.on_snapshot(&uri, move |s| handlers::references::references(s, &p))
+            .await
+    }
+
+    async fn document_highlight(
+        &self,
+        p: DocumentHighlightParams,
+    ) -> Result<Option<Vec<DocumentHighlight>>> {
+        let at = p.text_document_position_params;
+        self.on_snapshot(&at.text_document.uri, move |s| {
+            handlers::document_highlight::document_highlight(s, at.position)
+        })
+        .await
+    }
+
+    async fn prepare_rename(
+        &self,
+        p: TextDocumentPositionParams,
+    ) -> Result<Option<PrepareRenameResponse>> {
+        self.on_snapshot(&p.text_document.uri, move |s| {
+            handlers::prepare_rename::prepare_rename(s, p.position)
+        })
+        .await?
+    }
+
+    async fn rename(&self, p: RenameParams) -> Result<Option<WorkspaceEdit>> {
+        let uri = p.text_document_position.text_document.uri.clone();
+        self.on_snapshot(&uri, move |s| handlers::rename::rename(s, &p))
+            .await?
+    }
+
+    async fn document_symbol(
+        &self,
+        p: DocumentSymbolParams,
+    ) -> Result<Option<DocumentSymbolResponse>> {
+        self.on_snapshot(
+            &p.text_document.uri,
+            handlers::document_symbol::document_symbol,
+        )
+        .await
+    }
+
+    async fn symbol(&self, p: WorkspaceSymbolParams) -> Result<Option<WorkspaceSymbolResponse>> {
+        let snapshots: Vec<Arc<Snapshot>> = self.state.world().snapshots().cloned().collect();
+        let found = tokio::task::spawn_blocking(move || {
+            handlers::workspace_symbol::workspace_symbol(&snapshots, &p.query)
+        })
+        .await
+        .map_err(|_| Error::internal_error())?;
+        Ok(Some(WorkspaceSymbolResponse::Flat(found)))
+    }
+
+    async fn semantic_tokens_full(
+        &self,
+        p: SemanticTokensParams,
+    ) -> Result<Option<SemanticTokensResult>> {
+        let tokens = self
+            .on_snapshot(&p.text_document.uri, |s| {
+                handlers::semantic_tokens::semantic_tokens(s, None)
+            })
+            .await?;
+        Ok(tokens.map(SemanticTokensResult::Tokens))
+    }
+
+    async fn semantic_tokens_range(
+        &self,
+        p: SemanticTokensRangeParams,
+    ) -> Result<Option<SemanticTokensRangeResult>> {
+        let range = p.range;
+        let tokens = self
+            .on_snapshot(&p.text_document.uri, move |s| {
+                handlers::semantic_tokens::semantic_tokens(s, Some(range))
+            })
+            .await?;
+        Ok(tokens.map(SemanticTokensRangeResult::Tokens))
+    }
+
+    async fn folding_range(&self, p: FoldingRangeParams) -> Result<Option<Vec<FoldingRange>>> {
+        self.on_snapshot(&p.text_document.uri, handlers::folding_range::folding_range)
+            .await
+    }
+
+    async fn selection_range(
+        &self,
+        p: SelectionRangeParams,
+    ) -> Result<Option<Vec<SelectionRange>>> {
+        let positions = p.positions;
+        self.on_snapshot(&p.text_document.uri, move |s| {
+            handlers::selection_range::selection_range(s, &positions)
+        })
+        .await
+    }
 }

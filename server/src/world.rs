@@ -242,6 +242,11 @@ impl World {
         self.files.keys()
     }
 
+    /// The current snapshot of every file the server knows.
+    pub fn snapshots(&self) -> impl Iterator<Item = &Arc<Snapshot>> {
+        self.files.values().map(|f| &f.snapshot)
+    }
+
     pub fn catalog(&mut self) -> Arc<CatalogState> {
         if let Some(c) = &self.catalog {
             return c.clone();

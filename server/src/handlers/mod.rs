@@ -4,13 +4,26 @@
 pub mod catalog;
 pub mod code_actions;
 pub mod completion;
+pub mod definition;
+pub mod document_highlight;
+pub mod document_symbol;
+pub mod folding_range;
 pub mod formatting;
 pub mod hover;
 pub mod inlay_hints;
+pub mod prepare_rename;
+pub mod references;
+pub mod rename;
+pub mod selection_range;
+pub mod semantic_tokens;
 pub mod signature_help;
 pub mod taskgraph;
+pub mod workspace_symbol;
 
-use crate::encoding::Encoding;
+use crate::encoding::{Encoding, LineMap};
+use crate::world::Snapshot;
+use semo::Analysis;
+use tower_lsp_server::jsonrpc;
 use tower_lsp_server::ls_types::*;
 
 /// What this server can do, announced at `initialize`.
@@ -45,6 +58,47 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
             code_action_kinds: Some(vec![CodeActionKind::QUICKFIX]),
             ..Default::default()
         })),
+        // Navigation and structure.
+        definition_provider: Some(OneOf::Left(true)),
+        references_provider: Some(OneOf::Left(true)),
+        document_highlight_provider: Some(OneOf::Left(true)),
+        rename_provider: Some(OneOf::Right(RenameOptions {
+            prepare_provider: Some(true),
+            work_done_progress_options: WorkDoneProgressOptions::default(),
+        })),
+        document_symbol_provider: Some(OneOf::Left(true)),
+        workspace_symbol_provider: Some(OneOf::Left(true)),
+        semantic_tokens_provider: Some(SemanticTokensServerCapabilities::SemanticTokensOptions(
+            SemanticTokensOptions {
+                legend: semantic_tokens::legend(),
+                range: Some(true),
+                full: Some(SemanticTokensFullOptions::Bool(true)),
+                ..Default::default()
+            },
+        )),
+        folding_range_provider: Some(FoldingRangeProviderCapability::Simple(true)),
+        selection_range_provider: Some(SelectionRangeProviderCapability::Simple(true)),
         ..Default::default()
+    }
+}
+
+/// Runs `f` on the analysed mission of a snapshot; `None` for files that are
+/// not missions (catalogs, task graphs).
+pub fn with_mission<T>(
+    snapshot: &Snapshot,
+    f: impl FnOnce(&Analysis, LineMap<'_>) -> T,
+) -> Option<T> {
+    let analysis = snapshot.analysis();
+    let mission = analysis.mission.as_ref()?;
+    Some(f(mission, snapshot.line_map(&analysis)))
+}
+
+/// The protocol's `RequestFailed`: a valid request that cannot be carried
+/// out, with the reason for the user.
+pub fn request_failed(message: String) -> jsonrpc::Error {
+    jsonrpc::Error {
+        code: jsonrpc::ErrorCode::ServerError(-32803),
+        message: message.into(),
+        data: None,
     }
 }

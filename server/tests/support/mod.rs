@@ -2,6 +2,8 @@
 //! one document open.
 #![allow(dead_code)] // each test file uses its own part
 
+pub mod render;
+
 use semo_server::harness::TestClient;
 use serde_json::{Value, json};
 
