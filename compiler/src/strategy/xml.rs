@@ -182,6 +182,25 @@ impl Reader<'_> {
         out
     }
 
+    /// An element with no attributes of its own around a list of `child`
+    /// elements (`<ActionInfo>` around `<Action>`s): each child read by `read`.
+    fn entries<'e, T>(
+        &mut self,
+        wrapper: &'e Elem,
+        child: &str,
+        mut read: impl FnMut(&mut Self, &'e Elem) -> T,
+    ) -> Vec<T> {
+        self.check_attributes(wrapper, &[]);
+        let children = self.children(wrapper, &[child]);
+        children.into_iter().map(|c| read(self, c)).collect()
+    }
+
+    /// An element with attributes among `allowed` and no children.
+    fn leaf(&mut self, e: &Elem, allowed: &[&str]) {
+        self.check_attributes(e, allowed);
+        self.children(e, &[]);
+    }
+
     /// At most one child named `name` among `children`: E085 for the others.
     fn at_most_one<'e>(&mut self, children: &[&'e Elem], name: &str) -> Option<&'e Elem> {
         let mut found = children.iter().filter(|c| c.local == name);
@@ -418,32 +437,22 @@ impl Reader<'_> {
         for section in children {
             match section.local.as_str() {
                 "ValueInfo" => {
-                    self.check_attributes(section, &[]);
-                    for v in self.children(section, &["Value"]) {
-                        let value = self.value(v);
-                        strategy.values.push(value);
-                    }
+                    let values = self.entries(section, "Value", Self::value);
+                    strategy.values.extend(values);
                 }
                 "ServiceInfo" => {
-                    self.check_attributes(section, &[]);
-                    for s in self.children(section, &["Service"]) {
-                        let service = self.service(s);
-                        strategy.services.push(service);
-                    }
+                    let services = self.entries(section, "Service", Self::service);
+                    strategy.services.extend(services);
                 }
                 "GroupingInfo" => {
                     let grouping = self.grouping(section);
                     strategy.grouping = strategy.grouping.take().or(Some(grouping));
                 }
                 _ => {
-                    self.check_attributes(section, &[]);
-                    for b in self.children(section, &["BatteryRequirement"]) {
-                        self.check_attributes(b, &[]);
-                        for c in self.children(b, &["Condition"]) {
-                            let rule = self.battery_rule(c);
-                            strategy.battery_rules.push(rule);
-                        }
-                    }
+                    let rules = self.entries(section, "BatteryRequirement", |r, b| {
+                        r.entries(b, "Condition", Self::battery_rule)
+                    });
+                    strategy.battery_rules.extend(rules.into_iter().flatten());
                 }
             }
         }
@@ -451,8 +460,7 @@ impl Reader<'_> {
     }
 
     fn target(&mut self, e: &Elem) -> TargetRobot {
-        self.check_attributes(e, TARGET_ATTRS);
-        self.children(e, &[]);
+        self.leaf(e, TARGET_ATTRS);
         let name = self.required(e, "name");
         let name = self.ident(name);
         let nick_name = self.optional(e, "nickName");
@@ -515,8 +523,7 @@ impl Reader<'_> {
     }
 
     fn parameter(&mut self, e: &Elem) -> Parameter {
-        self.check_attributes(e, PARAMETER_ATTRS);
-        self.children(e, &[]);
+        self.leaf(e, PARAMETER_ATTRS);
         let name = self.required(e, "name");
         let name = self.ident(name);
         let ty = self.required(e, "type").map(Self::named);
@@ -616,11 +623,7 @@ impl Reader<'_> {
             }
         }
         if let Some(info) = info {
-            self.check_attributes(info, &[]);
-            for a in self.children(info, &["Action"]) {
-                let action = self.action(a);
-                entry.actions.push(action);
-            }
+            entry.actions = self.entries(info, "Action", Self::action);
         }
         entry
     }
@@ -663,11 +666,7 @@ impl Reader<'_> {
             }
         }
         if let Some(info) = info {
-            self.check_attributes(info, &[]);
-            for t in self.children(info, &["Transition"]) {
-                let transition = self.transition(t);
-                action.transitions.push(transition);
-            }
+            action.transitions = self.entries(info, "Transition", Self::transition);
         }
         action
     }
@@ -680,8 +679,7 @@ impl Reader<'_> {
         let dst = self.id(dst);
         let children = self.children(e, &["Condition"]);
         let condition = self.at_most_one(&children, "Condition").and_then(|c| {
-            self.check_attributes(c, CONDITION_ATTRS);
-            self.children(c, &[]);
+            self.leaf(c, CONDITION_ATTRS);
             self.condition(c)
         });
         Transition {
@@ -698,8 +696,7 @@ impl Reader<'_> {
         let leader = self.at_most_one(&children, "LeaderSelectionInfo");
         let sync = self.at_most_one(&children, "GroupSync");
         let leader_selection = leader.map(|l| {
-            self.check_attributes(l, LEADER_ATTRS);
-            self.children(l, &[]);
+            self.leaf(l, LEADER_ATTRS);
             let algorithm = self
                 .required(l, "algorithm")
                 .and_then(|a| self.choice(a, &LeaderAlgorithm::ALL));
@@ -726,8 +723,7 @@ impl Reader<'_> {
             }
         });
         let sync_timeout = sync.and_then(|s| {
-            self.check_attributes(s, SYNC_ATTRS);
-            self.children(s, &[]);
+            self.leaf(s, SYNC_ATTRS);
             let timeout = self.required(s, "timeout");
             self.duration(timeout)
         });
@@ -753,8 +749,7 @@ impl Reader<'_> {
             } else {
                 (ACTUATOR_ATTRS, "speedLevel")
             };
-            self.check_attributes(c, attrs);
-            self.children(c, &[]);
+            self.leaf(c, attrs);
             let name = self.required(c, "name").map(Self::named);
             let level = self.required(c, level_key).and_then(|a| self.number(a, 0));
             let setting = LevelSetting {
