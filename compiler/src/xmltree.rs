@@ -85,6 +85,90 @@ pub(crate) fn one_line_diagnostic(
     Diagnostic::new(code, file, span, message)
 }
 
+/// What a format reports of the elements and attributes it does not know,
+/// once the tree is read.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Vocabulary<'a> {
+    pub file: FileId,
+    /// The code of an attribute an element does not have.
+    pub unknown_attribute: Code,
+    /// The code of an element not allowed where it is written, and of text.
+    pub unknown_element: Code,
+    /// Every element of the format, with where it belongs.
+    pub elements: &'a [(&'a str, &'a str)],
+}
+
+impl Vocabulary<'_> {
+    /// Reports the attributes of `e` not among `allowed` (nor namespace
+    /// declarations); `hint` may name the attribute meant before the nearest
+    /// of `allowed` is guessed.
+    pub fn check_attributes(
+        &self,
+        out: &mut Vec<Diagnostic>,
+        e: &Elem,
+        allowed: &[&str],
+        hint: impl Fn(&str) -> Option<String>,
+    ) {
+        for a in &e.attrs {
+            if xmlpos::is_namespace_attribute(&a.key) || allowed.contains(&a.key.as_str()) {
+                continue;
+            }
+            let message = format!(
+                "`<{}>` has no attribute `{}`; it is ignored",
+                e.local, a.key
+            );
+            let suggestion = hint(&a.key).or_else(|| xmlpos::suggest(&a.key, allowed));
+            let mut d = one_line_diagnostic(self.unknown_attribute, self.file, a.key_span, message);
+            d.suggest(suggestion);
+            out.push(d);
+        }
+    }
+
+    /// The children of `e` among `allowed`; the others, and text, reported.
+    pub fn children<'e>(
+        &self,
+        out: &mut Vec<Diagnostic>,
+        e: &'e Elem,
+        allowed: &[&str],
+    ) -> Vec<&'e Elem> {
+        let code = self.unknown_element;
+        if let Some(&text) = e.texts.first() {
+            let message = format!("text is not allowed inside `<{}>`", e.local);
+            out.push(one_line_diagnostic(code, self.file, text, message));
+        }
+        let mut children = Vec::new();
+        for c in &e.children {
+            if allowed.contains(&c.local.as_str()) {
+                children.push(c);
+                continue;
+            }
+            match self.elements.iter().find(|(name, _)| *name == c.local) {
+                Some((name, belongs)) => {
+                    let message = format!(
+                        "`<{name}>` is not allowed inside `<{}>`: it goes {belongs}",
+                        e.local
+                    );
+                    out.push(one_line_diagnostic(code, self.file, c.name_span, message));
+                }
+                None => {
+                    let message = if allowed.is_empty() {
+                        format!(
+                            "unknown element `<{}>`: `<{}>` cannot contain elements",
+                            c.qname, e.local
+                        )
+                    } else {
+                        format!("unknown element `<{}>` inside `<{}>`", c.qname, e.local)
+                    };
+                    let mut d = one_line_diagnostic(code, self.file, c.name_span, message);
+                    d.suggest(xmlpos::suggest(&c.local, allowed));
+                    out.push(d);
+                }
+            }
+        }
+        children
+    }
+}
+
 /// Malformed XML: stop reading the file.
 struct Stop;
 

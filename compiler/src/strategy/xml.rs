@@ -19,8 +19,8 @@ use crate::diag::{Code, Diagnostic, FileId};
 use crate::span::Span;
 use crate::syntax::ast::TimeUnit;
 use crate::syntax::{parse_expr, parse_expr_mapped};
-use crate::xmlpos::{Attr, get, is_ident, is_namespace_attribute, shown, suggest, value_offsets};
-use crate::xmltree::{Elem, TreeFormat, one_line_diagnostic, read_tree};
+use crate::xmlpos::{Attr, get, is_ident, shown, suggest, value_offsets};
+use crate::xmltree::{Elem, TreeFormat, Vocabulary, one_line_diagnostic, read_tree};
 
 /// Reads one strategy file: the strategy (`None` when the file has no
 /// `<Strategy>` root element) and the diagnostics of reading it. The checks of
@@ -127,59 +127,25 @@ impl Reader<'_> {
 
     // --- shared helpers ----------------------------------------------------
 
+    fn vocabulary(&self) -> Vocabulary<'static> {
+        Vocabulary {
+            file: self.file,
+            unknown_attribute: Code::StrategyUnknownAttribute,
+            unknown_element: Code::StrategyUnknownElement,
+            elements: ELEMENTS,
+        }
+    }
+
     /// W080 for attributes that the element does not have.
     fn check_attributes(&mut self, e: &Elem, allowed: &[&str]) {
-        for a in &e.attrs {
-            if is_namespace_attribute(&a.key) || allowed.contains(&a.key.as_str()) {
-                continue;
-            }
-            let message = format!(
-                "`<{}>` has no attribute `{}`; it is ignored",
-                e.local, a.key
-            );
-            self.report(Code::StrategyUnknownAttribute, a.key_span, message)
-                .suggest(suggest(&a.key, allowed));
-        }
+        self.vocabulary()
+            .check_attributes(&mut self.diagnostics, e, allowed, |_| None);
     }
 
     /// The children among `allowed`; E082 for the others and for text.
     fn children<'e>(&mut self, e: &'e Elem, allowed: &[&str]) -> Vec<&'e Elem> {
-        if let Some(&text) = e.texts.first() {
-            self.report(
-                Code::StrategyUnknownElement,
-                text,
-                format!("text is not allowed inside `<{}>`", e.local),
-            );
-        }
-        let mut out = Vec::new();
-        for c in &e.children {
-            if allowed.contains(&c.local.as_str()) {
-                out.push(c);
-                continue;
-            }
-            match ELEMENTS.iter().find(|(name, _)| *name == c.local) {
-                Some((name, belongs)) => {
-                    let message = format!(
-                        "`<{name}>` is not allowed inside `<{}>`: it goes {belongs}",
-                        e.local
-                    );
-                    self.report(Code::StrategyUnknownElement, c.name_span, message);
-                }
-                None => {
-                    let message = if allowed.is_empty() {
-                        format!(
-                            "unknown element `<{}>`: `<{}>` cannot contain elements",
-                            c.qname, e.local
-                        )
-                    } else {
-                        format!("unknown element `<{}>` inside `<{}>`", c.qname, e.local)
-                    };
-                    self.report(Code::StrategyUnknownElement, c.name_span, message)
-                        .suggest(suggest(&c.local, allowed));
-                }
-            }
-        }
-        out
+        self.vocabulary()
+            .children(&mut self.diagnostics, e, allowed)
     }
 
     /// An element with no attributes of its own around a list of `child`
