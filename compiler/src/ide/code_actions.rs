@@ -173,19 +173,7 @@ impl Fixes<'_> {
                 _ => None,
             })
             .next_back();
-        match last_mode {
-            Some(span) => TextEdit {
-                span: Span::new(span.end, span.end),
-                new_text: format!("\n{definition}"),
-            },
-            None => {
-                let at = line_start(self.text, main.span.start);
-                TextEdit {
-                    span: Span::new(at, at),
-                    new_text: format!("{definition}\n\n"),
-                }
-            }
-        }
+        insert_definition(self.text, definition, last_mode, "\n", main.span)
     }
 
     /// E016: `set(P, S)` where plan `P` has no service `S` (or there is no
@@ -223,22 +211,10 @@ impl Fixes<'_> {
                 .map(|s| s.span)
                 .max_by_key(|s| s.end)
         };
-        let edit = match plan
+        let after = plan
             .and_then(|p| services(Some(p)))
-            .or_else(|| services(None))
-        {
-            Some(after) => TextEdit {
-                span: Span::new(after.end, after.end),
-                new_text: format!("\n\n{definition}"),
-            },
-            None => {
-                let at = line_start(self.text, mode.span.start);
-                TextEdit {
-                    span: Span::new(at, at),
-                    new_text: format!("{definition}\n\n"),
-                }
-            }
-        };
+            .or_else(|| services(None));
+        let edit = insert_definition(self.text, definition, after, "\n\n", mode.span);
         let title = match plan {
             Some(_) => format!("Create composite service `{path}`"),
             None => format!("Create composite service `{path}` (and the plan)"),
@@ -428,6 +404,30 @@ impl Fixes<'_> {
             vec![edit],
             true,
         ))
+    }
+}
+
+/// Inserts `definition` right after `after` (`gap` between them), or else on
+/// its own lines before the line of `before`.
+fn insert_definition(
+    text: &str,
+    definition: String,
+    after: Option<Span>,
+    gap: &str,
+    before: Span,
+) -> TextEdit {
+    match after {
+        Some(after) => TextEdit {
+            span: Span::new(after.end, after.end),
+            new_text: format!("{gap}{definition}"),
+        },
+        None => {
+            let at = line_start(text, before.start);
+            TextEdit {
+                span: Span::new(at, at),
+                new_text: format!("{definition}\n\n"),
+            }
+        }
     }
 }
 

@@ -713,13 +713,7 @@ impl<'a> Completions<'a> {
                     0 => "event: no mode catches it yet".to_string(),
                     _ => format!("event of {}", t.name),
                 };
-                self.add(
-                    rank,
-                    CompletionKind::Event,
-                    e.name.as_str(),
-                    Some(detail),
-                    Some(docs::event(t, &e.name)),
-                );
+                self.add_event(rank, t, &e.name, detail);
             }
         }
     }
@@ -770,6 +764,17 @@ impl<'a> Completions<'a> {
                 None,
             );
         }
+    }
+
+    fn add_event(&mut self, rank: u8, t: &Team, name: &Name, detail: String) {
+        let doc = docs::event(t, name);
+        self.add(
+            rank,
+            CompletionKind::Event,
+            name.as_str(),
+            Some(detail),
+            Some(doc),
+        );
     }
 
     fn add_user(&mut self, rank: u8) {
@@ -1066,13 +1071,7 @@ impl<'a> Completions<'a> {
                 ),
                 false => format!("event of {}", t.name),
             };
-            self.add(
-                rank,
-                CompletionKind::Event,
-                e.name.as_str(),
-                Some(detail),
-                Some(docs::event(t, &e.name)),
-            );
+            self.add_event(rank, t, &e.name, detail);
         }
     }
 }
