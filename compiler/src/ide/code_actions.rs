@@ -125,17 +125,21 @@ impl Fixes<'_> {
     /// The team of the main block whose range holds the diagnostic.
     fn main_at(&self) -> Option<(&ast::MainDef, TeamId)> {
         let span = self.diagnostic.span;
-        let main = self
-            .analysis
+        let main = self.main_syntax(|m| m.span.start <= span.start && span.end <= m.span.end)?;
+        let team = self.analysis.mission.team_by_name(&main.team.name)?;
+        Some((main, team))
+    }
+
+    /// The first main block (as written) that `pick` accepts.
+    fn main_syntax(&self, pick: impl Fn(&ast::MainDef) -> bool) -> Option<&ast::MainDef> {
+        self.analysis
             .syntax
             .items
             .iter()
             .find_map(|item| match item {
-                Item::Main(m) if m.span.start <= span.start && span.end <= m.span.end => Some(m),
+                Item::Main(m) if pick(m) => Some(m),
                 _ => None,
-            })?;
-        let team = self.analysis.mission.team_by_name(&main.team.name)?;
-        Some((main, team))
+            })
     }
 
     fn team(&self, id: TeamId) -> &Team {
@@ -226,16 +230,7 @@ impl Fixes<'_> {
     /// mode; a new mode when the team has none).
     fn add_default(&self) -> Vec<CodeAction> {
         let span = self.diagnostic.span;
-        let Some(main) = self
-            .analysis
-            .syntax
-            .items
-            .iter()
-            .find_map(|item| match item {
-                Item::Main(m) if m.team.span.start == span.start => Some(m),
-                _ => None,
-            })
-        else {
+        let Some(main) = self.main_syntax(|m| m.team.span.start == span.start) else {
             return Vec::new();
         };
         let Some(team) = self.analysis.mission.team_by_name(&main.team.name) else {
@@ -312,16 +307,7 @@ impl Fixes<'_> {
         let Some(main_ir) = &t.main else {
             return Vec::new();
         };
-        let Some(main) = self
-            .analysis
-            .syntax
-            .items
-            .iter()
-            .find_map(|item| match item {
-                Item::Main(m) if m.span == main_ir.span => Some(m),
-                _ => None,
-            })
-        else {
+        let Some(main) = self.main_syntax(|m| m.span == main_ir.span) else {
             return Vec::new();
         };
         // The modes that run a service throwing the event, else the default.
