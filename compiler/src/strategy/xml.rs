@@ -104,12 +104,6 @@ const SYNC_ATTRS: &[&str] = &["timeout"];
 const SENSOR_ATTRS: &[&str] = &["name", "periodLevel"];
 const ACTUATOR_ATTRS: &[&str] = &["name", "speedLevel"];
 
-const TASK_USES: [(&str, TaskUseKind); 3] = [
-    ("CheckSensor", TaskUseKind::CheckSensor),
-    ("ExecuteActuator", TaskUseKind::ExecuteActuator),
-    ("ExecuteAlgorithm", TaskUseKind::ExecuteAlgorithm),
-];
-
 struct Reader<'t> {
     file: FileId,
     text: &'t str,
@@ -469,7 +463,7 @@ impl Reader<'_> {
     }
 
     fn task_use(&mut self, e: &Elem) -> TaskUse {
-        let kind = TASK_USES
+        let kind = TaskUseKind::ALL
             .iter()
             .find(|(tag, _)| *tag == e.local)
             .map_or(TaskUseKind::CheckSensor, |(_, k)| *k);
