@@ -190,32 +190,51 @@ enum Mutation {
     Swap(usize, usize),
 }
 
-fn mutated_example() -> impl Strategy<Value = String> {
+/// Line mutations (delete, duplicate, swap) of one of `examples`.
+fn line_mutations(examples: fn() -> &'static Vec<String>) -> impl Strategy<Value = String> {
     let mutation = prop_oneof![
         any::<usize>().prop_map(Mutation::Delete),
         any::<usize>().prop_map(Mutation::Duplicate),
         (any::<usize>(), any::<usize>()).prop_map(|(a, b)| Mutation::Swap(a, b)),
     ];
-    (0..examples().len(), prop::collection::vec(mutation, 1..8)).prop_map(|(which, mutations)| {
-        let mut lines: Vec<String> = examples()[which].lines().map(str::to_string).collect();
-        for m in mutations {
-            let n = lines.len();
-            if n == 0 {
-                break;
-            }
-            match m {
-                Mutation::Delete(i) => {
-                    lines.remove(i % n);
+    (0..examples().len(), prop::collection::vec(mutation, 1..8)).prop_map(
+        move |(which, mutations)| {
+            let mut lines: Vec<String> = examples()[which].lines().map(str::to_string).collect();
+            for m in mutations {
+                let n = lines.len();
+                if n == 0 {
+                    break;
                 }
-                Mutation::Duplicate(i) => {
-                    let line = lines[i % n].clone();
-                    lines.insert(i % n, line);
+                match m {
+                    Mutation::Delete(i) => {
+                        lines.remove(i % n);
+                    }
+                    Mutation::Duplicate(i) => {
+                        let line = lines[i % n].clone();
+                        lines.insert(i % n, line);
+                    }
+                    Mutation::Swap(a, b) => lines.swap(a % n, b % n),
                 }
-                Mutation::Swap(a, b) => lines.swap(a % n, b % n),
             }
-        }
-        lines.join("\n")
-    })
+            lines.join("\n")
+        },
+    )
+}
+
+fn mutated_example() -> impl Strategy<Value = String> {
+    line_mutations(examples)
+}
+
+/// `text` with the characters from `at` (up to `len`) replaced by `c`; `at`
+/// is taken modulo the text's length (plus one).
+fn replace_chars(text: &str, at: usize, len: usize, c: char) -> String {
+    let chars: Vec<char> = text.chars().collect();
+    let at = at % (chars.len() + 1);
+    let end = (at + len).min(chars.len());
+    let mut out: String = chars[..at].iter().collect();
+    out.push(c);
+    out.extend(&chars[end..]);
+    out
 }
 
 /// Byte-level damage inside an example: truncation or a character cut in half
@@ -227,15 +246,7 @@ fn damaged_example() -> impl Strategy<Value = String> {
         any::<usize>(),
         any::<char>(),
     )
-        .prop_map(|(which, at, len, c)| {
-            let chars: Vec<char> = examples()[which].chars().collect();
-            let at = at % (chars.len() + 1);
-            let end = (at + len % 16).min(chars.len());
-            let mut out: String = chars[..at].iter().collect();
-            out.push(c);
-            out.extend(&chars[end..]);
-            out
-        })
+        .prop_map(|(which, at, len, c)| replace_chars(&examples()[which], at, len % 16, c))
 }
 
 proptest! {
@@ -351,49 +362,13 @@ fn damaged_strategy() -> impl Strategy<Value = String> {
         any::<bool>(),
     )
         .prop_map(|(which, at, len, xml_char, any_char, xml)| {
-            let chars: Vec<char> = strategy_examples()[which].chars().collect();
-            let at = at % (chars.len() + 1);
-            let end = (at + len % 24).min(chars.len());
-            let mut out: String = chars[..at].iter().collect();
-            out.push(if xml { xml_char } else { any_char });
-            out.extend(&chars[end..]);
-            out
+            let c = if xml { xml_char } else { any_char };
+            replace_chars(&strategy_examples()[which], at, len % 24, c)
         })
 }
 
 fn mutated_strategy() -> impl Strategy<Value = String> {
-    let mutation = prop_oneof![
-        any::<usize>().prop_map(Mutation::Delete),
-        any::<usize>().prop_map(Mutation::Duplicate),
-        (any::<usize>(), any::<usize>()).prop_map(|(a, b)| Mutation::Swap(a, b)),
-    ];
-    (
-        0..strategy_examples().len(),
-        prop::collection::vec(mutation, 1..8),
-    )
-        .prop_map(|(which, mutations)| {
-            let mut lines: Vec<String> = strategy_examples()[which]
-                .lines()
-                .map(str::to_string)
-                .collect();
-            for m in mutations {
-                let n = lines.len();
-                if n == 0 {
-                    break;
-                }
-                match m {
-                    Mutation::Delete(i) => {
-                        lines.remove(i % n);
-                    }
-                    Mutation::Duplicate(i) => {
-                        let line = lines[i % n].clone();
-                        lines.insert(i % n, line);
-                    }
-                    Mutation::Swap(a, b) => lines.swap(a % n, b % n),
-                }
-            }
-            lines.join("\n")
-        })
+    line_mutations(strategy_examples)
 }
 
 const XML_SOUP: &[&str] = &[
@@ -481,6 +456,12 @@ fn the_strategy_examples_load_cleanly() {
     check_strategy_never_panics(&long);
 }
 
+/// Up to 2000 random bytes, read as UTF-8 where they are not.
+fn random_text() -> impl Strategy<Value = String> {
+    prop::collection::vec(any::<u8>(), 0..2000)
+        .prop_map(|b| String::from_utf8_lossy(&b).into_owned())
+}
+
 #[test]
 #[ignore = "long-running: many more random cases"]
 fn long_running_fuzz() {
@@ -493,8 +474,7 @@ fn long_running_fuzz() {
         ..ProptestConfig::default()
     });
     let strategy = prop_oneof![
-        prop::collection::vec(any::<u8>(), 0..2000)
-            .prop_map(|b| String::from_utf8_lossy(&b).into_owned()),
+        random_text(),
         token_soup(),
         mutated_example(),
         damaged_example(),
@@ -506,8 +486,7 @@ fn long_running_fuzz() {
         })
         .unwrap();
     let strategy_files = prop_oneof![
-        prop::collection::vec(any::<u8>(), 0..2000)
-            .prop_map(|b| String::from_utf8_lossy(&b).into_owned()),
+        random_text(),
         xml_soup(),
         mutated_strategy(),
         damaged_strategy(),

@@ -5,9 +5,10 @@
 
 use crate::span::Span;
 use crate::suggest::{did_you_mean, edit_distance};
+use quick_xml::Reader;
 use quick_xml::encoding::Decoder;
 use quick_xml::events::attributes::AttrError;
-use quick_xml::events::{BytesRef, BytesStart};
+use quick_xml::events::{BytesEnd, BytesRef, BytesStart};
 
 /// One attribute as written.
 #[derive(Clone, Debug)]
@@ -86,6 +87,29 @@ pub(crate) fn end_tag_span(text: &str, name: &[u8], tag_end: usize) -> Span {
         name_span.start.saturating_sub(2),
         tag_end.max(name_span.end),
     )
+}
+
+/// A quick-xml reader over `text` that leaves end tags to be matched by the
+/// caller (to report them with both positions) and keeps text untrimmed.
+pub(crate) fn reader(text: &str) -> Reader<&[u8]> {
+    let mut reader = Reader::from_str(text);
+    let config = reader.config_mut();
+    config.check_end_names = false;
+    config.allow_unmatched_ends = true;
+    config.trim_text(false);
+    reader
+}
+
+/// An end tag's range (`</` to `>`) and its name.
+pub(crate) fn end_tag(text: &str, e: &BytesEnd<'_>, tag_end: usize) -> (Span, String) {
+    let name = e.name();
+    let span = end_tag_span(text, name.as_ref(), tag_end);
+    (span, String::from_utf8_lossy(name.as_ref()).into_owned())
+}
+
+/// The message for an element open when the file ends.
+pub(crate) fn never_closed(qname: &str) -> String {
+    format!("`<{qname}>` is never closed: add `</{qname}>`")
 }
 
 /// The message for `</name>` with no element open.
@@ -194,6 +218,40 @@ pub(crate) fn start_tag_spans(text: &str, e: &BytesStart<'_>, tag_end: usize) ->
         tag_end.max(name_span.end),
     );
     (name_span, tag)
+}
+
+/// A start tag's names and ranges.
+pub(crate) struct StartTag {
+    pub qname: String,
+    /// The name without a namespace prefix.
+    pub local: String,
+    pub name_span: Span,
+    /// `<` to `>`.
+    pub tag: Span,
+}
+
+/// The names and ranges of a start tag; `Err` (range, message) for a `<`
+/// followed by no name, which is malformed XML.
+pub(crate) fn start_tag(
+    text: &str,
+    e: &BytesStart<'_>,
+    tag_end: usize,
+) -> Result<StartTag, (Span, &'static str)> {
+    let (name_span, tag) = start_tag_spans(text, e, tag_end);
+    let qname = String::from_utf8_lossy(e.name().as_ref()).into_owned();
+    let local = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
+    if local.is_empty() {
+        return Err((
+            word_at(text, tag.start),
+            "a `<` must be followed by an element name: write `&lt;` for a plain `<`",
+        ));
+    }
+    Ok(StartTag {
+        qname,
+        local,
+        name_span,
+        tag,
+    })
 }
 
 /// What is said of a `<` inside an attribute value when reading stops there:

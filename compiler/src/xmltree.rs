@@ -8,10 +8,9 @@
 use crate::diag::{Code, Diagnostic, FileId};
 use crate::span::Span;
 use crate::xmlpos::{
-    self, Attr, read_attributes, read_attributes_keeping_lt, resolve_reference, start_tag_spans,
+    self, Attr, StartTag, read_attributes, read_attributes_keeping_lt, resolve_reference,
     trim_span, xml_error_message,
 };
-use quick_xml::Reader;
 use quick_xml::encoding::Decoder;
 use quick_xml::errors::SyntaxError;
 use quick_xml::events::{BytesEnd, BytesStart, Event};
@@ -85,6 +84,90 @@ pub(crate) fn one_line_diagnostic(
     Diagnostic::new(code, file, span, message)
 }
 
+/// What a format reports of the elements and attributes it does not know,
+/// once the tree is read.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Vocabulary<'a> {
+    pub file: FileId,
+    /// The code of an attribute an element does not have.
+    pub unknown_attribute: Code,
+    /// The code of an element not allowed where it is written, and of text.
+    pub unknown_element: Code,
+    /// Every element of the format, with where it belongs.
+    pub elements: &'a [(&'a str, &'a str)],
+}
+
+impl Vocabulary<'_> {
+    /// Reports the attributes of `e` not among `allowed` (nor namespace
+    /// declarations); `hint` may name the attribute meant before the nearest
+    /// of `allowed` is guessed.
+    pub fn check_attributes(
+        &self,
+        out: &mut Vec<Diagnostic>,
+        e: &Elem,
+        allowed: &[&str],
+        hint: impl Fn(&str) -> Option<String>,
+    ) {
+        for a in &e.attrs {
+            if xmlpos::is_namespace_attribute(&a.key) || allowed.contains(&a.key.as_str()) {
+                continue;
+            }
+            let message = format!(
+                "`<{}>` has no attribute `{}`; it is ignored",
+                e.local, a.key
+            );
+            let suggestion = hint(&a.key).or_else(|| xmlpos::suggest(&a.key, allowed));
+            let mut d = one_line_diagnostic(self.unknown_attribute, self.file, a.key_span, message);
+            d.suggest(suggestion);
+            out.push(d);
+        }
+    }
+
+    /// The children of `e` among `allowed`; the others, and text, reported.
+    pub fn children<'e>(
+        &self,
+        out: &mut Vec<Diagnostic>,
+        e: &'e Elem,
+        allowed: &[&str],
+    ) -> Vec<&'e Elem> {
+        let code = self.unknown_element;
+        if let Some(&text) = e.texts.first() {
+            let message = format!("text is not allowed inside `<{}>`", e.local);
+            out.push(one_line_diagnostic(code, self.file, text, message));
+        }
+        let mut children = Vec::new();
+        for c in &e.children {
+            if allowed.contains(&c.local.as_str()) {
+                children.push(c);
+                continue;
+            }
+            match self.elements.iter().find(|(name, _)| *name == c.local) {
+                Some((name, belongs)) => {
+                    let message = format!(
+                        "`<{name}>` is not allowed inside `<{}>`: it goes {belongs}",
+                        e.local
+                    );
+                    out.push(one_line_diagnostic(code, self.file, c.name_span, message));
+                }
+                None => {
+                    let message = if allowed.is_empty() {
+                        format!(
+                            "unknown element `<{}>`: `<{}>` cannot contain elements",
+                            c.qname, e.local
+                        )
+                    } else {
+                        format!("unknown element `<{}>` inside `<{}>`", c.qname, e.local)
+                    };
+                    let mut d = one_line_diagnostic(code, self.file, c.name_span, message);
+                    d.suggest(xmlpos::suggest(&c.local, allowed));
+                    out.push(d);
+                }
+            }
+        }
+        children
+    }
+}
+
 /// Malformed XML: stop reading the file.
 struct Stop;
 
@@ -110,14 +193,7 @@ impl TreeBuilder<'_, '_> {
     /// Reads events until the end or an error; returns where reading stopped.
     fn run(&mut self) -> usize {
         let text = self.text;
-        let mut reader = Reader::from_str(text);
-        {
-            let config = reader.config_mut();
-            // End tags are matched here, to report them with both positions.
-            config.check_end_names = false;
-            config.allow_unmatched_ends = true;
-            config.trim_text(false);
-        }
+        let mut reader = xmlpos::reader(text);
         let decoder = reader.decoder();
         loop {
             let before = (reader.buffer_position() as usize).min(text.len());
@@ -189,7 +265,7 @@ impl TreeBuilder<'_, '_> {
 
     fn eof(&mut self) {
         if let Some(open) = self.stack.last() {
-            let message = format!("`<{0}>` is never closed: add `</{0}>`", open.qname);
+            let message = xmlpos::never_closed(&open.qname);
             let tag = open.tag;
             self.report(self.format.xml_code, tag, message);
         } else if self.root.is_none() {
@@ -261,16 +337,15 @@ impl TreeBuilder<'_, '_> {
     }
 
     fn start(&mut self, e: &BytesStart<'_>, tag_end: usize, empty: bool, decoder: Decoder) -> Flow {
-        let (name_span, tag) = start_tag_spans(self.text, e, tag_end);
-        let qname = String::from_utf8_lossy(e.name().as_ref()).into_owned();
-        let local = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
-        if local.is_empty() {
-            let span = xmlpos::word_at(self.text, tag.start);
-            return self.malformed(
-                span,
-                "a `<` must be followed by an element name: write `&lt;` for a plain `<`",
-            );
-        }
+        let StartTag {
+            qname,
+            local,
+            name_span,
+            tag,
+        } = match xmlpos::start_tag(self.text, e, tag_end) {
+            Ok(start) => start,
+            Err((span, message)) => return self.malformed(span, message),
+        };
         let attrs = self.attributes(e, tag, decoder)?;
         if self.stack.is_empty() {
             if let Some(root) = &self.root {
@@ -301,9 +376,7 @@ impl TreeBuilder<'_, '_> {
     }
 
     fn end(&mut self, e: &BytesEnd<'_>, tag_end: usize) -> Flow {
-        let name = e.name();
-        let span = xmlpos::end_tag_span(self.text, name.as_ref(), tag_end);
-        let name = String::from_utf8_lossy(name.as_ref()).into_owned();
+        let (span, name) = xmlpos::end_tag(self.text, e, tag_end);
         match self.stack.pop() {
             None => self.malformed(span, xmlpos::unopened_close(&name)),
             Some(open) if open.qname != name => {

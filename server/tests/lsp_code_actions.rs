@@ -118,13 +118,12 @@ fn render(session: &mut Session, doc: &support::ide::Doc) -> String {
 
 #[test]
 fn code_action_fixtures() {
-    let mut session = Session::new();
-    insta::glob!("fixtures/code_actions/*.mission", |path| {
-        let doc = session.open_fixture(path);
-        assert!(!doc.diagnostics.is_empty(), "a fixture needs diagnostics");
-        insta::assert_snapshot!(render(&mut session, &doc));
-    });
-    session.shutdown();
+    snapshot_fixtures!(
+        "fixtures/code_actions/*.mission",
+        diagnostics,
+        "a fixture needs diagnostics",
+        render
+    );
 }
 
 /// A client that asks for other kinds of actions gets no quick fixes; one

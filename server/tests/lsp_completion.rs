@@ -7,7 +7,7 @@
 mod support;
 
 use serde_json::{Value, json};
-use support::ide::{Session, show_position};
+use support::ide::{Session, render_cursors};
 use support::text_at;
 
 fn kind_name(kind: &Value) -> &'static str {
@@ -36,16 +36,12 @@ fn visible(text: &str) -> String {
 
 /// The completion list at each cursor of a document, rendered for a reader.
 fn render(session: &mut Session, doc: &support::ide::Doc) -> String {
-    let mut out = String::new();
-    for position in doc.cursors.clone() {
-        let result = session.at("textDocument/completion", doc, &position);
-        out.push_str(&show_position(&doc.text, &position));
-        out.push('\n');
+    render_cursors(session, doc, "textDocument/completion", |result| {
         let items = result["items"].as_array().cloned().unwrap_or_default();
         if items.is_empty() {
-            out.push_str("(nothing)\n\n");
-            continue;
+            return None;
         }
+        let mut out = String::new();
         let replaced = text_at(&doc.text, &items[0]["textEdit"]["range"]);
         if !replaced.is_empty() {
             out.push_str(&format!("replacing `{replaced}`:\n"));
@@ -77,19 +73,18 @@ fn render(session: &mut Session, doc: &support::ide::Doc) -> String {
             out.push('\n');
         }
         out.push('\n');
-    }
-    out
+        Some(out)
+    })
 }
 
 #[test]
 fn completion_fixtures() {
-    let mut session = Session::new();
-    insta::glob!("fixtures/completion/*.mission", |path| {
-        let doc = session.open_fixture(path);
-        assert!(!doc.cursors.is_empty(), "a fixture needs a $0 cursor");
-        insta::assert_snapshot!(render(&mut session, &doc));
-    });
-    session.shutdown();
+    snapshot_fixtures!(
+        "fixtures/completion/*.mission",
+        cursors,
+        "a fixture needs a $0 cursor",
+        render
+    );
 }
 
 /// A client without snippet support gets plain text: names, and constructs

@@ -5,38 +5,32 @@
 mod support;
 
 use serde_json::json;
-use support::ide::{Session, positions_past_the_end, show_position};
+use support::ide::{Session, positions_past_the_end, render_cursors};
 use support::text_at;
 
 fn render(session: &mut Session, doc: &support::ide::Doc) -> String {
-    let mut out = String::new();
-    for position in doc.cursors.clone() {
-        let result = session.at("textDocument/hover", doc, &position);
-        out.push_str(&show_position(&doc.text, &position));
-        out.push('\n');
+    render_cursors(session, doc, "textDocument/hover", |result| {
         if result.is_null() {
-            out.push_str("(nothing)\n\n");
-            continue;
+            return None;
         }
         let range = text_at(&doc.text, &result["range"]);
         assert_eq!(result["contents"]["kind"], "markdown");
         let markdown = result["contents"]["value"].as_str().unwrap();
-        out.push_str(&format!("hovering `{range}`:\n    "));
-        out.push_str(&markdown.replace('\n', "\n    "));
-        out.push_str("\n\n");
-    }
-    out
+        Some(format!(
+            "hovering `{range}`:\n    {}\n\n",
+            markdown.replace('\n', "\n    ")
+        ))
+    })
 }
 
 #[test]
 fn hover_fixtures() {
-    let mut session = Session::new();
-    insta::glob!("fixtures/hover/*.mission", |path| {
-        let doc = session.open_fixture(path);
-        assert!(!doc.cursors.is_empty(), "a fixture needs a $0 cursor");
-        insta::assert_snapshot!(render(&mut session, &doc));
-    });
-    session.shutdown();
+    snapshot_fixtures!(
+        "fixtures/hover/*.mission",
+        cursors,
+        "a fixture needs a $0 cursor",
+        render
+    );
 }
 
 /// Past the end of the text, in an empty file and on blank space: no hover,

@@ -6,7 +6,7 @@
 mod support;
 
 use serde_json::Value;
-use support::ide::{Session, show_position};
+use support::ide::{Session, render_cursors};
 
 /// The label with the active parameter marked, from UTF-16 label offsets.
 fn marked(signature: &Value, active: Option<u64>) -> String {
@@ -29,34 +29,28 @@ fn marked(signature: &Value, active: Option<u64>) -> String {
 }
 
 fn render(session: &mut Session, doc: &support::ide::Doc) -> String {
-    let mut out = String::new();
-    for position in doc.cursors.clone() {
-        let result = session.at("textDocument/signatureHelp", doc, &position);
-        out.push_str(&show_position(&doc.text, &position));
-        out.push('\n');
+    render_cursors(session, doc, "textDocument/signatureHelp", |result| {
         if result.is_null() {
-            out.push_str("(nothing)\n\n");
-            continue;
+            return None;
         }
         let signature = &result["signatures"][0];
         assert_eq!(result["activeSignature"], 0);
         let active = result["activeParameter"].as_u64();
-        out.push_str(&format!("    {}\n", marked(signature, active)));
+        let mut out = format!("    {}\n", marked(signature, active));
         if let Some(doc) = signature["documentation"]["value"].as_str() {
             out.push_str(&format!("    {doc}\n"));
         }
         out.push('\n');
-    }
-    out
+        Some(out)
+    })
 }
 
 #[test]
 fn signature_help_fixtures() {
-    let mut session = Session::new();
-    insta::glob!("fixtures/signature_help/*.mission", |path| {
-        let doc = session.open_fixture(path);
-        assert!(!doc.cursors.is_empty(), "a fixture needs a $0 cursor");
-        insta::assert_snapshot!(render(&mut session, &doc));
-    });
-    session.shutdown();
+    snapshot_fixtures!(
+        "fixtures/signature_help/*.mission",
+        cursors,
+        "a fixture needs a $0 cursor",
+        render
+    );
 }

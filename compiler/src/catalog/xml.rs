@@ -12,10 +12,9 @@ use super::{
 use crate::diag::{Code, Diagnostic, FileId};
 use crate::span::Span;
 use crate::xmlpos::{
-    self, Attr, get, is_ident, is_namespace_attribute, read_attributes, resolve_reference, suggest,
-    trim_span, xml_error_message,
+    self, Attr, StartTag, get, is_ident, is_namespace_attribute, read_attributes,
+    resolve_reference, suggest, trim_span, xml_error_message,
 };
-use quick_xml::Reader;
 use quick_xml::encoding::Decoder;
 use quick_xml::events::{BytesEnd, BytesStart, Event};
 use std::collections::HashMap;
@@ -316,14 +315,7 @@ struct Parser<'t, 'p> {
 
 impl Parser<'_, '_> {
     fn run(&mut self) {
-        let mut reader = Reader::from_str(self.text);
-        {
-            let config = reader.config_mut();
-            // End tags are matched here, to report them with both positions.
-            config.check_end_names = false;
-            config.allow_unmatched_ends = true;
-            config.trim_text(false);
-        }
+        let mut reader = xmlpos::reader(self.text);
         let decoder = reader.decoder();
         loop {
             let event = reader.read_event();
@@ -398,12 +390,8 @@ impl Parser<'_, '_> {
 
     fn eof(&mut self) {
         if let Some(open) = self.stack.last() {
-            let name = open.qname.clone();
-            self.sink.report(
-                Code::CatalogXml,
-                open.tag,
-                format!("`<{name}>` is never closed: add `</{name}>`"),
-            );
+            let (tag, message) = (open.tag, xmlpos::never_closed(&open.qname));
+            self.sink.report(Code::CatalogXml, tag, message);
         } else if !self.seen_root {
             let end = self.text.len();
             self.sink.report(
@@ -478,23 +466,15 @@ impl Parser<'_, '_> {
     }
 
     fn start(&mut self, e: &BytesStart<'_>, tag_end: usize, empty: bool, decoder: Decoder) -> Flow {
-        let qname = e.name();
-        let name_span = self
-            .slice_span(qname.as_ref())
-            .unwrap_or(Span::new(tag_end, tag_end));
-        let tag = Span::new(
-            name_span.start.saturating_sub(1),
-            tag_end.max(name_span.end),
-        );
-        let qname = String::from_utf8_lossy(qname.as_ref()).into_owned();
-        let local = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
-        if local.is_empty() {
-            let span = self.word_at(tag.start);
-            return self.malformed(
-                span,
-                "a `<` must be followed by an element name: write `&lt;` for a plain `<`",
-            );
-        }
+        let StartTag {
+            qname,
+            local,
+            name_span,
+            tag,
+        } = match xmlpos::start_tag(self.text, e, tag_end) {
+            Ok(start) => start,
+            Err((span, message)) => return self.malformed(span, message),
+        };
         let attrs = self.attributes(e, tag, decoder)?;
         let parent = self.stack.last().map(|o| o.kind);
         let kind = match parent {
@@ -568,9 +548,7 @@ impl Parser<'_, '_> {
     }
 
     fn end(&mut self, e: &BytesEnd<'_>, tag_end: usize) -> Flow {
-        let name = e.name();
-        let span = xmlpos::end_tag_span(self.text, name.as_ref(), tag_end);
-        let name = String::from_utf8_lossy(name.as_ref()).into_owned();
+        let (span, name) = xmlpos::end_tag(self.text, e, tag_end);
         match self.stack.pop() {
             None => self.malformed(span, xmlpos::unopened_close(&name)),
             Some(open) if open.qname != name => {

@@ -125,17 +125,21 @@ impl Fixes<'_> {
     /// The team of the main block whose range holds the diagnostic.
     fn main_at(&self) -> Option<(&ast::MainDef, TeamId)> {
         let span = self.diagnostic.span;
-        let main = self
-            .analysis
+        let main = self.main_syntax(|m| m.span.start <= span.start && span.end <= m.span.end)?;
+        let team = self.analysis.mission.team_by_name(&main.team.name)?;
+        Some((main, team))
+    }
+
+    /// The first main block (as written) that `pick` accepts.
+    fn main_syntax(&self, pick: impl Fn(&ast::MainDef) -> bool) -> Option<&ast::MainDef> {
+        self.analysis
             .syntax
             .items
             .iter()
             .find_map(|item| match item {
-                Item::Main(m) if m.span.start <= span.start && span.end <= m.span.end => Some(m),
+                Item::Main(m) if pick(m) => Some(m),
                 _ => None,
-            })?;
-        let team = self.analysis.mission.team_by_name(&main.team.name)?;
-        Some((main, team))
+            })
     }
 
     fn team(&self, id: TeamId) -> &Team {
@@ -173,19 +177,7 @@ impl Fixes<'_> {
                 _ => None,
             })
             .next_back();
-        match last_mode {
-            Some(span) => TextEdit {
-                span: Span::new(span.end, span.end),
-                new_text: format!("\n{definition}"),
-            },
-            None => {
-                let at = line_start(self.text, main.span.start);
-                TextEdit {
-                    span: Span::new(at, at),
-                    new_text: format!("{definition}\n\n"),
-                }
-            }
-        }
+        insert_definition(self.text, definition, last_mode, "\n", main.span)
     }
 
     /// E016: `set(P, S)` where plan `P` has no service `S` (or there is no
@@ -223,22 +215,10 @@ impl Fixes<'_> {
                 .map(|s| s.span)
                 .max_by_key(|s| s.end)
         };
-        let edit = match plan
+        let after = plan
             .and_then(|p| services(Some(p)))
-            .or_else(|| services(None))
-        {
-            Some(after) => TextEdit {
-                span: Span::new(after.end, after.end),
-                new_text: format!("\n\n{definition}"),
-            },
-            None => {
-                let at = line_start(self.text, mode.span.start);
-                TextEdit {
-                    span: Span::new(at, at),
-                    new_text: format!("{definition}\n\n"),
-                }
-            }
-        };
+            .or_else(|| services(None));
+        let edit = insert_definition(self.text, definition, after, "\n\n", mode.span);
         let title = match plan {
             Some(_) => format!("Create composite service `{path}`"),
             None => format!("Create composite service `{path}` (and the plan)"),
@@ -250,16 +230,7 @@ impl Fixes<'_> {
     /// mode; a new mode when the team has none).
     fn add_default(&self) -> Vec<CodeAction> {
         let span = self.diagnostic.span;
-        let Some(main) = self
-            .analysis
-            .syntax
-            .items
-            .iter()
-            .find_map(|item| match item {
-                Item::Main(m) if m.team.span.start == span.start => Some(m),
-                _ => None,
-            })
-        else {
+        let Some(main) = self.main_syntax(|m| m.team.span.start == span.start) else {
             return Vec::new();
         };
         let Some(team) = self.analysis.mission.team_by_name(&main.team.name) else {
@@ -336,16 +307,7 @@ impl Fixes<'_> {
         let Some(main_ir) = &t.main else {
             return Vec::new();
         };
-        let Some(main) = self
-            .analysis
-            .syntax
-            .items
-            .iter()
-            .find_map(|item| match item {
-                Item::Main(m) if m.span == main_ir.span => Some(m),
-                _ => None,
-            })
-        else {
+        let Some(main) = self.main_syntax(|m| m.span == main_ir.span) else {
             return Vec::new();
         };
         // The modes that run a service throwing the event, else the default.
@@ -428,6 +390,30 @@ impl Fixes<'_> {
             vec![edit],
             true,
         ))
+    }
+}
+
+/// Inserts `definition` right after `after` (`gap` between them), or else on
+/// its own lines before the line of `before`.
+fn insert_definition(
+    text: &str,
+    definition: String,
+    after: Option<Span>,
+    gap: &str,
+    before: Span,
+) -> TextEdit {
+    match after {
+        Some(after) => TextEdit {
+            span: Span::new(after.end, after.end),
+            new_text: format!("{gap}{definition}"),
+        },
+        None => {
+            let at = line_start(text, before.start);
+            TextEdit {
+                span: Span::new(at, at),
+                new_text: format!("{definition}\n\n"),
+            }
+        }
     }
 }
 

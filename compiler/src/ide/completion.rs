@@ -12,7 +12,7 @@ use super::context::{self, Head, Lt, Paren, Place, Scan};
 use super::docs;
 use super::robots::{self, RobotsHere};
 use super::snippets::{self, Snippet};
-use crate::catalog::{Catalog, ValueType};
+use crate::catalog::{Catalog, ValueDef, ValueType};
 use crate::sema::{Analysis, Index, Mission, ScopeKind, Team, TeamId, is_user};
 use crate::span::Span;
 use crate::syntax::ast::{self, Name};
@@ -322,15 +322,7 @@ impl<'a> Completions<'a> {
     fn item_start(&mut self) {
         let teams: Vec<Name> = self.mission.teams.iter().map(|t| t.name.clone()).collect();
         for t in &self.mission.teams {
-            let doc = docs::team_brief(t);
-            let detail = format!("team of {} robot{}", t.robots.len(), plural(t.robots.len()));
-            self.add(
-                EXACT,
-                CompletionKind::Team,
-                t.name.as_str(),
-                Some(detail),
-                Some(doc),
-            );
+            self.add_team(EXACT, t);
         }
         let has_formation = self
             .analysis
@@ -721,13 +713,7 @@ impl<'a> Completions<'a> {
                     0 => "event: no mode catches it yet".to_string(),
                     _ => format!("event of {}", t.name),
                 };
-                self.add(
-                    rank,
-                    CompletionKind::Event,
-                    e.name.as_str(),
-                    Some(detail),
-                    Some(docs::event(t, &e.name)),
-                );
+                self.add_event(rank, t, &e.name, detail);
             }
         }
     }
@@ -740,19 +726,55 @@ impl<'a> Completions<'a> {
             } else {
                 EXACT
             };
-            self.add(
-                rank,
-                CompletionKind::Team,
-                t.name.as_str(),
-                Some(format!(
-                    "team of {} robot{}",
-                    t.robots.len(),
-                    plural(t.robots.len())
-                )),
-                Some(docs::team_brief(t)),
-            );
+            self.add_team(rank, t);
         }
         self.add_user(LIKELY);
+    }
+
+    fn add_team(&mut self, rank: u8, t: &Team) {
+        let detail = format!("team of {} robot{}", t.robots.len(), plural(t.robots.len()));
+        let doc = docs::team_brief(t);
+        self.add(
+            rank,
+            CompletionKind::Team,
+            t.name.as_str(),
+            Some(detail),
+            Some(doc),
+        );
+    }
+
+    /// A catalog value, documented as `owner.NAME` when written after `owner.`.
+    fn add_value(&mut self, rank: u8, v: &ValueDef, owner: Option<&str>) {
+        self.add(
+            rank,
+            CompletionKind::Value,
+            v.name.as_str(),
+            Some(docs::value_detail(v)),
+            Some(docs::value(owner, v)),
+        );
+    }
+
+    fn add_team_variables(&mut self, rank: u8, t: &Team) {
+        for var in &t.variables {
+            self.add(
+                rank,
+                CompletionKind::TeamVariable,
+                var.as_str(),
+                Some(format!("team variable of {}", t.name)),
+                None,
+            );
+        }
+    }
+
+    fn add_event(&mut self, rank: u8, t: &Team, name: &Name, detail: String) {
+        let doc = docs::event(t, name);
+        self.add(
+            rank,
+            CompletionKind::Event,
+            name.as_str(),
+            Some(detail),
+            Some(doc),
+        );
     }
 
     fn add_user(&mut self, rank: u8) {
@@ -800,38 +822,13 @@ impl<'a> Completions<'a> {
         }
         let types = here.types(self.mission);
         for v in robots::shared_values(self.catalog, &types) {
-            self.add(
-                LIKELY,
-                CompletionKind::Value,
-                v.name.as_str(),
-                Some(docs::value_detail(v)),
-                Some(docs::value(None, v)),
-            );
+            self.add_value(LIKELY, v, None);
         }
         for team in here.teams() {
-            let t = self.mission.team(team);
-            for var in &t.variables {
-                self.add(
-                    LIKELY,
-                    CompletionKind::TeamVariable,
-                    var.as_str(),
-                    Some(format!("team variable of {}", t.name)),
-                    None,
-                );
-            }
+            self.add_team_variables(LIKELY, self.mission.team(team));
         }
         for t in &self.mission.teams {
-            self.add(
-                OTHER,
-                CompletionKind::Team,
-                t.name.as_str(),
-                Some(format!(
-                    "team of {} robot{}",
-                    t.robots.len(),
-                    plural(t.robots.len())
-                )),
-                Some(docs::team_brief(t)),
-            );
+            self.add_team(OTHER, t);
         }
         self.add_user(OTHER);
         for word in ["true", "false", "not"] {
@@ -848,13 +845,7 @@ impl<'a> Completions<'a> {
                 .map(|u| u.values.clone())
                 .unwrap_or_default();
             for v in &values {
-                self.add(
-                    EXACT,
-                    CompletionKind::Value,
-                    v.name.as_str(),
-                    Some(docs::value_detail(v)),
-                    Some(docs::value(Some("USER"), v)),
-                );
+                self.add_value(EXACT, v, Some("USER"));
             }
             return;
         }
@@ -870,23 +861,9 @@ impl<'a> Completions<'a> {
             robots::any_values(self.catalog, &robots::team_types(self.mission, team))
         };
         for v in values {
-            self.add(
-                EXACT,
-                CompletionKind::Value,
-                v.name.as_str(),
-                Some(docs::value_detail(v)),
-                Some(docs::value(Some(&t.name), v)),
-            );
+            self.add_value(EXACT, v, Some(&t.name));
         }
-        for var in &t.variables {
-            self.add(
-                EXACT,
-                CompletionKind::TeamVariable,
-                var.as_str(),
-                Some(format!("team variable of {}", t.name)),
-                None,
-            );
-        }
+        self.add_team_variables(EXACT, t);
     }
 
     /// The type of the value an attribute names, if it is a catalog value.
@@ -1094,13 +1071,7 @@ impl<'a> Completions<'a> {
                 ),
                 false => format!("event of {}", t.name),
             };
-            self.add(
-                rank,
-                CompletionKind::Event,
-                e.name.as_str(),
-                Some(detail),
-                Some(docs::event(t, &e.name)),
-            );
+            self.add_event(rank, t, &e.name, detail);
         }
     }
 }

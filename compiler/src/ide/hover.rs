@@ -8,7 +8,7 @@
 use super::docs::{self, list};
 use super::robots::{self, RobotsHere};
 use crate::catalog::{Catalog, RobotTypeId};
-use crate::sema::{Analysis, Symbol, TeamId};
+use crate::sema::{Analysis, Mission, Symbol, TeamId};
 use crate::span::Span;
 use std::fmt::Write;
 
@@ -146,15 +146,7 @@ fn builtin_service(
         .find_map(|ty| catalog.get(*ty).service(name))?;
     let mut out = docs::service(def);
     let mut shown: Vec<RobotTypeId> = Vec::new();
-    for team in here.teams() {
-        let providing: Vec<RobotTypeId> = types_here
-            .iter()
-            .copied()
-            .filter(|ty| providers.contains(ty) && robots::team_types(mission, team).contains(ty))
-            .collect();
-        if providing.is_empty() {
-            continue;
-        }
+    for (team, providing) in types_per_team(mission, &here, |ty| providers.contains(&ty)) {
         write!(
             out,
             "\n\nIn team `{}`, provided by {}.",
@@ -248,22 +240,37 @@ fn capability(analysis: &Analysis, catalog: &Catalog, name: &str, offset: usize)
         .collect();
     write!(out, "\n\nRobot types that have it: {}.", list(&types)).ok();
     let here = RobotsHere::at(analysis, offset, None);
-    for team in here.teams() {
-        let having: Vec<RobotTypeId> = here
-            .types(mission)
-            .into_iter()
-            .filter(|ty| catalog.get(*ty).has_capability(name))
-            .filter(|ty| robots::team_types(mission, team).contains(ty))
-            .collect();
-        if !having.is_empty() {
-            write!(
-                out,
-                "\n\nIn team `{}`: {}.",
-                mission.team(team).name,
-                docs::types_with_robots(catalog, mission, team, &having)
-            )
-            .ok();
-        }
+    let has = |ty: RobotTypeId| catalog.get(ty).has_capability(name);
+    for (team, having) in types_per_team(mission, &here, has) {
+        write!(
+            out,
+            "\n\nIn team `{}`: {}.",
+            mission.team(team).name,
+            docs::types_with_robots(catalog, mission, team, &having)
+        )
+        .ok();
     }
     out
+}
+
+/// Per team running the place, the robot types there (of that team) that
+/// `keep` accepts; teams with none are left out.
+fn types_per_team(
+    mission: &Mission,
+    here: &RobotsHere,
+    keep: impl Fn(RobotTypeId) -> bool,
+) -> Vec<(TeamId, Vec<RobotTypeId>)> {
+    let types_here = here.types(mission);
+    here.teams()
+        .into_iter()
+        .filter_map(|team| {
+            let team_types = robots::team_types(mission, team);
+            let types: Vec<RobotTypeId> = types_here
+                .iter()
+                .copied()
+                .filter(|ty| keep(*ty) && team_types.contains(ty))
+                .collect();
+            (!types.is_empty()).then_some((team, types))
+        })
+        .collect()
 }

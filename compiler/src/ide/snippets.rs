@@ -118,6 +118,12 @@ pub fn item_snippets(teams: &[&str], types: &[&str]) -> Vec<Snippet> {
 pub fn statement_snippets(teams: &[&str], types: &[&str]) -> Vec<Snippet> {
     let team = |i| choice(i, teams, "Team");
     let ty = |i| choice(i, types, "RobotType");
+    // `send`, `receive`, `publish`, `subscribe`: a team and a value.
+    let message = |label: &'static str, detail: &'static str| Snippet {
+        label,
+        detail,
+        body: format!("{label}({}, ${{2:VALUE}})", team(1)),
+    };
     vec![
         Snippet {
             label: "if",
@@ -139,26 +145,19 @@ pub fn statement_snippets(teams: &[&str], types: &[&str]) -> Vec<Snippet> {
             detail: "throw EVENT: the main block may change mode",
             body: "throw ${1:EVENT}".to_string(),
         },
-        Snippet {
-            label: "send",
-            detail: "send(Team, value): deliver reliably to every robot of a team",
-            body: format!("send({}, ${{2:VALUE}})", team(1)),
-        },
-        Snippet {
-            label: "receive",
-            detail: "receive(Team, Team.VALUE): wait for a value from a team",
-            body: format!("receive({}, ${{2:VALUE}})", team(1)),
-        },
-        Snippet {
-            label: "publish",
-            detail: "publish(Team, value): broadcast, best effort",
-            body: format!("publish({}, ${{2:VALUE}})", team(1)),
-        },
-        Snippet {
-            label: "subscribe",
-            detail: "subscribe(Team, Team.VALUE): read the latest value published by a team",
-            body: format!("subscribe({}, ${{2:VALUE}})", team(1)),
-        },
+        message(
+            "send",
+            "send(Team, value): deliver reliably to every robot of a team",
+        ),
+        message(
+            "receive",
+            "receive(Team, Team.VALUE): wait for a value from a team",
+        ),
+        message("publish", "publish(Team, value): broadcast, best effort"),
+        message(
+            "subscribe",
+            "subscribe(Team, Team.VALUE): read the latest value published by a team",
+        ),
         Snippet {
             label: "[[ group ]]",
             detail: "split the robots: each runs the first group it belongs to",

@@ -162,6 +162,17 @@ fn list(names: &[&str], max: usize) -> String {
     out
 }
 
+/// `names` without repetitions, in their first order.
+fn distinct<'a>(names: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
+    let mut out: Vec<&str> = Vec::new();
+    for name in names {
+        if !out.contains(&name) {
+            out.push(name);
+        }
+    }
+    out
+}
+
 /// One built-in service call run by a team's composite service.
 struct BuiltinCall {
     /// The catalog's name of the service.
@@ -300,6 +311,57 @@ impl Cross<'_> {
             .unwrap_or_else(|| unreachable!())
     }
 
+    /// A report of `written`, which is none of `candidates`, with the nearest
+    /// candidate suggested.
+    fn report_unknown(
+        &mut self,
+        code: Code,
+        file: FileId,
+        span: Span,
+        written: &str,
+        candidates: &[&str],
+        message: String,
+    ) -> &mut Diagnostic {
+        let guess = did_you_mean(written, candidates.iter().copied());
+        self.report(code, file, span, message).suggest(guess)
+    }
+
+    /// `code` for an entry `name` that some of `targets` lack: `missing` gives,
+    /// for a robot type without it, what the type has instead.
+    fn not_of_targets(
+        &mut self,
+        code: Code,
+        file: FileId,
+        name: &Named,
+        targets: &[(&Named, RobotTypeId)],
+        missing: impl Fn(&RobotType) -> Option<Vec<&str>>,
+        message: impl Fn(&RobotType, &str) -> String,
+    ) {
+        let catalog = self.catalog;
+        for (_, id) in targets {
+            let robot = catalog.get(*id);
+            if let Some(names) = missing(robot) {
+                let message = message(robot, &list(&names, 12));
+                self.report_unknown(code, file, name.span, &name.name, &names, message);
+            }
+        }
+    }
+
+    /// `code` (E091, E092) for a plan the team does not have.
+    fn no_plan(&mut self, code: Code, file: FileId, mission: &Mission, team: &Team, plan: &Named) {
+        let plans: Vec<&str> = team.plans.iter().map(|p| p.name.as_str()).collect();
+        let message = format!(
+            "team {} has no plan `{}` (its plans are {})",
+            team.name,
+            plan.name,
+            list(&plans, 12)
+        );
+        let related = Self::team_related(mission, team);
+        self.report_unknown(code, file, plan.span, &plan.name, &plans, message)
+            .related
+            .push(related);
+    }
+
     /// The known robot types among `targets`.
     fn known<'t>(&self, targets: &'t [TargetRobot]) -> Vec<(&'t Named, RobotTypeId)> {
         targets
@@ -329,22 +391,22 @@ impl Cross<'_> {
         for value in &strategy.values {
             let targets = self.known(&value.targets);
             if let Some(name) = &value.name {
-                for (_, id) in &targets {
-                    let robot = catalog.get(*id);
-                    if robot.value(&name.name).is_none() {
-                        let names: Vec<&str> =
-                            robot.values.iter().map(|v| v.name.as_str()).collect();
-                        let guess = did_you_mean(&name.name, names.iter().copied());
-                        let message = format!(
-                            "`{}` is not a value of {} (its values are {})",
-                            name.name,
-                            robot.name,
-                            list(&names, 12)
-                        );
-                        self.report(Code::StrategyUnknownValue, file, name.span, message)
-                            .suggest(guess);
-                    }
-                }
+                self.not_of_targets(
+                    Code::StrategyUnknownValue,
+                    file,
+                    name,
+                    &targets,
+                    |robot| {
+                        let values = robot.values.iter().map(|v| v.name.as_str());
+                        robot.value(&name.name).is_none().then(|| values.collect())
+                    },
+                    |robot, names| {
+                        format!(
+                            "`{}` is not a value of {} (its values are {names})",
+                            name.name, robot.name
+                        )
+                    },
+                );
             }
             let params = value.tasks.iter().flat_map(|t| t.parameters.iter());
             self.tasks(file, params, &targets);
@@ -352,22 +414,25 @@ impl Cross<'_> {
         for service in &strategy.services {
             let targets = self.known(&service.targets);
             if let Some(name) = &service.name {
-                for (_, id) in &targets {
-                    let robot = catalog.get(*id);
-                    if robot.service(&name.name).is_none() {
-                        let names: Vec<&str> =
-                            robot.services.iter().map(|s| s.name.as_str()).collect();
-                        let guess = did_you_mean(&name.name, names.iter().copied());
-                        let message = format!(
-                            "{} does not provide a service `{}` (its services are {})",
-                            robot.name,
-                            name.name,
-                            list(&names, 12)
-                        );
-                        self.report(Code::StrategyServiceNotProvided, file, name.span, message)
-                            .suggest(guess);
-                    }
-                }
+                self.not_of_targets(
+                    Code::StrategyServiceNotProvided,
+                    file,
+                    name,
+                    &targets,
+                    |robot| {
+                        let services = robot.services.iter().map(|s| s.name.as_str());
+                        robot
+                            .service(&name.name)
+                            .is_none()
+                            .then(|| services.collect())
+                    },
+                    |robot, names| {
+                        format!(
+                            "{} does not provide a service `{}` (its services are {names})",
+                            robot.name, name.name
+                        )
+                    },
+                );
             }
             self.tasks(file, service.parameters(), &targets);
         }
@@ -396,15 +461,20 @@ impl Cross<'_> {
                     if library.contains(&task.name.as_str()) {
                         continue;
                     }
-                    let guess = did_you_mean(&task.name, library.iter().copied());
                     let message = format!(
                         "`{}` ({key}) is not a task of {} (its tasks are {})",
                         task.name,
                         robot.name,
                         list(library, 16)
                     );
-                    self.report(Code::StrategyUnknownTask, file, task.span, message)
-                        .suggest(guess);
+                    self.report_unknown(
+                        Code::StrategyUnknownTask,
+                        file,
+                        task.span,
+                        &task.name,
+                        library,
+                        message,
+                    );
                 }
             }
         }
@@ -470,25 +540,25 @@ impl Cross<'_> {
             .filter_map(|m| m.mission().team_by_name(&team_name.name).map(|t| (m, t)))
             .collect();
         if teams.is_empty() {
-            let mut names: Vec<&str> = Vec::new();
-            for team in missions.iter().flat_map(|m| m.mission().teams.iter()) {
-                if !names.contains(&team.name.as_str()) {
-                    names.push(&team.name);
-                }
-            }
-            let guess = did_you_mean(&team_name.name, names.iter().copied());
+            let names = distinct(
+                missions
+                    .iter()
+                    .flat_map(|m| m.mission().teams.iter())
+                    .map(|team| team.name.as_str()),
+            );
             let message = format!(
                 "no mission of this check declares a team `{}` (the teams are {})",
                 team_name.name,
                 list(&names, 12)
             );
-            self.report(
+            self.report_unknown(
                 Code::StrategyUnknownTeam,
                 strategy.file,
                 team_name.span,
+                &team_name.name,
+                &names,
                 message,
-            )
-            .suggest(guess);
+            );
             return;
         }
         for (summary, team) in teams {
@@ -523,13 +593,7 @@ impl Cross<'_> {
             if team_types.contains(&id) {
                 continue;
             }
-            let mut type_names: Vec<&str> = Vec::new();
-            for r in &team.robots {
-                if !type_names.contains(&r.type_name.as_str()) {
-                    type_names.push(&r.type_name);
-                }
-            }
-            let guess = did_you_mean(&target.name, type_names.iter().copied());
+            let type_names = distinct(team.robots.iter().map(|r| r.type_name.as_str()));
             let message = format!(
                 "{} is not a robot type of team {} (its robot types are {})",
                 target.name,
@@ -537,9 +601,16 @@ impl Cross<'_> {
                 list(&type_names, 12)
             );
             let related = Self::team_related(mission, team);
-            let d = self.report(Code::StrategyRobotNotInTeam, file, target.span, message);
-            d.suggest(guess);
-            d.related.push(related);
+            self.report_unknown(
+                Code::StrategyRobotNotInTeam,
+                file,
+                target.span,
+                &target.name,
+                &type_names,
+                message,
+            )
+            .related
+            .push(related);
         }
 
         // Services: called by the team in that plan.
@@ -548,18 +619,7 @@ impl Cross<'_> {
                 continue;
             };
             let Some(plan_index) = team.plan_by_name(&plan.name) else {
-                let plans: Vec<&str> = team.plans.iter().map(|p| p.name.as_str()).collect();
-                let guess = did_you_mean(&plan.name, plans.iter().copied());
-                let message = format!(
-                    "team {} has no plan `{}` (its plans are {})",
-                    team.name,
-                    plan.name,
-                    list(&plans, 12)
-                );
-                let related = Self::team_related(mission, team);
-                let d = self.report(Code::StrategyServiceNotCalled, file, plan.span, message);
-                d.suggest(guess);
-                d.related.push(related);
+                self.no_plan(Code::StrategyServiceNotCalled, file, mission, team, plan);
                 continue;
             };
             // The catalog's name of the service (`stand_by` is `standby`).
@@ -636,24 +696,14 @@ impl Cross<'_> {
     ) {
         let mission = summary.mission();
         let team = mission.team(team_id);
-        let related = Self::team_related(mission, team);
         let Some(plan_index) = team.plan_by_name(&plan.name) else {
-            let plans: Vec<&str> = team.plans.iter().map(|p| p.name.as_str()).collect();
-            let guess = did_you_mean(&plan.name, plans.iter().copied());
-            let message = format!(
-                "team {} has no plan `{}` (its plans are {})",
-                team.name,
-                plan.name,
-                list(&plans, 12)
-            );
-            let d = self.report(
+            self.no_plan(
                 Code::StrategyUnknownCompositeService,
                 file,
-                plan.span,
-                message,
+                mission,
+                team,
+                plan,
             );
-            d.suggest(guess);
-            d.related.push(related);
             return;
         };
         let Some(index) = team.service_in_plan(plan_index, &service.name) else {
@@ -663,7 +713,6 @@ impl Cross<'_> {
                 .filter(|s| s.plan == plan_index)
                 .map(|s| s.name.as_str())
                 .collect();
-            let guess = did_you_mean(&service.name, names.iter().copied());
             let message = format!(
                 "team {} has no composite service `{}` in plan {} (its services there are {})",
                 team.name,
@@ -671,14 +720,17 @@ impl Cross<'_> {
                 plan.name,
                 list(&names, 12)
             );
-            let d = self.report(
+            let related = Self::team_related(mission, team);
+            self.report_unknown(
                 Code::StrategyUnknownCompositeService,
                 file,
                 service.span,
+                &service.name,
+                &names,
                 message,
-            );
-            d.suggest(guess);
-            d.related.push(related);
+            )
+            .related
+            .push(related);
             return;
         };
         if !summary.electing[team_id.0 as usize].contains(&index) {

@@ -10,6 +10,35 @@ use crate::diag::FileId;
 use crate::span::Span;
 use crate::syntax::ast;
 
+/// An enum of the words an attribute or element name may be, each written
+/// once: `ALL` (word, value) for reading, and the method named after `by` for
+/// the word of a value.
+macro_rules! words {
+    (
+        $(#[$meta:meta])*
+        pub enum $name:ident, by $word_of:ident {
+            $($(#[$variant_meta:meta])* $variant:ident = $word:literal,)*
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum $name {
+            $($(#[$variant_meta])* $variant,)*
+        }
+
+        impl $name {
+            pub const ALL: [(&'static str, $name); [$($word),*].len()] =
+                [$(($word, $name::$variant)),*];
+
+            pub fn $word_of(self) -> &'static str {
+                match self {
+                    $($name::$variant => $word,)*
+                }
+            }
+        }
+    };
+}
+
 /// A name or word as written in an attribute, trimmed, with its range.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Named {
@@ -60,24 +89,15 @@ pub struct ValueEntry {
     pub tag: Span,
 }
 
-/// Which kind of task an action (or value) uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum TaskUseKind {
-    /// `<CheckSensor>`: read a sensor task.
-    CheckSensor,
-    /// `<ExecuteActuator>`: drive an actuator task.
-    ExecuteActuator,
-    /// `<ExecuteAlgorithm>`: run an algorithm task.
-    ExecuteAlgorithm,
-}
-
-impl TaskUseKind {
-    pub fn tag(self) -> &'static str {
-        match self {
-            TaskUseKind::CheckSensor => "CheckSensor",
-            TaskUseKind::ExecuteActuator => "ExecuteActuator",
-            TaskUseKind::ExecuteAlgorithm => "ExecuteAlgorithm",
-        }
+words! {
+    /// Which kind of task an action (or value) uses.
+    pub enum TaskUseKind, by tag {
+        /// `<CheckSensor>`: read a sensor task.
+        CheckSensor = "CheckSensor",
+        /// `<ExecuteActuator>`: drive an actuator task.
+        ExecuteActuator = "ExecuteActuator",
+        /// `<ExecuteAlgorithm>`: run an algorithm task.
+        ExecuteAlgorithm = "ExecuteAlgorithm",
     }
 }
 
@@ -90,30 +110,15 @@ pub struct TaskUse {
     pub span: Span,
 }
 
-/// `dataCharacteristic`: how a parameter's data moves.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum DataCharacteristic {
-    /// A FIFO channel from or to a task (`srcTask` → `dstTask`).
-    Channel,
-    /// A variable local to the control task.
-    Variable,
-    /// A task parameter set through the runtime, then the task is called.
-    SysRequest,
-}
-
-impl DataCharacteristic {
-    pub const ALL: [(&'static str, DataCharacteristic); 3] = [
-        ("channel", DataCharacteristic::Channel),
-        ("variable", DataCharacteristic::Variable),
-        ("sysRequest", DataCharacteristic::SysRequest),
-    ];
-
-    pub fn as_str(self) -> &'static str {
-        match self {
-            DataCharacteristic::Channel => "channel",
-            DataCharacteristic::Variable => "variable",
-            DataCharacteristic::SysRequest => "sysRequest",
-        }
+words! {
+    /// `dataCharacteristic`: how a parameter's data moves.
+    pub enum DataCharacteristic, by as_str {
+        /// A FIFO channel from or to a task (`srcTask` → `dstTask`).
+        Channel = "channel",
+        /// A variable local to the control task.
+        Variable = "variable",
+        /// A task parameter set through the runtime, then the task is called.
+        SysRequest = "sysRequest",
     }
 }
 
@@ -269,27 +274,12 @@ pub struct Grouping {
     pub span: Span,
 }
 
-/// The leader-selection algorithms.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum LeaderAlgorithm {
-    LowestId,
-    HighestBattery,
-    Bully,
-}
-
-impl LeaderAlgorithm {
-    pub const ALL: [(&'static str, LeaderAlgorithm); 3] = [
-        ("lowest_id", LeaderAlgorithm::LowestId),
-        ("highest_battery", LeaderAlgorithm::HighestBattery),
-        ("bully", LeaderAlgorithm::Bully),
-    ];
-
-    pub fn as_str(self) -> &'static str {
-        match self {
-            LeaderAlgorithm::LowestId => "lowest_id",
-            LeaderAlgorithm::HighestBattery => "highest_battery",
-            LeaderAlgorithm::Bully => "bully",
-        }
+words! {
+    /// The leader-selection algorithms.
+    pub enum LeaderAlgorithm, by as_str {
+        LowestId = "lowest_id",
+        HighestBattery = "highest_battery",
+        Bully = "bully",
     }
 }
 

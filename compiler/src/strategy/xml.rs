@@ -19,8 +19,8 @@ use crate::diag::{Code, Diagnostic, FileId};
 use crate::span::Span;
 use crate::syntax::ast::TimeUnit;
 use crate::syntax::{parse_expr, parse_expr_mapped};
-use crate::xmlpos::{Attr, get, is_ident, is_namespace_attribute, shown, suggest, value_offsets};
-use crate::xmltree::{Elem, TreeFormat, one_line_diagnostic, read_tree};
+use crate::xmlpos::{Attr, get, is_ident, shown, suggest, value_offsets};
+use crate::xmltree::{Elem, TreeFormat, Vocabulary, one_line_diagnostic, read_tree};
 
 /// Reads one strategy file: the strategy (`None` when the file has no
 /// `<Strategy>` root element) and the diagnostics of reading it. The checks of
@@ -104,12 +104,6 @@ const SYNC_ATTRS: &[&str] = &["timeout"];
 const SENSOR_ATTRS: &[&str] = &["name", "periodLevel"];
 const ACTUATOR_ATTRS: &[&str] = &["name", "speedLevel"];
 
-const TASK_USES: [(&str, TaskUseKind); 3] = [
-    ("CheckSensor", TaskUseKind::CheckSensor),
-    ("ExecuteActuator", TaskUseKind::ExecuteActuator),
-    ("ExecuteAlgorithm", TaskUseKind::ExecuteAlgorithm),
-];
-
 struct Reader<'t> {
     file: FileId,
     text: &'t str,
@@ -127,59 +121,44 @@ impl Reader<'_> {
 
     // --- shared helpers ----------------------------------------------------
 
+    fn vocabulary(&self) -> Vocabulary<'static> {
+        Vocabulary {
+            file: self.file,
+            unknown_attribute: Code::StrategyUnknownAttribute,
+            unknown_element: Code::StrategyUnknownElement,
+            elements: ELEMENTS,
+        }
+    }
+
     /// W080 for attributes that the element does not have.
     fn check_attributes(&mut self, e: &Elem, allowed: &[&str]) {
-        for a in &e.attrs {
-            if is_namespace_attribute(&a.key) || allowed.contains(&a.key.as_str()) {
-                continue;
-            }
-            let message = format!(
-                "`<{}>` has no attribute `{}`; it is ignored",
-                e.local, a.key
-            );
-            self.report(Code::StrategyUnknownAttribute, a.key_span, message)
-                .suggest(suggest(&a.key, allowed));
-        }
+        self.vocabulary()
+            .check_attributes(&mut self.diagnostics, e, allowed, |_| None);
     }
 
     /// The children among `allowed`; E082 for the others and for text.
     fn children<'e>(&mut self, e: &'e Elem, allowed: &[&str]) -> Vec<&'e Elem> {
-        if let Some(&text) = e.texts.first() {
-            self.report(
-                Code::StrategyUnknownElement,
-                text,
-                format!("text is not allowed inside `<{}>`", e.local),
-            );
-        }
-        let mut out = Vec::new();
-        for c in &e.children {
-            if allowed.contains(&c.local.as_str()) {
-                out.push(c);
-                continue;
-            }
-            match ELEMENTS.iter().find(|(name, _)| *name == c.local) {
-                Some((name, belongs)) => {
-                    let message = format!(
-                        "`<{name}>` is not allowed inside `<{}>`: it goes {belongs}",
-                        e.local
-                    );
-                    self.report(Code::StrategyUnknownElement, c.name_span, message);
-                }
-                None => {
-                    let message = if allowed.is_empty() {
-                        format!(
-                            "unknown element `<{}>`: `<{}>` cannot contain elements",
-                            c.qname, e.local
-                        )
-                    } else {
-                        format!("unknown element `<{}>` inside `<{}>`", c.qname, e.local)
-                    };
-                    self.report(Code::StrategyUnknownElement, c.name_span, message)
-                        .suggest(suggest(&c.local, allowed));
-                }
-            }
-        }
-        out
+        self.vocabulary()
+            .children(&mut self.diagnostics, e, allowed)
+    }
+
+    /// An element with no attributes of its own around a list of `child`
+    /// elements (`<ActionInfo>` around `<Action>`s): each child read by `read`.
+    fn entries<'e, T>(
+        &mut self,
+        wrapper: &'e Elem,
+        child: &str,
+        mut read: impl FnMut(&mut Self, &'e Elem) -> T,
+    ) -> Vec<T> {
+        self.check_attributes(wrapper, &[]);
+        let children = self.children(wrapper, &[child]);
+        children.into_iter().map(|c| read(self, c)).collect()
+    }
+
+    /// An element with attributes among `allowed` and no children.
+    fn leaf(&mut self, e: &Elem, allowed: &[&str]) {
+        self.check_attributes(e, allowed);
+        self.children(e, &[]);
     }
 
     /// At most one child named `name` among `children`: E085 for the others.
@@ -418,32 +397,22 @@ impl Reader<'_> {
         for section in children {
             match section.local.as_str() {
                 "ValueInfo" => {
-                    self.check_attributes(section, &[]);
-                    for v in self.children(section, &["Value"]) {
-                        let value = self.value(v);
-                        strategy.values.push(value);
-                    }
+                    let values = self.entries(section, "Value", Self::value);
+                    strategy.values.extend(values);
                 }
                 "ServiceInfo" => {
-                    self.check_attributes(section, &[]);
-                    for s in self.children(section, &["Service"]) {
-                        let service = self.service(s);
-                        strategy.services.push(service);
-                    }
+                    let services = self.entries(section, "Service", Self::service);
+                    strategy.services.extend(services);
                 }
                 "GroupingInfo" => {
                     let grouping = self.grouping(section);
                     strategy.grouping = strategy.grouping.take().or(Some(grouping));
                 }
                 _ => {
-                    self.check_attributes(section, &[]);
-                    for b in self.children(section, &["BatteryRequirement"]) {
-                        self.check_attributes(b, &[]);
-                        for c in self.children(b, &["Condition"]) {
-                            let rule = self.battery_rule(c);
-                            strategy.battery_rules.push(rule);
-                        }
-                    }
+                    let rules = self.entries(section, "BatteryRequirement", |r, b| {
+                        r.entries(b, "Condition", Self::battery_rule)
+                    });
+                    strategy.battery_rules.extend(rules.into_iter().flatten());
                 }
             }
         }
@@ -451,8 +420,7 @@ impl Reader<'_> {
     }
 
     fn target(&mut self, e: &Elem) -> TargetRobot {
-        self.check_attributes(e, TARGET_ATTRS);
-        self.children(e, &[]);
+        self.leaf(e, TARGET_ATTRS);
         let name = self.required(e, "name");
         let name = self.ident(name);
         let nick_name = self.optional(e, "nickName");
@@ -495,7 +463,7 @@ impl Reader<'_> {
     }
 
     fn task_use(&mut self, e: &Elem) -> TaskUse {
-        let kind = TASK_USES
+        let kind = TaskUseKind::ALL
             .iter()
             .find(|(tag, _)| *tag == e.local)
             .map_or(TaskUseKind::CheckSensor, |(_, k)| *k);
@@ -515,8 +483,7 @@ impl Reader<'_> {
     }
 
     fn parameter(&mut self, e: &Elem) -> Parameter {
-        self.check_attributes(e, PARAMETER_ATTRS);
-        self.children(e, &[]);
+        self.leaf(e, PARAMETER_ATTRS);
         let name = self.required(e, "name");
         let name = self.ident(name);
         let ty = self.required(e, "type").map(Self::named);
@@ -616,11 +583,7 @@ impl Reader<'_> {
             }
         }
         if let Some(info) = info {
-            self.check_attributes(info, &[]);
-            for a in self.children(info, &["Action"]) {
-                let action = self.action(a);
-                entry.actions.push(action);
-            }
+            entry.actions = self.entries(info, "Action", Self::action);
         }
         entry
     }
@@ -663,11 +626,7 @@ impl Reader<'_> {
             }
         }
         if let Some(info) = info {
-            self.check_attributes(info, &[]);
-            for t in self.children(info, &["Transition"]) {
-                let transition = self.transition(t);
-                action.transitions.push(transition);
-            }
+            action.transitions = self.entries(info, "Transition", Self::transition);
         }
         action
     }
@@ -680,8 +639,7 @@ impl Reader<'_> {
         let dst = self.id(dst);
         let children = self.children(e, &["Condition"]);
         let condition = self.at_most_one(&children, "Condition").and_then(|c| {
-            self.check_attributes(c, CONDITION_ATTRS);
-            self.children(c, &[]);
+            self.leaf(c, CONDITION_ATTRS);
             self.condition(c)
         });
         Transition {
@@ -698,8 +656,7 @@ impl Reader<'_> {
         let leader = self.at_most_one(&children, "LeaderSelectionInfo");
         let sync = self.at_most_one(&children, "GroupSync");
         let leader_selection = leader.map(|l| {
-            self.check_attributes(l, LEADER_ATTRS);
-            self.children(l, &[]);
+            self.leaf(l, LEADER_ATTRS);
             let algorithm = self
                 .required(l, "algorithm")
                 .and_then(|a| self.choice(a, &LeaderAlgorithm::ALL));
@@ -726,8 +683,7 @@ impl Reader<'_> {
             }
         });
         let sync_timeout = sync.and_then(|s| {
-            self.check_attributes(s, SYNC_ATTRS);
-            self.children(s, &[]);
+            self.leaf(s, SYNC_ATTRS);
             let timeout = self.required(s, "timeout");
             self.duration(timeout)
         });
@@ -753,8 +709,7 @@ impl Reader<'_> {
             } else {
                 (ACTUATOR_ATTRS, "speedLevel")
             };
-            self.check_attributes(c, attrs);
-            self.children(c, &[]);
+            self.leaf(c, attrs);
             let name = self.required(c, "name").map(Self::named);
             let level = self.required(c, level_key).and_then(|a| self.number(a, 0));
             let setting = LevelSetting {

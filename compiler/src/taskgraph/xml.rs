@@ -44,8 +44,8 @@ use crate::diag::{Code, Diagnostic, FileId, sort_and_dedup};
 use crate::span::Span;
 use crate::suggest::did_you_mean;
 use crate::syntax::ast::TimeUnit;
-use crate::xmlpos::{Attr, get, is_ident, is_namespace_attribute, shown, suggest};
-use crate::xmltree::{Elem, TreeFormat, one_line_diagnostic, read_tree};
+use crate::xmlpos::{Attr, get, is_ident, shown, suggest};
+use crate::xmltree::{Elem, TreeFormat, Vocabulary, one_line_diagnostic, read_tree};
 use quick_xml::Reader;
 use quick_xml::events::Event;
 use std::collections::{HashMap, HashSet};
@@ -228,69 +228,28 @@ struct Loader<'s> {
 impl Loader<'_> {
     // --- shared helpers ----------------------------------------------------
 
+    fn vocabulary(&self) -> Vocabulary<'static> {
+        Vocabulary {
+            file: self.file,
+            unknown_attribute: Code::GraphUnknownAttribute,
+            unknown_element: Code::GraphUnknownElement,
+            elements: SEMO_ELEMENTS,
+        }
+    }
+
     /// W060 for attributes that the element does not have.
     fn check_attributes(&mut self, e: &Elem, allowed: &[&str]) {
-        for a in &e.attrs {
-            if is_namespace_attribute(&a.key) || allowed.contains(&a.key.as_str()) {
-                continue;
-            }
-            let message = format!(
-                "`<{}>` has no attribute `{}`; it is ignored",
-                e.local, a.key
-            );
-            // A loop node's port has an outer and an inner rate.
-            let suggestion = if a.key == "rate" && allowed.contains(&"outerRate") {
-                Some("outerRate".to_string())
-            } else {
-                suggest(&a.key, allowed)
-            };
-            self.sink
-                .report(Code::GraphUnknownAttribute, a.key_span, message)
-                .suggest(suggestion);
-        }
+        // A loop node's port has an outer and an inner rate.
+        let hint = |key: &str| {
+            (key == "rate" && allowed.contains(&"outerRate")).then(|| "outerRate".to_string())
+        };
+        self.vocabulary()
+            .check_attributes(&mut self.sink.list, e, allowed, hint);
     }
 
     /// The child elements among `allowed`; E061 for the others and for text.
     fn children<'e>(&mut self, e: &'e Elem, allowed: &[&str]) -> Vec<&'e Elem> {
-        if let Some(&text) = e.texts.first() {
-            self.sink.report(
-                Code::GraphUnknownElement,
-                text,
-                format!("text is not allowed inside `<{}>`", e.local),
-            );
-        }
-        let mut out = Vec::new();
-        for c in &e.children {
-            if allowed.contains(&c.local.as_str()) {
-                out.push(c);
-                continue;
-            }
-            let known = SEMO_ELEMENTS.iter().find(|(name, _)| *name == c.local);
-            match known {
-                Some((name, belongs)) => {
-                    let message = format!(
-                        "`<{name}>` is not allowed inside `<{}>`: it goes {belongs}",
-                        e.local
-                    );
-                    self.sink
-                        .report(Code::GraphUnknownElement, c.name_span, message);
-                }
-                None => {
-                    let message = if allowed.is_empty() {
-                        format!(
-                            "unknown element `<{}>`: `<{}>` cannot contain elements",
-                            c.qname, e.local
-                        )
-                    } else {
-                        format!("unknown element `<{}>` inside `<{}>`", c.qname, e.local)
-                    };
-                    self.sink
-                        .report(Code::GraphUnknownElement, c.name_span, message)
-                        .suggest(suggest(&c.local, allowed));
-                }
-            }
-        }
-        out
+        self.vocabulary().children(&mut self.sink.list, e, allowed)
     }
 
     /// A required attribute: E062 when missing, E065 when blank.

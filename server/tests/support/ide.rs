@@ -108,6 +108,45 @@ impl Session {
     }
 }
 
+/// Snapshots `render(&mut session, &doc)` for each fixture matching `glob`
+/// (relative to the calling test file), opened as a document in one session;
+/// `needs` is what a fixture must have (`cursors`, `diagnostics`), with the
+/// message when it has none. A macro, so that `insta` names the snapshots
+/// after the calling test.
+#[macro_export]
+macro_rules! snapshot_fixtures {
+    ($glob:literal, $needs:ident, $message:literal, $render:expr) => {{
+        let mut session = $crate::support::ide::Session::new();
+        insta::glob!($glob, |path| {
+            let doc = session.open_fixture(path);
+            assert!(!doc.$needs.is_empty(), $message);
+            insta::assert_snapshot!($render(&mut session, &doc));
+        });
+        session.shutdown();
+    }};
+}
+
+/// For each cursor of `doc`: the line with the cursor, then what `render`
+/// makes of the result of `method` there, or `(nothing)` when it gives `None`.
+pub fn render_cursors(
+    session: &mut Session,
+    doc: &Doc,
+    method: &str,
+    mut render: impl FnMut(&Value) -> Option<String>,
+) -> String {
+    let mut out = String::new();
+    for position in &doc.cursors {
+        let result = session.at(method, doc, position);
+        out.push_str(&show_position(&doc.text, position));
+        out.push('\n');
+        match render(&result) {
+            Some(shown) => out.push_str(&shown),
+            None => out.push_str("(nothing)\n\n"),
+        }
+    }
+    out
+}
+
 /// Where a position is, for a reader: the line with `$0` at the position.
 pub fn show_position(text: &str, position: &Value) -> String {
     let line = position["line"].as_u64().unwrap() as usize;
