@@ -106,3 +106,29 @@ async def test_completion_offers_the_services_the_robots_have(client: LanguageCl
     # Snippets were offered by this client: the parameters are placeholders.
     assert move.insert_text_format == types.InsertTextFormat.Snippet
     assert move.text_edit.new_text.startswith("move($1")
+
+
+async def test_rename_a_mode_everywhere_it_is_used(client: LanguageClient):
+    open_mission(client, MISSION.replace("mvoe", "move"))
+    assert list(await diagnostics_for_version(client, 1)) == []
+    # `GO` in `Base.GO{ ... }`, line 6.
+    at = types.Position(line=6, character=6)
+    prepared = await client.text_document_prepare_rename_async(
+        types.PrepareRenameParams(text_document=types.TextDocumentIdentifier(uri=URI), position=at)
+    )
+    assert prepared is not None
+    edit = await client.text_document_rename_async(
+        types.RenameParams(
+            text_document=types.TextDocumentIdentifier(uri=URI), position=at, new_name="PATROL"
+        )
+    )
+    changes = edit.changes[URI] if edit.changes else edit.document_changes[0].edits
+    lines = MISSION.replace("mvoe", "move").split("\n")
+    for change in sorted(changes, key=lambda c: (c.range.start.line, c.range.start.character), reverse=True):
+        line = lines[change.range.start.line]
+        start, end = change.range.start.character, change.range.end.character
+        assert line[start:end] == "GO"
+        lines[change.range.start.line] = line[:start] + change.new_text + line[end:]
+    renamed = "\n".join(lines)
+    assert "Base.PATROL{" in renamed and "mode = PATROL" in renamed
+    assert "GO" not in renamed.replace("Go", "")
