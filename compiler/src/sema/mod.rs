@@ -59,7 +59,12 @@ impl Analysis {
 
 /// Parses and checks one mission script.
 pub fn check_source(file: FileId, text: &str, catalog: &Catalog) -> Analysis {
-    let parse = syntax::parse(file, text);
+    check_parsed(file, syntax::parse(file, text), catalog)
+}
+
+/// Checks a mission script already parsed (by [`syntax::parse`] or
+/// [`syntax::parse_incremental`]): the same analysis as [`check_source`].
+pub fn check_parsed(file: FileId, parse: syntax::Parse, catalog: &Catalog) -> Analysis {
     let (mission, mut diagnostics) = check(file, &parse.file, catalog);
     diagnostics.extend(parse.diagnostics);
     diag::sort_and_dedup(&mut diagnostics);
