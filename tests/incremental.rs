@@ -165,11 +165,9 @@ fn splice(text: &str, start: usize, n: usize, with: &str) -> String {
 fn apply(text: &str, edit: &Edit, history: &[String]) -> String {
     let lines: Vec<&str> = text.split_inclusive('\n').collect();
     match edit {
-        Edit::Type(at, what) => splice(text, boundary(text, at), 0, *what.get::<&str>(TYPED)),
+        Edit::Type(at, what) => splice(text, boundary(text, at), 0, what.get::<&str>(TYPED)),
         Edit::Delete(at, n) => splice(text, boundary(text, at), *n, ""),
-        Edit::Replace(at, n, what) => {
-            splice(text, boundary(text, at), *n, *what.get::<&str>(TYPED))
-        }
+        Edit::Replace(at, n, what) => splice(text, boundary(text, at), *n, what.get::<&str>(TYPED)),
         Edit::DeleteLine(at) if !lines.is_empty() => {
             let i = at.index(lines.len());
             let mut lines = lines;

@@ -204,8 +204,6 @@ struct FileEntry {
     /// Where the file is on disk, if it is a `file:` URI.
     path: Option<PathBuf>,
     snapshot: Arc<Snapshot>,
-    /// Handed from each snapshot of the file to the next.
-    parses: Arc<ParseSlot>,
 }
 
 #[derive(Default)]
@@ -398,13 +396,7 @@ impl World {
         } else {
             self.catalog()
         };
-        let parses = self
-            .files
-            .get(&uri)
-            .map(|f| f.parses.clone())
-            .unwrap_or_default();
-        let snapshot =
-            Arc::new(self.new_snapshot(&uri, id, kind, version, text, catalog, parses.clone()));
+        let snapshot = Arc::new(self.new_snapshot(&uri, id, kind, version, text, catalog));
         self.files.insert(
             uri.clone(),
             FileEntry {
@@ -412,7 +404,6 @@ impl World {
                 document,
                 path,
                 snapshot,
-                parses,
             },
         );
         let mut changed = if is_catalog {
@@ -436,7 +427,6 @@ impl World {
         version: Option<i32>,
         text: Arc<str>,
         catalog: Arc<CatalogState>,
-        parses: Arc<ParseSlot>,
     ) -> Snapshot {
         let missions = if kind == FileKind::Strategy {
             self.files
@@ -456,7 +446,12 @@ impl World {
             catalog,
             encoding: self.encoding,
             missions,
-            parses,
+            // Handed from each snapshot of the file to the next.
+            parses: self
+                .files
+                .get(uri)
+                .map(|f| f.snapshot.parses.clone())
+                .unwrap_or_default(),
             analysis: OnceLock::new(),
         }
     }
@@ -480,7 +475,6 @@ impl World {
                 old.version,
                 old.text.clone(),
                 catalog.clone(),
-                old.parses.clone(),
             ));
             self.files.get_mut(uri).expect("listed above").snapshot = fresh;
         }
@@ -508,7 +502,6 @@ impl World {
                 old.version,
                 old.text.clone(),
                 catalog.clone(),
-                old.parses.clone(),
             ));
             self.files.get_mut(&uri).expect("listed above").snapshot = fresh;
             changed.files.push(uri);
