@@ -1,28 +1,33 @@
 //! Incremental parsing: a new version of a file parsed with what is still
-//! valid from the previous one, so that a keystroke re-lexes a few lines and
+//! valid from the previous one, so that a keystroke re-lexes a line or two and
 //! re-parses one chunk. The result is always exactly [`super::parse`]'s.
 //!
 //! How it stays exact:
 //! - No token spans a newline, so the lines that did not change lex to the same
 //!   tokens. The texts are compared (common prefix and suffix); only the lines
 //!   from the first difference to the end of the last one are lexed again, and
-//!   the old tokens after them are moved by the change in length.
-//! - The file is cut into chunks again, over all tokens (a linear pass).
+//!   the old tokens after them are moved by the change in length. Lexical
+//!   diagnostics are kept and moved the same way.
+//! - Chunks are cut again only around the edit: from the last chunk start at
+//!   least six tokens before the first re-lexed token (cutting reads at most
+//!   six tokens ahead, and the state after a cut is always the same), until a
+//!   chunk starts, past the re-lexed tokens, where an old chunk started. The
+//!   chunks before and after are the old ones (see [`chunks::split_from`]).
 //! - A chunk's items and syntax diagnostics depend only on the chunk's own text
 //!   (from its first token to its last; bracket balancing and the parser look
 //!   at nothing else, and only at relative positions). So a chunk whose text is
 //!   unchanged takes the items and diagnostics parsed before, with every
-//!   position moved by the distance the chunk moved. A chunk is found at its
-//!   old place (before or after the edit, free to confirm: the texts there are
+//!   position moved by the distance the chunk moved. Around the edit a chunk is
+//!   found at its old place (before or after the edit, where the texts are
 //!   equal by construction), else by the hash of its text, confirmed by
-//!   comparing the texts.
-//! - Lexical diagnostics come from all tokens, as in `parse`; then each chunk's
-//!   diagnostics in chunk order, sorted stably by position as in `parse`.
+//!   comparing the texts; the rest is parsed.
+//! - Diagnostics are assembled as `parse` does: lexical ones first, then each
+//!   chunk's in chunk order, sorted stably by position.
 
 use super::shift::Shift;
 use super::token::{self, Token};
 use super::{ChunkParse, Parse, ast, chunks, lex, parallel, parse_ranges, report_lexical_errors};
-use crate::diag::FileId;
+use crate::diag::{Diagnostic, FileId};
 use crate::span::Span;
 use chumsky::span::SimpleSpan;
 use std::collections::HashMap;
@@ -36,9 +41,14 @@ use std::sync::Arc;
 pub struct ParseCache {
     file: FileId,
     text: Box<str>,
-    /// Every token of `text` as the lexer gave it (lexical errors included),
-    /// with the text of names, numbers and strings left out: `text[span]`.
+    /// The tokens the parser reads (lexical errors repaired: unknown characters
+    /// dropped, unterminated strings taken as strings), with the text of
+    /// names, numbers and strings left out: it is `text[span]`.
     tokens: Vec<RawToken>,
+    /// The lexical diagnostics (unknown characters, unterminated strings), in
+    /// order.
+    lexical: Vec<Diagnostic>,
+    /// The chunks, in order.
     chunks: Vec<CachedChunk>,
     /// Chunks parsed anew (not reused) when this cache was made.
     reparsed: usize,
@@ -50,13 +60,17 @@ type RawToken = (Token<'static>, SimpleSpan);
 
 #[derive(Clone)]
 struct CachedChunk {
-    /// The chunk's text in the cache's text: its first token's start to its
-    /// last token's end.
+    /// The chunk's tokens.
+    tokens: Range<usize>,
+    /// The chunk's text: its first token's start to its last token's end.
     span: Span,
     /// The hash of that text.
     hash: u64,
     parsed: Arc<ParsedChunk>,
 }
+
+/// A chunk of the previous version with the same text: its parse and hash.
+type Found = (Arc<ParsedChunk>, u64);
 
 struct ParsedChunk {
     /// Where the chunk's text started when it was parsed: its items and
@@ -105,85 +119,120 @@ pub fn parse_incremental(
     text: &str,
     previous: Option<&ParseCache>,
 ) -> (Parse, ParseCache) {
-    let previous = previous.filter(|p| p.file == file);
-    let (old_text, old_tokens, old_chunks): (&str, &[RawToken], &[CachedChunk]) = match previous {
-        Some(p) => (&p.text, &p.tokens, &p.chunks),
-        None => ("", &[], &[]),
+    let empty = ParseCache {
+        file,
+        text: Box::default(),
+        tokens: Vec::new(),
+        lexical: Vec::new(),
+        chunks: Vec::new(),
+        reparsed: 0,
+        relexed: 0..0,
     };
-    let edit = Edit::between(old_text, text);
-    let raw = relex(old_tokens, text, &edit);
+    let old = previous.filter(|p| p.file == file).unwrap_or(&empty);
+    let edit = Edit::between(&old.text, text);
+    let lexed = relex(file, old, text, &edit);
+    let tokens = &lexed.tokens;
 
-    let mut diagnostics = Vec::new();
-    let mut tokens: Vec<token::Spanned<'_>> = raw
-        .iter()
-        .map(|&(t, span)| (with_text(t, text, span), span))
-        .collect();
-    report_lexical_errors(file, &mut tokens, &mut diagnostics);
-    let ranges = chunks::split(&tokens);
+    // Cut chunks again from a chunk start far enough before the edit...
+    let resume = old
+        .chunks
+        .partition_point(|c| c.tokens.start + 6 <= lexed.kept_before)
+        .saturating_sub(1);
+    let from = old.chunks.get(resume).map_or(0, |c| c.tokens.start);
+    // ...until a chunk starts after the new tokens where an old one did.
+    let in_old = |i: usize| i - lexed.kept_after + lexed.kept_after_old;
+    let old_chunk_at = |i: usize| old.chunks.binary_search_by_key(&i, |c| c.tokens.start).ok();
+    let (middle, stop) = chunks::split_from(tokens, from, |at| {
+        at >= lexed.kept_after && old_chunk_at(in_old(at)).is_some()
+    });
+    let after = match stop < tokens.len() {
+        true => old_chunk_at(in_old(stop)).unwrap_or(old.chunks.len()),
+        false => old.chunks.len(),
+    };
+    let token_delta = lexed.kept_after as isize - lexed.kept_after_old as isize;
+    let byte_delta = edit.delta();
 
-    // Each chunk: reused from the previous version, or to be parsed.
+    // Each chunk around the edit: found in the previous version, or parsed.
     let mut finder = Finder {
-        old_text,
-        old_chunks,
+        old_text: &old.text,
+        old_chunks: &old.chunks,
         by_hash: None,
     };
-    let mut reuse: Vec<Option<(Arc<ParsedChunk>, u64)>> = Vec::with_capacity(ranges.len());
-    let mut spans: Vec<Span> = Vec::with_capacity(ranges.len());
+    let mut around: Vec<(Range<usize>, Span, Option<Found>)> = Vec::with_capacity(middle.len());
     let mut to_parse: Vec<Range<usize>> = Vec::new();
+    // Only the chunks to parse get the text of their tokens back.
+    let mut readable: Vec<token::Spanned<'_>> = Vec::new();
     let mut parse_bytes = 0;
-    for range in &ranges {
+    for range in middle {
         let span = Span::new(tokens[range.start].1.start, tokens[range.end - 1].1.end);
         let found = finder.find(text, span, &edit);
         if found.is_none() {
-            to_parse.push(range.clone());
+            let start = readable.len();
+            readable.extend(
+                tokens[range.clone()]
+                    .iter()
+                    .map(|&(t, s)| (with_text(t, text, s), s)),
+            );
+            to_parse.push(start..readable.len());
             parse_bytes += span.len();
         }
-        reuse.push(found);
-        spans.push(span);
+        around.push((range, span, found));
     }
     let mut parsed =
-        parse_ranges(file, text, &tokens, &to_parse, parallel(parse_bytes)).into_iter();
+        parse_ranges(file, text, &readable, &to_parse, parallel(parse_bytes)).into_iter();
 
-    let mut items = Vec::new();
-    let mut chunks = Vec::with_capacity(ranges.len());
-    for (span, found) in spans.into_iter().zip(reuse) {
-        let (chunk, hash) = match found {
-            Some((chunk, hash)) => {
-                let delta = span.start as isize - chunk.at as isize;
-                let start = items.len();
-                items.extend_from_slice(&chunk.result.items);
-                let first = diagnostics.len();
-                diagnostics.extend_from_slice(&chunk.result.diagnostics);
-                if delta != 0 {
-                    items[start..].shift_all(delta);
-                    diagnostics[first..].shift_all(delta);
-                }
-                (chunk, hash)
-            }
-            None => {
-                // `parse_ranges` gives one result per range, in order.
-                let result = parsed.next().unwrap_or_default();
-                items.extend_from_slice(&result.items);
-                diagnostics.extend_from_slice(&result.diagnostics);
-                let chunk = Arc::new(ParsedChunk {
+    let mut chunks: Vec<CachedChunk> = Vec::with_capacity(old.chunks.len() + around.len());
+    chunks.extend_from_slice(&old.chunks[..resume]);
+    for (range, span, found) in around {
+        let (parsed, hash) = found.unwrap_or_else(|| {
+            // `parse_ranges` gives one result per range, in order.
+            let result = parsed.next().unwrap_or_default();
+            let hash = hash_text(&text[span.range()]);
+            (
+                Arc::new(ParsedChunk {
                     at: span.start,
                     result,
-                });
-                (chunk, hash_text(&text[span.range()]))
-            }
-        };
+                }),
+                hash,
+            )
+        });
         chunks.push(CachedChunk {
+            tokens: range,
             span,
             hash,
-            parsed: chunk,
+            parsed,
         });
+    }
+    chunks.extend(old.chunks[after..].iter().map(|c| CachedChunk {
+        tokens: c.tokens.start.wrapping_add_signed(token_delta)
+            ..c.tokens.end.wrapping_add_signed(token_delta),
+        span: c.span.shifted(byte_delta),
+        hash: c.hash,
+        parsed: c.parsed.clone(),
+    }));
+
+    // The parse: every chunk's items and diagnostics where the chunk is now.
+    let mut items = Vec::new();
+    let mut diagnostics = lexed.lexical.clone();
+    for chunk in &chunks {
+        let parsed = &chunk.parsed;
+        let delta = chunk.span.start as isize - parsed.at as isize;
+        let start = items.len();
+        items.extend_from_slice(&parsed.result.items);
+        let first = diagnostics.len();
+        diagnostics.extend_from_slice(&parsed.result.diagnostics);
+        if delta != 0 {
+            items[start..].shift_all(delta);
+            diagnostics[first..].shift_all(delta);
+        }
     }
     diagnostics.sort_by_key(|d| (d.span.start, d.span.end));
 
     let cache = ParseCache {
         file,
         text: text.into(),
-        tokens: raw,
+        tokens: lexed.tokens,
+        lexical: lexed.lexical,
         chunks,
         reparsed: to_parse.len(),
         relexed: edit.lines_start..edit.new_lines_end,
@@ -287,26 +336,69 @@ fn common_suffix(a: &[u8], b: &[u8]) -> usize {
     i
 }
 
+/// The tokens and lexical diagnostics of a new version.
+struct Lexed {
+    tokens: Vec<RawToken>,
+    lexical: Vec<Diagnostic>,
+    /// Tokens kept from before the edited lines (the same in both versions).
+    kept_before: usize,
+    /// Where the tokens kept from after the edited lines start, in the new
+    /// tokens and in the old.
+    kept_after: usize,
+    kept_after_old: usize,
+}
+
 /// The tokens of the new text: the old ones before the edited lines, those
-/// lines lexed again, and the old ones after them, moved.
-fn relex(old: &[RawToken], text: &str, edit: &Edit) -> Vec<RawToken> {
-    let keep_before = old.partition_point(|t| t.1.start < edit.lines_start);
-    let keep_after = old.partition_point(|t| t.1.start < edit.old_lines_end);
+/// lines lexed again, and the old ones after them, moved; the same for the
+/// lexical diagnostics.
+fn relex(file: FileId, old: &ParseCache, text: &str, edit: &Edit) -> Lexed {
+    let kept_before = old.tokens.partition_point(|t| t.1.start < edit.lines_start);
+    let kept_after_old = old
+        .tokens
+        .partition_point(|t| t.1.start < edit.old_lines_end);
     let lines = &text[edit.lines_start..edit.new_lines_end];
-    let fresh = lex(lines, parallel(lines.len()));
-    let delta = edit.delta();
-    let mut tokens = Vec::with_capacity(keep_before + fresh.len() + (old.len() - keep_after));
-    tokens.extend_from_slice(&old[..keep_before]);
-    tokens.extend(fresh.into_iter().map(|(t, s)| {
-        let s = SimpleSpan::from(s.start + edit.lines_start..s.end + edit.lines_start);
-        (without_text(t), s)
+    let mut fresh = lex(lines, parallel(lines.len()));
+    let mut fresh_lexical = Vec::new();
+    report_lexical_errors(file, &mut fresh, &mut fresh_lexical);
+
+    let (base, delta) = (edit.lines_start as isize, edit.delta());
+    let moved = |s: SimpleSpan, by: isize| {
+        SimpleSpan::from(s.start.wrapping_add_signed(by)..s.end.wrapping_add_signed(by))
+    };
+    let after = &old.tokens[kept_after_old..];
+    let mut tokens = Vec::with_capacity(kept_before + fresh.len() + after.len());
+    tokens.extend_from_slice(&old.tokens[..kept_before]);
+    tokens.extend(
+        fresh
+            .into_iter()
+            .map(|(t, s)| (without_text(t), moved(s, base))),
+    );
+    let kept_after = tokens.len();
+    tokens.extend(after.iter().map(|&(t, s)| (t, moved(s, delta))));
+
+    let lexical_before = old
+        .lexical
+        .partition_point(|d| d.span.start < edit.lines_start);
+    let lexical_after = old
+        .lexical
+        .partition_point(|d| d.span.start < edit.old_lines_end);
+    let mut lexical = old.lexical[..lexical_before].to_vec();
+    lexical.extend(fresh_lexical.into_iter().map(|mut d| {
+        d.shift(base);
+        d
     }));
-    tokens.extend(old[keep_after..].iter().map(|&(t, s)| {
-        let s =
-            SimpleSpan::from(s.start.wrapping_add_signed(delta)..s.end.wrapping_add_signed(delta));
-        (t, s)
+    lexical.extend(old.lexical[lexical_after..].iter().map(|d| {
+        let mut d = d.clone();
+        d.shift(delta);
+        d
     }));
-    tokens
+    Lexed {
+        tokens,
+        lexical,
+        kept_before,
+        kept_after,
+        kept_after_old,
+    }
 }
 
 /// Finds the parse of a chunk of the previous version with the same text.
@@ -318,7 +410,7 @@ struct Finder<'a> {
 }
 
 impl Finder<'_> {
-    fn find(&mut self, text: &str, span: Span, edit: &Edit) -> Option<(Arc<ParsedChunk>, u64)> {
+    fn find(&mut self, text: &str, span: Span, edit: &Edit) -> Option<Found> {
         // Wholly before or wholly after the edit: the old chunk at the same
         // place (moved by the edit) has the same text if it has the same length.
         let old_span = if span.end <= edit.prefix {
@@ -485,6 +577,18 @@ mod tests {
         // Unbalancing a brace: the header after it still starts a chunk.
         chain(&[MISSION, &MISSION.replacen('}', "", 1), MISSION]);
         chain(&[MISSION, &MISSION.replacen('{', "", 2), MISSION]);
+    }
+
+    #[test]
+    fn an_edit_to_a_header_written_over_lines() {
+        // Only the brace's line is lexed again, but the chunk start two lines
+        // up depends on it: the mode's header stops being one, and its text
+        // joins the service's chunk.
+        let text = "A.P.S {\n stop() }\nA.M\n{ set(P, S) }\n";
+        let cache = chain(&[text, &text.replace("\n{", "\n("), text]);
+        assert_eq!(cache.chunks(), 2);
+        let text = "A.P.S { stop() }\ndef\nf\n{ stop() }\n";
+        chain(&[text, &text.replace("\n{", "\n("), text]);
     }
 
     #[test]
