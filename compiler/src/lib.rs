@@ -13,6 +13,8 @@
 pub mod catalog;
 pub mod cli;
 pub mod diag;
+/// A fast deterministic hasher for the checker's maps.
+mod fasthash;
 pub mod sema;
 pub mod span;
 pub mod strategy;
