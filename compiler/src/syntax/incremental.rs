@@ -28,9 +28,9 @@ use super::shift::Shift;
 use super::token::{self, Token};
 use super::{ChunkParse, Parse, ast, chunks, lex, parallel, parse_ranges, report_lexical_errors};
 use crate::diag::{Diagnostic, FileId};
+use crate::fasthash::{FastHasher, FastMap};
 use crate::span::Span;
 use chumsky::span::SimpleSpan;
-use std::collections::HashMap;
 use std::hash::Hasher;
 use std::ops::Range;
 use std::sync::Arc;
@@ -212,8 +212,15 @@ pub fn parse_incremental(
     }));
 
     // The parse: every chunk's items and diagnostics where the chunk is now.
-    let mut items = Vec::new();
-    let mut diagnostics = lexed.lexical.clone();
+    let (item_count, diagnostic_count) = chunks.iter().fold((0, 0), |(i, d), c| {
+        (
+            i + c.parsed.result.items.len(),
+            d + c.parsed.result.diagnostics.len(),
+        )
+    });
+    let mut items = Vec::with_capacity(item_count);
+    let mut diagnostics = Vec::with_capacity(lexed.lexical.len() + diagnostic_count);
+    diagnostics.extend_from_slice(&lexed.lexical);
     for chunk in &chunks {
         let parsed = &chunk.parsed;
         let delta = chunk.span.start as isize - parsed.at as isize;
@@ -406,7 +413,7 @@ struct Finder<'a> {
     old_text: &'a str,
     old_chunks: &'a [CachedChunk],
     /// Old chunks by the hash of their text, built when first needed.
-    by_hash: Option<HashMap<u64, usize>>,
+    by_hash: Option<FastMap<u64, usize>>,
 }
 
 impl Finder<'_> {
@@ -435,7 +442,8 @@ impl Finder<'_> {
         let hash = hash_text(chunk_text);
         let old_chunks = self.old_chunks;
         let by_hash = self.by_hash.get_or_insert_with(|| {
-            let mut map = HashMap::with_capacity(old_chunks.len());
+            let mut map = FastMap::default();
+            map.reserve(old_chunks.len());
             for (i, c) in old_chunks.iter().enumerate() {
                 map.entry(c.hash).or_insert(i);
             }
@@ -447,8 +455,8 @@ impl Finder<'_> {
 }
 
 fn hash_text(text: &str) -> u64 {
-    // Fixed keys: the same text always hashes the same.
-    let mut hasher = std::hash::DefaultHasher::new();
+    // Deterministic and fast; a collision costs only a comparison of texts.
+    let mut hasher = FastHasher::default();
     hasher.write(text.as_bytes());
     hasher.finish()
 }
