@@ -12,6 +12,7 @@ use chumsky::span::SimpleSpan;
 type Tok<'s> = (Token<'s>, SimpleSpan);
 
 /// If an item header starts at token `i`, the index of its opening brace.
+#[inline(always)]
 fn header_brace(tokens: &[Tok<'_>], i: usize) -> Option<usize> {
     let at = |k: usize| tokens.get(i + k).map(|t| t.0);
     let ident = |k: usize| matches!(at(k), Some(Token::Ident(_)));
@@ -50,16 +51,6 @@ pub fn split_from(
     let mut chunks = Vec::new();
     let mut start = from;
     let mut depth: usize = 0;
-    // Whether a chunk starting at `at` was cut off, and the split should stop there.
-    let mut cut = |chunks: &mut Vec<std::ops::Range<usize>>, start: &mut usize, at: usize| {
-        if at > *start {
-            chunks.push(*start..at);
-            *start = at;
-            at < tokens.len() && stop(at)
-        } else {
-            false
-        }
-    };
     // The brace that opens the body of the header seen last: not a new chunk.
     let mut body_brace = None;
     for i in from..tokens.len() {
@@ -74,7 +65,7 @@ pub fn split_from(
                 && matches!(token, Token::Ident(_))
                 && tokens.get(i + 1).map(|t| t.0) == Some(Token::Colon))
         {
-            if cut(&mut chunks, &mut start, i) {
+            if cut(&mut chunks, &mut start, i) && stop(i) {
                 return (chunks, i);
             }
             depth = 0;
@@ -85,10 +76,10 @@ pub fn split_from(
         match token {
             Token::LBrace => depth += 1,
             Token::RBrace if depth == 0 => {
-                if cut(&mut chunks, &mut start, i) {
+                if cut(&mut chunks, &mut start, i) && stop(i) {
                     return (chunks, i);
                 }
-                if cut(&mut chunks, &mut start, i + 1) {
+                if cut(&mut chunks, &mut start, i + 1) && i + 1 < tokens.len() && stop(i + 1) {
                     return (chunks, i + 1);
                 }
             }
@@ -98,6 +89,18 @@ pub fn split_from(
     }
     cut(&mut chunks, &mut start, tokens.len());
     (chunks, tokens.len())
+}
+
+/// Ends the chunk that began at `start` before token `at`, if it is not
+/// empty; whether it did (a new chunk starts at `at`).
+fn cut(chunks: &mut Vec<std::ops::Range<usize>>, start: &mut usize, at: usize) -> bool {
+    if at > *start {
+        chunks.push(*start..at);
+        *start = at;
+        true
+    } else {
+        false
+    }
 }
 
 #[cfg(test)]
