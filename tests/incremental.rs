@@ -4,7 +4,8 @@
 //! undo) are applied to the reference examples, the repository's missions and
 //! fixtures and a generated mission, and after every edit
 //! `syntax::parse_incremental`, chained from an earlier version's cache, must
-//! equal `syntax::parse`: items, positions, diagnostics and their order.
+//! equal `syntax::parse`: items, positions, diagnostics and their order. So
+//! must any text parsed with the cache of any other.
 
 mod support;
 
@@ -276,6 +277,35 @@ proptest! {
         edits in edits(24),
     ) {
         check_edits(which.get::<String>(corpus()), &edits)?;
+    }
+}
+
+/// Text made of the characters that matter to lexing and cutting chunks.
+const SOUP: &str = "[{}()\\[\\]\"\\\\#\n .:,;=<>!@a-fTMPS0-9한😀]{0,160}";
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 600, ..ProptestConfig::default() })]
+
+    /// Any text parsed with the cache of any other gives what parsing it
+    /// from scratch gives; so does one sharing a beginning and an end with it.
+    #[test]
+    fn any_text_after_any_other_parses_as_from_scratch(
+        a in SOUP,
+        b in SOUP,
+        middle in SOUP,
+    ) {
+        let file = FileId(1);
+        let (_, cache) = parse_incremental(file, &a, None);
+        let (incremental, _) = parse_incremental(file, &b, Some(&cache));
+        if let Some(diff) = difference(&incremental, &parse(file, &b)) {
+            return Err(TestCaseError::fail(format!("{a:?} then {b:?}: {diff}")));
+        }
+        let joined = format!("{a}{middle}{b}");
+        let (_, cache) = parse_incremental(file, &format!("{a}\n{b}"), None);
+        let (incremental, _) = parse_incremental(file, &joined, Some(&cache));
+        if let Some(diff) = difference(&incremental, &parse(file, &joined)) {
+            return Err(TestCaseError::fail(format!("{joined:?}: {diff}")));
+        }
     }
 }
 
