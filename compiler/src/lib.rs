@@ -17,6 +17,8 @@
 pub mod catalog;
 pub mod cli;
 pub mod diag;
+/// A fast deterministic hasher for the checker's maps.
+mod fasthash;
 pub mod format;
 pub mod ide;
 pub mod sema;

@@ -41,6 +41,16 @@ impl Span {
     pub fn range(self) -> std::ops::Range<usize> {
         self.start..self.end
     }
+
+    /// The same range `delta` bytes later (earlier when negative): where text
+    /// that moved keeps its positions. Wraps rather than panics; callers shift
+    /// only ranges that stay inside their text.
+    pub fn shifted(self, delta: isize) -> Span {
+        Span::new(
+            self.start.wrapping_add_signed(delta),
+            self.end.wrapping_add_signed(delta),
+        )
+    }
 }
 
 impl fmt::Debug for Span {

@@ -41,8 +41,14 @@ async fn run() {
     // Type a character at the end of the first line (a comment), then delete
     // it: every version is a real edit that must be re-checked.
     let line0_len = text.lines().next().unwrap().encode_utf16().count() as u32;
-    let mut latencies = Vec::with_capacity(1000);
-    for i in 0..1000u32 {
+    // `SEMO_BENCH_EDITS` (default 1000): fewer, to count instructions per
+    // edit under callgrind (the difference between two counts).
+    let edits: u32 = std::env::var("SEMO_BENCH_EDITS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1000);
+    let mut latencies = Vec::with_capacity(edits as usize);
+    for i in 0..edits {
         let version = i as i64 + 2;
         let (range, new_text) = if i % 2 == 0 {
             ((line0_len, line0_len), "x")
@@ -100,6 +106,9 @@ async fn run() {
 }
 
 fn report(what: &str, samples: &mut [Duration]) {
+    if samples.is_empty() {
+        return;
+    }
     samples.sort();
     let at = |q: f64| samples[((samples.len() - 1) as f64 * q).round() as usize];
     println!(

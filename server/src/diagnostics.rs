@@ -5,7 +5,7 @@
 
 use crate::State;
 use crate::encoding::LineMap;
-use crate::world::{FileAnalysis, Snapshot};
+use crate::world::{FileAnalysis, Snapshot, retire};
 use semo::catalog::BUILTIN_FILE;
 use semo::diag::{Code, FileId, Severity};
 use semo::text::LineIndex;
@@ -65,15 +65,21 @@ async fn publish(state: &State, client: &Client, uri: Uri) {
     let others = {
         let world = state.world();
         if !world.is_current(&snapshot) {
-            return; // stale: the newer snapshot is queued
+            // Stale: the newer snapshot is queued. This may be the last
+            // reference to the old one: it is freed in the background.
+            drop(world);
+            drop(analysis);
+            retire(snapshot);
+            return;
         }
         related_files(&analysis, |id| world.uri_of(id).cloned())
     };
     let mut diagnostics = to_lsp(&snapshot, &analysis, &others);
     cap(&mut diagnostics);
-    client
-        .publish_diagnostics(uri, diagnostics, snapshot.version)
-        .await;
+    let version = snapshot.version;
+    drop(analysis);
+    retire(snapshot);
+    client.publish_diagnostics(uri, diagnostics, version).await;
 }
 
 /// The URIs of the other files that related information points into.

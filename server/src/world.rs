@@ -12,13 +12,14 @@ use crate::document::Document;
 use crate::encoding::{Encoding, LineMap};
 use semo::catalog::{Catalog, CatalogSource, load_catalog};
 use semo::diag::{self, Diagnostic, FileId};
-use semo::sema::Analysis;
+use semo::sema::{Analysis, check_parsed};
 use semo::strategy::{Strategy, cross_check, load_strategy};
+use semo::syntax::{ParseCache, parse_incremental};
 use semo::text::LineIndex;
 use semo::workspace::{FileKind, GraphRun, analyze_graph_text};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock, PoisonError, mpsc};
 use tower_lsp_server::ls_types::{TextDocumentContentChangeEvent, Uri};
 
 /// The catalog files of the workspace and, built on first use, the catalog they
@@ -71,6 +72,26 @@ impl CatalogState {
     }
 }
 
+/// The parse cache of the version of a file analysed last, shared by all
+/// snapshots of the file: a mission's analysis parses incrementally from it
+/// and leaves its own cache. Any cache gives the same result (only unchanged
+/// text is reused); a recent one only makes it faster.
+#[derive(Default)]
+struct ParseSlot(Mutex<Option<Arc<ParseCache>>>);
+
+impl ParseSlot {
+    fn get(&self) -> Option<Arc<ParseCache>> {
+        self.0
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
+    }
+
+    fn put(&self, cache: ParseCache) {
+        *self.0.lock().unwrap_or_else(PoisonError::into_inner) = Some(Arc::new(cache));
+    }
+}
+
 /// One version of one file, with the catalog it is checked against.
 pub struct Snapshot {
     pub uri: Uri,
@@ -83,6 +104,7 @@ pub struct Snapshot {
     pub encoding: Encoding,
     /// For a strategy file: the missions it is cross-checked against.
     pub missions: Vec<Arc<Snapshot>>,
+    parses: Arc<ParseSlot>,
     analysis: OnceLock<Arc<FileAnalysis>>,
 }
 
@@ -108,7 +130,11 @@ impl Snapshot {
         let lines = LineIndex::new(&self.text);
         match self.kind {
             FileKind::Mission => {
-                let analysis = semo::check_source(self.id, &self.text, self.catalog.catalog());
+                let previous = self.parses.get();
+                let (parse, cache) = parse_incremental(self.id, &self.text, previous.as_deref());
+                drop(previous);
+                self.parses.put(cache);
+                let analysis = check_parsed(self.id, parse, self.catalog.catalog());
                 FileAnalysis {
                     lines,
                     diagnostics: analysis.diagnostics.clone(),
@@ -168,6 +194,29 @@ impl Snapshot {
             index: &analysis.lines,
             encoding: self.encoding,
         }
+    }
+}
+
+/// Lets go of a snapshot that a newer one replaced. Freeing an analysed
+/// mission (its tree and IR) takes about a millisecond on a 10k-line file:
+/// that is done on a background thread, so that it delays neither the next
+/// edit's diagnostics nor, under the world's lock, other requests.
+pub fn retire(snapshot: Arc<Snapshot>) {
+    static DROPPER: OnceLock<Option<mpsc::Sender<Arc<Snapshot>>>> = OnceLock::new();
+    if snapshot.analysis.get().is_none() {
+        return; // little to free
+    }
+    let dropper = DROPPER.get_or_init(|| {
+        let (send, receive) = mpsc::channel::<Arc<Snapshot>>();
+        std::thread::Builder::new()
+            .name("semo-drop".into())
+            .spawn(move || receive.into_iter().for_each(drop))
+            .ok()
+            .map(|_| send)
+    });
+    // Without the thread (it could not start), the snapshot is dropped here.
+    if let Some(send) = dropper {
+        let _ = send.send(snapshot);
     }
 }
 
@@ -349,6 +398,7 @@ impl World {
         let Some(entry) = self.files.remove(uri) else {
             return Changed::default();
         };
+        retire(entry.snapshot.clone());
         let mut changed = match entry.kind {
             FileKind::Catalog => self.catalog_changed(),
             FileKind::Mission => self.missions_changed(),
@@ -376,7 +426,7 @@ impl World {
             self.catalog()
         };
         let snapshot = Arc::new(self.new_snapshot(&uri, id, kind, version, text, catalog));
-        self.files.insert(
+        let old = self.files.insert(
             uri.clone(),
             FileEntry {
                 kind,
@@ -385,6 +435,9 @@ impl World {
                 snapshot,
             },
         );
+        if let Some(old) = old {
+            retire(old.snapshot);
+        }
         let mut changed = if is_catalog {
             self.catalog_changed()
         } else if kind == FileKind::Mission {
@@ -425,6 +478,12 @@ impl World {
             catalog,
             encoding: self.encoding,
             missions,
+            // Handed from each snapshot of the file to the next.
+            parses: self
+                .files
+                .get(uri)
+                .map(|f| f.snapshot.parses.clone())
+                .unwrap_or_default(),
             analysis: OnceLock::new(),
         }
     }
@@ -449,7 +508,8 @@ impl World {
                 old.text.clone(),
                 catalog.clone(),
             ));
-            self.files.get_mut(uri).expect("listed above").snapshot = fresh;
+            let entry = self.files.get_mut(uri).expect("listed above");
+            retire(std::mem::replace(&mut entry.snapshot, fresh));
         }
         Changed { files: strategies }
     }
@@ -476,7 +536,8 @@ impl World {
                 old.text.clone(),
                 catalog.clone(),
             ));
-            self.files.get_mut(&uri).expect("listed above").snapshot = fresh;
+            let entry = self.files.get_mut(&uri).expect("listed above");
+            retire(std::mem::replace(&mut entry.snapshot, fresh));
             changed.files.push(uri);
         }
         // Strategies last, on the missions' new snapshots.
@@ -510,4 +571,68 @@ pub fn read_text(path: &Path) -> Option<String> {
         String::from_utf8(bytes)
             .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tower_lsp_server::ls_types::{Position, Range};
+
+    const MISSION: &str = "{ A: Turtlebot3_Burger tb }\n\
+        A.P.S { move(\"1,1\") }\n\
+        A.M { set(P, S) }\n\
+        A.main { default: mode = M }\n";
+
+    #[test]
+    fn each_version_of_a_mission_is_parsed_from_the_cache_of_the_last() {
+        let mut world = World::default();
+        let uri = Uri::from_file_path("/t/a.mission").expect("a file URI");
+        world.open(uri.clone(), "mission", MISSION, 1);
+        let first = world.snapshot(&uri).expect("open");
+        first.analysis();
+        assert_eq!(first.parses.get().map(|c| c.reparsed()), Some(4));
+        // `move("1,1")` becomes `move("1,12")`: one chunk changes.
+        let typed = TextDocumentContentChangeEvent {
+            range: Some(Range::new(Position::new(1, 17), Position::new(1, 17))),
+            range_length: None,
+            text: "2".to_string(),
+        };
+        world.change(&uri, 2, vec![typed]);
+        let second = world.snapshot(&uri).expect("open");
+        let analysis = second.analysis();
+        let cache = second.parses.get().expect("left by the analysis");
+        assert_eq!((cache.chunks(), cache.reparsed()), (4, 1));
+        let scratch = semo::check_source(second.id, &second.text, second.catalog.catalog());
+        assert_eq!(analysis.diagnostics, scratch.diagnostics);
+        assert_eq!(
+            analysis.mission.as_ref().map(|m| &m.syntax),
+            Some(&scratch.syntax)
+        );
+        // Snapshots of the same text on a new catalog reuse every chunk.
+        world.catalog_changed();
+        let third = world.snapshot(&uri).expect("open");
+        assert!(!Arc::ptr_eq(&second, &third));
+        third.analysis();
+        assert_eq!(third.parses.get().map(|c| c.reparsed()), Some(0));
+    }
+
+    #[test]
+    fn replaced_snapshots_are_freed_in_the_background() {
+        let mut world = World::default();
+        let uri = Uri::from_file_path("/t/b.mission").expect("a file URI");
+        world.open(uri.clone(), "mission", MISSION, 1);
+        let first = world.snapshot(&uri).expect("open");
+        first.analysis();
+        let weak = Arc::downgrade(&first);
+        drop(first);
+        world.change(&uri, 2, Vec::new());
+        let start = std::time::Instant::now();
+        while weak.upgrade().is_some() {
+            assert!(
+                start.elapsed().as_secs() < 10,
+                "the old snapshot was never freed"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+    }
 }

@@ -5,9 +5,9 @@
 use super::ir::*;
 use super::{Checker, suggestion};
 use crate::diag::{Code, Severity};
+use crate::fasthash::FastSet;
 use crate::syntax::ast::Name;
 use crate::syntax::ast::{self, Item, SetTarget};
-use std::collections::HashSet;
 
 impl<'a> Checker<'a> {
     pub(super) fn check_behaviour(&mut self, source: &'a ast::SourceFile) {
@@ -334,7 +334,7 @@ impl<'a> Checker<'a> {
         else {
             return;
         };
-        let mut reached = HashSet::from([*start]);
+        let mut reached = FastSet::from_iter([*start]);
         let mut queue = vec![*start];
         while let Some(mode) = queue.pop() {
             for tr in transitions.iter().filter(|tr| tr.from == mode) {
@@ -362,7 +362,7 @@ impl<'a> Checker<'a> {
 
     fn services_never_set(&mut self, team: TeamId) {
         let t = self.team(team);
-        let set: HashSet<Index> = t
+        let set: FastSet<Index> = t
             .modes
             .iter()
             .flat_map(|m| m.sets.iter().filter_map(|s| s.service))

@@ -366,10 +366,11 @@ impl<'a> Checker<'a> {
         let catalog = self.catalog;
         let anywhere = catalog.types().find_map(|(_, r)| r.service(name));
         let types = scope.types.clone();
-        let providers: Vec<&ServiceDef> = types
+        let mut providing = types
             .iter()
-            .filter_map(|(ty, _)| catalog.get(*ty).service(name))
-            .collect();
+            .filter_map(|(ty, _)| catalog.get(*ty).service(name));
+        let first_provider = providing.next();
+        let providers = first_provider.map_or(0, |_| 1 + providing.count());
         let Some(any_def) = anywhere else {
             let mut candidates: Vec<&str> =
                 self.functions_by_name.keys().map(Name::as_str).collect();
@@ -395,13 +396,13 @@ impl<'a> Checker<'a> {
             .suggest(guess);
             return;
         };
-        let def = providers.first().copied().unwrap_or(any_def);
+        let def = first_provider.unwrap_or(any_def);
         self.occurrence(
             call.name.span,
             Symbol::BuiltinService(Name::new(&def.name)),
             false,
         );
-        if providers.len() < types.len() {
+        if providers < types.len() {
             let lacking: Vec<(RobotTypeId, Vec<Name>)> = types
                 .iter()
                 .filter(|(ty, _)| catalog.get(*ty).service(name).is_none())
@@ -416,7 +417,7 @@ impl<'a> Checker<'a> {
                 .team
                 .map(|t| self.team(t).name.clone())
                 .unwrap_or_default();
-            let advice = if providers.is_empty() {
+            let advice = if providers == 0 {
                 format!(
                     "only {} {} it",
                     having.join(", "),
@@ -637,15 +638,15 @@ impl<'a> Checker<'a> {
     fn resolve_in_team(&self, team: TeamId, name: &str, scope: &Scope, bare: bool) -> Resolution {
         let types = self.types_for(team, scope);
         let catalog = self.catalog;
-        let defs: Vec<_> = types
+        let mut defs = types
             .iter()
-            .filter_map(|(ty, _)| catalog.get(*ty).value(name))
-            .collect();
+            .filter_map(|(ty, _)| catalog.get(*ty).value(name));
+        let first = defs.next();
         // Robots read their own values; another team's value is what its robots
         // that have it send or publish, so only its own team must all have it.
         let own = scope.team == Some(team);
-        if let Some(def) = defs.first() {
-            if own && defs.len() < types.len() {
+        if let Some(def) = first {
+            if own && 1 + defs.count() < types.len() {
                 let having: Vec<&str> = types
                     .iter()
                     .filter(|(ty, _)| catalog.get(*ty).value(name).is_some())

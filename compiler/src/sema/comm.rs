@@ -6,8 +6,8 @@
 use super::Checker;
 use super::ir::*;
 use crate::diag::Code;
+use crate::fasthash::FastSet;
 use crate::syntax::ast::CommKind;
-use std::collections::HashSet;
 
 /// The statement that would feed (or drain) `kind`.
 fn counterpart(kind: CommKind) -> CommKind {
@@ -22,7 +22,7 @@ fn counterpart(kind: CommKind) -> CommKind {
 impl Checker<'_> {
     pub(super) fn check_communication(&mut self) {
         // (kind, running team, other team, value)
-        let present: HashSet<(CommKind, TeamId, TeamId, &AttrKey)> = self
+        let present: FastSet<(CommKind, TeamId, TeamId, &AttrKey)> = self
             .mission
             .messages
             .iter()

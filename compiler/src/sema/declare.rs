@@ -5,13 +5,13 @@
 use super::ir::*;
 use super::{Checker, is_user, suggestion};
 use crate::diag::Code;
+use crate::fasthash::FastMap;
 use crate::span::Span;
 use crate::syntax::ast::{self, Item, Name};
-use std::collections::HashMap;
 
 impl<'a> Checker<'a> {
     pub(super) fn declare(&mut self, source: &'a ast::SourceFile) {
-        let mut robot_names = HashMap::new();
+        let mut robot_names = FastMap::default();
         for item in &source.items {
             if let Item::Formation(formation) = item {
                 for decl in &formation.teams {
@@ -34,7 +34,7 @@ impl<'a> Checker<'a> {
         self.collect_variables();
     }
 
-    fn declare_team(&mut self, decl: &ast::TeamDecl, robot_names: &mut HashMap<Name, Span>) {
+    fn declare_team(&mut self, decl: &ast::TeamDecl, robot_names: &mut FastMap<Name, Span>) {
         let name = &decl.name;
         if is_user(&name.name) {
             self.report(
@@ -274,7 +274,7 @@ impl<'a> Checker<'a> {
     fn collect_variables(&mut self) {
         let mut found = Vec::new();
         let mut visit =
-            |owner: Option<TeamId>, block: &ast::Block, teams: &HashMap<Name, TeamId>| {
+            |owner: Option<TeamId>, block: &ast::Block, teams: &FastMap<Name, TeamId>| {
                 block.walk(&mut |stmt| {
                     let ast::StmtKind::Comm(comm) = &stmt.kind else {
                         return;

@@ -12,6 +12,7 @@ use chumsky::span::SimpleSpan;
 type Tok<'s> = (Token<'s>, SimpleSpan);
 
 /// If an item header starts at token `i`, the index of its opening brace.
+#[inline(always)]
 fn header_brace(tokens: &[Tok<'_>], i: usize) -> Option<usize> {
     let at = |k: usize| tokens.get(i + k).map(|t| t.0);
     let ident = |k: usize| matches!(at(k), Some(Token::Ident(_)));
@@ -30,18 +31,29 @@ fn header_brace(tokens: &[Tok<'_>], i: usize) -> Option<usize> {
 
 /// Token index ranges of the chunks, in order, covering every token.
 pub fn split(tokens: &[Tok<'_>]) -> Vec<std::ops::Range<usize>> {
+    split_from(tokens, 0, |_| false).0
+}
+
+/// The chunks from token `from` on, where a chunk starts; stops early where
+/// `stop` says so when a chunk starts at a token after `from`.
+///
+/// Returns the chunks before the stop, and where it stopped (`tokens.len()`
+/// when it did not). Resuming at a chunk start is exact: after a cut the state
+/// is always the same (depth zero, and no header whose brace is still to come,
+/// as no chunk starts inside a header), so the chunks after a chunk start
+/// depend only on the tokens from there on. Incremental parsing relies on
+/// this, to cut again only around an edit.
+pub fn split_from(
+    tokens: &[Tok<'_>],
+    from: usize,
+    mut stop: impl FnMut(usize) -> bool,
+) -> (Vec<std::ops::Range<usize>>, usize) {
     let mut chunks = Vec::new();
-    let mut start = 0;
+    let mut start = from;
     let mut depth: usize = 0;
-    let cut = |chunks: &mut Vec<std::ops::Range<usize>>, start: &mut usize, at: usize| {
-        if at > *start {
-            chunks.push(*start..at);
-        }
-        *start = at;
-    };
     // The brace that opens the body of the header seen last: not a new chunk.
     let mut body_brace = None;
-    for i in 0..tokens.len() {
+    for i in from..tokens.len() {
         let token = tokens[i].0;
         let at_top = depth == 0;
         // Inside `A.P.S {`, `P.S {` looks like a mode header: not a new item.
@@ -53,7 +65,9 @@ pub fn split(tokens: &[Tok<'_>]) -> Vec<std::ops::Range<usize>> {
                 && matches!(token, Token::Ident(_))
                 && tokens.get(i + 1).map(|t| t.0) == Some(Token::Colon))
         {
-            cut(&mut chunks, &mut start, i);
+            if cut(&mut chunks, &mut start, i) && stop(i) {
+                return (chunks, i);
+            }
             depth = 0;
         }
         if header.is_some() {
@@ -62,15 +76,31 @@ pub fn split(tokens: &[Tok<'_>]) -> Vec<std::ops::Range<usize>> {
         match token {
             Token::LBrace => depth += 1,
             Token::RBrace if depth == 0 => {
-                cut(&mut chunks, &mut start, i);
-                cut(&mut chunks, &mut start, i + 1);
+                if cut(&mut chunks, &mut start, i) && stop(i) {
+                    return (chunks, i);
+                }
+                if cut(&mut chunks, &mut start, i + 1) && i + 1 < tokens.len() && stop(i + 1) {
+                    return (chunks, i + 1);
+                }
             }
             Token::RBrace => depth -= 1,
             _ => {}
         }
     }
     cut(&mut chunks, &mut start, tokens.len());
-    chunks
+    (chunks, tokens.len())
+}
+
+/// Ends the chunk that began at `start` before token `at`, if it is not
+/// empty; whether it did (a new chunk starts at `at`).
+fn cut(chunks: &mut Vec<std::ops::Range<usize>>, start: &mut usize, at: usize) -> bool {
+    if at > *start {
+        chunks.push(*start..at);
+        *start = at;
+        true
+    } else {
+        false
+    }
 }
 
 #[cfg(test)]
@@ -108,5 +138,24 @@ mod tests {
             chunk_texts(text),
             vec!["A: x a", "B: y b[2]", "}", "def f { stop() }"]
         );
+    }
+
+    #[test]
+    fn resuming_at_any_chunk_start_cuts_the_same_chunks() {
+        let text = "{ A: x a\n B: y b }\n} } A.P.S { { move() } A.M { set(P, S) }\n\
+                    T: a b { def f { x } T.main { } ) } A.P.S { B.C.D {";
+        let tokens = lex(text);
+        let all = split(&tokens);
+        assert!(all.len() > 8, "{all:?}");
+        for (k, chunk) in all.iter().enumerate() {
+            let (rest, end) = split_from(&tokens, chunk.start, |_| false);
+            assert_eq!(rest, all[k..], "resumed at chunk {k}");
+            assert_eq!(end, tokens.len());
+            // Stopping where a later chunk starts gives the chunks before it.
+            if let Some(later) = all.get(k + 2) {
+                let (some, at) = split_from(&tokens, chunk.start, |at| at == later.start);
+                assert_eq!((some.as_slice(), at), (&all[k..k + 2], later.start));
+            }
+        }
     }
 }

@@ -5,8 +5,12 @@
 pub mod ast;
 mod chunks;
 mod delimiters;
+mod incremental;
 mod parser;
+mod shift;
 pub mod token;
+
+pub use incremental::{ParseCache, parse_incremental};
 
 use crate::diag::{Code, Diagnostic, FileId};
 use crate::span::Span;
@@ -24,9 +28,9 @@ pub struct Parse {
 /// Files at least this large are lexed and parsed on two threads.
 const PARALLEL_MIN_BYTES: usize = 64 * 1024;
 
-fn parallel(text: &str) -> bool {
-    text.len() >= PARALLEL_MIN_BYTES
-        && std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
+/// Whether `len` bytes of text are worth two threads (and there are two).
+fn parallel(len: usize) -> bool {
+    len >= PARALLEL_MIN_BYTES && std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2)
 }
 
 /// Runs `a` here and `b` on another thread; a panic in `b` is passed on.
@@ -45,7 +49,7 @@ fn join<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B + 
 /// newline, so the two halves of the text lex independently, and chunks parse
 /// independently; the result is the same as on one thread.
 pub fn parse(file: FileId, text: &str) -> Parse {
-    parse_with(file, text, parallel(text)).0
+    parse_with(file, text, parallel(text.len())).0
 }
 
 /// [`parse`], also giving the tokens the tree was parsed from, for tools that
@@ -53,7 +57,7 @@ pub fn parse(file: FileId, text: &str) -> Parse {
 /// as repaired for the parser: unknown characters dropped, unterminated
 /// strings taken as strings.
 pub fn parse_with_tokens(file: FileId, text: &str) -> (Parse, Vec<token::Spanned<'_>>) {
-    parse_with(file, text, parallel(text))
+    parse_with(file, text, parallel(text.len()))
 }
 
 fn parse_with(file: FileId, text: &str, two_threads: bool) -> (Parse, Vec<token::Spanned<'_>>) {
@@ -61,27 +65,48 @@ fn parse_with(file: FileId, text: &str, two_threads: bool) -> (Parse, Vec<token:
     let mut tokens = lex(text, two_threads);
     report_lexical_errors(file, &mut tokens, &mut diagnostics);
     let ranges = chunks::split(&tokens);
-    let half = tokens.len() / 2;
-    let cut = ranges.partition_point(|r| r.start < half);
-    let (items, chunk_diagnostics) = if two_threads && cut > 0 && cut < ranges.len() {
-        let (first, second) = ranges.split_at(cut);
-        let ((mut items, mut diags), (more_items, more_diags)) = join(
-            || parse_chunks(file, text, &tokens, first),
-            || parse_chunks(file, text, &tokens, second),
-        );
-        items.extend(more_items);
-        diags.extend(more_diags);
-        (items, diags)
-    } else {
-        parse_chunks(file, text, &tokens, &ranges)
-    };
-    diagnostics.extend(chunk_diagnostics);
+    let mut items = Vec::new();
+    for chunk in parse_ranges(file, text, &tokens, &ranges, two_threads) {
+        items.extend(chunk.items);
+        diagnostics.extend(chunk.diagnostics);
+    }
     diagnostics.sort_by_key(|d| (d.span.start, d.span.end));
     let parse = Parse {
         file: ast::SourceFile { items },
         diagnostics,
     };
     (parse, tokens)
+}
+
+/// Balances and parses the chunks `ranges` of `tokens`, on two threads if
+/// asked (each taking about half of the tokens); the result is the same.
+fn parse_ranges(
+    file: FileId,
+    text: &str,
+    tokens: &[token::Spanned<'_>],
+    ranges: &[std::ops::Range<usize>],
+    two_threads: bool,
+) -> Vec<ChunkParse> {
+    let total: usize = ranges.iter().map(|r| r.len()).sum();
+    let mut before = 0;
+    let cut = ranges
+        .iter()
+        .position(|r| {
+            before += r.len();
+            before > total / 2
+        })
+        .map_or(ranges.len(), |i| i + 1);
+    if two_threads && cut > 0 && cut < ranges.len() {
+        let (first, second) = ranges.split_at(cut);
+        let (mut chunks, more) = join(
+            || parse_chunks(file, text, tokens, first),
+            || parse_chunks(file, text, tokens, second),
+        );
+        chunks.extend(more);
+        chunks
+    } else {
+        parse_chunks(file, text, tokens, ranges)
+    }
 }
 
 /// Lexes `text`, in two halves cut at a newline when it is large.
@@ -133,22 +158,36 @@ fn report_lexical_errors(
     });
 }
 
-/// Balances and parses the chunks `ranges` of `tokens`.
+/// One chunk balanced and parsed. Everything in it depends only on the
+/// chunk's own text: the same text elsewhere gives the same result, moved.
+#[derive(Clone, Debug, Default)]
+struct ChunkParse {
+    items: Vec<ast::Item>,
+    /// Bracket repairs first, then parse errors.
+    diagnostics: Vec<Diagnostic>,
+}
+
+/// Balances and parses the chunks `ranges` of `tokens`, one result per range.
 fn parse_chunks(
     file: FileId,
     text: &str,
     tokens: &[token::Spanned<'_>],
     ranges: &[std::ops::Range<usize>],
-) -> (Vec<ast::Item>, Vec<Diagnostic>) {
-    let mut diagnostics = Vec::new();
+) -> Vec<ChunkParse> {
+    let mut results: Vec<ChunkParse> = Vec::with_capacity(ranges.len());
     let chunks: Vec<_> = ranges
         .iter()
-        .map(|range| delimiters::balance(text, &tokens[range.clone()], file, &mut diagnostics))
+        .map(|range| {
+            let mut result = ChunkParse::default();
+            let chunk =
+                delimiters::balance(text, &tokens[range.clone()], file, &mut result.diagnostics);
+            results.push(result);
+            chunk
+        })
         .collect();
     let fast = parser::items::<_, chumsky::error::EmptyErr>();
     let rich = parser::items::<_, parser::RichError<'_, '_>>();
-    let mut items = Vec::new();
-    for chunk in &chunks {
+    for (chunk, result) in chunks.iter().zip(&mut results) {
         let (Some(first), Some(last)) = (chunk.first(), chunk.last()) else {
             continue;
         };
@@ -158,29 +197,29 @@ fn parse_chunks(
         if let (Some(parsed), errors) = fast.parse(input()).into_output_errors()
             && errors.is_empty()
         {
-            items.extend(parsed);
+            result.items = parsed;
             continue;
         }
         let (output, errors) = rich.parse(input()).into_output_errors();
         for error in &errors {
-            diagnostics.push(syntax_diagnostic(file, error));
+            result.diagnostics.push(syntax_diagnostic(file, error));
         }
         match output {
-            Some(parsed) => items.extend(parsed),
+            Some(parsed) => result.items = parsed,
             None => {
                 if errors.is_empty() {
-                    diagnostics.push(Diagnostic::new(
+                    result.diagnostics.push(Diagnostic::new(
                         Code::SyntaxError,
                         file,
                         chunk_span,
                         "this text could not be understood",
                     ));
                 }
-                items.push(ast::Item::Error(chunk_span));
+                result.items.push(ast::Item::Error(chunk_span));
             }
         }
     }
-    (items, diagnostics)
+    results
 }
 
 /// A standalone expression parsed with the mission grammar (spec section 2,
