@@ -139,7 +139,9 @@ impl TestClient {
     pub async fn shutdown(mut self) {
         let _ = self.request("shutdown", Value::Null).await;
         self.notify("exit", Value::Null).await;
-        let _ = self.server.await;
+        // A server that does not stop after `exit` fails the test, not hangs it.
+        let stopped = tokio::time::timeout(std::time::Duration::from_secs(20), self.server).await;
+        assert!(stopped.is_ok(), "the server did not stop after `exit`");
     }
 
     /// The messages read but not yet consumed (notifications, and responses

@@ -110,7 +110,12 @@ impl Backend {
             })
             .ok(),
         };
-        let _ = self.client.register_capability(vec![registration]).await;
+        // Not awaited here: a client that exits before answering would leave
+        // `initialized` waiting for ever, and the server could not stop.
+        let client = self.client.clone();
+        tokio::spawn(async move {
+            let _ = client.register_capability(vec![registration]).await;
+        });
     }
 
     async fn index_workspace(&self) {
