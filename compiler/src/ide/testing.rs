@@ -74,81 +74,11 @@ pub(crate) fn spans_text(text: &str, spans: impl IntoIterator<Item = Span>) -> S
         .join(", ")
 }
 
-/// A realistic mission of about 50 lines per team (as the throughput bench):
+/// The throughput bench's generated mission (about 65 lines per team):
 /// groups, communication between neighbouring teams, modes, a function.
 pub(crate) fn large_mission(teams: usize) -> String {
-    use std::fmt::Write;
-    let mut m = String::from("# Generated mission (한국어 주석)\n{\n");
-    for t in 0..teams {
-        writeln!(
-            m,
-            "  Team{t}: Turtlebot3_Burger tb{t}[3], Ev3_Robot ev{t}[2], iRobotCreate cr{t}"
-        )
-        .unwrap();
-    }
-    m.push_str("}\n\ndef report_home {\n  move(\"0,0\")\n  standby()\n}\n\n");
-    for t in 0..teams {
-        let next = (t + 1) % teams;
-        let prev = (t + teams - 1) % teams;
-        write!(
-            m,
-            r#"# ----- Team{t} -----
-Team{t}.Listen.Hear{{
-  receive(Team{prev}, Team{prev}.Status)
-  subscribe(Team{t}, Team{t}.Alarm)
-  if(Team{t}.Alarm == DARK) throw hide
-  else if(Team{prev}.Status == "done 😀") throw finish
-  else throw resume
-}} repeat(500 MSEC)
-
-Team{t}.Report.Tell{{
-  send(Team{next}, Team{t}.Status = "working")
-  send(USER, Team{t}.LOCATION)
-  [[
-    leader(instance of Turtlebot3_Burger){{
-      light_on()
-      publish(Team{t}, Team{t}.Alarm = BRIGHT)
-    }}
-  ]]
-}} repeat(1 SEC)
-
-Team{t}.Action.Patrol{{
-  [[
-    group(instance of Turtlebot3_Burger){{
-      loop(2 SEC){{
-        if(Team{t}.LIGHTNESS < 200 and BATTERY > 20)
-          publish(Team{t}, Team{t}.Alarm = DARK)
-      }}
-    }}
-    group(capable of color_sensor){{
-      search(colored_paper)
-      scatter()
-    }}
-    others{{
-      move("3,3"), timeout = 10 SEC
-      move("0,3")
-    }}
-  ]]
-}} repeat()
-
-Team{t}.Action.Return{{
-  report_home()
-}}
-
-Team{t}.PATROL{{ set(Listen, Hear); set(Report, Tell); set(Action, Patrol) }}
-Team{t}.HOME{{ set(Listen, OFF); set(Report, OFF); set(Action, Return) }}
-Team{t}.main{{
-  case (PATROL):
-    catch (hide): mode = PATROL
-    catch (finish): mode = HOME
-  case (HOME):
-    catch (resume): mode = PATROL
-  default: mode = PATROL
-}}
-
-"#
-        )
-        .unwrap();
-    }
-    m
+    generated::generate(teams)
 }
+
+#[path = "../../benches/common/mission.rs"]
+mod generated;
