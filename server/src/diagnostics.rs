@@ -88,7 +88,7 @@ fn related_files(
     uri_of: impl Fn(FileId) -> Option<Uri>,
 ) -> HashMap<FileId, Uri> {
     let mut out = HashMap::new();
-    for d in &analysis.diagnostics {
+    for d in analysis.diagnostics() {
         for r in &d.related {
             if r.file != d.file && r.file != BUILTIN_FILE {
                 if let Some(uri) = uri_of(r.file) {
@@ -110,7 +110,7 @@ pub fn to_lsp(
     // Line indexes of other (catalog) files, built once each.
     let mut other_lines: HashMap<FileId, LineIndex> = HashMap::new();
     analysis
-        .diagnostics
+        .diagnostics()
         .iter()
         .map(|d| {
             let related = d

@@ -2,9 +2,10 @@
 //! JSON-RPC framing on the other. Tests and benchmarks drive the server through
 //! it exactly as an editor would, without a process or a socket.
 
+use crate::transport::{Frame, read_frame, write_frame};
 use serde_json::{Value, json};
 use std::collections::VecDeque;
-use tokio::io::{AsyncBufReadExt, AsyncReadExt, AsyncWriteExt, BufReader, DuplexStream};
+use tokio::io::{AsyncWriteExt, BufReader, DuplexStream};
 use tokio::task::JoinHandle;
 
 pub struct TestClient {
@@ -155,9 +156,9 @@ impl TestClient {
     }
 
     async fn send(&mut self, msg: &Value) {
-        let body = msg.to_string();
-        let frame = format!("Content-Length: {}\r\n\r\n{body}", body.len());
-        self.send_raw(frame.as_bytes()).await;
+        write_frame(&mut self.to_server, msg.to_string().as_bytes())
+            .await
+            .expect("pipe open");
     }
 
     /// A message that is not the awaited response: server requests are
@@ -177,23 +178,12 @@ impl TestClient {
         self.send(&reply).await;
     }
 
+    /// The next message from the server, framed as the server frames it
+    /// (the transport's own reader); `None` when the server has gone.
     async fn read_message(&mut self) -> Option<Value> {
-        let mut length = None;
-        loop {
-            let mut line = String::new();
-            if self.from_server.read_line(&mut line).await.ok()? == 0 {
-                return None;
-            }
-            let line = line.trim_end();
-            if line.is_empty() {
-                break;
-            }
-            if let Some(n) = line.strip_prefix("Content-Length: ") {
-                length = n.parse::<usize>().ok();
-            }
+        match read_frame(&mut self.from_server).await {
+            Frame::Body(body) => serde_json::from_slice(&body).ok(),
+            Frame::BadHeader(_) | Frame::End => None,
         }
-        let mut body = vec![0; length?];
-        self.from_server.read_exact(&mut body).await.ok()?;
-        serde_json::from_slice(&body).ok()
     }
 }

@@ -35,14 +35,14 @@ where
 }
 
 /// A frame as read: its body, or why there is none.
-enum Frame {
+pub(crate) enum Frame {
     Body(Vec<u8>),
     /// Headers without a usable `Content-Length`.
     BadHeader(String),
     End,
 }
 
-async fn read_frame<R: AsyncRead + Unpin>(input: &mut BufReader<R>) -> Frame {
+pub(crate) async fn read_frame<R: AsyncRead + Unpin>(input: &mut BufReader<R>) -> Frame {
     let mut length: Option<Result<usize, String>> = None;
     let mut saw_header = false;
     loop {
@@ -171,7 +171,10 @@ async fn write_frames<W: AsyncWrite + Unpin>(
     }
 }
 
-async fn write_frame<W: AsyncWrite + Unpin>(output: &mut W, body: &[u8]) -> std::io::Result<()> {
+pub(crate) async fn write_frame<W: AsyncWrite + Unpin>(
+    output: &mut W,
+    body: &[u8],
+) -> std::io::Result<()> {
     output
         .write_all(format!("Content-Length: {}\r\n\r\n", body.len()).as_bytes())
         .await?;

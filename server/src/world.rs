@@ -111,11 +111,33 @@ pub struct Snapshot {
 /// What is known about a snapshot once analysed.
 pub struct FileAnalysis {
     pub lines: LineIndex,
-    /// Diagnostics of this file, sorted.
-    pub diagnostics: Vec<Diagnostic>,
+    /// The diagnostics of catalog and strategy files (missions and task
+    /// graphs keep theirs in their own results).
+    other_diagnostics: Vec<Diagnostic>,
     pub mission: Option<Analysis>,
     pub graph: Option<GraphRun>,
     pub strategy: Option<Strategy>,
+}
+
+impl FileAnalysis {
+    fn new(lines: LineIndex) -> FileAnalysis {
+        FileAnalysis {
+            lines,
+            other_diagnostics: Vec::new(),
+            mission: None,
+            graph: None,
+            strategy: None,
+        }
+    }
+
+    /// Diagnostics of this file, sorted.
+    pub fn diagnostics(&self) -> &[Diagnostic] {
+        match (&self.mission, &self.graph) {
+            (Some(mission), _) => &mission.diagnostics,
+            (_, Some(run)) => &run.diagnostics,
+            _ => &self.other_diagnostics,
+        }
+    }
 }
 
 impl Snapshot {
@@ -127,44 +149,20 @@ impl Snapshot {
     }
 
     fn analyse(&self) -> FileAnalysis {
-        let lines = LineIndex::new(&self.text);
+        let mut out = FileAnalysis::new(LineIndex::new(&self.text));
         match self.kind {
             FileKind::Mission => {
                 let previous = self.parses.get();
                 let (parse, cache) = parse_incremental(self.id, &self.text, previous.as_deref());
                 drop(previous);
                 self.parses.put(cache);
-                let analysis = check_parsed(self.id, parse, self.catalog.catalog());
-                FileAnalysis {
-                    lines,
-                    diagnostics: analysis.diagnostics.clone(),
-                    mission: Some(analysis),
-                    graph: None,
-                    strategy: None,
-                }
+                out.mission = Some(check_parsed(self.id, parse, self.catalog.catalog()));
             }
             FileKind::Catalog => {
-                let mut diagnostics: Vec<Diagnostic> =
-                    self.catalog.diagnostics_of(self.id).cloned().collect();
-                diag::sort_and_dedup(&mut diagnostics);
-                FileAnalysis {
-                    lines,
-                    diagnostics,
-                    mission: None,
-                    graph: None,
-                    strategy: None,
-                }
+                out.other_diagnostics = self.catalog.diagnostics_of(self.id).cloned().collect();
+                diag::sort_and_dedup(&mut out.other_diagnostics);
             }
-            FileKind::TaskGraph => {
-                let run = analyze_graph_text(self.id, &self.text);
-                FileAnalysis {
-                    lines,
-                    diagnostics: run.diagnostics.clone(),
-                    mission: None,
-                    graph: Some(run),
-                    strategy: None,
-                }
-            }
+            FileKind::TaskGraph => out.graph = Some(analyze_graph_text(self.id, &self.text)),
             FileKind::Strategy => {
                 let (strategy, mut diagnostics) = load_strategy(self.id, &self.text);
                 if let Some(strategy) = &strategy {
@@ -176,15 +174,11 @@ impl Snapshot {
                     diagnostics.extend(cross.into_iter().filter(|d| d.file == self.id));
                     diag::sort_and_dedup(&mut diagnostics);
                 }
-                FileAnalysis {
-                    lines,
-                    diagnostics,
-                    mission: None,
-                    graph: None,
-                    strategy,
-                }
+                out.other_diagnostics = diagnostics;
+                out.strategy = strategy;
             }
         }
+        out
     }
 
     /// Converts positions of this snapshot's text.
@@ -491,14 +485,30 @@ impl World {
     /// Strategy files are cross-checked against the missions: they get new
     /// snapshots on the current missions.
     fn missions_changed(&mut self) -> Changed {
+        self.renew(|kind| kind == FileKind::Strategy)
+    }
+
+    /// Every file gets a new snapshot on the new catalog (missions are
+    /// re-checked against it, catalog files get their new diagnostics).
+    fn catalog_changed(&mut self) -> Changed {
+        self.catalog = None;
+        let mut changed = self.renew(|kind| matches!(kind, FileKind::Mission | FileKind::Catalog));
+        // Strategies last, on the missions' new snapshots.
+        changed.files.extend(self.missions_changed().files);
+        changed
+    }
+
+    /// New snapshots (same text, the current catalog) for the files of the
+    /// kinds `which` selects; the old ones are retired.
+    fn renew(&mut self, which: impl Fn(FileKind) -> bool) -> Changed {
         let catalog = self.catalog();
-        let strategies: Vec<Uri> = self
+        let uris: Vec<Uri> = self
             .files
             .iter()
-            .filter(|(_, f)| f.kind == FileKind::Strategy)
+            .filter(|(_, f)| which(f.kind))
             .map(|(u, _)| u.clone())
             .collect();
-        for uri in &strategies {
+        for uri in &uris {
             let old = self.files[uri].snapshot.clone();
             let fresh = Arc::new(self.new_snapshot(
                 uri,
@@ -511,38 +521,7 @@ impl World {
             let entry = self.files.get_mut(uri).expect("listed above");
             retire(std::mem::replace(&mut entry.snapshot, fresh));
         }
-        Changed { files: strategies }
-    }
-
-    /// Every file gets a new snapshot on the new catalog (missions are
-    /// re-checked against it, catalog files get their new diagnostics).
-    fn catalog_changed(&mut self) -> Changed {
-        self.catalog = None;
-        let catalog = self.catalog();
-        let mut changed = Changed::default();
-        let uris: Vec<Uri> = self
-            .files
-            .iter()
-            .filter(|(_, f)| matches!(f.kind, FileKind::Mission | FileKind::Catalog))
-            .map(|(u, _)| u.clone())
-            .collect();
-        for uri in uris {
-            let old = self.files[&uri].snapshot.clone();
-            let fresh = Arc::new(self.new_snapshot(
-                &uri,
-                old.id,
-                old.kind,
-                old.version,
-                old.text.clone(),
-                catalog.clone(),
-            ));
-            let entry = self.files.get_mut(&uri).expect("listed above");
-            retire(std::mem::replace(&mut entry.snapshot, fresh));
-            changed.files.push(uri);
-        }
-        // Strategies last, on the missions' new snapshots.
-        changed.files.extend(self.missions_changed().files);
-        changed
+        Changed { files: uris }
     }
 }
 
@@ -603,7 +582,7 @@ mod tests {
         let cache = second.parses.get().expect("left by the analysis");
         assert_eq!((cache.chunks(), cache.reparsed()), (4, 1));
         let scratch = semo::check_source(second.id, &second.text, second.catalog.catalog());
-        assert_eq!(analysis.diagnostics, scratch.diagnostics);
+        assert_eq!(analysis.diagnostics(), &scratch.diagnostics[..]);
         assert_eq!(
             analysis.mission.as_ref().map(|m| &m.syntax),
             Some(&scratch.syntax)

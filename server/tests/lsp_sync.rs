@@ -1,8 +1,11 @@
 //! Document synchronisation through the protocol: diagnostics on open and
 //! change, edits applied in order under bursts, and both position encodings.
 
+mod support;
+
 use semo_server::harness::TestClient;
 use serde_json::{Value, json};
+use support::position_of;
 
 const MISSION: &str = "{\n  Team: iRobotCreate r\n}\nTeam.Plan.Go{\n  move(\"1,1\")\n} repeat()\nTeam.M{ set(Plan, Go) }\nTeam.main{ default: mode = M }\n";
 
@@ -72,15 +75,6 @@ impl Lcg {
     }
 }
 
-/// The UTF-16 position of byte `offset` in `text`.
-fn utf16_position(text: &str, offset: usize) -> Value {
-    let before = &text[..offset];
-    let line = before.matches('\n').count();
-    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
-    let col: usize = before[line_start..].encode_utf16().count();
-    json!({ "line": line, "character": col })
-}
-
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_burst_of_a_thousand_edits_ends_in_the_expected_text_and_diagnostics() {
     let mut client = TestClient::start();
@@ -110,7 +104,7 @@ async fn a_burst_of_a_thousand_edits_ends_in_the_expected_text_and_diagnostics()
             (at, alphabet[rng.next(alphabet.len())].to_string())
         };
         let change = json!({
-            "range": { "start": utf16_position(&text, at), "end": utf16_position(&text, end) },
+            "range": { "start": position_of(&text, at), "end": position_of(&text, end) },
             "text": insert,
         });
         text.replace_range(at..end, &insert);
