@@ -1,0 +1,219 @@
+/* semo_runtime.h: the SeMo runtime API (targets `linux` and `linux-sim`).
+ *
+ * Generated robot programs and the task files users write call only what is
+ * declared here. Names of the task-facing calls follow the HOPES/UEM
+ * convention (UFPort_*, UFControl_*, UFTimer_*, LIBCALL/LIBFUNC) so existing
+ * task code ports over. The generated files provide the descriptor tables
+ * (tasks, channels, multicast groups, peers) in one `semo_program_desc`
+ * handed to `semo_main`.
+ *
+ * Threads: one POSIX thread per task; every call below is thread-safe.
+ * Time: "mission time" in milliseconds since start. In simulation
+ * (`-DSEMO_SIM`) it runs `time_scale` times faster than the wall clock.
+ */
+#ifndef SEMO_RUNTIME_H
+#define SEMO_RUNTIME_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/* ---------------------------------------------------------------- values */
+
+/* Every mission value travels as text: numbers in decimal, locations "x,y",
+ * strings and symbolic constants as written. */
+#define SEMO_VALUE_MAX 64
+typedef struct {
+    char text[SEMO_VALUE_MAX];
+} semo_value;
+
+/* A literal value: `SEMO_LIT("5,5")` is a `const semo_value *`. */
+#define SEMO_LIT(s) (&(const semo_value){.text = s})
+
+void semo_value_set(semo_value *v, const char *text); /* truncates to fit */
+void semo_value_set_int(semo_value *v, long long n);
+/* Numeric comparison when both parse completely as numbers, else strcmp.
+ * Returns <0, 0 or >0. */
+int semo_value_compare(const semo_value *a, const semo_value *b);
+/* "true" or a non-zero number. */
+bool semo_value_truthy(const semo_value *v);
+
+/* ------------------------------------------------------------------ time */
+
+int64_t semo_now_ms(void);         /* mission time since start */
+void semo_sleep_ms(int64_t ms);    /* mission ms; returns early when the program stops */
+
+/* -------------------------------------------------------- program tables */
+
+typedef enum { SEMO_TRIGGER_TIME, SEMO_TRIGGER_DATA, SEMO_TRIGGER_CONTROL } semo_trigger;
+
+typedef struct {
+    const char *name;
+    semo_trigger trigger;
+    int64_t period_ms; /* SEMO_TRIGGER_TIME only */
+    void (*init)(void);
+    void (*go)(void);  /* one firing */
+    void (*wrapup)(void);
+} semo_task_desc;
+
+/* A FIFO channel of the task graph: a bounded ring buffer of fixed-size samples. */
+typedef struct {
+    const char *src_task, *src_port, *dst_task, *dst_port;
+    size_t sample_size;
+    size_t capacity;          /* samples, from the buffer analysis */
+    unsigned initial_samples; /* zero-filled samples present at start */
+} semo_channel_desc;
+
+/* A multicast group: a buffer holding the latest sample. */
+typedef struct {
+    const char *name;
+    size_t sample_size;
+} semo_multicast_desc;
+
+/* Every robot of the mission (for the transport): its team, name and index.
+ * Robot i listens on UDP port `port_base + i` of 127.0.0.1. */
+typedef struct {
+    const char *team;
+    const char *robot;
+} semo_peer;
+
+typedef struct {
+    const char *mission; /* file name, for traces */
+    const char *team;
+    const char *robot;
+    const char *robot_type;
+    const semo_task_desc *tasks;
+    size_t task_count;
+    const semo_channel_desc *channels;
+    size_t channel_count;
+    const semo_multicast_desc *groups;
+    size_t group_count;
+    const semo_peer *peers;
+    size_t peer_count;
+    size_t self; /* index of this robot in `peers` */
+} semo_program_desc;
+
+/* Runs the program: parses the command line (`--trace FILE`,
+ * `--port-base N`, `--duration MS`; simulation also `--scenario FILE` and
+ * `--time-scale X`), allocates channels, opens the transport, calls every
+ * task's init, starts one thread per task (time-driven tasks fire every
+ * period, data-driven tasks fire again as soon as a firing returns,
+ * control-driven tasks wait for UFControl_*), and waits until
+ * `semo_stop_program` is called or the duration elapses; then stops the
+ * threads, calls every wrapup and returns the exit status. */
+int semo_main(int argc, char **argv, const semo_program_desc *program);
+
+/* Ends the program (from any task). */
+void semo_stop_program(void);
+bool semo_running(void);
+/* The program being run (valid inside semo_main). */
+const semo_program_desc *semo_program(void);
+
+/* ----------------------------------------------------------------- ports */
+
+/* The channel id of a task's port, or -1 when the task has no such port. */
+int UFPort_Initialize(const char *task, const char *port);
+/* Blocks until one sample is available; returns the bytes read, or 0 when
+ * the program is stopping or `size` is not the channel's sample size. */
+int UFPort_ReadFromQueue(int port, void *buf, size_t size);
+/* Never blocks: returns the bytes written, or 0 when the channel is full
+ * (the sample is dropped and counted) or `size` is wrong. */
+int UFPort_WriteToQueue(int port, const void *buf, size_t size);
+/* Samples waiting in the channel; never blocks. -1 for a bad id. */
+int UFPort_GetNumOfAvailableData(int port);
+
+/* ------------------------------------------------------------- multicast */
+
+/* Latest-value groups: Write replaces the value, Read copies the latest
+ * (returns the bytes read, 0 while nothing was written yet). */
+int UFMulticast_Write(const char *group, const void *buf, size_t size);
+int UFMulticast_Read(const char *group, void *buf, size_t size);
+
+/* --------------------------------------------------------------- control */
+
+typedef enum { SEMO_TASK_IDLE, SEMO_TASK_RUNNING, SEMO_TASK_SUSPENDED } semo_task_state;
+
+int UFControl_RunTask(const char *task);     /* fire repeatedly until stopped */
+int UFControl_CallTask(const char *task);    /* fire once, then back to idle */
+int UFControl_StopTask(const char *task);    /* ask to stop; idle after the current firing */
+int UFControl_SuspendTask(const char *task); /* no new firing until resumed */
+int UFControl_ResumeTask(const char *task);
+semo_task_state UFControl_GetTaskState(const char *task);
+/* For task bodies that take long: true when the control task asked this
+ * task to stop (or the program is stopping). */
+bool UFControl_StopRequested(const char *task);
+
+/* Task parameters (per task, by name); unknown ones read as 0. */
+int UFTask_SetIntegerParameter(const char *task, const char *param, long long value);
+long long UFTask_GetIntegerParameter(const char *task, const char *param);
+
+/* ---------------------------------------------------------------- timers */
+
+typedef enum { SEMO_MSEC, SEMO_SEC, SEMO_MIN, SEMO_HOUR } semo_time_unit;
+/* A one-shot timer in mission time; returns its id (>= 0) or -1. */
+int UFTimer_Set(int64_t period, semo_time_unit unit);
+/* True once the timer's period has elapsed (the timer stays alarmed). */
+bool UFTimer_GetAlarmed(int id);
+void UFTimer_Cancel(int id);
+
+/* -------------------------------------------------------------- libraries */
+
+/* Library tasks live in the program's address space: a library function is
+ * a plain C function (which locks its own state), and a call goes straight
+ * to it. `LIBFUNC(int, allFound, (void))`, `LIBCALL(colors, allFound)`. */
+#define LIBFUNC(ret, name, params) ret name params
+#define LIBCALL(port, func, ...) func(__VA_ARGS__)
+
+/* ---------------------------------------------------- inter-robot messages */
+
+typedef enum { SEMO_MSG_SEND = 's', SEMO_MSG_PUBLISH = 'p' } semo_msg_kind;
+
+typedef struct {
+    char kind;            /* semo_msg_kind */
+    char from_team[32];
+    char from_robot[32];
+    char key[64];         /* "SlaveTeam.COLOR", "USER.RC_CMD" */
+    semo_value value;
+} semo_message;
+
+/* Delivers to every robot of `to_team` ("USER": the operator console, which
+ * only traces it). Returns the number of robots it was sent to, -1 on error. */
+int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value);
+/* The next message received (operator commands of the simulation arrive
+ * here too, from team "USER"); waits at most `timeout_ms` mission ms.
+ * Returns 1 with `*out` filled, 0 on timeout or stop. */
+int semo_comm_poll(semo_message *out, int64_t timeout_ms);
+
+/* The transport interface: UDP on 127.0.0.1 today; an MQTT transport is a
+ * second instance of this table. */
+typedef struct {
+    const char *name;
+    int (*open)(const semo_program_desc *program, int port_base);
+    int (*send)(size_t peer, const void *data, size_t len);
+    /* Bytes received, 0 on timeout, -1 on error. */
+    int (*recv)(void *data, size_t cap, int timeout_ms);
+    void (*close)(void);
+} semo_transport;
+extern const semo_transport semo_udp_transport;
+
+/* ----------------------------------------------------------------- traces */
+
+/* Appends one JSON line `{"t":<mission ms>,"robot":"<robot>","event":"<event>",
+ * "<k1>":"<v1>",...}` to the trace (`--trace FILE`; none without it). The
+ * arguments after `event` are key/value string pairs ending with NULL;
+ * values are JSON-escaped. */
+void semo_trace(const char *event, ...);
+
+/* ------------------------------------------------------------- simulation */
+
+#ifdef SEMO_SIM
+/* The scenario's latest value of `value` (e.g. "LOCATION") for this robot
+ * at the current mission time; false when the scenario gives none yet. */
+bool semo_sim_sensor(const char *value, semo_value *out);
+/* An actuator command: traced as {"event":"actuate","task":..,"value":..}. */
+void semo_sim_actuate(const char *task, const semo_value *command);
+/* How long (mission ms) a built-in service takes in the scenario (default 100). */
+int64_t semo_sim_service_ms(const char *service);
+#endif
+
+#endif /* SEMO_RUNTIME_H */
