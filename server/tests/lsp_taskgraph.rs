@@ -92,7 +92,7 @@ async fn hover_completion_and_inlay_hints_on_the_data_loop() {
 
 const PARENT: &str = r#"<TaskGraph name="parent" xmlns="urn:semo:taskgraph:1">
   <Task name="A"><Port name="o" dir="out"/></Task>
-  <Task name="B" subgraph="$0child.taskgraph.xml"><Port name="in" dir="in"/></Task>
+  <Task name="$0B" subgraph="$0child.taskgraph.xml"><Port name="in" dir="in"/></Task>
   <Channel src="A.o" dst="B.in"/>
 </TaskGraph>
 "#;
@@ -127,6 +127,18 @@ async fn sub_graph_problems_follow_the_referenced_document() {
     client.open(child_uri, CHILD).await;
     let diags = client.diagnostics(parent_uri, Some(1)).await;
     assert_eq!(codes(&diags), Vec::<&str>::new(), "{diags:?}");
+    let hover = client
+        .request(
+            "textDocument/hover",
+            json!({ "textDocument": { "uri": parent_uri }, "position": at[0] }),
+        )
+        .await
+        .unwrap();
+    let md = hover["contents"]["value"].as_str().unwrap();
+    assert!(
+        md.contains("stands for the sub-graph `child.taskgraph.xml`: each firing runs one iteration of it (C×1)"),
+        "{md}"
+    );
 
     // Renaming the child's open port breaks the correspondence.
     client
@@ -146,7 +158,7 @@ async fn sub_graph_problems_follow_the_referenced_document() {
     let found = client
         .request(
             "textDocument/definition",
-            json!({ "textDocument": { "uri": parent_uri }, "position": at[0] }),
+            json!({ "textDocument": { "uri": parent_uri }, "position": at[1] }),
         )
         .await
         .unwrap();
