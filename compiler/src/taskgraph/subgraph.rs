@@ -158,7 +158,8 @@ impl Walk<'_> {
                     continue;
                 };
                 match found {
-                    Found::Usable(target, source, child, nested) => {
+                    Found::Usable(usable) => {
+                        let (target, source, child, nested) = *usable;
                         if let Some(links) = match_ports(
                             graph.file,
                             task,
@@ -326,12 +327,12 @@ impl Walk<'_> {
             );
             return Some(Found::Broken);
         }
-        Some(Found::Usable(target, source, child, nested))
+        Some(Found::Usable(Box::new((target, source, child, nested))))
     }
 }
 
 enum Found {
-    Usable(PathBuf, SubgraphSource, TaskGraph, Hierarchy),
+    Usable(Box<(PathBuf, SubgraphSource, TaskGraph, Hierarchy)>),
     /// A cycle returning to the file at this index of the chain, as file names.
     Cycle(usize, Vec<String>),
     /// Reported on the reference already.
