@@ -346,3 +346,97 @@ fn check_reads_an_explicitly_named_sdf3_file_as_a_task_graph() {
         "checked 0 missions and 0 catalog files, 1 task graph: 0 errors, 0 warnings, 0 hints\n"
     );
 }
+
+fn subgraph_fixtures() -> std::path::PathBuf {
+    support::repo_root().join("tests/fixtures/subgraph")
+}
+
+#[test]
+fn a_task_runs_one_iteration_of_its_sub_graph_as_a_nested_level() {
+    let (code, v) = analyze_json(&subgraph_fixtures(), "tracker.taskgraph.xml");
+    assert_eq!(code, 0, "{v}");
+    assert_eq!(v["diagnostics"], serde_json::json!([]));
+    let top = &v["levels"][0];
+    assert_eq!(repetition(top, "detect"), 1);
+    // Without a wcet, `detect` takes one iteration of its sub-graph on one
+    // processor: 2 firings of filter (2) + 1 of merge (4) = 8.
+    assert_eq!(top["throughput"]["period"], "8");
+    assert_eq!(
+        top["throughput"]["critical_cycle"],
+        serde_json::json!(["detect"])
+    );
+    let inner = &v["levels"][1];
+    assert_eq!(inner["path"], "tracker/detect");
+    assert_eq!(
+        (repetition(inner, "filter"), repetition(inner, "merge")),
+        (2, 1)
+    );
+    assert_eq!(inner["deadlock_free"], true);
+    assert_eq!(v["looped_schedule"], "camera 2filter merge track");
+}
+
+#[test]
+fn schedule_and_check_follow_sub_graph_references() {
+    let dir = subgraph_fixtures();
+    let out = semo_in(&dir, &["graph", "schedule", "tracker.taskgraph.xml"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert_eq!(out.stdout, "camera 2filter merge track\n");
+    let cores = semo_in(
+        &dir,
+        &["graph", "schedule", "--cores", "1", "tracker.taskgraph.xml"],
+    );
+    // `detect` takes its sub-graph's time, 8: track starts at 1 + 8.
+    assert!(
+        cores.stdout.contains("core 0: camera@0 detect@1 track@9"),
+        "{}",
+        cores.stdout
+    );
+    assert!(
+        cores
+            .stdout
+            .contains("tracker/detect on 1 core:\n  core 0: filter@0 filter@2 merge@4"),
+        "{}",
+        cores.stdout
+    );
+    let (code, diags) =
+        support::check_json_in(&support::repo_root().join("tests/fixtures"), &["subgraph"]);
+    assert_eq!((code, diags.len()), (0, 0), "{}", support::listing(&diags));
+}
+
+#[test]
+fn dot_and_svg_name_the_sub_graph_file_on_its_task() {
+    let dir = subgraph_fixtures();
+    let dot = semo_in(&dir, &["graph", "dot", "tracker.taskgraph.xml"]);
+    assert_eq!(dot.code, 0, "{}", dot.stderr);
+    assert!(
+        dot.stdout
+            .contains("\"detect\" [label=\"detect\\n⤷ detect.taskgraph.xml\"];"),
+        "{}",
+        dot.stdout
+    );
+    let svg = semo_in(&dir, &["graph", "svg", "tracker.taskgraph.xml"]);
+    assert_eq!(svg.code, 0, "{}", svg.stderr);
+    assert!(
+        svg.stdout.contains(">⤷ detect.taskgraph.xml</text>"),
+        "{}",
+        svg.stdout
+    );
+}
+
+#[test]
+fn a_missing_sub_graph_fails_the_analysis_on_the_reference() {
+    let dir = support::repo_root().join("tests/fixtures/diagnostics/E067_subgraph_unreadable");
+    let (code, v) = analyze_json(&dir, "graph.taskgraph.xml");
+    assert_eq!(code, 1, "{v}");
+    let d = &v["diagnostics"][0];
+    assert_eq!(d["code"], "E067");
+    let text = std::fs::read_to_string(dir.join("graph.taskgraph.xml")).unwrap();
+    let line = text
+        .lines()
+        .position(|l| l.contains("missing.taskgraph"))
+        .unwrap() as u64
+        + 1;
+    assert_eq!(d["start"]["line"], line);
+    // The graph itself is still analysed: B stands for nothing it could time.
+    assert_eq!(v["levels"].as_array().map(Vec::len), Some(1));
+}

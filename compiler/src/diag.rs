@@ -112,6 +112,9 @@ codes! {
     GraphUnknownEndpoint = "E064", Error, "a channel end that names no task or port";
     GraphBadAttribute = "E065", Error, "a task-graph attribute value of the wrong form";
     GraphPortDirection = "E066", Error, "a channel from an input port or into an output port";
+    SubgraphUnreadable = "E067", Error, "a task's `subgraph` file that cannot be found or read";
+    SubgraphHasErrors = "E068", Error, "a task's `subgraph` file that has errors of its own";
+    SubgraphCycle = "E069", Error, "`subgraph` references that lead back to a file on the way (a → b → a), or nest too deep";
     GraphUnknownAttribute = "W060", Warning, "an attribute that the task-graph format does not have";
     BufferTooSmall = "W061", Warning, "a channel whose declared capacity is smaller than the schedule needs";
     InconsistentRates = "E070", Error, "sample rates that no repetition vector satisfies";
@@ -122,6 +125,8 @@ codes! {
     ExitTaskNotInLoop = "E075", Error, "a loop's exitTask that is not a task of its body";
     UnknownLibrary = "E076", Error, "a library port naming a library that is not declared";
     UnknownLibraryFunction = "E077", Error, "a call through a library port to a function the library lacks";
+    SubgraphPortMismatch = "E078", Error, "a task's ports that do not match the open ports of its sub-graph (by name and direction)";
+    SubgraphBoundaryRate = "E079", Error, "a task's port rates that do not carry exactly one iteration of its sub-graph";
     MulticastWithoutReader = "W062", Warning, "a multicast group that tasks write but none reads";
     MulticastWithoutWriter = "W063", Warning, "a multicast group that tasks read but none writes";
     // Strategy files (*.strategy.xml).

@@ -10,6 +10,7 @@ use crate::catalog::{
 use crate::diag::{self, Diagnostic, FileId};
 use crate::sema::{Analysis, check_source};
 use crate::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
+use crate::taskgraph::subgraph::{self, Hierarchy, Resolver, SubgraphSource};
 use crate::text::LineIndex;
 use std::path::{Path, PathBuf};
 
@@ -242,8 +243,9 @@ pub fn check_files(files: Files) -> CheckRun {
         &catalog,
     );
     diagnostics.extend(found);
+    let mut resolver = DiskResolver::new(&files);
     for f in files.iter().filter(|f| f.kind == FileKind::TaskGraph) {
-        diagnostics.extend(analyze_graph(f).diagnostics);
+        diagnostics.extend(analyze_graph(f, &mut resolver).diagnostics);
     }
     diag::sort_and_dedup(&mut diagnostics);
     CheckRun {
@@ -260,30 +262,93 @@ pub fn check_files(files: Files) -> CheckRun {
 pub struct GraphRun {
     /// `None` when the file could not be read as a task graph at all.
     pub graph: Option<crate::taskgraph::TaskGraph>,
+    /// The sub-graphs its tasks reference, resolved.
+    pub hierarchy: Hierarchy,
     pub report: crate::taskgraph::analysis::GraphReport,
-    /// Loading and analysis diagnostics, sorted.
+    /// Loading, reference and analysis diagnostics, sorted.
     pub diagnostics: Vec<Diagnostic>,
 }
 
-/// Loads a task graph (ours or SDF3) and runs its analyses; a graph that did
-/// not load cleanly is not analysed, so that its problems are not reported twice.
-pub fn analyze_graph(file: &SourceFile) -> GraphRun {
-    analyze_graph_text(file.id, &file.text)
+/// Loads a task graph (ours or SDF3), follows its `subgraph` references from
+/// the disk, and runs its analyses; a graph that did not load cleanly is not
+/// analysed, so that its problems are not reported twice.
+pub fn analyze_graph(file: &SourceFile, resolver: &mut DiskResolver) -> GraphRun {
+    analyze_graph_at(file.id, &file.text, Some(&file.path), resolver)
 }
 
-/// [`analyze_graph`] for text held elsewhere (the language server's documents).
-pub fn analyze_graph_text(file: FileId, text: &str) -> GraphRun {
+/// [`analyze_graph`] for text held anywhere (the language server's
+/// documents), at `location` if it has one, reading referenced files through
+/// `resolver`.
+pub fn analyze_graph_at(
+    file: FileId,
+    text: &str,
+    location: Option<&Path>,
+    resolver: &mut dyn Resolver,
+) -> GraphRun {
     let (graph, mut diagnostics) = crate::taskgraph::load_task_graph(file, text);
     let loaded_cleanly = !diagnostics.iter().any(Diagnostic::is_error);
-    let report = match &graph {
-        Some(g) if loaded_cleanly => crate::taskgraph::analysis::analyze(g),
-        _ => crate::taskgraph::analysis::GraphReport::default(),
+    let (hierarchy, report) = match &graph {
+        Some(g) if loaded_cleanly => {
+            let hierarchy = subgraph::resolve(g, location, resolver);
+            let report = crate::taskgraph::analysis::analyze_with(g, &hierarchy);
+            (hierarchy, report)
+        }
+        _ => Default::default(),
     };
+    diagnostics.extend(hierarchy.diagnostics.iter().cloned());
     diagnostics.extend(report.diagnostics.iter().cloned());
     diag::sort_and_dedup(&mut diagnostics);
     GraphRun {
         graph,
+        hierarchy,
         report,
         diagnostics,
+    }
+}
+
+/// Reads referenced sub-graph files from the disk for the CLI. A file of the
+/// check keeps its id and text; others get ids after the check's files.
+pub struct DiskResolver {
+    known: std::collections::HashMap<PathBuf, SubgraphSource>,
+    next: u32,
+}
+
+impl DiskResolver {
+    pub fn new(files: &Files) -> DiskResolver {
+        let known = files
+            .iter()
+            .map(|f| {
+                let source = SubgraphSource {
+                    file: f.id,
+                    text: f.text.as_str().into(),
+                };
+                (subgraph::normalize(&f.path), source)
+            })
+            .collect();
+        DiskResolver {
+            known,
+            next: files.iter().count() as u32,
+        }
+    }
+}
+
+impl Resolver for DiskResolver {
+    fn read(&mut self, path: &Path) -> Result<SubgraphSource, String> {
+        if let Some(source) = self.known.get(path) {
+            return Ok(source.clone());
+        }
+        let bytes = std::fs::read(path).map_err(|e| match e.kind() {
+            std::io::ErrorKind::NotFound => format!("there is no file {}", path.display()),
+            _ => format!("{}: {e}", path.display()),
+        })?;
+        let text = String::from_utf8(bytes)
+            .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned());
+        let source = SubgraphSource {
+            file: FileId(self.next),
+            text: text.into(),
+        };
+        self.next += 1;
+        self.known.insert(path.to_path_buf(), source.clone());
+        Ok(source)
     }
 }

@@ -15,8 +15,9 @@ use semo::diag::{self, Diagnostic, FileId};
 use semo::sema::{Analysis, check_parsed};
 use semo::strategy::{Strategy, cross_check, load_strategy};
 use semo::syntax::{ParseCache, parse_incremental};
+use semo::taskgraph::subgraph::{self, SubgraphSource};
 use semo::text::LineIndex;
-use semo::workspace::{FileKind, GraphRun, analyze_graph_text};
+use semo::workspace::{FileKind, GraphRun, analyze_graph_at};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock, PoisonError, mpsc};
@@ -104,8 +105,39 @@ pub struct Snapshot {
     pub encoding: Encoding,
     /// For a strategy file: the missions it is cross-checked against.
     pub missions: Vec<Arc<Snapshot>>,
+    /// For a task graph: the task-graph files the server knows, by path,
+    /// where its `subgraph` references are looked up before the disk.
+    pub graphs: GraphFiles,
     parses: Arc<ParseSlot>,
     analysis: OnceLock<Arc<FileAnalysis>>,
+}
+
+/// Task-graph texts by (normalized) path: open documents as the client has
+/// them, workspace files as read from the disk.
+pub type GraphFiles = Arc<HashMap<PathBuf, SubgraphSource>>;
+
+/// Looks referenced sub-graph files up in the server's files, else reads
+/// them from the disk. Files the server does not know get ids counting down
+/// from below the built-in catalog's: they are read for this analysis only
+/// and nothing is published for them.
+struct GraphResolver<'a> {
+    known: &'a GraphFiles,
+    next: u32,
+}
+
+impl subgraph::Resolver for GraphResolver<'_> {
+    fn read(&mut self, path: &Path) -> Result<SubgraphSource, String> {
+        if let Some(source) = self.known.get(path) {
+            return Ok(source.clone());
+        }
+        let text = read_text(path)
+            .ok_or_else(|| format!("there is no readable file {}", path.display()))?;
+        self.next -= 1;
+        Ok(SubgraphSource {
+            file: FileId(self.next),
+            text: text.into(),
+        })
+    }
 }
 
 /// What is known about a snapshot once analysed.
@@ -162,7 +194,19 @@ impl Snapshot {
                 out.other_diagnostics = self.catalog.diagnostics_of(self.id).cloned().collect();
                 diag::sort_and_dedup(&mut out.other_diagnostics);
             }
-            FileKind::TaskGraph => out.graph = Some(analyze_graph_text(self.id, &self.text)),
+            FileKind::TaskGraph => {
+                let location = self.uri.to_file_path();
+                let mut resolver = GraphResolver {
+                    known: &self.graphs,
+                    next: semo::catalog::BUILTIN_FILE.0,
+                };
+                out.graph = Some(analyze_graph_at(
+                    self.id,
+                    &self.text,
+                    location.as_deref(),
+                    &mut resolver,
+                ));
+            }
             FileKind::Strategy => {
                 let (strategy, mut diagnostics) = load_strategy(self.id, &self.text);
                 if let Some(strategy) = &strategy {
@@ -232,6 +276,8 @@ pub struct World {
     uris: Vec<Uri>,
     ids: HashMap<Uri, FileId>,
     catalog: Option<Arc<CatalogState>>,
+    /// The task-graph files by path, built when a task graph needs it.
+    graph_files: Option<GraphFiles>,
 }
 
 /// What a change did, so the caller knows which files to re-check.
@@ -396,6 +442,7 @@ impl World {
         let mut changed = match entry.kind {
             FileKind::Catalog => self.catalog_changed(),
             FileKind::Mission => self.missions_changed(),
+            FileKind::TaskGraph => self.graph_changed(uri, entry.path.as_deref()),
             _ => Changed::default(),
         };
         changed.files.push(uri.clone());
@@ -413,6 +460,10 @@ impl World {
         let id = self.file_id(&uri);
         let version = document.as_ref().map(|d| d.version);
         let is_catalog = kind == FileKind::Catalog;
+        if kind == FileKind::TaskGraph {
+            // Its new text is looked up by the graphs referencing it.
+            self.graph_files = None;
+        }
         // A catalog file gets its snapshot on the new catalog just below.
         let catalog = if is_catalog {
             Arc::new(CatalogState::new(Vec::new()))
@@ -436,6 +487,9 @@ impl World {
             self.catalog_changed()
         } else if kind == FileKind::Mission {
             self.missions_changed()
+        } else if kind == FileKind::TaskGraph {
+            let path = self.files.get(&uri).and_then(|f| f.path.clone());
+            self.graph_changed(&uri, path.as_deref())
         } else {
             Changed::default()
         };
@@ -446,7 +500,7 @@ impl World {
     }
 
     fn new_snapshot(
-        &self,
+        &mut self,
         uri: &Uri,
         id: FileId,
         kind: FileKind,
@@ -463,6 +517,11 @@ impl World {
         } else {
             Vec::new()
         };
+        let graphs = if kind == FileKind::TaskGraph {
+            self.graph_files()
+        } else {
+            GraphFiles::default()
+        };
         Snapshot {
             uri: uri.clone(),
             id,
@@ -472,6 +531,7 @@ impl World {
             catalog,
             encoding: self.encoding,
             missions,
+            graphs,
             // Handed from each snapshot of the file to the next.
             parses: self
                 .files
@@ -482,30 +542,74 @@ impl World {
         }
     }
 
+    /// The task-graph files by path (built again after a task graph changed).
+    fn graph_files(&mut self) -> GraphFiles {
+        if let Some(files) = &self.graph_files {
+            return files.clone();
+        }
+        let files: GraphFiles = Arc::new(
+            self.files
+                .values()
+                .filter(|f| f.kind == FileKind::TaskGraph)
+                .filter_map(|f| {
+                    let path = subgraph::normalize(f.path.as_deref()?);
+                    let source = SubgraphSource {
+                        file: f.snapshot.id,
+                        text: f.snapshot.text.clone(),
+                    };
+                    Some((path, source))
+                })
+                .collect(),
+        );
+        self.graph_files = Some(files.clone());
+        files
+    }
+
+    /// The task graph at `uri` (at `path` on disk) changed or went away: the
+    /// other task graphs that read it through `subgraph` references (or that
+    /// were not analysed yet, so nobody knows) get new snapshots seeing its
+    /// new text.
+    fn graph_changed(&mut self, uri: &Uri, path: Option<&Path>) -> Changed {
+        self.graph_files = None;
+        let Some(path) = path.map(subgraph::normalize) else {
+            return Changed::default();
+        };
+        self.renew(|other, entry| {
+            entry.kind == FileKind::TaskGraph
+                && other != uri
+                && entry.snapshot.analysis.get().is_none_or(|a| {
+                    a.graph
+                        .as_ref()
+                        .is_some_and(|run| run.hierarchy.reads.contains(&path))
+                })
+        })
+    }
+
     /// Strategy files are cross-checked against the missions: they get new
     /// snapshots on the current missions.
     fn missions_changed(&mut self) -> Changed {
-        self.renew(|kind| kind == FileKind::Strategy)
+        self.renew(|_, f| f.kind == FileKind::Strategy)
     }
 
     /// Every file gets a new snapshot on the new catalog (missions are
     /// re-checked against it, catalog files get their new diagnostics).
     fn catalog_changed(&mut self) -> Changed {
         self.catalog = None;
-        let mut changed = self.renew(|kind| matches!(kind, FileKind::Mission | FileKind::Catalog));
+        let mut changed =
+            self.renew(|_, f| matches!(f.kind, FileKind::Mission | FileKind::Catalog));
         // Strategies last, on the missions' new snapshots.
         changed.files.extend(self.missions_changed().files);
         changed
     }
 
-    /// New snapshots (same text, the current catalog) for the files of the
-    /// kinds `which` selects; the old ones are retired.
-    fn renew(&mut self, which: impl Fn(FileKind) -> bool) -> Changed {
+    /// New snapshots (same text, the current catalog) for the files `which`
+    /// selects; the old ones are retired.
+    fn renew(&mut self, which: impl Fn(&Uri, &FileEntry) -> bool) -> Changed {
         let catalog = self.catalog();
         let uris: Vec<Uri> = self
             .files
             .iter()
-            .filter(|(_, f)| which(f.kind))
+            .filter(|(u, f)| which(u, f))
             .map(|(u, _)| u.clone())
             .collect();
         for uri in &uris {

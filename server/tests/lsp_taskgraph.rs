@@ -89,3 +89,105 @@ async fn hover_completion_and_inlay_hints_on_the_data_loop() {
     assert_eq!(labels, ["×1", "×1", "×1", "×1", "×1"]);
     client.shutdown().await;
 }
+
+const PARENT: &str = r#"<TaskGraph name="parent" xmlns="urn:semo:taskgraph:1">
+  <Task name="A"><Port name="o" dir="out"/></Task>
+  <Task name="$0B" subgraph="$0child.taskgraph.xml"><Port name="in" dir="in"/></Task>
+  <Channel src="A.o" dst="B.in"/>
+</TaskGraph>
+"#;
+
+/// `in` is the open input port that `B.in` stands for.
+const CHILD: &str = r#"<TaskGraph name="child" xmlns="urn:semo:taskgraph:1">
+  <Task name="C"><Port name="in" dir="in"/></Task>
+</TaskGraph>
+"#;
+
+fn codes(diagnostics: &[Value]) -> Vec<&str> {
+    diagnostics
+        .iter()
+        .map(|d| d["code"].as_str().unwrap_or_default())
+        .collect()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn sub_graph_problems_follow_the_referenced_document() {
+    let (parent, at) = cursors(PARENT);
+    let parent_uri = "file:///g/parent.taskgraph.xml";
+    let child_uri = "file:///g/child.taskgraph.xml";
+    let mut client = semo_server::harness::TestClient::start();
+    client.initialize(&["utf-16"], None).await;
+    client.open(parent_uri, &parent).await;
+    // Neither open nor on the disk.
+    let diags = client.diagnostics(parent_uri, Some(1)).await;
+    assert_eq!(codes(&diags), ["E067"]);
+    assert_eq!(text_at(&parent, &diags[0]["range"]), "child.taskgraph.xml");
+
+    // Opening the child re-checks the graph referencing it.
+    client.open(child_uri, CHILD).await;
+    let diags = client.diagnostics(parent_uri, Some(1)).await;
+    assert_eq!(codes(&diags), Vec::<&str>::new(), "{diags:?}");
+    let hover = client
+        .request(
+            "textDocument/hover",
+            json!({ "textDocument": { "uri": parent_uri }, "position": at[0] }),
+        )
+        .await
+        .unwrap();
+    let md = hover["contents"]["value"].as_str().unwrap();
+    assert!(
+        md.contains("stands for the sub-graph `child.taskgraph.xml`: each firing runs one iteration of it (C×1)"),
+        "{md}"
+    );
+
+    // Renaming the child's open port breaks the correspondence.
+    client
+        .notify(
+            "textDocument/didChange",
+            json!({
+                "textDocument": { "uri": child_uri, "version": 2 },
+                "contentChanges": [{ "text": CHILD.replace("name=\"in\"", "name=\"input\"") }],
+            }),
+        )
+        .await;
+    let diags = client.diagnostics(parent_uri, Some(1)).await;
+    assert_eq!(codes(&diags), ["E078", "E078"], "{diags:?}");
+    assert_eq!(text_at(&parent, &diags[0]["range"]), "child.taskgraph.xml");
+
+    // Go to definition on the attribute value opens the file it names.
+    let found = client
+        .request(
+            "textDocument/definition",
+            json!({ "textDocument": { "uri": parent_uri }, "position": at[1] }),
+        )
+        .await
+        .unwrap();
+    assert_eq!(found["uri"], child_uri, "{found}");
+    assert_eq!(
+        found["range"]["start"],
+        json!({ "line": 0, "character": 0 })
+    );
+    client.shutdown().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_sub_graph_cycle_is_reported_on_the_reference_closing_it() {
+    let (parent, _) = cursors(PARENT);
+    let parent_uri = "file:///g/parent.taskgraph.xml";
+    let child = CHILD.replace(
+        "<Task name=\"C\">",
+        "<Task name=\"C\" subgraph=\"../g/parent.taskgraph.xml\">",
+    );
+    let mut client = client_with("file:///g/child.taskgraph.xml", &child).await;
+    client.open(parent_uri, &parent).await;
+    let diags = client.diagnostics(parent_uri, Some(1)).await;
+    let cycle = diags
+        .iter()
+        .find(|d| d["code"] == "E069")
+        .unwrap_or_else(|| panic!("{diags:?}"));
+    assert_eq!(
+        cycle["message"],
+        "`child.taskgraph.xml` leads back to this file: parent.taskgraph.xml → child.taskgraph.xml → parent.taskgraph.xml"
+    );
+    client.shutdown().await;
+}

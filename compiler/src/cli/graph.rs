@@ -4,7 +4,7 @@
 
 use super::render;
 use crate::diag::Diagnostic;
-use crate::workspace::{FileKind, Files, analyze_graph};
+use crate::workspace::{DiskResolver, FileKind, Files, analyze_graph};
 use std::io::Write;
 use std::path::Path;
 
@@ -78,7 +78,7 @@ pub fn analyze(path: &Path, json: bool, color: bool, out: &mut impl Write) -> i3
     let Some(text) = read(path) else { return 2 };
     let mut files = Files::default();
     let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
-    let run = analyze_graph(files.get(id));
+    let run = analyze_graph(files.get(id), &mut DiskResolver::new(&files));
     let written = if json {
         write_json(&files, &run, out)
     } else {
@@ -208,11 +208,11 @@ fn write_json(
 /// `semo graph schedule`: the looped schedule of the whole graph, and with
 /// `cores` a list schedule of each level's iteration onto that many cores.
 pub fn schedule(path: &Path, cores: Option<usize>, out: &mut impl Write) -> i32 {
-    use crate::taskgraph::analysis::{level::Level, schedule};
+    use crate::taskgraph::analysis::{hierarchy_levels, schedule};
     let Some(text) = read(path) else { return 2 };
     let mut files = Files::default();
     let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
-    let run = analyze_graph(files.get(id));
+    let run = analyze_graph(files.get(id), &mut DiskResolver::new(&files));
     let Some(graph) = run
         .graph
         .as_ref()
@@ -232,8 +232,9 @@ pub fn schedule(path: &Path, cores: Option<usize>, out: &mut impl Write) -> i32 
         }
     }
     if let Some(cores) = cores {
-        // The report's levels are `Level::all`'s, in the same order.
-        for (level, report) in Level::all(graph).iter().zip(&run.report.levels) {
+        // The report's levels are these, in the same order.
+        let levels = hierarchy_levels(graph, &run.hierarchy);
+        for (level, report) in levels.iter().zip(&run.report.levels) {
             let (Some(counts), Some(true)) = (&report.repetition, report.deadlock_free) else {
                 continue;
             };

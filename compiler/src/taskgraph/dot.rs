@@ -1,7 +1,8 @@
 //! A picture of a task graph in Graphviz DOT: tasks as boxes (control tasks
 //! bold, library tasks as components), loop nodes as clusters holding their
 //! inner graphs, channels labelled with their rates, initial samples as black
-//! squares (●), library calls as dashed edges, multicast groups as notes.
+//! squares (●), library calls as dashed edges, multicast groups as notes; a
+//! task standing for a sub-graph file is a box naming the file (`⤷ file`).
 
 use super::model::*;
 use std::fmt::Write;
@@ -65,10 +66,15 @@ fn level(out: &mut String, graph: &TaskGraph, prefix: &str, depth: usize) {
                     TaskKind::Library => ", shape=component",
                     _ => "",
                 };
-                let label = match task.wcet {
+                let mut label = match task.wcet {
                     Some(w) => format!("{name}\\n{w}"),
                     None => name.clone(),
                 };
+                // A sub-graph is not drawn inside its task: the task names
+                // its file (`semo graph dot` on that file draws it).
+                if let Some(sub) = &task.subgraph {
+                    label.push_str(&format!("\\n⤷ {}", sub.name));
+                }
                 let _ = writeln!(
                     out,
                     "{pad}{} [label=\"{}\"{style}];",

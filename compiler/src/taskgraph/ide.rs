@@ -129,6 +129,37 @@ fn task_doc(level: &LevelRef<'_>, report: &GraphReport, task: &Task) -> String {
     if !rates.is_empty() {
         let _ = write!(md, "\n\nrates: {}", rates.join(", "));
     }
+    if let Some(sub) = &task.subgraph {
+        let inner = format!("{}/{}", level.path, task.name.name);
+        let per_firing = level_report(report, &inner).and_then(|r| {
+            let counts = r.repetition.as_ref()?;
+            Some(
+                r.nodes
+                    .iter()
+                    .zip(counts)
+                    .filter(|(n, _)| !n.ends_with(')'))
+                    .map(|(n, c)| format!("{n}×{c}"))
+                    .collect::<Vec<_>>(),
+            )
+        });
+        match per_firing {
+            Some(rep) => {
+                let _ = write!(
+                    md,
+                    "\n\nstands for the sub-graph `{}`: each firing runs one iteration of it ({})",
+                    sub.name,
+                    rep.join(", ")
+                );
+            }
+            None => {
+                let _ = write!(
+                    md,
+                    "\n\nstands for the sub-graph `{}` (not analysed here)",
+                    sub.name
+                );
+            }
+        }
+    }
     if let Some(l) = &task.loop_node {
         let kind = match l.loop_type {
             LoopType::D => "data loop (D)",

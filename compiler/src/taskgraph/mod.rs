@@ -4,6 +4,7 @@ pub mod analysis;
 pub mod dot;
 pub mod ide;
 pub mod model;
+pub mod subgraph;
 pub mod svg;
 mod xml;
 

@@ -1,5 +1,6 @@
 //! `textDocument/definition`: from a name to where its symbol is defined, in
-//! the mission or in a workspace catalog file (see `semo::ide::navigation`).
+//! the mission or in a workspace catalog file (see `semo::ide::navigation`);
+//! in a task graph, from a `subgraph` attribute to the file it names.
 
 use crate::encoding::LineMap;
 use crate::world::Snapshot;
@@ -8,9 +9,39 @@ use semo::text::LineIndex;
 use std::collections::HashMap;
 use tower_lsp_server::ls_types::{GotoDefinitionResponse, Location, Position, Range, Uri};
 
-/// The definitions of the name at `position`, as ranges of files by id
-/// (the caller maps ids to URIs under the world lock).
-pub fn definition(snapshot: &Snapshot, position: Position) -> Vec<(FileId, Range)> {
+/// Where a definition is: a file the world knows by id (the caller maps ids
+/// to URIs under the world lock), or a file by its URI.
+pub enum Place {
+    File(FileId),
+    Uri(Uri),
+}
+
+/// The definitions of the name at `position`.
+pub fn definition(snapshot: &Snapshot, position: Position) -> Vec<(Place, Range)> {
+    if let Some(found) = sub_graph_file(snapshot, position) {
+        return vec![(Place::Uri(found), Range::default())];
+    }
+    mission_definition(snapshot, position)
+        .into_iter()
+        .map(|(file, range)| (Place::File(file), range))
+        .collect()
+}
+
+/// On the value of a task's `subgraph` attribute: the file it names, when
+/// it could be read (the start of the file is its definition).
+fn sub_graph_file(snapshot: &Snapshot, position: Position) -> Option<Uri> {
+    let analysis = snapshot.analysis();
+    let run = analysis.graph.as_ref()?;
+    let offset = snapshot.line_map(&analysis).offset(position);
+    let reference = run
+        .hierarchy
+        .references
+        .iter()
+        .find(|r| r.readable && r.span.touches(offset))?;
+    Uri::from_file_path(&reference.location)
+}
+
+fn mission_definition(snapshot: &Snapshot, position: Position) -> Vec<(FileId, Range)> {
     super::with_mission(snapshot, |analysis, lines| {
         let offset = lines.offset(position);
         let catalog = &snapshot.catalog;
@@ -40,12 +71,18 @@ pub fn definition(snapshot: &Snapshot, position: Position) -> Vec<(FileId, Range
 
 /// The protocol answer: one location, several, or none.
 pub fn response(
-    found: Vec<(FileId, Range)>,
+    found: Vec<(Place, Range)>,
     uri_of: impl Fn(FileId) -> Option<Uri>,
 ) -> Option<GotoDefinitionResponse> {
     let mut locations: Vec<Location> = found
         .into_iter()
-        .filter_map(|(file, range)| Some(Location::new(uri_of(file)?, range)))
+        .filter_map(|(place, range)| {
+            let uri = match place {
+                Place::File(file) => uri_of(file)?,
+                Place::Uri(uri) => uri,
+            };
+            Some(Location::new(uri, range))
+        })
         .collect();
     match locations.len() {
         0 => None,

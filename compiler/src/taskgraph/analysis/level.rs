@@ -5,6 +5,7 @@
 
 use crate::span::Span;
 use crate::taskgraph::model::{Direction, Task, TaskGraph};
+use crate::taskgraph::subgraph::{Hierarchy, PortLink};
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Node {
@@ -12,6 +13,10 @@ pub struct Node {
     /// The task of the graph, or `None` for a loop boundary node.
     pub task: Option<usize>,
     pub span: Span,
+    /// The execution time of one firing: the task's `wcet`, or for a task
+    /// standing for a sub-graph without one, the time of one iteration of
+    /// the sub-graph (set by the analysis); `None` for boundary nodes.
+    pub wcet: Option<u64>,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -37,8 +42,19 @@ pub struct Level<'g> {
     pub graph: &'g TaskGraph,
     pub nodes: Vec<Node>,
     pub edges: Vec<Edge>,
-    /// The boundary nodes (inputs side, outputs side) inside a loop body.
+    /// The boundary nodes (inputs side, outputs side) inside a loop body or
+    /// a task's sub-graph.
     pub boundary: Option<(usize, usize)>,
+    /// In a sub-graph's top level: the name of the task it stands for.
+    pub stands_for: Option<String>,
+}
+
+/// A level of a graph's whole hierarchy, and which of the graph's own
+/// sub-graph references (an index in its `Hierarchy::subgraphs`) it lies
+/// under, if any.
+pub struct HierarchyLevel<'g> {
+    pub level: Level<'g>,
+    pub under: Option<usize>,
 }
 
 impl<'g> Level<'g> {
@@ -54,6 +70,7 @@ impl<'g> Level<'g> {
                 name: t.name.name.clone(),
                 task: Some(i),
                 span: t.name.span,
+                wcet: t.wcet,
             })
             .collect();
         let boundary = enclosing.map(|l| {
@@ -63,6 +80,7 @@ impl<'g> Level<'g> {
                     name: format!("{} ({side})", l.name.name),
                     task: None,
                     span: l.name.span,
+                    wcet: None,
                 });
             }
             (inputs, inputs + 1)
@@ -124,6 +142,7 @@ impl<'g> Level<'g> {
             nodes,
             edges,
             boundary,
+            stands_for: None,
         }
     }
 
@@ -134,5 +153,127 @@ impl<'g> Level<'g> {
             .into_iter()
             .map(|l| Level::build(l.graph, l.enclosing, l.path))
             .collect()
+    }
+
+    /// The top level of the sub-graph `graph` that `task` stands for: its
+    /// tasks and channels, and the two boundary nodes joined to the open
+    /// ports `links` pairs with the task's ports, carrying the task's rates
+    /// (one boundary firing is one firing of the task).
+    pub fn subgraph(
+        graph: &'g TaskGraph,
+        task: &Task,
+        links: &[PortLink],
+        path: String,
+    ) -> Level<'g> {
+        let mut level = Level::build(graph, None, path);
+        let inputs = level.nodes.len();
+        for side in ["inputs", "outputs"] {
+            level.nodes.push(Node {
+                name: format!("{} ({side})", task.name.name),
+                task: None,
+                span: graph.span,
+                wcet: None,
+            });
+        }
+        let outputs = inputs + 1;
+        for link in links {
+            let (Some(outer), Some(inner_task)) =
+                (task.ports.get(link.outer), graph.tasks.get(link.inner_task))
+            else {
+                continue;
+            };
+            let Some(inner) = inner_task.ports.get(link.inner_port) else {
+                continue;
+            };
+            let (outer_end, inner_end) = (
+                format!("{}.{}", task.name.name, outer.name.name),
+                format!("{}.{}", inner_task.name.name, inner.name.name),
+            );
+            let (src, dst, produce, consume, label) = match outer.dir {
+                Direction::In => (
+                    inputs,
+                    link.inner_task,
+                    outer.rate,
+                    inner.rate,
+                    format!("{outer_end} → {inner_end}"),
+                ),
+                Direction::Out => (
+                    link.inner_task,
+                    outputs,
+                    inner.rate,
+                    outer.rate,
+                    format!("{inner_end} → {outer_end}"),
+                ),
+            };
+            if produce == 0 || consume == 0 {
+                continue;
+            }
+            level.edges.push(Edge {
+                src,
+                dst,
+                produce,
+                consume,
+                initial_tokens: 0,
+                // No channel of the graph.
+                channel: usize::MAX,
+                span: inner.name.span,
+                label,
+            });
+        }
+        level.boundary = Some((inputs, outputs));
+        level.stands_for = Some(task.name.name.clone());
+        level
+    }
+
+    /// Every level of `graph` and of the sub-graphs it references
+    /// (`hierarchy`), outermost first: the graph's own levels as
+    /// [`Level::all`] gives them, then each sub-graph's levels (its top level
+    /// at `<level>/<task>`), and theirs in turn. A level comes before the
+    /// levels nested in it.
+    pub fn all_with(graph: &'g TaskGraph, hierarchy: &'g Hierarchy) -> Vec<HierarchyLevel<'g>> {
+        let mut out = Vec::new();
+        collect(graph, &graph.name, None, hierarchy, None, &mut out);
+        out
+    }
+}
+
+/// The levels of `graph` (its paths starting with `prefix` instead of its
+/// name), entered through `boundary` when it is a sub-graph, then those of
+/// its sub-graphs.
+fn collect<'g>(
+    graph: &'g TaskGraph,
+    prefix: &str,
+    boundary: Option<(&Task, &[PortLink])>,
+    hierarchy: &'g Hierarchy,
+    under: Option<usize>,
+    out: &mut Vec<HierarchyLevel<'g>>,
+) {
+    let levels = graph.levels();
+    let repath = |path: &str| format!("{prefix}{}", &path[graph.name.len().min(path.len())..]);
+    for l in &levels {
+        let path = repath(&l.path);
+        let level = match (l.enclosing, boundary) {
+            (None, Some((task, links))) => Level::subgraph(l.graph, task, links, path),
+            _ => Level::build(l.graph, l.enclosing, path),
+        };
+        out.push(HierarchyLevel { level, under });
+    }
+    for (i, s) in hierarchy.subgraphs.iter().enumerate() {
+        let Some(task) = levels
+            .iter()
+            .find(|l| l.path == s.level)
+            .and_then(|l| l.graph.tasks.get(s.task))
+        else {
+            continue;
+        };
+        let path = format!("{}/{}", repath(&s.level), task.name.name);
+        collect(
+            &s.graph,
+            &path,
+            Some((task, &s.links)),
+            &s.nested,
+            under.or(Some(i)),
+            out,
+        );
     }
 }

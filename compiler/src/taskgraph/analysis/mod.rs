@@ -14,9 +14,11 @@ pub mod throughput;
 
 use crate::diag::{Code, Diagnostic};
 use crate::taskgraph::model::TaskGraph;
+use crate::taskgraph::subgraph::Hierarchy;
 use consistency::{RateProblem, repetition_vector};
 use deadlock::find_deadlock;
 use level::Level;
+use std::collections::HashMap;
 
 /// What the analyses found about one hierarchy level.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -77,50 +79,211 @@ impl GraphReport {
 
 /// Runs the analyses on every level of `graph`.
 pub fn analyze(graph: &TaskGraph) -> GraphReport {
+    analyze_with(graph, &Hierarchy::default())
+}
+
+/// Runs the analyses on every level of `graph` and of the sub-graphs its
+/// tasks reference (`hierarchy`, from [`crate::taskgraph::subgraph::resolve`]),
+/// each at `<level>/<task>` after the graph's own levels.
+///
+/// A task standing for a sub-graph fires once per iteration of it: its ports
+/// carry one iteration's samples (E079 otherwise, on its `subgraph`
+/// attribute), and without a `wcet` of its own its execution time is the
+/// time one iteration of the sub-graph takes on one processor, in schedule
+/// order: Σ γ(v)·t(v) over the sub-graph's top level, where a loop node takes
+/// `loopCount` times its body's time (a C-type loop at most that many) and a
+/// task standing for a sub-graph that sub-graph's time, recursively. (A loop
+/// node's own firing still takes no time in its level's throughput, as
+/// before.)
+pub fn analyze_with(graph: &TaskGraph, hierarchy: &Hierarchy) -> GraphReport {
     let mut report = GraphReport {
         diagnostics: rules::check(graph),
         ..GraphReport::default()
     };
-    let levels = Level::all(graph);
+    let (mut levels, under): (Vec<Level<'_>>, Vec<Option<usize>>) =
+        Level::all_with(graph, hierarchy)
+            .into_iter()
+            .map(|h| (h.level, h.under))
+            .unzip();
+    let n = levels.len();
+    let mut reports = Vec::with_capacity(n);
+    let mut found = Vec::with_capacity(n);
     // Each level's single-appearance schedule, kept to write the whole
     // hierarchy's looped schedule at the end.
-    let mut single_appearance = Vec::with_capacity(levels.len());
-    for level in &levels {
-        let nodes = level.nodes.iter().map(|n| n.name.clone()).collect();
-        let mut level_report = LevelReport {
-            path: level.path.clone(),
-            nodes,
-            repetition: None,
-            deadlock_free: None,
-            schedule: None,
-            buffers: Vec::new(),
-            throughput: None,
-        };
-        let mut sas = None;
-        match repetition_vector(level) {
-            Ok(counts) => {
-                let blocked = find_deadlock(level, &counts);
-                match &blocked {
-                    Some(b) => report.diagnostics.push(deadlock_diagnostic(level, b)),
-                    None => {
-                        sas = schedule_level(
-                            level,
-                            &counts,
-                            &mut level_report,
-                            &mut report.diagnostics,
-                        )
-                    }
-                }
-                level_report.deadlock_free = Some(blocked.is_none());
-                level_report.repetition = Some(counts);
-            }
-            Err(problem) => report.diagnostics.push(rate_diagnostic(level, &problem)),
+    let mut single_appearance = Vec::with_capacity(n);
+    // The time of one iteration of each level analysed so far, by path.
+    let mut work: HashMap<String, u64> = HashMap::new();
+    // Innermost first: a level's sub-graph tasks take their sub-graph's time.
+    for level in levels.iter_mut().rev() {
+        sub_graph_times(level, &work);
+        let mut diagnostics = Vec::new();
+        let (level_report, sas) = analyze_level(level, &mut diagnostics);
+        if let Some(w) = level_report
+            .repetition
+            .as_ref()
+            .and_then(|counts| iteration_time(level, counts, &work))
+        {
+            work.insert(level.path.clone(), w);
         }
+        reports.push(level_report);
+        found.push(diagnostics);
         single_appearance.push(sas);
+    }
+    reports.reverse();
+    found.reverse();
+    single_appearance.reverse();
+    for ((level_report, diagnostics), under) in reports.into_iter().zip(found).zip(&under) {
+        match under {
+            None => report.diagnostics.extend(diagnostics),
+            Some(i) => report
+                .diagnostics
+                .extend(at_reference(graph, hierarchy, *i, diagnostics)),
+        }
         report.levels.push(level_report);
     }
     report.looped_schedule = schedule::render_hierarchy(&levels, &single_appearance);
     report
+}
+
+/// The levels of the whole hierarchy as [`analyze_with`] analyses them (in
+/// the order of its report's levels), the tasks standing for sub-graphs
+/// timed by their sub-graph: for schedules made outside the analysis.
+pub fn hierarchy_levels<'g>(graph: &'g TaskGraph, hierarchy: &'g Hierarchy) -> Vec<Level<'g>> {
+    let mut levels: Vec<Level<'g>> = Level::all_with(graph, hierarchy)
+        .into_iter()
+        .map(|h| h.level)
+        .collect();
+    let mut work: HashMap<String, u64> = HashMap::new();
+    for level in levels.iter_mut().rev() {
+        sub_graph_times(level, &work);
+        if let Some(w) = repetition_vector(level)
+            .ok()
+            .and_then(|counts| iteration_time(level, &counts, &work))
+        {
+            work.insert(level.path.clone(), w);
+        }
+    }
+    levels
+}
+
+/// Consistency, deadlock, schedule and throughput of one level.
+fn analyze_level(
+    level: &Level<'_>,
+    diagnostics: &mut Vec<Diagnostic>,
+) -> (LevelReport, Option<Vec<schedule::Schedule>>) {
+    let nodes = level.nodes.iter().map(|n| n.name.clone()).collect();
+    let mut level_report = LevelReport {
+        path: level.path.clone(),
+        nodes,
+        repetition: None,
+        deadlock_free: None,
+        schedule: None,
+        buffers: Vec::new(),
+        throughput: None,
+    };
+    let mut sas = None;
+    match repetition_vector(level) {
+        Ok(counts) => {
+            let blocked = find_deadlock(level, &counts);
+            match &blocked {
+                Some(b) => diagnostics.push(deadlock_diagnostic(level, b)),
+                None => sas = schedule_level(level, &counts, &mut level_report, diagnostics),
+            }
+            level_report.deadlock_free = Some(blocked.is_none());
+            level_report.repetition = Some(counts);
+        }
+        Err(problem) => diagnostics.push(rate_diagnostic(level, &problem)),
+    }
+    (level_report, sas)
+}
+
+/// Gives the tasks of `level` that stand for a sub-graph and have no `wcet`
+/// of their own the time of one iteration of their sub-graph (already in
+/// `work` when the sub-graph's level is consistent).
+fn sub_graph_times(level: &mut Level<'_>, work: &HashMap<String, u64>) {
+    let graph = level.graph;
+    for node in &mut level.nodes {
+        let Some(task) = node.task.and_then(|t| graph.tasks.get(t)) else {
+            continue;
+        };
+        if task.wcet.is_none() && task.subgraph.is_some() {
+            let inner = format!("{}/{}", level.path, task.name.name);
+            node.wcet = work.get(&inner).copied().filter(|&w| w > 0);
+        }
+    }
+}
+
+/// Σ γ(v)·t(v) over the level: the time one iteration takes on one
+/// processor. A loop node takes `loopCount` times its body's time; boundary
+/// nodes and tasks without a known time take none. `None` on overflow.
+fn iteration_time(level: &Level<'_>, counts: &[u64], work: &HashMap<String, u64>) -> Option<u64> {
+    let mut total = 0u64;
+    for (node, &count) in level.nodes.iter().zip(counts) {
+        let task = node.task.and_then(|t| level.graph.tasks.get(t));
+        let time = match task.and_then(|t| t.loop_node.as_ref().map(|l| (t, l))) {
+            Some((t, l)) => {
+                let body = work
+                    .get(&format!("{}/{}", level.path, t.name.name))
+                    .copied()
+                    .unwrap_or(0);
+                body.checked_mul(l.loop_count)?
+            }
+            None => node.wcet.unwrap_or(0),
+        };
+        total = total.checked_add(time.checked_mul(count)?)?;
+    }
+    Some(total)
+}
+
+/// The errors found in a sub-graph's levels, moved to the `subgraph`
+/// attribute of the reference they lie under: the sub-graph has no errors of
+/// its own (else it is not analysed here), so these come from the task's
+/// rates. Warnings are the sub-graph's own and stay there.
+fn at_reference(
+    graph: &TaskGraph,
+    hierarchy: &Hierarchy,
+    index: usize,
+    diagnostics: Vec<Diagnostic>,
+) -> Vec<Diagnostic> {
+    let Some(sub) = hierarchy.subgraphs.get(index) else {
+        return Vec::new();
+    };
+    let Some(task) = graph
+        .levels()
+        .into_iter()
+        .find(|l| l.path == sub.level)
+        .and_then(|l| l.graph.tasks.get(sub.task))
+    else {
+        return Vec::new();
+    };
+    let Some(attr) = &task.subgraph else {
+        return Vec::new();
+    };
+    diagnostics
+        .into_iter()
+        .filter(Diagnostic::is_error)
+        .map(|d| {
+            let code = match d.code {
+                Code::InconsistentRates | Code::RateOverflow => Code::SubgraphBoundaryRate,
+                other => other,
+            };
+            let mut moved = Diagnostic::new(
+                code,
+                graph.file,
+                attr.span,
+                format!(
+                    "the port rates of `{}` do not fit one iteration of its sub-graph `{}`: {}",
+                    task.name.name, attr.name, d.message
+                ),
+            );
+            for port in &task.ports {
+                if let Some(span) = port.rate_span {
+                    moved.relate(span, format!("the rate of `{}`", port.name.name));
+                }
+            }
+            moved
+        })
+        .collect()
 }
 
 /// The schedule of a live level, its buffer bounds, capacity warnings, and
@@ -132,10 +295,7 @@ fn schedule_level(
     report: &mut LevelReport,
     diagnostics: &mut Vec<Diagnostic>,
 ) -> Option<Vec<schedule::Schedule>> {
-    let timed = level.nodes.iter().any(|n| {
-        n.task
-            .is_some_and(|t| level.graph.tasks[t].wcet.is_some_and(|w| w > 0))
-    });
+    let timed = level.nodes.iter().any(|n| n.wcet.is_some_and(|w| w > 0));
     if timed {
         report.throughput = throughput::throughput(level, counts).map(|t| ThroughputReport {
             period: t.period,
@@ -215,6 +375,22 @@ fn rate_diagnostic(level: &Level<'_>, problem: &RateProblem) -> Diagnostic {
                 file,
                 span,
                 "the repetition counts of these rates are too large to compute (over 64 bits)",
+            )
+        }
+        RateProblem::Boundary { node, count } if level.stands_for.is_some() => {
+            let task = level.stands_for.as_deref().unwrap_or_default();
+            let side = if level.boundary.is_some_and(|(inputs, _)| inputs == *node) {
+                "input"
+            } else {
+                "output"
+            };
+            Diagnostic::new(
+                Code::InconsistentRates,
+                file,
+                level.nodes[*node].span,
+                format!(
+                    "one iteration needs the samples of {count} firings of `{task}` at its {side}s, not one: the {side} rates of `{task}` would have to be {count} times larger"
+                ),
             )
         }
         RateProblem::Boundary { node, count } => {

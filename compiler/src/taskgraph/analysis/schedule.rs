@@ -157,6 +157,13 @@ fn render_at(
             } else {
                 format!("{}({body})", l.loop_count)
             });
+        } else if task.subgraph.is_some() {
+            // A task standing for a sub-graph runs one iteration of it; a
+            // reference that did not resolve has no level: the task's name.
+            let path = format!("{}/{}", level.path, task.name.name);
+            if let Some(inner) = levels.iter().position(|other| other.path == path) {
+                bodies[v] = Some(render_at(levels, schedules, inner)?);
+            }
         }
     }
     Some(render_with(level, schedule, &|v| {
@@ -653,9 +660,8 @@ pub fn execution_time(level: &Level<'_>, node: usize) -> u64 {
     level
         .nodes
         .get(node)
-        .and_then(|n| n.task)
-        .and_then(|t| level.graph.tasks.get(t))
-        .map_or(0, |t| t.wcet.unwrap_or(1))
+        .filter(|n| n.task.is_some())
+        .map_or(0, |n| n.wcet.unwrap_or(1))
 }
 
 /// One iteration's firings list-scheduled onto `cores` cores: per core, the

@@ -48,11 +48,7 @@ pub fn throughput(level: &Level<'_>, counts: &[u64]) -> Option<Throughput> {
     if level.nodes.is_empty() || counts.len() != level.nodes.len() {
         return None;
     }
-    let wcet: Vec<u64> = level
-        .nodes
-        .iter()
-        .map(|n| n.task.and_then(|t| level.graph.tasks[t].wcet).unwrap_or(0))
-        .collect();
+    let wcet: Vec<u64> = level.nodes.iter().map(|n| n.wcet.unwrap_or(0)).collect();
     let hsdf =
         if counts.iter().all(|&c| c == 1) && level.edges.iter().all(|e| e.produce == e.consume) {
             Hsdf::direct(level, wcet)
@@ -671,11 +667,7 @@ mod tests {
     /// node; the level's period is the largest (with unbounded channels, a
     /// faster part upstream or downstream does not change a part's period).
     fn simulated_period(level: &Level<'_>, counts: &[u64]) -> Ratio {
-        let wcet: Vec<u64> = level
-            .nodes
-            .iter()
-            .map(|n| n.task.and_then(|t| level.graph.tasks[t].wcet).unwrap_or(0))
-            .collect();
+        let wcet: Vec<u64> = level.nodes.iter().map(|n| n.wcet.unwrap_or(0)).collect();
         components(level)
             .iter()
             .map(|part| simulate_part(level, counts, &wcet, part))

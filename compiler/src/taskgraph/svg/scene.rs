@@ -487,6 +487,10 @@ fn task_node(task: &Task, path: String) -> Node {
     if let Some(w) = task.wcet {
         detail.push(format!("wcet {w}"));
     }
+    // A sub-graph file is named, not drawn inside (it is a picture of its own).
+    if let Some(sub) = &task.subgraph {
+        detail.push(format!("⤷ {}", sub.name));
+    }
     let kind = match task.kind {
         TaskKind::Computational => "computational task",
         TaskKind::Control => "control task",
