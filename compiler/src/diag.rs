@@ -144,6 +144,10 @@ codes! {
     StrategyUnknownAttribute = "W080", Warning, "an attribute that the strategy format does not have";
     UnreachableAction = "W081", Warning, "an action that cannot be reached from the initial action";
     NoFinalAction = "W082", Warning, "an action machine in which no final action can be reached: the service never ends";
+    // Code generation (`semo build`).
+    CodegenUnsupported = "E100", Error, "a construct that code generation does not support yet";
+    RefinedGraphInvalid = "E101", Error, "a robot's refined task graph fails the SDF/L analyses";
+    OutputNameEscapes = "E102", Error, "a name from the mission that would write outside the output folder";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

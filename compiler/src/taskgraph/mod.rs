@@ -7,6 +7,7 @@ pub mod model;
 pub mod svg;
 mod xml;
 
+pub mod write;
 pub use model::*;
 pub use svg::to_svg;
 pub use xml::{GraphFormat, detect_format, load_task_graph};
