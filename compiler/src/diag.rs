@@ -146,8 +146,7 @@ codes! {
     NoFinalAction = "W082", Warning, "an action machine in which no final action can be reached: the service never ends";
     // Code generation (`semo build`).
     CodegenUnsupported = "E100", Error, "a construct that code generation does not support yet";
-    RefinedGraphInvalid = "E101", Error, "a robot's refined task graph fails the SDF/L analyses";
-    OutputNameEscapes = "E102", Error, "a name from the mission that would write outside the output folder";
+    OutputNameEscapes = "E101", Error, "a name that cannot become a file or C identifier of the generated code (it could write outside the output folder, or clashes with a generated task)";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

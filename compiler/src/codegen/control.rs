@@ -277,16 +277,31 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
     );
     let next = pc + 1;
     match &state.kind {
-        StateKind::Receive { messages } => {
+        StateKind::Receive {
+            messages,
+            timeout_ms,
+            mark,
+        } => {
             let ready: Vec<String> = messages
                 .iter()
                 .map(|i| format!("UFPort_GetNumOfAvailableData(in_port[{i}]) > 0"))
                 .collect();
-            let _ = writeln!(
-                out,
-                "        if (!({}))\n            return STEP_WAIT;",
-                ready.join(" && ")
-            );
+            let ready = ready.join(" && ");
+            match timeout_ms {
+                // `receive(...), timeout = P`: go on without the values after P.
+                Some(t) => {
+                    let _ = writeln!(
+                        out,
+                        "        if (r->phase == 0) {{\n            r->mark[{mark}] = semo_now_ms();\n            r->phase = 1;\n        }}\n        if (!({ready})) {{\n            if (semo_now_ms() - r->mark[{mark}] <= {t})\n                return STEP_WAIT;\n            semo_trace(\"timeout\", \"statement\", \"receive\", NULL);\n            r->phase = 0;\n            r->pc = {next};\n            return STEP_NEXT;\n        }}\n        r->phase = 0;"
+                    );
+                }
+                None => {
+                    let _ = writeln!(
+                        out,
+                        "        if (!({ready}))\n            return STEP_WAIT;"
+                    );
+                }
+            }
             for &i in messages {
                 let s = m.incoming[i].slot;
                 let _ = writeln!(

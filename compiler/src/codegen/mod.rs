@@ -324,6 +324,26 @@ pub fn build(
             .into_iter()
             .chain(program.tasks.iter().map(|t| &t.task))
             .chain(program.library.iter().map(|l| &l.name));
+        let reserved = [
+            crate::refine::graph::CONTROL_TASK,
+            crate::refine::graph::COMM_SEND,
+            crate::refine::graph::COMM_RECEIVE,
+        ];
+        for role in &program.tasks {
+            let clashes = reserved.contains(&role.task.as_str())
+                && !matches!(role.kind, RoleKind::CommSend | RoleKind::CommReceive);
+            if clashes {
+                diagnostics.push(Diagnostic::new(
+                    Code::OutputNameEscapes,
+                    mission,
+                    span,
+                    format!(
+                        "task `{}` (of robot `{}`) has the name of a task the generator adds: rename it in the catalog or strategy",
+                        role.task, program.robot
+                    ),
+                ));
+            }
+        }
         for name in names {
             if !c::is_safe_name(name) {
                 diagnostics.push(Diagnostic::new(

@@ -245,7 +245,7 @@ pub fn check(graph: &TaskGraph, file: FileId, robot: Span) -> (Vec<u64>, Vec<Dia
         .filter(|d| d.severity == Severity::Error)
         .map(|d| {
             Diagnostic::new(
-                Code::RefinedGraphInvalid,
+                Code::CodegenUnsupported,
                 file,
                 robot,
                 format!(

@@ -103,6 +103,9 @@ pub enum StateKind {
     /// [`ControlMachine::incoming`]), storing each in its slot.
     Receive {
         messages: Vec<usize>,
+        /// `receive(...), timeout = P`: give up after P (mark holds the start).
+        timeout_ms: Option<i64>,
+        mark: usize,
     },
     /// Send each item (storing assigned values in their shared slot first).
     Send {

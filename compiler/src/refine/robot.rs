@@ -344,7 +344,7 @@ impl Builder<'_, '_> {
                     None => {}
                 }
             }
-            StmtKind::Comm(c) => self.comm(c, stmt.span, states),
+            StmtKind::Comm(c) => self.comm(c, stmt.span, states, marks),
             StmtKind::Throw(event) => {
                 self.push(
                     states,
@@ -395,7 +395,7 @@ impl Builder<'_, '_> {
         group.others.as_ref().map(|o| &o.body)
     }
 
-    fn comm(&mut self, comm: &ast::Comm, span: Span, states: &mut Vec<State>) {
+    fn comm(&mut self, comm: &ast::Comm, span: Span, states: &mut Vec<State>, marks: &mut usize) {
         let peer = if crate::sema::is_user(&comm.team.name) {
             "USER".to_string()
         } else {
@@ -428,7 +428,17 @@ impl Builder<'_, '_> {
                     let key = self.attr_key(&item.attr);
                     messages.push(self.incoming(&peer, &key));
                 }
-                self.push(states, StateKind::Receive { messages }, span);
+                let timeout_ms = comm.timeout.as_ref().and_then(period_ms);
+                let mark = next_mark(marks);
+                self.push(
+                    states,
+                    StateKind::Receive {
+                        messages,
+                        timeout_ms,
+                        mark,
+                    },
+                    span,
+                );
             }
             ast::CommKind::Subscribe => {
                 for item in &comm.items {
