@@ -247,10 +247,12 @@ void semo_trace(const char *event, ...)
             fputc(',', g_trace);
             write_json_string(g_trace, key);
             fputc(':', g_trace);
-            if (value)
-                write_json_string(g_trace, value);
-            else
+            if (!value) {
+                /* An odd list: the NULL meant as the end came as a value. */
                 fputs("null", g_trace);
+                break;
+            }
+            write_json_string(g_trace, value);
         }
         va_end(args);
         fputs("}\n", g_trace);
