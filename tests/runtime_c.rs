@@ -27,7 +27,10 @@ use std::time::{Duration, Instant};
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Flavor {
     /// The generator's flags with a given compiler; `sim` adds `-DSEMO_SIM`.
-    Plain { cc: &'static str, sim: bool },
+    Plain {
+        cc: &'static str,
+        sim: bool,
+    },
     AsanUbsan,
     Tsan,
 }
@@ -46,7 +49,14 @@ impl Flavor {
     }
 
     fn flags(self) -> Vec<&'static str> {
-        let mut flags = vec!["-std=c11", "-Wall", "-Wextra", "-Werror", "-pedantic", "-pthread"];
+        let mut flags = vec![
+            "-std=c11",
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            "-pedantic",
+            "-pthread",
+        ];
         match self {
             Flavor::Plain { .. } => flags.push("-O2"),
             Flavor::AsanUbsan => flags.extend([
@@ -76,12 +86,24 @@ fn has_clang() -> bool {
 /// a note), each with and without simulation, and the two sanitizer builds.
 fn flavors() -> Vec<Flavor> {
     let mut all = vec![
-        Flavor::Plain { cc: "gcc", sim: false },
-        Flavor::Plain { cc: "gcc", sim: true },
+        Flavor::Plain {
+            cc: "gcc",
+            sim: false,
+        },
+        Flavor::Plain {
+            cc: "gcc",
+            sim: true,
+        },
     ];
     if has_clang() {
-        all.push(Flavor::Plain { cc: "clang", sim: false });
-        all.push(Flavor::Plain { cc: "clang", sim: true });
+        all.push(Flavor::Plain {
+            cc: "clang",
+            sim: false,
+        });
+        all.push(Flavor::Plain {
+            cc: "clang",
+            sim: true,
+        });
     } else {
         eprintln!("note: clang is not installed; the runtime is tested with gcc only");
     }
@@ -217,7 +239,11 @@ impl Program {
             .command(args, env)
             .spawn()
             .unwrap_or_else(|e| panic!("{} starts: {e}", self.exe.display()));
-        finish(child, Instant::now(), &format!("{} {args:?}", self.flavor.name()))
+        finish(
+            child,
+            Instant::now(),
+            &format!("{} {args:?}", self.flavor.name()),
+        )
     }
 
     /// Runs a mode that must succeed: exit 0, nothing on stderr.
@@ -274,17 +300,29 @@ fn read_trace(path: &Path, robot: &str) -> Vec<Value> {
     let _ = std::fs::remove_file(path);
     let events: Vec<Value> = text
         .lines()
-        .map(|line| serde_json::from_str(line).unwrap_or_else(|e| panic!("trace line {line:?}: {e}")))
+        .map(|line| {
+            serde_json::from_str(line).unwrap_or_else(|e| panic!("trace line {line:?}: {e}"))
+        })
         .collect();
     let mut last = 0;
     for e in &events {
-        let t = e["t"].as_u64().unwrap_or_else(|| panic!("integer t in {e}"));
+        let t = e["t"]
+            .as_u64()
+            .unwrap_or_else(|| panic!("integer t in {e}"));
         assert!(t >= last, "time goes back at {e}");
         last = t;
         assert_eq!(e["robot"], robot, "{e}");
     }
-    assert_eq!(events.first().map(|e| &e["event"]), Some(&Value::from("start")), "{text}");
-    assert_eq!(events.last().map(|e| &e["event"]), Some(&Value::from("stop")), "{text}");
+    assert_eq!(
+        events.first().map(|e| &e["event"]),
+        Some(&Value::from("start")),
+        "{text}"
+    );
+    assert_eq!(
+        events.last().map(|e| &e["event"]),
+        Some(&Value::from("stop")),
+        "{text}"
+    );
     events
 }
 
@@ -361,11 +399,11 @@ fn wait_for_start(trace: &Path, child: &mut Child) {
 fn send_datagrams_to(port: u16) {
     let junk: [&[u8]; 7] = [
         b"hello",
-        b"SEMO\x01s\x05Alpha",                     // cut short
-        &[b'x'; 2000],                             // larger than any message
-        b"SEMO\x01z\x01A\x01a\x01k\x01v",          // unknown kind
-        b"SEMO\x01s\x01\x00\x01a\x01k\x01v",       // NUL inside a field
-        b"SEMO\x01s\x01A\x01a\x01k\x01vX",         // bytes after the value
+        b"SEMO\x01s\x05Alpha",               // cut short
+        &[b'x'; 2000],                       // larger than any message
+        b"SEMO\x01z\x01A\x01a\x01k\x01v",    // unknown kind
+        b"SEMO\x01s\x01\x00\x01a\x01k\x01v", // NUL inside a field
+        b"SEMO\x01s\x01A\x01a\x01k\x01vX",   // bytes after the value
         b"SEMO\x01s\x28AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA\x01a\x01k\x01v", // team too long
     ];
     let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
@@ -373,7 +411,10 @@ fn send_datagrams_to(port: u16) {
         socket.send_to(datagram, ("127.0.0.1", port)).unwrap();
     }
     socket
-        .send_to(b"SEMO\x01s\x05Alpha\x01a\x0aAlpha.NOTE\x02hi", ("127.0.0.1", port))
+        .send_to(
+            b"SEMO\x01s\x05Alpha\x01a\x0aAlpha.NOTE\x02hi",
+            ("127.0.0.1", port),
+        )
         .unwrap();
 }
 
@@ -411,12 +452,18 @@ fn two_robots_exchange_messages_over_udp_and_reject_malformed_datagrams() {
                 .any(|e| e["to"] == "Beta" && e["key"] == "Alpha.PING")
         );
         let pong = events(&a_trace, "receive");
-        let pong = pong.iter().find(|e| e["key"] == "Beta.PONG").expect("PONG received");
+        let pong = pong
+            .iter()
+            .find(|e| e["key"] == "Beta.PONG")
+            .expect("PONG received");
         assert_eq!(pong["from"], "Beta");
         assert_eq!(pong["from_robot"], "b");
         assert_eq!(pong["value"], "pong \"1\"");
         let received = events(&b_trace, "receive");
-        let note = received.iter().find(|e| e["key"] == "Alpha.NOTE").expect("well-formed datagram");
+        let note = received
+            .iter()
+            .find(|e| e["key"] == "Alpha.NOTE")
+            .expect("well-formed datagram");
         assert_eq!(note["value"], "hi");
         assert!(received.iter().any(|e| e["key"] == "Alpha.BYE"));
         assert_eq!(events(&b_trace, "reject").len(), 7, "{b_trace:#?}");
@@ -443,22 +490,43 @@ fn simulation_feeds_scenario_sensors_and_operator_commands() {
         let commands: Vec<_> = events(&trace, "receive")
             .iter()
             .map(|e| {
-                assert_eq!((&e["from"], &e["from_robot"]), (&"USER".into(), &"USER".into()));
+                assert_eq!(
+                    (&e["from"], &e["from_robot"]),
+                    (&"USER".into(), &"USER".into())
+                );
                 assert_eq!(e["key"], "USER.RC_CMD");
-                (e["t"].as_u64().unwrap(), e["value"].as_str().unwrap().to_string())
+                (
+                    e["t"].as_u64().unwrap(),
+                    e["value"].as_str().unwrap().to_string(),
+                )
             })
             .collect();
         let values: Vec<_> = commands.iter().map(|(_, v)| v.as_str()).collect();
         assert_eq!(
             values,
-            ["NONE", "NONE", "AUTO_MODE", "NONE", "NONE", "NONE", "NONE", "FINISH"]
+            [
+                "NONE",
+                "NONE",
+                "AUTO_MODE",
+                "NONE",
+                "NONE",
+                "NONE",
+                "NONE",
+                "FINISH"
+            ]
         );
         // Each command arrives at (not before) its scenario time.
-        for ((t, _), due) in commands.iter().zip([0, 400, 500, 800, 1200, 1600, 2000, 3000]) {
+        for ((t, _), due) in commands
+            .iter()
+            .zip([0, 400, 500, 800, 1200, 1600, 2000, 3000])
+        {
             assert!(*t >= due, "{commands:?}");
         }
         let actuate = events(&trace, "actuate");
-        assert_eq!((&actuate[0]["task"], &actuate[0]["value"]), (&"Move".into(), &"5,5".into()));
+        assert_eq!(
+            (&actuate[0]["task"], &actuate[0]["value"]),
+            (&"Move".into(), &"5,5".into())
+        );
         assert!(trace.last().unwrap()["t"].as_u64().unwrap() >= 3000);
     }
 }
@@ -478,17 +546,35 @@ fn duration_is_in_mission_time_and_the_command_line_beats_the_scenario() {
             "--trace",
             trace.to_str().unwrap(),
         ]);
-        assert!(run.elapsed >= Duration::from_millis(100), "{:?}", run.elapsed);
+        assert!(
+            run.elapsed >= Duration::from_millis(100),
+            "{:?}",
+            run.elapsed
+        );
         let trace = read_trace(&trace, "solo");
         assert!(trace.last().unwrap()["t"].as_u64().unwrap() >= 100);
         if flavor.sim() {
             // The scenario alone: 5 000 mission ms at 0.01 take 50 wall ms.
-            let fast = work_dir().join(format!("fast-{}-{}.json", flavor.name(), std::process::id()));
+            let fast = work_dir().join(format!(
+                "fast-{}-{}.json",
+                flavor.name(),
+                std::process::id()
+            ));
             std::fs::write(&fast, r#"{"time_scale": 0.01, "duration": 5000}"#).unwrap();
-            let run = p.run_ok(&["minimal", "--port-base", &base, "--scenario", fast.to_str().unwrap()]);
+            let run = p.run_ok(&[
+                "minimal",
+                "--port-base",
+                &base,
+                "--scenario",
+                fast.to_str().unwrap(),
+            ]);
             assert!(run.elapsed < Duration::from_secs(3), "{:?}", run.elapsed);
             // The command line wins: a scenario at real time, run 100 times faster.
-            let slow = work_dir().join(format!("slow-{}-{}.json", flavor.name(), std::process::id()));
+            let slow = work_dir().join(format!(
+                "slow-{}-{}.json",
+                flavor.name(),
+                std::process::id()
+            ));
             std::fs::write(&slow, r#"{"time_scale": 1, "duration": 5000}"#).unwrap();
             let run = p.run_ok(&[
                 "minimal",
@@ -512,7 +598,13 @@ fn sigterm_stops_the_program_cleanly() {
         let p = program(flavor);
         let trace = trace_path("sigterm", flavor);
         let base = free_port_pair().to_string();
-        let (mut child, started) = p.spawn(&["minimal", "--port-base", &base, "--trace", trace.to_str().unwrap()]);
+        let (mut child, started) = p.spawn(&[
+            "minimal",
+            "--port-base",
+            &base,
+            "--trace",
+            trace.to_str().unwrap(),
+        ]);
         wait_for_start(&trace, &mut child);
         let killed = Command::new("kill")
             .args(["-TERM", &child.id().to_string()])
@@ -528,43 +620,96 @@ fn sigterm_stops_the_program_cleanly() {
 
 #[test]
 fn bad_command_lines_are_refused_with_usage() {
-    let p = program(Flavor::Plain { cc: "gcc", sim: false });
+    let p = program(Flavor::Plain {
+        cc: "gcc",
+        sim: false,
+    });
     let refused = |args: &[&str], env: &[(&str, &str)], says: &str| {
         let run = p.run(args, env);
         assert_eq!(run.code, 2, "{args:?}: {}", run.stderr);
         assert!(run.stderr.contains(says), "{args:?}: {}", run.stderr);
     };
     refused(&["minimal", "--bogus"], &[], "unknown option \"--bogus\"");
-    refused(&["minimal", "--bogus"], &[], "usage: minimal [--trace FILE]");
+    refused(
+        &["minimal", "--bogus"],
+        &[],
+        "usage: minimal [--trace FILE]",
+    );
     refused(&["minimal", "--duration"], &[], "--duration needs a value");
-    refused(&["minimal", "--duration", "-5"], &[], "whole number of milliseconds");
-    refused(&["minimal", "--port-base", "0"], &[], "port number from 1 to 65535");
+    refused(
+        &["minimal", "--duration", "-5"],
+        &[],
+        "whole number of milliseconds",
+    );
+    refused(
+        &["minimal", "--port-base", "0"],
+        &[],
+        "port number from 1 to 65535",
+    );
     refused(&["minimal", "--port-base=70000"], &[], "not \"70000\"");
-    refused(&["minimal"], &[("SEMO_PORT_BASE", "x")], "SEMO_PORT_BASE must be a port number");
-    refused(&["minimal", "--scenario", "s.json"], &[], "needs a simulation build");
+    refused(
+        &["minimal"],
+        &[("SEMO_PORT_BASE", "x")],
+        "SEMO_PORT_BASE must be a port number",
+    );
+    refused(
+        &["minimal", "--scenario", "s.json"],
+        &[],
+        "needs a simulation build",
+    );
     let help = p.run(&["minimal", "--help"], &[]);
     assert_eq!(help.code, 0);
     assert!(help.stdout.starts_with("usage: minimal"), "{}", help.stdout);
 
-    let sim = program(Flavor::Plain { cc: "gcc", sim: true });
+    let sim = program(Flavor::Plain {
+        cc: "gcc",
+        sim: true,
+    });
     let run = sim.run(&["minimal", "--time-scale", "0"], &[]);
     assert_eq!(run.code, 2);
-    assert!(run.stderr.contains("--time-scale must be a positive number"), "{}", run.stderr);
+    assert!(
+        run.stderr
+            .contains("--time-scale must be a positive number"),
+        "{}",
+        run.stderr
+    );
     let unreachable = sim.run(&["minimal", "--trace", "/nonexistent/dir/trace.jsonl"], &[]);
     assert_eq!(unreachable.code, 1);
-    assert!(unreachable.stderr.contains("cannot write the trace"), "{}", unreachable.stderr);
+    assert!(
+        unreachable.stderr.contains("cannot write the trace"),
+        "{}",
+        unreachable.stderr
+    );
 }
 
 #[test]
 fn bad_scenarios_are_refused_with_line_and_column() {
     let cases: &[(&str, &str)] = &[
-        ("{\n  \"robots\": {\n    \"irobot\": [1,]\n  }\n}", "3:18: unexpected character (expected a value)"),
+        (
+            "{\n  \"robots\": {\n    \"irobot\": [1,]\n  }\n}",
+            "3:18: unexpected character (expected a value)",
+        ),
         ("{\"robots\": {}", "1:14: expected ',' or '}'"),
-        ("{\"robots\": {}} x", "1:16: unexpected text after the scenario object"),
-        ("{\"time_scale\": 0}", "1:16: \"time_scale\" must be a positive number"),
-        ("{\"duration\": 1.5}", "1:14: \"duration\" must be a whole number of milliseconds"),
-        ("{\"robot\": {}}", "1:11: unknown key \"robot\" in the scenario"),
-        ("{\"robots\": {\"a\": 1, \"a\": 2}}", "1:21: duplicate key \"a\""),
+        (
+            "{\"robots\": {}} x",
+            "1:16: unexpected text after the scenario object",
+        ),
+        (
+            "{\"time_scale\": 0}",
+            "1:16: \"time_scale\" must be a positive number",
+        ),
+        (
+            "{\"duration\": 1.5}",
+            "1:14: \"duration\" must be a whole number of milliseconds",
+        ),
+        (
+            "{\"robot\": {}}",
+            "1:11: unknown key \"robot\" in the scenario",
+        ),
+        (
+            "{\"robots\": {\"a\": 1, \"a\": 2}}",
+            "1:21: duplicate key \"a\"",
+        ),
         (
             "{\"robots\": {\"someone\": {\"sensors\": [{\"at\": 0, \"value\": \"X\"}]}}}",
             "1:37: missing \"is\"",
@@ -579,14 +724,21 @@ fn bad_scenarios_are_refused_with_line_and_column() {
         ),
         ("{\"a\": \"\\ud800\"}", "unpaired surrogate"),
         ("{\"a\": \"tab\there\"}", "control character in a string"),
-        ("[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]", "nesting deeper than 32"),
+        (
+            "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]",
+            "nesting deeper than 32",
+        ),
         ("", "1:1: unexpected end of file"),
         ("{\"n\": 01}", "1:8: expected ',' or '}'"),
     ];
     for flavor in flavors().into_iter().filter(|f| f.sim()) {
         let p = program(flavor);
         for (i, (text, says)) in cases.iter().enumerate() {
-            let path = work_dir().join(format!("bad-{i}-{}-{}.json", flavor.name(), std::process::id()));
+            let path = work_dir().join(format!(
+                "bad-{i}-{}-{}.json",
+                flavor.name(),
+                std::process::id()
+            ));
             std::fs::write(&path, text).unwrap();
             let run = p.run(&["minimal", "--scenario", path.to_str().unwrap()], &[]);
             let _ = std::fs::remove_file(&path);
@@ -597,7 +749,12 @@ fn bad_scenarios_are_refused_with_line_and_column() {
                 "{text}\nexpected {says:?} in:\n{}",
                 run.stderr
             );
-            assert_eq!(run.stderr.lines().count(), 1, "one clear line: {}", run.stderr);
+            assert_eq!(
+                run.stderr.lines().count(),
+                1,
+                "one clear line: {}",
+                run.stderr
+            );
         }
         let missing = p.run(&["minimal", "--scenario", "/nonexistent.json"], &[]);
         assert_eq!(missing.code, 2);
