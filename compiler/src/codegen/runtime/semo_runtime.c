@@ -704,7 +704,7 @@ static bool decode_message(const unsigned char *in, size_t len, semo_message *m)
            take_field(in, len, &at, m->value.text, sizeof m->value.text) && at == len;
 }
 
-static const semo_transport *g_transport; /* NULL: no peers */
+static const semo_transport *g_transport; /* NULL: no other robots */
 static semo_message g_inbox[COMM_QUEUE_CAPACITY];
 static size_t g_inbox_head, g_inbox_count;
 static pthread_mutex_t g_inbox_lock = PTHREAD_MUTEX_INITIALIZER;
@@ -1141,7 +1141,8 @@ static int run(const options *o)
 
     clock_gettime(CLOCK_MONOTONIC, &g_t0);
     atomic_store(&g_running, true);
-    if (p->peer_count) {
+    /* A robot alone in its mission has no one to hear from: no port, no receiver. */
+    if (p->peer_count > 1) {
         if (semo_udp_transport.open(p, (int)o->port_base) != 0) {
             fprintf(stderr, "semo runtime: cannot open the %s transport on port %ld\n", semo_udp_transport.name,
                     o->port_base + (long)p->self);
