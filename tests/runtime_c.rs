@@ -158,7 +158,6 @@ fn compile(flavor: Flavor) -> Program {
             "semo_runtime.c",
             "semo_udp.c",
             "semo_sim.c",
-            "-lm",
             "-o",
         ])
         .arg(&partial)

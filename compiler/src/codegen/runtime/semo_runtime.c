@@ -71,7 +71,7 @@ int64_t semo_now_ms(void)
  * so rounding never turns a wait into a spin. */
 static struct timespec wall_deadline(int64_t mission_ms)
 {
-    double ns = ceil((double)mission_ms * g_scale * 1e6) + 1e3;
+    double ns = (double)mission_ms * g_scale * 1e6 + 1e3;
     if (ns > 1e17) /* three years: far enough, and no overflow below */
         ns = 1e17;
     if (ns < 0)

@@ -205,9 +205,10 @@ extern const semo_transport semo_udp_transport;
 /* ----------------------------------------------------------------- traces */
 
 /* Appends one JSON line `{"t":<mission ms>,"robot":"<robot>","event":"<event>",
- * "<k1>":"<v1>",...}` to the trace (`--trace FILE`; none without it). The
- * arguments after `event` are key/value string pairs ending with NULL;
- * values are JSON-escaped. */
+ * "<k1>":"<v1>",...}` to the trace (`--trace FILE`, `-` for standard output;
+ * none without it). The arguments after `event` are key/value string pairs
+ * ending with NULL; values are JSON-escaped (a NULL value is written as null
+ * and ends the list). */
 void semo_trace(const char *event, ...);
 
 /* ------------------------------------------------------------- simulation */

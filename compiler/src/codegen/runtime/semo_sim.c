@@ -416,7 +416,8 @@ static bool want(reader *r, const json *v, json_kind kind, const char *what)
 
 static bool want_ms(reader *r, const json *v, const char *key, int64_t min, int64_t *out)
 {
-    if (v->kind != J_NUMBER || v->number != floor(v->number) || v->number < (double)min || v->number > (double)MAX_MS)
+    if (v->kind != J_NUMBER || v->number < (double)min || v->number > (double)MAX_MS ||
+        v->number != (double)(int64_t)v->number)
         return fail_at(r, v->line, v->col, "\"%s\" must be a whole number of milliseconds%s", key,
                        min > 0 ? " above 0" : "");
     *out = (int64_t)v->number;
