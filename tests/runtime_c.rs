@@ -536,7 +536,9 @@ fn duration_is_in_mission_time_and_the_command_line_beats_the_scenario() {
         let p = program(flavor);
         let trace = trace_path("duration", flavor);
         let base = free_port_pair().to_string();
-        let run = p.run_ok(&[
+        // The wall time is not checked from here (the program may have run a
+        // while before `spawn` returned); its own clock is in the trace.
+        p.run_ok(&[
             "minimal",
             "--duration",
             "100",
@@ -545,11 +547,6 @@ fn duration_is_in_mission_time_and_the_command_line_beats_the_scenario() {
             "--trace",
             trace.to_str().unwrap(),
         ]);
-        assert!(
-            run.elapsed >= Duration::from_millis(100),
-            "{:?}",
-            run.elapsed
-        );
         let trace = read_trace(&trace, "solo");
         assert!(trace.last().unwrap()["t"].as_u64().unwrap() >= 100);
         if flavor.sim() {
