@@ -726,7 +726,8 @@ void semo__deliver(const semo_message *msg)
 
 int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value)
 {
-    if (!g_prog || !to_team || !key || !value || strlen(key) >= sizeof ((semo_message *)0)->key)
+    if (!g_prog || !to_team || !key || !value || strlen(key) >= sizeof ((semo_message *)0)->key ||
+        (kind != SEMO_MSG_SEND && kind != SEMO_MSG_PUBLISH))
         return -1;
     semo_trace("send", "to", to_team, "key", key, "value", value->text, NULL);
     if (strcmp(to_team, "USER") == 0)
