@@ -14,7 +14,9 @@ use std::process::Command;
 use std::time::Duration;
 
 fn shared(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/examples").join(path)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/examples")
+        .join(path)
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -78,7 +80,11 @@ fn follow_memory() {
     while child.try_wait().ok().flatten().is_none() {
         if let Ok(text) = std::fs::read_to_string(&status) {
             for line in text.lines() {
-                let kb = |l: &str| l.split_whitespace().nth(1).and_then(|v| v.parse::<u64>().ok());
+                let kb = |l: &str| {
+                    l.split_whitespace()
+                        .nth(1)
+                        .and_then(|v| v.parse::<u64>().ok())
+                };
                 if line.starts_with("VmRSS:") {
                     rss = rss.max(kb(line).unwrap_or(0));
                 } else if line.starts_with("VmSize:") {

@@ -27,7 +27,11 @@ fn programs(text: &str, strategies: &[&str]) -> Vec<RobotProgram> {
     let (links, _) = if strategies.is_empty() {
         (StrategyLinks::default(), Vec::new())
     } else {
-        cross_check(&strategies.iter().collect::<Vec<_>>(), &[&analysis], &catalog)
+        cross_check(
+            &strategies.iter().collect::<Vec<_>>(),
+            &[&analysis],
+            &catalog,
+        )
     };
     let names: Vec<_> = strategies
         .iter()
@@ -68,14 +72,29 @@ fn calls(program: &RobotProgram) -> Vec<String> {
 }
 
 fn task_names(program: &RobotProgram) -> Vec<&str> {
-    program.graph.tasks.iter().map(|t| t.name.name.as_str()).collect()
+    program
+        .graph
+        .tasks
+        .iter()
+        .map(|t| t.name.name.as_str())
+        .collect()
 }
 
 #[test]
 fn every_robot_gets_a_program_with_its_peers() {
     let programs = programs(&shared("scouting/scouting.mission"), &[]);
-    let robots: Vec<_> = programs.iter().map(|p| (p.team.as_str(), p.robot.as_str())).collect();
-    assert_eq!(robots, [("MasterTeam", "irobot"), ("SlaveTeam", "ti"), ("SlaveTeam", "nxt")]);
+    let robots: Vec<_> = programs
+        .iter()
+        .map(|p| (p.team.as_str(), p.robot.as_str()))
+        .collect();
+    assert_eq!(
+        robots,
+        [
+            ("MasterTeam", "irobot"),
+            ("SlaveTeam", "ti"),
+            ("SlaveTeam", "nxt")
+        ]
+    );
     assert_eq!(programs[2].self_peer, 2);
     assert_eq!(programs[0].peers.len(), 3);
 }
@@ -94,10 +113,25 @@ fn the_strategy_refines_the_masters_move_only() {
     );
     let actions = &master.control.actions[0];
     let names: Vec<_> = actions.actions.iter().map(|a| a.name.as_str()).collect();
-    assert_eq!(names, ["CheckGoal", "CheckObstacle", "MoveToGoal", "AvoidObstacle", "Finish"]);
-    assert_eq!(actions.actions[2].commands, [("wheel".to_string(), "Forward".to_string())]);
+    assert_eq!(
+        names,
+        [
+            "CheckGoal",
+            "CheckObstacle",
+            "MoveToGoal",
+            "AvoidObstacle",
+            "Finish"
+        ]
+    );
+    assert_eq!(
+        actions.actions[2].commands,
+        [("wheel".to_string(), "Forward".to_string())]
+    );
     // The slaves have no strategy: their move calls the implementing task.
-    assert_eq!(calls(program(&programs, "ti")), ["move", "search", "process", "move"]);
+    assert_eq!(
+        calls(program(&programs, "ti")),
+        ["move", "search", "process", "move"]
+    );
 }
 
 #[test]
@@ -119,7 +153,10 @@ fn the_task_graph_has_sensor_service_and_communication_tasks() {
     let ti = program(&programs, "ti");
     let lib = ti.library.as_ref().unwrap();
     assert_eq!(lib.name, "SlaveTeamShared");
-    assert!(lib.attributes.contains(&"USER.RC_CMD".to_string()), "{lib:?}");
+    assert!(
+        lib.attributes.contains(&"USER.RC_CMD".to_string()),
+        "{lib:?}"
+    );
     // One capacity per channel, at least what refinement declared.
     assert_eq!(ti.capacities.len(), ti.graph.channels.len());
     assert!(ti.capacities.iter().all(|&c| c >= 2));
