@@ -149,6 +149,9 @@ codes! {
     StrategyUnknownAttribute = "W080", Warning, "an attribute that the strategy format does not have";
     UnreachableAction = "W081", Warning, "an action that cannot be reached from the initial action";
     NoFinalAction = "W082", Warning, "an action machine in which no final action can be reached: the service never ends";
+    // Code generation (`semo build`).
+    CodegenUnsupported = "E100", Error, "a construct that code generation does not support yet";
+    OutputNameEscapes = "E101", Error, "a name that cannot become a file or C identifier of the generated code (it could write outside the output folder, or clashes with a generated task)";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

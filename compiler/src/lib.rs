@@ -16,11 +16,13 @@
 
 pub mod catalog;
 pub mod cli;
+pub mod codegen;
 pub mod diag;
 /// A fast deterministic hasher for the checker's maps.
 mod fasthash;
 pub mod format;
 pub mod ide;
+pub mod refine;
 pub mod sema;
 pub mod span;
 pub mod strategy;

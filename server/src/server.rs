@@ -20,6 +20,8 @@ pub struct Backend {
     can_watch: std::sync::atomic::AtomicBool,
     /// Whether the client takes snippets in completion items (from `initialize`).
     snippets: AtomicBool,
+    /// Whether the client shows `$/progress` (`window.workDoneProgress`).
+    progress: AtomicBool,
 }
 
 impl Backend {
@@ -32,6 +34,7 @@ impl Backend {
             state,
             can_watch: Default::default(),
             snippets: AtomicBool::new(false),
+            progress: AtomicBool::new(false),
         }
     }
 
@@ -86,6 +89,113 @@ impl Backend {
         Ok(self.snapshot(&params.uri)?.text.to_string())
     }
 
+    /// `semo.generateCode`: generates the code of a mission, reporting each
+    /// robot as `$/progress`; a refusal publishes its reasons as the mission's
+    /// diagnostics and is shown to the user.
+    async fn generate_code(
+        &self,
+        arguments: &[serde_json::Value],
+        token: Option<ProgressToken>,
+    ) -> Result<serde_json::Value> {
+        use handlers::generate_code as generate;
+        let params = generate::params(arguments).map_err(Error::invalid_params)?;
+        let (job, encoding) = {
+            let world = self.state.world();
+            let job = generate::job(&world, params).map_err(handlers::request_failed)?;
+            (job, world.encoding)
+        };
+        let job = Arc::new(job);
+        let work = job.clone();
+        let (result, text) = tokio::task::spawn_blocking(move || generate::generate(&work))
+            .await
+            .map_err(|_| Error::internal_error())?;
+        if result.refused() {
+            let errors = result.diagnostics.iter().filter(|d| d.is_error()).count();
+            let diagnostics =
+                generate::mission_diagnostics(&job, &text, &result.diagnostics, encoding);
+            self.client
+                .publish_diagnostics(job.mission_uri.clone(), diagnostics, None)
+                .await;
+            let message = format!(
+                "SeMo: code generation refused: {errors} error(s) in {} (see Problems)",
+                job.mission_path.display()
+            );
+            self.client.show_message(MessageType::ERROR, &message).await;
+            let reasons: Vec<String> = result
+                .diagnostics
+                .iter()
+                .filter(|d| d.is_error())
+                .map(|d| format!("[{}] {}", d.code.as_str(), d.message))
+                .collect();
+            return Ok(serde_json::json!({ "refused": true, "errors": reasons }));
+        }
+        let token = match token {
+            Some(t) => Some(t),
+            None if self.progress.load(Ordering::Relaxed) => {
+                let t = ProgressToken::String(format!("semo-generate-{}", std::process::id()));
+                self.client
+                    .create_work_done_progress(t.clone())
+                    .await
+                    .ok()
+                    .map(|_| t)
+            }
+            None => None,
+        };
+        let progress = match token {
+            Some(t) => Some(
+                self.client
+                    .progress(t, "SeMo: generating code")
+                    .with_percentage(0)
+                    .begin()
+                    .await,
+            ),
+            None => None,
+        };
+        let total = result.robots.len().max(1);
+        let mut robots = Vec::new();
+        for (i, robot) in result.robots.into_iter().enumerate() {
+            if let Some(p) = &progress {
+                let percent = (100 * i / total) as u32;
+                p.report_with_message(format!("{}/{}", robot.team, robot.robot), percent)
+                    .await;
+            }
+            let out = job.out.clone();
+            let written = tokio::task::spawn_blocking(move || {
+                codegen_write(&out, &robot).map(|w| (robot, w))
+            })
+            .await
+            .map_err(|_| Error::internal_error())?;
+            match written {
+                Ok((robot, w)) => robots.push(generate::robot_summary(&robot, &w)),
+                Err(e) => {
+                    if let Some(p) = progress {
+                        p.finish_with_message("failed").await;
+                    }
+                    let message = format!("SeMo: cannot write the generated code: {e}");
+                    self.client.show_message(MessageType::ERROR, &message).await;
+                    return Err(handlers::request_failed(message));
+                }
+            }
+        }
+        if let Some(p) = progress {
+            p.finish_with_message(format!("{} robot(s)", robots.len()))
+                .await;
+        }
+        let message = format!(
+            "SeMo: generated code for {} robot(s) ({}) in {}",
+            robots.len(),
+            job.target.name(),
+            job.out.display()
+        );
+        self.client.show_message(MessageType::INFO, &message).await;
+        Ok(serde_json::json!({
+            "refused": false,
+            "outputFolder": job.out.display().to_string(),
+            "target": job.target.name(),
+            "robots": robots,
+        }))
+    }
+
     async fn register_watchers(&self) {
         if !self.can_watch.load(std::sync::atomic::Ordering::Relaxed) {
             return;
@@ -133,6 +243,13 @@ impl Backend {
     }
 }
 
+fn codegen_write(
+    out: &std::path::Path,
+    robot: &semo::codegen::RobotOutput,
+) -> std::io::Result<semo::codegen::output::Written> {
+    semo::codegen::output::write_robot(out, robot)
+}
+
 fn roots(params: &InitializeParams) -> Vec<std::path::PathBuf> {
     let folders = params.workspace_folders.iter().flatten().map(|f| &f.uri);
     #[allow(deprecated)] // rootUri is what older clients send
@@ -155,6 +272,13 @@ impl LanguageServer for Backend {
             .unwrap_or(false);
         self.can_watch
             .store(can_watch, std::sync::atomic::Ordering::Relaxed);
+        let progress = params
+            .capabilities
+            .window
+            .as_ref()
+            .and_then(|w| w.work_done_progress)
+            .unwrap_or(false);
+        self.progress.store(progress, Ordering::Relaxed);
         let snippets = handlers::completion::snippet_support(&params.capabilities);
         self.snippets.store(snippets, Ordering::Relaxed);
         {
@@ -396,5 +520,22 @@ impl LanguageServer for Backend {
             handlers::selection_range::selection_range(s, &positions)
         })
         .await
+    }
+
+    async fn code_lens(&self, p: CodeLensParams) -> Result<Option<Vec<CodeLens>>> {
+        let lenses = self
+            .on_snapshot(&p.text_document.uri, handlers::generate_code::code_lenses)
+            .await?;
+        Ok(Some(lenses))
+    }
+
+    async fn execute_command(&self, p: ExecuteCommandParams) -> Result<Option<LSPAny>> {
+        match p.command.as_str() {
+            handlers::generate_code::COMMAND => self
+                .generate_code(&p.arguments, p.work_done_progress_params.work_done_token)
+                .await
+                .map(Some),
+            other => Err(Error::invalid_params(format!("unknown command `{other}`"))),
+        }
     }
 }

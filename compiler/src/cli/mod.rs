@@ -1,6 +1,7 @@
 //! The `semo` command. Exit codes: 0 no errors, 1 errors found, 2 usage or I/O
 //! problem.
 
+pub mod build;
 mod fmt;
 mod graph;
 mod render;
@@ -71,6 +72,37 @@ enum Command {
         /// Print the formatted text instead of rewriting the files.
         #[arg(long, conflicts_with = "check")]
         stdout: bool,
+    },
+    /// Generate the code of a mission: one folder per robot with its refined
+    /// task graph and a C program that builds with `make`.
+    #[command(
+        long_about = "Generate the code of a mission: for every robot, the refined task \
+        graph (taskgraph.xml) and a C program (main.c, control_task.c, channels.c, comm_task.c, \
+        library and task files, the runtime, a Makefile) in OUT/<Team>/<robot>/.\n\n\
+        The catalog (*.robot.xml) and strategy (*.strategy.xml) files beside the mission are \
+        read, and those under each --strategy path. Generation is refused while the mission, \
+        catalog or strategies have errors. Each robot's folder is replaced atomically; task \
+        files the user fills (target linux) are created once and never overwritten."
+    )]
+    Build {
+        /// The mission script.
+        mission: PathBuf,
+        /// More strategy (and catalog) files or folders to read.
+        #[arg(long)]
+        strategy: Vec<PathBuf>,
+        /// The output folder (default: `out` beside the mission).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+        /// `linux` (POSIX threads; you fill the task files) or `linux-sim`
+        /// (sensors, actuators and the operator simulated from a scenario file).
+        #[arg(long, default_value = "linux", value_parser = parse_target)]
+        target: crate::codegen::Target,
+        /// `all` (C code, Makefile and task graph) or `taskgraph` (only the
+        /// refined task graphs).
+        #[arg(long, value_enum, default_value_t = EmitArg::All)]
+        emit: EmitArg,
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
     },
     /// Analyse task graphs (`*.taskgraph.xml` or SDF3 files).
     #[command(subcommand)]
@@ -183,6 +215,27 @@ pub fn main(lsp: fn() -> i32) -> i32 {
         Command::Graph(GraphCommand::Schedule { file, cores }) => {
             graph::schedule(&file, cores, &mut out)
         }
+        Command::Build {
+            mission,
+            strategy,
+            out: out_dir,
+            target,
+            emit,
+            color,
+        } => build::run(
+            build::Options {
+                mission,
+                strategy,
+                out: out_dir,
+                target,
+                emit: match emit {
+                    EmitArg::All => crate::codegen::Emit::All,
+                    EmitArg::Taskgraph => crate::codegen::Emit::TaskGraph,
+                },
+                color: use_color(color),
+            },
+            &mut out,
+        ),
         Command::Explain { code } => explain(code.as_deref(), &mut out),
         Command::Lsp { stdio: _ } => {
             // The protocol owns stdout from here on.
@@ -192,6 +245,19 @@ pub fn main(lsp: fn() -> i32) -> i32 {
     };
     let _ = out.flush();
     code
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum EmitArg {
+    All,
+    Taskgraph,
+}
+
+fn parse_target(name: &str) -> Result<crate::codegen::Target, String> {
+    crate::codegen::Target::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = crate::codegen::TARGETS.iter().map(|t| t.name).collect();
+        format!("unknown target `{name}` (targets: {})", names.join(", "))
+    })
 }
 
 fn use_color(choice: ColorChoice) -> bool {

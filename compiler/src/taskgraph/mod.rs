@@ -8,6 +8,7 @@ pub mod subgraph;
 pub mod svg;
 mod xml;
 
+pub mod write;
 pub use model::*;
 pub use svg::to_svg;
 pub use xml::{GraphFormat, detect_format, load_task_graph};

@@ -9,6 +9,7 @@ pub mod document_highlight;
 pub mod document_symbol;
 pub mod folding_range;
 pub mod formatting;
+pub mod generate_code;
 pub mod hover;
 pub mod inlay_hints;
 pub mod prepare_rename;
@@ -78,6 +79,16 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
         )),
         folding_range_provider: Some(FoldingRangeProviderCapability::Simple(true)),
         selection_range_provider: Some(SelectionRangeProviderCapability::Simple(true)),
+        // Code generation.
+        code_lens_provider: Some(CodeLensOptions {
+            resolve_provider: Some(false),
+        }),
+        execute_command_provider: Some(ExecuteCommandOptions {
+            commands: vec![generate_code::COMMAND.to_string()],
+            work_done_progress_options: WorkDoneProgressOptions {
+                work_done_progress: Some(true),
+            },
+        }),
         ..Default::default()
     }
 }

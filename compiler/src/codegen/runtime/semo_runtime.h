@@ -139,6 +139,10 @@ int UFControl_StopTask(const char *task);    /* ask to stop; idle after the curr
 int UFControl_SuspendTask(const char *task); /* no new firing until resumed */
 int UFControl_ResumeTask(const char *task);
 semo_task_state UFControl_GetTaskState(const char *task);
+/* Waits (at most `timeout_ms` mission ms; < 0: no limit) until the task is
+ * idle, e.g. after UFControl_CallTask; true when it is. Saves the control
+ * task from polling UFControl_GetTaskState. */
+bool UFControl_WaitIdle(const char *task, int64_t timeout_ms);
 /* For task bodies that take long: true when the control task asked this
  * task to stop (or the program is stopping). */
 bool UFControl_StopRequested(const char *task);
@@ -176,11 +180,13 @@ typedef struct {
     semo_value value;
 } semo_message;
 
-/* Delivers to every robot of `to_team` ("USER": the operator console, which
- * only traces it). Returns the number of robots it was sent to, -1 on error. */
+/* Delivers to every other robot of `to_team` (or to the robot of that name;
+ * "USER": the operator console, which only traces it and counts as one).
+ * Returns the number of robots it was sent to, -1 on error. */
 int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value);
 /* The next message received (operator commands of the simulation arrive
- * here too, from team "USER"); waits at most `timeout_ms` mission ms.
+ * here too, from team "USER"); waits at most `timeout_ms` mission ms
+ * (< 0: until a message arrives or the program stops).
  * Returns 1 with `*out` filled, 0 on timeout or stop. */
 int semo_comm_poll(semo_message *out, int64_t timeout_ms);
 
@@ -199,9 +205,10 @@ extern const semo_transport semo_udp_transport;
 /* ----------------------------------------------------------------- traces */
 
 /* Appends one JSON line `{"t":<mission ms>,"robot":"<robot>","event":"<event>",
- * "<k1>":"<v1>",...}` to the trace (`--trace FILE`; none without it). The
- * arguments after `event` are key/value string pairs ending with NULL;
- * values are JSON-escaped. */
+ * "<k1>":"<v1>",...}` to the trace (`--trace FILE`, `-` for standard output;
+ * none without it). The arguments after `event` are key/value string pairs
+ * ending with NULL; values are JSON-escaped (a NULL value is written as null
+ * and ends the list). */
 void semo_trace(const char *event, ...);
 
 /* ------------------------------------------------------------- simulation */

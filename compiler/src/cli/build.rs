@@ -1,0 +1,117 @@
+//! `semo build`: a mission, its strategy files and the catalog → one folder of
+//! C code (and the refined task graph) per robot.
+
+use super::render;
+use crate::codegen::{self, Emit, Target};
+use crate::workspace::{self, FileKind, Files};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+pub struct Options {
+    pub mission: PathBuf,
+    pub strategy: Vec<PathBuf>,
+    pub out: Option<PathBuf>,
+    pub target: Target,
+    pub emit: Emit,
+    pub color: bool,
+}
+
+/// The files a build reads: the mission, and the catalog and strategy files
+/// beside it (its folder, recursively) and under each `--strategy` path.
+pub fn load(
+    mission: &Path,
+    strategy: &[PathBuf],
+) -> Result<(Files, crate::diag::FileId), workspace::LoadError> {
+    let read = |path: &Path| {
+        let bytes = std::fs::read(path).map_err(|e| workspace::LoadError {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        Ok::<_, workspace::LoadError>(
+            String::from_utf8(bytes)
+                .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()),
+        )
+    };
+    let mut files = Files::default();
+    let id = files.add(mission.to_path_buf(), FileKind::Mission, read(mission)?);
+    let folder = mission
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+        .to_path_buf();
+    let mut roots = vec![folder];
+    roots.extend(strategy.iter().cloned());
+    let mut seen = std::collections::BTreeSet::new();
+    for (path, kind) in workspace::collect(&roots)? {
+        if matches!(kind, FileKind::Catalog | FileKind::Strategy) && seen.insert(path.clone()) {
+            let text = read(&path)?;
+            files.add(path, kind, text);
+        }
+    }
+    Ok((files, id))
+}
+
+pub fn run(options: Options, out: &mut impl Write) -> i32 {
+    let started = std::time::Instant::now();
+    let (files, mission) = match load(&options.mission, &options.strategy) {
+        Ok(loaded) => loaded,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let mut run = workspace::check_files(files);
+    let result = codegen::build(&run, mission, options.target, options.emit);
+    if result.refused() {
+        run.diagnostics = result.diagnostics;
+        let _ = render::human(&run, options.color, out);
+        let _ = writeln!(
+            out,
+            "error: code generation refused: fix the errors above first"
+        );
+        return 1;
+    }
+    let out_dir = options.out.clone().unwrap_or_else(|| {
+        options
+            .mission
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join("out")
+    });
+    let generated = started.elapsed();
+    for robot in &result.robots {
+        match codegen::output::write_robot(&out_dir, robot) {
+            Ok(written) => {
+                let (generated, user) = robot.line_counts();
+                let share = if generated + user == 0 {
+                    100.0
+                } else {
+                    100.0 * generated as f64 / (generated + user) as f64
+                };
+                let _ = writeln!(
+                    out,
+                    "{}/{}: {} ({} generated files; {} task files created, {} kept; {generated} lines generated, {user} in task files: {share:.0}% generated)",
+                    robot.team,
+                    robot.robot,
+                    written.folder.display(),
+                    written.generated,
+                    written.created,
+                    written.kept,
+                );
+            }
+            Err(e) => {
+                eprintln!("error: cannot write {}/{}: {e}", robot.team, robot.robot);
+                return 2;
+            }
+        }
+    }
+    let _ = writeln!(
+        out,
+        "built {} robot(s) for target {} in {:.1} ms ({:.1} ms generating)",
+        result.robots.len(),
+        options.target.name(),
+        started.elapsed().as_secs_f64() * 1000.0,
+        generated.as_secs_f64() * 1000.0
+    );
+    0
+}

@@ -1,0 +1,70 @@
+//! C spelling: string literals, comments and identifiers from mission names.
+
+/// A C string literal for `text`: quotes, backslashes, control characters,
+/// non-ASCII bytes (as octal) and `?` (no trigraphs) escaped.
+pub fn string(text: &str) -> String {
+    let mut out = String::from("\"");
+    for b in text.bytes() {
+        match b {
+            b'"' => out.push_str("\\\""),
+            b'\\' => out.push_str("\\\\"),
+            b'?' => out.push_str("\\?"),
+            b'\n' => out.push_str("\\n"),
+            0x20..=0x7e => out.push(b as char),
+            other => out.push_str(&format!("\\{other:03o}")),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// Text safe inside a `/* */` comment on one line.
+pub fn comment(text: &str) -> String {
+    text.replace("*/", "* /")
+        .replace("/*", "/ *")
+        .replace("??", "? ?")
+        .replace(['\n', '\r'], " ")
+        .replace('\\', "/")
+}
+
+/// An identifier fragment: letters, digits and `_`, everything else `_`.
+pub fn ident(text: &str) -> String {
+    text.chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect()
+}
+
+/// Whether `name` can be a file or folder name and a C identifier as it is.
+pub fn is_safe_name(name: &str) -> bool {
+    let mut chars = name.chars();
+    chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && name.len() <= 64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strings_are_escaped() {
+        assert_eq!(string("a\"b\\c"), r#""a\"b\\c""#);
+        assert_eq!(string("??="), r#""\?\?=""#);
+        assert_eq!(string("é"), r#""\303\251""#);
+    }
+
+    #[test]
+    fn comments_cannot_end_early() {
+        assert_eq!(comment("x */ y ??/"), "x * / y ? ?/");
+    }
+
+    #[test]
+    fn unsafe_names() {
+        assert!(is_safe_name("irobot_0"));
+        assert!(!is_safe_name("../etc"));
+        assert!(!is_safe_name(""));
+        assert!(!is_safe_name("a/b"));
+    }
+}

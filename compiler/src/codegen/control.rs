@@ -1,0 +1,669 @@
+//! `control_task.c`: the control task's hierarchical state machine as C.
+//!
+//! Every firing (one per control period) the task reads its inputs, then
+//! advances each region of the current mode until it waits, and finally
+//! applies a mode change that an event asked for. A region's service is a
+//! `switch` over its states (`pc`); a state returns `STEP_NEXT` (go on in
+//! this firing), `STEP_WAIT` (try again next firing) or `STEP_DONE`.
+
+use super::c;
+use crate::refine::graph::{CONTROL_TASK, getter, setter};
+use crate::refine::{
+    ActionMachine, ControlMachine, Expr, Operand, RobotProgram, SlotSource, State, StateKind,
+};
+use crate::syntax::ast::CmpOp;
+use std::fmt::Write;
+
+/// State transitions a region may take in one firing: a service whose
+/// states never wait (only sends and branches) still yields to the others.
+const STEPS_PER_FIRING: usize = 64;
+
+pub fn control_task(program: &RobotProgram, header: &str) -> String {
+    let m = &program.control;
+    let mut out = String::new();
+    out.push_str(header);
+    out.push_str("#include \"program.h\"\n#include <string.h>\n\n");
+    let _ = writeln!(
+        out,
+        "/* The hierarchical state machine of robot {} (team {}): modes, then one\n * region per plan running its composite service, then strategy actions. */\n",
+        c::comment(&program.robot),
+        c::comment(&program.team)
+    );
+    out.push_str("enum { STEP_NEXT, STEP_WAIT, STEP_DONE };\n\n");
+
+    // Values.
+    let _ = writeln!(out, "/* Values the machine reads and writes. */");
+    let _ = writeln!(out, "#define SLOT_COUNT {}", m.slots.len().max(1));
+    let _ = writeln!(out, "static semo_value slot[SLOT_COUNT];");
+    for (i, s) in m.slots.iter().enumerate() {
+        let from = match &s.source {
+            SlotSource::Sensor { task, .. } => format!("sensor task {task}"),
+            SlotSource::Shared => "shared information (library)".into(),
+            SlotSource::Local => "strategy variable".into(),
+        };
+        let _ = writeln!(out, "/* slot[{i}]: {} ({from}) */", c::comment(&s.key));
+    }
+    out.push('\n');
+
+    // Ports.
+    // Modes.
+    out.push_str("/* Modes (top level). */\nenum {");
+    for (i, mode) in m.modes.iter().enumerate() {
+        let _ = write!(
+            out,
+            "{}MODE_{}",
+            if i == 0 { " " } else { ", " },
+            c::ident(&mode.name)
+        );
+    }
+    if m.modes.is_empty() {
+        out.push_str(" MODE_NONE_");
+    }
+    out.push_str(" };\nstatic const char *const mode_name[] = {");
+    for (i, mode) in m.modes.iter().enumerate() {
+        let _ = write!(
+            out,
+            "{}{}",
+            if i == 0 { " " } else { ", " },
+            c::string(&mode.name)
+        );
+    }
+    if m.modes.is_empty() {
+        out.push_str(" \"\"");
+    }
+    out.push_str(" };\n\n");
+
+    let regions = m
+        .modes
+        .iter()
+        .map(|mo| mo.regions.len())
+        .max()
+        .unwrap_or(0)
+        .max(1);
+    let marks = m.services.iter().map(|s| s.marks).max().unwrap_or(0).max(1);
+    let _ = writeln!(
+        out,
+        "#define REGION_COUNT {regions}\n#define MARK_COUNT {marks}"
+    );
+    out.push_str(
+        "typedef struct {\n    int service;        /* running service machine, -1 when none */\n    int pc;             /* its current state */\n    int phase;          /* progress inside a state that takes several firings */\n    int action;         /* current strategy action */\n    bool done;\n    int64_t started;    /* when the service started (mode timeouts) */\n    int64_t pass_start; /* when the current pass started (repeat periods) */\n    int64_t timeout_ms; /* from `set(..., timeout = P)`, 0 for none */\n    int64_t mark[MARK_COUNT];\n    const char *plan;\n} region;\n\n",
+    );
+    out.push_str("static region regions[REGION_COUNT];\nstatic int current_mode = -1;\nstatic int pending_mode = -1;\n\n");
+
+    // The machine first, so that only the helpers and port tables it uses
+    // are written (unused static functions and arrays fail -Werror).
+    let mut body = String::new();
+    for (i, machine) in m.actions.iter().enumerate() {
+        emit_action_machine(&mut body, program, i, machine);
+    }
+    for (i, service) in m.services.iter().enumerate() {
+        let _ = writeln!(
+            body,
+            "/* {}.{}.{} ({}:{}) */\nstatic int service_{i}(region *r)\n{{\n    switch (r->pc) {{",
+            c::comment(&program.team),
+            c::comment(&service.plan),
+            c::comment(&service.name),
+            c::comment(&program.mission),
+            service.line
+        );
+        for (pc, state) in service.states.iter().enumerate() {
+            emit_state(&mut body, program, pc, state);
+        }
+        body.push_str("    default:\n        return STEP_DONE;\n    }\n}\n\n");
+    }
+    emit_dispatch(&mut body, program);
+    emit_modes(&mut body, program);
+    emit_task(&mut body, program);
+    let mut helpers = String::new();
+    emit_helpers(&mut helpers, program, &body);
+    let tables = [
+        (
+            "sensor_port",
+            m.slots
+                .iter()
+                .filter(|s| matches!(s.source, SlotSource::Sensor { .. }))
+                .count(),
+        ),
+        ("request_port", m.request_tasks.len()),
+        ("out_port", m.outgoing.len()),
+        ("in_port", m.incoming.len()),
+    ];
+    for (name, len) in tables {
+        if len > 0 {
+            let _ = writeln!(out, "static int {name}[{len}];");
+        }
+    }
+    out.push('\n');
+    out.push_str(&helpers);
+    out.push_str(&body);
+    out
+}
+
+fn operand(program: &RobotProgram, op: &Operand) -> String {
+    match op {
+        Operand::Slot(s) => {
+            let _ = program;
+            format!("&slot[{s}]")
+        }
+        Operand::Literal(text) => format!("SEMO_LIT({})", c::string(text)),
+    }
+}
+
+fn expr(program: &RobotProgram, e: &Expr) -> String {
+    match e {
+        Expr::Or(a, b) => format!("({} || {})", expr(program, a), expr(program, b)),
+        Expr::And(a, b) => format!("({} && {})", expr(program, a), expr(program, b)),
+        Expr::Not(a) => format!("!{}", expr(program, a)),
+        Expr::Bool(b) => b.to_string(),
+        Expr::Truthy(o) => format!("semo_value_truthy({})", operand(program, o)),
+        Expr::Compare(a, op, b) => {
+            let op = match op {
+                CmpOp::Eq => "==",
+                CmpOp::Ne => "!=",
+                CmpOp::Lt => "<",
+                CmpOp::Le => "<=",
+                CmpOp::Gt => ">",
+                CmpOp::Ge => ">=",
+            };
+            format!(
+                "(semo_value_compare({}, {}) {op} 0)",
+                operand(program, a),
+                operand(program, b)
+            )
+        }
+    }
+}
+
+/// The helpers `body` calls: `store`, `read_inputs`, `throw_event`, `request`.
+fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
+    let m = &program.control;
+    let uses = |name: &str| body.contains(&format!("{name}("));
+    // Storing a shared value goes through the library task.
+    if uses("store") {
+        out.push_str("/* Stores a value in its slot and, for shared information, in the library task. */\nstatic void store(int s, const semo_value *v)\n{\n    if (&slot[s] != v)\n        slot[s] = *v;\n    switch (s) {\n");
+        for (i, s) in m.slots.iter().enumerate() {
+            if s.source == SlotSource::Shared
+                && let Some(lib) = &program.library
+            {
+                let _ = writeln!(
+                    out,
+                    "    case {i}:\n        LIBCALL(shared, {}_{}, &slot[{i}]);\n        break;",
+                    c::ident(&lib.name),
+                    setter(&s.key)
+                );
+            }
+        }
+        out.push_str("    default:\n        break;\n    }\n}\n\n");
+    }
+
+    out.push_str("/* Reads the inputs at the start of a firing: the latest sensor samples and\n * the shared information. */\nstatic void read_inputs(void)\n{\n");
+    let mut sensor = 0;
+    for (i, s) in m.slots.iter().enumerate() {
+        match &s.source {
+            SlotSource::Sensor { .. } => {
+                let _ = writeln!(
+                    out,
+                    "    while (UFPort_GetNumOfAvailableData(sensor_port[{sensor}]) > 0)\n        UFPort_ReadFromQueue(sensor_port[{sensor}], &slot[{i}], sizeof slot[{i}]);"
+                );
+                sensor += 1;
+            }
+            SlotSource::Shared => {
+                if let Some(lib) = &program.library {
+                    let _ = writeln!(
+                        out,
+                        "    slot[{i}] = LIBCALL(shared, {}_{});",
+                        c::ident(&lib.name),
+                        getter(&s.key)
+                    );
+                }
+            }
+            SlotSource::Local => {}
+        }
+    }
+    out.push_str("}\n\n");
+
+    if uses("throw_event") {
+        out.push_str("/* `throw`: asks for the mode change that the current mode's `catch` names. */\nstatic void throw_event(const char *event)\n{\n    semo_trace(\"throw\", \"event\", event, NULL);\n    switch (current_mode) {\n");
+        for (from, mode) in m.modes.iter().enumerate() {
+            let catches: Vec<_> = m.transitions.iter().filter(|t| t.from == from).collect();
+            if catches.is_empty() {
+                continue;
+            }
+            let _ = writeln!(out, "    case MODE_{}:", c::ident(&mode.name));
+            for t in catches {
+                let _ = writeln!(
+                    out,
+                    "        if (strcmp(event, {}) == 0 && pending_mode < 0) {{ /* {}:{} */\n            pending_mode = MODE_{};\n            semo_trace(\"catch\", \"event\", event, \"mode\", mode_name[pending_mode], NULL);\n        }}",
+                    c::string(&t.event),
+                    c::comment(&program.mission),
+                    t.line,
+                    c::ident(&m.modes[t.to].name)
+                );
+            }
+            out.push_str("        break;\n");
+        }
+        out.push_str("    default:\n        break;\n    }\n}\n\n");
+    }
+
+    if uses("request") {
+        out.push_str("/* Writes a service request to the task's queue and starts one firing of it. */\nstatic bool request(int port, const char *task, const char *service, int argc, const semo_value *const *args)\n{\n    semo_request req;\n    memset(&req, 0, sizeof req);\n    strncpy(req.service, service, sizeof req.service - 1);\n    for (int i = 0; i < argc && i < SEMO_MAX_ARGS; i++)\n        req.args[i] = *args[i];\n    req.argc = argc < SEMO_MAX_ARGS ? argc : SEMO_MAX_ARGS;\n    if (UFControl_GetTaskState(task) != SEMO_TASK_IDLE)\n        return false;\n    if (UFPort_WriteToQueue(port, &req, sizeof req) == 0)\n        return false;\n    UFControl_CallTask(task);\n    return true;\n}\n\n");
+    }
+}
+
+fn request_index(program: &RobotProgram, task: &str) -> usize {
+    program
+        .control
+        .request_tasks
+        .iter()
+        .position(|t| t == task)
+        .unwrap_or(0)
+}
+
+fn args_array(program: &RobotProgram, args: &[Operand]) -> String {
+    if args.is_empty() {
+        return "NULL".into();
+    }
+    let items: Vec<String> = args.iter().map(|a| operand(program, a)).collect();
+    format!("(const semo_value *const[]){{{}}}", items.join(", "))
+}
+
+fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State) {
+    let m = &program.control;
+    let _ = writeln!(
+        out,
+        "    case {pc}: /* line {}: {} */",
+        state.line,
+        c::comment(&state.text)
+    );
+    let next = pc + 1;
+    match &state.kind {
+        StateKind::Receive {
+            messages,
+            timeout_ms,
+            mark,
+        } => {
+            let ready: Vec<String> = messages
+                .iter()
+                .map(|i| format!("UFPort_GetNumOfAvailableData(in_port[{i}]) > 0"))
+                .collect();
+            let ready = ready.join(" && ");
+            match timeout_ms {
+                // `receive(...), timeout = P`: go on without the values after P.
+                Some(t) => {
+                    let _ = writeln!(
+                        out,
+                        "        if (r->phase == 0) {{\n            r->mark[{mark}] = semo_now_ms();\n            r->phase = 1;\n        }}\n        if (!({ready})) {{\n            if (semo_now_ms() - r->mark[{mark}] <= {t})\n                return STEP_WAIT;\n            semo_trace(\"timeout\", \"statement\", \"receive\", NULL);\n            r->phase = 0;\n            r->pc = {next};\n            return STEP_NEXT;\n        }}\n        r->phase = 0;"
+                    );
+                }
+                None => {
+                    let _ = writeln!(
+                        out,
+                        "        if (!({ready}))\n            return STEP_WAIT;"
+                    );
+                }
+            }
+            for &i in messages {
+                let s = m.incoming[i].slot;
+                let _ = writeln!(
+                    out,
+                    "        {{\n            semo_value v;\n            if (UFPort_ReadFromQueue(in_port[{i}], &v, sizeof v) > 0)\n                store({s}, &v);\n        }}"
+                );
+            }
+            let _ = writeln!(out, "        r->pc = {next};\n        return STEP_NEXT;");
+        }
+        StateKind::Send { items } => {
+            for item in items {
+                let value = operand(program, &item.value);
+                if let Some(s) = item.store {
+                    let _ = writeln!(out, "        store({s}, {value});");
+                }
+                let sent = match item.store {
+                    Some(s) => format!("&slot[{s}]"),
+                    None => value,
+                };
+                let _ = writeln!(
+                    out,
+                    "        UFPort_WriteToQueue(out_port[{}], {sent}, sizeof(semo_value)); /* {} */",
+                    item.message,
+                    c::comment(&m.outgoing[item.message].key)
+                );
+            }
+            let _ = writeln!(out, "        r->pc = {next};\n        return STEP_NEXT;");
+        }
+        StateKind::Subscribe { group, slot } => {
+            let _ = writeln!(
+                out,
+                "        {{\n            semo_value v;\n            if (UFMulticast_Read({}, &v, sizeof v) > 0)\n                store({slot}, &v);\n        }}\n        r->pc = {next};\n        return STEP_NEXT;",
+                c::string(&m.subscribed[*group])
+            );
+        }
+        StateKind::Throw { event } => {
+            let _ = writeln!(
+                out,
+                "        throw_event({});\n        r->pc = {next};\n        return STEP_NEXT;",
+                c::string(event)
+            );
+        }
+        StateKind::Call {
+            service,
+            task,
+            args,
+            timeout_ms,
+            mark,
+        } => {
+            let port = request_index(program, task);
+            let _ = writeln!(
+                out,
+                "        if (r->phase == 0) {{\n            if (!request(request_port[{port}], {task}, {service}, {argc}, {args}))\n                return STEP_WAIT;\n            r->mark[{mark}] = semo_now_ms();\n            r->phase = 1;\n            return STEP_WAIT;\n        }}",
+                task = c::string(task),
+                service = c::string(service),
+                argc = args.len(),
+                args = args_array(program, args),
+            );
+            if let Some(t) = timeout_ms {
+                let _ = writeln!(
+                    out,
+                    "        if (semo_now_ms() - r->mark[{mark}] > {t}) {{\n            UFControl_StopTask({});\n            semo_trace(\"timeout\", \"service\", {}, NULL);\n        }} else",
+                    c::string(task),
+                    c::string(service)
+                );
+            }
+            let _ = writeln!(
+                out,
+                "        if (UFControl_GetTaskState({}) != SEMO_TASK_IDLE)\n            return STEP_WAIT;\n        r->phase = 0;\n        r->pc = {next};\n        return STEP_NEXT;",
+                c::string(task)
+            );
+        }
+        StateKind::RunActions {
+            service,
+            machine,
+            args,
+            timeout_ms,
+            mark,
+        } => {
+            let am = &m.actions[*machine];
+            let _ = writeln!(out, "        if (r->phase == 0) {{");
+            for (i, slot) in am.arguments.iter().enumerate() {
+                if let Some(arg) = args.get(i) {
+                    let _ = writeln!(out, "            store({slot}, {});", operand(program, arg));
+                }
+            }
+            let _ = writeln!(
+                out,
+                "            r->action = {};\n            r->phase = 1;\n            r->mark[{mark}] = semo_now_ms();\n            semo_trace(\"actions_start\", \"service\", {}, NULL);\n        }}",
+                am.initial,
+                c::string(service)
+            );
+            if let Some(t) = timeout_ms {
+                let _ = writeln!(
+                    out,
+                    "        if (semo_now_ms() - r->mark[{mark}] > {t}) {{\n            semo_trace(\"timeout\", \"service\", {}, NULL);\n            r->phase = 0;\n            r->pc = {next};\n            return STEP_NEXT;\n        }}",
+                    c::string(service)
+                );
+            }
+            let _ = writeln!(
+                out,
+                "        if (actions_{machine}(r) != STEP_DONE)\n            return STEP_WAIT;\n        semo_trace(\"actions_end\", \"service\", {}, NULL);\n        r->phase = 0;\n        r->pc = {next};\n        return STEP_NEXT;",
+                c::string(service)
+            );
+        }
+        StateKind::Branch { condition, else_to } => {
+            let _ = writeln!(
+                out,
+                "        r->pc = {} ? {next} : {else_to};\n        return STEP_NEXT;",
+                expr(program, condition)
+            );
+        }
+        StateKind::Jump { to } => {
+            let _ = writeln!(out, "        r->pc = {to};\n        return STEP_NEXT;");
+        }
+        StateKind::LoopHead {
+            condition,
+            exit_to,
+            mark,
+        } => {
+            if let Some(cond) = condition {
+                let _ = writeln!(
+                    out,
+                    "        if (!{}) {{\n            r->pc = {exit_to};\n            return STEP_NEXT;\n        }}",
+                    expr(program, cond)
+                );
+            }
+            let _ = writeln!(
+                out,
+                "        r->mark[{mark}] = semo_now_ms();\n        r->pc = {next};\n        return STEP_NEXT;"
+            );
+        }
+        StateKind::LoopTail {
+            period_ms,
+            mark,
+            to,
+        } => {
+            match period_ms {
+                Some(p) => {
+                    let _ = writeln!(
+                        out,
+                        "        if (semo_now_ms() - r->mark[{mark}] < {p})\n            return STEP_WAIT;"
+                    );
+                    let _ = writeln!(out, "        r->pc = {to};\n        return STEP_NEXT;");
+                }
+                // Without a period, one iteration per firing.
+                None => {
+                    let _ = writeln!(out, "        r->pc = {to};\n        return STEP_WAIT;");
+                }
+            }
+        }
+        StateKind::Repeat {
+            period_ms,
+            condition,
+            forever,
+        } => {
+            if let Some(cond) = condition {
+                let _ = writeln!(
+                    out,
+                    "        if (!{})\n            return STEP_DONE;",
+                    expr(program, cond)
+                );
+            }
+            if let Some(p) = period_ms {
+                let _ = writeln!(
+                    out,
+                    "        if (semo_now_ms() - r->pass_start < {p})\n            return STEP_WAIT;\n        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        return STEP_NEXT;"
+                );
+            } else if *forever || condition.is_some() {
+                // The next pass starts at the next firing.
+                out.push_str("        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        return STEP_WAIT;\n");
+            } else {
+                out.push_str("        return STEP_DONE;\n");
+            }
+        }
+    }
+}
+
+fn emit_action_machine(out: &mut String, program: &RobotProgram, index: usize, am: &ActionMachine) {
+    let m = &program.control;
+    let _ = writeln!(
+        out,
+        "/* Strategy actions of `{}` ({}): phase 1 enters r->action (issues its\n * commands), phase 2 waits for them and takes the first transition that holds. */\nstatic int actions_{index}(region *r)\n{{\n    switch (r->action) {{",
+        c::comment(&am.service),
+        c::comment(&am.source)
+    );
+    for (i, action) in am.actions.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "    case {i}: /* action {} `{}`{} */",
+            action.id,
+            c::comment(&action.name),
+            if action.is_final { ", final" } else { "" }
+        );
+        if action.is_final {
+            out.push_str("        return STEP_DONE;\n");
+            continue;
+        }
+        if !action.commands.is_empty() {
+            out.push_str("        if (r->phase == 1) {\n");
+            for (task, command) in &action.commands {
+                let port = request_index(program, task);
+                let _ = writeln!(
+                    out,
+                    "            if (!request(request_port[{port}], {}, {}, 1, (const semo_value *const[]){{SEMO_LIT({})}}))\n                return STEP_WAIT;",
+                    c::string(task),
+                    c::string(&actuator_name(program, task)),
+                    c::string(command)
+                );
+            }
+            out.push_str("            r->phase = 2;\n            return STEP_WAIT;\n        }\n");
+            for (task, _) in &action.commands {
+                let _ = writeln!(
+                    out,
+                    "        if (UFControl_GetTaskState({}) != SEMO_TASK_IDLE)\n            return STEP_WAIT;",
+                    c::string(task)
+                );
+            }
+        }
+        for (condition, to) in &action.transitions {
+            let test = condition
+                .as_ref()
+                .map_or_else(|| "true".to_string(), |c| expr(program, c));
+            let _ = writeln!(
+                out,
+                "        if ({test}) {{\n            r->action = {to};\n            r->phase = 1;\n            return STEP_NEXT;\n        }}"
+            );
+        }
+        out.push_str("        return STEP_WAIT;\n");
+    }
+    out.push_str("    default:\n        return STEP_DONE;\n    }\n}\n\n");
+    let _ = m;
+}
+
+/// The actuator command name a task runs (`Move` for `wheel`).
+fn actuator_name(program: &RobotProgram, task: &str) -> String {
+    program
+        .tasks
+        .iter()
+        .find(|t| t.task == task)
+        .and_then(|t| match &t.kind {
+            crate::refine::RoleKind::Service { services } => services.first().cloned(),
+            _ => None,
+        })
+        .unwrap_or_else(|| task.to_string())
+}
+
+fn emit_dispatch(out: &mut String, program: &RobotProgram) {
+    let m = &program.control;
+    out.push_str("static int step(region *r)\n{\n    switch (r->service) {\n");
+    for i in 0..m.services.len() {
+        let _ = writeln!(out, "    case {i}:\n        return service_{i}(r);");
+    }
+    out.push_str("    default:\n        return STEP_DONE;\n    }\n}\n\n");
+    out.push_str("static const char *const service_name[] = {");
+    for (i, s) in m.services.iter().enumerate() {
+        let _ = write!(
+            out,
+            "{}{}",
+            if i == 0 { " " } else { ", " },
+            c::string(&s.name)
+        );
+    }
+    if m.services.is_empty() {
+        out.push_str(" \"\"");
+    }
+    out.push_str(" };\n\n");
+}
+
+fn emit_modes(out: &mut String, program: &RobotProgram) {
+    let m = &program.control;
+    out.push_str("/* Enters a mode: every plan the mode sets starts its service. */\nstatic void enter_mode(int mode)\n{\n    for (int i = 0; i < REGION_COUNT; i++) {\n        regions[i].service = -1;\n        regions[i].done = true;\n    }\n    current_mode = mode;\n    semo_trace(\"mode\", \"mode\", mode_name[mode], NULL);\n    switch (mode) {\n");
+    for mode in &m.modes {
+        let _ = writeln!(
+            out,
+            "    case MODE_{}: /* {}:{} */",
+            c::ident(&mode.name),
+            c::comment(&program.mission),
+            mode.line
+        );
+        for (i, region) in mode.regions.iter().enumerate() {
+            let _ = writeln!(
+                out,
+                "        regions[{i}].service = {};\n        regions[{i}].plan = {};\n        regions[{i}].timeout_ms = {};",
+                region.service,
+                c::string(&region.plan),
+                region.timeout_ms.unwrap_or(0)
+            );
+        }
+        out.push_str("        break;\n");
+    }
+    out.push_str("    default:\n        break;\n    }\n    for (int i = 0; i < REGION_COUNT; i++) {\n        region *r = &regions[i];\n        if (r->service < 0)\n            continue;\n        r->pc = 0;\n        r->phase = 0;\n        r->done = false;\n        r->started = r->pass_start = semo_now_ms();\n        semo_trace(\"service_start\", \"plan\", r->plan, \"service\", service_name[r->service], NULL);\n    }\n}\n\n");
+    out.push_str("/* Leaves the current mode: tasks its services called are stopped. */\nstatic void leave_mode(void)\n{\n    for (int i = 0; i < REGION_COUNT; i++) {\n        region *r = &regions[i];\n        if (r->service >= 0 && !r->done)\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], \"why\", \"mode change\", NULL);\n    }\n");
+    for task in &m.request_tasks {
+        let _ = writeln!(
+            out,
+            "    if (UFControl_GetTaskState({0}) != SEMO_TASK_IDLE)\n        UFControl_StopTask({0});",
+            c::string(task)
+        );
+    }
+    out.push_str("}\n\n");
+}
+
+fn emit_task(out: &mut String, program: &RobotProgram) {
+    let m = &program.control;
+    let name = c::ident(CONTROL_TASK);
+    let _ = writeln!(out, "void task_{name}_init(void)\n{{");
+    let mut sensor = 0;
+    for s in &m.slots {
+        if let SlotSource::Sensor { port, .. } = &s.source {
+            let _ = writeln!(
+                out,
+                "    sensor_port[{sensor}] = UFPort_Initialize({}, {});",
+                c::string(CONTROL_TASK),
+                c::string(port)
+            );
+            sensor += 1;
+        }
+    }
+    for (i, task) in m.request_tasks.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "    request_port[{i}] = UFPort_Initialize({}, {});",
+            c::string(CONTROL_TASK),
+            c::string(&format!("req_{task}"))
+        );
+    }
+    for (i, o) in m.outgoing.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "    out_port[{i}] = UFPort_Initialize({}, {});",
+            c::string(CONTROL_TASK),
+            c::string(&o.port)
+        );
+    }
+    for (i, o) in m.incoming.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "    in_port[{i}] = UFPort_Initialize({}, {});",
+            c::string(CONTROL_TASK),
+            c::string(&o.port)
+        );
+    }
+    out.push_str(
+        "    for (int i = 0; i < REGION_COUNT; i++)\n        regions[i].service = -1;\n}\n\n",
+    );
+    let default = m
+        .default_mode
+        .map(|d| format!("MODE_{}", c::ident(&m.modes[d].name)));
+    let _ = writeln!(
+        out,
+        "/* One firing: read inputs, advance every region, then change mode if an\n * event asked for it; the robot is finished when no region runs any more. */\nvoid task_{name}_go(void)\n{{\n    read_inputs();"
+    );
+    match default {
+        Some(d) => {
+            let _ = writeln!(out, "    if (current_mode < 0)\n        enter_mode({d});");
+        }
+        None => out.push_str("    if (current_mode < 0) {\n        semo_trace(\"finish\", \"why\", \"no default mode\", NULL);\n        semo_stop_program();\n        return;\n    }\n"),
+    }
+    let _ = writeln!(
+        out,
+        "    bool running = false;\n    for (int i = 0; i < REGION_COUNT && pending_mode < 0; i++) {{\n        region *r = &regions[i];\n        if (r->service < 0 || r->done)\n            continue;\n        if (r->timeout_ms > 0 && semo_now_ms() - r->started > r->timeout_ms) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], \"why\", \"timeout\", NULL);\n            continue;\n        }}\n        int result = STEP_NEXT;\n        for (int n = 0; n < {STEPS_PER_FIRING} && result == STEP_NEXT && pending_mode < 0; n++)\n            result = step(r);\n        if (result == STEP_DONE) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], NULL);\n        }} else {{\n            running = true;\n        }}\n    }}\n    if (pending_mode >= 0) {{\n        int next = pending_mode;\n        leave_mode();\n        pending_mode = -1;\n        enter_mode(next);\n        return;\n    }}\n    if (!running) {{\n        semo_trace(\"finish\", \"mode\", mode_name[current_mode], NULL);\n        semo_stop_program();\n    }}\n}}\n\nvoid task_{name}_wrapup(void)\n{{\n}}"
+    );
+    let _ = ControlMachine::default;
+}

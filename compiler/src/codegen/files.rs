@@ -1,0 +1,372 @@
+//! The other files of a robot's folder: `program.h`, `main.c`, `channels.c`,
+//! `comm_task.c`, `lib_<name>.c`, `tasks/<task>.c` and the `Makefile`.
+
+use super::Target;
+use super::c;
+use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK, getter, setter};
+use crate::refine::{RobotProgram, RoleKind};
+use crate::taskgraph::Trigger;
+use std::fmt::Write;
+
+/// Samples of a request channel: a service name and its arguments.
+fn is_request_channel(src_task: &str, src_port: &str) -> bool {
+    src_task == CONTROL_TASK && src_port.starts_with("req_")
+}
+
+/// Every task of the program with the C prefix of its functions.
+fn task_functions(program: &RobotProgram) -> Vec<(String, String)> {
+    program
+        .graph
+        .tasks
+        .iter()
+        .map(|t| {
+            (
+                t.name.name.clone(),
+                format!("task_{}", c::ident(&t.name.name)),
+            )
+        })
+        .collect()
+}
+
+pub fn program_h(program: &RobotProgram, header: &str) -> String {
+    let mut out = String::from(header);
+    out.push_str(
+        "#ifndef SEMO_PROGRAM_H\n#define SEMO_PROGRAM_H\n\n#include \"semo_runtime.h\"\n\n",
+    );
+    out.push_str("/* A service request from the control task to a task: the service (or\n * actuator command) and its arguments. */\n#define SEMO_MAX_ARGS 4\ntypedef struct {\n    char service[32];\n    int argc;\n    semo_value args[SEMO_MAX_ARGS];\n} semo_request;\n\n");
+    out.push_str("/* Task files: `TASK_INIT { }`, `TASK_GO { }` (one firing), `TASK_WRAPUP { }`;\n * the Makefile compiles tasks/<name>.c with SEMO_TASK=task_<name>. */\n#define SEMO_CAT_(a, b) a##b\n#define SEMO_CAT(a, b) SEMO_CAT_(a, b)\n#define SEMO_STR_(a) #a\n#define SEMO_STR(a) SEMO_STR_(a)\n#define TASK_INIT void SEMO_CAT(SEMO_TASK, _init)(void)\n#define TASK_GO void SEMO_CAT(SEMO_TASK, _go)(void)\n#define TASK_WRAPUP void SEMO_CAT(SEMO_TASK, _wrapup)(void)\n/* The task's name, for UFPort_Initialize and UFControl_*. */\n#define TASK_NAME (&SEMO_STR(SEMO_TASK)[5])\n\n");
+    for (_, prefix) in task_functions(program) {
+        let _ = writeln!(
+            out,
+            "void {prefix}_init(void);\nvoid {prefix}_go(void);\nvoid {prefix}_wrapup(void);"
+        );
+    }
+    if let Some(lib) = &program.library {
+        let _ = writeln!(
+            out,
+            "\n/* Library task {}: the team's shared information. */",
+            lib.name
+        );
+        for key in &lib.attributes {
+            let prefix = c::ident(&lib.name);
+            let _ = writeln!(
+                out,
+                "LIBFUNC(semo_value, {prefix}_{}, (void));\nLIBFUNC(void, {prefix}_{}, (const semo_value *value));",
+                getter(key),
+                setter(key)
+            );
+        }
+    }
+    let _ = writeln!(
+        out,
+        "\n/* The task graph's channels (channels.c). */\n#define SEMO_CHANNEL_COUNT {}\nextern const semo_channel_desc semo_program_channels[];",
+        program.graph.channels.len()
+    );
+    out.push_str("\n#endif\n");
+    out
+}
+
+pub fn channels_c(program: &RobotProgram, header: &str) -> String {
+    let mut out = String::from(header);
+    out.push_str("#include \"program.h\"\n\n/* The channels of the task graph; capacities from the buffer analysis. */\nconst semo_channel_desc semo_program_channels[] = {\n");
+    for (ch, capacity) in program.graph.channels.iter().zip(&program.capacities) {
+        let sample = if is_request_channel(&ch.src.task, &ch.src.port) {
+            "sizeof(semo_request)"
+        } else {
+            "sizeof(semo_value)"
+        };
+        let _ = writeln!(
+            out,
+            "    {{{}, {}, {}, {}, {sample}, {capacity}, {}}},",
+            c::string(&ch.src.task),
+            c::string(&ch.src.port),
+            c::string(&ch.dst.task),
+            c::string(&ch.dst.port),
+            ch.initial_tokens
+        );
+    }
+    if program.graph.channels.is_empty() {
+        out.push_str("    {\"\", \"\", \"\", \"\", sizeof(semo_value), 1, 0},\n");
+    }
+    out.push_str("};\n");
+    out
+}
+
+pub fn main_c(program: &RobotProgram, header: &str) -> String {
+    let mut out = String::from(header);
+    out.push_str("#include \"program.h\"\n\n/* Tasks: one thread each. */\nstatic const semo_task_desc tasks[] = {\n");
+    for task in &program.graph.tasks {
+        let prefix = format!("task_{}", c::ident(&task.name.name));
+        let (trigger, period) = match &task.trigger {
+            Trigger::Time { period_ms } => ("SEMO_TRIGGER_TIME", period_ms.round() as i64),
+            Trigger::Data => ("SEMO_TRIGGER_DATA", 0),
+            Trigger::Control => ("SEMO_TRIGGER_CONTROL", 0),
+        };
+        let _ = writeln!(
+            out,
+            "    {{{}, {trigger}, {period}, {prefix}_init, {prefix}_go, {prefix}_wrapup}},",
+            c::string(&task.name.name)
+        );
+    }
+    out.push_str("};\n\n");
+    let groups = &program.control.subscribed;
+    if !groups.is_empty() {
+        out.push_str("/* Multicast groups: the latest published value of each. */\nstatic const semo_multicast_desc groups[] = {\n");
+        for g in groups {
+            let _ = writeln!(out, "    {{{}, sizeof(semo_value)}},", c::string(g));
+        }
+        out.push_str("};\n\n");
+    }
+    out.push_str("/* Every robot of the mission: robot i listens on UDP port base + i. */\nstatic const semo_peer peers[] = {\n");
+    for (team, robot) in &program.peers {
+        let _ = writeln!(out, "    {{{}, {}}},", c::string(team), c::string(robot));
+    }
+    out.push_str("};\n\n");
+    let _ = writeln!(
+        out,
+        "static const semo_program_desc program = {{\n    .mission = {},\n    .team = {},\n    .robot = {},\n    .robot_type = {},\n    .tasks = tasks,\n    .task_count = sizeof tasks / sizeof tasks[0],\n    .channels = semo_program_channels,\n    .channel_count = SEMO_CHANNEL_COUNT,\n    .groups = {},\n    .group_count = {},\n    .peers = peers,\n    .peer_count = sizeof peers / sizeof peers[0],\n    .self = {},\n}};\n\nint main(int argc, char **argv)\n{{\n    return semo_main(argc, argv, &program);\n}}",
+        c::string(&program.mission),
+        c::string(&program.team),
+        c::string(&program.robot),
+        c::string(&program.robot_type),
+        if groups.is_empty() { "NULL" } else { "groups" },
+        groups.len(),
+        program.self_peer
+    );
+    out
+}
+
+pub fn comm_task_c(program: &RobotProgram, header: &str) -> String {
+    let m = &program.control;
+    let mut out = String::from(header);
+    out.push_str("#include \"program.h\"\n#include <string.h>\n\n");
+    if !m.outgoing.is_empty() {
+        out.push_str("/* CommSend: every value the control task sends goes to the robots of its\n * team (through the transport). */\nstatic const struct {\n    const char *port;\n    const char *to_team;\n    semo_msg_kind kind;\n    const char *key;\n} outgoing[] = {\n");
+        for o in &m.outgoing {
+            let _ = writeln!(
+                out,
+                "    {{{}, {}, {}, {}}},",
+                c::string(&o.port),
+                c::string(&o.to_team),
+                if o.publish {
+                    "SEMO_MSG_PUBLISH"
+                } else {
+                    "SEMO_MSG_SEND"
+                },
+                c::string(&o.key)
+            );
+        }
+        let n = m.outgoing.len();
+        let _ = writeln!(
+            out,
+            "}};\nstatic int outgoing_port[{n}];\n\nvoid task_{send}_init(void)\n{{\n    for (int i = 0; i < {n}; i++)\n        outgoing_port[i] = UFPort_Initialize({send_name}, outgoing[i].port);\n}}\n\nvoid task_{send}_go(void)\n{{\n    for (int i = 0; i < {n}; i++) {{\n        semo_value v;\n        while (UFPort_GetNumOfAvailableData(outgoing_port[i]) > 0\n               && UFPort_ReadFromQueue(outgoing_port[i], &v, sizeof v) > 0)\n            semo_comm_send(outgoing[i].to_team, outgoing[i].kind, outgoing[i].key, &v);\n    }}\n}}\n\nvoid task_{send}_wrapup(void)\n{{\n}}\n",
+            send = c::ident(COMM_SEND),
+            send_name = c::string(COMM_SEND)
+        );
+    }
+    if !m.incoming.is_empty() || !m.subscribed.is_empty() {
+        out.push_str("/* CommReceive: each message received goes to the control task's port for\n * it (sends) or to its multicast group (publishes). */\n");
+        let n = m.incoming.len();
+        if n > 0 {
+            out.push_str("static const struct {\n    const char *port;\n    const char *from_team;\n    const char *key;\n} incoming[] = {\n");
+            for i in &m.incoming {
+                let _ = writeln!(
+                    out,
+                    "    {{{}, {}, {}}},",
+                    c::string(&i.port),
+                    c::string(&i.from_team),
+                    c::string(&i.key)
+                );
+            }
+            let _ = writeln!(out, "}};\nstatic int incoming_port[{n}];\n");
+        }
+        if !m.subscribed.is_empty() {
+            out.push_str("static const char *const subscribed[] = {");
+            for (i, g) in m.subscribed.iter().enumerate() {
+                let _ = write!(out, "{}{}", if i == 0 { " " } else { ", " }, c::string(g));
+            }
+            out.push_str(" };\n\n");
+        }
+        let recv = c::ident(COMM_RECEIVE);
+        let _ = writeln!(out, "void task_{recv}_init(void)\n{{");
+        if n > 0 {
+            let _ = writeln!(
+                out,
+                "    for (int i = 0; i < {n}; i++)\n        incoming_port[i] = UFPort_Initialize({}, incoming[i].port);",
+                c::string(COMM_RECEIVE)
+            );
+        }
+        let _ = writeln!(
+            out,
+            "}}\n\nvoid task_{recv}_go(void)\n{{\n    semo_message m;\n    if (!semo_comm_poll(&m, 50))\n        return;"
+        );
+        if !m.subscribed.is_empty() {
+            let _ = writeln!(
+                out,
+                "    if (m.kind == SEMO_MSG_PUBLISH) {{\n        for (size_t i = 0; i < sizeof subscribed / sizeof subscribed[0]; i++)\n            if (strcmp(subscribed[i], m.key) == 0)\n                UFMulticast_Write(subscribed[i], &m.value, sizeof m.value);\n        return;\n    }}"
+            );
+        }
+        if n > 0 {
+            let _ = writeln!(
+                out,
+                "    for (int i = 0; i < {n}; i++)\n        if (strcmp(incoming[i].from_team, m.from_team) == 0 && strcmp(incoming[i].key, m.key) == 0)\n            UFPort_WriteToQueue(incoming_port[i], &m.value, sizeof m.value);"
+            );
+        }
+        let _ = writeln!(out, "}}\n\nvoid task_{recv}_wrapup(void)\n{{\n}}");
+    }
+    if m.outgoing.is_empty() && m.incoming.is_empty() && m.subscribed.is_empty() {
+        out.push_str(
+            "/* This robot exchanges no messages. */\ntypedef int semo_no_communication;\n",
+        );
+    }
+    out
+}
+
+pub fn library_c(program: &RobotProgram, header: &str) -> Option<(String, String)> {
+    let lib = program.library.as_ref()?;
+    let prefix = c::ident(&lib.name);
+    let mut out = String::from(header);
+    out.push_str("#include \"program.h\"\n#include <pthread.h>\n\n");
+    let _ = writeln!(
+        out,
+        "/* Library task {}: the team's shared information, one value per attribute,\n * read and written by its getters and setters under one lock. */\nstatic pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;\nstatic semo_value value[{}];\n",
+        c::comment(&lib.name),
+        lib.attributes.len()
+    );
+    for (i, key) in lib.attributes.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "/* {} */\nLIBFUNC(semo_value, {prefix}_{}, (void))\n{{\n    pthread_mutex_lock(&lock);\n    semo_value v = value[{i}];\n    pthread_mutex_unlock(&lock);\n    return v;\n}}\n\nLIBFUNC(void, {prefix}_{}, (const semo_value *v))\n{{\n    pthread_mutex_lock(&lock);\n    value[{i}] = *v;\n    pthread_mutex_unlock(&lock);\n}}\n",
+            c::comment(key),
+            getter(key),
+            setter(key)
+        );
+    }
+    Some((format!("lib_{prefix}.c"), out))
+}
+
+/// `tasks/<task>.c`: the simulation's own body for `linux-sim`; for `linux`
+/// a template for the user to fill (written only when absent).
+pub fn task_c(
+    program: &RobotProgram,
+    role: &crate::refine::TaskRole,
+    target: Target,
+    header: &str,
+) -> Option<String> {
+    let mut out = String::from(header);
+    out.push_str("#include \"../program.h\"\n\n");
+    match (&role.kind, target) {
+        (RoleKind::Sensor { values, period_ms }, _) => {
+            let _ = writeln!(
+                out,
+                "/* Sensor task `{}` of robot {}: every {period_ms} ms, one sample of {}. */",
+                c::comment(&role.task),
+                c::comment(&program.robot),
+                c::comment(&values.join(", "))
+            );
+            for v in values {
+                let _ = writeln!(out, "static int port_{} = -1;", c::ident(v));
+            }
+            out.push_str("\nTASK_INIT\n{\n");
+            for v in values {
+                let _ = writeln!(
+                    out,
+                    "    port_{} = UFPort_Initialize(TASK_NAME, {});",
+                    c::ident(v),
+                    c::string(v)
+                );
+            }
+            out.push_str("}\n\nTASK_GO\n{\n    semo_value value;\n");
+            for v in values {
+                match target {
+                    Target::LinuxSim => {
+                        let _ = writeln!(
+                            out,
+                            "    if (semo_sim_sensor({}, &value))\n        UFPort_WriteToQueue(port_{}, &value, sizeof value);",
+                            c::string(v),
+                            c::ident(v)
+                        );
+                    }
+                    Target::Linux => {
+                        let _ = writeln!(
+                            out,
+                            "    /* TODO: read {v} from the sensor, e.g. semo_value_set(&value, \"...\"),\n     * then write it: UFPort_WriteToQueue(port_{id}, &value, sizeof value). */\n    (void)value;\n    (void)port_{id};",
+                            v = c::comment(v),
+                            id = c::ident(v)
+                        );
+                    }
+                }
+            }
+            out.push_str("}\n\nTASK_WRAPUP\n{\n}\n");
+        }
+        (RoleKind::Service { services }, _) => {
+            let _ = writeln!(
+                out,
+                "/* Task `{}` of robot {}: runs {} when the control task calls it. */\nstatic int port_request = -1;\n\nTASK_INIT\n{{\n    port_request = UFPort_Initialize(TASK_NAME, \"request\");\n}}\n\nTASK_GO\n{{\n    semo_request req;\n    if (UFPort_ReadFromQueue(port_request, &req, sizeof req) == 0)\n        return;",
+                c::comment(&role.task),
+                c::comment(&program.robot),
+                c::comment(&services.join(", "))
+            );
+            match target {
+                Target::LinuxSim => {
+                    out.push_str("    const char *arg = req.argc > 0 ? req.args[0].text : \"\";\n    semo_trace(\"call_start\", \"task\", TASK_NAME, \"service\", req.service, \"arg\", arg, NULL);\n    if (req.argc > 0)\n        semo_sim_actuate(TASK_NAME, &req.args[0]);\n    /* The simulated service takes the scenario's time for it. */\n    int64_t end = semo_now_ms() + semo_sim_service_ms(req.service);\n    while (semo_running() && !UFControl_StopRequested(TASK_NAME) && semo_now_ms() < end) {\n        int64_t left = end - semo_now_ms();\n        semo_sleep_ms(left < 10 ? left : 10);\n    }\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n");
+                }
+                Target::Linux => {
+                    out.push_str("    /* TODO: perform the service; req.args[0 .. req.argc - 1] are its arguments.\n     * Check UFControl_StopRequested(TASK_NAME) during long work. */\n");
+                    for s in services {
+                        let _ = writeln!(
+                            out,
+                            "    if (strcmp(req.service, {}) == 0) {{\n        /* {} */\n    }}",
+                            c::string(s),
+                            c::comment(s)
+                        );
+                    }
+                }
+            }
+            out.push_str("}\n\nTASK_WRAPUP\n{\n}\n");
+            if target == Target::Linux {
+                out = out.replacen(
+                    "#include \"../program.h\"\n",
+                    "#include \"../program.h\"\n#include <string.h>\n",
+                    1,
+                );
+            }
+        }
+        (RoleKind::CommSend | RoleKind::CommReceive, _) => return None,
+    }
+    Some(out)
+}
+
+pub fn makefile(
+    program: &RobotProgram,
+    target: Target,
+    sources: &[String],
+    tasks: &[String],
+    header: &str,
+) -> String {
+    let mut out = String::new();
+    for line in header.lines() {
+        let text = line
+            .trim_start_matches("/*")
+            .trim_end_matches("*/")
+            .trim_start_matches(" *")
+            .trim();
+        if !text.is_empty() {
+            let _ = writeln!(out, "# {text}");
+        }
+    }
+    let _ = writeln!(
+        out,
+        "\n# `make` builds the program `{robot}` for target {target}; CC and CFLAGS may be\n# overridden (`make CC=clang CFLAGS=\"-O1 -fsanitize=thread\"`).\nCFLAGS ?= -std=c11 -Wall -Wextra -O2\nSEMO_CFLAGS = -std=c11 -D_POSIX_C_SOURCE=200809L{sim} -I.\nLDLIBS += -lpthread -lm\n\nPROGRAM = {robot}\nSOURCES = {sources}\nTASKS = {tasks}\nOBJECTS = $(SOURCES:.c=.o) $(TASKS:.c=.o)\nHEADERS = program.h semo_runtime.h\n\nall: $(PROGRAM)\n\n$(PROGRAM): $(OBJECTS)\n\t$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(OBJECTS) $(LDLIBS)\n\ntasks/%.o: tasks/%.c $(HEADERS)\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -DSEMO_TASK=task_$* -c $< -o $@\n\n%.o: %.c $(HEADERS)\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -c $< -o $@\n\nclean:\n\trm -f $(PROGRAM) $(OBJECTS)\n\n.PHONY: all clean",
+        robot = program.robot,
+        target = target.name(),
+        sim = if target == Target::LinuxSim {
+            " -DSEMO_SIM"
+        } else {
+            ""
+        },
+        sources = sources.join(" "),
+        tasks = tasks.join(" "),
+    );
+    out
+}

@@ -1,0 +1,1251 @@
+/* semo_runtime.c: the SeMo runtime for POSIX targets (`linux`, `linux-sim`).
+ *
+ * One thread per task, plus a message receiver, a signal watcher and (in
+ * simulation) the operator. Every shared structure has its own mutex; every
+ * wait is on a condition variable tied to the monotonic clock, and stopping
+ * the program broadcasts all of them so that no thread sleeps through it.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include "semo_internal.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* Task code is small: a modest stack keeps the program's footprint low. */
+#define TASK_STACK_BYTES (512u * 1024u)
+#define COMM_QUEUE_CAPACITY 64
+#define RECV_POLL_MS 50
+#define DEFAULT_PORT_BASE 47000
+
+/* ------------------------------------------------------------ run state */
+
+static const semo_program_desc *g_prog;
+static atomic_bool g_running;
+static struct timespec g_t0;
+static double g_scale = 1.0; /* wall ms per mission ms */
+static pthread_mutex_t g_run_lock = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t g_run_cond;
+
+static void init_cond(pthread_cond_t *cond)
+{
+    pthread_condattr_t attr;
+    pthread_condattr_init(&attr);
+    /* Timed waits must not jump when someone sets the wall clock. */
+    pthread_condattr_setclock(&attr, CLOCK_MONOTONIC);
+    pthread_cond_init(cond, &attr);
+    pthread_condattr_destroy(&attr);
+}
+
+bool semo_running(void)
+{
+    return atomic_load(&g_running);
+}
+
+const semo_program_desc *semo_program(void)
+{
+    return g_prog;
+}
+
+/* ------------------------------------------------------------------ time */
+
+int64_t semo_now_ms(void)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    double wall_ns = (double)(now.tv_sec - g_t0.tv_sec) * 1e9 + (double)(now.tv_nsec - g_t0.tv_nsec);
+    return (int64_t)(wall_ns / (g_scale * 1e6));
+}
+
+/* The monotonic instant at which mission time reaches `mission_ms`. A
+ * microsecond of slack makes sure semo_now_ms() has reached it on waking,
+ * so rounding never turns a wait into a spin. */
+static struct timespec wall_deadline(int64_t mission_ms)
+{
+    double ns = (double)mission_ms * g_scale * 1e6 + 1e3;
+    if (ns > 1e17) /* three years: far enough, and no overflow below */
+        ns = 1e17;
+    if (ns < 0)
+        ns = 0;
+    long long total = (long long)g_t0.tv_nsec + (long long)ns;
+    struct timespec at = {.tv_sec = g_t0.tv_sec + (time_t)(total / 1000000000LL),
+                          .tv_nsec = (long)(total % 1000000000LL)};
+    return at;
+}
+
+/* Waits on `cond` until woken or mission time `deadline_ms` (< 0: no limit). */
+static void wait_until(pthread_cond_t *cond, pthread_mutex_t *lock, int64_t deadline_ms)
+{
+    if (deadline_ms < 0) {
+        pthread_cond_wait(cond, lock);
+    } else {
+        struct timespec at = wall_deadline(deadline_ms);
+        pthread_cond_timedwait(cond, lock, &at);
+    }
+}
+
+bool semo__wait_until(int64_t deadline_ms)
+{
+    pthread_mutex_lock(&g_run_lock);
+    while (semo_running() && semo_now_ms() < deadline_ms)
+        wait_until(&g_run_cond, &g_run_lock, deadline_ms);
+    bool running = semo_running();
+    pthread_mutex_unlock(&g_run_lock);
+    return running;
+}
+
+void semo_sleep_ms(int64_t ms)
+{
+    if (ms > 0)
+        semo__wait_until(semo_now_ms() + ms);
+}
+
+/* ----------------------------------------------------------------- values */
+
+void semo_value_set(semo_value *v, const char *text)
+{
+    if (!text)
+        text = "";
+    size_t n = strlen(text);
+    if (n >= SEMO_VALUE_MAX) {
+        n = SEMO_VALUE_MAX - 1;
+        /* Never cut a UTF-8 character in half. */
+        while (n > 0 && ((unsigned char)text[n] & 0xC0) == 0x80)
+            n--;
+    }
+    memmove(v->text, text, n);
+    v->text[n] = '\0';
+}
+
+void semo_value_set_int(semo_value *v, long long n)
+{
+    snprintf(v->text, sizeof v->text, "%lld", n);
+}
+
+/* The whole text as a number: "5" and "-2.5e3" are, "5,5", " 5" and "" are not. */
+static bool parse_number(const char *s, double *out)
+{
+    if (*s == '\0' || *s == ' ' || (*s >= '\t' && *s <= '\r'))
+        return false;
+    char *end;
+    double d = strtod(s, &end);
+    if (*end != '\0' || isnan(d))
+        return false;
+    *out = d;
+    return true;
+}
+
+int semo_value_compare(const semo_value *a, const semo_value *b)
+{
+    double x, y;
+    if (parse_number(a->text, &x) && parse_number(b->text, &y))
+        return (x > y) - (x < y);
+    int c = strcmp(a->text, b->text);
+    return (c > 0) - (c < 0);
+}
+
+bool semo_value_truthy(const semo_value *v)
+{
+    double x;
+    if (strcmp(v->text, "true") == 0)
+        return true;
+    return parse_number(v->text, &x) && x != 0;
+}
+
+/* ----------------------------------------------------------------- traces */
+
+static FILE *g_trace;
+static bool g_trace_owned; /* false for "-" (stdout) */
+static pthread_mutex_t g_trace_lock = PTHREAD_MUTEX_INITIALIZER;
+
+/* Length of the valid UTF-8 sequence at `s`, or 0 (overlong, surrogate,
+ * beyond U+10FFFF, truncated). */
+static size_t utf8_sequence(const unsigned char *s)
+{
+    unsigned c = s[0];
+    size_t n;
+    unsigned min, cp;
+    if (c >= 0xC2 && c <= 0xDF) {
+        n = 2, min = 0x80, cp = c & 0x1F;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+        n = 3, min = 0x800, cp = c & 0x0F;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+        n = 4, min = 0x10000, cp = c & 0x07;
+    } else {
+        return 0;
+    }
+    for (size_t i = 1; i < n; i++) {
+        if ((s[i] & 0xC0) != 0x80)
+            return 0;
+        cp = (cp << 6) | (s[i] & 0x3F);
+    }
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
+        return 0;
+    return n;
+}
+
+/* A JSON string: control characters escaped, invalid UTF-8 as U+FFFD so
+ * that every line parses. */
+static void write_json_string(FILE *f, const char *text)
+{
+    const unsigned char *s = (const unsigned char *)(text ? text : "");
+    fputc('"', f);
+    while (*s) {
+        unsigned c = *s;
+        if (c == '"' || c == '\\') {
+            fputc('\\', f);
+            fputc((int)c, f);
+            s++;
+        } else if (c < 0x20) {
+            switch (c) {
+            case '\n': fputs("\\n", f); break;
+            case '\r': fputs("\\r", f); break;
+            case '\t': fputs("\\t", f); break;
+            default: fprintf(f, "\\u%04x", c); break;
+            }
+            s++;
+        } else if (c < 0x80) {
+            fputc((int)c, f);
+            s++;
+        } else {
+            size_t n = utf8_sequence(s);
+            if (n == 0) {
+                fputs("\\ufffd", f);
+                s++;
+            } else {
+                fwrite(s, 1, n, f);
+                s += n;
+            }
+        }
+    }
+    fputc('"', f);
+}
+
+void semo_trace(const char *event, ...)
+{
+    pthread_mutex_lock(&g_trace_lock);
+    if (g_trace) {
+        /* The time is read under the lock so that lines are in time order. */
+        fprintf(g_trace, "{\"t\":%lld,\"robot\":", (long long)semo_now_ms());
+        write_json_string(g_trace, g_prog ? g_prog->robot : "");
+        fputs(",\"event\":", g_trace);
+        write_json_string(g_trace, event);
+        va_list args;
+        va_start(args, event);
+        const char *key;
+        while ((key = va_arg(args, const char *)) != NULL) {
+            const char *value = va_arg(args, const char *);
+            fputc(',', g_trace);
+            write_json_string(g_trace, key);
+            fputc(':', g_trace);
+            if (!value) {
+                /* An odd list: the NULL meant as the end came as a value. */
+                fputs("null", g_trace);
+                break;
+            }
+            write_json_string(g_trace, value);
+        }
+        va_end(args);
+        fputs("}\n", g_trace);
+        fflush(g_trace);
+    }
+    pthread_mutex_unlock(&g_trace_lock);
+}
+
+/* --------------------------------------------------------------- channels */
+
+typedef struct {
+    const semo_channel_desc *desc;
+    unsigned char *buf;
+    size_t capacity, head, count;
+    unsigned long dropped;
+    pthread_mutex_t lock;
+    pthread_cond_t readable;
+} channel;
+
+static channel *g_channels;
+
+static channel *channel_at(int port)
+{
+    if (!g_prog || port < 0 || (size_t)port >= g_prog->channel_count)
+        return NULL;
+    return &g_channels[port];
+}
+
+int UFPort_Initialize(const char *task, const char *port)
+{
+    if (!g_prog || !task || !port)
+        return -1;
+    for (size_t i = 0; i < g_prog->channel_count; i++) {
+        const semo_channel_desc *c = &g_prog->channels[i];
+        bool input = strcmp(c->dst_task, task) == 0 && strcmp(c->dst_port, port) == 0;
+        bool output = strcmp(c->src_task, task) == 0 && strcmp(c->src_port, port) == 0;
+        if (input || output)
+            return (int)i;
+    }
+    return -1;
+}
+
+int UFPort_ReadFromQueue(int port, void *buf, size_t size)
+{
+    channel *c = channel_at(port);
+    if (!c || !buf || size != c->desc->sample_size)
+        return 0;
+    pthread_mutex_lock(&c->lock);
+    while (c->count == 0 && semo_running())
+        pthread_cond_wait(&c->readable, &c->lock);
+    int read = 0;
+    if (c->count > 0) {
+        memcpy(buf, c->buf + c->head * size, size);
+        c->head = (c->head + 1) % c->capacity;
+        c->count--;
+        read = (int)size;
+    }
+    pthread_mutex_unlock(&c->lock);
+    return read;
+}
+
+int UFPort_WriteToQueue(int port, const void *buf, size_t size)
+{
+    channel *c = channel_at(port);
+    if (!c || !buf || size != c->desc->sample_size)
+        return 0;
+    pthread_mutex_lock(&c->lock);
+    int written = 0;
+    if (c->count < c->capacity) {
+        size_t tail = (c->head + c->count) % c->capacity;
+        memcpy(c->buf + tail * size, buf, size);
+        c->count++;
+        written = (int)size;
+        pthread_cond_signal(&c->readable);
+    } else {
+        c->dropped++;
+    }
+    pthread_mutex_unlock(&c->lock);
+    return written;
+}
+
+int UFPort_GetNumOfAvailableData(int port)
+{
+    channel *c = channel_at(port);
+    if (!c)
+        return -1;
+    pthread_mutex_lock(&c->lock);
+    int n = (int)c->count;
+    pthread_mutex_unlock(&c->lock);
+    return n;
+}
+
+/* -------------------------------------------------------------- multicast */
+
+typedef struct {
+    const semo_multicast_desc *desc;
+    unsigned char *buf;
+    bool written;
+    pthread_mutex_t lock;
+} group;
+
+static group *g_groups;
+
+static group *find_group(const char *name, size_t size)
+{
+    if (!g_prog || !name)
+        return NULL;
+    for (size_t i = 0; i < g_prog->group_count; i++)
+        if (strcmp(g_prog->groups[i].name, name) == 0)
+            return size == g_prog->groups[i].sample_size ? &g_groups[i] : NULL;
+    return NULL;
+}
+
+int UFMulticast_Write(const char *name, const void *buf, size_t size)
+{
+    group *g = find_group(name, size);
+    if (!g || !buf)
+        return 0;
+    pthread_mutex_lock(&g->lock);
+    memcpy(g->buf, buf, size);
+    g->written = true;
+    pthread_mutex_unlock(&g->lock);
+    return (int)size;
+}
+
+int UFMulticast_Read(const char *name, void *buf, size_t size)
+{
+    group *g = find_group(name, size);
+    if (!g || !buf)
+        return 0;
+    pthread_mutex_lock(&g->lock);
+    int read = 0;
+    if (g->written) {
+        memcpy(buf, g->buf, size);
+        read = (int)size;
+    }
+    pthread_mutex_unlock(&g->lock);
+    return read;
+}
+
+/* ------------------------------------------------------------------ tasks */
+
+typedef struct param {
+    struct param *next;
+    long long value;
+    char name[]; /* owned copy */
+} param;
+
+typedef struct {
+    const semo_task_desc *desc;
+    pthread_t thread;
+    bool started;
+    pthread_mutex_t lock;
+    pthread_cond_t changed; /* any field below changed */
+    semo_task_state state;
+    bool repeat;         /* RunTask; otherwise `calls` firings are owed */
+    unsigned calls;
+    bool stop_requested;
+    param *params;
+} task;
+
+static task *g_tasks;
+
+static task *find_task(const char *name)
+{
+    if (!g_prog || !name)
+        return NULL;
+    for (size_t i = 0; i < g_prog->task_count; i++)
+        if (strcmp(g_prog->tasks[i].name, name) == 0)
+            return &g_tasks[i];
+    return NULL;
+}
+
+/* Time- and data-driven tasks start running; control-driven ones wait
+ * for the control task. All of them obey UFControl_*. */
+static void *task_thread(void *arg)
+{
+    task *t = arg;
+    const semo_task_desc *d = t->desc;
+    int64_t next_release = 0;
+    pthread_mutex_lock(&t->lock);
+    while (semo_running()) {
+        if (t->stop_requested && t->state != SEMO_TASK_IDLE) {
+            t->state = SEMO_TASK_IDLE;
+            t->stop_requested = false;
+            t->calls = 0;
+            pthread_cond_broadcast(&t->changed);
+            continue;
+        }
+        if (t->state != SEMO_TASK_RUNNING) {
+            pthread_cond_wait(&t->changed, &t->lock);
+            continue;
+        }
+        if (d->trigger == SEMO_TRIGGER_TIME) {
+            int64_t now = semo_now_ms();
+            if (now < next_release) {
+                /* Woken early by a state change or the end of the program. */
+                wait_until(&t->changed, &t->lock, next_release);
+                continue;
+            }
+            next_release = now + d->period_ms;
+        }
+        pthread_mutex_unlock(&t->lock);
+        if (d->go)
+            d->go();
+        pthread_mutex_lock(&t->lock);
+        if (!t->repeat && t->calls > 0 && --t->calls == 0)
+            t->state = SEMO_TASK_IDLE;
+        pthread_cond_broadcast(&t->changed);
+    }
+    pthread_mutex_unlock(&t->lock);
+    return NULL;
+}
+
+typedef enum { CONTROL_RUN, CONTROL_CALL, CONTROL_STOP, CONTROL_SUSPEND, CONTROL_RESUME } control_op;
+
+static int control(const char *name, control_op op)
+{
+    task *t = find_task(name);
+    if (!t)
+        return -1;
+    pthread_mutex_lock(&t->lock);
+    switch (op) {
+    case CONTROL_RUN:
+        t->repeat = true;
+        t->stop_requested = false;
+        if (t->state == SEMO_TASK_IDLE)
+            t->state = SEMO_TASK_RUNNING;
+        break;
+    case CONTROL_CALL:
+        if (t->state == SEMO_TASK_IDLE || !t->repeat) {
+            t->repeat = false;
+            t->calls++;
+            t->stop_requested = false;
+            if (t->state == SEMO_TASK_IDLE)
+                t->state = SEMO_TASK_RUNNING;
+        }
+        break;
+    case CONTROL_STOP:
+        if (t->state != SEMO_TASK_IDLE)
+            t->stop_requested = true;
+        break;
+    case CONTROL_SUSPEND:
+        if (t->state == SEMO_TASK_RUNNING)
+            t->state = SEMO_TASK_SUSPENDED;
+        break;
+    case CONTROL_RESUME:
+        if (t->state == SEMO_TASK_SUSPENDED)
+            t->state = SEMO_TASK_RUNNING;
+        break;
+    }
+    pthread_cond_broadcast(&t->changed);
+    pthread_mutex_unlock(&t->lock);
+    return 0;
+}
+
+int UFControl_RunTask(const char *task) { return control(task, CONTROL_RUN); }
+int UFControl_CallTask(const char *task) { return control(task, CONTROL_CALL); }
+int UFControl_StopTask(const char *task) { return control(task, CONTROL_STOP); }
+int UFControl_SuspendTask(const char *task) { return control(task, CONTROL_SUSPEND); }
+int UFControl_ResumeTask(const char *task) { return control(task, CONTROL_RESUME); }
+
+semo_task_state UFControl_GetTaskState(const char *name)
+{
+    task *t = find_task(name);
+    if (!t)
+        return SEMO_TASK_IDLE;
+    pthread_mutex_lock(&t->lock);
+    semo_task_state state = t->state;
+    pthread_mutex_unlock(&t->lock);
+    return state;
+}
+
+bool UFControl_WaitIdle(const char *name, int64_t timeout_ms)
+{
+    task *t = find_task(name);
+    if (!t)
+        return false;
+    int64_t deadline = timeout_ms < 0 ? -1 : semo_now_ms() + timeout_ms;
+    pthread_mutex_lock(&t->lock);
+    while (t->state != SEMO_TASK_IDLE && semo_running() && (deadline < 0 || semo_now_ms() < deadline))
+        wait_until(&t->changed, &t->lock, deadline);
+    bool idle = t->state == SEMO_TASK_IDLE;
+    pthread_mutex_unlock(&t->lock);
+    return idle;
+}
+
+bool UFControl_StopRequested(const char *name)
+{
+    task *t = find_task(name);
+    if (!semo_running())
+        return true;
+    if (!t)
+        return false;
+    pthread_mutex_lock(&t->lock);
+    bool stop = t->stop_requested;
+    pthread_mutex_unlock(&t->lock);
+    return stop;
+}
+
+int UFTask_SetIntegerParameter(const char *name, const char *param_name, long long value)
+{
+    task *t = find_task(name);
+    if (!t || !param_name)
+        return -1;
+    int result = 0;
+    pthread_mutex_lock(&t->lock);
+    param *p = t->params;
+    while (p && strcmp(p->name, param_name) != 0)
+        p = p->next;
+    if (!p) {
+        size_t len = strlen(param_name);
+        p = malloc(sizeof *p + len + 1);
+        if (p) {
+            memcpy(p->name, param_name, len + 1);
+            p->next = t->params;
+            t->params = p;
+        }
+    }
+    if (p)
+        p->value = value;
+    else
+        result = -1;
+    pthread_mutex_unlock(&t->lock);
+    return result;
+}
+
+long long UFTask_GetIntegerParameter(const char *name, const char *param_name)
+{
+    task *t = find_task(name);
+    if (!t || !param_name)
+        return 0;
+    long long value = 0;
+    pthread_mutex_lock(&t->lock);
+    for (param *p = t->params; p; p = p->next)
+        if (strcmp(p->name, param_name) == 0)
+            value = p->value;
+    pthread_mutex_unlock(&t->lock);
+    return value;
+}
+
+/* ----------------------------------------------------------------- timers */
+
+typedef struct {
+    int64_t due_ms;
+    bool used;
+} timer;
+
+static timer *g_timers;
+static size_t g_timer_count;
+static pthread_mutex_t g_timer_lock = PTHREAD_MUTEX_INITIALIZER;
+
+int UFTimer_Set(int64_t period, semo_time_unit unit)
+{
+    static const int64_t unit_ms[] = {[SEMO_MSEC] = 1, [SEMO_SEC] = 1000, [SEMO_MIN] = 60000, [SEMO_HOUR] = 3600000};
+    if (period < 0 || unit < SEMO_MSEC || unit > SEMO_HOUR || period > INT64_MAX / 2 / unit_ms[unit])
+        return -1;
+    int64_t due = semo_now_ms() + period * unit_ms[unit];
+    int id = -1;
+    pthread_mutex_lock(&g_timer_lock);
+    for (size_t i = 0; i < g_timer_count && id < 0; i++)
+        if (!g_timers[i].used)
+            id = (int)i;
+    if (id < 0 && g_timer_count < INT_MAX) {
+        size_t count = g_timer_count ? g_timer_count * 2 : 8;
+        timer *grown = realloc(g_timers, count * sizeof *grown);
+        if (grown) {
+            memset(grown + g_timer_count, 0, (count - g_timer_count) * sizeof *grown);
+            id = (int)g_timer_count;
+            g_timers = grown;
+            g_timer_count = count;
+        }
+    }
+    if (id >= 0)
+        g_timers[id] = (timer){.due_ms = due, .used = true};
+    pthread_mutex_unlock(&g_timer_lock);
+    return id;
+}
+
+bool UFTimer_GetAlarmed(int id)
+{
+    bool alarmed = false;
+    pthread_mutex_lock(&g_timer_lock);
+    if (id >= 0 && (size_t)id < g_timer_count && g_timers[id].used)
+        alarmed = semo_now_ms() >= g_timers[id].due_ms;
+    pthread_mutex_unlock(&g_timer_lock);
+    return alarmed;
+}
+
+void UFTimer_Cancel(int id)
+{
+    pthread_mutex_lock(&g_timer_lock);
+    if (id >= 0 && (size_t)id < g_timer_count)
+        g_timers[id].used = false;
+    pthread_mutex_unlock(&g_timer_lock);
+}
+
+/* --------------------------------------------------------------- messages */
+
+/* A datagram: "SEMO" 1 <kind> then from_team, from_robot, key, value, each
+ * as one length byte and that many bytes (no NUL), nothing after. */
+#define DATAGRAM_MAGIC "SEMO\x01"
+#define DATAGRAM_MAX (5 + 1 + 4 * 256)
+
+static size_t put_field(unsigned char *out, const char *text)
+{
+    size_t n = strlen(text);
+    out[0] = (unsigned char)n;
+    memcpy(out + 1, text, n);
+    return n + 1;
+}
+
+static size_t encode_message(const semo_message *m, unsigned char *out)
+{
+    size_t n = 5;
+    memcpy(out, DATAGRAM_MAGIC, 5);
+    out[n++] = (unsigned char)m->kind;
+    n += put_field(out + n, m->from_team);
+    n += put_field(out + n, m->from_robot);
+    n += put_field(out + n, m->key);
+    n += put_field(out + n, m->value.text);
+    return n;
+}
+
+static bool take_field(const unsigned char *in, size_t len, size_t *at, char *out, size_t cap)
+{
+    if (*at >= len)
+        return false;
+    size_t n = in[(*at)++];
+    if (n >= cap || n > len - *at || memchr(in + *at, '\0', n))
+        return false;
+    memcpy(out, in + *at, n);
+    out[n] = '\0';
+    *at += n;
+    return true;
+}
+
+static bool decode_message(const unsigned char *in, size_t len, semo_message *m)
+{
+    size_t at = 6;
+    if (len < at || memcmp(in, DATAGRAM_MAGIC, 5) != 0)
+        return false;
+    m->kind = (char)in[5];
+    if (m->kind != SEMO_MSG_SEND && m->kind != SEMO_MSG_PUBLISH)
+        return false;
+    return take_field(in, len, &at, m->from_team, sizeof m->from_team) &&
+           take_field(in, len, &at, m->from_robot, sizeof m->from_robot) &&
+           take_field(in, len, &at, m->key, sizeof m->key) &&
+           take_field(in, len, &at, m->value.text, sizeof m->value.text) && at == len;
+}
+
+static const semo_transport *g_transport; /* NULL: no other robots */
+static semo_message g_inbox[COMM_QUEUE_CAPACITY];
+static size_t g_inbox_head, g_inbox_count;
+static pthread_mutex_t g_inbox_lock = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t g_inbox_cond;
+
+void semo__deliver(const semo_message *msg)
+{
+    pthread_mutex_lock(&g_inbox_lock);
+    bool queued = g_inbox_count < COMM_QUEUE_CAPACITY;
+    if (queued) {
+        g_inbox[(g_inbox_head + g_inbox_count) % COMM_QUEUE_CAPACITY] = *msg;
+        g_inbox_count++;
+        pthread_cond_signal(&g_inbox_cond);
+    }
+    pthread_mutex_unlock(&g_inbox_lock);
+    if (!queued)
+        semo_trace("drop", "from", msg->from_team, "key", msg->key, "reason", "inbox full", NULL);
+}
+
+int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value)
+{
+    if (!g_prog || !to_team || !key || !value || strlen(key) >= sizeof ((semo_message *)0)->key ||
+        (kind != SEMO_MSG_SEND && kind != SEMO_MSG_PUBLISH))
+        return -1;
+    semo_trace("send", "to", to_team, "key", key, "value", value->text, NULL);
+    if (strcmp(to_team, "USER") == 0)
+        return 1; /* the operator console: the trace is its record */
+    if (!g_transport)
+        return -1;
+    semo_message m = {.kind = (char)kind};
+    snprintf(m.from_team, sizeof m.from_team, "%s", g_prog->team);
+    snprintf(m.from_robot, sizeof m.from_robot, "%s", g_prog->robot);
+    snprintf(m.key, sizeof m.key, "%s", key);
+    m.value = *value;
+    unsigned char datagram[DATAGRAM_MAX];
+    size_t len = encode_message(&m, datagram);
+    int sent = 0;
+    for (size_t i = 0; i < g_prog->peer_count; i++) {
+        const semo_peer *p = &g_prog->peers[i];
+        if (i == g_prog->self || (strcmp(p->team, to_team) != 0 && strcmp(p->robot, to_team) != 0))
+            continue;
+        if (g_transport->send(i, datagram, len) != 0) {
+            semo_trace("comm_error", "to", p->robot, "key", key, NULL);
+            return -1;
+        }
+        sent++;
+    }
+    return sent;
+}
+
+int semo_comm_poll(semo_message *out, int64_t timeout_ms)
+{
+    if (!out)
+        return 0;
+    int64_t deadline = timeout_ms < 0 ? -1 : semo_now_ms() + timeout_ms;
+    pthread_mutex_lock(&g_inbox_lock);
+    while (g_inbox_count == 0 && semo_running() && (deadline < 0 || semo_now_ms() < deadline))
+        wait_until(&g_inbox_cond, &g_inbox_lock, deadline);
+    bool got = g_inbox_count > 0;
+    if (got) {
+        *out = g_inbox[g_inbox_head];
+        g_inbox_head = (g_inbox_head + 1) % COMM_QUEUE_CAPACITY;
+        g_inbox_count--;
+    }
+    pthread_mutex_unlock(&g_inbox_lock);
+    if (got)
+        semo_trace("receive", "from", out->from_team, "from_robot", out->from_robot, "key", out->key, "value",
+                   out->value.text, NULL);
+    return got;
+}
+
+static void *receiver_thread(void *arg)
+{
+    (void)arg;
+    unsigned char buf[DATAGRAM_MAX + 1]; /* one spare byte detects oversized datagrams */
+    while (semo_running()) {
+        int n = g_transport->recv(buf, sizeof buf, RECV_POLL_MS);
+        semo_message m;
+        if (n < 0) {
+            semo_trace("comm_error", "reason", "receive failed", NULL);
+            semo_sleep_ms(RECV_POLL_MS);
+        } else if (n > 0 && decode_message(buf, (size_t)n, &m)) {
+            semo__deliver(&m);
+        } else if (n > 0) {
+            semo_trace("reject", "reason", "malformed datagram", NULL);
+        }
+    }
+    return NULL;
+}
+
+/* ------------------------------------------------------------- stopping */
+
+void semo_stop_program(void)
+{
+    if (!atomic_exchange(&g_running, false))
+        return;
+    /* Every waiter re-checks semo_running() under its own lock, so taking
+     * each lock before broadcasting means no one can miss the news. */
+    pthread_mutex_lock(&g_run_lock);
+    pthread_cond_broadcast(&g_run_cond);
+    pthread_mutex_unlock(&g_run_lock);
+    pthread_mutex_lock(&g_inbox_lock);
+    pthread_cond_broadcast(&g_inbox_cond);
+    pthread_mutex_unlock(&g_inbox_lock);
+    for (size_t i = 0; g_channels && i < g_prog->channel_count; i++) {
+        pthread_mutex_lock(&g_channels[i].lock);
+        pthread_cond_broadcast(&g_channels[i].readable);
+        pthread_mutex_unlock(&g_channels[i].lock);
+    }
+    for (size_t i = 0; g_tasks && i < g_prog->task_count; i++) {
+        pthread_mutex_lock(&g_tasks[i].lock);
+        pthread_cond_broadcast(&g_tasks[i].changed);
+        pthread_mutex_unlock(&g_tasks[i].lock);
+    }
+}
+
+/* SIGINT and SIGTERM end the program cleanly (wrapups run, traces close).
+ * They are blocked in every thread and taken here with sigwait. */
+static sigset_t g_signals;
+static atomic_bool g_signal_thread_done;
+
+static void *signal_thread(void *arg)
+{
+    (void)arg;
+    for (;;) {
+        int sig;
+        if (sigwait(&g_signals, &sig) != 0 || atomic_load(&g_signal_thread_done))
+            return NULL;
+        semo_trace("signal", "signal", sig == SIGINT ? "SIGINT" : "SIGTERM", NULL);
+        semo_stop_program();
+    }
+}
+
+/* ---------------------------------------------------------------- options */
+
+typedef struct {
+    const char *trace;
+    long port_base;
+    int64_t duration_ms;
+    bool duration_given;
+    const char *scenario;
+    double time_scale;
+    bool time_scale_given;
+} options;
+
+static void usage(FILE *f, const char *prog)
+{
+    fprintf(f,
+            "usage: %s [--trace FILE] [--port-base N] [--duration MS]"
+#ifdef SEMO_SIM
+            " [--scenario FILE] [--time-scale X]"
+#endif
+            "\n"
+            "  --trace FILE      write a JSON-lines trace to FILE (\"-\": standard output)\n"
+            "  --port-base N     robot i uses UDP port N+i on 127.0.0.1 (default %d, or $SEMO_PORT_BASE)\n"
+            "  --duration MS     stop after MS mission milliseconds (0: run until stopped)\n"
+#ifdef SEMO_SIM
+            "  --scenario FILE   the simulation scenario (JSON)\n"
+            "  --time-scale X    wall ms per mission ms (0.1: ten times faster; default 1)\n"
+#endif
+            ,
+            prog, DEFAULT_PORT_BASE);
+}
+
+static bool parse_long(const char *s, long min, long max, long *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (*s == '\0' || *end != '\0' || errno != 0 || v < min || v > max)
+        return false;
+    *out = v;
+    return true;
+}
+
+/* 0: run; 1: help printed; 2: bad command line (message printed). */
+static int parse_options(int argc, char **argv, options *o)
+{
+    const char *prog = argc > 0 && argv[0] ? argv[0] : "robot";
+    size_t peers = g_prog->peer_count ? g_prog->peer_count : 1;
+    long max_base = 65536 - (long)peers;
+    const char *env = getenv("SEMO_PORT_BASE");
+    o->port_base = DEFAULT_PORT_BASE;
+    if (env && !parse_long(env, 1, max_base, &o->port_base)) {
+        fprintf(stderr, "%s: SEMO_PORT_BASE must be a port number from 1 to %ld, not \"%s\"\n", prog, max_base, env);
+        return 2;
+    }
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i];
+        if (strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0) {
+            usage(stdout, prog);
+            return 1;
+        }
+        static const char *const names[] = {"--trace", "--port-base", "--duration", "--scenario", "--time-scale"};
+        size_t which = sizeof names / sizeof names[0];
+        const char *value = NULL;
+        for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
+            size_t len = strlen(names[k]);
+            if (strncmp(arg, names[k], len) == 0 && (arg[len] == '\0' || arg[len] == '=')) {
+                which = k;
+                value = arg[len] == '=' ? arg + len + 1 : (i + 1 < argc ? argv[++i] : NULL);
+            }
+        }
+#ifndef SEMO_SIM
+        if (which >= 3 && which < 5) {
+            fprintf(stderr, "%s: %s needs a simulation build (-DSEMO_SIM)\n", prog, names[which]);
+            return 2;
+        }
+#endif
+        if (which == sizeof names / sizeof names[0]) {
+            fprintf(stderr, "%s: unknown option \"%s\"\n", prog, arg);
+            usage(stderr, prog);
+            return 2;
+        }
+        if (!value) {
+            fprintf(stderr, "%s: %s needs a value\n", prog, names[which]);
+            usage(stderr, prog);
+            return 2;
+        }
+        long n;
+        char *end;
+        switch (which) {
+        case 0:
+            o->trace = value;
+            break;
+        case 1:
+            if (!parse_long(value, 1, max_base, &o->port_base)) {
+                fprintf(stderr, "%s: --port-base must be a port number from 1 to %ld, not \"%s\"\n", prog, max_base,
+                        value);
+                return 2;
+            }
+            break;
+        case 2:
+            if (!parse_long(value, 0, LONG_MAX, &n)) {
+                fprintf(stderr, "%s: --duration must be a whole number of milliseconds, not \"%s\"\n", prog, value);
+                return 2;
+            }
+            o->duration_ms = n;
+            o->duration_given = true;
+            break;
+        case 3:
+            o->scenario = value;
+            break;
+        case 4:
+            o->time_scale = strtod(value, &end);
+            if (*value == '\0' || *end != '\0' || !(o->time_scale > 0) || !isfinite(o->time_scale)) {
+                fprintf(stderr, "%s: --time-scale must be a positive number, not \"%s\"\n", prog, value);
+                return 2;
+            }
+            o->time_scale_given = true;
+            break;
+        }
+    }
+    return 0;
+}
+
+/* The generator's tables, checked once so that the calls above can trust them. */
+static bool program_is_valid(const semo_program_desc *p)
+{
+    const char *problem = NULL;
+    if (!p->team || !p->robot || strlen(p->team) >= 32 || strlen(p->robot) >= 32)
+        problem = "team and robot names must be given and shorter than 32 bytes";
+    else if ((p->task_count && !p->tasks) || (p->channel_count && !p->channels) || (p->group_count && !p->groups) ||
+             (p->peer_count && !p->peers))
+        problem = "a table has entries but no array";
+    else if (p->peer_count && p->self >= p->peer_count)
+        problem = "`self` is not an index of `peers`";
+    for (size_t i = 0; !problem && i < p->task_count; i++)
+        if (!p->tasks[i].name || (p->tasks[i].trigger == SEMO_TRIGGER_TIME && p->tasks[i].period_ms <= 0))
+            problem = "every task needs a name, and time-driven tasks a positive period";
+    for (size_t i = 0; !problem && i < p->channel_count; i++) {
+        const semo_channel_desc *c = &p->channels[i];
+        if (!c->src_task || !c->src_port || !c->dst_task || !c->dst_port || c->sample_size == 0 ||
+            c->sample_size > INT_MAX || c->capacity > SIZE_MAX / c->sample_size / 2 ||
+            c->initial_samples > SIZE_MAX / c->sample_size / 2)
+            problem = "a channel lacks a name or has an impossible size";
+    }
+    for (size_t i = 0; !problem && i < p->group_count; i++)
+        if (!p->groups[i].name || p->groups[i].sample_size == 0 || p->groups[i].sample_size > INT_MAX)
+            problem = "a multicast group lacks a name or a size";
+    for (size_t i = 0; !problem && i < p->peer_count; i++)
+        if (!p->peers[i].team || !p->peers[i].robot)
+            problem = "a peer lacks a team or robot name";
+    if (problem)
+        fprintf(stderr, "semo runtime: invalid program tables: %s\n", problem);
+    return !problem;
+}
+
+/* ------------------------------------------------------- set-up, tear-down */
+
+static void free_program_state(void)
+{
+    const semo_program_desc *p = g_prog;
+    for (size_t i = 0; g_channels && i < p->channel_count; i++) {
+        free(g_channels[i].buf);
+        pthread_mutex_destroy(&g_channels[i].lock);
+        pthread_cond_destroy(&g_channels[i].readable);
+    }
+    for (size_t i = 0; g_groups && i < p->group_count; i++) {
+        free(g_groups[i].buf);
+        pthread_mutex_destroy(&g_groups[i].lock);
+    }
+    for (size_t i = 0; g_tasks && i < p->task_count; i++) {
+        for (param *q = g_tasks[i].params, *next; q; q = next) {
+            next = q->next;
+            free(q);
+        }
+        pthread_mutex_destroy(&g_tasks[i].lock);
+        pthread_cond_destroy(&g_tasks[i].changed);
+    }
+    free(g_channels);
+    free(g_groups);
+    free(g_tasks);
+    free(g_timers);
+    g_channels = NULL;
+    g_groups = NULL;
+    g_tasks = NULL;
+    g_timers = NULL;
+    g_timer_count = 0;
+    g_inbox_head = g_inbox_count = 0;
+}
+
+static bool allocate_program_state(const semo_program_desc *p)
+{
+    g_channels = calloc(p->channel_count ? p->channel_count : 1, sizeof *g_channels);
+    g_groups = calloc(p->group_count ? p->group_count : 1, sizeof *g_groups);
+    g_tasks = calloc(p->task_count ? p->task_count : 1, sizeof *g_tasks);
+    if (!g_channels || !g_groups || !g_tasks)
+        return false;
+    bool ok = true;
+    for (size_t i = 0; i < p->channel_count; i++) {
+        channel *c = &g_channels[i];
+        c->desc = &p->channels[i];
+        c->capacity = c->desc->capacity;
+        if (c->capacity < c->desc->initial_samples)
+            c->capacity = c->desc->initial_samples;
+        if (c->capacity == 0)
+            c->capacity = 1;
+        c->count = c->desc->initial_samples;
+        c->buf = calloc(c->capacity, c->desc->sample_size);
+        ok = ok && c->buf;
+        pthread_mutex_init(&c->lock, NULL);
+        init_cond(&c->readable);
+    }
+    for (size_t i = 0; i < p->group_count; i++) {
+        g_groups[i].desc = &p->groups[i];
+        g_groups[i].buf = calloc(1, p->groups[i].sample_size);
+        ok = ok && g_groups[i].buf;
+        pthread_mutex_init(&g_groups[i].lock, NULL);
+    }
+    for (size_t i = 0; i < p->task_count; i++) {
+        task *t = &g_tasks[i];
+        t->desc = &p->tasks[i];
+        bool starts = t->desc->trigger != SEMO_TRIGGER_CONTROL;
+        t->state = starts ? SEMO_TASK_RUNNING : SEMO_TASK_IDLE;
+        t->repeat = starts;
+        pthread_mutex_init(&t->lock, NULL);
+        init_cond(&t->changed);
+    }
+    return ok;
+}
+
+static int open_trace(const char *path)
+{
+    if (!path)
+        return 0;
+    if (strcmp(path, "-") == 0) {
+        g_trace = stdout;
+        return 0;
+    }
+    g_trace = fopen(path, "w");
+    if (!g_trace) {
+        fprintf(stderr, "semo runtime: cannot write the trace \"%s\": %s\n", path, strerror(errno));
+        return -1;
+    }
+    g_trace_owned = true;
+    return 0;
+}
+
+static void close_trace(void)
+{
+    pthread_mutex_lock(&g_trace_lock);
+    if (g_trace_owned)
+        fclose(g_trace);
+    g_trace = NULL;
+    g_trace_owned = false;
+    pthread_mutex_unlock(&g_trace_lock);
+}
+
+static bool start_thread(pthread_t *thread, void *(*body)(void *), void *arg)
+{
+    pthread_attr_t attr;
+    pthread_attr_init(&attr);
+    pthread_attr_setstacksize(&attr, TASK_STACK_BYTES);
+    bool ok = pthread_create(thread, &attr, body, arg) == 0;
+    pthread_attr_destroy(&attr);
+    if (!ok)
+        fprintf(stderr, "semo runtime: cannot start a thread\n");
+    return ok;
+}
+
+static void trace_dropped_samples(void)
+{
+    for (size_t i = 0; i < g_prog->channel_count; i++) {
+        const semo_channel_desc *d = g_channels[i].desc;
+        pthread_mutex_lock(&g_channels[i].lock);
+        unsigned long dropped = g_channels[i].dropped;
+        pthread_mutex_unlock(&g_channels[i].lock);
+        if (dropped) {
+            char name[256], count[32];
+            snprintf(name, sizeof name, "%s.%s->%s.%s", d->src_task, d->src_port, d->dst_task, d->dst_port);
+            snprintf(count, sizeof count, "%lu", dropped);
+            semo_trace("dropped", "channel", name, "count", count, NULL);
+        }
+    }
+}
+
+/* Starts everything, waits for the end, stops everything; 0 or 1. */
+static int run(const options *o)
+{
+    const semo_program_desc *p = g_prog;
+    int status = 0;
+    pthread_t receiver, signals;
+    bool receiver_started = false, signals_started = false;
+    size_t initialized = 0; /* tasks whose init ran get their wrapup */
+#ifdef SEMO_SIM
+    bool sim_started = false;
+#endif
+    sigset_t old_mask;
+    sigemptyset(&g_signals);
+    sigaddset(&g_signals, SIGINT);
+    sigaddset(&g_signals, SIGTERM);
+    pthread_sigmask(SIG_BLOCK, &g_signals, &old_mask);
+    atomic_store(&g_signal_thread_done, false);
+
+    clock_gettime(CLOCK_MONOTONIC, &g_t0);
+    atomic_store(&g_running, true);
+    /* A robot alone in its mission has no one to hear from: no port, no receiver. */
+    if (p->peer_count > 1) {
+        if (semo_udp_transport.open(p, (int)o->port_base) != 0) {
+            fprintf(stderr, "semo runtime: cannot open the %s transport on port %ld\n", semo_udp_transport.name,
+                    o->port_base + (long)p->self);
+            status = 1;
+            goto stop;
+        }
+        g_transport = &semo_udp_transport;
+    }
+    semo_trace("start", "team", p->team, "type", p->robot_type ? p->robot_type : "", "mission",
+               p->mission ? p->mission : "", NULL);
+    signals_started = start_thread(&signals, signal_thread, NULL);
+    for (; initialized < p->task_count; initialized++)
+        if (p->tasks[initialized].init)
+            p->tasks[initialized].init();
+    if (g_transport)
+        receiver_started = start_thread(&receiver, receiver_thread, NULL);
+#ifdef SEMO_SIM
+    sim_started = semo__sim_start() == 0;
+    if (!sim_started)
+        status = 1;
+#endif
+    for (size_t i = 0; i < p->task_count && status == 0; i++) {
+        g_tasks[i].started = start_thread(&g_tasks[i].thread, task_thread, &g_tasks[i]);
+        if (!g_tasks[i].started)
+            status = 1;
+    }
+    if (!signals_started || (g_transport && !receiver_started))
+        status = 1;
+
+    if (status == 0)
+        semo__wait_until(o->duration_ms > 0 ? o->duration_ms : INT64_MAX);
+stop:
+    semo_stop_program();
+    for (size_t i = 0; i < p->task_count; i++)
+        if (g_tasks[i].started)
+            pthread_join(g_tasks[i].thread, NULL);
+    if (receiver_started)
+        pthread_join(receiver, NULL);
+#ifdef SEMO_SIM
+    if (sim_started)
+        semo__sim_stop();
+#endif
+    if (signals_started) {
+        atomic_store(&g_signal_thread_done, true);
+        pthread_kill(signals, SIGTERM); /* taken by its sigwait, never delivered */
+        pthread_join(signals, NULL);
+    }
+    for (size_t i = 0; i < initialized; i++)
+        if (p->tasks[i].wrapup)
+            p->tasks[i].wrapup();
+    trace_dropped_samples();
+    semo_trace("stop", NULL);
+    if (g_transport)
+        g_transport->close();
+    g_transport = NULL;
+    pthread_sigmask(SIG_SETMASK, &old_mask, NULL);
+    return status;
+}
+
+int semo_main(int argc, char **argv, const semo_program_desc *program)
+{
+    if (!program || g_prog) {
+        fprintf(stderr, "semo runtime: semo_main needs a program and runs one at a time\n");
+        return 1;
+    }
+    if (!program_is_valid(program))
+        return 1;
+    g_prog = program;
+    options o = {0};
+    int status = parse_options(argc, argv, &o);
+    if (status == 1) { /* --help */
+        g_prog = NULL;
+        return 0;
+    }
+#ifdef SEMO_SIM
+    if (status == 0 && o.scenario && semo__sim_load(o.scenario, program) != 0)
+        status = 2;
+    if (status == 0 && !o.time_scale_given && !semo__sim_time_scale(&o.time_scale))
+        o.time_scale = 1.0;
+    if (status == 0 && !o.duration_given && !semo__sim_duration(&o.duration_ms))
+        o.duration_ms = 0;
+#endif
+    if (status == 0) {
+        g_scale = o.time_scale > 0 ? o.time_scale : 1.0;
+        init_cond(&g_run_cond);
+        init_cond(&g_inbox_cond);
+        if (open_trace(o.trace) != 0) {
+            status = 1;
+        } else if (!allocate_program_state(program)) {
+            fprintf(stderr, "semo runtime: out of memory\n");
+            status = 1;
+        } else {
+            status = run(&o);
+        }
+        free_program_state();
+        close_trace();
+        pthread_cond_destroy(&g_run_cond);
+        pthread_cond_destroy(&g_inbox_cond);
+    }
+#ifdef SEMO_SIM
+    semo__sim_free();
+#endif
+    g_prog = NULL;
+    return status;
+}

@@ -1,0 +1,74 @@
+//! Refinement (codegen.md §1): a checked mission, its strategy files and the
+//! catalog become, for every robot, a task graph and the control task's
+//! hierarchical state machine ([`RobotProgram`]).
+//!
+//! - `robot.rs`: one robot's program: which services it runs (group arms it
+//!   can never join are dropped), statement machines, strategy action machines,
+//!   the values it reads, the messages it exchanges.
+//! - `graph.rs`: the robot's task graph from what the machine uses, checked
+//!   with the SDF/L analyses.
+//!
+//! Refinement reads only checked input: the caller refuses missions with errors.
+
+pub mod graph;
+pub mod program;
+mod robot;
+
+pub use program::*;
+
+use crate::Analysis;
+use crate::catalog::Catalog;
+use crate::diag::{self, Diagnostic, FileId};
+use crate::strategy::{Strategy, StrategyLinks};
+use crate::text::LineIndex;
+
+/// Everything refinement reads.
+pub struct RefineInput<'a> {
+    /// The mission's file name (for traces and file headers).
+    pub mission_name: &'a str,
+    pub file: FileId,
+    pub text: &'a str,
+    pub analysis: &'a Analysis,
+    pub catalog: &'a Catalog,
+    pub strategies: &'a [Strategy],
+    /// Strategy file names, by `Strategy::file`, for comments.
+    pub strategy_names: &'a [(FileId, String)],
+    pub links: &'a StrategyLinks,
+}
+
+/// One program per robot of the mission, in formation order, and the
+/// diagnostics that stop generation (constructs code generation does not
+/// support yet, inconsistent refined graphs).
+pub fn refine(input: &RefineInput<'_>) -> (Vec<RobotProgram>, Vec<Diagnostic>) {
+    let lines = LineIndex::new(input.text);
+    let mission = &input.analysis.mission;
+    let peers: Vec<(String, String)> = mission
+        .teams
+        .iter()
+        .flat_map(|t| {
+            t.robots
+                .iter()
+                .map(|r| (t.name.to_string(), r.name.to_string()))
+        })
+        .collect();
+    let mut programs = Vec::new();
+    let mut diagnostics = Vec::new();
+    for (team_index, team) in mission.teams.iter().enumerate() {
+        for (robot_index, _) in team.robots.iter().enumerate() {
+            let (program, found) = robot::refine_robot(
+                input,
+                &lines,
+                &peers,
+                crate::sema::TeamId(team_index as u32),
+                robot_index,
+            );
+            diagnostics.extend(found);
+            programs.extend(program);
+        }
+    }
+    diag::sort_and_dedup(&mut diagnostics);
+    (programs, diagnostics)
+}
+
+#[cfg(test)]
+mod tests;

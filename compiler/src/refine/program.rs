@@ -1,0 +1,284 @@
+//! What refinement produces for one robot: its task graph and the control
+//! task's hierarchical state machine, as plain data the code generator walks.
+//!
+//! Levels of the machine (codegen.md §1.5): modes (top) → one concurrent
+//! region per plan → the statement machine of the composite service the mode
+//! sets for that plan → for a built-in call the strategy refines, that
+//! entry's action machine (bottom).
+
+use crate::taskgraph::TaskGraph;
+
+/// One robot's refined program.
+#[derive(Clone, Debug)]
+pub struct RobotProgram {
+    pub mission: String,
+    pub team: String,
+    pub robot: String,
+    pub robot_type: String,
+    pub graph: TaskGraph,
+    /// Per channel of `graph`: the samples its buffer holds (the buffer
+    /// analysis's bound, at least the capacity refinement declared).
+    pub capacities: Vec<u64>,
+    pub control: ControlMachine,
+    /// The non-control tasks of `graph` and what each one does.
+    pub tasks: Vec<TaskRole>,
+    /// Every robot of the mission, in formation order: (team, robot).
+    pub peers: Vec<(String, String)>,
+    /// This robot's index in `peers`.
+    pub self_peer: usize,
+    /// The team's shared information, held by the library task.
+    pub library: Option<SharedLibrary>,
+}
+
+/// The control task's machine.
+#[derive(Clone, Debug, Default)]
+pub struct ControlMachine {
+    pub modes: Vec<ModeState>,
+    /// Index into `modes`.
+    pub default_mode: Option<usize>,
+    /// `case (from): catch (event): mode = to`, with the line of the catch.
+    pub transitions: Vec<ModeTransition>,
+    pub services: Vec<ServiceMachine>,
+    pub actions: Vec<ActionMachine>,
+    /// Every value the machine reads or writes.
+    pub slots: Vec<Slot>,
+    /// Channels the control task writes a service request to, by task.
+    pub request_tasks: Vec<String>,
+    /// Outgoing messages: one control-task port each.
+    pub outgoing: Vec<OutgoingMessage>,
+    /// Incoming messages: one control-task port each.
+    pub incoming: Vec<IncomingMessage>,
+    /// Latest-value groups the control task reads (`subscribe`).
+    pub subscribed: Vec<String>,
+}
+
+#[derive(Clone, Debug)]
+pub struct ModeState {
+    pub name: String,
+    pub line: u32,
+    /// One region per plan the mode runs (plans set to `OFF` have none).
+    pub regions: Vec<Region>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Region {
+    pub plan: String,
+    /// Index into [`ControlMachine::services`].
+    pub service: usize,
+    pub timeout_ms: Option<i64>,
+}
+
+#[derive(Clone, Debug)]
+pub struct ModeTransition {
+    pub from: usize,
+    pub event: String,
+    pub to: usize,
+    pub line: u32,
+}
+
+/// A composite service as a sequence of states; execution moves to the next
+/// state unless a state says otherwise.
+#[derive(Clone, Debug)]
+pub struct ServiceMachine {
+    pub plan: String,
+    pub name: String,
+    pub line: u32,
+    pub states: Vec<State>,
+    /// Timers and marks the states use (loop starts, call starts).
+    pub marks: usize,
+}
+
+#[derive(Clone, Debug)]
+pub struct State {
+    pub kind: StateKind,
+    /// The mission line the state comes from (1-based).
+    pub line: u32,
+    /// The statement as written, for the comment beside the state.
+    pub text: String,
+}
+
+#[derive(Clone, Debug)]
+pub enum StateKind {
+    /// Wait for one sample of each incoming message (indices into
+    /// [`ControlMachine::incoming`]), storing each in its slot.
+    Receive {
+        messages: Vec<usize>,
+        /// `receive(...), timeout = P`: give up after P (mark holds the start).
+        timeout_ms: Option<i64>,
+        mark: usize,
+    },
+    /// Send each item (storing assigned values in their shared slot first).
+    Send {
+        items: Vec<SendItem>,
+    },
+    /// Read the latest published value of a group into its slot.
+    Subscribe {
+        group: usize,
+        slot: usize,
+    },
+    Throw {
+        event: String,
+    },
+    /// Call the task implementing a built-in service and wait until it is idle.
+    Call {
+        service: String,
+        task: String,
+        args: Vec<Operand>,
+        timeout_ms: Option<i64>,
+        mark: usize,
+    },
+    /// Run a strategy action machine to its final action.
+    RunActions {
+        service: String,
+        machine: usize,
+        args: Vec<Operand>,
+        timeout_ms: Option<i64>,
+        mark: usize,
+    },
+    /// Continue at `else_to` unless the condition holds.
+    Branch {
+        condition: Expr,
+        else_to: usize,
+    },
+    Jump {
+        to: usize,
+    },
+    /// Head of `loop(period?, condition?)`: leave to `exit_to` when the
+    /// condition fails; mark the iteration's start.
+    LoopHead {
+        condition: Option<Expr>,
+        exit_to: usize,
+        mark: usize,
+    },
+    /// End of a loop body: wait for the period (from the mark), then `to`.
+    LoopTail {
+        period_ms: Option<i64>,
+        mark: usize,
+        to: usize,
+    },
+    /// After the body: `repeat(period?, condition?)`; `forever` for `repeat()`;
+    /// neither means the service runs once.
+    Repeat {
+        period_ms: Option<i64>,
+        condition: Option<Expr>,
+        forever: bool,
+    },
+}
+
+/// One value of a `send`/`publish`.
+#[derive(Clone, Debug)]
+pub struct SendItem {
+    /// Index into [`ControlMachine::outgoing`].
+    pub message: usize,
+    pub value: Operand,
+    /// `send(T, T.X = v)`: the shared slot `v` is stored in first.
+    pub store: Option<usize>,
+}
+
+/// A strategy entry's actions: the bottom level of the machine.
+#[derive(Clone, Debug)]
+pub struct ActionMachine {
+    pub service: String,
+    /// `Strategy file` line of the `<Service>` element.
+    pub source: String,
+    pub actions: Vec<ActionState>,
+    pub initial: usize,
+    /// Slots of the `variable` parameters set from the call's arguments, in order.
+    pub arguments: Vec<usize>,
+}
+
+#[derive(Clone, Debug)]
+pub struct ActionState {
+    pub name: String,
+    pub id: u64,
+    pub is_final: bool,
+    /// Actuator commands issued on entry: (task, command value).
+    pub commands: Vec<(String, String)>,
+    /// Checked in order; the first that holds is taken. `None` = always.
+    pub transitions: Vec<(Option<Expr>, usize)>,
+}
+
+/// A value of the machine and where it comes from.
+#[derive(Clone, Debug)]
+pub struct Slot {
+    /// `MasterTeam.LOCATION`, `USER.RC_CMD`, or `move.goalLocation`.
+    pub key: String,
+    pub source: SlotSource,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SlotSource {
+    /// The latest sample of a sensor task's output port.
+    Sensor { task: String, port: String },
+    /// Received from another robot, or set by `send(T, T.X = ...)`: held by
+    /// the team's library task.
+    Shared,
+    /// A strategy variable parameter (set from a call's argument).
+    Local,
+}
+
+#[derive(Clone, Debug)]
+pub struct OutgoingMessage {
+    pub to_team: String,
+    pub publish: bool,
+    pub key: String,
+    /// The control task's port (and the comm task's input port).
+    pub port: String,
+}
+
+#[derive(Clone, Debug)]
+pub struct IncomingMessage {
+    pub from_team: String,
+    pub key: String,
+    pub slot: usize,
+    pub port: String,
+}
+
+/// The team's shared information (library task `lib_<name>`).
+#[derive(Clone, Debug)]
+pub struct SharedLibrary {
+    pub name: String,
+    /// Slot keys it holds a getter and a setter for.
+    pub attributes: Vec<String>,
+}
+
+/// A non-control task of the robot and its job.
+#[derive(Clone, Debug)]
+pub struct TaskRole {
+    pub task: String,
+    pub kind: RoleKind,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum RoleKind {
+    /// Produces these values (port name = value name), every period.
+    Sensor {
+        values: Vec<String>,
+        period_ms: i64,
+    },
+    /// Runs built-in services or actuator commands on request.
+    Service {
+        services: Vec<String>,
+    },
+    CommSend,
+    CommReceive,
+}
+
+/// An expression of the machine: comparisons of operands.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Expr {
+    Or(Box<Expr>, Box<Expr>),
+    And(Box<Expr>, Box<Expr>),
+    Not(Box<Expr>),
+    Compare(Operand, crate::syntax::ast::CmpOp, Operand),
+    /// A bare attribute as a condition: its value is `true` or non-zero.
+    Truthy(Operand),
+    Bool(bool),
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Operand {
+    Slot(usize),
+    /// A literal's text (strings unescaped, numbers as written, constants by name).
+    Literal(String),
+}

@@ -1,0 +1,1009 @@
+//! One robot's program: the control machine and the tasks it uses.
+
+use super::RefineInput;
+use super::program::*;
+use crate::catalog::{Implementation, RobotType};
+use crate::diag::{Code, Diagnostic};
+use crate::sema::{Symbol, Team, TeamId};
+use crate::span::Span;
+use crate::strategy::{DataCharacteristic, ServiceEntry, TaskUseKind};
+use crate::syntax::ast::{self, CondKind, ExprKind, StmtKind};
+use crate::text::LineIndex;
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+
+/// How often sensor tasks sample, in mission milliseconds.
+pub(super) const SENSOR_PERIOD_MS: i64 = 100;
+/// How deep function calls may nest before refinement gives up (sema
+/// already rejects recursion; this only bounds the work).
+const MAX_INLINE_DEPTH: usize = 32;
+
+pub(super) fn refine_robot(
+    input: &RefineInput<'_>,
+    lines: &LineIndex,
+    peers: &[(String, String)],
+    team_id: TeamId,
+    robot_index: usize,
+) -> (Option<RobotProgram>, Vec<Diagnostic>) {
+    let mission = &input.analysis.mission;
+    let team = mission.team(team_id);
+    let robot = &team.robots[robot_index];
+    let Some(robot_type) = robot.robot_type.map(|id| input.catalog.get(id)) else {
+        return (None, Vec::new()); // an unknown type is a check error
+    };
+    let mut builder = Builder {
+        input,
+        lines,
+        team_id,
+        team,
+        robot_index,
+        robot_type,
+        machine: ControlMachine::default(),
+        slot_index: HashMap::new(),
+        sensors: BTreeMap::new(),
+        services: BTreeMap::new(),
+        service_machines: HashMap::new(),
+        action_machines: HashMap::new(),
+        diagnostics: Vec::new(),
+    };
+    builder.build_modes();
+    let Builder {
+        machine,
+        sensors,
+        services,
+        diagnostics,
+        ..
+    } = builder;
+    let self_peer = peers
+        .iter()
+        .position(|(t, r)| *t == team.name && *r == robot.name)
+        .unwrap_or(0);
+    let shared: Vec<String> = machine
+        .slots
+        .iter()
+        .filter(|s| s.source == SlotSource::Shared)
+        .map(|s| s.key.clone())
+        .collect();
+    let library = (!shared.is_empty()).then(|| SharedLibrary {
+        name: format!("{}Shared", team.name),
+        attributes: shared,
+    });
+    let mut tasks: Vec<TaskRole> = sensors
+        .into_iter()
+        .map(|(task, values)| TaskRole {
+            task,
+            kind: RoleKind::Sensor {
+                values: values.into_iter().collect(),
+                period_ms: SENSOR_PERIOD_MS,
+            },
+        })
+        .collect();
+    tasks.extend(services.into_iter().map(|(task, services)| TaskRole {
+        task,
+        kind: RoleKind::Service {
+            services: services.into_iter().collect(),
+        },
+    }));
+    if !machine.outgoing.is_empty() {
+        tasks.push(TaskRole {
+            task: graph::COMM_SEND.into(),
+            kind: RoleKind::CommSend,
+        });
+    }
+    if !machine.incoming.is_empty() || !machine.subscribed.is_empty() {
+        tasks.push(TaskRole {
+            task: graph::COMM_RECEIVE.into(),
+            kind: RoleKind::CommReceive,
+        });
+    }
+    let mut program = RobotProgram {
+        mission: input.mission_name.to_string(),
+        team: team.name.to_string(),
+        robot: robot.name.to_string(),
+        robot_type: robot_type.name.clone(),
+        capacities: Vec::new(),
+        graph: crate::taskgraph::TaskGraph {
+            name: robot.name.to_string(),
+            file: input.file,
+            span: team.name_span,
+            tasks: Vec::new(),
+            channels: Vec::new(),
+            libraries: Vec::new(),
+        },
+        control: machine,
+        tasks,
+        peers: peers.to_vec(),
+        self_peer,
+        library,
+    };
+    program.graph = graph::build(&program);
+    let (capacities, found) = graph::check(&program.graph, input.file, robot.name_span);
+    program.capacities = capacities;
+    let mut diagnostics = diagnostics;
+    diagnostics.extend(found);
+    (Some(program), diagnostics)
+}
+
+use super::graph;
+
+struct Builder<'a, 'i> {
+    input: &'a RefineInput<'i>,
+    lines: &'a LineIndex,
+    team_id: TeamId,
+    team: &'a Team,
+    robot_index: usize,
+    robot_type: &'a RobotType,
+    machine: ControlMachine,
+    slot_index: HashMap<(String, bool), usize>,
+    /// Sensor task → the values it provides.
+    sensors: BTreeMap<String, BTreeSet<String>>,
+    /// Service task → the services or actuator commands it runs.
+    services: BTreeMap<String, BTreeSet<String>>,
+    /// Team service index → machine index.
+    service_machines: HashMap<u32, usize>,
+    /// (strategy file, entry index) → action machine index.
+    action_machines: HashMap<(u32, usize), usize>,
+    diagnostics: Vec<Diagnostic>,
+}
+
+impl Builder<'_, '_> {
+    fn line(&self, span: Span) -> u32 {
+        let text = self.input.text;
+        let offset = span.start.min(text.len());
+        self.lines
+            .line_col(text, offset, crate::text::ColumnUnit::Utf8)
+            .line as u32
+            + 1
+    }
+
+    /// The statement's first line as written, for a comment.
+    fn excerpt(&self, span: Span) -> String {
+        let text = self.input.text;
+        let start = span.start.min(text.len());
+        let end = span.end.clamp(start, text.len());
+        let first = text[start..end].lines().next().unwrap_or("").trim();
+        let mut short: String = first.chars().take(70).collect();
+        if short.len() < first.len() {
+            short.push_str("...");
+        }
+        short
+    }
+
+    fn unsupported(&mut self, span: Span, what: &str) {
+        self.diagnostics.push(Diagnostic::new(
+            Code::CodegenUnsupported,
+            self.input.file,
+            span,
+            format!("code generation does not support {what} yet"),
+        ));
+    }
+
+    fn build_modes(&mut self) {
+        let team = self.team;
+        for mode in &team.modes {
+            let mut regions = Vec::new();
+            for set in &mode.sets {
+                let (Some(plan), Some(service)) = (set.plan, set.service) else {
+                    continue; // OFF
+                };
+                let machine = self.service_machine(service);
+                regions.push(Region {
+                    plan: team.plans[plan as usize].name.to_string(),
+                    service: machine,
+                    timeout_ms: set.timeout_ms.map(|t| t.round() as i64),
+                });
+            }
+            let line = self.line(mode.name_span);
+            self.machine.modes.push(ModeState {
+                name: mode.name.to_string(),
+                line,
+                regions,
+            });
+        }
+        if let Some(main) = &team.main {
+            self.machine.default_mode = main.default.map(|d| d as usize);
+            for t in &main.transitions {
+                let line = self.line(t.span);
+                self.machine.transitions.push(ModeTransition {
+                    from: t.from as usize,
+                    event: t.event.to_string(),
+                    to: t.to as usize,
+                    line,
+                });
+            }
+        }
+    }
+
+    fn service_machine(&mut self, service: u32) -> usize {
+        if let Some(&m) = self.service_machines.get(&service) {
+            return m;
+        }
+        let info = &self.team.services[service as usize];
+        let index = self.machine.services.len();
+        self.service_machines.insert(service, index);
+        self.machine.services.push(ServiceMachine {
+            plan: self.team.plans[info.plan as usize].name.to_string(),
+            name: info.name.to_string(),
+            line: self.line(info.name_span),
+            states: Vec::new(),
+            marks: 0,
+        });
+        let mut states = Vec::new();
+        let mut marks = 0;
+        if let Some(syntax) = self.input.analysis.service_syntax(info) {
+            self.block(&syntax.body, &mut states, &mut marks, 0);
+            let (period_ms, condition, forever, span) = match &syntax.repeat {
+                Some(r) => (
+                    r.period.as_ref().and_then(period_ms),
+                    r.condition.as_ref().map(|c| self.condition(c)),
+                    r.period.is_none() && r.condition.is_none(),
+                    r.span,
+                ),
+                None => (None, None, false, syntax.body.span),
+            };
+            let line = self.line(span);
+            let text = if syntax.repeat.is_some() {
+                self.excerpt(span)
+            } else {
+                "end of the service".into()
+            };
+            states.push(State {
+                kind: StateKind::Repeat {
+                    period_ms,
+                    condition,
+                    forever,
+                },
+                line,
+                text,
+            });
+        }
+        let m = &mut self.machine.services[index];
+        m.states = states;
+        m.marks = marks;
+        index
+    }
+
+    fn block(
+        &mut self,
+        block: &ast::Block,
+        states: &mut Vec<State>,
+        marks: &mut usize,
+        depth: usize,
+    ) {
+        for stmt in &block.stmts {
+            self.stmt(stmt, states, marks, depth);
+        }
+    }
+
+    fn push(&self, states: &mut Vec<State>, kind: StateKind, span: Span) -> usize {
+        states.push(State {
+            kind,
+            line: self.line(span),
+            text: self.excerpt(span),
+        });
+        states.len() - 1
+    }
+
+    fn stmt(&mut self, stmt: &ast::Stmt, states: &mut Vec<State>, marks: &mut usize, depth: usize) {
+        match &stmt.kind {
+            StmtKind::If(i) => {
+                let condition = self.condition(&i.condition);
+                let branch = self.push(
+                    states,
+                    StateKind::Branch {
+                        condition,
+                        else_to: usize::MAX,
+                    },
+                    stmt.span,
+                );
+                self.block(&i.then_block, states, marks, depth);
+                match &i.else_branch {
+                    None => patch(states, branch),
+                    Some(else_branch) => {
+                        let jump = self.push(states, StateKind::Jump { to: usize::MAX }, stmt.span);
+                        states[jump].text = "end of the `if` branch".into();
+                        patch(states, branch);
+                        match else_branch.as_ref() {
+                            ast::Else::If(s) => self.stmt(s, states, marks, depth),
+                            ast::Else::Block(b) => self.block(b, states, marks, depth),
+                        }
+                        patch(states, jump);
+                    }
+                }
+            }
+            StmtKind::Loop(l) => {
+                let mark = next_mark(marks);
+                let condition = l.condition.as_ref().map(|c| self.condition(c));
+                let head = self.push(
+                    states,
+                    StateKind::LoopHead {
+                        condition,
+                        exit_to: usize::MAX,
+                        mark,
+                    },
+                    stmt.span,
+                );
+                self.block(&l.body, states, marks, depth);
+                let tail = self.push(
+                    states,
+                    StateKind::LoopTail {
+                        period_ms: l.period.as_ref().and_then(period_ms),
+                        mark,
+                        to: head,
+                    },
+                    stmt.span,
+                );
+                states[tail].text = "end of the loop body".into();
+                patch(states, head);
+            }
+            StmtKind::Group(g) => {
+                // Group membership is static for a robot: its type and
+                // capabilities decide which arm it joins (the others are
+                // dropped from its program).
+                match self.chosen_arm(g) {
+                    Some(body) => self.block(body, states, marks, depth),
+                    None => {}
+                }
+            }
+            StmtKind::Comm(c) => self.comm(c, stmt.span, states, marks),
+            StmtKind::Throw(event) => {
+                self.push(
+                    states,
+                    StateKind::Throw {
+                        event: event.name.to_string(),
+                    },
+                    stmt.span,
+                );
+            }
+            StmtKind::Call(call) => self.call(call, stmt.span, states, marks, depth),
+            StmtKind::Error => {}
+        }
+    }
+
+    /// The arm of a group statement this robot runs: the first whose
+    /// condition it meets (for `leader`, only the team's first robot meeting
+    /// it), else `others`.
+    fn chosen_arm<'s>(&self, group: &'s ast::GroupStmt) -> Option<&'s ast::Block> {
+        for arm in &group.arms {
+            let meets = |r: &crate::sema::Robot| {
+                let Some(ty) = r.robot_type.map(|id| self.input.catalog.get(id)) else {
+                    return false;
+                };
+                arm.condition
+                    .names
+                    .iter()
+                    .any(|n| match arm.condition.kind {
+                        CondKind::InstanceOf => {
+                            ty.name == n.name.as_str() || ty.aliases.iter().any(|a| a == n.as_str())
+                        }
+                        CondKind::CapableOf => ty.has_capability(&n.name),
+                    })
+            };
+            let me = &self.team.robots[self.robot_index];
+            if !meets(me) {
+                continue;
+            }
+            if arm.kind == ast::ArmKind::Leader {
+                // Static election: the first robot of the team that meets the
+                // condition leads; the others fall through to `others`.
+                let first = self.team.robots.iter().position(meets);
+                if first != Some(self.robot_index) {
+                    return group.others.as_ref().map(|o| &o.body);
+                }
+            }
+            return Some(&arm.body);
+        }
+        group.others.as_ref().map(|o| &o.body)
+    }
+
+    fn comm(&mut self, comm: &ast::Comm, span: Span, states: &mut Vec<State>, marks: &mut usize) {
+        let peer = if crate::sema::is_user(&comm.team.name) {
+            "USER".to_string()
+        } else {
+            comm.team.name.to_string()
+        };
+        match comm.kind {
+            ast::CommKind::Send | ast::CommKind::Publish => {
+                let publish = comm.kind == ast::CommKind::Publish;
+                let mut items = Vec::new();
+                for item in &comm.items {
+                    let key = self.attr_key(&item.attr);
+                    let message = self.outgoing(&peer, publish, &key);
+                    // The value sent: the assigned expression's value (kept in
+                    // the team's shared slot), else the attribute's own value.
+                    let (value, store) = match &item.value {
+                        Some(v) => (self.condition_operand(v), Some(self.shared_slot(&key))),
+                        None => (self.attr_operand(&item.attr), None),
+                    };
+                    items.push(SendItem {
+                        message,
+                        value,
+                        store,
+                    });
+                }
+                self.push(states, StateKind::Send { items }, span);
+            }
+            ast::CommKind::Receive => {
+                let mut messages = Vec::new();
+                for item in &comm.items {
+                    let key = self.attr_key(&item.attr);
+                    messages.push(self.incoming(&peer, &key));
+                }
+                let timeout_ms = comm.timeout.as_ref().and_then(period_ms);
+                let mark = next_mark(marks);
+                self.push(
+                    states,
+                    StateKind::Receive {
+                        messages,
+                        timeout_ms,
+                        mark,
+                    },
+                    span,
+                );
+            }
+            ast::CommKind::Subscribe => {
+                for item in &comm.items {
+                    let key = self.attr_key(&item.attr);
+                    let slot = self.shared_slot(&key);
+                    let group = match self.machine.subscribed.iter().position(|g| *g == key) {
+                        Some(g) => g,
+                        None => {
+                            self.machine.subscribed.push(key.clone());
+                            self.machine.subscribed.len() - 1
+                        }
+                    };
+                    self.push(states, StateKind::Subscribe { group, slot }, span);
+                }
+            }
+        }
+    }
+
+    fn call(
+        &mut self,
+        call: &ast::Call,
+        span: Span,
+        states: &mut Vec<State>,
+        marks: &mut usize,
+        depth: usize,
+    ) {
+        let symbols = crate::ide::lookup::with_span(&self.input.analysis.mission, call.name.span);
+        let timeout_ms = call.timeout.as_ref().and_then(period_ms);
+        let args: Vec<Operand> = call.args.iter().map(|a| self.arg(a)).collect();
+        if let Some(function) = symbols.iter().find_map(|o| match o.symbol {
+            Symbol::Function(f) => Some(f),
+            _ => None,
+        }) {
+            if depth >= MAX_INLINE_DEPTH {
+                self.unsupported(call.name.span, "function calls nested this deep");
+                return;
+            }
+            let info = &self.input.analysis.mission.functions[function.0 as usize];
+            if let Some(ast::Item::Function(f)) = self.input.analysis.syntax.items.get(info.item) {
+                self.block(&f.body, states, marks, depth + 1);
+            }
+            return;
+        }
+        let name = call.name.name.to_string();
+        let Some(def) = self.robot_type.service(&name) else {
+            return; // not a service of this robot: a check error
+        };
+        let service = def.name.clone();
+        let mark = next_mark(marks);
+        if let Some(machine) = self.strategy_machine(call.name.span, &service) {
+            self.push(
+                states,
+                StateKind::RunActions {
+                    service,
+                    machine,
+                    args,
+                    timeout_ms,
+                    mark,
+                },
+                span,
+            );
+            return;
+        }
+        let task = implementing_task(&def.implementation, &service);
+        self.services
+            .entry(task.clone())
+            .or_default()
+            .insert(service.clone());
+        self.request_task(&task);
+        self.push(
+            states,
+            StateKind::Call {
+                service,
+                task,
+                args,
+                timeout_ms,
+                mark,
+            },
+            span,
+        );
+    }
+
+    fn request_task(&mut self, task: &str) {
+        if !self.machine.request_tasks.iter().any(|t| t == task) {
+            self.machine.request_tasks.push(task.to_string());
+        }
+    }
+
+    fn arg(&mut self, arg: &ast::Arg) -> Operand {
+        match arg {
+            ast::Arg::Words { text, .. } => Operand::Literal(text.clone()),
+            ast::Arg::Expr(e) => self.condition_operand(e),
+        }
+    }
+
+    /// The strategy entry refining the call at `span` for this robot's type.
+    fn strategy_machine(&mut self, span: Span, service: &str) -> Option<usize> {
+        let link = self
+            .input
+            .links
+            .at(self.input.file, span.start)
+            .find(|l| l.team == self.team_id && l.call == span)?;
+        let strategy = self
+            .input
+            .strategies
+            .iter()
+            .find(|s| s.file == link.entry.file)?;
+        let entry = strategy.services.get(link.entry.index)?;
+        let robot = &self.team.robots[self.robot_index];
+        let targeted = entry.targets.is_empty()
+            || entry.targets.iter().any(|t| {
+                t.name.as_ref().is_some_and(|n| {
+                    n.name == self.robot_type.name || self.robot_type.aliases.contains(&n.name)
+                }) || t.nick_name.as_ref().is_some_and(|n| n.name == robot.name)
+            });
+        if !targeted {
+            return None;
+        }
+        let key = (link.entry.file.0, link.entry.index);
+        if let Some(&m) = self.action_machines.get(&key) {
+            return Some(m);
+        }
+        let source = self
+            .input
+            .strategy_names
+            .iter()
+            .find(|(f, _)| *f == strategy.file)
+            .map(|(_, n)| n.clone())
+            .unwrap_or_default();
+        let machine = self.action_machine(entry, service, source, strategy);
+        self.machine.actions.push(machine);
+        let index = self.machine.actions.len() - 1;
+        self.action_machines.insert(key, index);
+        Some(index)
+    }
+
+    fn action_machine(
+        &mut self,
+        entry: &ServiceEntry,
+        service: &str,
+        source: String,
+        strategy: &crate::strategy::Strategy,
+    ) -> ActionMachine {
+        // Parameter names the conditions read, to their operands.
+        let mut names: HashMap<String, Operand> = HashMap::new();
+        let mut arguments = Vec::new();
+        for action in &entry.actions {
+            for task_use in &action.tasks {
+                for p in &task_use.parameters {
+                    let Some(name) = &p.name else { continue };
+                    match task_use.kind {
+                        TaskUseKind::CheckSensor => {
+                            let task = p
+                                .src_task
+                                .as_ref()
+                                .map(|t| t.name.clone())
+                                .unwrap_or_else(|| name.name.to_lowercase());
+                            let value = self
+                                .value_of_task(&task, strategy)
+                                .unwrap_or_else(|| name.name.clone());
+                            let slot = self.sensor_slot_with_task(&value, &task);
+                            names.insert(name.name.clone(), Operand::Slot(slot));
+                        }
+                        TaskUseKind::ExecuteActuator | TaskUseKind::ExecuteAlgorithm => {}
+                    }
+                }
+            }
+            for p in &action.parameters {
+                let Some(name) = &p.name else { continue };
+                if p.data == Some(DataCharacteristic::Variable) && p.value.is_none() {
+                    let slot = self.slot(&format!("{service}.{}", name.name), SlotSource::Local);
+                    if !arguments.contains(&slot) {
+                        arguments.push(slot);
+                    }
+                    names.insert(name.name.clone(), Operand::Slot(slot));
+                } else if let Some(v) = &p.value {
+                    names.insert(name.name.clone(), Operand::Literal(v.name.clone()));
+                }
+            }
+        }
+        let index_of: HashMap<u64, usize> = entry
+            .actions
+            .iter()
+            .enumerate()
+            .filter_map(|(i, a)| a.id.as_ref().map(|id| (id.value, i)))
+            .collect();
+        let mut actions = Vec::new();
+        for action in &entry.actions {
+            let mut commands = Vec::new();
+            for task_use in &action.tasks {
+                if task_use.kind == TaskUseKind::CheckSensor {
+                    continue;
+                }
+                let actuator = task_use
+                    .name
+                    .as_ref()
+                    .map(|n| n.name.clone())
+                    .unwrap_or_default();
+                for p in &task_use.parameters {
+                    let task = p
+                        .dst_task
+                        .as_ref()
+                        .map(|t| t.name.clone())
+                        .unwrap_or_else(|| actuator.to_lowercase());
+                    let command = p.value.as_ref().map(|v| v.name.clone()).unwrap_or_default();
+                    self.services
+                        .entry(task.clone())
+                        .or_default()
+                        .insert(actuator.clone());
+                    self.request_task(&task);
+                    commands.push((task, command));
+                }
+            }
+            let transitions = action
+                .transitions
+                .iter()
+                .filter_map(|t| {
+                    let to = *index_of.get(&t.dst.as_ref()?.value)?;
+                    let condition = t
+                        .condition
+                        .as_ref()
+                        .and_then(|c| c.expr.as_ref())
+                        .map(|e| self.strategy_condition(e, &names));
+                    Some((condition, to))
+                })
+                .collect();
+            actions.push(ActionState {
+                name: action
+                    .name
+                    .as_ref()
+                    .map(|n| n.name.clone())
+                    .unwrap_or_default(),
+                id: action.id.as_ref().map_or(0, |i| i.value),
+                is_final: action.is_final.is_yes(),
+                commands,
+                transitions,
+            });
+        }
+        let initial = entry
+            .actions
+            .iter()
+            .position(|a| a.initial.is_yes())
+            .unwrap_or(0);
+        ActionMachine {
+            service: service.to_string(),
+            source,
+            actions,
+            initial,
+            arguments,
+        }
+    }
+
+    /// The mission value a strategy task provides (`vicon` → `LOCATION`).
+    fn value_of_task(&self, task: &str, strategy: &crate::strategy::Strategy) -> Option<String> {
+        for value in &strategy.values {
+            let provides = value
+                .tasks
+                .iter()
+                .flat_map(|t| &t.parameters)
+                .any(|p| p.src_task.as_ref().is_some_and(|t| t.name == task));
+            if provides {
+                return value.name.as_ref().map(|n| n.name.clone());
+            }
+        }
+        self.robot_type
+            .values
+            .iter()
+            .find(|v| v.implementation == Implementation::Task(task.to_string()))
+            .map(|v| v.name.clone())
+    }
+
+    fn strategy_condition(&mut self, expr: &ast::Expr, names: &HashMap<String, Operand>) -> Expr {
+        let mut resolve = |attr: &ast::Attr| {
+            names
+                .get(attr.last().as_str())
+                .cloned()
+                .unwrap_or_else(|| Operand::Literal(attr.dotted()))
+        };
+        convert(expr, &mut resolve)
+    }
+
+    fn condition(&mut self, expr: &ast::Expr) -> Expr {
+        let mut operands = Vec::new();
+        collect_attrs(expr, &mut operands);
+        let resolved: HashMap<Span, Operand> = operands
+            .into_iter()
+            .map(|attr| (attr.span, self.attr_operand(attr)))
+            .collect();
+        convert(expr, &mut |attr| {
+            resolved
+                .get(&attr.span)
+                .cloned()
+                .unwrap_or_else(|| Operand::Literal(attr.dotted()))
+        })
+    }
+
+    /// An expression used as a value (a call argument, an assignment).
+    fn condition_operand(&mut self, expr: &ast::Expr) -> Operand {
+        match &expr.kind {
+            ExprKind::Attr(a) => self.attr_operand(a),
+            other => Operand::Literal(literal_text(other)),
+        }
+    }
+
+    /// What an attribute in an expression reads: a sensor, a shared value or
+    /// a constant.
+    fn attr_operand(&mut self, attr: &ast::Attr) -> Operand {
+        let symbols = crate::ide::lookup::with_span(&self.input.analysis.mission, attr.last().span);
+        let symbol = symbols.first().map(|o| o.symbol.clone());
+        match symbol {
+            Some(Symbol::Value {
+                owner: Some(owner),
+                name,
+            }) if owner == self.team_id => Operand::Slot(self.sensor_slot(&name)),
+            Some(Symbol::Value { .. }) | Some(Symbol::TeamVariable { .. }) => {
+                let key = self.attr_key(attr);
+                Operand::Slot(self.shared_slot(&key))
+            }
+            Some(Symbol::Constant(name)) => Operand::Literal(name.to_string()),
+            _ => Operand::Literal(attr.dotted()),
+        }
+    }
+
+    /// `Team.NAME` for an attribute as communication keys write it.
+    fn attr_key(&self, attr: &ast::Attr) -> String {
+        let name = attr.last().name.to_string();
+        let name = self.canonical_value_name(attr, &name);
+        match attr.segments.as_slice() {
+            [_] => format!("{}.{name}", self.team.name),
+            [team, _] if crate::sema::is_user(&team.name) => format!("USER.{name}"),
+            [team, ..] => format!("{}.{name}", team.name),
+            [] => name,
+        }
+    }
+
+    /// A value's catalog name for an alias (`USER.cmd` → `RC_CMD`).
+    fn canonical_value_name(&self, attr: &ast::Attr, name: &str) -> String {
+        let symbols = crate::ide::lookup::with_span(&self.input.analysis.mission, attr.last().span);
+        symbols
+            .iter()
+            .find_map(|o| match &o.symbol {
+                Symbol::Value { name, .. } => Some(name.to_string()),
+                _ => None,
+            })
+            .unwrap_or_else(|| name.to_string())
+    }
+
+    fn slot(&mut self, key: &str, source: SlotSource) -> usize {
+        let sensor = matches!(source, SlotSource::Sensor { .. });
+        if let Some(&i) = self.slot_index.get(&(key.to_string(), sensor)) {
+            return i;
+        }
+        self.machine.slots.push(Slot {
+            key: key.to_string(),
+            source,
+        });
+        let i = self.machine.slots.len() - 1;
+        self.slot_index.insert((key.to_string(), sensor), i);
+        i
+    }
+
+    fn shared_slot(&mut self, key: &str) -> usize {
+        self.slot(key, SlotSource::Shared)
+    }
+
+    /// The robot's own value `name`, read from the task that implements it
+    /// (the strategy's `ValueInfo` first, else the catalog).
+    fn sensor_slot(&mut self, name: &str) -> usize {
+        let task = self.value_task(name);
+        self.sensor_slot_with_task(name, &task)
+    }
+
+    fn sensor_slot_with_task(&mut self, value: &str, task: &str) -> usize {
+        let key = format!("{}.{value}", self.team.name);
+        if let Some(&i) = self.slot_index.get(&(key.clone(), true)) {
+            return i;
+        }
+        self.sensors
+            .entry(task.to_string())
+            .or_default()
+            .insert(value.to_string());
+        self.slot(
+            &key,
+            SlotSource::Sensor {
+                task: task.to_string(),
+                port: value.to_string(),
+            },
+        )
+    }
+
+    fn value_task(&self, name: &str) -> String {
+        for strategy in self.input.strategies {
+            if strategy
+                .team
+                .as_ref()
+                .is_none_or(|t| t.name != self.team.name)
+            {
+                continue;
+            }
+            for value in &strategy.values {
+                if value.name.as_ref().is_none_or(|n| n.name != name) {
+                    continue;
+                }
+                let task = value
+                    .tasks
+                    .iter()
+                    .flat_map(|t| &t.parameters)
+                    .find_map(|p| p.src_task.as_ref());
+                if let Some(task) = task {
+                    return task.name.clone();
+                }
+            }
+        }
+        match self.robot_type.value(name).map(|v| &v.implementation) {
+            Some(implementation) => implementing_task(implementation, &name.to_lowercase()),
+            None => name.to_lowercase(),
+        }
+    }
+
+    fn outgoing(&mut self, to_team: &str, publish: bool, key: &str) -> usize {
+        if let Some(i) = self
+            .machine
+            .outgoing
+            .iter()
+            .position(|m| m.to_team == to_team && m.publish == publish && m.key == key)
+        {
+            return i;
+        }
+        let port = format!(
+            "{}_{}_{}",
+            if publish { "pub" } else { "to" },
+            to_team,
+            key.replace('.', "_")
+        );
+        self.machine.outgoing.push(OutgoingMessage {
+            to_team: to_team.to_string(),
+            publish,
+            key: key.to_string(),
+            port,
+        });
+        self.machine.outgoing.len() - 1
+    }
+
+    fn incoming(&mut self, from_team: &str, key: &str) -> usize {
+        if let Some(i) = self
+            .machine
+            .incoming
+            .iter()
+            .position(|m| m.from_team == from_team && m.key == key)
+        {
+            return i;
+        }
+        let slot = self.shared_slot(key);
+        let port = format!("from_{}_{}", from_team, key.replace('.', "_"));
+        self.machine.incoming.push(IncomingMessage {
+            from_team: from_team.to_string(),
+            key: key.to_string(),
+            slot,
+            port,
+        });
+        self.machine.incoming.len() - 1
+    }
+}
+
+/// The task implementing a service or value: the catalog's task, a task
+/// named after a task-graph file, or one named after the service.
+pub(super) fn implementing_task(implementation: &Implementation, fallback: &str) -> String {
+    match implementation {
+        Implementation::Task(t) => t.clone(),
+        Implementation::Graph(g) => {
+            let file = g.rsplit(['/', '\\']).next().unwrap_or(g);
+            file.split('.').next().unwrap_or(file).to_string()
+        }
+        Implementation::Unspecified => fallback.to_string(),
+    }
+}
+
+fn next_mark(marks: &mut usize) -> usize {
+    *marks += 1;
+    *marks - 1
+}
+
+fn patch(states: &mut Vec<State>, at: usize) {
+    let target = states.len();
+    match &mut states[at].kind {
+        StateKind::Branch { else_to, .. } => *else_to = target,
+        StateKind::Jump { to } => *to = target,
+        StateKind::LoopHead { exit_to, .. } => *exit_to = target,
+        _ => {}
+    }
+}
+
+fn period_ms(period: &ast::Period) -> Option<i64> {
+    period.millis().map(|m| m.round() as i64)
+}
+
+fn collect_attrs<'e>(expr: &'e ast::Expr, out: &mut Vec<&'e ast::Attr>) {
+    match &expr.kind {
+        ExprKind::Or(a, b) | ExprKind::And(a, b) | ExprKind::Compare(a, _, b) => {
+            collect_attrs(a, out);
+            collect_attrs(b, out);
+        }
+        ExprKind::Not(a) => collect_attrs(a, out),
+        ExprKind::Attr(a) => out.push(a),
+        _ => {}
+    }
+}
+
+fn literal_text(kind: &ExprKind) -> String {
+    match kind {
+        ExprKind::Str(s) | ExprKind::Number(s) => s.clone(),
+        ExprKind::Bool(b) => b.to_string(),
+        ExprKind::Period(p) => p.millis().map_or_else(String::new, |m| format!("{m}")),
+        ExprKind::Attr(a) => a.dotted(),
+        _ => String::new(),
+    }
+}
+
+/// Converts a mission expression, resolving attributes with `resolve`.
+fn convert(expr: &ast::Expr, resolve: &mut dyn FnMut(&ast::Attr) -> Operand) -> Expr {
+    let operand = |e: &ast::Expr, resolve: &mut dyn FnMut(&ast::Attr) -> Operand| match &e.kind {
+        ExprKind::Attr(a) => resolve(a),
+        other => Operand::Literal(literal_text(other)),
+    };
+    match &expr.kind {
+        ExprKind::Or(a, b) => {
+            Expr::Or(Box::new(convert(a, resolve)), Box::new(convert(b, resolve)))
+        }
+        ExprKind::And(a, b) => {
+            Expr::And(Box::new(convert(a, resolve)), Box::new(convert(b, resolve)))
+        }
+        ExprKind::Not(a) => Expr::Not(Box::new(convert(a, resolve))),
+        ExprKind::Compare(a, op, b) => {
+            let is_boolean = |e: &ast::Expr| {
+                matches!(
+                    e.kind,
+                    ExprKind::Or(..)
+                        | ExprKind::And(..)
+                        | ExprKind::Not(..)
+                        | ExprKind::Compare(..)
+                )
+            };
+            if is_boolean(a) || is_boolean(b) {
+                // `(x < 3) == true`: compare truth values.
+                let l = convert(a, resolve);
+                let r = convert(b, resolve);
+                let same = Expr::Or(
+                    Box::new(Expr::And(Box::new(l.clone()), Box::new(r.clone()))),
+                    Box::new(Expr::And(
+                        Box::new(Expr::Not(Box::new(l))),
+                        Box::new(Expr::Not(Box::new(r))),
+                    )),
+                );
+                return match op {
+                    ast::CmpOp::Eq => same,
+                    _ => Expr::Not(Box::new(same)),
+                };
+            }
+            Expr::Compare(operand(a, resolve), *op, operand(b, resolve))
+        }
+        ExprKind::Bool(b) => Expr::Bool(*b),
+        ExprKind::Attr(a) => Expr::Truthy(resolve(a)),
+        ExprKind::Str(_) | ExprKind::Number(_) | ExprKind::Period(_) => {
+            Expr::Truthy(operand(expr, resolve))
+        }
+        ExprKind::Error => Expr::Bool(false),
+    }
+}

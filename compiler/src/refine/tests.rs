@@ -1,0 +1,221 @@
+//! Refinement as a specification: which robot runs what, which tasks its
+//! graph gets, and which services become strategy action machines.
+
+use super::*;
+use crate::catalog::builtin_catalog;
+use crate::diag::FileId;
+use crate::strategy::{StrategyLinks, cross_check, load_strategy};
+
+fn shared(path: &str) -> String {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/examples")
+        .join(path);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The programs of a mission (with the given strategy files), asserting that
+/// refinement reports nothing.
+fn programs(text: &str, strategies: &[&str]) -> Vec<RobotProgram> {
+    let catalog = builtin_catalog();
+    let analysis = crate::check_source(FileId(0), text, &catalog);
+    assert!(!analysis.has_errors(), "{:#?}", analysis.diagnostics);
+    let strategies: Vec<_> = strategies
+        .iter()
+        .enumerate()
+        .filter_map(|(i, s)| load_strategy(FileId(1 + i as u32), s).0)
+        .collect();
+    let (links, _) = if strategies.is_empty() {
+        (StrategyLinks::default(), Vec::new())
+    } else {
+        cross_check(
+            &strategies.iter().collect::<Vec<_>>(),
+            &[&analysis],
+            &catalog,
+        )
+    };
+    let names: Vec<_> = strategies
+        .iter()
+        .map(|s| (s.file, "strategy.xml".to_string()))
+        .collect();
+    let input = RefineInput {
+        mission_name: "test.mission",
+        file: FileId(0),
+        text,
+        analysis: &analysis,
+        catalog: &catalog,
+        strategies: &strategies,
+        strategy_names: &names,
+        links: &links,
+    };
+    let (programs, diagnostics) = refine(&input);
+    assert!(diagnostics.is_empty(), "{diagnostics:#?}");
+    programs
+}
+
+fn program<'p>(programs: &'p [RobotProgram], robot: &str) -> &'p RobotProgram {
+    programs.iter().find(|p| p.robot == robot).unwrap()
+}
+
+/// The built-in calls a robot's services make, in order.
+fn calls(program: &RobotProgram) -> Vec<String> {
+    program
+        .control
+        .services
+        .iter()
+        .flat_map(|s| &s.states)
+        .filter_map(|s| match &s.kind {
+            StateKind::Call { service, .. } => Some(service.clone()),
+            StateKind::RunActions { service, .. } => Some(format!("{service} (strategy)")),
+            _ => None,
+        })
+        .collect()
+}
+
+fn task_names(program: &RobotProgram) -> Vec<&str> {
+    program
+        .graph
+        .tasks
+        .iter()
+        .map(|t| t.name.name.as_str())
+        .collect()
+}
+
+#[test]
+fn every_robot_gets_a_program_with_its_peers() {
+    let programs = programs(&shared("scouting/scouting.mission"), &[]);
+    let robots: Vec<_> = programs
+        .iter()
+        .map(|p| (p.team.as_str(), p.robot.as_str()))
+        .collect();
+    assert_eq!(
+        robots,
+        [
+            ("MasterTeam", "irobot"),
+            ("SlaveTeam", "ti"),
+            ("SlaveTeam", "nxt")
+        ]
+    );
+    assert_eq!(programs[2].self_peer, 2);
+    assert_eq!(programs[0].peers.len(), 3);
+}
+
+#[test]
+fn the_strategy_refines_the_masters_move_only() {
+    let programs = programs(
+        &shared("scouting/scouting.mission"),
+        &[&shared("scouting/MasterTeam.strategy.xml")],
+    );
+    let master = program(&programs, "irobot");
+    // Services in the order the modes set them (RC_MODE first).
+    assert_eq!(
+        calls(master),
+        ["process", "move (strategy)", "standby", "move (strategy)"]
+    );
+    let actions = &master.control.actions[0];
+    let names: Vec<_> = actions.actions.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(
+        names,
+        [
+            "CheckGoal",
+            "CheckObstacle",
+            "MoveToGoal",
+            "AvoidObstacle",
+            "Finish"
+        ]
+    );
+    assert_eq!(
+        actions.actions[2].commands,
+        [("wheel".to_string(), "Forward".to_string())]
+    );
+    // The slaves have no strategy: their move calls the implementing task.
+    assert_eq!(
+        calls(program(&programs, "ti")),
+        ["move", "search", "process", "move"]
+    );
+}
+
+#[test]
+fn the_task_graph_has_sensor_service_and_communication_tasks() {
+    let programs = programs(&shared("scouting/scouting.mission"), &[]);
+    assert_eq!(
+        task_names(program(&programs, "ti")),
+        [
+            "ControlTask",
+            "color",
+            "odometry",
+            "remote_control",
+            "search",
+            "wheel",
+            "CommSend",
+            "CommReceive"
+        ]
+    );
+    let ti = program(&programs, "ti");
+    let lib = ti.library.as_ref().unwrap();
+    assert_eq!(lib.name, "SlaveTeamShared");
+    assert!(
+        lib.attributes.contains(&"USER.RC_CMD".to_string()),
+        "{lib:?}"
+    );
+    // One capacity per channel, at least what refinement declared.
+    assert_eq!(ti.capacities.len(), ti.graph.channels.len());
+    assert!(ti.capacities.iter().all(|&c| c >= 2));
+}
+
+#[test]
+fn group_arms_a_robot_can_never_join_are_dropped() {
+    let programs = programs(&shared("swarm/patrol_groups.mission"), &[]);
+    // Turtlebots watch the light (group arm); Ev3 robots patrol (others).
+    let tb = calls(program(&programs, "tb_1"));
+    let ev = calls(program(&programs, "ev_0"));
+    assert!(!tb.contains(&"move".to_string()), "{tb:?}");
+    assert!(ev.iter().filter(|c| *c == "move").count() >= 2, "{ev:?}");
+    assert!(!ev.contains(&"light_on".to_string()), "{ev:?}");
+    // `leader(instance of Turtlebot3_Burger)`: the first turtlebot leads.
+    assert!(calls(program(&programs, "tb_0")).contains(&"light_on".to_string()));
+    assert!(!calls(program(&programs, "tb_1")).contains(&"light_on".to_string()));
+}
+
+#[test]
+fn functions_are_inlined_into_the_services_that_call_them() {
+    let text = "{ T: iRobotCreate r }\ndef patrol { move(\"1,1\")\n stop() }\nT.A.S{ patrol()\n patrol() }\nT.M{ set(A, S) }\nT.main{ default: mode = M }\n";
+    let programs = programs(text, &[]);
+    assert_eq!(calls(&programs[0]), ["move", "stop", "move", "stop"]);
+}
+
+#[test]
+fn control_structures_become_states_with_jumps() {
+    let text = "{ T: iRobotCreate r }\nT.A.S{\n loop(1 SEC, DISTANCE > 10) { go_forward() }\n if (DISTANCE < 5) throw near else stop()\n} repeat(2 SEC)\nT.M{ set(A, S) }\nT.N{ set(A, OFF) }\nT.main{ case (M): catch (near): mode = N\n default: mode = M }\n";
+    let programs = programs(text, &[]);
+    let states: Vec<String> = programs[0].control.services[0]
+        .states
+        .iter()
+        .map(|s| match &s.kind {
+            StateKind::LoopHead { exit_to, .. } => format!("loop-head exit {exit_to}"),
+            StateKind::LoopTail { to, period_ms, .. } => format!("loop-tail {period_ms:?} to {to}"),
+            StateKind::Call { service, .. } => service.clone(),
+            StateKind::Branch { else_to, .. } => format!("branch else {else_to}"),
+            StateKind::Jump { to } => format!("jump {to}"),
+            StateKind::Throw { event } => format!("throw {event}"),
+            StateKind::Repeat { period_ms, .. } => format!("repeat {period_ms:?}"),
+            other => format!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(
+        states,
+        [
+            "loop-head exit 3",
+            "go_forward",
+            "loop-tail Some(1000) to 0",
+            "branch else 6",
+            "throw near",
+            "jump 7",
+            "stop",
+            "repeat Some(2000)",
+        ]
+    );
+    let machine = &programs[0].control;
+    assert_eq!(machine.modes.len(), 2);
+    assert!(machine.modes[1].regions.is_empty(), "N sets every plan OFF");
+    assert_eq!(machine.transitions[0].event, "near");
+}

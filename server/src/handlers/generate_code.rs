@@ -1,0 +1,195 @@
+//! `workspace/executeCommand` `semo.generateCode`, and the code lens that runs
+//! it on each team: the same library call as `semo build` (check, refine,
+//! generate, write each robot's folder atomically), over the server's view of
+//! the workspace (open documents as typed, other files from disk), with
+//! `$/progress` per robot.
+//!
+//! Arguments: one object `{ "uri": mission, "outputFolder"?: path (relative
+//! to the mission's folder; default `out` beside it), "target"?: "linux" |
+//! "linux-sim", "team"?: only this team's robots }`, or just the URI.
+
+use crate::encoding::LineMap;
+use crate::world::{Snapshot, World};
+use semo::codegen::{self, BuildResult, Emit, Target, output};
+use semo::diag::{Diagnostic, FileId};
+use semo::text::LineIndex;
+use semo::workspace::{FileKind, Files};
+use serde::Deserialize;
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use tower_lsp_server::ls_types::*;
+
+pub const COMMAND: &str = "semo.generateCode";
+
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct GenerateParams {
+    pub uri: Uri,
+    pub output_folder: Option<String>,
+    pub target: Option<String>,
+    pub team: Option<String>,
+}
+
+/// Reads the command's arguments.
+pub fn params(arguments: &[Value]) -> Result<GenerateParams, String> {
+    let first = arguments
+        .first()
+        .ok_or("semo.generateCode needs the mission's URI")?;
+    let params = match first {
+        Value::String(uri) => GenerateParams {
+            uri: uri.parse().map_err(|_| format!("`{uri}` is not a URI"))?,
+            output_folder: None,
+            target: None,
+            team: None,
+        },
+        other => serde_json::from_value(other.clone()).map_err(|e| e.to_string())?,
+    };
+    Ok(params)
+}
+
+/// What one generation works on, taken from the world at once.
+pub struct Job {
+    pub mission_uri: Uri,
+    pub mission_path: PathBuf,
+    pub files: Files,
+    pub mission: FileId,
+    pub out: PathBuf,
+    pub target: Target,
+    pub team: Option<String>,
+}
+
+/// Gathers the mission and every catalog and strategy file the server knows.
+pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
+    let target = match params.target.as_deref() {
+        None => Target::Linux,
+        Some(name) => Target::from_name(name).ok_or_else(|| format!("unknown target `{name}`"))?,
+    };
+    let mission = world
+        .snapshot(&params.uri)
+        .filter(|s| s.kind == FileKind::Mission)
+        .ok_or_else(|| format!("{} is not a mission the server knows", params.uri.as_str()))?;
+    let mission_path =
+        path_of(&mission).ok_or("code can only be generated for a mission saved as a file")?;
+    let mut files = Files::default();
+    let id = files.add(
+        mission_path.clone(),
+        FileKind::Mission,
+        mission.text.to_string(),
+    );
+    let others: Vec<Arc<Snapshot>> = world
+        .snapshots()
+        .filter(|s| matches!(s.kind, FileKind::Catalog | FileKind::Strategy))
+        .cloned()
+        .collect();
+    for s in others {
+        if let Some(path) = path_of(&s) {
+            files.add(path, s.kind, s.text.to_string());
+        }
+    }
+    let folder = mission_path
+        .parent()
+        .unwrap_or(Path::new("."))
+        .to_path_buf();
+    let out = match params.output_folder {
+        Some(f) if Path::new(&f).is_absolute() => PathBuf::from(f),
+        Some(f) => folder.join(f),
+        None => folder.join("out"),
+    };
+    Ok(Job {
+        mission_uri: params.uri,
+        mission_path,
+        files,
+        mission: id,
+        out,
+        target,
+        team: params.team,
+    })
+}
+
+fn path_of(snapshot: &Snapshot) -> Option<PathBuf> {
+    snapshot.uri.to_file_path().map(|p| p.into_owned())
+}
+
+/// Checks, refines and generates (no writing yet); the mission's text too,
+/// for positions.
+pub fn generate(job: &Job) -> (BuildResult, String) {
+    let text = job.files.get(job.mission).text.clone();
+    let run = semo::workspace::check_files(job.files.clone());
+    let mut result = codegen::build(&run, job.mission, job.target, Emit::All);
+    if let Some(team) = &job.team {
+        result.robots.retain(|r| &r.team == team);
+    }
+    (result, text)
+}
+
+/// The refusal's diagnostics in the mission, for publishing.
+pub fn mission_diagnostics(
+    job: &Job,
+    text: &str,
+    diagnostics: &[Diagnostic],
+    encoding: crate::encoding::Encoding,
+) -> Vec<tower_lsp_server::ls_types::Diagnostic> {
+    let index = LineIndex::new(text);
+    let map = LineMap {
+        text,
+        index: &index,
+        encoding,
+    };
+    diagnostics
+        .iter()
+        .filter(|d| d.file == job.mission)
+        .map(|d| tower_lsp_server::ls_types::Diagnostic {
+            range: map.range(d.span),
+            severity: Some(if d.is_error() {
+                DiagnosticSeverity::ERROR
+            } else {
+                DiagnosticSeverity::WARNING
+            }),
+            code: Some(NumberOrString::String(d.code.as_str().to_string())),
+            source: Some("semo build".into()),
+            message: d.message.clone(),
+            ..Default::default()
+        })
+        .collect()
+}
+
+/// A robot's line in the result.
+pub fn robot_summary(robot: &codegen::RobotOutput, written: &output::Written) -> Value {
+    let (generated, user) = robot.line_counts();
+    json!({
+        "team": robot.team,
+        "robot": robot.robot,
+        "folder": written.folder.display().to_string(),
+        "generatedFiles": written.generated,
+        "taskFilesCreated": written.created,
+        "taskFilesKept": written.kept,
+        "linesGenerated": generated,
+        "linesInTaskFiles": user,
+    })
+}
+
+/// A code lens on each team's name in the formation: generate its robots' code.
+pub fn code_lenses(snapshot: &Snapshot) -> Vec<CodeLens> {
+    super::with_mission(snapshot, |analysis, map| {
+        analysis
+            .mission
+            .teams
+            .iter()
+            .filter(|t| !t.robots.is_empty())
+            .map(|team| CodeLens {
+                range: map.range(team.name_span),
+                command: Some(Command {
+                    title: format!("▶ Generate code for {}", team.name),
+                    command: COMMAND.to_string(),
+                    arguments: Some(vec![json!({
+                        "uri": snapshot.uri.as_str(),
+                        "team": team.name.as_str(),
+                    })]),
+                }),
+                data: None,
+            })
+            .collect()
+    })
+    .unwrap_or_default()
+}

@@ -1,0 +1,434 @@
+//! `semo build` as a user runs it: the reference missions become C programs
+//! that compile cleanly with gcc and clang, and the scouting mission, built for
+//! the simulated platform, runs as three processes whose traces show the
+//! expected modes, also under AddressSanitizer/UBSan and ThreadSanitizer.
+
+mod support;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use support::{repo_root, semo_in, shared};
+
+const STRICT: &str = "-std=c11 -Wall -Wextra -Werror -O1 -g";
+
+/// A fresh folder under cargo's scratch space for tests.
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("build")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn build(mission: &Path, target: &str, out: &Path) -> support::Output {
+    let out_arg = out.display().to_string();
+    let mission_arg = mission.display().to_string();
+    semo_in(
+        &repo_root(),
+        &["build", &mission_arg, "--target", target, "-o", &out_arg],
+    )
+}
+
+/// Every robot folder under an output folder.
+fn robot_folders(out: &Path) -> Vec<PathBuf> {
+    let mut folders = Vec::new();
+    for team in std::fs::read_dir(out).unwrap() {
+        let team = team.unwrap().path();
+        if !team.is_dir() {
+            continue;
+        }
+        for robot in std::fs::read_dir(&team).unwrap() {
+            let robot = robot.unwrap().path();
+            let hidden = robot
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with('.');
+            if robot.is_dir() && !hidden {
+                folders.push(robot);
+            }
+        }
+    }
+    folders.sort();
+    folders
+}
+
+/// Runs `make` in a robot folder; the compiler's complaints on failure.
+fn make(folder: &Path, cc: &str, cflags: &str) -> Result<(), String> {
+    let out = Command::new("make")
+        .args([
+            "-s",
+            "-j2",
+            &format!("CC={cc}"),
+            &format!("CFLAGS={cflags}"),
+        ])
+        .current_dir(folder)
+        .output()
+        .expect("make runs");
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    if out.status.success() && !stderr.contains("warning") {
+        Ok(())
+    } else {
+        Err(format!("{}: {stderr}", folder.display()))
+    }
+}
+
+fn has(program: &str) -> bool {
+    Command::new(program).arg("--version").output().is_ok()
+}
+
+fn example(path: &str) -> PathBuf {
+    shared().join("examples").join(path)
+}
+
+#[test]
+fn reference_missions_compile_cleanly_with_gcc_and_clang() {
+    let compilers: Vec<&str> = ["gcc", "clang"].into_iter().filter(|c| has(c)).collect();
+    assert!(compilers.contains(&"gcc"), "gcc is required");
+    if !compilers.contains(&"clang") {
+        eprintln!("note: clang is not installed here; only gcc was tried (CI installs clang)");
+    }
+    let missions = [
+        "scouting/scouting.mission",
+        "follow/follow.mission",
+        "swarm/march.mission",
+        "swarm/patrol_groups.mission",
+    ];
+    for mission in missions {
+        for target in ["linux", "linux-sim"] {
+            let out = scratch(&format!("compile-{}-{target}", mission.replace('/', "-")));
+            let built = build(&example(mission), target, &out);
+            assert_eq!(built.code, 0, "{mission}: {}{}", built.stdout, built.stderr);
+            let folders = robot_folders(&out);
+            assert!(!folders.is_empty(), "{mission}: no robot folder");
+            for folder in &folders {
+                for cc in &compilers {
+                    if let Err(e) = make(folder, cc, STRICT) {
+                        panic!("{mission} ({target}, {cc}) does not compile cleanly:\n{e}");
+                    }
+                    let _ = Command::new("make")
+                        .arg("-s")
+                        .arg("clean")
+                        .current_dir(folder)
+                        .status();
+                }
+            }
+        }
+    }
+}
+
+/// One line of a trace.
+type Event = serde_json::Map<String, serde_json::Value>;
+
+/// Builds the scouting mission for the simulation with `cflags`, starts its
+/// three robots as processes and returns each robot's trace and stderr.
+fn run_scouting(
+    name: &str,
+    port_offset: u32,
+    cc: &str,
+    cflags: &str,
+    env: &[(&str, &str)],
+) -> BTreeMap<String, (Vec<Event>, String)> {
+    let out = scratch(name);
+    let built = build(&example("scouting/scouting.mission"), "linux-sim", &out);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    let scenario = repo_root().join("tests/fixtures/build/scouting.scenario.json");
+    // Each run gets its own ports, so runs in parallel do not hear each other.
+    // Below the ephemeral range (32768 and up), where other sockets come and go.
+    let port_base = 20000 + (std::process::id() % 250) * 40 + port_offset;
+    let folders = robot_folders(&out);
+    // Build every robot before starting any: they must start together.
+    for folder in &folders {
+        make(folder, cc, cflags).unwrap_or_else(|e| panic!("{e}"));
+    }
+    let mut children = Vec::new();
+    for folder in folders {
+        let robot = folder.file_name().unwrap().to_string_lossy().into_owned();
+        let trace = out.join(format!("{robot}.jsonl"));
+        let child = Command::new(folder.join(&robot))
+            .args(["--scenario", &scenario.display().to_string()])
+            .args(["--trace", &trace.display().to_string()])
+            .args(["--port-base", &port_base.to_string()])
+            .envs(env.iter().copied())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("the robot program starts");
+        children.push((robot, trace, child));
+    }
+    let mut result = BTreeMap::new();
+    for (robot, trace, child) in children {
+        let output = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+        assert!(
+            output.status.success(),
+            "{robot} exited with {:?}: {stderr}",
+            output.status
+        );
+        let text = std::fs::read_to_string(&trace).unwrap_or_default();
+        let events = text
+            .lines()
+            .map(|l| {
+                serde_json::from_str(l)
+                    .unwrap_or_else(|e| panic!("{robot}: bad trace line {l}: {e}"))
+            })
+            .collect();
+        result.insert(robot, (events, stderr));
+    }
+    result
+}
+
+fn field<'e>(event: &'e Event, key: &str) -> &'e str {
+    event.get(key).and_then(|v| v.as_str()).unwrap_or("")
+}
+
+fn modes(events: &[Event]) -> Vec<&str> {
+    events
+        .iter()
+        .filter(|e| field(e, "event") == "mode")
+        .map(|e| field(e, "mode"))
+        .collect()
+}
+
+fn assert_scouting_behaviour(runs: &BTreeMap<String, (Vec<Event>, String)>) {
+    let master = ["AUTO_MODE", "WAIT_MODE", "RETURN_MODE", "FINISH"];
+    let slave = ["AUTO_MODE", "SEARCH_MODE", "RETURN_MODE", "FINISH"];
+    assert_eq!(runs.len(), 3, "three robots");
+    for (robot, (events, _)) in runs {
+        let expected: &[&str] = if robot == "irobot" { &master } else { &slave };
+        assert_eq!(modes(events), expected, "{robot}'s modes");
+        assert!(
+            events.iter().any(|e| field(e, "event") == "finish"),
+            "{robot} reaches its end"
+        );
+    }
+    // The master hears the colors of both slaves.
+    let (master_events, _) = &runs["irobot"];
+    for slave in ["ti", "nxt"] {
+        let heard = master_events.iter().any(|e| {
+            field(e, "event") == "receive"
+                && field(e, "key") == "SlaveTeam.COLOR"
+                && field(e, "from_robot") == slave
+        });
+        assert!(heard, "the master receives SlaveTeam.COLOR from {slave}");
+    }
+    // The slaves report the colors they found, up to the complete set.
+    let (ti, _) = &runs["ti"];
+    assert!(ti.iter().any(|e| field(e, "event") == "send"
+        && field(e, "key") == "SlaveTeam.COLOR"
+        && field(e, "value") == "RGB"));
+    // The master leaves WAIT_MODE because of the operator's command.
+    assert!(
+        master_events
+            .iter()
+            .any(|e| field(e, "event") == "receive" && field(e, "value") == "RETURN_MODE")
+    );
+}
+
+#[test]
+fn scouting_runs_in_simulation_with_the_expected_modes() {
+    let runs = run_scouting("sim", 0, "gcc", STRICT, &[]);
+    assert_scouting_behaviour(&runs);
+}
+
+#[test]
+fn scouting_runs_clean_under_address_and_undefined_behaviour_sanitizers() {
+    let flags = format!(
+        "{STRICT} -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all"
+    );
+    let runs = run_scouting(
+        "asan",
+        20,
+        "gcc",
+        &flags,
+        &[
+            ("ASAN_OPTIONS", "detect_leaks=1:abort_on_error=1"),
+            ("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1"),
+        ],
+    );
+    for (robot, (_, stderr)) in &runs {
+        assert!(
+            stderr.trim().is_empty(),
+            "{robot}: sanitizer report:\n{stderr}"
+        );
+    }
+    assert_scouting_behaviour(&runs);
+}
+
+#[test]
+fn scouting_runs_clean_under_thread_sanitizer() {
+    let flags = format!("{STRICT} -fsanitize=thread");
+    let runs = run_scouting(
+        "tsan",
+        10,
+        "gcc",
+        &flags,
+        &[("TSAN_OPTIONS", "halt_on_error=1")],
+    );
+    for (robot, (_, stderr)) in &runs {
+        assert!(
+            stderr.trim().is_empty(),
+            "{robot}: ThreadSanitizer report:\n{stderr}"
+        );
+    }
+    assert_scouting_behaviour(&runs);
+}
+
+/// Every file under a folder with its bytes.
+fn contents(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p.strip_prefix(dir).unwrap().display().to_string();
+                out.insert(rel, std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn output_is_byte_identical_for_identical_inputs() {
+    let a = scratch("same-a");
+    let b = scratch("same-b");
+    for target in ["linux", "linux-sim"] {
+        assert_eq!(
+            build(&example("scouting/scouting.mission"), target, &a).code,
+            0
+        );
+        assert_eq!(
+            build(&example("scouting/scouting.mission"), target, &b).code,
+            0
+        );
+        let (left, right) = (contents(&a), contents(&b));
+        assert!(left.len() > 40, "{target}: {} files", left.len());
+        assert_eq!(left, right, "{target}");
+    }
+}
+
+#[test]
+fn task_files_the_user_filled_are_never_overwritten() {
+    let out = scratch("user-files");
+    let mission = example("follow/follow.mission");
+    assert_eq!(build(&mission, "linux", &out).code, 0);
+    let folder = out.join("Team1/create1");
+    let task = folder.join("tasks/follow.c");
+    assert!(task.exists(), "the follow task template is created");
+    let mine = "/* my follow algorithm */\n#include \"../program.h\"\nTASK_INIT {}\nTASK_GO {}\nTASK_WRAPUP {}\n";
+    std::fs::write(&task, mine).unwrap();
+    std::fs::write(folder.join("NOTES.txt"), "my notes").unwrap();
+    // A generated file edited by hand is regenerated.
+    std::fs::write(folder.join("main.c"), "garbage").unwrap();
+    let again = build(&mission, "linux", &out);
+    assert_eq!(again.code, 0, "{}", again.stderr);
+    assert!(again.stdout.contains("kept"), "{}", again.stdout);
+    assert_eq!(std::fs::read_to_string(&task).unwrap(), mine);
+    assert_eq!(
+        std::fs::read_to_string(folder.join("NOTES.txt")).unwrap(),
+        "my notes"
+    );
+    assert!(
+        std::fs::read_to_string(folder.join("main.c"))
+            .unwrap()
+            .contains("semo_main")
+    );
+    // The user's own task code still builds with the rest.
+    make(&folder, "gcc", STRICT).unwrap();
+}
+
+#[test]
+fn generation_is_refused_while_the_mission_has_errors() {
+    let dir = scratch("refused");
+    let mission = dir.join("broken.mission");
+    std::fs::write(
+        &mission,
+        "{ T: iRobotCreate r }\nT.A.S{ fly() }\nT.M{ set(A, S) }\nT.main{ default: mode = M }\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let built = build(&mission, "linux", &out);
+    assert_eq!(built.code, 1, "{}", built.stdout);
+    assert!(built.stdout.contains("refused"), "{}", built.stdout);
+    assert!(!out.exists(), "nothing is written");
+}
+
+#[test]
+fn every_build_fixture_gives_its_code() {
+    let root = repo_root().join("tests/fixtures/build");
+    let mut seen = 0;
+    for entry in std::fs::read_dir(&root).unwrap() {
+        let dir = entry.unwrap().path();
+        if !dir.is_dir() {
+            continue;
+        }
+        let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+        let code = &name[..4];
+        let mission = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.extension().is_some_and(|e| e == "mission"))
+            .expect("a fixture holds a mission");
+        let out = scratch(&format!("fixture-{name}"));
+        let built = build(&mission, "linux", &out);
+        assert_eq!(built.code, 1, "{name}: {}", built.stdout);
+        assert!(
+            built.stdout.contains(&format!("[{code}]")),
+            "{name}: {}",
+            built.stdout
+        );
+        assert!(robot_folders(&out).is_empty(), "{name}: nothing is written");
+        seen += 1;
+    }
+    assert!(seen >= 2);
+}
+
+#[test]
+fn refined_task_graphs_are_written_and_analyse_clean() {
+    let out = scratch("taskgraphs");
+    let built = semo_in(
+        &repo_root(),
+        &[
+            "build",
+            &example("scouting/scouting.mission").display().to_string(),
+            "--emit",
+            "taskgraph",
+            "-o",
+            &out.display().to_string(),
+        ],
+    );
+    assert_eq!(built.code, 0, "{}", built.stderr);
+    for folder in robot_folders(&out) {
+        let names: Vec<_> = std::fs::read_dir(&folder)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, ["taskgraph.xml"], "only the task graph");
+        let graph = folder.join("taskgraph.xml").display().to_string();
+        let analyzed = semo_in(
+            &repo_root(),
+            &["graph", "analyze", &graph, "--format", "json"],
+        );
+        assert_eq!(analyzed.code, 0, "{graph}: {}", analyzed.stdout);
+        let report: serde_json::Value = serde_json::from_str(&analyzed.stdout).unwrap();
+        assert_eq!(
+            report["diagnostics"].as_array().map(Vec::len),
+            Some(0),
+            "{graph}: {report}"
+        );
+        let svg = semo_in(&repo_root(), &["graph", "svg", &graph]);
+        assert!(svg.stdout.contains("ControlTask"), "{graph}");
+    }
+}
+
+#[test]
+fn unknown_targets_are_a_usage_error() {
+    let out = semo_in(&repo_root(), &["build", "x.mission", "--target", "amiga"]);
+    assert_eq!(out.code, 2);
+    assert!(out.stderr.contains("linux-sim"), "{}", out.stderr);
+}

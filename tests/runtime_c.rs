@@ -1,0 +1,761 @@
+//! The C runtime that generated robot programs link with
+//! (`compiler/src/codegen/runtime/`): its test program
+//! (`tests/runtime_test.c`, tables written the way the generator writes them)
+//! built with gcc and clang at `-std=c11 -Wall -Wextra -Werror -pedantic`,
+//! and under AddressSanitizer+UBSan and ThreadSanitizer; every program is run
+//! and its JSON-lines trace read back. Any compiler message or sanitizer
+//! report fails the test.
+//!
+//! ThreadSanitizer needs a memory layout that some kernels' address
+//! randomisation breaks ("unexpected memory mapping"); when the first TSan
+//! run says so, every TSan run goes through `setarch <arch> -R` (no ASLR for
+//! that process only).
+
+mod support;
+
+use serde_json::Value;
+use std::collections::HashMap;
+use std::net::UdpSocket;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+// ------------------------------------------------------------------ builds
+
+/// How the runtime and its test program are built.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Flavor {
+    /// The generator's flags with a given compiler; `sim` adds `-DSEMO_SIM`.
+    Plain {
+        cc: &'static str,
+        sim: bool,
+    },
+    AsanUbsan,
+    Tsan,
+}
+
+impl Flavor {
+    fn name(self) -> String {
+        match self {
+            Flavor::Plain { cc, sim } => format!("{cc}{}", if sim { "-sim" } else { "" }),
+            Flavor::AsanUbsan => "asan-ubsan".into(),
+            Flavor::Tsan => "tsan".into(),
+        }
+    }
+
+    fn sim(self) -> bool {
+        !matches!(self, Flavor::Plain { sim: false, .. })
+    }
+
+    fn flags(self) -> Vec<&'static str> {
+        let mut flags = vec![
+            "-std=c11",
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            "-pedantic",
+            "-pthread",
+        ];
+        match self {
+            Flavor::Plain { .. } => flags.push("-O2"),
+            Flavor::AsanUbsan => flags.extend([
+                "-g",
+                "-O1",
+                "-fno-omit-frame-pointer",
+                "-fsanitize=address,undefined",
+                "-fno-sanitize-recover=all",
+            ]),
+            Flavor::Tsan => flags.extend(["-g", "-O1", "-fsanitize=thread"]),
+        }
+        if self.sim() {
+            flags.push("-DSEMO_SIM");
+        }
+        flags
+    }
+}
+
+fn has_clang() -> bool {
+    Command::new("clang")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// Every flavor this machine can build: gcc and clang (when installed, else
+/// a note), each with and without simulation, and the two sanitizer builds.
+fn flavors() -> Vec<Flavor> {
+    let mut all = vec![
+        Flavor::Plain {
+            cc: "gcc",
+            sim: false,
+        },
+        Flavor::Plain {
+            cc: "gcc",
+            sim: true,
+        },
+    ];
+    if has_clang() {
+        all.push(Flavor::Plain {
+            cc: "clang",
+            sim: false,
+        });
+        all.push(Flavor::Plain {
+            cc: "clang",
+            sim: true,
+        });
+    } else {
+        eprintln!("note: clang is not installed; the runtime is tested with gcc only");
+    }
+    all.extend([Flavor::AsanUbsan, Flavor::Tsan]);
+    all
+}
+
+fn runtime_dir() -> PathBuf {
+    support::repo_root().join("compiler/src/codegen/runtime")
+}
+
+fn work_dir() -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("runtime-c");
+    std::fs::create_dir_all(&dir).expect("target dir is writable");
+    dir
+}
+
+/// A built test program, and whether it must run without ASLR.
+#[derive(Clone)]
+struct Program {
+    flavor: Flavor,
+    exe: PathBuf,
+    no_aslr: bool,
+}
+
+/// Builds once per flavor for the whole test process.
+fn program(flavor: Flavor) -> Program {
+    static BUILT: Mutex<Option<HashMap<String, Program>>> = Mutex::new(None);
+    let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
+    let built = built.get_or_insert_with(HashMap::new);
+    if let Some(p) = built.get(&flavor.name()) {
+        return p.clone();
+    }
+    let p = compile(flavor);
+    built.insert(flavor.name(), p.clone());
+    p
+}
+
+fn compile(flavor: Flavor) -> Program {
+    let dir = runtime_dir();
+    let exe = work_dir().join(format!("runtime_test-{}", flavor.name()));
+    // Built beside and renamed, so that a concurrent test run never sees half a file.
+    let partial = exe.with_extension(format!("partial-{}", std::process::id()));
+    let cc = match flavor {
+        Flavor::Plain { cc, .. } => cc,
+        _ => "gcc",
+    };
+    let out = Command::new(cc)
+        .args(flavor.flags())
+        .args([
+            "tests/runtime_test.c",
+            "semo_runtime.c",
+            "semo_udp.c",
+            "semo_sim.c",
+            "-o",
+        ])
+        .arg(&partial)
+        .current_dir(&dir)
+        .output()
+        .unwrap_or_else(|e| panic!("{cc} runs: {e}"));
+    let messages = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success() && messages.trim().is_empty(),
+        "{} build of the runtime is not clean:\n{messages}",
+        flavor.name()
+    );
+    std::fs::rename(&partial, &exe).expect("rename the built program");
+    let mut program = Program {
+        flavor,
+        exe,
+        no_aslr: false,
+    };
+    if flavor == Flavor::Tsan {
+        let probe = program.run(&["values"], &[]);
+        if probe.stderr.contains("unexpected memory mapping") {
+            program.no_aslr = true;
+        }
+    }
+    program
+}
+
+// ---------------------------------------------------------------- running
+
+struct Run {
+    code: i32,
+    stdout: String,
+    stderr: String,
+    elapsed: Duration,
+}
+
+const SANITIZER_ENV: [(&str, &str); 3] = [
+    (
+        "ASAN_OPTIONS",
+        "detect_leaks=1:halt_on_error=1:detect_stack_use_after_return=1",
+    ),
+    ("UBSAN_OPTIONS", "halt_on_error=1:print_stacktrace=1"),
+    ("TSAN_OPTIONS", "halt_on_error=1:second_deadlock_stack=1"),
+];
+
+/// No run may take this long; a hang fails instead of blocking the suite.
+const RUN_LIMIT: Duration = Duration::from_secs(60);
+
+impl Program {
+    fn command(&self, args: &[&str], env: &[(&str, &str)]) -> Command {
+        let mut cmd = if self.no_aslr {
+            let mut c = Command::new("setarch");
+            c.arg(std::env::consts::ARCH).arg("-R").arg(&self.exe);
+            c
+        } else {
+            Command::new(&self.exe)
+        };
+        cmd.args(args)
+            .envs(SANITIZER_ENV)
+            .env_remove("SEMO_PORT_BASE")
+            .envs(env.iter().copied())
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped());
+        cmd
+    }
+
+    fn spawn(&self, args: &[&str]) -> (Child, Instant) {
+        let child = self
+            .command(args, &[])
+            .spawn()
+            .unwrap_or_else(|e| panic!("{} starts: {e}", self.exe.display()));
+        (child, Instant::now())
+    }
+
+    fn run(&self, args: &[&str], env: &[(&str, &str)]) -> Run {
+        let child = self
+            .command(args, env)
+            .spawn()
+            .unwrap_or_else(|e| panic!("{} starts: {e}", self.exe.display()));
+        finish(
+            child,
+            Instant::now(),
+            &format!("{} {args:?}", self.flavor.name()),
+        )
+    }
+
+    /// Runs a mode that must succeed: exit 0, nothing on stderr.
+    fn run_ok(&self, args: &[&str]) -> Run {
+        let run = self.run(args, &[]);
+        self.assert_clean(&run, args);
+        run
+    }
+
+    fn assert_clean(&self, run: &Run, args: &[&str]) {
+        assert!(
+            run.code == 0 && run.stderr.trim().is_empty(),
+            "{} {args:?} exited {} with:\n{}",
+            self.flavor.name(),
+            run.code,
+            run.stderr
+        );
+    }
+}
+
+/// Waits (polling, bounded by RUN_LIMIT) and collects the output.
+fn finish(mut child: Child, started: Instant, what: &str) -> Run {
+    loop {
+        match child.try_wait().expect("wait for the program") {
+            Some(_) => break,
+            None if started.elapsed() > RUN_LIMIT => {
+                let _ = child.kill();
+                panic!("{what} did not end within {RUN_LIMIT:?}");
+            }
+            None => std::thread::sleep(Duration::from_millis(10)),
+        }
+    }
+    let out = child.wait_with_output().expect("program output");
+    Run {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+        elapsed: started.elapsed(),
+    }
+}
+
+fn trace_path(test: &str, flavor: Flavor) -> PathBuf {
+    work_dir().join(format!(
+        "{test}-{}-{}.jsonl",
+        flavor.name(),
+        std::process::id()
+    ))
+}
+
+/// Every line one JSON object with an integer, never decreasing "t" and
+/// this robot's name; the first event is "start", the last "stop".
+fn read_trace(path: &Path, robot: &str) -> Vec<Value> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let _ = std::fs::remove_file(path);
+    let events: Vec<Value> = text
+        .lines()
+        .map(|line| {
+            serde_json::from_str(line).unwrap_or_else(|e| panic!("trace line {line:?}: {e}"))
+        })
+        .collect();
+    let mut last = 0;
+    for e in &events {
+        let t = e["t"]
+            .as_u64()
+            .unwrap_or_else(|| panic!("integer t in {e}"));
+        assert!(t >= last, "time goes back at {e}");
+        last = t;
+        assert_eq!(e["robot"], robot, "{e}");
+    }
+    assert_eq!(
+        events.first().map(|e| &e["event"]),
+        Some(&Value::from("start")),
+        "{text}"
+    );
+    assert_eq!(
+        events.last().map(|e| &e["event"]),
+        Some(&Value::from("stop")),
+        "{text}"
+    );
+    events
+}
+
+fn events<'a>(trace: &'a [Value], event: &str) -> Vec<&'a Value> {
+    trace.iter().filter(|e| e["event"] == event).collect()
+}
+
+fn fixture(name: &str) -> String {
+    runtime_dir().join("tests").join(name).display().to_string()
+}
+
+// ------------------------------------------------------------------ tests
+
+#[test]
+fn values_compare_numerically_only_when_both_are_numbers() {
+    for flavor in flavors() {
+        program(flavor).run_ok(&["values"]);
+    }
+}
+
+#[test]
+fn tasks_channels_control_timers_and_trace_escaping() {
+    for flavor in flavors() {
+        let p = program(flavor);
+        let trace = trace_path("tasks", flavor);
+        p.run_ok(&["tasks", "--trace", trace.to_str().unwrap()]);
+        let trace = read_trace(&trace, "r1");
+        let start = &trace[0];
+        assert_eq!(start["team"], "TestTeam");
+        assert_eq!(start["type"], "TestBot");
+        assert_eq!(start["mission"], "test.mission");
+        let notes = events(&trace, "note");
+        assert_eq!(
+            notes[0]["text"],
+            "quote\" backslash\\ newline\n tab\t ctl\u{1} é bad\u{fffd}\u{fffd} end"
+        );
+        assert_eq!(notes[1]["text"], Value::Null);
+        let sends = events(&trace, "send");
+        assert_eq!(sends[0]["to"], "USER");
+        assert_eq!(sends[0]["key"], "Team.STATUS");
+        assert_eq!(sends[0]["value"], "ok");
+        let dropped = events(&trace, "dropped");
+        let spill = dropped
+            .iter()
+            .find(|e| e["channel"] == "Control.SPILL->Sink.IN")
+            .unwrap_or_else(|| panic!("{dropped:?}"));
+        assert_eq!(spill["count"], "1");
+    }
+}
+
+/// A base port with base and base+1 free on 127.0.0.1 right now.
+fn free_port_pair() -> u16 {
+    for _ in 0..100 {
+        let a = UdpSocket::bind("127.0.0.1:0").expect("bind a UDP port");
+        let base = a.local_addr().unwrap().port();
+        if base < 65535 && UdpSocket::bind(("127.0.0.1", base + 1)).is_ok() {
+            return base;
+        }
+    }
+    panic!("no two adjacent free UDP ports");
+}
+
+fn wait_for_start(trace: &Path, child: &mut Child) {
+    let started = Instant::now();
+    while !std::fs::read_to_string(trace).is_ok_and(|t| t.contains("\"start\"")) {
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("the program ended before it started: {status}");
+        }
+        assert!(started.elapsed() < RUN_LIMIT, "the program never started");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+/// Datagrams the receiver must reject (each traced as "reject"), and one
+/// well-formed message in the documented wire format.
+fn send_datagrams_to(port: u16) {
+    let junk: [&[u8]; 7] = [
+        b"hello",
+        b"SEMO\x01s\x05Alpha",               // cut short
+        &[b'x'; 2000],                       // larger than any message
+        b"SEMO\x01z\x01A\x01a\x01k\x01v",    // unknown kind
+        b"SEMO\x01s\x01\x00\x01a\x01k\x01v", // NUL inside a field
+        b"SEMO\x01s\x01A\x01a\x01k\x01vX",   // bytes after the value
+        b"SEMO\x01s\x28AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA\x01a\x01k\x01v", // team too long
+    ];
+    let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
+    for datagram in junk {
+        socket.send_to(datagram, ("127.0.0.1", port)).unwrap();
+    }
+    socket
+        .send_to(
+            b"SEMO\x01s\x05Alpha\x01a\x0aAlpha.NOTE\x02hi",
+            ("127.0.0.1", port),
+        )
+        .unwrap();
+}
+
+#[test]
+fn two_robots_exchange_messages_over_udp_and_reject_malformed_datagrams() {
+    for flavor in flavors() {
+        let p = program(flavor);
+        let base = free_port_pair().to_string();
+        let (trace_a, trace_b) = (trace_path("udp-a", flavor), trace_path("udp-b", flavor));
+        let args = |mode: &'static str, trace: &Path| {
+            vec![
+                mode.to_string(),
+                "--trace".into(),
+                trace.display().to_string(),
+                format!("--port-base={base}"),
+                "--duration".into(),
+                "20000".into(),
+            ]
+        };
+        let b_args = args("udp-b", &trace_b);
+        let (mut b, b_started) = p.spawn(&b_args.iter().map(String::as_str).collect::<Vec<_>>());
+        wait_for_start(&trace_b, &mut b);
+        send_datagrams_to(base.parse::<u16>().unwrap() + 1);
+        let a_args = args("udp-a", &trace_a);
+        let a = p.run(&a_args.iter().map(String::as_str).collect::<Vec<_>>(), &[]);
+        let b = finish(b, b_started, "udp-b");
+        p.assert_clean(&a, &["udp-a"]);
+        p.assert_clean(&b, &["udp-b"]);
+
+        let a_trace = read_trace(&trace_a, "a");
+        let b_trace = read_trace(&trace_b, "b");
+        assert!(
+            events(&a_trace, "send")
+                .iter()
+                .any(|e| e["to"] == "Beta" && e["key"] == "Alpha.PING")
+        );
+        let pong = events(&a_trace, "receive");
+        let pong = pong
+            .iter()
+            .find(|e| e["key"] == "Beta.PONG")
+            .expect("PONG received");
+        assert_eq!(pong["from"], "Beta");
+        assert_eq!(pong["from_robot"], "b");
+        assert_eq!(pong["value"], "pong \"1\"");
+        let received = events(&b_trace, "receive");
+        let note = received
+            .iter()
+            .find(|e| e["key"] == "Alpha.NOTE")
+            .expect("well-formed datagram");
+        assert_eq!(note["value"], "hi");
+        assert!(received.iter().any(|e| e["key"] == "Alpha.BYE"));
+        assert_eq!(events(&b_trace, "reject").len(), 7, "{b_trace:#?}");
+    }
+}
+
+#[test]
+fn simulation_feeds_scenario_sensors_and_operator_commands() {
+    for flavor in flavors().into_iter().filter(|f| f.sim()) {
+        let p = program(flavor);
+        let trace = trace_path("sim", flavor);
+        let run = p.run_ok(&[
+            "sim",
+            "--trace",
+            trace.to_str().unwrap(),
+            "--scenario",
+            &fixture("scenario.json"),
+        ]);
+        // 3 000 mission ms at the scenario's time scale of 0.05: 150 ms.
+        assert!(run.elapsed < Duration::from_secs(3), "{:?}", run.elapsed);
+        let trace = read_trace(&trace, "irobot");
+        assert_eq!(trace[0]["team"], "RemoteTeam");
+        assert_eq!(trace[0]["type"], "iRobot");
+        let commands: Vec<_> = events(&trace, "receive")
+            .iter()
+            .map(|e| {
+                assert_eq!(
+                    (&e["from"], &e["from_robot"]),
+                    (&"USER".into(), &"USER".into())
+                );
+                assert_eq!(e["key"], "USER.RC_CMD");
+                (
+                    e["t"].as_u64().unwrap(),
+                    e["value"].as_str().unwrap().to_string(),
+                )
+            })
+            .collect();
+        let values: Vec<_> = commands.iter().map(|(_, v)| v.as_str()).collect();
+        assert_eq!(
+            values,
+            [
+                "NONE",
+                "NONE",
+                "AUTO_MODE",
+                "NONE",
+                "NONE",
+                "NONE",
+                "NONE",
+                "FINISH"
+            ]
+        );
+        // Each command arrives at (not before) its scenario time.
+        for ((t, _), due) in commands
+            .iter()
+            .zip([0, 400, 500, 800, 1200, 1600, 2000, 3000])
+        {
+            assert!(*t >= due, "{commands:?}");
+        }
+        let actuate = events(&trace, "actuate");
+        assert_eq!(
+            (&actuate[0]["task"], &actuate[0]["value"]),
+            (&"Move".into(), &"5,5".into())
+        );
+        assert!(trace.last().unwrap()["t"].as_u64().unwrap() >= 3000);
+    }
+}
+
+#[test]
+fn duration_is_in_mission_time_and_the_command_line_beats_the_scenario() {
+    for flavor in flavors() {
+        let p = program(flavor);
+        let trace = trace_path("duration", flavor);
+        let base = free_port_pair().to_string();
+        // The wall time is not checked from here (the program may have run a
+        // while before `spawn` returned); its own clock is in the trace.
+        p.run_ok(&[
+            "minimal",
+            "--duration",
+            "100",
+            "--port-base",
+            &base,
+            "--trace",
+            trace.to_str().unwrap(),
+        ]);
+        let trace = read_trace(&trace, "solo");
+        assert!(trace.last().unwrap()["t"].as_u64().unwrap() >= 100);
+        if flavor.sim() {
+            // The scenario alone: 5 000 mission ms at 0.01 take 50 wall ms.
+            let fast = work_dir().join(format!(
+                "fast-{}-{}.json",
+                flavor.name(),
+                std::process::id()
+            ));
+            std::fs::write(&fast, r#"{"time_scale": 0.01, "duration": 5000}"#).unwrap();
+            let run = p.run_ok(&[
+                "minimal",
+                "--port-base",
+                &base,
+                "--scenario",
+                fast.to_str().unwrap(),
+            ]);
+            assert!(run.elapsed < Duration::from_secs(3), "{:?}", run.elapsed);
+            // The command line wins: a scenario at real time, run 100 times faster.
+            let slow = work_dir().join(format!(
+                "slow-{}-{}.json",
+                flavor.name(),
+                std::process::id()
+            ));
+            std::fs::write(&slow, r#"{"time_scale": 1, "duration": 5000}"#).unwrap();
+            let run = p.run_ok(&[
+                "minimal",
+                "--port-base",
+                &base,
+                "--scenario",
+                slow.to_str().unwrap(),
+                "--time-scale",
+                "0.01",
+            ]);
+            assert!(run.elapsed < Duration::from_secs(3), "{:?}", run.elapsed);
+            let _ = std::fs::remove_file(fast);
+            let _ = std::fs::remove_file(slow);
+        }
+    }
+}
+
+#[test]
+fn sigterm_stops_the_program_cleanly() {
+    for flavor in flavors() {
+        let p = program(flavor);
+        let trace = trace_path("sigterm", flavor);
+        let base = free_port_pair().to_string();
+        let (mut child, started) = p.spawn(&[
+            "minimal",
+            "--port-base",
+            &base,
+            "--trace",
+            trace.to_str().unwrap(),
+        ]);
+        wait_for_start(&trace, &mut child);
+        let killed = Command::new("kill")
+            .args(["-TERM", &child.id().to_string()])
+            .status()
+            .expect("kill runs");
+        assert!(killed.success());
+        let run = finish(child, started, "minimal");
+        p.assert_clean(&run, &["minimal"]);
+        let trace = read_trace(&trace, "solo");
+        assert_eq!(events(&trace, "signal")[0]["signal"], "SIGTERM");
+    }
+}
+
+#[test]
+fn bad_command_lines_are_refused_with_usage() {
+    let p = program(Flavor::Plain {
+        cc: "gcc",
+        sim: false,
+    });
+    let refused = |args: &[&str], env: &[(&str, &str)], says: &str| {
+        let run = p.run(args, env);
+        assert_eq!(run.code, 2, "{args:?}: {}", run.stderr);
+        assert!(run.stderr.contains(says), "{args:?}: {}", run.stderr);
+    };
+    refused(&["minimal", "--bogus"], &[], "unknown option \"--bogus\"");
+    refused(
+        &["minimal", "--bogus"],
+        &[],
+        "usage: minimal [--trace FILE]",
+    );
+    refused(&["minimal", "--duration"], &[], "--duration needs a value");
+    refused(
+        &["minimal", "--duration", "-5"],
+        &[],
+        "whole number of milliseconds",
+    );
+    refused(
+        &["minimal", "--port-base", "0"],
+        &[],
+        "port number from 1 to 65535",
+    );
+    refused(&["minimal", "--port-base=70000"], &[], "not \"70000\"");
+    refused(
+        &["minimal"],
+        &[("SEMO_PORT_BASE", "x")],
+        "SEMO_PORT_BASE must be a port number",
+    );
+    refused(
+        &["minimal", "--scenario", "s.json"],
+        &[],
+        "needs a simulation build",
+    );
+    let help = p.run(&["minimal", "--help"], &[]);
+    assert_eq!(help.code, 0);
+    assert!(help.stdout.starts_with("usage: minimal"), "{}", help.stdout);
+
+    let sim = program(Flavor::Plain {
+        cc: "gcc",
+        sim: true,
+    });
+    let run = sim.run(&["minimal", "--time-scale", "0"], &[]);
+    assert_eq!(run.code, 2);
+    assert!(
+        run.stderr
+            .contains("--time-scale must be a positive number"),
+        "{}",
+        run.stderr
+    );
+    let unreachable = sim.run(&["minimal", "--trace", "/nonexistent/dir/trace.jsonl"], &[]);
+    assert_eq!(unreachable.code, 1);
+    assert!(
+        unreachable.stderr.contains("cannot write the trace"),
+        "{}",
+        unreachable.stderr
+    );
+}
+
+#[test]
+fn bad_scenarios_are_refused_with_line_and_column() {
+    let cases: &[(&str, &str)] = &[
+        (
+            "{\n  \"robots\": {\n    \"irobot\": [1,]\n  }\n}",
+            "3:18: unexpected character (expected a value)",
+        ),
+        ("{\"robots\": {}", "1:14: expected ',' or '}'"),
+        (
+            "{\"robots\": {}} x",
+            "1:16: unexpected text after the scenario object",
+        ),
+        (
+            "{\"time_scale\": 0}",
+            "1:16: \"time_scale\" must be a positive number",
+        ),
+        (
+            "{\"duration\": 1.5}",
+            "1:14: \"duration\" must be a whole number of milliseconds",
+        ),
+        (
+            "{\"robot\": {}}",
+            "1:11: unknown key \"robot\" in the scenario",
+        ),
+        (
+            "{\"robots\": {\"a\": 1, \"a\": 2}}",
+            "1:21: duplicate key \"a\"",
+        ),
+        (
+            "{\"robots\": {\"someone\": {\"sensors\": [{\"at\": 0, \"value\": \"X\"}]}}}",
+            "1:37: missing \"is\"",
+        ),
+        (
+            "{\"operator\": [{\"at\": 1, \"every\": 2, \"to\": \"a\", \"value\": \"V\", \"is\": \"x\"}]}",
+            "1:15: an operator command needs either \"at\" or \"every\"",
+        ),
+        (
+            "{\"operator\": [{\"every\": 0, \"to\": \"a\", \"value\": \"V\", \"is\": \"x\"}]}",
+            "1:25: \"every\" must be a whole number of milliseconds above 0",
+        ),
+        ("{\"a\": \"\\ud800\"}", "unpaired surrogate"),
+        ("{\"a\": \"tab\there\"}", "control character in a string"),
+        (
+            "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]",
+            "nesting deeper than 32",
+        ),
+        ("", "1:1: unexpected end of file"),
+        ("{\"n\": 01}", "1:8: expected ',' or '}'"),
+    ];
+    for flavor in flavors().into_iter().filter(|f| f.sim()) {
+        let p = program(flavor);
+        for (i, (text, says)) in cases.iter().enumerate() {
+            let path = work_dir().join(format!(
+                "bad-{i}-{}-{}.json",
+                flavor.name(),
+                std::process::id()
+            ));
+            std::fs::write(&path, text).unwrap();
+            let run = p.run(&["minimal", "--scenario", path.to_str().unwrap()], &[]);
+            let _ = std::fs::remove_file(&path);
+            assert_eq!(run.code, 2, "{text}: {}", run.stderr);
+            let expected = format!("scenario {}:", path.display());
+            assert!(
+                run.stderr.starts_with(&expected) && run.stderr.contains(says),
+                "{text}\nexpected {says:?} in:\n{}",
+                run.stderr
+            );
+            assert_eq!(
+                run.stderr.lines().count(),
+                1,
+                "one clear line: {}",
+                run.stderr
+            );
+        }
+        let missing = p.run(&["minimal", "--scenario", "/nonexistent.json"], &[]);
+        assert_eq!(missing.code, 2);
+        assert!(missing.stderr.contains("cannot read"), "{}", missing.stderr);
+    }
+}
