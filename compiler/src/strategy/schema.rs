@@ -224,39 +224,63 @@ pub fn children(parent: Option<&str>, grandparent: Option<&str>) -> &'static [&'
 /// What an attribute of `element` means.
 pub fn attribute_doc(element: &str, attribute: &str) -> Option<&'static str> {
     Some(match (element, attribute) {
-        ("Strategy", "name") => "The team this strategy is for (a team of the workspace's missions).",
-        ("Value", "name") => "The mission value (a catalog value of the target robot types), e.g. `DISTANCE`.",
+        ("Strategy", "name") => {
+            "The team this strategy is for (a team of the workspace's missions)."
+        }
+        ("Value", "name") => {
+            "The mission value (a catalog value of the target robot types), e.g. `DISTANCE`."
+        }
         ("Service", "plan_name") => "The plan whose composite services call the service.",
         ("Service", "name" | "service_name") => {
             "The built-in service refined (called by the team's composite services in that plan); `service_name` is an alias."
         }
         ("TargetRobot", "name") => "A robot type of the strategy's team.",
         ("TargetRobot", "nickName") => "The robot's name in the mission (optional).",
-        ("TargetRobot", "ea") => "Kept as written (the original files carry it; its meaning is not specified).",
+        ("TargetRobot", "ea") => {
+            "Kept as written (the original files carry it; its meaning is not specified)."
+        }
         ("CheckSensor", "name") => "The sensor read.",
         ("ExecuteActuator", "name") => "The actuator driven.",
         ("ExecuteAlgorithm", "name") => "The algorithm run.",
         ("Parameter", "name") => "The parameter's name, read by conditions.",
-        ("Parameter", "type") => "The data type in the task code (`integer`, `viconInfo`), not a mission value type.",
+        ("Parameter", "type") => {
+            "The data type in the task code (`integer`, `viconInfo`), not a mission value type."
+        }
         ("Parameter", "dataCharacteristic") => {
             "How the data moves: `channel` (a FIFO from/to a task), `variable` (local to the control task), `sysRequest` (a task parameter set through the runtime, then the task is called)."
         }
         ("Parameter", "size") => "How many samples (at least 1).",
         ("Parameter", "value") => "The initial value, or the request sent.",
-        ("Parameter", "srcTask") => "The task the data comes from (`ControlTask` or a task of the target robot type).",
-        ("Parameter", "dstTask") => "The task the data goes to (`ControlTask` or a task of the target robot type).",
+        ("Parameter", "srcTask") => {
+            "The task the data comes from (`ControlTask` or a task of the target robot type)."
+        }
+        ("Parameter", "dstTask") => {
+            "The task the data goes to (`ControlTask` or a task of the target robot type)."
+        }
         ("Action", "name") => "The action's name.",
-        ("Action", "actionId") => "The action's number, unique in the service; transitions name actions by it.",
+        ("Action", "actionId") => {
+            "The action's number, unique in the service; transitions name actions by it."
+        }
         ("Action", "initial") => "`Yes`: the service starts with this action (exactly one action).",
         ("Action", "final") => "`Yes`: the service ends when this action is done.",
         ("Transition", "srcId") => "The enclosing action's `actionId`.",
         ("Transition", "dstId") => "The `actionId` of the action that follows.",
-        ("Condition", "cond") => "The guard, in the mission's expression syntax; write `<` as `&lt;`.",
+        ("Condition", "cond") => {
+            "The guard, in the mission's expression syntax; write `<` as `&lt;`."
+        }
         ("LeaderSelectionInfo", "algorithm") => "`lowest_id`, `highest_battery` or `bully`.",
-        ("LeaderSelectionInfo", "heartbeatPeriod") => "How often the leader says it is alive, e.g. `1 SEC`.",
-        ("LeaderSelectionInfo", "plan_name") => "The plan of the composite service whose leader elections this applies to.",
-        ("LeaderSelectionInfo", "cs_name") => "The composite service (with a `[[ leader(...) ... ]]` statement).",
-        ("GroupSync", "timeout") => "How long the robots of a group wait for each other, e.g. `5 SEC`.",
+        ("LeaderSelectionInfo", "heartbeatPeriod") => {
+            "How often the leader says it is alive, e.g. `1 SEC`."
+        }
+        ("LeaderSelectionInfo", "plan_name") => {
+            "The plan of the composite service whose leader elections this applies to."
+        }
+        ("LeaderSelectionInfo", "cs_name") => {
+            "The composite service (with a `[[ leader(...) ... ]]` statement)."
+        }
+        ("GroupSync", "timeout") => {
+            "How long the robots of a group wait for each other, e.g. `5 SEC`."
+        }
         ("Sensor", "name") => "The sensor whose period is lowered.",
         ("Sensor", "periodLevel") => "The period level to run it at.",
         ("Actuator", "name") => "The actuator whose speed is lowered.",

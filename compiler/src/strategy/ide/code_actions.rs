@@ -1,8 +1,8 @@
 //! Fixes for strategy files, each an edit after which the file checks
 //! without the diagnostic it fixes:
 //!
-//! - E081 (a plain `<` in an attribute value), and malformed XML at a plain
-//!   `&` in one: escape the value's `<`, `>` and `&`;
+//! - E081 (a plain `<` in an attribute value), and malformed XML in a value
+//!   with a plain `&`: escape the value's `<`, `>` and `&`;
 //! - a did-you-mean (any code with a suggestion): write the suggestion, and
 //!   for an element name also in its end tag.
 //!
@@ -31,13 +31,25 @@ pub struct CodeAction {
 pub fn code_actions(text: &str, diagnostics: &[Diagnostic], range: Span) -> Vec<CodeAction> {
     let mut out = Vec::new();
     for (index, d) in diagnostics.iter().enumerate() {
-        if d.span.end < range.start || d.span.start > range.end || text.get(d.span.range()).is_none()
+        if d.span.end < range.start
+            || d.span.start > range.end
+            || text.get(d.span.range()).is_none()
         {
             continue;
         }
-        let at_raw = |c: &str| d.span.len() == 1 && &text[d.span.range()] == c;
-        if d.code == Code::StrategyRawLt || (d.code == Code::StrategyXml && at_raw("&")) {
+        if d.code == Code::StrategyRawLt {
             out.extend(escape_value(text, d.span.start, index));
+            continue;
+        }
+        // Malformed XML inside a value with a plain `&`.
+        if d.code == Code::StrategyXml
+            && let Some(action) = escape_value(text, d.span.start, index)
+            && text[d.span.start..]
+                .split(['"', '\''])
+                .next()
+                .is_some_and(|v| v.contains('&'))
+        {
+            out.push(action);
             continue;
         }
         if let Some(suggestion) = &d.suggestion {
@@ -92,7 +104,14 @@ fn escape_value(text: &str, at: usize, diagnostic: usize) -> Option<CodeAction> 
         .collect();
     let title = match raw.as_slice() {
         ["<"] => format!("Write `<` as `&lt;` in `{}`", attr.name),
-        _ => format!("Escape {} in `{}`", raw.iter().map(|c| format!("`{c}`")).collect::<Vec<_>>().join(", "), attr.name),
+        _ => format!(
+            "Escape {} in `{}`",
+            raw.iter()
+                .map(|c| format!("`{c}`"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            attr.name
+        ),
     };
     Some(CodeAction {
         title,
@@ -112,7 +131,9 @@ fn did_you_mean(text: &str, d: &Diagnostic, suggestion: &str, index: usize) -> C
     }];
     // An element name: its end tag is renamed too.
     if d.code == Code::StrategyUnknownElement
-        && let Some(start) = text[..d.span.start].rfind('<').filter(|&i| i + 1 == d.span.start)
+        && let Some(start) = text[..d.span.start]
+            .rfind('<')
+            .filter(|&i| i + 1 == d.span.start)
         && let Some(close) = matching_close(text, start)
         && text[close.name_span.range()] == text[d.span.range()]
     {
@@ -177,7 +198,10 @@ pub fn create_entry(
     }
     let (at, base, wrap) = insertion_point(text)?;
     let indent = format!("{base}  ");
-    let mut entry = format!("{indent}<Service plan_name=\"{plan}\" name=\"{}\">\n", call.name);
+    let mut entry = format!(
+        "{indent}<Service plan_name=\"{plan}\" name=\"{}\">\n",
+        call.name
+    );
     for t in &types {
         entry.push_str(&format!("{indent}  <TargetRobot name=\"{t}\"/>\n"));
     }
@@ -194,7 +218,10 @@ pub fn create_entry(
         entry
     };
     Some(EntryEdit {
-        title: format!("Create the strategy entry for `{}` in plan {plan} ({team_name})", call.name),
+        title: format!(
+            "Create the strategy entry for `{}` in plan {plan} ({team_name})",
+            call.name
+        ),
         edit: TextEdit {
             span: Span::new(at, at),
             new_text,

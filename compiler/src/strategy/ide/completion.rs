@@ -249,10 +249,11 @@ fn values(
                         .filter(|s| s.plan as usize == index)
                         .map(|s| s.name.as_str())
                         .collect();
-                    out.push(
-                        item(&plan.name, K::Plan)
-                            .detail(format!("plan of {}: {}", team.name, services.join(", "))),
-                    );
+                    out.push(item(&plan.name, K::Plan).detail(format!(
+                        "plan of {}: {}",
+                        team.name,
+                        services.join(", ")
+                    )));
                 }
             }
             dedup_labels(out)
@@ -282,18 +283,26 @@ fn values(
                     let unit = value.unit.as_ref().map(|u| format!(" ({u})"));
                     out.push(
                         item(&value.name, K::Value)
-                            .detail(format!("{}{} of {}", value.ty, unit.unwrap_or_default(), robot.name))
+                            .detail(format!(
+                                "{}{} of {}",
+                                value.ty,
+                                unit.unwrap_or_default(),
+                                robot.name
+                            ))
                             .doc(value.doc.clone()),
                     );
                 }
             }
             dedup_labels(out)
         }
-        ("CheckSensor" | "ExecuteActuator" | "ExecuteAlgorithm" | "Sensor" | "Actuator", "name") => {
-            task_use_names(file, tag.name, offset, replace)
-        }
+        (
+            "CheckSensor" | "ExecuteActuator" | "ExecuteAlgorithm" | "Sensor" | "Actuator",
+            "name",
+        ) => task_use_names(file, tag.name, offset, replace),
         ("Parameter", "srcTask" | "dstTask") => {
-            let mut out = vec![item(CONTROL_TASK, K::Task).detail("the control task the refinement synthesizes")];
+            let mut out = vec![
+                item(CONTROL_TASK, K::Task).detail("the control task the refinement synthesizes"),
+            ];
             for robot in file.types_at(offset) {
                 for (task, what) in super::hover::tasks_of(robot) {
                     out.push(item(task, K::Task).detail(format!("{what} of {}", robot.name)));
@@ -322,10 +331,9 @@ fn values(
                 })
                 .collect()
         }
-        ("Action", "initial" | "final") => ["Yes", "No"]
-            .iter()
-            .map(|w| item(w, K::Keyword))
-            .collect(),
+        ("Action", "initial" | "final") => {
+            ["Yes", "No"].iter().map(|w| item(w, K::Keyword)).collect()
+        }
         ("Parameter", "dataCharacteristic") => DataCharacteristic::ALL
             .iter()
             .map(|(w, _)| item(w, K::Keyword))
@@ -388,14 +396,25 @@ fn services(file: &StrategyFile<'_>, tag: &RawTag<'_>, replace: Span) -> Vec<Com
 
 /// Sensor, actuator and algorithm names: those this file already uses for
 /// the same element, then the capabilities of the robot types concerned.
-fn task_use_names(file: &StrategyFile<'_>, element: &str, offset: usize, replace: Span) -> Vec<Completion> {
+fn task_use_names(
+    file: &StrategyFile<'_>,
+    element: &str,
+    offset: usize,
+    replace: Span,
+) -> Vec<Completion> {
     let mut out = Vec::new();
     if let Some(strategy) = file.strategy {
         let uses = strategy
             .values
             .iter()
             .flat_map(|v| v.tasks.iter())
-            .chain(strategy.services.iter().flat_map(|s| s.actions.iter()).flat_map(|a| a.tasks.iter()))
+            .chain(
+                strategy
+                    .services
+                    .iter()
+                    .flat_map(|s| s.actions.iter())
+                    .flat_map(|a| a.tasks.iter()),
+            )
             .filter(|t| t.kind.tag() == element)
             .filter_map(|t| t.name.as_ref());
         let rules = strategy.battery_rules.iter();
@@ -406,7 +425,10 @@ fn task_use_names(file: &StrategyFile<'_>, element: &str, offset: usize, replace
         };
         let named = uses.chain(levels.into_iter().filter_map(|l| l.name.as_ref()));
         for name in named.filter(|n| !n.span.touches(offset)) {
-            out.push(Completion::new(name.name.as_str(), CompletionKind::Task, replace).detail("used in this file"));
+            out.push(
+                Completion::new(name.name.as_str(), CompletionKind::Task, replace)
+                    .detail("used in this file"),
+            );
         }
     }
     for robot in file.types_at(offset) {

@@ -29,9 +29,10 @@ pub fn hover(file: &StrategyFile<'_>, offset: usize) -> Option<Hover> {
             markdown: element_doc(tag.name)?,
         });
     }
-    let attr = tag.attrs.iter().find(|a| {
-        a.name_span.touches(offset) || a.value_span.is_some_and(|v| v.touches(offset))
-    })?;
+    let attr = tag
+        .attrs
+        .iter()
+        .find(|a| a.name_span.touches(offset) || a.value_span.is_some_and(|v| v.touches(offset)))?;
     let in_value = attr.value_span.filter(|v| v.touches(offset));
     if let Some(span) = in_value
         && let Some(markdown) = refers_to(file, &tag, attr, offset)
@@ -143,7 +144,11 @@ fn refers_to(
                 .into_iter()
                 .find_map(|r| r.service(value))
                 .or_else(|| catalog.types().find_map(|(_, r)| r.service(value)))?;
-            let mut md = format!("**built-in service** `{}`\n\n{}", service.signature(), service.doc);
+            let mut md = format!(
+                "**built-in service** `{}`\n\n{}",
+                service.signature(),
+                service.doc
+            );
             let plan = tag.value("plan_name");
             let mut callers: Vec<String> = Vec::new();
             for (analysis, id, team) in file.teams() {
@@ -166,7 +171,11 @@ fn refers_to(
                 .types_at(offset)
                 .into_iter()
                 .find_map(|r| r.value(value).map(|v| (r, v)))?;
-            let unit = def.unit.as_ref().map(|u| format!(" ({u})")).unwrap_or_default();
+            let unit = def
+                .unit
+                .as_ref()
+                .map(|u| format!(" ({u})"))
+                .unwrap_or_default();
             Some(format!(
                 "**value** `{}`: {}{unit} of {}\n\n{}",
                 def.name, def.ty, robot.name, def.doc

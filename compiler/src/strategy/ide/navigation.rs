@@ -26,7 +26,8 @@ pub fn definition(file: &StrategyFile<'_>, links: &StrategyLinks, offset: usize)
     let Some(strategy) = file.strategy else {
         return Vec::new();
     };
-    let touches = |n: &Option<crate::strategy::Named>| n.as_ref().is_some_and(|n| n.span.touches(offset));
+    let touches =
+        |n: &Option<crate::strategy::Named>| n.as_ref().is_some_and(|n| n.span.touches(offset));
     if touches(&strategy.team) {
         return file
             .teams()
@@ -42,11 +43,18 @@ pub fn definition(file: &StrategyFile<'_>, links: &StrategyLinks, offset: usize)
             return calls_of(strategy, links, index);
         }
         if touches(&service.plan) {
-            let plan = service.plan.as_ref().map(|p| p.name.as_str()).unwrap_or_default();
+            let plan = service
+                .plan
+                .as_ref()
+                .map(|p| p.name.as_str())
+                .unwrap_or_default();
             return plans(file, plan);
         }
     }
-    if let Some(leader) = strategy.grouping.as_ref().and_then(|g| g.leader_selection.as_ref())
+    if let Some(leader) = strategy
+        .grouping
+        .as_ref()
+        .and_then(|g| g.leader_selection.as_ref())
         && let Some(plan) = leader.plan.as_ref().filter(|p| p.span.touches(offset))
     {
         return plans(file, &plan.name);

@@ -156,7 +156,9 @@ fn read_attr<'t>(text: &'t str, start: usize, attrs: &mut Vec<RawAttr<'t>>) -> u
             // An unquoted value (malformed, but read for the editor).
             value_start = pos;
             let mut i = pos;
-            while i < bytes.len() && !bytes[i].is_ascii_whitespace() && !matches!(bytes[i], b'>' | b'<')
+            while i < bytes.len()
+                && !bytes[i].is_ascii_whitespace()
+                && !matches!(bytes[i], b'>' | b'<')
             {
                 i += 1;
             }
@@ -172,7 +174,12 @@ fn read_attr<'t>(text: &'t str, start: usize, attrs: &mut Vec<RawAttr<'t>>) -> u
 }
 
 /// Comments, CDATA, processing instructions and declarations: skipped.
-const MARKUP: [(&str, &str); 4] = [("<!--", "-->"), ("<![CDATA[", "]]>"), ("<?", "?>"), ("<!", ">")];
+const MARKUP: [(&str, &str); 4] = [
+    ("<!--", "-->"),
+    ("<![CDATA[", "]]>"),
+    ("<?", "?>"),
+    ("<!", ">"),
+];
 
 /// Where an offset is, read from the text before it.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -244,7 +251,12 @@ pub fn position_at(text: &str, offset: usize) -> Position<'_> {
             if let Some(i) = out.open.iter().rposition(|&n| n == tag.name) {
                 out.open.truncate(i);
             }
-        } else if !tag.self_closing && !tag.name.is_empty() {
+        } else if !tag.self_closing
+            && !tag.name.is_empty()
+            && (tag.terminated || !tag.attrs.is_empty())
+        {
+            // An unterminated tag with attributes lacks only its `>`; one
+            // without is a name that was being typed.
             out.open.push(tag.name);
         }
         pos = tag.span.end.max(at + 1);
@@ -311,8 +323,7 @@ mod tests {
 
     #[test]
     fn closed_and_self_closing_elements_leave_the_stack() {
-        let (text, offset) =
-            at("<A><B x='1>2'/><C></C><D><E cond=\"a<2\"></E>$0</D>");
+        let (text, offset) = at("<A><B x='1>2'/><C></C><D><E cond=\"a<2\"></E>$0</D>");
         let p = position_at(&text, offset);
         assert_eq!(p.open, ["A", "D"]);
         assert_eq!(p.tag, None);
@@ -326,7 +337,18 @@ mod tests {
 
     #[test]
     fn any_text_gives_an_answer() {
-        for text in ["", "<", "</", "<a b=", "<a b='", "<<<>>>", "<!--", "<?", "é<ü x=\"ö", "<a/><"] {
+        for text in [
+            "",
+            "<",
+            "</",
+            "<a b=",
+            "<a b='",
+            "<<<>>>",
+            "<!--",
+            "<?",
+            "é<ü x=\"ö",
+            "<a/><",
+        ] {
             for offset in 0..=text.len() + 1 {
                 if text.is_char_boundary(offset.min(text.len())) {
                     let _ = position_at(text, offset);

@@ -78,17 +78,157 @@ fn labels_at(marked: &str) -> Vec<String> {
 fn element_names_follow_the_parent_even_half_typed() {
     let marked = STRATEGY.replacen("<ServiceInfo>\n", "<ServiceInfo>\n    <Se$0\n", 1);
     assert_eq!(labels_at(&marked), ["Service"]);
-    let marked = STRATEGY.replacen("<ActionInfo>\n", "<ActionInfo>\n<Action name=\"A\" actionId=\"9\">\n  $0\n</Action>\n", 1);
+    let marked = STRATEGY.replacen(
+        "<ActionInfo>\n",
+        "<ActionInfo>\n<Action name=\"A\" actionId=\"9\">\n  $0\n</Action>\n",
+        1,
+    );
     assert_eq!(
         labels_at(&marked),
-        ["CheckSensor", "ExecuteActuator", "ExecuteAlgorithm", "Parameter", "TransitionInfo"]
+        [
+            "CheckSensor",
+            "ExecuteActuator",
+            "ExecuteAlgorithm",
+            "Parameter",
+            "TransitionInfo"
+        ]
     );
 }
 
 #[test]
 fn attribute_names_leave_out_those_written() {
-    let marked = STRATEGY.replacen("<Action name=\"CheckGoal\"", "<Action $0 name=\"CheckGoal\"", 1);
+    let marked = STRATEGY.replacen(
+        "<Action name=\"CheckGoal\"",
+        "<Action $0 name=\"CheckGoal\"",
+        1,
+    );
     assert_eq!(labels_at(&marked), ["final"]);
     let marked = STRATEGY.replacen("<Service plan_name=", "<Service na$0 plan_name=", 1);
     assert_eq!(labels_at(&marked), ["service_name"]);
+}
+
+#[test]
+fn a_service_leads_to_its_mission_calls_and_back() {
+    let loaded = load(STRATEGY);
+    let missions = [&loaded.mission];
+    let file = loaded.file(STRATEGY, &missions);
+    let at = STRATEGY.find("name=\"move\"").unwrap() + 7;
+    let calls = definition(&file, &loaded.links, at);
+    let shown: Vec<&str> = calls.iter().map(|t| &MISSION[t.span.range()]).collect();
+    assert_eq!(shown, ["move", "move"]);
+    let strategy = loaded.strategy.as_ref().unwrap();
+    for call in &calls {
+        let back = entries_of_call(strategy, &loaded.links, call.file, call.span.start);
+        assert_eq!(
+            back.iter()
+                .map(|s| &STRATEGY[s.range()])
+                .collect::<Vec<_>>(),
+            ["move"]
+        );
+    }
+    let h = hover(&file, at).expect("a hover on the service");
+    assert!(
+        h.markdown.contains("`move(goal?: location)`"),
+        "{}",
+        h.markdown
+    );
+    assert!(
+        h.markdown.contains("`MasterTeam.Action.AutonomousMove`"),
+        "{}",
+        h.markdown
+    );
+}
+
+#[test]
+fn a_raw_lt_is_escaped_and_the_file_then_loads_clean() {
+    let text = STRATEGY.replacen("distance&lt;=20", "distance<=20", 1);
+    let loaded = load(&text);
+    let (index, d) = loaded
+        .diagnostics
+        .iter()
+        .enumerate()
+        .find(|(_, d)| d.code == crate::diag::Code::StrategyRawLt)
+        .expect("E081");
+    let actions = code_actions(&text, &loaded.diagnostics, d.span);
+    assert_eq!(actions.len(), 1);
+    assert_eq!(actions[0].diagnostic, index);
+    let mut fixed = text.clone();
+    let edit = &actions[0].edits[0];
+    fixed.replace_range(edit.span.range(), &edit.new_text);
+    assert_eq!(fixed, STRATEGY);
+    assert_eq!(load(&fixed).diagnostics, []);
+}
+
+#[test]
+fn a_created_entry_checks_clean_and_refines_the_call() {
+    let loaded = load(STRATEGY);
+    let at = MISSION.find("process(USER").unwrap() + 2;
+    let strategy = loaded.strategy.as_ref().unwrap();
+    let edit = create_entry(
+        &loaded.mission,
+        &loaded.catalog,
+        at,
+        strategy,
+        STRATEGY,
+        &loaded.links,
+    )
+    .expect("process has no entry");
+    let mut fixed = STRATEGY.to_string();
+    fixed.insert_str(edit.edit.span.start, &edit.edit.new_text);
+    let after = load(&fixed);
+    assert_eq!(after.diagnostics, []);
+    assert_eq!(after.links.at(FileId(0), at).count(), 1);
+    // `move` is refined already: nothing to create.
+    let moved = MISSION.find("move(\"5,5\")").unwrap();
+    assert_eq!(
+        create_entry(
+            &loaded.mission,
+            &loaded.catalog,
+            moved,
+            strategy,
+            STRATEGY,
+            &loaded.links
+        ),
+        None
+    );
+    // Without `<ServiceInfo>`, the entry comes with one.
+    let bare = "<Strategy name=\"MasterTeam\">\n</Strategy>\n";
+    let loaded = load(bare);
+    let strategy = loaded.strategy.as_ref().unwrap();
+    let edit = create_entry(
+        &loaded.mission,
+        &loaded.catalog,
+        at,
+        strategy,
+        bare,
+        &loaded.links,
+    )
+    .unwrap();
+    let mut fixed = bare.to_string();
+    fixed.insert_str(edit.edit.span.start, &edit.edit.new_text);
+    assert_eq!(load(&fixed).diagnostics, []);
+}
+
+#[test]
+fn the_outline_has_values_then_services_with_their_actions() {
+    let loaded = load(STRATEGY);
+    let symbols = document_symbols(loaded.strategy.as_ref().unwrap());
+    let names: Vec<(&str, usize)> = symbols
+        .iter()
+        .map(|s| (s.name.as_str(), s.children.len()))
+        .collect();
+    assert_eq!(
+        names,
+        [("DISTANCE", 0), ("LOCATION", 0), ("Action.move", 5)]
+    );
+    for s in symbols
+        .iter()
+        .chain(symbols.iter().flat_map(|s| s.children.iter()))
+    {
+        assert!(
+            s.span.start <= s.name_span.start && s.name_span.end <= s.span.end,
+            "{}",
+            s.name
+        );
+    }
 }
