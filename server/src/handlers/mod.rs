@@ -41,9 +41,10 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
             },
         )),
         completion_provider: Some(CompletionOptions {
-            // `"` opens a value in task-graph files (`src="`).
+            // `"` opens a value in XML files (`src="`), `<` an element in
+            // strategy files.
             trigger_characters: Some(
-                [".", "(", "=", ",", ":", "[", "\""]
+                [".", "(", "=", ",", ":", "[", "\"", "<"]
                     .map(String::from)
                     .to_vec(),
             ),
