@@ -35,15 +35,25 @@ pub struct StrategyFile<'a> {
 }
 
 impl<'a> StrategyFile<'a> {
+    /// The strategy's team: from the model, else (the file does not load
+    /// yet) from the `<Strategy name="...">` tag as written.
+    pub fn team_name(&self) -> Option<&'a str> {
+        if let Some(team) = self.strategy.and_then(|s| s.team.as_ref()) {
+            return Some(&team.name);
+        }
+        let start = self.text.find("<Strategy")?;
+        raw::read_tag(self.text, start).value("name").map(str::trim)
+    }
+
     /// The strategy's team in each mission that declares it.
     pub fn teams(&self) -> Vec<(&'a Analysis, TeamId, &'a Team)> {
-        let Some(name) = self.strategy.and_then(|s| s.team.as_ref()) else {
+        let Some(name) = self.team_name() else {
             return Vec::new();
         };
         self.missions
             .iter()
             .filter_map(|a| {
-                let id = a.mission.team_by_name(&name.name)?;
+                let id = a.mission.team_by_name(name)?;
                 Some((*a, id, a.mission.team(id)))
             })
             .collect()

@@ -232,3 +232,19 @@ fn the_outline_has_values_then_services_with_their_actions() {
         );
     }
 }
+
+#[test]
+fn the_team_is_read_from_the_text_when_the_file_does_not_load() {
+    // No `>` after the root tag: no model, but the team's services are known.
+    let marked =
+        "<Strategy name=\"MasterTeam\"\n<ServiceInfo><Service plan_name=\"Action\" name=\"$0";
+    let (text, at) = cursor(marked);
+    let loaded = load(&text);
+    assert!(loaded.strategy.is_none());
+    let missions = [&loaded.mission];
+    let labels: Vec<String> = completions(&loaded.file(&text, &missions), at, false)
+        .into_iter()
+        .map(|c| c.label)
+        .collect();
+    assert_eq!(labels, ["move", "process", "standby"]);
+}
