@@ -248,3 +248,32 @@ fn the_team_is_read_from_the_text_when_the_file_does_not_load() {
         .collect();
     assert_eq!(labels, ["move", "process", "standby"]);
 }
+
+/// A strategy of 10,000 lines: completion, hover and navigation at its end
+/// scan the text before the cursor once, and stay well under a keystroke.
+#[test]
+fn features_stay_fast_on_a_large_strategy() {
+    let start = STRATEGY.find("<ServiceInfo>").unwrap() + "<ServiceInfo>\n".len();
+    let service_start = STRATEGY.find("    <Service plan_name").unwrap();
+    let service_end = STRATEGY.find("</Service>").unwrap() + "</Service>\n".len();
+    let service = &STRATEGY[service_start..service_end];
+    let mut text = STRATEGY[..start].to_string();
+    while text.lines().count() < 10_000 {
+        text.push_str(service);
+    }
+    text.push_str("    <Service plan_name=\"Action\" name=\"");
+    let at = text.len();
+    text.push_str("\">\n");
+    text.push_str(&STRATEGY[service_end..]);
+    let loaded = load(&text);
+    let missions = [&loaded.mission];
+    let file = loaded.file(&text, &missions);
+    let started = std::time::Instant::now();
+    let items = completions(&file, at, false);
+    let _ = hover(&file, at);
+    let _ = definition(&file, &loaded.links, at);
+    let elapsed = started.elapsed();
+    assert_eq!(items.len(), 3);
+    // Loose, for debug builds on a busy machine; ~1 ms in release.
+    assert!(elapsed.as_millis() < 250, "{elapsed:?}");
+}
