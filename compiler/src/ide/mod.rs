@@ -13,7 +13,7 @@ mod docs;
 pub mod folding;
 pub mod hover;
 pub mod inlay_hints;
-mod lookup;
+pub(crate) mod lookup;
 pub mod navigation;
 pub mod rename;
 mod robots;

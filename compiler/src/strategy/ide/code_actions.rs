@@ -170,6 +170,14 @@ pub fn create_entry(
     text: &str,
     links: &StrategyLinks,
 ) -> Option<EntryEdit> {
+    // Cheap refusal first (code actions are asked for at every cursor move):
+    // the cursor must be on a built-in service's name.
+    let on_builtin = crate::ide::lookup::at(&mission.mission, offset)
+        .iter()
+        .any(|o| matches!(o.symbol, crate::sema::Symbol::BuiltinService(_)));
+    if !on_builtin {
+        return None;
+    }
     let team_name = &strategy.team.as_ref()?.name;
     let team_id = mission.mission.team_by_name(team_name)?;
     let team = mission.mission.team(team_id);
