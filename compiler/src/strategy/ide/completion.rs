@@ -81,13 +81,15 @@ pub fn completions(file: &StrategyFile<'_>, offset: usize, snippets: bool) -> Ve
     let Some(tag) = &position.tag else {
         // Between tags: a new element (with its `<`).
         let typed = Span::new(offset, offset);
-        return elements(&position, typed, "<");
+        return elements(&position, typed, "<", snippets);
     };
     if tag.closing {
         return close_tag(&position, tag, offset);
     }
     if tag.name_span.touches(offset) {
-        return elements(&position, tag.name_span, "");
+        // A bare name being typed gets its required attributes as well.
+        let bare = snippets && tag.attrs.is_empty() && !tag.terminated;
+        return elements(&position, tag.name_span, "", bare);
     }
     if let Some(attr) = tag.attrs.iter().find(|a| in_value(text, a, offset)) {
         return values(file, tag, attr, offset);
@@ -108,7 +110,14 @@ fn in_value(text: &str, attr: &RawAttr<'_>, offset: usize) -> bool {
     quoted && span.touches(offset)
 }
 
-fn elements(position: &Position<'_>, replace: Span, prefix: &str) -> Vec<Completion> {
+/// The elements allowed in the parent; with `required`, each inserted with
+/// its required attributes as snippet fields (`<Service plan_name="$1" name="$2"`).
+fn elements(
+    position: &Position<'_>,
+    replace: Span,
+    prefix: &str,
+    required: bool,
+) -> Vec<Completion> {
     children(position.parent(), position.grandparent())
         .iter()
         .map(|name| {
@@ -116,6 +125,12 @@ fn elements(position: &Position<'_>, replace: Span, prefix: &str) -> Vec<Complet
             item.insert = format!("{prefix}{name}");
             let info = element_info(name);
             if let Some(info) = info {
+                if required && !info.required.is_empty() {
+                    for (i, attr) in info.required.iter().enumerate() {
+                        item.insert.push_str(&format!(" {attr}=\"${}\"", i + 1));
+                    }
+                    item.snippet = true;
+                }
                 item = item.doc(info.doc);
                 if !info.required.is_empty() {
                     item = item.detail(format!("needs {}", info.required.join(", ")));
