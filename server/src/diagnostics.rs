@@ -121,7 +121,7 @@ pub fn to_lsp(
                         (snapshot.uri.clone(), here.range(r.span))
                     } else {
                         let uri = others.get(&r.file)?;
-                        let text = snapshot.catalog.text_of(r.file)?;
+                        let text = snapshot.text_of(r.file)?;
                         let index = other_lines
                             .entry(r.file)
                             .or_insert_with(|| LineIndex::new(text));

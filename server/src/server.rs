@@ -405,8 +405,11 @@ impl LanguageServer for Backend {
 
     async fn code_action(&self, p: CodeActionParams) -> Result<Option<CodeActionResponse>> {
         let uri = p.text_document.uri.clone();
-        self.on_snapshot(&uri, move |s| handlers::code_actions::code_actions(s, &p))
-            .await
+        let strategies = self.state.world().strategies();
+        self.on_snapshot(&uri, move |s| {
+            handlers::code_actions::code_actions(s, &strategies, &p)
+        })
+        .await
     }
 
     // Navigation and structure.
@@ -416,9 +419,10 @@ impl LanguageServer for Backend {
         p: GotoDefinitionParams,
     ) -> Result<Option<GotoDefinitionResponse>> {
         let at = p.text_document_position_params;
+        let strategies = self.state.world().strategies();
         let found = self
             .on_snapshot(&at.text_document.uri, move |s| {
-                handlers::definition::definition(s, at.position)
+                handlers::definition::definition(s, &strategies, at.position)
             })
             .await?;
         let world = self.state.world();

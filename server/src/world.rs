@@ -13,7 +13,7 @@ use crate::encoding::{Encoding, LineMap};
 use semo::catalog::{Catalog, CatalogSource, load_catalog};
 use semo::diag::{self, Diagnostic, FileId};
 use semo::sema::{Analysis, check_parsed};
-use semo::strategy::{Strategy, cross_check, load_strategy};
+use semo::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
 use semo::syntax::{ParseCache, parse_incremental};
 use semo::taskgraph::subgraph::{self, SubgraphSource};
 use semo::text::LineIndex;
@@ -149,6 +149,9 @@ pub struct FileAnalysis {
     pub mission: Option<Analysis>,
     pub graph: Option<GraphRun>,
     pub strategy: Option<Strategy>,
+    /// For a strategy file: the mission calls its entries refine (against
+    /// the snapshot's `missions`).
+    pub strategy_links: StrategyLinks,
 }
 
 impl FileAnalysis {
@@ -159,6 +162,7 @@ impl FileAnalysis {
             mission: None,
             graph: None,
             strategy: None,
+            strategy_links: StrategyLinks::default(),
         }
     }
 
@@ -214,8 +218,10 @@ impl Snapshot {
                         self.missions.iter().map(|m| m.analysis()).collect();
                     let missions: Vec<&Analysis> =
                         analyses.iter().filter_map(|a| a.mission.as_ref()).collect();
-                    let (_, cross) = cross_check(&[strategy], &missions, self.catalog.catalog());
+                    let (links, cross) =
+                        cross_check(&[strategy], &missions, self.catalog.catalog());
                     diagnostics.extend(cross.into_iter().filter(|d| d.file == self.id));
+                    out.strategy_links = links;
                     diag::sort_and_dedup(&mut diagnostics);
                 }
                 out.other_diagnostics = diagnostics;
@@ -223,6 +229,18 @@ impl Snapshot {
             }
         }
         out
+    }
+
+    /// The text of another file this snapshot's analysis refers to: one of
+    /// its missions or a catalog file.
+    pub fn text_of(&self, file: FileId) -> Option<&str> {
+        if file == self.id {
+            return Some(&self.text);
+        }
+        if let Some(m) = self.missions.iter().find(|m| m.id == file) {
+            return Some(&m.text);
+        }
+        self.catalog.text_of(file)
     }
 
     /// Converts positions of this snapshot's text.
@@ -334,6 +352,16 @@ impl World {
     /// The current snapshot of every file the server knows.
     pub fn snapshots(&self) -> impl Iterator<Item = &Arc<Snapshot>> {
         self.files.values().map(|f| &f.snapshot)
+    }
+
+    /// The current snapshot of every strategy file (for features of missions
+    /// that lead into strategies).
+    pub fn strategies(&self) -> Vec<Arc<Snapshot>> {
+        self.files
+            .values()
+            .filter(|f| f.kind == FileKind::Strategy)
+            .map(|f| f.snapshot.clone())
+            .collect()
     }
 
     pub fn catalog(&mut self) -> Arc<CatalogState> {

@@ -74,6 +74,69 @@ fn every_request_at_every_position_answers() {
     session.shutdown();
 }
 
+/// Strategy files being typed: unterminated tags, quotes and comments, raw
+/// `<` and `&`, Unicode, unknown elements.
+const STRATEGY_TEXTS: &[&str] = &[
+    "",
+    "<",
+    "</",
+    "<Strategy",
+    "<Strategy name=\"",
+    "<Strategy name='T'><ServiceInfo><Service name=\"mo",
+    "<?xml version=\"1.0\"?>\n<!-- <Strategy> \n",
+    "<Strategy name=\"MasterTeam\">\n<ServiceInfo>\n<Service plan_name=\"Action\" name=\"move\">\n<ActionInfo>\n<Action name=\"A\" actionId=\"x\" initial=\"Yes\">\n<TransitionInfo><Transition srcId=\"0\" dstId=\"\"><Condition cond=\"a<2 & b>\"/></Transition>\n</Action></ActionInfo></Service>\n",
+    "<Strategy name=\"팀😀\"><ValueInfo><Value name=\"😀\"><TargetRobot name=\"로봇\"/></Value></ValueInfo></Strategy>",
+    "<Strategy name=\"MasterTeam\"><Bogus><Service/></Bogus></Strategy></Strategy></",
+    "<<<>>>\"\"''<![CDATA[ <x> ]]><x y=z/>",
+];
+
+#[test]
+fn every_strategy_request_at_every_position_answers() {
+    let mut session = Session::new();
+    let scouting = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/examples/scouting/scouting.mission");
+    let mission = std::fs::read_to_string(scouting).expect("the scouting mission");
+    session.open("scouting.mission", &mission);
+    for text in STRATEGY_TEXTS {
+        let doc = session.open("robust.strategy.xml", text);
+        let params = json!({ "textDocument": { "uri": doc.uri } });
+        if let Err(e) = session.request("textDocument/documentSymbol", params) {
+            panic!("documentSymbol of {text:?}: {e}");
+        }
+        for position in positions(text) {
+            for method in [
+                "textDocument/completion",
+                "textDocument/hover",
+                "textDocument/definition",
+            ] {
+                let params = json!({ "textDocument": { "uri": doc.uri }, "position": position });
+                if let Err(e) = session.request(method, params) {
+                    panic!("{method} at {position} of {text:?}: {e}");
+                }
+            }
+            let params = json!({
+                "textDocument": { "uri": doc.uri },
+                "position": position,
+                "context": { "includeDeclaration": true },
+            });
+            if let Err(e) = session.request("textDocument/references", params) {
+                panic!("references at {position} of {text:?}: {e}");
+            }
+            let range = json!({ "start": position, "end": position });
+            let params = json!({
+                "textDocument": { "uri": doc.uri },
+                "range": range,
+                "context": { "diagnostics": doc.diagnostics },
+            });
+            if let Err(e) = session.request("textDocument/codeAction", params) {
+                panic!("codeAction at {position} of {text:?}: {e}");
+            }
+        }
+    }
+    assert!(session.client.server_is_running());
+    session.shutdown();
+}
+
 /// Requests about a document the server does not know are errors, not crashes.
 #[test]
 fn unknown_documents_are_an_error() {

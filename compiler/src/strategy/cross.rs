@@ -130,7 +130,7 @@ pub fn cross_check(
 }
 
 /// A robot type's task library, when it is fully known (see the module docs).
-fn task_library(robot: &RobotType) -> Option<Vec<&str>> {
+pub fn task_library(robot: &RobotType) -> Option<Vec<&str>> {
     let mut tasks = vec![CONTROL_TASK];
     let implementations = robot
         .values
@@ -174,12 +174,35 @@ fn distinct<'a>(names: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
 }
 
 /// One built-in service call run by a team's composite service.
-struct BuiltinCall {
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BuiltinCall {
     /// The catalog's name of the service.
-    name: ast::Name,
-    span: Span,
-    plan: Index,
-    service: Index,
+    pub name: ast::Name,
+    /// The called name's range in the mission.
+    pub span: Span,
+    pub plan: Index,
+    /// The composite service that runs it (directly or through functions).
+    pub service: Index,
+}
+
+/// The built-in calls that `team`'s composite services run, service by
+/// service (a call inside a function once per service running it): what a
+/// strategy of the team may refine.
+pub fn team_calls(analysis: &Analysis, team: TeamId) -> Vec<BuiltinCall> {
+    let Some(team) = analysis.mission.teams.get(team.0 as usize) else {
+        return Vec::new();
+    };
+    let mut calls = Vec::new();
+    for (index, service) in team.services.iter().enumerate() {
+        let walked = walk_service(analysis, service);
+        calls.extend(walked.calls.into_iter().map(|(name, span)| BuiltinCall {
+            name,
+            span,
+            plan: service.plan,
+            service: index as Index,
+        }));
+    }
+    calls
 }
 
 /// What the cross checks need of one mission, computed once.

@@ -6,6 +6,8 @@
 //!   forms; conditions parsed with the mission expression grammar).
 //! - `check`: per-file checks (duplicates, names read by conditions).
 //! - `machine`: each service's actions checked as a graph (petgraph).
+//! - [`schema`]: the vocabulary (attributes, children, descriptions).
+//! - [`ide`]: editor features over the raw text and the model.
 //! - [`cross`]: checks against the catalog and the missions of the same check,
 //!   and the link from mission calls to strategy entries ([`StrategyLinks`]).
 //!
@@ -13,11 +15,16 @@
 
 mod check;
 pub mod cross;
+pub mod ide;
 mod machine;
 pub mod model;
+pub mod schema;
 mod xml;
 
-pub use cross::{CONTROL_TASK, CallLink, ServiceEntryRef, StrategyLinks, cross_check};
+pub use cross::{
+    BuiltinCall, CONTROL_TASK, CallLink, ServiceEntryRef, StrategyLinks, cross_check, task_library,
+    team_calls,
+};
 pub use model::*;
 
 use crate::diag::{self, Diagnostic, FileId};

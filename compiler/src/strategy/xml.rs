@@ -15,6 +15,7 @@
 //!   where the value is written with entities (`&lt;`).
 
 use super::model::*;
+use super::schema::*;
 use crate::diag::{Code, Diagnostic, FileId};
 use crate::span::Span;
 use crate::syntax::ast::TimeUnit;
@@ -81,28 +82,6 @@ const ELEMENTS: &[(&str, &str)] = &[
         "inside the `<Condition>` of a `<BatteryRequirement>`",
     ),
 ];
-
-const STRATEGY_ATTRS: &[&str] = &["name"];
-const VALUE_ATTRS: &[&str] = &["name"];
-const SERVICE_ATTRS: &[&str] = &["plan_name", "name", "service_name"];
-const TARGET_ATTRS: &[&str] = &["name", "nickName", "ea"];
-const TASK_USE_ATTRS: &[&str] = &["name"];
-const PARAMETER_ATTRS: &[&str] = &[
-    "name",
-    "type",
-    "dataCharacteristic",
-    "size",
-    "value",
-    "srcTask",
-    "dstTask",
-];
-const ACTION_ATTRS: &[&str] = &["name", "actionId", "initial", "final"];
-const TRANSITION_ATTRS: &[&str] = &["srcId", "dstId"];
-const CONDITION_ATTRS: &[&str] = &["cond"];
-const LEADER_ATTRS: &[&str] = &["algorithm", "heartbeatPeriod", "plan_name", "cs_name"];
-const SYNC_ATTRS: &[&str] = &["timeout"];
-const SENSOR_ATTRS: &[&str] = &["name", "periodLevel"];
-const ACTUATOR_ATTRS: &[&str] = &["name", "speedLevel"];
 
 struct Reader<'t> {
     file: FileId,

@@ -4,29 +4,48 @@
 //! Fixes are computed from the snapshot's own diagnostics (so that their
 //! edits match the text the server has); each is attached to the client's
 //! copy of its diagnostic when the request carries it (same code and range),
-//! else to the diagnostic as the server publishes it.
+//! else to the diagnostic as the server publishes it. In a mission, a
+//! `refactor` action also creates the strategy entry of the built-in call at
+//! the cursor (see [`super::strategy::create_entries`]).
 
 use crate::diagnostics;
 use crate::world::Snapshot;
+use semo::workspace::FileKind;
 use std::collections::HashMap;
+use std::sync::Arc;
 use tower_lsp_server::ls_types::*;
 
-pub fn code_actions(snapshot: &Snapshot, params: &CodeActionParams) -> Option<CodeActionResponse> {
-    if let Some(only) = &params.context.only
-        && !only
-            .iter()
-            .any(|k| *k == CodeActionKind::QUICKFIX || k.as_str().is_empty())
-    {
-        return Some(Vec::new());
+pub fn code_actions(
+    snapshot: &Snapshot,
+    strategies: &[Arc<Snapshot>],
+    params: &CodeActionParams,
+) -> Option<CodeActionResponse> {
+    let wanted = |kind: &CodeActionKind| {
+        params.context.only.as_ref().is_none_or(|only| {
+            only.iter()
+                .any(|k| k.as_str().is_empty() || kind.as_str().starts_with(k.as_str()))
+        })
+    };
+    let mut assists = Vec::new();
+    if wanted(&CodeActionKind::REFACTOR) && snapshot.kind == FileKind::Mission {
+        assists = super::strategy::create_entries(snapshot, strategies, params.range);
+    }
+    if !wanted(&CodeActionKind::QUICKFIX) {
+        return Some(assists);
+    }
+    if snapshot.kind == FileKind::Strategy {
+        return Some(super::strategy::code_actions(snapshot, params));
     }
     let analysis = snapshot.analysis();
-    let mission = analysis.mission.as_ref()?;
+    let Some(mission) = analysis.mission.as_ref() else {
+        return Some(assists);
+    };
     let lines = snapshot.line_map(&analysis);
     let span = lines.span(params.range);
     let catalog = snapshot.catalog.catalog();
     let actions = semo::ide::code_actions::code_actions(mission, catalog, &snapshot.text, span);
     if actions.is_empty() {
-        return Some(Vec::new());
+        return Some(assists);
     }
     let published = diagnostics::to_lsp(snapshot, &analysis, &HashMap::new());
     let response = actions
@@ -61,6 +80,7 @@ pub fn code_actions(snapshot: &Snapshot, params: &CodeActionParams) -> Option<Co
                 ..CodeAction::default()
             }))
         })
+        .chain(assists)
         .collect();
     Some(response)
 }

@@ -2,6 +2,7 @@
 
 use crate::world::Snapshot;
 use semo::ide::completion::{self, CompletionConfig, CompletionKind};
+use semo::workspace::FileKind;
 use tower_lsp_server::ls_types::*;
 
 pub fn completion(
@@ -9,6 +10,13 @@ pub fn completion(
     position: Position,
     config: CompletionConfig,
 ) -> Option<CompletionResponse> {
+    if snapshot.kind == FileKind::Strategy {
+        return Some(super::strategy::completion(
+            snapshot,
+            position,
+            config.snippets,
+        ));
+    }
     let analysis = snapshot.analysis();
     if analysis.graph.is_some() {
         return super::taskgraph::completion(snapshot, &analysis, position);

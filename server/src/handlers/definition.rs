@@ -1,12 +1,16 @@
 //! `textDocument/definition`: from a name to where its symbol is defined, in
-//! the mission or in a workspace catalog file (see `semo::ide::navigation`);
-//! in a task graph, from a `subgraph` attribute to the file it names.
+//! the mission or in a workspace catalog file (see `semo::ide::navigation`),
+//! and from a built-in call to the strategy entries refining it; in a task
+//! graph, from a `subgraph` attribute to the file it names; in strategy files,
+//! see [`super::strategy`].
 
 use crate::encoding::LineMap;
 use crate::world::Snapshot;
 use semo::diag::FileId;
 use semo::text::LineIndex;
+use semo::workspace::FileKind;
 use std::collections::HashMap;
+use std::sync::Arc;
 use tower_lsp_server::ls_types::{GotoDefinitionResponse, Location, Position, Range, Uri};
 
 /// Where a definition is: a file the world knows by id (the caller maps ids
@@ -16,12 +20,23 @@ pub enum Place {
     Uri(Uri),
 }
 
-/// The definitions of the name at `position`.
-pub fn definition(snapshot: &Snapshot, position: Position) -> Vec<(Place, Range)> {
+/// The definitions of the name at `position`. From a mission's built-in
+/// call: the entries of the `strategies` refining it first, then the service
+/// in the catalog.
+pub fn definition(
+    snapshot: &Snapshot,
+    strategies: &[Arc<Snapshot>],
+    position: Position,
+) -> Vec<(Place, Range)> {
     if let Some(found) = sub_graph_file(snapshot, position) {
         return vec![(Place::Uri(found), Range::default())];
     }
-    mission_definition(snapshot, position)
+    let found = if snapshot.kind == FileKind::Strategy {
+        super::strategy::definition(snapshot, position)
+    } else {
+        mission_definition(snapshot, strategies, position)
+    };
+    found
         .into_iter()
         .map(|(file, range)| (Place::File(file), range))
         .collect()
@@ -41,15 +56,20 @@ fn sub_graph_file(snapshot: &Snapshot, position: Position) -> Option<Uri> {
     Uri::from_file_path(&reference.location)
 }
 
-fn mission_definition(snapshot: &Snapshot, position: Position) -> Vec<(FileId, Range)> {
+fn mission_definition(
+    snapshot: &Snapshot,
+    strategies: &[Arc<Snapshot>],
+    position: Position,
+) -> Vec<(FileId, Range)> {
     super::with_mission(snapshot, |analysis, lines| {
         let offset = lines.offset(position);
         let catalog = &snapshot.catalog;
         let targets = semo::ide::navigation::definition(analysis, catalog.catalog(), offset);
         let mut indexes: HashMap<FileId, LineIndex> = HashMap::new();
-        targets
+        let entries = super::strategy::entries_of_call(snapshot, strategies, offset);
+        entries
             .into_iter()
-            .filter_map(|target| {
+            .chain(targets.into_iter().filter_map(|target| {
                 if target.file == snapshot.id {
                     return Some((target.file, lines.range(target.span)));
                 }
@@ -63,7 +83,7 @@ fn mission_definition(snapshot: &Snapshot, position: Position) -> Vec<(FileId, R
                     encoding: snapshot.encoding,
                 };
                 Some((target.file, map.range(target.span)))
-            })
+            }))
             .collect()
     })
     .unwrap_or_default()

@@ -4,9 +4,13 @@
 use crate::encoding::LineMap;
 use crate::world::Snapshot;
 use semo::ide::symbols::{self, SymbolKind as Kind};
+use semo::workspace::FileKind;
 use tower_lsp_server::ls_types::{DocumentSymbol, DocumentSymbolResponse, SymbolKind};
 
 pub fn document_symbol(snapshot: &Snapshot) -> Option<DocumentSymbolResponse> {
+    if snapshot.kind == FileKind::Strategy {
+        return super::strategy::document_symbol(snapshot);
+    }
     super::with_mission(snapshot, |analysis, lines| {
         let outline = symbols::document_symbols(analysis, &snapshot.text);
         DocumentSymbolResponse::Nested(outline.iter().map(|s| convert(s, &lines)).collect())

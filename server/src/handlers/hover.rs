@@ -1,9 +1,13 @@
 //! `textDocument/hover`: [`semo::ide::hover`] in protocol types.
 
 use crate::world::Snapshot;
+use semo::workspace::FileKind;
 use tower_lsp_server::ls_types::*;
 
 pub fn hover(snapshot: &Snapshot, position: Position) -> Option<Hover> {
+    if snapshot.kind == FileKind::Strategy {
+        return super::strategy::hover(snapshot, position);
+    }
     let analysis = snapshot.analysis();
     if analysis.graph.is_some() {
         return super::taskgraph::hover(snapshot, &analysis, position);

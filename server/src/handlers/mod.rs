@@ -18,6 +18,7 @@ pub mod rename;
 pub mod selection_range;
 pub mod semantic_tokens;
 pub mod signature_help;
+pub mod strategy;
 pub mod taskgraph;
 pub mod workspace_symbol;
 
@@ -41,9 +42,10 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
             },
         )),
         completion_provider: Some(CompletionOptions {
-            // `"` opens a value in task-graph files (`src="`).
+            // `"` opens a value in XML files (`src="`), `<` an element in
+            // strategy files.
             trigger_characters: Some(
-                [".", "(", "=", ",", ":", "[", "\""]
+                [".", "(", "=", ",", ":", "[", "\"", "<"]
                     .map(String::from)
                     .to_vec(),
             ),
@@ -56,7 +58,7 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
         }),
         inlay_hint_provider: Some(OneOf::Left(true)),
         code_action_provider: Some(CodeActionProviderCapability::Options(CodeActionOptions {
-            code_action_kinds: Some(vec![CodeActionKind::QUICKFIX]),
+            code_action_kinds: Some(vec![CodeActionKind::QUICKFIX, CodeActionKind::REFACTOR]),
             ..Default::default()
         })),
         // Navigation and structure.

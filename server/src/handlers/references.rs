@@ -2,11 +2,16 @@
 //! the position; its definitions only if the client asks for declarations.
 
 use crate::world::Snapshot;
+use semo::workspace::FileKind;
 use tower_lsp_server::ls_types::{Location, ReferenceParams};
 
 pub fn references(snapshot: &Snapshot, params: &ReferenceParams) -> Option<Vec<Location>> {
     let include_declaration = params.context.include_declaration;
     let position = params.text_document_position.position;
+    if snapshot.kind == FileKind::Strategy {
+        let found = super::strategy::references(snapshot, position, include_declaration);
+        return (!found.is_empty()).then_some(found);
+    }
     super::with_mission(snapshot, |analysis, lines| {
         let offset = lines.offset(position);
         semo::ide::navigation::references(analysis, offset)

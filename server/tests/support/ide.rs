@@ -88,6 +88,12 @@ impl Session {
         self.runtime.block_on(self.client.request(method, params))
     }
 
+    /// The diagnostics published for `version` of `uri`.
+    pub fn diagnostics(&mut self, uri: &str, version: i64) -> Vec<Value> {
+        self.runtime
+            .block_on(self.client.diagnostics(uri, Some(version)))
+    }
+
     /// A request at a position of a document, which must succeed.
     pub fn at(&mut self, method: &str, doc: &Doc, position: &Value) -> Value {
         let params = json!({ "textDocument": { "uri": doc.uri }, "position": position });

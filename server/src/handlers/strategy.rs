@@ -1,0 +1,299 @@
+//! Completion, hover, navigation, outline and fixes in `*.strategy.xml`
+//! files: [`semo::strategy::ide`] in protocol types. The request handlers
+//! hand strategy files over to these; a strategy snapshot carries the
+//! missions it was checked against, so names lead into them.
+
+use crate::encoding::LineMap;
+use crate::world::{FileAnalysis, Snapshot};
+use semo::Analysis;
+use semo::diag::FileId;
+use semo::strategy::ide::{self, StrategyFile, navigation::Target};
+use semo::text::LineIndex;
+use std::collections::HashMap;
+use std::sync::Arc;
+use tower_lsp_server::ls_types::*;
+
+/// Runs `f` on the strategy file of `snapshot` with its missions analysed.
+fn with_file<T>(
+    snapshot: &Snapshot,
+    f: impl FnOnce(&StrategyFile<'_>, &FileAnalysis, LineMap<'_>) -> T,
+) -> T {
+    let analysis = snapshot.analysis();
+    let analyses: Vec<Arc<FileAnalysis>> = snapshot.missions.iter().map(|m| m.analysis()).collect();
+    let missions: Vec<&Analysis> = analyses.iter().filter_map(|a| a.mission.as_ref()).collect();
+    let file = StrategyFile {
+        text: &snapshot.text,
+        strategy: analysis.strategy.as_ref(),
+        missions: &missions,
+        catalog: snapshot.catalog.catalog(),
+    };
+    f(&file, &analysis, snapshot.line_map(&analysis))
+}
+
+pub fn completion(snapshot: &Snapshot, position: Position, snippets: bool) -> CompletionResponse {
+    with_file(snapshot, |file, _, lines| {
+        let offset = lines.offset(position);
+        let items = ide::completion::completions(file, offset, snippets)
+            .into_iter()
+            .enumerate()
+            .map(|(i, item)| CompletionItem {
+                kind: Some(kind(item.kind)),
+                detail: item.detail,
+                documentation: item.documentation.map(|value| {
+                    Documentation::MarkupContent(MarkupContent {
+                        kind: MarkupKind::Markdown,
+                        value,
+                    })
+                }),
+                insert_text_format: Some(match item.snippet {
+                    true => InsertTextFormat::SNIPPET,
+                    false => InsertTextFormat::PLAIN_TEXT,
+                }),
+                ..super::completion::in_order(i, item.label, lines.range(item.replace), item.insert)
+            })
+            .collect();
+        super::completion::list(items)
+    })
+}
+
+fn kind(kind: ide::completion::CompletionKind) -> CompletionItemKind {
+    use ide::completion::CompletionKind as K;
+    match kind {
+        K::Element => CompletionItemKind::CLASS,
+        K::Attribute => CompletionItemKind::PROPERTY,
+        K::Keyword => CompletionItemKind::ENUM_MEMBER,
+        K::Team => CompletionItemKind::MODULE,
+        K::Robot => CompletionItemKind::VARIABLE,
+        K::RobotType => CompletionItemKind::CLASS,
+        K::Plan => CompletionItemKind::STRUCT,
+        K::Service => CompletionItemKind::FUNCTION,
+        K::Value => CompletionItemKind::FIELD,
+        K::Task => CompletionItemKind::MODULE,
+        K::Action => CompletionItemKind::ENUM_MEMBER,
+    }
+}
+
+pub fn hover(snapshot: &Snapshot, position: Position) -> Option<Hover> {
+    with_file(snapshot, |file, _, lines| {
+        let found = ide::hover::hover(file, lines.offset(position))?;
+        Some(Hover {
+            contents: HoverContents::Markup(MarkupContent {
+                kind: MarkupKind::Markdown,
+                value: found.markdown,
+            }),
+            range: Some(lines.range(found.span)),
+        })
+    })
+}
+
+/// Targets as ranges of their files (the missions of the snapshot, catalog
+/// files, the file itself).
+fn ranges(snapshot: &Snapshot, targets: Vec<Target>) -> Vec<(FileId, Range)> {
+    let mut indexes: HashMap<FileId, LineIndex> = HashMap::new();
+    targets
+        .into_iter()
+        .filter_map(|t| {
+            let text = snapshot.text_of(t.file)?;
+            let index = indexes
+                .entry(t.file)
+                .or_insert_with(|| LineIndex::new(text));
+            let map = LineMap {
+                text,
+                index,
+                encoding: snapshot.encoding,
+            };
+            Some((t.file, map.range(t.span)))
+        })
+        .collect()
+}
+
+pub fn definition(snapshot: &Snapshot, position: Position) -> Vec<(FileId, Range)> {
+    let targets = with_file(snapshot, |file, analysis, lines| {
+        ide::navigation::definition(file, &analysis.strategy_links, lines.offset(position))
+    });
+    ranges(snapshot, targets)
+}
+
+pub fn references(
+    snapshot: &Snapshot,
+    position: Position,
+    include_declaration: bool,
+) -> Vec<Location> {
+    let targets = with_file(snapshot, |file, analysis, lines| {
+        let offset = lines.offset(position);
+        ide::navigation::references(file, &analysis.strategy_links, offset, include_declaration)
+    });
+    let uri_of = |id: FileId| {
+        if id == snapshot.id {
+            return Some(snapshot.uri.clone());
+        }
+        snapshot
+            .missions
+            .iter()
+            .find(|m| m.id == id)
+            .map(|m| m.uri.clone())
+    };
+    ranges(snapshot, targets)
+        .into_iter()
+        .filter_map(|(file, range)| Some(Location::new(uri_of(file)?, range)))
+        .collect()
+}
+
+/// From a mission call to the entries of the workspace's strategy files
+/// that refine it. A strategy snapshot is checked against the current
+/// missions, so its links point into this very version of the mission.
+pub fn entries_of_call(
+    mission: &Snapshot,
+    strategies: &[Arc<Snapshot>],
+    offset: usize,
+) -> Vec<(FileId, Range)> {
+    let mut out = Vec::new();
+    for strategy in strategies {
+        if !strategy
+            .missions
+            .iter()
+            .any(|m| std::ptr::eq(&**m, mission))
+        {
+            continue;
+        }
+        let analysis = strategy.analysis();
+        let Some(model) = &analysis.strategy else {
+            continue;
+        };
+        let lines = strategy.line_map(&analysis);
+        for span in
+            ide::navigation::entries_of_call(model, &analysis.strategy_links, mission.id, offset)
+        {
+            out.push((strategy.id, lines.range(span)));
+        }
+    }
+    out
+}
+
+pub fn document_symbol(snapshot: &Snapshot) -> Option<DocumentSymbolResponse> {
+    let analysis = snapshot.analysis();
+    let strategy = analysis.strategy.as_ref()?;
+    let lines = snapshot.line_map(&analysis);
+    let symbols = ide::symbols::document_symbols(strategy);
+    Some(DocumentSymbolResponse::Nested(
+        symbols.iter().map(|s| symbol(s, &lines)).collect(),
+    ))
+}
+
+fn symbol(s: &ide::symbols::Symbol, lines: &LineMap<'_>) -> DocumentSymbol {
+    use ide::symbols::SymbolKind as K;
+    #[allow(deprecated)] // `deprecated` must be written, even as None
+    DocumentSymbol {
+        name: s.name.clone(),
+        detail: s.detail.clone(),
+        kind: match s.kind {
+            K::Value => SymbolKind::FIELD,
+            K::Service => SymbolKind::FUNCTION,
+            K::Action => SymbolKind::ENUM_MEMBER,
+        },
+        tags: None,
+        deprecated: None,
+        range: lines.range(s.span),
+        selection_range: lines.range(s.name_span),
+        children: (!s.children.is_empty())
+            .then(|| s.children.iter().map(|c| symbol(c, lines)).collect()),
+    }
+}
+
+/// The quick fixes of the strategy's diagnostics that touch `range`.
+pub fn code_actions(snapshot: &Snapshot, params: &CodeActionParams) -> Vec<CodeActionOrCommand> {
+    let analysis = snapshot.analysis();
+    let lines = snapshot.line_map(&analysis);
+    let span = lines.span(params.range);
+    let actions = ide::code_actions::code_actions(&snapshot.text, analysis.diagnostics(), span);
+    if actions.is_empty() {
+        return Vec::new();
+    }
+    let published = crate::diagnostics::to_lsp(snapshot, &analysis, &HashMap::new());
+    actions
+        .into_iter()
+        .filter_map(|action| {
+            let ours = published.get(action.diagnostic)?;
+            let diagnostic = params
+                .context
+                .diagnostics
+                .iter()
+                .find(|d| d.range == ours.range && d.code == ours.code)
+                .unwrap_or(ours)
+                .clone();
+            let edits = action
+                .edits
+                .into_iter()
+                .map(|e| TextEdit {
+                    range: lines.range(e.span),
+                    new_text: e.new_text,
+                })
+                .collect();
+            Some(CodeActionOrCommand::CodeAction(CodeAction {
+                title: action.title,
+                kind: Some(CodeActionKind::QUICKFIX),
+                diagnostics: Some(vec![diagnostic]),
+                edit: Some(WorkspaceEdit {
+                    changes: Some(HashMap::from([(snapshot.uri.clone(), edits)])),
+                    ..WorkspaceEdit::default()
+                }),
+                is_preferred: Some(action.preferred),
+                ..CodeAction::default()
+            }))
+        })
+        .collect()
+}
+
+/// From a mission: create the entry of the built-in call in `range` in each
+/// strategy file of its team that does not refine it yet.
+pub fn create_entries(
+    mission: &Snapshot,
+    strategies: &[Arc<Snapshot>],
+    range: Range,
+) -> Vec<CodeActionOrCommand> {
+    let analysis = mission.analysis();
+    let Some(checked) = analysis.mission.as_ref() else {
+        return Vec::new();
+    };
+    let offset = mission.line_map(&analysis).offset(range.start);
+    let catalog = mission.catalog.catalog();
+    let mut out = Vec::new();
+    for strategy in strategies {
+        if !strategy
+            .missions
+            .iter()
+            .any(|m| std::ptr::eq(&**m, mission))
+        {
+            continue;
+        }
+        let s_analysis = strategy.analysis();
+        let Some(model) = &s_analysis.strategy else {
+            continue;
+        };
+        let Some(found) = ide::code_actions::create_entry(
+            checked,
+            catalog,
+            offset,
+            model,
+            &strategy.text,
+            &s_analysis.strategy_links,
+        ) else {
+            continue;
+        };
+        let lines = strategy.line_map(&s_analysis);
+        let edit = TextEdit {
+            range: lines.range(found.edit.span),
+            new_text: found.edit.new_text,
+        };
+        out.push(CodeActionOrCommand::CodeAction(CodeAction {
+            title: found.title,
+            kind: Some(CodeActionKind::REFACTOR),
+            edit: Some(WorkspaceEdit {
+                changes: Some(HashMap::from([(strategy.uri.clone(), vec![edit])])),
+                ..WorkspaceEdit::default()
+            }),
+            ..CodeAction::default()
+        }));
+    }
+    out
+}
