@@ -9,11 +9,7 @@
 /// <reference types="tree-sitter-cli/dsl" />
 // @ts-check
 
-const KEYWORDS = [
-  'if', 'else', 'loop', 'repeat', 'throw', 'send', 'receive', 'publish', 'subscribe',
-  'set', 'OFF', 'def', 'main', 'case', 'catch', 'default', 'mode', 'group', 'leader',
-  'others', 'instance', 'of', 'capable', 'timeout', 'true', 'false', 'and', 'or', 'not',
-];
+const WORD = /[A-Za-z_][A-Za-z0-9_]*/;
 
 /** `rule (, rule)*` */
 function commaSep1(rule) {
@@ -34,11 +30,6 @@ module.exports = grammar({
   // keeps `mainx` an identifier rather than `main` + `x`.
   word: $ => $.identifier,
 
-  conflicts: $ => [
-    // `move(a b)`: several bare words are one string argument; `move(a)` is a value.
-    [$._word, $.attribute],
-  ],
-
   rules: {
     source_file: $ => repeat($._item),
 
@@ -56,12 +47,13 @@ module.exports = grammar({
 
     formation: $ => seq('{', repeat($.team_declaration), '}'),
 
-    team_declaration: $ => seq(
+    // Its own `;`s belong to it, not to the items after it.
+    team_declaration: $ => prec.right(seq(
       field('name', $.identifier),
       ':',
       commaSep1($.robot_declaration),
       repeat(';'),
-    ),
+    )),
 
     robot_declaration: $ => seq(
       field('type', $.identifier),
@@ -193,10 +185,12 @@ module.exports = grammar({
 
     arguments: $ => seq('(', commaSep(choice($._expression, $.words)), ')'),
 
-    /** Several bare words form one string: `move(Paris palace of congress)`. */
-    words: $ => prec.dynamic(1, seq($._word, repeat1($._word))),
-
-    _word: $ => choice($.identifier, ...KEYWORDS),
+    /**
+     * Several bare words (names or keywords) form one string: `move(Paris palace of
+     * congress)`. One token, so that as in the compiler two words or more are always a
+     * string (`move(x or y)`), and one word is a value.
+     */
+    words: _ => token(seq(WORD, repeat1(seq(/\s+/, WORD)))),
 
     communication: $ => seq(
       field('kind', choice('send', 'receive', 'publish', 'subscribe')),
@@ -293,7 +287,7 @@ module.exports = grammar({
 
     string: _ => token(seq('"', repeat(choice(/[^"\\\n]/, /\\[^\n]/)), '"')),
 
-    identifier: _ => /[A-Za-z_][A-Za-z0-9_]*/,
+    identifier: _ => WORD,
 
     comment: _ => token(seq('#', /[^\n]*/)),
   },
