@@ -1,0 +1,128 @@
+-- SeMo in Neovim 0.7 and newer: the language server (`semo lsp`) for missions and for
+-- strategy, robot and task-graph XML files, and tree-sitter highlighting of missions.
+--
+--   vim.opt.runtimepath:append('/path/to/semo/editors/nvim')
+--   require('semo').setup()                 -- or setup({ cmd = { '/path/to/semo', 'lsp' } })
+--
+-- On Neovim 0.11+ `vim.lsp.enable('semo')` (lsp/semo.lua) can replace the LSP part.
+local M = {}
+
+-- XML files that the server reads; their filetype stays `xml`.
+M.xml_patterns = { '%.strategy%.xml$', '%.robot%.xml$', '%.taskgraph%.xml$' }
+
+local config = { cmd = { 'semo', 'lsp' }, treesitter = true }
+
+--- Whether the buffer is a mission or one of the server's XML files.
+function M.is_semo_buffer(bufnr)
+  if vim.bo[bufnr].filetype == 'semo' then
+    return true
+  end
+  local name = vim.api.nvim_buf_get_name(bufnr)
+  for _, pattern in ipairs(M.xml_patterns) do
+    if name:match(pattern) then
+      return true
+    end
+  end
+  return false
+end
+
+--- The workspace of a file: the nearest folder above it holding `.git`, else its folder.
+function M.root_dir(fname)
+  local dir = vim.fn.fnamemodify(fname, ':p:h')
+  local git = vim.fn.finddir('.git', dir .. ';')
+  if git == '' then
+    git = vim.fn.findfile('.git', dir .. ';') -- a worktree's `.git` is a file
+  end
+  if git ~= '' then
+    return vim.fn.fnamemodify(git, ':p:h:h')
+  end
+  return dir
+end
+
+-- Clients started on Neovim 0.7, by workspace folder (0.8+ `vim.lsp.start` reuses its own).
+local clients = {}
+
+--- Attaches the buffer to the server of its workspace, starting it if needed.
+function M.attach(bufnr)
+  local root = M.root_dir(vim.api.nvim_buf_get_name(bufnr))
+  local client_config = {
+    name = 'semo',
+    cmd = config.cmd,
+    root_dir = root,
+    workspace_folders = { { uri = vim.uri_from_fname(root), name = root } },
+  }
+  if vim.lsp.start then
+    return vim.lsp.start(client_config, { bufnr = bufnr })
+  end
+  local id = clients[root]
+  if id == nil or vim.lsp.get_client_by_id(id) == nil then
+    client_config.on_exit = function()
+      clients[root] = nil
+    end
+    id = vim.lsp.start_client(client_config)
+    if id == nil then
+      vim.notify('semo: could not start ' .. table.concat(config.cmd, ' '), vim.log.levels.ERROR)
+      return nil
+    end
+    clients[root] = id
+  end
+  vim.lsp.buf_attach_client(bufnr, id)
+  return id
+end
+
+--- Highlights the buffer with the tree-sitter parser, if `parser/semo.so` is installed.
+function M.start_treesitter(bufnr)
+  local ok, parser = pcall(vim.treesitter.get_parser, bufnr, 'semo')
+  if not ok or parser == nil then
+    return false
+  end
+  if vim.treesitter.start then
+    vim.treesitter.start(bufnr, 'semo')
+  else
+    vim.treesitter.highlighter.new(parser)
+  end
+  return true
+end
+
+--- This file's folder, to find the grammar beside the plugin (editors/nvim/lua/semo).
+local function repo_root()
+  local here = debug.getinfo(1, 'S').source:sub(2)
+  return vim.fn.fnamemodify(here, ':p:h:h:h:h:h')
+end
+
+--- Compiles the grammar's generated parser (grammars/tree-sitter-semo/src/parser.c) into
+--- `parser/semo.so` under `dir` (default: stdpath('data') .. '/site', on 'runtimepath').
+function M.build_parser(dir)
+  dir = dir or (vim.fn.stdpath('data') .. '/site')
+  local src = repo_root() .. '/grammars/tree-sitter-semo/src'
+  local out = dir .. '/parser/semo.so'
+  vim.fn.mkdir(dir .. '/parser', 'p')
+  local cc = vim.env.CC or 'cc'
+  local output = vim.fn.system({ cc, '-o', out, '-shared', '-fPIC', '-O2', '-I', src, src .. '/parser.c' })
+  if vim.v.shell_error ~= 0 then
+    error('semo: compiling the parser failed: ' .. output)
+  end
+  return out
+end
+
+function M.setup(opts)
+  config = vim.tbl_extend('force', config, opts or {})
+  local group = vim.api.nvim_create_augroup('semo', { clear = true })
+  vim.api.nvim_create_autocmd('FileType', {
+    group = group,
+    pattern = { 'semo', 'xml' },
+    callback = function(args)
+      if not M.is_semo_buffer(args.buf) then
+        return
+      end
+      if config.cmd then
+        M.attach(args.buf)
+      end
+      if config.treesitter and vim.bo[args.buf].filetype == 'semo' then
+        M.start_treesitter(args.buf)
+      end
+    end,
+  })
+end
+
+return M

@@ -1,0 +1,126 @@
+-- Run by tests/editors.rs in a headless Neovim (Debian's 0.7, or newer) with editors/nvim on
+-- 'runtimepath': the plugin as a user sets it up, against the real `semo lsp`.
+-- Environment: SEMO_BIN (the binary), SEMO_WORKSPACE (a copy of tests/editors/workspace),
+-- SEMO_SITE (where the tree-sitter parser is compiled to).
+-- Each check prints one line; any failure exits with status 1 and says what was expected.
+
+local function fail(message)
+  io.stderr:write('FAILED: ' .. message .. '\n')
+  vim.cmd('cquit 1')
+end
+
+local function check(condition, message)
+  if not condition then
+    fail(message)
+  end
+end
+
+local function report(line)
+  io.stdout:write(line .. '\n')
+end
+
+local function run()
+  local workspace = os.getenv('SEMO_WORKSPACE')
+  local site = os.getenv('SEMO_SITE')
+  local semo = require('semo')
+
+  -- The tree-sitter parser, compiled from the committed parser.c as the README says.
+  semo.build_parser(site)
+  vim.opt.runtimepath:prepend(site)
+  semo.setup({ cmd = { os.getenv('SEMO_BIN'), 'lsp' } })
+
+  vim.cmd('edit ' .. vim.fn.fnameescape(workspace .. '/rover.mission'))
+  local buf = vim.api.nvim_get_current_buf()
+  check(vim.bo[buf].filetype == 'semo', 'filetype of a .mission is ' .. vim.bo[buf].filetype)
+  report('filetype: semo')
+
+  -- 1. The diagnostic of the misspelt mode, published by the server.
+  local published = vim.wait(30000, function()
+    return #vim.diagnostic.get(buf) > 0
+  end, 50)
+  check(published, 'no diagnostics within 30 s')
+  local d = vim.diagnostic.get(buf)[1]
+  report(string.format('diagnostic: %d:%d %s: %s', d.lnum + 1, d.col + 1,
+    tostring(d.code), d.message))
+  check(d.lnum == 23 and d.col == 23, 'the diagnostic is not on `MOVNG` (line 24, column 24)')
+  check(d.severity == vim.diagnostic.severity.ERROR, 'the diagnostic is not an error')
+  check(d.message:find('MOVING', 1, true), 'the message does not suggest `MOVING`')
+
+  -- 2. Tree-sitter highlighting: the highlighter runs on the mission, and the query
+  -- captures `throw GO` as an exception keyword and its event.
+  check(vim.treesitter.highlighter.active[buf] ~= nil,
+    'the tree-sitter highlighter is not active on the mission')
+  local root = vim.treesitter.get_parser(buf, 'semo'):parse()[1]:root()
+  check(not root:has_error(), 'the mission does not parse without errors')
+  local get_query = (vim.treesitter.query and vim.treesitter.query.get) or vim.treesitter.get_query
+  local query = get_query('semo', 'highlights')
+  local function captures_at(row, col)
+    local names = {}
+    for id, node in query:iter_captures(root, buf, row, row + 1) do
+      local start_row, start_col, end_row, end_col = node:range()
+      if start_row == row and end_row == row and start_col <= col and col < end_col then
+        table.insert(names, '@' .. query.captures[id])
+      end
+    end
+    return table.concat(names, ' ')
+  end
+  local line = vim.api.nvim_buf_get_lines(buf, 8, 9, false)[1]
+  local throw_col = line:find('throw GO', 1, true) - 1
+  local throw = captures_at(8, throw_col)
+  local event = captures_at(8, throw_col + 6)
+  report('captures at `throw GO`: ' .. throw .. ' / ' .. event)
+  check(throw == '@keyword.exception', '`throw` is not captured as @keyword.exception')
+  check(event == '@label', 'the event `GO` is not captured as @label')
+  local team = captures_at(6, 0)
+  check(team == '@module', 'the team of a service header is ' .. team)
+
+  -- 3. Completion inside `set(Action, `: the services of plan Action, and OFF.
+  vim.api.nvim_buf_set_lines(buf, 18, 19, false, { '  set(Action, ' })
+  vim.api.nvim_win_set_cursor(0, { 19, 14 })
+  local params = vim.lsp.util.make_position_params()
+  local responses = vim.lsp.buf_request_sync(buf, 'textDocument/completion', params, 10000)
+  check(responses ~= nil, 'no completion response within 10 s')
+  local labels = {}
+  for _, response in pairs(responses) do
+    local result = response.result or {}
+    for _, item in ipairs(result.items or result) do
+      table.insert(labels, item.label)
+    end
+  end
+  table.sort(labels)
+  report('completion in `set(Action, `: ' .. table.concat(labels, ' '))
+  check(table.concat(labels, ' ') == 'Drive OFF Wait',
+    'expected the services of plan Action (Drive, Wait) and OFF')
+
+
+  -- 4. Strategy, robot and task-graph files stay `xml` but get the server; other XML not.
+  local function semo_clients(b)
+    local clients = vim.lsp.get_clients and vim.lsp.get_clients({ bufnr = b })
+      or vim.tbl_values(vim.lsp.buf_get_clients(b))
+    return #vim.tbl_filter(function(c) return c.name == 'semo' end, clients)
+  end
+  for _, name in ipairs({ 'Rover.strategy.xml', 'beacon.robot.xml', 'loop.taskgraph.xml', 'plain.xml' }) do
+    vim.cmd('edit ' .. vim.fn.fnameescape(workspace .. '/' .. name))
+    local b = vim.api.nvim_get_current_buf()
+    local want = name == 'plain.xml' and 0 or 1
+    report(string.format('%s: filetype %s, %d semo client(s)', name, vim.bo[b].filetype, semo_clients(b)))
+    check(vim.bo[b].filetype == 'xml', name .. ' is not xml')
+    check(semo_clients(b) == want, name .. ': expected ' .. want .. ' semo client(s)')
+  end
+
+  -- 5. lsp/semo.lua (for `vim.lsp.enable` on 0.11+) finds the workspace of a mission and
+  -- declines plain XML.
+  local spec = dofile(vim.api.nvim_get_runtime_file('lsp/semo.lua', false)[1])
+  check(spec.cmd[1] == 'semo' and spec.cmd[2] == 'lsp', 'lsp/semo.lua does not run `semo lsp`')
+  local roots = {}
+  spec.root_dir(buf, function(dir) table.insert(roots, dir) end)
+  spec.root_dir(vim.api.nvim_get_current_buf(), function(dir) table.insert(roots, dir) end)
+  check(#roots == 1 and roots[1] == vim.fn.resolve(workspace), 'lsp/semo.lua root_dir gave ' .. vim.inspect(roots))
+  report('lsp/semo.lua: root ' .. roots[1])
+end
+
+local ok, err = pcall(run)
+if not ok then
+  fail(tostring(err))
+end
+vim.cmd('qall!')
