@@ -8,6 +8,7 @@ set -euo pipefail
 prefix="$1"
 version="${CODE_SERVER_VERSION:-4.100.3}"
 if [ -x "$prefix/node_modules/.bin/code-server" ] && \
+   [ -d "$prefix/node_modules/code-server/lib/vscode/node_modules" ] && \
    grep -q "\"version\": \"$version\"" "$prefix/node_modules/code-server/package.json"; then
   echo "code-server $version already in $prefix"
   exit 0
@@ -25,5 +26,9 @@ for pair in "1.15.11 v13.0.0-10"; do
   rm -rf "$stage"
 done
 mkdir -p "$prefix"
+# Root needs unsafe-perm for the postinstall (which runs `npm install` in
+# lib/vscode, native modules included); npm 11 runs install scripts only
+# when allowed, and the nested installs read the same variable.
 export npm_config_unsafe_perm=true npm_config_yes=true
+export npm_config_dangerously_allow_all_scripts=true
 npm install --prefix "$prefix" --no-audit --no-fund "code-server@$version"
