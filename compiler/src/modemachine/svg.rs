@@ -104,9 +104,8 @@ fn panel(machine: &ModeMachine) -> (f64, f64, String) {
         layer_x.push(x);
         x += w + g;
     }
-    let width = (x - gap.last().copied().unwrap_or(0.0) + MARGIN).max(
-        text_width(&format!("{} modes", machine.team), FONT) + 2.0 * MARGIN,
-    );
+    let width = (x - gap.last().copied().unwrap_or(0.0) + MARGIN)
+        .max(text_width(&format!("{} modes", machine.team), FONT) + 2.0 * MARGIN);
     let tallest = layers.layers.iter().map(Vec::len).max().unwrap_or(0) as f64;
     let height = HEAD + tallest * SLOT + MARGIN;
     let mut centre = vec![P { x: 0.0, y: 0.0 }; total];
@@ -302,10 +301,10 @@ fn write_label(out: &mut String, at: P, label: &str, below: bool) {
 /// a mission without modes gives a picture saying so.
 pub fn to_svg(machines: &[ModeMachine]) -> String {
     let panels: Vec<(f64, f64, String)> = machines.iter().map(panel).collect();
-    let width = panels
-        .iter()
-        .map(|p| p.0)
-        .fold(text_width("This mission has no modes.", FONT) + 2.0 * MARGIN, f64::max);
+    let width = panels.iter().map(|p| p.0).fold(
+        text_width("This mission has no modes.", FONT) + 2.0 * MARGIN,
+        f64::max,
+    );
     let height = if panels.is_empty() {
         60.0
     } else {
