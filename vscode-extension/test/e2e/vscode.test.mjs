@@ -130,6 +130,12 @@ async function userJourney() {
   assert.ok(drawn, 'the mode machine webview shows the Scouts team');
   await shot('mode-machine');
 
+  // Check Workspace: the server re-reads the workspace; the Problems view
+  // opens on the mission's error.
+  await page.click('.monaco-editor .view-lines');
+  await runCommand('SeMo: Check Workspace');
+  await waitForText('.markers-panel .monaco-list-row', /unknown robot type `Rovr`/);
+
   // Generate Code is in the palette; run it. Without the server command the
   // extension says so; with it, the output folder fills.
   await page.click('.monaco-editor .view-lines');
@@ -147,6 +153,12 @@ async function userJourney() {
   } else {
     console.log('Generate Code: this server has no semo.generateCode yet; the extension said so');
   }
+
+  // A new mission from the template, in an untitled editor of language SeMo.
+  await runCommand('SeMo: New Mission from Template');
+  await waitForText('.monaco-editor .view-lines', /#\s1\.\sTeam\sformation/);
+  await waitForText('.statusbar-item', /SeMo Mission/);
+  await shot('new-mission');
 }
 
 /** Waits until some frame (webviews nest two iframes deep) holds `pattern`. */
