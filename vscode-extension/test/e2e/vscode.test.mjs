@@ -154,6 +154,19 @@ async function userJourney() {
     console.log('Generate Code: this server has no semo.generateCode yet; the extension said so');
   }
 
+  // A task graph's picture: open it from the explorer, then the palette.
+  await page.keyboard.down('Control');
+  await page.keyboard.down('Shift');
+  await page.keyboard.press('KeyE');
+  await page.keyboard.up('Shift');
+  await page.keyboard.up('Control');
+  const graphRow = await waitForText('.explorer-folders-view .monaco-list-row', /data_loop\.taskgraph\.xml/);
+  await graphRow.click();
+  await waitForText('.monaco-editor .view-lines', /<taskgraph|<Task/);
+  await runCommand('SeMo: Show Task Graph');
+  assert.ok(await waitForFrameContent(/D-loop × 10/, 60000), 'the task graph webview shows the loop');
+  await shot('task-graph');
+
   // A new mission from the template, in an untitled editor of language SeMo.
   await runCommand('SeMo: New Mission from Template');
   await waitForText('.monaco-editor .view-lines', /#\s1\.\sTeam\sformation/);
