@@ -15,12 +15,14 @@ export async function activate(context: vscode.ExtensionContext): Promise<void> 
   const robots = new RobotsView(server);
   const graphs = new GraphViews(server);
   const s = server;
+  const robotsTree = vscode.window.createTreeView('semo.robots', { treeDataProvider: robots });
+  robots.attach(robotsTree);
   context.subscriptions.push(
     output,
     server,
     robots,
     graphs,
-    vscode.window.registerTreeDataProvider('semo.robots', robots),
+    robotsTree,
     vscode.commands.registerCommand('semo.restartServer', () => s.restart()),
     vscode.commands.registerCommand('semo.showOutput', () => output.show()),
     vscode.commands.registerCommand('semo.newMission', newMission),

@@ -31,6 +31,13 @@ export class RobotsView implements vscode.TreeDataProvider<TreeNode>, vscode.Dis
         }
       }),
       vscode.window.onDidChangeActiveTextEditor(() => this.refreshSoon()),
+      // The server reads the workspace's catalog files after it started and
+      // publishes their diagnostics then: the catalog may have grown.
+      vscode.languages.onDidChangeDiagnostics((e) => {
+        if (e.uris.some((u) => u.path.endsWith('.robot.xml') || u.path.endsWith('.mission'))) {
+          this.refreshSoon();
+        }
+      }),
       server.onReady(() => this.refreshSoon()),
       this.changed,
     );
@@ -62,6 +69,17 @@ export class RobotsView implements vscode.TreeDataProvider<TreeNode>, vscode.Dis
       return;
     }
     this.changed.fire(undefined);
+  }
+
+  /** Refreshes whenever the panel is shown: what it shows is then current. */
+  attach(view: vscode.TreeView<TreeNode>): void {
+    this.disposables.push(
+      view.onDidChangeVisibility((e) => {
+        if (e.visible) {
+          this.refreshSoon();
+        }
+      }),
+    );
   }
 
   getChildren(node?: TreeNode): TreeNode[] {
