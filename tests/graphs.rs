@@ -439,4 +439,58 @@ fn a_missing_sub_graph_fails_the_analysis_on_the_reference() {
     assert_eq!(d["start"]["line"], line);
     // The graph itself is still analysed: B stands for nothing it could time.
     assert_eq!(v["levels"].as_array().map(Vec::len), Some(1));
+
+#[test]
+fn modes_draws_each_team_or_one_and_reports_errors_and_unknown_teams() {
+    let dir = shared().join("examples/scouting");
+    let all = semo_in(&dir, &["graph", "modes", "scouting.mission"]);
+    assert_eq!(all.code, 0, "{}", all.stderr);
+    assert!(
+        all.stdout
+            .starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\"")
+    );
+    assert!(all.stdout.contains("data-team=\"MasterTeam\""));
+    assert!(all.stdout.contains("data-team=\"SlaveTeam\""));
+    // SlaveTeam starts in AUTO_MODE and leaves RETURN_MODE on CHANGE_FINISH.
+    let slave = semo_in(
+        &dir,
+        &["graph", "modes", "scouting.mission", "--team", "SlaveTeam"],
+    );
+    assert_eq!(slave.code, 0, "{}", slave.stderr);
+    assert!(!slave.stdout.contains("data-team=\"MasterTeam\""));
+    assert!(
+        slave
+            .stdout
+            .contains("<g class=\"mode default\" data-mode=\"AUTO_MODE\">")
+    );
+    assert!(
+        slave
+            .stdout
+            .contains("data-from=\"RETURN_MODE\" data-to=\"FINISH\"")
+    );
+    assert!(slave.stdout.contains(">CHANGE_FINISH</text>"));
+    let unknown = semo_in(
+        &dir,
+        &["graph", "modes", "scouting.mission", "--team", "Nobody"],
+    );
+    assert_eq!(unknown.code, 2);
+    assert!(
+        unknown.stderr.contains("MasterTeam, SlaveTeam"),
+        "{}",
+        unknown.stderr
+    );
+    // A mission with an error: drawn as far as understood, the error on stderr, exit 1.
+    let broken = semo_in(
+        &support::repo_root().join("tests/fixtures/modes"),
+        &["graph", "modes", "unknown_mode.mission"],
+    );
+    assert_eq!(broken.code, 1, "{}", broken.stderr);
+    assert!(broken.stderr.contains("E0"), "{}", broken.stderr);
+    assert!(
+        broken.stdout.contains("data-mode=\"IDLE\""),
+        "{}",
+        broken.stdout
+    );
+    let missing = semo_in(&dir, &["graph", "modes", "no_such.mission"]);
+    assert_eq!(missing.code, 2);
 }

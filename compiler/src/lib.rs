@@ -11,6 +11,7 @@
 //!   tokens and the syntax tree.
 //! - [`ide`]: editor features over an analysis (completion, hover, navigation, rename,
 //!   outline, highlighting, folding, selection), as plain data in byte ranges.
+//! - [`modemachine`]: each team's modes and mode changes, and their SVG picture.
 //! - [`workspace`]: loading files and folders from disk for the CLI.
 //! - [`cli`]: the `semo` command (rendering with ariadne or JSON).
 
@@ -22,6 +23,7 @@ pub mod diag;
 mod fasthash;
 pub mod format;
 pub mod ide;
+pub mod modemachine;
 pub mod refine;
 pub mod sema;
 pub mod span;

@@ -48,6 +48,7 @@ where
 {
     let (service, socket) = LspService::build(server::Backend::new)
         .custom_method("semo/catalog", server::Backend::catalog)
+        .custom_method("semo/graphSvg", server::Backend::graph_svg)
         .custom_method("semo/viewFileText", server::Backend::view_file_text)
         .finish();
     Server::new(input, output, socket).serve(service).await;

@@ -83,6 +83,19 @@ impl Backend {
             .map_err(|_| Error::internal_error())
     }
 
+    /// `semo/graphSvg`: the SVG of a task graph, or of a mission's mode
+    /// machines (for the editor's graph view).
+    pub async fn graph_svg(
+        &self,
+        params: handlers::graph_svg::GraphSvgParams,
+    ) -> Result<serde_json::Value> {
+        let team = params.team;
+        self.on_snapshot(&params.text_document.uri, move |s| {
+            handlers::graph_svg::graph_svg(s, team.as_deref())
+        })
+        .await?
+    }
+
     /// `semo/viewFileText`: the server's text of a document, to debug
     /// synchronisation (as rust-analyzer's `viewFileText`).
     pub async fn view_file_text(&self, params: TextDocumentIdentifier) -> Result<String> {

@@ -1,6 +1,6 @@
 //! `semo graph analyze|schedule|dot|svg`: a task graph's repetition vectors
 //! and deadlock freedom level by level with its diagnostics, its schedules,
-//! and pictures of it.
+//! and pictures of it; `semo graph modes`: a mission's mode machines.
 
 use super::render;
 use crate::diag::Diagnostic;
@@ -58,7 +58,65 @@ pub fn svg(path: &Path, output: Option<&Path>, out: &mut impl Write) -> i32 {
         Ok(g) => g,
         Err(code) => return code,
     };
-    let picture = crate::taskgraph::to_svg(&graph);
+    write_picture(&crate::taskgraph::to_svg(&graph), output, out)
+}
+
+/// `semo graph modes`: the mode machines of a mission (checked against the
+/// built-in catalog and the `*.robot.xml` files beside it, as `semo check`
+/// of its folder would), all teams or `team`. Errors in the mission do not
+/// stop the drawing: what was understood is drawn, the errors are on stderr
+/// and the exit code is 1. An unknown team is a usage error (2).
+pub fn modes(path: &Path, team: Option<&str>, output: Option<&Path>, out: &mut impl Write) -> i32 {
+    let Some(text) = read(path) else { return 2 };
+    let mut files = Files::default();
+    // The catalog files beside the mission (and below), as `semo check DIR`.
+    let folder = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let beside = crate::workspace::collect(&[folder.to_path_buf()]).unwrap_or_default();
+    for (catalog, _) in beside.iter().filter(|(_, k)| *k == FileKind::Catalog) {
+        if let Some(text) = read(catalog) {
+            files.add(catalog.clone(), FileKind::Catalog, text);
+        }
+    }
+    let id = files.add(path.to_path_buf(), FileKind::Mission, text);
+    let run = crate::workspace::check_files(files);
+    let Some((_, analysis)) = run.analyses.iter().find(|(f, _)| *f == id) else {
+        return 2;
+    };
+    let mut machines = crate::modemachine::machines(&analysis.mission);
+    if let Some(team) = team {
+        machines.retain(|m| m.team == team);
+        if machines.is_empty() {
+            let known: Vec<&str> = analysis
+                .mission
+                .teams
+                .iter()
+                .map(|t| t.name.as_str())
+                .collect();
+            eprintln!(
+                "error: {}: no team `{team}` with modes (teams: {})",
+                path.display(),
+                known.join(", ")
+            );
+            return 2;
+        }
+    }
+    let errors: Vec<Diagnostic> = run
+        .diagnostics
+        .iter()
+        .filter(|d| d.is_error())
+        .cloned()
+        .collect();
+    let _ = render::diagnostics(&run.files, &errors, false, &mut std::io::stderr());
+    match write_picture(&crate::modemachine::to_svg(&machines), output, out) {
+        0 if !errors.is_empty() => 1,
+        code => code,
+    }
+}
+
+fn write_picture(picture: &str, output: Option<&Path>, out: &mut impl Write) -> i32 {
     match output {
         Some(file) => match std::fs::write(file, picture) {
             Ok(()) => 0,

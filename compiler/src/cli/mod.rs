@@ -158,6 +158,19 @@ enum GraphCommand {
         #[arg(short, long, value_name = "FILE")]
         output: Option<PathBuf>,
     },
+    /// Draw a mission's mode machines as SVG: each team's modes, the default
+    /// mode marked, and the mode changes of its `main` labelled with their
+    /// events.
+    Modes {
+        /// A mission script (`*.mission`).
+        file: PathBuf,
+        /// Draw only this team.
+        #[arg(long, value_name = "TEAM")]
+        team: Option<String>,
+        /// Write the SVG to this file instead of standard output.
+        #[arg(short, long, value_name = "FILE")]
+        output: Option<PathBuf>,
+    },
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
@@ -211,6 +224,9 @@ pub fn main(lsp: fn() -> i32) -> i32 {
         Command::Graph(GraphCommand::Dot { file }) => graph::dot(&file, &mut out),
         Command::Graph(GraphCommand::Svg { file, output }) => {
             graph::svg(&file, output.as_deref(), &mut out)
+        }
+        Command::Graph(GraphCommand::Modes { file, team, output }) => {
+            graph::modes(&file, team.as_deref(), output.as_deref(), &mut out)
         }
         Command::Graph(GraphCommand::Schedule { file, cores }) => {
             graph::schedule(&file, cores, &mut out)

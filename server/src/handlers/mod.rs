@@ -10,6 +10,7 @@ pub mod document_symbol;
 pub mod folding_range;
 pub mod formatting;
 pub mod generate_code;
+pub mod graph_svg;
 pub mod hover;
 pub mod inlay_hints;
 pub mod prepare_rename;

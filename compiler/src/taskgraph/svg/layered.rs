@@ -12,7 +12,7 @@ const MAX_PASSES: usize = 8;
 /// Where a node must go: anywhere, the first layer alone (a loop body's input
 /// ports), or the last layer alone (its output ports).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Pin {
+pub(crate) enum Pin {
     Free,
     First,
     Last,
@@ -20,7 +20,7 @@ pub(super) enum Pin {
 
 /// The way one input edge runs through the layers.
 #[derive(Clone, Debug)]
-pub(super) struct Chain {
+pub(crate) struct Chain {
     /// The node in the lower layer, the virtual nodes between, the node in
     /// the higher layer.
     pub nodes: Vec<usize>,
@@ -30,7 +30,7 @@ pub(super) struct Chain {
     pub flat: bool,
 }
 
-pub(super) struct Layers {
+pub(crate) struct Layers {
     /// Nodes `0..real` are the input's; the others are virtual.
     pub real: usize,
     /// Every node's layer.
@@ -45,7 +45,7 @@ pub(super) struct Layers {
 
 /// Ranks and orders the graph of `pins.len()` nodes and `edges` (tail,
 /// head); `weak` edges are the first to be drawn against the flow.
-pub(super) fn layer(pins: &[Pin], edges: &[(usize, usize)], weak: &[bool]) -> Layers {
+pub(crate) fn layer(pins: &[Pin], edges: &[(usize, usize)], weak: &[bool]) -> Layers {
     let n = pins.len();
     let reversed = orient(pins, edges, weak);
     let oriented: Vec<(usize, usize)> = edges

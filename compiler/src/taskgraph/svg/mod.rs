@@ -17,7 +17,7 @@
 //! are written with one decimal, and nothing depends on hash order: the same
 //! graph always gives the same bytes.
 
-mod layered;
+pub(crate) mod layered;
 mod place;
 mod render;
 mod scene;
@@ -44,7 +44,7 @@ const TITLE_FONT: f64 = 12.0;
 
 /// An estimate of the width of `text` in Helvetica at `size` px: a width per
 /// character class, erring on the wide side so that boxes hold their labels.
-fn text_width(text: &str, size: f64) -> f64 {
+pub(crate) fn text_width(text: &str, size: f64) -> f64 {
     let ems: f64 = text
         .chars()
         .map(|c| match c {

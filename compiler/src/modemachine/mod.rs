@@ -1,0 +1,77 @@
+//! A team's mode machine: its modes, the mode it starts in (`default` in its
+//! `main` block) and the mode changes `main` makes on events
+//! (`case (FROM): catch (EVENT): mode = TO`), read from the Mission IR.
+//! [`to_svg`] draws the machines of a mission (`semo graph modes`, the
+//! language server's `semo/graphSvg` for missions).
+
+mod svg;
+#[cfg(test)]
+mod tests;
+
+use crate::sema::Mission;
+use crate::syntax::ast::Name;
+
+pub use svg::to_svg;
+
+/// One team's modes and mode changes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ModeMachine {
+    pub team: Name,
+    /// Every mode of the team, in the order they are written.
+    pub modes: Vec<Name>,
+    /// The index in `modes` of the mode the team starts in.
+    pub default: Option<usize>,
+    /// The mode changes, one per (from, to) pair, with the events that make
+    /// it in the order they are written.
+    pub changes: Vec<ModeChange>,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ModeChange {
+    pub from: usize,
+    pub to: usize,
+    pub events: Vec<Name>,
+}
+
+/// The mode machine of each team of `mission` that has modes, in the order
+/// the teams are declared.
+pub fn machines(mission: &Mission) -> Vec<ModeMachine> {
+    mission
+        .teams
+        .iter()
+        .filter(|team| !team.modes.is_empty())
+        .map(|team| {
+            let modes: Vec<Name> = team.modes.iter().map(|m| m.name.clone()).collect();
+            let valid = |i: u32| (i as usize) < modes.len();
+            let mut changes: Vec<ModeChange> = Vec::new();
+            let main = team.main.as_ref();
+            for t in main.iter().flat_map(|m| &m.transitions) {
+                if !valid(t.from) || !valid(t.to) {
+                    continue;
+                }
+                let (from, to) = (t.from as usize, t.to as usize);
+                match changes.iter_mut().find(|c| c.from == from && c.to == to) {
+                    Some(change) => {
+                        if !change.events.contains(&t.event) {
+                            change.events.push(t.event.clone());
+                        }
+                    }
+                    None => changes.push(ModeChange {
+                        from,
+                        to,
+                        events: vec![t.event.clone()],
+                    }),
+                }
+            }
+            ModeMachine {
+                team: team.name.clone(),
+                default: main
+                    .and_then(|m| m.default)
+                    .filter(|&d| valid(d))
+                    .map(|d| d as usize),
+                modes,
+                changes,
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,143 @@
+// The palette's SeMo commands that are not about the server's life.
+
+import * as path from 'path';
+import * as vscode from 'vscode';
+import { ExecuteCommandRequest } from 'vscode-languageclient/node';
+import { missionTemplateSnippet } from './pure/template';
+import { Server } from './server';
+
+/** The server's `workspace/executeCommand` name for code generation. */
+export const GENERATE_CODE = 'semo.generateCode';
+
+/** "SeMo: New Mission from Template": an untitled mission holding the template. */
+export async function newMission(): Promise<void> {
+  const document = await vscode.workspace.openTextDocument({ language: 'semo', content: '' });
+  const editor = await vscode.window.showTextDocument(document);
+  // The same snippet as the server's completion: the cursor in the formation.
+  await editor.insertSnippet(new vscode.SnippetString(missionTemplateSnippet()));
+}
+
+/** The mission a command works on: the active editor's, else the last visible one. */
+function activeMission(): vscode.TextDocument | undefined {
+  const active = vscode.window.activeTextEditor?.document;
+  if (active?.languageId === 'semo') {
+    return active;
+  }
+  return vscode.window.visibleTextEditors.find((e) => e.document.languageId === 'semo')?.document;
+}
+
+/** The output folder setting made absolute against the mission's workspace folder. */
+export function outputFolderFor(document: vscode.TextDocument): string {
+  const setting =
+    vscode.workspace.getConfiguration('semo', document.uri).get<string>('codegen.outputFolder') ||
+    'generated';
+  if (path.isAbsolute(setting)) {
+    return setting;
+  }
+  const folder =
+    vscode.workspace.getWorkspaceFolder(document.uri)?.uri.fsPath ??
+    (document.uri.scheme === 'file' ? path.dirname(document.uri.fsPath) : undefined) ??
+    vscode.workspace.workspaceFolders?.[0]?.uri.fsPath;
+  return folder ? path.join(folder, setting) : setting;
+}
+
+/** Whether the running server announced `command` at `initialize`. */
+function serverOffers(server: Server, command: string): boolean {
+  const commands =
+    server.client?.initializeResult?.capabilities.executeCommandProvider?.commands ?? [];
+  return commands.includes(command);
+}
+
+/**
+ * "SeMo: Generate Code": asks the server (`workspace/executeCommand`
+ * `semo.generateCode` with `[{ uri, outputFolder }]`) to write the mission's
+ * code, with a progress notification, then shows the output folder.
+ */
+export async function generateCode(server: Server): Promise<void> {
+  const document = activeMission();
+  if (!document) {
+    void vscode.window.showWarningMessage('Open a mission (.mission) to generate its code.');
+    return;
+  }
+  const client = server.running();
+  if (!client) {
+    return;
+  }
+  if (!serverOffers(server, GENERATE_CODE)) {
+    void vscode.window.showErrorMessage(
+      `This semo server cannot generate code (it offers no "${GENERATE_CODE}" command). ` +
+        'Update semo, or point semo.server.path to a newer build.',
+    );
+    return;
+  }
+  if (document.isDirty) {
+    await document.save();
+  }
+  const outputFolder = outputFolderFor(document);
+  const result = await vscode.window.withProgress(
+    {
+      location: vscode.ProgressLocation.Notification,
+      title: `SeMo: generating code for ${path.basename(document.uri.path)}`,
+      cancellable: false,
+    },
+    async () => {
+      try {
+        return {
+          ok: true as const,
+          value: await client.sendRequest(ExecuteCommandRequest.type, {
+            command: GENERATE_CODE,
+            arguments: [{ uri: document.uri.toString(), outputFolder }],
+          }),
+        };
+      } catch (e) {
+        return { ok: false as const, error: e };
+      }
+    },
+  );
+  if (!result.ok) {
+    const message = result.error instanceof Error ? result.error.message : String(result.error);
+    server.output.appendLine(`[error] ${GENERATE_CODE}: ${message}`);
+    void vscode.window.showErrorMessage(`SeMo: code generation failed: ${message}`, 'Show Output')
+      .then((c) => c && server.output.show());
+    return;
+  }
+  server.output.appendLine(`[info] generated code in ${outputFolder}`);
+  const folderUri = vscode.Uri.file(outputFolder);
+  try {
+    await vscode.commands.executeCommand('revealInExplorer', folderUri);
+  } catch {
+    // Outside the workspace the explorer cannot show it; the message below can.
+  }
+  const open = 'Open Folder in New Window';
+  const choice = await vscode.window.showInformationMessage(
+    `SeMo: code generated in ${outputFolder}`,
+    open,
+  );
+  if (choice === open) {
+    await vscode.commands.executeCommand('vscode.openFolder', folderUri, { forceNewWindow: true });
+  }
+}
+
+/**
+ * "SeMo: Check Workspace": the server checks every mission, catalog, strategy
+ * file and task graph of the workspace folders at start; this tells it that
+ * each of them changed on disk (`workspace/didChangeWatchedFiles`), so it
+ * reads them again and publishes their diagnostics afresh, then shows the
+ * Problems view.
+ */
+export async function checkWorkspace(server: Server): Promise<void> {
+  const client = server.running();
+  if (!client) {
+    return;
+  }
+  const found = await vscode.workspace.findFiles(
+    '**/*.{mission,robot.xml,strategy.xml,taskgraph.xml}',
+    '**/{node_modules,target,.git}/**',
+  );
+  await client.sendNotification('workspace/didChangeWatchedFiles', {
+    changes: found.map((uri) => ({ uri: uri.toString(), type: 2 /* Changed */ })),
+  });
+  server.output.appendLine(`[info] Check Workspace: ${found.length} files sent to the server`);
+  await vscode.commands.executeCommand('workbench.actions.view.problems');
+  void vscode.window.setStatusBarMessage(`SeMo: checking ${found.length} files`, 3000);
+}
