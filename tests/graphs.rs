@@ -439,6 +439,7 @@ fn a_missing_sub_graph_fails_the_analysis_on_the_reference() {
     assert_eq!(d["start"]["line"], line);
     // The graph itself is still analysed: B stands for nothing it could time.
     assert_eq!(v["levels"].as_array().map(Vec::len), Some(1));
+}
 
 #[test]
 fn modes_draws_each_team_or_one_and_reports_errors_and_unknown_teams() {

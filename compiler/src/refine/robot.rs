@@ -151,7 +151,7 @@ impl Builder<'_, '_> {
         let offset = span.start.min(text.len());
         self.lines
             .line_col(text, offset, crate::text::ColumnUnit::Utf8)
-            .line as u32
+            .line
             + 1
     }
 
@@ -339,9 +339,8 @@ impl Builder<'_, '_> {
                 // Group membership is static for a robot: its type and
                 // capabilities decide which arm it joins (the others are
                 // dropped from its program).
-                match self.chosen_arm(g) {
-                    Some(body) => self.block(body, states, marks, depth),
-                    None => {}
+                if let Some(body) = self.chosen_arm(g) {
+                    self.block(body, states, marks, depth);
                 }
             }
             StmtKind::Comm(c) => self.comm(c, stmt.span, states, marks),
@@ -921,7 +920,7 @@ fn next_mark(marks: &mut usize) -> usize {
     *marks - 1
 }
 
-fn patch(states: &mut Vec<State>, at: usize) {
+fn patch(states: &mut [State], at: usize) {
     let target = states.len();
     match &mut states[at].kind {
         StateKind::Branch { else_to, .. } => *else_to = target,
