@@ -101,6 +101,15 @@ export async function generateCode(server: Server): Promise<void> {
       .then((c) => c && server.output.show());
     return;
   }
+  const summary = result.value as { refused?: boolean; errors?: string[]; robots?: unknown[] } | null;
+  if (summary?.refused) {
+    // The server has said why (a message, and the reasons as diagnostics).
+    server.output.appendLine(
+      `[info] code generation refused:\n  ${(summary.errors ?? []).join('\n  ')}`,
+    );
+    void vscode.commands.executeCommand('workbench.actions.view.problems');
+    return;
+  }
   server.output.appendLine(`[info] generated code in ${outputFolder}`);
   const folderUri = vscode.Uri.file(outputFolder);
   try {

@@ -9,7 +9,7 @@
 //! the cursor (see [`super::strategy::create_entries`]).
 
 use crate::diagnostics;
-use crate::world::Snapshot;
+use crate::world::{FileAnalysis, Snapshot};
 use semo::workspace::FileKind;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -47,8 +47,25 @@ pub fn code_actions(
     if actions.is_empty() {
         return Some(assists);
     }
-    let published = diagnostics::to_lsp(snapshot, &analysis, &HashMap::new());
-    let response = actions
+    let response = quick_fixes(snapshot, &analysis, params, actions)
+        .into_iter()
+        .chain(assists)
+        .collect();
+    Some(response)
+}
+
+/// The library's fixes as protocol actions: each edit of the snapshot's text,
+/// attached to the client's copy of the diagnostic it fixes when the request
+/// carries it (same code and range), else to the diagnostic as published.
+pub fn quick_fixes(
+    snapshot: &Snapshot,
+    analysis: &FileAnalysis,
+    params: &CodeActionParams,
+    actions: Vec<semo::ide::code_actions::CodeAction>,
+) -> Vec<CodeActionOrCommand> {
+    let lines = snapshot.line_map(analysis);
+    let published = diagnostics::to_lsp(snapshot, analysis, &HashMap::new());
+    actions
         .into_iter()
         .filter_map(|action| {
             let ours = published.get(action.diagnostic)?;
@@ -67,20 +84,17 @@ pub fn code_actions(
                     new_text: e.new_text,
                 })
                 .collect();
-            let edit = WorkspaceEdit {
-                changes: Some(HashMap::from([(snapshot.uri.clone(), edits)])),
-                ..WorkspaceEdit::default()
-            };
             Some(CodeActionOrCommand::CodeAction(CodeAction {
                 title: action.title,
                 kind: Some(CodeActionKind::QUICKFIX),
                 diagnostics: Some(vec![diagnostic]),
-                edit: Some(edit),
+                edit: Some(WorkspaceEdit {
+                    changes: Some(HashMap::from([(snapshot.uri.clone(), edits)])),
+                    ..WorkspaceEdit::default()
+                }),
                 is_preferred: Some(action.preferred),
                 ..CodeAction::default()
             }))
         })
-        .chain(assists)
-        .collect();
-    Some(response)
+        .collect()
 }

@@ -209,39 +209,7 @@ pub fn code_actions(snapshot: &Snapshot, params: &CodeActionParams) -> Vec<CodeA
     if actions.is_empty() {
         return Vec::new();
     }
-    let published = crate::diagnostics::to_lsp(snapshot, &analysis, &HashMap::new());
-    actions
-        .into_iter()
-        .filter_map(|action| {
-            let ours = published.get(action.diagnostic)?;
-            let diagnostic = params
-                .context
-                .diagnostics
-                .iter()
-                .find(|d| d.range == ours.range && d.code == ours.code)
-                .unwrap_or(ours)
-                .clone();
-            let edits = action
-                .edits
-                .into_iter()
-                .map(|e| TextEdit {
-                    range: lines.range(e.span),
-                    new_text: e.new_text,
-                })
-                .collect();
-            Some(CodeActionOrCommand::CodeAction(CodeAction {
-                title: action.title,
-                kind: Some(CodeActionKind::QUICKFIX),
-                diagnostics: Some(vec![diagnostic]),
-                edit: Some(WorkspaceEdit {
-                    changes: Some(HashMap::from([(snapshot.uri.clone(), edits)])),
-                    ..WorkspaceEdit::default()
-                }),
-                is_preferred: Some(action.preferred),
-                ..CodeAction::default()
-            }))
-        })
-        .collect()
+    super::code_actions::quick_fixes(snapshot, &analysis, params, actions)
 }
 
 /// From a mission: create the entry of the built-in call in `range` in each

@@ -136,23 +136,34 @@ async function userJourney() {
   await runCommand('SeMo: Check Workspace');
   await waitForText('.markers-panel .monaco-list-row', /unknown robot type `Rovr`/);
 
-  // Generate Code is in the palette; run it. Without the server command the
-  // extension says so; with it, the output folder fills.
+  // Generate Code is in the palette. This mission has errors: the server
+  // refuses and says why.
   await page.click('.monaco-editor .view-lines');
   await runCommand('SeMo: Generate Code');
-  const note = await waitForText(
+  const refused = await waitForText(
     '.notifications-toasts .notification-list-item',
-    /code generated in|offers no "semo\.generateCode"|code generation failed/,
+    /code generation refused|code generation failed/,
   );
-  const text = await note.evaluate((e) => e.textContent);
+  assert.match(await refused.evaluate((e) => e.textContent), /refused/);
+  await shot('generate-refused');
+
+  // A mission without errors: its robots' folders are written.
+  await page.keyboard.down('Control');
+  await page.keyboard.press('KeyP');
+  await page.keyboard.up('Control');
+  await page.waitForSelector('.quick-input-widget .quick-input-box input', { visible: true });
+  await page.keyboard.type('rovers.mission');
+  await waitForText('.quick-input-list .monaco-list-row', /rovers\.mission/);
+  await page.keyboard.press('Enter');
+  await waitForText('.tabs-container .tab.active', /rovers\.mission/);
+  // The new editor is focused once its text is laid out.
+  await waitForText('.monaco-editor .view-lines', /Rovers\.Explore\.Wander/);
+  await runCommand('SeMo: Generate Code');
+  await waitForText('.notifications-toasts .notification-list-item', /code generated in/);
   await shot('generate-code');
-  assert.doesNotMatch(text, /code generation failed/, text);
-  if (/code generated in/.test(text)) {
-    const folder = join(workspace, 'generated');
-    assert.ok(existsSync(folder) && readdirSync(folder).length > 0, `files in ${folder}`);
-  } else {
-    console.log('Generate Code: this server has no semo.generateCode yet; the extension said so');
-  }
+  const robot = join(workspace, 'generated', 'Rovers', 'r_0');
+  assert.ok(existsSync(join(robot, 'control_task.c')), `control_task.c in ${robot}`);
+  assert.ok(existsSync(join(robot, 'Makefile')), `Makefile in ${robot}`);
 
   // A task graph's picture: open it from the explorer, then the palette.
   await page.keyboard.down('Control');

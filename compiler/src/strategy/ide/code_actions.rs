@@ -12,20 +12,12 @@
 use super::raw::{matching_close, position_at};
 use crate::catalog::Catalog;
 use crate::diag::{Code, Diagnostic};
+pub use crate::ide::code_actions::CodeAction;
 use crate::ide::code_actions::TextEdit;
 use crate::sema::Analysis;
 use crate::span::Span;
 use crate::strategy::model::Strategy;
 use crate::strategy::{StrategyLinks, team_calls};
-
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct CodeAction {
-    pub title: String,
-    /// The diagnostic it fixes: an index into the diagnostics given.
-    pub diagnostic: usize,
-    pub edits: Vec<TextEdit>,
-    pub preferred: bool,
-}
 
 /// The fixes for the `diagnostics` of a strategy file (`text`) that touch `range`.
 pub fn code_actions(text: &str, diagnostics: &[Diagnostic], range: Span) -> Vec<CodeAction> {
