@@ -275,6 +275,81 @@ fn scouting_runs_clean_under_thread_sanitizer() {
     assert_scouting_behaviour(&runs);
 }
 
+#[test]
+fn a_failed_leader_is_replaced_by_the_next_robot() {
+    // patrol_groups: `leader(instance of Turtlebot3_Burger)` among tb_0..tb_2.
+    let out = scratch("leader");
+    let built = build(&example("swarm/patrol_groups.mission"), "linux-sim", &out);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    let folders = robot_folders(&out);
+    for folder in &folders {
+        make(folder, "gcc", STRICT).unwrap_or_else(|e| panic!("{e}"));
+    }
+    let scenario = out.join("scenario.json");
+    std::fs::write(&scenario, r#"{"time_scale": 1, "duration": 3500}"#).unwrap();
+    let port_base = 20000 + (std::process::id() % 250) * 40 + 30;
+    let mut children = BTreeMap::new();
+    for folder in &folders {
+        let robot = folder.file_name().unwrap().to_string_lossy().into_owned();
+        let child = Command::new(folder.join(&robot))
+            .args(["--scenario", &scenario.display().to_string()])
+            .args([
+                "--trace",
+                &out.join(format!("{robot}.jsonl")).display().to_string(),
+            ])
+            .args(["--port-base", &port_base.to_string()])
+            .spawn()
+            .expect("the robot program starts");
+        children.insert(robot, child);
+    }
+    // The first leader fails (killed, without a word) after a while.
+    std::thread::sleep(std::time::Duration::from_millis(1200));
+    children.get_mut("tb_0").unwrap().kill().unwrap();
+    for (robot, mut child) in children {
+        let status = child.wait().unwrap();
+        assert!(robot == "tb_0" || status.success(), "{robot}: {status:?}");
+    }
+    let trace = |robot: &str| -> Vec<Event> {
+        std::fs::read_to_string(out.join(format!("{robot}.jsonl")))
+            .unwrap()
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect()
+    };
+    let leaders = |events: &[Event]| -> Vec<String> {
+        events
+            .iter()
+            .filter(|e| field(e, "event") == "leader")
+            .map(|e| field(e, "leader").to_string())
+            .collect()
+    };
+    let tb_1 = trace("tb_1");
+    assert_eq!(
+        leaders(&tb_1),
+        ["tb_0", "tb_1"],
+        "tb_1 sees tb_0 fail and takes over"
+    );
+    assert_eq!(leaders(&trace("tb_2")), ["tb_0", "tb_1"]);
+    let took_over = tb_1
+        .iter()
+        .find(|e| field(e, "event") == "leader" && field(e, "leader") == "tb_1")
+        .and_then(|e| e["t"].as_i64())
+        .unwrap();
+    let lights_after = tb_1
+        .iter()
+        .filter(|e| field(e, "event") == "call_start" && field(e, "service") == "light_on")
+        .filter(|e| e["t"].as_i64().unwrap() >= took_over)
+        .count();
+    assert!(lights_after >= 1, "the new leader runs the leader's block");
+    let tb_2_lights = trace("tb_2")
+        .iter()
+        .filter(|e| field(e, "event") == "call_start" && field(e, "service") == "light_on")
+        .count();
+    assert_eq!(tb_2_lights, 0, "only the leader runs it");
+    // Robots of another type never take part.
+    assert!(leaders(&trace("ev_0")).is_empty());
+}
+
 /// Every file under a folder with its bytes.
 fn contents(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     let mut out = BTreeMap::new();

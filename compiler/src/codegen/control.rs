@@ -245,6 +245,14 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
         out.push_str("    default:\n        break;\n    }\n}\n\n");
     }
 
+    if uses("elected") {
+        let _ = writeln!(
+            out,
+            "/* Leader election: the first candidate (in formation order) that is this\n * robot or was heard from within three heartbeats leads. A change of leader\n * (a failed leader replaced) is traced. */\nstatic bool elected(const size_t *candidates, size_t n, long *last)\n{{\n    const semo_program_desc *p = semo_program();\n    size_t leader = p->self;\n    for (size_t i = 0; i < n; i++) {{\n        size_t c = candidates[i];\n        if (c == p->self || semo_now_ms() - comm_last_seen(c) <= 3 * {hb}) {{\n            leader = c;\n            break;\n        }}\n    }}\n    if ((long)leader != *last) {{\n        *last = (long)leader;\n        semo_trace(\"leader\", \"leader\", p->peers[leader].robot, NULL);\n    }}\n    return leader == p->self;\n}}\n",
+            hb = crate::refine::HEARTBEAT_MS
+        );
+    }
+
     if uses("request") {
         out.push_str("/* Writes a service request to the task's queue and starts one firing of it. */\nstatic bool request(int port, const char *task, const char *service, int argc, const semo_value *const *args)\n{\n    semo_request req;\n    memset(&req, 0, sizeof req);\n    strncpy(req.service, service, sizeof req.service - 1);\n    for (int i = 0; i < argc && i < SEMO_MAX_ARGS; i++)\n        req.args[i] = *args[i];\n    req.argc = argc < SEMO_MAX_ARGS ? argc : SEMO_MAX_ARGS;\n    if (UFControl_GetTaskState(task) != SEMO_TASK_IDLE)\n        return false;\n    if (UFPort_WriteToQueue(port, &req, sizeof req) == 0)\n        return false;\n    UFControl_CallTask(task);\n    return true;\n}\n\n");
     }
@@ -405,6 +413,18 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 out,
                 "        if (actions_{machine}(r) != STEP_DONE)\n            return STEP_WAIT;\n        semo_trace(\"actions_end\", \"service\", {}, NULL);\n        r->phase = 0;\n        r->pc = {next};\n        return STEP_NEXT;",
                 c::string(service)
+            );
+        }
+        StateKind::LeaderBranch {
+            candidates,
+            others_at,
+        } => {
+            let list: Vec<String> = candidates.iter().map(|c| c.to_string()).collect();
+            let _ = writeln!(
+                out,
+                "    {{\n        static const size_t candidates[] = {{{}}};\n        static long leader = -1; /* the last leader seen (control thread only) */\n        r->pc = elected(candidates, {}, &leader) ? {next} : {others_at};\n        return STEP_NEXT;\n    }}",
+                list.join(", "),
+                candidates.len()
             );
         }
         StateKind::Branch { condition, else_to } => {
@@ -655,6 +675,17 @@ fn emit_task(out: &mut String, program: &RobotProgram) {
         out,
         "/* One firing: read inputs, advance every region, then change mode if an\n * event asked for it; the robot is finished when no region runs any more. */\nvoid task_{name}_go(void)\n{{\n    read_inputs();"
     );
+    if m.heartbeat {
+        // Tell the team this robot is alive, for leader elections.
+        let _ = writeln!(
+            out,
+            "    static int64_t last_heartbeat = -{hb};\n    if (semo_now_ms() - last_heartbeat >= {hb}) {{\n        semo_value alive;\n        last_heartbeat = semo_now_ms();\n        semo_value_set(&alive, {robot});\n        semo_comm_send({team}, SEMO_MSG_PUBLISH, {key}, &alive);\n    }}",
+            hb = crate::refine::HEARTBEAT_MS,
+            robot = c::string(&program.robot),
+            team = c::string(&program.team),
+            key = c::string(&super::files::alive_key(program)),
+        );
+    }
     match default {
         Some(d) => {
             let _ = writeln!(out, "    if (current_mode < 0)\n        enter_mode({d});");

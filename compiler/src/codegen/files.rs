@@ -8,6 +8,11 @@ use crate::refine::{RobotProgram, RoleKind};
 use crate::taskgraph::Trigger;
 use std::fmt::Write;
 
+/// The key of the heartbeats a team's robots publish for leader elections.
+pub fn alive_key(program: &RobotProgram) -> String {
+    format!("{}.__alive", program.team)
+}
+
 /// Samples of a request channel: a service name and its arguments.
 fn is_request_channel(src_task: &str, src_port: &str) -> bool {
     src_task == CONTROL_TASK && src_port.starts_with("req_")
@@ -40,6 +45,9 @@ pub fn program_h(program: &RobotProgram, header: &str) -> String {
             out,
             "void {prefix}_init(void);\nvoid {prefix}_go(void);\nvoid {prefix}_wrapup(void);"
         );
+    }
+    if program.control.heartbeat {
+        out.push_str("\n/* When each robot was last heard from (mission ms; comm_task.c). */\nint64_t comm_last_seen(size_t peer);\n");
     }
     if let Some(lib) = &program.library {
         let _ = writeln!(
@@ -139,7 +147,7 @@ pub fn main_c(program: &RobotProgram, header: &str) -> String {
 pub fn comm_task_c(program: &RobotProgram, header: &str) -> String {
     let m = &program.control;
     let mut out = String::from(header);
-    out.push_str("#include \"program.h\"\n#include <string.h>\n\n");
+    out.push_str("#include \"program.h\"\n#include <pthread.h>\n#include <string.h>\n\n");
     if !m.outgoing.is_empty() {
         out.push_str("/* CommSend: every value the control task sends goes to the robots of its\n * team (through the transport). */\nstatic const struct {\n    const char *port;\n    const char *to_team;\n    semo_msg_kind kind;\n    const char *key;\n} outgoing[] = {\n");
         for o in &m.outgoing {
@@ -164,7 +172,15 @@ pub fn comm_task_c(program: &RobotProgram, header: &str) -> String {
             send_name = c::string(COMM_SEND)
         );
     }
-    if !m.incoming.is_empty() || !m.subscribed.is_empty() {
+    if m.heartbeat {
+        let _ = writeln!(
+            out,
+            "/* Heartbeats of the team's robots, for leader elections: when each robot\n * was last heard from. Every robot counts as alive at start. */\nstatic pthread_mutex_t seen_lock = PTHREAD_MUTEX_INITIALIZER;\nstatic int64_t seen[{peers}];\n\nint64_t comm_last_seen(size_t peer)\n{{\n    int64_t t = 0;\n    pthread_mutex_lock(&seen_lock);\n    if (peer < {peers})\n        t = seen[peer];\n    pthread_mutex_unlock(&seen_lock);\n    return t;\n}}\n\nstatic bool heard_alive(const semo_message *m)\n{{\n    if (m->kind != SEMO_MSG_PUBLISH || strcmp(m->key, {key}) != 0)\n        return false;\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        if (strcmp(p->peers[i].robot, m->from_robot) == 0) {{\n            pthread_mutex_lock(&seen_lock);\n            seen[i] = semo_now_ms();\n            pthread_mutex_unlock(&seen_lock);\n        }}\n    return true;\n}}\n",
+            peers = program.peers.len().max(1),
+            key = c::string(&alive_key(program))
+        );
+    }
+    if !m.incoming.is_empty() || !m.subscribed.is_empty() || m.heartbeat {
         out.push_str("/* CommReceive: each message received goes to the control task's port for\n * it (sends) or to its multicast group (publishes). */\n");
         let n = m.incoming.len();
         if n > 0 {
@@ -200,6 +216,9 @@ pub fn comm_task_c(program: &RobotProgram, header: &str) -> String {
             out,
             "}}\n\nvoid task_{recv}_go(void)\n{{\n    semo_message m;\n    if (!semo_comm_poll(&m, 50))\n        return;"
         );
+        if m.heartbeat {
+            out.push_str("    if (heard_alive(&m))\n        return;\n");
+        }
         if !m.subscribed.is_empty() {
             let _ = writeln!(
                 out,
@@ -214,7 +233,7 @@ pub fn comm_task_c(program: &RobotProgram, header: &str) -> String {
         }
         let _ = writeln!(out, "}}\n\nvoid task_{recv}_wrapup(void)\n{{\n}}");
     }
-    if m.outgoing.is_empty() && m.incoming.is_empty() && m.subscribed.is_empty() {
+    if m.outgoing.is_empty() && m.incoming.is_empty() && m.subscribed.is_empty() && !m.heartbeat {
         out.push_str(
             "/* This robot exchanges no messages. */\ntypedef int semo_no_communication;\n",
         );

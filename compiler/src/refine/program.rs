@@ -50,7 +50,14 @@ pub struct ControlMachine {
     pub incoming: Vec<IncomingMessage>,
     /// Latest-value groups the control task reads (`subscribe`).
     pub subscribed: Vec<String>,
+    /// Whether the robot takes part in a leader election: it then tells its
+    /// team it is alive every [`HEARTBEAT_MS`] and listens for theirs.
+    pub heartbeat: bool,
 }
+
+/// How often a robot that can be elected leader tells its team it is alive
+/// (mission ms); a robot not heard from for three periods counts as failed.
+pub const HEARTBEAT_MS: i64 = 200;
 
 #[derive(Clone, Debug)]
 pub struct ModeState {
@@ -134,6 +141,13 @@ pub enum StateKind {
         args: Vec<Operand>,
         timeout_ms: Option<i64>,
         mark: usize,
+    },
+    /// `leader(cond)` for a robot that meets `cond`: continue (run the
+    /// leader's block) if this robot is the first of `candidates` (peer
+    /// indices, in formation order) that is alive, else go to `others_at`.
+    LeaderBranch {
+        candidates: Vec<usize>,
+        others_at: usize,
     },
     /// Continue at `else_to` unless the condition holds.
     Branch {

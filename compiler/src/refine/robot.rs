@@ -89,7 +89,7 @@ pub(super) fn refine_robot(
             kind: RoleKind::CommSend,
         });
     }
-    if !machine.incoming.is_empty() || !machine.subscribed.is_empty() {
+    if !machine.incoming.is_empty() || !machine.subscribed.is_empty() || machine.heartbeat {
         tasks.push(TaskRole {
             task: graph::COMM_RECEIVE.into(),
             kind: RoleKind::CommReceive,
@@ -166,6 +166,15 @@ impl Builder<'_, '_> {
             short.push_str("...");
         }
         short
+    }
+
+    /// The peer index of the team's first robot (peers are in formation order).
+    fn first_peer(&self) -> usize {
+        let mission = &self.input.analysis.mission;
+        mission.teams[..self.team_id.0 as usize]
+            .iter()
+            .map(|t| t.robots.len())
+            .sum()
     }
 
     fn unsupported(&mut self, span: Span, what: &str) {
@@ -339,8 +348,36 @@ impl Builder<'_, '_> {
                 // Group membership is static for a robot: its type and
                 // capabilities decide which arm it joins (the others are
                 // dropped from its program).
-                if let Some(body) = self.chosen_arm(g) {
-                    self.block(body, states, marks, depth);
+                match self.chosen_arm(g) {
+                    ArmChoice::Static(Some(body)) => self.block(body, states, marks, depth),
+                    ArmChoice::Static(None) => {}
+                    ArmChoice::Leader {
+                        body,
+                        others,
+                        candidates,
+                    } => {
+                        // Peer indices of the candidates, in formation order:
+                        // the first one alive leads.
+                        let first_peer = self.first_peer();
+                        let candidates = candidates.iter().map(|i| first_peer + i).collect();
+                        self.machine.heartbeat = true;
+                        let branch = self.push(
+                            states,
+                            StateKind::LeaderBranch {
+                                candidates,
+                                others_at: usize::MAX,
+                            },
+                            stmt.span,
+                        );
+                        self.block(body, states, marks, depth);
+                        let jump = self.push(states, StateKind::Jump { to: usize::MAX }, stmt.span);
+                        states[jump].text = "end of the leader's block".into();
+                        patch(states, branch);
+                        if let Some(others) = others {
+                            self.block(others, states, marks, depth);
+                        }
+                        patch(states, jump);
+                    }
                 }
             }
             StmtKind::Comm(c) => self.comm(c, stmt.span, states, marks),
@@ -358,10 +395,12 @@ impl Builder<'_, '_> {
         }
     }
 
-    /// The arm of a group statement this robot runs: the first whose
-    /// condition it meets (for `leader`, only the team's first robot meeting
-    /// it), else `others`.
-    fn chosen_arm<'s>(&self, group: &'s ast::GroupStmt) -> Option<&'s ast::Block> {
+    /// What this robot runs of a group statement: the first arm whose
+    /// condition it meets (static: its type and capabilities decide), else
+    /// `others`. For a `leader` arm it meets, the choice is made at run time
+    /// among the team's robots that meet it (see [`StateKind::LeaderBranch`]).
+    fn chosen_arm<'s>(&self, group: &'s ast::GroupStmt) -> ArmChoice<'s> {
+        let others = group.others.as_ref().map(|o| &o.body);
         for arm in &group.arms {
             let meets = |r: &crate::sema::Robot| {
                 let Some(ty) = r.robot_type.map(|id| self.input.catalog.get(id)) else {
@@ -377,21 +416,27 @@ impl Builder<'_, '_> {
                         CondKind::CapableOf => ty.has_capability(&n.name),
                     })
             };
-            let me = &self.team.robots[self.robot_index];
-            if !meets(me) {
+            if !meets(&self.team.robots[self.robot_index]) {
                 continue;
             }
             if arm.kind == ast::ArmKind::Leader {
-                // Static election: the first robot of the team that meets the
-                // condition leads; the others fall through to `others`.
-                let first = self.team.robots.iter().position(meets);
-                if first != Some(self.robot_index) {
-                    return group.others.as_ref().map(|o| &o.body);
-                }
+                let candidates = self
+                    .team
+                    .robots
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, r)| meets(r))
+                    .map(|(i, _)| i)
+                    .collect();
+                return ArmChoice::Leader {
+                    body: &arm.body,
+                    others,
+                    candidates,
+                };
             }
-            return Some(&arm.body);
+            return ArmChoice::Static(Some(&arm.body));
         }
-        group.others.as_ref().map(|o| &o.body)
+        ArmChoice::Static(others)
     }
 
     fn comm(&mut self, comm: &ast::Comm, span: Span, states: &mut Vec<State>, marks: &mut usize) {
@@ -915,6 +960,19 @@ pub(super) fn implementing_task(implementation: &Implementation, fallback: &str)
     }
 }
 
+/// What a robot runs of a group statement.
+enum ArmChoice<'s> {
+    /// Decided by its type and capabilities: an arm, `others`, or nothing.
+    Static(Option<&'s ast::Block>),
+    /// A `leader` arm it can run: decided at run time by election among
+    /// `candidates` (indices into the team's robots).
+    Leader {
+        body: &'s ast::Block,
+        others: Option<&'s ast::Block>,
+        candidates: Vec<usize>,
+    },
+}
+
 fn next_mark(marks: &mut usize) -> usize {
     *marks += 1;
     *marks - 1
@@ -926,6 +984,7 @@ fn patch(states: &mut [State], at: usize) {
         StateKind::Branch { else_to, .. } => *else_to = target,
         StateKind::Jump { to } => *to = target,
         StateKind::LoopHead { exit_to, .. } => *exit_to = target,
+        StateKind::LeaderBranch { others_at, .. } => *others_at = target,
         _ => {}
     }
 }

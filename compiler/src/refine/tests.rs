@@ -171,9 +171,26 @@ fn group_arms_a_robot_can_never_join_are_dropped() {
     assert!(!tb.contains(&"move".to_string()), "{tb:?}");
     assert!(ev.iter().filter(|c| *c == "move").count() >= 2, "{ev:?}");
     assert!(!ev.contains(&"light_on".to_string()), "{ev:?}");
-    // `leader(instance of Turtlebot3_Burger)`: the first turtlebot leads.
-    assert!(calls(program(&programs, "tb_0")).contains(&"light_on".to_string()));
-    assert!(!calls(program(&programs, "tb_1")).contains(&"light_on".to_string()));
+    // `leader(instance of Turtlebot3_Burger)`: every turtlebot can lead, and
+    // an election at run time among peers 1-3 (tb_0..tb_2) decides; the Ev3
+    // robots never take part.
+    let branches = |robot: &str| -> Vec<Vec<usize>> {
+        program(&programs, robot)
+            .control
+            .services
+            .iter()
+            .flat_map(|s| &s.states)
+            .filter_map(|s| match &s.kind {
+                StateKind::LeaderBranch { candidates, .. } => Some(candidates.clone()),
+                _ => None,
+            })
+            .collect()
+    };
+    assert_eq!(branches("tb_1"), [vec![1, 2, 3]]);
+    assert!(calls(program(&programs, "tb_1")).contains(&"light_on".to_string()));
+    assert!(program(&programs, "tb_1").control.heartbeat);
+    assert!(branches("ev_0").is_empty());
+    assert!(!program(&programs, "ev_0").control.heartbeat);
 }
 
 #[test]
