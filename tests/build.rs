@@ -502,6 +502,55 @@ fn refined_task_graphs_are_written_and_analyse_clean() {
 }
 
 #[test]
+fn strategy_files_elsewhere_are_read_with_strategy() {
+    // The mission alone in one folder, its strategy in another.
+    let dir = scratch("strategy-option");
+    std::fs::create_dir_all(dir.join("mission")).unwrap();
+    std::fs::create_dir_all(dir.join("strategies")).unwrap();
+    std::fs::copy(
+        example("scouting/scouting.mission"),
+        dir.join("mission/scouting.mission"),
+    )
+    .unwrap();
+    std::fs::copy(
+        example("scouting/MasterTeam.strategy.xml"),
+        dir.join("strategies/MasterTeam.strategy.xml"),
+    )
+    .unwrap();
+    let mission = dir.join("mission/scouting.mission");
+    let control =
+        |out: &Path| std::fs::read_to_string(out.join("MasterTeam/irobot/control_task.c")).unwrap();
+    let without = dir.join("without");
+    assert_eq!(build(&mission, "linux", &without).code, 0);
+    assert!(
+        !control(&without).contains("Strategy actions"),
+        "no strategy found beside the mission"
+    );
+    let with = dir.join("with");
+    let built = semo_in(
+        &repo_root(),
+        &[
+            "build",
+            &mission.display().to_string(),
+            "--strategy",
+            &dir.join("strategies").display().to_string(),
+            "-o",
+            &with.display().to_string(),
+        ],
+    );
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    assert!(control(&with).contains("Strategy actions of `move` (MasterTeam.strategy.xml)"));
+}
+
+#[test]
+fn a_mission_that_cannot_be_read_is_an_io_error() {
+    let out = scratch("missing-mission");
+    let built = build(&out.join("nowhere.mission"), "linux", &out.join("out"));
+    assert_eq!(built.code, 2);
+    assert!(built.stderr.contains("nowhere.mission"), "{}", built.stderr);
+}
+
+#[test]
 fn unknown_targets_are_a_usage_error() {
     let out = semo_in(&repo_root(), &["build", "x.mission", "--target", "amiga"]);
     assert_eq!(out.code, 2);

@@ -193,17 +193,27 @@ impl CheckRun {
     }
 }
 
+/// A file's text. Invalid UTF-8 is replaced rather than refused, so the rest
+/// is still checked.
+pub fn read_text(path: &Path) -> std::io::Result<String> {
+    let bytes = std::fs::read(path)?;
+    Ok(String::from_utf8(bytes)
+        .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()))
+}
+
+/// [`read_text`] for the CLI's loaders: the error names the file.
+pub fn load_text(path: &Path) -> Result<String, LoadError> {
+    read_text(path).map_err(|e| LoadError {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })
+}
+
 /// Reads and checks the given files and folders.
 pub fn check_paths(paths: &[PathBuf]) -> Result<CheckRun, LoadError> {
     let mut files = Files::default();
     for (path, kind) in collect(paths)? {
-        let bytes = std::fs::read(&path).map_err(|e| LoadError {
-            path: path.clone(),
-            message: e.to_string(),
-        })?;
-        // Invalid UTF-8 is replaced rather than refused, so the rest is still checked.
-        let text = String::from_utf8(bytes)
-            .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned());
+        let text = load_text(&path)?;
         files.add(path, kind, text);
     }
     Ok(check_files(files))
@@ -337,12 +347,10 @@ impl Resolver for DiskResolver {
         if let Some(source) = self.known.get(path) {
             return Ok(source.clone());
         }
-        let bytes = std::fs::read(path).map_err(|e| match e.kind() {
+        let text = read_text(path).map_err(|e| match e.kind() {
             std::io::ErrorKind::NotFound => format!("there is no file {}", path.display()),
             _ => format!("{}: {e}", path.display()),
         })?;
-        let text = String::from_utf8(bytes)
-            .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned());
         let source = SubgraphSource {
             file: FileId(self.next),
             text: text.into(),

@@ -498,6 +498,37 @@ pub(crate) fn is_ident(s: &str) -> bool {
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
+/// Text for XML content or a quoted attribute: special characters escaped,
+/// characters XML 1.0 does not allow replaced by U+FFFD.
+#[derive(Clone, Copy)]
+pub(crate) struct Escaped<'s>(&'s str);
+
+pub(crate) fn escape(s: &str) -> Escaped<'_> {
+    Escaped(s)
+}
+
+impl std::fmt::Display for Escaped<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut plain = 0;
+        for (i, c) in self.0.char_indices() {
+            let replacement = match c {
+                '&' => "&amp;",
+                '<' => "&lt;",
+                '>' => "&gt;",
+                '"' => "&quot;",
+                '\'' => "&apos;",
+                '\t' | '\n' | '\r' => continue,
+                c if (c as u32) < 0x20 || c == '\u{FFFE}' || c == '\u{FFFF}' => "\u{FFFD}",
+                _ => continue,
+            };
+            f.write_str(&self.0[plain..i])?;
+            f.write_str(replacement)?;
+            plain = i + c.len_utf8();
+        }
+        f.write_str(&self.0[plain..])
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

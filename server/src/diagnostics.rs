@@ -139,22 +139,30 @@ pub fn to_lsp(
                 })
                 .collect::<Vec<_>>();
             lsp::Diagnostic {
-                range: here.range(d.span),
-                severity: Some(severity(d.severity)),
-                code: Some(NumberOrString::String(d.code.as_str().to_string())),
-                source: Some("semo".to_string()),
-                message: d.message.clone(),
                 related_information: (!related.is_empty()).then_some(related),
-                tags: is_unnecessary(d.code).then(|| vec![DiagnosticTag::UNNECESSARY]),
-                // The did-you-mean travels with the diagnostic, for quick fixes.
-                data: d
-                    .suggestion
-                    .as_ref()
-                    .map(|s| serde_json::json!({ "suggestion": s })),
-                code_description: None,
+                ..convert(d, here.range(d.span))
             }
         })
         .collect()
+}
+
+/// One diagnostic at `range`, without related information.
+pub fn convert(d: &semo::diag::Diagnostic, range: lsp::Range) -> lsp::Diagnostic {
+    lsp::Diagnostic {
+        range,
+        severity: Some(severity(d.severity)),
+        code: Some(NumberOrString::String(d.code.as_str().to_string())),
+        source: Some("semo".to_string()),
+        message: d.message.clone(),
+        related_information: None,
+        tags: is_unnecessary(d.code).then(|| vec![DiagnosticTag::UNNECESSARY]),
+        // The did-you-mean travels with the diagnostic, for quick fixes.
+        data: d
+            .suggestion
+            .as_ref()
+            .map(|s| serde_json::json!({ "suggestion": s })),
+        code_description: None,
+    }
 }
 
 /// Editors slow to a crawl on files with many thousands of problems (a pasted

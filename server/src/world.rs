@@ -677,11 +677,7 @@ pub fn read_roots(roots: &[PathBuf]) -> Vec<(Uri, Option<String>)> {
 
 /// A file's text, with invalid UTF-8 replaced (so the rest is still checked).
 pub fn read_text(path: &Path) -> Option<String> {
-    let bytes = std::fs::read(path).ok()?;
-    Some(
-        String::from_utf8(bytes)
-            .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()),
-    )
+    semo::workspace::read_text(path).ok()
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@ mod support;
 
 use serde_json::{Value, json};
 use std::collections::HashMap;
-use support::ide::{Session, apply_edits, listing};
+use support::ide::{Session, apply_edits, diff, listing};
 
 fn count_by_code(diagnostics: &[Value]) -> HashMap<String, usize> {
     let mut counts = HashMap::new();
@@ -19,28 +19,6 @@ fn count_by_code(diagnostics: &[Value]) -> HashMap<String, usize> {
             .or_default() += 1;
     }
     counts
-}
-
-/// The lines that differ between two texts: the old ones with `-`, the new
-/// ones with `+` (between the common first and last lines).
-fn diff(old: &str, new: &str) -> String {
-    let a: Vec<&str> = old.lines().collect();
-    let b: Vec<&str> = new.lines().collect();
-    let prefix = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
-    let suffix = a[prefix..]
-        .iter()
-        .rev()
-        .zip(b[prefix..].iter().rev())
-        .take_while(|(x, y)| x == y)
-        .count();
-    let mut out = String::new();
-    for line in &a[prefix..a.len() - suffix] {
-        out.push_str(&format!("      - {line}\n"));
-    }
-    for line in &b[prefix..b.len() - suffix] {
-        out.push_str(&format!("      + {line}\n"));
-    }
-    out
 }
 
 fn code_actions(session: &mut Session, uri: &str, diagnostic: &Value) -> Vec<Value> {

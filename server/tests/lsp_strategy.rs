@@ -9,7 +9,7 @@ mod support;
 
 use serde_json::{Value, json};
 use std::path::Path;
-use support::ide::{Doc, Session, apply_edits, listing, render_cursors};
+use support::ide::{Doc, Session, apply_edits, diff, listing, render_cursors};
 use support::render;
 use support::text_at;
 
@@ -199,27 +199,6 @@ fn the_outline_lists_values_services_and_actions() {
     show(&result, 0, &doc.text, &mut out);
     insta::assert_snapshot!(out);
     session.shutdown();
-}
-
-/// The lines that differ between two texts.
-fn diff(old: &str, new: &str) -> String {
-    let a: Vec<&str> = old.lines().collect();
-    let b: Vec<&str> = new.lines().collect();
-    let prefix = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
-    let suffix = a[prefix..]
-        .iter()
-        .rev()
-        .zip(b[prefix..].iter().rev())
-        .take_while(|(x, y)| x == y)
-        .count();
-    let mut out = String::new();
-    for line in &a[prefix..a.len() - suffix] {
-        out.push_str(&format!("      - {line}\n"));
-    }
-    for line in &b[prefix..b.len() - suffix] {
-        out.push_str(&format!("      + {line}\n"));
-    }
-    out
 }
 
 fn codes(diagnostics: &[Value]) -> Vec<String> {

@@ -22,18 +22,12 @@ pub fn load(
     mission: &Path,
     strategy: &[PathBuf],
 ) -> Result<(Files, crate::diag::FileId), workspace::LoadError> {
-    let read = |path: &Path| {
-        let bytes = std::fs::read(path).map_err(|e| workspace::LoadError {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
-        Ok::<_, workspace::LoadError>(
-            String::from_utf8(bytes)
-                .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()),
-        )
-    };
     let mut files = Files::default();
-    let id = files.add(mission.to_path_buf(), FileKind::Mission, read(mission)?);
+    let id = files.add(
+        mission.to_path_buf(),
+        FileKind::Mission,
+        workspace::load_text(mission)?,
+    );
     let folder = mission
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -44,7 +38,7 @@ pub fn load(
     let mut seen = std::collections::BTreeSet::new();
     for (path, kind) in workspace::collect(&roots)? {
         if matches!(kind, FileKind::Catalog | FileKind::Strategy) && seen.insert(path.clone()) {
-            let text = read(&path)?;
+            let text = workspace::load_text(&path)?;
             files.add(path, kind, text);
         }
     }

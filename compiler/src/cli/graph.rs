@@ -9,8 +9,8 @@ use std::io::Write;
 use std::path::Path;
 
 fn read(path: &Path) -> Option<String> {
-    match std::fs::read(path) {
-        Ok(bytes) => Some(String::from_utf8_lossy(&bytes).into_owned()),
+    match crate::workspace::read_text(path) {
+        Ok(text) => Some(text),
         Err(e) => {
             eprintln!("error: {}: {e}", path.display());
             None

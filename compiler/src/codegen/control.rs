@@ -8,10 +8,7 @@
 
 use super::c;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
-use crate::refine::{
-    ActionMachine, ControlMachine, Expr, Operand, RobotProgram, SlotSource, State, StateKind,
-};
-use crate::syntax::ast::CmpOp;
+use crate::refine::{ActionMachine, Expr, Operand, RobotProgram, SlotSource, State, StateKind};
 use std::fmt::Write;
 
 /// State transitions a region may take in one firing: a service whose
@@ -139,36 +136,26 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
     out
 }
 
-fn operand(program: &RobotProgram, op: &Operand) -> String {
+fn operand(op: &Operand) -> String {
     match op {
-        Operand::Slot(s) => {
-            let _ = program;
-            format!("&slot[{s}]")
-        }
+        Operand::Slot(s) => format!("&slot[{s}]"),
         Operand::Literal(text) => format!("SEMO_LIT({})", c::string(text)),
     }
 }
 
-fn expr(program: &RobotProgram, e: &Expr) -> String {
+fn expr(e: &Expr) -> String {
     match e {
-        Expr::Or(a, b) => format!("({} || {})", expr(program, a), expr(program, b)),
-        Expr::And(a, b) => format!("({} && {})", expr(program, a), expr(program, b)),
-        Expr::Not(a) => format!("!{}", expr(program, a)),
+        Expr::Or(a, b) => format!("({} || {})", expr(a), expr(b)),
+        Expr::And(a, b) => format!("({} && {})", expr(a), expr(b)),
+        Expr::Not(a) => format!("!{}", expr(a)),
         Expr::Bool(b) => b.to_string(),
-        Expr::Truthy(o) => format!("semo_value_truthy({})", operand(program, o)),
+        Expr::Truthy(o) => format!("semo_value_truthy({})", operand(o)),
         Expr::Compare(a, op, b) => {
-            let op = match op {
-                CmpOp::Eq => "==",
-                CmpOp::Ne => "!=",
-                CmpOp::Lt => "<",
-                CmpOp::Le => "<=",
-                CmpOp::Gt => ">",
-                CmpOp::Ge => ">=",
-            };
+            let op = op.as_str();
             format!(
                 "(semo_value_compare({}, {}) {op} 0)",
-                operand(program, a),
-                operand(program, b)
+                operand(a),
+                operand(b)
             )
         }
     }
@@ -267,11 +254,11 @@ fn request_index(program: &RobotProgram, task: &str) -> usize {
         .unwrap_or(0)
 }
 
-fn args_array(program: &RobotProgram, args: &[Operand]) -> String {
+fn args_array(args: &[Operand]) -> String {
     if args.is_empty() {
         return "NULL".into();
     }
-    let items: Vec<String> = args.iter().map(|a| operand(program, a)).collect();
+    let items: Vec<String> = args.iter().map(operand).collect();
     format!("(const semo_value *const[]){{{}}}", items.join(", "))
 }
 
@@ -321,7 +308,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
         }
         StateKind::Send { items } => {
             for item in items {
-                let value = operand(program, &item.value);
+                let value = operand(&item.value);
                 if let Some(s) = item.store {
                     let _ = writeln!(out, "        store({s}, {value});");
                 }
@@ -366,7 +353,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 task = c::string(task),
                 service = c::string(service),
                 argc = args.len(),
-                args = args_array(program, args),
+                args = args_array(args),
             );
             if let Some(t) = timeout_ms {
                 let _ = writeln!(
@@ -393,7 +380,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
             let _ = writeln!(out, "        if (r->phase == 0) {{");
             for (i, slot) in am.arguments.iter().enumerate() {
                 if let Some(arg) = args.get(i) {
-                    let _ = writeln!(out, "            store({slot}, {});", operand(program, arg));
+                    let _ = writeln!(out, "            store({slot}, {});", operand(arg));
                 }
             }
             let _ = writeln!(
@@ -431,7 +418,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
             let _ = writeln!(
                 out,
                 "        r->pc = {} ? {next} : {else_to};\n        return STEP_NEXT;",
-                expr(program, condition)
+                expr(condition)
             );
         }
         StateKind::Jump { to } => {
@@ -446,7 +433,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 let _ = writeln!(
                     out,
                     "        if (!{}) {{\n            r->pc = {exit_to};\n            return STEP_NEXT;\n        }}",
-                    expr(program, cond)
+                    expr(cond)
                 );
             }
             let _ = writeln!(
@@ -482,7 +469,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 let _ = writeln!(
                     out,
                     "        if (!{})\n            return STEP_DONE;",
-                    expr(program, cond)
+                    expr(cond)
                 );
             }
             if let Some(p) = period_ms {
@@ -501,7 +488,6 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
 }
 
 fn emit_action_machine(out: &mut String, program: &RobotProgram, index: usize, am: &ActionMachine) {
-    let m = &program.control;
     let _ = writeln!(
         out,
         "/* Strategy actions of `{}` ({}): phase 1 enters r->action (issues its\n * commands), phase 2 waits for them and takes the first transition that holds. */\nstatic int actions_{index}(region *r)\n{{\n    switch (r->action) {{",
@@ -542,9 +528,7 @@ fn emit_action_machine(out: &mut String, program: &RobotProgram, index: usize, a
             }
         }
         for (condition, to) in &action.transitions {
-            let test = condition
-                .as_ref()
-                .map_or_else(|| "true".to_string(), |c| expr(program, c));
+            let test = condition.as_ref().map_or_else(|| "true".to_string(), expr);
             let _ = writeln!(
                 out,
                 "        if ({test}) {{\n            r->action = {to};\n            r->phase = 1;\n            return STEP_NEXT;\n        }}"
@@ -553,7 +537,6 @@ fn emit_action_machine(out: &mut String, program: &RobotProgram, index: usize, a
         out.push_str("        return STEP_WAIT;\n");
     }
     out.push_str("    default:\n        return STEP_DONE;\n    }\n}\n\n");
-    let _ = m;
 }
 
 /// The actuator command name a task runs (`Move` for `wheel`).
@@ -696,5 +679,4 @@ fn emit_task(out: &mut String, program: &RobotProgram) {
         out,
         "    bool running = false;\n    for (int i = 0; i < REGION_COUNT && pending_mode < 0; i++) {{\n        region *r = &regions[i];\n        if (r->service < 0 || r->done)\n            continue;\n        if (r->timeout_ms > 0 && semo_now_ms() - r->started > r->timeout_ms) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], \"why\", \"timeout\", NULL);\n            continue;\n        }}\n        int result = STEP_NEXT;\n        for (int n = 0; n < {STEPS_PER_FIRING} && result == STEP_NEXT && pending_mode < 0; n++)\n            result = step(r);\n        if (result == STEP_DONE) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], NULL);\n        }} else {{\n            running = true;\n        }}\n    }}\n    if (pending_mode >= 0) {{\n        int next = pending_mode;\n        leave_mode();\n        pending_mode = -1;\n        enter_mode(next);\n        return;\n    }}\n    if (!running) {{\n        semo_trace(\"finish\", \"mode\", mode_name[current_mode], NULL);\n        semo_stop_program();\n    }}\n}}\n\nvoid task_{name}_wrapup(void)\n{{\n}}"
     );
-    let _ = ControlMachine::default;
 }

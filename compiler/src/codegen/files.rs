@@ -273,7 +273,13 @@ pub fn task_c(
     header: &str,
 ) -> Option<String> {
     let mut out = String::from(header);
-    out.push_str("#include \"../program.h\"\n\n");
+    // The user's service template compares service names (`strcmp`).
+    let needs_string_h = target == Target::Linux && matches!(role.kind, RoleKind::Service { .. });
+    out.push_str(if needs_string_h {
+        "#include \"../program.h\"\n#include <string.h>\n\n"
+    } else {
+        "#include \"../program.h\"\n\n"
+    });
     match (&role.kind, target) {
         (RoleKind::Sensor { values, period_ms }, _) => {
             let _ = writeln!(
@@ -343,13 +349,6 @@ pub fn task_c(
                 }
             }
             out.push_str("}\n\nTASK_WRAPUP\n{\n}\n");
-            if target == Target::Linux {
-                out = out.replacen(
-                    "#include \"../program.h\"\n",
-                    "#include \"../program.h\"\n#include <string.h>\n",
-                    1,
-                );
-            }
         }
         (RoleKind::CommSend | RoleKind::CommReceive, _) => return None,
     }

@@ -110,12 +110,7 @@ impl RobotOutput {
         let count = |owner| {
             self.files
                 .iter()
-                .filter(|f| f.owner == owner && f.path.ends_with(".c"))
-                .chain(
-                    self.files
-                        .iter()
-                        .filter(|f| f.owner == owner && f.path.ends_with(".h")),
-                )
+                .filter(|f| f.owner == owner && (f.path.ends_with(".c") || f.path.ends_with(".h")))
                 .map(|f| f.text.lines().count())
                 .sum()
         };

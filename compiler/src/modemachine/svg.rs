@@ -13,6 +13,7 @@
 use super::ModeMachine;
 use crate::taskgraph::svg::layered::{self, Pin};
 use crate::taskgraph::svg::text_width;
+use crate::xmlpos::escape;
 use std::fmt::Write;
 
 const FONT: f64 = 12.0;
@@ -44,20 +45,6 @@ fn num(v: f64) -> String {
     } else {
         format!("{r:.1}")
     }
-}
-
-fn escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            c => out.push(c),
-        }
-    }
-    out
 }
 
 fn label_of(events: &[crate::syntax::ast::Name]) -> String {

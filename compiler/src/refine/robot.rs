@@ -46,6 +46,7 @@ pub(super) fn refine_robot(
         diagnostics: Vec::new(),
     };
     builder.build_modes();
+    let self_peer = builder.first_peer() + robot_index;
     let Builder {
         machine,
         sensors,
@@ -53,10 +54,6 @@ pub(super) fn refine_robot(
         diagnostics,
         ..
     } = builder;
-    let self_peer = peers
-        .iter()
-        .position(|(t, r)| *t == team.name && *r == robot.name)
-        .unwrap_or(0);
     let shared: Vec<String> = machine
         .slots
         .iter()

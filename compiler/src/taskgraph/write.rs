@@ -2,6 +2,7 @@
 //! `semo build`), readable again by [`super::load_task_graph`].
 
 use super::model::*;
+use crate::xmlpos::escape;
 use std::fmt::Write;
 
 /// The graph as `*.taskgraph.xml` text, after a comment naming its origin.
@@ -9,20 +10,6 @@ pub fn to_xml(graph: &TaskGraph, comment: &str) -> String {
     let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let _ = writeln!(out, "<!-- {} -->", comment.replace("--", "- -"));
     write_graph(&mut out, graph, 0, true);
-    out
-}
-
-fn esc(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            c => out.push(c),
-        }
-    }
     out
 }
 
@@ -37,28 +24,37 @@ fn write_graph(out: &mut String, graph: &TaskGraph, depth: usize, root: bool) {
     } else {
         ""
     };
-    let _ = writeln!(out, "<TaskGraph name=\"{}\"{ns}>", esc(&graph.name));
+    let _ = writeln!(out, "<TaskGraph name=\"{}\"{ns}>", escape(&graph.name));
     for task in &graph.tasks {
         write_task(out, task, depth + 1);
     }
     for library in &graph.libraries {
         indent(out, depth + 1);
-        let _ = writeln!(out, "<Library name=\"{}\">", esc(&library.name.name));
+        let _ = writeln!(out, "<Library name=\"{}\">", escape(&library.name.name));
         for f in &library.functions {
             indent(out, depth + 2);
             let returns = f
                 .returns
                 .as_ref()
-                .map(|r| format!(" returns=\"{}\"", esc(r)))
+                .map(|r| format!(" returns=\"{}\"", escape(r)))
                 .unwrap_or_default();
             if f.params.is_empty() {
-                let _ = writeln!(out, "<Function name=\"{}\"{returns}/>", esc(&f.name.name));
+                let _ = writeln!(
+                    out,
+                    "<Function name=\"{}\"{returns}/>",
+                    escape(&f.name.name)
+                );
                 continue;
             }
-            let _ = writeln!(out, "<Function name=\"{}\"{returns}>", esc(&f.name.name));
+            let _ = writeln!(out, "<Function name=\"{}\"{returns}>", escape(&f.name.name));
             for (name, ty) in &f.params {
                 indent(out, depth + 3);
-                let _ = writeln!(out, "<Param name=\"{}\" type=\"{}\"/>", esc(name), esc(ty));
+                let _ = writeln!(
+                    out,
+                    "<Param name=\"{}\" type=\"{}\"/>",
+                    escape(name),
+                    escape(ty)
+                );
             }
             indent(out, depth + 2);
             out.push_str("</Function>\n");
@@ -71,10 +67,10 @@ fn write_graph(out: &mut String, graph: &TaskGraph, depth: usize, root: bool) {
         let _ = write!(
             out,
             "<Channel src=\"{}.{}\" dst=\"{}.{}\"",
-            esc(&c.src.task),
-            esc(&c.src.port),
-            esc(&c.dst.task),
-            esc(&c.dst.port)
+            escape(&c.src.task),
+            escape(&c.src.port),
+            escape(&c.dst.task),
+            escape(&c.dst.port)
         );
         if c.initial_tokens > 0 {
             let _ = write!(out, " initialTokens=\"{}\"", c.initial_tokens);
@@ -98,11 +94,11 @@ fn write_task(out: &mut String, task: &Task, depth: usize) {
         let _ = write!(
             out,
             "<Loop name=\"{}\" type=\"{kind}\" loopCount=\"{}\"",
-            esc(&task.name.name),
+            escape(&task.name.name),
             l.loop_count
         );
         if let Some(exit) = &l.exit_task {
-            let _ = write!(out, " exitTask=\"{}\"", esc(&exit.name));
+            let _ = write!(out, " exitTask=\"{}\"", escape(&exit.name));
         }
         out.push_str(">\n");
         for p in &task.ports {
@@ -110,7 +106,7 @@ fn write_task(out: &mut String, task: &Task, depth: usize) {
             let _ = write!(
                 out,
                 "<Port name=\"{}\" dir=\"{}\"",
-                esc(&p.name.name),
+                escape(&p.name.name),
                 dir(p.dir)
             );
             if let Some(kind) = p.kind {
@@ -140,7 +136,7 @@ fn write_task(out: &mut String, task: &Task, depth: usize) {
     let _ = write!(
         out,
         "<Task name=\"{}\" kind=\"{kind}\"",
-        esc(&task.name.name)
+        escape(&task.name.name)
     );
     match &task.trigger {
         Trigger::Time { period_ms } => {
@@ -153,10 +149,10 @@ fn write_task(out: &mut String, task: &Task, depth: usize) {
         let _ = write!(out, " wcet=\"{wcet}\"");
     }
     if let Some(source) = &task.source {
-        let _ = write!(out, " source=\"{}\"", esc(source));
+        let _ = write!(out, " source=\"{}\"", escape(source));
     }
     if let Some(sub) = &task.subgraph {
-        let _ = write!(out, " subgraph=\"{}\"", esc(&sub.name));
+        let _ = write!(out, " subgraph=\"{}\"", escape(&sub.name));
     }
     let empty =
         task.ports.is_empty() && task.library_ports.is_empty() && task.multicast_ports.is_empty();
@@ -170,12 +166,12 @@ fn write_task(out: &mut String, task: &Task, depth: usize) {
         let _ = write!(
             out,
             "<Port name=\"{}\" dir=\"{}\" rate=\"{}\"",
-            esc(&p.name.name),
+            escape(&p.name.name),
             dir(p.dir),
             p.rate
         );
         if let Some(ty) = &p.sample_type {
-            let _ = write!(out, " type=\"{}\"", esc(ty));
+            let _ = write!(out, " type=\"{}\"", escape(ty));
         }
         if let Some(size) = p.size {
             let _ = write!(out, " size=\"{size}\"");
@@ -192,12 +188,12 @@ fn write_task(out: &mut String, task: &Task, depth: usize) {
         let _ = write!(
             out,
             "<{element} name=\"{}\" library=\"{}\"",
-            esc(&l.name.name),
-            esc(&l.library.name)
+            escape(&l.name.name),
+            escape(&l.library.name)
         );
         if l.master && !l.calls.is_empty() {
             let calls: Vec<&str> = l.calls.iter().map(|c| c.name.as_str()).collect();
-            let _ = write!(out, " calls=\"{}\"", esc(&calls.join(" ")));
+            let _ = write!(out, " calls=\"{}\"", escape(&calls.join(" ")));
         }
         out.push_str("/>\n");
     }
@@ -206,9 +202,9 @@ fn write_task(out: &mut String, task: &Task, depth: usize) {
         let _ = writeln!(
             out,
             "<MulticastPort name=\"{}\" dir=\"{}\" group=\"{}\"/>",
-            esc(&m.name.name),
+            escape(&m.name.name),
             dir(m.dir),
-            esc(&m.group.name)
+            escape(&m.group.name)
         );
     }
     indent(out, depth);

@@ -140,16 +140,8 @@ pub fn mission_diagnostics(
         .iter()
         .filter(|d| d.file == job.mission)
         .map(|d| tower_lsp_server::ls_types::Diagnostic {
-            range: map.range(d.span),
-            severity: Some(if d.is_error() {
-                DiagnosticSeverity::ERROR
-            } else {
-                DiagnosticSeverity::WARNING
-            }),
-            code: Some(NumberOrString::String(d.code.as_str().to_string())),
             source: Some("semo build".into()),
-            message: d.message.clone(),
-            ..Default::default()
+            ..crate::diagnostics::convert(d, map.range(d.span))
         })
         .collect()
 }

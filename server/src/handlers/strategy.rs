@@ -139,6 +139,17 @@ pub fn references(
         .collect()
 }
 
+/// The strategy snapshots checked against this very version of `mission`
+/// (whose links and positions therefore point into it).
+fn checked_against<'s>(
+    mission: &'s Snapshot,
+    strategies: &'s [Arc<Snapshot>],
+) -> impl Iterator<Item = &'s Arc<Snapshot>> {
+    strategies
+        .iter()
+        .filter(move |s| s.missions.iter().any(|m| std::ptr::eq(&**m, mission)))
+}
+
 /// From a mission call to the entries of the workspace's strategy files
 /// that refine it. A strategy snapshot is checked against the current
 /// missions, so its links point into this very version of the mission.
@@ -148,14 +159,7 @@ pub fn entries_of_call(
     offset: usize,
 ) -> Vec<(FileId, Range)> {
     let mut out = Vec::new();
-    for strategy in strategies {
-        if !strategy
-            .missions
-            .iter()
-            .any(|m| std::ptr::eq(&**m, mission))
-        {
-            continue;
-        }
+    for strategy in checked_against(mission, strategies) {
         let analysis = strategy.analysis();
         let Some(model) = &analysis.strategy else {
             continue;
@@ -226,14 +230,7 @@ pub fn create_entries(
     let offset = mission.line_map(&analysis).offset(range.start);
     let catalog = mission.catalog.catalog();
     let mut out = Vec::new();
-    for strategy in strategies {
-        if !strategy
-            .missions
-            .iter()
-            .any(|m| std::ptr::eq(&**m, mission))
-        {
-            continue;
-        }
+    for strategy in checked_against(mission, strategies) {
         let s_analysis = strategy.analysis();
         let Some(model) = &s_analysis.strategy else {
             continue;

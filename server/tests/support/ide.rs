@@ -218,3 +218,25 @@ pub fn listing(diagnostics: &[Value]) -> String {
         .collect::<Vec<_>>()
         .join("\n")
 }
+
+/// The lines that differ between two texts: the old ones with `-`, the new
+/// ones with `+` (between the common first and last lines).
+pub fn diff(old: &str, new: &str) -> String {
+    let a: Vec<&str> = old.lines().collect();
+    let b: Vec<&str> = new.lines().collect();
+    let prefix = a.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let suffix = a[prefix..]
+        .iter()
+        .rev()
+        .zip(b[prefix..].iter().rev())
+        .take_while(|(x, y)| x == y)
+        .count();
+    let mut out = String::new();
+    for line in &a[prefix..a.len() - suffix] {
+        out.push_str(&format!("      - {line}\n"));
+    }
+    for line in &b[prefix..b.len() - suffix] {
+        out.push_str(&format!("      + {line}\n"));
+    }
+    out
+}

@@ -7,6 +7,7 @@
 use super::place::{Anchor, Label, Placed, Route, Seg};
 use super::scene::{End, Level, Shape, Side, Style};
 use super::{LABEL_FONT, NODE_FONT, PORT_FONT, TITLE_FONT, text_width};
+use crate::xmlpos::escape;
 use std::fmt::Write;
 
 /// Cluster fills by nesting depth.
@@ -432,37 +433,6 @@ impl std::fmt::Display for Num {
             0 => write!(f, "{sign}{whole}"),
             _ => write!(f, "{sign}{whole}.{tenth}"),
         }
-    }
-}
-
-/// Text for XML content or a quoted attribute: special characters escaped,
-/// characters XML 1.0 does not allow replaced by U+FFFD.
-#[derive(Clone, Copy)]
-struct Escaped<'s>(&'s str);
-
-fn escape(s: &str) -> Escaped<'_> {
-    Escaped(s)
-}
-
-impl std::fmt::Display for Escaped<'_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let mut plain = 0;
-        for (i, c) in self.0.char_indices() {
-            let replacement = match c {
-                '&' => "&amp;",
-                '<' => "&lt;",
-                '>' => "&gt;",
-                '"' => "&quot;",
-                '\'' => "&apos;",
-                '\t' | '\n' | '\r' => continue,
-                c if (c as u32) < 0x20 || c == '\u{FFFE}' || c == '\u{FFFF}' => "\u{FFFD}",
-                _ => continue,
-            };
-            f.write_str(&self.0[plain..i])?;
-            f.write_str(replacement)?;
-            plain = i + c.len_utf8();
-        }
-        f.write_str(&self.0[plain..])
     }
 }
 
