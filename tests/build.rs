@@ -8,7 +8,7 @@ mod support;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use support::{repo_root, semo_in, shared};
+use support::{examples, repo_root, semo_in};
 
 const STRICT: &str = "-std=c11 -Wall -Wextra -Werror -O1 -g";
 
@@ -80,7 +80,7 @@ fn has(program: &str) -> bool {
 }
 
 fn example(path: &str) -> PathBuf {
-    shared().join("examples").join(path)
+    examples().join(path)
 }
 
 #[test]

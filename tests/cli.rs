@@ -3,11 +3,11 @@
 
 mod support;
 
-use support::{check_json_in, semo, semo_in, semo_with_stdin, shared};
+use support::{check_json_in, examples, semo, semo_in, semo_with_stdin};
 
 #[test]
-fn every_shared_example_checks_without_errors() {
-    let examples = shared().join("examples");
+fn every_reference_example_checks_without_errors() {
+    let examples = examples();
     for folder in ["scouting", "follow", "swarm"] {
         let (code, diags) = check_json_in(&examples, &[folder]);
         let errors: Vec<_> = diags.iter().filter(|d| d.severity == "error").collect();
@@ -18,7 +18,7 @@ fn every_shared_example_checks_without_errors() {
 
 #[test]
 fn scouting_gives_exactly_the_unmatched_receive_warning() {
-    let (_, diags) = check_json_in(&shared().join("examples/scouting"), &["scouting.mission"]);
+    let (_, diags) = check_json_in(&examples().join("scouting"), &["scouting.mission"]);
     let warnings: Vec<_> = diags.iter().filter(|d| d.severity != "hint").collect();
     assert_eq!(warnings.len(), 1, "{warnings:#?}");
     let w = warnings[0];
@@ -40,10 +40,7 @@ fn scouting_gives_exactly_the_unmatched_receive_warning() {
 
 #[test]
 fn human_output_shows_the_source_line_and_a_summary() {
-    let out = semo_in(
-        &shared().join("examples/scouting"),
-        &["check", "scouting.mission"],
-    );
+    let out = semo_in(&examples().join("scouting"), &["check", "scouting.mission"]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert!(out.stdout.contains("[W004] Warning"), "{}", out.stdout);
     assert!(
@@ -71,7 +68,7 @@ fn human_output_shows_the_source_line_and_a_summary() {
 #[test]
 fn colours_can_be_forced() {
     let out = semo_in(
-        &shared().join("examples/scouting"),
+        &examples().join("scouting"),
         &["check", "--color", "always", "scouting.mission"],
     );
     assert!(out.stdout.contains("\u{1b}["), "{}", out.stdout);
@@ -464,7 +461,7 @@ fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
             copy_dir(&path, &target);
         } else {
             std::fs::copy(&path, &target).unwrap();
-            // The shared examples are read-only; their copies are ours to change.
+            // The examples may be read-only; their copies are ours to change.
             let mut permissions = std::fs::metadata(&target).unwrap().permissions();
             #[allow(clippy::permissions_set_readonly_false)]
             permissions.set_readonly(false);
@@ -476,8 +473,7 @@ fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
 #[test]
 fn formatting_the_examples_changes_nothing_that_semo_check_finds() {
     let dir = tempdir();
-    copy_dir(&shared().join("examples"), &dir.join("shared"));
-    copy_dir(&support::repo_root().join("examples"), &dir.join("ours"));
+    copy_dir(&examples(), &dir.join("examples"));
     let findings = || {
         let (code, diags) = check_json_in(&dir, &["."]);
         let found: Vec<(String, String, String)> = diags
@@ -498,7 +494,7 @@ fn formatting_the_examples_changes_nothing_that_semo_check_finds() {
 
 #[test]
 fn strategy_files_are_checked_against_their_missions() {
-    let out = semo_in(&shared().join("examples"), &["check", "scouting"]);
+    let out = semo_in(&examples(), &["check", "scouting"]);
     assert_eq!(out.code, 0, "{}", out.stdout);
     assert!(
         out.stdout

@@ -144,11 +144,7 @@ fn check_faithful_and_stable(text: &str) -> Result<String, FormatRefusal> {
 fn every_example_and_fixture_keeps_its_tokens_and_comments_and_is_stable() {
     let root = support::repo_root();
     let mut paths = Vec::new();
-    for dir in [
-        support::shared().join("examples"),
-        root.join("examples"),
-        root.join("tests/fixtures"),
-    ] {
+    for dir in [root.join("examples"), root.join("tests/fixtures")] {
         missions(&dir, &mut paths);
     }
     assert!(paths.len() > 60, "only {} missions found", paths.len());
@@ -179,7 +175,7 @@ fn every_example_and_fixture_keeps_its_tokens_and_comments_and_is_stable() {
 fn the_reference_examples_are_close_to_the_canonical_layout() {
     // The style follows the examples: formatting them changes few lines.
     for name in ["scouting/scouting.mission", "swarm/march.mission"] {
-        let text = std::fs::read_to_string(support::shared().join("examples").join(name)).unwrap();
+        let text = std::fs::read_to_string(support::examples().join(name)).unwrap();
         let out = format_source(&text).unwrap();
         let kept = text
             .lines()
@@ -606,7 +602,7 @@ fn random_layout(seed: u64) -> String {
 }
 
 fn mutated_example(which: usize, mutations: &[(u8, usize, usize)]) -> String {
-    let root = support::shared().join("examples");
+    let root = support::examples();
     let names = [
         "scouting/scouting.mission",
         "follow/follow.mission",

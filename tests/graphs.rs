@@ -6,7 +6,7 @@ mod support;
 
 use semo::diag::FileId;
 use semo::taskgraph::{Direction, TaskGraph, analysis, load_task_graph};
-use support::{semo_in, shared};
+use support::{examples, sdf3, semo_in};
 
 fn analyze_json(dir: &std::path::Path, file: &str) -> (i32, serde_json::Value) {
     let out = semo_in(dir, &["graph", "analyze", "--format", "json", file]);
@@ -30,10 +30,7 @@ fn repetition(level: &serde_json::Value, node: &str) -> u64 {
 
 #[test]
 fn consistent_example_has_its_repetition_vector() {
-    let (code, v) = analyze_json(
-        &shared().join("examples/taskgraphs"),
-        "consistent.taskgraph.xml",
-    );
+    let (code, v) = analyze_json(&examples().join("taskgraphs"), "consistent.taskgraph.xml");
     assert_eq!(code, 0, "{v}");
     assert_eq!(v["levels"][0]["consistent"], true);
     assert_eq!(v["levels"][0]["deadlock_free"], true);
@@ -42,10 +39,7 @@ fn consistent_example_has_its_repetition_vector() {
 
 #[test]
 fn inconsistent_example_names_the_channel_and_ratios() {
-    let (code, v) = analyze_json(
-        &shared().join("examples/taskgraphs"),
-        "inconsistent.taskgraph.xml",
-    );
+    let (code, v) = analyze_json(&examples().join("taskgraphs"), "inconsistent.taskgraph.xml");
     assert_eq!(code, 1);
     let d = &v["diagnostics"][0];
     assert_eq!(d["code"], "E070");
@@ -57,7 +51,7 @@ fn inconsistent_example_names_the_channel_and_ratios() {
 
 #[test]
 fn deadlock_example_names_the_cycle_and_the_fix() {
-    let dir = shared().join("examples/taskgraphs");
+    let dir = examples().join("taskgraphs");
     let (code, v) = analyze_json(&dir, "deadlock.taskgraph.xml");
     assert_eq!(code, 1);
     let d = &v["diagnostics"][0];
@@ -76,10 +70,7 @@ fn deadlock_example_names_the_cycle_and_the_fix() {
 
 #[test]
 fn data_loop_body_fires_once_per_iteration() {
-    let (code, v) = analyze_json(
-        &shared().join("examples/taskgraphs"),
-        "data_loop.taskgraph.xml",
-    );
+    let (code, v) = analyze_json(&examples().join("taskgraphs"), "data_loop.taskgraph.xml");
     assert_eq!(code, 0, "{v}");
     let top = &v["levels"][0];
     assert_eq!(
@@ -98,7 +89,7 @@ fn data_loop_body_fires_once_per_iteration() {
 #[test]
 fn human_report_lists_levels() {
     let out = semo_in(
-        &shared().join("examples/taskgraphs"),
+        &examples().join("taskgraphs"),
         &["graph", "analyze", "kmeans.taskgraph.xml"],
     );
     assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
@@ -117,7 +108,7 @@ fn human_report_lists_levels() {
 
 #[test]
 fn every_reference_example_loads() {
-    let dir = shared().join("examples/taskgraphs");
+    let dir = examples().join("taskgraphs");
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
         let text = std::fs::read_to_string(&path).unwrap();
@@ -165,7 +156,7 @@ fn gcd(a: u64, b: u64) -> u64 {
 
 #[test]
 fn every_sdf3_benchmark_is_consistent_and_deadlock_free() {
-    let dir = shared().join("data/sdf3");
+    let dir = sdf3();
     let mut checked = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
         let path = entry.unwrap().path();
@@ -196,7 +187,7 @@ fn every_sdf3_benchmark_is_consistent_and_deadlock_free() {
 
 #[test]
 fn check_reports_task_graph_problems_in_folders() {
-    let (code, diags) = support::check_json_in(&shared().join("examples"), &["taskgraphs"]);
+    let (code, diags) = support::check_json_in(&examples(), &["taskgraphs"]);
     assert_eq!(code, 1);
     let codes: Vec<&str> = diags.iter().map(|d| d.code.as_str()).collect();
     assert!(
@@ -208,7 +199,7 @@ fn check_reports_task_graph_problems_in_folders() {
 #[test]
 fn dot_draws_the_graph_and_refuses_a_broken_file() {
     let out = semo_in(
-        &shared().join("examples/taskgraphs"),
+        &examples().join("taskgraphs"),
         &["graph", "dot", "data_loop.taskgraph.xml"],
     );
     assert_eq!(out.code, 0, "{}", out.stderr);
@@ -238,7 +229,7 @@ fn dot_draws_the_graph_and_refuses_a_broken_file() {
 
 #[test]
 fn svg_draws_the_graph_to_stdout_or_a_file_and_refuses_a_broken_file() {
-    let dir = shared().join("examples/taskgraphs");
+    let dir = examples().join("taskgraphs");
     let out = semo_in(&dir, &["graph", "svg", "kmeans.taskgraph.xml"]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert!(
@@ -268,7 +259,7 @@ fn svg_draws_the_graph_to_stdout_or_a_file_and_refuses_a_broken_file() {
     let _ = std::fs::remove_file(&target);
     assert_eq!(file, out.stdout);
     // An SDF3 benchmark.
-    let sdf3 = semo_in(&shared().join("data/sdf3"), &["graph", "svg", "modem.xml"]);
+    let sdf3 = semo_in(&sdf3(), &["graph", "svg", "modem.xml"]);
     assert_eq!(sdf3.code, 0, "{}", sdf3.stderr);
     assert!(
         sdf3.stdout.contains("data-path=\"deci\""),
@@ -288,7 +279,7 @@ fn svg_draws_the_graph_to_stdout_or_a_file_and_refuses_a_broken_file() {
 
 #[test]
 fn data_loop_has_the_looped_single_appearance_schedule() {
-    let dir = shared().join("examples/taskgraphs");
+    let dir = examples().join("taskgraphs");
     let out = semo_in(&dir, &["graph", "schedule", "data_loop.taskgraph.xml"]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert_eq!(out.stdout, "A 10(B C) D\n");
@@ -299,7 +290,7 @@ fn data_loop_has_the_looped_single_appearance_schedule() {
 
 #[test]
 fn multicore_schedule_lists_each_core() {
-    let dir = shared().join("examples/taskgraphs");
+    let dir = examples().join("taskgraphs");
     let out = semo_in(
         &dir,
         &[
@@ -321,7 +312,7 @@ fn multicore_schedule_lists_each_core() {
 
 #[test]
 fn throughput_names_the_period_and_critical_cycle() {
-    let (code, v) = analyze_json(&shared().join("data/sdf3"), "h263encoder.xml");
+    let (code, v) = analyze_json(&sdf3(), "h263encoder.xml");
     assert_eq!(code, 0, "{v}");
     let t = &v["levels"][0]["throughput"];
     // Verified by an independent self-timed simulation in the unit tests.
@@ -339,7 +330,7 @@ fn throughput_names_the_period_and_critical_cycle() {
 
 #[test]
 fn check_reads_an_explicitly_named_sdf3_file_as_a_task_graph() {
-    let out = semo_in(&shared().join("data/sdf3"), &["check", "modem.xml"]);
+    let out = semo_in(&sdf3(), &["check", "modem.xml"]);
     assert_eq!(out.code, 0, "{}", out.stdout);
     assert_eq!(
         out.stdout,
@@ -443,7 +434,7 @@ fn a_missing_sub_graph_fails_the_analysis_on_the_reference() {
 
 #[test]
 fn modes_draws_each_team_or_one_and_reports_errors_and_unknown_teams() {
-    let dir = shared().join("examples/scouting");
+    let dir = examples().join("scouting");
     let all = semo_in(&dir, &["graph", "modes", "scouting.mission"]);
     assert_eq!(all.code, 0, "{}", all.stderr);
     assert!(

@@ -19,14 +19,13 @@ use semo::syntax::{Parse, ParseCache, parse, parse_incremental};
 use std::path::Path;
 use std::sync::OnceLock;
 
-/// Every mission script the repository and `../shared` hold.
+/// Every mission script the repository holds.
 fn corpus() -> &'static Vec<String> {
     static CORPUS: OnceLock<Vec<String>> = OnceLock::new();
     CORPUS.get_or_init(|| {
         let mut paths = Vec::new();
         for root in [
-            support::shared().join("examples"),
-            support::repo_root().join("examples"),
+            support::examples(),
             support::repo_root().join("tests/fixtures"),
         ] {
             missions_under(&root, &mut paths);

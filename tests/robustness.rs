@@ -22,7 +22,7 @@ fn catalog() -> &'static Catalog {
 fn examples() -> &'static Vec<String> {
     static EXAMPLES: OnceLock<Vec<String>> = OnceLock::new();
     EXAMPLES.get_or_init(|| {
-        let root = support::shared().join("examples");
+        let root = support::examples();
         [
             "scouting/scouting.mission",
             "follow/follow.mission",
@@ -282,7 +282,7 @@ fn strategy_examples() -> &'static Vec<String> {
     EXAMPLES.get_or_init(|| {
         let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
         [
-            support::shared().join("examples/scouting/MasterTeam.strategy.xml"),
+            support::examples().join("scouting/MasterTeam.strategy.xml"),
             // Every element of the format, and conditions with a plain `<`.
             fixtures.join("E081_strategy_plain_lt/Scouts.strategy.xml"),
         ]
@@ -299,7 +299,7 @@ fn strategy_missions() -> &'static Vec<(String, semo::Analysis)> {
     MISSIONS.get_or_init(|| {
         let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
         [
-            support::shared().join("examples/scouting/scouting.mission"),
+            support::examples().join("scouting/scouting.mission"),
             fixtures.join("E081_strategy_plain_lt/scouts.mission"),
         ]
         .iter()

@@ -15,7 +15,7 @@ use std::time::Duration;
 
 fn shared(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/examples")
+        .join("../examples")
         .join(path)
 }
 

@@ -50,7 +50,7 @@ fn generate(n: usize) -> String {
 
 fn main() {
     let budget = Duration::from_millis(700);
-    let sdf3 = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/sdf3");
+    let sdf3 = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sdf3");
     println!(
         "{:<40} {:>8} {:>10} {:>12} {:>12}",
         "SDF3 graph", "tasks", "load", "analyse", "svg"

@@ -1,6 +1,6 @@
 // Tokenizes every example mission with the TextMate grammar, as VS Code does, and fails
 // if any token is scoped `invalid` (a character the grammar does not expect). The examples
-// are the reference missions (../shared/examples), the repository's examples/ and the
+// are the repository's examples/ (the reference missions among them) and the
 // formatter's fixtures (valid missions in many layouts).
 'use strict';
 
@@ -11,7 +11,6 @@ const oniguruma = require('vscode-oniguruma');
 
 const repo = path.resolve(__dirname, '..', '..');
 const roots = [
-  path.resolve(repo, '..', 'shared', 'examples'),
   path.join(repo, 'examples'),
   path.join(repo, 'tests', 'fixtures', 'format'),
 ];

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 fn shared(path: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/examples")
+        .join("../examples")
         .join(path)
 }
 

@@ -6,7 +6,7 @@ use serde_json::{Value, json};
 
 fn shared(path: &str) -> String {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/examples")
+        .join("../examples")
         .join(path);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }

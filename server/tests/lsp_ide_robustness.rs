@@ -94,7 +94,7 @@ const STRATEGY_TEXTS: &[&str] = &[
 fn every_strategy_request_at_every_position_answers() {
     let mut session = Session::new();
     let scouting = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/examples/scouting/scouting.mission");
+        .join("../examples/scouting/scouting.mission");
     let mission = std::fs::read_to_string(scouting).expect("the scouting mission");
     session.open("scouting.mission", &mission);
     for text in STRATEGY_TEXTS {

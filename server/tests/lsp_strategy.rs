@@ -15,7 +15,7 @@ use support::text_at;
 
 fn scouting(name: &str) -> String {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/examples/scouting")
+        .join("../examples/scouting")
         .join(name);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }

@@ -9,7 +9,7 @@ use support::{client_with, cursors, text_at};
 
 fn example(name: &str) -> String {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/examples/taskgraphs")
+        .join("../examples/taskgraphs")
         .join(name);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 fn scouting(name: &str) -> String {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/examples/scouting")
+        .join("../examples/scouting")
         .join(name);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }

@@ -12,9 +12,15 @@ pub fn repo_root() -> PathBuf {
         .to_path_buf()
 }
 
-/// `../shared` beside the checkout: the reference examples.
-pub fn shared() -> PathBuf {
-    repo_root().join("../shared")
+/// The bundled examples: the reference missions, strategies and task graphs (copied from the
+/// project's shared reference material, see `examples/README.md`) and our own.
+pub fn examples() -> PathBuf {
+    repo_root().join("examples")
+}
+
+/// The SDF3 benchmark graphs (`tests/data/sdf3/README.md` says where they come from).
+pub fn sdf3() -> PathBuf {
+    repo_root().join("tests/data/sdf3")
 }
 
 pub struct Output {

@@ -332,7 +332,7 @@ fn every_feature_at(text: &str, analysis: &Analysis, offset: usize) {
 fn examples() -> &'static [String] {
     static EXAMPLES: OnceLock<Vec<String>> = OnceLock::new();
     EXAMPLES.get_or_init(|| {
-        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/examples");
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
         [
             "scouting/scouting.mission",
             "follow/follow.mission",

@@ -97,7 +97,7 @@ fn broken_missions_still_draw() {
 fn the_scouting_example_draws_both_teams() {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../shared/examples/scouting/scouting.mission"
+        "/../examples/scouting/scouting.mission"
     );
     let text = std::fs::read_to_string(path).expect("the scouting example");
     let found = machines_of(&text);

@@ -8,7 +8,7 @@ use crate::strategy::{StrategyLinks, cross_check, load_strategy};
 
 fn shared(path: &str) -> String {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/examples")
+        .join("../examples")
         .join(path);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }

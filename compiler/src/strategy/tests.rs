@@ -9,11 +9,11 @@ const MISSION: FileId = FileId(1);
 
 const SCOUTING_STRATEGY: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/examples/scouting/MasterTeam.strategy.xml"
+    "/../examples/scouting/MasterTeam.strategy.xml"
 ));
 const SCOUTING: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/examples/scouting/scouting.mission"
+    "/../examples/scouting/scouting.mission"
 ));
 
 fn load(text: &str) -> (Strategy, Vec<Diagnostic>) {

@@ -161,7 +161,7 @@ mod tests {
     fn loops_are_clusters_and_channels_carry_rates_and_samples() {
         let path = concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/../../shared/examples/taskgraphs/kmeans.taskgraph.xml"
+            "/../examples/taskgraphs/kmeans.taskgraph.xml"
         );
         let text = std::fs::read_to_string(path).unwrap();
         let graph = super::super::load_task_graph(FileId(0), &text).0.unwrap();

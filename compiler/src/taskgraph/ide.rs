@@ -356,7 +356,7 @@ mod tests {
 
     const DATA_LOOP: &str = include_str!(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../shared/examples/taskgraphs/data_loop.taskgraph.xml"
+        "/../examples/taskgraphs/data_loop.taskgraph.xml"
     ));
 
     fn load(text: &str) -> (TaskGraph, GraphReport) {

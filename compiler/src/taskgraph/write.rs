@@ -227,8 +227,7 @@ mod tests {
     /// tasks, ports, channels and libraries, and no diagnostics.
     #[test]
     fn reference_graphs_round_trip() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../shared/examples/taskgraphs");
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/taskgraphs");
         let mut seen = 0;
         for entry in std::fs::read_dir(&dir).expect("shared examples") {
             let path = entry.unwrap().path();

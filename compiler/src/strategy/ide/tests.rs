@@ -13,11 +13,11 @@ use crate::strategy::{StrategyLinks, cross_check, load_strategy};
 
 const MISSION: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/examples/scouting/scouting.mission"
+    "/../examples/scouting/scouting.mission"
 ));
 const STRATEGY: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/examples/scouting/MasterTeam.strategy.xml"
+    "/../examples/scouting/MasterTeam.strategy.xml"
 ));
 
 struct Loaded {

@@ -853,12 +853,12 @@ mod tests {
         };
         let data_loop = load(include_str!(concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/../../shared/examples/taskgraphs/data_loop.taskgraph.xml"
+            "/../examples/taskgraphs/data_loop.taskgraph.xml"
         )));
         assert_eq!(looped_schedule(&data_loop).unwrap(), "A 10(B C) D");
         let kmeans = load(include_str!(concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/../../shared/examples/taskgraphs/kmeans.taskgraph.xml"
+            "/../examples/taskgraphs/kmeans.taskgraph.xml"
         )));
         assert_eq!(
             looped_schedule(&kmeans).unwrap(),
@@ -1123,7 +1123,7 @@ mod tests {
 
     #[test]
     fn published_sdf3_graphs_get_valid_schedules() {
-        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/sdf3");
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sdf3");
         let mut seen = 0;
         for entry in std::fs::read_dir(dir).unwrap() {
             let path = entry.unwrap().path();

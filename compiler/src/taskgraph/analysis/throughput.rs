@@ -575,7 +575,7 @@ mod tests {
         assert!(checked > 100, "{checked}");
     }
 
-    const SDF3: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/sdf3");
+    const SDF3: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sdf3");
 
     #[test]
     fn every_sdf3_graph_agrees_with_simulation() {

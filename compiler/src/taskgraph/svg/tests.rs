@@ -423,7 +423,7 @@ fn shared(dir: &str) -> Vec<String> {
 
 fn example(name: &str) -> TaskGraph {
     load(&format!(
-        "{}/../../shared/examples/taskgraphs/{name}.taskgraph.xml",
+        "{}/../examples/taskgraphs/{name}.taskgraph.xml",
         env!("CARGO_MANIFEST_DIR")
     ))
 }

@@ -3,31 +3,28 @@ use proptest::prelude::*;
 
 const FILE: FileId = FileId(3);
 
-const EXAMPLES: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/examples/taskgraphs"
-);
-const SDF3: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/sdf3");
+const EXAMPLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/taskgraphs");
+const SDF3: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sdf3");
 
 const DATA_LOOP: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/examples/taskgraphs/data_loop.taskgraph.xml"
+    "/../examples/taskgraphs/data_loop.taskgraph.xml"
 ));
 const KMEANS: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/examples/taskgraphs/kmeans.taskgraph.xml"
+    "/../examples/taskgraphs/kmeans.taskgraph.xml"
 ));
 const SHARED_INFO: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/examples/taskgraphs/robot_shared_info.taskgraph.xml"
+    "/../examples/taskgraphs/robot_shared_info.taskgraph.xml"
 ));
 const MODEM: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/data/sdf3/modem.xml"
+    "/../tests/data/sdf3/modem.xml"
 ));
 const H263: &str = include_str!(concat!(
     env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/data/sdf3/h263decoder.xml"
+    "/../tests/data/sdf3/h263decoder.xml"
 ));
 
 /// A valid file using every element and attribute of our format.
