@@ -7,8 +7,8 @@
 mod common;
 use common::fastest;
 
-use semo::cli::build::load;
 use semo::codegen::{self, Emit, Target, output};
+use semo::workspace::load_build as load;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;

@@ -13,10 +13,11 @@
 //!   outline, highlighting, folding, selection), as plain data in byte ranges.
 //! - [`modemachine`]: each team's modes and mode changes, and their SVG picture.
 //! - [`workspace`]: loading files and folders from disk for the CLI.
-//! - [`cli`]: the `semo` command (rendering with ariadne or JSON).
+//!
+//! The `semo` command (rendering with ariadne or JSON) is the `semo-cli` crate
+//! (`cli/`), above this library and the language server.
 
 pub mod catalog;
-pub mod cli;
 pub mod codegen;
 pub mod diag;
 /// A fast deterministic hasher for the checker's maps.

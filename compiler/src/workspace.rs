@@ -209,6 +209,32 @@ pub fn load_text(path: &Path) -> Result<String, LoadError> {
     })
 }
 
+/// The files a build reads: the mission, and the catalog and strategy files
+/// beside it (its folder, recursively) and under each `--strategy` path.
+pub fn load_build(mission: &Path, strategy: &[PathBuf]) -> Result<(Files, FileId), LoadError> {
+    let mut files = Files::default();
+    let id = files.add(
+        mission.to_path_buf(),
+        FileKind::Mission,
+        load_text(mission)?,
+    );
+    let folder = mission
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+        .to_path_buf();
+    let mut roots = vec![folder];
+    roots.extend(strategy.iter().cloned());
+    let mut seen = std::collections::BTreeSet::new();
+    for (path, kind) in collect(&roots)? {
+        if matches!(kind, FileKind::Catalog | FileKind::Strategy) && seen.insert(path.clone()) {
+            let text = load_text(&path)?;
+            files.add(path, kind, text);
+        }
+    }
+    Ok((files, id))
+}
+
 /// Reads and checks the given files and folders.
 pub fn check_paths(paths: &[PathBuf]) -> Result<CheckRun, LoadError> {
     let mut files = Files::default();
