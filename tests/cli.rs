@@ -54,8 +54,9 @@ fn human_output_shows_the_source_line_and_a_summary() {
         out.stdout
     );
     assert!(
-        out.stdout
-            .contains("checked 1 mission and 0 catalog files: 0 errors, 1 warning, 2 hints"),
+        out.stdout.contains(
+            "checked 1 mission and 0 catalog files, 1 strategy file: 0 errors, 1 warning, 2 hints"
+        ),
         "{}",
         out.stdout
     );
@@ -547,12 +548,15 @@ fn strategy_files_are_checked_against_their_missions() {
         (Some(3), Some(3))
     );
 
-    // Named alone, a strategy file is checked against the catalog only.
-    let (code, diags) = check_json_in(
+    // Named alone, a strategy file is checked against the missions that see
+    // it (those beside it), exactly as when its folder is checked.
+    let (code, alone) = check_json_in(
         &fixtures,
         &["E090_strategy_robot_not_in_team/Scouts.strategy.xml"],
     );
-    assert_eq!((code, diags.len()), (0, 0), "{diags:#?}");
+    let (_, folder) = check_json_in(&fixtures, &["E090_strategy_robot_not_in_team"]);
+    assert_eq!(code, 1);
+    assert_eq!(support::listing(&alone), support::listing(&folder));
 }
 
 #[test]

@@ -3,7 +3,7 @@
 
 use super::render;
 use semo::codegen::{self, Emit, Target};
-use semo::workspace;
+use semo::host;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -18,19 +18,18 @@ pub struct Options {
 
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let started = std::time::Instant::now();
-    let (files, mission) = match workspace::load_build(&options.mission, &options.strategy) {
+    let (mut run, mission) = match host::load_build(&options.mission, &options.strategy) {
         Ok(loaded) => loaded,
         Err(e) => {
             eprintln!("error: {e}");
             return 2;
         }
     };
-    let mut run = workspace::check_files(files);
-    let Some(input) = run.build_input(mission) else {
+    let Some(input) = run.analysis().build_input(mission) else {
         eprintln!("internal error: the mission was loaded but not checked");
         return 2;
     };
-    let result = codegen::build(&input, options.target, options.emit);
+    let result = codegen::build(&input.input(), options.target, options.emit);
     if result.refused() {
         run.diagnostics = result.diagnostics;
         let _ = render::human(&run, options.color, out);

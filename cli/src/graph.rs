@@ -61,28 +61,25 @@ pub fn svg(path: &Path, output: Option<&Path>, out: &mut impl Write) -> i32 {
     write_picture(&semo::taskgraph::to_svg(&graph), output, out)
 }
 
-/// `semo graph modes`: the mode machines of a mission (checked against the
-/// built-in catalog and the `*.robot.xml` files beside it, as `semo check`
-/// of its folder would), all teams or `team`. Errors in the mission do not
-/// stop the drawing: what was understood is drawn, the errors are on stderr
-/// and the exit code is 1. An unknown team is a usage error (2).
+/// `semo graph modes`: the mode machines of a mission, checked as `semo check
+/// FILE` checks it (against the catalog files it sees), all teams or `team`.
+/// Errors in the mission or what it reads do not stop the drawing: what was
+/// understood is drawn, the errors are on stderr and the exit code is 1. An
+/// unknown team is a usage error (2).
 pub fn modes(path: &Path, team: Option<&str>, output: Option<&Path>, out: &mut impl Write) -> i32 {
-    let Some(text) = read(path) else { return 2 };
-    let mut files = Files::default();
-    // The catalog files beside the mission (and below), as `semo check DIR`.
-    let folder = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let beside = semo::workspace::collect(&[folder.to_path_buf()]).unwrap_or_default();
-    for (catalog, _) in beside.iter().filter(|(_, k)| *k == FileKind::Catalog) {
-        if let Some(text) = read(catalog) {
-            files.add(catalog.clone(), FileKind::Catalog, text);
+    let run = match semo::host::load_check(&[path.to_path_buf()]) {
+        Ok(run) => run,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
         }
-    }
-    let id = files.add(path.to_path_buf(), FileKind::Mission, text);
-    let run = semo::workspace::check_files(files);
-    let Some((_, analysis)) = run.analyses.iter().find(|(f, _)| *f == id) else {
+    };
+    let analysis = run
+        .checked
+        .first()
+        .and_then(|&id| run.analysis().mission(id));
+    let Some(analysis) = analysis else {
+        eprintln!("error: {}: not a mission", path.display());
         return 2;
     };
     let mut machines = semo::modemachine::machines(&analysis.mission);

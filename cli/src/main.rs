@@ -8,7 +8,6 @@ mod graph;
 mod render;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use semo::workspace;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 
@@ -296,7 +295,7 @@ fn check(paths: Vec<PathBuf>, format: Format, color: bool, out: &mut impl Write)
     } else {
         paths
     };
-    let run = match workspace::check_paths(&paths) {
+    let run = match semo::host::load_check(&paths) {
         Ok(run) => run,
         Err(e) => {
             eprintln!("error: {e}");

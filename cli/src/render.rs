@@ -4,8 +4,9 @@
 
 use ariadne::{Color, Config, IndexType, Label, Report, ReportKind};
 use semo::diag::{Diagnostic, Severity};
+use semo::host::CheckRun;
 use semo::text::ColumnUnit;
-use semo::workspace::{CheckRun, Files};
+use semo::workspace::Files;
 use std::io::{self, Write};
 
 fn kind(severity: Severity) -> ReportKind<'static> {
@@ -96,7 +97,12 @@ pub fn human(run: &CheckRun, colored: bool, out: &mut impl Write) -> io::Result<
     diagnostics(&run.files, &run.diagnostics, colored, out)?;
     let count = |s: Severity| run.diagnostics.iter().filter(|d| d.severity == s).count();
     let plural = |n: usize, word: &str| format!("{n} {word}{}", if n == 1 { "" } else { "s" });
-    let of_kind = |kind| run.files.iter().filter(|f| f.kind == kind).count();
+    let of_kind = |kind| {
+        run.checked
+            .iter()
+            .filter(|&&id| run.files.get(id).kind == kind)
+            .count()
+    };
     let graphs = of_kind(semo::workspace::FileKind::TaskGraph);
     let graphs = if graphs > 0 {
         format!(", {}", plural(graphs, "task graph"))

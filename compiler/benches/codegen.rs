@@ -8,7 +8,7 @@ mod common;
 use common::fastest;
 
 use semo::codegen::{self, Emit, Target, output};
-use semo::workspace::load_build as load;
+use semo::host::{AnalysisHost, load_build as load};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
@@ -26,10 +26,12 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 fn build(mission: &Path, target: Target, out: &Path) {
-    let (files, id) = load(mission, &[]).expect("the example loads");
-    let run = semo::workspace::check_files(files);
-    let input = run.build_input(id).expect("the mission is checked");
-    let result = codegen::build(&input, target, Emit::All);
+    let (run, id) = load(mission, &[]).expect("the example loads");
+    let build = run
+        .analysis()
+        .build_input(id)
+        .expect("the mission is checked");
+    let result = codegen::build(&build.input(), target, Emit::All);
     assert!(!result.refused(), "{:#?}", result.diagnostics);
     for robot in &result.robots {
         output::write_robot(out, robot).expect("written");
@@ -39,11 +41,18 @@ fn build(mission: &Path, target: Target, out: &Path) {
 fn main() {
     let mission = shared("scouting/scouting.mission");
     for target in [Target::Linux, Target::LinuxSim] {
-        let (files, id) = load(&mission, &[]).unwrap();
+        let (run, id) = load(&mission, &[]).unwrap();
         let in_memory = fastest(Duration::from_secs(2), || {
-            let run = semo::workspace::check_files(files.clone());
-            let input = run.build_input(id).expect("the mission is checked");
-            let result = codegen::build(&input, target, Emit::All);
+            // A fresh host each time: nothing memoised from the last run.
+            let mut host = AnalysisHost::new(run.host.roots().clone());
+            for f in run.files.iter() {
+                host.set_file(f.id, Some(f.path.clone()), f.kind, f.text.as_str().into());
+            }
+            let build = host
+                .analysis()
+                .build_input(id)
+                .expect("the mission is checked");
+            let result = codegen::build(&build.input(), target, Emit::All);
             std::hint::black_box(result.robots.len());
         });
         let out = scratch("scouting");

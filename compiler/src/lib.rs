@@ -5,8 +5,9 @@
 //! against every `crate::` path. From the bottom: positions and diagnostics
 //! ([`span`], [`text`], [`diag`], [`edit`]); the languages ([`syntax`],
 //! [`format`], [`catalog`], [`sema`], [`taskgraph`], [`strategy`]); what is
-//! made of them ([`modemachine`], [`ide`], [`refine`], [`codegen`]); and
-//! [`workspace`], which reads files from disk.
+//! made of them ([`modemachine`], [`ide`], [`refine`], [`codegen`]);
+//! [`workspace`], which reads files from disk; and on top [`host`], the one
+//! workspace analysis the command line and the language server both ask.
 //!
 //! The `semo` command (rendering with ariadne or JSON) is the `semo-cli` crate
 //! (`cli/`), above this library and the language server.
@@ -18,6 +19,7 @@ pub mod edit;
 /// A fast deterministic hasher for the checker's maps.
 mod fasthash;
 pub mod format;
+pub mod host;
 pub mod ide;
 /// Graph drawing shared by the task-graph and mode-machine pictures.
 mod layout;

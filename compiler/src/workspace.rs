@@ -1,16 +1,11 @@
-//! Loading a check's files from disk: the one place (besides the CLI) that reads
-//! files. A folder stands for every `.mission`, `.robot.xml`, `.strategy.xml`
-//! and `.taskgraph.xml` under it; all catalog files found form one catalog that
-//! every mission is checked against, and every strategy file is checked against
-//! the catalog and the missions.
+//! Files on disk: their kinds, reading them (the one place that reads files),
+//! listing folders (a folder stands for every `.mission`, `.robot.xml`,
+//! `.strategy.xml` and `.taskgraph.xml` under it), the texts of a check for
+//! rendering ([`Files`]), and task graphs analysed with their sub-graphs.
+//! Which files belong together is the host's rule (`crate::host`).
 
-use crate::catalog::{
-    BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE, Catalog, CatalogSource, load_catalog,
-};
-use crate::codegen::BuildInput;
+use crate::catalog::{BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE};
 use crate::diag::{self, Diagnostic, FileId};
-use crate::sema::{Analysis, check_source};
-use crate::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
 use crate::taskgraph::subgraph::{self, Hierarchy, Resolver, SubgraphSource};
 use crate::text::LineIndex;
 use std::path::{Path, PathBuf};
@@ -174,55 +169,6 @@ fn walk(dir: &Path, found: &mut Vec<(PathBuf, FileKind)>) -> Result<(), LoadErro
     Ok(())
 }
 
-/// The outcome of checking a set of files.
-pub struct CheckRun {
-    pub files: Files,
-    pub catalog: Catalog,
-    pub analyses: Vec<(FileId, Analysis)>,
-    /// The strategy files that could be read (a file without a `<Strategy>`
-    /// element is left out; its diagnostics say why).
-    pub strategies: Vec<Strategy>,
-    /// The missions' built-in calls linked to the strategy entries refining them.
-    pub strategy_links: StrategyLinks,
-    /// Every diagnostic, catalog files first, sorted by file and position.
-    pub diagnostics: Vec<Diagnostic>,
-}
-
-impl CheckRun {
-    pub fn error_count(&self) -> usize {
-        self.diagnostics.iter().filter(|d| d.is_error()).count()
-    }
-
-    /// What `mission` is built from: its analysis with this run's catalog,
-    /// strategies and diagnostics. `None` when `mission` is not one of the
-    /// run's missions.
-    pub fn build_input(&self, mission: FileId) -> Option<BuildInput<'_>> {
-        let (_, analysis) = self.analyses.iter().find(|(id, _)| *id == mission)?;
-        let name_of = |id: FileId| {
-            let path = &self.files.get(id).path;
-            path.file_name().map_or_else(
-                || path.display().to_string(),
-                |n| n.to_string_lossy().into_owned(),
-            )
-        };
-        Some(BuildInput {
-            mission,
-            mission_name: name_of(mission),
-            text: &self.files.get(mission).text,
-            analysis,
-            catalog: &self.catalog,
-            strategies: &self.strategies,
-            strategy_names: self
-                .strategies
-                .iter()
-                .map(|s| (s.file, name_of(s.file)))
-                .collect(),
-            links: &self.strategy_links,
-            diagnostics: &self.diagnostics,
-        })
-    }
-}
-
 /// A file's text. Invalid UTF-8 is replaced rather than refused, so the rest
 /// is still checked.
 pub fn read_text(path: &Path) -> std::io::Result<String> {
@@ -237,91 +183,6 @@ pub fn load_text(path: &Path) -> Result<String, LoadError> {
         path: path.to_path_buf(),
         message: e.to_string(),
     })
-}
-
-/// The files a build reads: the mission, and the catalog and strategy files
-/// beside it (its folder, recursively) and under each `--strategy` path.
-pub fn load_build(mission: &Path, strategy: &[PathBuf]) -> Result<(Files, FileId), LoadError> {
-    let mut files = Files::default();
-    let id = files.add(
-        mission.to_path_buf(),
-        FileKind::Mission,
-        load_text(mission)?,
-    );
-    let folder = mission
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."))
-        .to_path_buf();
-    let mut roots = vec![folder];
-    roots.extend(strategy.iter().cloned());
-    let mut seen = std::collections::BTreeSet::new();
-    for (path, kind) in collect(&roots)? {
-        if matches!(kind, FileKind::Catalog | FileKind::Strategy) && seen.insert(path.clone()) {
-            let text = load_text(&path)?;
-            files.add(path, kind, text);
-        }
-    }
-    Ok((files, id))
-}
-
-/// Reads and checks the given files and folders.
-pub fn check_paths(paths: &[PathBuf]) -> Result<CheckRun, LoadError> {
-    let mut files = Files::default();
-    for (path, kind) in collect(paths)? {
-        let text = load_text(&path)?;
-        files.add(path, kind, text);
-    }
-    Ok(check_files(files))
-}
-
-/// Checks files already loaded: the catalog files form the catalog, then each
-/// mission is checked against it; strategy files are checked on their own, then
-/// against the catalog and the missions; task graphs are loaded and analysed.
-pub fn check_files(files: Files) -> CheckRun {
-    let sources: Vec<CatalogSource<'_>> = files
-        .iter()
-        .filter(|f| f.kind == FileKind::Catalog)
-        .map(|f| CatalogSource {
-            file: f.id,
-            text: &f.text,
-            base_dir: f.path.parent(),
-        })
-        .collect();
-    let (catalog, mut diagnostics) = load_catalog(&sources);
-    let analyses: Vec<(FileId, Analysis)> = files
-        .iter()
-        .filter(|f| f.kind == FileKind::Mission)
-        .map(|f| (f.id, check_source(f.id, &f.text, &catalog)))
-        .collect();
-    for (_, analysis) in &analyses {
-        diagnostics.extend(analysis.diagnostics.iter().cloned());
-    }
-    let mut strategies = Vec::new();
-    for f in files.iter().filter(|f| f.kind == FileKind::Strategy) {
-        let (strategy, found) = load_strategy(f.id, &f.text);
-        diagnostics.extend(found);
-        strategies.extend(strategy);
-    }
-    let (strategy_links, found) = cross_check(
-        &strategies.iter().collect::<Vec<_>>(),
-        &analyses.iter().map(|(_, a)| a).collect::<Vec<_>>(),
-        &catalog,
-    );
-    diagnostics.extend(found);
-    let mut resolver = DiskResolver::new(&files);
-    for f in files.iter().filter(|f| f.kind == FileKind::TaskGraph) {
-        diagnostics.extend(analyze_graph(f, &mut resolver).diagnostics);
-    }
-    diag::sort_and_dedup(&mut diagnostics);
-    CheckRun {
-        files,
-        catalog,
-        analyses,
-        strategies,
-        strategy_links,
-        diagnostics,
-    }
 }
 
 /// A task graph file loaded and analysed.

@@ -53,20 +53,22 @@ fn allowed(architecture: &str) -> BTreeMap<String, BTreeSet<String>> {
     rows
 }
 
-/// The library's modules: `src/*.rs` (but `lib.rs`) and `src/*/`.
+/// The library's modules: `src/*.rs` (but `lib.rs`) and `src/*/`, each with
+/// its files.
 fn modules(src: &Path) -> BTreeMap<String, Vec<PathBuf>> {
     let mut modules = BTreeMap::new();
     for entry in std::fs::read_dir(src).unwrap() {
         let path = entry.unwrap().path();
         let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        // A module is `name.rs`, `name/`, or both (`host.rs` with `host/`).
+        let mut files = Vec::new();
         if path.is_dir() {
-            let mut files = Vec::new();
             rust_files(&path, &mut files);
-            if !files.is_empty() {
-                modules.insert(name, files);
-            }
         } else if path.extension().is_some_and(|e| e == "rs") && name != "lib" {
-            modules.insert(name, vec![path]);
+            files.push(path);
+        }
+        if !files.is_empty() {
+            modules.entry(name).or_insert_with(Vec::new).extend(files);
         }
     }
     modules

@@ -243,17 +243,12 @@ impl Backend {
     }
 
     async fn index_workspace(&self) {
-        let roots = self.state.world().roots.clone();
+        let roots = self.state.world().roots().to_vec();
         let Ok(found) = tokio::task::spawn_blocking(move || world::read_roots(&roots)).await else {
             return;
         };
-        let mut world = self.state.world();
-        let mut changed = Vec::new();
-        for (uri, text) in found {
-            changed.extend(world.disk_changed(&uri, text).files);
-        }
-        drop(world);
-        self.state.queue.push(changed);
+        let changed = self.state.world().index(found);
+        self.state.queue.push(changed.files);
     }
 }
 
@@ -298,8 +293,7 @@ impl LanguageServer for Backend {
         {
             let mut world = self.state.world();
             world.encoding = encoding;
-            world.roots = roots(&params);
-            world.roots.dedup();
+            world.set_roots(roots(&params));
         }
         Ok(InitializeResult {
             server_info: Some(ServerInfo {

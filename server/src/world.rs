@@ -10,90 +10,45 @@
 
 use crate::document::Document;
 use crate::encoding::{Encoding, LineMap};
-use semo::catalog::{Catalog, CatalogSource, load_catalog};
-use semo::diag::{self, Diagnostic, FileId};
-use semo::sema::{Analysis, check_parsed};
-use semo::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
-use semo::syntax::{ParseCache, parse_incremental};
-use semo::taskgraph::subgraph::{self, SubgraphSource};
+use semo::catalog::Catalog;
+use semo::diag::{Diagnostic, FileId};
+use semo::host::{self, AnalysisHost, CatalogResult, Roots};
+use semo::sema::Analysis;
+use semo::strategy::{Strategy, StrategyLinks};
 use semo::text::LineIndex;
-use semo::workspace::{FileKind, GraphRun, analyze_graph_at};
+use semo::workspace::{FileKind, GraphRun};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex, OnceLock, PoisonError, mpsc};
+use std::sync::{Arc, OnceLock, mpsc};
 use tower_lsp_server::ls_types::{TextDocumentContentChangeEvent, Uri};
 
-/// The catalog files of the workspace and, built on first use, the catalog they
-/// form with the built-in one.
+/// The catalog a file sees (built on first use, outside the world's lock),
+/// and the texts of its files.
 pub struct CatalogState {
-    pub files: Vec<CatalogFile>,
-    built: OnceLock<(Catalog, Vec<Diagnostic>)>,
-}
-
-pub struct CatalogFile {
-    pub id: FileId,
-    pub path: Option<PathBuf>,
-    pub text: Arc<str>,
+    analysis: host::Analysis,
+    /// The file whose view it is; `None` for the workspace root's view.
+    file: Option<FileId>,
+    built: OnceLock<Arc<CatalogResult>>,
 }
 
 impl CatalogState {
-    fn new(files: Vec<CatalogFile>) -> CatalogState {
-        CatalogState {
-            files,
-            built: OnceLock::new(),
-        }
-    }
-
-    fn built(&self) -> &(Catalog, Vec<Diagnostic>) {
-        self.built.get_or_init(|| {
-            let sources: Vec<CatalogSource<'_>> = self
-                .files
-                .iter()
-                .map(|f| CatalogSource {
-                    file: f.id,
-                    text: &f.text,
-                    base_dir: f.path.as_deref().and_then(Path::parent),
-                })
-                .collect();
-            load_catalog(&sources)
+    fn built(&self) -> &CatalogResult {
+        self.built.get_or_init(|| match self.file {
+            Some(file) => self.analysis.catalog(file),
+            None => self.analysis.root_catalog(),
         })
     }
 
     pub fn catalog(&self) -> &Catalog {
-        &self.built().0
-    }
-
-    /// The catalog diagnostics of one catalog file.
-    pub fn diagnostics_of(&self, file: FileId) -> impl Iterator<Item = &Diagnostic> {
-        self.built().1.iter().filter(move |d| d.file == file)
+        &self.built().catalog
     }
 
     pub fn text_of(&self, file: FileId) -> Option<&str> {
-        self.files.iter().find(|f| f.id == file).map(|f| &*f.text)
+        self.analysis.file(file).map(|f| &*f.text)
     }
 }
 
-/// The parse cache of the version of a file analysed last, shared by all
-/// snapshots of the file: a mission's analysis parses incrementally from it
-/// and leaves its own cache. Any cache gives the same result (only unchanged
-/// text is reused); a recent one only makes it faster.
-#[derive(Default)]
-struct ParseSlot(Mutex<Option<Arc<ParseCache>>>);
-
-impl ParseSlot {
-    fn get(&self) -> Option<Arc<ParseCache>> {
-        self.0
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .clone()
-    }
-
-    fn put(&self, cache: ParseCache) {
-        *self.0.lock().unwrap_or_else(PoisonError::into_inner) = Some(Arc::new(cache));
-    }
-}
-
-/// One version of one file, with the catalog it is checked against.
+/// One version of one file, with the workspace analysis it is part of.
 pub struct Snapshot {
     pub uri: Uri,
     pub id: FileId,
@@ -103,76 +58,29 @@ pub struct Snapshot {
     pub text: Arc<str>,
     pub catalog: Arc<CatalogState>,
     pub encoding: Encoding,
-    /// For a strategy file: the missions it is cross-checked against.
+    /// For a strategy file: the missions that see it (and it is checked against).
     pub missions: Vec<Arc<Snapshot>>,
-    /// For a task graph: the task-graph files the server knows, by path,
-    /// where its `subgraph` references are looked up before the disk.
-    pub graphs: GraphFiles,
-    parses: Arc<ParseSlot>,
+    /// The workspace as it was when this snapshot was taken.
+    host: host::Analysis,
     analysis: OnceLock<Arc<FileAnalysis>>,
-}
-
-/// Task-graph texts by (normalized) path: open documents as the client has
-/// them, workspace files as read from the disk.
-pub type GraphFiles = Arc<HashMap<PathBuf, SubgraphSource>>;
-
-/// Looks referenced sub-graph files up in the server's files, else reads
-/// them from the disk. Files the server does not know get ids counting down
-/// from below the built-in catalog's: they are read for this analysis only
-/// and nothing is published for them.
-struct GraphResolver<'a> {
-    known: &'a GraphFiles,
-    next: u32,
-}
-
-impl subgraph::Resolver for GraphResolver<'_> {
-    fn read(&mut self, path: &Path) -> Result<SubgraphSource, String> {
-        if let Some(source) = self.known.get(path) {
-            return Ok(source.clone());
-        }
-        let text = read_text(path)
-            .ok_or_else(|| format!("there is no readable file {}", path.display()))?;
-        self.next -= 1;
-        Ok(SubgraphSource {
-            file: FileId(self.next),
-            text: text.into(),
-        })
-    }
 }
 
 /// What is known about a snapshot once analysed.
 pub struct FileAnalysis {
     pub lines: LineIndex,
-    /// The diagnostics of catalog and strategy files (missions and task
-    /// graphs keep theirs in their own results).
-    other_diagnostics: Vec<Diagnostic>,
-    pub mission: Option<Analysis>,
-    pub graph: Option<GraphRun>,
+    diagnostics: Vec<Diagnostic>,
+    pub mission: Option<Arc<Analysis>>,
+    pub graph: Option<Arc<GraphRun>>,
     pub strategy: Option<Strategy>,
-    /// For a strategy file: the mission calls its entries refine (against
-    /// the snapshot's `missions`).
+    /// For a strategy file: the calls of the missions that see it refined by
+    /// its entries and the others they see.
     pub strategy_links: StrategyLinks,
 }
 
 impl FileAnalysis {
-    fn new(lines: LineIndex) -> FileAnalysis {
-        FileAnalysis {
-            lines,
-            other_diagnostics: Vec::new(),
-            mission: None,
-            graph: None,
-            strategy: None,
-            strategy_links: StrategyLinks::default(),
-        }
-    }
-
     /// Diagnostics of this file, sorted.
     pub fn diagnostics(&self) -> &[Diagnostic] {
-        match (&self.mission, &self.graph) {
-            (Some(mission), _) => &mission.diagnostics,
-            (_, Some(run)) => &run.diagnostics,
-            _ => &self.other_diagnostics,
-        }
+        &self.diagnostics
     }
 }
 
@@ -184,63 +92,33 @@ impl Snapshot {
             .clone()
     }
 
+    /// The host answers; the snapshot only gathers what the handlers read.
     fn analyse(&self) -> FileAnalysis {
-        let mut out = FileAnalysis::new(LineIndex::new(&self.text));
-        match self.kind {
-            FileKind::Mission => {
-                let previous = self.parses.get();
-                let (parse, cache) = parse_incremental(self.id, &self.text, previous.as_deref());
-                drop(previous);
-                self.parses.put(cache);
-                out.mission = Some(check_parsed(self.id, parse, self.catalog.catalog()));
-            }
-            FileKind::Catalog => {
-                out.other_diagnostics = self.catalog.diagnostics_of(self.id).cloned().collect();
-                diag::sort_and_dedup(&mut out.other_diagnostics);
-            }
-            FileKind::TaskGraph => {
-                let location = self.uri.to_file_path();
-                let mut resolver = GraphResolver {
-                    known: &self.graphs,
-                    next: semo::catalog::BUILTIN_FILE.0,
-                };
-                out.graph = Some(analyze_graph_at(
-                    self.id,
-                    &self.text,
-                    location.as_deref(),
-                    &mut resolver,
-                ));
-            }
-            FileKind::Strategy => {
-                let (strategy, mut diagnostics) = load_strategy(self.id, &self.text);
-                if let Some(strategy) = &strategy {
-                    let analyses: Vec<Arc<FileAnalysis>> =
-                        self.missions.iter().map(|m| m.analysis()).collect();
-                    let missions: Vec<&Analysis> =
-                        analyses.iter().filter_map(|a| a.mission.as_ref()).collect();
-                    let (links, cross) =
-                        cross_check(&[strategy], &missions, self.catalog.catalog());
-                    diagnostics.extend(cross.into_iter().filter(|d| d.file == self.id));
-                    out.strategy_links = links;
-                    diag::sort_and_dedup(&mut diagnostics);
-                }
-                out.other_diagnostics = diagnostics;
-                out.strategy = strategy;
-            }
+        let host = &self.host;
+        FileAnalysis {
+            lines: LineIndex::new(&self.text),
+            diagnostics: host.diagnostics(self.id),
+            mission: host.mission(self.id),
+            graph: host.graph(self.id),
+            strategy: host.strategy(self.id).and_then(|s| s.strategy.clone()),
+            strategy_links: match self.kind {
+                FileKind::Strategy => host.strategy_links(self.id),
+                _ => StrategyLinks::default(),
+            },
         }
-        out
     }
 
-    /// The text of another file this snapshot's analysis refers to: one of
-    /// its missions or a catalog file.
+    /// The text of another file this snapshot's analysis refers to.
     pub fn text_of(&self, file: FileId) -> Option<&str> {
         if file == self.id {
             return Some(&self.text);
         }
-        if let Some(m) = self.missions.iter().find(|m| m.id == file) {
-            return Some(&m.text);
-        }
-        self.catalog.text_of(file)
+        self.host.file(file).map(|f| &*f.text)
+    }
+
+    /// The workspace analysis this snapshot belongs to.
+    pub fn host(&self) -> &host::Analysis {
+        &self.host
     }
 
     /// Converts positions of this snapshot's text.
@@ -288,14 +166,14 @@ struct FileEntry {
 #[derive(Default)]
 pub struct World {
     pub encoding: Encoding,
-    pub roots: Vec<PathBuf>,
+    roots: Vec<PathBuf>,
     files: HashMap<Uri, FileEntry>,
     /// `FileId(i)` is `uris[i]`; ids are never reused within a session.
     uris: Vec<Uri>,
     ids: HashMap<Uri, FileId>,
-    catalog: Option<Arc<CatalogState>>,
-    /// The task-graph files by path, built when a task graph needs it.
-    graph_files: Option<GraphFiles>,
+    /// Every file's text: which files belong together, and every analysis,
+    /// is the host's (the same as `semo check` and `semo build`).
+    host: AnalysisHost,
 }
 
 /// What a change did, so the caller knows which files to re-check.
@@ -364,25 +242,33 @@ impl World {
             .collect()
     }
 
-    pub fn catalog(&mut self) -> Arc<CatalogState> {
-        if let Some(c) = &self.catalog {
-            return c.clone();
-        }
-        let mut files: Vec<CatalogFile> = self
-            .files
-            .iter()
-            .filter(|(_, f)| f.kind == FileKind::Catalog)
-            .map(|(uri, f)| CatalogFile {
-                id: self.ids[uri],
-                path: f.path.clone(),
-                text: f.snapshot.text.clone(),
-            })
-            .collect();
-        // A stable order, so "defined in another catalog file" always names the same one.
-        files.sort_by(|a, b| a.path.cmp(&b.path).then(a.id.0.cmp(&b.id.0)));
-        let state = Arc::new(CatalogState::new(files));
-        self.catalog = Some(state.clone());
-        state
+    /// The workspace folders: a file sees the catalog and strategy files up
+    /// to the root that holds it (see `semo::host`).
+    pub fn set_roots(&mut self, mut roots: Vec<PathBuf>) {
+        roots.dedup();
+        self.roots = roots.clone();
+        self.host.set_roots(Roots {
+            roots,
+            seen_by_all: Vec::new(),
+        });
+    }
+
+    pub fn roots(&self) -> &[PathBuf] {
+        &self.roots
+    }
+
+    /// The catalog of the workspace root (for requests about no file).
+    pub fn catalog(&self) -> Arc<CatalogState> {
+        Arc::new(CatalogState {
+            analysis: self.host.analysis(),
+            file: None,
+            built: OnceLock::new(),
+        })
+    }
+
+    /// The workspace analysis now.
+    pub fn analysis(&self) -> host::Analysis {
+        self.host.analysis()
     }
 
     /// The client opened a document.
@@ -450,6 +336,43 @@ impl World {
         }
     }
 
+    /// The workspace folders' files, read at start: all put into the host
+    /// first, then every file gets its snapshot once (rather than the files
+    /// added early being renewed for each file added after them).
+    pub fn index(&mut self, found: Vec<(Uri, Option<String>)>) -> Changed {
+        let mut ids = Vec::new();
+        for (uri, text) in found {
+            if self.is_open(&uri) {
+                continue;
+            }
+            let path = uri.to_file_path().map(|p| p.into_owned());
+            let (Some(path), Some(kind), Some(text)) = (path, World::kind_of(&uri, None), text)
+            else {
+                continue;
+            };
+            let id = self.file_id(&uri);
+            let text: Arc<str> = text.into();
+            self.host
+                .set_file(id, Some(path.clone()), kind, text.clone());
+            let snapshot = Arc::new(self.new_snapshot(&uri, id, kind, None, text));
+            let entry = FileEntry {
+                kind,
+                document: None,
+                path: Some(path),
+                snapshot,
+            };
+            if let Some(old) = self.files.insert(uri, entry) {
+                retire(old.snapshot);
+            }
+            ids.push(id);
+        }
+        // What the open documents see may have changed too.
+        ids.extend(self.files.values().map(|f| f.snapshot.id));
+        ids.sort();
+        ids.dedup();
+        self.renew(&ids)
+    }
+
     /// A file was deleted on disk. An open document stays as the client has it.
     pub fn disk_deleted(&mut self, uri: &Uri) -> Changed {
         if self.is_open(uri) {
@@ -463,16 +386,21 @@ impl World {
     }
 
     fn remove(&mut self, uri: &Uri) -> Changed {
+        let Some(&id) = self.ids.get(uri) else {
+            return Changed::default();
+        };
         let Some(entry) = self.files.remove(uri) else {
             return Changed::default();
         };
-        retire(entry.snapshot.clone());
-        let mut changed = match entry.kind {
-            FileKind::Catalog => self.catalog_changed(),
-            FileKind::Mission => self.missions_changed(),
-            FileKind::TaskGraph => self.graph_changed(uri, entry.path.as_deref()),
-            _ => Changed::default(),
+        let affected = if entry.kind == FileKind::Mission {
+            // Its folder may stop being a project of its own.
+            self.all_ids()
+        } else {
+            self.host.analysis().affected_by(id)
         };
+        retire(entry.snapshot);
+        self.host.remove_file(id);
+        let mut changed = self.renew(&affected);
         changed.files.push(uri.clone());
         changed
     }
@@ -487,18 +415,19 @@ impl World {
     ) -> Changed {
         let id = self.file_id(&uri);
         let version = document.as_ref().map(|d| d.version);
-        let is_catalog = kind == FileKind::Catalog;
-        if kind == FileKind::TaskGraph {
-            // Its new text is looked up by the graphs referencing it.
-            self.graph_files = None;
+        // What read the old version (a task graph's readers, a catalog's
+        // missions) and what reads the new one.
+        let added_mission = kind == FileKind::Mission && !self.files.contains_key(&uri);
+        let mut affected = self.host.analysis().affected_by(id);
+        self.host.set_file(id, path.clone(), kind, text.clone());
+        if added_mission {
+            // Its folder may become a project of its own (see `semo::host`).
+            affected.extend(self.all_ids());
         }
-        // A catalog file gets its snapshot on the new catalog just below.
-        let catalog = if is_catalog {
-            Arc::new(CatalogState::new(Vec::new()))
-        } else {
-            self.catalog()
-        };
-        let snapshot = Arc::new(self.new_snapshot(&uri, id, kind, version, text, catalog));
+        affected.extend(self.host.analysis().affected_by(id));
+        affected.sort();
+        affected.dedup();
+        let snapshot = Arc::new(self.new_snapshot(&uri, id, kind, version, text));
         let old = self.files.insert(
             uri.clone(),
             FileEntry {
@@ -511,44 +440,33 @@ impl World {
         if let Some(old) = old {
             retire(old.snapshot);
         }
-        let mut changed = if is_catalog {
-            self.catalog_changed()
-        } else if kind == FileKind::Mission {
-            self.missions_changed()
-        } else if kind == FileKind::TaskGraph {
-            let path = self.files.get(&uri).and_then(|f| f.path.clone());
-            self.graph_changed(&uri, path.as_deref())
-        } else {
-            Changed::default()
-        };
-        if !changed.files.contains(&uri) {
-            changed.files.push(uri);
+        // Renewed with the others, in order: a strategy's snapshot holds the
+        // current snapshots of its missions.
+        if !affected.contains(&id) {
+            affected.push(id);
         }
-        changed
+        self.renew(&affected)
     }
 
     fn new_snapshot(
-        &mut self,
+        &self,
         uri: &Uri,
         id: FileId,
         kind: FileKind,
         version: Option<i32>,
         text: Arc<str>,
-        catalog: Arc<CatalogState>,
     ) -> Snapshot {
+        let analysis = self.host.analysis();
         let missions = if kind == FileKind::Strategy {
-            self.files
-                .values()
-                .filter(|f| f.kind == FileKind::Mission)
+            analysis
+                .missions_seeing(id)
+                .into_iter()
+                .filter_map(|m| self.uri_of(m))
+                .filter_map(|m| self.files.get(m))
                 .map(|f| f.snapshot.clone())
                 .collect()
         } else {
             Vec::new()
-        };
-        let graphs = if kind == FileKind::TaskGraph {
-            self.graph_files()
-        } else {
-            GraphFiles::default()
         };
         Snapshot {
             uri: uri.clone(),
@@ -556,100 +474,45 @@ impl World {
             kind,
             version,
             text,
-            catalog,
+            catalog: Arc::new(CatalogState {
+                analysis: analysis.clone(),
+                file: Some(id),
+                built: OnceLock::new(),
+            }),
             encoding: self.encoding,
             missions,
-            graphs,
-            // Handed from each snapshot of the file to the next.
-            parses: self
-                .files
-                .get(uri)
-                .map(|f| f.snapshot.parses.clone())
-                .unwrap_or_default(),
+            host: analysis,
             analysis: OnceLock::new(),
         }
     }
 
-    /// The task-graph files by path (built again after a task graph changed).
-    fn graph_files(&mut self) -> GraphFiles {
-        if let Some(files) = &self.graph_files {
-            return files.clone();
-        }
-        let files: GraphFiles = Arc::new(
-            self.files
-                .values()
-                .filter(|f| f.kind == FileKind::TaskGraph)
-                .filter_map(|f| {
-                    let path = subgraph::normalize(f.path.as_deref()?);
-                    let source = SubgraphSource {
-                        file: f.snapshot.id,
-                        text: f.snapshot.text.clone(),
-                    };
-                    Some((path, source))
-                })
-                .collect(),
-        );
-        self.graph_files = Some(files.clone());
-        files
+    /// Every file but the task graphs.
+    fn all_ids(&self) -> Vec<FileId> {
+        self.files
+            .values()
+            .filter(|f| f.kind != FileKind::TaskGraph)
+            .map(|f| f.snapshot.id)
+            .collect()
     }
 
-    /// The task graph at `uri` (at `path` on disk) changed or went away: the
-    /// other task graphs that read it through `subgraph` references (or that
-    /// were not analysed yet, so nobody knows) get new snapshots seeing its
-    /// new text.
-    fn graph_changed(&mut self, uri: &Uri, path: Option<&Path>) -> Changed {
-        self.graph_files = None;
-        let Some(path) = path.map(subgraph::normalize) else {
-            return Changed::default();
-        };
-        self.renew(|other, entry| {
-            entry.kind == FileKind::TaskGraph
-                && other != uri
-                && entry.snapshot.analysis.get().is_none_or(|a| {
-                    a.graph
-                        .as_ref()
-                        .is_some_and(|run| run.hierarchy.reads.contains(&path))
-                })
-        })
-    }
-
-    /// Strategy files are cross-checked against the missions: they get new
-    /// snapshots on the current missions.
-    fn missions_changed(&mut self) -> Changed {
-        self.renew(|_, f| f.kind == FileKind::Strategy)
-    }
-
-    /// Every file gets a new snapshot on the new catalog (missions are
-    /// re-checked against it, catalog files get their new diagnostics).
-    fn catalog_changed(&mut self) -> Changed {
-        self.catalog = None;
-        let mut changed =
-            self.renew(|_, f| matches!(f.kind, FileKind::Mission | FileKind::Catalog));
-        // Strategies last, on the missions' new snapshots.
-        changed.files.extend(self.missions_changed().files);
-        changed
-    }
-
-    /// New snapshots (same text, the current catalog) for the files `which`
-    /// selects; the old ones are retired.
-    fn renew(&mut self, which: impl Fn(&Uri, &FileEntry) -> bool) -> Changed {
-        let catalog = self.catalog();
-        let uris: Vec<Uri> = self
-            .files
+    /// New snapshots (same text, the current workspace) for the files `ids`;
+    /// the old ones are retired. Missions first: strategy snapshots hold the
+    /// missions' current snapshots.
+    fn renew(&mut self, ids: &[FileId]) -> Changed {
+        let mut uris: Vec<Uri> = ids
             .iter()
-            .filter(|(u, f)| which(u, f))
-            .map(|(u, _)| u.clone())
+            .filter_map(|&id| self.uri_of(id).cloned())
+            .filter(|u| self.files.contains_key(u))
             .collect();
+        uris.sort_by_key(|u| match self.files[u].kind {
+            FileKind::Mission => 0,
+            FileKind::Catalog | FileKind::TaskGraph => 1,
+            FileKind::Strategy => 2,
+        });
         for uri in &uris {
             let old = self.files[uri].snapshot.clone();
-            let fresh = Arc::new(self.new_snapshot(
-                uri,
-                old.id,
-                old.kind,
-                old.version,
-                old.text.clone(),
-                catalog.clone(),
-            ));
+            let fresh =
+                Arc::new(self.new_snapshot(uri, old.id, old.kind, old.version, old.text.clone()));
             let entry = self.files.get_mut(uri).expect("listed above");
             retire(std::mem::replace(&mut entry.snapshot, fresh));
         }
@@ -697,7 +560,8 @@ mod tests {
         world.open(uri.clone(), "mission", MISSION, 1);
         let first = world.snapshot(&uri).expect("open");
         first.analysis();
-        assert_eq!(first.parses.get().map(|c| c.reparsed()), Some(4));
+        let cache = |s: &Snapshot| s.host().parse_cache(s.id);
+        assert_eq!(cache(&first).map(|c| c.reparsed()), Some(4));
         // `move("1,1")` becomes `move("1,12")`: one chunk changes.
         let typed = TextDocumentContentChangeEvent {
             range: Some(Range::new(Position::new(1, 17), Position::new(1, 17))),
@@ -707,8 +571,8 @@ mod tests {
         world.change(&uri, 2, vec![typed]);
         let second = world.snapshot(&uri).expect("open");
         let analysis = second.analysis();
-        let cache = second.parses.get().expect("left by the analysis");
-        assert_eq!((cache.chunks(), cache.reparsed()), (4, 1));
+        let left = cache(&second).expect("left by the analysis");
+        assert_eq!((left.chunks(), left.reparsed()), (4, 1));
         let scratch = semo::check_source(second.id, &second.text, second.catalog.catalog());
         assert_eq!(analysis.diagnostics(), &scratch.diagnostics[..]);
         assert_eq!(
@@ -716,11 +580,13 @@ mod tests {
             Some(&scratch.syntax)
         );
         // Snapshots of the same text on a new catalog reuse every chunk.
-        world.catalog_changed();
+        let catalog = Uri::from_file_path("/t/more.robot.xml").expect("a file URI");
+        let changed = world.open(catalog, "xml", "<robots/>", 1);
+        assert!(changed.files.contains(&uri), "{changed:?}");
         let third = world.snapshot(&uri).expect("open");
         assert!(!Arc::ptr_eq(&second, &third));
         third.analysis();
-        assert_eq!(third.parses.get().map(|c| c.reparsed()), Some(0));
+        assert_eq!(cache(&third).map(|c| c.reparsed()), Some(0));
     }
 
     #[test]

@@ -174,3 +174,41 @@ async fn the_catalog_request_lists_builtin_and_workspace_robot_types_and_follows
     assert_eq!(rover["services"][0]["name"], "dig");
     client.shutdown().await;
 }
+
+/// The editor cross-checks a strategy file with every strategy file its
+/// missions see (the host's rule, as `semo check`): a service refined in two
+/// files is reported, and the report goes away with the second file.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_service_refined_in_two_strategy_files_is_reported_in_the_editor() {
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], None).await;
+    let mission_uri = "file:///w/scouting.mission";
+    let first = "file:///w/MasterTeam.strategy.xml";
+    let second = "file:///w/Zweite.strategy.xml";
+    client
+        .open(mission_uri, &scouting("scouting.mission"))
+        .await;
+    let strategy = scouting("MasterTeam.strategy.xml");
+    client.open(first, &strategy).await;
+    assert_eq!(
+        client.diagnostics(first, Some(1)).await,
+        Vec::<Value>::new()
+    );
+    // The same entries again in a second file: the second one refines them
+    // twice (files are taken in path order).
+    client.open(second, &strategy).await;
+    let twice = client.diagnostics(second, Some(1)).await;
+    assert!(codes(&twice).contains(&"E085".to_string()), "{twice:#?}");
+    let related = &twice[0]["relatedInformation"][0]["location"]["uri"];
+    assert_eq!(related, first, "{twice:#?}");
+    client
+        .notify(
+            "textDocument/didClose",
+            json!({ "textDocument": { "uri": second } }),
+        )
+        .await;
+    // The first file is re-checked without it (and stays clean).
+    let alone = client.diagnostics(first, Some(1)).await;
+    assert_eq!(alone, Vec::<Value>::new());
+    client.shutdown().await;
+}

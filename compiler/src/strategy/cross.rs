@@ -84,6 +84,24 @@ impl StrategyLinks {
             .filter(move |l| l.call.touches(offset))
     }
 
+    /// The links of several checks in one (a strategy file seen by the
+    /// missions of several folders).
+    pub fn merged<'a>(all: impl IntoIterator<Item = &'a StrategyLinks>) -> StrategyLinks {
+        let mut calls: Vec<CallLink> = all.into_iter().flat_map(|l| l.calls.clone()).collect();
+        calls.sort_by_key(|l| {
+            (
+                l.mission,
+                l.call.start,
+                l.call.end,
+                l.entry,
+                l.team,
+                l.service,
+            )
+        });
+        calls.dedup();
+        StrategyLinks { calls }
+    }
+
     /// The calls that an entry refines: for references from a strategy file.
     pub fn of_entry(&self, entry: ServiceEntryRef) -> impl Iterator<Item = &CallLink> {
         self.calls.iter().filter(move |l| l.entry == entry)

@@ -1,8 +1,9 @@
 //! `workspace/executeCommand` `semo.generateCode`, and the code lens that runs
-//! it on each team: the same library call as `semo build` (check, refine,
-//! generate, write each robot's folder atomically), over the server's view of
-//! the workspace (open documents as typed, other files from disk), with
-//! `$/progress` per robot.
+//! it on each team: the same library calls as `semo build` (the host's
+//! `build_input`, so the same files by the same rule; refine, generate, write
+//! each robot's folder atomically), over the server's view of the workspace
+//! (open documents as typed, other files from disk), with `$/progress` per
+//! robot.
 //!
 //! Arguments: one object `{ "uri": mission, "outputFolder"?: path (relative
 //! to the mission's folder; default `out` beside it), "target"?: "linux" |
@@ -13,11 +14,10 @@ use crate::world::{Snapshot, World};
 use semo::codegen::{self, BuildResult, Emit, Target, output};
 use semo::diag::{Diagnostic, FileId};
 use semo::text::LineIndex;
-use semo::workspace::{FileKind, Files};
+use semo::workspace::FileKind;
 use serde::Deserialize;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use tower_lsp_server::ls_types::*;
 
 pub const COMMAND: &str = "semo.generateCode";
@@ -52,14 +52,15 @@ pub fn params(arguments: &[Value]) -> Result<GenerateParams, String> {
 pub struct Job {
     pub mission_uri: Uri,
     pub mission_path: PathBuf,
-    pub files: Files,
+    /// The workspace as it was when the command came.
+    pub analysis: semo::host::Analysis,
     pub mission: FileId,
     pub out: PathBuf,
     pub target: Target,
     pub team: Option<String>,
 }
 
-/// Gathers the mission and every catalog and strategy file the server knows.
+/// The mission and the workspace as they are now.
 pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
     let target = match params.target.as_deref() {
         None => Target::Linux,
@@ -71,22 +72,6 @@ pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
         .ok_or_else(|| format!("{} is not a mission the server knows", params.uri.as_str()))?;
     let mission_path =
         path_of(&mission).ok_or("code can only be generated for a mission saved as a file")?;
-    let mut files = Files::default();
-    let id = files.add(
-        mission_path.clone(),
-        FileKind::Mission,
-        mission.text.to_string(),
-    );
-    let others: Vec<Arc<Snapshot>> = world
-        .snapshots()
-        .filter(|s| matches!(s.kind, FileKind::Catalog | FileKind::Strategy))
-        .cloned()
-        .collect();
-    for s in others {
-        if let Some(path) = path_of(&s) {
-            files.add(path, s.kind, s.text.to_string());
-        }
-    }
     let folder = mission_path
         .parent()
         .unwrap_or(Path::new("."))
@@ -99,8 +84,8 @@ pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
     Ok(Job {
         mission_uri: params.uri,
         mission_path,
-        files,
-        mission: id,
+        analysis: world.analysis(),
+        mission: mission.id,
         out,
         target,
         team: params.team,
@@ -114,12 +99,12 @@ fn path_of(snapshot: &Snapshot) -> Option<PathBuf> {
 /// Checks, refines and generates (no writing yet); the mission's text too,
 /// for positions.
 pub fn generate(job: &Job) -> Result<(BuildResult, String), &'static str> {
-    let text = job.files.get(job.mission).text.clone();
-    let run = semo::workspace::check_files(job.files.clone());
-    let input = run
+    let build = job
+        .analysis
         .build_input(job.mission)
-        .ok_or("internal error: the mission was loaded but not checked")?;
-    let mut result = codegen::build(&input, job.target, Emit::All);
+        .ok_or("internal error: the mission is not in the workspace analysis")?;
+    let text = build.file.text.to_string();
+    let mut result = codegen::build(&build.input(), job.target, Emit::All);
     if let Some(team) = &job.team {
         result.robots.retain(|r| &r.team == team);
     }

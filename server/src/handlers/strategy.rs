@@ -20,7 +20,10 @@ fn with_file<T>(
 ) -> T {
     let analysis = snapshot.analysis();
     let analyses: Vec<Arc<FileAnalysis>> = snapshot.missions.iter().map(|m| m.analysis()).collect();
-    let missions: Vec<&Analysis> = analyses.iter().filter_map(|a| a.mission.as_ref()).collect();
+    let missions: Vec<&Analysis> = analyses
+        .iter()
+        .filter_map(|a| a.mission.as_deref())
+        .collect();
     let file = StrategyFile {
         text: &snapshot.text,
         strategy: analysis.strategy.as_ref(),

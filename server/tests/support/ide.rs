@@ -13,6 +13,8 @@ pub struct Session {
     runtime: tokio::runtime::Runtime,
     pub client: TestClient,
     opened: usize,
+    /// The file names opened so far.
+    names: std::collections::HashSet<String>,
 }
 
 /// A document opened from a fixture.
@@ -25,6 +27,9 @@ pub struct Doc {
     /// The diagnostics published when it was opened.
     pub diagnostics: Vec<Value>,
 }
+
+/// The workspace root of a session (no folder on disk: nothing is indexed).
+const ROOT: &str = "file:///fixtures";
 
 impl Session {
     /// A server initialized with UTF-16 positions and snippet support.
@@ -43,8 +48,8 @@ impl Session {
         let client = runtime.block_on(async {
             let mut client = TestClient::start();
             match capabilities {
-                Some(caps) => client.initialize_with(caps, None).await,
-                None => client.initialize(&["utf-16"], None).await,
+                Some(caps) => client.initialize_with(caps, Some(ROOT)).await,
+                None => client.initialize(&["utf-16"], Some(ROOT)).await,
             };
             client
         });
@@ -52,25 +57,51 @@ impl Session {
             runtime,
             client,
             opened: 0,
+            names: std::collections::HashSet::new(),
         }
     }
 
     /// Opens `text` (with `$0` markers) as a new document and waits for its
     /// diagnostics, so that its analysis is ready.
     pub fn open(&mut self, name: &str, text: &str) -> Doc {
-        let (clean, cursors) = cursors(text);
         self.opened += 1;
-        let uri = format!("file:///fixtures/{}/{name}", self.opened);
+        // The documents of a session are one workspace: one folder, where
+        // every file sees the others (a name opened again goes into a folder
+        // below, which still sees the files above it: the root is /fixtures).
+        let uri = if self.names.insert(name.to_string()) {
+            format!("file:///fixtures/{name}")
+        } else {
+            format!("file:///fixtures/{}/{name}", self.opened)
+        };
+        self.open_uri(&uri, text)
+    }
+
+    /// Opens `text` (with `$0` markers) at `uri` and waits for its diagnostics.
+    pub fn open_uri(&mut self, uri: &str, text: &str) -> Doc {
+        let (clean, cursors) = cursors(text);
         let diagnostics = self.runtime.block_on(async {
-            self.client.open(&uri, &clean).await;
-            self.client.diagnostics(&uri, Some(1)).await
+            self.client.open(uri, &clean).await;
+            self.client.diagnostics(uri, Some(1)).await
         });
         Doc {
-            uri,
+            uri: uri.to_string(),
             text: clean,
             cursors,
             diagnostics,
         }
+    }
+
+    /// Replaces the text of an open document (as version `version`) and
+    /// waits for its diagnostics.
+    pub fn replace(&mut self, doc: &Doc, version: i64, text: &str) -> Vec<Value> {
+        let params = serde_json::json!({
+            "textDocument": { "uri": doc.uri, "version": version },
+            "contentChanges": [{ "text": text }]
+        });
+        self.runtime.block_on(async {
+            self.client.notify("textDocument/didChange", params).await;
+            self.client.diagnostics(&doc.uri, Some(version)).await
+        })
     }
 
     /// Opens a fixture file.

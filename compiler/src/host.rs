@@ -1,0 +1,849 @@
+//! One analysis of a workspace for every door: `semo check FILE`, `semo check
+//! DIR`, `semo build` and the language server all put their files into an
+//! [`AnalysisHost`] and ask its [`Analysis`] snapshots for diagnostics, the
+//! checked mission, a strategy file's links, or what a mission is built from
+//! ([`Analysis::build_input`]). The doors only decide which files to load and
+//! how to show the answers (as rust-analyzer's `AnalysisHost`/`Analysis`).
+//!
+//! # Which files belong together
+//!
+//! A file sees the catalog (`*.robot.xml`) and strategy (`*.strategy.xml`)
+//! files in its own folder and the folders under it (but not into a folder
+//! holding missions of its own: that is another project, as each example or
+//! fixture folder is), and those directly in each folder above it up to its
+//! workspace root (the innermost root that
+//! holds it; a file under no root is its own folder's root), and the files
+//! named to be seen by all (`semo build --strategy`). Nothing else: two
+//! sibling folders do not see each other. [`sees`] is that rule, and the only
+//! place it is written.
+//!
+//! The missions of one folder see the same files: they form a *unit*. A
+//! unit's catalog files (sorted by path) make its catalog; its missions are
+//! checked against it; its strategy files are cross-checked together against
+//! its catalog and missions (so an entry refined in two files is found). A
+//! file's diagnostics are its own plus those found in it by every unit that
+//! sees it; a catalog or strategy file no unit sees is checked with the
+//! files its own folder sees. Task graphs are analysed on their own,
+//! following `subgraph` references through the host's files, else the disk.
+//!
+//! # Snapshots
+//!
+//! An [`Analysis`] is immutable and cheap to clone: the files as they were
+//! when it was taken. Results are computed on demand, without any lock held
+//! while computing, and kept in a memo shared by all snapshots of a host,
+//! keyed by the revisions of the files they read, so a new snapshot after a
+//! keystroke in a mission recomputes only that mission (parsed incrementally
+//! from its previous version's [`ParseCache`]) and what reads it.
+
+use crate::catalog::{Catalog, CatalogSource, load_catalog};
+use crate::codegen::BuildInput;
+use crate::diag::{self, Diagnostic, FileId};
+use crate::sema::{self, check_parsed};
+use crate::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
+use crate::syntax::{ParseCache, parse_incremental};
+use crate::taskgraph::subgraph::{self, SubgraphSource};
+use crate::workspace::{FileKind, GraphRun, analyze_graph_at};
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, MutexGuard, OnceLock, PoisonError, mpsc};
+
+/// Where a workspace is: its roots, and the files or folders every file
+/// sees besides (`semo build --strategy`).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Roots {
+    pub roots: Vec<PathBuf>,
+    pub seen_by_all: Vec<PathBuf>,
+}
+
+/// Whether a file at `reader` sees the catalog or strategy file at `file`
+/// (see the module documentation); `has_missions` tells which folders hold
+/// missions.
+pub fn sees(
+    roots: &Roots,
+    has_missions: impl Fn(&Path) -> bool,
+    reader: &Path,
+    file: &Path,
+) -> bool {
+    if roots.seen_by_all.iter().any(|p| file.starts_with(p)) {
+        return true;
+    }
+    let (Some(reader_dir), Some(file_dir)) = (folder(reader), folder(file)) else {
+        return false;
+    };
+    if file_dir.starts_with(reader_dir) {
+        // Not into a folder below with missions of its own.
+        return !file_dir
+            .ancestors()
+            .take_while(|d| *d != reader_dir)
+            .any(has_missions);
+    }
+    let roots = &roots.roots;
+    let root = roots
+        .iter()
+        .filter(|r| reader_dir.starts_with(r))
+        .max_by_key(|r| r.components().count())
+        .map_or(reader_dir, PathBuf::as_path);
+    reader_dir.starts_with(file_dir) && file_dir.starts_with(root)
+}
+
+fn folder(path: &Path) -> Option<&Path> {
+    path.parent()
+}
+
+/// The parse cache of the version of a mission analysed last, handed from
+/// each version of the file to the next: any cache gives the same result
+/// (only unchanged text is reused); a recent one makes it faster.
+#[derive(Default, Debug)]
+struct ParseSlot(Mutex<Option<Arc<ParseCache>>>);
+
+impl ParseSlot {
+    fn get(&self) -> Option<Arc<ParseCache>> {
+        lock(&self.0).clone()
+    }
+
+    fn put(&self, cache: ParseCache) {
+        *lock(&self.0) = Some(Arc::new(cache));
+    }
+}
+
+fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    // Every update of a memo or slot is one assignment: a panic elsewhere
+    // leaves it consistent.
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// One version of one file.
+#[derive(Debug)]
+pub struct SourceText {
+    pub id: FileId,
+    /// Where the file is, as the door named it (messages show it); `None`
+    /// for a document that is not a file (it then sees no other file).
+    pub path: Option<PathBuf>,
+    /// `path` made absolute and without `.`/`..`: what the rule compares.
+    key: Option<PathBuf>,
+    pub kind: FileKind,
+    pub text: Arc<str>,
+    /// Changes with every new text of the file (unique within a host).
+    revision: u64,
+    parses: Arc<ParseSlot>,
+}
+
+type Files = Arc<BTreeMap<FileId, Arc<SourceText>>>;
+
+/// The files of a workspace, changed by the door; see the module documentation.
+pub struct AnalysisHost {
+    roots: Arc<Roots>,
+    files: Files,
+    next_revision: u64,
+    /// Bumped whenever a task graph changes (they read each other).
+    graphs_revision: u64,
+    /// How many missions each folder holds.
+    mission_folders: Arc<BTreeMap<PathBuf, usize>>,
+    memo: Arc<Memo>,
+}
+
+impl Default for AnalysisHost {
+    fn default() -> Self {
+        AnalysisHost::new(Roots::default())
+    }
+}
+
+impl AnalysisHost {
+    pub fn new(roots: Roots) -> AnalysisHost {
+        AnalysisHost {
+            roots: Arc::new(roots),
+            files: Files::default(),
+            next_revision: 0,
+            graphs_revision: 0,
+            mission_folders: Arc::default(),
+            memo: Arc::default(),
+        }
+    }
+
+    pub fn set_roots(&mut self, roots: Roots) {
+        self.roots = Arc::new(roots);
+    }
+
+    pub fn roots(&self) -> &Roots {
+        &self.roots
+    }
+
+    /// A file was added or its text changed. The caller chooses the ids
+    /// (diagnostics name files by them).
+    pub fn set_file(&mut self, id: FileId, path: Option<PathBuf>, kind: FileKind, text: Arc<str>) {
+        self.next_revision += 1;
+        let parses = self
+            .files
+            .get(&id)
+            .filter(|old| old.kind == kind)
+            .map(|old| old.parses.clone())
+            .unwrap_or_default();
+        let was_graph = self
+            .files
+            .get(&id)
+            .is_some_and(|f| f.kind == FileKind::TaskGraph);
+        if kind == FileKind::TaskGraph || was_graph {
+            self.graphs_revision += 1;
+        }
+        let key = path.as_deref().map(|p| {
+            let absolute = std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+            subgraph::normalize(&absolute)
+        });
+        let file = SourceText {
+            id,
+            path,
+            key,
+            kind,
+            text,
+            revision: self.next_revision,
+            parses,
+        };
+        let old = Arc::make_mut(&mut self.files).insert(id, Arc::new(file));
+        if let Some(old) = old {
+            self.count_mission(&old, -1);
+        }
+        let new = self.files[&id].clone();
+        self.count_mission(&new, 1);
+    }
+
+    fn count_mission(&mut self, file: &SourceText, delta: isize) {
+        let Some(dir) = file.key.as_deref().and_then(folder) else {
+            return;
+        };
+        if file.kind != FileKind::Mission {
+            return;
+        }
+        let counts = Arc::make_mut(&mut self.mission_folders);
+        let count = counts.entry(dir.to_path_buf()).or_insert(0);
+        *count = count.saturating_add_signed(delta);
+        if *count == 0 {
+            counts.remove(dir);
+        }
+    }
+
+    /// A file went away.
+    pub fn remove_file(&mut self, id: FileId) {
+        if let Some(old) = Arc::make_mut(&mut self.files).remove(&id) {
+            if old.kind == FileKind::TaskGraph {
+                self.graphs_revision += 1;
+            }
+            self.count_mission(&old, -1);
+            self.memo.forget(id);
+        }
+    }
+
+    /// A snapshot of the files as they are now.
+    pub fn analysis(&self) -> Analysis {
+        Analysis {
+            roots: self.roots.clone(),
+            files: self.files.clone(),
+            graphs_revision: self.graphs_revision,
+            mission_folders: self.mission_folders.clone(),
+            memo: self.memo.clone(),
+        }
+    }
+}
+
+/// The catalog a group of files sees, with the diagnostics of its files.
+#[derive(Debug)]
+pub struct CatalogResult {
+    pub catalog: Catalog,
+    pub diagnostics: Vec<Diagnostic>,
+    /// The catalog files it was made of, in order.
+    pub files: Vec<FileId>,
+}
+
+/// A strategy file on its own: its model (`None` when the file has no
+/// `<Strategy>` element; its diagnostics say why) and per-file diagnostics.
+#[derive(Debug)]
+pub struct LoadedStrategy {
+    pub strategy: Option<Strategy>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// The missions of one folder with everything they see, checked together.
+/// The strategies are those the folder's files see, which are the ones each
+/// of its missions sees.
+#[derive(Debug)]
+pub struct Unit {
+    pub catalog: Arc<CatalogResult>,
+    pub missions: Vec<(FileId, Arc<sema::Analysis>)>,
+    pub strategies: Vec<(FileId, Arc<LoadedStrategy>)>,
+    /// The missions' built-in calls linked to the entries refining them.
+    pub links: StrategyLinks,
+    /// The cross-check's diagnostics (in the strategy files).
+    pub cross: Vec<Diagnostic>,
+}
+
+/// Revisions of the files a result was computed from: equal keys, equal results.
+type Key = Vec<(FileId, u64)>;
+
+/// Results kept between snapshots; each map holds only the newest result per
+/// file or folder, so it is bounded by the workspace's size. A replaced result
+/// is freed on a background thread (freeing a 10k-line mission's analysis
+/// takes about a millisecond, which the next edit should not wait for).
+#[derive(Default)]
+struct Memo {
+    /// By folder (`None`: documents that are not files).
+    catalogs: Memoised<Option<PathBuf>, Key, CatalogResult>,
+    /// By file: (its revision, its catalog's key).
+    missions: Memoised<FileId, (u64, Key), sema::Analysis>,
+    strategies: Memoised<FileId, u64, LoadedStrategy>,
+    units: Memoised<Option<PathBuf>, Key, Unit>,
+    /// By file: (its revision, the task graphs' revision).
+    graphs: Memoised<FileId, (u64, u64), GraphRun>,
+}
+
+/// Results by slot, each with the key it was computed from.
+type Memoised<Slot, K, V> = Mutex<HashMap<Slot, (K, Arc<V>)>>;
+
+/// The memo's result if it was computed from `key`.
+fn fresh<K: PartialEq, V: Clone>(entry: Option<&(K, V)>, key: &K) -> Option<V> {
+    entry.filter(|(k, _)| k == key).map(|(_, v)| v.clone())
+}
+
+impl Memo {
+    fn forget(&self, id: FileId) {
+        drop_later(lock(&self.missions).remove(&id));
+        drop_later(lock(&self.strategies).remove(&id));
+        drop_later(lock(&self.graphs).remove(&id));
+    }
+}
+
+/// Drops `value` on a background thread (or here, if none could start).
+fn drop_later<T: Send + 'static>(value: T) {
+    type Boxed = Box<dyn Send>;
+    static DROPPER: OnceLock<Option<Mutex<mpsc::Sender<Boxed>>>> = OnceLock::new();
+    let dropper = DROPPER.get_or_init(|| {
+        let (send, receive) = mpsc::channel::<Boxed>();
+        std::thread::Builder::new()
+            .name("semo-host-drop".into())
+            .spawn(move || receive.into_iter().for_each(drop))
+            .ok()
+            .map(|_| Mutex::new(send))
+    });
+    if let Some(send) = dropper {
+        let _ = lock(send).send(Box::new(value));
+    }
+}
+
+/// An immutable snapshot of a host's files; see the module documentation.
+#[derive(Clone)]
+pub struct Analysis {
+    roots: Arc<Roots>,
+    files: Files,
+    graphs_revision: u64,
+    mission_folders: Arc<BTreeMap<PathBuf, usize>>,
+    memo: Arc<Memo>,
+}
+
+impl Analysis {
+    pub fn file(&self, id: FileId) -> Option<&SourceText> {
+        self.files.get(&id).map(|f| &**f)
+    }
+
+    pub fn files(&self) -> impl Iterator<Item = &SourceText> {
+        self.files.values().map(|f| &**f)
+    }
+
+    /// [`sees`] over this snapshot's files.
+    fn sees(&self, reader: &Path, file: &Path) -> bool {
+        sees(
+            &self.roots,
+            |d| self.mission_folders.contains_key(d),
+            reader,
+            file,
+        )
+    }
+
+    /// The folder a file's view starts from (`None` for a document that is
+    /// not a file).
+    fn folder_of(&self, id: FileId) -> Option<PathBuf> {
+        let path = self.file(id)?.key.as_deref()?;
+        folder(path).map(Path::to_path_buf)
+    }
+
+    /// The catalog and strategy files the files of `folder` see, sorted by
+    /// path (catalogs replace built-in types in this order).
+    fn seen_from(&self, folder: Option<&Path>) -> Vec<&SourceText> {
+        let Some(folder) = folder else {
+            return Vec::new();
+        };
+        // A file in `folder` (the name does not matter to the rule).
+        let reader = folder.join("_");
+        let mut seen: Vec<&SourceText> = self
+            .files()
+            .filter(|f| matches!(f.kind, FileKind::Catalog | FileKind::Strategy))
+            .filter(|f| f.key.as_deref().is_some_and(|p| self.sees(&reader, p)))
+            .collect();
+        seen.sort_by(|a, b| a.key.cmp(&b.key).then(a.id.0.cmp(&b.id.0)));
+        seen
+    }
+
+    /// The files `id` reads besides itself: the catalog and strategy files it
+    /// sees (for a mission, what its build reads).
+    pub fn seen_by(&self, id: FileId) -> Vec<FileId> {
+        let folder = self.folder_of(id);
+        self.seen_from(folder.as_deref())
+            .into_iter()
+            .map(|f| f.id)
+            .filter(|&f| f != id)
+            .collect()
+    }
+
+    fn catalog_from(&self, folder: Option<&Path>) -> Arc<CatalogResult> {
+        let sources: Vec<&SourceText> = self
+            .seen_from(folder)
+            .into_iter()
+            .filter(|f| f.kind == FileKind::Catalog)
+            .collect();
+        self.catalog_of(sources, folder.map(Path::to_path_buf))
+    }
+
+    /// The catalog `sources` make (memoised in `slot`).
+    fn catalog_of(&self, sources: Vec<&SourceText>, slot: Option<PathBuf>) -> Arc<CatalogResult> {
+        let key: Key = sources.iter().map(|f| (f.id, f.revision)).collect();
+        if let Some(found) = fresh(lock(&self.memo.catalogs).get(&slot), &key) {
+            return found;
+        }
+        let (catalog, diagnostics) = load_catalog(
+            &sources
+                .iter()
+                .map(|f| CatalogSource {
+                    file: f.id,
+                    text: &f.text,
+                    base_dir: f.path.as_deref().and_then(Path::parent),
+                })
+                .collect::<Vec<_>>(),
+        );
+        let result = Arc::new(CatalogResult {
+            catalog,
+            diagnostics,
+            files: sources.iter().map(|f| f.id).collect(),
+        });
+        let old = lock(&self.memo.catalogs).insert(slot, (key, result.clone()));
+        drop_later(old);
+        result
+    }
+
+    /// The catalog `id` is checked against (the built-in one and the catalog
+    /// files it sees).
+    pub fn catalog(&self, id: FileId) -> Arc<CatalogResult> {
+        self.catalog_from(self.folder_of(id).as_deref())
+    }
+
+    /// The catalog every catalog file of the workspace makes (for requests
+    /// about no file in particular: the editor's list of robot types).
+    pub fn root_catalog(&self) -> Arc<CatalogResult> {
+        let mut sources: Vec<&SourceText> = self
+            .files()
+            .filter(|f| f.kind == FileKind::Catalog)
+            .collect();
+        sources.sort_by(|a, b| a.key.cmp(&b.key).then(a.id.0.cmp(&b.id.0)));
+        // A slot no folder has.
+        self.catalog_of(sources, Some(PathBuf::new()))
+    }
+
+    /// The parse cache a mission's last analysis left (to see what an edit
+    /// re-parsed).
+    pub fn parse_cache(&self, id: FileId) -> Option<Arc<ParseCache>> {
+        self.files.get(&id)?.parses.get()
+    }
+
+    /// A mission checked against its catalog; `None` for other files.
+    pub fn mission(&self, id: FileId) -> Option<Arc<sema::Analysis>> {
+        let file = self
+            .files
+            .get(&id)
+            .filter(|f| f.kind == FileKind::Mission)?;
+        let catalog = self.catalog(id);
+        let key: Key = catalog
+            .files
+            .iter()
+            .map(|&c| (c, self.revision(c)))
+            .collect();
+        let memo_key = (file.revision, key);
+        if let Some(found) = fresh(lock(&self.memo.missions).get(&id), &memo_key) {
+            return Some(found);
+        }
+        let previous = file.parses.get();
+        let (parse, cache) = parse_incremental(id, &file.text, previous.as_deref());
+        drop(previous);
+        file.parses.put(cache);
+        let analysis = Arc::new(check_parsed(id, parse, &catalog.catalog));
+        let old = lock(&self.memo.missions).insert(id, (memo_key, analysis.clone()));
+        drop_later(old);
+        Some(analysis)
+    }
+
+    fn revision(&self, id: FileId) -> u64 {
+        self.files.get(&id).map_or(0, |f| f.revision)
+    }
+
+    /// A strategy file loaded on its own; `None` for other files.
+    pub fn strategy(&self, id: FileId) -> Option<Arc<LoadedStrategy>> {
+        let file = self
+            .files
+            .get(&id)
+            .filter(|f| f.kind == FileKind::Strategy)?;
+        if let Some(found) = fresh(lock(&self.memo.strategies).get(&id), &file.revision) {
+            return Some(found);
+        }
+        let (strategy, diagnostics) = load_strategy(id, &file.text);
+        let loaded = Arc::new(LoadedStrategy {
+            strategy,
+            diagnostics,
+        });
+        let old = lock(&self.memo.strategies).insert(id, (file.revision, loaded.clone()));
+        drop_later(old);
+        Some(loaded)
+    }
+
+    /// The missions of `folder` (directly in it) and what they see, checked
+    /// together. A folder without missions makes a unit too (its catalog and
+    /// strategy files are checked with what they see).
+    fn unit_of(&self, folder: Option<&Path>) -> Arc<Unit> {
+        let missions: Vec<&SourceText> = match folder {
+            Some(folder) => self
+                .files()
+                .filter(|f| f.kind == FileKind::Mission)
+                .filter(|f| f.key.as_deref().and_then(self::folder) == Some(folder))
+                .collect(),
+            None => Vec::new(),
+        };
+        let seen = self.seen_from(folder);
+        let key: Key = missions
+            .iter()
+            .chain(&seen)
+            .map(|f| (f.id, f.revision))
+            .collect();
+        let slot = folder.map(Path::to_path_buf);
+        if let Some(found) = fresh(lock(&self.memo.units).get(&slot), &key) {
+            return found;
+        }
+        let catalog = self.catalog_from(folder);
+        let missions: Vec<(FileId, Arc<sema::Analysis>)> = missions
+            .iter()
+            .filter_map(|m| Some((m.id, self.mission(m.id)?)))
+            .collect();
+        let strategies: Vec<(FileId, Arc<LoadedStrategy>)> = seen
+            .iter()
+            .filter(|f| f.kind == FileKind::Strategy)
+            .filter_map(|f| Some((f.id, self.strategy(f.id)?)))
+            .collect();
+        let models: Vec<&Strategy> = strategies
+            .iter()
+            .filter_map(|(_, s)| s.strategy.as_ref())
+            .collect();
+        let analyses: Vec<&sema::Analysis> = missions.iter().map(|(_, a)| &**a).collect();
+        let (links, cross) = cross_check(&models, &analyses, &catalog.catalog);
+        let unit = Arc::new(Unit {
+            catalog,
+            missions,
+            strategies,
+            links,
+            cross,
+        });
+        let old = lock(&self.memo.units).insert(slot, (key, unit.clone()));
+        drop_later(old);
+        unit
+    }
+
+    /// The unit a mission belongs to (its folder's); `None` for other files.
+    pub fn unit(&self, mission: FileId) -> Option<Arc<Unit>> {
+        self.files
+            .get(&mission)
+            .filter(|f| f.kind == FileKind::Mission)?;
+        Some(self.unit_of(self.folder_of(mission).as_deref()))
+    }
+
+    /// The folders whose units see the catalog or strategy file `id`: the
+    /// folders of the missions that see it, else its own folder.
+    fn units_seeing(&self, id: FileId) -> Vec<Option<PathBuf>> {
+        let Some(path) = self.file(id).and_then(|f| f.key.as_deref()) else {
+            return vec![None];
+        };
+        let mut folders: Vec<Option<PathBuf>> = self
+            .files()
+            .filter(|f| f.kind == FileKind::Mission)
+            .filter_map(|m| m.key.as_deref())
+            .filter(|m| self.sees(m, path))
+            .map(|m| folder(m).map(Path::to_path_buf))
+            .collect();
+        folders.sort();
+        folders.dedup();
+        if folders.is_empty() {
+            folders.push(folder(path).map(Path::to_path_buf));
+        }
+        folders
+    }
+
+    /// The missions that see the strategy (or catalog) file `id`.
+    pub fn missions_seeing(&self, id: FileId) -> Vec<FileId> {
+        let Some(path) = self.file(id).and_then(|f| f.key.as_deref()) else {
+            return Vec::new();
+        };
+        self.files()
+            .filter(|f| f.kind == FileKind::Mission)
+            .filter(|m| m.key.as_deref().is_some_and(|m| self.sees(m, path)))
+            .map(|m| m.id)
+            .collect()
+    }
+
+    /// A strategy file's links: the calls of the missions that see it that
+    /// its entries (and the other entries of those missions' units) refine.
+    pub fn strategy_links(&self, id: FileId) -> StrategyLinks {
+        let units: Vec<Arc<Unit>> = self
+            .units_seeing(id)
+            .iter()
+            .map(|f| self.unit_of(f.as_deref()))
+            .collect();
+        StrategyLinks::merged(units.iter().map(|u| &u.links))
+    }
+
+    /// A task graph analysed with its sub-graphs; `None` for other files.
+    pub fn graph(&self, id: FileId) -> Option<Arc<GraphRun>> {
+        let file = self
+            .files
+            .get(&id)
+            .filter(|f| f.kind == FileKind::TaskGraph)?;
+        let key = (file.revision, self.graphs_revision);
+        if let Some(found) = fresh(lock(&self.memo.graphs).get(&id), &key) {
+            return Some(found);
+        }
+        let known: HashMap<PathBuf, SubgraphSource> = self
+            .files()
+            .filter(|f| f.kind == FileKind::TaskGraph)
+            .filter_map(|f| {
+                let source = SubgraphSource {
+                    file: f.id,
+                    text: f.text.clone(),
+                };
+                Some((subgraph::normalize(f.path.as_deref()?), source))
+            })
+            .collect();
+        // Files the host does not hold get ids counting down from below the
+        // built-in catalog's: read for this analysis only.
+        let mut next = crate::catalog::BUILTIN_FILE.0;
+        let mut resolver = |path: &Path| -> Result<SubgraphSource, String> {
+            if let Some(source) = known.get(path) {
+                return Ok(source.clone());
+            }
+            let text = crate::workspace::read_text(path).map_err(|e| match e.kind() {
+                std::io::ErrorKind::NotFound => format!("there is no file {}", path.display()),
+                _ => format!("{}: {e}", path.display()),
+            })?;
+            next -= 1;
+            Ok(SubgraphSource {
+                file: FileId(next),
+                text: text.into(),
+            })
+        };
+        let run = Arc::new(analyze_graph_at(
+            id,
+            &file.text,
+            file.path.as_deref(),
+            &mut resolver,
+        ));
+        let old = lock(&self.memo.graphs).insert(id, (key, run.clone()));
+        drop_later(old);
+        Some(run)
+    }
+
+    /// The diagnostics of one file, sorted: its own, and those every unit
+    /// that sees it found in it.
+    pub fn diagnostics(&self, id: FileId) -> Vec<Diagnostic> {
+        let Some(file) = self.file(id) else {
+            return Vec::new();
+        };
+        let mut found: Vec<Diagnostic> = match file.kind {
+            FileKind::Mission => self
+                .mission(id)
+                .map(|m| m.diagnostics.clone())
+                .unwrap_or_default(),
+            FileKind::TaskGraph => self
+                .graph(id)
+                .map(|g| g.diagnostics.clone())
+                .unwrap_or_default(),
+            FileKind::Catalog | FileKind::Strategy if file.key.is_none() => {
+                // A document that is not a file sees nothing: checked alone.
+                let mut found = self
+                    .strategy(id)
+                    .map(|s| s.diagnostics.clone())
+                    .unwrap_or_default();
+                if file.kind == FileKind::Catalog {
+                    let source = CatalogSource {
+                        file: id,
+                        text: &file.text,
+                        base_dir: None,
+                    };
+                    found.extend(load_catalog(&[source]).1);
+                }
+                found
+            }
+            FileKind::Catalog | FileKind::Strategy => {
+                let mut found = self
+                    .strategy(id)
+                    .map(|s| s.diagnostics.clone())
+                    .unwrap_or_default();
+                for folder in self.units_seeing(id) {
+                    let unit = self.unit_of(folder.as_deref());
+                    let in_file = |d: &&Diagnostic| d.file == id;
+                    found.extend(unit.catalog.diagnostics.iter().filter(in_file).cloned());
+                    found.extend(unit.cross.iter().filter(in_file).cloned());
+                }
+                found
+            }
+        };
+        diag::sort_and_dedup(&mut found);
+        found
+    }
+
+    /// The files a check of `id` reports on: itself and the catalog and
+    /// strategy files it sees (what its build reads).
+    pub fn reads(&self, id: FileId) -> Vec<FileId> {
+        let mut out = vec![id];
+        out.extend(self.seen_by(id));
+        out
+    }
+
+    /// What a mission is built from: the mission checked, the catalog and
+    /// strategy files it sees, and the diagnostics of all of them
+    /// ([`Analysis::diagnostics`] of each of [`Analysis::reads`]; any error
+    /// refuses the build). `None` for other files.
+    pub fn build_input(&self, mission: FileId) -> Option<BuildFiles> {
+        let unit = self.unit(mission)?;
+        let analysis = unit
+            .missions
+            .iter()
+            .find(|(id, _)| *id == mission)
+            .map(|(_, a)| a.clone())?;
+        let file = self.files.get(&mission)?.clone();
+        let name_of = |id: FileId| -> String {
+            match self.file(id).and_then(|f| f.path.as_deref()) {
+                Some(path) => path.file_name().map_or_else(
+                    || path.display().to_string(),
+                    |n| n.to_string_lossy().into_owned(),
+                ),
+                None => format!("file {}", id.0),
+            }
+        };
+        let strategies: Vec<Strategy> = unit
+            .strategies
+            .iter()
+            .filter_map(|(_, s)| s.strategy.clone())
+            .collect();
+        Some(BuildFiles {
+            mission_name: name_of(mission),
+            strategy_names: strategies
+                .iter()
+                .map(|s| (s.file, name_of(s.file)))
+                .collect(),
+            diagnostics: {
+                let mut all: Vec<Diagnostic> = self
+                    .reads(mission)
+                    .into_iter()
+                    .flat_map(|f| self.diagnostics(f))
+                    .collect();
+                diag::sort_and_dedup(&mut all);
+                all
+            },
+            strategies,
+            analysis,
+            file,
+            unit,
+        })
+    }
+
+    /// The files whose results may change when `id` changes (itself
+    /// included): for a mission, the strategy files it sees (cross-checked
+    /// against it) (a mission added or removed can change what the files
+    /// above its folder see: the door re-checks everything then); for a strategy file, the strategy files sharing a unit
+    /// with it (an entry refined in two files); for a catalog file, the
+    /// missions, catalog and strategy files sharing a unit with it; for a
+    /// task graph, the graphs that read it (or were not analysed yet).
+    pub fn affected_by(&self, id: FileId) -> Vec<FileId> {
+        let Some(file) = self.file(id) else {
+            return Vec::new();
+        };
+        let mut out = vec![id];
+        match file.kind {
+            FileKind::Mission => out.extend(
+                self.seen_by(id)
+                    .into_iter()
+                    .filter(|&f| self.file(f).is_some_and(|f| f.kind == FileKind::Strategy)),
+            ),
+            FileKind::Catalog | FileKind::Strategy => {
+                for unit_folder in self.units_seeing(id) {
+                    let reader = unit_folder.as_deref().map(|f| f.join("_"));
+                    for other in self.files() {
+                        let shares = match (&reader, other.kind, other.key.as_deref()) {
+                            (None, ..) | (_, _, None) | (_, FileKind::TaskGraph, _) => false,
+                            (Some(reader), FileKind::Mission, Some(p)) => {
+                                file.kind == FileKind::Catalog && folder(p) == folder(reader)
+                            }
+                            (Some(reader), FileKind::Catalog, Some(p)) => {
+                                file.kind == FileKind::Catalog && self.sees(reader, p)
+                            }
+                            (Some(reader), FileKind::Strategy, Some(p)) => self.sees(reader, p),
+                        };
+                        if shares {
+                            out.push(other.id);
+                        }
+                    }
+                }
+            }
+            FileKind::TaskGraph => {
+                let path = file.path.as_deref().map(subgraph::normalize);
+                let graphs = lock(&self.memo.graphs);
+                for other in self.files().filter(|f| f.kind == FileKind::TaskGraph) {
+                    let reads = match (graphs.get(&other.id), &path) {
+                        (None, _) => true,
+                        (Some((_, run)), Some(path)) => run.hierarchy.reads.contains(path),
+                        (Some(_), None) => false,
+                    };
+                    if reads {
+                        out.push(other.id);
+                    }
+                }
+            }
+        }
+        out.sort();
+        out.dedup();
+        out
+    }
+}
+
+/// What [`Analysis::build_input`] gathers, owned; [`BuildFiles::input`] lends
+/// it to `codegen::build`.
+pub struct BuildFiles {
+    pub file: Arc<SourceText>,
+    pub analysis: Arc<sema::Analysis>,
+    pub unit: Arc<Unit>,
+    pub strategies: Vec<Strategy>,
+    pub mission_name: String,
+    pub strategy_names: Vec<(FileId, String)>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl BuildFiles {
+    pub fn input(&self) -> BuildInput<'_> {
+        BuildInput {
+            mission: self.file.id,
+            mission_name: self.mission_name.clone(),
+            text: &self.file.text,
+            analysis: &self.analysis,
+            catalog: &self.unit.catalog.catalog,
+            strategies: &self.strategies,
+            strategy_names: self.strategy_names.clone(),
+            links: &self.unit.links,
+            diagnostics: &self.diagnostics,
+        }
+    }
+}
+
+mod disk;
+#[cfg(test)]
+mod tests;
+
+pub use disk::{CheckRun, load_build, load_check};

@@ -1,0 +1,159 @@
+//! The command line's doors into the host: which files `semo check PATH…` and
+//! `semo build MISSION` load from the disk and report on. The rule for what a
+//! file sees is the host's ([`super::sees`]); these only choose the roots and
+//! load every file the rule could make a reported file see.
+
+use super::{Analysis, AnalysisHost, Roots};
+use crate::diag::{self, Diagnostic, FileId};
+use crate::workspace::{FileKind, Files, LoadError, collect, load_text};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// Files loaded from disk into a host: their texts for rendering, the host,
+/// the files the report covers, and their diagnostics (sorted by file and
+/// position).
+pub struct CheckRun {
+    pub files: Files,
+    pub host: AnalysisHost,
+    /// The files the user asked about and those they read, in load order.
+    pub checked: Vec<FileId>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl CheckRun {
+    pub fn error_count(&self) -> usize {
+        self.diagnostics.iter().filter(|d| d.is_error()).count()
+    }
+
+    pub fn analysis(&self) -> Analysis {
+        self.host.analysis()
+    }
+}
+
+/// Where a path is for the host: absolute and without `.`/`..`, so that
+/// folders compare by prefix whatever way the user wrote them.
+fn absolute(path: &Path) -> PathBuf {
+    let path = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    crate::taskgraph::subgraph::normalize(&path)
+}
+
+fn folder_of(path: &Path) -> PathBuf {
+    path.parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+        .to_path_buf()
+}
+
+#[derive(Default)]
+struct Loader {
+    files: Files,
+    host: AnalysisHost,
+    by_path: HashMap<PathBuf, FileId>,
+    checked: Vec<FileId>,
+}
+
+impl Loader {
+    fn add(&mut self, path: &Path, kind: FileKind) -> Result<FileId, LoadError> {
+        let key = absolute(path);
+        if let Some(&id) = self.by_path.get(&key) {
+            return Ok(id);
+        }
+        let text = load_text(path)?;
+        let shared: Arc<str> = text.as_str().into();
+        let id = self.files.add(path.to_path_buf(), kind, text);
+        self.host
+            .set_file(id, Some(path.to_path_buf()), kind, shared);
+        self.by_path.insert(key, id);
+        Ok(id)
+    }
+
+    fn check(&mut self, id: FileId) {
+        if !self.checked.contains(&id) {
+            self.checked.push(id);
+        }
+    }
+
+    /// Every SeMo file under `folder`, so that whatever sees what, the
+    /// files are there.
+    fn add_folder(&mut self, folder: &Path) -> Result<Vec<FileId>, LoadError> {
+        let mut ids = Vec::new();
+        for (path, kind) in collect(&[folder.to_path_buf()])? {
+            ids.push(self.add(&path, kind)?);
+        }
+        Ok(ids)
+    }
+
+    /// A file named by the user, with every file of its folder: it is
+    /// reported with the files it reads.
+    fn add_named_file(&mut self, path: &Path) -> Result<FileId, LoadError> {
+        let id = self.add(path, FileKind::named_explicitly(path))?;
+        self.add_folder(&folder_of(path))?;
+        Ok(id)
+    }
+
+    fn finish(self, roots: Roots, named: Vec<FileId>) -> CheckRun {
+        let mut loader = self;
+        loader.host.set_roots(roots);
+        let analysis = loader.host.analysis();
+        for id in named {
+            for read in analysis.reads(id) {
+                loader.check(read);
+            }
+        }
+        let mut diagnostics: Vec<Diagnostic> = loader
+            .checked
+            .iter()
+            .flat_map(|&id| analysis.diagnostics(id))
+            .collect();
+        diag::sort_and_dedup(&mut diagnostics);
+        CheckRun {
+            files: loader.files,
+            host: loader.host,
+            checked: loader.checked,
+            diagnostics,
+        }
+    }
+}
+
+/// `semo check PATH…`: a folder is a workspace root, and every file under it
+/// is reported; a file's folder is its root, and the file is reported with
+/// the catalog and strategy files it sees.
+pub fn load_check(paths: &[PathBuf]) -> Result<CheckRun, LoadError> {
+    let mut loader = Loader::default();
+    let mut roots = Roots::default();
+    let mut named = Vec::new();
+    for path in paths {
+        if path.is_dir() {
+            roots.roots.push(absolute(path));
+            named.extend(loader.add_folder(path)?);
+        } else {
+            roots.roots.push(absolute(&folder_of(path)));
+            named.push(loader.add_named_file(path)?);
+        }
+    }
+    Ok(loader.finish(roots, named))
+}
+
+/// `semo build MISSION --strategy PATH…`: the mission's folder is its root;
+/// the catalog and strategy files under each `--strategy` path are seen by
+/// all. Gives the run (reporting the mission and what it reads) and the
+/// mission's id.
+pub fn load_build(mission: &Path, strategy: &[PathBuf]) -> Result<(CheckRun, FileId), LoadError> {
+    let mut loader = Loader::default();
+    let mut roots = Roots {
+        roots: vec![absolute(&folder_of(mission))],
+        seen_by_all: Vec::new(),
+    };
+    let id = loader.add(mission, FileKind::Mission)?;
+    loader.add_folder(&folder_of(mission))?;
+    for extra in strategy {
+        for (path, kind) in collect(std::slice::from_ref(extra))? {
+            if matches!(kind, FileKind::Catalog | FileKind::Strategy) {
+                loader.add(&path, kind)?;
+                roots.seen_by_all.push(absolute(&path));
+            }
+        }
+    }
+    Ok((loader.finish(roots, vec![id]), id))
+}

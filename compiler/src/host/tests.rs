@@ -1,0 +1,137 @@
+use super::*;
+use crate::diag::Code;
+
+fn roots(roots: &[&str]) -> Roots {
+    Roots {
+        roots: roots.iter().map(PathBuf::from).collect(),
+        seen_by_all: Vec::new(),
+    }
+}
+
+#[test]
+fn a_file_sees_its_folder_below_it_and_the_folders_above_it_up_to_its_root() {
+    let r = roots(&["/w"]);
+    // Folders with missions of their own.
+    let projects = |d: &Path| d == Path::new("/w/a/other") || d == Path::new("/w/a");
+    let sees = |r: &Roots, m: &Path, f: &Path| sees(r, projects, m, f);
+    let m = Path::new("/w/a/m.mission");
+    // Its folder and below.
+    assert!(sees(&r, m, Path::new("/w/a/x.robot.xml")));
+    assert!(sees(&r, m, Path::new("/w/a/robots/x.robot.xml")));
+    // Directly in the folders above, up to the root.
+    assert!(sees(&r, m, Path::new("/w/x.robot.xml")));
+    // Not a sibling folder, not another branch above, not above the root.
+    assert!(!sees(&r, m, Path::new("/w/b/x.robot.xml")));
+    assert!(!sees(&r, m, Path::new("/w/b/c/x.robot.xml")));
+    assert!(!sees(&r, m, Path::new("/x.robot.xml")));
+    // Under no root, its own folder is the root.
+    assert!(!sees(&roots(&[]), m, Path::new("/w/x.robot.xml")));
+    assert!(sees(&roots(&[]), m, Path::new("/w/a/b/x.robot.xml")));
+    // The innermost root holding the file counts.
+    assert!(!sees(
+        &roots(&["/w", "/w/a"]),
+        m,
+        Path::new("/w/x.robot.xml")
+    ));
+    // Files named for all (`semo build --strategy`).
+    let all = Roots {
+        roots: vec![PathBuf::from("/w")],
+        seen_by_all: vec![PathBuf::from("/elsewhere")],
+    };
+    assert!(sees(&all, m, Path::new("/elsewhere/s/x.strategy.xml")));
+    // Not into a folder below that is a project of its own.
+    assert!(!sees(&r, m, Path::new("/w/a/other/x.robot.xml")));
+    assert!(!sees(&r, m, Path::new("/w/a/other/robots/x.robot.xml")));
+}
+
+const MISSION: &str = "{ A: Turtlebot3_Burger tb }\n\
+    A.P.S { move(\"1,1\") }\n\
+    A.M { set(P, S) }\n\
+    A.main { default: mode = M }\n";
+
+const CATALOG: &str = r#"<?xml version="1.0"?>
+<Catalog xmlns="urn:semo:catalog:1">
+  <Robot type="Rover">
+    <Service name="dig" task="dig_task"/>
+  </Robot>
+</Catalog>
+"#;
+
+fn host_with(files: &[(u32, &str, FileKind, &str)]) -> AnalysisHost {
+    let mut host = AnalysisHost::new(roots(&["/w"]));
+    for &(id, path, kind, text) in files {
+        host.set_file(FileId(id), Some(PathBuf::from(path)), kind, text.into());
+    }
+    host
+}
+
+#[test]
+fn sibling_folders_do_not_share_catalogs() {
+    let dig = "{ T: Rover r }\nT.P.S { dig() } repeat()\nT.M { set(P, S) }\nT.main { default: mode = M }\n";
+    let host = host_with(&[
+        (0, "/w/a/dig.mission", FileKind::Mission, dig),
+        (1, "/w/a/rover.robot.xml", FileKind::Catalog, CATALOG),
+        (2, "/w/b/dig.mission", FileKind::Mission, dig),
+    ]);
+    let analysis = host.analysis();
+    assert_eq!(analysis.diagnostics(FileId(0)), Vec::new());
+    assert_eq!(analysis.reads(FileId(0)), vec![FileId(0), FileId(1)]);
+    let codes: Vec<Code> = analysis
+        .diagnostics(FileId(2))
+        .iter()
+        .map(|d| d.code)
+        .collect();
+    assert!(codes.contains(&Code::UnknownRobotType), "{codes:?}");
+    assert_eq!(analysis.reads(FileId(2)), vec![FileId(2)]);
+}
+
+#[test]
+fn an_edit_recomputes_only_what_reads_the_edited_file() {
+    let mut host = host_with(&[
+        (0, "/w/a/one.mission", FileKind::Mission, MISSION),
+        (1, "/w/a/two.mission", FileKind::Mission, MISSION),
+        (2, "/w/a/rover.robot.xml", FileKind::Catalog, CATALOG),
+    ]);
+    let before = host.analysis();
+    let (one, two, catalog) = (
+        before.mission(FileId(0)).unwrap(),
+        before.mission(FileId(1)).unwrap(),
+        before.catalog(FileId(0)),
+    );
+    host.set_file(
+        FileId(0),
+        Some(PathBuf::from("/w/a/one.mission")),
+        FileKind::Mission,
+        MISSION.replace("1,1", "2,2").into(),
+    );
+    let after = host.analysis();
+    assert!(Arc::ptr_eq(&catalog, &after.catalog(FileId(0))));
+    assert!(Arc::ptr_eq(&two, &after.mission(FileId(1)).unwrap()));
+    assert!(!Arc::ptr_eq(&one, &after.mission(FileId(0)).unwrap()));
+    // Parsed from the previous version's cache: one chunk of four.
+    let cache = after.parse_cache(FileId(0)).unwrap();
+    assert_eq!((cache.chunks(), cache.reparsed()), (4, 1));
+    // A catalog change reaches the missions that see it, not the others.
+    assert_eq!(
+        after.affected_by(FileId(2)),
+        vec![FileId(0), FileId(1), FileId(2)]
+    );
+    assert_eq!(after.affected_by(FileId(0)), vec![FileId(0)]);
+}
+
+#[test]
+fn the_build_input_carries_the_diagnostics_of_every_file_the_mission_reads() {
+    let broken = CATALOG.replace("</Catalog>", "");
+    let host = host_with(&[
+        (0, "/w/a/one.mission", FileKind::Mission, MISSION),
+        (1, "/w/a/rover.robot.xml", FileKind::Catalog, &broken),
+    ]);
+    let analysis = host.analysis();
+    let catalog_errors = analysis.diagnostics(FileId(1));
+    assert!(catalog_errors.iter().any(Diagnostic::is_error));
+    let build = analysis.build_input(FileId(0)).unwrap();
+    for d in &catalog_errors {
+        assert!(build.diagnostics.contains(d), "{d:?}");
+    }
+    assert!(analysis.build_input(FileId(1)).is_none());
+}

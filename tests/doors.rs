@@ -1,0 +1,216 @@
+//! The doors agree: for every example mission, `semo check FILE`, `semo check
+//! DIR` (the examples folder), `semo build` and the language server's
+//! published diagnostics report the same problems for the mission and the
+//! catalog and strategy files it reads, because all of them ask the library's
+//! one workspace analysis (`semo::host`) by its one rule.
+
+mod support;
+
+use semo_server::harness::TestClient;
+use serde_json::Value;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use support::{check_json_in, examples, semo_in};
+
+/// `(file, code, start line, start column, message)`, lines and columns from 1.
+type Problem = (String, String, u64, u64, String);
+
+fn missions(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    entries.sort();
+    for path in entries {
+        if path.is_dir() {
+            missions(&path, out);
+        } else if path.extension().is_some_and(|e| e == "mission") {
+            out.push(path);
+        }
+    }
+}
+
+fn absolute(file: &str, dir: &Path) -> String {
+    let path = Path::new(file);
+    let path = if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        dir.join(path)
+    };
+    let normalized: PathBuf = path.components().collect();
+    normalized.display().to_string()
+}
+
+fn from_check(dir: &Path, paths: &[&str]) -> (i32, BTreeSet<Problem>) {
+    let (code, diags) = check_json_in(dir, paths);
+    let problems = diags
+        .into_iter()
+        .map(|d| {
+            (
+                absolute(&d.file, dir),
+                d.code,
+                d.start.0,
+                d.start.1,
+                d.message,
+            )
+        })
+        .collect();
+    (code, problems)
+}
+
+/// The files compared for a mission: itself and the catalog and strategy
+/// files under its folder (what it reads in the examples, which keep their
+/// files beside their missions).
+fn compared_files(mission: &Path) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    out.insert(mission.display().to_string());
+    let mut stack = vec![mission.parent().unwrap().to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.to_string_lossy().into_owned();
+            if path.is_dir() {
+                stack.push(path);
+            } else if name.ends_with(".robot.xml") || name.ends_with(".strategy.xml") {
+                out.insert(name);
+            }
+        }
+    }
+    out
+}
+
+/// The diagnostics the server publishes for each file of `files`, with no
+/// workspace root (each file's folder is its root) and every SeMo file of
+/// the mission's folder open; each file is opened last in its own session,
+/// so its first publication already sees all the others.
+fn from_server(mission: &Path, files: &BTreeSet<String>) -> BTreeSet<Problem> {
+    let folder = mission.parent().unwrap();
+    let mut all: Vec<PathBuf> = Vec::new();
+    for entry in std::fs::read_dir(folder).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.to_string_lossy().into_owned();
+        if name.ends_with(".mission") || name.ends_with(".strategy.xml") {
+            all.push(path);
+        }
+    }
+    for file in files {
+        if !all.iter().any(|p| p.display().to_string() == *file) {
+            all.push(PathBuf::from(file));
+        }
+    }
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    let mut problems = BTreeSet::new();
+    for file in files {
+        let found: Vec<Value> = runtime.block_on(async {
+            let mut client = TestClient::start();
+            client.initialize(&["utf-16"], None).await;
+            let others = all.iter().filter(|p| p.display().to_string() != *file);
+            for path in others.chain(std::iter::once(&PathBuf::from(file))) {
+                let text = std::fs::read_to_string(path).unwrap();
+                client
+                    .open(&format!("file://{}", path.display()), &text)
+                    .await;
+            }
+            let uri = format!("file://{file}");
+            let found = client.diagnostics(&uri, Some(1)).await;
+            client.shutdown().await;
+            found
+        });
+        for d in found {
+            problems.insert((
+                file.clone(),
+                d["code"].as_str().unwrap().to_string(),
+                d["range"]["start"]["line"].as_u64().unwrap() + 1,
+                d["range"]["start"]["character"].as_u64().unwrap() + 1,
+                d["message"].as_str().unwrap().to_string(),
+            ));
+        }
+    }
+    problems
+}
+
+fn listing(problems: &BTreeSet<Problem>) -> String {
+    problems
+        .iter()
+        .map(|(f, c, l, col, m)| format!("  {f}:{l}:{col} {c} {m}\n"))
+        .collect()
+}
+
+#[test]
+fn every_example_gets_the_same_diagnostics_at_every_door() {
+    let root = examples();
+    let mut all = Vec::new();
+    missions(&root, &mut all);
+    assert!(all.len() >= 5, "{all:?}");
+    let (_, whole) = from_check(&root, &["."]);
+    let out = std::env::temp_dir().join(format!("semo-doors-{}", std::process::id()));
+    for mission in &all {
+        let files = compared_files(mission);
+        let keep = |problems: &BTreeSet<Problem>| -> BTreeSet<Problem> {
+            problems
+                .iter()
+                .filter(|p| files.contains(&p.0))
+                .cloned()
+                .collect()
+        };
+        let name = mission.display().to_string();
+        let (code, single) = from_check(&root, &[name.as_str()]);
+        // `semo check FILE` reports only the mission and what it reads.
+        assert_eq!(
+            single,
+            keep(&single),
+            "{name}: check FILE reports other files"
+        );
+        assert_eq!(
+            listing(&single),
+            listing(&keep(&whole)),
+            "{name}: check FILE and check DIR disagree"
+        );
+        assert_eq!(
+            listing(&single),
+            listing(&from_server(mission, &files)),
+            "{name}: check FILE and the editor disagree"
+        );
+        let has_errors = code == 1;
+        let build = semo_in(
+            &root,
+            &[
+                "build",
+                &name,
+                "--emit",
+                "taskgraph",
+                "--out",
+                &out.display().to_string(),
+                "--color",
+                "never",
+            ],
+        );
+        assert_eq!(
+            build.code,
+            if has_errors { 1 } else { 0 },
+            "{name}: check exit {code}, build said:\n{}{}",
+            build.stdout,
+            build.stderr
+        );
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn checking_a_mission_reads_the_catalog_beside_it() {
+    // The bug this analysis fixed: the patrol mission's robot type and its
+    // service live in `robots/beacon.robot.xml` beside it.
+    let root = examples();
+    let (code, problems) = from_check(&root, &["patrol/patrol.mission"]);
+    assert_eq!(code, 0, "{}", listing(&problems));
+    let out = semo_in(&root, &["check", "patrol/patrol.mission"]);
+    assert!(
+        out.stdout.contains("checked 1 mission and 1 catalog file"),
+        "{}",
+        out.stdout
+    );
+}
