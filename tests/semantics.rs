@@ -185,3 +185,32 @@ fn robots_without_values_and_shared_getters_compile_pedantically() {
         }
     }
 }
+
+#[test]
+fn a_request_stopped_before_its_task_fired_does_not_survive_a_mode_change() {
+    // The stale request appears only when the mode changes before the task's
+    // thread takes the request: a race, so several runs.
+    for run in 0..3 {
+        let out = scratch(&format!("semantics/stale-request-{run}"));
+        let traces = run_in_simulation(&fixture("stale_request.mission"), &out, SHORT_RUN);
+        let ev = events(&traces["ev"]);
+        let in_m1 = ev
+            .iter()
+            .position(|e| field(e, "event") == "mode" && field(e, "mode") == "M1")
+            .expect("the robot reaches M1");
+        let goals: Vec<&str> = ev[in_m1..]
+            .iter()
+            .filter(|e| field(e, "event") == "call_start")
+            .map(|e| field(e, "arg"))
+            .collect();
+        // A "1,1" already taken by the task may still be traced after the
+        // change; what must not happen is the old goal taking the new call's
+        // place (the robot never moves to "9,9").
+        assert_eq!(
+            goals.last(),
+            Some(&"9,9"),
+            "run {run}: moves started in M1: {goals:?}"
+        );
+        assert!(goals.len() <= 2, "run {run}: {goals:?}");
+    }
+}

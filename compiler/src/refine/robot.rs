@@ -424,6 +424,15 @@ impl Builder<'_, '_> {
                 continue;
             }
             if arm.kind == ast::ArmKind::Leader {
+                // A robot the checker does not let run `others` (the only
+                // candidate always leads) has no `others` branch.
+                let others = match others {
+                    Some(body) => self
+                        .runners_of(body.span)
+                        .filter(|r| r.contains(&self.robot_index))
+                        .map(|_| body),
+                    None => None,
+                };
                 return ArmChoice::Leader {
                     body: &arm.body,
                     others,
@@ -557,7 +566,18 @@ impl Builder<'_, '_> {
             }
             return;
         }
-        let name = call.name.name.to_string();
+        // The built-in service the checker resolved the name to.
+        let Some(name) = symbols.iter().find_map(|o| match &o.symbol {
+            Symbol::BuiltinService(name) => Some(name.to_string()),
+            _ => None,
+        }) else {
+            let what = format!(
+                "the checker resolved the call `{}` to no service or function",
+                call.name.name
+            );
+            self.internal_error(call.name.span, &what);
+            return;
+        };
         let Some(def) = self.robot_type.service(&name) else {
             let what = format!(
                 "robot type `{}` has no service `{name}`, yet the checker let this robot call it",
@@ -648,7 +668,7 @@ impl Builder<'_, '_> {
             .find(|(f, _)| *f == strategy.file)
             .map(|(_, n)| n.clone())
             .unwrap_or_default();
-        let machine = self.action_machine(entry, service, source, strategy);
+        let machine = self.action_machine(entry, service, source, strategy, span);
         self.machine.actions.push(machine);
         let index = self.machine.actions.len() - 1;
         self.action_machines.insert(key, index);
@@ -661,6 +681,7 @@ impl Builder<'_, '_> {
         service: &str,
         source: String,
         strategy: &crate::strategy::Strategy,
+        call: Span,
     ) -> ActionMachine {
         // Parameter names the conditions read, to their operands.
         let mut names: HashMap<String, Operand> = HashMap::new();
@@ -732,19 +753,29 @@ impl Builder<'_, '_> {
                     commands.push((task, command));
                 }
             }
-            let transitions = action
-                .transitions
-                .iter()
-                .filter_map(|t| {
-                    let to = *index_of.get(&t.dst.as_ref()?.value)?;
-                    let condition = t
-                        .condition
-                        .as_ref()
-                        .and_then(|c| c.expr.as_ref())
-                        .map(|e| self.strategy_condition(e, &names));
-                    Some((condition, to))
-                })
-                .collect();
+            let mut transitions = Vec::new();
+            for t in &action.transitions {
+                let Some(to) = t.dst.as_ref().and_then(|d| index_of.get(&d.value)) else {
+                    let what = format!(
+                        "a transition of strategy action {} of `{service}` goes to no action",
+                        action.describe()
+                    );
+                    self.internal_error(call, &what);
+                    continue;
+                };
+                let condition = match &t.condition {
+                    None => None,
+                    Some(c) => match &c.expr {
+                        Some(e) => Some(self.strategy_condition(e, &names)),
+                        None => {
+                            let what = format!("the condition `{}` did not parse", c.text);
+                            self.internal_error(call, &what);
+                            continue;
+                        }
+                    },
+                };
+                transitions.push((condition, *to));
+            }
             actions.push(ActionState {
                 name: action
                     .name
@@ -757,11 +788,14 @@ impl Builder<'_, '_> {
                 transitions,
             });
         }
-        let initial = entry
-            .actions
-            .iter()
-            .position(|a| a.initial.is_yes())
-            .unwrap_or(0);
+        let initial = match entry.actions.iter().position(|a| a.initial.is_yes()) {
+            Some(i) => i,
+            None => {
+                let what = format!("the strategy of `{service}` has no initial action");
+                self.internal_error(call, &what);
+                0
+            }
+        };
         ActionMachine {
             service: service.to_string(),
             source,

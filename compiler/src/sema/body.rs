@@ -881,6 +881,10 @@ impl<'a> Checker<'a> {
                 };
                 self.report(Code::UnknownAttribute, attr.span, message)
                     .suggest(guess.map(|g| format!("{team}.{g}")));
+                // What it means all the same (a warning lets the mission
+                // build): a team variable nobody sets, which stays empty.
+                let owner = self.team_id(&team);
+                self.occurrence(last, Symbol::TeamVariable { team: owner, name }, false);
                 Type::Unknown
             }
             Resolution::NotATeam { team } => {
@@ -891,6 +895,8 @@ impl<'a> Checker<'a> {
                     format!("`{}`: `{team}` is not a team", attr.dotted()),
                 )
                 .suggest(guess);
+                // What it means all the same: the words as written.
+                self.occurrence(last, Symbol::Constant(Name::new(attr.dotted())), false);
                 Type::Unknown
             }
             Resolution::TooLong => {
@@ -902,6 +908,7 @@ impl<'a> Checker<'a> {
                         attr.dotted()
                     ),
                 );
+                self.occurrence(last, Symbol::Constant(Name::new(attr.dotted())), false);
                 Type::Unknown
             }
             Resolution::Bare { name, .. } if bare_is_constant => {
@@ -919,6 +926,8 @@ impl<'a> Checker<'a> {
                     ),
                 )
                 .suggest(guess);
+                // What it means all the same: a symbolic constant.
+                self.occurrence(last, Symbol::Constant(name), false);
                 Type::Unknown
             }
             Resolution::Unchecked => Type::Unknown,
