@@ -1,13 +1,14 @@
-//! The `semo` command. Exit codes: 0 no errors, 1 errors found, 2 usage or I/O
-//! problem.
+//! The `semo` command: the compiler library's door for people and scripts, and
+//! `semo lsp`, the language server's door for editors. Exit codes: 0 no errors,
+//! 1 errors found, 2 usage or I/O problem.
 
-pub mod build;
+mod build;
 mod fmt;
 mod graph;
 mod render;
 
-use crate::workspace;
 use clap::{Parser, Subcommand, ValueEnum};
+use semo::workspace;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 
@@ -96,7 +97,7 @@ enum Command {
         /// `linux` (POSIX threads; you fill the task files) or `linux-sim`
         /// (sensors, actuators and the operator simulated from a scenario file).
         #[arg(long, default_value = "linux", value_parser = parse_target)]
-        target: crate::codegen::Target,
+        target: semo::codegen::Target,
         /// `all` (C code, Makefile and task graph) or `taskgraph` (only the
         /// refined task graphs).
         #[arg(long, value_enum, default_value_t = EmitArg::All)]
@@ -186,9 +187,12 @@ enum ColorChoice {
     Never,
 }
 
-/// Runs the command line and gives the process exit code. The language server
-/// lives in a crate above this library, so the binary hands it in as `lsp`.
-pub fn main(lsp: fn() -> i32) -> i32 {
+fn main() {
+    std::process::exit(run());
+}
+
+/// Runs the command line and gives the process exit code.
+fn run() -> i32 {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
@@ -245,8 +249,8 @@ pub fn main(lsp: fn() -> i32) -> i32 {
                 out: out_dir,
                 target,
                 emit: match emit {
-                    EmitArg::All => crate::codegen::Emit::All,
-                    EmitArg::Taskgraph => crate::codegen::Emit::TaskGraph,
+                    EmitArg::All => semo::codegen::Emit::All,
+                    EmitArg::Taskgraph => semo::codegen::Emit::TaskGraph,
                 },
                 color: use_color(color),
             },
@@ -256,7 +260,7 @@ pub fn main(lsp: fn() -> i32) -> i32 {
         Command::Lsp { stdio: _ } => {
             // The protocol owns stdout from here on.
             drop(out);
-            return lsp();
+            return semo_server::run_stdio();
         }
     };
     let _ = out.flush();
@@ -269,9 +273,9 @@ enum EmitArg {
     Taskgraph,
 }
 
-fn parse_target(name: &str) -> Result<crate::codegen::Target, String> {
-    crate::codegen::Target::from_name(name).ok_or_else(|| {
-        let names: Vec<&str> = crate::codegen::TARGETS.iter().map(|t| t.name).collect();
+fn parse_target(name: &str) -> Result<semo::codegen::Target, String> {
+    semo::codegen::Target::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = semo::codegen::TARGETS.iter().map(|t| t.name).collect();
         format!("unknown target `{name}` (targets: {})", names.join(", "))
     })
 }
@@ -316,7 +320,7 @@ fn check(paths: Vec<PathBuf>, format: Format, color: bool, out: &mut impl Write)
 }
 
 fn explain(code: Option<&str>, out: &mut impl Write) -> i32 {
-    use crate::diag::Code;
+    use semo::diag::Code;
     let codes: Vec<Code> = match code {
         None => Code::ALL.to_vec(),
         Some(c) => match Code::from_code(&c.to_ascii_uppercase()) {
