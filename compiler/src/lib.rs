@@ -12,6 +12,8 @@
 //! - [`ide`]: editor features over an analysis (completion, hover, navigation, rename,
 //!   outline, highlighting, folding, selection), as plain data in byte ranges.
 //! - [`modemachine`]: each team's modes and mode changes, and their SVG picture.
+//! - [`sim`]: the simulator: every robot's refined program run at once in
+//!   virtual time on a scenario (`semo simulate`).
 //! - [`workspace`]: loading files and folders from disk for the CLI.
 //!
 //! The `semo` command (rendering with ariadne or JSON) is the `semo-cli` crate
@@ -27,6 +29,7 @@ pub mod ide;
 pub mod modemachine;
 pub mod refine;
 pub mod sema;
+pub mod sim;
 pub mod span;
 pub mod strategy;
 pub mod suggest;

@@ -13,7 +13,7 @@
 
 mod c;
 mod control;
-mod files;
+pub(crate) mod files;
 pub mod output;
 
 use crate::refine::{RobotProgram, RoleKind};
@@ -265,19 +265,54 @@ pub fn build(
     target: Target,
     emit: Emit,
 ) -> BuildResult {
+    let Refined {
+        programs,
+        diagnostics,
+        sources,
+    } = refine_checked(run, mission);
+    if programs.is_empty() {
+        return BuildResult {
+            robots: Vec::new(),
+            diagnostics,
+        };
+    }
+    let robots = programs
+        .iter()
+        .map(|p| generate(p, target, emit, &sources))
+        .collect();
+    BuildResult {
+        robots,
+        diagnostics,
+    }
+}
+
+/// A checked mission's refined programs, as code generation and the
+/// simulator (`sim`) read them.
+pub struct Refined {
+    /// One per robot, in formation order; empty when refused.
+    pub programs: Vec<crate::refine::RobotProgram>,
+    /// The check's diagnostics and refinement's; any error refuses.
+    pub diagnostics: Vec<crate::diag::Diagnostic>,
+    /// The mission's and the strategy files' names (file headers).
+    pub sources: Vec<String>,
+}
+
+/// Refines the mission `mission` of a checked workspace: every error of the
+/// check (mission, catalog, strategies) refuses, as do problems found while
+/// refining and names that cannot be files or C identifiers (E101).
+pub fn refine_checked(run: &crate::workspace::CheckRun, mission: crate::diag::FileId) -> Refined {
     use crate::diag::{Code, Diagnostic};
     let mut diagnostics: Vec<Diagnostic> = run.diagnostics.clone();
+    let refused = |diagnostics| Refined {
+        programs: Vec::new(),
+        diagnostics,
+        sources: Vec::new(),
+    };
     let Some((_, analysis)) = run.analyses.iter().find(|(id, _)| *id == mission) else {
-        return BuildResult {
-            robots: Vec::new(),
-            diagnostics,
-        };
+        return refused(diagnostics);
     };
     if diagnostics.iter().any(Diagnostic::is_error) {
-        return BuildResult {
-            robots: Vec::new(),
-            diagnostics,
-        };
+        return refused(diagnostics);
     }
     let file = run.files.get(mission);
     let name_of = |id: crate::diag::FileId| {
@@ -355,19 +390,13 @@ pub fn build(
     }
     crate::diag::sort_and_dedup(&mut diagnostics);
     if diagnostics.iter().any(Diagnostic::is_error) {
-        return BuildResult {
-            robots: Vec::new(),
-            diagnostics,
-        };
+        return refused(diagnostics);
     }
     let mut sources = vec![mission_name.clone()];
     sources.extend(strategy_names.iter().map(|(_, n)| n.clone()));
-    let robots = programs
-        .iter()
-        .map(|p| generate(p, target, emit, &sources))
-        .collect();
-    BuildResult {
-        robots,
+    Refined {
+        programs,
         diagnostics,
+        sources,
     }
 }
