@@ -210,7 +210,7 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
     out.push_str("}\n\n");
 
     if uses("throw_event") {
-        out.push_str("/* `throw`: asks for the mode change that the current mode's `catch` names. */\nstatic void throw_event(const char *event)\n{\n    semo_trace(\"throw\", \"event\", event, NULL);\n    switch (current_mode) {\n");
+        out.push_str("/* `throw`: asks for the mode change that the current mode's `catch` names. */\nstatic void throw_event(const char *event)\n{\n    semo_trace(\"throw\", \"name\", event, NULL);\n    switch (current_mode) {\n");
         for (from, mode) in m.modes.iter().enumerate() {
             let catches: Vec<_> = m.transitions.iter().filter(|t| t.from == from).collect();
             if catches.is_empty() {
@@ -220,7 +220,7 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
             for t in catches {
                 let _ = writeln!(
                     out,
-                    "        if (strcmp(event, {}) == 0 && pending_mode < 0) {{ /* {}:{} */\n            pending_mode = MODE_{};\n            semo_trace(\"catch\", \"event\", event, \"mode\", mode_name[pending_mode], NULL);\n        }}",
+                    "        if (strcmp(event, {}) == 0 && pending_mode < 0) {{ /* {}:{} */\n            pending_mode = MODE_{};\n            semo_trace(\"catch\", \"name\", event, \"mode\", mode_name[pending_mode], NULL);\n        }}",
                     c::string(&t.event),
                     c::comment(&program.mission),
                     t.line,

@@ -824,7 +824,7 @@ impl<'p> Sim<'p> {
     // -------------------------------------------------------- the machine
 
     fn throw_event(&mut self, r: usize, event: &str) {
-        self.emit(r, "throw", vec![("event", event.to_string())]);
+        self.emit(r, "throw", vec![("name", event.to_string())]);
         let robot = &self.robots[r];
         let m = &robot.program.control;
         let Some(current) = robot.current_mode else {
@@ -843,7 +843,7 @@ impl<'p> Sim<'p> {
             self.emit(
                 r,
                 "catch",
-                vec![("event", event.to_string()), ("mode", mode)],
+                vec![("name", event.to_string()), ("mode", mode)],
             );
         }
     }

@@ -218,11 +218,11 @@ pub fn to_svg(run: &Run, programs: &[RobotProgram], scenario: &Scenario) -> Stri
             let _ = writeln!(
                 out,
                 "<path class=\"{class}\" data-event=\"{}\" data-t=\"{}\" transform=\"translate({:.1},{:.1})\" d=\"{shape}\" fill=\"#d62728\" stroke=\"#d62728\"><title>{class} {} at {} ms</title></path>",
-                escape(e.field("event").unwrap_or_default()),
+                escape(e.field("name").unwrap_or_default()),
                 e.t,
                 x(e.t),
                 lane.middle(),
-                escape(e.field("event").unwrap_or_default()),
+                escape(e.field("name").unwrap_or_default()),
                 e.t
             );
         }

@@ -98,6 +98,19 @@ fn the_trace_is_the_runtime_schema_and_the_same_for_a_seed() {
         first,
         r#"{"t":0,"robot":"irobot","event":"start","team":"MasterTeam","type":"iRobotCreate","mission":"scouting.mission"}"#
     );
+    // One key per field: no field repeats the line's own keys.
+    assert!(
+        a.trace.iter().all(|e| e
+            .fields
+            .iter()
+            .all(|(k, _)| !["t", "robot", "event"].contains(k))),
+        "a field named like the line's own keys"
+    );
+    assert!(
+        a.trace
+            .iter()
+            .any(|e| e.event == "catch" && e.field("name").is_some())
+    );
     // Time never goes back.
     assert!(a.trace.windows(2).all(|w| w[0].t <= w[1].t));
 }
