@@ -26,7 +26,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         }
     };
     let mut run = workspace::check_files(files);
-    let result = codegen::build(&run, mission, options.target, options.emit);
+    let Some(input) = run.build_input(mission) else {
+        eprintln!("internal error: the mission was loaded but not checked");
+        return 2;
+    };
+    let result = codegen::build(&input, options.target, options.emit);
     if result.refused() {
         run.diagnostics = result.diagnostics;
         let _ = render::human(&run, options.color, out);

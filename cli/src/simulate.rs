@@ -58,7 +58,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         }
     };
     let mut check = workspace::check_files(files);
-    let refined = semo::codegen::refine_checked(&check, mission);
+    let Some(input) = check.build_input(mission) else {
+        eprintln!("internal error: the mission was loaded but not checked");
+        return 2;
+    };
+    let refined = semo::codegen::refine_checked(&input);
     if refined.diagnostics.iter().any(|d| d.is_error()) {
         check.diagnostics = refined.diagnostics;
         let _ = render::human(&check, options.color, &mut std::io::stderr());

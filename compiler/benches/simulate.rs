@@ -14,7 +14,8 @@ use std::time::Duration;
 
 fn programs(files: semo::workspace::Files, id: semo::diag::FileId) -> Vec<RobotProgram> {
     let run = semo::workspace::check_files(files);
-    let refined = semo::codegen::refine_checked(&run, id);
+    let input = run.build_input(id).expect("the mission was checked");
+    let refined = semo::codegen::refine_checked(&input);
     assert!(!refined.programs.is_empty(), "{:#?}", refined.diagnostics);
     refined.programs
 }

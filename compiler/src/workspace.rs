@@ -7,6 +7,7 @@
 use crate::catalog::{
     BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE, Catalog, CatalogSource, load_catalog,
 };
+use crate::codegen::BuildInput;
 use crate::diag::{self, Diagnostic, FileId};
 use crate::sema::{Analysis, check_source};
 use crate::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
@@ -190,6 +191,35 @@ pub struct CheckRun {
 impl CheckRun {
     pub fn error_count(&self) -> usize {
         self.diagnostics.iter().filter(|d| d.is_error()).count()
+    }
+
+    /// What `mission` is built from: its analysis with this run's catalog,
+    /// strategies and diagnostics. `None` when `mission` is not one of the
+    /// run's missions.
+    pub fn build_input(&self, mission: FileId) -> Option<BuildInput<'_>> {
+        let (_, analysis) = self.analyses.iter().find(|(id, _)| *id == mission)?;
+        let name_of = |id: FileId| {
+            let path = &self.files.get(id).path;
+            path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            )
+        };
+        Some(BuildInput {
+            mission,
+            mission_name: name_of(mission),
+            text: &self.files.get(mission).text,
+            analysis,
+            catalog: &self.catalog,
+            strategies: &self.strategies,
+            strategy_names: self
+                .strategies
+                .iter()
+                .map(|s| (s.file, name_of(s.file)))
+                .collect(),
+            links: &self.strategy_links,
+            diagnostics: &self.diagnostics,
+        })
     }
 }
 

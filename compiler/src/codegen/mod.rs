@@ -256,26 +256,33 @@ impl BuildResult {
     }
 }
 
-/// Generates the code of the mission `mission` of a checked workspace: every
-/// error of the check (in the mission, the catalog or the strategies)
-/// refuses generation, as do problems found while refining.
-pub fn build(
-    run: &crate::workspace::CheckRun,
-    mission: crate::diag::FileId,
-    target: Target,
-    emit: Emit,
-) -> BuildResult {
+/// What a mission is built from: its analysis, the catalog and the strategy
+/// files it sees (as the workspace analysis decided), and every diagnostic of
+/// those files, since any error among them refuses generation.
+pub struct BuildInput<'a> {
+    pub mission: crate::diag::FileId,
+    /// The mission's file name, written into generated headers.
+    pub mission_name: String,
+    pub text: &'a str,
+    pub analysis: &'a crate::sema::Analysis,
+    pub catalog: &'a crate::catalog::Catalog,
+    pub strategies: &'a [crate::strategy::Strategy],
+    /// Each strategy file's name, for generated headers.
+    pub strategy_names: Vec<(crate::diag::FileId, String)>,
+    pub links: &'a crate::strategy::StrategyLinks,
+    /// The diagnostics of the mission, the catalog and the strategies.
+    pub diagnostics: &'a [crate::diag::Diagnostic],
+}
+
+/// Generates the code of a mission: every error of the check (in the
+/// mission, the catalog or the strategies) refuses generation, as do problems
+/// found while refining.
+pub fn build(build: &BuildInput<'_>, target: Target, emit: Emit) -> BuildResult {
     let Refined {
         programs,
         diagnostics,
         sources,
-    } = refine_checked(run, mission);
-    if programs.is_empty() {
-        return BuildResult {
-            robots: Vec::new(),
-            diagnostics,
-        };
-    }
+    } = refine_checked(build);
     let robots = programs
         .iter()
         .map(|p| generate(p, target, emit, &sources))
@@ -286,8 +293,8 @@ pub fn build(
     }
 }
 
-/// A checked mission's refined programs, as code generation and the
-/// simulator (`sim`) read them.
+/// A mission's refined programs, as code generation and the simulator
+/// (`sim`) read them.
 pub struct Refined {
     /// One per robot, in formation order; empty when refused.
     pub programs: Vec<crate::refine::RobotProgram>,
@@ -297,46 +304,31 @@ pub struct Refined {
     pub sources: Vec<String>,
 }
 
-/// Refines the mission `mission` of a checked workspace: every error of the
-/// check (mission, catalog, strategies) refuses, as do problems found while
-/// refining and names that cannot be files or C identifiers (E101).
-pub fn refine_checked(run: &crate::workspace::CheckRun, mission: crate::diag::FileId) -> Refined {
+/// Refines a mission: every error of the check (mission, catalog,
+/// strategies) refuses, as do problems found while refining and names that
+/// cannot be files or C identifiers (E101).
+pub fn refine_checked(build: &BuildInput<'_>) -> Refined {
     use crate::diag::{Code, Diagnostic};
-    let mut diagnostics: Vec<Diagnostic> = run.diagnostics.clone();
+    let mut diagnostics: Vec<Diagnostic> = build.diagnostics.to_vec();
     let refused = |diagnostics| Refined {
         programs: Vec::new(),
         diagnostics,
         sources: Vec::new(),
     };
-    let Some((_, analysis)) = run.analyses.iter().find(|(id, _)| *id == mission) else {
-        return refused(diagnostics);
-    };
     if diagnostics.iter().any(Diagnostic::is_error) {
         return refused(diagnostics);
     }
-    let file = run.files.get(mission);
-    let name_of = |id: crate::diag::FileId| {
-        let path = &run.files.get(id).path;
-        path.file_name().map_or_else(
-            || path.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        )
-    };
-    let strategy_names: Vec<_> = run
-        .strategies
-        .iter()
-        .map(|s| (s.file, name_of(s.file)))
-        .collect();
-    let mission_name = name_of(mission);
+    let (mission, analysis) = (build.mission, build.analysis);
+    let (mission_name, strategy_names) = (&build.mission_name, &build.strategy_names);
     let input = crate::refine::RefineInput {
-        mission_name: &mission_name,
+        mission_name,
         file: mission,
-        text: &file.text,
+        text: build.text,
         analysis,
-        catalog: &run.catalog,
-        strategies: &run.strategies,
-        strategy_names: &strategy_names,
-        links: &run.strategy_links,
+        catalog: build.catalog,
+        strategies: build.strategies,
+        strategy_names,
+        links: build.links,
     };
     let (programs, found) = crate::refine::refine(&input);
     diagnostics.extend(found);

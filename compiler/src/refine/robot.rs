@@ -506,7 +506,7 @@ impl Builder<'_, '_> {
         marks: &mut usize,
         depth: usize,
     ) {
-        let symbols = crate::ide::lookup::with_span(&self.input.analysis.mission, call.name.span);
+        let symbols = crate::sema::lookup::with_span(&self.input.analysis.mission, call.name.span);
         let timeout_ms = call.timeout.as_ref().and_then(period_ms);
         let args: Vec<Operand> = call.args.iter().map(|a| self.arg(a)).collect();
         if let Some(function) = symbols.iter().find_map(|o| match o.symbol {
@@ -787,7 +787,8 @@ impl Builder<'_, '_> {
     /// What an attribute in an expression reads: a sensor, a shared value or
     /// a constant.
     fn attr_operand(&mut self, attr: &ast::Attr) -> Operand {
-        let symbols = crate::ide::lookup::with_span(&self.input.analysis.mission, attr.last().span);
+        let symbols =
+            crate::sema::lookup::with_span(&self.input.analysis.mission, attr.last().span);
         let symbol = symbols.first().map(|o| o.symbol.clone());
         match symbol {
             Some(Symbol::Value {
@@ -817,7 +818,8 @@ impl Builder<'_, '_> {
 
     /// A value's catalog name for an alias (`USER.cmd` → `RC_CMD`).
     fn canonical_value_name(&self, attr: &ast::Attr, name: &str) -> String {
-        let symbols = crate::ide::lookup::with_span(&self.input.analysis.mission, attr.last().span);
+        let symbols =
+            crate::sema::lookup::with_span(&self.input.analysis.mission, attr.last().span);
         symbols
             .iter()
             .find_map(|o| match &o.symbol {

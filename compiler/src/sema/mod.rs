@@ -10,13 +10,16 @@
 //!    reachability, uncaught events, unused services and functions.
 //! 4. [`comm`]: every receive/subscribe matched with a send/publish, and back.
 //!
-//! Sema never reads files and never panics.
+//! Sema never reads files and never panics. [`lookup`] answers "which
+//! symbols are written here" by binary search in the IR's sorted occurrences,
+//! for the editor and for refinement alike.
 
 mod behaviour;
 mod body;
 mod comm;
 mod declare;
 pub mod ir;
+pub(crate) mod lookup;
 
 pub use ir::*;
 

@@ -13,7 +13,8 @@ fn repo(path: &str) -> std::path::PathBuf {
 fn programs(mission: &str) -> Vec<RobotProgram> {
     let (files, id) = crate::workspace::load_build(&repo(mission), &[]).unwrap();
     let run = crate::workspace::check_files(files);
-    let refined = crate::codegen::refine_checked(&run, id);
+    let input = run.build_input(id).expect("the mission was checked");
+    let refined = crate::codegen::refine_checked(&input);
     assert!(!refined.programs.is_empty(), "{:#?}", refined.diagnostics);
     refined.programs
 }
