@@ -5,8 +5,9 @@
 //! against every `crate::` path. From the bottom: positions and diagnostics
 //! ([`span`], [`text`], [`diag`], [`edit`]); the languages ([`syntax`],
 //! [`format`], [`catalog`], [`sema`], [`taskgraph`], [`strategy`]); what is
-//! made of them ([`modemachine`], [`ide`], [`refine`], [`codegen`]); and
-//! [`workspace`], which reads files from disk.
+//! made of them ([`modemachine`], [`ide`], [`refine`], [`codegen`]);
+//! [`workspace`], which reads files from disk; and [`sim`], the simulator
+//! running the refined programs of a mission on a scenario.
 //!
 //! The `semo` command (rendering with ariadne or JSON) is the `semo-cli` crate
 //! (`cli/`), above this library and the language server.
@@ -24,6 +25,7 @@ mod layout;
 pub mod modemachine;
 pub mod refine;
 pub mod sema;
+pub mod sim;
 pub mod span;
 pub mod strategy;
 pub mod suggest;
