@@ -6,6 +6,7 @@ mod build;
 mod fmt;
 mod graph;
 mod render;
+mod simulate;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::io::{IsTerminal, Write};
@@ -104,6 +105,46 @@ enum Command {
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
     },
+    /// Run every robot of a mission together in virtual time on a scenario,
+    /// and check the scenario's expectations.
+    #[command(
+        long_about = "Run every robot of a mission together in virtual time, in milliseconds of \
+        wall time: the refined programs `semo build` turns into C, on a scenario file \
+        (timed sensor values, service durations, operator commands, network, faults and \
+        expectations; see docs/scenario-and-trace.md). Prints each robot's modes and every \
+        expectation; --trace writes the trace (JSON lines, as linux-sim programs write it), \
+        --svg the timeline.\n\n\
+        Exit status: 0 when every expectation holds, 1 when one fails, 2 for bad input \
+        (mission errors, a bad scenario, options)."
+    )]
+    Simulate {
+        /// The mission script.
+        mission: PathBuf,
+        /// The scenario file (`*.scenario.json`).
+        #[arg(long)]
+        scenario: PathBuf,
+        /// More strategy (and catalog) files or folders to read.
+        #[arg(long)]
+        strategy: Vec<PathBuf>,
+        /// How much mission time to run: `10min`, `90s`, `500ms`, `1h` (default:
+        /// the scenario's duration, else 10min or until every robot finished).
+        #[arg(long, value_parser = simulate::parse_duration)]
+        until: Option<i64>,
+        /// Seeds the message losses; the same seed gives the same run.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// `text` (modes per robot, expectations) or `json` (one object).
+        #[arg(long, value_enum, default_value_t = SummaryFormat::Text)]
+        format: SummaryFormat,
+        /// Write the timeline picture (SVG) to this file (`-`: standard output).
+        #[arg(long, value_name = "OUT")]
+        svg: Option<PathBuf>,
+        /// Write the trace (JSON lines) to this file (`-`: standard output).
+        #[arg(long, value_name = "FILE")]
+        trace: Option<PathBuf>,
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
+    },
     /// Analyse task graphs (`*.taskgraph.xml` or SDF3 files).
     #[command(subcommand)]
     Graph(GraphCommand),
@@ -180,6 +221,12 @@ enum Format {
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+enum SummaryFormat {
+    Text,
+    Json,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
 enum ColorChoice {
     Auto,
     Always,
@@ -251,6 +298,30 @@ fn run() -> i32 {
                     EmitArg::All => semo::codegen::Emit::All,
                     EmitArg::Taskgraph => semo::codegen::Emit::TaskGraph,
                 },
+                color: use_color(color),
+            },
+            &mut out,
+        ),
+        Command::Simulate {
+            mission,
+            scenario,
+            strategy,
+            until,
+            seed,
+            format,
+            svg,
+            trace,
+            color,
+        } => simulate::run(
+            simulate::Options {
+                mission,
+                scenario,
+                strategy,
+                until_ms: until,
+                seed,
+                json: format == SummaryFormat::Json,
+                svg,
+                trace,
                 color: use_color(color),
             },
             &mut out,

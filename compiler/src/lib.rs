@@ -6,8 +6,10 @@
 //! ([`span`], [`text`], [`diag`], [`edit`]); the languages ([`syntax`],
 //! [`format`], [`catalog`], [`sema`], [`taskgraph`], [`strategy`]); what is
 //! made of them ([`modemachine`], [`ide`], [`refine`], [`codegen`]);
-//! [`workspace`], which reads files from disk; and on top [`host`], the one
-//! workspace analysis the command line and the language server both ask.
+//! [`sim`], the simulator running the refined programs of a mission on a
+//! scenario; [`workspace`], which reads files from disk; and on top
+//! [`host`], the one workspace analysis the command line and the language
+//! server both ask.
 //!
 //! The `semo` command (rendering with ariadne or JSON) is the `semo-cli` crate
 //! (`cli/`), above this library and the language server.
@@ -26,6 +28,7 @@ mod layout;
 pub mod modemachine;
 pub mod refine;
 pub mod sema;
+pub mod sim;
 pub mod span;
 pub mod strategy;
 pub mod suggest;

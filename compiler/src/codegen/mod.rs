@@ -13,7 +13,7 @@
 
 mod c;
 mod control;
-mod files;
+pub(crate) mod files;
 pub mod output;
 
 use crate::refine::{RobotProgram, RoleKind};
@@ -278,13 +278,45 @@ pub struct BuildInput<'a> {
 /// mission, the catalog or the strategies) refuses generation, as do problems
 /// found while refining.
 pub fn build(build: &BuildInput<'_>, target: Target, emit: Emit) -> BuildResult {
+    let Refined {
+        programs,
+        diagnostics,
+        sources,
+    } = refine_checked(build);
+    let robots = programs
+        .iter()
+        .map(|p| generate(p, target, emit, &sources))
+        .collect();
+    BuildResult {
+        robots,
+        diagnostics,
+    }
+}
+
+/// A mission's refined programs, as code generation and the simulator
+/// (`sim`) read them.
+pub struct Refined {
+    /// One per robot, in formation order; empty when refused.
+    pub programs: Vec<crate::refine::RobotProgram>,
+    /// The check's diagnostics and refinement's; any error refuses.
+    pub diagnostics: Vec<crate::diag::Diagnostic>,
+    /// The mission's and the strategy files' names (file headers).
+    pub sources: Vec<String>,
+}
+
+/// Refines a mission: every error of the check (mission, catalog,
+/// strategies) refuses, as do problems found while refining and names that
+/// cannot be files or C identifiers (E101).
+pub fn refine_checked(build: &BuildInput<'_>) -> Refined {
     use crate::diag::{Code, Diagnostic};
     let mut diagnostics: Vec<Diagnostic> = build.diagnostics.to_vec();
+    let refused = |diagnostics| Refined {
+        programs: Vec::new(),
+        diagnostics,
+        sources: Vec::new(),
+    };
     if diagnostics.iter().any(Diagnostic::is_error) {
-        return BuildResult {
-            robots: Vec::new(),
-            diagnostics,
-        };
+        return refused(diagnostics);
     }
     let (mission, analysis) = (build.mission, build.analysis);
     let (mission_name, strategy_names) = (&build.mission_name, &build.strategy_names);
@@ -350,19 +382,13 @@ pub fn build(build: &BuildInput<'_>, target: Target, emit: Emit) -> BuildResult 
     }
     crate::diag::sort_and_dedup(&mut diagnostics);
     if diagnostics.iter().any(Diagnostic::is_error) {
-        return BuildResult {
-            robots: Vec::new(),
-            diagnostics,
-        };
+        return refused(diagnostics);
     }
     let mut sources = vec![mission_name.clone()];
     sources.extend(strategy_names.iter().map(|(_, n)| n.clone()));
-    let robots = programs
-        .iter()
-        .map(|p| generate(p, target, emit, &sources))
-        .collect();
-    BuildResult {
-        robots,
+    Refined {
+        programs,
         diagnostics,
+        sources,
     }
 }

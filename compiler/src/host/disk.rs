@@ -55,7 +55,9 @@ struct Loader {
 
 impl Loader {
     fn add(&mut self, path: &Path, kind: FileKind) -> Result<FileId, LoadError> {
-        let key = absolute(path);
+        // A file reached two ways (`--strategy DIR` inside the mission's
+        // folder, a link) is loaded once.
+        let key = std::fs::canonicalize(path).unwrap_or_else(|_| absolute(path));
         if let Some(&id) = self.by_path.get(&key) {
             return Ok(id);
         }
