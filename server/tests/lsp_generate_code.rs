@@ -236,3 +236,50 @@ async fn bad_arguments_are_errors_not_crashes() {
     assert!(client.server_is_running());
     client.shutdown().await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_refined_graph_that_fails_its_own_check_is_refused_naming_robot_and_cause() {
+    // tests/fixtures/build/E102_refined_graph_fails: a catalog value named
+    // like a generated port; the mission checks clean, its refined graph
+    // does not.
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures/build/E102_refined_graph_fails");
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("lsp_generate")
+        .join("refined-graph-fails");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for file in ["clash.mission", "robots.robot.xml"] {
+        std::fs::copy(fixture.join(file), dir.join(file)).unwrap();
+    }
+    let mut client = semo_server::harness::TestClient::start();
+    client.initialize_with(json!({}), Some(&uri(&dir))).await;
+    let mission = dir.join("clash.mission");
+    let mission_uri = uri(&mission);
+    client
+        .open(&mission_uri, &std::fs::read_to_string(&mission).unwrap())
+        .await;
+    client.diagnostics(&mission_uri, Some(1)).await;
+    let result = client
+        .request(
+            "workspace/executeCommand",
+            json!({ "command": "semo.generateCode", "arguments": [mission_uri] }),
+        )
+        .await
+        .unwrap();
+    assert_eq!(result["refused"], true, "{result}");
+    let reasons: Vec<&str> = result["errors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|r| r.as_str())
+        .collect();
+    assert!(
+        reasons
+            .iter()
+            .any(|r| r.contains("robot `bot`") && r.contains("E063")),
+        "{result}"
+    );
+    assert!(!dir.join("out").exists(), "nothing written");
+    client.shutdown().await;
+}

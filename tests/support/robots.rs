@@ -105,8 +105,11 @@ pub fn run_in_simulation(
     let scenario_path = out.join("scenario.json");
     std::fs::write(&scenario_path, scenario).unwrap();
     // Each run gets its own ports (below the ephemeral range), so runs in
-    // parallel do not hear each other.
-    let port_base = 24000 + (std::process::id() % 200) * 40 + (hash(out) % 8) * 5;
+    // parallel do not hear each other: a block of 40 per test process, 4 per
+    // run in it (no mission run here has more robots).
+    static RUNS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed) % 10;
+    let port_base = 24000 + (std::process::id() % 200) * 40 + run * 4;
     let mut children = Vec::new();
     for folder in folders {
         let robot = folder.file_name().unwrap().to_string_lossy().into_owned();
@@ -133,12 +136,6 @@ pub fn run_in_simulation(
         traces.insert(robot, text.lines().map(str::to_string).collect());
     }
     traces
-}
-
-fn hash(path: &Path) -> u32 {
-    path.to_string_lossy()
-        .bytes()
-        .fold(0u32, |h, b| h.wrapping_mul(31).wrapping_add(b as u32))
 }
 
 /// A trace's lines as JSON objects.
