@@ -255,9 +255,13 @@ pub fn load_build(mission: &Path, strategy: &[PathBuf]) -> Result<(Files, FileId
         .to_path_buf();
     let mut roots = vec![folder];
     roots.extend(strategy.iter().cloned());
+    // A file reached from two roots (`--strategy DIR` inside the mission's
+    // folder: `DIR/x` and `./DIR/x`) is read once: files are known by their
+    // canonical path.
     let mut seen = std::collections::BTreeSet::new();
     for (path, kind) in collect(&roots)? {
-        if matches!(kind, FileKind::Catalog | FileKind::Strategy) && seen.insert(path.clone()) {
+        let canonical = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
+        if matches!(kind, FileKind::Catalog | FileKind::Strategy) && seen.insert(canonical) {
             let text = load_text(&path)?;
             files.add(path, kind, text);
         }
