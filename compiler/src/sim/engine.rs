@@ -569,7 +569,15 @@ impl<'p> Sim<'p> {
             Expr::Bool(b) => *b,
             Expr::Truthy(o) => truthy(self.value_ref(r, o)),
             Expr::Compare(a, op, b) => {
-                let ord = compare(self.value_ref(r, a), self.value_ref(r, b));
+                let (a, b) = (self.value_ref(r, a), self.value_ref(r, b));
+                // Words are never ordered: an ordered comparison of a value
+                // that is not a number is false (`semo_value_numeric`).
+                if !matches!(op, CmpOp::Eq | CmpOp::Ne)
+                    && (number(a).is_none() || number(b).is_none())
+                {
+                    return false;
+                }
+                let ord = compare(a, b);
                 use std::cmp::Ordering::*;
                 match op {
                     CmpOp::Eq => ord == Equal,
@@ -1070,6 +1078,10 @@ impl<'p> Sim<'p> {
                         }
                         None => value,
                     };
+                    if let Some(group) = item.own_group {
+                        // Its own publication is the latest its subscription sees.
+                        self.robots[r].groups[group] = Some(sent.clone());
+                    }
                     let out = &m.outgoing[item.message];
                     self.comm_send(r, &out.to_team, out.publish, &out.key, sent);
                 }
