@@ -102,6 +102,21 @@ impl Backend {
         Ok(self.snapshot(&params.uri)?.text.to_string())
     }
 
+    /// `semo.simulate`: the mission's robots run on a scenario; the summary,
+    /// the timeline SVG and the expectations, or the reason for refusing.
+    async fn simulate(&self, arguments: &[serde_json::Value]) -> Result<serde_json::Value> {
+        use handlers::simulate;
+        let params = simulate::params(arguments).map_err(Error::invalid_params)?;
+        let job = {
+            let world = self.state.world();
+            simulate::job(&world, params).map_err(handlers::request_failed)?
+        };
+        tokio::task::spawn_blocking(move || simulate::simulate(&job))
+            .await
+            .map_err(|_| Error::internal_error())?
+            .map_err(handlers::request_failed)
+    }
+
     /// `semo.generateCode`: generates the code of a mission, reporting each
     /// robot as `$/progress`; a refusal publishes its reasons as the mission's
     /// diagnostics and is shown to the user.
@@ -547,6 +562,7 @@ impl LanguageServer for Backend {
                 .generate_code(&p.arguments, p.work_done_progress_params.work_done_token)
                 .await
                 .map(Some),
+            handlers::simulate::COMMAND => self.simulate(&p.arguments).await.map(Some),
             other => Err(Error::invalid_params(format!("unknown command `{other}`"))),
         }
     }

@@ -690,8 +690,18 @@ fn emit_task(out: &mut String, program: &RobotProgram) {
         }
         None => out.push_str("    if (current_mode < 0) {\n        semo_trace(\"finish\", \"why\", \"no default mode\", NULL);\n        semo_stop_program();\n        return;\n    }\n"),
     }
+    // Messages written in the last firing go out before the program ends
+    // (the communication task would otherwise be stopped first).
+    let flush = if m.outgoing.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "        task_{}_go();\n",
+            c::ident(crate::refine::graph::COMM_SEND)
+        )
+    };
     let _ = writeln!(
         out,
-        "    bool running = false;\n    for (int i = 0; i < REGION_COUNT && pending_mode < 0; i++) {{\n        region *r = &regions[i];\n        if (r->service < 0 || r->done)\n            continue;\n        if (r->timeout_ms > 0 && semo_now_ms() - r->started > r->timeout_ms) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], \"why\", \"timeout\", NULL);\n            continue;\n        }}\n        int result = STEP_NEXT;\n        for (int n = 0; n < {STEPS_PER_FIRING} && result == STEP_NEXT && pending_mode < 0; n++)\n            result = step(r);\n        if (result == STEP_DONE) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], NULL);\n        }} else {{\n            running = true;\n        }}\n    }}\n    if (pending_mode >= 0) {{\n        int next = pending_mode;\n        leave_mode();\n        pending_mode = -1;\n        enter_mode(next);\n        return;\n    }}\n    if (!running) {{\n        semo_trace(\"finish\", \"mode\", mode_name[current_mode], NULL);\n        semo_stop_program();\n    }}\n}}\n\nvoid task_{name}_wrapup(void)\n{{\n}}"
+        "    bool running = false;\n    for (int i = 0; i < REGION_COUNT && pending_mode < 0; i++) {{\n        region *r = &regions[i];\n        if (r->service < 0 || r->done)\n            continue;\n        if (r->timeout_ms > 0 && semo_now_ms() - r->started > r->timeout_ms) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], \"why\", \"timeout\", NULL);\n            continue;\n        }}\n        int result = STEP_NEXT;\n        for (int n = 0; n < {STEPS_PER_FIRING} && result == STEP_NEXT && pending_mode < 0; n++)\n            result = step(r);\n        if (result == STEP_DONE) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], NULL);\n        }} else {{\n            running = true;\n        }}\n    }}\n    if (pending_mode >= 0) {{\n        int next = pending_mode;\n        leave_mode();\n        pending_mode = -1;\n        enter_mode(next);\n        return;\n    }}\n    if (!running) {{\n        semo_trace(\"finish\", \"mode\", mode_name[current_mode], NULL);\n{flush}        semo_stop_program();\n    }}\n}}\n\nvoid task_{name}_wrapup(void)\n{{\n}}"
     );
 }

@@ -29,6 +29,7 @@ use rand_core::{Rng, SeedableRng};
 use rand_xorshift::XorShiftRng;
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap, VecDeque};
+use std::rc::Rc;
 
 /// The sensor tasks' period (refinement's `SENSOR_PERIOD_MS`).
 const SENSOR_PERIOD_MS: i64 = 100;
@@ -74,7 +75,8 @@ enum Event {
     Deliver {
         to: usize,
         epoch: u32,
-        message: Message,
+        /// Shared by every robot the message goes to.
+        message: Rc<Message>,
     },
     ServiceDone {
         robot: usize,
@@ -143,7 +145,10 @@ struct Robot<'p> {
     epoch: u32,
     started_at: i64,
     slots: Vec<String>,
-    library: HashMap<String, String>,
+    /// The library task's values, one per shared key (`lib_<name>.c`).
+    library: Vec<String>,
+    /// Per slot: its value's place in `library` (shared slots only).
+    library_index: Vec<Option<usize>>,
     /// Per incoming message: the channel to the control task (capacity).
     inbox: Vec<(VecDeque<String>, usize)>,
     /// Per subscribed group: the latest value.
@@ -176,6 +181,9 @@ pub struct Sim<'p> {
     trace: Vec<TraceEvent>,
     /// Next occurrence of each operator command.
     operator_next: Vec<i64>,
+    /// The robots a message to a team or robot name goes to (`semo_comm_send`'s
+    /// peer loop, computed once).
+    recipients: HashMap<String, Rc<[usize]>>,
 }
 
 fn truncate(mut s: String) -> String {
@@ -263,13 +271,29 @@ impl<'p> Robot<'p> {
             .iter()
             .map(|i| (VecDeque::new(), channel_capacity(program, &i.port)))
             .collect();
+        // One value per shared key, as the library task holds them.
+        let mut library_keys: Vec<&str> = Vec::new();
+        for slot in &m.slots {
+            if slot.source == SlotSource::Shared && !library_keys.contains(&slot.key.as_str()) {
+                library_keys.push(&slot.key);
+            }
+        }
         Robot {
             program,
             alive: true,
             epoch,
             started_at: at,
             slots: vec![String::new(); m.slots.len()],
-            library: HashMap::new(),
+            library: vec![String::new(); library_keys.len()],
+            library_index: m
+                .slots
+                .iter()
+                .map(|s| {
+                    (s.source == SlotSource::Shared && program.library.is_some())
+                        .then(|| library_keys.iter().position(|k| *k == s.key))
+                        .flatten()
+                })
+                .collect(),
             inbox,
             groups: vec![None; m.subscribed.len()],
             regions: vec![
@@ -331,6 +355,7 @@ impl<'p> Sim<'p> {
             rng: XorShiftRng::seed_from_u64(seed),
             trace: Vec::new(),
             operator_next: scenario.operator.iter().map(|c| c.first).collect(),
+            recipients: recipients(programs),
         };
         for r in 0..programs.len() {
             sim.start(r);
@@ -445,7 +470,7 @@ impl<'p> Sim<'p> {
             }
             Event::Deliver { to, epoch, message } => {
                 if self.robots[to].alive && self.robots[to].epoch == epoch {
-                    self.deliver(to, message);
+                    self.deliver(to, &message);
                 }
             }
             Event::Operator(i) => self.operator(i),
@@ -467,7 +492,7 @@ impl<'p> Sim<'p> {
         for r in 0..self.robots.len() {
             let p = self.robots[r].program;
             if (p.robot == command.to || p.team == command.to) && self.robots[r].alive {
-                self.deliver(r, message.clone());
+                self.deliver(r, &message);
             }
         }
         if let Some(every) = command.every {
@@ -544,7 +569,15 @@ impl<'p> Sim<'p> {
             Expr::Bool(b) => *b,
             Expr::Truthy(o) => truthy(self.value_ref(r, o)),
             Expr::Compare(a, op, b) => {
-                let ord = compare(self.value_ref(r, a), self.value_ref(r, b));
+                let (a, b) = (self.value_ref(r, a), self.value_ref(r, b));
+                // Words are never ordered: an ordered comparison of a value
+                // that is not a number is false (`semo_value_numeric`).
+                if !matches!(op, CmpOp::Eq | CmpOp::Ne)
+                    && (number(a).is_none() || number(b).is_none())
+                {
+                    return false;
+                }
+                let ord = compare(a, b);
                 use std::cmp::Ordering::*;
                 match op {
                     CmpOp::Eq => ord == Equal,
@@ -561,11 +594,8 @@ impl<'p> Sim<'p> {
     /// `store`: the slot, and the library for shared information.
     fn store(&mut self, r: usize, slot: usize, value: String) {
         let robot = &mut self.robots[r];
-        let program = robot.program;
-        if program.control.slots[slot].source == SlotSource::Shared && program.library.is_some() {
-            robot
-                .library
-                .insert(program.control.slots[slot].key.clone(), value.clone());
+        if let Some(k) = robot.library_index[slot] {
+            robot.library[k].clone_from(&value);
         }
         robot.slots[slot] = value;
     }
@@ -597,11 +627,10 @@ impl<'p> Sim<'p> {
                     }
                 }
                 SlotSource::Shared => {
-                    if program.library.is_some() {
-                        let v = robot.library.get(&s.key).map_or("", String::as_str);
-                        if robot.slots[i] != v {
-                            robot.slots[i] = v.to_string();
-                        }
+                    if let Some(k) = robot.library_index[i]
+                        && robot.slots[i] != robot.library[k]
+                    {
+                        robot.slots[i].clone_from(&robot.library[k]);
                     }
                 }
                 SlotSource::Local => {}
@@ -627,24 +656,24 @@ impl<'p> Sim<'p> {
             return;
         }
         let program = self.robots[r].program;
-        for (peer, (team, robot)) in program.peers.iter().enumerate() {
-            if peer == program.self_peer || (team != to && robot != to) {
+        let Some(targets) = self.recipients.get(to).cloned() else {
+            return;
+        };
+        let message = Rc::new(Message {
+            publish,
+            from_team: program.team.clone(),
+            from_robot: program.robot.clone(),
+            from_peer: Some(program.self_peer),
+            key: key.to_string(),
+            value,
+            sent_at: self.now,
+        });
+        for &dst in targets.iter() {
+            if dst == r {
                 continue;
             }
-            let Some(dst) = self.index_of(robot) else {
-                continue;
-            };
             let Some(latency) = self.link(r, dst) else {
                 continue;
-            };
-            let message = Message {
-                publish,
-                from_team: program.team.clone(),
-                from_robot: program.robot.clone(),
-                from_peer: Some(program.self_peer),
-                key: key.to_string(),
-                value: value.clone(),
-                sent_at: self.now,
             };
             let epoch = self.robots[dst].epoch;
             self.schedule(
@@ -652,7 +681,7 @@ impl<'p> Sim<'p> {
                 Event::Deliver {
                     to: dst,
                     epoch,
-                    message,
+                    message: message.clone(),
                 },
             );
         }
@@ -706,7 +735,7 @@ impl<'p> Sim<'p> {
 
     /// The receive task: traced, then a heartbeat, a published value for a
     /// group, or a sample for the control task's port.
-    fn deliver(&mut self, r: usize, message: Message) {
+    fn deliver(&mut self, r: usize, message: &Message) {
         if !self.robots[r].has_receiver {
             return; // no receive task reads the inbox
         }
@@ -1049,6 +1078,10 @@ impl<'p> Sim<'p> {
                         }
                         None => value,
                     };
+                    if let Some(group) = item.own_group {
+                        // Its own publication is the latest its subscription sees.
+                        self.robots[r].groups[group] = Some(sent.clone());
+                    }
                     let out = &m.outgoing[item.message];
                     self.comm_send(r, &out.to_team, out.publish, &out.key, sent);
                 }
@@ -1270,6 +1303,19 @@ impl<'p> Sim<'p> {
         }
         leader == me
     }
+}
+
+/// For every team and robot name, the robots (program indices) a message
+/// to that name goes to: the robots of the team, or the robot itself.
+fn recipients(programs: &[RobotProgram]) -> HashMap<String, Rc<[usize]>> {
+    let mut map: HashMap<String, Vec<usize>> = HashMap::new();
+    for (i, p) in programs.iter().enumerate() {
+        map.entry(p.team.clone()).or_default().push(i);
+        if p.robot != p.team {
+            map.entry(p.robot.clone()).or_default().push(i);
+        }
+    }
+    map.into_iter().map(|(k, v)| (k, v.into())).collect()
 }
 
 /// The actuator command name a task runs (`control.rs`'s `actuator_name`).

@@ -19,6 +19,7 @@ pub mod rename;
 pub mod selection_range;
 pub mod semantic_tokens;
 pub mod signature_help;
+pub mod simulate;
 pub mod strategy;
 pub mod taskgraph;
 pub mod workspace_symbol;
@@ -87,7 +88,10 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
             resolve_provider: Some(false),
         }),
         execute_command_provider: Some(ExecuteCommandOptions {
-            commands: vec![generate_code::COMMAND.to_string()],
+            commands: vec![
+                generate_code::COMMAND.to_string(),
+                simulate::COMMAND.to_string(),
+            ],
             work_done_progress_options: WorkDoneProgressOptions {
                 work_done_progress: Some(true),
             },

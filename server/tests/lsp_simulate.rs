@@ -1,0 +1,127 @@
+//! "Simulate Mission" from the editor: `workspace/executeCommand`
+//! `semo.simulate {uri, scenario}` runs the library's simulator on the
+//! server's view of the mission (the open text, not the file on disk) and
+//! answers with the summary, the timeline SVG and each expectation with its
+//! place in the scenario file; a bad scenario is refused with its position.
+
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+
+fn repo(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(path)
+}
+
+fn workspace(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("lsp_simulate")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for file in ["scouting.mission", "MasterTeam.strategy.xml"] {
+        std::fs::copy(repo(&format!("examples/scouting/{file}")), dir.join(file)).unwrap();
+    }
+    std::fs::copy(
+        repo("tests/fixtures/build/scouting.scenario.json"),
+        dir.join("scouting.scenario.json"),
+    )
+    .unwrap();
+    dir
+}
+
+fn uri(path: &Path) -> String {
+    format!("file://{}", path.display())
+}
+
+async fn simulate(
+    client: &mut semo_server::harness::TestClient,
+    mission: &str,
+    scenario: &str,
+) -> Result<Value, String> {
+    client
+        .request(
+            "workspace/executeCommand",
+            json!({"command": "semo.simulate", "arguments": [{"uri": mission, "scenario": scenario}]}),
+        )
+        .await
+        .map_err(|e| e["message"].as_str().unwrap_or_default().to_string())
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_open_mission_is_simulated_with_its_scenario() {
+    let dir = workspace("run");
+    let mut client = semo_server::harness::TestClient::start();
+    client.initialize_with(json!({}), Some(&uri(&dir))).await;
+    let mission = dir.join("scouting.mission");
+    let mission_uri = uri(&mission);
+    let text = std::fs::read_to_string(&mission).unwrap();
+    client.open(&mission_uri, &text).await;
+    client.diagnostics(&mission_uri, Some(1)).await;
+
+    let answer = simulate(&mut client, &mission_uri, "scouting.scenario.json")
+        .await
+        .unwrap();
+    assert_eq!(answer["ok"], true, "{}", answer["summary"]);
+    assert!(
+        answer["summary"]
+            .as_str()
+            .unwrap()
+            .contains("MasterTeam/irobot: AUTO_MODE@0 -> WAIT_MODE@1050")
+    );
+    assert!(answer["svg"].as_str().unwrap().starts_with("<svg"));
+    let scenario_text = std::fs::read_to_string(dir.join("scouting.scenario.json")).unwrap();
+    let first = &answer["expectations"][0];
+    let line = first["range"]["start"]["line"].as_u64().unwrap() as usize;
+    assert!(
+        scenario_text
+            .lines()
+            .nth(line)
+            .unwrap()
+            .contains("\"enters\": \"WAIT_MODE\""),
+        "{first}"
+    );
+
+    // The open text counts: when AUTO_MODE's CHANGE_WAIT_MODE leads to
+    // RETURN_MODE instead, the master never waits and the expectation fails.
+    let edited = text.replacen(
+        "catch (CHANGE_WAIT_MODE): mode = WAIT_MODE",
+        "catch (CHANGE_WAIT_MODE): mode = RETURN_MODE",
+        1,
+    );
+    assert_ne!(edited, text);
+    client
+        .notify(
+            "textDocument/didChange",
+            json!({
+                "textDocument": {"uri": mission_uri, "version": 2},
+                "contentChanges": [{"text": edited}],
+            }),
+        )
+        .await;
+    let answer = simulate(
+        &mut client,
+        &mission_uri,
+        &uri(&dir.join("scouting.scenario.json")),
+    )
+    .await
+    .unwrap();
+    assert_eq!(answer["ok"], false);
+    assert_eq!(answer["expectations"][0]["met"], false);
+    assert_eq!(answer["expectations"][0]["why"], "never entered");
+
+    // A bad scenario: refused with its line and column.
+    std::fs::write(
+        dir.join("bad.scenario.json"),
+        "{\n  \"duration\": \"soon\"\n}\n",
+    )
+    .unwrap();
+    let refused = simulate(&mut client, &mission_uri, "bad.scenario.json")
+        .await
+        .unwrap_err();
+    assert!(
+        refused.contains(
+            "bad.scenario.json:2:15: \"duration\" must be a whole number of milliseconds"
+        ),
+        "{refused}"
+    );
+    client.shutdown().await;
+}
