@@ -1,7 +1,7 @@
 //! `workspace/executeCommand` `semo.simulate`: the mission's robots run on a
 //! scenario by the library's simulator (`semo::sim`, the same call as
 //! `semo simulate`), over the server's view of the workspace (open documents
-//! as typed, other files from disk, gathered as `semo.generateCode` does).
+//! as typed, other files from disk: the workspace analysis `semo.generateCode` reads).
 //!
 //! Arguments: one object `{ "uri": mission, "scenario": path or file URI
 //! (relative paths from the mission's folder), "untilMs"?: mission ms,
@@ -40,7 +40,8 @@ pub fn params(arguments: &[Value]) -> Result<SimulateParams, String> {
 
 /// What one simulation works on, taken from the world at once.
 pub struct Job {
-    files: semo::workspace::Files,
+    /// The workspace as it was when the command came (open documents as typed).
+    analysis: semo::host::Analysis,
     mission: semo::diag::FileId,
     scenario: PathBuf,
     until_ms: Option<i64>,
@@ -70,7 +71,7 @@ pub fn job(world: &World, params: SimulateParams) -> Result<Job, String> {
         _ => folder.join(&params.scenario),
     };
     Ok(Job {
-        files: generate.files,
+        analysis: generate.analysis,
         mission: generate.mission,
         scenario,
         until_ms: params.until_ms,
@@ -82,11 +83,11 @@ pub fn job(world: &World, params: SimulateParams) -> Result<Job, String> {
 pub fn simulate(job: &Job) -> Result<Value, String> {
     let text = semo::workspace::read_text(&job.scenario)
         .map_err(|e| format!("{}: {e}", job.scenario.display()))?;
-    let run = semo::workspace::check_files(job.files.clone());
-    let input = run
+    let build = job
+        .analysis
         .build_input(job.mission)
-        .ok_or("internal error: the mission was loaded but not checked")?;
-    let refined = semo::codegen::refine_checked(&input);
+        .ok_or("internal error: the mission is not in the workspace analysis")?;
+    let refined = semo::codegen::refine_checked(&build.input());
     let errors = refined.diagnostics.iter().filter(|d| d.is_error()).count();
     if errors > 0 {
         return Err(format!(
