@@ -202,5 +202,8 @@ fn compile_robot(job: &Job<'_>, runtime: &[PathBuf]) -> Result<(), String> {
     args.extend(task_objects);
     args.extend(runtime.iter().map(|o| o.display().to_string()));
     args.extend(["-lpthread".into(), "-lm".into()]);
-    cc(job.compiler, &args, &job.folder)
+    cc(job.compiler, &args, &job.folder)?;
+    // Thousands of robots: keep only what a failure needs to be looked at.
+    let _ = std::fs::remove_dir_all(&objects_dir);
+    Ok(())
 }
