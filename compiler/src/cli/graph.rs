@@ -4,7 +4,9 @@
 
 use super::render;
 use crate::diag::Diagnostic;
-use crate::workspace::{DiskResolver, FileKind, Files, analyze_graph};
+use crate::workspace::{
+    DiskResolver, FileKind, Files, GraphReading, analyze_graph, analyze_graph_as,
+};
 use std::io::Write;
 use std::path::Path;
 
@@ -132,11 +134,24 @@ fn write_picture(picture: &str, output: Option<&Path>, out: &mut impl Write) -> 
     }
 }
 
-pub fn analyze(path: &Path, json: bool, color: bool, out: &mut impl Write) -> i32 {
+pub fn analyze(
+    path: &Path,
+    reading: GraphReading,
+    json: bool,
+    color: bool,
+    out: &mut impl Write,
+) -> i32 {
     let Some(text) = read(path) else { return 2 };
     let mut files = Files::default();
     let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
-    let run = analyze_graph(files.get(id), &mut DiskResolver::new(&files));
+    let file = files.get(id);
+    let run = analyze_graph_as(
+        id,
+        &file.text,
+        Some(&file.path),
+        &mut DiskResolver::new(&files),
+        reading,
+    );
     let written = if json {
         write_json(&files, &run, out)
     } else {
@@ -162,6 +177,17 @@ fn write_human(
     out: &mut impl Write,
 ) -> std::io::Result<()> {
     render::diagnostics(files, &run.diagnostics, color, out)?;
+    if !run.report.levels.is_empty() {
+        let meaning = match run.report.concurrency {
+            crate::taskgraph::analysis::Concurrency::Auto => {
+                "auto (a task fires concurrently with itself unless a self-loop channel limits it)"
+            }
+            crate::taskgraph::analysis::Concurrency::Single => {
+                "single (one firing of a task at a time)"
+            }
+        };
+        writeln!(out, "concurrency: {meaning}")?;
+    }
     for level in &run.report.levels {
         let state = match (&level.repetition, level.deadlock_free) {
             (None, _) => "inconsistent".to_string(),
@@ -189,10 +215,11 @@ fn write_human(
         }
         if let Some(t) = &level.throughput {
             let cycle = match t.critical_cycle.as_slice() {
-                [one] => format!("{one} alone"),
-                many => format!("{} → {}", many.join(" → "), many[0]),
+                [] => "no cycle: unbounded throughput".to_string(),
+                [one] => format!("bounded by {one} alone"),
+                many => format!("bounded by {} → {}", many.join(" → "), many[0]),
             };
-            writeln!(out, "  iteration period: {} (bounded by {cycle})", t.period)?;
+            writeln!(out, "  iteration period: {} ({cycle})", t.period)?;
         }
         if !level.buffers.is_empty() {
             let bounds: Vec<String> = level
@@ -256,6 +283,7 @@ fn write_json(
         .collect();
     let value = serde_json::json!({
         "graph": run.graph.as_ref().map(|g| g.name.clone()),
+        "concurrency": run.report.concurrency.as_str(),
         "looped_schedule": run.report.looped_schedule,
         "levels": levels,
         "diagnostics": diagnostics,

@@ -132,6 +132,8 @@ enum GraphCommand {
         format: Format,
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
+        #[command(flatten)]
+        reading: ReadingArgs,
     },
     /// A static schedule: the looped single-appearance schedule of the whole
     /// graph (`A 10(B C) D`), and with `--cores N` each level's iteration
@@ -171,6 +173,47 @@ enum GraphCommand {
         #[arg(short, long, value_name = "FILE")]
         output: Option<PathBuf>,
     },
+}
+
+/// How an analysed graph file is read: its concurrency and, for SDF3 files,
+/// which execution time an actor has.
+#[derive(clap::Args, Debug, Clone, Copy)]
+struct ReadingArgs {
+    /// Whether a task fires concurrently with itself: `auto` (SDF3's
+    /// meaning: as often as its input samples allow, unless a self-loop
+    /// channel limits it) or `single` (one firing at a time, as the generated
+    /// code runs a task). Default: `auto` for SDF3 files, `single` for
+    /// `*.taskgraph.xml`.
+    #[arg(long, value_enum)]
+    concurrency: Option<ConcurrencyArg>,
+    /// Read SDF3 execution times as SDF3's own loader does (the last
+    /// `<processor>` with a `default` attribute, whatever its value) instead
+    /// of the one marked `default="true"`.
+    #[arg(long)]
+    sdf3_compat: bool,
+}
+
+impl ReadingArgs {
+    fn reading(self) -> crate::workspace::GraphReading {
+        use crate::taskgraph::analysis::Concurrency;
+        crate::workspace::GraphReading {
+            concurrency: self.concurrency.map(|c| match c {
+                ConcurrencyArg::Auto => Concurrency::Auto,
+                ConcurrencyArg::Single => Concurrency::Single,
+            }),
+            times: if self.sdf3_compat {
+                crate::taskgraph::ExecutionTimes::Sdf3Compat
+            } else {
+                crate::taskgraph::ExecutionTimes::FileDefault
+            },
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+enum ConcurrencyArg {
+    Auto,
+    Single,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
@@ -220,7 +263,14 @@ pub fn main(lsp: fn() -> i32) -> i32 {
             file,
             format,
             color,
-        }) => graph::analyze(&file, format == Format::Json, use_color(color), &mut out),
+            reading,
+        }) => graph::analyze(
+            &file,
+            reading.reading(),
+            format == Format::Json,
+            use_color(color),
+            &mut out,
+        ),
         Command::Graph(GraphCommand::Dot { file }) => graph::dot(&file, &mut out),
         Command::Graph(GraphCommand::Svg { file, output }) => {
             graph::svg(&file, output.as_deref(), &mut out)
