@@ -575,3 +575,77 @@ fn modes_draws_each_team_or_one_and_reports_errors_and_unknown_teams() {
     let missing = semo_in(&dir, &["graph", "modes", "no_such.mission"]);
     assert_eq!(missing.code, 2);
 }
+
+/// `semo graph buffers`: SDF3's storage/throughput front on modem (its
+/// `sdf3analysis-sdf --algo buffersize`: 70 → 1/0.03125, 71 → 1/0.0555556,
+/// 72 → 1/0.0625), the channel sizes of a chosen point, and bounds where the
+/// minimum is not known exactly.
+#[test]
+fn buffers_give_the_trade_off_and_a_chosen_point() {
+    let out = semo_in(
+        &sdf3(),
+        &["graph", "buffers", "--format", "json", "modem.xml"],
+    );
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    assert_eq!(v["concurrency"], "auto");
+    assert_eq!(v["max_period"], "16");
+    assert_eq!(
+        v["points"],
+        serde_json::json!([
+            {"size": 70, "period": "32"},
+            {"size": 71, "period": "18"},
+            {"size": 72, "period": "16"}
+        ])
+    );
+    assert_eq!(
+        v["minimal_size"],
+        serde_json::json!({"lower_bound": 72, "found": 72, "exact": true})
+    );
+    let channels = v["chosen"]["channels"].as_object().unwrap();
+    let total: u64 = channels.values().map(|c| c.as_u64().unwrap()).sum();
+    assert_eq!(total, 72);
+
+    // A throughput of 1/18 chooses the point of size 71.
+    let out = semo_in(
+        &sdf3(),
+        &["graph", "buffers", "--throughput", "1/18", "modem.xml"],
+    );
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout
+            .contains("channel sizes for period at most 18 (71 → 18):"),
+        "{}",
+        out.stdout
+    );
+    // Where the search cannot tell the minimum exactly, it says so.
+    let out = semo_in(&sdf3(), &["graph", "buffers", "mp3playback.xml"]);
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout
+            .contains("smallest total size for the maximal throughput: between 2907 and 2918"),
+        "{}",
+        out.stdout
+    );
+    // A throughput no distribution reaches, and one that is not a number.
+    let out = semo_in(
+        &sdf3(),
+        &["graph", "buffers", "--throughput", "1", "modem.xml"],
+    );
+    assert_eq!(out.code, 1, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stderr.contains("no buffer distribution found reaches"),
+        "{}",
+        out.stderr
+    );
+    let out = semo_in(
+        &sdf3(),
+        &["graph", "buffers", "--throughput", "fast", "modem.xml"],
+    );
+    assert_eq!(out.code, 2);
+    assert!(
+        out.stderr.contains("`fast` is not a throughput"),
+        "{}",
+        out.stderr
+    );
+}

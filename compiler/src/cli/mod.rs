@@ -145,6 +145,24 @@ enum GraphCommand {
         #[arg(long)]
         cores: Option<usize>,
     },
+    /// The buffer/throughput trade-off of the graph's top level (SDF3's buffer
+    /// sizing model): Pareto points (total buffer size → iteration period),
+    /// the smallest total size reaching the maximal throughput (exact, or
+    /// between stated bounds), and the channel sizes of a chosen point.
+    Buffers {
+        /// A `*.taskgraph.xml` file or an SDF3 graph.
+        file: PathBuf,
+        /// The point whose channel sizes are listed: `max` (the maximal
+        /// throughput) or a throughput in iterations per time unit (`1/104`,
+        /// `0.0096`): the smallest point found reaching at least it.
+        #[arg(long, default_value = "max")]
+        throughput: String,
+        /// `human` or `json`.
+        #[arg(long, value_enum, default_value_t = Format::Human)]
+        format: Format,
+        #[command(flatten)]
+        reading: ReadingArgs,
+    },
     /// Print the graph in Graphviz DOT: tasks, loop nodes as clusters, rates
     /// and initial samples on channels (`semo graph dot g.taskgraph.xml | dot -Tsvg`).
     Dot {
@@ -281,6 +299,18 @@ pub fn main(lsp: fn() -> i32) -> i32 {
         Command::Graph(GraphCommand::Schedule { file, cores }) => {
             graph::schedule(&file, cores, &mut out)
         }
+        Command::Graph(GraphCommand::Buffers {
+            file,
+            throughput,
+            format,
+            reading,
+        }) => graph::buffers(
+            &file,
+            reading.reading(),
+            &throughput,
+            format == Format::Json,
+            &mut out,
+        ),
         Command::Build {
             mission,
             strategy,

@@ -11,6 +11,7 @@ pub mod ratio;
 pub mod rules;
 pub mod schedule;
 pub mod throughput;
+pub mod tradeoff;
 
 use crate::diag::{Code, Diagnostic};
 use crate::taskgraph::model::TaskGraph;
