@@ -7,6 +7,7 @@
 use crate::catalog::{
     BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE, Catalog, CatalogSource, load_catalog,
 };
+use crate::codegen::BuildInput;
 use crate::diag::{self, Diagnostic, FileId};
 use crate::sema::{Analysis, check_source};
 use crate::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
@@ -191,6 +192,35 @@ impl CheckRun {
     pub fn error_count(&self) -> usize {
         self.diagnostics.iter().filter(|d| d.is_error()).count()
     }
+
+    /// What `mission` is built from: its analysis with this run's catalog,
+    /// strategies and diagnostics. `None` when `mission` is not one of the
+    /// run's missions.
+    pub fn build_input(&self, mission: FileId) -> Option<BuildInput<'_>> {
+        let (_, analysis) = self.analyses.iter().find(|(id, _)| *id == mission)?;
+        let name_of = |id: FileId| {
+            let path = &self.files.get(id).path;
+            path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            )
+        };
+        Some(BuildInput {
+            mission,
+            mission_name: name_of(mission),
+            text: &self.files.get(mission).text,
+            analysis,
+            catalog: &self.catalog,
+            strategies: &self.strategies,
+            strategy_names: self
+                .strategies
+                .iter()
+                .map(|s| (s.file, name_of(s.file)))
+                .collect(),
+            links: &self.strategy_links,
+            diagnostics: &self.diagnostics,
+        })
+    }
 }
 
 /// A file's text. Invalid UTF-8 is replaced rather than refused, so the rest
@@ -207,6 +237,36 @@ pub fn load_text(path: &Path) -> Result<String, LoadError> {
         path: path.to_path_buf(),
         message: e.to_string(),
     })
+}
+
+/// The files a build reads: the mission, and the catalog and strategy files
+/// beside it (its folder, recursively) and under each `--strategy` path.
+pub fn load_build(mission: &Path, strategy: &[PathBuf]) -> Result<(Files, FileId), LoadError> {
+    let mut files = Files::default();
+    let id = files.add(
+        mission.to_path_buf(),
+        FileKind::Mission,
+        load_text(mission)?,
+    );
+    let folder = mission
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+        .to_path_buf();
+    let mut roots = vec![folder];
+    roots.extend(strategy.iter().cloned());
+    // A file reached from two roots (`--strategy DIR` inside the mission's
+    // folder: `DIR/x` and `./DIR/x`) is read once: files are known by their
+    // canonical path.
+    let mut seen = std::collections::BTreeSet::new();
+    for (path, kind) in collect(&roots)? {
+        let canonical = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
+        if matches!(kind, FileKind::Catalog | FileKind::Strategy) && seen.insert(canonical) {
+            let text = load_text(&path)?;
+            files.add(path, kind, text);
+        }
+    }
+    Ok((files, id))
 }
 
 /// Reads and checks the given files and folders.

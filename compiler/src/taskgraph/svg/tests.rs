@@ -409,7 +409,8 @@ fn load(path: &str) -> TaskGraph {
         .unwrap_or_else(|| panic!("{path} loads"))
 }
 
-/// The `*.xml` files of a folder of the repository.
+/// The `.xml` files of a folder of the repository (`examples/taskgraphs`,
+/// `tests/data/sdf3`).
 fn in_repository(dir: &str) -> Vec<String> {
     let dir = format!("{}/../{dir}", env!("CARGO_MANIFEST_DIR"));
     let mut paths: Vec<String> = std::fs::read_dir(&dir)

@@ -3,16 +3,16 @@
 //! and pictures of it; `semo graph modes`: a mission's mode machines.
 
 use super::render;
-use crate::diag::Diagnostic;
-use crate::taskgraph::analysis::ratio::Ratio;
-use crate::workspace::{
+use semo::diag::Diagnostic;
+use semo::taskgraph::analysis::ratio::Ratio;
+use semo::workspace::{
     DiskResolver, FileKind, Files, GraphReading, analyze_graph, analyze_graph_as,
 };
 use std::io::Write;
 use std::path::Path;
 
 fn read(path: &Path) -> Option<String> {
-    match crate::workspace::read_text(path) {
+    match semo::workspace::read_text(path) {
         Ok(text) => Some(text),
         Err(e) => {
             eprintln!("error: {}: {e}", path.display());
@@ -23,13 +23,13 @@ fn read(path: &Path) -> Option<String> {
 
 /// The graph in `path` when it loads without errors; otherwise the errors
 /// are printed and the exit code given.
-fn load_clean(path: &Path) -> Result<crate::taskgraph::TaskGraph, i32> {
+fn load_clean(path: &Path) -> Result<semo::taskgraph::TaskGraph, i32> {
     let Some(text) = read(path) else {
         return Err(2);
     };
     let mut files = Files::default();
     let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
-    let (graph, diagnostics) = crate::taskgraph::load_task_graph(id, &files.get(id).text);
+    let (graph, diagnostics) = semo::taskgraph::load_task_graph(id, &files.get(id).text);
     let errors: Vec<Diagnostic> = diagnostics
         .into_iter()
         .filter(Diagnostic::is_error)
@@ -47,7 +47,7 @@ fn load_clean(path: &Path) -> Result<crate::taskgraph::TaskGraph, i32> {
 pub fn dot(path: &Path, out: &mut impl Write) -> i32 {
     match load_clean(path) {
         Ok(g) => {
-            let _ = out.write_all(crate::taskgraph::dot::to_dot(&g).as_bytes());
+            let _ = out.write_all(semo::taskgraph::dot::to_dot(&g).as_bytes());
             0
         }
         Err(code) => code,
@@ -61,7 +61,7 @@ pub fn svg(path: &Path, output: Option<&Path>, out: &mut impl Write) -> i32 {
         Ok(g) => g,
         Err(code) => return code,
     };
-    write_picture(&crate::taskgraph::to_svg(&graph), output, out)
+    write_picture(&semo::taskgraph::to_svg(&graph), output, out)
 }
 
 /// `semo graph modes`: the mode machines of a mission (checked against the
@@ -77,18 +77,18 @@ pub fn modes(path: &Path, team: Option<&str>, output: Option<&Path>, out: &mut i
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let beside = crate::workspace::collect(&[folder.to_path_buf()]).unwrap_or_default();
+    let beside = semo::workspace::collect(&[folder.to_path_buf()]).unwrap_or_default();
     for (catalog, _) in beside.iter().filter(|(_, k)| *k == FileKind::Catalog) {
         if let Some(text) = read(catalog) {
             files.add(catalog.clone(), FileKind::Catalog, text);
         }
     }
     let id = files.add(path.to_path_buf(), FileKind::Mission, text);
-    let run = crate::workspace::check_files(files);
+    let run = semo::workspace::check_files(files);
     let Some((_, analysis)) = run.analyses.iter().find(|(f, _)| *f == id) else {
         return 2;
     };
-    let mut machines = crate::modemachine::machines(&analysis.mission);
+    let mut machines = semo::modemachine::machines(&analysis.mission);
     if let Some(team) = team {
         machines.retain(|m| m.team == team);
         if machines.is_empty() {
@@ -113,7 +113,7 @@ pub fn modes(path: &Path, team: Option<&str>, output: Option<&Path>, out: &mut i
         .cloned()
         .collect();
     let _ = render::diagnostics(&run.files, &errors, false, &mut std::io::stderr());
-    match write_picture(&crate::modemachine::to_svg(&machines), output, out) {
+    match write_picture(&semo::modemachine::to_svg(&machines), output, out) {
         0 if !errors.is_empty() => 1,
         code => code,
     }
@@ -173,17 +173,17 @@ pub fn analyze(
 
 fn write_human(
     files: &Files,
-    run: &crate::workspace::GraphRun,
+    run: &semo::workspace::GraphRun,
     color: bool,
     out: &mut impl Write,
 ) -> std::io::Result<()> {
     render::diagnostics(files, &run.diagnostics, color, out)?;
     if !run.report.levels.is_empty() {
         let meaning = match run.report.concurrency {
-            crate::taskgraph::analysis::Concurrency::Auto => {
+            semo::taskgraph::analysis::Concurrency::Auto => {
                 "auto (a task fires concurrently with itself unless a self-loop channel limits it)"
             }
-            crate::taskgraph::analysis::Concurrency::Single => {
+            semo::taskgraph::analysis::Concurrency::Single => {
                 "single (one firing of a task at a time)"
             }
         };
@@ -242,7 +242,7 @@ fn write_human(
 
 fn write_json(
     files: &Files,
-    run: &crate::workspace::GraphRun,
+    run: &semo::workspace::GraphRun,
     out: &mut impl Write,
 ) -> std::io::Result<()> {
     let levels: Vec<serde_json::Value> = run
@@ -295,7 +295,7 @@ fn write_json(
 /// `semo graph schedule`: the looped schedule of the whole graph, and with
 /// `cores` a list schedule of each level's iteration onto that many cores.
 pub fn schedule(path: &Path, cores: Option<usize>, out: &mut impl Write) -> i32 {
-    use crate::taskgraph::analysis::{hierarchy_levels, schedule};
+    use semo::taskgraph::analysis::{hierarchy_levels, schedule};
     let Some(text) = read(path) else { return 2 };
     let mut files = Files::default();
     let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
@@ -388,7 +388,7 @@ pub fn buffers(
     json: bool,
     out: &mut impl Write,
 ) -> i32 {
-    use crate::taskgraph::analysis::{level::Level, tradeoff};
+    use semo::taskgraph::analysis::{level::Level, tradeoff};
     let bound = match period_bound(throughput) {
         Ok(b) => b,
         Err(message) => {
@@ -455,7 +455,7 @@ pub fn buffers(
     0
 }
 
-fn minimum_words(found: &crate::taskgraph::analysis::tradeoff::TradeOff) -> String {
+fn minimum_words(found: &semo::taskgraph::analysis::tradeoff::TradeOff) -> String {
     match found.for_max_throughput() {
         Some(p) if found.exact() => format!("{} (exact: the lower bound is reached)", p.size),
         Some(p) => format!(
@@ -470,11 +470,11 @@ fn minimum_words(found: &crate::taskgraph::analysis::tradeoff::TradeOff) -> Stri
 }
 
 fn buffers_human(
-    level: &crate::taskgraph::analysis::level::Level<'_>,
-    found: &crate::taskgraph::analysis::tradeoff::TradeOff,
-    concurrency: crate::taskgraph::analysis::Concurrency,
+    level: &semo::taskgraph::analysis::level::Level<'_>,
+    found: &semo::taskgraph::analysis::tradeoff::TradeOff,
+    concurrency: semo::taskgraph::analysis::Concurrency,
     bound: Option<Ratio>,
-    chosen: Option<&crate::taskgraph::analysis::tradeoff::Point>,
+    chosen: Option<&semo::taskgraph::analysis::tradeoff::Point>,
     out: &mut impl Write,
 ) -> std::io::Result<()> {
     writeln!(out, "concurrency: {}", concurrency.as_str())?;
@@ -512,10 +512,10 @@ fn buffers_human(
 }
 
 fn buffers_json(
-    level: &crate::taskgraph::analysis::level::Level<'_>,
-    found: &crate::taskgraph::analysis::tradeoff::TradeOff,
-    concurrency: crate::taskgraph::analysis::Concurrency,
-    chosen: Option<&crate::taskgraph::analysis::tradeoff::Point>,
+    level: &semo::taskgraph::analysis::level::Level<'_>,
+    found: &semo::taskgraph::analysis::tradeoff::TradeOff,
+    concurrency: semo::taskgraph::analysis::Concurrency,
+    chosen: Option<&semo::taskgraph::analysis::tradeoff::Point>,
     out: &mut impl Write,
 ) -> std::io::Result<()> {
     let points: Vec<serde_json::Value> = found
