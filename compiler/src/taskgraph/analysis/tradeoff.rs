@@ -216,10 +216,13 @@ pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff
     // growing one channel at a time is stuck on ties, and the search from
     // above takes over.
     let mut stale = 0usize;
+    // Steps in a row that left the distribution blocked.
+    let mut blocked = 0usize;
     while search.within(MAX_WORK / 3) && stale <= caps.len() + 4 {
         let grow: Vec<usize> = match &current {
             Outcome::Period(period, on_cycle) => {
                 let size = caps.iter().sum();
+                blocked = 0;
                 stale += 1;
                 if points.last().is_none_or(|p| *period < p.period) {
                     stale = 0;
@@ -235,7 +238,22 @@ pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff
                 }
                 on_cycle.clone()
             }
-            Outcome::Blocked(space) => space.clone(),
+            Outcome::Blocked(space) if !space.is_empty() && blocked > 8 => {
+                // Still not live after a few steps (a large graph far from
+                // live): double the blocking cycle's channels (the lower
+                // bound still says how far from the minimum it lands).
+                let mut trial = caps.clone();
+                for &i in space {
+                    trial[i] = trial[i].saturating_mul(2).max(trial[i] + steps[i]);
+                }
+                current = search.evaluate(&bounded_caps(&trial))?;
+                caps = trial;
+                continue;
+            }
+            Outcome::Blocked(space) => {
+                blocked += 1;
+                space.clone()
+            }
         };
         let grow = if grow.is_empty() {
             // No space edge found on the cycle (ties between cycles): grow
