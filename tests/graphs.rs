@@ -310,21 +310,110 @@ fn multicore_schedule_lists_each_core() {
     assert!(out.stdout.contains("\n  core 1: "), "{}", out.stdout);
 }
 
+fn period_as(file: &str, flags: &[&str]) -> (String, serde_json::Value) {
+    let mut args = vec!["graph", "analyze", "--format", "json"];
+    args.extend(flags);
+    args.push(file);
+    let out = semo_in(&sdf3(), &args);
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    let v: serde_json::Value = serde_json::from_str(&out.stdout).expect("one JSON object");
+    (
+        v["concurrency"].as_str().unwrap().to_string(),
+        v["levels"][0]["throughput"].clone(),
+    )
+}
+
 #[test]
 fn throughput_names_the_period_and_critical_cycle() {
-    let (code, v) = analyze_json(&sdf3(), "h263encoder.xml");
-    assert_eq!(code, 0, "{v}");
-    let t = &v["levels"][0]["throughput"];
     // Verified by an independent self-timed simulation in the unit tests.
+    let cycle = serde_json::json!([
+        "motion_estimation",
+        "mb_encoding",
+        "mb_decoding",
+        "motion_compensation"
+    ]);
+    // An SDF3 file means auto-concurrency; the file's default="true" times.
+    let (concurrency, t) = period_as("h263encoder.xml", &[]);
+    assert_eq!(concurrency, "auto");
+    assert_eq!(t["period"], "408448");
+    assert_eq!(t["critical_cycle"], cycle);
+    // SDF3's reading of the times: SDF3's own answer (1/4.72981e-06).
+    let (_, t) = period_as("h263encoder.xml", &["--sdf3-compat"]);
+    assert_eq!(t["period"], "211425");
+    // One firing at a time, as the generated code runs a task.
+    let (concurrency, t) = period_as("h263encoder.xml", &["--concurrency", "single"]);
+    assert_eq!(concurrency, "single");
     assert_eq!(t["period"], "1232530");
-    assert_eq!(
-        t["critical_cycle"],
-        serde_json::json!([
-            "motion_estimation",
-            "mb_encoding",
-            "mb_decoding",
-            "motion_compensation"
-        ])
+    assert_eq!(t["critical_cycle"], cycle);
+}
+
+/// `semo graph analyze --sdf3-compat` gives SDF3's iteration period on every
+/// SDF3 benchmark graph (the table in `tests/data/sdf3/README.md`: SDF3's
+/// `sdf3analysis-sdf --algo throughput`, the period its inverse).
+#[test]
+fn sdf3_compat_gives_sdf3_periods_on_its_benchmarks() {
+    let expected = [
+        ("h263decoder", "332046"),
+        ("h263encoder", "211425"),
+        ("modem", "16"),
+        ("mp3decoder_block_parallelism", "278650"),
+        ("mp3decoder_granule_parallelism", "278650"),
+        ("mp3playback", "120000"),
+        ("random_1000", "463"),
+        ("random_200", "170"),
+        ("random_50", "104"),
+        ("samplerate", "960"),
+        ("satellite", "1056"),
+    ];
+    for (name, period) in expected {
+        let (concurrency, t) = period_as(&format!("{name}.xml"), &["--sdf3-compat"]);
+        assert_eq!(concurrency, "auto", "{name}");
+        assert_eq!(t["period"], period, "{name}");
+    }
+}
+
+#[test]
+fn human_report_says_which_concurrency() {
+    let out = semo_in(&sdf3(), &["graph", "analyze", "random_50.xml"]);
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout.starts_with("concurrency: auto"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stdout.contains("iteration period: 104 ("),
+        "{}",
+        out.stdout
+    );
+    let out = semo_in(
+        &sdf3(),
+        &[
+            "graph",
+            "analyze",
+            "--concurrency",
+            "single",
+            "random_50.xml",
+        ],
+    );
+    assert!(
+        out.stdout.starts_with("concurrency: single"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stdout.contains("iteration period: 280 ("),
+        "{}",
+        out.stdout
+    );
+    let out = semo_in(
+        &examples().join("taskgraphs"),
+        &["graph", "analyze", "kmeans.taskgraph.xml"],
+    );
+    assert!(
+        out.stdout.starts_with("concurrency: single"),
+        "{}",
+        out.stdout
     );
 }
 
@@ -485,4 +574,78 @@ fn modes_draws_each_team_or_one_and_reports_errors_and_unknown_teams() {
     );
     let missing = semo_in(&dir, &["graph", "modes", "no_such.mission"]);
     assert_eq!(missing.code, 2);
+}
+
+/// `semo graph buffers`: SDF3's storage/throughput front on modem (its
+/// `sdf3analysis-sdf --algo buffersize`: 70 → 1/0.03125, 71 → 1/0.0555556,
+/// 72 → 1/0.0625), the channel sizes of a chosen point, and bounds where the
+/// minimum is not known exactly.
+#[test]
+fn buffers_give_the_trade_off_and_a_chosen_point() {
+    let out = semo_in(
+        &sdf3(),
+        &["graph", "buffers", "--format", "json", "modem.xml"],
+    );
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    assert_eq!(v["concurrency"], "auto");
+    assert_eq!(v["max_period"], "16");
+    assert_eq!(
+        v["points"],
+        serde_json::json!([
+            {"size": 70, "period": "32"},
+            {"size": 71, "period": "18"},
+            {"size": 72, "period": "16"}
+        ])
+    );
+    assert_eq!(
+        v["minimal_size"],
+        serde_json::json!({"lower_bound": 72, "found": 72, "exact": true})
+    );
+    let channels = v["chosen"]["channels"].as_object().unwrap();
+    let total: u64 = channels.values().map(|c| c.as_u64().unwrap()).sum();
+    assert_eq!(total, 72);
+
+    // A throughput of 1/18 chooses the point of size 71.
+    let out = semo_in(
+        &sdf3(),
+        &["graph", "buffers", "--throughput", "1/18", "modem.xml"],
+    );
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout
+            .contains("channel sizes for period at most 18 (71 → 18):"),
+        "{}",
+        out.stdout
+    );
+    // Where the search cannot tell the minimum exactly, it says so.
+    let out = semo_in(&sdf3(), &["graph", "buffers", "mp3playback.xml"]);
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout
+            .contains("smallest total size for the maximal throughput: between 2907 and 2918"),
+        "{}",
+        out.stdout
+    );
+    // A throughput no distribution reaches, and one that is not a number.
+    let out = semo_in(
+        &sdf3(),
+        &["graph", "buffers", "--throughput", "1", "modem.xml"],
+    );
+    assert_eq!(out.code, 1, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stderr.contains("no buffer distribution found reaches"),
+        "{}",
+        out.stderr
+    );
+    let out = semo_in(
+        &sdf3(),
+        &["graph", "buffers", "--throughput", "fast", "modem.xml"],
+    );
+    assert_eq!(out.code, 2);
+    assert!(
+        out.stderr.contains("`fast` is not a throughput"),
+        "{}",
+        out.stderr
+    );
 }

@@ -4,7 +4,10 @@
 
 use super::render;
 use semo::diag::Diagnostic;
-use semo::workspace::{DiskResolver, FileKind, Files, analyze_graph};
+use semo::taskgraph::analysis::ratio::Ratio;
+use semo::workspace::{
+    DiskResolver, FileKind, Files, GraphReading, analyze_graph, analyze_graph_as,
+};
 use std::io::Write;
 use std::path::Path;
 
@@ -129,11 +132,24 @@ fn write_picture(picture: &str, output: Option<&Path>, out: &mut impl Write) -> 
     }
 }
 
-pub fn analyze(path: &Path, json: bool, color: bool, out: &mut impl Write) -> i32 {
+pub fn analyze(
+    path: &Path,
+    reading: GraphReading,
+    json: bool,
+    color: bool,
+    out: &mut impl Write,
+) -> i32 {
     let Some(text) = read(path) else { return 2 };
     let mut files = Files::default();
     let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
-    let run = analyze_graph(files.get(id), &mut DiskResolver::new(&files));
+    let file = files.get(id);
+    let run = analyze_graph_as(
+        id,
+        &file.text,
+        Some(&file.path),
+        &mut DiskResolver::new(&files),
+        reading,
+    );
     let written = if json {
         write_json(&files, &run, out)
     } else {
@@ -159,6 +175,17 @@ fn write_human(
     out: &mut impl Write,
 ) -> std::io::Result<()> {
     render::diagnostics(files, &run.diagnostics, color, out)?;
+    if !run.report.levels.is_empty() {
+        let meaning = match run.report.concurrency {
+            semo::taskgraph::analysis::Concurrency::Auto => {
+                "auto (a task fires concurrently with itself unless a self-loop channel limits it)"
+            }
+            semo::taskgraph::analysis::Concurrency::Single => {
+                "single (one firing of a task at a time)"
+            }
+        };
+        writeln!(out, "concurrency: {meaning}")?;
+    }
     for level in &run.report.levels {
         let state = match (&level.repetition, level.deadlock_free) {
             (None, _) => "inconsistent".to_string(),
@@ -186,10 +213,11 @@ fn write_human(
         }
         if let Some(t) = &level.throughput {
             let cycle = match t.critical_cycle.as_slice() {
-                [one] => format!("{one} alone"),
-                many => format!("{} → {}", many.join(" → "), many[0]),
+                [] => "no cycle: unbounded throughput".to_string(),
+                [one] => format!("bounded by {one} alone"),
+                many => format!("bounded by {} → {}", many.join(" → "), many[0]),
             };
-            writeln!(out, "  iteration period: {} (bounded by {cycle})", t.period)?;
+            writeln!(out, "  iteration period: {} ({cycle})", t.period)?;
         }
         if !level.buffers.is_empty() {
             let bounds: Vec<String> = level
@@ -253,6 +281,7 @@ fn write_json(
         .collect();
     let value = serde_json::json!({
         "graph": run.graph.as_ref().map(|g| g.name.clone()),
+        "concurrency": run.report.concurrency.as_str(),
         "looped_schedule": run.report.looped_schedule,
         "levels": levels,
         "diagnostics": diagnostics,
@@ -315,4 +344,204 @@ pub fn schedule(path: &Path, cores: Option<usize>, out: &mut impl Write) -> i32 
     }
     let _ = out.write_all(text.as_bytes());
     0
+}
+
+/// A throughput `max`, `A/B` or a decimal, as the period bound it means:
+/// `Ok(None)` for `max`.
+fn period_bound(text: &str) -> Result<Option<Ratio>, String> {
+    let text = text.trim();
+    if text == "max" {
+        return Ok(None);
+    }
+    let bad =
+        || format!("`{text}` is not a throughput: give `max`, `A/B` or a decimal such as 0.0096");
+    let (num, den) = match text.split_once('/') {
+        Some((a, b)) => (
+            a.trim().parse::<u64>().map_err(|_| bad())?,
+            b.trim().parse::<u64>().map_err(|_| bad())?,
+        ),
+        None => {
+            let (whole, frac) = text.split_once('.').unwrap_or((text, ""));
+            if frac.len() > 18 || !(whole.chars().chain(frac.chars())).all(|c| c.is_ascii_digit()) {
+                return Err(bad());
+            }
+            let den = 10u64.pow(frac.len() as u32);
+            let digits = format!("{whole}{frac}");
+            (digits.parse::<u64>().map_err(|_| bad())?, den)
+        }
+    };
+    if num == 0 || den == 0 {
+        return Err(bad());
+    }
+    // The period bound is the inverse of the throughput.
+    Ratio::new(den, num).map(Some).ok_or_else(bad)
+}
+
+/// `semo graph buffers`: the storage/throughput trade-off of the top level.
+pub fn buffers(
+    path: &Path,
+    reading: GraphReading,
+    throughput: &str,
+    json: bool,
+    out: &mut impl Write,
+) -> i32 {
+    use semo::taskgraph::analysis::{level::Level, tradeoff};
+    let bound = match period_bound(throughput) {
+        Ok(b) => b,
+        Err(message) => {
+            eprintln!("error: {message}");
+            return 2;
+        }
+    };
+    let Some(text) = read(path) else { return 2 };
+    let mut files = Files::default();
+    let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
+    let file = files.get(id);
+    let run = analyze_graph_as(
+        id,
+        &file.text,
+        Some(&file.path),
+        &mut DiskResolver::new(&files),
+        reading,
+    );
+    let live = run
+        .report
+        .levels
+        .first()
+        .is_some_and(|l| l.deadlock_free == Some(true));
+    let Some(graph) = run
+        .graph
+        .as_ref()
+        .filter(|_| live && !run.diagnostics.iter().any(Diagnostic::is_error))
+    else {
+        let _ = render::diagnostics(&files, &run.diagnostics, false, &mut std::io::stderr());
+        eprintln!(
+            "error: {}: the buffers of a graph with errors cannot be sized",
+            path.display()
+        );
+        return 1;
+    };
+    let concurrency = run.report.concurrency;
+    let level = Level::build(graph, None, graph.name.clone());
+    let Some(found) = tradeoff::trade_off(&level, concurrency) else {
+        eprintln!(
+            "error: {}: the period of this graph cannot be computed (too large an expansion or overflow)",
+            path.display()
+        );
+        return 1;
+    };
+    let chosen = match bound {
+        None => found.for_max_throughput(),
+        Some(period) => found.for_period(period),
+    };
+    let written = if json {
+        buffers_json(&level, &found, concurrency, chosen, out)
+    } else {
+        buffers_human(&level, &found, concurrency, bound, chosen, out)
+    };
+    if let Err(e) = written
+        && e.kind() != std::io::ErrorKind::BrokenPipe
+    {
+        eprintln!("error: cannot write the report: {e}");
+        return 2;
+    }
+    if chosen.is_none() {
+        eprintln!("error: no buffer distribution found reaches that throughput");
+        return 1;
+    }
+    0
+}
+
+fn minimum_words(found: &semo::taskgraph::analysis::tradeoff::TradeOff) -> String {
+    match found.for_max_throughput() {
+        Some(p) if found.exact() => format!("{} (exact: the lower bound is reached)", p.size),
+        Some(p) => format!(
+            "between {} and {} (a distribution of {} was found; no smaller one than {} can reach it)",
+            found.lower_bound, p.size, p.size, found.lower_bound
+        ),
+        None => format!(
+            "at least {} (the search stopped after {} evaluations before reaching it)",
+            found.lower_bound, found.evaluations
+        ),
+    }
+}
+
+fn buffers_human(
+    level: &semo::taskgraph::analysis::level::Level<'_>,
+    found: &semo::taskgraph::analysis::tradeoff::TradeOff,
+    concurrency: semo::taskgraph::analysis::Concurrency,
+    bound: Option<Ratio>,
+    chosen: Option<&semo::taskgraph::analysis::tradeoff::Point>,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
+    writeln!(out, "concurrency: {}", concurrency.as_str())?;
+    writeln!(
+        out,
+        "maximal throughput: period {} (unbounded buffers)",
+        found.max_period
+    )?;
+    writeln!(
+        out,
+        "trade-off (total buffer size → period; each point a distribution found):"
+    )?;
+    for p in &found.points {
+        writeln!(out, "  {} → {}", p.size, p.period)?;
+    }
+    writeln!(
+        out,
+        "smallest total size for the maximal throughput: {}",
+        minimum_words(found)
+    )?;
+    match chosen {
+        Some(p) => {
+            let what = match bound {
+                None => "the maximal throughput".to_string(),
+                Some(b) => format!("period at most {b}"),
+            };
+            writeln!(out, "channel sizes for {what} ({} → {}):", p.size, p.period)?;
+            for (e, cap) in level.edges.iter().zip(&p.capacities) {
+                writeln!(out, "  {}: {cap}", e.label)?;
+            }
+        }
+        None => writeln!(out, "no distribution found reaches that throughput")?,
+    }
+    Ok(())
+}
+
+fn buffers_json(
+    level: &semo::taskgraph::analysis::level::Level<'_>,
+    found: &semo::taskgraph::analysis::tradeoff::TradeOff,
+    concurrency: semo::taskgraph::analysis::Concurrency,
+    chosen: Option<&semo::taskgraph::analysis::tradeoff::Point>,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
+    let points: Vec<serde_json::Value> = found
+        .points
+        .iter()
+        .map(|p| serde_json::json!({"size": p.size, "period": p.period.to_string()}))
+        .collect();
+    let channels = chosen.map(|p| {
+        level
+            .edges
+            .iter()
+            .zip(&p.capacities)
+            .map(|(e, cap)| (e.label.clone(), serde_json::json!(cap)))
+            .collect::<serde_json::Map<_, _>>()
+    });
+    let value = serde_json::json!({
+        "concurrency": concurrency.as_str(),
+        "max_period": found.max_period.to_string(),
+        "points": points,
+        "minimal_size": {
+            "lower_bound": found.lower_bound,
+            "found": found.for_max_throughput().map(|p| p.size),
+            "exact": found.exact(),
+        },
+        "chosen": chosen.map(|p| serde_json::json!({
+            "size": p.size,
+            "period": p.period.to_string(),
+            "channels": channels,
+        })),
+    });
+    writeln!(out, "{value}")
 }

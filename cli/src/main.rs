@@ -173,6 +173,8 @@ enum GraphCommand {
         format: Format,
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
+        #[command(flatten)]
+        reading: ReadingArgs,
     },
     /// A static schedule: the looped single-appearance schedule of the whole
     /// graph (`A 10(B C) D`), and with `--cores N` each level's iteration
@@ -183,6 +185,24 @@ enum GraphCommand {
         /// Also schedule each level onto this many cores.
         #[arg(long)]
         cores: Option<usize>,
+    },
+    /// The buffer/throughput trade-off of the graph's top level (SDF3's buffer
+    /// sizing model): Pareto points (total buffer size → iteration period),
+    /// the smallest total size reaching the maximal throughput (exact, or
+    /// between stated bounds), and the channel sizes of a chosen point.
+    Buffers {
+        /// A `*.taskgraph.xml` file or an SDF3 graph.
+        file: PathBuf,
+        /// The point whose channel sizes are listed: `max` (the maximal
+        /// throughput) or a throughput in iterations per time unit (`1/104`,
+        /// `0.0096`): the smallest point found reaching at least it.
+        #[arg(long, default_value = "max")]
+        throughput: String,
+        /// `human` or `json`.
+        #[arg(long, value_enum, default_value_t = Format::Human)]
+        format: Format,
+        #[command(flatten)]
+        reading: ReadingArgs,
     },
     /// Print the graph in Graphviz DOT: tasks, loop nodes as clusters, rates
     /// and initial samples on channels (`semo graph dot g.taskgraph.xml | dot -Tsvg`).
@@ -212,6 +232,47 @@ enum GraphCommand {
         #[arg(short, long, value_name = "FILE")]
         output: Option<PathBuf>,
     },
+}
+
+/// How an analysed graph file is read: its concurrency and, for SDF3 files,
+/// which execution time an actor has.
+#[derive(clap::Args, Debug, Clone, Copy)]
+struct ReadingArgs {
+    /// Whether a task fires concurrently with itself: `auto` (SDF3's
+    /// meaning: as often as its input samples allow, unless a self-loop
+    /// channel limits it) or `single` (one firing at a time, as the generated
+    /// code runs a task). Default: `auto` for SDF3 files, `single` for
+    /// `*.taskgraph.xml`.
+    #[arg(long, value_enum)]
+    concurrency: Option<ConcurrencyArg>,
+    /// Read SDF3 execution times as SDF3's own loader does (the last
+    /// `<processor>` with a `default` attribute, whatever its value) instead
+    /// of the one marked `default="true"`.
+    #[arg(long)]
+    sdf3_compat: bool,
+}
+
+impl ReadingArgs {
+    fn reading(self) -> semo::workspace::GraphReading {
+        use semo::taskgraph::analysis::Concurrency;
+        semo::workspace::GraphReading {
+            concurrency: self.concurrency.map(|c| match c {
+                ConcurrencyArg::Auto => Concurrency::Auto,
+                ConcurrencyArg::Single => Concurrency::Single,
+            }),
+            times: if self.sdf3_compat {
+                semo::taskgraph::ExecutionTimes::Sdf3Compat
+            } else {
+                semo::taskgraph::ExecutionTimes::FileDefault
+            },
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+enum ConcurrencyArg {
+    Auto,
+    Single,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
@@ -270,7 +331,14 @@ fn run() -> i32 {
             file,
             format,
             color,
-        }) => graph::analyze(&file, format == Format::Json, use_color(color), &mut out),
+            reading,
+        }) => graph::analyze(
+            &file,
+            reading.reading(),
+            format == Format::Json,
+            use_color(color),
+            &mut out,
+        ),
         Command::Graph(GraphCommand::Dot { file }) => graph::dot(&file, &mut out),
         Command::Graph(GraphCommand::Svg { file, output }) => {
             graph::svg(&file, output.as_deref(), &mut out)
@@ -281,6 +349,18 @@ fn run() -> i32 {
         Command::Graph(GraphCommand::Schedule { file, cores }) => {
             graph::schedule(&file, cores, &mut out)
         }
+        Command::Graph(GraphCommand::Buffers {
+            file,
+            throughput,
+            format,
+            reading,
+        }) => graph::buffers(
+            &file,
+            reading.reading(),
+            &throughput,
+            format == Format::Json,
+            &mut out,
+        ),
         Command::Build {
             mission,
             strategy,

@@ -107,7 +107,11 @@ fn main() {
             black_box(deadlock::find_deadlock(black_box(&level), &counts));
         });
         let period = fastest(budget, || {
-            black_box(throughput::throughput(black_box(&level), &counts));
+            black_box(throughput::throughput(
+                black_box(&level),
+                &counts,
+                throughput::Concurrency::Single,
+            ));
         });
         // The picture of 100k tasks is a few tens of megabytes: not timed.
         let svg = (n <= 10_000).then(|| {

@@ -30,6 +30,6 @@ fn main() {
     buffers::buffer_bounds(&level, &flat);
     println!("buffers      {:?}", t.elapsed());
     let t = Instant::now();
-    throughput::throughput(&level, &counts);
+    throughput::throughput(&level, &counts, throughput::Concurrency::Auto);
     println!("throughput   {:?}", t.elapsed());
 }

@@ -212,15 +212,47 @@ pub fn analyze_graph_at(
     location: Option<&Path>,
     resolver: &mut dyn Resolver,
 ) -> GraphRun {
-    let (graph, mut diagnostics) = crate::taskgraph::load_task_graph(file, text);
+    analyze_graph_as(file, text, location, resolver, GraphReading::default())
+}
+
+/// How a task-graph file is read and analysed; by default as its format
+/// means it (see [`GraphReading::concurrency`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GraphReading {
+    /// Whether a task fires concurrently with itself; `None`: as the file's
+    /// format means it (SDF3 files auto-concurrency, ours one at a time).
+    pub concurrency: Option<crate::taskgraph::analysis::Concurrency>,
+    /// Which of an SDF3 actor's execution times is its time.
+    pub times: crate::taskgraph::ExecutionTimes,
+}
+
+/// [`analyze_graph_at`], read and analysed as `reading` says.
+pub fn analyze_graph_as(
+    file: FileId,
+    text: &str,
+    location: Option<&Path>,
+    resolver: &mut dyn Resolver,
+    reading: GraphReading,
+) -> GraphRun {
+    use crate::taskgraph::analysis::Concurrency;
+    let (graph, mut diagnostics) = crate::taskgraph::load_task_graph_as(file, text, reading.times);
     let loaded_cleanly = !diagnostics.iter().any(Diagnostic::is_error);
+    let concurrency = reading.concurrency.unwrap_or_else(|| {
+        crate::taskgraph::detect_format(text).map_or(Concurrency::Single, Concurrency::of)
+    });
     let (hierarchy, report) = match &graph {
         Some(g) if loaded_cleanly => {
             let hierarchy = subgraph::resolve(g, location, resolver);
-            let report = crate::taskgraph::analysis::analyze_with(g, &hierarchy);
+            let report = crate::taskgraph::analysis::analyze_as(g, &hierarchy, concurrency);
             (hierarchy, report)
         }
-        _ => Default::default(),
+        _ => (
+            Hierarchy::default(),
+            crate::taskgraph::analysis::GraphReport {
+                concurrency,
+                ..Default::default()
+            },
+        ),
     };
     diagnostics.extend(hierarchy.diagnostics.iter().cloned());
     diagnostics.extend(report.diagnostics.iter().cloned());

@@ -11,4 +11,4 @@ mod xml;
 pub mod write;
 pub use model::*;
 pub use svg::to_svg;
-pub use xml::{GraphFormat, detect_format, load_task_graph};
+pub use xml::{ExecutionTimes, GraphFormat, detect_format, load_task_graph, load_task_graph_as};

@@ -38,6 +38,10 @@
 //!
 //! SDF3 files are read leniently: elements and attributes the loader does not
 //! use are ignored silently (no E061/W060), as are properties of unknown actors.
+//!
+//! An SDF3 actor may list execution times for several processor types; which
+//! one is its time is an [`ExecutionTimes`] choice, by default the file's
+//! (`default="true"`).
 
 use super::model::*;
 use crate::diag::{Code, Diagnostic, FileId, sort_and_dedup};
@@ -59,11 +63,34 @@ pub enum GraphFormat {
     Sdf3,
 }
 
+/// Which of an SDF3 actor's `<processor>` entries gives its execution time.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ExecutionTimes {
+    /// What the file says: the first processor with `default="true"`, else
+    /// the first one.
+    #[default]
+    FileDefault,
+    /// What SDF3's loader (`TimedSDFactor::setProperties`, 2009 release)
+    /// does: the last processor that has a `default` attribute, whatever its
+    /// value (`default="false"` too), and none (time 0) when no processor has
+    /// one.
+    Sdf3Compat,
+}
+
 /// Reads one task-graph file, in our format or SDF3 (told apart by the root
 /// element): the graph, as much of it as could be read, and the diagnostics.
 /// `None` when no graph could be read at all (no root element, an unknown root
 /// element, an SDF3 file of another graph type, an SDF3 file without `<sdf>`).
 pub fn load_task_graph(file: FileId, text: &str) -> (Option<TaskGraph>, Vec<Diagnostic>) {
+    load_task_graph_as(file, text, ExecutionTimes::FileDefault)
+}
+
+/// [`load_task_graph`], reading SDF3 execution times as `times` says.
+pub fn load_task_graph_as(
+    file: FileId,
+    text: &str,
+    times: ExecutionTimes,
+) -> (Option<TaskGraph>, Vec<Diagnostic>) {
     let mut sink = Sink {
         file,
         list: Vec::new(),
@@ -83,6 +110,7 @@ pub fn load_task_graph(file: FileId, text: &str) -> (Option<TaskGraph>, Vec<Diag
             file,
             sink: &mut sink,
             sdf3: root.local == "sdf3",
+            times,
         };
         match root.local.as_str() {
             "TaskGraph" => Some(loader.semo_root(&root)),
@@ -223,6 +251,7 @@ struct Loader<'s> {
     sink: &'s mut Sink,
     /// Reading SDF3: messages say "actor".
     sdf3: bool,
+    times: ExecutionTimes,
 }
 
 impl Loader<'_> {
@@ -1157,8 +1186,8 @@ impl Loader<'_> {
         })
     }
 
-    /// Execution times from `<sdfProperties>`: per actor, the default
-    /// processor's (the first with default="true", else the first).
+    /// Execution times from `<sdfProperties>`: per actor, the chosen
+    /// processor's (see [`ExecutionTimes`]).
     fn sdf3_times(&mut self, props: &Elem) -> HashMap<String, u64> {
         let mut times = HashMap::new();
         for ap in props
@@ -1174,10 +1203,23 @@ impl Loader<'_> {
                 .iter()
                 .filter(|c| c.local == "processor")
                 .collect();
-            let chosen = processors
-                .iter()
-                .find(|p| get(&p.attrs, "default").is_some_and(|d| d.trimmed() == "true"))
-                .or(processors.first());
+            let chosen = match self.times {
+                ExecutionTimes::FileDefault => processors
+                    .iter()
+                    .find(|p| get(&p.attrs, "default").is_some_and(|d| d.trimmed() == "true"))
+                    .or(processors.first()),
+                ExecutionTimes::Sdf3Compat => {
+                    // SDF3 keeps the type of the last processor marked
+                    // `default` and then takes the first entry of that type.
+                    let kind = |p: &&Elem| get(&p.attrs, "type").map(|t| t.trimmed().to_string());
+                    let last = processors
+                        .iter()
+                        .rev()
+                        .find(|p| get(&p.attrs, "default").is_some());
+                    last.and_then(kind)
+                        .and_then(|k| processors.iter().find(|p| kind(p).as_ref() == Some(&k)))
+                }
+            };
             let time = chosen
                 .and_then(|p| p.children.iter().find(|c| c.local == "executionTime"))
                 .and_then(|t| get(&t.attrs, "time"));

@@ -11,6 +11,7 @@ pub mod ratio;
 pub mod rules;
 pub mod schedule;
 pub mod throughput;
+pub mod tradeoff;
 
 use crate::diag::{Code, Diagnostic};
 use crate::taskgraph::model::TaskGraph;
@@ -19,6 +20,7 @@ use consistency::{RateProblem, repetition_vector};
 use deadlock::find_deadlock;
 use level::Level;
 use std::collections::HashMap;
+pub use throughput::Concurrency;
 
 /// What the analyses found about one hierarchy level.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -46,7 +48,8 @@ pub struct ThroughputReport {
     /// Time units per iteration, exact (`16`, `11/2`).
     pub period: ratio::Ratio,
     /// Node names around the critical cycle, in flow order (one name: that
-    /// task alone, which cannot overlap with itself, bounds the period).
+    /// task alone bounds the period, by not overlapping with itself or by its
+    /// self-loop channel); empty when no cycle bounds it (period 0).
     pub critical_cycle: Vec<String>,
 }
 
@@ -58,13 +61,27 @@ pub struct BufferBound {
     pub samples: u64,
 }
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct GraphReport {
+    /// How the throughput was computed: whether a task fires concurrently
+    /// with itself.
+    pub concurrency: Concurrency,
     pub levels: Vec<LevelReport>,
     /// The whole hierarchy as one looped schedule (`A 10(B C) D`), where every
     /// level has a single-appearance schedule.
     pub looped_schedule: Option<String>,
     pub diagnostics: Vec<Diagnostic>,
+}
+
+impl Default for GraphReport {
+    fn default() -> GraphReport {
+        GraphReport {
+            concurrency: Concurrency::Single,
+            levels: Vec::new(),
+            looped_schedule: None,
+            diagnostics: Vec::new(),
+        }
+    }
 }
 
 impl GraphReport {
@@ -77,9 +94,15 @@ impl GraphReport {
     }
 }
 
-/// Runs the analyses on every level of `graph`.
+/// Runs the analyses on every level of `graph`, one firing of a task at a
+/// time (as the generated code runs it).
 pub fn analyze(graph: &TaskGraph) -> GraphReport {
     analyze_with(graph, &Hierarchy::default())
+}
+
+/// [`analyze_with`], one firing of a task at a time.
+pub fn analyze_with(graph: &TaskGraph, hierarchy: &Hierarchy) -> GraphReport {
+    analyze_as(graph, hierarchy, Concurrency::Single)
 }
 
 /// Runs the analyses on every level of `graph` and of the sub-graphs its
@@ -94,9 +117,14 @@ pub fn analyze(graph: &TaskGraph) -> GraphReport {
 /// `loopCount` times its body's time (a C-type loop at most that many) and a
 /// task standing for a sub-graph that sub-graph's time, recursively. (A loop
 /// node's own firing still takes no time in its level's throughput, as
-/// before.)
-pub fn analyze_with(graph: &TaskGraph, hierarchy: &Hierarchy) -> GraphReport {
+/// before.) The throughput lets a task fire as `concurrency` says.
+pub fn analyze_as(
+    graph: &TaskGraph,
+    hierarchy: &Hierarchy,
+    concurrency: Concurrency,
+) -> GraphReport {
     let mut report = GraphReport {
+        concurrency,
         diagnostics: rules::check(graph),
         ..GraphReport::default()
     };
@@ -117,7 +145,7 @@ pub fn analyze_with(graph: &TaskGraph, hierarchy: &Hierarchy) -> GraphReport {
     for level in levels.iter_mut().rev() {
         sub_graph_times(level, &work);
         let mut diagnostics = Vec::new();
-        let (level_report, sas) = analyze_level(level, &mut diagnostics);
+        let (level_report, sas) = analyze_level(level, concurrency, &mut diagnostics);
         if let Some(w) = level_report
             .repetition
             .as_ref()
@@ -169,6 +197,7 @@ pub fn hierarchy_levels<'g>(graph: &'g TaskGraph, hierarchy: &'g Hierarchy) -> V
 /// Consistency, deadlock, schedule and throughput of one level.
 fn analyze_level(
     level: &Level<'_>,
+    concurrency: Concurrency,
     diagnostics: &mut Vec<Diagnostic>,
 ) -> (LevelReport, Option<Vec<schedule::Schedule>>) {
     let nodes = level.nodes.iter().map(|n| n.name.clone()).collect();
@@ -187,7 +216,10 @@ fn analyze_level(
             let blocked = find_deadlock(level, &counts);
             match &blocked {
                 Some(b) => diagnostics.push(deadlock_diagnostic(level, b)),
-                None => sas = schedule_level(level, &counts, &mut level_report, diagnostics),
+                None => {
+                    sas =
+                        schedule_level(level, &counts, concurrency, &mut level_report, diagnostics)
+                }
             }
             level_report.deadlock_free = Some(blocked.is_none());
             level_report.repetition = Some(counts);
@@ -292,19 +324,21 @@ fn at_reference(
 fn schedule_level(
     level: &Level<'_>,
     counts: &[u64],
+    concurrency: Concurrency,
     report: &mut LevelReport,
     diagnostics: &mut Vec<Diagnostic>,
 ) -> Option<Vec<schedule::Schedule>> {
     let timed = level.nodes.iter().any(|n| n.wcet.is_some_and(|w| w > 0));
     if timed {
-        report.throughput = throughput::throughput(level, counts).map(|t| ThroughputReport {
-            period: t.period,
-            critical_cycle: t
-                .critical_cycle
-                .iter()
-                .map(|&n| level.nodes[n].name.clone())
-                .collect(),
-        });
+        report.throughput =
+            throughput::throughput(level, counts, concurrency).map(|t| ThroughputReport {
+                period: t.period,
+                critical_cycle: t
+                    .critical_cycle
+                    .iter()
+                    .map(|&n| level.nodes[n].name.clone())
+                    .collect(),
+            });
     }
     let single_appearance = schedule::single_appearance(level, counts);
     // The flat (sample-frugal) schedule: the buffer bounds are measured under

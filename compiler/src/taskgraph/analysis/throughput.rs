@@ -3,10 +3,15 @@
 //! maximum cycle mean of the equivalent homogeneous SDF graph (HSDF), and the
 //! cycle that attains it.
 //!
-//! A node cannot overlap with itself, which the HSDF models by chaining the
-//! firings of each node with one sample on the edge from its last firing back
-//! to its first: even an acyclic level has cycles, and its period is at least
-//! every node's γ·wcet.
+//! Two meanings of a node firing ([`Concurrency`]): with `Single` (our task
+//! graphs, as the generated code runs them: one thread per task) a node cannot
+//! overlap with itself, which the HSDF models by chaining the firings of each
+//! node with one sample on the edge from its last firing back to its first:
+//! even an acyclic level has cycles, and its period is at least every node's
+//! γ·wcet. With `Auto` (SDF3's meaning of its own files) a node fires
+//! concurrently with itself as often as its input samples allow: only the
+//! level's channels (a self-loop channel among them) bound it, and a level
+//! without a cycle has period 0 (no bound on its throughput).
 //!
 //! Method: the level is expanded to its HSDF (when every repetition count is
 //! 1 the level already is one, and only its edges are read, no firing is
@@ -22,6 +27,35 @@
 use super::level::Level;
 use super::ratio::Ratio;
 
+/// Whether a node may fire concurrently with itself.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Concurrency {
+    /// Auto-concurrency (SDF3): as many firings of a node at once as its
+    /// input samples allow; a self-loop channel with `n` samples limits it to
+    /// `n` at a time.
+    Auto,
+    /// One firing at a time per node (our task graphs and generated code).
+    Single,
+}
+
+impl Concurrency {
+    /// The meaning of a file of `format`: SDF3's own for SDF3 files, ours for
+    /// ours.
+    pub fn of(format: crate::taskgraph::GraphFormat) -> Concurrency {
+        match format {
+            crate::taskgraph::GraphFormat::Sdf3 => Concurrency::Auto,
+            crate::taskgraph::GraphFormat::SemoXml => Concurrency::Single,
+        }
+    }
+
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Concurrency::Auto => "auto",
+            Concurrency::Single => "single",
+        }
+    }
+}
+
 /// The throughput of one level.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Throughput {
@@ -29,7 +63,9 @@ pub struct Throughput {
     pub period: Ratio,
     /// Nodes of the level around the cycle that bounds the period, in flow
     /// order, the first-declared node first. A single node means that node
-    /// alone bounds it (its firings of one iteration back to back).
+    /// alone bounds it (its firings of one iteration back to back, or its
+    /// self-loop channel). Empty when no cycle bounds the period (period 0,
+    /// only with [`Concurrency::Auto`]).
     pub critical_cycle: Vec<usize>,
 }
 
@@ -38,23 +74,35 @@ const MAX_HSDF: u64 = 1 << 23;
 
 /// The period of the self-timed execution of `level` with repetition vector
 /// `counts`, taking each task's `wcet` (0 when unknown or for boundary nodes)
-/// as its execution time. The level must be consistent and deadlock-free.
+/// as its execution time, a node firing as `concurrency` says. The level must
+/// be consistent and deadlock-free.
 ///
 /// `None` for an empty level, and also (rather than a wrong or panicking
 /// answer) when `counts` does not fit the level, when the HSDF would exceed
 /// 2^23 nodes plus edges (`MAX_HSDF`), when a cycle without initial samples is met
 /// (a deadlock), or when the exact arithmetic would overflow.
-pub fn throughput(level: &Level<'_>, counts: &[u64]) -> Option<Throughput> {
+pub fn throughput(
+    level: &Level<'_>,
+    counts: &[u64],
+    concurrency: Concurrency,
+) -> Option<Throughput> {
     if level.nodes.is_empty() || counts.len() != level.nodes.len() {
         return None;
     }
     let wcet: Vec<u64> = level.nodes.iter().map(|n| n.wcet.unwrap_or(0)).collect();
+    let chained = concurrency == Concurrency::Single;
     let hsdf =
         if counts.iter().all(|&c| c == 1) && level.edges.iter().all(|e| e.produce == e.consume) {
-            Hsdf::direct(level, wcet)
+            Hsdf::direct(level, wcet, chained)
         } else {
-            Hsdf::expand(level, counts, &wcet)?
+            Hsdf::expand(level, counts, &wcet, chained)?
         };
+    let Some(hsdf) = hsdf.on_cycles() else {
+        return Some(Throughput {
+            period: Ratio { num: 0, den: 1 },
+            critical_cycle: Vec::new(),
+        });
+    };
     let (period, cycle) = max_cycle_ratio(&hsdf)?;
     let walk: Vec<usize> = cycle.iter().map(|&v| hsdf.actor(v)).collect();
     Some(Throughput {
@@ -114,13 +162,15 @@ impl Hsdf {
     /// Every node fires once per iteration (and so every edge has equal
     /// rates): the level is its own HSDF. An edge with `d` samples and rate
     /// `p` lets a firing depend on the firing `⌊d/p⌋` iterations earlier.
-    fn direct(level: &Level<'_>, weight: Vec<u64>) -> Hsdf {
+    /// `chained`: each node also waits for its own previous firing.
+    fn direct(level: &Level<'_>, weight: Vec<u64>, chained: bool) -> Hsdf {
         let n = level.nodes.len();
+        let chains = if chained { n } else { 0 };
         let edges = level
             .edges
             .iter()
             .map(|e| (e.src, e.dst, e.initial_tokens / e.produce))
-            .chain((0..n).map(|v| (v, v, 1)))
+            .chain((0..chains).map(|v| (v, v, 1)))
             .collect();
         Hsdf::from_edges(weight, edges, Vec::new())
     }
@@ -133,7 +183,8 @@ impl Hsdf {
     /// iteration ⌈-j/γ(src)⌉ earlier when j < 0: the HSDF edge carries that
     /// many samples. Of several dependencies on the same source firing only
     /// the nearest iteration matters, so j runs over at most γ(src) values.
-    fn expand(level: &Level<'_>, counts: &[u64], wcet: &[u64]) -> Option<Hsdf> {
+    /// `chained`: firing k of a node also waits for its firing k - 1.
+    fn expand(level: &Level<'_>, counts: &[u64], wcet: &[u64], chained: bool) -> Option<Hsdf> {
         let n = level.nodes.len();
         let mut offset = Vec::with_capacity(n + 1);
         let mut total = 0u64;
@@ -162,7 +213,7 @@ impl Hsdf {
             }
         }
         let mut edges = Vec::new();
-        for v in 0..n {
+        for v in (0..n).filter(|_| chained) {
             // Firing k waits for firing k - 1 of the same node.
             let g = offset[v + 1] - offset[v];
             for k in 0..g {
@@ -189,6 +240,57 @@ impl Hsdf {
                 }
             }
         }
+        Some(Hsdf::from_edges(weight, edges, actor))
+    }
+}
+
+impl Hsdf {
+    /// The part of the graph whose nodes reach a cycle (every node keeps an
+    /// outgoing edge, as the policy iteration needs); the others lie on no
+    /// cycle and do not bound the period. `None` when no node is on a cycle.
+    fn on_cycles(self) -> Option<Hsdf> {
+        let n = self.len();
+        let mut outs: Vec<usize> = (0..n).map(|v| self.out(v).len()).collect();
+        if outs.iter().all(|&d| d > 0) {
+            return Some(self);
+        }
+        let mut into = vec![Vec::new(); n];
+        for v in 0..n {
+            for e in self.out(v) {
+                into[self.head[e]].push(v);
+            }
+        }
+        let mut dead: Vec<usize> = (0..n).filter(|&v| outs[v] == 0).collect();
+        let mut alive = vec![true; n];
+        while let Some(v) = dead.pop() {
+            alive[v] = false;
+            for &u in &into[v] {
+                outs[u] -= 1;
+                if outs[u] == 0 {
+                    dead.push(u);
+                }
+            }
+        }
+        let mut index = vec![usize::MAX; n];
+        let mut kept = Vec::new();
+        for v in (0..n).filter(|&v| alive[v]) {
+            index[v] = kept.len();
+            kept.push(v);
+        }
+        if kept.is_empty() {
+            return None;
+        }
+        let mut edges = Vec::new();
+        for &v in &kept {
+            for e in self.out(v) {
+                let u = self.head[e];
+                if alive[u] {
+                    edges.push((index[v], index[u], self.tokens[e]));
+                }
+            }
+        }
+        let weight = kept.iter().map(|&v| self.weight[v]).collect();
+        let actor = kept.iter().map(|&v| self.actor(v)).collect();
         Some(Hsdf::from_edges(weight, edges, actor))
     }
 }
@@ -366,9 +468,9 @@ mod tests {
     use crate::taskgraph::analysis::consistency::repetition_vector;
     use crate::taskgraph::analysis::deadlock::find_deadlock;
     use crate::taskgraph::model::*;
-    use std::collections::HashMap;
+    use proptest::prelude::*;
 
-    use crate::taskgraph::analysis::testing::{self, port};
+    use crate::taskgraph::analysis::testing::{self, port, simulated_period};
 
     fn task(name: &str, wcet: u64, ports: &[&str]) -> Task {
         Task {
@@ -394,8 +496,11 @@ mod tests {
         let level = Level::build(g, None, g.name.clone());
         let counts = repetition_vector(&level).unwrap();
         assert_eq!(find_deadlock(&level, &counts), None);
-        let t = throughput(&level, &counts).unwrap();
-        assert_eq!(t.period, simulated_period(&level, &counts));
+        let t = throughput(&level, &counts, Concurrency::Single).unwrap();
+        assert_eq!(
+            t.period,
+            simulated_period(&level, &counts, Concurrency::Single)
+        );
         t
     }
 
@@ -513,7 +618,7 @@ mod tests {
     fn an_empty_level_has_no_period() {
         let g = graph(Vec::new(), Vec::new());
         let level = Level::build(&g, None, "g".into());
-        assert_eq!(throughput(&level, &[]), None);
+        assert_eq!(throughput(&level, &[], Concurrency::Single), None);
     }
 
     #[test]
@@ -568,70 +673,226 @@ mod tests {
             if find_deadlock(&level, &counts).is_some() {
                 continue;
             }
-            let t = throughput(&level, &counts).unwrap();
-            assert_eq!(t.period, simulated_period(&level, &counts), "{g:#?}");
+            let t = throughput(&level, &counts, Concurrency::Single).unwrap();
+            assert_eq!(
+                t.period,
+                simulated_period(&level, &counts, Concurrency::Single),
+                "{g:#?}"
+            );
             checked += 1;
         }
         assert!(checked > 100, "{checked}");
     }
 
+    /// A random consistent level: a ring through all nodes plus `extra`
+    /// channels, repetition counts `gamma`, rates a multiple of what the
+    /// counts need, initial samples from `fill`, and a self-loop channel with
+    /// 1 or 2 samples on the nodes `looped` says.
+    #[derive(Debug, Clone)]
+    struct RandomLevel {
+        gamma: Vec<u64>,
+        wcet: Vec<u64>,
+        extra: Vec<(usize, usize, u64, u64)>,
+        ring: Vec<(u64, u64)>,
+        looped: Vec<u64>,
+    }
+
+    impl RandomLevel {
+        fn graph(&self) -> TaskGraph {
+            let n = self.gamma.len();
+            let mut tasks: Vec<Task> = (0..n)
+                .map(|v| task(&format!("T{v}"), self.wcet[v], &[]))
+                .collect();
+            let mut channels = Vec::new();
+            let ring = (0..n).map(|i| (i, (i + 1) % n, self.ring[i].0, self.ring[i].1));
+            let extra = self.extra.iter().map(|&(s, d, m, f)| (s % n, d % n, m, f));
+            for (i, (s, d, m, fill)) in ring.chain(extra).enumerate() {
+                let (gs, gd) = (self.gamma[s], self.gamma[d]);
+                let l = super::super::ratio::lcm(gs, gd).unwrap() * m;
+                let (p, c) = (l / gs, l / gd);
+                tasks[s].ports.push(port(&format!("o{i}>{p}")));
+                tasks[d].ports.push(port(&format!("i{i}<{c}")));
+                let tokens = fill % (2 * l + 1);
+                channels.push(channel(
+                    &format!("T{s}.o{i}"),
+                    &format!("T{d}.i{i}"),
+                    tokens,
+                ));
+            }
+            for (v, &samples) in self.looped.iter().enumerate().take(n) {
+                if samples > 0 {
+                    tasks[v].ports.push(port("so>1"));
+                    tasks[v].ports.push(port("si<1"));
+                    channels.push(channel(&format!("T{v}.so"), &format!("T{v}.si"), samples));
+                }
+            }
+            graph(tasks, channels)
+        }
+    }
+
+    fn random_level() -> impl Strategy<Value = RandomLevel> {
+        (2usize..6).prop_flat_map(|n| {
+            (
+                proptest::collection::vec(1u64..4, n),
+                proptest::collection::vec(1u64..7, n),
+                proptest::collection::vec((0usize..6, 0usize..6, 1u64..3, 0u64..40), 0..4),
+                proptest::collection::vec((1u64..3, 0u64..40), n),
+                proptest::collection::vec(0u64..3, n),
+            )
+                .prop_map(|(gamma, wcet, extra, ring, looped)| RandomLevel {
+                    gamma,
+                    wcet,
+                    extra,
+                    ring,
+                    looped,
+                })
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(400))]
+
+        /// Both readings of concurrency, both engines (the direct HSDF and
+        /// the expansion), with and without self-loop channels: the period
+        /// is the one the self-timed simulation reaches, and with `Single`
+        /// a self-loop of one sample on every node changes nothing.
+        #[test]
+        fn random_levels_have_the_simulated_period(random in random_level()) {
+            let g = random.graph();
+            let level = Level::build(&g, None, "g".into());
+            let counts = repetition_vector(&level).unwrap();
+            prop_assume!(find_deadlock(&level, &counts).is_none());
+            for concurrency in [Concurrency::Auto, Concurrency::Single] {
+                let t = throughput(&level, &counts, concurrency).unwrap();
+                prop_assert_eq!(
+                    t.period,
+                    simulated_period(&level, &counts, concurrency),
+                    "{:?}", concurrency
+                );
+                prop_assert_eq!(t.critical_cycle.is_empty(), t.period.num == 0);
+            }
+            let mut once = random.clone();
+            once.looped = vec![1; random.gamma.len()];
+            let g = once.graph();
+            let level = Level::build(&g, None, "g".into());
+            let counts = repetition_vector(&level).unwrap();
+            prop_assert_eq!(
+                throughput(&level, &counts, Concurrency::Auto).map(|t| t.period),
+                throughput(&level, &counts, Concurrency::Single).map(|t| t.period)
+            );
+        }
+    }
+
     const SDF3: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sdf3");
 
+    /// Per graph of `tests/data/sdf3/` (its README has the table and how the
+    /// SDF3 numbers were measured): the period SDF3 gives (auto-concurrency,
+    /// SDF3's reading of execution times), the period with auto-concurrency
+    /// and the file's `default="true"` times, and with one firing at a time.
+    const PERIODS: &[(&str, &str, &str, &str)] = &[
+        ("h263decoder", "332046", "332046", "332046"),
+        ("h263encoder", "211425", "408448", "1232530"),
+        ("modem", "16", "16", "16"),
+        (
+            "mp3decoder_block_parallelism",
+            "278650",
+            "278650",
+            "3732276",
+        ),
+        (
+            "mp3decoder_granule_parallelism",
+            "278650",
+            "278650",
+            "3732276",
+        ),
+        ("mp3playback", "120000", "120000", "120000"),
+        ("random_1000", "463", "463", "7378"),
+        ("random_200", "170", "170", "1422"),
+        ("random_50", "104", "104", "280"),
+        ("samplerate", "960", "960", "960"),
+        ("satellite", "1056", "1056", "1056"),
+        ("generated/r12_1", "67", "67", "184"),
+        ("generated/r12_1_falsedefault", "66", "67", "184"),
+        ("generated/r12_1_selfloops", "123", "123", "184"),
+        ("generated/r12_1_somelooped", "123", "123", "184"),
+        ("generated/r12_2", "57", "57", "70"),
+        ("generated/r12_2_falsedefault", "43", "57", "70"),
+        ("generated/r12_2_selfloops", "70", "70", "70"),
+        ("generated/r12_2_somelooped", "70", "70", "70"),
+        ("generated/r12_3", "54", "54", "210"),
+        ("generated/r12_3_falsedefault", "63", "54", "210"),
+        ("generated/r12_3_selfloops", "138", "138", "210"),
+        ("generated/r12_3_somelooped", "62", "62", "210"),
+        ("generated/r12_4", "45", "45", "238"),
+        ("generated/r12_4_falsedefault", "46", "45", "238"),
+        ("generated/r12_4_selfloops", "119", "119", "238"),
+        ("generated/r12_4_somelooped", "119", "119", "238"),
+        ("generated/r12_5", "62", "62", "62"),
+        ("generated/r12_5_falsedefault", "71", "62", "62"),
+        ("generated/r12_5_selfloops", "62", "62", "62"),
+        ("generated/r12_5_somelooped", "62", "62", "62"),
+        ("generated/r12_6", "83", "83", "159"),
+        ("generated/r12_6_falsedefault", "124", "83", "159"),
+        ("generated/r12_6_selfloops", "144", "144", "159"),
+        ("generated/r12_6_somelooped", "104", "104", "159"),
+        ("generated/r30_1", "137/2", "137/2", "121"),
+        ("generated/r30_1_falsedefault", "111/2", "137/2", "121"),
+        ("generated/r30_1_selfloops", "121", "121", "121"),
+        ("generated/r30_1_somelooped", "81", "81", "121"),
+        ("generated/r30_2", "110", "110", "308"),
+        ("generated/r30_2_falsedefault", "138", "110", "308"),
+        ("generated/r30_2_selfloops", "308", "308", "308"),
+        ("generated/r30_2_somelooped", "130", "130", "308"),
+    ];
+
+    fn load(name: &str, times: crate::taskgraph::ExecutionTimes) -> TaskGraph {
+        let text = std::fs::read_to_string(format!("{SDF3}/{name}.xml")).unwrap();
+        let (g, diagnostics) = crate::taskgraph::load_task_graph_as(FileId(0), &text, times);
+        assert!(diagnostics.is_empty(), "{name}: {diagnostics:?}");
+        g.unwrap()
+    }
+
+    /// Every SDF3 benchmark graph and the generated ones (with and without
+    /// self-loops, several execution times per actor): SDF3's own period
+    /// exactly, under each reading, each also checked against the simulation.
     #[test]
-    fn every_sdf3_graph_agrees_with_simulation() {
-        let mut files: Vec<_> = std::fs::read_dir(SDF3)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|x| x == "xml"))
-            .collect();
-        files.sort();
-        assert_eq!(files.len(), 11);
-        let mut periods = Vec::new();
-        for path in files {
-            let text = std::fs::read_to_string(&path).unwrap();
-            let (g, _) = crate::taskgraph::load_task_graph(FileId(0), &text);
-            let g = g.unwrap();
-            let level = Level::build(&g, None, g.name.clone());
-            let counts = repetition_vector(&level).unwrap();
-            let started = std::time::Instant::now();
-            let t = throughput(&level, &counts).unwrap();
-            let elapsed = started.elapsed();
-            assert!(t.period.num > 0, "{}", path.display());
-            assert!(elapsed.as_secs() < 2, "{}: {elapsed:?}", path.display());
-            let name = path.file_stem().unwrap().to_string_lossy().into_owned();
-            let cycle: Vec<&str> = t
-                .critical_cycle
-                .iter()
-                .map(|&v| level.nodes[v].name.as_str())
-                .collect();
-            eprintln!("{name}: period {} on {cycle:?} ({elapsed:?})", t.period);
-            assert_eq!(
-                t.period,
-                simulated_period(&level, &counts),
-                "{}",
-                path.display()
-            );
-            periods.push((name, t.period));
+    fn sdf3_graphs_have_sdf3_periods_and_agree_with_simulation() {
+        use crate::taskgraph::ExecutionTimes::{FileDefault, Sdf3Compat};
+        let mut listed: Vec<String> = Vec::new();
+        for dir in ["", "generated/"] {
+            for e in std::fs::read_dir(format!("{SDF3}/{dir}")).unwrap() {
+                let path = e.unwrap().path();
+                if path.extension().is_some_and(|x| x == "xml") {
+                    let stem = path.file_stem().unwrap().to_string_lossy();
+                    listed.push(format!("{dir}{stem}"));
+                }
+            }
         }
-        // Each checked against the simulation above.
-        let expected = [
-            ("h263decoder", 332046),
-            ("h263encoder", 1232530),
-            ("modem", 16),
-            ("mp3decoder_block_parallelism", 3732276),
-            ("mp3decoder_granule_parallelism", 3732276),
-            ("mp3playback", 120000),
-            ("random_1000", 7378),
-            ("random_200", 1422),
-            ("random_50", 280),
-            ("samplerate", 960),
-            ("satellite", 1056),
-        ];
-        let expected: Vec<(String, Ratio)> = expected
-            .iter()
-            .map(|&(name, period)| (name.to_string(), ratio(period, 1)))
-            .collect();
-        assert_eq!(periods, expected);
+        listed.sort();
+        let mut names: Vec<String> = PERIODS.iter().map(|r| r.0.to_string()).collect();
+        names.sort();
+        assert_eq!(listed, names, "every graph in the table");
+        for &(name, sdf3, auto, single) in PERIODS {
+            let readings = [
+                (Sdf3Compat, Concurrency::Auto, sdf3),
+                (FileDefault, Concurrency::Auto, auto),
+                (FileDefault, Concurrency::Single, single),
+            ];
+            for (times, concurrency, expected) in readings {
+                let g = load(name, times);
+                let level = Level::build(&g, None, g.name.clone());
+                let counts = repetition_vector(&level).unwrap();
+                assert_eq!(find_deadlock(&level, &counts), None, "{name}");
+                let t = throughput(&level, &counts, concurrency).unwrap();
+                let what = format!("{name}, {times:?}, {concurrency:?}");
+                assert_eq!(t.period.to_string(), expected, "{what}");
+                assert_eq!(
+                    t.period,
+                    simulated_period(&level, &counts, concurrency),
+                    "{what}"
+                );
+            }
+        }
     }
 
     #[test]
@@ -640,13 +901,13 @@ mod tests {
         g.tasks[0].wcet = Some(u64::MAX);
         g.tasks[1].wcet = Some(u64::MAX);
         let level = Level::build(&g, None, "g".into());
-        assert_eq!(throughput(&level, &[1, 1]), None);
+        assert_eq!(throughput(&level, &[1, 1], Concurrency::Single), None);
         // Times that fit: the exact period, far beyond what f64 holds exactly.
         g.tasks[0].wcet = Some(u64::MAX / 2 - 1);
         g.tasks[1].wcet = Some(1);
         let level = Level::build(&g, None, "g".into());
         assert_eq!(
-            throughput(&level, &[1, 1]).map(|t| t.period),
+            throughput(&level, &[1, 1], Concurrency::Single).map(|t| t.period),
             Some(ratio(u64::MAX / 2, 1))
         );
         let g = graph(
@@ -656,158 +917,11 @@ mod tests {
         let level = Level::build(&g, None, "g".into());
         let counts = repetition_vector(&level).unwrap();
         assert_eq!(counts, [1, 1_000_000_000]);
-        assert_eq!(throughput(&level, &counts), None);
-        assert_eq!(throughput(&level, &[1]), None, "counts of another level");
-    }
-
-    /// The period of the self-timed execution found by running it: each node
-    /// fires as soon as its inputs allow and it is idle, taking its wcet. Each
-    /// strongly connected part is run alone until its state (samples on its
-    /// edges, remaining time of each node) repeats at a start of its first
-    /// node; the level's period is the largest (with unbounded channels, a
-    /// faster part upstream or downstream does not change a part's period).
-    fn simulated_period(level: &Level<'_>, counts: &[u64]) -> Ratio {
-        let wcet: Vec<u64> = level.nodes.iter().map(|n| n.wcet.unwrap_or(0)).collect();
-        components(level)
-            .iter()
-            .map(|part| simulate_part(level, counts, &wcet, part))
-            .max()
-            .unwrap()
-    }
-
-    fn simulate_part(level: &Level<'_>, counts: &[u64], wcet: &[u64], part: &[usize]) -> Ratio {
-        if part.iter().all(|&v| wcet[v] == 0) {
-            return Ratio::new(0, 1).unwrap();
-        }
-        let n = level.nodes.len();
-        let mut inside = vec![false; n];
-        for &v in part {
-            inside[v] = true;
-        }
-        let edges: Vec<&super::super::level::Edge> = level
-            .edges
-            .iter()
-            .filter(|e| inside[e.src] && inside[e.dst])
-            .collect();
-        let mut tokens: Vec<u64> = edges.iter().map(|e| e.initial_tokens).collect();
-        let mut busy = vec![0u64; n]; // remaining time; 0 when idle
-        let reference = part[0];
-        let (mut time, mut fired) = (0u64, 0u64);
-        let mut seen: HashMap<(Vec<u64>, Vec<u64>), (u64, u64)> = HashMap::new();
-        let mut inputs = vec![Vec::new(); n];
-        let mut outputs = vec![Vec::new(); n];
-        for (i, e) in edges.iter().enumerate() {
-            inputs[e.dst].push(i);
-            outputs[e.src].push(i);
-        }
-        let produce = |v: usize, tokens: &mut Vec<u64>| {
-            for &i in &outputs[v] {
-                tokens[i] += edges[i].produce;
-            }
-        };
-        for _ in 0..10_000_000 {
-            let mut started = false;
-            loop {
-                let mut progress = false;
-                for &v in part {
-                    if busy[v] > 0 || inputs[v].iter().any(|&i| tokens[i] < edges[i].consume) {
-                        continue;
-                    }
-                    for &i in &inputs[v] {
-                        tokens[i] -= edges[i].consume;
-                    }
-                    if wcet[v] == 0 {
-                        produce(v, &mut tokens);
-                    } else {
-                        busy[v] = wcet[v];
-                    }
-                    if v == reference {
-                        fired += 1;
-                        started = true;
-                    }
-                    progress = true;
-                }
-                if !progress {
-                    break;
-                }
-            }
-            if started {
-                let state = (tokens.clone(), part.iter().map(|&v| busy[v]).collect());
-                if let Some((t0, f0)) = seen.insert(state, (time, fired)) {
-                    return Ratio::new((time - t0) * counts[reference], fired - f0).unwrap();
-                }
-            }
-            let dt = part
-                .iter()
-                .map(|&v| busy[v])
-                .filter(|&b| b > 0)
-                .min()
-                .expect("deadlock in simulation");
-            time += dt;
-            for &v in part {
-                if busy[v] > 0 {
-                    busy[v] -= dt;
-                    if busy[v] == 0 {
-                        produce(v, &mut tokens);
-                    }
-                }
-            }
-        }
-        panic!("no periodic state within the step budget");
-    }
-
-    /// Strongly connected components (Kosaraju), each listed by node index.
-    fn components(level: &Level<'_>) -> Vec<Vec<usize>> {
-        let n = level.nodes.len();
-        let mut out = vec![Vec::new(); n];
-        let mut inn = vec![Vec::new(); n];
-        for e in &level.edges {
-            out[e.src].push(e.dst);
-            inn[e.dst].push(e.src);
-        }
-        let mut order = Vec::new();
-        let mut seen = vec![false; n];
-        for root in 0..n {
-            if seen[root] {
-                continue;
-            }
-            seen[root] = true;
-            let mut stack = vec![(root, 0)];
-            while let Some((v, i)) = stack.pop() {
-                if i < out[v].len() {
-                    stack.push((v, i + 1));
-                    let u = out[v][i];
-                    if !seen[u] {
-                        seen[u] = true;
-                        stack.push((u, 0));
-                    }
-                } else {
-                    order.push(v);
-                }
-            }
-        }
-        let mut part = vec![usize::MAX; n];
-        let mut parts: Vec<Vec<usize>> = Vec::new();
-        for &root in order.iter().rev() {
-            if part[root] != usize::MAX {
-                continue;
-            }
-            let id = parts.len();
-            part[root] = id;
-            let mut members = vec![root];
-            let mut stack = vec![root];
-            while let Some(v) = stack.pop() {
-                for &u in &inn[v] {
-                    if part[u] == usize::MAX {
-                        part[u] = id;
-                        members.push(u);
-                        stack.push(u);
-                    }
-                }
-            }
-            members.sort();
-            parts.push(members);
-        }
-        parts
+        assert_eq!(throughput(&level, &counts, Concurrency::Single), None);
+        assert_eq!(
+            throughput(&level, &[1], Concurrency::Single),
+            None,
+            "counts of another level"
+        );
     }
 }

@@ -1,0 +1,476 @@
+//! The storage/throughput trade-off of a level: how small the channels'
+//! buffers can be for each iteration period, as SDF3's buffer sizing
+//! (Stuijk et al., DAC 2006) defines it.
+//!
+//! Model: a channel of capacity α holding `d` initial samples gets a reverse
+//! edge with α − d samples ("space"); a firing claims space for its output
+//! samples when it starts and frees the space of its input samples when it
+//! ends (SDF3's `startActorFiring`/`endActorFiring`). The period of a
+//! distribution of capacities is then the period of the level with those
+//! reverse edges ([`super::throughput`], the same concurrency), exactly.
+//!
+//! Search: from SDF3's per-channel lower bounds (`p + c − gcd(p, c) + d mod
+//! gcd(p, c)`, at least `d`; `p + max(c, d)` on a self-loop), grow the
+//! capacity of a channel whose space edge lies on the critical cycle (or on
+//! the blocking cycle while the distribution deadlocks) by its step
+//! `gcd(p, c)`, trying each such channel and keeping the one giving the
+//! smallest period, until the period with unbounded buffers is reached. Every
+//! point found is a distribution that reaches its period (so its size is an
+//! upper bound on the smallest one that does). Lower bound on the smallest
+//! total reaching the maximal throughput: the sum, over channels, of the
+//! smallest capacity of that channel alone (all others unbounded) that keeps
+//! the maximal throughput, found by bisection when the level is small enough,
+//! else SDF3's per-channel lower bounds. When both bounds meet, the minimum is
+//! exact.
+//!
+//! Cost: each step evaluates one period per candidate channel (at most
+//! [`MAX_CANDIDATES`] tried one by one; beyond, all are grown together), and
+//! the search stops after [`MAX_EVALUATIONS`] periods with what it has found,
+//! stating the bounds.
+
+use super::consistency::repetition_vector;
+use super::level::{Edge, Level};
+use super::ratio::{Ratio, gcd};
+use super::throughput::{Concurrency, throughput};
+
+/// Candidate channels tried one at a time per step; more are grown together.
+const MAX_CANDIDATES: usize = 8;
+/// The work the search may do, counted as Σ over evaluated distributions of
+/// the level's firings plus edges (an evaluation is linear in the HSDF per
+/// policy iteration); half of it for the trade-off, the rest for the lower
+/// bound. Beyond it, the search stops with what it has and says so.
+const MAX_WORK: u64 = 6_000_000;
+
+/// One distribution of buffer capacities and the period it reaches.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Point {
+    /// Σ capacities.
+    pub size: u64,
+    pub period: Ratio,
+    /// Per edge of the level, its capacity in samples.
+    pub capacities: Vec<u64>,
+}
+
+/// The trade-off found for one level.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TradeOff {
+    /// The period with unbounded buffers (the maximal throughput).
+    pub max_period: Ratio,
+    /// Distributions found, by increasing size and strictly decreasing
+    /// period; the last reaches `max_period` when `complete`.
+    pub points: Vec<Point>,
+    /// No distribution smaller than this reaches `max_period`.
+    pub lower_bound: u64,
+    /// Whether the search reached `max_period` within its budget.
+    pub complete: bool,
+    /// Periods evaluated.
+    pub evaluations: usize,
+}
+
+impl TradeOff {
+    /// The smallest distribution found that reaches the maximal throughput.
+    pub fn for_max_throughput(&self) -> Option<&Point> {
+        self.points
+            .last()
+            .filter(|p| self.complete && p.period == self.max_period)
+    }
+
+    /// Whether the smallest total size for the maximal throughput is known
+    /// exactly (found, and equal to the lower bound).
+    pub fn exact(&self) -> bool {
+        self.for_max_throughput()
+            .is_some_and(|p| p.size == self.lower_bound)
+    }
+
+    /// The smallest distribution found whose period is at most `period`.
+    pub fn for_period(&self, period: Ratio) -> Option<&Point> {
+        self.points.iter().find(|p| p.period <= period)
+    }
+}
+
+/// SDF3's lower bound on a channel's capacity for a positive throughput.
+pub fn minimal_capacity(e: &Edge) -> u64 {
+    let (p, c, d) = (e.produce, e.consume, e.initial_tokens);
+    if e.src == e.dst {
+        return p + c.max(d);
+    }
+    let g = gcd(p, c).max(1);
+    (p + c - g + d % g).max(d)
+}
+
+/// The level with a space edge for each capacity: its edges, then per edge
+/// `i` an edge from its destination to its source carrying `caps[i] − d`.
+fn bounded<'g>(level: &Level<'g>, caps: &[Option<u64>]) -> Level<'g> {
+    let mut out = level.clone();
+    for (e, cap) in level.edges.iter().zip(caps) {
+        if let Some(cap) = cap {
+            out.edges.push(Edge {
+                src: e.dst,
+                dst: e.src,
+                produce: e.consume,
+                consume: e.produce,
+                initial_tokens: cap.saturating_sub(e.initial_tokens),
+                channel: e.channel,
+                span: e.span,
+                label: e.label.clone(),
+            });
+        }
+    }
+    out
+}
+
+/// What a distribution gives: its period, or the space edges (as level
+/// edge indices) of a cycle that blocks it.
+enum Outcome {
+    Period(Ratio, Vec<usize>),
+    Blocked(Vec<usize>),
+}
+
+struct Search<'l, 'g> {
+    level: &'l Level<'g>,
+    counts: Vec<u64>,
+    concurrency: Concurrency,
+    evaluations: usize,
+    work: u64,
+}
+
+impl Search<'_, '_> {
+    /// The work of one evaluation: the size of the HSDF with space edges
+    /// (as `throughput` expands it).
+    fn cost(&self) -> u64 {
+        let g = &self.counts;
+        let mut size: u64 = g.iter().sum();
+        for e in &self.level.edges {
+            let data = g[e.dst].saturating_mul((e.consume.div_ceil(e.produce) + 1).min(g[e.src]));
+            let space = g[e.src].saturating_mul((e.produce.div_ceil(e.consume) + 1).min(g[e.dst]));
+            size = size.saturating_add(data).saturating_add(space);
+        }
+        size
+    }
+
+    fn within(&self, budget: u64) -> bool {
+        self.work.saturating_add(self.cost()) <= budget
+    }
+
+    fn evaluate(&mut self, caps: &[Option<u64>]) -> Option<Outcome> {
+        self.evaluations += 1;
+        self.work = self.work.saturating_add(self.cost());
+        let n = self.level.edges.len();
+        let with_space = bounded(self.level, caps);
+        // Space edge k of `with_space` (k ≥ n) belongs to the k-th bounded edge.
+        let owner: Vec<usize> = (0..n).filter(|&i| caps[i].is_some()).collect();
+        if let Some(blocked) = super::deadlock::find_deadlock(&with_space, &self.counts) {
+            let space: Vec<usize> = blocked
+                .edges
+                .iter()
+                .filter(|&&k| k >= n)
+                .map(|&k| owner[k - n])
+                .collect();
+            return Some(Outcome::Blocked(space));
+        }
+        let t = throughput(&with_space, &self.counts, self.concurrency)?;
+        // Space edges joining consecutive nodes of the critical cycle (a
+        // self-loop's when the cycle is one node).
+        let cycle = &t.critical_cycle;
+        let mut on_cycle = Vec::new();
+        for (k, e) in with_space.edges.iter().enumerate().skip(n) {
+            let joins = if e.src == e.dst {
+                cycle.contains(&e.src)
+            } else {
+                (0..cycle.len()).any(|i| e.src == cycle[i] && e.dst == cycle[(i + 1) % cycle.len()])
+            };
+            if joins {
+                on_cycle.push(owner[k - n]);
+            }
+        }
+        Some(Outcome::Period(t.period, on_cycle))
+    }
+}
+
+/// The storage/throughput trade-off of a consistent, deadlock-free level
+/// under `concurrency`; `None` when the level is inconsistent or its period
+/// cannot be computed (see [`throughput`]).
+pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff> {
+    let counts = repetition_vector(level).ok()?;
+    let max_period = throughput(level, &counts, concurrency)?.period;
+    let mut search = Search {
+        level,
+        counts,
+        concurrency,
+        evaluations: 1,
+        work: 0,
+    };
+    search.work = search.cost();
+    let steps: Vec<u64> = level
+        .edges
+        .iter()
+        .map(|e| gcd(e.produce, e.consume).max(1))
+        .collect();
+    let mut caps: Vec<u64> = level.edges.iter().map(minimal_capacity).collect();
+
+    let mut points: Vec<Point> = Vec::new();
+    let mut complete = false;
+    let bounded_caps = |caps: &[u64]| caps.iter().map(|&c| Some(c)).collect::<Vec<_>>();
+    let mut current = search.evaluate(&bounded_caps(&caps))?;
+    // Steps in a row that did not lower the period: past a few per channel,
+    // growing one channel at a time is stuck on ties, and the search from
+    // above takes over.
+    let mut stale = 0usize;
+    // Steps in a row that left the distribution blocked.
+    let mut blocked = 0usize;
+    while search.within(MAX_WORK / 3) && stale <= caps.len() + 4 {
+        let grow: Vec<usize> = match &current {
+            Outcome::Period(period, on_cycle) => {
+                let size = caps.iter().sum();
+                blocked = 0;
+                stale += 1;
+                if points.last().is_none_or(|p| *period < p.period) {
+                    stale = 0;
+                    points.push(Point {
+                        size,
+                        period: *period,
+                        capacities: caps.clone(),
+                    });
+                }
+                if *period <= max_period {
+                    complete = true;
+                    break;
+                }
+                on_cycle.clone()
+            }
+            Outcome::Blocked(space) if !space.is_empty() && blocked > 8 => {
+                // Still not live after a few steps (a large graph far from
+                // live): double the blocking cycle's channels (the lower
+                // bound still says how far from the minimum it lands).
+                let mut trial = caps.clone();
+                for &i in space {
+                    trial[i] = trial[i].saturating_mul(2).max(trial[i] + steps[i]);
+                }
+                current = search.evaluate(&bounded_caps(&trial))?;
+                caps = trial;
+                continue;
+            }
+            Outcome::Blocked(space) => {
+                blocked += 1;
+                space.clone()
+            }
+        };
+        let grow = if grow.is_empty() {
+            // No space edge found on the cycle (ties between cycles): grow
+            // every channel, which only moves towards unbounded buffers.
+            (0..caps.len()).collect()
+        } else {
+            grow
+        };
+        let mut best: Option<(Ratio, Vec<u64>, Outcome)> = None;
+        if grow.len() <= MAX_CANDIDATES {
+            for &i in &grow {
+                let mut trial = caps.clone();
+                trial[i] = trial[i].saturating_add(steps[i]);
+                let Some(outcome) = search.evaluate(&bounded_caps(&trial)) else {
+                    continue;
+                };
+                let rank = match &outcome {
+                    Outcome::Period(p, _) => *p,
+                    Outcome::Blocked(_) => Ratio {
+                        num: u64::MAX,
+                        den: 1,
+                    },
+                };
+                if best.as_ref().is_none_or(|b| rank < b.0) {
+                    best = Some((rank, trial, outcome));
+                }
+            }
+        }
+        let (trial, outcome) = match best {
+            Some((_, trial, outcome)) => (trial, outcome),
+            None => {
+                let mut trial = caps.clone();
+                for &i in &grow {
+                    trial[i] = trial[i].saturating_add(steps[i]);
+                }
+                let outcome = search.evaluate(&bounded_caps(&trial))?;
+                (trial, outcome)
+            }
+        };
+        caps = trial;
+        current = outcome;
+    }
+    let minimal: Vec<u64> = level.edges.iter().map(minimal_capacity).collect();
+    let reaching = if complete {
+        Some(caps.clone())
+    } else if max_period.num == 0 {
+        // Nothing bounds the throughput but the buffers: no finite
+        // distribution reaches it.
+        None
+    } else {
+        grown(&mut search, &caps, &steps, max_period)
+    };
+    if let Some(reaching) = reaching {
+        // Each channel alone brought down as far as the others allow.
+        let caps = shrink(&mut search, reaching, &minimal, max_period);
+        let size: u64 = caps.iter().sum();
+        // The points grown from below that are no smaller are dominated.
+        points.retain(|p| p.size < size && p.period > max_period);
+        points.push(Point {
+            size,
+            period: max_period,
+            capacities: caps,
+        });
+        complete = true;
+    }
+    let reached = points
+        .last()
+        .filter(|p| complete && p.period == max_period)
+        .map(|p| p.capacities.clone());
+    let lower_bound = lower_bound(&mut search, max_period, reached.as_deref());
+    Some(TradeOff {
+        max_period,
+        points,
+        lower_bound,
+        complete,
+        evaluations: search.evaluations,
+    })
+}
+
+/// A distribution reaching `max_period`, for levels where growing from below
+/// did not get there within its budget: the channels on the critical (or
+/// blocking) cycle are doubled until the period is reached. `None` if the
+/// budget runs out first.
+fn grown(
+    search: &mut Search<'_, '_>,
+    from: &[u64],
+    steps: &[u64],
+    max_period: Ratio,
+) -> Option<Vec<u64>> {
+    let budget = 2 * MAX_WORK / 3;
+    let all = |caps: &[u64]| caps.iter().map(|&c| Some(c)).collect::<Vec<_>>();
+    let mut caps = from.to_vec();
+    let mut last = None;
+    loop {
+        if !search.within(budget) {
+            return None;
+        }
+        let (period, grow) = match search.evaluate(&all(&caps))? {
+            Outcome::Period(p, _) if p <= max_period => break,
+            Outcome::Period(p, on_cycle) => (Some(p), on_cycle),
+            Outcome::Blocked(on_cycle) => (None, on_cycle),
+        };
+        // Every channel when the cycle's did not help last time.
+        let stuck = period.is_some() && period == last;
+        last = period;
+        let grow: Vec<usize> = if grow.is_empty() || stuck {
+            (0..caps.len()).collect()
+        } else {
+            grow
+        };
+        for i in grow {
+            caps[i] = caps[i].checked_mul(2)?.max(caps[i] + steps[i]);
+        }
+    }
+    Some(caps)
+}
+
+/// `caps` (reaching `max_period`) with each channel in turn bisected down
+/// to the smallest capacity (at least `minimal`) that keeps the period, the
+/// others fixed, while the work budget lasts.
+fn shrink(
+    search: &mut Search<'_, '_>,
+    mut caps: Vec<u64>,
+    minimal: &[u64],
+    max_period: Ratio,
+) -> Vec<u64> {
+    let all = |caps: &[u64]| caps.iter().map(|&c| Some(c)).collect::<Vec<_>>();
+    let reaches = |search: &mut Search<'_, '_>, caps: &[u64]| matches!(search.evaluate(&all(caps)), Some(Outcome::Period(p, _)) if p <= max_period);
+    for i in 0..caps.len() {
+        let (mut low, mut high) = (minimal[i], caps[i]);
+        if low >= high || !search.within(MAX_WORK * 2 / 3) {
+            continue;
+        }
+        let mut trial = caps.clone();
+        trial[i] = low;
+        if reaches(search, &trial) {
+            caps[i] = low;
+            continue;
+        }
+        // `low` fails, `high` reaches.
+        while high - low > 1 && search.within(MAX_WORK * 2 / 3) {
+            let middle = low + (high - low) / 2;
+            trial[i] = middle;
+            if reaches(search, &trial) {
+                high = middle;
+            } else {
+                low = middle;
+            }
+        }
+        caps[i] = high;
+    }
+    caps
+}
+
+/// Σ over channels of the smallest capacity of that channel alone (the
+/// others unbounded) keeping `max_period`, each at least SDF3's lower bound
+/// (`found`: the capacities of a distribution reaching it, if any). A channel
+/// at its SDF3 lower bound in `found` needs no search; the others are
+/// bisected while the work budget lasts, and keep SDF3's bound beyond it.
+fn lower_bound(search: &mut Search<'_, '_>, max_period: Ratio, found: Option<&[u64]>) -> u64 {
+    let level = search.level;
+    let minimal: Vec<u64> = level.edges.iter().map(minimal_capacity).collect();
+    let mut total = 0u64;
+    for i in 0..level.edges.len() {
+        let ceiling = found.map(|caps| caps[i]);
+        if ceiling == Some(minimal[i]) || !search.within(MAX_WORK) {
+            total += minimal[i];
+            continue;
+        }
+        let reaches = |search: &mut Search<'_, '_>, cap: u64| {
+            let mut caps = vec![None; level.edges.len()];
+            caps[i] = Some(cap);
+            matches!(search.evaluate(&caps), Some(Outcome::Period(p, _)) if p <= max_period)
+        };
+        let mut low = minimal[i];
+        if reaches(search, low) {
+            total += low;
+            continue;
+        }
+        let high = match ceiling {
+            Some(high) => Some(high),
+            None => {
+                // Double until the channel alone no longer holds the period back.
+                let mut high = low;
+                let mut reached = None;
+                while search.within(MAX_WORK) {
+                    let Some(next) = high.checked_mul(2) else {
+                        break;
+                    };
+                    high = next;
+                    if reaches(search, high) {
+                        reached = Some(high);
+                        break;
+                    }
+                    low = high;
+                }
+                reached
+            }
+        };
+        let Some(mut high) = high else {
+            total += low;
+            continue;
+        };
+        // `low` fails, `high` reaches (capacity only ever helps).
+        while high - low > 1 && search.within(MAX_WORK) {
+            let middle = low + (high - low) / 2;
+            if reaches(search, middle) {
+                high = middle;
+            } else {
+                low = middle;
+            }
+        }
+        // Cut short: `low + 1` is still a sure bound.
+        total += if high - low > 1 { low + 1 } else { high };
+    }
+    total
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,211 @@
+use super::*;
+use crate::diag::FileId;
+use crate::taskgraph::ExecutionTimes;
+use crate::taskgraph::analysis::testing::{self, port, simulated_period};
+use crate::taskgraph::model::*;
+use proptest::prelude::*;
+
+const SDF3: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sdf3");
+
+fn load(name: &str) -> TaskGraph {
+    let text = std::fs::read_to_string(format!("{SDF3}/{name}.xml")).unwrap();
+    let (g, _) = crate::taskgraph::load_task_graph_as(FileId(0), &text, ExecutionTimes::Sdf3Compat);
+    g.unwrap()
+}
+
+fn ratio(num: u64, den: u64) -> Ratio {
+    Ratio::new(num, den).unwrap()
+}
+
+/// Each point's distribution reaches its period: checked by running the
+/// level with its space edges in the independent simulation.
+fn check_points(level: &Level<'_>, found: &TradeOff, concurrency: Concurrency) {
+    let counts = repetition_vector(level).unwrap();
+    for p in &found.points {
+        assert_eq!(p.size, p.capacities.iter().sum::<u64>());
+        let caps: Vec<Option<u64>> = p.capacities.iter().map(|&c| Some(c)).collect();
+        let with_space = bounded(level, &caps);
+        assert_eq!(
+            simulated_period(&with_space, &counts, concurrency),
+            p.period,
+            "{} at {:?}",
+            level.path,
+            p.capacities
+        );
+    }
+    for pair in found.points.windows(2) {
+        assert!(pair[0].size < pair[1].size && pair[0].period > pair[1].period);
+    }
+}
+
+/// The trade-off SDF3's `sdf3analysis-sdf --algo buffersize` gives (its
+/// whole Pareto front, `tests/data/sdf3/README.md`), found exactly.
+#[test]
+fn sdf3_buffer_fronts_are_found() {
+    let cases: &[(&str, &[(u64, u64)])] = &[
+        ("modem", &[(70, 32), (71, 18), (72, 16)]),
+        ("samplerate", &[(44, 1088), (45, 1029), (46, 960)]),
+        ("random_200", &[(982, 203), (983, 181), (984, 170)]),
+        ("satellite", &[(1586, 1320), (1588, 1056)]),
+    ];
+    for &(name, front) in cases {
+        let g = load(name);
+        let level = Level::build(&g, None, g.name.clone());
+        let found = trade_off(&level, Concurrency::Auto).unwrap();
+        let points: Vec<(u64, Ratio)> = found.points.iter().map(|p| (p.size, p.period)).collect();
+        let expected: Vec<(u64, Ratio)> = front.iter().map(|&(s, p)| (s, ratio(p, 1))).collect();
+        assert_eq!(points, expected, "{name}");
+        assert!(found.exact(), "{name}");
+        check_points(&level, &found, Concurrency::Auto);
+    }
+}
+
+/// The smallest total size for the maximal throughput, against SDF3's on
+/// the graphs it explores within 120 s, and with bounds that hold SDF3's
+/// answer where `semo` cannot tell it exactly; on the three graphs SDF3 does
+/// not finish, an answer and bounds.
+#[test]
+fn smallest_size_for_the_maximal_throughput() {
+    // (graph, lower bound, size found, SDF3's minimum if it finished)
+    let cases = [
+        ("h263decoder", 1220, 1230, Some(1230)),
+        ("h263encoder", 401, 401, Some(401)),
+        ("modem", 72, 72, Some(72)),
+        ("random_50", 242, 242, Some(242)),
+        ("random_200", 984, 984, Some(984)),
+        ("random_1000", 6611, 6611, Some(6611)),
+        ("samplerate", 46, 46, Some(46)),
+        ("satellite", 1588, 1588, Some(1588)),
+        ("mp3decoder_granule_parallelism", 82, 82, None),
+        ("mp3decoder_block_parallelism", 1784, 1898, None),
+        ("mp3playback", 2907, 2918, None),
+    ];
+    for (name, low, size, sdf3) in cases {
+        let g = load(name);
+        let level = Level::build(&g, None, g.name.clone());
+        let found = trade_off(&level, Concurrency::Auto).unwrap();
+        let reached = found.for_max_throughput().expect(name);
+        assert_eq!((found.lower_bound, reached.size), (low, size), "{name}");
+        assert_eq!(found.exact(), low == size, "{name}");
+        if let Some(sdf3) = sdf3 {
+            assert!(low <= sdf3 && sdf3 <= size, "{name}");
+        }
+    }
+}
+
+/// A two-task cycle by hand: A (time 1) makes 2 samples per firing for B
+/// (time 1, takes 3); B sends 3 back, A takes 2, 6 initial samples there.
+/// The channel A → B needs 2 + 3 − 1 = 4 places to run at all.
+#[test]
+fn a_multirate_pair_by_hand() {
+    let mut a = testing::task("A", &["o>2", "i<2"]);
+    a.wcet = Some(1);
+    let mut b = testing::task("B", &["i<3", "o>3"]);
+    b.wcet = Some(1);
+    let g = testing::graph(
+        "g",
+        vec![a, b],
+        vec![
+            testing::channel("A.o", "B.i", 0, 0),
+            testing::channel("B.o", "A.i", 6, 1),
+        ],
+    );
+    let level = Level::build(&g, None, "g".into());
+    assert_eq!(minimal_capacity(&level.edges[0]), 4);
+    assert_eq!(minimal_capacity(&level.edges[1]), 6);
+    let found = trade_off(&level, Concurrency::Auto).unwrap();
+    check_points(&level, &found, Concurrency::Auto);
+    assert_eq!(found.points[0].size, 10);
+    assert_eq!(found.points.last().unwrap().period, found.max_period);
+}
+
+/// A random consistent, live level of 2 or 3 tasks and up to 4 channels.
+fn small_level() -> impl Strategy<Value = TaskGraph> {
+    (2usize..4).prop_flat_map(|n| {
+        (
+            proptest::collection::vec(1u64..4, n),
+            proptest::collection::vec(1u64..5, n),
+            proptest::collection::vec((0usize..3, 0usize..3, 1u64..3, 0u64..8), n..n + 2),
+        )
+            .prop_map(move |(gamma, wcet, edges)| {
+                let mut tasks: Vec<Task> = (0..n)
+                    .map(|v| Task {
+                        wcet: Some(wcet[v]),
+                        ..testing::task(&format!("T{v}"), &[])
+                    })
+                    .collect();
+                let mut channels = Vec::new();
+                for (i, &(s, d, m, fill)) in edges.iter().enumerate() {
+                    // The first n channels make a ring; the others are random.
+                    let (s, d) = if i < n {
+                        (i, (i + 1) % n)
+                    } else {
+                        (s % n, d % n)
+                    };
+                    let l = crate::taskgraph::analysis::ratio::lcm(gamma[s], gamma[d]).unwrap() * m;
+                    let (p, c) = (l / gamma[s], l / gamma[d]);
+                    tasks[s].ports.push(port(&format!("o{i}>{p}")));
+                    tasks[d].ports.push(port(&format!("i{i}<{c}")));
+                    channels.push(testing::channel(
+                        &format!("T{s}.o{i}"),
+                        &format!("T{d}.i{i}"),
+                        fill,
+                        i,
+                    ));
+                }
+                testing::graph("g", tasks, channels)
+            })
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// On small levels, every distribution of capacities up to the one
+    /// found (plus a margin) is tried: none smaller than the lower bound
+    /// reaches the maximal throughput, and when the answer is called exact
+    /// none smaller than it does; every point reaches its period in the
+    /// simulation.
+    #[test]
+    fn bounds_hold_against_exhaustive_search(g in small_level()) {
+        let level = Level::build(&g, None, "g".into());
+        let counts = repetition_vector(&level).unwrap();
+        prop_assume!(super::super::deadlock::find_deadlock(&level, &counts).is_none());
+        for concurrency in [Concurrency::Auto, Concurrency::Single] {
+            let found = trade_off(&level, concurrency).unwrap();
+            check_points(&level, &found, concurrency);
+            let reached = found.for_max_throughput().unwrap();
+            let minimal: Vec<u64> = level.edges.iter().map(minimal_capacity).collect();
+            let top: Vec<u64> = reached.capacities.iter().map(|&c| c + 1).collect();
+            let tries: u64 = top.iter().zip(&minimal).map(|(t, m)| t - m + 1).product();
+            prop_assume!(tries <= 1000);
+            // Every distribution between the minimal capacities and `top`.
+            let mut caps = minimal.clone();
+            let mut smallest = u64::MAX;
+            'all: loop {
+                let size: u64 = caps.iter().sum();
+                if size < smallest {
+                    let with_space = bounded(&level, &caps.iter().map(|&c| Some(c)).collect::<Vec<_>>());
+                    if super::super::deadlock::find_deadlock(&with_space, &counts).is_none()
+                        && throughput(&with_space, &counts, concurrency).unwrap().period <= found.max_period
+                    {
+                        smallest = size;
+                    }
+                }
+                for i in 0..caps.len() {
+                    if caps[i] < top[i] {
+                        caps[i] += 1;
+                        continue 'all;
+                    }
+                    caps[i] = minimal[i];
+                }
+                break;
+            }
+            prop_assert!(found.lower_bound <= smallest, "{:?}: {} > {}", concurrency, found.lower_bound, smallest);
+            prop_assert!(smallest <= reached.size);
+            if found.exact() {
+                prop_assert_eq!(smallest, reached.size);
+            }
+        }
+    }
+}
