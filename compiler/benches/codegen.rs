@@ -30,8 +30,11 @@ fn build(mission: &Path, target: Target, out: &Path) {
     let run = semo::workspace::check_files(files);
     let result = codegen::build(&run, id, target, Emit::All);
     assert!(!result.refused(), "{:#?}", result.diagnostics);
+    let mut transaction = output::Transaction::begin(out, || {}).expect("the output folder");
     for robot in &result.robots {
-        output::write_robot(out, robot).expect("written");
+        transaction
+            .write_robot(robot, target, false)
+            .expect("written");
     }
 }
 

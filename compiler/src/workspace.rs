@@ -145,29 +145,35 @@ pub fn collect(paths: &[PathBuf]) -> Result<Vec<(PathBuf, FileKind)>, LoadError>
     Ok(found)
 }
 
+/// A folder's files of the kinds above, sorted. Hidden entries, `target` and
+/// `node_modules` are skipped; symbolic links to files are read, but links to
+/// folders are not followed, so a link to the folder itself or an ancestor
+/// cannot make the walk loop (nor can a link to `/` make it read the disk).
 fn walk(dir: &Path, found: &mut Vec<(PathBuf, FileKind)>) -> Result<(), LoadError> {
-    let err = |e: std::io::Error| LoadError {
-        path: dir.to_path_buf(),
-        message: e.to_string(),
+    let skipped = |e: &walkdir::DirEntry| {
+        e.depth() > 0
+            && e.file_name()
+                .to_str()
+                .is_some_and(|n| n.starts_with('.') || n == "target" || n == "node_modules")
     };
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(err)?
-        .map(|e| e.map(|e| e.path()))
-        .collect::<Result<_, _>>()
-        .map_err(err)?;
-    entries.sort();
-    for path in entries {
-        let hidden = path
-            .file_name()
-            .and_then(|n| n.to_str())
-            .is_some_and(|n| n.starts_with('.') || n == "target" || n == "node_modules");
-        if hidden {
-            continue;
-        }
-        if path.is_dir() {
-            walk(&path, found)?;
-        } else if let Some(kind) = FileKind::of(&path) {
-            found.push((path, kind));
+    let entries = walkdir::WalkDir::new(dir)
+        .follow_links(false)
+        .sort_by_file_name()
+        .into_iter()
+        .filter_entry(|e| !skipped(e));
+    for entry in entries {
+        let entry = entry.map_err(|e| LoadError {
+            path: e.path().unwrap_or(dir).to_path_buf(),
+            message: e.to_string(),
+        })?;
+        let is_file = match entry.file_type() {
+            t if t.is_file() => true,
+            // A link is read when it leads to a file (`metadata` follows it once).
+            t if t.is_symlink() => std::fs::metadata(entry.path()).is_ok_and(|m| m.is_file()),
+            _ => false,
+        };
+        if let (true, Some(kind)) = (is_file, FileKind::of(entry.path())) {
+            found.push((entry.into_path(), kind));
         }
     }
     Ok(())
@@ -193,10 +199,66 @@ impl CheckRun {
     }
 }
 
-/// A file's text. Invalid UTF-8 is replaced rather than refused, so the rest
-/// is still checked.
+/// The largest file read (missions, catalogs, strategies, task graphs and the
+/// sub-graphs they reference): larger ones are refused with a message rather
+/// than held in memory.
+pub const MAX_FILE_BYTES: u64 = 16 * 1024 * 1024;
+
+/// A file's text: the one reader of every input file of the CLI and the
+/// server. Only regular files are read (a FIFO, a device such as `/dev/zero`
+/// or a socket is refused without blocking on it), and only up to
+/// [`MAX_FILE_BYTES`]. Invalid UTF-8 is replaced rather than refused, so the
+/// rest is still checked.
 pub fn read_text(path: &Path) -> std::io::Result<String> {
-    let bytes = std::fs::read(path)?;
+    read_text_limited(path, MAX_FILE_BYTES)
+}
+
+/// [`read_text`] with another size limit.
+pub fn read_text_limited(path: &Path, limit: u64) -> std::io::Result<String> {
+    use std::io::{Error, ErrorKind, Read};
+    use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
+    // Non-blocking, so that opening a FIFO returns at once instead of waiting
+    // for a writer; the type is checked on the opened file itself.
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(rustix::fs::OFlags::NONBLOCK.bits() as i32)
+        .open(path)?;
+    let meta = file.metadata()?;
+    let kind = meta.file_type();
+    let not_regular = if kind.is_dir() {
+        Some("a folder")
+    } else if kind.is_fifo() {
+        Some("a FIFO")
+    } else if kind.is_char_device() || kind.is_block_device() {
+        Some("a device")
+    } else if kind.is_socket() {
+        Some("a socket")
+    } else if !kind.is_file() {
+        Some("not a regular file")
+    } else {
+        None
+    };
+    if let Some(what) = not_regular {
+        return Err(Error::new(
+            ErrorKind::InvalidInput,
+            format!("is {what}, not a regular file: not read"),
+        ));
+    }
+    let too_large = |size: u64| {
+        Error::new(
+            ErrorKind::FileTooLarge,
+            format!("is {size} bytes, more than the {limit} bytes a file may have: not read"),
+        )
+    };
+    if meta.len() > limit {
+        return Err(too_large(meta.len()));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        // It grew while being read.
+        return Err(too_large(bytes.len() as u64));
+    }
     Ok(String::from_utf8(bytes)
         .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()))
 }
