@@ -590,3 +590,96 @@ fn hostile_file_names_are_escaped_in_every_generated_language() {
         assert_eq!(value["target"], "linux");
     }
 }
+
+#[test]
+fn a_nonsense_time_scale_is_refused_and_the_bounds_run_clean_under_ubsan() {
+    let dir = scratch("time-scale");
+    let mission = copy_example("follow", "follow.mission", &dir);
+    let out = dir.join("out");
+    assert_eq!(build(&mission, &out, &["--target", "linux-sim"]).code, 0);
+    let folder = out.join("Team1/create1");
+    let ubsan = "-std=c11 -O1 -g -fsanitize=undefined -fno-sanitize-recover=all";
+    let made = Command::new("make")
+        .args([
+            "-s",
+            &format!("CFLAGS={ubsan}"),
+            "LDFLAGS=-fsanitize=undefined",
+        ])
+        .current_dir(&folder)
+        .output()
+        .unwrap();
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    let run = |args: &[&str]| {
+        let done = Command::new(folder.join("create1"))
+            .args(args)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&done.stderr).into_owned();
+        assert!(!stderr.contains("runtime error"), "UBSan: {stderr}");
+        (done.status.code(), stderr)
+    };
+    for scale in ["1e-18", "0", "-1", "1e300", "nan"] {
+        std::fs::write(dir.join("s.json"), format!("{{\"time_scale\": {scale}}}")).unwrap();
+        let (code, stderr) = run(&["--scenario", "s.json", "--duration", "10"]);
+        if scale != "nan" {
+            // `nan` is not JSON: refused by the reader before the range.
+            assert!(
+                stderr.contains("\"time_scale\" must be a number from"),
+                "{scale}: {stderr}"
+            );
+        }
+        assert_ne!(code, Some(0), "{scale}");
+        let (code, stderr) = run(&["--time-scale", scale, "--duration", "10"]);
+        assert_eq!(code, Some(2), "{scale}: {stderr}");
+        assert!(
+            stderr.contains("--time-scale must be a number from"),
+            "{scale}: {stderr}"
+        );
+    }
+    // The fastest scale allowed runs a second of mission time and stops.
+    std::fs::write(
+        dir.join("s.json"),
+        "{\"time_scale\": 0.000001, \"duration\": 1000}",
+    )
+    .unwrap();
+    let (code, stderr) = run(&["--scenario", "s.json", "--trace", "trace.jsonl"]);
+    assert_eq!(code, Some(0), "{stderr}");
+}
+
+#[test]
+fn junk_gets_a_bounded_number_of_diagnostics() {
+    let dir = scratch("junk");
+    let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
+    let junk: Vec<u8> = (0..1 << 20)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 24) as u8
+        })
+        .collect();
+    std::fs::write(dir.join("junk.mission"), &junk).unwrap();
+    std::fs::write(dir.join("nul.mission"), vec![0u8; 200_000]).unwrap();
+    for name in ["junk.mission", "nul.mission"] {
+        let (code, diags) = support::check_json_in(&dir, &[name]);
+        assert_eq!(code, 1, "{name}");
+        let syntax = diags.iter().filter(|d| d.code.starts_with("E00")).count();
+        assert!(syntax <= 101, "{name}: {syntax} syntax diagnostics");
+        // Semantic checks add about one per item the junk happens to form.
+        assert!(diags.len() <= 400, "{name}: {} diagnostics", diags.len());
+    }
+    let (_, diags) = support::check_json_in(&dir, &["junk.mission"]);
+    assert!(
+        diags.iter().any(|d| d.code == "E004"),
+        "{}",
+        support::listing(&diags)
+    );
+    // A run of unknown characters is one diagnostic.
+    let (_, diags) = support::check_json_in(&dir, &["nul.mission"]);
+    assert_eq!(diags.iter().filter(|d| d.code == "E001").count(), 1);
+}

@@ -26,7 +26,10 @@
 
 use super::shift::Shift;
 use super::token::{self, Token};
-use super::{ChunkParse, Parse, ast, chunks, lex, parallel, parse_ranges, report_lexical_errors};
+use super::{
+    ChunkParse, Parse, ast, chunks, lex, limit_diagnostics, parallel, parse_ranges,
+    report_lexical_errors,
+};
 use crate::diag::{Diagnostic, FileId};
 use crate::fasthash::{FastHasher, FastMap};
 use crate::span::Span;
@@ -234,6 +237,7 @@ pub fn parse_incremental(
         }
     }
     diagnostics.sort_by_key(|d| (d.span.start, d.span.end));
+    limit_diagnostics(file, &mut diagnostics);
 
     let cache = ParseCache {
         file,

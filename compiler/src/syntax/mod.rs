@@ -71,6 +71,7 @@ fn parse_with(file: FileId, text: &str, two_threads: bool) -> (Parse, Vec<token:
         diagnostics.extend(chunk.diagnostics);
     }
     diagnostics.sort_by_key(|d| (d.span.start, d.span.end));
+    limit_diagnostics(file, &mut diagnostics);
     let parse = Parse {
         file: ast::SourceFile { items },
         diagnostics,
@@ -125,26 +126,53 @@ fn lex(text: &str, two_threads: bool) -> Vec<token::Spanned<'_>> {
 }
 
 /// Reports characters the language does not use and unterminated strings, and
-/// repairs the tokens so that the parser sees the rest of the statement.
+/// repairs the tokens so that the parser sees the rest of the statement. A run
+/// of unknown characters (no space between them) is one diagnostic, so junk
+/// costs one diagnostic per run, not per byte; runs never cross a newline, so
+/// a line's diagnostics depend only on the line (incremental lexing relies on it).
 fn report_lexical_errors(
     file: FileId,
     tokens: &mut Vec<token::Spanned<'_>>,
     diagnostics: &mut Vec<Diagnostic>,
 ) {
-    tokens.retain_mut(|(tok, span)| match *tok {
-        Token::Error(c) => {
-            diagnostics.push(Diagnostic::new(
-                Code::InvalidCharacter,
-                file,
-                Span::new(span.start, span.end),
+    // The run being collected: its span, first character and whether it is
+    // more than that character.
+    let mut run: Option<(Span, char, bool)> = None;
+    let flush = |run: &mut Option<(Span, char, bool)>, diagnostics: &mut Vec<Diagnostic>| {
+        if let Some((span, first, more)) = run.take() {
+            let message = if more {
+                format!(
+                    "these characters (from `{}` on) are not used in mission scripts",
+                    first.escape_debug()
+                )
+            } else {
                 format!(
                     "the character `{}` is not used in mission scripts",
-                    c.escape_debug()
-                ),
-            ));
-            false
+                    first.escape_debug()
+                )
+            };
+            diagnostics.push(Diagnostic::new(Code::InvalidCharacter, file, span, message));
         }
-        Token::Unterminated(raw) => {
+    };
+    tokens.retain_mut(|(tok, span)| {
+        if let Token::Error(c) = *tok {
+            // A token is a run of unknown characters already (the lexer
+            // joins them); runs that touch (`&` then `\0`) are joined here.
+            let one_char = span.end - span.start == c.len_utf8();
+            match &mut run {
+                Some((run_span, _, more)) if run_span.end == span.start => {
+                    run_span.end = span.end;
+                    *more = true;
+                }
+                _ => {
+                    flush(&mut run, diagnostics);
+                    run = Some((Span::new(span.start, span.end), c, !one_char));
+                }
+            }
+            return false;
+        }
+        flush(&mut run, diagnostics);
+        if let Token::Unterminated(raw) = *tok {
             diagnostics.push(Diagnostic::new(
                 Code::UnterminatedString,
                 file,
@@ -152,10 +180,33 @@ fn report_lexical_errors(
                 "this string has no closing quote `\"`",
             ));
             *tok = Token::Str(raw);
-            true
         }
-        _ => true,
+        true
     });
+    flush(&mut run, diagnostics);
+}
+
+/// The most syntax diagnostics reported for one file: past them, the file is
+/// more likely junk than a script, and each costs memory and the editor's time.
+pub const MAX_SYNTAX_DIAGNOSTICS: usize = 100;
+
+/// Keeps the first [`MAX_SYNTAX_DIAGNOSTICS`] of `diagnostics` (sorted by
+/// position) and says how many more there were, where the first of them is.
+fn limit_diagnostics(file: FileId, diagnostics: &mut Vec<Diagnostic>) {
+    if diagnostics.len() <= MAX_SYNTAX_DIAGNOSTICS {
+        return;
+    }
+    let more = diagnostics.len() - MAX_SYNTAX_DIAGNOSTICS;
+    let at = diagnostics[MAX_SYNTAX_DIAGNOSTICS].span;
+    diagnostics.truncate(MAX_SYNTAX_DIAGNOSTICS);
+    diagnostics.push(Diagnostic::new(
+        Code::TooManyProblems,
+        file,
+        at,
+        format!(
+            "{more} more syntax problem(s) from here on are not shown: fix the ones above first (is this a mission script?)"
+        ),
+    ));
 }
 
 /// One chunk balanced and parsed. Everything in it depends only on the

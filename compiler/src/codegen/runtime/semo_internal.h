@@ -20,6 +20,12 @@ void semo__deliver(const semo_message *msg);
 int semo__sim_load(const char *path, const semo_program_desc *program);
 /* The scenario's settings; false when it gives none. */
 bool semo__sim_time_scale(double *out);
+/* The time scales accepted (wall ms per mission ms), from the command line or
+ * a scenario: a million times faster to a million times slower. Beyond them
+ * mission times no longer fit the clock's arithmetic (1e-18 would overflow
+ * the conversion to int64_t), and no simulation needs them. */
+#define SEMO_TIME_SCALE_MIN 1e-6
+#define SEMO_TIME_SCALE_MAX 1e6
 bool semo__sim_duration(int64_t *out);
 /* Starts and stops the thread that injects the operator's commands. */
 int semo__sim_start(void);
