@@ -7,8 +7,8 @@
 mod common;
 use common::fastest;
 
-use semo::cli::build::load;
 use semo::codegen::{self, Emit, Target, output};
+use semo::workspace::load_build as load;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
@@ -28,7 +28,8 @@ fn scratch(name: &str) -> PathBuf {
 fn build(mission: &Path, target: Target, out: &Path) {
     let (files, id) = load(mission, &[]).expect("the example loads");
     let run = semo::workspace::check_files(files);
-    let result = codegen::build(&run, id, target, Emit::All);
+    let input = run.build_input(id).expect("the mission is checked");
+    let result = codegen::build(&input, target, Emit::All);
     assert!(!result.refused(), "{:#?}", result.diagnostics);
     let mut transaction = output::Transaction::begin(out, || {}).expect("the output folder");
     for robot in &result.robots {
@@ -44,7 +45,8 @@ fn main() {
         let (files, id) = load(&mission, &[]).unwrap();
         let in_memory = fastest(Duration::from_secs(2), || {
             let run = semo::workspace::check_files(files.clone());
-            let result = codegen::build(&run, id, target, Emit::All);
+            let input = run.build_input(id).expect("the mission is checked");
+            let result = codegen::build(&input, target, Emit::All);
             std::hint::black_box(result.robots.len());
         });
         let out = scratch("scouting");

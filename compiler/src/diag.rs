@@ -96,6 +96,7 @@ codes! {
     DuplicateCatch = "E032", Error, "a case that catches the same event twice";
     ValueNotProvided = "E033", Error, "a robot value that some robot reading it lacks";
     InvalidPeriod = "E034", Error, "a period or timeout that is not positive";
+    OrderingNotNumeric = "E035", Error, "`<`, `<=`, `>` or `>=` with an operand that is not a number (a word, a string, a text value)";
     // Catalog files (*.robot.xml).
     CatalogXml = "E050", Error, "a catalog file that is not well-formed XML";
     CatalogUnknownElement = "E051", Error, "an element that the catalog format does not have";
@@ -150,9 +151,14 @@ codes! {
     StrategyUnknownAttribute = "W080", Warning, "an attribute that the strategy format does not have";
     UnreachableAction = "W081", Warning, "an action that cannot be reached from the initial action";
     NoFinalAction = "W082", Warning, "an action machine in which no final action can be reached: the service never ends";
+    FinalWithTransitions = "E096", Error, "a final action with outgoing transitions: the service ends there, so they are never taken";
+    UncoveredGuards = "W083", Warning, "an action whose transition conditions leave some values of the variable they compare uncovered: the action waits there for ever";
+    GuardNeverHolds = "W084", Warning, "a transition condition that no value of its variable satisfies";
+    OverlappingGuards = "W085", Warning, "two transitions of one action that can be taken at once: the machine is not deterministic";
     // Code generation (`semo build`).
     CodegenUnsupported = "E100", Error, "a construct that code generation does not support yet";
     OutputNameEscapes = "E101", Error, "a name that cannot become a file or C identifier of the generated code (it could write outside the output folder, or clashes with a generated task)";
+    CodegenInternal = "E102", Error, "an internal error of refinement or code generation: something the checker should have excluded (please report it)";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

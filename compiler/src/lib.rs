@@ -1,31 +1,32 @@
 //! SeMo compiler library: mission scripts for teams of cooperating robots.
 //!
-//! Layers (each reads only the ones above it in this list):
-//! - [`span`], [`text`], [`diag`], [`suggest`]: positions and diagnostics shared by all.
-//! - [`syntax`]: lexer and parser (chumsky) from text to a positioned AST; never panics.
-//! - [`catalog`]: robot types from the built-in catalog and `*.robot.xml` files.
-//! - [`sema`]: name resolution and checks, producing the [`sema::Mission`] IR.
-//! - [`strategy`]: strategy files (`*.strategy.xml`), checked on their own and
-//!   against the catalog and the Mission IR.
-//! - [`format`]: the canonical layout of mission scripts (`semo fmt`), from the
-//!   tokens and the syntax tree.
-//! - [`ide`]: editor features over an analysis (completion, hover, navigation, rename,
-//!   outline, highlighting, folding, selection), as plain data in byte ranges.
-//! - [`modemachine`]: each team's modes and mode changes, and their SVG picture.
-//! - [`workspace`]: loading files and folders from disk for the CLI.
-//! - [`cli`]: the `semo` command (rendering with ariadne or JSON).
+//! The modules are layered: each reads only the modules below it in the
+//! `## Layers` table of ARCHITECTURE.md, which `tests/layering.rs` checks
+//! against every `crate::` path. From the bottom: positions and diagnostics
+//! ([`span`], [`text`], [`diag`], [`edit`]); the languages ([`syntax`],
+//! [`format`], [`catalog`], [`sema`], [`taskgraph`], [`strategy`]); what is
+//! made of them ([`modemachine`], [`ide`], [`refine`], [`codegen`]);
+//! [`workspace`], which reads files from disk; and [`sim`], the simulator
+//! running the refined programs of a mission on a scenario.
+//!
+//! The `semo` command (rendering with ariadne or JSON) is the `semo-cli` crate
+//! (`cli/`), above this library and the language server.
 
 pub mod catalog;
-pub mod cli;
 pub mod codegen;
 pub mod diag;
+pub mod edit;
 /// A fast deterministic hasher for the checker's maps.
 mod fasthash;
 pub mod format;
+pub mod fsread;
 pub mod ide;
+/// Graph drawing shared by the task-graph and mode-machine pictures.
+mod layout;
 pub mod modemachine;
 pub mod refine;
 pub mod sema;
+pub mod sim;
 pub mod span;
 pub mod strategy;
 pub mod suggest;

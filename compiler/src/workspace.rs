@@ -7,6 +7,7 @@
 use crate::catalog::{
     BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE, Catalog, CatalogSource, load_catalog,
 };
+use crate::codegen::BuildInput;
 use crate::diag::{self, Diagnostic, FileId};
 use crate::sema::{Analysis, check_source};
 use crate::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
@@ -197,71 +198,38 @@ impl CheckRun {
     pub fn error_count(&self) -> usize {
         self.diagnostics.iter().filter(|d| d.is_error()).count()
     }
+
+    /// What `mission` is built from: its analysis with this run's catalog,
+    /// strategies and diagnostics. `None` when `mission` is not one of the
+    /// run's missions.
+    pub fn build_input(&self, mission: FileId) -> Option<BuildInput<'_>> {
+        let (_, analysis) = self.analyses.iter().find(|(id, _)| *id == mission)?;
+        let name_of = |id: FileId| {
+            let path = &self.files.get(id).path;
+            path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            )
+        };
+        Some(BuildInput {
+            mission,
+            mission_name: name_of(mission),
+            text: &self.files.get(mission).text,
+            analysis,
+            catalog: &self.catalog,
+            strategies: &self.strategies,
+            strategy_names: self
+                .strategies
+                .iter()
+                .map(|s| (s.file, name_of(s.file)))
+                .collect(),
+            links: &self.strategy_links,
+            diagnostics: &self.diagnostics,
+        })
+    }
 }
 
-/// The largest file read (missions, catalogs, strategies, task graphs and the
-/// sub-graphs they reference): larger ones are refused with a message rather
-/// than held in memory.
-pub const MAX_FILE_BYTES: u64 = 16 * 1024 * 1024;
-
-/// A file's text: the one reader of every input file of the CLI and the
-/// server. Only regular files are read (a FIFO, a device such as `/dev/zero`
-/// or a socket is refused without blocking on it), and only up to
-/// [`MAX_FILE_BYTES`]. Invalid UTF-8 is replaced rather than refused, so the
-/// rest is still checked.
-pub fn read_text(path: &Path) -> std::io::Result<String> {
-    read_text_limited(path, MAX_FILE_BYTES)
-}
-
-/// [`read_text`] with another size limit.
-pub fn read_text_limited(path: &Path, limit: u64) -> std::io::Result<String> {
-    use std::io::{Error, ErrorKind, Read};
-    use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
-    // Non-blocking, so that opening a FIFO returns at once instead of waiting
-    // for a writer; the type is checked on the opened file itself.
-    let file = std::fs::OpenOptions::new()
-        .read(true)
-        .custom_flags(rustix::fs::OFlags::NONBLOCK.bits() as i32)
-        .open(path)?;
-    let meta = file.metadata()?;
-    let kind = meta.file_type();
-    let not_regular = if kind.is_dir() {
-        Some("a folder")
-    } else if kind.is_fifo() {
-        Some("a FIFO")
-    } else if kind.is_char_device() || kind.is_block_device() {
-        Some("a device")
-    } else if kind.is_socket() {
-        Some("a socket")
-    } else if !kind.is_file() {
-        Some("not a regular file")
-    } else {
-        None
-    };
-    if let Some(what) = not_regular {
-        return Err(Error::new(
-            ErrorKind::InvalidInput,
-            format!("is {what}, not a regular file: not read"),
-        ));
-    }
-    let too_large = |size: u64| {
-        Error::new(
-            ErrorKind::FileTooLarge,
-            format!("is {size} bytes, more than the {limit} bytes a file may have: not read"),
-        )
-    };
-    if meta.len() > limit {
-        return Err(too_large(meta.len()));
-    }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    file.take(limit + 1).read_to_end(&mut bytes)?;
-    if bytes.len() as u64 > limit {
-        // It grew while being read.
-        return Err(too_large(bytes.len() as u64));
-    }
-    Ok(String::from_utf8(bytes)
-        .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()))
-}
+pub use crate::fsread::{MAX_FILE_BYTES, read_text, read_text_limited};
 
 /// [`read_text`] for the CLI's loaders: the error names the file.
 pub fn load_text(path: &Path) -> Result<String, LoadError> {
@@ -269,6 +237,36 @@ pub fn load_text(path: &Path) -> Result<String, LoadError> {
         path: path.to_path_buf(),
         message: e.to_string(),
     })
+}
+
+/// The files a build reads: the mission, and the catalog and strategy files
+/// beside it (its folder, recursively) and under each `--strategy` path.
+pub fn load_build(mission: &Path, strategy: &[PathBuf]) -> Result<(Files, FileId), LoadError> {
+    let mut files = Files::default();
+    let id = files.add(
+        mission.to_path_buf(),
+        FileKind::Mission,
+        load_text(mission)?,
+    );
+    let folder = mission
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+        .to_path_buf();
+    let mut roots = vec![folder];
+    roots.extend(strategy.iter().cloned());
+    // A file reached from two roots (`--strategy DIR` inside the mission's
+    // folder: `DIR/x` and `./DIR/x`) is read once: files are known by their
+    // canonical path.
+    let mut seen = std::collections::BTreeSet::new();
+    for (path, kind) in collect(&roots)? {
+        let canonical = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
+        if matches!(kind, FileKind::Catalog | FileKind::Strategy) && seen.insert(canonical) {
+            let text = load_text(&path)?;
+            files.add(path, kind, text);
+        }
+    }
+    Ok((files, id))
 }
 
 /// Reads and checks the given files and folders.

@@ -1,6 +1,5 @@
-//! The SeMo language server. It also builds the `semo` binary, since the
-//! server depends on the compiler library and one binary serves both the CLI
-//! and editors (`semo lsp`).
+//! The SeMo language server, served by the `semo` binary's `semo lsp` (the
+//! `semo-cli` crate calls [`run_stdio`]).
 //!
 //! - [`world`]: files, documents and snapshots (the state, under one std lock).
 //! - [`diagnostics`]: the queue and task that publish diagnostics.

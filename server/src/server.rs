@@ -121,7 +121,8 @@ impl Backend {
         let work = job.clone();
         let (result, text) = tokio::task::spawn_blocking(move || generate::generate(&work))
             .await
-            .map_err(|_| Error::internal_error())?;
+            .map_err(|_| Error::internal_error())?
+            .map_err(|e| handlers::request_failed(e.to_string()))?;
         if result.refused() {
             let errors = result.diagnostics.iter().filter(|d| d.is_error()).count();
             let diagnostics =

@@ -1,6 +1,10 @@
 //! Helpers shared by the end-to-end tests: running the real `semo` binary.
 #![allow(dead_code)]
 
+pub mod cc;
+pub mod missiongen;
+pub mod robots;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

@@ -9,6 +9,7 @@
 use super::c;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::{ActionMachine, Expr, Operand, RobotProgram, SlotSource, State, StateKind};
+use crate::syntax::ast::CmpOp;
 use std::fmt::Write;
 
 /// State transitions a region may take in one firing: a service whose
@@ -30,8 +31,10 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
 
     // Values.
     let _ = writeln!(out, "/* Values the machine reads and writes. */");
-    let _ = writeln!(out, "#define SLOT_COUNT {}", m.slots.len().max(1));
-    let _ = writeln!(out, "static semo_value slot[SLOT_COUNT];");
+    // A robot that reads no values has no slots (an unused array fails -Werror).
+    if !m.slots.is_empty() {
+        let _ = writeln!(out, "static semo_value slot[{}];", m.slots.len());
+    }
     for (i, s) in m.slots.iter().enumerate() {
         let from = match &s.source {
             SlotSource::Sensor { task, .. } => format!("sensor task {task}"),
@@ -151,12 +154,16 @@ fn expr(e: &Expr) -> String {
         Expr::Bool(b) => b.to_string(),
         Expr::Truthy(o) => format!("semo_value_truthy({})", operand(o)),
         Expr::Compare(a, op, b) => {
-            let op = op.as_str();
-            format!(
-                "(semo_value_compare({}, {}) {op} 0)",
-                operand(a),
-                operand(b)
-            )
+            let (a, b) = (operand(a), operand(b));
+            let compared = format!("semo_value_compare({a}, {b}) {} 0", op.as_str());
+            match op {
+                CmpOp::Eq | CmpOp::Ne => format!("({compared})"),
+                // Words are never ordered: the checker refuses them, and a
+                // value that is not a number at run time makes it false.
+                CmpOp::Lt | CmpOp::Le | CmpOp::Gt | CmpOp::Ge => {
+                    format!("(semo_value_numeric({a}) && semo_value_numeric({b}) && {compared})")
+                }
+            }
         }
     }
 }
@@ -198,7 +205,7 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
                 if let Some(lib) = &program.library {
                     let _ = writeln!(
                         out,
-                        "    slot[{i}] = LIBCALL(shared, {}_{});",
+                        "    slot[{i}] = LIBCALL(shared, {}_{}, );",
                         c::ident(&lib.name),
                         getter(&s.key)
                     );
@@ -210,7 +217,7 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
     out.push_str("}\n\n");
 
     if uses("throw_event") {
-        out.push_str("/* `throw`: asks for the mode change that the current mode's `catch` names. */\nstatic void throw_event(const char *event)\n{\n    semo_trace(\"throw\", \"event\", event, NULL);\n    switch (current_mode) {\n");
+        out.push_str("/* `throw`: asks for the mode change that the current mode's `catch` names. */\nstatic void throw_event(const char *event)\n{\n    semo_trace(\"throw\", \"name\", event, NULL);\n    switch (current_mode) {\n");
         for (from, mode) in m.modes.iter().enumerate() {
             let catches: Vec<_> = m.transitions.iter().filter(|t| t.from == from).collect();
             if catches.is_empty() {
@@ -220,7 +227,7 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
             for t in catches {
                 let _ = writeln!(
                     out,
-                    "        if (strcmp(event, {}) == 0 && pending_mode < 0) {{ /* {}:{} */\n            pending_mode = MODE_{};\n            semo_trace(\"catch\", \"event\", event, \"mode\", mode_name[pending_mode], NULL);\n        }}",
+                    "        if (strcmp(event, {}) == 0 && pending_mode < 0) {{ /* {}:{} */\n            pending_mode = MODE_{};\n            semo_trace(\"catch\", \"name\", event, \"mode\", mode_name[pending_mode], NULL);\n        }}",
                     c::string(&t.event),
                     c::comment(&program.mission),
                     t.line,
@@ -241,7 +248,7 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
     }
 
     if uses("request") {
-        out.push_str("/* Writes a service request to the task's queue and starts one firing of it. */\nstatic bool request(int port, const char *task, const char *service, int argc, const semo_value *const *args)\n{\n    semo_request req;\n    memset(&req, 0, sizeof req);\n    strncpy(req.service, service, sizeof req.service - 1);\n    for (int i = 0; i < argc && i < SEMO_MAX_ARGS; i++)\n        req.args[i] = *args[i];\n    req.argc = argc < SEMO_MAX_ARGS ? argc : SEMO_MAX_ARGS;\n    if (UFControl_GetTaskState(task) != SEMO_TASK_IDLE)\n        return false;\n    if (UFPort_WriteToQueue(port, &req, sizeof req) == 0)\n        return false;\n    UFControl_CallTask(task);\n    return true;\n}\n\n");
+        out.push_str("/* Writes a service request to the task's queue and starts one firing of it. */\nstatic bool request(int port, const char *task, const char *service, int argc, const semo_value *const *args)\n{\n    semo_request req;\n    memset(&req, 0, sizeof req);\n    strncpy(req.service, service, sizeof req.service - 1);\n    for (int i = 0; i < argc && i < SEMO_MAX_ARGS; i++)\n        req.args[i] = *args[i];\n    req.argc = argc < SEMO_MAX_ARGS ? argc : SEMO_MAX_ARGS;\n    if (UFControl_GetTaskState(task) != SEMO_TASK_IDLE)\n        return false;\n    /* The task is idle: a request still queued was stopped before its task\n     * fired (a mode change, a timeout) and must not run now. */\n    semo_request stale;\n    while (UFPort_GetNumOfAvailableData(port) > 0)\n        UFPort_ReadFromQueue(port, &stale, sizeof stale);\n    if (UFPort_WriteToQueue(port, &req, sizeof req) == 0)\n        return false;\n    UFControl_CallTask(task);\n    return true;\n}\n\n");
     }
 }
 
@@ -322,6 +329,14 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                     item.message,
                     c::comment(&m.outgoing[item.message].key)
                 );
+                if let Some(group) = item.own_group {
+                    // Its own publication is the latest its subscription sees.
+                    let _ = writeln!(
+                        out,
+                        "        UFMulticast_Write({}, {sent}, sizeof(semo_value));",
+                        c::string(&m.subscribed[group])
+                    );
+                }
             }
             let _ = writeln!(out, "        r->pc = {next};\n        return STEP_NEXT;");
         }

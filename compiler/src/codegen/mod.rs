@@ -13,7 +13,7 @@
 
 mod c;
 mod control;
-mod files;
+pub(crate) mod files;
 pub mod output;
 
 use crate::refine::{RobotProgram, RoleKind};
@@ -256,52 +256,79 @@ impl BuildResult {
     }
 }
 
-/// Generates the code of the mission `mission` of a checked workspace: every
-/// error of the check (in the mission, the catalog or the strategies)
-/// refuses generation, as do problems found while refining.
-pub fn build(
-    run: &crate::workspace::CheckRun,
-    mission: crate::diag::FileId,
-    target: Target,
-    emit: Emit,
-) -> BuildResult {
+/// What a mission is built from: its analysis, the catalog and the strategy
+/// files it sees (as the workspace analysis decided), and every diagnostic of
+/// those files, since any error among them refuses generation.
+pub struct BuildInput<'a> {
+    pub mission: crate::diag::FileId,
+    /// The mission's file name, written into generated headers.
+    pub mission_name: String,
+    pub text: &'a str,
+    pub analysis: &'a crate::sema::Analysis,
+    pub catalog: &'a crate::catalog::Catalog,
+    pub strategies: &'a [crate::strategy::Strategy],
+    /// Each strategy file's name, for generated headers.
+    pub strategy_names: Vec<(crate::diag::FileId, String)>,
+    pub links: &'a crate::strategy::StrategyLinks,
+    /// The diagnostics of the mission, the catalog and the strategies.
+    pub diagnostics: &'a [crate::diag::Diagnostic],
+}
+
+/// Generates the code of a mission: every error of the check (in the
+/// mission, the catalog or the strategies) refuses generation, as do problems
+/// found while refining.
+pub fn build(build: &BuildInput<'_>, target: Target, emit: Emit) -> BuildResult {
+    let Refined {
+        programs,
+        diagnostics,
+        sources,
+    } = refine_checked(build);
+    let robots = programs
+        .iter()
+        .map(|p| generate(p, target, emit, &sources))
+        .collect();
+    BuildResult {
+        robots,
+        diagnostics,
+    }
+}
+
+/// A mission's refined programs, as code generation and the simulator
+/// (`sim`) read them.
+pub struct Refined {
+    /// One per robot, in formation order; empty when refused.
+    pub programs: Vec<crate::refine::RobotProgram>,
+    /// The check's diagnostics and refinement's; any error refuses.
+    pub diagnostics: Vec<crate::diag::Diagnostic>,
+    /// The mission's and the strategy files' names (file headers).
+    pub sources: Vec<String>,
+}
+
+/// Refines a mission: every error of the check (mission, catalog,
+/// strategies) refuses, as do problems found while refining and names that
+/// cannot be files or C identifiers (E101).
+pub fn refine_checked(build: &BuildInput<'_>) -> Refined {
     use crate::diag::{Code, Diagnostic};
-    let mut diagnostics: Vec<Diagnostic> = run.diagnostics.clone();
-    let Some((_, analysis)) = run.analyses.iter().find(|(id, _)| *id == mission) else {
-        return BuildResult {
-            robots: Vec::new(),
-            diagnostics,
-        };
+    let mut diagnostics: Vec<Diagnostic> = build.diagnostics.to_vec();
+    let refused = |diagnostics| Refined {
+        programs: Vec::new(),
+        diagnostics,
+        sources: Vec::new(),
     };
     if diagnostics.iter().any(Diagnostic::is_error) {
-        return BuildResult {
-            robots: Vec::new(),
-            diagnostics,
-        };
+        return refused(diagnostics);
     }
-    let file = run.files.get(mission);
-    let name_of = |id: crate::diag::FileId| {
-        let path = &run.files.get(id).path;
-        path.file_name().map_or_else(
-            || path.display().to_string(),
-            |n| n.to_string_lossy().into_owned(),
-        )
-    };
-    let strategy_names: Vec<_> = run
-        .strategies
-        .iter()
-        .map(|s| (s.file, name_of(s.file)))
-        .collect();
-    let mission_name = name_of(mission);
+    let (mission, analysis) = (build.mission, build.analysis);
+    let (mission_name, strategy_names) = (&build.mission_name, &build.strategy_names);
     let input = crate::refine::RefineInput {
-        mission_name: &mission_name,
+        mission_name,
         file: mission,
-        text: &file.text,
+        text: build.text,
         analysis,
-        catalog: &run.catalog,
-        strategies: &run.strategies,
-        strategy_names: &strategy_names,
-        links: &run.strategy_links,
+        catalog: build.catalog,
+        strategies: build.strategies,
+        strategy_names,
+        links: build.links,
     };
     let (programs, found) = crate::refine::refine(&input);
     diagnostics.extend(found);
@@ -355,19 +382,13 @@ pub fn build(
     }
     crate::diag::sort_and_dedup(&mut diagnostics);
     if diagnostics.iter().any(Diagnostic::is_error) {
-        return BuildResult {
-            robots: Vec::new(),
-            diagnostics,
-        };
+        return refused(diagnostics);
     }
     let mut sources = vec![mission_name.clone()];
     sources.extend(strategy_names.iter().map(|(_, n)| n.clone()));
-    let robots = programs
-        .iter()
-        .map(|p| generate(p, target, emit, &sources))
-        .collect();
-    BuildResult {
-        robots,
+    Refined {
+        programs,
         diagnostics,
+        sources,
     }
 }

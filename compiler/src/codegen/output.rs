@@ -580,7 +580,7 @@ impl<'r> Plan<'r> {
         }
         fsops::write_new(
             &temp.join(manifest::FILE_NAME),
-            manifest.to_json().as_bytes(),
+            manifest.to_text().as_bytes(),
         )
     }
 }
@@ -649,7 +649,7 @@ fn save(
 /// A regular file's bytes, if it is one and not larger than any file
 /// generation writes could be (a larger one is the user's).
 fn read_bounded(path: &Path) -> Option<Vec<u8>> {
-    crate::workspace::read_text_limited(path, crate::workspace::MAX_FILE_BYTES)
+    crate::fsread::read_text_limited(path, crate::fsread::MAX_FILE_BYTES)
         .ok()
         .map(String::into_bytes)
 }

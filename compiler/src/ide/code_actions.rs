@@ -11,27 +11,10 @@
 
 use crate::catalog::Catalog;
 use crate::diag::{Code, Diagnostic};
+pub use crate::edit::{CodeAction, TextEdit};
 use crate::sema::{Analysis, Index, Team, TeamId};
 use crate::span::Span;
 use crate::syntax::ast::{self, Item, SetTarget};
-
-/// Replace `span` with `new_text` (an insertion when `span` is empty).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct TextEdit {
-    pub span: Span,
-    pub new_text: String,
-}
-
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct CodeAction {
-    pub title: String,
-    /// The diagnostic it fixes: an index into the analysis' diagnostics.
-    pub diagnostic: usize,
-    /// Edits of the mission's text, not overlapping, in order.
-    pub edits: Vec<TextEdit>,
-    /// The fix most likely wanted for that diagnostic.
-    pub preferred: bool,
-}
 
 /// The quick fixes for the diagnostics that touch `range`.
 pub fn code_actions(

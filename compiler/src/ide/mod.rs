@@ -13,7 +13,6 @@ mod docs;
 pub mod folding;
 pub mod hover;
 pub mod inlay_hints;
-pub(crate) mod lookup;
 pub mod navigation;
 pub mod rename;
 mod robots;

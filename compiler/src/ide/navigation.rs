@@ -18,10 +18,10 @@
 //! robots of `tb[3]`; a function called by several teams, whose `throw e`
 //! raises an event of each), the results of all of them are given.
 
-use super::lookup;
 use crate::Analysis;
 use crate::catalog::{BUILTIN_FILE, Catalog, Origin, RobotTypeId};
 use crate::diag::FileId;
+use crate::sema::lookup;
 use crate::sema::{Symbol, TeamId};
 use crate::span::Span;
 use crate::syntax::ast::{Item, StmtKind};

@@ -18,11 +18,11 @@
 //! other names mean (a function named like a robot service would take over
 //! its calls).
 
-use super::lookup;
 use super::navigation;
 use crate::Analysis;
 use crate::catalog::Catalog;
 use crate::sema::Symbol;
+use crate::sema::lookup;
 use crate::span::Span;
 use crate::syntax::token::{self, Kw, Token};
 use std::fmt;

@@ -2,9 +2,9 @@
 //! with what it is. Keywords, strings, numbers and comments are left to the
 //! editor's grammar.
 
-use super::lookup;
 use crate::Analysis;
 use crate::sema::Symbol;
+use crate::sema::lookup;
 use crate::span::Span;
 
 /// What a highlighted name is. The protocol legend lists [`TokenKind::ALL`]

@@ -1,6 +1,6 @@
 //! Mode machines as one SVG: a panel per team, modes as rounded boxes laid
 //! out left to right by the task-graph picture's layering stage
-//! ([`crate::taskgraph::svg::layered`]: cycles broken, longest-path layers,
+//! ([`crate::layout::layered`]: cycles broken, longest-path layers,
 //! virtual nodes on long edges, barycenter ordering), mode changes as arrows
 //! labelled with their events, the default mode drawn bold with an initial
 //! dot pointing at it. Changes against the flow (closing a cycle) bow below
@@ -11,8 +11,8 @@
 //! order: the same mission always gives the same bytes.
 
 use super::ModeMachine;
-use crate::taskgraph::svg::layered::{self, Pin};
-use crate::taskgraph::svg::text_width;
+use crate::layout::layered::{self, Pin};
+use crate::layout::text_width;
 use crate::xmlpos::escape;
 use std::fmt::Write;
 

@@ -7,7 +7,7 @@
 //! control task does not wait for its own sends, and SDF would report such a
 //! cycle as a deadlock.
 
-use super::program::{RobotProgram, RoleKind};
+use super::program::{RobotProgram, RoleKind, StateKind};
 use crate::diag::{Code, Diagnostic, FileId, Severity};
 use crate::span::Span;
 use crate::taskgraph::{
@@ -223,6 +223,26 @@ pub fn build(program: &RobotProgram) -> TaskGraph {
             functions,
         });
     }
+    // The control task writes its own publications to the groups it reads.
+    let own_groups: std::collections::BTreeSet<usize> = machine
+        .services
+        .iter()
+        .flat_map(|s| &s.states)
+        .filter_map(|s| match &s.kind {
+            StateKind::Send { items } => Some(items),
+            _ => None,
+        })
+        .flatten()
+        .filter_map(|i| i.own_group)
+        .collect();
+    for g in own_groups {
+        control.multicast_ports.push(MulticastPort {
+            name: named(&format!("own_{g}")),
+            span: Span::default(),
+            dir: Direction::Out,
+            group: named(&machine.subscribed[g]),
+        });
+    }
     tasks.insert(0, control);
     TaskGraph {
         name: program.robot.clone(),
@@ -239,18 +259,23 @@ pub fn build(program: &RobotProgram) -> TaskGraph {
 /// buffer size: the analysis's bound, at least the declared capacity.
 pub fn check(graph: &TaskGraph, file: FileId, robot: Span) -> (Vec<u64>, Vec<Diagnostic>) {
     let report = crate::taskgraph::analysis::analyze(graph);
-    let diagnostics = report
-        .diagnostics
+    // The graph as it is written (`taskgraph.xml`) is read back by the
+    // loader too: it holds the rules of the format itself (names unique,
+    // channel ends exist, ...) that the analyses assume.
+    let written = crate::taskgraph::write::to_xml(graph, "");
+    let (_, loaded) = crate::taskgraph::load_task_graph(FileId(u32::MAX), &written);
+    let diagnostics = loaded
         .iter()
+        .chain(&report.diagnostics)
         .filter(|d| d.severity == Severity::Error)
         .map(|d| {
             Diagnostic::new(
-                Code::CodegenUnsupported,
+                Code::CodegenInternal,
                 file,
                 robot,
                 format!(
-                    "the task graph refined for robot `{}` fails its analysis: {}",
-                    graph.name, d.message
+                    "the task graph refined for robot `{}` fails its own analysis: [{}] {}",
+                    graph.name, d.code, d.message
                 ),
             )
         })

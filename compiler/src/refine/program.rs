@@ -187,6 +187,10 @@ pub struct SendItem {
     pub value: Operand,
     /// `send(T, T.X = v)`: the shared slot `v` is stored in first.
     pub store: Option<usize>,
+    /// A publication of a value this robot also subscribes to: the index into
+    /// [`ControlMachine::subscribed`] of the group it is written to at once,
+    /// since the latest value team T published includes the robot's own.
+    pub own_group: Option<usize>,
 }
 
 /// A strategy entry's actions: the bottom level of the machine.

@@ -7,7 +7,7 @@ use crate::diag::{Code, Diagnostic};
 use crate::sema::{Symbol, Team, TeamId};
 use crate::span::Span;
 use crate::strategy::{DataCharacteristic, ServiceEntry, TaskUseKind};
-use crate::syntax::ast::{self, CondKind, ExprKind, StmtKind};
+use crate::syntax::ast::{self, ExprKind, StmtKind};
 use crate::text::LineIndex;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
@@ -48,12 +48,14 @@ pub(super) fn refine_robot(
     builder.build_modes();
     let self_peer = builder.first_peer() + robot_index;
     let Builder {
-        machine,
-        sensors,
+        mut machine,
+        mut sensors,
         services,
         diagnostics,
         ..
     } = builder;
+    separate_sensor_tasks(&mut machine, &mut sensors, &services);
+    link_own_publications(&mut machine);
     let shared: Vec<String> = machine
         .slots
         .iter()
@@ -172,6 +174,21 @@ impl Builder<'_, '_> {
             .iter()
             .map(|t| t.robots.len())
             .sum()
+    }
+
+    /// A condition the checker should have excluded: refinement refuses
+    /// rather than generate a program that differs from the mission.
+    fn internal_error(&mut self, span: Span, what: &str) {
+        let line = self.line(span);
+        self.diagnostics.push(Diagnostic::new(
+            Code::CodegenInternal,
+            self.input.file,
+            span,
+            format!(
+                "internal error while refining robot `{}` (line {line}): {what}; please report it",
+                self.team.robots[self.robot_index].name
+            ),
+        ));
     }
 
     fn unsupported(&mut self, span: Span, what: &str) {
@@ -392,48 +409,73 @@ impl Builder<'_, '_> {
         }
     }
 
-    /// What this robot runs of a group statement: the first arm whose
-    /// condition it meets (static: its type and capabilities decide), else
-    /// `others`. For a `leader` arm it meets, the choice is made at run time
-    /// among the team's robots that meet it (see [`StateKind::LeaderBranch`]).
-    fn chosen_arm<'s>(&self, group: &'s ast::GroupStmt) -> ArmChoice<'s> {
+    /// What this robot runs of a group statement, as the checker decided it
+    /// (`Mission::scopes`: each arm's body with the robots that run it): the
+    /// first arm it runs, else `others`. For a `leader` arm it runs, the choice
+    /// is made at run time among the robots that run that arm (see
+    /// [`StateKind::LeaderBranch`]).
+    fn chosen_arm<'s>(&mut self, group: &'s ast::GroupStmt) -> ArmChoice<'s> {
         let others = group.others.as_ref().map(|o| &o.body);
         for arm in &group.arms {
-            let meets = |r: &crate::sema::Robot| {
-                let Some(ty) = r.robot_type.map(|id| self.input.catalog.get(id)) else {
-                    return false;
-                };
-                arm.condition
-                    .names
-                    .iter()
-                    .any(|n| match arm.condition.kind {
-                        CondKind::InstanceOf => {
-                            ty.name == n.name.as_str() || ty.aliases.iter().any(|a| a == n.as_str())
-                        }
-                        CondKind::CapableOf => ty.has_capability(&n.name),
-                    })
+            let Some(runners) = self.runners_of(arm.body.span) else {
+                return ArmChoice::Static(None);
             };
-            if !meets(&self.team.robots[self.robot_index]) {
+            if !runners.contains(&self.robot_index) {
                 continue;
             }
             if arm.kind == ast::ArmKind::Leader {
-                let candidates = self
-                    .team
-                    .robots
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, r)| meets(r))
-                    .map(|(i, _)| i)
-                    .collect();
+                // A robot the checker does not let run `others` (the only
+                // candidate always leads) has no `others` branch.
+                let others = match others {
+                    Some(body) => self
+                        .runners_of(body.span)
+                        .filter(|r| r.contains(&self.robot_index))
+                        .map(|_| body),
+                    None => None,
+                };
                 return ArmChoice::Leader {
                     body: &arm.body,
                     others,
-                    candidates,
+                    candidates: runners.into_iter().collect(),
                 };
             }
             return ArmChoice::Static(Some(&arm.body));
         }
-        ArmChoice::Static(others)
+        match others {
+            Some(body) => match self.runners_of(body.span) {
+                Some(runners) if runners.contains(&self.robot_index) => {
+                    ArmChoice::Static(Some(body))
+                }
+                _ => ArmChoice::Static(None),
+            },
+            None => ArmChoice::Static(None),
+        }
+    }
+
+    /// The robots of this robot's team that run the scope at `span`, as the
+    /// checker recorded them (every context it was checked in). A body the
+    /// checker did not record is an internal error.
+    fn runners_of(&mut self, span: Span) -> Option<BTreeSet<usize>> {
+        let mission = &self.input.analysis.mission;
+        let first = mission
+            .scopes
+            .partition_point(|s| s.span.start < span.start);
+        let scope = mission.scopes[first..]
+            .iter()
+            .take_while(|s| s.span.start == span.start)
+            .find(|s| s.span == span);
+        let Some(scope) = scope else {
+            self.internal_error(span, "the checker recorded no robots for this block");
+            return None;
+        };
+        Some(
+            scope
+                .runs
+                .iter()
+                .filter(|r| r.team == Some(self.team_id))
+                .flat_map(|r| r.robots.iter().map(|&i| i as usize))
+                .collect(),
+        )
     }
 
     fn comm(&mut self, comm: &ast::Comm, span: Span, states: &mut Vec<State>, marks: &mut usize) {
@@ -459,6 +501,7 @@ impl Builder<'_, '_> {
                         message,
                         value,
                         store,
+                        own_group: None,
                     });
                 }
                 self.push(states, StateKind::Send { items }, span);
@@ -506,7 +549,7 @@ impl Builder<'_, '_> {
         marks: &mut usize,
         depth: usize,
     ) {
-        let symbols = crate::ide::lookup::with_span(&self.input.analysis.mission, call.name.span);
+        let symbols = crate::sema::lookup::with_span(&self.input.analysis.mission, call.name.span);
         let timeout_ms = call.timeout.as_ref().and_then(period_ms);
         let args: Vec<Operand> = call.args.iter().map(|a| self.arg(a)).collect();
         if let Some(function) = symbols.iter().find_map(|o| match o.symbol {
@@ -523,9 +566,25 @@ impl Builder<'_, '_> {
             }
             return;
         }
-        let name = call.name.name.to_string();
+        // The built-in service the checker resolved the name to.
+        let Some(name) = symbols.iter().find_map(|o| match &o.symbol {
+            Symbol::BuiltinService(name) => Some(name.to_string()),
+            _ => None,
+        }) else {
+            let what = format!(
+                "the checker resolved the call `{}` to no service or function",
+                call.name.name
+            );
+            self.internal_error(call.name.span, &what);
+            return;
+        };
         let Some(def) = self.robot_type.service(&name) else {
-            return; // not a service of this robot: a check error
+            let what = format!(
+                "robot type `{}` has no service `{name}`, yet the checker let this robot call it",
+                self.robot_type.name
+            );
+            self.internal_error(call.name.span, &what);
+            return;
         };
         let service = def.name.clone();
         let mark = next_mark(marks);
@@ -609,7 +668,7 @@ impl Builder<'_, '_> {
             .find(|(f, _)| *f == strategy.file)
             .map(|(_, n)| n.clone())
             .unwrap_or_default();
-        let machine = self.action_machine(entry, service, source, strategy);
+        let machine = self.action_machine(entry, service, source, strategy, span);
         self.machine.actions.push(machine);
         let index = self.machine.actions.len() - 1;
         self.action_machines.insert(key, index);
@@ -622,6 +681,7 @@ impl Builder<'_, '_> {
         service: &str,
         source: String,
         strategy: &crate::strategy::Strategy,
+        call: Span,
     ) -> ActionMachine {
         // Parameter names the conditions read, to their operands.
         let mut names: HashMap<String, Operand> = HashMap::new();
@@ -693,19 +753,29 @@ impl Builder<'_, '_> {
                     commands.push((task, command));
                 }
             }
-            let transitions = action
-                .transitions
-                .iter()
-                .filter_map(|t| {
-                    let to = *index_of.get(&t.dst.as_ref()?.value)?;
-                    let condition = t
-                        .condition
-                        .as_ref()
-                        .and_then(|c| c.expr.as_ref())
-                        .map(|e| self.strategy_condition(e, &names));
-                    Some((condition, to))
-                })
-                .collect();
+            let mut transitions = Vec::new();
+            for t in &action.transitions {
+                let Some(to) = t.dst.as_ref().and_then(|d| index_of.get(&d.value)) else {
+                    let what = format!(
+                        "a transition of strategy action {} of `{service}` goes to no action",
+                        action.describe()
+                    );
+                    self.internal_error(call, &what);
+                    continue;
+                };
+                let condition = match &t.condition {
+                    None => None,
+                    Some(c) => match &c.expr {
+                        Some(e) => Some(self.strategy_condition(e, &names)),
+                        None => {
+                            let what = format!("the condition `{}` did not parse", c.text);
+                            self.internal_error(call, &what);
+                            continue;
+                        }
+                    },
+                };
+                transitions.push((condition, *to));
+            }
             actions.push(ActionState {
                 name: action
                     .name
@@ -718,11 +788,14 @@ impl Builder<'_, '_> {
                 transitions,
             });
         }
-        let initial = entry
-            .actions
-            .iter()
-            .position(|a| a.initial.is_yes())
-            .unwrap_or(0);
+        let initial = match entry.actions.iter().position(|a| a.initial.is_yes()) {
+            Some(i) => i,
+            None => {
+                let what = format!("the strategy of `{service}` has no initial action");
+                self.internal_error(call, &what);
+                0
+            }
+        };
         ActionMachine {
             service: service.to_string(),
             source,
@@ -787,20 +860,55 @@ impl Builder<'_, '_> {
     /// What an attribute in an expression reads: a sensor, a shared value or
     /// a constant.
     fn attr_operand(&mut self, attr: &ast::Attr) -> Operand {
-        let symbols = crate::ide::lookup::with_span(&self.input.analysis.mission, attr.last().span);
+        let symbols =
+            crate::sema::lookup::with_span(&self.input.analysis.mission, attr.last().span);
         let symbol = symbols.first().map(|o| o.symbol.clone());
         match symbol {
+            // The robot's own value: its sensor when its type has one, else
+            // the value its team receives (spec §3: no sensor needed).
             Some(Symbol::Value {
                 owner: Some(owner),
                 name,
-            }) if owner == self.team_id => Operand::Slot(self.sensor_slot(&name)),
+            }) if owner == self.team_id => {
+                if self.robot_type.value(&name).is_some() {
+                    Operand::Slot(self.sensor_slot(&name))
+                } else if self.team_receives(&name) {
+                    let key = self.attr_key(attr);
+                    Operand::Slot(self.shared_slot(&key))
+                } else {
+                    let what = format!(
+                        "robot type `{}` has no value `{name}` and its team does not receive it",
+                        self.robot_type.name
+                    );
+                    self.internal_error(attr.span, &what);
+                    Operand::Literal(String::new())
+                }
+            }
             Some(Symbol::Value { .. }) | Some(Symbol::TeamVariable { .. }) => {
                 let key = self.attr_key(attr);
                 Operand::Slot(self.shared_slot(&key))
             }
             Some(Symbol::Constant(name)) => Operand::Literal(name.to_string()),
-            _ => Operand::Literal(attr.dotted()),
+            other => {
+                let what = format!(
+                    "`{}` is read as a value, but the checker resolved it to {other:?}",
+                    attr.dotted()
+                );
+                self.internal_error(attr.span, &what);
+                Operand::Literal(String::new())
+            }
         }
+    }
+
+    /// Whether the robot's team receives or subscribes to its own value `name`
+    /// (the checker's record of every communication).
+    fn team_receives(&self, name: &str) -> bool {
+        self.input.analysis.mission.messages.iter().any(|m| {
+            m.team == self.team_id
+                && !m.kind.is_outgoing()
+                && m.value.owner == self.team.name
+                && m.value.name == name
+        })
     }
 
     /// `Team.NAME` for an attribute as communication keys write it.
@@ -817,7 +925,8 @@ impl Builder<'_, '_> {
 
     /// A value's catalog name for an alias (`USER.cmd` → `RC_CMD`).
     fn canonical_value_name(&self, attr: &ast::Attr, name: &str) -> String {
-        let symbols = crate::ide::lookup::with_span(&self.input.analysis.mission, attr.last().span);
+        let symbols =
+            crate::sema::lookup::with_span(&self.input.analysis.mission, attr.last().span);
         symbols
             .iter()
             .find_map(|o| match &o.symbol {
@@ -941,6 +1050,59 @@ impl Builder<'_, '_> {
             port,
         });
         self.machine.incoming.len() - 1
+    }
+}
+
+/// Each publication of a value the robot subscribes to also goes to its own
+/// multicast group (known only once every statement is refined).
+fn link_own_publications(machine: &mut ControlMachine) {
+    let ControlMachine {
+        services,
+        outgoing,
+        subscribed,
+        ..
+    } = machine;
+    for state in services.iter_mut().flat_map(|s| s.states.iter_mut()) {
+        if let StateKind::Send { items } = &mut state.kind {
+            for item in items {
+                let message = &outgoing[item.message];
+                if message.publish {
+                    item.own_group = subscribed.iter().position(|g| *g == message.key);
+                }
+            }
+        }
+    }
+}
+
+/// A catalog task may both provide values and serve services (`Ev3_Robot`'s
+/// `search` provides `SEARCHEDCOLOR` and runs `search()`). The generated
+/// program runs the two roles as two tasks (a periodic sensor task and a
+/// called service task), so the sensor role is named `<task>_values` (with
+/// more `_` until the name is free) everywhere the machine refers to it.
+fn separate_sensor_tasks(
+    machine: &mut ControlMachine,
+    sensors: &mut BTreeMap<String, BTreeSet<String>>,
+    services: &BTreeMap<String, BTreeSet<String>>,
+) {
+    let clashing: Vec<String> = sensors
+        .keys()
+        .filter(|t| services.contains_key(*t))
+        .cloned()
+        .collect();
+    for task in clashing {
+        let mut name = format!("{task}_values");
+        while sensors.contains_key(&name) || services.contains_key(&name) {
+            name.push('_');
+        }
+        let values = sensors.remove(&task).unwrap_or_default();
+        sensors.insert(name.clone(), values);
+        for slot in &mut machine.slots {
+            if let SlotSource::Sensor { task: t, .. } = &mut slot.source
+                && *t == task
+            {
+                *t = name.clone();
+            }
+        }
     }
 }
 

@@ -75,6 +75,16 @@ enum Resolution {
     Unchecked,
 }
 
+/// A value read or sent by robots of which some lack it: E033 unless their
+/// team receives it somewhere.
+#[derive(Clone, Debug)]
+pub(super) struct LackingValue {
+    team: Name,
+    name: Name,
+    span: Span,
+    message: String,
+}
+
 /// Where did-you-mean candidates for a bare name come from.
 #[derive(Clone, Debug)]
 enum Candidates {
@@ -109,6 +119,20 @@ impl Type {
             Type::Constant(c) => format!("the constant `{c}`"),
             Type::Unknown => "a value".into(),
         }
+    }
+
+    /// Whether `<`, `<=`, `>`, `>=` may order it: a number, a numeric value,
+    /// a period, or what the checker cannot type (a team variable, or a name
+    /// already reported).
+    fn is_numeric(&self) -> bool {
+        matches!(
+            self,
+            Type::Int
+                | Type::Float
+                | Type::Period
+                | Type::Unknown
+                | Type::Value(ValueType::Int | ValueType::Float)
+        )
     }
 
     /// Whether an argument of this type fits a parameter of type `param`.
@@ -189,6 +213,7 @@ impl<'a> Checker<'a> {
             self.record_scope(body.span, ScopeKind::Rejected, &scope);
             self.block(body, &scope);
         }
+        self.report_lacking_values();
         // Functions nobody calls are still checked, as far as possible without robots.
         for f in 0..self.function_syntax.len() {
             if !self.mission.functions[f].called {
@@ -202,6 +227,16 @@ impl<'a> Checker<'a> {
                 let span = self.function_syntax[f].span;
                 self.record_scope(span, ScopeKind::Function(FunctionId(f as u32)), &scope);
                 self.block(&self.function_syntax[f].body, &scope);
+            }
+        }
+    }
+
+    /// E033 for the values some robots lack and their team does not receive.
+    fn report_lacking_values(&mut self) {
+        for lacking in std::mem::take(&mut self.lacking_values) {
+            let key = (lacking.team.clone(), lacking.name.clone());
+            if !self.received_values.contains(&key) {
+                self.report(Code::ValueNotProvided, lacking.span, lacking.message);
             }
         }
     }
@@ -514,8 +549,8 @@ impl<'a> Checker<'a> {
                 self.condition(a, scope);
                 Type::Bool
             }
-            ExprKind::Compare(lhs, _, rhs) => {
-                self.compare(lhs, rhs, scope);
+            ExprKind::Compare(lhs, op, rhs) => {
+                self.compare(lhs, *op, rhs, scope);
                 Type::Bool
             }
             ExprKind::Str(_) => Type::Text,
@@ -534,7 +569,7 @@ impl<'a> Checker<'a> {
         }
     }
 
-    fn compare(&mut self, lhs: &Expr, rhs: &Expr, scope: &Scope) {
+    fn compare(&mut self, lhs: &Expr, op: ast::CmpOp, rhs: &Expr, scope: &Scope) {
         // A bare unknown name is a constant on the right, and on the left when the
         // right is a known value (`DARK == Guards.Alarm`); against a literal it is
         // a misspelt value (`LIGHTNES < 200`).
@@ -547,6 +582,24 @@ impl<'a> Checker<'a> {
         };
         let lt = self.expr(lhs, scope, rhs_known);
         let rt = self.expr(rhs, scope, true);
+        if matches!(
+            op,
+            ast::CmpOp::Lt | ast::CmpOp::Le | ast::CmpOp::Gt | ast::CmpOp::Ge
+        ) {
+            for (ty, side) in [(&lt, lhs), (&rt, rhs)] {
+                if !ty.is_numeric() {
+                    self.report(
+                        Code::OrderingNotNumeric,
+                        side.span,
+                        format!(
+                            "`{}` orders numbers, but this is {}: compare it with `==` or `!=`, or compare a numeric value",
+                            op.as_str(),
+                            ty.describe()
+                        ),
+                    );
+                }
+            }
+        }
         for (value, value_expr, other, other_span) in
             [(&lt, lhs, &rt, rhs.span), (&rt, rhs, &lt, lhs.span)]
         {
@@ -788,12 +841,28 @@ impl<'a> Checker<'a> {
                 advice,
                 ..
             } => {
-                self.report(
-                    Code::ValueNotProvided,
-                    attr.span,
-                    format!("`{name}` is not a value of {lacking} in team {team}; {advice}"),
+                // Robots read (or send) a value they lack only if their team
+                // receives it: decided once every body is checked.
+                let owner = self.team_id(&team);
+                let ty = self.catalog_value_type(&name);
+                self.occurrence(
+                    last,
+                    Symbol::Value {
+                        owner,
+                        name: name.clone(),
+                    },
+                    false,
                 );
-                Type::Unknown
+                let message = format!(
+                    "`{name}` is not a value of {lacking} in team {team}; {advice}, or receive it"
+                );
+                self.lacking_values.push(LackingValue {
+                    team,
+                    name,
+                    span: attr.span,
+                    message,
+                });
+                ty.map_or(Type::Unknown, Type::Value)
             }
             Resolution::NotInTeam { team, name, known } => {
                 let guess = suggestion(&name, known.iter().map(String::as_str));
@@ -812,6 +881,10 @@ impl<'a> Checker<'a> {
                 };
                 self.report(Code::UnknownAttribute, attr.span, message)
                     .suggest(guess.map(|g| format!("{team}.{g}")));
+                // What it means all the same (a warning lets the mission
+                // build): a team variable nobody sets, which stays empty.
+                let owner = self.team_id(&team);
+                self.occurrence(last, Symbol::TeamVariable { team: owner, name }, false);
                 Type::Unknown
             }
             Resolution::NotATeam { team } => {
@@ -822,6 +895,8 @@ impl<'a> Checker<'a> {
                     format!("`{}`: `{team}` is not a team", attr.dotted()),
                 )
                 .suggest(guess);
+                // What it means all the same: the words as written.
+                self.occurrence(last, Symbol::Constant(Name::new(attr.dotted())), false);
                 Type::Unknown
             }
             Resolution::TooLong => {
@@ -833,6 +908,7 @@ impl<'a> Checker<'a> {
                         attr.dotted()
                     ),
                 );
+                self.occurrence(last, Symbol::Constant(Name::new(attr.dotted())), false);
                 Type::Unknown
             }
             Resolution::Bare { name, .. } if bare_is_constant => {
@@ -850,10 +926,19 @@ impl<'a> Checker<'a> {
                     ),
                 )
                 .suggest(guess);
+                // What it means all the same: a symbolic constant.
+                self.occurrence(last, Symbol::Constant(name), false);
                 Type::Unknown
             }
             Resolution::Unchecked => Type::Unknown,
         }
+    }
+
+    /// The type of a catalog value, from the first robot type that has it.
+    fn catalog_value_type(&self, name: &str) -> Option<ValueType> {
+        self.catalog
+            .types()
+            .find_map(|(_, r)| r.value(name).map(|v| v.ty.clone()))
     }
 
     // ----- groups -----
@@ -1069,6 +1154,15 @@ impl<'a> Checker<'a> {
                     true,
                 );
             } else {
+                // The team's own value, received from its other robots.
+                let receiver = scope.team.map(|t| self.team(t).name.clone());
+                if !comm.kind.is_outgoing()
+                    && let Some(key) = &key
+                    && receiver.as_ref() == Some(&key.owner)
+                {
+                    self.received_values
+                        .insert((key.owner.clone(), key.name.clone()));
+                }
                 self.record_attr(&item.attr, resolution, false);
             }
             match (scope.team, scope.service, peer, key) {

@@ -10,13 +10,16 @@
 //!    reachability, uncaught events, unused services and functions.
 //! 4. [`comm`]: every receive/subscribe matched with a send/publish, and back.
 //!
-//! Sema never reads files and never panics.
+//! Sema never reads files and never panics. [`lookup`] answers "which
+//! symbols are written here" by binary search in the IR's sorted occurrences,
+//! for the editor and for refinement alike.
 
 mod behaviour;
 mod body;
 mod comm;
 mod declare;
 pub mod ir;
+pub(crate) mod lookup;
 
 pub use ir::*;
 
@@ -120,6 +123,12 @@ pub(crate) struct Checker<'a> {
     /// Communication statements naming an unknown team (already reported), as
     /// (kind, running team, value): they may be the counterpart of another.
     comms_with_unknown_team: Vec<(ast::CommKind, TeamId, AttrKey)>,
+    /// A team's own values that its robots receive or subscribe to (team
+    /// name, value): they may read them without having them (spec §3).
+    received_values: std::collections::HashSet<(Name, Name)>,
+    /// E033 findings held back until every body is checked: a value a robot
+    /// lacks is fine wherever its team receives it.
+    lacking_values: Vec<body::LackingValue>,
     /// Function bodies already checked for a (function, team, service, robots):
     /// checking again would find the same, and nested calls would be exponential.
     inlined: FastSet<InlinedBody>,
@@ -151,6 +160,8 @@ impl<'a> Checker<'a> {
             set_by_duplicate_modes: FastSet::default(),
             mains_with_unknown_modes: FastSet::default(),
             comms_with_unknown_team: Vec::new(),
+            received_values: Default::default(),
+            lacking_values: Vec::new(),
             inlined: FastSet::default(),
             team_types: Vec::new(),
             rejected_bodies: Vec::new(),

@@ -10,6 +10,11 @@
 //!   ends, and the statement calling it never returns (unless a timeout
 //!   bounds the call).
 //!
+//! - a final action has no outgoing transitions (E096);
+//! - each action's transition conditions, where they compare one variable
+//!   with numbers, cover every value, each can hold, and no two hold at once
+//!   (`guards.rs`: W083–W085).
+//!
 //! A transition with a wrong `srcId` still counts as leaving its enclosing
 //! action (where it is written), so that one mistake is reported once.
 //! Actions without a usable `actionId` of their own (missing, malformed or
@@ -99,6 +104,19 @@ pub(super) fn check_machine(
                 }
             }
         }
+    }
+
+    for action in actions {
+        if action.is_final.is_yes()
+            && let Some(first) = action.transitions.first()
+        {
+            let message = format!(
+                "{} is final: {name} ends when it is done, so its transitions are never taken (remove them, or its `final` mark)",
+                action.describe()
+            );
+            sink.report(Code::FinalWithTransitions, first.span, message);
+        }
+        super::guards::check_guards(file, action, sink.diagnostics);
     }
 
     if !service.complete {

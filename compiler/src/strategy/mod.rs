@@ -6,6 +6,8 @@
 //!   forms; conditions parsed with the mission expression grammar).
 //! - `check`: per-file checks (duplicates, names read by conditions).
 //! - `machine`: each service's actions checked as a graph (petgraph).
+//! - `guards`: each action's transition conditions over one variable
+//!   (uncovered values, conditions that never hold, overlaps).
 //! - [`schema`]: the vocabulary (attributes, children, descriptions).
 //! - [`ide`]: editor features over the raw text and the model.
 //! - [`cross`]: checks against the catalog and the missions of the same check,
@@ -15,6 +17,7 @@
 
 mod check;
 pub mod cross;
+mod guards;
 pub mod ide;
 mod machine;
 pub mod model;

@@ -111,7 +111,7 @@ fn the_scouting_strategy_loads_cleanly_with_positions() {
 fn a_plain_lt_is_reported_at_the_lt_and_read_as_meant() {
     let text = with_actions(
         r#"<Action name="A" initial="Yes" actionId="0"><Parameter name="distance" type="integer" dataCharacteristic="variable"/>
-<TransitionInfo><Transition srcId="0" dstId="1"><Condition cond="distance<20"/></Transition></TransitionInfo></Action>
+<TransitionInfo><Transition srcId="0" dstId="1"><Condition cond="distance<20"/></Transition><Transition srcId="0" dstId="1"><Condition cond="distance &gt;= 20"/></Transition></TransitionInfo></Action>
 <Action name="B" actionId="1" final="Yes"/>"#,
     );
     let (s, diags) = load(&text);
@@ -132,8 +132,9 @@ fn a_plain_lt_is_reported_at_the_lt_and_read_as_meant() {
 #[test]
 fn conditions_that_do_not_parse_use_the_mission_syntax_codes() {
     let text = with_actions(
-        r#"<Action name="A" initial="Yes" actionId="0" final="Yes"><Parameter name="d" type="integer" dataCharacteristic="variable"/>
-<TransitionInfo><Transition srcId="0" dstId="0"><Condition cond="d &gt;= "/></Transition></TransitionInfo></Action>"#,
+        r#"<Action name="A" initial="Yes" actionId="0"><Parameter name="d" type="integer" dataCharacteristic="variable"/>
+<TransitionInfo><Transition srcId="0" dstId="1"><Condition cond="d &gt;= "/></Transition></TransitionInfo></Action>
+<Action name="B" actionId="1" final="Yes"/>"#,
     );
     let (_, diags) = load(&text);
     assert_eq!(codes(&diags), ["E003"], "{diags:#?}");

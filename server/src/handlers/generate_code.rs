@@ -128,14 +128,17 @@ fn path_of(snapshot: &Snapshot) -> Option<PathBuf> {
 
 /// Checks, refines and generates (no writing yet); the mission's text too,
 /// for positions.
-pub fn generate(job: &Job) -> (BuildResult, String) {
+pub fn generate(job: &Job) -> Result<(BuildResult, String), &'static str> {
     let text = job.files.get(job.mission).text.clone();
     let run = semo::workspace::check_files(job.files.clone());
-    let mut result = codegen::build(&run, job.mission, job.target, Emit::All);
+    let input = run
+        .build_input(job.mission)
+        .ok_or("internal error: the mission was loaded but not checked")?;
+    let mut result = codegen::build(&input, job.target, Emit::All);
     if let Some(team) = &job.team {
         result.robots.retain(|r| &r.team == team);
     }
-    (result, text)
+    Ok((result, text))
 }
 
 /// The refusal's diagnostics in the mission, for publishing.

@@ -156,6 +156,12 @@ int semo_value_compare(const semo_value *a, const semo_value *b)
     return (c > 0) - (c < 0);
 }
 
+bool semo_value_numeric(const semo_value *v)
+{
+    double x;
+    return parse_number(v->text, &x);
+}
+
 bool semo_value_truthy(const semo_value *v)
 {
     double x;

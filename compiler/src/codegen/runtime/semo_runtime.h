@@ -35,6 +35,9 @@ void semo_value_set_int(semo_value *v, long long n);
 /* Numeric comparison when both parse completely as numbers, else strcmp.
  * Returns <0, 0 or >0. */
 int semo_value_compare(const semo_value *a, const semo_value *b);
+/* Whether the value is a number (ordering comparisons hold only between
+ * numbers: generated code never orders words). */
+bool semo_value_numeric(const semo_value *v);
 /* "true" or a non-zero number. */
 bool semo_value_truthy(const semo_value *v);
 
@@ -164,7 +167,9 @@ void UFTimer_Cancel(int id);
 
 /* Library tasks live in the program's address space: a library function is
  * a plain C function (which locks its own state), and a call goes straight
- * to it. `LIBFUNC(int, allFound, (void))`, `LIBCALL(colors, allFound)`. */
+ * to it. `LIBFUNC(int, allFound, (void))`, `LIBCALL(colors, allFound, )`:
+ * a call without arguments still writes the comma, since C11 wants an
+ * argument for `...` (an empty one will do; -Wpedantic checks it). */
 #define LIBFUNC(ret, name, params) ret name params
 #define LIBCALL(port, func, ...) func(__VA_ARGS__)
 

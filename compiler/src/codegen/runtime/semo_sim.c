@@ -501,7 +501,7 @@ static bool read_sensor(reader *r, const json *v, bool keep)
 
 static bool read_robot(reader *r, const json *v, bool keep)
 {
-    static const char *const keys[] = {"sensors", "services", NULL};
+    static const char *const keys[] = {"sensors", "services", "battery", NULL}; /* battery: the simulator's */
     if (!want(r, v, J_OBJECT, "a robot {\"sensors\": [...], \"services\": {...}}") ||
         !known_keys(r, v, keys, "a robot"))
         return false;
@@ -569,7 +569,11 @@ static bool read_command(reader *r, const json *v, const semo_program_desc *prog
 
 static bool read_scenario(reader *r, const json *root, const semo_program_desc *program)
 {
-    static const char *const keys[] = {"time_scale", "duration", "robots", "operator", NULL};
+    /* The shared schema (docs/scenario-and-trace.md): "version", "network",
+     * "faults" and "expect" are the simulator's (`semo simulate`); they are
+     * accepted here and left to it. */
+    static const char *const keys[] = {"version", "time_scale", "duration", "robots", "operator",
+                                       "network", "faults", "expect", NULL};
     if (!want(r, root, J_OBJECT, "a scenario object {\"robots\": ..., \"operator\": ...}") ||
         !known_keys(r, root, keys, "the scenario"))
         return false;

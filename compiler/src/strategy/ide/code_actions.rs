@@ -12,8 +12,8 @@
 use super::raw::{matching_close, position_at};
 use crate::catalog::Catalog;
 use crate::diag::{Code, Diagnostic};
-pub use crate::ide::code_actions::CodeAction;
-use crate::ide::code_actions::TextEdit;
+pub use crate::edit::CodeAction;
+use crate::edit::TextEdit;
 use crate::sema::Analysis;
 use crate::span::Span;
 use crate::strategy::model::Strategy;
@@ -164,7 +164,7 @@ pub fn create_entry(
 ) -> Option<EntryEdit> {
     // Cheap refusal first (code actions are asked for at every cursor move):
     // the cursor must be on a built-in service's name.
-    let on_builtin = crate::ide::lookup::at(&mission.mission, offset)
+    let on_builtin = crate::sema::lookup::at(&mission.mission, offset)
         .iter()
         .any(|o| matches!(o.symbol, crate::sema::Symbol::BuiltinService(_)));
     if !on_builtin {

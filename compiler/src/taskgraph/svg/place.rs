@@ -12,9 +12,10 @@
 //! (through their virtual nodes) and as S-curves across gaps; several edge ends
 //! on one side of a box are spread out in the order of the nodes they go to.
 
-use super::layered::{self, Layers, Pin};
 use super::scene::{Edge, Level, Node, Shape, Side, Style};
-use super::{DETAIL_FONT, LABEL_FONT, NODE_FONT, TITLE_FONT, text_width};
+use super::{DETAIL_FONT, LABEL_FONT, NODE_FONT, TITLE_FONT};
+use crate::layout::layered::{self, Layers, Pin};
+use crate::layout::text_width;
 
 /// Space around the whole picture.
 const MARGIN: f64 = 16.0;

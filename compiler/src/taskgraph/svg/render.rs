@@ -6,7 +6,8 @@
 
 use super::place::{Anchor, Label, Placed, Route, Seg};
 use super::scene::{End, Level, Shape, Side, Style};
-use super::{LABEL_FONT, NODE_FONT, PORT_FONT, TITLE_FONT, text_width};
+use super::{LABEL_FONT, NODE_FONT, PORT_FONT, TITLE_FONT};
+use crate::layout::text_width;
 use crate::xmlpos::escape;
 use std::fmt::Write;
 

@@ -409,8 +409,10 @@ fn load(path: &str) -> TaskGraph {
         .unwrap_or_else(|| panic!("{path} loads"))
 }
 
-fn shared(dir: &str) -> Vec<String> {
-    let dir = format!("{}/../../shared/{dir}", env!("CARGO_MANIFEST_DIR"));
+/// The `.xml` files of a folder of the repository (`examples/taskgraphs`,
+/// `tests/data/sdf3`).
+fn in_repository(dir: &str) -> Vec<String> {
+    let dir = format!("{}/../{dir}", env!("CARGO_MANIFEST_DIR"));
     let mut paths: Vec<String> = std::fs::read_dir(&dir)
         .unwrap_or_else(|e| panic!("{dir}: {e}"))
         .filter_map(|e| e.ok())
@@ -430,7 +432,7 @@ fn example(name: &str) -> TaskGraph {
 
 #[test]
 fn every_reference_example_is_drawn() {
-    let paths = shared("examples/taskgraphs");
+    let paths = in_repository("examples/taskgraphs");
     assert!(paths.len() >= 8, "{paths:?}");
     for path in paths {
         check(&load(&path), &path);
@@ -439,7 +441,7 @@ fn every_reference_example_is_drawn() {
 
 #[test]
 fn every_sdf3_benchmark_is_drawn() {
-    let paths = shared("data/sdf3");
+    let paths = in_repository("tests/data/sdf3");
     assert_eq!(paths.len(), 11, "{paths:?}");
     for path in paths {
         check(&load(&path), &path);

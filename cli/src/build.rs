@@ -2,9 +2,9 @@
 //! C code (and the refined task graph) per robot.
 
 use super::render;
-use crate::codegen::output::{OutputError, Transaction};
-use crate::codegen::{self, Emit, Target};
-use crate::workspace::{self, FileKind, Files};
+use semo::codegen::output::{OutputError, Transaction};
+use semo::codegen::{self, Emit, Target};
+use semo::workspace;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -19,38 +19,9 @@ pub struct Options {
     pub force: bool,
 }
 
-/// The files a build reads: the mission, and the catalog and strategy files
-/// beside it (its folder, recursively) and under each `--strategy` path.
-pub fn load(
-    mission: &Path,
-    strategy: &[PathBuf],
-) -> Result<(Files, crate::diag::FileId), workspace::LoadError> {
-    let mut files = Files::default();
-    let id = files.add(
-        mission.to_path_buf(),
-        FileKind::Mission,
-        workspace::load_text(mission)?,
-    );
-    let folder = mission
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."))
-        .to_path_buf();
-    let mut roots = vec![folder];
-    roots.extend(strategy.iter().cloned());
-    let mut seen = std::collections::BTreeSet::new();
-    for (path, kind) in workspace::collect(&roots)? {
-        if matches!(kind, FileKind::Catalog | FileKind::Strategy) && seen.insert(path.clone()) {
-            let text = workspace::load_text(&path)?;
-            files.add(path, kind, text);
-        }
-    }
-    Ok((files, id))
-}
-
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let started = std::time::Instant::now();
-    let (files, mission) = match load(&options.mission, &options.strategy) {
+    let (files, mission) = match workspace::load_build(&options.mission, &options.strategy) {
         Ok(loaded) => loaded,
         Err(e) => {
             eprintln!("error: {e}");
@@ -58,7 +29,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         }
     };
     let mut run = workspace::check_files(files);
-    let result = codegen::build(&run, mission, options.target, options.emit);
+    let Some(input) = run.build_input(mission) else {
+        eprintln!("internal error: the mission was loaded but not checked");
+        return 2;
+    };
+    let result = codegen::build(&input, options.target, options.emit);
     if result.refused() {
         run.diagnostics = result.diagnostics;
         let _ = render::human(&run, options.color, out);

@@ -2,7 +2,7 @@
 //! through `semo check` (the real binary, reading, checking and rendering)
 //! and through the language server (opened as a mission, then edited: the
 //! time from each edit to its diagnostics). Targets: under 1 s for the check,
-//! under 100 ms per edit. Run with `cargo bench -p semo-server --bench junk`.
+//! under 100 ms per edit. Run with `cargo bench -p semo-cli --bench junk`.
 
 use semo_server::harness::TestClient;
 use serde_json::json;

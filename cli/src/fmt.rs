@@ -1,12 +1,12 @@
 //! `semo fmt`: rewrites mission scripts in the canonical layout
-//! ([`crate::format`]). A file is rewritten only when its layout changes, by
+//! ([`semo::format`]). A file is rewritten only when its layout changes, by
 //! writing a temporary file beside it and renaming it over the original, so
 //! that a failure never leaves a truncated file. Files with syntax errors are
 //! left as they are and reported.
 
-use crate::format::{FormatRefusal, format_source};
-use crate::text::{ColumnUnit, LineIndex};
-use crate::workspace::{self, FileKind};
+use semo::format::{FormatRefusal, format_source};
+use semo::text::{ColumnUnit, LineIndex};
+use semo::workspace::{self, FileKind};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 

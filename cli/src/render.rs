@@ -2,10 +2,10 @@
 //! lines). Positions become 1-based lines and columns here, columns counted in
 //! characters.
 
-use crate::diag::{Diagnostic, Severity};
-use crate::text::ColumnUnit;
-use crate::workspace::{CheckRun, Files};
 use ariadne::{Color, Config, IndexType, Label, Report, ReportKind};
+use semo::diag::{Diagnostic, Severity};
+use semo::text::ColumnUnit;
+use semo::workspace::{CheckRun, Files};
 use std::io::{self, Write};
 
 fn kind(severity: Severity) -> ReportKind<'static> {
@@ -30,7 +30,7 @@ fn path_of(files: &Files, d: &Diagnostic) -> String {
 
 /// Clamps a span to the text and to character boundaries, so that a bad span
 /// can never make the renderer fail.
-fn safe_range(text: &str, span: crate::span::Span) -> std::ops::Range<usize> {
+fn safe_range(text: &str, span: semo::span::Span) -> std::ops::Range<usize> {
     let fix = |mut i: usize| {
         i = i.min(text.len());
         while !text.is_char_boundary(i) {
@@ -56,7 +56,7 @@ pub fn diagnostics(
     for f in files.iter() {
         sources.push((f.path.display().to_string(), f.text.clone()));
     }
-    let builtin = files.get(crate::catalog::BUILTIN_FILE);
+    let builtin = files.get(semo::catalog::BUILTIN_FILE);
     sources.push((builtin.path.display().to_string(), builtin.text.clone()));
     let mut cache = ariadne::sources(sources);
 
@@ -97,13 +97,13 @@ pub fn human(run: &CheckRun, colored: bool, out: &mut impl Write) -> io::Result<
     let count = |s: Severity| run.diagnostics.iter().filter(|d| d.severity == s).count();
     let plural = |n: usize, word: &str| format!("{n} {word}{}", if n == 1 { "" } else { "s" });
     let of_kind = |kind| run.files.iter().filter(|f| f.kind == kind).count();
-    let graphs = of_kind(crate::workspace::FileKind::TaskGraph);
+    let graphs = of_kind(semo::workspace::FileKind::TaskGraph);
     let graphs = if graphs > 0 {
         format!(", {}", plural(graphs, "task graph"))
     } else {
         String::new()
     };
-    let strategies = of_kind(crate::workspace::FileKind::Strategy);
+    let strategies = of_kind(semo::workspace::FileKind::Strategy);
     let strategies = if strategies > 0 {
         format!(", {}", plural(strategies, "strategy file"))
     } else {
@@ -112,8 +112,8 @@ pub fn human(run: &CheckRun, colored: bool, out: &mut impl Write) -> io::Result<
     writeln!(
         out,
         "checked {} and {}{graphs}{strategies}: {}, {}, {}",
-        plural(of_kind(crate::workspace::FileKind::Mission), "mission"),
-        plural(of_kind(crate::workspace::FileKind::Catalog), "catalog file"),
+        plural(of_kind(semo::workspace::FileKind::Mission), "mission"),
+        plural(of_kind(semo::workspace::FileKind::Catalog), "catalog file"),
         plural(count(Severity::Error), "error"),
         plural(count(Severity::Warning), "warning"),
         plural(count(Severity::Hint), "hint"),

@@ -1,13 +1,15 @@
-//! The `semo` command. Exit codes: 0 no errors, 1 errors found, 2 usage or I/O
-//! problem.
+//! The `semo` command: the compiler library's door for people and scripts, and
+//! `semo lsp`, the language server's door for editors. Exit codes: 0 no errors,
+//! 1 errors found, 2 usage or I/O problem.
 
-pub mod build;
+mod build;
 mod fmt;
 mod graph;
 mod render;
+mod simulate;
 
-use crate::workspace;
 use clap::{Parser, Subcommand, ValueEnum};
+use semo::workspace;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 
@@ -99,7 +101,7 @@ enum Command {
         /// `linux` (POSIX threads; you fill the task files) or `linux-sim`
         /// (sensors, actuators and the operator simulated from a scenario file).
         #[arg(long, default_value = "linux", value_parser = parse_target)]
-        target: crate::codegen::Target,
+        target: semo::codegen::Target,
         /// `all` (C code, Makefile and task graph) or `taskgraph` (only the
         /// refined task graphs).
         #[arg(long, value_enum, default_value_t = EmitArg::All)]
@@ -111,6 +113,46 @@ enum Command {
         /// under OUT/.semo-backup/<time>/.
         #[arg(long)]
         force: bool,
+    },
+    /// Run every robot of a mission together in virtual time on a scenario,
+    /// and check the scenario's expectations.
+    #[command(
+        long_about = "Run every robot of a mission together in virtual time, in milliseconds of \
+        wall time: the refined programs `semo build` turns into C, on a scenario file \
+        (timed sensor values, service durations, operator commands, network, faults and \
+        expectations; see docs/scenario-and-trace.md). Prints each robot's modes and every \
+        expectation; --trace writes the trace (JSON lines, as linux-sim programs write it), \
+        --svg the timeline.\n\n\
+        Exit status: 0 when every expectation holds, 1 when one fails, 2 for bad input \
+        (mission errors, a bad scenario, options)."
+    )]
+    Simulate {
+        /// The mission script.
+        mission: PathBuf,
+        /// The scenario file (`*.scenario.json`).
+        #[arg(long)]
+        scenario: PathBuf,
+        /// More strategy (and catalog) files or folders to read.
+        #[arg(long)]
+        strategy: Vec<PathBuf>,
+        /// How much mission time to run: `10min`, `90s`, `500ms`, `1h` (default:
+        /// the scenario's duration, else 10min or until every robot finished).
+        #[arg(long, value_parser = simulate::parse_duration)]
+        until: Option<i64>,
+        /// Seeds the message losses; the same seed gives the same run.
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// `text` (modes per robot, expectations) or `json` (one object).
+        #[arg(long, value_enum, default_value_t = SummaryFormat::Text)]
+        format: SummaryFormat,
+        /// Write the timeline picture (SVG) to this file (`-`: standard output).
+        #[arg(long, value_name = "OUT")]
+        svg: Option<PathBuf>,
+        /// Write the trace (JSON lines) to this file (`-`: standard output).
+        #[arg(long, value_name = "FILE")]
+        trace: Option<PathBuf>,
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
     },
     /// Analyse task graphs (`*.taskgraph.xml` or SDF3 files).
     #[command(subcommand)]
@@ -188,15 +230,24 @@ enum Format {
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+enum SummaryFormat {
+    Text,
+    Json,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
 enum ColorChoice {
     Auto,
     Always,
     Never,
 }
 
-/// Runs the command line and gives the process exit code. The language server
-/// lives in a crate above this library, so the binary hands it in as `lsp`.
-pub fn main(lsp: fn() -> i32) -> i32 {
+fn main() {
+    std::process::exit(run());
+}
+
+/// Runs the command line and gives the process exit code.
+fn run() -> i32 {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
@@ -254,11 +305,35 @@ pub fn main(lsp: fn() -> i32) -> i32 {
                 out: out_dir,
                 target,
                 emit: match emit {
-                    EmitArg::All => crate::codegen::Emit::All,
-                    EmitArg::Taskgraph => crate::codegen::Emit::TaskGraph,
+                    EmitArg::All => semo::codegen::Emit::All,
+                    EmitArg::Taskgraph => semo::codegen::Emit::TaskGraph,
                 },
                 color: use_color(color),
                 force,
+            },
+            &mut out,
+        ),
+        Command::Simulate {
+            mission,
+            scenario,
+            strategy,
+            until,
+            seed,
+            format,
+            svg,
+            trace,
+            color,
+        } => simulate::run(
+            simulate::Options {
+                mission,
+                scenario,
+                strategy,
+                until_ms: until,
+                seed,
+                json: format == SummaryFormat::Json,
+                svg,
+                trace,
+                color: use_color(color),
             },
             &mut out,
         ),
@@ -266,7 +341,7 @@ pub fn main(lsp: fn() -> i32) -> i32 {
         Command::Lsp { stdio: _ } => {
             // The protocol owns stdout from here on.
             drop(out);
-            return lsp();
+            return semo_server::run_stdio();
         }
     };
     let _ = out.flush();
@@ -279,9 +354,9 @@ enum EmitArg {
     Taskgraph,
 }
 
-fn parse_target(name: &str) -> Result<crate::codegen::Target, String> {
-    crate::codegen::Target::from_name(name).ok_or_else(|| {
-        let names: Vec<&str> = crate::codegen::TARGETS.iter().map(|t| t.name).collect();
+fn parse_target(name: &str) -> Result<semo::codegen::Target, String> {
+    semo::codegen::Target::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = semo::codegen::TARGETS.iter().map(|t| t.name).collect();
         format!("unknown target `{name}` (targets: {})", names.join(", "))
     })
 }
@@ -326,7 +401,7 @@ fn check(paths: Vec<PathBuf>, format: Format, color: bool, out: &mut impl Write)
 }
 
 fn explain(code: Option<&str>, out: &mut impl Write) -> i32 {
-    use crate::diag::Code;
+    use semo::diag::Code;
     let codes: Vec<Code> = match code {
         None => Code::ALL.to_vec(),
         Some(c) => match Code::from_code(&c.to_ascii_uppercase()) {

@@ -5,8 +5,8 @@
 //! either share their span (one name meaning several symbols: the robots of
 //! `tb[3]`, or a function body inlined for several teams) or do not overlap.
 
-use crate::Analysis;
-use crate::sema::{Mission, Occurrence, Symbol, TeamId};
+use super::Analysis;
+use super::{Mission, Occurrence, Symbol, TeamId};
 use crate::span::Span;
 use crate::syntax::ast::{Item, SourceFile};
 

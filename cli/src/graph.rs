@@ -3,13 +3,13 @@
 //! and pictures of it; `semo graph modes`: a mission's mode machines.
 
 use super::render;
-use crate::diag::Diagnostic;
-use crate::workspace::{DiskResolver, FileKind, Files, analyze_graph};
+use semo::diag::Diagnostic;
+use semo::workspace::{DiskResolver, FileKind, Files, analyze_graph};
 use std::io::Write;
 use std::path::Path;
 
 fn read(path: &Path) -> Option<String> {
-    match crate::workspace::read_text(path) {
+    match semo::workspace::read_text(path) {
         Ok(text) => Some(text),
         Err(e) => {
             eprintln!("error: {}: {e}", path.display());
@@ -20,13 +20,13 @@ fn read(path: &Path) -> Option<String> {
 
 /// The graph in `path` when it loads without errors; otherwise the errors
 /// are printed and the exit code given.
-fn load_clean(path: &Path) -> Result<crate::taskgraph::TaskGraph, i32> {
+fn load_clean(path: &Path) -> Result<semo::taskgraph::TaskGraph, i32> {
     let Some(text) = read(path) else {
         return Err(2);
     };
     let mut files = Files::default();
     let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
-    let (graph, diagnostics) = crate::taskgraph::load_task_graph(id, &files.get(id).text);
+    let (graph, diagnostics) = semo::taskgraph::load_task_graph(id, &files.get(id).text);
     let errors: Vec<Diagnostic> = diagnostics
         .into_iter()
         .filter(Diagnostic::is_error)
@@ -44,7 +44,7 @@ fn load_clean(path: &Path) -> Result<crate::taskgraph::TaskGraph, i32> {
 pub fn dot(path: &Path, out: &mut impl Write) -> i32 {
     match load_clean(path) {
         Ok(g) => {
-            let _ = out.write_all(crate::taskgraph::dot::to_dot(&g).as_bytes());
+            let _ = out.write_all(semo::taskgraph::dot::to_dot(&g).as_bytes());
             0
         }
         Err(code) => code,
@@ -58,7 +58,7 @@ pub fn svg(path: &Path, output: Option<&Path>, out: &mut impl Write) -> i32 {
         Ok(g) => g,
         Err(code) => return code,
     };
-    write_picture(&crate::taskgraph::to_svg(&graph), output, out)
+    write_picture(&semo::taskgraph::to_svg(&graph), output, out)
 }
 
 /// `semo graph modes`: the mode machines of a mission (checked against the
@@ -74,18 +74,18 @@ pub fn modes(path: &Path, team: Option<&str>, output: Option<&Path>, out: &mut i
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let beside = crate::workspace::collect(&[folder.to_path_buf()]).unwrap_or_default();
+    let beside = semo::workspace::collect(&[folder.to_path_buf()]).unwrap_or_default();
     for (catalog, _) in beside.iter().filter(|(_, k)| *k == FileKind::Catalog) {
         if let Some(text) = read(catalog) {
             files.add(catalog.clone(), FileKind::Catalog, text);
         }
     }
     let id = files.add(path.to_path_buf(), FileKind::Mission, text);
-    let run = crate::workspace::check_files(files);
+    let run = semo::workspace::check_files(files);
     let Some((_, analysis)) = run.analyses.iter().find(|(f, _)| *f == id) else {
         return 2;
     };
-    let mut machines = crate::modemachine::machines(&analysis.mission);
+    let mut machines = semo::modemachine::machines(&analysis.mission);
     if let Some(team) = team {
         machines.retain(|m| m.team == team);
         if machines.is_empty() {
@@ -110,7 +110,7 @@ pub fn modes(path: &Path, team: Option<&str>, output: Option<&Path>, out: &mut i
         .cloned()
         .collect();
     let _ = render::diagnostics(&run.files, &errors, false, &mut std::io::stderr());
-    match write_picture(&crate::modemachine::to_svg(&machines), output, out) {
+    match write_picture(&semo::modemachine::to_svg(&machines), output, out) {
         0 if !errors.is_empty() => 1,
         code => code,
     }
@@ -157,7 +157,7 @@ pub fn analyze(path: &Path, json: bool, color: bool, out: &mut impl Write) -> i3
 
 fn write_human(
     files: &Files,
-    run: &crate::workspace::GraphRun,
+    run: &semo::workspace::GraphRun,
     color: bool,
     out: &mut impl Write,
 ) -> std::io::Result<()> {
@@ -214,7 +214,7 @@ fn write_human(
 
 fn write_json(
     files: &Files,
-    run: &crate::workspace::GraphRun,
+    run: &semo::workspace::GraphRun,
     out: &mut impl Write,
 ) -> std::io::Result<()> {
     let levels: Vec<serde_json::Value> = run
@@ -266,7 +266,7 @@ fn write_json(
 /// `semo graph schedule`: the looped schedule of the whole graph, and with
 /// `cores` a list schedule of each level's iteration onto that many cores.
 pub fn schedule(path: &Path, cores: Option<usize>, out: &mut impl Write) -> i32 {
-    use crate::taskgraph::analysis::{hierarchy_levels, schedule};
+    use semo::taskgraph::analysis::{hierarchy_levels, schedule};
     let Some(text) = read(path) else { return 2 };
     let mut files = Files::default();
     let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);

@@ -1,0 +1,166 @@
+//! `semo simulate`: a mission's robots run together in virtual time on a
+//! scenario (`semo::sim`); a summary, the trace, the timeline picture, and
+//! the scenario's expectations judged. Exit status: 0 every expectation
+//! holds, 1 one fails, 2 bad input (mission errors, a bad scenario, options).
+
+use super::render;
+use semo::sim::{self, scenario};
+use semo::workspace;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+pub struct Options {
+    pub mission: PathBuf,
+    pub scenario: PathBuf,
+    pub strategy: Vec<PathBuf>,
+    pub until_ms: Option<i64>,
+    pub seed: u64,
+    pub json: bool,
+    pub svg: Option<PathBuf>,
+    pub trace: Option<PathBuf>,
+    pub color: bool,
+}
+
+/// `--until`: mission time as `10min`, `90s`, `500ms`, `1h` or plain milliseconds.
+pub fn parse_duration(text: &str) -> Result<i64, String> {
+    let split = text
+        .find(|c: char| !c.is_ascii_digit())
+        .unwrap_or(text.len());
+    let (number, unit) = text.split_at(split);
+    let scale = match unit {
+        "" | "ms" => 1,
+        "s" | "sec" => 1000,
+        "min" => 60_000,
+        "h" => 3_600_000,
+        _ => return Err(format!("unknown unit `{unit}` (ms, s, min, h)")),
+    };
+    number
+        .parse::<i64>()
+        .ok()
+        .and_then(|n| n.checked_mul(scale))
+        .filter(|n| *n > 0 && *n <= 1_000_000_000_000_000)
+        .ok_or_else(|| format!("`{text}` is not a positive mission time such as 10min or 500ms"))
+}
+
+pub fn run(options: Options, out: &mut impl Write) -> i32 {
+    let (files, mission) = match workspace::load_build(&options.mission, &options.strategy) {
+        Ok(loaded) => loaded,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let scenario_text = match workspace::read_text(&options.scenario) {
+        Ok(text) => text,
+        Err(e) => {
+            eprintln!("error: {}: {e}", options.scenario.display());
+            return 2;
+        }
+    };
+    let mut check = workspace::check_files(files);
+    let Some(input) = check.build_input(mission) else {
+        eprintln!("internal error: the mission was loaded but not checked");
+        return 2;
+    };
+    let refined = semo::codegen::refine_checked(&input);
+    if refined.diagnostics.iter().any(|d| d.is_error()) {
+        check.diagnostics = refined.diagnostics;
+        let _ = render::human(&check, options.color, &mut std::io::stderr());
+        eprintln!("error: cannot simulate: fix the errors above first");
+        return 2;
+    }
+    let programs = refined.programs;
+    let scenario = match scenario::parse(&scenario_text, &programs) {
+        Ok(s) => s,
+        Err(e) => {
+            let (line, col) = e.line_col(&scenario_text);
+            eprintln!(
+                "scenario {}:{line}:{col}: {}",
+                options.scenario.display(),
+                e.message
+            );
+            return 2;
+        }
+    };
+    let run = sim::simulate(
+        &programs,
+        &scenario,
+        &sim::Options {
+            until_ms: options.until_ms,
+            seed: options.seed,
+        },
+    );
+    let verdicts = sim::expect::judge(&run, &scenario.expect);
+    if let Some(path) = &options.trace
+        && write_to(path, &run.trace_lines(), out) != 0
+    {
+        return 2;
+    }
+    if let Some(path) = &options.svg {
+        let picture = sim::svg::to_svg(&run, &programs, &scenario);
+        if write_to(path, &picture, out) != 0 {
+            return 2;
+        }
+    }
+    let writes_stdout = |p: &Option<PathBuf>| p.as_deref() == Some(Path::new("-"));
+    if !writes_stdout(&options.trace) && !writes_stdout(&options.svg) {
+        let report = if options.json {
+            json_summary(&run, &verdicts)
+        } else {
+            sim::summary(&run, &verdicts)
+        };
+        let _ = out.write_all(report.as_bytes());
+    }
+    if verdicts.iter().all(|v| v.met) { 0 } else { 1 }
+}
+
+/// Writes `text` to a file, or to standard output for `-`.
+fn write_to(path: &Path, text: &str, out: &mut impl Write) -> i32 {
+    if path == Path::new("-") {
+        let _ = out.write_all(text.as_bytes());
+        return 0;
+    }
+    match std::fs::write(path, text) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("error: {}: {e}", path.display());
+            2
+        }
+    }
+}
+
+/// `--format json`: one object with each robot's modes and every expectation.
+fn json_summary(run: &sim::Run, verdicts: &[sim::Verdict]) -> String {
+    let robots: Vec<serde_json::Value> = run
+        .robots
+        .iter()
+        .enumerate()
+        .map(|(r, (team, robot))| {
+            let modes: Vec<serde_json::Value> = sim::expect::modes(run, r)
+                .into_iter()
+                .map(|(t, mode)| serde_json::json!({"t": t, "mode": mode}))
+                .collect();
+            serde_json::json!({"team": team, "robot": robot, "modes": modes})
+        })
+        .collect();
+    let expectations: Vec<serde_json::Value> = verdicts
+        .iter()
+        .map(|v| {
+            serde_json::json!({
+                "expectation": v.expectation.kind.to_string(),
+                "met": v.met,
+                "why": v.why,
+            })
+        })
+        .collect();
+    let mut text = serde_json::json!({
+        "end_ms": run.end_ms,
+        "events": run.events,
+        "robots": robots,
+        "expectations": expectations,
+        "ok": verdicts.iter().all(|v| v.met),
+    })
+    .to_string();
+    text.push('\n');
+    text
+}

@@ -1,0 +1,1302 @@
+//! The discrete-event engine: every robot's [`RobotProgram`] run at once in
+//! virtual time, exactly as the generated C runs it (`codegen/control.rs`
+//! writes the control task; `codegen/files.rs` the communication, service
+//! and library tasks; `codegen/runtime/` the runtime they call). Where the
+//! generated program has threads, the simulator has events, ordered by
+//! (time, kind, sequence number), so a run is a function of the programs,
+//! the scenario and the seed alone.
+//!
+//! Correspondence (C → here):
+//! - `task_control_go` every `CONTROL_PERIOD_MS` → [`Sim::fire`];
+//! - a sensor task every `SENSOR_PERIOD_MS`, writing the scenario's latest
+//!   value → the value as of the robot's last sensor period ([`Sim::sensor`]);
+//! - a service task called with `UFControl_CallTask`, busy for the
+//!   scenario's duration → [`Sim::request`] and a `ServiceDone` event;
+//! - `semo_comm_send` → [`Sim::comm_send`] (the network: latency, loss and
+//!   link faults), the receive task's routing → [`Sim::deliver`];
+//! - `comm_last_seen` and `elected` → `last_seen` and [`Sim::elected`];
+//! - the library task's values → `Robot::library`.
+
+use super::scenario::{Command, DEFAULT_SERVICE_MS, FaultKind, Scenario};
+use super::trace::TraceEvent;
+use crate::refine::graph::CONTROL_PERIOD_MS;
+use crate::refine::{
+    ActionMachine, ControlMachine, Expr, HEARTBEAT_MS, Operand, RobotProgram, RoleKind, SlotSource,
+    StateKind,
+};
+use crate::syntax::ast::CmpOp;
+use rand_core::{Rng, SeedableRng};
+use rand_xorshift::XorShiftRng;
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashMap, VecDeque};
+
+/// The sensor tasks' period (refinement's `SENSOR_PERIOD_MS`).
+const SENSOR_PERIOD_MS: i64 = 100;
+/// State transitions a region may take in one firing (`control.rs`).
+const STEPS_PER_FIRING: usize = 64;
+/// `semo_value`: text of at most 63 bytes.
+const VALUE_MAX: usize = 63;
+/// Default length of a run when neither the caller nor the scenario bounds it.
+pub const DEFAULT_UNTIL_MS: i64 = 10 * 60 * 1000;
+
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Mission ms to run (default: the scenario's `duration`, else 10 min).
+    pub until_ms: Option<i64>,
+    /// Seeds message loss; a run is a function of programs, scenario and seed.
+    pub seed: u64,
+}
+
+/// The outcome of a run.
+#[derive(Clone, Debug)]
+pub struct Run {
+    /// Every robot, in formation order: (team, robot).
+    pub robots: Vec<(String, String)>,
+    pub trace: Vec<TraceEvent>,
+    /// When the run ended (every robot stopped, or the time limit).
+    pub end_ms: i64,
+    /// Events the engine processed (for the cost per event).
+    pub events: u64,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Step {
+    Next,
+    Wait,
+    Done,
+}
+
+/// An event of the queue; at equal times deliveries come first, then
+/// service completions, faults, operator commands, and control firings last
+/// (a control firing sees everything that arrived by its time).
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Event {
+    Deliver {
+        to: usize,
+        epoch: u32,
+        message: Message,
+    },
+    ServiceDone {
+        robot: usize,
+        task: usize,
+        generation: u64,
+    },
+    Fault(usize),
+    Operator(usize),
+    Fire {
+        robot: usize,
+        epoch: u32,
+    },
+}
+
+impl Event {
+    fn order(&self) -> u8 {
+        match self {
+            Event::Deliver { .. } => 0,
+            Event::ServiceDone { .. } => 1,
+            Event::Fault(_) => 2,
+            Event::Operator(_) => 3,
+            Event::Fire { .. } => 4,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Message {
+    publish: bool,
+    from_team: String,
+    from_robot: String,
+    /// Index of the sender in the peers (operator: `None`).
+    from_peer: Option<usize>,
+    key: String,
+    value: String,
+    sent_at: i64,
+}
+
+#[derive(Clone, Debug, Default)]
+struct Region {
+    service: Option<usize>,
+    pc: usize,
+    phase: u8,
+    action: usize,
+    done: bool,
+    started: i64,
+    pass_start: i64,
+    timeout_ms: i64,
+    marks: Vec<i64>,
+    plan: String,
+}
+
+#[derive(Clone, Debug, Default)]
+struct TaskState {
+    busy: bool,
+    service: String,
+    /// Invalidates the completion of a call that was stopped.
+    generation: u64,
+}
+
+/// One robot's running program (one process of `linux-sim`).
+struct Robot<'p> {
+    program: &'p RobotProgram,
+    alive: bool,
+    /// Counts restarts: events of an earlier incarnation are ignored.
+    epoch: u32,
+    started_at: i64,
+    slots: Vec<String>,
+    library: HashMap<String, String>,
+    /// Per incoming message: the channel to the control task (capacity).
+    inbox: Vec<(VecDeque<String>, usize)>,
+    /// Per subscribed group: the latest value.
+    groups: Vec<Option<String>>,
+    regions: Vec<Region>,
+    current_mode: Option<usize>,
+    pending_mode: Option<usize>,
+    last_heartbeat: i64,
+    last_seen: Vec<i64>,
+    /// The last leader each `LeaderBranch` state saw, by (service, pc).
+    leaders: HashMap<(usize, usize), usize>,
+    /// Service tasks by name (the `request_tasks` and those of action commands).
+    tasks: Vec<(String, TaskState)>,
+    has_receiver: bool,
+    alive_key: String,
+    /// Per slot fed by a sensor: its value's entries (at, value), by time.
+    sensor_series: Vec<Option<Vec<(i64, String)>>>,
+    battery: Vec<(i64, f64)>,
+    service_ms: HashMap<String, i64>,
+}
+
+pub struct Sim<'p> {
+    programs: &'p [RobotProgram],
+    scenario: &'p Scenario,
+    robots: Vec<Robot<'p>>,
+    queue: BinaryHeap<Reverse<(i64, u8, u64, Event)>>,
+    seq: u64,
+    now: i64,
+    rng: XorShiftRng,
+    trace: Vec<TraceEvent>,
+    /// Next occurrence of each operator command.
+    operator_next: Vec<i64>,
+}
+
+fn truncate(mut s: String) -> String {
+    if s.len() > VALUE_MAX {
+        let mut end = VALUE_MAX;
+        while !s.is_char_boundary(end) {
+            end -= 1;
+        }
+        s.truncate(end);
+    }
+    s
+}
+
+/// `parse_number` of the runtime: the whole text is a number (no leading space).
+fn number(text: &str) -> Option<f64> {
+    let first = text.as_bytes().first()?;
+    if first.is_ascii_whitespace() {
+        return None;
+    }
+    text.parse::<f64>().ok().filter(|d| !d.is_nan())
+}
+
+/// `semo_value_compare`: numerically when both are numbers, else bytewise.
+fn compare(a: &str, b: &str) -> std::cmp::Ordering {
+    match (number(a), number(b)) {
+        (Some(x), Some(y)) => x.partial_cmp(&y).unwrap_or(std::cmp::Ordering::Equal),
+        _ => a.as_bytes().cmp(b.as_bytes()),
+    }
+}
+
+/// `semo_value_truthy`.
+fn truthy(v: &str) -> bool {
+    v == "true" || number(v).is_some_and(|x| x != 0.0)
+}
+
+impl<'p> Robot<'p> {
+    fn new(program: &'p RobotProgram, scenario: &Scenario, at: i64, epoch: u32) -> Robot<'p> {
+        let m = &program.control;
+        let world = scenario.robots.iter().find(|w| w.robot == program.robot);
+        let sensor_series = m
+            .slots
+            .iter()
+            .map(|s| match &s.source {
+                SlotSource::Sensor { port, .. } => {
+                    let mut series: Vec<(i64, String)> = world
+                        .map(|w| {
+                            w.sensors
+                                .iter()
+                                .filter(|(_, v, _)| v == port)
+                                .map(|(at, _, is)| (*at, is.clone()))
+                                .collect()
+                        })
+                        .unwrap_or_default();
+                    // Stable: equal times keep file order, and the later wins.
+                    series.sort_by_key(|(at, _)| *at);
+                    Some(series)
+                }
+                _ => None,
+            })
+            .collect();
+        let mut tasks: Vec<(String, TaskState)> = m
+            .request_tasks
+            .iter()
+            .map(|t| (t.clone(), TaskState::default()))
+            .collect();
+        for am in &m.actions {
+            for action in &am.actions {
+                for (task, _) in &action.commands {
+                    if !tasks.iter().any(|(t, _)| t == task) {
+                        tasks.push((task.clone(), TaskState::default()));
+                    }
+                }
+            }
+        }
+        let regions = m
+            .modes
+            .iter()
+            .map(|mo| mo.regions.len())
+            .max()
+            .unwrap_or(0)
+            .max(1);
+        let marks = m.services.iter().map(|s| s.marks).max().unwrap_or(0).max(1);
+        let inbox = m
+            .incoming
+            .iter()
+            .map(|i| (VecDeque::new(), channel_capacity(program, &i.port)))
+            .collect();
+        Robot {
+            program,
+            alive: true,
+            epoch,
+            started_at: at,
+            slots: vec![String::new(); m.slots.len()],
+            library: HashMap::new(),
+            inbox,
+            groups: vec![None; m.subscribed.len()],
+            regions: vec![
+                Region {
+                    marks: vec![0; marks],
+                    done: true,
+                    ..Region::default()
+                };
+                regions
+            ],
+            current_mode: None,
+            pending_mode: None,
+            last_heartbeat: at - HEARTBEAT_MS,
+            last_seen: vec![at; program.peers.len()],
+            leaders: HashMap::new(),
+            tasks,
+            has_receiver: !m.incoming.is_empty() || !m.subscribed.is_empty() || m.heartbeat,
+            alive_key: crate::codegen::files::alive_key(program),
+            sensor_series,
+            battery: world.map(|w| w.battery.clone()).unwrap_or_default(),
+            service_ms: world
+                .map(|w| w.services.iter().cloned().collect())
+                .unwrap_or_default(),
+        }
+    }
+
+    fn task_index(&self, task: &str) -> usize {
+        self.tasks
+            .iter()
+            .position(|(t, _)| t == task)
+            .expect("every called task is listed when the robot starts")
+    }
+}
+
+/// The capacity of the channel into the control task's port `port`
+/// (the buffer analysis's bound), at least one sample.
+fn channel_capacity(program: &RobotProgram, port: &str) -> usize {
+    program
+        .graph
+        .channels
+        .iter()
+        .zip(&program.capacities)
+        .find(|(c, _)| c.dst.task == crate::refine::graph::CONTROL_TASK && c.dst.port == port)
+        .map_or(1, |(_, cap)| (*cap).max(1) as usize)
+}
+
+impl<'p> Sim<'p> {
+    pub fn new(programs: &'p [RobotProgram], scenario: &'p Scenario, seed: u64) -> Sim<'p> {
+        let mut sim = Sim {
+            programs,
+            scenario,
+            robots: programs
+                .iter()
+                .map(|p| Robot::new(p, scenario, 0, 0))
+                .collect(),
+            queue: BinaryHeap::new(),
+            seq: 0,
+            now: 0,
+            rng: XorShiftRng::seed_from_u64(seed),
+            trace: Vec::new(),
+            operator_next: scenario.operator.iter().map(|c| c.first).collect(),
+        };
+        for r in 0..programs.len() {
+            sim.start(r);
+        }
+        for (i, c) in scenario.operator.iter().enumerate() {
+            if c.first <= c.until {
+                sim.schedule(c.first, Event::Operator(i));
+            }
+        }
+        for (i, fault) in scenario.faults.iter().enumerate() {
+            if let FaultKind::Kill { at, .. } | FaultKind::Restart { at, .. } = fault.kind {
+                sim.schedule(at, Event::Fault(i));
+            }
+        }
+        sim
+    }
+
+    fn schedule(&mut self, at: i64, event: Event) {
+        self.seq += 1;
+        self.queue
+            .push(Reverse((at, event.order(), self.seq, event)));
+    }
+
+    fn emit(&mut self, robot: usize, event: &'static str, fields: Vec<(&'static str, String)>) {
+        self.trace.push(TraceEvent {
+            t: self.now,
+            robot,
+            event,
+            fields,
+            sent_at: None,
+        });
+    }
+
+    fn start(&mut self, r: usize) {
+        let p = self.robots[r].program;
+        self.emit(
+            r,
+            "start",
+            vec![
+                ("team", p.team.clone()),
+                ("type", p.robot_type.clone()),
+                ("mission", p.mission.clone()),
+            ],
+        );
+        let epoch = self.robots[r].epoch;
+        self.schedule(self.now, Event::Fire { robot: r, epoch });
+    }
+
+    /// Runs until `until` mission ms or until every robot has stopped.
+    pub fn run(mut self, options: &Options) -> Run {
+        let until = options
+            .until_ms
+            .or(self.scenario.duration_ms)
+            .unwrap_or(DEFAULT_UNTIL_MS);
+        let mut events = 0u64;
+        while let Some(Reverse((t, _, _, event))) = self.queue.pop() {
+            if t > until {
+                break;
+            }
+            self.now = t;
+            events += 1;
+            self.handle(event);
+            if self.robots.iter().all(|r| !r.alive) && !self.restart_pending() {
+                break;
+            }
+        }
+        if self.robots.iter().any(|r| r.alive) {
+            self.now = until;
+            for r in 0..self.robots.len() {
+                if self.robots[r].alive {
+                    self.stop(r);
+                }
+            }
+        }
+        Run {
+            robots: self
+                .programs
+                .iter()
+                .map(|p| (p.team.clone(), p.robot.clone()))
+                .collect(),
+            end_ms: self.now,
+            trace: self.trace,
+            events,
+        }
+    }
+
+    fn restart_pending(&self) -> bool {
+        self.queue.iter().any(|Reverse((_, _, _, e))| {
+            matches!(e, Event::Fault(i) if matches!(self.scenario.faults[*i].kind, FaultKind::Restart { .. }))
+        })
+    }
+
+    fn handle(&mut self, event: Event) {
+        match event {
+            Event::Fire { robot, epoch } => {
+                if self.robots[robot].alive && self.robots[robot].epoch == epoch {
+                    self.fire(robot);
+                    if self.robots[robot].alive {
+                        self.schedule(self.now + CONTROL_PERIOD_MS, Event::Fire { robot, epoch });
+                    }
+                }
+            }
+            Event::ServiceDone {
+                robot,
+                task,
+                generation,
+            } => {
+                let state = &self.robots[robot].tasks[task].1;
+                if self.robots[robot].alive && state.busy && state.generation == generation {
+                    self.end_call(robot, task);
+                }
+            }
+            Event::Deliver { to, epoch, message } => {
+                if self.robots[to].alive && self.robots[to].epoch == epoch {
+                    self.deliver(to, message);
+                }
+            }
+            Event::Operator(i) => self.operator(i),
+            Event::Fault(i) => self.fault(i),
+        }
+    }
+
+    fn operator(&mut self, i: usize) {
+        let command: &Command = &self.scenario.operator[i];
+        let message = Message {
+            publish: false,
+            from_team: "USER".into(),
+            from_robot: "USER".into(),
+            from_peer: None,
+            key: command.key.clone(),
+            value: truncate(command.value.clone()),
+            sent_at: self.now,
+        };
+        for r in 0..self.robots.len() {
+            let p = self.robots[r].program;
+            if (p.robot == command.to || p.team == command.to) && self.robots[r].alive {
+                self.deliver(r, message.clone());
+            }
+        }
+        if let Some(every) = command.every {
+            let next = self.operator_next[i] + every;
+            if next <= command.until {
+                self.operator_next[i] = next;
+                self.schedule(next, Event::Operator(i));
+            }
+        }
+    }
+
+    fn fault(&mut self, i: usize) {
+        match &self.scenario.faults[i].kind {
+            FaultKind::Kill { robot, .. } => {
+                let Some(r) = self.index_of(robot) else {
+                    return;
+                };
+                if self.robots[r].alive {
+                    // Killed without a word: no `stop`, calls end with it.
+                    self.robots[r].alive = false;
+                    self.emit(r, "fault", vec![("fault", "kill".into())]);
+                }
+            }
+            FaultKind::Restart { robot, .. } => {
+                let Some(r) = self.index_of(robot) else {
+                    return;
+                };
+                if !self.robots[r].alive {
+                    let epoch = self.robots[r].epoch + 1;
+                    self.robots[r] =
+                        Robot::new(self.robots[r].program, self.scenario, self.now, epoch);
+                    self.emit(r, "fault", vec![("fault", "restart".into())]);
+                    self.start(r);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn index_of(&self, robot: &str) -> Option<usize> {
+        self.programs.iter().position(|p| p.robot == robot)
+    }
+
+    fn stop(&mut self, r: usize) {
+        self.robots[r].alive = false;
+        self.emit(r, "stop", Vec::new());
+    }
+
+    // ------------------------------------------------------------ values
+
+    fn value(&self, r: usize, op: &Operand) -> String {
+        self.value_ref(r, op).to_string()
+    }
+
+    /// An operand's text without copying it (conditions are read every firing).
+    fn value_ref<'a>(&'a self, r: usize, op: &'a Operand) -> &'a str {
+        match op {
+            Operand::Slot(s) => &self.robots[r].slots[*s],
+            Operand::Literal(text) => {
+                let mut end = text.len().min(VALUE_MAX);
+                while !text.is_char_boundary(end) {
+                    end -= 1;
+                }
+                &text[..end]
+            }
+        }
+    }
+
+    fn eval(&self, r: usize, e: &Expr) -> bool {
+        match e {
+            Expr::Or(a, b) => self.eval(r, a) || self.eval(r, b),
+            Expr::And(a, b) => self.eval(r, a) && self.eval(r, b),
+            Expr::Not(a) => !self.eval(r, a),
+            Expr::Bool(b) => *b,
+            Expr::Truthy(o) => truthy(self.value_ref(r, o)),
+            Expr::Compare(a, op, b) => {
+                let ord = compare(self.value_ref(r, a), self.value_ref(r, b));
+                use std::cmp::Ordering::*;
+                match op {
+                    CmpOp::Eq => ord == Equal,
+                    CmpOp::Ne => ord != Equal,
+                    CmpOp::Lt => ord == Less,
+                    CmpOp::Le => ord != Greater,
+                    CmpOp::Gt => ord == Greater,
+                    CmpOp::Ge => ord != Less,
+                }
+            }
+        }
+    }
+
+    /// `store`: the slot, and the library for shared information.
+    fn store(&mut self, r: usize, slot: usize, value: String) {
+        let robot = &mut self.robots[r];
+        let program = robot.program;
+        if program.control.slots[slot].source == SlotSource::Shared && program.library.is_some() {
+            robot
+                .library
+                .insert(program.control.slots[slot].key.clone(), value.clone());
+        }
+        robot.slots[slot] = value;
+    }
+
+    /// Reads the latest sensor samples (the scenario's latest value at the
+    /// robot's last sensor period) and the shared information into the
+    /// slots (`read_inputs`); a slot is written only when its value changed.
+    fn read_inputs(&mut self, r: usize) {
+        let now = self.now;
+        let robot = &mut self.robots[r];
+        let program = robot.program;
+        let sampled =
+            robot.started_at + (now - robot.started_at) / SENSOR_PERIOD_MS * SENSOR_PERIOD_MS;
+        for (i, s) in program.control.slots.iter().enumerate() {
+            match &s.source {
+                SlotSource::Sensor { port, .. } => {
+                    let Some(series) = &robot.sensor_series[i] else {
+                        continue;
+                    };
+                    let n = series.partition_point(|(at, _)| *at <= sampled);
+                    if n > 0 {
+                        if robot.slots[i] != series[n - 1].1 {
+                            robot.slots[i].clone_from(&series[n - 1].1);
+                        }
+                    } else if port == "BATTERY"
+                        && let Some(level) = battery_level(&robot.battery, sampled)
+                    {
+                        robot.slots[i] = format!("{}", level.round());
+                    }
+                }
+                SlotSource::Shared => {
+                    if program.library.is_some() {
+                        let v = robot.library.get(&s.key).map_or("", String::as_str);
+                        if robot.slots[i] != v {
+                            robot.slots[i] = v.to_string();
+                        }
+                    }
+                }
+                SlotSource::Local => {}
+            }
+        }
+    }
+
+    // ---------------------------------------------------- communication
+
+    /// `semo_comm_send`: traced, then to every other robot of `to` (team or
+    /// robot name) through the network; `USER` only traces.
+    fn comm_send(&mut self, r: usize, to: &str, publish: bool, key: &str, value: String) {
+        self.emit(
+            r,
+            "send",
+            vec![
+                ("to", to.to_string()),
+                ("key", key.to_string()),
+                ("value", value.clone()),
+            ],
+        );
+        if to == "USER" {
+            return;
+        }
+        let program = self.robots[r].program;
+        for (peer, (team, robot)) in program.peers.iter().enumerate() {
+            if peer == program.self_peer || (team != to && robot != to) {
+                continue;
+            }
+            let Some(dst) = self.index_of(robot) else {
+                continue;
+            };
+            let Some(latency) = self.link(r, dst) else {
+                continue;
+            };
+            let message = Message {
+                publish,
+                from_team: program.team.clone(),
+                from_robot: program.robot.clone(),
+                from_peer: Some(program.self_peer),
+                key: key.to_string(),
+                value: value.clone(),
+                sent_at: self.now,
+            };
+            let epoch = self.robots[dst].epoch;
+            self.schedule(
+                self.now + latency,
+                Event::Deliver {
+                    to: dst,
+                    epoch,
+                    message,
+                },
+            );
+        }
+    }
+
+    /// The latency of a message from `a` to `b` now, or `None` when it is lost.
+    fn link(&mut self, a: usize, b: usize) -> Option<i64> {
+        let (na, nb) = (&self.programs[a].robot, &self.programs[b].robot);
+        let pair = |(x, y): &(String, String)| (x == na && y == nb) || (x == nb && y == na);
+        let network = &self.scenario.network;
+        let link = network.links.iter().find(|l| pair(&l.between));
+        let mut latency = link
+            .and_then(|l| l.latency_ms)
+            .unwrap_or(network.latency_ms);
+        let loss = link.and_then(|l| l.loss).unwrap_or(network.loss);
+        let now = self.now;
+        for fault in &self.scenario.faults {
+            match &fault.kind {
+                FaultKind::Drop {
+                    between,
+                    from,
+                    until,
+                } if pair(between) && (*from..*until).contains(&now) => return None,
+                FaultKind::Delay {
+                    between,
+                    by,
+                    from,
+                    until,
+                } if pair(between) && (*from..*until).contains(&now) => latency += by,
+                FaultKind::Partition {
+                    groups,
+                    from,
+                    until,
+                } if (*from..*until).contains(&now) => {
+                    let group_of =
+                        |n: &String| groups.iter().position(|g| g.iter().any(|m| m == n));
+                    if group_of(na) != group_of(nb) {
+                        return None;
+                    }
+                }
+                _ => {}
+            }
+        }
+        // Draw only when loss is possible, so that a lossless run does not
+        // depend on how many messages came before.
+        if loss > 0.0 && (self.rng.next_u64() as f64 / u64::MAX as f64) < loss {
+            return None;
+        }
+        Some(latency)
+    }
+
+    /// The receive task: traced, then a heartbeat, a published value for a
+    /// group, or a sample for the control task's port.
+    fn deliver(&mut self, r: usize, message: Message) {
+        if !self.robots[r].has_receiver {
+            return; // no receive task reads the inbox
+        }
+        self.trace.push(TraceEvent {
+            t: self.now,
+            robot: r,
+            event: "receive",
+            fields: vec![
+                ("from", message.from_team.clone()),
+                ("from_robot", message.from_robot.clone()),
+                ("key", message.key.clone()),
+                ("value", message.value.clone()),
+            ],
+            sent_at: Some(message.sent_at),
+        });
+        let robot = &mut self.robots[r];
+        let m = &robot.program.control;
+        if m.heartbeat && message.publish && message.key == robot.alive_key {
+            for (i, (_, name)) in robot.program.peers.iter().enumerate() {
+                if *name == message.from_robot {
+                    robot.last_seen[i] = self.now;
+                }
+            }
+            return;
+        }
+        if !m.subscribed.is_empty() && message.publish {
+            for (i, g) in m.subscribed.iter().enumerate() {
+                if *g == message.key {
+                    robot.groups[i] = Some(message.value.clone());
+                }
+            }
+            return;
+        }
+        let mut dropped = Vec::new();
+        for (i, incoming) in m.incoming.iter().enumerate() {
+            if incoming.from_team == message.from_team && incoming.key == message.key {
+                let (queue, capacity) = &mut robot.inbox[i];
+                if queue.len() < *capacity {
+                    queue.push_back(message.value.clone());
+                } else {
+                    dropped.push(incoming.port.clone());
+                }
+            }
+        }
+        // A full channel drops the sample (the runtime counts it).
+        let _ = dropped;
+    }
+
+    // ------------------------------------------------------ service tasks
+
+    /// `request`: a service task starts one call unless it is busy.
+    fn request(&mut self, r: usize, task: &str, service: &str, args: Vec<String>) -> bool {
+        let t = self.robots[r].task_index(task);
+        if self.robots[r].tasks[t].1.busy {
+            return false;
+        }
+        let arg = args.first().cloned().unwrap_or_default();
+        let ms = self.robots[r]
+            .service_ms
+            .get(service)
+            .copied()
+            .unwrap_or(DEFAULT_SERVICE_MS);
+        let state = &mut self.robots[r].tasks[t].1;
+        state.busy = true;
+        state.service = service.to_string();
+        state.generation += 1;
+        let generation = state.generation;
+        self.emit(
+            r,
+            "call_start",
+            vec![
+                ("task", task.to_string()),
+                ("service", service.to_string()),
+                ("arg", arg.clone()),
+            ],
+        );
+        if !args.is_empty() {
+            self.emit(
+                r,
+                "actuate",
+                vec![("task", task.to_string()), ("value", arg)],
+            );
+        }
+        self.schedule(
+            self.now + ms,
+            Event::ServiceDone {
+                robot: r,
+                task: t,
+                generation,
+            },
+        );
+        true
+    }
+
+    fn end_call(&mut self, r: usize, t: usize) {
+        let (task, state) = &mut self.robots[r].tasks[t];
+        state.busy = false;
+        let fields = vec![("task", task.clone()), ("service", state.service.clone())];
+        self.emit(r, "call_end", fields);
+    }
+
+    /// `UFControl_StopTask`: the call ends now.
+    fn stop_task(&mut self, r: usize, task: &str) {
+        let t = self.robots[r].task_index(task);
+        if self.robots[r].tasks[t].1.busy {
+            self.end_call(r, t);
+        }
+    }
+
+    fn busy(&self, r: usize, task: &str) -> bool {
+        let robot = &self.robots[r];
+        robot.tasks[robot.task_index(task)].1.busy
+    }
+
+    // -------------------------------------------------------- the machine
+
+    fn throw_event(&mut self, r: usize, event: &str) {
+        self.emit(r, "throw", vec![("name", event.to_string())]);
+        let robot = &self.robots[r];
+        let m = &robot.program.control;
+        let Some(current) = robot.current_mode else {
+            return;
+        };
+        if robot.pending_mode.is_some() {
+            return;
+        }
+        if let Some(t) = m
+            .transitions
+            .iter()
+            .find(|t| t.from == current && t.event == event)
+        {
+            self.robots[r].pending_mode = Some(t.to);
+            let mode = m.modes[t.to].name.clone();
+            self.emit(
+                r,
+                "catch",
+                vec![("name", event.to_string()), ("mode", mode)],
+            );
+        }
+    }
+
+    fn enter_mode(&mut self, r: usize, mode: usize) {
+        let m: &ControlMachine = &self.robots[r].program.control;
+        for region in &mut self.robots[r].regions {
+            region.service = None;
+            region.done = true;
+        }
+        self.robots[r].current_mode = Some(mode);
+        self.emit(r, "mode", vec![("mode", m.modes[mode].name.clone())]);
+        for (i, region) in m.modes[mode].regions.iter().enumerate() {
+            let slot = &mut self.robots[r].regions[i];
+            slot.service = Some(region.service);
+            slot.plan = region.plan.clone();
+            slot.timeout_ms = region.timeout_ms.unwrap_or(0);
+        }
+        let now = self.now;
+        for i in 0..self.robots[r].regions.len() {
+            let region = &mut self.robots[r].regions[i];
+            let Some(service) = region.service else {
+                continue;
+            };
+            region.pc = 0;
+            region.phase = 0;
+            region.done = false;
+            region.started = now;
+            region.pass_start = now;
+            let fields = vec![
+                ("plan", region.plan.clone()),
+                ("service", m.services[service].name.clone()),
+            ];
+            self.emit(r, "service_start", fields);
+        }
+    }
+
+    fn leave_mode(&mut self, r: usize) {
+        let m = &self.robots[r].program.control;
+        for i in 0..self.robots[r].regions.len() {
+            let region = &self.robots[r].regions[i];
+            if let Some(service) = region.service
+                && !region.done
+            {
+                let fields = vec![
+                    ("plan", region.plan.clone()),
+                    ("service", m.services[service].name.clone()),
+                    ("why", "mode change".to_string()),
+                ];
+                self.emit(r, "service_end", fields);
+            }
+        }
+        for task in &m.request_tasks {
+            self.stop_task(r, task);
+        }
+    }
+
+    /// `task_control_go`: one firing of the control task.
+    fn fire(&mut self, r: usize) {
+        let program = self.robots[r].program;
+        let m = &program.control;
+        self.read_inputs(r);
+        if m.heartbeat && self.now - self.robots[r].last_heartbeat >= HEARTBEAT_MS {
+            self.robots[r].last_heartbeat = self.now;
+            let key = self.robots[r].alive_key.clone();
+            self.comm_send(
+                r,
+                &program.team,
+                true,
+                &key,
+                truncate(program.robot.clone()),
+            );
+        }
+        if self.robots[r].current_mode.is_none() {
+            match m.default_mode {
+                Some(d) => self.enter_mode(r, d),
+                None => {
+                    self.emit(r, "finish", vec![("why", "no default mode".into())]);
+                    self.stop(r);
+                    return;
+                }
+            }
+        }
+        let mut running = false;
+        for i in 0..self.robots[r].regions.len() {
+            if self.robots[r].pending_mode.is_some() {
+                break;
+            }
+            let region = &self.robots[r].regions[i];
+            let Some(service) = region.service else {
+                continue;
+            };
+            if region.done {
+                continue;
+            }
+            if region.timeout_ms > 0 && self.now - region.started > region.timeout_ms {
+                let plan = region.plan.clone();
+                self.robots[r].regions[i].done = true;
+                let fields = vec![
+                    ("plan", plan),
+                    ("service", m.services[service].name.clone()),
+                    ("why", "timeout".to_string()),
+                ];
+                self.emit(r, "service_end", fields);
+                continue;
+            }
+            let mut result = Step::Next;
+            let mut n = 0;
+            while n < STEPS_PER_FIRING
+                && result == Step::Next
+                && self.robots[r].pending_mode.is_none()
+            {
+                result = self.step(r, i, service);
+                n += 1;
+            }
+            if result == Step::Done {
+                let region = &mut self.robots[r].regions[i];
+                region.done = true;
+                let fields = vec![
+                    ("plan", region.plan.clone()),
+                    ("service", m.services[service].name.clone()),
+                ];
+                self.emit(r, "service_end", fields);
+            } else {
+                running = true;
+            }
+        }
+        if let Some(next) = self.robots[r].pending_mode {
+            self.leave_mode(r);
+            self.robots[r].pending_mode = None;
+            self.enter_mode(r, next);
+            return;
+        }
+        if !running {
+            let mode = self.robots[r]
+                .current_mode
+                .map(|c| m.modes[c].name.clone())
+                .unwrap_or_default();
+            self.emit(r, "finish", vec![("mode", mode)]);
+            self.stop(r);
+        }
+    }
+
+    fn region(&mut self, r: usize, i: usize) -> &mut Region {
+        &mut self.robots[r].regions[i]
+    }
+
+    /// One state of region `i`'s service (`service_<n>` of the C).
+    fn step(&mut self, r: usize, i: usize, service: usize) -> Step {
+        let program: &'p RobotProgram = self.robots[r].program;
+        let m = &program.control;
+        let pc = self.robots[r].regions[i].pc;
+        let Some(state) = m.services[service].states.get(pc) else {
+            return Step::Done;
+        };
+        let next = pc + 1;
+        let now = self.now;
+        match &state.kind {
+            StateKind::Receive {
+                messages,
+                timeout_ms,
+                mark,
+            } => {
+                if timeout_ms.is_some() && self.robots[r].regions[i].phase == 0 {
+                    let region = self.region(r, i);
+                    region.marks[*mark] = now;
+                    region.phase = 1;
+                }
+                let ready = messages
+                    .iter()
+                    .all(|&k| !self.robots[r].inbox[k].0.is_empty());
+                if !ready {
+                    let Some(t) = timeout_ms else {
+                        return Step::Wait;
+                    };
+                    if now - self.robots[r].regions[i].marks[*mark] <= *t {
+                        return Step::Wait;
+                    }
+                    self.emit(r, "timeout", vec![("statement", "receive".into())]);
+                    let region = self.region(r, i);
+                    region.phase = 0;
+                    region.pc = next;
+                    return Step::Next;
+                }
+                if timeout_ms.is_some() {
+                    self.region(r, i).phase = 0;
+                }
+                for &k in messages {
+                    if let Some(v) = self.robots[r].inbox[k].0.pop_front() {
+                        self.store(r, m.incoming[k].slot, v);
+                    }
+                }
+                self.region(r, i).pc = next;
+                Step::Next
+            }
+            StateKind::Send { items } => {
+                for item in items {
+                    let value = self.value(r, &item.value);
+                    let sent = match item.store {
+                        Some(s) => {
+                            self.store(r, s, value);
+                            self.robots[r].slots[s].clone()
+                        }
+                        None => value,
+                    };
+                    let out = &m.outgoing[item.message];
+                    self.comm_send(r, &out.to_team, out.publish, &out.key, sent);
+                }
+                self.region(r, i).pc = next;
+                Step::Next
+            }
+            StateKind::Subscribe { group, slot } => {
+                if let Some(v) = self.robots[r].groups[*group].clone() {
+                    self.store(r, *slot, v);
+                }
+                self.region(r, i).pc = next;
+                Step::Next
+            }
+            StateKind::Throw { event } => {
+                self.throw_event(r, event);
+                self.region(r, i).pc = next;
+                Step::Next
+            }
+            StateKind::Call {
+                service,
+                task,
+                args,
+                timeout_ms,
+                mark,
+            } => {
+                if self.robots[r].regions[i].phase == 0 {
+                    let values = args.iter().map(|a| self.value(r, a)).collect();
+                    if !self.request(r, task, service, values) {
+                        return Step::Wait;
+                    }
+                    let region = self.region(r, i);
+                    region.marks[*mark] = now;
+                    region.phase = 1;
+                    return Step::Wait;
+                }
+                let timed_out =
+                    timeout_ms.is_some_and(|t| now - self.robots[r].regions[i].marks[*mark] > t);
+                if timed_out {
+                    self.stop_task(r, task);
+                    self.emit(r, "timeout", vec![("service", service.clone())]);
+                } else if self.busy(r, task) {
+                    return Step::Wait;
+                }
+                let region = self.region(r, i);
+                region.phase = 0;
+                region.pc = next;
+                Step::Next
+            }
+            StateKind::RunActions {
+                service,
+                machine,
+                args,
+                timeout_ms,
+                mark,
+            } => {
+                let am = &m.actions[*machine];
+                if self.robots[r].regions[i].phase == 0 {
+                    for (k, slot) in am.arguments.iter().enumerate() {
+                        if let Some(arg) = args.get(k) {
+                            let v = self.value(r, arg);
+                            self.store(r, *slot, v);
+                        }
+                    }
+                    let region = self.region(r, i);
+                    region.action = am.initial;
+                    region.phase = 1;
+                    region.marks[*mark] = now;
+                    self.emit(r, "actions_start", vec![("service", service.clone())]);
+                }
+                if let Some(t) = timeout_ms
+                    && now - self.robots[r].regions[i].marks[*mark] > *t
+                {
+                    self.emit(r, "timeout", vec![("service", service.clone())]);
+                    let region = self.region(r, i);
+                    region.phase = 0;
+                    region.pc = next;
+                    return Step::Next;
+                }
+                if self.actions(r, i, am) != Step::Done {
+                    return Step::Wait;
+                }
+                self.emit(r, "actions_end", vec![("service", service.clone())]);
+                let region = self.region(r, i);
+                region.phase = 0;
+                region.pc = next;
+                Step::Next
+            }
+            StateKind::LeaderBranch {
+                candidates,
+                others_at,
+            } => {
+                let elected = self.elected(r, (service, pc), candidates);
+                self.region(r, i).pc = if elected { next } else { *others_at };
+                Step::Next
+            }
+            StateKind::Branch { condition, else_to } => {
+                let holds = self.eval(r, condition);
+                self.region(r, i).pc = if holds { next } else { *else_to };
+                Step::Next
+            }
+            StateKind::Jump { to } => {
+                self.region(r, i).pc = *to;
+                Step::Next
+            }
+            StateKind::LoopHead {
+                condition,
+                exit_to,
+                mark,
+            } => {
+                if let Some(cond) = condition
+                    && !self.eval(r, cond)
+                {
+                    self.region(r, i).pc = *exit_to;
+                    return Step::Next;
+                }
+                let region = self.region(r, i);
+                region.marks[*mark] = now;
+                region.pc = next;
+                Step::Next
+            }
+            StateKind::LoopTail {
+                period_ms,
+                mark,
+                to,
+            } => match period_ms {
+                Some(p) => {
+                    if now - self.robots[r].regions[i].marks[*mark] < *p {
+                        return Step::Wait;
+                    }
+                    self.region(r, i).pc = *to;
+                    Step::Next
+                }
+                None => {
+                    self.region(r, i).pc = *to;
+                    Step::Wait
+                }
+            },
+            StateKind::Repeat {
+                period_ms,
+                condition,
+                forever,
+            } => {
+                if let Some(cond) = condition
+                    && !self.eval(r, cond)
+                {
+                    return Step::Done;
+                }
+                if let Some(p) = period_ms {
+                    if now - self.robots[r].regions[i].pass_start < *p {
+                        return Step::Wait;
+                    }
+                    let region = self.region(r, i);
+                    region.pass_start = now;
+                    region.pc = 0;
+                    Step::Next
+                } else if *forever || condition.is_some() {
+                    let region = self.region(r, i);
+                    region.pass_start = now;
+                    region.pc = 0;
+                    Step::Wait
+                } else {
+                    Step::Done
+                }
+            }
+        }
+    }
+
+    /// `actions_<n>`: phase 1 enters the current action (issues its
+    /// commands), phase 2 waits for them and takes the first transition that holds.
+    fn actions(&mut self, r: usize, i: usize, am: &'p ActionMachine) -> Step {
+        let Some(action) = am.actions.get(self.robots[r].regions[i].action) else {
+            return Step::Done;
+        };
+        if action.is_final {
+            return Step::Done;
+        }
+        if !action.commands.is_empty() {
+            if self.robots[r].regions[i].phase == 1 {
+                for (task, command) in &action.commands {
+                    let name = actuator_name(self.robots[r].program, task);
+                    if !self.request(r, task, &name, vec![truncate(command.clone())]) {
+                        return Step::Wait;
+                    }
+                }
+                self.region(r, i).phase = 2;
+                return Step::Wait;
+            }
+            for (task, _) in &action.commands {
+                if self.busy(r, task) {
+                    return Step::Wait;
+                }
+            }
+        }
+        for (condition, to) in &action.transitions {
+            if condition.as_ref().is_none_or(|c| self.eval(r, c)) {
+                let region = self.region(r, i);
+                region.action = *to;
+                region.phase = 1;
+                return Step::Next;
+            }
+        }
+        Step::Wait
+    }
+
+    /// `elected`: the first candidate that is this robot or was heard from
+    /// within three heartbeats leads; a change of leader is traced.
+    fn elected(&mut self, r: usize, state: (usize, usize), candidates: &[usize]) -> bool {
+        let robot = &self.robots[r];
+        let me = robot.program.self_peer;
+        let leader = candidates
+            .iter()
+            .copied()
+            .find(|&c| c == me || self.now - robot.last_seen[c] <= 3 * HEARTBEAT_MS)
+            .unwrap_or(me);
+        if robot.leaders.get(&state) != Some(&leader) {
+            self.robots[r].leaders.insert(state, leader);
+            let name = self.robots[r].program.peers[leader].1.clone();
+            self.emit(r, "leader", vec![("leader", name)]);
+        }
+        leader == me
+    }
+}
+
+/// The actuator command name a task runs (`control.rs`'s `actuator_name`).
+fn actuator_name(program: &RobotProgram, task: &str) -> String {
+    program
+        .tasks
+        .iter()
+        .find(|t| t.task == task)
+        .and_then(|t| match &t.kind {
+            RoleKind::Service { services } => services.first().cloned(),
+            _ => None,
+        })
+        .unwrap_or_else(|| task.to_string())
+}
+
+/// The battery level at `t`: linear between the scenario's points, the
+/// first before them and the last after them.
+fn battery_level(points: &[(i64, f64)], t: i64) -> Option<f64> {
+    let first = points.first()?;
+    if t <= first.0 {
+        return Some(first.1);
+    }
+    for pair in points.windows(2) {
+        let ((t0, l0), (t1, l1)) = (pair[0], pair[1]);
+        if t <= t1 {
+            return Some(l0 + (l1 - l0) * (t - t0) as f64 / (t1 - t0) as f64);
+        }
+    }
+    points.last().map(|p| p.1)
+}

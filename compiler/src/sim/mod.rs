@@ -1,0 +1,105 @@
+//! The simulator (`semo simulate`): every robot of a mission run at once as
+//! a deterministic discrete-event simulation in virtual time, from the same
+//! refined [`RobotProgram`]s the C generator walks — the reference meaning
+//! of a mission, against which the generated `linux-sim` programs are tested.
+//!
+//! - `json.rs`: a strict JSON reader keeping each value's position.
+//! - `scenario.rs`: the scenario file (sensors, services, operator, network,
+//!   faults, expectations), names checked against the programs.
+//! - `engine.rs`: the event loop mirroring the generated control task and
+//!   the runtime.
+//! - `trace.rs`: trace events, written as `linux-sim` writes them.
+//! - `expect.rs`: expectations judged on the trace.
+//! - `svg.rs`: the timeline picture.
+//!
+//! Nothing reads the wall clock; a run is a function of the programs, the
+//! scenario and the seed.
+
+mod engine;
+pub mod expect;
+mod json;
+pub mod scenario;
+pub mod svg;
+pub mod trace;
+
+pub use engine::{DEFAULT_UNTIL_MS, Options, Run};
+pub use expect::Verdict;
+pub use scenario::{Scenario, ScenarioError};
+pub use trace::TraceEvent;
+
+use crate::refine::RobotProgram;
+use std::fmt::Write;
+
+/// Runs every program on the scenario.
+pub fn simulate(programs: &[RobotProgram], scenario: &Scenario, options: &Options) -> Run {
+    engine::Sim::new(programs, scenario, options.seed).run(options)
+}
+
+impl Run {
+    /// The trace as JSON lines, each ending in a newline.
+    pub fn trace_lines(&self) -> String {
+        let mut out = String::new();
+        for e in &self.trace {
+            out.push_str(&e.to_json(&self.robots[e.robot].1));
+            out.push('\n');
+        }
+        out
+    }
+}
+
+/// The text summary: each robot's modes in order, then every expectation.
+pub fn summary(run: &Run, verdicts: &[Verdict]) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "simulated {} robot(s) for {} ms of mission time ({} events)",
+        run.robots.len(),
+        run.end_ms,
+        run.events
+    );
+    for (r, (team, robot)) in run.robots.iter().enumerate() {
+        let modes: Vec<String> = expect::modes(run, r)
+            .iter()
+            .map(|(t, m)| format!("{m}@{t}"))
+            .collect();
+        // The robot's last word: finished, killed, or still running.
+        let end = run
+            .trace
+            .iter()
+            .rev()
+            .filter(|e| e.robot == r)
+            .find_map(|e| match (e.event, e.field("fault")) {
+                ("finish", _) => Some(format!("finished at {} ms", e.t)),
+                ("fault", Some("kill")) => Some(format!("killed at {} ms", e.t)),
+                ("start", _) => Some(format!("running at {} ms", run.end_ms)),
+                _ => None,
+            })
+            .unwrap_or_default();
+        let _ = writeln!(
+            out,
+            "  {team}/{robot}: {} ({end})",
+            if modes.is_empty() {
+                "no mode".to_string()
+            } else {
+                modes.join(" -> ")
+            }
+        );
+    }
+    if !verdicts.is_empty() {
+        let met = verdicts.iter().filter(|v| v.met).count();
+        let _ = writeln!(out, "expectations: {met} of {} met", verdicts.len());
+        for v in verdicts {
+            let _ = writeln!(
+                out,
+                "  {} {}: {}",
+                if v.met { "ok  " } else { "FAIL" },
+                v.expectation.kind,
+                v.why
+            );
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,729 @@
+//! The scenario file (`*.scenario.json`, schema version 1, documented in
+//! `docs/scenario-and-trace.md`): what the world does around the robots
+//! (timed sensor values, service durations, operator commands, the network,
+//! faults) and what the run is expected to show. `linux-sim` programs read
+//! the same file (`semo_sim.c`); the keys it does not act on (`network`,
+//! `faults`, `expect`, `battery`) it accepts and ignores.
+//!
+//! Every mistake is reported at the value that holds it (a byte offset,
+//! turned into line and column by [`ScenarioError::line_col`]), including
+//! names the mission does not have.
+
+use super::json::{self, Kind, Value};
+use crate::refine::RobotProgram;
+
+/// The schema version this reader understands.
+pub const VERSION: i64 = 1;
+/// A built-in service's duration when the scenario gives none (`semo_sim.c`).
+pub const DEFAULT_SERVICE_MS: i64 = 100;
+/// Longest time the scenario may name (the runtime's `MAX_MS`).
+const MAX_MS: f64 = 1e15;
+
+#[derive(Clone, Debug, Default)]
+pub struct Scenario {
+    /// Mission ms the run lasts (`duration`; `None`: until every robot finished).
+    pub duration_ms: Option<i64>,
+    /// Per robot of the mission, by name.
+    pub robots: Vec<RobotWorld>,
+    pub operator: Vec<Command>,
+    pub network: Network,
+    pub faults: Vec<Fault>,
+    pub expect: Vec<Expectation>,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct RobotWorld {
+    pub robot: String,
+    /// (at, value name, value), in file order.
+    pub sensors: Vec<(i64, String, String)>,
+    pub services: Vec<(String, i64)>,
+    /// (at, level): the `BATTERY` sensor value, linear between points.
+    pub battery: Vec<(i64, f64)>,
+}
+
+/// An operator command: `USER.<value>` sent to a robot or team.
+#[derive(Clone, Debug)]
+pub struct Command {
+    pub to: String,
+    pub key: String,
+    pub value: String,
+    pub first: i64,
+    pub every: Option<i64>,
+    pub until: i64,
+}
+
+#[derive(Clone, Debug)]
+pub struct Network {
+    pub latency_ms: i64,
+    pub loss: f64,
+    /// Per pair of robots (either direction).
+    pub links: Vec<Link>,
+}
+
+impl Default for Network {
+    fn default() -> Self {
+        Network {
+            latency_ms: DEFAULT_LATENCY_MS,
+            loss: 0.0,
+            links: Vec::new(),
+        }
+    }
+}
+
+/// Delivery time of a message when the scenario names none: one mission ms.
+pub const DEFAULT_LATENCY_MS: i64 = 1;
+
+#[derive(Clone, Debug)]
+pub struct Link {
+    pub between: (String, String),
+    pub latency_ms: Option<i64>,
+    pub loss: Option<f64>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Fault {
+    /// Byte offset of the fault's object (for pictures and messages).
+    pub at_offset: usize,
+    pub kind: FaultKind,
+}
+
+#[derive(Clone, Debug)]
+pub enum FaultKind {
+    /// The robot stops at `at` without a word (as a killed process).
+    Kill { robot: String, at: i64 },
+    /// The robot starts again from its default mode.
+    Restart { robot: String, at: i64 },
+    /// Messages between the two robots are lost during [from, until).
+    Drop {
+        between: (String, String),
+        from: i64,
+        until: i64,
+    },
+    /// Messages between the two robots take `by` ms longer during [from, until).
+    Delay {
+        between: (String, String),
+        by: i64,
+        from: i64,
+        until: i64,
+    },
+    /// Robots in different groups cannot talk during [from, until).
+    Partition {
+        groups: Vec<Vec<String>>,
+        from: i64,
+        until: i64,
+    },
+}
+
+#[derive(Clone, Debug)]
+pub struct Expectation {
+    /// Byte offset of the expectation's object in the scenario.
+    pub at_offset: usize,
+    pub kind: ExpectKind,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ExpectKind {
+    /// The robot enters the mode (at or) before `before` ms (any time if `None`).
+    Enters {
+        robot: String,
+        mode: String,
+        before: Option<i64>,
+    },
+    NeverEnters {
+        robot: String,
+        mode: String,
+    },
+    /// The robot receives `key` from robot `from` (any sender if `None`).
+    Receives {
+        robot: String,
+        key: String,
+        from: Option<String>,
+        before: Option<i64>,
+    },
+    /// Every robot's last mode is this one.
+    AllEndIn {
+        mode: String,
+    },
+}
+
+impl std::fmt::Display for ExpectKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ExpectKind::Enters {
+                robot,
+                mode,
+                before,
+            } => {
+                write!(f, "{robot} enters {mode}")?;
+                if let Some(t) = before {
+                    write!(f, " before {t} ms")?;
+                }
+                Ok(())
+            }
+            ExpectKind::NeverEnters { robot, mode } => write!(f, "{robot} never enters {mode}"),
+            ExpectKind::Receives {
+                robot,
+                key,
+                from,
+                before,
+            } => {
+                write!(f, "{robot} receives {key}")?;
+                if let Some(from) = from {
+                    write!(f, " from {from}")?;
+                }
+                if let Some(t) = before {
+                    write!(f, " before {t} ms")?;
+                }
+                Ok(())
+            }
+            ExpectKind::AllEndIn { mode } => write!(f, "all robots end in {mode}"),
+        }
+    }
+}
+
+/// A mistake in the scenario, at a byte offset of its text.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScenarioError {
+    pub at: usize,
+    pub message: String,
+}
+
+impl ScenarioError {
+    /// 1-based line and column (in characters) of the mistake.
+    pub fn line_col(&self, text: &str) -> (u32, u32) {
+        let index = crate::text::LineIndex::new(text);
+        let lc = index.line_col(text, self.at, crate::text::ColumnUnit::Char);
+        (lc.line + 1, lc.col + 1)
+    }
+}
+
+type Result<T> = std::result::Result<T, ScenarioError>;
+
+fn fail<T>(v: &Value, message: impl Into<String>) -> Result<T> {
+    Err(ScenarioError {
+        at: v.at,
+        message: message.into(),
+    })
+}
+
+/// Reads a scenario and checks its names against the mission's programs.
+pub fn parse(text: &str, programs: &[RobotProgram]) -> Result<Scenario> {
+    let root = json::parse(text).map_err(|e| ScenarioError {
+        at: e.at,
+        message: e.message,
+    })?;
+    Reader { programs }.scenario(&root)
+}
+
+struct Reader<'a> {
+    programs: &'a [RobotProgram],
+}
+
+fn object<'v>(v: &'v Value, what: &str, keys: &[&str]) -> Result<&'v [(String, Value)]> {
+    let Kind::Object(members) = &v.kind else {
+        return fail(v, format!("expected {what}"));
+    };
+    for (key, value) in members {
+        if !keys.contains(&key.as_str()) {
+            return fail(
+                value,
+                format!(
+                    "unknown key \"{key}\" in {what} (expected one of: {})",
+                    keys.join(", ")
+                ),
+            );
+        }
+    }
+    Ok(members)
+}
+
+fn array<'v>(v: &'v Value, what: &str) -> Result<&'v [Value]> {
+    match &v.kind {
+        Kind::Array(items) => Ok(items),
+        _ => fail(v, format!("expected {what}")),
+    }
+}
+
+fn require<'v>(object: &'v Value, key: &str) -> Result<&'v Value> {
+    match object.member(key) {
+        Some(v) => Ok(v),
+        None => fail(object, format!("missing \"{key}\"")),
+    }
+}
+
+fn ms(v: &Value, key: &str, min: i64) -> Result<i64> {
+    match &v.kind {
+        Kind::Number(n, _) if *n >= min as f64 && *n <= MAX_MS && n.fract() == 0.0 => Ok(*n as i64),
+        _ => fail(
+            v,
+            format!(
+                "\"{key}\" must be a whole number of milliseconds{}",
+                if min > 0 { " above 0" } else { "" }
+            ),
+        ),
+    }
+}
+
+fn opt_ms(object: &Value, key: &str, min: i64) -> Result<Option<i64>> {
+    object.member(key).map(|v| ms(v, key, min)).transpose()
+}
+
+fn name<'v>(v: &'v Value, key: &str) -> Result<&'v str> {
+    match &v.kind {
+        Kind::String(s) if !s.is_empty() && s.len() < 48 => Ok(s),
+        _ => fail(
+            v,
+            format!("\"{key}\" must be a non-empty string shorter than 48 bytes"),
+        ),
+    }
+}
+
+/// `"is"`: a string, or a number as written.
+fn value_text(v: &Value) -> Result<String> {
+    match &v.kind {
+        Kind::String(s) | Kind::Number(_, s) if s.len() < 64 => Ok(s.clone()),
+        _ => fail(v, "\"is\" must be a string or number shorter than 64 bytes"),
+    }
+}
+
+fn probability(v: &Value, key: &str) -> Result<f64> {
+    match &v.kind {
+        Kind::Number(n, _) if (0.0..=1.0).contains(n) => Ok(*n),
+        _ => fail(v, format!("\"{key}\" must be a number from 0 to 1")),
+    }
+}
+
+impl Reader<'_> {
+    fn robot(&self, v: &Value, key: &str) -> Result<String> {
+        let robot = name(v, key)?;
+        if self.programs.iter().any(|p| p.robot == robot) {
+            return Ok(robot.to_string());
+        }
+        let known: Vec<&str> = self.programs.iter().map(|p| p.robot.as_str()).collect();
+        fail(
+            v,
+            format!(
+                "robot \"{robot}\" is not in the mission (robots: {})",
+                known.join(", ")
+            ),
+        )
+    }
+
+    fn robot_or_team(&self, v: &Value, key: &str) -> Result<String> {
+        let to = name(v, key)?;
+        if self.programs.iter().any(|p| p.robot == to || p.team == to) {
+            return Ok(to.to_string());
+        }
+        fail(
+            v,
+            format!("\"{to}\" is neither a robot nor a team of the mission"),
+        )
+    }
+
+    /// A mode of `robot`'s team (or of any team when `robot` is `None`).
+    fn mode(&self, v: &Value, key: &str, robot: Option<&str>) -> Result<String> {
+        let mode = name(v, key)?;
+        let programs: Vec<&RobotProgram> = self
+            .programs
+            .iter()
+            .filter(|p| robot.is_none_or(|r| p.robot == r))
+            .collect();
+        if programs
+            .iter()
+            .any(|p| p.control.modes.iter().any(|m| m.name == mode))
+        {
+            return Ok(mode.to_string());
+        }
+        let mut known: Vec<&str> = programs
+            .iter()
+            .flat_map(|p| p.control.modes.iter().map(|m| m.name.as_str()))
+            .collect();
+        known.sort_unstable();
+        known.dedup();
+        fail(
+            v,
+            format!(
+                "no mode \"{mode}\"{} (modes: {})",
+                robot.map_or(String::new(), |r| format!(" for robot {r}")),
+                known.join(", ")
+            ),
+        )
+    }
+
+    fn pair(&self, v: &Value, key: &str) -> Result<(String, String)> {
+        let items = array(v, &format!("\"{key}\": two robot names"))?;
+        if items.len() != 2 {
+            return fail(v, format!("\"{key}\" must name two robots"));
+        }
+        Ok((self.robot(&items[0], key)?, self.robot(&items[1], key)?))
+    }
+
+    fn scenario(&self, root: &Value) -> Result<Scenario> {
+        object(
+            root,
+            "a scenario object {\"robots\": ..., \"operator\": ...}",
+            &[
+                "version",
+                "time_scale",
+                "duration",
+                "robots",
+                "operator",
+                "network",
+                "faults",
+                "expect",
+            ],
+        )?;
+        let mut scenario = Scenario::default();
+        if let Some(v) = root.member("version") {
+            match &v.kind {
+                Kind::Number(n, _) if *n == VERSION as f64 => {}
+                _ => return fail(v, format!("\"version\" must be {VERSION}")),
+            }
+        }
+        if let Some(v) = root.member("time_scale") {
+            match &v.kind {
+                Kind::Number(n, _) if *n > 0.0 => {}
+                _ => return fail(v, "\"time_scale\" must be a positive number"),
+            }
+        }
+        scenario.duration_ms = opt_ms(root, "duration", 0)?;
+        if let Some(robots) = root.member("robots") {
+            let Kind::Object(members) = &robots.kind else {
+                return fail(robots, "expected an object of robots {\"name\": {...}}");
+            };
+            for (robot, v) in members {
+                scenario.robots.push(self.robot_world(robot, v)?);
+            }
+        }
+        if let Some(commands) = root.member("operator") {
+            for v in array(commands, "an array of operator commands")? {
+                scenario.operator.push(self.command(v)?);
+            }
+        }
+        if let Some(v) = root.member("network") {
+            scenario.network = self.network(v)?;
+        }
+        if let Some(faults) = root.member("faults") {
+            for v in array(faults, "an array of faults")? {
+                scenario.faults.push(self.fault(v)?);
+            }
+        }
+        if let Some(expect) = root.member("expect") {
+            for v in array(expect, "an array of expectations")? {
+                scenario.expect.push(self.expectation(v)?);
+            }
+        }
+        Ok(scenario)
+    }
+
+    fn robot_world(&self, robot: &str, v: &Value) -> Result<RobotWorld> {
+        if !self.programs.iter().any(|p| p.robot == robot) {
+            let known: Vec<&str> = self.programs.iter().map(|p| p.robot.as_str()).collect();
+            return fail(
+                v,
+                format!(
+                    "robot \"{robot}\" is not in the mission (robots: {})",
+                    known.join(", ")
+                ),
+            );
+        }
+        object(
+            v,
+            "a robot {\"sensors\": [...], \"services\": {...}, \"battery\": [...]}",
+            &["sensors", "services", "battery"],
+        )?;
+        let mut world = RobotWorld {
+            robot: robot.to_string(),
+            ..RobotWorld::default()
+        };
+        if let Some(sensors) = v.member("sensors") {
+            for entry in array(sensors, "an array of sensor entries")? {
+                object(
+                    entry,
+                    "a sensor entry {\"at\", \"value\", \"is\"}",
+                    &["at", "value", "is"],
+                )?;
+                let at = ms(require(entry, "at")?, "at", 0)?;
+                let value = name(require(entry, "value")?, "value")?.to_string();
+                let is = value_text(require(entry, "is")?)?;
+                world.sensors.push((at, value, is));
+            }
+        }
+        if let Some(services) = v.member("services") {
+            let Kind::Object(members) = &services.kind else {
+                return fail(
+                    services,
+                    "expected an object of service durations {\"move\": 300}",
+                );
+            };
+            for (service, d) in members {
+                world.services.push((service.clone(), ms(d, service, 0)?));
+            }
+        }
+        if let Some(battery) = v.member("battery") {
+            let mut last = -1;
+            for entry in array(battery, "an array of battery levels {\"at\", \"level\"}")? {
+                object(
+                    entry,
+                    "a battery level {\"at\", \"level\"}",
+                    &["at", "level"],
+                )?;
+                let at_value = require(entry, "at")?;
+                let at = ms(at_value, "at", 0)?;
+                if at <= last {
+                    return fail(at_value, "battery levels must be in time order");
+                }
+                last = at;
+                let level = require(entry, "level")?;
+                let Kind::Number(n, _) = level.kind else {
+                    return fail(level, "\"level\" must be a number");
+                };
+                world.battery.push((at, n));
+            }
+        }
+        Ok(world)
+    }
+
+    fn command(&self, v: &Value) -> Result<Command> {
+        object(
+            v,
+            "an operator command {\"at\"|\"every\", \"to\", \"value\", \"is\"}",
+            &["at", "every", "from", "until", "to", "value", "is"],
+        )?;
+        let to = self.robot_or_team(require(v, "to")?, "to")?;
+        let key = format!("USER.{}", name(require(v, "value")?, "value")?);
+        let value = value_text(require(v, "is")?)?;
+        let (at, every) = (v.member("at"), v.member("every"));
+        if at.is_some() == every.is_some() {
+            return fail(v, "an operator command needs either \"at\" or \"every\"");
+        }
+        if at.is_some() && (v.member("from").is_some() || v.member("until").is_some()) {
+            return fail(v, "\"from\" and \"until\" go with \"every\", not \"at\"");
+        }
+        Ok(match at {
+            Some(at) => {
+                let at = ms(at, "at", 0)?;
+                Command {
+                    to,
+                    key,
+                    value,
+                    first: at,
+                    every: None,
+                    until: at,
+                }
+            }
+            None => Command {
+                to,
+                key,
+                value,
+                first: opt_ms(v, "from", 0)?.unwrap_or(0),
+                every: Some(ms(every.unwrap_or(v), "every", 1)?),
+                until: opt_ms(v, "until", 0)?.unwrap_or(MAX_MS as i64),
+            },
+        })
+    }
+
+    fn network(&self, v: &Value) -> Result<Network> {
+        object(
+            v,
+            "a network {\"latency\", \"loss\", \"links\"}",
+            &["latency", "loss", "links"],
+        )?;
+        let mut network = Network {
+            latency_ms: opt_ms(v, "latency", 0)?.unwrap_or(DEFAULT_LATENCY_MS),
+            loss: v
+                .member("loss")
+                .map(|l| probability(l, "loss"))
+                .transpose()?
+                .unwrap_or(0.0),
+            links: Vec::new(),
+        };
+        if let Some(links) = v.member("links") {
+            for link in array(links, "an array of links")? {
+                object(
+                    link,
+                    "a link {\"between\", \"latency\", \"loss\"}",
+                    &["between", "latency", "loss"],
+                )?;
+                network.links.push(Link {
+                    between: self.pair(require(link, "between")?, "between")?,
+                    latency_ms: opt_ms(link, "latency", 0)?,
+                    loss: link
+                        .member("loss")
+                        .map(|l| probability(l, "loss"))
+                        .transpose()?,
+                });
+            }
+        }
+        Ok(network)
+    }
+
+    fn interval(&self, v: &Value) -> Result<(i64, i64)> {
+        let from = ms(require(v, "from")?, "from", 0)?;
+        let until_value = require(v, "until")?;
+        let until = ms(until_value, "until", 0)?;
+        if until <= from {
+            return fail(until_value, "\"until\" must be after \"from\"");
+        }
+        Ok((from, until))
+    }
+
+    fn fault(&self, v: &Value) -> Result<Fault> {
+        object(
+            v,
+            "a fault {\"kill\"|\"restart\"|\"drop\"|\"delay\"|\"partition\", ...}",
+            &[
+                "at",
+                "kill",
+                "restart",
+                "drop",
+                "delay",
+                "by",
+                "partition",
+                "from",
+                "until",
+            ],
+        )?;
+        let kinds = ["kill", "restart", "drop", "delay", "partition"];
+        let given: Vec<&str> = kinds
+            .into_iter()
+            .filter(|k| v.member(k).is_some())
+            .collect();
+        if given.len() != 1 {
+            return fail(
+                v,
+                "a fault is exactly one of \"kill\", \"restart\", \"drop\", \"delay\", \"partition\"",
+            );
+        }
+        let kind = match given[0] {
+            "kill" | "restart" => {
+                let robot = self.robot(require(v, given[0])?, given[0])?;
+                let at = ms(require(v, "at")?, "at", 0)?;
+                if given[0] == "kill" {
+                    FaultKind::Kill { robot, at }
+                } else {
+                    FaultKind::Restart { robot, at }
+                }
+            }
+            "drop" => {
+                let (from, until) = self.interval(v)?;
+                FaultKind::Drop {
+                    between: self.pair(require(v, "drop")?, "drop")?,
+                    from,
+                    until,
+                }
+            }
+            "delay" => {
+                let (from, until) = self.interval(v)?;
+                FaultKind::Delay {
+                    between: self.pair(require(v, "delay")?, "delay")?,
+                    by: ms(require(v, "by")?, "by", 0)?,
+                    from,
+                    until,
+                }
+            }
+            _ => {
+                let (from, until) = self.interval(v)?;
+                let partition = require(v, "partition")?;
+                let mut groups = Vec::new();
+                for group in array(partition, "an array of groups of robot names")? {
+                    let robots = array(group, "a group: an array of robot names")?;
+                    groups.push(
+                        robots
+                            .iter()
+                            .map(|r| self.robot(r, "partition"))
+                            .collect::<Result<Vec<_>>>()?,
+                    );
+                }
+                FaultKind::Partition {
+                    groups,
+                    from,
+                    until,
+                }
+            }
+        };
+        Ok(Fault {
+            at_offset: v.at,
+            kind,
+        })
+    }
+
+    fn expectation(&self, v: &Value) -> Result<Expectation> {
+        object(
+            v,
+            "an expectation {\"robot\", \"enters\"|\"never_enters\"|\"receives\", ...} or {\"all_end_in\"}",
+            &[
+                "robot",
+                "enters",
+                "never_enters",
+                "receives",
+                "from",
+                "before",
+                "all_end_in",
+            ],
+        )?;
+        let kinds = ["enters", "never_enters", "receives", "all_end_in"];
+        let given: Vec<&str> = kinds
+            .into_iter()
+            .filter(|k| v.member(k).is_some())
+            .collect();
+        if given.len() != 1 {
+            return fail(
+                v,
+                "an expectation is exactly one of \"enters\", \"never_enters\", \"receives\", \"all_end_in\"",
+            );
+        }
+        let before = opt_ms(v, "before", 0)?;
+        let kind = if given[0] == "all_end_in" {
+            if let Some(extra) = v.member("robot").or(v.member("before")) {
+                return fail(
+                    extra,
+                    "\"all_end_in\" is about every robot: no \"robot\" or \"before\"",
+                );
+            }
+            ExpectKind::AllEndIn {
+                mode: self.mode(require(v, "all_end_in")?, "all_end_in", None)?,
+            }
+        } else {
+            let robot = self.robot(require(v, "robot")?, "robot")?;
+            match given[0] {
+                "enters" => ExpectKind::Enters {
+                    mode: self.mode(require(v, "enters")?, "enters", Some(&robot))?,
+                    robot,
+                    before,
+                },
+                "never_enters" => {
+                    if let Some(b) = v.member("before") {
+                        return fail(b, "\"never_enters\" takes no \"before\"");
+                    }
+                    ExpectKind::NeverEnters {
+                        mode: self.mode(
+                            require(v, "never_enters")?,
+                            "never_enters",
+                            Some(&robot),
+                        )?,
+                        robot,
+                    }
+                }
+                _ => ExpectKind::Receives {
+                    key: name(require(v, "receives")?, "receives")?.to_string(),
+                    from: v
+                        .member("from")
+                        .map(|f| self.robot(f, "from"))
+                        .transpose()?,
+                    robot,
+                    before,
+                },
+            }
+        };
+        if given[0] != "receives"
+            && let Some(from) = v.member("from")
+        {
+            return fail(from, "\"from\" goes with \"receives\"");
+        }
+        Ok(Expectation {
+            at_offset: v.at,
+            kind,
+        })
+    }
+}

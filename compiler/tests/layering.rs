@@ -1,0 +1,374 @@
+//! The library's layering, checked against the table written once in
+//! ARCHITECTURE.md ("## Layers"). A row names the modules a module reads
+//! directly; it may also read what those read, and so on down. Every
+//! `crate::…` path in a module's source must be allowed that way, every
+//! module a row names must really be read (so the table cannot drift from the
+//! code), every module of `src/` has a row, and the table has no cycle (it is
+//! a layering). Comments and strings are ignored; test code counts like any
+//! other.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+const HEADING: &str = "## Layers";
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).to_path_buf()
+}
+
+/// The rows of the table under [`HEADING`]: module → the modules it may use.
+/// A row is `| `module` | `a`, `b` | why |`; `—` for none.
+fn allowed(architecture: &str) -> BTreeMap<String, BTreeSet<String>> {
+    let start = architecture
+        .find(HEADING)
+        .unwrap_or_else(|| panic!("ARCHITECTURE.md has no `{HEADING}` section"));
+    let mut rows = BTreeMap::new();
+    let mut in_table = false;
+    for line in architecture[start..].lines().skip(1) {
+        let line = line.trim();
+        if !line.starts_with('|') {
+            if in_table {
+                break;
+            }
+            continue;
+        }
+        in_table = true;
+        let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
+        let names = |cell: &str| -> Vec<String> {
+            cell.split('`')
+                .skip(1)
+                .step_by(2)
+                .map(str::to_string)
+                .collect()
+        };
+        let module = names(cells[0]);
+        let [module] = module.as_slice() else {
+            continue; // the header and the separator
+        };
+        let uses = cells.get(1).map_or_else(Vec::new, |c| names(c));
+        let previous = rows.insert(module.clone(), uses.into_iter().collect());
+        assert!(previous.is_none(), "`{module}` has two rows in {HEADING}");
+    }
+    assert!(!rows.is_empty(), "the {HEADING} table is empty");
+    rows
+}
+
+/// The library's modules: `src/*.rs` (but `lib.rs`) and `src/*/`.
+fn modules(src: &Path) -> BTreeMap<String, Vec<PathBuf>> {
+    let mut modules = BTreeMap::new();
+    for entry in std::fs::read_dir(src).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        if path.is_dir() {
+            let mut files = Vec::new();
+            rust_files(&path, &mut files);
+            if !files.is_empty() {
+                modules.insert(name, files);
+            }
+        } else if path.extension().is_some_and(|e| e == "rs") && name != "lib" {
+            modules.insert(name, vec![path]);
+        }
+    }
+    modules
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The source without comments (`//…` to the end of the line, `/*…*/`) and
+/// with string and char literals blanked: a path in a comment or a string is
+/// no dependency.
+fn code_only(source: &str) -> String {
+    let bytes = source.as_bytes();
+    let mut out = String::with_capacity(source.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'/' if bytes.get(i + 1) == Some(&b'/') => {
+                while i < bytes.len() && bytes[i] != b'\n' {
+                    i += 1;
+                }
+            }
+            b'/' if bytes.get(i + 1) == Some(&b'*') => {
+                let end = source[i + 2..]
+                    .find("*/")
+                    .map_or(bytes.len(), |e| i + 2 + e + 2);
+                i = end;
+            }
+            b'r' if source[i..].starts_with("r#\"") || source[i..].starts_with("r\"") => {
+                let hashes = source[i + 1..].bytes().take_while(|&b| b == b'#').count();
+                let close = format!("\"{}", "#".repeat(hashes));
+                let body = i + 1 + hashes + 1;
+                i = source[body..]
+                    .find(&close)
+                    .map_or(bytes.len(), |e| body + e + close.len());
+                out.push_str("\"\"");
+            }
+            // A char literal (`'"'`, `'\''`), not a lifetime (`'a`).
+            b'\'' if bytes.get(i + 1) == Some(&b'\\') => {
+                let end = source[i + 3..]
+                    .find('\'')
+                    .map_or(bytes.len(), |e| i + 3 + e + 1);
+                i = end;
+                out.push_str("' '");
+            }
+            b'\'' if source[i + 1..].chars().nth(1) == Some('\'') => {
+                i += 1 + source[i + 1..].chars().next().unwrap().len_utf8() + 1;
+                out.push_str("' '");
+            }
+            b'"' => {
+                i += 1;
+                while i < bytes.len() && bytes[i] != b'"' {
+                    i += if bytes[i] == b'\\' { 2 } else { 1 };
+                }
+                i += 1;
+                out.push_str("\"\"");
+            }
+            _ => {
+                // Copy one whole character (the source is UTF-8).
+                let len = source[i..].chars().next().unwrap().len_utf8();
+                out.push_str(&source[i..i + len]);
+                i += len;
+            }
+        }
+    }
+    out
+}
+
+/// The first segments of every `crate::` path: `crate::a::b` gives `a`,
+/// `crate::{a::b, c}` gives `a` and `c`.
+fn crate_paths(code: &str) -> BTreeSet<String> {
+    let mut found = BTreeSet::new();
+    let ident = |s: &str| -> String {
+        s.chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect()
+    };
+    for (at, _) in code.match_indices("crate::") {
+        let preceded = code[..at]
+            .chars()
+            .next_back()
+            .is_some_and(|c| c.is_alphanumeric() || c == '_' || c == '$');
+        if preceded {
+            continue; // `$crate::`, or a name ending in `crate`
+        }
+        let rest = code[at + "crate::".len()..].trim_start();
+        if let Some(group) = rest.strip_prefix('{') {
+            let mut depth = 0;
+            let mut start = true;
+            for (i, c) in group.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => break,
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => start = true,
+                    c if start && !c.is_whitespace() => {
+                        start = false;
+                        found.insert(ident(&group[i..]));
+                    }
+                    _ => {}
+                }
+            }
+        } else {
+            found.insert(ident(rest));
+        }
+    }
+    found.remove("");
+    found
+}
+
+/// Names `lib.rs` re-exports at the root (`pub use sema::{Analysis, …};`),
+/// with the module they come from.
+fn root_reexports(lib: &str) -> BTreeMap<String, String> {
+    let mut names = BTreeMap::new();
+    for line in code_only(lib).lines() {
+        let Some(rest) = line.trim().strip_prefix("pub use ") else {
+            continue;
+        };
+        let module = rest.split("::").next().unwrap_or("").to_string();
+        let items = rest.trim_end_matches(';');
+        let items = items.split_once('{').map_or(items, |(_, i)| i);
+        for item in items.trim_end_matches('}').split(',') {
+            let name = item.trim().rsplit("::").next().unwrap_or("").trim();
+            if !name.is_empty() {
+                names.insert(name.to_string(), module.clone());
+            }
+        }
+    }
+    names
+}
+
+/// The modules `module` may read: those its row names, and theirs, down.
+fn below(module: &str, rows: &BTreeMap<String, BTreeSet<String>>) -> BTreeSet<String> {
+    let mut seen = BTreeSet::new();
+    let mut stack: Vec<&str> = vec![module];
+    while let Some(next) = stack.pop() {
+        for used in rows.get(next).into_iter().flatten() {
+            if seen.insert(used.clone()) {
+                stack.push(used);
+            }
+        }
+    }
+    seen
+}
+
+fn find_cycle(rows: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
+    fn visit(
+        node: &str,
+        rows: &BTreeMap<String, BTreeSet<String>>,
+        state: &mut BTreeMap<String, u8>,
+        stack: &mut Vec<String>,
+    ) -> Option<Vec<String>> {
+        match state.get(node) {
+            Some(2) => return None,
+            Some(1) => {
+                let from = stack.iter().position(|n| n == node).unwrap();
+                let mut cycle = stack[from..].to_vec();
+                cycle.push(node.to_string());
+                return Some(cycle);
+            }
+            _ => {}
+        }
+        state.insert(node.to_string(), 1);
+        stack.push(node.to_string());
+        for next in rows.get(node).into_iter().flatten() {
+            if let Some(cycle) = visit(next, rows, state, stack) {
+                return Some(cycle);
+            }
+        }
+        stack.pop();
+        state.insert(node.to_string(), 2);
+        None
+    }
+    let mut state = BTreeMap::new();
+    rows.keys()
+        .find_map(|m| visit(m, rows, &mut state, &mut Vec::new()))
+}
+
+#[test]
+fn modules_use_only_what_the_architecture_table_allows() {
+    let architecture = std::fs::read_to_string(root().join("../ARCHITECTURE.md")).unwrap();
+    let rows = allowed(&architecture);
+    let src = root().join("src");
+    let modules = modules(&src);
+    let reexports = root_reexports(&std::fs::read_to_string(src.join("lib.rs")).unwrap());
+    let mut problems = Vec::new();
+
+    for name in modules.keys().filter(|m| !rows.contains_key(*m)) {
+        problems.push(format!("`{name}` (compiler/src) has no row in {HEADING}"));
+    }
+    for (name, uses) in &rows {
+        if !modules.contains_key(name) {
+            problems.push(format!(
+                "{HEADING} has a row for `{name}`, which is no module"
+            ));
+        }
+        for used in uses.iter().filter(|u| !rows.contains_key(*u)) {
+            problems.push(format!("`{name}`'s row allows `{used}`, which has no row"));
+        }
+    }
+    if let Some(cycle) = find_cycle(&rows) {
+        problems.push(format!("{HEADING} has a cycle: {}", cycle.join(" → ")));
+    }
+
+    if !problems.is_empty() {
+        panic!(
+            "ARCHITECTURE.md's {HEADING} table is broken:\n  {}",
+            problems.join("\n  ")
+        );
+    }
+    for (name, files) in &modules {
+        let named = &rows[name];
+        let may_use = below(name, &rows);
+        let mut used = BTreeSet::new();
+        for file in files {
+            let code = code_only(&std::fs::read_to_string(file).unwrap());
+            for first in crate_paths(&code) {
+                let module = match reexports.get(&first) {
+                    Some(module) => module.clone(),
+                    None => first,
+                };
+                if !modules.contains_key(&module) {
+                    problems.push(format!(
+                        "{}: `crate::{module}` is no module of the library",
+                        file.display()
+                    ));
+                    continue;
+                }
+                if module == *name {
+                    continue;
+                }
+                if !may_use.contains(&module) {
+                    problems.push(format!(
+                        "{}: `{name}` uses `{module}`, which its row in {HEADING} does not allow",
+                        file.strip_prefix(&src).unwrap_or(file).display()
+                    ));
+                }
+                used.insert(module);
+            }
+        }
+        for unused in named.difference(&used) {
+            problems.push(format!(
+                "`{name}`'s row in {HEADING} names `{unused}`, which it does not read: remove it"
+            ));
+        }
+    }
+    assert!(
+        problems.is_empty(),
+        "ARCHITECTURE.md's layering and the code disagree:\n  {}",
+        problems.join("\n  ")
+    );
+}
+
+#[test]
+fn the_path_reader_finds_plain_grouped_and_reexported_paths() {
+    let code = code_only(
+        "use crate::diag::{self, Code};\n\
+         use crate::{sema::Mission, span::Span as S,\n  text};\n\
+         // use crate::ide::lookup;\n\
+         /* crate::refine */ let s = \"crate::codegen\";\n\
+         let a = crate::check_source(x);\n\
+         macro_rules! m { () => { $crate::workspace::x } }\n",
+    );
+    let found: Vec<String> = crate_paths(&code).into_iter().collect();
+    assert_eq!(found, ["check_source", "diag", "sema", "span", "text"]);
+    let reexports = root_reexports("pub use sema::{Analysis, check_source};\n");
+    assert_eq!(reexports["check_source"], "sema");
+    assert_eq!(reexports["Analysis"], "sema");
+}
+
+#[test]
+fn the_table_reader_reads_rows_and_rejects_nothing_silently() {
+    let rows = allowed(
+        "# A\n\n## Layers\n\ntext\n\n| module | may use | why |\n| --- | --- | --- |\n\
+         | `span` | — | base |\n| `diag` | `span` | |\n\n| `other` | `x` | |\n",
+    );
+    assert_eq!(rows.len(), 2);
+    assert!(rows["span"].is_empty());
+    assert_eq!(rows["diag"].iter().collect::<Vec<_>>(), ["span"]);
+    let cyclic: BTreeMap<String, BTreeSet<String>> = [
+        ("a".to_string(), ["b".to_string()].into()),
+        ("b".to_string(), ["a".to_string()].into()),
+    ]
+    .into();
+    assert!(find_cycle(&cyclic).is_some());
+    let layered: BTreeMap<String, BTreeSet<String>> = [
+        ("a".to_string(), ["b".to_string()].into()),
+        ("b".to_string(), ["c".to_string()].into()),
+        ("c".to_string(), BTreeSet::new()),
+    ]
+    .into();
+    assert!(find_cycle(&layered).is_none());
+    assert_eq!(
+        below("a", &layered).into_iter().collect::<Vec<_>>(),
+        ["b", "c"]
+    );
+}

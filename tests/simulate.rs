@@ -1,0 +1,345 @@
+//! `semo simulate` as a user runs it: the scouting scenario (the same file
+//! `tests/build.rs` runs the generated C programs on) meets its expectations,
+//! a failing expectation exits 1, a bad scenario exits 2 with its position,
+//! a killed leader is replaced, a seed gives the same run, and the timeline
+//! picture has a lane per robot with bands, bars and labels that do not overlap.
+
+mod support;
+
+use std::path::{Path, PathBuf};
+use support::{examples, repo_root, semo};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("simulate")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn scouting() -> String {
+    examples()
+        .join("scouting/scouting.mission")
+        .display()
+        .to_string()
+}
+
+fn scouting_scenario() -> PathBuf {
+    repo_root().join("tests/fixtures/build/scouting.scenario.json")
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn scouting_meets_its_expectations() {
+    let scenario = scouting_scenario().display().to_string();
+    let out = semo(&["simulate", &scouting(), "--scenario", &scenario]);
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    let lines: Vec<&str> = out.stdout.lines().collect();
+    assert!(
+        lines.contains(&"  MasterTeam/irobot: AUTO_MODE@0 -> WAIT_MODE@1050 -> RETURN_MODE@6000 -> FINISH@9010 (finished at 9020 ms)"),
+        "{}",
+        out.stdout
+    );
+    for slave in ["ti", "nxt"] {
+        let line = lines
+            .iter()
+            .find(|l| l.starts_with(&format!("  SlaveTeam/{slave}: ")))
+            .unwrap();
+        let modes: Vec<&str> = line
+            .split(": ")
+            .nth(1)
+            .unwrap()
+            .split(" (")
+            .next()
+            .unwrap()
+            .split(" -> ")
+            .map(|m| m.split('@').next().unwrap())
+            .collect();
+        assert_eq!(
+            modes,
+            ["AUTO_MODE", "SEARCH_MODE", "RETURN_MODE", "FINISH"],
+            "{slave}"
+        );
+    }
+    assert!(
+        out.stdout.contains("expectations: 8 of 8 met"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stdout
+            .contains("  ok   irobot receives SlaveTeam.COLOR from ti: received at")
+    );
+}
+
+#[test]
+fn a_failing_expectation_exits_1_and_says_why() {
+    let dir = scratch("failing");
+    let text = std::fs::read_to_string(scouting_scenario())
+        .unwrap()
+        .replacen(
+            "\"expect\": [",
+            r#""expect": [{"robot": "irobot", "never_enters": "RETURN_MODE"},"#,
+            1,
+        );
+    let scenario = write(&dir, "s.scenario.json", &text);
+    let out = semo(&["simulate", &scouting(), "--scenario", &scenario]);
+    assert_eq!(out.code, 1, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout.contains("expectations: 8 of 9 met"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stdout
+            .contains("  FAIL irobot never enters RETURN_MODE: entered at 6000 ms"),
+        "{}",
+        out.stdout
+    );
+    let json = semo(&[
+        "simulate",
+        &scouting(),
+        "--scenario",
+        &scenario,
+        "--format",
+        "json",
+    ]);
+    assert_eq!(json.code, 1);
+    let summary: serde_json::Value = serde_json::from_str(&json.stdout).unwrap();
+    assert_eq!(summary["ok"], false);
+    assert_eq!(summary["expectations"][0]["met"], false);
+    assert_eq!(summary["robots"][0]["modes"][1]["mode"], "WAIT_MODE");
+}
+
+#[test]
+fn a_bad_scenario_exits_2_with_its_position() {
+    let dir = scratch("bad");
+    for (text, message) in [
+        (
+            "{\n  \"expect\": [\n    {\"robot\": \"irobot\", \"enters\": \"SEARCH_MODE\"}\n  ]\n}\n",
+            ":3:35: no mode \"SEARCH_MODE\" for robot irobot (modes: AUTO_MODE, FINISH, RC_MODE, RETURN_MODE, WAIT_MODE)",
+        ),
+        ("{\"duration\": 100,}", ":1:18: expected a key in quotes"),
+        (
+            "{\"faults\": [{\"at\": 10, \"kill\": \"r2d2\"}]}",
+            ":1:32: robot \"r2d2\" is not in the mission (robots: irobot, ti, nxt)",
+        ),
+    ] {
+        let scenario = write(&dir, "bad.scenario.json", text);
+        let out = semo(&["simulate", &scouting(), "--scenario", &scenario]);
+        assert_eq!(out.code, 2, "{text}: {}{}", out.stdout, out.stderr);
+        assert_eq!(
+            out.stderr.trim_end(),
+            format!("scenario {scenario}{message}"),
+            "{text}"
+        );
+        assert!(out.stdout.is_empty());
+    }
+    let missing = semo(&[
+        "simulate",
+        &scouting(),
+        "--scenario",
+        &dir.join("none.json").display().to_string(),
+    ]);
+    assert_eq!(missing.code, 2);
+    let until = semo(&[
+        "simulate",
+        &scouting(),
+        "--scenario",
+        &scouting_scenario().display().to_string(),
+        "--until",
+        "5 parsecs",
+    ]);
+    assert_eq!(until.code, 2, "{}", until.stderr);
+}
+
+#[test]
+fn a_killed_leader_is_replaced() {
+    let dir = scratch("leader");
+    let scenario = write(
+        &dir,
+        "kill.scenario.json",
+        r#"{
+  "duration": 3500,
+  "faults": [{"at": 1200, "kill": "tb_0"}],
+  "expect": [{"robot": "tb_1", "receives": "SwarmTeam.__alive", "from": "tb_2"}]
+}"#,
+    );
+    let mission = examples()
+        .join("swarm/patrol_groups.mission")
+        .display()
+        .to_string();
+    let trace = dir.join("trace.jsonl");
+    let out = semo(&[
+        "simulate",
+        &mission,
+        "--scenario",
+        &scenario,
+        "--trace",
+        &trace.display().to_string(),
+    ]);
+    assert!(out.code <= 1, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout.contains("kill at 1200 ms") || out.stdout.contains("killed at 1200 ms"),
+        "{}",
+        out.stdout
+    );
+    let events: Vec<serde_json::Value> = std::fs::read_to_string(&trace)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let leaders = |robot: &str| -> Vec<String> {
+        events
+            .iter()
+            .filter(|e| e["robot"] == robot && e["event"] == "leader")
+            .map(|e| e["leader"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(leaders("tb_1"), ["tb_0", "tb_1"]);
+    assert_eq!(leaders("tb_2"), ["tb_0", "tb_1"]);
+    assert!(leaders("ev_0").is_empty());
+}
+
+#[test]
+fn a_seed_gives_the_same_run() {
+    let dir = scratch("seed");
+    let text = std::fs::read_to_string(scouting_scenario())
+        .unwrap()
+        .replacen('{', r#"{"network": {"loss": 0.2},"#, 1);
+    let scenario = write(&dir, "lossy.scenario.json", &text);
+    let trace = |seed: &str| {
+        let out = semo(&[
+            "simulate",
+            &scouting(),
+            "--scenario",
+            &scenario,
+            "--seed",
+            seed,
+            "--trace",
+            "-",
+        ]);
+        assert!(out.code <= 1, "{}", out.stderr);
+        out.stdout
+    };
+    let a = trace("3");
+    assert_eq!(a, trace("3"));
+    assert_ne!(a, trace("4"));
+    for line in a.lines() {
+        let event: serde_json::Value = serde_json::from_str(line).unwrap();
+        let object = event.as_object().unwrap();
+        assert!(object["t"].is_i64());
+        assert!(
+            object
+                .iter()
+                .filter(|(k, _)| *k != "t")
+                .all(|(_, v)| v.is_string()),
+            "{line}"
+        );
+    }
+}
+
+/// Elements of the SVG by class, with their attributes.
+fn svg_elements(svg: &str) -> Vec<(String, Vec<(String, String)>)> {
+    use quick_xml::events::Event;
+    let mut reader = quick_xml::Reader::from_str(svg);
+    let mut found = Vec::new();
+    loop {
+        match reader.read_event().expect("the SVG is well-formed XML") {
+            Event::Eof => break,
+            Event::Start(e) | Event::Empty(e) => {
+                let attrs = e
+                    .attributes()
+                    .map(|a| {
+                        let a = a.unwrap();
+                        (
+                            String::from_utf8(a.key.as_ref().to_vec()).unwrap(),
+                            a.unescape_value().unwrap().into_owned(),
+                        )
+                    })
+                    .collect();
+                found.push((
+                    String::from_utf8(e.name().as_ref().to_vec()).unwrap(),
+                    attrs,
+                ));
+            }
+            _ => {}
+        }
+    }
+    found
+}
+
+fn attr<'a>(attrs: &'a [(String, String)], key: &str) -> Option<&'a str> {
+    attrs
+        .iter()
+        .find(|(k, _)| k == key)
+        .map(|(_, v)| v.as_str())
+}
+
+#[test]
+fn the_timeline_has_a_lane_per_robot_with_its_modes_and_services() {
+    let dir = scratch("svg");
+    let svg = dir.join("scouting.svg");
+    let scenario = scouting_scenario().display().to_string();
+    let out = semo(&[
+        "simulate",
+        &scouting(),
+        "--scenario",
+        &scenario,
+        "--svg",
+        &svg.display().to_string(),
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let elements = svg_elements(&std::fs::read_to_string(&svg).unwrap());
+    let class = |c: &str| -> Vec<&Vec<(String, String)>> {
+        elements
+            .iter()
+            .filter(|(_, a)| attr(a, "class") == Some(c))
+            .map(|(_, a)| a)
+            .collect()
+    };
+    let lanes = class("lane");
+    let robots: Vec<&str> = lanes
+        .iter()
+        .map(|a| attr(a, "data-robot").unwrap())
+        .collect();
+    assert_eq!(robots, ["irobot", "ti", "nxt"]);
+    // Four mode bands per robot, each with the line of its mode.
+    let modes = class("mode");
+    assert_eq!(modes.len(), 12);
+    let mission = std::fs::read_to_string(scouting()).unwrap();
+    for band in &modes {
+        let line: usize = attr(band, "data-line").unwrap().parse().unwrap();
+        let mode = attr(band, "data-mode").unwrap();
+        let text = mission.lines().nth(line - 1).unwrap();
+        assert!(text.contains(&format!(".{mode}{{")), "line {line}: {text}");
+    }
+    // Service bars point at their service's line.
+    let bars = class("service");
+    assert!(bars.len() >= 12, "{}", bars.len());
+    for bar in &bars {
+        let line: usize = attr(bar, "data-line").unwrap().parse().unwrap();
+        let service = attr(bar, "data-service").unwrap();
+        let text = mission.lines().nth(line - 1).unwrap();
+        assert!(
+            text.contains(&format!(".{service}{{")),
+            "line {line}: {text}"
+        );
+    }
+    assert!(!class("message").is_empty());
+    assert!(!class("throw").is_empty() && !class("catch").is_empty());
+    // Lane labels do not overlap: at least a line of text apart.
+    let mut ys: Vec<f64> = class("lane-label")
+        .iter()
+        .map(|a| attr(a, "y").unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(ys.len(), 3);
+    ys.sort_by(f64::total_cmp);
+    assert!(ys.windows(2).all(|w| w[1] - w[0] >= 12.0), "{ys:?}");
+}

@@ -1,0 +1,172 @@
+//! Building missions as a user does and running the robot programs: `semo build`
+//! into a scratch folder, `make` in each robot folder, the `linux-sim` programs
+//! started together and their JSON traces read back.
+
+use super::{Output, repo_root, semo_in};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The flags every generated program must compile with, warnings as errors.
+pub const PEDANTIC: &str = "-std=c11 -Wall -Wextra -Wpedantic -Werror -O0";
+
+/// One line of a trace.
+pub type Event = serde_json::Map<String, serde_json::Value>;
+
+/// A fresh folder under cargo's scratch space for tests.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `semo build MISSION --target TARGET -o OUT`, run from the repository root.
+pub fn build(mission: &Path, target: &str, out: &Path) -> Output {
+    let out_arg = out.display().to_string();
+    let mission_arg = mission.display().to_string();
+    semo_in(
+        &repo_root(),
+        &["build", &mission_arg, "--target", target, "-o", &out_arg],
+    )
+}
+
+/// Every robot folder under an output folder, sorted.
+pub fn robot_folders(out: &Path) -> Vec<PathBuf> {
+    let mut folders = Vec::new();
+    let Ok(teams) = std::fs::read_dir(out) else {
+        return folders;
+    };
+    for team in teams {
+        let team = team.unwrap().path();
+        if !team.is_dir() {
+            continue;
+        }
+        for robot in std::fs::read_dir(&team).unwrap() {
+            let robot = robot.unwrap().path();
+            let hidden = robot
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .starts_with('.');
+            if robot.is_dir() && !hidden {
+                folders.push(robot);
+            }
+        }
+    }
+    folders.sort();
+    folders
+}
+
+/// Runs `make` in a robot folder; the compiler's complaints on failure (a
+/// warning is a failure).
+pub fn make(folder: &Path, cc: &str, cflags: &str) -> Result<(), String> {
+    let out = Command::new("make")
+        .args(["-s", &format!("CC={cc}"), &format!("CFLAGS={cflags}")])
+        .current_dir(folder)
+        .output()
+        .expect("make runs");
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    if out.status.success() && !stderr.contains("warning") {
+        Ok(())
+    } else {
+        Err(format!("{}: {stderr}", folder.display()))
+    }
+}
+
+pub fn has(program: &str) -> bool {
+    Command::new(program).arg("--version").output().is_ok()
+}
+
+/// gcc, and clang where it is installed (CI installs it).
+pub fn compilers() -> Vec<&'static str> {
+    let found: Vec<&str> = ["gcc", "clang"].into_iter().filter(|c| has(c)).collect();
+    assert!(found.contains(&"gcc"), "gcc is required");
+    if !found.contains(&"clang") {
+        eprintln!("note: clang is not installed here; only gcc was tried (CI installs clang)");
+    }
+    found
+}
+
+/// Builds `mission` for `linux-sim` into `out`, compiles every robot with gcc,
+/// runs them together with `scenario` (JSON text) and returns each robot's
+/// trace lines as written.
+pub fn run_in_simulation(
+    mission: &Path,
+    out: &Path,
+    scenario: &str,
+) -> BTreeMap<String, Vec<String>> {
+    let built = build(mission, "linux-sim", out);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    let folders = robot_folders(out);
+    for folder in &folders {
+        make(folder, "gcc", PEDANTIC).unwrap_or_else(|e| panic!("{e}"));
+    }
+    let scenario_path = out.join("scenario.json");
+    std::fs::write(&scenario_path, scenario).unwrap();
+    // Each run gets its own ports (below the ephemeral range), so runs in
+    // parallel do not hear each other.
+    let port_base = 24000 + (std::process::id() % 200) * 40 + (hash(out) % 8) * 5;
+    let mut children = Vec::new();
+    for folder in folders {
+        let robot = folder.file_name().unwrap().to_string_lossy().into_owned();
+        let trace = out.join(format!("{robot}.jsonl"));
+        let child = Command::new(folder.join(&robot))
+            .args(["--scenario", &scenario_path.display().to_string()])
+            .args(["--trace", &trace.display().to_string()])
+            .args(["--port-base", &port_base.to_string()])
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("the robot program starts");
+        children.push((robot, trace, child));
+    }
+    let mut traces = BTreeMap::new();
+    for (robot, trace, child) in children {
+        let output = child.wait_with_output().unwrap();
+        assert!(
+            output.status.success(),
+            "{robot} exited with {:?}: {}",
+            output.status,
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let text = std::fs::read_to_string(&trace).unwrap_or_default();
+        traces.insert(robot, text.lines().map(str::to_string).collect());
+    }
+    traces
+}
+
+fn hash(path: &Path) -> u32 {
+    path.to_string_lossy()
+        .bytes()
+        .fold(0u32, |h, b| h.wrapping_mul(31).wrapping_add(b as u32))
+}
+
+/// A trace's lines as JSON objects.
+pub fn events(lines: &[String]) -> Vec<Event> {
+    lines
+        .iter()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("bad trace line {l}: {e}")))
+        .collect()
+}
+
+pub fn field<'e>(event: &'e Event, key: &str) -> &'e str {
+    event.get(key).and_then(|v| v.as_str()).unwrap_or("")
+}
+
+/// The modes a robot entered, in order.
+pub fn modes(events: &[Event]) -> Vec<String> {
+    events
+        .iter()
+        .filter(|e| field(e, "event") == "mode")
+        .map(|e| field(e, "mode").to_string())
+        .collect()
+}
+
+/// The services a robot's tasks started, in order.
+pub fn calls(events: &[Event]) -> Vec<String> {
+    events
+        .iter()
+        .filter(|e| field(e, "event") == "call_start")
+        .map(|e| field(e, "service").to_string())
+        .collect()
+}
