@@ -61,17 +61,16 @@ pub fn parse_with_tokens(file: FileId, text: &str) -> (Parse, Vec<token::Spanned
 }
 
 fn parse_with(file: FileId, text: &str, two_threads: bool) -> (Parse, Vec<token::Spanned<'_>>) {
-    let mut diagnostics = Vec::new();
+    let mut others = Vec::new();
     let mut tokens = lex(text, two_threads);
-    report_lexical_errors(file, &mut tokens, &mut diagnostics);
+    let lexical = lexical_errors(&mut tokens);
     let ranges = chunks::split(&tokens);
     let mut items = Vec::new();
     for chunk in parse_ranges(file, text, &tokens, &ranges, two_threads) {
         items.extend(chunk.items);
-        diagnostics.extend(chunk.diagnostics);
+        others.extend(chunk.diagnostics);
     }
-    diagnostics.sort_by_key(|d| (d.span.start, d.span.end));
-    limit_diagnostics(file, &mut diagnostics);
+    let diagnostics = assemble_diagnostics(file, &lexical, others);
     let parse = Parse {
         file: ast::SourceFile { items },
         diagnostics,
@@ -125,88 +124,156 @@ fn lex(text: &str, two_threads: bool) -> Vec<token::Spanned<'_>> {
     tokens
 }
 
-/// Reports characters the language does not use and unterminated strings, and
-/// repairs the tokens so that the parser sees the rest of the statement. A run
-/// of unknown characters (no space between them) is one diagnostic, so junk
-/// costs one diagnostic per run, not per byte; runs never cross a newline, so
-/// a line's diagnostics depend only on the line (incremental lexing relies on it).
-fn report_lexical_errors(
-    file: FileId,
-    tokens: &mut Vec<token::Spanned<'_>>,
-    diagnostics: &mut Vec<Diagnostic>,
-) {
-    // The run being collected: its span, first character and whether it is
-    // more than that character.
-    let mut run: Option<(Span, char, bool)> = None;
-    let flush = |run: &mut Option<(Span, char, bool)>, diagnostics: &mut Vec<Diagnostic>| {
-        if let Some((span, first, more)) = run.take() {
-            let message = if more {
-                format!(
-                    "these characters (from `{}` on) are not used in mission scripts",
-                    first.escape_debug()
-                )
-            } else {
-                format!(
-                    "the character `{}` is not used in mission scripts",
-                    first.escape_debug()
-                )
-            };
-            diagnostics.push(Diagnostic::new(Code::InvalidCharacter, file, span, message));
+/// A lexical error, kept in this compact form (no message yet) so that a
+/// file of junk costs little per error: the incremental cache holds every
+/// one, but only the reported ones become [`Diagnostic`]s.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct LexError {
+    pub(crate) span: Span,
+    kind: LexErrorKind,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum LexErrorKind {
+    /// Characters the language does not use: the first, and whether more follow.
+    Unknown {
+        first: char,
+        more: bool,
+    },
+    Unterminated,
+}
+
+impl LexError {
+    pub(crate) fn diagnostic(&self, file: FileId) -> Diagnostic {
+        match self.kind {
+            LexErrorKind::Unknown { first, more } => {
+                let message = if more {
+                    format!(
+                        "these characters (from `{}` on) are not used in mission scripts",
+                        first.escape_debug()
+                    )
+                } else {
+                    format!(
+                        "the character `{}` is not used in mission scripts",
+                        first.escape_debug()
+                    )
+                };
+                Diagnostic::new(Code::InvalidCharacter, file, self.span, message)
+            }
+            LexErrorKind::Unterminated => Diagnostic::new(
+                Code::UnterminatedString,
+                file,
+                self.span,
+                "this string has no closing quote `\"`",
+            ),
         }
-    };
-    tokens.retain_mut(|(tok, span)| {
-        if let Token::Error(c) = *tok {
+    }
+
+    pub(crate) fn shifted(mut self, by: isize) -> LexError {
+        self.span = Span::new(
+            self.span.start.wrapping_add_signed(by),
+            self.span.end.wrapping_add_signed(by),
+        );
+        self
+    }
+}
+
+/// Finds characters the language does not use and unterminated strings, and
+/// repairs the tokens so that the parser sees the rest of the statement. A run
+/// of unknown characters (no space between them) is one error, so junk costs
+/// one error per run, not per byte; runs never cross a newline, so a line's
+/// errors depend only on the line (incremental lexing relies on it). In order.
+fn lexical_errors(tokens: &mut Vec<token::Spanned<'_>>) -> Vec<LexError> {
+    let mut errors: Vec<LexError> = Vec::new();
+    tokens.retain_mut(|(tok, span)| match *tok {
+        Token::Error(c) => {
             // A token is a run of unknown characters already (the lexer
             // joins them); runs that touch (`&` then `\0`) are joined here.
             let one_char = span.end - span.start == c.len_utf8();
-            match &mut run {
-                Some((run_span, _, more)) if run_span.end == span.start => {
-                    run_span.end = span.end;
+            match errors.last_mut() {
+                Some(LexError {
+                    span: run,
+                    kind: LexErrorKind::Unknown { more, .. },
+                }) if run.end == span.start => {
+                    run.end = span.end;
                     *more = true;
                 }
-                _ => {
-                    flush(&mut run, diagnostics);
-                    run = Some((Span::new(span.start, span.end), c, !one_char));
-                }
+                _ => errors.push(LexError {
+                    span: Span::new(span.start, span.end),
+                    kind: LexErrorKind::Unknown {
+                        first: c,
+                        more: !one_char,
+                    },
+                }),
             }
-            return false;
+            false
         }
-        flush(&mut run, diagnostics);
-        if let Token::Unterminated(raw) = *tok {
-            diagnostics.push(Diagnostic::new(
-                Code::UnterminatedString,
-                file,
-                Span::new(span.start, span.end),
-                "this string has no closing quote `\"`",
-            ));
+        Token::Unterminated(raw) => {
+            errors.push(LexError {
+                span: Span::new(span.start, span.end),
+                kind: LexErrorKind::Unterminated,
+            });
             *tok = Token::Str(raw);
+            true
         }
-        true
+        _ => true,
     });
-    flush(&mut run, diagnostics);
+    errors
 }
 
 /// The most syntax diagnostics reported for one file: past them, the file is
 /// more likely junk than a script, and each costs memory and the editor's time.
 pub const MAX_SYNTAX_DIAGNOSTICS: usize = 100;
 
-/// Keeps the first [`MAX_SYNTAX_DIAGNOSTICS`] of `diagnostics` (sorted by
-/// position) and says how many more there were, where the first of them is.
-fn limit_diagnostics(file: FileId, diagnostics: &mut Vec<Diagnostic>) {
-    if diagnostics.len() <= MAX_SYNTAX_DIAGNOSTICS {
-        return;
+/// A file's syntax diagnostics: the lexical errors and the others (brackets,
+/// grammar) in the order of a stable sort by position of the lexical ones
+/// followed by the others, the first [`MAX_SYNTAX_DIAGNOSTICS`] of them, and
+/// then, if there were more, one E004 saying how many and where they start.
+/// Only the kept lexical errors become diagnostics.
+pub(crate) fn assemble_diagnostics(
+    file: FileId,
+    lexical: &[LexError],
+    mut others: Vec<Diagnostic>,
+) -> Vec<Diagnostic> {
+    let key = |s: Span| (s.start, s.end);
+    others.sort_by_key(|d| key(d.span));
+    let total = lexical.len() + others.len();
+    let mut out = Vec::with_capacity(total.min(MAX_SYNTAX_DIAGNOSTICS + 1));
+    let (mut l, mut o) = (0, 0);
+    let mut others = others.into_iter().peekable();
+    while out.len() < MAX_SYNTAX_DIAGNOSTICS && l + o < total {
+        // On equal positions the lexical error comes first, as in a stable sort.
+        let take_lexical = match (lexical.get(l), others.peek()) {
+            (Some(lex), Some(d)) => key(lex.span) <= key(d.span),
+            (Some(_), None) => true,
+            _ => false,
+        };
+        if take_lexical {
+            out.push(lexical[l].diagnostic(file));
+            l += 1;
+        } else if let Some(d) = others.next() {
+            out.push(d);
+            o += 1;
+        }
     }
-    let more = diagnostics.len() - MAX_SYNTAX_DIAGNOSTICS;
-    let at = diagnostics[MAX_SYNTAX_DIAGNOSTICS].span;
-    diagnostics.truncate(MAX_SYNTAX_DIAGNOSTICS);
-    diagnostics.push(Diagnostic::new(
-        Code::TooManyProblems,
-        file,
-        at,
-        format!(
-            "{more} more syntax problem(s) from here on are not shown: fix the ones above first (is this a mission script?)"
-        ),
-    ));
+    if l + o < total {
+        let next = match (lexical.get(l), others.peek()) {
+            (Some(lex), Some(d)) if key(lex.span) <= key(d.span) => lex.span,
+            (_, Some(d)) => d.span,
+            (Some(lex), None) => lex.span,
+            (None, None) => unreachable!("fewer than the total"),
+        };
+        out.push(Diagnostic::new(
+            Code::TooManyProblems,
+            file,
+            next,
+            format!(
+                "{} more syntax problem(s) from here on are not shown: fix the ones above first (is this a mission script?)",
+                total - l - o
+            ),
+        ));
+    }
+    out
 }
 
 /// One chunk balanced and parsed. Everything in it depends only on the
@@ -295,9 +362,11 @@ pub fn parse_expr(file: FileId, text: &str, base: usize) -> ExprParse {
 /// text that was unescaped from the file (an XML attribute written with
 /// `&lt;` is shorter once read).
 pub fn parse_expr_mapped(file: FileId, text: &str, position: impl Fn(usize) -> usize) -> ExprParse {
-    let mut diagnostics = Vec::new();
     let mut tokens = token::lex(text);
-    report_lexical_errors(file, &mut tokens, &mut diagnostics);
+    let mut diagnostics: Vec<Diagnostic> = lexical_errors(&mut tokens)
+        .iter()
+        .map(|e| e.diagnostic(file))
+        .collect();
     // Brackets balanced and nesting bounded, as in a mission.
     let tokens = delimiters::balance(text, &tokens, file, &mut diagnostics);
     let map =
