@@ -635,7 +635,7 @@ fn a_nonsense_time_scale_is_refused_and_the_bounds_run_clean_under_ubsan() {
         if scale != "nan" {
             // `nan` is not JSON: refused by the reader before the range.
             assert!(
-                stderr.contains("\"time_scale\" must be a number from"),
+                stderr.contains("\"time_scale\" must be a positive number from"),
                 "{scale}: {stderr}"
             );
         }
@@ -643,7 +643,7 @@ fn a_nonsense_time_scale_is_refused_and_the_bounds_run_clean_under_ubsan() {
         let (code, stderr) = run(&["--time-scale", scale, "--duration", "10"]);
         assert_eq!(code, Some(2), "{scale}: {stderr}");
         assert!(
-            stderr.contains("--time-scale must be a number from"),
+            stderr.contains("--time-scale must be a positive number from"),
             "{scale}: {stderr}"
         );
     }

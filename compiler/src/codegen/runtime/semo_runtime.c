@@ -961,7 +961,7 @@ static int parse_options(int argc, char **argv, options *o)
             o->time_scale = strtod(value, &end);
             if (*value == '\0' || *end != '\0' ||
                 !(o->time_scale >= SEMO_TIME_SCALE_MIN && o->time_scale <= SEMO_TIME_SCALE_MAX)) {
-                fprintf(stderr, "%s: --time-scale must be a number from 0.000001 to 1000000, not \"%s\"\n", prog,
+                fprintf(stderr, "%s: --time-scale must be a positive number from 0.000001 to 1000000, not \"%s\"\n", prog,
                         value);
                 return 2;
             }
