@@ -47,3 +47,44 @@ fn semo_lsp_over_stdio_with_pytest_lsp() {
         "the pytest-lsp suite failed (output above)"
     );
 }
+
+/// The real `semo lsp` process given `messages`, then `exit`; its exit code.
+fn lsp_exit_code(messages: &[serde_json::Value]) -> i32 {
+    use std::io::{Read, Write};
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_semo"))
+        .arg("lsp")
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut stdin = child.stdin.take().unwrap();
+    let exit = serde_json::json!({ "jsonrpc": "2.0", "method": "exit" });
+    for message in messages.iter().chain([&exit]) {
+        let body = message.to_string();
+        write!(stdin, "Content-Length: {}\r\n\r\n{body}", body.len()).unwrap();
+    }
+    stdin.flush().unwrap();
+    let mut answers = String::new();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut answers)
+        .unwrap();
+    drop(stdin);
+    child.wait().unwrap().code().unwrap_or(-1)
+}
+
+#[test]
+fn exit_without_shutdown_exits_1_and_after_it_0() {
+    let initialize = serde_json::json!({
+        "jsonrpc": "2.0", "id": 1, "method": "initialize",
+        "params": { "processId": null, "rootUri": null, "capabilities": {} }
+    });
+    let initialized =
+        serde_json::json!({ "jsonrpc": "2.0", "method": "initialized", "params": {} });
+    let shutdown = serde_json::json!({ "jsonrpc": "2.0", "id": 2, "method": "shutdown" });
+    assert_eq!(lsp_exit_code(&[initialize.clone(), initialized.clone()]), 1);
+    assert_eq!(lsp_exit_code(&[initialize, initialized, shutdown]), 0);
+}

@@ -2,6 +2,7 @@
 //! C code (and the refined task graph) per robot.
 
 use super::render;
+use semo::codegen::output::{OutputError, Transaction};
 use semo::codegen::{self, Emit, Target};
 use semo::host;
 use std::io::Write;
@@ -14,6 +15,8 @@ pub struct Options {
     pub target: Target,
     pub emit: Emit,
     pub color: bool,
+    /// Replace files in the way (saved to the backup folder first).
+    pub force: bool,
 }
 
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
@@ -47,8 +50,36 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             .join("out")
     });
     let generated = started.elapsed();
+    let mut transaction = match Transaction::begin(&out_dir, || {
+        eprintln!(
+            "waiting for another generation writing to {}...",
+            out_dir.display()
+        )
+    }) {
+        Ok(t) => t,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    for line in &transaction.recovered {
+        let _ = writeln!(out, "recovered: {line}");
+    }
+    if !options.force {
+        match transaction.conflicts(&result.robots, options.target) {
+            Ok(conflicts) if conflicts.is_empty() => {}
+            Ok(conflicts) => {
+                eprintln!("error: {}", OutputError::Conflicts(conflicts));
+                return 1;
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                return 2;
+            }
+        }
+    }
     for robot in &result.robots {
-        match codegen::output::write_robot(&out_dir, robot) {
+        match transaction.write_robot(robot, options.target, options.force) {
             Ok(written) => {
                 let (generated, user) = robot.line_counts();
                 let share = if generated + user == 0 {
@@ -66,6 +97,16 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
                     written.created,
                     written.kept,
                 );
+                for saved in &written.backed_up {
+                    let _ = writeln!(out, "  saved the file in the way as {}", saved.display());
+                }
+                for special in &written.left_alone {
+                    let _ = writeln!(
+                        out,
+                        "  left alone (not a regular file, not opened): {}",
+                        special.display()
+                    );
+                }
             }
             Err(e) => {
                 eprintln!("error: cannot write {}/{}: {e}", robot.team, robot.robot);

@@ -82,8 +82,11 @@ enum Command {
         library and task files, the runtime, a Makefile) in OUT/<Team>/<robot>/.\n\n\
         The catalog (*.robot.xml) and strategy (*.strategy.xml) files beside the mission are \
         read, and those under each --strategy path. Generation is refused while the mission, \
-        catalog or strategies have errors. Each robot's folder is replaced atomically; task \
-        files the user fills (target linux) are created once and never overwritten."
+        catalog or strategies have errors. One generation per output folder at a time \
+        (OUT/.semo.lock); each robot's folder is replaced atomically, and a later run repairs \
+        what an interrupted one left. Task files the user fills (target linux) are created \
+        once and never overwritten; a generated file you edited, or a task file of another \
+        target, stops generation with its name unless --force (which saves it first)."
     )]
     Build {
         /// The mission script.
@@ -104,6 +107,11 @@ enum Command {
         emit: EmitArg,
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
+        /// Replace files generation would otherwise refuse to (generated
+        /// files you edited, task files of another target), saving them first
+        /// under OUT/.semo-backup/<time>/.
+        #[arg(long)]
+        force: bool,
     },
     /// Run every robot of a mission together in virtual time on a scenario,
     /// and check the scenario's expectations.
@@ -368,6 +376,7 @@ fn run() -> i32 {
             target,
             emit,
             color,
+            force,
         } => build::run(
             build::Options {
                 mission,
@@ -379,6 +388,7 @@ fn run() -> i32 {
                     EmitArg::Taskgraph => semo::codegen::Emit::TaskGraph,
                 },
                 color: use_color(color),
+                force,
             },
             &mut out,
         ),

@@ -33,8 +33,11 @@ fn build(mission: &Path, target: Target, out: &Path) {
         .expect("the mission is checked");
     let result = codegen::build(&build.input(), target, Emit::All);
     assert!(!result.refused(), "{:#?}", result.diagnostics);
+    let mut transaction = output::Transaction::begin(out, || {}).expect("the output folder");
     for robot in &result.robots {
-        output::write_robot(out, robot).expect("written");
+        transaction
+            .write_robot(robot, target, false)
+            .expect("written");
     }
 }
 

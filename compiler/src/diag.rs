@@ -69,6 +69,7 @@ codes! {
     InvalidCharacter = "E001", Error, "a character that the language does not use";
     UnterminatedString = "E002", Error, "a string without its closing quote";
     SyntaxError = "E003", Error, "the text does not follow the grammar";
+    TooManyProblems = "E004", Error, "more syntax problems than are shown (the first 100 are; the file may not be a mission script)";
     // Names and structure.
     UnknownRobotType = "E010", Error, "a robot type that the catalog does not have";
     DuplicateTeam = "E011", Error, "a team declared twice";

@@ -22,6 +22,7 @@ pub mod edit;
 mod fasthash;
 pub mod format;
 pub mod host;
+pub mod fsread;
 pub mod ide;
 /// Graph drawing shared by the task-graph and mode-machine pictures.
 mod layout;

@@ -141,41 +141,41 @@ pub fn collect(paths: &[PathBuf]) -> Result<Vec<(PathBuf, FileKind)>, LoadError>
     Ok(found)
 }
 
+/// A folder's files of the kinds above, sorted. Hidden entries, `target` and
+/// `node_modules` are skipped; symbolic links to files are read, but links to
+/// folders are not followed, so a link to the folder itself or an ancestor
+/// cannot make the walk loop (nor can a link to `/` make it read the disk).
 fn walk(dir: &Path, found: &mut Vec<(PathBuf, FileKind)>) -> Result<(), LoadError> {
-    let err = |e: std::io::Error| LoadError {
-        path: dir.to_path_buf(),
-        message: e.to_string(),
+    let skipped = |e: &walkdir::DirEntry| {
+        e.depth() > 0
+            && e.file_name()
+                .to_str()
+                .is_some_and(|n| n.starts_with('.') || n == "target" || n == "node_modules")
     };
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(err)?
-        .map(|e| e.map(|e| e.path()))
-        .collect::<Result<_, _>>()
-        .map_err(err)?;
-    entries.sort();
-    for path in entries {
-        let hidden = path
-            .file_name()
-            .and_then(|n| n.to_str())
-            .is_some_and(|n| n.starts_with('.') || n == "target" || n == "node_modules");
-        if hidden {
-            continue;
-        }
-        if path.is_dir() {
-            walk(&path, found)?;
-        } else if let Some(kind) = FileKind::of(&path) {
-            found.push((path, kind));
+    let entries = walkdir::WalkDir::new(dir)
+        .follow_links(false)
+        .sort_by_file_name()
+        .into_iter()
+        .filter_entry(|e| !skipped(e));
+    for entry in entries {
+        let entry = entry.map_err(|e| LoadError {
+            path: e.path().unwrap_or(dir).to_path_buf(),
+            message: e.to_string(),
+        })?;
+        let is_file = match entry.file_type() {
+            t if t.is_file() => true,
+            // A link is read when it leads to a file (`metadata` follows it once).
+            t if t.is_symlink() => std::fs::metadata(entry.path()).is_ok_and(|m| m.is_file()),
+            _ => false,
+        };
+        if let (true, Some(kind)) = (is_file, FileKind::of(entry.path())) {
+            found.push((entry.into_path(), kind));
         }
     }
     Ok(())
 }
 
-/// A file's text. Invalid UTF-8 is replaced rather than refused, so the rest
-/// is still checked.
-pub fn read_text(path: &Path) -> std::io::Result<String> {
-    let bytes = std::fs::read(path)?;
-    Ok(String::from_utf8(bytes)
-        .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()))
-}
+pub use crate::fsread::{MAX_FILE_BYTES, read_text, read_text_limited};
 
 /// [`read_text`] for the CLI's loaders: the error names the file.
 pub fn load_text(path: &Path) -> Result<String, LoadError> {

@@ -503,6 +503,24 @@ pub(crate) fn is_ident(s: &str) -> bool {
 #[derive(Clone, Copy)]
 pub(crate) struct Escaped<'s>(&'s str);
 
+/// Text safe inside an XML comment (`<!-- … -->`): no `--` however the
+/// pieces meet, no `-` at the end (it would meet the closing `-->`), and no
+/// control characters (they are not XML characters), in one pass.
+pub(crate) fn comment(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '-' if out.ends_with('-') => out.push_str(" -"),
+            c if c.is_control() => out.push(' '),
+            c => out.push(c),
+        }
+    }
+    if out.ends_with('-') {
+        out.push(' ');
+    }
+    out
+}
+
 pub(crate) fn escape(s: &str) -> Escaped<'_> {
     Escaped(s)
 }
@@ -532,6 +550,14 @@ impl std::fmt::Display for Escaped<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn xml_comments_cannot_end_early() {
+        assert_eq!(comment("a-->b"), "a- ->b");
+        assert_eq!(comment("---"), "- - - ");
+        assert_eq!(comment("x-"), "x- ");
+        assert_eq!(comment("l1\nl2"), "l1 l2");
+    }
 
     fn attr(value: &str, start: usize) -> Attr {
         Attr {

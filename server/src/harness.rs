@@ -86,6 +86,39 @@ impl TestClient {
         }
     }
 
+    /// Sends every request before reading any answer (as an editor does on
+    /// a double click); the answers in the order of `requests`.
+    pub async fn requests_at_once(
+        &mut self,
+        requests: &[(&str, Value)],
+    ) -> Vec<Result<Value, Value>> {
+        let first = self.next_id + 1;
+        for (method, params) in requests {
+            self.next_id += 1;
+            let id = self.next_id;
+            self.send(&json!({ "jsonrpc": "2.0", "id": id, "method": method, "params": params }))
+                .await;
+        }
+        let mut answers = vec![None; requests.len()];
+        while answers.iter().any(Option::is_none) {
+            let msg = self.read_message().await.expect("the server answers");
+            let slot = msg
+                .get("id")
+                .and_then(Value::as_i64)
+                .filter(|_| msg.get("method").is_none());
+            match slot {
+                Some(id) if (first..=self.next_id).contains(&id) => {
+                    answers[(id - first) as usize] = Some(match msg.get("error") {
+                        Some(e) => Err(e.clone()),
+                        None => Ok(msg.get("result").cloned().unwrap_or(Value::Null)),
+                    });
+                }
+                _ => self.keep(msg).await,
+            }
+        }
+        answers.into_iter().map(|a| a.expect("answered")).collect()
+    }
+
     pub async fn notify(&mut self, method: &str, params: Value) {
         self.send(&json!({ "jsonrpc": "2.0", "method": method, "params": params }))
             .await;

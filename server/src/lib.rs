@@ -65,12 +65,12 @@ pub fn run_stdio() -> i32 {
             return 2;
         }
     };
-    runtime.block_on(transport::serve_guarded(
+    let code = runtime.block_on(transport::serve_guarded_status(
         tokio::io::stdin(),
         tokio::io::stdout(),
     ));
     // tokio reads stdin on a blocking thread that would hold a normal shutdown
     // until the client writes again: after `exit`, do not wait for it.
     runtime.shutdown_background();
-    0
+    code
 }

@@ -161,7 +161,10 @@ impl Backend {
         let token = match token {
             Some(t) => Some(t),
             None if self.progress.load(Ordering::Relaxed) => {
-                let t = ProgressToken::String(format!("semo-generate-{}", std::process::id()));
+                // One token per generation: two at once must not share one.
+                static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+                let n = NEXT.fetch_add(1, Ordering::Relaxed);
+                let t = ProgressToken::String(format!("semo-generate-{n}"));
                 self.client
                     .create_work_done_progress(t.clone())
                     .await
@@ -182,20 +185,45 @@ impl Backend {
         };
         let total = result.robots.len().max(1);
         let mut robots = Vec::new();
-        for (i, robot) in result.robots.into_iter().enumerate() {
+        let (work, all) = (job.clone(), Arc::new(result.robots));
+        let robots_of = all.clone();
+        let begun = tokio::task::spawn_blocking(move || generate::begin(&work, &robots_of))
+            .await
+            .map_err(|_| Error::internal_error())?;
+        let mut transaction = match begun {
+            Ok(t) => t,
+            Err(message) => {
+                if let Some(p) = progress {
+                    p.finish_with_message("refused").await;
+                }
+                let message = format!("SeMo: {message}");
+                self.client.show_message(MessageType::ERROR, &message).await;
+                return Err(handlers::request_failed(message));
+            }
+        };
+        let recovered = transaction.recovered.clone();
+        for line in &recovered {
+            let message = format!("SeMo: recovered: {line}");
+            self.client
+                .show_message(MessageType::WARNING, &message)
+                .await;
+        }
+        for i in 0..all.len() {
             if let Some(p) = &progress {
                 let percent = (100 * i / total) as u32;
-                p.report_with_message(format!("{}/{}", robot.team, robot.robot), percent)
+                p.report_with_message(format!("{}/{}", all[i].team, all[i].robot), percent)
                     .await;
             }
-            let out = job.out.clone();
-            let written = tokio::task::spawn_blocking(move || {
-                codegen_write(&out, &robot).map(|w| (robot, w))
+            let (target, force, robots_of) = (job.target, job.force, all.clone());
+            let (back, written) = tokio::task::spawn_blocking(move || {
+                let written = transaction.write_robot(&robots_of[i], target, force);
+                (transaction, written)
             })
             .await
             .map_err(|_| Error::internal_error())?;
+            transaction = back;
             match written {
-                Ok((robot, w)) => robots.push(generate::robot_summary(&robot, &w)),
+                Ok(w) => robots.push(generate::robot_summary(&all[i], &w)),
                 Err(e) => {
                     if let Some(p) = progress {
                         p.finish_with_message("failed").await;
@@ -206,6 +234,7 @@ impl Backend {
                 }
             }
         }
+        drop(transaction);
         if let Some(p) = progress {
             p.finish_with_message(format!("{} robot(s)", robots.len()))
                 .await;
@@ -222,6 +251,7 @@ impl Backend {
             "outputFolder": job.out.display().to_string(),
             "target": job.target.name(),
             "robots": robots,
+            "recovered": recovered,
         }))
     }
 
@@ -265,13 +295,6 @@ impl Backend {
         let changed = self.state.world().index(found);
         self.state.queue.push(changed.files);
     }
-}
-
-fn codegen_write(
-    out: &std::path::Path,
-    robot: &semo::codegen::RobotOutput,
-) -> std::io::Result<semo::codegen::output::Written> {
-    semo::codegen::output::write_robot(out, robot)
 }
 
 fn roots(params: &InitializeParams) -> Vec<std::path::PathBuf> {

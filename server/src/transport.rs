@@ -4,8 +4,15 @@
 //! session. Here every frame is read and checked first: a valid JSON-RPC
 //! message is passed on, re-framed with only its `Content-Length`; anything
 //! else is answered with the JSON-RPC error it deserves and skipped.
+//!
+//! The guard also keeps two promises of the protocol tower-lsp does not: a
+//! request whose method starts with `$/` (protocol-internal, and unknown to
+//! us) is answered with MethodNotFound rather than never, and the process's
+//! exit code says whether `shutdown` came before the end (0) or not (1).
 
 use serde_json::{Value, json};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use tokio::io::{AsyncBufReadExt, AsyncRead, AsyncReadExt, AsyncWrite, AsyncWriteExt, BufReader};
 use tokio::sync::mpsc;
 use tower_lsp_server::jsonrpc::{Request, Response};
@@ -20,11 +27,27 @@ where
     I: AsyncRead + Unpin + Send + 'static,
     O: AsyncWrite + Unpin + Send + 'static,
 {
+    serve_guarded_status(input, output).await;
+}
+
+/// [`serve_guarded`], giving the exit code the protocol asks for: 0 when
+/// the client sent `shutdown` before the session ended, else 1.
+pub async fn serve_guarded_status<I, O>(input: I, output: O) -> i32
+where
+    I: AsyncRead + Unpin + Send + 'static,
+    O: AsyncWrite + Unpin + Send + 'static,
+{
     let (to_server, server_in) = tokio::io::duplex(1 << 16);
     let (server_out, from_server) = tokio::io::duplex(1 << 16);
     // Whole frame bodies to write out: the server's, and our error replies.
     let (out_tx, out_rx) = mpsc::unbounded_channel();
-    let reader = tokio::spawn(forward_valid(input, to_server, out_tx.clone()));
+    let shutdown = Arc::new(AtomicBool::new(false));
+    let reader = tokio::spawn(forward_valid(
+        input,
+        to_server,
+        out_tx.clone(),
+        shutdown.clone(),
+    ));
     let pump = tokio::spawn(pump_frames(from_server, out_tx));
     let writer = tokio::spawn(write_frames(out_rx, output));
     crate::serve(server_in, server_out).await;
@@ -32,6 +55,11 @@ where
     let _ = reader.await;
     let _ = pump.await;
     let _ = writer.await;
+    if shutdown.load(Ordering::SeqCst) {
+        0
+    } else {
+        1
+    }
 }
 
 /// A frame as read: its body, or why there is none.
@@ -97,16 +125,29 @@ pub(crate) async fn read_frame<R: AsyncRead + Unpin>(input: &mut BufReader<R>) -
     }
 }
 
-/// Whether tower-lsp will accept the body, else the error to answer with.
-fn check(body: &[u8]) -> Result<(), Value> {
+/// Whether tower-lsp will accept the body (and the method of a request),
+/// else the error to answer with.
+fn check(body: &[u8]) -> Result<Option<String>, Value> {
     let value: Value = match serde_json::from_slice(body) {
         Ok(v) => v,
         Err(e) => return Err(error(Value::Null, -32700, &format!("Parse error: {e}"))),
     };
-    if serde_json::from_value::<Request>(value.clone()).is_ok()
-        || serde_json::from_value::<Response>(value.clone()).is_ok()
-    {
-        return Ok(());
+    let request_id = value
+        .get("id")
+        .filter(|id| matches!(id, Value::Number(_) | Value::String(_)));
+    let method = value.get("method").and_then(Value::as_str);
+    if let (Some(id), Some(method)) = (request_id, method) {
+        if method.starts_with("$/") {
+            // tower-lsp drops these without an answer; every request gets one.
+            let message = format!("Method not found: {method}");
+            return Err(error(id.clone(), -32601, &message));
+        }
+    }
+    if serde_json::from_value::<Request>(value.clone()).is_ok() {
+        return Ok(request_id.and(method).map(str::to_string));
+    }
+    if serde_json::from_value::<Response>(value.clone()).is_ok() {
+        return Ok(None);
     }
     // Answer with the request's id when it has a usable one.
     let id = match value.get("id") {
@@ -124,8 +165,12 @@ fn error(id: Value, code: i64, message: &str) -> Value {
     json!({ "jsonrpc": "2.0", "id": id, "error": { "code": code, "message": message } })
 }
 
-async fn forward_valid<R, W>(input: R, mut to_server: W, out: mpsc::UnboundedSender<Vec<u8>>)
-where
+async fn forward_valid<R, W>(
+    input: R,
+    mut to_server: W,
+    out: mpsc::UnboundedSender<Vec<u8>>,
+    shutdown: Arc<AtomicBool>,
+) where
     R: AsyncRead + Unpin,
     W: AsyncWrite + Unpin,
 {
@@ -135,7 +180,10 @@ where
             Frame::End => break,
             Frame::BadHeader(why) => error(Value::Null, -32700, &format!("Parse error: {why}")),
             Frame::Body(body) => match check(&body) {
-                Ok(()) => {
+                Ok(method) => {
+                    if method.as_deref() == Some("shutdown") {
+                        shutdown.store(true, Ordering::SeqCst);
+                    }
                     if write_frame(&mut to_server, &body).await.is_err() {
                         return; // the server is gone
                     }

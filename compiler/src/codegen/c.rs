@@ -18,13 +18,23 @@ pub fn string(text: &str) -> String {
     out
 }
 
-/// Text safe inside a `/* */` comment on one line.
+/// Text safe inside a `/* */` comment on one line: no line breaks or other
+/// control characters, no backslash (a line splice before the comment's end),
+/// and no `*/`, `/*` or `??` however the pieces meet (one pass, so no
+/// replacement can create what an earlier one removed).
 pub fn comment(text: &str) -> String {
-    text.replace("*/", "* /")
-        .replace("/*", "/ *")
-        .replace("??", "? ?")
-        .replace(['\n', '\r'], " ")
-        .replace('\\', "/")
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        let c = if c == '\\' { '/' } else { c };
+        match c {
+            c if c.is_control() => out.push(' '),
+            '*' if out.ends_with('/') => out.push_str(" *"),
+            '/' if out.ends_with('*') => out.push_str(" /"),
+            '?' if out.ends_with('?') => out.push_str(" ?"),
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 /// An identifier fragment: letters, digits and `_`, everything else `_`.
@@ -58,6 +68,10 @@ mod tests {
     #[test]
     fn comments_cannot_end_early() {
         assert_eq!(comment("x */ y ??/"), "x * / y ? ?/");
+        // A backslash becomes `/`, which must not close the comment either.
+        assert_eq!(comment("x*\\ int i; \\*"), "x* / int i; / *");
+        assert_eq!(comment("*/*/"), "* / * /");
+        assert_eq!(comment("a\nb\r\tc"), "a b  c");
     }
 
     #[test]

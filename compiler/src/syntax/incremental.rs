@@ -26,8 +26,11 @@
 
 use super::shift::Shift;
 use super::token::{self, Token};
-use super::{ChunkParse, Parse, ast, chunks, lex, parallel, parse_ranges, report_lexical_errors};
-use crate::diag::{Diagnostic, FileId};
+use super::{
+    ChunkParse, LexError, Parse, assemble_diagnostics, ast, chunks, lex, lexical_errors, parallel,
+    parse_ranges,
+};
+use crate::diag::FileId;
 use crate::fasthash::{FastHasher, FastMap};
 use crate::span::Span;
 use chumsky::span::SimpleSpan;
@@ -47,7 +50,7 @@ pub struct ParseCache {
     tokens: Vec<RawToken>,
     /// The lexical diagnostics (unknown characters, unterminated strings), in
     /// order.
-    lexical: Vec<Diagnostic>,
+    lexical: Vec<LexError>,
     /// The chunks, in order.
     chunks: Vec<CachedChunk>,
     /// Chunks parsed anew (not reused) when this cache was made.
@@ -130,7 +133,7 @@ pub fn parse_incremental(
     };
     let old = previous.filter(|p| p.file == file).unwrap_or(&empty);
     let edit = Edit::between(&old.text, text);
-    let lexed = relex(file, old, text, &edit);
+    let lexed = relex(old, text, &edit);
     let tokens = &lexed.tokens;
 
     // Cut chunks again from a chunk start far enough before the edit...
@@ -219,21 +222,20 @@ pub fn parse_incremental(
         )
     });
     let mut items = Vec::with_capacity(item_count);
-    let mut diagnostics = Vec::with_capacity(lexed.lexical.len() + diagnostic_count);
-    diagnostics.extend_from_slice(&lexed.lexical);
+    let mut others = Vec::with_capacity(diagnostic_count);
     for chunk in &chunks {
         let parsed = &chunk.parsed;
         let delta = chunk.span.start as isize - parsed.at as isize;
         let start = items.len();
         items.extend_from_slice(&parsed.result.items);
-        let first = diagnostics.len();
-        diagnostics.extend_from_slice(&parsed.result.diagnostics);
+        let first = others.len();
+        others.extend_from_slice(&parsed.result.diagnostics);
         if delta != 0 {
             items[start..].shift_all(delta);
-            diagnostics[first..].shift_all(delta);
+            others[first..].shift_all(delta);
         }
     }
-    diagnostics.sort_by_key(|d| (d.span.start, d.span.end));
+    let diagnostics = assemble_diagnostics(file, &lexed.lexical, others);
 
     let cache = ParseCache {
         file,
@@ -346,7 +348,7 @@ fn common_suffix(a: &[u8], b: &[u8]) -> usize {
 /// The tokens and lexical diagnostics of a new version.
 struct Lexed {
     tokens: Vec<RawToken>,
-    lexical: Vec<Diagnostic>,
+    lexical: Vec<LexError>,
     /// Tokens kept from before the edited lines (the same in both versions).
     kept_before: usize,
     /// Where the tokens kept from after the edited lines start, in the new
@@ -357,16 +359,15 @@ struct Lexed {
 
 /// The tokens of the new text: the old ones before the edited lines, those
 /// lines lexed again, and the old ones after them, moved; the same for the
-/// lexical diagnostics.
-fn relex(file: FileId, old: &ParseCache, text: &str, edit: &Edit) -> Lexed {
+/// lexical errors.
+fn relex(old: &ParseCache, text: &str, edit: &Edit) -> Lexed {
     let kept_before = old.tokens.partition_point(|t| t.1.start < edit.lines_start);
     let kept_after_old = old
         .tokens
         .partition_point(|t| t.1.start < edit.old_lines_end);
     let lines = &text[edit.lines_start..edit.new_lines_end];
     let mut fresh = lex(lines, parallel(lines.len()));
-    let mut fresh_lexical = Vec::new();
-    report_lexical_errors(file, &mut fresh, &mut fresh_lexical);
+    let fresh_lexical = lexical_errors(&mut fresh);
 
     let (base, delta) = (edit.lines_start as isize, edit.delta());
     let moved = |s: SimpleSpan, by: isize| {
@@ -390,15 +391,12 @@ fn relex(file: FileId, old: &ParseCache, text: &str, edit: &Edit) -> Lexed {
         .lexical
         .partition_point(|d| d.span.start < edit.old_lines_end);
     let mut lexical = old.lexical[..lexical_before].to_vec();
-    lexical.extend(fresh_lexical.into_iter().map(|mut d| {
-        d.shift(base);
-        d
-    }));
-    lexical.extend(old.lexical[lexical_after..].iter().map(|d| {
-        let mut d = d.clone();
-        d.shift(delta);
-        d
-    }));
+    lexical.extend(fresh_lexical.into_iter().map(|e| e.shifted(base)));
+    lexical.extend(
+        old.lexical[lexical_after..]
+            .iter()
+            .map(|e| e.shifted(delta)),
+    );
     Lexed {
         tokens,
         lexical,
@@ -534,6 +532,33 @@ mod tests {
         A.M { set(P, S) }\n\
         A.main {\n  case (M):\n    catch (done): mode = M\n  default: mode = M\n}\n\
         def f {\n  stop()\n}\n";
+
+    #[test]
+    fn junk_past_the_diagnostic_limit_parses_incrementally_as_from_scratch() {
+        // 150 lexical errors and some grammar errors among them: past the
+        // limit either way, and edits move the cut and the E004 count.
+        let junk: String = (0..50)
+            .map(|i| {
+                format!(
+                    "@ $$ {} \u{0}\u{0}\n",
+                    if i % 7 == 0 { "A.P.S { move( }" } else { "&|" }
+                )
+            })
+            .collect();
+        let fewer = junk.replacen("@ $$", "", 30);
+        let more = format!("%%\n{junk}\n\"open");
+        let versions = [junk.as_str(), &fewer, &more, MISSION, &junk];
+        chain(&versions);
+        let last = parse(FileId(3), &junk);
+        assert_eq!(
+            last.diagnostics.len(),
+            crate::syntax::MAX_SYNTAX_DIAGNOSTICS + 1
+        );
+        assert_eq!(
+            last.diagnostics.last().map(|d| d.code),
+            Some(crate::diag::Code::TooManyProblems)
+        );
+    }
 
     #[test]
     fn an_edit_in_one_item_reparses_only_that_chunk() {

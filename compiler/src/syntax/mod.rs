@@ -61,16 +61,16 @@ pub fn parse_with_tokens(file: FileId, text: &str) -> (Parse, Vec<token::Spanned
 }
 
 fn parse_with(file: FileId, text: &str, two_threads: bool) -> (Parse, Vec<token::Spanned<'_>>) {
-    let mut diagnostics = Vec::new();
+    let mut others = Vec::new();
     let mut tokens = lex(text, two_threads);
-    report_lexical_errors(file, &mut tokens, &mut diagnostics);
+    let lexical = lexical_errors(&mut tokens);
     let ranges = chunks::split(&tokens);
     let mut items = Vec::new();
     for chunk in parse_ranges(file, text, &tokens, &ranges, two_threads) {
         items.extend(chunk.items);
-        diagnostics.extend(chunk.diagnostics);
+        others.extend(chunk.diagnostics);
     }
-    diagnostics.sort_by_key(|d| (d.span.start, d.span.end));
+    let diagnostics = assemble_diagnostics(file, &lexical, others);
     let parse = Parse {
         file: ast::SourceFile { items },
         diagnostics,
@@ -124,38 +124,156 @@ fn lex(text: &str, two_threads: bool) -> Vec<token::Spanned<'_>> {
     tokens
 }
 
-/// Reports characters the language does not use and unterminated strings, and
-/// repairs the tokens so that the parser sees the rest of the statement.
-fn report_lexical_errors(
-    file: FileId,
-    tokens: &mut Vec<token::Spanned<'_>>,
-    diagnostics: &mut Vec<Diagnostic>,
-) {
+/// A lexical error, kept in this compact form (no message yet) so that a
+/// file of junk costs little per error: the incremental cache holds every
+/// one, but only the reported ones become [`Diagnostic`]s.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct LexError {
+    pub(crate) span: Span,
+    kind: LexErrorKind,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum LexErrorKind {
+    /// Characters the language does not use: the first, and whether more follow.
+    Unknown {
+        first: char,
+        more: bool,
+    },
+    Unterminated,
+}
+
+impl LexError {
+    pub(crate) fn diagnostic(&self, file: FileId) -> Diagnostic {
+        match self.kind {
+            LexErrorKind::Unknown { first, more } => {
+                let message = if more {
+                    format!(
+                        "these characters (from `{}` on) are not used in mission scripts",
+                        first.escape_debug()
+                    )
+                } else {
+                    format!(
+                        "the character `{}` is not used in mission scripts",
+                        first.escape_debug()
+                    )
+                };
+                Diagnostic::new(Code::InvalidCharacter, file, self.span, message)
+            }
+            LexErrorKind::Unterminated => Diagnostic::new(
+                Code::UnterminatedString,
+                file,
+                self.span,
+                "this string has no closing quote `\"`",
+            ),
+        }
+    }
+
+    pub(crate) fn shifted(mut self, by: isize) -> LexError {
+        self.span = Span::new(
+            self.span.start.wrapping_add_signed(by),
+            self.span.end.wrapping_add_signed(by),
+        );
+        self
+    }
+}
+
+/// Finds characters the language does not use and unterminated strings, and
+/// repairs the tokens so that the parser sees the rest of the statement. A run
+/// of unknown characters (no space between them) is one error, so junk costs
+/// one error per run, not per byte; runs never cross a newline, so a line's
+/// errors depend only on the line (incremental lexing relies on it). In order.
+fn lexical_errors(tokens: &mut Vec<token::Spanned<'_>>) -> Vec<LexError> {
+    let mut errors: Vec<LexError> = Vec::new();
     tokens.retain_mut(|(tok, span)| match *tok {
         Token::Error(c) => {
-            diagnostics.push(Diagnostic::new(
-                Code::InvalidCharacter,
-                file,
-                Span::new(span.start, span.end),
-                format!(
-                    "the character `{}` is not used in mission scripts",
-                    c.escape_debug()
-                ),
-            ));
+            // A token is a run of unknown characters already (the lexer
+            // joins them); runs that touch (`&` then `\0`) are joined here.
+            let one_char = span.end - span.start == c.len_utf8();
+            match errors.last_mut() {
+                Some(LexError {
+                    span: run,
+                    kind: LexErrorKind::Unknown { more, .. },
+                }) if run.end == span.start => {
+                    run.end = span.end;
+                    *more = true;
+                }
+                _ => errors.push(LexError {
+                    span: Span::new(span.start, span.end),
+                    kind: LexErrorKind::Unknown {
+                        first: c,
+                        more: !one_char,
+                    },
+                }),
+            }
             false
         }
         Token::Unterminated(raw) => {
-            diagnostics.push(Diagnostic::new(
-                Code::UnterminatedString,
-                file,
-                Span::new(span.start, span.end),
-                "this string has no closing quote `\"`",
-            ));
+            errors.push(LexError {
+                span: Span::new(span.start, span.end),
+                kind: LexErrorKind::Unterminated,
+            });
             *tok = Token::Str(raw);
             true
         }
         _ => true,
     });
+    errors
+}
+
+/// The most syntax diagnostics reported for one file: past them, the file is
+/// more likely junk than a script, and each costs memory and the editor's time.
+pub const MAX_SYNTAX_DIAGNOSTICS: usize = 100;
+
+/// A file's syntax diagnostics: the lexical errors and the others (brackets,
+/// grammar) in the order of a stable sort by position of the lexical ones
+/// followed by the others, the first [`MAX_SYNTAX_DIAGNOSTICS`] of them, and
+/// then, if there were more, one E004 saying how many and where they start.
+/// Only the kept lexical errors become diagnostics.
+pub(crate) fn assemble_diagnostics(
+    file: FileId,
+    lexical: &[LexError],
+    mut others: Vec<Diagnostic>,
+) -> Vec<Diagnostic> {
+    let key = |s: Span| (s.start, s.end);
+    others.sort_by_key(|d| key(d.span));
+    let total = lexical.len() + others.len();
+    let mut out = Vec::with_capacity(total.min(MAX_SYNTAX_DIAGNOSTICS + 1));
+    let (mut l, mut o) = (0, 0);
+    let mut others = others.into_iter().peekable();
+    while out.len() < MAX_SYNTAX_DIAGNOSTICS && l + o < total {
+        // On equal positions the lexical error comes first, as in a stable sort.
+        let take_lexical = match (lexical.get(l), others.peek()) {
+            (Some(lex), Some(d)) => key(lex.span) <= key(d.span),
+            (Some(_), None) => true,
+            _ => false,
+        };
+        if take_lexical {
+            out.push(lexical[l].diagnostic(file));
+            l += 1;
+        } else if let Some(d) = others.next() {
+            out.push(d);
+            o += 1;
+        }
+    }
+    if l + o < total {
+        let next = match (lexical.get(l), others.peek()) {
+            (Some(lex), Some(d)) if key(lex.span) <= key(d.span) => lex.span,
+            (_, Some(d)) => d.span,
+            (Some(lex), None) => lex.span,
+            (None, None) => unreachable!("fewer than the total"),
+        };
+        out.push(Diagnostic::new(
+            Code::TooManyProblems,
+            file,
+            next,
+            format!(
+                "{} more syntax problem(s) from here on are not shown: fix the ones above first (is this a mission script?)",
+                total - l - o
+            ),
+        ));
+    }
+    out
 }
 
 /// One chunk balanced and parsed. Everything in it depends only on the
@@ -244,9 +362,11 @@ pub fn parse_expr(file: FileId, text: &str, base: usize) -> ExprParse {
 /// text that was unescaped from the file (an XML attribute written with
 /// `&lt;` is shorter once read).
 pub fn parse_expr_mapped(file: FileId, text: &str, position: impl Fn(usize) -> usize) -> ExprParse {
-    let mut diagnostics = Vec::new();
     let mut tokens = token::lex(text);
-    report_lexical_errors(file, &mut tokens, &mut diagnostics);
+    let mut diagnostics: Vec<Diagnostic> = lexical_errors(&mut tokens)
+        .iter()
+        .map(|e| e.diagnostic(file))
+        .collect();
     // Brackets balanced and nesting bounded, as in a mission.
     let tokens = delimiters::balance(text, &tokens, file, &mut diagnostics);
     let map =

@@ -280,7 +280,9 @@ fn lexer<'src>() -> impl Parser<'src, &'src str, Vec<Spanned<'src>>, extra::Defa
         number,
         two_chars,
         prefix_of_two,
-        any().map(Token::Error),
+        // An unknown character, with the ones right after it that cannot
+        // start a token either: junk is one token per run, not per byte.
+        any().map(Token::Error).then_ignore(unknown_run_rest()),
     ));
 
     // Whitespace and `#` comments, skipped in one tight loop: trivia is most of
@@ -305,6 +307,25 @@ fn lexer<'src>() -> impl Parser<'src, &'src str, Vec<Spanned<'src>>, extra::Defa
         .repeated()
         .collect()
         .then_ignore(trivia)
+}
+
+/// Whether `c` can never start a token or trivia (see the lexer above): such
+/// characters after an unknown one join its run.
+fn never_starts_token(c: char) -> bool {
+    !(c.is_ascii_alphanumeric()
+        || c == '_'
+        || c.is_whitespace()
+        || "-\"{}():;,.[]=<>!&|#".contains(c))
+}
+
+/// The rest of a run of unknown characters, skipped in one tight loop.
+fn unknown_run_rest<'src>() -> impl Parser<'src, &'src str, (), extra::Default> + Clone {
+    custom::<_, &'src str, (), extra::Default>(|inp| {
+        while inp.peek().is_some_and(never_starts_token) {
+            inp.skip();
+        }
+        Ok(())
+    })
 }
 
 /// Splits `text` into tokens. Never fails: unknown characters and unterminated

@@ -8,7 +8,7 @@ use std::fmt::Write;
 /// The graph as `*.taskgraph.xml` text, after a comment naming its origin.
 pub fn to_xml(graph: &TaskGraph, comment: &str) -> String {
     let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    let _ = writeln!(out, "<!-- {} -->", comment.replace("--", "- -"));
+    let _ = writeln!(out, "<!-- {} -->", crate::xmlpos::comment(comment));
     write_graph(&mut out, graph, 0, true);
     out
 }

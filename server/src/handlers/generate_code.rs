@@ -7,7 +7,12 @@
 //!
 //! Arguments: one object `{ "uri": mission, "outputFolder"?: path (relative
 //! to the mission's folder; default `out` beside it), "target"?: "linux" |
-//! "linux-sim", "team"?: only this team's robots }`, or just the URI.
+//! "linux-sim", "team"?: only this team's robots, "force"?: replace files in
+//! the way, saved first (as `semo build --force`) }`, or just the URI.
+//!
+//! The output folder, with `..` and symbolic links resolved, must lie inside
+//! a workspace folder (the mission's folder when there is none): the editor's
+//! request cannot make the server write anywhere else.
 
 use crate::encoding::LineMap;
 use crate::world::{Snapshot, World};
@@ -29,6 +34,8 @@ pub struct GenerateParams {
     pub output_folder: Option<String>,
     pub target: Option<String>,
     pub team: Option<String>,
+    #[serde(default)]
+    pub force: bool,
 }
 
 /// Reads the command's arguments.
@@ -42,6 +49,7 @@ pub fn params(arguments: &[Value]) -> Result<GenerateParams, String> {
             output_folder: None,
             target: None,
             team: None,
+            force: false,
         },
         other => serde_json::from_value(other.clone()).map_err(|e| e.to_string())?,
     };
@@ -58,6 +66,7 @@ pub struct Job {
     pub out: PathBuf,
     pub target: Target,
     pub team: Option<String>,
+    pub force: bool,
 }
 
 /// The mission and the workspace as they are now.
@@ -76,11 +85,16 @@ pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
         .parent()
         .unwrap_or(Path::new("."))
         .to_path_buf();
-    let out = match params.output_folder {
-        Some(f) if Path::new(&f).is_absolute() => PathBuf::from(f),
+    let requested = match params.output_folder {
         Some(f) => folder.join(f),
         None => folder.join("out"),
     };
+    let allowed = if world.roots().is_empty() {
+        std::slice::from_ref(&folder)
+    } else {
+        world.roots()
+    };
+    let out = output::confine(&requested, allowed)?;
     Ok(Job {
         mission_uri: params.uri,
         mission_path,
@@ -89,6 +103,7 @@ pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
         out,
         target,
         team: params.team,
+        force: params.force,
     })
 }
 
@@ -137,7 +152,12 @@ pub fn mission_diagnostics(
 /// A robot's line in the result.
 pub fn robot_summary(robot: &codegen::RobotOutput, written: &output::Written) -> Value {
     let (generated, user) = robot.line_counts();
+    let paths = |list: &[PathBuf]| -> Vec<String> {
+        list.iter().map(|p| p.display().to_string()).collect()
+    };
     json!({
+        "backedUp": paths(&written.backed_up),
+        "leftAlone": paths(&written.left_alone),
         "team": robot.team,
         "robot": robot.robot,
         "folder": written.folder.display().to_string(),
@@ -172,4 +192,20 @@ pub fn code_lenses(snapshot: &Snapshot) -> Vec<CodeLens> {
             .collect()
     })
     .unwrap_or_default()
+}
+
+/// Takes the output folder's lock (waiting for another generation) and
+/// recovers what an interrupted one left; then checks, unless forced, that no
+/// robot folder holds files in the way. Blocking: run off the async threads.
+pub fn begin(job: &Job, robots: &[codegen::RobotOutput]) -> Result<output::Transaction, String> {
+    let transaction = output::Transaction::begin(&job.out, || {}).map_err(|e| e.to_string())?;
+    if !job.force {
+        let conflicts = transaction
+            .conflicts(robots, job.target)
+            .map_err(|e| e.to_string())?;
+        if !conflicts.is_empty() {
+            return Err(output::OutputError::Conflicts(conflicts).to_string());
+        }
+    }
+    Ok(transaction)
 }

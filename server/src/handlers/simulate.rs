@@ -56,6 +56,7 @@ pub fn job(world: &World, params: SimulateParams) -> Result<Job, String> {
             output_folder: None,
             target: None,
             team: None,
+            force: false,
         },
     )?;
     let folder = generate

@@ -14,6 +14,13 @@ bool semo__wait_until(int64_t deadline_ms);
 /* Queues a message as if it had arrived over the transport. */
 void semo__deliver(const semo_message *msg);
 
+/* The time scales accepted (wall ms per mission ms), from the command line or
+ * a scenario: a million times faster to a million times slower. Beyond them
+ * mission times no longer fit the clock's arithmetic (1e-18 would overflow
+ * the conversion to int64_t), and no simulation needs them. */
+#define SEMO_TIME_SCALE_MIN 1e-6
+#define SEMO_TIME_SCALE_MAX 1e6
+
 #ifdef SEMO_SIM
 /* Reads the scenario for `program->robot`; on error prints
  * "scenario FILE:LINE:COL: message" and returns -1. */

@@ -580,8 +580,9 @@ static bool read_scenario(reader *r, const json *root, const semo_program_desc *
     const json *scale = member(root, "time_scale"), *duration = member(root, "duration");
     const json *robots = member(root, "robots"), *commands = member(root, "operator");
     if (scale) {
-        if (scale->kind != J_NUMBER || !(scale->number > 0))
-            return fail_at(r, scale->line, scale->col, "\"time_scale\" must be a positive number");
+        if (scale->kind != J_NUMBER || !(scale->number >= SEMO_TIME_SCALE_MIN && scale->number <= SEMO_TIME_SCALE_MAX))
+            return fail_at(r, scale->line, scale->col,
+                           "\"time_scale\" must be a positive number from 0.000001 (a million times faster) to 1000000");
         g_sim.time_scale = scale->number;
         g_sim.has_time_scale = true;
     }
