@@ -34,6 +34,9 @@ const START_MS: i64 = 250;
 
 type Event = serde_json::Map<String, serde_json::Value>;
 
+/// Held while a test's robot processes run (see [`run_processes`]).
+static RUNNING: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 fn scratch(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("differential")
@@ -161,6 +164,10 @@ fn run_processes(
         assert!(made.success(), "{}", folder.display());
     }
     let port_base = 20000 + (std::process::id() % 250) * 40 + port_offset;
+    // The processes keep mission time on their own clocks, so robots of two
+    // tests running at once would delay each other past the tolerance on a
+    // loaded machine: one test's robots run at a time (building overlaps).
+    let _one_run_at_a_time = RUNNING.lock().unwrap_or_else(|e| e.into_inner());
     let mut children = BTreeMap::new();
     for (robot, folder) in &folders {
         let child = Command::new(folder.join(robot))

@@ -21,8 +21,8 @@ pub mod edit;
 /// A fast deterministic hasher for the checker's maps.
 mod fasthash;
 pub mod format;
-pub mod host;
 pub mod fsread;
+pub mod host;
 pub mod ide;
 /// Graph drawing shared by the task-graph and mode-machine pictures.
 mod layout;
