@@ -23,8 +23,6 @@ pub mod snippets;
 pub mod symbols;
 
 #[cfg(test)]
-mod latency;
-#[cfg(test)]
 mod testing;
 #[cfg(test)]
 mod tests;

@@ -73,12 +73,3 @@ pub(crate) fn spans_text(text: &str, spans: impl IntoIterator<Item = Span>) -> S
         .collect::<Vec<_>>()
         .join(", ")
 }
-
-/// The throughput bench's generated mission (about 65 lines per team):
-/// groups, communication between neighbouring teams, modes, a function.
-pub(crate) fn large_mission(teams: usize) -> String {
-    generated::generate(teams)
-}
-
-#[path = "../../benches/common/mission.rs"]
-mod generated;
