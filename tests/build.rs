@@ -8,6 +8,7 @@ mod support;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use support::robots::robot_folders;
 use support::{examples, repo_root, semo_in};
 
 const STRICT: &str = "-std=c11 -Wall -Wextra -Wpedantic -Werror -O1 -g";
@@ -29,30 +30,6 @@ fn build(mission: &Path, target: &str, out: &Path) -> support::Output {
         &repo_root(),
         &["build", &mission_arg, "--target", target, "-o", &out_arg],
     )
-}
-
-/// Every robot folder under an output folder.
-fn robot_folders(out: &Path) -> Vec<PathBuf> {
-    let mut folders = Vec::new();
-    for team in std::fs::read_dir(out).unwrap() {
-        let team = team.unwrap().path();
-        if !team.is_dir() {
-            continue;
-        }
-        for robot in std::fs::read_dir(&team).unwrap() {
-            let robot = robot.unwrap().path();
-            let hidden = robot
-                .file_name()
-                .unwrap()
-                .to_string_lossy()
-                .starts_with('.');
-            if robot.is_dir() && !hidden {
-                folders.push(robot);
-            }
-        }
-    }
-    folders.sort();
-    folders
 }
 
 /// Runs `make` in a robot folder; the compiler's complaints on failure.

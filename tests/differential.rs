@@ -113,22 +113,13 @@ fn mode_times(events: &[&Event]) -> Vec<i64> {
 
 /// Every robot folder under an output folder, as (robot, folder).
 fn robot_folders(out: &Path) -> Vec<(String, PathBuf)> {
-    let mut folders = Vec::new();
-    for team in std::fs::read_dir(out).unwrap() {
-        let team = team.unwrap().path();
-        if !team.is_dir() {
-            continue;
-        }
-        for robot in std::fs::read_dir(&team).unwrap() {
-            let robot = robot.unwrap().path();
-            let name = robot.file_name().unwrap().to_string_lossy().into_owned();
-            if robot.is_dir() && !name.starts_with('.') {
-                folders.push((name, robot));
-            }
-        }
-    }
-    folders.sort();
-    folders
+    support::robots::robot_folders(out)
+        .into_iter()
+        .map(|folder| {
+            let robot = folder.file_name().unwrap().to_string_lossy().into_owned();
+            (robot, folder)
+        })
+        .collect()
 }
 
 /// Runs the generated programs of `mission` on `scenario` (killing robots
