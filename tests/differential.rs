@@ -34,7 +34,8 @@ const START_MS: i64 = 250;
 
 type Event = serde_json::Map<String, serde_json::Value>;
 
-/// Held while a test's robot processes run (see [`run_processes`]).
+/// Held while a test's robot processes run (see [`run_processes`]), the
+/// random missions' included.
 static RUNNING: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 fn scratch(name: &str) -> PathBuf {
@@ -352,7 +353,10 @@ fn random_missions(seeds: std::ops::Range<u64>) {
         let scenario_path = dir.join("scenario.json");
         std::fs::write(&scenario_path, &scenario).unwrap();
         let reference = simulate(&mission, &scenario_path);
-        let processes = support::robots::run_in_simulation(&mission, &dir.join("out"), &scenario);
+        let processes = {
+            let _one_run_at_a_time = RUNNING.lock().unwrap_or_else(|e| e.into_inner());
+            support::robots::run_in_simulation(&mission, &dir.join("out"), &scenario)
+        };
         for (robot, lines) in &processes {
             let c_events = support::robots::events(lines);
             let c: Vec<&Event> = c_events.iter().collect();
