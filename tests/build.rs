@@ -8,7 +8,7 @@ mod support;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use support::robots::robot_folders;
+use support::robots::{make, robot_command, robot_folders};
 use support::{examples, repo_root, semo_in};
 
 const STRICT: &str = "-std=c11 -Wall -Wextra -Wpedantic -Werror -O1 -g";
@@ -30,26 +30,6 @@ fn build(mission: &Path, target: &str, out: &Path) -> support::Output {
         &repo_root(),
         &["build", &mission_arg, "--target", target, "-o", &out_arg],
     )
-}
-
-/// Runs `make` in a robot folder; the compiler's complaints on failure.
-fn make(folder: &Path, cc: &str, cflags: &str) -> Result<(), String> {
-    let out = Command::new("make")
-        .args([
-            "-s",
-            "-j2",
-            &format!("CC={cc}"),
-            &format!("CFLAGS={cflags}"),
-        ])
-        .current_dir(folder)
-        .output()
-        .expect("make runs");
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    if out.status.success() && !stderr.contains("warning") {
-        Ok(())
-    } else {
-        Err(format!("{}: {stderr}", folder.display()))
-    }
 }
 
 fn example(path: &str) -> PathBuf {
@@ -286,13 +266,8 @@ fn a_failed_leader_is_replaced_by_the_next_robot() {
     let mut children = BTreeMap::new();
     for folder in &folders {
         let robot = folder.file_name().unwrap().to_string_lossy().into_owned();
-        let child = Command::new(folder.join(&robot))
-            .args(["--scenario", &scenario.display().to_string()])
-            .args([
-                "--trace",
-                &out.join(format!("{robot}.jsonl")).display().to_string(),
-            ])
-            .args(["--port-base", &port_base.to_string()])
+        let trace = out.join(format!("{robot}.jsonl"));
+        let child = robot_command(folder, &scenario, &trace, port_base)
             .spawn()
             .expect("the robot program starts");
         children.insert(robot, child);

@@ -162,13 +162,8 @@ fn run_processes(
     let _one_run_at_a_time = RUNNING.lock().unwrap_or_else(|e| e.into_inner());
     let mut children = BTreeMap::new();
     for (robot, folder) in &folders {
-        let child = Command::new(folder.join(robot))
-            .args(["--scenario", &scenario.display().to_string()])
-            .args([
-                "--trace",
-                &out.join(format!("{robot}.jsonl")).display().to_string(),
-            ])
-            .args(["--port-base", &port_base.to_string()])
+        let trace = out.join(format!("{robot}.jsonl"));
+        let child = support::robots::robot_command(folder, scenario, &trace, port_base)
             .spawn()
             .expect("the robot program starts");
         children.insert(robot.clone(), child);

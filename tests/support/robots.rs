@@ -62,7 +62,12 @@ pub fn robot_folders(out: &Path) -> Vec<PathBuf> {
 /// warning is a failure).
 pub fn make(folder: &Path, cc: &str, cflags: &str) -> Result<(), String> {
     let out = Command::new("make")
-        .args(["-s", &format!("CC={cc}"), &format!("CFLAGS={cflags}")])
+        .args([
+            "-s",
+            "-j2",
+            &format!("CC={cc}"),
+            &format!("CFLAGS={cflags}"),
+        ])
         .current_dir(folder)
         .output()
         .expect("make runs");
@@ -72,6 +77,18 @@ pub fn make(folder: &Path, cc: &str, cflags: &str) -> Result<(), String> {
     } else {
         Err(format!("{}: {stderr}", folder.display()))
     }
+}
+
+/// The `linux-sim` program of a robot folder, set to run `scenario` and write
+/// its trace to `trace`, on the ports from `port_base`.
+pub fn robot_command(folder: &Path, scenario: &Path, trace: &Path, port_base: u32) -> Command {
+    let robot = folder.file_name().expect("a robot folder").to_owned();
+    let mut command = Command::new(folder.join(robot));
+    command
+        .args(["--scenario", &scenario.display().to_string()])
+        .args(["--trace", &trace.display().to_string()])
+        .args(["--port-base", &port_base.to_string()]);
+    command
 }
 
 pub fn has(program: &str) -> bool {
@@ -114,10 +131,7 @@ pub fn run_in_simulation(
     for folder in folders {
         let robot = folder.file_name().unwrap().to_string_lossy().into_owned();
         let trace = out.join(format!("{robot}.jsonl"));
-        let child = Command::new(folder.join(&robot))
-            .args(["--scenario", &scenario_path.display().to_string()])
-            .args(["--trace", &trace.display().to_string()])
-            .args(["--port-base", &port_base.to_string()])
+        let child = robot_command(&folder, &scenario_path, &trace, port_base)
             .stderr(std::process::Stdio::piped())
             .spawn()
             .expect("the robot program starts");
