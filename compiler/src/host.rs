@@ -292,6 +292,8 @@ struct Memo {
     units: Memoised<Option<PathBuf>, Key, Unit>,
     /// By file: (its revision, the task graphs' revision).
     graphs: Memoised<FileId, (u64, u64), GraphRun>,
+    /// By mission: the revisions of what it reads and of the task graphs.
+    dataflow: Memoised<FileId, Key, crate::dataflow::MissionDataflow>,
 }
 
 /// Results by slot, each with the key it was computed from.
@@ -307,6 +309,7 @@ impl Memo {
         drop_later(lock(&self.missions).remove(&id));
         drop_later(lock(&self.strategies).remove(&id));
         drop_later(lock(&self.graphs).remove(&id));
+        drop_later(lock(&self.dataflow).remove(&id));
     }
 }
 
@@ -842,6 +845,7 @@ impl BuildFiles {
     }
 }
 
+mod dataflow;
 mod disk;
 #[cfg(test)]
 mod tests;
