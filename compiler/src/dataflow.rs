@@ -47,6 +47,8 @@ pub struct MissionDataflow {
     pub robots: Vec<RobotDataflow>,
     /// Warnings in the mission file, sorted.
     pub diagnostics: Vec<Diagnostic>,
+    /// The service graph files analysed (a change to one changes this).
+    pub graphs: Vec<FileId>,
 }
 
 /// One robot's dataflow.
@@ -82,10 +84,54 @@ pub struct DataflowInput<'a> {
 pub fn analyze(input: &DataflowInput<'_>) -> MissionDataflow {
     let mut out = MissionDataflow::default();
     for program in input.programs {
-        out.robots.push(robot(input, program, &mut out.diagnostics));
+        out.robots
+            .push(robot(input, program, &mut out.diagnostics, &mut out.graphs));
     }
     diag::sort_and_dedup(&mut out.diagnostics);
+    out.graphs.sort();
+    out.graphs.dedup();
     out
+}
+
+/// For a hover on a team's name at `offset`: each of its robots' iteration
+/// period, in markdown; `None` elsewhere, when no robot of the team calls a
+/// service graph with execution times, or when the mission was not refined
+/// (it has errors). `dataflow` is asked only on a team's name.
+pub fn team_periods_at(
+    mission: &Mission,
+    offset: usize,
+    dataflow: impl FnOnce() -> Option<Arc<MissionDataflow>>,
+) -> Option<String> {
+    let team = crate::sema::lookup::at(mission, offset)
+        .iter()
+        .find_map(|o| match o.symbol {
+            crate::sema::Symbol::Team(t) => Some(mission.team(t)),
+            _ => None,
+        })?;
+    let dataflow = dataflow()?;
+    let robots: Vec<&RobotDataflow> = dataflow
+        .robots
+        .iter()
+        .filter(|r| team.name == r.team.as_str())
+        .collect();
+    // Nothing to say of a team none of whose robots runs a timed graph.
+    if robots.iter().all(|r| r.period.is_none()) {
+        return None;
+    }
+    let mut out = String::from("**Iteration period** (dataflow):");
+    for r in robots {
+        let line = match (&r.period, &r.bounded_by) {
+            (Some(p), Some((service, graph))) => {
+                format!("\n- `{}`: {p} ms (`{service}`: `{graph}`)", r.robot)
+            }
+            _ => format!(
+                "\n- `{}`: not bounded (it calls no service graph with execution times)",
+                r.robot
+            ),
+        };
+        out.push_str(&line);
+    }
+    Some(out)
 }
 
 /// One call of a service implemented by a graph.
@@ -102,6 +148,7 @@ fn robot(
     input: &DataflowInput<'_>,
     program: &RobotProgram,
     diagnostics: &mut Vec<Diagnostic>,
+    graphs: &mut Vec<FileId>,
 ) -> RobotDataflow {
     let mut found = RobotDataflow {
         team: program.team.clone(),
@@ -110,6 +157,7 @@ fn robot(
         bounded_by: None,
     };
     for call in graph_calls(input, program) {
+        graphs.extend(call.run.graph.as_ref().map(|g| g.file));
         diagnostics.extend(graph_problems(input.file, &call));
         let Some(period) = iteration_period(&call.run) else {
             continue;

@@ -764,7 +764,8 @@ impl Analysis {
     /// above its folder see: the door re-checks everything then); for a strategy file, the strategy files sharing a unit
     /// with it (an entry refined in two files); for a catalog file, the
     /// missions, catalog and strategy files sharing a unit with it; for a
-    /// task graph, the graphs that read it (or were not analysed yet).
+    /// task graph, the graphs that read it (or were not analysed yet) and the
+    /// missions whose dataflow ([`Analysis::dataflow`]) read it.
     pub fn affected_by(&self, id: FileId) -> Vec<FileId> {
         let Some(file) = self.file(id) else {
             return Vec::new();
@@ -798,6 +799,12 @@ impl Analysis {
             }
             FileKind::TaskGraph => {
                 let path = file.path.as_deref().map(subgraph::normalize);
+                // The missions whose dataflow read it (as a service graph).
+                for (mission, (_, found)) in lock(&self.memo.dataflow).iter() {
+                    if found.graphs.contains(&id) {
+                        out.push(*mission);
+                    }
+                }
                 let graphs = lock(&self.memo.graphs);
                 for other in self.files().filter(|f| f.kind == FileKind::TaskGraph) {
                     let reads = match (graphs.get(&other.id), &path) {

@@ -233,6 +233,13 @@ fn editing_the_graph_gives_a_new_answer_and_an_unchanged_workspace_the_same_one(
     let again = w.host.analysis().dataflow_if_known(MISSION_ID).unwrap();
     assert!(Arc::ptr_eq(&first, &again));
     assert_eq!(codes(&first.diagnostics), [Code::DataflowTooSlow]);
+    // The editor re-publishes the mission when the graph changes.
+    assert!(
+        w.host
+            .analysis()
+            .affected_by(GRAPH_ID)
+            .contains(&MISSION_ID)
+    );
     let faster = TIMED.replace("wcet=\"50\"", "wcet=\"40\"");
     w.host.set_file(
         GRAPH_ID,
@@ -242,4 +249,45 @@ fn editing_the_graph_gives_a_new_answer_and_an_unchanged_workspace_the_same_one(
     );
     assert!(w.host.analysis().dataflow_if_known(MISSION_ID).is_none());
     assert_eq!(w.warnings(), Vec::new());
+}
+
+#[test]
+fn a_team_hover_lists_its_robots_periods() {
+    let text = mission("T.P.S { scan() } repeat(60 MSEC)");
+    let w = Workspace::new("hover", &text, TIMED);
+    let analysis = w.host.analysis();
+    let mission = analysis.mission(MISSION_ID).unwrap();
+    let at_team = text.find("T:").unwrap();
+    let periods = crate::dataflow::team_periods_at(&mission.mission, at_team, || {
+        analysis.dataflow(MISSION_ID)
+    });
+    assert_eq!(
+        periods.as_deref(),
+        Some(
+            "**Iteration period** (dataflow):\n\
+             - `r_0`: 50 ms (`scan`: `graphs/scan.taskgraph.xml`)\n\
+             - `r_1`: 50 ms (`scan`: `graphs/scan.taskgraph.xml`)"
+        )
+    );
+    let at_call = text.find("scan()").unwrap();
+    let asked = std::cell::Cell::new(false);
+    let none = crate::dataflow::team_periods_at(&mission.mission, at_call, || {
+        asked.set(true);
+        analysis.dataflow(MISSION_ID)
+    });
+    assert_eq!(none, None);
+    assert!(!asked.get(), "the dataflow is asked only on a team");
+}
+
+#[test]
+fn a_team_without_timed_service_graphs_gets_no_period_section() {
+    let text = mission("T.P.S { dig() }");
+    let w = Workspace::new("hover-untimed", &text, TIMED);
+    let analysis = w.host.analysis();
+    let mission = analysis.mission(MISSION_ID).unwrap();
+    let at_team = text.find("T:").unwrap();
+    let periods = crate::dataflow::team_periods_at(&mission.mission, at_team, || {
+        analysis.dataflow(MISSION_ID)
+    });
+    assert_eq!(periods, None);
 }
