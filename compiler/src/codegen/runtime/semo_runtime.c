@@ -29,7 +29,7 @@
 #define SEMO_STACK_BYTES (512u * 1024u)
 #endif
 #define COMM_QUEUE_CAPACITY 64
-#define RECV_POLL_MS 50
+#define RECV_ERROR_PAUSE_MS 50
 #define DEFAULT_PORT_BASE 47000
 
 /* ------------------------------------------------------------ run state */
@@ -422,6 +422,19 @@ bool UFControl_WaitIdle(const char *name, int64_t timeout_ms)
     return idle;
 }
 
+bool UFControl_WaitStop(const char *name, int64_t until_ms)
+{
+    task *t = find_task(name);
+    if (!t)
+        return !semo_running();
+    pthread_mutex_lock(&t->lock);
+    while (!t->stop_requested && semo_running() && semo_now_ms() < until_ms)
+        wait_until(&t->changed, &t->lock, until_ms);
+    bool stop = t->stop_requested || !semo_running();
+    pthread_mutex_unlock(&t->lock);
+    return stop;
+}
+
 bool UFControl_StopRequested(const char *name)
 {
     task *t = find_task(name);
@@ -663,11 +676,12 @@ static void *receiver_thread(void *arg)
     (void)arg;
     unsigned char buf[DATAGRAM_MAX + 1]; /* one spare byte detects oversized datagrams */
     while (semo_running()) {
-        int n = g_transport->recv(buf, sizeof buf, RECV_POLL_MS);
+        /* No timeout: semo_stop_program interrupts the wait. */
+        int n = g_transport->recv(buf, sizeof buf, -1);
         semo_message m;
         if (n < 0) {
             semo_trace("comm_error", "reason", "receive failed", NULL);
-            semo_sleep_ms(RECV_POLL_MS);
+            semo_sleep_ms(RECV_ERROR_PAUSE_MS); /* a failing socket must not spin */
         } else if (n > 0 && decode_message(buf, (size_t)n, &m)) {
             semo__deliver(&m);
         } else if (n > 0) {
@@ -701,6 +715,10 @@ void semo_stop_program(void)
         pthread_cond_broadcast(&g_tasks[i].changed);
         pthread_mutex_unlock(&g_tasks[i].lock);
     }
+    /* The receiver waits on the socket without a timeout. */
+    const semo_transport *transport = g_transport;
+    if (transport && transport->interrupt)
+        transport->interrupt();
 }
 
 /* SIGINT and SIGTERM end the program cleanly (wrapups run, traces close).

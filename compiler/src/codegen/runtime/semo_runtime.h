@@ -191,6 +191,11 @@ bool UFControl_WaitIdle(const char *task, int64_t timeout_ms);
 /* For task bodies that take long: true when the control task asked this
  * task to stop (or the program is stopping). */
 bool UFControl_StopRequested(const char *task);
+/* Waits until mission time `until_ms`, or until the control task asks the
+ * task to stop, or the program stops, without polling; true when asked to
+ * stop (or stopping). On the static schedule it never waits (it answers
+ * UFControl_StopRequested). */
+bool UFControl_WaitStop(const char *task, int64_t until_ms);
 
 /* Task parameters (per task, by name); unknown ones read as 0. */
 int UFTask_SetIntegerParameter(const char *task, const char *param, long long value);
@@ -243,8 +248,12 @@ typedef struct {
     const char *name;
     int (*open)(const semo_program_desc *program, int port_base);
     int (*send)(size_t peer, const void *data, size_t len);
-    /* Bytes received, 0 on timeout, -1 on error. */
+    /* Bytes received, 0 on timeout or interrupt, -1 on error; timeout_ms < 0
+     * waits until a datagram arrives or `interrupt` is called. */
     int (*recv)(void *data, size_t cap, int timeout_ms);
+    /* Makes a recv under way, and every later one, return 0 at once (the
+     * program is stopping); safe from any thread. */
+    void (*interrupt)(void);
     void (*close)(void);
 } semo_transport;
 extern const semo_transport semo_udp_transport;

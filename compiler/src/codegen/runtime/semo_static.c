@@ -291,6 +291,13 @@ bool UFControl_WaitIdle(const char *name, int64_t timeout_ms)
     return UFControl_GetTaskState(name) == SEMO_TASK_IDLE;
 }
 
+/* Nothing else would run while this waited: it only answers. */
+bool UFControl_WaitStop(const char *name, int64_t until_ms)
+{
+    (void)until_ms;
+    return UFControl_StopRequested(name);
+}
+
 bool UFControl_StopRequested(const char *name)
 {
     task *t = find_task(name);
