@@ -163,6 +163,7 @@ codes! {
     CodegenUnsupported = "E100", Error, "a construct that code generation does not support yet";
     OutputNameEscapes = "E101", Error, "a name that cannot become a file or C identifier of the generated code (it could write outside the output folder, or clashes with a generated task)";
     CodegenInternal = "E102", Error, "an internal error of refinement or code generation: something the checker should have excluded (please report it)";
+    TargetUnsupported = "E103", Error, "a robot the chosen target cannot run as written: on `cortex-m` a robot that messages other robots (no transport there yet), or `cortex-m-sim` without `--scenario`";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";
