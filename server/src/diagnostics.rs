@@ -74,8 +74,8 @@ async fn publish(state: &State, client: &Client, uri: Uri) {
         }
         related_files(&analysis, |id| world.uri_of(id).cloned())
     };
-    let mut diagnostics = to_lsp(&snapshot, &analysis, &others);
-    cap(&mut diagnostics);
+    // Already capped per file by the library (`diag::MAX_PER_FILE`).
+    let diagnostics = to_lsp(&snapshot, &analysis, &others);
     let version = snapshot.version;
     drop(analysis);
     retire(snapshot);
@@ -163,29 +163,6 @@ pub fn convert(d: &semo::diag::Diagnostic, range: lsp::Range) -> lsp::Diagnostic
             .map(|s| serde_json::json!({ "suggestion": s })),
         code_description: None,
     }
-}
-
-/// Editors slow to a crawl on files with many thousands of problems (a pasted
-/// binary, say): the first [`MAX_PUBLISHED`] are published, then one note.
-pub const MAX_PUBLISHED: usize = 1000;
-
-fn cap(diagnostics: &mut Vec<lsp::Diagnostic>) {
-    if diagnostics.len() <= MAX_PUBLISHED {
-        return;
-    }
-    let hidden = diagnostics.len() - MAX_PUBLISHED;
-    diagnostics.truncate(MAX_PUBLISHED);
-    let range = diagnostics[MAX_PUBLISHED - 1].range;
-    diagnostics.push(lsp::Diagnostic {
-        range,
-        severity: Some(lsp::DiagnosticSeverity::INFORMATION),
-        source: Some("semo".to_string()),
-        message: format!(
-            "{hidden} more problems in this file are not shown (the first {MAX_PUBLISHED} are); \
-             `semo check` lists them all"
-        ),
-        ..Default::default()
-    });
 }
 
 fn severity(s: Severity) -> lsp::DiagnosticSeverity {
