@@ -848,4 +848,4 @@ mod disk;
 #[cfg(test)]
 mod tests;
 
-pub use disk::{CheckRun, load_build, load_check};
+pub use disk::{CheckRun, STDIN_NAME, load_build, load_check, load_check_stdin};
