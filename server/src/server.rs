@@ -192,13 +192,16 @@ impl Backend {
             .map_err(|_| Error::internal_error())?;
         let mut transaction = match begun {
             Ok(t) => t,
-            Err(message) => {
+            Err(refused) => {
                 if let Some(p) = progress {
                     p.finish_with_message("refused").await;
                 }
-                let message = format!("SeMo: {message}");
+                let message = format!("SeMo: {}", refused.message);
                 self.client.show_message(MessageType::ERROR, &message).await;
-                return Err(handlers::request_failed(message));
+                return Err(Error {
+                    data: refused.data,
+                    ..handlers::request_failed(message)
+                });
             }
         };
         let recovered = transaction.recovered.clone();
