@@ -103,7 +103,8 @@ impl Backend {
     }
 
     /// `semo.simulate`: the mission's robots run on a scenario; the summary,
-    /// the timeline SVG and the expectations, or the reason for refusing.
+    /// the timeline SVG and the expectations, or the reason for refusing;
+    /// the scenario file's diagnostics published.
     async fn simulate(&self, arguments: &[serde_json::Value]) -> Result<serde_json::Value> {
         use handlers::simulate;
         let params = simulate::params(arguments).map_err(Error::invalid_params)?;
@@ -111,10 +112,15 @@ impl Backend {
             let world = self.state.world();
             simulate::job(&world, params).map_err(handlers::request_failed)?
         };
-        tokio::task::spawn_blocking(move || simulate::simulate(&job))
+        let outcome = tokio::task::spawn_blocking(move || simulate::simulate(&job))
             .await
-            .map_err(|_| Error::internal_error())?
-            .map_err(handlers::request_failed)
+            .map_err(|_| Error::internal_error())?;
+        if let Some((uri, diagnostics)) = outcome.scenario {
+            self.client
+                .publish_diagnostics(uri, diagnostics, None)
+                .await;
+        }
+        outcome.answer.map_err(handlers::request_failed)
     }
 
     /// `semo.generateCode`: generates the code of a mission, reporting each
