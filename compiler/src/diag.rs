@@ -131,6 +131,10 @@ codes! {
     SubgraphBoundaryRate = "E079", Error, "a task's port rates that do not carry exactly one iteration of its sub-graph";
     MulticastWithoutReader = "W062", Warning, "a multicast group that tasks write but none reads";
     MulticastWithoutWriter = "W063", Warning, "a multicast group that tasks read but none writes";
+    DataflowInconsistent = "W070", Warning, "a mission line calling a service whose task graph has inconsistent sample rates";
+    DataflowDeadlock = "W071", Warning, "a mission line calling a service whose task graph deadlocks";
+    DataflowBufferTooSmall = "W072", Warning, "a mission line calling a service whose task graph has a channel smaller than its schedule needs";
+    DataflowTooSlow = "W073", Warning, "a `repeat(P)` or `loop(P)` period shorter than the iteration period of a service graph called inside: the robot cannot keep up";
     // Strategy files (*.strategy.xml).
     StrategyXml = "E080", Error, "a strategy file that is not well-formed XML";
     StrategyRawLt = "E081", Error, "a plain `<` inside an attribute value, where XML needs `&lt;`";
