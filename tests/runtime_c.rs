@@ -155,6 +155,7 @@ fn compile(flavor: Flavor) -> Program {
         .args(flavor.flags())
         .args([
             "tests/runtime_test.c",
+            "semo_core.c",
             "semo_runtime.c",
             "semo_udp.c",
             "semo_sim.c",
@@ -369,6 +370,17 @@ fn tasks_channels_control_timers_and_trace_escaping() {
             .find(|e| e["channel"] == "Control.SPILL->Sink.IN")
             .unwrap_or_else(|| panic!("{dropped:?}"));
         assert_eq!(spill["count"], "1");
+    }
+}
+
+/// A time-driven task that calls `semo_next_firing(INT64_MAX)` sleeps
+/// through its periods and fires again only when a sample arrives (the
+/// program checks its own counts: 2 firings, 1 sample, over 300 ms of
+/// 10 ms periods).
+#[test]
+fn a_task_waiting_for_events_does_not_poll() {
+    for flavor in flavors() {
+        program(flavor).run_ok(&["wake"]);
     }
 }
 
