@@ -91,12 +91,21 @@ pub fn throughput(
     }
     let wcet: Vec<u64> = level.nodes.iter().map(|n| n.wcet.unwrap_or(0)).collect();
     let chained = concurrency == Concurrency::Single;
-    let hsdf =
-        if counts.iter().all(|&c| c == 1) && level.edges.iter().all(|e| e.produce == e.consume) {
-            Hsdf::direct(level, wcet, chained)
-        } else {
-            Hsdf::expand(level, counts, &wcet, chained)?
-        };
+    let direct =
+        counts.iter().all(|&c| c == 1) && level.edges.iter().all(|e| e.produce == e.consume);
+    if !direct && symbolic_is_cheaper(level, counts, chained) {
+        if let Some((period, critical_cycle)) = symbolic::period(level, counts, &wcet, chained) {
+            return Some(Throughput {
+                period,
+                critical_cycle,
+            });
+        }
+    }
+    let hsdf = if direct {
+        Hsdf::direct(level, wcet, chained)
+    } else {
+        Hsdf::expand(level, counts, &wcet, chained)?
+    };
     let Some(hsdf) = hsdf.on_cycles() else {
         return Some(Throughput {
             period: Ratio { num: 0, den: 1 },
@@ -110,6 +119,23 @@ pub fn throughput(
         critical_cycle: level_cycle(walk),
     })
 }
+
+/// Whether the symbolic iteration ([`symbolic`]) costs less than the HSDF
+/// expansion. Its steps (a max over D integers) are several times cheaper
+/// than the expansion's (edges sorted, then policy iterations in exact
+/// ratios), hence the factor.
+fn symbolic_is_cheaper(level: &Level<'_>, counts: &[u64], chained: bool) -> bool {
+    const STEP_RATIO: u64 = 8;
+    match (
+        symbolic::cost(level, counts, chained),
+        Hsdf::expanded_size(level, counts),
+    ) {
+        (Some(symbolic), Some(hsdf)) => symbolic <= hsdf.saturating_mul(STEP_RATIO),
+        _ => false,
+    }
+}
+
+mod symbolic;
 
 /// A graph in compressed adjacency form; edge `e` goes from the node whose
 /// range `first[v]..first[v + 1]` holds it to `head[e]`, carrying `tokens[e]`
@@ -175,6 +201,17 @@ impl Hsdf {
         Hsdf::from_edges(weight, edges, Vec::new())
     }
 
+    /// At most how many nodes plus edges [`Hsdf::expand`] makes.
+    fn expanded_size(level: &Level<'_>, counts: &[u64]) -> Option<u64> {
+        let total = counts.iter().try_fold(0u64, |s, &c| s.checked_add(c))?;
+        let mut size = total.checked_mul(2)?;
+        for e in &level.edges {
+            let per = (e.consume.div_ceil(e.produce).saturating_add(1)).min(counts[e.src]);
+            size = size.checked_add(counts[e.dst].checked_mul(per)?)?;
+        }
+        Some(size)
+    }
+
     /// The classic SDF→HSDF expansion: node (v, k) for each firing k < γ(v).
     /// On an edge with rates p, c and d initial samples, firing k of the
     /// destination consumes the samples numbered k·c .. k·c + c - 1 of the
@@ -196,12 +233,7 @@ impl Hsdf {
             total = total.checked_add(c)?;
             offset.push(usize::try_from(total).ok()?);
         }
-        let mut size = total.checked_mul(2)?;
-        for e in &level.edges {
-            let per = (e.consume.div_ceil(e.produce).saturating_add(1)).min(counts[e.src]);
-            size = size.checked_add(counts[e.dst].checked_mul(per)?)?;
-        }
-        if size > MAX_HSDF {
+        if Hsdf::expanded_size(level, counts)? > MAX_HSDF {
             return None;
         }
         let mut weight = Vec::with_capacity(offset[n]);
@@ -770,6 +802,13 @@ mod tests {
                     "{:?}", concurrency
                 );
                 prop_assert_eq!(t.critical_cycle.is_empty(), t.period.num == 0);
+                // The symbolic iteration, whichever engine `throughput` chose.
+                let wcet: Vec<u64> = level.nodes.iter().map(|n| n.wcet.unwrap_or(0)).collect();
+                let chained = concurrency == Concurrency::Single;
+                let (period, cycle) = symbolic::period(&level, &counts, &wcet, chained).unwrap();
+                prop_assert_eq!(period, t.period, "symbolic, {:?}", concurrency);
+                prop_assert_eq!(cycle.is_empty(), period.num == 0);
+                prop_assert!(cycle.iter().all(|&v| v < level.nodes.len()));
             }
             let mut once = random.clone();
             once.looped = vec![1; random.gamma.len()];

@@ -1,0 +1,270 @@
+//! The period without expanding to the HSDF: one iteration executed
+//! symbolically in max-plus algebra (Geilen 2009, "Reduction techniques for
+//! synchronous dataflow graphs"; SDF3's own state-space method computes the
+//! same number).
+//!
+//! Every initial sample (one per sample on a channel, and with `chained` one
+//! per node for its previous firing) gets a coordinate. A sample made during
+//! the iteration carries a vector: for each initial sample, the longest time
+//! from that sample to it (−∞: it does not depend on it). A firing starts at
+//! the max of its input samples' vectors and ends `wcet` later. After one
+//! iteration every channel holds as many samples as it started with, in the
+//! same order: their vectors are the rows of the iteration's max-plus matrix
+//! G, and the period of the self-timed execution is G's largest cycle mean,
+//! found by the same policy iteration as the HSDF's ([`max_cycle_ratio`]) on
+//! G's graph (token j → token i weighing G[i][j]).
+//!
+//! The cost is D·(Σγ + the samples' runs moved), D the number of initial
+//! samples, against the HSDF's Σγ nodes and their edges: far less on a level
+//! with few initial samples and large repetition counts (`mp3playback`:
+//! D = 6, Σγ = 10 601). Samples made by one firing share its vector, so a
+//! channel holds runs (origin, count), not samples.
+//!
+//! The critical cycle is traced back through the firings: each vector entry
+//! remembers which input gave its max.
+
+use super::{Hsdf, level_cycle, max_cycle_ratio};
+use crate::taskgraph::analysis::level::Level;
+use crate::taskgraph::analysis::ratio::Ratio;
+use std::collections::VecDeque;
+
+const NEG_INF: i64 = i64::MIN;
+
+/// Initial samples beyond which the vectors cost more than they save.
+const MAX_SAMPLES: u64 = 4096;
+
+struct Channel {
+    src: usize,
+    dst: usize,
+    produce: u64,
+    consume: u64,
+    tokens: u64,
+}
+
+fn channels(level: &Level<'_>, chained: bool) -> Vec<Channel> {
+    let mut out: Vec<Channel> = level
+        .edges
+        .iter()
+        .map(|e| Channel {
+            src: e.src,
+            dst: e.dst,
+            produce: e.produce,
+            consume: e.consume,
+            tokens: e.initial_tokens,
+        })
+        .collect();
+    if chained {
+        out.extend((0..level.nodes.len()).map(|v| Channel {
+            src: v,
+            dst: v,
+            produce: 1,
+            consume: 1,
+            tokens: 1,
+        }));
+    }
+    out
+}
+
+/// D·(Σγ + Σ over channels of γ(src) + γ(dst)): the work of [`period`], to
+/// compare with the HSDF's size. `None` when it does not apply (too many
+/// initial samples, vectors beyond the HSDF's memory budget, overflow).
+pub(super) fn cost(level: &Level<'_>, counts: &[u64], chained: bool) -> Option<u64> {
+    let channels = channels(level, chained);
+    let samples = channels
+        .iter()
+        .try_fold(0u64, |sum, c| sum.checked_add(c.tokens))?;
+    if samples > MAX_SAMPLES {
+        return None;
+    }
+    let firings = counts.iter().try_fold(0u64, |s, &c| s.checked_add(c))?;
+    // One vector of D entries per firing is kept (for the critical cycle):
+    // within the HSDF's memory budget.
+    if firings.checked_mul(samples)? > super::MAX_HSDF {
+        return None;
+    }
+    let mut moves = firings;
+    for c in &channels {
+        moves = moves.checked_add(counts[c.src].checked_add(counts[c.dst])?)?;
+    }
+    samples.max(1).checked_mul(moves)
+}
+
+/// The origin of a run of samples: initial sample `o` when `o < D`, else
+/// firing `o - D` of the iteration.
+type Origin = usize;
+
+/// The period and the level nodes around a critical cycle (in flow order,
+/// before [`level_cycle`]); `None` on overflow or when the iteration cannot
+/// complete (the caller then uses the HSDF).
+pub(super) fn period(
+    level: &Level<'_>,
+    counts: &[u64],
+    wcet: &[u64],
+    chained: bool,
+) -> Option<(Ratio, Vec<usize>)> {
+    // Within the bounds (samples, memory) whatever the caller checked.
+    cost(level, counts, chained)?;
+    let n = level.nodes.len();
+    let channels = channels(level, chained);
+    let mut base = Vec::with_capacity(channels.len());
+    let mut d = 0usize;
+    for c in &channels {
+        base.push(d);
+        d = d.checked_add(usize::try_from(c.tokens).ok()?)?;
+    }
+    let mut inputs = vec![Vec::new(); n];
+    let mut outputs = vec![Vec::new(); n];
+    for (i, c) in channels.iter().enumerate() {
+        inputs[c.dst].push(i);
+        outputs[c.src].push(i);
+    }
+    let mut queues: Vec<VecDeque<(Origin, u64)>> = channels
+        .iter()
+        .zip(&base)
+        .map(|(c, &b)| (b..b + c.tokens as usize).map(|o| (o, 1)).collect())
+        .collect();
+    let mut available: Vec<u64> = channels.iter().map(|c| c.tokens).collect();
+    let mut remaining = counts.to_vec();
+    let total = usize::try_from(counts.iter().try_fold(0u64, |s, &c| s.checked_add(c))?).ok()?;
+    // Per firing: its actor, its end vector and which origin gave each entry.
+    let mut actor: Vec<usize> = Vec::with_capacity(total);
+    let mut ends: Vec<i64> = Vec::with_capacity(total.checked_mul(d)?);
+    let mut from: Vec<Origin> = Vec::with_capacity(total.checked_mul(d)?);
+    let mut start = vec![NEG_INF; d];
+    let mut start_from = vec![usize::MAX; d];
+    let mut pending: Vec<usize> = (0..n).rev().collect();
+    let mut queued = vec![true; n];
+    while let Some(v) = pending.pop() {
+        queued[v] = false;
+        let mut fired = false;
+        while remaining[v] > 0
+            && inputs[v]
+                .iter()
+                .all(|&i| available[i] >= channels[i].consume)
+        {
+            start.fill(NEG_INF);
+            start_from.fill(usize::MAX);
+            for &i in &inputs[v] {
+                let mut need = channels[i].consume;
+                available[i] -= need;
+                while need > 0 {
+                    let (origin, count) = queues[i].front_mut()?;
+                    let origin = *origin;
+                    let taken = need.min(*count);
+                    *count -= taken;
+                    need -= taken;
+                    if *count == 0 {
+                        queues[i].pop_front();
+                    }
+                    merge(origin, d, &ends, &mut start, &mut start_from);
+                }
+            }
+            let f = actor.len();
+            actor.push(v);
+            let w = i64::try_from(wcet[v]).ok()?;
+            for (s, &o) in start.iter().zip(&start_from) {
+                ends.push(if *s == NEG_INF {
+                    NEG_INF
+                } else {
+                    s.checked_add(w)?
+                });
+                from.push(o);
+            }
+            for &i in &outputs[v] {
+                queues[i].push_back((d + f, channels[i].produce));
+                available[i] = available[i].checked_add(channels[i].produce)?;
+            }
+            remaining[v] -= 1;
+            fired = true;
+        }
+        if fired {
+            for &i in &outputs[v] {
+                let u = channels[i].dst;
+                if !queued[u] {
+                    queued[u] = true;
+                    pending.push(u);
+                }
+            }
+        }
+    }
+    if remaining.iter().any(|&r| r > 0) {
+        return None;
+    }
+    // The rows of G: the final samples, channel by channel in order.
+    let mut rows: Vec<Origin> = Vec::with_capacity(d);
+    for q in &queues {
+        for &(origin, count) in q {
+            for _ in 0..count {
+                rows.push(origin);
+            }
+        }
+    }
+    if rows.len() != d {
+        return None;
+    }
+    let entry = |origin: Origin, j: usize| -> i64 {
+        if origin < d {
+            if origin == j { 0 } else { NEG_INF }
+        } else {
+            ends[(origin - d) * d + j]
+        }
+    };
+    // G's graph: token nodes 0..d weigh nothing; an entry G[i][j] is a node
+    // of its weight between j and i, the edge into i carrying one sample.
+    let mut weight = vec![0u64; d];
+    let mut edges = Vec::new();
+    let mut entries = Vec::new();
+    for (i, &origin) in rows.iter().enumerate() {
+        for j in 0..d {
+            let g = entry(origin, j);
+            if g != NEG_INF {
+                let mid = weight.len();
+                weight.push(u64::try_from(g).ok()?);
+                entries.push((i, j));
+                edges.push((j, mid, 0));
+                edges.push((mid, i, 1));
+            }
+        }
+    }
+    let Some(graph) = Hsdf::from_edges(weight, edges, Vec::new()).on_cycles() else {
+        return Some((Ratio { num: 0, den: 1 }, Vec::new()));
+    };
+    let (ratio, cycle) = max_cycle_ratio(&graph)?;
+    // Each entry node on the cycle: the firings from sample j to sample i.
+    let mut walk = Vec::new();
+    for v in cycle {
+        let original = graph.actor(v);
+        let Some(&(i, j)) = original.checked_sub(d).and_then(|m| entries.get(m)) else {
+            continue;
+        };
+        let mut path = Vec::new();
+        let mut origin = rows[i];
+        while origin >= d {
+            let f = origin - d;
+            path.push(actor[f]);
+            origin = from[f * d + j];
+        }
+        path.reverse();
+        walk.extend(path);
+    }
+    Some((ratio, level_cycle(walk)))
+}
+
+/// `start = max(start, the vector of origin)`, remembering where each
+/// entry's max came from.
+fn merge(origin: Origin, d: usize, ends: &[i64], start: &mut [i64], start_from: &mut [Origin]) {
+    if origin < d {
+        if start[origin] < 0 {
+            start[origin] = 0;
+            start_from[origin] = origin;
+        }
+        return;
+    }
+    let row = &ends[(origin - d) * d..(origin - d + 1) * d];
+    for ((s, f), &e) in start.iter_mut().zip(start_from.iter_mut()).zip(row) {
+        if e > *s {
+            *s = e;
+            *f = origin;
+        }
+    }
+}
