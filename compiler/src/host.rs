@@ -45,7 +45,7 @@ use crate::taskgraph::subgraph::{self, SubgraphSource};
 use crate::workspace::{FileKind, GraphRun, analyze_graph_at};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, Mutex, MutexGuard, OnceLock, PoisonError, mpsc};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 /// Where a workspace is: its roots, and the files or folders every file
 /// sees besides (`semo build --strategy`).
@@ -280,8 +280,7 @@ type Key = Vec<(FileId, u64)>;
 
 /// Results kept between snapshots; each map holds only the newest result per
 /// file or folder, so it is bounded by the workspace's size. A replaced result
-/// is freed on a background thread (freeing a 10k-line mission's analysis
-/// takes about a millisecond, which the next edit should not wait for).
+/// is freed by [`drop_later`] (off this thread, with a bounded backlog).
 #[derive(Default)]
 struct Memo {
     /// By folder (`None`: documents that are not files).
@@ -310,23 +309,6 @@ impl Memo {
         drop_later(lock(&self.strategies).remove(&id));
         drop_later(lock(&self.graphs).remove(&id));
         drop_later(lock(&self.dataflow).remove(&id));
-    }
-}
-
-/// Drops `value` on a background thread (or here, if none could start).
-fn drop_later<T: Send + 'static>(value: T) {
-    type Boxed = Box<dyn Send>;
-    static DROPPER: OnceLock<Option<Mutex<mpsc::Sender<Boxed>>>> = OnceLock::new();
-    let dropper = DROPPER.get_or_init(|| {
-        let (send, receive) = mpsc::channel::<Boxed>();
-        std::thread::Builder::new()
-            .name("semo-host-drop".into())
-            .spawn(move || receive.into_iter().for_each(drop))
-            .ok()
-            .map(|_| Mutex::new(send))
-    });
-    if let Some(send) = dropper {
-        let _ = lock(send).send(Box::new(value));
     }
 }
 
@@ -856,7 +838,9 @@ impl BuildFiles {
 
 mod dataflow;
 mod disk;
+mod dropper;
 #[cfg(test)]
 mod tests;
 
 pub use disk::{CheckRun, STDIN_NAME, load_build, load_check, load_check_stdin};
+pub use dropper::{Dropper, drop_later};

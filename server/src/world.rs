@@ -12,14 +12,14 @@ use crate::document::Document;
 use crate::encoding::{Encoding, LineMap};
 use semo::catalog::Catalog;
 use semo::diag::{Diagnostic, FileId};
-use semo::host::{self, AnalysisHost, CatalogResult, Roots};
+use semo::host::{self, AnalysisHost, CatalogResult, Dropper, Roots};
 use semo::sema::Analysis;
 use semo::strategy::{Strategy, StrategyLinks};
 use semo::text::LineIndex;
 use semo::workspace::{FileKind, GraphRun};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::{Arc, OnceLock, mpsc};
+use std::sync::{Arc, OnceLock};
 use tower_lsp_server::ls_types::{TextDocumentContentChangeEvent, Uri};
 
 /// The catalog a file sees (built on first use, outside the world's lock),
@@ -133,25 +133,18 @@ impl Snapshot {
 
 /// Lets go of a snapshot that a newer one replaced. Freeing an analysed
 /// mission (its tree and IR) takes about a millisecond on a 10k-line file:
-/// that is done on a background thread, so that it delays neither the next
-/// edit's diagnostics nor, under the world's lock, other requests.
+/// the shared [`Dropper`] does it on its thread (backlog bounded), so that it
+/// delays neither the next edit's diagnostics nor, under the world's lock,
+/// other requests.
 pub fn retire(snapshot: Arc<Snapshot>) {
-    static DROPPER: OnceLock<Option<mpsc::Sender<Arc<Snapshot>>>> = OnceLock::new();
+    retire_to(Dropper::shared(), snapshot);
+}
+
+fn retire_to(dropper: &Dropper, snapshot: Arc<Snapshot>) {
     if snapshot.analysis.get().is_none() {
         return; // little to free
     }
-    let dropper = DROPPER.get_or_init(|| {
-        let (send, receive) = mpsc::channel::<Arc<Snapshot>>();
-        std::thread::Builder::new()
-            .name("semo-drop".into())
-            .spawn(move || receive.into_iter().for_each(drop))
-            .ok()
-            .map(|_| send)
-    });
-    // Without the thread (it could not start), the snapshot is dropped here.
-    if let Some(send) = dropper {
-        let _ = send.send(snapshot);
-    }
+    dropper.drop_later(snapshot);
 }
 
 struct FileEntry {
@@ -174,6 +167,8 @@ pub struct World {
     /// Every file's text: which files belong together, and every analysis,
     /// is the host's (the same as `semo check` and `semo build`).
     host: AnalysisHost,
+    /// Frees replaced snapshots (the shared one; tests give their own).
+    dropper: Dropper,
 }
 
 /// What a change did, so the caller knows which files to re-check.
@@ -362,7 +357,7 @@ impl World {
                 snapshot,
             };
             if let Some(old) = self.files.insert(uri, entry) {
-                retire(old.snapshot);
+                retire_to(&self.dropper, old.snapshot);
             }
             ids.push(id);
         }
@@ -398,7 +393,7 @@ impl World {
         } else {
             self.host.analysis().affected_by(id)
         };
-        retire(entry.snapshot);
+        retire_to(&self.dropper, entry.snapshot);
         self.host.remove_file(id);
         let mut changed = self.renew(&affected);
         changed.files.push(uri.clone());
@@ -438,7 +433,7 @@ impl World {
             },
         );
         if let Some(old) = old {
-            retire(old.snapshot);
+            retire_to(&self.dropper, old.snapshot);
         }
         // Renewed with the others, in order: a strategy's snapshot holds the
         // current snapshots of its missions.
@@ -514,7 +509,7 @@ impl World {
             let fresh =
                 Arc::new(self.new_snapshot(uri, old.id, old.kind, old.version, old.text.clone()));
             let entry = self.files.get_mut(uri).expect("listed above");
-            retire(std::mem::replace(&mut entry.snapshot, fresh));
+            retire_to(&self.dropper, std::mem::replace(&mut entry.snapshot, fresh));
         }
         Changed { files: uris }
     }
@@ -546,6 +541,7 @@ pub fn read_text(path: &Path) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::sync::mpsc;
     use tower_lsp_server::ls_types::{Position, Range};
 
     const MISSION: &str = "{ A: Turtlebot3_Burger tb }\n\
@@ -589,23 +585,64 @@ mod tests {
         assert_eq!(cache(&third).map(|c| c.reparsed()), Some(0));
     }
 
+    /// Holds the thread that frees it until `release` says so, after telling
+    /// `started` that it is being freed.
+    struct Blocker {
+        started: mpsc::Sender<()>,
+        release: mpsc::Receiver<()>,
+    }
+
+    impl Drop for Blocker {
+        fn drop(&mut self) {
+            let _ = self.started.send(());
+            let _ = self.release.recv();
+        }
+    }
+
+    /// Tells when it is freed.
+    struct Probe(mpsc::Sender<()>);
+
+    impl Drop for Probe {
+        fn drop(&mut self) {
+            let _ = self.0.send(());
+        }
+    }
+
     #[test]
-    fn replaced_snapshots_are_freed_in_the_background() {
-        let mut world = World::default();
+    fn replaced_snapshots_are_freed_by_the_droppers_thread() {
+        let dropper = Dropper::start("test-world-drop", 8);
+        let mut world = World {
+            dropper: dropper.clone(),
+            ..World::default()
+        };
         let uri = Uri::from_file_path("/t/b.mission").expect("a file URI");
         world.open(uri.clone(), "mission", MISSION, 1);
         let first = world.snapshot(&uri).expect("open");
         first.analysis();
         let weak = Arc::downgrade(&first);
         drop(first);
+        // The dropper's thread is held: whatever it is given waits.
+        let (started, is_started) = mpsc::channel();
+        let (release, released) = mpsc::channel();
+        dropper.drop_later(Blocker {
+            started,
+            release: released,
+        });
+        is_started.recv().expect("the blocker reaches the thread");
         world.change(&uri, 2, Vec::new());
-        let start = std::time::Instant::now();
-        while weak.upgrade().is_some() {
-            assert!(
-                start.elapsed().as_secs() < 10,
-                "the old snapshot was never freed"
-            );
-            std::thread::sleep(std::time::Duration::from_millis(1));
-        }
+        assert!(
+            weak.upgrade().is_some(),
+            "the replaced snapshot was freed by the editing thread"
+        );
+        // Let the thread go; once it has freed a probe given after the
+        // snapshot, it has freed the snapshot (it frees in order).
+        release.send(()).expect("the blocker waits");
+        let (tell, told) = mpsc::channel();
+        dropper.drop_later(Probe(tell));
+        told.recv().expect("the probe is freed");
+        assert!(
+            weak.upgrade().is_none(),
+            "the replaced snapshot is still alive"
+        );
     }
 }
