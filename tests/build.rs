@@ -413,8 +413,12 @@ fn every_build_fixture_gives_its_code() {
             .map(|e| e.unwrap().path())
             .find(|p| p.extension().is_some_and(|e| e == "mission"))
             .expect("a fixture holds a mission");
+        // A fixture for another target names it in a file `target`.
+        let target = std::fs::read_to_string(dir.join("target"))
+            .map(|t| t.trim().to_string())
+            .unwrap_or_else(|_| "linux".to_string());
         let out = scratch(&format!("fixture-{name}"));
-        let built = build(&mission, "linux", &out);
+        let built = build(&mission, &target, &out);
         assert_eq!(built.code, 1, "{name}: {}", built.stdout);
         assert!(
             built.stdout.contains(&format!("[{code}]")),

@@ -77,13 +77,14 @@ fn colours_can_be_forced() {
 
 #[test]
 fn errors_exit_with_1_and_json_has_every_field() {
-    let dir = tempdir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     std::fs::write(
         dir.join("typo.mission"),
         "{ T: iRobotCreat a }\nT.Action.Go { move(\"1,1\") } repeat()\nT.GO { set(Action, Go) }\nT.main { default: mode = GO }\n",
     )
     .unwrap();
-    let out = semo_in(&dir, &["check", "--format", "json", "typo.mission"]);
+    let out = semo_in(dir, &["check", "--format", "json", "typo.mission"]);
     assert_eq!(out.code, 1);
     let line = out.stdout.lines().next().expect("one diagnostic");
     let v: serde_json::Value = serde_json::from_str(line).unwrap();
@@ -142,7 +143,8 @@ fn explain_describes_a_code() {
 
 #[test]
 fn folders_are_checked_recursively_with_their_catalog_files() {
-    let dir = tempdir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     std::fs::create_dir_all(dir.join("robots")).unwrap();
     std::fs::write(
         dir.join("robots/scout.robot.xml"),
@@ -157,7 +159,7 @@ fn folders_are_checked_recursively_with_their_catalog_files() {
          T.GO { set(Action, Go) }\nT.REST { set(Action, Rest) }\nT.main { case (GO): catch (hot): mode = REST default: mode = GO }\n",
     )
     .unwrap();
-    let (code, diags) = check_json_in(&dir, &["."]);
+    let (code, diags) = check_json_in(dir, &["."]);
     assert_eq!(code, 1, "Scout has no `stop`: {diags:#?}");
     assert_eq!(diags.len(), 1, "{diags:#?}");
     // `stop` exists in the catalog, but not for the Scout type of this folder.
@@ -173,7 +175,8 @@ fn folders_are_checked_recursively_with_their_catalog_files() {
 
 #[test]
 fn positions_count_characters_after_korean_and_emoji() {
-    let dir = tempdir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     let line = "T.Report.Say { if (COLOR == \"😀 안녕\") send(USER, COLOUR) } repeat(1 SEC)";
     std::fs::write(
         dir.join("u.mission"),
@@ -182,7 +185,7 @@ fn positions_count_characters_after_korean_and_emoji() {
         ),
     )
     .unwrap();
-    let (_, diags) = check_json_in(&dir, &["u.mission"]);
+    let (_, diags) = check_json_in(dir, &["u.mission"]);
     let d = diags
         .iter()
         .find(|d| d.code == "W007")
@@ -196,20 +199,6 @@ fn positions_count_characters_after_korean_and_emoji() {
     );
     assert_eq!((d.start, d.end), ((3, column), (3, column + 6)), "{d:#?}");
     assert_eq!(d.suggestion.as_deref(), Some("COLOR"));
-}
-
-/// A fresh empty folder under the target directory.
-fn tempdir() -> std::path::PathBuf {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    static N: AtomicUsize = AtomicUsize::new(0);
-    let dir = std::env::temp_dir().join(format!(
-        "semo-cli-test-{}-{}",
-        std::process::id(),
-        N.fetch_add(1, Ordering::SeqCst)
-    ));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 #[test]
@@ -244,14 +233,15 @@ fn three_unrelated_syntax_errors_are_each_reported_and_the_rest_is_checked() {
 
 #[test]
 fn rejected_definitions_are_still_checked() {
-    let dir = tempdir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     std::fs::write(
         dir.join("dup.mission"),
         "{ T: iRobotCreate a }\nT.Action.Go { move(\"1,1\") } repeat()\nT.Action.Go { mvoe(\"1,1\") }\n\
          U.Action.X { stopp() }\nT.GO { set(Action, Go) }\nT.main { default: mode = GO }\n",
     )
     .unwrap();
-    let (_, diags) = check_json_in(&dir, &["dup.mission"]);
+    let (_, diags) = check_json_in(dir, &["dup.mission"]);
     let found: Vec<(&str, u64, Option<&str>)> = diags
         .iter()
         .map(|d| (d.code.as_str(), d.start.0, d.suggestion.as_deref()))
@@ -290,14 +280,15 @@ fn names(dir: &std::path::Path) -> Vec<String> {
 
 #[test]
 fn fmt_rewrites_only_the_missions_that_change_and_lists_them() {
-    let dir = tempdir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     std::fs::create_dir(dir.join("sub")).unwrap();
     std::fs::write(dir.join("a.mission"), UNFORMATTED).unwrap();
     std::fs::write(dir.join("sub/b.mission"), UNFORMATTED).unwrap();
     std::fs::write(dir.join("c.mission"), FORMATTED).unwrap();
     std::fs::write(dir.join("robots.robot.xml"), "<robots>  </robots>").unwrap();
     std::fs::write(dir.join("notes.txt"), "T.A.S{x()}").unwrap();
-    let out = semo_in(&dir, &["fmt", "."]);
+    let out = semo_in(dir, &["fmt", "."]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert_eq!(
         out.stdout,
@@ -310,7 +301,7 @@ fn fmt_rewrites_only_the_missions_that_change_and_lists_them() {
     assert_eq!(read(&dir.join("notes.txt")), "T.A.S{x()}");
     // No temporary file is left behind.
     assert_eq!(
-        names(&dir),
+        names(dir),
         [
             "a.mission",
             "c.mission",
@@ -321,30 +312,32 @@ fn fmt_rewrites_only_the_missions_that_change_and_lists_them() {
     );
     assert_eq!(names(&dir.join("sub")), ["b.mission"]);
     // Without a path, the current folder; nothing is left to change.
-    let again = semo_in(&dir, &["fmt"]);
+    let again = semo_in(dir, &["fmt"]);
     assert_eq!((again.code, again.stdout.as_str()), (0, ""));
 }
 
 #[test]
 fn fmt_check_lists_the_files_that_would_change_and_writes_nothing() {
-    let dir = tempdir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     std::fs::write(dir.join("a.mission"), UNFORMATTED).unwrap();
     std::fs::write(dir.join("c.mission"), FORMATTED).unwrap();
-    let out = semo_in(&dir, &["fmt", "--check", "a.mission", "c.mission"]);
+    let out = semo_in(dir, &["fmt", "--check", "a.mission", "c.mission"]);
     assert_eq!((out.code, out.stdout.as_str()), (1, "a.mission\n"));
     assert_eq!(read(&dir.join("a.mission")), UNFORMATTED);
-    assert_eq!(names(&dir), ["a.mission", "c.mission"]);
-    let out = semo_in(&dir, &["fmt", "--check", "c.mission"]);
+    assert_eq!(names(dir), ["a.mission", "c.mission"]);
+    let out = semo_in(dir, &["fmt", "--check", "c.mission"]);
     assert_eq!((out.code, out.stdout.as_str()), (0, ""));
 }
 
 #[test]
 fn fmt_leaves_a_file_with_syntax_errors_as_it_is_and_says_where() {
-    let dir = tempdir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     let broken = "T.Action.Go {\n  move(\"1,1\"\n  stop()\n}\n  # keep   this\n";
     std::fs::write(dir.join("broken.mission"), broken).unwrap();
     std::fs::write(dir.join("fine.mission"), UNFORMATTED).unwrap();
-    let out = semo_in(&dir, &["fmt", "broken.mission", "fine.mission"]);
+    let out = semo_in(dir, &["fmt", "broken.mission", "fine.mission"]);
     assert_eq!(out.code, 1, "{}", out.stderr);
     assert!(
         out.stderr.contains(
@@ -361,10 +354,11 @@ fn fmt_leaves_a_file_with_syntax_errors_as_it_is_and_says_where() {
 
 #[test]
 fn fmt_leaves_a_file_that_is_not_utf8_as_it_is() {
-    let dir = tempdir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     let bytes = b"# caf\xe9\n{ T: iRobotCreate a }\n";
     std::fs::write(dir.join("latin1.mission"), bytes).unwrap();
-    let out = semo_in(&dir, &["fmt", "latin1.mission"]);
+    let out = semo_in(dir, &["fmt", "latin1.mission"]);
     assert_eq!(out.code, 1);
     assert!(
         out.stderr.contains("latin1.mission: not UTF-8 text"),
@@ -376,52 +370,55 @@ fn fmt_leaves_a_file_that_is_not_utf8_as_it_is() {
 
 #[test]
 fn fmt_reads_standard_input_and_can_print_instead_of_writing() {
-    let dir = tempdir();
-    let out = semo_with_stdin(&dir, &["fmt", "-"], UNFORMATTED);
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let out = semo_with_stdin(dir, &["fmt", "-"], UNFORMATTED);
     assert_eq!(
         (out.code, out.stdout.as_str()),
         (0, FORMATTED),
         "{}",
         out.stderr
     );
-    let out = semo_with_stdin(&dir, &["fmt", "--check", "-"], UNFORMATTED);
+    let out = semo_with_stdin(dir, &["fmt", "--check", "-"], UNFORMATTED);
     assert_eq!((out.code, out.stdout.as_str()), (1, "<stdin>\n"));
-    let out = semo_with_stdin(&dir, &["fmt", "-"], "T.A.S { move( }");
+    let out = semo_with_stdin(dir, &["fmt", "-"], "T.A.S { move( }");
     assert_eq!((out.code, out.stdout.as_str()), (1, ""));
     assert!(out.stderr.contains("<stdin>:1:13:"), "{}", out.stderr);
 
     std::fs::write(dir.join("a.mission"), UNFORMATTED).unwrap();
-    let out = semo_in(&dir, &["fmt", "--stdout", "a.mission"]);
+    let out = semo_in(dir, &["fmt", "--stdout", "a.mission"]);
     assert_eq!((out.code, out.stdout.as_str()), (0, FORMATTED));
     assert_eq!(read(&dir.join("a.mission")), UNFORMATTED);
 }
 
 #[test]
 fn fmt_path_and_usage_problems_exit_with_2() {
-    let dir = tempdir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     std::fs::write(dir.join("robots.robot.xml"), "<robots/>").unwrap();
-    let out = semo_in(&dir, &["fmt", "missing.mission"]);
+    let out = semo_in(dir, &["fmt", "missing.mission"]);
     assert_eq!(out.code, 2);
     assert!(out.stderr.contains("missing.mission"), "{}", out.stderr);
-    let out = semo_in(&dir, &["fmt", "robots.robot.xml"]);
+    let out = semo_in(dir, &["fmt", "robots.robot.xml"]);
     assert_eq!(out.code, 2);
     assert!(
         out.stderr.contains("not a mission script"),
         "{}",
         out.stderr
     );
-    let out = semo_in(&dir, &["fmt", "--check", "--stdout", "."]);
+    let out = semo_in(dir, &["fmt", "--check", "--stdout", "."]);
     assert_eq!(out.code, 2);
 }
 
 #[cfg(unix)]
 #[test]
 fn fmt_through_a_symbolic_link_rewrites_the_file_and_keeps_the_link() {
-    let dir = tempdir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     std::fs::create_dir(dir.join("real")).unwrap();
     std::fs::write(dir.join("real/a.mission"), UNFORMATTED).unwrap();
     std::os::unix::fs::symlink("real/a.mission", dir.join("link.mission")).unwrap();
-    let out = semo_in(&dir, &["fmt", "link.mission"]);
+    let out = semo_in(dir, &["fmt", "link.mission"]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert!(
         std::fs::symlink_metadata(dir.join("link.mission"))
@@ -435,13 +432,14 @@ fn fmt_through_a_symbolic_link_rewrites_the_file_and_keeps_the_link() {
 
 #[test]
 fn fmt_does_not_replace_a_read_only_file() {
-    let dir = tempdir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     let path = dir.join("locked.mission");
     std::fs::write(&path, UNFORMATTED).unwrap();
     let mut permissions = std::fs::metadata(&path).unwrap().permissions();
     permissions.set_readonly(true);
     std::fs::set_permissions(&path, permissions).unwrap();
-    let out = semo_in(&dir, &["fmt", "locked.mission"]);
+    let out = semo_in(dir, &["fmt", "locked.mission"]);
     assert_eq!(out.code, 2);
     assert!(
         out.stderr
@@ -450,7 +448,7 @@ fn fmt_does_not_replace_a_read_only_file() {
         out.stderr
     );
     assert_eq!(read(&path), UNFORMATTED);
-    assert_eq!(names(&dir), ["locked.mission"]);
+    assert_eq!(names(dir), ["locked.mission"]);
 }
 
 fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
@@ -473,10 +471,11 @@ fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
 
 #[test]
 fn formatting_the_examples_changes_nothing_that_semo_check_finds() {
-    let dir = tempdir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     copy_dir(&examples(), &dir.join("examples"));
     let findings = || {
-        let (code, diags) = check_json_in(&dir, &["."]);
+        let (code, diags) = check_json_in(dir, &["."]);
         let found: Vec<(String, String, String)> = diags
             .into_iter()
             .map(|d| (d.file, d.code, d.message))
@@ -485,11 +484,11 @@ fn formatting_the_examples_changes_nothing_that_semo_check_finds() {
     };
     let before = findings();
     assert!(!before.1.is_empty());
-    let out = semo_in(&dir, &["fmt", "."]);
+    let out = semo_in(dir, &["fmt", "."]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert!(out.stdout.contains("scouting.mission"), "{}", out.stdout);
     assert_eq!(findings(), before);
-    let check = semo_in(&dir, &["fmt", "--check", "."]);
+    let check = semo_in(dir, &["fmt", "--check", "."]);
     assert_eq!((check.code, check.stdout.as_str()), (0, ""));
 }
 

@@ -214,3 +214,96 @@ fn checking_a_mission_reads_the_catalog_beside_it() {
         out.stdout
     );
 }
+
+/// The mission's dataflow warnings as the server publishes them: the
+/// fixture folder is the workspace root (indexed, so the catalog and the
+/// service graph are there), the mission open; the publication that has
+/// `code`.
+fn dataflow_from_server(dir: &Path, mission: &Path, code: &str) -> BTreeSet<Problem> {
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    let file = mission.display().to_string();
+    let found: Vec<Value> = runtime.block_on(async {
+        let mut client = TestClient::start();
+        client
+            .initialize(&["utf-16"], Some(&format!("file://{}", dir.display())))
+            .await;
+        let uri = format!("file://{file}");
+        let text = std::fs::read_to_string(mission).unwrap();
+        client.open(&uri, &text).await;
+        let published = client
+            .notification("textDocument/publishDiagnostics", |p| {
+                p["uri"] == uri.as_str()
+                    && p["version"] == 1
+                    && p["diagnostics"]
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .any(|d| d["code"] == code)
+            })
+            .await;
+        client.shutdown().await;
+        published["diagnostics"].as_array().unwrap().clone()
+    });
+    found
+        .iter()
+        .map(|d| {
+            (
+                file.clone(),
+                d["code"].as_str().unwrap().to_string(),
+                d["range"]["start"]["line"].as_u64().unwrap() + 1,
+                d["range"]["start"]["character"].as_u64().unwrap() + 1,
+                d["message"].as_str().unwrap().to_string(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn dataflow_warnings_are_the_same_at_every_door() {
+    let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
+    for code in ["W070", "W071", "W072", "W073"] {
+        let dir = std::fs::read_dir(&fixtures)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.file_name().unwrap().to_string_lossy().starts_with(code))
+            .unwrap();
+        let mission = dir.join("scan.mission");
+        let name = mission.display().to_string();
+        let in_mission = |problems: BTreeSet<Problem>| -> BTreeSet<Problem> {
+            problems.into_iter().filter(|p| p.0 == name).collect()
+        };
+        let (_, single) = from_check(&dir, &[name.as_str()]);
+        let (_, whole) = from_check(&dir, &["."]);
+        let single = in_mission(single);
+        assert!(single.iter().any(|p| p.1 == code), "{}", listing(&single));
+        assert_eq!(
+            listing(&single),
+            listing(&in_mission(whole)),
+            "{code}: FILE and DIR"
+        );
+        assert_eq!(
+            listing(&single),
+            listing(&dataflow_from_server(&dir, &mission, code)),
+            "{code}: check and the editor"
+        );
+        // Warnings: the mission builds.
+        let out = std::env::temp_dir().join(format!("semo-doors-{code}-{}", std::process::id()));
+        let build = semo_in(
+            &dir,
+            &[
+                "build",
+                &name,
+                "--emit",
+                "taskgraph",
+                "--out",
+                &out.display().to_string(),
+            ],
+        );
+        assert_eq!(build.code, 0, "{}{}", build.stdout, build.stderr);
+        let _ = std::fs::remove_dir_all(&out);
+    }
+}

@@ -155,6 +155,7 @@ fn compile(flavor: Flavor) -> Program {
         .args(flavor.flags())
         .args([
             "tests/runtime_test.c",
+            "semo_core.c",
             "semo_runtime.c",
             "semo_udp.c",
             "semo_sim.c",

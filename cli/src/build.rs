@@ -13,6 +13,8 @@ pub struct Options {
     pub strategy: Vec<PathBuf>,
     pub out: Option<PathBuf>,
     pub target: Target,
+    /// Compiled into each robot (targets that need it: `cortex-m-sim`).
+    pub scenario: Option<PathBuf>,
     pub emit: Emit,
     pub color: bool,
     /// Replace files in the way (saved to the backup folder first).
@@ -21,6 +23,23 @@ pub struct Options {
 
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let started = std::time::Instant::now();
+    if options.scenario.is_some() != options.target.needs_scenario() {
+        eprintln!(
+            "error: {}",
+            if options.scenario.is_some() {
+                format!(
+                    "--scenario is compiled in only for target cortex-m-sim (target {} reads it at run time, if at all)",
+                    options.target.name()
+                )
+            } else {
+                format!(
+                    "target {} compiles a scenario into each robot: give --scenario FILE",
+                    options.target.name()
+                )
+            }
+        );
+        return 2;
+    }
     let (mut run, mission) = match host::load_build(&options.mission, &options.strategy) {
         Ok(loaded) => loaded,
         Err(e) => {
@@ -32,7 +51,17 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         eprintln!("internal error: the mission was loaded but not checked");
         return 2;
     };
-    let result = codegen::build(&input.input(), options.target, options.emit);
+    let input = input.input();
+    let result = match &options.scenario {
+        None => codegen::build(&input, options.target, options.emit),
+        Some(path) => match build_with_scenario(&input, path, &options) {
+            Ok(result) => result,
+            Err(message) => {
+                eprintln!("{message}");
+                return 2;
+            }
+        },
+    };
     if result.refused() {
         run.diagnostics = result.diagnostics;
         let _ = render::human(&run, options.color, out);
@@ -123,4 +152,42 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         generated.as_secs_f64() * 1000.0
     );
     0
+}
+
+/// Builds for a target that compiles the scenario in: the mission is refined
+/// first, since the scenario's names are checked against its programs.
+fn build_with_scenario(
+    input: &codegen::BuildInput<'_>,
+    path: &Path,
+    options: &Options,
+) -> Result<codegen::BuildResult, String> {
+    let text =
+        semo::workspace::read_text(path).map_err(|e| format!("error: {}: {e}", path.display()))?;
+    let refined = codegen::refine_checked(input);
+    if refined.programs.is_empty() {
+        // Refused: the mission's own errors come first.
+        return Ok(codegen::build_refined(
+            input,
+            refined,
+            options.target,
+            options.emit,
+            &[],
+        ));
+    }
+    let scenario = semo::sim::scenario::parse(&text, &refined.programs).map_err(|e| {
+        let (line, col) = e.line_col(&text);
+        format!("scenario {}:{line}:{col}: {}", path.display(), e.message)
+    })?;
+    let worlds: Vec<_> = refined
+        .programs
+        .iter()
+        .map(|p| scenario.compiled_for(p))
+        .collect();
+    Ok(codegen::build_refined(
+        input,
+        refined,
+        options.target,
+        options.emit,
+        &worlds,
+    ))
 }

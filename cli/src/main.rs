@@ -97,10 +97,17 @@ enum Command {
         /// The output folder (default: `out` beside the mission).
         #[arg(long, short)]
         out: Option<PathBuf>,
-        /// `linux` (POSIX threads; you fill the task files) or `linux-sim`
-        /// (sensors, actuators and the operator simulated from a scenario file).
+        /// `linux` (POSIX threads; you fill the task files), `linux-sim`
+        /// (sensors, actuators and the operator simulated from a scenario
+        /// file given at run time), `cortex-m` (bare-metal TI Stellaris
+        /// LM3S6965, a static schedule; you fill the task files) or
+        /// `cortex-m-sim` (the same with --scenario compiled in, for QEMU).
         #[arg(long, default_value = "linux", value_parser = parse_target)]
         target: semo::codegen::Target,
+        /// The scenario (`*.scenario.json`) compiled into each robot: needed
+        /// by, and only by, `--target cortex-m-sim`.
+        #[arg(long)]
+        scenario: Option<PathBuf>,
         /// `all` (C code, Makefile and task graph) or `taskgraph` (only the
         /// refined task graphs).
         #[arg(long, value_enum, default_value_t = EmitArg::All)]
@@ -374,6 +381,7 @@ fn run() -> i32 {
             strategy,
             out: out_dir,
             target,
+            scenario,
             emit,
             color,
             force,
@@ -383,6 +391,7 @@ fn run() -> i32 {
                 strategy,
                 out: out_dir,
                 target,
+                scenario,
                 emit: match emit {
                     EmitArg::All => semo::codegen::Emit::All,
                     EmitArg::Taskgraph => semo::codegen::Emit::TaskGraph,

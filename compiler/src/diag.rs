@@ -131,6 +131,10 @@ codes! {
     SubgraphBoundaryRate = "E079", Error, "a task's port rates that do not carry exactly one iteration of its sub-graph";
     MulticastWithoutReader = "W062", Warning, "a multicast group that tasks write but none reads";
     MulticastWithoutWriter = "W063", Warning, "a multicast group that tasks read but none writes";
+    DataflowInconsistent = "W070", Warning, "a mission line calling a service whose task graph has inconsistent sample rates";
+    DataflowDeadlock = "W071", Warning, "a mission line calling a service whose task graph deadlocks";
+    DataflowBufferTooSmall = "W072", Warning, "a mission line calling a service whose task graph has a channel smaller than its schedule needs";
+    DataflowTooSlow = "W073", Warning, "a `repeat(P)` or `loop(P)` period shorter than the iteration period of a service graph called inside: the robot cannot keep up";
     // Strategy files (*.strategy.xml).
     StrategyXml = "E080", Error, "a strategy file that is not well-formed XML";
     StrategyRawLt = "E081", Error, "a plain `<` inside an attribute value, where XML needs `&lt;`";
@@ -159,6 +163,7 @@ codes! {
     CodegenUnsupported = "E100", Error, "a construct that code generation does not support yet";
     OutputNameEscapes = "E101", Error, "a name that cannot become a file or C identifier of the generated code (it could write outside the output folder, or clashes with a generated task)";
     CodegenInternal = "E102", Error, "an internal error of refinement or code generation: something the checker should have excluded (please report it)";
+    TargetUnsupported = "E103", Error, "a robot the chosen target cannot run as written: on `cortex-m` a robot that messages other robots (no transport there yet), or `cortex-m-sim` without `--scenario`";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

@@ -292,6 +292,8 @@ struct Memo {
     units: Memoised<Option<PathBuf>, Key, Unit>,
     /// By file: (its revision, the task graphs' revision).
     graphs: Memoised<FileId, (u64, u64), GraphRun>,
+    /// By mission: the revisions of what it reads and of the task graphs.
+    dataflow: Memoised<FileId, Key, crate::dataflow::MissionDataflow>,
 }
 
 /// Results by slot, each with the key it was computed from.
@@ -307,6 +309,7 @@ impl Memo {
         drop_later(lock(&self.missions).remove(&id));
         drop_later(lock(&self.strategies).remove(&id));
         drop_later(lock(&self.graphs).remove(&id));
+        drop_later(lock(&self.dataflow).remove(&id));
     }
 }
 
@@ -761,7 +764,8 @@ impl Analysis {
     /// above its folder see: the door re-checks everything then); for a strategy file, the strategy files sharing a unit
     /// with it (an entry refined in two files); for a catalog file, the
     /// missions, catalog and strategy files sharing a unit with it; for a
-    /// task graph, the graphs that read it (or were not analysed yet).
+    /// task graph, the graphs that read it (or were not analysed yet) and the
+    /// missions whose dataflow ([`Analysis::dataflow`]) read it.
     pub fn affected_by(&self, id: FileId) -> Vec<FileId> {
         let Some(file) = self.file(id) else {
             return Vec::new();
@@ -795,6 +799,12 @@ impl Analysis {
             }
             FileKind::TaskGraph => {
                 let path = file.path.as_deref().map(subgraph::normalize);
+                // The missions whose dataflow read it (as a service graph).
+                for (mission, (_, found)) in lock(&self.memo.dataflow).iter() {
+                    if found.graphs.contains(&id) {
+                        out.push(*mission);
+                    }
+                }
                 let graphs = lock(&self.memo.graphs);
                 for other in self.files().filter(|f| f.kind == FileKind::TaskGraph) {
                     let reads = match (graphs.get(&other.id), &path) {
@@ -842,6 +852,7 @@ impl BuildFiles {
     }
 }
 
+mod dataflow;
 mod disk;
 #[cfg(test)]
 mod tests;

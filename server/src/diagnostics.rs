@@ -2,6 +2,13 @@
 //! queue, analysing the *newest* snapshot of each file, so a burst of edits is
 //! coalesced into one analysis without any fixed delay. A result whose
 //! snapshot was replaced meanwhile is dropped: its file is queued again.
+//!
+//! A mission's dataflow warnings (`semo::dataflow`: it refines every robot)
+//! are slower than its check: they never delay the keystroke's diagnostics.
+//! Those are published at once, with the dataflow warnings when the host
+//! already knows them for this snapshot; else a background task waits
+//! [`DATAFLOW_DEBOUNCE`] (an edit meanwhile drops it), computes them, and
+//! if there are any, publishes both again if the snapshot is still current.
 
 use crate::State;
 use crate::encoding::LineMap;
@@ -9,6 +16,7 @@ use crate::world::{FileAnalysis, Snapshot, retire};
 use semo::catalog::BUILTIN_FILE;
 use semo::diag::{Code, FileId, Severity};
 use semo::text::LineIndex;
+use semo::workspace::FileKind;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 use tokio::sync::Notify;
@@ -42,6 +50,9 @@ impl Queue {
     }
 }
 
+/// How long the typing must pause before a mission's dataflow is computed.
+pub const DATAFLOW_DEBOUNCE: std::time::Duration = std::time::Duration::from_millis(300);
+
 /// Runs for the life of the server.
 pub async fn publish_loop(state: Arc<State>, client: Client) {
     loop {
@@ -52,7 +63,7 @@ pub async fn publish_loop(state: Arc<State>, client: Client) {
     }
 }
 
-async fn publish(state: &State, client: &Client, uri: Uri) {
+async fn publish(state: &Arc<State>, client: &Client, uri: Uri) {
     let Some(snapshot) = state.world().snapshot(&uri) else {
         // Forgotten (closed and not in the workspace, or deleted): clear.
         client.publish_diagnostics(uri, Vec::new(), None).await;
@@ -72,23 +83,93 @@ async fn publish(state: &State, client: &Client, uri: Uri) {
             retire(snapshot);
             return;
         }
-        related_files(&analysis, |id| world.uri_of(id).cloned())
+        related_files(analysis.diagnostics(), |id| world.uri_of(id).cloned())
     };
+    let dataflow = match snapshot.kind {
+        FileKind::Mission => snapshot.host().dataflow_if_known(snapshot.id),
+        _ => None,
+    };
+    let later = snapshot.kind == FileKind::Mission && dataflow.is_none();
+    let extra = dataflow.as_ref().map_or(&[][..], |d| &d.diagnostics[..]);
     let mut diagnostics = to_lsp(&snapshot, &analysis, &others);
+    diagnostics.extend(dataflow_to_lsp(state, &snapshot, &analysis, extra));
     cap(&mut diagnostics);
     let version = snapshot.version;
+    drop(analysis);
+    if later {
+        tokio::spawn(publish_dataflow(
+            state.clone(),
+            client.clone(),
+            snapshot.clone(),
+        ));
+    }
+    retire(snapshot);
+    client.publish_diagnostics(uri, diagnostics, version).await;
+}
+
+/// The mission's diagnostics again, with its dataflow warnings, unless the
+/// snapshot is replaced before they are known.
+async fn publish_dataflow(state: Arc<State>, client: Client, snapshot: Arc<Snapshot>) {
+    tokio::time::sleep(DATAFLOW_DEBOUNCE).await;
+    if !state.world().is_current(&snapshot) {
+        return retire(snapshot);
+    }
+    let analysed = snapshot.clone();
+    let Ok((analysis, dataflow)) = tokio::task::spawn_blocking(move || {
+        (analysed.analysis(), analysed.host().dataflow(analysed.id))
+    })
+    .await
+    else {
+        return;
+    };
+    let others = {
+        let world = state.world();
+        if !world.is_current(&snapshot) {
+            drop(world);
+            drop(analysis);
+            return retire(snapshot);
+        }
+        related_files(analysis.diagnostics(), |id| world.uri_of(id).cloned())
+    };
+    let extra = dataflow.as_ref().map_or(&[][..], |d| &d.diagnostics[..]);
+    if extra.is_empty() {
+        // What was published holds: nothing to add.
+        drop(analysis);
+        return retire(snapshot);
+    }
+    let mut diagnostics = to_lsp(&snapshot, &analysis, &others);
+    diagnostics.extend(dataflow_to_lsp(&state, &snapshot, &analysis, extra));
+    cap(&mut diagnostics);
+    let (uri, version) = (snapshot.uri.clone(), snapshot.version);
     drop(analysis);
     retire(snapshot);
     client.publish_diagnostics(uri, diagnostics, version).await;
 }
 
+/// A mission's dataflow warnings, as the protocol has them.
+fn dataflow_to_lsp(
+    state: &State,
+    snapshot: &Snapshot,
+    analysis: &FileAnalysis,
+    found: &[semo::diag::Diagnostic],
+) -> Vec<lsp::Diagnostic> {
+    if found.is_empty() {
+        return Vec::new();
+    }
+    let others = {
+        let world = state.world();
+        related_files(found, |id| world.uri_of(id).cloned())
+    };
+    convert_all(snapshot, analysis, found, &others)
+}
+
 /// The URIs of the other files that related information points into.
 fn related_files(
-    analysis: &FileAnalysis,
+    diagnostics: &[semo::diag::Diagnostic],
     uri_of: impl Fn(FileId) -> Option<Uri>,
 ) -> HashMap<FileId, Uri> {
     let mut out = HashMap::new();
-    for d in analysis.diagnostics() {
+    for d in diagnostics {
         for r in &d.related {
             if r.file != d.file && r.file != BUILTIN_FILE {
                 if let Some(uri) = uri_of(r.file) {
@@ -106,11 +187,20 @@ pub fn to_lsp(
     analysis: &FileAnalysis,
     others: &HashMap<FileId, Uri>,
 ) -> Vec<lsp::Diagnostic> {
+    convert_all(snapshot, analysis, analysis.diagnostics(), others)
+}
+
+/// `found` (diagnostics in the snapshot's file) as the protocol has them.
+fn convert_all(
+    snapshot: &Snapshot,
+    analysis: &FileAnalysis,
+    found: &[semo::diag::Diagnostic],
+    others: &HashMap<FileId, Uri>,
+) -> Vec<lsp::Diagnostic> {
     let here = snapshot.line_map(analysis);
     // Line indexes of other (catalog) files, built once each.
     let mut other_lines: HashMap<FileId, LineIndex> = HashMap::new();
-    analysis
-        .diagnostics()
+    found
         .iter()
         .map(|d| {
             let related = d

@@ -2,8 +2,10 @@
 # The extension in the real VS Code: packages the .vsix, installs code-server
 # (once, under target/), installs the .vsix into a fresh profile, serves a
 # copy of test/e2e/workspace and drives it with headless Chromium
-# (test/e2e/run.mjs). The server is the release build: build it first with
-# `cargo build --release` (or set SEMO_BIN).
+# (test/e2e/). The .vsix is the platform one with the release build inside
+# (scripts/package-platform.sh): build it first with `cargo build --release`
+# (or set SEMO_BIN). No `semo.server.path` and no `semo` on code-server's
+# PATH, so the extension runs the server it bundles, as a user's would.
 #
 # Needs Debian's chromium, ripgrep and libkrb5-dev (see .ci/run).
 # Artifacts (screenshots, code-server's log) land in target/vscode-e2e/.
@@ -21,7 +23,8 @@ port="${SEMO_E2E_PORT:-18080}"
 started=$(date +%s)
 cd "$ext"
 [ -d node_modules ] || npm ci --no-audit --no-fund
-npm run package
+bash scripts/package-platform.sh "$semo"
+vsix="$ext/semo-linux-x64.vsix"
 cs_prefix="${CODE_SERVER_PREFIX:-$work/code-server}"
 bash scripts/install-code-server.sh "$cs_prefix"
 code_server="$cs_prefix/node_modules/.bin/code-server"
@@ -34,7 +37,7 @@ mkdir -p "$work/profile/User" "$work/extensions" "$work/shots"
 cp -r "$ext/test/e2e/workspace" "$work/workspace"
 cat > "$work/profile/User/settings.json" <<JSON
 {
-  "semo.server.path": "$semo",
+  "[semo]": { "editor.formatOnSave": true },
   "semo.trace.server": "messages",
   "workbench.startupEditor": "none",
   "workbench.tips.enabled": false,
@@ -52,9 +55,19 @@ cat > "$work/profile/User/settings.json" <<JSON
 JSON
 : > "$work/code-server.yaml"
 common=(--config "$work/code-server.yaml" --user-data-dir "$work/profile" --extensions-dir "$work/extensions")
-"$code_server" "${common[@]}" --install-extension "$ext/semo.vsix"
+"$code_server" "${common[@]}" --install-extension "$vsix"
 
-"$code_server" "${common[@]}" --auth none --bind-addr "127.0.0.1:$port" \
+# code-server's PATH without any folder holding a `semo`.
+clean_path=""
+IFS=: read -ra dirs <<< "$PATH"
+for d in "${dirs[@]}"; do
+  [ -e "$d/semo" ] || clean_path="${clean_path:+$clean_path:}$d"
+done
+if PATH="$clean_path" command -v semo > /dev/null; then
+  echo "e2e: semo is still on the PATH" >&2; exit 1
+fi
+
+PATH="$clean_path" "$code_server" "${common[@]}" --auth none --bind-addr "127.0.0.1:$port" \
   --disable-telemetry --disable-update-check --disable-workspace-trust \
   --disable-getting-started-override "$work/workspace" > "$work/code-server.log" 2>&1 &
 server_pid=$!

@@ -1,8 +1,8 @@
 //! The other files of a robot's folder: `program.h`, `main.c`, `channels.c`,
 //! `comm_task.c`, `lib_<name>.c`, `tasks/<task>.c` and the `Makefile`.
 
-use super::Target;
 use super::c;
+use super::{CompiledScenario, Platform, Target};
 use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK, getter, setter};
 use crate::refine::{RobotProgram, RoleKind};
 use crate::taskgraph::Trigger;
@@ -74,35 +74,72 @@ pub fn program_h(program: &RobotProgram, header: &str) -> String {
     out
 }
 
-pub fn channels_c(program: &RobotProgram, header: &str) -> String {
+pub fn channels_c(program: &RobotProgram, target: Target, header: &str) -> String {
     let mut out = String::from(header);
-    out.push_str("#include \"program.h\"\n\n/* The channels of the task graph; capacities from the buffer analysis. */\nconst semo_channel_desc semo_program_channels[] = {\n");
-    for (ch, capacity) in program.graph.channels.iter().zip(&program.capacities) {
-        let sample = if is_request_channel(&ch.src.task, &ch.src.port) {
+    out.push_str("#include \"program.h\"\n\n");
+    let sample = |ch: &crate::taskgraph::model::Channel| {
+        if is_request_channel(&ch.src.task, &ch.src.port) {
             "sizeof(semo_request)"
         } else {
             "sizeof(semo_value)"
+        }
+    };
+    // Without a heap, every channel's ring is a static buffer of its own.
+    let fixed = target.platform() == Platform::Static;
+    if fixed {
+        out.push_str("/* Each channel's samples and ring state (no heap on this target). */\n");
+        for (i, (ch, capacity)) in program
+            .graph
+            .channels
+            .iter()
+            .zip(&program.capacities)
+            .enumerate()
+        {
+            let _ = writeln!(
+                out,
+                "static unsigned char buffer_{i}[{capacity} * {}];\nstatic semo_channel_state state_{i};",
+                sample(ch)
+            );
+        }
+        out.push('\n');
+    }
+    out.push_str("/* The channels of the task graph; capacities from the buffer analysis. */\nconst semo_channel_desc semo_program_channels[] = {\n");
+    for (i, (ch, capacity)) in program
+        .graph
+        .channels
+        .iter()
+        .zip(&program.capacities)
+        .enumerate()
+    {
+        let storage = if fixed {
+            format!("buffer_{i}, &state_{i}")
+        } else {
+            "NULL, NULL".to_string()
         };
         let _ = writeln!(
             out,
-            "    {{{}, {}, {}, {}, {sample}, {capacity}, {}}},",
+            "    {{{}, {}, {}, {}, {}, {capacity}, {}, {storage}}},",
             c::string(&ch.src.task),
             c::string(&ch.src.port),
             c::string(&ch.dst.task),
             c::string(&ch.dst.port),
+            sample(ch),
             ch.initial_tokens
         );
     }
     if program.graph.channels.is_empty() {
-        out.push_str("    {\"\", \"\", \"\", \"\", sizeof(semo_value), 1, 0},\n");
+        out.push_str("    {\"\", \"\", \"\", \"\", sizeof(semo_value), 1, 0, NULL, NULL},\n");
     }
     out.push_str("};\n");
     out
 }
 
-pub fn main_c(program: &RobotProgram, header: &str) -> String {
+pub fn main_c(program: &RobotProgram, target: Target, header: &str) -> String {
     let mut out = String::from(header);
-    out.push_str("#include \"program.h\"\n\n/* Tasks: one thread each. */\nstatic const semo_task_desc tasks[] = {\n");
+    out.push_str(match target.platform() {
+        Platform::Threads => "#include \"program.h\"\n\n/* Tasks: one thread each. */\nstatic const semo_task_desc tasks[] = {\n",
+        Platform::Static => "#include \"program.h\"\n\n/* Tasks: fired by Core_1_go in the order of `schedule`. */\nstatic const semo_task_desc tasks[] = {\n",
+    });
     for task in &program.graph.tasks {
         let prefix = format!("task_{}", c::ident(&task.name.name));
         let (trigger, period) = match &task.trigger {
@@ -125,6 +162,24 @@ pub fn main_c(program: &RobotProgram, header: &str) -> String {
         }
         out.push_str("};\n\n");
     }
+    let static_schedule = target.platform() == Platform::Static;
+    if static_schedule {
+        match super::schedule::firings(&program.graph) {
+            Ok(firings) => {
+                out.push_str("/* One iteration of the task graph's single-appearance schedule:\n * (task index, consecutive firings). */\nstatic const semo_firing schedule[] = {\n");
+                for (task, count) in &firings {
+                    let name = program.graph.tasks.get(*task).map_or("", |t| &t.name.name);
+                    let _ = writeln!(out, "    {{{task}, {count}}}, /* {} */", c::comment(name));
+                }
+                out.push_str("};\n\n");
+            }
+            // The build refuses such a program first (E102); a folder
+            // generated anyway must not compile into a different program.
+            Err(why) => {
+                let _ = writeln!(out, "#error \"no static schedule: {}\"\n", c::comment(&why));
+            }
+        }
+    }
     out.push_str("/* Every robot of the mission: robot i listens on UDP port base + i. */\nstatic const semo_peer peers[] = {\n");
     for (team, robot) in &program.peers {
         let _ = writeln!(out, "    {{{}, {}}},", c::string(team), c::string(robot));
@@ -132,22 +187,52 @@ pub fn main_c(program: &RobotProgram, header: &str) -> String {
     out.push_str("};\n\n");
     let _ = writeln!(
         out,
-        "static const semo_program_desc program = {{\n    .mission = {},\n    .team = {},\n    .robot = {},\n    .robot_type = {},\n    .tasks = tasks,\n    .task_count = sizeof tasks / sizeof tasks[0],\n    .channels = semo_program_channels,\n    .channel_count = SEMO_CHANNEL_COUNT,\n    .groups = {},\n    .group_count = {},\n    .peers = peers,\n    .peer_count = sizeof peers / sizeof peers[0],\n    .self = {},\n}};\n\nint main(int argc, char **argv)\n{{\n    return semo_main(argc, argv, &program);\n}}",
+        "static const semo_program_desc program = {{\n    .mission = {},\n    .team = {},\n    .robot = {},\n    .robot_type = {},\n    .tasks = tasks,\n    .task_count = sizeof tasks / sizeof tasks[0],\n    .channels = semo_program_channels,\n    .channel_count = SEMO_CHANNEL_COUNT,\n    .groups = {},\n    .group_count = {},\n    .peers = peers,\n    .peer_count = sizeof peers / sizeof peers[0],\n    .self = {},\n{}}};\n\nint main(int argc, char **argv)\n{{\n    return semo_main(argc, argv, &program);\n}}",
         c::string(&program.mission),
         c::string(&program.team),
         c::string(&program.robot),
         c::string(&program.robot_type),
         if groups.is_empty() { "NULL" } else { "groups" },
         groups.len(),
-        program.self_peer
+        program.self_peer,
+        if static_schedule {
+            "    .schedule = schedule,\n    .schedule_count = sizeof schedule / sizeof schedule[0],\n"
+        } else {
+            ""
+        }
     );
     out
 }
 
-pub fn comm_task_c(program: &RobotProgram, header: &str) -> String {
+/// The lock of state shared between tasks: a mutex on threads, nothing on
+/// the static schedule (one task runs at a time). `(include, declare, lock,
+/// unlock)` for a lock named `name`.
+fn lock(target: Target, name: &str) -> (&'static str, String, String, String) {
+    match target.platform() {
+        Platform::Threads => (
+            "#include <pthread.h>\n",
+            format!("static pthread_mutex_t {name} = PTHREAD_MUTEX_INITIALIZER;\n"),
+            format!("pthread_mutex_lock(&{name});"),
+            format!("pthread_mutex_unlock(&{name});"),
+        ),
+        Platform::Static => (
+            "",
+            String::new(),
+            "/* no lock: one task runs at a time */".into(),
+            "/* end of the access */".into(),
+        ),
+    }
+}
+
+pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> String {
     let m = &program.control;
     let mut out = String::from(header);
-    out.push_str("#include \"program.h\"\n#include <pthread.h>\n#include <string.h>\n\n");
+    let (include, declare, lock_seen, unlock_seen) = lock(target, "seen_lock");
+    let _ = write!(
+        out,
+        "#include \"program.h\"\n{}#include <string.h>\n\n",
+        if m.heartbeat { include } else { "" }
+    );
     if !m.outgoing.is_empty() {
         out.push_str("/* CommSend: every value the control task sends goes to the robots of its\n * team (through the transport). */\nstatic const struct {\n    const char *port;\n    const char *to_team;\n    semo_msg_kind kind;\n    const char *key;\n} outgoing[] = {\n");
         for o in &m.outgoing {
@@ -175,7 +260,7 @@ pub fn comm_task_c(program: &RobotProgram, header: &str) -> String {
     if m.heartbeat {
         let _ = writeln!(
             out,
-            "/* Heartbeats of the team's robots, for leader elections: when each robot\n * was last heard from. Every robot counts as alive at start. */\nstatic pthread_mutex_t seen_lock = PTHREAD_MUTEX_INITIALIZER;\nstatic int64_t seen[{peers}];\n\nint64_t comm_last_seen(size_t peer)\n{{\n    int64_t t = 0;\n    pthread_mutex_lock(&seen_lock);\n    if (peer < {peers})\n        t = seen[peer];\n    pthread_mutex_unlock(&seen_lock);\n    return t;\n}}\n\nstatic bool heard_alive(const semo_message *m)\n{{\n    if (m->kind != SEMO_MSG_PUBLISH || strcmp(m->key, {key}) != 0)\n        return false;\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        if (strcmp(p->peers[i].robot, m->from_robot) == 0) {{\n            pthread_mutex_lock(&seen_lock);\n            seen[i] = semo_now_ms();\n            pthread_mutex_unlock(&seen_lock);\n        }}\n    return true;\n}}\n",
+            "/* Heartbeats of the team's robots, for leader elections: when each robot\n * was last heard from. Every robot counts as alive at start. */\n{declare}static int64_t seen[{peers}];\n\nint64_t comm_last_seen(size_t peer)\n{{\n    int64_t t = 0;\n    {lock_seen}\n    if (peer < {peers})\n        t = seen[peer];\n    {unlock_seen}\n    return t;\n}}\n\nstatic bool heard_alive(const semo_message *m)\n{{\n    if (m->kind != SEMO_MSG_PUBLISH || strcmp(m->key, {key}) != 0)\n        return false;\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        if (strcmp(p->peers[i].robot, m->from_robot) == 0) {{\n            {lock_seen}\n            seen[i] = semo_now_ms();\n            {unlock_seen}\n        }}\n    return true;\n}}\n",
             peers = program.peers.len().max(1),
             key = c::string(&alive_key(program))
         );
@@ -214,7 +299,7 @@ pub fn comm_task_c(program: &RobotProgram, header: &str) -> String {
         }
         let _ = writeln!(
             out,
-            "}}\n\nvoid task_{recv}_go(void)\n{{\n    semo_message m;\n    if (!semo_comm_poll(&m, 50))\n        return;"
+            "}}\n\nvoid task_{recv}_go(void)\n{{\n    semo_message m;\n    if (!semo_comm_poll(&m, -1))\n        return;"
         );
         if m.heartbeat {
             out.push_str("    if (heard_alive(&m))\n        return;\n");
@@ -241,21 +326,22 @@ pub fn comm_task_c(program: &RobotProgram, header: &str) -> String {
     out
 }
 
-pub fn library_c(program: &RobotProgram, header: &str) -> Option<(String, String)> {
+pub fn library_c(program: &RobotProgram, target: Target, header: &str) -> Option<(String, String)> {
     let lib = program.library.as_ref()?;
     let prefix = c::ident(&lib.name);
     let mut out = String::from(header);
-    out.push_str("#include \"program.h\"\n#include <pthread.h>\n\n");
+    let (include, declare, lock, unlock) = lock(target, "lock");
+    let _ = write!(out, "#include \"program.h\"\n{include}\n");
     let _ = writeln!(
         out,
-        "/* Library task {}: the team's shared information, one value per attribute,\n * read and written by its getters and setters under one lock. */\nstatic pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;\nstatic semo_value value[{}];\n",
+        "/* Library task {}: the team's shared information, one value per attribute,\n * read and written by its getters and setters under one lock. */\n{declare}static semo_value value[{}];\n",
         c::comment(&lib.name),
         lib.attributes.len()
     );
     for (i, key) in lib.attributes.iter().enumerate() {
         let _ = writeln!(
             out,
-            "/* {} */\nLIBFUNC(semo_value, {prefix}_{}, (void))\n{{\n    pthread_mutex_lock(&lock);\n    semo_value v = value[{i}];\n    pthread_mutex_unlock(&lock);\n    return v;\n}}\n\nLIBFUNC(void, {prefix}_{}, (const semo_value *v))\n{{\n    pthread_mutex_lock(&lock);\n    value[{i}] = *v;\n    pthread_mutex_unlock(&lock);\n}}\n",
+            "/* {} */\nLIBFUNC(semo_value, {prefix}_{}, (void))\n{{\n    {lock}\n    semo_value v = value[{i}];\n    {unlock}\n    return v;\n}}\n\nLIBFUNC(void, {prefix}_{}, (const semo_value *v))\n{{\n    {lock}\n    value[{i}] = *v;\n    {unlock}\n}}\n",
             c::comment(key),
             getter(key),
             setter(key)
@@ -274,7 +360,7 @@ pub fn task_c(
 ) -> Option<String> {
     let mut out = String::from(header);
     // The user's service template compares service names (`strcmp`).
-    let needs_string_h = target == Target::Linux && matches!(role.kind, RoleKind::Service { .. });
+    let needs_string_h = !target.simulated() && matches!(role.kind, RoleKind::Service { .. });
     out.push_str(if needs_string_h {
         "#include \"../program.h\"\n#include <string.h>\n\n"
     } else {
@@ -303,8 +389,8 @@ pub fn task_c(
             }
             out.push_str("}\n\nTASK_GO\n{\n    semo_value value;\n");
             for v in values {
-                match target {
-                    Target::LinuxSim => {
+                match target.simulated() {
+                    true => {
                         let _ = writeln!(
                             out,
                             "    if (semo_sim_sensor({}, &value))\n        UFPort_WriteToQueue(port_{}, &value, sizeof value);",
@@ -312,7 +398,7 @@ pub fn task_c(
                             c::ident(v)
                         );
                     }
-                    Target::Linux => {
+                    false => {
                         let _ = writeln!(
                             out,
                             "    /* TODO: read {v} from the sensor, e.g. semo_value_set(&value, \"...\"),\n     * then write it: UFPort_WriteToQueue(port_{id}, &value, sizeof value). */\n    (void)value;\n    (void)port_{id};",
@@ -324,6 +410,19 @@ pub fn task_c(
             }
             out.push_str("}\n\nTASK_WRAPUP\n{\n}\n");
         }
+        (RoleKind::Service { services }, _)
+            if target.simulated() && target.platform() == Platform::Static =>
+        {
+            // Nothing may block on the static schedule: the call spans
+            // passes of the loop (semo_firing_continues) until its time is up.
+            let _ = writeln!(
+                out,
+                "/* Task `{}` of robot {}: runs {} when the control task calls it; the\n * simulated service takes the scenario's time for it, over several passes\n * of the schedule. */\nstatic int port_request = -1;\nstatic semo_request req;\nstatic bool busy;\nstatic int64_t end;\n\nTASK_INIT\n{{\n    port_request = UFPort_Initialize(TASK_NAME, \"request\");\n}}\n\nTASK_GO\n{{\n    if (!busy) {{\n        if (UFPort_ReadFromQueue(port_request, &req, sizeof req) == 0)\n            return;\n        const char *arg = req.argc > 0 ? req.args[0].text : \"\";\n        semo_trace(\"call_start\", \"task\", TASK_NAME, \"service\", req.service, \"arg\", arg, NULL);\n        if (req.argc > 0)\n            semo_sim_actuate(TASK_NAME, &req.args[0]);\n        end = semo_now_ms() + semo_sim_service_ms(req.service);\n        busy = true;\n    }}\n    if (semo_running() && !UFControl_StopRequested(TASK_NAME) && semo_now_ms() < end) {{\n        semo_firing_continues();\n        return;\n    }}\n    busy = false;\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n}}\n\nTASK_WRAPUP\n{{\n}}",
+                c::comment(&role.task),
+                c::comment(&program.robot),
+                c::comment(&services.join(", "))
+            );
+        }
         (RoleKind::Service { services }, _) => {
             let _ = writeln!(
                 out,
@@ -332,11 +431,13 @@ pub fn task_c(
                 c::comment(&program.robot),
                 c::comment(&services.join(", "))
             );
-            match target {
-                Target::LinuxSim => {
-                    out.push_str("    const char *arg = req.argc > 0 ? req.args[0].text : \"\";\n    semo_trace(\"call_start\", \"task\", TASK_NAME, \"service\", req.service, \"arg\", arg, NULL);\n    if (req.argc > 0)\n        semo_sim_actuate(TASK_NAME, &req.args[0]);\n    /* The simulated service takes the scenario's time for it. */\n    int64_t end = semo_now_ms() + semo_sim_service_ms(req.service);\n    while (semo_running() && !UFControl_StopRequested(TASK_NAME) && semo_now_ms() < end) {\n        int64_t left = end - semo_now_ms();\n        semo_sleep_ms(left < 10 ? left : 10);\n    }\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n");
+            match (target.simulated(), target.platform()) {
+                (true, Platform::Threads) => {
+                    out.push_str("    const char *arg = req.argc > 0 ? req.args[0].text : \"\";\n    semo_trace(\"call_start\", \"task\", TASK_NAME, \"service\", req.service, \"arg\", arg, NULL);\n    if (req.argc > 0)\n        semo_sim_actuate(TASK_NAME, &req.args[0]);\n    /* The simulated service takes the scenario's time for it, or ends when\n     * the control task stops it. */\n    UFControl_WaitStop(TASK_NAME, semo_now_ms() + semo_sim_service_ms(req.service));\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n");
                 }
-                Target::Linux => {
+                // The static simulation's body is the arm above.
+                (true, Platform::Static) => {}
+                (false, _) => {
                     out.push_str("    /* TODO: perform the service; req.args[0 .. req.argc - 1] are its arguments.\n     * Check UFControl_StopRequested(TASK_NAME) during long work. */\n");
                     for s in services {
                         let _ = writeln!(
@@ -355,12 +456,40 @@ pub fn task_c(
     Some(out)
 }
 
+/// The runtime's table sizes on the static schedule, from the program; the
+/// Makefile's defaults (`make SEMO_STACK_BYTES=4096` overrides).
+pub struct StaticSizes {
+    /// Bytes of a value's text (`SEMO_VALUE_MAX`): the program's longest
+    /// literal and scenario value fit, and at least 32.
+    pub value_bytes: usize,
+    pub tasks: usize,
+    pub groups: usize,
+    /// Messages received and not yet taken.
+    pub inbox: usize,
+}
+
+impl StaticSizes {
+    pub fn of(program: &RobotProgram, longest_value: usize) -> StaticSizes {
+        let receives = program
+            .tasks
+            .iter()
+            .any(|t| t.kind == RoleKind::CommReceive);
+        StaticSizes {
+            value_bytes: (longest_value + 1).max(32).next_multiple_of(4),
+            tasks: program.graph.tasks.len().max(1),
+            groups: program.control.subscribed.len().max(1),
+            inbox: if receives { 4 } else { 1 },
+        }
+    }
+}
+
 pub fn makefile(
     program: &RobotProgram,
     target: Target,
     sources: &[String],
     tasks: &[String],
     header: &str,
+    sizes: &StaticSizes,
 ) -> String {
     let mut out = String::new();
     for line in header.lines() {
@@ -373,18 +502,94 @@ pub fn makefile(
             let _ = writeln!(out, "# {text}");
         }
     }
+    if target.platform() == Platform::Static {
+        let _ = writeln!(
+            out,
+            "\n# `make` builds `{robot}.elf` for target {target} (TI Stellaris LM3S6965, a\n# Cortex-M3) with arm-none-eabi-gcc and newlib-nano; `make size` prints its\n# flash and RAM, `make run` runs it in QEMU (UART0 on standard output{exit}).\n# CFLAGS may be overridden; the runtime's static tables (sized from the task\n# graph) and the stack with\n# make variables (`make SEMO_STACK_BYTES=4096`).\nCC = arm-none-eabi-gcc\nSIZE = arm-none-eabi-size\nQEMU = qemu-system-arm\nCFLAGS ?= -std=c11 -Wall -Wextra -Os\nARCH = -mcpu=cortex-m3 -mthumb\nSEMO_STACK_BYTES ?= 2048\nSEMO_VALUE_MAX ?= {value_bytes}\nSEMO_MAX_TASKS ?= {task_count}\nSEMO_MAX_GROUPS ?= {groups}\nSEMO_INBOX ?= {inbox}\nSIZES = -DSEMO_STACK_BYTES=$(SEMO_STACK_BYTES) -DSEMO_VALUE_MAX=$(SEMO_VALUE_MAX) -DSEMO_MAX_TASKS=$(SEMO_MAX_TASKS) -DSEMO_MAX_GROUPS=$(SEMO_MAX_GROUPS) -DSEMO_INBOX=$(SEMO_INBOX)\nSEMO_CFLAGS = -std=c11 $(ARCH) -ffunction-sections -fdata-sections -DSEMO_STATIC{sim} $(SIZES) -I.\nLDFLAGS += $(ARCH) -nostartfiles --specs=nano.specs -T lm3s6965.ld -Wl,--gc-sections\n\nPROGRAM = {robot}.elf\nSOURCES = {sources}\nTASKS = {tasks}\nOBJECTS = $(SOURCES:.c=.o) $(TASKS:.c=.o)\nHEADERS = program.h semo_runtime.h semo_internal.h\n\nall: $(PROGRAM)\n\n$(PROGRAM): $(OBJECTS) lm3s6965.ld\n\t$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(OBJECTS) $(LDLIBS)\n\ntasks/%.o: tasks/%.c $(HEADERS)\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -DSEMO_TASK=task_$* -c $< -o $@\n\n%.o: %.c $(HEADERS)\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -c $< -o $@\n\nsize: $(PROGRAM)\n\t$(SIZE) $(PROGRAM)\n\nrun: $(PROGRAM)\n\t$(QEMU) -M lm3s6965evb -nographic -semihosting -kernel $(PROGRAM)\n\nclean:\n\trm -f $(PROGRAM) $(OBJECTS)\n\n.PHONY: all size run clean",
+            robot = program.robot,
+            target = target.name(),
+            value_bytes = sizes.value_bytes,
+            task_count = sizes.tasks,
+            groups = sizes.groups,
+            inbox = sizes.inbox,
+            exit = if target.simulated() {
+                "; it exits when the scenario ends"
+            } else {
+                ""
+            },
+            sim = if target.simulated() {
+                " -DSEMO_SIM -DSEMO_SEMIHOSTING"
+            } else {
+                ""
+            },
+            sources = sources.join(" "),
+            tasks = tasks.join(" "),
+        );
+        return out;
+    }
     let _ = writeln!(
         out,
-        "\n# `make` builds the program `{robot}` for target {target}; CC and CFLAGS may be\n# overridden (`make CC=clang CFLAGS=\"-O1 -fsanitize=thread\"`).\nCFLAGS ?= -std=c11 -Wall -Wextra -O2\nSEMO_CFLAGS = -std=c11 -D_POSIX_C_SOURCE=200809L{sim} -I.\nLDLIBS += -lpthread -lm\n\nPROGRAM = {robot}\nSOURCES = {sources}\nTASKS = {tasks}\nOBJECTS = $(SOURCES:.c=.o) $(TASKS:.c=.o)\nHEADERS = program.h semo_runtime.h\n\nall: $(PROGRAM)\n\n$(PROGRAM): $(OBJECTS)\n\t$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(OBJECTS) $(LDLIBS)\n\ntasks/%.o: tasks/%.c $(HEADERS)\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -DSEMO_TASK=task_$* -c $< -o $@\n\n%.o: %.c $(HEADERS)\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -c $< -o $@\n\nclean:\n\trm -f $(PROGRAM) $(OBJECTS)\n\n.PHONY: all clean",
+        "\n# `make` builds the program `{robot}` for target {target}; CC and CFLAGS may be\n# overridden (`make CC=clang CFLAGS=\"-O1 -fsanitize=thread\"`). `make STATIC=1`\n# links statically with musl (Debian musl-tools) and 64 KiB thread stacks: the\n# smallest footprint (`make clean` first when switching).\nCFLAGS ?= -std=c11 -Wall -Wextra -O2\nSEMO_CFLAGS = -std=c11 -D_POSIX_C_SOURCE=200809L{sim} -I.\nLDLIBS += -lpthread -lm\nifeq ($(STATIC),1)\nCC = musl-gcc\nLDFLAGS += -static\nSEMO_CFLAGS += -DSEMO_STACK_BYTES=65536\nendif\n\nPROGRAM = {robot}\nSOURCES = {sources}\nTASKS = {tasks}\nOBJECTS = $(SOURCES:.c=.o) $(TASKS:.c=.o)\nHEADERS = program.h semo_runtime.h\n\nall: $(PROGRAM)\n\n$(PROGRAM): $(OBJECTS)\n\t$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(OBJECTS) $(LDLIBS)\n\ntasks/%.o: tasks/%.c $(HEADERS)\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -DSEMO_TASK=task_$* -c $< -o $@\n\n%.o: %.c $(HEADERS)\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -c $< -o $@\n\nclean:\n\trm -f $(PROGRAM) $(OBJECTS)\n\n.PHONY: all clean",
         robot = program.robot,
         target = target.name(),
-        sim = if target == Target::LinuxSim {
+        sim = if target.simulated() {
             " -DSEMO_SIM"
         } else {
             ""
         },
         sources = sources.join(" "),
         tasks = tasks.join(" "),
+    );
+    out
+}
+
+/// `scenario.c` of a static-schedule simulation: the robot's world from the
+/// scenario as constant tables (`semo__sim_tables`, `semo_internal.h`).
+pub fn scenario_c(world: &CompiledScenario, header: &str) -> String {
+    let mut out = String::from(header);
+    out.push_str("#include \"semo_internal.h\"\n\n/* This robot's world from the scenario, compiled in. */\n");
+    let _ = writeln!(out, "static const semo__sim_sensor_entry sensors[] = {{");
+    for (at, value, is) in &world.sensors {
+        let _ = writeln!(
+            out,
+            "    {{{at}, {}, {}}},",
+            c::string(value),
+            c::string(is)
+        );
+    }
+    if world.sensors.is_empty() {
+        out.push_str("    {0, \"\", \"\"}, /* none: the count below is 0 */\n");
+    }
+    out.push_str("};\nstatic const semo__sim_service_entry services[] = {\n");
+    for (service, ms) in &world.services {
+        let _ = writeln!(out, "    {{{}, {ms}}},", c::string(service));
+    }
+    if world.services.is_empty() {
+        out.push_str("    {\"\", 0}, /* none */\n");
+    }
+    out.push_str("};\nstatic const semo__sim_command_entry operator_commands[] = {\n");
+    for command in &world.operator {
+        let _ = writeln!(
+            out,
+            "    {{{}, {}, {}, {}, {}}},",
+            command.first,
+            command.every.unwrap_or(0),
+            command.until,
+            c::string(&command.key),
+            c::string(&command.value)
+        );
+    }
+    if world.operator.is_empty() {
+        out.push_str("    {0, 0, -1, \"\", \"\"}, /* none */\n");
+    }
+    let _ = writeln!(
+        out,
+        "}};\nstatic int64_t operator_next[{}];\n\nconst semo__sim_tables semo__scenario = {{\n    .duration_ms = {},\n    .sensors = sensors,\n    .sensor_count = {},\n    .services = services,\n    .service_count = {},\n    .operator_commands = operator_commands,\n    .operator_next = operator_next,\n    .operator_count = {},\n}};",
+        world.operator.len().max(1),
+        world.duration_ms.unwrap_or(0),
+        world.sensors.len(),
+        world.services.len(),
+        world.operator.len()
     );
     out
 }

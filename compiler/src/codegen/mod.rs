@@ -6,15 +6,22 @@
 //!   library task, the task files and the `Makefile`.
 //! - `output.rs`: writing a robot's folder atomically, never overwriting a
 //!   file the user owns.
-//! - `runtime/`: the hand-written C runtime copied into every folder.
+//! - `schedule.rs`: the static schedule's firing order from the SDF analysis.
+//! - `target.rs`: what a target refuses (inter-robot messages on bare metal).
+//! - `runtime/`: the hand-written C runtime copied into every folder: the
+//!   portable core and a platform layer (POSIX threads or a static schedule
+//!   with a board file).
 //!
-//! Targets are data: a target is a row of [`TARGETS`] (its runtime files and
-//! compile definitions); the generated code is the same for all.
+//! Targets are data: a target is a row of [`TARGETS`] (its platform, whether
+//! it simulates, its runtime files); the generated code differs only where
+//! the platform does (locks, blocking, the schedule table, the Makefile).
 
 mod c;
 mod control;
 pub(crate) mod files;
 pub mod output;
+mod schedule;
+mod target;
 
 use crate::refine::{RobotProgram, RoleKind};
 use crate::taskgraph::write::to_xml;
@@ -27,38 +34,75 @@ pub enum Target {
     /// The same program with sensors, actuators and the operator simulated
     /// from a scenario file, writing a trace.
     LinuxSim,
+    /// Bare metal on a Cortex-M3 (TI Stellaris LM3S6965): a static schedule,
+    /// no threads, no heap; the user fills the task files.
+    CortexM,
+    /// The same with the scenario compiled in as tables (`semo build
+    /// --scenario FILE`), tracing on UART0 and exiting through semihosting,
+    /// so that a run in `qemu-system-arm -M lm3s6965evb` is a test.
+    CortexMSim,
 }
 
-/// One row per target: its name and the runtime files its folder gets.
+/// How a target runs its tasks: the platform layer of the runtime.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Platform {
+    /// One POSIX thread per task (`semo_runtime.c`).
+    Threads,
+    /// One loop firing the tasks in the single-appearance schedule's order
+    /// (`semo_static.c` and a board file).
+    Static,
+}
+
+/// One row per target: its name, its platform, whether sensors and the
+/// operator are simulated, and the runtime files its folder gets.
 pub struct TargetInfo {
     pub target: Target,
     pub name: &'static str,
+    pub platform: Platform,
+    /// Sensors, services and the operator come from a scenario: at run time
+    /// (`--scenario FILE`, POSIX) or compiled in (static, `scenario.c`).
+    pub simulated: bool,
     pub runtime: &'static [(&'static str, &'static str)],
 }
 
-const COMMON_RUNTIME: [(&str, &str); 4] = [
-    ("semo_runtime.h", include_str!("runtime/semo_runtime.h")),
-    ("semo_internal.h", include_str!("runtime/semo_internal.h")),
-    ("semo_runtime.c", include_str!("runtime/semo_runtime.c")),
-    ("semo_udp.c", include_str!("runtime/semo_udp.c")),
-];
+const API: (&str, &str) = ("semo_runtime.h", include_str!("runtime/semo_runtime.h"));
+const INTERNAL: (&str, &str) = ("semo_internal.h", include_str!("runtime/semo_internal.h"));
+const CORE: (&str, &str) = ("semo_core.c", include_str!("runtime/semo_core.c"));
+const POSIX: (&str, &str) = ("semo_runtime.c", include_str!("runtime/semo_runtime.c"));
+const UDP: (&str, &str) = ("semo_udp.c", include_str!("runtime/semo_udp.c"));
+const POSIX_SIM: (&str, &str) = ("semo_sim.c", include_str!("runtime/semo_sim.c"));
+const STATIC: (&str, &str) = ("semo_static.c", include_str!("runtime/semo_static.c"));
+const LM3S6965: (&str, &str) = ("semo_lm3s6965.c", include_str!("runtime/semo_lm3s6965.c"));
+const LM3S6965_LD: (&str, &str) = ("lm3s6965.ld", include_str!("runtime/lm3s6965.ld"));
 
 pub const TARGETS: &[TargetInfo] = &[
     TargetInfo {
         target: Target::Linux,
         name: "linux",
-        runtime: &COMMON_RUNTIME,
+        platform: Platform::Threads,
+        simulated: false,
+        runtime: &[API, INTERNAL, CORE, POSIX, UDP],
     },
     TargetInfo {
         target: Target::LinuxSim,
         name: "linux-sim",
-        runtime: &[
-            COMMON_RUNTIME[0],
-            COMMON_RUNTIME[1],
-            COMMON_RUNTIME[2],
-            COMMON_RUNTIME[3],
-            ("semo_sim.c", include_str!("runtime/semo_sim.c")),
-        ],
+        platform: Platform::Threads,
+        simulated: true,
+        runtime: &[API, INTERNAL, CORE, POSIX, UDP, POSIX_SIM],
+    },
+    TargetInfo {
+        target: Target::CortexM,
+        name: "cortex-m",
+        platform: Platform::Static,
+        simulated: false,
+        runtime: &[API, INTERNAL, CORE, STATIC, LM3S6965, LM3S6965_LD],
+    },
+    TargetInfo {
+        target: Target::CortexMSim,
+        name: "cortex-m-sim",
+        platform: Platform::Static,
+        simulated: true,
+        runtime: &[API, INTERNAL, CORE, STATIC, LM3S6965, LM3S6965_LD],
     },
 ];
 
@@ -77,6 +121,45 @@ impl Target {
     pub fn from_name(name: &str) -> Option<Target> {
         TARGETS.iter().find(|t| t.name == name).map(|t| t.target)
     }
+
+    pub fn platform(self) -> Platform {
+        self.info().platform
+    }
+
+    pub fn simulated(self) -> bool {
+        self.info().simulated
+    }
+
+    /// The scenario is compiled into the program (`semo build --scenario`).
+    pub fn needs_scenario(self) -> bool {
+        self.simulated() && self.platform() == Platform::Static
+    }
+}
+
+/// The world of one robot from a scenario, compiled into a static-schedule
+/// simulation (`scenario.c`). The simulator's scenario reader (`sim`) makes
+/// it from a scenario file.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct CompiledScenario {
+    /// Mission ms the run lasts; `None`: until the robot stops itself.
+    pub duration_ms: Option<i64>,
+    /// (at, value name, value), in file order.
+    pub sensors: Vec<(i64, String, String)>,
+    /// (service, ms).
+    pub services: Vec<(String, i64)>,
+    /// The operator's commands to this robot or its team.
+    pub operator: Vec<OperatorCommand>,
+}
+
+/// `key` (`USER.<value>`) = `value`, first at `first`, then every `every`
+/// ms while at most `until`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct OperatorCommand {
+    pub key: String,
+    pub value: String,
+    pub first: i64,
+    pub every: Option<i64>,
+    pub until: i64,
 }
 
 /// Who owns a generated file.
@@ -128,12 +211,14 @@ pub enum Emit {
 }
 
 /// The files of one robot's folder. `sources` names the input files for the
-/// header of every generated file.
+/// header of every generated file; `scenario` is the world compiled into a
+/// target that [`Target::needs_scenario`] (ignored by the others).
 pub fn generate(
     program: &RobotProgram,
     target: Target,
     emit: Emit,
     sources: &[String],
+    scenario: Option<&CompiledScenario>,
 ) -> RobotOutput {
     let header = header(program, target, sources);
     let mut files = Vec::new();
@@ -173,10 +258,14 @@ pub fn generate(
         files::program_h(program, &header),
         Owner::Generated,
     );
-    push("main.c", files::main_c(program, &header), Owner::Generated);
+    push(
+        "main.c",
+        files::main_c(program, target, &header),
+        Owner::Generated,
+    );
     push(
         "channels.c",
-        files::channels_c(program, &header),
+        files::channels_c(program, target, &header),
         Owner::Generated,
     );
     push(
@@ -191,12 +280,12 @@ pub fn generate(
     if comm {
         push(
             "comm_task.c",
-            files::comm_task_c(program, &header),
+            files::comm_task_c(program, target, &header),
             Owner::Generated,
         );
         sources_c.push("comm_task.c".into());
     }
-    if let Some((name, text)) = files::library_c(program, &header) {
+    if let Some((name, text)) = files::library_c(program, target, &header) {
         push(&name, text, Owner::Generated);
         sources_c.push(name);
     }
@@ -204,13 +293,22 @@ pub fn generate(
     for role in &program.tasks {
         if let Some(text) = files::task_c(program, role, target, &header) {
             let path = format!("tasks/{}.c", role.task);
-            let owner = match target {
-                Target::Linux => Owner::User,
-                Target::LinuxSim => Owner::Generated,
+            let owner = if target.simulated() {
+                Owner::Generated
+            } else {
+                Owner::User
             };
             push(&path, text, owner);
             tasks.push(path);
         }
+    }
+    if let (true, Some(world)) = (target.needs_scenario(), scenario) {
+        push(
+            "scenario.c",
+            files::scenario_c(world, &header),
+            Owner::Generated,
+        );
+        sources_c.push("scenario.c".into());
     }
     for (name, text) in target.info().runtime {
         push(name, text.to_string(), Owner::Generated);
@@ -218,13 +316,35 @@ pub fn generate(
             sources_c.push(name.to_string());
         }
     }
-    let makefile = files::makefile(program, target, &sources_c, &tasks, &header);
-    push("Makefile", makefile, Owner::Generated);
+    let sizes = files::StaticSizes::of(program, longest_value(&files, scenario));
+    let makefile = files::makefile(program, target, &sources_c, &tasks, &header, &sizes);
+    files.push(GeneratedFile {
+        path: "Makefile".to_string(),
+        text: makefile,
+        owner: Owner::Generated,
+    });
     RobotOutput {
         team: program.team.clone(),
         robot: program.robot.clone(),
         files,
     }
+}
+
+/// Bytes of the longest value the program holds that is known at build
+/// time: the literals of the generated code (`SEMO_LIT("...")`, measured as
+/// written, escapes included, so never short) and the scenario's values.
+fn longest_value(files: &[GeneratedFile], scenario: Option<&CompiledScenario>) -> usize {
+    let literals = files
+        .iter()
+        .flat_map(|f| f.text.split("SEMO_LIT(\"").skip(1))
+        .map(|rest| rest.find("\")").unwrap_or(rest.len()));
+    let world = scenario.into_iter().flat_map(|w| {
+        w.sensors
+            .iter()
+            .map(|(_, _, is)| is.len())
+            .chain(w.operator.iter().map(|c| c.value.len()))
+    });
+    literals.chain(world).max().unwrap_or(0)
 }
 
 /// The comment every generated C file starts with.
@@ -278,14 +398,49 @@ pub struct BuildInput<'a> {
 /// mission, the catalog or the strategies) refuses generation, as do problems
 /// found while refining.
 pub fn build(build: &BuildInput<'_>, target: Target, emit: Emit) -> BuildResult {
+    build_refined(build, refine_checked(build), target, emit, &[])
+}
+
+/// Generates the code of refined programs (from [`refine_checked`]) for
+/// `target`, refusing what the target cannot run ([`target::check`]).
+/// `scenarios` holds one compiled world per program, in order, for a target
+/// that [`Target::needs_scenario`].
+pub fn build_refined(
+    build: &BuildInput<'_>,
+    refined: Refined,
+    target: Target,
+    emit: Emit,
+    scenarios: &[CompiledScenario],
+) -> BuildResult {
     let Refined {
         programs,
-        diagnostics,
+        mut diagnostics,
         sources,
-    } = refine_checked(build);
+    } = refined;
+    if programs.is_empty() {
+        return BuildResult {
+            robots: Vec::new(),
+            diagnostics,
+        };
+    }
+    diagnostics.extend(target::check(
+        build,
+        &programs,
+        target,
+        emit,
+        scenarios.len() == programs.len(),
+    ));
+    crate::diag::sort_and_dedup(&mut diagnostics);
+    if diagnostics.iter().any(crate::diag::Diagnostic::is_error) {
+        return BuildResult {
+            robots: Vec::new(),
+            diagnostics,
+        };
+    }
     let robots = programs
         .iter()
-        .map(|p| generate(p, target, emit, &sources))
+        .enumerate()
+        .map(|(i, p)| generate(p, target, emit, &sources, scenarios.get(i)))
         .collect();
     BuildResult {
         robots,

@@ -103,10 +103,17 @@ impl Loader {
                 loader.check(read);
             }
         }
+        // Each mission's dataflow warnings too: the editor shows them after
+        // the keystroke's diagnostics; here there is no hurry.
         let mut diagnostics: Vec<Diagnostic> = loader
             .checked
             .iter()
-            .flat_map(|&id| analysis.diagnostics(id))
+            .flat_map(|&id| {
+                let dataflow = analysis.dataflow(id);
+                let mut found = analysis.diagnostics(id);
+                found.extend(dataflow.iter().flat_map(|d| d.diagnostics.iter().cloned()));
+                found
+            })
             .collect();
         diag::sort_and_dedup(&mut diagnostics);
         CheckRun {

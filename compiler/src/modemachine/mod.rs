@@ -21,6 +21,8 @@ pub struct ModeMachine {
     pub modes: Vec<Name>,
     /// The index in `modes` of the mode the team starts in.
     pub default: Option<usize>,
+    /// The modes the checker found can never be entered (W002).
+    pub unreachable: Vec<usize>,
     /// The mode changes, one per (from, to) pair, with the events that make
     /// it in the order they are written.
     pub changes: Vec<ModeChange>,
@@ -31,6 +33,16 @@ pub struct ModeChange {
     pub from: usize,
     pub to: usize,
     pub events: Vec<Name>,
+    /// The events of `events` that no service of the `from` mode throws, as
+    /// the checker found (W009): those catches never fire.
+    pub never_thrown: Vec<Name>,
+}
+
+impl ModeChange {
+    /// Whether no event of this change is ever thrown in its `from` mode.
+    pub fn is_dead(&self) -> bool {
+        self.events.iter().all(|e| self.never_thrown.contains(e))
+    }
 }
 
 /// The mode machine of each team of `mission` that has modes, in the order
@@ -50,17 +62,23 @@ pub fn machines(mission: &Mission) -> Vec<ModeMachine> {
                     continue;
                 }
                 let (from, to) = (t.from as usize, t.to as usize);
-                match changes.iter_mut().find(|c| c.from == from && c.to == to) {
-                    Some(change) => {
-                        if !change.events.contains(&t.event) {
-                            change.events.push(t.event.clone());
-                        }
+                let change = match changes.iter().position(|c| c.from == from && c.to == to) {
+                    Some(i) => &mut changes[i],
+                    None => {
+                        changes.push(ModeChange {
+                            from,
+                            to,
+                            events: Vec::new(),
+                            never_thrown: Vec::new(),
+                        });
+                        changes.last_mut().expect("just pushed")
                     }
-                    None => changes.push(ModeChange {
-                        from,
-                        to,
-                        events: vec![t.event.clone()],
-                    }),
+                };
+                if !change.events.contains(&t.event) {
+                    change.events.push(t.event.clone());
+                }
+                if t.never_thrown && !change.never_thrown.contains(&t.event) {
+                    change.never_thrown.push(t.event.clone());
                 }
             }
             ModeMachine {
@@ -69,6 +87,12 @@ pub fn machines(mission: &Mission) -> Vec<ModeMachine> {
                     .and_then(|m| m.default)
                     .filter(|&d| valid(d))
                     .map(|d| d as usize),
+                unreachable: main
+                    .iter()
+                    .flat_map(|m| &m.unreachable)
+                    .filter(|&&i| valid(i))
+                    .map(|&i| i as usize)
+                    .collect(),
                 modes,
                 changes,
             }

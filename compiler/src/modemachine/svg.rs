@@ -91,10 +91,10 @@ fn panel(machine: &ModeMachine) -> (f64, f64, String) {
         layer_x.push(x);
         x += w + g;
     }
-    let width = (x - gap.last().copied().unwrap_or(0.0) + MARGIN)
+    let mut width = (x - gap.last().copied().unwrap_or(0.0) + MARGIN)
         .max(text_width(&format!("{} modes", machine.team), FONT) + 2.0 * MARGIN);
     let tallest = layers.layers.iter().map(Vec::len).max().unwrap_or(0) as f64;
-    let height = HEAD + tallest * SLOT + MARGIN;
+    let mut height = HEAD + tallest * SLOT + MARGIN;
     let mut centre = vec![P { x: 0.0, y: 0.0 }; total];
     for (r, members) in layers.layers.iter().enumerate() {
         let top = HEAD + (tallest - members.len() as f64) * SLOT / 2.0;
@@ -106,6 +106,22 @@ fn panel(machine: &ModeMachine) -> (f64, f64, String) {
         }
     }
 
+    let routes = routes(machine, &layers.chains, &centre, &width_of);
+    // Labels go where they cover no box and no other label.
+    let mut taken: Vec<Rect> = (0..n)
+        .map(|v| Rect::around(centre[v], width_of(v), BOX_H).grow(2.0))
+        .collect();
+    let mut labels = Vec::with_capacity(routes.len());
+    for (change, route) in machine.changes.iter().zip(&routes) {
+        let label = label_of(&change.events);
+        let w = text_width(&label, LABEL_FONT) + 6.0;
+        let spot = place_label(&route.label_spots, w, &taken);
+        taken.push(spot.grow(1.0));
+        width = width.max(spot.x1 + MARGIN);
+        height = height.max(spot.y1 + MARGIN);
+        labels.push((label, spot));
+    }
+
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -114,50 +130,64 @@ fn panel(machine: &ModeMachine) -> (f64, f64, String) {
         num(FONT),
         escape(&machine.team)
     );
-    for (change, chain) in machine.changes.iter().zip(&layers.chains) {
-        let label = label_of(&change.events);
+    for ((change, route), (label, spot)) in machine.changes.iter().zip(&routes).zip(&labels) {
+        let dead = change.is_dead();
         let _ = write!(
             out,
-            "<g class=\"change\" data-from=\"{}\" data-to=\"{}\">",
+            "<g class=\"change{}\" data-from=\"{}\" data-to=\"{}\">",
+            if dead { " dead" } else { "" },
             escape(&machine.modes[change.from]),
             escape(&machine.modes[change.to])
         );
-        match chain {
-            None => self_loop(&mut out, centre[change.from], &label),
-            Some(chain) => {
-                let mut points: Vec<P> = chain.nodes.iter().map(|&v| centre[v]).collect();
-                if chain.reversed {
-                    points.reverse();
-                }
-                let mut ends = chain.nodes.clone();
-                if chain.reversed {
-                    ends.reverse();
-                }
-                let widths: Vec<f64> = ends.iter().map(|&v| width_of(v)).collect();
-                arrow(&mut out, &points, &widths, chain.reversed, &label);
-            }
+        if !change.never_thrown.is_empty() {
+            let _ = write!(
+                out,
+                "<title>never fires on {}: no service of {} throws it</title>",
+                escape(&label_of(&change.never_thrown)),
+                escape(&machine.modes[change.from])
+            );
         }
+        let (stroke, dash) = if dead {
+            ("#999", " stroke-dasharray=\"5 4\"")
+        } else {
+            ("#333", "")
+        };
+        let _ = write!(
+            out,
+            "<path d=\"{}\" fill=\"none\" stroke=\"{stroke}\" stroke-width=\"1.2\"{dash} marker-end=\"url(#semo-mode-arrow)\"/>",
+            route.path
+        );
+        write_label(&mut out, *spot, label, dead);
         out.push_str("</g>\n");
     }
     for (v, name) in machine.modes.iter().enumerate() {
         let c = centre[v];
         let w = width_of(v);
         let is_default = machine.default == Some(v);
+        let unreachable = machine.unreachable.contains(&v);
         let _ = write!(
             out,
-            "<g class=\"mode{}\" data-mode=\"{}\"><title>{}{}</title>",
+            "<g class=\"mode{}{}\" data-mode=\"{}\"><title>{}{}</title>",
             if is_default { " default" } else { "" },
+            if unreachable { " unreachable" } else { "" },
             escape(name),
             escape(name),
             if is_default {
                 " (default: the team starts here)"
+            } else if unreachable {
+                " (unreachable: no catch leads here from the default mode)"
             } else {
                 ""
             }
         );
+        let (fill, stroke, dash, ink) = if unreachable {
+            ("#f2f2f2", "#888", " stroke-dasharray=\"5 4\"", "#777")
+        } else {
+            ("#e8f0fe", "#1a4d8f", "", "#111")
+        };
         let _ = write!(
             out,
-            "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" rx=\"12\" fill=\"#e8f0fe\" stroke=\"#1a4d8f\" stroke-width=\"{}\"/>",
+            "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" rx=\"12\" fill=\"{fill}\" stroke=\"{stroke}\" stroke-width=\"{}\"{dash}/>",
             num(c.x - w / 2.0),
             num(c.y - BOX_H / 2.0),
             num(w),
@@ -166,7 +196,7 @@ fn panel(machine: &ModeMachine) -> (f64, f64, String) {
         );
         let _ = write!(
             out,
-            "<text x=\"{}\" y=\"{}\" font-size=\"{}\" text-anchor=\"middle\" fill=\"#111\"{}>{}</text>",
+            "<text x=\"{}\" y=\"{}\" font-size=\"{}\" text-anchor=\"middle\" fill=\"{ink}\"{}>{}</text>",
             num(c.x),
             num(c.y + FONT * 0.35),
             num(FONT),
@@ -195,91 +225,219 @@ fn panel(machine: &ModeMachine) -> (f64, f64, String) {
     (width, height, out)
 }
 
-/// A change between different modes along `points` (tail first); `widths`
-/// are the widths of the boxes at those points, so that the arrow starts and
-/// ends at the boxes' sides.
-fn arrow(out: &mut String, points: &[P], widths: &[f64], bowed: bool, label: &str) {
-    let (Some(first), Some(last)) = (points.first(), points.last()) else {
-        return;
-    };
-    if points.len() < 2 || widths.len() != points.len() {
-        return;
-    }
-    let mut pts = points.to_vec();
-    let dir = if last.x >= first.x { 1.0 } else { -1.0 };
-    let k = pts.len() - 1;
-    pts[0].x += dir * widths[0] / 2.0;
-    pts[k].x -= dir * widths[k] / 2.0;
-    let bow = if bowed { BOW } else { 0.0 };
-    if bowed {
-        // Leave and enter the boxes lower, clear of the forward arrow.
-        pts[0].y += 7.0;
-        pts[k].y += 7.0;
-    }
-    let mut d = format!("M{} {}", num(pts[0].x), num(pts[0].y));
-    for pair in pts.windows(2) {
-        let (a, b) = (pair[0], pair[1]);
-        let _ = write!(
-            d,
-            " Q{} {} {} {}",
-            num((a.x + b.x) / 2.0),
-            num((a.y + b.y) / 2.0 + 2.0 * bow),
-            num(b.x),
-            num(b.y)
-        );
-    }
-    let _ = write!(
-        out,
-        "<path d=\"{d}\" fill=\"none\" stroke=\"#333\" stroke-width=\"1.2\" marker-end=\"url(#semo-mode-arrow)\"/>"
-    );
-    // The label on the first segment's midpoint (on the bow's apex).
-    let (a, b) = (pts[0], pts[1]);
-    let at = P {
-        x: (a.x + b.x) / 2.0,
-        y: (a.y + b.y) / 2.0 + bow,
-    };
-    write_label(out, at, label, bowed);
+/// An axis-aligned box: `(x0, y0)` top left, `(x1, y1)` bottom right.
+#[derive(Clone, Copy, Debug)]
+struct Rect {
+    x0: f64,
+    y0: f64,
+    x1: f64,
+    y1: f64,
 }
 
-fn self_loop(out: &mut String, c: P, label: &str) {
+impl Rect {
+    fn around(c: P, w: f64, h: f64) -> Rect {
+        Rect {
+            x0: c.x - w / 2.0,
+            y0: c.y - h / 2.0,
+            x1: c.x + w / 2.0,
+            y1: c.y + h / 2.0,
+        }
+    }
+
+    fn grow(self, by: f64) -> Rect {
+        Rect {
+            x0: self.x0 - by,
+            y0: self.y0 - by,
+            x1: self.x1 + by,
+            y1: self.y1 + by,
+        }
+    }
+
+    fn shifted(self, dy: f64) -> Rect {
+        Rect {
+            y0: self.y0 + dy,
+            y1: self.y1 + dy,
+            ..self
+        }
+    }
+
+    fn overlaps(&self, other: &Rect) -> bool {
+        self.x0 < other.x1 && other.x0 < self.x1 && self.y0 < other.y1 && other.y0 < self.y1
+    }
+}
+
+/// A change drawn: its path, and the points along it where its label may
+/// sit, best first.
+struct Route {
+    path: String,
+    label_spots: Vec<P>,
+}
+
+/// Where each arrow leaves and enters its boxes. The arrows at one side of
+/// a box get ports of their own, spread over the side in the order of where
+/// they come from, so arrowheads never stack and arrows do not cross at the
+/// box.
+fn routes(
+    machine: &ModeMachine,
+    chains: &[Option<layered::Chain>],
+    centre: &[P],
+    width_of: &dyn Fn(usize) -> f64,
+) -> Vec<Route> {
+    // Each chain's points, tail first, and whether it runs against the flow.
+    let lines: Vec<Option<(Vec<usize>, bool)>> = chains
+        .iter()
+        .map(|chain| {
+            chain.as_ref().map(|chain| {
+                let mut nodes = chain.nodes.clone();
+                if chain.reversed {
+                    nodes.reverse();
+                }
+                (nodes, chain.reversed)
+            })
+        })
+        .collect();
+    // Ports per (box, side): (order key, change, is the tail).
+    let mut ports: Vec<((usize, bool), f64, usize, bool)> = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        let Some((nodes, bowed)) = line else { continue };
+        let k = nodes.len() - 1;
+        let rightward = centre[nodes[k]].x >= centre[nodes[0]].x;
+        let lower = if *bowed { 2.0 * BOW } else { 0.0 };
+        ports.push(((nodes[0], rightward), centre[nodes[1]].y + lower, i, true));
+        ports.push((
+            (nodes[k], !rightward),
+            centre[nodes[k - 1]].y + lower,
+            i,
+            false,
+        ));
+    }
+    ports.sort_by(|a, b| {
+        (a.0.cmp(&b.0))
+            .then(a.1.total_cmp(&b.1))
+            .then(a.2.cmp(&b.2))
+            .then(a.3.cmp(&b.3))
+    });
+    let mut offset = vec![(0.0, 0.0); lines.len()];
+    for group in ports.chunk_by(|a, b| a.0 == b.0) {
+        let room = BOX_H - 10.0;
+        for (j, &(_, _, change, tail)) in group.iter().enumerate() {
+            let dy = room * ((j as f64 + 0.5) / group.len() as f64 - 0.5);
+            if tail {
+                offset[change].0 = dy;
+            } else {
+                offset[change].1 = dy;
+            }
+        }
+    }
+
+    let mut out = Vec::with_capacity(lines.len());
+    for (i, (change, line)) in machine.changes.iter().zip(&lines).enumerate() {
+        let Some((nodes, bowed)) = line else {
+            out.push(self_loop(centre[change.from]));
+            continue;
+        };
+        let mut pts: Vec<P> = nodes.iter().map(|&v| centre[v]).collect();
+        let k = pts.len() - 1;
+        let dir = if pts[k].x >= pts[0].x { 1.0 } else { -1.0 };
+        pts[0].x += dir * width_of(nodes[0]) / 2.0;
+        pts[0].y += offset[i].0;
+        pts[k].x -= dir * width_of(nodes[k]) / 2.0;
+        pts[k].y += offset[i].1;
+        let bow = if *bowed { BOW } else { 0.0 };
+        let mut d = format!("M{} {}", num(pts[0].x), num(pts[0].y));
+        let mut spots = Vec::new();
+        for pair in pts.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            let c = P {
+                x: (a.x + b.x) / 2.0,
+                y: (a.y + b.y) / 2.0 + 2.0 * bow,
+            };
+            let _ = write!(d, " Q{} {} {} {}", num(c.x), num(c.y), num(b.x), num(b.y));
+            for t in [0.5, 0.35, 0.65, 0.2, 0.8] {
+                let u = 1.0 - t;
+                spots.push(P {
+                    x: u * u * a.x + 2.0 * u * t * c.x + t * t * b.x,
+                    y: u * u * a.y + 2.0 * u * t * c.y + t * t * b.y,
+                });
+            }
+        }
+        out.push(Route {
+            path: d,
+            label_spots: spots,
+        });
+    }
+    out
+}
+
+/// A change from a mode to itself: a loop above its box.
+fn self_loop(c: P) -> Route {
     let top = c.y - BOX_H / 2.0;
-    let _ = write!(
-        out,
-        "<path d=\"M{} {} C{} {} {} {} {} {}\" fill=\"none\" stroke=\"#333\" stroke-width=\"1.2\" marker-end=\"url(#semo-mode-arrow)\"/>",
-        num(c.x - 10.0),
-        num(top),
-        num(c.x - 30.0),
-        num(top - 32.0),
-        num(c.x + 30.0),
-        num(top - 32.0),
-        num(c.x + 10.0),
-        num(top)
-    );
-    write_label(
-        out,
-        P {
+    Route {
+        path: format!(
+            "M{} {} C{} {} {} {} {} {}",
+            num(c.x - 10.0),
+            num(top),
+            num(c.x - 30.0),
+            num(top - 32.0),
+            num(c.x + 30.0),
+            num(top - 32.0),
+            num(c.x + 10.0),
+            num(top)
+        ),
+        label_spots: vec![P {
             x: c.x,
-            y: top - 30.0,
-        },
-        label,
-        false,
-    );
+            y: top - 26.0,
+        }],
+    }
 }
 
-/// An event label centred on `at`, on a white ground so that it stays
-/// readable over other arrows; below the point when `below`.
-fn write_label(out: &mut String, at: P, label: &str, below: bool) {
-    let w = text_width(label, LABEL_FONT) + 6.0;
-    let y = if below { at.y + 8.0 } else { at.y - 4.0 };
+/// The label box of width `w` nearest the best spot that covers nothing in
+/// `taken` and stays below the panel's title: just above or below a spot on
+/// the arrow if one is free, else the first spot moved up or down.
+fn place_label(spots: &[P], w: f64, taken: &[Rect]) -> Rect {
+    const H: f64 = 13.0;
+    let free = |r: &Rect| r.y0 >= 28.0 && r.x0 >= 2.0 && !taken.iter().any(|t| t.overlaps(r));
+    let box_at = |p: P, dy: f64| Rect {
+        x0: p.x - w / 2.0,
+        y0: p.y + dy,
+        x1: p.x + w / 2.0,
+        y1: p.y + dy + H,
+    };
+    for &p in spots {
+        for dy in [-H - 1.0, 2.0] {
+            let r = box_at(p, dy);
+            if free(&r) {
+                return r;
+            }
+        }
+    }
+    let first = box_at(
+        spots.first().copied().unwrap_or(P { x: w, y: 40.0 }),
+        -H - 1.0,
+    );
+    (1..)
+        .map(|step| {
+            let reach = (step / 2 + 1) as f64 * (H + 2.0);
+            first.shifted(if step % 2 == 1 { reach } else { -reach })
+        })
+        .find(free)
+        .expect("a free place below everything exists")
+}
+
+/// An event label in `spot`, on a white ground so that it stays readable
+/// over other arrows; greyed for a change that never fires.
+fn write_label(out: &mut String, spot: Rect, label: &str, dead: bool) {
     let _ = write!(
         out,
-        "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"13\" fill=\"#fff\" fill-opacity=\"0.85\"/><text x=\"{}\" y=\"{}\" font-size=\"{}\" text-anchor=\"middle\" fill=\"#7a2e00\">{}</text>",
-        num(at.x - w / 2.0),
-        num(y - 10.0),
-        num(w),
-        num(at.x),
-        num(y),
+        "<rect class=\"label\" x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"#fff\" fill-opacity=\"0.85\"/><text x=\"{}\" y=\"{}\" font-size=\"{}\" text-anchor=\"middle\" fill=\"{}\">{}</text>",
+        num(spot.x0),
+        num(spot.y0),
+        num(spot.x1 - spot.x0),
+        num(spot.y1 - spot.y0),
+        num((spot.x0 + spot.x1) / 2.0),
+        num(spot.y0 + 10.0),
         num(LABEL_FONT),
+        if dead { "#999" } else { "#7a2e00" },
         escape(label)
     );
 }

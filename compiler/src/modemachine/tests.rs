@@ -75,7 +75,7 @@ fn the_picture_shows_modes_events_the_default_and_a_self_loop() {
     assert_eq!(svg.matches("class=\"initial\"").count(), 1);
     assert!(svg.contains(">CALM, HOLD</text>"));
     assert!(svg.contains("data-from=\"ACTIVE\" data-to=\"ACTIVE\""));
-    assert_eq!(svg.matches("<g class=\"change\"").count(), 5);
+    assert_eq!(svg.matches("<g class=\"change").count(), 5);
 }
 
 #[test]
@@ -108,4 +108,134 @@ fn the_scouting_example_draws_both_teams() {
     let svg = to_svg(&found);
     assert!(svg.contains("data-team=\"MasterTeam\""));
     assert!(svg.contains("data-team=\"SlaveTeam\""));
+}
+
+/// `(x0, y0, x1, y1)` of every element of the picture whose tag starts
+/// with `prefix` (`<rect class="label"`, a mode's `<rect x=`), in panel
+/// coordinates offset by the panel's translation.
+fn boxes(svg: &str, prefix: &str) -> Vec<(f64, f64, f64, f64)> {
+    let attr = |tag: &str, name: &str| -> f64 {
+        let at = tag.find(&format!(" {name}=\"")).expect(name) + name.len() + 3;
+        tag[at..at + tag[at..].find('"').unwrap()].parse().unwrap()
+    };
+    let mut out = Vec::new();
+    for panel in svg.split("<g class=\"team\"").skip(1) {
+        let dy: f64 = panel
+            .split_once("translate(0 ")
+            .and_then(|(_, rest)| rest.split_once(')'))
+            .map(|(y, _)| y.parse().unwrap())
+            .unwrap();
+        for (i, _) in panel.match_indices(prefix) {
+            let tag = &panel[i..i + panel[i..].find("/>").unwrap()];
+            let (x, y) = (attr(tag, "x"), attr(tag, "y") + dy);
+            out.push((x, y, x + attr(tag, "width"), y + attr(tag, "height")));
+        }
+    }
+    out
+}
+
+fn overlap(a: (f64, f64, f64, f64), b: (f64, f64, f64, f64)) -> bool {
+    a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3
+}
+
+/// Every mission of the examples and the diagnostics fixtures.
+fn every_mission() -> Vec<(std::path::PathBuf, String)> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut found = Vec::new();
+    for folder in [
+        "examples",
+        "tests/fixtures/diagnostics",
+        "tests/fixtures/build",
+    ] {
+        for entry in walkdir::WalkDir::new(root.join(folder)).sort_by_file_name() {
+            let entry = entry.unwrap();
+            if entry.path().extension().is_some_and(|e| e == "mission") {
+                let text = std::fs::read_to_string(entry.path()).unwrap();
+                found.push((entry.path().to_path_buf(), text));
+            }
+        }
+    }
+    assert!(found.len() > 20, "{} missions", found.len());
+    found
+}
+
+#[test]
+fn labels_never_cover_each_other_or_a_mode_and_arrowheads_never_stack() {
+    let mut drawn = 0;
+    for (path, text) in every_mission() {
+        let svg = to_svg(&machines_of(&text));
+        let labels = boxes(&svg, "<rect class=\"label\"");
+        let modes = boxes(&svg, "<rect x=");
+        drawn += labels.len();
+        for (i, a) in labels.iter().enumerate() {
+            for b in &labels[i + 1..] {
+                assert!(
+                    !overlap(*a, *b),
+                    "{}: labels {a:?} and {b:?}",
+                    path.display()
+                );
+            }
+            for m in &modes {
+                assert!(
+                    !overlap(*a, *m),
+                    "{}: label {a:?} on mode {m:?}",
+                    path.display()
+                );
+            }
+        }
+        // The arrows' ends (the last point of each change's path).
+        let mut heads: Vec<(f64, f64)> = svg
+            .split("<g class=\"change")
+            .skip(1)
+            .filter_map(|g| {
+                let d = g.split_once(" d=\"")?.1.split_once('"')?.0;
+                let nums: Vec<f64> = d
+                    .split(|c: char| c.is_ascii_alphabetic() || c == ' ')
+                    .filter_map(|n| n.parse().ok())
+                    .collect();
+                Some((nums[nums.len() - 2], nums[nums.len() - 1]))
+            })
+            .collect();
+        heads.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        for pair in heads.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            assert!(
+                (a.0 - b.0).abs() + (a.1 - b.1).abs() > 3.0,
+                "{}: two arrowheads at {a:?} and {b:?}",
+                path.display()
+            );
+        }
+    }
+    assert!(drawn > 30, "only {drawn} labels drawn");
+}
+
+#[test]
+fn unreachable_modes_and_catches_that_never_fire_are_drawn_apart() {
+    let text = "\
+{
+  T: iRobotCreate a
+}
+T.Work.Go{
+  throw DONE
+} repeat()
+T.BUSY{ set(Work, Go) }
+T.IDLE{ set(Work, OFF) }
+T.LOST{ set(Work, OFF) }
+T.main{
+  case (BUSY):
+    catch (DONE): mode = IDLE
+  case (IDLE):
+    catch (DONE): mode = BUSY
+  default: mode = BUSY
+}
+";
+    let found = machines_of(text);
+    assert_eq!(found[0].unreachable, [2], "LOST is never entered");
+    let dead: Vec<bool> = found[0].changes.iter().map(|c| c.is_dead()).collect();
+    assert_eq!(dead, [false, true], "IDLE runs nothing that throws DONE");
+    let svg = to_svg(&found);
+    assert!(svg.contains("<g class=\"mode unreachable\" data-mode=\"LOST\">"));
+    assert!(svg.contains("<g class=\"change dead\" data-from=\"IDLE\" data-to=\"BUSY\">"));
+    assert!(svg.contains("<g class=\"change\" data-from=\"BUSY\" data-to=\"IDLE\">"));
+    assert_eq!(svg.matches("stroke-dasharray").count(), 2);
 }

@@ -6,6 +6,7 @@
 //! sets for that plan → for a built-in call the strategy refines, that
 //! entry's action machine (bottom).
 
+use crate::span::Span;
 use crate::taskgraph::TaskGraph;
 
 /// One robot's refined program.
@@ -100,6 +101,10 @@ pub struct State {
     pub kind: StateKind,
     /// The mission line the state comes from (1-based).
     pub line: u32,
+    /// The mission text it comes from: the statement; for a loop's end and a
+    /// `repeat`, the period when one is written (what the dataflow warnings
+    /// point at).
+    pub span: Span,
     /// The statement as written, for the comment beside the state.
     pub text: String,
 }

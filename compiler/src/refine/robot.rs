@@ -254,14 +254,15 @@ impl Builder<'_, '_> {
         let mut marks = 0;
         if let Some(syntax) = self.input.analysis.service_syntax(info) {
             self.block(&syntax.body, &mut states, &mut marks, 0);
-            let (period_ms, condition, forever, span) = match &syntax.repeat {
+            let (period_ms, condition, forever, span, period_span) = match &syntax.repeat {
                 Some(r) => (
                     r.period.as_ref().and_then(period_ms),
                     r.condition.as_ref().map(|c| self.condition(c)),
                     r.period.is_none() && r.condition.is_none(),
                     r.span,
+                    r.period.as_ref().map_or(r.span, |p| p.span),
                 ),
-                None => (None, None, false, syntax.body.span),
+                None => (None, None, false, syntax.body.span, syntax.body.span),
             };
             let line = self.line(span);
             let text = if syntax.repeat.is_some() {
@@ -276,6 +277,7 @@ impl Builder<'_, '_> {
                     forever,
                 },
                 line,
+                span: period_span,
                 text,
             });
         }
@@ -301,6 +303,7 @@ impl Builder<'_, '_> {
         states.push(State {
             kind,
             line: self.line(span),
+            span,
             text: self.excerpt(span),
         });
         states.len() - 1
@@ -356,6 +359,9 @@ impl Builder<'_, '_> {
                     stmt.span,
                 );
                 states[tail].text = "end of the loop body".into();
+                if let Some(period) = &l.period {
+                    states[tail].span = period.span;
+                }
                 patch(states, head);
             }
             StmtKind::Group(g) => {

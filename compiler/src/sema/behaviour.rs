@@ -233,6 +233,7 @@ impl<'a> Checker<'a> {
                         event_span: catch.event.span,
                         to,
                         span: catch.span,
+                        never_thrown: false,
                     });
                 }
             }
@@ -241,6 +242,7 @@ impl<'a> Checker<'a> {
             span: m.span,
             default,
             transitions,
+            unreachable: Vec::new(),
         });
     }
 
@@ -297,7 +299,8 @@ impl<'a> Checker<'a> {
         };
         let t = self.team(team);
         let mut findings = Vec::new();
-        for tr in &main.transitions {
+        let mut never_thrown = Vec::new();
+        for (i, tr) in main.transitions.iter().enumerate() {
             let mode = &t.modes[tr.from as usize];
             let thrown = mode
                 .sets
@@ -305,6 +308,7 @@ impl<'a> Checker<'a> {
                 .filter_map(|s| s.service)
                 .any(|s| t.services[s as usize].throws.contains(&tr.event));
             if !thrown {
+                never_thrown.push(i);
                 findings.push((
                     tr.event_span,
                     format!(
@@ -312,6 +316,11 @@ impl<'a> Checker<'a> {
                         mode.name, tr.event
                     ),
                 ));
+            }
+        }
+        if let Some(main) = &mut self.team_mut(team).main {
+            for i in never_thrown {
+                main.transitions[i].never_thrown = true;
             }
         }
         for (span, message) in findings {
@@ -344,14 +353,22 @@ impl<'a> Checker<'a> {
             }
         }
         let default_name = t.modes[*start as usize].name.clone();
-        let unreachable: Vec<(crate::span::Span, Name)> = t
-            .modes
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| !reached.contains(&(*i as Index)))
-            .map(|(_, m)| (m.name_span, m.name.clone()))
+        let unreachable: Vec<Index> = (0..t.modes.len() as Index)
+            .filter(|i| !reached.contains(i))
             .collect();
-        for (span, name) in unreachable {
+        let findings: Vec<(crate::span::Span, Name)> = unreachable
+            .iter()
+            .map(|&i| {
+                (
+                    t.modes[i as usize].name_span,
+                    t.modes[i as usize].name.clone(),
+                )
+            })
+            .collect();
+        if let Some(main) = &mut self.team_mut(team).main {
+            main.unreachable = unreachable;
+        }
+        for (span, name) in findings {
             self.report(
                 Code::UnreachableMode,
                 span,

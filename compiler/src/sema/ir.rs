@@ -99,6 +99,10 @@ pub struct Main {
     pub span: Span,
     pub default: Option<Index>,
     pub transitions: Vec<Transition>,
+    /// The modes no catch leads to from the default mode (W002), in order;
+    /// empty when that was not decided (no default, or a catch naming an
+    /// unknown mode).
+    pub unreachable: Vec<Index>,
 }
 
 /// `case (from): catch (event): mode = to`.
@@ -109,6 +113,9 @@ pub struct Transition {
     pub event_span: Span,
     pub to: Index,
     pub span: Span,
+    /// No service that the `from` mode runs throws the event, so the catch
+    /// never fires there (W009).
+    pub never_thrown: bool,
 }
 
 #[derive(Clone, Debug, Default)]

@@ -206,6 +206,32 @@ fn fail<T>(v: &Value, message: impl Into<String>) -> Result<T> {
     })
 }
 
+impl Scenario {
+    /// The world of `program`'s robot, to compile into a static-schedule
+    /// simulation (`semo build --target cortex-m-sim --scenario FILE`): its
+    /// sensors and services, and the operator's commands to it or its team.
+    pub fn compiled_for(&self, program: &RobotProgram) -> crate::codegen::CompiledScenario {
+        let world = self.robots.iter().find(|w| w.robot == program.robot);
+        crate::codegen::CompiledScenario {
+            duration_ms: self.duration_ms,
+            sensors: world.map(|w| w.sensors.clone()).unwrap_or_default(),
+            services: world.map(|w| w.services.clone()).unwrap_or_default(),
+            operator: self
+                .operator
+                .iter()
+                .filter(|c| c.to == program.robot || c.to == program.team)
+                .map(|c| crate::codegen::OperatorCommand {
+                    key: c.key.clone(),
+                    value: c.value.clone(),
+                    first: c.first,
+                    every: c.every,
+                    until: c.until,
+                })
+                .collect(),
+        }
+    }
+}
+
 /// Reads a scenario and checks its names against the mission's programs.
 pub fn parse(text: &str, programs: &[RobotProgram]) -> Result<Scenario> {
     let root = json::parse(text).map_err(|e| ScenarioError {

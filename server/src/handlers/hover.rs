@@ -17,10 +17,19 @@ pub fn hover(snapshot: &Snapshot, position: Position) -> Option<Hover> {
     let offset = lines.offset(position);
     let catalog = snapshot.catalog.catalog();
     let found = semo::ide::hover::hover(mission, catalog, &snapshot.text, offset)?;
+    let mut markdown = found.markdown;
+    // On a team: its robots' iteration periods (refines the mission once
+    // per version; the diagnostics task usually has already).
+    if let Some(periods) = semo::dataflow::team_periods_at(&mission.mission, offset, || {
+        snapshot.host().dataflow(snapshot.id)
+    }) {
+        markdown.push_str("\n\n---\n\n");
+        markdown.push_str(&periods);
+    }
     Some(Hover {
         contents: HoverContents::Markup(MarkupContent {
             kind: MarkupKind::Markdown,
-            value: found.markdown,
+            value: markdown,
         }),
         range: Some(lines.range(found.range)),
     })

@@ -1,11 +1,13 @@
 // The extension in the real VS Code (code-server), driven by headless
-// Chromium: scripts/e2e.sh starts code-server on a copy of
-// test/e2e/workspace and sets SEMO_E2E_URL. One test, in the order a user
-// goes: open the mission, see its error, open the Robots panel, insert a
-// service, run palette commands. Screenshots go to $SEMO_E2E_OUT/shots.
+// Chromium: scripts/e2e.sh installs the platform .vsix (the server inside it)
+// and starts code-server on a copy of test/e2e/workspace with SEMO_E2E_URL
+// set. Two tests, in the order a user goes: open the mission, see its error,
+// open the Robots panel, insert a service, run palette commands; then edit:
+// a quick fix, hover, rename, completion and format on save, served by the
+// bundled server. Screenshots go to $SEMO_E2E_OUT/shots.
 
 import { strict as assert } from 'node:assert';
-import { existsSync, readdirSync } from 'node:fs';
+import { existsSync, readFileSync, readdirSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
 import puppeteer from 'puppeteer-core';
@@ -102,8 +104,14 @@ async function userJourney() {
   await page.waitForSelector('.monaco-editor .squiggly-error', { timeout: 90000 });
   const problems = await page.$eval('[id="status.problems"]', (e) => e.getAttribute('aria-label') ?? e.textContent);
   assert.match(problems, /\b1\b/, `problems status: ${problems}`);
-  // The status bar item says the server is ready.
-  await waitForText('.statusbar-item', /SeMo server is ready|SeMo/);
+  // The extension's status bar item says the server is ready.
+  await page.waitForFunction(
+    () => {
+      const item = document.querySelector('.statusbar-item[id^="semo.semo"]');
+      return item?.querySelector('.codicon-check') && item.textContent.trim() === 'SeMo';
+    },
+    { timeout: 60000, polling: 250 },
+  );
 
   // The Robots panel lists the workspace's robot type and the built-in ones.
   const robots = await page.waitForSelector('.activitybar .action-item a[aria-label^="SeMo Robots"], .activitybar .action-item [aria-label^="SeMo Robots"]');
@@ -202,4 +210,163 @@ async function waitForFrameContent(pattern, timeout) {
     await new Promise((r) => setTimeout(r, 500));
   }
   return false;
+}
+
+test('editing a mission: quick fix, hover, rename, completion, format on save', { timeout: 240000 }, async () => {
+  try {
+    await editingJourney();
+  } catch (e) {
+    await shot('editing-failure').catch(() => {});
+    throw e;
+  }
+});
+
+async function editingJourney() {
+  // The server is the one inside the extension: the settings name none and
+  // code-server's PATH has none (scripts/e2e.sh).
+  const servers = await waitFor(() => {
+    const found = languageServers();
+    return found.length > 0 ? found : undefined;
+  });
+  for (const argv of servers) {
+    assert.match(argv[0], /\/extensions\/semo\.semo-[^/]+\/server\/semo$/, `the server runs as ${argv.join(' ')}`);
+  }
+
+  // scouts.mission as the workspace has it (the first test inserted a call into it).
+  const original = readFileSync(join(import.meta.dirname, 'workspace', 'scouts.mission'), 'utf8');
+  writeFileSync(join(workspace, 'scouts.mission'), original);
+  await openFile('scouts.mission');
+  await runCommand('File: Revert File');
+  await page.waitForFunction(
+    () => !/drive\(distance/.test(document.querySelector('.editor-group-container .monaco-editor .view-lines')?.textContent),
+    { timeout: 30000, polling: 250 },
+  );
+  await waitForText('.monaco-editor .view-lines', /Scouts:\sRovr\sr\[2\]/);
+  await page.waitForSelector('.monaco-editor .squiggly-error', { timeout: 90000 });
+
+  // Quick fix: `Rovr` becomes `Rover`, and the error goes away.
+  // F8 puts the cursor on the file's first problem.
+  await page.click('.editor-group-container .monaco-editor .view-lines');
+  await chord('Control', 'Home');
+  await page.keyboard.press('F8');
+  await waitForText('.marker-widget, .zone-widget', /unknown robot type `Rovr`/);
+  await page.keyboard.press('Escape');
+  await chord('Control', 'Period');
+  const fix = await waitForText('.action-widget .monaco-list-row', /Change `Rovr` to `Rover`/);
+  await shot('quick-fix');
+  await fix.click();
+  await waitForText('.monaco-editor .view-lines', /Scouts:\sRover\sr\[2\]/);
+  await page.waitForFunction(() => !document.querySelector('.monaco-editor .squiggly-error'), {
+    timeout: 60000,
+    polling: 250,
+  });
+
+  // Hover on a robot service shows its documentation from the workspace catalog.
+  await goTo(7, 3); // `  drive(100)`
+  await chord('Control', 'KeyK');
+  await chord('Control', 'KeyI');
+  await waitForText('.monaco-hover', /Drive ahead\./);
+  await shot('hover');
+  await page.keyboard.press('Escape');
+
+  // Rename a mode: its declaration and its use change together.
+  await goTo(10, 8); // `Scouts.SEARCH{ set(Explore, Wander) }`
+  await page.keyboard.press('F2');
+  await page.waitForFunction(() => document.activeElement?.closest('.rename-box'), {
+    timeout: 30000,
+    polling: 100,
+  });
+  await chord('Control', 'KeyA');
+  await page.keyboard.type('ROAM');
+  await page.keyboard.press('Enter');
+  // (One line at a time: the editor keeps its line elements in no fixed order.)
+  await waitForText('.monaco-editor .view-line', /^Scouts\.ROAM\{/);
+  await waitForText('.monaco-editor .view-line', /^\s*default:\smode\s=\sROAM\s*$/);
+
+  // Completion offers the robot's service; accepting it writes the call.
+  await goTo(7, 3);
+  await page.keyboard.press('End');
+  await page.keyboard.press('Enter');
+  await page.keyboard.type('dri');
+  await chord('Control', 'Space');
+  const item = await waitForText('.suggest-widget .monaco-list-row', /drive\(distance: int, speed\?: int\)/);
+  const labels = await page.$$eval('.suggest-widget .monaco-list-row .label-name', (rows) =>
+    rows.map((r) => r.textContent.trim()),
+  );
+  assert.ok(labels.includes('drive'), `completion labels: ${labels.join(', ')}`);
+  await shot('completion');
+  await item.click();
+  await page.keyboard.press('Escape');
+  await waitForText('.monaco-editor .view-line', /^\s*drive\(distance\)\s*$/);
+
+  // Format on save: the canonical layout, in the editor and on disk.
+  await chord('Control', 'KeyS');
+  await waitForText('.monaco-editor .view-lines', /Scouts\.Explore\.Wander\s\{/);
+  const saved = await waitFor(() => {
+    const text = readFileSync(join(workspace, 'scouts.mission'), 'utf8');
+    return text.includes('Scouts.Explore.Wander {') ? text : undefined;
+  });
+  assert.match(saved, /Scouts: Rover r\[2\]/);
+  assert.match(saved, /Scouts\.ROAM \{/);
+  assert.match(saved, /default: mode = ROAM/);
+  assert.match(saved, /drive\(100\)\n\s+drive\(distance/);
+  await shot('formatted');
+}
+
+/** Presses `key` with `modifier` held. */
+async function chord(modifier, key) {
+  await page.keyboard.down(modifier);
+  await page.keyboard.press(key);
+  await page.keyboard.up(modifier);
+}
+
+/** Opens a workspace file from the explorer, in the first editor group. */
+async function openFile(name) {
+  await runCommand('View: Focus First Editor Group');
+  await page.keyboard.down('Control');
+  await page.keyboard.down('Shift');
+  await page.keyboard.press('KeyE');
+  await page.keyboard.up('Shift');
+  await page.keyboard.up('Control');
+  const row = await waitForText('.explorer-folders-view .monaco-list-row', new RegExp(`^\\s*${escapeRe(name)}`));
+  await row.click();
+  await waitForText('.tabs-container .tab.active', new RegExp(escapeRe(name)));
+}
+
+/** Puts the cursor of the active editor at `line`:`column` (Go to Line). */
+async function goTo(line, column) {
+  await chord('Control', 'KeyG');
+  await page.waitForSelector('.quick-input-widget .quick-input-box input', { visible: true });
+  await page.keyboard.type(`${line}:${column}`);
+  await page.keyboard.press('Enter');
+  await waitForText('.statusbar-item', new RegExp(`Ln ${line}, Col ${column}\\b`));
+}
+
+/** Polls `probe` until it returns something, for at most `timeout` ms. */
+async function waitFor(probe, timeout = 30000) {
+  const deadline = Date.now() + timeout;
+  while (Date.now() < deadline) {
+    const value = probe();
+    if (value !== undefined) {
+      return value;
+    }
+    await new Promise((r) => setTimeout(r, 250));
+  }
+  throw new Error(`timed out after ${timeout} ms`);
+}
+
+/** The command lines of the running `semo lsp` processes (from /proc). */
+function languageServers() {
+  const found = [];
+  for (const pid of readdirSync('/proc').filter((p) => /^\d+$/.test(p))) {
+    try {
+      const argv = readFileSync(`/proc/${pid}/cmdline`, 'utf8').split('\0').filter(Boolean);
+      if (argv.length >= 2 && argv[1] === 'lsp' && /(^|\/)semo$/.test(argv[0])) {
+        found.push(argv);
+      }
+    } catch {
+      // The process ended meanwhile.
+    }
+  }
+  return found;
 }

@@ -1,13 +1,30 @@
 /* semo_internal.h: what the runtime's own files share (not for task code).
  *
- * semo_runtime.c owns the clock, the run state and the message queue;
- * semo_sim.c (built with -DSEMO_SIM) reads the scenario and feeds operator
- * commands into that queue.
+ * semo_core.c is the portable core (values, trace lines, numbers); a
+ * platform layer owns the clock, the run state, channels, tasks and the
+ * message queue: semo_runtime.c (POSIX threads) or semo_static.c (one loop,
+ * with a board file such as semo_lm3s6965.c). semo_sim.c (POSIX, built with
+ * -DSEMO_SIM) reads the scenario and feeds operator commands into the queue;
+ * on the static schedule the scenario is compiled in (scenario.c).
  */
 #ifndef SEMO_INTERNAL_H
 #define SEMO_INTERNAL_H
 
 #include "semo_runtime.h"
+
+#include <stdarg.h>
+
+/* Where the bytes of a trace line go (a file, a UART). */
+typedef struct {
+    void (*put)(void *ctx, const char *bytes, size_t n);
+    void *ctx;
+} semo__sink;
+
+/* Writes one trace line (see semo_trace) to `sink`. */
+void semo__trace_line(const semo__sink *sink, int64_t t, const char *robot, const char *event, va_list args);
+/* `n` in decimal into `out` (at least 21 bytes); returns its length. No
+ * printf: newlib-nano's has no `%lld`. */
+size_t semo__format_i64(char *out, int64_t n);
 
 /* Waits until mission time `deadline_ms`; false when the program stopped first. */
 bool semo__wait_until(int64_t deadline_ms);
@@ -21,7 +38,7 @@ void semo__deliver(const semo_message *msg);
 #define SEMO_TIME_SCALE_MIN 1e-6
 #define SEMO_TIME_SCALE_MAX 1e6
 
-#ifdef SEMO_SIM
+#if defined(SEMO_SIM) && !defined(SEMO_STATIC)
 /* Reads the scenario for `program->robot`; on error prints
  * "scenario FILE:LINE:COL: message" and returns -1. */
 int semo__sim_load(const char *path, const semo_program_desc *program);
@@ -32,6 +49,48 @@ bool semo__sim_duration(int64_t *out);
 int semo__sim_start(void);
 void semo__sim_stop(void);
 void semo__sim_free(void);
+#endif
+
+#if defined(SEMO_SIM) && defined(SEMO_STATIC)
+/* The scenario compiled in as tables (the generated scenario.c). */
+typedef struct {
+    int64_t at;
+    const char *value;
+    const char *is;
+} semo__sim_sensor_entry;
+typedef struct {
+    const char *service;
+    int64_t ms;
+} semo__sim_service_entry;
+/* An operator command to this robot: first at `first`, then every `every`
+ * ms (0: once) while <= `until` (-1: forever). */
+typedef struct {
+    int64_t first, every, until;
+    const char *key; /* "USER.<value>" */
+    const char *is;
+} semo__sim_command_entry;
+typedef struct {
+    int64_t duration_ms; /* 0: until the program stops itself */
+    const semo__sim_sensor_entry *sensors;
+    size_t sensor_count;
+    const semo__sim_service_entry *services;
+    size_t service_count;
+    const semo__sim_command_entry *operator_commands;
+    int64_t *operator_next; /* per command: when it is due next, -1 when done */
+    size_t operator_count;
+} semo__sim_tables;
+extern const semo__sim_tables semo__scenario;
+#endif
+
+/* Platform hooks of the static schedule, given by the board file
+ * (semo_lm3s6965.c): a millisecond clock, the trace's output, sleeping
+ * until the next tick and ending the program. */
+#ifdef SEMO_STATIC
+void semo__board_init(void);
+int64_t semo__board_now_ms(void);
+void semo__board_put(void *ctx, const char *bytes, size_t n);
+void semo__board_idle(void);
+void semo__board_exit(int status);
 #endif
 
 #endif /* SEMO_INTERNAL_H */

@@ -1,4 +1,6 @@
-/* semo_runtime.c: the SeMo runtime for POSIX targets (`linux`, `linux-sim`).
+/* semo_runtime.c: the POSIX-threads platform layer of the SeMo runtime
+ * (targets `linux`, `linux-sim`); values and trace lines are the portable
+ * core's (semo_core.c).
  *
  * One thread per task, plus a message receiver, a signal watcher and (in
  * simulation) the operator. Every shared structure has its own mutex; every
@@ -21,10 +23,13 @@
 #include <string.h>
 #include <time.h>
 
-/* Task code is small: a modest stack keeps the program's footprint low. */
-#define TASK_STACK_BYTES (512u * 1024u)
+/* Task code is small: a modest stack keeps the program's footprint low
+ * (`make CFLAGS="-O2 -DSEMO_STACK_BYTES=65536"` for less). */
+#ifndef SEMO_STACK_BYTES
+#define SEMO_STACK_BYTES (512u * 1024u)
+#endif
 #define COMM_QUEUE_CAPACITY 64
-#define RECV_POLL_MS 50
+#define RECV_ERROR_PAUSE_MS 50
 #define DEFAULT_PORT_BASE 47000
 
 /* ------------------------------------------------------------ run state */
@@ -112,131 +117,15 @@ void semo_sleep_ms(int64_t ms)
         semo__wait_until(semo_now_ms() + ms);
 }
 
-/* ----------------------------------------------------------------- values */
-
-void semo_value_set(semo_value *v, const char *text)
-{
-    if (!text)
-        text = "";
-    size_t n = strlen(text);
-    if (n >= SEMO_VALUE_MAX) {
-        n = SEMO_VALUE_MAX - 1;
-        /* Never cut a UTF-8 character in half. */
-        while (n > 0 && ((unsigned char)text[n] & 0xC0) == 0x80)
-            n--;
-    }
-    memmove(v->text, text, n);
-    v->text[n] = '\0';
-}
-
-void semo_value_set_int(semo_value *v, long long n)
-{
-    snprintf(v->text, sizeof v->text, "%lld", n);
-}
-
-/* The whole text as a number: "5" and "-2.5e3" are, "5,5", " 5" and "" are not. */
-static bool parse_number(const char *s, double *out)
-{
-    if (*s == '\0' || *s == ' ' || (*s >= '\t' && *s <= '\r'))
-        return false;
-    char *end;
-    double d = strtod(s, &end);
-    if (*end != '\0' || isnan(d))
-        return false;
-    *out = d;
-    return true;
-}
-
-int semo_value_compare(const semo_value *a, const semo_value *b)
-{
-    double x, y;
-    if (parse_number(a->text, &x) && parse_number(b->text, &y))
-        return (x > y) - (x < y);
-    int c = strcmp(a->text, b->text);
-    return (c > 0) - (c < 0);
-}
-
-bool semo_value_numeric(const semo_value *v)
-{
-    double x;
-    return parse_number(v->text, &x);
-}
-
-bool semo_value_truthy(const semo_value *v)
-{
-    double x;
-    if (strcmp(v->text, "true") == 0)
-        return true;
-    return parse_number(v->text, &x) && x != 0;
-}
-
 /* ----------------------------------------------------------------- traces */
 
 static FILE *g_trace;
 static bool g_trace_owned; /* false for "-" (stdout) */
 static pthread_mutex_t g_trace_lock = PTHREAD_MUTEX_INITIALIZER;
 
-/* Length of the valid UTF-8 sequence at `s`, or 0 (overlong, surrogate,
- * beyond U+10FFFF, truncated). */
-static size_t utf8_sequence(const unsigned char *s)
+static void put_file(void *file, const char *bytes, size_t n)
 {
-    unsigned c = s[0];
-    size_t n;
-    unsigned min, cp;
-    if (c >= 0xC2 && c <= 0xDF) {
-        n = 2, min = 0x80, cp = c & 0x1F;
-    } else if (c >= 0xE0 && c <= 0xEF) {
-        n = 3, min = 0x800, cp = c & 0x0F;
-    } else if (c >= 0xF0 && c <= 0xF4) {
-        n = 4, min = 0x10000, cp = c & 0x07;
-    } else {
-        return 0;
-    }
-    for (size_t i = 1; i < n; i++) {
-        if ((s[i] & 0xC0) != 0x80)
-            return 0;
-        cp = (cp << 6) | (s[i] & 0x3F);
-    }
-    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
-        return 0;
-    return n;
-}
-
-/* A JSON string: control characters escaped, invalid UTF-8 as U+FFFD so
- * that every line parses. */
-static void write_json_string(FILE *f, const char *text)
-{
-    const unsigned char *s = (const unsigned char *)(text ? text : "");
-    fputc('"', f);
-    while (*s) {
-        unsigned c = *s;
-        if (c == '"' || c == '\\') {
-            fputc('\\', f);
-            fputc((int)c, f);
-            s++;
-        } else if (c < 0x20) {
-            switch (c) {
-            case '\n': fputs("\\n", f); break;
-            case '\r': fputs("\\r", f); break;
-            case '\t': fputs("\\t", f); break;
-            default: fprintf(f, "\\u%04x", c); break;
-            }
-            s++;
-        } else if (c < 0x80) {
-            fputc((int)c, f);
-            s++;
-        } else {
-            size_t n = utf8_sequence(s);
-            if (n == 0) {
-                fputs("\\ufffd", f);
-                s++;
-            } else {
-                fwrite(s, 1, n, f);
-                s += n;
-            }
-        }
-    }
-    fputc('"', f);
+    fwrite(bytes, 1, n, (FILE *)file);
 }
 
 void semo_trace(const char *event, ...)
@@ -244,27 +133,11 @@ void semo_trace(const char *event, ...)
     pthread_mutex_lock(&g_trace_lock);
     if (g_trace) {
         /* The time is read under the lock so that lines are in time order. */
-        fprintf(g_trace, "{\"t\":%lld,\"robot\":", (long long)semo_now_ms());
-        write_json_string(g_trace, g_prog ? g_prog->robot : "");
-        fputs(",\"event\":", g_trace);
-        write_json_string(g_trace, event);
+        semo__sink sink = {put_file, g_trace};
         va_list args;
         va_start(args, event);
-        const char *key;
-        while ((key = va_arg(args, const char *)) != NULL) {
-            const char *value = va_arg(args, const char *);
-            fputc(',', g_trace);
-            write_json_string(g_trace, key);
-            fputc(':', g_trace);
-            if (!value) {
-                /* An odd list: the NULL meant as the end came as a value. */
-                fputs("null", g_trace);
-                break;
-            }
-            write_json_string(g_trace, value);
-        }
+        semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args);
         va_end(args);
-        fputs("}\n", g_trace);
         fflush(g_trace);
     }
     pthread_mutex_unlock(&g_trace_lock);
@@ -549,6 +422,19 @@ bool UFControl_WaitIdle(const char *name, int64_t timeout_ms)
     return idle;
 }
 
+bool UFControl_WaitStop(const char *name, int64_t until_ms)
+{
+    task *t = find_task(name);
+    if (!t)
+        return !semo_running();
+    pthread_mutex_lock(&t->lock);
+    while (!t->stop_requested && semo_running() && semo_now_ms() < until_ms)
+        wait_until(&t->changed, &t->lock, until_ms);
+    bool stop = t->stop_requested || !semo_running();
+    pthread_mutex_unlock(&t->lock);
+    return stop;
+}
+
 bool UFControl_StopRequested(const char *name)
 {
     task *t = find_task(name);
@@ -790,11 +676,12 @@ static void *receiver_thread(void *arg)
     (void)arg;
     unsigned char buf[DATAGRAM_MAX + 1]; /* one spare byte detects oversized datagrams */
     while (semo_running()) {
-        int n = g_transport->recv(buf, sizeof buf, RECV_POLL_MS);
+        /* No timeout: semo_stop_program interrupts the wait. */
+        int n = g_transport->recv(buf, sizeof buf, -1);
         semo_message m;
         if (n < 0) {
             semo_trace("comm_error", "reason", "receive failed", NULL);
-            semo_sleep_ms(RECV_POLL_MS);
+            semo_sleep_ms(RECV_ERROR_PAUSE_MS); /* a failing socket must not spin */
         } else if (n > 0 && decode_message(buf, (size_t)n, &m)) {
             semo__deliver(&m);
         } else if (n > 0) {
@@ -828,6 +715,10 @@ void semo_stop_program(void)
         pthread_cond_broadcast(&g_tasks[i].changed);
         pthread_mutex_unlock(&g_tasks[i].lock);
     }
+    /* The receiver waits on the socket without a timeout. */
+    const semo_transport *transport = g_transport;
+    if (transport && transport->interrupt)
+        transport->interrupt();
 }
 
 /* SIGINT and SIGTERM end the program cleanly (wrapups run, traces close).
@@ -1109,7 +1000,7 @@ static bool start_thread(pthread_t *thread, void *(*body)(void *), void *arg)
 {
     pthread_attr_t attr;
     pthread_attr_init(&attr);
-    pthread_attr_setstacksize(&attr, TASK_STACK_BYTES);
+    pthread_attr_setstacksize(&attr, SEMO_STACK_BYTES);
     bool ok = pthread_create(thread, &attr, body, arg) == 0;
     pthread_attr_destroy(&attr);
     if (!ok)

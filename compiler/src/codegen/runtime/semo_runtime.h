@@ -1,4 +1,4 @@
-/* semo_runtime.h: the SeMo runtime API (targets `linux` and `linux-sim`).
+/* semo_runtime.h: the SeMo runtime API (every target).
  *
  * Generated robot programs and the task files users write call only what is
  * declared here. Names of the task-facing calls follow the HOPES/UEM
@@ -7,9 +7,14 @@
  * (tasks, channels, multicast groups, peers) in one `semo_program_desc`
  * handed to `semo_main`.
  *
- * Threads: one POSIX thread per task; every call below is thread-safe.
+ * Platforms: POSIX threads (`linux`, `linux-sim`: one thread per task, every
+ * call below is thread-safe) or a static schedule (`-DSEMO_STATIC`, targets
+ * `cortex-m`, `cortex-m-sim`: one loop, `Core_1_go`, fires the tasks in the
+ * order of the task graph's single-appearance schedule; no threads, no
+ * heap, and no call blocks).
  * Time: "mission time" in milliseconds since start. In simulation
- * (`-DSEMO_SIM`) it runs `time_scale` times faster than the wall clock.
+ * (`-DSEMO_SIM`) on POSIX it runs `time_scale` times faster than the wall
+ * clock.
  */
 #ifndef SEMO_RUNTIME_H
 #define SEMO_RUNTIME_H
@@ -21,8 +26,12 @@
 /* ---------------------------------------------------------------- values */
 
 /* Every mission value travels as text: numbers in decimal, locations "x,y",
- * strings and symbolic constants as written. */
+ * strings and symbolic constants as written; longer text is cut to
+ * SEMO_VALUE_MAX - 1 bytes. The static-schedule targets' Makefile sets it
+ * from the program (its longest literal and scenario value, at least 32). */
+#ifndef SEMO_VALUE_MAX
 #define SEMO_VALUE_MAX 64
+#endif
 typedef struct {
     char text[SEMO_VALUE_MAX];
 } semo_value;
@@ -59,13 +68,31 @@ typedef struct {
     void (*wrapup)(void);
 } semo_task_desc;
 
+/* Where a channel's samples are on the static schedule (no heap): the
+ * generated channels.c gives each channel its buffer and this state. */
+typedef struct {
+    size_t head, count;
+    unsigned long dropped;
+} semo_channel_state;
+
 /* A FIFO channel of the task graph: a bounded ring buffer of fixed-size samples. */
 typedef struct {
     const char *src_task, *src_port, *dst_task, *dst_port;
     size_t sample_size;
     size_t capacity;          /* samples, from the buffer analysis */
     unsigned initial_samples; /* zero-filled samples present at start */
+    /* Static schedule only (NULL on POSIX, which allocates them):
+     * `capacity * sample_size` bytes, and the ring's state. */
+    unsigned char *storage;
+    semo_channel_state *state;
 } semo_channel_desc;
+
+/* One term of the static schedule: `count` firings of task `task` (an index
+ * into the task table). */
+typedef struct {
+    unsigned short task;
+    unsigned short count;
+} semo_firing;
 
 /* A multicast group: a buffer holding the latest sample. */
 typedef struct {
@@ -94,6 +121,9 @@ typedef struct {
     const semo_peer *peers;
     size_t peer_count;
     size_t self; /* index of this robot in `peers` */
+    /* Static schedule only: one iteration of the single-appearance schedule. */
+    const semo_firing *schedule;
+    size_t schedule_count;
 } semo_program_desc;
 
 /* Runs the program: parses the command line (`--trace FILE`,
@@ -105,6 +135,18 @@ typedef struct {
  * `semo_stop_program` is called or the duration elapses; then stops the
  * threads, calls every wrapup and returns the exit status. */
 int semo_main(int argc, char **argv, const semo_program_desc *program);
+
+#ifdef SEMO_STATIC
+/* One pass of the static schedule: every task of `schedule` that is due
+ * (time-driven: its period elapsed; data-driven: always, its body returns
+ * when no data waits; control-driven: running or called) fires, in order.
+ * semo_main calls it once per clock tick until the program stops. */
+void Core_1_go(void);
+/* For a task body on the static schedule that must wait (a service taking
+ * time): the current firing is not over; the body returns and is called
+ * again at the next pass, and the task stays busy (not idle) meanwhile. */
+void semo_firing_continues(void);
+#endif
 
 /* Ends the program (from any task). */
 void semo_stop_program(void);
@@ -149,6 +191,11 @@ bool UFControl_WaitIdle(const char *task, int64_t timeout_ms);
 /* For task bodies that take long: true when the control task asked this
  * task to stop (or the program is stopping). */
 bool UFControl_StopRequested(const char *task);
+/* Waits until mission time `until_ms`, or until the control task asks the
+ * task to stop, or the program stops, without polling; true when asked to
+ * stop (or stopping). On the static schedule it never waits (it answers
+ * UFControl_StopRequested). */
+bool UFControl_WaitStop(const char *task, int64_t until_ms);
 
 /* Task parameters (per task, by name); unknown ones read as 0. */
 int UFTask_SetIntegerParameter(const char *task, const char *param, long long value);
@@ -201,8 +248,12 @@ typedef struct {
     const char *name;
     int (*open)(const semo_program_desc *program, int port_base);
     int (*send)(size_t peer, const void *data, size_t len);
-    /* Bytes received, 0 on timeout, -1 on error. */
+    /* Bytes received, 0 on timeout or interrupt, -1 on error; timeout_ms < 0
+     * waits until a datagram arrives or `interrupt` is called. */
     int (*recv)(void *data, size_t cap, int timeout_ms);
+    /* Makes a recv under way, and every later one, return 0 at once (the
+     * program is stopping); safe from any thread. */
+    void (*interrupt)(void);
     void (*close)(void);
 } semo_transport;
 extern const semo_transport semo_udp_transport;

@@ -18,6 +18,9 @@
 /* Set by open before any thread uses the transport, cleared by close after
  * they are joined; the kernel serialises concurrent sendto/recv. */
 static int g_fd = -1;
+/* A pipe whose read end becomes readable when the program stops, so that
+ * recv can wait on the socket without a timeout. */
+static int g_wake[2] = {-1, -1};
 static int g_port_base;
 static size_t g_peer_count;
 
@@ -42,9 +45,13 @@ static int udp_open(const semo_program_desc *program, int port_base)
     /* Child processes (a task running a helper) must not inherit the port. */
     fcntl(fd, F_SETFD, FD_CLOEXEC);
     struct sockaddr_in self = loopback(port_base + (int)program->self);
-    if (bind(fd, (const struct sockaddr *)&self, sizeof self) != 0) {
+    if (bind(fd, (const struct sockaddr *)&self, sizeof self) != 0 || pipe(g_wake) != 0) {
         close(fd);
         return -1;
+    }
+    for (int i = 0; i < 2; i++) {
+        fcntl(g_wake[i], F_SETFD, FD_CLOEXEC);
+        fcntl(g_wake[i], F_SETFL, O_NONBLOCK);
     }
     g_fd = fd;
     g_port_base = port_base;
@@ -70,11 +77,11 @@ static int udp_recv(void *data, size_t cap, int timeout_ms)
 {
     if (g_fd < 0)
         return -1;
-    struct pollfd pfd = {.fd = g_fd, .events = POLLIN};
-    int ready = poll(&pfd, 1, timeout_ms);
+    struct pollfd pfd[2] = {{.fd = g_fd, .events = POLLIN}, {.fd = g_wake[0], .events = POLLIN}};
+    int ready = poll(pfd, 2, timeout_ms < 0 ? -1 : timeout_ms);
     if (ready < 0)
         return errno == EINTR ? 0 : -1;
-    if (ready == 0)
+    if (ready == 0 || pfd[1].revents != 0)
         return 0;
     ssize_t n = recv(g_fd, data, cap, 0);
     if (n < 0)
@@ -82,10 +89,23 @@ static int udp_recv(void *data, size_t cap, int timeout_ms)
     return (int)n;
 }
 
+static void udp_interrupt(void)
+{
+    if (g_wake[1] >= 0) {
+        ssize_t written = write(g_wake[1], "x", 1); /* a full pipe is awake already */
+        (void)written;
+    }
+}
+
 static void udp_close(void)
 {
     if (g_fd >= 0)
         close(g_fd);
+    for (int i = 0; i < 2; i++) {
+        if (g_wake[i] >= 0)
+            close(g_wake[i]);
+        g_wake[i] = -1;
+    }
     g_fd = -1;
     g_peer_count = 0;
 }
@@ -95,5 +115,6 @@ const semo_transport semo_udp_transport = {
     .open = udp_open,
     .send = udp_send,
     .recv = udp_recv,
+    .interrupt = udp_interrupt,
     .close = udp_close,
 };

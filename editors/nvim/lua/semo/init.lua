@@ -155,9 +155,38 @@ function M.simulate(bufnr, scenario, svg, done)
   end, bufnr)
 end
 
+-- The server's own semantic token types, linked to the standard LSP groups so colour
+-- schemes colour them (Neovim 0.9+ highlights a token as `@lsp.type.<type>.<filetype>`
+-- and links only the standard types itself). The same types as package.json declares.
+M.token_links = {
+  team = '@lsp.type.namespace',
+  robot = '@lsp.type.variable',
+  robotType = '@lsp.type.type',
+  capability = '@lsp.type.interface',
+  plan = '@lsp.type.property',
+  service = '@lsp.type.function',
+  mode = '@lsp.type.enumMember',
+  value = '@lsp.type.enumMember',
+  constant = '@lsp.type.variable',
+}
+
+--- Links the token highlight groups (a colour scheme clears them, so again on each).
+--- Returns false on Neovim before 0.9, which has no semantic-token highlighting.
+function M.link_token_highlights()
+  if vim.fn.has('nvim-0.9') == 0 then
+    return false
+  end
+  for name, target in pairs(M.token_links) do
+    vim.api.nvim_set_hl(0, '@lsp.type.' .. name .. '.semo', { link = target, default = true })
+  end
+  return true
+end
+
 function M.setup(opts)
   config = vim.tbl_extend('force', config, opts or {})
   local group = vim.api.nvim_create_augroup('semo', { clear = true })
+  M.link_token_highlights()
+  vim.api.nvim_create_autocmd('ColorScheme', { group = group, callback = M.link_token_highlights })
   vim.api.nvim_create_user_command('SemoSimulate', function(command)
     local args = command.fargs
     M.simulate(vim.api.nvim_get_current_buf(), args[1], args[2], function(err, answer)

@@ -77,10 +77,10 @@ static int run_values(void)
 enum { CH_SENSOR_FILTER, CH_FILTER_CONTROL, CH_LOOP, CH_SPILL };
 
 static const semo_channel_desc task_channels[] = {
-    [CH_SENSOR_FILTER] = {"Sensor", "OUT", "Filter", "IN", sizeof(int), 4, 0},
-    [CH_FILTER_CONTROL] = {"Filter", "OUT", "Control", "VALUE", sizeof(int), 64, 0},
-    [CH_LOOP] = {"Control", "LOOP_OUT", "Control", "LOOP_IN", sizeof(long long), 3, 2},
-    [CH_SPILL] = {"Control", "SPILL", "Sink", "IN", sizeof(int), 2, 0},
+    [CH_SENSOR_FILTER] = {"Sensor", "OUT", "Filter", "IN", sizeof(int), 4, 0, NULL, NULL},
+    [CH_FILTER_CONTROL] = {"Filter", "OUT", "Control", "VALUE", sizeof(int), 64, 0, NULL, NULL},
+    [CH_LOOP] = {"Control", "LOOP_OUT", "Control", "LOOP_IN", sizeof(long long), 3, 2, NULL, NULL},
+    [CH_SPILL] = {"Control", "SPILL", "Sink", "IN", sizeof(int), 2, 0, NULL, NULL},
 };
 static const semo_multicast_desc task_groups[] = {{"latest", sizeof(int)}, {"empty", sizeof(int)}};
 
@@ -486,7 +486,7 @@ static const semo_task_desc sim_tasks[] = {
     {"Control", SEMO_TRIGGER_DATA, 0, NULL, sim_control_go, NULL},
 };
 static const semo_channel_desc sim_channels[] = {
-    {"Location", "OUT", "Control", "LOCATION", sizeof(semo_value), 8, 0},
+    {"Location", "OUT", "Control", "LOCATION", sizeof(semo_value), 8, 0, NULL, NULL},
 };
 
 static int run_sim(int argc, char **argv)

@@ -1,0 +1,580 @@
+/* semo_static.c: the static-schedule platform layer of the SeMo runtime
+ * (targets `cortex-m`, `cortex-m-sim`; built with -DSEMO_STATIC).
+ *
+ * One loop and no threads: `Core_1_go` fires the due tasks in the order of
+ * the single-appearance schedule, once per clock tick, and the board sleeps
+ * until the next tick (an idle robot only wakes for its clock). No call
+ * blocks, nothing is allocated: channels live in the buffers the generated
+ * channels.c gives them, everything else in the fixed tables below (sizes
+ * overridable with -D). The board file (semo_lm3s6965.c) gives the clock,
+ * the trace's output and the exit.
+ */
+#include "semo_internal.h"
+
+#include <string.h>
+
+#ifndef SEMO_MAX_TASKS
+#define SEMO_MAX_TASKS 32
+#endif
+#ifndef SEMO_MAX_TIMERS
+#define SEMO_MAX_TIMERS 8
+#endif
+#ifndef SEMO_MAX_PARAMS
+#define SEMO_MAX_PARAMS 8
+#endif
+#ifndef SEMO_MAX_GROUPS
+#define SEMO_MAX_GROUPS 4
+#endif
+/* Messages received and not yet taken (operator commands). */
+#ifndef SEMO_INBOX
+#define SEMO_INBOX 8
+#endif
+
+/* ------------------------------------------------------------ run state */
+
+static const semo_program_desc *g_prog;
+static bool g_running;
+static int64_t g_start_ms;
+
+bool semo_running(void)
+{
+    return g_running;
+}
+
+const semo_program_desc *semo_program(void)
+{
+    return g_prog;
+}
+
+void semo_stop_program(void)
+{
+    g_running = false;
+}
+
+/* ------------------------------------------------------------------ time */
+
+int64_t semo_now_ms(void)
+{
+    return semo__board_now_ms() - g_start_ms;
+}
+
+/* Blocks the whole loop: only for start-up code, never in a task body. */
+void semo_sleep_ms(int64_t ms)
+{
+    int64_t end = semo_now_ms() + ms;
+    while (g_running && semo_now_ms() < end)
+        semo__board_idle();
+}
+
+/* ----------------------------------------------------------------- traces */
+
+void semo_trace(const char *event, ...)
+{
+    semo__sink sink = {semo__board_put, NULL};
+    va_list args;
+    va_start(args, event);
+    semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args);
+    va_end(args);
+}
+
+/* --------------------------------------------------------------- channels */
+
+static const semo_channel_desc *channel_at(int port)
+{
+    if (!g_prog || port < 0 || (size_t)port >= g_prog->channel_count)
+        return NULL;
+    const semo_channel_desc *c = &g_prog->channels[port];
+    return c->storage && c->state ? c : NULL;
+}
+
+int UFPort_Initialize(const char *task, const char *port)
+{
+    if (!g_prog || !task || !port)
+        return -1;
+    for (size_t i = 0; i < g_prog->channel_count; i++) {
+        const semo_channel_desc *c = &g_prog->channels[i];
+        bool input = strcmp(c->dst_task, task) == 0 && strcmp(c->dst_port, port) == 0;
+        bool output = strcmp(c->src_task, task) == 0 && strcmp(c->src_port, port) == 0;
+        if (input || output)
+            return (int)i;
+    }
+    return -1;
+}
+
+/* Never blocks: 0 when the channel is empty. */
+int UFPort_ReadFromQueue(int port, void *buf, size_t size)
+{
+    const semo_channel_desc *c = channel_at(port);
+    if (!c || !buf || size != c->sample_size || c->state->count == 0)
+        return 0;
+    memcpy(buf, c->storage + c->state->head * c->sample_size, size);
+    c->state->head = (c->state->head + 1) % c->capacity;
+    c->state->count--;
+    return (int)size;
+}
+
+int UFPort_WriteToQueue(int port, const void *buf, size_t size)
+{
+    const semo_channel_desc *c = channel_at(port);
+    if (!c || !buf || size != c->sample_size)
+        return 0;
+    if (c->state->count == c->capacity) {
+        c->state->dropped++;
+        return 0;
+    }
+    size_t tail = (c->state->head + c->state->count) % c->capacity;
+    memcpy(c->storage + tail * c->sample_size, buf, size);
+    c->state->count++;
+    return (int)size;
+}
+
+int UFPort_GetNumOfAvailableData(int port)
+{
+    const semo_channel_desc *c = channel_at(port);
+    return c ? (int)c->state->count : -1;
+}
+
+/* -------------------------------------------------------------- multicast */
+
+static semo_value g_group_value[SEMO_MAX_GROUPS];
+static bool g_group_written[SEMO_MAX_GROUPS];
+
+static int find_group(const char *name, size_t size)
+{
+    for (size_t i = 0; g_prog && name && i < g_prog->group_count && i < SEMO_MAX_GROUPS; i++)
+        if (strcmp(g_prog->groups[i].name, name) == 0 && size == g_prog->groups[i].sample_size &&
+            size <= sizeof(semo_value))
+            return (int)i;
+    return -1;
+}
+
+int UFMulticast_Write(const char *name, const void *buf, size_t size)
+{
+    int g = find_group(name, size);
+    if (g < 0 || !buf)
+        return 0;
+    memcpy(&g_group_value[g], buf, size);
+    g_group_written[g] = true;
+    return (int)size;
+}
+
+int UFMulticast_Read(const char *name, void *buf, size_t size)
+{
+    int g = find_group(name, size);
+    if (g < 0 || !buf || !g_group_written[g])
+        return 0;
+    memcpy(buf, &g_group_value[g], size);
+    return (int)size;
+}
+
+/* ------------------------------------------------------------------ tasks */
+
+typedef struct {
+    semo_task_state state;
+    bool repeat; /* RunTask; otherwise `calls` firings are owed */
+    unsigned calls;
+    bool stop_requested;
+    bool in_firing; /* a body said semo_firing_continues */
+    int64_t next_release;
+} task;
+
+static task g_tasks[SEMO_MAX_TASKS];
+static bool g_continues; /* set by the body being fired */
+
+static task *find_task(const char *name)
+{
+    if (!g_prog || !name)
+        return NULL;
+    for (size_t i = 0; i < g_prog->task_count; i++)
+        if (strcmp(g_prog->tasks[i].name, name) == 0)
+            return &g_tasks[i];
+    return NULL;
+}
+
+void semo_firing_continues(void)
+{
+    g_continues = true;
+}
+
+/* Fires task `i` if it is due; the rules of the POSIX threads, one step at a time. */
+static void fire_if_due(size_t i)
+{
+    task *t = &g_tasks[i];
+    const semo_task_desc *d = &g_prog->tasks[i];
+    if (t->stop_requested && t->state != SEMO_TASK_IDLE && !t->in_firing) {
+        t->state = SEMO_TASK_IDLE;
+        t->stop_requested = false;
+        t->calls = 0;
+        return;
+    }
+    if (t->state != SEMO_TASK_RUNNING && !t->in_firing)
+        return;
+    if (d->trigger == SEMO_TRIGGER_TIME && !t->in_firing) {
+        int64_t now = semo_now_ms();
+        if (now < t->next_release)
+            return;
+        t->next_release = now + d->period_ms;
+    }
+    g_continues = false;
+    if (d->go)
+        d->go();
+    t->in_firing = g_continues && g_running;
+    if (t->in_firing)
+        return;
+    if (t->stop_requested) {
+        t->state = SEMO_TASK_IDLE;
+        t->stop_requested = false;
+        t->calls = 0;
+    } else if (!t->repeat && t->calls > 0 && --t->calls == 0) {
+        t->state = SEMO_TASK_IDLE;
+    }
+}
+
+typedef enum { CONTROL_RUN, CONTROL_CALL, CONTROL_STOP, CONTROL_SUSPEND, CONTROL_RESUME } control_op;
+
+static int control(const char *name, control_op op)
+{
+    task *t = find_task(name);
+    if (!t)
+        return -1;
+    switch (op) {
+    case CONTROL_RUN:
+        t->repeat = true;
+        t->stop_requested = false;
+        if (t->state == SEMO_TASK_IDLE)
+            t->state = SEMO_TASK_RUNNING;
+        break;
+    case CONTROL_CALL:
+        if (t->state == SEMO_TASK_IDLE || !t->repeat) {
+            t->repeat = false;
+            t->calls++;
+            t->stop_requested = false;
+            if (t->state == SEMO_TASK_IDLE)
+                t->state = SEMO_TASK_RUNNING;
+        }
+        break;
+    case CONTROL_STOP:
+        if (t->state != SEMO_TASK_IDLE)
+            t->stop_requested = true;
+        break;
+    case CONTROL_SUSPEND:
+        if (t->state == SEMO_TASK_RUNNING)
+            t->state = SEMO_TASK_SUSPENDED;
+        break;
+    case CONTROL_RESUME:
+        if (t->state == SEMO_TASK_SUSPENDED)
+            t->state = SEMO_TASK_RUNNING;
+        break;
+    }
+    return 0;
+}
+
+int UFControl_RunTask(const char *task) { return control(task, CONTROL_RUN); }
+int UFControl_CallTask(const char *task) { return control(task, CONTROL_CALL); }
+int UFControl_StopTask(const char *task) { return control(task, CONTROL_STOP); }
+int UFControl_SuspendTask(const char *task) { return control(task, CONTROL_SUSPEND); }
+int UFControl_ResumeTask(const char *task) { return control(task, CONTROL_RESUME); }
+
+semo_task_state UFControl_GetTaskState(const char *name)
+{
+    task *t = find_task(name);
+    if (!t)
+        return SEMO_TASK_IDLE;
+    /* A firing still going on keeps the task busy. */
+    return t->in_firing && t->state == SEMO_TASK_IDLE ? SEMO_TASK_RUNNING : t->state;
+}
+
+/* Nothing else runs while this waits: only an idle task (or no time) succeeds. */
+bool UFControl_WaitIdle(const char *name, int64_t timeout_ms)
+{
+    (void)timeout_ms;
+    return UFControl_GetTaskState(name) == SEMO_TASK_IDLE;
+}
+
+/* Nothing else would run while this waited: it only answers. */
+bool UFControl_WaitStop(const char *name, int64_t until_ms)
+{
+    (void)until_ms;
+    return UFControl_StopRequested(name);
+}
+
+bool UFControl_StopRequested(const char *name)
+{
+    task *t = find_task(name);
+    if (!g_running)
+        return true;
+    return t && t->stop_requested;
+}
+
+static struct {
+    const char *task, *name; /* names from the program's code: never freed */
+    long long value;
+} g_params[SEMO_MAX_PARAMS];
+
+int UFTask_SetIntegerParameter(const char *name, const char *param_name, long long value)
+{
+    if (!find_task(name) || !param_name)
+        return -1;
+    for (size_t i = 0; i < SEMO_MAX_PARAMS; i++) {
+        bool same = g_params[i].task && strcmp(g_params[i].task, name) == 0 &&
+                    strcmp(g_params[i].name, param_name) == 0;
+        if (same || !g_params[i].task) {
+            g_params[i].task = g_prog->tasks[find_task(name) - g_tasks].name;
+            g_params[i].name = param_name;
+            g_params[i].value = value;
+            return 0;
+        }
+    }
+    return -1;
+}
+
+long long UFTask_GetIntegerParameter(const char *name, const char *param_name)
+{
+    for (size_t i = 0; name && param_name && i < SEMO_MAX_PARAMS && g_params[i].task; i++)
+        if (strcmp(g_params[i].task, name) == 0 && strcmp(g_params[i].name, param_name) == 0)
+            return g_params[i].value;
+    return 0;
+}
+
+/* ----------------------------------------------------------------- timers */
+
+static struct {
+    int64_t due_ms;
+    bool used;
+} g_timers[SEMO_MAX_TIMERS];
+
+int UFTimer_Set(int64_t period, semo_time_unit unit)
+{
+    static const int64_t unit_ms[] = {[SEMO_MSEC] = 1, [SEMO_SEC] = 1000, [SEMO_MIN] = 60000, [SEMO_HOUR] = 3600000};
+    /* An enum may be unsigned here (AAPCS): one unsigned comparison covers both ends. */
+    if (period < 0 || (unsigned)unit > (unsigned)SEMO_HOUR || period > INT64_MAX / 2 / unit_ms[unit])
+        return -1;
+    for (int i = 0; i < SEMO_MAX_TIMERS; i++)
+        if (!g_timers[i].used) {
+            g_timers[i].due_ms = semo_now_ms() + period * unit_ms[unit];
+            g_timers[i].used = true;
+            return i;
+        }
+    return -1;
+}
+
+bool UFTimer_GetAlarmed(int id)
+{
+    return id >= 0 && id < SEMO_MAX_TIMERS && g_timers[id].used && semo_now_ms() >= g_timers[id].due_ms;
+}
+
+void UFTimer_Cancel(int id)
+{
+    if (id >= 0 && id < SEMO_MAX_TIMERS)
+        g_timers[id].used = false;
+}
+
+/* --------------------------------------------------------------- messages */
+
+static semo_message g_inbox[SEMO_INBOX];
+static size_t g_inbox_head, g_inbox_count;
+
+void semo__deliver(const semo_message *msg)
+{
+    if (g_inbox_count == SEMO_INBOX) {
+        semo_trace("drop", "from", msg->from_team, "key", msg->key, "reason", "inbox full", NULL);
+        return;
+    }
+    g_inbox[(g_inbox_head + g_inbox_count) % SEMO_INBOX] = *msg;
+    g_inbox_count++;
+}
+
+/* Only the operator console ("USER", whose record is the trace) is reachable
+ * here: the generator refuses missions that message other robots on a
+ * static-schedule target (E113), so anything else is an error. */
+int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value)
+{
+    if (!g_prog || !to_team || !key || !value || (kind != SEMO_MSG_SEND && kind != SEMO_MSG_PUBLISH))
+        return -1;
+    semo_trace("send", "to", to_team, "key", key, "value", value->text, NULL);
+    if (strcmp(to_team, "USER") == 0)
+        return 1;
+    semo_trace("comm_error", "to", to_team, "key", key, NULL);
+    return -1;
+}
+
+/* Never waits (nothing else would run meanwhile): the timeout is ignored. */
+int semo_comm_poll(semo_message *out, int64_t timeout_ms)
+{
+    (void)timeout_ms;
+    if (!out || g_inbox_count == 0)
+        return 0;
+    *out = g_inbox[g_inbox_head];
+    g_inbox_head = (g_inbox_head + 1) % SEMO_INBOX;
+    g_inbox_count--;
+    semo_trace("receive", "from", out->from_team, "from_robot", out->from_robot, "key", out->key, "value",
+               out->value.text, NULL);
+    return 1;
+}
+
+/* ------------------------------------------------------------- simulation */
+
+#ifdef SEMO_SIM
+#define DEFAULT_SERVICE_MS 100
+
+bool semo_sim_sensor(const char *value, semo_value *out)
+{
+    const semo__sim_sensor_entry *latest = NULL;
+    int64_t now = semo_now_ms();
+    for (size_t i = 0; value && i < semo__scenario.sensor_count; i++) {
+        const semo__sim_sensor_entry *e = &semo__scenario.sensors[i];
+        if (e->at <= now && strcmp(e->value, value) == 0 && (!latest || e->at >= latest->at))
+            latest = e;
+    }
+    if (latest && out)
+        semo_value_set(out, latest->is);
+    return latest != NULL;
+}
+
+void semo_sim_actuate(const char *task, const semo_value *command)
+{
+    semo_trace("actuate", "task", task, "value", command ? command->text : "", NULL);
+}
+
+int64_t semo_sim_service_ms(const char *service)
+{
+    for (size_t i = 0; service && i < semo__scenario.service_count; i++)
+        if (strcmp(semo__scenario.services[i].service, service) == 0)
+            return semo__scenario.services[i].ms;
+    return DEFAULT_SERVICE_MS;
+}
+
+/* Delivers the operator's commands that are due, in time order. */
+static void deliver_operator_commands(void)
+{
+    int64_t now = semo_now_ms();
+    for (;;) {
+        size_t due = semo__scenario.operator_count;
+        for (size_t i = 0; i < semo__scenario.operator_count; i++) {
+            int64_t next = semo__scenario.operator_next[i];
+            if (next >= 0 && next <= now && (due == semo__scenario.operator_count || next < semo__scenario.operator_next[due]))
+                due = i;
+        }
+        if (due == semo__scenario.operator_count)
+            return;
+        const semo__sim_command_entry *c = &semo__scenario.operator_commands[due];
+        semo_message m = {.kind = SEMO_MSG_SEND, .from_team = "USER", .from_robot = "USER"};
+        strncpy(m.key, c->key, sizeof m.key - 1);
+        semo_value_set(&m.value, c->is);
+        semo__deliver(&m);
+        int64_t *next = &semo__scenario.operator_next[due];
+        *next = c->every > 0 && (c->until < 0 || *next + c->every <= c->until) ? *next + c->every : -1;
+    }
+}
+
+static void start_operator(void)
+{
+    for (size_t i = 0; i < semo__scenario.operator_count; i++) {
+        const semo__sim_command_entry *c = &semo__scenario.operator_commands[i];
+        semo__scenario.operator_next[i] = c->until < 0 || c->first <= c->until ? c->first : -1;
+    }
+}
+#endif
+
+/* ---------------------------------------------------------------- the loop */
+
+void Core_1_go(void)
+{
+#ifdef SEMO_SIM
+    deliver_operator_commands();
+#endif
+    for (size_t s = 0; s < g_prog->schedule_count && g_running; s++) {
+        const semo_firing *f = &g_prog->schedule[s];
+        for (unsigned n = 0; n < f->count && g_running; n++)
+            fire_if_due(f->task);
+    }
+}
+
+static void trace_dropped_samples(void)
+{
+    for (size_t i = 0; i < g_prog->channel_count; i++) {
+        const semo_channel_desc *d = &g_prog->channels[i];
+        if (d->state && d->state->dropped) {
+            char count[21];
+            semo__format_i64(count, (int64_t)d->state->dropped);
+            /* The channel's name is four parts: written as the POSIX layer's "A.p->B.q". */
+            char name[128];
+            size_t len = 0;
+            const char *parts[] = {d->src_task, ".", d->src_port, "->", d->dst_task, ".", d->dst_port};
+            for (size_t p = 0; p < sizeof parts / sizeof parts[0]; p++)
+                for (const char *c = parts[p]; *c && len + 1 < sizeof name; c++)
+                    name[len++] = *c;
+            name[len] = '\0';
+            semo_trace("dropped", "channel", name, "count", count, NULL);
+        }
+    }
+}
+
+/* A program the static schedule can run: every table within its bounds. */
+static bool program_fits(const semo_program_desc *p)
+{
+    if (p->task_count > SEMO_MAX_TASKS || p->group_count > SEMO_MAX_GROUPS)
+        return false;
+    for (size_t s = 0; s < p->schedule_count; s++)
+        if (p->schedule[s].task >= p->task_count)
+            return false;
+    for (size_t i = 0; i < p->channel_count; i++) {
+        const semo_channel_desc *c = &p->channels[i];
+        if (!c->storage || !c->state || c->capacity == 0 || c->initial_samples > c->capacity)
+            return false;
+    }
+    return true;
+}
+
+/* No command line on the board: `argc`/`argv` are ignored. The duration is
+ * the scenario's in simulation, else the program runs until it stops itself. */
+int semo_main(int argc, char **argv, const semo_program_desc *program)
+{
+    (void)argc;
+    (void)argv;
+    semo__board_init();
+    if (!program || !program_fits(program)) {
+        static const char message[] = "semo runtime: the program does not fit the static tables\n";
+        semo__board_put(NULL, message, sizeof message - 1);
+        semo__board_exit(1);
+        return 1;
+    }
+    g_prog = program;
+    for (size_t i = 0; i < program->channel_count; i++) {
+        const semo_channel_desc *c = &program->channels[i];
+        memset(c->storage, 0, c->capacity * c->sample_size);
+        *c->state = (semo_channel_state){.count = c->initial_samples};
+    }
+    for (size_t i = 0; i < program->task_count; i++)
+        g_tasks[i] = (task){.state = program->tasks[i].trigger == SEMO_TRIGGER_CONTROL ? SEMO_TASK_IDLE
+                                                                                        : SEMO_TASK_RUNNING,
+                            .repeat = true};
+    g_start_ms = semo__board_now_ms();
+    g_running = true;
+    int64_t duration = 0;
+#ifdef SEMO_SIM
+    duration = semo__scenario.duration_ms;
+    start_operator();
+#endif
+    semo_trace("start", "team", program->team, "type", program->robot_type ? program->robot_type : "", "mission",
+               program->mission ? program->mission : "", NULL);
+    for (size_t i = 0; i < program->task_count; i++)
+        if (program->tasks[i].init)
+            program->tasks[i].init();
+    while (g_running) {
+        Core_1_go();
+        if (duration > 0 && semo_now_ms() >= duration)
+            break;
+        semo__board_idle();
+        if (duration > 0 && semo_now_ms() >= duration)
+            break;
+    }
+    g_running = false;
+    for (size_t i = 0; i < program->task_count; i++)
+        if (program->tasks[i].wrapup)
+            program->tasks[i].wrapup();
+    trace_dropped_samples();
+    semo_trace("stop", NULL);
+    semo__board_exit(0);
+    return 0;
+}

@@ -1,0 +1,293 @@
+//! One test per warning, through the workspace analysis (`semo::host`) as
+//! every door reaches it: a mission, a catalog whose service is implemented
+//! by a task graph, and that graph, in a folder on disk (the catalog checks
+//! that its `graph=` file exists).
+
+use crate::diag::{Code, Diagnostic, FileId};
+use crate::host::{AnalysisHost, Roots};
+use crate::taskgraph::analysis::ratio::Ratio;
+use crate::workspace::FileKind;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+const CATALOG: &str = r#"<?xml version="1.0"?>
+<Catalog xmlns="urn:semo:catalog:1">
+  <Robot type="Rover">
+    <Service name="scan" graph="graphs/scan.taskgraph.xml" doc="Scan the ground."/>
+    <Service name="dig" task="dig_task"/>
+  </Robot>
+</Catalog>
+"#;
+
+/// A consistent graph: `A` then `B`, 30 and 50 ms; one firing of a task at
+/// a time, so an iteration every 50 ms.
+const TIMED: &str = r#"<TaskGraph name="scan" xmlns="urn:semo:taskgraph:1">
+  <Task name="A" wcet="30"><Port name="o" dir="out"/></Task>
+  <Task name="B" wcet="50"><Port name="i" dir="in"/></Task>
+  <Channel src="A.o" dst="B.i"/>
+</TaskGraph>
+"#;
+
+const INCONSISTENT: &str = r#"<TaskGraph name="scan" xmlns="urn:semo:taskgraph:1">
+  <Task name="A"><Port name="o1" dir="out"/><Port name="o2" dir="out"/></Task>
+  <Task name="B"><Port name="i1" dir="in"/><Port name="i2" dir="in" rate="2"/></Task>
+  <Channel src="A.o1" dst="B.i1"/>
+  <Channel src="A.o2" dst="B.i2"/>
+</TaskGraph>
+"#;
+
+const DEADLOCK: &str = r#"<TaskGraph name="scan" xmlns="urn:semo:taskgraph:1">
+  <Task name="X"><Port name="i" dir="in"/><Port name="o" dir="out"/></Task>
+  <Task name="Y"><Port name="i" dir="in"/><Port name="o" dir="out"/></Task>
+  <Channel src="X.o" dst="Y.i"/>
+  <Channel src="Y.o" dst="X.i"/>
+</TaskGraph>
+"#;
+
+const SMALL_BUFFER: &str = r#"<TaskGraph name="scan" xmlns="urn:semo:taskgraph:1">
+  <Task name="A"><Port name="o" dir="out" rate="2"/></Task>
+  <Task name="B"><Port name="i" dir="in" rate="3"/></Task>
+  <Channel src="A.o" dst="B.i" capacity="3"/>
+</TaskGraph>
+"#;
+
+fn mission(body: &str) -> String {
+    format!("{{ T: Rover r[2] }}\n{body}\nT.M {{ set(P, S) }}\nT.main {{ default: mode = M }}\n")
+}
+
+/// A folder on disk holding the three files, loaded into a host.
+struct Workspace {
+    dir: PathBuf,
+    host: AnalysisHost,
+}
+
+const MISSION_ID: FileId = FileId(0);
+const GRAPH_ID: FileId = FileId(2);
+
+impl Workspace {
+    fn new(name: &str, mission: &str, graph: &str) -> Workspace {
+        let dir = std::env::temp_dir().join(format!("semo-dataflow-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("graphs")).unwrap();
+        let files = [
+            (MISSION_ID, "m.mission", FileKind::Mission, mission),
+            (FileId(1), "rover.robot.xml", FileKind::Catalog, CATALOG),
+            (
+                GRAPH_ID,
+                "graphs/scan.taskgraph.xml",
+                FileKind::TaskGraph,
+                graph,
+            ),
+        ];
+        let mut host = AnalysisHost::new(Roots {
+            roots: vec![dir.clone()],
+            seen_by_all: Vec::new(),
+        });
+        for (id, name, kind, text) in files {
+            let path = dir.join(name);
+            std::fs::write(&path, text).unwrap();
+            host.set_file(id, Some(path), kind, Arc::from(text));
+        }
+        Workspace { dir, host }
+    }
+
+    fn warnings(&self) -> Vec<Diagnostic> {
+        let analysis = self.host.analysis();
+        assert_eq!(
+            analysis
+                .diagnostics(MISSION_ID)
+                .iter()
+                .filter(|d| d.is_error())
+                .count(),
+            0,
+            "{:#?}",
+            analysis.diagnostics(MISSION_ID)
+        );
+        analysis.dataflow(MISSION_ID).unwrap().diagnostics.clone()
+    }
+
+    fn text_at(&self, mission: &str, d: &Diagnostic) -> String {
+        mission[d.span.range()].to_string()
+    }
+}
+
+impl Drop for Workspace {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
+fn codes(found: &[Diagnostic]) -> Vec<Code> {
+    found.iter().map(|d| d.code).collect()
+}
+
+#[test]
+fn an_inconsistent_service_graph_is_reported_on_the_call() {
+    let text = mission("T.P.S { dig()\n scan() }");
+    let w = Workspace::new("inconsistent", &text, INCONSISTENT);
+    let found = w.warnings();
+    // Both robots call it on the same line: one warning.
+    assert_eq!(codes(&found), [Code::DataflowInconsistent], "{found:#?}");
+    assert_eq!(w.text_at(&text, &found[0]), "scan()");
+    assert!(found[0].message.contains("graphs/scan.taskgraph.xml"));
+    // It points at the channel in the graph where the rates contradict.
+    assert_eq!(found[0].related[0].file, GRAPH_ID);
+    assert_eq!(
+        &INCONSISTENT[found[0].related[0].span.range()],
+        r#"<Channel src="A.o2" dst="B.i2"/>"#
+    );
+}
+
+#[test]
+fn a_deadlocking_service_graph_is_reported_on_the_call() {
+    let text = mission("T.P.S { scan() }");
+    let w = Workspace::new("deadlock", &text, DEADLOCK);
+    let found = w.warnings();
+    assert_eq!(codes(&found), [Code::DataflowDeadlock], "{found:#?}");
+    assert_eq!(w.text_at(&text, &found[0]), "scan()");
+    assert!(
+        found[0].message.contains("deadlock"),
+        "{}",
+        found[0].message
+    );
+}
+
+#[test]
+fn a_buffer_too_small_in_a_service_graph_is_reported_on_the_call() {
+    let text = mission("T.P.S { scan() }");
+    let w = Workspace::new("buffer", &text, SMALL_BUFFER);
+    let found = w.warnings();
+    assert_eq!(codes(&found), [Code::DataflowBufferTooSmall], "{found:#?}");
+    assert_eq!(w.text_at(&text, &found[0]), "scan()");
+}
+
+#[test]
+fn a_repeat_period_shorter_than_the_graph_period_is_reported_on_the_period() {
+    let text = mission("T.P.S { scan() } repeat(40 MSEC)");
+    let w = Workspace::new("repeat", &text, TIMED);
+    let found = w.warnings();
+    assert_eq!(codes(&found), [Code::DataflowTooSlow], "{found:#?}");
+    assert_eq!(w.text_at(&text, &found[0]), "40 MSEC");
+    assert!(found[0].message.contains("50 ms"), "{}", found[0].message);
+    assert_eq!(&text[found[0].related[0].span.range()], "scan()");
+}
+
+#[test]
+fn the_innermost_loop_period_is_the_one_asked_for() {
+    // The repeat leaves 100 ms, but the loop asks for an iteration every 20.
+    let text = mission("T.P.S { loop(20 MSEC) { scan() } } repeat(100 MSEC)");
+    let w = Workspace::new("loop", &text, TIMED);
+    let found = w.warnings();
+    assert_eq!(codes(&found), [Code::DataflowTooSlow], "{found:#?}");
+    assert_eq!(w.text_at(&text, &found[0]), "20 MSEC");
+}
+
+#[test]
+fn a_period_the_graph_keeps_up_with_gives_no_warning_and_each_robot_its_period() {
+    let text = mission("T.P.S { loop(50 MSEC) { scan() } } repeat(60 MSEC)");
+    let w = Workspace::new("fast-enough", &text, TIMED);
+    assert_eq!(w.warnings(), Vec::new());
+    let dataflow = w.host.analysis().dataflow(MISSION_ID).unwrap();
+    let periods: Vec<(&str, Option<Ratio>)> = dataflow
+        .robots
+        .iter()
+        .map(|r| (r.robot.as_str(), r.period))
+        .collect();
+    let fifty = Ratio::new(50, 1);
+    assert_eq!(periods, [("r_0", fifty), ("r_1", fifty)]);
+    assert_eq!(
+        dataflow.robots[0].bounded_by,
+        Some(("scan".to_string(), "graphs/scan.taskgraph.xml".to_string()))
+    );
+}
+
+#[test]
+fn a_robot_calling_no_service_graph_has_no_period() {
+    let text = mission("T.P.S { dig() } repeat(10 MSEC)");
+    let w = Workspace::new("no-graph", &text, TIMED);
+    assert_eq!(w.warnings(), Vec::new());
+    let dataflow = w.host.analysis().dataflow(MISSION_ID).unwrap();
+    assert!(dataflow.robots.iter().all(|r| r.period.is_none()));
+}
+
+#[test]
+fn a_mission_with_errors_is_not_refined_and_gives_no_dataflow() {
+    let text = mission("T.P.S { scan() } repeat(40 MSEC)\nT.P.S { dig() }");
+    let w = Workspace::new("errors", &text, TIMED);
+    let analysis = w.host.analysis();
+    assert!(
+        analysis
+            .diagnostics(MISSION_ID)
+            .iter()
+            .any(|d| d.is_error())
+    );
+    let dataflow = analysis.dataflow(MISSION_ID).unwrap();
+    assert!(dataflow.diagnostics.is_empty() && dataflow.robots.is_empty());
+}
+
+#[test]
+fn editing_the_graph_gives_a_new_answer_and_an_unchanged_workspace_the_same_one() {
+    let text = mission("T.P.S { scan() } repeat(40 MSEC)");
+    let mut w = Workspace::new("edit", &text, TIMED);
+    let first = w.host.analysis().dataflow(MISSION_ID).unwrap();
+    let again = w.host.analysis().dataflow_if_known(MISSION_ID).unwrap();
+    assert!(Arc::ptr_eq(&first, &again));
+    assert_eq!(codes(&first.diagnostics), [Code::DataflowTooSlow]);
+    // The editor re-publishes the mission when the graph changes.
+    assert!(
+        w.host
+            .analysis()
+            .affected_by(GRAPH_ID)
+            .contains(&MISSION_ID)
+    );
+    let faster = TIMED.replace("wcet=\"50\"", "wcet=\"40\"");
+    w.host.set_file(
+        GRAPH_ID,
+        Some(w.dir.join("graphs/scan.taskgraph.xml")),
+        FileKind::TaskGraph,
+        Arc::from(faster.as_str()),
+    );
+    assert!(w.host.analysis().dataflow_if_known(MISSION_ID).is_none());
+    assert_eq!(w.warnings(), Vec::new());
+}
+
+#[test]
+fn a_team_hover_lists_its_robots_periods() {
+    let text = mission("T.P.S { scan() } repeat(60 MSEC)");
+    let w = Workspace::new("hover", &text, TIMED);
+    let analysis = w.host.analysis();
+    let mission = analysis.mission(MISSION_ID).unwrap();
+    let at_team = text.find("T:").unwrap();
+    let periods = crate::dataflow::team_periods_at(&mission.mission, at_team, || {
+        analysis.dataflow(MISSION_ID)
+    });
+    assert_eq!(
+        periods.as_deref(),
+        Some(
+            "**Iteration period** (dataflow):\n\
+             - `r_0`: 50 ms (`scan`: `graphs/scan.taskgraph.xml`)\n\
+             - `r_1`: 50 ms (`scan`: `graphs/scan.taskgraph.xml`)"
+        )
+    );
+    let at_call = text.find("scan()").unwrap();
+    let asked = std::cell::Cell::new(false);
+    let none = crate::dataflow::team_periods_at(&mission.mission, at_call, || {
+        asked.set(true);
+        analysis.dataflow(MISSION_ID)
+    });
+    assert_eq!(none, None);
+    assert!(!asked.get(), "the dataflow is asked only on a team");
+}
+
+#[test]
+fn a_team_without_timed_service_graphs_gets_no_period_section() {
+    let text = mission("T.P.S { dig() }");
+    let w = Workspace::new("hover-untimed", &text, TIMED);
+    let analysis = w.host.analysis();
+    let mission = analysis.mission(MISSION_ID).unwrap();
+    let at_team = text.find("T:").unwrap();
+    let periods = crate::dataflow::team_periods_at(&mission.mission, at_team, || {
+        analysis.dataflow(MISSION_ID)
+    });
+    assert_eq!(periods, None);
+}

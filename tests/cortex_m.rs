@@ -1,0 +1,343 @@
+//! Target `cortex-m` end to end: `semo build --target cortex-m-sim --scenario
+//! FILE` for the follow robot and a swarm robot, `make` with
+//! arm-none-eabi-gcc, a run in `qemu-system-arm -M lm3s6965evb -nographic
+//! -semihosting` (the trace on UART0, the exit through semihosting when the
+//! scenario ends), and its trace compared with the `linux-sim` program's on
+//! the same scenario, and with the simulator's (`semo simulate`): the same
+//! modes, services and calls in the same order.
+//! And the budgets of issue 19 as size checks (`arm-none-eabi-size`; sizes
+//! are deterministic).
+//!
+//! Without arm-none-eabi-gcc or qemu-system-arm the tests say so and pass,
+//! unless `SEMO_CORTEX_M_TESTS=require` (CI), where a missing tool fails.
+//!
+//! QEMU runs with `-icount shift=0,sleep=off`: time is virtual and skips
+//! ahead while the robot waits for its next tick, so a run is deterministic
+//! and takes well under a second. A run that does not end within
+//! [`QEMU_LIMIT`] is killed and fails (a hang, not a slow machine).
+
+mod support;
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+use support::examples;
+use support::robots::{self, Event, calls, events, field, modes, run_in_simulation, scratch};
+
+const QEMU_LIMIT: Duration = Duration::from_secs(120);
+/// The warnings the generated C must compile without, as on linux.
+const CFLAGS: &str = "-std=c11 -Wall -Wextra -Wpedantic -Werror -Os";
+
+/// Whether the tools are here; without them the test is skipped (with a
+/// message) unless `SEMO_CORTEX_M_TESTS=require`.
+fn tools_present(test: &str) -> bool {
+    let missing: Vec<&str> = ["arm-none-eabi-gcc", "arm-none-eabi-size", "qemu-system-arm"]
+        .into_iter()
+        .filter(|tool| !robots::has(tool))
+        .collect();
+    if missing.is_empty() {
+        return true;
+    }
+    let required = std::env::var("SEMO_CORTEX_M_TESTS").is_ok_and(|v| v == "require");
+    assert!(
+        !required,
+        "{test}: SEMO_CORTEX_M_TESTS=require but {} missing (apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm)",
+        missing.join(", ")
+    );
+    eprintln!(
+        "skipped {test}: {} not installed (CI installs them and sets SEMO_CORTEX_M_TESTS=require)",
+        missing.join(", ")
+    );
+    false
+}
+
+fn fixture(name: &str) -> PathBuf {
+    support::repo_root()
+        .join("tests/fixtures/cortex_m")
+        .join(name)
+}
+
+/// `semo build MISSION --target TARGET [--scenario FILE] -o OUT`; every robot folder.
+fn build_for(mission: &Path, target: &str, scenario: Option<&Path>, out: &Path) -> Vec<PathBuf> {
+    let (mission, out_arg) = (mission.display().to_string(), out.display().to_string());
+    let mut args = vec!["build", &mission, "--target", target, "-o", &out_arg];
+    let scenario = scenario.map(|s| s.display().to_string());
+    if let Some(s) = &scenario {
+        args.extend(["--scenario", s]);
+    }
+    let built = support::semo_in(&support::repo_root(), &args);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    robots::robot_folders(out)
+}
+
+/// `make` in a robot folder with the target's own compiler; the ELF file.
+fn make(folder: &Path) -> PathBuf {
+    let out = Command::new("make")
+        .args(["-s", "-j2", &format!("CFLAGS={CFLAGS}")])
+        .current_dir(folder)
+        .output()
+        .expect("make runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success() && !stderr.contains("warning"),
+        "{}: {stderr}",
+        folder.display()
+    );
+    let robot = folder.file_name().unwrap().to_string_lossy();
+    folder.join(format!("{robot}.elf"))
+}
+
+/// Flash (text + data) and RAM (data + bss, the stack included) of an ELF file.
+fn size(elf: &Path) -> (u64, u64) {
+    let out = Command::new("arm-none-eabi-size")
+        .arg(elf)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    let numbers: Vec<u64> = text
+        .lines()
+        .nth(1)
+        .expect("a line of sizes")
+        .split_whitespace()
+        .take(3)
+        .map(|n| n.parse().unwrap())
+        .collect();
+    let (text, data, bss) = (numbers[0], numbers[1], numbers[2]);
+    (text + data, data + bss)
+}
+
+/// Runs the program in QEMU until it exits through semihosting; its UART
+/// output (the trace). Killed and failed after [`QEMU_LIMIT`].
+fn run_in_qemu(elf: &Path) -> Vec<String> {
+    let mut child = Command::new("qemu-system-arm")
+        .args(["-M", "lm3s6965evb", "-nographic", "-semihosting"])
+        .args(["-icount", "shift=0,sleep=off"])
+        .arg("-kernel")
+        .arg(elf)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("qemu-system-arm starts");
+    let mut stdout = child.stdout.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut text = String::new();
+        stdout.read_to_string(&mut text).unwrap();
+        text
+    });
+    let started = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if started.elapsed() > QEMU_LIMIT {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{}: QEMU did not exit within {QEMU_LIMIT:?}", elf.display());
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let text = reader.join().unwrap();
+    let mut stderr = String::new();
+    let _ = child.stderr.take().unwrap().read_to_string(&mut stderr);
+    assert!(
+        status.success(),
+        "{}: {status}: {text}{stderr}",
+        elf.display()
+    );
+    text.lines().map(str::to_string).collect()
+}
+
+/// What must match between the two traces: modes, services started and
+/// ended per plan, events thrown, and the services called, in order. A
+/// service called again and again counts once per run of calls: how many
+/// calls fit in a time differs by a control period between the two
+/// schedules (threads racing at the end of a call, or a loop firing the
+/// control task first), as between linux-sim and the simulator.
+fn behaviour(events: &[Event], until: i64) -> Vec<String> {
+    let mut out: Vec<String> = events
+        .iter()
+        .filter(|e| e["t"].as_i64().unwrap() <= until)
+        .filter_map(|e| {
+            let what = match field(e, "event") {
+                "mode" => format!("mode {}", field(e, "mode")),
+                "service_start" => format!("start {}.{}", field(e, "plan"), field(e, "service")),
+                "service_end" => format!("end {}.{}", field(e, "plan"), field(e, "service")),
+                "call_start" => format!("call {}", field(e, "service")),
+                "throw" => format!("throw {}", field(e, "name")),
+                _ => return None,
+            };
+            Some(what)
+        })
+        .collect();
+    out.dedup_by(|a, b| a == b && a.starts_with("call "));
+    out
+}
+
+/// The robot's behaviour on cortex-m-sim in QEMU and on linux-sim is the same:
+/// each run's behaviour up to `margin` ms before the end begins the other's
+/// (the linux-sim process starts its clock a little before its first firing,
+/// so one of the two may get one more call in at the end).
+fn same_behaviour(robot: &str, qemu: &[Event], other: &[Event], duration: i64, margin: i64) {
+    let linux = other;
+    let (q_all, l_all) = (behaviour(qemu, i64::MAX), behaviour(linux, i64::MAX));
+    let (q_early, l_early) = (
+        behaviour(qemu, duration - margin),
+        behaviour(linux, duration - margin),
+    );
+    assert!(
+        q_early.len() > 3,
+        "{robot}: the QEMU run shows too little to compare: {q_all:?}"
+    );
+    let starts =
+        |early: &[String], all: &[String]| all.len() >= early.len() && all[..early.len()] == *early;
+    assert!(
+        starts(&q_early, &l_all) && starts(&l_early, &q_all),
+        "{robot}: cortex-m-sim (QEMU) and the other run differ\nQEMU:  {q_all:?}\nother: {l_all:?}"
+    );
+    assert_eq!(modes(qemu), modes(linux), "{robot}: modes");
+}
+
+fn compare_with_linux_sim(name: &str, mission: &Path, scenario: &Path, robot: &str) -> Vec<Event> {
+    let out = scratch(&format!("cortex-m-{name}"));
+    let folders = build_for(
+        mission,
+        "cortex-m-sim",
+        Some(scenario),
+        &out.join("cortex-m"),
+    );
+    let folder = folders
+        .iter()
+        .find(|f| f.ends_with(robot))
+        .unwrap_or_else(|| panic!("no folder for {robot}"));
+    let lines = run_in_qemu(&make(folder));
+    // QEMU may print a line of its own ("Timer with period zero") on stderr
+    // only; every line on the UART is a trace line.
+    let qemu = events(&lines);
+    assert_eq!(field(&qemu[0], "event"), "start", "{lines:?}");
+    assert_eq!(field(qemu.last().unwrap(), "event"), "stop", "{lines:?}");
+
+    let text = std::fs::read_to_string(scenario).unwrap();
+    let linux = run_in_simulation(mission, &out.join("linux-sim"), &text);
+    let linux = events(&linux[robot]);
+    let duration = serde_json::from_str::<serde_json::Value>(&text).unwrap()["duration"]
+        .as_i64()
+        .unwrap();
+    same_behaviour(robot, &qemu, &linux, duration, 500);
+
+    // And the simulator's (`semo simulate`), the reference of linux-sim.
+    let trace = out.join("simulated.jsonl");
+    let simulated = support::semo_in(
+        &support::repo_root(),
+        &[
+            "simulate",
+            &mission.display().to_string(),
+            "--scenario",
+            &scenario.display().to_string(),
+            "--trace",
+            &trace.display().to_string(),
+        ],
+    );
+    assert_eq!(
+        simulated.code, 0,
+        "{}{}",
+        simulated.stdout, simulated.stderr
+    );
+    let lines: Vec<String> = std::fs::read_to_string(&trace)
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect();
+    let simulated: Vec<Event> = events(&lines)
+        .into_iter()
+        .filter(|e| field(e, "robot") == robot)
+        .collect();
+    same_behaviour(robot, &qemu, &simulated, duration, 500);
+    qemu
+}
+
+#[test]
+fn the_follow_robot_runs_in_qemu_as_on_linux_sim() {
+    if !tools_present("the_follow_robot_runs_in_qemu_as_on_linux_sim") {
+        return;
+    }
+    let qemu = compare_with_linux_sim(
+        "follow",
+        &examples().join("follow/follow.mission"),
+        &fixture("follow.scenario.json"),
+        "create1",
+    );
+    // The scenario drives it from remote control to following, and the
+    // operator's commands and its reports pass the compiled-in operator.
+    assert_eq!(modes(&qemu), ["RC_MODE", "AUTO_MODE"]);
+    let calls = calls(&qemu);
+    assert!(
+        calls.contains(&"process".to_string()) && calls.contains(&"follow".to_string()),
+        "{calls:?}"
+    );
+    let received = qemu
+        .iter()
+        .filter(|e| field(e, "event") == "receive" && field(e, "key") == "USER.RC_CMD")
+        .count();
+    assert!(received >= 4, "operator commands every 500 ms: {received}");
+    let sent_location = qemu.iter().any(|e| {
+        field(e, "event") == "send"
+            && field(e, "key") == "Team1.LOCATION"
+            && field(e, "value") == "2,3"
+    });
+    assert!(
+        sent_location,
+        "the scenario's sensor value is reported to USER"
+    );
+}
+
+#[test]
+fn a_swarm_robot_runs_in_qemu_as_on_linux_sim() {
+    if !tools_present("a_swarm_robot_runs_in_qemu_as_on_linux_sim") {
+        return;
+    }
+    let qemu = compare_with_linux_sim(
+        "swarm",
+        &fixture("swarm.mission"),
+        &fixture("swarm.scenario.json"),
+        "quad_1",
+    );
+    assert_eq!(modes(&qemu), ["MARCH", "AVOID"]);
+    assert_eq!(calls(&qemu).last().map(String::as_str), Some("turn_back"));
+}
+
+/// Issue 19's budgets: the follow robot within 32 KB of flash and 8 KB of
+/// RAM, the swarm robots within 64 KB and 16 KB (the build a user makes:
+/// target cortex-m, the task files as generated).
+#[test]
+fn robots_fit_the_flash_and_ram_budgets() {
+    if !tools_present("robots_fit_the_flash_and_ram_budgets") {
+        return;
+    }
+    let out = scratch("cortex-m-budgets");
+    let follow = build_for(
+        &examples().join("follow/follow.mission"),
+        "cortex-m",
+        None,
+        &out.join("follow"),
+    );
+    let (flash, ram) = size(&make(&follow[0]));
+    eprintln!("follow robot on cortex-m: flash {flash} B, RAM {ram} B");
+    assert!(flash <= 32 * 1024, "follow robot flash {flash} B > 32 KB");
+    assert!(ram <= 8 * 1024, "follow robot RAM {ram} B > 8 KB");
+    for folder in build_for(
+        &fixture("swarm.mission"),
+        "cortex-m",
+        None,
+        &out.join("swarm"),
+    ) {
+        let (flash, ram) = size(&make(&folder));
+        eprintln!("{}: flash {flash} B, RAM {ram} B", folder.display());
+        assert!(
+            flash <= 64 * 1024 && ram <= 16 * 1024,
+            "{}: {flash} B / {ram} B",
+            folder.display()
+        );
+    }
+}
