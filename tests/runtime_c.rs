@@ -373,6 +373,17 @@ fn tasks_channels_control_timers_and_trace_escaping() {
     }
 }
 
+/// A time-driven task that calls `semo_next_firing(INT64_MAX)` sleeps
+/// through its periods and fires again only when a sample arrives (the
+/// program checks its own counts: 2 firings, 1 sample, over 300 ms of
+/// 10 ms periods).
+#[test]
+fn a_task_waiting_for_events_does_not_poll() {
+    for flavor in flavors() {
+        program(flavor).run_ok(&["wake"]);
+    }
+}
+
 /// A base port with base and base+1 free on 127.0.0.1 right now.
 fn free_port_pair() -> u16 {
     for _ in 0..100 {

@@ -18,9 +18,14 @@ use std::path::PathBuf;
     version,
     about = "SeMo: mission scripts for teams of cooperating robots",
     long_about = "SeMo checks mission scripts (*.mission) against a robot catalog (the built-in \
-                  one plus any *.robot.xml files), lays them out canonically (`semo fmt`), and \
-                  will refine them into per-robot task graphs and C code.\n\nExit status: 0 when no errors were found, 1 when \
-                  errors were found, 2 for a usage or I/O problem."
+                  one plus any *.robot.xml files) and strategy files (`semo check`), lays them \
+                  out canonically (`semo fmt`), refines them into one task graph and C program \
+                  per robot (`semo build`), runs them together in virtual time (`semo simulate`), \
+                  analyses and draws task graphs and mode machines (`semo graph`), explains \
+                  diagnostic codes (`semo explain`) and serves editors (`semo lsp`).\n\n\
+                  Colour: --color, else NO_COLOR turns it off, CLICOLOR_FORCE on, TERM=dumb \
+                  off, and otherwise it is on only on a terminal.\n\nExit status: 0 when no \
+                  errors were found, 1 when errors were found, 2 for a usage or I/O problem."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -37,10 +42,11 @@ enum Command {
         *.strategy.xml and *.taskgraph.xml file under it. All catalog files found form one \
         catalog (on top of the built-in one), every mission is checked against it, and \
         every strategy file against the catalog and the missions. With no PATH, the \
-        current folder is checked."
+        current folder is checked. `-` reads a mission from standard input (checked \
+        against the built-in catalog alone)."
     )]
     Check {
-        /// Files or folders to check.
+        /// Files or folders to check (`-`: a mission on standard input).
         paths: Vec<PathBuf>,
         /// How to print diagnostics: `human` (source snippets) or `json` (one
         /// object per line: code, severity, file, start/end line and column,
@@ -50,6 +56,10 @@ enum Command {
         /// Colour the human output: `auto` colours it when writing to a terminal.
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
+        /// Treat these as errors for the exit status: `warnings` makes any
+        /// warning exit with 1.
+        #[arg(long, value_enum, value_name = "WHAT")]
+        deny: Vec<Deny>,
     },
     /// Rewrite mission scripts in the canonical layout.
     #[command(
@@ -303,6 +313,11 @@ enum SummaryFormat {
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+enum Deny {
+    Warnings,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
 enum ColorChoice {
     Auto,
     Always,
@@ -329,7 +344,14 @@ fn run() -> i32 {
             paths,
             format,
             color,
-        } => check(paths, format, use_color(color), &mut out),
+            deny,
+        } => check(
+            paths,
+            format,
+            use_color(color),
+            deny.contains(&Deny::Warnings),
+            &mut out,
+        ),
         Command::Fmt {
             paths,
             check,
@@ -450,22 +472,57 @@ fn parse_target(name: &str) -> Result<semo::codegen::Target, String> {
 }
 
 fn use_color(choice: ColorChoice) -> bool {
+    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty());
+    colour_auto(
+        choice,
+        var("NO_COLOR").is_some(),
+        var("CLICOLOR_FORCE").is_some_and(|v| v != "0"),
+        std::env::var_os("TERM").is_some_and(|t| t == "dumb"),
+        std::io::stdout().is_terminal(),
+    )
+}
+
+/// Whether to colour: an explicit `--color` wins; else `NO_COLOR` (set, not
+/// empty) turns it off, `CLICOLOR_FORCE` (set, not `0`) on, `TERM=dumb` off,
+/// and otherwise a terminal decides (no-color.org, bixense.com/clicolors).
+fn colour_auto(
+    choice: ColorChoice,
+    no_color: bool,
+    force: bool,
+    dumb: bool,
+    terminal: bool,
+) -> bool {
     match choice {
         ColorChoice::Always => true,
         ColorChoice::Never => false,
-        ColorChoice::Auto => {
-            std::io::stdout().is_terminal() && std::env::var_os("NO_COLOR").is_none()
-        }
+        ColorChoice::Auto => !no_color && (force || (!dumb && terminal)),
     }
 }
 
-fn check(paths: Vec<PathBuf>, format: Format, color: bool, out: &mut impl Write) -> i32 {
+fn check(
+    paths: Vec<PathBuf>,
+    format: Format,
+    color: bool,
+    deny_warnings: bool,
+    out: &mut impl Write,
+) -> i32 {
     let paths = if paths.is_empty() {
         vec![PathBuf::from(".")]
     } else {
         paths
     };
-    let run = match semo::host::load_check(&paths) {
+    let loaded = if paths.iter().any(|p| p.as_os_str() == "-") {
+        if paths.len() > 1 {
+            eprintln!(
+                "error: `-` (a mission on standard input) cannot be checked with other paths"
+            );
+            return 2;
+        }
+        read_stdin().map(semo::host::load_check_stdin)
+    } else {
+        semo::host::load_check(&paths).map_err(|e| e.to_string())
+    };
+    let run = match loaded {
         Ok(run) => run,
         Err(e) => {
             eprintln!("error: {e}");
@@ -485,7 +542,38 @@ fn check(paths: Vec<PathBuf>, format: Format, color: bool, out: &mut impl Write)
         }
         Ok(()) => {}
     }
-    if run.error_count() > 0 { 1 } else { 0 }
+    let warnings = run
+        .diagnostics
+        .iter()
+        .filter(|d| d.severity == semo::diag::Severity::Warning)
+        .count();
+    if run.error_count() > 0 {
+        1
+    } else if deny_warnings && warnings > 0 {
+        eprintln!("error: {warnings} warning(s), denied by --deny warnings");
+        1
+    } else {
+        0
+    }
+}
+
+/// All of standard input as text (at most the limit any input file has).
+fn read_stdin() -> Result<String, String> {
+    use std::io::Read;
+    let limit = semo::fsread::MAX_FILE_BYTES;
+    let mut bytes = Vec::new();
+    std::io::stdin()
+        .lock()
+        .take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read standard input: {e}"))?;
+    if bytes.len() as u64 > limit {
+        return Err(format!(
+            "standard input is larger than {limit} bytes, the most a mission may be"
+        ));
+    }
+    // As for files: invalid UTF-8 is replaced, and then reported where it is.
+    Ok(String::from_utf8_lossy(&bytes).into_owned())
 }
 
 fn explain(code: Option<&str>, out: &mut impl Write) -> i32 {
@@ -509,4 +597,32 @@ fn explain(code: Option<&str>, out: &mut impl Write) -> i32 {
         );
     }
     0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{ColorChoice, colour_auto};
+
+    #[test]
+    fn colour_follows_the_flag_then_the_environment_then_the_terminal() {
+        use ColorChoice::*;
+        // (choice, NO_COLOR, CLICOLOR_FORCE, TERM=dumb, terminal) → colour
+        let cases = [
+            (Always, true, false, true, false, true),
+            (Never, false, true, false, true, false),
+            (Auto, false, false, false, true, true),
+            (Auto, false, false, false, false, false),
+            (Auto, true, true, false, true, false),
+            (Auto, false, true, false, false, true),
+            (Auto, false, true, true, false, true),
+            (Auto, false, false, true, true, false),
+        ];
+        for (choice, no, force, dumb, tty, want) in cases {
+            assert_eq!(
+                colour_auto(choice, no, force, dumb, tty),
+                want,
+                "{choice:?} NO_COLOR={no} CLICOLOR_FORCE={force} dumb={dumb} tty={tty}"
+            );
+        }
+    }
 }

@@ -13,7 +13,8 @@ fn kind(severity: Severity) -> ReportKind<'static> {
     match severity {
         Severity::Error => ReportKind::Error,
         Severity::Warning => ReportKind::Warning,
-        Severity::Hint => ReportKind::Advice,
+        // ariadne calls them "Advice"; the toolchain calls them hints.
+        Severity::Hint => ReportKind::Custom("Hint", Color::Cyan),
     }
 }
 

@@ -87,6 +87,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         &sim::Options {
             until_ms: options.until_ms,
             seed: options.seed,
+            ..sim::Options::default()
         },
     );
     let verdicts = sim::expect::judge(&run, &scenario.expect);

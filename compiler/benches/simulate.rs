@@ -2,7 +2,9 @@
 //! mission time until every robot finished, 3 robots; goal under 20 ms of
 //! wall time) and 102 robots of the generated benchmark mission for 10
 //! minutes of mission time (goal under 1 s), each with the cost per
-//! simulated event. Run with `cargo bench --bench simulate`.
+//! simulated event. Each is measured also with every control firing
+//! simulated (`Options::every_firing`), which skipping idle firings
+//! replaces. Run with `cargo bench --bench simulate`.
 
 mod common;
 use common::fastest;
@@ -27,8 +29,29 @@ fn programs(files: semo::workspace::Files, id: semo::diag::FileId) -> Vec<RobotP
 }
 
 fn measure(name: &str, programs: &[RobotProgram], scenario_text: &str, until_ms: Option<i64>) {
+    for every_firing in [false, true] {
+        let name = if every_firing {
+            format!("{name} (every firing, the reference)")
+        } else {
+            name.to_string()
+        };
+        measure_once(&name, programs, scenario_text, until_ms, every_firing);
+    }
+}
+
+fn measure_once(
+    name: &str,
+    programs: &[RobotProgram],
+    scenario_text: &str,
+    until_ms: Option<i64>,
+    every_firing: bool,
+) {
     let scenario = scenario::parse(scenario_text, programs).expect("the scenario reads");
-    let options = sim::Options { until_ms, seed: 1 };
+    let options = sim::Options {
+        until_ms,
+        seed: 1,
+        every_firing,
+    };
     let run = sim::simulate(programs, &scenario, &options);
     let best = fastest(Duration::from_secs(3), || {
         std::hint::black_box(sim::simulate(programs, &scenario, &options).events);

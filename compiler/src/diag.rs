@@ -69,7 +69,7 @@ codes! {
     InvalidCharacter = "E001", Error, "a character that the language does not use";
     UnterminatedString = "E002", Error, "a string without its closing quote";
     SyntaxError = "E003", Error, "the text does not follow the grammar";
-    TooManyProblems = "E004", Error, "more syntax problems than are shown (the first 100 are; the file may not be a mission script)";
+    TooManyProblems = "E004", Error, "more problems than are shown (the first 100 syntax problems and the first 200 of a file are; the file may not be what it claims to be)";
     // Names and structure.
     UnknownRobotType = "E010", Error, "a robot type that the catalog does not have";
     DuplicateTeam = "E011", Error, "a team declared twice";
@@ -266,4 +266,69 @@ pub fn sort_and_dedup(diags: &mut Vec<Diagnostic>) {
     diags.dedup_by(|a, b| {
         a.file == b.file && a.span == b.span && a.code == b.code && a.message == b.message
     });
+}
+
+/// The most diagnostics reported for one file, whatever found them (syntax,
+/// checker, loaders, cross-checks): past them the file is more likely junk
+/// than work in progress, and every further one costs the renderer and the
+/// editor time and memory without telling the user anything new.
+pub const MAX_PER_FILE: usize = 200;
+
+/// Keeps the first [`MAX_PER_FILE`] of one file's sorted diagnostics and, if
+/// there were more, adds one E004 at the first one left out saying how many.
+pub fn cap_per_file(diags: &mut Vec<Diagnostic>) {
+    if diags.len() <= MAX_PER_FILE {
+        return;
+    }
+    let hidden = diags.len() - MAX_PER_FILE;
+    let first_hidden = &diags[MAX_PER_FILE];
+    let note = Diagnostic::new(
+        Code::TooManyProblems,
+        first_hidden.file,
+        first_hidden.span,
+        format!(
+            "{hidden} more problem(s) in this file from here on are not shown \
+             (the first {MAX_PER_FILE} are): fix the ones above first"
+        ),
+    );
+    diags.truncate(MAX_PER_FILE);
+    diags.push(note);
+}
+
+#[cfg(test)]
+mod cap_tests {
+    use super::*;
+
+    fn at(start: usize) -> Diagnostic {
+        Diagnostic::new(
+            Code::UnknownTeam,
+            FileId(3),
+            Span::new(start, start + 1),
+            "x",
+        )
+    }
+
+    #[test]
+    fn a_file_with_few_diagnostics_keeps_them_all() {
+        let mut diags: Vec<Diagnostic> = (0..MAX_PER_FILE).map(at).collect();
+        cap_per_file(&mut diags);
+        assert_eq!(diags.len(), MAX_PER_FILE);
+        assert!(diags.iter().all(|d| d.code == Code::UnknownTeam));
+    }
+
+    #[test]
+    fn past_the_cap_one_e004_says_how_many_more_and_where_they_start() {
+        let mut diags: Vec<Diagnostic> = (0..MAX_PER_FILE + 57).map(at).collect();
+        cap_per_file(&mut diags);
+        assert_eq!(diags.len(), MAX_PER_FILE + 1);
+        let note = diags.last().unwrap();
+        assert_eq!(note.code, Code::TooManyProblems);
+        assert_eq!(note.file, FileId(3));
+        assert_eq!(note.span, Span::new(MAX_PER_FILE, MAX_PER_FILE + 1));
+        assert!(
+            note.message.starts_with("57 more problem(s)"),
+            "{}",
+            note.message
+        );
+    }
 }

@@ -654,7 +654,8 @@ impl Analysis {
     }
 
     /// The diagnostics of one file, sorted: its own, and those every unit
-    /// that sees it found in it.
+    /// that sees it found in it; at most [`diag::MAX_PER_FILE`], then one E004
+    /// (every door reports through here, so all report the same).
     pub fn diagnostics(&self, id: FileId) -> Vec<Diagnostic> {
         let Some(file) = self.file(id) else {
             return Vec::new();
@@ -699,6 +700,7 @@ impl Analysis {
             }
         };
         diag::sort_and_dedup(&mut found);
+        diag::cap_per_file(&mut found);
         found
     }
 
@@ -857,4 +859,4 @@ mod disk;
 #[cfg(test)]
 mod tests;
 
-pub use disk::{CheckRun, load_build, load_check};
+pub use disk::{CheckRun, STDIN_NAME, load_build, load_check, load_check_stdin};

@@ -91,9 +91,10 @@ async fn publish(state: &Arc<State>, client: &Client, uri: Uri) {
     };
     let later = snapshot.kind == FileKind::Mission && dataflow.is_none();
     let extra = dataflow.as_ref().map_or(&[][..], |d| &d.diagnostics[..]);
+    // The file's own diagnostics are capped by the library (`diag::MAX_PER_FILE`);
+    // the dataflow warnings are at most a few per service call.
     let mut diagnostics = to_lsp(&snapshot, &analysis, &others);
     diagnostics.extend(dataflow_to_lsp(state, &snapshot, &analysis, extra));
-    cap(&mut diagnostics);
     let version = snapshot.version;
     drop(analysis);
     if later {
@@ -139,7 +140,6 @@ async fn publish_dataflow(state: Arc<State>, client: Client, snapshot: Arc<Snaps
     }
     let mut diagnostics = to_lsp(&snapshot, &analysis, &others);
     diagnostics.extend(dataflow_to_lsp(&state, &snapshot, &analysis, extra));
-    cap(&mut diagnostics);
     let (uri, version) = (snapshot.uri.clone(), snapshot.version);
     drop(analysis);
     retire(snapshot);
@@ -253,29 +253,6 @@ pub fn convert(d: &semo::diag::Diagnostic, range: lsp::Range) -> lsp::Diagnostic
             .map(|s| serde_json::json!({ "suggestion": s })),
         code_description: None,
     }
-}
-
-/// Editors slow to a crawl on files with many thousands of problems (a pasted
-/// binary, say): the first [`MAX_PUBLISHED`] are published, then one note.
-pub const MAX_PUBLISHED: usize = 1000;
-
-fn cap(diagnostics: &mut Vec<lsp::Diagnostic>) {
-    if diagnostics.len() <= MAX_PUBLISHED {
-        return;
-    }
-    let hidden = diagnostics.len() - MAX_PUBLISHED;
-    diagnostics.truncate(MAX_PUBLISHED);
-    let range = diagnostics[MAX_PUBLISHED - 1].range;
-    diagnostics.push(lsp::Diagnostic {
-        range,
-        severity: Some(lsp::DiagnosticSeverity::INFORMATION),
-        source: Some("semo".to_string()),
-        message: format!(
-            "{hidden} more problems in this file are not shown (the first {MAX_PUBLISHED} are); \
-             `semo check` lists them all"
-        ),
-        ..Default::default()
-    });
 }
 
 fn severity(s: Severity) -> lsp::DiagnosticSeverity {

@@ -103,7 +103,8 @@ impl Backend {
     }
 
     /// `semo.simulate`: the mission's robots run on a scenario; the summary,
-    /// the timeline SVG and the expectations, or the reason for refusing.
+    /// the timeline SVG and the expectations, or the reason for refusing;
+    /// the scenario file's diagnostics published.
     async fn simulate(&self, arguments: &[serde_json::Value]) -> Result<serde_json::Value> {
         use handlers::simulate;
         let params = simulate::params(arguments).map_err(Error::invalid_params)?;
@@ -111,10 +112,15 @@ impl Backend {
             let world = self.state.world();
             simulate::job(&world, params).map_err(handlers::request_failed)?
         };
-        tokio::task::spawn_blocking(move || simulate::simulate(&job))
+        let outcome = tokio::task::spawn_blocking(move || simulate::simulate(&job))
             .await
-            .map_err(|_| Error::internal_error())?
-            .map_err(handlers::request_failed)
+            .map_err(|_| Error::internal_error())?;
+        if let Some((uri, diagnostics)) = outcome.scenario {
+            self.client
+                .publish_diagnostics(uri, diagnostics, None)
+                .await;
+        }
+        outcome.answer.map_err(handlers::request_failed)
     }
 
     /// `semo.generateCode`: generates the code of a mission, reporting each
@@ -192,13 +198,16 @@ impl Backend {
             .map_err(|_| Error::internal_error())?;
         let mut transaction = match begun {
             Ok(t) => t,
-            Err(message) => {
+            Err(refused) => {
                 if let Some(p) = progress {
                     p.finish_with_message("refused").await;
                 }
-                let message = format!("SeMo: {message}");
+                let message = format!("SeMo: {}", refused.message);
                 self.client.show_message(MessageType::ERROR, &message).await;
-                return Err(handlers::request_failed(message));
+                return Err(Error {
+                    data: refused.data,
+                    ..handlers::request_failed(message)
+                });
             }
         };
         let recovered = transaction.recovered.clone();

@@ -148,6 +148,20 @@ async fn a_target_switch_over_an_edited_task_file_is_refused_unless_forced() {
     let text = message(&refused);
     assert!(text.contains("tasks/follow.c"), "{text}");
     assert!(text.contains("force"), "{text}");
+    // The files in the way as data, for the editor's "Back up and regenerate".
+    let conflicts = refused["data"]["conflicts"].as_array().unwrap();
+    assert_eq!(conflicts.len(), 1, "{refused}");
+    assert!(
+        conflicts[0]["path"]
+            .as_str()
+            .unwrap()
+            .ends_with("tasks/follow.c"),
+        "{refused}"
+    );
+    assert!(
+        !conflicts[0]["why"].as_str().unwrap().is_empty(),
+        "{refused}"
+    );
     assert_eq!(std::fs::read_to_string(&task).unwrap(), "/* mine */\n");
     let mut forced = sim;
     forced["force"] = json!(true);

@@ -146,10 +146,14 @@ async fn a_ten_megabyte_document_is_checked_and_its_diagnostics_capped() {
     client.initialize(&["utf-16"], None).await;
     client.open(uri, &text).await;
     let diags: Vec<Value> = client.diagnostics(uri, Some(1)).await;
-    assert_eq!(diags.len(), semo_server::diagnostics::MAX_PUBLISHED + 1);
+    assert_eq!(diags.len(), semo::diag::MAX_PER_FILE + 1);
     let last = diags.last().unwrap();
+    assert_eq!(last["code"], "E004", "{last}");
     assert!(
-        last["message"].as_str().unwrap().contains("more problems"),
+        last["message"]
+            .as_str()
+            .unwrap()
+            .contains("more problem(s)"),
         "{last}"
     );
     // An edit at the end of the huge document is applied and re-checked.

@@ -61,6 +61,11 @@ async fn the_open_mission_is_simulated_with_its_scenario() {
         .await
         .unwrap();
     assert_eq!(answer["ok"], true, "{}", answer["summary"]);
+    let scenario_uri = uri(&dir.join("scouting.scenario.json"));
+    assert_eq!(
+        client.diagnostics(&scenario_uri, None).await,
+        Vec::<Value>::new()
+    );
     assert!(
         answer["summary"]
             .as_str()
@@ -107,6 +112,17 @@ async fn the_open_mission_is_simulated_with_its_scenario() {
     assert_eq!(answer["ok"], false);
     assert_eq!(answer["expectations"][0]["met"], false);
     assert_eq!(answer["expectations"][0]["why"], "never entered");
+    // The failure is a diagnostic on the scenario file, at the expectation.
+    let diagnostics = client.diagnostics(&scenario_uri, None).await;
+    assert_eq!(diagnostics.len(), 1, "{diagnostics:?}");
+    assert_eq!(
+        diagnostics[0]["range"], answer["expectations"][0]["range"],
+        "{diagnostics:?}"
+    );
+    assert_eq!(
+        diagnostics[0]["message"],
+        "expectation failed: irobot enters WAIT_MODE before 5000 ms: never entered"
+    );
 
     // A bad scenario: refused with its line and column.
     std::fs::write(
@@ -123,5 +139,36 @@ async fn the_open_mission_is_simulated_with_its_scenario() {
         ),
         "{refused}"
     );
+    // ... and a diagnostic at the value.
+    let diagnostics = client
+        .diagnostics(&uri(&dir.join("bad.scenario.json")), None)
+        .await;
+    assert_eq!(
+        diagnostics[0]["range"]["start"],
+        json!({"line": 1, "character": 14}),
+        "{diagnostics:?}"
+    );
+    client.shutdown().await;
+}
+
+/// Simulating writes nothing: a mission outside every workspace root (a
+/// file opened on its own) is simulated all the same.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_mission_outside_the_workspace_roots_is_simulated() {
+    let dir = workspace("outside");
+    let root = dir.join("elsewhere");
+    std::fs::create_dir_all(&root).unwrap();
+    let mut client = semo_server::harness::TestClient::start();
+    client.initialize_with(json!({}), Some(&uri(&root))).await;
+    let mission = dir.join("scouting.mission");
+    let mission_uri = uri(&mission);
+    client
+        .open(&mission_uri, &std::fs::read_to_string(&mission).unwrap())
+        .await;
+    client.diagnostics(&mission_uri, Some(1)).await;
+    let answer = simulate(&mut client, &mission_uri, "scouting.scenario.json")
+        .await
+        .unwrap();
+    assert_eq!(answer["ok"], true, "{}", answer["summary"]);
     client.shutdown().await;
 }

@@ -117,6 +117,37 @@ local function run()
   spec.root_dir(vim.api.nvim_get_current_buf(), function(dir) table.insert(roots, dir) end)
   check(#roots == 1 and roots[1] == vim.fn.resolve(workspace), 'lsp/semo.lua root_dir gave ' .. vim.inspect(roots))
   report('lsp/semo.lua: root ' .. roots[1])
+
+  -- 6. `:SemoSimulate`'s function on the mission with its mistake fixed: the summary, the
+  -- timeline written as SVG, and the failed expectation as a diagnostic on the scenario.
+  -- The empty strategy and catalog buffers of step 4 are closed first (they are errors).
+  for _, name in ipairs({ 'Rover.strategy.xml', 'beacon.robot.xml', 'loop.taskgraph.xml', 'plain.xml' }) do
+    vim.cmd('bwipeout! ' .. vim.fn.fnameescape(workspace .. '/' .. name))
+  end
+  local fixed = table.concat(vim.fn.readfile(workspace .. '/rover.mission'), '\n'):gsub('MOVNG', 'MOVING')
+  vim.fn.writefile(vim.split(fixed, '\n'), workspace .. '/drive.mission')
+  vim.fn.writefile({ '{"duration": 3000,',
+    ' "operator": [{"at": 1000, "to": "r", "value": "RC_CMD", "is": "go"}],',
+    ' "expect": [{"robot": "r", "enters": "MOVING", "before": 2500},',
+    '            {"robot": "r", "never_enters": "IDLE"}]}' }, workspace .. '/drive.scenario.json')
+  vim.cmd('edit ' .. vim.fn.fnameescape(workspace .. '/drive.mission'))
+  local mission = vim.api.nvim_get_current_buf()
+  check(vim.wait(30000, function() return semo_clients(mission) == 1 end, 50), 'drive.mission has no server')
+  check(vim.fn.exists(':SemoSimulate') == 2, 'no :SemoSimulate command')
+  local result
+  semo.simulate(mission, nil, nil, function(err, answer) result = { err = err, answer = answer } end)
+  check(vim.wait(30000, function() return result ~= nil end, 50), 'no simulation answer within 30 s')
+  check(result.err == nil, 'the simulation was refused: ' .. tostring(result.err))
+  local modes = result.answer.summary:match('Rover/r: ([^\n(]*)')
+  report('simulate: ' .. vim.trim(modes or '?') .. ', ok ' .. tostring(result.answer.ok))
+  local svg = table.concat(vim.fn.readfile(workspace .. '/drive.svg'), '\n')
+  check(result.answer.svg_path == workspace .. '/drive.svg' and svg:find('<svg', 1, true) == 1,
+    'the timeline was not written to drive.svg')
+  local scenario = vim.uri_to_bufnr(vim.uri_from_fname(workspace .. '/drive.scenario.json'))
+  check(vim.wait(10000, function() return #vim.diagnostic.get(scenario) > 0 end, 50),
+    'no diagnostic on the scenario')
+  local failed = vim.diagnostic.get(scenario)[1]
+  report(string.format('scenario diagnostic: %d:%d %s', failed.lnum + 1, failed.col + 1, failed.message))
 end
 
 local ok, err = pcall(run)

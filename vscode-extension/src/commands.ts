@@ -3,6 +3,13 @@
 import * as path from 'path';
 import * as vscode from 'vscode';
 import { ExecuteCommandRequest } from 'vscode-languageclient/node';
+import {
+  BACK_UP_AND_REGENERATE,
+  ConflictRefusal,
+  GenerateArguments,
+  forcePrompt,
+  generateWithConsent,
+} from './pure/generate';
 import { missionTemplateSnippet } from './pure/template';
 import { Server } from './server';
 
@@ -74,27 +81,40 @@ export async function generateCode(server: Server): Promise<void> {
     await document.save();
   }
   const outputFolder = outputFolderFor(document);
-  const result = await vscode.window.withProgress(
-    {
-      location: vscode.ProgressLocation.Notification,
-      title: `SeMo: generating code for ${path.basename(document.uri.path)}`,
-      cancellable: false,
-    },
-    async () => {
-      try {
-        return {
-          ok: true as const,
-          value: await client.sendRequest(ExecuteCommandRequest.type, {
-            command: GENERATE_CODE,
-            arguments: [{ uri: document.uri.toString(), outputFolder }],
-          }),
-        };
-      } catch (e) {
-        return { ok: false as const, error: e };
-      }
-    },
+  const send = (args: GenerateArguments) =>
+    vscode.window.withProgress(
+      {
+        location: vscode.ProgressLocation.Notification,
+        title: `SeMo: generating code for ${path.basename(document.uri.path)}`,
+        cancellable: false,
+      },
+      () =>
+        client.sendRequest(ExecuteCommandRequest.type, {
+          command: GENERATE_CODE,
+          arguments: [args],
+        }),
+    );
+  // Files in the way (edited, or another target's): a modal offers to save
+  // them under .semo-backup/ and generate again with `force`.
+  const askToForce = async (refusal: ConflictRefusal) => {
+    const { message, detail } = forcePrompt(refusal);
+    const choice = await vscode.window.showWarningMessage(
+      message,
+      { modal: true, detail },
+      BACK_UP_AND_REGENERATE,
+    );
+    return choice === BACK_UP_AND_REGENERATE;
+  };
+  const result = await generateWithConsent(
+    send,
+    { uri: document.uri.toString(), outputFolder },
+    askToForce,
   );
-  if (!result.ok) {
+  if (result.kind === 'declined') {
+    server.output.appendLine(`[info] code generation not forced:\n${result.refusal.message}`);
+    return;
+  }
+  if (result.kind === 'failed') {
     const message = result.error instanceof Error ? result.error.message : String(result.error);
     server.output.appendLine(`[error] ${GENERATE_CODE}: ${message}`);
     void vscode.window.showErrorMessage(`SeMo: code generation failed: ${message}`, 'Show Output')

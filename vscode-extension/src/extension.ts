@@ -6,6 +6,7 @@ import { checkWorkspace, generateCode, newMission } from './commands';
 import { GraphViews } from './graphView';
 import { insertNode, RobotsView } from './robotsView';
 import { Server } from './server';
+import { SimulationViews } from './simulateView';
 
 let server: Server | undefined;
 
@@ -14,6 +15,7 @@ export async function activate(context: vscode.ExtensionContext): Promise<void> 
   server = new Server(context, output);
   const robots = new RobotsView(server);
   const graphs = new GraphViews(server);
+  const simulations = new SimulationViews(server);
   const s = server;
   const robotsTree = vscode.window.createTreeView('semo.robots', { treeDataProvider: robots });
   robots.attach(robotsTree);
@@ -22,6 +24,7 @@ export async function activate(context: vscode.ExtensionContext): Promise<void> 
     server,
     robots,
     graphs,
+    simulations,
     robotsTree,
     vscode.commands.registerCommand('semo.restartServer', () => s.restart()),
     vscode.commands.registerCommand('semo.showOutput', () => output.show()),
@@ -30,6 +33,7 @@ export async function activate(context: vscode.ExtensionContext): Promise<void> 
     vscode.commands.registerCommand('semo.showTaskGraph', () => graphs.show('taskgraph')),
     vscode.commands.registerCommand('semo.showModeMachine', () => graphs.show('modes')),
     vscode.commands.registerCommand('semo.checkWorkspace', () => checkWorkspace(s)),
+    vscode.commands.registerCommand('semo.simulateMission', () => simulations.simulate()),
     vscode.commands.registerCommand('semo.robots.refresh', () => robots.refresh()),
     vscode.commands.registerCommand('semo.robots.insert', insertNode),
     vscode.workspace.onDidChangeConfiguration((e) => {

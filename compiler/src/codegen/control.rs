@@ -89,6 +89,7 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
         "typedef struct {\n    int service;        /* running service machine, -1 when none */\n    int pc;             /* its current state */\n    int phase;          /* progress inside a state that takes several firings */\n    int action;         /* current strategy action */\n    bool done;\n    int64_t started;    /* when the service started (mode timeouts) */\n    int64_t pass_start; /* when the current pass started (repeat periods) */\n    int64_t timeout_ms; /* from `set(..., timeout = P)`, 0 for none */\n    int64_t mark[MARK_COUNT];\n    const char *plan;\n} region;\n\n",
     );
     out.push_str("static region regions[REGION_COUNT];\nstatic int current_mode = -1;\nstatic int pending_mode = -1;\n\n");
+    out.push_str("/* When the machine next needs a firing without an event (data on its\n * channels, a task's state changed): the earliest deadline a waiting state\n * named in this firing. Waits on events name none: the task sleeps until one\n * comes (semo_next_firing). */\nstatic int64_t next_wake;\n\nstatic void wake_at(int64_t at)\n{\n    if (at < next_wake)\n        next_wake = at;\n}\n\n");
 
     // The machine first, so that only the helpers and port tables it uses
     // are written (unused static functions and arrays fail -Werror).
@@ -294,7 +295,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 Some(t) => {
                     let _ = writeln!(
                         out,
-                        "        if (r->phase == 0) {{\n            r->mark[{mark}] = semo_now_ms();\n            r->phase = 1;\n        }}\n        if (!({ready})) {{\n            if (semo_now_ms() - r->mark[{mark}] <= {t})\n                return STEP_WAIT;\n            semo_trace(\"timeout\", \"statement\", \"receive\", NULL);\n            r->phase = 0;\n            r->pc = {next};\n            return STEP_NEXT;\n        }}\n        r->phase = 0;"
+                        "        if (r->phase == 0) {{\n            r->mark[{mark}] = semo_now_ms();\n            r->phase = 1;\n        }}\n        if (!({ready})) {{\n            if (semo_now_ms() - r->mark[{mark}] <= {t}) {{\n                wake_at(r->mark[{mark}] + {t} + 1);\n                return STEP_WAIT;\n            }}\n            semo_trace(\"timeout\", \"statement\", \"receive\", NULL);\n            r->phase = 0;\n            r->pc = {next};\n            return STEP_NEXT;\n        }}\n        r->phase = 0;"
                     );
                 }
                 None => {
@@ -362,9 +363,14 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
             mark,
         } => {
             let port = request_index(program, task);
+            // The called task going idle wakes the control task; a timeout
+            // is a deadline of its own.
+            let wake = timeout_ms.map_or(String::new(), |t| {
+                format!("\n            wake_at(r->mark[{mark}] + {t} + 1);")
+            });
             let _ = writeln!(
                 out,
-                "        if (r->phase == 0) {{\n            if (!request(request_port[{port}], {task}, {service}, {argc}, {args}))\n                return STEP_WAIT;\n            r->mark[{mark}] = semo_now_ms();\n            r->phase = 1;\n            return STEP_WAIT;\n        }}",
+                "        if (r->phase == 0) {{\n            if (!request(request_port[{port}], {task}, {service}, {argc}, {args}))\n                return STEP_WAIT;\n            r->mark[{mark}] = semo_now_ms();\n            r->phase = 1;{wake}\n            return STEP_WAIT;\n        }}",
                 task = c::string(task),
                 service = c::string(service),
                 argc = args.len(),
@@ -373,7 +379,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
             if let Some(t) = timeout_ms {
                 let _ = writeln!(
                     out,
-                    "        if (semo_now_ms() - r->mark[{mark}] > {t}) {{\n            UFControl_StopTask({});\n            semo_trace(\"timeout\", \"service\", {}, NULL);\n        }} else",
+                    "        wake_at(r->mark[{mark}] + {t} + 1);\n        if (semo_now_ms() - r->mark[{mark}] > {t}) {{\n            UFControl_StopTask({});\n            semo_trace(\"timeout\", \"service\", {}, NULL);\n        }} else",
                     c::string(task),
                     c::string(service)
                 );
@@ -407,7 +413,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
             if let Some(t) = timeout_ms {
                 let _ = writeln!(
                     out,
-                    "        if (semo_now_ms() - r->mark[{mark}] > {t}) {{\n            semo_trace(\"timeout\", \"service\", {}, NULL);\n            r->phase = 0;\n            r->pc = {next};\n            return STEP_NEXT;\n        }}",
+                    "        wake_at(r->mark[{mark}] + {t} + 1);\n        if (semo_now_ms() - r->mark[{mark}] > {t}) {{\n            semo_trace(\"timeout\", \"service\", {}, NULL);\n            r->phase = 0;\n            r->pc = {next};\n            return STEP_NEXT;\n        }}",
                     c::string(service)
                 );
             }
@@ -465,13 +471,16 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 Some(p) => {
                     let _ = writeln!(
                         out,
-                        "        if (semo_now_ms() - r->mark[{mark}] < {p})\n            return STEP_WAIT;"
+                        "        if (semo_now_ms() - r->mark[{mark}] < {p}) {{\n            wake_at(r->mark[{mark}] + {p});\n            return STEP_WAIT;\n        }}"
                     );
                     let _ = writeln!(out, "        r->pc = {to};\n        return STEP_NEXT;");
                 }
                 // Without a period, one iteration per firing.
                 None => {
-                    let _ = writeln!(out, "        r->pc = {to};\n        return STEP_WAIT;");
+                    let _ = writeln!(
+                        out,
+                        "        r->pc = {to};\n        wake_at(semo_now_ms());\n        return STEP_WAIT;"
+                    );
                 }
             }
         }
@@ -490,11 +499,11 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
             if let Some(p) = period_ms {
                 let _ = writeln!(
                     out,
-                    "        if (semo_now_ms() - r->pass_start < {p})\n            return STEP_WAIT;\n        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        return STEP_NEXT;"
+                    "        if (semo_now_ms() - r->pass_start < {p}) {{\n            wake_at(r->pass_start + {p});\n            return STEP_WAIT;\n        }}\n        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        return STEP_NEXT;"
                 );
             } else if *forever || condition.is_some() {
                 // The next pass starts at the next firing.
-                out.push_str("        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        return STEP_WAIT;\n");
+                out.push_str("        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        wake_at(semo_now_ms());\n        return STEP_WAIT;\n");
             } else {
                 out.push_str("        return STEP_DONE;\n");
             }
@@ -671,13 +680,13 @@ fn emit_task(out: &mut String, program: &RobotProgram) {
         .map(|d| format!("MODE_{}", c::ident(&m.modes[d].name)));
     let _ = writeln!(
         out,
-        "/* One firing: read inputs, advance every region, then change mode if an\n * event asked for it; the robot is finished when no region runs any more. */\nvoid task_{name}_go(void)\n{{\n    read_inputs();"
+        "/* One firing: read inputs, advance every region, then change mode if an\n * event asked for it; the robot is finished when no region runs any more. */\nvoid task_{name}_go(void)\n{{\n    next_wake = INT64_MAX;\n    read_inputs();"
     );
     if m.heartbeat {
         // Tell the team this robot is alive, for leader elections.
         let _ = writeln!(
             out,
-            "    static int64_t last_heartbeat = -{hb};\n    if (semo_now_ms() - last_heartbeat >= {hb}) {{\n        semo_value alive;\n        last_heartbeat = semo_now_ms();\n        semo_value_set(&alive, {robot});\n        semo_comm_send({team}, SEMO_MSG_PUBLISH, {key}, &alive);\n    }}",
+            "    static int64_t last_heartbeat = -{hb};\n    if (semo_now_ms() - last_heartbeat >= {hb}) {{\n        semo_value alive;\n        last_heartbeat = semo_now_ms();\n        semo_value_set(&alive, {robot});\n        semo_comm_send({team}, SEMO_MSG_PUBLISH, {key}, &alive);\n    }}\n    wake_at(last_heartbeat + {hb});",
             hb = crate::refine::HEARTBEAT_MS,
             robot = c::string(&program.robot),
             team = c::string(&program.team),
@@ -702,6 +711,6 @@ fn emit_task(out: &mut String, program: &RobotProgram) {
     };
     let _ = writeln!(
         out,
-        "    bool running = false;\n    for (int i = 0; i < REGION_COUNT && pending_mode < 0; i++) {{\n        region *r = &regions[i];\n        if (r->service < 0 || r->done)\n            continue;\n        if (r->timeout_ms > 0 && semo_now_ms() - r->started > r->timeout_ms) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], \"why\", \"timeout\", NULL);\n            continue;\n        }}\n        int result = STEP_NEXT;\n        for (int n = 0; n < {STEPS_PER_FIRING} && result == STEP_NEXT && pending_mode < 0; n++)\n            result = step(r);\n        if (result == STEP_DONE) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], NULL);\n        }} else {{\n            running = true;\n        }}\n    }}\n    if (pending_mode >= 0) {{\n        int next = pending_mode;\n        leave_mode();\n        pending_mode = -1;\n        enter_mode(next);\n        return;\n    }}\n    if (!running) {{\n        semo_trace(\"finish\", \"mode\", mode_name[current_mode], NULL);\n{flush}        semo_stop_program();\n    }}\n}}\n\nvoid task_{name}_wrapup(void)\n{{\n}}"
+        "    bool running = false;\n    for (int i = 0; i < REGION_COUNT && pending_mode < 0; i++) {{\n        region *r = &regions[i];\n        if (r->service < 0 || r->done)\n            continue;\n        if (r->timeout_ms > 0 && semo_now_ms() - r->started > r->timeout_ms) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], \"why\", \"timeout\", NULL);\n            continue;\n        }}\n        if (r->timeout_ms > 0)\n            wake_at(r->started + r->timeout_ms + 1);\n        int result = STEP_NEXT;\n        for (int n = 0; n < {STEPS_PER_FIRING} && result == STEP_NEXT && pending_mode < 0; n++)\n            result = step(r);\n        if (result == STEP_NEXT)\n            wake_at(semo_now_ms()); /* more to do than one firing takes */\n        if (result == STEP_DONE) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], NULL);\n        }} else {{\n            running = true;\n        }}\n    }}\n    if (pending_mode >= 0) {{\n        int next = pending_mode;\n        leave_mode();\n        pending_mode = -1;\n        enter_mode(next);\n        return;\n    }}\n    if (!running) {{\n        semo_trace(\"finish\", \"mode\", mode_name[current_mode], NULL);\n{flush}        semo_stop_program();\n        return;\n    }}\n    semo_next_firing(next_wake);\n}}\n\nvoid task_{name}_wrapup(void)\n{{\n}}"
     );
 }

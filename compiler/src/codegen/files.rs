@@ -252,7 +252,7 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         let n = m.outgoing.len();
         let _ = writeln!(
             out,
-            "}};\nstatic int outgoing_port[{n}];\n\nvoid task_{send}_init(void)\n{{\n    for (int i = 0; i < {n}; i++)\n        outgoing_port[i] = UFPort_Initialize({send_name}, outgoing[i].port);\n}}\n\nvoid task_{send}_go(void)\n{{\n    for (int i = 0; i < {n}; i++) {{\n        semo_value v;\n        while (UFPort_GetNumOfAvailableData(outgoing_port[i]) > 0\n               && UFPort_ReadFromQueue(outgoing_port[i], &v, sizeof v) > 0)\n            semo_comm_send(outgoing[i].to_team, outgoing[i].kind, outgoing[i].key, &v);\n    }}\n}}\n\nvoid task_{send}_wrapup(void)\n{{\n}}\n",
+            "}};\nstatic int outgoing_port[{n}];\n\nvoid task_{send}_init(void)\n{{\n    for (int i = 0; i < {n}; i++)\n        outgoing_port[i] = UFPort_Initialize({send_name}, outgoing[i].port);\n}}\n\nvoid task_{send}_go(void)\n{{\n    for (int i = 0; i < {n}; i++) {{\n        semo_value v;\n        while (UFPort_GetNumOfAvailableData(outgoing_port[i]) > 0\n               && UFPort_ReadFromQueue(outgoing_port[i], &v, sizeof v) > 0)\n            semo_comm_send(outgoing[i].to_team, outgoing[i].kind, outgoing[i].key, &v);\n    }}\n    /* Nothing to send until the control task writes again. */\n    semo_next_firing(INT64_MAX);\n}}\n\nvoid task_{send}_wrapup(void)\n{{\n}}\n",
             send = c::ident(COMM_SEND),
             send_name = c::string(COMM_SEND)
         );

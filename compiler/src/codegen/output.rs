@@ -28,6 +28,12 @@
 //!   as links, and FIFOs, sockets and devices are carried over unopened and
 //!   reported ([`Written::left_alone`]). The server's output folder must lie
 //!   in the workspace ([`confine`]).
+//! - **Durable.** Every file written is synced; the new robot folder is synced
+//!   whole before the swap, the team folder after every rename, exchange and
+//!   removal, backups before what they save is replaced (all through
+//!   `fsops`, counted steps). After a power cut each robot folder is thus
+//!   the old or the new one, or the old one under its journal name (restored
+//!   by the next run); only the interrupted generation itself may be lost.
 
 mod fsops;
 pub mod manifest;
@@ -203,6 +209,9 @@ impl Transaction {
                     ));
                 }
             }
+            if !leftovers.is_empty() {
+                fsops::sync_dir(&team_dir).map_err(at(&team_dir))?;
+            }
         }
         Ok(())
     }
@@ -250,11 +259,20 @@ impl Transaction {
             save(&conflict.path, &saved, kind, &plan.old, rel).map_err(at(&saved))?;
             written.backed_up.push(saved);
         }
+        if !plan.conflicts.is_empty() {
+            // The saved copies are on disk before anything they save goes.
+            fsops::sync_tree(&self.backup).map_err(at(&self.backup))?;
+            for folder in self.backup.ancestors().skip(1).take(2) {
+                fsops::sync_dir(folder).map_err(at(folder))?;
+            }
+        }
         let temp = sibling(&folder, "semo-new");
         if std::fs::symlink_metadata(&temp).is_ok() {
             fsops::remove_tree(&temp).map_err(at(&temp))?;
         }
         plan.fill(&temp, &folder, &mut written).map_err(at(&temp))?;
+        // The new folder whole on disk before it replaces the old one.
+        fsops::sync_tree(&temp).map_err(at(&temp))?;
         swap(&temp, &folder)?;
         Ok(written)
     }
@@ -269,7 +287,8 @@ impl Transaction {
         let team_dir = self.out.join(&robot.team);
         match std::fs::symlink_metadata(&team_dir) {
             Err(e) if e.kind() == io::ErrorKind::NotFound => {
-                fsops::create_dir(&team_dir).map_err(at(&team_dir))?
+                fsops::create_dir(&team_dir).map_err(at(&team_dir))?;
+                fsops::sync_dir(&self.out).map_err(at(&self.out))?
             }
             Err(e) => return Err(OutputError::Io(team_dir, e)),
             Ok(m) => check_real_dir(&team_dir, &m)?,
@@ -328,22 +347,33 @@ fn leftover(name: &str) -> Option<(&str, bool)> {
     }
 }
 
-/// Swaps the filled `temp` in as `folder`; then the old folder goes.
+/// Swaps the filled `temp` in as `folder`; then the old folder goes. The
+/// team folder is synced after each change of its names, so that after a
+/// power cut it holds what the journal says (see the module's documentation).
 fn swap(temp: &Path, folder: &Path) -> Result<(), OutputError> {
+    let parent = folder.parent().unwrap_or(Path::new("."));
+    let sync = || fsops::sync_dir(parent).map_err(at(parent));
     if std::fs::symlink_metadata(folder).is_err() {
-        return fsops::rename(temp, folder).map_err(at(folder));
+        fsops::rename(temp, folder).map_err(at(folder))?;
+        return sync();
     }
     if fsops::exchange(temp, folder).map_err(at(folder))? {
+        sync()?;
         // `temp` now holds the old folder.
-        return fsops::remove_tree(temp).map_err(at(temp));
+        fsops::remove_tree(temp).map_err(at(temp))?;
+        return sync();
     }
     let old = sibling(folder, "semo-old");
     if std::fs::symlink_metadata(&old).is_ok() {
         fsops::remove_tree(&old).map_err(at(&old))?;
+        sync()?;
     }
     fsops::rename(folder, &old).map_err(at(folder))?;
+    sync()?;
     fsops::rename(temp, folder).map_err(at(folder))?;
-    fsops::remove_tree(&old).map_err(at(&old))
+    sync()?;
+    fsops::remove_tree(&old).map_err(at(&old))?;
+    sync()
 }
 
 /// What an entry of the old folder is (without following links).

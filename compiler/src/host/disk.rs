@@ -125,6 +125,22 @@ impl Loader {
     }
 }
 
+/// How a mission read from standard input is named in reports.
+pub const STDIN_NAME: &str = "<stdin>";
+
+/// `semo check -`: a mission given as text, not a file, so it sees no other
+/// file (as an editor's unsaved document): checked against the built-in
+/// catalog alone.
+pub fn load_check_stdin(text: String) -> CheckRun {
+    let mut loader = Loader::default();
+    let shared: Arc<str> = text.as_str().into();
+    let id = loader
+        .files
+        .add(PathBuf::from(STDIN_NAME), FileKind::Mission, text);
+    loader.host.set_file(id, None, FileKind::Mission, shared);
+    loader.finish(Roots::default(), vec![id])
+}
+
 /// `semo check PATH…`: a folder is a workspace root, and every file under it
 /// is reported; a file's folder is its root, and the file is reported with
 /// the catalog and strategy files it sees.

@@ -16,6 +16,15 @@
 //!   link faults), the receive task's routing → [`Sim::deliver`];
 //! - `comm_last_seen` and `elected` → `last_seen` and [`Sim::elected`];
 //! - the library task's values → `Robot::library`.
+//!
+//! Idle firings are skipped: a firing that traced nothing and changed no
+//! state (`Robot::progressed`) would repeat itself exactly until something
+//! it reads changes, so the robot's next firing is put at its next wake-up
+//! ([`Sim::wake_up`]: a timer, a sensor sample, a heartbeat) or at the first
+//! firing after a message or a call's end reaches it ([`Sim::wake`]). The
+//! firing of a control task is on the same 10 ms grid and in the same order
+//! among robots as when every firing is simulated ([`Options::every_firing`],
+//! the reference the skipping is tested against), so the trace is the same.
 
 use super::scenario::{Command, DEFAULT_SERVICE_MS, FaultKind, Scenario};
 use super::trace::TraceEvent;
@@ -40,12 +49,15 @@ const VALUE_MAX: usize = 63;
 /// Default length of a run when neither the caller nor the scenario bounds it.
 pub const DEFAULT_UNTIL_MS: i64 = 10 * 60 * 1000;
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Options {
     /// Mission ms to run (default: the scenario's `duration`, else 10 min).
     pub until_ms: Option<i64>,
     /// Seeds message loss; a run is a function of programs, scenario and seed.
     pub seed: u64,
+    /// Simulates every control firing, idle ones too: the slow reference
+    /// against which skipping idle firings is tested (the trace is the same).
+    pub every_firing: bool,
 }
 
 /// The outcome of a run.
@@ -88,6 +100,8 @@ enum Event {
     Fire {
         robot: usize,
         epoch: u32,
+        /// Invalidates a firing moved earlier by [`Sim::wake`].
+        token: u64,
     },
 }
 
@@ -106,13 +120,40 @@ impl Event {
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
 struct Message {
     publish: bool,
-    from_team: String,
-    from_robot: String,
+    from_team: Rc<str>,
+    from_robot: Rc<str>,
     /// Index of the sender in the peers (operator: `None`).
     from_peer: Option<usize>,
-    key: String,
-    value: String,
+    key: Rc<str>,
+    value: Rc<str>,
     sent_at: i64,
+}
+
+/// A robot's names as its messages and trace carry them, shared rather
+/// than copied (most of a large run's trace is messages).
+struct Names {
+    team: Rc<str>,
+    /// The value of its heartbeat: its name, as a value.
+    heartbeat: Rc<str>,
+    alive_key: Rc<str>,
+    /// Per outgoing message: (to, key).
+    outgoing: Vec<(Rc<str>, Rc<str>)>,
+}
+
+impl Names {
+    fn new(program: &RobotProgram) -> Names {
+        Names {
+            team: program.team.as_str().into(),
+            heartbeat: truncate(program.robot.clone()).into(),
+            alive_key: crate::codegen::files::alive_key(program).into(),
+            outgoing: program
+                .control
+                .outgoing
+                .iter()
+                .map(|o| (o.to_team.as_str().into(), o.key.as_str().into()))
+                .collect(),
+        }
+    }
 }
 
 #[derive(Clone, Debug, Default)]
@@ -163,11 +204,19 @@ struct Robot<'p> {
     /// Service tasks by name (the `request_tasks` and those of action commands).
     tasks: Vec<(String, TaskState)>,
     has_receiver: bool,
-    alive_key: String,
     /// Per slot fed by a sensor: its value's entries (at, value), by time.
     sensor_series: Vec<Option<Vec<(i64, String)>>>,
     battery: Vec<(i64, f64)>,
     service_ms: HashMap<String, i64>,
+    /// Orders the control firings of robots at the same time: robots that
+    /// started earlier fire first, as each firing schedules the next.
+    chain: u64,
+    /// When the control task fires next (`None`: when woken).
+    next_fire: Option<i64>,
+    /// The token of the firing scheduled at `next_fire`.
+    fire_token: u64,
+    /// Whether the current firing changed any state (see [`Sim::wake_up`]).
+    progressed: bool,
 }
 
 pub struct Sim<'p> {
@@ -184,6 +233,11 @@ pub struct Sim<'p> {
     /// The robots a message to a team or robot name goes to (`semo_comm_send`'s
     /// peer loop, computed once).
     recipients: HashMap<String, Rc<[usize]>>,
+    /// Per robot (program).
+    names: Vec<Names>,
+    /// The last control firing handled: (time, chain).
+    last_fire: (i64, u64),
+    every_firing: bool,
 }
 
 fn truncate(mut s: String) -> String {
@@ -311,12 +365,15 @@ impl<'p> Robot<'p> {
             leaders: HashMap::new(),
             tasks,
             has_receiver: !m.incoming.is_empty() || !m.subscribed.is_empty() || m.heartbeat,
-            alive_key: crate::codegen::files::alive_key(program),
             sensor_series,
             battery: world.map(|w| w.battery.clone()).unwrap_or_default(),
             service_ms: world
                 .map(|w| w.services.iter().cloned().collect())
                 .unwrap_or_default(),
+            chain: 0,
+            next_fire: None,
+            fire_token: 0,
+            progressed: false,
         }
     }
 
@@ -341,7 +398,7 @@ fn channel_capacity(program: &RobotProgram, port: &str) -> usize {
 }
 
 impl<'p> Sim<'p> {
-    pub fn new(programs: &'p [RobotProgram], scenario: &'p Scenario, seed: u64) -> Sim<'p> {
+    pub fn new(programs: &'p [RobotProgram], scenario: &'p Scenario, options: &Options) -> Sim<'p> {
         let mut sim = Sim {
             programs,
             scenario,
@@ -352,10 +409,13 @@ impl<'p> Sim<'p> {
             queue: BinaryHeap::new(),
             seq: 0,
             now: 0,
-            rng: XorShiftRng::seed_from_u64(seed),
+            rng: XorShiftRng::seed_from_u64(options.seed),
             trace: Vec::new(),
             operator_next: scenario.operator.iter().map(|c| c.first).collect(),
             recipients: recipients(programs),
+            names: programs.iter().map(Names::new).collect(),
+            last_fire: (-1, 0),
+            every_firing: options.every_firing,
         };
         for r in 0..programs.len() {
             sim.start(r);
@@ -375,11 +435,30 @@ impl<'p> Sim<'p> {
 
     fn schedule(&mut self, at: i64, event: Event) {
         self.seq += 1;
-        self.queue
-            .push(Reverse((at, event.order(), self.seq, event)));
+        let tie = match event {
+            Event::Fire { robot, .. } => self.robots[robot].chain,
+            _ => self.seq,
+        };
+        self.queue.push(Reverse((at, event.order(), tie, event)));
     }
 
-    fn emit(&mut self, robot: usize, event: &'static str, fields: Vec<(&'static str, String)>) {
+    /// Puts robot `r`'s next control firing at `at` (a time of its grid).
+    fn schedule_fire(&mut self, r: usize, at: i64) {
+        let robot = &mut self.robots[r];
+        robot.fire_token += 1;
+        robot.next_fire = Some(at);
+        let (epoch, token) = (robot.epoch, robot.fire_token);
+        self.schedule(
+            at,
+            Event::Fire {
+                robot: r,
+                epoch,
+                token,
+            },
+        );
+    }
+
+    fn emit(&mut self, robot: usize, event: &'static str, fields: Vec<(&'static str, Rc<str>)>) {
         self.trace.push(TraceEvent {
             t: self.now,
             robot,
@@ -395,13 +474,14 @@ impl<'p> Sim<'p> {
             r,
             "start",
             vec![
-                ("team", p.team.clone()),
-                ("type", p.robot_type.clone()),
-                ("mission", p.mission.clone()),
+                ("team", p.team.clone().into()),
+                ("type", p.robot_type.clone().into()),
+                ("mission", p.mission.clone().into()),
             ],
         );
-        let epoch = self.robots[r].epoch;
-        self.schedule(self.now, Event::Fire { robot: r, epoch });
+        self.seq += 1;
+        self.robots[r].chain = self.seq;
+        self.schedule_fire(r, self.now);
     }
 
     /// Runs until `until` mission ms or until every robot has stopped.
@@ -450,11 +530,29 @@ impl<'p> Sim<'p> {
 
     fn handle(&mut self, event: Event) {
         match event {
-            Event::Fire { robot, epoch } => {
-                if self.robots[robot].alive && self.robots[robot].epoch == epoch {
+            Event::Fire {
+                robot,
+                epoch,
+                token,
+            } => {
+                let r = &self.robots[robot];
+                if r.alive && r.epoch == epoch && r.fire_token == token {
+                    self.last_fire = (self.now, r.chain);
+                    self.robots[robot].progressed = false;
+                    let traced = self.trace.len();
                     self.fire(robot);
                     if self.robots[robot].alive {
-                        self.schedule(self.now + CONTROL_PERIOD_MS, Event::Fire { robot, epoch });
+                        let idle = !self.every_firing
+                            && !self.robots[robot].progressed
+                            && self.trace.len() == traced;
+                        match if idle {
+                            self.wake_up(robot)
+                        } else {
+                            Some(self.now + CONTROL_PERIOD_MS)
+                        } {
+                            Some(at) => self.schedule_fire(robot, at),
+                            None => self.robots[robot].next_fire = None,
+                        }
                     }
                 }
             }
@@ -466,6 +564,7 @@ impl<'p> Sim<'p> {
                 let state = &self.robots[robot].tasks[task].1;
                 if self.robots[robot].alive && state.busy && state.generation == generation {
                     self.end_call(robot, task);
+                    self.wake(robot);
                 }
             }
             Event::Deliver { to, epoch, message } => {
@@ -485,8 +584,8 @@ impl<'p> Sim<'p> {
             from_team: "USER".into(),
             from_robot: "USER".into(),
             from_peer: None,
-            key: command.key.clone(),
-            value: truncate(command.value.clone()),
+            key: command.key.as_str().into(),
+            value: truncate(command.value.clone()).into(),
             sent_at: self.now,
         };
         for r in 0..self.robots.len() {
@@ -594,6 +693,7 @@ impl<'p> Sim<'p> {
     /// `store`: the slot, and the library for shared information.
     fn store(&mut self, r: usize, slot: usize, value: String) {
         let robot = &mut self.robots[r];
+        robot.progressed = true;
         if let Some(k) = robot.library_index[slot] {
             robot.library[k].clone_from(&value);
         }
@@ -619,11 +719,16 @@ impl<'p> Sim<'p> {
                     if n > 0 {
                         if robot.slots[i] != series[n - 1].1 {
                             robot.slots[i].clone_from(&series[n - 1].1);
+                            robot.progressed = true;
                         }
                     } else if port == "BATTERY"
                         && let Some(level) = battery_level(&robot.battery, sampled)
                     {
-                        robot.slots[i] = format!("{}", level.round());
+                        let level = format!("{}", level.round());
+                        if robot.slots[i] != level {
+                            robot.slots[i] = level;
+                            robot.progressed = true;
+                        }
                     }
                 }
                 SlotSource::Shared => {
@@ -631,6 +736,7 @@ impl<'p> Sim<'p> {
                         && robot.slots[i] != robot.library[k]
                     {
                         robot.slots[i].clone_from(&robot.library[k]);
+                        robot.progressed = true;
                     }
                 }
                 SlotSource::Local => {}
@@ -642,29 +748,29 @@ impl<'p> Sim<'p> {
 
     /// `semo_comm_send`: traced, then to every other robot of `to` (team or
     /// robot name) through the network; `USER` only traces.
-    fn comm_send(&mut self, r: usize, to: &str, publish: bool, key: &str, value: String) {
+    fn comm_send(&mut self, r: usize, to: Rc<str>, publish: bool, key: Rc<str>, value: Rc<str>) {
         self.emit(
             r,
             "send",
             vec![
-                ("to", to.to_string()),
-                ("key", key.to_string()),
+                ("to", to.clone()),
+                ("key", key.clone()),
                 ("value", value.clone()),
             ],
         );
-        if to == "USER" {
+        if &*to == "USER" {
             return;
         }
         let program = self.robots[r].program;
-        let Some(targets) = self.recipients.get(to).cloned() else {
+        let Some(targets) = self.recipients.get(&*to).cloned() else {
             return;
         };
         let message = Rc::new(Message {
             publish,
-            from_team: program.team.clone(),
-            from_robot: program.robot.clone(),
+            from_team: self.names[r].team.clone(),
+            from_robot: self.names[r].heartbeat.clone(),
             from_peer: Some(program.self_peer),
-            key: key.to_string(),
+            key,
             value,
             sent_at: self.now,
         });
@@ -753,9 +859,9 @@ impl<'p> Sim<'p> {
         });
         let robot = &mut self.robots[r];
         let m = &robot.program.control;
-        if m.heartbeat && message.publish && message.key == robot.alive_key {
+        if m.heartbeat && message.publish && message.key == self.names[r].alive_key {
             for (i, (_, name)) in robot.program.peers.iter().enumerate() {
-                if *name == message.from_robot {
+                if **name == *message.from_robot {
                     robot.last_seen[i] = self.now;
                 }
             }
@@ -763,25 +869,28 @@ impl<'p> Sim<'p> {
         }
         if !m.subscribed.is_empty() && message.publish {
             for (i, g) in m.subscribed.iter().enumerate() {
-                if *g == message.key {
-                    robot.groups[i] = Some(message.value.clone());
+                if **g == *message.key {
+                    robot.groups[i] = Some(message.value.to_string());
                 }
             }
             return;
         }
-        let mut dropped = Vec::new();
+        // A full channel drops the sample (the runtime counts it).
+        let mut queued = false;
         for (i, incoming) in m.incoming.iter().enumerate() {
-            if incoming.from_team == message.from_team && incoming.key == message.key {
+            if *incoming.from_team == *message.from_team && *incoming.key == *message.key {
                 let (queue, capacity) = &mut robot.inbox[i];
                 if queue.len() < *capacity {
-                    queue.push_back(message.value.clone());
-                } else {
-                    dropped.push(incoming.port.clone());
+                    queue.push_back(message.value.to_string());
+                    queued = true;
                 }
             }
         }
-        // A full channel drops the sample (the runtime counts it).
-        let _ = dropped;
+        // Only a `receive` waits for a message: heartbeats and published
+        // values are read on the way through a state, never waited for.
+        if queued {
+            self.wake(r);
+        }
     }
 
     // ------------------------------------------------------ service tasks
@@ -807,16 +916,16 @@ impl<'p> Sim<'p> {
             r,
             "call_start",
             vec![
-                ("task", task.to_string()),
-                ("service", service.to_string()),
-                ("arg", arg.clone()),
+                ("task", task.to_string().into()),
+                ("service", service.to_string().into()),
+                ("arg", arg.clone().into()),
             ],
         );
         if !args.is_empty() {
             self.emit(
                 r,
                 "actuate",
-                vec![("task", task.to_string()), ("value", arg)],
+                vec![("task", task.to_string().into()), ("value", arg.into())],
             );
         }
         self.schedule(
@@ -833,7 +942,10 @@ impl<'p> Sim<'p> {
     fn end_call(&mut self, r: usize, t: usize) {
         let (task, state) = &mut self.robots[r].tasks[t];
         state.busy = false;
-        let fields = vec![("task", task.clone()), ("service", state.service.clone())];
+        let fields = vec![
+            ("task", task.as_str().into()),
+            ("service", state.service.as_str().into()),
+        ];
         self.emit(r, "call_end", fields);
     }
 
@@ -853,7 +965,7 @@ impl<'p> Sim<'p> {
     // -------------------------------------------------------- the machine
 
     fn throw_event(&mut self, r: usize, event: &str) {
-        self.emit(r, "throw", vec![("name", event.to_string())]);
+        self.emit(r, "throw", vec![("name", event.to_string().into())]);
         let robot = &self.robots[r];
         let m = &robot.program.control;
         let Some(current) = robot.current_mode else {
@@ -872,7 +984,7 @@ impl<'p> Sim<'p> {
             self.emit(
                 r,
                 "catch",
-                vec![("name", event.to_string()), ("mode", mode)],
+                vec![("name", event.to_string().into()), ("mode", mode.into())],
             );
         }
     }
@@ -884,7 +996,7 @@ impl<'p> Sim<'p> {
             region.done = true;
         }
         self.robots[r].current_mode = Some(mode);
-        self.emit(r, "mode", vec![("mode", m.modes[mode].name.clone())]);
+        self.emit(r, "mode", vec![("mode", m.modes[mode].name.clone().into())]);
         for (i, region) in m.modes[mode].regions.iter().enumerate() {
             let slot = &mut self.robots[r].regions[i];
             slot.service = Some(region.service);
@@ -903,8 +1015,8 @@ impl<'p> Sim<'p> {
             region.started = now;
             region.pass_start = now;
             let fields = vec![
-                ("plan", region.plan.clone()),
-                ("service", m.services[service].name.clone()),
+                ("plan", region.plan.as_str().into()),
+                ("service", m.services[service].name.as_str().into()),
             ];
             self.emit(r, "service_start", fields);
         }
@@ -918,9 +1030,9 @@ impl<'p> Sim<'p> {
                 && !region.done
             {
                 let fields = vec![
-                    ("plan", region.plan.clone()),
-                    ("service", m.services[service].name.clone()),
-                    ("why", "mode change".to_string()),
+                    ("plan", region.plan.as_str().into()),
+                    ("service", m.services[service].name.as_str().into()),
+                    ("why", "mode change".into()),
                 ];
                 self.emit(r, "service_end", fields);
             }
@@ -937,14 +1049,13 @@ impl<'p> Sim<'p> {
         self.read_inputs(r);
         if m.heartbeat && self.now - self.robots[r].last_heartbeat >= HEARTBEAT_MS {
             self.robots[r].last_heartbeat = self.now;
-            let key = self.robots[r].alive_key.clone();
-            self.comm_send(
-                r,
-                &program.team,
-                true,
-                &key,
-                truncate(program.robot.clone()),
+            let names = &self.names[r];
+            let (team, key, value) = (
+                names.team.clone(),
+                names.alive_key.clone(),
+                names.heartbeat.clone(),
             );
+            self.comm_send(r, team, true, key, value);
         }
         if self.robots[r].current_mode.is_none() {
             match m.default_mode {
@@ -969,12 +1080,12 @@ impl<'p> Sim<'p> {
                 continue;
             }
             if region.timeout_ms > 0 && self.now - region.started > region.timeout_ms {
-                let plan = region.plan.clone();
+                let plan: Rc<str> = region.plan.as_str().into();
                 self.robots[r].regions[i].done = true;
                 let fields = vec![
                     ("plan", plan),
-                    ("service", m.services[service].name.clone()),
-                    ("why", "timeout".to_string()),
+                    ("service", m.services[service].name.as_str().into()),
+                    ("why", "timeout".into()),
                 ];
                 self.emit(r, "service_end", fields);
                 continue;
@@ -992,8 +1103,8 @@ impl<'p> Sim<'p> {
                 let region = &mut self.robots[r].regions[i];
                 region.done = true;
                 let fields = vec![
-                    ("plan", region.plan.clone()),
-                    ("service", m.services[service].name.clone()),
+                    ("plan", region.plan.as_str().into()),
+                    ("service", m.services[service].name.as_str().into()),
                 ];
                 self.emit(r, "service_end", fields);
             } else {
@@ -1011,12 +1122,118 @@ impl<'p> Sim<'p> {
                 .current_mode
                 .map(|c| m.modes[c].name.clone())
                 .unwrap_or_default();
-            self.emit(r, "finish", vec![("mode", mode)]);
+            self.emit(r, "finish", vec![("mode", mode.into())]);
             self.stop(r);
         }
     }
 
+    /// The first firing of robot `r`'s grid at or after `at`, and after the
+    /// firing under way (a robot fires every period from its start).
+    fn grid_at_or_after(&self, r: usize, at: i64) -> i64 {
+        let start = self.robots[r].started_at;
+        let k = (at - start + CONTROL_PERIOD_MS - 1).div_euclid(CONTROL_PERIOD_MS);
+        let t = start + k.max(0) * CONTROL_PERIOD_MS;
+        // At the current time, a robot whose firing would come before the
+        // one just handled has had it (idle) already.
+        if t == self.now && self.last_fire.0 == self.now && self.robots[r].chain <= self.last_fire.1
+        {
+            t + CONTROL_PERIOD_MS
+        } else {
+            t
+        }
+    }
+
+    /// Something a waiting firing reads (a message in the inbox, the end of
+    /// a call) changed: a sleeping robot fires at its next period.
+    fn wake(&mut self, r: usize) {
+        if self.every_firing || !self.robots[r].alive {
+            return;
+        }
+        let at = self.grid_at_or_after(r, self.now);
+        if self.robots[r].next_fire.is_none_or(|next| at < next) {
+            self.schedule_fire(r, at);
+        }
+    }
+
+    /// After an idle firing of robot `r`, its next firing that can differ:
+    /// every firing until then would read the same state and do nothing,
+    /// except where time passes a threshold the firing compares against
+    /// (a timeout, a period, the heartbeat) or a sensor sample changes.
+    /// Messages and the ends of calls wake it ([`Sim::wake`]); `None` when
+    /// only they can.
+    fn wake_up(&self, r: usize) -> Option<i64> {
+        let robot = &self.robots[r];
+        let m = &robot.program.control;
+        let mut at: Option<i64> = None;
+        let mut at_least = |t: i64| at = Some(at.map_or(t, |a| a.min(t)));
+        if m.heartbeat {
+            at_least(robot.last_heartbeat + HEARTBEAT_MS);
+        }
+        for region in &robot.regions {
+            let Some(service) = region.service.filter(|_| !region.done) else {
+                continue;
+            };
+            if region.timeout_ms > 0 {
+                at_least(region.started + region.timeout_ms + 1);
+            }
+            let Some(state) = m.services[service].states.get(region.pc) else {
+                continue;
+            };
+            match &state.kind {
+                StateKind::Receive {
+                    timeout_ms, mark, ..
+                }
+                | StateKind::Call {
+                    timeout_ms, mark, ..
+                }
+                | StateKind::RunActions {
+                    timeout_ms, mark, ..
+                } => {
+                    if let Some(t) = timeout_ms
+                        && region.phase > 0
+                    {
+                        at_least(region.marks[*mark] + t + 1);
+                    }
+                }
+                StateKind::LoopTail {
+                    period_ms: Some(p),
+                    mark,
+                    ..
+                } => at_least(region.marks[*mark] + p),
+                StateKind::Repeat {
+                    period_ms: Some(p), ..
+                } => at_least(region.pass_start + p),
+                // Not a state that waits: fire again next period.
+                _ => at_least(self.now + CONTROL_PERIOD_MS),
+            }
+        }
+        // The next sensor sample that brings a new value.
+        let sampled =
+            robot.started_at + (self.now - robot.started_at) / SENSOR_PERIOD_MS * SENSOR_PERIOD_MS;
+        for (i, s) in m.slots.iter().enumerate() {
+            let (SlotSource::Sensor { port, .. }, Some(series)) =
+                (&s.source, &robot.sensor_series[i])
+            else {
+                continue;
+            };
+            let n = series.partition_point(|(t, _)| *t <= sampled);
+            if let Some((t, _)) = series.get(n) {
+                let periods = (t - robot.started_at + SENSOR_PERIOD_MS - 1) / SENSOR_PERIOD_MS;
+                at_least(robot.started_at + periods * SENSOR_PERIOD_MS);
+            }
+            if n == 0
+                && port == "BATTERY"
+                && robot.battery.last().is_some_and(|(t, _)| *t > sampled)
+            {
+                at_least(sampled + SENSOR_PERIOD_MS);
+            }
+        }
+        at.map(|t| self.grid_at_or_after(r, t.max(self.now + 1)))
+    }
+
+    /// Region `i` to change: the firing progressed.
     fn region(&mut self, r: usize, i: usize) -> &mut Region {
+        self.robots[r].progressed = true;
         &mut self.robots[r].regions[i]
     }
 
@@ -1082,8 +1299,9 @@ impl<'p> Sim<'p> {
                         // Its own publication is the latest its subscription sees.
                         self.robots[r].groups[group] = Some(sent.clone());
                     }
-                    let out = &m.outgoing[item.message];
-                    self.comm_send(r, &out.to_team, out.publish, &out.key, sent);
+                    let publish = m.outgoing[item.message].publish;
+                    let (to, key) = self.names[r].outgoing[item.message].clone();
+                    self.comm_send(r, to, publish, key, sent.into());
                 }
                 self.region(r, i).pc = next;
                 Step::Next
@@ -1121,7 +1339,7 @@ impl<'p> Sim<'p> {
                     timeout_ms.is_some_and(|t| now - self.robots[r].regions[i].marks[*mark] > t);
                 if timed_out {
                     self.stop_task(r, task);
-                    self.emit(r, "timeout", vec![("service", service.clone())]);
+                    self.emit(r, "timeout", vec![("service", service.clone().into())]);
                 } else if self.busy(r, task) {
                     return Step::Wait;
                 }
@@ -1149,12 +1367,16 @@ impl<'p> Sim<'p> {
                     region.action = am.initial;
                     region.phase = 1;
                     region.marks[*mark] = now;
-                    self.emit(r, "actions_start", vec![("service", service.clone())]);
+                    self.emit(
+                        r,
+                        "actions_start",
+                        vec![("service", service.clone().into())],
+                    );
                 }
                 if let Some(t) = timeout_ms
                     && now - self.robots[r].regions[i].marks[*mark] > *t
                 {
-                    self.emit(r, "timeout", vec![("service", service.clone())]);
+                    self.emit(r, "timeout", vec![("service", service.clone().into())]);
                     let region = self.region(r, i);
                     region.phase = 0;
                     region.pc = next;
@@ -1163,7 +1385,7 @@ impl<'p> Sim<'p> {
                 if self.actions(r, i, am) != Step::Done {
                     return Step::Wait;
                 }
-                self.emit(r, "actions_end", vec![("service", service.clone())]);
+                self.emit(r, "actions_end", vec![("service", service.clone().into())]);
                 let region = self.region(r, i);
                 region.phase = 0;
                 region.pc = next;
@@ -1299,7 +1521,7 @@ impl<'p> Sim<'p> {
         if robot.leaders.get(&state) != Some(&leader) {
             self.robots[r].leaders.insert(state, leader);
             let name = self.robots[r].program.peers[leader].1.clone();
-            self.emit(r, "leader", vec![("leader", name)]);
+            self.emit(r, "leader", vec![("leader", name.into())]);
         }
         leader == me
     }

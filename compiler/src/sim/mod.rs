@@ -32,7 +32,7 @@ use std::fmt::Write;
 
 /// Runs every program on the scenario.
 pub fn simulate(programs: &[RobotProgram], scenario: &Scenario, options: &Options) -> Run {
-    engine::Sim::new(programs, scenario, options.seed).run(options)
+    engine::Sim::new(programs, scenario, options).run(options)
 }
 
 impl Run {

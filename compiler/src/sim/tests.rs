@@ -23,14 +23,22 @@ fn programs(mission: &str) -> Vec<RobotProgram> {
 
 fn run(programs: &[RobotProgram], scenario: &str, seed: u64) -> (Run, Vec<Verdict>) {
     let scenario = scenario::parse(scenario, programs).unwrap_or_else(|e| panic!("{e:?}"));
-    let run = simulate(
+    let options = Options {
+        seed,
+        ..Options::default()
+    };
+    let run = simulate(programs, &scenario, &options);
+    // Skipping idle firings changes nothing of the trace.
+    let every_firing = simulate(
         programs,
         &scenario,
         &Options {
-            until_ms: None,
-            seed,
+            every_firing: true,
+            ..options
         },
     );
+    assert_eq!(run.trace_lines(), every_firing.trace_lines());
+    assert_eq!(run.end_ms, every_firing.end_ms);
     let verdicts = expect::judge(&run, &scenario.expect);
     (run, verdicts)
 }

@@ -3,6 +3,7 @@
 //! `{"t":<mission ms>,"robot":"<robot>","event":"<event>", <string fields>}`.
 
 use std::fmt::Write;
+use std::rc::Rc;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct TraceEvent {
@@ -12,7 +13,7 @@ pub struct TraceEvent {
     pub robot: usize,
     pub event: &'static str,
     /// String fields in the order the runtime writes them.
-    pub fields: Vec<(&'static str, String)>,
+    pub fields: Vec<(&'static str, Rc<str>)>,
     /// For `receive`: when the message was sent (pictures draw the arrow
     /// from there; not part of the line).
     pub sent_at: Option<i64>,
@@ -23,7 +24,7 @@ impl TraceEvent {
         self.fields
             .iter()
             .find(|(k, _)| *k == key)
-            .map(|(_, v)| v.as_str())
+            .map(|(_, v)| &**v)
     }
 
     /// The event as one JSON line (without the newline), as `semo_trace` writes it.

@@ -9,6 +9,8 @@
 //! to the mission's folder; default `out` beside it), "target"?: "linux" |
 //! "linux-sim", "team"?: only this team's robots, "force"?: replace files in
 //! the way, saved first (as `semo build --force`) }`, or just the URI.
+//! Refused over files in the way, the error's `data` is `{ "conflicts":
+//! [{ "path", "why" }] }`, so that an editor can offer to force.
 //!
 //! The output folder, with `..` and symbolic links resolved, must lie inside
 //! a workspace folder (the mission's folder when there is none): the editor's
@@ -194,17 +196,36 @@ pub fn code_lenses(snapshot: &Snapshot) -> Vec<CodeLens> {
     .unwrap_or_default()
 }
 
+/// Why a generation did not begin: the message, and for files in the way
+/// their list `{ "conflicts": [{ "path", "why" }] }` (the JSON-RPC error's
+/// `data`, so that an editor can offer to back them up and force).
+pub struct NotBegun {
+    pub message: String,
+    pub data: Option<Value>,
+}
+
 /// Takes the output folder's lock (waiting for another generation) and
 /// recovers what an interrupted one left; then checks, unless forced, that no
 /// robot folder holds files in the way. Blocking: run off the async threads.
-pub fn begin(job: &Job, robots: &[codegen::RobotOutput]) -> Result<output::Transaction, String> {
-    let transaction = output::Transaction::begin(&job.out, || {}).map_err(|e| e.to_string())?;
+pub fn begin(job: &Job, robots: &[codegen::RobotOutput]) -> Result<output::Transaction, NotBegun> {
+    let failed = |e: output::OutputError| NotBegun {
+        message: e.to_string(),
+        data: None,
+    };
+    let transaction = output::Transaction::begin(&job.out, || {}).map_err(failed)?;
     if !job.force {
-        let conflicts = transaction
-            .conflicts(robots, job.target)
-            .map_err(|e| e.to_string())?;
+        let conflicts = transaction.conflicts(robots, job.target).map_err(failed)?;
         if !conflicts.is_empty() {
-            return Err(output::OutputError::Conflicts(conflicts).to_string());
+            let data = json!({
+                "conflicts": conflicts
+                    .iter()
+                    .map(|c| json!({ "path": c.path.display().to_string(), "why": c.why }))
+                    .collect::<Vec<_>>(),
+            });
+            return Err(NotBegun {
+                message: output::OutputError::Conflicts(conflicts).to_string(),
+                data: Some(data),
+            });
         }
     }
     Ok(transaction)

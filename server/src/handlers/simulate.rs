@@ -9,16 +9,17 @@
 //! prints), "svg" (the timeline), "expectations": [{ "expectation", "met",
 //! "why", "range" (the expectation in the scenario file) }] }`. A mission with
 //! errors or a bad scenario is refused with the reason (the scenario's line
-//! and column).
+//! and column). The failed expectations, or the scenario's mistake, are
+//! published as the scenario file's diagnostics.
 
-use super::generate_code::{self, GenerateParams};
 use crate::world::World;
 use semo::sim;
 use semo::text::{ColumnUnit, LineIndex};
+use semo::workspace::FileKind;
 use serde::Deserialize;
 use serde_json::{Value, json};
 use std::path::PathBuf;
-use tower_lsp_server::ls_types::Uri;
+use tower_lsp_server::ls_types::{Diagnostic, DiagnosticSeverity, Position, Range, Uri};
 
 pub const COMMAND: &str = "semo.simulate";
 
@@ -48,78 +49,140 @@ pub struct Job {
     seed: u64,
 }
 
+/// The mission as the editor has it, wherever it is: simulating writes
+/// nothing, so unlike generating code it needs no workspace root.
 pub fn job(world: &World, params: SimulateParams) -> Result<Job, String> {
-    let generate = generate_code::job(
-        world,
-        GenerateParams {
-            uri: params.uri,
-            output_folder: None,
-            target: None,
-            team: None,
-            force: false,
-        },
-    )?;
-    let folder = generate
-        .mission_path
-        .parent()
-        .map(PathBuf::from)
-        .unwrap_or_default();
+    let mission = world
+        .snapshot(&params.uri)
+        .filter(|s| s.kind == FileKind::Mission)
+        .ok_or_else(|| format!("{} is not a mission the server knows", params.uri.as_str()))?;
+    let folder = mission
+        .uri
+        .to_file_path()
+        .and_then(|p| p.parent().map(PathBuf::from));
     let scenario = match params.scenario.parse::<Uri>() {
         Ok(uri) if params.scenario.starts_with("file:") => uri
             .to_file_path()
             .map(|p| p.into_owned())
             .ok_or_else(|| format!("{} is not a file", params.scenario))?,
-        _ => folder.join(&params.scenario),
+        _ => folder
+            .ok_or("a scenario path relative to an unsaved mission: give the scenario's file URI")?
+            .join(&params.scenario),
     };
     Ok(Job {
-        analysis: generate.analysis,
-        mission: generate.mission,
+        analysis: world.analysis(),
+        mission: mission.id,
         scenario,
         until_ms: params.until_ms,
         seed: params.seed.unwrap_or(0),
     })
 }
 
-/// Refines, reads the scenario, simulates; the answer or the reason for refusing.
-pub fn simulate(job: &Job) -> Result<Value, String> {
-    let text = semo::workspace::read_text(&job.scenario)
-        .map_err(|e| format!("{}: {e}", job.scenario.display()))?;
-    let build = job
-        .analysis
-        .build_input(job.mission)
-        .ok_or("internal error: the mission is not in the workspace analysis")?;
+/// A simulation's answer, and what the editor shows on the scenario file.
+pub struct Outcome {
+    pub answer: Result<Value, String>,
+    /// The scenario file and its diagnostics: each failed expectation, or
+    /// the scenario's mistake; none when every expectation holds (which
+    /// clears the last run's).
+    pub scenario: Option<(Uri, Vec<Diagnostic>)>,
+}
+
+/// Refines, reads the scenario, simulates.
+pub fn simulate(job: &Job) -> Outcome {
+    let uri = Uri::from_file_path(&job.scenario);
+    let text = match semo::workspace::read_text(&job.scenario) {
+        Ok(text) => text,
+        Err(e) => {
+            return Outcome {
+                answer: Err(format!("{}: {e}", job.scenario.display())),
+                scenario: None,
+            };
+        }
+    };
+    let index = LineIndex::new(&text);
+    // JSON text is ASCII around the places named (an expectation's opening
+    // brace, a value's first character): UTF-16 columns are exact there.
+    let at = |offset: usize| {
+        let lc = index.line_col(&text, offset, ColumnUnit::Utf16);
+        Range::new(
+            Position::new(lc.line, lc.col),
+            Position::new(lc.line, lc.col + 1),
+        )
+    };
+    let (answer, diagnostics) = match run(job, &text) {
+        Ok((answer, failed)) => {
+            let diagnostics = failed
+                .iter()
+                .map(|v| {
+                    diagnostic(
+                        at(v.expectation.at_offset),
+                        format!("expectation failed: {}: {}", v.expectation.kind, v.why),
+                    )
+                })
+                .collect();
+            (Ok(answer), diagnostics)
+        }
+        Err(Refusal::Scenario(e)) => {
+            let (line, col) = e.line_col(&text);
+            let message = format!(
+                "scenario {}:{line}:{col}: {}",
+                job.scenario.display(),
+                e.message
+            );
+            (Err(message), vec![diagnostic(at(e.at), e.message)])
+        }
+        Err(Refusal::Mission(message)) => (Err(message), Vec::new()),
+    };
+    Outcome {
+        answer,
+        scenario: uri.map(|uri| (uri, diagnostics)),
+    }
+}
+
+fn diagnostic(range: Range, message: String) -> Diagnostic {
+    Diagnostic {
+        range,
+        severity: Some(DiagnosticSeverity::ERROR),
+        source: Some("semo simulate".into()),
+        message,
+        ..Diagnostic::default()
+    }
+}
+
+enum Refusal {
+    Mission(String),
+    Scenario(sim::ScenarioError),
+}
+
+/// The answer and the failed expectations.
+fn run(job: &Job, text: &str) -> Result<(Value, Vec<sim::Verdict>), Refusal> {
+    let build = job.analysis.build_input(job.mission).ok_or_else(|| {
+        Refusal::Mission("internal error: the mission is not in the workspace analysis".into())
+    })?;
     let refined = semo::codegen::refine_checked(&build.input());
     let errors = refined.diagnostics.iter().filter(|d| d.is_error()).count();
     if errors > 0 {
-        return Err(format!(
+        return Err(Refusal::Mission(format!(
             "cannot simulate: {errors} error(s) in the mission, its catalog or strategies"
-        ));
+        )));
     }
     let programs = refined.programs;
-    let scenario = sim::scenario::parse(&text, &programs).map_err(|e| {
-        let (line, col) = e.line_col(&text);
-        format!(
-            "scenario {}:{line}:{col}: {}",
-            job.scenario.display(),
-            e.message
-        )
-    })?;
+    let scenario = sim::scenario::parse(text, &programs).map_err(Refusal::Scenario)?;
     let result = sim::simulate(
         &programs,
         &scenario,
         &sim::Options {
             until_ms: job.until_ms,
             seed: job.seed,
+            ..sim::Options::default()
         },
     );
     let verdicts = sim::expect::judge(&result, &scenario.expect);
-    let index = LineIndex::new(&text);
+    let index = LineIndex::new(text);
     let expectations: Vec<Value> = verdicts
         .iter()
         .map(|v| {
-            // JSON text is ASCII around an expectation's opening brace, and
-            // the brace is one character: UTF-16 columns are exact here.
-            let at = index.line_col(&text, v.expectation.at_offset, ColumnUnit::Utf16);
+            let at = index.line_col(text, v.expectation.at_offset, ColumnUnit::Utf16);
             json!({
                 "expectation": v.expectation.kind.to_string(),
                 "met": v.met,
@@ -131,10 +194,11 @@ pub fn simulate(job: &Job) -> Result<Value, String> {
             })
         })
         .collect();
-    Ok(json!({
+    let answer = json!({
         "ok": verdicts.iter().all(|v| v.met),
         "summary": sim::summary(&result, &verdicts),
         "svg": sim::svg::to_svg(&result, &programs, &scenario),
         "expectations": expectations,
-    }))
+    });
+    Ok((answer, verdicts.into_iter().filter(|v| !v.met).collect()))
 }

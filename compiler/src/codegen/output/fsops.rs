@@ -12,6 +12,12 @@
 //!
 //! Nothing here follows a symbolic link: files are created with `O_EXCL`
 //! (which refuses an existing link), links and renames act on the names.
+//!
+//! Durability: a file written here is on disk (`fsync`) before its step
+//! counts; a change of names (create, link, rename, exchange, remove) is on
+//! disk once its folder is synced ([`sync_dir`], [`sync_tree`]), which the
+//! transaction does before every step that relies on it. Syncs are counted
+//! steps too, so the fault injection kills between them as well.
 
 use std::fs::{File, OpenOptions};
 use std::io::{self, Write};
@@ -54,7 +60,8 @@ pub fn write_new(path: &Path, bytes: &[u8]) -> io::Result<()> {
         .create_new(true)
         .custom_flags(rustix::fs::OFlags::NOFOLLOW.bits() as i32)
         .open(path)?;
-    step(file.write_all(bytes))
+    file.write_all(bytes)?;
+    step(file.sync_all())
 }
 
 /// A second name for the entry `from` (a file, a FIFO, a symbolic link
@@ -80,7 +87,33 @@ pub fn copy_regular(from: &Path, to: &Path) -> io::Result<()> {
         .create_new(true)
         .custom_flags(rustix::fs::OFlags::NOFOLLOW.bits() as i32)
         .open(to)?;
-    step(io::copy(&mut &source, &mut target).map(|_| ()))
+    io::copy(&mut &source, &mut target)?;
+    step(target.sync_all())
+}
+
+/// Makes the names in the folder `path` durable (its entries created,
+/// linked, renamed or removed so far): `fsync` on the folder itself.
+pub fn sync_dir(path: &Path) -> io::Result<()> {
+    step(open_dir(path)?.sync_all())
+}
+
+/// [`sync_dir`] on `path` and every folder inside it (links not followed),
+/// as one step: a new robot folder made durable before it is swapped in.
+pub fn sync_tree(path: &Path) -> io::Result<()> {
+    for entry in walkdir::WalkDir::new(path).contents_first(true) {
+        let entry = entry.map_err(io::Error::other)?;
+        if entry.file_type().is_dir() {
+            open_dir(entry.path())?.sync_all()?;
+        }
+    }
+    step(Ok(()))
+}
+
+fn open_dir(path: &Path) -> io::Result<File> {
+    OpenOptions::new()
+        .read(true)
+        .custom_flags((rustix::fs::OFlags::DIRECTORY | rustix::fs::OFlags::NOFOLLOW).bits() as i32)
+        .open(path)
 }
 
 /// Recreates the symbolic link `from` at `to` (its target is not touched).

@@ -160,7 +160,11 @@ typedef struct {
     unsigned long dropped;
     pthread_mutex_t lock;
     pthread_cond_t readable;
+    struct task_s *reader; /* the task reading it, woken by a write */
 } channel;
+
+static void wake_task(struct task_s *t);
+static void wake_hinted_tasks(void);
 
 static channel *g_channels;
 
@@ -221,6 +225,8 @@ int UFPort_WriteToQueue(int port, const void *buf, size_t size)
         c->dropped++;
     }
     pthread_mutex_unlock(&c->lock);
+    if (written)
+        wake_task(c->reader);
     return written;
 }
 
@@ -265,6 +271,7 @@ int UFMulticast_Write(const char *name, const void *buf, size_t size)
     memcpy(g->buf, buf, size);
     g->written = true;
     pthread_mutex_unlock(&g->lock);
+    wake_hinted_tasks();
     return (int)size;
 }
 
@@ -291,7 +298,7 @@ typedef struct param {
     char name[]; /* owned copy */
 } param;
 
-typedef struct {
+typedef struct task_s {
     const semo_task_desc *desc;
     pthread_t thread;
     bool started;
@@ -302,9 +309,49 @@ typedef struct {
     unsigned calls;
     bool stop_requested;
     param *params;
+    /* semo_next_firing: a time-driven task that said when its next firing
+     * is needed sleeps until then, or until `woken` (data on one of its
+     * channels, a task's state changed, a multicast group written). */
+    bool hinted, woken;
+    int64_t hint_ms;
 } task;
 
 static task *g_tasks;
+/* The task whose thread this is (NULL in other threads). */
+static _Thread_local task *g_current;
+
+/* Wakes a task sleeping on its hint; never called with another task's lock held. */
+static void wake_task(task *t)
+{
+    if (!t || t == g_current)
+        return;
+    pthread_mutex_lock(&t->lock);
+    /* Kept even while the task fires: a hint given later in that firing
+     * must not sleep through it. */
+    t->woken = true;
+    if (t->hinted)
+        pthread_cond_broadcast(&t->changed);
+    pthread_mutex_unlock(&t->lock);
+}
+
+/* Something every waiting task may care about happened (a task's state
+ * changed, a multicast group was written). */
+static void wake_hinted_tasks(void)
+{
+    for (size_t i = 0; g_tasks && g_prog && i < g_prog->task_count; i++)
+        wake_task(&g_tasks[i]);
+}
+
+void semo_next_firing(int64_t at_ms)
+{
+    task *t = g_current;
+    if (!t || t->desc->trigger != SEMO_TRIGGER_TIME)
+        return;
+    pthread_mutex_lock(&t->lock);
+    t->hinted = true;
+    t->hint_ms = at_ms;
+    pthread_mutex_unlock(&t->lock);
+}
 
 static task *find_task(const char *name)
 {
@@ -323,6 +370,7 @@ static void *task_thread(void *arg)
     task *t = arg;
     const semo_task_desc *d = t->desc;
     int64_t next_release = 0;
+    g_current = t;
     pthread_mutex_lock(&t->lock);
     while (semo_running()) {
         if (t->stop_requested && t->state != SEMO_TASK_IDLE) {
@@ -330,6 +378,9 @@ static void *task_thread(void *arg)
             t->stop_requested = false;
             t->calls = 0;
             pthread_cond_broadcast(&t->changed);
+            pthread_mutex_unlock(&t->lock);
+            wake_hinted_tasks(); /* the control task waits for idle tasks */
+            pthread_mutex_lock(&t->lock);
             continue;
         }
         if (t->state != SEMO_TASK_RUNNING) {
@@ -338,20 +389,32 @@ static void *task_thread(void *arg)
         }
         if (d->trigger == SEMO_TRIGGER_TIME) {
             int64_t now = semo_now_ms();
-            if (now < next_release) {
-                /* Woken early by a state change or the end of the program. */
-                wait_until(&t->changed, &t->lock, next_release);
+            /* The period is the shortest gap; a task that gave a hint sleeps
+             * until it unless something it may wait for happens first. */
+            int64_t due = next_release;
+            if (t->hinted && !t->woken && t->hint_ms > due)
+                due = t->hint_ms;
+            if (now < due) {
+                /* Woken early by a state change, an event or the end of the program. */
+                wait_until(&t->changed, &t->lock, due == INT64_MAX ? -1 : due);
                 continue;
             }
             next_release = now + d->period_ms;
+            t->hinted = t->woken = false;
         }
         pthread_mutex_unlock(&t->lock);
         if (d->go)
             d->go();
         pthread_mutex_lock(&t->lock);
-        if (!t->repeat && t->calls > 0 && --t->calls == 0)
+        bool went_idle = !t->repeat && t->calls > 0 && --t->calls == 0;
+        if (went_idle)
             t->state = SEMO_TASK_IDLE;
         pthread_cond_broadcast(&t->changed);
+        if (went_idle) {
+            pthread_mutex_unlock(&t->lock);
+            wake_hinted_tasks();
+            pthread_mutex_lock(&t->lock);
+        }
     }
     pthread_mutex_unlock(&t->lock);
     return NULL;
@@ -396,6 +459,7 @@ static int control(const char *name, control_op op)
     }
     pthread_cond_broadcast(&t->changed);
     pthread_mutex_unlock(&t->lock);
+    wake_hinted_tasks();
     return 0;
 }
 
@@ -1037,6 +1101,10 @@ static bool allocate_program_state(const semo_program_desc *p)
         ok = ok && g_groups[i].buf;
         pthread_mutex_init(&g_groups[i].lock, NULL);
     }
+    for (size_t i = 0; i < p->channel_count; i++)
+        for (size_t k = 0; k < p->task_count; k++)
+            if (strcmp(p->channels[i].dst_task, p->tasks[k].name) == 0)
+                g_channels[i].reader = &g_tasks[k];
     for (size_t i = 0; i < p->task_count; i++) {
         task *t = &g_tasks[i];
         t->desc = &p->tasks[i];

@@ -198,6 +198,14 @@ bool UFControl_StopRequested(const char *task);
  * UFControl_StopRequested). */
 bool UFControl_WaitStop(const char *task, int64_t until_ms);
 
+/* Called by a time-driven task's body: its next firing is not needed before
+ * mission time `at_ms` (INT64_MAX: only on an event) unless data arrives on
+ * one of its channels, a task changes state or a multicast group is
+ * written; its period stays the shortest gap. A task that never calls it
+ * fires every period. So an idle robot's control task sleeps instead of
+ * polling. No effect elsewhere (and on the static schedule). */
+void semo_next_firing(int64_t at_ms);
+
 /* Task parameters (per task, by name); unknown ones read as 0. */
 int UFTask_SetIntegerParameter(const char *task, const char *param, long long value);
 long long UFTask_GetIntegerParameter(const char *task, const char *param);

@@ -191,6 +191,12 @@ static task *find_task(const char *name)
     return NULL;
 }
 
+/* The loop fires at every tick anyway (and sleeps in between). */
+void semo_next_firing(int64_t at_ms)
+{
+    (void)at_ms;
+}
+
 void semo_firing_continues(void)
 {
     g_continues = true;

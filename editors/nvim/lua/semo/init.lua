@@ -5,6 +5,11 @@
 --   require('semo').setup()                 -- or setup({ cmd = { '/path/to/semo', 'lsp' } })
 --
 -- On Neovim 0.11+ `vim.lsp.enable('semo')` (lsp/semo.lua) can replace the LSP part.
+--
+-- `:SemoSimulate [SCENARIO [OUT.svg]]` in a mission runs it on a scenario (default: the
+-- `*.scenario.json` named after the mission, beside it) through the server's `semo.simulate`,
+-- shows the summary and writes the timeline SVG (default: the scenario's name, `.svg`).
+-- Failed expectations appear as diagnostics on the scenario file.
 local M = {}
 
 -- XML files that the server reads; their filetype stays `xml`.
@@ -132,11 +137,69 @@ function M.link_token_highlights()
   return true
 end
 
+--- The semo client attached to the buffer, if any.
+local function client_of(bufnr)
+  local get = vim.lsp.get_clients or vim.lsp.get_active_clients
+  for _, client in ipairs(get({ bufnr = bufnr })) do
+    if client.name == 'semo' then
+      return client
+    end
+  end
+  return nil
+end
+
+--- Runs the mission of `bufnr` on `scenario` (path, relative to the mission's folder) and
+--- writes the timeline to `svg`; `done(err, answer)` is called with the server's answer
+--- (`ok`, `summary`, `svg`, `expectations`) or the reason it refused.
+function M.simulate(bufnr, scenario, svg, done)
+  local mission = vim.api.nvim_buf_get_name(bufnr)
+  local folder = vim.fn.fnamemodify(mission, ':p:h')
+  scenario = scenario or (vim.fn.fnamemodify(mission, ':t:r') .. '.scenario.json')
+  if scenario:sub(1, 1) ~= '/' then
+    scenario = folder .. '/' .. scenario
+  end
+  svg = svg or (scenario:gsub('%.scenario%.json$', ''):gsub('%.json$', '') .. '.svg')
+  local client = client_of(bufnr)
+  if client == nil then
+    return done('no semo server is attached to this buffer')
+  end
+  local params = {
+    command = 'semo.simulate',
+    arguments = { { uri = vim.uri_from_bufnr(bufnr), scenario = vim.uri_from_fname(scenario) } },
+  }
+  client.request('workspace/executeCommand', params, function(err, answer)
+    if err then
+      return done(err.message or tostring(err))
+    end
+    local file = io.open(svg, 'w')
+    if file == nil then
+      return done('cannot write ' .. svg)
+    end
+    file:write(answer.svg)
+    file:close()
+    answer.svg_path = svg
+    done(nil, answer)
+  end, bufnr)
+end
+
 function M.setup(opts)
   config = vim.tbl_extend('force', config, opts or {})
   local group = vim.api.nvim_create_augroup('semo', { clear = true })
   M.link_token_highlights()
   vim.api.nvim_create_autocmd('ColorScheme', { group = group, callback = M.link_token_highlights })
+  vim.api.nvim_create_user_command('SemoSimulate', function(command)
+    local args = command.fargs
+    M.simulate(vim.api.nvim_get_current_buf(), args[1], args[2], function(err, answer)
+      vim.schedule(function()
+        if err then
+          vim.notify('semo: ' .. err, vim.log.levels.ERROR)
+        else
+          vim.notify(answer.summary .. 'timeline: ' .. answer.svg_path,
+            answer.ok and vim.log.levels.INFO or vim.log.levels.WARN)
+        end
+      end)
+    end)
+  end, { nargs = '*', complete = 'file', desc = 'Simulate the mission on a scenario (semo.simulate)' })
   vim.api.nvim_create_autocmd('FileType', {
     group = group,
     pattern = { 'semo', 'xml' },

@@ -364,6 +364,67 @@ static int run_minimal(int argc, char **argv)
     return semo_main(argc, argv, &program);
 }
 
+/* ------------------------------------------------------------------ wake */
+
+/* A time-driven task that asks to fire only on events (semo_next_firing with
+ * INT64_MAX) fires once at start and once more when a sample arrives; it
+ * does not poll at its 10 ms period in between. */
+static atomic_int sleeper_firings, sleeper_samples;
+static int sleeper_in = -1, poker_out = -1;
+
+static void sleeper_go(void)
+{
+    atomic_fetch_add(&sleeper_firings, 1);
+    int sample;
+    while (UFPort_GetNumOfAvailableData(sleeper_in) > 0 && UFPort_ReadFromQueue(sleeper_in, &sample, sizeof sample) > 0)
+        atomic_fetch_add(&sleeper_samples, 1);
+    semo_next_firing(INT64_MAX);
+}
+
+static void poker_go(void)
+{
+    static bool poked;
+    if (!poked && semo_now_ms() >= 100) {
+        int sample = 1;
+        poked = UFPort_WriteToQueue(poker_out, &sample, sizeof sample) > 0;
+    }
+    if (semo_now_ms() >= 300)
+        semo_stop_program();
+}
+
+static void wake_init(void)
+{
+    sleeper_in = UFPort_Initialize("Sleeper", "IN");
+    poker_out = UFPort_Initialize("Poker", "OUT");
+}
+
+static const semo_task_desc wake_tasks[] = {
+    {"Sleeper", SEMO_TRIGGER_TIME, 10, wake_init, sleeper_go, NULL},
+    {"Poker", SEMO_TRIGGER_TIME, 10, NULL, poker_go, NULL},
+};
+static const semo_channel_desc wake_channels[] = {{"Poker", "OUT", "Sleeper", "IN", sizeof(int), 4, 0, NULL, NULL}};
+
+static int run_wake(int argc, char **argv)
+{
+    const semo_program_desc program = {
+        .mission = "wake.mission",
+        .team = "SoloTeam",
+        .robot = "solo",
+        .robot_type = "TestBot",
+        .tasks = wake_tasks,
+        .task_count = 2,
+        .channels = wake_channels,
+        .channel_count = 1,
+        .peers = minimal_peers,
+        .peer_count = 1,
+    };
+    int status = semo_main(argc, argv, &program);
+    CHECK(atomic_load(&sleeper_samples) == 1);
+    CHECK(atomic_load(&sleeper_firings) == 2);
+    return atomic_load(&failures) ? 1 : status;
+}
+
+
 /* ------------------------------------------------------------------- udp */
 
 static const semo_peer udp_peers[] = {{"Alpha", "a"}, {"Beta", "b"}};
@@ -525,12 +586,14 @@ int main(int argc, char **argv)
         return run_tasks(argc - 1, argv + 1);
     if (strcmp(mode, "minimal") == 0)
         return run_minimal(argc - 1, argv + 1);
+    if (strcmp(mode, "wake") == 0)
+        return run_wake(argc - 1, argv + 1);
     if (strcmp(mode, "udp-a") == 0 || strcmp(mode, "udp-b") == 0)
         return run_udp(argc - 1, argv + 1, mode[4] == 'a');
 #ifdef SEMO_SIM
     if (strcmp(mode, "sim") == 0)
         return run_sim(argc - 1, argv + 1);
 #endif
-    fprintf(stderr, "usage: runtime_test values|tasks|minimal|udp-a|udp-b|sim [options]\n");
+    fprintf(stderr, "usage: runtime_test values|tasks|minimal|wake|udp-a|udp-b|sim [options]\n");
     return 64;
 }
