@@ -53,8 +53,29 @@ pub enum Platform {
     Static,
 }
 
+/// How a robot program reaches the other robots by default (overridable at
+/// run time with `--transport`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Transport {
+    /// UDP on 127.0.0.1, a port per robot (`semo_udp.c`): no broker needed.
+    Udp,
+    /// An MQTT broker through libmosquitto (`semo_mqtt.c`, `-lmosquitto`).
+    Mqtt,
+}
+
+impl Transport {
+    /// The name `--transport` and the Makefile's `TRANSPORT` take.
+    pub fn name(self) -> &'static str {
+        match self {
+            Transport::Udp => "udp",
+            Transport::Mqtt => "mqtt",
+        }
+    }
+}
+
 /// One row per target: its name, its platform, whether sensors and the
-/// operator are simulated, and the runtime files its folder gets.
+/// operator are simulated, its default transport, and the runtime files its
+/// folder gets.
 pub struct TargetInfo {
     pub target: Target,
     pub name: &'static str,
@@ -62,6 +83,8 @@ pub struct TargetInfo {
     /// Sensors, services and the operator come from a scenario: at run time
     /// (`--scenario FILE`, POSIX) or compiled in (static, `scenario.c`).
     pub simulated: bool,
+    /// None: the program talks only to the operator (static schedule, E103).
+    pub transport: Option<Transport>,
     pub runtime: &'static [(&'static str, &'static str)],
 }
 
@@ -70,6 +93,7 @@ const INTERNAL: (&str, &str) = ("semo_internal.h", include_str!("runtime/semo_in
 const CORE: (&str, &str) = ("semo_core.c", include_str!("runtime/semo_core.c"));
 const POSIX: (&str, &str) = ("semo_runtime.c", include_str!("runtime/semo_runtime.c"));
 const UDP: (&str, &str) = ("semo_udp.c", include_str!("runtime/semo_udp.c"));
+const MQTT: (&str, &str) = ("semo_mqtt.c", include_str!("runtime/semo_mqtt.c"));
 const POSIX_SIM: (&str, &str) = ("semo_sim.c", include_str!("runtime/semo_sim.c"));
 const STATIC: (&str, &str) = ("semo_static.c", include_str!("runtime/semo_static.c"));
 const LM3S6965: (&str, &str) = ("semo_lm3s6965.c", include_str!("runtime/semo_lm3s6965.c"));
@@ -81,20 +105,23 @@ pub const TARGETS: &[TargetInfo] = &[
         name: "linux",
         platform: Platform::Threads,
         simulated: false,
-        runtime: &[API, INTERNAL, CORE, POSIX, UDP],
+        transport: Some(Transport::Mqtt),
+        runtime: &[API, INTERNAL, CORE, POSIX, UDP, MQTT],
     },
     TargetInfo {
         target: Target::LinuxSim,
         name: "linux-sim",
         platform: Platform::Threads,
         simulated: true,
-        runtime: &[API, INTERNAL, CORE, POSIX, UDP, POSIX_SIM],
+        transport: Some(Transport::Udp),
+        runtime: &[API, INTERNAL, CORE, POSIX, UDP, MQTT, POSIX_SIM],
     },
     TargetInfo {
         target: Target::CortexM,
         name: "cortex-m",
         platform: Platform::Static,
         simulated: false,
+        transport: None,
         runtime: &[API, INTERNAL, CORE, STATIC, LM3S6965, LM3S6965_LD],
     },
     TargetInfo {
@@ -102,6 +129,7 @@ pub const TARGETS: &[TargetInfo] = &[
         name: "cortex-m-sim",
         platform: Platform::Static,
         simulated: true,
+        transport: None,
         runtime: &[API, INTERNAL, CORE, STATIC, LM3S6965, LM3S6965_LD],
     },
 ];
@@ -128,6 +156,10 @@ impl Target {
 
     pub fn simulated(self) -> bool {
         self.info().simulated
+    }
+
+    pub fn transport(self) -> Option<Transport> {
+        self.info().transport
     }
 
     /// The scenario is compiled into the program (`semo build --scenario`).

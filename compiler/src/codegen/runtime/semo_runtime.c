@@ -31,6 +31,14 @@
 #define COMM_QUEUE_CAPACITY 64
 #define RECV_ERROR_PAUSE_MS 50
 #define DEFAULT_PORT_BASE 47000
+#define DEFAULT_BROKER "mqtt://127.0.0.1:1883"
+/* The target's transport (the Makefile's TRANSPORT); MQTT is compiled in
+ * only where it is the default, as only then is libmosquitto linked. */
+#ifdef SEMO_MQTT
+#define DEFAULT_TRANSPORT "mqtt"
+#else
+#define DEFAULT_TRANSPORT "udp"
+#endif
 
 /* ------------------------------------------------------------ run state */
 
@@ -705,11 +713,17 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
         const semo_peer *p = &g_prog->peers[i];
         if (i == g_prog->self || (strcmp(p->team, to_team) != 0 && strcmp(p->robot, to_team) != 0))
             continue;
+        sent++;
+        if (g_transport->send_to)
+            continue; /* one message for all of them, below */
         if (g_transport->send(i, datagram, len) != 0) {
             semo_trace("comm_error", "to", p->robot, "key", key, NULL);
             return -1;
         }
-        sent++;
+    }
+    if (g_transport->send_to && sent > 0 && g_transport->send_to(to_team, datagram, len) != 0) {
+        semo_trace("comm_error", "to", to_team, "key", key, NULL);
+        return -1;
     }
     return sent;
 }
@@ -806,6 +820,9 @@ static void *signal_thread(void *arg)
 
 typedef struct {
     const char *trace;
+    const semo_transport *transport;
+    char broker_host[256];
+    int broker_port;
     long port_base;
     int64_t duration_ms;
     bool duration_given;
@@ -817,20 +834,22 @@ typedef struct {
 static void usage(FILE *f, const char *prog)
 {
     fprintf(f,
-            "usage: %s [--trace FILE] [--port-base N] [--duration MS]"
+            "usage: %s [--trace FILE] [--transport udp|mqtt] [--port-base N] [--broker URL] [--duration MS]"
 #ifdef SEMO_SIM
             " [--scenario FILE] [--time-scale X]"
 #endif
             "\n"
             "  --trace FILE      write a JSON-lines trace to FILE (\"-\": standard output)\n"
-            "  --port-base N     robot i uses UDP port N+i on 127.0.0.1 (default %d, or $SEMO_PORT_BASE)\n"
+            "  --transport T     udp (loopback) or mqtt (default %s, or $SEMO_TRANSPORT)\n"
+            "  --port-base N     udp: robot i uses UDP port N+i on 127.0.0.1 (default %d, or $SEMO_PORT_BASE)\n"
+            "  --broker URL      mqtt: the broker, mqtt://HOST[:PORT] (default " DEFAULT_BROKER ", or $SEMO_BROKER)\n"
             "  --duration MS     stop after MS mission milliseconds (0: run until stopped)\n"
 #ifdef SEMO_SIM
             "  --scenario FILE   the simulation scenario (JSON)\n"
             "  --time-scale X    wall ms per mission ms (0.1: ten times faster; default 1)\n"
 #endif
             ,
-            prog, DEFAULT_PORT_BASE);
+            prog, DEFAULT_TRANSPORT, DEFAULT_PORT_BASE);
 }
 
 static bool parse_long(const char *s, long min, long max, long *out)
@@ -841,6 +860,52 @@ static bool parse_long(const char *s, long min, long max, long *out)
     if (*s == '\0' || *end != '\0' || errno != 0 || v < min || v > max)
         return false;
     *out = v;
+    return true;
+}
+
+/* `udp` or `mqtt` (when built in): the transport of that name. */
+static bool parse_transport(const char *prog, const char *name, const semo_transport **out)
+{
+    if (strcmp(name, "udp") == 0) {
+        *out = &semo_udp_transport;
+        return true;
+    }
+#ifdef SEMO_MQTT
+    if (strcmp(name, "mqtt") == 0) {
+        *out = &semo_mqtt_transport;
+        return true;
+    }
+#else
+    if (strcmp(name, "mqtt") == 0) {
+        fprintf(stderr, "%s: this program was built without the mqtt transport (rebuild with `make TRANSPORT=mqtt`)\n",
+                prog);
+        return false;
+    }
+#endif
+    fprintf(stderr, "%s: the transport must be udp or mqtt, not \"%s\"\n", prog, name);
+    return false;
+}
+
+/* `mqtt://HOST[:PORT]` (port 1883 when left out) into the options. */
+static bool parse_broker(const char *prog, const char *url, options *o)
+{
+    const char *rest = strncmp(url, "mqtt://", 7) == 0 ? url + 7 : NULL;
+    if (!rest) {
+        fprintf(stderr, "%s: the broker must be mqtt://HOST[:PORT]%s, not \"%s\"\n", prog,
+                strncmp(url, "mqtts://", 8) == 0 ? " (TLS is not supported yet)" : "", url);
+        return false;
+    }
+    const char *colon = strrchr(rest, ':');
+    size_t host_len = colon ? (size_t)(colon - rest) : strlen(rest);
+    long port = 1883;
+    if (host_len == 0 || host_len >= sizeof o->broker_host || (colon && !parse_long(colon + 1, 1, 65535, &port))) {
+        fprintf(stderr, "%s: the broker must be mqtt://HOST[:PORT] with a port from 1 to 65535, not \"%s\"\n", prog,
+                url);
+        return false;
+    }
+    memcpy(o->broker_host, rest, host_len);
+    o->broker_host[host_len] = '\0';
+    o->broker_port = (int)port;
     return true;
 }
 
@@ -856,13 +921,20 @@ static int parse_options(int argc, char **argv, options *o)
         fprintf(stderr, "%s: SEMO_PORT_BASE must be a port number from 1 to %ld, not \"%s\"\n", prog, max_base, env);
         return 2;
     }
+    env = getenv("SEMO_TRANSPORT");
+    if (!parse_transport(prog, env && *env ? env : DEFAULT_TRANSPORT, &o->transport))
+        return 2;
+    env = getenv("SEMO_BROKER");
+    if (!parse_broker(prog, env && *env ? env : DEFAULT_BROKER, o))
+        return 2;
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         if (strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0) {
             usage(stdout, prog);
             return 1;
         }
-        static const char *const names[] = {"--trace", "--port-base", "--duration", "--scenario", "--time-scale"};
+        static const char *const names[] = {"--trace",      "--port-base", "--duration", "--scenario",
+                                            "--time-scale", "--transport", "--broker"};
         size_t which = sizeof names / sizeof names[0];
         const char *value = NULL;
         for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
@@ -921,6 +993,14 @@ static int parse_options(int argc, char **argv, options *o)
                 return 2;
             }
             o->time_scale_given = true;
+            break;
+        case 5:
+            if (!parse_transport(prog, value, &o->transport))
+                return 2;
+            break;
+        case 6:
+            if (!parse_broker(prog, value, o))
+                return 2;
             break;
         }
     }
@@ -1114,13 +1194,17 @@ static int run(const options *o)
     atomic_store(&g_running, true);
     /* A robot alone in its mission has no one to hear from: no port, no receiver. */
     if (p->peer_count > 1) {
-        if (semo_udp_transport.open(p, (int)o->port_base) != 0) {
-            fprintf(stderr, "semo runtime: cannot open the %s transport on port %ld\n", semo_udp_transport.name,
-                    o->port_base + (long)p->self);
+        semo_transport_config net = {
+            .port_base = o->port_base, .broker_host = o->broker_host, .broker_port = o->broker_port};
+        if (o->transport->open(p, &net) != 0) {
+            if (o->transport == &semo_udp_transport)
+                fprintf(stderr, "semo runtime: cannot open the udp transport on port %ld\n", o->port_base + (long)p->self);
+            else
+                fprintf(stderr, "semo runtime: cannot open the %s transport\n", o->transport->name);
             status = 1;
             goto stop;
         }
-        g_transport = &semo_udp_transport;
+        g_transport = o->transport;
     }
     semo_trace("start", "team", p->team, "type", p->robot_type ? p->robot_type : "", "mission",
                p->mission ? p->mission : "", NULL);

@@ -101,7 +101,7 @@ typedef struct {
 } semo_multicast_desc;
 
 /* Every robot of the mission (for the transport): its team, name and index.
- * Robot i listens on UDP port `port_base + i` of 127.0.0.1. */
+ * Over UDP robot i listens on port `port_base + i` of 127.0.0.1. */
 typedef struct {
     const char *team;
     const char *robot;
@@ -127,7 +127,8 @@ typedef struct {
 } semo_program_desc;
 
 /* Runs the program: parses the command line (`--trace FILE`,
- * `--port-base N`, `--duration MS`; simulation also `--scenario FILE` and
+ * `--transport udp|mqtt`, `--port-base N`, `--broker URL`, `--duration MS`;
+ * simulation also `--scenario FILE` and
  * `--time-scale X`), allocates channels, opens the transport, calls every
  * task's init, starts one thread per task (time-driven tasks fire every
  * period, data-driven tasks fire again as soon as a firing returns,
@@ -250,12 +251,23 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
  * Returns 1 with `*out` filled, 0 on timeout or stop. */
 int semo_comm_poll(semo_message *out, int64_t timeout_ms);
 
-/* The transport interface: UDP on 127.0.0.1 today; an MQTT transport is a
- * second instance of this table. */
+/* Where the transports reach the other robots (`--port-base`, `--broker`). */
+typedef struct {
+    long port_base;          /* udp: robot i owns port port_base + i of 127.0.0.1 */
+    const char *broker_host; /* mqtt */
+    int broker_port;
+} semo_transport_config;
+
+/* The transport interface: loopback UDP (`semo_udp.c`) and MQTT
+ * (`semo_mqtt.c`, with -DSEMO_MQTT). */
 typedef struct {
     const char *name;
-    int (*open)(const semo_program_desc *program, int port_base);
+    int (*open)(const semo_program_desc *program, const semo_transport_config *config);
+    /* To one robot of the peer table; NULL when the transport has send_to. */
     int (*send)(size_t peer, const void *data, size_t len);
+    /* To every other robot of a team, or to the robot of that name, at once
+     * (a broker fans out); NULL when the transport has send. */
+    int (*send_to)(const char *to, const void *data, size_t len);
     /* Bytes received, 0 on timeout or interrupt, -1 on error; timeout_ms < 0
      * waits until a datagram arrives or `interrupt` is called. */
     int (*recv)(void *data, size_t cap, int timeout_ms);
@@ -265,6 +277,9 @@ typedef struct {
     void (*close)(void);
 } semo_transport;
 extern const semo_transport semo_udp_transport;
+#ifdef SEMO_MQTT
+extern const semo_transport semo_mqtt_transport;
+#endif
 
 /* ----------------------------------------------------------------- traces */
 

@@ -34,8 +34,9 @@ static struct sockaddr_in loopback(int port)
     return addr;
 }
 
-static int udp_open(const semo_program_desc *program, int port_base)
+static int udp_open(const semo_program_desc *program, const semo_transport_config *config)
 {
+    long port_base = config->port_base;
     if (g_fd >= 0 || program->self >= program->peer_count || port_base < 1 ||
         (long)port_base + (long)program->peer_count > 65536)
         return -1;
@@ -44,7 +45,7 @@ static int udp_open(const semo_program_desc *program, int port_base)
         return -1;
     /* Child processes (a task running a helper) must not inherit the port. */
     fcntl(fd, F_SETFD, FD_CLOEXEC);
-    struct sockaddr_in self = loopback(port_base + (int)program->self);
+    struct sockaddr_in self = loopback((int)port_base + (int)program->self);
     if (bind(fd, (const struct sockaddr *)&self, sizeof self) != 0 || pipe(g_wake) != 0) {
         close(fd);
         return -1;
@@ -54,7 +55,7 @@ static int udp_open(const semo_program_desc *program, int port_base)
         fcntl(g_wake[i], F_SETFL, O_NONBLOCK);
     }
     g_fd = fd;
-    g_port_base = port_base;
+    g_port_base = (int)port_base;
     g_peer_count = program->peer_count;
     return 0;
 }

@@ -1,0 +1,370 @@
+/* semo_mqtt.c: the MQTT transport, through libmosquitto. Compiled only with
+ * -DSEMO_MQTT (the Makefile's TRANSPORT=mqtt, which also links -lmosquitto);
+ * without it this file is empty.
+ *
+ * Topics: a message to a team goes to `semo/<mission>/<team>/<key>`, one to a
+ * single robot to `semo/<mission>/<team>/<robot>/<key>`; every robot
+ * subscribes to both levels of its own team and robot. The payload is the
+ * runtime's datagram unchanged. `send` messages travel at QoS 1 and the
+ * session is persistent (clean_session false, client id
+ * `semo-<mission>-<robot>`), so a robot that was away gets what was sent
+ * meanwhile; `publish` messages at QoS 0, retained, so a robot that joins
+ * gets the latest value. TCP_NODELAY is set: without it a QoS 1 round trip
+ * on loopback waits for Nagle's algorithm (tens of ms instead of 0.1 ms).
+ */
+#ifdef SEMO_MQTT
+#define _POSIX_C_SOURCE 200809L
+
+#include "semo_runtime.h"
+
+#include <mosquitto.h>
+#include <pthread.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+#define MQTT_QUEUE 64
+/* The runtime's largest datagram (4 fields of at most 255 bytes) and a
+ * spare byte: a longer payload arrives truncated and is rejected as
+ * malformed by the runtime. */
+#define MQTT_PAYLOAD_MAX (6 + 4 * 256 + 1)
+#define MQTT_TOPIC_MAX 512
+#define MQTT_KEEPALIVE_S 10
+/* How long open waits for the broker's CONNACK and SUBACK, and close for
+ * the acknowledgements of QoS 1 messages still in flight (wall ms). */
+#define MQTT_OPEN_WAIT_MS 5000
+#define MQTT_CLOSE_WAIT_MS 2000
+
+typedef struct {
+    size_t len;
+    unsigned char data[MQTT_PAYLOAD_MAX];
+} mqtt_payload;
+
+static struct mosquitto *g_mosq;
+static const semo_program_desc *g_program;
+static char g_mission[64];
+static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t g_changed; /* monotonic clock; every state change below */
+static mqtt_payload g_queue[MQTT_QUEUE];
+static size_t g_head, g_count;
+static bool g_interrupted;
+static bool g_subscribed;
+static int g_connect_refused; /* the broker's CONNACK code when it refused */
+static int g_subscribe_mid = -1;
+static long g_unacked; /* messages handed to libmosquitto whose on_publish has not come */
+
+/* A topic level made of a name: the characters MQTT gives a meaning to
+ * (level separator, wildcards) become `_`. */
+static void append_level(char *topic, size_t cap, const char *name)
+{
+    size_t at = strlen(topic);
+    if (at + 1 < cap)
+        topic[at++] = '/';
+    for (; *name && at + 1 < cap; name++)
+        topic[at++] = (*name == '/' || *name == '+' || *name == '#') ? '_' : *name;
+    topic[at] = '\0';
+}
+
+/* The mission's name for topics: the file name without `.mission`. */
+static void mission_name(const char *mission)
+{
+    snprintf(g_mission, sizeof g_mission, "%s", mission && *mission ? mission : "mission");
+    char *dot = strstr(g_mission, ".mission");
+    if (dot && dot != g_mission && dot[8] == '\0')
+        *dot = '\0';
+}
+
+static void topic_of(char *topic, size_t cap, const char *team, const char *robot, const char *key)
+{
+    snprintf(topic, cap, "semo");
+    append_level(topic, cap, g_mission);
+    append_level(topic, cap, team);
+    if (robot)
+        append_level(topic, cap, robot);
+    if (key)
+        append_level(topic, cap, key);
+    else
+        snprintf(topic + strlen(topic), cap - strlen(topic), "/+"); /* a subscription: any key */
+}
+
+/* The datagram's fields after "SEMO" 0x01 <kind>: each a length byte and
+ * that many bytes. Copies field `index` (0 team, 1 robot, 2 key) into `out`. */
+static bool datagram_field(const unsigned char *data, size_t len, int index, char *out, size_t cap)
+{
+    size_t at = 6;
+    for (int i = 0; at < len; i++) {
+        size_t n = data[at++];
+        if (at + n > len)
+            return false;
+        if (i == index) {
+            if (n >= cap)
+                return false;
+            memcpy(out, data + at, n);
+            out[n] = '\0';
+            return true;
+        }
+        at += n;
+    }
+    return false;
+}
+
+static struct timespec deadline_after(int ms)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    t.tv_sec += ms / 1000;
+    t.tv_nsec += (long)(ms % 1000) * 1000000L;
+    if (t.tv_nsec >= 1000000000L) {
+        t.tv_sec++;
+        t.tv_nsec -= 1000000000L;
+    }
+    return t;
+}
+
+/* On every (re)connection: subscribe again (the persistent session keeps the
+ * subscriptions, but a broker that lost its state must learn them). */
+static void on_connect(struct mosquitto *mosq, void *obj, int rc)
+{
+    (void)obj;
+    if (rc != 0) {
+        pthread_mutex_lock(&g_lock);
+        g_connect_refused = rc;
+        pthread_cond_broadcast(&g_changed);
+        pthread_mutex_unlock(&g_lock);
+        return;
+    }
+    const semo_peer *self = &g_program->peers[g_program->self];
+    char team[MQTT_TOPIC_MAX], robot[MQTT_TOPIC_MAX];
+    topic_of(team, sizeof team, self->team, NULL, NULL);
+    topic_of(robot, sizeof robot, self->team, self->robot, NULL);
+    char *topics[] = {team, robot};
+    int mid;
+    if (mosquitto_subscribe_multiple(mosq, &mid, 2, topics, 1, 0, NULL) == MOSQ_ERR_SUCCESS) {
+        pthread_mutex_lock(&g_lock);
+        g_subscribe_mid = mid;
+        pthread_mutex_unlock(&g_lock);
+    }
+}
+
+static void on_subscribe(struct mosquitto *mosq, void *obj, int mid, int count, const int *granted)
+{
+    (void)mosq;
+    (void)obj;
+    (void)count;
+    (void)granted;
+    pthread_mutex_lock(&g_lock);
+    if (mid == g_subscribe_mid) {
+        g_subscribed = true;
+        pthread_cond_broadcast(&g_changed);
+    }
+    pthread_mutex_unlock(&g_lock);
+}
+
+static void on_publish(struct mosquitto *mosq, void *obj, int mid)
+{
+    (void)mosq;
+    (void)obj;
+    (void)mid;
+    pthread_mutex_lock(&g_lock);
+    if (g_unacked > 0)
+        g_unacked--;
+    pthread_cond_broadcast(&g_changed);
+    pthread_mutex_unlock(&g_lock);
+}
+
+static void on_message(struct mosquitto *mosq, void *obj, const struct mosquitto_message *msg)
+{
+    (void)mosq;
+    (void)obj;
+    const semo_peer *self = &g_program->peers[g_program->self];
+    const unsigned char *data = msg->payload;
+    size_t len = msg->payloadlen > 0 ? (size_t)msg->payloadlen : 0;
+    /* A message to our team that we sent ourselves: UDP never sends to self. */
+    char team[256], robot[256];
+    if (datagram_field(data, len, 0, team, sizeof team) && datagram_field(data, len, 1, robot, sizeof robot) &&
+        strcmp(team, self->team) == 0 && strcmp(robot, self->robot) == 0)
+        return;
+    pthread_mutex_lock(&g_lock);
+    /* A full queue holds back the network thread (and so the broker's
+     * acknowledgement) rather than losing a message. */
+    while (g_count == MQTT_QUEUE && !g_interrupted)
+        pthread_cond_wait(&g_changed, &g_lock);
+    if (!g_interrupted) {
+        mqtt_payload *slot = &g_queue[(g_head + g_count) % MQTT_QUEUE];
+        slot->len = len < sizeof slot->data ? len : sizeof slot->data;
+        memcpy(slot->data, data, slot->len);
+        g_count++;
+        pthread_cond_broadcast(&g_changed);
+    }
+    pthread_mutex_unlock(&g_lock);
+}
+
+static int mqtt_open(const semo_program_desc *program, const semo_transport_config *config)
+{
+    if (g_mosq || program->self >= program->peer_count || !config->broker_host)
+        return -1;
+    g_program = program;
+    mission_name(program->mission);
+    g_head = g_count = 0;
+    g_interrupted = g_subscribed = false;
+    g_connect_refused = 0;
+    g_subscribe_mid = -1;
+    g_unacked = 0;
+    pthread_condattr_t attr;
+    pthread_condattr_init(&attr);
+    pthread_condattr_setclock(&attr, CLOCK_MONOTONIC);
+    pthread_cond_init(&g_changed, &attr);
+    pthread_condattr_destroy(&attr);
+
+    mosquitto_lib_init();
+    char client_id[MQTT_TOPIC_MAX];
+    snprintf(client_id, sizeof client_id, "semo-%s-%s", g_mission, program->peers[program->self].robot);
+    g_mosq = mosquitto_new(client_id, false, NULL);
+    if (!g_mosq) {
+        mosquitto_lib_cleanup();
+        return -1;
+    }
+    mosquitto_int_option(g_mosq, MOSQ_OPT_TCP_NODELAY, 1);
+    mosquitto_connect_callback_set(g_mosq, on_connect);
+    mosquitto_subscribe_callback_set(g_mosq, on_subscribe);
+    mosquitto_publish_callback_set(g_mosq, on_publish);
+    mosquitto_message_callback_set(g_mosq, on_message);
+    /* After a lost connection the network thread reconnects by itself. */
+    mosquitto_reconnect_delay_set(g_mosq, 1, 8, true);
+    int rc = mosquitto_connect(g_mosq, config->broker_host, config->broker_port, MQTT_KEEPALIVE_S);
+    if (rc != MOSQ_ERR_SUCCESS || mosquitto_loop_start(g_mosq) != MOSQ_ERR_SUCCESS) {
+        fprintf(stderr, "semo runtime: cannot reach the MQTT broker at %s:%d: %s\n", config->broker_host,
+                config->broker_port, mosquitto_strerror(rc));
+        mosquitto_destroy(g_mosq);
+        g_mosq = NULL;
+        mosquitto_lib_cleanup();
+        return -1;
+    }
+    /* Sending before our subscriptions stand would lose the answers. */
+    struct timespec deadline = deadline_after(MQTT_OPEN_WAIT_MS);
+    pthread_mutex_lock(&g_lock);
+    int waited = 0;
+    while (!g_subscribed && !g_connect_refused && waited == 0)
+        waited = pthread_cond_timedwait(&g_changed, &g_lock, &deadline);
+    bool ready = g_subscribed;
+    int refused = g_connect_refused;
+    pthread_mutex_unlock(&g_lock);
+    if (!ready) {
+        fprintf(stderr, "semo runtime: the MQTT broker at %s:%d %s\n", config->broker_host, config->broker_port,
+                refused ? mosquitto_connack_string(refused) : "did not confirm the subscriptions in time");
+        mosquitto_disconnect(g_mosq);
+        mosquitto_loop_stop(g_mosq, false);
+        mosquitto_destroy(g_mosq);
+        g_mosq = NULL;
+        mosquitto_lib_cleanup();
+        return -1;
+    }
+    return 0;
+}
+
+/* `to` is a team (every robot of it hears) or one robot's name. */
+static int mqtt_send_to(const char *to, const void *data, size_t len)
+{
+    if (!g_mosq || len < 6 || len > MQTT_PAYLOAD_MAX)
+        return -1;
+    char key[256];
+    if (!datagram_field(data, len, 2, key, sizeof key))
+        return -1;
+    char topic[MQTT_TOPIC_MAX];
+    bool team = false;
+    const semo_peer *robot = NULL;
+    for (size_t i = 0; i < g_program->peer_count; i++) {
+        if (strcmp(g_program->peers[i].team, to) == 0)
+            team = true;
+        else if (strcmp(g_program->peers[i].robot, to) == 0)
+            robot = &g_program->peers[i];
+    }
+    if (team)
+        topic_of(topic, sizeof topic, to, NULL, key);
+    else if (robot)
+        topic_of(topic, sizeof topic, robot->team, robot->robot, key);
+    else
+        return -1;
+    bool is_send = ((const unsigned char *)data)[5] == SEMO_MSG_SEND;
+    int qos = is_send ? 1 : 0;
+    /* Counted before publishing: on_publish (QoS 1: the broker's PUBACK;
+     * QoS 0: written to the socket) may come first. */
+    pthread_mutex_lock(&g_lock);
+    g_unacked++;
+    pthread_mutex_unlock(&g_lock);
+    /* While disconnected libmosquitto queues QoS 1 messages and sends them on
+     * reconnection; a QoS 0 publish is then lost, as on UDP. */
+    int rc = mosquitto_publish(g_mosq, NULL, topic, (int)len, data, qos, !is_send);
+    if (rc != MOSQ_ERR_SUCCESS) {
+        pthread_mutex_lock(&g_lock);
+        g_unacked--;
+        pthread_mutex_unlock(&g_lock);
+    }
+    return rc == MOSQ_ERR_SUCCESS || (rc == MOSQ_ERR_NO_CONN && qos == 0) ? 0 : -1;
+}
+
+static int mqtt_recv(void *data, size_t cap, int timeout_ms)
+{
+    struct timespec deadline = deadline_after(timeout_ms < 0 ? 0 : timeout_ms);
+    pthread_mutex_lock(&g_lock);
+    int waited = 0;
+    while (g_count == 0 && !g_interrupted && waited == 0) {
+        if (timeout_ms < 0)
+            pthread_cond_wait(&g_changed, &g_lock);
+        else
+            waited = pthread_cond_timedwait(&g_changed, &g_lock, &deadline);
+    }
+    int n = 0;
+    if (g_count > 0 && !g_interrupted) {
+        mqtt_payload *slot = &g_queue[g_head];
+        n = (int)(slot->len < cap ? slot->len : cap);
+        memcpy(data, slot->data, (size_t)n);
+        g_head = (g_head + 1) % MQTT_QUEUE;
+        g_count--;
+        pthread_cond_broadcast(&g_changed);
+    }
+    pthread_mutex_unlock(&g_lock);
+    return n;
+}
+
+static void mqtt_interrupt(void)
+{
+    pthread_mutex_lock(&g_lock);
+    g_interrupted = true;
+    pthread_cond_broadcast(&g_changed);
+    pthread_mutex_unlock(&g_lock);
+}
+
+static void mqtt_close(void)
+{
+    if (!g_mosq)
+        return;
+    /* What we sent at QoS 1 must reach the broker before we go: after a
+     * disconnection libmosquitto forgets its queue. */
+    struct timespec deadline = deadline_after(MQTT_CLOSE_WAIT_MS);
+    pthread_mutex_lock(&g_lock);
+    int waited = 0;
+    while (g_unacked > 0 && waited == 0)
+        waited = pthread_cond_timedwait(&g_changed, &g_lock, &deadline);
+    pthread_mutex_unlock(&g_lock);
+    mosquitto_disconnect(g_mosq);
+    mosquitto_loop_stop(g_mosq, false);
+    mosquitto_destroy(g_mosq);
+    g_mosq = NULL;
+    mosquitto_lib_cleanup();
+    pthread_cond_destroy(&g_changed);
+}
+
+const semo_transport semo_mqtt_transport = {
+    .name = "mqtt",
+    .open = mqtt_open,
+    .send_to = mqtt_send_to,
+    .recv = mqtt_recv,
+    .interrupt = mqtt_interrupt,
+    .close = mqtt_close,
+};
+#else
+/* ISO C wants at least one declaration in a translation unit. */
+typedef int semo_mqtt_not_built;
+#endif

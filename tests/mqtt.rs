@@ -1,0 +1,425 @@
+//! The MQTT transport as a user runs it: a private `mosquitto` broker on a
+//! free loopback port, the scouting mission built with `semo build` and
+//! `make TRANSPORT=mqtt`, its robots started as processes with `--transport
+//! mqtt --broker mqtt://127.0.0.1:PORT`. They must behave as over the
+//! loopback UDP transport (same modes, the master hears every slave's
+//! color), and a `send` (QoS 1, persistent session) must reach a robot that
+//! was away when it was sent.
+//!
+//! Needs `mosquitto` and `libmosquitto-dev` (Debian). Skipped with a message
+//! when the broker is missing, unless `SEMO_MQTT_TESTS=require` (CI).
+
+mod support;
+
+use std::collections::BTreeMap;
+use std::net::{TcpListener, TcpStream};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use support::robots::{
+    Event, PEDANTIC, build, events, field, modes, robot_command, robot_folders, scratch,
+};
+use support::{examples, repo_root};
+
+/// The `mosquitto` binary (Debian puts it in /usr/sbin, often not on PATH).
+fn mosquitto() -> Option<PathBuf> {
+    let on_path = std::env::var_os("PATH")
+        .into_iter()
+        .flat_map(|p| std::env::split_paths(&p).collect::<Vec<_>>());
+    on_path
+        .chain([PathBuf::from("/usr/sbin"), PathBuf::from("/usr/local/sbin")])
+        .map(|dir| dir.join("mosquitto"))
+        .find(|path| path.is_file())
+}
+
+/// The broker, or None (after saying why) when the test must be skipped.
+fn broker_or_skip(test: &str) -> Option<PathBuf> {
+    let found = mosquitto();
+    if found.is_none() {
+        let required = std::env::var("SEMO_MQTT_TESTS").as_deref() == Ok("require");
+        assert!(
+            !required,
+            "SEMO_MQTT_TESTS=require but `mosquitto` is not installed (apt-get install mosquitto libmosquitto-dev)"
+        );
+        eprintln!(
+            "skipping {test}: `mosquitto` is not installed (set SEMO_MQTT_TESTS=require to fail instead)"
+        );
+    }
+    found
+}
+
+/// Processes this test started; each is killed when the guard goes, so a
+/// failing assertion leaves no broker or robot behind.
+#[derive(Default)]
+struct Processes(Vec<Child>);
+
+impl Processes {
+    fn push(&mut self, child: Child) -> usize {
+        self.0.push(child);
+        self.0.len() - 1
+    }
+
+    /// SIGTERM and wait: a broker then saves its state (SIGKILL would not).
+    fn terminate(&mut self, index: usize) {
+        let child = &mut self.0[index];
+        let sent = Command::new("kill")
+            .args(["-TERM", &child.id().to_string()])
+            .status()
+            .expect("kill runs");
+        assert!(sent.success(), "kill -TERM {}", child.id());
+        child.wait().expect("wait for the terminated process");
+    }
+
+    /// Waits for a robot to end by itself and returns its stderr; a failure
+    /// status fails the test.
+    fn wait_success(&mut self, index: usize, what: &str) -> String {
+        let child = &mut self.0[index];
+        let status = child.wait().expect("wait for the robot");
+        let mut stderr = String::new();
+        if let Some(mut pipe) = child.stderr.take() {
+            use std::io::Read;
+            let _ = pipe.read_to_string(&mut stderr);
+        }
+        assert!(status.success(), "{what} exited with {status:?}: {stderr}");
+        stderr
+    }
+}
+
+impl Drop for Processes {
+    fn drop(&mut self) {
+        for child in &mut self.0 {
+            let _ = child.kill();
+            let _ = child.wait();
+        }
+    }
+}
+
+/// A private broker: its configuration, persistence and log in `dir`, on a
+/// free port of 127.0.0.1. Returns its port once it accepts connections.
+fn start_broker(binary: &Path, dir: &Path, processes: &mut Processes) -> (u16, usize) {
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let index = start_broker_on(binary, dir, port, processes);
+    (port, index)
+}
+
+fn start_broker_on(binary: &Path, dir: &Path, port: u16, processes: &mut Processes) -> usize {
+    let config = dir.join("mosquitto.conf");
+    // Started as root, mosquitto drops to the `mosquitto` user, which cannot
+    // write into our folder: it stays the user we are (no effect otherwise).
+    let whoami = Command::new("id").arg("-un").output().expect("id runs");
+    let user = String::from_utf8_lossy(&whoami.stdout).trim().to_string();
+    std::fs::write(
+        &config,
+        format!(
+            "user {user}\nlistener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\npersistence true\npersistence_location {}/\nlog_dest file {}\n",
+            dir.display(),
+            dir.join("mosquitto.log").display()
+        ),
+    )
+    .unwrap();
+    let child = Command::new(binary)
+        .arg("-c")
+        .arg(&config)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("mosquitto starts");
+    let index = processes.push(child);
+    // Ready when it accepts a connection; a broker that never does (the port
+    // taken meanwhile) fails the test after many tries rather than hanging.
+    for _ in 0..500 {
+        if TcpStream::connect(("127.0.0.1", port)).is_ok() {
+            return index;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let log = std::fs::read_to_string(dir.join("mosquitto.log")).unwrap_or_default();
+    panic!("mosquitto did not listen on port {port}: {log}");
+}
+
+/// `semo build` of the scouting mission for linux-sim, each robot made with
+/// the MQTT transport built in (`make TRANSPORT=mqtt`), warnings as errors.
+fn build_scouting(out: &Path) -> Vec<PathBuf> {
+    let built = build(
+        &examples().join("scouting/scouting.mission"),
+        "linux-sim",
+        out,
+    );
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    let folders = robot_folders(out);
+    for folder in &folders {
+        let made = Command::new("make")
+            .args([
+                "-s",
+                "-j2",
+                "CC=gcc",
+                &format!("CFLAGS={PEDANTIC}"),
+                "TRANSPORT=mqtt",
+            ])
+            .current_dir(folder)
+            .output()
+            .expect("make runs");
+        let stderr = String::from_utf8_lossy(&made.stderr);
+        assert!(
+            made.status.success() && !stderr.contains("warning"),
+            "{}: {stderr}",
+            folder.display()
+        );
+    }
+    folders
+}
+
+fn scenario() -> PathBuf {
+    repo_root().join("tests/fixtures/build/scouting.scenario.json")
+}
+
+fn robot_name(folder: &Path) -> String {
+    folder.file_name().unwrap().to_string_lossy().into_owned()
+}
+
+fn read_trace(path: &Path) -> Vec<Event> {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    events(&text.lines().map(str::to_string).collect::<Vec<_>>())
+}
+
+/// Runs every robot together with `transport_args` and returns its trace.
+fn run_together(
+    folders: &[PathBuf],
+    out: &Path,
+    tag: &str,
+    transport_args: &[String],
+    processes: &mut Processes,
+) -> BTreeMap<String, Vec<Event>> {
+    // tests/build.rs's block of ports for this process id, at an offset it
+    // does not use: runs in parallel do not hear each other.
+    let port_base = 20000 + (std::process::id() % 250) * 40 + 30;
+    let mut started = Vec::new();
+    for folder in folders {
+        let robot = robot_name(folder);
+        let trace = out.join(format!("{robot}.{tag}.jsonl"));
+        let child = robot_command(folder, &scenario(), &trace, port_base)
+            .args(transport_args)
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the robot program starts");
+        started.push((robot, trace, processes.push(child)));
+    }
+    let mut traces = BTreeMap::new();
+    for (robot, trace, index) in started {
+        processes.wait_success(index, &format!("{robot} ({tag})"));
+        traces.insert(robot, read_trace(&trace));
+    }
+    traces
+}
+
+fn received_from(events: &[Event], robot: &str, key: &str) -> Vec<String> {
+    events
+        .iter()
+        .filter(|e| {
+            field(e, "event") == "receive"
+                && field(e, "from_robot") == robot
+                && field(e, "key") == key
+        })
+        .map(|e| field(e, "value").to_string())
+        .collect()
+}
+
+#[test]
+fn scouting_over_mqtt_behaves_as_over_udp() {
+    let Some(binary) = broker_or_skip("scouting_over_mqtt_behaves_as_over_udp") else {
+        return;
+    };
+    let out = scratch("mqtt-scouting");
+    let broker_dir = out.join("broker");
+    std::fs::create_dir_all(&broker_dir).unwrap();
+    let folders = build_scouting(&out);
+    let mut processes = Processes::default();
+    let (port, _) = start_broker(&binary, &broker_dir, &mut processes);
+
+    let udp = run_together(
+        &folders,
+        &out,
+        "udp",
+        &["--transport".into(), "udp".into()],
+        &mut processes,
+    );
+    let mqtt = run_together(
+        &folders,
+        &out,
+        "mqtt",
+        &[
+            "--transport".into(),
+            "mqtt".into(),
+            "--broker".into(),
+            format!("mqtt://127.0.0.1:{port}"),
+        ],
+        &mut processes,
+    );
+
+    assert_eq!(mqtt.len(), 3, "three robots");
+    for (robot, events) in &mqtt {
+        assert_eq!(
+            modes(events),
+            modes(&udp[robot]),
+            "{robot}'s modes over MQTT and over UDP"
+        );
+        assert_eq!(modes(events).last().map(String::as_str), Some("FINISH"));
+    }
+    for slave in ["ti", "nxt"] {
+        let heard = received_from(&mqtt["irobot"], slave, "SlaveTeam.COLOR");
+        assert!(
+            !heard.is_empty()
+                && !received_from(&udp["irobot"], slave, "SlaveTeam.COLOR").is_empty(),
+            "the master receives SlaveTeam.COLOR from {slave} over both transports"
+        );
+        assert!(
+            heard.iter().any(|v| v == "RGB"),
+            "the master hears {slave}'s complete set of colors over MQTT: {heard:?}"
+        );
+    }
+}
+
+#[test]
+fn a_send_reaches_a_robot_that_was_away_when_it_was_sent() {
+    let Some(binary) = broker_or_skip("a_send_reaches_a_robot_that_was_away_when_it_was_sent")
+    else {
+        return;
+    };
+    let out = scratch("mqtt-qos1");
+    let broker_dir = out.join("broker");
+    std::fs::create_dir_all(&broker_dir).unwrap();
+    let folders = build_scouting(&out);
+    let folder = |name: &str| {
+        folders
+            .iter()
+            .find(|f| robot_name(f) == name)
+            .unwrap()
+            .clone()
+    };
+    let mut processes = Processes::default();
+    let (port, broker) = start_broker(&binary, &broker_dir, &mut processes);
+    let mqtt = [
+        "--transport".to_string(),
+        "mqtt".into(),
+        "--broker".into(),
+        format!("mqtt://127.0.0.1:{port}"),
+    ];
+    let run = |processes: &mut Processes, robot: &str, tag: &str, extra: &[&str]| {
+        let trace = out.join(format!("{robot}.{tag}.jsonl"));
+        let child = robot_command(&folder(robot), &scenario(), &trace, 1)
+            .args(&mqtt)
+            .args(extra)
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the robot program starts");
+        let index = processes.push(child);
+        processes.wait_success(index, &format!("{robot} ({tag})"));
+        read_trace(&trace)
+    };
+
+    // The master connects once (its session and subscriptions now exist at
+    // the broker) and goes away.
+    run(&mut processes, "irobot", "first", &["--duration", "10"]);
+    // The broker restarts (its state survives in its persistence file).
+    processes.terminate(broker);
+    start_broker_on(&binary, &broker_dir, port, &mut processes);
+    // A slave runs its whole mission while the master is away.
+    let ti = run(&mut processes, "ti", "alone", &[]);
+    assert!(
+        ti.iter().any(|e| field(e, "event") == "send"
+            && field(e, "key") == "SlaveTeam.COLOR"
+            && field(e, "value") == "RGB"),
+        "ti sends its colors"
+    );
+    // The master comes back and gets what was sent meanwhile.
+    let back = run(&mut processes, "irobot", "back", &["--duration", "3000"]);
+    let heard = received_from(&back, "ti", "SlaveTeam.COLOR");
+    assert!(
+        !heard.is_empty(),
+        "the master, back, receives the colors ti sent while it was away"
+    );
+}
+
+/// Runs a robot program with `args` and returns its exit code and stderr.
+fn run_with(folder: &Path, args: &[&str]) -> (Option<i32>, String) {
+    let mut processes = Processes::default();
+    let child = Command::new(folder.join(robot_name(folder)))
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the robot program starts");
+    let index = processes.push(child);
+    let child = &mut processes.0[index];
+    let status = child.wait().unwrap();
+    let mut stderr = String::new();
+    use std::io::Read;
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut stderr)
+        .unwrap();
+    (status.code(), stderr)
+}
+
+#[test]
+fn transport_options_are_checked_and_an_unreachable_broker_is_reported() {
+    let out = scratch("mqtt-options");
+    let folders = build_scouting(&out);
+    let irobot = folders.iter().find(|f| robot_name(f) == "irobot").unwrap();
+    for (args, says) in [
+        (
+            &["--transport", "tcp"][..],
+            "the transport must be udp or mqtt",
+        ),
+        (
+            &["--broker", "mqtts://example.org"],
+            "TLS is not supported yet",
+        ),
+        (&["--broker", "mqtt://host:99999"], "port from 1 to 65535"),
+        (
+            &["--broker", "tcp://host:1883"],
+            "the broker must be mqtt://HOST[:PORT]",
+        ),
+    ] {
+        let (code, stderr) = run_with(irobot, args);
+        assert_eq!(code, Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+    }
+    // Nothing listens on a port just freed: the robot says so and stops.
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let broker = format!("mqtt://127.0.0.1:{port}");
+    let (code, stderr) = run_with(irobot, &["--transport", "mqtt", "--broker", &broker]);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains(&format!("cannot reach the MQTT broker at 127.0.0.1:{port}")),
+        "{stderr}"
+    );
+    // Built with the default of linux-sim (udp only), mqtt is not there.
+    let udp_only = scratch("mqtt-options-udp");
+    let built = build(
+        &examples().join("scouting/scouting.mission"),
+        "linux-sim",
+        &udp_only,
+    );
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    let folder = robot_folders(&udp_only)
+        .into_iter()
+        .find(|f| robot_name(f) == "irobot")
+        .unwrap();
+    support::robots::make(&folder, "gcc", PEDANTIC).unwrap_or_else(|e| panic!("{e}"));
+    let (code, stderr) = run_with(&folder, &["--transport", "mqtt"]);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(
+        stderr.contains("built without the mqtt transport"),
+        "{stderr}"
+    );
+}
