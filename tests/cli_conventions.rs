@@ -1,7 +1,8 @@
 //! The command-line conventions users expect of a tool (issue 18, "CLI"),
 //! each through the `semo` binary: `-` for standard input, `--deny
 //! warnings`, colour by `--color` then `NO_COLOR`, `CLICOLOR_FORCE` and
-//! `TERM=dumb`, hints called hints, and `--help` saying what the tool does.
+//! `TERM=dumb`, hints called hints, one `-o/--output` meaning, and `--help`
+//! saying what the tool does.
 
 mod support;
 
@@ -64,8 +65,10 @@ fn hints_are_called_hints() {
         &["check", "-"],
         &fixture("W009_catch_never_thrown.mission"),
     );
-    assert!(out.stdout.contains("Hint"), "{}", out.stdout);
+    assert!(out.stdout.contains("[W009] Hint:"), "{}", out.stdout);
     assert!(!out.stdout.contains("Advice"), "{}", out.stdout);
+    // Without colour, not a single escape sequence, the hint's header too.
+    assert!(!out.stdout.contains('\u{1b}'), "{:?}", out.stdout);
 }
 
 /// `semo check` of a mission with an error, its output not a terminal, in
@@ -120,4 +123,33 @@ fn help_says_what_the_tool_does_now() {
     ] {
         assert!(out.stdout.contains(command), "{command}: {}", out.stdout);
     }
+}
+
+#[test]
+fn dash_o_and_output_mean_the_output_everywhere() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_conventions_output");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let mission = dir.join("follow.mission");
+    std::fs::copy(repo_root().join("examples/follow/follow.mission"), &mission).unwrap();
+    let mission = mission.display().to_string();
+    for (flag, folder) in [("-o", "a"), ("--output", "b"), ("--out", "c")] {
+        let out = dir.join(folder).display().to_string();
+        let run = semo(&["build", &mission, flag, &out, "--emit", "taskgraph"]);
+        assert_eq!(run.code, 0, "{flag}: {}{}", run.stdout, run.stderr);
+        assert!(dir.join(folder).join("Team1").is_dir(), "{flag}");
+    }
+    let svg = dir.join("modes.svg");
+    for flag in ["-o", "--output"] {
+        let _ = std::fs::remove_file(&svg);
+        let run = semo(&["graph", "modes", &mission, flag, &svg.display().to_string()]);
+        assert_eq!(run.code, 0, "{flag}: {}", run.stderr);
+        assert!(
+            std::fs::read_to_string(&svg).unwrap().contains("<svg"),
+            "{flag}"
+        );
+    }
+    // The help names one meaning.
+    let help = semo(&["build", "--help"]).stdout;
+    assert!(help.contains("-o, --output <OUT>"), "{help}");
 }

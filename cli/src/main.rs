@@ -104,8 +104,14 @@ enum Command {
         /// More strategy (and catalog) files or folders to read.
         #[arg(long)]
         strategy: Vec<PathBuf>,
-        /// The output folder (default: `out` beside the mission).
-        #[arg(long, short)]
+        /// The output folder (default: `out` beside the mission). `-o` and
+        /// `--output` as in every command that writes; `--out` still works.
+        #[arg(
+            long = "output",
+            short = 'o',
+            visible_alias = "out",
+            value_name = "OUT"
+        )]
         out: Option<PathBuf>,
         /// `linux` (POSIX threads; you fill the task files), `linux-sim`
         /// (sensors, actuators and the operator simulated from a scenario

@@ -88,9 +88,36 @@ pub fn diagnostics(
         if let Some(s) = &d.suggestion {
             report = report.with_help(format!("did you mean `{s}`?"));
         }
-        report.finish().write(&mut cache, &mut *out)?;
+        if colored || d.severity != Severity::Hint {
+            report.finish().write(&mut cache, &mut *out)?;
+        } else {
+            // ariadne colours a custom kind's header ("Hint") even with
+            // colour off: written aside and its escape sequences dropped.
+            let mut text = Vec::new();
+            report.finish().write(&mut cache, &mut text)?;
+            out.write_all(&without_escapes(&text))?;
+        }
     }
     Ok(())
+}
+
+/// `bytes` without ANSI escape sequences (`ESC [ … letter`).
+fn without_escapes(bytes: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == 0x1b && bytes.get(i + 1) == Some(&b'[') {
+            i += 2;
+            while i < bytes.len() && !bytes[i].is_ascii_alphabetic() {
+                i += 1;
+            }
+            i += 1;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    out
 }
 
 /// `semo check`'s report: the diagnostics, then a one-line summary.
