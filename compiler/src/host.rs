@@ -13,7 +13,8 @@
 //! fixture folder is), and those directly in each folder above it up to its
 //! workspace root (the innermost root that
 //! holds it; a file under no root is its own folder's root), and the files
-//! named to be seen by all (`semo build --strategy`). Nothing else: two
+//! named to be seen by all (`semo build --strategy`). A document that is not a file (an unsaved editor
+//! buffer) sees what a file directly in the first workspace root would. Nothing else: two
 //! sibling folders do not see each other. [`sees`] is that rule, and the only
 //! place it is written.
 //!
@@ -43,6 +44,7 @@ use crate::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
 use crate::syntax::{ParseCache, parse_incremental};
 use crate::taskgraph::subgraph::{self, SubgraphSource};
 use crate::workspace::{FileKind, GraphRun, analyze_graph_at};
+use std::borrow::Cow;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
@@ -85,6 +87,9 @@ pub fn sees(
         .map_or(reader_dir, PathBuf::as_path);
     reader_dir.starts_with(file_dir) && file_dir.starts_with(root)
 }
+
+/// The file name an unsaved document is read as having (see `Analysis::place`).
+const UNSAVED: &str = "<unsaved>";
 
 fn folder(path: &Path) -> Option<&Path> {
     path.parent()
@@ -341,11 +346,25 @@ impl Analysis {
         )
     }
 
-    /// The folder a file's view starts from (`None` for a document that is
-    /// not a file).
+    /// Where a file reads from: its path, else (a document that is not a
+    /// file, such as an unsaved editor buffer) a place in the first workspace
+    /// root, so that it sees what a file there would; with no root, nowhere
+    /// (it sees only the built-in catalog).
+    fn place<'a>(&self, file: &'a SourceText) -> Option<Cow<'a, Path>> {
+        match &file.key {
+            Some(key) => Some(Cow::Borrowed(key)),
+            None => self
+                .roots
+                .roots
+                .first()
+                .map(|root| Cow::Owned(root.join(UNSAVED))),
+        }
+    }
+
+    /// The folder a file's view starts from (see [`Analysis::place`]).
     fn folder_of(&self, id: FileId) -> Option<PathBuf> {
-        let path = self.file(id)?.key.as_deref()?;
-        folder(path).map(Path::to_path_buf)
+        let path = self.place(self.file(id)?)?;
+        folder(&path).map(Path::to_path_buf)
     }
 
     /// The catalog and strategy files the files of `folder` see, sorted by
@@ -492,7 +511,7 @@ impl Analysis {
             Some(folder) => self
                 .files()
                 .filter(|f| f.kind == FileKind::Mission)
-                .filter(|f| f.key.as_deref().and_then(self::folder) == Some(folder))
+                .filter(|f| self.place(f).as_deref().and_then(self::folder) == Some(folder))
                 .collect(),
             None => Vec::new(),
         };
@@ -551,9 +570,9 @@ impl Analysis {
         let mut folders: Vec<Option<PathBuf>> = self
             .files()
             .filter(|f| f.kind == FileKind::Mission)
-            .filter_map(|m| m.key.as_deref())
+            .filter_map(|m| self.place(m))
             .filter(|m| self.sees(m, path))
-            .map(|m| folder(m).map(Path::to_path_buf))
+            .map(|m| folder(&m).map(Path::to_path_buf))
             .collect();
         folders.sort();
         folders.dedup();
@@ -570,7 +589,7 @@ impl Analysis {
         };
         self.files()
             .filter(|f| f.kind == FileKind::Mission)
-            .filter(|m| m.key.as_deref().is_some_and(|m| self.sees(m, path)))
+            .filter(|m| self.place(m).is_some_and(|m| self.sees(&m, path)))
             .map(|m| m.id)
             .collect()
     }
@@ -765,7 +784,8 @@ impl Analysis {
                 for unit_folder in self.units_seeing(id) {
                     let reader = unit_folder.as_deref().map(|f| f.join("_"));
                     for other in self.files() {
-                        let shares = match (&reader, other.kind, other.key.as_deref()) {
+                        let place = self.place(other);
+                        let shares = match (&reader, other.kind, place.as_deref()) {
                             (None, ..) | (_, _, None) | (_, FileKind::TaskGraph, _) => false,
                             (Some(reader), FileKind::Mission, Some(p)) => {
                                 file.kind == FileKind::Catalog && folder(p) == folder(reader)

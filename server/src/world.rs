@@ -272,7 +272,7 @@ impl World {
             return Changed::default();
         };
         let document = Document::new(text, version);
-        let path = uri.to_file_path().map(|p| p.into_owned());
+        let path = file_path(&uri);
         self.set_text(uri, kind, path, Some(document), text.into())
     }
 
@@ -321,7 +321,7 @@ impl World {
         if self.is_open(uri) {
             return Changed::default();
         }
-        let path = uri.to_file_path().map(|p| p.into_owned());
+        let path = file_path(uri);
         let kind = World::kind_of(uri, None);
         match (path, kind, text) {
             (Some(path), Some(kind), Some(text)) => {
@@ -340,7 +340,7 @@ impl World {
             if self.is_open(&uri) {
                 continue;
             }
-            let path = uri.to_file_path().map(|p| p.into_owned());
+            let path = file_path(&uri);
             let (Some(path), Some(kind), Some(text)) = (path, World::kind_of(&uri, None), text)
             else {
                 continue;
@@ -531,6 +531,18 @@ pub fn read_roots(roots: &[PathBuf]) -> Vec<(Uri, Option<String>)> {
         }
     }
     found
+}
+
+/// Where a `file:` URI's file is; `None` for other schemes (an unsaved
+/// buffer's `untitled:Untitled-1` is no file: the protocol crate's
+/// `to_file_path` would make it the relative path `Untitled-1`).
+pub fn file_path(uri: &Uri) -> Option<PathBuf> {
+    let is_file = uri.scheme().as_str().eq_ignore_ascii_case("file");
+    is_file
+        .then(|| uri.to_file_path())
+        .flatten()
+        .map(|p| p.into_owned())
+        .filter(|p| p.is_absolute())
 }
 
 /// A file's text, with invalid UTF-8 replaced (so the rest is still checked).

@@ -212,3 +212,22 @@ async fn a_service_refined_in_two_strategy_files_is_reported_in_the_editor() {
     assert_eq!(alone, Vec::<Value>::new());
     client.shutdown().await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_unsaved_document_sees_the_workspace_catalog() {
+    let dir = temp_workspace("unsaved");
+    let catalog = dir.join("rover.robot.xml");
+    std::fs::write(&catalog, CATALOG).unwrap();
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], Some(&uri(&dir))).await;
+    // Indexed (its diagnostics are published) before the buffer opens.
+    client.diagnostics(&uri(&catalog), None).await;
+    // A new buffer, never saved: its URI names no file.
+    let unsaved = "untitled:Untitled-1";
+    let mission = "{ T: Rover r }\nT.P.S { dig() } repeat()\nT.M { set(P, S) }\nT.main { default: mode = M }\n";
+    client.open(unsaved, mission).await;
+    let diagnostics = client.diagnostics(unsaved, Some(1)).await;
+    assert_eq!(diagnostics, Vec::<Value>::new());
+    client.shutdown().await;
+    let _ = std::fs::remove_dir_all(&dir);
+}

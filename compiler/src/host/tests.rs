@@ -135,3 +135,25 @@ fn the_build_input_carries_the_diagnostics_of_every_file_the_mission_reads() {
     }
     assert!(analysis.build_input(FileId(1)).is_none());
 }
+
+#[test]
+fn an_unsaved_document_sees_the_workspace_roots_catalogs() {
+    let dig = "{ T: Rover r }\nT.P.S { dig() } repeat()\nT.M { set(P, S) }\nT.main { default: mode = M }\n";
+    let mut host = host_with(&[(1, "/w/rover.robot.xml", FileKind::Catalog, CATALOG)]);
+    host.set_file(FileId(0), None, FileKind::Mission, dig.into());
+    let analysis = host.analysis();
+    assert_eq!(analysis.diagnostics(FileId(0)), Vec::new());
+    assert_eq!(analysis.reads(FileId(0)), vec![FileId(0), FileId(1)]);
+    // A change of that catalog re-checks it.
+    assert!(analysis.affected_by(FileId(1)).contains(&FileId(0)));
+    // With no workspace root it sees only the built-in catalog.
+    let mut alone = AnalysisHost::default();
+    alone.set_file(FileId(0), None, FileKind::Mission, dig.into());
+    let codes: Vec<Code> = alone
+        .analysis()
+        .diagnostics(FileId(0))
+        .iter()
+        .map(|d| d.code)
+        .collect();
+    assert!(codes.contains(&Code::UnknownRobotType), "{codes:?}");
+}
