@@ -73,17 +73,11 @@ async fn publish(state: &Arc<State>, client: &Client, uri: Uri) {
     let Ok(analysis) = tokio::task::spawn_blocking(move || analysed.analysis()).await else {
         return;
     };
-    let others = {
-        let world = state.world();
-        if !world.is_current(&snapshot) {
-            // Stale: the newer snapshot is queued. This may be the last
-            // reference to the old one: it is freed in the background.
-            drop(world);
-            drop(analysis);
-            retire(snapshot);
-            return;
-        }
-        related_files(analysis.diagnostics(), |id| world.uri_of(id).cloned())
+    let Some(others) = related_if_current(state, &snapshot, analysis.diagnostics()) else {
+        // Stale: the newer snapshot is queued. This may be the last
+        // reference to the old one: it is freed in the background.
+        drop(analysis);
+        return retire(snapshot);
     };
     let dataflow = match snapshot.kind {
         FileKind::Mission => snapshot.host().dataflow_if_known(snapshot.id),
@@ -123,14 +117,9 @@ async fn publish_dataflow(state: Arc<State>, client: Client, snapshot: Arc<Snaps
     else {
         return;
     };
-    let others = {
-        let world = state.world();
-        if !world.is_current(&snapshot) {
-            drop(world);
-            drop(analysis);
-            return retire(snapshot);
-        }
-        related_files(analysis.diagnostics(), |id| world.uri_of(id).cloned())
+    let Some(others) = related_if_current(&state, &snapshot, analysis.diagnostics()) else {
+        drop(analysis);
+        return retire(snapshot);
     };
     let extra = dataflow.as_ref().map_or(&[][..], |d| &d.diagnostics[..]);
     if extra.is_empty() {
@@ -161,6 +150,19 @@ fn dataflow_to_lsp(
         related_files(found, |id| world.uri_of(id).cloned())
     };
     convert_all(snapshot, analysis, found, &others)
+}
+
+/// [`related_files`] of `diagnostics`, while `snapshot` is still the current
+/// one (the world's lock is released before returning); `None` once it is not.
+fn related_if_current(
+    state: &State,
+    snapshot: &Arc<Snapshot>,
+    diagnostics: &[semo::diag::Diagnostic],
+) -> Option<HashMap<FileId, Uri>> {
+    let world = state.world();
+    world
+        .is_current(snapshot)
+        .then(|| related_files(diagnostics, |id| world.uri_of(id).cloned()))
 }
 
 /// The URIs of the other files that related information points into.
