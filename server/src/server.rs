@@ -310,10 +310,7 @@ fn roots(params: &InitializeParams) -> Vec<std::path::PathBuf> {
     let folders = params.workspace_folders.iter().flatten().map(|f| &f.uri);
     #[allow(deprecated)] // rootUri is what older clients send
     let root = params.root_uri.iter();
-    folders
-        .chain(root)
-        .filter_map(|uri| uri.to_file_path().map(|p| p.into_owned()))
-        .collect()
+    folders.chain(root).filter_map(world::file_path).collect()
 }
 
 impl LanguageServer for Backend {
@@ -398,10 +395,7 @@ impl LanguageServer for Backend {
             let text = if event.typ == FileChangeType::DELETED {
                 None
             } else {
-                event
-                    .uri
-                    .to_file_path()
-                    .and_then(|path| world::read_text(&path))
+                world::file_path(&event.uri).and_then(|path| world::read_text(&path))
             };
             let mut world = self.state.world();
             changed.extend(match text {

@@ -283,3 +283,26 @@ async fn a_refined_graph_that_fails_its_own_check_is_refused_naming_robot_and_ca
     assert!(!dir.join("out").exists(), "nothing written");
     client.shutdown().await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_unsaved_mission_is_refused_and_nothing_is_written() {
+    let dir = scouting_workspace("unsaved");
+    let (mut client, _, text) = started(&dir, json!({})).await;
+    // The same mission in a new buffer, never saved: `untitled:` names no file,
+    // not even one relative to the server's working folder.
+    let unsaved = "untitled:Untitled-1";
+    client.open(unsaved, &text).await;
+    client.diagnostics(unsaved, Some(1)).await;
+    let answer = client
+        .request(
+            "workspace/executeCommand",
+            json!({ "command": "semo.generateCode", "arguments": [unsaved] }),
+        )
+        .await;
+    let error = answer.expect_err("an unsaved mission has no folder to generate beside");
+    assert!(error.to_string().contains("saved as a file"), "{error}");
+    let cwd = std::env::current_dir().unwrap();
+    assert!(!cwd.join("Untitled-1").exists() && !cwd.join("out").exists());
+    assert!(!dir.join("out").exists(), "nothing written");
+    client.shutdown().await;
+}

@@ -110,7 +110,7 @@ pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
 }
 
 fn path_of(snapshot: &Snapshot) -> Option<PathBuf> {
-    snapshot.uri.to_file_path().map(|p| p.into_owned())
+    crate::world::file_path(&snapshot.uri)
 }
 
 /// Checks, refines and generates (no writing yet); the mission's text too,

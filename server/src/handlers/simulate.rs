@@ -56,14 +56,9 @@ pub fn job(world: &World, params: SimulateParams) -> Result<Job, String> {
         .snapshot(&params.uri)
         .filter(|s| s.kind == FileKind::Mission)
         .ok_or_else(|| format!("{} is not a mission the server knows", params.uri.as_str()))?;
-    let folder = mission
-        .uri
-        .to_file_path()
-        .and_then(|p| p.parent().map(PathBuf::from));
+    let folder = crate::world::file_path(&mission.uri).and_then(|p| p.parent().map(PathBuf::from));
     let scenario = match params.scenario.parse::<Uri>() {
-        Ok(uri) if params.scenario.starts_with("file:") => uri
-            .to_file_path()
-            .map(|p| p.into_owned())
+        Ok(uri) if params.scenario.starts_with("file:") => crate::world::file_path(&uri)
             .ok_or_else(|| format!("{} is not a file", params.scenario))?,
         _ => folder
             .ok_or("a scenario path relative to an unsaved mission: give the scenario's file URI")?
