@@ -1,7 +1,7 @@
 /**
  * @file Tree-sitter grammar for SeMo mission scripts (`.mission`).
  *
- * It follows the language reference (../shared/spec/mission-language.md, section 2) and the
+ * It follows the mission language reference (section 2, the grammar) and the
  * compiler's own lexer and parser (compiler/src/syntax/token.rs, parser.rs), which are the
  * ground truth: where the two differ, this grammar accepts what the compiler accepts.
  */
