@@ -6,7 +6,7 @@ use super::render;
 use semo::diag::Diagnostic;
 use semo::taskgraph::analysis::ratio::Ratio;
 use semo::workspace::{
-    DiskResolver, FileKind, Files, GraphReading, analyze_graph, analyze_graph_as,
+    DiskResolver, FileKind, Files, GraphReading, GraphRun, analyze_graph, analyze_graph_as,
 };
 use std::io::Write;
 use std::path::Path;
@@ -19,6 +19,23 @@ fn read(path: &Path) -> Option<String> {
             None
         }
     }
+}
+
+/// The graph file at `path` read (a message on failure) and analysed with
+/// `reading`; its sub-graph references are read from the disk.
+fn read_and_analyze(path: &Path, reading: GraphReading) -> Option<(Files, GraphRun)> {
+    let text = read(path)?;
+    let mut files = Files::default();
+    let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
+    let file = files.get(id);
+    let run = analyze_graph_as(
+        id,
+        &file.text,
+        Some(&file.path),
+        &mut DiskResolver::new(&files),
+        reading,
+    );
+    Some((files, run))
 }
 
 /// The graph in `path` when it loads without errors; otherwise the errors
@@ -139,17 +156,9 @@ pub fn analyze(
     color: bool,
     out: &mut impl Write,
 ) -> i32 {
-    let Some(text) = read(path) else { return 2 };
-    let mut files = Files::default();
-    let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
-    let file = files.get(id);
-    let run = analyze_graph_as(
-        id,
-        &file.text,
-        Some(&file.path),
-        &mut DiskResolver::new(&files),
-        reading,
-    );
+    let Some((files, run)) = read_and_analyze(path, reading) else {
+        return 2;
+    };
     let written = if json {
         write_json(&files, &run, out)
     } else {
@@ -393,17 +402,9 @@ pub fn buffers(
             return 2;
         }
     };
-    let Some(text) = read(path) else { return 2 };
-    let mut files = Files::default();
-    let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
-    let file = files.get(id);
-    let run = analyze_graph_as(
-        id,
-        &file.text,
-        Some(&file.path),
-        &mut DiskResolver::new(&files),
-        reading,
-    );
+    let Some((files, run)) = read_and_analyze(path, reading) else {
+        return 2;
+    };
     let live = run
         .report
         .levels

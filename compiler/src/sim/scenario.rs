@@ -199,6 +199,19 @@ impl ScenarioError {
 
 type Result<T> = std::result::Result<T, ScenarioError>;
 
+/// The one member of `kinds` that the object `v` has (`what`: "a fault"),
+/// else an error at `v` listing them.
+fn one_of(v: &Value, what: &str, kinds: &[&'static str]) -> Result<&'static str> {
+    let mut given = kinds.iter().copied().filter(|k| v.member(k).is_some());
+    match (given.next(), given.next()) {
+        (Some(kind), None) => Ok(kind),
+        _ => {
+            let listed: Vec<String> = kinds.iter().map(|k| format!("\"{k}\"")).collect();
+            fail(v, format!("{what} is exactly one of {}", listed.join(", ")))
+        }
+    }
+}
+
 fn fail<T>(v: &Value, message: impl Into<String>) -> Result<T> {
     Err(ScenarioError {
         at: v.at,
@@ -610,22 +623,16 @@ impl Reader<'_> {
                 "until",
             ],
         )?;
-        let kinds = ["kill", "restart", "drop", "delay", "partition"];
-        let given: Vec<&str> = kinds
-            .into_iter()
-            .filter(|k| v.member(k).is_some())
-            .collect();
-        if given.len() != 1 {
-            return fail(
-                v,
-                "a fault is exactly one of \"kill\", \"restart\", \"drop\", \"delay\", \"partition\"",
-            );
-        }
-        let kind = match given[0] {
+        let given = one_of(
+            v,
+            "a fault",
+            &["kill", "restart", "drop", "delay", "partition"],
+        )?;
+        let kind = match given {
             "kill" | "restart" => {
-                let robot = self.robot(require(v, given[0])?, given[0])?;
+                let robot = self.robot(require(v, given)?, given)?;
                 let at = ms(require(v, "at")?, "at", 0)?;
-                if given[0] == "kill" {
+                if given == "kill" {
                     FaultKind::Kill { robot, at }
                 } else {
                     FaultKind::Restart { robot, at }
@@ -688,19 +695,13 @@ impl Reader<'_> {
                 "all_end_in",
             ],
         )?;
-        let kinds = ["enters", "never_enters", "receives", "all_end_in"];
-        let given: Vec<&str> = kinds
-            .into_iter()
-            .filter(|k| v.member(k).is_some())
-            .collect();
-        if given.len() != 1 {
-            return fail(
-                v,
-                "an expectation is exactly one of \"enters\", \"never_enters\", \"receives\", \"all_end_in\"",
-            );
-        }
+        let given = one_of(
+            v,
+            "an expectation",
+            &["enters", "never_enters", "receives", "all_end_in"],
+        )?;
         let before = opt_ms(v, "before", 0)?;
-        let kind = if given[0] == "all_end_in" {
+        let kind = if given == "all_end_in" {
             if let Some(extra) = v.member("robot").or(v.member("before")) {
                 return fail(
                     extra,
@@ -712,7 +713,7 @@ impl Reader<'_> {
             }
         } else {
             let robot = self.robot(require(v, "robot")?, "robot")?;
-            match given[0] {
+            match given {
                 "enters" => ExpectKind::Enters {
                     mode: self.mode(require(v, "enters")?, "enters", Some(&robot))?,
                     robot,
@@ -742,7 +743,7 @@ impl Reader<'_> {
                 },
             }
         };
-        if given[0] != "receives"
+        if given != "receives"
             && let Some(from) = v.member("from")
         {
             return fail(from, "\"from\" goes with \"receives\"");
