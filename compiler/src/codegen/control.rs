@@ -73,14 +73,8 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
     }
     out.push_str(" };\n\n");
 
-    let regions = m
-        .modes
-        .iter()
-        .map(|mo| mo.regions.len())
-        .max()
-        .unwrap_or(0)
-        .max(1);
-    let marks = m.services.iter().map(|s| s.marks).max().unwrap_or(0).max(1);
+    let regions = m.region_count();
+    let marks = m.mark_count();
     let _ = writeln!(
         out,
         "#define REGION_COUNT {regions}\n#define MARK_COUNT {marks}"

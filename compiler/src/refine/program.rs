@@ -56,6 +56,29 @@ pub struct ControlMachine {
     pub heartbeat: bool,
 }
 
+impl ControlMachine {
+    /// The most plans any mode runs at once (at least 1): the size of the
+    /// machine's per-plan state, in C and in the simulator alike.
+    pub fn region_count(&self) -> usize {
+        self.modes
+            .iter()
+            .map(|mode| mode.regions.len())
+            .max()
+            .unwrap_or(0)
+            .max(1)
+    }
+
+    /// The most marks any service machine uses (at least 1).
+    pub fn mark_count(&self) -> usize {
+        self.services
+            .iter()
+            .map(|s| s.marks)
+            .max()
+            .unwrap_or(0)
+            .max(1)
+    }
+}
+
 /// How often a robot that can be elected leader tells its team it is alive
 /// (mission ms); a robot not heard from for three periods counts as failed.
 pub const HEARTBEAT_MS: i64 = 200;

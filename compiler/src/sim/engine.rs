@@ -312,14 +312,8 @@ impl<'p> Robot<'p> {
                 }
             }
         }
-        let regions = m
-            .modes
-            .iter()
-            .map(|mo| mo.regions.len())
-            .max()
-            .unwrap_or(0)
-            .max(1);
-        let marks = m.services.iter().map(|s| s.marks).max().unwrap_or(0).max(1);
+        let regions = m.region_count();
+        let marks = m.mark_count();
         let inbox = m
             .incoming
             .iter()
