@@ -13,6 +13,7 @@ use crate::encoding::{Encoding, LineMap};
 use semo::catalog::Catalog;
 use semo::diag::{Diagnostic, FileId};
 use semo::host::{self, AnalysisHost, CatalogResult, Dropper, Roots};
+use semo::ide::FilePosition;
 use semo::sema::Analysis;
 use semo::strategy::{Strategy, StrategyLinks};
 use semo::text::LineIndex;
@@ -20,7 +21,7 @@ use semo::workspace::{FileKind, GraphRun};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
-use tower_lsp_server::ls_types::{TextDocumentContentChangeEvent, Uri};
+use tower_lsp_server::ls_types::{Position, TextDocumentContentChangeEvent, Uri};
 
 /// The catalog a file sees (built on first use, outside the world's lock),
 /// and the texts of its files.
@@ -119,6 +120,15 @@ impl Snapshot {
     /// The workspace analysis this snapshot belongs to.
     pub fn host(&self) -> &host::Analysis {
         &self.host
+    }
+
+    /// A protocol position of this snapshot's text as the library's
+    /// [`FilePosition`] (what the workspace analysis' queries take).
+    pub fn position(&self, lines: &LineMap<'_>, position: Position) -> FilePosition {
+        FilePosition {
+            file: self.id,
+            offset: lines.offset(position),
+        }
     }
 
     /// Converts positions of this snapshot's text.
