@@ -694,6 +694,29 @@ fn a_file_of_the_wrong_kind_is_refused_in_one_line_and_nothing_is_written() {
         "a task graph",
         "a mission script",
     );
+    // `semo check` knows a file by its name: a name that lies is refused.
+    let lying = dir.join("graph.mission");
+    std::fs::copy(
+        repo_root().join("examples/taskgraphs/kmeans.taskgraph.xml"),
+        &lying,
+    )
+    .unwrap();
+    let out = semo(&["check", &path_str(&lying)]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert_eq!(out.stderr.lines().count(), 1, "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("is a task graph, but its name makes it a mission script"),
+        "{}",
+        out.stderr
+    );
+    // XML of no known kind where XML is wanted is left to the reader, which
+    // points at the root element.
+    let odd = dir.join("odd.taskgraph.xml");
+    std::fs::write(&odd, "<TaskGrap name=\"g\"/>\n").unwrap();
+    let out = semo(&["graph", "analyze", &path_str(&odd)]);
+    assert_eq!(out.code, 1, "{}", out.stderr);
+    assert!(out.stderr.contains("[E061]"), "{}", out.stderr);
 }
 
 #[test]

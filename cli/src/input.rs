@@ -3,6 +3,7 @@
 //! wrong kind says so in one line and does nothing, instead of reading, say,
 //! a task graph as a mission and reporting every line of it.
 
+use semo::workspace::FileKind;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
@@ -71,8 +72,11 @@ impl Content {
         let text = text.trim_start_matches('\u{feff}').trim_start();
         // A mission opens with its team declarations, `{ Team: … }`; a
         // scenario is a JSON object, `{ "duration": … }`.
-        if let Some(object) = text.strip_prefix('{')
-            && object.trim_start().starts_with(['"', '}'])
+        if let Some(object) = text.strip_prefix('{').map(str::trim_start)
+            && (object.starts_with('"')
+                || object
+                    .strip_prefix('}')
+                    .is_some_and(|r| r.trim().is_empty()))
         {
             return Content::Scenario;
         }
@@ -125,11 +129,62 @@ fn root_element(mut text: &str) -> Option<&str> {
     }
 }
 
+impl Content {
+    fn is_xml(self) -> bool {
+        matches!(
+            self,
+            Content::Catalog | Content::TaskGraph | Content::Strategy | Content::OtherXml
+        )
+    }
+
+    /// What a file of `kind` holds.
+    fn of_kind(kind: FileKind) -> Content {
+        match kind {
+            FileKind::Mission => Content::Mission,
+            FileKind::Catalog => Content::Catalog,
+            FileKind::TaskGraph => Content::TaskGraph,
+            FileKind::Strategy => Content::Strategy,
+        }
+    }
+
+    /// Whether a file holding this can be read as `wanted`: the same kind,
+    /// or XML of no known kind where XML is wanted (its reader then points
+    /// at the root element, with a did-you-mean).
+    fn fits(self, wanted: Content) -> bool {
+        self == wanted || (self == Content::OtherXml && wanted.is_xml())
+    }
+}
+
+/// For `semo check`, which knows a file by its name: whether a file named on
+/// the command line holds what its name makes it; if not, prints the one
+/// line that says so. Folders, `-` and unreadable files pass (the check
+/// reports the latter).
+pub fn named_file_fits_its_name(path: &Path) -> bool {
+    if is_stdin(path) || path.is_dir() {
+        return true;
+    }
+    let Ok(text) = semo::workspace::read_text(path) else {
+        return true;
+    };
+    let wanted = Content::of_kind(FileKind::named_explicitly(path));
+    let found = Content::of(&text);
+    if found.fits(wanted) {
+        return true;
+    }
+    eprintln!(
+        "error: {} is {}, but its name makes it {}: `semo check` knows a file by its name (*.mission, *.robot.xml, *.strategy.xml, *.taskgraph.xml, another *.xml is a task graph)",
+        path.display(),
+        found.words(),
+        wanted.words()
+    );
+    false
+}
+
 /// Whether `text` (of `path`) holds what `command` takes; if not, prints
 /// the one line that says so and gives `false`.
 pub fn is_kind(path: &Path, text: &str, wanted: Content, command: &str) -> bool {
     let found = Content::of(text);
-    if found == wanted {
+    if found.fits(wanted) {
         return true;
     }
     eprintln!(
@@ -161,6 +216,8 @@ mod tests {
             ("{ T: iRobotCreate a }", Content::Mission),
             ("// a mission\n{ T: x a }", Content::Mission),
             ("  {\"duration\": \"1min\"}", Content::Scenario),
+            ("{ }\n", Content::Scenario),
+            ("{ }\nT.main{ default: mode = M }", Content::Mission),
             ("<Catalog xmlns=\"urn:semo:catalog:1\">", Content::Catalog),
             (
                 "<?xml version=\"1.0\"?>\n<!-- c -->\n<TaskGraph name=\"g\">",

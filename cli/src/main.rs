@@ -538,6 +538,9 @@ fn check(
     } else {
         paths
     };
+    if !paths.iter().all(|p| input::named_file_fits_its_name(p)) {
+        return 2;
+    }
     let loaded = if paths.iter().any(|p| p.as_os_str() == "-") {
         if paths.len() > 1 {
             eprintln!(
