@@ -42,26 +42,26 @@ fn scouting_gives_exactly_the_unmatched_receive_warning() {
 fn human_output_shows_the_source_line_and_a_summary() {
     let out = semo_in(&examples().join("scouting"), &["check", "scouting.mission"]);
     assert_eq!(out.code, 0, "{}", out.stderr);
-    assert!(out.stdout.contains("[W004] Warning"), "{}", out.stdout);
+    assert!(out.stderr.contains("[W004] Warning"), "{}", out.stderr);
     assert!(
-        out.stdout.contains("receive(SlaveTeam, SlaveTeam.COLOR)"),
+        out.stderr.contains("receive(SlaveTeam, SlaveTeam.COLOR)"),
         "{}",
-        out.stdout
+        out.stderr
     );
     assert!(
-        out.stdout.contains("scouting.mission:126:22"),
+        out.stderr.contains("scouting.mission:126:22"),
         "{}",
-        out.stdout
+        out.stderr
     );
     assert!(
-        out.stdout.contains(
+        out.stderr.contains(
             "checked 1 mission and 0 catalog files, 1 strategy file: 0 errors, 1 warning, 2 hints"
         ),
         "{}",
-        out.stdout
+        out.stderr
     );
     assert!(
-        !out.stdout.contains("\u{1b}["),
+        !out.stderr.contains("\u{1b}["),
         "NO_COLOR output has no escape codes"
     );
 }
@@ -72,7 +72,7 @@ fn colours_can_be_forced() {
         &examples().join("scouting"),
         &["check", "--color", "always", "scouting.mission"],
     );
-    assert!(out.stdout.contains("\u{1b}["), "{}", out.stdout);
+    assert!(out.stderr.contains("\u{1b}["), "{}", out.stderr);
 }
 
 #[test]
@@ -86,8 +86,8 @@ fn errors_exit_with_1_and_json_has_every_field() {
     .unwrap();
     let out = semo_in(dir, &["check", "--format", "json", "typo.mission"]);
     assert_eq!(out.code, 1);
-    let line = out.stdout.lines().next().expect("one diagnostic");
-    let v: serde_json::Value = serde_json::from_str(line).unwrap();
+    let document: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    let v = &document["diagnostics"][0];
     assert_eq!(v["code"], "E010");
     assert_eq!(v["severity"], "error");
     assert_eq!(v["file"], "typo.mission");
@@ -528,12 +528,12 @@ fn the_examples_are_formatted_and_formatting_changes_nothing_that_semo_check_fin
 #[test]
 fn strategy_files_are_checked_against_their_missions() {
     let out = semo_in(&examples(), &["check", "scouting"]);
-    assert_eq!(out.code, 0, "{}", out.stdout);
+    assert_eq!(out.code, 0, "{}", out.stderr);
     assert!(
-        out.stdout
+        out.stderr
             .contains("checked 1 mission and 0 catalog files, 1 strategy file: 0 errors"),
         "{}",
-        out.stdout
+        out.stderr
     );
     assert!(
         semo(&["check", "--help"]).stdout.contains("*.strategy.xml"),
@@ -544,18 +544,18 @@ fn strategy_files_are_checked_against_their_missions() {
     // team's declaration in the mission beside it.
     let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
     let out = semo_in(&fixtures, &["check", "E090_strategy_robot_not_in_team"]);
-    assert_eq!(out.code, 1, "{}", out.stdout);
-    assert!(out.stdout.contains("[E090] Error"), "{}", out.stdout);
+    assert_eq!(out.code, 1, "{}", out.stderr);
+    assert!(out.stderr.contains("[E090] Error"), "{}", out.stderr);
     assert!(
-        out.stdout.contains("Scouts.strategy.xml:5:26"),
+        out.stderr.contains("Scouts.strategy.xml:5:26"),
         "{}",
-        out.stdout
+        out.stderr
     );
-    assert!(out.stdout.contains("scouts.mission:3:3"), "{}", out.stdout);
+    assert!(out.stderr.contains("scouts.mission:3:3"), "{}", out.stderr);
     assert!(
-        out.stdout.contains("team Scouts is declared here"),
+        out.stderr.contains("team Scouts is declared here"),
         "{}",
-        out.stdout
+        out.stderr
     );
     let json = semo_in(
         &fixtures,
@@ -566,7 +566,8 @@ fn strategy_files_are_checked_against_their_missions() {
             "E090_strategy_robot_not_in_team",
         ],
     );
-    let v: serde_json::Value = serde_json::from_str(json.stdout.lines().next().unwrap()).unwrap();
+    let document: serde_json::Value = serde_json::from_str(&json.stdout).unwrap();
+    let v = &document["diagnostics"][0];
     let related = &v["related"][0];
     assert!(
         related["file"]
@@ -595,16 +596,16 @@ fn strategy_files_are_checked_against_their_missions() {
 fn a_plain_lt_in_a_condition_points_at_the_lt_with_the_fix() {
     let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
     let out = semo_in(&fixtures, &["check", "E081_strategy_plain_lt"]);
-    assert_eq!(out.code, 1, "{}", out.stdout);
+    assert_eq!(out.code, 1, "{}", out.stderr);
     assert!(
-        out.stdout.contains("Scouts.strategy.xml:25:40"),
+        out.stderr.contains("Scouts.strategy.xml:25:40"),
         "{}",
-        out.stdout
+        out.stderr
     );
     assert!(
-        out.stdout.contains("did you mean `&lt;`?"),
+        out.stderr.contains("did you mean `&lt;`?"),
         "{}",
-        out.stdout
+        out.stderr
     );
     let (_, diags) = check_json_in(&fixtures, &["E081_strategy_plain_lt"]);
     assert!(diags.iter().all(|d| d.code == "E081"), "{diags:#?}");
