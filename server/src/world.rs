@@ -501,7 +501,7 @@ impl World {
             .collect();
         uris.sort_by_key(|u| match self.files[u].kind {
             FileKind::Mission => 0,
-            FileKind::Catalog | FileKind::TaskGraph => 1,
+            FileKind::Catalog | FileKind::TaskGraph | FileKind::Project => 1,
             FileKind::Strategy => 2,
         });
         for uri in &uris {

@@ -13,7 +13,7 @@ fn a_file_sees_its_folder_below_it_and_the_folders_above_it_up_to_its_root() {
     let r = roots(&["/w"]);
     // Folders with missions of their own.
     let projects = |d: &Path| d == Path::new("/w/a/other") || d == Path::new("/w/a");
-    let sees = |r: &Roots, m: &Path, f: &Path| sees(r, projects, m, f);
+    let sees = |r: &Roots, m: &Path, f: &Path| sees(r, projects, None, m, f);
     let m = Path::new("/w/a/m.mission");
     // Its folder and below.
     assert!(sees(&r, m, Path::new("/w/a/x.robot.xml")));
@@ -42,6 +42,27 @@ fn a_file_sees_its_folder_below_it_and_the_folders_above_it_up_to_its_root() {
     // Not into a folder below that is a project of its own.
     assert!(!sees(&r, m, Path::new("/w/a/other/x.robot.xml")));
     assert!(!sees(&r, m, Path::new("/w/a/other/robots/x.robot.xml")));
+    // Down to SEEN_DEPTH folders below its own, no deeper.
+    assert!(sees(&r, m, Path::new("/w/a/1/2/3/x.robot.xml")));
+    assert!(!sees(&r, m, Path::new("/w/a/1/2/3/4/x.robot.xml")));
+}
+
+#[test]
+fn under_a_project_file_a_file_sees_the_folders_it_names_and_nothing_else() {
+    let text = "[project]\ncatalogs = [\"robots\", \"../shared\"]\nstrategies = [\"s\"]\n";
+    let (project, diagnostics) = crate::project::parse(FileId(0), Path::new("/w/p"), text);
+    assert!(diagnostics.is_empty(), "{diagnostics:?}");
+    let r = roots(&["/w"]);
+    let sees = |m: &str, f: &str| sees(&r, |_| false, Some(&project), Path::new(m), Path::new(f));
+    let m = "/w/p/missions/m.mission";
+    assert!(sees(m, "/w/p/robots/deep/down/below/x.robot.xml"));
+    assert!(sees(m, "/w/shared/x.robot.xml"));
+    assert!(sees(m, "/w/p/s/x.strategy.xml"));
+    // A strategy file in a catalog folder, a catalog beside the mission,
+    // one in the project root: not named, not seen.
+    assert!(!sees(m, "/w/p/robots/x.strategy.xml"));
+    assert!(!sees(m, "/w/p/missions/x.robot.xml"));
+    assert!(!sees(m, "/w/p/x.robot.xml"));
 }
 
 const MISSION: &str = "{ A: Turtlebot3_Burger tb }\n\
