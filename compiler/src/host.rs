@@ -978,5 +978,7 @@ mod dropper;
 #[cfg(test)]
 mod tests;
 
-pub use disk::{CheckRun, STDIN_NAME, load_build, load_check, load_check_stdin};
+pub use disk::{
+    CheckRun, ProjectInputs, STDIN_NAME, load_build, load_check, load_check_stdin, project_inputs,
+};
 pub use dropper::{Dropper, drop_later};

@@ -18,6 +18,8 @@ export const DOCUMENT_SELECTOR = [
   { language: 'xml', pattern: '**/*.strategy.xml' },
   { language: 'xml', pattern: '**/*.robot.xml' },
   { language: 'xml', pattern: '**/*.taskgraph.xml' },
+  // The project file, whatever language an installed extension gives TOML.
+  { scheme: 'file', pattern: '**/semo.toml' },
 ];
 
 function isExecutable(file: string): boolean {

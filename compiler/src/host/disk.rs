@@ -149,25 +149,16 @@ impl Loader {
     /// The project file that applies to `folder` and every file of the
     /// folders it names; whether there is one.
     fn add_project(&mut self, folder: &Path) -> Result<bool, LoadError> {
-        let Some(root) = project::find(folder) else {
+        let Some(inputs) = project_inputs(folder) else {
             return Ok(false);
         };
-        if self.projects.contains(&root) {
+        if self.projects.contains(&inputs.file) {
             return Ok(true);
         }
-        self.projects.push(root.clone());
-        let id = self.add(&root.join(project::FILE_NAME), FileKind::Project)?;
-        let Some(loaded) = self.host.analysis().project(id) else {
-            return Ok(true);
-        };
-        let project = &loaded.project;
-        let folders = project
-            .catalogs
-            .iter()
-            .chain(&project.strategies)
-            .chain(&project.task_graphs);
-        for folder in folders.filter(|f| f.path.is_dir()) {
-            self.add_folder(&folder.path)?;
+        self.projects.push(inputs.file.clone());
+        self.add(&inputs.file, FileKind::Project)?;
+        for folder in &inputs.folders {
+            self.add_folder(folder)?;
         }
         Ok(true)
     }
@@ -202,6 +193,35 @@ impl Loader {
             diagnostics,
         }
     }
+}
+
+/// A project file and the input folders it names that exist: what a door
+/// loads, besides its own folders, for the files under the project.
+pub struct ProjectInputs {
+    pub file: PathBuf,
+    pub folders: Vec<PathBuf>,
+}
+
+/// The project file that applies to `folder` ([`project::find`]) and its
+/// catalog, strategy and task-graph folders (the CLI's loaders and the
+/// language server's workspace scan both load these).
+pub fn project_inputs(folder: &Path) -> Option<ProjectInputs> {
+    let root = project::find(folder)?;
+    let file = root.join(project::FILE_NAME);
+    // An unreadable project file is reported when the door loads it.
+    let text = load_text(&file).unwrap_or_default();
+    let (project, _) = project::parse(FileId::default(), &root, &text);
+    let mut folders: Vec<PathBuf> = project
+        .catalogs
+        .iter()
+        .chain(&project.strategies)
+        .chain(&project.task_graphs)
+        .map(|f| f.path.clone())
+        .filter(|f| f.is_dir())
+        .collect();
+    folders.sort();
+    folders.dedup();
+    Some(ProjectInputs { file, folders })
 }
 
 /// How a mission read from standard input is named in reports.

@@ -10,6 +10,9 @@ pub fn completion(
     position: Position,
     config: CompletionConfig,
 ) -> Option<CompletionResponse> {
+    if snapshot.kind == FileKind::Project {
+        return Some(super::project::completion(snapshot, position));
+    }
     if snapshot.kind == FileKind::Strategy {
         return Some(super::strategy::completion(
             snapshot,

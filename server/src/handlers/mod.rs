@@ -14,6 +14,7 @@ pub mod graph_svg;
 pub mod hover;
 pub mod inlay_hints;
 pub mod prepare_rename;
+pub mod project;
 pub mod references;
 pub mod rename;
 pub mod selection_range;
