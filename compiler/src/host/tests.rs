@@ -178,3 +178,46 @@ fn an_unsaved_document_sees_the_workspace_roots_catalogs() {
         .collect();
     assert!(codes.contains(&Code::UnknownRobotType), "{codes:?}");
 }
+
+#[test]
+fn a_project_file_in_the_host_decides_what_is_seen_and_at_which_level() {
+    use crate::diag::Severity;
+    // W010: a function never called; W002: a mode never reached.
+    let warned = "{ T: Rover r }\ndef f{\n  dig()\n}\nT.P.S { dig() } repeat()\nT.M { set(P, S) }\nT.N { set(P, OFF) }\nT.main { default: mode = M }\n";
+    let mut host = host_with(&[
+        (0, "/w/p/m/dig.mission", FileKind::Mission, warned),
+        (1, "/w/p/robots/rover.robot.xml", FileKind::Catalog, CATALOG),
+    ]);
+    let levels = |analysis: &Analysis| -> Vec<(Code, Severity)> {
+        analysis
+            .diagnostics(FileId(0))
+            .iter()
+            .map(|d| (d.code, d.severity))
+            .collect()
+    };
+    // Without a project file, the catalog in the sibling folder is not seen.
+    let before = host.analysis();
+    assert!(levels(&before).contains(&(Code::UnknownRobotType, Severity::Error)));
+    let project =
+        "[project]\ncatalogs = [\"robots\"]\n[lints]\nW010 = \"allow\"\nW002 = \"deny\"\n";
+    host.set_file(
+        FileId(2),
+        Some(PathBuf::from("/w/p/semo.toml")),
+        FileKind::Project,
+        project.into(),
+    );
+    let after = host.analysis();
+    assert_eq!(levels(&after), [(Code::UnreachableMode, Severity::Error)]);
+    assert_eq!(after.reads(FileId(0)), [FileId(0), FileId(1), FileId(2)]);
+    assert_eq!(after.project(FileId(0)).unwrap().file, FileId(2));
+    // A project file change affects every file.
+    assert_eq!(
+        after.affected_by(FileId(2)),
+        [FileId(0), FileId(1), FileId(2)]
+    );
+    // An unsaved project file is the project of no file.
+    host.set_file(FileId(2), None, FileKind::Project, project.into());
+    assert!(host.analysis().project(FileId(0)).is_none());
+    host.remove_file(FileId(2));
+    assert_eq!(levels(&host.analysis()), levels(&before));
+}

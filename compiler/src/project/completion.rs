@@ -1,8 +1,8 @@
 //! Completion in `semo.toml` (as taplo completes from a schema): on a
 //! header line the tables, at a key's place the keys of the table the
-//! cursor is in (in `[lints]` every warning and hint code, and `E` codes,
-//! which may only be denied), after `=` the values a key takes (lint levels,
-//! target names). Read from the text around the cursor, so it works while
+//! cursor is in that it does not have yet (in `[lints]` every warning and
+//! hint code, and `E` codes, which may only be denied), after `=` the values
+//! a key takes (lint levels, target names). Read from the text around the cursor, so it works while
 //! the file does not parse.
 
 use super::{BUILD_KEYS, Level, PROJECT_KEYS, TABLES};
@@ -93,8 +93,10 @@ pub fn completions(text: &str, offset: usize) -> Vec<Completion> {
             _ => Vec::new(),
         };
     }
+    let written = written_keys(text, line_start, offset);
     let keys = |keys: &[(&str, &str)]| -> Vec<Completion> {
         keys.iter()
+            .filter(|(k, _)| !written.iter().any(|w| w == k))
             .map(|(k, d)| item(CompletionKind::Key, k, d, format!("{k} = ")))
             .collect()
     };
@@ -111,6 +113,7 @@ pub fn completions(text: &str, offset: usize) -> Vec<Completion> {
             codes.sort_by_key(|c| (c.default_severity() == Severity::Error, c.as_str()));
             codes
                 .into_iter()
+                .filter(|c| !written.iter().any(|w| w == c.as_str()))
                 .map(|c| {
                     let detail = format!("{} ({}): {}", c, c.default_severity(), c.summary());
                     item(CompletionKind::Code, c.as_str(), &detail, format!("{c} = "))
@@ -127,6 +130,27 @@ fn level_detail(level: &str) -> &'static str {
         "warn" => "reported as a warning",
         _ => "reported as an error",
     }
+}
+
+/// The keys written in the table the cursor's line (from `line_start`,
+/// the cursor at `offset`) is in, on its other lines.
+fn written_keys(text: &str, line_start: usize, offset: usize) -> Vec<String> {
+    let key = |line: &str| -> Option<String> {
+        let (key, _) = line.split_once('=')?;
+        Some(key.trim().trim_matches('"').to_string())
+    };
+    let is_header = |line: &str| line.trim_start().starts_with('[');
+    let before = text[..line_start]
+        .lines()
+        .rev()
+        .take_while(|l| !is_header(l))
+        .filter_map(key);
+    let after_cursor = text[offset..].split_once('\n').map_or("", |(_, rest)| rest);
+    let after = after_cursor
+        .lines()
+        .take_while(|l| !is_header(l))
+        .filter_map(key);
+    before.chain(after).collect()
 }
 
 /// The table whose header is the last one in `before` (the text above the

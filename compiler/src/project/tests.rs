@@ -242,6 +242,14 @@ fn completion_offers_tables_keys_codes_and_values() {
     );
     assert_eq!(offered("[lints]\nE019 = $0"), ["deny→\"deny\""]);
     assert!(offered("[project]\n# a comment $0").is_empty());
+    // Keys and codes already written in the table are not offered again.
+    assert_eq!(
+        offered("[build]\ntarget = \"linux\"\n$0\noutput = \"out\"\n[project]\n"),
+        ["deployment→deployment = "]
+    );
+    let codes = offered("[lints]\nW001 = \"allow\"\nW0$0");
+    assert!(!codes.contains(&"W001→W001 = ".to_string()));
+    assert!(codes.contains(&"W002→W002 = ".to_string()));
 }
 
 #[test]
