@@ -139,7 +139,7 @@ impl Loader {
                 format!(
                     "looked at only the first {MAX_ENTRIES} entries under {} for catalog and \
                      strategy files; put a semo.toml at the project root to say where they are",
-                    folder.display()
+                    absolute(folder).display()
                 ),
             ));
         }
