@@ -12,8 +12,10 @@ use std::path::{Path, PathBuf};
 pub struct Options {
     pub mission: PathBuf,
     pub strategy: Vec<PathBuf>,
+    /// Else the project file's `[build] output`, else `out` beside the mission.
     pub out: Option<PathBuf>,
-    pub target: Target,
+    /// Else the project file's `[build] target`, else `linux`.
+    pub target: Option<Target>,
     /// Compiled into each robot (targets that need it: `cortex-m-sim`).
     pub scenario: Option<PathBuf>,
     pub emit: Emit,
@@ -41,23 +43,6 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     {
         return 2;
     }
-    if options.scenario.is_some() != options.target.needs_scenario() {
-        eprintln!(
-            "error: {}",
-            if options.scenario.is_some() {
-                format!(
-                    "--scenario is compiled in only for target cortex-m-sim (target {} reads it at run time, if at all)",
-                    options.target.name()
-                )
-            } else {
-                format!(
-                    "target {} compiles a scenario into each robot: give --scenario FILE",
-                    options.target.name()
-                )
-            }
-        );
-        return 2;
-    }
     let (mut run, mission) = match host::load_build(&options.mission, &options.strategy) {
         Ok(loaded) => loaded,
         Err(e) => {
@@ -65,14 +50,53 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     };
+    // What the command line does not say, the project file does.
+    let project = run.analysis().project(mission);
+    let project = project.as_ref().map(|p| &p.project);
+    let target = options
+        .target
+        .or(project.and_then(|p| p.target))
+        .unwrap_or(Target::Linux);
+    let out_dir = options
+        .out
+        .clone()
+        .or_else(|| {
+            project
+                .and_then(|p| p.output.as_ref())
+                .map(|o| o.path.clone())
+        })
+        .unwrap_or_else(|| {
+            options
+                .mission
+                .parent()
+                .unwrap_or(Path::new("."))
+                .join("out")
+        });
+    if options.scenario.is_some() != target.needs_scenario() {
+        eprintln!(
+            "error: {}",
+            if options.scenario.is_some() {
+                format!(
+                    "--scenario is compiled in only for target cortex-m-sim (target {} reads it at run time, if at all)",
+                    target.name()
+                )
+            } else {
+                format!(
+                    "target {} compiles a scenario into each robot: give --scenario FILE",
+                    target.name()
+                )
+            }
+        );
+        return 2;
+    }
     let Some(input) = run.analysis().build_input(mission) else {
         eprintln!("internal error: the mission was loaded but not checked");
         return 2;
     };
     let input = input.input();
     let result = match &options.scenario {
-        None => codegen::build(&input, options.target, options.emit),
-        Some(path) => match build_with_scenario(&input, path, &options) {
+        None => codegen::build(&input, target, options.emit),
+        Some(path) => match build_with_scenario(&input, path, target, &options) {
             Ok(result) => result,
             Err(ScenarioError::Unreadable(message)) => {
                 eprintln!("{message}");
@@ -94,7 +118,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
                 &run.files,
                 &run.diagnostics,
                 options.color,
-                serde_json::json!({ "target": options.target.name(), "robots": [] }),
+                serde_json::json!({ "target": target.name(), "robots": [] }),
                 out,
             ),
         };
@@ -106,13 +130,6 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     }
     let human = options.format == Format::Human;
     let mut robots_json = Vec::new();
-    let out_dir = options.out.clone().unwrap_or_else(|| {
-        options
-            .mission
-            .parent()
-            .unwrap_or(Path::new("."))
-            .join("out")
-    });
     let generated = started.elapsed();
     let mut transaction = match Transaction::begin(&out_dir, || {
         eprintln!(
@@ -134,7 +151,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         }
     }
     if !options.force {
-        match transaction.conflicts(&result.robots, options.target) {
+        match transaction.conflicts(&result.robots, target) {
             Ok(conflicts) if conflicts.is_empty() => {}
             Ok(conflicts) => {
                 eprintln!("error: {}", OutputError::Conflicts(conflicts));
@@ -147,7 +164,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         }
     }
     for robot in &result.robots {
-        match transaction.write_robot(robot, options.target, options.force) {
+        match transaction.write_robot(robot, target, options.force) {
             Ok(written) => {
                 let (generated, user) = robot.line_counts();
                 let share = if generated + user == 0 {
@@ -200,7 +217,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             &run.files,
             &[],
             options.color,
-            serde_json::json!({ "target": options.target.name(), "robots": robots_json }),
+            serde_json::json!({ "target": target.name(), "robots": robots_json }),
             out,
         );
         return output::written(reported).err().unwrap_or(0);
@@ -209,7 +226,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         out,
         "built {} robot(s) for target {} in {:.1} ms ({:.1} ms generating)",
         result.robots.len(),
-        options.target.name(),
+        target.name(),
         started.elapsed().as_secs_f64() * 1000.0,
         generated.as_secs_f64() * 1000.0
     );
@@ -248,6 +265,7 @@ fn report_scenario(record: &Record, format: Format, out: &mut impl Write) {
 fn build_with_scenario(
     input: &codegen::BuildInput<'_>,
     path: &Path,
+    target: Target,
     options: &Options,
 ) -> Result<codegen::BuildResult, ScenarioError> {
     let text = semo::workspace::read_text(path)
@@ -258,7 +276,7 @@ fn build_with_scenario(
         return Ok(codegen::build_refined(
             input,
             refined,
-            options.target,
+            target,
             options.emit,
             &[],
         ));
@@ -275,7 +293,7 @@ fn build_with_scenario(
     Ok(codegen::build_refined(
         input,
         refined,
-        options.target,
+        target,
         options.emit,
         &worlds,
     ))

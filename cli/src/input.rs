@@ -63,6 +63,8 @@ pub enum Content {
     Strategy,
     /// JSON: a scenario (`*.scenario.json`).
     Scenario,
+    /// TOML: the project file (`semo.toml`).
+    Project,
     /// XML of a kind SeMo does not read.
     OtherXml,
 }
@@ -81,7 +83,10 @@ impl Content {
             return Content::Scenario;
         }
         if !text.starts_with('<') {
-            return Content::Mission;
+            return match looks_like_toml(text) {
+                true => Content::Project,
+                false => Content::Mission,
+            };
         }
         match root_element(text) {
             Some("Catalog") => Content::Catalog,
@@ -99,9 +104,31 @@ impl Content {
             Content::TaskGraph => "a task graph",
             Content::Strategy => "a strategy file",
             Content::Scenario => "a scenario (JSON)",
+            Content::Project => "a project file (TOML)",
             Content::OtherXml => "an XML file SeMo does not read",
         }
     }
+}
+
+/// Whether the first line that is not blank or a `#` comment (both
+/// languages have those) is a TOML table header or `key = value`, which no
+/// mission line is.
+fn looks_like_toml(text: &str) -> bool {
+    let Some(line) = text
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with('#'))
+    else {
+        return false;
+    };
+    line.starts_with('[')
+        || line.split_once('=').is_some_and(|(key, _)| {
+            let key = key.trim();
+            !key.is_empty()
+                && key
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "_-.\"".contains(c))
+        })
 }
 
 /// The local name of an XML text's root element, past the declaration,
@@ -144,6 +171,7 @@ impl Content {
             FileKind::Catalog => Content::Catalog,
             FileKind::TaskGraph => Content::TaskGraph,
             FileKind::Strategy => Content::Strategy,
+            FileKind::Project => Content::Project,
         }
     }
 

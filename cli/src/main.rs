@@ -5,6 +5,7 @@
 mod build;
 mod fmt;
 mod graph;
+mod init;
 mod input;
 mod output;
 mod render;
@@ -113,7 +114,8 @@ enum Command {
         /// More strategy (and catalog) files or folders to read.
         #[arg(long)]
         strategy: Vec<PathBuf>,
-        /// The output folder (default: `out` beside the mission). `-o` and
+        /// The output folder (default: the project file's `[build] output`,
+        /// else `out` beside the mission). `-o` and
         /// `--output` as in every command that writes; `--out` still works.
         #[arg(
             long = "output",
@@ -127,8 +129,9 @@ enum Command {
         /// file given at run time), `cortex-m` (bare-metal TI Stellaris
         /// LM3S6965, a static schedule; you fill the task files) or
         /// `cortex-m-sim` (the same with --scenario compiled in, for QEMU).
-        #[arg(long, default_value = "linux", value_parser = parse_target)]
-        target: semo::codegen::Target,
+        /// Default: the project file's `[build] target`, else `linux`.
+        #[arg(long, value_parser = parse_target)]
+        target: Option<semo::codegen::Target>,
         /// The scenario (`*.scenario.json`) compiled into each robot: needed
         /// by, and only by, `--target cortex-m-sim`.
         #[arg(long)]
@@ -199,6 +202,20 @@ enum Command {
         /// Accepted because editors pass it; stdio is the only transport.
         #[arg(long)]
         stdio: bool,
+    },
+    /// Start a project: write `semo.toml`, a first mission and a catalog in
+    /// DIR (default: the current folder).
+    #[command(
+        long_about = "Start a project: write semo.toml (the project file: catalog and strategy \
+        folders, output folder, target, lint levels; see docs/project-file.md), main.mission \
+        and robots/rover.robot.xml in DIR (default: the current folder, created if missing). \
+        `semo check DIR` accepts them as written.\n\n\
+        Nothing is overwritten: if any of these files exists, nothing is written and the \
+        exit status is 1."
+    )]
+    Init {
+        /// The project's folder.
+        dir: Option<PathBuf>,
     },
     /// Explain a diagnostic code (e.g. `semo explain E019`): what it means,
     /// a wrong and a right example; with no code, list them all.
@@ -475,6 +492,7 @@ fn run() -> i32 {
             &mut out,
         ),
         Command::Explain { code } => explain(code.as_deref(), &mut out),
+        Command::Init { dir } => init::run(dir, &mut out),
         Command::Lsp { stdio: _ } => {
             // The protocol owns stdout from here on.
             drop(out);

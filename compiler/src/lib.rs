@@ -29,6 +29,7 @@ pub mod ide;
 /// Graph drawing shared by the task-graph and mode-machine pictures.
 mod layout;
 pub mod modemachine;
+pub mod project;
 pub mod refine;
 pub mod sema;
 pub mod sim;

@@ -297,6 +297,7 @@ impl Backend {
             "**/*.robot.xml",
             "**/*.strategy.xml",
             "**/*.taskgraph.xml",
+            "**/semo.toml",
         ]
         .into_iter()
         .map(|glob| FileSystemWatcher {

@@ -11,8 +11,8 @@
 use super::Analysis;
 use crate::diag::FileId;
 use crate::ide::{
-    self, CompletionConfig, CompletionItem, FilePosition, HoverResult, NavigationTarget,
-    strategy::StrategyFile,
+    self, CompletionConfig, CompletionItem, CompletionKind, FilePosition, HoverResult,
+    NavigationTarget, strategy::StrategyFile,
 };
 use crate::sema;
 use crate::workspace::FileKind;
@@ -48,7 +48,7 @@ impl Analysis {
                 let run = self.graph(file)?;
                 ide::taskgraph::hover(run.graph.as_ref()?, &run.report, offset)
             }
-            FileKind::Catalog => None,
+            FileKind::Catalog | FileKind::Project => None,
         }
     }
 
@@ -86,6 +86,12 @@ impl Analysis {
                     offset,
                 ))
             }
+            FileKind::Project => Some(
+                crate::project::completions(&source.text, offset)
+                    .into_iter()
+                    .map(project_completion)
+                    .collect(),
+            ),
             FileKind::Catalog => None,
         }
     }
@@ -119,7 +125,7 @@ impl Analysis {
                     ide::strategy::navigation::definition(s, &links, offset)
                 })
             }
-            FileKind::TaskGraph | FileKind::Catalog => Vec::new(),
+            FileKind::TaskGraph | FileKind::Catalog | FileKind::Project => Vec::new(),
         }
     }
 
@@ -174,3 +180,17 @@ impl Analysis {
 
 #[cfg(test)]
 mod tests;
+
+/// A `semo.toml` completion in the editor vocabulary.
+fn project_completion(item: crate::project::Completion) -> CompletionItem {
+    use crate::project::CompletionKind as P;
+    let kind = match item.kind {
+        P::Table => CompletionKind::Element,
+        P::Key => CompletionKind::Attribute,
+        P::Code => CompletionKind::Constant,
+        P::Value => CompletionKind::Value,
+    };
+    let mut out = CompletionItem::new(item.label, kind, item.replace).detail(item.detail);
+    out.insert = item.insert;
+    out
+}
