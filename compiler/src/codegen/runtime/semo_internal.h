@@ -84,12 +84,13 @@ extern const semo__sim_tables semo__scenario;
 
 /* Platform hooks of the static schedule, given by the board file
  * (semo_lm3s6965.c): a millisecond clock, the trace's output, sleeping
- * until the next tick and ending the program. */
+ * until a deadline of that clock (or an interrupt: the caller looks at the
+ * time again; INT64_MAX: no deadline) and ending the program. */
 #ifdef SEMO_STATIC
 void semo__board_init(void);
 int64_t semo__board_now_ms(void);
 void semo__board_put(void *ctx, const char *bytes, size_t n);
-void semo__board_idle(void);
+void semo__board_sleep_until(int64_t deadline_ms);
 void semo__board_exit(int status);
 #endif
 

@@ -2,8 +2,10 @@
  * (targets `cortex-m`, `cortex-m-sim`; built with -DSEMO_STATIC).
  *
  * One loop and no threads: `Core_1_go` fires the due tasks in the order of
- * the single-appearance schedule, once per clock tick, and the board sleeps
- * until the next tick (an idle robot only wakes for its clock). No call
+ * the single-appearance schedule; then the loop works out when a task is
+ * next due (a period, a task's `semo_next_firing`, data waiting, an
+ * operator command, the end of the run) and the board sleeps until then:
+ * no clock tick, so an idle robot wakes only for its deadlines. No call
  * blocks, nothing is allocated: channels live in the buffers the generated
  * channels.c gives them, everything else in the fixed tables below (sizes
  * overridable with -D). The board file (semo_lm3s6965.c) gives the clock,
@@ -35,6 +37,7 @@
 static const semo_program_desc *g_prog;
 static bool g_running;
 static int64_t g_start_ms;
+static unsigned long g_passes; /* loop iterations: wake-ups (-DSEMO_COUNT_PASSES prints them) */
 
 bool semo_running(void)
 {
@@ -63,7 +66,7 @@ void semo_sleep_ms(int64_t ms)
 {
     int64_t end = semo_now_ms() + ms;
     while (g_running && semo_now_ms() < end)
-        semo__board_idle();
+        semo__board_sleep_until(g_start_ms + end);
 }
 
 /* ----------------------------------------------------------------- traces */
@@ -78,6 +81,8 @@ void semo_trace(const char *event, ...)
 }
 
 /* --------------------------------------------------------------- channels */
+
+static void wake_tasks(void);
 
 static const semo_channel_desc *channel_at(int port)
 {
@@ -125,6 +130,7 @@ int UFPort_WriteToQueue(int port, const void *buf, size_t size)
     size_t tail = (c->state->head + c->state->count) % c->capacity;
     memcpy(c->storage + tail * c->sample_size, buf, size);
     c->state->count++;
+    wake_tasks();
     return (int)size;
 }
 
@@ -155,6 +161,7 @@ int UFMulticast_Write(const char *name, const void *buf, size_t size)
         return 0;
     memcpy(&g_group_value[g], buf, size);
     g_group_written[g] = true;
+    wake_tasks();
     return (int)size;
 }
 
@@ -176,10 +183,15 @@ typedef struct {
     bool stop_requested;
     bool in_firing; /* a body said semo_firing_continues */
     int64_t next_release;
+    /* semo_next_firing, as on POSIX: not needed before `hint_ms` unless
+     * `woken` (data written, a task's state changed, a group written). */
+    bool hinted, woken;
+    int64_t hint_ms;
 } task;
 
 static task g_tasks[SEMO_MAX_TASKS];
 static bool g_continues; /* set by the body being fired */
+static task *g_current;  /* the task being fired */
 
 static task *find_task(const char *name)
 {
@@ -191,10 +203,24 @@ static task *find_task(const char *name)
     return NULL;
 }
 
-/* The loop fires at every tick anyway (and sleeps in between). */
+/* Something a waiting task may care about happened: every other task's
+ * hint is void (as on POSIX, where it wakes them). */
+static void wake_tasks(void)
+{
+    for (size_t i = 0; g_prog && i < g_prog->task_count; i++)
+        if (&g_tasks[i] != g_current)
+            g_tasks[i].woken = true;
+}
+
+/* On the static schedule any task may say it: a time-driven one for its
+ * next firing, a continuing firing (semo_firing_continues) for its next
+ * step. The loop sleeps until the earliest. */
 void semo_next_firing(int64_t at_ms)
 {
-    (void)at_ms;
+    if (g_current) {
+        g_current->hinted = true;
+        g_current->hint_ms = at_ms;
+    }
 }
 
 void semo_firing_continues(void)
@@ -211,19 +237,26 @@ static void fire_if_due(size_t i)
         t->state = SEMO_TASK_IDLE;
         t->stop_requested = false;
         t->calls = 0;
+        wake_tasks();
         return;
     }
     if (t->state != SEMO_TASK_RUNNING && !t->in_firing)
         return;
+    int64_t now = semo_now_ms();
+    bool hint_holds = t->hinted && !t->woken;
+    if (t->in_firing && hint_holds && now < t->hint_ms)
+        return;
     if (d->trigger == SEMO_TRIGGER_TIME && !t->in_firing) {
-        int64_t now = semo_now_ms();
-        if (now < t->next_release)
+        if (now < t->next_release || (hint_holds && now < t->hint_ms))
             return;
         t->next_release = now + d->period_ms;
     }
+    t->hinted = t->woken = false;
     g_continues = false;
+    g_current = t;
     if (d->go)
         d->go();
+    g_current = NULL;
     t->in_firing = g_continues && g_running;
     if (t->in_firing)
         return;
@@ -231,8 +264,10 @@ static void fire_if_due(size_t i)
         t->state = SEMO_TASK_IDLE;
         t->stop_requested = false;
         t->calls = 0;
+        wake_tasks();
     } else if (!t->repeat && t->calls > 0 && --t->calls == 0) {
         t->state = SEMO_TASK_IDLE;
+        wake_tasks();
     }
 }
 
@@ -272,6 +307,7 @@ static int control(const char *name, control_op op)
             t->state = SEMO_TASK_RUNNING;
         break;
     }
+    wake_tasks();
     return 0;
 }
 
@@ -379,6 +415,7 @@ void UFTimer_Cancel(int id)
 
 static semo_message g_inbox[SEMO_INBOX];
 static size_t g_inbox_head, g_inbox_count;
+static bool g_inbox_read; /* some task polls the inbox */
 
 void semo__deliver(const semo_message *msg)
 {
@@ -388,6 +425,7 @@ void semo__deliver(const semo_message *msg)
     }
     g_inbox[(g_inbox_head + g_inbox_count) % SEMO_INBOX] = *msg;
     g_inbox_count++;
+    wake_tasks();
 }
 
 /* Only the operator console ("USER", whose record is the trace) is reachable
@@ -408,6 +446,7 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
 int semo_comm_poll(semo_message *out, int64_t timeout_ms)
 {
     (void)timeout_ms;
+    g_inbox_read = true;
     if (!out || g_inbox_count == 0)
         return 0;
     *out = g_inbox[g_inbox_head];
@@ -473,6 +512,16 @@ static void deliver_operator_commands(void)
     }
 }
 
+/* When the next operator command is due (INT64_MAX: none). */
+static int64_t next_operator_command(void)
+{
+    int64_t next = INT64_MAX;
+    for (size_t i = 0; i < semo__scenario.operator_count; i++)
+        if (semo__scenario.operator_next[i] >= 0 && semo__scenario.operator_next[i] < next)
+            next = semo__scenario.operator_next[i];
+    return next;
+}
+
 static void start_operator(void)
 {
     for (size_t i = 0; i < semo__scenario.operator_count; i++) {
@@ -494,6 +543,47 @@ void Core_1_go(void)
         for (unsigned n = 0; n < f->count && g_running; n++)
             fire_if_due(f->task);
     }
+}
+
+/* Whether a sample waits in one of task `i`'s input channels. */
+static bool input_waiting(size_t i)
+{
+    for (size_t c = 0; c < g_prog->channel_count; c++)
+        if (g_prog->channels[c].state->count > 0 && g_prog->channels[c].state->reader == i)
+            return true;
+    return false;
+}
+
+/* The mission time at which the next pass has something to do: the
+ * earliest time a task is due by the rules of fire_if_due. A data-driven
+ * (or running control-driven) task is due only when a sample waits for it,
+ * a call is owed or a message waits in the inbox: its body returns at once
+ * otherwise, and what it waits for is written in a pass, which wakes it. */
+static int64_t next_due(int64_t now)
+{
+    int64_t next = INT64_MAX;
+    for (size_t i = 0; i < g_prog->task_count; i++) {
+        const task *t = &g_tasks[i];
+        bool hint_holds = t->hinted && !t->woken;
+        int64_t due = INT64_MAX;
+        if (t->in_firing) {
+            /* A firing that goes on without naming when: as with a clock tick. */
+            due = hint_holds ? t->hint_ms : t->hinted ? now : now + 1;
+        } else if (t->stop_requested && t->state != SEMO_TASK_IDLE) {
+            due = now;
+        } else if (t->state != SEMO_TASK_RUNNING) {
+            continue;
+        } else if (g_prog->tasks[i].trigger == SEMO_TRIGGER_TIME) {
+            due = t->next_release;
+            if (hint_holds && t->hint_ms > due)
+                due = t->hint_ms;
+        } else if ((!t->repeat && t->calls > 0) || input_waiting(i) || (g_inbox_read && g_inbox_count > 0)) {
+            due = now;
+        }
+        if (due < next)
+            next = due;
+    }
+    return next;
 }
 
 static void trace_dropped_samples(void)
@@ -549,7 +639,10 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
     for (size_t i = 0; i < program->channel_count; i++) {
         const semo_channel_desc *c = &program->channels[i];
         memset(c->storage, 0, c->capacity * c->sample_size);
-        *c->state = (semo_channel_state){.count = c->initial_samples};
+        *c->state = (semo_channel_state){.count = c->initial_samples, .reader = SEMO_MAX_TASKS};
+        for (size_t k = 0; k < program->task_count; k++)
+            if (strcmp(c->dst_task, program->tasks[k].name) == 0)
+                c->state->reader = (unsigned short)k;
     }
     for (size_t i = 0; i < program->task_count; i++)
         g_tasks[i] = (task){.state = program->tasks[i].trigger == SEMO_TRIGGER_CONTROL ? SEMO_TASK_IDLE
@@ -569,11 +662,20 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
             program->tasks[i].init();
     while (g_running) {
         Core_1_go();
-        if (duration > 0 && semo_now_ms() >= duration)
+        g_passes++;
+        int64_t now = semo_now_ms();
+        if (duration > 0 && now >= duration)
             break;
-        semo__board_idle();
-        if (duration > 0 && semo_now_ms() >= duration)
-            break;
+        int64_t wake = next_due(now);
+#ifdef SEMO_SIM
+        int64_t command = next_operator_command();
+        if (command < wake)
+            wake = command;
+#endif
+        if (duration > 0 && duration < wake)
+            wake = duration;
+        if (wake > now)
+            semo__board_sleep_until(wake == INT64_MAX ? INT64_MAX : g_start_ms + wake);
     }
     g_running = false;
     for (size_t i = 0; i < program->task_count; i++)
@@ -581,6 +683,17 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
             program->tasks[i].wrapup();
     trace_dropped_samples();
     semo_trace("stop", NULL);
+#ifdef SEMO_COUNT_PASSES
+    /* For measuring (not a trace line: built only with -DSEMO_COUNT_PASSES). */
+    char passes[21], ms[21];
+    semo__format_i64(passes, (int64_t)g_passes);
+    semo__format_i64(ms, semo_now_ms());
+    static const char *const parts[] = {"semo passes ", NULL, " ms ", NULL, "\n"};
+    for (size_t p = 0; p < 5; p++) {
+        const char *text = p == 1 ? passes : p == 3 ? ms : parts[p];
+        semo__board_put(NULL, text, strlen(text));
+    }
+#endif
     semo__board_exit(0);
     return 0;
 }
