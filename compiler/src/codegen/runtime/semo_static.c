@@ -27,10 +27,6 @@
 #ifndef SEMO_MAX_GROUPS
 #define SEMO_MAX_GROUPS 4
 #endif
-/* Messages received and not yet taken (operator commands). */
-#ifndef SEMO_INBOX
-#define SEMO_INBOX 8
-#endif
 
 /* ------------------------------------------------------------ run state */
 
@@ -84,60 +80,41 @@ void semo_trace(const char *event, ...)
 
 static void wake_tasks(void);
 
-static const semo_channel_desc *channel_at(int port)
+/* The rings are the core's (semo_core.c); here they live in the buffers of
+ * the generated channels.c, and nothing locks or waits. */
+bool semo__channel_ring(int port, semo__ring *out)
 {
     if (!g_prog || port < 0 || (size_t)port >= g_prog->channel_count)
-        return NULL;
+        return false;
     const semo_channel_desc *c = &g_prog->channels[port];
-    return c->storage && c->state ? c : NULL;
+    if (!c->storage || !c->state)
+        return false;
+    *out = (semo__ring){c->storage, c->state, c->capacity, c->sample_size};
+    return true;
 }
 
-int UFPort_Initialize(const char *task, const char *port)
+void semo__queue_lock(int queue)
 {
-    if (!g_prog || !task || !port)
-        return -1;
-    for (size_t i = 0; i < g_prog->channel_count; i++) {
-        const semo_channel_desc *c = &g_prog->channels[i];
-        bool input = strcmp(c->dst_task, task) == 0 && strcmp(c->dst_port, port) == 0;
-        bool output = strcmp(c->src_task, task) == 0 && strcmp(c->src_port, port) == 0;
-        if (input || output)
-            return (int)i;
-    }
-    return -1;
+    (void)queue;
 }
 
-/* Never blocks: 0 when the channel is empty. */
-int UFPort_ReadFromQueue(int port, void *buf, size_t size)
+void semo__queue_unlock(int queue)
 {
-    const semo_channel_desc *c = channel_at(port);
-    if (!c || !buf || size != c->sample_size || c->state->count == 0)
-        return 0;
-    memcpy(buf, c->storage + c->state->head * c->sample_size, size);
-    c->state->head = (c->state->head + 1) % c->capacity;
-    c->state->count--;
-    return (int)size;
+    (void)queue;
 }
 
-int UFPort_WriteToQueue(int port, const void *buf, size_t size)
+/* Nothing would write while this waited: a read of an empty queue returns. */
+bool semo__queue_wait(int queue, int64_t deadline_ms)
 {
-    const semo_channel_desc *c = channel_at(port);
-    if (!c || !buf || size != c->sample_size)
-        return 0;
-    if (c->state->count == c->capacity) {
-        c->state->dropped++;
-        return 0;
-    }
-    size_t tail = (c->state->head + c->state->count) % c->capacity;
-    memcpy(c->storage + tail * c->sample_size, buf, size);
-    c->state->count++;
+    (void)queue;
+    (void)deadline_ms;
+    return false;
+}
+
+void semo__queue_written(int queue)
+{
+    (void)queue;
     wake_tasks();
-    return (int)size;
-}
-
-int UFPort_GetNumOfAvailableData(int port)
-{
-    const semo_channel_desc *c = channel_at(port);
-    return c ? (int)c->state->count : -1;
 }
 
 /* -------------------------------------------------------------- multicast */
@@ -413,48 +390,17 @@ void UFTimer_Cancel(int id)
 
 /* --------------------------------------------------------------- messages */
 
-static semo_message g_inbox[SEMO_INBOX];
-static size_t g_inbox_head, g_inbox_count;
-static bool g_inbox_read; /* some task polls the inbox */
-
-void semo__deliver(const semo_message *msg)
-{
-    if (g_inbox_count == SEMO_INBOX) {
-        semo_trace("drop", "from", msg->from_team, "key", msg->key, "reason", "inbox full", NULL);
-        return;
-    }
-    g_inbox[(g_inbox_head + g_inbox_count) % SEMO_INBOX] = *msg;
-    g_inbox_count++;
-    wake_tasks();
-}
-
 /* Only the operator console ("USER", whose record is the trace) is reachable
  * here: the generator refuses missions that message other robots on a
- * static-schedule target (E113), so anything else is an error. */
+ * static-schedule target (E103), so anything else is an error. The inbox
+ * (semo_comm_poll, semo__deliver) is the core's. */
 int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value)
 {
-    if (!g_prog || !to_team || !key || !value || (kind != SEMO_MSG_SEND && kind != SEMO_MSG_PUBLISH))
-        return -1;
-    semo_trace("send", "to", to_team, "key", key, "value", value->text, NULL);
-    if (strcmp(to_team, "USER") == 0)
-        return 1;
+    int local = semo__comm_send_local(to_team, kind, key, value);
+    if (local != 0)
+        return local;
     semo_trace("comm_error", "to", to_team, "key", key, NULL);
     return -1;
-}
-
-/* Never waits (nothing else would run meanwhile): the timeout is ignored. */
-int semo_comm_poll(semo_message *out, int64_t timeout_ms)
-{
-    (void)timeout_ms;
-    g_inbox_read = true;
-    if (!out || g_inbox_count == 0)
-        return 0;
-    *out = g_inbox[g_inbox_head];
-    g_inbox_head = (g_inbox_head + 1) % SEMO_INBOX;
-    g_inbox_count--;
-    semo_trace("receive", "from", out->from_team, "from_robot", out->from_robot, "key", out->key, "value",
-               out->value.text, NULL);
-    return 1;
 }
 
 /* ------------------------------------------------------------- simulation */
@@ -577,33 +523,13 @@ static int64_t next_due(int64_t now)
             due = t->next_release;
             if (hint_holds && t->hint_ms > due)
                 due = t->hint_ms;
-        } else if ((!t->repeat && t->calls > 0) || input_waiting(i) || (g_inbox_read && g_inbox_count > 0)) {
+        } else if ((!t->repeat && t->calls > 0) || input_waiting(i) || semo__inbox_waiting()) {
             due = now;
         }
         if (due < next)
             next = due;
     }
     return next;
-}
-
-static void trace_dropped_samples(void)
-{
-    for (size_t i = 0; i < g_prog->channel_count; i++) {
-        const semo_channel_desc *d = &g_prog->channels[i];
-        if (d->state && d->state->dropped) {
-            char count[21];
-            semo__format_i64(count, (int64_t)d->state->dropped);
-            /* The channel's name is four parts: written as the POSIX layer's "A.p->B.q". */
-            char name[128];
-            size_t len = 0;
-            const char *parts[] = {d->src_task, ".", d->src_port, "->", d->dst_task, ".", d->dst_port};
-            for (size_t p = 0; p < sizeof parts / sizeof parts[0]; p++)
-                for (const char *c = parts[p]; *c && len + 1 < sizeof name; c++)
-                    name[len++] = *c;
-            name[len] = '\0';
-            semo_trace("dropped", "channel", name, "count", count, NULL);
-        }
-    }
 }
 
 /* A program the static schedule can run: every table within its bounds. */
@@ -648,6 +574,7 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
         g_tasks[i] = (task){.state = program->tasks[i].trigger == SEMO_TRIGGER_CONTROL ? SEMO_TASK_IDLE
                                                                                         : SEMO_TASK_RUNNING,
                             .repeat = true};
+    semo__inbox_reset();
     g_start_ms = semo__board_now_ms();
     g_running = true;
     int64_t duration = 0;
@@ -681,7 +608,7 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
     for (size_t i = 0; i < program->task_count; i++)
         if (program->tasks[i].wrapup)
             program->tasks[i].wrapup();
-    trace_dropped_samples();
+    semo__trace_dropped_samples();
     semo_trace("stop", NULL);
 #ifdef SEMO_COUNT_PASSES
     /* For measuring (not a trace line: built only with -DSEMO_COUNT_PASSES). */
