@@ -163,7 +163,8 @@ typedef struct {
 } channel;
 
 static void wake_task(struct task_s *t);
-static void wake_hinted_tasks(void);
+static void wake_group_readers(void);
+static void mark_group_reader(void);
 
 static channel *g_channels;
 
@@ -247,7 +248,7 @@ int UFMulticast_Write(const char *name, const void *buf, size_t size)
     memcpy(g->buf, buf, size);
     g->written = true;
     pthread_mutex_unlock(&g->lock);
-    wake_hinted_tasks();
+    wake_group_readers();
     return (int)size;
 }
 
@@ -256,6 +257,7 @@ int UFMulticast_Read(const char *name, void *buf, size_t size)
     group *g = find_group(name, size);
     if (!g || !buf)
         return 0;
+    mark_group_reader();
     pthread_mutex_lock(&g->lock);
     int read = 0;
     if (g->written) {
@@ -286,10 +288,14 @@ typedef struct task_s {
     bool stop_requested;
     param *params;
     /* semo_next_firing: a time-driven task that said when its next firing
-     * is needed sleeps until then, or until `woken` (data on one of its
-     * channels, a task's state changed, a multicast group written). */
+     * is needed sleeps until then, or until `woken` by what it may wait
+     * for: data on one of its channels, a change of state of a task it
+     * controls (UFControl_*: `controller` below), a multicast group
+     * written when it reads groups. Nothing else wakes it. */
     bool hinted, woken;
     int64_t hint_ms;
+    struct task_s *controller; /* the task that last ran, called or stopped it */
+    atomic_bool reads_groups;  /* it has called UFMulticast_Read */
 } task;
 
 static task *g_tasks;
@@ -310,12 +316,18 @@ static void wake_task(task *t)
     pthread_mutex_unlock(&t->lock);
 }
 
-/* Something every waiting task may care about happened (a task's state
- * changed, a multicast group was written). */
-static void wake_hinted_tasks(void)
+/* A multicast group was written: wakes the tasks that read groups. */
+static void wake_group_readers(void)
 {
     for (size_t i = 0; g_tasks && g_prog && i < g_prog->task_count; i++)
-        wake_task(&g_tasks[i]);
+        if (atomic_load(&g_tasks[i].reads_groups))
+            wake_task(&g_tasks[i]);
+}
+
+static void mark_group_reader(void)
+{
+    if (g_current)
+        atomic_store(&g_current->reads_groups, true);
 }
 
 void semo_next_firing(int64_t at_ms)
@@ -354,8 +366,9 @@ static void *task_thread(void *arg)
             t->stop_requested = false;
             t->calls = 0;
             pthread_cond_broadcast(&t->changed);
+            task *controller = t->controller;
             pthread_mutex_unlock(&t->lock);
-            wake_hinted_tasks(); /* the control task waits for idle tasks */
+            wake_task(controller); /* the control task waits for idle tasks */
             pthread_mutex_lock(&t->lock);
             continue;
         }
@@ -387,8 +400,9 @@ static void *task_thread(void *arg)
             t->state = SEMO_TASK_IDLE;
         pthread_cond_broadcast(&t->changed);
         if (went_idle) {
+            task *controller = t->controller;
             pthread_mutex_unlock(&t->lock);
-            wake_hinted_tasks();
+            wake_task(controller);
             pthread_mutex_lock(&t->lock);
         }
     }
@@ -433,9 +447,11 @@ static int control(const char *name, control_op op)
             t->state = SEMO_TASK_RUNNING;
         break;
     }
+    if (g_current && g_current != t)
+        t->controller = g_current;
+    t->woken = true; /* its own hint is void: it was told what to do */
     pthread_cond_broadcast(&t->changed);
     pthread_mutex_unlock(&t->lock);
-    wake_hinted_tasks();
     return 0;
 }
 

@@ -78,7 +78,9 @@ void semo_trace(const char *event, ...)
 
 /* --------------------------------------------------------------- channels */
 
-static void wake_tasks(void);
+static void wake_reader(int port);
+static void wake_group_readers(void);
+static void mark_group_reader(void);
 
 /* The rings are the core's (semo_core.c); here they live in the buffers of
  * the generated channels.c, and nothing locks or waits. */
@@ -111,10 +113,12 @@ bool semo__queue_wait(int queue, int64_t deadline_ms)
     return false;
 }
 
+/* A sample voids its reader's hint; a message needs no wake-up (the loop
+ * looks at the inbox: semo__inbox_waiting). */
 void semo__queue_written(int queue)
 {
-    (void)queue;
-    wake_tasks();
+    if (queue >= 0)
+        wake_reader(queue);
 }
 
 /* -------------------------------------------------------------- multicast */
@@ -138,13 +142,14 @@ int UFMulticast_Write(const char *name, const void *buf, size_t size)
         return 0;
     memcpy(&g_group_value[g], buf, size);
     g_group_written[g] = true;
-    wake_tasks();
+    wake_group_readers();
     return (int)size;
 }
 
 int UFMulticast_Read(const char *name, void *buf, size_t size)
 {
     int g = find_group(name, size);
+    mark_group_reader();
     if (g < 0 || !buf || !g_group_written[g])
         return 0;
     memcpy(buf, &g_group_value[g], size);
@@ -153,7 +158,8 @@ int UFMulticast_Read(const char *name, void *buf, size_t size)
 
 /* ------------------------------------------------------------------ tasks */
 
-typedef struct {
+typedef struct task_s task;
+struct task_s {
     semo_task_state state;
     bool repeat; /* RunTask; otherwise `calls` firings are owed */
     unsigned calls;
@@ -161,10 +167,13 @@ typedef struct {
     bool in_firing; /* a body said semo_firing_continues */
     int64_t next_release;
     /* semo_next_firing, as on POSIX: not needed before `hint_ms` unless
-     * `woken` (data written, a task's state changed, a group written). */
+     * `woken` (a sample in one of its channels, a change of state of a task
+     * it controls, a group written when it reads groups). */
     bool hinted, woken;
     int64_t hint_ms;
-} task;
+    task *controller; /* the task that last ran, called or stopped it */
+    bool reads_groups;
+};
 
 static task g_tasks[SEMO_MAX_TASKS];
 static bool g_continues; /* set by the body being fired */
@@ -180,13 +189,31 @@ static task *find_task(const char *name)
     return NULL;
 }
 
-/* Something a waiting task may care about happened: every other task's
- * hint is void (as on POSIX, where it wakes them). */
-static void wake_tasks(void)
+/* Something task `t` may wait for happened: its hint is void. */
+static void wake_task(task *t)
+{
+    if (t && t != g_current)
+        t->woken = true;
+}
+
+static void wake_reader(int port)
+{
+    unsigned short reader = g_prog->channels[port].state->reader;
+    if (reader < g_prog->task_count)
+        wake_task(&g_tasks[reader]);
+}
+
+static void wake_group_readers(void)
 {
     for (size_t i = 0; g_prog && i < g_prog->task_count; i++)
-        if (&g_tasks[i] != g_current)
-            g_tasks[i].woken = true;
+        if (g_tasks[i].reads_groups)
+            wake_task(&g_tasks[i]);
+}
+
+static void mark_group_reader(void)
+{
+    if (g_current)
+        g_current->reads_groups = true;
 }
 
 /* On the static schedule any task may say it: a time-driven one for its
@@ -214,7 +241,7 @@ static void fire_if_due(size_t i)
         t->state = SEMO_TASK_IDLE;
         t->stop_requested = false;
         t->calls = 0;
-        wake_tasks();
+        wake_task(t->controller);
         return;
     }
     if (t->state != SEMO_TASK_RUNNING && !t->in_firing)
@@ -241,10 +268,10 @@ static void fire_if_due(size_t i)
         t->state = SEMO_TASK_IDLE;
         t->stop_requested = false;
         t->calls = 0;
-        wake_tasks();
+        wake_task(t->controller);
     } else if (!t->repeat && t->calls > 0 && --t->calls == 0) {
         t->state = SEMO_TASK_IDLE;
-        wake_tasks();
+        wake_task(t->controller);
     }
 }
 
@@ -284,7 +311,9 @@ static int control(const char *name, control_op op)
             t->state = SEMO_TASK_RUNNING;
         break;
     }
-    wake_tasks();
+    if (g_current && g_current != t)
+        t->controller = g_current;
+    t->woken = true; /* its own hint is void: it was told what to do */
     return 0;
 }
 
