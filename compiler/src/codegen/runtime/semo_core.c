@@ -137,6 +137,34 @@ int semo_value_compare(const semo_value *a, const semo_value *b)
     return (c > 0) - (c < 0);
 }
 
+static bool ordered(int order, semo_cmp op)
+{
+    switch (op) {
+    case SEMO_EQ: return order == 0;
+    case SEMO_NE: return order != 0;
+    case SEMO_LT: return order < 0;
+    case SEMO_LE: return order <= 0;
+    case SEMO_GT: return order > 0;
+    case SEMO_GE: return order >= 0;
+    }
+    return false;
+}
+
+bool semo_value_numbers(const semo_value *a, semo_cmp op, const semo_value *b)
+{
+    double x, y;
+    if (!parse_number(a->text, &x) || !parse_number(b->text, &y))
+        return false;
+    return ordered((x > y) - (x < y), op);
+}
+
+bool semo_value_words(const semo_value *a, semo_cmp op, const semo_value *b)
+{
+    if (op != SEMO_EQ && op != SEMO_NE)
+        return false;
+    return ordered(strcmp(a->text, b->text), op);
+}
+
 bool semo_value_numeric(const semo_value *v)
 {
     double x;

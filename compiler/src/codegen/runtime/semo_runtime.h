@@ -49,6 +49,13 @@ int semo_value_compare(const semo_value *a, const semo_value *b);
 bool semo_value_numeric(const semo_value *v);
 /* "true" or a non-zero number. */
 bool semo_value_truthy(const semo_value *v);
+/* How generated code compares, as the checker typed each comparison (never
+ * guessing from the values). As numbers: false when either value is not a
+ * number. As words: equal when the texts are; words are never ordered
+ * (SEMO_LT ... are false). */
+typedef enum { SEMO_EQ, SEMO_NE, SEMO_LT, SEMO_LE, SEMO_GT, SEMO_GE } semo_cmp;
+bool semo_value_numbers(const semo_value *a, semo_cmp op, const semo_value *b);
+bool semo_value_words(const semo_value *a, semo_cmp op, const semo_value *b);
 
 /* ------------------------------------------------------------------ time */
 
