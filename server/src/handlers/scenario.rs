@@ -57,8 +57,8 @@ pub fn completion(job: &Job, position: Position) -> CompletionResponse {
     let items = complete::completions(&job.text, lines.offset(position), &programs)
         .into_iter()
         .map(|item| {
-            let mut out = CompletionItem::new(item.label, kind(item.kind), item.replace)
-                .detail(item.detail);
+            let mut out =
+                CompletionItem::new(item.label, kind(item.kind), item.replace).detail(item.detail);
             out.insert = item.insert;
             out
         })
