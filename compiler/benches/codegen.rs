@@ -4,8 +4,10 @@
 //! measured 0.44 MB RSS / 25.55 MB VSZ for its generated remote-control
 //! program) and its wake-ups per second while idle (voluntary context
 //! switches of all its threads over one second), in the default build and
-//! in `make STATIC=1` (musl, when `musl-gcc` is installed); on target
-//! `cortex-m` its flash and RAM (`arm-none-eabi-size`; budget 32 KB / 8 KB).
+//! in `make STATIC=1` (musl, when `musl-gcc` is installed); the same for a
+//! robot with no periods that waits for the operator (`fixtures/idle.mission`:
+//! it should not wake at all); on target `cortex-m` the follow robot's flash
+//! and RAM (`arm-none-eabi-size`; budget 32 KB / 8 KB).
 //! Run with `cargo bench --bench codegen`; the second part needs `make` and
 //! `cc`, the last `arm-none-eabi-gcc`.
 
@@ -102,10 +104,30 @@ fn follow_memory() {
             println!("follow robot (linux, {label}): skipped (make, cc or musl-gcc missing)");
             continue;
         }
-        follow_run(&folder, label);
+        follow_run(&folder, "create1", label);
     }
     let _ = std::fs::remove_dir_all(&out);
+    idle_robot();
     follow_cortex_m();
+}
+
+/// A robot with no sensor and no period, waiting for an operator command
+/// that never comes: what wakes it is what polls.
+fn idle_robot() {
+    let out = scratch("idle");
+    let mission = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/fixtures/idle.mission");
+    build(&mission, Target::Linux, &out);
+    let folder = out.join("Team1/waiter");
+    let made = Command::new("make")
+        .args(["-s", "TRANSPORT=udp", "CFLAGS=-std=c11 -O2"])
+        .current_dir(&folder)
+        .status();
+    if made.is_ok_and(|s| s.success()) {
+        follow_run(&folder, "waiter", "idle robot, no periods");
+    } else {
+        println!("idle robot (linux): skipped (make or cc missing)");
+    }
+    let _ = std::fs::remove_dir_all(&out);
 }
 
 /// Voluntary context switches of every thread of process `pid`.
@@ -127,9 +149,9 @@ fn wakeups(pid: u32) -> u64 {
         .sum()
 }
 
-fn follow_run(folder: &Path, label: &str) {
+fn follow_run(folder: &Path, robot: &str, label: &str) {
     let port_base = (21000 + std::process::id() % 1000).to_string();
-    let mut child = Command::new(folder.join("create1"))
+    let mut child = Command::new(folder.join(robot))
         .args(["--duration", "3000", "--port-base", &port_base])
         .spawn()
         .expect("the program starts");
@@ -163,7 +185,7 @@ fn follow_run(folder: &Path, label: &str) {
         std::thread::sleep(Duration::from_millis(20));
     }
     println!(
-        "follow robot (linux, -O2, {label}) while running: peak RSS {:.2} MB, VSZ {:.2} MB (thesis: 0.44 MB / 25.55 MB); {} wake-ups per second while idle",
+        "{robot} robot (linux, -O2, {label}) while running: peak RSS {:.2} MB, VSZ {:.2} MB (thesis: 0.44 MB / 25.55 MB); {} wake-ups per second while idle",
         rss as f64 / 1024.0,
         vsz as f64 / 1024.0,
         per_second.map_or("?".to_string(), |n| n.to_string())

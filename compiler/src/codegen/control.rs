@@ -9,6 +9,7 @@
 use super::c;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::{ActionMachine, Expr, Operand, RobotProgram, SlotSource, State, StateKind};
+use crate::sema::Compared;
 use crate::syntax::ast::CmpOp;
 use std::fmt::Write;
 
@@ -148,17 +149,22 @@ fn expr(e: &Expr) -> String {
         Expr::Not(a) => format!("!{}", expr(a)),
         Expr::Bool(b) => b.to_string(),
         Expr::Truthy(o) => format!("semo_value_truthy({})", operand(o)),
-        Expr::Compare(a, op, b) => {
-            let (a, b) = (operand(a), operand(b));
-            let compared = format!("semo_value_compare({a}, {b}) {} 0", op.as_str());
-            match op {
-                CmpOp::Eq | CmpOp::Ne => format!("({compared})"),
-                // Words are never ordered: the checker refuses them, and a
-                // value that is not a number at run time makes it false.
-                CmpOp::Lt | CmpOp::Le | CmpOp::Gt | CmpOp::Ge => {
-                    format!("(semo_value_numeric({a}) && semo_value_numeric({b}) && {compared})")
-                }
-            }
+        // As the checker typed the comparison: the runtime never guesses
+        // from the values whether they are numbers.
+        Expr::Compare(a, op, b, compared) => {
+            let function = match compared {
+                Compared::Numbers => "semo_value_numbers",
+                Compared::Words => "semo_value_words",
+            };
+            let op = match op {
+                CmpOp::Eq => "SEMO_EQ",
+                CmpOp::Ne => "SEMO_NE",
+                CmpOp::Lt => "SEMO_LT",
+                CmpOp::Le => "SEMO_LE",
+                CmpOp::Gt => "SEMO_GT",
+                CmpOp::Ge => "SEMO_GE",
+            };
+            format!("{function}({}, {op}, {})", operand(a), operand(b))
         }
     }
 }

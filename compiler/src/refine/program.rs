@@ -316,7 +316,14 @@ pub enum Expr {
     Or(Box<Expr>, Box<Expr>),
     And(Box<Expr>, Box<Expr>),
     Not(Box<Expr>),
-    Compare(Operand, crate::syntax::ast::CmpOp, Operand),
+    /// Compared as the checker typed the comparison (numbers by value, words
+    /// by text).
+    Compare(
+        Operand,
+        crate::syntax::ast::CmpOp,
+        Operand,
+        crate::sema::Compared,
+    ),
     /// A bare attribute as a condition: its value is `true` or non-zero.
     Truthy(Operand),
     Bool(bool),

@@ -4,7 +4,7 @@ use super::RefineInput;
 use super::program::*;
 use crate::catalog::{Implementation, RobotType};
 use crate::diag::{Code, Diagnostic};
-use crate::sema::{Symbol, Team, TeamId};
+use crate::sema::{Compared, Symbol, Team, TeamId};
 use crate::span::Span;
 use crate::strategy::{DataCharacteristic, ServiceEntry, TaskUseKind};
 use crate::syntax::ast::{self, ExprKind, StmtKind};
@@ -837,7 +837,18 @@ impl Builder<'_, '_> {
                 .cloned()
                 .unwrap_or_else(|| Operand::Literal(attr.dotted()))
         };
-        convert(expr, &mut resolve)
+        // The strategy checker reads a guard as a variable against numbers
+        // (strategy::guards): a comparison with a number compares numbers.
+        let mut compare_as = |e: &ast::Expr| match &e.kind {
+            ExprKind::Compare(a, _, b)
+                if matches!(a.kind, ExprKind::Number(_))
+                    || matches!(b.kind, ExprKind::Number(_)) =>
+            {
+                Compared::Numbers
+            }
+            _ => Compared::Words,
+        };
+        convert(expr, &mut resolve, &mut compare_as)
     }
 
     fn condition(&mut self, expr: &ast::Expr) -> Expr {
@@ -847,12 +858,27 @@ impl Builder<'_, '_> {
             .into_iter()
             .map(|attr| (attr.span, self.attr_operand(attr)))
             .collect();
-        convert(expr, &mut |attr| {
-            resolved
-                .get(&attr.span)
-                .cloned()
-                .unwrap_or_else(|| Operand::Literal(attr.dotted()))
-        })
+        let mission = &self.input.analysis.mission;
+        let mut untyped = Vec::new();
+        let converted = convert(
+            expr,
+            &mut |attr| {
+                resolved
+                    .get(&attr.span)
+                    .cloned()
+                    .unwrap_or_else(|| Operand::Literal(attr.dotted()))
+            },
+            &mut |e| {
+                mission.compared_at(e.span).unwrap_or_else(|| {
+                    untyped.push(e.span);
+                    Compared::Words
+                })
+            },
+        );
+        for span in untyped {
+            self.internal_error(span, "the checker did not type this comparison");
+        }
+        converted
     }
 
     /// An expression used as a value (a call argument, an assignment).
@@ -1181,19 +1207,28 @@ fn literal_text(kind: &ExprKind) -> String {
 }
 
 /// Converts a mission expression, resolving attributes with `resolve`.
-fn convert(expr: &ast::Expr, resolve: &mut dyn FnMut(&ast::Attr) -> Operand) -> Expr {
+/// How the comparison `expr` compares (see [`Compared`]).
+type CompareAs<'c> = dyn FnMut(&ast::Expr) -> Compared + 'c;
+
+fn convert(
+    expr: &ast::Expr,
+    resolve: &mut dyn FnMut(&ast::Attr) -> Operand,
+    compare_as: &mut CompareAs<'_>,
+) -> Expr {
     let operand = |e: &ast::Expr, resolve: &mut dyn FnMut(&ast::Attr) -> Operand| match &e.kind {
         ExprKind::Attr(a) => resolve(a),
         other => Operand::Literal(literal_text(other)),
     };
     match &expr.kind {
-        ExprKind::Or(a, b) => {
-            Expr::Or(Box::new(convert(a, resolve)), Box::new(convert(b, resolve)))
-        }
-        ExprKind::And(a, b) => {
-            Expr::And(Box::new(convert(a, resolve)), Box::new(convert(b, resolve)))
-        }
-        ExprKind::Not(a) => Expr::Not(Box::new(convert(a, resolve))),
+        ExprKind::Or(a, b) => Expr::Or(
+            Box::new(convert(a, resolve, compare_as)),
+            Box::new(convert(b, resolve, compare_as)),
+        ),
+        ExprKind::And(a, b) => Expr::And(
+            Box::new(convert(a, resolve, compare_as)),
+            Box::new(convert(b, resolve, compare_as)),
+        ),
+        ExprKind::Not(a) => Expr::Not(Box::new(convert(a, resolve, compare_as))),
         ExprKind::Compare(a, op, b) => {
             let is_boolean = |e: &ast::Expr| {
                 matches!(
@@ -1206,8 +1241,8 @@ fn convert(expr: &ast::Expr, resolve: &mut dyn FnMut(&ast::Attr) -> Operand) -> 
             };
             if is_boolean(a) || is_boolean(b) {
                 // `(x < 3) == true`: compare truth values.
-                let l = convert(a, resolve);
-                let r = convert(b, resolve);
+                let l = convert(a, resolve, compare_as);
+                let r = convert(b, resolve, compare_as);
                 let same = Expr::Or(
                     Box::new(Expr::And(Box::new(l.clone()), Box::new(r.clone()))),
                     Box::new(Expr::And(
@@ -1220,7 +1255,8 @@ fn convert(expr: &ast::Expr, resolve: &mut dyn FnMut(&ast::Attr) -> Operand) -> 
                     _ => Expr::Not(Box::new(same)),
                 };
             }
-            Expr::Compare(operand(a, resolve), *op, operand(b, resolve))
+            let compared = compare_as(expr);
+            Expr::Compare(operand(a, resolve), *op, operand(b, resolve), compared)
         }
         ExprKind::Bool(b) => Expr::Bool(*b),
         ExprKind::Attr(a) => Expr::Truthy(resolve(a)),

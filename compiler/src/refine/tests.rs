@@ -236,3 +236,22 @@ fn control_structures_become_states_with_jumps() {
     assert!(machine.modes[1].regions.is_empty(), "N sets every plan OFF");
     assert_eq!(machine.transitions[0].event, "near");
 }
+
+/// A comparison compares as the checker typed it (`sema::Compared`): an
+/// `int` value against a number by value, the operator's `string` command
+/// against a constant by its text. Generated code and the simulator read
+/// this, never the values, to decide.
+#[test]
+fn comparisons_carry_the_checkers_typing() {
+    let text = "{\n  Team1: iRobotCreate r\n}\n\nTeam1.Act.Go{\n  if(DISTANCE < 30) throw near\n  if(USER.RC_CMD == LEFT) throw left\n} repeat(1 SEC)\n\nTeam1.M{\n  set(Act, Go)\n}\n\nTeam1.main{\n  case (M):\n    catch (near): mode = M\n    catch (left): mode = M\n  default: mode = M\n}\n";
+    let programs = programs(text, &[]);
+    let machine = format!("{:?}", program(&programs, "r").control.services);
+    assert!(
+        machine.contains("Lt, Literal(\"30\"), Numbers)"),
+        "{machine}"
+    );
+    assert!(
+        machine.contains("Eq, Literal(\"LEFT\"), Words)"),
+        "{machine}"
+    );
+}

@@ -107,6 +107,18 @@ enum Type {
     Unknown,
 }
 
+/// How a comparison of these two sides compares (see [`Compared`]).
+fn compared(lt: &Type, rt: &Type, ordering: bool) -> Compared {
+    let known_number = |t: &Type| t.is_numeric() && *t != Type::Unknown;
+    let numbers =
+        lt.is_numeric() && rt.is_numeric() && (known_number(lt) || known_number(rt) || ordering);
+    if numbers {
+        Compared::Numbers
+    } else {
+        Compared::Words
+    }
+}
+
 impl Type {
     fn describe(&self) -> String {
         match self {
@@ -550,7 +562,7 @@ impl<'a> Checker<'a> {
                 Type::Bool
             }
             ExprKind::Compare(lhs, op, rhs) => {
-                self.compare(lhs, *op, rhs, scope);
+                self.compare(e.span, lhs, *op, rhs, scope);
                 Type::Bool
             }
             ExprKind::Str(_) => Type::Text,
@@ -569,7 +581,7 @@ impl<'a> Checker<'a> {
         }
     }
 
-    fn compare(&mut self, lhs: &Expr, op: ast::CmpOp, rhs: &Expr, scope: &Scope) {
+    fn compare(&mut self, span: Span, lhs: &Expr, op: ast::CmpOp, rhs: &Expr, scope: &Scope) {
         // A bare unknown name is a constant on the right, and on the left when the
         // right is a known value (`DARK == Guards.Alarm`); against a literal it is
         // a misspelt value (`LIGHTNES < 200`).
@@ -582,10 +594,12 @@ impl<'a> Checker<'a> {
         };
         let lt = self.expr(lhs, scope, rhs_known);
         let rt = self.expr(rhs, scope, true);
-        if matches!(
+        let ordering = matches!(
             op,
             ast::CmpOp::Lt | ast::CmpOp::Le | ast::CmpOp::Gt | ast::CmpOp::Ge
-        ) {
+        );
+        self.comparison(span, compared(&lt, &rt, ordering));
+        if ordering {
             for (ty, side) in [(&lt, lhs), (&rt, rhs)] {
                 if !ty.is_numeric() {
                     self.report(

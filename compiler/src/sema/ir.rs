@@ -29,6 +29,24 @@ pub struct Mission {
     /// The parts of the file whose statements robots run (service and function
     /// bodies, group arms), outer before inner: see [`Mission::scope_at`].
     pub scopes: Vec<RobotScope>,
+    /// How each comparison (`a < b`, `a == b`) compares, as the checker typed
+    /// its sides, by the comparison's range, sorted: see [`Mission::compared_at`].
+    pub comparisons: Vec<(Span, Compared)>,
+}
+
+/// How a comparison compares, decided by the checker from its sides' types
+/// (the catalog's value types, the literals): generated code and the
+/// simulator compare exactly so, never by looking at the values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Compared {
+    /// Both sides are numbers (whole or real numbers, numeric values,
+    /// periods; a team variable counts as one when the other side is, and
+    /// two variables are ordered as numbers): by value. A side that is not
+    /// a number at run time makes the comparison false.
+    Numbers,
+    /// Anything else (words, strings, locations, symbolic constants, truth
+    /// values, two variables with `==`/`!=`): equal when the texts are.
+    Words,
 }
 
 #[derive(Clone, Debug)]
@@ -294,6 +312,15 @@ impl Mission {
             }
             candidate = scope.parent? as usize;
         }
+    }
+
+    /// How the comparison written at `span` compares (None: not a comparison
+    /// the checker saw).
+    pub fn compared_at(&self, span: Span) -> Option<Compared> {
+        self.comparisons
+            .binary_search_by(|(s, _)| (s.start, s.end).cmp(&(span.start, span.end)))
+            .ok()
+            .map(|i| self.comparisons[i].1)
     }
 
     /// Every occurrence of a symbol (definitions and uses).

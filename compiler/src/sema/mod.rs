@@ -140,6 +140,8 @@ pub(crate) struct Checker<'a> {
     /// Where each scope of `mission.scopes` is, by its range: a function body
     /// walked for several callers is one scope with several runners.
     scope_index: FastMap<Span, usize>,
+    /// Where each comparison of `mission.comparisons` is, by its range.
+    comparison_index: FastMap<Span, usize>,
 }
 
 impl<'a> Checker<'a> {
@@ -166,6 +168,7 @@ impl<'a> Checker<'a> {
             team_types: Vec::new(),
             rejected_bodies: Vec::new(),
             scope_index: FastMap::default(),
+            comparison_index: FastMap::default(),
         }
     }
 
@@ -200,6 +203,20 @@ impl<'a> Checker<'a> {
 
     fn team(&self, id: TeamId) -> &Team {
         &self.mission.teams[id.0 as usize]
+    }
+
+    /// Records how the comparison at `span` compares. A body walked for
+    /// several callers is typed each time: it compares numbers only when
+    /// every walk found numbers.
+    fn comparison(&mut self, span: Span, compared: Compared) {
+        let comparisons = &mut self.mission.comparisons;
+        let index = *self.comparison_index.entry(span).or_insert_with(|| {
+            comparisons.push((span, compared));
+            comparisons.len() - 1
+        });
+        if compared == Compared::Words {
+            comparisons[index].1 = Compared::Words;
+        }
     }
 
     fn team_mut(&mut self, id: TeamId) -> &mut Team {
@@ -243,6 +260,9 @@ impl<'a> Checker<'a> {
         self.mission.occurrences =
             sorted_occurrences(std::mem::take(&mut self.mission.occurrences));
         nest_scopes(&mut self.mission.scopes);
+        self.mission
+            .comparisons
+            .sort_by_key(|(span, _)| (span.start, span.end));
         (self.mission, self.diagnostics)
     }
 }

@@ -282,7 +282,7 @@ fn compared_literals(expr: &Expr, wanted: &dyn Fn(&Operand) -> bool, found: &mut
             compared_literals(b, wanted, found);
         }
         Expr::Not(a) => compared_literals(a, wanted, found),
-        Expr::Compare(a, _, b) => match (a, b) {
+        Expr::Compare(a, _, b, _) => match (a, b) {
             (slot, Operand::Literal(l)) | (Operand::Literal(l), slot) if wanted(slot) => found(l),
             _ => {}
         },

@@ -33,6 +33,7 @@ use crate::refine::{
     ActionMachine, ControlMachine, Expr, HEARTBEAT_MS, Operand, RobotProgram, RoleKind, SlotSource,
     StateKind,
 };
+use crate::sema::Compared;
 use crate::syntax::ast::CmpOp;
 use rand_core::{Rng, SeedableRng};
 use rand_xorshift::XorShiftRng;
@@ -258,14 +259,6 @@ fn number(text: &str) -> Option<f64> {
         return None;
     }
     text.parse::<f64>().ok().filter(|d| !d.is_nan())
-}
-
-/// `semo_value_compare`: numerically when both are numbers, else bytewise.
-fn compare(a: &str, b: &str) -> std::cmp::Ordering {
-    match (number(a), number(b)) {
-        (Some(x), Some(y)) => x.partial_cmp(&y).unwrap_or(std::cmp::Ordering::Equal),
-        _ => a.as_bytes().cmp(b.as_bytes()),
-    }
 }
 
 /// `semo_value_truthy`.
@@ -661,16 +654,24 @@ impl<'p> Sim<'p> {
             Expr::Not(a) => !self.eval(r, a),
             Expr::Bool(b) => *b,
             Expr::Truthy(o) => truthy(self.value_ref(r, o)),
-            Expr::Compare(a, op, b) => {
+            Expr::Compare(a, op, b, compared) => {
                 let (a, b) = (self.value_ref(r, a), self.value_ref(r, b));
-                // Words are never ordered: an ordered comparison of a value
-                // that is not a number is false (`semo_value_numeric`).
-                if !matches!(op, CmpOp::Eq | CmpOp::Ne)
-                    && (number(a).is_none() || number(b).is_none())
-                {
+                // As the checker typed it (`semo_value_numbers`,
+                // `semo_value_words`): numbers by value, false when a side is
+                // not a number; words by their text, never ordered.
+                let ord = match compared {
+                    Compared::Numbers => match (number(a), number(b)) {
+                        (Some(x), Some(y)) => x.partial_cmp(&y),
+                        _ => None,
+                    },
+                    Compared::Words => match op {
+                        CmpOp::Eq | CmpOp::Ne => Some(a.as_bytes().cmp(b.as_bytes())),
+                        _ => None,
+                    },
+                };
+                let Some(ord) = ord else {
                     return false;
-                }
-                let ord = compare(a, b);
+                };
                 use std::cmp::Ordering::*;
                 match op {
                     CmpOp::Eq => ord == Equal,

@@ -1,9 +1,11 @@
 /* semo_core.c: the portable core of the SeMo runtime, shared by every
  * platform layer (POSIX threads, static schedule).
  *
- * No POSIX, no stdio, no heap: values, the trace line format and integer
- * formatting. Platforms give the bytes of a trace line a destination (a file,
- * a UART) through a `semo__sink`.
+ * No POSIX, no stdio, no heap: values, the trace line format, integer
+ * formatting, channels (ports), the inbox of messages and what a send does
+ * before the transport. Platforms give the bytes of a trace line a
+ * destination (a file, a UART) through a `semo__sink`, and the queues their
+ * storage, lock and wake-ups through the hooks of semo_internal.h.
  */
 #include "semo_internal.h"
 
@@ -135,6 +137,34 @@ int semo_value_compare(const semo_value *a, const semo_value *b)
     return (c > 0) - (c < 0);
 }
 
+static bool ordered(int order, semo_cmp op)
+{
+    switch (op) {
+    case SEMO_EQ: return order == 0;
+    case SEMO_NE: return order != 0;
+    case SEMO_LT: return order < 0;
+    case SEMO_LE: return order <= 0;
+    case SEMO_GT: return order > 0;
+    case SEMO_GE: return order >= 0;
+    }
+    return false;
+}
+
+bool semo_value_numbers(const semo_value *a, semo_cmp op, const semo_value *b)
+{
+    double x, y;
+    if (!parse_number(a->text, &x) || !parse_number(b->text, &y))
+        return false;
+    return ordered((x > y) - (x < y), op);
+}
+
+bool semo_value_words(const semo_value *a, semo_cmp op, const semo_value *b)
+{
+    if (op != SEMO_EQ && op != SEMO_NE)
+        return false;
+    return ordered(strcmp(a->text, b->text), op);
+}
+
 bool semo_value_numeric(const semo_value *v)
 {
     double x;
@@ -254,4 +284,172 @@ void semo__trace_line(const semo__sink *sink, int64_t t, const char *robot, cons
         put_json_string(sink, value);
     }
     put_text(sink, "}\n");
+}
+
+/* ------------------------------------------------- channels and the inbox */
+
+/* The rings are the same on every platform; the platform gives their
+ * storage and the hooks around them (semo_internal.h): a lock (none on the
+ * static schedule), a wait for the next write (none there: nothing else
+ * runs meanwhile), and the wake-up of who waits after a write. */
+
+static bool ring_take(const semo__ring *r, void *out)
+{
+    if (r->state->count == 0)
+        return false;
+    memcpy(out, r->storage + r->state->head * r->sample_size, r->sample_size);
+    r->state->head = (r->state->head + 1) % r->capacity;
+    r->state->count--;
+    return true;
+}
+
+/* A full ring drops the sample and counts it. */
+static bool ring_put(const semo__ring *r, const void *sample)
+{
+    if (r->state->count == r->capacity) {
+        r->state->dropped++;
+        return false;
+    }
+    size_t tail = (r->state->head + r->state->count) % r->capacity;
+    memcpy(r->storage + tail * r->sample_size, sample, r->sample_size);
+    r->state->count++;
+    return true;
+}
+
+int UFPort_Initialize(const char *task, const char *port)
+{
+    const semo_program_desc *p = semo_program();
+    if (!p || !task || !port)
+        return -1;
+    for (size_t i = 0; i < p->channel_count; i++) {
+        const semo_channel_desc *c = &p->channels[i];
+        bool input = strcmp(c->dst_task, task) == 0 && strcmp(c->dst_port, port) == 0;
+        bool output = strcmp(c->src_task, task) == 0 && strcmp(c->src_port, port) == 0;
+        if (input || output)
+            return (int)i;
+    }
+    return -1;
+}
+
+int UFPort_ReadFromQueue(int port, void *buf, size_t size)
+{
+    semo__ring r;
+    if (!semo__channel_ring(port, &r) || !buf || size != r.sample_size)
+        return 0;
+    semo__queue_lock(port);
+    while (r.state->count == 0 && semo_running() && semo__queue_wait(port, -1))
+        ;
+    bool read = ring_take(&r, buf);
+    semo__queue_unlock(port);
+    return read ? (int)size : 0;
+}
+
+int UFPort_WriteToQueue(int port, const void *buf, size_t size)
+{
+    semo__ring r;
+    if (!semo__channel_ring(port, &r) || !buf || size != r.sample_size)
+        return 0;
+    semo__queue_lock(port);
+    bool written = ring_put(&r, buf);
+    semo__queue_unlock(port);
+    if (written)
+        semo__queue_written(port);
+    return written ? (int)size : 0;
+}
+
+int UFPort_GetNumOfAvailableData(int port)
+{
+    semo__ring r;
+    if (!semo__channel_ring(port, &r))
+        return -1;
+    semo__queue_lock(port);
+    int n = (int)r.state->count;
+    semo__queue_unlock(port);
+    return n;
+}
+
+void semo__trace_dropped_samples(void)
+{
+    const semo_program_desc *p = semo_program();
+    for (size_t i = 0; p && i < p->channel_count; i++) {
+        semo__ring r;
+        if (!semo__channel_ring((int)i, &r))
+            continue;
+        semo__queue_lock((int)i);
+        unsigned long dropped = r.state->dropped;
+        semo__queue_unlock((int)i);
+        if (dropped == 0)
+            continue;
+        const semo_channel_desc *d = &p->channels[i];
+        char count[21], name[256];
+        semo__format_i64(count, (int64_t)dropped);
+        /* "Src.port->Dst.port", cut to fit. */
+        size_t len = 0;
+        const char *parts[] = {d->src_task, ".", d->src_port, "->", d->dst_task, ".", d->dst_port};
+        for (size_t k = 0; k < sizeof parts / sizeof parts[0]; k++)
+            for (const char *c = parts[k]; *c && len + 1 < sizeof name; c++)
+                name[len++] = *c;
+        name[len] = '\0';
+        semo_trace("dropped", "channel", name, "count", count, NULL);
+    }
+}
+
+/* Messages received and not yet taken. */
+static semo_message g_inbox[SEMO_INBOX];
+static semo_channel_state g_inbox_state;
+static const semo__ring g_inbox_ring = {(unsigned char *)g_inbox, &g_inbox_state, SEMO_INBOX, sizeof(semo_message)};
+
+static bool g_inbox_polled; /* some task called semo_comm_poll */
+
+void semo__inbox_reset(void)
+{
+    g_inbox_state = (semo_channel_state){0};
+    g_inbox_polled = false;
+}
+
+bool semo__inbox_waiting(void)
+{
+    semo__queue_lock(SEMO__INBOX);
+    bool waiting = g_inbox_polled && g_inbox_state.count > 0;
+    semo__queue_unlock(SEMO__INBOX);
+    return waiting;
+}
+
+void semo__deliver(const semo_message *msg)
+{
+    semo__queue_lock(SEMO__INBOX);
+    bool queued = ring_put(&g_inbox_ring, msg);
+    semo__queue_unlock(SEMO__INBOX);
+    if (queued)
+        semo__queue_written(SEMO__INBOX);
+    else
+        semo_trace("drop", "from", msg->from_team, "key", msg->key, "reason", "inbox full", NULL);
+}
+
+int semo_comm_poll(semo_message *out, int64_t timeout_ms)
+{
+    if (!out)
+        return 0;
+    int64_t deadline = timeout_ms < 0 ? -1 : semo_now_ms() + timeout_ms;
+    semo__queue_lock(SEMO__INBOX);
+    g_inbox_polled = true;
+    while (g_inbox_state.count == 0 && semo_running() && (deadline < 0 || semo_now_ms() < deadline) &&
+           semo__queue_wait(SEMO__INBOX, deadline))
+        ;
+    bool got = ring_take(&g_inbox_ring, out);
+    semo__queue_unlock(SEMO__INBOX);
+    if (got)
+        semo_trace("receive", "from", out->from_team, "from_robot", out->from_robot, "key", out->key, "value",
+                   out->value.text, NULL);
+    return got;
+}
+
+int semo__comm_send_local(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value)
+{
+    if (!semo_program() || !to_team || !key || !value || strlen(key) >= sizeof ((semo_message *)0)->key ||
+        (kind != SEMO_MSG_SEND && kind != SEMO_MSG_PUBLISH))
+        return -1;
+    semo_trace("send", "to", to_team, "key", key, "value", value->text, NULL);
+    /* The operator console: the trace is its record. */
+    return strcmp(to_team, "USER") == 0 ? 1 : 0;
 }

@@ -28,8 +28,51 @@ size_t semo__format_i64(char *out, int64_t n);
 
 /* Waits until mission time `deadline_ms`; false when the program stopped first. */
 bool semo__wait_until(int64_t deadline_ms);
+
+/* Channels and the inbox of messages are the core's (semo_core.c): one ring
+ * code for every platform. A queue is a channel (its port id) or the inbox
+ * (SEMO__INBOX); the platform gives each channel's storage and the hooks. */
+#define SEMO__INBOX (-1)
+/* Messages received and not yet taken (`drop` beyond). */
+#ifndef SEMO_INBOX
+#ifdef SEMO_STATIC
+#define SEMO_INBOX 8
+#else
+#define SEMO_INBOX 64
+#endif
+#endif
+typedef struct {
+    unsigned char *storage; /* capacity * sample_size bytes */
+    semo_channel_state *state;
+    size_t capacity, sample_size;
+} semo__ring;
+/* Platform: channel `port`'s ring; false for a bad id. */
+bool semo__channel_ring(int port, semo__ring *out);
+/* Platform: the queue's lock (none on the static schedule). */
+void semo__queue_lock(int queue);
+void semo__queue_unlock(int queue);
+/* Platform, with the lock held: waits until the queue is written, mission
+ * time `deadline_ms` (< 0: none) or the program stops (the caller looks
+ * again); false when the platform cannot wait (the static schedule, where
+ * nothing else runs meanwhile). */
+bool semo__queue_wait(int queue, int64_t deadline_ms);
+/* Platform, after the lock is released: something was added to the queue;
+ * wakes its reader (and tasks sleeping on a semo_next_firing hint). */
+void semo__queue_written(int queue);
+
 /* Queues a message as if it had arrived over the transport. */
 void semo__deliver(const semo_message *msg);
+/* Empties the inbox (start-up, shut-down). */
+void semo__inbox_reset(void);
+/* Whether a message waits for a task that polls the inbox. */
+bool semo__inbox_waiting(void);
+/* What every send does before the transport: checks the arguments and
+ * traces the send; -1 on bad arguments, 1 when it went to the operator
+ * console ("USER", whose record is the trace), 0 when the transport must
+ * carry it. */
+int semo__comm_send_local(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value);
+/* Traces `dropped` for every channel that dropped samples. */
+void semo__trace_dropped_samples(void);
 
 /* The time scales accepted (wall ms per mission ms), from the command line or
  * a scenario: a million times faster to a million times slower. Beyond them
@@ -99,12 +142,13 @@ extern const semo__sim_tables semo__scenario;
 
 /* Platform hooks of the static schedule, given by the board file
  * (semo_lm3s6965.c): a millisecond clock, the trace's output, sleeping
- * until the next tick and ending the program. */
+ * until a deadline of that clock (or an interrupt: the caller looks at the
+ * time again; INT64_MAX: no deadline) and ending the program. */
 #ifdef SEMO_STATIC
 void semo__board_init(void);
 int64_t semo__board_now_ms(void);
 void semo__board_put(void *ctx, const char *bytes, size_t n);
-void semo__board_idle(void);
+void semo__board_sleep_until(int64_t deadline_ms);
 void semo__board_exit(int status);
 #endif
 

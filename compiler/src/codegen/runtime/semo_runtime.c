@@ -28,7 +28,6 @@
 #ifndef SEMO_STACK_BYTES
 #define SEMO_STACK_BYTES (512u * 1024u)
 #endif
-#define COMM_QUEUE_CAPACITY 64
 #define RECV_ERROR_PAUSE_MS 50
 #define DEFAULT_PORT_BASE 47000
 #define DEFAULT_BROKER "mqtt://127.0.0.1:1883"
@@ -165,92 +164,70 @@ void semo_trace(const char *event, ...)
 
 /* --------------------------------------------------------------- channels */
 
+/* The rings are the core's (semo_core.c); here each has its lock and a
+ * condition variable its reader waits on. */
 typedef struct {
-    const semo_channel_desc *desc;
-    unsigned char *buf;
-    size_t capacity, head, count;
-    unsigned long dropped;
+    semo__ring ring;
+    semo_channel_state state;
     pthread_mutex_t lock;
     pthread_cond_t readable;
     struct task_s *reader; /* the task reading it, woken by a write */
 } channel;
 
 static void wake_task(struct task_s *t);
-static void wake_hinted_tasks(void);
+static void wake_group_readers(void);
+static void mark_group_reader(void);
 
 static channel *g_channels;
 
 static channel *channel_at(int port)
 {
-    if (!g_prog || port < 0 || (size_t)port >= g_prog->channel_count)
+    if (!g_prog || !g_channels || port < 0 || (size_t)port >= g_prog->channel_count)
         return NULL;
     return &g_channels[port];
 }
 
-int UFPort_Initialize(const char *task, const char *port)
-{
-    if (!g_prog || !task || !port)
-        return -1;
-    for (size_t i = 0; i < g_prog->channel_count; i++) {
-        const semo_channel_desc *c = &g_prog->channels[i];
-        bool input = strcmp(c->dst_task, task) == 0 && strcmp(c->dst_port, port) == 0;
-        bool output = strcmp(c->src_task, task) == 0 && strcmp(c->src_port, port) == 0;
-        if (input || output)
-            return (int)i;
-    }
-    return -1;
-}
-
-int UFPort_ReadFromQueue(int port, void *buf, size_t size)
-{
-    channel *c = channel_at(port);
-    if (!c || !buf || size != c->desc->sample_size)
-        return 0;
-    pthread_mutex_lock(&c->lock);
-    while (c->count == 0 && semo_running())
-        pthread_cond_wait(&c->readable, &c->lock);
-    int read = 0;
-    if (c->count > 0) {
-        memcpy(buf, c->buf + c->head * size, size);
-        c->head = (c->head + 1) % c->capacity;
-        c->count--;
-        read = (int)size;
-    }
-    pthread_mutex_unlock(&c->lock);
-    return read;
-}
-
-int UFPort_WriteToQueue(int port, const void *buf, size_t size)
-{
-    channel *c = channel_at(port);
-    if (!c || !buf || size != c->desc->sample_size)
-        return 0;
-    pthread_mutex_lock(&c->lock);
-    int written = 0;
-    if (c->count < c->capacity) {
-        size_t tail = (c->head + c->count) % c->capacity;
-        memcpy(c->buf + tail * size, buf, size);
-        c->count++;
-        written = (int)size;
-        pthread_cond_signal(&c->readable);
-    } else {
-        c->dropped++;
-    }
-    pthread_mutex_unlock(&c->lock);
-    if (written)
-        wake_task(c->reader);
-    return written;
-}
-
-int UFPort_GetNumOfAvailableData(int port)
+bool semo__channel_ring(int port, semo__ring *out)
 {
     channel *c = channel_at(port);
     if (!c)
-        return -1;
-    pthread_mutex_lock(&c->lock);
-    int n = (int)c->count;
-    pthread_mutex_unlock(&c->lock);
-    return n;
+        return false;
+    *out = c->ring;
+    return true;
+}
+
+static pthread_mutex_t g_inbox_lock = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t g_inbox_cond;
+
+void semo__queue_lock(int queue)
+{
+    pthread_mutex_lock(queue == SEMO__INBOX ? &g_inbox_lock : &g_channels[queue].lock);
+}
+
+void semo__queue_unlock(int queue)
+{
+    pthread_mutex_unlock(queue == SEMO__INBOX ? &g_inbox_lock : &g_channels[queue].lock);
+}
+
+bool semo__queue_wait(int queue, int64_t deadline_ms)
+{
+    if (queue == SEMO__INBOX)
+        wait_until(&g_inbox_cond, &g_inbox_lock, deadline_ms);
+    else
+        wait_until(&g_channels[queue].readable, &g_channels[queue].lock, deadline_ms);
+    return true;
+}
+
+/* A waiter looks at the count under the lock before it waits, so a signal
+ * after the lock is released is never missed. */
+void semo__queue_written(int queue)
+{
+    if (queue == SEMO__INBOX) {
+        pthread_cond_signal(&g_inbox_cond);
+    } else {
+        pthread_cond_signal(&g_channels[queue].readable);
+        wake_task(g_channels[queue].reader);
+    }
 }
 
 /* -------------------------------------------------------------- multicast */
@@ -283,7 +260,7 @@ int UFMulticast_Write(const char *name, const void *buf, size_t size)
     memcpy(g->buf, buf, size);
     g->written = true;
     pthread_mutex_unlock(&g->lock);
-    wake_hinted_tasks();
+    wake_group_readers();
     return (int)size;
 }
 
@@ -292,6 +269,7 @@ int UFMulticast_Read(const char *name, void *buf, size_t size)
     group *g = find_group(name, size);
     if (!g || !buf)
         return 0;
+    mark_group_reader();
     pthread_mutex_lock(&g->lock);
     int read = 0;
     if (g->written) {
@@ -322,10 +300,14 @@ typedef struct task_s {
     bool stop_requested;
     param *params;
     /* semo_next_firing: a time-driven task that said when its next firing
-     * is needed sleeps until then, or until `woken` (data on one of its
-     * channels, a task's state changed, a multicast group written). */
+     * is needed sleeps until then, or until `woken` by what it may wait
+     * for: data on one of its channels, a change of state of a task it
+     * controls (UFControl_*: `controller` below), a multicast group
+     * written when it reads groups. Nothing else wakes it. */
     bool hinted, woken;
     int64_t hint_ms;
+    struct task_s *controller; /* the task that last ran, called or stopped it */
+    atomic_bool reads_groups;  /* it has called UFMulticast_Read */
 } task;
 
 static task *g_tasks;
@@ -346,12 +328,18 @@ static void wake_task(task *t)
     pthread_mutex_unlock(&t->lock);
 }
 
-/* Something every waiting task may care about happened (a task's state
- * changed, a multicast group was written). */
-static void wake_hinted_tasks(void)
+/* A multicast group was written: wakes the tasks that read groups. */
+static void wake_group_readers(void)
 {
     for (size_t i = 0; g_tasks && g_prog && i < g_prog->task_count; i++)
-        wake_task(&g_tasks[i]);
+        if (atomic_load(&g_tasks[i].reads_groups))
+            wake_task(&g_tasks[i]);
+}
+
+static void mark_group_reader(void)
+{
+    if (g_current)
+        atomic_store(&g_current->reads_groups, true);
 }
 
 void semo_next_firing(int64_t at_ms)
@@ -390,8 +378,9 @@ static void *task_thread(void *arg)
             t->stop_requested = false;
             t->calls = 0;
             pthread_cond_broadcast(&t->changed);
+            task *controller = t->controller;
             pthread_mutex_unlock(&t->lock);
-            wake_hinted_tasks(); /* the control task waits for idle tasks */
+            wake_task(controller); /* the control task waits for idle tasks */
             pthread_mutex_lock(&t->lock);
             continue;
         }
@@ -423,8 +412,9 @@ static void *task_thread(void *arg)
             t->state = SEMO_TASK_IDLE;
         pthread_cond_broadcast(&t->changed);
         if (went_idle) {
+            task *controller = t->controller;
             pthread_mutex_unlock(&t->lock);
-            wake_hinted_tasks();
+            wake_task(controller);
             pthread_mutex_lock(&t->lock);
         }
     }
@@ -469,9 +459,11 @@ static int control(const char *name, control_op op)
             t->state = SEMO_TASK_RUNNING;
         break;
     }
+    if (g_current && g_current != t)
+        t->controller = g_current;
+    t->woken = true; /* its own hint is void: it was told what to do */
     pthread_cond_broadcast(&t->changed);
     pthread_mutex_unlock(&t->lock);
-    wake_hinted_tasks();
     return 0;
 }
 
@@ -684,33 +676,12 @@ static bool decode_message(const unsigned char *in, size_t len, semo_message *m)
 }
 
 static const semo_transport *g_transport; /* NULL: no other robots */
-static semo_message g_inbox[COMM_QUEUE_CAPACITY];
-static size_t g_inbox_head, g_inbox_count;
-static pthread_mutex_t g_inbox_lock = PTHREAD_MUTEX_INITIALIZER;
-static pthread_cond_t g_inbox_cond;
-
-void semo__deliver(const semo_message *msg)
-{
-    pthread_mutex_lock(&g_inbox_lock);
-    bool queued = g_inbox_count < COMM_QUEUE_CAPACITY;
-    if (queued) {
-        g_inbox[(g_inbox_head + g_inbox_count) % COMM_QUEUE_CAPACITY] = *msg;
-        g_inbox_count++;
-        pthread_cond_signal(&g_inbox_cond);
-    }
-    pthread_mutex_unlock(&g_inbox_lock);
-    if (!queued)
-        semo_trace("drop", "from", msg->from_team, "key", msg->key, "reason", "inbox full", NULL);
-}
 
 int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value)
 {
-    if (!g_prog || !to_team || !key || !value || strlen(key) >= sizeof ((semo_message *)0)->key ||
-        (kind != SEMO_MSG_SEND && kind != SEMO_MSG_PUBLISH))
-        return -1;
-    semo_trace("send", "to", to_team, "key", key, "value", value->text, NULL);
-    if (strcmp(to_team, "USER") == 0)
-        return 1; /* the operator console: the trace is its record */
+    int local = semo__comm_send_local(to_team, kind, key, value);
+    if (local != 0)
+        return local;
     if (!g_transport)
         return -1;
     semo_message m = {.kind = (char)kind};
@@ -747,27 +718,6 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
         return -1;
     }
     return sent;
-}
-
-int semo_comm_poll(semo_message *out, int64_t timeout_ms)
-{
-    if (!out)
-        return 0;
-    int64_t deadline = timeout_ms < 0 ? -1 : semo_now_ms() + timeout_ms;
-    pthread_mutex_lock(&g_inbox_lock);
-    while (g_inbox_count == 0 && semo_running() && (deadline < 0 || semo_now_ms() < deadline))
-        wait_until(&g_inbox_cond, &g_inbox_lock, deadline);
-    bool got = g_inbox_count > 0;
-    if (got) {
-        *out = g_inbox[g_inbox_head];
-        g_inbox_head = (g_inbox_head + 1) % COMM_QUEUE_CAPACITY;
-        g_inbox_count--;
-    }
-    pthread_mutex_unlock(&g_inbox_lock);
-    if (got)
-        semo_trace("receive", "from", out->from_team, "from_robot", out->from_robot, "key", out->key, "value",
-                   out->value.text, NULL);
-    return got;
 }
 
 static void *receiver_thread(void *arg)
@@ -1084,7 +1034,7 @@ static void free_program_state(void)
 {
     const semo_program_desc *p = g_prog;
     for (size_t i = 0; g_channels && i < p->channel_count; i++) {
-        free(g_channels[i].buf);
+        free(g_channels[i].ring.storage);
         pthread_mutex_destroy(&g_channels[i].lock);
         pthread_cond_destroy(&g_channels[i].readable);
     }
@@ -1109,7 +1059,7 @@ static void free_program_state(void)
     g_tasks = NULL;
     g_timers = NULL;
     g_timer_count = 0;
-    g_inbox_head = g_inbox_count = 0;
+    semo__inbox_reset();
 }
 
 static bool allocate_program_state(const semo_program_desc *p)
@@ -1122,15 +1072,15 @@ static bool allocate_program_state(const semo_program_desc *p)
     bool ok = true;
     for (size_t i = 0; i < p->channel_count; i++) {
         channel *c = &g_channels[i];
-        c->desc = &p->channels[i];
-        c->capacity = c->desc->capacity;
-        if (c->capacity < c->desc->initial_samples)
-            c->capacity = c->desc->initial_samples;
-        if (c->capacity == 0)
-            c->capacity = 1;
-        c->count = c->desc->initial_samples;
-        c->buf = calloc(c->capacity, c->desc->sample_size);
-        ok = ok && c->buf;
+        const semo_channel_desc *d = &p->channels[i];
+        size_t capacity = d->capacity;
+        if (capacity < d->initial_samples)
+            capacity = d->initial_samples;
+        if (capacity == 0)
+            capacity = 1;
+        c->state.count = d->initial_samples;
+        c->ring = (semo__ring){calloc(capacity, d->sample_size), &c->state, capacity, d->sample_size};
+        ok = ok && c->ring.storage;
         pthread_mutex_init(&c->lock, NULL);
         init_cond(&c->readable);
     }
@@ -1193,22 +1143,6 @@ static bool start_thread(pthread_t *thread, void *(*body)(void *), void *arg)
     if (!ok)
         fprintf(stderr, "semo runtime: cannot start a thread\n");
     return ok;
-}
-
-static void trace_dropped_samples(void)
-{
-    for (size_t i = 0; i < g_prog->channel_count; i++) {
-        const semo_channel_desc *d = g_channels[i].desc;
-        pthread_mutex_lock(&g_channels[i].lock);
-        unsigned long dropped = g_channels[i].dropped;
-        pthread_mutex_unlock(&g_channels[i].lock);
-        if (dropped) {
-            char name[256], count[32];
-            snprintf(name, sizeof name, "%s.%s->%s.%s", d->src_task, d->src_port, d->dst_task, d->dst_port);
-            snprintf(count, sizeof count, "%lu", dropped);
-            semo_trace("dropped", "channel", name, "count", count, NULL);
-        }
-    }
 }
 
 /* Starts everything, waits for the end, stops everything; 0 or 1. */
@@ -1318,7 +1252,7 @@ stop:
     for (size_t i = 0; i < initialized; i++)
         if (p->tasks[i].wrapup)
             p->tasks[i].wrapup();
-    trace_dropped_samples();
+    semo__trace_dropped_samples();
     semo_trace("stop", NULL);
     if (g_transport)
         g_transport->close();

@@ -49,6 +49,13 @@ int semo_value_compare(const semo_value *a, const semo_value *b);
 bool semo_value_numeric(const semo_value *v);
 /* "true" or a non-zero number. */
 bool semo_value_truthy(const semo_value *v);
+/* How generated code compares, as the checker typed each comparison (never
+ * guessing from the values). As numbers: false when either value is not a
+ * number. As words: equal when the texts are; words are never ordered
+ * (SEMO_LT ... are false). */
+typedef enum { SEMO_EQ, SEMO_NE, SEMO_LT, SEMO_LE, SEMO_GT, SEMO_GE } semo_cmp;
+bool semo_value_numbers(const semo_value *a, semo_cmp op, const semo_value *b);
+bool semo_value_words(const semo_value *a, semo_cmp op, const semo_value *b);
 
 /* ------------------------------------------------------------------ time */
 
@@ -73,6 +80,7 @@ typedef struct {
 typedef struct {
     size_t head, count;
     unsigned long dropped;
+    unsigned short reader; /* index of the task reading it (set at start) */
 } semo_channel_state;
 
 /* A FIFO channel of the task graph: a bounded ring buffer of fixed-size samples. */
@@ -139,9 +147,10 @@ int semo_main(int argc, char **argv, const semo_program_desc *program);
 
 #ifdef SEMO_STATIC
 /* One pass of the static schedule: every task of `schedule` that is due
- * (time-driven: its period elapsed; data-driven: always, its body returns
- * when no data waits; control-driven: running or called) fires, in order.
- * semo_main calls it once per clock tick until the program stops. */
+ * (time-driven: its period elapsed and its semo_next_firing reached;
+ * data-driven: always, its body returns when no data waits;
+ * control-driven: running or called) fires, in order. semo_main calls it,
+ * then sleeps until the earliest time a task is due next (no clock tick). */
 void Core_1_go(void);
 /* For a task body on the static schedule that must wait (a service taking
  * time): the current firing is not over; the body returns and is called
@@ -203,7 +212,9 @@ bool UFControl_WaitStop(const char *task, int64_t until_ms);
  * one of its channels, a task changes state or a multicast group is
  * written; its period stays the shortest gap. A task that never calls it
  * fires every period. So an idle robot's control task sleeps instead of
- * polling. No effect elsewhere (and on the static schedule). */
+ * polling. On the static schedule a firing that continues
+ * (semo_firing_continues) may say it too: when its next step is needed;
+ * no effect in other tasks. */
 void semo_next_firing(int64_t at_ms);
 
 /* Task parameters (per task, by name); unknown ones read as 0. */

@@ -2,8 +2,10 @@
  * (targets `cortex-m`, `cortex-m-sim`; built with -DSEMO_STATIC).
  *
  * One loop and no threads: `Core_1_go` fires the due tasks in the order of
- * the single-appearance schedule, once per clock tick, and the board sleeps
- * until the next tick (an idle robot only wakes for its clock). No call
+ * the single-appearance schedule; then the loop works out when a task is
+ * next due (a period, a task's `semo_next_firing`, data waiting, an
+ * operator command, the end of the run) and the board sleeps until then:
+ * no clock tick, so an idle robot wakes only for its deadlines. No call
  * blocks, nothing is allocated: channels live in the buffers the generated
  * channels.c gives them, everything else in the fixed tables below (sizes
  * overridable with -D). The board file (semo_lm3s6965.c) gives the clock,
@@ -25,16 +27,13 @@
 #ifndef SEMO_MAX_GROUPS
 #define SEMO_MAX_GROUPS 4
 #endif
-/* Messages received and not yet taken (operator commands). */
-#ifndef SEMO_INBOX
-#define SEMO_INBOX 8
-#endif
 
 /* ------------------------------------------------------------ run state */
 
 static const semo_program_desc *g_prog;
 static bool g_running;
 static int64_t g_start_ms;
+static unsigned long g_passes; /* loop iterations: wake-ups (-DSEMO_COUNT_PASSES prints them) */
 
 bool semo_running(void)
 {
@@ -63,7 +62,7 @@ void semo_sleep_ms(int64_t ms)
 {
     int64_t end = semo_now_ms() + ms;
     while (g_running && semo_now_ms() < end)
-        semo__board_idle();
+        semo__board_sleep_until(g_start_ms + end);
 }
 
 /* ----------------------------------------------------------------- traces */
@@ -79,59 +78,47 @@ void semo_trace(const char *event, ...)
 
 /* --------------------------------------------------------------- channels */
 
-static const semo_channel_desc *channel_at(int port)
+static void wake_reader(int port);
+static void wake_group_readers(void);
+static void mark_group_reader(void);
+
+/* The rings are the core's (semo_core.c); here they live in the buffers of
+ * the generated channels.c, and nothing locks or waits. */
+bool semo__channel_ring(int port, semo__ring *out)
 {
     if (!g_prog || port < 0 || (size_t)port >= g_prog->channel_count)
-        return NULL;
+        return false;
     const semo_channel_desc *c = &g_prog->channels[port];
-    return c->storage && c->state ? c : NULL;
+    if (!c->storage || !c->state)
+        return false;
+    *out = (semo__ring){c->storage, c->state, c->capacity, c->sample_size};
+    return true;
 }
 
-int UFPort_Initialize(const char *task, const char *port)
+void semo__queue_lock(int queue)
 {
-    if (!g_prog || !task || !port)
-        return -1;
-    for (size_t i = 0; i < g_prog->channel_count; i++) {
-        const semo_channel_desc *c = &g_prog->channels[i];
-        bool input = strcmp(c->dst_task, task) == 0 && strcmp(c->dst_port, port) == 0;
-        bool output = strcmp(c->src_task, task) == 0 && strcmp(c->src_port, port) == 0;
-        if (input || output)
-            return (int)i;
-    }
-    return -1;
+    (void)queue;
 }
 
-/* Never blocks: 0 when the channel is empty. */
-int UFPort_ReadFromQueue(int port, void *buf, size_t size)
+void semo__queue_unlock(int queue)
 {
-    const semo_channel_desc *c = channel_at(port);
-    if (!c || !buf || size != c->sample_size || c->state->count == 0)
-        return 0;
-    memcpy(buf, c->storage + c->state->head * c->sample_size, size);
-    c->state->head = (c->state->head + 1) % c->capacity;
-    c->state->count--;
-    return (int)size;
+    (void)queue;
 }
 
-int UFPort_WriteToQueue(int port, const void *buf, size_t size)
+/* Nothing would write while this waited: a read of an empty queue returns. */
+bool semo__queue_wait(int queue, int64_t deadline_ms)
 {
-    const semo_channel_desc *c = channel_at(port);
-    if (!c || !buf || size != c->sample_size)
-        return 0;
-    if (c->state->count == c->capacity) {
-        c->state->dropped++;
-        return 0;
-    }
-    size_t tail = (c->state->head + c->state->count) % c->capacity;
-    memcpy(c->storage + tail * c->sample_size, buf, size);
-    c->state->count++;
-    return (int)size;
+    (void)queue;
+    (void)deadline_ms;
+    return false;
 }
 
-int UFPort_GetNumOfAvailableData(int port)
+/* A sample voids its reader's hint; a message needs no wake-up (the loop
+ * looks at the inbox: semo__inbox_waiting). */
+void semo__queue_written(int queue)
 {
-    const semo_channel_desc *c = channel_at(port);
-    return c ? (int)c->state->count : -1;
+    if (queue >= 0)
+        wake_reader(queue);
 }
 
 /* -------------------------------------------------------------- multicast */
@@ -155,12 +142,14 @@ int UFMulticast_Write(const char *name, const void *buf, size_t size)
         return 0;
     memcpy(&g_group_value[g], buf, size);
     g_group_written[g] = true;
+    wake_group_readers();
     return (int)size;
 }
 
 int UFMulticast_Read(const char *name, void *buf, size_t size)
 {
     int g = find_group(name, size);
+    mark_group_reader();
     if (g < 0 || !buf || !g_group_written[g])
         return 0;
     memcpy(buf, &g_group_value[g], size);
@@ -169,17 +158,26 @@ int UFMulticast_Read(const char *name, void *buf, size_t size)
 
 /* ------------------------------------------------------------------ tasks */
 
-typedef struct {
+typedef struct task_s task;
+struct task_s {
     semo_task_state state;
     bool repeat; /* RunTask; otherwise `calls` firings are owed */
     unsigned calls;
     bool stop_requested;
     bool in_firing; /* a body said semo_firing_continues */
     int64_t next_release;
-} task;
+    /* semo_next_firing, as on POSIX: not needed before `hint_ms` unless
+     * `woken` (a sample in one of its channels, a change of state of a task
+     * it controls, a group written when it reads groups). */
+    bool hinted, woken;
+    int64_t hint_ms;
+    task *controller; /* the task that last ran, called or stopped it */
+    bool reads_groups;
+};
 
 static task g_tasks[SEMO_MAX_TASKS];
 static bool g_continues; /* set by the body being fired */
+static task *g_current;  /* the task being fired */
 
 static task *find_task(const char *name)
 {
@@ -191,10 +189,42 @@ static task *find_task(const char *name)
     return NULL;
 }
 
-/* The loop fires at every tick anyway (and sleeps in between). */
+/* Something task `t` may wait for happened: its hint is void. */
+static void wake_task(task *t)
+{
+    if (t && t != g_current)
+        t->woken = true;
+}
+
+static void wake_reader(int port)
+{
+    unsigned short reader = g_prog->channels[port].state->reader;
+    if (reader < g_prog->task_count)
+        wake_task(&g_tasks[reader]);
+}
+
+static void wake_group_readers(void)
+{
+    for (size_t i = 0; g_prog && i < g_prog->task_count; i++)
+        if (g_tasks[i].reads_groups)
+            wake_task(&g_tasks[i]);
+}
+
+static void mark_group_reader(void)
+{
+    if (g_current)
+        g_current->reads_groups = true;
+}
+
+/* On the static schedule any task may say it: a time-driven one for its
+ * next firing, a continuing firing (semo_firing_continues) for its next
+ * step. The loop sleeps until the earliest. */
 void semo_next_firing(int64_t at_ms)
 {
-    (void)at_ms;
+    if (g_current) {
+        g_current->hinted = true;
+        g_current->hint_ms = at_ms;
+    }
 }
 
 void semo_firing_continues(void)
@@ -211,19 +241,26 @@ static void fire_if_due(size_t i)
         t->state = SEMO_TASK_IDLE;
         t->stop_requested = false;
         t->calls = 0;
+        wake_task(t->controller);
         return;
     }
     if (t->state != SEMO_TASK_RUNNING && !t->in_firing)
         return;
+    int64_t now = semo_now_ms();
+    bool hint_holds = t->hinted && !t->woken;
+    if (t->in_firing && hint_holds && now < t->hint_ms)
+        return;
     if (d->trigger == SEMO_TRIGGER_TIME && !t->in_firing) {
-        int64_t now = semo_now_ms();
-        if (now < t->next_release)
+        if (now < t->next_release || (hint_holds && now < t->hint_ms))
             return;
         t->next_release = now + d->period_ms;
     }
+    t->hinted = t->woken = false;
     g_continues = false;
+    g_current = t;
     if (d->go)
         d->go();
+    g_current = NULL;
     t->in_firing = g_continues && g_running;
     if (t->in_firing)
         return;
@@ -231,8 +268,10 @@ static void fire_if_due(size_t i)
         t->state = SEMO_TASK_IDLE;
         t->stop_requested = false;
         t->calls = 0;
+        wake_task(t->controller);
     } else if (!t->repeat && t->calls > 0 && --t->calls == 0) {
         t->state = SEMO_TASK_IDLE;
+        wake_task(t->controller);
     }
 }
 
@@ -272,6 +311,9 @@ static int control(const char *name, control_op op)
             t->state = SEMO_TASK_RUNNING;
         break;
     }
+    if (g_current && g_current != t)
+        t->controller = g_current;
+    t->woken = true; /* its own hint is void: it was told what to do */
     return 0;
 }
 
@@ -377,45 +419,17 @@ void UFTimer_Cancel(int id)
 
 /* --------------------------------------------------------------- messages */
 
-static semo_message g_inbox[SEMO_INBOX];
-static size_t g_inbox_head, g_inbox_count;
-
-void semo__deliver(const semo_message *msg)
-{
-    if (g_inbox_count == SEMO_INBOX) {
-        semo_trace("drop", "from", msg->from_team, "key", msg->key, "reason", "inbox full", NULL);
-        return;
-    }
-    g_inbox[(g_inbox_head + g_inbox_count) % SEMO_INBOX] = *msg;
-    g_inbox_count++;
-}
-
 /* Only the operator console ("USER", whose record is the trace) is reachable
  * here: the generator refuses missions that message other robots on a
- * static-schedule target (E113), so anything else is an error. */
+ * static-schedule target (E103), so anything else is an error. The inbox
+ * (semo_comm_poll, semo__deliver) is the core's. */
 int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value)
 {
-    if (!g_prog || !to_team || !key || !value || (kind != SEMO_MSG_SEND && kind != SEMO_MSG_PUBLISH))
-        return -1;
-    semo_trace("send", "to", to_team, "key", key, "value", value->text, NULL);
-    if (strcmp(to_team, "USER") == 0)
-        return 1;
+    int local = semo__comm_send_local(to_team, kind, key, value);
+    if (local != 0)
+        return local;
     semo_trace("comm_error", "to", to_team, "key", key, NULL);
     return -1;
-}
-
-/* Never waits (nothing else would run meanwhile): the timeout is ignored. */
-int semo_comm_poll(semo_message *out, int64_t timeout_ms)
-{
-    (void)timeout_ms;
-    if (!out || g_inbox_count == 0)
-        return 0;
-    *out = g_inbox[g_inbox_head];
-    g_inbox_head = (g_inbox_head + 1) % SEMO_INBOX;
-    g_inbox_count--;
-    semo_trace("receive", "from", out->from_team, "from_robot", out->from_robot, "key", out->key, "value",
-               out->value.text, NULL);
-    return 1;
 }
 
 /* ------------------------------------------------------------- simulation */
@@ -473,6 +487,16 @@ static void deliver_operator_commands(void)
     }
 }
 
+/* When the next operator command is due (INT64_MAX: none). */
+static int64_t next_operator_command(void)
+{
+    int64_t next = INT64_MAX;
+    for (size_t i = 0; i < semo__scenario.operator_count; i++)
+        if (semo__scenario.operator_next[i] >= 0 && semo__scenario.operator_next[i] < next)
+            next = semo__scenario.operator_next[i];
+    return next;
+}
+
 static void start_operator(void)
 {
     for (size_t i = 0; i < semo__scenario.operator_count; i++) {
@@ -496,24 +520,45 @@ void Core_1_go(void)
     }
 }
 
-static void trace_dropped_samples(void)
+/* Whether a sample waits in one of task `i`'s input channels. */
+static bool input_waiting(size_t i)
 {
-    for (size_t i = 0; i < g_prog->channel_count; i++) {
-        const semo_channel_desc *d = &g_prog->channels[i];
-        if (d->state && d->state->dropped) {
-            char count[21];
-            semo__format_i64(count, (int64_t)d->state->dropped);
-            /* The channel's name is four parts: written as the POSIX layer's "A.p->B.q". */
-            char name[128];
-            size_t len = 0;
-            const char *parts[] = {d->src_task, ".", d->src_port, "->", d->dst_task, ".", d->dst_port};
-            for (size_t p = 0; p < sizeof parts / sizeof parts[0]; p++)
-                for (const char *c = parts[p]; *c && len + 1 < sizeof name; c++)
-                    name[len++] = *c;
-            name[len] = '\0';
-            semo_trace("dropped", "channel", name, "count", count, NULL);
+    for (size_t c = 0; c < g_prog->channel_count; c++)
+        if (g_prog->channels[c].state->count > 0 && g_prog->channels[c].state->reader == i)
+            return true;
+    return false;
+}
+
+/* The mission time at which the next pass has something to do: the
+ * earliest time a task is due by the rules of fire_if_due. A data-driven
+ * (or running control-driven) task is due only when a sample waits for it,
+ * a call is owed or a message waits in the inbox: its body returns at once
+ * otherwise, and what it waits for is written in a pass, which wakes it. */
+static int64_t next_due(int64_t now)
+{
+    int64_t next = INT64_MAX;
+    for (size_t i = 0; i < g_prog->task_count; i++) {
+        const task *t = &g_tasks[i];
+        bool hint_holds = t->hinted && !t->woken;
+        int64_t due = INT64_MAX;
+        if (t->in_firing) {
+            /* A firing that goes on without naming when: as with a clock tick. */
+            due = hint_holds ? t->hint_ms : t->hinted ? now : now + 1;
+        } else if (t->stop_requested && t->state != SEMO_TASK_IDLE) {
+            due = now;
+        } else if (t->state != SEMO_TASK_RUNNING) {
+            continue;
+        } else if (g_prog->tasks[i].trigger == SEMO_TRIGGER_TIME) {
+            due = t->next_release;
+            if (hint_holds && t->hint_ms > due)
+                due = t->hint_ms;
+        } else if ((!t->repeat && t->calls > 0) || input_waiting(i) || semo__inbox_waiting()) {
+            due = now;
         }
+        if (due < next)
+            next = due;
     }
+    return next;
 }
 
 /* A program the static schedule can run: every table within its bounds. */
@@ -549,12 +594,16 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
     for (size_t i = 0; i < program->channel_count; i++) {
         const semo_channel_desc *c = &program->channels[i];
         memset(c->storage, 0, c->capacity * c->sample_size);
-        *c->state = (semo_channel_state){.count = c->initial_samples};
+        *c->state = (semo_channel_state){.count = c->initial_samples, .reader = SEMO_MAX_TASKS};
+        for (size_t k = 0; k < program->task_count; k++)
+            if (strcmp(c->dst_task, program->tasks[k].name) == 0)
+                c->state->reader = (unsigned short)k;
     }
     for (size_t i = 0; i < program->task_count; i++)
         g_tasks[i] = (task){.state = program->tasks[i].trigger == SEMO_TRIGGER_CONTROL ? SEMO_TASK_IDLE
                                                                                         : SEMO_TASK_RUNNING,
                             .repeat = true};
+    semo__inbox_reset();
     g_start_ms = semo__board_now_ms();
     g_running = true;
     int64_t duration = 0;
@@ -569,18 +618,38 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
             program->tasks[i].init();
     while (g_running) {
         Core_1_go();
-        if (duration > 0 && semo_now_ms() >= duration)
+        g_passes++;
+        int64_t now = semo_now_ms();
+        if (duration > 0 && now >= duration)
             break;
-        semo__board_idle();
-        if (duration > 0 && semo_now_ms() >= duration)
-            break;
+        int64_t wake = next_due(now);
+#ifdef SEMO_SIM
+        int64_t command = next_operator_command();
+        if (command < wake)
+            wake = command;
+#endif
+        if (duration > 0 && duration < wake)
+            wake = duration;
+        if (wake > now)
+            semo__board_sleep_until(wake == INT64_MAX ? INT64_MAX : g_start_ms + wake);
     }
     g_running = false;
     for (size_t i = 0; i < program->task_count; i++)
         if (program->tasks[i].wrapup)
             program->tasks[i].wrapup();
-    trace_dropped_samples();
+    semo__trace_dropped_samples();
     semo_trace("stop", NULL);
+#ifdef SEMO_COUNT_PASSES
+    /* For measuring (not a trace line: built only with -DSEMO_COUNT_PASSES). */
+    char passes[21], ms[21];
+    semo__format_i64(passes, (int64_t)g_passes);
+    semo__format_i64(ms, semo_now_ms());
+    static const char *const parts[] = {"semo passes ", NULL, " ms ", NULL, "\n"};
+    for (size_t p = 0; p < 5; p++) {
+        const char *text = p == 1 ? passes : p == 3 ? ms : parts[p];
+        semo__board_put(NULL, text, strlen(text));
+    }
+#endif
     semo__board_exit(0);
     return 0;
 }

@@ -42,6 +42,15 @@ static int run_values(void)
     CHECK(semo_value_compare(SEMO_LIT("RED"), SEMO_LIT("GREEN")) > 0);
     CHECK(semo_value_compare(SEMO_LIT(""), SEMO_LIT("0")) < 0);
     CHECK(semo_value_compare(SEMO_LIT("nan"), SEMO_LIT("nan")) == 0);
+    /* As the checker typed the comparison (what generated code calls). */
+    CHECK(semo_value_numbers(SEMO_LIT("5"), SEMO_LT, SEMO_LIT("10")));
+    CHECK(semo_value_numbers(SEMO_LIT("2.50"), SEMO_EQ, SEMO_LIT("2.5")));
+    CHECK(semo_value_numbers(SEMO_LIT("-1e3"), SEMO_LE, SEMO_LIT("-999")));
+    CHECK(!semo_value_numbers(SEMO_LIT("5,5"), SEMO_NE, SEMO_LIT("5"))); /* not a number: false */
+    CHECK(!semo_value_numbers(SEMO_LIT("x"), SEMO_GE, SEMO_LIT("1")));
+    CHECK(semo_value_words(SEMO_LIT("10"), SEMO_NE, SEMO_LIT("10.0"))); /* by text */
+    CHECK(semo_value_words(SEMO_LIT("LEFT"), SEMO_EQ, SEMO_LIT("LEFT")));
+    CHECK(!semo_value_words(SEMO_LIT("A"), SEMO_LT, SEMO_LIT("B"))); /* never ordered */
     CHECK(semo_value_truthy(SEMO_LIT("true")));
     CHECK(semo_value_truthy(SEMO_LIT("2")));
     CHECK(semo_value_truthy(SEMO_LIT("-0.5")));
