@@ -975,6 +975,7 @@ impl BuildFiles {
 mod dataflow;
 mod disk;
 mod dropper;
+mod ide;
 #[cfg(test)]
 mod tests;
 

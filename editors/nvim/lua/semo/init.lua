@@ -13,15 +13,16 @@
 -- Failed expectations appear as diagnostics on the scenario file.
 local M = {}
 
--- XML files that the server reads; their filetype stays `xml`.
-M.xml_patterns = { '%.strategy%.xml$', '%.robot%.xml$', '%.taskgraph%.xml$' }
+-- XML files that the server reads, and scenario files it completes; their filetype stays
+-- `xml` or `json`.
+M.file_patterns = { '%.strategy%.xml$', '%.robot%.xml$', '%.taskgraph%.xml$', '%.scenario%.json$' }
 
 -- The project file (filetype `toml`): checked and completed by the server.
 M.project_pattern = '/semo%.toml$'
 
 local config = { cmd = { 'semo', 'lsp' }, treesitter = true }
 
---- Whether the buffer is a mission, one of the server's XML files or a `semo.toml`.
+--- Whether the buffer is a mission, one of the server's XML or scenario files, or a `semo.toml`.
 function M.is_semo_buffer(bufnr)
   if vim.bo[bufnr].filetype == 'semo' then
     return true
@@ -30,7 +31,7 @@ function M.is_semo_buffer(bufnr)
   if name:match(M.project_pattern) then
     return true
   end
-  for _, pattern in ipairs(M.xml_patterns) do
+  for _, pattern in ipairs(M.file_patterns) do
     if name:match(pattern) then
       return true
     end
@@ -209,7 +210,7 @@ function M.setup(opts)
   end, { nargs = '*', complete = 'file', desc = 'Simulate the mission on a scenario (semo.simulate)' })
   vim.api.nvim_create_autocmd('FileType', {
     group = group,
-    pattern = { 'semo', 'xml', 'toml' },
+    pattern = { 'semo', 'xml', 'json', 'toml' },
     callback = function(args)
       if not M.is_semo_buffer(args.buf) then
         return
