@@ -807,7 +807,11 @@ fn codes_of(dir: &std::path::Path, example: &Example) -> Vec<String> {
             .to_vec(),
         Some(command) => {
             let mut args = command.clone();
-            args.extend(["--format", "json", "-o", &out_dir].map(String::from));
+            args.extend(["--format", "json"].map(String::from));
+            // Only commands that write take an output folder.
+            if args[0] == "build" {
+                args.extend(["-o", &out_dir].map(String::from));
+            }
             args
         }
     };
@@ -839,6 +843,12 @@ fn explain_gives_every_code_a_wrong_example_that_has_it_and_a_right_one_that_doe
             if !right.files.iter().any(|(n, _)| n == name) {
                 right.files.push((name.clone(), text.clone()));
             }
+        }
+        // W112 needs more directory entries than an example holds: its
+        // examples are shown, and the code is made by tests/project.rs
+        // (`without_a_project_file_the_search_beside_a_mission_is_bounded`).
+        if code == "W112" {
+            continue;
         }
         let dir = scratch.join(code);
         let found = codes_of(&dir, &wrong);
