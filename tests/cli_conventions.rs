@@ -817,7 +817,8 @@ fn codes_of(dir: &std::path::Path, example: &Example, crowd: usize) -> Vec<Strin
         Some(command) => {
             let mut args = command.clone();
             args.extend(["--format", "json"].map(String::from));
-            if args[0] != "check" {
+            // Only commands that write take an output folder.
+            if args[0] == "build" {
                 args.extend(["-o", &out_dir].map(String::from));
             }
             args

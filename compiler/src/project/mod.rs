@@ -305,6 +305,24 @@ impl Reader<'_> {
             .push(Diagnostic::new(code, self.file, span, message));
     }
 
+    /// W110 on `key`, with a did-you-mean among `known`.
+    fn unknown<'k>(
+        &mut self,
+        key: &toml_edit::Key,
+        message: String,
+        known: impl IntoIterator<Item = &'k str>,
+    ) {
+        let mut d = Diagnostic::new(
+            Code::ProjectUnknownKey,
+            self.file,
+            span_of(key.span()),
+            message,
+        );
+        d.suggest(did_you_mean(key.get(), known));
+        self.diagnostics.push(d);
+    }
+
+    /// W110 for a table or key the format does not have, listing `known`.
     fn unknown_key<'k>(
         &mut self,
         key: &toml_edit::Key,
@@ -312,18 +330,12 @@ impl Reader<'_> {
         known: impl IntoIterator<Item = &'k str> + Clone,
     ) {
         let listed: Vec<&str> = known.clone().into_iter().collect();
-        let mut d = Diagnostic::new(
-            Code::ProjectUnknownKey,
-            self.file,
-            span_of(key.span()),
-            format!(
-                "unknown {what} `{}` (known: {})",
-                key.get(),
-                listed.join(", ")
-            ),
+        let message = format!(
+            "unknown {what} `{}` (known: {})",
+            key.get(),
+            listed.join(", ")
         );
-        d.suggest(did_you_mean(key.get(), known));
-        self.diagnostics.push(d);
+        self.unknown(key, message, known);
     }
 
     fn document(&mut self, table: &toml_edit::Table) {
@@ -486,15 +498,9 @@ impl Reader<'_> {
                 continue;
             };
             let Some(code) = Code::from_code(name) else {
+                // Too many codes to list: the did-you-mean only.
                 let codes = Code::ALL.iter().map(|c| c.as_str());
-                self.unknown_key(key, "diagnostic code", codes);
-                // The list is long: keep only the suggestion in the message.
-                if let Some(d) = self.diagnostics.last_mut() {
-                    d.message = format!("unknown diagnostic code `{name}`");
-                    if let Some(s) = &d.suggestion {
-                        d.message.push_str(&format!(" (did you mean `{s}`?)"));
-                    }
-                }
+                self.unknown(key, format!("unknown diagnostic code `{name}`"), codes);
                 continue;
             };
             let span = item_span(key, item);
