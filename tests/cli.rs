@@ -35,7 +35,7 @@ fn scouting_gives_exactly_the_unmatched_receive_warning() {
         w.message
     );
     // `receive(SlaveTeam, SlaveTeam.COLOR)`: the range is the value received.
-    assert_eq!((w.start, w.end), ((122, 22), (122, 37)));
+    assert_eq!((w.start, w.end), ((126, 22), (126, 37)));
 }
 
 #[test]
@@ -49,7 +49,7 @@ fn human_output_shows_the_source_line_and_a_summary() {
         out.stderr
     );
     assert!(
-        out.stderr.contains("scouting.mission:122:22"),
+        out.stderr.contains("scouting.mission:126:22"),
         "{}",
         out.stderr
     );
@@ -470,7 +470,16 @@ fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
 }
 
 #[test]
-fn formatting_the_examples_changes_nothing_that_semo_check_finds() {
+fn the_examples_are_formatted_and_formatting_changes_nothing_that_semo_check_finds() {
+    let clean = semo_in(&examples(), &["fmt", "--check", "."]);
+    assert_eq!(
+        (clean.code, clean.stdout.as_str()),
+        (0, ""),
+        "{}",
+        clean.stderr
+    );
+    // Each example with its indentation stripped: the same findings, and
+    // `semo fmt` gives back the example exactly.
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     copy_dir(&examples(), &dir.join("examples"));
@@ -484,12 +493,36 @@ fn formatting_the_examples_changes_nothing_that_semo_check_finds() {
     };
     let before = findings();
     assert!(!before.1.is_empty());
+    let missions: Vec<(std::path::PathBuf, String)> = walkdir::WalkDir::new(dir)
+        .into_iter()
+        .filter_map(Result::ok)
+        .filter(|e| e.path().extension().is_some_and(|x| x == "mission"))
+        .map(|e| {
+            let text = std::fs::read_to_string(e.path()).unwrap();
+            (e.into_path(), text)
+        })
+        .collect();
+    assert!(missions.len() >= 5, "{missions:?}");
+    for (path, text) in &missions {
+        let stripped: String = text
+            .lines()
+            .map(|l| format!("{}\n", l.trim_start()))
+            .collect();
+        assert_ne!(&stripped, text, "{}", path.display());
+        std::fs::write(path, stripped).unwrap();
+    }
+    assert_eq!(findings(), before);
     let out = semo_in(dir, &["fmt", "."]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert!(out.stdout.contains("scouting.mission"), "{}", out.stdout);
-    assert_eq!(findings(), before);
-    let check = semo_in(dir, &["fmt", "--check", "."]);
-    assert_eq!((check.code, check.stdout.as_str()), (0, ""));
+    for (path, text) in &missions {
+        assert_eq!(
+            &std::fs::read_to_string(path).unwrap(),
+            text,
+            "{}",
+            path.display()
+        );
+    }
 }
 
 #[test]

@@ -18,6 +18,7 @@ pub mod catalog;
 pub mod codegen;
 pub mod dataflow;
 pub mod diag;
+mod digraph;
 pub mod edit;
 /// A fast deterministic hasher for the checker's maps.
 mod fasthash;

@@ -5,24 +5,21 @@
 
 use super::StrategyFile;
 use crate::diag::FileId;
+use crate::ide::NavigationTarget;
 use crate::sema::Symbol;
 use crate::span::Span;
 use crate::strategy::cross::{ServiceEntryRef, StrategyLinks};
 use crate::strategy::model::Strategy;
 
-/// A place in some file of the workspace (a mission, a catalog file, a
-/// strategy file).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Target {
-    pub file: FileId,
-    pub span: Span,
-}
-
 /// Where the name at `offset` leads: a `Service`'s name or plan to the
 /// mission calls it refines, a `Value`'s name to the mission lines reading
 /// the value, the strategy's team, a `TargetRobot` or a `plan_name` to its
 /// declaration.
-pub fn definition(file: &StrategyFile<'_>, links: &StrategyLinks, offset: usize) -> Vec<Target> {
+pub fn definition(
+    file: &StrategyFile<'_>,
+    links: &StrategyLinks,
+    offset: usize,
+) -> Vec<NavigationTarget> {
     let Some(strategy) = file.strategy else {
         return Vec::new();
     };
@@ -32,7 +29,7 @@ pub fn definition(file: &StrategyFile<'_>, links: &StrategyLinks, offset: usize)
         return file
             .teams()
             .into_iter()
-            .map(|(a, _, team)| Target {
+            .map(|(a, _, team)| NavigationTarget {
                 file: a.mission.file,
                 span: team.name_span,
             })
@@ -74,7 +71,7 @@ pub fn definition(file: &StrategyFile<'_>, links: &StrategyLinks, offset: usize)
             return file
                 .catalog
                 .robot(&name.name)
-                .map(|r| Target {
+                .map(|r| NavigationTarget {
                     file: r.origin.file,
                     span: r.origin.span,
                 })
@@ -86,14 +83,14 @@ pub fn definition(file: &StrategyFile<'_>, links: &StrategyLinks, offset: usize)
 }
 
 /// The mission calls that entry `index` refines.
-fn calls_of(strategy: &Strategy, links: &StrategyLinks, index: usize) -> Vec<Target> {
+fn calls_of(strategy: &Strategy, links: &StrategyLinks, index: usize) -> Vec<NavigationTarget> {
     let entry = ServiceEntryRef {
         file: strategy.file,
         index,
     };
-    let mut out: Vec<Target> = Vec::new();
+    let mut out: Vec<NavigationTarget> = Vec::new();
     for link in links.of_entry(entry) {
-        let target = Target {
+        let target = NavigationTarget {
             file: link.mission,
             span: link.call,
         };
@@ -105,12 +102,12 @@ fn calls_of(strategy: &Strategy, links: &StrategyLinks, index: usize) -> Vec<Tar
     out
 }
 
-fn plans(file: &StrategyFile<'_>, plan: &str) -> Vec<Target> {
+fn plans(file: &StrategyFile<'_>, plan: &str) -> Vec<NavigationTarget> {
     file.teams()
         .into_iter()
         .filter_map(|(a, _, team)| {
             let index = team.plan_by_name(plan)?;
-            Some(Target {
+            Some(NavigationTarget {
                 file: a.mission.file,
                 span: team.plans[index as usize].span,
             })
@@ -119,7 +116,7 @@ fn plans(file: &StrategyFile<'_>, plan: &str) -> Vec<Target> {
 }
 
 /// Where the team's missions read the value `name`.
-fn value_uses(file: &StrategyFile<'_>, name: &str) -> Vec<Target> {
+fn value_uses(file: &StrategyFile<'_>, name: &str) -> Vec<NavigationTarget> {
     let mut out = Vec::new();
     for (analysis, id, _) in file.teams() {
         for o in &analysis.mission.occurrences {
@@ -130,7 +127,7 @@ fn value_uses(file: &StrategyFile<'_>, name: &str) -> Vec<Target> {
                 && *owner == id
                 && used == name
             {
-                out.push(Target {
+                out.push(NavigationTarget {
                     file: analysis.mission.file,
                     span: o.span,
                 });
@@ -148,7 +145,7 @@ pub fn references(
     links: &StrategyLinks,
     offset: usize,
     include_declaration: bool,
-) -> Vec<Target> {
+) -> Vec<NavigationTarget> {
     let Some(strategy) = file.strategy else {
         return Vec::new();
     };
@@ -162,7 +159,7 @@ pub fn references(
     };
     let mut out = Vec::new();
     if include_declaration {
-        out.push(Target {
+        out.push(NavigationTarget {
             file: strategy.file,
             span: name.span,
         });

@@ -227,7 +227,7 @@ impl<'a> Node<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ide::testing::Fixture;
+    use crate::ide::mission::testing::Fixture;
 
     const MISSION: &str = r#"{
   Guards: Turtlebot3_Burger tb[3], Ev3_Robot ev

@@ -302,7 +302,7 @@ fn word_at(text: &str, offset: usize) -> Option<&str> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ide::testing::Fixture;
+    use crate::ide::mission::testing::Fixture;
 
     const MISSION: &str = r#"{
   Base: iRobotCreate base

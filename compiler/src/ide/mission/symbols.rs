@@ -272,7 +272,7 @@ pub fn match_score(query: &str, name: &str) -> Option<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ide::testing::Fixture;
+    use crate::ide::mission::testing::Fixture;
 
     const MISSION: &str = r#"# Guarding
 {

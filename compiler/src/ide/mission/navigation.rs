@@ -20,18 +20,11 @@
 
 use crate::Analysis;
 use crate::catalog::{BUILTIN_FILE, Catalog, Origin, RobotTypeId};
-use crate::diag::FileId;
+use crate::ide::NavigationTarget;
 use crate::sema::lookup;
 use crate::sema::{Symbol, TeamId};
 use crate::span::Span;
 use crate::syntax::ast::{Item, StmtKind};
-
-/// Where a definition is: a range of the mission itself or of a catalog file.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub struct Target {
-    pub file: FileId,
-    pub span: Span,
-}
 
 /// The name at an offset and the symbols it means (usually one).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -68,18 +61,18 @@ pub fn name_at(analysis: &Analysis, offset: usize) -> Option<NameAt> {
 
 /// The definitions of the name at `offset`, sorted; empty when there is no
 /// name there or its definition has no place (see the module docs).
-pub fn definition(analysis: &Analysis, catalog: &Catalog, offset: usize) -> Vec<Target> {
+pub fn definition(analysis: &Analysis, catalog: &Catalog, offset: usize) -> Vec<NavigationTarget> {
     let Some(name) = name_at(analysis, offset) else {
         return Vec::new();
     };
-    let mut targets: Vec<Target> = Vec::new();
+    let mut targets: Vec<NavigationTarget> = Vec::new();
     for symbol in &name.symbols {
         if let Some(origins) = catalog_origins(analysis, catalog, symbol, offset) {
             targets.extend(
                 origins
                     .into_iter()
                     .filter(|o| o.file != BUILTIN_FILE)
-                    .map(|o| Target {
+                    .map(|o| NavigationTarget {
                         file: o.file,
                         span: o.span,
                     }),
@@ -89,7 +82,7 @@ pub fn definition(analysis: &Analysis, catalog: &Catalog, offset: usize) -> Vec<
             targets.extend(
                 definition_spans(analysis, symbol)
                     .into_iter()
-                    .map(|span| Target { file, span }),
+                    .map(|span| NavigationTarget { file, span }),
             );
         }
     }
@@ -255,7 +248,7 @@ fn running_types(analysis: &Analysis, team: Option<TeamId>) -> Vec<RobotTypeId> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ide::testing::{Fixture, spans_text};
+    use crate::ide::mission::testing::{Fixture, spans_text};
 
     const MISSION: &str = r#"{
   Base: iRobotCreate base

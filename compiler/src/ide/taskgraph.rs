@@ -4,6 +4,7 @@
 //! `task.port` names inside a channel's `src`/`dst`. Plain data with byte
 //! ranges; the language server turns it into protocol types.
 
+use crate::ide::{CompletionItem, CompletionKind, HoverResult};
 use crate::span::Span;
 use crate::taskgraph::analysis::{GraphReport, LevelReport};
 use crate::taskgraph::model::{
@@ -22,24 +23,17 @@ fn repetition(report: &GraphReport, path: &str, task: &str) -> Option<u64> {
     level.repetition.as_ref()?.get(i).copied()
 }
 
-/// A hover: the range it is about and its markdown.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Hover {
-    pub span: Span,
-    pub markdown: String,
-}
-
 /// What is under `offset`: a channel endpoint, a port, or a task (by its name
 /// or anywhere in its element outside ports and inner graphs).
-pub fn hover(graph: &TaskGraph, report: &GraphReport, offset: usize) -> Option<Hover> {
+pub fn hover(graph: &TaskGraph, report: &GraphReport, offset: usize) -> Option<HoverResult> {
     let levels = graph.levels();
     // Innermost level first: a body's elements lie inside its loop's element.
     for level in levels.iter().rev() {
         for channel in &level.graph.channels {
             for end in [&channel.src, &channel.dst] {
                 if end.span.touches(offset) {
-                    return Some(Hover {
-                        span: end.span,
+                    return Some(HoverResult {
+                        range: end.span,
                         markdown: channel_doc(level, report, channel),
                     });
                 }
@@ -63,8 +57,8 @@ pub fn hover(graph: &TaskGraph, report: &GraphReport, offset: usize) -> Option<H
                 if let Some(size) = port.size {
                     let _ = write!(md, ", {size} bytes each");
                 }
-                return Some(Hover {
-                    span: port.name.span,
+                return Some(HoverResult {
+                    range: port.name.span,
                     markdown: md,
                 });
             }
@@ -73,8 +67,8 @@ pub fn hover(graph: &TaskGraph, report: &GraphReport, offset: usize) -> Option<H
                 .as_ref()
                 .is_some_and(|l| l.body.span.contains(offset));
             if task.span.contains(offset) && !in_body {
-                return Some(Hover {
-                    span: task.name.span,
+                return Some(HoverResult {
+                    range: task.name.span,
                     markdown: task_doc(level, report, task),
                 });
             }
@@ -245,24 +239,15 @@ pub fn inlay_hints(graph: &TaskGraph, report: &GraphReport) -> Vec<InlayHint> {
     hints
 }
 
-/// A `task.port` to complete in a channel end.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct EndpointCompletion {
-    pub label: String,
-    pub detail: String,
-}
-
-/// Inside the value of a `<Channel>`'s `src` or `dst`: the range to replace
-/// (the whole value) and the ports that can go there: outputs of the level's
+/// Inside the value of a `<Channel>`'s `src` or `dst`: the ports that can go
+/// there, each replacing the whole value: outputs of the level's
 /// tasks for `src` (and, in a loop body, the loop's inputs), inputs for `dst`.
-pub fn complete_endpoint(
-    text: &str,
-    graph: &TaskGraph,
-    offset: usize,
-) -> Option<(Span, Vec<EndpointCompletion>)> {
-    let (element, attribute, value) = attribute_value_at(text, offset)?;
+pub fn complete_endpoint(text: &str, graph: &TaskGraph, offset: usize) -> Vec<CompletionItem> {
+    let Some((element, attribute, value)) = attribute_value_at(text, offset) else {
+        return Vec::new();
+    };
     if element != "Channel" || !matches!(attribute, "src" | "dst") {
-        return None;
+        return Vec::new();
     }
     let wanted = if attribute == "src" {
         Direction::Out
@@ -275,19 +260,22 @@ pub fn complete_endpoint(
         .iter()
         .rev()
         .find(|l| l.graph.span.contains(offset))
-        .or(all.first())?;
+        .or(all.first());
+    let Some(level) = level else {
+        return Vec::new();
+    };
     let mut items = Vec::new();
     for task in &level.graph.tasks {
         for port in task.ports.iter().filter(|p| p.dir == wanted) {
-            items.push(EndpointCompletion {
-                label: format!("{}.{}", task.name.name, port.name.name),
-                detail: format!(
+            let label = format!("{}.{}", task.name.name, port.name.name);
+            items.push(
+                CompletionItem::new(label, CompletionKind::Port, value).detail(format!(
                     "{} port of {}, rate {}",
                     direction(port.dir),
                     task.name.name,
                     port.rate
-                ),
-            });
+                )),
+            );
         }
     }
     if let Some(l) = level.enclosing {
@@ -298,17 +286,17 @@ pub fn complete_endpoint(
             Direction::Out
         };
         for port in l.ports.iter().filter(|p| p.dir == inside) {
-            items.push(EndpointCompletion {
-                label: format!("{}.{}", l.name.name, port.name.name),
-                detail: format!(
+            let label = format!("{}.{}", l.name.name, port.name.name);
+            items.push(
+                CompletionItem::new(label, CompletionKind::Port, value).detail(format!(
                     "{} port of the enclosing loop, inner rate {}",
                     direction(port.dir),
                     port.inner_rate.unwrap_or(1)
-                ),
-            });
+                )),
+            );
         }
     }
-    Some((value, items))
+    items
 }
 
 /// The element name, attribute name and value range of the attribute value
@@ -374,7 +362,7 @@ mod tests {
     fn hover_on_a_task_shows_its_repetition_count_and_rates() {
         let (graph, report) = load(DATA_LOOP);
         let h = hover(&graph, &report, at(DATA_LOOP, "name=\"B\"") + 7).expect("hover on B");
-        assert_eq!(&DATA_LOOP[h.span.range()], "B");
+        assert_eq!(&DATA_LOOP[h.range.range()], "B");
         assert!(
             h.markdown
                 .contains("fires **1×** per iteration of `data_loop/L`"),
@@ -404,7 +392,7 @@ mod tests {
     fn hover_on_channels_and_ports() {
         let (graph, report) = load(DATA_LOOP);
         let c = hover(&graph, &report, at(DATA_LOOP, "src=\"A.o\"") + 6).unwrap();
-        assert_eq!(&DATA_LOOP[c.span.range()], "A.o");
+        assert_eq!(&DATA_LOOP[c.range.range()], "A.o");
         assert!(c.markdown.contains("`A.o → L.in`"), "{}", c.markdown);
         assert!(
             c.markdown.contains("produces 10, consumes 10"),
@@ -459,7 +447,9 @@ mod tests {
         let (graph, _) = load(DATA_LOOP);
         let labels = |needle: &str, skip: usize| {
             let offset = at(DATA_LOOP, needle) + skip;
-            let (span, items) = complete_endpoint(DATA_LOOP, &graph, offset).expect("in a value");
+            let items = complete_endpoint(DATA_LOOP, &graph, offset);
+            let span = items.first().expect("in a value").replace;
+            assert!(items.iter().all(|i| i.replace == span));
             let labels: Vec<String> = items.into_iter().map(|i| i.label).collect();
             (DATA_LOOP[span.range()].to_string(), labels)
         };
@@ -481,7 +471,7 @@ mod tests {
         );
         assert_eq!(
             complete_endpoint(DATA_LOOP, &graph, at(DATA_LOOP, "loopCount") + 2),
-            None
+            Vec::new()
         );
     }
 

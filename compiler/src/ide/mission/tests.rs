@@ -4,13 +4,14 @@
 //! mission. The protocol tests of `semo-server` cover each feature end to end.
 
 use super::code_actions::code_actions;
-use super::completion::{CompletionConfig, CompletionItem, CompletionKind, completions};
+use super::completion::completions;
 use super::context::{self, Place};
 use super::hover::hover;
 use super::inlay_hints::inlay_hints;
 use super::signature_help::signature_help;
 use crate::catalog::{Catalog, CatalogSource, builtin_catalog, load_catalog};
 use crate::diag::FileId;
+use crate::ide::{CompletionConfig, CompletionItem, CompletionKind};
 use crate::sema::{Analysis, ScopeKind};
 use crate::span::Span;
 use crate::syntax::ast::ArmKind;

@@ -140,7 +140,7 @@ fn classify(symbol: &Symbol) -> (TokenKind, u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ide::testing::Fixture;
+    use crate::ide::mission::testing::Fixture;
 
     const MISSION: &str = r#"{ T: Turtlebot3_Burger tb[2] }
 def f { throw e }

@@ -5,18 +5,12 @@
 use super::StrategyFile;
 use super::raw::{RawAttr, RawTag, position_at};
 use crate::catalog::{Implementation, RobotType};
-use crate::span::Span;
+use crate::ide::HoverResult;
 use crate::strategy::schema::{attribute_doc, children, element_info};
 use crate::strategy::{CONTROL_TASK, team_calls};
 use std::fmt::Write;
 
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Hover {
-    pub span: Span,
-    pub markdown: String,
-}
-
-pub fn hover(file: &StrategyFile<'_>, offset: usize) -> Option<Hover> {
+pub fn hover(file: &StrategyFile<'_>, offset: usize) -> Option<HoverResult> {
     let text = file.text;
     let offset = offset.min(text.len());
     if !text.is_char_boundary(offset) {
@@ -24,8 +18,8 @@ pub fn hover(file: &StrategyFile<'_>, offset: usize) -> Option<Hover> {
     }
     let tag = position_at(text, offset).tag?;
     if tag.name_span.touches(offset) && !tag.name.is_empty() {
-        return Some(Hover {
-            span: tag.name_span,
+        return Some(HoverResult {
+            range: tag.name_span,
             markdown: element_doc(tag.name)?,
         });
     }
@@ -37,11 +31,14 @@ pub fn hover(file: &StrategyFile<'_>, offset: usize) -> Option<Hover> {
     if let Some(span) = in_value
         && let Some(markdown) = refers_to(file, &tag, attr, offset)
     {
-        return Some(Hover { span, markdown });
+        return Some(HoverResult {
+            range: span,
+            markdown,
+        });
     }
     let doc = attribute_doc(tag.name, attr.name)?;
-    Some(Hover {
-        span: in_value.unwrap_or(attr.name_span),
+    Some(HoverResult {
+        range: in_value.unwrap_or(attr.name_span),
         markdown: format!("**`{}`** of `<{}>`\n\n{doc}", attr.name, tag.name),
     })
 }

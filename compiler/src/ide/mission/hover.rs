@@ -8,16 +8,9 @@
 use super::docs::{self, list};
 use super::robots::{self, RobotsHere};
 use crate::catalog::{Catalog, RobotTypeId};
+use crate::ide::HoverResult;
 use crate::sema::{Analysis, Mission, Symbol, TeamId};
-use crate::span::Span;
 use std::fmt::Write;
-
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct HoverResult {
-    /// The hovered name.
-    pub range: Span,
-    pub markdown: String,
-}
 
 /// The hover at `offset`, if a known name is there.
 pub fn hover(

@@ -19,9 +19,9 @@ pub mod navigation;
 pub mod raw;
 pub mod symbols;
 
-use super::model::{ServiceEntry, Strategy, TargetRobot, ValueEntry};
 use crate::catalog::{Catalog, RobotType, RobotTypeId};
 use crate::sema::{Analysis, Team, TeamId};
+use crate::strategy::model::{ServiceEntry, Strategy, TargetRobot, ValueEntry};
 
 /// What the editor features of one strategy file read: its text, its model
 /// (`None` when it has no `<Strategy>` yet), the workspace's missions and the

@@ -1,74 +1,18 @@
-//! Completion in strategy files, from the raw text around the cursor: element
+//! CompletionItem in strategy files, from the raw text around the cursor: element
 //! names allowed in the parent element, the attributes the tag does not have
 //! yet, and attribute values taken from the missions (teams, robot types,
 //! plans, the built-in services a team calls) and the catalog (values, tasks).
 
 use super::raw::{Position, RawAttr, RawTag, position_at};
 use super::{StrategyFile, distinct};
+use crate::ide::{CompletionItem, CompletionKind};
 use crate::span::Span;
 use crate::strategy::model::{DataCharacteristic, LeaderAlgorithm};
 use crate::strategy::schema::{attribute_doc, children, element_info};
 use crate::strategy::{CONTROL_TASK, team_calls};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CompletionKind {
-    Element,
-    Attribute,
-    /// A fixed word (`Yes`, `channel`, `lowest_id`).
-    Keyword,
-    Team,
-    Robot,
-    RobotType,
-    Plan,
-    Service,
-    Value,
-    Task,
-    Action,
-}
-
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Completion {
-    pub label: String,
-    pub kind: CompletionKind,
-    pub detail: Option<String>,
-    pub documentation: Option<String>,
-    /// Replaces `replace`.
-    pub insert: String,
-    pub replace: Span,
-    /// `insert` is a snippet (`$1` for the cursor).
-    pub snippet: bool,
-}
-
-impl Completion {
-    fn new(label: impl Into<String>, kind: CompletionKind, replace: Span) -> Completion {
-        let label = label.into();
-        Completion {
-            insert: label.clone(),
-            label,
-            kind,
-            detail: None,
-            documentation: None,
-            replace,
-            snippet: false,
-        }
-    }
-
-    fn detail(mut self, detail: impl Into<String>) -> Completion {
-        self.detail = Some(detail.into());
-        self
-    }
-
-    fn doc(mut self, doc: impl Into<String>) -> Completion {
-        let doc = doc.into();
-        if !doc.is_empty() {
-            self.documentation = Some(doc);
-        }
-        self
-    }
-}
-
 /// The completions at `offset`, most specific first.
-pub fn completions(file: &StrategyFile<'_>, offset: usize, snippets: bool) -> Vec<Completion> {
+pub fn completions(file: &StrategyFile<'_>, offset: usize, snippets: bool) -> Vec<CompletionItem> {
     let text = file.text;
     let offset = offset.min(text.len());
     if !text.is_char_boundary(offset) {
@@ -117,11 +61,11 @@ fn elements(
     replace: Span,
     prefix: &str,
     required: bool,
-) -> Vec<Completion> {
+) -> Vec<CompletionItem> {
     children(position.parent(), position.grandparent())
         .iter()
         .map(|name| {
-            let mut item = Completion::new(*name, CompletionKind::Element, replace);
+            let mut item = CompletionItem::new(*name, CompletionKind::Element, replace);
             item.insert = format!("{prefix}{name}");
             let info = element_info(name);
             if let Some(info) = info {
@@ -131,7 +75,7 @@ fn elements(
                     }
                     item.snippet = true;
                 }
-                item = item.doc(info.doc);
+                item = item.documentation(info.doc);
                 if !info.required.is_empty() {
                     item = item.detail(format!("needs {}", info.required.join(", ")));
                 }
@@ -142,14 +86,14 @@ fn elements(
 }
 
 /// `</` closes the innermost open element.
-fn close_tag(position: &Position<'_>, tag: &RawTag<'_>, offset: usize) -> Vec<Completion> {
+fn close_tag(position: &Position<'_>, tag: &RawTag<'_>, offset: usize) -> Vec<CompletionItem> {
     let Some(parent) = position.parent() else {
         return Vec::new();
     };
     if offset < tag.name_span.start {
         return Vec::new();
     }
-    let mut item = Completion::new(parent, CompletionKind::Element, tag.name_span);
+    let mut item = CompletionItem::new(parent, CompletionKind::Element, tag.name_span);
     if !tag.terminated {
         item.insert.push('>');
     }
@@ -161,7 +105,7 @@ fn attributes(
     editing: Option<&RawAttr<'_>>,
     offset: usize,
     snippets: bool,
-) -> Vec<Completion> {
+) -> Vec<CompletionItem> {
     let Some(info) = element_info(tag.name) else {
         return Vec::new();
     };
@@ -175,7 +119,7 @@ fn attributes(
                 .any(|a| a.name == **name && Some(a) != editing)
         })
         .map(|name| {
-            let mut item = Completion::new(*name, CompletionKind::Attribute, replace);
+            let mut item = CompletionItem::new(*name, CompletionKind::Attribute, replace);
             if !has_value {
                 item.insert = if snippets {
                     format!("{name}=\"$1\"")
@@ -187,7 +131,7 @@ fn attributes(
             if info.required.contains(name) {
                 item = item.detail("required");
             }
-            item.doc(attribute_doc(tag.name, name).unwrap_or_default())
+            item.documentation(attribute_doc(tag.name, name).unwrap_or_default())
         })
         .collect()
 }
@@ -198,7 +142,7 @@ fn values(
     tag: &RawTag<'_>,
     attr: &RawAttr<'_>,
     offset: usize,
-) -> Vec<Completion> {
+) -> Vec<CompletionItem> {
     let text = file.text;
     let Some(span) = attr.value_span else {
         return Vec::new();
@@ -212,11 +156,11 @@ fn values(
             .map_or(span.end, |i| offset + i)
     };
     let replace = Span::new(span.start, end);
-    let item = |label: &str, kind| Completion::new(label, kind, replace);
+    let item = |label: &str, kind| CompletionItem::new(label, kind, replace);
     use CompletionKind as K;
     match (tag.name, attr.name) {
         ("Strategy", "name") => {
-            let mut out: Vec<Completion> = Vec::new();
+            let mut out: Vec<CompletionItem> = Vec::new();
             for analysis in file.missions {
                 for team in &analysis.mission.teams {
                     if out.iter().any(|c| c.label == team.name.as_str()) {
@@ -238,7 +182,7 @@ fn values(
             .map(|robot| {
                 item(&robot.name, K::RobotType)
                     .detail("robot type")
-                    .doc(robot.doc.clone())
+                    .documentation(robot.doc.clone())
             })
             .collect(),
         ("TargetRobot", "nickName") => {
@@ -284,7 +228,7 @@ fn values(
                         continue;
                     }
                     out.push(
-                        item(&service.name, K::Service)
+                        item(&service.name, K::BuiltinService)
                             .detail(team.service_path(index as crate::sema::Index)),
                     );
                 }
@@ -304,7 +248,7 @@ fn values(
                                 unit.unwrap_or_default(),
                                 robot.name
                             ))
-                            .doc(value.doc.clone()),
+                            .documentation(value.doc.clone()),
                     );
                 }
             }
@@ -347,15 +291,15 @@ fn values(
                 .collect()
         }
         ("Action", "initial" | "final") => {
-            ["Yes", "No"].iter().map(|w| item(w, K::Keyword)).collect()
+            ["Yes", "No"].iter().map(|w| item(w, K::Choice)).collect()
         }
         ("Parameter", "dataCharacteristic") => DataCharacteristic::ALL
             .iter()
-            .map(|(w, _)| item(w, K::Keyword))
+            .map(|(w, _)| item(w, K::Choice))
             .collect(),
         ("LeaderSelectionInfo", "algorithm") => LeaderAlgorithm::ALL
             .iter()
-            .map(|(w, _)| item(w, K::Keyword))
+            .map(|(w, _)| item(w, K::Choice))
             .collect(),
         _ => Vec::new(),
     }
@@ -363,7 +307,7 @@ fn values(
 
 /// The built-in services the team calls in the tag's plan (all plans when
 /// none is written), else those the target robot types provide.
-fn services(file: &StrategyFile<'_>, tag: &RawTag<'_>, replace: Span) -> Vec<Completion> {
+fn services(file: &StrategyFile<'_>, tag: &RawTag<'_>, replace: Span) -> Vec<CompletionItem> {
     let plan = tag.value("plan_name");
     let signature = |name: &str| {
         file.catalog
@@ -371,7 +315,7 @@ fn services(file: &StrategyFile<'_>, tag: &RawTag<'_>, replace: Span) -> Vec<Com
             .find_map(|(_, r)| r.service(name))
             .map(|s| (s.signature(), s.doc.clone()))
     };
-    let mut out: Vec<Completion> = Vec::new();
+    let mut out: Vec<CompletionItem> = Vec::new();
     for (analysis, id, team) in file.teams() {
         for call in team_calls(analysis, id) {
             let plan_name = &team.plans[call.plan as usize].name;
@@ -387,8 +331,9 @@ fn services(file: &StrategyFile<'_>, tag: &RawTag<'_>, replace: Span) -> Vec<Com
                 continue;
             }
             let (detail, doc) = signature(&call.name).unwrap_or_default();
-            let mut item = Completion::new(call.name.as_str(), CompletionKind::Service, replace)
-                .detail(detail);
+            let mut item =
+                CompletionItem::new(call.name.as_str(), CompletionKind::BuiltinService, replace)
+                    .detail(detail);
             item.documentation = Some(format!("{doc}\n\ncalled by `{caller}`"));
             out.push(item);
         }
@@ -400,9 +345,13 @@ fn services(file: &StrategyFile<'_>, tag: &RawTag<'_>, replace: Span) -> Vec<Com
     for robot in file.types_for(&[]) {
         for service in &robot.services {
             out.push(
-                Completion::new(service.name.as_str(), CompletionKind::Service, replace)
-                    .detail(service.signature())
-                    .doc(service.doc.clone()),
+                CompletionItem::new(
+                    service.name.as_str(),
+                    CompletionKind::BuiltinService,
+                    replace,
+                )
+                .detail(service.signature())
+                .documentation(service.doc.clone()),
             );
         }
     }
@@ -416,7 +365,7 @@ fn task_use_names(
     element: &str,
     offset: usize,
     replace: Span,
-) -> Vec<Completion> {
+) -> Vec<CompletionItem> {
     let mut out = Vec::new();
     if let Some(strategy) = file.strategy {
         let uses = strategy
@@ -441,7 +390,7 @@ fn task_use_names(
         let named = uses.chain(levels.into_iter().filter_map(|l| l.name.as_ref()));
         for name in named.filter(|n| !n.span.touches(offset)) {
             out.push(
-                Completion::new(name.name.as_str(), CompletionKind::Task, replace)
+                CompletionItem::new(name.name.as_str(), CompletionKind::Task, replace)
                     .detail("used in this file"),
             );
         }
@@ -449,7 +398,7 @@ fn task_use_names(
     for robot in file.types_at(offset) {
         for capability in &robot.capabilities {
             out.push(
-                Completion::new(capability.as_str(), CompletionKind::Task, replace)
+                CompletionItem::new(capability.as_str(), CompletionKind::Task, replace)
                     .detail(format!("capability of {}", robot.name)),
             );
         }
@@ -458,8 +407,8 @@ fn task_use_names(
 }
 
 /// The first item of each label.
-fn dedup_labels(items: Vec<Completion>) -> Vec<Completion> {
-    let mut out: Vec<Completion> = Vec::new();
+fn dedup_labels(items: Vec<CompletionItem>) -> Vec<CompletionItem> {
+    let mut out: Vec<CompletionItem> = Vec::new();
     for item in items {
         if !out.iter().any(|c| c.label == item.label) {
             out.push(item);

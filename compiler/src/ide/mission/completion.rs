@@ -13,62 +13,11 @@ use super::docs;
 use super::robots::{self, RobotsHere};
 use super::snippets::{self, Snippet};
 use crate::catalog::{Catalog, ValueDef, ValueType};
+use crate::ide::{CompletionConfig, CompletionItem, CompletionKind};
 use crate::sema::{Analysis, Index, Mission, ScopeKind, Team, TeamId, is_user};
 use crate::span::Span;
 use crate::syntax::ast::{self, Name};
 use crate::syntax::token::Token;
-
-/// What a completion item is, for the editor's icon.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum CompletionKind {
-    /// A built-in service of the catalog (`move`).
-    BuiltinService,
-    /// A function defined with `def`.
-    Function,
-    /// A robot value (`LOCATION`).
-    Value,
-    /// A team variable (`Alarm` of `publish(T, T.Alarm = DARK)`).
-    TeamVariable,
-    Team,
-    /// The operator's console.
-    User,
-    RobotType,
-    Capability,
-    Plan,
-    /// A composite service of a team.
-    Service,
-    Mode,
-    Event,
-    /// A symbolic constant (`DARK`, a value of an enumeration, `OFF`).
-    Constant,
-    /// A time unit (`SEC`).
-    Unit,
-    Keyword,
-    /// A construct's skeleton.
-    Snippet,
-}
-
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct CompletionItem {
-    pub label: String,
-    pub kind: CompletionKind,
-    /// One line: a signature, a type.
-    pub detail: Option<String>,
-    /// Markdown.
-    pub documentation: Option<String>,
-    /// What replaces [`CompletionItem::replace`]: snippet syntax when
-    /// `snippet`, plain text otherwise.
-    pub insert: String,
-    pub snippet: bool,
-    /// The identifier prefix being typed (empty at a fresh place).
-    pub replace: Span,
-}
-
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct CompletionConfig {
-    /// Whether the editor understands snippets (`${1:goal}`).
-    pub snippets: bool,
-}
 
 /// The completions at `offset` in `text`, most specific first.
 pub fn completions(

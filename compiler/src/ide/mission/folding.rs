@@ -176,7 +176,7 @@ impl Folds<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ide::testing::Fixture;
+    use crate::ide::mission::testing::Fixture;
 
     const MISSION: &str = r#"##########
 # Guards
