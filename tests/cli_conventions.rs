@@ -625,6 +625,52 @@ fn every_file_argument_accepts_dash_for_standard_input() {
         assert!(out.stderr.contains("mission's folder"), "{}", out.stderr);
     }
     assert!(!dir.join("out").exists());
+    // Nor can a strategy file, seen by its path, be standard input.
+    let out = semo(&[
+        "build",
+        "examples/follow/follow.mission",
+        "--strategy",
+        "-",
+        "-o",
+        &out_dir,
+    ]);
+    assert_eq!(out.code, 2);
+    assert_eq!(out.stderr.lines().count(), 1, "{}", out.stderr);
+    assert!(!dir.join("out").exists());
+    // A picture's `-o -` is standard output.
+    let out = semo(&[
+        "graph",
+        "modes",
+        "examples/follow/follow.mission",
+        "-o",
+        "-",
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(out.stdout.starts_with("<svg"), "{}", out.stdout);
+    assert!(!repo_root().join("-").exists());
+    // build's compiled-in scenario from standard input: a mistake in it is
+    // positioned at `<stdin>`, and nothing is written.
+    let out = semo_with_stdin(
+        &root,
+        &[
+            "build",
+            "examples/follow/follow.mission",
+            "--target",
+            "cortex-m-sim",
+            "--scenario",
+            "-",
+            "-o",
+            &out_dir,
+        ],
+        "{\"duration\": 100,}",
+    );
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("scenario <stdin>:1:18:"),
+        "{}",
+        out.stderr
+    );
+    assert!(!dir.join("out").exists());
 }
 
 /// `semo ARGS` refuses a file of the wrong kind: exit 2, one line on

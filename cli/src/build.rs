@@ -35,14 +35,23 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         );
         return 2;
     }
-    if !input::file_is_kind(&options.mission, Content::Mission, BUILD)
-        || options
-            .scenario
-            .as_deref()
-            .is_some_and(|s| !input::file_is_kind(s, Content::Scenario, BUILD))
-    {
+    if !input::strategy_paths_are_files(&options.strategy) {
         return 2;
     }
+    if !input::file_is_kind(&options.mission, Content::Mission, BUILD) {
+        return 2;
+    }
+    // Read before anything else, so that a wrong file stops the build
+    // before the output folder is touched (`-`: standard input).
+    let scenario = match &options.scenario {
+        None => None,
+        Some(path) => match input::read(path) {
+            Some((name, text)) if input::is_kind(&name, &text, Content::Scenario, BUILD) => {
+                Some((name, text))
+            }
+            _ => return 2,
+        },
+    };
     let (mut run, mission) = match host::load_build(&options.mission, &options.strategy) {
         Ok(loaded) => loaded,
         Err(e) => {
@@ -94,15 +103,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         return 2;
     };
     let input = input.input();
-    let result = match &options.scenario {
+    let result = match &scenario {
         None => codegen::build(&input, target, options.emit),
-        Some(path) => match build_with_scenario(&input, path, target, &options) {
+        Some((name, text)) => match build_with_scenario(&input, name, text, target, &options) {
             Ok(result) => result,
-            Err(ScenarioError::Unreadable(message)) => {
-                eprintln!("{message}");
-                return 2;
-            }
-            Err(ScenarioError::Bad(record)) => {
+            Err(record) => {
                 report_scenario(&record, options.format, out);
                 return 2;
             }
@@ -233,13 +238,6 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     0
 }
 
-enum ScenarioError {
-    /// The file cannot be read (the message says why).
-    Unreadable(String),
-    /// The scenario has an error, at a position.
-    Bad(Box<Record>),
-}
-
 /// A scenario's error for people (`scenario FILE:LINE:COL: message`, on
 /// standard error) or in a JSON document or SARIF log.
 fn report_scenario(record: &Record, format: Format, out: &mut impl Write) {
@@ -260,16 +258,16 @@ fn report_scenario(record: &Record, format: Format, out: &mut impl Write) {
     let _ = output::written(written);
 }
 
-/// Builds for a target that compiles the scenario in: the mission is refined
-/// first, since the scenario's names are checked against its programs.
+/// Builds for a target that compiles the scenario (`text`, read from
+/// `path`) in: the mission is refined first, since the scenario's names are
+/// checked against its programs. A scenario's mistake is given positioned.
 fn build_with_scenario(
     input: &codegen::BuildInput<'_>,
     path: &Path,
+    text: &str,
     target: Target,
     options: &Options,
-) -> Result<codegen::BuildResult, ScenarioError> {
-    let text = semo::workspace::read_text(path)
-        .map_err(|e| ScenarioError::Unreadable(format!("error: {}: {e}", path.display())))?;
+) -> Result<codegen::BuildResult, Box<Record>> {
     let refined = codegen::refine_checked(input);
     if refined.programs.is_empty() {
         // Refused: the mission's own errors come first.
@@ -281,9 +279,9 @@ fn build_with_scenario(
             &[],
         ));
     }
-    let scenario = semo::sim::scenario::parse(&text, &refined.programs).map_err(|e| {
-        let (line, col) = e.line_col(&text);
-        ScenarioError::Bad(Box::new(Record::uncoded_error(path, line, col, e.message)))
+    let scenario = semo::sim::scenario::parse(text, &refined.programs).map_err(|e| {
+        let (line, col) = e.line_col(text);
+        Box::new(Record::uncoded_error(path, line, col, e.message))
     })?;
     let worlds: Vec<_> = refined
         .programs

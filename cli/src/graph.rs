@@ -157,8 +157,9 @@ pub fn modes(path: &Path, team: Option<&str>, output: Option<&Path>, out: &mut i
     }
 }
 
+/// Writes a picture to `output`, or standard output (no `-o`, or `-o -`).
 fn write_picture(picture: &str, output: Option<&Path>, out: &mut impl Write) -> i32 {
-    match output {
+    match output.filter(|file| !input::is_stdin(file)) {
         Some(file) => match std::fs::write(file, picture) {
             Ok(()) => 0,
             Err(e) => {

@@ -14,6 +14,18 @@ pub fn is_stdin(path: &Path) -> bool {
     path.as_os_str() == "-"
 }
 
+/// `--strategy` paths are seen by path (by the files under the same
+/// roots), so standard input cannot be one: says so in one line.
+pub fn strategy_paths_are_files(paths: &[PathBuf]) -> bool {
+    if paths.iter().any(|p| is_stdin(p)) {
+        eprintln!(
+            "error: --strategy takes files and folders (strategy and catalog files are seen by their paths), not `-`"
+        );
+        return false;
+    }
+    true
+}
+
 /// All of standard input as text (at most the limit any input file has).
 pub fn read_stdin() -> Result<String, String> {
     let limit = semo::fsread::MAX_FILE_BYTES;

@@ -111,7 +111,8 @@ enum Command {
         /// The mission script (a file: its folder holds the catalog and
         /// strategy files it reads, so not `-`).
         mission: PathBuf,
-        /// More strategy (and catalog) files or folders to read.
+        /// More strategy (and catalog) files or folders to read (not `-`:
+        /// they are seen by their paths).
         #[arg(long)]
         strategy: Vec<PathBuf>,
         /// The output folder (default: the project file's `[build] output`,
@@ -132,8 +133,8 @@ enum Command {
         /// Default: the project file's `[build] target`, else `linux`.
         #[arg(long, value_parser = parse_target)]
         target: Option<semo::codegen::Target>,
-        /// The scenario (`*.scenario.json`) compiled into each robot: needed
-        /// by, and only by, `--target cortex-m-sim`.
+        /// The scenario (`*.scenario.json`; `-`: standard input) compiled
+        /// into each robot: needed by, and only by, `--target cortex-m-sim`.
         #[arg(long)]
         scenario: Option<PathBuf>,
         /// `all` (C code, Makefile and task graph) or `taskgraph` (only the
@@ -172,7 +173,8 @@ enum Command {
         /// The scenario file (`*.scenario.json`; `-`: standard input).
         #[arg(long)]
         scenario: PathBuf,
-        /// More strategy (and catalog) files or folders to read.
+        /// More strategy (and catalog) files or folders to read (not `-`:
+        /// they are seen by their paths).
         #[arg(long)]
         strategy: Vec<PathBuf>,
         /// How much mission time to run: `10min`, `90s`, `500ms`, `1h` (default:
@@ -281,7 +283,8 @@ enum GraphCommand {
     Svg {
         /// A `*.taskgraph.xml` file or an SDF3 graph (`-`: standard input).
         file: PathBuf,
-        /// Write the SVG to this file instead of standard output.
+        /// Write the SVG to this file instead of standard output (`-`:
+        /// standard output).
         #[arg(short, long, value_name = "FILE")]
         output: Option<PathBuf>,
     },
@@ -295,7 +298,8 @@ enum GraphCommand {
         /// Draw only this team.
         #[arg(long, value_name = "TEAM")]
         team: Option<String>,
-        /// Write the SVG to this file instead of standard output.
+        /// Write the SVG to this file instead of standard output (`-`:
+        /// standard output).
         #[arg(short, long, value_name = "FILE")]
         output: Option<PathBuf>,
     },

@@ -4,7 +4,7 @@
 //! "diagnostics", …}`, docs/diagnostics-json.md) and SARIF 2.1.0 are built
 //! here from [`Record`]s, so every command's machine output agrees.
 
-use semo::diag::{Diagnostic, Severity};
+use semo::diag::{Code, Diagnostic, Severity};
 use semo::text::ColumnUnit;
 use semo::workspace::Files;
 use serde::Serialize;
@@ -46,7 +46,8 @@ pub struct RelatedRecord {
 pub struct Record {
     /// The code (`E015`), or null for a problem outside the code table (a
     /// scenario file's error).
-    pub code: Option<&'static str>,
+    #[serde(serialize_with = "code_name")]
+    pub code: Option<Code>,
     pub severity: &'static str,
     pub file: String,
     pub start: Position,
@@ -67,7 +68,7 @@ impl Record {
             }
         };
         Record {
-            code: Some(d.code.as_str()),
+            code: Some(d.code),
             severity: d.severity.as_str(),
             file: file.path.display().to_string(),
             start: position(d.span.start),
@@ -105,6 +106,11 @@ impl Record {
             related: Vec::new(),
         }
     }
+}
+
+/// A code as its stable name (`E015`).
+fn code_name<S: serde::Serializer>(code: &Option<Code>, to: S) -> Result<S::Ok, S::Error> {
+    code.map(Code::as_str).serialize(to)
 }
 
 pub fn records(files: &Files, diagnostics: &[Diagnostic]) -> Vec<Record> {
@@ -180,17 +186,16 @@ fn sarif_location(file: &str, start: Position, end: Position) -> serde_json::Val
 /// A SARIF 2.1.0 log of one run of `semo`: each code reported is a rule (its
 /// summary and default level), each record a result.
 pub fn sarif(records: &[Record]) -> serde_json::Value {
-    let mut rule_ids: Vec<&str> = records.iter().filter_map(|r| r.code).collect();
-    rule_ids.sort_unstable();
-    rule_ids.dedup();
-    let rules: Vec<serde_json::Value> = rule_ids
+    let mut rule_codes: Vec<Code> = records.iter().filter_map(|r| r.code).collect();
+    rule_codes.sort_unstable();
+    rule_codes.dedup();
+    let rules: Vec<serde_json::Value> = rule_codes
         .iter()
-        .map(|id| {
-            let code = semo::diag::Code::from_code(id).expect("a record's code is in the table");
+        .map(|code| {
             serde_json::json!({
-                "id": id,
+                "id": code.as_str(),
                 "shortDescription": { "text": code.summary() },
-                "help": { "text": format!("semo explain {id}") },
+                "help": { "text": format!("semo explain {code}") },
                 "defaultConfiguration": { "level": sarif_level(code.default_severity().as_str()) },
             })
         })
@@ -204,8 +209,8 @@ pub fn sarif(records: &[Record]) -> serde_json::Value {
                 "locations": [sarif_location(&r.file, r.start, r.end)],
             });
             if let Some(code) = r.code {
-                result["ruleId"] = code.into();
-                result["ruleIndex"] = rule_ids.iter().position(|id| *id == code).into();
+                result["ruleId"] = code.as_str().into();
+                result["ruleIndex"] = rule_codes.binary_search(&code).ok().into();
             }
             if !r.related.is_empty() {
                 let related: Vec<serde_json::Value> = r

@@ -56,6 +56,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         );
         return 2;
     }
+    if !input::strategy_paths_are_files(&options.strategy) {
+        return 2;
+    }
     if !input::file_is_kind(&options.mission, Content::Mission, SIMULATE) {
         return 2;
     }
