@@ -2,7 +2,6 @@
 
 pub mod analysis;
 pub mod dot;
-pub mod ide;
 pub mod model;
 pub mod subgraph;
 pub mod svg;
@@ -10,5 +9,5 @@ mod xml;
 
 pub mod write;
 pub use model::*;
-pub use svg::to_svg;
+pub use svg::{to_svg, to_svg_analyzed};
 pub use xml::{ExecutionTimes, GraphFormat, detect_format, load_task_graph, load_task_graph_as};
