@@ -49,6 +49,10 @@ pub fn diagnostics(
     colored: bool,
     out: &mut impl Write,
 ) -> io::Result<()> {
+    if diagnostics.is_empty() {
+        // Nothing to show: no copy of every file's text for the renderer.
+        return Ok(());
+    }
     let config = Config::default()
         .with_color(colored)
         .with_index_type(IndexType::Byte);

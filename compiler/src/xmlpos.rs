@@ -9,14 +9,17 @@ use quick_xml::Reader;
 use quick_xml::encoding::Decoder;
 use quick_xml::events::attributes::AttrError;
 use quick_xml::events::{BytesEnd, BytesRef, BytesStart};
+use smol_str::SmolStr;
 
-/// One attribute as written.
+/// One attribute as written. Names and values are small strings (inline up
+/// to 23 bytes): a large graph file has hundreds of thousands of them, and a
+/// heap allocation each was most of its reading time.
 #[derive(Clone, Debug)]
 pub(crate) struct Attr {
-    pub key: String,
+    pub key: SmolStr,
     pub key_span: Span,
     /// The value with entities replaced.
-    pub value: String,
+    pub value: SmolStr,
     /// The byte range of the value (between the quotes).
     pub span: Span,
     /// Whether `value` is byte-for-byte the text at `span` (no entities), so that
@@ -222,9 +225,9 @@ pub(crate) fn start_tag_spans(text: &str, e: &BytesStart<'_>, tag_end: usize) ->
 
 /// A start tag's names and ranges.
 pub(crate) struct StartTag {
-    pub qname: String,
+    pub qname: SmolStr,
     /// The name without a namespace prefix.
-    pub local: String,
+    pub local: SmolStr,
     pub name_span: Span,
     /// `<` to `>`.
     pub tag: Span,
@@ -238,8 +241,8 @@ pub(crate) fn start_tag(
     tag_end: usize,
 ) -> Result<StartTag, (Span, &'static str)> {
     let (name_span, tag) = start_tag_spans(text, e, tag_end);
-    let qname = String::from_utf8_lossy(e.name().as_ref()).into_owned();
-    let local = String::from_utf8_lossy(e.local_name().as_ref()).into_owned();
+    let qname = SmolStr::new(String::from_utf8_lossy(e.name().as_ref()));
+    let local = SmolStr::new(String::from_utf8_lossy(e.local_name().as_ref()));
     if local.is_empty() {
         return Err((
             word_at(text, tag.start),
@@ -352,7 +355,7 @@ pub(crate) fn read_attributes_keeping_lt(
                 return Err(fail(&raw_lt, word_at(text, content_start + pos), message));
             }
         };
-        let key = String::from_utf8_lossy(attr.key.as_ref()).into_owned();
+        let key = SmolStr::new(String::from_utf8_lossy(attr.key.as_ref()));
         let key_span = slice_span(text, attr.key.as_ref()).unwrap_or(tag);
         let raw: &[u8] = &attr.value;
         let span = slice_span(text, raw).unwrap_or(tag);
@@ -363,7 +366,7 @@ pub(crate) fn read_attributes_keeping_lt(
                 .map(|(i, _)| span.start + i),
         );
         let value = match attr.decode_and_unescape_value(decoder) {
-            Ok(v) => v.into_owned(),
+            Ok(v) => SmolStr::new(v),
             Err(_) => {
                 let message =
                     "this value has an unknown `&...;` entity: write `&amp;` for a plain `&`";

@@ -18,9 +18,9 @@ use quick_xml::events::{BytesEnd, BytesStart, Event};
 /// One element as written.
 #[derive(Debug)]
 pub(crate) struct Elem {
-    pub qname: String,
+    pub qname: smol_str::SmolStr,
     /// The name without a namespace prefix.
-    pub local: String,
+    pub local: smol_str::SmolStr,
     pub name_span: Span,
     /// The start tag, `<` to `>`.
     pub tag: Span,

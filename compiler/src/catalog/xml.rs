@@ -542,7 +542,11 @@ impl Parser<'_, '_> {
         if empty {
             self.finish(kind);
         } else {
-            self.stack.push(Open { qname, kind, tag });
+            self.stack.push(Open {
+                qname: qname.into(),
+                kind,
+                tag,
+            });
         }
         Ok(())
     }

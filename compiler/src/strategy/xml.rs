@@ -326,7 +326,7 @@ impl Reader<'_> {
         };
         self.diagnostics.extend(parse.diagnostics);
         Some(Condition {
-            text: a.value.clone(),
+            text: a.value.to_string(),
             span: a.span,
             expr: parse.expr,
         })

@@ -83,14 +83,21 @@ fn execute(
 /// `None` when one iteration completes; otherwise the blocking cycle.
 pub fn find_deadlock(level: &Level<'_>, counts: &[u64]) -> Option<Blocked> {
     let (remaining, tokens) = execute(level, counts, None).err()?;
+    // Each node's input edges, in edge order: a walk along a long chain of
+    // waits reads each node's inputs, not every edge, per step.
+    let mut inputs: Vec<Vec<usize>> = vec![Vec::new(); level.nodes.len()];
+    for (i, e) in level.edges.iter().enumerate() {
+        if let Some(list) = inputs.get_mut(e.dst) {
+            list.push(i);
+        }
+    }
     // Each blocked node waits on an input edge short of samples whose source
     // is blocked too; following these waits must come back round to a node.
     let waits_for = |v: usize| {
-        level
-            .edges
+        inputs[v]
             .iter()
-            .enumerate()
-            .find(|(i, e)| e.dst == v && tokens[*i] < e.consume && remaining[e.src] > 0)
+            .map(|&i| (i, &level.edges[i]))
+            .find(|(i, e)| tokens[*i] < e.consume && remaining[e.src] > 0)
     };
     let start = (0..level.nodes.len()).find(|&v| remaining[v] > 0)?;
     let mut seen: Vec<Option<usize>> = vec![None; level.nodes.len()];

@@ -181,7 +181,8 @@ pub fn single_appearance(level: &Level<'_>, counts: &[u64]) -> Option<Vec<Schedu
     }
     let n = level.nodes.len();
     let all: Vec<usize> = (0..n).collect();
-    let schedule = schedule_set(level, &all, counts, false)?;
+    let mut frames = Frames::new(level);
+    let schedule = frames.schedule_set(&all, &mut counts.to_vec(), false)?;
     if fired(&schedule, n)? != counts {
         return None;
     }
@@ -212,68 +213,101 @@ pub fn balanced(level: &Level<'_>, counts: &[u64]) -> bool {
         })
 }
 
-/// Schedules the nodes `members` (sorted) of one frame, where node `v` fires
-/// `q[v]` times. `split` says whether edges with enough initial samples may be
-/// removed (the members are one strongly connected component).
-fn schedule_set(
-    level: &Level<'_>,
-    members: &[usize],
-    q: &[u64],
-    split: bool,
-) -> Option<Vec<Schedule>> {
-    if members.is_empty() {
-        return Some(Vec::new());
-    }
-    if let [v] = members {
-        // A self-loop keeps its sample count across a firing (consistent
-        // rates): enough for one firing is enough for all.
-        let starved = level
-            .edges
-            .iter()
-            .any(|e| e.src == *v && e.dst == *v && e.initial_tokens < e.consume);
-        return if starved {
-            None
-        } else {
-            Some(vec![Schedule::Fire {
-                node: *v,
-                count: q[*v],
-            }])
-        };
-    }
-    let keep = |e: &super::level::Edge| {
-        !split
-            || q[e.dst]
-                .checked_mul(e.consume)
-                .is_none_or(|need| e.initial_tokens < need)
-    };
-    let components = ordered_components(level, members, &keep);
-    if components.len() == 1 {
-        if split {
-            return None; // tightly interdependent
-        }
-        // One strongly connected component: schedule it in its own frame.
-        return schedule_component(level, &components[0], q).map(|(c, body)| wrap(c, body));
-    }
-    let mut clusters = Vec::with_capacity(components.len());
-    for component in &components {
-        clusters.push(schedule_component(level, component, q)?);
-    }
-    Some(factor(level, &components, &clusters, q))
+/// What the frames of the single-appearance recursion share: each node's
+/// outgoing edges, so that a frame reads only its members' edges and the
+/// recursion costs the level's size once per nesting depth, not once per
+/// frame (a 20,000-node level has about as many frames); and a node-indexed
+/// scratch array, all `usize::MAX` between uses.
+struct Frames<'l, 'g> {
+    level: &'l Level<'g>,
+    outputs: Vec<Vec<usize>>,
+    scratch: Vec<usize>,
 }
 
-/// A component as a cluster: its count (gcd of its nodes' counts) and the
-/// schedule of one cluster firing.
-fn schedule_component(
-    level: &Level<'_>,
-    component: &[usize],
-    q: &[u64],
-) -> Option<(u64, Vec<Schedule>)> {
-    let c = component.iter().fold(0, |g, &v| gcd(g, q[v])).max(1);
-    let mut inner = q.to_vec();
-    for &v in component {
-        inner[v] = q[v] / c;
+impl<'l, 'g> Frames<'l, 'g> {
+    fn new(level: &'l Level<'g>) -> Frames<'l, 'g> {
+        Frames {
+            level,
+            outputs: adjacency(level).1,
+            scratch: vec![usize::MAX; level.nodes.len()],
+        }
     }
-    Some((c, schedule_set(level, component, &inner, true)?))
+
+    /// Schedules the nodes `members` (sorted) of one frame, where node `v`
+    /// fires `q[v]` times. `split` says whether edges with enough initial
+    /// samples may be removed (the members are one strongly connected
+    /// component). `q` is the same on return.
+    fn schedule_set(
+        &mut self,
+        members: &[usize],
+        q: &mut [u64],
+        split: bool,
+    ) -> Option<Vec<Schedule>> {
+        let level = self.level;
+        if members.is_empty() {
+            return Some(Vec::new());
+        }
+        if let [v] = members {
+            // A self-loop keeps its sample count across a firing (consistent
+            // rates): enough for one firing is enough for all.
+            let starved = self.outputs[*v].iter().any(|&i| {
+                let e = &level.edges[i];
+                e.dst == *v && e.initial_tokens < e.consume
+            });
+            return if starved {
+                None
+            } else {
+                Some(vec![Schedule::Fire {
+                    node: *v,
+                    count: q[*v],
+                }])
+            };
+        }
+        let components = {
+            let q = &*q;
+            let keep = |e: &super::level::Edge| {
+                !split
+                    || q[e.dst]
+                        .checked_mul(e.consume)
+                        .is_none_or(|need| e.initial_tokens < need)
+            };
+            ordered_components(level, &self.outputs, &mut self.scratch, members, &keep)
+        };
+        if components.len() == 1 {
+            if split {
+                return None; // tightly interdependent
+            }
+            // One strongly connected component: schedule it in its own frame.
+            return self
+                .schedule_component(&components[0], q)
+                .map(|(c, body)| wrap(c, body));
+        }
+        let mut clusters = Vec::with_capacity(components.len());
+        for component in &components {
+            clusters.push(self.schedule_component(component, q)?);
+        }
+        Some(factor(self, &components, &clusters, q))
+    }
+
+    /// A component as a cluster: its count (gcd of its nodes' counts) and the
+    /// schedule of one cluster firing (its nodes' counts divided by it while
+    /// it is scheduled, then restored).
+    fn schedule_component(
+        &mut self,
+        component: &[usize],
+        q: &mut [u64],
+    ) -> Option<(u64, Vec<Schedule>)> {
+        let c = component.iter().fold(0, |g, &v| gcd(g, q[v])).max(1);
+        let saved: Vec<u64> = component.iter().map(|&v| q[v]).collect();
+        for &v in component {
+            q[v] /= c;
+        }
+        let body = self.schedule_set(component, q, true);
+        for (&v, count) in component.iter().zip(saved) {
+            q[v] = count;
+        }
+        Some((c, body?))
+    }
 }
 
 /// `body` repeated `count` times, merging a single term into the count.
@@ -304,13 +338,15 @@ fn wrap(count: u64, body: Vec<Schedule>) -> Vec<Schedule> {
     vec![Schedule::Loop { count, body }]
 }
 
-/// Nests the ordered clusters into loops (DPPO, see the module documentation).
+/// Nests the ordered clusters into loops (DPPO, see the module
+/// documentation).
 fn factor(
-    level: &Level<'_>,
+    frames: &mut Frames<'_, '_>,
     components: &[Vec<usize>],
     clusters: &[(u64, Vec<Schedule>)],
     q: &[u64],
 ) -> Vec<Schedule> {
+    let level = frames.level;
     let m = clusters.len();
     let counts: Vec<u64> = clusters.iter().map(|(c, _)| *c).collect();
     if m > DPPO_LIMIT {
@@ -322,21 +358,27 @@ fn factor(
         return wrap(g, body);
     }
     // Samples per frame iteration between each pair of clusters.
-    let mut cluster_of = vec![usize::MAX; level.nodes.len()];
+    let cluster_of = &mut frames.scratch;
     for (i, component) in components.iter().enumerate() {
         for &v in component {
             cluster_of[v] = i;
         }
     }
     let mut weight = vec![vec![0u128; m]; m];
-    for e in &level.edges {
-        let (a, b) = (cluster_of[e.src], cluster_of[e.dst]);
-        if a == usize::MAX || b == usize::MAX || a == b {
-            continue;
+    for &v in components.iter().flatten() {
+        for &i in &frames.outputs[v] {
+            let e = &level.edges[i];
+            let (a, b) = (cluster_of[e.src], cluster_of[e.dst]);
+            if b == usize::MAX || a == b {
+                continue;
+            }
+            let t = u128::from(q[e.src]) * u128::from(e.produce);
+            weight[a][b] = weight[a][b].saturating_add(t);
+            weight[b][a] = weight[b][a].saturating_add(t);
         }
-        let t = u128::from(q[e.src]) * u128::from(e.produce);
-        weight[a][b] = weight[a][b].saturating_add(t);
-        weight[b][a] = weight[b][a].saturating_add(t);
+    }
+    for &v in components.iter().flatten() {
+        cluster_of[v] = usize::MAX;
     }
     // prefix[a][b]: sum of weight[..a][..b].
     let mut prefix = vec![vec![0u128; m + 1]; m + 1];
@@ -407,24 +449,33 @@ fn build(
 
 /// The strongly connected components of the sub-graph of `members` through
 /// the edges that `keep` accepts, in topological order (ties: the component
-/// with the smallest node first), each sorted.
+/// with the smallest node first), each sorted. `outputs` are each node's
+/// outgoing edges ([`adjacency`]); `local` is node-indexed scratch, all
+/// `usize::MAX` before and after: the cost is the members' edges, not the
+/// level's.
 fn ordered_components(
     level: &Level<'_>,
+    outputs: &[Vec<usize>],
+    local: &mut [usize],
     members: &[usize],
     keep: &dyn Fn(&super::level::Edge) -> bool,
 ) -> Vec<Vec<usize>> {
-    let n = level.nodes.len();
-    let mut local = vec![usize::MAX; n];
     for (i, &v) in members.iter().enumerate() {
         local[v] = i;
     }
     let m = members.len();
     let mut succ: Vec<Vec<usize>> = vec![Vec::new(); m];
-    for e in &level.edges {
-        let (a, b) = (local[e.src], local[e.dst]);
-        if a != usize::MAX && b != usize::MAX && a != b && keep(e) {
-            succ[a].push(b);
+    for (a, &v) in members.iter().enumerate() {
+        for &i in &outputs[v] {
+            let e = &level.edges[i];
+            let b = local[e.dst];
+            if b != usize::MAX && a != b && keep(e) {
+                succ[a].push(b);
+            }
         }
+    }
+    for &v in members {
+        local[v] = usize::MAX;
     }
     let (comp, ncomp) =
         crate::digraph::components(m, (0..m).flat_map(|a| succ[a].iter().map(move |&b| (a, b))));
@@ -562,15 +613,16 @@ pub fn flat_schedule(level: &Level<'_>, counts: &[u64]) -> Option<Vec<usize>> {
         return None;
     }
     let all: Vec<usize> = (0..n).collect();
-    let order: Vec<usize> = ordered_components(level, &all, &|_| true)
-        .into_iter()
-        .flatten()
-        .collect();
+    let (inputs, outputs) = adjacency(level);
+    let order: Vec<usize> =
+        ordered_components(level, &outputs, &mut vec![usize::MAX; n], &all, &|_| true)
+            .into_iter()
+            .flatten()
+            .collect();
     let mut rank = vec![0usize; n];
     for (r, &v) in order.iter().enumerate() {
         rank[v] = r;
     }
-    let (inputs, outputs) = adjacency(level);
     let mut tokens: Vec<u64> = level.edges.iter().map(|e| e.initial_tokens).collect();
     let mut remaining = counts.to_vec();
     let can_fire = |v: usize, tokens: &[u64], remaining: &[u64]| {

@@ -162,13 +162,11 @@ impl Hsdf {
         self.actor.get(v).copied().unwrap_or(v)
     }
 
-    fn from_edges(
-        weight: Vec<u64>,
-        mut edges: Vec<(usize, usize, u64)>,
-        actor: Vec<usize>,
-    ) -> Hsdf {
+    /// Edges grouped by source in one counting pass (each source's edges
+    /// in the order given, as a stable sort would leave them): a sort of the
+    /// expansion's edges was a tenth of a small graph's whole analysis.
+    fn from_edges(weight: Vec<u64>, edges: Vec<(usize, usize, u64)>, actor: Vec<usize>) -> Hsdf {
         let n = weight.len();
-        edges.sort_by_key(|&(src, _, _)| src);
         let mut first = vec![0; n + 1];
         for &(src, _, _) in &edges {
             first[src + 1] += 1;
@@ -176,11 +174,19 @@ impl Hsdf {
         for v in 0..n {
             first[v + 1] += first[v];
         }
+        let mut next = first.clone();
+        let mut head = vec![0; edges.len()];
+        let mut tokens = vec![0; edges.len()];
+        for (src, dst, t) in edges {
+            head[next[src]] = dst;
+            tokens[next[src]] = t;
+            next[src] += 1;
+        }
         Hsdf {
             weight,
             first,
-            head: edges.iter().map(|&(_, dst, _)| dst).collect(),
-            tokens: edges.iter().map(|&(_, _, t)| t).collect(),
+            head,
+            tokens,
             actor,
         }
     }

@@ -132,29 +132,30 @@ struct Search<'l, 'g> {
     concurrency: Concurrency,
     evaluations: usize,
     work: u64,
+    /// [`evaluation_cost`] of the level, which the search does not change.
+    cost: u64,
+}
+
+/// The work of one evaluation: the size of the HSDF with space edges (as
+/// `throughput` expands it).
+fn evaluation_cost(level: &Level<'_>, g: &[u64]) -> u64 {
+    let mut size: u64 = g.iter().sum();
+    for e in &level.edges {
+        let data = g[e.dst].saturating_mul((e.consume.div_ceil(e.produce) + 1).min(g[e.src]));
+        let space = g[e.src].saturating_mul((e.produce.div_ceil(e.consume) + 1).min(g[e.dst]));
+        size = size.saturating_add(data).saturating_add(space);
+    }
+    size
 }
 
 impl Search<'_, '_> {
-    /// The work of one evaluation: the size of the HSDF with space edges
-    /// (as `throughput` expands it).
-    fn cost(&self) -> u64 {
-        let g = &self.counts;
-        let mut size: u64 = g.iter().sum();
-        for e in &self.level.edges {
-            let data = g[e.dst].saturating_mul((e.consume.div_ceil(e.produce) + 1).min(g[e.src]));
-            let space = g[e.src].saturating_mul((e.produce.div_ceil(e.consume) + 1).min(g[e.dst]));
-            size = size.saturating_add(data).saturating_add(space);
-        }
-        size
-    }
-
     fn within(&self, budget: u64) -> bool {
-        self.work.saturating_add(self.cost()) <= budget
+        self.work.saturating_add(self.cost) <= budget
     }
 
     fn evaluate(&mut self, caps: &[Option<u64>]) -> Option<Outcome> {
         self.evaluations += 1;
-        self.work = self.work.saturating_add(self.cost());
+        self.work = self.work.saturating_add(self.cost);
         let n = self.level.edges.len();
         let with_space = bounded(self.level, caps);
         // Space edge k of `with_space` (k ≥ n) belongs to the k-th bounded edge.
@@ -193,14 +194,15 @@ impl Search<'_, '_> {
 pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff> {
     let counts = repetition_vector(level).ok()?;
     let max_period = throughput(level, &counts, concurrency)?.period;
+    let cost = evaluation_cost(level, &counts);
     let mut search = Search {
         level,
         counts,
         concurrency,
         evaluations: 1,
-        work: 0,
+        work: cost,
+        cost,
     };
-    search.work = search.cost();
     let steps: Vec<u64> = level
         .edges
         .iter()
