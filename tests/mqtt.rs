@@ -105,24 +105,41 @@ fn start_broker(binary: &Path, dir: &Path, processes: &mut Processes) -> (u16, u
     (port, index)
 }
 
+/// The user we are: started as root, mosquitto drops to the `mosquitto`
+/// user, which cannot read or write our folders; `user <us>` keeps it us (no
+/// effect otherwise).
+fn current_user() -> String {
+    let whoami = Command::new("id").arg("-un").output().expect("id runs");
+    String::from_utf8_lossy(&whoami.stdout).trim().to_string()
+}
+
 fn start_broker_on(binary: &Path, dir: &Path, port: u16, processes: &mut Processes) -> usize {
     let config = dir.join("mosquitto.conf");
-    // Started as root, mosquitto drops to the `mosquitto` user, which cannot
-    // write into our folder: it stays the user we are (no effect otherwise).
-    let whoami = Command::new("id").arg("-un").output().expect("id runs");
-    let user = String::from_utf8_lossy(&whoami.stdout).trim().to_string();
     std::fs::write(
         &config,
         format!(
-            "user {user}\nlistener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\npersistence true\npersistence_location {}/\nlog_dest file {}\n",
+            "user {}\nlistener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\npersistence true\npersistence_location {}/\nlog_dest file {}\n",
+            current_user(),
             dir.display(),
             dir.join("mosquitto.log").display()
         ),
     )
     .unwrap();
+    start_broker_with(binary, &config, dir, port, processes)
+}
+
+/// Starts mosquitto with `config` (which listens on `port` of 127.0.0.1)
+/// and waits until it accepts connections; its log goes to `dir`.
+fn start_broker_with(
+    binary: &Path,
+    config: &Path,
+    dir: &Path,
+    port: u16,
+    processes: &mut Processes,
+) -> usize {
     let child = Command::new(binary)
         .arg("-c")
-        .arg(&config)
+        .arg(config)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
@@ -143,11 +160,23 @@ fn start_broker_on(binary: &Path, dir: &Path, port: u16, processes: &mut Process
 /// `semo build` of the scouting mission for linux-sim, each robot made with
 /// the MQTT transport built in (`make TRANSPORT=mqtt`), warnings as errors.
 fn build_scouting(out: &Path) -> Vec<PathBuf> {
-    let built = build(
-        &examples().join("scouting/scouting.mission"),
+    build_scouting_with(out, &[])
+}
+
+/// The same with more `semo build` arguments (`--deploy FILE`).
+fn build_scouting_with(out: &Path, extra: &[&str]) -> Vec<PathBuf> {
+    let mission = examples().join("scouting/scouting.mission");
+    let (mission, out_arg) = (mission.display().to_string(), out.display().to_string());
+    let mut args = vec![
+        "build",
+        mission.as_str(),
+        "--target",
         "linux-sim",
-        out,
-    );
+        "-o",
+        out_arg.as_str(),
+    ];
+    args.extend_from_slice(extra);
+    let built = support::semo_in(&repo_root(), &args);
     assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
     let folders = robot_folders(out);
     for folder in &folders {
@@ -378,12 +407,12 @@ fn transport_options_are_checked_and_an_unreachable_broker_is_reported() {
         ),
         (
             &["--broker", "mqtts://example.org"],
-            "TLS is not supported yet",
+            "an mqtts:// broker needs the CA that signed its certificate",
         ),
         (&["--broker", "mqtt://host:99999"], "port from 1 to 65535"),
         (
             &["--broker", "tcp://host:1883"],
-            "the broker must be mqtt://HOST[:PORT]",
+            "the broker must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT]",
         ),
     ] {
         let (code, stderr) = run_with(irobot, args);
@@ -421,5 +450,249 @@ fn transport_options_are_checked_and_an_unreachable_broker_is_reported() {
     assert!(
         stderr.contains("built without the mqtt transport"),
         "{stderr}"
+    );
+}
+
+/// A scouting deployment in `dir` for a broker on `port`: the master with
+/// its own user, the slaves sharing their team's, the operator; the
+/// broker's password file made with `mosquitto_passwd -b`. `tls`: also the
+/// CA and certificates (`tls_files`).
+fn scouting_deployment(dir: &Path, port: u16, tls: bool) -> PathBuf {
+    let users = [
+        ("irobot", "irobot-secret"),
+        ("slaves", "slaves-secret"),
+        ("operator", "operator-secret"),
+    ];
+    for (i, (user, password)) in users.iter().enumerate() {
+        std::fs::write(dir.join(format!("{user}.pw")), format!("{password}\n")).unwrap();
+        let mut command = Command::new("mosquitto_passwd");
+        if i == 0 {
+            command.arg("-c");
+        }
+        let made = command
+            .arg("-b")
+            .arg(dir.join("passwd"))
+            .args([user, password])
+            .output()
+            .expect("mosquitto_passwd runs");
+        assert!(made.status.success(), "{made:?}");
+    }
+    let (scheme, tls_top, tls_broker, tls_irobot) = if tls {
+        (
+            "mqtts",
+            "ca = \"ca.crt\"\n",
+            "cert = \"server.crt\"\nkey = \"server.key\"\n",
+            "cert = \"irobot.crt\"\nkey = \"irobot.key\"\n",
+        )
+    } else {
+        ("mqtt", "", "", "")
+    };
+    let file = dir.join("scouting.deploy.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "# The scouting robots on a private broker (tests/mqtt.rs).\nbroker = \"{scheme}://127.0.0.1:{port}\"\n{tls_top}\n[broker_config]\npassword_file = \"passwd\"\n{tls_broker}\n[operator]\nuser = \"operator\"\npassword_file = \"operator.pw\"\n\n[teams.SlaveTeam]\nuser = \"slaves\"\npassword_file = \"slaves.pw\"\n\n[robots.irobot]\nuser = \"irobot\"\npassword_file = \"irobot.pw\"\n{tls_irobot}"
+        ),
+    )
+    .unwrap();
+    file
+}
+
+/// `semo deploy broker-config` into `dir/broker`, run as this user, logging
+/// to `dir/broker/mosquitto.log`; returns the configuration's path.
+fn broker_config(dir: &Path, deploy: &Path) -> PathBuf {
+    let out = dir.join("broker");
+    let mission = examples().join("scouting/scouting.mission");
+    let written = support::semo_in(
+        dir,
+        &[
+            "deploy",
+            "broker-config",
+            &mission.display().to_string(),
+            "--deploy",
+            &deploy.display().to_string(),
+            "-o",
+            &out.display().to_string(),
+        ],
+    );
+    assert_eq!(written.code, 0, "{}{}", written.stdout, written.stderr);
+    let config = out.join("mosquitto.conf");
+    let mut text = std::fs::read_to_string(&config).unwrap();
+    text.push_str(&format!(
+        "user {}\nlog_dest file {}\n",
+        current_user(),
+        out.join("mosquitto.log").display()
+    ));
+    std::fs::write(&config, text).unwrap();
+    config
+}
+
+/// A `USER` command as the runtime's datagram: "SEMO" 1, kind `s`, then
+/// team, robot, key and value, each a length byte and its bytes.
+fn user_command(key: &str, value: &str) -> Vec<u8> {
+    let mut datagram = b"SEMO\x01s".to_vec();
+    for field in ["USER", "operator", key, value] {
+        datagram.push(field.len() as u8);
+        datagram.extend_from_slice(field.as_bytes());
+    }
+    datagram
+}
+
+/// Publishes `datagram` to `topic` with `mosquitto_pub` every 100 ms (as
+/// `user`, or anonymously) until `stop` is set. Returns how many publishes
+/// the broker accepted at the protocol level (exit status 0).
+fn keep_publishing(
+    port: u16,
+    topic: String,
+    datagram: PathBuf,
+    user: Option<(&'static str, &'static str)>,
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+) -> std::thread::JoinHandle<usize> {
+    std::thread::spawn(move || {
+        let mut accepted = 0;
+        while !stop.load(std::sync::atomic::Ordering::SeqCst) {
+            let mut command = Command::new("mosquitto_pub");
+            command
+                .args(["-h", "127.0.0.1", "-p", &port.to_string(), "-q", "1"])
+                .args(["-t", &topic])
+                .arg("-f")
+                .arg(&datagram);
+            if let Some((user, password)) = user {
+                command.args(["-u", user, "-P", password]);
+            }
+            let status = command
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .status()
+                .expect("mosquitto_pub runs (Debian mosquitto-clients)");
+            accepted += usize::from(status.success());
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+        accepted
+    })
+}
+
+/// Runs the scouting robots (built with the deployment: no --broker, the
+/// baked defaults connect them) while `forgers` publish `RC_CMD = RC_MODE`
+/// to the master as USER commands; returns the traces.
+fn run_while_forging(
+    folders: &[PathBuf],
+    out: &Path,
+    tag: &str,
+    port: u16,
+    forgers: &[Option<(&'static str, &'static str)>],
+    processes: &mut Processes,
+) -> BTreeMap<String, Vec<Event>> {
+    let datagram = out.join("forged.bin");
+    std::fs::write(&datagram, user_command("USER.RC_CMD", "RC_MODE")).unwrap();
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let threads: Vec<_> = forgers
+        .iter()
+        .map(|user| {
+            keep_publishing(
+                port,
+                "semo/scouting/MasterTeam/USER.RC_CMD".into(),
+                datagram.clone(),
+                *user,
+                stop.clone(),
+            )
+        })
+        .collect();
+    let traces = run_together(
+        folders,
+        out,
+        tag,
+        &["--transport".into(), "mqtt".into()],
+        processes,
+    );
+    stop.store(true, std::sync::atomic::Ordering::SeqCst);
+    for thread in threads {
+        thread.join().unwrap();
+    }
+    traces
+}
+
+#[test]
+fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
+    let Some(binary) =
+        broker_or_skip("the_generated_acl_lets_only_the_operator_switch_a_robots_mode")
+    else {
+        return;
+    };
+    let out = scratch("mqtt-acl");
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let deploy = scouting_deployment(&out, port, false);
+    let config = broker_config(&out, &deploy);
+    let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
+    insta::assert_snapshot!(
+        "scouting_acl",
+        acl.replace(&deploy.display().to_string(), "scouting.deploy.toml")
+    );
+    let conf = std::fs::read_to_string(&config).unwrap();
+    for line in [
+        "allow_anonymous false",
+        "set_tcp_nodelay true",
+        "acl_file ",
+        "password_file ",
+    ] {
+        assert!(conf.contains(line), "{line}: {conf}");
+    }
+    let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
+    let header = std::fs::read_to_string(folders[0].join("semo_deploy.h")).unwrap();
+    assert!(
+        header.contains("SEMO_DEPLOY_PASSWORD_FILE") && !header.contains("secret\""),
+        "the password file's path, not the password: {header}"
+    );
+    let mut processes = Processes::default();
+    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+
+    // Anonymous clients and the slaves' credentials cannot command the master.
+    let forged = run_while_forging(
+        &folders,
+        &out,
+        "forged",
+        port,
+        &[None, Some(("slaves", "slaves-secret"))],
+        &mut processes,
+    );
+    for (robot, events) in &forged {
+        assert_eq!(
+            modes(events).last().map(String::as_str),
+            Some("FINISH"),
+            "{robot}: {:?}",
+            modes(events)
+        );
+    }
+    assert!(
+        !modes(&forged["irobot"]).iter().any(|m| m == "RC_MODE"),
+        "a forged USER command switched the master: {:?}",
+        modes(&forged["irobot"])
+    );
+    for slave in ["ti", "nxt"] {
+        assert!(
+            received_from(&forged["irobot"], slave, "SlaveTeam.COLOR")
+                .iter()
+                .any(|v| v == "RGB"),
+            "the master hears {slave} through the ACL"
+        );
+    }
+    // The same command from the operator's user does switch it: the
+    // forgeries above failed because of the ACL, not for another reason.
+    let commanded = run_while_forging(
+        &folders,
+        &out,
+        "operator",
+        port,
+        &[Some(("operator", "operator-secret"))],
+        &mut processes,
+    );
+    assert!(
+        modes(&commanded["irobot"]).iter().any(|m| m == "RC_MODE"),
+        "the operator's USER command switches the master: {:?}",
+        modes(&commanded["irobot"])
     );
 }

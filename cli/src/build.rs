@@ -19,6 +19,8 @@ pub struct Options {
     pub color: bool,
     /// Replace files in the way (saved to the backup folder first).
     pub force: bool,
+    /// A deployment file baked into every robot folder.
+    pub deploy: Option<PathBuf>,
 }
 
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
@@ -47,12 +49,25 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     };
+    let deployment = match &options.deploy {
+        None => None,
+        Some(path) => match super::deploy::load(path, options.color, out) {
+            Ok(loaded) => Some(loaded),
+            Err(code) => return code,
+        },
+    };
     let Some(input) = run.analysis().build_input(mission) else {
         eprintln!("internal error: the mission was loaded but not checked");
         return 2;
     };
     let input = input.input();
-    let result = match &options.scenario {
+    if let Some((deployment, file)) = &deployment {
+        let found = semo::deploy::check(deployment, &input.analysis.mission);
+        if found.iter().any(|d| d.is_error()) {
+            return super::deploy::refuse(file, &found, options.color, out);
+        }
+    }
+    let mut result = match &options.scenario {
         None => codegen::build(&input, options.target, options.emit),
         Some(path) => match build_with_scenario(&input, path, &options) {
             Ok(result) => result,
@@ -70,6 +85,16 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             "error: code generation refused: fix the errors above first"
         );
         return 1;
+    }
+    let baking = options.emit == Emit::All;
+    if let (Some((deployment, _)), true) = (&deployment, baking) {
+        if !semo::deploy::bake(deployment, &mut result) {
+            eprintln!(
+                "error: --deploy: target {} has no network transport to deploy",
+                options.target.name()
+            );
+            return 2;
+        }
     }
     let out_dir = options.out.clone().unwrap_or_else(|| {
         options

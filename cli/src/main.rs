@@ -3,6 +3,7 @@
 //! 1 errors found, 2 usage or I/O problem.
 
 mod build;
+mod deploy;
 mod fmt;
 mod graph;
 mod render;
@@ -135,7 +136,15 @@ enum Command {
         /// under OUT/.semo-backup/<time>/.
         #[arg(long)]
         force: bool,
+        /// A deployment file (`*.deploy.toml`, docs/deployment.md): its
+        /// broker and each robot's credentials become the defaults baked
+        /// into the robot folders (`semo_deploy.h`; no secret is copied).
+        #[arg(long, value_name = "FILE")]
+        deploy: Option<PathBuf>,
     },
+    /// Deployment on real networks: the broker's configuration.
+    #[command(subcommand)]
+    Deploy(DeployCommand),
     /// Run every robot of a mission together in virtual time on a scenario,
     /// and check the scenario's expectations.
     #[command(
@@ -189,6 +198,29 @@ enum Command {
     Explain {
         /// A code such as E019; all codes when omitted.
         code: Option<String>,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum DeployCommand {
+    /// Write a mosquitto configuration (`mosquitto.conf`) and its ACL
+    /// (`semo.acl`) for a mission: each robot's user may write only its own
+    /// topics and read what is sent to it, only the operator may write USER
+    /// commands, anonymous clients are refused, TCP_NODELAY is on.
+    BrokerConfig {
+        /// The mission script.
+        mission: PathBuf,
+        /// The deployment file (`*.deploy.toml`).
+        #[arg(long, value_name = "FILE")]
+        deploy: PathBuf,
+        /// More strategy (and catalog) files or folders to read.
+        #[arg(long)]
+        strategy: Vec<PathBuf>,
+        /// The folder to write the configuration into.
+        #[arg(long = "output", short = 'o', value_name = "DIR")]
+        out: PathBuf,
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
     },
 }
 
@@ -413,6 +445,7 @@ fn run() -> i32 {
             emit,
             color,
             force,
+            deploy,
         } => build::run(
             build::Options {
                 mission,
@@ -420,6 +453,7 @@ fn run() -> i32 {
                 out: out_dir,
                 target,
                 scenario,
+                deploy,
                 emit: match emit {
                     EmitArg::All => semo::codegen::Emit::All,
                     EmitArg::Taskgraph => semo::codegen::Emit::TaskGraph,
@@ -427,6 +461,20 @@ fn run() -> i32 {
                 color: use_color(color),
                 force,
             },
+            &mut out,
+        ),
+        Command::Deploy(DeployCommand::BrokerConfig {
+            mission,
+            deploy,
+            strategy,
+            out: out_dir,
+            color,
+        }) => deploy::broker_config(
+            &mission,
+            &strategy,
+            &deploy,
+            &out_dir,
+            use_color(color),
             &mut out,
         ),
         Command::Simulate {

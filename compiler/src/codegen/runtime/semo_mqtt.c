@@ -200,6 +200,51 @@ static void on_message(struct mosquitto *mosq, void *obj, const struct mosquitto
     pthread_mutex_unlock(&g_lock);
 }
 
+/* The password: the first line of its file, without the line break. */
+static int read_password(const char *path, char *out, size_t cap)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        fprintf(stderr, "semo runtime: cannot read the MQTT password file \"%s\"\n", path);
+        return -1;
+    }
+    bool got = fgets(out, (int)cap, f) != NULL;
+    fclose(f);
+    if (!got) {
+        fprintf(stderr, "semo runtime: the MQTT password file \"%s\" is empty\n", path);
+        return -1;
+    }
+    out[strcspn(out, "\r\n")] = '\0';
+    return 0;
+}
+
+/* Who we are at the broker (user and password) and, for mqtts://, TLS with
+ * the CA that signed the broker's certificate and our own certificate. */
+static int identify(const semo_transport_config *config)
+{
+    if (config->user) {
+        char password[256] = "";
+        if (config->password_file && read_password(config->password_file, password, sizeof password) != 0)
+            return -1;
+        int rc = mosquitto_username_pw_set(g_mosq, config->user, config->password_file ? password : NULL);
+        /* The password stays in libmosquitto only. */
+        memset(password, 0, sizeof password);
+        if (rc != MOSQ_ERR_SUCCESS) {
+            fprintf(stderr, "semo runtime: MQTT user \"%s\": %s\n", config->user, mosquitto_strerror(rc));
+            return -1;
+        }
+    }
+    if (config->broker_tls) {
+        int rc = mosquitto_tls_set(g_mosq, config->ca, NULL, config->cert, config->key, NULL);
+        if (rc != MOSQ_ERR_SUCCESS) {
+            fprintf(stderr, "semo runtime: TLS with CA \"%s\"%s%s: %s\n", config->ca ? config->ca : "",
+                    config->cert ? " and certificate " : "", config->cert ? config->cert : "", mosquitto_strerror(rc));
+            return -1;
+        }
+    }
+    return 0;
+}
+
 static int mqtt_open(const semo_program_desc *program, const semo_transport_config *config)
 {
     if (g_mosq || program->self >= program->peer_count || !config->broker_host)
@@ -219,9 +264,18 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
 
     mosquitto_lib_init();
     char client_id[MQTT_TOPIC_MAX];
-    snprintf(client_id, sizeof client_id, "semo-%s-%s", g_mission, program->peers[program->self].robot);
+    if (config->client_id)
+        snprintf(client_id, sizeof client_id, "%s", config->client_id);
+    else
+        snprintf(client_id, sizeof client_id, "semo-%s-%s", g_mission, program->peers[program->self].robot);
     g_mosq = mosquitto_new(client_id, false, NULL);
     if (!g_mosq) {
+        mosquitto_lib_cleanup();
+        return -1;
+    }
+    if (identify(config) != 0) {
+        mosquitto_destroy(g_mosq);
+        g_mosq = NULL;
         mosquitto_lib_cleanup();
         return -1;
     }

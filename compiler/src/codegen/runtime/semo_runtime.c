@@ -31,7 +31,16 @@
 #define COMM_QUEUE_CAPACITY 64
 #define RECV_ERROR_PAUSE_MS 50
 #define DEFAULT_PORT_BASE 47000
+/* The deployment baked in by `semo build --deploy` (the generated Makefile
+ * defines SEMO_DEPLOY; without a deployment the header defines nothing). */
+#ifdef SEMO_DEPLOY
+#include "semo_deploy.h"
+#endif
+#ifdef SEMO_DEPLOY_BROKER
+#define DEFAULT_BROKER SEMO_DEPLOY_BROKER
+#else
 #define DEFAULT_BROKER "mqtt://127.0.0.1:1883"
+#endif
 /* The target's transport (the Makefile's TRANSPORT); MQTT is compiled in
  * only where it is the default, as only then is libmosquitto linked. */
 #ifdef SEMO_MQTT
@@ -823,6 +832,8 @@ typedef struct {
     const semo_transport *transport;
     char broker_host[256];
     int broker_port;
+    bool broker_tls;
+    semo_transport_config identity; /* mqtt: who the robot is at the broker */
     long port_base;
     int64_t duration_ms;
     bool duration_given;
@@ -842,7 +853,10 @@ static void usage(FILE *f, const char *prog)
             "  --trace FILE      write a JSON-lines trace to FILE (\"-\": standard output)\n"
             "  --transport T     udp (loopback) or mqtt (default %s, or $SEMO_TRANSPORT)\n"
             "  --port-base N     udp: robot i uses UDP port N+i on 127.0.0.1 (default %d, or $SEMO_PORT_BASE)\n"
-            "  --broker URL      mqtt: the broker, mqtt://HOST[:PORT] (default " DEFAULT_BROKER ", or $SEMO_BROKER)\n"
+            "  --broker URL      mqtt: the broker, mqtt://HOST[:PORT] or mqtts://HOST[:PORT] (TLS)\n"
+            "                    (default " DEFAULT_BROKER ", or $SEMO_BROKER); who the robot is there:\n"
+            "                    $SEMO_MQTT_CLIENT_ID, $SEMO_MQTT_USER, $SEMO_MQTT_PASSWORD_FILE, $SEMO_MQTT_CA,\n"
+            "                    $SEMO_MQTT_CERT, $SEMO_MQTT_KEY (defaults from semo build --deploy)\n"
             "  --duration MS     stop after MS mission milliseconds (0: run until stopped)\n"
 #ifdef SEMO_SIM
             "  --scenario FILE   the simulation scenario (JSON)\n"
@@ -886,27 +900,85 @@ static bool parse_transport(const char *prog, const char *name, const semo_trans
     return false;
 }
 
-/* `mqtt://HOST[:PORT]` (port 1883 when left out) into the options. */
+/* `mqtt://HOST[:PORT]` or `mqtts://HOST[:PORT]` (port 1883 or 8883 when
+ * left out) into the options. */
 static bool parse_broker(const char *prog, const char *url, options *o)
 {
-    const char *rest = strncmp(url, "mqtt://", 7) == 0 ? url + 7 : NULL;
+    bool tls = strncmp(url, "mqtts://", 8) == 0;
+    const char *rest = tls ? url + 8 : strncmp(url, "mqtt://", 7) == 0 ? url + 7 : NULL;
     if (!rest) {
-        fprintf(stderr, "%s: the broker must be mqtt://HOST[:PORT]%s, not \"%s\"\n", prog,
-                strncmp(url, "mqtts://", 8) == 0 ? " (TLS is not supported yet)" : "", url);
+        fprintf(stderr, "%s: the broker must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT], not \"%s\"\n", prog, url);
         return false;
     }
     const char *colon = strrchr(rest, ':');
     size_t host_len = colon ? (size_t)(colon - rest) : strlen(rest);
-    long port = 1883;
+    long port = tls ? 8883 : 1883;
     if (host_len == 0 || host_len >= sizeof o->broker_host || (colon && !parse_long(colon + 1, 1, 65535, &port))) {
-        fprintf(stderr, "%s: the broker must be mqtt://HOST[:PORT] with a port from 1 to 65535, not \"%s\"\n", prog,
-                url);
+        fprintf(stderr, "%s: the broker must be %s://HOST[:PORT] with a port from 1 to 65535, not \"%s\"\n", prog,
+                tls ? "mqtts" : "mqtt", url);
         return false;
     }
     memcpy(o->broker_host, rest, host_len);
     o->broker_host[host_len] = '\0';
     o->broker_port = (int)port;
+    o->broker_tls = tls;
     return true;
+}
+
+/* The deployment's value of a connection setting, under its environment
+ * variable; NULL when neither gives one. */
+static const char *setting(const char *env_name, const char *deployed)
+{
+    const char *env = getenv(env_name);
+    return env && *env ? env : deployed;
+}
+
+#ifndef SEMO_DEPLOY_CLIENT_ID
+#define SEMO_DEPLOY_CLIENT_ID NULL
+#endif
+#ifndef SEMO_DEPLOY_USER
+#define SEMO_DEPLOY_USER NULL
+#endif
+#ifndef SEMO_DEPLOY_PASSWORD_FILE
+#define SEMO_DEPLOY_PASSWORD_FILE NULL
+#endif
+#ifndef SEMO_DEPLOY_CA
+#define SEMO_DEPLOY_CA NULL
+#endif
+#ifndef SEMO_DEPLOY_CERT
+#define SEMO_DEPLOY_CERT NULL
+#endif
+#ifndef SEMO_DEPLOY_KEY
+#define SEMO_DEPLOY_KEY NULL
+#endif
+
+/* Who the robot is at the broker, into `o->identity`; with the MQTT
+ * transport chosen, false (the problem printed) when the settings do not fit
+ * together. */
+static bool mqtt_identity(const char *prog, options *o)
+{
+    semo_transport_config *net = &o->identity;
+    net->broker_tls = o->broker_tls;
+    net->client_id = setting("SEMO_MQTT_CLIENT_ID", SEMO_DEPLOY_CLIENT_ID);
+    net->user = setting("SEMO_MQTT_USER", SEMO_DEPLOY_USER);
+    net->password_file = setting("SEMO_MQTT_PASSWORD_FILE", SEMO_DEPLOY_PASSWORD_FILE);
+    net->ca = setting("SEMO_MQTT_CA", SEMO_DEPLOY_CA);
+    net->cert = setting("SEMO_MQTT_CERT", SEMO_DEPLOY_CERT);
+    net->key = setting("SEMO_MQTT_KEY", SEMO_DEPLOY_KEY);
+    const char *problem = NULL;
+    if (net->password_file && !net->user)
+        problem = "a password file needs a user ($SEMO_MQTT_USER)";
+    else if (!net->cert != !net->key)
+        problem = "a client certificate needs both $SEMO_MQTT_CERT and $SEMO_MQTT_KEY";
+    else if (net->broker_tls && !net->ca)
+        problem = "an mqtts:// broker needs the CA that signed its certificate ($SEMO_MQTT_CA)";
+    else if (!net->broker_tls && net->cert)
+        problem = "a client certificate needs an mqtts:// broker";
+    if (o->transport == &semo_udp_transport)
+        return true;
+    if (problem)
+        fprintf(stderr, "%s: %s\n", prog, problem);
+    return !problem;
 }
 
 /* 0: run; 1: help printed; 2: bad command line (message printed). */
@@ -1004,7 +1076,7 @@ static int parse_options(int argc, char **argv, options *o)
             break;
         }
     }
-    return 0;
+    return mqtt_identity(prog, o) ? 0 : 2;
 }
 
 /* The generator's tables, checked once so that the calls above can trust them. */
@@ -1194,8 +1266,10 @@ static int run(const options *o)
     atomic_store(&g_running, true);
     /* A robot alone in its mission has no one to hear from: no port, no receiver. */
     if (p->peer_count > 1) {
-        semo_transport_config net = {
-            .port_base = o->port_base, .broker_host = o->broker_host, .broker_port = o->broker_port};
+        semo_transport_config net = o->identity;
+        net.port_base = o->port_base;
+        net.broker_host = o->broker_host;
+        net.broker_port = o->broker_port;
         if (o->transport->open(p, &net) != 0) {
             if (o->transport == &semo_udp_transport)
                 fprintf(stderr, "semo runtime: cannot open the udp transport on port %ld\n", o->port_base + (long)p->self);
