@@ -696,3 +696,138 @@ fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
         modes(&commanded["irobot"])
     );
 }
+
+/// A throwaway CA in `dir` (`ca.crt`), the broker's certificate for
+/// 127.0.0.1 (`server.crt`/`server.key`) and a client certificate for the
+/// master (`irobot.crt`/`irobot.key`), made with `openssl`.
+fn tls_files(dir: &Path) {
+    let openssl = |args: &[&str]| {
+        let out = Command::new("openssl")
+            .args(args)
+            .current_dir(dir)
+            .output()
+            .expect("openssl runs");
+        assert!(
+            out.status.success(),
+            "openssl {args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    openssl(&[
+        "req",
+        "-x509",
+        "-newkey",
+        "rsa:2048",
+        "-nodes",
+        "-days",
+        "2",
+        "-subj",
+        "/CN=semo test CA",
+        "-keyout",
+        "ca.key",
+        "-out",
+        "ca.crt",
+    ]);
+    std::fs::write(dir.join("server.ext"), "subjectAltName = IP:127.0.0.1\n").unwrap();
+    for (name, extensions) in [("server", Some("server.ext")), ("irobot", None)] {
+        let (key, csr, crt) = (
+            format!("{name}.key"),
+            format!("{name}.csr"),
+            format!("{name}.crt"),
+        );
+        openssl(&[
+            "req",
+            "-newkey",
+            "rsa:2048",
+            "-nodes",
+            "-subj",
+            &format!("/CN={name}"),
+            "-keyout",
+            &key,
+            "-out",
+            &csr,
+        ]);
+        let mut sign = vec![
+            "x509",
+            "-req",
+            "-in",
+            &csr,
+            "-CA",
+            "ca.crt",
+            "-CAkey",
+            "ca.key",
+            "-CAcreateserial",
+            "-days",
+            "2",
+            "-out",
+            &crt,
+        ];
+        if let Some(file) = extensions {
+            sign.extend(["-extfile", file]);
+        }
+        openssl(&sign);
+    }
+}
+
+#[test]
+fn robots_run_over_tls_with_client_certificates() {
+    let Some(binary) = broker_or_skip("robots_run_over_tls_with_client_certificates") else {
+        return;
+    };
+    let out = scratch("mqtt-tls");
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    tls_files(&out);
+    let deploy = scouting_deployment(&out, port, true);
+    let config = broker_config(&out, &deploy);
+    let conf = std::fs::read_to_string(&config).unwrap();
+    assert!(
+        conf.contains("certfile ") && conf.contains("cafile "),
+        "{conf}"
+    );
+    let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
+    let mut processes = Processes::default();
+    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+    let traces = run_together(
+        &folders,
+        &out,
+        "tls",
+        &["--transport".into(), "mqtt".into()],
+        &mut processes,
+    );
+    assert_eq!(traces.len(), 3);
+    for (robot, events) in &traces {
+        assert_eq!(
+            modes(events).last().map(String::as_str),
+            Some("FINISH"),
+            "{robot} over TLS: {:?}",
+            modes(events)
+        );
+    }
+    for slave in ["ti", "nxt"] {
+        assert!(
+            received_from(&traces["irobot"], slave, "SlaveTeam.COLOR")
+                .iter()
+                .any(|v| v == "RGB"),
+            "the master hears {slave} over TLS"
+        );
+    }
+    // The broker speaks only TLS: a plain connection with a slave's
+    // credentials is refused, so the robots above did use TLS.
+    let nxt = folders.iter().find(|f| robot_name(f) == "nxt").unwrap();
+    let (code, stderr) = run_with(
+        nxt,
+        &[
+            "--transport",
+            "mqtt",
+            "--broker",
+            &format!("mqtt://127.0.0.1:{port}"),
+            "--duration",
+            "100",
+        ],
+    );
+    assert_eq!(code, Some(1), "{stderr}");
+}
