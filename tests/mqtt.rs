@@ -831,3 +831,85 @@ fn robots_run_over_tls_with_client_certificates() {
     );
     assert_eq!(code, Some(1), "{stderr}");
 }
+
+/// The retained status of `robot` on the broker at `port` (anonymous), as
+/// a JSON object; None when there is none within a few seconds.
+fn retained_status(port: u16, robot: &str) -> Option<serde_json::Value> {
+    let out = Command::new("mosquitto_sub")
+        .args(["-h", "127.0.0.1", "-p", &port.to_string()])
+        .args(["-t", &format!("semo/scouting/status/{robot}")])
+        .args(["-C", "1", "-W", "3", "--retained-only"])
+        .output()
+        .expect("mosquitto_sub runs (Debian mosquitto-clients)");
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text.lines().next()?;
+    Some(serde_json::from_str(line).unwrap_or_else(|e| panic!("{line}: {e}")))
+}
+
+#[test]
+fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
+    let Some(binary) =
+        broker_or_skip("each_robot_keeps_a_retained_status_and_a_killed_one_is_lost")
+    else {
+        return;
+    };
+    let out = scratch("mqtt-status");
+    let broker_dir = out.join("broker");
+    std::fs::create_dir_all(&broker_dir).unwrap();
+    let folders = build_scouting(&out);
+    let mut processes = Processes::default();
+    let (port, _) = start_broker(&binary, &broker_dir, &mut processes);
+    let mqtt = [
+        "--transport".to_string(),
+        "mqtt".into(),
+        "--broker".into(),
+        format!("mqtt://127.0.0.1:{port}"),
+    ];
+    let traces = run_together(&folders, &out, "status", &mqtt, &mut processes);
+    // After the run: each robot stopped, in its last mode, as its trace says.
+    for (robot, events) in &traces {
+        let status = retained_status(port, robot).unwrap_or_else(|| panic!("{robot}: no status"));
+        assert_eq!(status["robot"], robot.as_str(), "{status}");
+        assert_eq!(status["state"], "stopped", "{robot}: {status}");
+        assert_eq!(
+            status["mode"].as_str(),
+            modes(events).last().map(String::as_str),
+            "{robot}: {status}"
+        );
+    }
+    // A robot killed while running: the broker publishes its last will.
+    let irobot = folders.iter().find(|f| robot_name(f) == "irobot").unwrap();
+    let child = robot_command(irobot, &scenario(), &out.join("irobot.killed.jsonl"), 1)
+        .args(&mqtt)
+        .args(["--duration", "1000000"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the robot program starts");
+    let index = processes.push(child);
+    let mut running = None;
+    for _ in 0..50 {
+        running = retained_status(port, "irobot").filter(|s| s["state"] == "running");
+        if running.is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let running = running.expect("the running robot's status");
+    assert!(
+        running["services"]
+            .as_str()
+            .is_some_and(|s| s.contains("Action=")),
+        "the status names the service each plan runs: {running}"
+    );
+    processes.0[index].kill().unwrap();
+    processes.0[index].wait().unwrap();
+    let mut lost = None;
+    for _ in 0..50 {
+        lost = retained_status(port, "irobot").filter(|s| s["state"] == "lost");
+        if lost.is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    assert!(lost.is_some(), "the killed robot's status says lost");
+}

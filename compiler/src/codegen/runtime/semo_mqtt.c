@@ -200,6 +200,8 @@ static void on_message(struct mosquitto *mosq, void *obj, const struct mosquitto
     pthread_mutex_unlock(&g_lock);
 }
 
+static void status_topic(char *topic, size_t cap);
+
 /* The password: the first line of its file, without the line break. */
 static int read_password(const char *path, char *out, size_t cap)
 {
@@ -280,6 +282,12 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
         return -1;
     }
     mosquitto_int_option(g_mosq, MOSQ_OPT_TCP_NODELAY, 1);
+    /* If we vanish without disconnecting, the broker says so on our status. */
+    char will_topic[MQTT_TOPIC_MAX], will[MQTT_TOPIC_MAX];
+    status_topic(will_topic, sizeof will_topic);
+    int will_len = snprintf(will, sizeof will, "{\"robot\":\"%s\",\"event\":\"status\",\"state\":\"lost\"}",
+                            program->peers[program->self].robot);
+    mosquitto_will_set(g_mosq, will_topic, will_len, will, 1, true);
     mosquitto_connect_callback_set(g_mosq, on_connect);
     mosquitto_subscribe_callback_set(g_mosq, on_subscribe);
     mosquitto_publish_callback_set(g_mosq, on_publish);
@@ -382,6 +390,35 @@ static int mqtt_recv(void *data, size_t cap, int timeout_ms)
     return n;
 }
 
+/* semo/<mission>/status/<robot>. */
+static void status_topic(char *topic, size_t cap)
+{
+    snprintf(topic, cap, "semo");
+    append_level(topic, cap, g_mission);
+    append_level(topic, cap, "status");
+    append_level(topic, cap, g_program->peers[g_program->self].robot);
+}
+
+/* Retained, so that an operator who connects later sees it; QoS 1, so that
+ * the last one (stopped) reaches the broker before we disconnect. */
+static int mqtt_status(const char *json, size_t len)
+{
+    if (!g_mosq)
+        return -1;
+    char topic[MQTT_TOPIC_MAX];
+    status_topic(topic, sizeof topic);
+    pthread_mutex_lock(&g_lock);
+    g_unacked++;
+    pthread_mutex_unlock(&g_lock);
+    int rc = mosquitto_publish(g_mosq, NULL, topic, (int)len, json, 1, true);
+    if (rc != MOSQ_ERR_SUCCESS) {
+        pthread_mutex_lock(&g_lock);
+        g_unacked--;
+        pthread_mutex_unlock(&g_lock);
+    }
+    return rc == MOSQ_ERR_SUCCESS ? 0 : -1;
+}
+
 static void mqtt_interrupt(void)
 {
     pthread_mutex_lock(&g_lock);
@@ -416,6 +453,7 @@ const semo_transport semo_mqtt_transport = {
     .send_to = mqtt_send_to,
     .recv = mqtt_recv,
     .interrupt = mqtt_interrupt,
+    .status = mqtt_status,
     .close = mqtt_close,
 };
 #else

@@ -145,8 +145,14 @@ static void put_file(void *file, const char *bytes, size_t n)
     fwrite(bytes, 1, n, (FILE *)file);
 }
 
+static void observe_status(const char *event, va_list args);
+
 void semo_trace(const char *event, ...)
 {
+    va_list seen;
+    va_start(seen, event);
+    observe_status(event, seen);
+    va_end(seen);
     pthread_mutex_lock(&g_trace_lock);
     if (g_trace) {
         /* The time is read under the lock so that lines are in time order. */
@@ -756,6 +762,124 @@ int semo_comm_poll(semo_message *out, int64_t timeout_ms)
         semo_trace("receive", "from", out->from_team, "from_robot", out->from_robot, "key", out->key, "value",
                    out->value.text, NULL);
     return got;
+}
+
+/* -------------------------------------------------------------- status */
+
+/* The robot's status for operators, kept from the trace's own events (the
+ * trace is the record of what the robot does, so the status cannot say
+ * something else): its state (running, finished, stopped; the broker's last
+ * will says lost), mode, leader and the service each plan runs. Published
+ * on every change through the transport's `status` (MQTT: retained on
+ * semo/<mission>/status/<robot>) as one JSON line of the trace's form:
+ * {"t":..,"robot":..,"event":"status","state":..,"mode":..,"leader":..,
+ * "services":"Plan=Service,..."}. */
+#define STATUS_PLANS 16
+#define STATUS_NAME 64
+static struct {
+    pthread_mutex_t lock;
+    char state[16];
+    char mode[STATUS_NAME];
+    char leader[STATUS_NAME];
+    struct {
+        char plan[STATUS_NAME], service[STATUS_NAME];
+    } running[STATUS_PLANS];
+    size_t running_count;
+} g_status = {.lock = PTHREAD_MUTEX_INITIALIZER};
+
+typedef struct {
+    char text[1024 + 4 * STATUS_PLANS * STATUS_NAME];
+    size_t len;
+} status_buffer;
+
+static void put_status(void *ctx, const char *bytes, size_t n)
+{
+    status_buffer *b = ctx;
+    size_t room = sizeof b->text - 1 - b->len;
+    n = n < room ? n : room;
+    memcpy(b->text + b->len, bytes, n);
+    b->len += n;
+    b->text[b->len] = '\0';
+}
+
+static void status_line(status_buffer *b, const char *event, ...)
+{
+    semo__sink sink = {put_status, b};
+    va_list args;
+    va_start(args, event);
+    semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args);
+    va_end(args);
+}
+
+/* The value of `key` among a trace call's pairs, or NULL. */
+static const char *pair_value(va_list args, const char *key)
+{
+    va_list scan;
+    va_copy(scan, args);
+    const char *found = NULL;
+    for (const char *k = va_arg(scan, const char *); k && !found; k = va_arg(scan, const char *)) {
+        const char *v = va_arg(scan, const char *);
+        if (!v)
+            break;
+        if (strcmp(k, key) == 0)
+            found = v;
+    }
+    va_end(scan);
+    return found;
+}
+
+static void copy_name(char *out, const char *name)
+{
+    snprintf(out, STATUS_NAME, "%s", name ? name : "");
+}
+
+static void observe_status(const char *event, va_list args)
+{
+    const semo_transport *transport = g_transport;
+    if (!transport || !transport->status)
+        return;
+    pthread_mutex_lock(&g_status.lock);
+    bool changed = true;
+    if (strcmp(event, "start") == 0) {
+        snprintf(g_status.state, sizeof g_status.state, "running");
+    } else if (strcmp(event, "finish") == 0) {
+        snprintf(g_status.state, sizeof g_status.state, "finished");
+    } else if (strcmp(event, "stop") == 0) {
+        snprintf(g_status.state, sizeof g_status.state, "stopped");
+    } else if (strcmp(event, "mode") == 0) {
+        copy_name(g_status.mode, pair_value(args, "mode"));
+    } else if (strcmp(event, "leader") == 0) {
+        copy_name(g_status.leader, pair_value(args, "leader"));
+    } else if (strcmp(event, "service_start") == 0 || strcmp(event, "service_end") == 0) {
+        const char *plan = pair_value(args, "plan");
+        size_t i = 0;
+        while (i < g_status.running_count && strcmp(g_status.running[i].plan, plan ? plan : "") != 0)
+            i++;
+        bool starts = strcmp(event, "service_start") == 0;
+        if (starts && i == g_status.running_count && i < STATUS_PLANS) {
+            g_status.running_count++;
+            copy_name(g_status.running[i].plan, plan);
+        }
+        if (i < g_status.running_count)
+            copy_name(g_status.running[i].service, starts ? pair_value(args, "service") : "");
+    } else {
+        changed = false;
+    }
+    if (changed) {
+        char services[STATUS_PLANS * 2 * STATUS_NAME + STATUS_PLANS * 2] = "";
+        size_t at = 0;
+        for (size_t i = 0; i < g_status.running_count; i++)
+            if (g_status.running[i].service[0] && at < sizeof services)
+                at += (size_t)snprintf(services + at, sizeof services - at, "%s%s=%s", at ? "," : "",
+                                       g_status.running[i].plan, g_status.running[i].service);
+        status_buffer line = {.len = 0};
+        status_line(&line, "status", "state", g_status.state, "mode", g_status.mode, "leader", g_status.leader,
+                    "services", services, NULL);
+        if (line.len > 0 && line.text[line.len - 1] == '\n')
+            line.text[--line.len] = '\0'; /* one JSON object, not a line */
+        transport->status(line.text, line.len);
+    }
+    pthread_mutex_unlock(&g_status.lock);
 }
 
 static void *receiver_thread(void *arg)

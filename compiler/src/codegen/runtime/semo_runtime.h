@@ -282,6 +282,9 @@ typedef struct {
     /* Makes a recv under way, and every later one, return 0 at once (the
      * program is stopping); safe from any thread. */
     void (*interrupt)(void);
+    /* Publishes the robot's status (a JSON object, see semo_runtime.c) for
+     * operators, replacing the last one; NULL: the transport has none. */
+    int (*status)(const char *json, size_t len);
     void (*close)(void);
 } semo_transport;
 extern const semo_transport semo_udp_transport;
