@@ -273,6 +273,25 @@ fn svg_draws_the_graph_to_stdout_or_a_file_and_refuses_a_broken_file() {
     assert_eq!(broken.code, 1);
     assert!(broken.stdout.is_empty());
     assert!(broken.stderr.contains("E064"), "{}", broken.stderr);
+    // A graph that deadlocks is drawn, its blocking cycle in red.
+    let deadlock = semo_in(
+        &support::repo_root().join("tests/fixtures/diagnostics/E071_deadlock"),
+        &["graph", "svg", "graph.taskgraph.xml"],
+    );
+    assert_eq!(deadlock.code, 0, "{}", deadlock.stderr);
+    for task in ["X", "Y"] {
+        let marked = format!("<g class=\"node task deadlock\" data-path=\"{task}\">");
+        assert!(deadlock.stdout.contains(&marked), "{}", deadlock.stdout);
+    }
+    assert_eq!(
+        deadlock
+            .stdout
+            .matches("<g class=\"edge data deadlock\"")
+            .count(),
+        2,
+        "{}",
+        deadlock.stdout
+    );
     let missing = semo_in(&dir, &["graph", "svg", "no_such.taskgraph.xml"]);
     assert_eq!(missing.code, 2, "{}", missing.stderr);
 }

@@ -71,14 +71,19 @@ pub fn dot(path: &Path, out: &mut impl Write) -> i32 {
     }
 }
 
-/// `semo graph svg`: the SVG picture on `out` or in `output`, or the loading
-/// errors (exit 1).
+/// `semo graph svg`: the SVG picture on `out` or in `output`, with the cycles
+/// that deadlock marked, or the loading errors (exit 1).
 pub fn svg(path: &Path, output: Option<&Path>, out: &mut impl Write) -> i32 {
     let graph = match load_clean(path) {
         Ok(g) => g,
         Err(code) => return code,
     };
-    write_picture(&semo::taskgraph::to_svg(&graph), output, out)
+    let report = semo::taskgraph::analysis::analyze(&graph);
+    write_picture(
+        &semo::taskgraph::to_svg_analyzed(&graph, &report),
+        output,
+        out,
+    )
 }
 
 /// `semo graph modes`: the mode machines of a mission, checked as `semo check

@@ -39,6 +39,29 @@ async fn a_task_graph_is_drawn_as_the_cli_draws_it() {
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_deadlocked_cycle_is_marked_in_the_editor_picture() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures/diagnostics/E071_deadlock/graph.taskgraph.xml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let uri = "file:///g/deadlock.taskgraph.xml";
+    let mut client = semo_server::harness::TestClient::start();
+    client.initialize(&["utf-16"], None).await;
+    client.open(uri, &text).await;
+    let answer = graph_svg(&mut client, uri, None).await.unwrap();
+    let svg = answer["svg"].as_str().unwrap();
+    assert!(
+        svg.contains("<g class=\"node task deadlock\" data-path=\"X\">"),
+        "{svg}"
+    );
+    assert_eq!(
+        svg.matches("<g class=\"edge data deadlock\"").count(),
+        2,
+        "{svg}"
+    );
+    client.shutdown().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_mission_gives_its_mode_machines_as_edited() {
     let text = shared("scouting/scouting.mission");
     let uri = "file:///m/scouting.mission";

@@ -10,5 +10,5 @@ mod xml;
 
 pub mod write;
 pub use model::*;
-pub use svg::to_svg;
+pub use svg::{to_svg, to_svg_analyzed};
 pub use xml::{ExecutionTimes, GraphFormat, detect_format, load_task_graph, load_task_graph_as};

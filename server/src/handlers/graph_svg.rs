@@ -23,7 +23,9 @@ pub fn graph_svg(snapshot: &Snapshot, team: Option<&str>) -> jsonrpc::Result<Val
     let analysis = snapshot.analysis();
     if let Some(run) = &analysis.graph {
         return match &run.graph {
-            Some(graph) => Ok(json!({ "svg": semo::taskgraph::to_svg(graph) })),
+            Some(graph) => {
+                Ok(json!({ "svg": semo::taskgraph::to_svg_analyzed(graph, &run.report) }))
+            }
             None => Err(super::request_failed(
                 "the task graph could not be read; see its diagnostics".to_string(),
             )),

@@ -33,6 +33,8 @@ pub struct LevelReport {
     pub repetition: Option<Vec<u64>>,
     /// Whether one iteration completes (`None` when inconsistent).
     pub deadlock_free: Option<bool>,
+    /// When it does not: the cycle that blocks it.
+    pub blocked: Option<BlockedCycle>,
     /// A looped single-appearance schedule (`3A 2B`), else a flat one, when
     /// the level is consistent and deadlock-free.
     pub schedule: Option<String>,
@@ -40,6 +42,16 @@ pub struct LevelReport {
     pub buffers: Vec<BufferBound>,
     /// The self-timed iteration period, when execution times are known.
     pub throughput: Option<ThroughputReport>,
+}
+
+/// A cycle of a level whose tasks wait for each other, so that one iteration
+/// cannot complete: what the deadlock diagnostic names, as data for pictures.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BlockedCycle {
+    /// The level's node names around the cycle, in flow order.
+    pub nodes: Vec<String>,
+    /// The cycle's channels: indices in the level's graph's `channels`.
+    pub channels: Vec<usize>,
 }
 
 /// The iteration period of the self-timed execution and the cycle bounding it.
@@ -206,6 +218,7 @@ fn analyze_level(
         nodes,
         repetition: None,
         deadlock_free: None,
+        blocked: None,
         schedule: None,
         buffers: Vec::new(),
         throughput: None,
@@ -222,6 +235,14 @@ fn analyze_level(
                 }
             }
             level_report.deadlock_free = Some(blocked.is_none());
+            level_report.blocked = blocked.map(|b| BlockedCycle {
+                nodes: b
+                    .nodes
+                    .iter()
+                    .map(|&n| level.nodes[n].name.clone())
+                    .collect(),
+                channels: b.edges.iter().map(|&e| level.edges[e].channel).collect(),
+            });
             level_report.repetition = Some(counts);
         }
         Err(problem) => diagnostics.push(rate_diagnostic(level, &problem)),

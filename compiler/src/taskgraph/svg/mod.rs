@@ -23,13 +23,24 @@ mod scene;
 #[cfg(test)]
 mod tests;
 
+use super::analysis::GraphReport;
 use super::model::TaskGraph;
 
 /// The SVG picture of `graph`: a standalone document (`xmlns`, `viewBox`).
 /// Accepts any graph the loader returns, including ones with errors (a
 /// channel end naming no task is drawn as a dashed placeholder).
 pub fn to_svg(graph: &TaskGraph) -> String {
-    let scene = scene::build(graph);
+    draw(graph, None)
+}
+
+/// [`to_svg`] with what the analysis of `graph` found marked: the tasks and
+/// channels of a cycle that deadlocks are drawn in red (class `deadlock`).
+pub fn to_svg_analyzed(graph: &TaskGraph, report: &GraphReport) -> String {
+    draw(graph, Some(report))
+}
+
+fn draw(graph: &TaskGraph, report: Option<&GraphReport>) -> String {
+    let scene = scene::build(graph, report);
     let placed = place::layout(&scene);
     render::svg(&graph.name, &scene, &placed)
 }

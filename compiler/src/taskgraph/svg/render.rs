@@ -45,8 +45,11 @@ pub(super) fn svg(name: &str, root: &Level, placed: &Placed) -> String {
         "<marker id=\"semo-arrow\" viewBox=\"0 0 10 10\" refX=\"10\" refY=\"5\" markerWidth=\"7\" markerHeight=\"7\" orient=\"auto\"><path d=\"M0,1L10,5L0,9z\" fill=\"#333\"/></marker>\n",
         "<marker id=\"semo-odot\" viewBox=\"0 0 10 10\" refX=\"9\" refY=\"5\" markerWidth=\"7\" markerHeight=\"7\" orient=\"auto\"><circle cx=\"5\" cy=\"5\" r=\"4\" fill=\"#fff\" stroke=\"#2e7d32\" stroke-width=\"1.5\"/></marker>\n",
         "<marker id=\"semo-open\" viewBox=\"0 0 10 10\" refX=\"10\" refY=\"5\" markerWidth=\"7\" markerHeight=\"7\" orient=\"auto\"><path d=\"M1,1L10,5L1,9\" fill=\"none\" stroke=\"#7b1fa2\" stroke-width=\"1.5\"/></marker>\n",
-        "</defs>\n"
     ));
+    if has_deadlock(root) {
+        out.push_str("<marker id=\"semo-arrow-deadlock\" viewBox=\"0 0 10 10\" refX=\"10\" refY=\"5\" markerWidth=\"6\" markerHeight=\"6\" orient=\"auto\"><path d=\"M0,1L10,5L0,9z\" fill=\"#c62828\"/></marker>\n");
+    }
+    out.push_str("</defs>\n");
     let _ = writeln!(
         out,
         "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"#fff\"/>",
@@ -110,8 +113,12 @@ impl Writer {
                 self.edges(body, inner, ox + b.x, oy + b.y);
             }
         }
-        for (edge, route) in level.edges.iter().zip(&placed.routes) {
+        for (e, (edge, route)) in level.edges.iter().zip(&placed.routes).enumerate() {
+            let deadlocked = level.deadlocked_edges.contains(&e);
             let (class, stroke) = match edge.style {
+                Style::Data if deadlocked => {
+                    ("data deadlock", "stroke=\"#c62828\" stroke-width=\"2.4\"")
+                }
                 Style::Data => ("data", "stroke=\"#333\" stroke-width=\"1.2\""),
                 Style::Call => (
                     "call",
@@ -130,6 +137,7 @@ impl Writer {
             // where it reaches its library or group, not at a relay.
             let marker = match edge.style {
                 _ if edge.style != Style::Data && is_relay(level, edge.to) => "",
+                Style::Data if deadlocked => " marker-end=\"url(#semo-arrow-deadlock)\"",
                 Style::Data => " marker-end=\"url(#semo-arrow)\"",
                 Style::Call => " marker-end=\"url(#semo-odot)\"",
                 Style::Serve => "",
@@ -142,6 +150,11 @@ impl Writer {
                 escape(end_path(level, edge.to)),
                 path_data(route, ox, oy)
             );
+            if deadlocked {
+                self.out.push_str(
+                    "<title>a channel of a deadlocked cycle: too few initial samples for one iteration</title>",
+                );
+            }
             for label in [&route.tail, &route.head].into_iter().flatten() {
                 self.label(label, ox, oy, false);
             }
@@ -239,6 +252,17 @@ impl Writer {
                 ),
             };
             let (class, paint) = style;
+            let (class, paint, tooltip) = if level.deadlocked_nodes.contains(&v) {
+                // The node's own fill, a red border.
+                let fill = paint.split(" stroke=").next().unwrap_or(paint);
+                (
+                    format!("{class} deadlock"),
+                    format!("{fill} stroke=\"#c62828\" stroke-width=\"2.6\""),
+                    format!("{tooltip} (in a deadlocked cycle)"),
+                )
+            } else {
+                (class.to_string(), paint.to_string(), tooltip.to_string())
+            };
             let _ = write!(
                 self.out,
                 "<g class=\"node {class}\" data-path=\"{path}\"><title>{tooltip}</title><rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" rx=\"4\" {paint}/>",
@@ -319,6 +343,17 @@ impl Writer {
 
 /// The `data-path` of what an edge end attaches to (a cluster's port or relay,
 /// or the node itself).
+/// Whether `level` or a loop body inside it has a deadlocked channel, so
+/// that its arrowhead is defined only in pictures that use it.
+fn has_deadlock(level: &Level) -> bool {
+    !level.deadlocked_edges.is_empty()
+        || level
+            .nodes
+            .iter()
+            .filter_map(|n| n.cluster.as_deref())
+            .any(has_deadlock)
+}
+
 fn end_path(level: &Level, end: End) -> &str {
     let node = &level.nodes[end.node];
     match (end.port, &node.cluster) {

@@ -9,6 +9,7 @@
 //! level (groups are global), and a call from inside a loop is drawn as a
 //! dashed line to the border and on from there to the library.
 
+use crate::taskgraph::analysis::{BlockedCycle, GraphReport};
 use crate::taskgraph::model::*;
 use std::collections::{HashMap, HashSet};
 
@@ -90,6 +91,10 @@ pub(super) struct Edge {
 pub(super) struct Level {
     pub nodes: Vec<Node>,
     pub edges: Vec<Edge>,
+    /// The nodes and edges of a cycle that blocks this level (the analysis's
+    /// deadlock), drawn in red.
+    pub deadlocked_nodes: HashSet<usize>,
+    pub deadlocked_edges: HashSet<usize>,
 }
 
 /// A connection that must leave a loop body.
@@ -99,9 +104,10 @@ enum Ext {
     Group(String),
 }
 
-/// The picture's top level.
-pub(super) fn build(graph: &TaskGraph) -> Level {
-    let mut b = Builder::new(String::new());
+/// The picture's top level; `report`, the graph's analysis, marks the cycles
+/// that deadlock.
+pub(super) fn build(graph: &TaskGraph, report: Option<&GraphReport>) -> Level {
+    let mut b = Builder::new(String::new(), graph.name.clone(), report);
     b.fill(graph);
     b.level
 }
@@ -110,8 +116,11 @@ pub(super) fn build(graph: &TaskGraph) -> Level {
 /// rate seen from inside) by port name.
 type Enclosing = (String, HashMap<String, (usize, String)>);
 
-struct Builder {
+struct Builder<'r> {
     prefix: String,
+    /// The level's path in the analysis report (`graph`, `graph/Loop`).
+    analysis_path: String,
+    report: Option<&'r GraphReport>,
     level: Level,
     enclosing: Option<Enclosing>,
     /// Task name → (node index, index in the graph's tasks).
@@ -126,10 +135,12 @@ struct Builder {
     requests: Vec<(Ext, Side, usize)>,
 }
 
-impl Builder {
-    fn new(prefix: String) -> Builder {
+impl<'r> Builder<'r> {
+    fn new(prefix: String, analysis_path: String, report: Option<&'r GraphReport>) -> Builder<'r> {
         Builder {
             prefix,
+            analysis_path,
+            report,
             level: Level::default(),
             enclosing: None,
             tasks: HashMap::new(),
@@ -173,6 +184,7 @@ impl Builder {
     /// channels, then library and multicast connections (those of inner
     /// loops last, once every library of this level is known).
     fn fill(&mut self, graph: &TaskGraph) {
+        let blocked = self.blocked_cycle();
         let mut pending = Vec::new();
         // The ports that this level's channels name, per task: a loop's
         // cluster needs a place for each.
@@ -204,6 +216,9 @@ impl Builder {
             self.tasks
                 .entry(task.name.name.clone())
                 .or_insert((index, t));
+            if blocked.is_some_and(|b| b.nodes.contains(&task.name.name)) {
+                self.level.deadlocked_nodes.insert(index);
+            }
         }
         for library in &graph.libraries {
             let node = Node {
@@ -219,7 +234,10 @@ impl Builder {
                 .entry(library.name.name.clone())
                 .or_insert(index);
         }
-        for channel in &graph.channels {
+        for (c, channel) in graph.channels.iter().enumerate() {
+            if blocked.is_some_and(|b| b.channels.contains(&c)) {
+                self.level.deadlocked_edges.insert(self.level.edges.len());
+            }
             let (from, tail) = self.channel_end(graph, &channel.src);
             let (to, head) = self.channel_end(graph, &channel.dst);
             let mid = match channel.initial_tokens {
@@ -317,7 +335,11 @@ impl Builder {
                 ports.push((port.to_string(), side, None));
             }
         }
-        let mut inner = Builder::new(format!("{path}/"));
+        let mut inner = Builder::new(
+            format!("{path}/"),
+            format!("{}/{name}", self.analysis_path),
+            self.report,
+        );
         let mut by_name = HashMap::new();
         let mut from_inside = HashMap::new();
         for (port, side, declared) in ports {
@@ -360,6 +382,16 @@ impl Builder {
         let index = self.add(node);
         self.cluster_ports.insert(index, by_name);
         (index, inner.requests)
+    }
+
+    /// The cycle that blocks this level, if the analysis found one.
+    fn blocked_cycle(&self) -> Option<&'r BlockedCycle> {
+        let report = self.report?;
+        let level = report
+            .levels
+            .iter()
+            .find(|l| l.path == self.analysis_path)?;
+        level.blocked.as_ref()
     }
 
     /// Where a channel end attaches, and the rate written next to it.

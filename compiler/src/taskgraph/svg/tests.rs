@@ -715,3 +715,76 @@ proptest! {
         check(&g, "random");
     }
 }
+
+/// The picture of `g` with its analysis: the paths of the nodes drawn as
+/// deadlocked, and the ends of the channels drawn so.
+fn deadlock_marks(g: &TaskGraph) -> (Vec<String>, Vec<(String, String)>) {
+    let report = crate::taskgraph::analysis::analyze(g);
+    let pic = read_picture(&super::to_svg_analyzed(g, &report));
+    let mut nodes: Vec<String> = pic
+        .shapes
+        .iter()
+        .filter(|(_, s)| s.class.ends_with(" deadlock"))
+        .map(|(path, _)| path.clone())
+        .collect();
+    nodes.sort();
+    let mut edges: Vec<(String, String)> = pic
+        .edges
+        .iter()
+        .filter(|e| e.class == "edge data deadlock")
+        .map(|e| (e.from.clone(), e.to.clone()))
+        .collect();
+    edges.sort();
+    (nodes, edges)
+}
+
+fn pair(a: &str, b: &str) -> (String, String) {
+    (a.to_string(), b.to_string())
+}
+
+#[test]
+fn a_deadlocked_cycle_is_drawn_in_red_and_nothing_else_is() {
+    // S feeds the cycle X → Y → X, which has no initial sample; Z hangs off it.
+    let g = graph_of(concat!(
+        "<Task name=\"S\"><Port name=\"o\" dir=\"out\"/></Task>",
+        "<Task name=\"X\"><Port name=\"in\" dir=\"in\"/><Port name=\"fb\" dir=\"in\"/><Port name=\"o\" dir=\"out\"/></Task>",
+        "<Task name=\"Y\"><Port name=\"i\" dir=\"in\"/><Port name=\"back\" dir=\"out\"/><Port name=\"o\" dir=\"out\"/></Task>",
+        "<Task name=\"Z\"><Port name=\"i\" dir=\"in\"/></Task>",
+        "<Channel src=\"S.o\" dst=\"X.in\"/>",
+        "<Channel src=\"X.o\" dst=\"Y.i\"/>",
+        "<Channel src=\"Y.back\" dst=\"X.fb\"/>",
+        "<Channel src=\"Y.o\" dst=\"Z.i\"/>",
+    ));
+    let (nodes, edges) = deadlock_marks(&g);
+    assert_eq!(nodes, ["X", "Y"]);
+    assert_eq!(edges, [pair("X", "Y"), pair("Y", "X")]);
+    // Without the analysis, or once a sample starts the cycle, nothing is red.
+    assert!(!to_svg(&g).contains("deadlock"));
+    let fixed = graph_of(concat!(
+        "<Task name=\"X\"><Port name=\"fb\" dir=\"in\"/><Port name=\"o\" dir=\"out\"/></Task>",
+        "<Task name=\"Y\"><Port name=\"i\" dir=\"in\"/><Port name=\"back\" dir=\"out\"/></Task>",
+        "<Channel src=\"X.o\" dst=\"Y.i\"/>",
+        "<Channel src=\"Y.back\" dst=\"X.fb\" initialTokens=\"1\"/>",
+    ));
+    assert_eq!(deadlock_marks(&fixed), (vec![], vec![]));
+}
+
+#[test]
+fn a_deadlock_inside_a_loop_body_is_marked_in_its_cluster() {
+    let g = graph_of(concat!(
+        "<Task name=\"A\"><Port name=\"o\" dir=\"out\"/></Task>",
+        "<Loop name=\"L\" type=\"D\" loopCount=\"2\">",
+        "<Port name=\"i\" dir=\"in\" kind=\"distributing\" outerRate=\"2\" innerRate=\"1\"/>",
+        "<TaskGraph>",
+        "<Task name=\"B\"><Port name=\"i\" dir=\"in\"/><Port name=\"fb\" dir=\"in\"/><Port name=\"o\" dir=\"out\"/></Task>",
+        "<Task name=\"C\"><Port name=\"i\" dir=\"in\"/><Port name=\"back\" dir=\"out\"/></Task>",
+        "<Channel src=\"L.i\" dst=\"B.i\"/>",
+        "<Channel src=\"B.o\" dst=\"C.i\"/>",
+        "<Channel src=\"C.back\" dst=\"B.fb\"/>",
+        "</TaskGraph></Loop>",
+        "<Channel src=\"A.o\" dst=\"L.i\"/>",
+    ));
+    let (nodes, edges) = deadlock_marks(&g);
+    assert_eq!(nodes, ["L/B", "L/C"]);
+    assert_eq!(edges, [pair("L/B", "L/C"), pair("L/C", "L/B")]);
+}
