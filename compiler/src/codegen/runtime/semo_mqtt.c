@@ -21,6 +21,7 @@
 #include <pthread.h>
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -53,6 +54,21 @@ static bool g_subscribed;
 static int g_connect_refused; /* the broker's CONNACK code when it refused */
 static int g_subscribe_mid = -1;
 static long g_unacked; /* messages handed to libmosquitto whose on_publish has not come */
+
+/* Sends made while the broker was unreachable, oldest first; g_send_lock
+ * also keeps sends in order against the flush (never held by a callback
+ * while it waits for g_lock, nor taken under g_lock). */
+/* At most this many (a robot sending every 10 ms waits about 80 s); each
+ * takes only its own size, allocated when the broker is away. */
+#define MQTT_OUTBOX 8192
+typedef struct {
+    size_t len;
+    unsigned char *data;
+    char topic[]; /* then the payload */
+} mqtt_outgoing;
+static pthread_mutex_t g_send_lock = PTHREAD_MUTEX_INITIALIZER;
+static mqtt_outgoing *g_outbox[MQTT_OUTBOX];
+static size_t g_out_head, g_out_count;
 
 /* A topic level made of a name: the characters MQTT gives a meaning to
  * (level separator, wildcards) become `_`. */
@@ -122,6 +138,8 @@ static struct timespec deadline_after(int ms)
     return t;
 }
 
+static void outbox_flush(void);
+
 /* On every (re)connection: subscribe again (the persistent session keeps the
  * subscriptions, but a broker that lost its state must learn them). */
 static void on_connect(struct mosquitto *mosq, void *obj, int rc)
@@ -145,6 +163,7 @@ static void on_connect(struct mosquitto *mosq, void *obj, int rc)
         g_subscribe_mid = mid;
         pthread_mutex_unlock(&g_lock);
     }
+    outbox_flush();
 }
 
 static void on_subscribe(struct mosquitto *mosq, void *obj, int mid, int count, const int *granted)
@@ -258,6 +277,7 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     g_connect_refused = 0;
     g_subscribe_mid = -1;
     g_unacked = 0;
+    g_out_head = g_out_count = 0;
     pthread_condattr_t attr;
     pthread_condattr_init(&attr);
     pthread_condattr_setclock(&attr, CLOCK_MONOTONIC);
@@ -325,6 +345,61 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     return 0;
 }
 
+/* Publishes, counting the message until on_publish (QoS 1: the broker's
+ * PUBACK; QoS 0: written to the socket), which may come first. */
+static int publish(const char *topic, const void *data, size_t len, int qos, bool retain)
+{
+    pthread_mutex_lock(&g_lock);
+    g_unacked++;
+    pthread_mutex_unlock(&g_lock);
+    int rc = mosquitto_publish(g_mosq, NULL, topic, (int)len, data, qos, retain);
+    if (rc != MOSQ_ERR_SUCCESS) {
+        pthread_mutex_lock(&g_lock);
+        g_unacked--;
+        pthread_mutex_unlock(&g_lock);
+    }
+    return rc;
+}
+
+/* Under g_send_lock: keeps a send for the next connection; false when the
+ * outbox is full (the send is then lost, and said so by the caller). */
+static bool outbox_put(const char *topic, const void *data, size_t len)
+{
+    size_t topic_len = strlen(topic) + 1;
+    mqtt_outgoing *kept = g_out_count < MQTT_OUTBOX ? malloc(sizeof *kept + topic_len + len) : NULL;
+    if (!kept)
+        return false;
+    memcpy(kept->topic, topic, topic_len);
+    kept->data = (unsigned char *)kept->topic + topic_len;
+    kept->len = len;
+    memcpy(kept->data, data, len);
+    g_outbox[(g_out_head + g_out_count) % MQTT_OUTBOX] = kept;
+    g_out_count++;
+    pthread_mutex_lock(&g_lock); /* close waits for it too */
+    g_unacked++;
+    pthread_mutex_unlock(&g_lock);
+    return true;
+}
+
+/* On a (re)connection: the sends kept meanwhile go first, in order. */
+static void outbox_flush(void)
+{
+    pthread_mutex_lock(&g_send_lock);
+    while (g_out_count > 0) {
+        mqtt_outgoing *kept = g_outbox[g_out_head];
+        if (publish(kept->topic, kept->data, kept->len, 1, false) != MOSQ_ERR_SUCCESS)
+            break; /* gone again: the next connection retries */
+        free(kept);
+        g_outbox[g_out_head] = NULL;
+        g_out_head = (g_out_head + 1) % MQTT_OUTBOX;
+        g_out_count--;
+        pthread_mutex_lock(&g_lock); /* now counted by publish */
+        g_unacked--;
+        pthread_mutex_unlock(&g_lock);
+    }
+    pthread_mutex_unlock(&g_send_lock);
+}
+
 /* `to` is a team (every robot of it hears) or one robot's name. */
 static int mqtt_send_to(const char *to, const void *data, size_t len)
 {
@@ -349,21 +424,19 @@ static int mqtt_send_to(const char *to, const void *data, size_t len)
     else
         return -1;
     bool is_send = ((const unsigned char *)data)[5] == SEMO_MSG_SEND;
-    int qos = is_send ? 1 : 0;
-    /* Counted before publishing: on_publish (QoS 1: the broker's PUBACK;
-     * QoS 0: written to the socket) may come first. */
-    pthread_mutex_lock(&g_lock);
-    g_unacked++;
-    pthread_mutex_unlock(&g_lock);
-    /* While disconnected libmosquitto queues QoS 1 messages and sends them on
-     * reconnection; a QoS 0 publish is then lost, as on UDP. */
-    int rc = mosquitto_publish(g_mosq, NULL, topic, (int)len, data, qos, !is_send);
-    if (rc != MOSQ_ERR_SUCCESS) {
-        pthread_mutex_lock(&g_lock);
-        g_unacked--;
-        pthread_mutex_unlock(&g_lock);
+    if (!is_send) {
+        /* A publish while disconnected is lost, as on UDP: the next one
+         * carries the latest value. */
+        int rc = publish(topic, data, len, 0, true);
+        return rc == MOSQ_ERR_SUCCESS || rc == MOSQ_ERR_NO_CONN ? 0 : -1;
     }
-    return rc == MOSQ_ERR_SUCCESS || (rc == MOSQ_ERR_NO_CONN && qos == 0) ? 0 : -1;
+    /* A send is never lost: while the broker is away (libmosquitto refuses
+     * to publish then) it waits in the outbox, in order, until on_connect. */
+    pthread_mutex_lock(&g_send_lock);
+    int rc = g_out_count == 0 ? publish(topic, data, len, 1, false) : MOSQ_ERR_NO_CONN;
+    bool queued = rc == MOSQ_ERR_NO_CONN || rc == MOSQ_ERR_CONN_LOST ? outbox_put(topic, data, len) : false;
+    pthread_mutex_unlock(&g_send_lock);
+    return rc == MOSQ_ERR_SUCCESS || queued ? 0 : -1;
 }
 
 static int mqtt_recv(void *data, size_t cap, int timeout_ms)
@@ -407,16 +480,8 @@ static int mqtt_status(const char *json, size_t len)
         return -1;
     char topic[MQTT_TOPIC_MAX];
     status_topic(topic, sizeof topic);
-    pthread_mutex_lock(&g_lock);
-    g_unacked++;
-    pthread_mutex_unlock(&g_lock);
-    int rc = mosquitto_publish(g_mosq, NULL, topic, (int)len, json, 1, true);
-    if (rc != MOSQ_ERR_SUCCESS) {
-        pthread_mutex_lock(&g_lock);
-        g_unacked--;
-        pthread_mutex_unlock(&g_lock);
-    }
-    return rc == MOSQ_ERR_SUCCESS ? 0 : -1;
+    int rc = publish(topic, json, len, 1, true);
+    return rc == MOSQ_ERR_SUCCESS || rc == MOSQ_ERR_NO_CONN ? 0 : -1;
 }
 
 static void mqtt_interrupt(void)
@@ -445,6 +510,12 @@ static void mqtt_close(void)
     g_mosq = NULL;
     mosquitto_lib_cleanup();
     pthread_cond_destroy(&g_changed);
+    /* Sends the broker never came back for are lost with the program. */
+    for (; g_out_count > 0; g_out_count--) {
+        free(g_outbox[g_out_head]);
+        g_outbox[g_out_head] = NULL;
+        g_out_head = (g_out_head + 1) % MQTT_OUTBOX;
+    }
 }
 
 const semo_transport semo_mqtt_transport = {

@@ -692,18 +692,32 @@ static size_t g_inbox_head, g_inbox_count;
 static pthread_mutex_t g_inbox_lock = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t g_inbox_cond;
 
+static bool g_inbox_read; /* a task polls the inbox (under g_inbox_lock) */
+
+/* How long a message waits for room in a full inbox that no task has read
+ * yet (mission ms): a robot that receives nothing must not hold back its
+ * transport for ever. */
+#define INBOX_UNREAD_WAIT_MS 1000
+
 void semo__deliver(const semo_message *msg)
 {
     pthread_mutex_lock(&g_inbox_lock);
+    /* A full inbox holds back the receiver, and through it the transport
+     * (MQTT: the broker keeps the rest of a burst, such as what it queued
+     * for a robot that reconnects), rather than losing a message. */
+    int64_t deadline = semo_now_ms() + INBOX_UNREAD_WAIT_MS;
+    while (g_inbox_count == COMM_QUEUE_CAPACITY && semo_running() && (g_inbox_read || semo_now_ms() < deadline))
+        wait_until(&g_inbox_cond, &g_inbox_lock, g_inbox_read ? -1 : deadline);
     bool queued = g_inbox_count < COMM_QUEUE_CAPACITY;
     if (queued) {
         g_inbox[(g_inbox_head + g_inbox_count) % COMM_QUEUE_CAPACITY] = *msg;
         g_inbox_count++;
-        pthread_cond_signal(&g_inbox_cond);
+        pthread_cond_broadcast(&g_inbox_cond);
     }
     pthread_mutex_unlock(&g_inbox_lock);
     if (!queued)
-        semo_trace("drop", "from", msg->from_team, "key", msg->key, "reason", "inbox full", NULL);
+        semo_trace("drop", "from", msg->from_team, "key", msg->key, "reason",
+                   semo_running() ? "inbox full" : "stopping", NULL);
 }
 
 int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value)
@@ -749,6 +763,7 @@ int semo_comm_poll(semo_message *out, int64_t timeout_ms)
         return 0;
     int64_t deadline = timeout_ms < 0 ? -1 : semo_now_ms() + timeout_ms;
     pthread_mutex_lock(&g_inbox_lock);
+    g_inbox_read = true;
     while (g_inbox_count == 0 && semo_running() && (deadline < 0 || semo_now_ms() < deadline))
         wait_until(&g_inbox_cond, &g_inbox_lock, deadline);
     bool got = g_inbox_count > 0;
@@ -756,6 +771,7 @@ int semo_comm_poll(semo_message *out, int64_t timeout_ms)
         *out = g_inbox[g_inbox_head];
         g_inbox_head = (g_inbox_head + 1) % COMM_QUEUE_CAPACITY;
         g_inbox_count--;
+        pthread_cond_broadcast(&g_inbox_cond); /* room for a waiting delivery */
     }
     pthread_mutex_unlock(&g_inbox_lock);
     if (got)
@@ -1267,6 +1283,7 @@ static void free_program_state(void)
     g_timers = NULL;
     g_timer_count = 0;
     g_inbox_head = g_inbox_count = 0;
+    g_inbox_read = false;
 }
 
 static bool allocate_program_state(const semo_program_desc *p)
