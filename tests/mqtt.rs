@@ -1043,3 +1043,95 @@ fn robots_reconnect_after_a_broker_restart_and_no_send_is_lost() {
         "each robot connected twice: {log}"
     );
 }
+
+#[test]
+fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
+    let Some(binary) =
+        broker_or_skip("a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead")
+    else {
+        return;
+    };
+    let out = scratch("mqtt-robot-restart");
+    let broker_dir = out.join("broker");
+    std::fs::create_dir_all(&broker_dir).unwrap();
+    let folders = build_scouting(&out);
+    let mut processes = Processes::default();
+    let (port, _) = start_broker(&binary, &broker_dir, &mut processes);
+    const SCALE: f64 = 0.4; // wall ms per mission ms
+    let spawn = |processes: &mut Processes, folder: &Path, tag: &str| {
+        let trace = out.join(format!("{}.{tag}.jsonl", robot_name(folder)));
+        let child = robot_command(folder, &scenario(), &trace, 1)
+            .args(["--transport", "mqtt", "--time-scale", &SCALE.to_string()])
+            .args(["--broker", &format!("mqtt://127.0.0.1:{port}")])
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the robot program starts");
+        (trace, processes.push(child))
+    };
+    let started = std::time::Instant::now();
+    let mut slaves = Vec::new();
+    let mut master = None;
+    for folder in &folders {
+        let (trace, index) = spawn(&mut processes, folder, "life");
+        if robot_name(folder) == "irobot" {
+            master = Some((folder.clone(), index));
+        } else {
+            slaves.push((robot_name(folder), trace, index));
+        }
+    }
+    let (irobot, first) = master.unwrap();
+    // Killed while the slaves send their colors; back a moment later.
+    std::thread::sleep(std::time::Duration::from_millis(600));
+    processes.0[first].kill().unwrap();
+    processes.0[first].wait().unwrap();
+    let killed = started.elapsed().as_secs_f64() * 1000.0;
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let back_at = started.elapsed().as_secs_f64() * 1000.0;
+    let (second_trace, second) = spawn(&mut processes, &irobot, "second-life");
+    let mut slave_traces = BTreeMap::new();
+    for (robot, trace, index) in slaves {
+        processes.wait_success(index, &robot);
+        slave_traces.insert(robot, read_trace(&trace));
+    }
+    processes.wait_success(second, "irobot (second life)");
+    let second_life = read_trace(&second_trace);
+    assert_eq!(
+        modes(&second_life).last().map(String::as_str),
+        Some("FINISH"),
+        "the restarted master runs its mission: {:?}",
+        modes(&second_life)
+    );
+    // What each slave sent while the master was dead (its mission clock
+    // started with ours; 50 ms of margin at each end) reaches the master's
+    // second life: its persistent session kept it.
+    let (from, to) = ((killed + 50.0) / SCALE, (back_at - 50.0) / SCALE);
+    for (slave, events) in &slave_traces {
+        let meanwhile: Vec<(String, String)> = events
+            .iter()
+            .filter(|e| {
+                let t = e["t"].as_f64().unwrap_or(0.0);
+                field(e, "event") == "send" && field(e, "to") == "MasterTeam" && t > from && t < to
+            })
+            .map(|e| (field(e, "key").to_string(), field(e, "value").to_string()))
+            .collect();
+        assert!(
+            !meanwhile.is_empty(),
+            "{slave} sent while the master was dead"
+        );
+        let mut received = received_all_from(&second_life, slave);
+        for message in &meanwhile {
+            let at = received.iter().position(|r| r == message);
+            assert!(
+                at.is_some(),
+                "{slave}'s {message:?}, sent while the master was dead, reaches its second life"
+            );
+            received.remove(at.unwrap());
+        }
+        assert!(
+            !slave_traces[slave]
+                .iter()
+                .any(|e| field(e, "event") == "comm_error"),
+            "{slave} never fails to send"
+        );
+    }
+}
