@@ -1135,3 +1135,117 @@ fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
         );
     }
 }
+
+#[test]
+fn the_operator_console_drives_scouting_to_finish() {
+    let Some(binary) = broker_or_skip("the_operator_console_drives_scouting_to_finish") else {
+        return;
+    };
+    let out = scratch("mqtt-operator");
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let deploy = scouting_deployment(&out, port, false);
+    let config = broker_config(&out, &deploy);
+    let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
+    let mut processes = Processes::default();
+    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+    // The scouting world without its simulated operator: only the console
+    // can tell the master to return (it waits in WAIT_MODE until then).
+    let mut world: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scenario()).unwrap()).unwrap();
+    world["operator"] = serde_json::json!([]);
+    world.as_object_mut().unwrap().remove("expect");
+    let alone = out.join("no-operator.scenario.json");
+    std::fs::write(&alone, world.to_string()).unwrap();
+
+    let mut console = Command::new(env!("CARGO_BIN_EXE_semo"))
+        .args(["operator"])
+        .arg(examples().join("scouting/scouting.mission"))
+        .arg("--deploy")
+        .arg(&deploy)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("semo operator starts");
+    let mut stdin = console.stdin.take().unwrap();
+    let stdout = console.stdout.take().unwrap();
+    let (lines_tx, lines) = std::sync::mpsc::channel::<String>();
+    let reader = std::thread::spawn(move || {
+        use std::io::BufRead;
+        let mut all = Vec::new();
+        for line in std::io::BufReader::new(stdout).lines() {
+            let line = line.unwrap();
+            let _ = lines_tx.send(line.clone());
+            all.push(line);
+        }
+        all
+    });
+    let console = processes.push(console);
+    let first = lines
+        .recv_timeout(std::time::Duration::from_secs(30))
+        .expect("the console says what it can send");
+    assert!(first.contains("RC_CMD (to MasterTeam)"), "{first}");
+
+    let mut started = Vec::new();
+    for folder in &folders {
+        let robot = robot_name(folder);
+        let trace = out.join(format!("{robot}.operated.jsonl"));
+        let child = robot_command(folder, &alone, &trace, 1)
+            .args(["--transport", "mqtt"])
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the robot program starts");
+        started.push((robot, trace, processes.push(child)));
+    }
+    // When the console shows the master waiting, the operator sends it home.
+    let waiting =
+        std::iter::from_fn(|| lines.recv_timeout(std::time::Duration::from_secs(30)).ok())
+            .find(|l| l.starts_with("status irobot: running WAIT_MODE"));
+    assert!(waiting.is_some(), "the console shows the master waiting");
+    use std::io::Write;
+    writeln!(stdin, "RC_CMD RETURN_MODE").unwrap();
+    stdin.flush().unwrap();
+    let mut traces = BTreeMap::new();
+    for (robot, trace, index) in started {
+        processes.wait_success(index, &format!("{robot} (operated)"));
+        traces.insert(robot, read_trace(&trace));
+    }
+    drop(stdin);
+    processes.wait_success(console, "semo operator");
+    let printed = reader.join().unwrap();
+    let master = modes(&traces["irobot"]);
+    assert_eq!(
+        master,
+        ["AUTO_MODE", "WAIT_MODE", "RETURN_MODE", "FINISH"],
+        "the console's command drives the master to FINISH"
+    );
+    for (robot, events) in &traces {
+        assert_eq!(
+            modes(events).last().map(String::as_str),
+            Some("FINISH"),
+            "{robot}"
+        );
+    }
+    assert!(
+        printed
+            .iter()
+            .any(|l| l == "sent USER.RC_CMD = RETURN_MODE"),
+        "{printed:?}"
+    );
+    assert!(
+        printed
+            .iter()
+            .any(|l| l.starts_with("irobot: send(USER, MasterTeam.DISTANCE) = ")),
+        "the console prints what the master sends the operator: {printed:?}"
+    );
+    assert!(
+        printed
+            .iter()
+            .any(|l| l.starts_with("status irobot: stopped FINISH")),
+        "{printed:?}"
+    );
+}

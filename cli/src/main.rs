@@ -6,6 +6,7 @@ mod build;
 mod deploy;
 mod fmt;
 mod graph;
+mod operator;
 mod render;
 mod simulate;
 
@@ -145,6 +146,25 @@ enum Command {
     /// Deployment on real networks: the broker's configuration.
     #[command(subcommand)]
     Deploy(DeployCommand),
+    /// The operator console of a running mission: send the USER commands
+    /// it receives (`NAME VALUE` per line on standard input), print what
+    /// robots send(USER, …) and each robot's status as it changes.
+    Operator {
+        /// The mission script.
+        mission: PathBuf,
+        /// The broker, mqtt://HOST[:PORT] (default: the deployment's, else
+        /// mqtt://127.0.0.1:1883).
+        #[arg(long, value_name = "URL")]
+        broker: Option<String>,
+        /// A deployment file: the operator's credentials (and broker).
+        #[arg(long, value_name = "FILE")]
+        deploy: Option<PathBuf>,
+        /// More strategy (and catalog) files or folders to read.
+        #[arg(long)]
+        strategy: Vec<PathBuf>,
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
+    },
     /// Run every robot of a mission together in virtual time on a scenario,
     /// and check the scenario's expectations.
     #[command(
@@ -460,6 +480,22 @@ fn run() -> i32 {
                 },
                 color: use_color(color),
                 force,
+            },
+            &mut out,
+        ),
+        Command::Operator {
+            mission,
+            broker,
+            deploy,
+            strategy,
+            color,
+        } => operator::run(
+            operator::Options {
+                mission,
+                strategy,
+                broker,
+                deploy,
+                color: use_color(color),
             },
             &mut out,
         ),

@@ -78,8 +78,12 @@ pub fn files(
                 rights
                     .write
                     .insert(topics::to_robot(&mission, team, &out.to_team, &out.key));
+            } else if out.to_team == "USER" {
+                // What the robot tells the operator consoles.
+                rights
+                    .write
+                    .insert(topics::to_team(&mission, "USER", &out.key));
             }
-            // `USER`: the operator reads the robot's status and trace, no topic.
         }
         if program.control.heartbeat {
             let key = crate::codegen::files::alive_key(program);
@@ -132,6 +136,9 @@ pub fn files(
         rights
             .read
             .insert(format!("semo/{}/status/+", topics::level(&mission)));
+        rights
+            .read
+            .insert(format!("semo/{}/USER/+", topics::level(&mission)));
     }
     if !found.is_empty() {
         return Err(found);

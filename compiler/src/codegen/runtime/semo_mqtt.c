@@ -417,7 +417,7 @@ static int mqtt_send_to(const char *to, const void *data, size_t len)
         else if (strcmp(g_program->peers[i].robot, to) == 0)
             robot = &g_program->peers[i];
     }
-    if (team)
+    if (team || strcmp(to, "USER") == 0) /* USER: every operator console */
         topic_of(topic, sizeof topic, to, NULL, key);
     else if (robot)
         topic_of(topic, sizeof topic, robot->team, robot->robot, key);

@@ -726,10 +726,9 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
         (kind != SEMO_MSG_SEND && kind != SEMO_MSG_PUBLISH))
         return -1;
     semo_trace("send", "to", to_team, "key", key, "value", value->text, NULL);
-    if (strcmp(to_team, "USER") == 0)
-        return 1; /* the operator console: the trace is its record */
+    bool to_operator = strcmp(to_team, "USER") == 0;
     if (!g_transport)
-        return -1;
+        return to_operator ? 1 : -1; /* the operator console: the trace is its record */
     semo_message m = {.kind = (char)kind};
     snprintf(m.from_team, sizeof m.from_team, "%s", g_prog->team);
     snprintf(m.from_robot, sizeof m.from_robot, "%s", g_prog->robot);
@@ -737,6 +736,13 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
     m.value = *value;
     unsigned char datagram[DATAGRAM_MAX];
     size_t len = encode_message(&m, datagram);
+    if (to_operator) {
+        /* A transport that reaches operators (MQTT: semo/<mission>/USER/<key>,
+         * `semo operator`) tells them too; the trace stays the record. */
+        if (g_transport->send_to)
+            g_transport->send_to("USER", datagram, len);
+        return 1;
+    }
     int sent = 0;
     for (size_t i = 0; i < g_prog->peer_count; i++) {
         const semo_peer *p = &g_prog->peers[i];
