@@ -6,7 +6,7 @@
 
 mod support;
 
-use semo::ide::semantic_tokens::{MODIFIERS, TokenKind};
+use semo::ide::mission::semantic_tokens::{MODIFIERS, TokenKind};
 use serde_json::Value;
 use std::collections::BTreeSet;
 use std::process::Command;

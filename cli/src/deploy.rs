@@ -1,31 +1,28 @@
 //! `semo build --deploy FILE` (reading the deployment file) and `semo
 //! deploy broker-config`: the broker's configuration and ACL for a mission.
 
+use super::output::{self, Format};
 use super::render;
 use semo::codegen;
 use semo::deploy::{self, Deployment, broker};
-use semo::diag::{Diagnostic, FileId};
-use semo::host;
+use semo::diag::Diagnostic;
+use semo::host::{self, CheckRun};
+use semo::workspace::FileKind;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// A deployment file as read: its text, for rendering its diagnostics.
-pub struct DeployFile {
-    pub path: PathBuf,
-    pub text: String,
-}
-
-/// The id the deployment file's diagnostics carry: past every file of the
-/// check, so never one of them.
-const DEPLOY_FILE: FileId = FileId(u32::MAX);
-
-/// Reads and parses a deployment file. `Err(2)`: unreadable (said on
-/// stderr); `Err(1)`: its diagnostics were printed.
+/// Reads and parses a deployment file into `run.files` (so that its
+/// diagnostics render and report like the check's; it is not one of
+/// `run.checked`, and `Files` has no kind for it, so it is labelled a
+/// mission only for that table). `Err(2)`: unreadable (said on stderr);
+/// `Err(1)`: refused, its diagnostics reported.
 pub fn load(
+    run: &mut CheckRun,
     path: &Path,
+    format: Format,
     color: bool,
     out: &mut impl Write,
-) -> Result<(Deployment, DeployFile), i32> {
+) -> Result<Deployment, i32> {
     let text = match semo::workspace::read_text(path) {
         Ok(text) => text,
         Err(e) => {
@@ -36,60 +33,41 @@ pub fn load(
             return Err(2);
         }
     };
-    let file = DeployFile {
-        path: path.to_path_buf(),
-        text,
-    };
+    let file = run
+        .files
+        .add(path.to_path_buf(), FileKind::Mission, text.clone());
     let base = path.parent().unwrap_or(Path::new("."));
-    match deploy::parse(&file.text, DEPLOY_FILE, base) {
-        Ok(deployment) => Ok((deployment, file)),
-        Err(found) => Err(refuse(&file, &found, color, out)),
-    }
+    deploy::parse(&text, file, base).map_err(|found| refuse(run, found, format, color, out))
 }
 
-/// Prints the deployment file's diagnostics and says the command was
-/// refused; returns 1.
-pub fn refuse(file: &DeployFile, found: &[Diagnostic], color: bool, out: &mut impl Write) -> i32 {
-    let _ = render_in(file, found, color, out);
-    let errors = found.iter().filter(|d| d.is_error()).count();
-    let _ = writeln!(
+/// Reports the deployment file's diagnostics as `format` says and that the
+/// command was refused; returns 1 (2 when the report cannot be written).
+pub fn refuse(
+    run: &mut CheckRun,
+    found: Vec<Diagnostic>,
+    format: Format,
+    color: bool,
+    out: &mut impl Write,
+) -> i32 {
+    run.diagnostics = found;
+    let reported = output::report(
+        format,
+        "build",
+        &run.files,
+        &run.diagnostics,
+        color,
+        serde_json::json!({ "robots": [] }),
         out,
+    );
+    if let Err(code) = output::written(reported) {
+        return code;
+    }
+    let errors = run.diagnostics.iter().filter(|d| d.is_error()).count();
+    eprintln!(
         "error: refused: {errors} error{} in the deployment file",
         if errors == 1 { "" } else { "s" }
     );
     1
-}
-
-/// Diagnostics in the deployment file, as `render` shows a check's.
-fn render_in(
-    file: &DeployFile,
-    found: &[Diagnostic],
-    colored: bool,
-    out: &mut impl Write,
-) -> std::io::Result<()> {
-    use ariadne::{Config, IndexType, Label, Report};
-    let config = Config::default()
-        .with_color(colored)
-        .with_index_type(IndexType::Byte);
-    let name = file.path.display().to_string();
-    let mut cache = ariadne::sources([(name.clone(), file.text.clone())]);
-    for d in found {
-        let range = render::safe_range(&file.text, d.span);
-        let mut report = Report::build(render::kind(d.severity), (name.clone(), range.clone()))
-            .with_config(config)
-            .with_code(d.code.as_str())
-            .with_message(&d.message)
-            .with_label(
-                Label::new((name.clone(), range))
-                    .with_message(d.code.summary())
-                    .with_color(render::color(d.severity)),
-            );
-        if let Some(s) = &d.suggestion {
-            report = report.with_help(format!("did you mean `{s}`?"));
-        }
-        report.finish().write(&mut cache, &mut *out)?;
-    }
-    Ok(())
 }
 
 /// `semo deploy broker-config MISSION --deploy FILE -o DIR`.
@@ -108,8 +86,8 @@ pub fn broker_config(
             return 2;
         }
     };
-    let (deployment, file) = match load(deploy_file, color, out) {
-        Ok(loaded) => loaded,
+    let deployment = match load(&mut run, deploy_file, Format::Human, color, out) {
+        Ok(deployment) => deployment,
         Err(code) => return code,
     };
     let Some(input) = run.analysis().build_input(mission) else {
@@ -120,8 +98,8 @@ pub fn broker_config(
     let refined = codegen::refine_checked(&input);
     if refined.programs.is_empty() {
         run.diagnostics = refined.diagnostics;
-        let _ = render::human(&run, color, out);
-        let _ = writeln!(out, "error: refused: fix the errors above first");
+        let _ = render::human(&run, color, &mut std::io::stderr());
+        eprintln!("error: refused: fix the errors above first");
         return 1;
     }
     let mut found = deploy::check(&deployment, &input.analysis.mission);
@@ -129,10 +107,10 @@ pub fn broker_config(
     let source = deploy_file.display().to_string();
     let files = match broker::files(&deployment, &refined.programs, &out_dir, &source) {
         Ok(files) if !found.iter().any(|d| d.is_error()) => files,
-        Ok(_) => return refuse(&file, &found, color, out),
+        Ok(_) => return refuse(&mut run, found, Format::Human, color, out),
         Err(more) => {
             found.extend(more);
-            return refuse(&file, &found, color, out);
+            return refuse(&mut run, found, Format::Human, color, out);
         }
     };
     let written = std::fs::create_dir_all(&out_dir)

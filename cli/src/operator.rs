@@ -38,12 +38,21 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     };
+    let mut run = run;
     let deployment = match &options.deploy {
         None => None,
-        Some(path) => match super::deploy::load(path, options.color, out) {
-            Ok((deployment, _)) => Some(deployment),
-            Err(code) => return code,
-        },
+        Some(path) => {
+            match super::deploy::load(
+                &mut run,
+                path,
+                super::output::Format::Human,
+                options.color,
+                out,
+            ) {
+                Ok(deployment) => Some(deployment),
+                Err(code) => return code,
+            }
+        }
     };
     let Some(input) = run.analysis().build_input(mission) else {
         eprintln!("internal error: the mission was loaded but not checked");
@@ -52,10 +61,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let input = input.input();
     let refined = codegen::refine_checked(&input);
     let Some(first) = refined.programs.first() else {
-        let mut run = run;
         run.diagnostics = refined.diagnostics;
-        let _ = super::render::human(&run, options.color, out);
-        let _ = writeln!(out, "error: refused: fix the errors above first");
+        let _ = super::render::human(&run, options.color, &mut std::io::stderr());
+        eprintln!("error: refused: fix the errors above first");
         return 1;
     };
     let mission_topic = topics::mission(&first.mission);

@@ -859,6 +859,7 @@ impl BuildFiles {
 mod dataflow;
 mod disk;
 mod dropper;
+mod ide;
 #[cfg(test)]
 mod tests;
 

@@ -19,6 +19,7 @@ pub mod codegen;
 pub mod dataflow;
 pub mod deploy;
 pub mod diag;
+mod digraph;
 pub mod edit;
 /// A fast deterministic hasher for the checker's maps.
 mod fasthash;
