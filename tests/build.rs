@@ -418,7 +418,7 @@ fn every_build_fixture_gives_its_code() {
             .map(|t| t.trim().to_string())
             .unwrap_or_else(|_| "linux".to_string());
         let out = scratch(&format!("fixture-{name}"));
-        // A deployment fixture (E110–E113) holds the `*.deploy.toml` it is about.
+        // A deployment fixture (E120–E123) holds the `*.deploy.toml` it is about.
         let deploy = std::fs::read_dir(&dir)
             .unwrap()
             .map(|e| e.unwrap().path())

@@ -176,10 +176,10 @@ codes! {
     CodegenInternal = "E102", Error, "an internal error of refinement or code generation: something the checker should have excluded (please report it)";
     TargetUnsupported = "E103", Error, "a robot the chosen target cannot run as written: on `cortex-m` a robot that messages other robots (no transport there yet), or `cortex-m-sim` without `--scenario`";
     // Deployment files (`*.deploy.toml`, `semo build --deploy`, `semo deploy`).
-    DeployInvalid = "E110", Error, "a deployment file that is not valid TOML or not of the deployment format (unknown key, wrong type, a certificate without its key, a robot without credentials the broker needs)";
-    DeployUnknownName = "E111", Error, "a deployment file naming a robot or team that the mission does not have";
-    DeployBadBroker = "E112", Error, "a broker address that is not `mqtt://HOST[:PORT]` or `mqtts://HOST[:PORT]`";
-    DeployMissingFile = "E113", Error, "a deployment file naming a password, CA, certificate or key file that does not exist";
+    DeployInvalid = "E120", Error, "a deployment file that is not valid TOML or not of the deployment format (unknown key, wrong type, a certificate without its key, a robot without credentials the broker needs)";
+    DeployUnknownName = "E121", Error, "a deployment file naming a robot or team that the mission does not have";
+    DeployBadBroker = "E122", Error, "a broker address that is not `mqtt://HOST[:PORT]` or `mqtts://HOST[:PORT]`";
+    DeployMissingFile = "E123", Error, "a deployment file naming a password, CA, certificate or key file that does not exist";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

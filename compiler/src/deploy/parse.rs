@@ -283,7 +283,7 @@ impl Reader<'_> {
     }
 
     /// A path value, absolute (resolved against the file's folder); with
-    /// `must_exist`, a regular file (E113 otherwise).
+    /// `must_exist`, a regular file (E123 otherwise).
     fn path_of(&mut self, table: &dyn TableLike, key: &str, must_exist: bool) -> Option<PathBuf> {
         let (text, at) = self.string(table.get(key)?, key)?;
         if text.is_empty() {

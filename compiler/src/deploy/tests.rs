@@ -125,20 +125,20 @@ fn mistakes_are_positioned() {
     assert_eq!(
         mistakes("broker = \"tcp://x:1\"\n", &[]),
         [
-            "E112 '\"tcp://x:1\"': the broker must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT], not \"tcp://x:1\""
+            "E122 '\"tcp://x:1\"': the broker must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT], not \"tcp://x:1\""
         ]
     );
     assert_eq!(
         mistakes("broker = \"mqtt://x:99999\"\n", &[]),
         [
-            "E112 '\"mqtt://x:99999\"': the broker must be mqtt://HOST[:PORT] with a host name or address and a port from 1 to 65535, not \"mqtt://x:99999\""
+            "E122 '\"mqtt://x:99999\"': the broker must be mqtt://HOST[:PORT] with a host name or address and a port from 1 to 65535, not \"mqtt://x:99999\""
         ]
     );
     assert_eq!(
         mistakes("brokr = \"mqtt://x\"\n", &[]),
         [
-            "E110 'brokr': the deployment file has no key `brokr` (it has `broker`, `ca`, `broker_config`, `operator`, `teams`, `robots`) (did you mean `broker`?)",
-            "E110 '': the deployment file has no `broker = \"mqtt://HOST[:PORT]\"`"
+            "E120 'brokr': the deployment file has no key `brokr` (it has `broker`, `ca`, `broker_config`, `operator`, `teams`, `robots`) (did you mean `broker`?)",
+            "E120 '': the deployment file has no `broker = \"mqtt://HOST[:PORT]\"`"
         ]
     );
     let missing = &mistakes(
@@ -146,7 +146,7 @@ fn mistakes_are_positioned() {
         &[],
     )[0];
     assert!(
-        missing.starts_with("E113 '\"ti.pw\"': `password_file`: no file /")
+        missing.starts_with("E123 '\"ti.pw\"': `password_file`: no file /")
             && missing.ends_with("/ti.pw"),
         "{missing}"
     );
@@ -156,8 +156,8 @@ fn mistakes_are_positioned() {
             &["c"]
         ),
         [
-            "E110 '4': `id` must be a string",
-            "E110 'cert': [robots.ti] has a `cert` but no `key`: a client certificate needs both"
+            "E120 '4': `id` must be a string",
+            "E120 'cert': [robots.ti] has a `cert` but no `key`: a client certificate needs both"
         ]
     );
     assert_eq!(
@@ -165,11 +165,11 @@ fn mistakes_are_positioned() {
             "broker = \"mqtt://x\"\n[robots.a]\nid = \"x\"\n[robots.b]\nid = \"x\"\n",
             &[]
         ),
-        ["E110 'b': robot `b` has the `id` \"x\" of another robot"]
+        ["E120 'b': robot `b` has the `id` \"x\" of another robot"]
     );
     let toml = mistakes("broker = \"mqtt://x\n", &[]);
     assert_eq!(toml.len(), 1);
-    assert!(toml[0].starts_with("E110 "), "{toml:?}");
+    assert!(toml[0].starts_with("E120 "), "{toml:?}");
 }
 
 #[test]
@@ -193,9 +193,9 @@ fn names_are_checked_against_the_mission() {
     assert_eq!(
         found,
         [
-            "E111 'MasterTeem': the mission has no team `MasterTeem` (did you mean `MasterTeam`?)",
-            "E111 'irobt': the mission has no robot `irobt` (did you mean `irobot`?)",
-            "E110 '\"mqtts://x\"': robot `irobot` connects with TLS (mqtts://) but has no `ca` to check the broker with: give `ca` at the top, in [teams.MasterTeam] or in [robots.irobot]"
+            "E121 'MasterTeem': the mission has no team `MasterTeem` (did you mean `MasterTeam`?)",
+            "E121 'irobt': the mission has no robot `irobt` (did you mean `irobot`?)",
+            "E120 '\"mqtts://x\"': robot `irobot` connects with TLS (mqtts://) but has no `ca` to check the broker with: give `ca` at the top, in [teams.MasterTeam] or in [robots.irobot]"
         ]
     );
 }
