@@ -418,7 +418,27 @@ fn every_build_fixture_gives_its_code() {
             .map(|t| t.trim().to_string())
             .unwrap_or_else(|_| "linux".to_string());
         let out = scratch(&format!("fixture-{name}"));
-        let built = build(&mission, &target, &out);
+        // A deployment fixture (E120–E123) holds the `*.deploy.toml` it is about.
+        let deploy = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.to_string_lossy().ends_with(".deploy.toml"));
+        let built = match &deploy {
+            None => build(&mission, &target, &out),
+            Some(deploy) => semo_in(
+                &repo_root(),
+                &[
+                    "build",
+                    &mission.display().to_string(),
+                    "--target",
+                    &target,
+                    "-o",
+                    &out.display().to_string(),
+                    "--deploy",
+                    &deploy.display().to_string(),
+                ],
+            ),
+        };
         assert_eq!(built.code, 1, "{name}: {}", built.stderr);
         assert!(
             built.stderr.contains(&format!("[{code}]")),

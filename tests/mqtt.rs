@@ -105,24 +105,41 @@ fn start_broker(binary: &Path, dir: &Path, processes: &mut Processes) -> (u16, u
     (port, index)
 }
 
+/// The user we are: started as root, mosquitto drops to the `mosquitto`
+/// user, which cannot read or write our folders; `user <us>` keeps it us (no
+/// effect otherwise).
+fn current_user() -> String {
+    let whoami = Command::new("id").arg("-un").output().expect("id runs");
+    String::from_utf8_lossy(&whoami.stdout).trim().to_string()
+}
+
 fn start_broker_on(binary: &Path, dir: &Path, port: u16, processes: &mut Processes) -> usize {
     let config = dir.join("mosquitto.conf");
-    // Started as root, mosquitto drops to the `mosquitto` user, which cannot
-    // write into our folder: it stays the user we are (no effect otherwise).
-    let whoami = Command::new("id").arg("-un").output().expect("id runs");
-    let user = String::from_utf8_lossy(&whoami.stdout).trim().to_string();
     std::fs::write(
         &config,
         format!(
-            "user {user}\nlistener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\npersistence true\npersistence_location {}/\nlog_dest file {}\n",
+            "user {}\nlistener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\npersistence true\npersistence_location {}/\nlog_dest file {}\n",
+            current_user(),
             dir.display(),
             dir.join("mosquitto.log").display()
         ),
     )
     .unwrap();
+    start_broker_with(binary, &config, dir, port, processes)
+}
+
+/// Starts mosquitto with `config` (which listens on `port` of 127.0.0.1)
+/// and waits until it accepts connections; its log goes to `dir`.
+fn start_broker_with(
+    binary: &Path,
+    config: &Path,
+    dir: &Path,
+    port: u16,
+    processes: &mut Processes,
+) -> usize {
     let child = Command::new(binary)
         .arg("-c")
-        .arg(&config)
+        .arg(config)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
@@ -143,11 +160,23 @@ fn start_broker_on(binary: &Path, dir: &Path, port: u16, processes: &mut Process
 /// `semo build` of the scouting mission for linux-sim, each robot made with
 /// the MQTT transport built in (`make TRANSPORT=mqtt`), warnings as errors.
 fn build_scouting(out: &Path) -> Vec<PathBuf> {
-    let built = build(
-        &examples().join("scouting/scouting.mission"),
+    build_scouting_with(out, &[])
+}
+
+/// The same with more `semo build` arguments (`--deploy FILE`).
+fn build_scouting_with(out: &Path, extra: &[&str]) -> Vec<PathBuf> {
+    let mission = examples().join("scouting/scouting.mission");
+    let (mission, out_arg) = (mission.display().to_string(), out.display().to_string());
+    let mut args = vec![
+        "build",
+        mission.as_str(),
+        "--target",
         "linux-sim",
-        out,
-    );
+        "-o",
+        out_arg.as_str(),
+    ];
+    args.extend_from_slice(extra);
+    let built = support::semo_in(&repo_root(), &args);
     assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
     let folders = robot_folders(out);
     for folder in &folders {
@@ -341,6 +370,51 @@ fn a_send_reaches_a_robot_that_was_away_when_it_was_sent() {
         !heard.is_empty(),
         "the master, back, receives the colors ti sent while it was away"
     );
+    // All of them: the burst of hundreds of queued messages at reconnection
+    // is held back by a full inbox, never dropped.
+    let sent = sent_to(&ti, "MasterTeam");
+    assert!(sent.len() > 64, "more than an inbox holds: {}", sent.len());
+    assert_eq!(
+        received_all_from(&back, "ti"),
+        sent,
+        "every send of ti arrives"
+    );
+    assert!(
+        !back.iter().any(|e| field(e, "event") == "drop"),
+        "nothing is dropped"
+    );
+}
+
+/// The first of `sent` (with its index) that `received` lacks, taking them
+/// in order, duplicates in `received` skipped: None when `sent` is a
+/// subsequence of `received`.
+fn missing_from(
+    sent: &[(String, String)],
+    received: &[(String, String)],
+) -> Option<(usize, (String, String))> {
+    let mut rest = received.iter();
+    sent.iter()
+        .enumerate()
+        .find(|(_, m)| !rest.any(|r| r == *m))
+        .map(|(i, m)| (i, m.clone()))
+}
+
+/// The (key, value) of every `send` to `to`, in order.
+fn sent_to(events: &[Event], to: &str) -> Vec<(String, String)> {
+    events
+        .iter()
+        .filter(|e| field(e, "event") == "send" && field(e, "to") == to)
+        .map(|e| (field(e, "key").to_string(), field(e, "value").to_string()))
+        .collect()
+}
+
+/// The (key, value) of everything received from `robot`, in order.
+fn received_all_from(events: &[Event], robot: &str) -> Vec<(String, String)> {
+    events
+        .iter()
+        .filter(|e| field(e, "event") == "receive" && field(e, "from_robot") == robot)
+        .map(|e| (field(e, "key").to_string(), field(e, "value").to_string()))
+        .collect()
 }
 
 /// Runs a robot program with `args` and returns its exit code and stderr.
@@ -378,12 +452,12 @@ fn transport_options_are_checked_and_an_unreachable_broker_is_reported() {
         ),
         (
             &["--broker", "mqtts://example.org"],
-            "TLS is not supported yet",
+            "an mqtts:// broker needs the CA that signed its certificate",
         ),
         (&["--broker", "mqtt://host:99999"], "port from 1 to 65535"),
         (
             &["--broker", "tcp://host:1883"],
-            "the broker must be mqtt://HOST[:PORT]",
+            "the broker must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT]",
         ),
     ] {
         let (code, stderr) = run_with(irobot, args);
@@ -421,5 +495,757 @@ fn transport_options_are_checked_and_an_unreachable_broker_is_reported() {
     assert!(
         stderr.contains("built without the mqtt transport"),
         "{stderr}"
+    );
+}
+
+/// A scouting deployment in `dir` for a broker on `port`: the master with
+/// its own user, the slaves sharing their team's, the operator; the
+/// broker's password file made with `mosquitto_passwd -b`. `tls`: also the
+/// CA and certificates (`tls_files`).
+fn scouting_deployment(dir: &Path, port: u16, tls: bool) -> PathBuf {
+    let users = [
+        ("irobot", "irobot-secret"),
+        ("slaves", "slaves-secret"),
+        ("operator", "operator-secret"),
+    ];
+    for (i, (user, password)) in users.iter().enumerate() {
+        std::fs::write(dir.join(format!("{user}.pw")), format!("{password}\n")).unwrap();
+        let mut command = Command::new("mosquitto_passwd");
+        if i == 0 {
+            command.arg("-c");
+        }
+        let made = command
+            .arg("-b")
+            .arg(dir.join("passwd"))
+            .args([user, password])
+            .output()
+            .expect("mosquitto_passwd runs");
+        assert!(made.status.success(), "{made:?}");
+    }
+    let (scheme, tls_top, tls_broker, tls_irobot) = if tls {
+        (
+            "mqtts",
+            "ca = \"ca.crt\"\n",
+            "cert = \"server.crt\"\nkey = \"server.key\"\n",
+            "cert = \"irobot.crt\"\nkey = \"irobot.key\"\n",
+        )
+    } else {
+        ("mqtt", "", "", "")
+    };
+    let file = dir.join("scouting.deploy.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "# The scouting robots on a private broker (tests/mqtt.rs).\nbroker = \"{scheme}://127.0.0.1:{port}\"\n{tls_top}\n[broker_config]\npassword_file = \"passwd\"\n{tls_broker}\n[operator]\nuser = \"operator\"\npassword_file = \"operator.pw\"\n\n[teams.SlaveTeam]\nuser = \"slaves\"\npassword_file = \"slaves.pw\"\n\n[robots.irobot]\nuser = \"irobot\"\npassword_file = \"irobot.pw\"\n{tls_irobot}"
+        ),
+    )
+    .unwrap();
+    file
+}
+
+/// `semo deploy broker-config` into `dir/broker`, run as this user, logging
+/// to `dir/broker/mosquitto.log`; returns the configuration's path.
+fn broker_config(dir: &Path, deploy: &Path) -> PathBuf {
+    let out = dir.join("broker");
+    let mission = examples().join("scouting/scouting.mission");
+    let written = support::semo_in(
+        dir,
+        &[
+            "deploy",
+            "broker-config",
+            &mission.display().to_string(),
+            "--deploy",
+            &deploy.display().to_string(),
+            "-o",
+            &out.display().to_string(),
+        ],
+    );
+    assert_eq!(written.code, 0, "{}{}", written.stdout, written.stderr);
+    let config = out.join("mosquitto.conf");
+    let mut text = std::fs::read_to_string(&config).unwrap();
+    text.push_str(&format!(
+        "user {}\nlog_dest file {}\n",
+        current_user(),
+        out.join("mosquitto.log").display()
+    ));
+    std::fs::write(&config, text).unwrap();
+    config
+}
+
+/// A `USER` command as the runtime's datagram: "SEMO" 1, kind `s`, then
+/// team, robot, key and value, each a length byte and its bytes.
+fn user_command(key: &str, value: &str) -> Vec<u8> {
+    let mut datagram = b"SEMO\x01s".to_vec();
+    for field in ["USER", "operator", key, value] {
+        datagram.push(field.len() as u8);
+        datagram.extend_from_slice(field.as_bytes());
+    }
+    datagram
+}
+
+/// Publishes `datagram` to `topic` with `mosquitto_pub` every 100 ms (as
+/// `user`, or anonymously) until `stop` is set. Returns how many publishes
+/// the broker accepted at the protocol level (exit status 0).
+fn keep_publishing(
+    port: u16,
+    topic: String,
+    datagram: PathBuf,
+    user: Option<(&'static str, &'static str)>,
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+) -> std::thread::JoinHandle<usize> {
+    std::thread::spawn(move || {
+        let mut accepted = 0;
+        while !stop.load(std::sync::atomic::Ordering::SeqCst) {
+            let mut command = Command::new("mosquitto_pub");
+            command
+                .args(["-h", "127.0.0.1", "-p", &port.to_string(), "-q", "1"])
+                .args(["-t", &topic])
+                .arg("-f")
+                .arg(&datagram);
+            if let Some((user, password)) = user {
+                command.args(["-u", user, "-P", password]);
+            }
+            let status = command
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .status()
+                .expect("mosquitto_pub runs (Debian mosquitto-clients)");
+            accepted += usize::from(status.success());
+            std::thread::sleep(std::time::Duration::from_millis(100));
+        }
+        accepted
+    })
+}
+
+/// Runs the scouting robots (built with the deployment: no --broker, the
+/// baked defaults connect them) while `forgers` publish `RC_CMD = RC_MODE`
+/// to the master as USER commands; returns the traces.
+fn run_while_forging(
+    folders: &[PathBuf],
+    out: &Path,
+    tag: &str,
+    port: u16,
+    forgers: &[Option<(&'static str, &'static str)>],
+    processes: &mut Processes,
+) -> BTreeMap<String, Vec<Event>> {
+    let datagram = out.join("forged.bin");
+    std::fs::write(&datagram, user_command("USER.RC_CMD", "RC_MODE")).unwrap();
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let threads: Vec<_> = forgers
+        .iter()
+        .map(|user| {
+            keep_publishing(
+                port,
+                "semo/scouting/MasterTeam/USER.RC_CMD".into(),
+                datagram.clone(),
+                *user,
+                stop.clone(),
+            )
+        })
+        .collect();
+    let traces = run_together(
+        folders,
+        out,
+        tag,
+        &["--transport".into(), "mqtt".into()],
+        processes,
+    );
+    stop.store(true, std::sync::atomic::Ordering::SeqCst);
+    for thread in threads {
+        thread.join().unwrap();
+    }
+    traces
+}
+
+#[test]
+fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
+    let Some(binary) =
+        broker_or_skip("the_generated_acl_lets_only_the_operator_switch_a_robots_mode")
+    else {
+        return;
+    };
+    let out = scratch("mqtt-acl");
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let deploy = scouting_deployment(&out, port, false);
+    let config = broker_config(&out, &deploy);
+    let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
+    insta::assert_snapshot!(
+        "scouting_acl",
+        acl.replace(&deploy.display().to_string(), "scouting.deploy.toml")
+    );
+    let conf = std::fs::read_to_string(&config).unwrap();
+    for line in [
+        "allow_anonymous false",
+        "set_tcp_nodelay true",
+        "acl_file ",
+        "password_file ",
+    ] {
+        assert!(conf.contains(line), "{line}: {conf}");
+    }
+    let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
+    let header = std::fs::read_to_string(folders[0].join("semo_deploy.h")).unwrap();
+    assert!(
+        header.contains("SEMO_DEPLOY_PASSWORD_FILE") && !header.contains("secret\""),
+        "the password file's path, not the password: {header}"
+    );
+    let mut processes = Processes::default();
+    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+
+    // Anonymous clients and the slaves' credentials cannot command the master.
+    let forged = run_while_forging(
+        &folders,
+        &out,
+        "forged",
+        port,
+        &[None, Some(("slaves", "slaves-secret"))],
+        &mut processes,
+    );
+    for (robot, events) in &forged {
+        assert_eq!(
+            modes(events).last().map(String::as_str),
+            Some("FINISH"),
+            "{robot}: {:?}",
+            modes(events)
+        );
+    }
+    assert!(
+        !modes(&forged["irobot"]).iter().any(|m| m == "RC_MODE"),
+        "a forged USER command switched the master: {:?}",
+        modes(&forged["irobot"])
+    );
+    for slave in ["ti", "nxt"] {
+        assert!(
+            received_from(&forged["irobot"], slave, "SlaveTeam.COLOR")
+                .iter()
+                .any(|v| v == "RGB"),
+            "the master hears {slave} through the ACL"
+        );
+    }
+    // The same command from the operator's user does switch it: the
+    // forgeries above failed because of the ACL, not for another reason.
+    let commanded = run_while_forging(
+        &folders,
+        &out,
+        "operator",
+        port,
+        &[Some(("operator", "operator-secret"))],
+        &mut processes,
+    );
+    assert!(
+        modes(&commanded["irobot"]).iter().any(|m| m == "RC_MODE"),
+        "the operator's USER command switches the master: {:?}",
+        modes(&commanded["irobot"])
+    );
+}
+
+/// A throwaway CA in `dir` (`ca.crt`), the broker's certificate for
+/// 127.0.0.1 (`server.crt`/`server.key`) and a client certificate for the
+/// master (`irobot.crt`/`irobot.key`), made with `openssl`.
+fn tls_files(dir: &Path) {
+    let openssl = |args: &[&str]| {
+        let out = Command::new("openssl")
+            .args(args)
+            .current_dir(dir)
+            .output()
+            .expect("openssl runs");
+        assert!(
+            out.status.success(),
+            "openssl {args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    openssl(&[
+        "req",
+        "-x509",
+        "-newkey",
+        "rsa:2048",
+        "-nodes",
+        "-days",
+        "2",
+        "-subj",
+        "/CN=semo test CA",
+        "-keyout",
+        "ca.key",
+        "-out",
+        "ca.crt",
+    ]);
+    std::fs::write(dir.join("server.ext"), "subjectAltName = IP:127.0.0.1\n").unwrap();
+    for (name, extensions) in [("server", Some("server.ext")), ("irobot", None)] {
+        let (key, csr, crt) = (
+            format!("{name}.key"),
+            format!("{name}.csr"),
+            format!("{name}.crt"),
+        );
+        openssl(&[
+            "req",
+            "-newkey",
+            "rsa:2048",
+            "-nodes",
+            "-subj",
+            &format!("/CN={name}"),
+            "-keyout",
+            &key,
+            "-out",
+            &csr,
+        ]);
+        let mut sign = vec![
+            "x509",
+            "-req",
+            "-in",
+            &csr,
+            "-CA",
+            "ca.crt",
+            "-CAkey",
+            "ca.key",
+            "-CAcreateserial",
+            "-days",
+            "2",
+            "-out",
+            &crt,
+        ];
+        if let Some(file) = extensions {
+            sign.extend(["-extfile", file]);
+        }
+        openssl(&sign);
+    }
+}
+
+#[test]
+fn robots_run_over_tls_with_client_certificates() {
+    let Some(binary) = broker_or_skip("robots_run_over_tls_with_client_certificates") else {
+        return;
+    };
+    let out = scratch("mqtt-tls");
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    tls_files(&out);
+    let deploy = scouting_deployment(&out, port, true);
+    let config = broker_config(&out, &deploy);
+    let conf = std::fs::read_to_string(&config).unwrap();
+    assert!(
+        conf.contains("certfile ") && conf.contains("cafile "),
+        "{conf}"
+    );
+    let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
+    let mut processes = Processes::default();
+    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+    let traces = run_together(
+        &folders,
+        &out,
+        "tls",
+        &["--transport".into(), "mqtt".into()],
+        &mut processes,
+    );
+    assert_eq!(traces.len(), 3);
+    for (robot, events) in &traces {
+        assert_eq!(
+            modes(events).last().map(String::as_str),
+            Some("FINISH"),
+            "{robot} over TLS: {:?}",
+            modes(events)
+        );
+    }
+    for slave in ["ti", "nxt"] {
+        assert!(
+            received_from(&traces["irobot"], slave, "SlaveTeam.COLOR")
+                .iter()
+                .any(|v| v == "RGB"),
+            "the master hears {slave} over TLS"
+        );
+    }
+    // The broker speaks only TLS: a plain connection with a slave's
+    // credentials is refused, so the robots above did use TLS.
+    let nxt = folders.iter().find(|f| robot_name(f) == "nxt").unwrap();
+    let (code, stderr) = run_with(
+        nxt,
+        &[
+            "--transport",
+            "mqtt",
+            "--broker",
+            &format!("mqtt://127.0.0.1:{port}"),
+            "--duration",
+            "100",
+        ],
+    );
+    assert_eq!(code, Some(1), "{stderr}");
+}
+
+/// The retained status of `robot` on the broker at `port` (anonymous), as
+/// a JSON object; None when there is none within a few seconds.
+fn retained_status(port: u16, robot: &str) -> Option<serde_json::Value> {
+    let out = Command::new("mosquitto_sub")
+        .args(["-h", "127.0.0.1", "-p", &port.to_string()])
+        .args(["-t", &format!("semo/scouting/status/{robot}")])
+        .args(["-C", "1", "-W", "3", "--retained-only"])
+        .output()
+        .expect("mosquitto_sub runs (Debian mosquitto-clients)");
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text.lines().next()?;
+    Some(serde_json::from_str(line).unwrap_or_else(|e| panic!("{line}: {e}")))
+}
+
+#[test]
+fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
+    let Some(binary) =
+        broker_or_skip("each_robot_keeps_a_retained_status_and_a_killed_one_is_lost")
+    else {
+        return;
+    };
+    let out = scratch("mqtt-status");
+    let broker_dir = out.join("broker");
+    std::fs::create_dir_all(&broker_dir).unwrap();
+    let folders = build_scouting(&out);
+    let mut processes = Processes::default();
+    let (port, _) = start_broker(&binary, &broker_dir, &mut processes);
+    let mqtt = [
+        "--transport".to_string(),
+        "mqtt".into(),
+        "--broker".into(),
+        format!("mqtt://127.0.0.1:{port}"),
+    ];
+    let traces = run_together(&folders, &out, "status", &mqtt, &mut processes);
+    // After the run: each robot stopped, in its last mode, as its trace says.
+    for (robot, events) in &traces {
+        let status = retained_status(port, robot).unwrap_or_else(|| panic!("{robot}: no status"));
+        assert_eq!(status["robot"], robot.as_str(), "{status}");
+        assert_eq!(status["state"], "stopped", "{robot}: {status}");
+        assert_eq!(
+            status["mode"].as_str(),
+            modes(events).last().map(String::as_str),
+            "{robot}: {status}"
+        );
+    }
+    // A robot killed while running: the broker publishes its last will.
+    let irobot = folders.iter().find(|f| robot_name(f) == "irobot").unwrap();
+    let child = robot_command(irobot, &scenario(), &out.join("irobot.killed.jsonl"), 1)
+        .args(&mqtt)
+        .args(["--duration", "1000000"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the robot program starts");
+    let index = processes.push(child);
+    let mut running = None;
+    for _ in 0..50 {
+        // Running, and past its first firing: a service in each plan.
+        running = retained_status(port, "irobot").filter(|s| {
+            s["state"] == "running"
+                && s["services"]
+                    .as_str()
+                    .is_some_and(|s| s.contains("Action="))
+        });
+        if running.is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let running = running.expect("the running robot's status names the service each plan runs");
+    assert!(
+        running["mode"]
+            .as_str()
+            .is_some_and(|m| m.ends_with("_MODE")),
+        "{running}"
+    );
+    processes.0[index].kill().unwrap();
+    processes.0[index].wait().unwrap();
+    let mut lost = None;
+    for _ in 0..50 {
+        lost = retained_status(port, "irobot").filter(|s| s["state"] == "lost");
+        if lost.is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    assert!(lost.is_some(), "the killed robot's status says lost");
+}
+
+#[test]
+fn robots_reconnect_after_a_broker_restart_and_no_send_is_lost() {
+    let Some(binary) =
+        broker_or_skip("robots_reconnect_after_a_broker_restart_and_no_send_is_lost")
+    else {
+        return;
+    };
+    let out = scratch("mqtt-broker-restart");
+    let broker_dir = out.join("broker");
+    std::fs::create_dir_all(&broker_dir).unwrap();
+    let folders = build_scouting(&out);
+    let mut processes = Processes::default();
+    let (port, broker) = start_broker(&binary, &broker_dir, &mut processes);
+    // Four times slower than the scenario's pace: the robots' reconnection
+    // (libmosquitto waits 1 s first) falls inside the slaves' search.
+    let mut started = Vec::new();
+    for folder in &folders {
+        let robot = robot_name(folder);
+        let trace = out.join(format!("{robot}.restart.jsonl"));
+        let child = robot_command(folder, &scenario(), &trace, 1)
+            .args(["--transport", "mqtt", "--time-scale", "0.4"])
+            .args(["--broker", &format!("mqtt://127.0.0.1:{port}")])
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the robot program starts");
+        started.push((robot, trace, processes.push(child)));
+    }
+    // While the slaves search and send their colors, the broker goes down
+    // (saving its state, as a service stop does) and comes back.
+    std::thread::sleep(std::time::Duration::from_millis(700));
+    processes.terminate(broker);
+    start_broker_on(&binary, &broker_dir, port, &mut processes);
+    let mut traces = BTreeMap::new();
+    for (robot, trace, index) in started {
+        processes.wait_success(index, &format!("{robot} (broker restart)"));
+        traces.insert(robot, read_trace(&trace));
+    }
+    for (robot, events) in &traces {
+        assert_eq!(
+            modes(events).last().map(String::as_str),
+            Some("FINISH"),
+            "{robot}: {:?}",
+            modes(events)
+        );
+    }
+    for slave in ["ti", "nxt"] {
+        let sent = sent_to(&traces[slave], "MasterTeam");
+        assert!(!sent.is_empty(), "{slave} sends");
+        assert!(
+            !traces[slave]
+                .iter()
+                .any(|e| field(e, "event") == "comm_error"),
+            "{slave}'s sends during the outage wait for the broker"
+        );
+        let received = received_all_from(&traces["irobot"], slave);
+        // QoS 1 is at least once: a message the broker had not seen
+        // acknowledged comes again after the restart, never one less; and
+        // MQTT keeps the order per topic (one key), not across topics.
+        for key in ["SlaveTeam.COLOR", "SlaveTeam.LOCATION"] {
+            let of_key = |all: &[(String, String)]| -> Vec<(String, String)> {
+                all.iter().filter(|(k, _)| k == key).cloned().collect()
+            };
+            let (sent, received) = (of_key(&sent), of_key(&received));
+            let missing = missing_from(&sent, &received);
+            assert!(
+                missing.is_none(),
+                "every {key} {slave} sends reaches the master across the broker's restart, in order: {} sent, {} received, the first missing {missing:?}",
+                sent.len(),
+                received.len()
+            );
+        }
+    }
+    let log = std::fs::read_to_string(broker_dir.join("mosquitto.log")).unwrap_or_default();
+    assert!(
+        log.matches("New client connected").count() >= 6,
+        "each robot connected twice: {log}"
+    );
+}
+
+#[test]
+fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
+    let Some(binary) =
+        broker_or_skip("a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead")
+    else {
+        return;
+    };
+    let out = scratch("mqtt-robot-restart");
+    let broker_dir = out.join("broker");
+    std::fs::create_dir_all(&broker_dir).unwrap();
+    let folders = build_scouting(&out);
+    let mut processes = Processes::default();
+    let (port, _) = start_broker(&binary, &broker_dir, &mut processes);
+    const SCALE: f64 = 0.4; // wall ms per mission ms
+    let spawn = |processes: &mut Processes, folder: &Path, tag: &str| {
+        let trace = out.join(format!("{}.{tag}.jsonl", robot_name(folder)));
+        let child = robot_command(folder, &scenario(), &trace, 1)
+            .args(["--transport", "mqtt", "--time-scale", &SCALE.to_string()])
+            .args(["--broker", &format!("mqtt://127.0.0.1:{port}")])
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the robot program starts");
+        (trace, processes.push(child))
+    };
+    let started = std::time::Instant::now();
+    let mut slaves = Vec::new();
+    let mut master = None;
+    for folder in &folders {
+        let (trace, index) = spawn(&mut processes, folder, "life");
+        if robot_name(folder) == "irobot" {
+            master = Some((folder.clone(), index));
+        } else {
+            slaves.push((robot_name(folder), trace, index));
+        }
+    }
+    let (irobot, first) = master.unwrap();
+    // Killed while the slaves send their colors; back a moment later.
+    std::thread::sleep(std::time::Duration::from_millis(600));
+    processes.0[first].kill().unwrap();
+    processes.0[first].wait().unwrap();
+    let killed = started.elapsed().as_secs_f64() * 1000.0;
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let back_at = started.elapsed().as_secs_f64() * 1000.0;
+    let (second_trace, second) = spawn(&mut processes, &irobot, "second-life");
+    let mut slave_traces = BTreeMap::new();
+    for (robot, trace, index) in slaves {
+        processes.wait_success(index, &robot);
+        slave_traces.insert(robot, read_trace(&trace));
+    }
+    processes.wait_success(second, "irobot (second life)");
+    let second_life = read_trace(&second_trace);
+    assert_eq!(
+        modes(&second_life).last().map(String::as_str),
+        Some("FINISH"),
+        "the restarted master runs its mission: {:?}",
+        modes(&second_life)
+    );
+    // What each slave sent while the master was dead (its mission clock
+    // started with ours; 50 ms of margin at each end) reaches the master's
+    // second life: its persistent session kept it.
+    let (from, to) = ((killed + 50.0) / SCALE, (back_at - 50.0) / SCALE);
+    for (slave, events) in &slave_traces {
+        let meanwhile: Vec<(String, String)> = events
+            .iter()
+            .filter(|e| {
+                let t = e["t"].as_f64().unwrap_or(0.0);
+                field(e, "event") == "send" && field(e, "to") == "MasterTeam" && t > from && t < to
+            })
+            .map(|e| (field(e, "key").to_string(), field(e, "value").to_string()))
+            .collect();
+        assert!(
+            !meanwhile.is_empty(),
+            "{slave} sent while the master was dead"
+        );
+        let mut received = received_all_from(&second_life, slave);
+        for message in &meanwhile {
+            let at = received.iter().position(|r| r == message);
+            assert!(
+                at.is_some(),
+                "{slave}'s {message:?}, sent while the master was dead, reaches its second life"
+            );
+            received.remove(at.unwrap());
+        }
+        assert!(
+            !slave_traces[slave]
+                .iter()
+                .any(|e| field(e, "event") == "comm_error"),
+            "{slave} never fails to send"
+        );
+    }
+}
+
+#[test]
+fn the_operator_console_drives_scouting_to_finish() {
+    let Some(binary) = broker_or_skip("the_operator_console_drives_scouting_to_finish") else {
+        return;
+    };
+    let out = scratch("mqtt-operator");
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let deploy = scouting_deployment(&out, port, false);
+    let config = broker_config(&out, &deploy);
+    let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
+    let mut processes = Processes::default();
+    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+    // The scouting world without its simulated operator: only the console
+    // can tell the master to return (it waits in WAIT_MODE until then).
+    let mut world: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scenario()).unwrap()).unwrap();
+    world["operator"] = serde_json::json!([]);
+    world.as_object_mut().unwrap().remove("expect");
+    let alone = out.join("no-operator.scenario.json");
+    std::fs::write(&alone, world.to_string()).unwrap();
+
+    let mut console = Command::new(env!("CARGO_BIN_EXE_semo"))
+        .args(["operator"])
+        .arg(examples().join("scouting/scouting.mission"))
+        .arg("--deploy")
+        .arg(&deploy)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("semo operator starts");
+    let mut stdin = console.stdin.take().unwrap();
+    let stdout = console.stdout.take().unwrap();
+    let (lines_tx, lines) = std::sync::mpsc::channel::<String>();
+    let reader = std::thread::spawn(move || {
+        use std::io::BufRead;
+        let mut all = Vec::new();
+        for line in std::io::BufReader::new(stdout).lines() {
+            let line = line.unwrap();
+            let _ = lines_tx.send(line.clone());
+            all.push(line);
+        }
+        all
+    });
+    let console = processes.push(console);
+    let first = lines
+        .recv_timeout(std::time::Duration::from_secs(30))
+        .expect("the console says what it can send");
+    assert!(first.contains("RC_CMD (to MasterTeam)"), "{first}");
+
+    let mut started = Vec::new();
+    for folder in &folders {
+        let robot = robot_name(folder);
+        let trace = out.join(format!("{robot}.operated.jsonl"));
+        let child = robot_command(folder, &alone, &trace, 1)
+            .args(["--transport", "mqtt"])
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the robot program starts");
+        started.push((robot, trace, processes.push(child)));
+    }
+    // When the console shows the master waiting, the operator sends it home.
+    let waiting =
+        std::iter::from_fn(|| lines.recv_timeout(std::time::Duration::from_secs(30)).ok())
+            .find(|l| l.starts_with("status irobot: running WAIT_MODE"));
+    assert!(waiting.is_some(), "the console shows the master waiting");
+    use std::io::Write;
+    writeln!(stdin, "RC_CMD RETURN_MODE").unwrap();
+    stdin.flush().unwrap();
+    let mut traces = BTreeMap::new();
+    for (robot, trace, index) in started {
+        processes.wait_success(index, &format!("{robot} (operated)"));
+        traces.insert(robot, read_trace(&trace));
+    }
+    drop(stdin);
+    processes.wait_success(console, "semo operator");
+    let printed = reader.join().unwrap();
+    let master = modes(&traces["irobot"]);
+    assert_eq!(
+        master,
+        ["AUTO_MODE", "WAIT_MODE", "RETURN_MODE", "FINISH"],
+        "the console's command drives the master to FINISH"
+    );
+    for (robot, events) in &traces {
+        assert_eq!(
+            modes(events).last().map(String::as_str),
+            Some("FINISH"),
+            "{robot}"
+        );
+    }
+    assert!(
+        printed
+            .iter()
+            .any(|l| l == "sent USER.RC_CMD = RETURN_MODE"),
+        "{printed:?}"
+    );
+    assert!(
+        printed
+            .iter()
+            .any(|l| l.starts_with("irobot: send(USER, MasterTeam.DISTANCE) = ")),
+        "the console prints what the master sends the operator: {printed:?}"
+    );
+    assert!(
+        printed
+            .iter()
+            .any(|l| l.starts_with("status irobot: stopped FINISH")),
+        "{printed:?}"
     );
 }

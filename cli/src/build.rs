@@ -23,6 +23,8 @@ pub struct Options {
     pub color: bool,
     /// Replace files in the way (saved to the backup folder first).
     pub force: bool,
+    /// A deployment file baked into every robot folder.
+    pub deploy: Option<PathBuf>,
 }
 
 const BUILD: &str = "semo build";
@@ -98,12 +100,34 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         );
         return 2;
     }
+    // The deployment file: the command line's, else the project file's.
+    let deploy_path = options.deploy.clone().or_else(|| {
+        project
+            .and_then(|p| p.deployment.as_ref())
+            .map(|d| d.path.clone())
+    });
+    let deployment = match &deploy_path {
+        None => None,
+        Some(path) => {
+            match super::deploy::load(&mut run, path, options.format, options.color, out) {
+                Ok(deployment) => Some(deployment),
+                Err(code) => return code,
+            }
+        }
+    };
     let Some(input) = run.analysis().build_input(mission) else {
         eprintln!("internal error: the mission was loaded but not checked");
         return 2;
     };
     let input = input.input();
-    let result = match &scenario {
+    if let Some(deployment) = &deployment {
+        let found = semo::deploy::check(deployment, &input.analysis.mission);
+        if found.iter().any(|d| d.is_error()) {
+            drop(input);
+            return super::deploy::refuse(&mut run, found, options.format, options.color, out);
+        }
+    }
+    let mut result = match &scenario {
         None => codegen::build(&input, target, options.emit),
         Some((name, text)) => match build_with_scenario(&input, name, text, target, &options) {
             Ok(result) => result,
@@ -132,6 +156,16 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         }
         eprintln!("error: code generation refused: fix the errors above first");
         return 1;
+    }
+    let baking = options.emit == Emit::All;
+    if let (Some(deployment), true) = (&deployment, baking) {
+        if !semo::deploy::bake(deployment, &mut result) {
+            eprintln!(
+                "error: --deploy: target {} has no network transport to deploy",
+                target.name()
+            );
+            return 2;
+        }
     }
     let human = options.format == Format::Human;
     let mut robots_json = Vec::new();

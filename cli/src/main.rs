@@ -3,10 +3,12 @@
 //! 1 errors found, 2 usage or I/O problem.
 
 mod build;
+mod deploy;
 mod fmt;
 mod graph;
 mod init;
 mod input;
+mod operator;
 mod output;
 mod render;
 mod simulate;
@@ -153,6 +155,33 @@ enum Command {
         /// under OUT/.semo-backup/<time>/.
         #[arg(long)]
         force: bool,
+        /// A deployment file (`*.deploy.toml`, docs/deployment.md): its
+        /// broker and each robot's credentials become the defaults baked
+        /// into the robot folders (`semo_deploy.h`; no secret is copied).
+        #[arg(long, value_name = "FILE")]
+        deploy: Option<PathBuf>,
+    },
+    /// Deployment on real networks: the broker's configuration.
+    #[command(subcommand)]
+    Deploy(DeployCommand),
+    /// The operator console of a running mission: send the USER commands
+    /// it receives (`NAME VALUE` per line on standard input), print what
+    /// robots send(USER, …) and each robot's status as it changes.
+    Operator {
+        /// The mission script.
+        mission: PathBuf,
+        /// The broker, mqtt://HOST[:PORT] (default: the deployment's, else
+        /// mqtt://127.0.0.1:1883).
+        #[arg(long, value_name = "URL")]
+        broker: Option<String>,
+        /// A deployment file: the operator's credentials (and broker).
+        #[arg(long, value_name = "FILE")]
+        deploy: Option<PathBuf>,
+        /// More strategy (and catalog) files or folders to read.
+        #[arg(long)]
+        strategy: Vec<PathBuf>,
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
     },
     /// Run every robot of a mission together in virtual time on a scenario,
     /// and check the scenario's expectations.
@@ -224,6 +253,29 @@ enum Command {
     Explain {
         /// A code such as E019; all codes when omitted.
         code: Option<String>,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum DeployCommand {
+    /// Write a mosquitto configuration (`mosquitto.conf`) and its ACL
+    /// (`semo.acl`) for a mission: each robot's user may write only its own
+    /// topics and read what is sent to it, only the operator may write USER
+    /// commands, anonymous clients are refused, TCP_NODELAY is on.
+    BrokerConfig {
+        /// The mission script.
+        mission: PathBuf,
+        /// The deployment file (`*.deploy.toml`).
+        #[arg(long, value_name = "FILE")]
+        deploy: PathBuf,
+        /// More strategy (and catalog) files or folders to read.
+        #[arg(long)]
+        strategy: Vec<PathBuf>,
+        /// The folder to write the configuration into.
+        #[arg(long = "output", short = 'o', value_name = "DIR")]
+        out: PathBuf,
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
     },
 }
 
@@ -454,6 +506,7 @@ fn run() -> i32 {
             format,
             color,
             force,
+            deploy,
         } => build::run(
             build::Options {
                 mission,
@@ -461,6 +514,7 @@ fn run() -> i32 {
                 out: out_dir,
                 target,
                 scenario,
+                deploy,
                 emit: match emit {
                     EmitArg::All => semo::codegen::Emit::All,
                     EmitArg::Taskgraph => semo::codegen::Emit::TaskGraph,
@@ -469,6 +523,36 @@ fn run() -> i32 {
                 color: use_color(color),
                 force,
             },
+            &mut out,
+        ),
+        Command::Operator {
+            mission,
+            broker,
+            deploy,
+            strategy,
+            color,
+        } => operator::run(
+            operator::Options {
+                mission,
+                strategy,
+                broker,
+                deploy,
+                color: use_color(color),
+            },
+            &mut out,
+        ),
+        Command::Deploy(DeployCommand::BrokerConfig {
+            mission,
+            deploy,
+            strategy,
+            out: out_dir,
+            color,
+        }) => deploy::broker_config(
+            &mission,
+            &strategy,
+            &deploy,
+            &out_dir,
+            use_color(color),
             &mut out,
         ),
         Command::Simulate {

@@ -7,7 +7,7 @@ use semo::host::CheckRun;
 use semo::workspace::Files;
 use std::io::{self, Write};
 
-fn kind(severity: Severity) -> ReportKind<'static> {
+pub fn kind(severity: Severity) -> ReportKind<'static> {
     match severity {
         Severity::Error => ReportKind::Error,
         Severity::Warning => ReportKind::Warning,
@@ -16,7 +16,7 @@ fn kind(severity: Severity) -> ReportKind<'static> {
     }
 }
 
-fn color(severity: Severity) -> Color {
+pub fn color(severity: Severity) -> Color {
     match severity {
         Severity::Error => Color::Red,
         Severity::Warning => Color::Yellow,
@@ -30,7 +30,7 @@ fn path_of(files: &Files, d: &Diagnostic) -> String {
 
 /// Clamps a span to the text and to character boundaries, so that a bad span
 /// can never make the renderer fail.
-fn safe_range(text: &str, span: semo::span::Span) -> std::ops::Range<usize> {
+pub fn safe_range(text: &str, span: semo::span::Span) -> std::ops::Range<usize> {
     let fix = |mut i: usize| {
         i = i.min(text.len());
         while !text.is_char_boundary(i) {

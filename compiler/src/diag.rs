@@ -182,6 +182,11 @@ codes! {
     ProjectUnknownKey = "W110", Warning, "a key or table that the project file format does not have, or a lint naming no diagnostic code";
     ProjectMissingPath = "W111", Warning, "a catalog, strategy or task-graph folder or a deployment file named in the project file that does not exist";
     SearchBounded = "W112", Warning, "without a project file, the search for the catalog and strategy files beside a mission stopped at its bound (too many entries): put a `semo.toml` at the project root";
+    // Deployment files (`*.deploy.toml`, `semo build --deploy`, `semo deploy`).
+    DeployInvalid = "E120", Error, "a deployment file that is not valid TOML or not of the deployment format (unknown key, wrong type, a certificate without its key, a robot without credentials the broker needs)";
+    DeployUnknownName = "E121", Error, "a deployment file naming a robot or team that the mission does not have";
+    DeployBadBroker = "E122", Error, "a broker address that is not `mqtt://HOST[:PORT]` or `mqtts://HOST[:PORT]`";
+    DeployMissingFile = "E123", Error, "a deployment file naming a password, CA, certificate or key file that does not exist";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

@@ -17,6 +17,7 @@
 pub mod catalog;
 pub mod codegen;
 pub mod dataflow;
+pub mod deploy;
 pub mod diag;
 mod digraph;
 pub mod edit;

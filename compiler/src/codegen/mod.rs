@@ -26,6 +26,17 @@ mod target;
 use crate::refine::{RobotProgram, RoleKind};
 use crate::taskgraph::write::to_xml;
 
+/// The header a threads target's runtime reads its connection defaults from
+/// (broker, client id, credentials' paths): generated without any, and
+/// filled by `deploy::bake` when `semo build --deploy` names a deployment.
+pub const DEPLOY_HEADER: &str = "semo_deploy.h";
+
+/// `text` as a C string literal (escaped), for files written beside the
+/// generated code (`deploy::bake`).
+pub fn c_string(text: &str) -> String {
+    c::string(text)
+}
+
 /// A code-generation target.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Target {
@@ -341,6 +352,13 @@ pub fn generate(
             Owner::Generated,
         );
         sources_c.push("scenario.c".into());
+    }
+    if target.platform() == Platform::Threads {
+        push(
+            DEPLOY_HEADER,
+            "/* No deployment file was given (`semo build --deploy FILE`): the runtime's\n * defaults, options and environment variables decide the connection. */\n".into(),
+            Owner::Generated,
+        );
     }
     for (name, text) in target.info().runtime {
         push(name, text.to_string(), Owner::Generated);

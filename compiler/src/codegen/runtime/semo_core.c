@@ -415,15 +415,30 @@ bool semo__inbox_waiting(void)
     return waiting;
 }
 
+/* How long a message waits for room in a full inbox that no task has polled
+ * yet (mission ms): a robot that receives nothing must not hold back its
+ * transport for ever. */
+#define INBOX_UNPOLLED_WAIT_MS 1000
+
 void semo__deliver(const semo_message *msg)
 {
     semo__queue_lock(SEMO__INBOX);
+    /* A full inbox holds back the deliverer, and through it the transport
+     * (MQTT: the broker keeps the rest of a burst, such as what it queued
+     * for a robot that reconnects), rather than losing a message; where the
+     * platform cannot wait (the static schedule) the message is dropped. */
+    int64_t deadline = semo_now_ms() + INBOX_UNPOLLED_WAIT_MS;
+    while (g_inbox_state.count == g_inbox_ring.capacity && semo_running() &&
+           (g_inbox_polled || semo_now_ms() < deadline) &&
+           semo__queue_wait(SEMO__INBOX, g_inbox_polled ? -1 : deadline))
+        ;
     bool queued = ring_put(&g_inbox_ring, msg);
     semo__queue_unlock(SEMO__INBOX);
     if (queued)
         semo__queue_written(SEMO__INBOX);
     else
-        semo_trace("drop", "from", msg->from_team, "key", msg->key, "reason", "inbox full", NULL);
+        semo_trace("drop", "from", msg->from_team, "key", msg->key, "reason",
+                   semo_running() ? "inbox full" : "stopping", NULL);
 }
 
 int semo_comm_poll(semo_message *out, int64_t timeout_ms)
@@ -438,6 +453,8 @@ int semo_comm_poll(semo_message *out, int64_t timeout_ms)
         ;
     bool got = ring_take(&g_inbox_ring, out);
     semo__queue_unlock(SEMO__INBOX);
+    if (got)
+        semo__queue_written(SEMO__INBOX); /* room for a held-back delivery */
     if (got)
         semo_trace("receive", "from", out->from_team, "from_robot", out->from_robot, "key", out->key, "value",
                    out->value.text, NULL);

@@ -21,6 +21,7 @@
 #include <pthread.h>
 #include <stdbool.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -53,6 +54,21 @@ static bool g_subscribed;
 static int g_connect_refused; /* the broker's CONNACK code when it refused */
 static int g_subscribe_mid = -1;
 static long g_unacked; /* messages handed to libmosquitto whose on_publish has not come */
+
+/* Sends made while the broker was unreachable, oldest first; g_send_lock
+ * also keeps sends in order against the flush (never held by a callback
+ * while it waits for g_lock, nor taken under g_lock). */
+/* At most this many (a robot sending every 10 ms waits about 80 s); each
+ * takes only its own size, allocated when the broker is away. */
+#define MQTT_OUTBOX 8192
+typedef struct {
+    size_t len;
+    unsigned char *data;
+    char topic[]; /* then the payload */
+} mqtt_outgoing;
+static pthread_mutex_t g_send_lock = PTHREAD_MUTEX_INITIALIZER;
+static mqtt_outgoing *g_outbox[MQTT_OUTBOX];
+static size_t g_out_head, g_out_count;
 
 /* A topic level made of a name: the characters MQTT gives a meaning to
  * (level separator, wildcards) become `_`. */
@@ -122,6 +138,8 @@ static struct timespec deadline_after(int ms)
     return t;
 }
 
+static void outbox_flush(void);
+
 /* On every (re)connection: subscribe again (the persistent session keeps the
  * subscriptions, but a broker that lost its state must learn them). */
 static void on_connect(struct mosquitto *mosq, void *obj, int rc)
@@ -145,6 +163,7 @@ static void on_connect(struct mosquitto *mosq, void *obj, int rc)
         g_subscribe_mid = mid;
         pthread_mutex_unlock(&g_lock);
     }
+    outbox_flush();
 }
 
 static void on_subscribe(struct mosquitto *mosq, void *obj, int mid, int count, const int *granted)
@@ -200,6 +219,53 @@ static void on_message(struct mosquitto *mosq, void *obj, const struct mosquitto
     pthread_mutex_unlock(&g_lock);
 }
 
+static void status_topic(char *topic, size_t cap);
+
+/* The password: the first line of its file, without the line break. */
+static int read_password(const char *path, char *out, size_t cap)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) {
+        fprintf(stderr, "semo runtime: cannot read the MQTT password file \"%s\"\n", path);
+        return -1;
+    }
+    bool got = fgets(out, (int)cap, f) != NULL;
+    fclose(f);
+    if (!got) {
+        fprintf(stderr, "semo runtime: the MQTT password file \"%s\" is empty\n", path);
+        return -1;
+    }
+    out[strcspn(out, "\r\n")] = '\0';
+    return 0;
+}
+
+/* Who we are at the broker (user and password) and, for mqtts://, TLS with
+ * the CA that signed the broker's certificate and our own certificate. */
+static int identify(const semo_transport_config *config)
+{
+    if (config->user) {
+        char password[256] = "";
+        if (config->password_file && read_password(config->password_file, password, sizeof password) != 0)
+            return -1;
+        int rc = mosquitto_username_pw_set(g_mosq, config->user, config->password_file ? password : NULL);
+        /* The password stays in libmosquitto only. */
+        memset(password, 0, sizeof password);
+        if (rc != MOSQ_ERR_SUCCESS) {
+            fprintf(stderr, "semo runtime: MQTT user \"%s\": %s\n", config->user, mosquitto_strerror(rc));
+            return -1;
+        }
+    }
+    if (config->broker_tls) {
+        int rc = mosquitto_tls_set(g_mosq, config->ca, NULL, config->cert, config->key, NULL);
+        if (rc != MOSQ_ERR_SUCCESS) {
+            fprintf(stderr, "semo runtime: TLS with CA \"%s\"%s%s: %s\n", config->ca ? config->ca : "",
+                    config->cert ? " and certificate " : "", config->cert ? config->cert : "", mosquitto_strerror(rc));
+            return -1;
+        }
+    }
+    return 0;
+}
+
 static int mqtt_open(const semo_program_desc *program, const semo_transport_config *config)
 {
     if (g_mosq || program->self >= program->peer_count || !config->broker_host)
@@ -211,6 +277,7 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     g_connect_refused = 0;
     g_subscribe_mid = -1;
     g_unacked = 0;
+    g_out_head = g_out_count = 0;
     pthread_condattr_t attr;
     pthread_condattr_init(&attr);
     pthread_condattr_setclock(&attr, CLOCK_MONOTONIC);
@@ -219,13 +286,28 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
 
     mosquitto_lib_init();
     char client_id[MQTT_TOPIC_MAX];
-    snprintf(client_id, sizeof client_id, "semo-%s-%s", g_mission, program->peers[program->self].robot);
+    if (config->client_id)
+        snprintf(client_id, sizeof client_id, "%s", config->client_id);
+    else
+        snprintf(client_id, sizeof client_id, "semo-%s-%s", g_mission, program->peers[program->self].robot);
     g_mosq = mosquitto_new(client_id, false, NULL);
     if (!g_mosq) {
         mosquitto_lib_cleanup();
         return -1;
     }
+    if (identify(config) != 0) {
+        mosquitto_destroy(g_mosq);
+        g_mosq = NULL;
+        mosquitto_lib_cleanup();
+        return -1;
+    }
     mosquitto_int_option(g_mosq, MOSQ_OPT_TCP_NODELAY, 1);
+    /* If we vanish without disconnecting, the broker says so on our status. */
+    char will_topic[MQTT_TOPIC_MAX], will[MQTT_TOPIC_MAX];
+    status_topic(will_topic, sizeof will_topic);
+    int will_len = snprintf(will, sizeof will, "{\"robot\":\"%s\",\"event\":\"status\",\"state\":\"lost\"}",
+                            program->peers[program->self].robot);
+    mosquitto_will_set(g_mosq, will_topic, will_len, will, 1, true);
     mosquitto_connect_callback_set(g_mosq, on_connect);
     mosquitto_subscribe_callback_set(g_mosq, on_subscribe);
     mosquitto_publish_callback_set(g_mosq, on_publish);
@@ -263,6 +345,61 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     return 0;
 }
 
+/* Publishes, counting the message until on_publish (QoS 1: the broker's
+ * PUBACK; QoS 0: written to the socket), which may come first. */
+static int publish(const char *topic, const void *data, size_t len, int qos, bool retain)
+{
+    pthread_mutex_lock(&g_lock);
+    g_unacked++;
+    pthread_mutex_unlock(&g_lock);
+    int rc = mosquitto_publish(g_mosq, NULL, topic, (int)len, data, qos, retain);
+    if (rc != MOSQ_ERR_SUCCESS) {
+        pthread_mutex_lock(&g_lock);
+        g_unacked--;
+        pthread_mutex_unlock(&g_lock);
+    }
+    return rc;
+}
+
+/* Under g_send_lock: keeps a send for the next connection; false when the
+ * outbox is full (the send is then lost, and said so by the caller). */
+static bool outbox_put(const char *topic, const void *data, size_t len)
+{
+    size_t topic_len = strlen(topic) + 1;
+    mqtt_outgoing *kept = g_out_count < MQTT_OUTBOX ? malloc(sizeof *kept + topic_len + len) : NULL;
+    if (!kept)
+        return false;
+    memcpy(kept->topic, topic, topic_len);
+    kept->data = (unsigned char *)kept->topic + topic_len;
+    kept->len = len;
+    memcpy(kept->data, data, len);
+    g_outbox[(g_out_head + g_out_count) % MQTT_OUTBOX] = kept;
+    g_out_count++;
+    pthread_mutex_lock(&g_lock); /* close waits for it too */
+    g_unacked++;
+    pthread_mutex_unlock(&g_lock);
+    return true;
+}
+
+/* On a (re)connection: the sends kept meanwhile go first, in order. */
+static void outbox_flush(void)
+{
+    pthread_mutex_lock(&g_send_lock);
+    while (g_out_count > 0) {
+        mqtt_outgoing *kept = g_outbox[g_out_head];
+        if (publish(kept->topic, kept->data, kept->len, 1, false) != MOSQ_ERR_SUCCESS)
+            break; /* gone again: the next connection retries */
+        free(kept);
+        g_outbox[g_out_head] = NULL;
+        g_out_head = (g_out_head + 1) % MQTT_OUTBOX;
+        g_out_count--;
+        pthread_mutex_lock(&g_lock); /* now counted by publish */
+        g_unacked--;
+        pthread_mutex_unlock(&g_lock);
+    }
+    pthread_mutex_unlock(&g_send_lock);
+}
+
 /* `to` is a team (every robot of it hears) or one robot's name. */
 static int mqtt_send_to(const char *to, const void *data, size_t len)
 {
@@ -280,28 +417,26 @@ static int mqtt_send_to(const char *to, const void *data, size_t len)
         else if (strcmp(g_program->peers[i].robot, to) == 0)
             robot = &g_program->peers[i];
     }
-    if (team)
+    if (team || strcmp(to, "USER") == 0) /* USER: every operator console */
         topic_of(topic, sizeof topic, to, NULL, key);
     else if (robot)
         topic_of(topic, sizeof topic, robot->team, robot->robot, key);
     else
         return -1;
     bool is_send = ((const unsigned char *)data)[5] == SEMO_MSG_SEND;
-    int qos = is_send ? 1 : 0;
-    /* Counted before publishing: on_publish (QoS 1: the broker's PUBACK;
-     * QoS 0: written to the socket) may come first. */
-    pthread_mutex_lock(&g_lock);
-    g_unacked++;
-    pthread_mutex_unlock(&g_lock);
-    /* While disconnected libmosquitto queues QoS 1 messages and sends them on
-     * reconnection; a QoS 0 publish is then lost, as on UDP. */
-    int rc = mosquitto_publish(g_mosq, NULL, topic, (int)len, data, qos, !is_send);
-    if (rc != MOSQ_ERR_SUCCESS) {
-        pthread_mutex_lock(&g_lock);
-        g_unacked--;
-        pthread_mutex_unlock(&g_lock);
+    if (!is_send) {
+        /* A publish while disconnected is lost, as on UDP: the next one
+         * carries the latest value. */
+        int rc = publish(topic, data, len, 0, true);
+        return rc == MOSQ_ERR_SUCCESS || rc == MOSQ_ERR_NO_CONN ? 0 : -1;
     }
-    return rc == MOSQ_ERR_SUCCESS || (rc == MOSQ_ERR_NO_CONN && qos == 0) ? 0 : -1;
+    /* A send is never lost: while the broker is away (libmosquitto refuses
+     * to publish then) it waits in the outbox, in order, until on_connect. */
+    pthread_mutex_lock(&g_send_lock);
+    int rc = g_out_count == 0 ? publish(topic, data, len, 1, false) : MOSQ_ERR_NO_CONN;
+    bool queued = rc == MOSQ_ERR_NO_CONN || rc == MOSQ_ERR_CONN_LOST ? outbox_put(topic, data, len) : false;
+    pthread_mutex_unlock(&g_send_lock);
+    return rc == MOSQ_ERR_SUCCESS || queued ? 0 : -1;
 }
 
 static int mqtt_recv(void *data, size_t cap, int timeout_ms)
@@ -326,6 +461,27 @@ static int mqtt_recv(void *data, size_t cap, int timeout_ms)
     }
     pthread_mutex_unlock(&g_lock);
     return n;
+}
+
+/* semo/<mission>/status/<robot>. */
+static void status_topic(char *topic, size_t cap)
+{
+    snprintf(topic, cap, "semo");
+    append_level(topic, cap, g_mission);
+    append_level(topic, cap, "status");
+    append_level(topic, cap, g_program->peers[g_program->self].robot);
+}
+
+/* Retained, so that an operator who connects later sees it; QoS 1, so that
+ * the last one (stopped) reaches the broker before we disconnect. */
+static int mqtt_status(const char *json, size_t len)
+{
+    if (!g_mosq)
+        return -1;
+    char topic[MQTT_TOPIC_MAX];
+    status_topic(topic, sizeof topic);
+    int rc = publish(topic, json, len, 1, true);
+    return rc == MOSQ_ERR_SUCCESS || rc == MOSQ_ERR_NO_CONN ? 0 : -1;
 }
 
 static void mqtt_interrupt(void)
@@ -354,6 +510,12 @@ static void mqtt_close(void)
     g_mosq = NULL;
     mosquitto_lib_cleanup();
     pthread_cond_destroy(&g_changed);
+    /* Sends the broker never came back for are lost with the program. */
+    for (; g_out_count > 0; g_out_count--) {
+        free(g_outbox[g_out_head]);
+        g_outbox[g_out_head] = NULL;
+        g_out_head = (g_out_head + 1) % MQTT_OUTBOX;
+    }
 }
 
 const semo_transport semo_mqtt_transport = {
@@ -362,6 +524,7 @@ const semo_transport semo_mqtt_transport = {
     .send_to = mqtt_send_to,
     .recv = mqtt_recv,
     .interrupt = mqtt_interrupt,
+    .status = mqtt_status,
     .close = mqtt_close,
 };
 #else

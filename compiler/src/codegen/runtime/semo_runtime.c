@@ -30,7 +30,16 @@
 #endif
 #define RECV_ERROR_PAUSE_MS 50
 #define DEFAULT_PORT_BASE 47000
+/* The deployment baked in by `semo build --deploy` (the generated Makefile
+ * defines SEMO_DEPLOY; without a deployment the header defines nothing). */
+#ifdef SEMO_DEPLOY
+#include "semo_deploy.h"
+#endif
+#ifdef SEMO_DEPLOY_BROKER
+#define DEFAULT_BROKER SEMO_DEPLOY_BROKER
+#else
 #define DEFAULT_BROKER "mqtt://127.0.0.1:1883"
+#endif
 /* The target's transport (the Makefile's TRANSPORT); MQTT is compiled in
  * only where it is the default, as only then is libmosquitto linked. */
 #ifdef SEMO_MQTT
@@ -147,8 +156,14 @@ static void put_file(void *file, const char *bytes, size_t n)
     fwrite(bytes, 1, n, (FILE *)file);
 }
 
+static void observe_status(const char *event, va_list args);
+
 void semo_trace(const char *event, ...)
 {
+    va_list seen;
+    va_start(seen, event);
+    observe_status(event, seen);
+    va_end(seen);
     pthread_mutex_lock(&g_trace_lock);
     if (g_trace) {
         /* The time is read under the lock so that lines are in time order. */
@@ -223,7 +238,8 @@ bool semo__queue_wait(int queue, int64_t deadline_ms)
 void semo__queue_written(int queue)
 {
     if (queue == SEMO__INBOX) {
-        pthread_cond_signal(&g_inbox_cond);
+        /* Both a poller and a held-back delivery may wait on the inbox. */
+        pthread_cond_broadcast(&g_inbox_cond);
     } else {
         pthread_cond_signal(&g_channels[queue].readable);
         wake_task(g_channels[queue].reader);
@@ -680,10 +696,11 @@ static const semo_transport *g_transport; /* NULL: no other robots */
 int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value)
 {
     int local = semo__comm_send_local(to_team, kind, key, value);
-    if (local != 0)
+    if (local < 0)
         return local;
+    bool to_operator = local == 1;
     if (!g_transport)
-        return -1;
+        return to_operator ? 1 : -1; /* the operator console: the trace is its record */
     semo_message m = {.kind = (char)kind};
     snprintf(m.from_team, sizeof m.from_team, "%s", g_prog->team);
     snprintf(m.from_robot, sizeof m.from_robot, "%s", g_prog->robot);
@@ -691,6 +708,13 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
     m.value = *value;
     unsigned char datagram[DATAGRAM_MAX];
     size_t len = encode_message(&m, datagram);
+    if (to_operator) {
+        /* A transport that reaches operators (MQTT: semo/<mission>/USER/<key>,
+         * `semo operator`) tells them too; the trace stays the record. */
+        if (g_transport->send_to)
+            g_transport->send_to("USER", datagram, len);
+        return 1;
+    }
     int sent = 0;
     for (size_t i = 0; i < g_prog->peer_count; i++) {
         const semo_peer *p = &g_prog->peers[i];
@@ -718,6 +742,124 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
         return -1;
     }
     return sent;
+}
+
+/* -------------------------------------------------------------- status */
+
+/* The robot's status for operators, kept from the trace's own events (the
+ * trace is the record of what the robot does, so the status cannot say
+ * something else): its state (running, finished, stopped; the broker's last
+ * will says lost), mode, leader and the service each plan runs. Published
+ * on every change through the transport's `status` (MQTT: retained on
+ * semo/<mission>/status/<robot>) as one JSON line of the trace's form:
+ * {"t":..,"robot":..,"event":"status","state":..,"mode":..,"leader":..,
+ * "services":"Plan=Service,..."}. */
+#define STATUS_PLANS 16
+#define STATUS_NAME 64
+static struct {
+    pthread_mutex_t lock;
+    char state[16];
+    char mode[STATUS_NAME];
+    char leader[STATUS_NAME];
+    struct {
+        char plan[STATUS_NAME], service[STATUS_NAME];
+    } running[STATUS_PLANS];
+    size_t running_count;
+} g_status = {.lock = PTHREAD_MUTEX_INITIALIZER};
+
+typedef struct {
+    char text[1024 + 4 * STATUS_PLANS * STATUS_NAME];
+    size_t len;
+} status_buffer;
+
+static void put_status(void *ctx, const char *bytes, size_t n)
+{
+    status_buffer *b = ctx;
+    size_t room = sizeof b->text - 1 - b->len;
+    n = n < room ? n : room;
+    memcpy(b->text + b->len, bytes, n);
+    b->len += n;
+    b->text[b->len] = '\0';
+}
+
+static void status_line(status_buffer *b, const char *event, ...)
+{
+    semo__sink sink = {put_status, b};
+    va_list args;
+    va_start(args, event);
+    semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args);
+    va_end(args);
+}
+
+/* The value of `key` among a trace call's pairs, or NULL. */
+static const char *pair_value(va_list args, const char *key)
+{
+    va_list scan;
+    va_copy(scan, args);
+    const char *found = NULL;
+    for (const char *k = va_arg(scan, const char *); k && !found; k = va_arg(scan, const char *)) {
+        const char *v = va_arg(scan, const char *);
+        if (!v)
+            break;
+        if (strcmp(k, key) == 0)
+            found = v;
+    }
+    va_end(scan);
+    return found;
+}
+
+static void copy_name(char *out, const char *name)
+{
+    snprintf(out, STATUS_NAME, "%s", name ? name : "");
+}
+
+static void observe_status(const char *event, va_list args)
+{
+    const semo_transport *transport = g_transport;
+    if (!transport || !transport->status)
+        return;
+    pthread_mutex_lock(&g_status.lock);
+    bool changed = true;
+    if (strcmp(event, "start") == 0) {
+        snprintf(g_status.state, sizeof g_status.state, "running");
+    } else if (strcmp(event, "finish") == 0) {
+        snprintf(g_status.state, sizeof g_status.state, "finished");
+    } else if (strcmp(event, "stop") == 0) {
+        snprintf(g_status.state, sizeof g_status.state, "stopped");
+    } else if (strcmp(event, "mode") == 0) {
+        copy_name(g_status.mode, pair_value(args, "mode"));
+    } else if (strcmp(event, "leader") == 0) {
+        copy_name(g_status.leader, pair_value(args, "leader"));
+    } else if (strcmp(event, "service_start") == 0 || strcmp(event, "service_end") == 0) {
+        const char *plan = pair_value(args, "plan");
+        size_t i = 0;
+        while (i < g_status.running_count && strcmp(g_status.running[i].plan, plan ? plan : "") != 0)
+            i++;
+        bool starts = strcmp(event, "service_start") == 0;
+        if (starts && i == g_status.running_count && i < STATUS_PLANS) {
+            g_status.running_count++;
+            copy_name(g_status.running[i].plan, plan);
+        }
+        if (i < g_status.running_count)
+            copy_name(g_status.running[i].service, starts ? pair_value(args, "service") : "");
+    } else {
+        changed = false;
+    }
+    if (changed) {
+        char services[STATUS_PLANS * 2 * STATUS_NAME + STATUS_PLANS * 2] = "";
+        size_t at = 0;
+        for (size_t i = 0; i < g_status.running_count; i++)
+            if (g_status.running[i].service[0] && at < sizeof services)
+                at += (size_t)snprintf(services + at, sizeof services - at, "%s%s=%s", at ? "," : "",
+                                       g_status.running[i].plan, g_status.running[i].service);
+        status_buffer line = {.len = 0};
+        status_line(&line, "status", "state", g_status.state, "mode", g_status.mode, "leader", g_status.leader,
+                    "services", services, NULL);
+        if (line.len > 0 && line.text[line.len - 1] == '\n')
+            line.text[--line.len] = '\0'; /* one JSON object, not a line */
+        transport->status(line.text, line.len);
+    }
+    pthread_mutex_unlock(&g_status.lock);
 }
 
 static void *receiver_thread(void *arg)
@@ -794,6 +936,8 @@ typedef struct {
     const semo_transport *transport;
     char broker_host[256];
     int broker_port;
+    bool broker_tls;
+    semo_transport_config identity; /* mqtt: who the robot is at the broker */
     long port_base;
     int64_t duration_ms;
     bool duration_given;
@@ -818,7 +962,10 @@ static void usage(FILE *f, const char *prog)
             "  --trace FILE      write a JSON-lines trace to FILE (\"-\": standard output)\n"
             "  --transport T     udp (loopback) or mqtt (default %s, or $SEMO_TRANSPORT)\n"
             "  --port-base N     udp: robot i uses UDP port N+i on 127.0.0.1 (default %d, or $SEMO_PORT_BASE)\n"
-            "  --broker URL      mqtt: the broker, mqtt://HOST[:PORT] (default " DEFAULT_BROKER ", or $SEMO_BROKER)\n"
+            "  --broker URL      mqtt: the broker, mqtt://HOST[:PORT] or mqtts://HOST[:PORT] (TLS)\n"
+            "                    (default " DEFAULT_BROKER ", or $SEMO_BROKER); who the robot is there:\n"
+            "                    $SEMO_MQTT_CLIENT_ID, $SEMO_MQTT_USER, $SEMO_MQTT_PASSWORD_FILE, $SEMO_MQTT_CA,\n"
+            "                    $SEMO_MQTT_CERT, $SEMO_MQTT_KEY (defaults from semo build --deploy)\n"
             "  --duration MS     stop after MS mission milliseconds (0: run until stopped)\n"
             "  --start-at T      mission time 0 is the wall-clock instant T (ms since 1970, or $SEMO_START_AT):\n"
             "                    robots given the same T start together; a T passed continues its mission time\n"
@@ -864,27 +1011,85 @@ static bool parse_transport(const char *prog, const char *name, const semo_trans
     return false;
 }
 
-/* `mqtt://HOST[:PORT]` (port 1883 when left out) into the options. */
+/* `mqtt://HOST[:PORT]` or `mqtts://HOST[:PORT]` (port 1883 or 8883 when
+ * left out) into the options. */
 static bool parse_broker(const char *prog, const char *url, options *o)
 {
-    const char *rest = strncmp(url, "mqtt://", 7) == 0 ? url + 7 : NULL;
+    bool tls = strncmp(url, "mqtts://", 8) == 0;
+    const char *rest = tls ? url + 8 : strncmp(url, "mqtt://", 7) == 0 ? url + 7 : NULL;
     if (!rest) {
-        fprintf(stderr, "%s: the broker must be mqtt://HOST[:PORT]%s, not \"%s\"\n", prog,
-                strncmp(url, "mqtts://", 8) == 0 ? " (TLS is not supported yet)" : "", url);
+        fprintf(stderr, "%s: the broker must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT], not \"%s\"\n", prog, url);
         return false;
     }
     const char *colon = strrchr(rest, ':');
     size_t host_len = colon ? (size_t)(colon - rest) : strlen(rest);
-    long port = 1883;
+    long port = tls ? 8883 : 1883;
     if (host_len == 0 || host_len >= sizeof o->broker_host || (colon && !parse_long(colon + 1, 1, 65535, &port))) {
-        fprintf(stderr, "%s: the broker must be mqtt://HOST[:PORT] with a port from 1 to 65535, not \"%s\"\n", prog,
-                url);
+        fprintf(stderr, "%s: the broker must be %s://HOST[:PORT] with a port from 1 to 65535, not \"%s\"\n", prog,
+                tls ? "mqtts" : "mqtt", url);
         return false;
     }
     memcpy(o->broker_host, rest, host_len);
     o->broker_host[host_len] = '\0';
     o->broker_port = (int)port;
+    o->broker_tls = tls;
     return true;
+}
+
+/* The deployment's value of a connection setting, under its environment
+ * variable; NULL when neither gives one. */
+static const char *setting(const char *env_name, const char *deployed)
+{
+    const char *env = getenv(env_name);
+    return env && *env ? env : deployed;
+}
+
+#ifndef SEMO_DEPLOY_CLIENT_ID
+#define SEMO_DEPLOY_CLIENT_ID NULL
+#endif
+#ifndef SEMO_DEPLOY_USER
+#define SEMO_DEPLOY_USER NULL
+#endif
+#ifndef SEMO_DEPLOY_PASSWORD_FILE
+#define SEMO_DEPLOY_PASSWORD_FILE NULL
+#endif
+#ifndef SEMO_DEPLOY_CA
+#define SEMO_DEPLOY_CA NULL
+#endif
+#ifndef SEMO_DEPLOY_CERT
+#define SEMO_DEPLOY_CERT NULL
+#endif
+#ifndef SEMO_DEPLOY_KEY
+#define SEMO_DEPLOY_KEY NULL
+#endif
+
+/* Who the robot is at the broker, into `o->identity`; with the MQTT
+ * transport chosen, false (the problem printed) when the settings do not fit
+ * together. */
+static bool mqtt_identity(const char *prog, options *o)
+{
+    semo_transport_config *net = &o->identity;
+    net->broker_tls = o->broker_tls;
+    net->client_id = setting("SEMO_MQTT_CLIENT_ID", SEMO_DEPLOY_CLIENT_ID);
+    net->user = setting("SEMO_MQTT_USER", SEMO_DEPLOY_USER);
+    net->password_file = setting("SEMO_MQTT_PASSWORD_FILE", SEMO_DEPLOY_PASSWORD_FILE);
+    net->ca = setting("SEMO_MQTT_CA", SEMO_DEPLOY_CA);
+    net->cert = setting("SEMO_MQTT_CERT", SEMO_DEPLOY_CERT);
+    net->key = setting("SEMO_MQTT_KEY", SEMO_DEPLOY_KEY);
+    const char *problem = NULL;
+    if (net->password_file && !net->user)
+        problem = "a password file needs a user ($SEMO_MQTT_USER)";
+    else if (!net->cert != !net->key)
+        problem = "a client certificate needs both $SEMO_MQTT_CERT and $SEMO_MQTT_KEY";
+    else if (net->broker_tls && !net->ca)
+        problem = "an mqtts:// broker needs the CA that signed its certificate ($SEMO_MQTT_CA)";
+    else if (!net->broker_tls && net->cert)
+        problem = "a client certificate needs an mqtts:// broker";
+    if (o->transport == &semo_udp_transport)
+        return true;
+    if (problem)
+        fprintf(stderr, "%s: %s\n", prog, problem);
+    return !problem;
 }
 
 /* 0: run; 1: help printed; 2: bad command line (message printed). */
@@ -993,7 +1198,7 @@ static int parse_options(int argc, char **argv, options *o)
             break;
         }
     }
-    return 0;
+    return mqtt_identity(prog, o) ? 0 : 2;
 }
 
 /* The generator's tables, checked once so that the calls above can trust them. */
@@ -1187,8 +1392,10 @@ static int run(const options *o)
     atomic_store(&g_running, true);
     /* A robot alone in its mission has no one to hear from: no port, no receiver. */
     if (p->peer_count > 1) {
-        semo_transport_config net = {
-            .port_base = o->port_base, .broker_host = o->broker_host, .broker_port = o->broker_port};
+        semo_transport_config net = o->identity;
+        net.port_base = o->port_base;
+        net.broker_host = o->broker_host;
+        net.broker_port = o->broker_port;
         if (o->transport->open(p, &net) != 0) {
             if (o->transport == &semo_udp_transport)
                 fprintf(stderr, "semo runtime: cannot open the udp transport on port %ld\n", o->port_base + (long)p->self);

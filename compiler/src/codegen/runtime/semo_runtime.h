@@ -262,11 +262,19 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
  * Returns 1 with `*out` filled, 0 on timeout or stop. */
 int semo_comm_poll(semo_message *out, int64_t timeout_ms);
 
-/* Where the transports reach the other robots (`--port-base`, `--broker`). */
+/* Where the transports reach the other robots (`--port-base`, `--broker`)
+ * and, for MQTT, who the robot is there: the deployment's defaults
+ * (`semo_deploy.h`) under the environment (`SEMO_MQTT_*`). NULL: not given. */
 typedef struct {
     long port_base;          /* udp: robot i owns port port_base + i of 127.0.0.1 */
     const char *broker_host; /* mqtt */
     int broker_port;
+    bool broker_tls;         /* mqtts:// */
+    const char *client_id;   /* default semo-<mission>-<robot> */
+    const char *user;
+    const char *password_file; /* its first line is the password */
+    const char *ca;            /* TLS: the CA that signed the broker's certificate */
+    const char *cert, *key;    /* TLS: the client's certificate and key */
 } semo_transport_config;
 
 /* The transport interface: loopback UDP (`semo_udp.c`) and MQTT
@@ -285,6 +293,9 @@ typedef struct {
     /* Makes a recv under way, and every later one, return 0 at once (the
      * program is stopping); safe from any thread. */
     void (*interrupt)(void);
+    /* Publishes the robot's status (a JSON object, see semo_runtime.c) for
+     * operators, replacing the last one; NULL: the transport has none. */
+    int (*status)(const char *json, size_t len);
     void (*close)(void);
 } semo_transport;
 extern const semo_transport semo_udp_transport;

@@ -1,0 +1,324 @@
+//! `semo operator MISSION --broker URL`: the operator console on a live
+//! mission (rumqttc). It sends the `USER` commands the mission receives
+//! (one per line on standard input: `RC_CMD RETURN_MODE`), prints what the
+//! robots `send(USER, …)`, and prints each robot's status whenever it
+//! changes (the retained `semo/<mission>/status/<robot>` topics). It ends
+//! when standard input does.
+//!
+//! The commands and their receivers come from the refined programs (each
+//! robot's incoming messages from `USER`); the topics and the datagram are
+//! the runtime's (`deploy::topics`, `semo_runtime.c`'s encode_message).
+
+use semo::codegen;
+use semo::deploy::topics;
+use semo::host;
+use std::collections::{BTreeMap, BTreeSet};
+use std::io::{BufRead, Write};
+use std::path::PathBuf;
+
+pub struct Options {
+    pub mission: PathBuf,
+    pub strategy: Vec<PathBuf>,
+    pub broker: Option<String>,
+    pub deploy: Option<PathBuf>,
+    pub color: bool,
+}
+
+/// A `USER` command and the teams that receive it.
+struct Command {
+    key: String,
+    teams: BTreeSet<String>,
+}
+
+pub fn run(options: Options, out: &mut impl Write) -> i32 {
+    let (run, mission) = match host::load_build(&options.mission, &options.strategy) {
+        Ok(loaded) => loaded,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let mut run = run;
+    let deployment = match &options.deploy {
+        None => None,
+        Some(path) => {
+            match super::deploy::load(
+                &mut run,
+                path,
+                super::output::Format::Human,
+                options.color,
+                out,
+            ) {
+                Ok(deployment) => Some(deployment),
+                Err(code) => return code,
+            }
+        }
+    };
+    let Some(input) = run.analysis().build_input(mission) else {
+        eprintln!("internal error: the mission was loaded but not checked");
+        return 2;
+    };
+    let input = input.input();
+    let refined = codegen::refine_checked(&input);
+    let Some(first) = refined.programs.first() else {
+        run.diagnostics = refined.diagnostics;
+        let _ = super::render::human(&run, options.color, &mut std::io::stderr());
+        eprintln!("error: refused: fix the errors above first");
+        return 1;
+    };
+    let mission_topic = topics::mission(&first.mission);
+    let mut commands: BTreeMap<String, Command> = BTreeMap::new();
+    for program in &refined.programs {
+        for incoming in program
+            .control
+            .incoming
+            .iter()
+            .filter(|i| i.from_team == "USER")
+        {
+            let name = incoming.key.strip_prefix("USER.").unwrap_or(&incoming.key);
+            commands
+                .entry(name.to_string())
+                .or_insert_with(|| Command {
+                    key: incoming.key.clone(),
+                    teams: BTreeSet::new(),
+                })
+                .teams
+                .insert(program.team.clone());
+        }
+    }
+    let url = match (&options.broker, &deployment) {
+        (Some(url), _) => url.clone(),
+        (None, Some(d)) => d.broker.url.clone(),
+        (None, None) => "mqtt://127.0.0.1:1883".to_string(),
+    };
+    let Some((host_name, port)) = mqtt_address(&url) else {
+        eprintln!(
+            "error: the broker must be mqtt://HOST[:PORT] (the console has no TLS), not {url:?}"
+        );
+        return 2;
+    };
+    let mut mqtt = rumqttc::MqttOptions::new(
+        format!("semo-operator-{}-{}", mission_topic, std::process::id()),
+        host_name,
+        port,
+    );
+    mqtt.set_keep_alive(std::time::Duration::from_secs(10));
+    if let Some(credentials) = deployment.as_ref().map(|d| d.operator_credentials()) {
+        if let Some(user) = credentials.user {
+            let password = match &credentials.password_file {
+                None => String::new(),
+                Some(path) => match std::fs::read_to_string(path) {
+                    Ok(text) => text.lines().next().unwrap_or("").to_string(),
+                    Err(e) => {
+                        eprintln!(
+                            "error: cannot read the operator's password file {}: {e}",
+                            path.display()
+                        );
+                        return 2;
+                    }
+                },
+            };
+            mqtt.set_credentials(user, password);
+        }
+    }
+    let (client, mut connection) = rumqttc::Client::new(mqtt, 64);
+    let level = topics::level(&mission_topic);
+    for topic in [
+        format!("semo/{level}/status/+"),
+        format!("semo/{level}/USER/+"),
+    ] {
+        if let Err(e) = client.subscribe(topic, rumqttc::QoS::AtLeastOnce) {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    }
+    let listing: Vec<String> = commands
+        .iter()
+        .map(|(name, c)| {
+            format!(
+                "{name} (to {})",
+                c.teams.iter().cloned().collect::<Vec<_>>().join(", ")
+            )
+        })
+        .collect();
+    let _ = writeln!(
+        out,
+        "operator on {url}, mission {mission_topic}; commands: {}; type `NAME VALUE` per line",
+        if listing.is_empty() {
+            "none".to_string()
+        } else {
+            listing.join(", ")
+        }
+    );
+    let _ = out.flush();
+    // The broker's messages and the operator's lines come to this thread
+    // (which holds standard output) as they arrive.
+    enum Input {
+        Broker(String),
+        Line(String),
+        End,
+    }
+    let (tx, rx) = std::sync::mpsc::channel();
+    let listener = {
+        let tx = tx.clone();
+        std::thread::spawn(move || {
+            let mut printed = BTreeMap::new();
+            for event in connection.iter() {
+                match event {
+                    Ok(rumqttc::Event::Incoming(rumqttc::Packet::Publish(p))) => {
+                        if let Some(line) = describe(&p.topic, &p.payload, &mut printed) {
+                            let _ = tx.send(Input::Broker(line));
+                        }
+                    }
+                    Ok(rumqttc::Event::Outgoing(rumqttc::Outgoing::Disconnect)) => break,
+                    Ok(_) => {}
+                    Err(e) => {
+                        eprintln!("operator: connection to the broker: {e} (retrying)");
+                        std::thread::sleep(std::time::Duration::from_secs(1));
+                    }
+                }
+            }
+        })
+    };
+    std::thread::spawn(move || {
+        for line in std::io::stdin().lock().lines() {
+            let Ok(line) = line else { break };
+            if tx.send(Input::Line(line)).is_err() {
+                return;
+            }
+        }
+        let _ = tx.send(Input::End);
+    });
+    let mut status = 0;
+    for input in rx.iter() {
+        let line = match input {
+            Input::Broker(line) => {
+                let _ = writeln!(out, "{line}");
+                let _ = out.flush();
+                continue;
+            }
+            Input::End => break,
+            Input::Line(line) => line,
+        };
+        let line = line.trim();
+        if line.is_empty() {
+            continue;
+        }
+        let (name, value) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
+        let name = name.strip_prefix("USER.").unwrap_or(name);
+        let Some(command) = commands.get(name) else {
+            eprintln!(
+                "operator: the mission receives no USER command `{name}` (it receives: {})",
+                commands.keys().cloned().collect::<Vec<_>>().join(", ")
+            );
+            status = 1;
+            continue;
+        };
+        let payload = datagram(&command.key, value.trim());
+        for team in &command.teams {
+            let topic = topics::to_team(&mission_topic, team, &command.key);
+            if let Err(e) = client.publish(topic, rumqttc::QoS::AtLeastOnce, false, payload.clone())
+            {
+                eprintln!("operator: {e}");
+                status = 1;
+            }
+        }
+        let _ = writeln!(out, "sent {} = {}", command.key, value.trim());
+        let _ = out.flush();
+    }
+    let _ = client.disconnect();
+    let _ = listener.join();
+    status
+}
+
+/// `mqtt://HOST[:PORT]`.
+fn mqtt_address(url: &str) -> Option<(String, u16)> {
+    let rest = url.strip_prefix("mqtt://")?;
+    match rest.rsplit_once(':') {
+        Some((host, port)) if !host.is_empty() => Some((host.to_string(), port.parse().ok()?)),
+        None if !rest.is_empty() => Some((rest.to_string(), 1883)),
+        _ => None,
+    }
+}
+
+/// A `send` from the operator as the runtime's datagram: "SEMO" 1, `s`,
+/// then team `USER`, robot `operator`, the key and the value, each a length
+/// byte and at most 255 bytes.
+fn datagram(key: &str, value: &str) -> Vec<u8> {
+    let mut out = b"SEMO\x01s".to_vec();
+    for field in ["USER", "operator", key, value] {
+        let bytes = &field.as_bytes()[..field.len().min(255)];
+        out.push(bytes.len() as u8);
+        out.extend_from_slice(bytes);
+    }
+    out
+}
+
+/// The fields of a runtime datagram: (team, robot, key, value).
+fn fields(data: &[u8]) -> Option<[String; 4]> {
+    if data.len() < 6 || &data[..5] != b"SEMO\x01" {
+        return None;
+    }
+    let mut at = 6;
+    let mut take = || {
+        let n = *data.get(at)? as usize;
+        let text = data.get(at + 1..at + 1 + n)?;
+        at += 1 + n;
+        Some(String::from_utf8_lossy(text).into_owned())
+    };
+    Some([take()?, take()?, take()?, take()?])
+}
+
+/// The line to print for a message: a robot's `send(USER, …)`, or its
+/// status when it changed.
+fn describe(topic: &str, payload: &[u8], printed: &mut BTreeMap<String, String>) -> Option<String> {
+    let mut levels = topic.rsplit('/');
+    let last = levels.next()?;
+    match levels.next()? {
+        "USER" => {
+            let [_, robot, key, value] = fields(payload)?;
+            Some(format!("{robot}: send(USER, {key}) = {value}"))
+        }
+        "status" => {
+            let status: serde_json::Value = serde_json::from_slice(payload).ok()?;
+            let text = |k: &str| status[k].as_str().unwrap_or("").to_string();
+            let line = format!(
+                "status {last}: {} {}{}{}",
+                text("state"),
+                text("mode"),
+                match text("services").as_str() {
+                    "" => String::new(),
+                    s => format!(" [{s}]"),
+                },
+                match text("leader").as_str() {
+                    "" => String::new(),
+                    l => format!(" leader {l}"),
+                }
+            );
+            (printed.get(last) != Some(&line)).then(|| {
+                printed.insert(last.to_string(), line.clone());
+                line
+            })
+        }
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_command_is_the_runtimes_datagram_and_reads_back() {
+        let d = super::datagram("USER.RC_CMD", "RETURN_MODE");
+        assert_eq!(
+            super::fields(&d),
+            Some([
+                "USER".into(),
+                "operator".into(),
+                "USER.RC_CMD".into(),
+                "RETURN_MODE".into()
+            ])
+        );
+        assert_eq!(super::mqtt_address("mqtt://h:99"), Some(("h".into(), 99)));
+        assert_eq!(super::mqtt_address("mqtts://h"), None);
+    }
+}
