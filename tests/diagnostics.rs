@@ -41,9 +41,14 @@ fn every_code_has_a_fixture() {
         .flat_map(|dir| std::fs::read_dir(support::repo_root().join(dir)).unwrap())
         .map(|e| fixture_code(&e.unwrap().path()))
         .collect();
+    // W112 needs more directory entries than a fixture should hold: it is
+    // made and checked by tests/project.rs
+    // (`without_a_project_file_the_search_beside_a_mission_is_bounded`).
+    let made_by_tests = ["W112"];
     let missing: Vec<&str> = Code::ALL
         .iter()
         .map(|c| c.as_str())
+        .filter(|c| !made_by_tests.contains(c))
         .filter(|c| !codes.iter().any(|f| f == c))
         .collect();
     assert!(missing.is_empty(), "codes without a fixture: {missing:?}");

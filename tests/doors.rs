@@ -209,9 +209,9 @@ fn checking_a_mission_reads_the_catalog_beside_it() {
     assert_eq!(code, 0, "{}", listing(&problems));
     let out = semo_in(&root, &["check", "patrol/patrol.mission"]);
     assert!(
-        out.stdout.contains("checked 1 mission and 1 catalog file"),
+        out.stderr.contains("checked 1 mission and 1 catalog file"),
         "{}",
-        out.stdout
+        out.stderr
     );
 }
 
@@ -306,4 +306,100 @@ fn dataflow_warnings_are_the_same_at_every_door() {
         assert_eq!(build.code, 0, "{}{}", build.stdout, build.stderr);
         let _ = std::fs::remove_dir_all(&out);
     }
+}
+
+/// The diagnostics the server publishes for `mission` when `root` is the
+/// workspace folder (indexed from disk, the mission unopened).
+fn indexed_from_server(root: &Path, mission: &Path) -> BTreeSet<Problem> {
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    let file = mission.display().to_string();
+    let found = runtime.block_on(async {
+        let mut client = TestClient::start();
+        client
+            .initialize(&["utf-16"], Some(&format!("file://{}", root.display())))
+            .await;
+        let found = client.diagnostics(&format!("file://{file}"), None).await;
+        client.shutdown().await;
+        found
+    });
+    found
+        .iter()
+        .map(|d| {
+            (
+                file.clone(),
+                d["code"].as_str().unwrap().to_string(),
+                d["range"]["start"]["line"].as_u64().unwrap() + 1,
+                d["range"]["start"]["character"].as_u64().unwrap() + 1,
+                d["message"].as_str().unwrap().to_string(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn a_project_files_folders_and_levels_are_the_same_at_every_door() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path();
+    // A repository root: the search for a project file stops here.
+    std::fs::create_dir(root.join(".git")).unwrap();
+    let write = |path: &str, text: &str| {
+        let path = root.join(path);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, text).unwrap();
+    };
+    write(
+        "semo.toml",
+        "[project]\nversion = 1\ncatalogs = [\"robots\"]\n\n[lints]\nW010 = \"allow\"\nW002 = \"deny\"\n",
+    );
+    write(
+        "robots/rover.robot.xml",
+        "<Catalog xmlns=\"urn:semo:catalog:1\">\n  <Robot type=\"Rover\">\n    <Service name=\"beep\" task=\"buzzer\"/>\n  </Robot>\n</Catalog>\n",
+    );
+    // Beside the mission but in no catalog folder of the project: unread.
+    write("missions/stray.robot.xml", "<Catalog");
+    // A W010 (allowed) and a W002 (denied).
+    write(
+        "missions/m.mission",
+        "{ A: Rover r }\ndef zigzag{\n  beep()\n}\nA.P.S{\n  beep()\n} repeat(1 SEC)\nA.M{ set(P, S) }\nA.REST{ set(P, OFF) }\nA.main{\n  default: mode = M\n}\n",
+    );
+    let mission = root.join("missions/m.mission");
+    let name = mission.display().to_string();
+    let only_mission = |problems: BTreeSet<Problem>| -> BTreeSet<Problem> {
+        problems.into_iter().filter(|p| p.0 == name).collect()
+    };
+    let (code, single) = from_check(root, &[name.as_str()]);
+    assert_eq!(code, 1, "W002 denied: an error\n{}", listing(&single));
+    let codes: Vec<&str> = single.iter().map(|p| p.1.as_str()).collect();
+    assert_eq!(codes, ["W002"], "{}", listing(&single));
+    let (_, whole) = from_check(root, &["."]);
+    assert_eq!(
+        listing(&single),
+        listing(&only_mission(whole)),
+        "FILE and DIR"
+    );
+    // The editor opened on the missions folder: the project file above it
+    // and its catalog folder beside it are found as the CLI finds them.
+    assert_eq!(
+        listing(&single),
+        listing(&indexed_from_server(&root.join("missions"), &mission)),
+        "check and the editor"
+    );
+    let out = root.join("out");
+    let build = semo_in(
+        root,
+        &[
+            "build",
+            &name,
+            "--emit",
+            "taskgraph",
+            "-o",
+            &out.display().to_string(),
+        ],
+    );
+    assert_eq!(build.code, 1, "{}{}", build.stdout, build.stderr);
+    assert!(!out.exists());
 }

@@ -6,7 +6,7 @@
 
 mod support;
 
-use semo::ide::semantic_tokens::{MODIFIERS, TokenKind};
+use semo::ide::mission::semantic_tokens::{MODIFIERS, TokenKind};
 use serde_json::Value;
 use std::collections::BTreeSet;
 use std::process::Command;
@@ -293,4 +293,46 @@ fn neovim_links_the_same_token_types_that_vs_code_declares() {
         linked.insert(c[1].to_string());
     }
     assert_eq!(linked, declared);
+}
+
+/// The entries of `DOCUMENT_SELECTOR` in the extension's `server.ts`: the
+/// files VS Code sends to the server.
+fn document_selector() -> Vec<String> {
+    let source = std::fs::read_to_string(repo_root().join("vscode-extension/src/server.ts"))
+        .expect("server.ts");
+    let start = source
+        .find("export const DOCUMENT_SELECTOR = [")
+        .expect("server.ts declares DOCUMENT_SELECTOR");
+    let body = &source[start..];
+    let body = &body[..body.find("];").expect("the selector ends")];
+    body.lines()
+        .map(str::trim)
+        .filter(|l| l.starts_with('{'))
+        .map(str::to_string)
+        .collect()
+}
+
+#[test]
+fn the_project_file_wakes_the_extension_and_is_sent_to_the_server() {
+    let package = package_json();
+    let events = package["activationEvents"]
+        .as_array()
+        .expect("activationEvents");
+    assert!(
+        events.iter().any(|e| e == "workspaceContains:**/semo.toml"),
+        "{events:?}"
+    );
+    let selector = document_selector();
+    assert!(
+        selector
+            .iter()
+            .any(|entry| entry == "{ scheme: 'file', pattern: '**/semo.toml' },"),
+        "{selector:#?}"
+    );
+    // Only the project file among TOML files (no `language: 'toml'` entry).
+    assert!(
+        !selector
+            .iter()
+            .any(|e| e.contains("toml'") && e.contains("language"))
+    );
 }

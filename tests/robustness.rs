@@ -59,7 +59,7 @@ fn check_never_panics(text: &str) {
 /// The editor features on the analysis, at a spread of offsets (past the end
 /// too): no panic, and their ranges lie inside the text, sorted or nested.
 fn ide_never_panics(text: &str, analysis: &semo::Analysis) {
-    use semo::ide::*;
+    use semo::ide::mission::*;
     let inside = |s: semo::span::Span| s.start <= s.end && s.end <= text.len();
     let tokens = semantic_tokens::semantic_tokens(analysis, None);
     assert!(tokens.iter().all(|t| inside(t.span)));

@@ -12,8 +12,9 @@ use common::mission::generate;
 
 use semo::catalog::builtin_catalog;
 use semo::diag::FileId;
-use semo::ide::completion::{CompletionConfig, completions};
-use semo::ide::{folding, hover, navigation, rename, selection, semantic_tokens, symbols};
+use semo::ide::CompletionConfig;
+use semo::ide::mission::completion::completions;
+use semo::ide::mission::{folding, hover, navigation, rename, selection, semantic_tokens, symbols};
 use std::hint::black_box;
 use std::time::Duration;
 

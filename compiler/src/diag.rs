@@ -60,6 +60,17 @@ macro_rules! codes {
             pub fn from_code(code: &str) -> Option<Code> {
                 match code { $($code => Some(Code::$variant),)* _ => None }
             }
+
+            /// The full explanation (`semo explain CODE`): what the code
+            /// means and why, then a `## Wrong` and a `## Right` example,
+            /// each one or more files in fenced blocks whose info string is
+            /// the file name. One file per code, `diag/explain/CODE.md`: a
+            /// code without one does not compile.
+            pub fn explanation(self) -> &'static str {
+                match self {
+                    $(Code::$variant => include_str!(concat!("diag/explain/", $code, ".md")),)*
+                }
+            }
         }
     };
 }
@@ -164,6 +175,13 @@ codes! {
     OutputNameEscapes = "E101", Error, "a name that cannot become a file or C identifier of the generated code (it could write outside the output folder, or clashes with a generated task)";
     CodegenInternal = "E102", Error, "an internal error of refinement or code generation: something the checker should have excluded (please report it)";
     TargetUnsupported = "E103", Error, "a robot the chosen target cannot run as written: on `cortex-m` a robot that messages other robots (no transport there yet), or `cortex-m-sim` without `--scenario`";
+    // The project file (`semo.toml`).
+    ProjectSyntax = "E110", Error, "a project file (`semo.toml`) that is not valid TOML";
+    ProjectBadValue = "E111", Error, "a project-file value of the wrong type or form (a folder list that is not a list of strings, an unknown target or lint level, a format version this semo does not read)";
+    ProjectErrorAllowed = "E112", Error, "`[lints]` lowering an error code: only warnings and hints can be allowed or made warnings (an `E` code may only be `deny`)";
+    ProjectUnknownKey = "W110", Warning, "a key or table that the project file format does not have, or a lint naming no diagnostic code";
+    ProjectMissingPath = "W111", Warning, "a catalog, strategy or task-graph folder or a deployment file named in the project file that does not exist";
+    SearchBounded = "W112", Warning, "without a project file, the search for the catalog and strategy files beside a mission stopped at its bound (too many entries): put a `semo.toml` at the project root";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

@@ -7,16 +7,26 @@
 //!
 //! # Which files belong together
 //!
-//! A file sees the catalog (`*.robot.xml`) and strategy (`*.strategy.xml`)
-//! files in its own folder and the folders under it (but not into a folder
-//! holding missions of its own: that is another project, as each example or
-//! fixture folder is), and those directly in each folder above it up to its
-//! workspace root (the innermost root that
-//! holds it; a file under no root is its own folder's root), and the files
-//! named to be seen by all (`semo build --strategy`). A document that is not a file (an unsaved editor
-//! buffer) sees what a file directly in the first workspace root would. Nothing else: two
-//! sibling folders do not see each other. [`sees`] is that rule, and the only
-//! place it is written.
+//! A file under a project file (`semo.toml` in its folder or one above it,
+//! the innermost; see [`crate::project`]) sees the catalog files in the
+//! project's catalog folders and the strategy files in its strategy folders,
+//! wherever they are, and nothing else of the disk.
+//!
+//! Without a project file, a file sees the catalog (`*.robot.xml`) and
+//! strategy (`*.strategy.xml`) files in its own folder and the folders under
+//! it down to [`SEEN_DEPTH`] levels (but not into a folder holding missions
+//! of its own: that is another project, as each example or fixture folder
+//! is), and those directly in each folder above it up to its workspace root
+//! (the innermost root that holds it; a file under no root is its own
+//! folder's root).
+//!
+//! Either way it sees the files named to be seen by all (`semo build
+//! --strategy`). A document that is not a file (an unsaved editor buffer)
+//! sees what a file directly in the first workspace root would. Nothing
+//! else: two sibling folders do not see each other. [`sees`] is that rule,
+//! and the only place it is written. A project's `[lints]` levels apply to
+//! the diagnostics of every file under it ([`Analysis::diagnostics`],
+//! [`Analysis::dataflow`]).
 //!
 //! The missions of one folder see the same files: they form a *unit*. A
 //! unit's catalog files (sorted by path) make its catalog; its missions are
@@ -39,6 +49,7 @@
 use crate::catalog::{Catalog, CatalogSource, load_catalog};
 use crate::codegen::BuildInput;
 use crate::diag::{self, Diagnostic, FileId};
+use crate::project::{self, Project};
 use crate::sema::{self, check_parsed};
 use crate::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
 use crate::syntax::{ParseCache, parse_incremental};
@@ -57,27 +68,41 @@ pub struct Roots {
     pub seen_by_all: Vec<PathBuf>,
 }
 
+/// How many folders below its own a file without a project file looks for
+/// catalog and strategy files (`semo check`, `semo build` read no deeper).
+pub const SEEN_DEPTH: usize = 3;
+
 /// Whether a file at `reader` sees the catalog or strategy file at `file`
 /// (see the module documentation); `has_missions` tells which folders hold
-/// missions.
+/// missions, `project` is the project file `reader` is under, if any.
 pub fn sees(
     roots: &Roots,
     has_missions: impl Fn(&Path) -> bool,
+    project: Option<&Project>,
     reader: &Path,
     file: &Path,
 ) -> bool {
     if roots.seen_by_all.iter().any(|p| file.starts_with(p)) {
         return true;
     }
+    if let Some(project) = project {
+        return match FileKind::of(file) {
+            Some(FileKind::Catalog) => Project::in_folders(&project.catalogs, file),
+            Some(FileKind::Strategy) => Project::in_folders(&project.strategies, file),
+            _ => false,
+        };
+    }
     let (Some(reader_dir), Some(file_dir)) = (folder(reader), folder(file)) else {
         return false;
     };
     if file_dir.starts_with(reader_dir) {
+        let depth = file_dir.components().count() - reader_dir.components().count();
         // Not into a folder below with missions of its own.
-        return !file_dir
-            .ancestors()
-            .take_while(|d| *d != reader_dir)
-            .any(has_missions);
+        return depth <= SEEN_DEPTH
+            && !file_dir
+                .ancestors()
+                .take_while(|d| *d != reader_dir)
+                .any(has_missions);
     }
     let roots = &roots.roots;
     let root = roots
@@ -144,8 +169,24 @@ pub struct AnalysisHost {
     graphs_revision: u64,
     /// How many missions each folder holds.
     mission_folders: Arc<BTreeMap<PathBuf, usize>>,
+    /// Every project file, read.
+    projects: Projects,
     memo: Arc<Memo>,
 }
+
+/// A project file read: the project (rooted at the file's folder; a
+/// document that is not a file is the project of no file) and the
+/// diagnostics of its text.
+#[derive(Debug)]
+pub struct LoadedProject {
+    pub file: FileId,
+    pub project: Project,
+    pub diagnostics: Vec<Diagnostic>,
+    /// Whether it is a file on disk (only those are the project of files).
+    on_disk: bool,
+}
+
+type Projects = Arc<BTreeMap<FileId, Arc<LoadedProject>>>;
 
 impl Default for AnalysisHost {
     fn default() -> Self {
@@ -161,6 +202,7 @@ impl AnalysisHost {
             next_revision: 0,
             graphs_revision: 0,
             mission_folders: Arc::default(),
+            projects: Projects::default(),
             memo: Arc::default(),
         }
     }
@@ -209,6 +251,30 @@ impl AnalysisHost {
         }
         let new = self.files[&id].clone();
         self.count_mission(&new, 1);
+        self.read_project(&new);
+    }
+
+    /// Keeps the project files read (they decide what every file sees, so
+    /// they are read once per version, not per question).
+    fn read_project(&mut self, file: &SourceText) {
+        let projects = Arc::make_mut(&mut self.projects);
+        if file.kind != FileKind::Project {
+            projects.remove(&file.id);
+            return;
+        }
+        let root = file
+            .key
+            .as_deref()
+            .and_then(folder)
+            .unwrap_or(Path::new("."));
+        let (project, diagnostics) = project::parse(file.id, root, &file.text);
+        let loaded = LoadedProject {
+            file: file.id,
+            project,
+            diagnostics,
+            on_disk: file.key.is_some(),
+        };
+        projects.insert(file.id, Arc::new(loaded));
     }
 
     fn count_mission(&mut self, file: &SourceText, delta: isize) {
@@ -233,6 +299,7 @@ impl AnalysisHost {
                 self.graphs_revision += 1;
             }
             self.count_mission(&old, -1);
+            Arc::make_mut(&mut self.projects).remove(&id);
             self.memo.forget(id);
         }
     }
@@ -244,6 +311,7 @@ impl AnalysisHost {
             files: self.files.clone(),
             graphs_revision: self.graphs_revision,
             mission_folders: self.mission_folders.clone(),
+            projects: self.projects.clone(),
             memo: self.memo.clone(),
         }
     }
@@ -324,6 +392,7 @@ pub struct Analysis {
     files: Files,
     graphs_revision: u64,
     mission_folders: Arc<BTreeMap<PathBuf, usize>>,
+    projects: Projects,
     memo: Arc<Memo>,
 }
 
@@ -341,9 +410,37 @@ impl Analysis {
         sees(
             &self.roots,
             |d| self.mission_folders.contains_key(d),
+            self.project_at(reader).map(|p| &p.project),
             reader,
             file,
         )
+    }
+
+    /// The project a file at `path` is under: the project file on disk in
+    /// its folder or the nearest one above.
+    fn project_at(&self, path: &Path) -> Option<&Arc<LoadedProject>> {
+        let dir = folder(path)?;
+        self.projects
+            .values()
+            .filter(|p| p.on_disk && dir.starts_with(&p.project.root))
+            .max_by_key(|p| (p.project.root.components().count(), p.file))
+    }
+
+    /// The project file `id` belongs to (see [`Analysis::project_at`]); for
+    /// a project file, itself.
+    pub fn project(&self, id: FileId) -> Option<Arc<LoadedProject>> {
+        if let Some(own) = self.projects.get(&id) {
+            return Some(own.clone());
+        }
+        let file = self.file(id)?;
+        self.project_at(&self.place(file)?).cloned()
+    }
+
+    /// `diagnostics` of `id` at the levels of its project's `[lints]`.
+    fn apply_lints(&self, id: FileId, diagnostics: &mut Vec<Diagnostic>) {
+        if let Some(project) = self.project(id) {
+            project.project.apply_lints(diagnostics);
+        }
     }
 
     /// Where a file reads from: its path, else (a document that is not a
@@ -670,6 +767,17 @@ impl Analysis {
                 .graph(id)
                 .map(|g| g.diagnostics.clone())
                 .unwrap_or_default(),
+            FileKind::Project => match self.projects.get(&id) {
+                Some(loaded) => {
+                    let mut found = loaded.diagnostics.clone();
+                    if loaded.on_disk {
+                        let exists = |p: &Path| p.exists();
+                        found.extend(loaded.project.missing_paths(id, exists));
+                    }
+                    found
+                }
+                None => Vec::new(),
+            },
             FileKind::Catalog | FileKind::Strategy if file.key.is_none() => {
                 // A document that is not a file sees nothing: checked alone.
                 let mut found = self
@@ -700,16 +808,20 @@ impl Analysis {
                 found
             }
         };
+        self.apply_lints(id, &mut found);
         diag::sort_and_dedup(&mut found);
         diag::cap_per_file(&mut found);
         found
     }
 
-    /// The files a check of `id` reports on: itself and the catalog and
-    /// strategy files it sees (what its build reads).
+    /// The files a check of `id` reports on: itself, the catalog and
+    /// strategy files it sees (what its build reads) and its project file.
     pub fn reads(&self, id: FileId) -> Vec<FileId> {
         let mut out = vec![id];
         out.extend(self.seen_by(id));
+        if let Some(project) = self.project(id).filter(|p| p.file != id) {
+            out.push(project.file);
+        }
         out
     }
 
@@ -768,13 +880,15 @@ impl Analysis {
     /// with it (an entry refined in two files); for a catalog file, the
     /// missions, catalog and strategy files sharing a unit with it; for a
     /// task graph, the graphs that read it (or were not analysed yet) and the
-    /// missions whose dataflow ([`Analysis::dataflow`]) read it.
+    /// missions whose dataflow ([`Analysis::dataflow`]) read it; for a
+    /// project file, every file (it decides what each sees and its levels).
     pub fn affected_by(&self, id: FileId) -> Vec<FileId> {
         let Some(file) = self.file(id) else {
             return Vec::new();
         };
         let mut out = vec![id];
         match file.kind {
+            FileKind::Project => out.extend(self.files.keys().copied()),
             FileKind::Mission => out.extend(
                 self.seen_by(id)
                     .into_iter()
@@ -786,7 +900,9 @@ impl Analysis {
                     for other in self.files() {
                         let place = self.place(other);
                         let shares = match (&reader, other.kind, place.as_deref()) {
-                            (None, ..) | (_, _, None) | (_, FileKind::TaskGraph, _) => false,
+                            (None, ..)
+                            | (_, _, None)
+                            | (_, FileKind::TaskGraph | FileKind::Project, _) => false,
                             (Some(reader), FileKind::Mission, Some(p)) => {
                                 file.kind == FileKind::Catalog && folder(p) == folder(reader)
                             }
@@ -859,8 +975,11 @@ impl BuildFiles {
 mod dataflow;
 mod disk;
 mod dropper;
+mod ide;
 #[cfg(test)]
 mod tests;
 
-pub use disk::{CheckRun, STDIN_NAME, load_build, load_check, load_check_stdin};
+pub use disk::{
+    CheckRun, ProjectInputs, STDIN_NAME, load_build, load_check, load_check_stdin, project_inputs,
+};
 pub use dropper::{Dropper, drop_later};

@@ -18,6 +18,7 @@ pub mod catalog;
 pub mod codegen;
 pub mod dataflow;
 pub mod diag;
+mod digraph;
 pub mod edit;
 /// A fast deterministic hasher for the checker's maps.
 mod fasthash;
@@ -28,6 +29,7 @@ pub mod ide;
 /// Graph drawing shared by the task-graph and mode-machine pictures.
 mod layout;
 pub mod modemachine;
+pub mod project;
 pub mod refine;
 pub mod sema;
 pub mod sim;

@@ -1,6 +1,6 @@
 //! Files on disk: their kinds, reading them (the one place that reads files),
 //! listing folders (a folder stands for every `.mission`, `.robot.xml`,
-//! `.strategy.xml` and `.taskgraph.xml` under it), the texts of a check for
+//! `.strategy.xml` and `.taskgraph.xml` file and every `semo.toml` under it), the texts of a check for
 //! rendering ([`Files`]), and task graphs analysed with their sub-graphs.
 //! Which files belong together is the host's rule (`crate::host`).
 
@@ -18,12 +18,16 @@ pub enum FileKind {
     TaskGraph,
     /// `*.strategy.xml`.
     Strategy,
+    /// `semo.toml`, the project file (`crate::project`).
+    Project,
 }
 
 impl FileKind {
     pub fn of(path: &Path) -> Option<FileKind> {
         let name = path.file_name()?.to_str()?;
-        if name.ends_with(".robot.xml") {
+        if name == crate::project::FILE_NAME {
+            Some(FileKind::Project)
+        } else if name.ends_with(".robot.xml") {
             Some(FileKind::Catalog)
         } else if name.ends_with(".taskgraph.xml") {
             Some(FileKind::TaskGraph)
@@ -141,17 +145,81 @@ pub fn collect(paths: &[PathBuf]) -> Result<Vec<(PathBuf, FileKind)>, LoadError>
     Ok(found)
 }
 
+/// How far [`collect_bounded`] goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Bound {
+    /// Folders below the first one (0: only its own entries).
+    pub depth: usize,
+    /// Directory entries looked at, at most.
+    pub entries: usize,
+}
+
+/// [`collect`] for one folder within `bound`, nearest first: the folder's
+/// entries, then those of its sub-folders, and so on (breadth first), so
+/// the bound cuts what is farthest away. Skips and links as [`walk`]. The
+/// flag says whether it stopped at `bound.entries` (entries past it were not
+/// looked at); the files come sorted by path.
+pub fn collect_bounded(
+    dir: &Path,
+    bound: Bound,
+) -> Result<(Vec<(PathBuf, FileKind)>, bool), LoadError> {
+    let error = |path: &Path, e: std::io::Error| LoadError {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let mut found: Vec<(PathBuf, FileKind)> = Vec::new();
+    let mut level = vec![dir.to_path_buf()];
+    let mut seen = 0usize;
+    for depth in 0..=bound.depth {
+        let mut below = Vec::new();
+        for folder in &level {
+            let mut entries = std::fs::read_dir(folder)
+                .map_err(|e| error(folder, e))?
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| error(folder, e))?;
+            entries.sort_by_key(|e| e.file_name());
+            for entry in entries {
+                if skipped(&entry.file_name()) {
+                    continue;
+                }
+                seen += 1;
+                if seen > bound.entries {
+                    found.sort_by(|a, b| a.0.cmp(&b.0));
+                    return Ok((found, true));
+                }
+                let path = entry.path();
+                let kind = entry.file_type().map_err(|e| error(&path, e))?;
+                if kind.is_dir() {
+                    if depth < bound.depth {
+                        below.push(path);
+                    }
+                    continue;
+                }
+                let is_file = kind.is_file()
+                    || (kind.is_symlink() && std::fs::metadata(&path).is_ok_and(|m| m.is_file()));
+                if let (true, Some(kind)) = (is_file, FileKind::of(&path)) {
+                    found.push((path, kind));
+                }
+            }
+        }
+        level = below;
+    }
+    found.sort_by(|a, b| a.0.cmp(&b.0));
+    Ok((found, false))
+}
+
+/// Entries no walk goes into: hidden ones, `target`, `node_modules`.
+fn skipped(name: &std::ffi::OsStr) -> bool {
+    name.to_str()
+        .is_some_and(|n| n.starts_with('.') || n == "target" || n == "node_modules")
+}
+
 /// A folder's files of the kinds above, sorted. Hidden entries, `target` and
 /// `node_modules` are skipped; symbolic links to files are read, but links to
 /// folders are not followed, so a link to the folder itself or an ancestor
 /// cannot make the walk loop (nor can a link to `/` make it read the disk).
 fn walk(dir: &Path, found: &mut Vec<(PathBuf, FileKind)>) -> Result<(), LoadError> {
-    let skipped = |e: &walkdir::DirEntry| {
-        e.depth() > 0
-            && e.file_name()
-                .to_str()
-                .is_some_and(|n| n.starts_with('.') || n == "target" || n == "node_modules")
-    };
+    let skipped = |e: &walkdir::DirEntry| e.depth() > 0 && skipped(e.file_name());
     let entries = walkdir::WalkDir::new(dir)
         .follow_links(false)
         .sort_by_file_name()

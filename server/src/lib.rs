@@ -5,6 +5,7 @@
 //! - [`diagnostics`]: the queue and task that publish diagnostics.
 //! - [`server`]: the `LanguageServer` implementation, one line per method,
 //!   delegating to [`handlers`] (one file per request).
+//! - [`to_proto`]: the library's editor vocabulary in protocol types.
 //! - [`encoding`], [`document`]: positions and incremental edits at the door.
 //! - [`transport`]: a guard that keeps malformed frames away from tower-lsp.
 //! - [`harness`]: an in-memory client, for tests and benchmarks.
@@ -15,6 +16,7 @@ pub mod encoding;
 pub mod handlers;
 pub mod harness;
 pub mod server;
+pub mod to_proto;
 pub mod transport;
 pub mod world;
 

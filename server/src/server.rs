@@ -6,7 +6,8 @@ use crate::encoding::Encoding;
 use crate::handlers;
 use crate::world::{self, Snapshot};
 use crate::{State, diagnostics};
-use semo::ide::completion::CompletionConfig;
+use semo::host;
+use semo::ide::CompletionConfig;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use tower_lsp_server::jsonrpc::{Error, Result};
@@ -41,11 +42,34 @@ impl Backend {
     /// The current snapshot of a document, or an error for files never opened
     /// nor found in the workspace.
     fn snapshot(&self, uri: &Uri) -> Result<Arc<Snapshot>> {
-        self.state.world().snapshot(uri).ok_or_else(|| Error {
-            code: tower_lsp_server::jsonrpc::ErrorCode::InvalidParams,
-            message: format!("unknown document {}", uri.as_str()).into(),
-            data: None,
-        })
+        self.state
+            .world()
+            .snapshot(uri)
+            .ok_or_else(|| unknown_document(uri))
+    }
+
+    /// Runs `f` on a document's snapshot and the workspace analysis taken
+    /// with it (under one lock, so the analysis holds the snapshot's text),
+    /// off the async threads: for the position queries, which may read other
+    /// files of the workspace (a strategy file the mission's own snapshot
+    /// predates).
+    async fn on_query<T: Send + 'static>(
+        &self,
+        uri: &Uri,
+        f: impl FnOnce(&Snapshot, &host::Analysis) -> T + Send + 'static,
+    ) -> Result<T> {
+        let (snapshot, workspace) = {
+            let world = self.state.world();
+            (world.snapshot(uri), world.analysis())
+        };
+        let snapshot = snapshot.ok_or_else(|| unknown_document(uri))?;
+        tokio::task::spawn_blocking(move || f(&snapshot, &workspace))
+            .await
+            .map_err(|e| Error {
+                code: tower_lsp_server::jsonrpc::ErrorCode::InternalError,
+                message: format!("the request failed: {e}").into(),
+                data: None,
+            })
     }
 
     /// Runs `f` on a snapshot off the async threads. A panic inside a handler
@@ -273,6 +297,7 @@ impl Backend {
             "**/*.robot.xml",
             "**/*.strategy.xml",
             "**/*.taskgraph.xml",
+            "**/semo.toml",
         ]
         .into_iter()
         .map(|glob| FileSystemWatcher {
@@ -428,8 +453,8 @@ impl LanguageServer for Backend {
                 data: None,
             });
         }
-        self.on_snapshot(uri, move |s| {
-            handlers::completion::completion(s, position, config)
+        self.on_query(uri, move |s, w| {
+            handlers::completion::completion(s, w, position, config)
         })
         .await
     }
@@ -441,9 +466,9 @@ impl LanguageServer for Backend {
 
     async fn hover(&self, p: HoverParams) -> Result<Option<Hover>> {
         let position = p.text_document_position_params.position;
-        self.on_snapshot(
+        self.on_query(
             &p.text_document_position_params.text_document.uri,
-            move |s| handlers::hover::hover(s, position),
+            move |s, w| handlers::hover::hover(s, w, position),
         )
         .await
     }
@@ -481,10 +506,9 @@ impl LanguageServer for Backend {
         p: GotoDefinitionParams,
     ) -> Result<Option<GotoDefinitionResponse>> {
         let at = p.text_document_position_params;
-        let strategies = self.state.world().strategies();
         let found = self
-            .on_snapshot(&at.text_document.uri, move |s| {
-                handlers::definition::definition(s, &strategies, at.position)
+            .on_query(&at.text_document.uri, move |s, w| {
+                handlers::definition::definition(s, w, at.position)
             })
             .await?;
         let world = self.state.world();
@@ -604,5 +628,13 @@ impl LanguageServer for Backend {
             handlers::simulate::COMMAND => self.simulate(&p.arguments).await.map(Some),
             other => Err(Error::invalid_params(format!("unknown command `{other}`"))),
         }
+    }
+}
+
+fn unknown_document(uri: &Uri) -> Error {
+    Error {
+        code: tower_lsp_server::jsonrpc::ErrorCode::InvalidParams,
+        message: format!("unknown document {}", uri.as_str()).into(),
+        data: None,
     }
 }

@@ -13,6 +13,7 @@ use crate::encoding::{Encoding, LineMap};
 use semo::catalog::Catalog;
 use semo::diag::{Diagnostic, FileId};
 use semo::host::{self, AnalysisHost, CatalogResult, Dropper, Roots};
+use semo::ide::FilePosition;
 use semo::sema::Analysis;
 use semo::strategy::{Strategy, StrategyLinks};
 use semo::text::LineIndex;
@@ -20,7 +21,7 @@ use semo::workspace::{FileKind, GraphRun};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
-use tower_lsp_server::ls_types::{TextDocumentContentChangeEvent, Uri};
+use tower_lsp_server::ls_types::{Position, TextDocumentContentChangeEvent, Uri};
 
 /// The catalog a file sees (built on first use, outside the world's lock),
 /// and the texts of its files.
@@ -119,6 +120,15 @@ impl Snapshot {
     /// The workspace analysis this snapshot belongs to.
     pub fn host(&self) -> &host::Analysis {
         &self.host
+    }
+
+    /// A protocol position of this snapshot's text as the library's
+    /// [`FilePosition`] (what the workspace analysis' queries take).
+    pub fn position(&self, lines: &LineMap<'_>, position: Position) -> FilePosition {
+        FilePosition {
+            file: self.id,
+            offset: lines.offset(position),
+        }
     }
 
     /// Converts positions of this snapshot's text.
@@ -520,7 +530,7 @@ impl World {
             .collect();
         uris.sort_by_key(|u| match self.files[u].kind {
             FileKind::Mission => 0,
-            FileKind::Catalog | FileKind::TaskGraph => 1,
+            FileKind::Catalog | FileKind::TaskGraph | FileKind::Project => 1,
             FileKind::Strategy => 2,
         });
         for uri in &uris {
@@ -534,18 +544,34 @@ impl World {
     }
 }
 
-/// Every mission, catalog and task graph under the given roots, with its text
-/// (read without holding any lock).
+/// Every mission, catalog, strategy, task graph and project file under the
+/// given roots, with its text (read without holding any lock); and for each
+/// root, the project file that applies to it and the folders that file
+/// names, wherever they are (`semo::host::project_inputs`, as the CLI loads
+/// them).
 pub fn read_roots(roots: &[PathBuf]) -> Vec<(Uri, Option<String>)> {
     let mut found = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    let mut add = |path: &Path, found: &mut Vec<(Uri, Option<String>)>| {
+        if let Some(uri) = Uri::from_file_path(path)
+            && seen.insert(uri.clone())
+        {
+            found.push((uri, read_text(path)));
+        }
+    };
     for root in roots {
-        // A root that cannot be listed has nothing to index.
-        let Ok(files) = semo::workspace::collect(std::slice::from_ref(root)) else {
-            continue;
-        };
-        for (path, _) in files {
-            if let Some(uri) = Uri::from_file_path(&path) {
-                found.push((uri, read_text(&path)));
+        let mut folders = vec![root.clone()];
+        if let Some(inputs) = semo::host::project_inputs(root) {
+            add(&inputs.file, &mut found);
+            folders.extend(inputs.folders);
+        }
+        for folder in folders {
+            // A folder that cannot be listed has nothing to index.
+            let Ok(files) = semo::workspace::collect(std::slice::from_ref(&folder)) else {
+                continue;
+            };
+            for (path, _) in files {
+                add(&path, &mut found);
             }
         }
     }

@@ -108,6 +108,27 @@ local function run()
     check(semo_clients(b) == want, name .. ': expected ' .. want .. ' semo client(s)')
   end
 
+  -- 4b. The project file (filetype toml) gets the server, and its diagnostics: an error
+  -- code cannot be allowed (E112). Other TOML files do not get the server.
+  vim.fn.writefile({ '[lints]', 'E010 = "allow"' }, workspace .. '/semo.toml')
+  vim.fn.writefile({ '[package]' }, workspace .. '/other.toml')
+  vim.cmd('edit ' .. vim.fn.fnameescape(workspace .. '/other.toml'))
+  local other = vim.api.nvim_get_current_buf()
+  vim.cmd('edit ' .. vim.fn.fnameescape(workspace .. '/semo.toml'))
+  local project = vim.api.nvim_get_current_buf()
+  check(vim.wait(30000, function() return #vim.diagnostic.get(project) > 0 end, 50),
+    'no diagnostics on semo.toml within 30 s')
+  local e112 = vim.diagnostic.get(project)[1]
+  report(string.format('semo.toml: filetype %s, %d semo client(s), %d:%d %s', vim.bo[project].filetype,
+    semo_clients(project), e112.lnum + 1, e112.col + 1, tostring(e112.code)))
+  check(e112.code == 'E112' and e112.lnum == 1 and e112.col == 7, 'expected E112 on "allow" (2:8)')
+  check(semo_clients(other) == 0, 'other.toml got the semo server')
+  -- Deleted, then closed: the server forgets it (what it reads is on disk no more).
+  for _, name in ipairs({ 'semo.toml', 'other.toml' }) do
+    vim.fn.delete(workspace .. '/' .. name)
+    vim.cmd('bwipeout! ' .. vim.fn.fnameescape(workspace .. '/' .. name))
+  end
+
   -- 5. lsp/semo.lua (for `vim.lsp.enable` on 0.11+) finds the workspace of a mission and
   -- declines plain XML.
   local spec = dofile(vim.api.nvim_get_runtime_file('lsp/semo.lua', false)[1])

@@ -149,7 +149,7 @@ export async function generateCode(server: Server): Promise<void> {
 
 /**
  * "SeMo: Check Workspace": the server checks every mission, catalog, strategy
- * file and task graph of the workspace folders at start; this tells it that
+ * file, task graph and project file of the workspace folders at start; this tells it that
  * each of them changed on disk (`workspace/didChangeWatchedFiles`), so it
  * reads them again and publishes their diagnostics afresh, then shows the
  * Problems view.
@@ -160,7 +160,7 @@ export async function checkWorkspace(server: Server): Promise<void> {
     return;
   }
   const found = await vscode.workspace.findFiles(
-    '**/*.{mission,robot.xml,strategy.xml,taskgraph.xml}',
+    '**/{*.mission,*.robot.xml,*.strategy.xml,*.taskgraph.xml,semo.toml}',
     '**/{node_modules,target,.git}/**',
   );
   await client.sendNotification('workspace/didChangeWatchedFiles', {

@@ -20,6 +20,8 @@ export const DOCUMENT_SELECTOR = [
   { language: 'xml', pattern: '**/*.taskgraph.xml' },
   // Scenario files: completion of the names of their mission.
   { language: 'json', pattern: '**/*.scenario.json' },
+  // The project file, whatever language an installed extension gives TOML.
+  { scheme: 'file', pattern: '**/semo.toml' },
 ];
 
 function isExecutable(file: string): boolean {

@@ -1,11 +1,17 @@
 //! The command line's doors into the host: which files `semo check PATH…` and
 //! `semo build MISSION` load from the disk and report on. The rule for what a
 //! file sees is the host's ([`super::sees`]); these only choose the roots and
-//! load every file the rule could make a reported file see.
+//! load every file the rule could make a reported file see: the project
+//! file above a path (`project::find`) and the folders it names, else the
+//! named file's folder down to [`super::SEEN_DEPTH`] folders and at most
+//! [`MAX_ENTRIES`] entries (past them, W112 on the file: a mission in
+//! `/tmp` does not read all of `/tmp`).
 
-use super::{Analysis, AnalysisHost, Roots};
-use crate::diag::{self, Diagnostic, FileId};
-use crate::workspace::{FileKind, Files, LoadError, collect, load_text};
+use super::{Analysis, AnalysisHost, Roots, SEEN_DEPTH};
+use crate::diag::{self, Code, Diagnostic, FileId};
+use crate::project;
+use crate::span::Span;
+use crate::workspace::{Bound, FileKind, Files, LoadError, collect, collect_bounded, load_text};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -45,12 +51,20 @@ fn folder_of(path: &Path) -> PathBuf {
         .to_path_buf()
 }
 
+/// How many directory entries the search beside a named file looks at
+/// when no project file says where to look.
+pub const MAX_ENTRIES: usize = 20_000;
+
 #[derive(Default)]
 struct Loader {
     files: Files,
     host: AnalysisHost,
     by_path: HashMap<PathBuf, FileId>,
     checked: Vec<FileId>,
+    /// Project roots whose folders are loaded.
+    projects: Vec<PathBuf>,
+    /// Found while loading (W112), reported with the rest.
+    notes: Vec<Diagnostic>,
 }
 
 impl Loader {
@@ -86,12 +100,67 @@ impl Loader {
         Ok(ids)
     }
 
-    /// A file named by the user, with every file of its folder: it is
-    /// reported with the files it reads.
+    /// A file named by the user, with the files it may read: it is
+    /// reported with them.
     fn add_named_file(&mut self, path: &Path) -> Result<FileId, LoadError> {
         let id = self.add(path, FileKind::named_explicitly(path))?;
-        self.add_folder(&folder_of(path))?;
+        self.add_beside(path, id)?;
         Ok(id)
+    }
+
+    /// What the file `id` at `path` may read: its project's folders and the
+    /// other missions of its folder (its unit), else what is beside it.
+    fn add_beside(&mut self, path: &Path, id: FileId) -> Result<(), LoadError> {
+        let folder = folder_of(path);
+        let depth = if self.add_project(&folder)? {
+            0
+        } else {
+            SEEN_DEPTH
+        };
+        self.add_bounded(&folder, depth, id)
+    }
+
+    /// The files under `folder` within `depth` folders and [`MAX_ENTRIES`]
+    /// entries; a W112 on `named` when the entries ran out.
+    fn add_bounded(&mut self, folder: &Path, depth: usize, named: FileId) -> Result<(), LoadError> {
+        let bound = Bound {
+            depth,
+            entries: MAX_ENTRIES,
+        };
+        let (found, stopped) = collect_bounded(folder, bound)?;
+        for (path, kind) in found {
+            self.add(&path, kind)?;
+        }
+        if stopped {
+            self.notes.push(Diagnostic::new(
+                Code::SearchBounded,
+                named,
+                Span::new(0, 0),
+                format!(
+                    "looked at only the first {MAX_ENTRIES} entries under {} for catalog and \
+                     strategy files; put a semo.toml at the project root to say where they are",
+                    absolute(folder).display()
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The project file that applies to `folder` and every file of the
+    /// folders it names; whether there is one.
+    fn add_project(&mut self, folder: &Path) -> Result<bool, LoadError> {
+        let Some(inputs) = project_inputs(folder) else {
+            return Ok(false);
+        };
+        if self.projects.contains(&inputs.file) {
+            return Ok(true);
+        }
+        self.projects.push(inputs.file.clone());
+        self.add(&inputs.file, FileKind::Project)?;
+        for folder in &inputs.folders {
+            self.add_folder(folder)?;
+        }
+        Ok(true)
     }
 
     fn finish(self, roots: Roots, named: Vec<FileId>) -> CheckRun {
@@ -115,6 +184,7 @@ impl Loader {
                 found
             })
             .collect();
+        diagnostics.extend(loader.notes.iter().cloned());
         diag::sort_and_dedup(&mut diagnostics);
         CheckRun {
             files: loader.files,
@@ -123,6 +193,35 @@ impl Loader {
             diagnostics,
         }
     }
+}
+
+/// A project file and the input folders it names that exist: what a door
+/// loads, besides its own folders, for the files under the project.
+pub struct ProjectInputs {
+    pub file: PathBuf,
+    pub folders: Vec<PathBuf>,
+}
+
+/// The project file that applies to `folder` ([`project::find`]) and its
+/// catalog, strategy and task-graph folders (the CLI's loaders and the
+/// language server's workspace scan both load these).
+pub fn project_inputs(folder: &Path) -> Option<ProjectInputs> {
+    let root = project::find(folder)?;
+    let file = root.join(project::FILE_NAME);
+    // An unreadable project file is reported when the door loads it.
+    let text = load_text(&file).unwrap_or_default();
+    let (project, _) = project::parse(FileId::default(), &root, &text);
+    let mut folders: Vec<PathBuf> = project
+        .catalogs
+        .iter()
+        .chain(&project.strategies)
+        .chain(&project.task_graphs)
+        .map(|f| f.path.clone())
+        .filter(|f| f.is_dir())
+        .collect();
+    folders.sort();
+    folders.dedup();
+    Some(ProjectInputs { file, folders })
 }
 
 /// How a mission read from standard input is named in reports.
@@ -152,6 +251,7 @@ pub fn load_check(paths: &[PathBuf]) -> Result<CheckRun, LoadError> {
         if path.is_dir() {
             roots.roots.push(absolute(path));
             named.extend(loader.add_folder(path)?);
+            loader.add_project(path)?;
         } else {
             roots.roots.push(absolute(&folder_of(path)));
             named.push(loader.add_named_file(path)?);
@@ -171,7 +271,7 @@ pub fn load_build(mission: &Path, strategy: &[PathBuf]) -> Result<(CheckRun, Fil
         seen_by_all: Vec::new(),
     };
     let id = loader.add(mission, FileKind::Mission)?;
-    loader.add_folder(&folder_of(mission))?;
+    loader.add_beside(mission, id)?;
     for extra in strategy {
         for (path, kind) in collect(std::slice::from_ref(extra))? {
             if matches!(kind, FileKind::Catalog | FileKind::Strategy) {

@@ -13,7 +13,7 @@ fn a_file_sees_its_folder_below_it_and_the_folders_above_it_up_to_its_root() {
     let r = roots(&["/w"]);
     // Folders with missions of their own.
     let projects = |d: &Path| d == Path::new("/w/a/other") || d == Path::new("/w/a");
-    let sees = |r: &Roots, m: &Path, f: &Path| sees(r, projects, m, f);
+    let sees = |r: &Roots, m: &Path, f: &Path| sees(r, projects, None, m, f);
     let m = Path::new("/w/a/m.mission");
     // Its folder and below.
     assert!(sees(&r, m, Path::new("/w/a/x.robot.xml")));
@@ -42,6 +42,27 @@ fn a_file_sees_its_folder_below_it_and_the_folders_above_it_up_to_its_root() {
     // Not into a folder below that is a project of its own.
     assert!(!sees(&r, m, Path::new("/w/a/other/x.robot.xml")));
     assert!(!sees(&r, m, Path::new("/w/a/other/robots/x.robot.xml")));
+    // Down to SEEN_DEPTH folders below its own, no deeper.
+    assert!(sees(&r, m, Path::new("/w/a/1/2/3/x.robot.xml")));
+    assert!(!sees(&r, m, Path::new("/w/a/1/2/3/4/x.robot.xml")));
+}
+
+#[test]
+fn under_a_project_file_a_file_sees_the_folders_it_names_and_nothing_else() {
+    let text = "[project]\ncatalogs = [\"robots\", \"../shared\"]\nstrategies = [\"s\"]\n";
+    let (project, diagnostics) = crate::project::parse(FileId(0), Path::new("/w/p"), text);
+    assert!(diagnostics.is_empty(), "{diagnostics:?}");
+    let r = roots(&["/w"]);
+    let sees = |m: &str, f: &str| sees(&r, |_| false, Some(&project), Path::new(m), Path::new(f));
+    let m = "/w/p/missions/m.mission";
+    assert!(sees(m, "/w/p/robots/deep/down/below/x.robot.xml"));
+    assert!(sees(m, "/w/shared/x.robot.xml"));
+    assert!(sees(m, "/w/p/s/x.strategy.xml"));
+    // A strategy file in a catalog folder, a catalog beside the mission,
+    // one in the project root: not named, not seen.
+    assert!(!sees(m, "/w/p/robots/x.strategy.xml"));
+    assert!(!sees(m, "/w/p/missions/x.robot.xml"));
+    assert!(!sees(m, "/w/p/x.robot.xml"));
 }
 
 const MISSION: &str = "{ A: Turtlebot3_Burger tb }\n\
@@ -156,4 +177,47 @@ fn an_unsaved_document_sees_the_workspace_roots_catalogs() {
         .map(|d| d.code)
         .collect();
     assert!(codes.contains(&Code::UnknownRobotType), "{codes:?}");
+}
+
+#[test]
+fn a_project_file_in_the_host_decides_what_is_seen_and_at_which_level() {
+    use crate::diag::Severity;
+    // W010: a function never called; W002: a mode never reached.
+    let warned = "{ T: Rover r }\ndef f{\n  dig()\n}\nT.P.S { dig() } repeat()\nT.M { set(P, S) }\nT.N { set(P, OFF) }\nT.main { default: mode = M }\n";
+    let mut host = host_with(&[
+        (0, "/w/p/m/dig.mission", FileKind::Mission, warned),
+        (1, "/w/p/robots/rover.robot.xml", FileKind::Catalog, CATALOG),
+    ]);
+    let levels = |analysis: &Analysis| -> Vec<(Code, Severity)> {
+        analysis
+            .diagnostics(FileId(0))
+            .iter()
+            .map(|d| (d.code, d.severity))
+            .collect()
+    };
+    // Without a project file, the catalog in the sibling folder is not seen.
+    let before = host.analysis();
+    assert!(levels(&before).contains(&(Code::UnknownRobotType, Severity::Error)));
+    let project =
+        "[project]\ncatalogs = [\"robots\"]\n[lints]\nW010 = \"allow\"\nW002 = \"deny\"\n";
+    host.set_file(
+        FileId(2),
+        Some(PathBuf::from("/w/p/semo.toml")),
+        FileKind::Project,
+        project.into(),
+    );
+    let after = host.analysis();
+    assert_eq!(levels(&after), [(Code::UnreachableMode, Severity::Error)]);
+    assert_eq!(after.reads(FileId(0)), [FileId(0), FileId(1), FileId(2)]);
+    assert_eq!(after.project(FileId(0)).unwrap().file, FileId(2));
+    // A project file change affects every file.
+    assert_eq!(
+        after.affected_by(FileId(2)),
+        [FileId(0), FileId(1), FileId(2)]
+    );
+    // An unsaved project file is the project of no file.
+    host.set_file(FileId(2), None, FileKind::Project, project.into());
+    assert!(host.analysis().project(FileId(0)).is_none());
+    host.remove_file(FileId(2));
+    assert_eq!(levels(&host.analysis()), levels(&before));
 }

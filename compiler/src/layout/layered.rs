@@ -115,7 +115,7 @@ fn orient(pins: &[Pin], edges: &[(usize, usize)], weak: &[bool]) -> Vec<bool> {
         if pre[e] { (b, a) } else { (a, b) }
     };
     // Only an edge on a cycle can be feedback: weak ones elsewhere count as strong.
-    let component = components(n, &(0..edges.len()).map(turned).collect::<Vec<_>>());
+    let (component, _) = crate::digraph::components(n, (0..edges.len()).map(turned));
     let weak: Vec<bool> = (0..edges.len())
         .map(|e| {
             let (a, b) = turned(e);
@@ -205,66 +205,6 @@ fn orient(pins: &[Pin], edges: &[(usize, usize)], weak: &[bool]) -> Vec<bool> {
             }
         })
         .collect()
-}
-
-/// The strongly connected component of each node (Tarjan's algorithm,
-/// without recursion).
-fn components(n: usize, edges: &[(usize, usize)]) -> Vec<usize> {
-    let mut out: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for &(a, b) in edges {
-        out[a].push(b);
-    }
-    let unseen = usize::MAX;
-    let mut index = vec![unseen; n];
-    let mut low = vec![0usize; n];
-    let mut on_stack = vec![false; n];
-    let mut component = vec![unseen; n];
-    let mut stack = Vec::new();
-    let mut calls: Vec<(usize, usize)> = Vec::new();
-    let mut next = 0;
-    let mut found = 0;
-    for root in 0..n {
-        if index[root] != unseen {
-            continue;
-        }
-        calls.push((root, 0));
-        index[root] = next;
-        low[root] = next;
-        next += 1;
-        stack.push(root);
-        on_stack[root] = true;
-        while let Some(&mut (v, ref mut i)) = calls.last_mut() {
-            if let Some(&w) = out[v].get(*i) {
-                *i += 1;
-                if index[w] == unseen {
-                    index[w] = next;
-                    low[w] = next;
-                    next += 1;
-                    stack.push(w);
-                    on_stack[w] = true;
-                    calls.push((w, 0));
-                } else if on_stack[w] {
-                    low[v] = low[v].min(index[w]);
-                }
-                continue;
-            }
-            calls.pop();
-            if let Some(&(parent, _)) = calls.last() {
-                low[parent] = low[parent].min(low[v]);
-            }
-            if low[v] == index[v] {
-                while let Some(w) = stack.pop() {
-                    on_stack[w] = false;
-                    component[w] = found;
-                    if w == v {
-                        break;
-                    }
-                }
-                found += 1;
-            }
-        }
-    }
-    component
 }
 
 /// Longest-path layers of the acyclic `edges`; sources move right next to

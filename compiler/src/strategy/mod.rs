@@ -9,7 +9,7 @@
 //! - `guards`: each action's transition conditions over one variable
 //!   (uncovered values, conditions that never hold, overlaps).
 //! - [`schema`]: the vocabulary (attributes, children, descriptions).
-//! - [`ide`]: editor features over the raw text and the model.
+//! - Its editor features are `crate::ide::strategy`.
 //! - [`cross`]: checks against the catalog and the missions of the same check,
 //!   and the link from mission calls to strategy entries ([`StrategyLinks`]).
 //!
@@ -18,7 +18,6 @@
 mod check;
 pub mod cross;
 mod guards;
-pub mod ide;
 mod machine;
 pub mod model;
 pub mod schema;

@@ -2,7 +2,6 @@
 
 pub mod analysis;
 pub mod dot;
-pub mod ide;
 pub mod model;
 pub mod subgraph;
 pub mod svg;

@@ -1,4 +1,4 @@
-//! `textDocument/codeAction`: the quick fixes of [`semo::ide::code_actions`],
+//! `textDocument/codeAction`: the quick fixes of [`semo::ide::mission::code_actions`],
 //! each attached to the diagnostic it fixes.
 //!
 //! Fixes are computed from the snapshot's own diagnostics (so that their
@@ -43,7 +43,8 @@ pub fn code_actions(
     let lines = snapshot.line_map(&analysis);
     let span = lines.span(params.range);
     let catalog = snapshot.catalog.catalog();
-    let actions = semo::ide::code_actions::code_actions(mission, catalog, &snapshot.text, span);
+    let actions =
+        semo::ide::mission::code_actions::code_actions(mission, catalog, &snapshot.text, span);
     if actions.is_empty() {
         return Some(assists);
     }
@@ -61,7 +62,7 @@ pub fn quick_fixes(
     snapshot: &Snapshot,
     analysis: &FileAnalysis,
     params: &CodeActionParams,
-    actions: Vec<semo::ide::code_actions::CodeAction>,
+    actions: Vec<semo::ide::mission::code_actions::CodeAction>,
 ) -> Vec<CodeActionOrCommand> {
     let lines = snapshot.line_map(analysis);
     let published = diagnostics::to_lsp(snapshot, analysis, &HashMap::new());

@@ -3,7 +3,7 @@
 //! writes, the other uses reads.
 
 use crate::world::Snapshot;
-use semo::ide::navigation::Access;
+use semo::ide::mission::navigation::Access;
 use tower_lsp_server::ls_types::{DocumentHighlight, DocumentHighlightKind, Position};
 
 pub fn document_highlight(
@@ -12,7 +12,7 @@ pub fn document_highlight(
 ) -> Option<Vec<DocumentHighlight>> {
     super::with_mission(snapshot, |analysis, lines| {
         let offset = lines.offset(position);
-        semo::ide::navigation::references(analysis, offset)
+        semo::ide::mission::navigation::references(analysis, offset)
             .into_iter()
             .map(|r| DocumentHighlight {
                 range: lines.range(r.span),

@@ -3,7 +3,7 @@
 
 use crate::encoding::LineMap;
 use crate::world::Snapshot;
-use semo::ide::symbols::{self, SymbolKind as Kind};
+use semo::ide::mission::symbols::{self, SymbolKind as Kind};
 use semo::workspace::FileKind;
 use tower_lsp_server::ls_types::{DocumentSymbol, DocumentSymbolResponse, SymbolKind};
 

@@ -1,8 +1,8 @@
 //! `textDocument/foldingRange`: blocks, `case`s, group statements and comment
-//! banners spanning lines (see `semo::ide::folding`), as whole lines.
+//! banners spanning lines (see `semo::ide::mission::folding`), as whole lines.
 
 use crate::world::Snapshot;
-use semo::ide::folding::{self, FoldKind};
+use semo::ide::mission::folding::{self, FoldKind};
 use semo::text::ColumnUnit;
 use tower_lsp_server::ls_types::{FoldingRange, FoldingRangeKind};
 

@@ -1,7 +1,7 @@
-//! `textDocument/inlayHint`: [`semo::ide::inlay_hints`] in protocol types.
+//! `textDocument/inlayHint`: [`semo::ide::mission::inlay_hints`] in protocol types.
 
 use crate::world::Snapshot;
-use semo::ide::inlay_hints::InlayKind;
+use semo::ide::mission::inlay_hints::InlayKind;
 use tower_lsp_server::ls_types::*;
 
 pub fn inlay_hints(snapshot: &Snapshot, range: Range) -> Option<Vec<InlayHint>> {
@@ -13,7 +13,8 @@ pub fn inlay_hints(snapshot: &Snapshot, range: Range) -> Option<Vec<InlayHint>> 
     let lines = snapshot.line_map(&analysis);
     let span = lines.span(range);
     let catalog = snapshot.catalog.catalog();
-    let hints = semo::ide::inlay_hints::inlay_hints(mission, catalog, &snapshot.text, span);
+    let hints =
+        semo::ide::mission::inlay_hints::inlay_hints(mission, catalog, &snapshot.text, span);
     Some(
         hints
             .into_iter()

@@ -11,7 +11,7 @@ pub fn prepare_rename(
 ) -> Result<Option<PrepareRenameResponse>> {
     super::with_mission(snapshot, |analysis, lines| {
         let offset = lines.offset(position);
-        semo::ide::rename::prepare_rename(analysis, &snapshot.text, offset)
+        semo::ide::mission::rename::prepare_rename(analysis, &snapshot.text, offset)
             .map(|span| PrepareRenameResponse::Range(lines.range(span)))
             .map_err(|e| super::request_failed(e.to_string()))
     })

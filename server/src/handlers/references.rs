@@ -14,7 +14,7 @@ pub fn references(snapshot: &Snapshot, params: &ReferenceParams) -> Option<Vec<L
     }
     super::with_mission(snapshot, |analysis, lines| {
         let offset = lines.offset(position);
-        semo::ide::navigation::references(analysis, offset)
+        semo::ide::mission::navigation::references(analysis, offset)
             .into_iter()
             .filter(|r| include_declaration || !r.is_definition)
             .map(|r| Location::new(snapshot.uri.clone(), lines.range(r.span)))

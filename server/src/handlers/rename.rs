@@ -12,9 +12,14 @@ pub fn rename(snapshot: &Snapshot, params: &RenameParams) -> Result<Option<Works
     super::with_mission(snapshot, |analysis, lines| {
         let offset = lines.offset(position);
         let catalog = snapshot.catalog.catalog();
-        let spans =
-            semo::ide::rename::rename(analysis, catalog, &snapshot.text, offset, &params.new_name)
-                .map_err(|e| super::request_failed(e.to_string()))?;
+        let spans = semo::ide::mission::rename::rename(
+            analysis,
+            catalog,
+            &snapshot.text,
+            offset,
+            &params.new_name,
+        )
+        .map_err(|e| super::request_failed(e.to_string()))?;
         let edits = spans
             .into_iter()
             .map(|span| TextEdit::new(lines.range(span), params.new_name.clone()))

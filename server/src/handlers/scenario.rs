@@ -4,12 +4,14 @@
 //! as the workspace analysis has it (open documents as typed).
 
 use crate::encoding::{Encoding, LineMap};
+use crate::to_proto;
 use crate::world::World;
 use semo::diag::FileId;
+use semo::ide::{CompletionItem, CompletionKind};
 use semo::sim::complete::{self, ScenarioCompletionKind};
 use semo::text::LineIndex;
 use semo::workspace::FileKind;
-use tower_lsp_server::ls_types::*;
+use tower_lsp_server::ls_types::{CompletionResponse, Position, Uri};
 
 /// What one completion works on, taken from the world at once.
 pub struct Job {
@@ -54,24 +56,25 @@ pub fn completion(job: &Job, position: Position) -> CompletionResponse {
     };
     let items = complete::completions(&job.text, lines.offset(position), &programs)
         .into_iter()
-        .enumerate()
-        .map(|(i, item)| CompletionItem {
-            kind: Some(kind(item.kind)),
-            detail: Some(item.detail),
-            ..super::completion::in_order(i, item.label, lines.range(item.replace), item.insert)
+        .map(|item| {
+            let mut out =
+                CompletionItem::new(item.label, kind(item.kind), item.replace).detail(item.detail);
+            out.insert = item.insert;
+            out
         })
         .collect();
-    super::completion::list(items)
+    to_proto::completion_list(items, &lines)
 }
 
-fn kind(kind: ScenarioCompletionKind) -> CompletionItemKind {
+/// The editor vocabulary's kind of each scenario completion.
+fn kind(kind: ScenarioCompletionKind) -> CompletionKind {
     match kind {
-        ScenarioCompletionKind::Robot => CompletionItemKind::CLASS,
-        ScenarioCompletionKind::Team => CompletionItemKind::MODULE,
-        ScenarioCompletionKind::Value => CompletionItemKind::FIELD,
-        ScenarioCompletionKind::Service => CompletionItemKind::METHOD,
-        ScenarioCompletionKind::Mode => CompletionItemKind::ENUM_MEMBER,
-        ScenarioCompletionKind::Command => CompletionItemKind::EVENT,
-        ScenarioCompletionKind::Constant => CompletionItemKind::CONSTANT,
+        ScenarioCompletionKind::Robot => CompletionKind::Robot,
+        ScenarioCompletionKind::Team => CompletionKind::Team,
+        ScenarioCompletionKind::Value => CompletionKind::Value,
+        ScenarioCompletionKind::Service => CompletionKind::Service,
+        ScenarioCompletionKind::Mode => CompletionKind::Mode,
+        ScenarioCompletionKind::Command => CompletionKind::Event,
+        ScenarioCompletionKind::Constant => CompletionKind::Constant,
     }
 }

@@ -1,5 +1,5 @@
 //! `textDocument/selectionRange`: for each position, the ranges holding it
-//! from the name outward to the file (see `semo::ide::selection`).
+//! from the name outward to the file (see `semo::ide::mission::selection`).
 
 use crate::world::Snapshot;
 use tower_lsp_server::ls_types::{Position, SelectionRange};
@@ -10,8 +10,11 @@ pub fn selection_range(snapshot: &Snapshot, positions: &[Position]) -> Option<Ve
             .iter()
             .map(|&position| {
                 let offset = lines.offset(position);
-                let spans =
-                    semo::ide::selection::selection_ranges(analysis, &snapshot.text, offset);
+                let spans = semo::ide::mission::selection::selection_ranges(
+                    analysis,
+                    &snapshot.text,
+                    offset,
+                );
                 let mut chain: Option<Box<SelectionRange>> = None;
                 for span in spans.iter().rev() {
                     chain = Some(Box::new(SelectionRange {

@@ -7,7 +7,7 @@
 
 use crate::encoding::Encoding;
 use crate::world::Snapshot;
-use semo::ide::semantic_tokens::{self as ide, HighlightToken, TokenKind};
+use semo::ide::mission::semantic_tokens::{self as ide, HighlightToken, TokenKind};
 use semo::span::Span;
 use semo::text::{ColumnUnit, LineIndex};
 use tower_lsp_server::ls_types::{

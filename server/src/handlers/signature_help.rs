@@ -1,4 +1,4 @@
-//! `textDocument/signatureHelp`: [`semo::ide::signature_help`] in protocol types.
+//! `textDocument/signatureHelp`: [`semo::ide::mission::signature_help`] in protocol types.
 
 use crate::encoding::Encoding;
 use crate::world::Snapshot;
@@ -10,7 +10,12 @@ pub fn signature_help(snapshot: &Snapshot, position: Position) -> Option<Signatu
     let lines = snapshot.line_map(&analysis);
     let offset = lines.offset(position);
     let catalog = snapshot.catalog.catalog();
-    let help = semo::ide::signature_help::signature_help(mission, catalog, &snapshot.text, offset)?;
+    let help = semo::ide::mission::signature_help::signature_help(
+        mission,
+        catalog,
+        &snapshot.text,
+        offset,
+    )?;
     // Parameter offsets count in the negotiated encoding, as positions do.
     let units = |s: &str| -> u32 {
         match snapshot.encoding {

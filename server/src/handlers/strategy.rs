@@ -1,14 +1,14 @@
 //! Completion, hover, navigation, outline and fixes in `*.strategy.xml`
-//! files: [`semo::strategy::ide`] in protocol types. The request handlers
+//! files: [`semo::ide::strategy`] in protocol types. The request handlers
 //! hand strategy files over to these; a strategy snapshot carries the
 //! missions it was checked against, so names lead into them.
 
 use crate::encoding::LineMap;
+use crate::to_proto;
 use crate::world::{FileAnalysis, Snapshot};
 use semo::Analysis;
 use semo::diag::FileId;
-use semo::strategy::ide::{self, StrategyFile, navigation::Target};
-use semo::text::LineIndex;
+use semo::ide::strategy::{self as ide, StrategyFile};
 use std::collections::HashMap;
 use std::sync::Arc;
 use tower_lsp_server::ls_types::*;
@@ -33,90 +33,6 @@ fn with_file<T>(
     f(&file, &analysis, snapshot.line_map(&analysis))
 }
 
-pub fn completion(snapshot: &Snapshot, position: Position, snippets: bool) -> CompletionResponse {
-    with_file(snapshot, |file, _, lines| {
-        let offset = lines.offset(position);
-        let items = ide::completion::completions(file, offset, snippets)
-            .into_iter()
-            .enumerate()
-            .map(|(i, item)| CompletionItem {
-                kind: Some(kind(item.kind)),
-                detail: item.detail,
-                documentation: item.documentation.map(|value| {
-                    Documentation::MarkupContent(MarkupContent {
-                        kind: MarkupKind::Markdown,
-                        value,
-                    })
-                }),
-                insert_text_format: Some(match item.snippet {
-                    true => InsertTextFormat::SNIPPET,
-                    false => InsertTextFormat::PLAIN_TEXT,
-                }),
-                ..super::completion::in_order(i, item.label, lines.range(item.replace), item.insert)
-            })
-            .collect();
-        super::completion::list(items)
-    })
-}
-
-fn kind(kind: ide::completion::CompletionKind) -> CompletionItemKind {
-    use ide::completion::CompletionKind as K;
-    match kind {
-        K::Element => CompletionItemKind::CLASS,
-        K::Attribute => CompletionItemKind::PROPERTY,
-        K::Keyword => CompletionItemKind::ENUM_MEMBER,
-        K::Team => CompletionItemKind::MODULE,
-        K::Robot => CompletionItemKind::VARIABLE,
-        K::RobotType => CompletionItemKind::CLASS,
-        K::Plan => CompletionItemKind::STRUCT,
-        K::Service => CompletionItemKind::FUNCTION,
-        K::Value => CompletionItemKind::FIELD,
-        K::Task => CompletionItemKind::MODULE,
-        K::Action => CompletionItemKind::ENUM_MEMBER,
-    }
-}
-
-pub fn hover(snapshot: &Snapshot, position: Position) -> Option<Hover> {
-    with_file(snapshot, |file, _, lines| {
-        let found = ide::hover::hover(file, lines.offset(position))?;
-        Some(Hover {
-            contents: HoverContents::Markup(MarkupContent {
-                kind: MarkupKind::Markdown,
-                value: found.markdown,
-            }),
-            range: Some(lines.range(found.span)),
-        })
-    })
-}
-
-/// Targets as ranges of their files (the missions of the snapshot, catalog
-/// files, the file itself).
-fn ranges(snapshot: &Snapshot, targets: Vec<Target>) -> Vec<(FileId, Range)> {
-    let mut indexes: HashMap<FileId, LineIndex> = HashMap::new();
-    targets
-        .into_iter()
-        .filter_map(|t| {
-            let text = snapshot.text_of(t.file)?;
-            let index = indexes
-                .entry(t.file)
-                .or_insert_with(|| LineIndex::new(text));
-            let map = LineMap {
-                text,
-                index,
-                encoding: snapshot.encoding,
-            };
-            Some((t.file, map.range(t.span)))
-        })
-        .collect()
-}
-
-pub fn definition(snapshot: &Snapshot, position: Position) -> Vec<(FileId, Range)> {
-    let targets = with_file(snapshot, |file, analysis, lines| {
-        ide::navigation::definition(file, &analysis.strategy_links, lines.offset(position))
-    });
-    ranges(snapshot, targets)
-}
-
 pub fn references(
     snapshot: &Snapshot,
     position: Position,
@@ -136,7 +52,9 @@ pub fn references(
             .find(|m| m.id == id)
             .map(|m| m.uri.clone())
     };
-    ranges(snapshot, targets)
+    let analysis = snapshot.analysis();
+    let lines = snapshot.line_map(&analysis);
+    to_proto::target_ranges(snapshot, snapshot.host(), &lines, targets)
         .into_iter()
         .filter_map(|(file, range)| Some(Location::new(uri_of(file)?, range)))
         .collect()
@@ -151,30 +69,6 @@ fn checked_against<'s>(
     strategies
         .iter()
         .filter(move |s| s.missions.iter().any(|m| std::ptr::eq(&**m, mission)))
-}
-
-/// From a mission call to the entries of the workspace's strategy files
-/// that refine it. A strategy snapshot is checked against the current
-/// missions, so its links point into this very version of the mission.
-pub fn entries_of_call(
-    mission: &Snapshot,
-    strategies: &[Arc<Snapshot>],
-    offset: usize,
-) -> Vec<(FileId, Range)> {
-    let mut out = Vec::new();
-    for strategy in checked_against(mission, strategies) {
-        let analysis = strategy.analysis();
-        let Some(model) = &analysis.strategy else {
-            continue;
-        };
-        let lines = strategy.line_map(&analysis);
-        for span in
-            ide::navigation::entries_of_call(model, &analysis.strategy_links, mission.id, offset)
-        {
-            out.push((strategy.id, lines.range(span)));
-        }
-    }
-    out
 }
 
 pub fn document_symbol(snapshot: &Snapshot) -> Option<DocumentSymbolResponse> {

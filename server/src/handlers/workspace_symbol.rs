@@ -15,7 +15,7 @@ pub fn workspace_symbol(snapshots: &[Arc<Snapshot>], query: &str) -> Vec<SymbolI
     let mut found: Vec<(u32, SymbolInformation)> = Vec::new();
     for snapshot in snapshots.iter().filter(|s| s.kind == FileKind::Mission) {
         super::with_mission(snapshot, |analysis, lines| {
-            for symbol in semo::ide::symbols::workspace_symbols(analysis, query) {
+            for symbol in semo::ide::mission::symbols::workspace_symbols(analysis, query) {
                 #[allow(deprecated)] // `deprecated` must be written, even as None
                 let info = SymbolInformation {
                     name: symbol.name,

@@ -49,14 +49,14 @@ export interface TreeNode {
   children: TreeNode[];
 }
 
-/** Escapes text for the snippet syntax (as `ide::snippets::escape`). */
+/** Escapes text for the snippet syntax (as `ide::mission::snippets::escape`). */
 export function escapeSnippet(text: string): string {
   return text.replace(/[\\$}]/g, (c) => `\\${c}`);
 }
 
 /**
  * The call a service's entry inserts, by the rule the server's completion
- * uses (`service_call_snippet` in compiler/src/ide/completion.rs): required
+ * uses (`service_call_snippet` in compiler/src/ide/mission/completion.rs): required
  * parameters become placeholders, optional ones are left out.
  */
 export function serviceCallSnippet(service: CatalogService): string {

@@ -1,5 +1,5 @@
 // The skeleton of a new mission (spec §6). The same text as
-// `MISSION_TEMPLATE` in compiler/src/ide/snippets.rs, which the server's
+// `MISSION_TEMPLATE` in compiler/src/ide/mission/snippets.rs, which the server's
 // completion offers; a unit test keeps the two equal.
 
 export const MISSION_TEMPLATE = `# 1. Team formation:  TeamName: RobotType robot_name

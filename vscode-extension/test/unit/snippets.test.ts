@@ -28,8 +28,8 @@ function rustConst(source: string, name: string): string {
   return source.slice(from, end).replace(/\\"/g, '"').replace(/\\\\/g, '\\');
 }
 
-test('the template is the server’s MISSION_TEMPLATE (compiler/src/ide/snippets.rs)', () => {
-  const rust = readFileSync(join(repo, 'compiler', 'src', 'ide', 'snippets.rs'), 'utf8');
+test('the template is the server’s MISSION_TEMPLATE (compiler/src/ide/mission/snippets.rs)', () => {
+  const rust = readFileSync(join(repo, 'compiler', 'src', 'ide', 'mission', 'snippets.rs'), 'utf8');
   assert.equal(MISSION_TEMPLATE, rustConst(rust, 'MISSION_TEMPLATE'));
 });
 
@@ -39,7 +39,7 @@ test('the template snippet puts the cursor inside the formation', () => {
 });
 
 test('every construct has a snippet, under the server’s labels', () => {
-  const rust = readFileSync(join(repo, 'compiler', 'src', 'ide', 'snippets.rs'), 'utf8');
+  const rust = readFileSync(join(repo, 'compiler', 'src', 'ide', 'mission', 'snippets.rs'), 'utf8');
   const serverLabels = [...rust.matchAll(/label: "([^"]+)"/g)].map((m) => m[1]);
   for (const label of serverLabels) {
     if (label === 'mission template' || snippets[label]) {

@@ -42,6 +42,8 @@ impl Analysis {
                 service_graph: &service_graph,
             })
         };
+        let mut found = found;
+        self.apply_lints(mission, &mut found.diagnostics);
         let found = Arc::new(found);
         let old = lock(&self.memo.dataflow).insert(mission, (key, found.clone()));
         drop_later(old);
@@ -56,11 +58,14 @@ impl Analysis {
     }
 
     /// What a mission's dataflow is computed from: the mission, the files it
-    /// sees, and every task graph (`FileId(u32::MAX)` carries their revision).
+    /// sees, its project file (the levels of its warnings), and every task
+    /// graph (`FileId(u32::MAX)` carries their revision).
     fn dataflow_key(&self, mission: FileId) -> Key {
+        let project = self.project(mission).map(|p| p.file);
         let mut key: Key = self
             .reads(mission)
             .into_iter()
+            .chain(project)
             .map(|f| (f, self.revision(f)))
             .collect();
         key.push((FileId(u32::MAX), self.graphs_revision));

@@ -426,55 +426,8 @@ fn ordered_components(
             succ[a].push(b);
         }
     }
-    // Tarjan, iteratively.
-    let mut index = vec![usize::MAX; m];
-    let mut low = vec![0usize; m];
-    let mut on_stack = vec![false; m];
-    let mut stack = Vec::new();
-    let mut comp = vec![usize::MAX; m];
-    let mut ncomp = 0;
-    let mut next = 0;
-    for root in 0..m {
-        if index[root] != usize::MAX {
-            continue;
-        }
-        let mut call: Vec<(usize, usize)> = vec![(root, 0)];
-        index[root] = next;
-        low[root] = next;
-        next += 1;
-        stack.push(root);
-        on_stack[root] = true;
-        while let Some(&mut (v, ref mut pos)) = call.last_mut() {
-            if let Some(&w) = succ[v].get(*pos) {
-                *pos += 1;
-                if index[w] == usize::MAX {
-                    index[w] = next;
-                    low[w] = next;
-                    next += 1;
-                    stack.push(w);
-                    on_stack[w] = true;
-                    call.push((w, 0));
-                } else if on_stack[w] {
-                    low[v] = low[v].min(index[w]);
-                }
-            } else {
-                call.pop();
-                if let Some(&(parent, _)) = call.last() {
-                    low[parent] = low[parent].min(low[v]);
-                }
-                if low[v] == index[v] {
-                    while let Some(w) = stack.pop() {
-                        on_stack[w] = false;
-                        comp[w] = ncomp;
-                        if w == v {
-                            break;
-                        }
-                    }
-                    ncomp += 1;
-                }
-            }
-        }
-    }
+    let (comp, ncomp) =
+        crate::digraph::components(m, (0..m).flat_map(|a| succ[a].iter().map(move |&b| (a, b))));
     let mut components: Vec<Vec<usize>> = vec![Vec::new(); ncomp];
     for (i, &c) in comp.iter().enumerate() {
         components[c].push(members[i]);

@@ -1,5 +1,6 @@
--- SeMo in Neovim 0.7 and newer: the language server (`semo lsp`) for missions and for
--- strategy, robot and task-graph XML files, and tree-sitter highlighting of missions.
+-- SeMo in Neovim 0.7 and newer: the language server (`semo lsp`) for missions, for
+-- strategy, robot and task-graph XML files and for the project file `semo.toml`, and
+-- tree-sitter highlighting of missions.
 --
 --   vim.opt.runtimepath:append('/path/to/semo/editors/nvim')
 --   require('semo').setup()                 -- or setup({ cmd = { '/path/to/semo', 'lsp' } })
@@ -16,14 +17,20 @@ local M = {}
 -- `xml` or `json`.
 M.file_patterns = { '%.strategy%.xml$', '%.robot%.xml$', '%.taskgraph%.xml$', '%.scenario%.json$' }
 
+-- The project file (filetype `toml`): checked and completed by the server.
+M.project_pattern = '/semo%.toml$'
+
 local config = { cmd = { 'semo', 'lsp' }, treesitter = true }
 
---- Whether the buffer is a mission or one of the server's XML or scenario files.
+--- Whether the buffer is a mission, one of the server's XML or scenario files, or a `semo.toml`.
 function M.is_semo_buffer(bufnr)
   if vim.bo[bufnr].filetype == 'semo' then
     return true
   end
   local name = vim.api.nvim_buf_get_name(bufnr)
+  if name:match(M.project_pattern) then
+    return true
+  end
   for _, pattern in ipairs(M.file_patterns) do
     if name:match(pattern) then
       return true
@@ -203,7 +210,7 @@ function M.setup(opts)
   end, { nargs = '*', complete = 'file', desc = 'Simulate the mission on a scenario (semo.simulate)' })
   vim.api.nvim_create_autocmd('FileType', {
     group = group,
-    pattern = { 'semo', 'xml', 'json' },
+    pattern = { 'semo', 'xml', 'json', 'toml' },
     callback = function(args)
       if not M.is_semo_buffer(args.buf) then
         return

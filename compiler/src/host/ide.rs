@@ -1,0 +1,196 @@
+//! The editor's facade: position queries on an [`Analysis`] snapshot. Each
+//! finds the file's kind, gathers what that kind's features in
+//! [`crate::ide`] read from this snapshot (the checked mission, the catalog
+//! the file sees, the missions a strategy file is checked against, a task
+//! graph's report) and answers in [`crate::ide`]'s vocabulary. A door asks
+//! these, never `ide::mission`/`ide::strategy`/`ide::taskgraph` directly, so
+//! every door and every file kind reads the same workspace.
+//!
+//! Adding a kind of file: a submodule of `ide`, then one arm per query here.
+
+use super::Analysis;
+use crate::diag::FileId;
+use crate::ide::{
+    self, CompletionConfig, CompletionItem, CompletionKind, FilePosition, HoverResult,
+    NavigationTarget, strategy::StrategyFile,
+};
+use crate::sema;
+use crate::workspace::FileKind;
+use std::sync::Arc;
+
+impl Analysis {
+    /// What hovering at `position` shows.
+    pub fn hover(&self, position: FilePosition) -> Option<HoverResult> {
+        let FilePosition { file, offset } = position;
+        match self.file(file)?.kind {
+            FileKind::Mission => {
+                let text = &self.file(file)?.text;
+                let mission = self.mission(file)?;
+                let catalog = self.catalog(file);
+                let mut found =
+                    ide::mission::hover::hover(&mission, &catalog.catalog, text, offset)?;
+                // On a team: its robots' iteration periods (refines the
+                // mission once per version; the server's diagnostics task
+                // usually has already).
+                let periods = crate::dataflow::team_periods_at(&mission.mission, offset, || {
+                    self.dataflow(file)
+                });
+                if let Some(periods) = periods {
+                    found.markdown.push_str("\n\n---\n\n");
+                    found.markdown.push_str(&periods);
+                }
+                Some(found)
+            }
+            FileKind::Strategy => {
+                self.with_strategy(file, |s| ide::strategy::hover::hover(s, offset))
+            }
+            FileKind::TaskGraph => {
+                let run = self.graph(file)?;
+                ide::taskgraph::hover(run.graph.as_ref()?, &run.report, offset)
+            }
+            FileKind::Catalog | FileKind::Project => None,
+        }
+    }
+
+    /// What may be written at `position`, most specific first; `None` where
+    /// the file has no completion at all (a catalog file, a task graph that
+    /// does not load).
+    pub fn completions(
+        &self,
+        position: FilePosition,
+        config: CompletionConfig,
+    ) -> Option<Vec<CompletionItem>> {
+        let FilePosition { file, offset } = position;
+        let source = self.file(file)?;
+        match source.kind {
+            FileKind::Mission => {
+                let mission = self.mission(file)?;
+                let catalog = self.catalog(file);
+                Some(ide::mission::completion::completions(
+                    &mission,
+                    &catalog.catalog,
+                    &source.text,
+                    offset,
+                    config,
+                ))
+            }
+            FileKind::Strategy => Some(self.with_strategy(file, |s| {
+                ide::strategy::completion::completions(s, offset, config.snippets)
+            })),
+            FileKind::TaskGraph => {
+                let run = self.graph(file)?;
+                let graph = run.graph.as_ref()?;
+                Some(ide::taskgraph::complete_endpoint(
+                    &source.text,
+                    graph,
+                    offset,
+                ))
+            }
+            FileKind::Project => Some(
+                crate::project::completions(&source.text, offset)
+                    .into_iter()
+                    .map(project_completion)
+                    .collect(),
+            ),
+            FileKind::Catalog => None,
+        }
+    }
+
+    /// Where the name at `position` is defined. In a mission: from a built-in
+    /// call, the strategy entries refining it first, then its definition (in
+    /// the mission or a catalog file). In a strategy file: the mission lines
+    /// an entry refines, the team, plan or robot type it names.
+    pub fn definition(&self, position: FilePosition) -> Vec<NavigationTarget> {
+        let FilePosition { file, offset } = position;
+        let Some(source) = self.file(file) else {
+            return Vec::new();
+        };
+        match source.kind {
+            FileKind::Mission => {
+                let Some(mission) = self.mission(file) else {
+                    return Vec::new();
+                };
+                let catalog = self.catalog(file);
+                let mut found = self.entries_of_call(position);
+                found.extend(ide::mission::navigation::definition(
+                    &mission,
+                    &catalog.catalog,
+                    offset,
+                ));
+                found
+            }
+            FileKind::Strategy => {
+                let links = self.strategy_links(file);
+                self.with_strategy(file, |s| {
+                    ide::strategy::navigation::definition(s, &links, offset)
+                })
+            }
+            FileKind::TaskGraph | FileKind::Catalog | FileKind::Project => Vec::new(),
+        }
+    }
+
+    /// From a mission's built-in call at `position` to the entries of the
+    /// strategy files it sees that refine it.
+    fn entries_of_call(&self, position: FilePosition) -> Vec<NavigationTarget> {
+        let mut out = Vec::new();
+        for strategy_file in self.seen_by(position.file) {
+            let Some(loaded) = self.strategy(strategy_file) else {
+                continue;
+            };
+            let Some(model) = &loaded.strategy else {
+                continue;
+            };
+            let links = self.strategy_links(strategy_file);
+            let spans = ide::strategy::navigation::entries_of_call(
+                model,
+                &links,
+                position.file,
+                position.offset,
+            );
+            out.extend(spans.into_iter().map(|span| NavigationTarget {
+                file: strategy_file,
+                span,
+            }));
+        }
+        out
+    }
+
+    /// Runs `f` on the strategy file `file` as its features read it: its
+    /// text and model, the missions that see it (checked), its catalog.
+    fn with_strategy<T: Default>(&self, file: FileId, f: impl FnOnce(&StrategyFile<'_>) -> T) -> T {
+        let Some(source) = self.file(file) else {
+            return T::default();
+        };
+        let loaded = self.strategy(file);
+        let checked: Vec<Arc<sema::Analysis>> = self
+            .missions_seeing(file)
+            .into_iter()
+            .filter_map(|m| self.mission(m))
+            .collect();
+        let missions: Vec<&sema::Analysis> = checked.iter().map(|m| &**m).collect();
+        let catalog = self.catalog(file);
+        f(&StrategyFile {
+            text: &source.text,
+            strategy: loaded.as_ref().and_then(|l| l.strategy.as_ref()),
+            missions: &missions,
+            catalog: &catalog.catalog,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests;
+
+/// A `semo.toml` completion in the editor vocabulary.
+fn project_completion(item: crate::project::Completion) -> CompletionItem {
+    use crate::project::CompletionKind as P;
+    let kind = match item.kind {
+        P::Table => CompletionKind::Element,
+        P::Key => CompletionKind::Attribute,
+        P::Code => CompletionKind::Constant,
+        P::Value => CompletionKind::Value,
+    };
+    let mut out = CompletionItem::new(item.label, kind, item.replace).detail(item.detail);
+    out.insert = item.insert;
+    out
+}

@@ -1,0 +1,269 @@
+//! Hover: what the name under the cursor means, in markdown.
+//!
+//! Services: signature, doc, and which robot types provide them (of this team,
+//! where the name is used in a statement); values: type, unit, doc, providers;
+//! teams: their robots; modes: what each plan runs; events: who throws them
+//! and who catches them.
+
+use super::docs::{self, list};
+use super::robots::{self, RobotsHere};
+use crate::catalog::{Catalog, RobotTypeId};
+use crate::ide::HoverResult;
+use crate::sema::{Analysis, Mission, Symbol, TeamId};
+use std::fmt::Write;
+
+/// The hover at `offset`, if a known name is there.
+pub fn hover(
+    analysis: &Analysis,
+    catalog: &Catalog,
+    text: &str,
+    offset: usize,
+) -> Option<HoverResult> {
+    let mission = &analysis.mission;
+    let occurrence = robots::occurrence_at(mission, offset.min(text.len()))?;
+    let range = occurrence.span;
+    let markdown = match &occurrence.symbol {
+        Symbol::Team(t) => docs::team(catalog, mission.team(*t)),
+        Symbol::User => {
+            let mut out = "**USER**: the operator's console".to_string();
+            if let Some(u) = catalog.user() {
+                if !u.doc.is_empty() {
+                    write!(out, "\n\n{}", u.doc).ok();
+                }
+                let values: Vec<String> = u
+                    .values
+                    .iter()
+                    .map(|v| format!("`USER.{}` ({})", v.name, v.ty))
+                    .collect();
+                if !values.is_empty() {
+                    write!(out, "\n\nValues: {}.", values.join(", ")).ok();
+                }
+            }
+            out
+        }
+        Symbol::Robot { team, robot } => {
+            let t = mission.team(*team);
+            let r = t.robots.get(*robot as usize)?;
+            let mut out = docs::code(&format!("{} {}", r.type_name, r.name));
+            write!(out, "\n\nA robot of team `{}`.", t.name).ok();
+            if let Some(ty) = r.robot_type {
+                let doc = &catalog.get(ty).doc;
+                if !doc.is_empty() {
+                    write!(out, "\n\n{doc}").ok();
+                }
+            }
+            out
+        }
+        Symbol::RobotType(name) => docs::robot_type(catalog.robot(name)?),
+        Symbol::Capability(name) => capability(analysis, catalog, name, offset),
+        Symbol::Plan { team, plan } => docs::plan(text, mission.team(*team), *plan),
+        Symbol::Service { team, service } => {
+            docs::composite_service(analysis, text, *team, *service)
+        }
+        Symbol::Mode { team, mode } => docs::mode(text, mission.team(*team), *mode),
+        Symbol::Event { team, name } => docs::event(mission.team(*team), name),
+        Symbol::Function(f) => {
+            let info = mission.functions.get(f.0 as usize)?;
+            let mut out = docs::code(&format!("def {}", info.name));
+            out.push_str("\n\nA function: its statements are copied where it is called.");
+            let teams: Vec<String> = mission
+                .scopes
+                .iter()
+                .filter(|s| s.kind == crate::sema::ScopeKind::Function(*f))
+                .flat_map(|s| &s.runs)
+                .filter_map(|r| r.team)
+                .map(|t| format!("`{}`", mission.team(t).name))
+                .collect::<std::collections::BTreeSet<_>>()
+                .into_iter()
+                .collect();
+            if teams.is_empty() {
+                out.push_str("\n\nNo service calls it.");
+            } else {
+                write!(out, "\n\nCalled by services of {}.", list(&teams)).ok();
+            }
+            out
+        }
+        Symbol::BuiltinService(name) => builtin_service(analysis, catalog, name, offset)?,
+        Symbol::Value { owner, name } => value(analysis, catalog, *owner, name, offset)?,
+        Symbol::TeamVariable { team, name } => {
+            let mut out = docs::code(&match team {
+                Some(t) => format!("{}.{name}", mission.team(*t).name),
+                None => name.to_string(),
+            });
+            out.push_str("\n\nA team variable: set where it is sent or published with `=`.");
+            let owner = team.map(|t| mission.team(t).name.clone());
+            let senders: Vec<String> = mission
+                .messages
+                .iter()
+                .filter(|m| m.kind.is_outgoing())
+                .filter(|m| m.value.name == *name)
+                .filter(|m| owner.as_ref().is_none_or(|o| m.value.owner == *o))
+                .map(|m| {
+                    format!(
+                        "`{}` ({})",
+                        mission.team(m.team).service_path(m.service),
+                        m.kind.as_str()
+                    )
+                })
+                .collect::<std::collections::BTreeSet<_>>()
+                .into_iter()
+                .collect();
+            if !senders.is_empty() {
+                write!(out, "\n\nDelivered by {}.", list(&senders)).ok();
+            }
+            out
+        }
+        Symbol::Constant(name) => format!(
+            "{}\n\nA symbolic constant: a word passed or compared as it is written.",
+            docs::code(name)
+        ),
+    };
+    Some(HoverResult { range, markdown })
+}
+
+/// A built-in service where it is called: which types of the robots running
+/// the statement provide it, and which other catalog types do.
+fn builtin_service(
+    analysis: &Analysis,
+    catalog: &Catalog,
+    name: &str,
+    offset: usize,
+) -> Option<String> {
+    let mission = &analysis.mission;
+    let providers = robots::service_providers(catalog, name);
+    let here = RobotsHere::at(analysis, offset, None);
+    let types_here = here.types(mission);
+    let def = types_here
+        .iter()
+        .chain(&providers)
+        .find_map(|ty| catalog.get(*ty).service(name))?;
+    let mut out = docs::service(def);
+    let mut shown: Vec<RobotTypeId> = Vec::new();
+    for (team, providing) in types_per_team(mission, &here, |ty| providers.contains(&ty)) {
+        write!(
+            out,
+            "\n\nIn team `{}`, provided by {}.",
+            mission.team(team).name,
+            docs::types_with_robots(catalog, mission, team, &providing)
+        )
+        .ok();
+        shown.extend(providing);
+    }
+    let others: Vec<String> = providers
+        .iter()
+        .filter(|ty| !shown.contains(ty))
+        .map(|ty| format!("`{}`", catalog.get(*ty).name))
+        .collect();
+    if !others.is_empty() {
+        let lead = if shown.is_empty() {
+            "Provided by"
+        } else {
+            "Also provided by"
+        };
+        write!(out, "\n\n{lead} {}.", list(&others)).ok();
+    }
+    Some(out)
+}
+
+/// A robot value: its definition, and which types of the team have it.
+fn value(
+    analysis: &Analysis,
+    catalog: &Catalog,
+    owner: Option<TeamId>,
+    name: &str,
+    offset: usize,
+) -> Option<String> {
+    let mission = &analysis.mission;
+    let Some(team) = owner else {
+        let def = catalog.user()?.value(name)?;
+        return Some(docs::value(Some("USER"), def));
+    };
+    // The robots reading it: those running the statement for the team's own
+    // values, all of the team's robots for another team's.
+    let here = RobotsHere::at(analysis, offset, None);
+    let types = if here.teams() == [team] {
+        here.types(mission)
+    } else {
+        robots::team_types(mission, team)
+    };
+    let having: Vec<RobotTypeId> = types
+        .iter()
+        .copied()
+        .filter(|ty| catalog.get(*ty).value(name).is_some())
+        .collect();
+    let def = having
+        .iter()
+        .find_map(|ty| catalog.get(*ty).value(name))
+        .or_else(|| catalog.types().find_map(|(_, r)| r.value(name)))?;
+    let t = mission.team(team);
+    let mut out = docs::value(Some(&t.name), def);
+    if !having.is_empty() {
+        write!(
+            out,
+            "\n\nIn team `{}`, read from {}.",
+            t.name,
+            docs::types_with_robots(catalog, mission, team, &having)
+        )
+        .ok();
+    }
+    // Where the types differ, say what each means by it.
+    let docs_differ = having
+        .iter()
+        .filter_map(|ty| catalog.get(*ty).value(name))
+        .any(|v| v.doc != def.doc);
+    if docs_differ {
+        for ty in &having {
+            if let Some(v) = catalog.get(*ty).value(name) {
+                write!(out, "\n- `{}`: {}", catalog.get(*ty).name, v.doc).ok();
+            }
+        }
+    }
+    Some(out)
+}
+
+/// A capability in a group condition: which robot types have it, and which
+/// robots of the team.
+fn capability(analysis: &Analysis, catalog: &Catalog, name: &str, offset: usize) -> String {
+    let mission = &analysis.mission;
+    let mut out = format!("**capability** `{name}`");
+    let types: Vec<String> = catalog
+        .types()
+        .filter(|(_, r)| r.has_capability(name))
+        .map(|(_, r)| format!("`{}`", r.name))
+        .collect();
+    write!(out, "\n\nRobot types that have it: {}.", list(&types)).ok();
+    let here = RobotsHere::at(analysis, offset, None);
+    let has = |ty: RobotTypeId| catalog.get(ty).has_capability(name);
+    for (team, having) in types_per_team(mission, &here, has) {
+        write!(
+            out,
+            "\n\nIn team `{}`: {}.",
+            mission.team(team).name,
+            docs::types_with_robots(catalog, mission, team, &having)
+        )
+        .ok();
+    }
+    out
+}
+
+/// Per team running the place, the robot types there (of that team) that
+/// `keep` accepts; teams with none are left out.
+fn types_per_team(
+    mission: &Mission,
+    here: &RobotsHere,
+    keep: impl Fn(RobotTypeId) -> bool,
+) -> Vec<(TeamId, Vec<RobotTypeId>)> {
+    let types_here = here.types(mission);
+    here.teams()
+        .into_iter()
+        .filter_map(|team| {
+            let team_types = robots::team_types(mission, team);
+            let types: Vec<RobotTypeId> = types_here
+                .iter()
+                .copied()
+                .filter(|ty| keep(*ty) && team_types.contains(ty))
+                .collect();
+            (!types.is_empty()).then_some((team, types))
+        })
+        .collect()
+}

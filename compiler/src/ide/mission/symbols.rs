@@ -1,0 +1,380 @@
+//! The outline of a mission (document symbols) and the symbols a workspace
+//! search finds.
+//!
+//! The outline has one entry per team, holding its robots, its plans with
+//! their composite services, its modes and its main block; functions are at
+//! the top level. Items of undeclared teams and duplicate definitions (both
+//! reported by the checker) are not in it.
+
+use crate::Analysis;
+use crate::sema::Team;
+use crate::span::Span;
+use crate::syntax::ast::{self, Item};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SymbolKind {
+    Team,
+    Robot,
+    Plan,
+    Service,
+    Mode,
+    Main,
+    Function,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DocumentSymbol {
+    pub name: String,
+    pub detail: Option<String>,
+    pub kind: SymbolKind,
+    /// The whole definition (for a team or a plan: from its first to its
+    /// last item).
+    pub span: Span,
+    /// The name, inside `span`.
+    pub name_span: Span,
+    pub children: Vec<DocumentSymbol>,
+}
+
+/// The outline of the mission, in file order.
+pub fn document_symbols(analysis: &Analysis, text: &str) -> Vec<DocumentSymbol> {
+    let mission = &analysis.mission;
+    let decls: Vec<&ast::TeamDecl> = analysis
+        .syntax
+        .items
+        .iter()
+        .filter_map(|i| match i {
+            Item::Formation(f) => Some(&f.teams),
+            _ => None,
+        })
+        .flatten()
+        .collect();
+    let mains: Vec<&ast::MainDef> = analysis
+        .syntax
+        .items
+        .iter()
+        .filter_map(|i| match i {
+            Item::Main(m) => Some(m),
+            _ => None,
+        })
+        .collect();
+    let mut symbols: Vec<DocumentSymbol> = mission
+        .teams
+        .iter()
+        .filter_map(|team| {
+            let decl = decls.iter().find(|d| d.name.span == team.name_span)?;
+            Some(team_symbol(team, decl, &mains, text))
+        })
+        .collect();
+    symbols.extend(mission.functions.iter().map(|f| {
+        DocumentSymbol {
+            name: f.name.to_string(),
+            detail: None,
+            kind: SymbolKind::Function,
+            span: analysis
+                .function_syntax(f)
+                .map_or(f.name_span, |syntax| syntax.span),
+            name_span: f.name_span,
+            children: Vec::new(),
+        }
+    }));
+    symbols.sort_by_key(|s| s.span.start);
+    symbols
+}
+
+fn team_symbol(
+    team: &Team,
+    decl: &ast::TeamDecl,
+    mains: &[&ast::MainDef],
+    text: &str,
+) -> DocumentSymbol {
+    let mut children = Vec::new();
+    for robot in &decl.robots {
+        if !team.robots.iter().any(|r| r.name_span == robot.name.span) {
+            continue; // a duplicate name, reported
+        }
+        // `tb[3]` as written.
+        let name = match robot.count {
+            Some(_) => text
+                .get(robot.name.span.start..robot.span.end)
+                .unwrap_or(&robot.name.name)
+                .to_string(),
+            None => robot.name.name.to_string(),
+        };
+        children.push(DocumentSymbol {
+            name,
+            detail: Some(robot.robot_type.name.to_string()),
+            kind: SymbolKind::Robot,
+            span: robot.span,
+            name_span: robot.name.span,
+            children: Vec::new(),
+        });
+    }
+    for (p, plan) in team.plans.iter().enumerate() {
+        let services: Vec<DocumentSymbol> = team
+            .services
+            .iter()
+            .filter(|s| s.plan as usize == p)
+            .map(|s| DocumentSymbol {
+                name: s.name.to_string(),
+                detail: Some(format!("{}.{}.{}", team.name, plan.name, s.name)),
+                kind: SymbolKind::Service,
+                span: s.span,
+                name_span: s.name_span,
+                children: Vec::new(),
+            })
+            .collect();
+        let span = services
+            .iter()
+            .fold(plan.span, |span, s| span.cover(s.span));
+        children.push(DocumentSymbol {
+            name: plan.name.to_string(),
+            detail: None,
+            kind: SymbolKind::Plan,
+            span,
+            name_span: plan.span,
+            children: services,
+        });
+    }
+    for mode in &team.modes {
+        let sets: Vec<String> = mode
+            .sets
+            .iter()
+            .filter_map(|set| {
+                let plan = &team.plans.get(set.plan? as usize)?.name;
+                let service = match set.service {
+                    Some(s) => team.services.get(s as usize)?.name.as_str(),
+                    None => "OFF",
+                };
+                Some(format!("{plan}: {service}"))
+            })
+            .collect();
+        children.push(DocumentSymbol {
+            name: mode.name.to_string(),
+            detail: (!sets.is_empty()).then(|| sets.join(", ")),
+            kind: SymbolKind::Mode,
+            span: mode.span,
+            name_span: mode.name_span,
+            children: Vec::new(),
+        });
+    }
+    if let Some(main) = &team.main
+        && let Some(syntax) = mains.iter().find(|m| m.span == main.span)
+    {
+        let default = main
+            .default
+            .and_then(|m| team.modes.get(m as usize))
+            .map(|m| format!("default: {}", m.name));
+        children.push(DocumentSymbol {
+            name: "main".to_string(),
+            detail: default,
+            kind: SymbolKind::Main,
+            span: main.span,
+            name_span: syntax.main_span,
+            children: Vec::new(),
+        });
+    }
+    let span = children
+        .iter()
+        .fold(decl.span, |span, c| span.cover(c.span));
+    let robots = team.robots.len();
+    DocumentSymbol {
+        name: team.name.to_string(),
+        detail: Some(format!(
+            "{robots} robot{}",
+            if robots == 1 { "" } else { "s" }
+        )),
+        kind: SymbolKind::Team,
+        span,
+        name_span: team.name_span,
+        children,
+    }
+}
+
+/// A symbol found by a workspace search.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WorkspaceSymbol {
+    pub name: String,
+    pub kind: SymbolKind,
+    /// `Team` for a mode, `Team.Plan` for a service.
+    pub container: Option<String>,
+    pub name_span: Span,
+    /// How well the name matches the query; lower is better (see [`match_score`]).
+    pub score: u32,
+}
+
+/// The teams, composite services, modes and functions of the mission whose
+/// name matches `query`, best first.
+pub fn workspace_symbols(analysis: &Analysis, query: &str) -> Vec<WorkspaceSymbol> {
+    let mission = &analysis.mission;
+    let mut found = Vec::new();
+    let mut add = |name: &str, kind, container: Option<String>, name_span| {
+        if let Some(score) = match_score(query, name) {
+            found.push(WorkspaceSymbol {
+                name: name.to_string(),
+                kind,
+                container,
+                name_span,
+                score,
+            });
+        }
+    };
+    for team in &mission.teams {
+        add(&team.name, SymbolKind::Team, None, team.name_span);
+        for s in &team.services {
+            let plan = team
+                .plans
+                .get(s.plan as usize)
+                .map_or("", |p| p.name.as_str());
+            let container = Some(format!("{}.{plan}", team.name));
+            add(&s.name, SymbolKind::Service, container, s.name_span);
+        }
+        for m in &team.modes {
+            add(
+                &m.name,
+                SymbolKind::Mode,
+                Some(team.name.to_string()),
+                m.name_span,
+            );
+        }
+    }
+    for f in &mission.functions {
+        add(&f.name, SymbolKind::Function, None, f.name_span);
+    }
+    found.sort_by(|a, b| (a.score, &a.name, a.name_span).cmp(&(b.score, &b.name, b.name_span)));
+    found
+}
+
+/// How `name` matches `query`, ignoring case: 0 equal (case too), 1 equal,
+/// 2 prefix, 3 substring, 4 the query's characters in order (`amm` for
+/// `AutonomousMove`); `None` if not at all. An empty query matches all (4).
+pub fn match_score(query: &str, name: &str) -> Option<u32> {
+    if query.is_empty() {
+        return Some(4);
+    }
+    if query == name {
+        return Some(0);
+    }
+    let (q, n) = (query.to_lowercase(), name.to_lowercase());
+    if q == n {
+        Some(1)
+    } else if n.starts_with(&q) {
+        Some(2)
+    } else if n.contains(&q) {
+        Some(3)
+    } else {
+        let mut chars = n.chars();
+        q.chars()
+            .all(|c| chars.by_ref().any(|d| d == c))
+            .then_some(4)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ide::mission::testing::Fixture;
+
+    const MISSION: &str = r#"# Guarding
+{
+  Base: iRobotCreate base
+  Guards: Turtlebot3_Burger tb[3], Ev3_Robot ev
+}
+def warn { throw alarm }
+Base.Listen.Collect {
+  warn()
+} repeat(1 SEC)
+Base.Action.Hold { standby() } repeat()
+Guards.Action.Patrol { warn() } repeat()
+Base.Action.AutonomousMove { move("1,1") }
+Base.WATCH { set(Listen, Collect); set(Action, Hold) }
+Base.ALERT { set(Listen, OFF); set(Action, AutonomousMove) }
+Base.main {
+  case (WATCH):
+    catch (alarm): mode = ALERT
+  default: mode = WATCH
+}
+Guards.GO { set(Action, Patrol) }
+Guards.main { case (GO): catch (alarm): mode = GO default: mode = GO }
+Nobody.Plan.Lost { standby() }
+"#;
+
+    fn outline(f: &Fixture, symbols: &[DocumentSymbol], depth: usize, out: &mut String) {
+        for s in symbols {
+            let (line, _) = f.line_col(s.span.start);
+            let (end, _) = f.line_col(s.span.end);
+            assert!(
+                s.span.start <= s.name_span.start && s.name_span.end <= s.span.end,
+                "{s:?}"
+            );
+            out.push_str(&format!(
+                "{:indent$}{:?} {} [{}] lines {line}-{end}{}\n",
+                "",
+                s.kind,
+                s.name,
+                &f.text[s.name_span.range()],
+                s.detail
+                    .as_ref()
+                    .map(|d| format!(" ({d})"))
+                    .unwrap_or_default(),
+                indent = depth * 2
+            ));
+            outline(f, &s.children, depth + 1, out);
+        }
+    }
+
+    #[test]
+    fn outline_per_team() {
+        let f = Fixture::new(MISSION);
+        let mut out = String::new();
+        outline(&f, &document_symbols(&f.analysis, &f.text), 0, &mut out);
+        assert_eq!(
+            out,
+            "\
+Team Base [Base] lines 3-19 (1 robot)
+  Robot base [base] lines 3-3 (iRobotCreate)
+  Plan Listen [Listen] lines 7-9
+    Service Collect [Collect] lines 7-9 (Base.Listen.Collect)
+  Plan Action [Action] lines 10-12
+    Service Hold [Hold] lines 10-10 (Base.Action.Hold)
+    Service AutonomousMove [AutonomousMove] lines 12-12 (Base.Action.AutonomousMove)
+  Mode WATCH [WATCH] lines 13-13 (Listen: Collect, Action: Hold)
+  Mode ALERT [ALERT] lines 14-14 (Listen: OFF, Action: AutonomousMove)
+  Main main [main] lines 15-19 (default: WATCH)
+Team Guards [Guards] lines 4-21 (4 robots)
+  Robot tb[3] [tb] lines 4-4 (Turtlebot3_Burger)
+  Robot ev [ev] lines 4-4 (Ev3_Robot)
+  Plan Action [Action] lines 11-11
+    Service Patrol [Patrol] lines 11-11 (Guards.Action.Patrol)
+  Mode GO [GO] lines 20-20 (Action: Patrol)
+  Main main [main] lines 21-21 (default: GO)
+Function warn [warn] lines 6-6
+"
+        );
+    }
+
+    #[test]
+    fn workspace_search_ranks_exact_prefix_substring_subsequence() {
+        let f = Fixture::new(MISSION);
+        let found = |query: &str| {
+            workspace_symbols(&f.analysis, query)
+                .iter()
+                .map(|s| match &s.container {
+                    Some(c) => format!("{c}.{}", s.name),
+                    None => s.name.clone(),
+                })
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        assert_eq!(found("alert"), "Base.ALERT");
+        assert_eq!(
+            found("a"),
+            "Base.ALERT, Base.Action.AutonomousMove, Base, Guards, Guards.Action.Patrol, Base.WATCH, warn"
+        );
+        assert_eq!(found("amv"), "Base.Action.AutonomousMove");
+        assert_eq!(found("Lost"), "");
+        assert_eq!(found("").split(", ").count(), 10);
+        assert_eq!(match_score("GO", "GO"), Some(0));
+        assert_eq!(match_score("go", "GO"), Some(1));
+        assert_eq!(match_score("xyz", "GO"), None);
+    }
+}

@@ -1,0 +1,450 @@
+//! Unit tests of the `ide` functions on small missions: the scopes the checker
+//! records, places found in half-typed text, catalog-dependent completions,
+//! robustness on arbitrary text and offsets, and completion latency on a large
+//! mission. The protocol tests of `semo-server` cover each feature end to end.
+
+use super::code_actions::code_actions;
+use super::completion::completions;
+use super::context::{self, Place};
+use super::hover::hover;
+use super::inlay_hints::inlay_hints;
+use super::signature_help::signature_help;
+use crate::catalog::{Catalog, CatalogSource, builtin_catalog, load_catalog};
+use crate::diag::FileId;
+use crate::ide::{CompletionConfig, CompletionItem, CompletionKind};
+use crate::sema::{Analysis, ScopeKind};
+use crate::span::Span;
+use crate::syntax::ast::ArmKind;
+use proptest::prelude::*;
+use std::sync::OnceLock;
+
+fn builtin() -> &'static Catalog {
+    static CATALOG: OnceLock<Catalog> = OnceLock::new();
+    CATALOG.get_or_init(builtin_catalog)
+}
+
+fn analyse(text: &str) -> Analysis {
+    crate::check_source(FileId(0), text, builtin())
+}
+
+/// The text without its `$0`, and the marker's offset.
+fn cursor(text: &str) -> (String, usize) {
+    let at = text.find("$0").expect("a $0 marker");
+    (text.replacen("$0", "", 1), at)
+}
+
+fn complete_with(text: &str, catalog: &Catalog) -> Vec<CompletionItem> {
+    let (text, at) = cursor(text);
+    let analysis = crate::check_source(FileId(0), &text, catalog);
+    completions(
+        &analysis,
+        catalog,
+        &text,
+        at,
+        CompletionConfig { snippets: true },
+    )
+}
+
+fn labels_of(items: &[CompletionItem], kind: CompletionKind) -> Vec<String> {
+    items
+        .iter()
+        .filter(|i| i.kind == kind)
+        .map(|i| i.label.clone())
+        .collect()
+}
+
+fn place_at(text: &str) -> Place {
+    let (text, at) = cursor(text);
+    let analysis = analyse(&text);
+    let start = context::prefix_at(&text, at).start;
+    context::place(&context::scan(&analysis, &text, start))
+}
+
+const GUARDS: &str = "{
+  Guards: Turtlebot3_Burger tb[2], Ev3_Robot ev
+}
+Guards.Action.Patrol{
+  stop()
+  [[
+    group(instance of Turtlebot3_Burger){
+      light_on()
+    }
+    others{
+      scatter()
+    }
+  ]]
+} repeat()
+def helper{
+  [[ leader(instance of Turtlebot3_Burger){ light_off() } ]]
+}
+Guards.Report.Tell{ helper() } repeat(1 SEC)
+Guards.PATROL{ set(Action, Patrol); set(Report, Tell) }
+Guards.main{ default: mode = PATROL }
+";
+
+#[test]
+fn scopes_nest_and_give_the_robots_of_each_place() {
+    let analysis = analyse(GUARDS);
+    let mission = &analysis.mission;
+    let at = |needle: &str| GUARDS.find(needle).unwrap() + 1;
+    let robots = |offset: usize| {
+        let scope = mission.scope_at(offset).expect("a scope");
+        let mut names: Vec<String> = scope
+            .runs
+            .iter()
+            .flat_map(|r| {
+                let t = mission.team(r.team.unwrap());
+                r.robots
+                    .iter()
+                    .map(|&i| t.robots[i as usize].name.to_string())
+            })
+            .collect();
+        names.sort();
+        (scope.kind, names)
+    };
+    let (kind, names) = robots(at("stop()"));
+    assert!(matches!(kind, ScopeKind::Service { .. }));
+    assert_eq!(names, ["ev", "tb_0", "tb_1"]);
+    let (kind, names) = robots(at("light_on"));
+    assert!(matches!(
+        kind,
+        ScopeKind::Arm {
+            kind: ArmKind::Group,
+            ..
+        }
+    ));
+    assert_eq!(names, ["tb_0", "tb_1"]);
+    let (kind, names) = robots(at("scatter"));
+    assert!(matches!(kind, ScopeKind::Others { .. }));
+    assert_eq!(names, ["ev"]);
+    // The arm inside the function is run by the caller's robots.
+    let (_, names) = robots(at("light_off"));
+    assert_eq!(names, ["tb_0", "tb_1"]);
+    let function = mission.scope_at(at("[[ leader")).unwrap();
+    assert!(matches!(function.kind, ScopeKind::Function(_)));
+    // Between items, and at the very ends of a body: no scope.
+    assert!(mission.scope_at(at("Guards.PATROL")).is_none());
+    assert!(mission.scope_at(0).is_none());
+    assert!(mission.scope_at(GUARDS.len() + 10).is_none());
+    // Outer before inner, each linked to the smallest one around it.
+    for (i, s) in mission.scopes.iter().enumerate() {
+        if let Some(p) = s.parent {
+            let parent = &mission.scopes[p as usize];
+            assert!((p as usize) < i);
+            assert!(parent.span.start <= s.span.start && s.span.end <= parent.span.end);
+        }
+    }
+}
+
+#[test]
+fn places_in_half_typed_text() {
+    let cases: &[(&str, Place)] = &[
+        ("{ T: $0", Place::RobotType),
+        ("{ T: A a, $0", Place::RobotType),
+        ("{ T: A $0", Place::Nothing),
+        ("T: A a\n$0", Place::Item),
+        ("T.P.S{ st$0", Place::Statement),
+        (
+            "T.P.S{ move($0",
+            Place::Expr {
+                qualifier: None,
+                compared: None,
+            },
+        ),
+        ("T.P.S{ move(\n  $0", Place::Statement),
+        (
+            "T.P.S{ if(T.$0",
+            Place::Expr {
+                qualifier: Some("T".into()),
+                compared: None,
+            },
+        ),
+        (
+            "T.P.S{ if(T.COLOR == $0",
+            Place::Expr {
+                qualifier: None,
+                compared: Some(vec!["T".into(), "COLOR".into()]),
+            },
+        ),
+        ("T.P.S{ throw $0", Place::Throw),
+        ("T.P.S{ send($0", Place::CommTeam),
+        (
+            "T.P.S{ [[ $0",
+            Place::GroupArm {
+                first: true,
+                leader: false,
+            },
+        ),
+        ("T.P.S{ [[ group($0", Place::ArmCondition),
+        ("T.P.S{ [[ group(instance of A, $0", Place::ArmTypes),
+        ("T.P.S{ [[ group(capable of $0", Place::ArmCapabilities),
+        (
+            "T.P.S{ x() } repeat($0",
+            Place::Expr {
+                qualifier: None,
+                compared: None,
+            },
+        ),
+        (
+            "T.P.S{ x() } repeat(2 $0",
+            Place::Unit {
+                in_condition: false,
+            },
+        ),
+        ("T.M{ $0", Place::SetStart),
+        ("T.M{ set($0", Place::SetPlan),
+        ("T.M{ set(P, $0", Place::SetService { plan: "P".into() }),
+        ("T.M{ set(P, S, $0", Place::SetTimeout),
+        ("T.main{ case($0", Place::CaseMode),
+        (
+            "T.main{ case(A): catch($0",
+            Place::CatchEvent {
+                mode: Some("A".into()),
+            },
+        ),
+        ("T.main{ case(A): catch(e): $0", Place::ModeKeyword),
+        ("T.main{ case(A): catch(e): mode = $0", Place::ModeName),
+        ("T.main{ default: $0", Place::ModeKeyword),
+        ("T.main{ case(A): $0", Place::MainArm { in_case: true }),
+        ("$0", Place::Item),
+        ("T.$0", Place::ItemAfterTeam { team: "T".into() }),
+        (
+            "T.P.$0",
+            Place::ItemAfterPlan {
+                team: "T".into(),
+                plan: "P".into(),
+            },
+        ),
+        ("T.P.S.$0", Place::Nothing),
+        (
+            "T.P.S{ x() } repeat()\nT.$0",
+            Place::ItemAfterTeam { team: "T".into() },
+        ),
+        ("T.P.S{ x() }\n$0", Place::Item),
+    ];
+    for (text, expected) in cases {
+        assert_eq!(&place_at(text), expected, "in {text:?}");
+    }
+}
+
+#[test]
+fn trivia_and_prefixes() {
+    use context::{Trivia, prefix_at, trivia_at};
+    assert_eq!(trivia_at("a # b", 5), Trivia::Comment);
+    assert_eq!(trivia_at("move(\"a # b", 10), Trivia::String);
+    assert_eq!(trivia_at("move(\"a\\\" b", 10), Trivia::String);
+    assert_eq!(trivia_at("move(\"a\") b", 10), Trivia::Code);
+    assert_eq!(trivia_at("# x\nmove(", 9), Trivia::Code);
+    assert_eq!(prefix_at("move(ab", 7), Span::new(5, 7));
+    assert_eq!(prefix_at("2SE", 3), Span::new(1, 3));
+    assert_eq!(prefix_at("한국ab", 8), Span::new(6, 8));
+    assert_eq!(prefix_at("", 4), Span::new(0, 0));
+}
+
+/// A workspace catalog with an enumerated value and a service of its own.
+fn enum_catalog() -> Catalog {
+    let xml = r#"<Catalog>
+  <Robot type="Lamp">
+    <Value name="MODE" type="enum" domain="RED GREEN BLUE" doc="The lamp's color."/>
+    <Value name="ON" type="bool" doc="Whether it is lit."/>
+    <Service name="blink" doc="Blink."><Param name="times" type="int"/></Service>
+  </Robot>
+</Catalog>"#;
+    let (catalog, diags) = load_catalog(&[CatalogSource {
+        file: FileId(1),
+        text: xml,
+        base_dir: None,
+    }]);
+    assert!(diags.is_empty(), "{diags:#?}");
+    catalog
+}
+
+const LAMPS: &str = "{ L: Lamp l }\nL.Action.Go{\n  if(MODE == $0)\n} repeat()\nL.M{ set(Action, Go) }\nL.main{ default: mode = M }\n";
+
+#[test]
+fn constants_of_an_enumeration_after_a_comparison() {
+    let catalog = enum_catalog();
+    let items = complete_with(LAMPS, &catalog);
+    assert_eq!(
+        labels_of(&items, CompletionKind::Constant),
+        ["RED", "GREEN", "BLUE"]
+    );
+    assert_eq!(items[0].label, "RED", "the domain comes first");
+    let items = complete_with(&LAMPS.replace("MODE == $0", "L.ON == $0"), &catalog);
+    assert_eq!(items[0].label, "true");
+    let items = complete_with(&LAMPS.replace("if(MODE == $0)", "$0"), &catalog);
+    assert_eq!(labels_of(&items, CompletionKind::BuiltinService), ["blink"]);
+    let blink = items.iter().find(|i| i.label == "blink").unwrap();
+    assert_eq!(blink.insert, "blink(${1:times})$0");
+    assert_eq!(blink.detail.as_deref(), Some("blink(times: int)"));
+}
+
+#[test]
+fn did_you_mean_of_a_string_keeps_the_quotes() {
+    let catalog = enum_catalog();
+    let text = LAMPS.replace("MODE == $0)", "MODE == \"GREN\") blink(2)");
+    let analysis = crate::check_source(FileId(0), &text, &catalog);
+    let at = text.find("GREN").unwrap();
+    let actions = code_actions(&analysis, &catalog, &text, Span::new(at, at));
+    assert_eq!(actions.len(), 1, "{actions:#?}");
+    assert_eq!(actions[0].edits[0].new_text, "\"GREEN\"");
+    assert_eq!(&text[actions[0].edits[0].span.range()], "\"GREN\"");
+}
+
+/// Every `ide` function at `offset` of `text`: nothing panics, and every
+/// range returned lies in the text, on character boundaries.
+fn every_feature_at(text: &str, analysis: &Analysis, offset: usize) {
+    let catalog = builtin();
+    let valid = |span: Span| {
+        assert!(span.start <= span.end && span.end <= text.len(), "{span:?}");
+        assert!(text.is_char_boundary(span.start) && text.is_char_boundary(span.end));
+    };
+    for snippets in [true, false] {
+        for item in completions(
+            analysis,
+            catalog,
+            text,
+            offset,
+            CompletionConfig { snippets },
+        ) {
+            valid(item.replace);
+            assert!(item.replace.end == offset.min(text.len()) || item.replace.is_empty());
+        }
+    }
+    if let Some(h) = hover(analysis, catalog, text, offset) {
+        valid(h.range);
+    }
+    if let Some(s) = signature_help(analysis, catalog, text, offset) {
+        for (range, _) in &s.parameters {
+            assert!(s.label.get(range.clone()).is_some());
+        }
+    }
+    let range = Span::new(offset.saturating_sub(40), offset + 40);
+    for h in inlay_hints(analysis, catalog, text, range) {
+        valid(Span::new(h.offset, h.offset));
+    }
+    for action in code_actions(analysis, catalog, text, range) {
+        for e in action.edits {
+            valid(e.span);
+        }
+    }
+}
+
+fn examples() -> &'static [String] {
+    static EXAMPLES: OnceLock<Vec<String>> = OnceLock::new();
+    EXAMPLES.get_or_init(|| {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
+        [
+            "scouting/scouting.mission",
+            "follow/follow.mission",
+            "swarm/march.mission",
+            "swarm/patrol_groups.mission",
+        ]
+        .iter()
+        .filter_map(|p| std::fs::read_to_string(root.join(p)).ok())
+        .chain([GUARDS.to_string(), LAMPS.replace("$0", "")])
+        .collect()
+    })
+}
+
+#[test]
+fn every_offset_of_the_examples() {
+    for text in examples() {
+        let analysis = analyse(text);
+        for offset in (0..=text.len() + 2).filter(|&o| o > text.len() || text.is_char_boundary(o)) {
+            every_feature_at(text, &analysis, offset);
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Cuts of the examples (a prefix, as while typing, plus random text)
+    /// at random offsets.
+    #[test]
+    fn never_panics_on_half_typed_text(
+        which in 0usize..6,
+        cut in 0.0f64..1.0,
+        tail in "[a-zA-Z_.,:;=<>!()\\[\\]{}\"# \n0-9한😀]{0,12}",
+        at in 0.0f64..1.2,
+    ) {
+        let examples = examples();
+        let base = &examples[which % examples.len()];
+        let mut end = ((base.len() as f64) * cut) as usize;
+        while !base.is_char_boundary(end) {
+            end -= 1;
+        }
+        let text = format!("{}{tail}", &base[..end]);
+        let analysis = analyse(&text);
+        let mut offset = ((text.len() as f64) * at) as usize;
+        while offset <= text.len() && !text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        every_feature_at(&text, &analysis, offset);
+    }
+}
+
+/// A mission of about 10,000 lines: teams with groups, functions, modes.
+fn large_mission(teams: usize) -> String {
+    use std::fmt::Write;
+    let mut m = String::from("{\n");
+    for t in 0..teams {
+        writeln!(
+            m,
+            "  Team{t}: Turtlebot3_Burger tb{t}[3], Ev3_Robot ev{t}[2]"
+        )
+        .unwrap();
+    }
+    m.push_str("}\ndef home {\n  move(\"0,0\")\n}\n");
+    for t in 0..teams {
+        let next = (t + 1) % teams;
+        write!(
+            m,
+            "Team{t}.Listen.Hear{{\n  subscribe(Team{t}, Team{t}.Alarm)\n  receive(Team{next}, Team{next}.Status)\n  if(Team{t}.Alarm == DARK) throw hide\n  else throw resume\n}} repeat(500 MSEC)\n\
+             Team{t}.Action.Patrol{{\n  [[\n    group(instance of Turtlebot3_Burger){{\n      loop(2 SEC){{\n        if(LIGHTNESS < 200 and BATTERY > 20)\n          publish(Team{t}, Team{t}.Alarm = DARK)\n      }}\n    }}\n    others{{\n      search(colored_paper)\n      home()\n    }}\n  ]]\n}} repeat()\n\
+             Team{t}.Action.Hide{{\n  if(DISTANCE > 30){{\n    go_forward()\n  }} else {{\n    turn_left()\n  }}\n  send(Team{next}, Team{t}.Status = \"hiding\")\n}} repeat(LOCATION != \"0,0\")\n\
+             Team{t}.PATROL{{ set(Listen, Hear); set(Action, Patrol) }}\nTeam{t}.HIDE{{ set(Listen, Hear); set(Action, Hide, timeout = 30 SEC) }}\n\
+             Team{t}.main{{\n  case (PATROL):\n    catch (hide): mode = HIDE\n  case (HIDE):\n    catch (resume): mode = PATROL\n  default: mode = PATROL\n}}\n"
+        )
+        .unwrap();
+    }
+    m
+}
+
+/// Completion answers all over a 10,000-line mission (its latency is measured
+/// by `cargo bench --bench ide_latency`, not asserted here).
+#[test]
+fn completion_answers_all_over_a_large_mission() {
+    let text = large_mission(265);
+    assert!(text.lines().count() >= 10_000, "{}", text.lines().count());
+    let analysis = analyse(&text);
+    let catalog = builtin();
+    // Places all over the file: statements, conditions, `Team.`, `set(`...
+    let mut offsets: Vec<usize> = Vec::new();
+    for needle in [
+        "      home()",
+        "LIGHTNESS <",
+        "Team",
+        "set(Action, ",
+        "catch (",
+        "  [[",
+    ] {
+        offsets.extend(
+            text.match_indices(needle)
+                .step_by(7)
+                .map(|(i, _)| i + needle.len()),
+        );
+    }
+    assert!(offsets.len() > 300, "{}", offsets.len());
+    for &offset in &offsets {
+        let items = completions(
+            &analysis,
+            catalog,
+            &text,
+            offset,
+            CompletionConfig { snippets: true },
+        );
+        assert!(!items.is_empty(), "no completion at {offset}");
+    }
+}
