@@ -11,21 +11,29 @@
 //! runtime's send path) and battery levels (the runtime's `BATTERY` value);
 //! the random missions get random ones (`missiongen::scenario`).
 //!
-//! The tolerance on times, [`TOLERANCE_MS`]: the processes run at
-//! `time_scale` 0.2 (5 mission ms per wall ms; patrol_groups at 1) behind a
-//! start barrier (`--start-at`: every process has opened its port and starts
-//! its clock at the same instant), and the simulator orders same-time events
-//! one fixed way where threads race. A sensor-driven change waits for the next
-//! sensor sample (period 100 ms) and, in a loop around a service call, for
-//! the call under way to end (the scenario's 100 ms plus a control period of
-//! 10 ms): 210 ms, plus 90 mission ms (18 wall ms) for the scheduling of a
-//! loaded machine: 300 ms. Measured on a 2-core machine at load average
-//! 14: up to 243 ms (scouting), 216 ms (scouting with link faults), 174 ms
-//! (march), 59 ms (follow), 39 ms (patrol_groups at time scale 1). Before the
-//! barrier each process started its clock on its own, its first control
-//! firing up to about 190 mission ms after the others' (start-up, ~40 wall
-//! ms, scaled), and the tolerance was 400 ms (scouting measured up to 285).
-//! Differences beyond it, or in any sequence, are a bug in one of the two.
+//! The tolerance on times: the processes run at `time_scale` 0.2 (5 mission
+//! ms per wall ms; patrol_groups at 1) behind a start barrier (`--start-at`:
+//! every process has opened its port and starts its clock at the same
+//! instant; measured: the robots of a run start within 3 mission ms of each
+//! other), and the simulator orders same-time events one fixed way where
+//! threads race. So the C times are compared one-sided:
+//!
+//! - never earlier than the simulator's by more than [`EARLY_MS`] (210 ms:
+//!   a race at one instant resolved the other way costs one period of the
+//!   service polling for it, 200 ms for march's `Watch`, the one such race
+//!   among the examples' compared mode changes, and one control period,
+//!   10 ms). Measured: -177 ms (march, a publication that arrived just before
+//!   a late `Watch` instead of just after it), otherwise never earlier. Before
+//!   the barrier each process started its clock on its own, up to about 190
+//!   mission ms after the others (start-up, ~40 wall ms, scaled), which came
+//!   on top both ways: one tolerance of 400 ms served both.
+//! - never later by more than [`LATE_MS`] (500 ms): a sensor-driven change
+//!   waits for the next sample (100 ms) and the call under way (100 ms + 10
+//!   ms); every step of a chain a thread wakes late adds up. Measured on the
+//!   shared 2-core machine: up to 263 ms at load average 14, 433 ms at load
+//!   average 20 (scouting's FINISH, after some 30 steps).
+//!
+//! Differences beyond them, or in any sequence, are a bug in one of the two.
 
 mod support;
 
@@ -34,12 +42,17 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use support::{examples, repo_root, semo_in};
 
-const TOLERANCE_MS: i64 = 300;
+const EARLY_MS: i64 = 210;
+const LATE_MS: i64 = 500;
 
-/// How long after their start the processes of a random mission may still
-/// miss each other's messages: their start-up spread (measured up to about
-/// 190 mission ms at `time_scale` 0.2, see [`TOLERANCE_MS`]).
-const START_MS: i64 = 250;
+/// The start-up window of a random mission's run, whose receptions are not
+/// compared: behind the barrier every port is open from mission time 0, but
+/// each process's first control firing still comes when its threads get the
+/// cores (measured up to 38 mission ms after 0 at `time_scale` 0.2), so a
+/// robot that finishes at its first firing (random seed 6) may hear the
+/// others' first messages in C and not in the simulator, where every robot
+/// fires at 0 and a message takes 1 ms. Before the barrier: 250 ms.
+const START_MS: i64 = 100;
 
 type Event = serde_json::Map<String, serde_json::Value>;
 
@@ -68,15 +81,35 @@ fn parse_trace(text: &str) -> Vec<Event> {
         .collect()
 }
 
-/// What is compared of one robot's trace.
+/// What is compared of one robot's trace. The sequences are compared as
+/// runs of equal items (the item, and whether it repeats): a mode that
+/// catches its own event is entered again at every control firing it keeps
+/// up with, a rate that a loaded machine lowers in C (random seed 11 at
+/// `time_scale` 0.2 fired 115 times in C, 200 in the simulator), while a
+/// different event, mode, service or leader, another order, or a repetition
+/// on one side only is still a difference.
 #[derive(Debug, PartialEq, Eq)]
 struct Behaviour {
-    modes: Vec<String>,
-    services: BTreeMap<String, Vec<String>>,
-    catches: Vec<(String, String)>,
-    leaders: Vec<String>,
+    modes: Runs<String>,
+    services: BTreeMap<String, Runs<String>>,
+    catches: Runs<(String, String)>,
+    leaders: Runs<String>,
     sent: BTreeSet<(String, String)>,
     received: BTreeSet<(String, String)>,
+}
+
+/// A sequence as runs of equal consecutive items: (item, repeated).
+type Runs<T> = Vec<(T, bool)>;
+
+fn runs<T: PartialEq>(items: impl IntoIterator<Item = T>) -> Runs<T> {
+    let mut out: Runs<T> = Vec::new();
+    for item in items {
+        match out.last_mut() {
+            Some((last, repeated)) if *last == item => *repeated = true,
+            _ => out.push((item, false)),
+        }
+    }
+    out
 }
 
 fn behaviour(events: &[&Event]) -> Behaviour {
@@ -91,16 +124,16 @@ fn behaviour(events: &[&Event]) -> Behaviour {
             .push(field(e, "service").to_string());
     }
     Behaviour {
-        modes: of(events, "mode")
-            .map(|e| field(e, "mode").to_string())
+        modes: runs(of(events, "mode").map(|e| field(e, "mode").to_string())),
+        services: services
+            .into_iter()
+            .map(|(plan, list)| (plan, runs(list)))
             .collect(),
-        services,
-        catches: of(events, "catch")
-            .map(|e| (field(e, "name").to_string(), field(e, "mode").to_string()))
-            .collect(),
-        leaders: of(events, "leader")
-            .map(|e| field(e, "leader").to_string())
-            .collect(),
+        catches: runs(
+            of(events, "catch")
+                .map(|e| (field(e, "name").to_string(), field(e, "mode").to_string())),
+        ),
+        leaders: runs(of(events, "leader").map(|e| field(e, "leader").to_string())),
         sent: of(events, "send")
             .map(|e| (field(e, "to").to_string(), field(e, "key").to_string()))
             .collect(),
@@ -115,12 +148,17 @@ fn behaviour(events: &[&Event]) -> Behaviour {
     }
 }
 
+/// When each run of modes began (see [`Behaviour`]).
 fn mode_times(events: &[&Event]) -> Vec<i64> {
-    events
-        .iter()
-        .filter(|e| field(e, "event") == "mode")
-        .map(|e| e["t"].as_i64().unwrap())
-        .collect()
+    let mut times = Vec::new();
+    let mut last = None;
+    for e in events.iter().filter(|e| field(e, "event") == "mode") {
+        if last != Some(field(e, "mode")) {
+            times.push(e["t"].as_i64().unwrap());
+            last = Some(field(e, "mode"));
+        }
+    }
+    times
 }
 
 /// Every robot folder under an output folder, as (robot, folder).
@@ -284,11 +322,11 @@ fn compare(name: &str, mission: &Path, scenario_text: &str, port: u32) {
         let worst = mode_times(&c)
             .into_iter()
             .zip(mode_times(&s))
-            .map(|(tc, ts)| (tc - ts).abs())
-            .max()
+            .map(|(tc, ts)| tc - ts)
+            .max_by_key(|d| d.abs())
             .unwrap_or(0);
         eprintln!(
-            "{name}/{robot}: {} modes, {} catches, {} leaders, {} kinds of message sent, {} received; mode times differ by up to {worst} ms",
+            "{name}/{robot}: {} modes, {} catches, {} leaders, {} kinds of message sent, {} received; C mode times differ by up to {worst:+} ms",
             bs.modes.len(),
             bs.catches.len(),
             bs.leaders.len(),
@@ -296,7 +334,7 @@ fn compare(name: &str, mission: &Path, scenario_text: &str, port: u32) {
             bs.received.len()
         );
         for (tc, ts) in mode_times(&c).into_iter().zip(mode_times(&s)) {
-            if (tc - ts).abs() > TOLERANCE_MS {
+            if tc - ts < -EARLY_MS || tc - ts > LATE_MS {
                 problems.push(format!(
                     "{robot}: modes entered at {:?} (C) and {:?} (sim)",
                     mode_times(&c),
@@ -409,16 +447,23 @@ fn until<'e>(events: &[&'e Event], until: i64) -> Vec<&'e Event> {
 }
 
 /// `early` (one run's sequence up to a time both runs certainly reached) is
-/// where `all` (the other run's whole sequence) begins.
-fn starts<T: PartialEq + std::fmt::Debug>(early: &[T], all: &[T]) -> bool {
-    all.len() >= early.len() && all[..early.len()] == *early
+/// where `all` (the other run's whole sequence) begins; its last run may
+/// have been cut before it repeated.
+fn starts<T: PartialEq>(early: &[(T, bool)], all: &[(T, bool)]) -> bool {
+    let Some(((last, repeated), before)) = early.split_last() else {
+        return true;
+    };
+    all.len() >= early.len()
+        && all[..before.len()] == *before
+        && all[before.len()].0 == *last
+        && (!repeated || all[before.len()].1)
 }
 
-/// Random valid missions (the generator of `support/missiongen.rs`) on an
-/// empty scenario: the same checks as for the examples, except that a run
+/// Random valid missions (the generator of `support/missiongen.rs`) on
+/// random scenarios (battery levels, link faults): the same checks as for the examples, except that a run
 /// ends at a cut-off one of the two may reach a little earlier, so each
-/// run's behaviour up to [`TOLERANCE_MS`] before the end must begin the
-/// other's.
+/// run's behaviour up to [`LATE_MS`] before the end must begin the
+/// other's; receptions of the start-up window ([`START_MS`]) are left out.
 fn random_missions(seeds: std::ops::Range<u64>) {
     let catalog = semo::catalog::builtin_catalog();
     let duration = 2000;
@@ -429,7 +474,7 @@ fn random_missions(seeds: std::ops::Range<u64>) {
         std::fs::write(&mission, support::missiongen::mission(seed, &catalog)).unwrap();
         let folders = build_robots(&format!("random-{seed}-out"), &mission);
         let robots: Vec<String> = folders.iter().map(|(r, _)| r.clone()).collect();
-        let scenario = support::missiongen::scenario(seed, &robots, duration, START_MS, 0.2);
+        let scenario = support::missiongen::scenario(seed, &robots, duration, 0.2);
         let scenario_path = dir.join("scenario.json");
         std::fs::write(&scenario_path, &scenario).unwrap();
         let reference = simulate(&mission, &scenario_path);
@@ -441,12 +486,8 @@ fn random_missions(seeds: std::ops::Range<u64>) {
                 .iter()
                 .filter(|e| field(e, "robot") == robot)
                 .collect();
-            // The processes start a little apart and do not wait for each
-            // other: a message sent before its receiver listens is lost (UDP),
-            // where the simulator starts every robot at once. Receptions in
-            // the start-up window are left out on both sides.
             let (c, s) = (settled(&c), settled(&s));
-            let cut = duration - TOLERANCE_MS;
+            let cut = duration - LATE_MS;
             let (c_early, s_early) = (behaviour(&until(&c, cut)), behaviour(&until(&s, cut)));
             let (c_all, s_all) = (behaviour(&c), behaviour(&s));
             let agree = |a: &Behaviour, b: &Behaviour| {

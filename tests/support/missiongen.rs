@@ -564,15 +564,11 @@ fn seed_bit(i: usize) -> bool {
 /// A random scenario for a generated mission's `robots` (its robot names):
 /// each robot's battery falling over the run (the `BATTERY` value the
 /// missions compare), and link faults (drop, delay, partition) over
-/// intervals of the run, each decided by `seed`. Faults start after
-/// `settle_ms` (the processes' start-up) and end before `duration`.
-pub fn scenario(
-    seed: u64,
-    robots: &[String],
-    duration: i64,
-    settle_ms: i64,
-    time_scale: f64,
-) -> String {
+/// intervals of the run, each decided by `seed`, within `duration`.
+pub fn scenario(seed: u64, robots: &[String], duration: i64, time_scale: f64) -> String {
+    // Faults begin after the robots' first firings, so that some of them
+    // change what a robot already does.
+    let settle_ms = 100;
     let mut rng = Rng::new(seed ^ 0xFA17);
     let ms = |rng: &mut Rng, from: i64, until: i64| {
         from + (rng.next() % (until - from).max(1) as u64) as i64 / 10 * 10
@@ -587,9 +583,19 @@ pub fn scenario(
         ));
     }
     let mut faults = Vec::new();
+    // A link fault begins and ends halfway between two heartbeats (every
+    // 200 ms from 0, HEARTBEAT_MS), so that the robots miss a whole number of
+    // them whatever the processes' scheduling; never two, since a gap of
+    // three periods is exactly when a silent robot counts as failed, a
+    // boundary decided by microseconds in C (random seed 14).
     let interval = |rng: &mut Rng| {
-        let from = ms(rng, settle_ms, duration - 400);
-        (from, ms(rng, from + 100, duration))
+        let periods = (duration / 200 - 1).max(2) as usize;
+        let first = rng.below(periods - 1);
+        let missed = *rng.pick(&[1usize, 3, 4, 5]);
+        let last = (first + missed).min(periods);
+        let missed = if last - first == 2 { 1 } else { last - first };
+        let at = |k: usize| 100 + 200 * k as i64;
+        (at(first), at(first + missed))
     };
     if robots.len() >= 2 {
         let pair = |rng: &mut Rng| {

@@ -96,7 +96,7 @@ pub fn robot_command(folder: &Path, scenario: &Path, trace: &Path, port_base: u3
 /// its port (`--start-at`, Unix ms), so that they start together and no
 /// first message is lost; also the same moment on this process's clock.
 pub fn start_barrier(robots: usize) -> (std::time::Instant, u64) {
-    let lead = std::time::Duration::from_millis(300 + 100 * robots as u64);
+    let lead = std::time::Duration::from_millis(600 + 100 * robots as u64);
     let unix = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .expect("the clock is after 1970");
