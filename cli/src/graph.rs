@@ -6,7 +6,7 @@ use super::render;
 use semo::diag::Diagnostic;
 use semo::taskgraph::analysis::ratio::Ratio;
 use semo::workspace::{
-    DiskResolver, FileKind, Files, GraphReading, GraphRun, analyze_graph, analyze_graph_as,
+    FileKind, FileResolver, Files, GraphReading, GraphRun, analyze_graph, analyze_graph_as,
 };
 use std::io::Write;
 use std::path::Path;
@@ -32,7 +32,7 @@ fn read_and_analyze(path: &Path, reading: GraphReading) -> Option<(Files, GraphR
         id,
         &file.text,
         Some(&file.path),
-        &mut DiskResolver::new(&files),
+        &mut FileResolver::new(&files),
         reading,
     );
     Some((files, run))
@@ -310,7 +310,7 @@ pub fn schedule(path: &Path, cores: Option<usize>, out: &mut impl Write) -> i32 
     let Some(text) = read(path) else { return 2 };
     let mut files = Files::default();
     let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
-    let run = analyze_graph(files.get(id), &mut DiskResolver::new(&files));
+    let run = analyze_graph(files.get(id), &mut FileResolver::new(&files));
     let Some(graph) = run
         .graph
         .as_ref()
