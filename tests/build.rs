@@ -392,8 +392,8 @@ fn generation_is_refused_while_the_mission_has_errors() {
     .unwrap();
     let out = dir.join("out");
     let built = build(&mission, "linux", &out);
-    assert_eq!(built.code, 1, "{}", built.stdout);
-    assert!(built.stdout.contains("refused"), "{}", built.stdout);
+    assert_eq!(built.code, 1, "{}", built.stderr);
+    assert!(built.stderr.contains("refused"), "{}", built.stderr);
     assert!(!out.exists(), "nothing is written");
 }
 
@@ -419,11 +419,11 @@ fn every_build_fixture_gives_its_code() {
             .unwrap_or_else(|_| "linux".to_string());
         let out = scratch(&format!("fixture-{name}"));
         let built = build(&mission, &target, &out);
-        assert_eq!(built.code, 1, "{name}: {}", built.stdout);
+        assert_eq!(built.code, 1, "{name}: {}", built.stderr);
         assert!(
-            built.stdout.contains(&format!("[{code}]")),
+            built.stderr.contains(&format!("[{code}]")),
             "{name}: {}",
-            built.stdout
+            built.stderr
         );
         assert!(robot_folders(&out).is_empty(), "{name}: nothing is written");
         seen += 1;

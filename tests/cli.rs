@@ -35,33 +35,33 @@ fn scouting_gives_exactly_the_unmatched_receive_warning() {
         w.message
     );
     // `receive(SlaveTeam, SlaveTeam.COLOR)`: the range is the value received.
-    assert_eq!((w.start, w.end), ((122, 22), (122, 37)));
+    assert_eq!((w.start, w.end), ((126, 22), (126, 37)));
 }
 
 #[test]
 fn human_output_shows_the_source_line_and_a_summary() {
     let out = semo_in(&examples().join("scouting"), &["check", "scouting.mission"]);
     assert_eq!(out.code, 0, "{}", out.stderr);
-    assert!(out.stdout.contains("[W004] Warning"), "{}", out.stdout);
+    assert!(out.stderr.contains("[W004] Warning"), "{}", out.stderr);
     assert!(
-        out.stdout.contains("receive(SlaveTeam, SlaveTeam.COLOR)"),
+        out.stderr.contains("receive(SlaveTeam, SlaveTeam.COLOR)"),
         "{}",
-        out.stdout
+        out.stderr
     );
     assert!(
-        out.stdout.contains("scouting.mission:122:22"),
+        out.stderr.contains("scouting.mission:126:22"),
         "{}",
-        out.stdout
+        out.stderr
     );
     assert!(
-        out.stdout.contains(
+        out.stderr.contains(
             "checked 1 mission and 0 catalog files, 1 strategy file: 0 errors, 1 warning, 2 hints"
         ),
         "{}",
-        out.stdout
+        out.stderr
     );
     assert!(
-        !out.stdout.contains("\u{1b}["),
+        !out.stderr.contains("\u{1b}["),
         "NO_COLOR output has no escape codes"
     );
 }
@@ -72,7 +72,7 @@ fn colours_can_be_forced() {
         &examples().join("scouting"),
         &["check", "--color", "always", "scouting.mission"],
     );
-    assert!(out.stdout.contains("\u{1b}["), "{}", out.stdout);
+    assert!(out.stderr.contains("\u{1b}["), "{}", out.stderr);
 }
 
 #[test]
@@ -86,8 +86,8 @@ fn errors_exit_with_1_and_json_has_every_field() {
     .unwrap();
     let out = semo_in(dir, &["check", "--format", "json", "typo.mission"]);
     assert_eq!(out.code, 1);
-    let line = out.stdout.lines().next().expect("one diagnostic");
-    let v: serde_json::Value = serde_json::from_str(line).unwrap();
+    let document: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    let v = &document["diagnostics"][0];
     assert_eq!(v["code"], "E010");
     assert_eq!(v["severity"], "error");
     assert_eq!(v["file"], "typo.mission");
@@ -470,7 +470,16 @@ fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
 }
 
 #[test]
-fn formatting_the_examples_changes_nothing_that_semo_check_finds() {
+fn the_examples_are_formatted_and_formatting_changes_nothing_that_semo_check_finds() {
+    let clean = semo_in(&examples(), &["fmt", "--check", "."]);
+    assert_eq!(
+        (clean.code, clean.stdout.as_str()),
+        (0, ""),
+        "{}",
+        clean.stderr
+    );
+    // Each example with its indentation stripped: the same findings, and
+    // `semo fmt` gives back the example exactly.
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     copy_dir(&examples(), &dir.join("examples"));
@@ -484,23 +493,47 @@ fn formatting_the_examples_changes_nothing_that_semo_check_finds() {
     };
     let before = findings();
     assert!(!before.1.is_empty());
+    let missions: Vec<(std::path::PathBuf, String)> = walkdir::WalkDir::new(dir)
+        .into_iter()
+        .filter_map(Result::ok)
+        .filter(|e| e.path().extension().is_some_and(|x| x == "mission"))
+        .map(|e| {
+            let text = std::fs::read_to_string(e.path()).unwrap();
+            (e.into_path(), text)
+        })
+        .collect();
+    assert!(missions.len() >= 5, "{missions:?}");
+    for (path, text) in &missions {
+        let stripped: String = text
+            .lines()
+            .map(|l| format!("{}\n", l.trim_start()))
+            .collect();
+        assert_ne!(&stripped, text, "{}", path.display());
+        std::fs::write(path, stripped).unwrap();
+    }
+    assert_eq!(findings(), before);
     let out = semo_in(dir, &["fmt", "."]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     assert!(out.stdout.contains("scouting.mission"), "{}", out.stdout);
-    assert_eq!(findings(), before);
-    let check = semo_in(dir, &["fmt", "--check", "."]);
-    assert_eq!((check.code, check.stdout.as_str()), (0, ""));
+    for (path, text) in &missions {
+        assert_eq!(
+            &std::fs::read_to_string(path).unwrap(),
+            text,
+            "{}",
+            path.display()
+        );
+    }
 }
 
 #[test]
 fn strategy_files_are_checked_against_their_missions() {
     let out = semo_in(&examples(), &["check", "scouting"]);
-    assert_eq!(out.code, 0, "{}", out.stdout);
+    assert_eq!(out.code, 0, "{}", out.stderr);
     assert!(
-        out.stdout
+        out.stderr
             .contains("checked 1 mission and 0 catalog files, 1 strategy file: 0 errors"),
         "{}",
-        out.stdout
+        out.stderr
     );
     assert!(
         semo(&["check", "--help"]).stdout.contains("*.strategy.xml"),
@@ -511,18 +544,18 @@ fn strategy_files_are_checked_against_their_missions() {
     // team's declaration in the mission beside it.
     let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
     let out = semo_in(&fixtures, &["check", "E090_strategy_robot_not_in_team"]);
-    assert_eq!(out.code, 1, "{}", out.stdout);
-    assert!(out.stdout.contains("[E090] Error"), "{}", out.stdout);
+    assert_eq!(out.code, 1, "{}", out.stderr);
+    assert!(out.stderr.contains("[E090] Error"), "{}", out.stderr);
     assert!(
-        out.stdout.contains("Scouts.strategy.xml:5:26"),
+        out.stderr.contains("Scouts.strategy.xml:5:26"),
         "{}",
-        out.stdout
+        out.stderr
     );
-    assert!(out.stdout.contains("scouts.mission:3:3"), "{}", out.stdout);
+    assert!(out.stderr.contains("scouts.mission:3:3"), "{}", out.stderr);
     assert!(
-        out.stdout.contains("team Scouts is declared here"),
+        out.stderr.contains("team Scouts is declared here"),
         "{}",
-        out.stdout
+        out.stderr
     );
     let json = semo_in(
         &fixtures,
@@ -533,7 +566,8 @@ fn strategy_files_are_checked_against_their_missions() {
             "E090_strategy_robot_not_in_team",
         ],
     );
-    let v: serde_json::Value = serde_json::from_str(json.stdout.lines().next().unwrap()).unwrap();
+    let document: serde_json::Value = serde_json::from_str(&json.stdout).unwrap();
+    let v = &document["diagnostics"][0];
     let related = &v["related"][0];
     assert!(
         related["file"]
@@ -562,16 +596,16 @@ fn strategy_files_are_checked_against_their_missions() {
 fn a_plain_lt_in_a_condition_points_at_the_lt_with_the_fix() {
     let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
     let out = semo_in(&fixtures, &["check", "E081_strategy_plain_lt"]);
-    assert_eq!(out.code, 1, "{}", out.stdout);
+    assert_eq!(out.code, 1, "{}", out.stderr);
     assert!(
-        out.stdout.contains("Scouts.strategy.xml:25:40"),
+        out.stderr.contains("Scouts.strategy.xml:25:40"),
         "{}",
-        out.stdout
+        out.stderr
     );
     assert!(
-        out.stdout.contains("did you mean `&lt;`?"),
+        out.stderr.contains("did you mean `&lt;`?"),
         "{}",
-        out.stdout
+        out.stderr
     );
     let (_, diags) = check_json_in(&fixtures, &["E081_strategy_plain_lt"]);
     assert!(diags.iter().all(|d| d.code == "E081"), "{diags:#?}");

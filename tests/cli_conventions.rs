@@ -19,12 +19,12 @@ fn check_dash_reads_a_mission_from_standard_input() {
     let good = std::fs::read_to_string(root.join("examples/follow/follow.mission")).unwrap();
     let out = semo_with_stdin(&root, &["check", "-"], &good);
     assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
-    assert!(out.stdout.contains("checked 1 mission"), "{}", out.stdout);
+    assert!(out.stderr.contains("checked 1 mission"), "{}", out.stderr);
 
     let bad = fixture("E015_unknown_team.mission");
     let out = semo_with_stdin(&root, &["check", "--format", "json", "-"], &bad);
     assert_eq!(out.code, 1, "{}{}", out.stdout, out.stderr);
-    let diags = support::parse_json_lines(&out.stdout);
+    let diags = support::parse_json_report(&out.stdout);
     assert!(
         diags
             .iter()
@@ -43,10 +43,10 @@ fn deny_warnings_makes_a_warning_fail_the_check() {
     let root = repo_root();
     let warned = fixture("W011_team_without_main.mission");
     let out = semo_with_stdin(&root, &["check", "-"], &warned);
-    assert_eq!(out.code, 0, "{}", out.stdout);
-    assert!(out.stdout.contains("W011"), "{}", out.stdout);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(out.stderr.contains("W011"), "{}", out.stderr);
     let out = semo_with_stdin(&root, &["check", "--deny", "warnings", "-"], &warned);
-    assert_eq!(out.code, 1, "{}", out.stdout);
+    assert_eq!(out.code, 1, "{}", out.stderr);
     assert!(
         out.stderr.contains("denied by --deny warnings"),
         "{}",
@@ -65,10 +65,10 @@ fn hints_are_called_hints() {
         &["check", "-"],
         &fixture("W009_catch_never_thrown.mission"),
     );
-    assert!(out.stdout.contains("[W009] Hint:"), "{}", out.stdout);
-    assert!(!out.stdout.contains("Advice"), "{}", out.stdout);
+    assert!(out.stderr.contains("[W009] Hint:"), "{}", out.stderr);
+    assert!(!out.stderr.contains("Advice"), "{}", out.stderr);
     // Without colour, not a single escape sequence, the hint's header too.
-    assert!(!out.stdout.contains('\u{1b}'), "{:?}", out.stdout);
+    assert!(!out.stderr.contains('\u{1b}'), "{:?}", out.stderr);
 }
 
 /// `semo check` of a mission with an error, its output not a terminal, in
@@ -88,7 +88,7 @@ fn coloured(args: &[&str], env: &[(&str, &str)]) -> bool {
     }
     let out = command.output().unwrap();
     assert_eq!(out.status.code(), Some(1));
-    out.stdout.contains(&0x1b)
+    out.stderr.contains(&0x1b)
 }
 
 #[test]
@@ -152,4 +152,707 @@ fn dash_o_and_output_mean_the_output_everywhere() {
     // The help names one meaning.
     let help = semo(&["build", "--help"]).stdout;
     assert!(help.contains("-o, --output <OUT>"), "{help}");
+}
+
+/// A scratch folder for one test, emptied first.
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("cli_conventions")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn path_str(path: &std::path::Path) -> String {
+    path.display().to_string()
+}
+
+fn example(path: &str) -> String {
+    path_str(&repo_root().join("examples").join(path))
+}
+
+fn fixture_path(name: &str) -> String {
+    path_str(&repo_root().join("tests/fixtures/diagnostics").join(name))
+}
+
+/// A scenario that runs follow.mission for a second.
+const SHORT_SCENARIO: &str = "{\"duration\": 1000}\n";
+
+#[test]
+fn diagnostics_go_to_stderr_and_data_to_stdout_in_every_command() {
+    let dir = scratch("streams");
+    // check: the whole report for people is diagnostics.
+    let out = semo(&["check", &fixture_path("E015_unknown_team.mission")]);
+    assert_eq!(out.code, 1);
+    assert_eq!(out.stdout, "");
+    assert!(out.stderr.contains("[E015] Error"), "{}", out.stderr);
+    assert!(out.stderr.contains("checked 1 mission"), "{}", out.stderr);
+    // graph analyze: the errors on stderr, the analysis on stdout.
+    let out = semo(&[
+        "graph",
+        "analyze",
+        &example("taskgraphs/deadlock.taskgraph.xml"),
+    ]);
+    assert_eq!(out.code, 1);
+    assert!(out.stderr.contains("[E071] Error"), "{}", out.stderr);
+    assert!(!out.stdout.contains("E071"), "{}", out.stdout);
+    assert!(out.stdout.contains("deadlocks"), "{}", out.stdout);
+    // graph modes: the picture on stdout, the mission's errors on stderr.
+    let out = semo(&["graph", "modes", &fixture_path("E017_unknown_mode.mission")]);
+    assert_eq!(out.code, 1);
+    assert!(out.stdout.starts_with("<svg"), "{}", out.stdout);
+    assert!(out.stderr.contains("[E017] Error"), "{}", out.stderr);
+    // graph dot: a graph that does not load prints no picture.
+    let broken = dir.join("broken.taskgraph.xml");
+    std::fs::write(
+        &broken,
+        "<TaskGraph name=\"g\" xmlns=\"urn:semo:taskgraph:1\">\n  <Task/>\n</TaskGraph>\n",
+    )
+    .unwrap();
+    let out = semo(&["graph", "dot", &path_str(&broken)]);
+    assert_eq!(out.code, 1);
+    assert_eq!(out.stdout, "");
+    assert!(out.stderr.contains("[E062] Error"), "{}", out.stderr);
+    // build: what was written on stdout; a refusal and its reasons on stderr.
+    let mission = dir.join("bad.mission");
+    std::fs::copy(
+        repo_root().join("tests/fixtures/diagnostics/E015_unknown_team.mission"),
+        &mission,
+    )
+    .unwrap();
+    let out = semo(&[
+        "build",
+        &path_str(&mission),
+        "-o",
+        &path_str(&dir.join("out")),
+    ]);
+    assert_eq!(out.code, 1);
+    assert_eq!(out.stdout, "");
+    assert!(out.stderr.contains("[E015] Error"), "{}", out.stderr);
+    assert!(out.stderr.contains("refused"), "{}", out.stderr);
+    let out = semo(&[
+        "build",
+        &example("follow/follow.mission"),
+        "-o",
+        &path_str(&dir.join("out")),
+        "--emit",
+        "taskgraph",
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(out.stdout.contains("built 1 robot(s)"), "{}", out.stdout);
+    // simulate: a mission with errors is reported on stderr.
+    let scenario = dir.join("s.scenario.json");
+    std::fs::write(&scenario, SHORT_SCENARIO).unwrap();
+    let out = semo(&[
+        "simulate",
+        &path_str(&mission),
+        "--scenario",
+        &path_str(&scenario),
+    ]);
+    assert_eq!(out.code, 2);
+    assert_eq!(out.stdout, "");
+    assert!(out.stderr.contains("[E015] Error"), "{}", out.stderr);
+}
+
+/// One diagnostic of any command's JSON document, with exactly the fields
+/// docs/diagnostics-json.md lists.
+#[derive(serde::Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)]
+struct JsonDiagnostic {
+    code: Option<String>,
+    severity: String,
+    file: String,
+    start: JsonPosition,
+    end: JsonPosition,
+    message: String,
+    suggestion: Option<String>,
+    related: Vec<JsonRelated>,
+}
+
+#[derive(serde::Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)]
+struct JsonPosition {
+    line: u32,
+    column: u32,
+}
+
+#[derive(serde::Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)]
+struct JsonRelated {
+    file: String,
+    line: u32,
+    column: u32,
+    message: String,
+}
+
+/// A command's `--format json` output as the one document shape: its
+/// version, its command, its diagnostics (each in the one shape).
+fn document(stdout: &str, command: &str) -> (serde_json::Value, Vec<JsonDiagnostic>) {
+    assert_eq!(
+        stdout.lines().count(),
+        1,
+        "one document on one line: {stdout}"
+    );
+    let value: serde_json::Value = serde_json::from_str(stdout).expect(stdout);
+    assert_eq!(value["version"], 1, "{value}");
+    assert_eq!(value["command"], command, "{value}");
+    let diagnostics: Vec<JsonDiagnostic> =
+        serde_json::from_value(value["diagnostics"].clone()).expect("the one diagnostic shape");
+    (value, diagnostics)
+}
+
+#[test]
+fn every_commands_json_is_one_document_with_one_diagnostic_shape() {
+    let dir = scratch("json");
+    let codes =
+        |d: &[JsonDiagnostic]| -> Vec<String> { d.iter().filter_map(|d| d.code.clone()).collect() };
+    // check, with a related location.
+    let out = semo(&[
+        "check",
+        "--format",
+        "json",
+        &fixture_path("E090_strategy_robot_not_in_team"),
+    ]);
+    assert_eq!(out.code, 1);
+    let (_, diags) = document(&out.stdout, "check");
+    assert!(codes(&diags).contains(&"E090".to_string()));
+    assert!(diags.iter().any(|d| !d.related.is_empty()));
+    // build, refused, then done.
+    let mission = dir.join("bad.mission");
+    std::fs::copy(
+        repo_root().join("tests/fixtures/diagnostics/E015_unknown_team.mission"),
+        &mission,
+    )
+    .unwrap();
+    let out_dir = path_str(&dir.join("out"));
+    let out = semo(&[
+        "build",
+        "--format",
+        "json",
+        &path_str(&mission),
+        "-o",
+        &out_dir,
+    ]);
+    assert_eq!(out.code, 1);
+    let (value, diags) = document(&out.stdout, "build");
+    assert!(codes(&diags).contains(&"E015".to_string()));
+    assert_eq!(value["robots"], serde_json::json!([]));
+    let out = semo(&[
+        "build",
+        "--format",
+        "json",
+        &example("follow/follow.mission"),
+        "-o",
+        &out_dir,
+        "--emit",
+        "taskgraph",
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let (value, diags) = document(&out.stdout, "build");
+    assert!(diags.is_empty());
+    assert_eq!(value["robots"][0]["robot"], "create1");
+    // graph analyze and graph buffers, on a graph with an error.
+    let deadlock = example("taskgraphs/deadlock.taskgraph.xml");
+    let out = semo(&["graph", "analyze", "--format", "json", &deadlock]);
+    assert_eq!(out.code, 1);
+    let (value, diags) = document(&out.stdout, "graph analyze");
+    assert!(codes(&diags).contains(&"E071".to_string()));
+    assert!(value["levels"].is_array());
+    let out = semo(&["graph", "buffers", "--format", "json", &deadlock]);
+    assert_eq!(out.code, 1);
+    let (_, diags) = document(&out.stdout, "graph buffers");
+    assert!(codes(&diags).contains(&"E071".to_string()));
+    // simulate: a mission with errors, a bad scenario (no code), a run.
+    let scenario = dir.join("s.scenario.json");
+    std::fs::write(&scenario, SHORT_SCENARIO).unwrap();
+    let scenario = path_str(&scenario);
+    let out = semo(&[
+        "simulate",
+        "--format",
+        "json",
+        &path_str(&mission),
+        "--scenario",
+        &scenario,
+    ]);
+    assert_eq!(out.code, 2);
+    let (_, diags) = document(&out.stdout, "simulate");
+    assert!(codes(&diags).contains(&"E015".to_string()));
+    let bad = dir.join("bad.scenario.json");
+    std::fs::write(&bad, "{\"duration\": 100,}").unwrap();
+    let follow = example("follow/follow.mission");
+    let out = semo(&[
+        "simulate",
+        "--format",
+        "json",
+        &follow,
+        "--scenario",
+        &path_str(&bad),
+    ]);
+    assert_eq!(out.code, 2);
+    let (_, diags) = document(&out.stdout, "simulate");
+    assert_eq!(diags.len(), 1);
+    assert_eq!(diags[0].code, None);
+    assert_eq!((diags[0].start.line, diags[0].start.column), (1, 18));
+    let out = semo(&[
+        "simulate",
+        "--format",
+        "json",
+        &follow,
+        "--scenario",
+        &scenario,
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let (value, diags) = document(&out.stdout, "simulate");
+    assert!(diags.is_empty());
+    assert_eq!(value["ok"], true);
+}
+
+/// The official SARIF 2.1.0 schema (tests/data/sarif/README.md says where
+/// it comes from), compiled once per test.
+fn sarif_validator() -> jsonschema::Validator {
+    let text =
+        std::fs::read_to_string(repo_root().join("tests/data/sarif/sarif-schema-2.1.0.json"))
+            .unwrap();
+    let schema: serde_json::Value = serde_json::from_str(&text).unwrap();
+    // The schema is a draft-04 one; formats (`uri-reference`, …) checked.
+    jsonschema::draft4::options()
+        .should_validate_formats(true)
+        .build(&schema)
+        .expect("the SARIF schema compiles")
+}
+
+fn valid_sarif(validator: &jsonschema::Validator, stdout: &str) -> serde_json::Value {
+    let log: serde_json::Value = serde_json::from_str(stdout).expect(stdout);
+    let errors: Vec<String> = validator
+        .iter_errors(&log)
+        .map(|e| format!("{} at {}", e, e.instance_path()))
+        .collect();
+    assert!(errors.is_empty(), "{errors:#?}\n{log:#}");
+    log
+}
+
+#[test]
+fn sarif_output_validates_against_the_official_schema() {
+    let validator = sarif_validator();
+    // The schema is not a rubber stamp: a log without its version fails.
+    assert!(!validator.is_valid(&serde_json::json!({"runs": []})));
+    let results = |log: &serde_json::Value| log["runs"][0]["results"].as_array().unwrap().clone();
+
+    // Errors, warnings and hints, with related locations, in several files.
+    let fixtures = repo_root().join("tests/fixtures/diagnostics");
+    let args = [
+        "E090_strategy_robot_not_in_team",
+        "W009_catch_never_thrown.mission",
+        "E010_unknown_robot_type.mission",
+    ];
+    let mut command = vec!["check", "--format", "sarif"];
+    command.extend(args);
+    let out = semo_in_dir(&fixtures, &command);
+    assert_eq!(out.code, 1, "{}", out.stderr);
+    let log = valid_sarif(&validator, &out.stdout);
+    let mut json_command = vec!["check", "--format", "json"];
+    json_command.extend(args);
+    let json = semo_in_dir(&fixtures, &json_command);
+    let (_, diags) = document(&json.stdout, "check");
+    // The same findings as the JSON document, in the same order.
+    let found: Vec<(String, String, u64)> = results(&log)
+        .iter()
+        .map(|r| {
+            (
+                r["ruleId"].as_str().unwrap().to_string(),
+                r["level"].as_str().unwrap().to_string(),
+                r["locations"][0]["physicalLocation"]["region"]["startLine"]
+                    .as_u64()
+                    .unwrap(),
+            )
+        })
+        .collect();
+    let expected: Vec<(String, String, u64)> = diags
+        .iter()
+        .map(|d| {
+            let level = match d.severity.as_str() {
+                "hint" => "note",
+                other => other,
+            };
+            (
+                d.code.clone().unwrap(),
+                level.to_string(),
+                d.start.line as u64,
+            )
+        })
+        .collect();
+    assert_eq!(found, expected);
+    assert!(found.iter().any(|(_, level, _)| level == "note"));
+    assert!(
+        results(&log)
+            .iter()
+            .any(|r| r["relatedLocations"].is_array())
+    );
+    let rules = log["runs"][0]["tool"]["driver"]["rules"]
+        .as_array()
+        .unwrap();
+    assert!(rules.iter().any(|r| r["id"] == "E090"));
+
+    // Standard input (`<stdin>` is not a URI as it stands) and absolute paths.
+    let out = semo_with_stdin(
+        &repo_root(),
+        &["check", "--format", "sarif", "-"],
+        &fixture("E015_unknown_team.mission"),
+    );
+    assert_eq!(out.code, 1);
+    let log = valid_sarif(&validator, &out.stdout);
+    assert_eq!(
+        results(&log)[0]["locations"][0]["physicalLocation"]["artifactLocation"]["uri"],
+        "%3Cstdin%3E"
+    );
+    let out = semo(&[
+        "graph",
+        "analyze",
+        "--format",
+        "sarif",
+        &example("taskgraphs/deadlock.taskgraph.xml"),
+    ]);
+    assert_eq!(out.code, 1);
+    let log = valid_sarif(&validator, &out.stdout);
+    let uri = results(&log)[0]["locations"][0]["physicalLocation"]["artifactLocation"]["uri"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    assert!(uri.starts_with("file:///"), "{uri}");
+    // A clean build: a valid log with no results.
+    let dir = scratch("sarif");
+    let out = semo(&[
+        "build",
+        "--format",
+        "sarif",
+        &example("follow/follow.mission"),
+        "-o",
+        &path_str(&dir.join("out")),
+        "--emit",
+        "taskgraph",
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(results(&valid_sarif(&validator, &out.stdout)).is_empty());
+}
+
+fn semo_in_dir(dir: &std::path::Path, args: &[&str]) -> support::Output {
+    support::semo_in(dir, args)
+}
+
+#[test]
+fn every_file_argument_accepts_dash_for_standard_input() {
+    let root = repo_root();
+    let graph =
+        std::fs::read_to_string(root.join("examples/taskgraphs/consistent.taskgraph.xml")).unwrap();
+    let from_file = semo(&[
+        "graph",
+        "analyze",
+        "examples/taskgraphs/consistent.taskgraph.xml",
+    ]);
+    let from_stdin = semo_with_stdin(&root, &["graph", "analyze", "-"], &graph);
+    assert_eq!(from_stdin.code, 0, "{}", from_stdin.stderr);
+    assert_eq!(from_stdin.stdout, from_file.stdout);
+    for command in [
+        &["graph", "dot", "-"][..],
+        &["graph", "svg", "-"],
+        &["graph", "schedule", "-"],
+        &["graph", "buffers", "-"],
+    ] {
+        let file: Vec<&str> = command[..2]
+            .iter()
+            .copied()
+            .chain(["examples/taskgraphs/consistent.taskgraph.xml"])
+            .collect();
+        let expected = semo(&file);
+        let out = semo_with_stdin(&root, command, &graph);
+        assert_eq!(out.code, 0, "{command:?}: {}", out.stderr);
+        assert!(!out.stdout.is_empty(), "{command:?}");
+        assert_eq!(out.stdout, expected.stdout, "{command:?}");
+    }
+    // A graph's diagnostics name standard input.
+    let out = semo_with_stdin(
+        &root,
+        &["graph", "analyze", "--format", "json", "-"],
+        "<TaskGraph name=\"g\" xmlns=\"urn:semo:taskgraph:1\">\n  <Task/>\n</TaskGraph>\n",
+    );
+    assert_eq!(out.code, 1);
+    let (_, diags) = document(&out.stdout, "graph analyze");
+    assert!(diags.iter().all(|d| d.file == "<stdin>"), "{diags:?}");
+
+    let mission = std::fs::read_to_string(root.join("examples/follow/follow.mission")).unwrap();
+    let out = semo_with_stdin(&root, &["graph", "modes", "-"], &mission);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(out.stdout.contains("AUTO_MODE"), "{}", out.stdout);
+
+    // simulate: the mission or the scenario from standard input.
+    let dir = scratch("stdin");
+    let scenario = dir.join("s.scenario.json");
+    std::fs::write(&scenario, SHORT_SCENARIO).unwrap();
+    let from_file = semo(&[
+        "simulate",
+        "examples/follow/follow.mission",
+        "--scenario",
+        &path_str(&scenario),
+    ]);
+    assert_eq!(from_file.code, 0, "{}", from_file.stderr);
+    let out = semo_with_stdin(
+        &root,
+        &[
+            "simulate",
+            "examples/follow/follow.mission",
+            "--scenario",
+            "-",
+        ],
+        SHORT_SCENARIO,
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert_eq!(out.stdout, from_file.stdout);
+
+    // build and simulate read the mission's folder: one line says so.
+    let out_dir = path_str(&dir.join("out"));
+    for command in [
+        &["build", "-", "-o", &out_dir][..],
+        &["simulate", "-", "--scenario", &path_str(&scenario)],
+    ] {
+        let out = semo_with_stdin(&root, command, &mission);
+        assert_eq!(out.code, 2, "{command:?}");
+        assert_eq!(out.stdout, "", "{command:?}");
+        assert_eq!(out.stderr.lines().count(), 1, "{}", out.stderr);
+        assert!(out.stderr.contains("mission's folder"), "{}", out.stderr);
+    }
+    assert!(!dir.join("out").exists());
+}
+
+/// `semo ARGS` refuses a file of the wrong kind: exit 2, one line on
+/// stderr naming what the file is and what was wanted, nothing on stdout.
+fn refused(args: &[&str], is: &str, wanted: &str) {
+    let out = semo(args);
+    assert_eq!(out.code, 2, "{args:?}: {}{}", out.stdout, out.stderr);
+    assert_eq!(out.stdout, "", "{args:?}");
+    assert_eq!(out.stderr.lines().count(), 1, "{args:?}: {}", out.stderr);
+    assert!(
+        out.stderr.contains(&format!("is {is}, not {wanted}")),
+        "{args:?}: {}",
+        out.stderr
+    );
+}
+
+#[test]
+fn a_file_of_the_wrong_kind_is_refused_in_one_line_and_nothing_is_written() {
+    let dir = scratch("wrong_kind");
+    let graph = example("taskgraphs/kmeans.taskgraph.xml");
+    let mission = example("follow/follow.mission");
+    let catalog = example("patrol/robots/beacon.robot.xml");
+    let strategy = example("scouting/MasterTeam.strategy.xml");
+    let svg = dir.join("modes.svg");
+    refused(
+        &["graph", "modes", &graph, "-o", &path_str(&svg)],
+        "a task graph",
+        "a mission script",
+    );
+    assert!(!svg.exists());
+    for command in ["analyze", "dot", "svg", "schedule", "buffers"] {
+        refused(
+            &["graph", command, &mission],
+            "a mission script",
+            "a task graph",
+        );
+    }
+    refused(
+        &["graph", "analyze", &strategy],
+        "a strategy file",
+        "a task graph",
+    );
+    let out = dir.join("out");
+    refused(
+        &["build", &catalog, "-o", &path_str(&out)],
+        "a robot catalog",
+        "a mission script",
+    );
+    assert!(!out.exists());
+    // A mission given as the scenario.
+    let trace = dir.join("trace.jsonl");
+    refused(
+        &[
+            "simulate",
+            &mission,
+            "--scenario",
+            &mission,
+            "--trace",
+            &path_str(&trace),
+        ],
+        "a mission script",
+        "a scenario (JSON)",
+    );
+    assert!(!trace.exists());
+    refused(
+        &["simulate", &graph, "--scenario", &mission],
+        "a task graph",
+        "a mission script",
+    );
+    // `semo check` knows a file by its name: a name that lies is refused.
+    let lying = dir.join("graph.mission");
+    std::fs::copy(
+        repo_root().join("examples/taskgraphs/kmeans.taskgraph.xml"),
+        &lying,
+    )
+    .unwrap();
+    let out = semo(&["check", &path_str(&lying)]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert_eq!(out.stderr.lines().count(), 1, "{}", out.stderr);
+    assert!(
+        out.stderr
+            .contains("is a task graph, but its name makes it a mission script"),
+        "{}",
+        out.stderr
+    );
+    // XML of no known kind where XML is wanted is left to the reader, which
+    // points at the root element.
+    let odd = dir.join("odd.taskgraph.xml");
+    std::fs::write(&odd, "<TaskGrap name=\"g\"/>\n").unwrap();
+    let out = semo(&["graph", "analyze", &path_str(&odd)]);
+    assert_eq!(out.code, 1, "{}", out.stderr);
+    assert!(out.stderr.contains("[E061]"), "{}", out.stderr);
+}
+
+#[test]
+fn check_watch_checks_again_when_a_file_changes() {
+    use std::io::BufRead;
+    use std::process::Stdio;
+    use std::time::Duration;
+    let dir = scratch("watch");
+    let mission = dir.join("m.mission");
+    std::fs::copy(repo_root().join("examples/follow/follow.mission"), &mission).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_semo"))
+        .args(["check", "--watch", "--format", "json"])
+        .arg(&dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let stdout = child.stdout.take().unwrap();
+    let (lines, reports) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in std::io::BufReader::new(stdout).lines() {
+            if lines.send(line.unwrap()).is_err() {
+                break;
+            }
+        }
+    });
+    // Generous: the machine may be busy; this waits, it measures nothing.
+    let next = || reports.recv_timeout(Duration::from_secs(120));
+    let first = next().expect("the first report");
+    let (_, diags) = document(&first, "check");
+    assert!(diags.is_empty(), "{diags:?}");
+    std::fs::write(&mission, fixture("E015_unknown_team.mission")).unwrap();
+    let second = next().expect("a report after the change");
+    let (_, diags) = document(&second, "check");
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        diags.iter().any(|d| d.code.as_deref() == Some("E015")),
+        "{diags:?}"
+    );
+}
+
+/// One example of an explanation: its files (name, text) and the command
+/// it is checked with (`semo check` when it names none).
+#[derive(Default, Clone)]
+struct Example {
+    files: Vec<(String, String)>,
+    command: Option<Vec<String>>,
+}
+
+/// The `## Wrong` and `## Right` examples of `semo explain CODE`'s text:
+/// fenced blocks named by their file, and an optional `$ semo …` line.
+fn examples(text: &str) -> (Example, Example) {
+    let (mut wrong, mut right) = (Example::default(), Example::default());
+    let mut section: Option<&mut Example> = None;
+    let mut lines = text.lines();
+    while let Some(line) = lines.next() {
+        if line == "## Wrong" {
+            section = Some(&mut wrong);
+        } else if line == "## Right" {
+            section = Some(&mut right);
+        } else if let Some(example) = section.as_deref_mut() {
+            if let Some(command) = line.strip_prefix("$ semo ") {
+                example.command = Some(command.split(' ').map(str::to_string).collect());
+            } else if let Some(name) = line.strip_prefix("```").filter(|n| !n.is_empty()) {
+                let body: Vec<&str> = lines.by_ref().take_while(|l| *l != "```").collect();
+                example
+                    .files
+                    .push((name.to_string(), body.join("\n") + "\n"));
+            }
+        }
+    }
+    (wrong, right)
+}
+
+/// The codes an example's files give through the binary, in a fresh folder.
+fn codes_of(dir: &std::path::Path, example: &Example) -> Vec<String> {
+    let _ = std::fs::remove_dir_all(dir);
+    for (name, text) in &example.files {
+        let path = dir.join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, text).unwrap();
+    }
+    let out_dir = path_str(&dir.join("out"));
+    let args: Vec<String> = match &example.command {
+        None => ["check", "--format", "json", "."]
+            .map(String::from)
+            .to_vec(),
+        Some(command) => {
+            let mut args = command.clone();
+            args.extend(["--format", "json", "-o", &out_dir].map(String::from));
+            args
+        }
+    };
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = support::semo_in(dir, &args);
+    assert!(out.code <= 1, "{args:?}: {}{}", out.stdout, out.stderr);
+    let (_, diags) = document(&out.stdout, args[0]);
+    diags.into_iter().filter_map(|d| d.code).collect()
+}
+
+#[test]
+fn explain_gives_every_code_a_wrong_example_that_has_it_and_a_right_one_that_does_not() {
+    let scratch = scratch("explain");
+    for code in semo::diag::Code::ALL {
+        let code = code.as_str();
+        let out = semo(&["explain", code]);
+        assert_eq!(out.code, 0, "{code}");
+        assert!(
+            out.stdout.starts_with(&format!("{code} (")),
+            "{}",
+            out.stdout
+        );
+        let (wrong, mut right) = examples(&out.stdout);
+        assert!(!wrong.files.is_empty(), "{code}: no wrong example");
+        assert!(!right.files.is_empty(), "{code}: no right example");
+        // The right example shows the files it changes; the others are the
+        // wrong example's.
+        for (name, text) in &wrong.files {
+            if !right.files.iter().any(|(n, _)| n == name) {
+                right.files.push((name.clone(), text.clone()));
+            }
+        }
+        let dir = scratch.join(code);
+        let found = codes_of(&dir, &wrong);
+        assert!(
+            found.iter().any(|c| c == code),
+            "{code}: the wrong example gives {found:?}"
+        );
+        let found = codes_of(&dir, &right);
+        assert!(
+            !found.iter().any(|c| c == code),
+            "{code}: the right example gives {found:?}"
+        );
+    }
+    // Without a code: one line per code.
+    let all = semo(&["explain"]);
+    assert_eq!(all.stdout.lines().count(), semo::diag::Code::ALL.len());
 }

@@ -209,9 +209,9 @@ fn checking_a_mission_reads_the_catalog_beside_it() {
     assert_eq!(code, 0, "{}", listing(&problems));
     let out = semo_in(&root, &["check", "patrol/patrol.mission"]);
     assert!(
-        out.stdout.contains("checked 1 mission and 1 catalog file"),
+        out.stderr.contains("checked 1 mission and 1 catalog file"),
         "{}",
-        out.stdout
+        out.stderr
     );
 }
 

@@ -106,7 +106,7 @@ fn pipeline_holds(name: &str, seeds: std::ops::Range<u64>) {
         assert_eq!(
             checked.code, 0,
             "seed {seed}: the generator wrote a mission `semo check` refuses:\n{text}\n{}",
-            checked.stdout
+            checked.stderr
         );
         for target in TARGETS {
             let out = dir.join(target);

@@ -439,9 +439,9 @@ fn human_report_says_which_concurrency() {
 #[test]
 fn check_reads_an_explicitly_named_sdf3_file_as_a_task_graph() {
     let out = semo_in(&sdf3(), &["check", "modem.xml"]);
-    assert_eq!(out.code, 0, "{}", out.stdout);
+    assert_eq!(out.code, 0, "{}", out.stderr);
     assert_eq!(
-        out.stdout,
+        out.stderr,
         "checked 0 missions and 0 catalog files, 1 task graph: 0 errors, 0 warnings, 0 hints\n"
     );
 }

@@ -544,6 +544,55 @@ fn simulation_feeds_scenario_sensors_and_operator_commands() {
     }
 }
 
+/// `--start-at`: an instant ahead holds the start until then (no line of
+/// the trace before mission time 0); an instant passed starts the clock
+/// there, as for a robot restarted in a running mission.
+#[test]
+fn the_start_barrier_holds_the_start_and_a_passed_start_continues_mission_time() {
+    let p = program(Flavor::Plain {
+        cc: "gcc",
+        sim: false,
+    });
+    let unix_ms = || {
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_millis() as i64
+    };
+    let base = free_port_pair().to_string();
+    let run = |start_at: i64, duration: &str, name: &str| {
+        let trace = trace_path(
+            name,
+            Flavor::Plain {
+                cc: "gcc",
+                sim: false,
+            },
+        );
+        p.run_ok(&[
+            "minimal",
+            "--start-at",
+            &start_at.to_string(),
+            "--duration",
+            duration,
+            "--port-base",
+            &base,
+            "--trace",
+            trace.to_str().unwrap(),
+        ]);
+        read_trace(&trace, "solo")
+    };
+    let ahead = run(unix_ms() + 300, "50", "start-ahead");
+    assert_eq!(ahead[0]["event"], "start");
+    assert!(
+        ahead.iter().all(|e| e["t"].as_i64().unwrap() >= 0),
+        "{ahead:?}"
+    );
+    let passed = run(unix_ms() - 10_000, "10050", "start-passed");
+    assert_eq!(passed[0]["event"], "start");
+    assert!(passed[0]["t"].as_i64().unwrap() >= 10_000, "{passed:?}");
+    assert_eq!(passed.last().unwrap()["event"], "stop");
+}
+
 #[test]
 fn duration_is_in_mission_time_and_the_command_line_beats_the_scenario() {
     for flavor in flavors() {
@@ -647,6 +696,16 @@ fn bad_command_lines_are_refused_with_usage() {
     );
     refused(&["minimal", "--duration"], &[], "--duration needs a value");
     refused(
+        &["minimal", "--start-at", "soon"],
+        &[],
+        "--start-at must be a time in ms since 1970",
+    );
+    refused(
+        &["minimal"],
+        &[("SEMO_START_AT", "-1")],
+        "SEMO_START_AT must be a time in ms since 1970",
+    );
+    refused(
         &["minimal", "--duration", "-5"],
         &[],
         "whole number of milliseconds",
@@ -740,6 +799,35 @@ fn bad_scenarios_are_refused_with_line_and_column() {
         ),
         ("", "1:1: unexpected end of file"),
         ("{\"n\": 01}", "1:8: expected ',' or '}'"),
+        // Battery levels and faults, read by linux-sim as by the simulator.
+        (
+            "{\"robots\": {\"x\": {\"battery\": [{\"at\": 5, \"level\": 1}, {\"at\": 5, \"level\": 2}]}}}",
+            "1:61: battery levels must be in time order",
+        ),
+        (
+            "{\"robots\": {\"x\": {\"battery\": [{\"at\": 0, \"level\": \"full\"}]}}}",
+            "1:50: \"level\" must be a number",
+        ),
+        (
+            "{\"faults\": [{\"at\": 1}]}",
+            "1:13: a fault is exactly one of \"kill\", \"restart\", \"drop\", \"delay\", \"partition\"",
+        ),
+        (
+            "{\"faults\": [{\"at\": 1, \"kill\": \"nobody\"}]}",
+            "1:31: robot \"nobody\" is not in the mission",
+        ),
+        (
+            "{\"faults\": [{\"from\": 5, \"until\": 5, \"drop\": [\"solo\", \"solo\"]}]}",
+            "1:34: \"until\" must be after \"from\"",
+        ),
+        (
+            "{\"faults\": [{\"from\": 1, \"until\": 5, \"delay\": [\"solo\"], \"by\": 3}]}",
+            "1:46: \"delay\" must name two robots",
+        ),
+        (
+            "{\"faults\": [{\"from\": 1, \"until\": 5, \"partition\": [[\"solo\", 7]]}]}",
+            "1:60: \"partition\" must be a non-empty string",
+        ),
     ];
     for flavor in flavors().into_iter().filter(|f| f.sim()) {
         let p = program(flavor);

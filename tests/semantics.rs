@@ -70,8 +70,8 @@ fn a_received_value_needs_no_sensor_on_the_receiver() {
         "check",
         &fixture("received_value.mission").display().to_string(),
     ]);
-    assert_eq!(checked.code, 0, "{}{}", checked.stdout, checked.stderr);
-    assert!(!checked.stdout.contains("E033"), "{}", checked.stdout);
+    assert_eq!(checked.code, 0, "{}{}", checked.stderr, checked.stderr);
+    assert!(!checked.stderr.contains("E033"), "{}", checked.stderr);
     let out = scratch("semantics/received-value");
     let traces = run_in_simulation(
         &fixture("received_value.mission"),
@@ -96,8 +96,8 @@ fn a_value_sent_without_having_or_receiving_it_is_still_reported() {
             .display()
             .to_string(),
     ]);
-    assert_eq!(checked.code, 1, "{}", checked.stdout);
-    assert!(checked.stdout.contains("E033"), "{}", checked.stdout);
+    assert_eq!(checked.code, 1, "{}", checked.stderr);
+    assert!(checked.stderr.contains("E033"), "{}", checked.stderr);
 }
 
 #[test]

@@ -318,7 +318,7 @@ fn the_timeline_has_a_lane_per_robot_with_its_modes_and_services() {
         let line: usize = attr(band, "data-line").unwrap().parse().unwrap();
         let mode = attr(band, "data-mode").unwrap();
         let text = mission.lines().nth(line - 1).unwrap();
-        assert!(text.contains(&format!(".{mode}{{")), "line {line}: {text}");
+        assert!(text.contains(&format!(".{mode} {{")), "line {line}: {text}");
     }
     // Service bars point at their service's line.
     let bars = class("service");
@@ -328,7 +328,7 @@ fn the_timeline_has_a_lane_per_robot_with_its_modes_and_services() {
         let service = attr(bar, "data-service").unwrap();
         let text = mission.lines().nth(line - 1).unwrap();
         assert!(
-            text.contains(&format!(".{service}{{")),
+            text.contains(&format!(".{service} {{")),
             "line {line}: {text}"
         );
     }

@@ -1,7 +1,8 @@
 //! `semo build`: a mission, its strategy files and the catalog → one folder of
 //! C code (and the refined task graph) per robot.
 
-use super::render;
+use super::input::{self, Content};
+use super::output::{self, Format, Record};
 use semo::codegen::output::{OutputError, Transaction};
 use semo::codegen::{self, Emit, Target};
 use semo::host;
@@ -16,13 +17,30 @@ pub struct Options {
     /// Compiled into each robot (targets that need it: `cortex-m-sim`).
     pub scenario: Option<PathBuf>,
     pub emit: Emit,
+    pub format: Format,
     pub color: bool,
     /// Replace files in the way (saved to the backup folder first).
     pub force: bool,
 }
 
+const BUILD: &str = "semo build";
+
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let started = std::time::Instant::now();
+    if input::is_stdin(&options.mission) {
+        eprintln!(
+            "error: `semo build` reads the mission's folder (its catalog and strategy files, `out/` beside it): give the mission's file, not `-`"
+        );
+        return 2;
+    }
+    if !input::file_is_kind(&options.mission, Content::Mission, BUILD)
+        || options
+            .scenario
+            .as_deref()
+            .is_some_and(|s| !input::file_is_kind(s, Content::Scenario, BUILD))
+    {
+        return 2;
+    }
     if options.scenario.is_some() != options.target.needs_scenario() {
         eprintln!(
             "error: {}",
@@ -56,21 +74,38 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         None => codegen::build(&input, options.target, options.emit),
         Some(path) => match build_with_scenario(&input, path, &options) {
             Ok(result) => result,
-            Err(message) => {
+            Err(ScenarioError::Unreadable(message)) => {
                 eprintln!("{message}");
+                return 2;
+            }
+            Err(ScenarioError::Bad(record)) => {
+                report_scenario(&record, options.format, out);
                 return 2;
             }
         },
     };
     if result.refused() {
         run.diagnostics = result.diagnostics;
-        let _ = render::human(&run, options.color, out);
-        let _ = writeln!(
-            out,
-            "error: code generation refused: fix the errors above first"
-        );
+        let reported = match options.format {
+            Format::Human => super::render::human(&run, options.color, &mut std::io::stderr()),
+            format => output::report(
+                format,
+                "build",
+                &run.files,
+                &run.diagnostics,
+                options.color,
+                serde_json::json!({ "target": options.target.name(), "robots": [] }),
+                out,
+            ),
+        };
+        if let Err(code) = output::written(reported) {
+            return code;
+        }
+        eprintln!("error: code generation refused: fix the errors above first");
         return 1;
     }
+    let human = options.format == Format::Human;
+    let mut robots_json = Vec::new();
     let out_dir = options.out.clone().unwrap_or_else(|| {
         options
             .mission
@@ -92,7 +127,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         }
     };
     for line in &transaction.recovered {
-        let _ = writeln!(out, "recovered: {line}");
+        if human {
+            let _ = writeln!(out, "recovered: {line}");
+        } else {
+            eprintln!("recovered: {line}");
+        }
     }
     if !options.force {
         match transaction.conflicts(&result.robots, options.target) {
@@ -116,6 +155,17 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
                 } else {
                     100.0 * generated as f64 / (generated + user) as f64
                 };
+                robots_json.push(serde_json::json!({
+                    "team": robot.team,
+                    "robot": robot.robot,
+                    "folder": written.folder.display().to_string(),
+                    "generated_files": written.generated,
+                    "task_files_created": written.created,
+                    "task_files_kept": written.kept,
+                }));
+                if !human {
+                    continue;
+                }
                 let _ = writeln!(
                     out,
                     "{}/{}: {} ({} generated files; {} task files created, {} kept; {generated} lines generated, {user} in task files: {share:.0}% generated)",
@@ -143,6 +193,18 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             }
         }
     }
+    if !human {
+        let reported = output::report(
+            options.format,
+            "build",
+            &run.files,
+            &[],
+            options.color,
+            serde_json::json!({ "target": options.target.name(), "robots": robots_json }),
+            out,
+        );
+        return output::written(reported).err().unwrap_or(0);
+    }
     let _ = writeln!(
         out,
         "built {} robot(s) for target {} in {:.1} ms ({:.1} ms generating)",
@@ -154,15 +216,42 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     0
 }
 
+enum ScenarioError {
+    /// The file cannot be read (the message says why).
+    Unreadable(String),
+    /// The scenario has an error, at a position.
+    Bad(Box<Record>),
+}
+
+/// A scenario's error for people (`scenario FILE:LINE:COL: message`, on
+/// standard error) or in a JSON document or SARIF log.
+fn report_scenario(record: &Record, format: Format, out: &mut impl Write) {
+    let written = match format {
+        Format::Human => {
+            eprintln!(
+                "scenario {}:{}:{}: {}",
+                record.file, record.start.line, record.start.column, record.message
+            );
+            Ok(())
+        }
+        Format::Json => output::write_json(
+            out,
+            &output::json_document("build", std::slice::from_ref(record), serde_json::json!({})),
+        ),
+        Format::Sarif => output::write_json(out, &output::sarif(std::slice::from_ref(record))),
+    };
+    let _ = output::written(written);
+}
+
 /// Builds for a target that compiles the scenario in: the mission is refined
 /// first, since the scenario's names are checked against its programs.
 fn build_with_scenario(
     input: &codegen::BuildInput<'_>,
     path: &Path,
     options: &Options,
-) -> Result<codegen::BuildResult, String> {
-    let text =
-        semo::workspace::read_text(path).map_err(|e| format!("error: {}: {e}", path.display()))?;
+) -> Result<codegen::BuildResult, ScenarioError> {
+    let text = semo::workspace::read_text(path)
+        .map_err(|e| ScenarioError::Unreadable(format!("error: {}: {e}", path.display())))?;
     let refined = codegen::refine_checked(input);
     if refined.programs.is_empty() {
         // Refused: the mission's own errors come first.
@@ -176,7 +265,7 @@ fn build_with_scenario(
     }
     let scenario = semo::sim::scenario::parse(&text, &refined.programs).map_err(|e| {
         let (line, col) = e.line_col(&text);
-        format!("scenario {}:{line}:{col}: {}", path.display(), e.message)
+        ScenarioError::Bad(Box::new(Record::uncoded_error(path, line, col, e.message)))
     })?;
     let worlds: Vec<_> = refined
         .programs

@@ -2,6 +2,8 @@
 //! and deadlock freedom level by level with its diagnostics, its schedules,
 //! and pictures of it; `semo graph modes`: a mission's mode machines.
 
+use super::input::{self, Content};
+use super::output::{self, Format};
 use super::render;
 use semo::diag::Diagnostic;
 use semo::taskgraph::analysis::ratio::Ratio;
@@ -9,24 +11,26 @@ use semo::workspace::{
     FileKind, FileResolver, Files, GraphReading, GraphRun, analyze_graph, analyze_graph_as,
 };
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-fn read(path: &Path) -> Option<String> {
-    match semo::workspace::read_text(path) {
-        Ok(text) => Some(text),
-        Err(e) => {
-            eprintln!("error: {}: {e}", path.display());
-            None
-        }
-    }
+/// The graph file at `path` (`-`: standard input) when it holds a task
+/// graph, with the name reports give it; otherwise a message is printed.
+fn read(path: &Path, command: &str) -> Option<(PathBuf, String)> {
+    let (name, text) = input::read(path)?;
+    input::is_kind(&name, &text, Content::TaskGraph, command).then_some((name, text))
 }
 
 /// The graph file at `path` read (a message on failure) and analysed with
-/// `reading`; its sub-graph references are read from the disk.
-fn read_and_analyze(path: &Path, reading: GraphReading) -> Option<(Files, GraphRun)> {
-    let text = read(path)?;
+/// `reading`; its sub-graph references are read from the disk (beside the
+/// file, or from the current folder for standard input).
+fn read_and_analyze(
+    path: &Path,
+    reading: GraphReading,
+    command: &str,
+) -> Option<(Files, GraphRun)> {
+    let (name, text) = read(path, command)?;
     let mut files = Files::default();
-    let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
+    let id = files.add(name, FileKind::TaskGraph, text);
     let file = files.get(id);
     let run = analyze_graph_as(
         id,
@@ -40,12 +44,12 @@ fn read_and_analyze(path: &Path, reading: GraphReading) -> Option<(Files, GraphR
 
 /// The graph in `path` when it loads without errors; otherwise the errors
 /// are printed and the exit code given.
-fn load_clean(path: &Path) -> Result<semo::taskgraph::TaskGraph, i32> {
-    let Some(text) = read(path) else {
+fn load_clean(path: &Path, command: &str) -> Result<semo::taskgraph::TaskGraph, i32> {
+    let Some((name, text)) = read(path, command) else {
         return Err(2);
     };
     let mut files = Files::default();
-    let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
+    let id = files.add(name, FileKind::TaskGraph, text);
     let (graph, diagnostics) = semo::taskgraph::load_task_graph(id, &files.get(id).text);
     let errors: Vec<Diagnostic> = diagnostics
         .into_iter()
@@ -62,7 +66,7 @@ fn load_clean(path: &Path) -> Result<semo::taskgraph::TaskGraph, i32> {
 
 /// `semo graph dot`: the DOT text, or the loading errors (exit 1).
 pub fn dot(path: &Path, out: &mut impl Write) -> i32 {
-    match load_clean(path) {
+    match load_clean(path, "semo graph dot") {
         Ok(g) => {
             let _ = out.write_all(semo::taskgraph::dot::to_dot(&g).as_bytes());
             0
@@ -74,7 +78,7 @@ pub fn dot(path: &Path, out: &mut impl Write) -> i32 {
 /// `semo graph svg`: the SVG picture on `out` or in `output`, with the cycles
 /// that deadlock marked, or the loading errors (exit 1).
 pub fn svg(path: &Path, output: Option<&Path>, out: &mut impl Write) -> i32 {
-    let graph = match load_clean(path) {
+    let graph = match load_clean(path, "semo graph svg") {
         Ok(g) => g,
         Err(code) => return code,
     };
@@ -86,18 +90,33 @@ pub fn svg(path: &Path, output: Option<&Path>, out: &mut impl Write) -> i32 {
     )
 }
 
+const MODES: &str = "semo graph modes";
+
+/// The mission `semo graph modes` draws, checked; `None` when it cannot be
+/// read or is not a mission (the reason printed).
+fn load_mission(path: &Path) -> Option<semo::host::CheckRun> {
+    if input::is_stdin(path) {
+        let (name, text) = input::read(path)?;
+        return input::is_kind(&name, &text, Content::Mission, MODES)
+            .then(|| semo::host::load_check_stdin(text));
+    }
+    if !input::file_is_kind(path, Content::Mission, MODES) {
+        return None;
+    }
+    semo::host::load_check(&[path.to_path_buf()])
+        .map_err(|e| eprintln!("error: {e}"))
+        .ok()
+}
+
 /// `semo graph modes`: the mode machines of a mission, checked as `semo check
-/// FILE` checks it (against the catalog files it sees), all teams or `team`.
+/// FILE` checks it (against the catalog files it sees; standard input
+/// against the built-in catalog alone), all teams or `team`.
 /// Errors in the mission or what it reads do not stop the drawing: what was
 /// understood is drawn, the errors are on stderr and the exit code is 1. An
 /// unknown team is a usage error (2).
 pub fn modes(path: &Path, team: Option<&str>, output: Option<&Path>, out: &mut impl Write) -> i32 {
-    let run = match semo::host::load_check(&[path.to_path_buf()]) {
-        Ok(run) => run,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
+    let Some(run) = load_mission(path) else {
+        return 2;
     };
     let analysis = run
         .checked
@@ -157,23 +176,42 @@ fn write_picture(picture: &str, output: Option<&Path>, out: &mut impl Write) -> 
 pub fn analyze(
     path: &Path,
     reading: GraphReading,
-    json: bool,
+    format: Format,
     color: bool,
     out: &mut impl Write,
 ) -> i32 {
-    let Some((files, run)) = read_and_analyze(path, reading) else {
+    let Some((files, run)) = read_and_analyze(path, reading, "semo graph analyze") else {
         return 2;
     };
-    let written = if json {
-        write_json(&files, &run, out)
-    } else {
-        write_human(&files, &run, color, out)
+    let written = match format {
+        Format::Human => render::diagnostics(
+            &files,
+            &run.diagnostics,
+            color,
+            &mut std::io::stderr().lock(),
+        )
+        .and_then(|()| write_human(&run, out)),
+        Format::Json => output::report(
+            format,
+            "graph analyze",
+            &files,
+            &run.diagnostics,
+            color,
+            analysis_json(&run),
+            out,
+        ),
+        Format::Sarif => output::report(
+            format,
+            "graph analyze",
+            &files,
+            &run.diagnostics,
+            color,
+            serde_json::Value::Null,
+            out,
+        ),
     };
-    if let Err(e) = written
-        && e.kind() != std::io::ErrorKind::BrokenPipe
-    {
-        eprintln!("error: cannot write the report: {e}");
-        return 2;
+    if let Err(code) = output::written(written) {
+        return code;
     }
     if run.diagnostics.iter().any(Diagnostic::is_error) {
         1
@@ -182,13 +220,8 @@ pub fn analyze(
     }
 }
 
-fn write_human(
-    files: &Files,
-    run: &semo::workspace::GraphRun,
-    color: bool,
-    out: &mut impl Write,
-) -> std::io::Result<()> {
-    render::diagnostics(files, &run.diagnostics, color, out)?;
+/// The analysis for people (its diagnostics went to standard error).
+fn write_human(run: &semo::workspace::GraphRun, out: &mut impl Write) -> std::io::Result<()> {
     if !run.report.levels.is_empty() {
         let meaning = match run.report.concurrency {
             semo::taskgraph::analysis::Concurrency::Auto => {
@@ -251,11 +284,8 @@ fn write_human(
     Ok(())
 }
 
-fn write_json(
-    files: &Files,
-    run: &semo::workspace::GraphRun,
-    out: &mut impl Write,
-) -> std::io::Result<()> {
+/// The analysis's own fields of the JSON document.
+fn analysis_json(run: &semo::workspace::GraphRun) -> serde_json::Value {
     let levels: Vec<serde_json::Value> = run
         .report
         .levels
@@ -288,28 +318,23 @@ fn write_json(
             })
         })
         .collect();
-    let diagnostics: Vec<serde_json::Value> = run
-        .diagnostics
-        .iter()
-        .map(|d| render::json_value(files, d))
-        .collect();
-    let value = serde_json::json!({
+    serde_json::json!({
         "graph": run.graph.as_ref().map(|g| g.name.clone()),
         "concurrency": run.report.concurrency.as_str(),
         "looped_schedule": run.report.looped_schedule,
         "levels": levels,
-        "diagnostics": diagnostics,
-    });
-    writeln!(out, "{value}")
+    })
 }
 
 /// `semo graph schedule`: the looped schedule of the whole graph, and with
 /// `cores` a list schedule of each level's iteration onto that many cores.
 pub fn schedule(path: &Path, cores: Option<usize>, out: &mut impl Write) -> i32 {
     use semo::taskgraph::analysis::{hierarchy_levels, schedule};
-    let Some(text) = read(path) else { return 2 };
+    let Some((name, text)) = read(path, "semo graph schedule") else {
+        return 2;
+    };
     let mut files = Files::default();
-    let id = files.add(path.to_path_buf(), FileKind::TaskGraph, text);
+    let id = files.add(name, FileKind::TaskGraph, text);
     let run = analyze_graph(files.get(id), &mut FileResolver::new(&files));
     let Some(graph) = run
         .graph
@@ -407,7 +432,7 @@ pub fn buffers(
             return 2;
         }
     };
-    let Some((files, run)) = read_and_analyze(path, reading) else {
+    let Some((files, run)) = read_and_analyze(path, reading, "semo graph buffers") else {
         return 2;
     };
     let live = run
@@ -420,7 +445,19 @@ pub fn buffers(
         .as_ref()
         .filter(|_| live && !run.diagnostics.iter().any(Diagnostic::is_error))
     else {
-        let _ = render::diagnostics(&files, &run.diagnostics, false, &mut std::io::stderr());
+        let format = if json { Format::Json } else { Format::Human };
+        let reported = output::report(
+            format,
+            "graph buffers",
+            &files,
+            &run.diagnostics,
+            false,
+            serde_json::json!({}),
+            out,
+        );
+        if let Err(code) = output::written(reported) {
+            return code;
+        }
         eprintln!(
             "error: {}: the buffers of a graph with errors cannot be sized",
             path.display()
@@ -534,7 +571,7 @@ fn buffers_json(
             .map(|(e, cap)| (e.label.clone(), serde_json::json!(cap)))
             .collect::<serde_json::Map<_, _>>()
     });
-    let value = serde_json::json!({
+    let data = serde_json::json!({
         "concurrency": concurrency.as_str(),
         "max_period": found.max_period.to_string(),
         "points": points,
@@ -549,5 +586,5 @@ fn buffers_json(
             "channels": channels,
         })),
     });
-    writeln!(out, "{value}")
+    output::write_json(out, &output::json_document("graph buffers", &[], data))
 }

@@ -5,10 +5,14 @@
 mod build;
 mod fmt;
 mod graph;
+mod input;
+mod output;
 mod render;
 mod simulate;
+mod watch;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use output::Format;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 
@@ -48,9 +52,9 @@ enum Command {
     Check {
         /// Files or folders to check (`-`: a mission on standard input).
         paths: Vec<PathBuf>,
-        /// How to print diagnostics: `human` (source snippets) or `json` (one
-        /// object per line: code, severity, file, start/end line and column,
-        /// message, suggestion).
+        /// How to report: `human` (source snippets and a summary, on standard
+        /// error), `json` (one document on standard output, see
+        /// docs/diagnostics-json.md) or `sarif` (SARIF 2.1.0, for code scanning).
         #[arg(long, value_enum, default_value_t = Format::Human)]
         format: Format,
         /// Colour the human output: `auto` colours it when writing to a terminal.
@@ -60,6 +64,10 @@ enum Command {
         /// warning exit with 1.
         #[arg(long, value_enum, value_name = "WHAT")]
         deny: Vec<Deny>,
+        /// Check again whenever a mission, catalog, strategy or task-graph
+        /// file under the paths changes, until stopped.
+        #[arg(long)]
+        watch: bool,
     },
     /// Rewrite mission scripts in the canonical layout.
     #[command(
@@ -99,7 +107,8 @@ enum Command {
         target, stops generation with its name unless --force (which saves it first)."
     )]
     Build {
-        /// The mission script.
+        /// The mission script (a file: its folder holds the catalog and
+        /// strategy files it reads, so not `-`).
         mission: PathBuf,
         /// More strategy (and catalog) files or folders to read.
         #[arg(long)]
@@ -128,6 +137,11 @@ enum Command {
         /// refined task graphs).
         #[arg(long, value_enum, default_value_t = EmitArg::All)]
         emit: EmitArg,
+        /// `human` (what was written, on standard output; diagnostics on
+        /// standard error), `json` (one document: diagnostics and the robots
+        /// written) or `sarif` (the diagnostics).
+        #[arg(long, value_enum, default_value_t = Format::Human)]
+        format: Format,
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
         /// Replace files generation would otherwise refuse to (generated
@@ -149,9 +163,10 @@ enum Command {
         (mission errors, a bad scenario, options)."
     )]
     Simulate {
-        /// The mission script.
+        /// The mission script (a file: its folder holds the catalog and
+        /// strategy files it reads, so not `-`).
         mission: PathBuf,
-        /// The scenario file (`*.scenario.json`).
+        /// The scenario file (`*.scenario.json`; `-`: standard input).
         #[arg(long)]
         scenario: PathBuf,
         /// More strategy (and catalog) files or folders to read.
@@ -185,7 +200,8 @@ enum Command {
         #[arg(long)]
         stdio: bool,
     },
-    /// Explain a diagnostic code (e.g. `semo explain E019`), or list them all.
+    /// Explain a diagnostic code (e.g. `semo explain E019`): what it means,
+    /// a wrong and a right example; with no code, list them all.
     Explain {
         /// A code such as E019; all codes when omitted.
         code: Option<String>,
@@ -197,9 +213,11 @@ enum GraphCommand {
     /// Consistency (repetition vector per level) and deadlock freedom of a
     /// task graph, with diagnostics on the channel concerned.
     Analyze {
-        /// A `*.taskgraph.xml` file or an SDF3 graph (`<sdf3 type="sdf">`).
+        /// A `*.taskgraph.xml` file or an SDF3 graph (`<sdf3 type="sdf">`;
+        /// `-`: standard input).
         file: PathBuf,
-        /// `human` or `json` (one object: levels and diagnostics).
+        /// `human` (diagnostics on standard error, the analysis on standard
+        /// output), `json` (one document: diagnostics and levels) or `sarif`.
         #[arg(long, value_enum, default_value_t = Format::Human)]
         format: Format,
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
@@ -211,7 +229,7 @@ enum GraphCommand {
     /// graph (`A 10(B C) D`), and with `--cores N` each level's iteration
     /// scheduled onto N cores (task@start time).
     Schedule {
-        /// A `*.taskgraph.xml` file or an SDF3 graph.
+        /// A `*.taskgraph.xml` file or an SDF3 graph (`-`: standard input).
         file: PathBuf,
         /// Also schedule each level onto this many cores.
         #[arg(long)]
@@ -222,29 +240,29 @@ enum GraphCommand {
     /// the smallest total size reaching the maximal throughput (exact, or
     /// between stated bounds), and the channel sizes of a chosen point.
     Buffers {
-        /// A `*.taskgraph.xml` file or an SDF3 graph.
+        /// A `*.taskgraph.xml` file or an SDF3 graph (`-`: standard input).
         file: PathBuf,
         /// The point whose channel sizes are listed: `max` (the maximal
         /// throughput) or a throughput in iterations per time unit (`1/104`,
         /// `0.0096`): the smallest point found reaching at least it.
         #[arg(long, default_value = "max")]
         throughput: String,
-        /// `human` or `json`.
-        #[arg(long, value_enum, default_value_t = Format::Human)]
-        format: Format,
+        /// `human` or `json` (one document: diagnostics and the trade-off).
+        #[arg(long, value_enum, default_value_t = DataFormat::Human)]
+        format: DataFormat,
         #[command(flatten)]
         reading: ReadingArgs,
     },
     /// Print the graph in Graphviz DOT: tasks, loop nodes as clusters, rates
     /// and initial samples on channels (`semo graph dot g.taskgraph.xml | dot -Tsvg`).
     Dot {
-        /// A `*.taskgraph.xml` file or an SDF3 graph.
+        /// A `*.taskgraph.xml` file or an SDF3 graph (`-`: standard input).
         file: PathBuf,
     },
     /// Draw the graph as SVG, without Graphviz: tasks, loop nodes as
     /// clusters, rates and initial samples on channels.
     Svg {
-        /// A `*.taskgraph.xml` file or an SDF3 graph.
+        /// A `*.taskgraph.xml` file or an SDF3 graph (`-`: standard input).
         file: PathBuf,
         /// Write the SVG to this file instead of standard output.
         #[arg(short, long, value_name = "FILE")]
@@ -254,7 +272,8 @@ enum GraphCommand {
     /// mode marked, and the mode changes of its `main` labelled with their
     /// events.
     Modes {
-        /// A mission script (`*.mission`).
+        /// A mission script (`*.mission`; `-`: standard input, checked
+        /// against the built-in catalog alone).
         file: PathBuf,
         /// Draw only this team.
         #[arg(long, value_name = "TEAM")]
@@ -307,7 +326,7 @@ enum ConcurrencyArg {
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
-enum Format {
+enum DataFormat {
     Human,
     Json,
 }
@@ -351,13 +370,19 @@ fn run() -> i32 {
             format,
             color,
             deny,
-        } => check(
-            paths,
-            format,
-            use_color(color),
-            deny.contains(&Deny::Warnings),
-            &mut out,
-        ),
+            watch,
+        } => {
+            let (color, deny) = (use_color(color), deny.contains(&Deny::Warnings));
+            if watch {
+                watch::run(&paths, || {
+                    let code = check(paths.clone(), format, color, deny, &mut out);
+                    let _ = out.flush();
+                    code
+                })
+            } else {
+                check(paths, format, color, deny, &mut out)
+            }
+        }
         Command::Fmt {
             paths,
             check,
@@ -375,13 +400,7 @@ fn run() -> i32 {
             format,
             color,
             reading,
-        }) => graph::analyze(
-            &file,
-            reading.reading(),
-            format == Format::Json,
-            use_color(color),
-            &mut out,
-        ),
+        }) => graph::analyze(&file, reading.reading(), format, use_color(color), &mut out),
         Command::Graph(GraphCommand::Dot { file }) => graph::dot(&file, &mut out),
         Command::Graph(GraphCommand::Svg { file, output }) => {
             graph::svg(&file, output.as_deref(), &mut out)
@@ -401,7 +420,7 @@ fn run() -> i32 {
             &file,
             reading.reading(),
             &throughput,
-            format == Format::Json,
+            format == DataFormat::Json,
             &mut out,
         ),
         Command::Build {
@@ -411,6 +430,7 @@ fn run() -> i32 {
             target,
             scenario,
             emit,
+            format,
             color,
             force,
         } => build::run(
@@ -424,6 +444,7 @@ fn run() -> i32 {
                     EmitArg::All => semo::codegen::Emit::All,
                     EmitArg::Taskgraph => semo::codegen::Emit::TaskGraph,
                 },
+                format,
                 color: use_color(color),
                 force,
             },
@@ -484,7 +505,7 @@ fn use_color(choice: ColorChoice) -> bool {
         var("NO_COLOR").is_some(),
         var("CLICOLOR_FORCE").is_some_and(|v| v != "0"),
         std::env::var_os("TERM").is_some_and(|t| t == "dumb"),
-        std::io::stdout().is_terminal(),
+        std::io::stderr().is_terminal(),
     )
 }
 
@@ -517,6 +538,9 @@ fn check(
     } else {
         paths
     };
+    if !paths.iter().all(|p| input::named_file_fits_its_name(p)) {
+        return 2;
+    }
     let loaded = if paths.iter().any(|p| p.as_os_str() == "-") {
         if paths.len() > 1 {
             eprintln!(
@@ -524,7 +548,7 @@ fn check(
             );
             return 2;
         }
-        read_stdin().map(semo::host::load_check_stdin)
+        input::read_stdin().map(semo::host::load_check_stdin)
     } else {
         semo::host::load_check(&paths).map_err(|e| e.to_string())
     };
@@ -536,17 +560,20 @@ fn check(
         }
     };
     let written = match format {
-        Format::Human => render::human(&run, color, out),
-        Format::Json => render::json(&run, out),
+        // The report for people, summary included, is diagnostics: stderr.
+        Format::Human => render::human(&run, color, &mut std::io::stderr().lock()),
+        _ => output::report(
+            format,
+            "check",
+            &run.files,
+            &run.diagnostics,
+            color,
+            serde_json::json!({}),
+            out,
+        ),
     };
-    match written {
-        // The reader went away (`semo check | head`): not a problem to report.
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
-        Err(e) => {
-            eprintln!("error: cannot write the report: {e}");
-            return 2;
-        }
-        Ok(()) => {}
+    if let Err(code) = output::written(written) {
+        return code;
     }
     let warnings = run
         .diagnostics
@@ -563,25 +590,6 @@ fn check(
     }
 }
 
-/// All of standard input as text (at most the limit any input file has).
-fn read_stdin() -> Result<String, String> {
-    use std::io::Read;
-    let limit = semo::fsread::MAX_FILE_BYTES;
-    let mut bytes = Vec::new();
-    std::io::stdin()
-        .lock()
-        .take(limit + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot read standard input: {e}"))?;
-    if bytes.len() as u64 > limit {
-        return Err(format!(
-            "standard input is larger than {limit} bytes, the most a mission may be"
-        ));
-    }
-    // As for files: invalid UTF-8 is replaced, and then reported where it is.
-    Ok(String::from_utf8_lossy(&bytes).into_owned())
-}
-
 fn explain(code: Option<&str>, out: &mut impl Write) -> i32 {
     use semo::diag::Code;
     let codes: Vec<Code> = match code {
@@ -594,6 +602,7 @@ fn explain(code: Option<&str>, out: &mut impl Write) -> i32 {
             }
         },
     };
+    let full = code.is_some();
     for code in codes {
         let _ = writeln!(
             out,
@@ -601,6 +610,10 @@ fn explain(code: Option<&str>, out: &mut impl Write) -> i32 {
             code.default_severity(),
             code.summary()
         );
+        // One code: its whole explanation, with a wrong and a right example.
+        if full {
+            let _ = write!(out, "\n{}", code.explanation());
+        }
     }
     0
 }

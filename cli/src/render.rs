@@ -1,11 +1,9 @@
-//! Rendering diagnostics for people (ariadne snippets) and for programs (JSON
-//! lines). Positions become 1-based lines and columns here, columns counted in
-//! characters.
+//! Rendering diagnostics for people: ariadne snippets and `semo check`'s
+//! summary line (machine shapes are in `output`).
 
 use ariadne::{Color, Config, IndexType, Label, Report, ReportKind};
 use semo::diag::{Diagnostic, Severity};
 use semo::host::CheckRun;
-use semo::text::ColumnUnit;
 use semo::workspace::Files;
 use std::io::{self, Write};
 
@@ -152,45 +150,4 @@ pub fn human(run: &CheckRun, colored: bool, out: &mut impl Write) -> io::Result<
         plural(count(Severity::Warning), "warning"),
         plural(count(Severity::Hint), "hint"),
     )
-}
-
-/// One diagnostic as a JSON object (the `--format json` line).
-pub fn json_value(files: &Files, d: &Diagnostic) -> serde_json::Value {
-    let file = files.get(d.file);
-    let position = |offset: usize| {
-        let lc = file.lines.line_col(&file.text, offset, ColumnUnit::Char);
-        serde_json::json!({ "line": lc.line + 1, "column": lc.col + 1 })
-    };
-    let related: Vec<serde_json::Value> = d
-        .related
-        .iter()
-        .map(|r| {
-            let rf = files.get(r.file);
-            let lc = rf.lines.line_col(&rf.text, r.span.start, ColumnUnit::Char);
-            serde_json::json!({
-                "file": rf.path.display().to_string(),
-                "line": lc.line + 1,
-                "column": lc.col + 1,
-                "message": r.message,
-            })
-        })
-        .collect();
-    serde_json::json!({
-        "code": d.code.as_str(),
-        "severity": d.severity.as_str(),
-        "file": file.path.display().to_string(),
-        "start": position(d.span.start),
-        "end": position(d.span.end),
-        "message": d.message,
-        "suggestion": d.suggestion,
-        "related": related,
-    })
-}
-
-pub fn json(run: &CheckRun, out: &mut impl Write) -> io::Result<()> {
-    for d in &run.diagnostics {
-        let value = json_value(&run.files, d);
-        writeln!(out, "{value}")?;
-    }
-    Ok(())
 }

@@ -3,9 +3,9 @@
 //! the scenario's expectations judged. Exit status: 0 every expectation
 //! holds, 1 one fails, 2 bad input (mission errors, a bad scenario, options).
 
-use super::render;
+use super::input::{self, Content};
+use super::output::{self, Format, Record};
 use semo::sim::{self, scenario};
-use semo::workspace;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -42,7 +42,23 @@ pub fn parse_duration(text: &str) -> Result<i64, String> {
         .ok_or_else(|| format!("`{text}` is not a positive mission time such as 10min or 500ms"))
 }
 
+const SIMULATE: &str = "semo simulate";
+
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
+    let format = if options.json {
+        Format::Json
+    } else {
+        Format::Human
+    };
+    if input::is_stdin(&options.mission) {
+        eprintln!(
+            "error: `semo simulate` reads the mission's folder (its catalog and strategy files): give the mission's file, not `-` (the scenario may be `-`)"
+        );
+        return 2;
+    }
+    if !input::file_is_kind(&options.mission, Content::Mission, SIMULATE) {
+        return 2;
+    }
     let (mut check, mission) = match semo::host::load_build(&options.mission, &options.strategy) {
         Ok(loaded) => loaded,
         Err(e) => {
@@ -50,13 +66,12 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     };
-    let scenario_text = match workspace::read_text(&options.scenario) {
-        Ok(text) => text,
-        Err(e) => {
-            eprintln!("error: {}: {e}", options.scenario.display());
-            return 2;
-        }
+    let Some((scenario_name, scenario_text)) = input::read(&options.scenario) else {
+        return 2;
     };
+    if !input::is_kind(&scenario_name, &scenario_text, Content::Scenario, SIMULATE) {
+        return 2;
+    }
     let Some(build) = check.analysis().build_input(mission) else {
         eprintln!("internal error: the mission was loaded but not checked");
         return 2;
@@ -64,7 +79,21 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let refined = semo::codegen::refine_checked(&build.input());
     if refined.diagnostics.iter().any(|d| d.is_error()) {
         check.diagnostics = refined.diagnostics;
-        let _ = render::human(&check, options.color, &mut std::io::stderr());
+        let reported = match format {
+            Format::Human => {
+                super::render::human(&check, options.color, &mut std::io::stderr().lock())
+            }
+            _ => output::report(
+                format,
+                "simulate",
+                &check.files,
+                &check.diagnostics,
+                options.color,
+                serde_json::json!({}),
+                out,
+            ),
+        };
+        let _ = output::written(reported);
         eprintln!("error: cannot simulate: fix the errors above first");
         return 2;
     }
@@ -73,11 +102,21 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         Ok(s) => s,
         Err(e) => {
             let (line, col) = e.line_col(&scenario_text);
-            eprintln!(
-                "scenario {}:{line}:{col}: {}",
-                options.scenario.display(),
-                e.message
-            );
+            let record = Record::uncoded_error(&scenario_name, line, col, e.message);
+            if format == Format::Human {
+                eprintln!(
+                    "scenario {}:{line}:{col}: {}",
+                    scenario_name.display(),
+                    record.message
+                );
+            } else {
+                let document = output::json_document(
+                    "simulate",
+                    std::slice::from_ref(&record),
+                    serde_json::json!({}),
+                );
+                let _ = output::written(output::write_json(out, &document));
+            }
             return 2;
         }
     };
@@ -153,14 +192,14 @@ fn json_summary(run: &sim::Run, verdicts: &[sim::Verdict]) -> String {
             })
         })
         .collect();
-    let mut text = serde_json::json!({
+    let data = serde_json::json!({
         "end_ms": run.end_ms,
         "events": run.events,
         "robots": robots,
         "expectations": expectations,
         "ok": verdicts.iter().all(|v| v.met),
-    })
-    .to_string();
+    });
+    let mut text = output::json_document("simulate", &[], data).to_string();
     text.push('\n');
     text
 }

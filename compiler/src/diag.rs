@@ -60,6 +60,17 @@ macro_rules! codes {
             pub fn from_code(code: &str) -> Option<Code> {
                 match code { $($code => Some(Code::$variant),)* _ => None }
             }
+
+            /// The full explanation (`semo explain CODE`): what the code
+            /// means and why, then a `## Wrong` and a `## Right` example,
+            /// each one or more files in fenced blocks whose info string is
+            /// the file name. One file per code, `diag/explain/CODE.md`: a
+            /// code without one does not compile.
+            pub fn explanation(self) -> &'static str {
+                match self {
+                    $(Code::$variant => include_str!(concat!("diag/explain/", $code, ".md")),)*
+                }
+            }
         }
     };
 }

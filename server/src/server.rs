@@ -439,7 +439,20 @@ impl LanguageServer for Backend {
         let config = CompletionConfig {
             snippets: self.snippets.load(Ordering::Relaxed),
         };
-        self.on_query(&p.text_document_position.text_document.uri, move |s, w| {
+        let uri = &p.text_document_position.text_document.uri;
+        let scenario = handlers::scenario::job(&self.state.world(), uri);
+        if let Some(job) = scenario {
+            return tokio::task::spawn_blocking(move || {
+                Some(handlers::scenario::completion(&job, position))
+            })
+            .await
+            .map_err(|e| Error {
+                code: tower_lsp_server::jsonrpc::ErrorCode::InternalError,
+                message: format!("the request failed: {e}").into(),
+                data: None,
+            });
+        }
+        self.on_query(uri, move |s, w| {
             handlers::completion::completion(s, w, position, config)
         })
         .await

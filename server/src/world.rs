@@ -179,6 +179,9 @@ pub struct World {
     host: AnalysisHost,
     /// Frees replaced snapshots (the shared one; tests give their own).
     dropper: Dropper,
+    /// Open scenario files (`*.scenario.json`): no part of any analysis,
+    /// kept for their editor features (`handlers::scenario`).
+    scenarios: HashMap<Uri, Document>,
 }
 
 /// What a change did, so the caller knows which files to re-check.
@@ -276,8 +279,17 @@ impl World {
         self.host.analysis()
     }
 
+    /// The text of an open scenario file.
+    pub fn scenario_text(&self, uri: &Uri) -> Option<String> {
+        self.scenarios.get(uri).map(|d| d.rope.to_string())
+    }
+
     /// The client opened a document.
     pub fn open(&mut self, uri: Uri, language_id: &str, text: &str, version: i32) -> Changed {
+        if is_scenario(&uri) {
+            self.scenarios.insert(uri, Document::new(text, version));
+            return Changed::default();
+        }
         let Some(kind) = World::kind_of(&uri, Some(language_id)) else {
             return Changed::default();
         };
@@ -295,6 +307,10 @@ impl World {
         changes: Vec<TextDocumentContentChangeEvent>,
     ) -> Changed {
         let encoding = self.encoding;
+        if let Some(scenario) = self.scenarios.get_mut(uri) {
+            scenario.apply(changes, version, encoding);
+            return Changed::default();
+        }
         let Some(entry) = self.files.get_mut(uri) else {
             return Changed::default();
         };
@@ -310,6 +326,9 @@ impl World {
     /// The client closed a document: it falls back to its text on disk if it
     /// is in the workspace, else it is forgotten.
     pub fn close(&mut self, uri: &Uri) -> Changed {
+        if self.scenarios.remove(uri).is_some() {
+            return Changed::default();
+        }
         let Some(entry) = self.files.get(uri) else {
             return Changed::default();
         };
@@ -541,6 +560,11 @@ pub fn read_roots(roots: &[PathBuf]) -> Vec<(Uri, Option<String>)> {
         }
     }
     found
+}
+
+/// Whether a URI names a scenario file (by its name, whatever the scheme).
+fn is_scenario(uri: &Uri) -> bool {
+    semo::sim::complete::is_scenario(Path::new(uri.path().as_str()))
 }
 
 /// Where a `file:` URI's file is; `None` for other schemes (an unsaved

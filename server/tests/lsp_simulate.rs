@@ -172,3 +172,73 @@ async fn a_mission_outside_the_workspace_roots_is_simulated() {
     assert_eq!(answer["ok"], true, "{}", answer["summary"]);
     client.shutdown().await;
 }
+
+/// Completion in a scenario file offers the names of the mission beside it
+/// (`scouting.scenario.json` belongs to `scouting.mission`), as the editor has
+/// it: a mode renamed in the open mission is offered at an expectation's mode.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_scenario_completes_the_names_of_its_mission() {
+    let dir = workspace("complete");
+    let mut client = semo_server::harness::TestClient::start();
+    client.initialize_with(json!({}), Some(&uri(&dir))).await;
+    let mission_uri = uri(&dir.join("scouting.mission"));
+    let text = std::fs::read_to_string(dir.join("scouting.mission")).unwrap();
+    client
+        .open(&mission_uri, &text.replace("WAIT_MODE", "PAUSE_MODE"))
+        .await;
+    let diagnostics = client.diagnostics(&mission_uri, Some(1)).await;
+    assert!(
+        diagnostics.iter().all(|d| d["severity"] != 1),
+        "{diagnostics:?}"
+    );
+
+    let scenario = "{\n  \"expect\": [\n    {\"robot\": \"irobot\", \"enters\": \"PA\"}\n  ]\n}\n";
+    let complete = async |client: &mut semo_server::harness::TestClient, name: &str| {
+        let scenario_uri = uri(&dir.join(name));
+        client
+            .notify(
+                "textDocument/didOpen",
+                json!({ "textDocument": {
+                    "uri": scenario_uri, "languageId": "json", "version": 1, "text": scenario
+                }}),
+            )
+            .await;
+        // The cursor after `"PA`.
+        let position = json!({"line": 2, "character": 37});
+        client
+            .request(
+                "textDocument/completion",
+                json!({"textDocument": {"uri": scenario_uri}, "position": position}),
+            )
+            .await
+            .unwrap()
+    };
+    let answer = complete(&mut client, "scouting.scenario.json").await;
+    let labels: Vec<&str> = answer["items"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| i["label"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        labels,
+        [
+            "RC_MODE",
+            "AUTO_MODE",
+            "PAUSE_MODE",
+            "RETURN_MODE",
+            "FINISH"
+        ]
+    );
+    // The edit replaces the string's contents, quotes kept.
+    assert_eq!(
+        answer["items"][2]["textEdit"],
+        json!({"range": {"start": {"line": 2, "character": 35}, "end": {"line": 2, "character": 37}},
+               "newText": "PAUSE_MODE"})
+    );
+    assert_eq!(answer["items"][2]["kind"], 20); // EnumMember
+
+    // No mission is named `other.mission`: nothing to offer.
+    let answer = complete(&mut client, "other.scenario.json").await;
+    assert_eq!(answer["items"], json!([]));
+}

@@ -148,6 +148,28 @@ local function run()
     'no diagnostic on the scenario')
   local failed = vim.diagnostic.get(scenario)[1]
   report(string.format('scenario diagnostic: %d:%d %s', failed.lnum + 1, failed.col + 1, failed.message))
+
+  -- 7. The scenario file (filetype json) gets the server, and completion of an expectation's
+  -- mode offers the modes of its mission (drive.scenario.json belongs to drive.mission).
+  vim.cmd('edit ' .. vim.fn.fnameescape(workspace .. '/drive.scenario.json'))
+  local sbuf = vim.api.nvim_get_current_buf()
+  check(vim.wait(30000, function() return semo_clients(sbuf) == 1 end, 50), 'the scenario has no server')
+  local sline = vim.api.nvim_buf_get_lines(sbuf, 2, 3, false)[1]
+  vim.api.nvim_win_set_cursor(0, { 3, sline:find('MOVING', 1, true) - 1 })
+  local sresponses = vim.lsp.buf_request_sync(sbuf, 'textDocument/completion',
+    vim.lsp.util.make_position_params(), 10000)
+  check(sresponses ~= nil, 'no scenario completion within 10 s')
+  local modes_offered = {}
+  for _, response in pairs(sresponses) do
+    local result = response.result or {}
+    for _, item in ipairs(result.items or result) do
+      table.insert(modes_offered, item.label)
+    end
+  end
+  table.sort(modes_offered)
+  report('scenario completion at `"enters": "`: ' .. table.concat(modes_offered, ' '))
+  check(vim.tbl_contains(modes_offered, 'MOVING') and vim.tbl_contains(modes_offered, 'IDLE'),
+    'expected the modes of drive.mission')
 end
 
 local ok, err = pcall(run)

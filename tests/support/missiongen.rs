@@ -560,3 +560,77 @@ impl Generator<'_> {
 fn seed_bit(i: usize) -> bool {
     i % 2 == 0
 }
+
+/// A random scenario for a generated mission's `robots` (its robot names):
+/// each robot's battery falling over the run (the `BATTERY` value the
+/// missions compare), and link faults (drop, delay, partition) over
+/// intervals of the run, each decided by `seed`. Faults start after
+/// `settle_ms` (the processes' start-up) and end before `duration`.
+pub fn scenario(
+    seed: u64,
+    robots: &[String],
+    duration: i64,
+    settle_ms: i64,
+    time_scale: f64,
+) -> String {
+    let mut rng = Rng::new(seed ^ 0xFA17);
+    let ms = |rng: &mut Rng, from: i64, until: i64| {
+        from + (rng.next() % (until - from).max(1) as u64) as i64 / 10 * 10
+    };
+    let mut worlds = Vec::new();
+    for robot in robots {
+        let start = 20 + rng.below(81);
+        let end = rng.below(start);
+        let at = ms(&mut rng, settle_ms, duration);
+        worlds.push(format!(
+            r#""{robot}": {{"battery": [{{"at": 0, "level": {start}}}, {{"at": {at}, "level": {end}}}]}}"#
+        ));
+    }
+    let mut faults = Vec::new();
+    let interval = |rng: &mut Rng| {
+        let from = ms(rng, settle_ms, duration - 400);
+        (from, ms(rng, from + 100, duration))
+    };
+    if robots.len() >= 2 {
+        let pair = |rng: &mut Rng| {
+            let a = rng.below(robots.len());
+            let b = (a + 1 + rng.below(robots.len() - 1)) % robots.len();
+            (&robots[a], &robots[b])
+        };
+        if rng.chance(60) {
+            let ((a, b), (from, until)) = (pair(&mut rng), interval(&mut rng));
+            faults.push(format!(
+                r#"{{"from": {from}, "until": {until}, "drop": ["{a}", "{b}"]}}"#
+            ));
+        }
+        if rng.chance(60) {
+            let ((a, b), (from, until)) = (pair(&mut rng), interval(&mut rng));
+            let by = 50 + 50 * rng.below(6);
+            faults.push(format!(
+                r#"{{"from": {from}, "until": {until}, "delay": ["{a}", "{b}"], "by": {by}}}"#
+            ));
+        }
+        if rng.chance(40) {
+            let (from, until) = interval(&mut rng);
+            let (mut one, mut other) = (Vec::new(), Vec::new());
+            for robot in robots {
+                // Some robots in no group: cut off from every group.
+                match rng.below(5) {
+                    0 => {}
+                    1 | 2 => one.push(format!("\"{robot}\"")),
+                    _ => other.push(format!("\"{robot}\"")),
+                }
+            }
+            faults.push(format!(
+                r#"{{"from": {from}, "until": {until}, "partition": [[{}], [{}]]}}"#,
+                one.join(", "),
+                other.join(", ")
+            ));
+        }
+    }
+    format!(
+        "{{\"time_scale\": {time_scale}, \"duration\": {duration},\n \"robots\": {{{}}},\n \"faults\": [{}]}}\n",
+        worlds.join(",\n  "),
+        faults.join(",\n  ")
+    )
+}

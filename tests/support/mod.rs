@@ -61,12 +61,17 @@ pub fn semo_with_stdin(dir: &Path, args: &[&str], input: &str) -> Output {
         .stderr(Stdio::piped())
         .spawn()
         .expect("the semo binary runs");
-    child
+    // A command may end without reading its input (a usage error): a
+    // broken pipe here is its answer, not the test's failure.
+    match child
         .stdin
         .take()
         .expect("stdin is piped")
         .write_all(input.as_bytes())
-        .expect("write stdin");
+    {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {}
+        written => written.expect("write stdin"),
+    }
     let out = child.wait_with_output().expect("semo finishes");
     Output {
         code: out.status.code().unwrap_or(-1),
@@ -91,12 +96,16 @@ pub struct Diag {
     pub suggestion: Option<String>,
 }
 
-pub fn parse_json_lines(stdout: &str) -> Vec<Diag> {
-    stdout
-        .lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|line| {
-            let v: serde_json::Value = serde_json::from_str(line).expect("each line is JSON");
+/// The diagnostics of a `--format json` document (docs/diagnostics-json.md).
+pub fn parse_json_report(stdout: &str) -> Vec<Diag> {
+    let document: serde_json::Value =
+        serde_json::from_str(stdout).expect("the output is one JSON document");
+    assert_eq!(document["version"], 1, "{document}");
+    document["diagnostics"]
+        .as_array()
+        .expect("a diagnostics array")
+        .iter()
+        .map(|v| {
             let pos = |key: &str| {
                 (
                     v[key]["line"].as_u64().expect("line"),
@@ -127,7 +136,7 @@ pub fn check_json_in(dir: &Path, paths: &[&str]) -> (i32, Vec<Diag>) {
         out.code,
         out.stderr
     );
-    (out.code, parse_json_lines(&out.stdout))
+    (out.code, parse_json_report(&out.stdout))
 }
 
 /// A compact, readable listing for snapshots: `file:line:col-line:col CODE severity: message`.

@@ -91,6 +91,21 @@ pub fn robot_command(folder: &Path, scenario: &Path, trace: &Path, port_base: u3
     command
 }
 
+/// The start barrier of a run of `robots` programs: mission time 0 is a
+/// moment far enough ahead for every one of them to have started and opened
+/// its port (`--start-at`, Unix ms), so that they start together and no
+/// first message is lost; also the same moment on this process's clock.
+pub fn start_barrier(robots: usize) -> (std::time::Instant, u64) {
+    let lead = std::time::Duration::from_millis(300 + 100 * robots as u64);
+    let unix = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .expect("the clock is after 1970");
+    (
+        std::time::Instant::now() + lead,
+        (unix + lead).as_millis() as u64,
+    )
+}
+
 pub fn has(program: &str) -> bool {
     Command::new(program).arg("--version").output().is_ok()
 }
@@ -128,10 +143,12 @@ pub fn run_in_simulation(
     let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed) % 10;
     let port_base = 24000 + (std::process::id() % 200) * 40 + run * 4;
     let mut children = Vec::new();
+    let (_, start_at) = start_barrier(folders.len());
     for folder in folders {
         let robot = folder.file_name().unwrap().to_string_lossy().into_owned();
         let trace = out.join(format!("{robot}.jsonl"));
         let child = robot_command(&folder, &scenario_path, &trace, port_base)
+            .args(["--start-at", &start_at.to_string()])
             .stderr(std::process::Stdio::piped())
             .spawn()
             .expect("the robot program starts");

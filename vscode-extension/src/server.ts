@@ -18,6 +18,8 @@ export const DOCUMENT_SELECTOR = [
   { language: 'xml', pattern: '**/*.strategy.xml' },
   { language: 'xml', pattern: '**/*.robot.xml' },
   { language: 'xml', pattern: '**/*.taskgraph.xml' },
+  // Scenario files: completion of the names of their mission.
+  { language: 'json', pattern: '**/*.scenario.json' },
 ];
 
 function isExecutable(file: string): boolean {

@@ -11,10 +11,13 @@
 //! - `trace.rs`: trace events, written as `linux-sim` writes them.
 //! - `expect.rs`: expectations judged on the trace.
 //! - `svg.rs`: the timeline picture.
+//! - `complete.rs`: completion in scenario files, and which mission a
+//!   scenario belongs to.
 //!
 //! Nothing reads the wall clock; a run is a function of the programs, the
 //! scenario and the seed.
 
+pub mod complete;
 mod engine;
 pub mod expect;
 mod json;

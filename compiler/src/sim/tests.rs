@@ -10,7 +10,7 @@ fn repo(path: &str) -> std::path::PathBuf {
 }
 
 /// The refined programs of an example mission, as `semo simulate` gets them.
-fn programs(mission: &str) -> Vec<RobotProgram> {
+pub(super) fn programs(mission: &str) -> Vec<RobotProgram> {
     let (run, id) = crate::host::load_build(&repo(mission), &[]).unwrap();
     let build = run
         .analysis()

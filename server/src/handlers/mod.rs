@@ -16,6 +16,7 @@ pub mod inlay_hints;
 pub mod prepare_rename;
 pub mod references;
 pub mod rename;
+pub mod scenario;
 pub mod selection_range;
 pub mod semantic_tokens;
 pub mod signature_help;

@@ -39,6 +39,21 @@ void semo__deliver(const semo_message *msg);
 #define SEMO_TIME_SCALE_MAX 1e6
 
 #if defined(SEMO_SIM) && !defined(SEMO_STATIC)
+#include <pthread.h>
+
+/* A condition variable on the runtime's clock, and a wait on it until woken
+ * or mission time `deadline_ms` (< 0: no limit). */
+void semo__cond_init(pthread_cond_t *cond);
+void semo__cond_wait_until(pthread_cond_t *cond, pthread_mutex_t *lock, int64_t deadline_ms);
+/* The scenario's link faults on a message from this robot to `peer` sent
+ * now: false when it is lost, else the extra delay (ms, 0: none). */
+bool semo__sim_link(size_t peer, int64_t *delay_ms);
+/* Sends `data` to `peer` through `transport` `delay_ms` from now. */
+void semo__sim_send_later(const semo_transport *transport, size_t peer, const void *data, size_t len,
+                          int64_t delay_ms);
+/* Whether the scenario has link faults touching this robot (they need a
+ * transport that sends to each robot). */
+bool semo__sim_has_link_faults(void);
 /* Reads the scenario for `program->robot`; on error prints
  * "scenario FILE:LINE:COL: message" and returns -1. */
 int semo__sim_load(const char *path, const semo_program_desc *program);

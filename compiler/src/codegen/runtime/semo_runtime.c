@@ -109,6 +109,18 @@ static void wait_until(pthread_cond_t *cond, pthread_mutex_t *lock, int64_t dead
     }
 }
 
+#ifdef SEMO_SIM
+void semo__cond_init(pthread_cond_t *cond)
+{
+    init_cond(cond);
+}
+
+void semo__cond_wait_until(pthread_cond_t *cond, pthread_mutex_t *lock, int64_t deadline_ms)
+{
+    wait_until(cond, lock, deadline_ms);
+}
+#endif
+
 bool semo__wait_until(int64_t deadline_ms)
 {
     pthread_mutex_lock(&g_run_lock);
@@ -716,6 +728,15 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
         sent++;
         if (g_transport->send_to)
             continue; /* one message for all of them, below */
+#ifdef SEMO_SIM
+        int64_t delay_ms;
+        if (!semo__sim_link(i, &delay_ms))
+            continue; /* a link fault of the scenario loses it */
+        if (delay_ms > 0) {
+            semo__sim_send_later(g_transport, i, datagram, len, delay_ms);
+            continue;
+        }
+#endif
         if (g_transport->send(i, datagram, len) != 0) {
             semo_trace("comm_error", "to", p->robot, "key", key, NULL);
             return -1;
@@ -829,12 +850,17 @@ typedef struct {
     const char *scenario;
     double time_scale;
     bool time_scale_given;
+    long start_at_ms; /* --start-at: Unix ms of mission time 0; 0: when the program starts */
 } options;
+
+/* The latest --start-at (the year 2096): keeps the clock's arithmetic in 64 bits. */
+#define START_AT_MAX 4000000000000L
 
 static void usage(FILE *f, const char *prog)
 {
     fprintf(f,
             "usage: %s [--trace FILE] [--transport udp|mqtt] [--port-base N] [--broker URL] [--duration MS]"
+            " [--start-at UNIX_MS]"
 #ifdef SEMO_SIM
             " [--scenario FILE] [--time-scale X]"
 #endif
@@ -844,6 +870,8 @@ static void usage(FILE *f, const char *prog)
             "  --port-base N     udp: robot i uses UDP port N+i on 127.0.0.1 (default %d, or $SEMO_PORT_BASE)\n"
             "  --broker URL      mqtt: the broker, mqtt://HOST[:PORT] (default " DEFAULT_BROKER ", or $SEMO_BROKER)\n"
             "  --duration MS     stop after MS mission milliseconds (0: run until stopped)\n"
+            "  --start-at T      mission time 0 is the wall-clock instant T (ms since 1970, or $SEMO_START_AT):\n"
+            "                    robots given the same T start together; a T passed continues its mission time\n"
 #ifdef SEMO_SIM
             "  --scenario FILE   the simulation scenario (JSON)\n"
             "  --time-scale X    wall ms per mission ms (0.1: ten times faster; default 1)\n"
@@ -921,6 +949,11 @@ static int parse_options(int argc, char **argv, options *o)
         fprintf(stderr, "%s: SEMO_PORT_BASE must be a port number from 1 to %ld, not \"%s\"\n", prog, max_base, env);
         return 2;
     }
+    env = getenv("SEMO_START_AT");
+    if (env && *env && !parse_long(env, 1, START_AT_MAX, &o->start_at_ms)) {
+        fprintf(stderr, "%s: SEMO_START_AT must be a time in ms since 1970, not \"%s\"\n", prog, env);
+        return 2;
+    }
     env = getenv("SEMO_TRANSPORT");
     if (!parse_transport(prog, env && *env ? env : DEFAULT_TRANSPORT, &o->transport))
         return 2;
@@ -934,7 +967,7 @@ static int parse_options(int argc, char **argv, options *o)
             return 1;
         }
         static const char *const names[] = {"--trace",      "--port-base", "--duration", "--scenario",
-                                            "--time-scale", "--transport", "--broker"};
+                                            "--time-scale", "--transport", "--broker",  "--start-at"};
         size_t which = sizeof names / sizeof names[0];
         const char *value = NULL;
         for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
@@ -1001,6 +1034,12 @@ static int parse_options(int argc, char **argv, options *o)
         case 6:
             if (!parse_broker(prog, value, o))
                 return 2;
+            break;
+        case 7:
+            if (!parse_long(value, 1, START_AT_MAX, &o->start_at_ms)) {
+                fprintf(stderr, "%s: --start-at must be a time in ms since 1970, not \"%s\"\n", prog, value);
+                return 2;
+            }
             break;
         }
     }
@@ -1173,6 +1212,26 @@ static void trace_dropped_samples(void)
 }
 
 /* Starts everything, waits for the end, stops everything; 0 or 1. */
+/* Mission time 0: now, or the wall-clock instant `start_at_ms` (Unix ms),
+ * as a monotonic instant (in the future: the start barrier; in the past: a
+ * restarted robot continues its mission's time). */
+static void start_clock(long start_at_ms)
+{
+    clock_gettime(CLOCK_MONOTONIC, &g_t0);
+    if (start_at_ms <= 0)
+        return;
+    struct timespec real;
+    clock_gettime(CLOCK_REALTIME, &real);
+    long long ahead_ns = ((long long)start_at_ms - (long long)real.tv_sec * 1000LL) * 1000000LL - real.tv_nsec;
+    long long t0_ns = (long long)g_t0.tv_nsec + ahead_ns % 1000000000LL;
+    g_t0.tv_sec += (time_t)(ahead_ns / 1000000000LL) + (time_t)(t0_ns / 1000000000LL);
+    g_t0.tv_nsec = (long)(t0_ns % 1000000000LL);
+    if (g_t0.tv_nsec < 0) {
+        g_t0.tv_nsec += 1000000000L;
+        g_t0.tv_sec -= 1;
+    }
+}
+
 static int run(const options *o)
 {
     const semo_program_desc *p = g_prog;
@@ -1190,7 +1249,7 @@ static int run(const options *o)
     pthread_sigmask(SIG_BLOCK, &g_signals, &old_mask);
     atomic_store(&g_signal_thread_done, false);
 
-    clock_gettime(CLOCK_MONOTONIC, &g_t0);
+    start_clock(o->start_at_ms);
     atomic_store(&g_running, true);
     /* A robot alone in its mission has no one to hear from: no port, no receiver. */
     if (p->peer_count > 1) {
@@ -1205,10 +1264,21 @@ static int run(const options *o)
             goto stop;
         }
         g_transport = o->transport;
+#ifdef SEMO_SIM
+        if (o->transport->send_to && semo__sim_has_link_faults()) {
+            fprintf(stderr, "semo runtime: the scenario's link faults need a transport that sends to each robot (udp)\n");
+            status = 1;
+            goto stop;
+        }
+#endif
     }
+    signals_started = start_thread(&signals, signal_thread, NULL);
+    /* The start barrier: the transport is open (a robot's messages reach the
+     * others from the first), the clock starts at the agreed instant. */
+    if (!semo__wait_until(0))
+        goto stop;
     semo_trace("start", "team", p->team, "type", p->robot_type ? p->robot_type : "", "mission",
                p->mission ? p->mission : "", NULL);
-    signals_started = start_thread(&signals, signal_thread, NULL);
     for (; initialized < p->task_count; initialized++)
         if (p->tasks[initialized].init)
             p->tasks[initialized].init();

@@ -1,10 +1,16 @@
 /* semo_sim.c: the simulated platform (built only with -DSEMO_SIM).
  *
- * A scenario file gives, per robot, timed sensor values and service
- * durations, and the operator's commands. Sensor tasks read the latest
- * value; operator commands are delivered into the message queue at their
- * time by one thread. The scenario is read once, before any task runs, by a
- * small strict JSON reader that reports the line and column of a mistake.
+ * A scenario file gives, per robot, timed sensor values, battery levels and
+ * service durations, the operator's commands, and faults. Sensor tasks read
+ * the latest value (BATTERY, when no entry names it, the battery level at
+ * that time); operator commands are delivered into the message queue at
+ * their time by one thread. Link faults (drop, delay, partition) act on the
+ * send path: semo_comm_send asks semo__sim_link for each robot it sends to,
+ * and a delayed datagram is sent by a second thread at its time. Kill and
+ * restart faults happen to the process from outside (a crash is not
+ * something a program does to itself); they are checked here. The scenario
+ * is read once, before any task runs, by a small strict JSON reader that
+ * reports the line and column of a mistake.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -385,6 +391,20 @@ typedef struct {
 } service_entry;
 
 typedef struct {
+    int64_t at;
+    double level;
+} battery_entry;
+
+/* A link fault that touches this robot: its messages to the peers marked in
+ * `peers` (sent in [from, until)) are lost, or `by` ms late. */
+typedef enum { LINK_LOST, LINK_DELAYED } link_effect;
+typedef struct {
+    link_effect effect;
+    int64_t from, until, by;
+    bool *peers; /* per peer of the program */
+} link_fault;
+
+typedef struct {
     int64_t next, every, until; /* every == 0: once, at `next` */
     bool done;
     char key[64];
@@ -401,6 +421,10 @@ static struct {
     size_t service_count;
     command_entry *commands;
     size_t command_count;
+    battery_entry *battery;
+    size_t battery_count;
+    link_fault *links;
+    size_t link_count;
 } g_sim;
 
 static pthread_t g_operator;
@@ -499,13 +523,44 @@ static bool read_sensor(reader *r, const json *v, bool keep)
     return true;
 }
 
+/* "battery": levels {"at", "level"} in time order (the sensor value BATTERY). */
+static bool read_battery(reader *r, const json *v, bool keep)
+{
+    static const char *const keys[] = {"at", "level", NULL};
+    if (!want(r, v, J_ARRAY, "an array of battery levels {\"at\", \"level\"}"))
+        return false;
+    int64_t last = -1;
+    for (size_t i = 0; i < v->count; i++) {
+        const json *entry = &v->items[i], *at, *level;
+        battery_entry e;
+        if (!want(r, entry, J_OBJECT, "a battery level {\"at\", \"level\"}") ||
+            !known_keys(r, entry, keys, "a battery level") || !require(r, entry, "at", &at) ||
+            !require(r, entry, "level", &level) || !want_ms(r, at, "at", 0, &e.at))
+            return false;
+        if (e.at <= last)
+            return fail_at(r, at->line, at->col, "battery levels must be in time order");
+        last = e.at;
+        if (level->kind != J_NUMBER)
+            return fail_at(r, level->line, level->col, "\"level\" must be a number");
+        e.level = level->number;
+        if (keep) {
+            if (!grow(r, (void **)&g_sim.battery, g_sim.battery_count, sizeof e))
+                return false;
+            g_sim.battery[g_sim.battery_count++] = e;
+        }
+    }
+    return true;
+}
+
 static bool read_robot(reader *r, const json *v, bool keep)
 {
-    static const char *const keys[] = {"sensors", "services", "battery", NULL}; /* battery: the simulator's */
-    if (!want(r, v, J_OBJECT, "a robot {\"sensors\": [...], \"services\": {...}}") ||
+    static const char *const keys[] = {"sensors", "services", "battery", NULL};
+    if (!want(r, v, J_OBJECT, "a robot {\"sensors\": [...], \"services\": {...}, \"battery\": [...]}") ||
         !known_keys(r, v, keys, "a robot"))
         return false;
-    const json *sensors = member(v, "sensors"), *services = member(v, "services");
+    const json *sensors = member(v, "sensors"), *services = member(v, "services"), *battery = member(v, "battery");
+    if (battery && !read_battery(r, battery, keep))
+        return false;
     if (sensors) {
         if (!want(r, sensors, J_ARRAY, "an array of sensor entries"))
             return false;
@@ -567,18 +622,127 @@ static bool read_command(reader *r, const json *v, const semo_program_desc *prog
     return true;
 }
 
+/* The peer index of robot `v` (a name of the mission), or an error at it. */
+static bool want_robot(reader *r, const json *v, const char *key, const semo_program_desc *program, size_t *out)
+{
+    char name[64];
+    if (!want_name(r, v, key, NAME_MAX_BYTES, name))
+        return false;
+    for (size_t i = 0; i < program->peer_count; i++)
+        if (strcmp(program->peers[i].robot, name) == 0) {
+            *out = i;
+            return true;
+        }
+    return fail_at(r, v->line, v->col, "robot \"%s\" is not in the mission", name);
+}
+
+static bool want_interval(reader *r, const json *v, int64_t *from, int64_t *until)
+{
+    const json *f, *u;
+    if (!require(r, v, "from", &f) || !want_ms(r, f, "from", 0, from) || !require(r, v, "until", &u) ||
+        !want_ms(r, u, "until", 0, until))
+        return false;
+    if (*until <= *from)
+        return fail_at(r, u->line, u->col, "\"until\" must be after \"from\"");
+    return true;
+}
+
+/* One fault. Only link faults touching this robot are kept, as the peers
+ * whose messages from it they affect (the simulator's Sim::link). */
+static bool read_fault(reader *r, const json *v, const semo_program_desc *program)
+{
+    static const char *const keys[] = {"at", "kill", "restart", "drop", "delay", "by", "partition", "from", "until",
+                                       NULL};
+    static const char *const kinds[] = {"kill", "restart", "drop", "delay", "partition"};
+    if (!want(r, v, J_OBJECT, "a fault {\"kill\"|\"restart\"|\"drop\"|\"delay\"|\"partition\", ...}") ||
+        !known_keys(r, v, keys, "a fault"))
+        return false;
+    int kind = -1, given = 0;
+    for (int k = 0; k < 5; k++)
+        if (member(v, kinds[k])) {
+            kind = k;
+            given++;
+        }
+    if (given != 1)
+        return fail_at(r, v->line, v->col,
+                       "a fault is exactly one of \"kill\", \"restart\", \"drop\", \"delay\", \"partition\"");
+    const json *what = member(v, kinds[kind]), *at;
+    size_t robot;
+    int64_t ms;
+    if (kind <= 1) /* kill, restart: done to the process from outside */
+        return want_robot(r, what, kinds[kind], program, &robot) && require(r, v, "at", &at) &&
+               want_ms(r, at, "at", 0, &ms);
+    link_fault f = {.effect = kind == 3 ? LINK_DELAYED : LINK_LOST};
+    if (!want_interval(r, v, &f.from, &f.until))
+        return false;
+    if (kind == 3) {
+        const json *by;
+        if (!require(r, v, "by", &by) || !want_ms(r, by, "by", 0, &f.by))
+            return false;
+    }
+    f.peers = calloc(program->peer_count ? program->peer_count : 1, sizeof *f.peers);
+    if (!f.peers)
+        return FAIL(r, "out of memory");
+    bool touches = false;
+    if (kind != 4) { /* drop, delay: between two robots, both directions */
+        size_t a, b;
+        bool ok = want(r, what, J_ARRAY, "two robot names") &&
+                  (what->count == 2 || fail_at(r, what->line, what->col, "\"%s\" must name two robots", kinds[kind])) &&
+                  want_robot(r, &what->items[0], kinds[kind], program, &a) &&
+                  want_robot(r, &what->items[1], kinds[kind], program, &b);
+        if (!ok) {
+            free(f.peers);
+            return false;
+        }
+        if (a == program->self || b == program->self) {
+            f.peers[a == program->self ? b : a] = true;
+            touches = true;
+        }
+    } else { /* partition: robots of different groups (no group is one more) cannot talk */
+        long *group = malloc((program->peer_count ? program->peer_count : 1) * sizeof *group);
+        bool out_of_memory = group == NULL;
+        bool ok = !out_of_memory && want(r, what, J_ARRAY, "an array of groups of robot names");
+        for (size_t i = 0; ok && i < program->peer_count; i++)
+            group[i] = -1;
+        for (size_t g = 0; ok && g < what->count; g++) {
+            const json *members = &what->items[g];
+            ok = want(r, members, J_ARRAY, "a group: an array of robot names");
+            for (size_t m = 0; ok && m < members->count; m++) {
+                size_t peer;
+                ok = want_robot(r, &members->items[m], "partition", program, &peer);
+                if (ok && group[peer] < 0)
+                    group[peer] = (long)g;
+            }
+        }
+        for (size_t i = 0; ok && i < program->peer_count; i++)
+            if (i != program->self && group[i] != group[program->self])
+                f.peers[i] = touches = true;
+        free(group);
+        if (!ok) {
+            free(f.peers);
+            return out_of_memory ? FAIL(r, "out of memory") : false;
+        }
+    }
+    if (!touches || !grow(r, (void **)&g_sim.links, g_sim.link_count, sizeof f)) {
+        free(f.peers);
+        return !touches;
+    }
+    g_sim.links[g_sim.link_count++] = f;
+    return true;
+}
+
 static bool read_scenario(reader *r, const json *root, const semo_program_desc *program)
 {
-    /* The shared schema (docs/scenario-and-trace.md): "version", "network",
-     * "faults" and "expect" are the simulator's (`semo simulate`); they are
-     * accepted here and left to it. */
+    /* The shared schema (docs/scenario-and-trace.md): "version", "network"
+     * and "expect" are the simulator's (`semo simulate`); they are accepted
+     * here and left to it. */
     static const char *const keys[] = {"version", "time_scale", "duration", "robots", "operator",
                                        "network", "faults", "expect", NULL};
     if (!want(r, root, J_OBJECT, "a scenario object {\"robots\": ..., \"operator\": ...}") ||
         !known_keys(r, root, keys, "the scenario"))
         return false;
     const json *scale = member(root, "time_scale"), *duration = member(root, "duration");
-    const json *robots = member(root, "robots"), *commands = member(root, "operator");
+    const json *robots = member(root, "robots"), *commands = member(root, "operator"), *faults = member(root, "faults");
     if (scale) {
         if (scale->kind != J_NUMBER || !(scale->number >= SEMO_TIME_SCALE_MIN && scale->number <= SEMO_TIME_SCALE_MAX))
             return fail_at(r, scale->line, scale->col,
@@ -604,6 +768,13 @@ static bool read_scenario(reader *r, const json *root, const semo_program_desc *
             return false;
         for (size_t i = 0; i < commands->count; i++)
             if (!read_command(r, &commands->items[i], program))
+                return false;
+    }
+    if (faults) {
+        if (!want(r, faults, J_ARRAY, "an array of faults"))
+            return false;
+        for (size_t i = 0; i < faults->count; i++)
+            if (!read_fault(r, &faults->items[i], program))
                 return false;
     }
     return true;
@@ -689,11 +860,20 @@ bool semo__sim_duration(int64_t *out)
     return g_sim.has_duration;
 }
 
+bool semo__sim_has_link_faults(void)
+{
+    return g_sim.link_count > 0;
+}
+
 void semo__sim_free(void)
 {
     free(g_sim.sensors);
     free(g_sim.services);
     free(g_sim.commands);
+    free(g_sim.battery);
+    for (size_t i = 0; i < g_sim.link_count; i++)
+        free(g_sim.links[i].peers);
+    free(g_sim.links);
     memset(&g_sim, 0, sizeof g_sim);
 }
 
@@ -723,8 +903,113 @@ static void *operator_thread(void *arg)
     }
 }
 
+bool semo__sim_link(size_t peer, int64_t *delay_ms)
+{
+    int64_t now = semo_now_ms();
+    *delay_ms = 0;
+    for (size_t i = 0; i < g_sim.link_count; i++) {
+        const link_fault *f = &g_sim.links[i];
+        if (!f->peers[peer] || now < f->from || now >= f->until)
+            continue;
+        if (f->effect == LINK_LOST)
+            return false;
+        *delay_ms += f->by;
+    }
+    return true;
+}
+
+/* Datagrams held back by a delay fault, sent by one thread at their time. */
+typedef struct late_datagram {
+    struct late_datagram *next;
+    int64_t due;
+    size_t peer, len;
+    unsigned char data[];
+} late_datagram;
+
+static struct {
+    pthread_mutex_t lock;
+    pthread_cond_t changed;
+    late_datagram *queue; /* unordered; a delay fault holds few at a time */
+    const semo_transport *transport;
+    bool stopping, started;
+    pthread_t thread;
+} g_late = {.lock = PTHREAD_MUTEX_INITIALIZER};
+
+static bool has_delays(void)
+{
+    for (size_t i = 0; i < g_sim.link_count; i++)
+        if (g_sim.links[i].effect == LINK_DELAYED)
+            return true;
+    return false;
+}
+
+void semo__sim_send_later(const semo_transport *transport, size_t peer, const void *data, size_t len,
+                          int64_t delay_ms)
+{
+    late_datagram *d = malloc(sizeof *d + len);
+    if (!d) {
+        semo_trace("comm_error", "reason", "out of memory for a delayed message", NULL);
+        return;
+    }
+    d->due = semo_now_ms() + delay_ms;
+    d->peer = peer;
+    d->len = len;
+    memcpy(d->data, data, len);
+    pthread_mutex_lock(&g_late.lock);
+    g_late.transport = transport;
+    d->next = g_late.queue;
+    g_late.queue = d;
+    pthread_cond_signal(&g_late.changed);
+    pthread_mutex_unlock(&g_late.lock);
+}
+
+static void *late_thread(void *arg)
+{
+    (void)arg;
+    pthread_mutex_lock(&g_late.lock);
+    while (!g_late.stopping) {
+        late_datagram **first = NULL;
+        for (late_datagram **d = &g_late.queue; *d; d = &(*d)->next)
+            if (!first || (*d)->due < (*first)->due)
+                first = d;
+        if (!first) {
+            semo__cond_wait_until(&g_late.changed, &g_late.lock, -1);
+            continue;
+        }
+        if (semo_now_ms() < (*first)->due) {
+            semo__cond_wait_until(&g_late.changed, &g_late.lock, (*first)->due);
+            continue;
+        }
+        late_datagram *due = *first;
+        *first = due->next;
+        const semo_transport *transport = g_late.transport;
+        pthread_mutex_unlock(&g_late.lock);
+        if (transport->send(due->peer, due->data, due->len) != 0)
+            semo_trace("comm_error", "to", semo_program()->peers[due->peer].robot, NULL);
+        free(due);
+        pthread_mutex_lock(&g_late.lock);
+    }
+    while (g_late.queue) { /* not due before the program stopped */
+        late_datagram *d = g_late.queue;
+        g_late.queue = d->next;
+        free(d);
+    }
+    pthread_mutex_unlock(&g_late.lock);
+    return NULL;
+}
+
 int semo__sim_start(void)
 {
+    if (has_delays()) {
+        semo__cond_init(&g_late.changed);
+        g_late.stopping = false;
+        if (pthread_create(&g_late.thread, NULL, late_thread, NULL) != 0) {
+            fprintf(stderr, "semo runtime: cannot start the simulated network\n");
+            pthread_cond_destroy(&g_late.changed);
+            return -1;
+        }
+        g_late.started = true;
+    }
     if (g_sim.command_count == 0)
         return 0;
     if (pthread_create(&g_operator, NULL, operator_thread, NULL) != 0) {
@@ -740,6 +1025,43 @@ void semo__sim_stop(void)
     if (g_operator_started)
         pthread_join(g_operator, NULL);
     g_operator_started = false;
+    if (g_late.started) {
+        pthread_mutex_lock(&g_late.lock);
+        g_late.stopping = true;
+        pthread_cond_signal(&g_late.changed);
+        pthread_mutex_unlock(&g_late.lock);
+        pthread_join(g_late.thread, NULL);
+        pthread_cond_destroy(&g_late.changed);
+    }
+    g_late.started = false;
+}
+
+/* The battery level at `t`: linear between the scenario's points, the first
+ * before them and the last after them (the simulator's battery_level, the
+ * same operations in the same order). */
+static double battery_level(int64_t t)
+{
+    const battery_entry *b = g_sim.battery;
+    if (t <= b[0].at)
+        return b[0].level;
+    for (size_t i = 1; i < g_sim.battery_count; i++)
+        if (t <= b[i].at)
+            return b[i - 1].level + (b[i].level - b[i - 1].level) * (double)(t - b[i - 1].at) / (double)(b[i].at - b[i - 1].at);
+    return b[g_sim.battery_count - 1].level;
+}
+
+/* Rust's f64::round (halves away from zero) without libm: doubles of 2^52
+ * and more are whole already. */
+static double round_half_away(double x)
+{
+    if (!(x > -4503599627370496.0 && x < 4503599627370496.0))
+        return x;
+    double whole = (double)(long long)x; /* toward zero; the fraction is exact */
+    if (x - whole >= 0.5)
+        return whole + 1;
+    if (whole - x >= 0.5)
+        return whole - 1;
+    return whole;
 }
 
 bool semo_sim_sensor(const char *value, semo_value *out)
@@ -753,6 +1075,14 @@ bool semo_sim_sensor(const char *value, semo_value *out)
     }
     if (latest && out)
         *out = latest->is;
+    if (!latest && value && strcmp(value, "BATTERY") == 0 && g_sim.battery_count > 0) {
+        if (out) {
+            char text[400]; /* "%.0f" of any double fits */
+            snprintf(text, sizeof text, "%.0f", round_half_away(battery_level(now)));
+            semo_value_set(out, text);
+        }
+        return true;
+    }
     return latest != NULL;
 }
 

@@ -12,18 +12,19 @@
 -- Failed expectations appear as diagnostics on the scenario file.
 local M = {}
 
--- XML files that the server reads; their filetype stays `xml`.
-M.xml_patterns = { '%.strategy%.xml$', '%.robot%.xml$', '%.taskgraph%.xml$' }
+-- XML files that the server reads, and scenario files it completes; their filetype stays
+-- `xml` or `json`.
+M.file_patterns = { '%.strategy%.xml$', '%.robot%.xml$', '%.taskgraph%.xml$', '%.scenario%.json$' }
 
 local config = { cmd = { 'semo', 'lsp' }, treesitter = true }
 
---- Whether the buffer is a mission or one of the server's XML files.
+--- Whether the buffer is a mission or one of the server's XML or scenario files.
 function M.is_semo_buffer(bufnr)
   if vim.bo[bufnr].filetype == 'semo' then
     return true
   end
   local name = vim.api.nvim_buf_get_name(bufnr)
-  for _, pattern in ipairs(M.xml_patterns) do
+  for _, pattern in ipairs(M.file_patterns) do
     if name:match(pattern) then
       return true
     end
@@ -202,7 +203,7 @@ function M.setup(opts)
   end, { nargs = '*', complete = 'file', desc = 'Simulate the mission on a scenario (semo.simulate)' })
   vim.api.nvim_create_autocmd('FileType', {
     group = group,
-    pattern = { 'semo', 'xml' },
+    pattern = { 'semo', 'xml', 'json' },
     callback = function(args)
       if not M.is_semo_buffer(args.buf) then
         return

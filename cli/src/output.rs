@@ -1,0 +1,280 @@
+//! Where and in what shape every command reports: diagnostics for people on
+//! standard error, data (and `--format json|sarif` documents) on standard
+//! output. The one JSON document shape (`{"version", "command",
+//! "diagnostics", …}`, docs/diagnostics-json.md) and SARIF 2.1.0 are built
+//! here from [`Record`]s, so every command's machine output agrees.
+
+use semo::diag::{Diagnostic, Severity};
+use semo::text::ColumnUnit;
+use semo::workspace::Files;
+use serde::Serialize;
+use std::io::{self, Write};
+use std::path::Path;
+
+/// The version of the JSON document shape; raised when a field changes
+/// meaning or goes away (new fields may be added within a version).
+pub const JSON_VERSION: u32 = 1;
+
+/// How a command reports its diagnostics.
+#[derive(Clone, Copy, Debug, clap::ValueEnum, PartialEq, Eq)]
+pub enum Format {
+    /// Source snippets on standard error; the command's data on standard output.
+    Human,
+    /// One JSON document on standard output (docs/diagnostics-json.md).
+    Json,
+    /// A SARIF 2.1.0 log on standard output (code-scanning tools).
+    Sarif,
+}
+
+/// A 1-based line and column (columns in characters).
+#[derive(Clone, Copy, Debug, Serialize, PartialEq, Eq)]
+pub struct Position {
+    pub line: u32,
+    pub column: u32,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct RelatedRecord {
+    pub file: String,
+    pub line: u32,
+    pub column: u32,
+    pub message: String,
+}
+
+/// One diagnostic as every machine-readable output shows it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Record {
+    /// The code (`E015`), or null for a problem outside the code table (a
+    /// scenario file's error).
+    pub code: Option<&'static str>,
+    pub severity: &'static str,
+    pub file: String,
+    pub start: Position,
+    pub end: Position,
+    pub message: String,
+    pub suggestion: Option<String>,
+    pub related: Vec<RelatedRecord>,
+}
+
+impl Record {
+    pub fn of(files: &Files, d: &Diagnostic) -> Record {
+        let file = files.get(d.file);
+        let position = |offset: usize| {
+            let lc = file.lines.line_col(&file.text, offset, ColumnUnit::Char);
+            Position {
+                line: lc.line + 1,
+                column: lc.col + 1,
+            }
+        };
+        Record {
+            code: Some(d.code.as_str()),
+            severity: d.severity.as_str(),
+            file: file.path.display().to_string(),
+            start: position(d.span.start),
+            end: position(d.span.end),
+            message: d.message.clone(),
+            suggestion: d.suggestion.clone(),
+            related: d
+                .related
+                .iter()
+                .map(|r| {
+                    let rf = files.get(r.file);
+                    let lc = rf.lines.line_col(&rf.text, r.span.start, ColumnUnit::Char);
+                    RelatedRecord {
+                        file: rf.path.display().to_string(),
+                        line: lc.line + 1,
+                        column: lc.col + 1,
+                        message: r.message.clone(),
+                    }
+                })
+                .collect(),
+        }
+    }
+
+    /// An error at one point of a file that has no code (a scenario's).
+    pub fn uncoded_error(file: &Path, line: u32, column: u32, message: String) -> Record {
+        let at = Position { line, column };
+        Record {
+            code: None,
+            severity: Severity::Error.as_str(),
+            file: file.display().to_string(),
+            start: at,
+            end: at,
+            message,
+            suggestion: None,
+            related: Vec::new(),
+        }
+    }
+}
+
+pub fn records(files: &Files, diagnostics: &[Diagnostic]) -> Vec<Record> {
+    diagnostics.iter().map(|d| Record::of(files, d)).collect()
+}
+
+/// The JSON document of `command`: its version, its diagnostics and the
+/// command's own `data` fields (an object, merged in).
+pub fn json_document(
+    command: &str,
+    records: &[Record],
+    data: serde_json::Value,
+) -> serde_json::Value {
+    let mut document = serde_json::json!({
+        "version": JSON_VERSION,
+        "command": command,
+        "diagnostics": records,
+    });
+    if let (Some(fields), serde_json::Value::Object(data)) = (document.as_object_mut(), data) {
+        fields.extend(data);
+    }
+    document
+}
+
+/// Writes one JSON document and a line break on `out`.
+pub fn write_json(out: &mut impl Write, document: &serde_json::Value) -> io::Result<()> {
+    writeln!(out, "{document}")
+}
+
+/// A URI reference for a path, as SARIF's `artifactLocation.uri` wants it:
+/// relative paths stay relative (to the folder the command ran in), absolute
+/// ones become `file://` URIs; anything else than unreserved characters and
+/// `/` is percent-encoded (so `<stdin>` is `%3Cstdin%3E`).
+fn uri_of(path: &str) -> String {
+    use percent_encoding::{AsciiSet, NON_ALPHANUMERIC, utf8_percent_encode};
+    const KEEP: &AsciiSet = &NON_ALPHANUMERIC
+        .remove(b'-')
+        .remove(b'.')
+        .remove(b'_')
+        .remove(b'~')
+        .remove(b'/');
+    let path = path.replace('\\', "/");
+    let encoded = utf8_percent_encode(&path, KEEP).to_string();
+    if path.starts_with('/') {
+        format!("file://{encoded}")
+    } else {
+        encoded
+    }
+}
+
+fn sarif_level(severity: &str) -> &'static str {
+    match severity {
+        "error" => "error",
+        "warning" => "warning",
+        _ => "note",
+    }
+}
+
+fn sarif_location(file: &str, start: Position, end: Position) -> serde_json::Value {
+    serde_json::json!({
+        "physicalLocation": {
+            "artifactLocation": { "uri": uri_of(file) },
+            "region": {
+                "startLine": start.line,
+                "startColumn": start.column,
+                "endLine": end.line,
+                "endColumn": end.column,
+            },
+        },
+    })
+}
+
+/// A SARIF 2.1.0 log of one run of `semo`: each code reported is a rule (its
+/// summary and default level), each record a result.
+pub fn sarif(records: &[Record]) -> serde_json::Value {
+    let mut rule_ids: Vec<&str> = records.iter().filter_map(|r| r.code).collect();
+    rule_ids.sort_unstable();
+    rule_ids.dedup();
+    let rules: Vec<serde_json::Value> = rule_ids
+        .iter()
+        .map(|id| {
+            let code = semo::diag::Code::from_code(id).expect("a record's code is in the table");
+            serde_json::json!({
+                "id": id,
+                "shortDescription": { "text": code.summary() },
+                "help": { "text": format!("semo explain {id}") },
+                "defaultConfiguration": { "level": sarif_level(code.default_severity().as_str()) },
+            })
+        })
+        .collect();
+    let results: Vec<serde_json::Value> = records
+        .iter()
+        .map(|r| {
+            let mut result = serde_json::json!({
+                "level": sarif_level(r.severity),
+                "message": { "text": r.message },
+                "locations": [sarif_location(&r.file, r.start, r.end)],
+            });
+            if let Some(code) = r.code {
+                result["ruleId"] = code.into();
+                result["ruleIndex"] = rule_ids.iter().position(|id| *id == code).into();
+            }
+            if !r.related.is_empty() {
+                let related: Vec<serde_json::Value> = r
+                    .related
+                    .iter()
+                    .enumerate()
+                    .map(|(i, rel)| {
+                        let at = Position {
+                            line: rel.line,
+                            column: rel.column,
+                        };
+                        let mut location = sarif_location(&rel.file, at, at);
+                        location["id"] = i.into();
+                        location["message"] = serde_json::json!({ "text": rel.message });
+                        location
+                    })
+                    .collect();
+                result["relatedLocations"] = related.into();
+            }
+            result
+        })
+        .collect();
+    serde_json::json!({
+        "$schema": "https://docs.oasis-open.org/sarif/sarif/v2.1.0/errata01/os/schemas/sarif-schema-2.1.0.json",
+        "version": "2.1.0",
+        "runs": [{
+            "tool": { "driver": {
+                "name": "semo",
+                "version": env!("CARGO_PKG_VERSION"),
+                "rules": rules,
+            }},
+            "columnKind": "unicodeCodePoints",
+            "results": results,
+        }],
+    })
+}
+
+/// Reports `diagnostics` of `command` in `format`: people's snippets on
+/// standard error, a JSON document (with `data`) or a SARIF log on `out`.
+pub fn report(
+    format: Format,
+    command: &str,
+    files: &Files,
+    diagnostics: &[Diagnostic],
+    color: bool,
+    data: serde_json::Value,
+    out: &mut impl Write,
+) -> io::Result<()> {
+    match format {
+        Format::Human => {
+            super::render::diagnostics(files, diagnostics, color, &mut io::stderr().lock())
+        }
+        Format::Json => write_json(
+            out,
+            &json_document(command, &records(files, diagnostics), data),
+        ),
+        Format::Sarif => write_json(out, &sarif(&records(files, diagnostics))),
+    }
+}
+
+/// What a failed write of a report means: a reader that went away (`semo
+/// check | head`) is no problem; anything else is exit status 2.
+pub fn written(result: io::Result<()>) -> Result<(), i32> {
+    match result {
+        Err(e) if e.kind() == io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => {
+            eprintln!("error: cannot write the report: {e}");
+            Err(2)
+        }
+        Ok(()) => Ok(()),
+    }
+}
