@@ -8,7 +8,7 @@ use super::render;
 use semo::diag::Diagnostic;
 use semo::taskgraph::analysis::ratio::Ratio;
 use semo::workspace::{
-    DiskResolver, FileKind, Files, GraphReading, GraphRun, analyze_graph, analyze_graph_as,
+    FileKind, FileResolver, Files, GraphReading, GraphRun, analyze_graph, analyze_graph_as,
 };
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -36,7 +36,7 @@ fn read_and_analyze(
         id,
         &file.text,
         Some(&file.path),
-        &mut DiskResolver::new(&files),
+        &mut FileResolver::new(&files),
         reading,
     );
     Some((files, run))
@@ -336,7 +336,7 @@ pub fn schedule(path: &Path, cores: Option<usize>, out: &mut impl Write) -> i32 
     };
     let mut files = Files::default();
     let id = files.add(name, FileKind::TaskGraph, text);
-    let run = analyze_graph(files.get(id), &mut DiskResolver::new(&files));
+    let run = analyze_graph(files.get(id), &mut FileResolver::new(&files));
     let Some(graph) = run
         .graph
         .as_ref()

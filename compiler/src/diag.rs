@@ -280,6 +280,98 @@ impl Diagnostic {
     }
 }
 
+/// Where a loader or checker puts what it finds, in the order found: the one
+/// `report` every pass uses (each used to carry its own copy). It is the
+/// list of diagnostics (it dereferences to it), with the file reported on.
+#[derive(Debug)]
+pub struct Sink {
+    file: FileId,
+    /// XML readers quote attribute values: their control characters become
+    /// spaces (as [`Sink::quoting_xml`] says), beyond the line breaks every
+    /// message escapes.
+    control_as_space: bool,
+    list: Vec<Diagnostic>,
+}
+
+impl Sink {
+    pub fn new(file: FileId) -> Sink {
+        Sink {
+            file,
+            control_as_space: false,
+            list: Vec::new(),
+        }
+    }
+
+    /// A sink whose messages have every control character as a space: for
+    /// the XML readers, whose messages quote attribute values.
+    pub fn quoting_xml(file: FileId) -> Sink {
+        Sink {
+            control_as_space: true,
+            ..Sink::new(file)
+        }
+    }
+
+    pub fn file(&self) -> FileId {
+        self.file
+    }
+
+    /// Reports `message` at `span` of the sink's file; the diagnostic can be
+    /// refined (a did-you-mean, related places).
+    pub fn report(
+        &mut self,
+        code: Code,
+        span: Span,
+        message: impl Into<String>,
+    ) -> &mut Diagnostic {
+        self.report_in(code, self.file, span, message)
+    }
+
+    /// Reports in another file (a cross-check finding a mission line).
+    pub fn report_in(
+        &mut self,
+        code: Code,
+        file: FileId,
+        span: Span,
+        message: impl Into<String>,
+    ) -> &mut Diagnostic {
+        let mut message: String = message.into();
+        if self.control_as_space {
+            message = message
+                .chars()
+                .map(|c| if c.is_control() { ' ' } else { c })
+                .collect();
+        }
+        push(&mut self.list, Diagnostic::new(code, file, span, message))
+    }
+
+    pub fn into_vec(self) -> Vec<Diagnostic> {
+        self.list
+    }
+}
+
+/// Adds `diagnostic` to `list` and gives it back to be refined: what
+/// [`Sink::report_in`] does, for a pass whose findings have no one file (the
+/// strategy cross-check).
+pub fn push(list: &mut Vec<Diagnostic>, diagnostic: Diagnostic) -> &mut Diagnostic {
+    list.push(diagnostic);
+    let last = list.len() - 1;
+    &mut list[last]
+}
+
+impl std::ops::Deref for Sink {
+    type Target = Vec<Diagnostic>;
+
+    fn deref(&self) -> &Vec<Diagnostic> {
+        &self.list
+    }
+}
+
+impl std::ops::DerefMut for Sink {
+    fn deref_mut(&mut self) -> &mut Vec<Diagnostic> {
+        &mut self.list
+    }
+}
+
 /// Sort diagnostics by file and position, and drop exact repeats (a function body
 /// checked at several call sites reports the same finding once).
 pub fn sort_and_dedup(diags: &mut Vec<Diagnostic>) {

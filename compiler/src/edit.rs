@@ -1,7 +1,6 @@
-//! Edits of a file's text and the code actions made of them: the vocabulary
-//! the editor features of every file kind share (missions in `ide`, strategy
-//! files in `strategy::ide`). It sits below both so that neither reads the
-//! other for it.
+//! Edits of a file's text and the code actions made of them: part of the
+//! editor vocabulary, re-exported by `ide` (a module of their own, below it,
+//! so that the vocabulary of edits stays apart from the features).
 
 use crate::span::Span;
 

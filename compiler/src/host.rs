@@ -54,7 +54,7 @@ use crate::sema::{self, check_parsed};
 use crate::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
 use crate::syntax::{ParseCache, parse_incremental};
 use crate::taskgraph::subgraph::{self, SubgraphSource};
-use crate::workspace::{FileKind, GraphRun, analyze_graph_at};
+use crate::workspace::{FileKind, FileResolver, GraphRun, analyze_graph_at};
 use std::borrow::Cow;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -712,7 +712,7 @@ impl Analysis {
         if let Some(found) = fresh(lock(&self.memo.graphs).get(&id), &key) {
             return Some(found);
         }
-        let known: HashMap<PathBuf, SubgraphSource> = self
+        let known = self
             .files()
             .filter(|f| f.kind == FileKind::TaskGraph)
             .filter_map(|f| {
@@ -721,25 +721,10 @@ impl Analysis {
                     text: f.text.clone(),
                 };
                 Some((subgraph::normalize(f.path.as_deref()?), source))
-            })
-            .collect();
+            });
         // Files the host does not hold get ids counting down from below the
         // built-in catalog's: read for this analysis only.
-        let mut next = crate::catalog::BUILTIN_FILE.0;
-        let mut resolver = |path: &Path| -> Result<SubgraphSource, String> {
-            if let Some(source) = known.get(path) {
-                return Ok(source.clone());
-            }
-            let text = crate::workspace::read_text(path).map_err(|e| match e.kind() {
-                std::io::ErrorKind::NotFound => format!("there is no file {}", path.display()),
-                _ => format!("{}: {e}", path.display()),
-            })?;
-            next -= 1;
-            Ok(SubgraphSource {
-                file: FileId(next),
-                text: text.into(),
-            })
-        };
+        let mut resolver = FileResolver::below(known, crate::catalog::BUILTIN_FILE);
         let run = Arc::new(analyze_graph_at(
             id,
             &file.text,

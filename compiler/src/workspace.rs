@@ -267,7 +267,7 @@ pub struct GraphRun {
 /// Loads a task graph (ours or SDF3), follows its `subgraph` references from
 /// the disk, and runs its analyses; a graph that did not load cleanly is not
 /// analysed, so that its problems are not reported twice.
-pub fn analyze_graph(file: &SourceFile, resolver: &mut DiskResolver) -> GraphRun {
+pub fn analyze_graph(file: &SourceFile, resolver: &mut FileResolver) -> GraphRun {
     analyze_graph_at(file.id, &file.text, Some(&file.path), resolver)
 }
 
@@ -333,33 +333,59 @@ pub fn analyze_graph_as(
     }
 }
 
-/// Reads referenced sub-graph files from the disk for the CLI. A file of the
-/// check keeps its id and text; others get ids after the check's files.
-pub struct DiskResolver {
+/// The one reader of referenced sub-graph files, for every door: a file the
+/// caller holds (the check's files, the host's documents) keeps its id and
+/// text; any other is read from the disk once and given a fresh id.
+pub struct FileResolver {
     known: std::collections::HashMap<PathBuf, SubgraphSource>,
     next: u32,
+    /// Fresh ids count down from `next` (below ids in use) or up from it.
+    downward: bool,
 }
 
-impl DiskResolver {
-    pub fn new(files: &Files) -> DiskResolver {
-        let known = files
-            .iter()
-            .map(|f| {
-                let source = SubgraphSource {
-                    file: f.id,
-                    text: f.text.as_str().into(),
-                };
-                (subgraph::normalize(&f.path), source)
-            })
-            .collect();
-        DiskResolver {
-            known,
+impl FileResolver {
+    /// For the CLI: the check's files; fresh ids after theirs.
+    pub fn new(files: &Files) -> FileResolver {
+        let known = files.iter().map(|f| {
+            let source = SubgraphSource {
+                file: f.id,
+                text: f.text.as_str().into(),
+            };
+            (subgraph::normalize(&f.path), source)
+        });
+        FileResolver {
+            known: known.collect(),
             next: files.iter().count() as u32,
+            downward: false,
+        }
+    }
+
+    /// Over `known` files (by normalized path); fresh ids count down from
+    /// just below `below` (the host's ids are small and dense; those below
+    /// the built-in catalog's are free).
+    pub fn below(
+        known: impl IntoIterator<Item = (PathBuf, SubgraphSource)>,
+        below: FileId,
+    ) -> Self {
+        FileResolver {
+            known: known.into_iter().collect(),
+            next: below.0,
+            downward: true,
+        }
+    }
+
+    fn fresh_id(&mut self) -> FileId {
+        if self.downward {
+            self.next -= 1;
+            FileId(self.next)
+        } else {
+            self.next += 1;
+            FileId(self.next - 1)
         }
     }
 }
 
-impl Resolver for DiskResolver {
+impl Resolver for FileResolver {
     fn read(&mut self, path: &Path) -> Result<SubgraphSource, String> {
         if let Some(source) = self.known.get(path) {
             return Ok(source.clone());
@@ -369,10 +395,9 @@ impl Resolver for DiskResolver {
             _ => format!("{}: {e}", path.display()),
         })?;
         let source = SubgraphSource {
-            file: FileId(self.next),
+            file: self.fresh_id(),
             text: text.into(),
         };
-        self.next += 1;
         self.known.insert(path.to_path_buf(), source.clone());
         Ok(source)
     }

@@ -5,7 +5,7 @@
 //! Malformed XML is reported with the format's own code and stops reading; what
 //! was read before the error is kept, the elements left open marked incomplete.
 
-use crate::diag::{Code, Diagnostic, FileId};
+use crate::diag::{Code, Diagnostic, FileId, Sink};
 use crate::span::Span;
 use crate::xmlpos::{
     self, Attr, StartTag, read_attributes, read_attributes_keeping_lt, resolve_reference,
@@ -54,8 +54,8 @@ pub(crate) struct TreeFormat<'a> {
 pub(crate) fn read_tree(text: &str, format: TreeFormat<'_>) -> (Option<Elem>, Vec<Diagnostic>) {
     let mut builder = TreeBuilder {
         text,
+        diagnostics: Sink::quoting_xml(format.file),
         format,
-        diagnostics: Vec::new(),
         stack: Vec::new(),
         root: None,
     };
@@ -66,7 +66,7 @@ pub(crate) fn read_tree(text: &str, format: TreeFormat<'_>) -> (Option<Elem>, Ve
         open.complete = false;
         builder.attach(open);
     }
-    (builder.root, builder.diagnostics)
+    (builder.root, builder.diagnostics.into_vec())
 }
 
 /// A diagnostic whose message is one line, whatever text it quotes.
@@ -176,20 +176,12 @@ type Flow = Result<(), Stop>;
 struct TreeBuilder<'t, 'f> {
     text: &'t str,
     format: TreeFormat<'f>,
-    diagnostics: Vec<Diagnostic>,
+    diagnostics: Sink,
     stack: Vec<Elem>,
     root: Option<Elem>,
 }
 
 impl TreeBuilder<'_, '_> {
-    fn report(&mut self, code: Code, span: Span, message: impl Into<String>) -> &mut Diagnostic {
-        self.diagnostics
-            .push(one_line_diagnostic(code, self.format.file, span, message));
-        self.diagnostics
-            .last_mut()
-            .unwrap_or_else(|| unreachable!())
-    }
-
     /// Reads events until the end or an error; returns where reading stopped.
     fn run(&mut self) -> usize {
         let text = self.text;
@@ -208,7 +200,7 @@ impl TreeBuilder<'_, '_> {
                         Some(lt) if unclosed => (lt, xmlpos::LT_IN_VALUE.to_string()),
                         _ => (xmlpos::word_at(text, pos), xml_error_message(&err)),
                     };
-                    self.report(self.format.xml_code, span, message);
+                    self.diagnostics.report(self.format.xml_code, span, message);
                     return pos.max(before);
                 }
                 Ok(Event::Eof) => {
@@ -248,7 +240,7 @@ impl TreeBuilder<'_, '_> {
     }
 
     fn malformed(&mut self, span: Span, message: impl Into<String>) -> Flow {
-        self.report(self.format.xml_code, span, message);
+        self.diagnostics.report(self.format.xml_code, span, message);
         Err(Stop)
     }
 
@@ -267,10 +259,10 @@ impl TreeBuilder<'_, '_> {
         if let Some(open) = self.stack.last() {
             let message = xmlpos::never_closed(&open.qname);
             let tag = open.tag;
-            self.report(self.format.xml_code, tag, message);
+            self.diagnostics.report(self.format.xml_code, tag, message);
         } else if self.root.is_none() {
             let end = self.text.len();
-            self.report(
+            self.diagnostics.report(
                 self.format.xml_code,
                 Span::new(end, end),
                 self.format.empty_message,
@@ -321,7 +313,7 @@ impl TreeBuilder<'_, '_> {
                     format!(" ({}=\"{}\")", a.key, xmlpos::shown(&fixed))
                 })
                 .unwrap_or_default();
-            self.report(
+            self.diagnostics.report(
                 code,
                 Span::new(at, at + 1),
                 format!("XML does not allow a plain `<` inside an attribute value: write `&lt;` instead{value}"),
@@ -332,7 +324,7 @@ impl TreeBuilder<'_, '_> {
     }
 
     fn report_stop(&mut self, span: Span, message: String) -> Stop {
-        self.report(self.format.xml_code, span, message);
+        self.diagnostics.report(self.format.xml_code, span, message);
         Stop
     }
 
@@ -382,7 +374,9 @@ impl TreeBuilder<'_, '_> {
             Some(open) if open.qname != name => {
                 let (message, opened) = xmlpos::mismatched_close(&name, &open.qname);
                 let code = self.format.xml_code;
-                self.report(code, span, message).relate(open.tag, opened);
+                self.diagnostics
+                    .report(code, span, message)
+                    .relate(open.tag, opened);
                 // Left open: the caller closes it as incomplete.
                 self.stack.push(open);
                 Err(Stop)

@@ -475,9 +475,9 @@ impl LanguageServer for Backend {
 
     async fn signature_help(&self, p: SignatureHelpParams) -> Result<Option<SignatureHelp>> {
         let position = p.text_document_position_params.position;
-        self.on_snapshot(
+        self.on_query(
             &p.text_document_position_params.text_document.uri,
-            move |s| handlers::signature_help::signature_help(s, position),
+            move |s, w| handlers::signature_help::signature_help(s, w, position),
         )
         .await
     }
@@ -519,8 +519,15 @@ impl LanguageServer for Backend {
 
     async fn references(&self, p: ReferenceParams) -> Result<Option<Vec<Location>>> {
         let uri = p.text_document_position.text_document.uri.clone();
-        self.on_snapshot(&uri, move |s| handlers::references::references(s, &p))
-            .await
+        let found = self
+            .on_query(&uri, move |s, w| handlers::references::references(s, w, &p))
+            .await?;
+        let world = self.state.world();
+        let locations: Vec<Location> = found
+            .into_iter()
+            .filter_map(|(file, range)| Some(Location::new(world.uri_of(file)?.clone(), range)))
+            .collect();
+        Ok((!locations.is_empty()).then_some(locations))
     }
 
     async fn document_highlight(
@@ -546,8 +553,21 @@ impl LanguageServer for Backend {
 
     async fn rename(&self, p: RenameParams) -> Result<Option<WorkspaceEdit>> {
         let uri = p.text_document_position.text_document.uri.clone();
-        self.on_snapshot(&uri, move |s| handlers::rename::rename(s, &p))
-            .await?
+        let Some(edits) = self
+            .on_query(&uri, move |s, w| handlers::rename::rename(s, w, &p))
+            .await??
+        else {
+            return Ok(None);
+        };
+        let world = self.state.world();
+        let changes = edits
+            .into_iter()
+            .filter_map(|(file, edits)| Some((world.uri_of(file)?.clone(), edits)))
+            .collect();
+        Ok(Some(WorkspaceEdit {
+            changes: Some(changes),
+            ..WorkspaceEdit::default()
+        }))
     }
 
     async fn document_symbol(

@@ -6,7 +6,7 @@ use crate::encoding::LineMap;
 use crate::world::Snapshot;
 use semo::diag::FileId;
 use semo::host::Analysis;
-use semo::ide::{self, CompletionKind, HoverResult, NavigationTarget};
+use semo::ide::{self, CompletionKind, HoverResult, NavigationTarget, SourceChange};
 use semo::text::LineIndex;
 use std::collections::HashMap;
 use tower_lsp_server::ls_types::*;
@@ -80,6 +80,35 @@ pub fn completion_kind(kind: CompletionKind) -> CompletionItemKind {
         K::Keyword => CompletionItemKind::KEYWORD,
         K::Snippet => CompletionItemKind::SNIPPET,
     }
+}
+
+/// Per file, its edits in protocol ranges (the caller names the files).
+pub type FileEdits = Vec<(FileId, Vec<TextEdit>)>;
+
+/// A change of several files: per file, its edits in protocol ranges.
+pub fn source_change(
+    snapshot: &Snapshot,
+    workspace: &Analysis,
+    lines: &LineMap<'_>,
+    change: SourceChange,
+) -> FileEdits {
+    change
+        .edits
+        .into_iter()
+        .map(|(file, edits)| {
+            let targets = edits
+                .iter()
+                .map(|e| NavigationTarget { file, span: e.span })
+                .collect();
+            let ranges = target_ranges(snapshot, workspace, lines, targets);
+            let edits = ranges
+                .into_iter()
+                .zip(edits)
+                .map(|((_, range), e)| TextEdit::new(range, e.new_text))
+                .collect();
+            (file, edits)
+        })
+        .collect()
 }
 
 /// Targets as ranges of their files (the snapshot's own text, or another

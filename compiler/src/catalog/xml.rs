@@ -9,7 +9,7 @@
 use super::{
     Implementation, Origin, ParamDef, Platform, RobotType, ServiceDef, ValueDef, ValueType,
 };
-use crate::diag::{Code, Diagnostic, FileId};
+use crate::diag::{Code, Diagnostic, FileId, Sink};
 use crate::span::Span;
 use crate::xmlpos::{
     self, Attr, StartTag, get, is_ident, is_namespace_attribute, read_attributes,
@@ -59,10 +59,7 @@ pub fn parse_catalog(file: FileId, text: &str, base_dir: Option<&Path>) -> Parse
     let mut parser = Parser {
         text,
         base_dir,
-        sink: Sink {
-            file,
-            list: Vec::new(),
-        },
+        sink: Sink::new(file),
         out_robots: Vec::new(),
         operator: None,
         stack: Vec::new(),
@@ -77,7 +74,7 @@ pub fn parse_catalog(file: FileId, text: &str, base_dir: Option<&Path>) -> Parse
     ParsedCatalog {
         robots: parser.out_robots,
         operator: parser.operator,
-        diagnostics: parser.sink.list,
+        diagnostics: parser.sink.into_vec(),
     }
 }
 
@@ -181,54 +178,10 @@ struct Stop;
 
 type Flow = Result<(), Stop>;
 
-struct Sink {
-    file: FileId,
-    list: Vec<Diagnostic>,
-}
-
-impl Sink {
-    fn report(&mut self, code: Code, span: Span, message: impl Into<String>) {
-        self.list
-            .push(Diagnostic::new(code, self.file, span, message));
-    }
-
-    /// A diagnostic with a did-you-mean.
-    fn report_suggest(
-        &mut self,
-        code: Code,
-        span: Span,
-        message: impl Into<String>,
-        suggestion: Option<String>,
-    ) {
-        let mut d = Diagnostic::new(code, self.file, span, message);
-        d.suggest(suggestion);
-        self.list.push(d);
-    }
-
-    /// A diagnostic with a second position in the same file.
-    fn report_related(
-        &mut self,
-        code: Code,
-        span: Span,
-        message: impl Into<String>,
-        other: Span,
-        other_message: impl Into<String>,
-    ) {
-        let mut d = Diagnostic::new(code, self.file, span, message);
-        d.relate(other, other_message);
-        self.list.push(d);
-    }
-
-    /// E053 with a pointer at the first definition.
-    fn duplicate(&mut self, span: Span, first: Span, message: impl Into<String>) {
-        self.report_related(
-            Code::CatalogDuplicateType,
-            span,
-            message,
-            first,
-            "first defined here",
-        );
-    }
+/// E053 with a pointer at the first definition.
+fn duplicate(sink: &mut Sink, span: Span, first: Span, message: impl Into<String>) {
+    sink.report(Code::CatalogDuplicateType, span, message)
+        .relate(first, "first defined here");
 }
 
 /// Did-you-mean for a value type, knowing the usual names from other languages.
@@ -452,16 +405,17 @@ impl Parser<'_, '_> {
             if is_namespace_attribute(&a.key) || allowed.contains(&a.key.as_str()) {
                 continue;
             }
-            self.sink.report_suggest(
-                Code::CatalogUnknownAttribute,
-                a.key_span,
-                format!(
-                    "`<{}>` has no attribute `{}`; it is ignored",
-                    kind.tag(),
-                    a.key
-                ),
-                suggest(&a.key, allowed),
-            );
+            self.sink
+                .report(
+                    Code::CatalogUnknownAttribute,
+                    a.key_span,
+                    format!(
+                        "`<{}>` has no attribute `{}`; it is ignored",
+                        kind.tag(),
+                        a.key
+                    ),
+                )
+                .suggest(suggest(&a.key, allowed));
         }
     }
 
@@ -525,12 +479,9 @@ impl Parser<'_, '_> {
                     } else {
                         format!("unknown element `<{qname}>` inside `<{}>`", parent.tag())
                     };
-                    self.sink.report_suggest(
-                        Code::CatalogUnknownElement,
-                        name_span,
-                        message,
-                        suggest(&local, &candidates),
-                    );
+                    self.sink
+                        .report(Code::CatalogUnknownElement, name_span, message)
+                        .suggest(suggest(&local, &candidates));
                     Kind::Skip
                 }
             },
@@ -558,7 +509,8 @@ impl Parser<'_, '_> {
             Some(open) if open.qname != name => {
                 let (message, opened) = xmlpos::mismatched_close(&name, &open.qname);
                 self.sink
-                    .report_related(Code::CatalogXml, span, message, open.tag, opened);
+                    .report(Code::CatalogXml, span, message)
+                    .relate(open.tag, opened);
                 Err(Stop)
             }
             Some(open) => {
@@ -660,7 +612,8 @@ impl Parser<'_, '_> {
                     continue;
                 }
                 if let Some(first) = seen.get(w.as_str()) {
-                    self.sink.duplicate(
+                    duplicate(
+                        &mut self.sink,
                         *span,
                         *first,
                         format!("`{w}` is listed twice in the domain"),
@@ -673,14 +626,9 @@ impl Parser<'_, '_> {
             return ValueType::Enum(values);
         }
         let Some(parsed) = ValueType::parse(name, None) else {
-            self.sink.report_suggest(
-                Code::CatalogUnknownValueType,
-                ty.span,
-                format!(
+            self.sink.report(Code::CatalogUnknownValueType, ty.span, format!(
                     "unknown type `{name}`: the types are int, float, bool, string, location, image and enum"
-                ),
-                suggest_type(name),
-            );
+                )).suggest(suggest_type(name));
             return ValueType::String;
         };
         if let Some(d) = domain {
@@ -742,7 +690,7 @@ impl Parser<'_, '_> {
 
     fn open(&mut self, kind: Kind, parent: Option<Kind>, tag: Span, attrs: &[Attr]) {
         let origin = Origin {
-            file: self.sink.file,
+            file: self.sink.file(),
             span: tag,
         };
         match kind {
@@ -759,7 +707,8 @@ impl Parser<'_, '_> {
                 };
                 if let Some(first) = robot.capabilities.get(&name) {
                     let first = *first;
-                    self.sink.duplicate(
+                    duplicate(
+                        &mut self.sink,
                         span,
                         first,
                         format!("capability `{name}` is listed twice for this robot"),
@@ -805,7 +754,8 @@ impl Parser<'_, '_> {
                 );
             } else if let Some(first) = self.robot_names.get(&name) {
                 let first = *first;
-                self.sink.duplicate(
+                duplicate(
+                    &mut self.sink,
                     span,
                     first,
                     format!("robot type `{name}` is defined twice in this file"),
@@ -822,7 +772,8 @@ impl Parser<'_, '_> {
             for (alias, span) in aliases {
                 if let Some(first) = self.robot_names.get(&alias) {
                     let first = *first;
-                    self.sink.duplicate(
+                    duplicate(
+                        &mut self.sink,
                         span,
                         first,
                         format!("`{alias}` is already the name of a robot type in this file"),
@@ -849,7 +800,8 @@ impl Parser<'_, '_> {
         };
         match *slot {
             Some(first) => {
-                self.sink.duplicate(
+                duplicate(
+                    &mut self.sink,
                     tag,
                     first,
                     format!("this `<{}>` is already documented", target.tag()),
@@ -871,8 +823,12 @@ impl Parser<'_, '_> {
             return;
         };
         if let Some(first) = robot.platform_at {
-            self.sink
-                .duplicate(tag, first, "this robot already has a `<Platform>`");
+            duplicate(
+                &mut self.sink,
+                tag,
+                first,
+                "this robot already has a `<Platform>`",
+            );
             return;
         }
         robot.platform_at = Some(tag);
@@ -924,7 +880,8 @@ impl Parser<'_, '_> {
         };
         if let Some(first) = names.get(&name.0) {
             let first = *first;
-            self.sink.duplicate(
+            duplicate(
+                &mut self.sink,
                 name.1,
                 first,
                 format!("this robot already has a {what} `{}`", name.0),
@@ -936,7 +893,8 @@ impl Parser<'_, '_> {
         for (alias, span) in aliases {
             if let Some(first) = names.get(&alias) {
                 let first = *first;
-                self.sink.duplicate(
+                duplicate(
+                    &mut self.sink,
                     span,
                     first,
                     format!("this robot already has a {what} `{alias}`"),
@@ -1025,7 +983,8 @@ impl Parser<'_, '_> {
         };
         if let Some(first) = service.param_names.get(&name) {
             let first = *first;
-            self.sink.duplicate(
+            duplicate(
+                &mut self.sink,
                 span,
                 first,
                 format!("this service already has a parameter `{name}`"),

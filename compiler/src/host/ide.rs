@@ -10,9 +10,11 @@
 
 use super::Analysis;
 use crate::diag::FileId;
+use crate::ide::mission::rename::RenameError;
+use crate::ide::mission::signature_help::SignatureHelp;
 use crate::ide::{
     self, CompletionConfig, CompletionItem, CompletionKind, FilePosition, HoverResult,
-    NavigationTarget, strategy::StrategyFile,
+    NavigationTarget, SourceChange, TextEdit, strategy::StrategyFile,
 };
 use crate::sema;
 use crate::workspace::FileKind;
@@ -127,6 +129,86 @@ impl Analysis {
             }
             FileKind::TaskGraph | FileKind::Catalog | FileKind::Project => Vec::new(),
         }
+    }
+
+    /// Every place meaning what the name at `position` means: in a mission,
+    /// its names (definitions only if `include_declaration`); in a strategy
+    /// file, the mission lines an entry refines or reads.
+    pub fn references(
+        &self,
+        position: FilePosition,
+        include_declaration: bool,
+    ) -> Vec<NavigationTarget> {
+        let FilePosition { file, offset } = position;
+        let Some(source) = self.file(file) else {
+            return Vec::new();
+        };
+        match source.kind {
+            FileKind::Mission => {
+                let Some(mission) = self.mission(file) else {
+                    return Vec::new();
+                };
+                ide::mission::navigation::references(&mission, offset)
+                    .into_iter()
+                    .filter(|r| include_declaration || !r.is_definition)
+                    .map(|r| NavigationTarget { file, span: r.span })
+                    .collect()
+            }
+            FileKind::Strategy => {
+                let links = self.strategy_links(file);
+                self.with_strategy(file, |s| {
+                    ide::strategy::navigation::references(s, &links, offset, include_declaration)
+                })
+            }
+            FileKind::TaskGraph | FileKind::Catalog | FileKind::Project => Vec::new(),
+        }
+    }
+
+    /// Renaming the name at `position` to `new_name`: the edits (a mission is
+    /// self-contained, so all in it), or why the rename is refused. `None`
+    /// where renaming means nothing (other kinds of file).
+    pub fn rename(
+        &self,
+        position: FilePosition,
+        new_name: &str,
+    ) -> Option<Result<SourceChange, RenameError>> {
+        let FilePosition { file, offset } = position;
+        let source = self.file(file).filter(|f| f.kind == FileKind::Mission)?;
+        let mission = self.mission(file)?;
+        let catalog = self.catalog(file);
+        let spans = ide::mission::rename::rename(
+            &mission,
+            &catalog.catalog,
+            &source.text,
+            offset,
+            new_name,
+        );
+        Some(spans.map(|spans| SourceChange {
+            edits: vec![(
+                file,
+                spans
+                    .into_iter()
+                    .map(|span| TextEdit {
+                        span,
+                        new_text: new_name.to_string(),
+                    })
+                    .collect(),
+            )],
+        }))
+    }
+
+    /// The signature of the call around `position` (missions only).
+    pub fn signature_help(&self, position: FilePosition) -> Option<SignatureHelp> {
+        let FilePosition { file, offset } = position;
+        let source = self.file(file).filter(|f| f.kind == FileKind::Mission)?;
+        let mission = self.mission(file)?;
+        let catalog = self.catalog(file);
+        ide::mission::signature_help::signature_help(
+            &mission,
+            &catalog.catalog,
+            &source.text,
+            offset,
+        )
     }
 
     /// From a mission's built-in call at `position` to the entries of the

@@ -29,7 +29,7 @@ impl<'a> Checker<'a> {
             let function = &self.mission.functions[f];
             if !function.called {
                 let (span, name) = (function.name_span, function.name.clone());
-                self.report(
+                self.diagnostics.report(
                     Code::FunctionNeverCalled,
                     span,
                     format!("the function `{name}` is never called"),
@@ -74,18 +74,20 @@ impl<'a> Checker<'a> {
                             plans.join(", ")
                         }
                     );
-                    self.report(Code::ServiceNotInPlan, set.plan.span, message)
+                    self.diagnostics
+                        .report(Code::ServiceNotInPlan, set.plan.span, message)
                         .suggest(guess);
                 }
             }
             if let Some(first) = sets.iter().find(|s| plan.is_some() && s.plan == plan) {
                 let first = first.span;
-                self.report(
-                    Code::PlanSetTwice,
-                    set.plan.span,
-                    format!("this mode already sets the plan `{}`", set.plan.name),
-                )
-                .relate(first, "first set here");
+                self.diagnostics
+                    .report(
+                        Code::PlanSetTwice,
+                        set.plan.span,
+                        format!("this mode already sets the plan `{}`", set.plan.name),
+                    )
+                    .relate(first, "first set here");
             }
             let service = match (&set.service, plan) {
                 (SetTarget::Off(_), _) => None,
@@ -136,7 +138,8 @@ impl<'a> Checker<'a> {
                 t.name, name.name
             ),
         };
-        self.report(Code::ServiceNotInPlan, name.span, message)
+        self.diagnostics
+            .report(Code::ServiceNotInPlan, name.span, message)
             .suggest(guess);
         None
     }
@@ -160,7 +163,8 @@ impl<'a> Checker<'a> {
                 let t = self.team(team);
                 let guess = suggestion(&name.name, t.modes.iter().map(|m| m.name.as_str()));
                 let message = format!("team {} has no mode `{}`", t.name, name.name);
-                self.report(Code::UnknownMode, name.span, message)
+                self.diagnostics
+                    .report(Code::UnknownMode, name.span, message)
                     .suggest(guess);
                 None
             }
@@ -173,18 +177,19 @@ impl<'a> Checker<'a> {
         };
         if let Some(first) = &self.team(team).main {
             let first = first.span;
-            self.report(
-                Code::DuplicateMain,
-                m.main_span,
-                format!("team {} already has a main block", m.team.name),
-            )
-            .relate(first, "first main block here");
+            self.diagnostics
+                .report(
+                    Code::DuplicateMain,
+                    m.main_span,
+                    format!("team {} already has a main block", m.team.name),
+                )
+                .relate(first, "first main block here");
             return;
         }
         let default = match &m.default {
             Some(name) => self.mode_ref(team, name),
             None => {
-                self.report(
+                self.diagnostics.report(
                     Code::MissingDefault,
                     m.team.span.cover(m.main_span),
                     format!(
@@ -201,12 +206,13 @@ impl<'a> Checker<'a> {
             let from = self.mode_ref(team, &case.mode);
             if let Some(from) = from {
                 if let Some(&(_, first)) = cased.iter().find(|(f, _)| *f == from) {
-                    self.report(
-                        Code::DuplicateCase,
-                        case.mode.span,
-                        format!("there is already a case for the mode `{}`", case.mode.name),
-                    )
-                    .relate(first, "first case here");
+                    self.diagnostics
+                        .report(
+                            Code::DuplicateCase,
+                            case.mode.span,
+                            format!("there is already a case for the mode `{}`", case.mode.name),
+                        )
+                        .relate(first, "first case here");
                 } else {
                     cased.push((from, case.mode.span));
                 }
@@ -216,12 +222,13 @@ impl<'a> Checker<'a> {
                 self.caught(team, &catch.event);
                 if let Some(first) = caught.iter().find(|e| e.name == catch.event.name) {
                     let first = first.span;
-                    self.report(
-                        Code::DuplicateCatch,
-                        catch.event.span,
-                        format!("this case already catches `{}`", catch.event.name),
-                    )
-                    .relate(first, "first caught here");
+                    self.diagnostics
+                        .report(
+                            Code::DuplicateCatch,
+                            catch.event.span,
+                            format!("this case already catches `{}`", catch.event.name),
+                        )
+                        .relate(first, "first caught here");
                 } else {
                     caught.push(&catch.event);
                 }
@@ -262,7 +269,8 @@ impl<'a> Checker<'a> {
                 "team {} has no main block, so its robots do nothing",
                 t.name
             );
-            self.report(Code::TeamWithoutMain, span, message);
+            self.diagnostics
+                .report(Code::TeamWithoutMain, span, message);
             return;
         }
         let caught: Vec<Name> = t
@@ -281,7 +289,7 @@ impl<'a> Checker<'a> {
         for (name, spans) in uncaught {
             let guess = suggestion(&name, caught.iter().map(Name::as_str));
             for span in spans {
-                self.report(
+                self.diagnostics.report(
                     Code::EventNeverCaught,
                     span,
                     format!(
@@ -324,7 +332,9 @@ impl<'a> Checker<'a> {
             }
         }
         for (span, message) in findings {
-            self.report(Code::CatchNeverThrown, span, message).severity = Severity::Hint;
+            self.diagnostics
+                .report(Code::CatchNeverThrown, span, message)
+                .severity = Severity::Hint;
         }
     }
 
@@ -369,7 +379,7 @@ impl<'a> Checker<'a> {
             main.unreachable = unreachable;
         }
         for (span, name) in findings {
-            self.report(
+            self.diagnostics.report(
                 Code::UnreachableMode,
                 span,
                 format!("the mode `{name}` can never be entered: no catch leads to it from the default mode {default_name}"),
@@ -389,7 +399,7 @@ impl<'a> Checker<'a> {
             .map(|s| (t.services[s as usize].name_span, t.service_path(s)))
             .collect();
         for (span, path) in unused {
-            self.report(
+            self.diagnostics.report(
                 Code::ServiceNeverSet,
                 span,
                 format!("`{path}` is never set in any mode, so it never runs"),

@@ -248,7 +248,8 @@ impl<'a> Checker<'a> {
         for lacking in std::mem::take(&mut self.lacking_values) {
             let key = (lacking.team.clone(), lacking.name.clone());
             if !self.received_values.contains(&key) {
-                self.report(Code::ValueNotProvided, lacking.span, lacking.message);
+                self.diagnostics
+                    .report(Code::ValueNotProvided, lacking.span, lacking.message);
             }
         }
     }
@@ -298,7 +299,7 @@ impl<'a> Checker<'a> {
 
     pub(super) fn period(&mut self, period: &ast::Period) {
         if !period.millis().is_some_and(|ms| ms > 0.0) {
-            self.report(
+            self.diagnostics.report(
                 Code::InvalidPeriod,
                 period.span,
                 "a period or timeout must be more than zero",
@@ -328,14 +329,14 @@ impl<'a> Checker<'a> {
         if let Some(&function) = self.functions_by_name.get(&call.name.name) {
             self.occurrence(call.name.span, Symbol::Function(function), false);
             if !call.args.is_empty() {
-                self.report(
+                self.diagnostics.report(
                     Code::WrongArgumentCount,
                     call.args_span,
                     format!("the function `{}` takes no arguments", call.name.name),
                 );
             }
             if scope.inlining.contains(&function) {
-                self.report(
+                self.diagnostics.report(
                     Code::RecursiveFunction,
                     call.name.span,
                     format!(
@@ -346,7 +347,7 @@ impl<'a> Checker<'a> {
                 return;
             }
             if scope.inlining.len() >= MAX_INLINING_DEPTH {
-                self.report(
+                self.diagnostics.report(
                     Code::RecursiveFunction,
                     call.name.span,
                     format!(
@@ -435,12 +436,13 @@ impl<'a> Checker<'a> {
                 );
             }
             let guess = suggestion(name, candidates);
-            self.report(
-                Code::UnknownService,
-                call.name.span,
-                format!("`{name}` is neither a robot service nor a function"),
-            )
-            .suggest(guess);
+            self.diagnostics
+                .report(
+                    Code::UnknownService,
+                    call.name.span,
+                    format!("`{name}` is neither a robot service nor a function"),
+                )
+                .suggest(guess);
             return;
         };
         let def = first_provider.unwrap_or(any_def);
@@ -489,7 +491,8 @@ impl<'a> Checker<'a> {
                 "`{name}` is not a service of {} in team {team}; {advice}",
                 self.describe_types(&lacking)
             );
-            self.report(Code::ServiceNotProvided, call.name.span, message);
+            self.diagnostics
+                .report(Code::ServiceNotProvided, call.name.span, message);
         }
         self.arguments(call, def, scope);
     }
@@ -504,7 +507,7 @@ impl<'a> Checker<'a> {
                 (0, b) => format!("at most {b} argument{}", if b == 1 { "" } else { "s" }),
                 (a, b) => format!("{a} to {b} arguments"),
             };
-            self.report(
+            self.diagnostics.report(
                 Code::WrongArgumentCount,
                 call.args_span,
                 format!(
@@ -521,7 +524,7 @@ impl<'a> Checker<'a> {
                 Arg::Expr(e) => self.expr(e, scope, true),
             };
             if !ty.fits(&param.ty) {
-                self.report(
+                self.diagnostics.report(
                     Code::WrongArgumentType,
                     arg.span(),
                     format!(
@@ -602,7 +605,7 @@ impl<'a> Checker<'a> {
         if ordering {
             for (ty, side) in [(&lt, lhs), (&rt, rhs)] {
                 if !ty.is_numeric() {
-                    self.report(
+                    self.diagnostics.report(
                         Code::OrderingNotNumeric,
                         side.span,
                         format!(
@@ -631,15 +634,16 @@ impl<'a> Checker<'a> {
             };
             if let Some(c) = written.filter(|c| !domain.contains(c)) {
                 let guess = suggestion(&c, domain.iter().map(String::as_str));
-                self.report(
-                    Code::ConstantOutsideDomain,
-                    other_span,
-                    format!(
-                        "`{c}` is not a possible value of {what}, which is one of {}",
-                        domain.join(", ")
-                    ),
-                )
-                .suggest(guess);
+                self.diagnostics
+                    .report(
+                        Code::ConstantOutsideDomain,
+                        other_span,
+                        format!(
+                            "`{c}` is not a possible value of {what}, which is one of {}",
+                            domain.join(", ")
+                        ),
+                    )
+                    .suggest(guess);
             }
         }
     }
@@ -893,7 +897,8 @@ impl<'a> Checker<'a> {
                         "`{team}.{name}` is neither a value of the robots of team {team} nor a team variable that is sent, published or received"
                     )
                 };
-                self.report(Code::UnknownAttribute, attr.span, message)
+                self.diagnostics
+                    .report(Code::UnknownAttribute, attr.span, message)
                     .suggest(guess.map(|g| format!("{team}.{g}")));
                 // What it means all the same (a warning lets the mission
                 // build): a team variable nobody sets, which stays empty.
@@ -903,18 +908,19 @@ impl<'a> Checker<'a> {
             }
             Resolution::NotATeam { team } => {
                 let guess = suggestion(&team, self.team_names().iter().map(String::as_str));
-                self.report(
-                    Code::UnknownAttribute,
-                    attr.span,
-                    format!("`{}`: `{team}` is not a team", attr.dotted()),
-                )
-                .suggest(guess);
+                self.diagnostics
+                    .report(
+                        Code::UnknownAttribute,
+                        attr.span,
+                        format!("`{}`: `{team}` is not a team", attr.dotted()),
+                    )
+                    .suggest(guess);
                 // What it means all the same: the words as written.
                 self.occurrence(last, Symbol::Constant(Name::new(attr.dotted())), false);
                 Type::Unknown
             }
             Resolution::TooLong => {
-                self.report(
+                self.diagnostics.report(
                     Code::UnknownAttribute,
                     attr.span,
                     format!(
@@ -932,7 +938,7 @@ impl<'a> Checker<'a> {
             Resolution::Bare { name, known } => {
                 let known = self.candidate_names(&known);
                 let guess = suggestion(&name, known.iter().map(String::as_str));
-                self.report(
+                self.diagnostics.report(
                     Code::UnknownAttribute,
                     attr.span,
                     format!(
@@ -980,12 +986,13 @@ impl<'a> Checker<'a> {
                             .flat_map(|(_, r)| r.capabilities.iter().map(String::as_str))
                             .collect();
                         let guess = suggestion(&name.name, all);
-                        self.report(
-                            Code::UnsatisfiableGroup,
-                            name.span,
-                            format!("no robot type has the capability `{}`", name.name),
-                        )
-                        .suggest(guess);
+                        self.diagnostics
+                            .report(
+                                Code::UnsatisfiableGroup,
+                                name.span,
+                                format!("no robot type has the capability `{}`", name.name),
+                            )
+                            .suggest(guess);
                     }
                 }
             }
@@ -1030,7 +1037,7 @@ impl<'a> Checker<'a> {
                     CondKind::CapableOf => "is capable of",
                 };
                 let names: Vec<&str> = arm.condition.names.iter().map(|n| n.as_str()).collect();
-                self.report(
+                self.diagnostics.report(
                     Code::UnsatisfiableGroup,
                     arm.condition.span,
                     format!(
@@ -1046,7 +1053,7 @@ impl<'a> Checker<'a> {
                 .collect();
             if arm.kind == ArmKind::Group && !overlap.is_empty() {
                 let names = self.robot_names(scope, &overlap);
-                self.report(
+                self.diagnostics.report(
                     Code::AmbiguousGroup,
                     arm.condition.span,
                     format!(
@@ -1089,7 +1096,7 @@ impl<'a> Checker<'a> {
                 .filter(|r| !taken.contains(r))
                 .collect();
             if checkable && rest.is_empty() {
-                self.report(
+                self.diagnostics.report(
                     Code::EmptyOthers,
                     others.keyword_span,
                     "every robot already belongs to a group above: no robot runs `others`",
@@ -1132,16 +1139,17 @@ impl<'a> Checker<'a> {
             let mut names = self.team_names();
             names.push("USER".into());
             let guess = suggestion(&comm.team.name, names.iter().map(String::as_str));
-            self.report(
-                Code::UnknownCommTeam,
-                comm.team.span,
-                format!(
-                    "`{}` is not a team: `{}` needs a declared team or USER",
-                    comm.team.name,
-                    comm.kind.as_str()
-                ),
-            )
-            .suggest(guess);
+            self.diagnostics
+                .report(
+                    Code::UnknownCommTeam,
+                    comm.team.span,
+                    format!(
+                        "`{}` is not a team: `{}` needs a declared team or USER",
+                        comm.team.name,
+                        comm.kind.as_str()
+                    ),
+                )
+                .suggest(guess);
             None
         };
         for item in &comm.items {

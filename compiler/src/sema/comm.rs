@@ -80,7 +80,7 @@ impl Checker<'_> {
             findings.push((code, m.span, message));
         }
         for (code, span, message) in findings {
-            self.report(code, span, message);
+            self.diagnostics.report(code, span, message);
         }
     }
 }

@@ -37,7 +37,7 @@ impl<'a> Checker<'a> {
     fn declare_team(&mut self, decl: &ast::TeamDecl, robot_names: &mut FastMap<Name, Span>) {
         let name = &decl.name;
         if is_user(&name.name) {
-            self.report(
+            self.diagnostics.report(
                 Code::ReservedName,
                 name.span,
                 format!(
@@ -49,12 +49,13 @@ impl<'a> Checker<'a> {
         }
         if let Some(existing) = self.team_id(&name.name) {
             let first = self.team(existing).name_span;
-            self.report(
-                Code::DuplicateTeam,
-                name.span,
-                format!("the team `{}` is already declared", name.name),
-            )
-            .relate(first, "first declared here");
+            self.diagnostics
+                .report(
+                    Code::DuplicateTeam,
+                    name.span,
+                    format!("the team `{}` is already declared", name.name),
+                )
+                .relate(first, "first declared here");
             return;
         }
         let id = TeamId(self.mission.teams.len() as u32);
@@ -69,7 +70,7 @@ impl<'a> Checker<'a> {
                     .map(|i| Name::new(format!("{}_{i}", robot.name.name)))
                     .collect(),
                 Some(count) => {
-                    self.report(
+                    self.diagnostics.report(
                         Code::EmptyRobotGroup,
                         count.span,
                         "the number of robots must be a whole number of at least 1",
@@ -79,12 +80,13 @@ impl<'a> Checker<'a> {
             };
             for robot_name in names {
                 if let Some(&first) = robot_names.get(&robot_name) {
-                    self.report(
-                        Code::DuplicateRobot,
-                        robot.name.span,
-                        format!("a robot named `{robot_name}` is already declared"),
-                    )
-                    .relate(first, "first declared here");
+                    self.diagnostics
+                        .report(
+                            Code::DuplicateRobot,
+                            robot.name.span,
+                            format!("a robot named `{robot_name}` is already declared"),
+                        )
+                        .relate(first, "first declared here");
                     continue;
                 }
                 robot_names.insert(robot_name.clone(), robot.name.span);
@@ -145,7 +147,8 @@ impl<'a> Checker<'a> {
                         )
                     }
                 };
-                self.report(Code::UnknownRobotType, name.span, message)
+                self.diagnostics
+                    .report(Code::UnknownRobotType, name.span, message)
                     .suggest(guess);
                 None
             }
@@ -159,24 +162,26 @@ impl<'a> Checker<'a> {
             return Some(id);
         }
         let guess = suggestion(&team.name, self.team_names().iter().map(String::as_str));
-        self.report(
-            Code::UnknownTeam,
-            team.span,
-            format!("{what} of `{}`, which is not a declared team", team.name),
-        )
-        .suggest(guess);
+        self.diagnostics
+            .report(
+                Code::UnknownTeam,
+                team.span,
+                format!("{what} of `{}`, which is not a declared team", team.name),
+            )
+            .suggest(guess);
         None
     }
 
     fn declare_function(&mut self, f: &'a ast::Function, item: usize) {
         if let Some(&existing) = self.functions_by_name.get(&f.name.name) {
             let first = self.mission.functions[existing.0 as usize].name_span;
-            self.report(
-                Code::DuplicateFunction,
-                f.name.span,
-                format!("the function `{}` is already defined", f.name.name),
-            )
-            .relate(first, "first defined here");
+            self.diagnostics
+                .report(
+                    Code::DuplicateFunction,
+                    f.name.span,
+                    format!("the function `{}` is already defined", f.name.name),
+                )
+                .relate(first, "first defined here");
             self.rejected_bodies.push((None, &f.body));
             return;
         }
@@ -215,15 +220,16 @@ impl<'a> Checker<'a> {
         };
         if let Some(existing) = self.team(team).service_in_plan(plan, &s.name.name) {
             let first = self.team(team).services[existing as usize].name_span;
-            self.report(
-                Code::DuplicateService,
-                s.name.span,
-                format!(
-                    "`{}.{}.{}` is already defined",
-                    s.team.name, s.plan.name, s.name.name
-                ),
-            )
-            .relate(first, "first defined here");
+            self.diagnostics
+                .report(
+                    Code::DuplicateService,
+                    s.name.span,
+                    format!(
+                        "`{}.{}.{}` is already defined",
+                        s.team.name, s.plan.name, s.name.name
+                    ),
+                )
+                .relate(first, "first defined here");
             self.rejected_bodies.push((Some(team), &s.body));
             return;
         }
@@ -247,15 +253,16 @@ impl<'a> Checker<'a> {
         };
         if let Some(existing) = self.team(team).mode_by_name(&m.name.name) {
             let first = self.team(team).modes[existing as usize].name_span;
-            self.report(
-                Code::DuplicateMode,
-                m.name.span,
-                format!(
-                    "the mode `{}.{}` is already defined",
-                    m.team.name, m.name.name
-                ),
-            )
-            .relate(first, "first defined here");
+            self.diagnostics
+                .report(
+                    Code::DuplicateMode,
+                    m.name.span,
+                    format!(
+                        "the mode `{}.{}` is already defined",
+                        m.team.name, m.name.name
+                    ),
+                )
+                .relate(first, "first defined here");
             return;
         }
         let t = self.team_mut(team);

@@ -24,7 +24,7 @@ pub(crate) mod lookup;
 pub use ir::*;
 
 use crate::catalog::Catalog;
-use crate::diag::{self, Code, Diagnostic, FileId};
+use crate::diag::{self, Diagnostic, FileId, Sink};
 use crate::fasthash::{FastMap, FastSet};
 use crate::span::Span;
 use crate::syntax::{self, ast, ast::Name};
@@ -101,14 +101,13 @@ pub(crate) fn is_user(name: &str) -> bool {
 type InlinedBody = (FunctionId, Option<TeamId>, Option<Index>, Vec<Index>);
 
 pub(crate) struct Checker<'a> {
-    file: FileId,
     /// The syntax of each team's services, parallel to `Team::services`, and of
     /// each function: bodies are walked from the tree, not from the IR copy.
     service_syntax: Vec<Vec<&'a ast::CompositeService>>,
     function_syntax: Vec<&'a ast::Function>,
     catalog: &'a Catalog,
     mission: Mission,
-    diagnostics: Vec<Diagnostic>,
+    diagnostics: Sink,
     teams_by_name: FastMap<Name, TeamId>,
     functions_by_name: FastMap<Name, FunctionId>,
     /// Team variables declared anywhere by `T.X = ...` or received, by name:
@@ -147,7 +146,6 @@ pub(crate) struct Checker<'a> {
 impl<'a> Checker<'a> {
     fn new(file: FileId, catalog: &'a Catalog) -> Self {
         Checker {
-            file,
             service_syntax: Vec::new(),
             function_syntax: Vec::new(),
             catalog,
@@ -155,7 +153,7 @@ impl<'a> Checker<'a> {
                 file,
                 ..Mission::default()
             },
-            diagnostics: Vec::new(),
+            diagnostics: Sink::new(file),
             teams_by_name: FastMap::default(),
             functions_by_name: FastMap::default(),
             variables: FastMap::default(),
@@ -170,14 +168,6 @@ impl<'a> Checker<'a> {
             scope_index: FastMap::default(),
             comparison_index: FastMap::default(),
         }
-    }
-
-    fn report(&mut self, code: Code, span: Span, message: impl Into<String>) -> &mut Diagnostic {
-        self.diagnostics
-            .push(Diagnostic::new(code, self.file, span, message));
-        self.diagnostics
-            .last_mut()
-            .unwrap_or_else(|| unreachable!())
     }
 
     fn occurrence(&mut self, span: Span, symbol: Symbol, is_definition: bool) {
@@ -263,7 +253,7 @@ impl<'a> Checker<'a> {
         self.mission
             .comparisons
             .sort_by_key(|(span, _)| (span.start, span.end));
-        (self.mission, self.diagnostics)
+        (self.mission, self.diagnostics.into_vec())
     }
 }
 

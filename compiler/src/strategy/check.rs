@@ -10,18 +10,15 @@
 //! `Battery` only.
 
 use super::model::*;
-use crate::diag::{Code, Diagnostic, FileId};
+use crate::diag::{Code, Sink};
 use crate::span::Span;
 use crate::suggest::did_you_mean;
 use crate::syntax::ast::{Expr, ExprKind};
 use std::collections::HashMap;
 
 /// Runs the per-file checks, adding to `diagnostics`.
-pub(super) fn check_strategy(strategy: &Strategy, diagnostics: &mut Vec<Diagnostic>) {
-    let mut checker = Checker {
-        file: strategy.file,
-        diagnostics,
-    };
+pub(super) fn check_strategy(strategy: &Strategy, diagnostics: &mut Sink) {
+    let mut checker = Checker { diagnostics };
     checker.duplicate_entries(strategy);
     for value in &strategy.values {
         checker.targets_once(&value.targets);
@@ -62,19 +59,10 @@ impl Seen {
 }
 
 struct Checker<'d> {
-    file: FileId,
-    diagnostics: &'d mut Vec<Diagnostic>,
+    diagnostics: &'d mut Sink,
 }
 
 impl Checker<'_> {
-    fn report(&mut self, code: Code, span: Span, message: impl Into<String>) -> &mut Diagnostic {
-        self.diagnostics
-            .push(Diagnostic::new(code, self.file, span, message));
-        self.diagnostics
-            .last_mut()
-            .unwrap_or_else(|| unreachable!())
-    }
-
     /// A value, or a service of a plan, refined twice for the same robot type.
     fn duplicate_entries(&mut self, strategy: &Strategy) {
         let mut values = Seen::default();
@@ -92,7 +80,8 @@ impl Checker<'_> {
                         "the value `{}` of {} is already described in this file",
                         name.name, robot.name
                     );
-                    self.report(Code::StrategyDuplicate, robot.span, message)
+                    self.diagnostics
+                        .report(Code::StrategyDuplicate, robot.span, message)
                         .relate(first, "first described here");
                 }
             }
@@ -115,7 +104,8 @@ impl Checker<'_> {
                         "the service `{}` of plan {} is already refined for {} in this file",
                         name.name, plan.name, robot.name
                     );
-                    self.report(Code::StrategyDuplicate, robot.span, message)
+                    self.diagnostics
+                        .report(Code::StrategyDuplicate, robot.span, message)
                         .relate(first, "first refined here");
                 }
             }
@@ -127,7 +117,8 @@ impl Checker<'_> {
         for name in targets.iter().filter_map(|t| t.name.as_ref()) {
             if let Some(first) = seen.first(name.name.clone(), name.span) {
                 let message = format!("`{}` is listed twice as a target robot here", name.name);
-                self.report(Code::StrategyDuplicate, name.span, message)
+                self.diagnostics
+                    .report(Code::StrategyDuplicate, name.span, message)
                     .relate(first, "first listed here");
             }
         }
@@ -138,7 +129,8 @@ impl Checker<'_> {
         for name in params.filter_map(|p| p.name.as_ref()) {
             if let Some(first) = seen.first(name.name.clone(), name.span) {
                 let message = format!("{scope} already has a parameter `{}`", name.name);
-                self.report(Code::StrategyDuplicate, name.span, message)
+                self.diagnostics
+                    .report(Code::StrategyDuplicate, name.span, message)
                     .relate(first, "first declared here");
             }
         }
@@ -193,7 +185,8 @@ impl Checker<'_> {
                 } else {
                     format!("`{name}` is not a parameter of {service_name} ({listed})")
                 };
-                self.report(Code::StrategyUnknownParameter, span, message)
+                self.diagnostics
+                    .report(Code::StrategyUnknownParameter, span, message)
                     .suggest(guess);
             }
         }
@@ -211,7 +204,8 @@ impl Checker<'_> {
             let message = format!(
                 "a battery requirement's condition reads `Battery` (the charge left, in percent), not `{name}`"
             );
-            self.report(Code::StrategyUnknownParameter, span, message)
+            self.diagnostics
+                .report(Code::StrategyUnknownParameter, span, message)
                 .suggest(Some("Battery".to_string()));
         }
     }
@@ -250,6 +244,7 @@ fn names_in(expr: &Expr) -> Vec<(String, Span, bool, bool)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::diag::FileId;
     use crate::syntax::parse_expr;
 
     #[test]

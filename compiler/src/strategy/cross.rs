@@ -26,7 +26,7 @@
 
 use super::model::*;
 use crate::catalog::{Catalog, Implementation, RobotType, RobotTypeId};
-use crate::diag::{Code, Diagnostic, FileId, Related};
+use crate::diag::{self, Code, Diagnostic, FileId, Related};
 use crate::sema::{Analysis, FunctionId, Index, Mission, Symbol, Team, TeamId};
 use crate::span::Span;
 use crate::suggest::did_you_mean;
@@ -345,11 +345,10 @@ impl Cross<'_> {
         span: Span,
         message: impl Into<String>,
     ) -> &mut Diagnostic {
-        self.diagnostics
-            .push(Diagnostic::new(code, file, span, message));
-        self.diagnostics
-            .last_mut()
-            .unwrap_or_else(|| unreachable!())
+        diag::push(
+            &mut self.diagnostics,
+            Diagnostic::new(code, file, span, message),
+        )
     }
 
     /// A report of `written`, which is none of `candidates`, with the nearest

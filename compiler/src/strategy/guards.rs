@@ -16,7 +16,7 @@
 //! condition always holds.
 
 use super::model::Action;
-use crate::diag::{Code, Diagnostic, FileId};
+use crate::diag::{Code, Sink};
 use crate::syntax::ast::{CmpOp, Expr, ExprKind};
 
 /// A guard over one variable, as a predicate on its value.
@@ -131,7 +131,7 @@ fn points(numbers: &mut Vec<f64>, variable: &str) -> Vec<Point> {
 }
 
 /// Checks the guards of `action`'s transitions, adding to `diagnostics`.
-pub(super) fn check_guards(file: FileId, action: &Action, diagnostics: &mut Vec<Diagnostic>) {
+pub(super) fn check_guards(action: &Action, sink: &mut Sink) {
     if action.transitions.is_empty() {
         return;
     }
@@ -155,9 +155,6 @@ pub(super) fn check_guards(file: FileId, action: &Action, diagnostics: &mut Vec<
     }
     let variable = variable.unwrap_or_default();
     let points = points(&mut numbers, &variable);
-    let report = |diagnostics: &mut Vec<Diagnostic>, code, span, message: String| {
-        diagnostics.push(Diagnostic::new(code, file, span, message));
-    };
     let what = action.describe();
     if points.is_empty() {
         // Only transitions without conditions.
@@ -166,14 +163,14 @@ pub(super) fn check_guards(file: FileId, action: &Action, diagnostics: &mut Vec<
                 "{what} has {} transitions without a condition: which one it takes is not determined",
                 guards.len()
             );
-            report(diagnostics, Code::OverlappingGuards, guards[1].1, message);
+            sink.report(Code::OverlappingGuards, guards[1].1, message);
         }
         return;
     }
     for (guard, span) in &guards {
         if !points.iter().any(|p| guard.holds(p.value)) {
             let message = format!("this condition never holds, for any value of `{variable}`");
-            report(diagnostics, Code::GuardNeverHolds, *span, message);
+            sink.report(Code::GuardNeverHolds, *span, message);
         }
     }
     for (i, (a, span_a)) in guards.iter().enumerate() {
@@ -183,10 +180,8 @@ pub(super) fn check_guards(file: FileId, action: &Action, diagnostics: &mut Vec<
                     "this condition and an earlier one of {what} both hold when {}: which transition is taken is not determined",
                     p.stretch
                 );
-                let mut diagnostic =
-                    Diagnostic::new(Code::OverlappingGuards, file, *span_b, message);
-                diagnostic.relate(*span_a, "the earlier condition");
-                diagnostics.push(diagnostic);
+                sink.report(Code::OverlappingGuards, *span_b, message)
+                    .relate(*span_a, "the earlier condition");
             }
         }
     }
@@ -201,6 +196,6 @@ pub(super) fn check_guards(file: FileId, action: &Action, diagnostics: &mut Vec<
             uncovered.join(", or ")
         );
         let span = action.name.as_ref().map_or(action.tag, |n| n.span);
-        report(diagnostics, Code::UncoveredGuards, span, message);
+        sink.report(Code::UncoveredGuards, span, message);
     }
 }

@@ -22,19 +22,13 @@
 //! transitions only.
 
 use super::model::*;
-use crate::diag::{Code, Diagnostic, FileId};
-use crate::span::Span;
+use crate::diag::{Code, Sink};
 use petgraph::graph::{DiGraph, NodeIndex};
 use petgraph::visit::Dfs;
 use std::collections::HashMap;
 
 /// Checks the action machine of `service`, adding to `diagnostics`.
-pub(super) fn check_machine(
-    file: FileId,
-    service: &ServiceEntry,
-    diagnostics: &mut Vec<Diagnostic>,
-) {
-    let mut sink = Sink { file, diagnostics };
+pub(super) fn check_machine(service: &ServiceEntry, sink: &mut Sink) {
     let actions = &service.actions;
     let name = service
         .name
@@ -116,7 +110,7 @@ pub(super) fn check_machine(
             );
             sink.report(Code::FinalWithTransitions, first.span, message);
         }
-        super::guards::check_guards(file, action, sink.diagnostics);
+        super::guards::check_guards(action, sink);
     }
 
     if !service.complete {
@@ -195,20 +189,5 @@ pub(super) fn check_machine(
             .as_ref()
             .map_or(actions[start].tag, |n| n.span);
         sink.report(Code::NoFinalAction, span, message);
-    }
-}
-
-struct Sink<'d> {
-    file: FileId,
-    diagnostics: &'d mut Vec<Diagnostic>,
-}
-
-impl Sink<'_> {
-    fn report(&mut self, code: Code, span: Span, message: String) -> &mut Diagnostic {
-        self.diagnostics
-            .push(Diagnostic::new(code, self.file, span, message));
-        self.diagnostics
-            .last_mut()
-            .unwrap_or_else(|| unreachable!())
     }
 }

@@ -35,13 +35,16 @@ use crate::diag::{self, Diagnostic, FileId};
 /// neither the catalog nor a mission): the strategy (`None` when the file has
 /// no `<Strategy>` element) and its diagnostics, sorted.
 pub fn load_strategy(file: FileId, text: &str) -> (Option<Strategy>, Vec<Diagnostic>) {
-    let (strategy, mut diagnostics) = xml::read_strategy(file, text);
+    let (strategy, read) = xml::read_strategy(file, text);
+    let mut sink = diag::Sink::new(file);
+    sink.extend(read);
     if let Some(strategy) = &strategy {
-        check::check_strategy(strategy, &mut diagnostics);
+        check::check_strategy(strategy, &mut sink);
         for service in &strategy.services {
-            machine::check_machine(file, service, &mut diagnostics);
+            machine::check_machine(service, &mut sink);
         }
     }
+    let mut diagnostics = sink.into_vec();
     diag::sort_and_dedup(&mut diagnostics);
     (strategy, diagnostics)
 }

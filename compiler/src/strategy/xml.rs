@@ -16,12 +16,11 @@
 
 use super::model::*;
 use super::schema::*;
-use crate::diag::{Code, Diagnostic, FileId};
-use crate::span::Span;
+use crate::diag::{Code, Diagnostic, FileId, Sink};
 use crate::syntax::ast::TimeUnit;
 use crate::syntax::{parse_expr, parse_expr_mapped};
 use crate::xmlpos::{Attr, get, is_ident, shown, suggest, value_offsets};
-use crate::xmltree::{Elem, TreeFormat, Vocabulary, one_line_diagnostic, read_tree};
+use crate::xmltree::{Elem, TreeFormat, Vocabulary, read_tree};
 
 /// Reads one strategy file: the strategy (`None` when the file has no
 /// `<Strategy>` root element) and the diagnostics of reading it. The checks of
@@ -36,13 +35,15 @@ pub fn read_strategy(file: FileId, text: &str) -> (Option<Strategy>, Vec<Diagnos
             raw_lt: Some(Code::StrategyRawLt),
         },
     );
+    let mut sink = Sink::quoting_xml(file);
+    sink.extend(diagnostics);
     let mut reader = Reader {
         file,
         text,
-        diagnostics,
+        diagnostics: sink,
     };
     let strategy = root.and_then(|root| reader.root(&root));
-    (strategy, reader.diagnostics)
+    (strategy, reader.diagnostics.into_vec())
 }
 
 /// Every element of the format, with where it belongs (for "not allowed here").
@@ -86,18 +87,10 @@ const ELEMENTS: &[(&str, &str)] = &[
 struct Reader<'t> {
     file: FileId,
     text: &'t str,
-    diagnostics: Vec<Diagnostic>,
+    diagnostics: Sink,
 }
 
 impl Reader<'_> {
-    fn report(&mut self, code: Code, span: Span, message: impl Into<String>) -> &mut Diagnostic {
-        self.diagnostics
-            .push(one_line_diagnostic(code, self.file, span, message));
-        self.diagnostics
-            .last_mut()
-            .unwrap_or_else(|| unreachable!())
-    }
-
     // --- shared helpers ----------------------------------------------------
 
     fn vocabulary(&self) -> Vocabulary<'static> {
@@ -145,12 +138,13 @@ impl Reader<'_> {
         let mut found = children.iter().filter(|c| c.local == name);
         let first = found.next().copied()?;
         for again in found {
-            self.report(
-                Code::StrategyDuplicate,
-                again.name_span,
-                format!("`<{name}>` is given twice here: write it once"),
-            )
-            .relate(first.name_span, "first given here");
+            self.diagnostics
+                .report(
+                    Code::StrategyDuplicate,
+                    again.name_span,
+                    format!("`<{name}>` is given twice here: write it once"),
+                )
+                .relate(first.name_span, "first given here");
         }
         Some(first)
     }
@@ -159,7 +153,8 @@ impl Reader<'_> {
     fn require_child(&mut self, e: &Elem, children: &[&Elem], child: &str, what: &str) {
         if e.complete && !children.iter().any(|c| c.local == child) {
             let message = format!("`<{}>` needs {what}", e.local);
-            self.report(Code::StrategyMissingAttribute, e.tag, message);
+            self.diagnostics
+                .report(Code::StrategyMissingAttribute, e.tag, message);
         }
     }
 
@@ -168,7 +163,8 @@ impl Reader<'_> {
         match get(&e.attrs, key) {
             None => {
                 let message = format!("`<{}>` needs a `{key}` attribute", e.local);
-                self.report(Code::StrategyMissingAttribute, e.tag, message);
+                self.diagnostics
+                    .report(Code::StrategyMissingAttribute, e.tag, message);
                 None
             }
             Some(a) => self.not_blank(a),
@@ -183,7 +179,8 @@ impl Reader<'_> {
     fn not_blank<'a>(&mut self, a: &'a Attr) -> Option<&'a Attr> {
         if a.trimmed().is_empty() {
             let message = format!("`{}` is empty", a.key);
-            self.report(Code::StrategyBadAttribute, a.span, message);
+            self.diagnostics
+                .report(Code::StrategyBadAttribute, a.span, message);
             return None;
         }
         Some(a)
@@ -208,7 +205,8 @@ impl Reader<'_> {
             a?.key,
             shown(&named.name)
         );
-        self.report(Code::StrategyBadAttribute, named.span, message);
+        self.diagnostics
+            .report(Code::StrategyBadAttribute, named.span, message);
         None
     }
 
@@ -229,7 +227,8 @@ impl Reader<'_> {
                 } else {
                     format!("`{}` must be {what}, not `{}`", a.key, shown(s))
                 };
-                self.report(Code::StrategyBadAttribute, a.trimmed_span(), message);
+                self.diagnostics
+                    .report(Code::StrategyBadAttribute, a.trimmed_span(), message);
                 None
             }
         }
@@ -267,7 +266,8 @@ impl Reader<'_> {
             .find(|w| w.eq_ignore_ascii_case(s))
             .map(|w| w.to_string())
             .or_else(|| suggest(s, &words));
-        self.report(Code::StrategyBadAttribute, a.span, message)
+        self.diagnostics
+            .report(Code::StrategyBadAttribute, a.span, message)
             .suggest(guess);
         None
     }
@@ -308,7 +308,8 @@ impl Reader<'_> {
                     a.key,
                     shown(a.trimmed())
                 );
-                self.report(Code::StrategyBadAttribute, a.span, message);
+                self.diagnostics
+                    .report(Code::StrategyBadAttribute, a.span, message);
                 None
             }
         }
@@ -340,7 +341,8 @@ impl Reader<'_> {
                 "a strategy file must start with `<Strategy name=\"Team\">`, not `<{}>`",
                 root.qname
             );
-            self.report(Code::StrategyUnknownElement, root.name_span, message)
+            self.diagnostics
+                .report(Code::StrategyUnknownElement, root.name_span, message)
                 .suggest(suggest(&root.local, &["Strategy"]));
             return None;
         }
@@ -490,7 +492,8 @@ impl Reader<'_> {
                         "goes to"
                     }
                 );
-                self.report(Code::StrategyMissingAttribute, e.tag, message);
+                self.diagnostics
+                    .report(Code::StrategyMissingAttribute, e.tag, message);
             }
         }
         Parameter {
@@ -513,18 +516,19 @@ impl Reader<'_> {
         let name = match (get(&e.attrs, "name"), get(&e.attrs, "service_name")) {
             (Some(a), Some(b)) => {
                 if a.trimmed() != b.trimmed() {
-                    self.report(
-                        Code::StrategyBadAttribute,
-                        b.span,
-                        "`service_name` is another spelling of `name`: give one of them",
-                    )
-                    .relate(a.span, "`name` is given here");
+                    self.diagnostics
+                        .report(
+                            Code::StrategyBadAttribute,
+                            b.span,
+                            "`service_name` is another spelling of `name`: give one of them",
+                        )
+                        .relate(a.span, "`name` is given here");
                 }
                 self.not_blank(a)
             }
             (Some(a), None) | (None, Some(a)) => self.not_blank(a),
             (None, None) => {
-                self.report(
+                self.diagnostics.report(
                     Code::StrategyMissingAttribute,
                     e.tag,
                     "`<Service>` needs a `name` attribute: the service it refines, such as `move`",
@@ -650,7 +654,7 @@ impl Reader<'_> {
                     let message = format!(
                         "`{has}` needs `{lacks}` too: together they name the composite service whose leader is elected"
                     );
-                    self.report(Code::StrategyMissingAttribute, a.key_span, message);
+                    self.diagnostics.report(Code::StrategyMissingAttribute, a.key_span, message);
                 }
             }
             LeaderSelection {

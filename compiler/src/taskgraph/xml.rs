@@ -44,12 +44,12 @@
 //! (`default="true"`).
 
 use super::model::*;
-use crate::diag::{Code, Diagnostic, FileId, sort_and_dedup};
+use crate::diag::{Code, Diagnostic, FileId, Sink, sort_and_dedup};
 use crate::span::Span;
 use crate::suggest::did_you_mean;
 use crate::syntax::ast::TimeUnit;
 use crate::xmlpos::{Attr, get, is_ident, shown, suggest};
-use crate::xmltree::{Elem, TreeFormat, Vocabulary, one_line_diagnostic, read_tree};
+use crate::xmltree::{Elem, TreeFormat, Vocabulary, read_tree};
 use quick_xml::Reader;
 use quick_xml::events::Event;
 use std::collections::{HashMap, HashSet};
@@ -91,10 +91,7 @@ pub fn load_task_graph_as(
     text: &str,
     times: ExecutionTimes,
 ) -> (Option<TaskGraph>, Vec<Diagnostic>) {
-    let mut sink = Sink {
-        file,
-        list: Vec::new(),
-    };
+    let mut sink = Sink::quoting_xml(file);
     let (root, xml_diagnostics) = read_tree(
         text,
         TreeFormat {
@@ -104,7 +101,7 @@ pub fn load_task_graph_as(
             raw_lt: None,
         },
     );
-    sink.list.extend(xml_diagnostics);
+    sink.extend(xml_diagnostics);
     let graph = root.and_then(|root| {
         let mut loader = Loader {
             file,
@@ -128,7 +125,7 @@ pub fn load_task_graph_as(
             }
         }
     });
-    let mut diags = sink.list;
+    let mut diags = sink.into_vec();
     sort_and_dedup(&mut diags);
     (graph, diags)
 }
@@ -149,19 +146,6 @@ pub fn detect_format(text: &str) -> Option<GraphFormat> {
             Ok(Event::Eof) | Err(_) => return None,
             Ok(_) => {}
         }
-    }
-}
-
-struct Sink {
-    file: FileId,
-    list: Vec<Diagnostic>,
-}
-
-impl Sink {
-    fn report(&mut self, code: Code, span: Span, message: impl Into<String>) -> &mut Diagnostic {
-        self.list
-            .push(one_line_diagnostic(code, self.file, span, message));
-        self.list.last_mut().expect("just pushed")
     }
 }
 
@@ -273,12 +257,12 @@ impl Loader<'_> {
             (key == "rate" && allowed.contains(&"outerRate")).then(|| "outerRate".to_string())
         };
         self.vocabulary()
-            .check_attributes(&mut self.sink.list, e, allowed, hint);
+            .check_attributes(self.sink, e, allowed, hint);
     }
 
     /// The child elements among `allowed`; E061 for the others and for text.
     fn children<'e>(&mut self, e: &'e Elem, allowed: &[&str]) -> Vec<&'e Elem> {
-        self.vocabulary().children(&mut self.sink.list, e, allowed)
+        self.vocabulary().children(self.sink, e, allowed)
     }
 
     /// A required attribute: E062 when missing, E065 when blank.

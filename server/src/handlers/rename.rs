@@ -1,33 +1,26 @@
-//! `textDocument/rename`: one edit per name meaning the renamed symbol, all in
-//! the mission (a mission is self-contained), or an error naming what the new
-//! name is wrong for.
+//! `textDocument/rename`: [`semo::host::Analysis::rename`], or an error
+//! naming what the new name is wrong for; the caller names the files.
 
+use crate::to_proto::{self, FileEdits};
 use crate::world::Snapshot;
-use std::collections::HashMap;
+use semo::host::Analysis;
 use tower_lsp_server::jsonrpc::Result;
-use tower_lsp_server::ls_types::{RenameParams, TextEdit, WorkspaceEdit};
+use tower_lsp_server::ls_types::RenameParams;
 
-pub fn rename(snapshot: &Snapshot, params: &RenameParams) -> Result<Option<WorkspaceEdit>> {
+pub fn rename(
+    snapshot: &Snapshot,
+    workspace: &Analysis,
+    params: &RenameParams,
+) -> Result<Option<FileEdits>> {
     let position = params.text_document_position.position;
-    super::with_mission(snapshot, |analysis, lines| {
-        let offset = lines.offset(position);
-        let catalog = snapshot.catalog.catalog();
-        let spans = semo::ide::mission::rename::rename(
-            analysis,
-            catalog,
-            &snapshot.text,
-            offset,
-            &params.new_name,
-        )
-        .map_err(|e| super::request_failed(e.to_string()))?;
-        let edits = spans
-            .into_iter()
-            .map(|span| TextEdit::new(lines.range(span), params.new_name.clone()))
-            .collect();
-        Ok(WorkspaceEdit {
-            changes: Some(HashMap::from([(snapshot.uri.clone(), edits)])),
-            ..WorkspaceEdit::default()
-        })
-    })
-    .transpose()
+    let analysis = snapshot.analysis();
+    let lines = snapshot.line_map(&analysis);
+    let Some(change) = workspace.rename(snapshot.position(&lines, position), &params.new_name)
+    else {
+        return Ok(None);
+    };
+    let change = change.map_err(|e| super::request_failed(e.to_string()))?;
+    Ok(Some(to_proto::source_change(
+        snapshot, workspace, &lines, change,
+    )))
 }

@@ -1,21 +1,18 @@
-//! `textDocument/signatureHelp`: [`semo::ide::mission::signature_help`] in protocol types.
+//! `textDocument/signatureHelp`: [`semo::host::Analysis::signature_help`] in protocol types.
 
 use crate::encoding::Encoding;
 use crate::world::Snapshot;
+use semo::host::Analysis;
 use tower_lsp_server::ls_types::*;
 
-pub fn signature_help(snapshot: &Snapshot, position: Position) -> Option<SignatureHelp> {
+pub fn signature_help(
+    snapshot: &Snapshot,
+    workspace: &Analysis,
+    position: Position,
+) -> Option<SignatureHelp> {
     let analysis = snapshot.analysis();
-    let mission = analysis.mission.as_ref()?;
     let lines = snapshot.line_map(&analysis);
-    let offset = lines.offset(position);
-    let catalog = snapshot.catalog.catalog();
-    let help = semo::ide::mission::signature_help::signature_help(
-        mission,
-        catalog,
-        &snapshot.text,
-        offset,
-    )?;
+    let help = workspace.signature_help(snapshot.position(&lines, position))?;
     // Parameter offsets count in the negotiated encoding, as positions do.
     let units = |s: &str| -> u32 {
         match snapshot.encoding {

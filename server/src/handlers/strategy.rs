@@ -1,64 +1,13 @@
-//! Completion, hover, navigation, outline and fixes in `*.strategy.xml`
-//! files: [`semo::ide::strategy`] in protocol types. The request handlers
-//! hand strategy files over to these; a strategy snapshot carries the
-//! missions it was checked against, so names lead into them.
+//! The outline and fixes of `*.strategy.xml` files, and a mission's fix
+//! creating a strategy entry: [`semo::ide::strategy`] in protocol types (the
+//! features not yet behind `semo::host::Analysis`'s position queries).
 
 use crate::encoding::LineMap;
-use crate::to_proto;
-use crate::world::{FileAnalysis, Snapshot};
-use semo::Analysis;
-use semo::diag::FileId;
-use semo::ide::strategy::{self as ide, StrategyFile};
+use crate::world::Snapshot;
+use semo::ide::strategy as ide;
 use std::collections::HashMap;
 use std::sync::Arc;
 use tower_lsp_server::ls_types::*;
-
-/// Runs `f` on the strategy file of `snapshot` with its missions analysed.
-fn with_file<T>(
-    snapshot: &Snapshot,
-    f: impl FnOnce(&StrategyFile<'_>, &FileAnalysis, LineMap<'_>) -> T,
-) -> T {
-    let analysis = snapshot.analysis();
-    let analyses: Vec<Arc<FileAnalysis>> = snapshot.missions.iter().map(|m| m.analysis()).collect();
-    let missions: Vec<&Analysis> = analyses
-        .iter()
-        .filter_map(|a| a.mission.as_deref())
-        .collect();
-    let file = StrategyFile {
-        text: &snapshot.text,
-        strategy: analysis.strategy.as_ref(),
-        missions: &missions,
-        catalog: snapshot.catalog.catalog(),
-    };
-    f(&file, &analysis, snapshot.line_map(&analysis))
-}
-
-pub fn references(
-    snapshot: &Snapshot,
-    position: Position,
-    include_declaration: bool,
-) -> Vec<Location> {
-    let targets = with_file(snapshot, |file, analysis, lines| {
-        let offset = lines.offset(position);
-        ide::navigation::references(file, &analysis.strategy_links, offset, include_declaration)
-    });
-    let uri_of = |id: FileId| {
-        if id == snapshot.id {
-            return Some(snapshot.uri.clone());
-        }
-        snapshot
-            .missions
-            .iter()
-            .find(|m| m.id == id)
-            .map(|m| m.uri.clone())
-    };
-    let analysis = snapshot.analysis();
-    let lines = snapshot.line_map(&analysis);
-    to_proto::target_ranges(snapshot, snapshot.host(), &lines, targets)
-        .into_iter()
-        .filter_map(|(file, range)| Some(Location::new(uri_of(file)?, range)))
-        .collect()
-}
 
 /// The strategy snapshots checked against this very version of `mission`
 /// (whose links and positions therefore point into it).

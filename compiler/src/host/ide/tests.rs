@@ -209,3 +209,46 @@ fn a_strategy_in_a_sibling_folder_is_not_a_definition() {
     ));
     insta::assert_snapshot!(w.definition(), @r#"/w/a/rover.robot.xml:3:5 <Service name="dig" task="dig_task" doc="Digs a hole."/>"#);
 }
+
+#[test]
+fn references_of_a_strategy_entry_are_its_name_and_the_calls_it_refines() {
+    let w = workspace(&format!(
+        "{MISSION}{CATALOG}{}",
+        STRATEGY.replace("name=\"dig\"", "name=\"d$0ig\"")
+    ));
+    let found = w.host.analysis().references(w.cursor, true);
+    insta::assert_snapshot!(w.show(&found), @r"
+    /w/a/A.strategy.xml:3:34 dig
+    /w/a/m.mission:2:9 dig
+    ");
+    let found = w.host.analysis().references(w.cursor, false);
+    insta::assert_snapshot!(w.show(&found), @"/w/a/m.mission:2:9 dig");
+}
+
+#[test]
+fn rename_in_a_mission_is_a_change_of_that_mission() {
+    let w = workspace(&format!(
+        "{}{CATALOG}",
+        MISSION.replace("A.M { set(P, S) }", "A.M { set($0P, S) }")
+    ));
+    let change = w.host.analysis().rename(w.cursor, "Q").expect("a mission");
+    let change = change.expect("a valid rename");
+    let [(file, edits)] = &change.edits[..] else {
+        panic!("one file: {change:?}");
+    };
+    assert_eq!(*file, w.cursor.file);
+    let targets: Vec<NavigationTarget> = edits
+        .iter()
+        .map(|e| NavigationTarget {
+            file: *file,
+            span: e.span,
+        })
+        .collect();
+    insta::assert_snapshot!(w.show(&targets), @r"
+    /w/a/m.mission:2:3 P
+    /w/a/m.mission:3:11 P
+    ");
+    assert!(edits.iter().all(|e| e.new_text == "Q"));
+    let refused = w.host.analysis().rename(w.cursor, "not a name");
+    assert!(matches!(refused, Some(Err(_))), "{refused:?}");
+}
