@@ -49,14 +49,14 @@ fn a_file_sees_its_folder_below_it_and_the_folders_above_it_up_to_its_root() {
 
 #[test]
 fn under_a_project_file_a_file_sees_the_folders_it_names_and_nothing_else() {
-    let text = "[project]\ncatalogs = [\"robots\", \"../shared\"]\nstrategies = [\"s\"]\n";
+    let text = "[project]\ncatalogs = [\"robots\", \"../common\"]\nstrategies = [\"s\"]\n";
     let (project, diagnostics) = crate::project::parse(FileId(0), Path::new("/w/p"), text);
     assert!(diagnostics.is_empty(), "{diagnostics:?}");
     let r = roots(&["/w"]);
     let sees = |m: &str, f: &str| sees(&r, |_| false, Some(&project), Path::new(m), Path::new(f));
     let m = "/w/p/missions/m.mission";
     assert!(sees(m, "/w/p/robots/deep/down/below/x.robot.xml"));
-    assert!(sees(m, "/w/shared/x.robot.xml"));
+    assert!(sees(m, "/w/common/x.robot.xml"));
     assert!(sees(m, "/w/p/s/x.strategy.xml"));
     // A strategy file in a catalog folder, a catalog beside the mission,
     // one in the project root: not named, not seen.

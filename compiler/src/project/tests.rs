@@ -30,7 +30,7 @@ fn a_full_project_file_is_read() {
 [project]
 version = 1
 name = "scouting"
-catalogs = ["robots", "../shared/robots"]
+catalogs = ["robots", "../common/robots"]
 strategies = ["./strategies"]
 task-graphs = ["graphs"]
 
@@ -51,7 +51,7 @@ E019 = "deny"
         ps.iter().map(|p| p.path.display().to_string()).collect()
     };
     assert_eq!(project.name.as_deref(), Some("scouting"));
-    assert_eq!(paths(&project.catalogs), ["/p/robots", "/shared/robots"]);
+    assert_eq!(paths(&project.catalogs), ["/p/robots", "/common/robots"]);
     assert_eq!(paths(&project.strategies), ["/p/strategies"]);
     assert_eq!(paths(&project.task_graphs), ["/p/graphs"]);
     assert_eq!(project.output.as_ref().unwrap().path, Path::new("/p/gen"));
