@@ -437,6 +437,40 @@ fn settled<'e>(events: &[&'e Event]) -> Vec<&'e Event> {
         .collect()
 }
 
+/// One heartbeat period of the generated missions (200 ms): after a link
+/// fault ends, which of two robots leads is decided by whether one's
+/// heartbeat or the other's message (each every 200 ms, a few ms apart)
+/// arrives first; within the simulator's link latency that is a race in real
+/// time (random seed 14: a leader's publish 2 ms after the heartbeat that
+/// ends its leadership).
+const HEAL_MS: i64 = 200;
+
+/// The events without the receptions of the heartbeat period after each
+/// link fault of `scenario` ends ([`HEAL_MS`]).
+fn healed<'e>(events: &[&'e Event], scenario: &str) -> Vec<&'e Event> {
+    let scenario: serde_json::Value = serde_json::from_str(scenario).unwrap();
+    let ends: Vec<i64> = scenario["faults"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter(|f| {
+            ["drop", "delay", "partition"]
+                .iter()
+                .any(|k| f.get(k).is_some())
+        })
+        .filter_map(|f| f["until"].as_i64())
+        .collect();
+    events
+        .iter()
+        .copied()
+        .filter(|e| {
+            let t = e["t"].as_i64().unwrap();
+            field(e, "event") != "receive"
+                || !ends.iter().any(|&end| (end..end + HEAL_MS).contains(&t))
+        })
+        .collect()
+}
+
 /// The events up to `until` mission ms.
 fn until<'e>(events: &[&'e Event], until: i64) -> Vec<&'e Event> {
     events
@@ -463,7 +497,8 @@ fn starts<T: PartialEq>(early: &[(T, bool)], all: &[(T, bool)]) -> bool {
 /// random scenarios (battery levels, link faults): the same checks as for the examples, except that a run
 /// ends at a cut-off one of the two may reach a little earlier, so each
 /// run's behaviour up to [`LATE_MS`] before the end must begin the
-/// other's; receptions of the start-up window ([`START_MS`]) are left out.
+/// other's; receptions of the start-up window ([`START_MS`]) and of the
+/// heartbeat period after a link fault ends ([`HEAL_MS`]) are left out.
 fn random_missions(seeds: std::ops::Range<u64>) {
     let catalog = semo::catalog::builtin_catalog();
     let duration = 2000;
@@ -487,6 +522,7 @@ fn random_missions(seeds: std::ops::Range<u64>) {
                 .filter(|e| field(e, "robot") == robot)
                 .collect();
             let (c, s) = (settled(&c), settled(&s));
+            let (c, s) = (healed(&c, &scenario), healed(&s, &scenario));
             let cut = duration - LATE_MS;
             let (c_early, s_early) = (behaviour(&until(&c, cut)), behaviour(&until(&s, cut)));
             let (c_all, s_all) = (behaviour(&c), behaviour(&s));
