@@ -115,9 +115,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             }
         }
     };
-    let Some(input) = run.analysis().build_input(mission) else {
-        eprintln!("internal error: the mission was loaded but not checked");
-        return 2;
+    let input = match super::build_files(&run.analysis(), mission) {
+        Ok(files) => files,
+        Err(code) => return code,
     };
     let input = input.input();
     if let Some(deployment) = &deployment {

@@ -90,9 +90,9 @@ pub fn broker_config(
         Ok(deployment) => deployment,
         Err(code) => return code,
     };
-    let Some(input) = run.analysis().build_input(mission) else {
-        eprintln!("internal error: the mission was loaded but not checked");
-        return 2;
+    let input = match super::build_files(&run.analysis(), mission) {
+        Ok(files) => files,
+        Err(code) => return code,
     };
     let input = input.input();
     let refined = codegen::refine_checked(&input);

@@ -597,6 +597,18 @@ enum EmitArg {
     Taskgraph,
 }
 
+/// The files `mission` is built with, from an analysis that loaded and
+/// checked it; a mission the analysis lacks is an internal error (exit 2).
+fn build_files(
+    analysis: &semo::host::Analysis,
+    mission: semo::diag::FileId,
+) -> Result<semo::host::BuildFiles, i32> {
+    analysis.build_input(mission).ok_or_else(|| {
+        eprintln!("internal error: the mission was loaded but not checked");
+        2
+    })
+}
+
 fn parse_target(name: &str) -> Result<semo::codegen::Target, String> {
     semo::codegen::Target::from_name(name).ok_or_else(|| {
         let names: Vec<&str> = semo::codegen::TARGETS.iter().map(|t| t.name).collect();

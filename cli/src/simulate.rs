@@ -75,9 +75,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     if !input::is_kind(&scenario_name, &scenario_text, Content::Scenario, SIMULATE) {
         return 2;
     }
-    let Some(build) = check.analysis().build_input(mission) else {
-        eprintln!("internal error: the mission was loaded but not checked");
-        return 2;
+    let build = match super::build_files(&check.analysis(), mission) {
+        Ok(files) => files,
+        Err(code) => return code,
     };
     let refined = semo::codegen::refine_checked(&build.input());
     if refined.diagnostics.iter().any(|d| d.is_error()) {
