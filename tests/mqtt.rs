@@ -1249,3 +1249,153 @@ fn the_operator_console_drives_scouting_to_finish() {
         "{printed:?}"
     );
 }
+
+/// The `semo/monitor` notification of the server behind `client` whose
+/// robots satisfy `wanted`; one that never comes fails the test.
+async fn monitor_view(
+    client: &mut semo_server::harness::TestClient,
+    wanted: impl Fn(&serde_json::Value) -> bool,
+) -> serde_json::Value {
+    tokio::time::timeout(
+        std::time::Duration::from_secs(60),
+        client.notification("semo/monitor", wanted),
+    )
+    .await
+    .expect("the awaited semo/monitor notification comes")
+}
+
+fn shown<'v>(view: &'v serde_json::Value, robot: &str) -> &'v serde_json::Value {
+    view["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["robot"] == robot)
+        .unwrap_or_else(|| panic!("{robot} is shown: {view}"))
+}
+
+#[test]
+fn the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost() {
+    let Some(binary) =
+        broker_or_skip("the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost")
+    else {
+        return;
+    };
+    // The broker of the deployment file with its ACL: the monitor finds it
+    // through the project's semo.toml and connects as the operator.
+    let out = scratch("mqtt-monitor");
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let deploy = scouting_deployment(&out, port, false);
+    let config = broker_config(&out, &deploy);
+    let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
+    let mut processes = Processes::default();
+    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+    let workspace = out.join("workspace");
+    std::fs::create_dir_all(&workspace).unwrap();
+    for file in ["scouting.mission", "MasterTeam.strategy.xml"] {
+        std::fs::copy(examples().join("scouting").join(file), workspace.join(file)).unwrap();
+    }
+    std::fs::write(
+        workspace.join("semo.toml"),
+        format!("[build]\ndeployment = \"{}\"\n", deploy.display()),
+    )
+    .unwrap();
+    // Without the simulated operator the master waits in WAIT_MODE: the
+    // robots stay running.
+    let mut world: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scenario()).unwrap()).unwrap();
+    world["operator"] = serde_json::json!([]);
+    world.as_object_mut().unwrap().remove("expect");
+    let alone = out.join("no-operator.scenario.json");
+    std::fs::write(&alone, world.to_string()).unwrap();
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let mut client = semo_server::harness::TestClient::start();
+        let root = format!("file://{}", workspace.display());
+        client
+            .initialize_with(serde_json::json!({}), Some(&root))
+            .await;
+        let mission = workspace.join("scouting.mission");
+        let uri = format!("file://{}", mission.display());
+        client
+            .open(&uri, &std::fs::read_to_string(&mission).unwrap())
+            .await;
+        client.diagnostics(&uri, Some(1)).await;
+        let answer = client
+            .request("semo/monitor/start", serde_json::json!({ "uri": uri }))
+            .await
+            .expect("the monitor starts");
+        assert_eq!(answer["broker"], format!("mqtt://127.0.0.1:{port}"));
+        let view = monitor_view(&mut client, |p| p["connection"] == "connected").await;
+        let names: Vec<String> = folders.iter().map(|f| robot_name(f)).collect();
+        for robot in &names {
+            assert_eq!(shown(&view, robot)["state"], "waiting", "{view}");
+        }
+
+        for folder in &folders {
+            let robot = robot_name(folder);
+            let trace = out.join(format!("{robot}.monitored.jsonl"));
+            let child = robot_command(folder, &alone, &trace, 1)
+                .args(["--transport", "mqtt", "--duration", "1000000"])
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("the robot program starts");
+            processes.push(child);
+        }
+        // Every robot running in a mode with its services; the master
+        // waiting for the operator, listening.
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|robots| {
+                robots.iter().all(|r| {
+                    r["state"] == "running"
+                        && r["mode"].is_string()
+                        && r["services"].as_array().is_some_and(|s| !s.is_empty())
+                }) && robots
+                    .iter()
+                    .any(|r| r["robot"] == "irobot" && r["mode"] == "WAIT_MODE")
+            })
+        })
+        .await;
+        let master = shown(&view, "irobot");
+        assert_eq!(master["team"], "MasterTeam");
+        assert!(
+            master["services"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|s| s["plan"] == "Listen" && s["service"] == "ReportStatus"),
+            "{view}"
+        );
+
+        // Killed: the broker's last will marks it lost, the others run on.
+        let irobot = names.iter().position(|n| n == "irobot").unwrap();
+        // The broker is process 0, the robots follow in folder order.
+        processes.0[1 + irobot].kill().unwrap();
+        processes.0[1 + irobot].wait().unwrap();
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|r| {
+                r.iter()
+                    .any(|r| r["robot"] == "irobot" && r["lost"] == true)
+            })
+        })
+        .await;
+        assert_eq!(shown(&view, "irobot")["lostBecause"], "lastWill");
+        for robot in names.iter().filter(|n| *n != "irobot") {
+            assert_eq!(shown(&view, robot)["state"], "running", "{view}");
+        }
+        let stopped = client
+            .request("semo/monitor/stop", serde_json::json!({ "uri": uri }))
+            .await
+            .unwrap();
+        assert_eq!(stopped["stopped"], true);
+        client.shutdown().await;
+    });
+}

@@ -420,6 +420,7 @@ impl LanguageServer for Backend {
     }
 
     async fn shutdown(&self) -> Result<()> {
+        self.monitors.stop_all();
         Ok(())
     }
 

@@ -64,6 +64,12 @@ impl Monitors {
         old.is_some()
     }
 
+    /// Ends every session (the server shuts down).
+    pub fn stop_all(&self) {
+        let all = std::mem::take(&mut *self.lock());
+        drop(all);
+    }
+
     fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<String, Session>> {
         self.sessions.lock().unwrap_or_else(|e| e.into_inner())
     }
