@@ -165,7 +165,12 @@ fn build_scouting(out: &Path) -> Vec<PathBuf> {
 
 /// The same with more `semo build` arguments (`--deploy FILE`).
 fn build_scouting_with(out: &Path, extra: &[&str]) -> Vec<PathBuf> {
-    let mission = examples().join("scouting/scouting.mission");
+    build_for_mqtt(&examples().join("scouting/scouting.mission"), out, extra)
+}
+
+/// `semo build MISSION --target linux-sim` with `extra` arguments, each
+/// robot made with the MQTT transport built in, warnings as errors.
+fn build_for_mqtt(mission: &Path, out: &Path, extra: &[&str]) -> Vec<PathBuf> {
     let (mission, out_arg) = (mission.display().to_string(), out.display().to_string());
     let mut args = vec![
         "build",
@@ -546,8 +551,12 @@ fn scouting_deployment(dir: &Path, port: u16, tls: bool) -> PathBuf {
 /// `semo deploy broker-config` into `dir/broker`, run as this user, logging
 /// to `dir/broker/mosquitto.log`; returns the configuration's path.
 fn broker_config(dir: &Path, deploy: &Path) -> PathBuf {
+    broker_config_for(dir, &examples().join("scouting/scouting.mission"), deploy)
+}
+
+/// The same for another mission.
+fn broker_config_for(dir: &Path, mission: &Path, deploy: &Path) -> PathBuf {
     let out = dir.join("broker");
-    let mission = examples().join("scouting/scouting.mission");
     let written = support::semo_in(
         dir,
         &[
@@ -1256,12 +1265,22 @@ async fn monitor_view(
     client: &mut semo_server::harness::TestClient,
     wanted: impl Fn(&serde_json::Value) -> bool,
 ) -> serde_json::Value {
-    tokio::time::timeout(
+    let last = std::sync::Mutex::new(serde_json::Value::Null);
+    let seen = |p: &serde_json::Value| {
+        *last.lock().unwrap() = p.clone();
+        wanted(p)
+    };
+    let found = tokio::time::timeout(
         std::time::Duration::from_secs(60),
-        client.notification("semo/monitor", wanted),
+        client.notification("semo/monitor", seen),
     )
-    .await
-    .expect("the awaited semo/monitor notification comes")
+    .await;
+    found.unwrap_or_else(|_| {
+        panic!(
+            "the awaited semo/monitor notification did not come; the last one: {}",
+            last.lock().unwrap()
+        )
+    })
 }
 
 fn shown<'v>(view: &'v serde_json::Value, robot: &str) -> &'v serde_json::Value {
@@ -1271,6 +1290,47 @@ fn shown<'v>(view: &'v serde_json::Value, robot: &str) -> &'v serde_json::Value 
         .iter()
         .find(|r| r["robot"] == robot)
         .unwrap_or_else(|| panic!("{robot} is shown: {view}"))
+}
+
+/// A workspace for the editor: `files` copied in, and a `semo.toml` whose
+/// `[build] deployment` is `deploy`.
+fn monitor_workspace(out: &Path, deploy: &Path, files: &[PathBuf]) -> PathBuf {
+    let workspace = out.join("workspace");
+    std::fs::create_dir_all(&workspace).unwrap();
+    for file in files {
+        std::fs::copy(file, workspace.join(file.file_name().unwrap())).unwrap();
+    }
+    std::fs::write(
+        workspace.join("semo.toml"),
+        format!("[build]\ndeployment = \"{}\"\n", deploy.display()),
+    )
+    .unwrap();
+    workspace
+}
+
+/// The language server (in-process) on `workspace`, `mission` open and
+/// checked, and its monitor started with no broker named (so the
+/// deployment file's); the client, the mission's URI and the answer.
+async fn start_monitor(
+    workspace: &Path,
+    mission: &str,
+) -> (semo_server::harness::TestClient, String, serde_json::Value) {
+    let mut client = semo_server::harness::TestClient::start();
+    let root = format!("file://{}", workspace.display());
+    client
+        .initialize_with(serde_json::json!({}), Some(&root))
+        .await;
+    let mission = workspace.join(mission);
+    let uri = format!("file://{}", mission.display());
+    client
+        .open(&uri, &std::fs::read_to_string(&mission).unwrap())
+        .await;
+    client.diagnostics(&uri, Some(1)).await;
+    let answer = client
+        .request("semo/monitor/start", serde_json::json!({ "uri": uri }))
+        .await
+        .expect("the monitor starts");
+    (client, uri, answer)
 }
 
 #[test]
@@ -1293,16 +1353,14 @@ fn the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost() {
     let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
     let mut processes = Processes::default();
     start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
-    let workspace = out.join("workspace");
-    std::fs::create_dir_all(&workspace).unwrap();
-    for file in ["scouting.mission", "MasterTeam.strategy.xml"] {
-        std::fs::copy(examples().join("scouting").join(file), workspace.join(file)).unwrap();
-    }
-    std::fs::write(
-        workspace.join("semo.toml"),
-        format!("[build]\ndeployment = \"{}\"\n", deploy.display()),
-    )
-    .unwrap();
+    let workspace = monitor_workspace(
+        &out,
+        &deploy,
+        &[
+            examples().join("scouting/scouting.mission"),
+            examples().join("scouting/MasterTeam.strategy.xml"),
+        ],
+    );
     // Without the simulated operator the master waits in WAIT_MODE: the
     // robots stay running.
     let mut world: serde_json::Value =
@@ -1318,21 +1376,7 @@ fn the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost() {
         .build()
         .unwrap();
     runtime.block_on(async {
-        let mut client = semo_server::harness::TestClient::start();
-        let root = format!("file://{}", workspace.display());
-        client
-            .initialize_with(serde_json::json!({}), Some(&root))
-            .await;
-        let mission = workspace.join("scouting.mission");
-        let uri = format!("file://{}", mission.display());
-        client
-            .open(&uri, &std::fs::read_to_string(&mission).unwrap())
-            .await;
-        client.diagnostics(&uri, Some(1)).await;
-        let answer = client
-            .request("semo/monitor/start", serde_json::json!({ "uri": uri }))
-            .await
-            .expect("the monitor starts");
+        let (mut client, uri, answer) = start_monitor(&workspace, "scouting.mission").await;
         assert_eq!(answer["broker"], format!("mqtt://127.0.0.1:{port}"));
         let view = monitor_view(&mut client, |p| p["connection"] == "connected").await;
         let names: Vec<String> = folders.iter().map(|f| robot_name(f)).collect();
@@ -1391,6 +1435,148 @@ fn the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost() {
         for robot in names.iter().filter(|n| *n != "irobot") {
             assert_eq!(shown(&view, robot)["state"], "running", "{view}");
         }
+        let stopped = client
+            .request("semo/monitor/stop", serde_json::json!({ "uri": uri }))
+            .await
+            .unwrap();
+        assert_eq!(stopped["stopped"], true);
+        client.shutdown().await;
+    });
+}
+
+/// patrol_groups's deployment: a user per team and the operator, on a
+/// private broker at `port`.
+fn patrol_deployment(dir: &Path, port: u16) -> PathBuf {
+    let users = [
+        ("base", "base-secret"),
+        ("guards", "guards-secret"),
+        ("operator", "operator-secret"),
+    ];
+    for (i, (user, password)) in users.iter().enumerate() {
+        std::fs::write(dir.join(format!("{user}.pw")), format!("{password}\n")).unwrap();
+        let mut command = Command::new("mosquitto_passwd");
+        if i == 0 {
+            command.arg("-c");
+        }
+        let made = command
+            .arg("-b")
+            .arg(dir.join("passwd"))
+            .args([user, password])
+            .output()
+            .expect("mosquitto_passwd runs");
+        assert!(made.status.success(), "{made:?}");
+    }
+    let file = dir.join("patrol_groups.deploy.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "broker = \"mqtt://127.0.0.1:{port}\"\n\n[broker_config]\npassword_file = \"passwd\"\n\n[operator]\nuser = \"operator\"\npassword_file = \"operator.pw\"\n\n[teams.Base]\nuser = \"base\"\npassword_file = \"base.pw\"\n\n[teams.Guards]\nuser = \"guards\"\npassword_file = \"guards.pw\"\n"
+        ),
+    )
+    .unwrap();
+    file
+}
+
+/// Sends `signal` (`STOP`, `CONT`) to a process.
+fn signal(child: &Child, signal: &str) {
+    let sent = Command::new("kill")
+        .args([&format!("-{signal}"), &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(sent.success(), "kill -{signal} {}", child.id());
+}
+
+#[test]
+fn the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor() {
+    let Some(binary) =
+        broker_or_skip("the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor")
+    else {
+        return;
+    };
+    // Team Guards elects a leader among its Turtlebots tb_0..tb_2 with
+    // heartbeats; the broker's ACL lets the operator (the monitor) read them.
+    let out = scratch("mqtt-monitor-leader");
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let mission = examples().join("swarm/patrol_groups.mission");
+    let deploy = patrol_deployment(&out, port);
+    let config = broker_config_for(&out, &mission, &deploy);
+    let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
+    assert!(
+        acl.contains("user operator\n")
+            && acl.contains("topic read semo/patrol_groups/Guards/Guards.__alive\n"),
+        "{acl}"
+    );
+    let folders = build_for_mqtt(&mission, &out, &["--deploy", &deploy.display().to_string()]);
+    let mut processes = Processes::default();
+    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+    let workspace = monitor_workspace(&out, &deploy, std::slice::from_ref(&mission));
+    let world = out.join("patrol.scenario.json");
+    std::fs::write(&world, r#"{"time_scale": 1, "duration": 1000000}"#).unwrap();
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let (mut client, uri, _) = start_monitor(&workspace, "patrol_groups.mission").await;
+        let mut robots = BTreeMap::new();
+        for folder in &folders {
+            let robot = robot_name(folder);
+            let trace = out.join(format!("{robot}.jsonl"));
+            let child = robot_command(folder, &world, &trace, 1)
+                .args(["--transport", "mqtt"])
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("the robot program starts");
+            robots.insert(robot, processes.push(child));
+        }
+        let leader_is = |robot: &'static str| {
+            move |p: &serde_json::Value| {
+                p["robots"].as_array().is_some_and(|all| {
+                    all.iter().all(|r| r["state"] == "running")
+                        && all
+                            .iter()
+                            .filter(|r| r["robot"].as_str().is_some_and(|n| n.starts_with("tb_")))
+                            .all(|r| r["leader"] == robot)
+                })
+            }
+        };
+        let view = monitor_view(&mut client, leader_is("tb_0")).await;
+        assert_eq!(shown(&view, "tb_0")["isLeader"], true, "{view}");
+        assert_eq!(shown(&view, "tb_1")["isLeader"], false, "{view}");
+
+        // The leader hangs (its connection stays open: no last will). It
+        // is shown lost once silent for three heartbeats, and tb_1 leads.
+        signal(&processes.0[robots["tb_0"]], "STOP");
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|all| {
+                all.iter()
+                    .any(|r| r["robot"] == "tb_0" && r["lostBecause"] == "silent")
+                    && all
+                        .iter()
+                        .any(|r| r["robot"] == "tb_1" && r["isLeader"] == true)
+                    && all
+                        .iter()
+                        .any(|r| r["robot"] == "tb_2" && r["leader"] == "tb_1")
+            })
+        })
+        .await;
+        assert_eq!(shown(&view, "base")["state"], "running", "{view}");
+
+        // Back: heard again, running again.
+        signal(&processes.0[robots["tb_0"]], "CONT");
+        monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|all| {
+                all.iter()
+                    .any(|r| r["robot"] == "tb_0" && r["state"] == "running")
+            })
+        })
+        .await;
         let stopped = client
             .request("semo/monitor/stop", serde_json::json!({ "uri": uri }))
             .await

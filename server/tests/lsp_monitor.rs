@@ -118,12 +118,22 @@ async fn started(client: &mut TestClient, root: &Path, uri: &str, text: &str) {
 /// The next `semo/monitor` notification whose robots satisfy `wanted`; a
 /// monitor that never sends it fails the test instead of hanging it.
 async fn view_where(client: &mut TestClient, wanted: impl Fn(&Value) -> bool) -> Value {
-    tokio::time::timeout(
+    let last = std::sync::Mutex::new(Value::Null);
+    let seen = |p: &Value| {
+        *last.lock().unwrap() = p.clone();
+        wanted(p)
+    };
+    let found = tokio::time::timeout(
         Duration::from_secs(30),
-        client.notification("semo/monitor", |p| wanted(p)),
+        client.notification("semo/monitor", seen),
     )
-    .await
-    .expect("the awaited semo/monitor notification comes")
+    .await;
+    found.unwrap_or_else(|_| {
+        panic!(
+            "the awaited semo/monitor notification did not come; the last one: {}",
+            last.lock().unwrap()
+        )
+    })
 }
 
 fn robot<'v>(view: &'v Value, name: &str) -> &'v Value {
