@@ -18,6 +18,7 @@
 
 mod c;
 mod control;
+pub use control::listen_ms;
 pub(crate) mod files;
 pub mod output;
 mod schedule;
