@@ -1585,6 +1585,8 @@ fn the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor() {
         assert_eq!(stopped["stopped"], true);
         client.shutdown().await;
     });
+}
+
 /// The first mission time at which two robots both lead by their own traces
 /// (`events` of every robot and incarnation, each a robot's name and its
 /// events): a robot leads from a `leader` event naming itself until one
