@@ -297,25 +297,39 @@ pub(crate) fn read_attributes(
     tag: Span,
     decoder: Decoder,
 ) -> Result<Vec<Attr>, (Span, String)> {
-    let (attrs, raw_lt) = read_attributes_keeping_lt(text, e, tag, decoder)?;
+    let mut attrs = Vec::new();
+    read_attributes_into(text, e, tag, decoder, &mut attrs).map(|()| attrs)
+}
+
+/// [`read_attributes`] into `out` (emptied first): a reader of many elements
+/// reuses one list.
+pub(crate) fn read_attributes_into(
+    text: &str,
+    e: &BytesStart<'_>,
+    tag: Span,
+    decoder: Decoder,
+    out: &mut Vec<Attr>,
+) -> Result<(), (Span, String)> {
+    let raw_lt = read_attributes_keeping_lt_into(text, e, tag, decoder, out)?;
     match raw_lt.first() {
         Some(&at) => Err((lt_span(text, at, tag), LT_IN_VALUE.to_string())),
-        None => Ok(attrs),
+        None => Ok(()),
     }
 }
 
 /// As [`read_attributes`], except that a `<` inside a value (which quick-xml
 /// reads as part of the value, and XML forbids) is kept: the byte position of
-/// every such `<` is returned with the attributes, for formats that report it
+/// every such `<` is returned, for formats that report it
 /// and read on. When the attribute list is malformed after such a `<`, the
 /// error is the `<` (a closing quote is likely missing there).
-pub(crate) fn read_attributes_keeping_lt(
+pub(crate) fn read_attributes_keeping_lt_into(
     text: &str,
     e: &BytesStart<'_>,
     tag: Span,
     decoder: Decoder,
-) -> Result<(Vec<Attr>, Vec<usize>), (Span, String)> {
-    let mut out = Vec::new();
+    out: &mut Vec<Attr>,
+) -> Result<Vec<usize>, (Span, String)> {
+    out.clear();
     let mut raw_lt: Vec<usize> = Vec::new();
     let fail = |raw_lt: &[usize], span: Span, message: String| match raw_lt.first() {
         Some(&at) => (lt_span(text, at, tag), LT_IN_VALUE.to_string()),
@@ -382,7 +396,7 @@ pub(crate) fn read_attributes_keeping_lt(
             exact,
         });
     }
-    Ok((out, raw_lt))
+    Ok(raw_lt)
 }
 
 /// For each byte offset of `attr.value` (and one past its end), the byte

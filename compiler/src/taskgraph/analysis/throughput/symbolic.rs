@@ -3,8 +3,8 @@
 //! synchronous dataflow graphs"; SDF3's own state-space method computes the
 //! same number).
 //!
-//! Every initial sample (one per sample on a channel, and with `chained` one
-//! per node for its previous firing) gets a coordinate. A sample made during
+//! Every initial sample (one per sample on a channel, and one per node
+//! `chained` for its previous firing) gets a coordinate. A sample made during
 //! the iteration carries a vector: for each initial sample, the longest time
 //! from that sample to it (−∞: it does not depend on it). A firing starts at
 //! the max of its input samples' vectors and ends `wcet` later. After one
@@ -41,7 +41,7 @@ struct Channel {
     tokens: u64,
 }
 
-fn channels(level: &Level<'_>, chained: bool) -> Vec<Channel> {
+fn channels(level: &Level<'_>, chained: &[bool]) -> Vec<Channel> {
     let mut out: Vec<Channel> = level
         .edges
         .iter()
@@ -53,14 +53,18 @@ fn channels(level: &Level<'_>, chained: bool) -> Vec<Channel> {
             tokens: e.initial_tokens,
         })
         .collect();
-    if chained {
-        out.extend((0..level.nodes.len()).map(|v| Channel {
-            src: v,
-            dst: v,
-            produce: 1,
-            consume: 1,
-            tokens: 1,
-        }));
+    {
+        out.extend(
+            (0..level.nodes.len())
+                .filter(|&v| chained[v])
+                .map(|v| Channel {
+                    src: v,
+                    dst: v,
+                    produce: 1,
+                    consume: 1,
+                    tokens: 1,
+                }),
+        );
     }
     out
 }
@@ -68,7 +72,7 @@ fn channels(level: &Level<'_>, chained: bool) -> Vec<Channel> {
 /// D·(Σγ + Σ over channels of γ(src) + γ(dst)): the work of [`period`], to
 /// compare with the HSDF's size. `None` when it does not apply (too many
 /// initial samples, vectors beyond the HSDF's memory budget, overflow).
-pub(super) fn cost(level: &Level<'_>, counts: &[u64], chained: bool) -> Option<u64> {
+pub(super) fn cost(level: &Level<'_>, counts: &[u64], chained: &[bool]) -> Option<u64> {
     let channels = channels(level, chained);
     let samples = channels
         .iter()
@@ -100,7 +104,7 @@ pub(super) fn period(
     level: &Level<'_>,
     counts: &[u64],
     wcet: &[u64],
-    chained: bool,
+    chained: &[bool],
 ) -> Option<(Ratio, Vec<usize>)> {
     // Within the bounds (samples, memory) whatever the caller checked.
     cost(level, counts, chained)?;
