@@ -369,23 +369,36 @@ pub(crate) fn read_attributes_keeping_lt_into(
                 return Err(fail(&raw_lt, word_at(text, content_start + pos), message));
             }
         };
-        let key = SmolStr::new(String::from_utf8_lossy(attr.key.as_ref()));
-        let key_span = slice_span(text, attr.key.as_ref()).unwrap_or(tag);
+        let key_in_text = slice_span(text, attr.key.as_ref());
+        // The text itself where it can be (it is already UTF-8): most of a
+        // large file's reading time otherwise.
+        let key = match key_in_text.and_then(|span| text.get(span.range())) {
+            Some(key) => SmolStr::new(key),
+            None => SmolStr::new(String::from_utf8_lossy(attr.key.as_ref())),
+        };
+        let key_span = key_in_text.unwrap_or(tag);
         let raw: &[u8] = &attr.value;
-        let span = slice_span(text, raw).unwrap_or(tag);
+        let value_in_text = slice_span(text, raw);
+        let span = value_in_text.unwrap_or(tag);
         raw_lt.extend(
             raw.iter()
                 .enumerate()
                 .filter(|&(_, &b)| b == b'<')
                 .map(|(i, _)| span.start + i),
         );
-        let value = match attr.decode_and_unescape_value(decoder) {
-            Ok(v) => SmolStr::new(v),
-            Err(_) => {
-                let message =
-                    "this value has an unknown `&...;` entity: write `&amp;` for a plain `&`";
-                return Err(fail(&raw_lt, span, message.to_string()));
-            }
+        let plain = value_in_text
+            .filter(|_| !raw.contains(&b'&'))
+            .and_then(|span| text.get(span.range()));
+        let value = match plain {
+            Some(value) => SmolStr::new(value),
+            None => match attr.decode_and_unescape_value(decoder) {
+                Ok(v) => SmolStr::new(v),
+                Err(_) => {
+                    let message =
+                        "this value has an unknown `&...;` entity: write `&amp;` for a plain `&`";
+                    return Err(fail(&raw_lt, span, message.to_string()));
+                }
+            },
         };
         let exact = value.as_bytes() == raw;
         out.push(Attr {

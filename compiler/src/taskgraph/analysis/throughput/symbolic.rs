@@ -130,12 +130,15 @@ pub(super) fn period(
     let mut available: Vec<u64> = channels.iter().map(|c| c.tokens).collect();
     let mut remaining = counts.to_vec();
     let total = usize::try_from(counts.iter().try_fold(0u64, |s, &c| s.checked_add(c))?).ok()?;
-    // Per firing: its actor, its end vector and which origin gave each entry.
-    let mut actor: Vec<usize> = Vec::with_capacity(total);
+    // Per firing: its actor, its end vector and which origin gave each entry
+    // (32 bits: these lists are most of the memory, and memory touched for
+    // the first time is most of the time on a graph like `mp3playback`).
+    u32::try_from(d.checked_add(total)?).ok()?;
+    let mut actor: Vec<u32> = Vec::with_capacity(total);
     let mut ends: Vec<i64> = Vec::with_capacity(total.checked_mul(d)?);
-    let mut from: Vec<Origin> = Vec::with_capacity(total.checked_mul(d)?);
+    let mut from: Vec<u32> = Vec::with_capacity(total.checked_mul(d)?);
     let mut start = vec![NEG_INF; d];
-    let mut start_from = vec![usize::MAX; d];
+    let mut start_from = vec![u32::MAX; d];
     let mut pending: Vec<usize> = (0..n).rev().collect();
     let mut queued = vec![true; n];
     while let Some(v) = pending.pop() {
@@ -147,7 +150,7 @@ pub(super) fn period(
                 .all(|&i| available[i] >= channels[i].consume)
         {
             start.fill(NEG_INF);
-            start_from.fill(usize::MAX);
+            start_from.fill(u32::MAX);
             for &i in &inputs[v] {
                 let mut need = channels[i].consume;
                 available[i] -= need;
@@ -164,7 +167,7 @@ pub(super) fn period(
                 }
             }
             let f = actor.len();
-            actor.push(v);
+            actor.push(v as u32);
             let w = i64::try_from(wcet[v]).ok()?;
             for (s, &o) in start.iter().zip(&start_from) {
                 ends.push(if *s == NEG_INF {
@@ -245,8 +248,8 @@ pub(super) fn period(
         let mut origin = rows[i];
         while origin >= d {
             let f = origin - d;
-            path.push(actor[f]);
-            origin = from[f * d + j];
+            path.push(actor[f] as usize);
+            origin = from[f * d + j] as usize;
         }
         path.reverse();
         walk.extend(path);
@@ -256,11 +259,11 @@ pub(super) fn period(
 
 /// `start = max(start, the vector of origin)`, remembering where each
 /// entry's max came from.
-fn merge(origin: Origin, d: usize, ends: &[i64], start: &mut [i64], start_from: &mut [Origin]) {
+fn merge(origin: Origin, d: usize, ends: &[i64], start: &mut [i64], start_from: &mut [u32]) {
     if origin < d {
         if start[origin] < 0 {
             start[origin] = 0;
-            start_from[origin] = origin;
+            start_from[origin] = origin as u32;
         }
         return;
     }
@@ -268,7 +271,7 @@ fn merge(origin: Origin, d: usize, ends: &[i64], start: &mut [i64], start_from: 
     for ((s, f), &e) in start.iter_mut().zip(start_from.iter_mut()).zip(row) {
         if e > *s {
             *s = e;
-            *f = origin;
+            *f = origin as u32;
         }
     }
 }
