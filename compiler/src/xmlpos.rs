@@ -241,8 +241,13 @@ pub(crate) fn start_tag(
     tag_end: usize,
 ) -> Result<StartTag, (Span, &'static str)> {
     let (name_span, tag) = start_tag_spans(text, e, tag_end);
-    let qname = SmolStr::new(String::from_utf8_lossy(e.name().as_ref()));
-    let local = SmolStr::new(String::from_utf8_lossy(e.local_name().as_ref()));
+    // The text itself where it can be (it is already UTF-8).
+    let name = |bytes: &[u8]| match slice_span(text, bytes).and_then(|s| text.get(s.range())) {
+        Some(name) => SmolStr::new(name),
+        None => SmolStr::new(String::from_utf8_lossy(bytes)),
+    };
+    let qname = name(e.name().as_ref());
+    let local = name(e.local_name().as_ref());
     if local.is_empty() {
         return Err((
             word_at(text, tag.start),

@@ -361,7 +361,7 @@ impl Loader<'_> {
     /// is needed). `Err(())` after a report.
     fn number(&mut self, a: &Attr, min: Min) -> Result<u64, ()> {
         let s = a.trimmed();
-        let quoted = shown(s);
+        let quoted = || shown(s);
         let parsed = if !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit()) {
             s.parse::<u64>().ok()
         } else {
@@ -374,19 +374,19 @@ impl Loader<'_> {
         match parsed {
             Some(n) if n >= 1 || min == Min::Zero => Ok(n),
             Some(_) => {
-                let message = format!("`{}` must be {what}, not `{quoted}`", a.key);
+                let message = format!("`{}` must be {what}, not `{}`", a.key, quoted());
                 self.sink
                     .report(Code::GraphBadAttribute, a.trimmed_span(), message);
                 Err(())
             }
             None if !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit()) => {
-                let message = format!("`{}` is too large: `{quoted}`", a.key);
+                let message = format!("`{}` is too large: `{}`", a.key, quoted());
                 self.sink
                     .report(Code::GraphBadAttribute, a.trimmed_span(), message);
                 Err(())
             }
             None => {
-                let message = format!("`{}` must be {what}, not `{quoted}`", a.key);
+                let message = format!("`{}` must be {what}, not `{}`", a.key, quoted());
                 self.sink.report(Code::GraphBadAttribute, a.span, message);
                 Err(())
             }
@@ -434,17 +434,17 @@ impl Loader<'_> {
         }
     }
 
-    /// E063 unless `named` is new in `names`.
+    /// E063 unless `named` is new in `names` (the message is made only then).
     fn register(
         &mut self,
         names: &mut HashMap<String, Span>,
         named: &Named,
-        message: String,
+        message: impl FnOnce() -> String,
     ) -> bool {
         if let Some(first) = names.get(&named.name) {
             let first = *first;
             self.sink
-                .report(Code::GraphDuplicateName, named.span, message)
+                .report(Code::GraphDuplicateName, named.span, message())
                 .relate(first, "first defined here");
             return false;
         }
@@ -509,7 +509,7 @@ impl Loader<'_> {
                             lib.name.name
                         );
                         let mut names = std::mem::take(&mut level.library_names);
-                        if self.register(&mut names, &lib.name, message) {
+                        if self.register(&mut names, &lib.name, || message) {
                             level.libraries.push(lib);
                         }
                         level.library_names = names;
@@ -559,7 +559,7 @@ impl Loader<'_> {
             ),
         };
         let mut names = std::mem::take(&mut level.task_names);
-        if self.register(&mut names, &task.name, message) {
+        if self.register(&mut names, &task.name, || message) {
             level.tasks.push(task);
             level.broken_ports.push(broken);
         }
@@ -702,7 +702,7 @@ impl Loader<'_> {
     /// Registers a port name in its task; `false` (after E063) for a second one.
     fn register_port(&mut self, build: &mut PortsBuild, name: &Named) -> bool {
         let what = if self.sdf3 { "actor" } else { "task" };
-        let message = format!("this {what} already has a port named `{}`", name.name);
+        let message = || format!("this {what} already has a port named `{}`", name.name);
         let mut names = std::mem::take(&mut build.names);
         let fresh = self.register(&mut names, name, message);
         build.names = names;
@@ -867,7 +867,7 @@ impl Loader<'_> {
                     continue;
                 };
                 let message = format!("this function already has a parameter `{}`", pname.name);
-                if self.register(&mut param_names, &pname, message) {
+                if self.register(&mut param_names, &pname, || message) {
                     params.push((pname.name, ty));
                 }
             }
@@ -875,7 +875,7 @@ impl Loader<'_> {
                 continue;
             };
             let message = format!("this library already has a function `{}`", fname.name);
-            if self.register(&mut names, &fname, message) {
+            if self.register(&mut names, &fname, || message) {
                 functions.push(LibraryFunction {
                     name: fname,
                     returns,

@@ -152,7 +152,7 @@ impl<'s> Sdf3Reader<'s> {
         let Some(name) = name else {
             return;
         };
-        let message = format!("actor `{}` is already defined", name.name);
+        let message = || format!("actor `{}` is already defined", name.name);
         let mut names = std::mem::take(&mut self.level.task_names);
         if self.loader.register(&mut names, &name, message) {
             self.level.tasks.push(Task {
