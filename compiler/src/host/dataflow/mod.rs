@@ -77,11 +77,7 @@ impl Analysis {
     fn service_graph(&self, catalog: FileId, path: &str) -> Option<Arc<GraphRun>> {
         let catalog_path = self.file(catalog)?.key.as_deref()?;
         let wanted = subgraph::normalize(&catalog_path.parent()?.join(Path::new(path)));
-        let graph = self
-            .files()
-            .filter(|f| f.kind == FileKind::TaskGraph)
-            .find(|f| f.key.as_deref() == Some(wanted.as_path()))?;
-        self.graph(graph.id)
+        self.graph(self.graph_at(&wanted)?)
     }
 }
 
