@@ -1560,3 +1560,67 @@ fn scouting_with_mqtt_compiles_pedantic_with_clang() {
     );
     assert_eq!(folders.len(), 3);
 }
+
+/// GroupSync (tests/fixtures/group_sync), every robot a process over a
+/// private broker: the robots drive 100, 700 and 1200 ms, tb_1 is killed
+/// on the way; tb_0 and tb_2 meet when tb_2 arrives (not at the 2 s
+/// timeout), and tb_0 waited for it.
+#[test]
+fn group_sync_over_mqtt_waits_for_the_live_members() {
+    let Some(mut fleet) = Fleet::start("mqtt-group-sync") else {
+        return;
+    };
+    let folders = support::mqtt::build(
+        &repo_root().join("tests/fixtures/group_sync/sync.mission"),
+        &fleet.out,
+        &[],
+    );
+    let scenario = fleet.out.join("sync.scenario.json");
+    std::fs::write(
+        &scenario,
+        r#"{"time_scale": 1, "duration": 4000,
+            "robots": {"tb_0": {"services": {"move": 100}},
+                       "tb_1": {"services": {"move": 700}},
+                       "tb_2": {"services": {"move": 1200}}}}"#,
+    )
+    .unwrap();
+    let (t0, start_at) = support::robots::start_barrier(folders.len());
+    let start_at = start_at.to_string();
+    let started: Vec<Started> = folders
+        .iter()
+        .map(|f| fleet.spawn(f, &scenario, "sync", &["--start-at", &start_at]))
+        .collect();
+    sleep_until(t0, 300);
+    let tb_1 = started.iter().find(|s| s.robot == "tb_1").unwrap();
+    fleet.processes.kill(tb_1.index);
+    let mut traces = BTreeMap::new();
+    for s in &started {
+        let events = if s.robot == "tb_1" {
+            read_trace(&s.trace)
+        } else {
+            fleet.finish(s, "group sync")
+        };
+        traces.insert(s.robot.clone(), events);
+    }
+    let at = |robot: &str, event: &str| {
+        traces[robot]
+            .iter()
+            .find(|e| field(e, "event") == event)
+            .map(|e| e["t"].as_i64().unwrap())
+    };
+    let arrived = traces["tb_2"]
+        .iter()
+        .find(|e| field(e, "event") == "send" && field(e, "key") == "Crew.__sync")
+        .map(|e| e["t"].as_i64().unwrap())
+        .expect("tb_2 announces its arrival");
+    assert!(arrived >= 1200, "tb_2 arrived at {arrived}");
+    for robot in ["tb_0", "tb_2"] {
+        let met = at(robot, "group_sync").unwrap_or_else(|| panic!("{robot} met the group"));
+        assert!(
+            met >= arrived && met < 2000,
+            "{robot} met at {met}, tb_2 arrived at {arrived}"
+        );
+        assert_eq!(at(robot, "timeout"), None, "{robot}");
+    }
+    assert_eq!(at("tb_1", "group_sync"), None);
+}
