@@ -13,7 +13,7 @@ mod support;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::{Child, Command, Stdio};
 use support::mqtt::{Fleet, Processes, Started, folder_of, free_port, read_trace, robot_name};
 use support::robots::{
     Event, PEDANTIC, build, field, modes, robot_command, robot_folders, scratch,
@@ -326,8 +326,12 @@ fn scouting_deployment(dir: &Path, port: u16, tls: bool) -> PathBuf {
 /// `semo deploy broker-config` into `dir/broker`, run as this user, logging
 /// to `dir/broker/mosquitto.log`; returns the configuration's path.
 fn broker_config(dir: &Path, deploy: &Path) -> PathBuf {
+    broker_config_for(dir, &examples().join("scouting/scouting.mission"), deploy)
+}
+
+/// The same for another mission.
+fn broker_config_for(dir: &Path, mission: &Path, deploy: &Path) -> PathBuf {
     let out = dir.join("broker");
-    let mission = examples().join("scouting/scouting.mission");
     let written = support::semo_in(
         dir,
         &[
@@ -975,6 +979,325 @@ fn the_operator_console_drives_scouting_to_finish() {
     );
 }
 
+/// The `semo/monitor` notification of the server behind `client` whose
+/// robots satisfy `wanted`; one that never comes fails the test.
+async fn monitor_view(
+    client: &mut semo_server::harness::TestClient,
+    wanted: impl Fn(&serde_json::Value) -> bool,
+) -> serde_json::Value {
+    let last = std::sync::Mutex::new(serde_json::Value::Null);
+    let seen = |p: &serde_json::Value| {
+        *last.lock().unwrap() = p.clone();
+        wanted(p)
+    };
+    let found = tokio::time::timeout(
+        std::time::Duration::from_secs(60),
+        client.notification("semo/monitor", seen),
+    )
+    .await;
+    found.unwrap_or_else(|_| {
+        panic!(
+            "the awaited semo/monitor notification did not come; the last one: {}",
+            last.lock().unwrap()
+        )
+    })
+}
+
+fn shown<'v>(view: &'v serde_json::Value, robot: &str) -> &'v serde_json::Value {
+    view["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["robot"] == robot)
+        .unwrap_or_else(|| panic!("{robot} is shown: {view}"))
+}
+
+/// A workspace for the editor: `files` copied in, and a `semo.toml` whose
+/// `[build] deployment` is `deploy`.
+fn monitor_workspace(out: &Path, deploy: &Path, files: &[PathBuf]) -> PathBuf {
+    let workspace = out.join("workspace");
+    std::fs::create_dir_all(&workspace).unwrap();
+    for file in files {
+        std::fs::copy(file, workspace.join(file.file_name().unwrap())).unwrap();
+    }
+    std::fs::write(
+        workspace.join("semo.toml"),
+        format!("[build]\ndeployment = \"{}\"\n", deploy.display()),
+    )
+    .unwrap();
+    workspace
+}
+
+/// The language server (in-process) on `workspace`, `mission` open and
+/// checked, and its monitor started with no broker named (so the
+/// deployment file's); the client, the mission's URI and the answer.
+async fn start_monitor(
+    workspace: &Path,
+    mission: &str,
+) -> (semo_server::harness::TestClient, String, serde_json::Value) {
+    let mut client = semo_server::harness::TestClient::start();
+    let root = format!("file://{}", workspace.display());
+    client
+        .initialize_with(serde_json::json!({}), Some(&root))
+        .await;
+    let mission = workspace.join(mission);
+    let uri = format!("file://{}", mission.display());
+    client
+        .open(&uri, &std::fs::read_to_string(&mission).unwrap())
+        .await;
+    client.diagnostics(&uri, Some(1)).await;
+    let answer = client
+        .request("semo/monitor/start", serde_json::json!({ "uri": uri }))
+        .await
+        .expect("the monitor starts");
+    (client, uri, answer)
+}
+
+#[test]
+fn the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost() {
+    // The broker of the deployment file with its ACL: the monitor finds it
+    // through the project's semo.toml and connects as the operator.
+    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-monitor", false) else {
+        return;
+    };
+    let (out, port) = (fleet.out.clone(), fleet.port);
+    let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
+    // The broker is process 0.
+    let processes = &mut fleet.processes;
+    let workspace = monitor_workspace(
+        &out,
+        &deploy,
+        &[
+            examples().join("scouting/scouting.mission"),
+            examples().join("scouting/MasterTeam.strategy.xml"),
+        ],
+    );
+    // Without the simulated operator the master waits in WAIT_MODE: the
+    // robots stay running.
+    let mut world: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scenario()).unwrap()).unwrap();
+    world["operator"] = serde_json::json!([]);
+    world.as_object_mut().unwrap().remove("expect");
+    let alone = out.join("no-operator.scenario.json");
+    std::fs::write(&alone, world.to_string()).unwrap();
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let (mut client, uri, answer) = start_monitor(&workspace, "scouting.mission").await;
+        assert_eq!(answer["broker"], format!("mqtt://127.0.0.1:{port}"));
+        let view = monitor_view(&mut client, |p| p["connection"] == "connected").await;
+        let names: Vec<String> = folders.iter().map(|f| robot_name(f)).collect();
+        for robot in &names {
+            assert_eq!(shown(&view, robot)["state"], "waiting", "{view}");
+        }
+
+        for folder in &folders {
+            let robot = robot_name(folder);
+            let trace = out.join(format!("{robot}.monitored.jsonl"));
+            let child = robot_command(folder, &alone, &trace, 1)
+                .args(["--transport", "mqtt", "--duration", "1000000"])
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("the robot program starts");
+            processes.push(child);
+        }
+        // Every robot running in a mode with its services; the master
+        // waiting for the operator, listening.
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|robots| {
+                robots.iter().all(|r| {
+                    r["state"] == "running"
+                        && r["mode"].is_string()
+                        && r["services"].as_array().is_some_and(|s| !s.is_empty())
+                }) && robots
+                    .iter()
+                    .any(|r| r["robot"] == "irobot" && r["mode"] == "WAIT_MODE")
+            })
+        })
+        .await;
+        let master = shown(&view, "irobot");
+        assert_eq!(master["team"], "MasterTeam");
+        assert!(
+            master["services"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|s| s["plan"] == "Listen" && s["service"] == "ReportStatus"),
+            "{view}"
+        );
+
+        // Killed: the broker's last will marks it lost, the others run on.
+        let irobot = names.iter().position(|n| n == "irobot").unwrap();
+        // The broker is process 0, the robots follow in folder order.
+        processes.0[1 + irobot].kill().unwrap();
+        processes.0[1 + irobot].wait().unwrap();
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|r| {
+                r.iter()
+                    .any(|r| r["robot"] == "irobot" && r["lost"] == true)
+            })
+        })
+        .await;
+        assert_eq!(shown(&view, "irobot")["lostBecause"], "lastWill");
+        for robot in names.iter().filter(|n| *n != "irobot") {
+            assert_eq!(shown(&view, robot)["state"], "running", "{view}");
+        }
+        let stopped = client
+            .request("semo/monitor/stop", serde_json::json!({ "uri": uri }))
+            .await
+            .unwrap();
+        assert_eq!(stopped["stopped"], true);
+        client.shutdown().await;
+    });
+}
+
+/// patrol_groups's deployment: a user per team and the operator, on a
+/// private broker at `port`.
+fn patrol_deployment(dir: &Path, port: u16) -> PathBuf {
+    let users = [
+        ("base", "base-secret"),
+        ("guards", "guards-secret"),
+        ("operator", "operator-secret"),
+    ];
+    for (i, (user, password)) in users.iter().enumerate() {
+        std::fs::write(dir.join(format!("{user}.pw")), format!("{password}\n")).unwrap();
+        let mut command = Command::new("mosquitto_passwd");
+        if i == 0 {
+            command.arg("-c");
+        }
+        let made = command
+            .arg("-b")
+            .arg(dir.join("passwd"))
+            .args([user, password])
+            .output()
+            .expect("mosquitto_passwd runs");
+        assert!(made.status.success(), "{made:?}");
+    }
+    let file = dir.join("patrol_groups.deploy.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "broker = \"mqtt://127.0.0.1:{port}\"\n\n[broker_config]\npassword_file = \"passwd\"\n\n[operator]\nuser = \"operator\"\npassword_file = \"operator.pw\"\n\n[teams.Base]\nuser = \"base\"\npassword_file = \"base.pw\"\n\n[teams.Guards]\nuser = \"guards\"\npassword_file = \"guards.pw\"\n"
+        ),
+    )
+    .unwrap();
+    file
+}
+
+/// Sends `signal` (`STOP`, `CONT`) to a process.
+fn signal(child: &Child, signal: &str) {
+    let sent = Command::new("kill")
+        .args([&format!("-{signal}"), &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(sent.success(), "kill -{signal} {}", child.id());
+}
+
+#[test]
+fn the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor() {
+    // Team Guards elects a leader among its Turtlebots tb_0..tb_2 with
+    // heartbeats; the broker's ACL lets the operator (the monitor) read them.
+    let mission = examples().join("swarm/patrol_groups.mission");
+    let mut deploy = None;
+    let Some(mut fleet) = Fleet::start_configured("mqtt-monitor-leader", |broker_dir, port| {
+        let out = broker_dir
+            .parent()
+            .expect("the broker folder is in the test's");
+        let file = patrol_deployment(out, port);
+        let config = broker_config_for(out, &mission, &file);
+        deploy = Some(file);
+        config
+    }) else {
+        return;
+    };
+    let deploy = deploy.expect("configured");
+    let out = fleet.out.clone();
+    let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
+    assert!(
+        acl.contains("user operator\n")
+            && acl.contains("topic read semo/patrol_groups/Guards/Guards.__alive\n"),
+        "{acl}"
+    );
+    let folders =
+        support::mqtt::build(&mission, &out, &["--deploy", &deploy.display().to_string()]);
+    let processes = &mut fleet.processes;
+    let workspace = monitor_workspace(&out, &deploy, std::slice::from_ref(&mission));
+    let world = out.join("patrol.scenario.json");
+    std::fs::write(&world, r#"{"time_scale": 1, "duration": 1000000}"#).unwrap();
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let (mut client, uri, _) = start_monitor(&workspace, "patrol_groups.mission").await;
+        let mut robots = BTreeMap::new();
+        for folder in &folders {
+            let robot = robot_name(folder);
+            let trace = out.join(format!("{robot}.jsonl"));
+            let child = robot_command(folder, &world, &trace, 1)
+                .args(["--transport", "mqtt"])
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("the robot program starts");
+            robots.insert(robot, processes.push(child));
+        }
+        let leader_is = |robot: &'static str| {
+            move |p: &serde_json::Value| {
+                p["robots"].as_array().is_some_and(|all| {
+                    all.iter().all(|r| r["state"] == "running")
+                        && all
+                            .iter()
+                            .filter(|r| r["robot"].as_str().is_some_and(|n| n.starts_with("tb_")))
+                            .all(|r| r["leader"] == robot)
+                })
+            }
+        };
+        let view = monitor_view(&mut client, leader_is("tb_0")).await;
+        assert_eq!(shown(&view, "tb_0")["isLeader"], true, "{view}");
+        assert_eq!(shown(&view, "tb_1")["isLeader"], false, "{view}");
+
+        // The leader hangs (its connection stays open: no last will). It
+        // is shown lost once silent for three heartbeats, and tb_1 leads.
+        signal(&processes.0[robots["tb_0"]], "STOP");
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|all| {
+                all.iter()
+                    .any(|r| r["robot"] == "tb_0" && r["lostBecause"] == "silent")
+                    && all
+                        .iter()
+                        .any(|r| r["robot"] == "tb_1" && r["isLeader"] == true)
+                    && all
+                        .iter()
+                        .any(|r| r["robot"] == "tb_2" && r["leader"] == "tb_1")
+            })
+        })
+        .await;
+        assert_eq!(shown(&view, "base")["state"], "running", "{view}");
+
+        // Back: heard again, running again.
+        signal(&processes.0[robots["tb_0"]], "CONT");
+        monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|all| {
+                all.iter()
+                    .any(|r| r["robot"] == "tb_0" && r["state"] == "running")
+            })
+        })
+        .await;
+        let stopped = client
+            .request("semo/monitor/stop", serde_json::json!({ "uri": uri }))
+            .await
+            .unwrap();
+        assert_eq!(stopped["stopped"], true);
+        client.shutdown().await;
+    });
+}
+
 /// The first mission time at which two robots both lead by their own traces
 /// (`events` of every robot and incarnation, each a robot's name and its
 /// events): a robot leads from a `leader` event naming itself until one
@@ -1056,12 +1379,15 @@ fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
     std::fs::write(
         &scenario,
         format!(
-            r#"{{"time_scale": 1, "duration": 8000, "robots": {{"tb_0": {dark}, "tb_1": {dark}, "tb_2": {dark}}}}}"#
+            r#"{{"time_scale": 1, "duration": 9000, "robots": {{"tb_0": {dark}, "tb_1": {dark}, "tb_2": {dark}}}}}"#
         ),
     )
     .unwrap();
-    const KILL_AT: i64 = 4000;
-    const RESTART_AT: i64 = 5500;
+    // tb_0 is dead three heartbeats (600 ms) after it is killed, and tb_1
+    // takes over at its next pass through the leader's statement (one a
+    // second): the restart comes after that.
+    const KILL_AT: i64 = 3500;
+    const RESTART_AT: i64 = 6000;
     let (t0, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let barrier = ["--start-at", start_at.as_str()];

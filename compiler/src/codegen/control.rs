@@ -136,6 +136,7 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
         }
         body.push_str("    default:\n        return STEP_DONE;\n    }\n}\n\n");
     }
+    body.push_str(&super::battery::resource_manager(program));
     emit_dispatch(&mut body, program);
     emit_modes(&mut body, program);
     emit_task(&mut body, program);
@@ -171,7 +172,7 @@ fn operand(op: &Operand) -> String {
     }
 }
 
-fn expr(e: &Expr) -> String {
+pub(super) fn expr(e: &Expr) -> String {
     match e {
         Expr::Or(a, b) => format!("({} || {})", expr(a), expr(b)),
         Expr::And(a, b) => format!("({} && {})", expr(a), expr(b)),
@@ -740,6 +741,9 @@ fn emit_task(out: &mut String, program: &RobotProgram) {
         out,
         "/* One firing: read inputs, advance every region, then change mode if an\n * event asked for it; the robot is finished when no region runs any more. */\nvoid task_{name}_go(void)\n{{\n    next_wake = INT64_MAX;\n    read_inputs();"
     );
+    if !m.battery.is_empty() {
+        out.push_str("    manage_resources();\n");
+    }
     if m.heartbeat {
         // Tell the team this robot is alive, for leader elections.
         let _ = writeln!(

@@ -423,7 +423,11 @@ pub fn task_c(
                     c::string(v)
                 );
             }
+            let level_hint = super::battery::sensor_level_hint(program, &role.task, *period_ms);
             out.push_str("}\n\nTASK_GO\n{\n    semo_value value;\n");
+            if level_hint.is_some() {
+                out.push_str("    int64_t fired = semo_now_ms();\n");
+            }
             for v in values {
                 match target.simulated() {
                     true => {
@@ -444,19 +448,27 @@ pub fn task_c(
                     }
                 }
             }
+            out.push_str(&level_hint.unwrap_or_default());
             out.push_str("}\n\nTASK_WRAPUP\n{\n}\n");
         }
         (RoleKind::Service { services }, _)
             if target.simulated() && target.platform() == Platform::Static =>
         {
+            let speed_scale = super::battery::actuator_speed_scale(program, &role.task);
+            out.push_str(speed_scale.as_deref().unwrap_or_default());
             // Nothing may block on the static schedule: the call spans
             // passes of the loop (semo_firing_continues) until its time is up.
             let _ = writeln!(
                 out,
-                "/* Task `{}` of robot {}: runs {} when the control task calls it; the\n * simulated service takes the scenario's time for it, over several passes\n * of the schedule. */\nstatic int port_request = -1;\nstatic semo_request req;\nstatic bool busy;\nstatic int64_t end;\n\nTASK_INIT\n{{\n    port_request = UFPort_Initialize(TASK_NAME, \"request\");\n}}\n\nTASK_GO\n{{\n    if (!busy) {{\n        if (UFPort_ReadFromQueue(port_request, &req, sizeof req) == 0)\n            return;\n        const char *arg = req.argc > 0 ? req.args[0].text : \"\";\n        semo_trace(\"call_start\", \"task\", TASK_NAME, \"service\", req.service, \"arg\", arg, NULL);\n        if (req.argc > 0)\n            semo_sim_actuate(TASK_NAME, &req.args[0]);\n        end = semo_now_ms() + semo_sim_service_ms(req.service);\n        busy = true;\n    }}\n    if (semo_running() && !UFControl_StopRequested(TASK_NAME) && semo_now_ms() < end) {{\n        semo_firing_continues();\n        semo_next_firing(end); /* or a stop request, whichever is first */\n        return;\n    }}\n    busy = false;\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n}}\n\nTASK_WRAPUP\n{{\n}}",
+                "/* Task `{}` of robot {}: runs {} when the control task calls it; the\n * simulated service takes the scenario's time for it, over several passes\n * of the schedule. */\nstatic int port_request = -1;\nstatic semo_request req;\nstatic bool busy;\nstatic int64_t end;\n\nTASK_INIT\n{{\n    port_request = UFPort_Initialize(TASK_NAME, \"request\");\n}}\n\nTASK_GO\n{{\n    if (!busy) {{\n        if (UFPort_ReadFromQueue(port_request, &req, sizeof req) == 0)\n            return;\n        const char *arg = req.argc > 0 ? req.args[0].text : \"\";\n        semo_trace(\"call_start\", \"task\", TASK_NAME, \"service\", req.service, \"arg\", arg, NULL);\n        if (req.argc > 0)\n            semo_sim_actuate(TASK_NAME, &req.args[0]);\n        end = semo_now_ms() + semo_sim_service_ms(req.service){scale};\n        busy = true;\n    }}\n    if (semo_running() && !UFControl_StopRequested(TASK_NAME) && semo_now_ms() < end) {{\n        semo_firing_continues();\n        semo_next_firing(end); /* or a stop request, whichever is first */\n        return;\n    }}\n    busy = false;\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n}}\n\nTASK_WRAPUP\n{{\n}}",
                 c::comment(&role.task),
                 c::comment(&program.robot),
-                c::comment(&services.join(", "))
+                c::comment(&services.join(", ")),
+                scale = if speed_scale.is_some() {
+                    " * speed_scale()"
+                } else {
+                    ""
+                },
             );
         }
         (RoleKind::Service { services }, _) => {
@@ -469,7 +481,18 @@ pub fn task_c(
             );
             match (target.simulated(), target.platform()) {
                 (true, Platform::Threads) => {
-                    out.push_str("    const char *arg = req.argc > 0 ? req.args[0].text : \"\";\n    semo_trace(\"call_start\", \"task\", TASK_NAME, \"service\", req.service, \"arg\", arg, NULL);\n    if (req.argc > 0)\n        semo_sim_actuate(TASK_NAME, &req.args[0]);\n    /* The simulated service takes the scenario's time for it, or ends when\n     * the control task stops it. */\n    UFControl_WaitStop(TASK_NAME, semo_now_ms() + semo_sim_service_ms(req.service));\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n");
+                    let scale = match super::battery::actuator_speed_scale(program, &role.task) {
+                        Some(function) => {
+                            // Before the task's functions.
+                            let at = out.find("TASK_INIT").unwrap_or(out.len());
+                            out.insert_str(at, &function);
+                            " * speed_scale()"
+                        }
+                        None => "",
+                    };
+                    out.push_str("    const char *arg = req.argc > 0 ? req.args[0].text : \"\";\n    semo_trace(\"call_start\", \"task\", TASK_NAME, \"service\", req.service, \"arg\", arg, NULL);\n    if (req.argc > 0)\n        semo_sim_actuate(TASK_NAME, &req.args[0]);\n    /* The simulated service takes the scenario's time for it, or ends when\n     * the control task stops it. */\n    UFControl_WaitStop(TASK_NAME, semo_now_ms() + semo_sim_service_ms(req.service)");
+                    out.push_str(scale);
+                    out.push_str(");\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n");
                 }
                 // The static simulation's body is the arm above.
                 (true, Platform::Static) => {}

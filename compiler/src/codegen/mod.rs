@@ -16,6 +16,7 @@
 //! it simulates, its runtime files); the generated code differs only where
 //! the platform does (locks, blocking, the schedule table, the Makefile).
 
+mod battery;
 mod c;
 mod control;
 pub use control::listen_ms;

@@ -62,6 +62,9 @@ pub struct ControlMachine {
     /// The group statements this robot synchronizes at (`GroupSync`), by
     /// their offset in the mission: what a sync announcement names.
     pub sync_points: Vec<usize>,
+    /// Adaptive resource management: the team strategy's battery policies,
+    /// checked at every firing against the robot's `BATTERY` value.
+    pub battery: Vec<BatteryPolicy>,
 }
 
 impl ControlMachine {
@@ -85,6 +88,58 @@ impl ControlMachine {
             .unwrap_or(0)
             .max(1)
     }
+}
+
+impl ControlMachine {
+    /// The period level (sensor) or speed level (actuator) of `task` while
+    /// the policies for which `holds` is true hold: the highest level any of
+    /// them gives it (the most saving one), 1 (unchanged) when none does.
+    pub fn battery_level(&self, task: &str, sensor: bool, holds: &[bool]) -> u64 {
+        self.battery
+            .iter()
+            .zip(holds)
+            .filter(|(_, h)| **h)
+            .flat_map(|(p, _)| if sensor { &p.sensors } else { &p.actuators })
+            .filter(|(t, _)| t == task)
+            .map(|(_, level)| *level)
+            .max()
+            .unwrap_or(1)
+    }
+
+    /// The tasks some policy gives a level, in first-mention order: sensors
+    /// (`true`) then actuators (`false`).
+    pub fn battery_tasks(&self) -> Vec<(&str, bool)> {
+        let mut tasks: Vec<(&str, bool)> = Vec::new();
+        for sensor in [true, false] {
+            for p in &self.battery {
+                for (t, _) in if sensor { &p.sensors } else { &p.actuators } {
+                    if !tasks.contains(&(t.as_str(), sensor)) {
+                        tasks.push((t, sensor));
+                    }
+                }
+            }
+        }
+        tasks
+    }
+}
+
+/// One battery requirement (`<Condition cond="Battery&lt;30">`) for one
+/// robot: while `condition` holds, each listed sensor task samples every
+/// `period × level` and each listed actuator task runs at `1 / level` of its
+/// speed (a call takes `level` times as long); when it stops holding, they
+/// return to level 1.
+#[derive(Clone, Debug)]
+pub struct BatteryPolicy {
+    /// The condition as written (`Battery<30`): the trace names the policy by it.
+    pub text: String,
+    /// Over the robot's `BATTERY` slot.
+    pub condition: Expr,
+    /// The strategy file it comes from (for comments).
+    pub source: String,
+    /// (sensor task, period level), each a task of this robot.
+    pub sensors: Vec<(String, u64)>,
+    /// (actuator task, speed level), each a task of this robot.
+    pub actuators: Vec<(String, u64)>,
 }
 
 /// How often a robot that can be elected leader tells its team it is alive

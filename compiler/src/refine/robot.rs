@@ -11,6 +11,8 @@ use crate::syntax::ast::{self, ExprKind, StmtKind};
 use crate::text::LineIndex;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
+mod battery;
+
 /// How often sensor tasks sample, in mission milliseconds.
 pub(super) const SENSOR_PERIOD_MS: i64 = 100;
 /// How deep function calls may nest before refinement gives up (sema
@@ -47,6 +49,7 @@ pub(super) fn refine_robot(
         diagnostics: Vec::new(),
     };
     builder.build_modes();
+    builder.machine.battery = builder.battery_policies();
     let self_peer = builder.first_peer() + robot_index;
     let Builder {
         mut machine,
@@ -1253,6 +1256,13 @@ fn separate_sensor_tasks(
                 && *t == task
             {
                 *t = name.clone();
+            }
+        }
+        for policy in &mut machine.battery {
+            for (t, _) in &mut policy.sensors {
+                if *t == task {
+                    *t = name.clone();
+                }
             }
         }
     }

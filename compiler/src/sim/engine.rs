@@ -41,6 +41,8 @@ use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
 
+mod battery;
+
 /// The sensor tasks' period (refinement's `SENSOR_PERIOD_MS`).
 const SENSOR_PERIOD_MS: i64 = 100;
 /// State transitions a region may take in one firing (`control.rs`).
@@ -231,6 +233,8 @@ struct Robot<'p> {
     fire_token: u64,
     /// Whether the current firing changed any state (see [`Sim::wake_up`]).
     progressed: bool,
+    /// The battery policies' state: levels and levelled sensors' samples.
+    resources: battery::Resources,
 }
 
 pub struct Sim<'p> {
@@ -387,6 +391,7 @@ impl<'p> Robot<'p> {
             next_fire: None,
             fire_token: 0,
             progressed: false,
+            resources: battery::Resources::new(program, at),
         }
     }
 
@@ -728,11 +733,11 @@ impl<'p> Sim<'p> {
         let now = self.now;
         let robot = &mut self.robots[r];
         let program = robot.program;
-        let sampled =
-            robot.started_at + (now - robot.started_at) / SENSOR_PERIOD_MS * SENSOR_PERIOD_MS;
+        robot.resources.advance(now);
         for (i, s) in program.control.slots.iter().enumerate() {
             match &s.source {
-                SlotSource::Sensor { port, .. } => {
+                SlotSource::Sensor { port, task } => {
+                    let sampled = robot.sampled_at(task, now);
                     let Some(series) = &robot.sensor_series[i] else {
                         continue;
                     };
@@ -946,7 +951,8 @@ impl<'p> Sim<'p> {
             .service_ms
             .get(service)
             .copied()
-            .unwrap_or(DEFAULT_SERVICE_MS);
+            .unwrap_or(DEFAULT_SERVICE_MS)
+            * self.robots[r].speed_scale(task);
         let state = &mut self.robots[r].tasks[t].1;
         state.busy = true;
         state.service = service.to_string();
@@ -1087,6 +1093,7 @@ impl<'p> Sim<'p> {
         let program = self.robots[r].program;
         let m = &program.control;
         self.read_inputs(r);
+        self.manage_resources(r);
         if m.heartbeat && self.now - self.robots[r].last_heartbeat >= m.heartbeat_ms {
             self.robots[r].last_heartbeat = self.now;
             let robot = &self.robots[r];
@@ -1246,24 +1253,22 @@ impl<'p> Sim<'p> {
             }
         }
         // The next sensor sample that brings a new value.
-        let sampled =
-            robot.started_at + (self.now - robot.started_at) / SENSOR_PERIOD_MS * SENSOR_PERIOD_MS;
         for (i, s) in m.slots.iter().enumerate() {
-            let (SlotSource::Sensor { port, .. }, Some(series)) =
+            let (SlotSource::Sensor { port, task }, Some(series)) =
                 (&s.source, &robot.sensor_series[i])
             else {
                 continue;
             };
+            let sampled = robot.sampled_at(task, self.now);
             let n = series.partition_point(|(t, _)| *t <= sampled);
             if let Some((t, _)) = series.get(n) {
-                let periods = (t - robot.started_at + SENSOR_PERIOD_MS - 1) / SENSOR_PERIOD_MS;
-                at_least(robot.started_at + periods * SENSOR_PERIOD_MS);
+                at_least(robot.sample_at_or_after(task, *t));
             }
             if n == 0
                 && port == "BATTERY"
                 && robot.battery.last().is_some_and(|(t, _)| *t > sampled)
             {
-                at_least(sampled + SENSOR_PERIOD_MS);
+                at_least(robot.sample_at_or_after(task, sampled + 1));
             }
         }
         at.map(|t| self.grid_at_or_after(r, t.max(self.now + 1)))
