@@ -12,151 +12,13 @@
 mod support;
 
 use std::collections::BTreeMap;
-use std::net::{TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
-use support::mqtt::{Fleet, Started, folder_of};
+use support::mqtt::{Fleet, Processes, Started, folder_of, free_port, read_trace, robot_name};
 use support::robots::{
-    Event, PEDANTIC, build, events, field, modes, robot_command, robot_folders, scratch,
+    Event, PEDANTIC, build, field, modes, robot_command, robot_folders, scratch,
 };
 use support::{examples, repo_root};
-
-/// The `mosquitto` binary (Debian puts it in /usr/sbin, often not on PATH).
-fn mosquitto() -> Option<PathBuf> {
-    let on_path = std::env::var_os("PATH")
-        .into_iter()
-        .flat_map(|p| std::env::split_paths(&p).collect::<Vec<_>>());
-    on_path
-        .chain([PathBuf::from("/usr/sbin"), PathBuf::from("/usr/local/sbin")])
-        .map(|dir| dir.join("mosquitto"))
-        .find(|path| path.is_file())
-}
-
-/// The broker, or None (after saying why) when the test must be skipped.
-fn broker_or_skip(test: &str) -> Option<PathBuf> {
-    let found = mosquitto();
-    if found.is_none() {
-        let required = std::env::var("SEMO_MQTT_TESTS").as_deref() == Ok("require");
-        assert!(
-            !required,
-            "SEMO_MQTT_TESTS=require but `mosquitto` is not installed (apt-get install mosquitto libmosquitto-dev)"
-        );
-        eprintln!(
-            "skipping {test}: `mosquitto` is not installed (set SEMO_MQTT_TESTS=require to fail instead)"
-        );
-    }
-    found
-}
-
-/// Processes this test started; each is killed when the guard goes, so a
-/// failing assertion leaves no broker or robot behind.
-#[derive(Default)]
-struct Processes(Vec<Child>);
-
-impl Processes {
-    fn push(&mut self, child: Child) -> usize {
-        self.0.push(child);
-        self.0.len() - 1
-    }
-
-    /// SIGTERM and wait: a broker then saves its state (SIGKILL would not).
-    fn terminate(&mut self, index: usize) {
-        let child = &mut self.0[index];
-        let sent = Command::new("kill")
-            .args(["-TERM", &child.id().to_string()])
-            .status()
-            .expect("kill runs");
-        assert!(sent.success(), "kill -TERM {}", child.id());
-        child.wait().expect("wait for the terminated process");
-    }
-
-    /// Waits for a robot to end by itself and returns its stderr; a failure
-    /// status fails the test.
-    fn wait_success(&mut self, index: usize, what: &str) -> String {
-        let child = &mut self.0[index];
-        let status = child.wait().expect("wait for the robot");
-        let mut stderr = String::new();
-        if let Some(mut pipe) = child.stderr.take() {
-            use std::io::Read;
-            let _ = pipe.read_to_string(&mut stderr);
-        }
-        assert!(status.success(), "{what} exited with {status:?}: {stderr}");
-        stderr
-    }
-}
-
-impl Drop for Processes {
-    fn drop(&mut self) {
-        for child in &mut self.0 {
-            let _ = child.kill();
-            let _ = child.wait();
-        }
-    }
-}
-
-/// A private broker: its configuration, persistence and log in `dir`, on a
-/// free port of 127.0.0.1. Returns its port once it accepts connections.
-fn start_broker(binary: &Path, dir: &Path, processes: &mut Processes) -> (u16, usize) {
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
-    let index = start_broker_on(binary, dir, port, processes);
-    (port, index)
-}
-
-/// The user we are: started as root, mosquitto drops to the `mosquitto`
-/// user, which cannot read or write our folders; `user <us>` keeps it us (no
-/// effect otherwise).
-fn current_user() -> String {
-    let whoami = Command::new("id").arg("-un").output().expect("id runs");
-    String::from_utf8_lossy(&whoami.stdout).trim().to_string()
-}
-
-fn start_broker_on(binary: &Path, dir: &Path, port: u16, processes: &mut Processes) -> usize {
-    let config = dir.join("mosquitto.conf");
-    std::fs::write(
-        &config,
-        format!(
-            "user {}\nlistener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\npersistence true\npersistence_location {}/\nlog_dest file {}\n",
-            current_user(),
-            dir.display(),
-            dir.join("mosquitto.log").display()
-        ),
-    )
-    .unwrap();
-    start_broker_with(binary, &config, dir, port, processes)
-}
-
-/// Starts mosquitto with `config` (which listens on `port` of 127.0.0.1)
-/// and waits until it accepts connections; its log goes to `dir`.
-fn start_broker_with(
-    binary: &Path,
-    config: &Path,
-    dir: &Path,
-    port: u16,
-    processes: &mut Processes,
-) -> usize {
-    let child = Command::new(binary)
-        .arg("-c")
-        .arg(config)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("mosquitto starts");
-    let index = processes.push(child);
-    // Ready when it accepts a connection; a broker that never does (the port
-    // taken meanwhile) fails the test after many tries rather than hanging.
-    for _ in 0..500 {
-        if TcpStream::connect(("127.0.0.1", port)).is_ok() {
-            return index;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(10));
-    }
-    let log = std::fs::read_to_string(dir.join("mosquitto.log")).unwrap_or_default();
-    panic!("mosquitto did not listen on port {port}: {log}");
-}
 
 /// `semo build` of the scouting mission for linux-sim, each robot made with
 /// the MQTT transport built in (`make TRANSPORT=mqtt`), warnings as errors.
@@ -166,58 +28,11 @@ fn build_scouting(out: &Path) -> Vec<PathBuf> {
 
 /// The same with more `semo build` arguments (`--deploy FILE`).
 fn build_scouting_with(out: &Path, extra: &[&str]) -> Vec<PathBuf> {
-    build_for_mqtt(&examples().join("scouting/scouting.mission"), out, extra)
-}
-
-/// `semo build MISSION --target linux-sim` with `extra` arguments, each
-/// robot made with the MQTT transport built in, warnings as errors.
-fn build_for_mqtt(mission: &Path, out: &Path, extra: &[&str]) -> Vec<PathBuf> {
-    let (mission, out_arg) = (mission.display().to_string(), out.display().to_string());
-    let mut args = vec![
-        "build",
-        mission.as_str(),
-        "--target",
-        "linux-sim",
-        "-o",
-        out_arg.as_str(),
-    ];
-    args.extend_from_slice(extra);
-    let built = support::semo_in(&repo_root(), &args);
-    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
-    let folders = robot_folders(out);
-    for folder in &folders {
-        let made = Command::new("make")
-            .args([
-                "-s",
-                "-j2",
-                "CC=gcc",
-                &format!("CFLAGS={PEDANTIC}"),
-                "TRANSPORT=mqtt",
-            ])
-            .current_dir(folder)
-            .output()
-            .expect("make runs");
-        let stderr = String::from_utf8_lossy(&made.stderr);
-        assert!(
-            made.status.success() && !stderr.contains("warning"),
-            "{}: {stderr}",
-            folder.display()
-        );
-    }
-    folders
+    support::mqtt::build(&examples().join("scouting/scouting.mission"), out, extra)
 }
 
 fn scenario() -> PathBuf {
     repo_root().join("tests/fixtures/build/scouting.scenario.json")
-}
-
-fn robot_name(folder: &Path) -> String {
-    folder.file_name().unwrap().to_string_lossy().into_owned()
-}
-
-fn read_trace(path: &Path) -> Vec<Event> {
-    let text = std::fs::read_to_string(path).unwrap_or_default();
-    events(&text.lines().map(str::to_string).collect::<Vec<_>>())
 }
 
 /// Runs every robot together with `transport_args` and returns its trace.
@@ -264,35 +79,18 @@ fn received_from(events: &[Event], robot: &str, key: &str) -> Vec<String> {
 
 #[test]
 fn scouting_over_mqtt_behaves_as_over_udp() {
-    let Some(binary) = broker_or_skip("scouting_over_mqtt_behaves_as_over_udp") else {
+    let Some(mut fleet) = Fleet::start("mqtt-scouting") else {
         return;
     };
-    let out = scratch("mqtt-scouting");
-    let broker_dir = out.join("broker");
-    std::fs::create_dir_all(&broker_dir).unwrap();
-    let folders = build_scouting(&out);
-    let mut processes = Processes::default();
-    let (port, _) = start_broker(&binary, &broker_dir, &mut processes);
-
+    let folders = build_scouting(&fleet.out);
     let udp = run_together(
         &folders,
-        &out,
+        &fleet.out,
         "udp",
         &["--transport".into(), "udp".into()],
-        &mut processes,
+        &mut fleet.processes,
     );
-    let mqtt = run_together(
-        &folders,
-        &out,
-        "mqtt",
-        &[
-            "--transport".into(),
-            "mqtt".into(),
-            "--broker".into(),
-            format!("mqtt://127.0.0.1:{port}"),
-        ],
-        &mut processes,
-    );
+    let mqtt = fleet.run_all(&folders, &scenario(), "mqtt", &[]);
 
     assert_eq!(mqtt.len(), 3, "three robots");
     for (robot, events) in &mqtt {
@@ -319,50 +117,25 @@ fn scouting_over_mqtt_behaves_as_over_udp() {
 
 #[test]
 fn a_send_reaches_a_robot_that_was_away_when_it_was_sent() {
-    let Some(binary) = broker_or_skip("a_send_reaches_a_robot_that_was_away_when_it_was_sent")
-    else {
+    let Some(mut fleet) = Fleet::start("mqtt-qos1") else {
         return;
     };
-    let out = scratch("mqtt-qos1");
-    let broker_dir = out.join("broker");
-    std::fs::create_dir_all(&broker_dir).unwrap();
-    let folders = build_scouting(&out);
-    let folder = |name: &str| {
-        folders
-            .iter()
-            .find(|f| robot_name(f) == name)
-            .unwrap()
-            .clone()
-    };
-    let mut processes = Processes::default();
-    let (port, broker) = start_broker(&binary, &broker_dir, &mut processes);
-    let mqtt = [
-        "--transport".to_string(),
-        "mqtt".into(),
-        "--broker".into(),
-        format!("mqtt://127.0.0.1:{port}"),
-    ];
-    let run = |processes: &mut Processes, robot: &str, tag: &str, extra: &[&str]| {
-        let trace = out.join(format!("{robot}.{tag}.jsonl"));
-        let child = robot_command(&folder(robot), &scenario(), &trace, 1)
-            .args(&mqtt)
-            .args(extra)
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("the robot program starts");
-        let index = processes.push(child);
-        processes.wait_success(index, &format!("{robot} ({tag})"));
-        read_trace(&trace)
-    };
+    let folders = build_scouting(&fleet.out);
+    let folder = |robot: &str| folder_of(&folders, robot);
 
     // The master connects once (its session and subscriptions now exist at
     // the broker) and goes away.
-    run(&mut processes, "irobot", "first", &["--duration", "10"]);
+    fleet.run(
+        &folder("irobot"),
+        &scenario(),
+        "first",
+        &["--duration", "10"],
+    );
     // The broker restarts (its state survives in its persistence file).
-    processes.terminate(broker);
-    start_broker_on(&binary, &broker_dir, port, &mut processes);
+    fleet.stop_broker();
+    fleet.start_broker();
     // A slave runs its whole mission while the master is away.
-    let ti = run(&mut processes, "ti", "alone", &[]);
+    let ti = fleet.run(&folder("ti"), &scenario(), "alone", &[]);
     assert!(
         ti.iter().any(|e| field(e, "event") == "send"
             && field(e, "key") == "SlaveTeam.COLOR"
@@ -370,7 +143,12 @@ fn a_send_reaches_a_robot_that_was_away_when_it_was_sent() {
         "ti sends its colors"
     );
     // The master comes back and gets what was sent meanwhile.
-    let back = run(&mut processes, "irobot", "back", &["--duration", "3000"]);
+    let back = fleet.run(
+        &folder("irobot"),
+        &scenario(),
+        "back",
+        &["--duration", "3000"],
+    );
     let heard = received_from(&back, "ti", "SlaveTeam.COLOR");
     assert!(
         !heard.is_empty(),
@@ -471,11 +249,7 @@ fn transport_options_are_checked_and_an_unreachable_broker_is_reported() {
         assert!(stderr.contains(says), "{args:?}: {stderr}");
     }
     // Nothing listens on a port just freed: the robot says so and stops.
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
+    let port = free_port();
     let broker = format!("mqtt://127.0.0.1:{port}");
     let (code, stderr) = run_with(irobot, &["--transport", "mqtt", "--broker", &broker]);
     assert_eq!(code, Some(1), "{stderr}");
@@ -575,7 +349,7 @@ fn broker_config_for(dir: &Path, mission: &Path, deploy: &Path) -> PathBuf {
     let mut text = std::fs::read_to_string(&config).unwrap();
     text.push_str(&format!(
         "user {}\nlog_dest file {}\n",
-        current_user(),
+        support::mqtt::current_user(),
         out.join("mosquitto.log").display()
     ));
     std::fs::write(&config, text).unwrap();
@@ -667,21 +441,33 @@ fn run_while_forging(
     traces
 }
 
+/// A fleet whose broker runs the configuration `semo deploy broker-config`
+/// writes for the scouting deployment (`scouting_deployment`, with TLS
+/// files when `tls`), and the deployment file.
+fn deployed_fleet(name: &str, tls: bool) -> Option<(Fleet, PathBuf)> {
+    let mut deploy = None;
+    let fleet = Fleet::start_configured(name, |broker_dir, port| {
+        let out = broker_dir
+            .parent()
+            .expect("the broker folder is in the test's");
+        if tls {
+            tls_files(out);
+        }
+        let file = scouting_deployment(out, port, tls);
+        let config = broker_config(out, &file);
+        deploy = Some(file);
+        config
+    })?;
+    Some((fleet, deploy.expect("configured")))
+}
+
 #[test]
 fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
-    let Some(binary) =
-        broker_or_skip("the_generated_acl_lets_only_the_operator_switch_a_robots_mode")
-    else {
+    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-acl", false) else {
         return;
     };
-    let out = scratch("mqtt-acl");
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
-    let deploy = scouting_deployment(&out, port, false);
-    let config = broker_config(&out, &deploy);
+    let (out, port) = (fleet.out.clone(), fleet.port);
+    let config = out.join("broker/mosquitto.conf");
     let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
     insta::assert_snapshot!(
         "scouting_acl",
@@ -702,8 +488,6 @@ fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
         header.contains("SEMO_DEPLOY_PASSWORD_FILE") && !header.contains("secret\""),
         "the password file's path, not the password: {header}"
     );
-    let mut processes = Processes::default();
-    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
 
     // Anonymous clients and the slaves' credentials cannot command the master.
     let forged = run_while_forging(
@@ -712,7 +496,7 @@ fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
         "forged",
         port,
         &[None, Some(("slaves", "slaves-secret"))],
-        &mut processes,
+        &mut fleet.processes,
     );
     for (robot, events) in &forged {
         assert_eq!(
@@ -743,7 +527,7 @@ fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
         "operator",
         port,
         &[Some(("operator", "operator-secret"))],
-        &mut processes,
+        &mut fleet.processes,
     );
     assert!(
         modes(&commanded["irobot"]).iter().any(|m| m == "RC_MODE"),
@@ -826,32 +610,23 @@ fn tls_files(dir: &Path) {
 
 #[test]
 fn robots_run_over_tls_with_client_certificates() {
-    let Some(binary) = broker_or_skip("robots_run_over_tls_with_client_certificates") else {
+    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-tls", true) else {
         return;
     };
-    let out = scratch("mqtt-tls");
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
-    tls_files(&out);
-    let deploy = scouting_deployment(&out, port, true);
-    let config = broker_config(&out, &deploy);
+    let (out, port) = (fleet.out.clone(), fleet.port);
+    let config = out.join("broker/mosquitto.conf");
     let conf = std::fs::read_to_string(&config).unwrap();
     assert!(
         conf.contains("certfile ") && conf.contains("cafile "),
         "{conf}"
     );
     let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
-    let mut processes = Processes::default();
-    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
     let traces = run_together(
         &folders,
         &out,
         "tls",
         &["--transport".into(), "mqtt".into()],
-        &mut processes,
+        &mut fleet.processes,
     );
     assert_eq!(traces.len(), 3);
     for (robot, events) in &traces {
@@ -903,24 +678,12 @@ fn retained_status(port: u16, robot: &str) -> Option<serde_json::Value> {
 
 #[test]
 fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
-    let Some(binary) =
-        broker_or_skip("each_robot_keeps_a_retained_status_and_a_killed_one_is_lost")
-    else {
+    let Some(mut fleet) = Fleet::start("mqtt-status") else {
         return;
     };
-    let out = scratch("mqtt-status");
-    let broker_dir = out.join("broker");
-    std::fs::create_dir_all(&broker_dir).unwrap();
-    let folders = build_scouting(&out);
-    let mut processes = Processes::default();
-    let (port, _) = start_broker(&binary, &broker_dir, &mut processes);
-    let mqtt = [
-        "--transport".to_string(),
-        "mqtt".into(),
-        "--broker".into(),
-        format!("mqtt://127.0.0.1:{port}"),
-    ];
-    let traces = run_together(&folders, &out, "status", &mqtt, &mut processes);
+    let port = fleet.port;
+    let folders = build_scouting(&fleet.out);
+    let traces = fleet.run_all(&folders, &scenario(), "status", &[]);
     // After the run: each robot stopped, in its last mode, as its trace says.
     for (robot, events) in &traces {
         let status = retained_status(port, robot).unwrap_or_else(|| panic!("{robot}: no status"));
@@ -933,14 +696,8 @@ fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
         );
     }
     // A robot killed while running: the broker publishes its last will.
-    let irobot = folders.iter().find(|f| robot_name(f) == "irobot").unwrap();
-    let child = robot_command(irobot, &scenario(), &out.join("irobot.killed.jsonl"), 1)
-        .args(&mqtt)
-        .args(["--duration", "1000000"])
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the robot program starts");
-    let index = processes.push(child);
+    let irobot = folder_of(&folders, "irobot");
+    let killed = fleet.spawn(&irobot, &scenario(), "killed", &["--duration", "1000000"]);
     let mut running = None;
     for _ in 0..50 {
         // Running, and past its first firing: a service in each plan.
@@ -962,8 +719,7 @@ fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
             .is_some_and(|m| m.ends_with("_MODE")),
         "{running}"
     );
-    processes.0[index].kill().unwrap();
-    processes.0[index].wait().unwrap();
+    fleet.processes.kill(killed.index);
     let mut lost = None;
     for _ in 0..50 {
         lost = retained_status(port, "irobot").filter(|s| s["state"] == "lost");
@@ -977,40 +733,24 @@ fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
 
 #[test]
 fn robots_reconnect_after_a_broker_restart_and_no_send_is_lost() {
-    let Some(binary) =
-        broker_or_skip("robots_reconnect_after_a_broker_restart_and_no_send_is_lost")
-    else {
+    let Some(mut fleet) = Fleet::start("mqtt-broker-restart") else {
         return;
     };
-    let out = scratch("mqtt-broker-restart");
-    let broker_dir = out.join("broker");
-    std::fs::create_dir_all(&broker_dir).unwrap();
-    let folders = build_scouting(&out);
-    let mut processes = Processes::default();
-    let (port, broker) = start_broker(&binary, &broker_dir, &mut processes);
+    let folders = build_scouting(&fleet.out);
     // Four times slower than the scenario's pace: the robots' reconnection
     // (libmosquitto waits 1 s first) falls inside the slaves' search.
-    let mut started = Vec::new();
-    for folder in &folders {
-        let robot = robot_name(folder);
-        let trace = out.join(format!("{robot}.restart.jsonl"));
-        let child = robot_command(folder, &scenario(), &trace, 1)
-            .args(["--transport", "mqtt", "--time-scale", "0.4"])
-            .args(["--broker", &format!("mqtt://127.0.0.1:{port}")])
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("the robot program starts");
-        started.push((robot, trace, processes.push(child)));
-    }
+    let started: Vec<Started> = folders
+        .iter()
+        .map(|f| fleet.spawn(f, &scenario(), "restart", &["--time-scale", "0.4"]))
+        .collect();
     // While the slaves search and send their colors, the broker goes down
     // (saving its state, as a service stop does) and comes back.
     std::thread::sleep(std::time::Duration::from_millis(700));
-    processes.terminate(broker);
-    start_broker_on(&binary, &broker_dir, port, &mut processes);
+    fleet.stop_broker();
+    fleet.start_broker();
     let mut traces = BTreeMap::new();
-    for (robot, trace, index) in started {
-        processes.wait_success(index, &format!("{robot} (broker restart)"));
-        traces.insert(robot, read_trace(&trace));
+    for run in &started {
+        traces.insert(run.robot.clone(), fleet.finish(run, "broker restart"));
     }
     for (robot, events) in &traces {
         assert_eq!(
@@ -1047,7 +787,7 @@ fn robots_reconnect_after_a_broker_restart_and_no_send_is_lost() {
             );
         }
     }
-    let log = std::fs::read_to_string(broker_dir.join("mosquitto.log")).unwrap_or_default();
+    let log = std::fs::read_to_string(fleet.broker_dir().join("mosquitto.log")).unwrap_or_default();
     assert!(
         log.matches("New client connected").count() >= 6,
         "each robot connected twice: {log}"
@@ -1056,33 +796,21 @@ fn robots_reconnect_after_a_broker_restart_and_no_send_is_lost() {
 
 #[test]
 fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
-    let Some(binary) =
-        broker_or_skip("a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead")
-    else {
+    let Some(mut fleet) = Fleet::start("mqtt-robot-restart") else {
         return;
     };
-    let out = scratch("mqtt-robot-restart");
-    let broker_dir = out.join("broker");
-    std::fs::create_dir_all(&broker_dir).unwrap();
-    let folders = build_scouting(&out);
-    let mut processes = Processes::default();
-    let (port, _) = start_broker(&binary, &broker_dir, &mut processes);
+    let folders = build_scouting(&fleet.out);
     const SCALE: f64 = 0.4; // wall ms per mission ms
-    let spawn = |processes: &mut Processes, folder: &Path, tag: &str| {
-        let trace = out.join(format!("{}.{tag}.jsonl", robot_name(folder)));
-        let child = robot_command(folder, &scenario(), &trace, 1)
-            .args(["--transport", "mqtt", "--time-scale", &SCALE.to_string()])
-            .args(["--broker", &format!("mqtt://127.0.0.1:{port}")])
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("the robot program starts");
-        (trace, processes.push(child))
+    let scale = SCALE.to_string();
+    let spawn = |fleet: &mut Fleet, folder: &Path, tag: &str| {
+        let run = fleet.spawn(folder, &scenario(), tag, &["--time-scale", &scale]);
+        (run.trace, run.index)
     };
     let started = std::time::Instant::now();
     let mut slaves = Vec::new();
     let mut master = None;
     for folder in &folders {
-        let (trace, index) = spawn(&mut processes, folder, "life");
+        let (trace, index) = spawn(&mut fleet, folder, "life");
         if robot_name(folder) == "irobot" {
             master = Some((folder.clone(), index));
         } else {
@@ -1092,18 +820,17 @@ fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
     let (irobot, first) = master.unwrap();
     // Killed while the slaves send their colors; back a moment later.
     std::thread::sleep(std::time::Duration::from_millis(600));
-    processes.0[first].kill().unwrap();
-    processes.0[first].wait().unwrap();
+    fleet.processes.kill(first);
     let killed = started.elapsed().as_secs_f64() * 1000.0;
     std::thread::sleep(std::time::Duration::from_millis(300));
     let back_at = started.elapsed().as_secs_f64() * 1000.0;
-    let (second_trace, second) = spawn(&mut processes, &irobot, "second-life");
+    let (second_trace, second) = spawn(&mut fleet, &irobot, "second-life");
     let mut slave_traces = BTreeMap::new();
     for (robot, trace, index) in slaves {
-        processes.wait_success(index, &robot);
+        fleet.processes.wait_success(index, &robot);
         slave_traces.insert(robot, read_trace(&trace));
     }
-    processes.wait_success(second, "irobot (second life)");
+    fleet.processes.wait_success(second, "irobot (second life)");
     let second_life = read_trace(&second_trace);
     assert_eq!(
         modes(&second_life).last().map(String::as_str),
@@ -1148,20 +875,12 @@ fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
 
 #[test]
 fn the_operator_console_drives_scouting_to_finish() {
-    let Some(binary) = broker_or_skip("the_operator_console_drives_scouting_to_finish") else {
+    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-operator", false) else {
         return;
     };
-    let out = scratch("mqtt-operator");
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
-    let deploy = scouting_deployment(&out, port, false);
-    let config = broker_config(&out, &deploy);
+    let out = fleet.out.clone();
     let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
-    let mut processes = Processes::default();
-    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+    let processes = &mut fleet.processes;
     // The scouting world without its simulated operator: only the console
     // can tell the master to return (it waits in WAIT_MODE until then).
     let mut world: serde_json::Value =
@@ -1336,24 +1055,15 @@ async fn start_monitor(
 
 #[test]
 fn the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost() {
-    let Some(binary) =
-        broker_or_skip("the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost")
-    else {
-        return;
-    };
     // The broker of the deployment file with its ACL: the monitor finds it
     // through the project's semo.toml and connects as the operator.
-    let out = scratch("mqtt-monitor");
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
-    let deploy = scouting_deployment(&out, port, false);
-    let config = broker_config(&out, &deploy);
+    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-monitor", false) else {
+        return;
+    };
+    let (out, port) = (fleet.out.clone(), fleet.port);
     let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
-    let mut processes = Processes::default();
-    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+    // The broker is process 0.
+    let processes = &mut fleet.processes;
     let workspace = monitor_workspace(
         &out,
         &deploy,
@@ -1489,31 +1199,32 @@ fn signal(child: &Child, signal: &str) {
 
 #[test]
 fn the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor() {
-    let Some(binary) =
-        broker_or_skip("the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor")
-    else {
-        return;
-    };
     // Team Guards elects a leader among its Turtlebots tb_0..tb_2 with
     // heartbeats; the broker's ACL lets the operator (the monitor) read them.
-    let out = scratch("mqtt-monitor-leader");
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
     let mission = examples().join("swarm/patrol_groups.mission");
-    let deploy = patrol_deployment(&out, port);
-    let config = broker_config_for(&out, &mission, &deploy);
+    let mut deploy = None;
+    let Some(mut fleet) = Fleet::start_configured("mqtt-monitor-leader", |broker_dir, port| {
+        let out = broker_dir
+            .parent()
+            .expect("the broker folder is in the test's");
+        let file = patrol_deployment(out, port);
+        let config = broker_config_for(out, &mission, &file);
+        deploy = Some(file);
+        config
+    }) else {
+        return;
+    };
+    let deploy = deploy.expect("configured");
+    let out = fleet.out.clone();
     let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
     assert!(
         acl.contains("user operator\n")
             && acl.contains("topic read semo/patrol_groups/Guards/Guards.__alive\n"),
         "{acl}"
     );
-    let folders = build_for_mqtt(&mission, &out, &["--deploy", &deploy.display().to_string()]);
-    let mut processes = Processes::default();
-    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+    let folders =
+        support::mqtt::build(&mission, &out, &["--deploy", &deploy.display().to_string()]);
+    let processes = &mut fleet.processes;
     let workspace = monitor_workspace(&out, &deploy, std::slice::from_ref(&mission));
     let world = out.join("patrol.scenario.json");
     std::fs::write(&world, r#"{"time_scale": 1, "duration": 1000000}"#).unwrap();
@@ -1668,12 +1379,15 @@ fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
     std::fs::write(
         &scenario,
         format!(
-            r#"{{"time_scale": 1, "duration": 8000, "robots": {{"tb_0": {dark}, "tb_1": {dark}, "tb_2": {dark}}}}}"#
+            r#"{{"time_scale": 1, "duration": 9000, "robots": {{"tb_0": {dark}, "tb_1": {dark}, "tb_2": {dark}}}}}"#
         ),
     )
     .unwrap();
-    const KILL_AT: i64 = 4000;
-    const RESTART_AT: i64 = 5500;
+    // tb_0 is dead three heartbeats (600 ms) after it is killed, and tb_1
+    // takes over at its next pass through the leader's statement (one a
+    // second): the restart comes after that.
+    const KILL_AT: i64 = 3500;
+    const RESTART_AT: i64 = 6000;
     let (t0, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let barrier = ["--start-at", start_at.as_str()];
@@ -1895,4 +1609,68 @@ fn scouting_with_mqtt_compiles_pedantic_with_clang() {
         PEDANTIC,
     );
     assert_eq!(folders.len(), 3);
+}
+
+/// GroupSync (tests/fixtures/group_sync), every robot a process over a
+/// private broker: the robots drive 100, 700 and 1200 ms, tb_1 is killed
+/// on the way; tb_0 and tb_2 meet when tb_2 arrives (not at the 2 s
+/// timeout), and tb_0 waited for it.
+#[test]
+fn group_sync_over_mqtt_waits_for_the_live_members() {
+    let Some(mut fleet) = Fleet::start("mqtt-group-sync") else {
+        return;
+    };
+    let folders = support::mqtt::build(
+        &repo_root().join("tests/fixtures/group_sync/sync.mission"),
+        &fleet.out,
+        &[],
+    );
+    let scenario = fleet.out.join("sync.scenario.json");
+    std::fs::write(
+        &scenario,
+        r#"{"time_scale": 1, "duration": 4000,
+            "robots": {"tb_0": {"services": {"move": 100}},
+                       "tb_1": {"services": {"move": 700}},
+                       "tb_2": {"services": {"move": 1200}}}}"#,
+    )
+    .unwrap();
+    let (t0, start_at) = support::robots::start_barrier(folders.len());
+    let start_at = start_at.to_string();
+    let started: Vec<Started> = folders
+        .iter()
+        .map(|f| fleet.spawn(f, &scenario, "sync", &["--start-at", &start_at]))
+        .collect();
+    sleep_until(t0, 300);
+    let tb_1 = started.iter().find(|s| s.robot == "tb_1").unwrap();
+    fleet.processes.kill(tb_1.index);
+    let mut traces = BTreeMap::new();
+    for s in &started {
+        let events = if s.robot == "tb_1" {
+            read_trace(&s.trace)
+        } else {
+            fleet.finish(s, "group sync")
+        };
+        traces.insert(s.robot.clone(), events);
+    }
+    let at = |robot: &str, event: &str| {
+        traces[robot]
+            .iter()
+            .find(|e| field(e, "event") == event)
+            .map(|e| e["t"].as_i64().unwrap())
+    };
+    let arrived = traces["tb_2"]
+        .iter()
+        .find(|e| field(e, "event") == "send" && field(e, "key") == "Crew.__sync")
+        .map(|e| e["t"].as_i64().unwrap())
+        .expect("tb_2 announces its arrival");
+    assert!(arrived >= 1200, "tb_2 arrived at {arrived}");
+    for robot in ["tb_0", "tb_2"] {
+        let met = at(robot, "group_sync").unwrap_or_else(|| panic!("{robot} met the group"));
+        assert!(
+            met >= arrived && met < 2000,
+            "{robot} met at {met}, tb_2 arrived at {arrived}"
+        );
+        assert_eq!(at(robot, "timeout"), None, "{robot}");
+    }
+    assert_eq!(at("tb_1", "group_sync"), None);
 }

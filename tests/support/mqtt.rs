@@ -105,7 +105,7 @@ pub fn free_port() -> u16 {
 /// The user we are: started as root, mosquitto drops to the `mosquitto`
 /// user, which cannot read or write our folders; `user <us>` keeps it us (no
 /// effect otherwise).
-fn current_user() -> String {
+pub fn current_user() -> String {
     let whoami = Command::new("id").arg("-un").output().expect("id runs");
     String::from_utf8_lossy(&whoami.stdout).trim().to_string()
 }
@@ -351,6 +351,13 @@ impl Fleet {
         self.processes
             .wait_success(started.index, &format!("{} ({tag})", started.robot));
         read_trace(&started.trace)
+    }
+
+    /// Runs one robot to its end (a failure fails the test) and returns its
+    /// trace.
+    pub fn run(&mut self, folder: &Path, scenario: &Path, tag: &str, extra: &[&str]) -> Vec<Event> {
+        let started = self.spawn(folder, scenario, tag, extra);
+        self.finish(&started, tag)
     }
 
     /// Runs every robot of `folders` together on `scenario` and returns the

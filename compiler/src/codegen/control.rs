@@ -475,6 +475,25 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 candidates.len()
             );
         }
+        StateKind::GroupSync {
+            members,
+            point,
+            timeout_ms,
+            mark,
+        } => {
+            let list: Vec<String> = members.iter().map(|c| c.to_string()).collect();
+            let list = list.join(", ");
+            let hb = m.heartbeat_ms;
+            let _ = writeln!(
+                out,
+                "    {{\n        static const size_t members[] = {{{list}}};\n        static long pass; /* how often this robot reached the statement (control thread only) */\n        const semo_program_desc *p = semo_program();\n        int64_t now = semo_now_ms();\n        if (r->phase == 0) {{\n            semo_value arrived;\n            char text[48];\n            pass++;\n            r->mark[{mark}] = now;\n            r->phase = 1;\n            snprintf(text, sizeof text, \"{offset} %ld\", pass);\n            semo_value_set(&arrived, text);\n            semo_comm_send({team}, SEMO_MSG_SEND, {key}, &arrived);\n        }}\n        int waiting = 0;\n        for (size_t k = 0; k < {count}; k++) {{\n            size_t peer = members[k];\n            comm_heartbeat h = comm_heard(peer);\n            if (peer == p->self || comm_sync_arrived(peer, {point}) >= pass || now - h.seen > 3 * {hb})\n                continue; /* here, arrived, or known dead */\n            waiting++;\n            wake_at(h.seen + 3 * {hb} + 1);\n        }}\n        if (waiting > 0 && now - r->mark[{mark}] <= {timeout_ms}) {{\n            wake_at(r->mark[{mark}] + {timeout_ms} + 1);\n            return STEP_WAIT;\n        }}\n        if (waiting > 0)\n            semo_trace(\"timeout\", \"statement\", \"GroupSync\", NULL);\n        else\n            semo_trace(\"group_sync\", \"line\", \"{line}\", NULL);\n        r->phase = 0;\n        r->pc = {next};\n        return STEP_NEXT;\n    }}",
+                count = members.len(),
+                offset = m.sync_points[*point],
+                team = c::string(&program.team),
+                key = c::string(&super::files::sync_key(program)),
+                line = state.line,
+            );
+        }
         StateKind::Branch { condition, else_to } => {
             let _ = writeln!(
                 out,

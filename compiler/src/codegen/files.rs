@@ -13,6 +13,12 @@ pub fn alive_key(program: &RobotProgram) -> String {
     format!("{}.__alive", program.team)
 }
 
+/// The key of the announcements a team's robots send when they reach a
+/// group statement they synchronize at (`GroupSync`).
+pub fn sync_key(program: &RobotProgram) -> String {
+    format!("{}.__sync", program.team)
+}
+
 /// Samples of a request channel: a service name and its arguments.
 fn is_request_channel(src_task: &str, src_port: &str) -> bool {
     src_task == CONTROL_TASK && src_port.starts_with("req_")
@@ -48,6 +54,9 @@ pub fn program_h(program: &RobotProgram, header: &str) -> String {
     }
     if program.control.heartbeat {
         out.push_str("\n/* What the last heartbeat of a robot said (comm_task.c): when it came\n * (mission ms), whether the robot claimed leadership, its battery level\n * (-1: unknown). */\ntypedef struct {\n    int64_t seen;\n    bool leads;\n    long battery;\n} comm_heartbeat;\ncomm_heartbeat comm_heard(size_t peer);\n");
+        if !program.control.sync_points.is_empty() {
+            out.push_str("/* The last pass of a robot through sync point `point` (an index into\n * the program's sync points) that it announced; 0 before any. */\nlong comm_sync_arrived(size_t peer, size_t point);\n");
+        }
     }
     if let Some(lib) = &program.library {
         let _ = writeln!(
@@ -270,6 +279,18 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
             key = c::string(&alive_key(program))
         );
     }
+    if !m.sync_points.is_empty() {
+        let points: Vec<String> = m.sync_points.iter().map(|p| p.to_string()).collect();
+        let _ = writeln!(
+            out,
+            "/* GroupSync: for each robot and sync point (the group statement's offset\n * in the mission), the last pass it announced (`Team.__sync` = \"<point>\n * <pass>\"). A new one wakes the control task, which may be waiting. */\nstatic const long sync_point[] = {{{list}}};\nstatic long arrived[{peers}][{n}];\n\nlong comm_sync_arrived(size_t peer, size_t point)\n{{\n    long pass = 0;\n    {lock_seen}\n    if (peer < {peers} && point < {n})\n        pass = arrived[peer][point];\n    {unlock_seen}\n    return pass;\n}}\n\nstatic bool heard_sync(const semo_message *m)\n{{\n    if (strcmp(m->key, {key}) != 0)\n        return false;\n    char *end;\n    long point = strtol(m->value.text, &end, 10), pass = strtol(end, NULL, 10);\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        for (size_t k = 0; k < {n}; k++)\n            if (strcmp(p->peers[i].robot, m->from_robot) == 0 && sync_point[k] == point) {{\n                {lock_seen}\n                if (pass > arrived[i][k])\n                    arrived[i][k] = pass;\n                {unlock_seen}\n            }}\n    semo_wake({control});\n    return true;\n}}\n",
+            list = points.join(", "),
+            n = m.sync_points.len(),
+            peers = program.peers.len().max(1),
+            key = c::string(&sync_key(program)),
+            control = c::string(CONTROL_TASK),
+        );
+    }
     if !m.incoming.is_empty() || !m.subscribed.is_empty() || m.heartbeat {
         out.push_str("/* CommReceive: each message received goes to the control task's port for\n * it (sends) or to its multicast group (publishes). */\n");
         let n = m.incoming.len();
@@ -315,6 +336,9 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         );
         if m.heartbeat {
             out.push_str("    if (heard_alive(&m))\n        return;\n");
+        }
+        if !m.sync_points.is_empty() {
+            out.push_str("    if (heard_sync(&m))\n        return;\n");
         }
         if !m.subscribed.is_empty() {
             let _ = writeln!(

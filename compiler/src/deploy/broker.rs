@@ -88,6 +88,12 @@ pub fn files(
         if program.control.heartbeat {
             rights.write.insert(topics::heartbeats(program));
         }
+        if !program.control.sync_points.is_empty() {
+            let key = crate::codegen::files::sync_key(program);
+            rights
+                .write
+                .insert(topics::to_team(&mission, &program.team, &key));
+        }
         rights
             .write
             .insert(topics::status(&mission, &program.robot));

@@ -59,6 +59,9 @@ pub struct ControlMachine {
     /// apply to the robot's elections), else [`HEARTBEAT_MS`]; 0 without
     /// `heartbeat`.
     pub heartbeat_ms: i64,
+    /// The group statements this robot synchronizes at (`GroupSync`), by
+    /// their offset in the mission: what a sync announcement names.
+    pub sync_points: Vec<usize>,
     /// Adaptive resource management: the team strategy's battery policies,
     /// checked at every firing against the robot's `BATTERY` value.
     pub battery: Vec<BatteryPolicy>,
@@ -244,6 +247,20 @@ pub enum StateKind {
         candidates: Vec<usize>,
         algorithm: LeaderAlgorithm,
         others_at: usize,
+    },
+    /// The start of a group statement when the team's strategy has
+    /// `<GroupSync timeout>`: tell the team this robot has arrived (its
+    /// pass through the statement: `Team.__sync` = `"<point> <pass>"`), then
+    /// wait until every other robot of `members` (peer indices: the robots
+    /// that run any arm of the statement, as the checker decided) has
+    /// arrived at that pass or is known dead (no heartbeat for three
+    /// periods), or `timeout_ms` has passed.
+    GroupSync {
+        members: Vec<usize>,
+        /// Index into [`ControlMachine::sync_points`].
+        point: usize,
+        timeout_ms: i64,
+        mark: usize,
     },
     /// Continue at `else_to` unless the condition holds.
     Branch {

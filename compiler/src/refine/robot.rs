@@ -296,6 +296,81 @@ impl Builder<'_, '_> {
         index
     }
 
+    /// The robot sends heartbeats at least every `period_ms`: one heartbeat
+    /// serves every election and sync of the robot, at the shortest period
+    /// any of them asks for.
+    fn need_heartbeat(&mut self, period_ms: i64) {
+        if !self.machine.heartbeat || period_ms < self.machine.heartbeat_ms {
+            self.machine.heartbeat_ms = period_ms;
+        }
+        self.machine.heartbeat = true;
+    }
+
+    /// `<GroupSync timeout>` of the team's strategy: the robots that run any
+    /// arm of a group statement meet at its start (a `GroupSync` state) when
+    /// this robot is one of them and not alone. Membership is the checker's
+    /// (`scopes`); liveness comes from heartbeats.
+    fn group_sync(
+        &mut self,
+        group: &ast::GroupStmt,
+        span: Span,
+        states: &mut Vec<State>,
+        marks: &mut usize,
+    ) {
+        let timeout = self
+            .input
+            .strategies
+            .iter()
+            .filter(|s| {
+                s.team
+                    .as_ref()
+                    .is_some_and(|t| t.name == self.team.name.as_str())
+            })
+            .find_map(|s| s.grouping.as_ref()?.sync_timeout);
+        let Some(timeout) = timeout else {
+            return;
+        };
+        let bodies = group
+            .arms
+            .iter()
+            .map(|a| a.body.span)
+            .chain(group.others.as_ref().map(|o| o.body.span));
+        let mut members = BTreeSet::new();
+        for body in bodies.collect::<Vec<_>>() {
+            members.extend(self.runners_of(body).unwrap_or_default());
+        }
+        if !members.contains(&self.robot_index) || members.len() < 2 {
+            return;
+        }
+        let first_peer = self.first_peer();
+        let point = match self
+            .machine
+            .sync_points
+            .iter()
+            .position(|&p| p == span.start)
+        {
+            Some(i) => i,
+            None => {
+                self.machine.sync_points.push(span.start);
+                self.machine.sync_points.len() - 1
+            }
+        };
+        let (_, heartbeat_ms) = self.leader_selection();
+        self.need_heartbeat(heartbeat_ms.unwrap_or(HEARTBEAT_MS));
+        let mark = next_mark(marks);
+        let state = self.push(
+            states,
+            StateKind::GroupSync {
+                members: members.into_iter().map(|i| first_peer + i).collect(),
+                point,
+                timeout_ms: (timeout.millis.round() as i64).max(0),
+                mark,
+            },
+            span,
+        );
+        states[state].text = "GroupSync: the group meets here".into();
+    }
+
     /// The strategy's leader selection for an election in the service being
     /// built: the team's `LeaderSelectionInfo` when it names no composite
     /// service or names this one; its algorithm (default lowest id) and its
@@ -410,6 +485,7 @@ impl Builder<'_, '_> {
                 patch(states, head);
             }
             StmtKind::Group(g) => {
+                self.group_sync(g, stmt.span, states, marks);
                 // Group membership is static for a robot: its type and
                 // capabilities decide which arm it joins (the others are
                 // dropped from its program).
@@ -426,13 +502,7 @@ impl Builder<'_, '_> {
                         let first_peer = self.first_peer();
                         let candidates = candidates.iter().map(|i| first_peer + i).collect();
                         let (algorithm, heartbeat_ms) = self.leader_selection();
-                        let heartbeat_ms = heartbeat_ms.unwrap_or(HEARTBEAT_MS);
-                        // One heartbeat serves every election of the robot:
-                        // the shortest period any of them asks for.
-                        if !self.machine.heartbeat || heartbeat_ms < self.machine.heartbeat_ms {
-                            self.machine.heartbeat_ms = heartbeat_ms;
-                        }
-                        self.machine.heartbeat = true;
+                        self.need_heartbeat(heartbeat_ms.unwrap_or(HEARTBEAT_MS));
                         let branch = self.push(
                             states,
                             StateKind::LeaderBranch {

@@ -139,6 +139,7 @@ struct Names {
     /// The value of its heartbeat: its name, as a value.
     heartbeat: Rc<str>,
     alive_key: Rc<str>,
+    sync_key: Rc<str>,
     /// Per outgoing message: (to, key).
     outgoing: Vec<(Rc<str>, Rc<str>)>,
 }
@@ -149,6 +150,7 @@ impl Names {
             team: program.team.as_str().into(),
             heartbeat: truncate(program.robot.clone()).into(),
             alive_key: crate::codegen::files::alive_key(program).into(),
+            sync_key: crate::codegen::files::sync_key(program).into(),
             outgoing: program
                 .control
                 .outgoing
@@ -209,6 +211,10 @@ struct Robot<'p> {
     /// Joined the mission under way (restarted after one heartbeat period):
     /// listens first, and follows a live claimant instead of claiming.
     rejoining: bool,
+    /// How often this robot reached each `GroupSync` state, by (service, pc).
+    sync_pass: HashMap<(usize, usize), i64>,
+    /// The last pass each (peer, sync point) announced (`comm_sync_arrived`).
+    sync_arrived: HashMap<(usize, usize), i64>,
     /// The last leader each `LeaderBranch` state saw, by (service, pc).
     leaders: HashMap<(usize, usize), usize>,
     /// Service tasks by name (the `request_tasks` and those of action commands).
@@ -371,6 +377,8 @@ impl<'p> Robot<'p> {
             ],
             leading: false,
             rejoining: m.heartbeat && at > m.heartbeat_ms,
+            sync_pass: HashMap::new(),
+            sync_arrived: HashMap::new(),
             leaders: HashMap::new(),
             tasks,
             has_receiver: !m.incoming.is_empty() || !m.subscribed.is_empty() || m.heartbeat,
@@ -884,6 +892,24 @@ impl<'p> Sim<'p> {
                     robot.heard[i] = heard;
                 }
             }
+            return;
+        }
+        // `heard_sync`: an arrival at a group statement; wakes the control task.
+        if !m.sync_points.is_empty() && message.key == self.names[r].sync_key {
+            let mut words = message.value.split(' ');
+            let number = |w: Option<&str>| w.and_then(|w| w.parse::<i64>().ok()).unwrap_or(0);
+            let (offset, pass) = (number(words.next()), number(words.next()));
+            let peer = robot
+                .program
+                .peers
+                .iter()
+                .position(|(_, name)| **name == *message.from_robot);
+            let point = m.sync_points.iter().position(|&p| p as i64 == offset);
+            if let (Some(peer), Some(point)) = (peer, point) {
+                let last = robot.sync_arrived.entry((peer, point)).or_insert(0);
+                *last = (*last).max(pass);
+            }
+            self.wake(r);
             return;
         }
         if !m.subscribed.is_empty() && message.publish {
@@ -1419,6 +1445,53 @@ impl<'p> Sim<'p> {
                     Step::Next
                 }
             },
+            StateKind::GroupSync {
+                members,
+                point,
+                timeout_ms,
+                mark,
+            } => {
+                if self.robots[r].regions[i].phase == 0 {
+                    let robot = &mut self.robots[r];
+                    let pass = robot.sync_pass.entry((service, pc)).or_insert(0);
+                    *pass += 1;
+                    let value = format!("{} {}", m.sync_points[*point], *pass);
+                    let region = self.region(r, i);
+                    region.marks[*mark] = now;
+                    region.phase = 1;
+                    let names = &self.names[r];
+                    let (team, key) = (names.team.clone(), names.sync_key.clone());
+                    self.comm_send(r, team, false, key, value.into());
+                }
+                let robot = &self.robots[r];
+                let pass = robot.sync_pass[&(service, pc)];
+                let hb = m.heartbeat_ms;
+                let me = program.self_peer;
+                let waiting = members.iter().any(|&peer| {
+                    peer != me
+                        && robot
+                            .sync_arrived
+                            .get(&(peer, *point))
+                            .copied()
+                            .unwrap_or(0)
+                            < pass
+                        && now - robot.heard[peer].seen <= 3 * hb
+                });
+                let started = robot.regions[i].marks[*mark];
+                if waiting && now - started <= *timeout_ms {
+                    return Step::Wait;
+                }
+                if waiting {
+                    self.emit(r, "timeout", vec![("statement", "GroupSync".into())]);
+                } else {
+                    let line = state.line.to_string();
+                    self.emit(r, "group_sync", vec![("line", line.into())]);
+                }
+                let region = self.region(r, i);
+                region.phase = 0;
+                region.pc = next;
+                Step::Next
+            }
             StateKind::Branch { condition, else_to } => {
                 let holds = self.eval(r, condition);
                 self.region(r, i).pc = if holds { next } else { *else_to };

@@ -377,3 +377,67 @@ fn scenario_mistakes_point_at_the_value() {
         );
     }
 }
+
+/// `tests/fixtures/group_sync`: the robots drive for `moves` ms (tb_0,
+/// tb_1, tb_2), then meet at the group statement (GroupSync, 2 s timeout).
+fn group_sync(moves: [i64; 3], faults: &str) -> Run {
+    let programs = programs("tests/fixtures/group_sync/sync.mission");
+    let robots: Vec<String> = moves
+        .iter()
+        .enumerate()
+        .map(|(i, ms)| format!(r#""tb_{i}": {{"services": {{"move": {ms}}}}}"#))
+        .collect();
+    let scenario = format!(
+        r#"{{"duration": 8000, "robots": {{{}}}, "faults": [{faults}]}}"#,
+        robots.join(", ")
+    );
+    run(&programs, &scenario, 0).0
+}
+
+/// When `robot` passed the group statement's start, and how.
+fn synced(run: &Run, robot: &str) -> Option<(i64, &'static str)> {
+    let r = run.robots.iter().position(|(_, n)| n == robot).unwrap();
+    run.trace
+        .iter()
+        .find(|e| {
+            e.robot == r
+                && (e.event == "group_sync"
+                    || (e.event == "timeout" && e.field("statement") == Some("GroupSync")))
+        })
+        .map(|e| (e.t, e.event))
+}
+
+#[test]
+fn group_sync_waits_for_every_member() {
+    let run_ = group_sync([100, 700, 1200], "");
+    for robot in ["tb_0", "tb_1", "tb_2"] {
+        let (t, how) = synced(&run_, robot).unwrap();
+        assert_eq!(how, "group_sync", "{robot}");
+        // Not before the slowest one arrived (1200 ms), and at once then.
+        assert!((1200..=1220).contains(&t), "{robot} met at {t}");
+    }
+}
+
+#[test]
+fn group_sync_does_not_wait_for_a_dead_member() {
+    // tb_1 dies on the way: the others meet when tb_2 arrives, without
+    // waiting for the timeout.
+    let run_ = group_sync([100, 700, 1200], r#"{"at": 300, "kill": "tb_1"}"#);
+    assert_eq!(synced(&run_, "tb_1"), None);
+    for robot in ["tb_0", "tb_2"] {
+        let (t, how) = synced(&run_, robot).unwrap();
+        assert_eq!(how, "group_sync", "{robot}");
+        assert!((1200..=1220).contains(&t), "{robot} met at {t}");
+    }
+}
+
+#[test]
+fn group_sync_gives_up_after_the_strategys_timeout() {
+    // tb_2 is alive but takes 5 s: tb_0 and tb_1 wait 2 s from their own
+    // arrival, then go on; tb_2, last, finds them finished (no heartbeat:
+    // dead) and goes on at once.
+    let run_ = group_sync([100, 700, 5000], "");
+    assert_eq!(synced(&run_, "tb_0"), Some((2110, "timeout")));
+    assert_eq!(synced(&run_, "tb_1"), Some((2710, "timeout")));
+    assert_eq!(synced(&run_, "tb_2"), Some((5000, "group_sync")));
+}

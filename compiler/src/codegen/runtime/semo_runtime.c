@@ -379,6 +379,11 @@ static task *find_task(const char *name)
     return NULL;
 }
 
+void semo_wake(const char *task_name)
+{
+    wake_task(find_task(task_name));
+}
+
 /* Time- and data-driven tasks start running; control-driven ones wait
  * for the control task. All of them obey UFControl_*. */
 static void *task_thread(void *arg)

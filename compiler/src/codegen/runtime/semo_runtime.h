@@ -225,6 +225,11 @@ bool UFControl_WaitStop(const char *task, int64_t until_ms);
  * no effect in other tasks. */
 void semo_next_firing(int64_t at_ms);
 
+/* Something task `task` waits for changed that is none of the above (the
+ * communication task recorded a robot's arrival at a group statement): if
+ * it sleeps on its semo_next_firing hint, it fires now. POSIX only. */
+void semo_wake(const char *task);
+
 /* Task parameters (per task, by name); unknown ones read as 0. */
 int UFTask_SetIntegerParameter(const char *task, const char *param, long long value);
 long long UFTask_GetIntegerParameter(const char *task, const char *param);
