@@ -322,6 +322,10 @@ bool semo_sim_sensor(const char *value, semo_value *out);
 void semo_sim_actuate(const char *task, const semo_value *command);
 /* How long (mission ms) a built-in service takes in the scenario (default 100). */
 int64_t semo_sim_service_ms(const char *service);
+/* The iteration (1, 2, ...) in which the exit task of the convergent SDF/L
+ * loop `loop` (the graph's name and the loop's path, "kmeans/Converge") sets the exit flag,
+ * from the scenario's "loops"; 0 when it never does. */
+int64_t semo_sim_loop_exit(const char *loop);
 #endif
 
 #endif /* SEMO_RUNTIME_H */
