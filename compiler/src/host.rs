@@ -838,7 +838,31 @@ impl Analysis {
             .iter()
             .filter_map(|(_, s)| s.strategy.clone())
             .collect();
+        // The task graphs of the catalog's services that the workspace holds.
+        let mut service_graphs: Vec<crate::refine::ServiceGraph> = Vec::new();
+        for (_, robot_type) in unit.catalog.catalog.types() {
+            for def in &robot_type.services {
+                let crate::catalog::Implementation::Graph(path) = &def.implementation else {
+                    continue;
+                };
+                let known = service_graphs
+                    .iter()
+                    .any(|g| g.catalog == def.origin.file && g.path == *path);
+                if known {
+                    continue;
+                }
+                let loaded = self.service_graph(def.origin.file, path);
+                if let Some(graph) = loaded.and_then(|run| run.graph.clone()) {
+                    service_graphs.push(crate::refine::ServiceGraph {
+                        catalog: def.origin.file,
+                        path: path.clone(),
+                        graph: Arc::new(graph),
+                    });
+                }
+            }
+        }
         Some(BuildFiles {
+            service_graphs,
             mission_name: name_of(mission),
             strategy_names: strategies
                 .iter()
@@ -947,6 +971,7 @@ pub struct BuildFiles {
     pub mission_name: String,
     pub strategy_names: Vec<(FileId, String)>,
     pub diagnostics: Vec<Diagnostic>,
+    pub service_graphs: Vec<crate::refine::ServiceGraph>,
 }
 
 impl BuildFiles {
@@ -961,6 +986,7 @@ impl BuildFiles {
             strategy_names: self.strategy_names.clone(),
             links: &self.unit.links,
             diagnostics: &self.diagnostics,
+            service_graphs: &self.service_graphs,
         }
     }
 }

@@ -479,6 +479,18 @@ pub fn task_c(
                 c::comment(&program.robot),
                 c::comment(&services.join(", "))
             );
+            // A service implemented by a task graph runs one iteration of
+            // it per call (target::check refuses it on static schedules).
+            let graph = program.graph_services.iter().find(|g| g.task == role.task);
+            if let Some(graph) = graph {
+                let at = out.find("TASK_INIT").unwrap_or(out.len());
+                out.insert_str(at, &super::loops::graph_runner(graph, target.simulated()));
+            }
+            let run_graph = if graph.is_some() {
+                "    run_graph();\n"
+            } else {
+                ""
+            };
             match (target.simulated(), target.platform()) {
                 (true, Platform::Threads) => {
                     let scale = match super::battery::actuator_speed_scale(program, &role.task) {
@@ -490,13 +502,16 @@ pub fn task_c(
                         }
                         None => "",
                     };
-                    out.push_str("    const char *arg = req.argc > 0 ? req.args[0].text : \"\";\n    semo_trace(\"call_start\", \"task\", TASK_NAME, \"service\", req.service, \"arg\", arg, NULL);\n    if (req.argc > 0)\n        semo_sim_actuate(TASK_NAME, &req.args[0]);\n    /* The simulated service takes the scenario's time for it, or ends when\n     * the control task stops it. */\n    UFControl_WaitStop(TASK_NAME, semo_now_ms() + semo_sim_service_ms(req.service)");
+                    out.push_str("    const char *arg = req.argc > 0 ? req.args[0].text : \"\";\n    semo_trace(\"call_start\", \"task\", TASK_NAME, \"service\", req.service, \"arg\", arg, NULL);\n    if (req.argc > 0)\n        semo_sim_actuate(TASK_NAME, &req.args[0]);\n");
+                    out.push_str(run_graph);
+                    out.push_str("    /* The simulated service takes the scenario's time for it, or ends when\n     * the control task stops it. */\n    UFControl_WaitStop(TASK_NAME, semo_now_ms() + semo_sim_service_ms(req.service)");
                     out.push_str(scale);
                     out.push_str(");\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n");
                 }
                 // The static simulation's body is the arm above.
                 (true, Platform::Static) => {}
                 (false, _) => {
+                    out.push_str(run_graph);
                     out.push_str("    /* TODO: perform the service; req.args[0 .. req.argc - 1] are its arguments.\n     * Check UFControl_StopRequested(TASK_NAME) during long work. */\n");
                     for s in services {
                         let _ = writeln!(

@@ -21,6 +21,7 @@ mod c;
 mod control;
 pub use control::listen_ms;
 pub(crate) mod files;
+mod loops;
 pub mod output;
 mod schedule;
 mod target;
@@ -444,6 +445,8 @@ pub struct BuildInput<'a> {
     pub links: &'a crate::strategy::StrategyLinks,
     /// The diagnostics of the mission, the catalog and the strategies.
     pub diagnostics: &'a [crate::diag::Diagnostic],
+    /// The task graphs implementing catalog services, as loaded.
+    pub service_graphs: &'a [crate::refine::ServiceGraph],
 }
 
 /// Generates the code of a mission: every error of the check (in the
@@ -593,6 +596,7 @@ pub fn refine_checked(build: &BuildInput<'_>) -> Refined {
         strategies: build.strategies,
         strategy_names,
         links: build.links,
+        service_graphs: build.service_graphs,
     };
     let (programs, found) = crate::refine::refine(&input);
     diagnostics.extend(found);

@@ -34,6 +34,16 @@ pub struct RefineInput<'a> {
     /// Strategy file names, by `Strategy::file`, for comments.
     pub strategy_names: &'a [(FileId, String)],
     pub links: &'a StrategyLinks,
+    /// The task graphs implementing catalog services that the workspace holds.
+    pub service_graphs: &'a [ServiceGraph],
+}
+
+/// A task graph a catalog names (`graph="path"` in catalog file `catalog`), as loaded.
+#[derive(Clone, Debug)]
+pub struct ServiceGraph {
+    pub catalog: FileId,
+    pub path: String,
+    pub graph: std::sync::Arc<crate::taskgraph::TaskGraph>,
 }
 
 /// One program per robot of the mission, in formation order, and the

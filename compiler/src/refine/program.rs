@@ -29,6 +29,45 @@ pub struct RobotProgram {
     pub self_peer: usize,
     /// The team's shared information, held by the library task.
     pub library: Option<SharedLibrary>,
+    /// The service tasks that run a task graph (`graph=` in the catalog).
+    pub graph_services: Vec<GraphService>,
+}
+
+/// A service the robot's type implements by a task graph: each call runs
+/// one iteration of the graph's looped schedule (`taskgraph::analysis`),
+/// its inner tasks fired in that order inside the service task.
+#[derive(Clone, Debug)]
+pub struct GraphService {
+    /// The service task (named after the graph file).
+    pub task: String,
+    /// The graph's name (`kmeans`).
+    pub graph: String,
+    /// The first call of the service in the mission.
+    pub call: Span,
+    /// One iteration of the top level, or why the graph has none (it is
+    /// inconsistent or deadlocks, which the dataflow warnings report on the
+    /// call; code generation refuses it, E100).
+    pub steps: Result<Vec<GraphStep>, String>,
+}
+
+/// A term of a service graph's looped schedule, loop nodes opened.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GraphStep {
+    /// `count` firings of an inner task; `task` is its path below the graph
+    /// (`Converge/Assign/Nearest`).
+    Fire { task: String, count: u64 },
+    /// A loop of the schedule: `body` `count` times.
+    Repeat { count: u64, body: Vec<GraphStep> },
+    /// An SDF/L loop node (`path` as for tasks): its body's schedule,
+    /// exactly `loop_count` times (D-type) or until its exit task sets the
+    /// exit flag, at most `loop_count` times (C-type, `exit_task` the path).
+    Loop {
+        path: String,
+        convergent: bool,
+        loop_count: u64,
+        exit_task: Option<String>,
+        body: Vec<GraphStep>,
+    },
 }
 
 /// The control task's machine.

@@ -12,6 +12,10 @@ use crate::text::LineIndex;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 mod battery;
+mod loops;
+
+#[cfg(test)]
+pub(super) use loops::steps_of;
 
 /// How often sensor tasks sample, in mission milliseconds.
 pub(super) const SENSOR_PERIOD_MS: i64 = 100;
@@ -50,6 +54,7 @@ pub(super) fn refine_robot(
     };
     builder.build_modes();
     builder.machine.battery = builder.battery_policies();
+    let graph_services = builder.graph_services();
     let self_peer = builder.first_peer() + robot_index;
     let Builder {
         mut machine,
@@ -117,6 +122,7 @@ pub(super) fn refine_robot(
         peers: peers.to_vec(),
         self_peer,
         library,
+        graph_services,
     };
     program.graph = graph::build(&program);
     let (capacities, found) = graph::check(&program.graph, input.file, robot.name_span);

@@ -46,6 +46,7 @@ fn programs(text: &str, strategies: &[&str]) -> Vec<RobotProgram> {
         strategies: &strategies,
         strategy_names: &names,
         links: &links,
+        service_graphs: &[],
     };
     let (programs, diagnostics) = refine(&input);
     assert!(diagnostics.is_empty(), "{diagnostics:#?}");
@@ -297,4 +298,52 @@ fn comparisons_carry_the_checkers_typing() {
         machine.contains("Eq, Literal(\"LEFT\"), Words)"),
         "{machine}"
     );
+}
+
+#[test]
+fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
+    use crate::refine::GraphStep::{Fire, Loop};
+    let fire = |task: &str| Fire {
+        task: task.to_string(),
+        count: 1,
+    };
+    let load = |name: &str| {
+        let text = shared(&format!("taskgraphs/{name}.taskgraph.xml"));
+        crate::taskgraph::load_task_graph(FileId(9), &text)
+            .0
+            .unwrap()
+    };
+    // `A 10(B C) D`: the D-type loop node is the `10(...)`.
+    assert_eq!(
+        robot::steps_of(&load("data_loop")).unwrap(),
+        [
+            fire("A"),
+            Loop {
+                path: "L".into(),
+                convergent: false,
+                loop_count: 10,
+                exit_task: None,
+                body: vec![fire("L/B"), fire("L/C")],
+            },
+            fire("D"),
+        ]
+    );
+    // k-means: a C-type loop (exit task ReplaceCenter) around a D-type one.
+    let kmeans = robot::steps_of(&load("kmeans")).unwrap();
+    let Loop {
+        convergent: true,
+        loop_count: 500,
+        exit_task: Some(exit),
+        body,
+        ..
+    } = &kmeans[2]
+    else {
+        panic!("{kmeans:?}");
+    };
+    assert_eq!(exit, "Converge/ReplaceCenter");
+    assert!(
+        matches!(&body[1], Loop { path, loop_count: 16, convergent: false, .. } if path == "Converge/Assign")
+    );
+    // No schedule, no program: a deadlocked graph is refused.
+    assert!(robot::steps_of(&load("deadlock")).is_err());
 }

@@ -42,6 +42,7 @@ use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
 
 mod battery;
+mod loops;
 
 /// The sensor tasks' period (refinement's `SENSOR_PERIOD_MS`).
 const SENSOR_PERIOD_MS: i64 = 100;
@@ -974,6 +975,7 @@ impl<'p> Sim<'p> {
                 vec![("task", task.to_string().into()), ("value", arg.into())],
             );
         }
+        self.run_graph(r, task);
         self.schedule(
             self.now + ms,
             Event::ServiceDone {

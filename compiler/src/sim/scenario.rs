@@ -39,6 +39,9 @@ pub struct RobotWorld {
     pub services: Vec<(String, i64)>,
     /// (at, level): the `BATTERY` sensor value, linear between points.
     pub battery: Vec<(i64, f64)>,
+    /// (SDF/L loop path, iteration): when a convergent loop's exit task
+    /// sets the exit flag.
+    pub loops: Vec<(String, u64)>,
 }
 
 /// An operator command: `USER.<value>` sent to a robot or team.
@@ -468,8 +471,8 @@ impl Reader<'_> {
         }
         object(
             v,
-            "a robot {\"sensors\": [...], \"services\": {...}, \"battery\": [...]}",
-            &["sensors", "services", "battery"],
+            "a robot {\"sensors\": [...], \"services\": {...}, \"battery\": [...], \"loops\": {...}}",
+            &["sensors", "services", "battery", "loops"],
         )?;
         let mut world = RobotWorld {
             robot: robot.to_string(),
@@ -497,6 +500,23 @@ impl Reader<'_> {
             };
             for (service, d) in members {
                 world.services.push((service.clone(), ms(d, service, 0)?));
+            }
+        }
+        if let Some(loops) = v.member("loops") {
+            let Kind::Object(members) = &loops.kind else {
+                return fail(loops, "expected an object of loop exits {\"Converge\": 3}");
+            };
+            for (path, n) in members {
+                let iteration = match n.kind {
+                    Kind::Number(x, _) if (1.0..=1e9).contains(&x) && x.fract() == 0.0 => x as u64,
+                    _ => {
+                        return fail(
+                            n,
+                            format!("\"{path}\" must be a whole number of iterations, 1 or more"),
+                        );
+                    }
+                };
+                world.loops.push((path.clone(), iteration));
             }
         }
         if let Some(battery) = v.member("battery") {

@@ -338,6 +338,10 @@ int64_t semo_sim_service_ms(const char *service);
 /* The scenario's battery level now, rounded (its "battery" points); false
  * when the scenario gives none. Heartbeats carry it (highest_battery). */
 bool semo_sim_battery(long long *level);
+/* The iteration (1, 2, ...) in which the exit task of the convergent SDF/L
+ * loop `loop` (the graph's name and the loop's path, "kmeans/Converge") sets the exit flag,
+ * from the scenario's "loops"; 0 when it never does. */
+int64_t semo_sim_loop_exit(const char *loop);
 #endif
 
 #endif /* SEMO_RUNTIME_H */

@@ -74,7 +74,7 @@ impl Analysis {
 
     /// The task graph a catalog file names (`graph="path"`, relative to the
     /// catalog file), analysed, if the workspace holds it.
-    fn service_graph(&self, catalog: FileId, path: &str) -> Option<Arc<GraphRun>> {
+    pub(super) fn service_graph(&self, catalog: FileId, path: &str) -> Option<Arc<GraphRun>> {
         let catalog_path = self.file(catalog)?.key.as_deref()?;
         let wanted = subgraph::normalize(&catalog_path.parent()?.join(Path::new(path)));
         self.graph(self.graph_at(&wanted)?)
