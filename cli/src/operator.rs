@@ -241,32 +241,17 @@ fn mqtt_address(url: &str) -> Option<(String, u16)> {
     }
 }
 
-/// A `send` from the operator as the runtime's datagram: "SEMO" 1, `s`,
-/// then team `USER`, robot `operator`, the key and the value, each a length
-/// byte and at most 255 bytes.
+/// A `send` from the operator as the runtime's datagram (`deploy::datagram`):
+/// team `USER`, robot `operator`, the value as typed (text: the robot reads
+/// it as the type its mission declares for the key).
 fn datagram(key: &str, value: &str) -> Vec<u8> {
-    let mut out = b"SEMO\x01s".to_vec();
-    for field in ["USER", "operator", key, value] {
-        let bytes = &field.as_bytes()[..field.len().min(255)];
-        out.push(bytes.len() as u8);
-        out.extend_from_slice(bytes);
-    }
-    out
-}
-
-/// The fields of a runtime datagram: (team, robot, key, value).
-fn fields(data: &[u8]) -> Option<[String; 4]> {
-    if data.len() < 6 || &data[..5] != b"SEMO\x01" {
-        return None;
-    }
-    let mut at = 6;
-    let mut take = || {
-        let n = *data.get(at)? as usize;
-        let text = data.get(at + 1..at + 1 + n)?;
-        at += 1 + n;
-        Some(String::from_utf8_lossy(text).into_owned())
-    };
-    Some([take()?, take()?, take()?, take()?])
+    semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+        publish: false,
+        team: "USER".into(),
+        robot: "operator".into(),
+        key: key.into(),
+        value: Some(semo::refine::Value::text(value)),
+    })
 }
 
 /// The line to print for a message: a robot's `send(USER, …)`, or its
@@ -276,8 +261,9 @@ fn describe(topic: &str, payload: &[u8], printed: &mut BTreeMap<String, String>)
     let last = levels.next()?;
     match levels.next()? {
         "USER" => {
-            let [_, robot, key, value] = fields(payload)?;
-            Some(format!("{robot}: send(USER, {key}) = {value}"))
+            let d = semo::deploy::datagram::decode(payload)?;
+            let value = d.value.map_or_else(|| "(none)".into(), |v| v.as_text());
+            Some(format!("{}: send(USER, {}) = {value}", d.robot, d.key))
         }
         "status" => {
             let status: serde_json::Value = serde_json::from_slice(payload).ok()?;
@@ -308,16 +294,11 @@ fn describe(topic: &str, payload: &[u8], printed: &mut BTreeMap<String, String>)
 mod tests {
     #[test]
     fn a_command_is_the_runtimes_datagram_and_reads_back() {
-        let d = super::datagram("USER.RC_CMD", "RETURN_MODE");
-        assert_eq!(
-            super::fields(&d),
-            Some([
-                "USER".into(),
-                "operator".into(),
-                "USER.RC_CMD".into(),
-                "RETURN_MODE".into()
-            ])
-        );
+        let d =
+            semo::deploy::datagram::decode(&super::datagram("USER.RC_CMD", "RETURN_MODE")).unwrap();
+        assert_eq!((d.team.as_str(), d.robot.as_str()), ("USER", "operator"));
+        assert_eq!(d.key, "USER.RC_CMD");
+        assert_eq!(d.value, Some(semo::refine::Value::text("RETURN_MODE")));
         assert_eq!(super::mqtt_address("mqtt://h:99"), Some(("h".into(), 99)));
         assert_eq!(super::mqtt_address("mqtts://h"), None);
     }

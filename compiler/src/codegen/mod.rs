@@ -22,6 +22,7 @@ pub(crate) mod files;
 pub mod output;
 mod schedule;
 mod target;
+mod values;
 
 use crate::refine::{RobotProgram, RoleKind};
 use crate::taskgraph::write::to_xml;
