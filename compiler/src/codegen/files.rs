@@ -48,7 +48,7 @@ pub fn program_h(program: &RobotProgram, header: &str) -> String {
         );
     }
     if program.control.heartbeat {
-        out.push_str("\n/* When each robot was last heard from (mission ms; comm_task.c). */\nint64_t comm_last_seen(size_t peer);\n");
+        out.push_str("\n/* What the last heartbeat of a robot said (comm_task.c): when it came\n * (mission ms), whether the robot claimed leadership, its battery level\n * (-1: unknown). */\ntypedef struct {\n    int64_t seen;\n    bool leads;\n    long battery;\n} comm_heartbeat;\ncomm_heartbeat comm_heard(size_t peer);\n");
     }
     if let Some(lib) = &program.library {
         let _ = writeln!(
@@ -244,8 +244,13 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
     let (include, declare, lock_seen, unlock_seen) = lock(target, "seen_lock");
     let _ = write!(
         out,
-        "#include \"program.h\"\n{}#include <string.h>\n\n",
-        if m.heartbeat { include } else { "" }
+        "#include \"program.h\"\n{}{}#include <string.h>\n\n",
+        if m.heartbeat { include } else { "" },
+        if m.heartbeat {
+            "#include <stdlib.h>\n"
+        } else {
+            ""
+        }
     );
     if !m.outgoing.is_empty() {
         out.push_str("/* CommSend: every value the control task sends goes to the robots of its\n * team (through the transport). */\nstatic const struct {\n    const char *port;\n    const char *to_team;\n    semo_msg_kind kind;\n    const char *key;\n} outgoing[] = {\n");
@@ -274,7 +279,7 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
     if m.heartbeat {
         let _ = writeln!(
             out,
-            "/* Heartbeats of the team's robots, for leader elections: when each robot\n * was last heard from. Every robot counts as alive at start. */\n{declare}static int64_t seen[{peers}];\n\nint64_t comm_last_seen(size_t peer)\n{{\n    int64_t t = 0;\n    {lock_seen}\n    if (peer < {peers})\n        t = seen[peer];\n    {unlock_seen}\n    return t;\n}}\n\nstatic bool heard_alive(const semo_message *m)\n{{\n    if (m->kind != SEMO_MSG_PUBLISH || strcmp(m->key, {key}) != 0)\n        return false;\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        if (strcmp(p->peers[i].robot, m->from_robot) == 0) {{\n            {lock_seen}\n            seen[i] = semo_now_ms();\n            {unlock_seen}\n        }}\n    return true;\n}}\n",
+            "/* Heartbeats of the team's robots, for leader elections: when each robot\n * was last heard from, and what it said (`leader 87`: it claims\n * leadership, battery 87; `member -`: it does not, battery unknown). Every\n * robot counts as alive at start. */\n{declare}static comm_heartbeat heard[{peers}];\n\ncomm_heartbeat comm_heard(size_t peer)\n{{\n    comm_heartbeat h = {{0, false, -1}};\n    {lock_seen}\n    if (peer < {peers})\n        h = heard[peer];\n    {unlock_seen}\n    return h;\n}}\n\nstatic bool heard_alive(const semo_message *m)\n{{\n    if (m->kind != SEMO_MSG_PUBLISH || strcmp(m->key, {key}) != 0)\n        return false;\n    /* The value is text; of another type it says only that the robot lives. */\n    const char *said = m->value.type == SEMO_TEXT ? m->value.text : \"\";\n    const char *battery = strchr(said, ' ');\n    comm_heartbeat h = {{semo_now_ms(), strncmp(said, \"leader \", 7) == 0, -1}};\n    if (battery && battery[1] >= '0' && battery[1] <= '9')\n        h.battery = strtol(battery + 1, NULL, 10);\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        if (strcmp(p->peers[i].robot, m->from_robot) == 0) {{\n            {lock_seen}\n            heard[i] = h;\n            {unlock_seen}\n        }}\n    return true;\n}}\n",
             peers = program.peers.len().max(1),
             key = c::string(&alive_key(program))
         );
@@ -305,6 +310,13 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         }
         let recv = c::ident(COMM_RECEIVE);
         let _ = writeln!(out, "void task_{recv}_init(void)\n{{");
+        if m.heartbeat {
+            let _ = writeln!(
+                out,
+                "    for (size_t i = 0; i < {}; i++)\n        heard[i].battery = -1;",
+                program.peers.len().max(1)
+            );
+        }
         if n > 0 {
             let _ = writeln!(
                 out,
@@ -402,7 +414,11 @@ pub fn task_c(
                     c::string(v)
                 );
             }
+            let level_hint = super::battery::sensor_level_hint(program, &role.task, *period_ms);
             out.push_str("}\n\nTASK_GO\n{\n    semo_value value;\n");
+            if level_hint.is_some() {
+                out.push_str("    int64_t fired = semo_now_ms();\n");
+            }
             for v in values {
                 // Refinement gives every sensor value a slot of its type.
                 let Some(kind) = program.control.sensor_kind(&role.task, v) else {
@@ -431,19 +447,27 @@ pub fn task_c(
                     }
                 }
             }
+            out.push_str(&level_hint.unwrap_or_default());
             out.push_str("}\n\nTASK_WRAPUP\n{\n}\n");
         }
         (RoleKind::Service { services }, _)
             if target.simulated() && target.platform() == Platform::Static =>
         {
+            let speed_scale = super::battery::actuator_speed_scale(program, &role.task);
+            out.push_str(speed_scale.as_deref().unwrap_or_default());
             // Nothing may block on the static schedule: the call spans
             // passes of the loop (semo_firing_continues) until its time is up.
             let _ = writeln!(
                 out,
-                "/* Task `{}` of robot {}: runs {} when the control task calls it; the\n * simulated service takes the scenario's time for it, over several passes\n * of the schedule. */\nstatic int port_request = -1;\nstatic semo_request req;\nstatic bool busy;\nstatic int64_t end;\n\nTASK_INIT\n{{\n    port_request = UFPort_Initialize(TASK_NAME, \"request\");\n}}\n\nTASK_GO\n{{\n    if (!busy) {{\n        if (UFPort_ReadFromQueue(port_request, &req, sizeof req) == 0)\n            return;\n        semo_trace_value(\"call_start\", \"arg\", req.argc > 0 ? &req.args[0] : SEMO_LIT(\"\"), \"task\", TASK_NAME, \"service\", req.service, NULL);\n        if (req.argc > 0)\n            semo_sim_actuate(TASK_NAME, &req.args[0]);\n        end = semo_now_ms() + semo_sim_service_ms(req.service);\n        busy = true;\n    }}\n    if (semo_running() && !UFControl_StopRequested(TASK_NAME) && semo_now_ms() < end) {{\n        semo_firing_continues();\n        semo_next_firing(end); /* or a stop request, whichever is first */\n        return;\n    }}\n    busy = false;\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n}}\n\nTASK_WRAPUP\n{{\n}}",
+                "/* Task `{}` of robot {}: runs {} when the control task calls it; the\n * simulated service takes the scenario's time for it, over several passes\n * of the schedule. */\nstatic int port_request = -1;\nstatic semo_request req;\nstatic bool busy;\nstatic int64_t end;\n\nTASK_INIT\n{{\n    port_request = UFPort_Initialize(TASK_NAME, \"request\");\n}}\n\nTASK_GO\n{{\n    if (!busy) {{\n        if (UFPort_ReadFromQueue(port_request, &req, sizeof req) == 0)\n            return;\n        semo_trace_value(\"call_start\", \"arg\", req.argc > 0 ? &req.args[0] : SEMO_LIT(\"\"), \"task\", TASK_NAME, \"service\", req.service, NULL);\n        if (req.argc > 0)\n            semo_sim_actuate(TASK_NAME, &req.args[0]);\n        end = semo_now_ms() + semo_sim_service_ms(req.service){scale};\n        busy = true;\n    }}\n    if (semo_running() && !UFControl_StopRequested(TASK_NAME) && semo_now_ms() < end) {{\n        semo_firing_continues();\n        semo_next_firing(end); /* or a stop request, whichever is first */\n        return;\n    }}\n    busy = false;\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n}}\n\nTASK_WRAPUP\n{{\n}}",
                 c::comment(&role.task),
                 c::comment(&program.robot),
-                c::comment(&services.join(", "))
+                c::comment(&services.join(", ")),
+                scale = if speed_scale.is_some() {
+                    " * speed_scale()"
+                } else {
+                    ""
+                },
             );
         }
         (RoleKind::Service { services }, _) => {
@@ -456,7 +480,18 @@ pub fn task_c(
             );
             match (target.simulated(), target.platform()) {
                 (true, Platform::Threads) => {
-                    out.push_str("    semo_trace_value(\"call_start\", \"arg\", req.argc > 0 ? &req.args[0] : SEMO_LIT(\"\"), \"task\", TASK_NAME, \"service\", req.service, NULL);\n    if (req.argc > 0)\n        semo_sim_actuate(TASK_NAME, &req.args[0]);\n    /* The simulated service takes the scenario's time for it, or ends when\n     * the control task stops it. */\n    UFControl_WaitStop(TASK_NAME, semo_now_ms() + semo_sim_service_ms(req.service));\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n");
+                    let scale = match super::battery::actuator_speed_scale(program, &role.task) {
+                        Some(function) => {
+                            // Before the task's functions.
+                            let at = out.find("TASK_INIT").unwrap_or(out.len());
+                            out.insert_str(at, &function);
+                            " * speed_scale()"
+                        }
+                        None => "",
+                    };
+                    out.push_str("    semo_trace_value(\"call_start\", \"arg\", req.argc > 0 ? &req.args[0] : SEMO_LIT(\"\"), \"task\", TASK_NAME, \"service\", req.service, NULL);\n    if (req.argc > 0)\n        semo_sim_actuate(TASK_NAME, &req.args[0]);\n    /* The simulated service takes the scenario's time for it, or ends when\n     * the control task stops it. */\n    UFControl_WaitStop(TASK_NAME, semo_now_ms() + semo_sim_service_ms(req.service)");
+                    out.push_str(scale);
+                    out.push_str(");\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n");
                 }
                 // The static simulation's body is the arm above.
                 (true, Platform::Static) => {}

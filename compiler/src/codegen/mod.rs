@@ -16,8 +16,10 @@
 //! it simulates, its runtime files); the generated code differs only where
 //! the platform does (locks, blocking, the schedule table, the Makefile).
 
+mod battery;
 mod c;
 mod control;
+pub use control::listen_ms;
 pub(crate) mod files;
 pub mod output;
 mod schedule;

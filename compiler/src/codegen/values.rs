@@ -95,6 +95,9 @@ fn each_literal(program: &RobotProgram, f: &mut dyn FnMut(&Value)) {
             _ => {}
         }
     }
+    for policy in &m.battery {
+        operands(&policy.condition, &mut add);
+    }
     for action in m.actions.iter().flat_map(|a| &a.actions) {
         for (_, command) in &action.commands {
             add(&Operand::Literal(command.clone()));

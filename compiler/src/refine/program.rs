@@ -53,8 +53,16 @@ pub struct ControlMachine {
     /// Latest-value groups the control task reads (`subscribe`).
     pub subscribed: Vec<String>,
     /// Whether the robot takes part in a leader election: it then tells its
-    /// team it is alive every [`HEARTBEAT_MS`] and listens for theirs.
+    /// team it is alive every `heartbeat_ms` and listens for theirs.
     pub heartbeat: bool,
+    /// The heartbeat period (mission ms): the strategy's
+    /// `LeaderSelectionInfo heartbeatPeriod` (the shortest of those that
+    /// apply to the robot's elections), else [`HEARTBEAT_MS`]; 0 without
+    /// `heartbeat`.
+    pub heartbeat_ms: i64,
+    /// Adaptive resource management: the team strategy's battery policies,
+    /// checked at every firing against the robot's `BATTERY` value.
+    pub battery: Vec<BatteryPolicy>,
 }
 
 impl ControlMachine {
@@ -80,9 +88,67 @@ impl ControlMachine {
     }
 }
 
+impl ControlMachine {
+    /// The period level (sensor) or speed level (actuator) of `task` while
+    /// the policies for which `holds` is true hold: the highest level any of
+    /// them gives it (the most saving one), 1 (unchanged) when none does.
+    pub fn battery_level(&self, task: &str, sensor: bool, holds: &[bool]) -> u64 {
+        self.battery
+            .iter()
+            .zip(holds)
+            .filter(|(_, h)| **h)
+            .flat_map(|(p, _)| if sensor { &p.sensors } else { &p.actuators })
+            .filter(|(t, _)| t == task)
+            .map(|(_, level)| *level)
+            .max()
+            .unwrap_or(1)
+    }
+
+    /// The tasks some policy gives a level, in first-mention order: sensors
+    /// (`true`) then actuators (`false`).
+    pub fn battery_tasks(&self) -> Vec<(&str, bool)> {
+        let mut tasks: Vec<(&str, bool)> = Vec::new();
+        for sensor in [true, false] {
+            for p in &self.battery {
+                for (t, _) in if sensor { &p.sensors } else { &p.actuators } {
+                    if !tasks.contains(&(t.as_str(), sensor)) {
+                        tasks.push((t, sensor));
+                    }
+                }
+            }
+        }
+        tasks
+    }
+}
+
+/// One battery requirement (`<Condition cond="Battery&lt;30">`) for one
+/// robot: while `condition` holds, each listed sensor task samples every
+/// `period × level` and each listed actuator task runs at `1 / level` of its
+/// speed (a call takes `level` times as long); when it stops holding, they
+/// return to level 1.
+#[derive(Clone, Debug)]
+pub struct BatteryPolicy {
+    /// The condition as written (`Battery<30`): the trace names the policy by it.
+    pub text: String,
+    /// Over the robot's `BATTERY` slot.
+    pub condition: Expr,
+    /// The strategy file it comes from (for comments).
+    pub source: String,
+    /// (sensor task, period level), each a task of this robot.
+    pub sensors: Vec<(String, u64)>,
+    /// (actuator task, speed level), each a task of this robot.
+    pub actuators: Vec<(String, u64)>,
+}
+
 /// How often a robot that can be elected leader tells its team it is alive
-/// (mission ms); a robot not heard from for three periods counts as failed.
+/// (mission ms) when its strategy names no `heartbeatPeriod`; a robot not
+/// heard from for three periods counts as failed.
 pub const HEARTBEAT_MS: i64 = 200;
+
+/// How a leader is chosen among the live candidates of a `leader(...)` arm:
+/// the strategy's `LeaderSelectionInfo algorithm`, else
+/// [`LeaderAlgorithm::LowestId`] (the first in formation order).
+pub use crate::strategy::LeaderAlgorithm;
 
 #[derive(Clone, Debug)]
 pub struct ModeState {
@@ -172,10 +238,12 @@ pub enum StateKind {
         mark: usize,
     },
     /// `leader(cond)` for a robot that meets `cond`: continue (run the
-    /// leader's block) if this robot is the first of `candidates` (peer
-    /// indices, in formation order) that is alive, else go to `others_at`.
+    /// leader's block) if `algorithm` chooses this robot among the live
+    /// `candidates` (peer indices, in formation order), else go to
+    /// `others_at`.
     LeaderBranch {
         candidates: Vec<usize>,
+        algorithm: LeaderAlgorithm,
         others_at: usize,
     },
     /// Continue at `else_to` unless the condition holds.

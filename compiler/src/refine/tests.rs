@@ -138,6 +138,49 @@ fn the_strategy_refines_the_masters_move_only() {
 }
 
 #[test]
+fn battery_requirements_become_policies_over_the_robots_own_tasks() {
+    let programs = programs(
+        &shared("scouting/scouting.mission"),
+        &[&shared("scouting/MasterTeam.strategy.xml")],
+    );
+    let master = program(&programs, "irobot");
+    let [policy] = &master.control.battery[..] else {
+        panic!("{:?}", master.control.battery);
+    };
+    assert_eq!(policy.text, "Battery<30");
+    // `Camera` is the task of that name; `Ultrasonic` the task its
+    // `CheckSensor` reads; `Move` the task its `ExecuteActuator` drives.
+    let named = |list: &[(String, u64)]| -> Vec<(String, u64)> { list.to_vec() };
+    assert_eq!(
+        named(&policy.sensors),
+        [("camera".to_string(), 2), ("ultrasonic".to_string(), 2)]
+    );
+    assert_eq!(named(&policy.actuators), [("wheel".to_string(), 2)]);
+    // The condition reads the robot's own battery, sampled by its task.
+    let Expr::Compare(
+        Operand::Slot(slot),
+        _,
+        Operand::Literal(limit),
+        crate::sema::Compared::Numbers,
+    ) = &policy.condition
+    else {
+        panic!("{:?}", policy.condition);
+    };
+    assert_eq!(limit, "30");
+    assert!(matches!(
+        &master.control.slots[*slot].source,
+        SlotSource::Sensor { port, .. } if port == "BATTERY"
+    ));
+    assert!(task_names(master).contains(&"battery"));
+    // Levels: the highest of the policies that hold, 1 when none does.
+    assert_eq!(master.control.battery_level("wheel", false, &[true]), 2);
+    assert_eq!(master.control.battery_level("wheel", false, &[false]), 1);
+    assert_eq!(master.control.battery_level("wheel", true, &[true]), 1);
+    // The slaves' team has no strategy, so no policy.
+    assert!(program(&programs, "ti").control.battery.is_empty());
+}
+
+#[test]
 fn the_task_graph_has_sensor_service_and_communication_tasks() {
     let programs = programs(&shared("scouting/scouting.mission"), &[]);
     assert_eq!(

@@ -193,6 +193,14 @@ void Core_1_go(void);
 void semo_firing_continues(void);
 #endif
 
+/* Mission time when this program started, after the start barrier: 0, or
+ * later for a robot restarted into a mission under way (`--start-at` in the
+ * past). Leader elections use it: a restarted robot listens first. */
+int64_t semo_joined_ms(void);
+/* Whether the transport found this robot's session from an earlier run (the
+ * MQTT broker still held it: the robot was restarted); false on UDP. */
+bool semo_session_resumed(void);
+
 /* Ends the program (from any task). */
 void semo_stop_program(void);
 bool semo_running(void);
@@ -361,6 +369,9 @@ bool semo_sim_sensor(const char *value, semo_type type, semo_value *out);
 void semo_sim_actuate(const char *task, const semo_value *command);
 /* How long (mission ms) a built-in service takes in the scenario (default 100). */
 int64_t semo_sim_service_ms(const char *service);
+/* The scenario's battery level now, rounded (its "battery" points); false
+ * when the scenario gives none. Heartbeats carry it (highest_battery). */
+bool semo_sim_battery(long long *level);
 #endif
 
 #endif /* SEMO_RUNTIME_H */

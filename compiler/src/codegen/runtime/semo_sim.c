@@ -1085,6 +1085,15 @@ bool semo_sim_sensor(const char *value, semo_type type, semo_value *out)
     return false;
 }
 
+bool semo_sim_battery(long long *level)
+{
+    if (g_sim.battery_count == 0)
+        return false;
+    if (level)
+        *level = (long long)round_half_away(battery_level(semo_now_ms()));
+    return true;
+}
+
 void semo_sim_actuate(const char *task, const semo_value *command)
 {
     semo_trace_value("actuate", "value", command ? command : SEMO_LIT(""), "task", task, NULL);
