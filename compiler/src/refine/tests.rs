@@ -166,7 +166,7 @@ fn battery_requirements_become_policies_over_the_robots_own_tasks() {
     else {
         panic!("{:?}", policy.condition);
     };
-    assert_eq!(limit, "30");
+    assert_eq!(limit, &crate::refine::Value::Int(30));
     assert!(matches!(
         &master.control.slots[*slot].source,
         SlotSource::Sensor { port, .. } if port == "BATTERY"
