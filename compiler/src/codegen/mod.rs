@@ -25,6 +25,7 @@ mod loops;
 pub mod output;
 mod schedule;
 mod target;
+mod values;
 
 use crate::refine::{RobotProgram, RoleKind};
 use crate::taskgraph::write::to_xml;

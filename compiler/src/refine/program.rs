@@ -6,6 +6,7 @@
 //! sets for that plan → for a built-in call the strategy refines, that
 //! entry's action machine (bottom).
 
+use super::value::{Value, ValueKind};
 use crate::span::Span;
 use crate::taskgraph::TaskGraph;
 
@@ -363,7 +364,7 @@ pub struct ActionState {
     pub id: u64,
     pub is_final: bool,
     /// Actuator commands issued on entry: (task, command value).
-    pub commands: Vec<(String, String)>,
+    pub commands: Vec<(String, Value)>,
     /// Checked in order; the first that holds is taken. `None` = always.
     pub transitions: Vec<(Option<Expr>, usize)>,
 }
@@ -374,6 +375,9 @@ pub struct Slot {
     /// `MasterTeam.LOCATION`, `USER.RC_CMD`, or `move.goalLocation`.
     pub key: String,
     pub source: SlotSource,
+    /// How its values are stored: the catalog's type of the value (of the
+    /// service parameter for a strategy variable).
+    pub kind: ValueKind,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -453,9 +457,21 @@ pub enum Expr {
     Bool(bool),
 }
 
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Operand {
     Slot(usize),
-    /// A literal's text (strings unescaped, numbers as written, constants by name).
-    Literal(String),
+    /// A literal, typed as written: a whole number an integer, another number
+    /// a real, a string text, `true`/`false` a truth value, a symbolic
+    /// constant a word.
+    Literal(Value),
+}
+
+impl ControlMachine {
+    /// The kind of the value a sensor task writes to `port` (the slot it feeds).
+    pub fn sensor_kind(&self, task: &str, port: &str) -> Option<&ValueKind> {
+        self.slots.iter().find_map(|s| match &s.source {
+            SlotSource::Sensor { task: t, port: p } if t == task && p == port => Some(&s.kind),
+            _ => None,
+        })
+    }
 }

@@ -487,7 +487,32 @@ impl Reader<'_> {
                 )?;
                 let at = ms(require(entry, "at")?, "at", 0)?;
                 let value = name(require(entry, "value")?, "value")?.to_string();
-                let is = value_text(require(entry, "is")?)?;
+                let is_value = require(entry, "is")?;
+                let is = value_text(is_value)?;
+                // Read as the catalog's type of the value, as the sensor task
+                // reads it (`semo_sim_sensor`): say so here, not by silence.
+                let kind = self
+                    .programs
+                    .iter()
+                    .filter(|p| p.robot == robot)
+                    .flat_map(|p| &p.control.slots)
+                    .find_map(|s| match &s.source {
+                        crate::refine::SlotSource::Sensor { port, .. } if *port == value => {
+                            Some(&s.kind)
+                        }
+                        _ => None,
+                    });
+                if let Some(kind) = kind
+                    && kind.parse(&is).is_none()
+                {
+                    return fail(
+                        is_value,
+                        format!(
+                            "\"is\" must be a value of {value}'s type ({}), not {is:?}",
+                            kind.describe()
+                        ),
+                    );
+                }
                 world.sensors.push((at, value, is));
             }
         }

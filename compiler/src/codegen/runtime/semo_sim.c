@@ -459,11 +459,12 @@ static bool want_name(reader *r, const json *v, const char *key, size_t cap, cha
     return true;
 }
 
-/* "is": a string, or a number taken as written. */
+/* "is": a string, or a number taken as written; held as text, read as the
+ * type of the value it is given to (a sensor's, a received key's). */
 static bool want_value(reader *r, const json *v, semo_value *out)
 {
-    if ((v->kind != J_STRING && v->kind != J_NUMBER) || strlen(v->text) >= SEMO_VALUE_MAX)
-        return fail_at(r, v->line, v->col, "\"is\" must be a string or number shorter than %d bytes", SEMO_VALUE_MAX);
+    if ((v->kind != J_STRING && v->kind != J_NUMBER) || strlen(v->text) >= SEMO_TEXT_MAX)
+        return fail_at(r, v->line, v->col, "\"is\" must be a string or number shorter than %d bytes", SEMO_TEXT_MAX);
     semo_value_set(out, v->text);
     return true;
 }
@@ -1088,7 +1089,7 @@ static double round_half_away(double x)
     return whole;
 }
 
-bool semo_sim_sensor(const char *value, semo_value *out)
+bool semo_sim_sensor(const char *value, semo_type type, semo_value *out)
 {
     const sensor_entry *latest = NULL;
     int64_t now = semo_now_ms();
@@ -1097,17 +1098,15 @@ bool semo_sim_sensor(const char *value, semo_value *out)
         if (e->at <= now && strcmp(e->value, value) == 0 && (!latest || e->at >= latest->at))
             latest = e;
     }
-    if (latest && out)
-        *out = latest->is;
-    if (!latest && value && strcmp(value, "BATTERY") == 0 && g_sim.battery_count > 0) {
-        if (out) {
-            char text[400]; /* "%.0f" of any double fits */
-            snprintf(text, sizeof text, "%.0f", round_half_away(battery_level(now)));
-            semo_value_set(out, text);
-        }
-        return true;
+    semo_value read;
+    if (latest)
+        return semo_value_parse(out ? out : &read, type, latest->is.text);
+    if (value && strcmp(value, "BATTERY") == 0 && g_sim.battery_count > 0) {
+        char text[400]; /* "%.0f" of any double fits */
+        snprintf(text, sizeof text, "%.0f", round_half_away(battery_level(now)));
+        return semo_value_parse(out ? out : &read, type, text);
     }
-    return latest != NULL;
+    return false;
 }
 
 bool semo_sim_battery(long long *level)
@@ -1121,7 +1120,7 @@ bool semo_sim_battery(long long *level)
 
 void semo_sim_actuate(const char *task, const semo_value *command)
 {
-    semo_trace("actuate", "task", task, "value", command ? command->text : "", NULL);
+    semo_trace_value("actuate", "value", command ? command : SEMO_LIT(""), "task", task, NULL);
 }
 
 int64_t semo_sim_service_ms(const char *service)
