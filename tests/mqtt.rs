@@ -12,150 +12,13 @@
 mod support;
 
 use std::collections::BTreeMap;
-use std::net::{TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
+use support::mqtt::{Fleet, Processes, Started, folder_of, free_port, read_trace, robot_name};
 use support::robots::{
-    Event, PEDANTIC, build, events, field, modes, robot_command, robot_folders, scratch,
+    Event, PEDANTIC, build, field, modes, robot_command, robot_folders, scratch,
 };
 use support::{examples, repo_root};
-
-/// The `mosquitto` binary (Debian puts it in /usr/sbin, often not on PATH).
-fn mosquitto() -> Option<PathBuf> {
-    let on_path = std::env::var_os("PATH")
-        .into_iter()
-        .flat_map(|p| std::env::split_paths(&p).collect::<Vec<_>>());
-    on_path
-        .chain([PathBuf::from("/usr/sbin"), PathBuf::from("/usr/local/sbin")])
-        .map(|dir| dir.join("mosquitto"))
-        .find(|path| path.is_file())
-}
-
-/// The broker, or None (after saying why) when the test must be skipped.
-fn broker_or_skip(test: &str) -> Option<PathBuf> {
-    let found = mosquitto();
-    if found.is_none() {
-        let required = std::env::var("SEMO_MQTT_TESTS").as_deref() == Ok("require");
-        assert!(
-            !required,
-            "SEMO_MQTT_TESTS=require but `mosquitto` is not installed (apt-get install mosquitto libmosquitto-dev)"
-        );
-        eprintln!(
-            "skipping {test}: `mosquitto` is not installed (set SEMO_MQTT_TESTS=require to fail instead)"
-        );
-    }
-    found
-}
-
-/// Processes this test started; each is killed when the guard goes, so a
-/// failing assertion leaves no broker or robot behind.
-#[derive(Default)]
-struct Processes(Vec<Child>);
-
-impl Processes {
-    fn push(&mut self, child: Child) -> usize {
-        self.0.push(child);
-        self.0.len() - 1
-    }
-
-    /// SIGTERM and wait: a broker then saves its state (SIGKILL would not).
-    fn terminate(&mut self, index: usize) {
-        let child = &mut self.0[index];
-        let sent = Command::new("kill")
-            .args(["-TERM", &child.id().to_string()])
-            .status()
-            .expect("kill runs");
-        assert!(sent.success(), "kill -TERM {}", child.id());
-        child.wait().expect("wait for the terminated process");
-    }
-
-    /// Waits for a robot to end by itself and returns its stderr; a failure
-    /// status fails the test.
-    fn wait_success(&mut self, index: usize, what: &str) -> String {
-        let child = &mut self.0[index];
-        let status = child.wait().expect("wait for the robot");
-        let mut stderr = String::new();
-        if let Some(mut pipe) = child.stderr.take() {
-            use std::io::Read;
-            let _ = pipe.read_to_string(&mut stderr);
-        }
-        assert!(status.success(), "{what} exited with {status:?}: {stderr}");
-        stderr
-    }
-}
-
-impl Drop for Processes {
-    fn drop(&mut self) {
-        for child in &mut self.0 {
-            let _ = child.kill();
-            let _ = child.wait();
-        }
-    }
-}
-
-/// A private broker: its configuration, persistence and log in `dir`, on a
-/// free port of 127.0.0.1. Returns its port once it accepts connections.
-fn start_broker(binary: &Path, dir: &Path, processes: &mut Processes) -> (u16, usize) {
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
-    let index = start_broker_on(binary, dir, port, processes);
-    (port, index)
-}
-
-/// The user we are: started as root, mosquitto drops to the `mosquitto`
-/// user, which cannot read or write our folders; `user <us>` keeps it us (no
-/// effect otherwise).
-fn current_user() -> String {
-    let whoami = Command::new("id").arg("-un").output().expect("id runs");
-    String::from_utf8_lossy(&whoami.stdout).trim().to_string()
-}
-
-fn start_broker_on(binary: &Path, dir: &Path, port: u16, processes: &mut Processes) -> usize {
-    let config = dir.join("mosquitto.conf");
-    std::fs::write(
-        &config,
-        format!(
-            "user {}\nlistener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\npersistence true\npersistence_location {}/\nlog_dest file {}\n",
-            current_user(),
-            dir.display(),
-            dir.join("mosquitto.log").display()
-        ),
-    )
-    .unwrap();
-    start_broker_with(binary, &config, dir, port, processes)
-}
-
-/// Starts mosquitto with `config` (which listens on `port` of 127.0.0.1)
-/// and waits until it accepts connections; its log goes to `dir`.
-fn start_broker_with(
-    binary: &Path,
-    config: &Path,
-    dir: &Path,
-    port: u16,
-    processes: &mut Processes,
-) -> usize {
-    let child = Command::new(binary)
-        .arg("-c")
-        .arg(config)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("mosquitto starts");
-    let index = processes.push(child);
-    // Ready when it accepts a connection; a broker that never does (the port
-    // taken meanwhile) fails the test after many tries rather than hanging.
-    for _ in 0..500 {
-        if TcpStream::connect(("127.0.0.1", port)).is_ok() {
-            return index;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(10));
-    }
-    let log = std::fs::read_to_string(dir.join("mosquitto.log")).unwrap_or_default();
-    panic!("mosquitto did not listen on port {port}: {log}");
-}
 
 /// `semo build` of the scouting mission for linux-sim, each robot made with
 /// the MQTT transport built in (`make TRANSPORT=mqtt`), warnings as errors.
@@ -165,53 +28,11 @@ fn build_scouting(out: &Path) -> Vec<PathBuf> {
 
 /// The same with more `semo build` arguments (`--deploy FILE`).
 fn build_scouting_with(out: &Path, extra: &[&str]) -> Vec<PathBuf> {
-    let mission = examples().join("scouting/scouting.mission");
-    let (mission, out_arg) = (mission.display().to_string(), out.display().to_string());
-    let mut args = vec![
-        "build",
-        mission.as_str(),
-        "--target",
-        "linux-sim",
-        "-o",
-        out_arg.as_str(),
-    ];
-    args.extend_from_slice(extra);
-    let built = support::semo_in(&repo_root(), &args);
-    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
-    let folders = robot_folders(out);
-    for folder in &folders {
-        let made = Command::new("make")
-            .args([
-                "-s",
-                "-j2",
-                "CC=gcc",
-                &format!("CFLAGS={PEDANTIC}"),
-                "TRANSPORT=mqtt",
-            ])
-            .current_dir(folder)
-            .output()
-            .expect("make runs");
-        let stderr = String::from_utf8_lossy(&made.stderr);
-        assert!(
-            made.status.success() && !stderr.contains("warning"),
-            "{}: {stderr}",
-            folder.display()
-        );
-    }
-    folders
+    support::mqtt::build(&examples().join("scouting/scouting.mission"), out, extra)
 }
 
 fn scenario() -> PathBuf {
     repo_root().join("tests/fixtures/build/scouting.scenario.json")
-}
-
-fn robot_name(folder: &Path) -> String {
-    folder.file_name().unwrap().to_string_lossy().into_owned()
-}
-
-fn read_trace(path: &Path) -> Vec<Event> {
-    let text = std::fs::read_to_string(path).unwrap_or_default();
-    events(&text.lines().map(str::to_string).collect::<Vec<_>>())
 }
 
 /// Runs every robot together with `transport_args` and returns its trace.
@@ -258,35 +79,18 @@ fn received_from(events: &[Event], robot: &str, key: &str) -> Vec<String> {
 
 #[test]
 fn scouting_over_mqtt_behaves_as_over_udp() {
-    let Some(binary) = broker_or_skip("scouting_over_mqtt_behaves_as_over_udp") else {
+    let Some(mut fleet) = Fleet::start("mqtt-scouting") else {
         return;
     };
-    let out = scratch("mqtt-scouting");
-    let broker_dir = out.join("broker");
-    std::fs::create_dir_all(&broker_dir).unwrap();
-    let folders = build_scouting(&out);
-    let mut processes = Processes::default();
-    let (port, _) = start_broker(&binary, &broker_dir, &mut processes);
-
+    let folders = build_scouting(&fleet.out);
     let udp = run_together(
         &folders,
-        &out,
+        &fleet.out,
         "udp",
         &["--transport".into(), "udp".into()],
-        &mut processes,
+        &mut fleet.processes,
     );
-    let mqtt = run_together(
-        &folders,
-        &out,
-        "mqtt",
-        &[
-            "--transport".into(),
-            "mqtt".into(),
-            "--broker".into(),
-            format!("mqtt://127.0.0.1:{port}"),
-        ],
-        &mut processes,
-    );
+    let mqtt = fleet.run_all(&folders, &scenario(), "mqtt", &[]);
 
     assert_eq!(mqtt.len(), 3, "three robots");
     for (robot, events) in &mqtt {
@@ -313,50 +117,25 @@ fn scouting_over_mqtt_behaves_as_over_udp() {
 
 #[test]
 fn a_send_reaches_a_robot_that_was_away_when_it_was_sent() {
-    let Some(binary) = broker_or_skip("a_send_reaches_a_robot_that_was_away_when_it_was_sent")
-    else {
+    let Some(mut fleet) = Fleet::start("mqtt-qos1") else {
         return;
     };
-    let out = scratch("mqtt-qos1");
-    let broker_dir = out.join("broker");
-    std::fs::create_dir_all(&broker_dir).unwrap();
-    let folders = build_scouting(&out);
-    let folder = |name: &str| {
-        folders
-            .iter()
-            .find(|f| robot_name(f) == name)
-            .unwrap()
-            .clone()
-    };
-    let mut processes = Processes::default();
-    let (port, broker) = start_broker(&binary, &broker_dir, &mut processes);
-    let mqtt = [
-        "--transport".to_string(),
-        "mqtt".into(),
-        "--broker".into(),
-        format!("mqtt://127.0.0.1:{port}"),
-    ];
-    let run = |processes: &mut Processes, robot: &str, tag: &str, extra: &[&str]| {
-        let trace = out.join(format!("{robot}.{tag}.jsonl"));
-        let child = robot_command(&folder(robot), &scenario(), &trace, 1)
-            .args(&mqtt)
-            .args(extra)
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("the robot program starts");
-        let index = processes.push(child);
-        processes.wait_success(index, &format!("{robot} ({tag})"));
-        read_trace(&trace)
-    };
+    let folders = build_scouting(&fleet.out);
+    let folder = |robot: &str| folder_of(&folders, robot);
 
     // The master connects once (its session and subscriptions now exist at
     // the broker) and goes away.
-    run(&mut processes, "irobot", "first", &["--duration", "10"]);
+    fleet.run(
+        &folder("irobot"),
+        &scenario(),
+        "first",
+        &["--duration", "10"],
+    );
     // The broker restarts (its state survives in its persistence file).
-    processes.terminate(broker);
-    start_broker_on(&binary, &broker_dir, port, &mut processes);
+    fleet.stop_broker();
+    fleet.start_broker();
     // A slave runs its whole mission while the master is away.
-    let ti = run(&mut processes, "ti", "alone", &[]);
+    let ti = fleet.run(&folder("ti"), &scenario(), "alone", &[]);
     assert!(
         ti.iter().any(|e| field(e, "event") == "send"
             && field(e, "key") == "SlaveTeam.COLOR"
@@ -364,7 +143,12 @@ fn a_send_reaches_a_robot_that_was_away_when_it_was_sent() {
         "ti sends its colors"
     );
     // The master comes back and gets what was sent meanwhile.
-    let back = run(&mut processes, "irobot", "back", &["--duration", "3000"]);
+    let back = fleet.run(
+        &folder("irobot"),
+        &scenario(),
+        "back",
+        &["--duration", "3000"],
+    );
     let heard = received_from(&back, "ti", "SlaveTeam.COLOR");
     assert!(
         !heard.is_empty(),
@@ -465,11 +249,7 @@ fn transport_options_are_checked_and_an_unreachable_broker_is_reported() {
         assert!(stderr.contains(says), "{args:?}: {stderr}");
     }
     // Nothing listens on a port just freed: the robot says so and stops.
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
+    let port = free_port();
     let broker = format!("mqtt://127.0.0.1:{port}");
     let (code, stderr) = run_with(irobot, &["--transport", "mqtt", "--broker", &broker]);
     assert_eq!(code, Some(1), "{stderr}");
@@ -546,8 +326,12 @@ fn scouting_deployment(dir: &Path, port: u16, tls: bool) -> PathBuf {
 /// `semo deploy broker-config` into `dir/broker`, run as this user, logging
 /// to `dir/broker/mosquitto.log`; returns the configuration's path.
 fn broker_config(dir: &Path, deploy: &Path) -> PathBuf {
+    broker_config_for(dir, &examples().join("scouting/scouting.mission"), deploy)
+}
+
+/// The same for another mission.
+fn broker_config_for(dir: &Path, mission: &Path, deploy: &Path) -> PathBuf {
     let out = dir.join("broker");
-    let mission = examples().join("scouting/scouting.mission");
     let written = support::semo_in(
         dir,
         &[
@@ -565,22 +349,23 @@ fn broker_config(dir: &Path, deploy: &Path) -> PathBuf {
     let mut text = std::fs::read_to_string(&config).unwrap();
     text.push_str(&format!(
         "user {}\nlog_dest file {}\n",
-        current_user(),
+        support::mqtt::current_user(),
         out.join("mosquitto.log").display()
     ));
     std::fs::write(&config, text).unwrap();
     config
 }
 
-/// A `USER` command as the runtime's datagram: "SEMO" 1, kind `s`, then
-/// team, robot, key and value, each a length byte and its bytes.
+/// A `USER` command as the runtime's datagram (`semo::deploy::datagram`):
+/// from team `USER`, robot `operator`, the value as text.
 fn user_command(key: &str, value: &str) -> Vec<u8> {
-    let mut datagram = b"SEMO\x01s".to_vec();
-    for field in ["USER", "operator", key, value] {
-        datagram.push(field.len() as u8);
-        datagram.extend_from_slice(field.as_bytes());
-    }
-    datagram
+    semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+        publish: false,
+        team: "USER".into(),
+        robot: "operator".into(),
+        key: key.into(),
+        value: Some(semo::refine::Value::text(value)),
+    })
 }
 
 /// Publishes `datagram` to `topic` with `mosquitto_pub` every 100 ms (as
@@ -657,21 +442,33 @@ fn run_while_forging(
     traces
 }
 
+/// A fleet whose broker runs the configuration `semo deploy broker-config`
+/// writes for the scouting deployment (`scouting_deployment`, with TLS
+/// files when `tls`), and the deployment file.
+fn deployed_fleet(name: &str, tls: bool) -> Option<(Fleet, PathBuf)> {
+    let mut deploy = None;
+    let fleet = Fleet::start_configured(name, |broker_dir, port| {
+        let out = broker_dir
+            .parent()
+            .expect("the broker folder is in the test's");
+        if tls {
+            tls_files(out);
+        }
+        let file = scouting_deployment(out, port, tls);
+        let config = broker_config(out, &file);
+        deploy = Some(file);
+        config
+    })?;
+    Some((fleet, deploy.expect("configured")))
+}
+
 #[test]
 fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
-    let Some(binary) =
-        broker_or_skip("the_generated_acl_lets_only_the_operator_switch_a_robots_mode")
-    else {
+    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-acl", false) else {
         return;
     };
-    let out = scratch("mqtt-acl");
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
-    let deploy = scouting_deployment(&out, port, false);
-    let config = broker_config(&out, &deploy);
+    let (out, port) = (fleet.out.clone(), fleet.port);
+    let config = out.join("broker/mosquitto.conf");
     let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
     insta::assert_snapshot!(
         "scouting_acl",
@@ -692,8 +489,6 @@ fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
         header.contains("SEMO_DEPLOY_PASSWORD_FILE") && !header.contains("secret\""),
         "the password file's path, not the password: {header}"
     );
-    let mut processes = Processes::default();
-    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
 
     // Anonymous clients and the slaves' credentials cannot command the master.
     let forged = run_while_forging(
@@ -702,7 +497,7 @@ fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
         "forged",
         port,
         &[None, Some(("slaves", "slaves-secret"))],
-        &mut processes,
+        &mut fleet.processes,
     );
     for (robot, events) in &forged {
         assert_eq!(
@@ -733,7 +528,7 @@ fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
         "operator",
         port,
         &[Some(("operator", "operator-secret"))],
-        &mut processes,
+        &mut fleet.processes,
     );
     assert!(
         modes(&commanded["irobot"]).iter().any(|m| m == "RC_MODE"),
@@ -816,32 +611,23 @@ fn tls_files(dir: &Path) {
 
 #[test]
 fn robots_run_over_tls_with_client_certificates() {
-    let Some(binary) = broker_or_skip("robots_run_over_tls_with_client_certificates") else {
+    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-tls", true) else {
         return;
     };
-    let out = scratch("mqtt-tls");
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
-    tls_files(&out);
-    let deploy = scouting_deployment(&out, port, true);
-    let config = broker_config(&out, &deploy);
+    let (out, port) = (fleet.out.clone(), fleet.port);
+    let config = out.join("broker/mosquitto.conf");
     let conf = std::fs::read_to_string(&config).unwrap();
     assert!(
         conf.contains("certfile ") && conf.contains("cafile "),
         "{conf}"
     );
     let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
-    let mut processes = Processes::default();
-    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
     let traces = run_together(
         &folders,
         &out,
         "tls",
         &["--transport".into(), "mqtt".into()],
-        &mut processes,
+        &mut fleet.processes,
     );
     assert_eq!(traces.len(), 3);
     for (robot, events) in &traces {
@@ -893,24 +679,12 @@ fn retained_status(port: u16, robot: &str) -> Option<serde_json::Value> {
 
 #[test]
 fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
-    let Some(binary) =
-        broker_or_skip("each_robot_keeps_a_retained_status_and_a_killed_one_is_lost")
-    else {
+    let Some(mut fleet) = Fleet::start("mqtt-status") else {
         return;
     };
-    let out = scratch("mqtt-status");
-    let broker_dir = out.join("broker");
-    std::fs::create_dir_all(&broker_dir).unwrap();
-    let folders = build_scouting(&out);
-    let mut processes = Processes::default();
-    let (port, _) = start_broker(&binary, &broker_dir, &mut processes);
-    let mqtt = [
-        "--transport".to_string(),
-        "mqtt".into(),
-        "--broker".into(),
-        format!("mqtt://127.0.0.1:{port}"),
-    ];
-    let traces = run_together(&folders, &out, "status", &mqtt, &mut processes);
+    let port = fleet.port;
+    let folders = build_scouting(&fleet.out);
+    let traces = fleet.run_all(&folders, &scenario(), "status", &[]);
     // After the run: each robot stopped, in its last mode, as its trace says.
     for (robot, events) in &traces {
         let status = retained_status(port, robot).unwrap_or_else(|| panic!("{robot}: no status"));
@@ -923,14 +697,8 @@ fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
         );
     }
     // A robot killed while running: the broker publishes its last will.
-    let irobot = folders.iter().find(|f| robot_name(f) == "irobot").unwrap();
-    let child = robot_command(irobot, &scenario(), &out.join("irobot.killed.jsonl"), 1)
-        .args(&mqtt)
-        .args(["--duration", "1000000"])
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the robot program starts");
-    let index = processes.push(child);
+    let irobot = folder_of(&folders, "irobot");
+    let killed = fleet.spawn(&irobot, &scenario(), "killed", &["--duration", "1000000"]);
     let mut running = None;
     for _ in 0..50 {
         // Running, and past its first firing: a service in each plan.
@@ -952,8 +720,7 @@ fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
             .is_some_and(|m| m.ends_with("_MODE")),
         "{running}"
     );
-    processes.0[index].kill().unwrap();
-    processes.0[index].wait().unwrap();
+    fleet.processes.kill(killed.index);
     let mut lost = None;
     for _ in 0..50 {
         lost = retained_status(port, "irobot").filter(|s| s["state"] == "lost");
@@ -967,40 +734,24 @@ fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
 
 #[test]
 fn robots_reconnect_after_a_broker_restart_and_no_send_is_lost() {
-    let Some(binary) =
-        broker_or_skip("robots_reconnect_after_a_broker_restart_and_no_send_is_lost")
-    else {
+    let Some(mut fleet) = Fleet::start("mqtt-broker-restart") else {
         return;
     };
-    let out = scratch("mqtt-broker-restart");
-    let broker_dir = out.join("broker");
-    std::fs::create_dir_all(&broker_dir).unwrap();
-    let folders = build_scouting(&out);
-    let mut processes = Processes::default();
-    let (port, broker) = start_broker(&binary, &broker_dir, &mut processes);
+    let folders = build_scouting(&fleet.out);
     // Four times slower than the scenario's pace: the robots' reconnection
     // (libmosquitto waits 1 s first) falls inside the slaves' search.
-    let mut started = Vec::new();
-    for folder in &folders {
-        let robot = robot_name(folder);
-        let trace = out.join(format!("{robot}.restart.jsonl"));
-        let child = robot_command(folder, &scenario(), &trace, 1)
-            .args(["--transport", "mqtt", "--time-scale", "0.4"])
-            .args(["--broker", &format!("mqtt://127.0.0.1:{port}")])
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("the robot program starts");
-        started.push((robot, trace, processes.push(child)));
-    }
+    let started: Vec<Started> = folders
+        .iter()
+        .map(|f| fleet.spawn(f, &scenario(), "restart", &["--time-scale", "0.4"]))
+        .collect();
     // While the slaves search and send their colors, the broker goes down
     // (saving its state, as a service stop does) and comes back.
     std::thread::sleep(std::time::Duration::from_millis(700));
-    processes.terminate(broker);
-    start_broker_on(&binary, &broker_dir, port, &mut processes);
+    fleet.stop_broker();
+    fleet.start_broker();
     let mut traces = BTreeMap::new();
-    for (robot, trace, index) in started {
-        processes.wait_success(index, &format!("{robot} (broker restart)"));
-        traces.insert(robot, read_trace(&trace));
+    for run in &started {
+        traces.insert(run.robot.clone(), fleet.finish(run, "broker restart"));
     }
     for (robot, events) in &traces {
         assert_eq!(
@@ -1037,7 +788,7 @@ fn robots_reconnect_after_a_broker_restart_and_no_send_is_lost() {
             );
         }
     }
-    let log = std::fs::read_to_string(broker_dir.join("mosquitto.log")).unwrap_or_default();
+    let log = std::fs::read_to_string(fleet.broker_dir().join("mosquitto.log")).unwrap_or_default();
     assert!(
         log.matches("New client connected").count() >= 6,
         "each robot connected twice: {log}"
@@ -1046,33 +797,21 @@ fn robots_reconnect_after_a_broker_restart_and_no_send_is_lost() {
 
 #[test]
 fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
-    let Some(binary) =
-        broker_or_skip("a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead")
-    else {
+    let Some(mut fleet) = Fleet::start("mqtt-robot-restart") else {
         return;
     };
-    let out = scratch("mqtt-robot-restart");
-    let broker_dir = out.join("broker");
-    std::fs::create_dir_all(&broker_dir).unwrap();
-    let folders = build_scouting(&out);
-    let mut processes = Processes::default();
-    let (port, _) = start_broker(&binary, &broker_dir, &mut processes);
+    let folders = build_scouting(&fleet.out);
     const SCALE: f64 = 0.4; // wall ms per mission ms
-    let spawn = |processes: &mut Processes, folder: &Path, tag: &str| {
-        let trace = out.join(format!("{}.{tag}.jsonl", robot_name(folder)));
-        let child = robot_command(folder, &scenario(), &trace, 1)
-            .args(["--transport", "mqtt", "--time-scale", &SCALE.to_string()])
-            .args(["--broker", &format!("mqtt://127.0.0.1:{port}")])
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("the robot program starts");
-        (trace, processes.push(child))
+    let scale = SCALE.to_string();
+    let spawn = |fleet: &mut Fleet, folder: &Path, tag: &str| {
+        let run = fleet.spawn(folder, &scenario(), tag, &["--time-scale", &scale]);
+        (run.trace, run.index)
     };
     let started = std::time::Instant::now();
     let mut slaves = Vec::new();
     let mut master = None;
     for folder in &folders {
-        let (trace, index) = spawn(&mut processes, folder, "life");
+        let (trace, index) = spawn(&mut fleet, folder, "life");
         if robot_name(folder) == "irobot" {
             master = Some((folder.clone(), index));
         } else {
@@ -1082,18 +821,17 @@ fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
     let (irobot, first) = master.unwrap();
     // Killed while the slaves send their colors; back a moment later.
     std::thread::sleep(std::time::Duration::from_millis(600));
-    processes.0[first].kill().unwrap();
-    processes.0[first].wait().unwrap();
+    fleet.processes.kill(first);
     let killed = started.elapsed().as_secs_f64() * 1000.0;
     std::thread::sleep(std::time::Duration::from_millis(300));
     let back_at = started.elapsed().as_secs_f64() * 1000.0;
-    let (second_trace, second) = spawn(&mut processes, &irobot, "second-life");
+    let (second_trace, second) = spawn(&mut fleet, &irobot, "second-life");
     let mut slave_traces = BTreeMap::new();
     for (robot, trace, index) in slaves {
-        processes.wait_success(index, &robot);
+        fleet.processes.wait_success(index, &robot);
         slave_traces.insert(robot, read_trace(&trace));
     }
-    processes.wait_success(second, "irobot (second life)");
+    fleet.processes.wait_success(second, "irobot (second life)");
     let second_life = read_trace(&second_trace);
     assert_eq!(
         modes(&second_life).last().map(String::as_str),
@@ -1138,20 +876,12 @@ fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
 
 #[test]
 fn the_operator_console_drives_scouting_to_finish() {
-    let Some(binary) = broker_or_skip("the_operator_console_drives_scouting_to_finish") else {
+    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-operator", false) else {
         return;
     };
-    let out = scratch("mqtt-operator");
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
-    let deploy = scouting_deployment(&out, port, false);
-    let config = broker_config(&out, &deploy);
+    let out = fleet.out.clone();
     let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
-    let mut processes = Processes::default();
-    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+    let processes = &mut fleet.processes;
     // The scouting world without its simulated operator: only the console
     // can tell the master to return (it waits in WAIT_MODE until then).
     let mut world: serde_json::Value =
@@ -1248,4 +978,700 @@ fn the_operator_console_drives_scouting_to_finish() {
             .any(|l| l.starts_with("status irobot: stopped FINISH")),
         "{printed:?}"
     );
+}
+
+/// The `semo/monitor` notification of the server behind `client` whose
+/// robots satisfy `wanted`; one that never comes fails the test.
+async fn monitor_view(
+    client: &mut semo_server::harness::TestClient,
+    wanted: impl Fn(&serde_json::Value) -> bool,
+) -> serde_json::Value {
+    let last = std::sync::Mutex::new(serde_json::Value::Null);
+    let seen = |p: &serde_json::Value| {
+        *last.lock().unwrap() = p.clone();
+        wanted(p)
+    };
+    let found = tokio::time::timeout(
+        std::time::Duration::from_secs(60),
+        client.notification("semo/monitor", seen),
+    )
+    .await;
+    found.unwrap_or_else(|_| {
+        panic!(
+            "the awaited semo/monitor notification did not come; the last one: {}",
+            last.lock().unwrap()
+        )
+    })
+}
+
+fn shown<'v>(view: &'v serde_json::Value, robot: &str) -> &'v serde_json::Value {
+    view["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["robot"] == robot)
+        .unwrap_or_else(|| panic!("{robot} is shown: {view}"))
+}
+
+/// A workspace for the editor: `files` copied in, and a `semo.toml` whose
+/// `[build] deployment` is `deploy`.
+fn monitor_workspace(out: &Path, deploy: &Path, files: &[PathBuf]) -> PathBuf {
+    let workspace = out.join("workspace");
+    std::fs::create_dir_all(&workspace).unwrap();
+    for file in files {
+        std::fs::copy(file, workspace.join(file.file_name().unwrap())).unwrap();
+    }
+    std::fs::write(
+        workspace.join("semo.toml"),
+        format!("[build]\ndeployment = \"{}\"\n", deploy.display()),
+    )
+    .unwrap();
+    workspace
+}
+
+/// The language server (in-process) on `workspace`, `mission` open and
+/// checked, and its monitor started with no broker named (so the
+/// deployment file's); the client, the mission's URI and the answer.
+async fn start_monitor(
+    workspace: &Path,
+    mission: &str,
+) -> (semo_server::harness::TestClient, String, serde_json::Value) {
+    let mut client = semo_server::harness::TestClient::start();
+    let root = format!("file://{}", workspace.display());
+    client
+        .initialize_with(serde_json::json!({}), Some(&root))
+        .await;
+    let mission = workspace.join(mission);
+    let uri = format!("file://{}", mission.display());
+    client
+        .open(&uri, &std::fs::read_to_string(&mission).unwrap())
+        .await;
+    client.diagnostics(&uri, Some(1)).await;
+    let answer = client
+        .request("semo/monitor/start", serde_json::json!({ "uri": uri }))
+        .await
+        .expect("the monitor starts");
+    (client, uri, answer)
+}
+
+#[test]
+fn the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost() {
+    // The broker of the deployment file with its ACL: the monitor finds it
+    // through the project's semo.toml and connects as the operator.
+    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-monitor", false) else {
+        return;
+    };
+    let (out, port) = (fleet.out.clone(), fleet.port);
+    let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
+    // The broker is process 0.
+    let processes = &mut fleet.processes;
+    let workspace = monitor_workspace(
+        &out,
+        &deploy,
+        &[
+            examples().join("scouting/scouting.mission"),
+            examples().join("scouting/MasterTeam.strategy.xml"),
+        ],
+    );
+    // Without the simulated operator the master waits in WAIT_MODE: the
+    // robots stay running.
+    let mut world: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scenario()).unwrap()).unwrap();
+    world["operator"] = serde_json::json!([]);
+    world.as_object_mut().unwrap().remove("expect");
+    let alone = out.join("no-operator.scenario.json");
+    std::fs::write(&alone, world.to_string()).unwrap();
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let (mut client, uri, answer) = start_monitor(&workspace, "scouting.mission").await;
+        assert_eq!(answer["broker"], format!("mqtt://127.0.0.1:{port}"));
+        let view = monitor_view(&mut client, |p| p["connection"] == "connected").await;
+        let names: Vec<String> = folders.iter().map(|f| robot_name(f)).collect();
+        for robot in &names {
+            assert_eq!(shown(&view, robot)["state"], "waiting", "{view}");
+        }
+
+        for folder in &folders {
+            let robot = robot_name(folder);
+            let trace = out.join(format!("{robot}.monitored.jsonl"));
+            let child = robot_command(folder, &alone, &trace, 1)
+                .args(["--transport", "mqtt", "--duration", "1000000"])
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("the robot program starts");
+            processes.push(child);
+        }
+        // Every robot running in a mode with its services; the master
+        // waiting for the operator, listening.
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|robots| {
+                robots.iter().all(|r| {
+                    r["state"] == "running"
+                        && r["mode"].is_string()
+                        && r["services"].as_array().is_some_and(|s| !s.is_empty())
+                }) && robots
+                    .iter()
+                    .any(|r| r["robot"] == "irobot" && r["mode"] == "WAIT_MODE")
+            })
+        })
+        .await;
+        let master = shown(&view, "irobot");
+        assert_eq!(master["team"], "MasterTeam");
+        assert!(
+            master["services"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|s| s["plan"] == "Listen" && s["service"] == "ReportStatus"),
+            "{view}"
+        );
+
+        // Killed: the broker's last will marks it lost, the others run on.
+        let irobot = names.iter().position(|n| n == "irobot").unwrap();
+        // The broker is process 0, the robots follow in folder order.
+        processes.0[1 + irobot].kill().unwrap();
+        processes.0[1 + irobot].wait().unwrap();
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|r| {
+                r.iter()
+                    .any(|r| r["robot"] == "irobot" && r["lost"] == true)
+            })
+        })
+        .await;
+        assert_eq!(shown(&view, "irobot")["lostBecause"], "lastWill");
+        for robot in names.iter().filter(|n| *n != "irobot") {
+            assert_eq!(shown(&view, robot)["state"], "running", "{view}");
+        }
+        let stopped = client
+            .request("semo/monitor/stop", serde_json::json!({ "uri": uri }))
+            .await
+            .unwrap();
+        assert_eq!(stopped["stopped"], true);
+        client.shutdown().await;
+    });
+}
+
+/// patrol_groups's deployment: a user per team and the operator, on a
+/// private broker at `port`.
+fn patrol_deployment(dir: &Path, port: u16) -> PathBuf {
+    let users = [
+        ("base", "base-secret"),
+        ("guards", "guards-secret"),
+        ("operator", "operator-secret"),
+    ];
+    for (i, (user, password)) in users.iter().enumerate() {
+        std::fs::write(dir.join(format!("{user}.pw")), format!("{password}\n")).unwrap();
+        let mut command = Command::new("mosquitto_passwd");
+        if i == 0 {
+            command.arg("-c");
+        }
+        let made = command
+            .arg("-b")
+            .arg(dir.join("passwd"))
+            .args([user, password])
+            .output()
+            .expect("mosquitto_passwd runs");
+        assert!(made.status.success(), "{made:?}");
+    }
+    let file = dir.join("patrol_groups.deploy.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "broker = \"mqtt://127.0.0.1:{port}\"\n\n[broker_config]\npassword_file = \"passwd\"\n\n[operator]\nuser = \"operator\"\npassword_file = \"operator.pw\"\n\n[teams.Base]\nuser = \"base\"\npassword_file = \"base.pw\"\n\n[teams.Guards]\nuser = \"guards\"\npassword_file = \"guards.pw\"\n"
+        ),
+    )
+    .unwrap();
+    file
+}
+
+/// Sends `signal` (`STOP`, `CONT`) to a process.
+fn signal(child: &Child, signal: &str) {
+    let sent = Command::new("kill")
+        .args([&format!("-{signal}"), &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(sent.success(), "kill -{signal} {}", child.id());
+}
+
+#[test]
+fn the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor() {
+    // Team Guards elects a leader among its Turtlebots tb_0..tb_2 with
+    // heartbeats; the broker's ACL lets the operator (the monitor) read them.
+    let mission = examples().join("swarm/patrol_groups.mission");
+    let mut deploy = None;
+    let Some(mut fleet) = Fleet::start_configured("mqtt-monitor-leader", |broker_dir, port| {
+        let out = broker_dir
+            .parent()
+            .expect("the broker folder is in the test's");
+        let file = patrol_deployment(out, port);
+        let config = broker_config_for(out, &mission, &file);
+        deploy = Some(file);
+        config
+    }) else {
+        return;
+    };
+    let deploy = deploy.expect("configured");
+    let out = fleet.out.clone();
+    let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
+    assert!(
+        acl.contains("user operator\n")
+            && acl.contains("topic read semo/patrol_groups/Guards/Guards.__alive\n"),
+        "{acl}"
+    );
+    let folders =
+        support::mqtt::build(&mission, &out, &["--deploy", &deploy.display().to_string()]);
+    let processes = &mut fleet.processes;
+    let workspace = monitor_workspace(&out, &deploy, std::slice::from_ref(&mission));
+    let world = out.join("patrol.scenario.json");
+    std::fs::write(&world, r#"{"time_scale": 1, "duration": 1000000}"#).unwrap();
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let (mut client, uri, _) = start_monitor(&workspace, "patrol_groups.mission").await;
+        let mut robots = BTreeMap::new();
+        for folder in &folders {
+            let robot = robot_name(folder);
+            let trace = out.join(format!("{robot}.jsonl"));
+            let child = robot_command(folder, &world, &trace, 1)
+                .args(["--transport", "mqtt"])
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("the robot program starts");
+            robots.insert(robot, processes.push(child));
+        }
+        let leader_is = |robot: &'static str| {
+            move |p: &serde_json::Value| {
+                p["robots"].as_array().is_some_and(|all| {
+                    all.iter().all(|r| r["state"] == "running")
+                        && all
+                            .iter()
+                            .filter(|r| r["robot"].as_str().is_some_and(|n| n.starts_with("tb_")))
+                            .all(|r| r["leader"] == robot)
+                })
+            }
+        };
+        let view = monitor_view(&mut client, leader_is("tb_0")).await;
+        assert_eq!(shown(&view, "tb_0")["isLeader"], true, "{view}");
+        assert_eq!(shown(&view, "tb_1")["isLeader"], false, "{view}");
+
+        // The leader hangs (its connection stays open: no last will). It
+        // is shown lost once silent for three heartbeats, and tb_1 leads.
+        signal(&processes.0[robots["tb_0"]], "STOP");
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|all| {
+                all.iter()
+                    .any(|r| r["robot"] == "tb_0" && r["lostBecause"] == "silent")
+                    && all
+                        .iter()
+                        .any(|r| r["robot"] == "tb_1" && r["isLeader"] == true)
+                    && all
+                        .iter()
+                        .any(|r| r["robot"] == "tb_2" && r["leader"] == "tb_1")
+            })
+        })
+        .await;
+        assert_eq!(shown(&view, "base")["state"], "running", "{view}");
+
+        // Back: heard again, running again.
+        signal(&processes.0[robots["tb_0"]], "CONT");
+        monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|all| {
+                all.iter()
+                    .any(|r| r["robot"] == "tb_0" && r["state"] == "running")
+            })
+        })
+        .await;
+        let stopped = client
+            .request("semo/monitor/stop", serde_json::json!({ "uri": uri }))
+            .await
+            .unwrap();
+        assert_eq!(stopped["stopped"], true);
+        client.shutdown().await;
+    });
+}
+
+/// The first mission time at which two robots both lead by their own traces
+/// (`events` of every robot and incarnation, each a robot's name and its
+/// events): a robot leads from a `leader` event naming itself until one
+/// naming another, or until `ends[robot]` (when it was killed).
+fn two_leaders(
+    lives: &[(String, Vec<Event>)],
+    ends: &BTreeMap<usize, i64>,
+) -> Option<(i64, String, String)> {
+    // (time, life, leads) changes, in time order.
+    let mut changes: Vec<(i64, usize, bool)> = Vec::new();
+    for (life, (robot, events)) in lives.iter().enumerate() {
+        for e in events.iter().filter(|e| field(e, "event") == "leader") {
+            let t = e["t"].as_i64().unwrap();
+            changes.push((t, life, field(e, "leader") == robot));
+        }
+        if let Some(&end) = ends.get(&life) {
+            changes.push((end, life, false));
+        }
+    }
+    changes.sort_by_key(|&(t, life, leads)| (t, leads, life));
+    let mut leading = vec![false; lives.len()];
+    for (t, life, leads) in changes {
+        leading[life] = leads;
+        let both: Vec<&String> = (0..lives.len())
+            .filter(|&l| leading[l])
+            .map(|l| &lives[l].0)
+            .collect();
+        if let [a, b, ..] = both.as_slice() {
+            return Some((t, a.to_string(), b.to_string()));
+        }
+    }
+    None
+}
+
+fn leaders_of(events: &[Event]) -> Vec<String> {
+    events
+        .iter()
+        .filter(|e| field(e, "event") == "leader")
+        .map(|e| field(e, "leader").to_string())
+        .collect()
+}
+
+/// Mission ms since the start barrier's instant `t0` (time scale 1;
+/// negative before it).
+fn mission_ms(t0: std::time::Instant) -> i64 {
+    let now = std::time::Instant::now();
+    match now.checked_duration_since(t0) {
+        Some(after) => after.as_millis() as i64,
+        None => -(t0.duration_since(now).as_millis() as i64),
+    }
+}
+
+/// Sleeps until mission time `at` (time scale 1) of a run whose mission
+/// time 0 is the instant `t0`.
+fn sleep_until(t0: std::time::Instant, at: i64) {
+    let when = t0 + std::time::Duration::from_millis(at as u64);
+    std::thread::sleep(when.saturating_duration_since(std::time::Instant::now()));
+}
+
+/// patrol_groups, every robot a process over a private broker: the modes
+/// the light levels call for, and the TurtleBots' leader killed and
+/// restarted: a new leader takes over, and after the restart the restarted
+/// robot listens and waits for the one that took over to give way: never
+/// two leaders at once (judged from the traces' mission times, on one
+/// clock: every process has the same `--start-at`).
+#[test]
+fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
+    let Some(mut fleet) = Fleet::start("mqtt-patrol-groups") else {
+        return;
+    };
+    let folders = support::mqtt::build(
+        &examples().join("swarm/patrol_groups.mission"),
+        &fleet.out,
+        &[],
+    );
+    // Dark from 1 s to 2.5 s: the TurtleBots warn the team, which hides.
+    let dark = r#"{"sensors": [{"at": 1000, "value": "LIGHTNESS", "is": "100"}, {"at": 2500, "value": "LIGHTNESS", "is": "600"}]}"#;
+    let scenario = fleet.out.join("patrol.scenario.json");
+    std::fs::write(
+        &scenario,
+        format!(
+            r#"{{"time_scale": 1, "duration": 9000, "robots": {{"tb_0": {dark}, "tb_1": {dark}, "tb_2": {dark}}}}}"#
+        ),
+    )
+    .unwrap();
+    // tb_0 is dead three heartbeats (600 ms) after it is killed, and tb_1
+    // takes over at its next pass through the leader's statement (one a
+    // second): the restart comes after that.
+    const KILL_AT: i64 = 3500;
+    const RESTART_AT: i64 = 6000;
+    let (t0, start_at) = support::robots::start_barrier(folders.len());
+    let start_at = start_at.to_string();
+    let barrier = ["--start-at", start_at.as_str()];
+    let mut lives: Vec<Started> = folders
+        .iter()
+        .map(|f| fleet.spawn(f, &scenario, "first", &barrier))
+        .collect();
+    let first_tb_0 = lives.iter().position(|s| s.robot == "tb_0").unwrap();
+    sleep_until(t0, KILL_AT);
+    fleet.processes.kill(lives[first_tb_0].index);
+    let killed_at = mission_ms(t0);
+    sleep_until(t0, RESTART_AT);
+    let restarted_at = mission_ms(t0);
+    lives.push(fleet.spawn(&folder_of(&folders, "tb_0"), &scenario, "second", &barrier));
+    let traces: Vec<(String, Vec<Event>)> = lives
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let events = if i == first_tb_0 {
+                read_trace(&s.trace)
+            } else {
+                fleet.finish(s, "patrol_groups")
+            };
+            (s.robot.clone(), events)
+        })
+        .collect();
+    let of =
+        |robot: &str| -> &Vec<Event> { &traces.iter().rev().find(|(r, _)| r == robot).unwrap().1 };
+
+    for robot in ["tb_1", "tb_2"] {
+        assert_eq!(modes(of(robot)), ["PATROL", "HIDE", "PATROL"], "{robot}");
+    }
+    assert_eq!(modes(&traces[first_tb_0].1), ["PATROL", "HIDE", "PATROL"]);
+    assert_eq!(modes(of("tb_0")), ["PATROL"], "tb_0's second life");
+    assert_eq!(modes(of("base")), ["WATCH"]);
+    for robot in ["ev_0", "ev_1"] {
+        let m = modes(of(robot));
+        assert_eq!(m.first().map(String::as_str), Some("PATROL"), "{robot}");
+        assert_eq!(m.last().map(String::as_str), Some("PATROL"), "{robot}");
+    }
+
+    // tb_1 takes over: tb_0 is dead three heartbeats after the last one it
+    // sent, and the leader's statement decides once a pass (every second).
+    let last_heartbeat = traces[first_tb_0]
+        .1
+        .iter()
+        .filter(|e| field(e, "event") == "send" && field(e, "key") == "Guards.__alive")
+        .map(|e| e["t"].as_i64().unwrap())
+        .next_back()
+        .expect("tb_0 sent heartbeats");
+    let took_over = of("tb_1")
+        .iter()
+        .find(|e| field(e, "event") == "leader" && field(e, "leader") == "tb_1")
+        .map(|e| e["t"].as_i64().unwrap())
+        .expect("tb_1 takes over");
+    assert!(
+        took_over > killed_at - 50 && took_over <= last_heartbeat + 3 * 200 + 1000 + 100,
+        "tb_1 took over at {took_over}, tb_0's last heartbeat at {last_heartbeat}"
+    );
+    // After the restart tb_0 leads again, and the others follow it.
+    assert_eq!(leaders_of(of("tb_1")), ["tb_0", "tb_1", "tb_0"]);
+    assert_eq!(leaders_of(of("tb_2")), ["tb_0", "tb_1", "tb_0"]);
+    let second = leaders_of(of("tb_0"));
+    assert_eq!(
+        second.last().map(String::as_str),
+        Some("tb_0"),
+        "{second:?}"
+    );
+    let claimed = of("tb_0")
+        .iter()
+        .find(|e| field(e, "event") == "leader" && field(e, "leader") == "tb_0")
+        .map(|e| e["t"].as_i64().unwrap())
+        .unwrap();
+    assert!(
+        claimed >= restarted_at + 300,
+        "the restarted tb_0 listened before claiming: restarted at {restarted_at}, claimed at {claimed}"
+    );
+    let ends = BTreeMap::from([(first_tb_0, killed_at)]);
+    assert_eq!(two_leaders(&traces, &ends), None);
+}
+
+/// `highest_battery` (tests/fixtures/elections): the processes' heartbeats
+/// carry the battery levels the scenario gives them, and the fullest robot
+/// leads.
+#[test]
+fn highest_battery_over_mqtt_elects_the_fullest_robot() {
+    let Some(mut fleet) = Fleet::start("mqtt-highest-battery") else {
+        return;
+    };
+    let folders = support::mqtt::build(
+        &repo_root().join("tests/fixtures/elections/highest_battery/election.mission"),
+        &fleet.out,
+        &[],
+    );
+    let scenario = fleet.out.join("battery.scenario.json");
+    std::fs::write(
+        &scenario,
+        r#"{"time_scale": 1, "duration": 1500,
+            "robots": {"tb_0": {"battery": [{"at": 0, "level": 40}]},
+                       "tb_1": {"battery": [{"at": 0, "level": 90}]},
+                       "tb_2": {"battery": [{"at": 0, "level": 60}]}}}"#,
+    )
+    .unwrap();
+    let (_, start_at) = support::robots::start_barrier(folders.len());
+    let start_at = start_at.to_string();
+    let traces = fleet.run_all(&folders, &scenario, "battery", &["--start-at", &start_at]);
+    let lives: Vec<(String, Vec<Event>)> = traces.clone().into_iter().collect();
+    for (robot, events) in &traces {
+        assert_eq!(leaders_of(events), ["tb_1"], "{robot}");
+        // Everyone listened one and a half heartbeats (100 ms) first.
+        let first = events
+            .iter()
+            .find(|e| field(e, "event") == "leader")
+            .map(|e| e["t"].as_i64().unwrap())
+            .unwrap();
+        assert!(first >= 150, "{robot} decided at {first}");
+    }
+    let heard: Vec<String> = traces["tb_0"]
+        .iter()
+        .filter(|e| {
+            field(e, "event") == "receive"
+                && field(e, "from_robot") == "tb_1"
+                && field(e, "key") == "Crew.__alive"
+        })
+        .map(|e| field(e, "value").to_string())
+        .collect();
+    assert!(heard.iter().any(|v| v == "member 90"), "{heard:?}");
+    assert!(heard.iter().any(|v| v == "leader 90"), "{heard:?}");
+    assert_eq!(two_leaders(&lives, &BTreeMap::new()), None);
+}
+
+/// The warnings every MQTT robot is built with for the sanitizer runs:
+/// `-Wpedantic -Werror`, some optimisation (the sanitizers' own advice), and
+/// debug information for their reports.
+const SANITIZED: &str = "-std=c11 -Wall -Wextra -Wpedantic -Werror -O1 -g -fno-omit-frame-pointer";
+
+/// Scouting with the MQTT transport built with `cc` and `sanitizer` flags,
+/// its robots run over a private broker with `env`: each robot's mode
+/// sequence ends in FINISH and no robot writes anything on stderr (a
+/// sanitizer report, which also fails the robot: halt_on_error).
+fn scouting_over_mqtt_is_clean(name: &str, cc: &str, sanitizer: &str, env: &[(&str, &str)]) {
+    if !support::robots::has(cc) {
+        eprintln!("skipping {name}: no {cc}");
+        return;
+    }
+    let Some(mut fleet) = Fleet::start(name) else {
+        return;
+    };
+    let folders = support::mqtt::build_with(
+        &examples().join("scouting/scouting.mission"),
+        &fleet.out,
+        &[],
+        cc,
+        &format!("{SANITIZED} {sanitizer}"),
+    );
+    let started: Vec<Started> = folders
+        .iter()
+        .map(|folder| fleet.spawn_with(folder, &scenario(), name, &[], env))
+        .collect();
+    for run in &started {
+        let stderr = fleet
+            .processes
+            .wait_success(run.index, &format!("{} ({name})", run.robot));
+        assert!(
+            stderr.trim().is_empty(),
+            "{} ({name}): sanitizer report:\n{stderr}",
+            run.robot
+        );
+        let events = read_trace(&run.trace);
+        assert_eq!(
+            modes(&events).last().map(String::as_str),
+            Some("FINISH"),
+            "{} ({name})",
+            run.robot
+        );
+    }
+}
+
+#[test]
+fn scouting_over_mqtt_is_clean_under_address_and_undefined_behaviour_sanitizers() {
+    scouting_over_mqtt_is_clean(
+        "mqtt-asan",
+        "gcc",
+        "-fsanitize=address,undefined -fno-sanitize-recover=all",
+        &[
+            ("ASAN_OPTIONS", "detect_leaks=1:abort_on_error=1"),
+            ("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1"),
+        ],
+    );
+}
+
+#[test]
+fn scouting_over_mqtt_is_clean_under_thread_sanitizer() {
+    scouting_over_mqtt_is_clean(
+        "mqtt-tsan",
+        "clang",
+        "-fsanitize=thread",
+        &[("TSAN_OPTIONS", "halt_on_error=1")],
+    );
+}
+
+/// The MQTT transport's code at `-Wpedantic -Werror` with clang too (gcc
+/// builds every other test's robots).
+#[test]
+fn scouting_with_mqtt_compiles_pedantic_with_clang() {
+    if !support::robots::has("clang") {
+        eprintln!("skipping: no clang");
+        return;
+    }
+    if support::mqtt::broker_or_skip("scouting_with_mqtt_compiles_pedantic_with_clang").is_none() {
+        return;
+    }
+    let out = scratch("mqtt-clang");
+    let folders = support::mqtt::build_with(
+        &examples().join("scouting/scouting.mission"),
+        &out,
+        &[],
+        "clang",
+        PEDANTIC,
+    );
+    assert_eq!(folders.len(), 3);
+}
+
+/// GroupSync (tests/fixtures/group_sync), every robot a process over a
+/// private broker: the robots drive 100, 700 and 1200 ms, tb_1 is killed
+/// on the way; tb_0 and tb_2 meet when tb_2 arrives (not at the 2 s
+/// timeout), and tb_0 waited for it.
+#[test]
+fn group_sync_over_mqtt_waits_for_the_live_members() {
+    let Some(mut fleet) = Fleet::start("mqtt-group-sync") else {
+        return;
+    };
+    let folders = support::mqtt::build(
+        &repo_root().join("tests/fixtures/group_sync/sync.mission"),
+        &fleet.out,
+        &[],
+    );
+    let scenario = fleet.out.join("sync.scenario.json");
+    std::fs::write(
+        &scenario,
+        r#"{"time_scale": 1, "duration": 4000,
+            "robots": {"tb_0": {"services": {"move": 100}},
+                       "tb_1": {"services": {"move": 700}},
+                       "tb_2": {"services": {"move": 1200}}}}"#,
+    )
+    .unwrap();
+    let (t0, start_at) = support::robots::start_barrier(folders.len());
+    let start_at = start_at.to_string();
+    let started: Vec<Started> = folders
+        .iter()
+        .map(|f| fleet.spawn(f, &scenario, "sync", &["--start-at", &start_at]))
+        .collect();
+    sleep_until(t0, 300);
+    let tb_1 = started.iter().find(|s| s.robot == "tb_1").unwrap();
+    fleet.processes.kill(tb_1.index);
+    let mut traces = BTreeMap::new();
+    for s in &started {
+        let events = if s.robot == "tb_1" {
+            read_trace(&s.trace)
+        } else {
+            fleet.finish(s, "group sync")
+        };
+        traces.insert(s.robot.clone(), events);
+    }
+    let at = |robot: &str, event: &str| {
+        traces[robot]
+            .iter()
+            .find(|e| field(e, "event") == event)
+            .map(|e| e["t"].as_i64().unwrap())
+    };
+    let arrived = traces["tb_2"]
+        .iter()
+        .find(|e| field(e, "event") == "send" && field(e, "key") == "Crew.__sync")
+        .map(|e| e["t"].as_i64().unwrap())
+        .expect("tb_2 announces its arrival");
+    assert!(arrived >= 1200, "tb_2 arrived at {arrived}");
+    for robot in ["tb_0", "tb_2"] {
+        let met = at(robot, "group_sync").unwrap_or_else(|| panic!("{robot} met the group"));
+        assert!(
+            met >= arrived && met < 2000,
+            "{robot} met at {met}, tb_2 arrived at {arrived}"
+        );
+        assert_eq!(at(robot, "timeout"), None, "{robot}");
+    }
+    assert_eq!(at("tb_1", "group_sync"), None);
 }

@@ -7,8 +7,11 @@
 //! this firing), `STEP_WAIT` (try again next firing) or `STEP_DONE`.
 
 use super::c;
+use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
-use crate::refine::{ActionMachine, Expr, Operand, RobotProgram, SlotSource, State, StateKind};
+use crate::refine::{
+    ActionMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, SlotSource, State, StateKind,
+};
 use crate::sema::Compared;
 use crate::syntax::ast::CmpOp;
 use std::fmt::Write;
@@ -17,11 +20,38 @@ use std::fmt::Write;
 /// states never wait (only sends and branches) still yields to the others.
 const STEPS_PER_FIRING: usize = 64;
 
+/// How long a robot that must first hear its team (a restarted robot, or
+/// every robot of a `highest_battery` election at start) listens before an
+/// election: one heartbeat period and half of one more, so that the
+/// heartbeat each robot sends once per period has arrived even when its
+/// sender's firing was a little late. The simulator uses the same.
+pub fn listen_ms(heartbeat_ms: i64) -> i64 {
+    heartbeat_ms + heartbeat_ms / 2
+}
+
+/// Leader elections (`@HB@`: the heartbeat period, `@LISTEN@`: [`listen_ms`]).
+/// `leading` is what this robot's heartbeats say: whether the last election
+/// it decided named it. A robot that joined a mission under way (restarted:
+/// its mission time was past one heartbeat period when it started, or the
+/// MQTT broker still held its session) listens first, and while another
+/// live robot claims leadership it follows that robot instead of claiming:
+/// the claimant gives way at its own next election, so that two robots never
+/// both lead after a restart.
+const ELECTION_C: &str = "/* Leader elections: each `leader(...)` arm's candidates (peer indices, in\n * formation order) and algorithm. A candidate is alive when it is this\n * robot or was heard from within three heartbeats. lowest_id: the first\n * alive; bully: the last alive (the highest id); highest_battery: the\n * highest battery level its heartbeat said (unknown counts lowest; ties: the\n * first), after every robot has listened at start. A robot that joined the\n * mission under way (restarted) listens too, and while another live robot\n * claims leadership it follows that one instead of claiming. A change of\n * leader is traced. Returns 1 (this robot leads), 0, or -1 while listening. */\nenum { ELECT_LOWEST_ID, ELECT_HIGHEST_BATTERY, ELECT_BULLY };\nstatic int elected(const size_t *candidates, size_t n, int algorithm, long *last)\n{\n    static int rejoining = -1;\n    const semo_program_desc *p = semo_program();\n    int64_t now = semo_now_ms();\n    if (rejoining < 0)\n        rejoining = semo_joined_ms() > @HB@ || semo_session_resumed();\n    if ((rejoining || algorithm == ELECT_HIGHEST_BATTERY) && now - semo_joined_ms() < @LISTEN@) {\n        wake_at(semo_joined_ms() + @LISTEN@);\n        return -1;\n    }\n    size_t leader = p->self;\n    bool found = false;\n    long best = -1;\n    for (size_t k = 0; k < n; k++) {\n        size_t c = candidates[algorithm == ELECT_BULLY ? n - 1 - k : k];\n        comm_heartbeat h = comm_heard(c);\n        if (c != p->self && now - h.seen > 3 * @HB@)\n            continue;\n        long level = c == p->self ? own_battery() : h.battery;\n        if (!found || (algorithm == ELECT_HIGHEST_BATTERY && level > best)) {\n            leader = c;\n            best = level;\n            found = true;\n        }\n        if (algorithm != ELECT_HIGHEST_BATTERY)\n            break;\n    }\n    if (rejoining && leader == p->self) {\n        for (size_t i = 0; i < p->peer_count; i++) {\n            comm_heartbeat h = comm_heard(i);\n            if (i != p->self && h.leads && now - h.seen <= 3 * @HB@) {\n                leader = i;\n                break;\n            }\n        }\n        if (leader == p->self)\n            rejoining = 0;\n    }\n    leading = leader == p->self;\n    if ((long)leader != *last) {\n        *last = (long)leader;\n        semo_trace(\"leader\", \"leader\", p->peers[leader].robot, NULL);\n    }\n    return leading;\n}\n";
+
+/// This robot's battery level for its heartbeats: the scenario's (in
+/// simulation), else unknown (-1).
+const OWN_BATTERY_C: &str = "/* Whether the last election this robot decided named it (its heartbeats say so). */\nstatic bool leading;\n\n/* This robot's battery level for its heartbeats: the scenario's in\n * simulation, else unknown (-1). */\nstatic long own_battery(void)\n{\n#ifdef SEMO_SIM\n    long long level;\n    if (semo_sim_battery(&level))\n        return (long)level;\n#endif\n    return -1;\n}\n\n";
+
 pub fn control_task(program: &RobotProgram, header: &str) -> String {
     let m = &program.control;
     let mut out = String::new();
     out.push_str(header);
-    out.push_str("#include \"program.h\"\n#include <string.h>\n\n");
+    out.push_str("#include \"program.h\"\n");
+    if m.heartbeat {
+        out.push_str("#include <stdio.h>\n");
+    }
+    out.push_str("#include <string.h>\n\n");
     let _ = writeln!(
         out,
         "/* The hierarchical state machine of robot {} (team {}): modes, then one\n * region per plan running its composite service, then strategy actions. */\n",
@@ -31,6 +61,7 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
     out.push_str("enum { STEP_NEXT, STEP_WAIT, STEP_DONE };\n\n");
 
     // Values.
+    let words = Words::of(program);
     let _ = writeln!(out, "/* Values the machine reads and writes. */");
     // A robot that reads no values has no slots (an unused array fails -Werror).
     if !m.slots.is_empty() {
@@ -42,7 +73,12 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
             SlotSource::Shared => "shared information (library)".into(),
             SlotSource::Local => "strategy variable".into(),
         };
-        let _ = writeln!(out, "/* slot[{i}]: {} ({from}) */", c::comment(&s.key));
+        let _ = writeln!(
+            out,
+            "/* slot[{i}]: {} ({from}): {} */",
+            c::comment(&s.key),
+            c::comment(&s.kind.describe())
+        );
     }
     out.push('\n');
 
@@ -90,7 +126,7 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
     // are written (unused static functions and arrays fail -Werror).
     let mut body = String::new();
     for (i, machine) in m.actions.iter().enumerate() {
-        emit_action_machine(&mut body, program, i, machine);
+        emit_action_machine(&mut body, program, &words, i, machine);
     }
     for (i, service) in m.services.iter().enumerate() {
         let _ = writeln!(
@@ -103,10 +139,11 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
             service.line
         );
         for (pc, state) in service.states.iter().enumerate() {
-            emit_state(&mut body, program, pc, state);
+            emit_state(&mut body, program, &words, pc, state);
         }
         body.push_str("    default:\n        return STEP_DONE;\n    }\n}\n\n");
     }
+    body.push_str(&super::battery::resource_manager(program));
     emit_dispatch(&mut body, program);
     emit_modes(&mut body, program);
     emit_task(&mut body, program);
@@ -135,20 +172,20 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
     out
 }
 
-fn operand(op: &Operand) -> String {
+fn operand(op: &Operand, words: &Words) -> String {
     match op {
         Operand::Slot(s) => format!("&slot[{s}]"),
-        Operand::Literal(text) => format!("SEMO_LIT({})", c::string(text)),
+        Operand::Literal(value) => words.literal(value),
     }
 }
 
-fn expr(e: &Expr) -> String {
+pub(super) fn expr(e: &Expr, words: &Words) -> String {
     match e {
-        Expr::Or(a, b) => format!("({} || {})", expr(a), expr(b)),
-        Expr::And(a, b) => format!("({} && {})", expr(a), expr(b)),
-        Expr::Not(a) => format!("!{}", expr(a)),
+        Expr::Or(a, b) => format!("({} || {})", expr(a, words), expr(b, words)),
+        Expr::And(a, b) => format!("({} && {})", expr(a, words), expr(b, words)),
+        Expr::Not(a) => format!("!{}", expr(a, words)),
         Expr::Bool(b) => b.to_string(),
-        Expr::Truthy(o) => format!("semo_value_truthy({})", operand(o)),
+        Expr::Truthy(o) => format!("semo_value_truthy({})", operand(o, words)),
         // As the checker typed the comparison: the runtime never guesses
         // from the values whether they are numbers.
         Expr::Compare(a, op, b, compared) => {
@@ -164,7 +201,11 @@ fn expr(e: &Expr) -> String {
                 CmpOp::Gt => "SEMO_GT",
                 CmpOp::Ge => "SEMO_GE",
             };
-            format!("{function}({}, {op}, {})", operand(a), operand(b))
+            format!(
+                "{function}({}, {op}, {})",
+                operand(a, words),
+                operand(b, words)
+            )
         }
     }
 }
@@ -240,12 +281,16 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
         out.push_str("    default:\n        break;\n    }\n}\n\n");
     }
 
+    if m.heartbeat {
+        out.push_str(OWN_BATTERY_C);
+    }
     if uses("elected") {
-        let _ = writeln!(
-            out,
-            "/* Leader election: the first candidate (in formation order) that is this\n * robot or was heard from within three heartbeats leads. A change of leader\n * (a failed leader replaced) is traced. */\nstatic bool elected(const size_t *candidates, size_t n, long *last)\n{{\n    const semo_program_desc *p = semo_program();\n    size_t leader = p->self;\n    for (size_t i = 0; i < n; i++) {{\n        size_t c = candidates[i];\n        if (c == p->self || semo_now_ms() - comm_last_seen(c) <= 3 * {hb}) {{\n            leader = c;\n            break;\n        }}\n    }}\n    if ((long)leader != *last) {{\n        *last = (long)leader;\n        semo_trace(\"leader\", \"leader\", p->peers[leader].robot, NULL);\n    }}\n    return leader == p->self;\n}}\n",
-            hb = crate::refine::HEARTBEAT_MS
+        out.push_str(
+            &ELECTION_C
+                .replace("@HB@", &m.heartbeat_ms.to_string())
+                .replace("@LISTEN@", &listen_ms(m.heartbeat_ms).to_string()),
         );
+        out.push('\n');
     }
 
     if uses("request") {
@@ -262,15 +307,15 @@ fn request_index(program: &RobotProgram, task: &str) -> usize {
         .unwrap_or(0)
 }
 
-fn args_array(args: &[Operand]) -> String {
+fn args_array(args: &[Operand], words: &Words) -> String {
     if args.is_empty() {
         return "NULL".into();
     }
-    let items: Vec<String> = args.iter().map(operand).collect();
+    let items: Vec<String> = args.iter().map(|a| operand(a, words)).collect();
     format!("(const semo_value *const[]){{{}}}", items.join(", "))
 }
 
-fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State) {
+fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize, state: &State) {
     let m = &program.control;
     let _ = writeln!(
         out,
@@ -316,7 +361,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
         }
         StateKind::Send { items } => {
             for item in items {
-                let value = operand(&item.value);
+                let value = operand(&item.value, words);
                 if let Some(s) = item.store {
                     let _ = writeln!(out, "        store({s}, {value});");
                 }
@@ -374,7 +419,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 task = c::string(task),
                 service = c::string(service),
                 argc = args.len(),
-                args = args_array(args),
+                args = args_array(args, words),
             );
             if let Some(t) = timeout_ms {
                 let _ = writeln!(
@@ -401,7 +446,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
             let _ = writeln!(out, "        if (r->phase == 0) {{");
             for (i, slot) in am.arguments.iter().enumerate() {
                 if let Some(arg) = args.get(i) {
-                    let _ = writeln!(out, "            store({slot}, {});", operand(arg));
+                    let _ = writeln!(out, "            store({slot}, {});", operand(arg, words));
                 }
             }
             let _ = writeln!(
@@ -425,21 +470,46 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
         }
         StateKind::LeaderBranch {
             candidates,
+            algorithm,
             others_at,
         } => {
             let list: Vec<String> = candidates.iter().map(|c| c.to_string()).collect();
+            let algorithm = match algorithm {
+                LeaderAlgorithm::LowestId => "ELECT_LOWEST_ID",
+                LeaderAlgorithm::HighestBattery => "ELECT_HIGHEST_BATTERY",
+                LeaderAlgorithm::Bully => "ELECT_BULLY",
+            };
             let _ = writeln!(
                 out,
-                "    {{\n        static const size_t candidates[] = {{{}}};\n        static long leader = -1; /* the last leader seen (control thread only) */\n        r->pc = elected(candidates, {}, &leader) ? {next} : {others_at};\n        return STEP_NEXT;\n    }}",
+                "    {{\n        static const size_t candidates[] = {{{}}};\n        static long leader = -1; /* the last leader seen (control thread only) */\n        int chosen = elected(candidates, {}, {algorithm}, &leader);\n        if (chosen < 0)\n            return STEP_WAIT; /* still listening */\n        r->pc = chosen ? {next} : {others_at};\n        return STEP_NEXT;\n    }}",
                 list.join(", "),
                 candidates.len()
+            );
+        }
+        StateKind::GroupSync {
+            members,
+            point,
+            timeout_ms,
+            mark,
+        } => {
+            let list: Vec<String> = members.iter().map(|c| c.to_string()).collect();
+            let list = list.join(", ");
+            let hb = m.heartbeat_ms;
+            let _ = writeln!(
+                out,
+                "    {{\n        static const size_t members[] = {{{list}}};\n        static long pass; /* how often this robot reached the statement (control thread only) */\n        const semo_program_desc *p = semo_program();\n        int64_t now = semo_now_ms();\n        if (r->phase == 0) {{\n            semo_value arrived;\n            char text[48];\n            pass++;\n            r->mark[{mark}] = now;\n            r->phase = 1;\n            snprintf(text, sizeof text, \"{offset} %ld\", pass);\n            semo_value_set(&arrived, text);\n            semo_comm_send({team}, SEMO_MSG_SEND, {key}, &arrived);\n        }}\n        int waiting = 0;\n        for (size_t k = 0; k < {count}; k++) {{\n            size_t peer = members[k];\n            comm_heartbeat h = comm_heard(peer);\n            if (peer == p->self || comm_sync_arrived(peer, {point}) >= pass || now - h.seen > 3 * {hb})\n                continue; /* here, arrived, or known dead */\n            waiting++;\n            wake_at(h.seen + 3 * {hb} + 1);\n        }}\n        if (waiting > 0 && now - r->mark[{mark}] <= {timeout_ms}) {{\n            wake_at(r->mark[{mark}] + {timeout_ms} + 1);\n            return STEP_WAIT;\n        }}\n        if (waiting > 0)\n            semo_trace(\"timeout\", \"statement\", \"GroupSync\", NULL);\n        else\n            semo_trace(\"group_sync\", \"line\", \"{line}\", NULL);\n        r->phase = 0;\n        r->pc = {next};\n        return STEP_NEXT;\n    }}",
+                count = members.len(),
+                offset = m.sync_points[*point],
+                team = c::string(&program.team),
+                key = c::string(&super::files::sync_key(program)),
+                line = state.line,
             );
         }
         StateKind::Branch { condition, else_to } => {
             let _ = writeln!(
                 out,
                 "        r->pc = {} ? {next} : {else_to};\n        return STEP_NEXT;",
-                expr(condition)
+                expr(condition, words)
             );
         }
         StateKind::Jump { to } => {
@@ -454,7 +524,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 let _ = writeln!(
                     out,
                     "        if (!{}) {{\n            r->pc = {exit_to};\n            return STEP_NEXT;\n        }}",
-                    expr(cond)
+                    expr(cond, words)
                 );
             }
             let _ = writeln!(
@@ -493,7 +563,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 let _ = writeln!(
                     out,
                     "        if (!{})\n            return STEP_DONE;",
-                    expr(cond)
+                    expr(cond, words)
                 );
             }
             if let Some(p) = period_ms {
@@ -511,7 +581,13 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
     }
 }
 
-fn emit_action_machine(out: &mut String, program: &RobotProgram, index: usize, am: &ActionMachine) {
+fn emit_action_machine(
+    out: &mut String,
+    program: &RobotProgram,
+    words: &Words,
+    index: usize,
+    am: &ActionMachine,
+) {
     let _ = writeln!(
         out,
         "/* Strategy actions of `{}` ({}): phase 1 enters r->action (issues its\n * commands), phase 2 waits for them and takes the first transition that holds. */\nstatic int actions_{index}(region *r)\n{{\n    switch (r->action) {{",
@@ -536,10 +612,10 @@ fn emit_action_machine(out: &mut String, program: &RobotProgram, index: usize, a
                 let port = request_index(program, task);
                 let _ = writeln!(
                     out,
-                    "            if (!request(request_port[{port}], {}, {}, 1, (const semo_value *const[]){{SEMO_LIT({})}}))\n                return STEP_WAIT;",
+                    "            if (!request(request_port[{port}], {}, {}, 1, (const semo_value *const[]){{{}}}))\n                return STEP_WAIT;",
                     c::string(task),
                     c::string(&actuator_name(program, task)),
-                    c::string(command)
+                    words.literal(command)
                 );
             }
             out.push_str("            r->phase = 2;\n            return STEP_WAIT;\n        }\n");
@@ -552,7 +628,9 @@ fn emit_action_machine(out: &mut String, program: &RobotProgram, index: usize, a
             }
         }
         for (condition, to) in &action.transitions {
-            let test = condition.as_ref().map_or_else(|| "true".to_string(), expr);
+            let test = condition
+                .as_ref()
+                .map_or_else(|| "true".to_string(), |c| expr(c, words));
             let _ = writeln!(
                 out,
                 "        if ({test}) {{\n            r->action = {to};\n            r->phase = 1;\n            return STEP_NEXT;\n        }}"
@@ -682,13 +760,15 @@ fn emit_task(out: &mut String, program: &RobotProgram) {
         out,
         "/* One firing: read inputs, advance every region, then change mode if an\n * event asked for it; the robot is finished when no region runs any more. */\nvoid task_{name}_go(void)\n{{\n    next_wake = INT64_MAX;\n    read_inputs();"
     );
+    if !m.battery.is_empty() {
+        out.push_str("    manage_resources();\n");
+    }
     if m.heartbeat {
         // Tell the team this robot is alive, for leader elections.
         let _ = writeln!(
             out,
-            "    static int64_t last_heartbeat = -{hb};\n    if (semo_now_ms() - last_heartbeat >= {hb}) {{\n        semo_value alive;\n        last_heartbeat = semo_now_ms();\n        semo_value_set(&alive, {robot});\n        semo_comm_send({team}, SEMO_MSG_PUBLISH, {key}, &alive);\n    }}\n    wake_at(last_heartbeat + {hb});",
-            hb = crate::refine::HEARTBEAT_MS,
-            robot = c::string(&program.robot),
+            "    static int64_t last_heartbeat = -{hb};\n    if (semo_now_ms() - last_heartbeat >= {hb}) {{\n        semo_value alive;\n        char text[32];\n        long battery = own_battery();\n        last_heartbeat = semo_now_ms();\n        if (battery < 0)\n            snprintf(text, sizeof text, \"%s -\", leading ? \"leader\" : \"member\");\n        else\n            snprintf(text, sizeof text, \"%s %ld\", leading ? \"leader\" : \"member\", battery);\n        semo_value_set(&alive, text);\n        semo_comm_send({team}, SEMO_MSG_PUBLISH, {key}, &alive);\n    }}\n    wake_at(last_heartbeat + {hb});",
+            hb = m.heartbeat_ms,
             team = c::string(&program.team),
             key = c::string(&super::files::alive_key(program)),
         );

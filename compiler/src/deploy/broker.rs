@@ -86,7 +86,10 @@ pub fn files(
             }
         }
         if program.control.heartbeat {
-            let key = crate::codegen::files::alive_key(program);
+            rights.write.insert(topics::heartbeats(program));
+        }
+        if !program.control.sync_points.is_empty() {
+            let key = crate::codegen::files::sync_key(program);
             rights
                 .write
                 .insert(topics::to_team(&mission, &program.team, &key));
@@ -139,6 +142,10 @@ pub fn files(
         rights
             .read
             .insert(format!("semo/{}/USER/+", topics::level(&mission)));
+        // The editor's robot monitor tells a robot that stops heart-beating.
+        for program in programs.iter().filter(|p| p.control.heartbeat) {
+            rights.read.insert(topics::heartbeats(program));
+        }
     }
     if !found.is_empty() {
         return Err(found);

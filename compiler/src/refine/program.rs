@@ -6,6 +6,7 @@
 //! sets for that plan → for a built-in call the strategy refines, that
 //! entry's action machine (bottom).
 
+use super::value::{Value, ValueKind};
 use crate::span::Span;
 use crate::taskgraph::TaskGraph;
 
@@ -29,6 +30,45 @@ pub struct RobotProgram {
     pub self_peer: usize,
     /// The team's shared information, held by the library task.
     pub library: Option<SharedLibrary>,
+    /// The service tasks that run a task graph (`graph=` in the catalog).
+    pub graph_services: Vec<GraphService>,
+}
+
+/// A service the robot's type implements by a task graph: each call runs
+/// one iteration of the graph's looped schedule (`taskgraph::analysis`),
+/// its inner tasks fired in that order inside the service task.
+#[derive(Clone, Debug)]
+pub struct GraphService {
+    /// The service task (named after the graph file).
+    pub task: String,
+    /// The graph's name (`kmeans`).
+    pub graph: String,
+    /// The first call of the service in the mission.
+    pub call: Span,
+    /// One iteration of the top level, or why the graph has none (it is
+    /// inconsistent or deadlocks, which the dataflow warnings report on the
+    /// call; code generation refuses it, E100).
+    pub steps: Result<Vec<GraphStep>, String>,
+}
+
+/// A term of a service graph's looped schedule, loop nodes opened.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GraphStep {
+    /// `count` firings of an inner task; `task` is its path below the graph
+    /// (`Converge/Assign/Nearest`).
+    Fire { task: String, count: u64 },
+    /// A loop of the schedule: `body` `count` times.
+    Repeat { count: u64, body: Vec<GraphStep> },
+    /// An SDF/L loop node (`path` as for tasks): its body's schedule,
+    /// exactly `loop_count` times (D-type) or until its exit task sets the
+    /// exit flag, at most `loop_count` times (C-type, `exit_task` the path).
+    Loop {
+        path: String,
+        convergent: bool,
+        loop_count: u64,
+        exit_task: Option<String>,
+        body: Vec<GraphStep>,
+    },
 }
 
 /// The control task's machine.
@@ -52,8 +92,19 @@ pub struct ControlMachine {
     /// Latest-value groups the control task reads (`subscribe`).
     pub subscribed: Vec<String>,
     /// Whether the robot takes part in a leader election: it then tells its
-    /// team it is alive every [`HEARTBEAT_MS`] and listens for theirs.
+    /// team it is alive every `heartbeat_ms` and listens for theirs.
     pub heartbeat: bool,
+    /// The heartbeat period (mission ms): the strategy's
+    /// `LeaderSelectionInfo heartbeatPeriod` (the shortest of those that
+    /// apply to the robot's elections), else [`HEARTBEAT_MS`]; 0 without
+    /// `heartbeat`.
+    pub heartbeat_ms: i64,
+    /// The group statements this robot synchronizes at (`GroupSync`), by
+    /// their offset in the mission: what a sync announcement names.
+    pub sync_points: Vec<usize>,
+    /// Adaptive resource management: the team strategy's battery policies,
+    /// checked at every firing against the robot's `BATTERY` value.
+    pub battery: Vec<BatteryPolicy>,
 }
 
 impl ControlMachine {
@@ -79,9 +130,67 @@ impl ControlMachine {
     }
 }
 
+impl ControlMachine {
+    /// The period level (sensor) or speed level (actuator) of `task` while
+    /// the policies for which `holds` is true hold: the highest level any of
+    /// them gives it (the most saving one), 1 (unchanged) when none does.
+    pub fn battery_level(&self, task: &str, sensor: bool, holds: &[bool]) -> u64 {
+        self.battery
+            .iter()
+            .zip(holds)
+            .filter(|(_, h)| **h)
+            .flat_map(|(p, _)| if sensor { &p.sensors } else { &p.actuators })
+            .filter(|(t, _)| t == task)
+            .map(|(_, level)| *level)
+            .max()
+            .unwrap_or(1)
+    }
+
+    /// The tasks some policy gives a level, in first-mention order: sensors
+    /// (`true`) then actuators (`false`).
+    pub fn battery_tasks(&self) -> Vec<(&str, bool)> {
+        let mut tasks: Vec<(&str, bool)> = Vec::new();
+        for sensor in [true, false] {
+            for p in &self.battery {
+                for (t, _) in if sensor { &p.sensors } else { &p.actuators } {
+                    if !tasks.contains(&(t.as_str(), sensor)) {
+                        tasks.push((t, sensor));
+                    }
+                }
+            }
+        }
+        tasks
+    }
+}
+
+/// One battery requirement (`<Condition cond="Battery&lt;30">`) for one
+/// robot: while `condition` holds, each listed sensor task samples every
+/// `period × level` and each listed actuator task runs at `1 / level` of its
+/// speed (a call takes `level` times as long); when it stops holding, they
+/// return to level 1.
+#[derive(Clone, Debug)]
+pub struct BatteryPolicy {
+    /// The condition as written (`Battery<30`): the trace names the policy by it.
+    pub text: String,
+    /// Over the robot's `BATTERY` slot.
+    pub condition: Expr,
+    /// The strategy file it comes from (for comments).
+    pub source: String,
+    /// (sensor task, period level), each a task of this robot.
+    pub sensors: Vec<(String, u64)>,
+    /// (actuator task, speed level), each a task of this robot.
+    pub actuators: Vec<(String, u64)>,
+}
+
 /// How often a robot that can be elected leader tells its team it is alive
-/// (mission ms); a robot not heard from for three periods counts as failed.
+/// (mission ms) when its strategy names no `heartbeatPeriod`; a robot not
+/// heard from for three periods counts as failed.
 pub const HEARTBEAT_MS: i64 = 200;
+
+/// How a leader is chosen among the live candidates of a `leader(...)` arm:
+/// the strategy's `LeaderSelectionInfo algorithm`, else
+/// [`LeaderAlgorithm::LowestId`] (the first in formation order).
+pub use crate::strategy::LeaderAlgorithm;
 
 #[derive(Clone, Debug)]
 pub struct ModeState {
@@ -171,11 +280,27 @@ pub enum StateKind {
         mark: usize,
     },
     /// `leader(cond)` for a robot that meets `cond`: continue (run the
-    /// leader's block) if this robot is the first of `candidates` (peer
-    /// indices, in formation order) that is alive, else go to `others_at`.
+    /// leader's block) if `algorithm` chooses this robot among the live
+    /// `candidates` (peer indices, in formation order), else go to
+    /// `others_at`.
     LeaderBranch {
         candidates: Vec<usize>,
+        algorithm: LeaderAlgorithm,
         others_at: usize,
+    },
+    /// The start of a group statement when the team's strategy has
+    /// `<GroupSync timeout>`: tell the team this robot has arrived (its
+    /// pass through the statement: `Team.__sync` = `"<point> <pass>"`), then
+    /// wait until every other robot of `members` (peer indices: the robots
+    /// that run any arm of the statement, as the checker decided) has
+    /// arrived at that pass or is known dead (no heartbeat for three
+    /// periods), or `timeout_ms` has passed.
+    GroupSync {
+        members: Vec<usize>,
+        /// Index into [`ControlMachine::sync_points`].
+        point: usize,
+        timeout_ms: i64,
+        mark: usize,
     },
     /// Continue at `else_to` unless the condition holds.
     Branch {
@@ -239,7 +364,7 @@ pub struct ActionState {
     pub id: u64,
     pub is_final: bool,
     /// Actuator commands issued on entry: (task, command value).
-    pub commands: Vec<(String, String)>,
+    pub commands: Vec<(String, Value)>,
     /// Checked in order; the first that holds is taken. `None` = always.
     pub transitions: Vec<(Option<Expr>, usize)>,
 }
@@ -250,6 +375,9 @@ pub struct Slot {
     /// `MasterTeam.LOCATION`, `USER.RC_CMD`, or `move.goalLocation`.
     pub key: String,
     pub source: SlotSource,
+    /// How its values are stored: the catalog's type of the value (of the
+    /// service parameter for a strategy variable).
+    pub kind: ValueKind,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -329,9 +457,21 @@ pub enum Expr {
     Bool(bool),
 }
 
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Operand {
     Slot(usize),
-    /// A literal's text (strings unescaped, numbers as written, constants by name).
-    Literal(String),
+    /// A literal, typed as written: a whole number an integer, another number
+    /// a real, a string text, `true`/`false` a truth value, a symbolic
+    /// constant a word.
+    Literal(Value),
+}
+
+impl ControlMachine {
+    /// The kind of the value a sensor task writes to `port` (the slot it feeds).
+    pub fn sensor_kind(&self, task: &str, port: &str) -> Option<&ValueKind> {
+        self.slots.iter().find_map(|s| match &s.source {
+            SlotSource::Sensor { task: t, port: p } if t == task && p == port => Some(&s.kind),
+            _ => None,
+        })
+    }
 }

@@ -14,7 +14,7 @@
 //!   scenario's duration → [`Sim::request`] and a `ServiceDone` event;
 //! - `semo_comm_send` → [`Sim::comm_send`] (the network: latency, loss and
 //!   link faults), the receive task's routing → [`Sim::deliver`];
-//! - `comm_last_seen` and `elected` → `last_seen` and [`Sim::elected`];
+//! - `comm_heard` and `elected` → `heard` and [`Sim::elected`];
 //! - the library task's values → `Robot::library`.
 //!
 //! Idle firings are skipped: a firing that traced nothing and changed no
@@ -29,9 +29,10 @@
 use super::scenario::{Command, DEFAULT_SERVICE_MS, FaultKind, Scenario};
 use super::trace::TraceEvent;
 use crate::refine::graph::CONTROL_PERIOD_MS;
+use crate::refine::value::{self, Value};
 use crate::refine::{
-    ActionMachine, ControlMachine, Expr, HEARTBEAT_MS, Operand, RobotProgram, RoleKind, SlotSource,
-    StateKind,
+    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, RoleKind,
+    SlotSource, StateKind,
 };
 use crate::sema::Compared;
 use crate::syntax::ast::CmpOp;
@@ -41,12 +42,18 @@ use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
 
+mod battery;
+mod loops;
+
 /// The sensor tasks' period (refinement's `SENSOR_PERIOD_MS`).
 const SENSOR_PERIOD_MS: i64 = 100;
 /// State transitions a region may take in one firing (`control.rs`).
 const STEPS_PER_FIRING: usize = 64;
-/// `semo_value`: text of at most 63 bytes.
-const VALUE_MAX: usize = 63;
+/// What a slot, a channel sample or a message holds: a typed value, or none
+/// (`SEMO_NONE`: never set).
+type Held = Option<Value>;
+/// A sensor value's scenario entries: (at, the value read as its type).
+type SensorSeries = Vec<(i64, Option<Value>)>;
 /// Default length of a run when neither the caller nor the scenario bounds it.
 pub const DEFAULT_UNTIL_MS: i64 = 10 * 60 * 1000;
 
@@ -126,17 +133,52 @@ struct Message {
     /// Index of the sender in the peers (operator: `None`).
     from_peer: Option<usize>,
     key: Rc<str>,
-    value: Rc<str>,
+    value: Payload,
     sent_at: i64,
+}
+
+/// A message's value. Events are ordered by (time, kind, sequence number),
+/// never by their payload, but the queue's element type needs an order:
+/// this one compares the value's JSON.
+#[derive(Clone, Debug)]
+struct Payload(Held);
+
+impl Payload {
+    fn key(&self) -> String {
+        let mut out = String::new();
+        super::trace::write_value(&mut out, self.0.as_ref());
+        out
+    }
+}
+
+impl PartialEq for Payload {
+    fn eq(&self, other: &Payload) -> bool {
+        self.key() == other.key()
+    }
+}
+
+impl Eq for Payload {}
+
+impl PartialOrd for Payload {
+    fn partial_cmp(&self, other: &Payload) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Payload {
+    fn cmp(&self, other: &Payload) -> std::cmp::Ordering {
+        self.key().cmp(&other.key())
+    }
 }
 
 /// A robot's names as its messages and trace carry them, shared rather
 /// than copied (most of a large run's trace is messages).
 struct Names {
     team: Rc<str>,
-    /// The value of its heartbeat: its name, as a value.
+    /// Its name (messages carry it; its heartbeat's value is its name as text).
     heartbeat: Rc<str>,
     alive_key: Rc<str>,
+    sync_key: Rc<str>,
     /// Per outgoing message: (to, key).
     outgoing: Vec<(Rc<str>, Rc<str>)>,
 }
@@ -145,8 +187,9 @@ impl Names {
     fn new(program: &RobotProgram) -> Names {
         Names {
             team: program.team.as_str().into(),
-            heartbeat: truncate(program.robot.clone()).into(),
+            heartbeat: program.robot.as_str().into(),
             alive_key: crate::codegen::files::alive_key(program).into(),
+            sync_key: crate::codegen::files::sync_key(program).into(),
             outgoing: program
                 .control
                 .outgoing
@@ -186,27 +229,40 @@ struct Robot<'p> {
     /// Counts restarts: events of an earlier incarnation are ignored.
     epoch: u32,
     started_at: i64,
-    slots: Vec<String>,
+    slots: Vec<Held>,
     /// The library task's values, one per shared key (`lib_<name>.c`).
-    library: Vec<String>,
+    library: Vec<Held>,
     /// Per slot: its value's place in `library` (shared slots only).
     library_index: Vec<Option<usize>>,
     /// Per incoming message: the channel to the control task (capacity).
-    inbox: Vec<(VecDeque<String>, usize)>,
+    inbox: Vec<(VecDeque<Held>, usize)>,
     /// Per subscribed group: the latest value.
-    groups: Vec<Option<String>>,
+    groups: Vec<Option<Held>>,
     regions: Vec<Region>,
     current_mode: Option<usize>,
     pending_mode: Option<usize>,
     last_heartbeat: i64,
-    last_seen: Vec<i64>,
+    /// Per peer: what its last heartbeat said (`comm_heard`).
+    heard: Vec<Heard>,
+    /// Whether the last election this robot decided named it (what its
+    /// heartbeats say).
+    leading: bool,
+    /// Joined the mission under way (restarted after one heartbeat period):
+    /// listens first, and follows a live claimant instead of claiming.
+    rejoining: bool,
+    /// How often this robot reached each `GroupSync` state, by (service, pc).
+    sync_pass: HashMap<(usize, usize), i64>,
+    /// The last pass each (peer, sync point) announced (`comm_sync_arrived`).
+    sync_arrived: HashMap<(usize, usize), i64>,
     /// The last leader each `LeaderBranch` state saw, by (service, pc).
     leaders: HashMap<(usize, usize), usize>,
     /// Service tasks by name (the `request_tasks` and those of action commands).
     tasks: Vec<(String, TaskState)>,
     has_receiver: bool,
-    /// Per slot fed by a sensor: its value's entries (at, value), by time.
-    sensor_series: Vec<Option<Vec<(i64, String)>>>,
+    /// Per slot fed by a sensor: its value's entries (at, value read as the
+    /// sensor's type; `None` when the text is not one, which the sensor
+    /// task skips: `semo_sim_sensor` is false), by time.
+    sensor_series: Vec<Option<SensorSeries>>,
     battery: Vec<(i64, f64)>,
     service_ms: HashMap<String, i64>,
     /// Orders the control firings of robots at the same time: robots that
@@ -218,6 +274,8 @@ struct Robot<'p> {
     fire_token: u64,
     /// Whether the current firing changed any state (see [`Sim::wake_up`]).
     progressed: bool,
+    /// The battery policies' state: levels and levelled sensors' samples.
+    resources: battery::Resources,
 }
 
 pub struct Sim<'p> {
@@ -241,31 +299,6 @@ pub struct Sim<'p> {
     every_firing: bool,
 }
 
-fn truncate(mut s: String) -> String {
-    if s.len() > VALUE_MAX {
-        let mut end = VALUE_MAX;
-        while !s.is_char_boundary(end) {
-            end -= 1;
-        }
-        s.truncate(end);
-    }
-    s
-}
-
-/// `parse_number` of the runtime: the whole text is a number (no leading space).
-fn number(text: &str) -> Option<f64> {
-    let first = text.as_bytes().first()?;
-    if first.is_ascii_whitespace() {
-        return None;
-    }
-    text.parse::<f64>().ok().filter(|d| !d.is_nan())
-}
-
-/// `semo_value_truthy`.
-fn truthy(v: &str) -> bool {
-    v == "true" || number(v).is_some_and(|x| x != 0.0)
-}
-
 impl<'p> Robot<'p> {
     fn new(program: &'p RobotProgram, scenario: &Scenario, at: i64, epoch: u32) -> Robot<'p> {
         let m = &program.control;
@@ -275,12 +308,12 @@ impl<'p> Robot<'p> {
             .iter()
             .map(|s| match &s.source {
                 SlotSource::Sensor { port, .. } => {
-                    let mut series: Vec<(i64, String)> = world
+                    let mut series: SensorSeries = world
                         .map(|w| {
                             w.sensors
                                 .iter()
                                 .filter(|(_, v, _)| v == port)
-                                .map(|(at, _, is)| (*at, is.clone()))
+                                .map(|(at, _, is)| (*at, s.kind.parse(is)))
                                 .collect()
                         })
                         .unwrap_or_default();
@@ -324,8 +357,8 @@ impl<'p> Robot<'p> {
             alive: true,
             epoch,
             started_at: at,
-            slots: vec![String::new(); m.slots.len()],
-            library: vec![String::new(); library_keys.len()],
+            slots: vec![None; m.slots.len()],
+            library: vec![None; library_keys.len()],
             library_index: m
                 .slots
                 .iter()
@@ -347,8 +380,21 @@ impl<'p> Robot<'p> {
             ],
             current_mode: None,
             pending_mode: None,
-            last_heartbeat: at - HEARTBEAT_MS,
-            last_seen: vec![at; program.peers.len()],
+            last_heartbeat: at - m.heartbeat_ms,
+            // As the C's static table: heard at mission time 0, claiming
+            // nothing, battery unknown.
+            heard: vec![
+                Heard {
+                    seen: 0,
+                    leads: false,
+                    battery: None,
+                };
+                program.peers.len()
+            ],
+            leading: false,
+            rejoining: m.heartbeat && at > m.heartbeat_ms,
+            sync_pass: HashMap::new(),
+            sync_arrived: HashMap::new(),
             leaders: HashMap::new(),
             tasks,
             has_receiver: !m.incoming.is_empty() || !m.subscribed.is_empty() || m.heartbeat,
@@ -361,6 +407,7 @@ impl<'p> Robot<'p> {
             next_fire: None,
             fire_token: 0,
             progressed: false,
+            resources: battery::Resources::new(program, at),
         }
     }
 
@@ -451,6 +498,7 @@ impl<'p> Sim<'p> {
             robot,
             event,
             fields,
+            value: None,
             sent_at: None,
         });
     }
@@ -572,7 +620,7 @@ impl<'p> Sim<'p> {
             from_robot: "USER".into(),
             from_peer: None,
             key: command.key.as_str().into(),
-            value: truncate(command.value.clone()).into(),
+            value: Payload(Some(Value::text(&command.value))),
             sent_at: self.now,
         };
         for r in 0..self.robots.len() {
@@ -629,21 +677,15 @@ impl<'p> Sim<'p> {
 
     // ------------------------------------------------------------ values
 
-    fn value(&self, r: usize, op: &Operand) -> String {
-        self.value_ref(r, op).to_string()
+    fn value(&self, r: usize, op: &Operand) -> Held {
+        self.value_ref(r, op).cloned()
     }
 
-    /// An operand's text without copying it (conditions are read every firing).
-    fn value_ref<'a>(&'a self, r: usize, op: &'a Operand) -> &'a str {
+    /// An operand's value without copying it (conditions are read every firing).
+    fn value_ref<'a>(&'a self, r: usize, op: &'a Operand) -> Option<&'a Value> {
         match op {
-            Operand::Slot(s) => &self.robots[r].slots[*s],
-            Operand::Literal(text) => {
-                let mut end = text.len().min(VALUE_MAX);
-                while !text.is_char_boundary(end) {
-                    end -= 1;
-                }
-                &text[..end]
-            }
+            Operand::Slot(s) => self.robots[r].slots[*s].as_ref(),
+            Operand::Literal(v) => Some(v),
         }
     }
 
@@ -653,19 +695,20 @@ impl<'p> Sim<'p> {
             Expr::And(a, b) => self.eval(r, a) && self.eval(r, b),
             Expr::Not(a) => !self.eval(r, a),
             Expr::Bool(b) => *b,
-            Expr::Truthy(o) => truthy(self.value_ref(r, o)),
+            Expr::Truthy(o) => value::truthy(self.value_ref(r, o)),
             Expr::Compare(a, op, b, compared) => {
                 let (a, b) = (self.value_ref(r, a), self.value_ref(r, b));
                 // As the checker typed it (`semo_value_numbers`,
                 // `semo_value_words`): numbers by value, false when a side is
-                // not a number; words by their text, never ordered.
+                // not a number; words by identity, never ordered.
                 let ord = match compared {
-                    Compared::Numbers => match (number(a), number(b)) {
-                        (Some(x), Some(y)) => x.partial_cmp(&y),
-                        _ => None,
-                    },
+                    Compared::Numbers => value::compare_numbers(a, b),
                     Compared::Words => match op {
-                        CmpOp::Eq | CmpOp::Ne => Some(a.as_bytes().cmp(b.as_bytes())),
+                        CmpOp::Eq | CmpOp::Ne => Some(if value::words_equal(a, b) {
+                            std::cmp::Ordering::Equal
+                        } else {
+                            std::cmp::Ordering::Less
+                        }),
                         _ => None,
                     },
                 };
@@ -686,7 +729,7 @@ impl<'p> Sim<'p> {
     }
 
     /// `store`: the slot, and the library for shared information.
-    fn store(&mut self, r: usize, slot: usize, value: String) {
+    fn store(&mut self, r: usize, slot: usize, value: Held) {
         let robot = &mut self.robots[r];
         robot.progressed = true;
         if let Some(k) = robot.library_index[slot] {
@@ -702,28 +745,29 @@ impl<'p> Sim<'p> {
         let now = self.now;
         let robot = &mut self.robots[r];
         let program = robot.program;
-        let sampled =
-            robot.started_at + (now - robot.started_at) / SENSOR_PERIOD_MS * SENSOR_PERIOD_MS;
+        robot.resources.advance(now);
         for (i, s) in program.control.slots.iter().enumerate() {
             match &s.source {
-                SlotSource::Sensor { port, .. } => {
+                SlotSource::Sensor { port, task } => {
+                    let sampled = robot.sampled_at(task, now);
                     let Some(series) = &robot.sensor_series[i] else {
                         continue;
                     };
                     let n = series.partition_point(|(at, _)| *at <= sampled);
-                    if n > 0 {
-                        if robot.slots[i] != series[n - 1].1 {
-                            robot.slots[i].clone_from(&series[n - 1].1);
-                            robot.progressed = true;
-                        }
+                    let read = if n > 0 {
+                        series[n - 1].1.clone()
                     } else if port == "BATTERY"
                         && let Some(level) = battery_level(&robot.battery, sampled)
                     {
-                        let level = format!("{}", level.round());
-                        if robot.slots[i] != level {
-                            robot.slots[i] = level;
-                            robot.progressed = true;
-                        }
+                        s.kind.parse(&format!("{}", level.round()))
+                    } else {
+                        None
+                    };
+                    if let Some(v) = read
+                        && robot.slots[i].as_ref() != Some(&v)
+                    {
+                        robot.slots[i] = Some(v);
+                        robot.progressed = true;
                     }
                 }
                 SlotSource::Shared => {
@@ -743,16 +787,15 @@ impl<'p> Sim<'p> {
 
     /// `semo_comm_send`: traced, then to every other robot of `to` (team or
     /// robot name) through the network; `USER` only traces.
-    fn comm_send(&mut self, r: usize, to: Rc<str>, publish: bool, key: Rc<str>, value: Rc<str>) {
-        self.emit(
-            r,
-            "send",
-            vec![
-                ("to", to.clone()),
-                ("key", key.clone()),
-                ("value", value.clone()),
-            ],
-        );
+    fn comm_send(&mut self, r: usize, to: Rc<str>, publish: bool, key: Rc<str>, value: Held) {
+        self.trace.push(TraceEvent {
+            t: self.now,
+            robot: r,
+            event: "send",
+            fields: vec![("to", to.clone()), ("key", key.clone())],
+            value: Some(("value", value.clone())),
+            sent_at: None,
+        });
         if &*to == "USER" {
             return;
         }
@@ -766,7 +809,7 @@ impl<'p> Sim<'p> {
             from_robot: self.names[r].heartbeat.clone(),
             from_peer: Some(program.self_peer),
             key,
-            value,
+            value: Payload(value),
             sent_at: self.now,
         });
         for &dst in targets.iter() {
@@ -848,38 +891,85 @@ impl<'p> Sim<'p> {
                 ("from", message.from_team.clone()),
                 ("from_robot", message.from_robot.clone()),
                 ("key", message.key.clone()),
-                ("value", message.value.clone()),
             ],
+            value: Some(("value", message.value.0.clone())),
             sent_at: Some(message.sent_at),
         });
         let robot = &mut self.robots[r];
         let m = &robot.program.control;
         if m.heartbeat && message.publish && message.key == self.names[r].alive_key {
+            // A heartbeat's value is text ("leader 80"); anything else says nothing.
+            let text = match &message.value.0 {
+                Some(Value::Text(t)) => t.as_str(),
+                _ => "",
+            };
+            let heard = Heard::parse(self.now, text);
             for (i, (_, name)) in robot.program.peers.iter().enumerate() {
                 if **name == *message.from_robot {
-                    robot.last_seen[i] = self.now;
+                    robot.heard[i] = heard;
                 }
             }
+            return;
+        }
+        // `heard_sync`: an arrival at a group statement; wakes the control task.
+        if !m.sync_points.is_empty() && message.key == self.names[r].sync_key {
+            // Its value is text ("<point> <pass>"); anything else says nothing.
+            let text = match &message.value.0 {
+                Some(Value::Text(t)) => t.as_str(),
+                _ => "",
+            };
+            let mut words = text.split(' ');
+            let number = |w: Option<&str>| w.and_then(|w| w.parse::<i64>().ok()).unwrap_or(0);
+            let (offset, pass) = (number(words.next()), number(words.next()));
+            let peer = robot
+                .program
+                .peers
+                .iter()
+                .position(|(_, name)| **name == *message.from_robot);
+            let point = m.sync_points.iter().position(|&p| p as i64 == offset);
+            if let (Some(peer), Some(point)) = (peer, point) {
+                let last = robot.sync_arrived.entry((peer, point)).or_insert(0);
+                *last = (*last).max(pass);
+            }
+            self.wake(r);
             return;
         }
         if !m.subscribed.is_empty() && message.publish {
             for (i, g) in m.subscribed.iter().enumerate() {
                 if **g == *message.key {
-                    robot.groups[i] = Some(message.value.to_string());
+                    robot.groups[i] = Some(message.value.0.clone());
                 }
             }
             return;
         }
         // A full channel drops the sample (the runtime counts it).
+        // A value of another type than the key's is refused
+        // (`semo_value_coerce`); text is read as the type.
         let mut queued = false;
+        let mut rejected = false;
         for (i, incoming) in m.incoming.iter().enumerate() {
             if *incoming.from_team == *message.from_team && *incoming.key == *message.key {
+                let kind = &m.slots[incoming.slot].kind;
+                let Some(value) = (match &message.value.0 {
+                    Some(v) => kind.coerce(v).map(Some),
+                    None => Some(None),
+                }) else {
+                    rejected = true;
+                    continue;
+                };
                 let (queue, capacity) = &mut robot.inbox[i];
                 if queue.len() < *capacity {
-                    queue.push_back(message.value.to_string());
+                    queue.push_back(value);
                     queued = true;
                 }
             }
+        }
+        if rejected {
+            let fields = vec![
+                ("key", message.key.clone()),
+                ("reason", "not a value of its type".into()),
+            ];
+            self.emit(r, "reject", fields);
         }
         // Only a `receive` waits for a message: heartbeats and published
         // values are read on the way through a state, never waited for.
@@ -891,38 +981,46 @@ impl<'p> Sim<'p> {
     // ------------------------------------------------------ service tasks
 
     /// `request`: a service task starts one call unless it is busy.
-    fn request(&mut self, r: usize, task: &str, service: &str, args: Vec<String>) -> bool {
+    fn request(&mut self, r: usize, task: &str, service: &str, args: Vec<Held>) -> bool {
         let t = self.robots[r].task_index(task);
         if self.robots[r].tasks[t].1.busy {
             return false;
         }
-        let arg = args.first().cloned().unwrap_or_default();
+        let arg = match args.first() {
+            Some(v) => v.clone(),
+            None => Some(Value::text("")),
+        };
         let ms = self.robots[r]
             .service_ms
             .get(service)
             .copied()
-            .unwrap_or(DEFAULT_SERVICE_MS);
+            .unwrap_or(DEFAULT_SERVICE_MS)
+            * self.robots[r].speed_scale(task);
         let state = &mut self.robots[r].tasks[t].1;
         state.busy = true;
         state.service = service.to_string();
         state.generation += 1;
         let generation = state.generation;
-        self.emit(
-            r,
-            "call_start",
-            vec![
-                ("task", task.to_string().into()),
-                ("service", service.to_string().into()),
-                ("arg", arg.clone().into()),
-            ],
-        );
+        let task_name: Rc<str> = task.into();
+        self.trace.push(TraceEvent {
+            t: self.now,
+            robot: r,
+            event: "call_start",
+            fields: vec![("task", task_name.clone()), ("service", service.into())],
+            value: Some(("arg", arg.clone())),
+            sent_at: None,
+        });
         if !args.is_empty() {
-            self.emit(
-                r,
-                "actuate",
-                vec![("task", task.to_string().into()), ("value", arg.into())],
-            );
+            self.trace.push(TraceEvent {
+                t: self.now,
+                robot: r,
+                event: "actuate",
+                fields: vec![("task", task_name)],
+                value: Some(("value", arg)),
+                sent_at: None,
+            });
         }
+        self.run_graph(r, task);
         self.schedule(
             self.now + ms,
             Event::ServiceDone {
@@ -1042,13 +1140,16 @@ impl<'p> Sim<'p> {
         let program = self.robots[r].program;
         let m = &program.control;
         self.read_inputs(r);
-        if m.heartbeat && self.now - self.robots[r].last_heartbeat >= HEARTBEAT_MS {
+        self.manage_resources(r);
+        if m.heartbeat && self.now - self.robots[r].last_heartbeat >= m.heartbeat_ms {
             self.robots[r].last_heartbeat = self.now;
+            let robot = &self.robots[r];
+            let value = heartbeat_value(robot.leading, own_battery(robot, self.now));
             let names = &self.names[r];
             let (team, key, value) = (
                 names.team.clone(),
                 names.alive_key.clone(),
-                names.heartbeat.clone(),
+                Some(Value::text(&value)),
             );
             self.comm_send(r, team, true, key, value);
         }
@@ -1162,7 +1263,7 @@ impl<'p> Sim<'p> {
         let mut at: Option<i64> = None;
         let mut at_least = |t: i64| at = Some(at.map_or(t, |a| a.min(t)));
         if m.heartbeat {
-            at_least(robot.last_heartbeat + HEARTBEAT_MS);
+            at_least(robot.last_heartbeat + m.heartbeat_ms);
         }
         for region in &robot.regions {
             let Some(service) = region.service.filter(|_| !region.done) else {
@@ -1203,24 +1304,22 @@ impl<'p> Sim<'p> {
             }
         }
         // The next sensor sample that brings a new value.
-        let sampled =
-            robot.started_at + (self.now - robot.started_at) / SENSOR_PERIOD_MS * SENSOR_PERIOD_MS;
         for (i, s) in m.slots.iter().enumerate() {
-            let (SlotSource::Sensor { port, .. }, Some(series)) =
+            let (SlotSource::Sensor { port, task }, Some(series)) =
                 (&s.source, &robot.sensor_series[i])
             else {
                 continue;
             };
+            let sampled = robot.sampled_at(task, self.now);
             let n = series.partition_point(|(t, _)| *t <= sampled);
             if let Some((t, _)) = series.get(n) {
-                let periods = (t - robot.started_at + SENSOR_PERIOD_MS - 1) / SENSOR_PERIOD_MS;
-                at_least(robot.started_at + periods * SENSOR_PERIOD_MS);
+                at_least(robot.sample_at_or_after(task, *t));
             }
             if n == 0
                 && port == "BATTERY"
                 && robot.battery.last().is_some_and(|(t, _)| *t > sampled)
             {
-                at_least(sampled + SENSOR_PERIOD_MS);
+                at_least(robot.sample_at_or_after(task, sampled + 1));
             }
         }
         at.map(|t| self.grid_at_or_after(r, t.max(self.now + 1)))
@@ -1296,7 +1395,7 @@ impl<'p> Sim<'p> {
                     }
                     let publish = m.outgoing[item.message].publish;
                     let (to, key) = self.names[r].outgoing[item.message].clone();
-                    self.comm_send(r, to, publish, key, sent.into());
+                    self.comm_send(r, to, publish, key, sent);
                 }
                 self.region(r, i).pc = next;
                 Step::Next
@@ -1388,10 +1487,60 @@ impl<'p> Sim<'p> {
             }
             StateKind::LeaderBranch {
                 candidates,
+                algorithm,
                 others_at,
+            } => match self.elected(r, (service, pc), candidates, *algorithm) {
+                None => Step::Wait, // still listening
+                Some(elected) => {
+                    self.region(r, i).pc = if elected { next } else { *others_at };
+                    Step::Next
+                }
+            },
+            StateKind::GroupSync {
+                members,
+                point,
+                timeout_ms,
+                mark,
             } => {
-                let elected = self.elected(r, (service, pc), candidates);
-                self.region(r, i).pc = if elected { next } else { *others_at };
+                if self.robots[r].regions[i].phase == 0 {
+                    let robot = &mut self.robots[r];
+                    let pass = robot.sync_pass.entry((service, pc)).or_insert(0);
+                    *pass += 1;
+                    let value = format!("{} {}", m.sync_points[*point], *pass);
+                    let region = self.region(r, i);
+                    region.marks[*mark] = now;
+                    region.phase = 1;
+                    let names = &self.names[r];
+                    let (team, key) = (names.team.clone(), names.sync_key.clone());
+                    self.comm_send(r, team, false, key, Some(Value::text(&value)));
+                }
+                let robot = &self.robots[r];
+                let pass = robot.sync_pass[&(service, pc)];
+                let hb = m.heartbeat_ms;
+                let me = program.self_peer;
+                let waiting = members.iter().any(|&peer| {
+                    peer != me
+                        && robot
+                            .sync_arrived
+                            .get(&(peer, *point))
+                            .copied()
+                            .unwrap_or(0)
+                            < pass
+                        && now - robot.heard[peer].seen <= 3 * hb
+                });
+                let started = robot.regions[i].marks[*mark];
+                if waiting && now - started <= *timeout_ms {
+                    return Step::Wait;
+                }
+                if waiting {
+                    self.emit(r, "timeout", vec![("statement", "GroupSync".into())]);
+                } else {
+                    let line = state.line.to_string();
+                    self.emit(r, "group_sync", vec![("line", line.into())]);
+                }
+                let region = self.region(r, i);
+                region.phase = 0;
+                region.pc = next;
                 Step::Next
             }
             StateKind::Branch { condition, else_to } => {
@@ -1479,7 +1628,7 @@ impl<'p> Sim<'p> {
             if self.robots[r].regions[i].phase == 1 {
                 for (task, command) in &action.commands {
                     let name = actuator_name(self.robots[r].program, task);
-                    if !self.request(r, task, &name, vec![truncate(command.clone())]) {
+                    if !self.request(r, task, &name, vec![Some(command.clone())]) {
                         return Step::Wait;
                     }
                 }
@@ -1503,23 +1652,111 @@ impl<'p> Sim<'p> {
         Step::Wait
     }
 
-    /// `elected`: the first candidate that is this robot or was heard from
-    /// within three heartbeats leads; a change of leader is traced.
-    fn elected(&mut self, r: usize, state: (usize, usize), candidates: &[usize]) -> bool {
+    /// `elected` (`codegen/control.rs`'s `ELECTION_C`): among the live
+    /// candidates (this robot, or heard from within three heartbeats) the
+    /// algorithm's choice; a robot that must listen first (restarted, or a
+    /// `highest_battery` election) answers `None` until it has; a rejoining
+    /// robot follows a live claimant instead of claiming. A change of leader
+    /// is traced.
+    fn elected(
+        &mut self,
+        r: usize,
+        state: (usize, usize),
+        candidates: &[usize],
+        algorithm: LeaderAlgorithm,
+    ) -> Option<bool> {
+        let now = self.now;
         let robot = &self.robots[r];
+        let hb = robot.program.control.heartbeat_ms;
+        let listens = robot.rejoining || algorithm == LeaderAlgorithm::HighestBattery;
+        if listens && now - robot.started_at < crate::codegen::listen_ms(hb) {
+            return None;
+        }
         let me = robot.program.self_peer;
-        let leader = candidates
-            .iter()
-            .copied()
-            .find(|&c| c == me || self.now - robot.last_seen[c] <= 3 * HEARTBEAT_MS)
-            .unwrap_or(me);
+        let alive = |c: usize| c == me || now - robot.heard[c].seen <= 3 * hb;
+        let level = |c: usize| {
+            if c == me {
+                own_battery(robot, now)
+            } else {
+                robot.heard[c].battery
+            }
+        };
+        let mut live = candidates.iter().copied().filter(|&c| alive(c));
+        let chosen = match algorithm {
+            LeaderAlgorithm::LowestId => live.next(),
+            LeaderAlgorithm::Bully => live.next_back(),
+            // The highest level, the first of equals; unknown is lowest.
+            LeaderAlgorithm::HighestBattery => {
+                live.fold(None, |best: Option<usize>, c| match best {
+                    Some(b) if level(c).unwrap_or(-1) <= level(b).unwrap_or(-1) => Some(b),
+                    _ => Some(c),
+                })
+            }
+        };
+        let mut leader = chosen.unwrap_or(me);
+        let mut rejoining = robot.rejoining;
+        if rejoining && leader == me {
+            let claimant = (0..robot.heard.len())
+                .find(|&i| i != me && robot.heard[i].leads && now - robot.heard[i].seen <= 3 * hb);
+            match claimant {
+                Some(c) => leader = c,
+                None => rejoining = false,
+            }
+        }
+        let robot = &mut self.robots[r];
+        robot.rejoining = rejoining;
+        robot.leading = leader == me;
         if robot.leaders.get(&state) != Some(&leader) {
-            self.robots[r].leaders.insert(state, leader);
-            let name = self.robots[r].program.peers[leader].1.clone();
+            robot.leaders.insert(state, leader);
+            let name = robot.program.peers[leader].1.clone();
             self.emit(r, "leader", vec![("leader", name.into())]);
         }
-        leader == me
+        Some(leader == me)
     }
+}
+
+/// What a robot's last heartbeat said (`comm_heartbeat` in the C).
+#[derive(Clone, Copy, Debug)]
+struct Heard {
+    /// When it came (mission ms).
+    seen: i64,
+    /// It claimed leadership.
+    leads: bool,
+    battery: Option<i64>,
+}
+
+impl Heard {
+    /// `heard_alive`: `leader 87` or `member -`.
+    fn parse(now: i64, value: &str) -> Heard {
+        let battery = value
+            .split_once(' ')
+            .map(|(_, b)| b)
+            .filter(|b| b.starts_with(|c: char| c.is_ascii_digit()))
+            .and_then(|b| {
+                let digits: String = b.chars().take_while(char::is_ascii_digit).collect();
+                digits.parse().ok()
+            });
+        Heard {
+            seen: now,
+            leads: value.starts_with("leader "),
+            battery,
+        }
+    }
+}
+
+/// A heartbeat's value: whether the robot claims leadership, and its battery.
+fn heartbeat_value(leading: bool, battery: Option<i64>) -> String {
+    let role = if leading { "leader" } else { "member" };
+    match battery {
+        Some(level) => format!("{role} {level}"),
+        None => format!("{role} -"),
+    }
+}
+
+/// A robot's battery level for its heartbeats (`own_battery`,
+/// `semo_sim_battery`): the scenario's battery points at `now`, rounded.
+fn own_battery(robot: &Robot<'_>, now: i64) -> Option<i64> {
+    battery_level(&robot.battery, now).map(|l| l.round() as i64)
 }
 
 /// For every team and robot name, the robots (program indices) a message

@@ -169,6 +169,121 @@ fn a_killed_leader_is_replaced_and_a_restarted_one_leads_again() {
         0,
     );
     assert_eq!(leaders(&run_, "tb_1"), ["tb_0", "tb_1", "tb_0"]);
+    // The restarted robot listens before it claims, and the one that took
+    // over gives way first: never two leaders at once.
+    // (tb_0's trace: before the kill, then after the restart.)
+    assert_eq!(leaders(&run_, "tb_0"), ["tb_0", "tb_1", "tb_0"]);
+    assert_eq!(two_leaders(&run_), None);
+    let tb_0 = run_.robots.iter().position(|(_, n)| n == "tb_0").unwrap();
+    let claimed = run_
+        .trace
+        .iter()
+        .find(|e| e.robot == tb_0 && e.t >= 3000 && e.field("leader") == Some("tb_0"))
+        .unwrap()
+        .t;
+    let listen = crate::codegen::listen_ms(crate::refine::HEARTBEAT_MS);
+    assert!(claimed >= 3000 + listen, "claimed at {claimed}");
+}
+
+/// The first instant two live robots both lead by their own traces (a
+/// robot leads from its `leader` event naming itself until another one, or
+/// until it is killed), with the two robots.
+fn two_leaders(run: &Run) -> Option<(i64, String, String)> {
+    let mut leading: Vec<bool> = vec![false; run.robots.len()];
+    for e in &run.trace {
+        let me = &run.robots[e.robot].1;
+        match e.event {
+            "leader" => leading[e.robot] = e.field("leader") == Some(me.as_str()),
+            "fault" | "start" => leading[e.robot] = false,
+            _ => continue,
+        }
+        let both: Vec<&String> = (0..leading.len())
+            .filter(|&r| leading[r])
+            .map(|r| &run.robots[r].1)
+            .collect();
+        if let [a, b, ..] = both.as_slice() {
+            return Some((e.t, a.to_string(), b.to_string()));
+        }
+    }
+    None
+}
+
+/// `tests/fixtures/elections/<algorithm>`: three robots with battery levels
+/// 40, 90 and 60; the one with 90 (tb_1) is killed at 1000 ms and restarted
+/// at 2000 ms.
+fn election(algorithm: &str) -> Run {
+    let programs = programs(&format!(
+        "tests/fixtures/elections/{algorithm}/election.mission"
+    ));
+    let scenario = r#"{"duration": 3000,
+        "robots": {"tb_0": {"battery": [{"at": 0, "level": 40}]},
+                   "tb_1": {"battery": [{"at": 0, "level": 90}]},
+                   "tb_2": {"battery": [{"at": 0, "level": 60}]}},
+        "faults": [{"at": 1000, "kill": "tb_1"}, {"at": 2000, "restart": "tb_1"}]}"#;
+    let (run_, _) = run(&programs, scenario, 0);
+    assert_eq!(two_leaders(&run_), None, "{algorithm}");
+    run_
+}
+
+#[test]
+fn lowest_id_elects_the_first_live_candidate() {
+    let run_ = election("lowest_id");
+    assert!(
+        run_.robots
+            .iter()
+            .all(|(_, r)| programs_heartbeat(&run_, r) == 100)
+    );
+    assert_eq!(leaders(&run_, "tb_0"), ["tb_0"]);
+    assert_eq!(leaders(&run_, "tb_2"), ["tb_0"]);
+    // Restarted, tb_1 listens and then follows tb_0.
+    assert_eq!(leaders(&run_, "tb_1"), ["tb_0", "tb_0"]);
+}
+
+#[test]
+fn bully_elects_the_last_live_candidate() {
+    let run_ = election("bully");
+    assert_eq!(leaders(&run_, "tb_0"), ["tb_2"]);
+    assert_eq!(leaders(&run_, "tb_1"), ["tb_2", "tb_2"]);
+}
+
+#[test]
+fn highest_battery_elects_by_the_levels_heartbeats_carry() {
+    let run_ = election("highest_battery");
+    // Everyone listens one and a half heartbeats (150 ms) first; tb_1 (90)
+    // leads, tb_2 (60) takes over when it dies, and gives way to the
+    // restarted tb_1, which waits for that before it claims.
+    assert_eq!(leaders(&run_, "tb_0"), ["tb_1", "tb_2", "tb_1"]);
+    assert_eq!(leaders(&run_, "tb_2"), ["tb_1", "tb_2", "tb_1"]);
+    assert_eq!(leaders(&run_, "tb_1"), ["tb_1", "tb_2", "tb_1"]);
+    let first = run_.trace.iter().find(|e| e.event == "leader").unwrap().t;
+    assert_eq!(first, 150);
+    let heartbeat = run_
+        .trace
+        .iter()
+        .find(|e| e.event == "send" && e.field("key") == Some("Crew.__alive") && e.t > 200)
+        .unwrap();
+    // A heartbeat's value is text.
+    assert!(
+        matches!(
+            heartbeat.value_json().as_str(),
+            r#""leader 90""# | r#""member 40""# | r#""member 60""#
+        ),
+        "{:?}",
+        heartbeat.value
+    );
+}
+
+/// The heartbeat period of a robot's program in a run, from its sends.
+fn programs_heartbeat(run: &Run, robot: &str) -> i64 {
+    let r = run.robots.iter().position(|(_, n)| n == robot).unwrap();
+    let sends: Vec<i64> = run
+        .trace
+        .iter()
+        .filter(|e| e.robot == r && e.event == "send" && e.field("key") == Some("Crew.__alive"))
+        .map(|e| e.t)
+        .take(3)
+        .collect();
+    sends[1] - sends[0]
 }
 
 #[test]
@@ -262,4 +377,68 @@ fn scenario_mistakes_point_at_the_value() {
             "{text}"
         );
     }
+}
+
+/// `tests/fixtures/group_sync`: the robots drive for `moves` ms (tb_0,
+/// tb_1, tb_2), then meet at the group statement (GroupSync, 2 s timeout).
+fn group_sync(moves: [i64; 3], faults: &str) -> Run {
+    let programs = programs("tests/fixtures/group_sync/sync.mission");
+    let robots: Vec<String> = moves
+        .iter()
+        .enumerate()
+        .map(|(i, ms)| format!(r#""tb_{i}": {{"services": {{"move": {ms}}}}}"#))
+        .collect();
+    let scenario = format!(
+        r#"{{"duration": 8000, "robots": {{{}}}, "faults": [{faults}]}}"#,
+        robots.join(", ")
+    );
+    run(&programs, &scenario, 0).0
+}
+
+/// When `robot` passed the group statement's start, and how.
+fn synced(run: &Run, robot: &str) -> Option<(i64, &'static str)> {
+    let r = run.robots.iter().position(|(_, n)| n == robot).unwrap();
+    run.trace
+        .iter()
+        .find(|e| {
+            e.robot == r
+                && (e.event == "group_sync"
+                    || (e.event == "timeout" && e.field("statement") == Some("GroupSync")))
+        })
+        .map(|e| (e.t, e.event))
+}
+
+#[test]
+fn group_sync_waits_for_every_member() {
+    let run_ = group_sync([100, 700, 1200], "");
+    for robot in ["tb_0", "tb_1", "tb_2"] {
+        let (t, how) = synced(&run_, robot).unwrap();
+        assert_eq!(how, "group_sync", "{robot}");
+        // Not before the slowest one arrived (1200 ms), and at once then.
+        assert!((1200..=1220).contains(&t), "{robot} met at {t}");
+    }
+}
+
+#[test]
+fn group_sync_does_not_wait_for_a_dead_member() {
+    // tb_1 dies on the way: the others meet when tb_2 arrives, without
+    // waiting for the timeout.
+    let run_ = group_sync([100, 700, 1200], r#"{"at": 300, "kill": "tb_1"}"#);
+    assert_eq!(synced(&run_, "tb_1"), None);
+    for robot in ["tb_0", "tb_2"] {
+        let (t, how) = synced(&run_, robot).unwrap();
+        assert_eq!(how, "group_sync", "{robot}");
+        assert!((1200..=1220).contains(&t), "{robot} met at {t}");
+    }
+}
+
+#[test]
+fn group_sync_gives_up_after_the_strategys_timeout() {
+    // tb_2 is alive but takes 5 s: tb_0 and tb_1 wait 2 s from their own
+    // arrival, then go on; tb_2, last, finds them finished (no heartbeat:
+    // dead) and goes on at once.
+    let run_ = group_sync([100, 700, 5000], "");
+    assert_eq!(synced(&run_, "tb_0"), Some((2110, "timeout")));
+    assert_eq!(synced(&run_, "tb_1"), Some((2710, "timeout")));
+    assert_eq!(synced(&run_, "tb_2"), Some((5000, "group_sync")));
 }

@@ -282,9 +282,13 @@ pub fn attribute_doc(element: &str, attribute: &str) -> Option<&'static str> {
             "How long the robots of a group wait for each other, e.g. `5 SEC`."
         }
         ("Sensor", "name") => "The sensor whose period is lowered.",
-        ("Sensor", "periodLevel") => "The period level to run it at.",
+        ("Sensor", "periodLevel") => {
+            "The period level while the condition holds (1 or more): the sensor samples every period × level; 1 is its own period."
+        }
         ("Actuator", "name") => "The actuator whose speed is lowered.",
-        ("Actuator", "speedLevel") => "The speed level to drive it at.",
+        ("Actuator", "speedLevel") => {
+            "The speed level while the condition holds (1 or more): the actuator runs at 1/level of its speed; 1 is full speed."
+        }
         _ => return None,
     })
 }

@@ -694,7 +694,8 @@ impl Reader<'_> {
             };
             self.leaf(c, attrs);
             let name = self.required(c, "name").map(Self::named);
-            let level = self.required(c, level_key).and_then(|a| self.number(a, 0));
+            // Levels count from 1, the task's own period or full speed.
+            let level = self.required(c, level_key).and_then(|a| self.number(a, 1));
             let setting = LevelSetting {
                 name,
                 level,

@@ -15,7 +15,7 @@
 #ifdef SEMO_MQTT
 #define _POSIX_C_SOURCE 200809L
 
-#include "semo_runtime.h"
+#include "semo_internal.h"
 
 #include <mosquitto.h>
 #include <pthread.h>
@@ -26,10 +26,10 @@
 #include <time.h>
 
 #define MQTT_QUEUE 64
-/* The runtime's largest datagram (4 fields of at most 255 bytes) and a
+/* The runtime's largest datagram (SEMO__DATAGRAM_MAX: 3 fields and a value) and a
  * spare byte: a longer payload arrives truncated and is rejected as
  * malformed by the runtime. */
-#define MQTT_PAYLOAD_MAX (6 + 4 * 256 + 1)
+#define MQTT_PAYLOAD_MAX (SEMO__DATAGRAM_MAX + 1)
 #define MQTT_TOPIC_MAX 512
 #define MQTT_KEEPALIVE_S 10
 /* How long open waits for the broker's CONNACK and SUBACK, and close for
@@ -52,6 +52,7 @@ static size_t g_head, g_count;
 static bool g_interrupted;
 static bool g_subscribed;
 static int g_connect_refused; /* the broker's CONNACK code when it refused */
+static bool g_connected_once, g_session_present; /* the first CONNACK's session-present flag */
 static int g_subscribe_mid = -1;
 static long g_unacked; /* messages handed to libmosquitto whose on_publish has not come */
 
@@ -104,7 +105,7 @@ static void topic_of(char *topic, size_t cap, const char *team, const char *robo
         snprintf(topic + strlen(topic), cap - strlen(topic), "/+"); /* a subscription: any key */
 }
 
-/* The datagram's fields after "SEMO" 0x01 <kind>: each a length byte and
+/* The datagram's fields after "SEMO" 0x02 <kind> (semo_internal.h): each a length byte and
  * that many bytes. Copies field `index` (0 team, 1 robot, 2 key) into `out`. */
 static bool datagram_field(const unsigned char *data, size_t len, int index, char *out, size_t cap)
 {
@@ -140,11 +141,26 @@ static struct timespec deadline_after(int ms)
 
 static void outbox_flush(void);
 
+bool semo__mqtt_session_present(void)
+{
+    pthread_mutex_lock(&g_lock);
+    bool present = g_session_present;
+    pthread_mutex_unlock(&g_lock);
+    return present;
+}
+
 /* On every (re)connection: subscribe again (the persistent session keeps the
  * subscriptions, but a broker that lost its state must learn them). */
-static void on_connect(struct mosquitto *mosq, void *obj, int rc)
+static void on_connect(struct mosquitto *mosq, void *obj, int rc, int flags)
 {
     (void)obj;
+    if (rc == 0) {
+        pthread_mutex_lock(&g_lock);
+        if (!g_connected_once)
+            g_session_present = (flags & 1) != 0;
+        g_connected_once = true;
+        pthread_mutex_unlock(&g_lock);
+    }
     if (rc != 0) {
         pthread_mutex_lock(&g_lock);
         g_connect_refused = rc;
@@ -308,7 +324,7 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     int will_len = snprintf(will, sizeof will, "{\"robot\":\"%s\",\"event\":\"status\",\"state\":\"lost\"}",
                             program->peers[program->self].robot);
     mosquitto_will_set(g_mosq, will_topic, will_len, will, 1, true);
-    mosquitto_connect_callback_set(g_mosq, on_connect);
+    mosquitto_connect_with_flags_callback_set(g_mosq, on_connect);
     mosquitto_subscribe_callback_set(g_mosq, on_subscribe);
     mosquitto_publish_callback_set(g_mosq, on_publish);
     mosquitto_message_callback_set(g_mosq, on_message);
