@@ -1463,7 +1463,8 @@ fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
     }
 
     // tb_1 takes over: tb_0 is dead three heartbeats after the last one it
-    // sent, and the leader's statement decides once a pass (every second).
+    // sent, and the leader's statement decides once a pass (every second);
+    // 300 ms for a late firing and delivery on a loaded machine.
     let last_heartbeat = traces[first_tb_0]
         .1
         .iter()
@@ -1477,7 +1478,7 @@ fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
         .map(|e| e["t"].as_i64().unwrap())
         .expect("tb_1 takes over");
     assert!(
-        took_over > killed_at - 50 && took_over <= last_heartbeat + 3 * 200 + 1000 + 100,
+        took_over > killed_at - 50 && took_over <= last_heartbeat + 3 * 200 + 1000 + 300,
         "tb_1 took over at {took_over}, tb_0's last heartbeat at {last_heartbeat}"
     );
     // After the restart tb_0 leads again, and the others follow it.
