@@ -1418,10 +1418,43 @@ fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
     let of =
         |robot: &str| -> &Vec<Event> { &traces.iter().rev().find(|(r, _)| r == robot).unwrap().1 };
 
-    for robot in ["tb_1", "tb_2"] {
-        assert_eq!(modes(of(robot)), ["PATROL", "HIDE", "PATROL"], "{robot}");
+    // The TurtleBots hide while it is dark and patrol again once it is
+    // bright (at the change, a robot may flip back and forth for a firing
+    // or two: its `Hear` can read the last DARK before the first BRIGHT,
+    // as in the simulator), then stay patrolling.
+    let mode_at = |events: &[Event], t: i64| -> String {
+        events
+            .iter()
+            .filter(|e| field(e, "event") == "mode" && e["t"].as_i64().unwrap() <= t)
+            .map(|e| field(e, "mode").to_string())
+            .next_back()
+            .unwrap_or_default()
+    };
+    let first_life = &traces[first_tb_0].1;
+    for (robot, events) in [
+        ("tb_1", of("tb_1")),
+        ("tb_2", of("tb_2")),
+        ("tb_0", first_life),
+    ] {
+        assert_eq!(mode_at(events, 500), "PATROL", "{robot}");
+        assert_eq!(
+            mode_at(events, 2400),
+            "HIDE",
+            "{robot}: {:?}",
+            modes(events)
+        );
+        assert_eq!(
+            mode_at(events, 3400),
+            "PATROL",
+            "{robot}: {:?}",
+            modes(events)
+        );
+        let late = events
+            .iter()
+            .filter(|e| field(e, "event") == "mode" && e["t"].as_i64().unwrap() > 3400)
+            .count();
+        assert_eq!(late, 0, "{robot} changes mode after the light settled");
     }
-    assert_eq!(modes(&traces[first_tb_0].1), ["PATROL", "HIDE", "PATROL"]);
     assert_eq!(modes(of("tb_0")), ["PATROL"], "tb_0's second life");
     assert_eq!(modes(of("base")), ["WATCH"]);
     for robot in ["ev_0", "ev_1"] {
@@ -1431,7 +1464,8 @@ fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
     }
 
     // tb_1 takes over: tb_0 is dead three heartbeats after the last one it
-    // sent, and the leader's statement decides once a pass (every second).
+    // sent, and the leader's statement decides once a pass (every second);
+    // 300 ms for a late firing and delivery on a loaded machine.
     let last_heartbeat = traces[first_tb_0]
         .1
         .iter()
@@ -1445,7 +1479,7 @@ fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
         .map(|e| e["t"].as_i64().unwrap())
         .expect("tb_1 takes over");
     assert!(
-        took_over > killed_at - 50 && took_over <= last_heartbeat + 3 * 200 + 1000 + 100,
+        took_over > killed_at - 50 && took_over <= last_heartbeat + 3 * 200 + 1000 + 300,
         "tb_1 took over at {took_over}, tb_0's last heartbeat at {last_heartbeat}"
     );
     // After the restart tb_0 leads again, and the others follow it.
