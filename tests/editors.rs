@@ -120,6 +120,7 @@ fn neovim_shows_the_diagnostic_completes_and_highlights_a_mission() {
         "plain.xml: filetype xml, 0 semo client(s)",
         "simulate: IDLE@0 -> MOVING@1000, ok false",
         "scenario diagnostic: 4:13 expectation failed: r never enters IDLE: entered at 0 ms",
+        "monitor: r          Rover        waiting",
     ] {
         assert!(out.contains(expected), "missing {expected:?} in:\n{out}");
     }

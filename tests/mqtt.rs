@@ -15,6 +15,7 @@ use std::collections::BTreeMap;
 use std::net::{TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
+use support::mqtt::{Fleet, Started, folder_of};
 use support::robots::{
     Event, PEDANTIC, build, events, field, modes, robot_command, robot_folders, scratch,
 };
@@ -165,7 +166,12 @@ fn build_scouting(out: &Path) -> Vec<PathBuf> {
 
 /// The same with more `semo build` arguments (`--deploy FILE`).
 fn build_scouting_with(out: &Path, extra: &[&str]) -> Vec<PathBuf> {
-    let mission = examples().join("scouting/scouting.mission");
+    build_for_mqtt(&examples().join("scouting/scouting.mission"), out, extra)
+}
+
+/// `semo build MISSION --target linux-sim` with `extra` arguments, each
+/// robot made with the MQTT transport built in, warnings as errors.
+fn build_for_mqtt(mission: &Path, out: &Path, extra: &[&str]) -> Vec<PathBuf> {
     let (mission, out_arg) = (mission.display().to_string(), out.display().to_string());
     let mut args = vec![
         "build",
@@ -546,8 +552,12 @@ fn scouting_deployment(dir: &Path, port: u16, tls: bool) -> PathBuf {
 /// `semo deploy broker-config` into `dir/broker`, run as this user, logging
 /// to `dir/broker/mosquitto.log`; returns the configuration's path.
 fn broker_config(dir: &Path, deploy: &Path) -> PathBuf {
+    broker_config_for(dir, &examples().join("scouting/scouting.mission"), deploy)
+}
+
+/// The same for another mission.
+fn broker_config_for(dir: &Path, mission: &Path, deploy: &Path) -> PathBuf {
     let out = dir.join("broker");
-    let mission = examples().join("scouting/scouting.mission");
     let written = support::semo_in(
         dir,
         &[
@@ -1248,4 +1258,641 @@ fn the_operator_console_drives_scouting_to_finish() {
             .any(|l| l.starts_with("status irobot: stopped FINISH")),
         "{printed:?}"
     );
+}
+
+/// The `semo/monitor` notification of the server behind `client` whose
+/// robots satisfy `wanted`; one that never comes fails the test.
+async fn monitor_view(
+    client: &mut semo_server::harness::TestClient,
+    wanted: impl Fn(&serde_json::Value) -> bool,
+) -> serde_json::Value {
+    let last = std::sync::Mutex::new(serde_json::Value::Null);
+    let seen = |p: &serde_json::Value| {
+        *last.lock().unwrap() = p.clone();
+        wanted(p)
+    };
+    let found = tokio::time::timeout(
+        std::time::Duration::from_secs(60),
+        client.notification("semo/monitor", seen),
+    )
+    .await;
+    found.unwrap_or_else(|_| {
+        panic!(
+            "the awaited semo/monitor notification did not come; the last one: {}",
+            last.lock().unwrap()
+        )
+    })
+}
+
+fn shown<'v>(view: &'v serde_json::Value, robot: &str) -> &'v serde_json::Value {
+    view["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["robot"] == robot)
+        .unwrap_or_else(|| panic!("{robot} is shown: {view}"))
+}
+
+/// A workspace for the editor: `files` copied in, and a `semo.toml` whose
+/// `[build] deployment` is `deploy`.
+fn monitor_workspace(out: &Path, deploy: &Path, files: &[PathBuf]) -> PathBuf {
+    let workspace = out.join("workspace");
+    std::fs::create_dir_all(&workspace).unwrap();
+    for file in files {
+        std::fs::copy(file, workspace.join(file.file_name().unwrap())).unwrap();
+    }
+    std::fs::write(
+        workspace.join("semo.toml"),
+        format!("[build]\ndeployment = \"{}\"\n", deploy.display()),
+    )
+    .unwrap();
+    workspace
+}
+
+/// The language server (in-process) on `workspace`, `mission` open and
+/// checked, and its monitor started with no broker named (so the
+/// deployment file's); the client, the mission's URI and the answer.
+async fn start_monitor(
+    workspace: &Path,
+    mission: &str,
+) -> (semo_server::harness::TestClient, String, serde_json::Value) {
+    let mut client = semo_server::harness::TestClient::start();
+    let root = format!("file://{}", workspace.display());
+    client
+        .initialize_with(serde_json::json!({}), Some(&root))
+        .await;
+    let mission = workspace.join(mission);
+    let uri = format!("file://{}", mission.display());
+    client
+        .open(&uri, &std::fs::read_to_string(&mission).unwrap())
+        .await;
+    client.diagnostics(&uri, Some(1)).await;
+    let answer = client
+        .request("semo/monitor/start", serde_json::json!({ "uri": uri }))
+        .await
+        .expect("the monitor starts");
+    (client, uri, answer)
+}
+
+#[test]
+fn the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost() {
+    let Some(binary) =
+        broker_or_skip("the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost")
+    else {
+        return;
+    };
+    // The broker of the deployment file with its ACL: the monitor finds it
+    // through the project's semo.toml and connects as the operator.
+    let out = scratch("mqtt-monitor");
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let deploy = scouting_deployment(&out, port, false);
+    let config = broker_config(&out, &deploy);
+    let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
+    let mut processes = Processes::default();
+    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+    let workspace = monitor_workspace(
+        &out,
+        &deploy,
+        &[
+            examples().join("scouting/scouting.mission"),
+            examples().join("scouting/MasterTeam.strategy.xml"),
+        ],
+    );
+    // Without the simulated operator the master waits in WAIT_MODE: the
+    // robots stay running.
+    let mut world: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scenario()).unwrap()).unwrap();
+    world["operator"] = serde_json::json!([]);
+    world.as_object_mut().unwrap().remove("expect");
+    let alone = out.join("no-operator.scenario.json");
+    std::fs::write(&alone, world.to_string()).unwrap();
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let (mut client, uri, answer) = start_monitor(&workspace, "scouting.mission").await;
+        assert_eq!(answer["broker"], format!("mqtt://127.0.0.1:{port}"));
+        let view = monitor_view(&mut client, |p| p["connection"] == "connected").await;
+        let names: Vec<String> = folders.iter().map(|f| robot_name(f)).collect();
+        for robot in &names {
+            assert_eq!(shown(&view, robot)["state"], "waiting", "{view}");
+        }
+
+        for folder in &folders {
+            let robot = robot_name(folder);
+            let trace = out.join(format!("{robot}.monitored.jsonl"));
+            let child = robot_command(folder, &alone, &trace, 1)
+                .args(["--transport", "mqtt", "--duration", "1000000"])
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("the robot program starts");
+            processes.push(child);
+        }
+        // Every robot running in a mode with its services; the master
+        // waiting for the operator, listening.
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|robots| {
+                robots.iter().all(|r| {
+                    r["state"] == "running"
+                        && r["mode"].is_string()
+                        && r["services"].as_array().is_some_and(|s| !s.is_empty())
+                }) && robots
+                    .iter()
+                    .any(|r| r["robot"] == "irobot" && r["mode"] == "WAIT_MODE")
+            })
+        })
+        .await;
+        let master = shown(&view, "irobot");
+        assert_eq!(master["team"], "MasterTeam");
+        assert!(
+            master["services"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|s| s["plan"] == "Listen" && s["service"] == "ReportStatus"),
+            "{view}"
+        );
+
+        // Killed: the broker's last will marks it lost, the others run on.
+        let irobot = names.iter().position(|n| n == "irobot").unwrap();
+        // The broker is process 0, the robots follow in folder order.
+        processes.0[1 + irobot].kill().unwrap();
+        processes.0[1 + irobot].wait().unwrap();
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|r| {
+                r.iter()
+                    .any(|r| r["robot"] == "irobot" && r["lost"] == true)
+            })
+        })
+        .await;
+        assert_eq!(shown(&view, "irobot")["lostBecause"], "lastWill");
+        for robot in names.iter().filter(|n| *n != "irobot") {
+            assert_eq!(shown(&view, robot)["state"], "running", "{view}");
+        }
+        let stopped = client
+            .request("semo/monitor/stop", serde_json::json!({ "uri": uri }))
+            .await
+            .unwrap();
+        assert_eq!(stopped["stopped"], true);
+        client.shutdown().await;
+    });
+}
+
+/// patrol_groups's deployment: a user per team and the operator, on a
+/// private broker at `port`.
+fn patrol_deployment(dir: &Path, port: u16) -> PathBuf {
+    let users = [
+        ("base", "base-secret"),
+        ("guards", "guards-secret"),
+        ("operator", "operator-secret"),
+    ];
+    for (i, (user, password)) in users.iter().enumerate() {
+        std::fs::write(dir.join(format!("{user}.pw")), format!("{password}\n")).unwrap();
+        let mut command = Command::new("mosquitto_passwd");
+        if i == 0 {
+            command.arg("-c");
+        }
+        let made = command
+            .arg("-b")
+            .arg(dir.join("passwd"))
+            .args([user, password])
+            .output()
+            .expect("mosquitto_passwd runs");
+        assert!(made.status.success(), "{made:?}");
+    }
+    let file = dir.join("patrol_groups.deploy.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "broker = \"mqtt://127.0.0.1:{port}\"\n\n[broker_config]\npassword_file = \"passwd\"\n\n[operator]\nuser = \"operator\"\npassword_file = \"operator.pw\"\n\n[teams.Base]\nuser = \"base\"\npassword_file = \"base.pw\"\n\n[teams.Guards]\nuser = \"guards\"\npassword_file = \"guards.pw\"\n"
+        ),
+    )
+    .unwrap();
+    file
+}
+
+/// Sends `signal` (`STOP`, `CONT`) to a process.
+fn signal(child: &Child, signal: &str) {
+    let sent = Command::new("kill")
+        .args([&format!("-{signal}"), &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(sent.success(), "kill -{signal} {}", child.id());
+}
+
+#[test]
+fn the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor() {
+    let Some(binary) =
+        broker_or_skip("the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor")
+    else {
+        return;
+    };
+    // Team Guards elects a leader among its Turtlebots tb_0..tb_2 with
+    // heartbeats; the broker's ACL lets the operator (the monitor) read them.
+    let out = scratch("mqtt-monitor-leader");
+    let port = TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let mission = examples().join("swarm/patrol_groups.mission");
+    let deploy = patrol_deployment(&out, port);
+    let config = broker_config_for(&out, &mission, &deploy);
+    let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
+    assert!(
+        acl.contains("user operator\n")
+            && acl.contains("topic read semo/patrol_groups/Guards/Guards.__alive\n"),
+        "{acl}"
+    );
+    let folders = build_for_mqtt(&mission, &out, &["--deploy", &deploy.display().to_string()]);
+    let mut processes = Processes::default();
+    start_broker_with(&binary, &config, &out.join("broker"), port, &mut processes);
+    let workspace = monitor_workspace(&out, &deploy, std::slice::from_ref(&mission));
+    let world = out.join("patrol.scenario.json");
+    std::fs::write(&world, r#"{"time_scale": 1, "duration": 1000000}"#).unwrap();
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let (mut client, uri, _) = start_monitor(&workspace, "patrol_groups.mission").await;
+        let mut robots = BTreeMap::new();
+        for folder in &folders {
+            let robot = robot_name(folder);
+            let trace = out.join(format!("{robot}.jsonl"));
+            let child = robot_command(folder, &world, &trace, 1)
+                .args(["--transport", "mqtt"])
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("the robot program starts");
+            robots.insert(robot, processes.push(child));
+        }
+        let leader_is = |robot: &'static str| {
+            move |p: &serde_json::Value| {
+                p["robots"].as_array().is_some_and(|all| {
+                    all.iter().all(|r| r["state"] == "running")
+                        && all
+                            .iter()
+                            .filter(|r| r["robot"].as_str().is_some_and(|n| n.starts_with("tb_")))
+                            .all(|r| r["leader"] == robot)
+                })
+            }
+        };
+        let view = monitor_view(&mut client, leader_is("tb_0")).await;
+        assert_eq!(shown(&view, "tb_0")["isLeader"], true, "{view}");
+        assert_eq!(shown(&view, "tb_1")["isLeader"], false, "{view}");
+
+        // The leader hangs (its connection stays open: no last will). It
+        // is shown lost once silent for three heartbeats, and tb_1 leads.
+        signal(&processes.0[robots["tb_0"]], "STOP");
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|all| {
+                all.iter()
+                    .any(|r| r["robot"] == "tb_0" && r["lostBecause"] == "silent")
+                    && all
+                        .iter()
+                        .any(|r| r["robot"] == "tb_1" && r["isLeader"] == true)
+                    && all
+                        .iter()
+                        .any(|r| r["robot"] == "tb_2" && r["leader"] == "tb_1")
+            })
+        })
+        .await;
+        assert_eq!(shown(&view, "base")["state"], "running", "{view}");
+
+        // Back: heard again, running again.
+        signal(&processes.0[robots["tb_0"]], "CONT");
+        monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|all| {
+                all.iter()
+                    .any(|r| r["robot"] == "tb_0" && r["state"] == "running")
+            })
+        })
+        .await;
+        let stopped = client
+            .request("semo/monitor/stop", serde_json::json!({ "uri": uri }))
+            .await
+            .unwrap();
+        assert_eq!(stopped["stopped"], true);
+        client.shutdown().await;
+    });
+}
+
+/// The first mission time at which two robots both lead by their own traces
+/// (`events` of every robot and incarnation, each a robot's name and its
+/// events): a robot leads from a `leader` event naming itself until one
+/// naming another, or until `ends[robot]` (when it was killed).
+fn two_leaders(
+    lives: &[(String, Vec<Event>)],
+    ends: &BTreeMap<usize, i64>,
+) -> Option<(i64, String, String)> {
+    // (time, life, leads) changes, in time order.
+    let mut changes: Vec<(i64, usize, bool)> = Vec::new();
+    for (life, (robot, events)) in lives.iter().enumerate() {
+        for e in events.iter().filter(|e| field(e, "event") == "leader") {
+            let t = e["t"].as_i64().unwrap();
+            changes.push((t, life, field(e, "leader") == robot));
+        }
+        if let Some(&end) = ends.get(&life) {
+            changes.push((end, life, false));
+        }
+    }
+    changes.sort_by_key(|&(t, life, leads)| (t, leads, life));
+    let mut leading = vec![false; lives.len()];
+    for (t, life, leads) in changes {
+        leading[life] = leads;
+        let both: Vec<&String> = (0..lives.len())
+            .filter(|&l| leading[l])
+            .map(|l| &lives[l].0)
+            .collect();
+        if let [a, b, ..] = both.as_slice() {
+            return Some((t, a.to_string(), b.to_string()));
+        }
+    }
+    None
+}
+
+fn leaders_of(events: &[Event]) -> Vec<String> {
+    events
+        .iter()
+        .filter(|e| field(e, "event") == "leader")
+        .map(|e| field(e, "leader").to_string())
+        .collect()
+}
+
+/// Mission ms since the start barrier's instant `t0` (time scale 1;
+/// negative before it).
+fn mission_ms(t0: std::time::Instant) -> i64 {
+    let now = std::time::Instant::now();
+    match now.checked_duration_since(t0) {
+        Some(after) => after.as_millis() as i64,
+        None => -(t0.duration_since(now).as_millis() as i64),
+    }
+}
+
+/// Sleeps until mission time `at` (time scale 1) of a run whose mission
+/// time 0 is the instant `t0`.
+fn sleep_until(t0: std::time::Instant, at: i64) {
+    let when = t0 + std::time::Duration::from_millis(at as u64);
+    std::thread::sleep(when.saturating_duration_since(std::time::Instant::now()));
+}
+
+/// patrol_groups, every robot a process over a private broker: the modes
+/// the light levels call for, and the TurtleBots' leader killed and
+/// restarted: a new leader takes over, and after the restart the restarted
+/// robot listens and waits for the one that took over to give way: never
+/// two leaders at once (judged from the traces' mission times, on one
+/// clock: every process has the same `--start-at`).
+#[test]
+fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
+    let Some(mut fleet) = Fleet::start("mqtt-patrol-groups") else {
+        return;
+    };
+    let folders = support::mqtt::build(
+        &examples().join("swarm/patrol_groups.mission"),
+        &fleet.out,
+        &[],
+    );
+    // Dark from 1 s to 2.5 s: the TurtleBots warn the team, which hides.
+    let dark = r#"{"sensors": [{"at": 1000, "value": "LIGHTNESS", "is": "100"}, {"at": 2500, "value": "LIGHTNESS", "is": "600"}]}"#;
+    let scenario = fleet.out.join("patrol.scenario.json");
+    std::fs::write(
+        &scenario,
+        format!(
+            r#"{{"time_scale": 1, "duration": 8000, "robots": {{"tb_0": {dark}, "tb_1": {dark}, "tb_2": {dark}}}}}"#
+        ),
+    )
+    .unwrap();
+    const KILL_AT: i64 = 4000;
+    const RESTART_AT: i64 = 5500;
+    let (t0, start_at) = support::robots::start_barrier(folders.len());
+    let start_at = start_at.to_string();
+    let barrier = ["--start-at", start_at.as_str()];
+    let mut lives: Vec<Started> = folders
+        .iter()
+        .map(|f| fleet.spawn(f, &scenario, "first", &barrier))
+        .collect();
+    let first_tb_0 = lives.iter().position(|s| s.robot == "tb_0").unwrap();
+    sleep_until(t0, KILL_AT);
+    fleet.processes.kill(lives[first_tb_0].index);
+    let killed_at = mission_ms(t0);
+    sleep_until(t0, RESTART_AT);
+    let restarted_at = mission_ms(t0);
+    lives.push(fleet.spawn(&folder_of(&folders, "tb_0"), &scenario, "second", &barrier));
+    let traces: Vec<(String, Vec<Event>)> = lives
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let events = if i == first_tb_0 {
+                read_trace(&s.trace)
+            } else {
+                fleet.finish(s, "patrol_groups")
+            };
+            (s.robot.clone(), events)
+        })
+        .collect();
+    let of =
+        |robot: &str| -> &Vec<Event> { &traces.iter().rev().find(|(r, _)| r == robot).unwrap().1 };
+
+    for robot in ["tb_1", "tb_2"] {
+        assert_eq!(modes(of(robot)), ["PATROL", "HIDE", "PATROL"], "{robot}");
+    }
+    assert_eq!(modes(&traces[first_tb_0].1), ["PATROL", "HIDE", "PATROL"]);
+    assert_eq!(modes(of("tb_0")), ["PATROL"], "tb_0's second life");
+    assert_eq!(modes(of("base")), ["WATCH"]);
+    for robot in ["ev_0", "ev_1"] {
+        let m = modes(of(robot));
+        assert_eq!(m.first().map(String::as_str), Some("PATROL"), "{robot}");
+        assert_eq!(m.last().map(String::as_str), Some("PATROL"), "{robot}");
+    }
+
+    // tb_1 takes over: tb_0 is dead three heartbeats after the last one it
+    // sent, and the leader's statement decides once a pass (every second).
+    let last_heartbeat = traces[first_tb_0]
+        .1
+        .iter()
+        .filter(|e| field(e, "event") == "send" && field(e, "key") == "Guards.__alive")
+        .map(|e| e["t"].as_i64().unwrap())
+        .next_back()
+        .expect("tb_0 sent heartbeats");
+    let took_over = of("tb_1")
+        .iter()
+        .find(|e| field(e, "event") == "leader" && field(e, "leader") == "tb_1")
+        .map(|e| e["t"].as_i64().unwrap())
+        .expect("tb_1 takes over");
+    assert!(
+        took_over > killed_at - 50 && took_over <= last_heartbeat + 3 * 200 + 1000 + 100,
+        "tb_1 took over at {took_over}, tb_0's last heartbeat at {last_heartbeat}"
+    );
+    // After the restart tb_0 leads again, and the others follow it.
+    assert_eq!(leaders_of(of("tb_1")), ["tb_0", "tb_1", "tb_0"]);
+    assert_eq!(leaders_of(of("tb_2")), ["tb_0", "tb_1", "tb_0"]);
+    let second = leaders_of(of("tb_0"));
+    assert_eq!(
+        second.last().map(String::as_str),
+        Some("tb_0"),
+        "{second:?}"
+    );
+    let claimed = of("tb_0")
+        .iter()
+        .find(|e| field(e, "event") == "leader" && field(e, "leader") == "tb_0")
+        .map(|e| e["t"].as_i64().unwrap())
+        .unwrap();
+    assert!(
+        claimed >= restarted_at + 300,
+        "the restarted tb_0 listened before claiming: restarted at {restarted_at}, claimed at {claimed}"
+    );
+    let ends = BTreeMap::from([(first_tb_0, killed_at)]);
+    assert_eq!(two_leaders(&traces, &ends), None);
+}
+
+/// `highest_battery` (tests/fixtures/elections): the processes' heartbeats
+/// carry the battery levels the scenario gives them, and the fullest robot
+/// leads.
+#[test]
+fn highest_battery_over_mqtt_elects_the_fullest_robot() {
+    let Some(mut fleet) = Fleet::start("mqtt-highest-battery") else {
+        return;
+    };
+    let folders = support::mqtt::build(
+        &repo_root().join("tests/fixtures/elections/highest_battery/election.mission"),
+        &fleet.out,
+        &[],
+    );
+    let scenario = fleet.out.join("battery.scenario.json");
+    std::fs::write(
+        &scenario,
+        r#"{"time_scale": 1, "duration": 1500,
+            "robots": {"tb_0": {"battery": [{"at": 0, "level": 40}]},
+                       "tb_1": {"battery": [{"at": 0, "level": 90}]},
+                       "tb_2": {"battery": [{"at": 0, "level": 60}]}}}"#,
+    )
+    .unwrap();
+    let (_, start_at) = support::robots::start_barrier(folders.len());
+    let start_at = start_at.to_string();
+    let traces = fleet.run_all(&folders, &scenario, "battery", &["--start-at", &start_at]);
+    let lives: Vec<(String, Vec<Event>)> = traces.clone().into_iter().collect();
+    for (robot, events) in &traces {
+        assert_eq!(leaders_of(events), ["tb_1"], "{robot}");
+        // Everyone listened one and a half heartbeats (100 ms) first.
+        let first = events
+            .iter()
+            .find(|e| field(e, "event") == "leader")
+            .map(|e| e["t"].as_i64().unwrap())
+            .unwrap();
+        assert!(first >= 150, "{robot} decided at {first}");
+    }
+    let heard: Vec<String> = traces["tb_0"]
+        .iter()
+        .filter(|e| {
+            field(e, "event") == "receive"
+                && field(e, "from_robot") == "tb_1"
+                && field(e, "key") == "Crew.__alive"
+        })
+        .map(|e| field(e, "value").to_string())
+        .collect();
+    assert!(heard.iter().any(|v| v == "member 90"), "{heard:?}");
+    assert!(heard.iter().any(|v| v == "leader 90"), "{heard:?}");
+    assert_eq!(two_leaders(&lives, &BTreeMap::new()), None);
+}
+
+/// The warnings every MQTT robot is built with for the sanitizer runs:
+/// `-Wpedantic -Werror`, some optimisation (the sanitizers' own advice), and
+/// debug information for their reports.
+const SANITIZED: &str = "-std=c11 -Wall -Wextra -Wpedantic -Werror -O1 -g -fno-omit-frame-pointer";
+
+/// Scouting with the MQTT transport built with `cc` and `sanitizer` flags,
+/// its robots run over a private broker with `env`: each robot's mode
+/// sequence ends in FINISH and no robot writes anything on stderr (a
+/// sanitizer report, which also fails the robot: halt_on_error).
+fn scouting_over_mqtt_is_clean(name: &str, cc: &str, sanitizer: &str, env: &[(&str, &str)]) {
+    if !support::robots::has(cc) {
+        eprintln!("skipping {name}: no {cc}");
+        return;
+    }
+    let Some(mut fleet) = Fleet::start(name) else {
+        return;
+    };
+    let folders = support::mqtt::build_with(
+        &examples().join("scouting/scouting.mission"),
+        &fleet.out,
+        &[],
+        cc,
+        &format!("{SANITIZED} {sanitizer}"),
+    );
+    let started: Vec<Started> = folders
+        .iter()
+        .map(|folder| fleet.spawn_with(folder, &scenario(), name, &[], env))
+        .collect();
+    for run in &started {
+        let stderr = fleet
+            .processes
+            .wait_success(run.index, &format!("{} ({name})", run.robot));
+        assert!(
+            stderr.trim().is_empty(),
+            "{} ({name}): sanitizer report:\n{stderr}",
+            run.robot
+        );
+        let events = read_trace(&run.trace);
+        assert_eq!(
+            modes(&events).last().map(String::as_str),
+            Some("FINISH"),
+            "{} ({name})",
+            run.robot
+        );
+    }
+}
+
+#[test]
+fn scouting_over_mqtt_is_clean_under_address_and_undefined_behaviour_sanitizers() {
+    scouting_over_mqtt_is_clean(
+        "mqtt-asan",
+        "gcc",
+        "-fsanitize=address,undefined -fno-sanitize-recover=all",
+        &[
+            ("ASAN_OPTIONS", "detect_leaks=1:abort_on_error=1"),
+            ("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1"),
+        ],
+    );
+}
+
+#[test]
+fn scouting_over_mqtt_is_clean_under_thread_sanitizer() {
+    scouting_over_mqtt_is_clean(
+        "mqtt-tsan",
+        "clang",
+        "-fsanitize=thread",
+        &[("TSAN_OPTIONS", "halt_on_error=1")],
+    );
+}
+
+/// The MQTT transport's code at `-Wpedantic -Werror` with clang too (gcc
+/// builds every other test's robots).
+#[test]
+fn scouting_with_mqtt_compiles_pedantic_with_clang() {
+    if !support::robots::has("clang") {
+        eprintln!("skipping: no clang");
+        return;
+    }
+    if support::mqtt::broker_or_skip("scouting_with_mqtt_compiles_pedantic_with_clang").is_none() {
+        return;
+    }
+    let out = scratch("mqtt-clang");
+    let folders = support::mqtt::build_with(
+        &examples().join("scouting/scouting.mission"),
+        &out,
+        &[],
+        "clang",
+        PEDANTIC,
+    );
+    assert_eq!(folders.len(), 3);
 }

@@ -7,11 +7,13 @@
 //!
 //! The commands and their receivers come from the refined programs (each
 //! robot's incoming messages from `USER`); the topics and the datagram are
-//! the runtime's (`deploy::topics`, `semo_runtime.c`'s encode_message).
+//! the runtime's (`deploy::topics`; the status and the datagram read and
+//! written by `semo_server::live`, which the editor's monitor shares).
 
 use semo::codegen;
 use semo::deploy::topics;
 use semo::host;
+use semo_server::live::{DEFAULT_BROKER, Status, datagram_fields, mqtt_address, operator_datagram};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::{BufRead, Write};
 use std::path::PathBuf;
@@ -89,7 +91,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let url = match (&options.broker, &deployment) {
         (Some(url), _) => url.clone(),
         (None, Some(d)) => d.broker.url.clone(),
-        (None, None) => "mqtt://127.0.0.1:1883".to_string(),
+        (None, None) => DEFAULT_BROKER.to_string(),
     };
     let Some((host_name, port)) = mqtt_address(&url) else {
         eprintln!(
@@ -214,7 +216,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             status = 1;
             continue;
         };
-        let payload = datagram(&command.key, value.trim());
+        let payload = operator_datagram(&command.key, value.trim());
         for team in &command.teams {
             let topic = topics::to_team(&mission_topic, team, &command.key);
             if let Err(e) = client.publish(topic, rumqttc::QoS::AtLeastOnce, false, payload.clone())
@@ -231,44 +233,6 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     status
 }
 
-/// `mqtt://HOST[:PORT]`.
-fn mqtt_address(url: &str) -> Option<(String, u16)> {
-    let rest = url.strip_prefix("mqtt://")?;
-    match rest.rsplit_once(':') {
-        Some((host, port)) if !host.is_empty() => Some((host.to_string(), port.parse().ok()?)),
-        None if !rest.is_empty() => Some((rest.to_string(), 1883)),
-        _ => None,
-    }
-}
-
-/// A `send` from the operator as the runtime's datagram: "SEMO" 1, `s`,
-/// then team `USER`, robot `operator`, the key and the value, each a length
-/// byte and at most 255 bytes.
-fn datagram(key: &str, value: &str) -> Vec<u8> {
-    let mut out = b"SEMO\x01s".to_vec();
-    for field in ["USER", "operator", key, value] {
-        let bytes = &field.as_bytes()[..field.len().min(255)];
-        out.push(bytes.len() as u8);
-        out.extend_from_slice(bytes);
-    }
-    out
-}
-
-/// The fields of a runtime datagram: (team, robot, key, value).
-fn fields(data: &[u8]) -> Option<[String; 4]> {
-    if data.len() < 6 || &data[..5] != b"SEMO\x01" {
-        return None;
-    }
-    let mut at = 6;
-    let mut take = || {
-        let n = *data.get(at)? as usize;
-        let text = data.get(at + 1..at + 1 + n)?;
-        at += 1 + n;
-        Some(String::from_utf8_lossy(text).into_owned())
-    };
-    Some([take()?, take()?, take()?, take()?])
-}
-
 /// The line to print for a message: a robot's `send(USER, …)`, or its
 /// status when it changed.
 fn describe(topic: &str, payload: &[u8], printed: &mut BTreeMap<String, String>) -> Option<String> {
@@ -276,21 +240,20 @@ fn describe(topic: &str, payload: &[u8], printed: &mut BTreeMap<String, String>)
     let last = levels.next()?;
     match levels.next()? {
         "USER" => {
-            let [_, robot, key, value] = fields(payload)?;
+            let [_, robot, key, value] = datagram_fields(payload)?;
             Some(format!("{robot}: send(USER, {key}) = {value}"))
         }
         "status" => {
-            let status: serde_json::Value = serde_json::from_slice(payload).ok()?;
-            let text = |k: &str| status[k].as_str().unwrap_or("").to_string();
+            let status = Status::decode(last, payload)?;
             let line = format!(
                 "status {last}: {} {}{}{}",
-                text("state"),
-                text("mode"),
-                match text("services").as_str() {
+                status.state,
+                status.mode,
+                match status.services_text().as_str() {
                     "" => String::new(),
                     s => format!(" [{s}]"),
                 },
-                match text("leader").as_str() {
+                match status.leader.as_str() {
                     "" => String::new(),
                     l => format!(" leader {l}"),
                 }
@@ -301,24 +264,5 @@ fn describe(topic: &str, payload: &[u8], printed: &mut BTreeMap<String, String>)
             })
         }
         _ => None,
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn a_command_is_the_runtimes_datagram_and_reads_back() {
-        let d = super::datagram("USER.RC_CMD", "RETURN_MODE");
-        assert_eq!(
-            super::fields(&d),
-            Some([
-                "USER".into(),
-                "operator".into(),
-                "USER.RC_CMD".into(),
-                "RETURN_MODE".into()
-            ])
-        );
-        assert_eq!(super::mqtt_address("mqtt://h:99"), Some(("h".into(), 99)));
-        assert_eq!(super::mqtt_address("mqtts://h"), None);
     }
 }

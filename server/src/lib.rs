@@ -8,6 +8,8 @@
 //! - [`to_proto`]: the library's editor vocabulary in protocol types.
 //! - [`encoding`], [`document`]: positions and incremental edits at the door.
 //! - [`transport`]: a guard that keeps malformed frames away from tower-lsp.
+//! - [`live`]: a running mission's status and datagrams on its broker (shared
+//!   with `semo operator`); [`monitor`]: the live robot monitor's sessions.
 //! - [`harness`]: an in-memory client, for tests and benchmarks.
 
 pub mod diagnostics;
@@ -15,6 +17,8 @@ pub mod document;
 pub mod encoding;
 pub mod handlers;
 pub mod harness;
+pub mod live;
+pub mod monitor;
 pub mod server;
 pub mod to_proto;
 pub mod transport;
@@ -51,6 +55,8 @@ where
         .custom_method("semo/catalog", server::Backend::catalog)
         .custom_method("semo/graphSvg", server::Backend::graph_svg)
         .custom_method("semo/viewFileText", server::Backend::view_file_text)
+        .custom_method(handlers::monitor::START, server::Backend::monitor_start)
+        .custom_method(handlers::monitor::STOP, server::Backend::monitor_stop)
         .finish();
     Server::new(input, output, socket).serve(service).await;
 }

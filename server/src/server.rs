@@ -23,6 +23,8 @@ pub struct Backend {
     snippets: AtomicBool,
     /// Whether the client shows `$/progress` (`window.workDoneProgress`).
     progress: AtomicBool,
+    /// The live robot monitors, one per mission document.
+    monitors: crate::monitor::Monitors,
 }
 
 impl Backend {
@@ -36,6 +38,7 @@ impl Backend {
             can_watch: Default::default(),
             snippets: AtomicBool::new(false),
             progress: AtomicBool::new(false),
+            monitors: Default::default(),
         }
     }
 
@@ -118,6 +121,43 @@ impl Backend {
             handlers::graph_svg::graph_svg(s, team.as_deref())
         })
         .await?
+    }
+
+    /// `semo/monitor/start`: the mission's robots and broker; then the
+    /// session's `semo/monitor` notifications (`handlers/monitor.rs`).
+    pub async fn monitor_start(
+        &self,
+        params: handlers::monitor::StartParams,
+    ) -> Result<serde_json::Value> {
+        use handlers::monitor;
+        let job = monitor::job(&self.state.world(), params).map_err(handlers::request_failed)?;
+        let plan = tokio::task::spawn_blocking(move || monitor::plan(&job))
+            .await
+            .map_err(|_| Error::internal_error())?
+            .map_err(handlers::request_failed)?;
+        let answer = monitor::started(&plan);
+        let (notify, mut notifications) = tokio::sync::mpsc::unbounded_channel();
+        let client = self.client.clone();
+        tokio::spawn(async move {
+            while let Some(params) = notifications.recv().await {
+                client
+                    .send_notification::<monitor::MonitorNotification>(params)
+                    .await;
+            }
+        });
+        self.monitors
+            .start(plan, notify)
+            .map_err(|e| handlers::request_failed(format!("cannot start the monitor: {e}")))?;
+        Ok(answer)
+    }
+
+    /// `semo/monitor/stop`: ends the mission's monitor; whether one ran.
+    pub async fn monitor_stop(
+        &self,
+        params: handlers::monitor::StopParams,
+    ) -> Result<serde_json::Value> {
+        let stopped = self.monitors.stop(params.uri.as_str());
+        Ok(serde_json::json!({ "stopped": stopped }))
     }
 
     /// `semo/viewFileText`: the server's text of a document, to debug
@@ -380,6 +420,7 @@ impl LanguageServer for Backend {
     }
 
     async fn shutdown(&self) -> Result<()> {
+        self.monitors.stop_all();
         Ok(())
     }
 
@@ -410,6 +451,7 @@ impl LanguageServer for Backend {
     }
 
     async fn did_close(&self, p: DidCloseTextDocumentParams) {
+        self.monitors.stop(p.text_document.uri.as_str());
         let changed = self.state.world().close(&p.text_document.uri);
         self.state.queue.push(changed.files);
     }

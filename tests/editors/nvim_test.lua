@@ -170,7 +170,23 @@ local function run()
   local failed = vim.diagnostic.get(scenario)[1]
   report(string.format('scenario diagnostic: %d:%d %s', failed.lnum + 1, failed.col + 1, failed.message))
 
-  -- 7. The scenario file (filetype json) gets the server, and completion of an expectation's
+  -- 7. `:SemoMonitor`'s function on the mission with a broker nobody listens on: every robot
+  -- waiting, the connection shown down; stopping it answers that it ran.
+  check(vim.fn.exists(':SemoMonitor') == 2, 'no :SemoMonitor command')
+  local seen, started
+  semo.monitor(mission, 'mqtt://127.0.0.1:1', function(view)
+    if view.connection == 'disconnected' then seen = view end
+  end, function(err, answer) started = { err = err, answer = answer } end)
+  check(vim.wait(30000, function() return started ~= nil and seen ~= nil end, 50),
+    'no disconnected monitor view within 30 s: ' .. vim.inspect(started))
+  check(started.err == nil, 'the monitor was refused: ' .. tostring(started.err))
+  report('monitor: ' .. vim.split(semo.monitor_table(seen), '\n')[2])
+  local stopped
+  semo.monitor_stop(mission, function(err, answer) stopped = { err = err, answer = answer } end)
+  check(vim.wait(10000, function() return stopped ~= nil end, 50), 'no answer to semo/monitor/stop')
+  check(stopped.answer and stopped.answer.stopped == true, 'the monitor did not run: ' .. vim.inspect(stopped))
+
+  -- 8. The scenario file (filetype json) gets the server, and completion of an expectation's
   -- mode offers the modes of its mission (drive.scenario.json belongs to drive.mission).
   vim.cmd('edit ' .. vim.fn.fnameescape(workspace .. '/drive.scenario.json'))
   local sbuf = vim.api.nvim_get_current_buf()

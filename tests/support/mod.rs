@@ -3,6 +3,7 @@
 
 pub mod cc;
 pub mod missiongen;
+pub mod mqtt;
 pub mod robots;
 
 use std::path::{Path, PathBuf};

@@ -1,9 +1,10 @@
-// The SeMo extension: the `semo lsp` client, the Robots panel, and the
-// palette's commands. Each part lives in its own module.
+// The SeMo extension: the `semo lsp` client, the Robots panel, the Robots
+// (live) view, and the palette's commands. Each part lives in its own module.
 
 import * as vscode from 'vscode';
 import { checkWorkspace, generateCode, newMission } from './commands';
 import { GraphViews } from './graphView';
+import { LiveRobotsView } from './liveRobotsView';
 import { insertNode, RobotsView } from './robotsView';
 import { Server } from './server';
 import { SimulationViews } from './simulateView';
@@ -16,9 +17,11 @@ export async function activate(context: vscode.ExtensionContext): Promise<void> 
   const robots = new RobotsView(server);
   const graphs = new GraphViews(server);
   const simulations = new SimulationViews(server);
+  const live = new LiveRobotsView(server);
   const s = server;
   const robotsTree = vscode.window.createTreeView('semo.robots', { treeDataProvider: robots });
   robots.attach(robotsTree);
+  const liveTree = vscode.window.createTreeView('semo.live', { treeDataProvider: live });
   context.subscriptions.push(
     output,
     server,
@@ -26,6 +29,8 @@ export async function activate(context: vscode.ExtensionContext): Promise<void> 
     graphs,
     simulations,
     robotsTree,
+    live,
+    liveTree,
     vscode.commands.registerCommand('semo.restartServer', () => s.restart()),
     vscode.commands.registerCommand('semo.showOutput', () => output.show()),
     vscode.commands.registerCommand('semo.newMission', newMission),
@@ -36,6 +41,8 @@ export async function activate(context: vscode.ExtensionContext): Promise<void> 
     vscode.commands.registerCommand('semo.simulateMission', () => simulations.simulate()),
     vscode.commands.registerCommand('semo.robots.refresh', () => robots.refresh()),
     vscode.commands.registerCommand('semo.robots.insert', insertNode),
+    vscode.commands.registerCommand('semo.monitorRobots', () => live.start()),
+    vscode.commands.registerCommand('semo.stopMonitoring', () => live.stop()),
     vscode.workspace.onDidChangeConfiguration((e) => {
       if (e.affectsConfiguration('semo.server')) {
         void vscode.window

@@ -8,7 +8,9 @@
 
 use super::c;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
-use crate::refine::{ActionMachine, Expr, Operand, RobotProgram, SlotSource, State, StateKind};
+use crate::refine::{
+    ActionMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, SlotSource, State, StateKind,
+};
 use crate::sema::Compared;
 use crate::syntax::ast::CmpOp;
 use std::fmt::Write;
@@ -17,11 +19,38 @@ use std::fmt::Write;
 /// states never wait (only sends and branches) still yields to the others.
 const STEPS_PER_FIRING: usize = 64;
 
+/// How long a robot that must first hear its team (a restarted robot, or
+/// every robot of a `highest_battery` election at start) listens before an
+/// election: one heartbeat period and half of one more, so that the
+/// heartbeat each robot sends once per period has arrived even when its
+/// sender's firing was a little late. The simulator uses the same.
+pub fn listen_ms(heartbeat_ms: i64) -> i64 {
+    heartbeat_ms + heartbeat_ms / 2
+}
+
+/// Leader elections (`@HB@`: the heartbeat period, `@LISTEN@`: [`listen_ms`]).
+/// `leading` is what this robot's heartbeats say: whether the last election
+/// it decided named it. A robot that joined a mission under way (restarted:
+/// its mission time was past one heartbeat period when it started, or the
+/// MQTT broker still held its session) listens first, and while another
+/// live robot claims leadership it follows that robot instead of claiming:
+/// the claimant gives way at its own next election, so that two robots never
+/// both lead after a restart.
+const ELECTION_C: &str = "/* Leader elections: each `leader(...)` arm's candidates (peer indices, in\n * formation order) and algorithm. A candidate is alive when it is this\n * robot or was heard from within three heartbeats. lowest_id: the first\n * alive; bully: the last alive (the highest id); highest_battery: the\n * highest battery level its heartbeat said (unknown counts lowest; ties: the\n * first), after every robot has listened at start. A robot that joined the\n * mission under way (restarted) listens too, and while another live robot\n * claims leadership it follows that one instead of claiming. A change of\n * leader is traced. Returns 1 (this robot leads), 0, or -1 while listening. */\nenum { ELECT_LOWEST_ID, ELECT_HIGHEST_BATTERY, ELECT_BULLY };\nstatic int elected(const size_t *candidates, size_t n, int algorithm, long *last)\n{\n    static int rejoining = -1;\n    const semo_program_desc *p = semo_program();\n    int64_t now = semo_now_ms();\n    if (rejoining < 0)\n        rejoining = semo_joined_ms() > @HB@ || semo_session_resumed();\n    if ((rejoining || algorithm == ELECT_HIGHEST_BATTERY) && now - semo_joined_ms() < @LISTEN@) {\n        wake_at(semo_joined_ms() + @LISTEN@);\n        return -1;\n    }\n    size_t leader = p->self;\n    bool found = false;\n    long best = -1;\n    for (size_t k = 0; k < n; k++) {\n        size_t c = candidates[algorithm == ELECT_BULLY ? n - 1 - k : k];\n        comm_heartbeat h = comm_heard(c);\n        if (c != p->self && now - h.seen > 3 * @HB@)\n            continue;\n        long level = c == p->self ? own_battery() : h.battery;\n        if (!found || (algorithm == ELECT_HIGHEST_BATTERY && level > best)) {\n            leader = c;\n            best = level;\n            found = true;\n        }\n        if (algorithm != ELECT_HIGHEST_BATTERY)\n            break;\n    }\n    if (rejoining && leader == p->self) {\n        for (size_t i = 0; i < p->peer_count; i++) {\n            comm_heartbeat h = comm_heard(i);\n            if (i != p->self && h.leads && now - h.seen <= 3 * @HB@) {\n                leader = i;\n                break;\n            }\n        }\n        if (leader == p->self)\n            rejoining = 0;\n    }\n    leading = leader == p->self;\n    if ((long)leader != *last) {\n        *last = (long)leader;\n        semo_trace(\"leader\", \"leader\", p->peers[leader].robot, NULL);\n    }\n    return leading;\n}\n";
+
+/// This robot's battery level for its heartbeats: the scenario's (in
+/// simulation), else unknown (-1).
+const OWN_BATTERY_C: &str = "/* Whether the last election this robot decided named it (its heartbeats say so). */\nstatic bool leading;\n\n/* This robot's battery level for its heartbeats: the scenario's in\n * simulation, else unknown (-1). */\nstatic long own_battery(void)\n{\n#ifdef SEMO_SIM\n    long long level;\n    if (semo_sim_battery(&level))\n        return (long)level;\n#endif\n    return -1;\n}\n\n";
+
 pub fn control_task(program: &RobotProgram, header: &str) -> String {
     let m = &program.control;
     let mut out = String::new();
     out.push_str(header);
-    out.push_str("#include \"program.h\"\n#include <string.h>\n\n");
+    out.push_str("#include \"program.h\"\n");
+    if m.heartbeat {
+        out.push_str("#include <stdio.h>\n");
+    }
+    out.push_str("#include <string.h>\n\n");
     let _ = writeln!(
         out,
         "/* The hierarchical state machine of robot {} (team {}): modes, then one\n * region per plan running its composite service, then strategy actions. */\n",
@@ -241,12 +270,16 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
         out.push_str("    default:\n        break;\n    }\n}\n\n");
     }
 
+    if m.heartbeat {
+        out.push_str(OWN_BATTERY_C);
+    }
     if uses("elected") {
-        let _ = writeln!(
-            out,
-            "/* Leader election: the first candidate (in formation order) that is this\n * robot or was heard from within three heartbeats leads. A change of leader\n * (a failed leader replaced) is traced. */\nstatic bool elected(const size_t *candidates, size_t n, long *last)\n{{\n    const semo_program_desc *p = semo_program();\n    size_t leader = p->self;\n    for (size_t i = 0; i < n; i++) {{\n        size_t c = candidates[i];\n        if (c == p->self || semo_now_ms() - comm_last_seen(c) <= 3 * {hb}) {{\n            leader = c;\n            break;\n        }}\n    }}\n    if ((long)leader != *last) {{\n        *last = (long)leader;\n        semo_trace(\"leader\", \"leader\", p->peers[leader].robot, NULL);\n    }}\n    return leader == p->self;\n}}\n",
-            hb = crate::refine::HEARTBEAT_MS
+        out.push_str(
+            &ELECTION_C
+                .replace("@HB@", &m.heartbeat_ms.to_string())
+                .replace("@LISTEN@", &listen_ms(m.heartbeat_ms).to_string()),
         );
+        out.push('\n');
     }
 
     if uses("request") {
@@ -426,12 +459,18 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
         }
         StateKind::LeaderBranch {
             candidates,
+            algorithm,
             others_at,
         } => {
             let list: Vec<String> = candidates.iter().map(|c| c.to_string()).collect();
+            let algorithm = match algorithm {
+                LeaderAlgorithm::LowestId => "ELECT_LOWEST_ID",
+                LeaderAlgorithm::HighestBattery => "ELECT_HIGHEST_BATTERY",
+                LeaderAlgorithm::Bully => "ELECT_BULLY",
+            };
             let _ = writeln!(
                 out,
-                "    {{\n        static const size_t candidates[] = {{{}}};\n        static long leader = -1; /* the last leader seen (control thread only) */\n        r->pc = elected(candidates, {}, &leader) ? {next} : {others_at};\n        return STEP_NEXT;\n    }}",
+                "    {{\n        static const size_t candidates[] = {{{}}};\n        static long leader = -1; /* the last leader seen (control thread only) */\n        int chosen = elected(candidates, {}, {algorithm}, &leader);\n        if (chosen < 0)\n            return STEP_WAIT; /* still listening */\n        r->pc = chosen ? {next} : {others_at};\n        return STEP_NEXT;\n    }}",
                 list.join(", "),
                 candidates.len()
             );
@@ -690,9 +729,8 @@ fn emit_task(out: &mut String, program: &RobotProgram) {
         // Tell the team this robot is alive, for leader elections.
         let _ = writeln!(
             out,
-            "    static int64_t last_heartbeat = -{hb};\n    if (semo_now_ms() - last_heartbeat >= {hb}) {{\n        semo_value alive;\n        last_heartbeat = semo_now_ms();\n        semo_value_set(&alive, {robot});\n        semo_comm_send({team}, SEMO_MSG_PUBLISH, {key}, &alive);\n    }}\n    wake_at(last_heartbeat + {hb});",
-            hb = crate::refine::HEARTBEAT_MS,
-            robot = c::string(&program.robot),
+            "    static int64_t last_heartbeat = -{hb};\n    if (semo_now_ms() - last_heartbeat >= {hb}) {{\n        semo_value alive;\n        char text[32];\n        long battery = own_battery();\n        last_heartbeat = semo_now_ms();\n        if (battery < 0)\n            snprintf(text, sizeof text, \"%s -\", leading ? \"leader\" : \"member\");\n        else\n            snprintf(text, sizeof text, \"%s %ld\", leading ? \"leader\" : \"member\", battery);\n        semo_value_set(&alive, text);\n        semo_comm_send({team}, SEMO_MSG_PUBLISH, {key}, &alive);\n    }}\n    wake_at(last_heartbeat + {hb});",
+            hb = m.heartbeat_ms,
             team = c::string(&program.team),
             key = c::string(&super::files::alive_key(program)),
         );

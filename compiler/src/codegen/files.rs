@@ -47,7 +47,7 @@ pub fn program_h(program: &RobotProgram, header: &str) -> String {
         );
     }
     if program.control.heartbeat {
-        out.push_str("\n/* When each robot was last heard from (mission ms; comm_task.c). */\nint64_t comm_last_seen(size_t peer);\n");
+        out.push_str("\n/* What the last heartbeat of a robot said (comm_task.c): when it came\n * (mission ms), whether the robot claimed leadership, its battery level\n * (-1: unknown). */\ntypedef struct {\n    int64_t seen;\n    bool leads;\n    long battery;\n} comm_heartbeat;\ncomm_heartbeat comm_heard(size_t peer);\n");
     }
     if let Some(lib) = &program.library {
         let _ = writeln!(
@@ -230,8 +230,13 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
     let (include, declare, lock_seen, unlock_seen) = lock(target, "seen_lock");
     let _ = write!(
         out,
-        "#include \"program.h\"\n{}#include <string.h>\n\n",
-        if m.heartbeat { include } else { "" }
+        "#include \"program.h\"\n{}{}#include <string.h>\n\n",
+        if m.heartbeat { include } else { "" },
+        if m.heartbeat {
+            "#include <stdlib.h>\n"
+        } else {
+            ""
+        }
     );
     if !m.outgoing.is_empty() {
         out.push_str("/* CommSend: every value the control task sends goes to the robots of its\n * team (through the transport). */\nstatic const struct {\n    const char *port;\n    const char *to_team;\n    semo_msg_kind kind;\n    const char *key;\n} outgoing[] = {\n");
@@ -260,7 +265,7 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
     if m.heartbeat {
         let _ = writeln!(
             out,
-            "/* Heartbeats of the team's robots, for leader elections: when each robot\n * was last heard from. Every robot counts as alive at start. */\n{declare}static int64_t seen[{peers}];\n\nint64_t comm_last_seen(size_t peer)\n{{\n    int64_t t = 0;\n    {lock_seen}\n    if (peer < {peers})\n        t = seen[peer];\n    {unlock_seen}\n    return t;\n}}\n\nstatic bool heard_alive(const semo_message *m)\n{{\n    if (m->kind != SEMO_MSG_PUBLISH || strcmp(m->key, {key}) != 0)\n        return false;\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        if (strcmp(p->peers[i].robot, m->from_robot) == 0) {{\n            {lock_seen}\n            seen[i] = semo_now_ms();\n            {unlock_seen}\n        }}\n    return true;\n}}\n",
+            "/* Heartbeats of the team's robots, for leader elections: when each robot\n * was last heard from, and what it said (`leader 87`: it claims\n * leadership, battery 87; `member -`: it does not, battery unknown). Every\n * robot counts as alive at start. */\n{declare}static comm_heartbeat heard[{peers}];\n\ncomm_heartbeat comm_heard(size_t peer)\n{{\n    comm_heartbeat h = {{0, false, -1}};\n    {lock_seen}\n    if (peer < {peers})\n        h = heard[peer];\n    {unlock_seen}\n    return h;\n}}\n\nstatic bool heard_alive(const semo_message *m)\n{{\n    if (m->kind != SEMO_MSG_PUBLISH || strcmp(m->key, {key}) != 0)\n        return false;\n    const char *battery = strchr(m->value.text, ' ');\n    comm_heartbeat h = {{semo_now_ms(), strncmp(m->value.text, \"leader \", 7) == 0, -1}};\n    if (battery && battery[1] >= '0' && battery[1] <= '9')\n        h.battery = strtol(battery + 1, NULL, 10);\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        if (strcmp(p->peers[i].robot, m->from_robot) == 0) {{\n            {lock_seen}\n            heard[i] = h;\n            {unlock_seen}\n        }}\n    return true;\n}}\n",
             peers = program.peers.len().max(1),
             key = c::string(&alive_key(program))
         );
@@ -290,6 +295,13 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         }
         let recv = c::ident(COMM_RECEIVE);
         let _ = writeln!(out, "void task_{recv}_init(void)\n{{");
+        if m.heartbeat {
+            let _ = writeln!(
+                out,
+                "    for (size_t i = 0; i < {}; i++)\n        heard[i].battery = -1;",
+                program.peers.len().max(1)
+            );
+        }
         if n > 0 {
             let _ = writeln!(
                 out,

@@ -19,6 +19,7 @@
 mod battery;
 mod c;
 mod control;
+pub use control::listen_ms;
 pub(crate) mod files;
 mod loops;
 pub mod output;

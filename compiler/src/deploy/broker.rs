@@ -86,10 +86,7 @@ pub fn files(
             }
         }
         if program.control.heartbeat {
-            let key = crate::codegen::files::alive_key(program);
-            rights
-                .write
-                .insert(topics::to_team(&mission, &program.team, &key));
+            rights.write.insert(topics::heartbeats(program));
         }
         rights
             .write
@@ -139,6 +136,10 @@ pub fn files(
         rights
             .read
             .insert(format!("semo/{}/USER/+", topics::level(&mission)));
+        // The editor's robot monitor tells a robot that stops heart-beating.
+        for program in programs.iter().filter(|p| p.control.heartbeat) {
+            rights.read.insert(topics::heartbeats(program));
+        }
     }
     if !found.is_empty() {
         return Err(found);

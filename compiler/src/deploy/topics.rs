@@ -45,6 +45,17 @@ pub fn status(mission: &str, robot: &str) -> String {
     format!("semo/{}/status/{}", level(mission), level(robot))
 }
 
+/// `semo/<mission>/<team>/<team>.__alive`: where the robots of `program`'s
+/// team publish their heartbeats for leader elections (when
+/// `program.control.heartbeat`).
+pub fn heartbeats(program: &crate::refine::RobotProgram) -> String {
+    to_team(
+        &mission(&program.mission),
+        &program.team,
+        &crate::codegen::files::alive_key(program),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     #[test]

@@ -91,8 +91,13 @@ pub struct ControlMachine {
     /// Latest-value groups the control task reads (`subscribe`).
     pub subscribed: Vec<String>,
     /// Whether the robot takes part in a leader election: it then tells its
-    /// team it is alive every [`HEARTBEAT_MS`] and listens for theirs.
+    /// team it is alive every `heartbeat_ms` and listens for theirs.
     pub heartbeat: bool,
+    /// The heartbeat period (mission ms): the strategy's
+    /// `LeaderSelectionInfo heartbeatPeriod` (the shortest of those that
+    /// apply to the robot's elections), else [`HEARTBEAT_MS`]; 0 without
+    /// `heartbeat`.
+    pub heartbeat_ms: i64,
     /// Adaptive resource management: the team strategy's battery policies,
     /// checked at every firing against the robot's `BATTERY` value.
     pub battery: Vec<BatteryPolicy>,
@@ -174,8 +179,14 @@ pub struct BatteryPolicy {
 }
 
 /// How often a robot that can be elected leader tells its team it is alive
-/// (mission ms); a robot not heard from for three periods counts as failed.
+/// (mission ms) when its strategy names no `heartbeatPeriod`; a robot not
+/// heard from for three periods counts as failed.
 pub const HEARTBEAT_MS: i64 = 200;
+
+/// How a leader is chosen among the live candidates of a `leader(...)` arm:
+/// the strategy's `LeaderSelectionInfo algorithm`, else
+/// [`LeaderAlgorithm::LowestId`] (the first in formation order).
+pub use crate::strategy::LeaderAlgorithm;
 
 #[derive(Clone, Debug)]
 pub struct ModeState {
@@ -265,10 +276,12 @@ pub enum StateKind {
         mark: usize,
     },
     /// `leader(cond)` for a robot that meets `cond`: continue (run the
-    /// leader's block) if this robot is the first of `candidates` (peer
-    /// indices, in formation order) that is alive, else go to `others_at`.
+    /// leader's block) if `algorithm` chooses this robot among the live
+    /// `candidates` (peer indices, in formation order), else go to
+    /// `others_at`.
     LeaderBranch {
         candidates: Vec<usize>,
+        algorithm: LeaderAlgorithm,
         others_at: usize,
     },
     /// Continue at `else_to` unless the condition holds.

@@ -49,6 +49,7 @@ pub(super) fn refine_robot(
         services: BTreeMap::new(),
         service_machines: HashMap::new(),
         action_machines: HashMap::new(),
+        current_service: None,
         diagnostics: Vec::new(),
     };
     builder.build_modes();
@@ -150,6 +151,9 @@ struct Builder<'a, 'i> {
     service_machines: HashMap<u32, usize>,
     /// (strategy file, entry index) → action machine index.
     action_machines: HashMap<(u32, usize), usize>,
+    /// The team service whose machine is being built (for the strategy's
+    /// leader selection scoped to a composite service).
+    current_service: Option<u32>,
     diagnostics: Vec<Diagnostic>,
 }
 
@@ -261,6 +265,7 @@ impl Builder<'_, '_> {
         });
         let mut states = Vec::new();
         let mut marks = 0;
+        let outer = self.current_service.replace(service);
         if let Some(syntax) = self.input.analysis.service_syntax(info) {
             self.block(&syntax.body, &mut states, &mut marks, 0);
             let (period_ms, condition, forever, span, period_span) = match &syntax.repeat {
@@ -290,10 +295,47 @@ impl Builder<'_, '_> {
                 text,
             });
         }
+        self.current_service = outer;
         let m = &mut self.machine.services[index];
         m.states = states;
         m.marks = marks;
         index
+    }
+
+    /// The strategy's leader selection for an election in the service being
+    /// built: the team's `LeaderSelectionInfo` when it names no composite
+    /// service or names this one; its algorithm (default lowest id) and its
+    /// heartbeat period (mission ms, if given).
+    fn leader_selection(&self) -> (LeaderAlgorithm, Option<i64>) {
+        let service = self
+            .current_service
+            .map(|s| &self.team.services[s as usize]);
+        let applies = |l: &crate::strategy::LeaderSelection| match (&l.plan, &l.service, service) {
+            (Some(plan), Some(cs), Some(s)) => {
+                cs.name == s.name.as_str()
+                    && plan.name == self.team.plans[s.plan as usize].name.as_str()
+            }
+            (Some(_), Some(_), None) => false,
+            _ => true,
+        };
+        let selection = self
+            .input
+            .strategies
+            .iter()
+            .filter(|s| {
+                s.team
+                    .as_ref()
+                    .is_some_and(|t| t.name == self.team.name.as_str())
+            })
+            .filter_map(|s| s.grouping.as_ref()?.leader_selection.as_ref())
+            .find(|l| applies(l));
+        match selection {
+            Some(l) => (
+                l.algorithm.unwrap_or(LeaderAlgorithm::LowestId),
+                l.heartbeat.map(|d| (d.millis.round() as i64).max(1)),
+            ),
+            None => (LeaderAlgorithm::LowestId, None),
+        }
     }
 
     fn block(
@@ -389,11 +431,19 @@ impl Builder<'_, '_> {
                         // the first one alive leads.
                         let first_peer = self.first_peer();
                         let candidates = candidates.iter().map(|i| first_peer + i).collect();
+                        let (algorithm, heartbeat_ms) = self.leader_selection();
+                        let heartbeat_ms = heartbeat_ms.unwrap_or(HEARTBEAT_MS);
+                        // One heartbeat serves every election of the robot:
+                        // the shortest period any of them asks for.
+                        if !self.machine.heartbeat || heartbeat_ms < self.machine.heartbeat_ms {
+                            self.machine.heartbeat_ms = heartbeat_ms;
+                        }
                         self.machine.heartbeat = true;
                         let branch = self.push(
                             states,
                             StateKind::LeaderBranch {
                                 candidates,
+                                algorithm,
                                 others_at: usize::MAX,
                             },
                             stmt.span,

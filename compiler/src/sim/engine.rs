@@ -14,7 +14,7 @@
 //!   scenario's duration → [`Sim::request`] and a `ServiceDone` event;
 //! - `semo_comm_send` → [`Sim::comm_send`] (the network: latency, loss and
 //!   link faults), the receive task's routing → [`Sim::deliver`];
-//! - `comm_last_seen` and `elected` → `last_seen` and [`Sim::elected`];
+//! - `comm_heard` and `elected` → `heard` and [`Sim::elected`];
 //! - the library task's values → `Robot::library`.
 //!
 //! Idle firings are skipped: a firing that traced nothing and changed no
@@ -30,8 +30,8 @@ use super::scenario::{Command, DEFAULT_SERVICE_MS, FaultKind, Scenario};
 use super::trace::TraceEvent;
 use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::{
-    ActionMachine, ControlMachine, Expr, HEARTBEAT_MS, Operand, RobotProgram, RoleKind, SlotSource,
-    StateKind,
+    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, RoleKind,
+    SlotSource, StateKind,
 };
 use crate::sema::Compared;
 use crate::syntax::ast::CmpOp;
@@ -202,7 +202,14 @@ struct Robot<'p> {
     current_mode: Option<usize>,
     pending_mode: Option<usize>,
     last_heartbeat: i64,
-    last_seen: Vec<i64>,
+    /// Per peer: what its last heartbeat said (`comm_heard`).
+    heard: Vec<Heard>,
+    /// Whether the last election this robot decided named it (what its
+    /// heartbeats say).
+    leading: bool,
+    /// Joined the mission under way (restarted after one heartbeat period):
+    /// listens first, and follows a live claimant instead of claiming.
+    rejoining: bool,
     /// The last leader each `LeaderBranch` state saw, by (service, pc).
     leaders: HashMap<(usize, usize), usize>,
     /// Service tasks by name (the `request_tasks` and those of action commands).
@@ -352,8 +359,19 @@ impl<'p> Robot<'p> {
             ],
             current_mode: None,
             pending_mode: None,
-            last_heartbeat: at - HEARTBEAT_MS,
-            last_seen: vec![at; program.peers.len()],
+            last_heartbeat: at - m.heartbeat_ms,
+            // As the C's static table: heard at mission time 0, claiming
+            // nothing, battery unknown.
+            heard: vec![
+                Heard {
+                    seen: 0,
+                    leads: false,
+                    battery: None,
+                };
+                program.peers.len()
+            ],
+            leading: false,
+            rejoining: m.heartbeat && at > m.heartbeat_ms,
             leaders: HashMap::new(),
             tasks,
             has_receiver: !m.incoming.is_empty() || !m.subscribed.is_empty() || m.heartbeat,
@@ -861,9 +879,10 @@ impl<'p> Sim<'p> {
         let robot = &mut self.robots[r];
         let m = &robot.program.control;
         if m.heartbeat && message.publish && message.key == self.names[r].alive_key {
+            let heard = Heard::parse(self.now, &message.value);
             for (i, (_, name)) in robot.program.peers.iter().enumerate() {
                 if **name == *message.from_robot {
-                    robot.last_seen[i] = self.now;
+                    robot.heard[i] = heard;
                 }
             }
             return;
@@ -1051,14 +1070,12 @@ impl<'p> Sim<'p> {
         let m = &program.control;
         self.read_inputs(r);
         self.manage_resources(r);
-        if m.heartbeat && self.now - self.robots[r].last_heartbeat >= HEARTBEAT_MS {
+        if m.heartbeat && self.now - self.robots[r].last_heartbeat >= m.heartbeat_ms {
             self.robots[r].last_heartbeat = self.now;
+            let robot = &self.robots[r];
+            let value = heartbeat_value(robot.leading, own_battery(robot, self.now));
             let names = &self.names[r];
-            let (team, key, value) = (
-                names.team.clone(),
-                names.alive_key.clone(),
-                names.heartbeat.clone(),
-            );
+            let (team, key, value) = (names.team.clone(), names.alive_key.clone(), value.into());
             self.comm_send(r, team, true, key, value);
         }
         if self.robots[r].current_mode.is_none() {
@@ -1171,7 +1188,7 @@ impl<'p> Sim<'p> {
         let mut at: Option<i64> = None;
         let mut at_least = |t: i64| at = Some(at.map_or(t, |a| a.min(t)));
         if m.heartbeat {
-            at_least(robot.last_heartbeat + HEARTBEAT_MS);
+            at_least(robot.last_heartbeat + m.heartbeat_ms);
         }
         for region in &robot.regions {
             let Some(service) = region.service.filter(|_| !region.done) else {
@@ -1395,12 +1412,15 @@ impl<'p> Sim<'p> {
             }
             StateKind::LeaderBranch {
                 candidates,
+                algorithm,
                 others_at,
-            } => {
-                let elected = self.elected(r, (service, pc), candidates);
-                self.region(r, i).pc = if elected { next } else { *others_at };
-                Step::Next
-            }
+            } => match self.elected(r, (service, pc), candidates, *algorithm) {
+                None => Step::Wait, // still listening
+                Some(elected) => {
+                    self.region(r, i).pc = if elected { next } else { *others_at };
+                    Step::Next
+                }
+            },
             StateKind::Branch { condition, else_to } => {
                 let holds = self.eval(r, condition);
                 self.region(r, i).pc = if holds { next } else { *else_to };
@@ -1510,23 +1530,111 @@ impl<'p> Sim<'p> {
         Step::Wait
     }
 
-    /// `elected`: the first candidate that is this robot or was heard from
-    /// within three heartbeats leads; a change of leader is traced.
-    fn elected(&mut self, r: usize, state: (usize, usize), candidates: &[usize]) -> bool {
+    /// `elected` (`codegen/control.rs`'s `ELECTION_C`): among the live
+    /// candidates (this robot, or heard from within three heartbeats) the
+    /// algorithm's choice; a robot that must listen first (restarted, or a
+    /// `highest_battery` election) answers `None` until it has; a rejoining
+    /// robot follows a live claimant instead of claiming. A change of leader
+    /// is traced.
+    fn elected(
+        &mut self,
+        r: usize,
+        state: (usize, usize),
+        candidates: &[usize],
+        algorithm: LeaderAlgorithm,
+    ) -> Option<bool> {
+        let now = self.now;
         let robot = &self.robots[r];
+        let hb = robot.program.control.heartbeat_ms;
+        let listens = robot.rejoining || algorithm == LeaderAlgorithm::HighestBattery;
+        if listens && now - robot.started_at < crate::codegen::listen_ms(hb) {
+            return None;
+        }
         let me = robot.program.self_peer;
-        let leader = candidates
-            .iter()
-            .copied()
-            .find(|&c| c == me || self.now - robot.last_seen[c] <= 3 * HEARTBEAT_MS)
-            .unwrap_or(me);
+        let alive = |c: usize| c == me || now - robot.heard[c].seen <= 3 * hb;
+        let level = |c: usize| {
+            if c == me {
+                own_battery(robot, now)
+            } else {
+                robot.heard[c].battery
+            }
+        };
+        let mut live = candidates.iter().copied().filter(|&c| alive(c));
+        let chosen = match algorithm {
+            LeaderAlgorithm::LowestId => live.next(),
+            LeaderAlgorithm::Bully => live.next_back(),
+            // The highest level, the first of equals; unknown is lowest.
+            LeaderAlgorithm::HighestBattery => {
+                live.fold(None, |best: Option<usize>, c| match best {
+                    Some(b) if level(c).unwrap_or(-1) <= level(b).unwrap_or(-1) => Some(b),
+                    _ => Some(c),
+                })
+            }
+        };
+        let mut leader = chosen.unwrap_or(me);
+        let mut rejoining = robot.rejoining;
+        if rejoining && leader == me {
+            let claimant = (0..robot.heard.len())
+                .find(|&i| i != me && robot.heard[i].leads && now - robot.heard[i].seen <= 3 * hb);
+            match claimant {
+                Some(c) => leader = c,
+                None => rejoining = false,
+            }
+        }
+        let robot = &mut self.robots[r];
+        robot.rejoining = rejoining;
+        robot.leading = leader == me;
         if robot.leaders.get(&state) != Some(&leader) {
-            self.robots[r].leaders.insert(state, leader);
-            let name = self.robots[r].program.peers[leader].1.clone();
+            robot.leaders.insert(state, leader);
+            let name = robot.program.peers[leader].1.clone();
             self.emit(r, "leader", vec![("leader", name.into())]);
         }
-        leader == me
+        Some(leader == me)
     }
+}
+
+/// What a robot's last heartbeat said (`comm_heartbeat` in the C).
+#[derive(Clone, Copy, Debug)]
+struct Heard {
+    /// When it came (mission ms).
+    seen: i64,
+    /// It claimed leadership.
+    leads: bool,
+    battery: Option<i64>,
+}
+
+impl Heard {
+    /// `heard_alive`: `leader 87` or `member -`.
+    fn parse(now: i64, value: &str) -> Heard {
+        let battery = value
+            .split_once(' ')
+            .map(|(_, b)| b)
+            .filter(|b| b.starts_with(|c: char| c.is_ascii_digit()))
+            .and_then(|b| {
+                let digits: String = b.chars().take_while(char::is_ascii_digit).collect();
+                digits.parse().ok()
+            });
+        Heard {
+            seen: now,
+            leads: value.starts_with("leader "),
+            battery,
+        }
+    }
+}
+
+/// A heartbeat's value: whether the robot claims leadership, and its battery.
+fn heartbeat_value(leading: bool, battery: Option<i64>) -> String {
+    let role = if leading { "leader" } else { "member" };
+    match battery {
+        Some(level) => format!("{role} {level}"),
+        None => format!("{role} -"),
+    }
+}
+
+/// A robot's battery level for its heartbeats (`own_battery`,
+/// `semo_sim_battery`): the scenario's battery points at `now`, rounded.
+fn own_battery(robot: &Robot<'_>, now: i64) -> Option<i64> {
+    battery_level(&robot.battery, now).map(|l| l.round() as i64)
 }
 
 /// For every team and robot name, the robots (program indices) a message

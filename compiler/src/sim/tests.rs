@@ -169,6 +169,120 @@ fn a_killed_leader_is_replaced_and_a_restarted_one_leads_again() {
         0,
     );
     assert_eq!(leaders(&run_, "tb_1"), ["tb_0", "tb_1", "tb_0"]);
+    // The restarted robot listens before it claims, and the one that took
+    // over gives way first: never two leaders at once.
+    // (tb_0's trace: before the kill, then after the restart.)
+    assert_eq!(leaders(&run_, "tb_0"), ["tb_0", "tb_1", "tb_0"]);
+    assert_eq!(two_leaders(&run_), None);
+    let tb_0 = run_.robots.iter().position(|(_, n)| n == "tb_0").unwrap();
+    let claimed = run_
+        .trace
+        .iter()
+        .find(|e| e.robot == tb_0 && e.t >= 3000 && e.field("leader") == Some("tb_0"))
+        .unwrap()
+        .t;
+    let listen = crate::codegen::listen_ms(crate::refine::HEARTBEAT_MS);
+    assert!(claimed >= 3000 + listen, "claimed at {claimed}");
+}
+
+/// The first instant two live robots both lead by their own traces (a
+/// robot leads from its `leader` event naming itself until another one, or
+/// until it is killed), with the two robots.
+fn two_leaders(run: &Run) -> Option<(i64, String, String)> {
+    let mut leading: Vec<bool> = vec![false; run.robots.len()];
+    for e in &run.trace {
+        let me = &run.robots[e.robot].1;
+        match e.event {
+            "leader" => leading[e.robot] = e.field("leader") == Some(me.as_str()),
+            "fault" | "start" => leading[e.robot] = false,
+            _ => continue,
+        }
+        let both: Vec<&String> = (0..leading.len())
+            .filter(|&r| leading[r])
+            .map(|r| &run.robots[r].1)
+            .collect();
+        if let [a, b, ..] = both.as_slice() {
+            return Some((e.t, a.to_string(), b.to_string()));
+        }
+    }
+    None
+}
+
+/// `tests/fixtures/elections/<algorithm>`: three robots with battery levels
+/// 40, 90 and 60; the one with 90 (tb_1) is killed at 1000 ms and restarted
+/// at 2000 ms.
+fn election(algorithm: &str) -> Run {
+    let programs = programs(&format!(
+        "tests/fixtures/elections/{algorithm}/election.mission"
+    ));
+    let scenario = r#"{"duration": 3000,
+        "robots": {"tb_0": {"battery": [{"at": 0, "level": 40}]},
+                   "tb_1": {"battery": [{"at": 0, "level": 90}]},
+                   "tb_2": {"battery": [{"at": 0, "level": 60}]}},
+        "faults": [{"at": 1000, "kill": "tb_1"}, {"at": 2000, "restart": "tb_1"}]}"#;
+    let (run_, _) = run(&programs, scenario, 0);
+    assert_eq!(two_leaders(&run_), None, "{algorithm}");
+    run_
+}
+
+#[test]
+fn lowest_id_elects_the_first_live_candidate() {
+    let run_ = election("lowest_id");
+    assert!(
+        run_.robots
+            .iter()
+            .all(|(_, r)| programs_heartbeat(&run_, r) == 100)
+    );
+    assert_eq!(leaders(&run_, "tb_0"), ["tb_0"]);
+    assert_eq!(leaders(&run_, "tb_2"), ["tb_0"]);
+    // Restarted, tb_1 listens and then follows tb_0.
+    assert_eq!(leaders(&run_, "tb_1"), ["tb_0", "tb_0"]);
+}
+
+#[test]
+fn bully_elects_the_last_live_candidate() {
+    let run_ = election("bully");
+    assert_eq!(leaders(&run_, "tb_0"), ["tb_2"]);
+    assert_eq!(leaders(&run_, "tb_1"), ["tb_2", "tb_2"]);
+}
+
+#[test]
+fn highest_battery_elects_by_the_levels_heartbeats_carry() {
+    let run_ = election("highest_battery");
+    // Everyone listens one and a half heartbeats (150 ms) first; tb_1 (90)
+    // leads, tb_2 (60) takes over when it dies, and gives way to the
+    // restarted tb_1, which waits for that before it claims.
+    assert_eq!(leaders(&run_, "tb_0"), ["tb_1", "tb_2", "tb_1"]);
+    assert_eq!(leaders(&run_, "tb_2"), ["tb_1", "tb_2", "tb_1"]);
+    assert_eq!(leaders(&run_, "tb_1"), ["tb_1", "tb_2", "tb_1"]);
+    let first = run_.trace.iter().find(|e| e.event == "leader").unwrap().t;
+    assert_eq!(first, 150);
+    let heartbeat = run_
+        .trace
+        .iter()
+        .find(|e| e.event == "send" && e.field("key") == Some("Crew.__alive") && e.t > 200)
+        .unwrap();
+    assert!(
+        matches!(
+            heartbeat.field("value"),
+            Some("leader 90" | "member 40" | "member 60")
+        ),
+        "{:?}",
+        heartbeat.field("value")
+    );
+}
+
+/// The heartbeat period of a robot's program in a run, from its sends.
+fn programs_heartbeat(run: &Run, robot: &str) -> i64 {
+    let r = run.robots.iter().position(|(_, n)| n == robot).unwrap();
+    let sends: Vec<i64> = run
+        .trace
+        .iter()
+        .filter(|e| e.robot == r && e.event == "send" && e.field("key") == Some("Crew.__alive"))
+        .map(|e| e.t)
+        .take(3)
+        .collect();
+    sends[1] - sends[0]
 }
 
 #[test]

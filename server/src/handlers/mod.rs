@@ -13,6 +13,7 @@ pub mod generate_code;
 pub mod graph_svg;
 pub mod hover;
 pub mod inlay_hints;
+pub mod monitor;
 pub mod prepare_rename;
 pub mod references;
 pub mod rename;

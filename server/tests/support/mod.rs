@@ -2,6 +2,7 @@
 //! one document open.
 #![allow(dead_code)] // each test file uses its own part
 
+pub mod broker;
 pub mod render;
 
 use semo_server::harness::TestClient;

@@ -152,4 +152,10 @@ void semo__board_sleep_until(int64_t deadline_ms);
 void semo__board_exit(int status);
 #endif
 
+#ifdef SEMO_MQTT
+/* Whether the broker still held this robot's session at the first
+ * connection (CONNACK's session-present flag): the robot was restarted. */
+bool semo__mqtt_session_present(void);
+#endif
+
 #endif /* SEMO_INTERNAL_H */

@@ -15,7 +15,7 @@
 #ifdef SEMO_MQTT
 #define _POSIX_C_SOURCE 200809L
 
-#include "semo_runtime.h"
+#include "semo_internal.h"
 
 #include <mosquitto.h>
 #include <pthread.h>
@@ -52,6 +52,7 @@ static size_t g_head, g_count;
 static bool g_interrupted;
 static bool g_subscribed;
 static int g_connect_refused; /* the broker's CONNACK code when it refused */
+static bool g_connected_once, g_session_present; /* the first CONNACK's session-present flag */
 static int g_subscribe_mid = -1;
 static long g_unacked; /* messages handed to libmosquitto whose on_publish has not come */
 
@@ -140,11 +141,26 @@ static struct timespec deadline_after(int ms)
 
 static void outbox_flush(void);
 
+bool semo__mqtt_session_present(void)
+{
+    pthread_mutex_lock(&g_lock);
+    bool present = g_session_present;
+    pthread_mutex_unlock(&g_lock);
+    return present;
+}
+
 /* On every (re)connection: subscribe again (the persistent session keeps the
  * subscriptions, but a broker that lost its state must learn them). */
-static void on_connect(struct mosquitto *mosq, void *obj, int rc)
+static void on_connect(struct mosquitto *mosq, void *obj, int rc, int flags)
 {
     (void)obj;
+    if (rc == 0) {
+        pthread_mutex_lock(&g_lock);
+        if (!g_connected_once)
+            g_session_present = (flags & 1) != 0;
+        g_connected_once = true;
+        pthread_mutex_unlock(&g_lock);
+    }
     if (rc != 0) {
         pthread_mutex_lock(&g_lock);
         g_connect_refused = rc;
@@ -308,7 +324,7 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     int will_len = snprintf(will, sizeof will, "{\"robot\":\"%s\",\"event\":\"status\",\"state\":\"lost\"}",
                             program->peers[program->self].robot);
     mosquitto_will_set(g_mosq, will_topic, will_len, will, 1, true);
-    mosquitto_connect_callback_set(g_mosq, on_connect);
+    mosquitto_connect_with_flags_callback_set(g_mosq, on_connect);
     mosquitto_subscribe_callback_set(g_mosq, on_subscribe);
     mosquitto_publish_callback_set(g_mosq, on_publish);
     mosquitto_message_callback_set(g_mosq, on_message);

@@ -692,6 +692,23 @@ static bool decode_message(const unsigned char *in, size_t len, semo_message *m)
 }
 
 static const semo_transport *g_transport; /* NULL: no other robots */
+/* Mission time when the program started (after the start barrier): written
+ * before any task thread starts. */
+static int64_t g_joined_at;
+
+int64_t semo_joined_ms(void)
+{
+    return g_joined_at;
+}
+
+bool semo_session_resumed(void)
+{
+#ifdef SEMO_MQTT
+    if (g_transport == &semo_mqtt_transport)
+        return semo__mqtt_session_present();
+#endif
+    return false;
+}
 
 int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value)
 {
@@ -1418,6 +1435,7 @@ static int run(const options *o)
      * others from the first), the clock starts at the agreed instant. */
     if (!semo__wait_until(0))
         goto stop;
+    g_joined_at = semo_now_ms();
     semo_trace("start", "team", p->team, "type", p->robot_type ? p->robot_type : "", "mission",
                p->mission ? p->mission : "", NULL);
     for (; initialized < p->task_count; initialized++)

@@ -158,6 +158,14 @@ void Core_1_go(void);
 void semo_firing_continues(void);
 #endif
 
+/* Mission time when this program started, after the start barrier: 0, or
+ * later for a robot restarted into a mission under way (`--start-at` in the
+ * past). Leader elections use it: a restarted robot listens first. */
+int64_t semo_joined_ms(void);
+/* Whether the transport found this robot's session from an earlier run (the
+ * MQTT broker still held it: the robot was restarted); false on UDP. */
+bool semo_session_resumed(void);
+
 /* Ends the program (from any task). */
 void semo_stop_program(void);
 bool semo_running(void);
@@ -326,6 +334,9 @@ int64_t semo_sim_service_ms(const char *service);
  * loop `loop` (the graph's name and the loop's path, "kmeans/Converge") sets the exit flag,
  * from the scenario's "loops"; 0 when it never does. */
 int64_t semo_sim_loop_exit(const char *loop);
+/* The scenario's battery level now, rounded (its "battery" points); false
+ * when the scenario gives none. Heartbeats carry it (highest_battery). */
+bool semo_sim_battery(long long *level);
 #endif
 
 #endif /* SEMO_RUNTIME_H */

@@ -1110,6 +1110,15 @@ bool semo_sim_sensor(const char *value, semo_value *out)
     return latest != NULL;
 }
 
+bool semo_sim_battery(long long *level)
+{
+    if (g_sim.battery_count == 0)
+        return false;
+    if (level)
+        *level = (long long)round_half_away(battery_level(semo_now_ms()));
+    return true;
+}
+
 void semo_sim_actuate(const char *task, const semo_value *command)
 {
     semo_trace("actuate", "task", task, "value", command ? command->text : "", NULL);

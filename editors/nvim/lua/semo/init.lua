@@ -11,6 +11,10 @@
 -- `*.scenario.json` named after the mission, beside it) through the server's `semo.simulate`,
 -- shows the summary and writes the timeline SVG (default: the scenario's name, `.svg`).
 -- Failed expectations appear as diagnostics on the scenario file.
+--
+-- `:SemoMonitor [BROKER]` in a mission watches its running robots on the MQTT broker (the
+-- server's `semo/monitor`; default: the deployment file's broker) and prints the table of
+-- robots, modes, services and leader whenever it changes; `:SemoMonitorStop` ends it.
 local M = {}
 
 -- XML files that the server reads, and scenario files it completes; their filetype stays
@@ -190,6 +194,86 @@ function M.simulate(bufnr, scenario, svg, done)
   end, bufnr)
 end
 
+-- The live robot monitor: the last `semo/monitor` view of each mission URI, and who wants it.
+M.monitor_views = {}
+local monitor_listeners = {}
+
+-- JSON null arrives as vim.NIL or nil depending on the Neovim version.
+local function present(value)
+  if value == nil or value == vim.NIL then
+    return nil
+  end
+  return value
+end
+
+--- A `semo/monitor` view (docs/live-monitor.md) as a table: a header, one line per robot
+--- (`*` marks a leader; lost robots say why).
+function M.monitor_table(view)
+  local error = present(view.error)
+  local lines = {
+    string.format('%s on %s: %s%s', view.mission, view.broker, view.connection,
+      error and (' (' .. error .. ')') or ''),
+  }
+  for _, robot in ipairs(view.robots) do
+    local services = {}
+    for _, s in ipairs(robot.services) do
+      table.insert(services, s.plan .. '=' .. s.service)
+    end
+    local state = robot.state
+    if robot.lost then
+      state = 'LOST (' .. (present(robot.lostBecause) or '?') .. ')'
+    end
+    table.insert(lines, vim.trim(string.format('%-10s %-12s %-16s %-14s %s',
+      robot.robot .. (robot.isLeader and ' *' or ''), robot.team, state,
+      present(robot.mode) or '', table.concat(services, ','))))
+  end
+  return table.concat(lines, '\n')
+end
+
+local function on_monitor_view(_, view)
+  if type(view) ~= 'table' or view.uri == nil then
+    return
+  end
+  M.monitor_views[view.uri] = view
+  local listener = monitor_listeners[view.uri]
+  if listener then
+    listener(view)
+  end
+end
+
+--- Starts the server's monitor of the mission in `bufnr` (`semo/monitor/start`); `broker`
+--- nil means the deployment file's, else mqtt://127.0.0.1:1883. `on_view(view)` gets every
+--- `semo/monitor` notification; `done(err, answer)` the answer or why it was refused.
+function M.monitor(bufnr, broker, on_view, done)
+  local client = client_of(bufnr)
+  if client == nil then
+    return done('no semo server is attached to this buffer')
+  end
+  local uri = vim.uri_from_bufnr(bufnr)
+  monitor_listeners[uri] = on_view
+  client.request('semo/monitor/start', { uri = uri, broker = broker }, function(err, answer)
+    if err then
+      monitor_listeners[uri] = nil
+      return done(err.message or tostring(err))
+    end
+    done(nil, answer)
+  end, bufnr)
+end
+
+--- Ends the monitor of the mission in `bufnr`; `done(err, answer)` (`answer.stopped`).
+function M.monitor_stop(bufnr, done)
+  local uri = vim.uri_from_bufnr(bufnr)
+  monitor_listeners[uri] = nil
+  M.monitor_views[uri] = nil
+  local client = client_of(bufnr)
+  if client == nil then
+    return done('no semo server is attached to this buffer')
+  end
+  client.request('semo/monitor/stop', { uri = uri }, function(err, answer)
+    done(err and (err.message or tostring(err)), answer)
+  end, bufnr)
+end
+
 function M.setup(opts)
   config = vim.tbl_extend('force', config, opts or {})
   local group = vim.api.nvim_create_augroup('semo', { clear = true })
@@ -208,6 +292,25 @@ function M.setup(opts)
       end)
     end)
   end, { nargs = '*', complete = 'file', desc = 'Simulate the mission on a scenario (semo.simulate)' })
+  vim.lsp.handlers['semo/monitor'] = on_monitor_view
+  vim.api.nvim_create_user_command('SemoMonitor', function(command)
+    local broker = command.fargs[1]
+    local shown
+    M.monitor(vim.api.nvim_get_current_buf(), broker, function(view)
+      local table_text = M.monitor_table(view)
+      if table_text ~= shown then
+        shown = table_text
+        vim.schedule(function() vim.notify(table_text, vim.log.levels.INFO) end)
+      end
+    end, function(err)
+      if err then
+        vim.schedule(function() vim.notify('semo: ' .. err, vim.log.levels.ERROR) end)
+      end
+    end)
+  end, { nargs = '?', desc = 'Show the live status of the mission\'s robots (semo/monitor)' })
+  vim.api.nvim_create_user_command('SemoMonitorStop', function()
+    M.monitor_stop(vim.api.nvim_get_current_buf(), function() end)
+  end, { desc = 'Stop monitoring the mission\'s robots' })
   vim.api.nvim_create_autocmd('FileType', {
     group = group,
     pattern = { 'semo', 'xml', 'json', 'toml' },

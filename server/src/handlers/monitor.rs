@@ -1,0 +1,169 @@
+//! `semo/monitor/start` and `semo/monitor/stop`: the live robot monitor of a
+//! mission (`docs/live-monitor.md`). Start answers with the mission's
+//! robots and the broker; the session (`crate::monitor`) then sends
+//! `semo/monitor` notifications.
+//!
+//! The robots are the refined programs of the mission as the workspace
+//! analysis checked it (`codegen::refine_checked` on the host's build
+//! input, as `semo operator` and `semo.simulate` read it): a mission with
+//! errors is refused. The broker: the request's `broker` (the editor's
+//! setting), else the deployment file of the mission's project (`semo.toml`
+//! `[build] deployment`), else `mqtt://127.0.0.1:1883`; the deployment
+//! file's operator credentials are used in every case.
+
+use crate::live;
+use crate::monitor::Plan;
+use crate::monitor::roster::Member;
+use crate::world::World;
+use semo::workspace::FileKind;
+use serde::Deserialize;
+use serde_json::{Value, json};
+use std::path::PathBuf;
+use tower_lsp_server::ls_types::Uri;
+
+pub const START: &str = "semo/monitor/start";
+pub const STOP: &str = "semo/monitor/stop";
+
+/// The notification a session sends.
+pub enum MonitorNotification {}
+
+impl tower_lsp_server::ls_types::notification::Notification for MonitorNotification {
+    type Params = Value;
+    const METHOD: &'static str = "semo/monitor";
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct StartParams {
+    pub uri: Uri,
+    /// `mqtt://HOST[:PORT]`; empty or absent: the deployment's, else the default.
+    pub broker: Option<String>,
+}
+
+#[derive(Debug, Deserialize)]
+pub struct StopParams {
+    pub uri: Uri,
+}
+
+/// What a start works on, taken from the world at once.
+pub struct Job {
+    uri: Uri,
+    analysis: semo::host::Analysis,
+    mission: semo::diag::FileId,
+    broker: Option<String>,
+    deployment: Option<PathBuf>,
+}
+
+pub fn job(world: &World, params: StartParams) -> Result<Job, String> {
+    let mission = world
+        .snapshot(&params.uri)
+        .filter(|s| s.kind == FileKind::Mission)
+        .ok_or_else(|| format!("{} is not a mission the server knows", params.uri.as_str()))?;
+    let analysis = world.analysis();
+    let deployment = analysis
+        .project(mission.id)
+        .and_then(|p| p.project.deployment.as_ref().map(|d| d.path.clone()));
+    Ok(Job {
+        uri: params.uri,
+        analysis,
+        mission: mission.id,
+        broker: params.broker.filter(|b| !b.trim().is_empty()),
+        deployment,
+    })
+}
+
+/// The session's plan: the robots, the broker, the credentials (reads the
+/// deployment file and the operator's password file: off the async threads).
+pub fn plan(job: &Job) -> Result<Plan, String> {
+    let build = job
+        .analysis
+        .build_input(job.mission)
+        .ok_or("internal error: the mission is not in the workspace analysis")?;
+    let refined = semo::codegen::refine_checked(&build.input());
+    let errors = refined.diagnostics.iter().filter(|d| d.is_error()).count();
+    if errors > 0 || refined.programs.is_empty() {
+        return Err(format!(
+            "cannot monitor: {errors} error(s) in the mission, its catalog or strategies"
+        ));
+    }
+    let deployment = match &job.deployment {
+        None => None,
+        Some(path) => Some(
+            semo::deploy::load(path, semo::diag::FileId(u32::MAX)).map_err(|found| {
+                let first = found.iter().find(|d| d.is_error()).or(found.first());
+                format!(
+                    "cannot monitor: the deployment file {} is wrong: {}",
+                    path.display(),
+                    first.map_or(String::new(), |d| format!(
+                        "[{}] {}",
+                        d.code.as_str(),
+                        d.message
+                    ))
+                )
+            })?,
+        ),
+    };
+    let broker = match (&job.broker, &deployment) {
+        (Some(url), _) => url.trim().to_string(),
+        (None, Some(d)) => d.broker.url.clone(),
+        (None, None) => live::DEFAULT_BROKER.to_string(),
+    };
+    let (host, port) = live::mqtt_address(&broker).ok_or_else(|| {
+        format!("cannot monitor: the broker must be mqtt://HOST[:PORT] (the monitor has no TLS), not {broker:?}")
+    })?;
+    let credentials = match deployment.as_ref().map(|d| d.operator_credentials()) {
+        Some(semo::deploy::Credentials {
+            user: Some(user),
+            password_file,
+            ..
+        }) => {
+            let password = match password_file {
+                None => String::new(),
+                Some(path) => std::fs::read_to_string(&path)
+                    .map_err(|e| {
+                        format!(
+                            "cannot monitor: cannot read the operator's password file {}: {e}",
+                            path.display()
+                        )
+                    })?
+                    .lines()
+                    .next()
+                    .unwrap_or("")
+                    .to_string(),
+            };
+            Some((user, password))
+        }
+        _ => None,
+    };
+    let members = refined
+        .programs
+        .iter()
+        .map(|p| Member {
+            robot: p.robot.clone(),
+            team: p.team.clone(),
+            heartbeat_topic: p
+                .control
+                .heartbeat
+                .then(|| semo::deploy::topics::heartbeats(p)),
+        })
+        .collect();
+    Ok(Plan {
+        uri: job.uri.as_str().to_string(),
+        mission: semo::deploy::topics::mission(&refined.programs[0].mission),
+        broker,
+        host,
+        port,
+        credentials,
+        members,
+        heartbeat_ms: semo::refine::HEARTBEAT_MS,
+    })
+}
+
+/// The answer to `semo/monitor/start`.
+pub fn started(plan: &Plan) -> Value {
+    json!({
+        "mission": plan.mission,
+        "broker": plan.broker,
+        "robots": plan.members.iter().map(|m| json!({ "robot": m.robot, "team": m.team })).collect::<Vec<_>>(),
+    })
+}

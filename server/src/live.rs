@@ -1,0 +1,172 @@
+//! What a running mission says on its MQTT broker, read by the two live
+//! doors: `semo operator` (the console) and the editor's robot monitor
+//! (`crate::monitor`). One decoding of the robots' retained status
+//! (`docs/deployment.md`, "Status"; written by `semo_runtime.c`'s
+//! `observe_status` and `semo_mqtt.c`'s last will) and of the runtime's
+//! datagram (`semo_runtime.c`'s `encode_message`), so that both read the
+//! same thing the same way.
+
+/// A robot's status message on `semo/<mission>/status/<robot>`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Status {
+    pub robot: String,
+    /// `running`, `finished`, `stopped`, or `lost` (the broker's last will).
+    pub state: String,
+    /// Empty in the last will, which knows nothing but the robot.
+    pub mode: String,
+    /// The leader the robot follows (empty without a leader election).
+    pub leader: String,
+    /// The service each plan runs, in the robot's order: `(plan, service)`.
+    pub services: Vec<(String, String)>,
+    /// The battery level, when the runtime reports one.
+    pub battery: Option<f64>,
+    /// The robot's mission time of the change (ms), when given.
+    pub t: Option<i64>,
+}
+
+impl Status {
+    /// Reads a status payload; `robot` is the topic's last level, used
+    /// when the payload does not name the robot. `None` for anything that
+    /// is not a JSON object.
+    pub fn decode(robot: &str, payload: &[u8]) -> Option<Status> {
+        let value: serde_json::Value = serde_json::from_slice(payload).ok()?;
+        let object = value.as_object()?;
+        let text = |key: &str| {
+            object
+                .get(key)
+                .and_then(serde_json::Value::as_str)
+                .unwrap_or("")
+                .to_string()
+        };
+        let services = text("services")
+            .split(',')
+            .filter_map(|pair| {
+                let (plan, service) = pair.split_once('=')?;
+                Some((plan.to_string(), service.to_string()))
+            })
+            .collect();
+        Some(Status {
+            robot: match text("robot") {
+                named if !named.is_empty() => named,
+                _ => robot.to_string(),
+            },
+            state: text("state"),
+            mode: text("mode"),
+            leader: text("leader"),
+            services,
+            battery: object.get("battery").and_then(serde_json::Value::as_f64),
+            t: object.get("t").and_then(serde_json::Value::as_i64),
+        })
+    }
+
+    /// `plan=service,…` as the runtime writes it.
+    pub fn services_text(&self) -> String {
+        self.services
+            .iter()
+            .map(|(plan, service)| format!("{plan}={service}"))
+            .collect::<Vec<_>>()
+            .join(",")
+    }
+}
+
+/// `mqtt://HOST[:PORT]` (1883 by default) as host and port; `None` for
+/// anything else (the live doors speak no TLS).
+pub fn mqtt_address(url: &str) -> Option<(String, u16)> {
+    let rest = url.strip_prefix("mqtt://")?;
+    let rest = rest.strip_suffix('/').unwrap_or(rest);
+    match rest.rsplit_once(':') {
+        Some((host, port)) if !host.is_empty() => Some((host.to_string(), port.parse().ok()?)),
+        None if !rest.is_empty() => Some((rest.to_string(), 1883)),
+        _ => None,
+    }
+}
+
+/// The broker a robot uses when nothing says otherwise.
+pub const DEFAULT_BROKER: &str = "mqtt://127.0.0.1:1883";
+
+/// A `send` from the operator as the runtime's datagram: "SEMO" 1, `s`,
+/// then team `USER`, robot `operator`, the key and the value, each a length
+/// byte and at most 255 bytes.
+pub fn operator_datagram(key: &str, value: &str) -> Vec<u8> {
+    let mut out = b"SEMO\x01s".to_vec();
+    for field in ["USER", "operator", key, value] {
+        let bytes = &field.as_bytes()[..field.len().min(255)];
+        out.push(bytes.len() as u8);
+        out.extend_from_slice(bytes);
+    }
+    out
+}
+
+/// The fields of a runtime datagram: (team, robot, key, value).
+pub fn datagram_fields(data: &[u8]) -> Option<[String; 4]> {
+    if data.len() < 6 || &data[..5] != b"SEMO\x01" {
+        return None;
+    }
+    let mut at = 6;
+    let mut take = || {
+        let n = *data.get(at)? as usize;
+        let text = data.get(at + 1..at + 1 + n)?;
+        at += 1 + n;
+        Some(String::from_utf8_lossy(text).into_owned())
+    };
+    Some([take()?, take()?, take()?, take()?])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_status_reads_as_the_runtime_writes_it() {
+        let payload = br#"{"t":5230,"robot":"irobot","event":"status","state":"running","mode":"WAIT_MODE","leader":"","services":"Listen=ReportStatus,Action=Wait"}"#;
+        let status = Status::decode("irobot", payload).unwrap();
+        assert_eq!(status.state, "running");
+        assert_eq!(status.mode, "WAIT_MODE");
+        assert_eq!(
+            status.services,
+            [
+                ("Listen".to_string(), "ReportStatus".to_string()),
+                ("Action".to_string(), "Wait".to_string())
+            ]
+        );
+        assert_eq!(status.services_text(), "Listen=ReportStatus,Action=Wait");
+        assert_eq!((status.t, status.battery), (Some(5230), None));
+        // The last will names only the robot and the state.
+        let will = Status::decode(
+            "x",
+            br#"{"robot":"irobot","event":"status","state":"lost"}"#,
+        )
+        .unwrap();
+        assert_eq!(
+            (will.robot.as_str(), will.state.as_str()),
+            ("irobot", "lost")
+        );
+        assert!(will.services.is_empty() && will.mode.is_empty());
+        assert_eq!(
+            Status::decode("r", br#"{"state":"running","battery":42.5}"#)
+                .map(|s| (s.robot, s.battery)),
+            Some(("r".to_string(), Some(42.5)))
+        );
+        assert_eq!(Status::decode("r", b"[1]"), None);
+        assert_eq!(Status::decode("r", b"\xff"), None);
+    }
+
+    #[test]
+    fn a_command_is_the_runtimes_datagram_and_reads_back() {
+        let d = operator_datagram("USER.RC_CMD", "RETURN_MODE");
+        assert_eq!(
+            datagram_fields(&d),
+            Some([
+                "USER".into(),
+                "operator".into(),
+                "USER.RC_CMD".into(),
+                "RETURN_MODE".into()
+            ])
+        );
+        assert_eq!(datagram_fields(&d[..d.len() - 1]), None);
+        assert_eq!(mqtt_address("mqtt://h:99"), Some(("h".into(), 99)));
+        assert_eq!(mqtt_address("mqtt://h"), Some(("h".into(), 1883)));
+        assert_eq!(mqtt_address("mqtts://h"), None);
+        assert_eq!(mqtt_address("mqtt://:1"), None);
+    }
+}

@@ -1,0 +1,292 @@
+//! The monitor's picture of a mission's robots, from what the broker
+//! delivers: every robot of the checked mission, `waiting` until its first
+//! status, then its state, mode, services and leader, and `lost` when its
+//! last will arrives or when it stops heart-beating. Pure: the time is the
+//! monitor's clock in ms, passed in, so the rules are tested without one.
+
+use crate::live::Status;
+use semo::deploy::topics;
+use serde_json::{Value, json};
+
+/// A robot is lost when a robot that heart-beats has not been heard from
+/// for this many heartbeat periods: the generated leader election's own
+/// rule (`codegen/control.rs`, `elected`: heard within three heartbeats).
+pub const SILENT_PERIODS: i64 = 3;
+
+/// A robot of the mission, as refinement made it.
+#[derive(Clone, Debug)]
+pub struct Member {
+    pub robot: String,
+    pub team: String,
+    /// Whether it publishes heartbeats (its team elects a leader), on
+    /// `heartbeat_topic`.
+    pub heartbeat_topic: Option<String>,
+}
+
+struct Robot {
+    member: Member,
+    status: Option<Status>,
+    /// When the robot was last heard from (a heartbeat or a status), once
+    /// a heartbeat has been heard: only then can its silence be told.
+    heard_at: Option<i64>,
+    silent: bool,
+}
+
+pub struct Roster {
+    status_prefix: String,
+    robots: Vec<Robot>,
+    silent_after_ms: i64,
+}
+
+impl Roster {
+    /// `mission` is the mission's topic name (`topics::mission`);
+    /// `heartbeat_ms` the runtime's heartbeat period.
+    pub fn new(mission: &str, members: Vec<Member>, heartbeat_ms: i64) -> Roster {
+        Roster {
+            status_prefix: format!("semo/{}/status/", topics::level(mission)),
+            robots: members
+                .into_iter()
+                .map(|member| Robot {
+                    member,
+                    status: None,
+                    heard_at: None,
+                    silent: false,
+                })
+                .collect(),
+            silent_after_ms: SILENT_PERIODS * heartbeat_ms,
+        }
+    }
+
+    /// The topics to subscribe to: every status, and the heartbeats of the
+    /// teams that elect a leader.
+    pub fn topics(&self) -> Vec<String> {
+        let mut topics = vec![format!("{}+", self.status_prefix)];
+        for robot in &self.robots {
+            if let Some(topic) = &robot.member.heartbeat_topic {
+                if !topics.contains(topic) {
+                    topics.push(topic.clone());
+                }
+            }
+        }
+        topics
+    }
+
+    /// A message from the broker at time `now`; messages of robots that
+    /// are not in the mission, and anything unreadable, are ignored.
+    pub fn message(&mut self, topic: &str, payload: &[u8], now: i64) {
+        if let Some(level) = topic.strip_prefix(&self.status_prefix) {
+            let Some(status) = Status::decode(level, payload) else {
+                return;
+            };
+            if let Some(robot) = self
+                .robots
+                .iter_mut()
+                .find(|r| topics::level(&r.member.robot) == level)
+            {
+                robot.status = Some(status);
+                robot.heard(now);
+            }
+            return;
+        }
+        let Some([_, from, _, _]) = crate::live::datagram_fields(payload) else {
+            return;
+        };
+        if let Some(robot) = self
+            .robots
+            .iter_mut()
+            .find(|r| r.member.robot == from && r.member.heartbeat_topic.as_deref() == Some(topic))
+        {
+            robot.heard_at = Some(now);
+            robot.silent = false;
+        }
+    }
+
+    /// Marks the running robots that heart-beat and have been silent for
+    /// too long at `now`.
+    pub fn tick(&mut self, now: i64) {
+        for robot in &mut self.robots {
+            let running = robot.status.as_ref().is_some_and(|s| s.state == "running");
+            if let Some(at) = robot.heard_at {
+                if running && now - at > self.silent_after_ms {
+                    robot.silent = true;
+                }
+            }
+        }
+    }
+
+    /// The robots as the `semo/monitor` notification shows them
+    /// (`docs/live-monitor.md`).
+    pub fn view(&self) -> Value {
+        Value::Array(self.robots.iter().map(Robot::view).collect())
+    }
+}
+
+impl Robot {
+    fn heard(&mut self, now: i64) {
+        if self.heard_at.is_some() {
+            self.heard_at = Some(now);
+        }
+        self.silent = false;
+    }
+
+    fn view(&self) -> Value {
+        let Some(status) = &self.status else {
+            return json!({
+                "robot": self.member.robot,
+                "team": self.member.team,
+                "state": "waiting",
+                "lost": false,
+                "mode": null,
+                "services": [],
+                "leader": null,
+                "isLeader": false,
+                "battery": null,
+            });
+        };
+        let will = status.state == "lost";
+        let lost_because = if will {
+            Some("lastWill")
+        } else if self.silent {
+            Some("silent")
+        } else {
+            None
+        };
+        let services: Vec<Value> = status
+            .services
+            .iter()
+            .map(|(plan, service)| json!({ "plan": plan, "service": service }))
+            .collect();
+        let mut view = json!({
+            "robot": self.member.robot,
+            "team": self.member.team,
+            "state": if lost_because.is_some() { "lost" } else { status.state.as_str() },
+            "lost": lost_because.is_some(),
+            "mode": (!status.mode.is_empty()).then_some(&status.mode),
+            "services": services,
+            "leader": (!status.leader.is_empty()).then_some(&status.leader),
+            "isLeader": status.leader == self.member.robot,
+            "battery": status.battery,
+        });
+        if let Some(why) = lost_because {
+            view["lostBecause"] = json!(why);
+        }
+        view
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ALIVE: &str = "semo/m/Team/Team.__alive";
+
+    fn roster() -> Roster {
+        Roster::new(
+            "m",
+            vec![
+                Member {
+                    robot: "a".into(),
+                    team: "Team".into(),
+                    heartbeat_topic: Some(ALIVE.into()),
+                },
+                Member {
+                    robot: "b".into(),
+                    team: "Team".into(),
+                    heartbeat_topic: Some(ALIVE.into()),
+                },
+                Member {
+                    robot: "c".into(),
+                    team: "Solo".into(),
+                    heartbeat_topic: None,
+                },
+            ],
+            200,
+        )
+    }
+
+    fn states(roster: &Roster) -> Vec<String> {
+        roster
+            .view()
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| {
+                format!(
+                    "{}={}",
+                    r["robot"].as_str().unwrap(),
+                    r["state"].as_str().unwrap()
+                )
+            })
+            .collect()
+    }
+
+    fn heartbeat(robot: &str) -> Vec<u8> {
+        let mut d = b"SEMO\x01p".to_vec();
+        for field in ["Team", robot, "Team.__alive", robot] {
+            d.push(field.len() as u8);
+            d.extend_from_slice(field.as_bytes());
+        }
+        d
+    }
+
+    const RUNNING_A: &[u8] = br#"{"t":1,"robot":"a","event":"status","state":"running","mode":"M","leader":"a","services":"P=S"}"#;
+
+    #[test]
+    fn every_robot_waits_until_its_status_comes() {
+        let mut r = roster();
+        assert_eq!(r.topics(), ["semo/m/status/+", ALIVE]);
+        assert_eq!(states(&r), ["a=waiting", "b=waiting", "c=waiting"]);
+        r.message("semo/m/status/a", RUNNING_A, 0);
+        r.message("semo/m/status/stranger", RUNNING_A, 0);
+        assert_eq!(states(&r), ["a=running", "b=waiting", "c=waiting"]);
+        let a = &r.view()[0];
+        assert_eq!(a["mode"], "M");
+        assert_eq!(a["isLeader"], true);
+        assert_eq!(a["services"], json!([{ "plan": "P", "service": "S" }]));
+    }
+
+    #[test]
+    fn the_last_will_makes_a_robot_lost() {
+        let mut r = roster();
+        r.message("semo/m/status/c", RUNNING_A, 0);
+        r.message(
+            "semo/m/status/c",
+            br#"{"robot":"c","event":"status","state":"lost"}"#,
+            5,
+        );
+        let c = &r.view()[2];
+        assert_eq!(
+            (c["state"].as_str(), c["lostBecause"].as_str()),
+            (Some("lost"), Some("lastWill"))
+        );
+    }
+
+    #[test]
+    fn a_running_robot_silent_for_three_heartbeats_is_lost_until_heard_again() {
+        let mut r = roster();
+        r.message("semo/m/status/a", RUNNING_A, 0);
+        // Without any heartbeat heard its silence means nothing (a broker
+        // whose ACL hides the heartbeats from the monitor).
+        r.tick(10_000);
+        assert_eq!(states(&r)[0], "a=running");
+        r.message(ALIVE, &heartbeat("a"), 10_000);
+        r.tick(10_600);
+        assert_eq!(states(&r)[0], "a=running");
+        r.tick(10_601);
+        assert_eq!(states(&r)[0], "a=lost");
+        assert_eq!(r.view()[0]["lostBecause"], "silent");
+        r.message(ALIVE, &heartbeat("a"), 10_700);
+        assert_eq!(states(&r)[0], "a=running");
+        // A stopped robot stops heart-beating: it is not lost.
+        r.message(
+            "semo/m/status/a",
+            br#"{"robot":"a","state":"stopped","mode":"M"}"#,
+            10_800,
+        );
+        r.tick(20_000);
+        assert_eq!(states(&r)[0], "a=stopped");
+        // A heartbeat on another team's topic is not this robot's.
+        r.message("semo/m/Other/Other.__alive", &heartbeat("b"), 20_000);
+        assert_eq!(r.robots[1].heard_at, None);
+    }
+}

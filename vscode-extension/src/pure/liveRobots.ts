@@ -1,0 +1,126 @@
+// The "Robots (live)" view's tree, from the server's `semo/monitor`
+// notifications (docs/live-monitor.md): one node per robot with its state
+// and mode, its services per plan below it, the leader marked, lost robots
+// marked. Pure: unit-tested without VS Code.
+
+/** A robot as `semo/monitor` sends it. */
+export interface LiveRobot {
+  robot: string;
+  team: string;
+  state: string;
+  lost: boolean;
+  lostBecause?: 'lastWill' | 'silent';
+  mode: string | null;
+  services: { plan: string; service: string }[];
+  leader: string | null;
+  isLeader: boolean;
+  battery: number | null;
+}
+
+/** The params of one `semo/monitor` notification. */
+export interface MonitorView {
+  uri: string;
+  mission: string;
+  broker: string;
+  connection: 'connecting' | 'connected' | 'disconnected';
+  error: string | null;
+  robots: LiveRobot[];
+}
+
+export type LiveKind = 'connection' | 'robot' | 'service';
+
+export interface LiveNode {
+  id: string;
+  kind: LiveKind;
+  label: string;
+  description: string;
+  tooltip: string;
+  /** A codicon name (`vscode.ThemeIcon`). */
+  icon: string;
+  /** A theme colour id for the icon, or none. */
+  color?: string;
+  children: LiveNode[];
+}
+
+/** Why a lost robot is lost, in words. */
+function lostWhy(robot: LiveRobot): string {
+  switch (robot.lostBecause) {
+    case 'lastWill':
+      return 'lost: its connection dropped (last will)';
+    case 'silent':
+      return 'lost: no heartbeat for three periods';
+    default:
+      return 'lost';
+  }
+}
+
+function robotNode(view: MonitorView, robot: LiveRobot): LiveNode {
+  const parts: string[] = [];
+  parts.push(robot.lost ? 'LOST' : robot.state);
+  if (robot.mode) {
+    parts.push(robot.mode);
+  }
+  if (robot.isLeader) {
+    parts.push('★ leader');
+  }
+  if (robot.battery !== null && robot.battery !== undefined) {
+    parts.push(`battery ${robot.battery}`);
+  }
+  const tooltip = [
+    `**${robot.robot}** (team ${robot.team})`,
+    '',
+    robot.lost ? lostWhy(robot) : `state: ${robot.state}`,
+    robot.mode ? `mode: ${robot.mode}` : 'mode: not reported yet',
+    robot.leader ? `leader: ${robot.leader}${robot.isLeader ? ' (itself)' : ''}` : '',
+  ]
+    .filter((line, i) => i < 2 || line !== '')
+    .join('\n\n');
+  const icon = robot.lost
+    ? { icon: 'error', color: 'errorForeground' }
+    : robot.state === 'waiting'
+      ? { icon: 'watch' }
+      : robot.isLeader
+        ? { icon: 'star-full', color: 'charts.yellow' }
+        : robot.state === 'running'
+          ? { icon: 'pass', color: 'testing.iconPassed' }
+          : { icon: 'circle-outline' };
+  return {
+    id: `${view.uri}#${robot.robot}`,
+    kind: 'robot',
+    label: robot.robot,
+    description: parts.join(' · '),
+    tooltip,
+    ...icon,
+    children: robot.services.map((s) => ({
+      id: `${view.uri}#${robot.robot}/${s.plan}`,
+      kind: 'service' as const,
+      label: s.plan,
+      description: s.service,
+      tooltip: `plan ${s.plan} runs ${s.service}`,
+      icon: 'symbol-method',
+      children: [],
+    })),
+  };
+}
+
+/** The tree of one monitor: the connection first, then each robot. */
+export function buildLiveTree(view: MonitorView): LiveNode[] {
+  const down = view.connection === 'disconnected';
+  const connection: LiveNode = {
+    id: `${view.uri}#connection`,
+    kind: 'connection',
+    label: view.mission,
+    description: `${view.connection} · ${view.broker}`,
+    tooltip: down && view.error ? `${view.broker}: ${view.error}` : `${view.broker}: ${view.connection}`,
+    icon: down ? 'debug-disconnect' : view.connection === 'connected' ? 'broadcast' : 'loading~spin',
+    color: down ? 'errorForeground' : undefined,
+    children: [],
+  };
+  return [connection, ...view.robots.map((r) => robotNode(view, r))];
+}
+
+/** Whether a notification's params are a monitor view at all. */
+export function isMonitorView(params: unknown): params is MonitorView {
+  const p = params as MonitorView | undefined;
+  return !!p && typeof p.uri === 'string' && Array.isArray(p.robots);
+}

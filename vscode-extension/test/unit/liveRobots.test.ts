@@ -1,0 +1,107 @@
+import { strict as assert } from 'node:assert';
+import { test } from 'node:test';
+import { buildLiveTree, isMonitorView, MonitorView } from '../../src/pure/liveRobots';
+
+/** A `semo/monitor` notification shaped as server/src/monitor/roster.rs writes it. */
+const VIEW: MonitorView = {
+  uri: 'file:///w/patrol_groups.mission',
+  mission: 'patrol_groups',
+  broker: 'mqtt://127.0.0.1:1883',
+  connection: 'connected',
+  error: null,
+  robots: [
+    {
+      robot: 'tb_0',
+      team: 'Guards',
+      state: 'running',
+      lost: false,
+      mode: 'PATROL',
+      services: [
+        { plan: 'Action', service: 'Patrol' },
+        { plan: 'Report', service: 'ToBase' },
+      ],
+      leader: 'tb_0',
+      isLeader: true,
+      battery: null,
+    },
+    {
+      robot: 'tb_1',
+      team: 'Guards',
+      state: 'lost',
+      lost: true,
+      lostBecause: 'silent',
+      mode: 'PATROL',
+      services: [],
+      leader: 'tb_0',
+      isLeader: false,
+      battery: 40,
+    },
+    {
+      robot: 'ev_0',
+      team: 'Guards',
+      state: 'waiting',
+      lost: false,
+      mode: null,
+      services: [],
+      leader: null,
+      isLeader: false,
+      battery: null,
+    },
+  ],
+};
+
+test('one node per robot after the connection, services below each', () => {
+  const tree = buildLiveTree(VIEW);
+  assert.deepEqual(
+    tree.map((n) => [n.kind, n.label]),
+    [
+      ['connection', 'patrol_groups'],
+      ['robot', 'tb_0'],
+      ['robot', 'tb_1'],
+      ['robot', 'ev_0'],
+    ],
+  );
+  assert.equal(tree[0].description, 'connected · mqtt://127.0.0.1:1883');
+  assert.deepEqual(
+    tree[1].children.map((c) => [c.label, c.description]),
+    [
+      ['Action', 'Patrol'],
+      ['Report', 'ToBase'],
+    ],
+  );
+  // Ids are stable and unique, so VS Code keeps what the user expanded.
+  const ids = tree.flatMap((n) => [n.id, ...n.children.map((c) => c.id)]);
+  assert.equal(new Set(ids).size, ids.length);
+});
+
+test('the leader is marked, lost robots are marked with the reason, waiting ones too', () => {
+  const [, leader, lost, waiting] = buildLiveTree(VIEW);
+  assert.equal(leader.description, 'running · PATROL · ★ leader');
+  assert.equal(leader.icon, 'star-full');
+  assert.equal(lost.description, 'LOST · PATROL · battery 40');
+  assert.equal(lost.icon, 'error');
+  assert.match(lost.tooltip, /no heartbeat for three periods/);
+  assert.equal(waiting.description, 'waiting');
+  assert.equal(waiting.icon, 'watch');
+  const will = buildLiveTree({
+    ...VIEW,
+    robots: [{ ...VIEW.robots[1], lostBecause: 'lastWill' }],
+  })[1];
+  assert.match(will.tooltip, /last will/);
+});
+
+test('a broker that cannot be reached shows why', () => {
+  const [connection] = buildLiveTree({
+    ...VIEW,
+    connection: 'disconnected',
+    error: 'I/O: Connection refused (os error 111)',
+  });
+  assert.equal(connection.icon, 'debug-disconnect');
+  assert.match(connection.tooltip, /Connection refused/);
+});
+
+test('only monitor views are taken', () => {
+  assert.ok(isMonitorView(VIEW));
+  assert.ok(!isMonitorView({ uri: 'x' }));
+  assert.ok(!isMonitorView(null));
+});
