@@ -337,7 +337,7 @@ fn fixture(name: &str) -> String {
 // ------------------------------------------------------------------ tests
 
 #[test]
-fn values_compare_numerically_only_when_both_are_numbers() {
+fn values_are_typed_and_compare_as_the_checker_typed_them() {
     for flavor in flavors() {
         program(flavor).run_ok(&["values"]);
     }
@@ -364,6 +364,10 @@ fn tasks_channels_control_timers_and_trace_escaping() {
         assert_eq!(sends[0]["to"], "USER");
         assert_eq!(sends[0]["key"], "Team.STATUS");
         assert_eq!(sends[0]["value"], "ok");
+        // A word is traced as its text, an integer as a JSON number.
+        assert_eq!(sends[1]["key"], "Team.TURN");
+        assert_eq!(sends[1]["value"], "RIGHT");
+        assert_eq!(sends[2]["value"], -3);
         let dropped = events(&trace, "dropped");
         let spill = dropped
             .iter()
@@ -410,14 +414,16 @@ fn wait_for_start(trace: &Path, child: &mut Child) {
 /// Datagrams the receiver must reject (each traced as "reject"), and one
 /// well-formed message in the documented wire format.
 fn send_datagrams_to(port: u16) {
-    let junk: [&[u8]; 7] = [
+    let junk: [&[u8]; 9] = [
         b"hello",
-        b"SEMO\x01s\x05Alpha",               // cut short
-        &[b'x'; 2000],                       // larger than any message
-        b"SEMO\x01z\x01A\x01a\x01k\x01v",    // unknown kind
-        b"SEMO\x01s\x01\x00\x01a\x01k\x01v", // NUL inside a field
-        b"SEMO\x01s\x01A\x01a\x01k\x01vX",   // bytes after the value
-        b"SEMO\x01s\x28AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA\x01a\x01k\x01v", // team too long
+        b"SEMO\x02s\x05Alpha",                   // cut short
+        &[b'x'; 2000],                           // larger than any message
+        b"SEMO\x02z\x01A\x01a\x01k\x05\x01v",    // unknown kind
+        b"SEMO\x02s\x01\x00\x01a\x01k\x05\x01v", // NUL inside a field
+        b"SEMO\x02s\x01A\x01a\x01k\x05\x01vX",   // bytes after the value
+        b"SEMO\x02s\x01A\x01a\x01k\x01\x00\x07", // an integer cut short
+        b"SEMO\x01s\x01A\x01a\x01k\x01v",        // the old text format
+        b"SEMO\x02s\x28AAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAAA\x01a\x01k\x05\x01v", // team too long
     ];
     let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
     for datagram in junk {
@@ -425,7 +431,13 @@ fn send_datagrams_to(port: u16) {
     }
     socket
         .send_to(
-            b"SEMO\x01s\x05Alpha\x01a\x0aAlpha.NOTE\x02hi",
+            &semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+                publish: false,
+                team: "Alpha".into(),
+                robot: "a".into(),
+                key: "Alpha.NOTE".into(),
+                value: Some(semo::refine::Value::text("hi")),
+            }),
             ("127.0.0.1", port),
         )
         .unwrap();
@@ -479,7 +491,7 @@ fn two_robots_exchange_messages_over_udp_and_reject_malformed_datagrams() {
             .expect("well-formed datagram");
         assert_eq!(note["value"], "hi");
         assert!(received.iter().any(|e| e["key"] == "Alpha.BYE"));
-        assert_eq!(events(&b_trace, "reject").len(), 7, "{b_trace:#?}");
+        assert_eq!(events(&b_trace, "reject").len(), 9, "{b_trace:#?}");
     }
 }
 

@@ -235,11 +235,14 @@ fn a_seed_gives_the_same_run() {
         let event: serde_json::Value = serde_json::from_str(line).unwrap();
         let object = event.as_object().unwrap();
         assert!(object["t"].is_i64());
+        // Every field is a string but a mission value (`value`, `arg`),
+        // which keeps its type: a number, true/false, a string or null.
         assert!(
             object
                 .iter()
                 .filter(|(k, _)| *k != "t")
-                .all(|(_, v)| v.is_string()),
+                .all(|(k, v)| v.is_string()
+                    || (["value", "arg"].contains(&k.as_str()) && !v.is_object() && !v.is_array())),
             "{line}"
         );
     }
@@ -370,7 +373,7 @@ fn busy_scenario(seed: u64, programs: &[semo::refine::RobotProgram]) -> String {
     use semo::refine::SlotSource;
     let mut rng = support::missiongen::Rng::new(seed);
     let values = [
-        "0", "15", "50", "250", "DARK", "BRIGHT", "done", "0,0", "3,3",
+        "0", "15", "50", "250", "DARK", "BRIGHT", "done", "0,0", "3,3", "true", "false",
     ];
     let names: Vec<&str> = programs.iter().map(|p| p.robot.as_str()).collect();
     let mut robots = Vec::new();
@@ -379,11 +382,19 @@ fn busy_scenario(seed: u64, programs: &[semo::refine::RobotProgram]) -> String {
         let mut sensors = Vec::new();
         for slot in &p.control.slots {
             if let SlotSource::Sensor { port, .. } = &slot.source {
+                // A sensor gives values of its catalog type (the scenario
+                // reader refuses others); the operator's text may be of
+                // any (a robot refuses a command not of its key's type).
+                let fitting: Vec<&str> = values
+                    .iter()
+                    .copied()
+                    .filter(|v| slot.kind.parse(v).is_some())
+                    .collect();
                 for _ in 0..3 {
                     sensors.push(format!(
                         r#"{{"at": {}, "value": "{port}", "is": "{}"}}"#,
                         rng.below(3000),
-                        rng.pick(&values)
+                        rng.pick(&fitting)
                     ));
                 }
             }

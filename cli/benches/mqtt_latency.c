@@ -35,18 +35,24 @@ static int open_as(size_t self, int port)
     return semo_mqtt_transport.open(&program, &config);
 }
 
-static size_t datagram(unsigned char *out, const char *value)
+/* The runtime's datagram (semo_internal.h; semo__encode_message is not
+ * linked here, the bench has no program around the transport): "SEMO" 0x02
+ * `s`, three fields, then the value, typed: SEMO_INT and 8 bytes big-endian. */
+static size_t datagram(unsigned char *out, int64_t value)
 {
-    const char *fields[] = {"Bench", "a", "Bench.t", value};
+    const char *fields[] = {"Bench", "a", "Bench.t"};
     size_t n = 0;
-    memcpy(out, "SEMO\x01s", 6);
+    memcpy(out, "SEMO\x02s", 6);
     n = 6;
-    for (int i = 0; i < 4; i++) {
+    for (int i = 0; i < 3; i++) {
         size_t len = strlen(fields[i]);
         out[n++] = (unsigned char)len;
         memcpy(out + n, fields[i], len);
         n += len;
     }
+    out[n++] = SEMO_INT;
+    for (int shift = 56; shift >= 0; shift -= 8)
+        out[n++] = (unsigned char)((uint64_t)value >> shift);
     return n;
 }
 
@@ -71,10 +77,8 @@ int main(int argc, char **argv)
         if (read(ready[0], &go, 1) != 1 || open_as(0, port) != 0)
             _exit(1);
         for (long i = 0; i < count; i++) {
-            char value[32];
-            snprintf(value, sizeof value, "%" PRId64, now_ns());
             unsigned char data[64];
-            size_t len = datagram(data, value);
+            size_t len = datagram(data, now_ns());
             if (semo_mqtt_transport.send_to("b", data, len) != 0)
                 _exit(1);
             struct timespec pause = {0, 1000000};
@@ -94,17 +98,13 @@ int main(int argc, char **argv)
         if (n <= 0)
             break;
         int64_t at = now_ns();
-        /* The value is the last field: its length byte, then the digits. */
-        size_t at_field = 6, field = 0;
-        while (field < 3 && at_field < (size_t)n) {
-            at_field += 1 + data[at_field];
-            field++;
-        }
-        char value[32] = "";
-        size_t len = data[at_field];
-        if (len < sizeof value && at_field + 1 + len <= (size_t)n)
-            memcpy(value, data + at_field + 1, len);
-        latency[got++] = at - strtoll(value, NULL, 10);
+        /* The value is last: SEMO_INT and the time in 8 bytes big-endian. */
+        if (n < 9 || data[n - 9] != SEMO_INT)
+            break;
+        uint64_t sent = 0;
+        for (int i = n - 8; i < n; i++)
+            sent = sent << 8 | data[i];
+        latency[got++] = at - (int64_t)sent;
     }
     int status = 1;
     waitpid(sender, &status, 0);

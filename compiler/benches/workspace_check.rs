@@ -6,6 +6,8 @@
 //! into folders of a temporary directory, plus generated 1k-line missions
 //! (one folder each, `SEMO_BENCH_BIG`, default 10). Prints files/s and MB/s
 //! of the fastest run. Run with `cargo bench -p semo --bench workspace_check`.
+//! `SEMO_BENCH_WORKSPACE=DIR` writes the workspace into `DIR` and keeps it
+//! (to time `semo check DIR` as a whole process, old binary against new).
 
 mod common;
 use common::fastest;
@@ -44,7 +46,10 @@ fn main() {
     // `cargo bench` passes `--bench`; a filter argument is accepted and ignored.
     let copies = env_or("SEMO_BENCH_COPIES", 20);
     let big = env_or("SEMO_BENCH_BIG", 10);
-    let root: PathBuf = std::env::temp_dir().join(format!("semo-bench-ws-{}", std::process::id()));
+    let kept = std::env::var_os("SEMO_BENCH_WORKSPACE").map(PathBuf::from);
+    let root: PathBuf = kept.clone().unwrap_or_else(|| {
+        std::env::temp_dir().join(format!("semo-bench-ws-{}", std::process::id()))
+    });
     let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples");
     let (mut files, mut bytes) = (0, 0);
     for i in 0..copies {
@@ -79,5 +84,7 @@ fn main() {
         files as f64 / secs,
         bytes as f64 / 1e6 / secs
     );
-    std::fs::remove_dir_all(&root).expect("remove the workspace");
+    if kept.is_none() {
+        std::fs::remove_dir_all(&root).expect("remove the workspace");
+    }
 }

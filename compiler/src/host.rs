@@ -59,6 +59,7 @@ use std::borrow::Cow;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+use view::View;
 
 /// Where a workspace is: its roots, and the files or folders every file
 /// sees besides (`semo build --strategy`).
@@ -171,6 +172,8 @@ pub struct AnalysisHost {
     mission_folders: Arc<BTreeMap<PathBuf, usize>>,
     /// Every project file, read.
     projects: Projects,
+    /// What sees what: kept while the layout stays (see [`view`]).
+    view: Arc<View>,
     memo: Arc<Memo>,
 }
 
@@ -203,12 +206,14 @@ impl AnalysisHost {
             graphs_revision: 0,
             mission_folders: Arc::default(),
             projects: Projects::default(),
+            view: Arc::default(),
             memo: Arc::default(),
         }
     }
 
     pub fn set_roots(&mut self, roots: Roots) {
         self.roots = Arc::new(roots);
+        self.view = Arc::default();
     }
 
     pub fn roots(&self) -> &Roots {
@@ -236,6 +241,15 @@ impl AnalysisHost {
             let absolute = std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
             subgraph::normalize(&absolute)
         });
+        // What sees what depends on where files are and on project files,
+        // not on other texts.
+        let same_place = self
+            .files
+            .get(&id)
+            .is_some_and(|old| old.kind == kind && old.path == path && old.key == key);
+        if !same_place || kind == FileKind::Project {
+            self.view = Arc::default();
+        }
         let file = SourceText {
             id,
             path,
@@ -300,6 +314,7 @@ impl AnalysisHost {
             }
             self.count_mission(&old, -1);
             Arc::make_mut(&mut self.projects).remove(&id);
+            self.view = Arc::default();
             self.memo.forget(id);
         }
     }
@@ -312,6 +327,7 @@ impl AnalysisHost {
             graphs_revision: self.graphs_revision,
             mission_folders: self.mission_folders.clone(),
             projects: self.projects.clone(),
+            view: self.view.clone(),
             memo: self.memo.clone(),
         }
     }
@@ -393,6 +409,7 @@ pub struct Analysis {
     graphs_revision: u64,
     mission_folders: Arc<BTreeMap<PathBuf, usize>>,
     projects: Projects,
+    view: Arc<View>,
     memo: Arc<Memo>,
 }
 
@@ -470,15 +487,8 @@ impl Analysis {
         let Some(folder) = folder else {
             return Vec::new();
         };
-        // A file in `folder` (the name does not matter to the rule).
-        let reader = folder.join("_");
-        let mut seen: Vec<&SourceText> = self
-            .files()
-            .filter(|f| matches!(f.kind, FileKind::Catalog | FileKind::Strategy))
-            .filter(|f| f.key.as_deref().is_some_and(|p| self.sees(&reader, p)))
-            .collect();
-        seen.sort_by(|a, b| a.key.cmp(&b.key).then(a.id.0.cmp(&b.id.0)));
-        seen
+        let seen = self.seen_ids(folder);
+        seen.iter().filter_map(|&id| self.file(id)).collect()
     }
 
     /// The files `id` reads besides itself: the catalog and strategy files it
@@ -606,9 +616,9 @@ impl Analysis {
     fn unit_of(&self, folder: Option<&Path>) -> Arc<Unit> {
         let missions: Vec<&SourceText> = match folder {
             Some(folder) => self
-                .files()
-                .filter(|f| f.kind == FileKind::Mission)
-                .filter(|f| self.place(f).as_deref().and_then(self::folder) == Some(folder))
+                .missions_in(folder)
+                .iter()
+                .filter_map(|&id| self.file(id))
                 .collect(),
             None => Vec::new(),
         };
@@ -664,31 +674,26 @@ impl Analysis {
         let Some(path) = self.file(id).and_then(|f| f.key.as_deref()) else {
             return vec![None];
         };
-        let mut folders: Vec<Option<PathBuf>> = self
-            .files()
-            .filter(|f| f.kind == FileKind::Mission)
-            .filter_map(|m| self.place(m))
-            .filter(|m| self.sees(m, path))
-            .map(|m| folder(&m).map(Path::to_path_buf))
-            .collect();
-        folders.sort();
-        folders.dedup();
+        let folders = self.folders_seeing(id);
         if folders.is_empty() {
-            folders.push(folder(path).map(Path::to_path_buf));
+            return vec![folder(path).map(Path::to_path_buf)];
         }
-        folders
+        folders.iter().cloned().map(Some).collect()
     }
 
     /// The missions that see the strategy (or catalog) file `id`.
     pub fn missions_seeing(&self, id: FileId) -> Vec<FileId> {
-        let Some(path) = self.file(id).and_then(|f| f.key.as_deref()) else {
+        if self.file(id).and_then(|f| f.key.as_deref()).is_none() {
             return Vec::new();
-        };
-        self.files()
-            .filter(|f| f.kind == FileKind::Mission)
-            .filter(|m| self.place(m).is_some_and(|m| self.sees(&m, path)))
-            .map(|m| m.id)
-            .collect()
+        }
+        let mut missions: Vec<FileId> = self
+            .folders_seeing(id)
+            .iter()
+            .flat_map(|dir| self.missions_in(dir))
+            .copied()
+            .collect();
+        missions.sort();
+        missions
     }
 
     /// A strategy file's links: the calls of the missions that see it that
@@ -712,16 +717,13 @@ impl Analysis {
         if let Some(found) = fresh(lock(&self.memo.graphs).get(&id), &key) {
             return Some(found);
         }
-        let known = self
-            .files()
-            .filter(|f| f.kind == FileKind::TaskGraph)
-            .filter_map(|f| {
-                let source = SubgraphSource {
-                    file: f.id,
-                    text: f.text.clone(),
-                };
-                Some((subgraph::normalize(f.path.as_deref()?), source))
-            });
+        let known = self.graphs_as_named().iter().filter_map(|(path, id)| {
+            let source = SubgraphSource {
+                file: *id,
+                text: self.file(*id)?.text.clone(),
+            };
+            Some((path.clone(), source))
+        });
         // Files the host does not hold get ids counting down from below the
         // built-in catalog's: read for this analysis only.
         let mut resolver = FileResolver::below(known, crate::catalog::BUILTIN_FILE);
@@ -836,7 +838,31 @@ impl Analysis {
             .iter()
             .filter_map(|(_, s)| s.strategy.clone())
             .collect();
+        // The task graphs of the catalog's services that the workspace holds.
+        let mut service_graphs: Vec<crate::refine::ServiceGraph> = Vec::new();
+        for (_, robot_type) in unit.catalog.catalog.types() {
+            for def in &robot_type.services {
+                let crate::catalog::Implementation::Graph(path) = &def.implementation else {
+                    continue;
+                };
+                let known = service_graphs
+                    .iter()
+                    .any(|g| g.catalog == def.origin.file && g.path == *path);
+                if known {
+                    continue;
+                }
+                let loaded = self.service_graph(def.origin.file, path);
+                if let Some(graph) = loaded.and_then(|run| run.graph.clone()) {
+                    service_graphs.push(crate::refine::ServiceGraph {
+                        catalog: def.origin.file,
+                        path: path.clone(),
+                        graph: Arc::new(graph),
+                    });
+                }
+            }
+        }
         Some(BuildFiles {
+            service_graphs,
             mission_name: name_of(mission),
             strategy_names: strategies
                 .iter()
@@ -880,23 +906,29 @@ impl Analysis {
                     .filter(|&f| self.file(f).is_some_and(|f| f.kind == FileKind::Strategy)),
             ),
             FileKind::Catalog | FileKind::Strategy => {
+                // Strategy files share a unit with every strategy file it
+                // sees; catalog files also with its catalog files and missions.
+                let shares = |kind: FileKind| {
+                    kind == FileKind::Strategy
+                        || (file.kind == FileKind::Catalog && kind == FileKind::Catalog)
+                };
                 for unit_folder in self.units_seeing(id) {
-                    let reader = unit_folder.as_deref().map(|f| f.join("_"));
-                    for other in self.files() {
-                        let place = self.place(other);
-                        let shares = match (&reader, other.kind, place.as_deref()) {
-                            (None, ..)
-                            | (_, _, None)
-                            | (_, FileKind::TaskGraph | FileKind::Project, _) => false,
-                            (Some(reader), FileKind::Mission, Some(p)) => {
-                                file.kind == FileKind::Catalog && folder(p) == folder(reader)
-                            }
-                            (Some(reader), FileKind::Catalog, Some(p)) => {
-                                file.kind == FileKind::Catalog && self.sees(reader, p)
-                            }
-                            (Some(reader), FileKind::Strategy, Some(p)) => self.sees(reader, p),
-                        };
-                        if shares {
+                    let Some(unit_folder) = unit_folder else {
+                        continue;
+                    };
+                    if file.kind == FileKind::Catalog {
+                        out.extend(self.missions_in(&unit_folder));
+                    }
+                    let seen = self.seen_ids(&unit_folder);
+                    out.extend(
+                        seen.iter()
+                            .filter(|&&f| self.file(f).is_some_and(|f| shares(f.kind))),
+                    );
+                    // Documents that are not files read as files in the
+                    // first root: the rule decides for them one by one.
+                    let reader = unit_folder.join("_");
+                    for other in self.files().filter(|f| f.key.is_none() && shares(f.kind)) {
+                        if self.place(other).is_some_and(|p| self.sees(&reader, &p)) {
                             out.push(other.id);
                         }
                     }
@@ -939,6 +971,7 @@ pub struct BuildFiles {
     pub mission_name: String,
     pub strategy_names: Vec<(FileId, String)>,
     pub diagnostics: Vec<Diagnostic>,
+    pub service_graphs: Vec<crate::refine::ServiceGraph>,
 }
 
 impl BuildFiles {
@@ -953,6 +986,7 @@ impl BuildFiles {
             strategy_names: self.strategy_names.clone(),
             links: &self.unit.links,
             diagnostics: &self.diagnostics,
+            service_graphs: &self.service_graphs,
         }
     }
 }
@@ -963,6 +997,7 @@ mod dropper;
 mod ide;
 #[cfg(test)]
 mod tests;
+mod view;
 
 pub use disk::{
     CheckRun, ProjectInputs, STDIN_NAME, load_build, load_check, load_check_stdin, project_inputs,

@@ -241,8 +241,13 @@ pub(crate) fn start_tag(
     tag_end: usize,
 ) -> Result<StartTag, (Span, &'static str)> {
     let (name_span, tag) = start_tag_spans(text, e, tag_end);
-    let qname = SmolStr::new(String::from_utf8_lossy(e.name().as_ref()));
-    let local = SmolStr::new(String::from_utf8_lossy(e.local_name().as_ref()));
+    // The text itself where it can be (it is already UTF-8).
+    let name = |bytes: &[u8]| match slice_span(text, bytes).and_then(|s| text.get(s.range())) {
+        Some(name) => SmolStr::new(name),
+        None => SmolStr::new(String::from_utf8_lossy(bytes)),
+    };
+    let qname = name(e.name().as_ref());
+    let local = name(e.local_name().as_ref());
     if local.is_empty() {
         return Err((
             word_at(text, tag.start),
@@ -297,25 +302,39 @@ pub(crate) fn read_attributes(
     tag: Span,
     decoder: Decoder,
 ) -> Result<Vec<Attr>, (Span, String)> {
-    let (attrs, raw_lt) = read_attributes_keeping_lt(text, e, tag, decoder)?;
+    let mut attrs = Vec::new();
+    read_attributes_into(text, e, tag, decoder, &mut attrs).map(|()| attrs)
+}
+
+/// [`read_attributes`] into `out` (emptied first): a reader of many elements
+/// reuses one list.
+pub(crate) fn read_attributes_into(
+    text: &str,
+    e: &BytesStart<'_>,
+    tag: Span,
+    decoder: Decoder,
+    out: &mut Vec<Attr>,
+) -> Result<(), (Span, String)> {
+    let raw_lt = read_attributes_keeping_lt_into(text, e, tag, decoder, out)?;
     match raw_lt.first() {
         Some(&at) => Err((lt_span(text, at, tag), LT_IN_VALUE.to_string())),
-        None => Ok(attrs),
+        None => Ok(()),
     }
 }
 
 /// As [`read_attributes`], except that a `<` inside a value (which quick-xml
 /// reads as part of the value, and XML forbids) is kept: the byte position of
-/// every such `<` is returned with the attributes, for formats that report it
+/// every such `<` is returned, for formats that report it
 /// and read on. When the attribute list is malformed after such a `<`, the
 /// error is the `<` (a closing quote is likely missing there).
-pub(crate) fn read_attributes_keeping_lt(
+pub(crate) fn read_attributes_keeping_lt_into(
     text: &str,
     e: &BytesStart<'_>,
     tag: Span,
     decoder: Decoder,
-) -> Result<(Vec<Attr>, Vec<usize>), (Span, String)> {
-    let mut out = Vec::new();
+    out: &mut Vec<Attr>,
+) -> Result<Vec<usize>, (Span, String)> {
+    out.clear();
     let mut raw_lt: Vec<usize> = Vec::new();
     let fail = |raw_lt: &[usize], span: Span, message: String| match raw_lt.first() {
         Some(&at) => (lt_span(text, at, tag), LT_IN_VALUE.to_string()),
@@ -355,23 +374,36 @@ pub(crate) fn read_attributes_keeping_lt(
                 return Err(fail(&raw_lt, word_at(text, content_start + pos), message));
             }
         };
-        let key = SmolStr::new(String::from_utf8_lossy(attr.key.as_ref()));
-        let key_span = slice_span(text, attr.key.as_ref()).unwrap_or(tag);
+        let key_in_text = slice_span(text, attr.key.as_ref());
+        // The text itself where it can be (it is already UTF-8): most of a
+        // large file's reading time otherwise.
+        let key = match key_in_text.and_then(|span| text.get(span.range())) {
+            Some(key) => SmolStr::new(key),
+            None => SmolStr::new(String::from_utf8_lossy(attr.key.as_ref())),
+        };
+        let key_span = key_in_text.unwrap_or(tag);
         let raw: &[u8] = &attr.value;
-        let span = slice_span(text, raw).unwrap_or(tag);
+        let value_in_text = slice_span(text, raw);
+        let span = value_in_text.unwrap_or(tag);
         raw_lt.extend(
             raw.iter()
                 .enumerate()
                 .filter(|&(_, &b)| b == b'<')
                 .map(|(i, _)| span.start + i),
         );
-        let value = match attr.decode_and_unescape_value(decoder) {
-            Ok(v) => SmolStr::new(v),
-            Err(_) => {
-                let message =
-                    "this value has an unknown `&...;` entity: write `&amp;` for a plain `&`";
-                return Err(fail(&raw_lt, span, message.to_string()));
-            }
+        let plain = value_in_text
+            .filter(|_| !raw.contains(&b'&'))
+            .and_then(|span| text.get(span.range()));
+        let value = match plain {
+            Some(value) => SmolStr::new(value),
+            None => match attr.decode_and_unescape_value(decoder) {
+                Ok(v) => SmolStr::new(v),
+                Err(_) => {
+                    let message =
+                        "this value has an unknown `&...;` entity: write `&amp;` for a plain `&`";
+                    return Err(fail(&raw_lt, span, message.to_string()));
+                }
+            },
         };
         let exact = value.as_bytes() == raw;
         out.push(Attr {
@@ -382,7 +414,7 @@ pub(crate) fn read_attributes_keeping_lt(
             exact,
         });
     }
-    Ok((out, raw_lt))
+    Ok(raw_lt)
 }
 
 /// For each byte offset of `attr.value` (and one past its end), the byte

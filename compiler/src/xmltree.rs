@@ -1,6 +1,9 @@
 //! A positioned XML element tree, read with quick-xml: every element, attribute
 //! and attribute value keeps its byte range. The task-graph and strategy loaders
-//! read a file into this tree first, then read the tree as their model.
+//! read a file into this tree first, then read the tree as their model. The
+//! walk under the tree ([`walk`], [`Visit`]) is for a loader that reads the
+//! elements as they come instead (SDF3 graphs, large ones): the same
+//! well-formedness checks and positions without holding the tree.
 //!
 //! Malformed XML is reported with the format's own code and stops reading; what
 //! was read before the error is kept, the elements left open marked incomplete.
@@ -8,7 +11,7 @@
 use crate::diag::{Code, Diagnostic, FileId, Sink};
 use crate::span::Span;
 use crate::xmlpos::{
-    self, Attr, StartTag, read_attributes, read_attributes_keeping_lt, resolve_reference,
+    self, Attr, StartTag, read_attributes_into, read_attributes_keeping_lt_into, resolve_reference,
     trim_span, xml_error_message,
 };
 use quick_xml::encoding::Decoder;
@@ -52,21 +55,101 @@ pub(crate) struct TreeFormat<'a> {
 /// Reads `text` into its root element (with everything read before any XML
 /// error) and the diagnostics of malformed XML.
 pub(crate) fn read_tree(text: &str, format: TreeFormat<'_>) -> (Option<Elem>, Vec<Diagnostic>) {
-    let mut builder = TreeBuilder {
+    let mut tree = TreeCollector::default();
+    let diagnostics = walk(text, format, &mut tree);
+    (tree.root, diagnostics)
+}
+
+/// What a reader does with the elements as they are read, in document order,
+/// instead of holding the whole tree: a loader that needs only some elements
+/// keeps only what it needs (the SDF3 reader).
+pub(crate) trait Visit {
+    /// A start tag: `elem` has its names, ranges and attributes, no children
+    /// or texts, and `span` is its tag. Its [`Visit::close`] follows after
+    /// its content (at once for `<a/>`).
+    fn open(&mut self, elem: &Elem);
+    /// The end of the element opened last: `span` is now the whole element,
+    /// `complete` false when malformed XML stopped reading inside it. The
+    /// visitor may take what it keeps (its attributes) out of `elem`.
+    fn close(&mut self, elem: &mut Elem);
+    /// Non-blank text directly inside the element opened last, trimmed.
+    fn text(&mut self, span: Span);
+}
+
+/// Walks `text` with quick-xml, checking that it is well-formed, and tells
+/// `visitor` the elements; returns the diagnostics of malformed XML. Elements
+/// left open by an error are closed as incomplete, innermost first.
+pub(crate) fn walk(
+    text: &str,
+    format: TreeFormat<'_>,
+    visitor: &mut impl Visit,
+) -> Vec<Diagnostic> {
+    let mut walker = Walker {
         text,
         diagnostics: Sink::quoting_xml(format.file),
         format,
         stack: Vec::new(),
         root: None,
+        spare: Vec::new(),
+        visitor,
     };
-    let stopped_at = builder.run();
-    // Elements left open by an error: keep them, marked incomplete.
-    while let Some(mut open) = builder.stack.pop() {
+    let stopped_at = walker.run();
+    while let Some(mut open) = walker.stack.pop() {
         open.span = Span::new(open.tag.start, stopped_at.max(open.tag.end));
         open.complete = false;
-        builder.attach(open);
+        walker.close(open);
     }
-    (builder.root, builder.diagnostics.into_vec())
+    walker.diagnostics.into_vec()
+}
+
+/// The [`Visit`] that keeps every element: the tree of [`read_tree`].
+#[derive(Default)]
+pub(crate) struct TreeCollector {
+    /// Per open element, the children and texts read so far.
+    open: Vec<(Vec<Elem>, Vec<Span>)>,
+    root: Option<Elem>,
+}
+
+impl TreeCollector {
+    /// The root element read, if any.
+    pub fn into_root(self) -> Option<Elem> {
+        self.root
+    }
+}
+
+impl Visit for TreeCollector {
+    fn open(&mut self, _: &Elem) {
+        self.open.push((Vec::new(), Vec::new()));
+    }
+
+    fn close(&mut self, elem: &mut Elem) {
+        let (children, texts) = self.open.pop().unwrap_or_default();
+        let elem = Elem {
+            qname: elem.qname.clone(),
+            local: elem.local.clone(),
+            name_span: elem.name_span,
+            tag: elem.tag,
+            span: elem.span,
+            attrs: std::mem::take(&mut elem.attrs),
+            children,
+            texts,
+            complete: elem.complete,
+        };
+        match self.open.last_mut() {
+            Some((siblings, _)) => siblings.push(elem),
+            None => {
+                if self.root.is_none() {
+                    self.root = Some(elem);
+                }
+            }
+        }
+    }
+
+    fn text(&mut self, span: Span) {
+        if let Some((_, texts)) = self.open.last_mut() {
+            texts.push(span);
+        }
+    }
 }
 
 /// A diagnostic whose message is one line, whatever text it quotes.
@@ -173,15 +256,20 @@ struct Stop;
 
 type Flow = Result<(), Stop>;
 
-struct TreeBuilder<'t, 'f> {
+struct Walker<'t, 'f, 'v, V> {
     text: &'t str,
     format: TreeFormat<'f>,
     diagnostics: Sink,
+    /// The elements open, outermost first (without children).
     stack: Vec<Elem>,
-    root: Option<Elem>,
+    /// The root element's name, once it is read.
+    root: Option<smol_str::SmolStr>,
+    /// Attribute lists of closed elements, reused for the next ones.
+    spare: Vec<Vec<Attr>>,
+    visitor: &'v mut V,
 }
 
-impl TreeBuilder<'_, '_> {
+impl<V: Visit> Walker<'_, '_, '_, V> {
     /// Reads events until the end or an error; returns where reading stopped.
     fn run(&mut self) -> usize {
         let text = self.text;
@@ -244,14 +332,13 @@ impl TreeBuilder<'_, '_> {
         Err(Stop)
     }
 
-    fn attach(&mut self, elem: Elem) {
-        match self.stack.last_mut() {
-            Some(parent) => parent.children.push(elem),
-            None => {
-                if self.root.is_none() {
-                    self.root = Some(elem);
-                }
-            }
+    /// Tells the visitor that `elem` ends, keeping its attribute list for
+    /// reuse when the visitor left it.
+    fn close(&mut self, mut elem: Elem) {
+        self.visitor.close(&mut elem);
+        if elem.attrs.capacity() > 0 {
+            elem.attrs.clear();
+            self.spare.push(elem.attrs);
         }
     }
 
@@ -278,9 +365,9 @@ impl TreeBuilder<'_, '_> {
             return Ok(());
         }
         let span = trim_span(s, span);
-        match self.stack.last_mut() {
-            Some(top) => {
-                top.texts.push(span);
+        match self.stack.last() {
+            Some(_) => {
+                self.visitor.text(span);
                 Ok(())
             }
             None => self.malformed(
@@ -296,11 +383,13 @@ impl TreeBuilder<'_, '_> {
         tag: Span,
         decoder: Decoder,
     ) -> Result<Vec<Attr>, Stop> {
+        let mut attrs = self.spare.pop().unwrap_or_default();
         let Some(code) = self.format.raw_lt else {
-            return read_attributes(self.text, e, tag, decoder)
+            return read_attributes_into(self.text, e, tag, decoder, &mut attrs)
+                .map(|()| attrs)
                 .map_err(|(span, message)| self.report_stop(span, message));
         };
-        let (attrs, raw_lt) = read_attributes_keeping_lt(self.text, e, tag, decoder)
+        let raw_lt = read_attributes_keeping_lt_into(self.text, e, tag, decoder, &mut attrs)
             .map_err(|(span, message)| self.report_stop(span, message))?;
         for at in raw_lt {
             let value = attrs
@@ -342,11 +431,11 @@ impl TreeBuilder<'_, '_> {
         if self.stack.is_empty() {
             if let Some(root) = &self.root {
                 let message = format!(
-                    "`<{qname}>` comes after the end of `<{}>`: a file has a single root element",
-                    root.qname
+                    "`<{qname}>` comes after the end of `<{root}>`: a file has a single root element"
                 );
                 return self.malformed(name_span, message);
             }
+            self.root = Some(qname.clone());
         }
         let elem = Elem {
             qname,
@@ -359,8 +448,9 @@ impl TreeBuilder<'_, '_> {
             texts: Vec::new(),
             complete: empty,
         };
+        self.visitor.open(&elem);
         if empty {
-            self.attach(elem);
+            self.close(elem);
         } else {
             self.stack.push(elem);
         }
@@ -384,7 +474,7 @@ impl TreeBuilder<'_, '_> {
             Some(mut open) => {
                 open.span = Span::new(open.tag.start, span.end);
                 open.complete = true;
-                self.attach(open);
+                self.close(open);
                 Ok(())
             }
         }

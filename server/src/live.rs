@@ -3,7 +3,8 @@
 //! (`crate::monitor`). One decoding of the robots' retained status
 //! (`docs/deployment.md`, "Status"; written by `semo_runtime.c`'s
 //! `observe_status` and `semo_mqtt.c`'s last will) and of the runtime's
-//! datagram (`semo_runtime.c`'s `encode_message`), so that both read the
+//! datagram (`semo_core.c`'s `semo__encode_message`, through
+//! `semo::deploy::datagram`), so that both read the
 //! same thing the same way.
 
 /// A robot's status message on `semo/<mission>/status/<robot>`.
@@ -84,32 +85,26 @@ pub fn mqtt_address(url: &str) -> Option<(String, u16)> {
 /// The broker a robot uses when nothing says otherwise.
 pub const DEFAULT_BROKER: &str = "mqtt://127.0.0.1:1883";
 
-/// A `send` from the operator as the runtime's datagram: "SEMO" 1, `s`,
-/// then team `USER`, robot `operator`, the key and the value, each a length
-/// byte and at most 255 bytes.
+/// A `send` from the operator as the runtime's datagram
+/// (`semo::deploy::datagram`, the bytes `semo_core.c` reads): team `USER`,
+/// robot `operator`, the value as text (the robot reads it as the type its
+/// mission declares for the key).
 pub fn operator_datagram(key: &str, value: &str) -> Vec<u8> {
-    let mut out = b"SEMO\x01s".to_vec();
-    for field in ["USER", "operator", key, value] {
-        let bytes = &field.as_bytes()[..field.len().min(255)];
-        out.push(bytes.len() as u8);
-        out.extend_from_slice(bytes);
-    }
-    out
+    semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+        publish: false,
+        team: "USER".into(),
+        robot: "operator".into(),
+        key: key.into(),
+        value: Some(semo::refine::Value::text(value)),
+    })
 }
 
-/// The fields of a runtime datagram: (team, robot, key, value).
+/// The fields of a runtime datagram: (team, robot, key, value), the value
+/// as text (`(none)` for a value never set).
 pub fn datagram_fields(data: &[u8]) -> Option<[String; 4]> {
-    if data.len() < 6 || &data[..5] != b"SEMO\x01" {
-        return None;
-    }
-    let mut at = 6;
-    let mut take = || {
-        let n = *data.get(at)? as usize;
-        let text = data.get(at + 1..at + 1 + n)?;
-        at += 1 + n;
-        Some(String::from_utf8_lossy(text).into_owned())
-    };
-    Some([take()?, take()?, take()?, take()?])
+    let d = semo::deploy::datagram::decode(data)?;
+    let value = d.value.map_or_else(|| "(none)".into(), |v| v.as_text());
+    Some([d.team, d.robot, d.key, value])
 }
 
 #[cfg(test)]

@@ -71,11 +71,15 @@ impl FakeRobot {
 
     /// A heartbeat of team Guards's leader election: the runtime's datagram.
     async fn heartbeat(&self) {
-        let mut datagram = b"SEMO\x01p".to_vec();
-        for field in ["Guards", &self.robot, "Guards.__alive", &self.robot] {
-            datagram.push(field.len() as u8);
-            datagram.extend_from_slice(field.as_bytes());
-        }
+        // The runtime's datagram (`semo::deploy::datagram`): a heartbeat's
+        // value is text.
+        let datagram = semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+            publish: true,
+            team: "Guards".into(),
+            robot: self.robot.clone(),
+            key: "Guards.__alive".into(),
+            value: Some(semo::refine::Value::text("member -")),
+        });
         self.client
             .publish(
                 "semo/patrol_groups/Guards/Guards.__alive",

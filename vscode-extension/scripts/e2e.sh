@@ -7,7 +7,7 @@
 # (or set SEMO_BIN). No `semo.server.path` and no `semo` on code-server's
 # PATH, so the extension runs the server it bundles, as a user's would.
 #
-# Needs Debian's chromium, ripgrep and libkrb5-dev (see .ci/run).
+# Needs Debian's chromium, ripgrep, libkrb5-dev, mosquitto and mosquitto-clients (see .ci/run).
 # Artifacts (screenshots, code-server's log) land in target/vscode-e2e/.
 set -euo pipefail
 ext="$(cd "$(dirname "$0")/.." && pwd)"
@@ -30,6 +30,17 @@ bash scripts/install-code-server.sh "$cs_prefix"
 code_server="$cs_prefix/node_modules/.bin/code-server"
 echo "e2e: setup took $(( $(date +%s) - started ))s"
 
+# A private MQTT broker for the Robots (live) test, on a free loopback port
+# (Debian's mosquitto, see .ci/run); the test publishes robot statuses to it.
+mosquitto_bin="$(command -v mosquitto || echo /usr/sbin/mosquitto)"
+[ -x "$mosquitto_bin" ] || { echo "e2e: mosquitto is missing (apt-get install mosquitto mosquitto-clients)" >&2; exit 1; }
+mqtt_port="$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')"
+mkdir -p "$work"
+printf 'user %s\nlistener %s 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\n' "$(id -un)" "$mqtt_port" > "$work/mosquitto.conf"
+"$mosquitto_bin" -c "$work/mosquitto.conf" > "$work/mosquitto.log" 2>&1 &
+broker_pid=$!
+trap 'kill "$broker_pid" 2>/dev/null || true' EXIT
+
 # A fresh profile and extensions folder each run; the workspace is a copy,
 # since the test writes into it.
 rm -rf "$work/profile" "$work/extensions" "$work/workspace" "$work/shots"
@@ -39,6 +50,7 @@ cat > "$work/profile/User/settings.json" <<JSON
 {
   "[semo]": { "editor.formatOnSave": true },
   "semo.trace.server": "messages",
+  "semo.monitor.broker": "mqtt://127.0.0.1:$mqtt_port",
   "workbench.startupEditor": "none",
   "workbench.tips.enabled": false,
   "workbench.enableExperiments": false,
@@ -71,7 +83,7 @@ PATH="$clean_path" "$code_server" "${common[@]}" --auth none --bind-addr "127.0.
   --disable-telemetry --disable-update-check --disable-workspace-trust \
   --disable-getting-started-override "$work/workspace" > "$work/code-server.log" 2>&1 &
 server_pid=$!
-trap 'kill "$server_pid" 2>/dev/null || true; wait "$server_pid" 2>/dev/null || true' EXIT
+trap 'kill "$server_pid" "$broker_pid" 2>/dev/null || true; wait "$server_pid" 2>/dev/null || true' EXIT
 for _ in $(seq 1 120); do
   if curl -fsS "http://127.0.0.1:$port/healthz" > /dev/null 2>&1; then break; fi
   if ! kill -0 "$server_pid" 2>/dev/null; then
@@ -81,6 +93,6 @@ for _ in $(seq 1 120); do
 done
 
 CHROMIUM="$chromium" SEMO_E2E_URL="http://127.0.0.1:$port/?folder=$work/workspace" \
-  SEMO_E2E_OUT="$work" SEMO_E2E_WORKSPACE="$work/workspace" \
+  SEMO_E2E_OUT="$work" SEMO_E2E_WORKSPACE="$work/workspace" SEMO_E2E_MQTT_PORT="$mqtt_port" \
   node --test --test-timeout=240000 "$ext/test/e2e/"
 echo "e2e: done in $(( $(date +%s) - started ))s; screenshots in $work/shots"

@@ -40,6 +40,7 @@ pub(super) fn resource_manager(program: &RobotProgram) -> String {
         return String::new();
     }
     let tasks = m.battery_tasks();
+    let words = super::values::Words::of(program);
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -55,7 +56,7 @@ pub(super) fn resource_manager(program: &RobotProgram) -> String {
             "    /* {} ({}) */\n    holds = {};\n    if (holds != policy_holds[{i}]) {{\n        policy_holds[{i}] = holds;\n        semo_trace(\"battery_policy\", \"condition\", {}, \"holds\", holds ? \"true\" : \"false\", NULL);\n    }}",
             c::comment(&policy.text),
             c::comment(&policy.source),
-            expr(&policy.condition),
+            expr(&policy.condition, &words),
             c::string(&policy.text),
         );
     }

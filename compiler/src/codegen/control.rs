@@ -7,6 +7,7 @@
 //! this firing), `STEP_WAIT` (try again next firing) or `STEP_DONE`.
 
 use super::c;
+use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::{
     ActionMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, SlotSource, State, StateKind,
@@ -60,6 +61,7 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
     out.push_str("enum { STEP_NEXT, STEP_WAIT, STEP_DONE };\n\n");
 
     // Values.
+    let words = Words::of(program);
     let _ = writeln!(out, "/* Values the machine reads and writes. */");
     // A robot that reads no values has no slots (an unused array fails -Werror).
     if !m.slots.is_empty() {
@@ -71,7 +73,12 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
             SlotSource::Shared => "shared information (library)".into(),
             SlotSource::Local => "strategy variable".into(),
         };
-        let _ = writeln!(out, "/* slot[{i}]: {} ({from}) */", c::comment(&s.key));
+        let _ = writeln!(
+            out,
+            "/* slot[{i}]: {} ({from}): {} */",
+            c::comment(&s.key),
+            c::comment(&s.kind.describe())
+        );
     }
     out.push('\n');
 
@@ -119,7 +126,7 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
     // are written (unused static functions and arrays fail -Werror).
     let mut body = String::new();
     for (i, machine) in m.actions.iter().enumerate() {
-        emit_action_machine(&mut body, program, i, machine);
+        emit_action_machine(&mut body, program, &words, i, machine);
     }
     for (i, service) in m.services.iter().enumerate() {
         let _ = writeln!(
@@ -132,7 +139,7 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
             service.line
         );
         for (pc, state) in service.states.iter().enumerate() {
-            emit_state(&mut body, program, pc, state);
+            emit_state(&mut body, program, &words, pc, state);
         }
         body.push_str("    default:\n        return STEP_DONE;\n    }\n}\n\n");
     }
@@ -165,20 +172,20 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
     out
 }
 
-fn operand(op: &Operand) -> String {
+fn operand(op: &Operand, words: &Words) -> String {
     match op {
         Operand::Slot(s) => format!("&slot[{s}]"),
-        Operand::Literal(text) => format!("SEMO_LIT({})", c::string(text)),
+        Operand::Literal(value) => words.literal(value),
     }
 }
 
-pub(super) fn expr(e: &Expr) -> String {
+pub(super) fn expr(e: &Expr, words: &Words) -> String {
     match e {
-        Expr::Or(a, b) => format!("({} || {})", expr(a), expr(b)),
-        Expr::And(a, b) => format!("({} && {})", expr(a), expr(b)),
-        Expr::Not(a) => format!("!{}", expr(a)),
+        Expr::Or(a, b) => format!("({} || {})", expr(a, words), expr(b, words)),
+        Expr::And(a, b) => format!("({} && {})", expr(a, words), expr(b, words)),
+        Expr::Not(a) => format!("!{}", expr(a, words)),
         Expr::Bool(b) => b.to_string(),
-        Expr::Truthy(o) => format!("semo_value_truthy({})", operand(o)),
+        Expr::Truthy(o) => format!("semo_value_truthy({})", operand(o, words)),
         // As the checker typed the comparison: the runtime never guesses
         // from the values whether they are numbers.
         Expr::Compare(a, op, b, compared) => {
@@ -194,7 +201,11 @@ pub(super) fn expr(e: &Expr) -> String {
                 CmpOp::Gt => "SEMO_GT",
                 CmpOp::Ge => "SEMO_GE",
             };
-            format!("{function}({}, {op}, {})", operand(a), operand(b))
+            format!(
+                "{function}({}, {op}, {})",
+                operand(a, words),
+                operand(b, words)
+            )
         }
     }
 }
@@ -296,15 +307,15 @@ fn request_index(program: &RobotProgram, task: &str) -> usize {
         .unwrap_or(0)
 }
 
-fn args_array(args: &[Operand]) -> String {
+fn args_array(args: &[Operand], words: &Words) -> String {
     if args.is_empty() {
         return "NULL".into();
     }
-    let items: Vec<String> = args.iter().map(operand).collect();
+    let items: Vec<String> = args.iter().map(|a| operand(a, words)).collect();
     format!("(const semo_value *const[]){{{}}}", items.join(", "))
 }
 
-fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State) {
+fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize, state: &State) {
     let m = &program.control;
     let _ = writeln!(
         out,
@@ -350,7 +361,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
         }
         StateKind::Send { items } => {
             for item in items {
-                let value = operand(&item.value);
+                let value = operand(&item.value, words);
                 if let Some(s) = item.store {
                     let _ = writeln!(out, "        store({s}, {value});");
                 }
@@ -408,7 +419,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 task = c::string(task),
                 service = c::string(service),
                 argc = args.len(),
-                args = args_array(args),
+                args = args_array(args, words),
             );
             if let Some(t) = timeout_ms {
                 let _ = writeln!(
@@ -435,7 +446,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
             let _ = writeln!(out, "        if (r->phase == 0) {{");
             for (i, slot) in am.arguments.iter().enumerate() {
                 if let Some(arg) = args.get(i) {
-                    let _ = writeln!(out, "            store({slot}, {});", operand(arg));
+                    let _ = writeln!(out, "            store({slot}, {});", operand(arg, words));
                 }
             }
             let _ = writeln!(
@@ -498,7 +509,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
             let _ = writeln!(
                 out,
                 "        r->pc = {} ? {next} : {else_to};\n        return STEP_NEXT;",
-                expr(condition)
+                expr(condition, words)
             );
         }
         StateKind::Jump { to } => {
@@ -513,7 +524,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 let _ = writeln!(
                     out,
                     "        if (!{}) {{\n            r->pc = {exit_to};\n            return STEP_NEXT;\n        }}",
-                    expr(cond)
+                    expr(cond, words)
                 );
             }
             let _ = writeln!(
@@ -552,7 +563,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
                 let _ = writeln!(
                     out,
                     "        if (!{})\n            return STEP_DONE;",
-                    expr(cond)
+                    expr(cond, words)
                 );
             }
             if let Some(p) = period_ms {
@@ -570,7 +581,13 @@ fn emit_state(out: &mut String, program: &RobotProgram, pc: usize, state: &State
     }
 }
 
-fn emit_action_machine(out: &mut String, program: &RobotProgram, index: usize, am: &ActionMachine) {
+fn emit_action_machine(
+    out: &mut String,
+    program: &RobotProgram,
+    words: &Words,
+    index: usize,
+    am: &ActionMachine,
+) {
     let _ = writeln!(
         out,
         "/* Strategy actions of `{}` ({}): phase 1 enters r->action (issues its\n * commands), phase 2 waits for them and takes the first transition that holds. */\nstatic int actions_{index}(region *r)\n{{\n    switch (r->action) {{",
@@ -595,10 +612,10 @@ fn emit_action_machine(out: &mut String, program: &RobotProgram, index: usize, a
                 let port = request_index(program, task);
                 let _ = writeln!(
                     out,
-                    "            if (!request(request_port[{port}], {}, {}, 1, (const semo_value *const[]){{SEMO_LIT({})}}))\n                return STEP_WAIT;",
+                    "            if (!request(request_port[{port}], {}, {}, 1, (const semo_value *const[]){{{}}}))\n                return STEP_WAIT;",
                     c::string(task),
                     c::string(&actuator_name(program, task)),
-                    c::string(command)
+                    words.literal(command)
                 );
             }
             out.push_str("            r->phase = 2;\n            return STEP_WAIT;\n        }\n");
@@ -611,7 +628,9 @@ fn emit_action_machine(out: &mut String, program: &RobotProgram, index: usize, a
             }
         }
         for (condition, to) in &action.transitions {
-            let test = condition.as_ref().map_or_else(|| "true".to_string(), expr);
+            let test = condition
+                .as_ref()
+                .map_or_else(|| "true".to_string(), |c| expr(c, words));
             let _ = writeln!(
                 out,
                 "        if ({test}) {{\n            r->action = {to};\n            r->phase = 1;\n            return STEP_NEXT;\n        }}"

@@ -2,6 +2,7 @@
 //! `comm_task.c`, `lib_<name>.c`, `tasks/<task>.c` and the `Makefile`.
 
 use super::c;
+use super::values::Words;
 use super::{CompiledScenario, Platform, Target};
 use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK, getter, setter};
 use crate::refine::{RobotProgram, RoleKind};
@@ -189,6 +190,14 @@ pub fn main_c(program: &RobotProgram, target: Target, header: &str) -> String {
             }
         }
     }
+    let words = Words::of(program);
+    if !words.list().is_empty() {
+        out.push_str("/* The words of the program: a word value is an index into it. */\nstatic const char *const words[] = {\n");
+        for w in words.list() {
+            let _ = writeln!(out, "    {},", c::string(w));
+        }
+        out.push_str("};\n\n");
+    }
     out.push_str("/* Every robot of the mission: robot i listens on UDP port base + i. */\nstatic const semo_peer peers[] = {\n");
     for (team, robot) in &program.peers {
         let _ = writeln!(out, "    {{{}, {}}},", c::string(team), c::string(robot));
@@ -196,7 +205,7 @@ pub fn main_c(program: &RobotProgram, target: Target, header: &str) -> String {
     out.push_str("};\n\n");
     let _ = writeln!(
         out,
-        "static const semo_program_desc program = {{\n    .mission = {},\n    .team = {},\n    .robot = {},\n    .robot_type = {},\n    .tasks = tasks,\n    .task_count = sizeof tasks / sizeof tasks[0],\n    .channels = semo_program_channels,\n    .channel_count = SEMO_CHANNEL_COUNT,\n    .groups = {},\n    .group_count = {},\n    .peers = peers,\n    .peer_count = sizeof peers / sizeof peers[0],\n    .self = {},\n{}}};\n\nint main(int argc, char **argv)\n{{\n    return semo_main(argc, argv, &program);\n}}",
+        "static const semo_program_desc program = {{\n    .mission = {},\n    .team = {},\n    .robot = {},\n    .robot_type = {},\n    .tasks = tasks,\n    .task_count = sizeof tasks / sizeof tasks[0],\n    .channels = semo_program_channels,\n    .channel_count = SEMO_CHANNEL_COUNT,\n    .groups = {},\n    .group_count = {},\n    .peers = peers,\n    .peer_count = sizeof peers / sizeof peers[0],\n    .self = {},\n{}{}}};\n\nint main(int argc, char **argv)\n{{\n    return semo_main(argc, argv, &program);\n}}",
         c::string(&program.mission),
         c::string(&program.team),
         c::string(&program.robot),
@@ -208,6 +217,11 @@ pub fn main_c(program: &RobotProgram, target: Target, header: &str) -> String {
             "    .schedule = schedule,\n    .schedule_count = sizeof schedule / sizeof schedule[0],\n"
         } else {
             ""
+        },
+        if words.list().is_empty() {
+            ""
+        } else {
+            "    .words = words,\n    .word_count = sizeof words / sizeof words[0],\n"
         }
     );
     out
@@ -274,7 +288,7 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
     if m.heartbeat {
         let _ = writeln!(
             out,
-            "/* Heartbeats of the team's robots, for leader elections: when each robot\n * was last heard from, and what it said (`leader 87`: it claims\n * leadership, battery 87; `member -`: it does not, battery unknown). Every\n * robot counts as alive at start. */\n{declare}static comm_heartbeat heard[{peers}];\n\ncomm_heartbeat comm_heard(size_t peer)\n{{\n    comm_heartbeat h = {{0, false, -1}};\n    {lock_seen}\n    if (peer < {peers})\n        h = heard[peer];\n    {unlock_seen}\n    return h;\n}}\n\nstatic bool heard_alive(const semo_message *m)\n{{\n    if (m->kind != SEMO_MSG_PUBLISH || strcmp(m->key, {key}) != 0)\n        return false;\n    const char *battery = strchr(m->value.text, ' ');\n    comm_heartbeat h = {{semo_now_ms(), strncmp(m->value.text, \"leader \", 7) == 0, -1}};\n    if (battery && battery[1] >= '0' && battery[1] <= '9')\n        h.battery = strtol(battery + 1, NULL, 10);\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        if (strcmp(p->peers[i].robot, m->from_robot) == 0) {{\n            {lock_seen}\n            heard[i] = h;\n            {unlock_seen}\n        }}\n    return true;\n}}\n",
+            "/* Heartbeats of the team's robots, for leader elections: when each robot\n * was last heard from, and what it said (`leader 87`: it claims\n * leadership, battery 87; `member -`: it does not, battery unknown). Every\n * robot counts as alive at start. */\n{declare}static comm_heartbeat heard[{peers}];\n\ncomm_heartbeat comm_heard(size_t peer)\n{{\n    comm_heartbeat h = {{0, false, -1}};\n    {lock_seen}\n    if (peer < {peers})\n        h = heard[peer];\n    {unlock_seen}\n    return h;\n}}\n\nstatic bool heard_alive(const semo_message *m)\n{{\n    if (m->kind != SEMO_MSG_PUBLISH || strcmp(m->key, {key}) != 0)\n        return false;\n    /* The value is text; of another type it says only that the robot lives. */\n    const char *said = m->value.type == SEMO_TEXT ? m->value.text : \"\";\n    const char *battery = strchr(said, ' ');\n    comm_heartbeat h = {{semo_now_ms(), strncmp(said, \"leader \", 7) == 0, -1}};\n    if (battery && battery[1] >= '0' && battery[1] <= '9')\n        h.battery = strtol(battery + 1, NULL, 10);\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        if (strcmp(p->peers[i].robot, m->from_robot) == 0) {{\n            {lock_seen}\n            heard[i] = h;\n            {unlock_seen}\n        }}\n    return true;\n}}\n",
             peers = program.peers.len().max(1),
             key = c::string(&alive_key(program))
         );
@@ -283,7 +297,7 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         let points: Vec<String> = m.sync_points.iter().map(|p| p.to_string()).collect();
         let _ = writeln!(
             out,
-            "/* GroupSync: for each robot and sync point (the group statement's offset\n * in the mission), the last pass it announced (`Team.__sync` = \"<point>\n * <pass>\"). A new one wakes the control task, which may be waiting. */\nstatic const long sync_point[] = {{{list}}};\nstatic long arrived[{peers}][{n}];\n\nlong comm_sync_arrived(size_t peer, size_t point)\n{{\n    long pass = 0;\n    {lock_seen}\n    if (peer < {peers} && point < {n})\n        pass = arrived[peer][point];\n    {unlock_seen}\n    return pass;\n}}\n\nstatic bool heard_sync(const semo_message *m)\n{{\n    if (strcmp(m->key, {key}) != 0)\n        return false;\n    char *end;\n    long point = strtol(m->value.text, &end, 10), pass = strtol(end, NULL, 10);\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        for (size_t k = 0; k < {n}; k++)\n            if (strcmp(p->peers[i].robot, m->from_robot) == 0 && sync_point[k] == point) {{\n                {lock_seen}\n                if (pass > arrived[i][k])\n                    arrived[i][k] = pass;\n                {unlock_seen}\n            }}\n    semo_wake({control});\n    return true;\n}}\n",
+            "/* GroupSync: for each robot and sync point (the group statement's offset\n * in the mission), the last pass it announced (`Team.__sync` = \"<point>\n * <pass>\"). A new one wakes the control task, which may be waiting. */\nstatic const long sync_point[] = {{{list}}};\nstatic long arrived[{peers}][{n}];\n\nlong comm_sync_arrived(size_t peer, size_t point)\n{{\n    long pass = 0;\n    {lock_seen}\n    if (peer < {peers} && point < {n})\n        pass = arrived[peer][point];\n    {unlock_seen}\n    return pass;\n}}\n\nstatic bool heard_sync(const semo_message *m)\n{{\n    if (strcmp(m->key, {key}) != 0)\n        return false;\n    /* The value is text; of another type it says nothing. */\n    const char *said = m->value.type == SEMO_TEXT ? m->value.text : \"\";\n    char *end;\n    long point = strtol(said, &end, 10), pass = strtol(end, NULL, 10);\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        for (size_t k = 0; k < {n}; k++)\n            if (strcmp(p->peers[i].robot, m->from_robot) == 0 && sync_point[k] == point) {{\n                {lock_seen}\n                if (pass > arrived[i][k])\n                    arrived[i][k] = pass;\n                {unlock_seen}\n            }}\n    semo_wake({control});\n    return true;\n}}\n",
             list = points.join(", "),
             n = m.sync_points.len(),
             peers = program.peers.len().max(1),
@@ -295,14 +309,15 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         out.push_str("/* CommReceive: each message received goes to the control task's port for\n * it (sends) or to its multicast group (publishes). */\n");
         let n = m.incoming.len();
         if n > 0 {
-            out.push_str("static const struct {\n    const char *port;\n    const char *from_team;\n    const char *key;\n} incoming[] = {\n");
+            out.push_str("static const struct {\n    const char *port;\n    const char *from_team;\n    const char *key;\n    semo_type type; /* as declared: a value of another type is refused */\n} incoming[] = {\n");
             for i in &m.incoming {
                 let _ = writeln!(
                     out,
-                    "    {{{}, {}, {}}},",
+                    "    {{{}, {}, {}, {}}},",
                     c::string(&i.port),
                     c::string(&i.from_team),
-                    c::string(&i.key)
+                    c::string(&i.key),
+                    m.slots[i.slot].kind.c_tag()
                 );
             }
             let _ = writeln!(out, "}};\nstatic int incoming_port[{n}];\n");
@@ -349,7 +364,7 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         if n > 0 {
             let _ = writeln!(
                 out,
-                "    for (int i = 0; i < {n}; i++)\n        if (strcmp(incoming[i].from_team, m.from_team) == 0 && strcmp(incoming[i].key, m.key) == 0)\n            UFPort_WriteToQueue(incoming_port[i], &m.value, sizeof m.value);"
+                "    for (int i = 0; i < {n}; i++) {{\n        if (strcmp(incoming[i].from_team, m.from_team) != 0 || strcmp(incoming[i].key, m.key) != 0)\n            continue;\n        semo_value v = m.value;\n        if (semo_value_coerce(&v, incoming[i].type))\n            UFPort_WriteToQueue(incoming_port[i], &v, sizeof v);\n        else\n            semo_trace(\"reject\", \"key\", m.key, \"reason\", \"not a value of its type\", NULL);\n    }}"
             );
         }
         let _ = writeln!(out, "}}\n\nvoid task_{recv}_wrapup(void)\n{{\n}}");
@@ -429,20 +444,28 @@ pub fn task_c(
                 out.push_str("    int64_t fired = semo_now_ms();\n");
             }
             for v in values {
+                // Refinement gives every sensor value a slot of its type.
+                let Some(kind) = program.control.sensor_kind(&role.task, v) else {
+                    let _ = writeln!(out, "#error \"sensor value {} has no type\"", c::comment(v));
+                    continue;
+                };
                 match target.simulated() {
                     true => {
                         let _ = writeln!(
                             out,
-                            "    if (semo_sim_sensor({}, &value))\n        UFPort_WriteToQueue(port_{}, &value, sizeof value);",
+                            "    if (semo_sim_sensor({}, {}, &value))\n        UFPort_WriteToQueue(port_{}, &value, sizeof value);",
                             c::string(v),
+                            kind.c_tag(),
                             c::ident(v)
                         );
                     }
                     false => {
                         let _ = writeln!(
                             out,
-                            "    /* TODO: read {v} from the sensor, e.g. semo_value_set(&value, \"...\"),\n     * then write it: UFPort_WriteToQueue(port_{id}, &value, sizeof value). */\n    (void)value;\n    (void)port_{id};",
+                            "    /* TODO: read {v} ({ty}) from the sensor, e.g. {example},\n     * then write it: UFPort_WriteToQueue(port_{id}, &value, sizeof value). */\n    (void)value;\n    (void)port_{id};",
                             v = c::comment(v),
+                            ty = c::comment(&kind.describe()),
+                            example = setter_example(kind),
                             id = c::ident(v)
                         );
                     }
@@ -460,7 +483,7 @@ pub fn task_c(
             // passes of the loop (semo_firing_continues) until its time is up.
             let _ = writeln!(
                 out,
-                "/* Task `{}` of robot {}: runs {} when the control task calls it; the\n * simulated service takes the scenario's time for it, over several passes\n * of the schedule. */\nstatic int port_request = -1;\nstatic semo_request req;\nstatic bool busy;\nstatic int64_t end;\n\nTASK_INIT\n{{\n    port_request = UFPort_Initialize(TASK_NAME, \"request\");\n}}\n\nTASK_GO\n{{\n    if (!busy) {{\n        if (UFPort_ReadFromQueue(port_request, &req, sizeof req) == 0)\n            return;\n        const char *arg = req.argc > 0 ? req.args[0].text : \"\";\n        semo_trace(\"call_start\", \"task\", TASK_NAME, \"service\", req.service, \"arg\", arg, NULL);\n        if (req.argc > 0)\n            semo_sim_actuate(TASK_NAME, &req.args[0]);\n        end = semo_now_ms() + semo_sim_service_ms(req.service){scale};\n        busy = true;\n    }}\n    if (semo_running() && !UFControl_StopRequested(TASK_NAME) && semo_now_ms() < end) {{\n        semo_firing_continues();\n        semo_next_firing(end); /* or a stop request, whichever is first */\n        return;\n    }}\n    busy = false;\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n}}\n\nTASK_WRAPUP\n{{\n}}",
+                "/* Task `{}` of robot {}: runs {} when the control task calls it; the\n * simulated service takes the scenario's time for it, over several passes\n * of the schedule. */\nstatic int port_request = -1;\nstatic semo_request req;\nstatic bool busy;\nstatic int64_t end;\n\nTASK_INIT\n{{\n    port_request = UFPort_Initialize(TASK_NAME, \"request\");\n}}\n\nTASK_GO\n{{\n    if (!busy) {{\n        if (UFPort_ReadFromQueue(port_request, &req, sizeof req) == 0)\n            return;\n        semo_trace_value(\"call_start\", \"arg\", req.argc > 0 ? &req.args[0] : SEMO_LIT(\"\"), \"task\", TASK_NAME, \"service\", req.service, NULL);\n        if (req.argc > 0)\n            semo_sim_actuate(TASK_NAME, &req.args[0]);\n        end = semo_now_ms() + semo_sim_service_ms(req.service){scale};\n        busy = true;\n    }}\n    if (semo_running() && !UFControl_StopRequested(TASK_NAME) && semo_now_ms() < end) {{\n        semo_firing_continues();\n        semo_next_firing(end); /* or a stop request, whichever is first */\n        return;\n    }}\n    busy = false;\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n}}\n\nTASK_WRAPUP\n{{\n}}",
                 c::comment(&role.task),
                 c::comment(&program.robot),
                 c::comment(&services.join(", ")),
@@ -479,6 +502,18 @@ pub fn task_c(
                 c::comment(&program.robot),
                 c::comment(&services.join(", "))
             );
+            // A service implemented by a task graph runs one iteration of
+            // it per call (target::check refuses it on static schedules).
+            let graph = program.graph_services.iter().find(|g| g.task == role.task);
+            if let Some(graph) = graph {
+                let at = out.find("TASK_INIT").unwrap_or(out.len());
+                out.insert_str(at, &super::loops::graph_runner(graph, target.simulated()));
+            }
+            let run_graph = if graph.is_some() {
+                "    run_graph();\n"
+            } else {
+                ""
+            };
             match (target.simulated(), target.platform()) {
                 (true, Platform::Threads) => {
                     let scale = match super::battery::actuator_speed_scale(program, &role.task) {
@@ -490,13 +525,16 @@ pub fn task_c(
                         }
                         None => "",
                     };
-                    out.push_str("    const char *arg = req.argc > 0 ? req.args[0].text : \"\";\n    semo_trace(\"call_start\", \"task\", TASK_NAME, \"service\", req.service, \"arg\", arg, NULL);\n    if (req.argc > 0)\n        semo_sim_actuate(TASK_NAME, &req.args[0]);\n    /* The simulated service takes the scenario's time for it, or ends when\n     * the control task stops it. */\n    UFControl_WaitStop(TASK_NAME, semo_now_ms() + semo_sim_service_ms(req.service)");
+                    out.push_str("    semo_trace_value(\"call_start\", \"arg\", req.argc > 0 ? &req.args[0] : SEMO_LIT(\"\"), \"task\", TASK_NAME, \"service\", req.service, NULL);\n    if (req.argc > 0)\n        semo_sim_actuate(TASK_NAME, &req.args[0]);\n");
+                    out.push_str(run_graph);
+                    out.push_str("    /* The simulated service takes the scenario's time for it, or ends when\n     * the control task stops it. */\n    UFControl_WaitStop(TASK_NAME, semo_now_ms() + semo_sim_service_ms(req.service)");
                     out.push_str(scale);
                     out.push_str(");\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n");
                 }
                 // The static simulation's body is the arm above.
                 (true, Platform::Static) => {}
                 (false, _) => {
+                    out.push_str(run_graph);
                     out.push_str("    /* TODO: perform the service; req.args[0 .. req.argc - 1] are its arguments.\n     * Check UFControl_StopRequested(TASK_NAME) during long work. */\n");
                     for s in services {
                         let _ = writeln!(
@@ -518,13 +556,15 @@ pub fn task_c(
 /// The runtime's table sizes on the static schedule, from the program; the
 /// Makefile's defaults (`make SEMO_STACK_BYTES=4096` overrides).
 pub struct StaticSizes {
-    /// Bytes of a value's text (`SEMO_VALUE_MAX`): the program's longest
-    /// literal and scenario value fit, and at least 32.
+    /// Bytes of a text value (`SEMO_TEXT_MAX`): the program's longest text
+    /// literal and scenario value fit, and at least 16.
     pub value_bytes: usize,
     pub tasks: usize,
     pub groups: usize,
     /// Messages received and not yet taken.
     pub inbox: usize,
+    /// Whether the program holds reals (else `-DSEMO_NO_REALS`).
+    pub reals: bool,
 }
 
 impl StaticSizes {
@@ -534,10 +574,11 @@ impl StaticSizes {
             .iter()
             .any(|t| t.kind == RoleKind::CommReceive);
         StaticSizes {
-            value_bytes: (longest_value + 1).max(32).next_multiple_of(4),
+            value_bytes: (longest_value + 1).max(16).next_multiple_of(4),
             tasks: program.graph.tasks.len().max(1),
             groups: program.control.subscribed.len().max(1),
             inbox: if receives { 4 } else { 1 },
+            reals: super::values::uses_reals(program),
         }
     }
 }
@@ -564,13 +605,14 @@ pub fn makefile(
     if target.platform() == Platform::Static {
         let _ = writeln!(
             out,
-            "\n# `make` builds `{robot}.elf` for target {target} (TI Stellaris LM3S6965, a\n# Cortex-M3) with arm-none-eabi-gcc and newlib-nano; `make size` prints its\n# flash and RAM, `make run` runs it in QEMU (UART0 on standard output{exit}).\n# CFLAGS may be overridden; the runtime's static tables (sized from the task\n# graph) and the stack with\n# make variables (`make SEMO_STACK_BYTES=4096`).\nCC = arm-none-eabi-gcc\nSIZE = arm-none-eabi-size\nQEMU = qemu-system-arm\nCFLAGS ?= -std=c11 -Wall -Wextra -Os\nARCH = -mcpu=cortex-m3 -mthumb\nSEMO_STACK_BYTES ?= 2048\nSEMO_VALUE_MAX ?= {value_bytes}\nSEMO_MAX_TASKS ?= {task_count}\nSEMO_MAX_GROUPS ?= {groups}\nSEMO_INBOX ?= {inbox}\nSIZES = -DSEMO_STACK_BYTES=$(SEMO_STACK_BYTES) -DSEMO_VALUE_MAX=$(SEMO_VALUE_MAX) -DSEMO_MAX_TASKS=$(SEMO_MAX_TASKS) -DSEMO_MAX_GROUPS=$(SEMO_MAX_GROUPS) -DSEMO_INBOX=$(SEMO_INBOX)\nSEMO_CFLAGS = -std=c11 $(ARCH) -ffunction-sections -fdata-sections -DSEMO_STATIC{sim} $(SIZES) -I.\nLDFLAGS += $(ARCH) -nostartfiles --specs=nano.specs -T lm3s6965.ld -Wl,--gc-sections\n\nPROGRAM = {robot}.elf\nSOURCES = {sources}\nTASKS = {tasks}\nOBJECTS = $(SOURCES:.c=.o) $(TASKS:.c=.o)\nHEADERS = program.h semo_runtime.h semo_internal.h\n\nall: $(PROGRAM)\n\n$(PROGRAM): $(OBJECTS) lm3s6965.ld\n\t$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(OBJECTS) $(LDLIBS)\n\ntasks/%.o: tasks/%.c $(HEADERS)\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -DSEMO_TASK=task_$* -c $< -o $@\n\n%.o: %.c $(HEADERS)\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -c $< -o $@\n\nsize: $(PROGRAM)\n\t$(SIZE) $(PROGRAM)\n\nrun: $(PROGRAM)\n\t$(QEMU) -M lm3s6965evb -nographic -semihosting -kernel $(PROGRAM)\n\nclean:\n\trm -f $(PROGRAM) $(OBJECTS)\n\n.PHONY: all size run clean",
+            "\n# `make` builds `{robot}.elf` for target {target} (TI Stellaris LM3S6965, a\n# Cortex-M3) with arm-none-eabi-gcc and newlib-nano; `make size` prints its\n# flash and RAM, `make run` runs it in QEMU (UART0 on standard output{exit}).\n# CFLAGS may be overridden; the runtime's static tables (sized from the task\n# graph) and the stack with\n# make variables (`make SEMO_STACK_BYTES=4096`).\nCC = arm-none-eabi-gcc\nSIZE = arm-none-eabi-size\nQEMU = qemu-system-arm\nCFLAGS ?= -std=c11 -Wall -Wextra -Os\nARCH = -mcpu=cortex-m3 -mthumb\nSEMO_STACK_BYTES ?= 2048\nSEMO_TEXT_MAX ?= {value_bytes}\nSEMO_MAX_TASKS ?= {task_count}\nSEMO_MAX_GROUPS ?= {groups}\nSEMO_INBOX ?= {inbox}\nSIZES = -DSEMO_STACK_BYTES=$(SEMO_STACK_BYTES) -DSEMO_TEXT_MAX=$(SEMO_TEXT_MAX) -DSEMO_MAX_TASKS=$(SEMO_MAX_TASKS) -DSEMO_MAX_GROUPS=$(SEMO_MAX_GROUPS) -DSEMO_INBOX=$(SEMO_INBOX)\nSEMO_CFLAGS = -std=c11 $(ARCH) -ffunction-sections -fdata-sections -DSEMO_STATIC{sim}{no_reals} $(SIZES) -I.\nLDFLAGS += $(ARCH) -nostartfiles --specs=nano.specs -T lm3s6965.ld -Wl,--gc-sections\n\nPROGRAM = {robot}.elf\nSOURCES = {sources}\nTASKS = {tasks}\nOBJECTS = $(SOURCES:.c=.o) $(TASKS:.c=.o)\nHEADERS = program.h semo_runtime.h semo_internal.h\n\nall: $(PROGRAM)\n\n$(PROGRAM): $(OBJECTS) lm3s6965.ld\n\t$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(OBJECTS) $(LDLIBS)\n\ntasks/%.o: tasks/%.c $(HEADERS)\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -DSEMO_TASK=task_$* -c $< -o $@\n\n%.o: %.c $(HEADERS)\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -c $< -o $@\n\nsize: $(PROGRAM)\n\t$(SIZE) $(PROGRAM)\n\nrun: $(PROGRAM)\n\t$(QEMU) -M lm3s6965evb -nographic -semihosting -kernel $(PROGRAM)\n\nclean:\n\trm -f $(PROGRAM) $(OBJECTS)\n\n.PHONY: all size run clean",
             robot = program.robot,
             target = target.name(),
             value_bytes = sizes.value_bytes,
             task_count = sizes.tasks,
             groups = sizes.groups,
             inbox = sizes.inbox,
+            no_reals = if sizes.reals { "" } else { " -DSEMO_NO_REALS" },
             exit = if target.simulated() {
                 "; it exits when the scenario ends"
             } else {
@@ -652,4 +694,16 @@ pub fn scenario_c(world: &CompiledScenario, header: &str) -> String {
         world.operator.len()
     );
     out
+}
+
+/// How a sensor task a user writes sets a value of this kind.
+fn setter_example(kind: &crate::refine::ValueKind) -> &'static str {
+    use crate::refine::ValueKind as K;
+    match kind {
+        K::Int => "semo_value_set_int(&value, 42)",
+        K::Real => "semo_value_set_real(&value, 0.5)",
+        K::Bool => "semo_value_set_bool(&value, true)",
+        K::Word(_) => "semo_value_set_word(&value, \"...\")",
+        K::Text | K::Variable => "semo_value_set(&value, \"...\")",
+    }
 }

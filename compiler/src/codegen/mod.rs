@@ -21,9 +21,11 @@ mod c;
 mod control;
 pub use control::listen_ms;
 pub(crate) mod files;
+mod loops;
 pub mod output;
 mod schedule;
 mod target;
+mod values;
 
 use crate::refine::{RobotProgram, RoleKind};
 use crate::taskgraph::write::to_xml;
@@ -444,6 +446,8 @@ pub struct BuildInput<'a> {
     pub links: &'a crate::strategy::StrategyLinks,
     /// The diagnostics of the mission, the catalog and the strategies.
     pub diagnostics: &'a [crate::diag::Diagnostic],
+    /// The task graphs implementing catalog services, as loaded.
+    pub service_graphs: &'a [crate::refine::ServiceGraph],
 }
 
 /// Generates the code of a mission: every error of the check (in the
@@ -489,15 +493,72 @@ pub fn build_refined(
             diagnostics,
         };
     }
-    let robots = programs
+    let robots: Vec<RobotOutput> = programs
         .iter()
         .enumerate()
         .map(|(i, p)| generate(p, target, emit, &sources, scenarios.get(i)))
         .collect();
+    diagnostics.extend(
+        programs
+            .iter()
+            .zip(&robots)
+            .flat_map(|(program, robot)| written_graph_errors(build, program, robot)),
+    );
+    if diagnostics.iter().any(crate::diag::Diagnostic::is_error) {
+        return BuildResult {
+            robots: Vec::new(),
+            diagnostics,
+        };
+    }
     BuildResult {
         robots,
         diagnostics,
     }
+}
+
+/// Each robot's `taskgraph.xml` read back by the task-graph loader, as a user
+/// opening it would: it holds the rules of the format itself (names unique,
+/// channel ends exist, ...) that the analyses assume. Any error there is
+/// refinement's fault (E102 on the robot's declaration).
+fn written_graph_errors(
+    build: &BuildInput<'_>,
+    program: &crate::refine::RobotProgram,
+    robot: &RobotOutput,
+) -> Vec<crate::diag::Diagnostic> {
+    use crate::diag::{Code, Diagnostic, FileId};
+    let Some(written) = robot.files.iter().find(|f| f.path == "taskgraph.xml") else {
+        return Vec::new();
+    };
+    let (_, loaded) = crate::taskgraph::load_task_graph(FileId(u32::MAX), &written.text);
+    let span = robot_span(build, &program.robot);
+    loaded
+        .iter()
+        .filter(|d| d.is_error())
+        .map(|d| {
+            Diagnostic::new(
+                Code::CodegenInternal,
+                build.mission,
+                span,
+                format!(
+                    "the task graph written for robot `{}` does not read back: [{}] {}",
+                    program.robot, d.code, d.message
+                ),
+            )
+        })
+        .collect()
+}
+
+/// The range of the declaration of the robot named `robot`.
+fn robot_span(build: &BuildInput<'_>, robot: &str) -> crate::span::Span {
+    build
+        .analysis
+        .mission
+        .teams
+        .iter()
+        .flat_map(|t| &t.robots)
+        .find(|r| r.name == robot)
+        .map(|r| r.name_span)
+        .unwrap_or_default()
 }
 
 /// A mission's refined programs, as code generation and the simulator
@@ -536,19 +597,13 @@ pub fn refine_checked(build: &BuildInput<'_>) -> Refined {
         strategies: build.strategies,
         strategy_names,
         links: build.links,
+        service_graphs: build.service_graphs,
     };
     let (programs, found) = crate::refine::refine(&input);
     diagnostics.extend(found);
     // Names become folders, files and C identifiers: only plain identifiers.
     for program in &programs {
-        let span = analysis
-            .mission
-            .teams
-            .iter()
-            .flat_map(|t| &t.robots)
-            .find(|r| r.name == program.robot)
-            .map(|r| r.name_span)
-            .unwrap_or_default();
+        let span = robot_span(build, &program.robot);
         let names = [&program.team, &program.robot]
             .into_iter()
             .chain(program.tasks.iter().map(|t| &t.task))

@@ -39,6 +39,20 @@ pub fn check(
             ),
         ));
     }
+    // A service graph without a schedule cannot be run (the dataflow
+    // warnings say why on the call).
+    for program in programs {
+        for graph in &program.graph_services {
+            if let Err(why) = &graph.steps {
+                found.push(Diagnostic::new(
+                    Code::CodegenUnsupported,
+                    build.mission,
+                    graph.call,
+                    format!("code generation does not support {why} yet"),
+                ));
+            }
+        }
+    }
     if target.platform() == Platform::Static {
         for program in programs {
             if let Err(why) = super::schedule::firings(&program.graph) {
@@ -47,6 +61,25 @@ pub fn check(
                     build.mission,
                     robot_span(build, &program.robot),
                     format!("robot `{}`: no static schedule: {why}", program.robot),
+                ));
+            }
+        }
+        // A task graph run inside a service task needs the hosted runtime
+        // (its loop ends are formatted with snprintf, its exit from the
+        // threads simulation's scenario).
+        for program in programs {
+            if let Some(graph) = program.graph_services.first() {
+                found.push(Diagnostic::new(
+                    Code::TargetUnsupported,
+                    build.mission,
+                    robot_span(build, &program.robot),
+                    format!(
+                        "robot `{}`: its service task `{}` runs task graph `{}`, which target {} cannot run yet: build for linux or linux-sim",
+                        program.robot,
+                        graph.task,
+                        graph.graph,
+                        target.name()
+                    ),
                 ));
             }
         }

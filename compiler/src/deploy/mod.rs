@@ -10,8 +10,10 @@
 //! - `check`: its names against the checked mission (unknown robots and
 //!   teams, a TLS robot without a CA).
 //! - `topics`: the topic scheme of `semo_mqtt.c`, written once on this side.
+//! - `datagram`: the runtime's datagram, for the operator console and tests.
 
 pub mod broker;
+pub mod datagram;
 mod parse;
 pub mod topics;
 

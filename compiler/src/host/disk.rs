@@ -173,17 +173,16 @@ impl Loader {
             }
         }
         // Each mission's dataflow warnings too: the editor shows them after
-        // the keystroke's diagnostics; here there is no hurry.
-        let mut diagnostics: Vec<Diagnostic> = loader
-            .checked
-            .iter()
-            .flat_map(|&id| {
-                let dataflow = analysis.dataflow(id);
-                let mut found = analysis.diagnostics(id);
-                found.extend(dataflow.iter().flat_map(|d| d.diagnostics.iter().cloned()));
-                found
-            })
-            .collect();
+        // the keystroke's diagnostics; here there is no hurry. They refine
+        // every robot, most of a check's work: the files are shared out
+        // among the processors (the snapshot's memo is shared; the order
+        // does not matter, the result is sorted).
+        let mut diagnostics = on_every_processor(&loader.checked, |id| {
+            let dataflow = analysis.dataflow(id);
+            let mut found = analysis.diagnostics(id);
+            found.extend(dataflow.iter().flat_map(|d| d.diagnostics.iter().cloned()));
+            found
+        });
         diagnostics.extend(loader.notes.iter().cloned());
         diag::sort_and_dedup(&mut diagnostics);
         CheckRun {
@@ -193,6 +192,38 @@ impl Loader {
             diagnostics,
         }
     }
+}
+
+/// `each` of every item, on as many threads as there are processors (each
+/// takes the next item when done), the results concatenated in any order.
+fn on_every_processor<T: Send>(items: &[FileId], each: impl Fn(FileId) -> Vec<T> + Sync) -> Vec<T> {
+    let threads = std::thread::available_parallelism().map_or(1, usize::from);
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let work = || {
+        let mut found = Vec::new();
+        while let Some(&id) = items.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed)) {
+            found.extend(each(id));
+        }
+        found
+    };
+    if threads < 2 || items.len() < 2 {
+        return work();
+    }
+    std::thread::scope(|scope| {
+        let helpers: Vec<_> = (1..threads.min(items.len()))
+            .map(|_| scope.spawn(work))
+            .collect();
+        let mut found = work();
+        for helper in helpers {
+            // A panic in a helper is a bug: raised here as it would have been.
+            found.extend(
+                helper
+                    .join()
+                    .unwrap_or_else(|e| std::panic::resume_unwind(e)),
+            );
+        }
+        found
+    })
 }
 
 /// A project file and the input folders it names that exist: what a door

@@ -239,6 +239,43 @@ impl Analysis {
 
     /// Runs `f` on the strategy file `file` as its features read it: its
     /// text and model, the missions that see it (checked), its catalog.
+    /// The ranges a file folds into (blocks, `case`s, group statements,
+    /// comment banners); empty for other kinds of files.
+    pub fn folding_ranges(&self, file: FileId) -> Vec<ide::mission::folding::Fold> {
+        match self.mission_of_kind(file) {
+            Some((mission, text)) => ide::mission::folding::folding_ranges(&mission, text),
+            None => Vec::new(),
+        }
+    }
+
+    /// The ranges holding `position`, innermost first (from the name outward
+    /// to the whole file); empty for other kinds of files.
+    pub fn selection_ranges(&self, position: FilePosition) -> Vec<crate::span::Span> {
+        let FilePosition { file, offset } = position;
+        match self.mission_of_kind(file) {
+            Some((mission, text)) => {
+                ide::mission::selection::selection_ranges(&mission, text, offset)
+            }
+            None => Vec::new(),
+        }
+    }
+
+    /// The names in the file meaning the symbol at `position`, each a read
+    /// or a write (definitions, throws, assigned team variables).
+    pub fn highlights(&self, position: FilePosition) -> Vec<ide::mission::navigation::Reference> {
+        let FilePosition { file, offset } = position;
+        match self.mission_of_kind(file) {
+            Some((mission, _)) => ide::mission::navigation::references(&mission, offset),
+            None => Vec::new(),
+        }
+    }
+
+    /// A mission file's checked mission and text; `None` for other files.
+    fn mission_of_kind(&self, file: FileId) -> Option<(Arc<sema::Analysis>, &str)> {
+        let source = self.file(file).filter(|f| f.kind == FileKind::Mission)?;
+        Some((self.mission(file)?, &source.text))
+    }
+
     fn with_strategy<T: Default>(&self, file: FileId, f: impl FnOnce(&StrategyFile<'_>) -> T) -> T {
         let Some(source) = self.file(file) else {
             return T::default();

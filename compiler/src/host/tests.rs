@@ -221,3 +221,65 @@ fn a_project_file_in_the_host_decides_what_is_seen_and_at_which_level() {
     host.remove_file(FileId(2));
     assert_eq!(levels(&host.analysis()), levels(&before));
 }
+
+/// The view answers what asking [`sees`] of every file answers, and is kept
+/// across a keystroke but not across a new file.
+#[test]
+fn the_view_agrees_with_the_rule_and_lives_as_long_as_the_layout() {
+    let mut host = AnalysisHost::new(roots(&["/w"]));
+    let paths = [
+        "/w/a/m.mission",
+        "/w/a/x.robot.xml",
+        "/w/a/robots/y.robot.xml",
+        "/w/a/other/n.mission",
+        "/w/a/other/z.robot.xml",
+        "/w/a/1/2/3/4/deep.robot.xml",
+        "/w/top.strategy.xml",
+        "/w/b/k.mission",
+        "/w/b/s.strategy.xml",
+        "/w/ab/t.robot.xml",
+        "/elsewhere/e.robot.xml",
+    ];
+    for (i, path) in paths.iter().enumerate() {
+        let kind = FileKind::of(Path::new(path)).expect("a SeMo file");
+        host.set_file(FileId(i as u32), Some(path.into()), kind, "".into());
+    }
+    let analysis = host.analysis();
+    let folders = [
+        "/w",
+        "/w/a",
+        "/w/a/other",
+        "/w/b",
+        "/w/ab",
+        "/elsewhere",
+        "/x",
+    ];
+    for folder in folders {
+        let reader = Path::new(folder).join("_");
+        let mut expected: Vec<(&Path, FileId)> = analysis
+            .files()
+            .filter(|f| matches!(f.kind, FileKind::Catalog | FileKind::Strategy))
+            .filter_map(|f| Some((f.key.as_deref()?, f.id)))
+            .filter(|(p, _)| analysis.sees(&reader, p))
+            .collect();
+        expected.sort();
+        let expected: Vec<FileId> = expected.into_iter().map(|(_, id)| id).collect();
+        assert_eq!(&*analysis.seen_ids(Path::new(folder)), expected, "{folder}");
+    }
+    // `/w/top.strategy.xml` is seen from /w/a, /w/a/other and /w/b.
+    let seeing: Vec<FileId> = analysis.missions_seeing(FileId(6));
+    assert_eq!(seeing, vec![FileId(0), FileId(3), FileId(7)]);
+
+    // A keystroke keeps the view; a new file replaces it.
+    let kept = host.analysis().view;
+    host.set_file(
+        FileId(0),
+        Some(paths[0].into()),
+        FileKind::Mission,
+        "x".into(),
+    );
+    assert!(Arc::ptr_eq(&kept, &host.analysis().view));
+    let path = PathBuf::from("/w/a/new.robot.xml");
+    host.set_file(FileId(99), Some(path), FileKind::Catalog, "".into());
+    assert!(!Arc::ptr_eq(&kept, &host.analysis().view));
+}

@@ -257,16 +257,15 @@ pub fn build(program: &RobotProgram) -> TaskGraph {
 /// Runs the SDF/L analyses on the refined graph: every error stops the
 /// generation (reported on the robot's declaration). Returns each channel's
 /// buffer size: the analysis's bound, at least the declared capacity.
+/// (The rules of the file format itself are checked where the graph is
+/// written, on the text written: `codegen::build_refined` reads every
+/// `taskgraph.xml` back. Refining for the dataflow warnings or the simulator
+/// writes none, and reading one back per robot was most of their time.)
 pub fn check(graph: &TaskGraph, file: FileId, robot: Span) -> (Vec<u64>, Vec<Diagnostic>) {
     let report = crate::taskgraph::analysis::analyze(graph);
-    // The graph as it is written (`taskgraph.xml`) is read back by the
-    // loader too: it holds the rules of the format itself (names unique,
-    // channel ends exist, ...) that the analyses assume.
-    let written = crate::taskgraph::write::to_xml(graph, "");
-    let (_, loaded) = crate::taskgraph::load_task_graph(FileId(u32::MAX), &written);
-    let diagnostics = loaded
+    let diagnostics = report
+        .diagnostics
         .iter()
-        .chain(&report.diagnostics)
         .filter(|d| d.severity == Severity::Error)
         .map(|d| {
             Diagnostic::new(

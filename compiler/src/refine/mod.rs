@@ -4,7 +4,10 @@
 //!
 //! - `robot.rs`: one robot's program: which services it runs (group arms it
 //!   can never join are dropped), statement machines, strategy action machines,
-//!   the values it reads, the messages it exchanges.
+//!   the values it reads (typed as the catalog declares them), the messages
+//!   it exchanges.
+//! - `value.rs`: typed values and the operations the generated C and the
+//!   simulator both perform on them.
 //! - `graph.rs`: the robot's task graph from what the machine uses, checked
 //!   with the SDF/L analyses.
 //!
@@ -13,8 +16,10 @@
 pub mod graph;
 pub mod program;
 mod robot;
+pub mod value;
 
 pub use program::*;
+pub use value::{Value, ValueKind};
 
 use crate::Analysis;
 use crate::catalog::Catalog;
@@ -34,6 +39,16 @@ pub struct RefineInput<'a> {
     /// Strategy file names, by `Strategy::file`, for comments.
     pub strategy_names: &'a [(FileId, String)],
     pub links: &'a StrategyLinks,
+    /// The task graphs implementing catalog services that the workspace holds.
+    pub service_graphs: &'a [ServiceGraph],
+}
+
+/// A task graph a catalog names (`graph="path"` in catalog file `catalog`), as loaded.
+#[derive(Clone, Debug)]
+pub struct ServiceGraph {
+    pub catalog: FileId,
+    pub path: String,
+    pub graph: std::sync::Arc<crate::taskgraph::TaskGraph>,
 }
 
 /// One program per robot of the mission, in formation order, and the

@@ -6,6 +6,7 @@
 //! sets for that plan → for a built-in call the strategy refines, that
 //! entry's action machine (bottom).
 
+use super::value::{Value, ValueKind};
 use crate::span::Span;
 use crate::taskgraph::TaskGraph;
 
@@ -29,6 +30,45 @@ pub struct RobotProgram {
     pub self_peer: usize,
     /// The team's shared information, held by the library task.
     pub library: Option<SharedLibrary>,
+    /// The service tasks that run a task graph (`graph=` in the catalog).
+    pub graph_services: Vec<GraphService>,
+}
+
+/// A service the robot's type implements by a task graph: each call runs
+/// one iteration of the graph's looped schedule (`taskgraph::analysis`),
+/// its inner tasks fired in that order inside the service task.
+#[derive(Clone, Debug)]
+pub struct GraphService {
+    /// The service task (named after the graph file).
+    pub task: String,
+    /// The graph's name (`kmeans`).
+    pub graph: String,
+    /// The first call of the service in the mission.
+    pub call: Span,
+    /// One iteration of the top level, or why the graph has none (it is
+    /// inconsistent or deadlocks, which the dataflow warnings report on the
+    /// call; code generation refuses it, E100).
+    pub steps: Result<Vec<GraphStep>, String>,
+}
+
+/// A term of a service graph's looped schedule, loop nodes opened.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GraphStep {
+    /// `count` firings of an inner task; `task` is its path below the graph
+    /// (`Converge/Assign/Nearest`).
+    Fire { task: String, count: u64 },
+    /// A loop of the schedule: `body` `count` times.
+    Repeat { count: u64, body: Vec<GraphStep> },
+    /// An SDF/L loop node (`path` as for tasks): its body's schedule,
+    /// exactly `loop_count` times (D-type) or until its exit task sets the
+    /// exit flag, at most `loop_count` times (C-type, `exit_task` the path).
+    Loop {
+        path: String,
+        convergent: bool,
+        loop_count: u64,
+        exit_task: Option<String>,
+        body: Vec<GraphStep>,
+    },
 }
 
 /// The control task's machine.
@@ -324,7 +364,7 @@ pub struct ActionState {
     pub id: u64,
     pub is_final: bool,
     /// Actuator commands issued on entry: (task, command value).
-    pub commands: Vec<(String, String)>,
+    pub commands: Vec<(String, Value)>,
     /// Checked in order; the first that holds is taken. `None` = always.
     pub transitions: Vec<(Option<Expr>, usize)>,
 }
@@ -335,6 +375,9 @@ pub struct Slot {
     /// `MasterTeam.LOCATION`, `USER.RC_CMD`, or `move.goalLocation`.
     pub key: String,
     pub source: SlotSource,
+    /// How its values are stored: the catalog's type of the value (of the
+    /// service parameter for a strategy variable).
+    pub kind: ValueKind,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -414,9 +457,21 @@ pub enum Expr {
     Bool(bool),
 }
 
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Operand {
     Slot(usize),
-    /// A literal's text (strings unescaped, numbers as written, constants by name).
-    Literal(String),
+    /// A literal, typed as written: a whole number an integer, another number
+    /// a real, a string text, `true`/`false` a truth value, a symbolic
+    /// constant a word.
+    Literal(Value),
+}
+
+impl ControlMachine {
+    /// The kind of the value a sensor task writes to `port` (the slot it feeds).
+    pub fn sensor_kind(&self, task: &str, port: &str) -> Option<&ValueKind> {
+        self.slots.iter().find_map(|s| match &s.source {
+            SlotSource::Sensor { task: t, port: p } if t == task && p == port => Some(&s.kind),
+            _ => None,
+        })
+    }
 }

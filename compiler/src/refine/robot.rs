@@ -2,6 +2,7 @@
 
 use super::RefineInput;
 use super::program::*;
+use super::value::{Value, ValueKind};
 use crate::catalog::{Implementation, RobotType};
 use crate::diag::{Code, Diagnostic};
 use crate::sema::{Compared, Symbol, Team, TeamId};
@@ -12,6 +13,10 @@ use crate::text::LineIndex;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 mod battery;
+mod loops;
+
+#[cfg(test)]
+pub(super) use loops::steps_of;
 
 /// How often sensor tasks sample, in mission milliseconds.
 pub(super) const SENSOR_PERIOD_MS: i64 = 100;
@@ -50,6 +55,7 @@ pub(super) fn refine_robot(
     };
     builder.build_modes();
     builder.machine.battery = builder.battery_policies();
+    let graph_services = builder.graph_services();
     let self_peer = builder.first_peer() + robot_index;
     let Builder {
         mut machine,
@@ -117,6 +123,7 @@ pub(super) fn refine_robot(
         peers: peers.to_vec(),
         self_peer,
         library,
+        graph_services,
     };
     program.graph = graph::build(&program);
     let (capacities, found) = graph::check(&program.graph, input.file, robot.name_span);
@@ -623,7 +630,10 @@ impl Builder<'_, '_> {
                     // The value sent: the assigned expression's value (kept in
                     // the team's shared slot), else the attribute's own value.
                     let (value, store) = match &item.value {
-                        Some(v) => (self.condition_operand(v), Some(self.shared_slot(&key))),
+                        Some(v) => (
+                            self.condition_operand(v),
+                            Some(self.shared_slot(&item.attr)),
+                        ),
                         None => (self.attr_operand(&item.attr), None),
                     };
                     items.push(SendItem {
@@ -638,8 +648,7 @@ impl Builder<'_, '_> {
             ast::CommKind::Receive => {
                 let mut messages = Vec::new();
                 for item in &comm.items {
-                    let key = self.attr_key(&item.attr);
-                    messages.push(self.incoming(&peer, &key));
+                    messages.push(self.incoming(&peer, &item.attr));
                 }
                 let timeout_ms = comm.timeout.as_ref().and_then(period_ms);
                 let mark = next_mark(marks);
@@ -656,7 +665,7 @@ impl Builder<'_, '_> {
             ast::CommKind::Subscribe => {
                 for item in &comm.items {
                     let key = self.attr_key(&item.attr);
-                    let slot = self.shared_slot(&key);
+                    let slot = self.shared_slot(&item.attr);
                     let group = match self.machine.subscribed.iter().position(|g| *g == key) {
                         Some(g) => g,
                         None => {
@@ -758,7 +767,7 @@ impl Builder<'_, '_> {
 
     fn arg(&mut self, arg: &ast::Arg) -> Operand {
         match arg {
-            ast::Arg::Words { text, .. } => Operand::Literal(text.clone()),
+            ast::Arg::Words { text, .. } => Operand::Literal(Value::text(text)),
             ast::Arg::Expr(e) => self.condition_operand(e),
         }
     }
@@ -829,7 +838,7 @@ impl Builder<'_, '_> {
                             let value = self
                                 .value_of_task(&task, strategy)
                                 .unwrap_or_else(|| name.name.clone());
-                            let slot = self.sensor_slot_with_task(&value, &task);
+                            let slot = self.sensor_slot_with_task(&value, &task, call);
                             names.insert(name.name.clone(), Operand::Slot(slot));
                         }
                         TaskUseKind::ExecuteActuator | TaskUseKind::ExecuteAlgorithm => {}
@@ -839,13 +848,18 @@ impl Builder<'_, '_> {
             for p in &action.parameters {
                 let Some(name) = &p.name else { continue };
                 if p.data == Some(DataCharacteristic::Variable) && p.value.is_none() {
-                    let slot = self.slot(&format!("{service}.{}", name.name), SlotSource::Local);
+                    let kind = self.parameter_kind(service, arguments.len(), call);
+                    let slot =
+                        self.slot(&format!("{service}.{}", name.name), SlotSource::Local, kind);
                     if !arguments.contains(&slot) {
                         arguments.push(slot);
                     }
                     names.insert(name.name.clone(), Operand::Slot(slot));
                 } else if let Some(v) = &p.value {
-                    names.insert(name.name.clone(), Operand::Literal(v.name.clone()));
+                    names.insert(
+                        name.name.clone(),
+                        Operand::Literal(Value::strategy(&v.name)),
+                    );
                 }
             }
         }
@@ -873,7 +887,7 @@ impl Builder<'_, '_> {
                         .as_ref()
                         .map(|t| t.name.clone())
                         .unwrap_or_else(|| actuator.to_lowercase());
-                    let command = p.value.as_ref().map(|v| v.name.clone()).unwrap_or_default();
+                    let command = Value::strategy(p.value.as_ref().map_or("", |v| &v.name));
                     self.services
                         .entry(task.clone())
                         .or_default()
@@ -958,7 +972,7 @@ impl Builder<'_, '_> {
             names
                 .get(attr.last().as_str())
                 .cloned()
-                .unwrap_or_else(|| Operand::Literal(attr.dotted()))
+                .unwrap_or_else(|| Operand::Literal(Value::Word(attr.dotted())))
         };
         // The strategy checker reads a guard as a variable against numbers
         // (strategy::guards): a comparison with a number compares numbers.
@@ -989,7 +1003,7 @@ impl Builder<'_, '_> {
                 resolved
                     .get(&attr.span)
                     .cloned()
-                    .unwrap_or_else(|| Operand::Literal(attr.dotted()))
+                    .unwrap_or_else(|| Operand::Literal(Value::Word(attr.dotted())))
             },
             &mut |e| {
                 mission.compared_at(e.span).unwrap_or_else(|| {
@@ -1008,7 +1022,7 @@ impl Builder<'_, '_> {
     fn condition_operand(&mut self, expr: &ast::Expr) -> Operand {
         match &expr.kind {
             ExprKind::Attr(a) => self.attr_operand(a),
-            other => Operand::Literal(literal_text(other)),
+            other => Operand::Literal(literal_value(other)),
         }
     }
 
@@ -1026,31 +1040,29 @@ impl Builder<'_, '_> {
                 name,
             }) if owner == self.team_id => {
                 if self.robot_type.value(&name).is_some() {
-                    Operand::Slot(self.sensor_slot(&name))
+                    Operand::Slot(self.sensor_slot(&name, attr.span))
                 } else if self.team_receives(&name) {
-                    let key = self.attr_key(attr);
-                    Operand::Slot(self.shared_slot(&key))
+                    Operand::Slot(self.shared_slot(attr))
                 } else {
                     let what = format!(
                         "robot type `{}` has no value `{name}` and its team does not receive it",
                         self.robot_type.name
                     );
                     self.internal_error(attr.span, &what);
-                    Operand::Literal(String::new())
+                    Operand::Literal(Value::text(""))
                 }
             }
             Some(Symbol::Value { .. }) | Some(Symbol::TeamVariable { .. }) => {
-                let key = self.attr_key(attr);
-                Operand::Slot(self.shared_slot(&key))
+                Operand::Slot(self.shared_slot(attr))
             }
-            Some(Symbol::Constant(name)) => Operand::Literal(name.to_string()),
+            Some(Symbol::Constant(name)) => Operand::Literal(Value::Word(name.to_string())),
             other => {
                 let what = format!(
                     "`{}` is read as a value, but the checker resolved it to {other:?}",
                     attr.dotted()
                 );
                 self.internal_error(attr.span, &what);
-                Operand::Literal(String::new())
+                Operand::Literal(Value::text(""))
             }
         }
     }
@@ -1091,7 +1103,7 @@ impl Builder<'_, '_> {
             .unwrap_or_else(|| name.to_string())
     }
 
-    fn slot(&mut self, key: &str, source: SlotSource) -> usize {
+    fn slot(&mut self, key: &str, source: SlotSource, kind: ValueKind) -> usize {
         let sensor = matches!(source, SlotSource::Sensor { .. });
         if let Some(&i) = self.slot_index.get(&(key.to_string(), sensor)) {
             return i;
@@ -1099,28 +1111,105 @@ impl Builder<'_, '_> {
         self.machine.slots.push(Slot {
             key: key.to_string(),
             source,
+            kind,
         });
         let i = self.machine.slots.len() - 1;
         self.slot_index.insert((key.to_string(), sensor), i);
         i
     }
 
-    fn shared_slot(&mut self, key: &str) -> usize {
-        self.slot(key, SlotSource::Shared)
+    /// The team's shared slot of the attribute (a value received, sent or
+    /// published, or a team variable), typed as the checker resolved it.
+    fn shared_slot(&mut self, attr: &ast::Attr) -> usize {
+        let key = self.attr_key(attr);
+        if let Some(&i) = self.slot_index.get(&(key.clone(), false)) {
+            return i;
+        }
+        let kind = self.attr_kind(attr);
+        self.slot(&key, SlotSource::Shared, kind)
+    }
+
+    /// How the values of an attribute are stored: the catalog's type of the
+    /// value the checker resolved it to (of the owner team's robots; `USER`'s
+    /// from the catalog's operator), or a team variable. Anything else is an
+    /// internal error: the build is refused, never typed by guess.
+    fn attr_kind(&mut self, attr: &ast::Attr) -> ValueKind {
+        let symbols =
+            crate::sema::lookup::with_span(&self.input.analysis.mission, attr.last().span);
+        let catalog = self.input.catalog;
+        let mission = &self.input.analysis.mission;
+        let declared = symbols.iter().find_map(|o| match &o.symbol {
+            Symbol::TeamVariable { .. } => Some(Some(ValueKind::Variable)),
+            Symbol::Value { owner, name } => {
+                let of_team = owner.and_then(|team| {
+                    mission.team(team).robots.iter().find_map(|r| {
+                        let ty = catalog.get(r.robot_type?);
+                        ty.value(name).map(|v| ValueKind::declared(&v.ty))
+                    })
+                });
+                // `USER.X`: the catalog's operator, as the checker resolves it.
+                let of_user = || {
+                    let user = catalog.user().filter(|_| owner.is_none())?;
+                    user.value(name).map(|v| ValueKind::declared(&v.ty))
+                };
+                Some(of_team.or_else(of_user))
+            }
+            _ => None,
+        });
+        match declared {
+            Some(Some(kind)) => kind,
+            _ => {
+                let what = format!(
+                    "`{}` is read as a value, but no catalog type declares it",
+                    attr.dotted()
+                );
+                self.internal_error(attr.span, &what);
+                ValueKind::Variable
+            }
+        }
+    }
+
+    /// The catalog type of the `index`th parameter of `service` (a strategy
+    /// variable set from the call's argument at that position).
+    fn parameter_kind(&mut self, service: &str, index: usize, call: Span) -> ValueKind {
+        let declared = self
+            .robot_type
+            .service(service)
+            .and_then(|def| def.params.get(index))
+            .map(|p| ValueKind::declared(&p.ty));
+        declared.unwrap_or_else(|| {
+            let what = format!(
+                "a strategy variable of `{service}` takes argument {} of the call, which the catalog does not declare",
+                index + 1
+            );
+            self.internal_error(call, &what);
+            ValueKind::Variable
+        })
     }
 
     /// The robot's own value `name`, read from the task that implements it
     /// (the strategy's `ValueInfo` first, else the catalog).
-    fn sensor_slot(&mut self, name: &str) -> usize {
+    fn sensor_slot(&mut self, name: &str, span: Span) -> usize {
         let task = self.value_task(name);
-        self.sensor_slot_with_task(name, &task)
+        self.sensor_slot_with_task(name, &task, span)
     }
 
-    fn sensor_slot_with_task(&mut self, value: &str, task: &str) -> usize {
+    fn sensor_slot_with_task(&mut self, value: &str, task: &str, span: Span) -> usize {
         let key = format!("{}.{value}", self.team.name);
         if let Some(&i) = self.slot_index.get(&(key.clone(), true)) {
             return i;
         }
+        let kind = match self.robot_type.value(value) {
+            Some(v) => ValueKind::declared(&v.ty),
+            None => {
+                let what = format!(
+                    "robot type `{}` has no value `{value}` for its sensor task `{task}`",
+                    self.robot_type.name
+                );
+                self.internal_error(span, &what);
+                ValueKind::Variable
+            }
+        };
         self.sensors
             .entry(task.to_string())
             .or_default()
@@ -1131,6 +1220,7 @@ impl Builder<'_, '_> {
                 task: task.to_string(),
                 port: value.to_string(),
             },
+            kind,
         )
     }
 
@@ -1187,16 +1277,17 @@ impl Builder<'_, '_> {
         self.machine.outgoing.len() - 1
     }
 
-    fn incoming(&mut self, from_team: &str, key: &str) -> usize {
+    fn incoming(&mut self, from_team: &str, attr: &ast::Attr) -> usize {
+        let key = self.attr_key(attr);
         if let Some(i) = self
             .machine
             .incoming
             .iter()
-            .position(|m| m.from_team == from_team && m.key == key)
+            .position(|m| m.from_team == from_team && *m.key == key)
         {
             return i;
         }
-        let slot = self.shared_slot(key);
+        let slot = self.shared_slot(attr);
         let port = format!("from_{}_{}", from_team, key.replace('.', "_"));
         self.machine.incoming.push(IncomingMessage {
             from_team: from_team.to_string(),
@@ -1326,13 +1417,20 @@ fn collect_attrs<'e>(expr: &'e ast::Expr, out: &mut Vec<&'e ast::Attr>) {
     }
 }
 
-fn literal_text(kind: &ExprKind) -> String {
+/// A literal as written (see [`Operand::Literal`]); a period is its
+/// milliseconds.
+fn literal_value(kind: &ExprKind) -> Value {
     match kind {
-        ExprKind::Str(s) | ExprKind::Number(s) => s.clone(),
-        ExprKind::Bool(b) => b.to_string(),
-        ExprKind::Period(p) => p.millis().map_or_else(String::new, |m| format!("{m}")),
-        ExprKind::Attr(a) => a.dotted(),
-        _ => String::new(),
+        ExprKind::Str(s) => Value::text(s),
+        ExprKind::Number(s) => Value::number(s),
+        ExprKind::Bool(b) => Value::Bool(*b),
+        ExprKind::Period(p) => match p.millis() {
+            Some(ms) if ms.fract() == 0.0 && ms.abs() < 9e15 => Value::Int(ms as i64),
+            Some(ms) => Value::Real(ms),
+            None => Value::text(""),
+        },
+        ExprKind::Attr(a) => Value::Word(a.dotted()),
+        _ => Value::text(""),
     }
 }
 
@@ -1347,7 +1445,7 @@ fn convert(
 ) -> Expr {
     let operand = |e: &ast::Expr, resolve: &mut dyn FnMut(&ast::Attr) -> Operand| match &e.kind {
         ExprKind::Attr(a) => resolve(a),
-        other => Operand::Literal(literal_text(other)),
+        other => Operand::Literal(literal_value(other)),
     };
     match &expr.kind {
         ExprKind::Or(a, b) => Expr::Or(

@@ -46,6 +46,7 @@ fn programs(text: &str, strategies: &[&str]) -> Vec<RobotProgram> {
         strategies: &strategies,
         strategy_names: &names,
         links: &links,
+        service_graphs: &[],
     };
     let (programs, diagnostics) = refine(&input);
     assert!(diagnostics.is_empty(), "{diagnostics:#?}");
@@ -125,7 +126,10 @@ fn the_strategy_refines_the_masters_move_only() {
     );
     assert_eq!(
         actions.actions[2].commands,
-        [("wheel".to_string(), "Forward".to_string())]
+        [(
+            "wheel".to_string(),
+            crate::refine::Value::Word("Forward".into())
+        )]
     );
     // The slaves have no strategy: their move calls the implementing task.
     assert_eq!(
@@ -163,7 +167,7 @@ fn battery_requirements_become_policies_over_the_robots_own_tasks() {
     else {
         panic!("{:?}", policy.condition);
     };
-    assert_eq!(limit, "30");
+    assert_eq!(limit, &crate::refine::Value::Int(30));
     assert!(matches!(
         &master.control.slots[*slot].source,
         SlotSource::Sensor { port, .. } if port == "BATTERY"
@@ -290,11 +294,76 @@ fn comparisons_carry_the_checkers_typing() {
     let programs = programs(text, &[]);
     let machine = format!("{:?}", program(&programs, "r").control.services);
     assert!(
-        machine.contains("Lt, Literal(\"30\"), Numbers)"),
+        machine.contains("Lt, Literal(Int(30)), Numbers)"),
         "{machine}"
     );
     assert!(
-        machine.contains("Eq, Literal(\"LEFT\"), Words)"),
+        machine.contains("Eq, Literal(Word(\"LEFT\")), Words)"),
         "{machine}"
     );
+}
+
+#[test]
+fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
+    use crate::refine::GraphStep::{Fire, Loop};
+    let fire = |task: &str| Fire {
+        task: task.to_string(),
+        count: 1,
+    };
+    let load = |name: &str| {
+        let text = shared(&format!("taskgraphs/{name}.taskgraph.xml"));
+        crate::taskgraph::load_task_graph(FileId(9), &text)
+            .0
+            .unwrap()
+    };
+    // `A 10(B C) D`: the D-type loop node is the `10(...)`.
+    assert_eq!(
+        robot::steps_of(&load("data_loop")).unwrap(),
+        [
+            fire("A"),
+            Loop {
+                path: "L".into(),
+                convergent: false,
+                loop_count: 10,
+                exit_task: None,
+                body: vec![fire("L/B"), fire("L/C")],
+            },
+            fire("D"),
+        ]
+    );
+    // k-means: a C-type loop (exit task ReplaceCenter) around a D-type one.
+    let kmeans = robot::steps_of(&load("kmeans")).unwrap();
+    let Loop {
+        convergent: true,
+        loop_count: 500,
+        exit_task: Some(exit),
+        body,
+        ..
+    } = &kmeans[2]
+    else {
+        panic!("{kmeans:?}");
+    };
+    assert_eq!(exit, "Converge/ReplaceCenter");
+    assert!(
+        matches!(&body[1], Loop { path, loop_count: 16, convergent: false, .. } if path == "Converge/Assign")
+    );
+    // No schedule, no program: a deadlocked graph is refused.
+    assert!(robot::steps_of(&load("deadlock")).is_err());
+}
+
+/// Slots carry the catalog's type of their value (a team variable has
+/// none: it holds what was assigned, typed as written), and literals are
+/// typed as written.
+#[test]
+fn slots_and_literals_are_typed_as_the_catalog_declares() {
+    let text = "{\n  Team1: iRobotCreate r\n}\n\nTeam1.Act.Go{\n  receive(USER, USER.RC_CMD)\n  send(Team1, Team1.count = 2.5)\n  if(DISTANCE < 30) throw near\n  move(\"5,5\")\n} repeat(1 SEC)\n\nTeam1.M{\n  set(Act, Go)\n}\n\nTeam1.main{\n  case (M):\n    catch (near): mode = M\n  default: mode = M\n}\n";
+    let programs = programs(text, &[]);
+    let m = &program(&programs, "r").control;
+    let kind = |key: &str| &m.slots.iter().find(|s| s.key == key).unwrap().kind;
+    assert_eq!(kind("Team1.DISTANCE"), &ValueKind::Int);
+    assert_eq!(kind("USER.RC_CMD"), &ValueKind::Text);
+    assert_eq!(kind("Team1.count"), &ValueKind::Variable);
+    let states = format!("{:?}", m.services);
+    assert!(states.contains("Literal(Real(2.5))"), "{states}");
+    assert!(states.contains("Literal(Text(\"5,5\"))"), "{states}");
 }

@@ -283,7 +283,9 @@ fn compared_literals(expr: &Expr, wanted: &dyn Fn(&Operand) -> bool, found: &mut
         }
         Expr::Not(a) => compared_literals(a, wanted, found),
         Expr::Compare(a, _, b, _) => match (a, b) {
-            (slot, Operand::Literal(l)) | (Operand::Literal(l), slot) if wanted(slot) => found(l),
+            (slot, Operand::Literal(l)) | (Operand::Literal(l), slot) if wanted(slot) => {
+                found(&l.as_text())
+            }
             _ => {}
         },
         Expr::Truthy(_) | Expr::Bool(_) => {}

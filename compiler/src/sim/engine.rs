@@ -29,6 +29,7 @@
 use super::scenario::{Command, DEFAULT_SERVICE_MS, FaultKind, Scenario};
 use super::trace::TraceEvent;
 use crate::refine::graph::CONTROL_PERIOD_MS;
+use crate::refine::value::{self, Value};
 use crate::refine::{
     ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, RoleKind,
     SlotSource, StateKind,
@@ -42,13 +43,17 @@ use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
 
 mod battery;
+mod loops;
 
 /// The sensor tasks' period (refinement's `SENSOR_PERIOD_MS`).
 const SENSOR_PERIOD_MS: i64 = 100;
 /// State transitions a region may take in one firing (`control.rs`).
 const STEPS_PER_FIRING: usize = 64;
-/// `semo_value`: text of at most 63 bytes.
-const VALUE_MAX: usize = 63;
+/// What a slot, a channel sample or a message holds: a typed value, or none
+/// (`SEMO_NONE`: never set).
+type Held = Option<Value>;
+/// A sensor value's scenario entries: (at, the value read as its type).
+type SensorSeries = Vec<(i64, Option<Value>)>;
 /// Default length of a run when neither the caller nor the scenario bounds it.
 pub const DEFAULT_UNTIL_MS: i64 = 10 * 60 * 1000;
 
@@ -128,15 +133,49 @@ struct Message {
     /// Index of the sender in the peers (operator: `None`).
     from_peer: Option<usize>,
     key: Rc<str>,
-    value: Rc<str>,
+    value: Payload,
     sent_at: i64,
+}
+
+/// A message's value. Events are ordered by (time, kind, sequence number),
+/// never by their payload, but the queue's element type needs an order:
+/// this one compares the value's JSON.
+#[derive(Clone, Debug)]
+struct Payload(Held);
+
+impl Payload {
+    fn key(&self) -> String {
+        let mut out = String::new();
+        super::trace::write_value(&mut out, self.0.as_ref());
+        out
+    }
+}
+
+impl PartialEq for Payload {
+    fn eq(&self, other: &Payload) -> bool {
+        self.key() == other.key()
+    }
+}
+
+impl Eq for Payload {}
+
+impl PartialOrd for Payload {
+    fn partial_cmp(&self, other: &Payload) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Payload {
+    fn cmp(&self, other: &Payload) -> std::cmp::Ordering {
+        self.key().cmp(&other.key())
+    }
 }
 
 /// A robot's names as its messages and trace carry them, shared rather
 /// than copied (most of a large run's trace is messages).
 struct Names {
     team: Rc<str>,
-    /// The value of its heartbeat: its name, as a value.
+    /// Its name (messages carry it; its heartbeat's value is its name as text).
     heartbeat: Rc<str>,
     alive_key: Rc<str>,
     sync_key: Rc<str>,
@@ -148,7 +187,7 @@ impl Names {
     fn new(program: &RobotProgram) -> Names {
         Names {
             team: program.team.as_str().into(),
-            heartbeat: truncate(program.robot.clone()).into(),
+            heartbeat: program.robot.as_str().into(),
             alive_key: crate::codegen::files::alive_key(program).into(),
             sync_key: crate::codegen::files::sync_key(program).into(),
             outgoing: program
@@ -190,15 +229,15 @@ struct Robot<'p> {
     /// Counts restarts: events of an earlier incarnation are ignored.
     epoch: u32,
     started_at: i64,
-    slots: Vec<String>,
+    slots: Vec<Held>,
     /// The library task's values, one per shared key (`lib_<name>.c`).
-    library: Vec<String>,
+    library: Vec<Held>,
     /// Per slot: its value's place in `library` (shared slots only).
     library_index: Vec<Option<usize>>,
     /// Per incoming message: the channel to the control task (capacity).
-    inbox: Vec<(VecDeque<String>, usize)>,
+    inbox: Vec<(VecDeque<Held>, usize)>,
     /// Per subscribed group: the latest value.
-    groups: Vec<Option<String>>,
+    groups: Vec<Option<Held>>,
     regions: Vec<Region>,
     current_mode: Option<usize>,
     pending_mode: Option<usize>,
@@ -220,8 +259,10 @@ struct Robot<'p> {
     /// Service tasks by name (the `request_tasks` and those of action commands).
     tasks: Vec<(String, TaskState)>,
     has_receiver: bool,
-    /// Per slot fed by a sensor: its value's entries (at, value), by time.
-    sensor_series: Vec<Option<Vec<(i64, String)>>>,
+    /// Per slot fed by a sensor: its value's entries (at, value read as the
+    /// sensor's type; `None` when the text is not one, which the sensor
+    /// task skips: `semo_sim_sensor` is false), by time.
+    sensor_series: Vec<Option<SensorSeries>>,
     battery: Vec<(i64, f64)>,
     service_ms: HashMap<String, i64>,
     /// Orders the control firings of robots at the same time: robots that
@@ -258,31 +299,6 @@ pub struct Sim<'p> {
     every_firing: bool,
 }
 
-fn truncate(mut s: String) -> String {
-    if s.len() > VALUE_MAX {
-        let mut end = VALUE_MAX;
-        while !s.is_char_boundary(end) {
-            end -= 1;
-        }
-        s.truncate(end);
-    }
-    s
-}
-
-/// `parse_number` of the runtime: the whole text is a number (no leading space).
-fn number(text: &str) -> Option<f64> {
-    let first = text.as_bytes().first()?;
-    if first.is_ascii_whitespace() {
-        return None;
-    }
-    text.parse::<f64>().ok().filter(|d| !d.is_nan())
-}
-
-/// `semo_value_truthy`.
-fn truthy(v: &str) -> bool {
-    v == "true" || number(v).is_some_and(|x| x != 0.0)
-}
-
 impl<'p> Robot<'p> {
     fn new(program: &'p RobotProgram, scenario: &Scenario, at: i64, epoch: u32) -> Robot<'p> {
         let m = &program.control;
@@ -292,12 +308,12 @@ impl<'p> Robot<'p> {
             .iter()
             .map(|s| match &s.source {
                 SlotSource::Sensor { port, .. } => {
-                    let mut series: Vec<(i64, String)> = world
+                    let mut series: SensorSeries = world
                         .map(|w| {
                             w.sensors
                                 .iter()
                                 .filter(|(_, v, _)| v == port)
-                                .map(|(at, _, is)| (*at, is.clone()))
+                                .map(|(at, _, is)| (*at, s.kind.parse(is)))
                                 .collect()
                         })
                         .unwrap_or_default();
@@ -341,8 +357,8 @@ impl<'p> Robot<'p> {
             alive: true,
             epoch,
             started_at: at,
-            slots: vec![String::new(); m.slots.len()],
-            library: vec![String::new(); library_keys.len()],
+            slots: vec![None; m.slots.len()],
+            library: vec![None; library_keys.len()],
             library_index: m
                 .slots
                 .iter()
@@ -482,6 +498,7 @@ impl<'p> Sim<'p> {
             robot,
             event,
             fields,
+            value: None,
             sent_at: None,
         });
     }
@@ -603,7 +620,7 @@ impl<'p> Sim<'p> {
             from_robot: "USER".into(),
             from_peer: None,
             key: command.key.as_str().into(),
-            value: truncate(command.value.clone()).into(),
+            value: Payload(Some(Value::text(&command.value))),
             sent_at: self.now,
         };
         for r in 0..self.robots.len() {
@@ -660,21 +677,15 @@ impl<'p> Sim<'p> {
 
     // ------------------------------------------------------------ values
 
-    fn value(&self, r: usize, op: &Operand) -> String {
-        self.value_ref(r, op).to_string()
+    fn value(&self, r: usize, op: &Operand) -> Held {
+        self.value_ref(r, op).cloned()
     }
 
-    /// An operand's text without copying it (conditions are read every firing).
-    fn value_ref<'a>(&'a self, r: usize, op: &'a Operand) -> &'a str {
+    /// An operand's value without copying it (conditions are read every firing).
+    fn value_ref<'a>(&'a self, r: usize, op: &'a Operand) -> Option<&'a Value> {
         match op {
-            Operand::Slot(s) => &self.robots[r].slots[*s],
-            Operand::Literal(text) => {
-                let mut end = text.len().min(VALUE_MAX);
-                while !text.is_char_boundary(end) {
-                    end -= 1;
-                }
-                &text[..end]
-            }
+            Operand::Slot(s) => self.robots[r].slots[*s].as_ref(),
+            Operand::Literal(v) => Some(v),
         }
     }
 
@@ -684,19 +695,20 @@ impl<'p> Sim<'p> {
             Expr::And(a, b) => self.eval(r, a) && self.eval(r, b),
             Expr::Not(a) => !self.eval(r, a),
             Expr::Bool(b) => *b,
-            Expr::Truthy(o) => truthy(self.value_ref(r, o)),
+            Expr::Truthy(o) => value::truthy(self.value_ref(r, o)),
             Expr::Compare(a, op, b, compared) => {
                 let (a, b) = (self.value_ref(r, a), self.value_ref(r, b));
                 // As the checker typed it (`semo_value_numbers`,
                 // `semo_value_words`): numbers by value, false when a side is
-                // not a number; words by their text, never ordered.
+                // not a number; words by identity, never ordered.
                 let ord = match compared {
-                    Compared::Numbers => match (number(a), number(b)) {
-                        (Some(x), Some(y)) => x.partial_cmp(&y),
-                        _ => None,
-                    },
+                    Compared::Numbers => value::compare_numbers(a, b),
                     Compared::Words => match op {
-                        CmpOp::Eq | CmpOp::Ne => Some(a.as_bytes().cmp(b.as_bytes())),
+                        CmpOp::Eq | CmpOp::Ne => Some(if value::words_equal(a, b) {
+                            std::cmp::Ordering::Equal
+                        } else {
+                            std::cmp::Ordering::Less
+                        }),
                         _ => None,
                     },
                 };
@@ -717,7 +729,7 @@ impl<'p> Sim<'p> {
     }
 
     /// `store`: the slot, and the library for shared information.
-    fn store(&mut self, r: usize, slot: usize, value: String) {
+    fn store(&mut self, r: usize, slot: usize, value: Held) {
         let robot = &mut self.robots[r];
         robot.progressed = true;
         if let Some(k) = robot.library_index[slot] {
@@ -742,19 +754,20 @@ impl<'p> Sim<'p> {
                         continue;
                     };
                     let n = series.partition_point(|(at, _)| *at <= sampled);
-                    if n > 0 {
-                        if robot.slots[i] != series[n - 1].1 {
-                            robot.slots[i].clone_from(&series[n - 1].1);
-                            robot.progressed = true;
-                        }
+                    let read = if n > 0 {
+                        series[n - 1].1.clone()
                     } else if port == "BATTERY"
                         && let Some(level) = battery_level(&robot.battery, sampled)
                     {
-                        let level = format!("{}", level.round());
-                        if robot.slots[i] != level {
-                            robot.slots[i] = level;
-                            robot.progressed = true;
-                        }
+                        s.kind.parse(&format!("{}", level.round()))
+                    } else {
+                        None
+                    };
+                    if let Some(v) = read
+                        && robot.slots[i].as_ref() != Some(&v)
+                    {
+                        robot.slots[i] = Some(v);
+                        robot.progressed = true;
                     }
                 }
                 SlotSource::Shared => {
@@ -774,16 +787,15 @@ impl<'p> Sim<'p> {
 
     /// `semo_comm_send`: traced, then to every other robot of `to` (team or
     /// robot name) through the network; `USER` only traces.
-    fn comm_send(&mut self, r: usize, to: Rc<str>, publish: bool, key: Rc<str>, value: Rc<str>) {
-        self.emit(
-            r,
-            "send",
-            vec![
-                ("to", to.clone()),
-                ("key", key.clone()),
-                ("value", value.clone()),
-            ],
-        );
+    fn comm_send(&mut self, r: usize, to: Rc<str>, publish: bool, key: Rc<str>, value: Held) {
+        self.trace.push(TraceEvent {
+            t: self.now,
+            robot: r,
+            event: "send",
+            fields: vec![("to", to.clone()), ("key", key.clone())],
+            value: Some(("value", value.clone())),
+            sent_at: None,
+        });
         if &*to == "USER" {
             return;
         }
@@ -797,7 +809,7 @@ impl<'p> Sim<'p> {
             from_robot: self.names[r].heartbeat.clone(),
             from_peer: Some(program.self_peer),
             key,
-            value,
+            value: Payload(value),
             sent_at: self.now,
         });
         for &dst in targets.iter() {
@@ -879,14 +891,19 @@ impl<'p> Sim<'p> {
                 ("from", message.from_team.clone()),
                 ("from_robot", message.from_robot.clone()),
                 ("key", message.key.clone()),
-                ("value", message.value.clone()),
             ],
+            value: Some(("value", message.value.0.clone())),
             sent_at: Some(message.sent_at),
         });
         let robot = &mut self.robots[r];
         let m = &robot.program.control;
         if m.heartbeat && message.publish && message.key == self.names[r].alive_key {
-            let heard = Heard::parse(self.now, &message.value);
+            // A heartbeat's value is text ("leader 80"); anything else says nothing.
+            let text = match &message.value.0 {
+                Some(Value::Text(t)) => t.as_str(),
+                _ => "",
+            };
+            let heard = Heard::parse(self.now, text);
             for (i, (_, name)) in robot.program.peers.iter().enumerate() {
                 if **name == *message.from_robot {
                     robot.heard[i] = heard;
@@ -896,7 +913,12 @@ impl<'p> Sim<'p> {
         }
         // `heard_sync`: an arrival at a group statement; wakes the control task.
         if !m.sync_points.is_empty() && message.key == self.names[r].sync_key {
-            let mut words = message.value.split(' ');
+            // Its value is text ("<point> <pass>"); anything else says nothing.
+            let text = match &message.value.0 {
+                Some(Value::Text(t)) => t.as_str(),
+                _ => "",
+            };
+            let mut words = text.split(' ');
             let number = |w: Option<&str>| w.and_then(|w| w.parse::<i64>().ok()).unwrap_or(0);
             let (offset, pass) = (number(words.next()), number(words.next()));
             let peer = robot
@@ -915,21 +937,39 @@ impl<'p> Sim<'p> {
         if !m.subscribed.is_empty() && message.publish {
             for (i, g) in m.subscribed.iter().enumerate() {
                 if **g == *message.key {
-                    robot.groups[i] = Some(message.value.to_string());
+                    robot.groups[i] = Some(message.value.0.clone());
                 }
             }
             return;
         }
         // A full channel drops the sample (the runtime counts it).
+        // A value of another type than the key's is refused
+        // (`semo_value_coerce`); text is read as the type.
         let mut queued = false;
+        let mut rejected = false;
         for (i, incoming) in m.incoming.iter().enumerate() {
             if *incoming.from_team == *message.from_team && *incoming.key == *message.key {
+                let kind = &m.slots[incoming.slot].kind;
+                let Some(value) = (match &message.value.0 {
+                    Some(v) => kind.coerce(v).map(Some),
+                    None => Some(None),
+                }) else {
+                    rejected = true;
+                    continue;
+                };
                 let (queue, capacity) = &mut robot.inbox[i];
                 if queue.len() < *capacity {
-                    queue.push_back(message.value.to_string());
+                    queue.push_back(value);
                     queued = true;
                 }
             }
+        }
+        if rejected {
+            let fields = vec![
+                ("key", message.key.clone()),
+                ("reason", "not a value of its type".into()),
+            ];
+            self.emit(r, "reject", fields);
         }
         // Only a `receive` waits for a message: heartbeats and published
         // values are read on the way through a state, never waited for.
@@ -941,12 +981,15 @@ impl<'p> Sim<'p> {
     // ------------------------------------------------------ service tasks
 
     /// `request`: a service task starts one call unless it is busy.
-    fn request(&mut self, r: usize, task: &str, service: &str, args: Vec<String>) -> bool {
+    fn request(&mut self, r: usize, task: &str, service: &str, args: Vec<Held>) -> bool {
         let t = self.robots[r].task_index(task);
         if self.robots[r].tasks[t].1.busy {
             return false;
         }
-        let arg = args.first().cloned().unwrap_or_default();
+        let arg = match args.first() {
+            Some(v) => v.clone(),
+            None => Some(Value::text("")),
+        };
         let ms = self.robots[r]
             .service_ms
             .get(service)
@@ -958,22 +1001,26 @@ impl<'p> Sim<'p> {
         state.service = service.to_string();
         state.generation += 1;
         let generation = state.generation;
-        self.emit(
-            r,
-            "call_start",
-            vec![
-                ("task", task.to_string().into()),
-                ("service", service.to_string().into()),
-                ("arg", arg.clone().into()),
-            ],
-        );
+        let task_name: Rc<str> = task.into();
+        self.trace.push(TraceEvent {
+            t: self.now,
+            robot: r,
+            event: "call_start",
+            fields: vec![("task", task_name.clone()), ("service", service.into())],
+            value: Some(("arg", arg.clone())),
+            sent_at: None,
+        });
         if !args.is_empty() {
-            self.emit(
-                r,
-                "actuate",
-                vec![("task", task.to_string().into()), ("value", arg.into())],
-            );
+            self.trace.push(TraceEvent {
+                t: self.now,
+                robot: r,
+                event: "actuate",
+                fields: vec![("task", task_name)],
+                value: Some(("value", arg)),
+                sent_at: None,
+            });
         }
+        self.run_graph(r, task);
         self.schedule(
             self.now + ms,
             Event::ServiceDone {
@@ -1099,7 +1146,11 @@ impl<'p> Sim<'p> {
             let robot = &self.robots[r];
             let value = heartbeat_value(robot.leading, own_battery(robot, self.now));
             let names = &self.names[r];
-            let (team, key, value) = (names.team.clone(), names.alive_key.clone(), value.into());
+            let (team, key, value) = (
+                names.team.clone(),
+                names.alive_key.clone(),
+                Some(Value::text(&value)),
+            );
             self.comm_send(r, team, true, key, value);
         }
         if self.robots[r].current_mode.is_none() {
@@ -1344,7 +1395,7 @@ impl<'p> Sim<'p> {
                     }
                     let publish = m.outgoing[item.message].publish;
                     let (to, key) = self.names[r].outgoing[item.message].clone();
-                    self.comm_send(r, to, publish, key, sent.into());
+                    self.comm_send(r, to, publish, key, sent);
                 }
                 self.region(r, i).pc = next;
                 Step::Next
@@ -1461,7 +1512,7 @@ impl<'p> Sim<'p> {
                     region.phase = 1;
                     let names = &self.names[r];
                     let (team, key) = (names.team.clone(), names.sync_key.clone());
-                    self.comm_send(r, team, false, key, value.into());
+                    self.comm_send(r, team, false, key, Some(Value::text(&value)));
                 }
                 let robot = &self.robots[r];
                 let pass = robot.sync_pass[&(service, pc)];
@@ -1577,7 +1628,7 @@ impl<'p> Sim<'p> {
             if self.robots[r].regions[i].phase == 1 {
                 for (task, command) in &action.commands {
                     let name = actuator_name(self.robots[r].program, task);
-                    if !self.request(r, task, &name, vec![truncate(command.clone())]) {
+                    if !self.request(r, task, &name, vec![Some(command.clone())]) {
                         return Step::Wait;
                     }
                 }

@@ -85,14 +85,9 @@ fn judge_one(run: &Run, kind: &ExpectKind) -> (bool, String) {
                         .is_none_or(|f| e.field("from_robot") == Some(f))
             });
             match received {
-                Some(e) if before.is_none_or(|b| e.t <= b) => (
-                    true,
-                    format!(
-                        "received at {} ms: {:?}",
-                        e.t,
-                        e.field("value").unwrap_or_default()
-                    ),
-                ),
+                Some(e) if before.is_none_or(|b| e.t <= b) => {
+                    (true, format!("received at {} ms: {}", e.t, e.value_json()))
+                }
                 Some(e) => (false, format!("received only at {} ms", e.t)),
                 None => (false, "never received".into()),
             }

@@ -39,6 +39,9 @@ pub struct RobotWorld {
     pub services: Vec<(String, i64)>,
     /// (at, level): the `BATTERY` sensor value, linear between points.
     pub battery: Vec<(i64, f64)>,
+    /// (SDF/L loop path, iteration): when a convergent loop's exit task
+    /// sets the exit flag.
+    pub loops: Vec<(String, u64)>,
 }
 
 /// An operator command: `USER.<value>` sent to a robot or team.
@@ -468,8 +471,8 @@ impl Reader<'_> {
         }
         object(
             v,
-            "a robot {\"sensors\": [...], \"services\": {...}, \"battery\": [...]}",
-            &["sensors", "services", "battery"],
+            "a robot {\"sensors\": [...], \"services\": {...}, \"battery\": [...], \"loops\": {...}}",
+            &["sensors", "services", "battery", "loops"],
         )?;
         let mut world = RobotWorld {
             robot: robot.to_string(),
@@ -484,7 +487,32 @@ impl Reader<'_> {
                 )?;
                 let at = ms(require(entry, "at")?, "at", 0)?;
                 let value = name(require(entry, "value")?, "value")?.to_string();
-                let is = value_text(require(entry, "is")?)?;
+                let is_value = require(entry, "is")?;
+                let is = value_text(is_value)?;
+                // Read as the catalog's type of the value, as the sensor task
+                // reads it (`semo_sim_sensor`): say so here, not by silence.
+                let kind = self
+                    .programs
+                    .iter()
+                    .filter(|p| p.robot == robot)
+                    .flat_map(|p| &p.control.slots)
+                    .find_map(|s| match &s.source {
+                        crate::refine::SlotSource::Sensor { port, .. } if *port == value => {
+                            Some(&s.kind)
+                        }
+                        _ => None,
+                    });
+                if let Some(kind) = kind
+                    && kind.parse(&is).is_none()
+                {
+                    return fail(
+                        is_value,
+                        format!(
+                            "\"is\" must be a value of {value}'s type ({}), not {is:?}",
+                            kind.describe()
+                        ),
+                    );
+                }
                 world.sensors.push((at, value, is));
             }
         }
@@ -497,6 +525,23 @@ impl Reader<'_> {
             };
             for (service, d) in members {
                 world.services.push((service.clone(), ms(d, service, 0)?));
+            }
+        }
+        if let Some(loops) = v.member("loops") {
+            let Kind::Object(members) = &loops.kind else {
+                return fail(loops, "expected an object of loop exits {\"Converge\": 3}");
+            };
+            for (path, n) in members {
+                let iteration = match n.kind {
+                    Kind::Number(x, _) if (1.0..=1e9).contains(&x) && x.fract() == 0.0 => x as u64,
+                    _ => {
+                        return fail(
+                            n,
+                            format!("\"{path}\" must be a whole number of iterations, 1 or more"),
+                        );
+                    }
+                };
+                world.loops.push((path.clone(), iteration));
             }
         }
         if let Some(battery) = v.member("battery") {

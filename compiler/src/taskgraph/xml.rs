@@ -2,11 +2,15 @@
 //! SDF3 graphs (`<sdf3 type="sdf">`), with positioned diagnostics (E060–E066,
 //! W060). See `shared/spec/taskgraph.md` for both formats.
 //!
-//! Reading happens in two steps: the XML is read into a small positioned
+//! Our format is read in two steps: the XML is read into a small positioned
 //! element tree ([`crate::xmltree`]: every element, attribute and attribute
-//! value keeps its byte range), then the tree is read as a graph. Malformed XML (E060) stops the
-//! first step; what was read before the error is still read as a graph, and
-//! channel ends are not checked in a graph level that was cut short.
+//! value keeps its byte range), then the tree is read as a graph. An SDF3
+//! file (the root's start tag tells) is read in one step, its elements as
+//! they come ([`sdf3`]), with the same positions and checks: its files are
+//! large, and the tree was most of the time of analysing one. Malformed XML
+//! (E060) stops reading; what was read before the error is still read as a
+//! graph, and channel ends are not checked in a graph level that was cut
+//! short.
 //!
 //! What the returned graph holds:
 //! - Entries that cannot be used are left out, so that analyses see no
@@ -45,14 +49,14 @@
 
 use super::model::*;
 use crate::diag::{Code, Diagnostic, FileId, Sink, sort_and_dedup};
+use crate::fasthash::{FastMap as HashMap, FastSet as HashSet};
 use crate::span::Span;
 use crate::suggest::did_you_mean;
 use crate::syntax::ast::TimeUnit;
 use crate::xmlpos::{Attr, get, is_ident, shown, suggest};
-use crate::xmltree::{Elem, TreeFormat, Vocabulary, read_tree};
+use crate::xmltree::{Elem, TreeCollector, TreeFormat, Visit, Vocabulary, walk};
 use quick_xml::Reader;
 use quick_xml::events::Event;
-use std::collections::{HashMap, HashSet};
 
 /// The two file formats a task graph can be read from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -92,42 +96,90 @@ pub fn load_task_graph_as(
     times: ExecutionTimes,
 ) -> (Option<TaskGraph>, Vec<Diagnostic>) {
     let mut sink = Sink::quoting_xml(file);
-    let (root, xml_diagnostics) = read_tree(
-        text,
-        TreeFormat {
-            file,
-            xml_code: Code::GraphXml,
-            empty_message: "this file is empty: a task graph needs a `<TaskGraph>` element",
-            raw_lt: None,
-        },
-    );
-    sink.extend(xml_diagnostics);
-    let graph = root.and_then(|root| {
-        let mut loader = Loader {
-            file,
-            sink: &mut sink,
-            sdf3: root.local == "sdf3",
-            times,
-        };
-        match root.local.as_str() {
-            "TaskGraph" => Some(loader.semo_root(&root)),
-            "sdf3" => loader.sdf3_root(&root),
-            _ => {
-                let message = format!(
-                    "a task-graph file must start with `<TaskGraph>` (or SDF3 `<sdf3 type=\"sdf\">`), not `<{}>`",
-                    root.qname
-                );
-                loader
-                    .sink
-                    .report(Code::GraphUnknownElement, root.name_span, message)
-                    .suggest(suggest(&root.local, &["TaskGraph", "sdf3"]));
-                None
+    let format = TreeFormat {
+        file,
+        xml_code: Code::GraphXml,
+        empty_message: "this file is empty: a task graph needs a `<TaskGraph>` element",
+        raw_lt: None,
+    };
+    let loader = Loader {
+        file,
+        sink: &mut sink,
+        sdf3: false,
+        times,
+    };
+    let mut reading = Reading::Undecided(Some(loader));
+    let xml_diagnostics = walk(text, format, &mut reading);
+    let graph = match reading {
+        Reading::Undecided(_) => None,
+        Reading::Sdf3(reader) => reader.finish(),
+        Reading::Tree(tree, mut loader) => tree.into_root().and_then(|root| {
+            match root.local.as_str() {
+                "TaskGraph" => Some(loader.semo_root(&root)),
+                _ => {
+                    let message = format!(
+                        "a task-graph file must start with `<TaskGraph>` (or SDF3 `<sdf3 type=\"sdf\">`), not `<{}>`",
+                        root.qname
+                    );
+                    loader
+                        .sink
+                        .report(Code::GraphUnknownElement, root.name_span, message)
+                        .suggest(suggest(&root.local, &["TaskGraph", "sdf3"]));
+                    None
+                }
             }
-        }
-    });
+        }),
+    };
+    sink.extend(xml_diagnostics);
     let mut diags = sink.into_vec();
     sort_and_dedup(&mut diags);
     (graph, diags)
+}
+
+/// How a file is read, decided by its root element's start tag: an SDF3
+/// graph as its elements come ([`sdf3`]), our format as an element tree.
+enum Reading<'s> {
+    /// No root element yet (the loader is waiting).
+    Undecided(Option<Loader<'s>>),
+    Sdf3(Box<sdf3::Sdf3Reader<'s>>),
+    Tree(TreeCollector, Loader<'s>),
+}
+
+impl Visit for Reading<'_> {
+    fn open(&mut self, e: &Elem) {
+        if let Reading::Undecided(loader) = self {
+            let Some(mut loader) = loader.take() else {
+                return;
+            };
+            *self = if e.local == "sdf3" {
+                loader.sdf3 = true;
+                Reading::Sdf3(Box::new(sdf3::Sdf3Reader::new(loader)))
+            } else {
+                Reading::Tree(TreeCollector::default(), loader)
+            };
+        }
+        match self {
+            Reading::Undecided(_) => {}
+            Reading::Sdf3(reader) => reader.open(e),
+            Reading::Tree(tree, _) => tree.open(e),
+        }
+    }
+
+    fn close(&mut self, e: &mut Elem) {
+        match self {
+            Reading::Undecided(_) => {}
+            Reading::Sdf3(reader) => reader.close(e),
+            Reading::Tree(tree, _) => tree.close(e),
+        }
+    }
+
+    fn text(&mut self, span: Span) {
+        match self {
+            Reading::Undecided(_) => {}
+            Reading::Sdf3(reader) => reader.text(span),
+            Reading::Tree(tree, _) => tree.text(span),
+        }
+    }
 }
 
 /// The format of a task-graph text, from its root element; `None` when the
@@ -309,7 +361,7 @@ impl Loader<'_> {
     /// is needed). `Err(())` after a report.
     fn number(&mut self, a: &Attr, min: Min) -> Result<u64, ()> {
         let s = a.trimmed();
-        let quoted = shown(s);
+        let quoted = || shown(s);
         let parsed = if !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit()) {
             s.parse::<u64>().ok()
         } else {
@@ -322,19 +374,19 @@ impl Loader<'_> {
         match parsed {
             Some(n) if n >= 1 || min == Min::Zero => Ok(n),
             Some(_) => {
-                let message = format!("`{}` must be {what}, not `{quoted}`", a.key);
+                let message = format!("`{}` must be {what}, not `{}`", a.key, quoted());
                 self.sink
                     .report(Code::GraphBadAttribute, a.trimmed_span(), message);
                 Err(())
             }
             None if !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit()) => {
-                let message = format!("`{}` is too large: `{quoted}`", a.key);
+                let message = format!("`{}` is too large: `{}`", a.key, quoted());
                 self.sink
                     .report(Code::GraphBadAttribute, a.trimmed_span(), message);
                 Err(())
             }
             None => {
-                let message = format!("`{}` must be {what}, not `{quoted}`", a.key);
+                let message = format!("`{}` must be {what}, not `{}`", a.key, quoted());
                 self.sink.report(Code::GraphBadAttribute, a.span, message);
                 Err(())
             }
@@ -382,17 +434,17 @@ impl Loader<'_> {
         }
     }
 
-    /// E063 unless `named` is new in `names`.
+    /// E063 unless `named` is new in `names` (the message is made only then).
     fn register(
         &mut self,
         names: &mut HashMap<String, Span>,
         named: &Named,
-        message: String,
+        message: impl FnOnce() -> String,
     ) -> bool {
         if let Some(first) = names.get(&named.name) {
             let first = *first;
             self.sink
-                .report(Code::GraphDuplicateName, named.span, message)
+                .report(Code::GraphDuplicateName, named.span, message())
                 .relate(first, "first defined here");
             return false;
         }
@@ -403,7 +455,7 @@ impl Loader<'_> {
     // --- our format ----------------------------------------------------------
 
     fn semo_root(&mut self, root: &Elem) -> TaskGraph {
-        self.graph(root, None, HashSet::new())
+        self.graph(root, None, HashSet::default())
     }
 
     /// One `<TaskGraph>`: the outer one, or a loop body (`enclosing` is then the
@@ -457,7 +509,7 @@ impl Loader<'_> {
                             lib.name.name
                         );
                         let mut names = std::mem::take(&mut level.library_names);
-                        if self.register(&mut names, &lib.name, message) {
+                        if self.register(&mut names, &lib.name, || message) {
                             level.libraries.push(lib);
                         }
                         level.library_names = names;
@@ -507,7 +559,7 @@ impl Loader<'_> {
             ),
         };
         let mut names = std::mem::take(&mut level.task_names);
-        if self.register(&mut names, &task.name, message) {
+        if self.register(&mut names, &task.name, || message) {
             level.tasks.push(task);
             level.broken_ports.push(broken);
         }
@@ -650,7 +702,7 @@ impl Loader<'_> {
     /// Registers a port name in its task; `false` (after E063) for a second one.
     fn register_port(&mut self, build: &mut PortsBuild, name: &Named) -> bool {
         let what = if self.sdf3 { "actor" } else { "task" };
-        let message = format!("this {what} already has a port named `{}`", name.name);
+        let message = || format!("this {what} already has a port named `{}`", name.name);
         let mut names = std::mem::take(&mut build.names);
         let fresh = self.register(&mut names, name, message);
         build.names = names;
@@ -797,7 +849,7 @@ impl Loader<'_> {
         self.check_attributes(e, LIBRARY_ATTRS);
         let name = self.name(e, "name");
         let mut functions = Vec::new();
-        let mut names = HashMap::new();
+        let mut names = HashMap::default();
         for f in self.children(e, &["Function"]) {
             self.check_attributes(f, FUNCTION_ATTRS);
             let fname = self.name(f, "name");
@@ -805,7 +857,7 @@ impl Loader<'_> {
                 .map(|a| a.trimmed().to_string())
                 .filter(|r| !r.is_empty());
             let mut params = Vec::new();
-            let mut param_names = HashMap::new();
+            let mut param_names = HashMap::default();
             for p in self.children(f, &["Param"]) {
                 self.check_attributes(p, PARAM_ATTRS);
                 self.children(p, &[]);
@@ -815,7 +867,7 @@ impl Loader<'_> {
                     continue;
                 };
                 let message = format!("this function already has a parameter `{}`", pname.name);
-                if self.register(&mut param_names, &pname, message) {
+                if self.register(&mut param_names, &pname, || message) {
                     params.push((pname.name, ty));
                 }
             }
@@ -823,7 +875,7 @@ impl Loader<'_> {
                 continue;
             };
             let message = format!("this library already has a function `{}`", fname.name);
-            if self.register(&mut names, &fname, message) {
+            if self.register(&mut names, &fname, || message) {
                 functions.push(LibraryFunction {
                     name: fname,
                     returns,
@@ -1088,231 +1140,6 @@ impl Loader<'_> {
             .report(Code::GraphPortDirection, span, message)
             .relate(port.name.span, "the port is declared here");
     }
-
-    // --- SDF3 ----------------------------------------------------------------
-
-    fn sdf3_root(&mut self, root: &Elem) -> Option<TaskGraph> {
-        match get(&root.attrs, "type") {
-            None => {
-                self.sink.report(
-                    Code::GraphMissingAttribute,
-                    root.tag,
-                    "`<sdf3>` needs a `type` attribute: only type=\"sdf\" graphs are read",
-                );
-            }
-            Some(a) if a.trimmed() != "sdf" => {
-                let message = format!(
-                    "only SDF3 graphs of type=\"sdf\" can be read, not `{}`",
-                    shown(a.trimmed())
-                );
-                self.sink.report(Code::GraphBadAttribute, a.span, message);
-                return None;
-            }
-            Some(_) => {}
-        }
-        let app = root.children.iter().find(|c| c.local == "applicationGraph");
-        let sdf = app.and_then(|a| a.children.iter().find(|c| c.local == "sdf"));
-        let Some(sdf) = sdf else {
-            if root.complete {
-                self.sink.report(
-                    Code::GraphMissingAttribute,
-                    root.tag,
-                    "this SDF3 file has no graph: it needs `<applicationGraph>` with an `<sdf>` element",
-                );
-            }
-            return None;
-        };
-        let name = get(&sdf.attrs, "name")
-            .or_else(|| app.and_then(|a| get(&a.attrs, "name")))
-            .map(|a| a.trimmed().to_string())
-            .unwrap_or_default();
-        let times = app
-            .and_then(|a| a.children.iter().find(|c| c.local == "sdfProperties"))
-            .map(|p| self.sdf3_times(p))
-            .unwrap_or_default();
-        let mut level = LevelBuild::default();
-        let mut pending = Vec::new();
-        for c in &sdf.children {
-            match c.local.as_str() {
-                "actor" => {
-                    if let Some((task, broken)) = self.sdf3_actor(c, &times) {
-                        let message = format!("actor `{}` is already defined", task.name.name);
-                        let mut names = std::mem::take(&mut level.task_names);
-                        if self.register(&mut names, &task.name, message) {
-                            level.tasks.push(task);
-                            level.broken_ports.push(broken);
-                        }
-                        level.task_names = names;
-                    }
-                }
-                "channel" => {
-                    if let Some(channel) = self.sdf3_channel(c) {
-                        pending.push(channel);
-                    }
-                }
-                _ => {}
-            }
-        }
-        for (channel, parts) in pending {
-            level.channels.push(channel);
-            level.channel_parts.push(parts);
-        }
-        if sdf.complete {
-            self.check_channels(&level, None);
-        }
-        Some(TaskGraph {
-            name,
-            file: self.file,
-            span: sdf.span,
-            tasks: level.tasks,
-            channels: level.channels,
-            libraries: Vec::new(),
-        })
-    }
-
-    /// Execution times from `<sdfProperties>`: per actor, the chosen
-    /// processor's (see [`ExecutionTimes`]).
-    fn sdf3_times(&mut self, props: &Elem) -> HashMap<String, u64> {
-        let mut times = HashMap::new();
-        for ap in props
-            .children
-            .iter()
-            .filter(|c| c.local == "actorProperties")
-        {
-            let Some(actor) = get(&ap.attrs, "actor") else {
-                continue;
-            };
-            let processors: Vec<&Elem> = ap
-                .children
-                .iter()
-                .filter(|c| c.local == "processor")
-                .collect();
-            let chosen = match self.times {
-                ExecutionTimes::FileDefault => processors
-                    .iter()
-                    .find(|p| get(&p.attrs, "default").is_some_and(|d| d.trimmed() == "true"))
-                    .or(processors.first()),
-                ExecutionTimes::Sdf3Compat => {
-                    // SDF3 keeps the type of the last processor marked
-                    // `default` and then takes the first entry of that type.
-                    let kind = |p: &&Elem| get(&p.attrs, "type").map(|t| t.trimmed().to_string());
-                    let last = processors
-                        .iter()
-                        .rev()
-                        .find(|p| get(&p.attrs, "default").is_some());
-                    last.and_then(kind)
-                        .and_then(|k| processors.iter().find(|p| kind(p).as_ref() == Some(&k)))
-                }
-            };
-            let time = chosen
-                .and_then(|p| p.children.iter().find(|c| c.local == "executionTime"))
-                .and_then(|t| get(&t.attrs, "time"));
-            if let Some(time) = time {
-                if let Ok(n) = self.number(time, Min::Zero) {
-                    times.entry(actor.trimmed().to_string()).or_insert(n);
-                }
-            }
-        }
-        times
-    }
-
-    fn sdf3_actor(
-        &mut self,
-        e: &Elem,
-        times: &HashMap<String, u64>,
-    ) -> Option<(Task, HashSet<String>)> {
-        let name = self.required(e, "name").map(|a| Named {
-            name: a.trimmed().to_string(),
-            span: a.trimmed_span(),
-        });
-        let mut build = PortsBuild::default();
-        for p in e.children.iter().filter(|c| c.local == "port") {
-            let pname = self.required(p, "name").map(|a| Named {
-                name: a.trimmed().to_string(),
-                span: a.trimmed_span(),
-            });
-            let dir = self.required(p, "type").and_then(|a| {
-                self.choice(a, &["in", "out"]).map(|d| match d {
-                    "in" => Direction::In,
-                    _ => Direction::Out,
-                })
-            });
-            let rate_attr = get(&p.attrs, "rate");
-            let rate = self.opt_number(p, "rate", Min::One);
-            let Some(pname) = pname else {
-                continue;
-            };
-            if !self.register_port(&mut build, &pname) {
-                continue;
-            }
-            let (Some(dir), Ok(rate)) = (dir, rate) else {
-                build.broken.insert(pname.name);
-                continue;
-            };
-            build.ports.push(Port {
-                name: pname,
-                span: p.span,
-                dir,
-                rate: rate.unwrap_or(1),
-                rate_span: rate_attr.map(Attr::trimmed_span),
-                sample_type: None,
-                size: None,
-                kind: None,
-                inner_rate: None,
-            });
-        }
-        let name = name?;
-        Some((
-            Task {
-                wcet: times.get(&name.name).copied(),
-                name,
-                span: e.span,
-                kind: TaskKind::Computational,
-                trigger: Trigger::Data,
-                source: None,
-                subgraph: None,
-                ports: build.ports,
-                library_ports: Vec::new(),
-                multicast_ports: Vec::new(),
-                loop_node: None,
-            },
-            build.broken,
-        ))
-    }
-
-    fn sdf3_channel(&mut self, e: &Elem) -> Option<(Channel, [(Span, Span); 2])> {
-        let mut end = |actor: &str, port: &str| -> Option<(Endpoint, (Span, Span))> {
-            let a = self.required(e, actor);
-            let p = self.required(e, port);
-            let (a, p) = (a?, p?);
-            let (a_span, p_span) = (a.trimmed_span(), p.trimmed_span());
-            Some((
-                Endpoint {
-                    task: a.trimmed().to_string(),
-                    port: p.trimmed().to_string(),
-                    span: a_span.cover(p_span),
-                },
-                (a_span, p_span),
-            ))
-        };
-        let src = end("srcActor", "srcPort");
-        let dst = end("dstActor", "dstPort");
-        let initial_tokens = self.opt_number(e, "initialTokens", Min::Zero);
-        let ((src, src_parts), (dst, dst_parts), Ok(initial_tokens)) = (src?, dst?, initial_tokens)
-        else {
-            return None;
-        };
-        Some((
-            Channel {
-                src,
-                dst,
-                initial_tokens: initial_tokens.unwrap_or(0),
-                capacity: None,
-                span: e.span,
-            },
-            [src_parts, dst_parts],
-        ))
-    }
 }
 
 enum LoopRead {
@@ -1329,5 +1156,6 @@ fn flip(d: Direction) -> Direction {
     }
 }
 
+mod sdf3;
 #[cfg(test)]
 mod tests;

@@ -1,6 +1,6 @@
 //! `textDocument/documentHighlight`: the names meaning the symbol at the
 //! position; definitions, throws and received or assigned team variables are
-//! writes, the other uses reads.
+//! writes, the other uses reads (`host::Analysis::highlights`).
 
 use crate::world::Snapshot;
 use semo::ide::mission::navigation::Access;
@@ -10,9 +10,11 @@ pub fn document_highlight(
     snapshot: &Snapshot,
     position: Position,
 ) -> Option<Vec<DocumentHighlight>> {
-    super::with_mission(snapshot, |analysis, lines| {
-        let offset = lines.offset(position);
-        semo::ide::mission::navigation::references(analysis, offset)
+    super::with_mission(snapshot, |_, lines| {
+        let at = snapshot.position(&lines, position);
+        snapshot
+            .host()
+            .highlights(at)
             .into_iter()
             .map(|r| DocumentHighlight {
                 range: lines.range(r.span),

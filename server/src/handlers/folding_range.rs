@@ -1,13 +1,13 @@
 //! `textDocument/foldingRange`: blocks, `case`s, group statements and comment
-//! banners spanning lines (see `semo::ide::mission::folding`), as whole lines.
+//! banners spanning lines (`host::Analysis::folding_ranges`), as whole lines.
 
 use crate::world::Snapshot;
-use semo::ide::mission::folding::{self, FoldKind};
+use semo::ide::mission::folding::FoldKind;
 use semo::text::ColumnUnit;
 use tower_lsp_server::ls_types::{FoldingRange, FoldingRangeKind};
 
 pub fn folding_range(snapshot: &Snapshot) -> Option<Vec<FoldingRange>> {
-    super::with_mission(snapshot, |analysis, lines| {
+    super::with_mission(snapshot, |_, lines| {
         // Whole lines: no column to count in the client's encoding.
         let line = |offset| {
             lines
@@ -16,7 +16,7 @@ pub fn folding_range(snapshot: &Snapshot) -> Option<Vec<FoldingRange>> {
                 .line
         };
         let mut ranges: Vec<FoldingRange> = Vec::new();
-        for fold in folding::folding_ranges(analysis, &snapshot.text) {
+        for fold in snapshot.host().folding_ranges(snapshot.id) {
             let (start_line, end_line) = (line(fold.span.start), line(fold.span.end));
             let duplicate = ranges
                 .iter()

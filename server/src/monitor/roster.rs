@@ -221,12 +221,13 @@ mod tests {
     }
 
     fn heartbeat(robot: &str) -> Vec<u8> {
-        let mut d = b"SEMO\x01p".to_vec();
-        for field in ["Team", robot, "Team.__alive", robot] {
-            d.push(field.len() as u8);
-            d.extend_from_slice(field.as_bytes());
-        }
-        d
+        semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+            publish: true,
+            team: "Team".into(),
+            robot: robot.into(),
+            key: "Team.__alive".into(),
+            value: Some(semo::refine::Value::text(robot)),
+        })
     }
 
     const RUNNING_A: &[u8] = br#"{"t":1,"robot":"a","event":"status","state":"running","mode":"M","leader":"a","services":"P=S"}"#;

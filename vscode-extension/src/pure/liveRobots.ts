@@ -85,7 +85,9 @@ function robotNode(view: MonitorView, robot: LiveRobot): LiveNode {
           ? { icon: 'pass', color: 'testing.iconPassed' }
           : { icon: 'circle-outline' };
   return {
-    id: `${view.uri}#${robot.robot}`,
+    // VS Code keeps an item's collapsed state by id: a robot gets another id
+    // once it has services, so that they show expanded when they first come.
+    id: `${view.uri}#${robot.robot}${robot.services.length > 0 ? '#running' : ''}`,
     kind: 'robot',
     label: robot.robot,
     description: parts.join(' · '),

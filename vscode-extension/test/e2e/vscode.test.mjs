@@ -1,12 +1,14 @@
 // The extension in the real VS Code (code-server), driven by headless
 // Chromium: scripts/e2e.sh installs the platform .vsix (the server inside it)
 // and starts code-server on a copy of test/e2e/workspace with SEMO_E2E_URL
-// set. Two tests, in the order a user goes: open the mission, see its error,
+// set. Three tests, in the order a user goes: open the mission, see its error,
 // open the Robots panel, insert a service, run palette commands; then edit:
 // a quick fix, hover, rename, completion and format on save, served by the
-// bundled server. Screenshots go to $SEMO_E2E_OUT/shots.
+// bundled server; then the Robots (live) view on a private MQTT broker
+// ($SEMO_E2E_MQTT_PORT, started by e2e.sh). Screenshots go to $SEMO_E2E_OUT/shots.
 
 import { strict as assert } from 'node:assert';
+import { execFileSync } from 'node:child_process';
 import { existsSync, readFileSync, readdirSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { after, before, test } from 'node:test';
@@ -311,6 +313,47 @@ async function editingJourney() {
   assert.match(saved, /default: mode = ROAM/);
   assert.match(saved, /drive\(100\)\n\s+drive\(distance/);
   await shot('formatted');
+}
+
+test('Robots (live): the robots of a running mission from its broker', { timeout: 240000 }, async () => {
+  try {
+    await liveJourney();
+  } catch (e) {
+    await shot('live-failure').catch(() => {});
+    throw e;
+  }
+});
+
+/** Publishes what a robot of `rovers` publishes: its retained status. */
+function publishStatus(robot, status) {
+  execFileSync('mosquitto_pub', [
+    '-h', '127.0.0.1', '-p', String(process.env.SEMO_E2E_MQTT_PORT), '-q', '1', '-r',
+    '-t', `semo/rovers/status/${robot}`, '-m', JSON.stringify({ robot, event: 'status', ...status }),
+  ]);
+}
+
+async function liveJourney() {
+  assert.ok(process.env.SEMO_E2E_MQTT_PORT, 'SEMO_E2E_MQTT_PORT: run through scripts/e2e.sh');
+  // The monitor on rovers.mission (the broker of the semo.monitor.broker
+  // setting): both robots waiting until they report.
+  await openFile('rovers.mission');
+  await runCommand('SeMo: Monitor Robots');
+  const rows = '.pane-body .monaco-list-row';
+  await waitForText(rows, /rovers.*connected/);
+  await waitForText(rows, /r_1\s*waiting/);
+  // A robot reports; then it vanishes and the broker sends its last will.
+  publishStatus('r_0', { t: 5, state: 'running', mode: 'SEARCH', leader: '', services: 'Explore=Wander' });
+  await waitForText(rows, /r_0\s*running · SEARCH/);
+  await waitForText(rows, /Explore\s*Wander/);
+  await shot('robots-live');
+  publishStatus('r_0', { state: 'lost' });
+  await waitForText(rows, /r_0\s*LOST/);
+  await waitForText(rows, /r_1\s*waiting/);
+  await runCommand('SeMo: Stop Monitoring');
+  await page.waitForFunction(
+    () => ![...document.querySelectorAll('.pane-body .monaco-list-row')].some((e) => /r_1\s*waiting/.test(e.textContent)),
+    { timeout: 30000, polling: 250 },
+  );
 }
 
 /** Presses `key` with `modifier` held. */

@@ -69,9 +69,12 @@ test('one node per robot after the connection, services below each', () => {
       ['Report', 'ToBase'],
     ],
   );
-  // Ids are stable and unique, so VS Code keeps what the user expanded.
+  // Ids are stable and unique, so VS Code keeps what the user expanded;
+  // a robot's changes once its services come (shown expanded then).
   const ids = tree.flatMap((n) => [n.id, ...n.children.map((c) => c.id)]);
   assert.equal(new Set(ids).size, ids.length);
+  assert.equal(buildLiveTree(VIEW)[1].id, tree[1].id);
+  assert.notEqual(tree[1].id, buildLiveTree({ ...VIEW, robots: [{ ...VIEW.robots[0], services: [] }] })[1].id);
 });
 
 test('the leader is marked, lost robots are marked with the reason, waiting ones too', () => {

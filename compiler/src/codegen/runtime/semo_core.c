@@ -33,11 +33,53 @@ size_t semo__format_i64(char *out, int64_t n)
     return len;
 }
 
+#ifndef SEMO_NO_REALS
+/* A finite real as `refine::value::format_real` prints it: up to six
+ * decimals, trailing zeros dropped, at least one; from 1e15 on, digits and an
+ * exponent. No printf: newlib-nano's has no floating point. `out` holds at
+ * least 32 bytes. */
+static size_t format_real(char *out, double x)
+{
+    size_t len = 0;
+    if (x < 0) {
+        out[len++] = '-';
+        x = -x;
+    }
+    if (x >= 1e15) {
+        int exponent = 0;
+        while (x >= 1e15) {
+            x /= 10.0;
+            exponent++;
+        }
+        len += semo__format_i64(out + len, (int64_t)(x + 0.5));
+        out[len++] = 'e';
+        return len + semo__format_i64(out + len, exponent);
+    }
+    /* Rounded half up by adding 0.5 (no libm: `round` is not linked). */
+    int64_t scaled = (int64_t)(x * 1e6 + 0.5);
+    int64_t whole = scaled / 1000000, fraction = scaled % 1000000;
+    len += semo__format_i64(out + len, whole);
+    out[len++] = '.';
+    int digits = 6;
+    while (digits > 1 && fraction % 10 == 0) {
+        fraction /= 10;
+        digits--;
+    }
+    for (int i = digits - 1; i >= 0; i--, fraction /= 10)
+        out[len + (size_t)i] = (char)('0' + fraction % 10);
+    len += (size_t)digits;
+    out[len] = '\0';
+    return len;
+}
+
+#endif
+
 static bool is_digit(char c)
 {
     return c >= '0' && c <= '9';
 }
 
+#ifndef SEMO_NO_REALS
 static bool same_word(const char *s, const char *word)
 {
     for (; *word; s++, word++)
@@ -105,37 +147,175 @@ static bool parse_number(const char *s, double *out)
     *out = negative ? -value : value;
     return true;
 }
+#endif
 
 /* ------------------------------------------------------------------ values */
+
+/* "[+-]digits" within int64. */
+static bool parse_int(const char *s, int64_t *out)
+{
+    bool negative = *s == '-';
+    if (*s == '-' || *s == '+')
+        s++;
+    if (!is_digit(*s))
+        return false;
+    uint64_t magnitude = 0, limit = negative ? (uint64_t)INT64_MAX + 1 : (uint64_t)INT64_MAX;
+    for (; is_digit(*s); s++) {
+        uint64_t digit = (uint64_t)(*s - '0');
+        if (magnitude > (limit - digit) / 10)
+            return false;
+        magnitude = magnitude * 10 + digit;
+    }
+    if (*s != '\0')
+        return false;
+    *out = negative ? (int64_t)(0 - magnitude) : (int64_t)magnitude;
+    return true;
+}
+
+/* The index of `word` in the program's word table, or -1. */
+static int word_index(const char *word)
+{
+    const semo_program_desc *p = semo_program();
+    for (size_t i = 0; p && i < p->word_count; i++)
+        if (strcmp(p->words[i], word) == 0)
+            return (int)i;
+    return -1;
+}
 
 void semo_value_set(semo_value *v, const char *text)
 {
     if (!text)
         text = "";
     size_t n = strlen(text);
-    if (n >= SEMO_VALUE_MAX) {
-        n = SEMO_VALUE_MAX - 1;
+    if (n >= SEMO_TEXT_MAX) {
+        n = SEMO_TEXT_MAX - 1;
         /* Never cut a UTF-8 character in half. */
         while (n > 0 && ((unsigned char)text[n] & 0xC0) == 0x80)
             n--;
     }
     memmove(v->text, text, n);
     v->text[n] = '\0';
+    v->type = SEMO_TEXT;
 }
 
-void semo_value_set_int(semo_value *v, long long n)
+void semo_value_set_int(semo_value *v, int64_t n)
 {
-    semo__format_i64(v->text, (int64_t)n);
+    v->type = SEMO_INT;
+    v->i = n;
 }
 
-int semo_value_compare(const semo_value *a, const semo_value *b)
+void semo_value_set_real(semo_value *v, double x)
 {
-    double x, y;
-    if (parse_number(a->text, &x) && parse_number(b->text, &y))
-        return (x > y) - (x < y);
-    int c = strcmp(a->text, b->text);
-    return (c > 0) - (c < 0);
+    v->type = SEMO_REAL;
+    v->r = x;
 }
+#ifdef SEMO_NO_REALS
+/* A program without reals (the static targets' Makefile says so with
+ * -DSEMO_NO_REALS) links no floating point: no soft float on a Cortex-M3. */
+#define REALS 0
+#else
+#define REALS 1
+#endif
+
+void semo_value_set_bool(semo_value *v, bool b)
+{
+    v->type = SEMO_BOOL;
+    v->b = b;
+}
+
+bool semo_value_set_word(semo_value *v, const char *word)
+{
+    int index = word ? word_index(word) : -1;
+    if (index < 0)
+        return false;
+    v->type = SEMO_WORD;
+    v->word = (unsigned short)index;
+    return true;
+}
+
+bool semo_value_parse(semo_value *v, semo_type type, const char *text)
+{
+    if (!text)
+        return false;
+    switch (type) {
+    case SEMO_INT: {
+        int64_t n;
+        if (!parse_int(text, &n))
+            return false;
+        semo_value_set_int(v, n);
+        return true;
+    }
+    case SEMO_REAL: {
+#if REALS
+        double x;
+        if (!parse_number(text, &x))
+            return false;
+        semo_value_set_real(v, x);
+        return true;
+#else
+        return false;
+#endif
+    }
+    case SEMO_BOOL:
+        if (strcmp(text, "true") != 0 && strcmp(text, "false") != 0)
+            return false;
+        semo_value_set_bool(v, text[0] == 't');
+        return true;
+    case SEMO_WORD:
+        return semo_value_set_word(v, text);
+    case SEMO_TEXT:
+    case SEMO_NONE:
+        semo_value_set(v, text);
+        return true;
+    }
+    return false;
+}
+
+const char *semo_value_word_text(const semo_value *v)
+{
+    if (v->type == SEMO_TEXT)
+        return v->text;
+    const semo_program_desc *p = semo_program();
+    if (v->type == SEMO_WORD && p && v->word < p->word_count)
+        return p->words[v->word];
+    return NULL;
+}
+
+bool semo_value_coerce(semo_value *v, semo_type type)
+{
+    if (type == SEMO_NONE || v->type == type)
+        return true;
+    if (REALS && type == SEMO_REAL && v->type == SEMO_INT) {
+        semo_value_set_real(v, (double)v->i);
+        return true;
+    }
+    if (type == SEMO_TEXT && v->type == SEMO_WORD) {
+        const char *word = semo_value_word_text(v);
+        if (!word)
+            return false;
+        semo_value_set(v, word);
+        return true;
+    }
+    if (v->type == SEMO_TEXT) {
+        char text[SEMO_TEXT_MAX];
+        memcpy(text, v->text, sizeof text);
+        return semo_value_parse(v, type, text);
+    }
+    return false;
+}
+
+#if REALS
+static bool as_number(const semo_value *v, double *out)
+{
+    if (v->type == SEMO_INT)
+        *out = (double)v->i;
+    else if (v->type == SEMO_REAL)
+        *out = v->r;
+    else
+        return false;
+    return true;
+}
+#endif
 
 static bool ordered(int order, semo_cmp op)
 {
@@ -152,31 +332,55 @@ static bool ordered(int order, semo_cmp op)
 
 bool semo_value_numbers(const semo_value *a, semo_cmp op, const semo_value *b)
 {
+    if (a->type == SEMO_INT && b->type == SEMO_INT)
+        return ordered((a->i > b->i) - (a->i < b->i), op);
+#if REALS
     double x, y;
-    if (!parse_number(a->text, &x) || !parse_number(b->text, &y))
+    if (!as_number(a, &x) || !as_number(b, &y) || x != x || y != y)
         return false;
     return ordered((x > y) - (x < y), op);
+#else
+    return false;
+#endif
+}
+
+/* Whether two values are the same (see semo_value_words). */
+static bool same_value(const semo_value *a, const semo_value *b)
+{
+    if (a->type == SEMO_NONE || b->type == SEMO_NONE)
+        return a->type == b->type;
+    if (a->type == SEMO_INT && b->type == SEMO_INT)
+        return a->i == b->i;
+    if (a->type == SEMO_BOOL && b->type == SEMO_BOOL)
+        return a->b == b->b;
+    if (a->type == SEMO_WORD && b->type == SEMO_WORD)
+        return a->word == b->word; /* identity: one table per program */
+#if REALS
+    double x, y;
+    if (as_number(a, &x) && as_number(b, &y))
+        return x == y;
+#endif
+    const char *s = semo_value_word_text(a), *t = semo_value_word_text(b);
+    return s && t && strcmp(s, t) == 0;
 }
 
 bool semo_value_words(const semo_value *a, semo_cmp op, const semo_value *b)
 {
     if (op != SEMO_EQ && op != SEMO_NE)
         return false;
-    return ordered(strcmp(a->text, b->text), op);
-}
-
-bool semo_value_numeric(const semo_value *v)
-{
-    double x;
-    return parse_number(v->text, &x);
+    return same_value(a, b) == (op == SEMO_EQ);
 }
 
 bool semo_value_truthy(const semo_value *v)
 {
-    double x;
-    if (strcmp(v->text, "true") == 0)
-        return true;
-    return parse_number(v->text, &x) && x != 0;
+    switch (v->type) {
+    case SEMO_BOOL: return v->b;
+    case SEMO_INT: return v->i != 0;
+#if REALS
+    case SEMO_REAL: return v->r != 0;
+#endif
+    default: return false;
+    }
 }
 
 /* ------------------------------------------------------------------ traces */
@@ -260,7 +464,68 @@ static void put_json_string(const semo__sink *sink, const char *text)
     put_text(sink, "\"");
 }
 
-void semo__trace_line(const semo__sink *sink, int64_t t, const char *robot, const char *event, va_list args)
+/* A value's JSON (semo_value_json) straight to the sink. */
+static void put_json_value(const semo__sink *sink, const semo_value *v)
+{
+    char number[40];
+    switch (v ? v->type : SEMO_NONE) {
+    case SEMO_INT:
+        sink->put(sink->ctx, number, semo__format_i64(number, v->i));
+        return;
+#if REALS
+    case SEMO_REAL:
+        if (v->r - v->r != 0) /* inf or nan: JSON has no such number */
+            break;
+        sink->put(sink->ctx, number, format_real(number, v->r));
+        return;
+#endif
+    case SEMO_BOOL:
+        put_text(sink, v->b ? "true" : "false");
+        return;
+    case SEMO_WORD:
+    case SEMO_TEXT: {
+        const char *text = semo_value_word_text(v);
+        if (!text)
+            break;
+        put_json_string(sink, text);
+        return;
+    }
+    default:
+        break;
+    }
+    put_text(sink, "null");
+}
+
+/* A sink that fills a buffer (semo_value_json). */
+typedef struct {
+    char *out;
+    size_t cap, len;
+} buffer_sink;
+
+static void buffer_put(void *ctx, const char *bytes, size_t n)
+{
+    buffer_sink *b = ctx;
+    size_t room = b->cap - 1 - b->len;
+    if (n > room)
+        n = room;
+    memcpy(b->out + b->len, bytes, n);
+    b->len += n;
+    b->out[b->len] = '\0';
+}
+
+size_t semo_value_json(const semo_value *v, char *out, size_t cap)
+{
+    if (!out || cap == 0)
+        return 0;
+    buffer_sink b = {out, cap, 0};
+    const semo__sink sink = {buffer_put, &b};
+    out[0] = '\0';
+    put_json_value(&sink, v);
+    return b.len;
+}
+
+void semo__trace_line(const semo__sink *sink, int64_t t, const char *robot, const char *event, va_list args,
+                      const char *value_key, const semo_value *value)
 {
     char number[21];
     put_text(sink, "{\"t\":");
@@ -283,7 +548,29 @@ void semo__trace_line(const semo__sink *sink, int64_t t, const char *robot, cons
         }
         put_json_string(sink, value);
     }
+    if (value_key) {
+        put_text(sink, ",");
+        put_json_string(sink, value_key);
+        put_text(sink, ":");
+        put_json_value(sink, value);
+    }
     put_text(sink, "}\n");
+}
+
+void semo_trace(const char *event, ...)
+{
+    va_list args;
+    va_start(args, event);
+    semo__trace_emit(event, NULL, NULL, args);
+    va_end(args);
+}
+
+void semo_trace_value(const char *event, const char *value_key, const semo_value *value, ...)
+{
+    va_list args;
+    va_start(args, value);
+    semo__trace_emit(event, value_key, value, args);
+    va_end(args);
 }
 
 /* ------------------------------------------------- channels and the inbox */
@@ -456,8 +743,8 @@ int semo_comm_poll(semo_message *out, int64_t timeout_ms)
     if (got)
         semo__queue_written(SEMO__INBOX); /* room for a held-back delivery */
     if (got)
-        semo_trace("receive", "from", out->from_team, "from_robot", out->from_robot, "key", out->key, "value",
-                   out->value.text, NULL);
+        semo_trace_value("receive", "value", &out->value, "from", out->from_team, "from_robot", out->from_robot,
+                         "key", out->key, NULL);
     return got;
 }
 
@@ -466,7 +753,131 @@ int semo__comm_send_local(const char *to_team, semo_msg_kind kind, const char *k
     if (!semo_program() || !to_team || !key || !value || strlen(key) >= sizeof ((semo_message *)0)->key ||
         (kind != SEMO_MSG_SEND && kind != SEMO_MSG_PUBLISH))
         return -1;
-    semo_trace("send", "to", to_team, "key", key, "value", value->text, NULL);
+    semo_trace_value("send", "value", value, "to", to_team, "key", key, NULL);
     /* The operator console: the trace is its record. */
     return strcmp(to_team, "USER") == 0 ? 1 : 0;
+}
+
+/* ------------------------------------------------------------ the wire */
+
+static size_t put_field(unsigned char *out, const char *text)
+{
+    size_t n = strlen(text);
+    if (n > 255)
+        n = 255;
+    out[0] = (unsigned char)n;
+    memcpy(out + 1, text, n);
+    return n + 1;
+}
+
+size_t semo__encode_message(const semo_message *m, unsigned char *out)
+{
+    size_t n = 5;
+    memcpy(out, SEMO__DATAGRAM_MAGIC, 5);
+    out[n++] = (unsigned char)m->kind;
+    n += put_field(out + n, m->from_team);
+    n += put_field(out + n, m->from_robot);
+    n += put_field(out + n, m->key);
+    const semo_value *v = &m->value;
+    uint64_t bits = 0;
+    switch (v->type) {
+    case SEMO_INT:
+    case SEMO_REAL:
+        if (v->type == SEMO_INT)
+            bits = (uint64_t)v->i;
+        else
+            memcpy(&bits, &v->r, sizeof bits);
+        out[n++] = v->type;
+        for (int shift = 56; shift >= 0; shift -= 8)
+            out[n++] = (unsigned char)(bits >> shift);
+        break;
+    case SEMO_BOOL:
+        out[n++] = SEMO_BOOL;
+        out[n++] = v->b ? 1 : 0;
+        break;
+    case SEMO_WORD:
+    case SEMO_TEXT: {
+        /* Words go as their text: word tables are per program. */
+        const char *text = semo_value_word_text(v);
+        out[n++] = v->type;
+        n += put_field(out + n, text ? text : "");
+        break;
+    }
+    default:
+        out[n++] = SEMO_NONE;
+        break;
+    }
+    return n;
+}
+
+static bool take_field(const unsigned char *in, size_t len, size_t *at, char *out, size_t cap)
+{
+    if (*at >= len)
+        return false;
+    size_t n = in[(*at)++];
+    if (n >= cap || n > len - *at || memchr(in + *at, '\0', n))
+        return false;
+    memcpy(out, in + *at, n);
+    out[n] = '\0';
+    *at += n;
+    return true;
+}
+
+static bool take_value(const unsigned char *in, size_t len, size_t *at, semo_value *v)
+{
+    if (*at >= len)
+        return false;
+    unsigned char type = in[(*at)++];
+    switch (type) {
+    case SEMO_NONE:
+        *v = (semo_value){.type = SEMO_NONE};
+        return true;
+    case SEMO_INT:
+    case SEMO_REAL: {
+        if (len - *at < 8)
+            return false;
+        uint64_t bits = 0;
+        for (int i = 0; i < 8; i++)
+            bits = bits << 8 | in[(*at)++];
+        if (type == SEMO_INT) {
+            semo_value_set_int(v, (int64_t)bits);
+        } else {
+            double x;
+            memcpy(&x, &bits, sizeof x);
+            semo_value_set_real(v, x);
+        }
+        return true;
+    }
+    case SEMO_BOOL:
+        if (*at >= len || in[*at] > 1)
+            return false;
+        semo_value_set_bool(v, in[(*at)++] == 1);
+        return true;
+    case SEMO_WORD:
+    case SEMO_TEXT: {
+        char text[256];
+        if (!take_field(in, len, at, text, sizeof text) || strlen(text) >= SEMO_TEXT_MAX)
+            return false;
+        /* A word this program does not know stays its text: it equals
+         * only the same text, as it would as a word. */
+        if (type == SEMO_TEXT || !semo_value_set_word(v, text))
+            semo_value_set(v, text);
+        return true;
+    }
+    default:
+        return false;
+    }
+}
+
+bool semo__decode_message(const unsigned char *in, size_t len, semo_message *m)
+{
+    size_t at = 6;
+    if (len < at || memcmp(in, SEMO__DATAGRAM_MAGIC, 5) != 0)
+        return false;
+    m->kind = (char)in[5];
+    if (m->kind != SEMO_MSG_SEND && m->kind != SEMO_MSG_PUBLISH)
+        return false;
+    return take_field(in, len, &at, m->from_team, sizeof m->from_team) &&
+           take_field(in, len, &at, m->from_robot, sizeof m->from_robot) &&
+           take_field(in, len, &at, m->key, sizeof m->key) && take_value(in, len, &at, &m->value) && at == len;
 }

@@ -20,8 +20,13 @@ typedef struct {
     void *ctx;
 } semo__sink;
 
-/* Writes one trace line (see semo_trace) to `sink`. */
-void semo__trace_line(const semo__sink *sink, int64_t t, const char *robot, const char *event, va_list args);
+/* Writes one trace line (see semo_trace) to `sink`; `value_key` (NULL:
+ * none) names a typed value written last (semo_trace_value). */
+void semo__trace_line(const semo__sink *sink, int64_t t, const char *robot, const char *event, va_list args,
+                      const char *value_key, const semo_value *value);
+/* Platform: writes one trace line where the platform's trace goes
+ * (semo_trace and semo_trace_value are the core's). */
+void semo__trace_emit(const char *event, const char *value_key, const semo_value *value, va_list args);
 /* `n` in decimal into `out` (at least 21 bytes); returns its length. No
  * printf: newlib-nano's has no `%lld`. */
 size_t semo__format_i64(char *out, int64_t n);
@@ -59,6 +64,17 @@ bool semo__queue_wait(int queue, int64_t deadline_ms);
 /* Platform, after the lock is released: something was added to the queue;
  * wakes its reader (and tasks sleeping on a semo_next_firing hint). */
 void semo__queue_written(int queue);
+
+/* The datagram of a message (the one wire format of every transport): "SEMO"
+ * 0x02 <kind>, then from_team, from_robot and key, each a length byte and
+ * that many bytes (no NUL), then the value: its type byte and, by type,
+ * nothing (none), 8 bytes big-endian (int64; a real's IEEE 754 bits), one
+ * byte (bool), or a length byte and the text (word, text). Nothing after. */
+#define SEMO__DATAGRAM_MAGIC "SEMO\x02"
+#define SEMO__DATAGRAM_MAX (6 + 3 * 256 + 1 + 256)
+size_t semo__encode_message(const semo_message *m, unsigned char *out);
+/* False for anything else (the message is then unspecified). */
+bool semo__decode_message(const unsigned char *in, size_t len, semo_message *m);
 
 /* Queues a message as if it had arrived over the transport. */
 void semo__deliver(const semo_message *msg);
@@ -114,7 +130,7 @@ void semo__sim_free(void);
 typedef struct {
     int64_t at;
     const char *value;
-    const char *is;
+    const char *is; /* read as the sensor's type when it is read */
 } semo__sim_sensor_entry;
 typedef struct {
     const char *service;

@@ -26,10 +26,10 @@
 #include <time.h>
 
 #define MQTT_QUEUE 64
-/* The runtime's largest datagram (4 fields of at most 255 bytes) and a
+/* The runtime's largest datagram (SEMO__DATAGRAM_MAX: 3 fields and a value) and a
  * spare byte: a longer payload arrives truncated and is rejected as
  * malformed by the runtime. */
-#define MQTT_PAYLOAD_MAX (6 + 4 * 256 + 1)
+#define MQTT_PAYLOAD_MAX (SEMO__DATAGRAM_MAX + 1)
 #define MQTT_TOPIC_MAX 512
 #define MQTT_KEEPALIVE_S 10
 /* How long open waits for the broker's CONNACK and SUBACK, and close for
@@ -105,7 +105,7 @@ static void topic_of(char *topic, size_t cap, const char *team, const char *robo
         snprintf(topic + strlen(topic), cap - strlen(topic), "/+"); /* a subscription: any key */
 }
 
-/* The datagram's fields after "SEMO" 0x01 <kind>: each a length byte and
+/* The datagram's fields after "SEMO" 0x02 <kind> (semo_internal.h): each a length byte and
  * that many bytes. Copies field `index` (0 team, 1 robot, 2 key) into `out`. */
 static bool datagram_field(const unsigned char *data, size_t len, int index, char *out, size_t cap)
 {

@@ -158,20 +158,17 @@ static void put_file(void *file, const char *bytes, size_t n)
 
 static void observe_status(const char *event, va_list args);
 
-void semo_trace(const char *event, ...)
+void semo__trace_emit(const char *event, const char *value_key, const semo_value *value, va_list args)
 {
     va_list seen;
-    va_start(seen, event);
+    va_copy(seen, args);
     observe_status(event, seen);
     va_end(seen);
     pthread_mutex_lock(&g_trace_lock);
     if (g_trace) {
         /* The time is read under the lock so that lines are in time order. */
         semo__sink sink = {put_file, g_trace};
-        va_list args;
-        va_start(args, event);
-        semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args);
-        va_end(args);
+        semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args, value_key, value);
         fflush(g_trace);
     }
     pthread_mutex_unlock(&g_trace_lock);
@@ -644,57 +641,8 @@ void UFTimer_Cancel(int id)
 
 /* --------------------------------------------------------------- messages */
 
-/* A datagram: "SEMO" 1 <kind> then from_team, from_robot, key, value, each
- * as one length byte and that many bytes (no NUL), nothing after. */
-#define DATAGRAM_MAGIC "SEMO\x01"
-#define DATAGRAM_MAX (5 + 1 + 4 * 256)
-
-static size_t put_field(unsigned char *out, const char *text)
-{
-    size_t n = strlen(text);
-    out[0] = (unsigned char)n;
-    memcpy(out + 1, text, n);
-    return n + 1;
-}
-
-static size_t encode_message(const semo_message *m, unsigned char *out)
-{
-    size_t n = 5;
-    memcpy(out, DATAGRAM_MAGIC, 5);
-    out[n++] = (unsigned char)m->kind;
-    n += put_field(out + n, m->from_team);
-    n += put_field(out + n, m->from_robot);
-    n += put_field(out + n, m->key);
-    n += put_field(out + n, m->value.text);
-    return n;
-}
-
-static bool take_field(const unsigned char *in, size_t len, size_t *at, char *out, size_t cap)
-{
-    if (*at >= len)
-        return false;
-    size_t n = in[(*at)++];
-    if (n >= cap || n > len - *at || memchr(in + *at, '\0', n))
-        return false;
-    memcpy(out, in + *at, n);
-    out[n] = '\0';
-    *at += n;
-    return true;
-}
-
-static bool decode_message(const unsigned char *in, size_t len, semo_message *m)
-{
-    size_t at = 6;
-    if (len < at || memcmp(in, DATAGRAM_MAGIC, 5) != 0)
-        return false;
-    m->kind = (char)in[5];
-    if (m->kind != SEMO_MSG_SEND && m->kind != SEMO_MSG_PUBLISH)
-        return false;
-    return take_field(in, len, &at, m->from_team, sizeof m->from_team) &&
-           take_field(in, len, &at, m->from_robot, sizeof m->from_robot) &&
-           take_field(in, len, &at, m->key, sizeof m->key) &&
-           take_field(in, len, &at, m->value.text, sizeof m->value.text) && at == len;
-}
+/* The datagram is the core's (semo__encode_message, semo_internal.h). */
+#define DATAGRAM_MAX SEMO__DATAGRAM_MAX
 
 static const semo_transport *g_transport; /* NULL: no other robots */
 /* Mission time when the program started (after the start barrier): written
@@ -729,7 +677,7 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
     snprintf(m.key, sizeof m.key, "%s", key);
     m.value = *value;
     unsigned char datagram[DATAGRAM_MAX];
-    size_t len = encode_message(&m, datagram);
+    size_t len = semo__encode_message(&m, datagram);
     if (to_operator) {
         /* A transport that reaches operators (MQTT: semo/<mission>/USER/<key>,
          * `semo operator`) tells them too; the trace stays the record. */
@@ -809,7 +757,7 @@ static void status_line(status_buffer *b, const char *event, ...)
     semo__sink sink = {put_status, b};
     va_list args;
     va_start(args, event);
-    semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args);
+    semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args, NULL, NULL);
     va_end(args);
 }
 
@@ -895,7 +843,7 @@ static void *receiver_thread(void *arg)
         if (n < 0) {
             semo_trace("comm_error", "reason", "receive failed", NULL);
             semo_sleep_ms(RECV_ERROR_PAUSE_MS); /* a failing socket must not spin */
-        } else if (n > 0 && decode_message(buf, (size_t)n, &m)) {
+        } else if (n > 0 && semo__decode_message(buf, (size_t)n, &m)) {
             semo__deliver(&m);
         } else if (n > 0) {
             semo_trace("reject", "reason", "malformed datagram", NULL);

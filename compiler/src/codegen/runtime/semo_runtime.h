@@ -25,37 +25,69 @@
 
 /* ---------------------------------------------------------------- values */
 
-/* Every mission value travels as text: numbers in decimal, locations "x,y",
- * strings and symbolic constants as written; longer text is cut to
- * SEMO_VALUE_MAX - 1 bytes. The static-schedule targets' Makefile sets it
- * from the program (its longest literal and scenario value, at least 32). */
-#ifndef SEMO_VALUE_MAX
-#define SEMO_VALUE_MAX 64
+/* Values are typed as the catalog declares them (`refine::value` is the
+ * simulator's side of the same rules): integers (int64), reals (double),
+ * truth values, words (an enum's constants and the mission's symbolic
+ * constants: an index into the program's word table, compared by identity)
+ * and text (catalog string, location "x,y", image) in a bounded buffer:
+ * longer text is cut to SEMO_TEXT_MAX - 1 bytes at a character. A value
+ * never set has type SEMO_NONE. The static-schedule targets' Makefile sets
+ * SEMO_TEXT_MAX from the program (its longest text literal and scenario
+ * value, at least 16), and -DSEMO_NO_REALS for a program without reals: no
+ * floating point is linked then (reals are neither parsed, compared nor
+ * printed: a SEMO_REAL value counts as no number). */
+#ifndef SEMO_TEXT_MAX
+#define SEMO_TEXT_MAX 64
 #endif
+typedef enum { SEMO_NONE, SEMO_INT, SEMO_REAL, SEMO_BOOL, SEMO_WORD, SEMO_TEXT } semo_type;
 typedef struct {
-    char text[SEMO_VALUE_MAX];
+    unsigned char type; /* semo_type */
+    union {
+        int64_t i;
+        double r;
+        bool b;
+        unsigned short word; /* index into semo_program()->words */
+        char text[SEMO_TEXT_MAX];
+    };
 } semo_value;
 
-/* A literal value: `SEMO_LIT("5,5")` is a `const semo_value *`. */
-#define SEMO_LIT(s) (&(const semo_value){.text = s})
+/* Literals, each a `const semo_value *`: SEMO_LIT("5,5") is text. */
+#define SEMO_LIT(s) (&(const semo_value){.type = SEMO_TEXT, .text = s})
+#define SEMO_LIT_INT(n) (&(const semo_value){.type = SEMO_INT, .i = (n)})
+#define SEMO_LIT_REAL(x) (&(const semo_value){.type = SEMO_REAL, .r = (x)})
+#define SEMO_LIT_BOOL(x) (&(const semo_value){.type = SEMO_BOOL, .b = (x)})
+#define SEMO_LIT_WORD(n) (&(const semo_value){.type = SEMO_WORD, .word = (n)})
 
-void semo_value_set(semo_value *v, const char *text); /* truncates to fit */
-void semo_value_set_int(semo_value *v, long long n);
-/* Numeric comparison when both parse completely as numbers, else strcmp.
- * Returns <0, 0 or >0. */
-int semo_value_compare(const semo_value *a, const semo_value *b);
-/* Whether the value is a number (ordering comparisons hold only between
- * numbers: generated code never orders words). */
-bool semo_value_numeric(const semo_value *v);
-/* "true" or a non-zero number. */
-bool semo_value_truthy(const semo_value *v);
+void semo_value_set(semo_value *v, const char *text); /* text, cut to fit */
+void semo_value_set_int(semo_value *v, int64_t n);
+void semo_value_set_real(semo_value *v, double x);
+void semo_value_set_bool(semo_value *v, bool b);
+/* False (and `v` unchanged) when `word` is not in the program's word table. */
+bool semo_value_set_word(semo_value *v, const char *word);
+/* `text` read as a value of `type` (scenario values, text received where
+ * a type is declared): integers "[+-]digits", reals in the grammar of
+ * `parse_number`, "true"/"false", a word of the table, any text. False (and
+ * `v` unchanged) when it is not one. */
+bool semo_value_parse(semo_value *v, semo_type type, const char *text);
+/* A received value where `type` is declared (SEMO_NONE: a team variable,
+ * any type): the same type passes, an integer widens to a real, text is
+ * parsed as the type, a word becomes text; false for anything else. */
+bool semo_value_coerce(semo_value *v, semo_type type);
+/* The text of a word or a text value, else NULL. */
+const char *semo_value_word_text(const semo_value *v);
+/* Writes the value as JSON (a number, true/false, a string; null for none)
+ * into `out`; returns its length (cut to `cap` - 1). */
+size_t semo_value_json(const semo_value *v, char *out, size_t cap);
 /* How generated code compares, as the checker typed each comparison (never
- * guessing from the values). As numbers: false when either value is not a
- * number. As words: equal when the texts are; words are never ordered
- * (SEMO_LT ... are false). */
+ * guessing from the values). As numbers: integers exactly, else as reals;
+ * false when either value is not a number. As words: equal when the same
+ * word, a word and a text with the same text, the same number or truth
+ * value, or both none; words are never ordered (SEMO_LT ... are false). */
 typedef enum { SEMO_EQ, SEMO_NE, SEMO_LT, SEMO_LE, SEMO_GT, SEMO_GE } semo_cmp;
 bool semo_value_numbers(const semo_value *a, semo_cmp op, const semo_value *b);
 bool semo_value_words(const semo_value *a, semo_cmp op, const semo_value *b);
+/* `true`, or a number other than zero. */
+bool semo_value_truthy(const semo_value *v);
 
 /* ------------------------------------------------------------------ time */
 
@@ -132,6 +164,9 @@ typedef struct {
     /* Static schedule only: one iteration of the single-appearance schedule. */
     const semo_firing *schedule;
     size_t schedule_count;
+    /* The words of the program (SEMO_WORD values are indices into it). */
+    const char *const *words;
+    size_t word_count;
 } semo_program_desc;
 
 /* Runs the program: parses the command line (`--trace FILE`,
@@ -324,13 +359,17 @@ extern const semo_transport semo_mqtt_transport;
  * ending with NULL; values are JSON-escaped (a NULL value is written as null
  * and ends the list). */
 void semo_trace(const char *event, ...);
+/* The same with a value as the last field, `"<value_key>":<its JSON>`
+ * (semo_value_json: the JSON type follows the value's type). */
+void semo_trace_value(const char *event, const char *value_key, const semo_value *value, ...);
 
 /* ------------------------------------------------------------- simulation */
 
 #ifdef SEMO_SIM
 /* The scenario's latest value of `value` (e.g. "LOCATION") for this robot
- * at the current mission time; false when the scenario gives none yet. */
-bool semo_sim_sensor(const char *value, semo_value *out);
+ * at the current mission time, read as `type` (the catalog's); false when
+ * the scenario gives none yet, or none of that type. */
+bool semo_sim_sensor(const char *value, semo_type type, semo_value *out);
 /* An actuator command: traced as {"event":"actuate","task":..,"value":..}. */
 void semo_sim_actuate(const char *task, const semo_value *command);
 /* How long (mission ms) a built-in service takes in the scenario (default 100). */
@@ -338,6 +377,10 @@ int64_t semo_sim_service_ms(const char *service);
 /* The scenario's battery level now, rounded (its "battery" points); false
  * when the scenario gives none. Heartbeats carry it (highest_battery). */
 bool semo_sim_battery(long long *level);
+/* The iteration (1, 2, ...) in which the exit task of the convergent SDF/L
+ * loop `loop` (the graph's name and the loop's path, "kmeans/Converge") sets the exit flag,
+ * from the scenario's "loops"; 0 when it never does. */
+int64_t semo_sim_loop_exit(const char *loop);
 #endif
 
 #endif /* SEMO_RUNTIME_H */

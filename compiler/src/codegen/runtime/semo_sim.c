@@ -419,6 +419,9 @@ static struct {
     size_t sensor_count;
     service_entry *services;
     size_t service_count;
+    /* "loops": per SDF/L loop path, the iteration whose exit task sets the exit flag. */
+    service_entry *loops;
+    size_t loop_count;
     command_entry *commands;
     size_t command_count;
     battery_entry *battery;
@@ -456,11 +459,12 @@ static bool want_name(reader *r, const json *v, const char *key, size_t cap, cha
     return true;
 }
 
-/* "is": a string, or a number taken as written. */
+/* "is": a string, or a number taken as written; held as text, read as the
+ * type of the value it is given to (a sensor's, a received key's). */
 static bool want_value(reader *r, const json *v, semo_value *out)
 {
-    if ((v->kind != J_STRING && v->kind != J_NUMBER) || strlen(v->text) >= SEMO_VALUE_MAX)
-        return fail_at(r, v->line, v->col, "\"is\" must be a string or number shorter than %d bytes", SEMO_VALUE_MAX);
+    if ((v->kind != J_STRING && v->kind != J_NUMBER) || strlen(v->text) >= SEMO_TEXT_MAX)
+        return fail_at(r, v->line, v->col, "\"is\" must be a string or number shorter than %d bytes", SEMO_TEXT_MAX);
     semo_value_set(out, v->text);
     return true;
 }
@@ -554,11 +558,31 @@ static bool read_battery(reader *r, const json *v, bool keep)
 
 static bool read_robot(reader *r, const json *v, bool keep)
 {
-    static const char *const keys[] = {"sensors", "services", "battery", NULL};
-    if (!want(r, v, J_OBJECT, "a robot {\"sensors\": [...], \"services\": {...}, \"battery\": [...]}") ||
+    static const char *const keys[] = {"sensors", "services", "battery", "loops", NULL};
+    if (!want(r, v, J_OBJECT, "a robot {\"sensors\": [...], \"services\": {...}, \"battery\": [...], \"loops\": {...}}") ||
         !known_keys(r, v, keys, "a robot"))
         return false;
     const json *sensors = member(v, "sensors"), *services = member(v, "services"), *battery = member(v, "battery");
+    const json *loops = member(v, "loops");
+    if (loops) {
+        if (!want(r, loops, J_OBJECT, "an object of loop exits {\"Converge\": 3}"))
+            return false;
+        for (size_t i = 0; i < loops->count; i++) {
+            service_entry e;
+            const json *n = &loops->items[i];
+            if (strlen(loops->keys[i]) >= sizeof e.name)
+                return fail_at(r, n->line, n->col, "loop path too long");
+            memcpy(e.name, loops->keys[i], strlen(loops->keys[i]) + 1);
+            if (n->kind != J_NUMBER || n->number < 1 || n->number > 1e9 || n->number != (double)(int64_t)n->number)
+                return fail_at(r, n->line, n->col, "\"%s\" must be a whole number of iterations, 1 or more", loops->keys[i]);
+            e.ms = (int64_t)n->number;
+            if (keep) {
+                if (!grow(r, (void **)&g_sim.loops, g_sim.loop_count, sizeof e))
+                    return false;
+                g_sim.loops[g_sim.loop_count++] = e;
+            }
+        }
+    }
     if (battery && !read_battery(r, battery, keep))
         return false;
     if (sensors) {
@@ -869,6 +893,7 @@ void semo__sim_free(void)
 {
     free(g_sim.sensors);
     free(g_sim.services);
+    free(g_sim.loops);
     free(g_sim.commands);
     free(g_sim.battery);
     for (size_t i = 0; i < g_sim.link_count; i++)
@@ -1064,7 +1089,7 @@ static double round_half_away(double x)
     return whole;
 }
 
-bool semo_sim_sensor(const char *value, semo_value *out)
+bool semo_sim_sensor(const char *value, semo_type type, semo_value *out)
 {
     const sensor_entry *latest = NULL;
     int64_t now = semo_now_ms();
@@ -1073,17 +1098,15 @@ bool semo_sim_sensor(const char *value, semo_value *out)
         if (e->at <= now && strcmp(e->value, value) == 0 && (!latest || e->at >= latest->at))
             latest = e;
     }
-    if (latest && out)
-        *out = latest->is;
-    if (!latest && value && strcmp(value, "BATTERY") == 0 && g_sim.battery_count > 0) {
-        if (out) {
-            char text[400]; /* "%.0f" of any double fits */
-            snprintf(text, sizeof text, "%.0f", round_half_away(battery_level(now)));
-            semo_value_set(out, text);
-        }
-        return true;
+    semo_value read;
+    if (latest)
+        return semo_value_parse(out ? out : &read, type, latest->is.text);
+    if (value && strcmp(value, "BATTERY") == 0 && g_sim.battery_count > 0) {
+        char text[400]; /* "%.0f" of any double fits */
+        snprintf(text, sizeof text, "%.0f", round_half_away(battery_level(now)));
+        return semo_value_parse(out ? out : &read, type, text);
     }
-    return latest != NULL;
+    return false;
 }
 
 bool semo_sim_battery(long long *level)
@@ -1097,7 +1120,7 @@ bool semo_sim_battery(long long *level)
 
 void semo_sim_actuate(const char *task, const semo_value *command)
 {
-    semo_trace("actuate", "task", task, "value", command ? command->text : "", NULL);
+    semo_trace_value("actuate", "value", command ? command : SEMO_LIT(""), "task", task, NULL);
 }
 
 int64_t semo_sim_service_ms(const char *service)
@@ -1106,6 +1129,14 @@ int64_t semo_sim_service_ms(const char *service)
         if (strcmp(g_sim.services[i].name, service) == 0)
             return g_sim.services[i].ms;
     return DEFAULT_SERVICE_MS;
+}
+
+int64_t semo_sim_loop_exit(const char *loop)
+{
+    for (size_t i = 0; loop && i < g_sim.loop_count; i++)
+        if (strcmp(g_sim.loops[i].name, loop) == 0)
+            return g_sim.loops[i].ms;
+    return 0;
 }
 
 #else

@@ -67,13 +67,10 @@ void semo_sleep_ms(int64_t ms)
 
 /* ----------------------------------------------------------------- traces */
 
-void semo_trace(const char *event, ...)
+void semo__trace_emit(const char *event, const char *value_key, const semo_value *value, va_list args)
 {
     semo__sink sink = {semo__board_put, NULL};
-    va_list args;
-    va_start(args, event);
-    semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args);
-    va_end(args);
+    semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args, value_key, value);
 }
 
 /* --------------------------------------------------------------- channels */
@@ -437,7 +434,7 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
 #ifdef SEMO_SIM
 #define DEFAULT_SERVICE_MS 100
 
-bool semo_sim_sensor(const char *value, semo_value *out)
+bool semo_sim_sensor(const char *value, semo_type type, semo_value *out)
 {
     const semo__sim_sensor_entry *latest = NULL;
     int64_t now = semo_now_ms();
@@ -446,14 +443,13 @@ bool semo_sim_sensor(const char *value, semo_value *out)
         if (e->at <= now && strcmp(e->value, value) == 0 && (!latest || e->at >= latest->at))
             latest = e;
     }
-    if (latest && out)
-        semo_value_set(out, latest->is);
-    return latest != NULL;
+    semo_value read;
+    return latest && semo_value_parse(out ? out : &read, type, latest->is);
 }
 
 void semo_sim_actuate(const char *task, const semo_value *command)
 {
-    semo_trace("actuate", "task", task, "value", command ? command->text : "", NULL);
+    semo_trace_value("actuate", "value", command ? command : SEMO_LIT(""), "task", task, NULL);
 }
 
 int64_t semo_sim_service_ms(const char *service)

@@ -74,14 +74,10 @@ impl Analysis {
 
     /// The task graph a catalog file names (`graph="path"`, relative to the
     /// catalog file), analysed, if the workspace holds it.
-    fn service_graph(&self, catalog: FileId, path: &str) -> Option<Arc<GraphRun>> {
+    pub(super) fn service_graph(&self, catalog: FileId, path: &str) -> Option<Arc<GraphRun>> {
         let catalog_path = self.file(catalog)?.key.as_deref()?;
         let wanted = subgraph::normalize(&catalog_path.parent()?.join(Path::new(path)));
-        let graph = self
-            .files()
-            .filter(|f| f.kind == FileKind::TaskGraph)
-            .find(|f| f.key.as_deref() == Some(wanted.as_path()))?;
-        self.graph(graph.id)
+        self.graph(self.graph_at(&wanted)?)
     }
 }
 

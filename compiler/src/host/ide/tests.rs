@@ -252,3 +252,45 @@ fn rename_in_a_mission_is_a_change_of_that_mission() {
     let refused = w.host.analysis().rename(w.cursor, "not a name");
     assert!(matches!(refused, Some(Err(_))), "{refused:?}");
 }
+
+#[test]
+fn structure_queries_answer_for_missions_and_nothing_for_other_files() {
+    let w = workspace(&format!(
+        "{}{CATALOG}{STRATEGY}",
+        MISSION.replace("A.M { set", "A.$0M { set")
+    ));
+    let analysis = w.host.analysis();
+    let mission = w.cursor.file;
+    let text = &w.texts[mission.0 as usize];
+    // The mode `M`: its definition is a write; `mode = M` a read.
+    let highlights: Vec<String> = analysis
+        .highlights(w.cursor)
+        .iter()
+        .map(|r| {
+            format!(
+                "{}@{} {:?}",
+                &text[r.span.start..r.span.end],
+                r.span.start,
+                r.access
+            )
+        })
+        .collect();
+    insta::assert_snapshot!(highlights.join("\n"), @r"
+    M@47 Write
+    M@88 Read
+    ");
+    let selection = analysis.selection_ranges(w.cursor);
+    assert_eq!(
+        selection.last().map(|s| s.len()),
+        Some(text.len()),
+        "ends at the file"
+    );
+    // A strategy file has none of these (its outline is separate).
+    let strategy = FilePosition {
+        file: FileId(2),
+        offset: 10,
+    };
+    assert!(analysis.highlights(strategy).is_empty());
+    assert!(analysis.selection_ranges(strategy).is_empty());
+    assert!(analysis.folding_ranges(FileId(2)).is_empty());
+}

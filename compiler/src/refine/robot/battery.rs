@@ -34,7 +34,7 @@ impl Builder<'_, '_> {
         if strategies.is_empty() {
             return Vec::new();
         }
-        let battery = self.sensor_slot(BATTERY_VALUE);
+        let battery = self.sensor_slot(BATTERY_VALUE, self.team.name_span);
         let mut policies = Vec::new();
         for strategy in strategies {
             let source = self
@@ -63,7 +63,7 @@ impl Builder<'_, '_> {
                     if attr.last().as_str().eq_ignore_ascii_case("battery") {
                         Operand::Slot(battery)
                     } else {
-                        Operand::Literal(attr.dotted())
+                        Operand::Literal(crate::refine::Value::Word(attr.dotted()))
                     }
                 };
                 let mut compare_as = |e: &crate::syntax::ast::Expr| match &e.kind {

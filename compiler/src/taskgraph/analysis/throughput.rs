@@ -90,11 +90,11 @@ pub fn throughput(
         return None;
     }
     let wcet: Vec<u64> = level.nodes.iter().map(|n| n.wcet.unwrap_or(0)).collect();
-    let chained = concurrency == Concurrency::Single;
+    let chained = chained(level, concurrency);
     let direct =
         counts.iter().all(|&c| c == 1) && level.edges.iter().all(|e| e.produce == e.consume);
-    if !direct && symbolic_is_cheaper(level, counts, chained) {
-        if let Some((period, critical_cycle)) = symbolic::period(level, counts, &wcet, chained) {
+    if !direct && symbolic_is_cheaper(level, counts, &chained) {
+        if let Some((period, critical_cycle)) = symbolic::period(level, counts, &wcet, &chained) {
             return Some(Throughput {
                 period,
                 critical_cycle,
@@ -102,9 +102,9 @@ pub fn throughput(
         }
     }
     let hsdf = if direct {
-        Hsdf::direct(level, wcet, chained)
+        Hsdf::direct(level, wcet, &chained)
     } else {
-        Hsdf::expand(level, counts, &wcet, chained)?
+        Hsdf::expand(level, counts, &wcet, &chained)?
     };
     let Some(hsdf) = hsdf.on_cycles() else {
         return Some(Throughput {
@@ -120,11 +120,33 @@ pub fn throughput(
     })
 }
 
+/// Per node, whether its firings are chained, one after the other: with
+/// [`Concurrency::Single`] every node's, except a node whose self-loop
+/// channel already lets only one of its firings run at a time (rates `p`
+/// and `p ≤ samples < 2p`: firing k + 1 needs the samples firing k gives
+/// back), where a chain would be a second copy of the same constraint. That
+/// keeps the work of `Single` at `Auto`'s on graphs that limit every node so
+/// (`mp3playback`: the symbolic iteration follows the file's 6 samples, not
+/// 10).
+fn chained(level: &Level<'_>, concurrency: Concurrency) -> Vec<bool> {
+    let mut chained = vec![concurrency == Concurrency::Single; level.nodes.len()];
+    for e in &level.edges {
+        let one_at_a_time = e.src == e.dst
+            && e.produce == e.consume
+            && e.produce <= e.initial_tokens
+            && e.initial_tokens / 2 < e.produce;
+        if one_at_a_time {
+            chained[e.src] = false;
+        }
+    }
+    chained
+}
+
 /// Whether the symbolic iteration ([`symbolic`]) costs less than the HSDF
 /// expansion. Its steps (a max over D integers) are several times cheaper
 /// than the expansion's (edges sorted, then policy iterations in exact
 /// ratios), hence the factor.
-fn symbolic_is_cheaper(level: &Level<'_>, counts: &[u64], chained: bool) -> bool {
+fn symbolic_is_cheaper(level: &Level<'_>, counts: &[u64], chained: &[bool]) -> bool {
     const STEP_RATIO: u64 = 8;
     match (
         symbolic::cost(level, counts, chained),
@@ -194,15 +216,14 @@ impl Hsdf {
     /// Every node fires once per iteration (and so every edge has equal
     /// rates): the level is its own HSDF. An edge with `d` samples and rate
     /// `p` lets a firing depend on the firing `⌊d/p⌋` iterations earlier.
-    /// `chained`: each node also waits for its own previous firing.
-    fn direct(level: &Level<'_>, weight: Vec<u64>, chained: bool) -> Hsdf {
+    /// `chained`: each of those nodes also waits for its own previous firing.
+    fn direct(level: &Level<'_>, weight: Vec<u64>, chained: &[bool]) -> Hsdf {
         let n = level.nodes.len();
-        let chains = if chained { n } else { 0 };
         let edges = level
             .edges
             .iter()
             .map(|e| (e.src, e.dst, e.initial_tokens / e.produce))
-            .chain((0..chains).map(|v| (v, v, 1)))
+            .chain((0..n).filter(|&v| chained[v]).map(|v| (v, v, 1)))
             .collect();
         Hsdf::from_edges(weight, edges, Vec::new())
     }
@@ -226,8 +247,8 @@ impl Hsdf {
     /// iteration ⌈-j/γ(src)⌉ earlier when j < 0: the HSDF edge carries that
     /// many samples. Of several dependencies on the same source firing only
     /// the nearest iteration matters, so j runs over at most γ(src) values.
-    /// `chained`: firing k of a node also waits for its firing k - 1.
-    fn expand(level: &Level<'_>, counts: &[u64], wcet: &[u64], chained: bool) -> Option<Hsdf> {
+    /// `chained`: firing k of such a node also waits for its firing k - 1.
+    fn expand(level: &Level<'_>, counts: &[u64], wcet: &[u64], chained: &[bool]) -> Option<Hsdf> {
         let n = level.nodes.len();
         let mut offset = Vec::with_capacity(n + 1);
         let mut total = 0u64;
@@ -251,7 +272,7 @@ impl Hsdf {
             }
         }
         let mut edges = Vec::new();
-        for v in (0..n).filter(|_| chained) {
+        for v in (0..n).filter(|&v| chained[v]) {
             // Firing k waits for firing k - 1 of the same node.
             let g = offset[v + 1] - offset[v];
             for k in 0..g {
@@ -810,8 +831,8 @@ mod tests {
                 prop_assert_eq!(t.critical_cycle.is_empty(), t.period.num == 0);
                 // The symbolic iteration, whichever engine `throughput` chose.
                 let wcet: Vec<u64> = level.nodes.iter().map(|n| n.wcet.unwrap_or(0)).collect();
-                let chained = concurrency == Concurrency::Single;
-                let (period, cycle) = symbolic::period(&level, &counts, &wcet, chained).unwrap();
+                let chained = chained(&level, concurrency);
+                let (period, cycle) = symbolic::period(&level, &counts, &wcet, &chained).unwrap();
                 prop_assert_eq!(period, t.period, "symbolic, {:?}", concurrency);
                 prop_assert_eq!(cycle.is_empty(), period.num == 0);
                 prop_assert!(cycle.iter().all(|&v| v < level.nodes.len()));

@@ -32,6 +32,7 @@ use super::consistency::repetition_vector;
 use super::level::{Edge, Level};
 use super::ratio::{Ratio, gcd};
 use super::throughput::{Concurrency, throughput};
+use crate::fasthash::FastSet;
 
 /// Candidate channels tried one at a time per step; more are grown together.
 const MAX_CANDIDATES: usize = 8;
@@ -172,13 +173,18 @@ impl Search<'_, '_> {
         let t = throughput(&with_space, &self.counts, self.concurrency)?;
         // Space edges joining consecutive nodes of the critical cycle (a
         // self-loop's when the cycle is one node).
+        // (As sets: on a large level the cycle can have thousands of nodes.)
         let cycle = &t.critical_cycle;
+        let nodes: FastSet<usize> = cycle.iter().copied().collect();
+        let steps: FastSet<(usize, usize)> = (0..cycle.len())
+            .map(|i| (cycle[i], cycle[(i + 1) % cycle.len()]))
+            .collect();
         let mut on_cycle = Vec::new();
         for (k, e) in with_space.edges.iter().enumerate().skip(n) {
             let joins = if e.src == e.dst {
-                cycle.contains(&e.src)
+                nodes.contains(&e.src)
             } else {
-                (0..cycle.len()).any(|i| e.src == cycle[i] && e.dst == cycle[(i + 1) % cycle.len()])
+                steps.contains(&(e.src, e.dst))
             };
             if joins {
                 on_cycle.push(owner[k - n]);
@@ -337,7 +343,8 @@ pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff
 
 /// A distribution reaching `max_period`, for levels where growing from below
 /// did not get there within its budget: the channels on the critical (or
-/// blocking) cycle are doubled until the period is reached. `None` if the
+/// blocking) cycle are doubled until the period is reached (every channel,
+/// on a level with more channels than evaluations left). `None` if the
 /// budget runs out first.
 fn grown(
     search: &mut Search<'_, '_>,
@@ -358,10 +365,16 @@ fn grown(
             Outcome::Period(p, on_cycle) => (Some(p), on_cycle),
             Outcome::Blocked(on_cycle) => (None, on_cycle),
         };
-        // Every channel when the cycle's did not help last time.
+        // Every channel when the cycle's did not help last time, or when
+        // there are more channels than evaluations left (a large graph: a
+        // cycle at a time could not get there; all doubled, the period is
+        // reached in a few steps, and `shrink` and the lower bound say how
+        // far above the minimum that is).
         let stuck = period.is_some() && period == last;
         last = period;
-        let grow: Vec<usize> = if grow.is_empty() || stuck {
+        let left = budget.saturating_sub(search.work) / search.cost.max(1);
+        let large = caps.len() as u64 > 4 * left;
+        let grow: Vec<usize> = if grow.is_empty() || stuck || large {
             (0..caps.len()).collect()
         } else {
             grow

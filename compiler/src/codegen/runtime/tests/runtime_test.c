@@ -31,37 +31,61 @@ static atomic_int failures;
 static int run_values(void)
 {
     semo_value a, b;
-    semo_value_set(&a, "5");
-    semo_value_set(&b, "10");
-    CHECK(semo_value_compare(&a, &b) < 0); /* numerically, not "5" > "10" */
-    CHECK(semo_value_compare(SEMO_LIT("2.50"), SEMO_LIT("2.5")) == 0);
-    CHECK(semo_value_compare(SEMO_LIT("-1e3"), SEMO_LIT("-999")) < 0);
-    CHECK(semo_value_compare(SEMO_LIT("5,5"), SEMO_LIT("5,5")) == 0);
-    CHECK(semo_value_compare(SEMO_LIT("5,5"), SEMO_LIT("5")) > 0); /* "5,5" is text */
-    CHECK(semo_value_compare(SEMO_LIT(" 5"), SEMO_LIT("5")) < 0);  /* so is " 5" */
-    CHECK(semo_value_compare(SEMO_LIT("RED"), SEMO_LIT("GREEN")) > 0);
-    CHECK(semo_value_compare(SEMO_LIT(""), SEMO_LIT("0")) < 0);
-    CHECK(semo_value_compare(SEMO_LIT("nan"), SEMO_LIT("nan")) == 0);
+    char json[80];
     /* As the checker typed the comparison (what generated code calls). */
-    CHECK(semo_value_numbers(SEMO_LIT("5"), SEMO_LT, SEMO_LIT("10")));
-    CHECK(semo_value_numbers(SEMO_LIT("2.50"), SEMO_EQ, SEMO_LIT("2.5")));
-    CHECK(semo_value_numbers(SEMO_LIT("-1e3"), SEMO_LE, SEMO_LIT("-999")));
-    CHECK(!semo_value_numbers(SEMO_LIT("5,5"), SEMO_NE, SEMO_LIT("5"))); /* not a number: false */
-    CHECK(!semo_value_numbers(SEMO_LIT("x"), SEMO_GE, SEMO_LIT("1")));
-    CHECK(semo_value_words(SEMO_LIT("10"), SEMO_NE, SEMO_LIT("10.0"))); /* by text */
+    CHECK(semo_value_numbers(SEMO_LIT_INT(5), SEMO_LT, SEMO_LIT_INT(10)));
+    CHECK(semo_value_numbers(SEMO_LIT_INT(9007199254740993), SEMO_GT, SEMO_LIT_INT(9007199254740992))); /* exact */
+    CHECK(semo_value_numbers(SEMO_LIT_REAL(2.5), SEMO_EQ, SEMO_LIT_REAL(2.50)));
+    CHECK(semo_value_numbers(SEMO_LIT_INT(-1000), SEMO_LE, SEMO_LIT_REAL(-999.5))); /* an integer and a real */
+    CHECK(!semo_value_numbers(SEMO_LIT("5"), SEMO_EQ, SEMO_LIT_INT(5))); /* text is no number: false */
+    CHECK(!semo_value_numbers(SEMO_LIT_BOOL(true), SEMO_GE, SEMO_LIT_INT(1)));
+    a.type = SEMO_NONE;
+    CHECK(!semo_value_numbers(&a, SEMO_NE, SEMO_LIT_INT(1))); /* none: false */
+    CHECK(semo_value_words(SEMO_LIT_INT(10), SEMO_EQ, SEMO_LIT_REAL(10.0))); /* numbers by value */
     CHECK(semo_value_words(SEMO_LIT("LEFT"), SEMO_EQ, SEMO_LIT("LEFT")));
+    CHECK(semo_value_words(SEMO_LIT("5"), SEMO_NE, SEMO_LIT_INT(5))); /* other types differ */
+    CHECK(semo_value_words(&a, SEMO_EQ, &a) && semo_value_words(&a, SEMO_NE, SEMO_LIT("")));
     CHECK(!semo_value_words(SEMO_LIT("A"), SEMO_LT, SEMO_LIT("B"))); /* never ordered */
-    CHECK(semo_value_truthy(SEMO_LIT("true")));
-    CHECK(semo_value_truthy(SEMO_LIT("2")));
-    CHECK(semo_value_truthy(SEMO_LIT("-0.5")));
-    CHECK(!semo_value_truthy(SEMO_LIT("0")));
-    CHECK(!semo_value_truthy(SEMO_LIT("false")));
-    CHECK(!semo_value_truthy(SEMO_LIT("TRUE")));
-    CHECK(!semo_value_truthy(SEMO_LIT("")));
-    semo_value_set_int(&a, -42);
-    CHECK(strcmp(a.text, "-42") == 0);
+    CHECK(semo_value_truthy(SEMO_LIT_BOOL(true)));
+    CHECK(semo_value_truthy(SEMO_LIT_INT(2)));
+    CHECK(semo_value_truthy(SEMO_LIT_REAL(-0.5)));
+    CHECK(!semo_value_truthy(SEMO_LIT_INT(0)));
+    CHECK(!semo_value_truthy(SEMO_LIT_BOOL(false)));
+    CHECK(!semo_value_truthy(SEMO_LIT("true"))); /* text is not a truth value */
+    CHECK(!semo_value_truthy(&a));
+    /* Text read as a type (scenario values, operator commands). */
+    CHECK(semo_value_parse(&b, SEMO_INT, "-42") && b.type == SEMO_INT && b.i == -42);
+    CHECK(semo_value_parse(&b, SEMO_INT, "9223372036854775807") && b.i == INT64_MAX);
+    CHECK(!semo_value_parse(&b, SEMO_INT, "9223372036854775808")); /* beyond int64 */
+    CHECK(!semo_value_parse(&b, SEMO_INT, "2.5") && !semo_value_parse(&b, SEMO_INT, " 5"));
+    CHECK(semo_value_parse(&b, SEMO_REAL, "-1e3") && b.type == SEMO_REAL && b.r == -1000.0);
+    CHECK(!semo_value_parse(&b, SEMO_REAL, "5,5"));
+    CHECK(semo_value_parse(&b, SEMO_BOOL, "true") && b.type == SEMO_BOOL && b.b);
+    CHECK(!semo_value_parse(&b, SEMO_BOOL, "TRUE"));
+    CHECK(!semo_value_parse(&b, SEMO_WORD, "LEFT")); /* no program: no words */
+    semo_value_set(&b, "7");
+    CHECK(semo_value_coerce(&b, SEMO_INT) && b.type == SEMO_INT && b.i == 7);
+    CHECK(semo_value_coerce(&b, SEMO_REAL) && b.type == SEMO_REAL && b.r == 7.0); /* widened */
+    CHECK(!semo_value_coerce(&b, SEMO_INT) && !semo_value_coerce(&b, SEMO_TEXT));
+    CHECK(semo_value_coerce(&b, SEMO_NONE)); /* a team variable takes any type */
+    /* JSON keeps the value's type; reals print as refine::value::format_real. */
+    semo_value_set_int(&b, INT64_MIN);
+    CHECK(semo_value_json(&b, json, sizeof json) == 20 && strcmp(json, "-9223372036854775808") == 0);
+    semo_value_set_real(&b, 2.0);
+    CHECK(semo_value_json(&b, json, sizeof json) > 0 && strcmp(json, "2.0") == 0);
+    semo_value_set_real(&b, 1.0 / 3.0);
+    CHECK(semo_value_json(&b, json, sizeof json) > 0 && strcmp(json, "0.333333") == 0);
+    semo_value_set_real(&b, -1.5e20);
+    CHECK(semo_value_json(&b, json, sizeof json) > 0 && strcmp(json, "-150000000000000e6") == 0);
+    semo_value_set_real(&b, 1.0 / 0.0);
+    CHECK(semo_value_json(&b, json, sizeof json) > 0 && strcmp(json, "null") == 0);
+    semo_value_set_bool(&b, false);
+    CHECK(semo_value_json(&b, json, sizeof json) > 0 && strcmp(json, "false") == 0);
+    CHECK(semo_value_json(SEMO_LIT("a\"b"), json, sizeof json) > 0 && strcmp(json, "\"a\\\"b\"") == 0);
+    CHECK(semo_value_json(&a, json, sizeof json) > 0 && strcmp(json, "null") == 0);
+    CHECK(semo_value_json(SEMO_LIT("abcdef"), json, 4) == 3 && strcmp(json, "\"ab") == 0); /* cut to fit */
     semo_value_set(&a, NULL);
-    CHECK(strcmp(a.text, "") == 0);
+    CHECK(a.type == SEMO_TEXT && strcmp(a.text, "") == 0);
     /* Truncation keeps whole UTF-8 characters: 62 ASCII bytes + "é" does not fit. */
     char long_text[80];
     memset(long_text, 'x', 62);
@@ -71,9 +95,9 @@ static int run_values(void)
     memset(long_text, 'y', 79);
     long_text[79] = '\0';
     semo_value_set(&a, long_text);
-    CHECK(strlen(a.text) == SEMO_VALUE_MAX - 1);
+    CHECK(strlen(a.text) == SEMO_TEXT_MAX - 1);
     semo_value_set(&a, a.text + 1); /* overlapping source */
-    CHECK(strlen(a.text) == SEMO_VALUE_MAX - 2);
+    CHECK(strlen(a.text) == SEMO_TEXT_MAX - 2);
     /* Outside semo_main every call fails softly. */
     CHECK(UFPort_Initialize("A", "B") == -1);
     CHECK(UFControl_RunTask("A") == -1);
@@ -311,6 +335,18 @@ static void control_go(void)
     semo_trace("note", "text", "quote\" backslash\\ newline\n tab\t ctl\x01 \xc3\xa9 bad\xff\xc3 end", NULL);
     semo_trace("note", "text", NULL);
     CHECK(semo_comm_send("USER", SEMO_MSG_SEND, "Team.STATUS", SEMO_LIT("ok")) == 1);
+    /* Words: indices into the program's table, compared by identity, a word
+     * and a text by their text; traced and sent as their text. */
+    semo_value w;
+    CHECK(semo_value_parse(&w, SEMO_WORD, "RIGHT") && w.type == SEMO_WORD && w.word == 1);
+    CHECK(!semo_value_parse(&w, SEMO_WORD, "UP"));
+    CHECK(semo_value_words(&w, SEMO_EQ, SEMO_LIT_WORD(1)) && semo_value_words(&w, SEMO_NE, SEMO_LIT_WORD(0)));
+    CHECK(semo_value_words(&w, SEMO_EQ, SEMO_LIT("RIGHT")));
+    semo_value_set(&w, "LEFT");
+    CHECK(semo_value_coerce(&w, SEMO_WORD) && w.type == SEMO_WORD && w.word == 0);
+    CHECK(semo_value_coerce(&w, SEMO_TEXT) && w.type == SEMO_TEXT && strcmp(w.text, "LEFT") == 0);
+    CHECK(semo_comm_send("USER", SEMO_MSG_SEND, "Team.TURN", SEMO_LIT_WORD(1)) == 1);
+    CHECK(semo_comm_send("USER", SEMO_MSG_SEND, "Team.COUNT", SEMO_LIT_INT(-3)) == 1);
     CHECK(semo_comm_send("Other", SEMO_MSG_SEND, "Team.STATUS", SEMO_LIT("ok")) == -1); /* no transport */
     semo_stop_program();
     CHECK(!semo_running());
@@ -324,9 +360,13 @@ static const semo_task_desc task_tasks[] = {
     {"Control", SEMO_TRIGGER_TIME, 100000, count_init, control_go, count_wrapup},
 };
 
+static const char *const task_words[] = {"LEFT", "RIGHT"};
+
 static int run_tasks(int argc, char **argv)
 {
     const semo_program_desc program = {
+        .words = task_words,
+        .word_count = 2,
         .mission = "test.mission",
         .team = "TestTeam",
         .robot = "r1",
@@ -505,14 +545,14 @@ static int run_udp(int argc, char **argv, bool alpha)
 
 #ifdef SEMO_SIM
 static bool saw_origin, saw_goal;
-static char commands[16][SEMO_VALUE_MAX];
+static char commands[16][SEMO_TEXT_MAX];
 static int command_count;
 
 static void location_go(void)
 {
     semo_value v;
     int64_t before = semo_now_ms();
-    bool known = semo_sim_sensor("LOCATION", &v);
+    bool known = semo_sim_sensor("LOCATION", SEMO_TEXT, &v);
     int64_t after = semo_now_ms();
     CHECK(known);
     if (after < 1500)
@@ -536,14 +576,16 @@ static void sim_control_go(void)
     CHECK(strcmp(m.from_team, "USER") == 0 && strcmp(m.from_robot, "USER") == 0);
     CHECK(strcmp(m.key, "USER.RC_CMD") == 0);
     if (command_count < 16)
-        memcpy(commands[command_count++], m.value.text, SEMO_VALUE_MAX);
+        memcpy(commands[command_count++], m.value.text, SEMO_TEXT_MAX);
+    CHECK(m.value.type == SEMO_TEXT); /* the operator's commands come as text */
     if (strcmp(m.value.text, "AUTO_MODE") == 0) {
         semo_sim_actuate("Move", SEMO_LIT("5,5"));
         CHECK(semo_sim_service_ms("move") == 300);
         CHECK(semo_sim_service_ms("grab") == 100);
         semo_value v;
-        CHECK(!semo_sim_sensor("NOPE", &v));
-        CHECK(semo_sim_sensor("BATTERY", &v) && strcmp(v.text, "97") == 0);
+        CHECK(!semo_sim_sensor("NOPE", SEMO_TEXT, &v));
+        CHECK(semo_sim_sensor("BATTERY", SEMO_INT, &v) && v.type == SEMO_INT && v.i == 97);
+        CHECK(!semo_sim_sensor("LOCATION", SEMO_INT, &v)); /* "5,5" is no integer */
     }
     if (strcmp(m.value.text, "FINISH") == 0) {
         CHECK(semo_now_ms() >= 3000);

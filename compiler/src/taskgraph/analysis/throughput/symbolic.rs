@@ -3,8 +3,8 @@
 //! synchronous dataflow graphs"; SDF3's own state-space method computes the
 //! same number).
 //!
-//! Every initial sample (one per sample on a channel, and with `chained` one
-//! per node for its previous firing) gets a coordinate. A sample made during
+//! Every initial sample (one per sample on a channel, and one per node
+//! `chained` for its previous firing) gets a coordinate. A sample made during
 //! the iteration carries a vector: for each initial sample, the longest time
 //! from that sample to it (−∞: it does not depend on it). A firing starts at
 //! the max of its input samples' vectors and ends `wcet` later. After one
@@ -41,7 +41,7 @@ struct Channel {
     tokens: u64,
 }
 
-fn channels(level: &Level<'_>, chained: bool) -> Vec<Channel> {
+fn channels(level: &Level<'_>, chained: &[bool]) -> Vec<Channel> {
     let mut out: Vec<Channel> = level
         .edges
         .iter()
@@ -53,14 +53,18 @@ fn channels(level: &Level<'_>, chained: bool) -> Vec<Channel> {
             tokens: e.initial_tokens,
         })
         .collect();
-    if chained {
-        out.extend((0..level.nodes.len()).map(|v| Channel {
-            src: v,
-            dst: v,
-            produce: 1,
-            consume: 1,
-            tokens: 1,
-        }));
+    {
+        out.extend(
+            (0..level.nodes.len())
+                .filter(|&v| chained[v])
+                .map(|v| Channel {
+                    src: v,
+                    dst: v,
+                    produce: 1,
+                    consume: 1,
+                    tokens: 1,
+                }),
+        );
     }
     out
 }
@@ -68,7 +72,7 @@ fn channels(level: &Level<'_>, chained: bool) -> Vec<Channel> {
 /// D·(Σγ + Σ over channels of γ(src) + γ(dst)): the work of [`period`], to
 /// compare with the HSDF's size. `None` when it does not apply (too many
 /// initial samples, vectors beyond the HSDF's memory budget, overflow).
-pub(super) fn cost(level: &Level<'_>, counts: &[u64], chained: bool) -> Option<u64> {
+pub(super) fn cost(level: &Level<'_>, counts: &[u64], chained: &[bool]) -> Option<u64> {
     let channels = channels(level, chained);
     let samples = channels
         .iter()
@@ -100,7 +104,7 @@ pub(super) fn period(
     level: &Level<'_>,
     counts: &[u64],
     wcet: &[u64],
-    chained: bool,
+    chained: &[bool],
 ) -> Option<(Ratio, Vec<usize>)> {
     // Within the bounds (samples, memory) whatever the caller checked.
     cost(level, counts, chained)?;
@@ -126,12 +130,16 @@ pub(super) fn period(
     let mut available: Vec<u64> = channels.iter().map(|c| c.tokens).collect();
     let mut remaining = counts.to_vec();
     let total = usize::try_from(counts.iter().try_fold(0u64, |s, &c| s.checked_add(c))?).ok()?;
-    // Per firing: its actor, its end vector and which origin gave each entry.
-    let mut actor: Vec<usize> = Vec::with_capacity(total);
-    let mut ends: Vec<i64> = Vec::with_capacity(total.checked_mul(d)?);
-    let mut from: Vec<Origin> = Vec::with_capacity(total.checked_mul(d)?);
+    // Per firing: its actor and which origin gave each entry of its vector
+    // (32 bits: memory touched for the first time is most of the time on a
+    // graph like `mp3playback`), and the vectors still needed.
+    u32::try_from(d.checked_add(total)?).ok()?;
+    let mut actor: Vec<u32> = Vec::with_capacity(total);
+    let mut from: Vec<u32> = Vec::with_capacity(total.checked_mul(d)?);
+    let mut ends = Ends::new(d, total);
+    let mut end = vec![NEG_INF; d];
     let mut start = vec![NEG_INF; d];
-    let mut start_from = vec![usize::MAX; d];
+    let mut start_from = vec![u32::MAX; d];
     let mut pending: Vec<usize> = (0..n).rev().collect();
     let mut queued = vec![true; n];
     while let Some(v) = pending.pop() {
@@ -143,7 +151,7 @@ pub(super) fn period(
                 .all(|&i| available[i] >= channels[i].consume)
         {
             start.fill(NEG_INF);
-            start_from.fill(usize::MAX);
+            start_from.fill(u32::MAX);
             for &i in &inputs[v] {
                 let mut need = channels[i].consume;
                 available[i] -= need;
@@ -153,23 +161,28 @@ pub(super) fn period(
                     let taken = need.min(*count);
                     *count -= taken;
                     need -= taken;
-                    if *count == 0 {
-                        queues[i].pop_front();
-                    }
+                    let emptied = *count == 0;
                     merge(origin, d, &ends, &mut start, &mut start_from);
+                    if emptied {
+                        queues[i].pop_front();
+                        if origin >= d {
+                            ends.release(origin - d);
+                        }
+                    }
                 }
             }
             let f = actor.len();
-            actor.push(v);
+            actor.push(v as u32);
             let w = i64::try_from(wcet[v]).ok()?;
-            for (s, &o) in start.iter().zip(&start_from) {
-                ends.push(if *s == NEG_INF {
+            for (e, s) in end.iter_mut().zip(&start) {
+                *e = if *s == NEG_INF {
                     NEG_INF
                 } else {
                     s.checked_add(w)?
-                });
-                from.push(o);
+                };
             }
+            from.extend_from_slice(&start_from);
+            ends.push(&end, outputs[v].len());
             for &i in &outputs[v] {
                 queues[i].push_back((d + f, channels[i].produce));
                 available[i] = available[i].checked_add(channels[i].produce)?;
@@ -206,7 +219,7 @@ pub(super) fn period(
         if origin < d {
             if origin == j { 0 } else { NEG_INF }
         } else {
-            ends[(origin - d) * d + j]
+            ends.row(origin - d)[j]
         }
     };
     // G's graph: token nodes 0..d weigh nothing; an entry G[i][j] is a node
@@ -241,8 +254,8 @@ pub(super) fn period(
         let mut origin = rows[i];
         while origin >= d {
             let f = origin - d;
-            path.push(actor[f]);
-            origin = from[f * d + j];
+            path.push(actor[f] as usize);
+            origin = from[f * d + j] as usize;
         }
         path.reverse();
         walk.extend(path);
@@ -252,19 +265,83 @@ pub(super) fn period(
 
 /// `start = max(start, the vector of origin)`, remembering where each
 /// entry's max came from.
-fn merge(origin: Origin, d: usize, ends: &[i64], start: &mut [i64], start_from: &mut [Origin]) {
+fn merge(origin: Origin, d: usize, ends: &Ends, start: &mut [i64], start_from: &mut [u32]) {
     if origin < d {
         if start[origin] < 0 {
             start[origin] = 0;
-            start_from[origin] = origin;
+            start_from[origin] = origin as u32;
         }
         return;
     }
-    let row = &ends[(origin - d) * d..(origin - d + 1) * d];
+    let row = ends.row(origin - d);
     for ((s, f), &e) in start.iter_mut().zip(start_from.iter_mut()).zip(row) {
         if e > *s {
             *s = e;
-            *f = origin;
+            *f = origin as u32;
+        }
+    }
+}
+
+/// The end vectors of the firings whose samples are still on a channel: a
+/// firing's vector is dropped (its slot reused) once the last run of
+/// samples it made is consumed, so the memory is that of the samples in
+/// flight, not of every firing (`mp3playback`: 10,601 firings, a few
+/// thousand runs in flight).
+struct Ends {
+    d: usize,
+    /// `d` entries per slot.
+    values: Vec<i64>,
+    /// Per slot, the runs of samples still referring to it.
+    refs: Vec<usize>,
+    free: Vec<usize>,
+    /// Per firing, its slot (`usize::MAX`: it made no samples).
+    slot: Vec<usize>,
+}
+
+impl Ends {
+    fn new(d: usize, firings: usize) -> Ends {
+        Ends {
+            d,
+            values: Vec::new(),
+            refs: Vec::new(),
+            free: Vec::new(),
+            slot: Vec::with_capacity(firings),
+        }
+    }
+
+    /// The vector of the next firing, which made `runs` runs of samples.
+    fn push(&mut self, vector: &[i64], runs: usize) {
+        if runs == 0 {
+            self.slot.push(usize::MAX);
+            return;
+        }
+        let slot = match self.free.pop() {
+            Some(slot) => {
+                self.values[slot * self.d..(slot + 1) * self.d].copy_from_slice(vector);
+                self.refs[slot] = runs;
+                slot
+            }
+            None => {
+                self.values.extend_from_slice(vector);
+                self.refs.push(runs);
+                self.refs.len() - 1
+            }
+        };
+        self.slot.push(slot);
+    }
+
+    /// The vector of firing `f`, which still has samples on a channel.
+    fn row(&self, f: usize) -> &[i64] {
+        let slot = self.slot[f];
+        &self.values[slot * self.d..(slot + 1) * self.d]
+    }
+
+    /// One run of firing `f`'s samples is consumed.
+    fn release(&mut self, f: usize) {
+        let slot = self.slot[f];
+        self.refs[slot] -= 1;
+        if self.refs[slot] == 0 {
+            self.free.push(slot);
         }
     }
 }

@@ -209,3 +209,75 @@ proptest! {
         }
     }
 }
+
+/// A random strongly connected, consistent, live SDF3 graph of `n` actors,
+/// as `tests/data/sdf3/mkbig.py` writes them (a ring plus chords, repetition
+/// counts 1..3, a full iteration of samples on every edge going backwards,
+/// times 1..20), from a fixed seed.
+fn big_graph(n: usize, seed: u64) -> String {
+    let mut state = seed;
+    let mut next = |below: u64| {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 33) % below
+    };
+    let gamma: Vec<u64> = (0..n).map(|_| [1, 1, 2, 3][next(4) as usize]).collect();
+    let mut edges: Vec<(usize, usize)> = (0..n).map(|i| (i, (i + 1) % n)).collect();
+    for _ in 0..n / 2 {
+        let (s, d) = (next(n as u64) as usize, next(n as u64) as usize);
+        if s != d {
+            edges.push((s, d));
+        }
+    }
+    let mut ports = vec![String::new(); n];
+    let mut channels = String::new();
+    for (k, &(s, d)) in edges.iter().enumerate() {
+        let l = gamma[s] * gamma[d] / gcd(gamma[s], gamma[d]);
+        let (p, c) = (l / gamma[s], l / gamma[d]);
+        ports[s] += &format!(r#"<port name="o{k}" type="out" rate="{p}"/>"#);
+        ports[d] += &format!(r#"<port name="i{k}" type="in" rate="{c}"/>"#);
+        let tokens = if d <= s { p * gamma[s] } else { 0 };
+        channels += &format!(
+            r#"<channel name="ch{k}" srcActor="a{s}" srcPort="o{k}" dstActor="a{d}" dstPort="i{k}" initialTokens="{tokens}"/>"#
+        );
+    }
+    let mut text = String::from(r#"<sdf3 type="sdf"><applicationGraph><sdf name="g">"#);
+    for (i, ports) in ports.iter().enumerate() {
+        text += &format!(r#"<actor name="a{i}">{ports}</actor>"#);
+    }
+    text += &channels;
+    text += "</sdf><sdfProperties>";
+    for i in 0..n {
+        let time = 1 + next(20);
+        text += &format!(
+            r#"<actorProperties actor="a{i}"><processor type="p" default="true"><executionTime time="{time}"/></processor></actorProperties>"#
+        );
+    }
+    text + "</sdfProperties></applicationGraph></sdf3>"
+}
+
+/// On a level with far more channels than the search's budget has
+/// evaluations (growing a cycle at a time cannot finish), every channel is
+/// grown at once: a distribution reaching the maximal throughput is still
+/// found, and the bounds hold around it.
+#[test]
+fn a_large_level_gets_a_distribution_reaching_the_maximal_throughput() {
+    let text = big_graph(3000, 1);
+    let (g, diagnostics) = crate::taskgraph::load_task_graph(FileId(0), &text);
+    assert!(diagnostics.is_empty(), "{diagnostics:?}");
+    let g = g.unwrap();
+    let level = Level::build(&g, None, g.name.clone());
+    let found = trade_off(&level, Concurrency::Auto).unwrap();
+    let reaching = found
+        .for_max_throughput()
+        .expect("a distribution reaching the maximal throughput");
+    assert!(found.lower_bound <= reaching.size);
+    let counts = repetition_vector(&level).unwrap();
+    let caps: Vec<Option<u64>> = reaching.capacities.iter().map(|&c| Some(c)).collect();
+    let with_space = bounded(&level, &caps);
+    assert_eq!(
+        throughput(&with_space, &counts, Concurrency::Auto).map(|t| t.period),
+        Some(found.max_period)
+    );
+}

@@ -1,0 +1,128 @@
+//! Typed values in the generated C: the program's word table and literals
+//! (`semo_value`, `semo_runtime.h`). Words are indices into one table per
+//! program, `words[]` in `main.c`, sorted; the runtime writes and sends their
+//! text, so tables of different robots need not agree.
+
+use super::c;
+use crate::refine::{Expr, Operand, RobotProgram, StateKind, Value, ValueKind};
+use std::collections::BTreeSet;
+
+/// The words a program uses: its word literals and the domains of its
+/// enumerated values, sorted.
+pub struct Words(Vec<String>);
+
+impl Words {
+    pub fn of(program: &RobotProgram) -> Words {
+        let mut words = BTreeSet::new();
+        for slot in &program.control.slots {
+            if let ValueKind::Word(domain) = &slot.kind {
+                words.extend(domain.iter().cloned());
+            }
+        }
+        each_literal(program, &mut |v| {
+            if let Value::Word(w) = v {
+                words.insert(w.clone());
+            }
+        });
+        Words(words.into_iter().collect())
+    }
+
+    pub fn list(&self) -> &[String] {
+        &self.0
+    }
+
+    fn index(&self, word: &str) -> usize {
+        // Every word literal was collected by `of`.
+        self.0
+            .binary_search_by(|w| w.as_str().cmp(word))
+            .unwrap_or(0)
+    }
+
+    /// A literal as a `const semo_value *` expression.
+    pub fn literal(&self, value: &Value) -> String {
+        match value {
+            Value::Int(i) if *i == i64::MIN => "SEMO_LIT_INT(INT64_MIN)".into(),
+            Value::Int(i) => format!("SEMO_LIT_INT({i})"),
+            Value::Real(r) if r.is_infinite() => format!(
+                "SEMO_LIT_REAL({}__builtin_inf())",
+                if *r < 0.0 { "-" } else { "" }
+            ),
+            // `{:e}` writes the shortest digits that read back exactly.
+            Value::Real(r) => format!("SEMO_LIT_REAL({r:e})"),
+            Value::Bool(b) => format!("SEMO_LIT_BOOL({b})"),
+            Value::Word(w) => format!("SEMO_LIT_WORD({}) /* {} */", self.index(w), c::comment(w)),
+            Value::Text(t) => format!("SEMO_LIT({})", c::string(t)),
+        }
+    }
+}
+
+/// Whether the program holds a real anywhere: a slot the catalog declares
+/// `float`, or a real literal. Without one the static targets build with
+/// `-DSEMO_NO_REALS` (no soft float linked). A team variable holds only what
+/// the program assigns or receives; on the static targets it receives only
+/// the operator's text.
+pub fn uses_reals(program: &RobotProgram) -> bool {
+    let mut reals = program
+        .control
+        .slots
+        .iter()
+        .any(|s| s.kind == ValueKind::Real);
+    each_literal(program, &mut |v| reals |= matches!(v, Value::Real(_)));
+    reals
+}
+
+/// Every literal of the program's machine.
+fn each_literal(program: &RobotProgram, f: &mut dyn FnMut(&Value)) {
+    let m = &program.control;
+    let mut add = |op: &Operand| {
+        if let Operand::Literal(v) = op {
+            f(v);
+        }
+    };
+    for state in m.services.iter().flat_map(|s| &s.states) {
+        match &state.kind {
+            StateKind::Send { items } => items.iter().for_each(|i| add(&i.value)),
+            StateKind::Call { args, .. } | StateKind::RunActions { args, .. } => {
+                args.iter().for_each(&mut add)
+            }
+            StateKind::Branch { condition, .. } => operands(condition, &mut add),
+            StateKind::LoopHead {
+                condition: Some(c), ..
+            }
+            | StateKind::Repeat {
+                condition: Some(c), ..
+            } => operands(c, &mut add),
+            _ => {}
+        }
+    }
+    for policy in &m.battery {
+        operands(&policy.condition, &mut add);
+    }
+    for action in m.actions.iter().flat_map(|a| &a.actions) {
+        for (_, command) in &action.commands {
+            add(&Operand::Literal(command.clone()));
+        }
+        for (condition, _) in action.transitions.iter() {
+            if let Some(c) = condition {
+                operands(c, &mut add);
+            }
+        }
+    }
+}
+
+/// Every operand of an expression.
+fn operands(e: &Expr, f: &mut dyn FnMut(&Operand)) {
+    match e {
+        Expr::Or(a, b) | Expr::And(a, b) => {
+            operands(a, f);
+            operands(b, f);
+        }
+        Expr::Not(a) => operands(a, f),
+        Expr::Compare(a, _, b, _) => {
+            f(a);
+            f(b);
+        }
+        Expr::Truthy(o) => f(o),
+        Expr::Bool(_) => {}
+    }
+}

@@ -1,0 +1,166 @@
+//! The runtime's datagram (`semo__encode_message` in `semo_core.c`, the
+//! format in `semo_internal.h`), written once on this side for the programs
+//! that speak to robots without being one: the operator console and the
+//! tests that forge operator commands.
+//!
+//! `"SEMO" 0x02 <kind>`, then team, robot and key (each a length byte and
+//! that many bytes), then the value: a type byte and, by type, nothing
+//! (none), 8 bytes big-endian (integer; a real's IEEE 754 bits), one byte
+//! (truth value), or a length byte and the text (word, text).
+
+use crate::refine::Value;
+
+const MAGIC: &[u8] = b"SEMO\x02";
+/// The type bytes (`semo_type`).
+const NONE: u8 = 0;
+const INT: u8 = 1;
+const REAL: u8 = 2;
+const BOOL: u8 = 3;
+const WORD: u8 = 4;
+const TEXT: u8 = 5;
+
+/// A decoded datagram.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Datagram {
+    pub publish: bool,
+    pub team: String,
+    pub robot: String,
+    pub key: String,
+    pub value: Option<Value>,
+}
+
+fn put_field(out: &mut Vec<u8>, text: &str) {
+    let mut end = text.len().min(255);
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    out.push(end as u8);
+    out.extend_from_slice(&text.as_bytes()[..end]);
+}
+
+/// A `send` from `team`/`robot` (a `USER` command: team `USER`). An
+/// operator's command goes as text: the robot reads it as the type its
+/// mission declares for the key (`semo_value_coerce`).
+pub fn encode(d: &Datagram) -> Vec<u8> {
+    let mut out = MAGIC.to_vec();
+    out.push(if d.publish { b'p' } else { b's' });
+    for field in [&d.team, &d.robot, &d.key] {
+        put_field(&mut out, field);
+    }
+    match &d.value {
+        None => out.push(NONE),
+        Some(Value::Int(i)) => {
+            out.push(INT);
+            out.extend_from_slice(&i.to_be_bytes());
+        }
+        Some(Value::Real(r)) => {
+            out.push(REAL);
+            out.extend_from_slice(&r.to_bits().to_be_bytes());
+        }
+        Some(Value::Bool(b)) => out.extend_from_slice(&[BOOL, *b as u8]),
+        Some(Value::Word(w)) => {
+            out.push(WORD);
+            put_field(&mut out, w);
+        }
+        Some(Value::Text(t)) => {
+            out.push(TEXT);
+            put_field(&mut out, t);
+        }
+    }
+    out
+}
+
+/// The datagram, or `None` for anything else.
+pub fn decode(data: &[u8]) -> Option<Datagram> {
+    let rest = data.strip_prefix(MAGIC)?;
+    let (&kind, mut rest) = rest.split_first()?;
+    let publish = match kind {
+        b'p' => true,
+        b's' => false,
+        _ => return None,
+    };
+    let field = |rest: &mut &[u8]| -> Option<String> {
+        let (&n, tail) = rest.split_first()?;
+        let text = tail.get(..n as usize)?;
+        *rest = &tail[n as usize..];
+        String::from_utf8(text.to_vec()).ok()
+    };
+    let team = field(&mut rest)?;
+    let robot = field(&mut rest)?;
+    let key = field(&mut rest)?;
+    let (&ty, mut rest) = rest.split_first()?;
+    let value = match ty {
+        NONE => None,
+        INT | REAL => {
+            let bytes: [u8; 8] = rest.get(..8)?.try_into().ok()?;
+            rest = &rest[8..];
+            Some(match ty {
+                INT => Value::Int(i64::from_be_bytes(bytes)),
+                _ => Value::Real(f64::from_bits(u64::from_be_bytes(bytes))),
+            })
+        }
+        BOOL => {
+            let (&b, tail) = rest.split_first()?;
+            rest = tail;
+            Some(Value::Bool(match b {
+                0 => false,
+                1 => true,
+                _ => return None,
+            }))
+        }
+        WORD => Some(Value::Word(field(&mut rest)?)),
+        TEXT => Some(Value::Text(field(&mut rest)?)),
+        _ => return None,
+    };
+    rest.is_empty().then_some(Datagram {
+        publish,
+        team,
+        robot,
+        key,
+        value,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_type_reads_back() {
+        for value in [
+            None,
+            Some(Value::Int(-42)),
+            Some(Value::Real(2.5)),
+            Some(Value::Bool(true)),
+            Some(Value::Word("LEFT".into())),
+            Some(Value::Text("5,5".into())),
+        ] {
+            let d = Datagram {
+                publish: false,
+                team: "USER".into(),
+                robot: "operator".into(),
+                key: "USER.RC_CMD".into(),
+                value,
+            };
+            assert_eq!(decode(&encode(&d)), Some(d));
+        }
+        assert_eq!(decode(b"SEMO\x01sabc"), None);
+    }
+
+    /// The bytes `semo_core.c` writes for an integer (the C side is held to
+    /// the same bytes by `tests/runtime_c.rs`).
+    #[test]
+    fn an_integer_is_eight_bytes_big_endian() {
+        let d = Datagram {
+            publish: true,
+            team: "T".into(),
+            robot: "r".into(),
+            key: "T.X".into(),
+            value: Some(Value::Int(258)),
+        };
+        assert_eq!(
+            encode(&d),
+            b"SEMO\x02p\x01T\x01r\x03T.X\x01\x00\x00\x00\x00\x00\x00\x01\x02".to_vec()
+        );
+    }
+}

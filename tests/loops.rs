@@ -1,0 +1,151 @@
+//! Services implemented by SDF/L task graphs (`graph=` in the catalog): the
+//! generated service task runs one iteration of the graph's looped schedule
+//! per call, its inner tasks in the schedule's order, D-type loops exactly
+//! `loopCount` times, C-type loops until their exit task sets the exit flag
+//! (in `linux-sim`, in the iteration the scenario's `loops` names). Checked
+//! from the trace of the generated `linux-sim` program and of `semo
+//! simulate`, on `tests/fixtures/loops/` (the thesis's k-means graph and the
+//! two loop examples, copied from `examples/taskgraphs/`), compiled with gcc
+//! and clang at `-Wpedantic -Werror`.
+
+mod support;
+
+use std::path::PathBuf;
+use support::robots::{
+    PEDANTIC, build, compilers, events, field, make, robot_folders, run_in_simulation, scratch,
+};
+use support::{repo_root, semo_in};
+
+fn fixture(name: &str) -> PathBuf {
+    repo_root().join("tests/fixtures/loops").join(name)
+}
+
+/// The graph events of a trace: `graph/task` for a firing, `graph/loop×n`
+/// for a loop's end.
+fn graph_events(events: &[support::robots::Event]) -> Vec<String> {
+    events
+        .iter()
+        .filter_map(|e| match field(e, "event") {
+            "graph_fire" => Some(format!("{}/{}", field(e, "graph"), field(e, "task"))),
+            "graph_loop" => Some(format!(
+                "{}/{}×{}",
+                field(e, "graph"),
+                field(e, "loop"),
+                field(e, "iterations")
+            )),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The looped schedules written out (`semo graph schedule` gives
+/// `ReadPoints InitCenters 500(Select 16(Nearest) ReplaceCenter) Output` and
+/// `A 10(B C) D` for both loop examples), with the scenario's exits:
+/// `kmeans/Converge` after 3 iterations, `convergent_loop/L` after 4 (an
+/// exit for the D-type `data_loop/L` is no exit: it runs all 10).
+fn expected() -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    let mut push = |s: &str| out.push(s.to_string());
+    push("kmeans/ReadPoints");
+    push("kmeans/InitCenters");
+    for _ in 0..3 {
+        push("kmeans/Converge/Select");
+        for _ in 0..16 {
+            push("kmeans/Converge/Assign/Nearest");
+        }
+        push("kmeans/Converge/Assign×16");
+        push("kmeans/Converge/ReplaceCenter");
+    }
+    push("kmeans/Converge×3");
+    push("kmeans/Output");
+    push("data_loop/A");
+    for _ in 0..10 {
+        push("data_loop/L/B");
+        push("data_loop/L/C");
+    }
+    push("data_loop/L×10");
+    push("data_loop/D");
+    push("convergent_loop/A");
+    for _ in 0..4 {
+        push("convergent_loop/L/B");
+        push("convergent_loop/L/C");
+    }
+    push("convergent_loop/L×4");
+    push("convergent_loop/D");
+    out
+}
+
+#[test]
+fn graph_services_run_their_looped_schedule_in_linux_sim_and_the_simulator() {
+    let scenario = std::fs::read_to_string(fixture("loops.scenario.json")).unwrap();
+    let out = scratch("loops/run");
+    let traces = run_in_simulation(&fixture("loops.mission"), &out, &scenario);
+    let c = graph_events(&events(&traces["c"]));
+    assert_eq!(c, expected(), "linux-sim");
+    let simulated = semo_in(
+        &repo_root(),
+        &[
+            "simulate",
+            &fixture("loops.mission").display().to_string(),
+            "--scenario",
+            &fixture("loops.scenario.json").display().to_string(),
+            "--trace",
+            "-",
+        ],
+    );
+    assert_eq!(simulated.code, 0, "{}", simulated.stderr);
+    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
+    assert_eq!(graph_events(&events(&lines)), expected(), "semo simulate");
+}
+
+/// Without an exit in the scenario, a convergent loop runs `loopCount`
+/// iterations (k-means: 500), never more.
+#[test]
+fn a_convergent_loop_without_an_exit_stops_at_its_loop_count() {
+    let out = scratch("loops/no-exit");
+    let traces = run_in_simulation(
+        &fixture("loops.mission"),
+        &out,
+        r#"{"time_scale": 0.2, "duration": 3000}"#,
+    );
+    let c = graph_events(&events(&traces["c"]));
+    let ends: Vec<&String> = c.iter().filter(|e| e.contains('×')).collect();
+    assert!(
+        ends.contains(&&"kmeans/Converge×500".to_string()),
+        "{ends:?}"
+    );
+    assert!(
+        ends.contains(&&"convergent_loop/L×10".to_string()),
+        "{ends:?}"
+    );
+    let nearest = c.iter().filter(|e| e.ends_with("/Nearest")).count();
+    assert_eq!(nearest, 500 * 16);
+}
+
+#[test]
+fn graph_services_compile_pedantically_with_gcc_and_clang() {
+    for target in ["linux", "linux-sim"] {
+        for cc in compilers() {
+            let out = scratch(&format!("loops/compile-{target}-{cc}"));
+            let built = build(&fixture("loops.mission"), target, &out);
+            assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+            for folder in robot_folders(&out) {
+                make(&folder, cc, PEDANTIC).unwrap_or_else(|e| panic!("{target} {cc}: {e}"));
+            }
+        }
+    }
+}
+
+/// Targets with a static schedule cannot run a graph inside a service task
+/// yet: the build says so (E103) instead of generating a stub.
+#[test]
+fn a_graph_service_on_cortex_m_is_refused() {
+    let out = scratch("loops/cortex-m");
+    let built = build(&fixture("loops.mission"), "cortex-m", &out);
+    assert_eq!(built.code, 1, "{}{}", built.stdout, built.stderr);
+    assert!(
+        built.stderr.contains("E103") && built.stderr.contains("runs task graph"),
+        "{}",
+        built.stderr
+    );
+}
