@@ -278,16 +278,9 @@ fn transport_options_are_checked_and_an_unreachable_broker_is_reported() {
     );
 }
 
-/// A scouting deployment in `dir` for a broker on `port`: the master with
-/// its own user, the slaves sharing their team's, the operator; the
-/// broker's password file made with `mosquitto_passwd -b`. `tls`: also the
-/// CA and certificates (`tls_files`).
-fn scouting_deployment(dir: &Path, port: u16, tls: bool) -> PathBuf {
-    let users = [
-        ("irobot", "irobot-secret"),
-        ("slaves", "slaves-secret"),
-        ("operator", "operator-secret"),
-    ];
+/// Each user's password file `USER.pw` in `dir`, and the broker's password
+/// file `passwd` for all of them, made with `mosquitto_passwd -b`.
+fn password_files(dir: &Path, users: &[(&str, &str)]) {
     for (i, (user, password)) in users.iter().enumerate() {
         std::fs::write(dir.join(format!("{user}.pw")), format!("{password}\n")).unwrap();
         let mut command = Command::new("mosquitto_passwd");
@@ -302,6 +295,19 @@ fn scouting_deployment(dir: &Path, port: u16, tls: bool) -> PathBuf {
             .expect("mosquitto_passwd runs");
         assert!(made.status.success(), "{made:?}");
     }
+}
+
+/// A scouting deployment in `dir` for a broker on `port`: the master with
+/// its own user, the slaves sharing their team's, the operator; the
+/// broker's password file made with `mosquitto_passwd -b`. `tls`: also the
+/// CA and certificates (`tls_files`).
+fn scouting_deployment(dir: &Path, port: u16, tls: bool) -> PathBuf {
+    let users = [
+        ("irobot", "irobot-secret"),
+        ("slaves", "slaves-secret"),
+        ("operator", "operator-secret"),
+    ];
+    password_files(dir, &users);
     let (scheme, tls_top, tls_broker, tls_irobot) = if tls {
         (
             "mqtts",
@@ -1164,20 +1170,7 @@ fn patrol_deployment(dir: &Path, port: u16) -> PathBuf {
         ("guards", "guards-secret"),
         ("operator", "operator-secret"),
     ];
-    for (i, (user, password)) in users.iter().enumerate() {
-        std::fs::write(dir.join(format!("{user}.pw")), format!("{password}\n")).unwrap();
-        let mut command = Command::new("mosquitto_passwd");
-        if i == 0 {
-            command.arg("-c");
-        }
-        let made = command
-            .arg("-b")
-            .arg(dir.join("passwd"))
-            .args([user, password])
-            .output()
-            .expect("mosquitto_passwd runs");
-        assert!(made.status.success(), "{made:?}");
-    }
+    password_files(dir, &users);
     let file = dir.join("patrol_groups.deploy.toml");
     std::fs::write(
         &file,
