@@ -5,7 +5,7 @@ use super::c;
 use super::values::Words;
 use super::{CompiledScenario, Platform, Target};
 use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK, getter, setter};
-use crate::refine::{RobotProgram, RoleKind};
+use crate::refine::{RobotProgram, RoleKind, ValueKind};
 use crate::taskgraph::Trigger;
 use std::fmt::Write;
 
@@ -309,15 +309,34 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         out.push_str("/* CommReceive: each message received goes to the control task's port for\n * it (sends) or to its multicast group (publishes). */\n");
         let n = m.incoming.len();
         if n > 0 {
-            out.push_str("static const struct {\n    const char *port;\n    const char *from_team;\n    const char *key;\n    semo_type type; /* as declared: a value of another type is refused */\n} incoming[] = {\n");
+            out.push_str("static const struct {\n    const char *port;\n    const char *from_team;\n    const char *key;\n    semo_type type; /* as declared: a value of another type is refused */\n    const unsigned short *domain; /* an enumeration's words (indices), or NULL */\n    unsigned short domain_len;\n} incoming[] = {\n");
+            let words = Words::of(program);
             for i in &m.incoming {
+                let kind = &m.slots[i.slot].kind;
+                // A word of another enumeration is refused, as the simulator does.
+                let domain = match kind {
+                    // `{0}` with length 0: an empty enumeration refuses every word.
+                    ValueKind::Word(domain) if domain.is_empty() => {
+                        "(const unsigned short[]){0}, 0".into()
+                    }
+                    ValueKind::Word(domain) => format!(
+                        "(const unsigned short[]){{{}}}, {}",
+                        domain
+                            .iter()
+                            .map(|w| words.index(w).to_string())
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                        domain.len()
+                    ),
+                    _ => "NULL, 0".into(),
+                };
                 let _ = writeln!(
                     out,
-                    "    {{{}, {}, {}, {}}},",
+                    "    {{{}, {}, {}, {}, {domain}}},",
                     c::string(&i.port),
                     c::string(&i.from_team),
                     c::string(&i.key),
-                    m.slots[i.slot].kind.c_tag()
+                    kind.c_tag()
                 );
             }
             let _ = writeln!(out, "}};\nstatic int incoming_port[{n}];\n");
@@ -364,7 +383,7 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         if n > 0 {
             let _ = writeln!(
                 out,
-                "    for (int i = 0; i < {n}; i++) {{\n        if (strcmp(incoming[i].from_team, m.from_team) != 0 || strcmp(incoming[i].key, m.key) != 0)\n            continue;\n        semo_value v = m.value;\n        if (semo_value_coerce(&v, incoming[i].type))\n            UFPort_WriteToQueue(incoming_port[i], &v, sizeof v);\n        else\n            semo_trace(\"reject\", \"key\", m.key, \"reason\", \"not a value of its type\", NULL);\n    }}"
+                "    for (int i = 0; i < {n}; i++) {{\n        if (strcmp(incoming[i].from_team, m.from_team) != 0 || strcmp(incoming[i].key, m.key) != 0)\n            continue;\n        semo_value v = m.value;\n        if (semo_value_coerce(&v, incoming[i].type) && semo_value_in(&v, incoming[i].domain, incoming[i].domain_len))\n            UFPort_WriteToQueue(incoming_port[i], &v, sizeof v);\n        else\n            semo_trace(\"reject\", \"key\", m.key, \"reason\", \"not a value of its type\", NULL);\n    }}"
             );
         }
         let _ = writeln!(out, "}}\n\nvoid task_{recv}_wrapup(void)\n{{\n}}");

@@ -31,7 +31,7 @@ impl Words {
         &self.0
     }
 
-    fn index(&self, word: &str) -> usize {
+    pub(super) fn index(&self, word: &str) -> usize {
         // Every word literal was collected by `of`.
         self.0
             .binary_search_by(|w| w.as_str().cmp(word))

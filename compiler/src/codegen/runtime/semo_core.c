@@ -304,6 +304,16 @@ bool semo_value_coerce(semo_value *v, semo_type type)
     return false;
 }
 
+bool semo_value_in(const semo_value *v, const unsigned short *domain, size_t n)
+{
+    if (!domain || v->type != SEMO_WORD)
+        return true;
+    for (size_t k = 0; k < n; k++)
+        if (domain[k] == v->word)
+            return true;
+    return false;
+}
+
 #if REALS
 static bool as_number(const semo_value *v, double *out)
 {

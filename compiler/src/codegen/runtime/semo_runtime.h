@@ -73,6 +73,9 @@ bool semo_value_parse(semo_value *v, semo_type type, const char *text);
  * any type): the same type passes, an integer widens to a real, text is
  * parsed as the type, a word becomes text; false for anything else. */
 bool semo_value_coerce(semo_value *v, semo_type type);
+/* Whether `v` is one of the `n` words of `domain` (indices into the
+ * program's words); true for a value that is not a word or no domain. */
+bool semo_value_in(const semo_value *v, const unsigned short *domain, size_t n);
 /* The text of a word or a text value, else NULL. */
 const char *semo_value_word_text(const semo_value *v);
 /* Writes the value as JSON (a number, true/false, a string; null for none)

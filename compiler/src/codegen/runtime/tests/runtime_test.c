@@ -345,6 +345,11 @@ static void control_go(void)
     semo_value_set(&w, "LEFT");
     CHECK(semo_value_coerce(&w, SEMO_WORD) && w.type == SEMO_WORD && w.word == 0);
     CHECK(semo_value_coerce(&w, SEMO_TEXT) && w.type == SEMO_TEXT && strcmp(w.text, "LEFT") == 0);
+    /* A received word must be one of its key's enumeration (CommReceive). */
+    static const unsigned short only_right[] = {1};
+    CHECK(semo_value_in(SEMO_LIT_WORD(1), only_right, 1));
+    CHECK(!semo_value_in(SEMO_LIT_WORD(0), only_right, 1));
+    CHECK(semo_value_in(SEMO_LIT_WORD(0), NULL, 0) && semo_value_in(SEMO_LIT("LEFT"), only_right, 1));
     CHECK(semo_comm_send("USER", SEMO_MSG_SEND, "Team.TURN", SEMO_LIT_WORD(1)) == 1);
     CHECK(semo_comm_send("USER", SEMO_MSG_SEND, "Team.COUNT", SEMO_LIT_INT(-3)) == 1);
     CHECK(semo_comm_send("Other", SEMO_MSG_SEND, "Team.STATUS", SEMO_LIT("ok")) == -1); /* no transport */
