@@ -545,3 +545,84 @@ fn unknown_targets_are_a_usage_error() {
     assert_eq!(out.code, 2);
     assert!(out.stderr.contains("linux-sim"), "{}", out.stderr);
 }
+
+/// CommReceive reads a received value as its key's declared type: a word
+/// of the key's enumeration is taken, and a word of another enumeration of
+/// the same program, an unknown word or a number are refused with a
+/// `reject` line (as the simulator refuses them).
+#[test]
+fn a_received_word_of_another_enumeration_is_refused() {
+    let out = scratch("enum-receive");
+    let fixture = repo_root().join("tests/fixtures/receive");
+    let built = build(&fixture.join("relay.mission"), "linux-sim", &out);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    let placer = robot_folders(&out)
+        .into_iter()
+        .find(|f| f.ends_with("q"))
+        .expect("the placer is built");
+    make(&placer, "cc", STRICT).unwrap_or_else(|e| panic!("{e}"));
+    let port_base = 21000 + (std::process::id() % 250) * 40;
+    let trace = out.join("q.jsonl");
+    let mut scenario: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(fixture.join("relay.scenario.json")).unwrap(),
+    )
+    .unwrap();
+    // Real time, long enough to hear the datagrams sent once it runs.
+    scenario["time_scale"] = 1.into();
+    scenario["duration"] = 4000.into();
+    let scenario_path = out.join("relay.scenario.json");
+    std::fs::write(&scenario_path, scenario.to_string()).unwrap();
+    let mut child = robot_command(&placer, &scenario_path, &trace, port_base as u32)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the placer starts");
+    // Its port is open once it traces its first mode.
+    while !std::fs::read_to_string(&trace).is_ok_and(|t| t.contains("\"mode\"")) {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the placer ended early"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    let values = [
+        semo::refine::Value::text("ON"),     // LAMP's, not BRICK's
+        semo::refine::Value::text("PURPLE"), // no enumeration's
+        semo::refine::Value::Int(3),         // not a word
+        semo::refine::Value::text("RED"),    // BRICK's: taken
+    ];
+    for value in values {
+        let datagram = semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+            publish: false,
+            team: "Pickers".into(),
+            robot: "p".into(),
+            key: "Pickers.BRICK".into(),
+            value: Some(value),
+        });
+        // The placer owns one of the two robots' ports; the other is closed.
+        for port in [port_base, port_base + 1] {
+            socket
+                .send_to(&datagram, ("127.0.0.1", port as u16))
+                .unwrap();
+        }
+    }
+    let output = child.wait_with_output().unwrap();
+    assert!(output.status.success(), "{output:?}");
+    let events: Vec<Event> = std::fs::read_to_string(&trace)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let rejected = events
+        .iter()
+        .filter(|e| field(e, "event") == "reject" && field(e, "key") == "Pickers.BRICK")
+        .count();
+    assert_eq!(rejected, 3, "{events:#?}");
+    // RED was taken: with the lamp on, the placer moves.
+    assert!(
+        events
+            .iter()
+            .any(|e| field(e, "event") == "call_start" && field(e, "service") == "move"),
+        "{events:#?}"
+    );
+}
