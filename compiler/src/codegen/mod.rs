@@ -29,6 +29,7 @@ mod values;
 
 use crate::refine::{RobotProgram, RoleKind};
 use crate::taskgraph::write::to_xml;
+use target::robot_span;
 
 /// The header a threads target's runtime reads its connection defaults from
 /// (broker, client id, credentials' paths): generated without any, and
@@ -546,19 +547,6 @@ fn written_graph_errors(
             )
         })
         .collect()
-}
-
-/// The range of the declaration of the robot named `robot`.
-fn robot_span(build: &BuildInput<'_>, robot: &str) -> crate::span::Span {
-    build
-        .analysis
-        .mission
-        .teams
-        .iter()
-        .flat_map(|t| &t.robots)
-        .find(|r| r.name == robot)
-        .map(|r| r.name_span)
-        .unwrap_or_default()
 }
 
 /// A mission's refined programs, as code generation and the simulator

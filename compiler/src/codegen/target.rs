@@ -118,8 +118,8 @@ pub fn check(
     found
 }
 
-/// Where the robot is declared.
-fn robot_span(build: &BuildInput<'_>, robot: &str) -> crate::span::Span {
+/// Where the robot is declared (diagnostics about one robot point there).
+pub(super) fn robot_span(build: &BuildInput<'_>, robot: &str) -> crate::span::Span {
     build
         .analysis
         .mission

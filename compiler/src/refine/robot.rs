@@ -7,7 +7,7 @@ use crate::catalog::{Implementation, RobotType};
 use crate::diag::{Code, Diagnostic};
 use crate::sema::{Compared, Symbol, Team, TeamId};
 use crate::span::Span;
-use crate::strategy::{DataCharacteristic, ServiceEntry, TaskUseKind};
+use crate::strategy::{DataCharacteristic, ServiceEntry, Strategy, TaskUseKind};
 use crate::syntax::ast::{self, ExprKind, StmtKind};
 use crate::text::LineIndex;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -158,6 +158,17 @@ struct Builder<'a, 'i> {
     diagnostics: Vec<Diagnostic>,
 }
 
+impl<'i> Builder<'_, 'i> {
+    /// The strategy files written for this robot's team, in file order.
+    fn team_strategies(&self) -> impl Iterator<Item = &'i Strategy> + use<'_, 'i> {
+        let team = self.team.name.as_str();
+        self.input
+            .strategies
+            .iter()
+            .filter(move |s| s.team.as_ref().is_some_and(|t| t.name == team))
+    }
+}
+
 impl Builder<'_, '_> {
     fn line(&self, span: Span) -> u32 {
         let text = self.input.text;
@@ -192,6 +203,16 @@ impl Builder<'_, '_> {
 
     /// A condition the checker should have excluded: refinement refuses
     /// rather than generate a program that differs from the mission.
+    /// The name a strategy file is shown by in generated comments.
+    fn strategy_name(&self, strategy: &Strategy) -> String {
+        self.input
+            .strategy_names
+            .iter()
+            .find(|(f, _)| *f == strategy.file)
+            .map(|(_, n)| n.clone())
+            .unwrap_or_default()
+    }
+
     fn internal_error(&mut self, span: Span, what: &str) {
         let line = self.line(span);
         self.diagnostics.push(Diagnostic::new(
@@ -325,14 +346,7 @@ impl Builder<'_, '_> {
         marks: &mut usize,
     ) {
         let timeout = self
-            .input
-            .strategies
-            .iter()
-            .filter(|s| {
-                s.team
-                    .as_ref()
-                    .is_some_and(|t| t.name == self.team.name.as_str())
-            })
+            .team_strategies()
             .find_map(|s| s.grouping.as_ref()?.sync_timeout);
         let Some(timeout) = timeout else {
             return;
@@ -395,14 +409,7 @@ impl Builder<'_, '_> {
             _ => true,
         };
         let selection = self
-            .input
-            .strategies
-            .iter()
-            .filter(|s| {
-                s.team
-                    .as_ref()
-                    .is_some_and(|t| t.name == self.team.name.as_str())
-            })
+            .team_strategies()
             .filter_map(|s| s.grouping.as_ref()?.leader_selection.as_ref())
             .find(|l| applies(l));
         match selection {
@@ -799,13 +806,7 @@ impl Builder<'_, '_> {
         if let Some(&m) = self.action_machines.get(&key) {
             return Some(m);
         }
-        let source = self
-            .input
-            .strategy_names
-            .iter()
-            .find(|(f, _)| *f == strategy.file)
-            .map(|(_, n)| n.clone())
-            .unwrap_or_default();
+        let source = self.strategy_name(strategy);
         let machine = self.action_machine(entry, service, source, strategy, span);
         self.machine.actions.push(machine);
         let index = self.machine.actions.len() - 1;

@@ -23,12 +23,8 @@ pub(crate) const BATTERY_VALUE: &str = "BATTERY";
 impl Builder<'_, '_> {
     /// The policies of every strategy of the robot's team, in file order.
     pub(super) fn battery_policies(&mut self) -> Vec<BatteryPolicy> {
-        let team = self.team.name.to_string();
         let strategies: Vec<&Strategy> = self
-            .input
-            .strategies
-            .iter()
-            .filter(|s| s.team.as_ref().is_some_and(|t| t.name == team))
+            .team_strategies()
             .filter(|s| !s.battery_rules.is_empty())
             .collect();
         if strategies.is_empty() {
@@ -37,13 +33,7 @@ impl Builder<'_, '_> {
         let battery = self.sensor_slot(BATTERY_VALUE, self.team.name_span);
         let mut policies = Vec::new();
         for strategy in strategies {
-            let source = self
-                .input
-                .strategy_names
-                .iter()
-                .find(|(f, _)| *f == strategy.file)
-                .map(|(_, n)| n.clone())
-                .unwrap_or_default();
+            let source = self.strategy_name(strategy);
             for rule in &strategy.battery_rules {
                 let Some(condition) = &rule.condition else {
                     self.internal_error(
