@@ -81,8 +81,27 @@ pub fn refine(input: &RefineInput<'_>) -> (Vec<RobotProgram>, Vec<Diagnostic>) {
             programs.extend(program);
         }
     }
+    assign_groups(&mut programs);
     diag::sort_and_dedup(&mut diagnostics);
     (programs, diagnostics)
+}
+
+/// Each team's group (`<GroupService>`): the robots whose refined programs
+/// call one of the team's group services, given to each of them.
+fn assign_groups(programs: &mut [RobotProgram]) {
+    let mut groups: std::collections::BTreeMap<String, Vec<usize>> = Default::default();
+    for p in programs.iter() {
+        if !p.control.group_services.is_empty() {
+            groups.entry(p.team.clone()).or_default().push(p.self_peer);
+        }
+    }
+    for p in programs.iter_mut() {
+        if !p.control.group_services.is_empty() {
+            let mut members = groups[&p.team].clone();
+            members.sort_unstable();
+            p.control.group = members;
+        }
+    }
 }
 
 #[cfg(test)]

@@ -23,6 +23,10 @@ newtype_index! {
     pub struct SlotId;
 }
 
+/// The robot's battery level, a catalog value: what a strategy's battery
+/// condition reads (`Battery`), and what the robot's status reports.
+pub const BATTERY_VALUE: &str = "BATTERY";
+
 /// One robot's refined program.
 #[derive(Clone, Debug)]
 pub struct RobotProgram {
@@ -115,6 +119,14 @@ pub struct ControlMachine {
     /// The group statements this robot synchronizes at (`GroupSync`), by
     /// their offset in the mission: what a sync announcement names.
     pub sync_points: Vec<usize>,
+    /// The group services (`<GroupService>`, by the catalog's name) this
+    /// robot calls: non-empty makes it a member of its team's group.
+    pub group_services: Vec<String>,
+    /// The team's group (peer indices, in formation order): the robots whose
+    /// programs call any of the team's group services; empty when this robot
+    /// is not one of them. Each member's rank is its place among the live
+    /// members (this robot, or heard from within three heartbeats).
+    pub group: Vec<usize>,
     /// Adaptive resource management: the team strategy's battery policies,
     /// checked at every firing against the robot's `BATTERY` value.
     pub battery: Vec<BatteryPolicy>,

@@ -256,6 +256,9 @@ struct Robot<'p> {
     sync_arrived: HashMap<(usize, usize), i64>,
     /// The last leader each `LeaderBranch` state saw, by (service, pc).
     leaders: HashMap<(usize, usize), usize>,
+    /// The last (rank, size) in the team's group this robot traced
+    /// (`semo_group_set`); `None` before its first heartbeat.
+    group: Option<(usize, usize)>,
     /// Service tasks by name (the `request_tasks` and those of action commands).
     tasks: Vec<(String, TaskState)>,
     has_receiver: bool,
@@ -396,6 +399,7 @@ impl<'p> Robot<'p> {
             sync_pass: HashMap::new(),
             sync_arrived: HashMap::new(),
             leaders: HashMap::new(),
+            group: None,
             tasks,
             has_receiver: !m.incoming.is_empty() || !m.subscribed.is_empty() || m.heartbeat,
             sensor_series,
@@ -1152,6 +1156,7 @@ impl<'p> Sim<'p> {
                 Some(Value::text(&value)),
             );
             self.comm_send(r, team, true, key, value);
+            self.group_update(r);
         }
         if self.robots[r].current_mode.is_none() {
             match m.default_mode {
@@ -1750,6 +1755,41 @@ fn heartbeat_value(leading: bool, battery: Option<i64>) -> String {
     match battery {
         Some(level) => format!("{role} {level}"),
         None => format!("{role} -"),
+    }
+}
+
+impl Sim<'_> {
+    /// At a heartbeat of a member of its team's group (`group_update` in
+    /// `codegen/control.rs`): its rank among the live members (formation
+    /// order) and their number, traced when they change. A member is alive
+    /// when it is this robot or was heard from within three heartbeats,
+    /// counted from when this robot joined.
+    fn group_update(&mut self, r: usize) {
+        let robot = &self.robots[r];
+        let m = &robot.program.control;
+        if m.group.is_empty() {
+            return;
+        }
+        let me = robot.program.self_peer;
+        let now = self.now;
+        let alive = |peer: usize| {
+            peer == me || now - robot.heard[peer].seen.max(robot.started_at) <= 3 * m.heartbeat_ms
+        };
+        let live: Vec<usize> = m.group.iter().copied().filter(|&p| alive(p)).collect();
+        let rank = live.iter().position(|&p| p == me).unwrap_or(0);
+        let now_group = (rank, live.len());
+        if self.robots[r].group == Some(now_group) {
+            return;
+        }
+        self.robots[r].group = Some(now_group);
+        self.emit(
+            r,
+            "group",
+            vec![
+                ("rank", rank.to_string().into()),
+                ("size", live.len().to_string().into()),
+            ],
+        );
     }
 }
 

@@ -442,3 +442,76 @@ fn group_sync_gives_up_after_the_strategys_timeout() {
     assert_eq!(synced(&run_, "tb_1"), Some((2710, "timeout")));
     assert_eq!(synced(&run_, "tb_2"), Some((5000, "group_sync")));
 }
+
+/// The (t, rank, size) of every `group` event of `robot` (group services).
+fn groups(run: &Run, robot: &str) -> Vec<(i64, String, String)> {
+    let r = run.robots.iter().position(|(_, n)| n == robot).unwrap();
+    run.trace
+        .iter()
+        .filter(|e| e.robot == r && e.event == "group")
+        .map(|e| {
+            let field = |k| e.field(k).unwrap().to_string();
+            (e.t, field("rank"), field("size"))
+        })
+        .collect()
+}
+
+fn ranks(run: &Run, robot: &str) -> Vec<(String, String)> {
+    groups(run, robot)
+        .into_iter()
+        .map(|(_, rank, size)| (rank, size))
+        .collect()
+}
+
+fn pairs(list: &[(&str, &str)]) -> Vec<(String, String)> {
+    list.iter()
+        .map(|(r, s)| (r.to_string(), s.to_string()))
+        .collect()
+}
+
+#[test]
+fn group_service_members_learn_rank_and_size() {
+    let programs = programs("tests/fixtures/group_service/sweep.mission");
+    assert!(programs.iter().all(|p| p.control.group == [0, 1, 2]));
+    let (run_, _) = run(&programs, r#"{"duration": 1000}"#, 0);
+    for (i, robot) in ["tb_0", "tb_1", "tb_2"].into_iter().enumerate() {
+        let rank = i.to_string();
+        assert_eq!(ranks(&run_, robot), pairs(&[(&rank, "3")]), "{robot}");
+    }
+}
+
+#[test]
+fn group_service_redivides_when_a_member_fails_and_returns() {
+    let programs = programs("tests/fixtures/group_service/sweep.mission");
+    let (run_, _) = run(
+        &programs,
+        r#"{"duration": 3000, "faults": [{"at": 500, "kill": "tb_1"}, {"at": 1500, "restart": "tb_1"}]}"#,
+        0,
+    );
+    // tb_1 fails: tb_2 moves up to rank 1 of 2; it returns: back to 2 of 3.
+    assert_eq!(
+        ranks(&run_, "tb_0"),
+        pairs(&[("0", "3"), ("0", "2"), ("0", "3")])
+    );
+    assert_eq!(
+        ranks(&run_, "tb_2"),
+        pairs(&[("2", "3"), ("1", "2"), ("2", "3")])
+    );
+    // tb_1's two lives: each starts with the whole group.
+    assert_eq!(ranks(&run_, "tb_1"), pairs(&[("1", "3"), ("1", "3")]));
+    // The failure is noticed after three silent heartbeats (200 ms each;
+    // the last one heard at 400), at the next heartbeat; the return at the
+    // first heartbeat after the restarted robot's first.
+    let (failed, _, _) = groups(&run_, "tb_2")[1].clone();
+    assert!((1000..=1400).contains(&failed), "{failed}");
+    let (returned, _, _) = groups(&run_, "tb_2")[2].clone();
+    assert!((1500..=1800).contains(&returned), "{returned}");
+}
+
+#[test]
+fn a_robot_in_no_group_traces_no_group() {
+    let programs = programs("tests/fixtures/group_sync/sync.mission");
+    assert!(programs.iter().all(|p| p.control.group.is_empty()));
+    let (run_, _) = run(&programs, r#"{"duration": 1000}"#, 0);
+    assert!(run_.trace.iter().all(|e| e.event != "group"));
+}

@@ -17,8 +17,7 @@ use crate::sema::Compared;
 use crate::strategy::{Strategy, TaskUseKind};
 use crate::syntax::ast::ExprKind;
 
-/// The mission value a battery condition reads (`Battery` in the strategy).
-pub(crate) const BATTERY_VALUE: &str = "BATTERY";
+use crate::refine::program::BATTERY_VALUE;
 
 impl Builder<'_, '_> {
     /// The policies of every strategy of the robot's team, in file order.
