@@ -80,6 +80,7 @@ pub fn refine(input: &RefineInput<'_>) -> (Vec<RobotProgram>, Vec<Diagnostic>) {
             diagnostics.extend(found);
             programs.extend(program);
         }
+        robot::shared::owners_of_team(&mut programs, &team.name);
     }
     diag::sort_and_dedup(&mut diagnostics);
     (programs, diagnostics)
