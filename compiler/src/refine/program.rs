@@ -439,6 +439,37 @@ pub struct SharedLibrary {
     pub name: String,
     /// Slot keys it holds a getter and a setter for.
     pub attributes: Vec<String>,
+    /// Who holds the globally shared attributes (`docs/shared-information.md`);
+    /// `None` when every attribute is a local copy (the team has one robot,
+    /// or the library holds only other teams' values and multicast values).
+    pub ownership: Option<Ownership>,
+}
+
+/// The globally shared attributes of a team's library and the robots that
+/// own them in turn: the first live robot of `owners` holds them, the others
+/// set them through messages to it and read what it last told them.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Ownership {
+    /// The globally shared attributes.
+    pub global: Vec<GlobalValue>,
+    /// Peer indices (into `RobotProgram::peers`) of the team's robots in the
+    /// order ownership passes when an owner is lost; the first is the owner
+    /// at start.
+    pub owners: Vec<usize>,
+}
+
+/// One globally shared attribute of a library.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GlobalValue {
+    /// Its index in [`SharedLibrary::attributes`].
+    pub at: usize,
+    /// The type of its values (its shared slot's): a value of another type
+    /// received is refused.
+    pub kind: ValueKind,
+    /// The key of a write sent to the owner (`Team.__set.X`).
+    pub set_key: String,
+    /// The key of the owner's value told to the team (`Team.__value.X`).
+    pub value_key: String,
 }
 
 /// A non-control task of the robot and its job.

@@ -14,6 +14,7 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 mod battery;
 mod loops;
+pub(super) mod shared;
 
 #[cfg(test)]
 pub(super) use loops::steps_of;
@@ -66,16 +67,7 @@ pub(super) fn refine_robot(
     } = builder;
     separate_sensor_tasks(&mut machine, &mut sensors, &services);
     link_own_publications(&mut machine);
-    let shared: Vec<String> = machine
-        .slots
-        .iter()
-        .filter(|s| s.source == SlotSource::Shared)
-        .map(|s| s.key.clone())
-        .collect();
-    let library = (!shared.is_empty()).then(|| SharedLibrary {
-        name: format!("{}Shared", team.name),
-        attributes: shared,
-    });
+    let library = shared::library(team, self_peer - robot_index, &mut machine);
     let mut tasks: Vec<TaskRole> = sensors
         .into_iter()
         .map(|(task, values)| TaskRole {

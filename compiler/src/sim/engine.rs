@@ -44,6 +44,7 @@ use std::rc::Rc;
 
 mod battery;
 mod loops;
+mod shared;
 
 /// The sensor tasks' period (refinement's `SENSOR_PERIOD_MS`).
 const SENSOR_PERIOD_MS: i64 = 100;
@@ -234,6 +235,9 @@ struct Robot<'p> {
     library: Vec<Held>,
     /// Per slot: its value's place in `library` (shared slots only).
     library_index: Vec<Option<usize>>,
+    /// The owner of the library's globally shared values now (a peer index;
+    /// `shared.rs`).
+    owner: usize,
     /// Per incoming message: the channel to the control task (capacity).
     inbox: Vec<(VecDeque<Held>, usize)>,
     /// Per subscribed group: the latest value.
@@ -371,6 +375,11 @@ impl<'p> Robot<'p> {
                         .flatten()
                 })
                 .collect(),
+            owner: program
+                .library
+                .as_ref()
+                .and_then(|l| l.ownership.as_ref())
+                .map_or(program.self_peer, |o| o.owners[0]),
             inbox,
             groups: vec![None; m.subscribed.len()],
             regions: vec![
@@ -736,10 +745,14 @@ impl<'p> Sim<'p> {
     fn store(&mut self, r: usize, slot: SlotId, value: Held) {
         let robot = &mut self.robots[r];
         robot.progressed = true;
-        if let Some(k) = robot.library_index[slot.index()] {
+        let library = robot.library_index[slot.index()];
+        if let Some(k) = library {
             robot.library[k].clone_from(&value);
         }
-        robot.slots[slot.index()] = value;
+        robot.slots[slot.index()].clone_from(&value);
+        if let Some(k) = library {
+            self.shared_set(r, k, &value);
+        }
     }
 
     /// Reads the latest sensor samples (the scenario's latest value at the
@@ -747,6 +760,8 @@ impl<'p> Sim<'p> {
     /// slots (`read_inputs`); a slot is written only when its value changed.
     fn read_inputs(&mut self, r: usize) {
         let now = self.now;
+        // The getters of globally shared values ask who owns them first.
+        self.current_owner(r);
         let robot = &mut self.robots[r];
         let program = robot.program;
         robot.resources.advance(now);
@@ -899,6 +914,9 @@ impl<'p> Sim<'p> {
             value: Some(("value", message.value.0.clone())),
             sent_at: Some(message.sent_at),
         });
+        if self.shared_heard(r, message) {
+            return;
+        }
         let robot = &mut self.robots[r];
         let m = &robot.program.control;
         if m.heartbeat && message.publish && message.key == self.names[r].alive_key {
@@ -1269,6 +1287,9 @@ impl<'p> Sim<'p> {
         let mut at_least = |t: i64| at = Some(at.map_or(t, |a| a.min(t)));
         if m.heartbeat {
             at_least(robot.last_heartbeat + m.heartbeat_ms);
+        }
+        if let Some(t) = self.owner_lost_at(r) {
+            at_least(t);
         }
         for region in &robot.regions {
             let Some(service) = region.service.filter(|_| !region.done) else {
