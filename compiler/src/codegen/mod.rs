@@ -22,6 +22,7 @@ mod control;
 pub use control::listen_ms;
 pub(crate) mod files;
 mod loops;
+pub use loops::GRAPH_TEXT_MAX;
 pub mod output;
 mod schedule;
 mod target;
