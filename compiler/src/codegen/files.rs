@@ -310,7 +310,7 @@ pub fn comm_task_c(program: &RobotProgram, words: &Words, target: Target, header
         if n > 0 {
             out.push_str("static const struct {\n    const char *port;\n    const char *from_team;\n    const char *key;\n    semo_type type; /* as declared: a value of another type is refused */\n    const unsigned short *domain; /* an enumeration's words (indices), or NULL */\n    unsigned short domain_len;\n} incoming[] = {\n");
             for i in &m.incoming {
-                let kind = &m.slots[i.slot].kind;
+                let kind = &m.slots[i.slot.index()].kind;
                 // A word of another enumeration is refused, as the simulator does.
                 let domain = match kind {
                     // `{0}` with length 0: an empty enumeration refuses every word.

@@ -7,8 +7,21 @@
 //! entry's action machine (bottom).
 
 use super::value::{Value, ValueKind};
+use crate::index::newtype_index;
 use crate::span::Span;
 use crate::taskgraph::TaskGraph;
+
+newtype_index! {
+    /// A state of its service machine: an index into [`ServiceMachine::states`]
+    /// (the generated C's `pc`).
+    pub struct StateId;
+}
+
+newtype_index! {
+    /// A value of the control machine: an index into [`ControlMachine::slots`]
+    /// (the generated C's `slot[]`).
+    pub struct SlotId;
+}
 
 /// One robot's refined program.
 #[derive(Clone, Debug)]
@@ -313,7 +326,7 @@ pub enum StateKind {
     /// Read the latest published value of a group into its slot.
     Subscribe {
         group: usize,
-        slot: usize,
+        slot: SlotId,
     },
     Throw {
         event: String,
@@ -341,7 +354,7 @@ pub enum StateKind {
     LeaderBranch {
         candidates: Vec<usize>,
         algorithm: LeaderAlgorithm,
-        others_at: usize,
+        others_at: StateId,
     },
     /// The start of a group statement when the team's strategy has
     /// `<GroupSync timeout>`: tell the team this robot has arrived (its
@@ -360,23 +373,23 @@ pub enum StateKind {
     /// Continue at `else_to` unless the condition holds.
     Branch {
         condition: Expr,
-        else_to: usize,
+        else_to: StateId,
     },
     Jump {
-        to: usize,
+        to: StateId,
     },
     /// Head of `loop(period?, condition?)`: leave to `exit_to` when the
     /// condition fails; mark the iteration's start.
     LoopHead {
         condition: Option<Expr>,
-        exit_to: usize,
+        exit_to: StateId,
         mark: usize,
     },
     /// End of a loop body: wait for the period (from the mark), then `to`.
     LoopTail {
         period_ms: Option<i64>,
         mark: usize,
-        to: usize,
+        to: StateId,
     },
     /// After the body: `repeat(period?, condition?)`; `forever` for `repeat()`;
     /// neither means the service runs once.
@@ -394,7 +407,7 @@ pub struct SendItem {
     pub message: usize,
     pub value: Operand,
     /// `send(T, T.X = v)`: the shared slot `v` is stored in first.
-    pub store: Option<usize>,
+    pub store: Option<SlotId>,
     /// A publication of a value this robot also subscribes to: the index into
     /// [`ControlMachine::subscribed`] of the group it is written to at once,
     /// since the latest value team T published includes the robot's own.
@@ -410,7 +423,7 @@ pub struct ActionMachine {
     pub actions: Vec<ActionState>,
     pub initial: usize,
     /// Slots of the `variable` parameters set from the call's arguments, in order.
-    pub arguments: Vec<usize>,
+    pub arguments: Vec<SlotId>,
 }
 
 #[derive(Clone, Debug)]
@@ -459,7 +472,7 @@ pub struct OutgoingMessage {
 pub struct IncomingMessage {
     pub from_team: String,
     pub key: String,
-    pub slot: usize,
+    pub slot: SlotId,
     pub port: String,
 }
 
@@ -514,7 +527,7 @@ pub enum Expr {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Operand {
-    Slot(usize),
+    Slot(SlotId),
     /// A literal, typed as written: a whole number an integer, another number
     /// a real, a string text, `true`/`false` a truth value, a symbolic
     /// constant a word.

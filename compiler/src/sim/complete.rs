@@ -237,7 +237,7 @@ impl Names<'_> {
                 Operand::Slot(i) => p
                     .control
                     .slots
-                    .get(*i)
+                    .get(i.index())
                     .is_some_and(|s| wanted(&s.source, &s.key)),
                 Operand::Literal(_) => false,
             };

@@ -31,7 +31,7 @@ use super::trace::TraceEvent;
 use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
 use crate::refine::{
-    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, RoleKind,
+    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, RoleKind, SlotId,
     SlotSource, StateKind,
 };
 use crate::sema::Compared;
@@ -687,7 +687,7 @@ impl<'p> Sim<'p> {
     /// An operand's value without copying it (conditions are read every firing).
     fn value_ref<'a>(&'a self, r: usize, op: &'a Operand) -> Option<&'a Value> {
         match op {
-            Operand::Slot(s) => self.robots[r].slots[*s].as_ref(),
+            Operand::Slot(s) => self.robots[r].slots[s.index()].as_ref(),
             Operand::Literal(v) => Some(v),
         }
     }
@@ -732,13 +732,13 @@ impl<'p> Sim<'p> {
     }
 
     /// `store`: the slot, and the library for shared information.
-    fn store(&mut self, r: usize, slot: usize, value: Held) {
+    fn store(&mut self, r: usize, slot: SlotId, value: Held) {
         let robot = &mut self.robots[r];
         robot.progressed = true;
-        if let Some(k) = robot.library_index[slot] {
+        if let Some(k) = robot.library_index[slot.index()] {
             robot.library[k].clone_from(&value);
         }
-        robot.slots[slot] = value;
+        robot.slots[slot.index()] = value;
     }
 
     /// Reads the latest sensor samples (the scenario's latest value at the
@@ -952,7 +952,7 @@ impl<'p> Sim<'p> {
         let mut rejected = false;
         for (i, incoming) in m.incoming.iter().enumerate() {
             if *incoming.from_team == *message.from_team && *incoming.key == *message.key {
-                let kind = &m.slots[incoming.slot].kind;
+                let kind = &m.slots[incoming.slot.index()].kind;
                 let Some(value) = (match &message.value.0 {
                     Some(v) => kind.coerce(v).map(Some),
                     None => Some(None),
@@ -1388,7 +1388,7 @@ impl<'p> Sim<'p> {
                     let sent = match item.store {
                         Some(s) => {
                             self.store(r, s, value);
-                            self.robots[r].slots[s].clone()
+                            self.robots[r].slots[s.index()].clone()
                         }
                         None => value,
                     };
@@ -1495,7 +1495,7 @@ impl<'p> Sim<'p> {
             } => match self.elected(r, (service, pc), candidates, *algorithm) {
                 None => Step::Wait, // still listening
                 Some(elected) => {
-                    self.region(r, i).pc = if elected { next } else { *others_at };
+                    self.region(r, i).pc = if elected { next } else { others_at.index() };
                     Step::Next
                 }
             },
@@ -1548,11 +1548,11 @@ impl<'p> Sim<'p> {
             }
             StateKind::Branch { condition, else_to } => {
                 let holds = self.eval(r, condition);
-                self.region(r, i).pc = if holds { next } else { *else_to };
+                self.region(r, i).pc = if holds { next } else { else_to.index() };
                 Step::Next
             }
             StateKind::Jump { to } => {
-                self.region(r, i).pc = *to;
+                self.region(r, i).pc = to.index();
                 Step::Next
             }
             StateKind::LoopHead {
@@ -1563,7 +1563,7 @@ impl<'p> Sim<'p> {
                 if let Some(cond) = condition
                     && !self.eval(r, cond)
                 {
-                    self.region(r, i).pc = *exit_to;
+                    self.region(r, i).pc = exit_to.index();
                     return Step::Next;
                 }
                 let region = self.region(r, i);
@@ -1580,11 +1580,11 @@ impl<'p> Sim<'p> {
                     if now - self.robots[r].regions[i].marks[*mark] < *p {
                         return Step::Wait;
                     }
-                    self.region(r, i).pc = *to;
+                    self.region(r, i).pc = to.index();
                     Step::Next
                 }
                 None => {
-                    self.region(r, i).pc = *to;
+                    self.region(r, i).pc = to.index();
                     Step::Wait
                 }
             },
