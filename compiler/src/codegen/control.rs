@@ -63,7 +63,7 @@ fn group_update(m: &ControlMachine) -> String {
 /// simulation), else unknown (-1).
 const OWN_BATTERY_C: &str = "/* Whether the last election this robot decided named it (its heartbeats say so). */\nstatic bool leading;\n\n/* This robot's battery level for its heartbeats: the scenario's in\n * simulation, else unknown (-1). */\nstatic long own_battery(void)\n{\n#ifdef SEMO_SIM\n    long long level;\n    if (semo_sim_battery(&level))\n        return (long)level;\n#endif\n    return -1;\n}\n\n";
 
-pub fn control_task(program: &RobotProgram, header: &str) -> String {
+pub fn control_task(program: &RobotProgram, words: &Words, header: &str) -> String {
     let m = &program.control;
     let mut out = String::new();
     out.push_str(header);
@@ -81,7 +81,6 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
     out.push_str("enum { STEP_NEXT, STEP_WAIT, STEP_DONE };\n\n");
 
     // Values.
-    let words = Words::of(program);
     let _ = writeln!(out, "/* Values the machine reads and writes. */");
     // A robot that reads no values has no slots (an unused array fails -Werror).
     if !m.slots.is_empty() {
@@ -146,7 +145,7 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
     // are written (unused static functions and arrays fail -Werror).
     let mut body = String::new();
     for (i, machine) in m.actions.iter().enumerate() {
-        emit_action_machine(&mut body, program, &words, i, machine);
+        emit_action_machine(&mut body, program, words, i, machine);
     }
     for (i, service) in m.services.iter().enumerate() {
         let _ = writeln!(
@@ -159,11 +158,11 @@ pub fn control_task(program: &RobotProgram, header: &str) -> String {
             service.line
         );
         for (pc, state) in service.states.iter().enumerate() {
-            emit_state(&mut body, program, &words, pc, state);
+            emit_state(&mut body, program, words, pc, state);
         }
         body.push_str("    default:\n        return STEP_DONE;\n    }\n}\n\n");
     }
-    body.push_str(&super::battery::resource_manager(program));
+    body.push_str(&super::battery::resource_manager(program, words));
     emit_dispatch(&mut body, program);
     emit_modes(&mut body, program);
     emit_task(&mut body, program);

@@ -129,7 +129,7 @@ pub fn channels_c(program: &RobotProgram, target: Target, header: &str) -> Strin
     out
 }
 
-pub fn main_c(program: &RobotProgram, target: Target, header: &str) -> String {
+pub fn main_c(program: &RobotProgram, words: &Words, target: Target, header: &str) -> String {
     let mut out = String::from(header);
     out.push_str(match target.platform() {
         Platform::Threads => "#include \"program.h\"\n\n/* Tasks: one thread each. */\nstatic const semo_task_desc tasks[] = {\n",
@@ -175,7 +175,6 @@ pub fn main_c(program: &RobotProgram, target: Target, header: &str) -> String {
             }
         }
     }
-    let words = Words::of(program);
     if !words.list().is_empty() {
         out.push_str("/* The words of the program: a word value is an index into it. */\nstatic const char *const words[] = {\n");
         for w in words.list() {
@@ -232,7 +231,7 @@ pub(super) fn lock(target: Target, name: &str) -> (&'static str, String, String,
     }
 }
 
-pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> String {
+pub fn comm_task_c(program: &RobotProgram, words: &Words, target: Target, header: &str) -> String {
     let m = &program.control;
     let mut out = String::from(header);
     let (include, declare, lock_seen, unlock_seen) = lock(target, "seen_lock");
@@ -295,7 +294,6 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         let n = m.incoming.len();
         if n > 0 {
             out.push_str("static const struct {\n    const char *port;\n    const char *from_team;\n    const char *key;\n    semo_type type; /* as declared: a value of another type is refused */\n    const unsigned short *domain; /* an enumeration's words (indices), or NULL */\n    unsigned short domain_len;\n} incoming[] = {\n");
-            let words = Words::of(program);
             for i in &m.incoming {
                 let kind = &m.slots[i.slot.index()].kind;
                 // A word of another enumeration is refused, as the simulator does.

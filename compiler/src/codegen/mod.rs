@@ -22,6 +22,7 @@ mod control;
 pub use control::listen_ms;
 pub(crate) mod files;
 mod loops;
+pub use loops::GRAPH_TEXT_MAX;
 pub mod output;
 mod schedule;
 mod shared;
@@ -261,15 +262,19 @@ pub enum Emit {
 
 /// The files of one robot's folder. `sources` names the input files for the
 /// header of every generated file; `scenario` is the world compiled into a
-/// target that [`Target::needs_scenario`] (ignored by the others).
+/// target that [`Target::needs_scenario`] (ignored by the others). With them,
+/// the words its code asked the word table for and it lacked (each refuses
+/// the build: `missing_word_errors`).
 pub fn generate(
     program: &RobotProgram,
     target: Target,
     emit: Emit,
     sources: &[String],
     scenario: Option<&CompiledScenario>,
-) -> RobotOutput {
+) -> (RobotOutput, Vec<String>) {
     let header = header(program, target, sources);
+    // One word table for every file: the words it lacked refuse the build.
+    let words = values::Words::of(program);
     let mut files = Vec::new();
     let mut push = |path: &str, text: String, owner: Owner| {
         files.push(GeneratedFile {
@@ -291,11 +296,12 @@ pub fn generate(
         Owner::Generated,
     );
     if emit == Emit::TaskGraph {
-        return RobotOutput {
+        let output = RobotOutput {
             team: program.team.clone(),
             robot: program.robot.clone(),
             files,
         };
+        return (output, Vec::new());
     }
     let mut sources_c = vec![
         "main.c".to_string(),
@@ -309,7 +315,7 @@ pub fn generate(
     );
     push(
         "main.c",
-        files::main_c(program, target, &header),
+        files::main_c(program, &words, target, &header),
         Owner::Generated,
     );
     push(
@@ -319,7 +325,7 @@ pub fn generate(
     );
     push(
         "control_task.c",
-        control::control_task(program, &header),
+        control::control_task(program, &words, &header),
         Owner::Generated,
     );
     let comm = program
@@ -329,7 +335,7 @@ pub fn generate(
     if comm {
         push(
             "comm_task.c",
-            files::comm_task_c(program, target, &header),
+            files::comm_task_c(program, &words, target, &header),
             Owner::Generated,
         );
         sources_c.push("comm_task.c".into());
@@ -379,11 +385,12 @@ pub fn generate(
         text: makefile,
         owner: Owner::Generated,
     });
-    RobotOutput {
+    let output = RobotOutput {
         team: program.team.clone(),
         robot: program.robot.clone(),
         files,
-    }
+    };
+    (output, words.missing())
 }
 
 /// Bytes of the longest value the program holds that is known at build
@@ -495,11 +502,12 @@ pub fn build_refined(
             diagnostics,
         };
     }
-    let robots: Vec<RobotOutput> = programs
-        .iter()
-        .enumerate()
-        .map(|(i, p)| generate(p, target, emit, &sources, scenarios.get(i)))
-        .collect();
+    let mut robots: Vec<RobotOutput> = Vec::new();
+    for (i, program) in programs.iter().enumerate() {
+        let (robot, missing) = generate(program, target, emit, &sources, scenarios.get(i));
+        diagnostics.extend(missing_word_errors(build, program, &missing));
+        robots.push(robot);
+    }
     diagnostics.extend(
         programs
             .iter()
@@ -516,6 +524,32 @@ pub fn build_refined(
         robots,
         diagnostics,
     }
+}
+
+/// The words generation asked the program's word table for and it lacked
+/// (`values::Words::index`): each an internal error (E102), never written
+/// as another word.
+fn missing_word_errors(
+    build: &BuildInput<'_>,
+    program: &crate::refine::RobotProgram,
+    missing: &[String],
+) -> Vec<crate::diag::Diagnostic> {
+    use crate::diag::{Code, Diagnostic};
+    let span = robot_span(build, &program.robot);
+    missing
+        .iter()
+        .map(|word| {
+            Diagnostic::new(
+                Code::CodegenInternal,
+                build.mission,
+                span,
+                format!(
+                    "the code generated for robot `{}` uses the word `{word}`, which its word table lacks",
+                    program.robot
+                ),
+            )
+        })
+        .collect()
 }
 
 /// Each robot's `taskgraph.xml` read back by the task-graph loader, as a user

@@ -66,6 +66,59 @@ pub struct GraphService {
     /// inconsistent or deadlocks, which the dataflow warnings report on the
     /// call; code generation refuses it, E100).
     pub steps: Result<Vec<GraphStep>, String>,
+    /// Every channel of every level (empty without steps), the index a
+    /// [`PortUse`] or [`LoopPort`] names.
+    pub channels: Vec<GraphChannel>,
+    /// The inner tasks fired (loop nodes are steps), in first-firing order.
+    pub tasks: Vec<InnerTask>,
+}
+
+/// A channel between inner tasks: a bounded FIFO of tokens. `capacity` is
+/// the analysis's buffer bound (`taskgraph::analysis::buffers`) for the
+/// order in which the service task runs its level: a loop body's boundary
+/// feeds the inputs first and takes the outputs last.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GraphChannel {
+    /// `Converge: ReplaceCenter.fb → Select.prev` (the level below the graph).
+    pub label: String,
+    pub capacity: u64,
+    /// Tokens held before the first iteration (each the integer 0).
+    pub initial_tokens: u64,
+}
+
+/// An inner task: the channels its data ports read and write, in the
+/// order its ports are declared (a port no channel joins is left out).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct InnerTask {
+    /// Its path below the graph, as in [`GraphStep::Fire`].
+    pub path: String,
+    pub inputs: Vec<PortUse>,
+    pub outputs: Vec<PortUse>,
+}
+
+/// A data port of an inner task: `rate` tokens per firing on `channel`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PortUse {
+    pub port: String,
+    pub channel: usize,
+    pub rate: u64,
+}
+
+/// A data port of an SDF/L loop node: an input takes `outer_rate` tokens
+/// from `outer` when the loop starts and gives each iteration `inner_rate`
+/// of them on `inner` (distributing: the iteration's share, in order;
+/// broadcasting: the same first ones); an output takes `inner_rate` from
+/// `inner` after each iteration and, when the loop ends, puts the last
+/// `outer_rate` taken on `outer`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LoopPort {
+    pub port: String,
+    pub input: bool,
+    pub distributing: bool,
+    pub outer_rate: u64,
+    pub inner_rate: u64,
+    pub outer: usize,
+    pub inner: usize,
 }
 
 /// A term of a service graph's looped schedule, loop nodes opened.
@@ -84,6 +137,8 @@ pub enum GraphStep {
         convergent: bool,
         loop_count: u64,
         exit_task: Option<String>,
+        /// Its data ports, in declaration order.
+        ports: Vec<LoopPort>,
         body: Vec<GraphStep>,
     },
 }

@@ -283,6 +283,8 @@ struct Robot<'p> {
     progressed: bool,
     /// The battery policies' state: levels and levelled sensors' samples.
     resources: battery::Resources,
+    /// The channels of the service graphs run so far (`loops.rs`).
+    graph_channels: loops::GraphChannels,
 }
 
 pub struct Sim<'p> {
@@ -421,6 +423,7 @@ impl<'p> Robot<'p> {
             fire_token: 0,
             progressed: false,
             resources: battery::Resources::new(program, at),
+            graph_channels: loops::GraphChannels::default(),
         }
     }
 
