@@ -5,7 +5,7 @@ use super::program::*;
 use super::value::{Value, ValueKind};
 use crate::catalog::{Implementation, RobotType};
 use crate::diag::{Code, Diagnostic};
-use crate::sema::{Compared, Symbol, Team, TeamId};
+use crate::sema::{Compared, ServiceId, Symbol, Team, TeamId};
 use crate::span::Span;
 use crate::strategy::{DataCharacteristic, ServiceEntry, Strategy, TaskUseKind};
 use crate::syntax::ast::{self, ExprKind, StmtKind};
@@ -148,13 +148,13 @@ struct Builder<'a, 'i> {
     sensors: BTreeMap<String, BTreeSet<String>>,
     /// Service task → the services or actuator commands it runs.
     services: BTreeMap<String, BTreeSet<String>>,
-    /// Team service index → machine index.
-    service_machines: HashMap<u32, usize>,
+    /// Team service → machine index.
+    service_machines: HashMap<ServiceId, usize>,
     /// (strategy file, entry index) → action machine index.
     action_machines: HashMap<(u32, usize), usize>,
     /// The team service whose machine is being built (for the strategy's
     /// leader selection scoped to a composite service).
-    current_service: Option<u32>,
+    current_service: Option<ServiceId>,
     diagnostics: Vec<Diagnostic>,
 }
 
@@ -245,7 +245,7 @@ impl Builder<'_, '_> {
                 };
                 let machine = self.service_machine(service);
                 regions.push(Region {
-                    plan: team.plans[plan as usize].name.to_string(),
+                    plan: team.plans[plan.index()].name.to_string(),
                     service: machine,
                     timeout_ms: set.timeout_ms.map(|t| t.round() as i64),
                 });
@@ -258,28 +258,28 @@ impl Builder<'_, '_> {
             });
         }
         if let Some(main) = &team.main {
-            self.machine.default_mode = main.default.map(|d| d as usize);
+            self.machine.default_mode = main.default.map(|d| d.index());
             for t in &main.transitions {
                 let line = self.line(t.span);
                 self.machine.transitions.push(ModeTransition {
-                    from: t.from as usize,
+                    from: t.from.index(),
                     event: t.event.to_string(),
-                    to: t.to as usize,
+                    to: t.to.index(),
                     line,
                 });
             }
         }
     }
 
-    fn service_machine(&mut self, service: u32) -> usize {
+    fn service_machine(&mut self, service: ServiceId) -> usize {
         if let Some(&m) = self.service_machines.get(&service) {
             return m;
         }
-        let info = &self.team.services[service as usize];
+        let info = &self.team.services[service.index()];
         let index = self.machine.services.len();
         self.service_machines.insert(service, index);
         self.machine.services.push(ServiceMachine {
-            plan: self.team.plans[info.plan as usize].name.to_string(),
+            plan: self.team.plans[info.plan.index()].name.to_string(),
             name: info.name.to_string(),
             line: self.line(info.name_span),
             states: Vec::new(),
@@ -397,13 +397,11 @@ impl Builder<'_, '_> {
     /// service or names this one; its algorithm (default lowest id) and its
     /// heartbeat period (mission ms, if given).
     fn leader_selection(&self) -> (LeaderAlgorithm, Option<i64>) {
-        let service = self
-            .current_service
-            .map(|s| &self.team.services[s as usize]);
+        let service = self.current_service.map(|s| &self.team.services[s.index()]);
         let applies = |l: &crate::strategy::LeaderSelection| match (&l.plan, &l.service, service) {
             (Some(plan), Some(cs), Some(s)) => {
                 cs.name == s.name.as_str()
-                    && plan.name == self.team.plans[s.plan as usize].name.as_str()
+                    && plan.name == self.team.plans[s.plan.index()].name.as_str()
             }
             (Some(_), Some(_), None) => false,
             _ => true,
@@ -616,7 +614,7 @@ impl Builder<'_, '_> {
                 .runs
                 .iter()
                 .filter(|r| r.team == Some(self.team_id))
-                .flat_map(|r| r.robots.iter().map(|&i| i as usize))
+                .flat_map(|r| r.robots.iter().map(|&i| i.index()))
                 .collect(),
         )
     }

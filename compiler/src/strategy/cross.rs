@@ -27,7 +27,7 @@
 use super::model::*;
 use crate::catalog::{Catalog, Implementation, RobotType, RobotTypeId};
 use crate::diag::{self, Code, Diagnostic, FileId, Related};
-use crate::sema::{Analysis, FunctionId, Index, Mission, Symbol, Team, TeamId};
+use crate::sema::{Analysis, FunctionId, Mission, PlanId, ServiceId, Symbol, Team, TeamId};
 use crate::span::Span;
 use crate::suggest::did_you_mean;
 use crate::syntax::ast::{self, ArmKind, StmtKind};
@@ -55,7 +55,7 @@ pub struct CallLink {
     pub team: TeamId,
     /// The composite service (of `team`) that runs the call, directly or
     /// through the functions it calls.
-    pub service: Index,
+    pub service: ServiceId,
     pub entry: ServiceEntryRef,
 }
 
@@ -198,9 +198,9 @@ pub struct BuiltinCall {
     pub name: ast::Name,
     /// The called name's range in the mission.
     pub span: Span,
-    pub plan: Index,
+    pub plan: PlanId,
     /// The composite service that runs it (directly or through functions).
-    pub service: Index,
+    pub service: ServiceId,
 }
 
 /// The built-in calls that `team`'s composite services run, service by
@@ -217,7 +217,7 @@ pub fn team_calls(analysis: &Analysis, team: TeamId) -> Vec<BuiltinCall> {
             name,
             span,
             plan: service.plan,
-            service: index as Index,
+            service: ServiceId::new(index),
         }));
     }
     calls
@@ -229,7 +229,7 @@ struct MissionSummary<'a> {
     /// Per team: the built-in calls its composite services run.
     calls: Vec<Vec<BuiltinCall>>,
     /// Per team: its composite services that elect a leader.
-    electing: Vec<HashSet<Index>>,
+    electing: Vec<HashSet<ServiceId>>,
 }
 
 impl<'a> MissionSummary<'a> {
@@ -241,7 +241,7 @@ impl<'a> MissionSummary<'a> {
             let mut team_calls = Vec::new();
             let mut team_electing = HashSet::new();
             for (index, service) in team.services.iter().enumerate() {
-                let index = index as Index;
+                let index = ServiceId::new(index);
                 let walked = walk_service(analysis, service);
                 if walked.elects_leader {
                     team_electing.insert(index);
@@ -692,7 +692,7 @@ impl Cross<'_> {
             let mut elsewhere: Vec<&str> = calls
                 .iter()
                 .filter(|c| c.name == service_name)
-                .map(|c| team.plans[c.plan as usize].name.as_str())
+                .map(|c| team.plans[c.plan.index()].name.as_str())
                 .collect();
             elsewhere.sort_unstable();
             elsewhere.dedup();
@@ -774,7 +774,7 @@ impl Cross<'_> {
             return;
         };
         if !summary.electing[team_id.0 as usize].contains(&index) {
-            let s = &team.services[index as usize];
+            let s = &team.services[index.index()];
             let message = format!(
                 "`{}` elects no leader: it has no `[[ leader(...) ... ]]` statement, so this leader selection is never used",
                 team.service_path(index)

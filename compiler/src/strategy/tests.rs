@@ -226,7 +226,7 @@ fn the_scouting_calls_of_move_are_linked_to_the_strategy_entry() {
         assert_eq!(link.team, team);
         assert_eq!(link.entry, entry);
         let t = analysis.mission.team(team);
-        assert_eq!(t.services[link.service as usize].name, service);
+        assert_eq!(t.services[link.service.index()].name, service);
     }
     // Go-to-definition from inside, or right after, the called name.
     let offset = calls[1].call.start + 2;
@@ -260,7 +260,7 @@ fn calls_through_functions_and_aliases_are_linked() {
     let link = &links.calls()[0];
     assert_eq!(at(SMALL, link.call), "stand_by");
     let team = analysis.mission.team(link.team);
-    assert_eq!(team.services[link.service as usize].name, "Go");
+    assert_eq!(team.services[link.service.index()].name, "Go");
 }
 
 #[test]

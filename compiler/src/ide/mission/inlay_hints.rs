@@ -76,7 +76,7 @@ fn robot_names(analysis: &Analysis, runs: &[Runners]) -> String {
         let robots: Vec<&str> = r
             .robots
             .iter()
-            .filter_map(|&i| t.robots.get(i as usize))
+            .filter_map(|&i| t.robots.get(i.index()))
             .map(|robot| robot.name.as_str())
             .collect();
         let part = match (teams.len(), robots.is_empty()) {
@@ -127,7 +127,7 @@ fn set_hints(analysis: &Analysis, text: &str, range: Span, hints: &mut Vec<Inlay
             let Some(service) = t.service_in_plan(plan, &name.name) else {
                 continue;
             };
-            let syntax = analysis.service_syntax(&t.services[service as usize]);
+            let syntax = analysis.service_syntax(&t.services[service.index()]);
             hints.push(InlayHint {
                 offset: name.span.end,
                 label: format!(": {}", docs::schedule(text, syntax)),

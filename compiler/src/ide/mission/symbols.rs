@@ -89,7 +89,7 @@ fn team_symbol(
         let services: Vec<StructureNode> = team
             .services
             .iter()
-            .filter(|s| s.plan as usize == p)
+            .filter(|s| s.plan.index() == p)
             .map(|s| StructureNode {
                 name: s.name.to_string(),
                 detail: Some(format!("{}.{}.{}", team.name, plan.name, s.name)),
@@ -116,9 +116,9 @@ fn team_symbol(
             .sets
             .iter()
             .filter_map(|set| {
-                let plan = &team.plans.get(set.plan? as usize)?.name;
+                let plan = &team.plans.get(set.plan?.index())?.name;
                 let service = match set.service {
-                    Some(s) => team.services.get(s as usize)?.name.as_str(),
+                    Some(s) => team.services.get(s.index())?.name.as_str(),
                     None => "OFF",
                 };
                 Some(format!("{plan}: {service}"))
@@ -138,7 +138,7 @@ fn team_symbol(
     {
         let default = main
             .default
-            .and_then(|m| team.modes.get(m as usize))
+            .and_then(|m| team.modes.get(m.index()))
             .map(|m| format!("default: {}", m.name));
         children.push(StructureNode {
             name: "main".to_string(),
@@ -190,7 +190,7 @@ pub fn workspace_symbols(analysis: &Analysis, query: &str) -> Vec<WorkspaceSymbo
         for s in &team.services {
             let plan = team
                 .plans
-                .get(s.plan as usize)
+                .get(s.plan.index())
                 .map_or("", |p| p.name.as_str());
             let container = Some(format!("{}.{plan}", team.name));
             add(&s.name, SymbolKind::Service, container, s.name_span);
