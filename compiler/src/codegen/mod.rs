@@ -599,6 +599,15 @@ pub struct Refined {
 /// strategies) refuses, as do problems found while refining and names that
 /// cannot be files or C identifiers (E101).
 pub fn refine_checked(build: &BuildInput<'_>) -> Refined {
+    refine_checked_robots(build, crate::refine::Robots::All)
+}
+
+/// [`refine_checked`] of the robots `robots` selects. With
+/// [`Robots::OnePerDeclaration`](crate::refine::Robots) it refuses exactly
+/// when `refine_checked` does: the other robots of a declaration differ
+/// only by the number ending their name, and the one refined has the
+/// longest (E101 bounds a name's length).
+pub fn refine_checked_robots(build: &BuildInput<'_>, robots: crate::refine::Robots) -> Refined {
     use crate::diag::{Code, Diagnostic};
     let mut diagnostics: Vec<Diagnostic> = build.diagnostics.to_vec();
     let refused = |diagnostics| Refined {
@@ -622,7 +631,7 @@ pub fn refine_checked(build: &BuildInput<'_>) -> Refined {
         links: build.links,
         service_graphs: build.service_graphs,
     };
-    let (programs, found) = crate::refine::refine(&input);
+    let (programs, found) = crate::refine::refine_robots(&input, robots);
     diagnostics.extend(found);
     // Names become folders, files and C identifiers: only plain identifiers.
     for program in &programs {

@@ -51,10 +51,32 @@ pub struct ServiceGraph {
     pub graph: std::sync::Arc<crate::taskgraph::TaskGraph>,
 }
 
+/// Which robots [`refine_robots`] refines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Robots {
+    /// Every robot: what code generation and the simulator run.
+    All,
+    /// One robot of each declaration (`name[N]` is one, see
+    /// [`crate::sema::Team::declarations`]): its last, whose name is the
+    /// longest. The robots of a declaration are refined alike but for their
+    /// names and their place among the peers, so what depends on neither
+    /// (the dataflow warnings, whether refinement finds an error) is found
+    /// from one of them: the cost is per declaration, not per robot.
+    OnePerDeclaration,
+}
+
 /// One program per robot of the mission, in formation order, and the
 /// diagnostics that stop generation (constructs code generation does not
 /// support yet, inconsistent refined graphs).
 pub fn refine(input: &RefineInput<'_>) -> (Vec<RobotProgram>, Vec<Diagnostic>) {
+    refine_robots(input, Robots::All)
+}
+
+/// [`refine`] of the robots `robots` selects, in formation order.
+pub fn refine_robots(
+    input: &RefineInput<'_>,
+    robots: Robots,
+) -> (Vec<RobotProgram>, Vec<Diagnostic>) {
     let lines = LineIndex::new(input.text);
     let mission = &input.analysis.mission;
     let peers: Vec<(String, String)> = mission
@@ -69,15 +91,23 @@ pub fn refine(input: &RefineInput<'_>) -> (Vec<RobotProgram>, Vec<Diagnostic>) {
     let mut programs = Vec::new();
     let mut diagnostics = Vec::new();
     for (team_index, team) in mission.teams.iter().enumerate() {
+        let selected: Vec<crate::sema::RobotId> = match robots {
+            Robots::All => team.robot_ids().collect(),
+            Robots::OnePerDeclaration => team
+                .declarations()
+                .iter()
+                .filter_map(|d| d.last().copied())
+                .collect(),
+        };
         // W130 for a team: what every one of its robots gives.
         let mut names_no_task: Vec<Vec<Diagnostic>> = Vec::new();
-        for (robot_index, _) in team.robots.iter().enumerate() {
+        for robot in selected {
             let (program, found) = robot::refine_robot(
                 input,
                 &lines,
                 &peers,
                 crate::sema::TeamId(team_index as u32),
-                robot_index,
+                robot.index(),
             );
             let (warned, found): (Vec<Diagnostic>, Vec<Diagnostic>) = found
                 .into_iter()

@@ -384,6 +384,20 @@ impl Team {
         &self.robots[robot.index()]
     }
 
+    /// The team's robots by declaration, in order: `name[N]` declares N
+    /// robots (sharing one `name_span`) that the checker treats alike: of
+    /// one type, they run the same scopes and join the same groups.
+    pub fn declarations(&self) -> Vec<Vec<RobotId>> {
+        let mut declarations: Vec<Vec<RobotId>> = Vec::new();
+        for (id, robot) in self.robot_ids().zip(&self.robots) {
+            match declarations.last_mut() {
+                Some(last) if self.robot(last[0]).name_span == robot.name_span => last.push(id),
+                _ => declarations.push(vec![id]),
+            }
+        }
+        declarations
+    }
+
     pub fn plan_ids(&self) -> impl DoubleEndedIterator<Item = PlanId> + Clone + use<> {
         PlanId::all(self.plans.len())
     }
