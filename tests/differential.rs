@@ -96,6 +96,8 @@ struct Behaviour {
     leaders: Runs<String>,
     /// Group services: (rank, size) as each change was traced.
     groups: Runs<(String, String)>,
+    /// The owners of the team's globally shared values it changed to.
+    owners: Runs<String>,
     sent: BTreeSet<(String, String)>,
     received: BTreeSet<(String, String)>,
     /// Adaptive resource management: the battery policies that start and
@@ -143,6 +145,7 @@ fn behaviour(events: &[&Event]) -> Behaviour {
             of(events, "group")
                 .map(|e| (field(e, "rank").to_string(), field(e, "size").to_string())),
         ),
+        owners: runs(of(events, "shared_owner").map(|e| field(e, "owner").to_string())),
         sent: of(events, "send")
             .map(|e| (field(e, "to").to_string(), field(e, "key").to_string()))
             .collect(),
@@ -461,6 +464,24 @@ fn a_group_service_redivides_the_same_way_in_c_and_in_the_simulator() {
         .map(|e| format!("{} of {}", field(e, "rank"), field(e, "size")))
         .collect();
     assert_eq!(sizes, ["2 of 3", "1 of 2", "2 of 3"]);
+}
+
+/// Globally shared information (`docs/shared-information.md`): the owner
+/// `a` killed, `b` takes over and a write of `c` reaches it, in both; what
+/// each reads shows in its modes (`tests/fixtures/shared`).
+#[test]
+fn a_killed_owner_of_shared_values_is_replaced_the_same_way_in_c_and_in_the_simulator() {
+    let fixture = repo_root().join("tests/fixtures/shared");
+    let scenario = std::fs::read_to_string(fixture.join("shared.scenario.json")).unwrap();
+    let (processes, _) = compare("shared", &fixture.join("shared.mission"), &scenario, 20);
+    for robot in ["b", "c"] {
+        let owners: Vec<&str> = processes[robot]
+            .iter()
+            .filter(|e| field(e, "event") == "shared_owner")
+            .map(|e| field(e, "owner"))
+            .collect();
+        assert_eq!(owners, ["b"], "{robot}");
+    }
 }
 
 /// Link faults in both: the master hears nothing from ti for two seconds,

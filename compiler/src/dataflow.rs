@@ -254,7 +254,7 @@ fn asked_period(states: &[State], index: usize) -> Option<(i64, Span)> {
                 period_ms: Some(p),
                 to: head,
                 ..
-            } if head < index && index < tail => Some((tail - head, (p, s.span))),
+            } if head.index() < index && index < tail => Some((tail - head.index(), (p, s.span))),
             _ => None,
         })
         .min_by_key(|(width, _)| *width)

@@ -69,6 +69,8 @@ pub fn refine(input: &RefineInput<'_>) -> (Vec<RobotProgram>, Vec<Diagnostic>) {
     let mut programs = Vec::new();
     let mut diagnostics = Vec::new();
     for (team_index, team) in mission.teams.iter().enumerate() {
+        // W130 for a team: what every one of its robots gives.
+        let mut names_no_task: Vec<Vec<Diagnostic>> = Vec::new();
         for (robot_index, _) in team.robots.iter().enumerate() {
             let (program, found) = robot::refine_robot(
                 input,
@@ -77,8 +79,21 @@ pub fn refine(input: &RefineInput<'_>) -> (Vec<RobotProgram>, Vec<Diagnostic>) {
                 crate::sema::TeamId(team_index as u32),
                 robot_index,
             );
+            let (warned, found): (Vec<Diagnostic>, Vec<Diagnostic>) = found
+                .into_iter()
+                .partition(|d| d.code == diag::Code::BatteryPolicyNamesNoTask);
+            names_no_task.push(warned);
             diagnostics.extend(found);
             programs.extend(program);
+        }
+        robot::shared::owners_of_team(&mut programs, &team.name);
+        if let Some((first, others)) = names_no_task.split_first() {
+            diagnostics.extend(
+                first
+                    .iter()
+                    .filter(|d| others.iter().all(|o| o.contains(d)))
+                    .cloned(),
+            );
         }
     }
     assign_groups(&mut programs);

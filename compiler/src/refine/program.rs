@@ -7,8 +7,21 @@
 //! entry's action machine (bottom).
 
 use super::value::{Value, ValueKind};
+use crate::index::newtype_index;
 use crate::span::Span;
 use crate::taskgraph::TaskGraph;
+
+newtype_index! {
+    /// A state of its service machine: an index into [`ServiceMachine::states`]
+    /// (the generated C's `pc`).
+    pub struct StateId;
+}
+
+newtype_index! {
+    /// A value of the control machine: an index into [`ControlMachine::slots`]
+    /// (the generated C's `slot[]`).
+    pub struct SlotId;
+}
 
 /// The robot's battery level, a catalog value: what a strategy's battery
 /// condition reads (`Battery`), and what the robot's status reports.
@@ -270,7 +283,7 @@ pub enum StateKind {
     /// Read the latest published value of a group into its slot.
     Subscribe {
         group: usize,
-        slot: usize,
+        slot: SlotId,
     },
     Throw {
         event: String,
@@ -298,7 +311,7 @@ pub enum StateKind {
     LeaderBranch {
         candidates: Vec<usize>,
         algorithm: LeaderAlgorithm,
-        others_at: usize,
+        others_at: StateId,
     },
     /// The start of a group statement when the team's strategy has
     /// `<GroupSync timeout>`: tell the team this robot has arrived (its
@@ -317,23 +330,23 @@ pub enum StateKind {
     /// Continue at `else_to` unless the condition holds.
     Branch {
         condition: Expr,
-        else_to: usize,
+        else_to: StateId,
     },
     Jump {
-        to: usize,
+        to: StateId,
     },
     /// Head of `loop(period?, condition?)`: leave to `exit_to` when the
     /// condition fails; mark the iteration's start.
     LoopHead {
         condition: Option<Expr>,
-        exit_to: usize,
+        exit_to: StateId,
         mark: usize,
     },
     /// End of a loop body: wait for the period (from the mark), then `to`.
     LoopTail {
         period_ms: Option<i64>,
         mark: usize,
-        to: usize,
+        to: StateId,
     },
     /// After the body: `repeat(period?, condition?)`; `forever` for `repeat()`;
     /// neither means the service runs once.
@@ -351,7 +364,7 @@ pub struct SendItem {
     pub message: usize,
     pub value: Operand,
     /// `send(T, T.X = v)`: the shared slot `v` is stored in first.
-    pub store: Option<usize>,
+    pub store: Option<SlotId>,
     /// A publication of a value this robot also subscribes to: the index into
     /// [`ControlMachine::subscribed`] of the group it is written to at once,
     /// since the latest value team T published includes the robot's own.
@@ -367,7 +380,7 @@ pub struct ActionMachine {
     pub actions: Vec<ActionState>,
     pub initial: usize,
     /// Slots of the `variable` parameters set from the call's arguments, in order.
-    pub arguments: Vec<usize>,
+    pub arguments: Vec<SlotId>,
 }
 
 #[derive(Clone, Debug)]
@@ -416,7 +429,7 @@ pub struct OutgoingMessage {
 pub struct IncomingMessage {
     pub from_team: String,
     pub key: String,
-    pub slot: usize,
+    pub slot: SlotId,
     pub port: String,
 }
 
@@ -426,6 +439,37 @@ pub struct SharedLibrary {
     pub name: String,
     /// Slot keys it holds a getter and a setter for.
     pub attributes: Vec<String>,
+    /// Who holds the globally shared attributes (`docs/shared-information.md`);
+    /// `None` when every attribute is a local copy (the team has one robot,
+    /// or the library holds only other teams' values and multicast values).
+    pub ownership: Option<Ownership>,
+}
+
+/// The globally shared attributes of a team's library and the robots that
+/// own them in turn: the first live robot of `owners` holds them, the others
+/// set them through messages to it and read what it last told them.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Ownership {
+    /// The globally shared attributes.
+    pub global: Vec<GlobalValue>,
+    /// Peer indices (into `RobotProgram::peers`) of the team's robots in the
+    /// order ownership passes when an owner is lost; the first is the owner
+    /// at start.
+    pub owners: Vec<usize>,
+}
+
+/// One globally shared attribute of a library.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GlobalValue {
+    /// Its index in [`SharedLibrary::attributes`].
+    pub at: usize,
+    /// The type of its values (its shared slot's): a value of another type
+    /// received is refused.
+    pub kind: ValueKind,
+    /// The key of a write sent to the owner (`Team.__set.X`).
+    pub set_key: String,
+    /// The key of the owner's value told to the team (`Team.__value.X`).
+    pub value_key: String,
 }
 
 /// A non-control task of the robot and its job.
@@ -471,7 +515,7 @@ pub enum Expr {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Operand {
-    Slot(usize),
+    Slot(SlotId),
     /// A literal, typed as written: a whole number an integer, another number
     /// a real, a string text, `true`/`false` a truth value, a symbolic
     /// constant a word.

@@ -14,6 +14,7 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 mod battery;
 mod loops;
+pub(super) mod shared;
 
 #[cfg(test)]
 pub(super) use loops::steps_of;
@@ -66,16 +67,7 @@ pub(super) fn refine_robot(
     } = builder;
     separate_sensor_tasks(&mut machine, &mut sensors, &services);
     link_own_publications(&mut machine);
-    let shared: Vec<String> = machine
-        .slots
-        .iter()
-        .filter(|s| s.source == SlotSource::Shared)
-        .map(|s| s.key.clone())
-        .collect();
-    let library = (!shared.is_empty()).then(|| SharedLibrary {
-        name: format!("{}Shared", team.name),
-        attributes: shared,
-    });
+    let library = shared::library(team, self_peer - robot_index, &mut machine);
     let mut tasks: Vec<TaskRole> = sensors
         .into_iter()
         .map(|(task, values)| TaskRole {
@@ -143,7 +135,7 @@ struct Builder<'a, 'i> {
     robot_index: usize,
     robot_type: &'a RobotType,
     machine: ControlMachine,
-    slot_index: HashMap<(String, bool), usize>,
+    slot_index: HashMap<(String, bool), SlotId>,
     /// Sensor task → the values it provides.
     sensors: BTreeMap<String, BTreeSet<String>>,
     /// Service task → the services or actuator commands it runs.
@@ -389,7 +381,7 @@ impl Builder<'_, '_> {
             },
             span,
         );
-        states[state].text = "GroupSync: the group meets here".into();
+        states[state.index()].text = "GroupSync: the group meets here".into();
     }
 
     /// The strategy's leader selection for an election in the service being
@@ -431,70 +423,76 @@ impl Builder<'_, '_> {
         }
     }
 
-    fn push(&self, states: &mut Vec<State>, kind: StateKind, span: Span) -> usize {
+    fn push(&self, states: &mut Vec<State>, kind: StateKind, span: Span) -> StateId {
         states.push(State {
             kind,
             line: self.line(span),
             span,
             text: self.excerpt(span),
         });
-        states.len() - 1
+        StateId::new(states.len() - 1)
+    }
+
+    /// Pushes a state that jumps forward past a block not refined yet
+    /// (`Branch`, `Jump`, `LoopHead`, `LeaderBranch`): `make` builds it with
+    /// its target, which is the state itself until [`land`] sets it.
+    fn push_forward(
+        &self,
+        states: &mut Vec<State>,
+        span: Span,
+        make: impl FnOnce(StateId) -> StateKind,
+    ) -> Forward {
+        let at = StateId::new(states.len());
+        Forward(self.push(states, make(at), span))
     }
 
     fn stmt(&mut self, stmt: &ast::Stmt, states: &mut Vec<State>, marks: &mut usize, depth: usize) {
         match &stmt.kind {
             StmtKind::If(i) => {
                 let condition = self.condition(&i.condition);
-                let branch = self.push(
-                    states,
-                    StateKind::Branch {
-                        condition,
-                        else_to: usize::MAX,
-                    },
-                    stmt.span,
-                );
+                let branch = self.push_forward(states, stmt.span, |else_to| StateKind::Branch {
+                    condition,
+                    else_to,
+                });
                 self.block(&i.then_block, states, marks, depth);
                 match &i.else_branch {
-                    None => patch(states, branch),
+                    None => land(states, branch),
                     Some(else_branch) => {
-                        let jump = self.push(states, StateKind::Jump { to: usize::MAX }, stmt.span);
-                        states[jump].text = "end of the `if` branch".into();
-                        patch(states, branch);
+                        let jump =
+                            self.push_forward(states, stmt.span, |to| StateKind::Jump { to });
+                        states[jump.0.index()].text = "end of the `if` branch".into();
+                        land(states, branch);
                         match else_branch.as_ref() {
                             ast::Else::If(s) => self.stmt(s, states, marks, depth),
                             ast::Else::Block(b) => self.block(b, states, marks, depth),
                         }
-                        patch(states, jump);
+                        land(states, jump);
                     }
                 }
             }
             StmtKind::Loop(l) => {
                 let mark = next_mark(marks);
                 let condition = l.condition.as_ref().map(|c| self.condition(c));
-                let head = self.push(
-                    states,
-                    StateKind::LoopHead {
-                        condition,
-                        exit_to: usize::MAX,
-                        mark,
-                    },
-                    stmt.span,
-                );
+                let head = self.push_forward(states, stmt.span, |exit_to| StateKind::LoopHead {
+                    condition,
+                    exit_to,
+                    mark,
+                });
                 self.block(&l.body, states, marks, depth);
                 let tail = self.push(
                     states,
                     StateKind::LoopTail {
                         period_ms: l.period.as_ref().and_then(period_ms),
                         mark,
-                        to: head,
+                        to: head.0,
                     },
                     stmt.span,
                 );
-                states[tail].text = "end of the loop body".into();
+                states[tail.index()].text = "end of the loop body".into();
                 if let Some(period) = &l.period {
-                    states[tail].span = period.span;
+                    states[tail.index()].span = period.span;
                 }
-                patch(states, head);
+                land(states, head);
             }
             StmtKind::Group(g) => {
                 self.group_sync(g, stmt.span, states, marks);
@@ -515,23 +513,22 @@ impl Builder<'_, '_> {
                         let candidates = candidates.iter().map(|i| first_peer + i).collect();
                         let (algorithm, heartbeat_ms) = self.leader_selection();
                         self.need_heartbeat(heartbeat_ms.unwrap_or(HEARTBEAT_MS));
-                        let branch = self.push(
-                            states,
+                        let branch = self.push_forward(states, stmt.span, |others_at| {
                             StateKind::LeaderBranch {
                                 candidates,
                                 algorithm,
-                                others_at: usize::MAX,
-                            },
-                            stmt.span,
-                        );
+                                others_at,
+                            }
+                        });
                         self.block(body, states, marks, depth);
-                        let jump = self.push(states, StateKind::Jump { to: usize::MAX }, stmt.span);
-                        states[jump].text = "end of the leader's block".into();
-                        patch(states, branch);
+                        let jump =
+                            self.push_forward(states, stmt.span, |to| StateKind::Jump { to });
+                        states[jump.0.index()].text = "end of the leader's block".into();
+                        land(states, branch);
                         if let Some(others) = others {
                             self.block(others, states, marks, depth);
                         }
-                        patch(states, jump);
+                        land(states, jump);
                     }
                 }
             }
@@ -1135,7 +1132,7 @@ impl Builder<'_, '_> {
             .unwrap_or_else(|| name.to_string())
     }
 
-    fn slot(&mut self, key: &str, source: SlotSource, kind: ValueKind) -> usize {
+    fn slot(&mut self, key: &str, source: SlotSource, kind: ValueKind) -> SlotId {
         let sensor = matches!(source, SlotSource::Sensor { .. });
         if let Some(&i) = self.slot_index.get(&(key.to_string(), sensor)) {
             return i;
@@ -1145,14 +1142,14 @@ impl Builder<'_, '_> {
             source,
             kind,
         });
-        let i = self.machine.slots.len() - 1;
+        let i = SlotId::new(self.machine.slots.len() - 1);
         self.slot_index.insert((key.to_string(), sensor), i);
         i
     }
 
     /// The team's shared slot of the attribute (a value received, sent or
     /// published, or a team variable), typed as the checker resolved it.
-    fn shared_slot(&mut self, attr: &ast::Attr) -> usize {
+    fn shared_slot(&mut self, attr: &ast::Attr) -> SlotId {
         let key = self.attr_key(attr);
         if let Some(&i) = self.slot_index.get(&(key.clone(), false)) {
             return i;
@@ -1221,12 +1218,12 @@ impl Builder<'_, '_> {
 
     /// The robot's own value `name`, read from the task that implements it
     /// (the strategy's `ValueInfo` first, else the catalog).
-    fn sensor_slot(&mut self, name: &str, span: Span) -> usize {
+    fn sensor_slot(&mut self, name: &str, span: Span) -> SlotId {
         let task = self.value_task(name);
         self.sensor_slot_with_task(name, &task, span)
     }
 
-    fn sensor_slot_with_task(&mut self, value: &str, task: &str, span: Span) -> usize {
+    fn sensor_slot_with_task(&mut self, value: &str, task: &str, span: Span) -> SlotId {
         let key = format!("{}.{value}", self.team.name);
         if let Some(&i) = self.slot_index.get(&(key.clone(), true)) {
             return i;
@@ -1422,14 +1419,21 @@ fn next_mark(marks: &mut usize) -> usize {
     *marks - 1
 }
 
-fn patch(states: &mut [State], at: usize) {
-    let target = states.len();
-    match &mut states[at].kind {
-        StateKind::Branch { else_to, .. } => *else_to = target,
-        StateKind::Jump { to } => *to = target,
-        StateKind::LoopHead { exit_to, .. } => *exit_to = target,
-        StateKind::LeaderBranch { others_at, .. } => *others_at = target,
-        _ => {}
+/// A state pushed by [`Builder::push_forward`] whose target is the state
+/// after a block still being refined: [`land`] sets it once that block is.
+#[must_use = "a forward state must land, or it jumps to itself"]
+struct Forward(StateId);
+
+/// Sets the target of `forward` to the next state to be pushed.
+fn land(states: &mut [State], forward: Forward) {
+    let target = StateId::new(states.len());
+    match &mut states[forward.0.index()].kind {
+        StateKind::Branch { else_to: to, .. }
+        | StateKind::Jump { to }
+        | StateKind::LoopHead { exit_to: to, .. }
+        | StateKind::LeaderBranch { others_at: to, .. } => *to = target,
+        // `push_forward` is only given the four kinds above.
+        other => unreachable!("a forward state cannot be {other:?}"),
     }
 }
 

@@ -169,7 +169,7 @@ fn battery_requirements_become_policies_over_the_robots_own_tasks() {
     };
     assert_eq!(limit, &crate::refine::Value::Int(30));
     assert!(matches!(
-        &master.control.slots[*slot].source,
+        &master.control.slots[slot.index()].source,
         SlotSource::Sensor { port, .. } if port == "BATTERY"
     ));
     assert!(task_names(master).contains(&"battery"));

@@ -31,7 +31,7 @@ use super::trace::TraceEvent;
 use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
 use crate::refine::{
-    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, RoleKind,
+    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, RoleKind, SlotId,
     SlotSource, StateKind,
 };
 use crate::sema::Compared;
@@ -44,6 +44,7 @@ use std::rc::Rc;
 
 mod battery;
 mod loops;
+mod shared;
 
 /// The sensor tasks' period (refinement's `SENSOR_PERIOD_MS`).
 const SENSOR_PERIOD_MS: i64 = 100;
@@ -234,6 +235,9 @@ struct Robot<'p> {
     library: Vec<Held>,
     /// Per slot: its value's place in `library` (shared slots only).
     library_index: Vec<Option<usize>>,
+    /// The owner of the library's globally shared values now (a peer index;
+    /// `shared.rs`).
+    owner: usize,
     /// Per incoming message: the channel to the control task (capacity).
     inbox: Vec<(VecDeque<Held>, usize)>,
     /// Per subscribed group: the latest value.
@@ -371,6 +375,11 @@ impl<'p> Robot<'p> {
                         .flatten()
                 })
                 .collect(),
+            owner: program
+                .library
+                .as_ref()
+                .and_then(|l| l.ownership.as_ref())
+                .map_or(program.self_peer, |o| o.owners[0]),
             inbox,
             groups: vec![None; m.subscribed.len()],
             regions: vec![
@@ -688,7 +697,7 @@ impl<'p> Sim<'p> {
     /// An operand's value without copying it (conditions are read every firing).
     fn value_ref<'a>(&'a self, r: usize, op: &'a Operand) -> Option<&'a Value> {
         match op {
-            Operand::Slot(s) => self.robots[r].slots[*s].as_ref(),
+            Operand::Slot(s) => self.robots[r].slots[s.index()].as_ref(),
             Operand::Literal(v) => Some(v),
         }
     }
@@ -733,13 +742,17 @@ impl<'p> Sim<'p> {
     }
 
     /// `store`: the slot, and the library for shared information.
-    fn store(&mut self, r: usize, slot: usize, value: Held) {
+    fn store(&mut self, r: usize, slot: SlotId, value: Held) {
         let robot = &mut self.robots[r];
         robot.progressed = true;
-        if let Some(k) = robot.library_index[slot] {
+        let library = robot.library_index[slot.index()];
+        if let Some(k) = library {
             robot.library[k].clone_from(&value);
         }
-        robot.slots[slot] = value;
+        robot.slots[slot.index()].clone_from(&value);
+        if let Some(k) = library {
+            self.shared_set(r, k, &value);
+        }
     }
 
     /// Reads the latest sensor samples (the scenario's latest value at the
@@ -747,6 +760,8 @@ impl<'p> Sim<'p> {
     /// slots (`read_inputs`); a slot is written only when its value changed.
     fn read_inputs(&mut self, r: usize) {
         let now = self.now;
+        // The getters of globally shared values ask who owns them first.
+        self.current_owner(r);
         let robot = &mut self.robots[r];
         let program = robot.program;
         robot.resources.advance(now);
@@ -899,6 +914,9 @@ impl<'p> Sim<'p> {
             value: Some(("value", message.value.0.clone())),
             sent_at: Some(message.sent_at),
         });
+        if self.shared_heard(r, message) {
+            return;
+        }
         let robot = &mut self.robots[r];
         let m = &robot.program.control;
         if m.heartbeat && message.publish && message.key == self.names[r].alive_key {
@@ -953,7 +971,7 @@ impl<'p> Sim<'p> {
         let mut rejected = false;
         for (i, incoming) in m.incoming.iter().enumerate() {
             if *incoming.from_team == *message.from_team && *incoming.key == *message.key {
-                let kind = &m.slots[incoming.slot].kind;
+                let kind = &m.slots[incoming.slot.index()].kind;
                 let Some(value) = (match &message.value.0 {
                     Some(v) => kind.coerce(v).map(Some),
                     None => Some(None),
@@ -1270,6 +1288,9 @@ impl<'p> Sim<'p> {
         if m.heartbeat {
             at_least(robot.last_heartbeat + m.heartbeat_ms);
         }
+        if let Some(t) = self.owner_lost_at(r) {
+            at_least(t);
+        }
         for region in &robot.regions {
             let Some(service) = region.service.filter(|_| !region.done) else {
                 continue;
@@ -1390,7 +1411,7 @@ impl<'p> Sim<'p> {
                     let sent = match item.store {
                         Some(s) => {
                             self.store(r, s, value);
-                            self.robots[r].slots[s].clone()
+                            self.robots[r].slots[s.index()].clone()
                         }
                         None => value,
                     };
@@ -1497,7 +1518,7 @@ impl<'p> Sim<'p> {
             } => match self.elected(r, (service, pc), candidates, *algorithm) {
                 None => Step::Wait, // still listening
                 Some(elected) => {
-                    self.region(r, i).pc = if elected { next } else { *others_at };
+                    self.region(r, i).pc = if elected { next } else { others_at.index() };
                     Step::Next
                 }
             },
@@ -1550,11 +1571,11 @@ impl<'p> Sim<'p> {
             }
             StateKind::Branch { condition, else_to } => {
                 let holds = self.eval(r, condition);
-                self.region(r, i).pc = if holds { next } else { *else_to };
+                self.region(r, i).pc = if holds { next } else { else_to.index() };
                 Step::Next
             }
             StateKind::Jump { to } => {
-                self.region(r, i).pc = *to;
+                self.region(r, i).pc = to.index();
                 Step::Next
             }
             StateKind::LoopHead {
@@ -1565,7 +1586,7 @@ impl<'p> Sim<'p> {
                 if let Some(cond) = condition
                     && !self.eval(r, cond)
                 {
-                    self.region(r, i).pc = *exit_to;
+                    self.region(r, i).pc = exit_to.index();
                     return Step::Next;
                 }
                 let region = self.region(r, i);
@@ -1582,11 +1603,11 @@ impl<'p> Sim<'p> {
                     if now - self.robots[r].regions[i].marks[*mark] < *p {
                         return Step::Wait;
                     }
-                    self.region(r, i).pc = *to;
+                    self.region(r, i).pc = to.index();
                     Step::Next
                 }
                 None => {
-                    self.region(r, i).pc = *to;
+                    self.region(r, i).pc = to.index();
                     Step::Wait
                 }
             },
