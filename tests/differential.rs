@@ -94,6 +94,10 @@ struct Behaviour {
     services: BTreeMap<String, Runs<String>>,
     catches: Runs<(String, String)>,
     leaders: Runs<String>,
+    /// The owners of the team's globally shared values it changed to.
+    owners: Runs<String>,
+    /// Group services: (rank, size) as each change was traced.
+    groups: Runs<(String, String)>,
     sent: BTreeSet<(String, String)>,
     received: BTreeSet<(String, String)>,
     /// Adaptive resource management: the battery policies that start and
@@ -137,6 +141,11 @@ fn behaviour(events: &[&Event]) -> Behaviour {
                 .map(|e| (field(e, "name").to_string(), field(e, "mode").to_string())),
         ),
         leaders: runs(of(events, "leader").map(|e| field(e, "leader").to_string())),
+        owners: runs(of(events, "shared_owner").map(|e| field(e, "owner").to_string())),
+        groups: runs(
+            of(events, "group")
+                .map(|e| (field(e, "rank").to_string(), field(e, "size").to_string())),
+        ),
         sent: of(events, "send")
             .map(|e| (field(e, "to").to_string(), field(e, "key").to_string()))
             .collect(),
@@ -434,6 +443,45 @@ fn a_restarted_leader_comes_back_the_same_way_in_c_and_in_the_simulator() {
             "faults": [{"at": 1200, "kill": "tb_0"}, {"at": 2200, "restart": "tb_0"}]}"#,
         10,
     );
+}
+
+/// Globally shared information (`docs/shared-information.md`): the owner
+/// `a` killed, `b` takes over and a write of `c` reaches it, in both; what
+/// each reads shows in its modes (`tests/fixtures/shared`).
+#[test]
+fn a_killed_owner_of_shared_values_is_replaced_the_same_way_in_c_and_in_the_simulator() {
+    let fixture = repo_root().join("tests/fixtures/shared");
+    let scenario = std::fs::read_to_string(fixture.join("shared.scenario.json")).unwrap();
+    let (processes, _) = compare("shared", &fixture.join("shared.mission"), &scenario, 20);
+    for robot in ["b", "c"] {
+        let owners: Vec<&str> = processes[robot]
+            .iter()
+            .filter(|e| field(e, "event") == "shared_owner")
+            .map(|e| field(e, "owner"))
+            .collect();
+        assert_eq!(owners, ["b"], "{robot}");
+    }
+}
+
+/// A group service (tests/fixtures/group_service: `move`, heartbeats every
+/// 200 ms) with tb_1 killed and restarted: the others' ranks and sizes
+/// change the same way in both (2 of 3 → 1 of 2 → 2 of 3 for tb_2), and
+/// tb_1 starts each life as 1 of 3.
+#[test]
+fn a_group_service_redivides_the_same_way_in_c_and_in_the_simulator() {
+    let (c, _) = compare(
+        "group_service",
+        &repo_root().join("tests/fixtures/group_service/sweep.mission"),
+        r#"{"time_scale": 1, "duration": 4000,
+            "faults": [{"at": 1000, "kill": "tb_1"}, {"at": 2500, "restart": "tb_1"}]}"#,
+        36,
+    );
+    let sizes: Vec<String> = c["tb_2"]
+        .iter()
+        .filter(|e| field(e, "event") == "group")
+        .map(|e| format!("{} of {}", field(e, "rank"), field(e, "size")))
+        .collect();
+    assert_eq!(sizes, ["2 of 3", "1 of 2", "2 of 3"]);
 }
 
 /// Link faults in both: the master hears nothing from ti for two seconds,

@@ -2,7 +2,9 @@
 //! generated service task runs one iteration of the graph's looped schedule
 //! per call, its inner tasks in the schedule's order, D-type loops exactly
 //! `loopCount` times, C-type loops until their exit task sets the exit flag
-//! (in `linux-sim`, in the iteration the scenario's `loops` names). Checked
+//! (in `linux-sim`, in the iteration the scenario's `loops` names), its
+//! channels carrying tokens between the inner tasks (the trace's `read` and
+//! `wrote`). Checked
 //! from the trace of the generated `linux-sim` program and of `semo
 //! simulate`, on `tests/fixtures/loops/` (the thesis's k-means graph and the
 //! two loop examples, copied from `examples/taskgraphs/`), compiled with gcc
@@ -75,6 +77,70 @@ fn expected() -> Vec<String> {
     out
 }
 
+/// The data of a trace's inner firings: `graph/task read→wrote`.
+fn graph_data(events: &[support::robots::Event]) -> Vec<String> {
+    events
+        .iter()
+        .filter(|e| field(e, "event") == "graph_fire")
+        .map(|e| {
+            format!(
+                "{}/{} {}→{}",
+                field(e, "graph"),
+                field(e, "task"),
+                field(e, "read"),
+                field(e, "wrote")
+            )
+        })
+        .collect()
+}
+
+fn numbers(range: std::ops::RangeInclusive<i64>) -> String {
+    range.map(|n| n.to_string()).collect::<Vec<_>>().join(",")
+}
+
+/// The tokens each inner task read and wrote, worked out by hand from the
+/// graphs and the `linux-sim` work (each output token `k` is `(sum of the
+/// tokens read + k + 1) mod 1000`): k-means's points and centres pass
+/// through the distributing and broadcasting ports, the feedback channel's
+/// initial token (0) reaches the first `Select`, and each convergent
+/// iteration's centre the next one.
+fn check_data(data: &[String]) {
+    let of = |task: &str| -> Vec<&str> {
+        data.iter()
+            .filter_map(|d| d.strip_prefix(task)?.strip_prefix(' '))
+            .collect()
+    };
+    let sixteen = numbers(1..=16);
+    assert_eq!(of("kmeans/ReadPoints"), [format!("→{sixteen}")]);
+    assert_eq!(of("kmeans/InitCenters"), ["→1"]);
+    assert_eq!(
+        of("kmeans/Converge/Select"),
+        ["1,0→2", "1,185→187", "1,145→147"]
+    );
+    let nearest = of("kmeans/Converge/Assign/Nearest");
+    assert_eq!(nearest.len(), 48);
+    assert_eq!(nearest[0], "1,2→4");
+    assert_eq!(nearest[15], "16,2→19");
+    assert_eq!(nearest[16], "1,187→189");
+    assert_eq!(
+        of("kmeans/Converge/ReplaceCenter"),
+        [
+            format!("{}→185,185", numbers(4..=19)),
+            format!("{}→145,145", numbers(189..=204)),
+            format!("{}→505,505", numbers(149..=164)),
+        ]
+    );
+    assert_eq!(of("kmeans/Output"), ["505→"]);
+    assert_eq!(of("data_loop/L/B")[9], "10→11");
+    assert_eq!(of("data_loop/D"), [format!("{}→", numbers(3..=12))]);
+    assert_eq!(
+        of("convergent_loop/L/B"),
+        ["1,0→2", "1,3→5", "1,6→8", "1,9→11"]
+    );
+    assert_eq!(of("convergent_loop/L/C")[3], "11→12,12");
+    assert_eq!(of("convergent_loop/D"), ["12→"]);
+}
+
 #[test]
 fn graph_services_run_their_looped_schedule_in_linux_sim_and_the_simulator() {
     let scenario = std::fs::read_to_string(fixture("loops.scenario.json")).unwrap();
@@ -82,6 +148,8 @@ fn graph_services_run_their_looped_schedule_in_linux_sim_and_the_simulator() {
     let traces = run_in_simulation(&fixture("loops.mission"), &out, &scenario);
     let c = graph_events(&events(&traces["c"]));
     assert_eq!(c, expected(), "linux-sim");
+    let data = graph_data(&events(&traces["c"]));
+    check_data(&data);
     let simulated = semo_in(
         &repo_root(),
         &[
@@ -96,6 +164,7 @@ fn graph_services_run_their_looped_schedule_in_linux_sim_and_the_simulator() {
     assert_eq!(simulated.code, 0, "{}", simulated.stderr);
     let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
     assert_eq!(graph_events(&events(&lines)), expected(), "semo simulate");
+    assert_eq!(graph_data(&events(&lines)), data, "semo simulate");
 }
 
 /// Without an exit in the scenario, a convergent loop runs `loopCount`

@@ -31,13 +31,14 @@
 //! be read, or has format errors, is reported in its own file (and E055 in
 //! the catalog) and gives no warning here.
 
-use crate::catalog::{Catalog, Implementation};
+use crate::catalog::{Catalog, Implementation, RobotType};
 use crate::diag::{self, Code, Diagnostic, FileId, Related};
 use crate::refine::{RobotProgram, State, StateKind};
 use crate::sema::Mission;
 use crate::span::Span;
 use crate::taskgraph::analysis::ratio::Ratio;
 use crate::workspace::GraphRun;
+use std::collections::HashMap;
 use std::sync::Arc;
 
 /// What the analyses of a mission's refined graphs found.
@@ -74,18 +75,46 @@ pub struct DataflowInput<'a> {
     pub file: FileId,
     pub mission: &'a Mission,
     pub catalog: &'a Catalog,
-    /// What refinement gave for the mission (`codegen::refine_checked`).
+    /// What refinement gave for the mission: a program for at least one
+    /// robot of each declaration (`codegen::refine_checked_robots` with
+    /// `Robots::OnePerDeclaration`). The robots of a declaration are refined
+    /// alike, so one program stands for all of them.
     pub programs: &'a [RobotProgram],
     /// The service graphs, analysed; `None` when one cannot be read.
     pub service_graph: &'a ServiceGraphs<'a>,
 }
 
-/// Analyses every robot's refined graph with the service graphs it calls.
+/// Analyses each declaration's refined graph with the service graphs it
+/// calls, once, and gives its result to each of the declaration's robots.
 pub fn analyze(input: &DataflowInput<'_>) -> MissionDataflow {
     let mut out = MissionDataflow::default();
-    for program in input.programs {
-        out.robots
-            .push(robot(input, program, &mut out.diagnostics, &mut out.graphs));
+    let programs: HashMap<(&str, &str), &RobotProgram> = input
+        .programs
+        .iter()
+        .map(|p| ((p.team.as_str(), p.robot.as_str()), p))
+        .collect();
+    for team in &input.mission.teams {
+        for declaration in team.declarations() {
+            let robots = declaration.iter().map(|&r| team.robot(r));
+            let refined = robots
+                .clone()
+                .find_map(|r| Some((r, *programs.get(&(team.name.as_str(), r.name.as_str()))?)));
+            let Some((refined, program)) = refined else {
+                continue; // not refined: its type is unknown (a check error)
+            };
+            let robot_type = refined.robot_type.map(|id| input.catalog.get(id));
+            let found = robot(
+                input,
+                program,
+                robot_type,
+                &mut out.diagnostics,
+                &mut out.graphs,
+            );
+            out.robots.extend(robots.map(|r| RobotDataflow {
+                robot: r.name.to_string(),
+                ..found.clone()
+            }));
+        }
     }
     diag::sort_and_dedup(&mut out.diagnostics);
     out.graphs.sort();
@@ -147,6 +176,7 @@ struct GraphCall<'p> {
 fn robot(
     input: &DataflowInput<'_>,
     program: &RobotProgram,
+    robot_type: Option<&RobotType>,
     diagnostics: &mut Vec<Diagnostic>,
     graphs: &mut Vec<FileId>,
 ) -> RobotDataflow {
@@ -156,7 +186,7 @@ fn robot(
         period: None,
         bounded_by: None,
     };
-    for call in graph_calls(input, program) {
+    for call in graph_calls(input, program, robot_type) {
         graphs.extend(call.run.graph.as_ref().map(|g| g.file));
         diagnostics.extend(graph_problems(input.file, &call));
         let Some(period) = iteration_period(&call.run) else {
@@ -200,19 +230,13 @@ fn robot(
     found
 }
 
-/// The calls of `program` whose service the robot's type implements by a
-/// task graph that could be read.
-fn graph_calls<'p>(input: &DataflowInput<'p>, program: &'p RobotProgram) -> Vec<GraphCall<'p>> {
-    // The robot's type as the checker resolved it.
-    let robot_type = input
-        .mission
-        .teams
-        .iter()
-        .filter(|t| t.name == program.team.as_str())
-        .flat_map(|t| &t.robots)
-        .find(|r| r.name == program.robot.as_str())
-        .and_then(|r| r.robot_type)
-        .map(|id| input.catalog.get(id));
+/// The calls of `program` whose service the robot's type (as the checker
+/// resolved it) implements by a task graph that could be read.
+fn graph_calls<'p>(
+    input: &DataflowInput<'p>,
+    program: &'p RobotProgram,
+    robot_type: Option<&'p RobotType>,
+) -> Vec<GraphCall<'p>> {
     let Some(robot_type) = robot_type else {
         return Vec::new();
     };
@@ -254,7 +278,7 @@ fn asked_period(states: &[State], index: usize) -> Option<(i64, Span)> {
                 period_ms: Some(p),
                 to: head,
                 ..
-            } if head < index && index < tail => Some((tail - head, (p, s.span))),
+            } if head.index() < index && index < tail => Some((tail - head.index(), (p, s.span))),
             _ => None,
         })
         .min_by_key(|(width, _)| *width)

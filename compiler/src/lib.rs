@@ -27,6 +27,8 @@ pub mod format;
 pub mod fsread;
 pub mod host;
 pub mod ide;
+/// Typed indices (`newtype_index!`): a plan's index is not a mode's.
+mod index;
 /// Graph drawing shared by the task-graph and mode-machine pictures.
 mod layout;
 pub mod modemachine;

@@ -24,7 +24,7 @@ pub const SPEED_LEVEL_PARAM: &str = "semo_speed_level";
 
 /// `static void manage_resources(void)` and its state, or nothing for a
 /// robot without policies.
-pub(super) fn resource_manager(program: &RobotProgram) -> String {
+pub(super) fn resource_manager(program: &RobotProgram, words: &super::values::Words) -> String {
     let m = &program.control;
     let sensor_period_ms = |task: &str| {
         program
@@ -40,7 +40,6 @@ pub(super) fn resource_manager(program: &RobotProgram) -> String {
         return String::new();
     }
     let tasks = m.battery_tasks();
-    let words = super::values::Words::of(program);
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -56,7 +55,7 @@ pub(super) fn resource_manager(program: &RobotProgram) -> String {
             "    /* {} ({}) */\n    holds = {};\n    if (holds != policy_holds[{i}]) {{\n        policy_holds[{i}] = holds;\n        semo_trace(\"battery_policy\", \"condition\", {}, \"holds\", holds ? \"true\" : \"false\", NULL);\n    }}",
             c::comment(&policy.text),
             c::comment(&policy.source),
-            expr(&policy.condition, &words),
+            expr(&policy.condition, words),
             c::string(&policy.text),
         );
     }

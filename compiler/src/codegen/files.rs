@@ -4,7 +4,7 @@
 use super::c;
 use super::values::Words;
 use super::{CompiledScenario, Platform, Target};
-use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK, getter, setter};
+use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK};
 use crate::refine::{RobotProgram, RoleKind, ValueKind};
 use crate::taskgraph::Trigger;
 use std::fmt::Write;
@@ -59,22 +59,7 @@ pub fn program_h(program: &RobotProgram, header: &str) -> String {
             out.push_str("/* The last pass of a robot through sync point `point` (an index into\n * the program's sync points) that it announced; 0 before any. */\nlong comm_sync_arrived(size_t peer, size_t point);\n");
         }
     }
-    if let Some(lib) = &program.library {
-        let _ = writeln!(
-            out,
-            "\n/* Library task {}: the team's shared information. */",
-            lib.name
-        );
-        for key in &lib.attributes {
-            let prefix = c::ident(&lib.name);
-            let _ = writeln!(
-                out,
-                "LIBFUNC(semo_value, {prefix}_{}, (void));\nLIBFUNC(void, {prefix}_{}, (const semo_value *value));",
-                getter(key),
-                setter(key)
-            );
-        }
-    }
+    out.push_str(&super::shared::declarations(program));
     let _ = writeln!(
         out,
         "\n/* The task graph's channels (channels.c). */\n#define SEMO_CHANNEL_COUNT {}\nextern const semo_channel_desc semo_program_channels[];",
@@ -144,7 +129,7 @@ pub fn channels_c(program: &RobotProgram, target: Target, header: &str) -> Strin
     out
 }
 
-pub fn main_c(program: &RobotProgram, target: Target, header: &str) -> String {
+pub fn main_c(program: &RobotProgram, words: &Words, target: Target, header: &str) -> String {
     let mut out = String::from(header);
     out.push_str(match target.platform() {
         Platform::Threads => "#include \"program.h\"\n\n/* Tasks: one thread each. */\nstatic const semo_task_desc tasks[] = {\n",
@@ -190,7 +175,6 @@ pub fn main_c(program: &RobotProgram, target: Target, header: &str) -> String {
             }
         }
     }
-    let words = Words::of(program);
     if !words.list().is_empty() {
         out.push_str("/* The words of the program: a word value is an index into it. */\nstatic const char *const words[] = {\n");
         for w in words.list() {
@@ -230,7 +214,7 @@ pub fn main_c(program: &RobotProgram, target: Target, header: &str) -> String {
 /// The lock of state shared between tasks: a mutex on threads, nothing on
 /// the static schedule (one task runs at a time). `(include, declare, lock,
 /// unlock)` for a lock named `name`.
-fn lock(target: Target, name: &str) -> (&'static str, String, String, String) {
+pub(super) fn lock(target: Target, name: &str) -> (&'static str, String, String, String) {
     match target.platform() {
         Platform::Threads => (
             "#include <pthread.h>\n",
@@ -247,7 +231,7 @@ fn lock(target: Target, name: &str) -> (&'static str, String, String, String) {
     }
 }
 
-pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> String {
+pub fn comm_task_c(program: &RobotProgram, words: &Words, target: Target, header: &str) -> String {
     let m = &program.control;
     let mut out = String::from(header);
     let (include, declare, lock_seen, unlock_seen) = lock(target, "seen_lock");
@@ -310,9 +294,8 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         let n = m.incoming.len();
         if n > 0 {
             out.push_str("static const struct {\n    const char *port;\n    const char *from_team;\n    const char *key;\n    semo_type type; /* as declared: a value of another type is refused */\n    const unsigned short *domain; /* an enumeration's words (indices), or NULL */\n    unsigned short domain_len;\n} incoming[] = {\n");
-            let words = Words::of(program);
             for i in &m.incoming {
-                let kind = &m.slots[i.slot].kind;
+                let kind = &m.slots[i.slot.index()].kind;
                 // A word of another enumeration is refused, as the simulator does.
                 let domain = match kind {
                     // `{0}` with length 0: an empty enumeration refuses every word.
@@ -374,6 +357,9 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         if !m.sync_points.is_empty() {
             out.push_str("    if (heard_sync(&m))\n        return;\n");
         }
+        if let Some(dispatch) = super::shared::comm_dispatch(program) {
+            out.push_str(&dispatch);
+        }
         if !m.subscribed.is_empty() {
             let _ = writeln!(
                 out,
@@ -394,30 +380,6 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         );
     }
     out
-}
-
-pub fn library_c(program: &RobotProgram, target: Target, header: &str) -> Option<(String, String)> {
-    let lib = program.library.as_ref()?;
-    let prefix = c::ident(&lib.name);
-    let mut out = String::from(header);
-    let (include, declare, lock, unlock) = lock(target, "lock");
-    let _ = write!(out, "#include \"program.h\"\n{include}\n");
-    let _ = writeln!(
-        out,
-        "/* Library task {}: the team's shared information, one value per attribute,\n * read and written by its getters and setters under one lock. */\n{declare}static semo_value value[{}];\n",
-        c::comment(&lib.name),
-        lib.attributes.len()
-    );
-    for (i, key) in lib.attributes.iter().enumerate() {
-        let _ = writeln!(
-            out,
-            "/* {} */\nLIBFUNC(semo_value, {prefix}_{}, (void))\n{{\n    {lock}\n    semo_value v = value[{i}];\n    {unlock}\n    return v;\n}}\n\nLIBFUNC(void, {prefix}_{}, (const semo_value *v))\n{{\n    {lock}\n    value[{i}] = *v;\n    {unlock}\n}}\n",
-            c::comment(key),
-            getter(key),
-            setter(key)
-        );
-    }
-    Some((format!("lib_{prefix}.c"), out))
 }
 
 /// `tasks/<task>.c`: the simulation's own body for `linux-sim`; for `linux`

@@ -1,97 +1,349 @@
 //! A service task that runs a task graph ([`GraphService`]: a catalog
-//! service implemented by `graph=`, SDF/L loop nodes opened): its inner
-//! tasks as functions, and `run_graph`, one iteration of the graph's looped
-//! schedule, which the service task runs at each call before the service's
-//! time. D-type loops repeat their body exactly `loop_count` times; C-type
-//! loops repeat it until their exit task sets the exit flag (checked after
-//! each iteration, so the exit task's iteration completes), at most
-//! `loop_count` times. Every inner firing is traced (`graph_fire`), and
-//! every SDF/L loop's end with its iterations (`graph_loop`). In
-//! `linux-sim` an exit task sets the flag in the iteration the scenario's
-//! `loops` names for `graph/loop` (`semo_sim_loop_exit`); for `linux` its body is the user's
-//! (the service task file is created once). The simulator runs the same
-//! steps (`sim/engine/loops.rs`).
+//! service implemented by `graph=`, SDF/L loop nodes opened): its channels,
+//! its inner tasks as functions, and `run_graph`, one iteration of the
+//! graph's looped schedule, which the service task runs at each call before
+//! the service's time.
+//!
+//! Each channel is a FIFO of tokens (`semo_value`) in a static ring of the
+//! analysis's buffer bound ([`GraphChannel::capacity`]), kept from call to
+//! call (a channel's initial tokens are the integer 0); a firing short of
+//! tokens or over the bound is a generator bug, traced (`graph_error`) and
+//! aborted. An inner task takes its inputs' tokens, runs its work function
+//! (`work_<n>_<task>`: its inputs and outputs as arrays, one parameter per
+//! port; the outputs start as the integer 0), traces `graph_fire` with the
+//! tokens it read and wrote, and puts its outputs. In `linux-sim` the work
+//! is the simulator's (`sim/engine/loops.rs`): every output token `k` of a
+//! port is `(sum of the tokens read + k + 1) mod 1000`; for `linux` its body
+//! is the user's (the service task file is created once).
+//!
+//! D-type loops repeat their body exactly `loop_count` times; C-type loops
+//! repeat it until their exit task sets the exit flag (checked after each
+//! iteration, so the exit task's iteration completes), at most `loop_count`
+//! times. A loop node takes its inputs' tokens when it starts, gives each
+//! iteration its share (distributing) or the same tokens (broadcasting),
+//! takes its body's outputs after each iteration and puts the last ones
+//! when it ends ([`LoopPort`]); its end is traced with its iterations
+//! (`graph_loop`). In `linux-sim` an exit task sets the flag in the
+//! iteration the scenario's `loops` names for `graph/loop`
+//! (`semo_sim_loop_exit`).
 
 use super::c;
-use crate::refine::{GraphService, GraphStep};
+use crate::refine::{GraphService, GraphStep, InnerTask, LoopPort, PortUse};
 use std::fmt::Write;
 
-/// The inner task functions and `run_graph` for `service`, placed before
-/// the task's functions; `simulated`: the exit tasks ask the scenario.
+/// Characters of a `graph_fire` trace's `read` or `wrote` field, at most
+/// (tokens beyond are cut, as `sim/engine/loops.rs` cuts them).
+pub const GRAPH_TEXT_MAX: u64 = 4096;
+
+/// Characters a token takes in a trace field, at most, for sizing: an
+/// integer and its comma.
+const TOKEN_TEXT: u64 = 24;
+
+/// The channels, inner task functions and `run_graph` for `service`, placed
+/// before the task's functions; `simulated`: the work is the simulator's and
+/// the exit tasks ask the scenario.
 pub(super) fn graph_runner(service: &GraphService, simulated: bool) -> String {
     let mut out = String::new();
     // target::check refuses a graph without a schedule before generation.
     let Ok(steps_of) = &service.steps else {
         return out;
     };
-    let mut fired: Vec<&str> = Vec::new();
     let mut exits: Vec<(&str, &str)> = Vec::new();
-    collect(steps_of, &mut fired, &mut exits);
-    // Only a graph with loop nodes traces their ends (an unused static
-    // function fails -Werror).
+    collect_exits(steps_of, &mut exits);
+    let graph = c::string(&service.graph);
     let has_loops = has_loop_nodes(steps_of);
+    let any_port = service
+        .tasks
+        .iter()
+        .any(|t| !t.inputs.is_empty() || !t.outputs.is_empty());
+    let keeps = has_loop_outputs(steps_of);
     let _ = writeln!(
         out,
-        "/* Task graph `{}`, run by this service task: one iteration per call. */\n{}",
-        c::comment(&service.graph),
-        if has_loops {
-            "#include <stdio.h>\n"
-        } else {
-            ""
-        }
+        "/* Task graph `{}`, run by this service task: one iteration per call. */",
+        c::comment(&service.graph)
     );
-    for task in &fired {
-        let exit_of = exits.iter().find(|(t, _)| t == task).map(|(_, l)| *l);
-        let _ = writeln!(out, "/* Inner task `{}`. */", c::comment(task));
-        match exit_of {
-            None => {
-                let _ = writeln!(out, "static void inner_{}(void)\n{{", c::ident(task));
-            }
-            Some(_) => {
-                let _ = writeln!(
-                    out,
-                    "/* The exit task of its convergent loop: true to set the exit flag. */\nstatic bool inner_{}(unsigned long iteration)\n{{",
-                    c::ident(task)
-                );
-            }
-        }
-        let _ = writeln!(
-            out,
-            "    semo_trace(\"graph_fire\", \"graph\", {}, \"task\", {}, NULL);",
-            c::string(&service.graph),
-            c::string(task)
-        );
-        match (exit_of, simulated) {
-            (None, true) => {}
-            (None, false) => out.push_str("    /* TODO: the task's work. */\n"),
-            (Some(l), true) => {
-                let _ = writeln!(
-                    out,
-                    "    int64_t exit_at = semo_sim_loop_exit({});\n    return exit_at > 0 && (int64_t)iteration >= exit_at;",
-                    c::string(&format!("{}/{l}", service.graph))
-                );
-            }
-            (Some(_), false) => out.push_str(
-                "    /* TODO: the task's work; true when the loop has converged. */\n    (void)iteration;\n    return false;\n",
-            ),
-        }
-        out.push_str("}\n\n");
+    if has_loops || !service.channels.is_empty() {
+        out.push_str("#include <stdio.h>\n");
+    }
+    if !service.channels.is_empty() {
+        out.push_str("#include <stdlib.h>\n");
+    }
+    if any_port || keeps {
+        out.push_str("#include <string.h>\n");
+    }
+    out.push('\n');
+    channels(&mut out, service, &graph, any_port, keeps);
+    for (index, task) in service.tasks.iter().enumerate() {
+        let exit_of = exits.iter().find(|(t, _)| *t == task.path).map(|(_, l)| *l);
+        inner_task(&mut out, service, index, task, exit_of, simulated, &graph);
     }
     if has_loops {
         out.push_str("/* Traces the end of an SDF/L loop with the iterations it ran. */\nstatic void loop_ended(const char *loop, unsigned long iterations)\n{\n    char text[24];\n    snprintf(text, sizeof text, \"%lu\", iterations);\n");
         let _ = writeln!(
             out,
-            "    semo_trace(\"graph_loop\", \"graph\", {}, \"loop\", loop, \"iterations\", text, NULL);\n}}\n",
-            c::string(&service.graph)
+            "    semo_trace(\"graph_loop\", \"graph\", {graph}, \"loop\", loop, \"iterations\", text, NULL);\n}}\n"
         );
     }
     out.push_str(
         "/* One iteration of the graph's looped schedule. */\nstatic void run_graph(void)\n{\n",
     );
     let mut depth = 0;
-    steps(&mut out, steps_of, 1, &mut depth, None);
+    steps(&mut out, service, steps_of, 1, &mut depth, None);
     out.push_str("}\n\n");
     out
+}
+
+/// The channel rings and the helpers that move tokens (each written only
+/// when used: an unused static function fails -Werror).
+fn channels(out: &mut String, service: &GraphService, graph: &str, any_port: bool, keeps: bool) {
+    if service.channels.is_empty() {
+        return;
+    }
+    out.push_str("/* A channel between inner tasks: a ring of tokens, `count` from `head`. */\ntypedef struct {\n    semo_value *token;\n    unsigned long capacity, head, count;\n    const char *label;\n} graph_channel;\n\n");
+    for (i, ch) in service.channels.iter().enumerate() {
+        let initial = if ch.initial_tokens > 0 {
+            let zeros = vec!["{.type = SEMO_INT}"; ch.initial_tokens.min(ch.capacity) as usize];
+            format!(" = {{{}}}", zeros.join(", "))
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            out,
+            "static semo_value channel{i}_token[{}]{initial}; /* {} */",
+            ch.capacity,
+            c::comment(&ch.label)
+        );
+    }
+    let _ = writeln!(
+        out,
+        "static graph_channel channel[{}] = {{",
+        service.channels.len()
+    );
+    for (i, ch) in service.channels.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "    {{channel{i}_token, {}, 0, {}, {}}},",
+            ch.capacity,
+            ch.initial_tokens,
+            c::string(&ch.label)
+        );
+    }
+    out.push_str("};\n\n");
+    let _ = writeln!(
+        out,
+        "/* A channel short of tokens or over its bound: the schedule and the\n * analysis's bounds exclude both, so this is a generator bug. */\nstatic void graph_broken(const graph_channel *c, const char *what)\n{{\n    semo_trace(\"graph_error\", \"graph\", {graph}, \"channel\", c->label, \"error\", what, NULL);\n    fprintf(stderr, \"semo: internal error: task graph %s: channel %s %s\\n\", {graph}, c->label, what);\n    abort();\n}}\n"
+    );
+    out.push_str("static void graph_take(graph_channel *c, semo_value *out, unsigned long n)\n{\n    for (unsigned long k = 0; k < n; k++) {\n        if (c->count == 0)\n            graph_broken(c, \"is empty\");\n        out[k] = c->token[c->head];\n        c->head = (c->head + 1) % c->capacity;\n        c->count--;\n    }\n}\n\n");
+    out.push_str("static void graph_put(graph_channel *c, const semo_value *in, unsigned long n)\n{\n    for (unsigned long k = 0; k < n; k++) {\n        if (c->count == c->capacity)\n            graph_broken(c, \"is full\");\n        c->token[(c->head + c->count) % c->capacity] = in[k];\n        c->count++;\n    }\n}\n\n");
+    if any_port {
+        let _ = writeln!(
+            out,
+            "/* Appends tokens to a trace field: their JSON, comma separated, cut at\n * {} characters. */\nstatic void graph_text(char *text, size_t cap, const semo_value *v, unsigned long n)\n{{\n    size_t len = strlen(text);\n    for (unsigned long k = 0; k < n && len + 1 < cap; k++) {{\n        if (len > 0) {{\n            text[len++] = ',';\n            text[len] = '\\0';\n        }}\n        len += semo_value_json(&v[k], text + len, cap - len);\n    }}\n}}\n",
+            GRAPH_TEXT_MAX - 1
+        );
+    }
+    if keeps {
+        out.push_str("/* Takes `n` tokens a loop iteration gave into the last `keep` taken. */\nstatic void graph_keep(graph_channel *c, semo_value *kept, unsigned long keep, unsigned long *held, unsigned long n)\n{\n    for (unsigned long k = 0; k < n; k++) {\n        semo_value v;\n        graph_take(c, &v, 1);\n        if (*held == keep) {\n            memmove(kept, kept + 1, (keep - 1) * sizeof *kept);\n            (*held)--;\n        }\n        kept[(*held)++] = v;\n    }\n}\n\n");
+    }
+}
+
+fn param(port: &PortUse, input: bool) -> String {
+    format!(
+        "{}_{}",
+        if input { "in" } else { "out" },
+        c::ident(&port.port)
+    )
+}
+
+/// Bytes of a trace field for `ports`' tokens.
+fn text_size(ports: &[PortUse]) -> u64 {
+    let tokens: u64 = ports.iter().map(|p| p.rate).sum();
+    tokens
+        .saturating_mul(TOKEN_TEXT)
+        .saturating_add(1)
+        .min(GRAPH_TEXT_MAX)
+}
+
+/// The work function of inner task `task` and its firing, `inner_<n>`.
+fn inner_task(
+    out: &mut String,
+    service: &GraphService,
+    index: usize,
+    task: &InnerTask,
+    exit_of: Option<&str>,
+    simulated: bool,
+    graph: &str,
+) {
+    let name = format!("{index}_{}", c::ident(&task.path));
+    let ports: Vec<(&PortUse, bool)> = task
+        .inputs
+        .iter()
+        .map(|p| (p, true))
+        .chain(task.outputs.iter().map(|p| (p, false)))
+        .collect();
+    let mut params: Vec<String> = ports
+        .iter()
+        .map(|(p, input)| {
+            format!(
+                "{}semo_value *{}",
+                if *input { "const " } else { "" },
+                param(p, *input)
+            )
+        })
+        .collect();
+    if exit_of.is_some() {
+        params.insert(0, "unsigned long iteration".into());
+    }
+    let signature = if params.is_empty() {
+        "void".to_string()
+    } else {
+        params.join(", ")
+    };
+    let returns = if exit_of.is_some() { "bool" } else { "void" };
+    let rates = |ports: &[PortUse]| {
+        ports
+            .iter()
+            .map(|p| format!("{}[{}]", c::comment(&p.port), p.rate))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let _ = writeln!(
+        out,
+        "/* The work of inner task `{}`: reads {}; writes {} (each output the\n * integer 0 until set).{} */\nstatic {returns} work_{name}({signature})\n{{",
+        c::comment(&task.path),
+        if task.inputs.is_empty() {
+            "nothing".into()
+        } else {
+            rates(&task.inputs)
+        },
+        if task.outputs.is_empty() {
+            "nothing".into()
+        } else {
+            rates(&task.outputs)
+        },
+        if exit_of.is_some() {
+            " The exit task of its convergent loop: true to set the exit flag."
+        } else {
+            ""
+        }
+    );
+    for (p, input) in &ports {
+        let _ = writeln!(out, "    (void){};", param(p, *input));
+    }
+    match (simulated, exit_of) {
+        (true, _) => {
+            if !task.outputs.is_empty() {
+                out.push_str("    /* The simulator's work: (sum of the tokens read + k + 1) mod 1000. */\n    int64_t sum = 0;\n");
+                for p in &task.inputs {
+                    let _ = writeln!(
+                        out,
+                        "    for (unsigned long k = 0; k < {}; k++)\n        sum = (sum + ({v}[k].type == SEMO_INT ? ({v}[k].i % 1000 + 1000) % 1000 : 0)) % 1000;",
+                        p.rate,
+                        v = param(p, true)
+                    );
+                }
+                for p in &task.outputs {
+                    let _ = writeln!(
+                        out,
+                        "    for (unsigned long k = 0; k < {}; k++)\n        semo_value_set_int(&{}[k], (sum + (int64_t)(k % 1000) + 1) % 1000);",
+                        p.rate,
+                        param(p, false)
+                    );
+                }
+            }
+            if let Some(l) = exit_of {
+                let _ = writeln!(
+                    out,
+                    "    int64_t exit_at = semo_sim_loop_exit({});\n    return exit_at > 0 && (int64_t)iteration >= exit_at;",
+                    c::string(&format!("{}/{l}", service.graph))
+                );
+            }
+        }
+        (false, None) => out.push_str("    /* TODO: the task's work. */\n"),
+        (false, Some(_)) => out.push_str(
+            "    /* TODO: the task's work; true when the loop has converged. */\n    (void)iteration;\n    return false;\n",
+        ),
+    }
+    out.push_str("}\n\n");
+    // The firing: take, work, trace, put.
+    let _ = writeln!(
+        out,
+        "/* A firing of inner task `{}`. */\nstatic {returns} inner_{name}({})\n{{",
+        c::comment(&task.path),
+        if exit_of.is_some() {
+            "unsigned long iteration"
+        } else {
+            "void"
+        }
+    );
+    for (p, input) in &ports {
+        let _ = writeln!(out, "    semo_value {}[{}];", param(p, *input), p.rate);
+    }
+    let texts = [("read", &task.inputs), ("wrote", &task.outputs)];
+    for (field, ports) in texts {
+        if !ports.is_empty() {
+            let _ = writeln!(out, "    char {field}[{}] = \"\";", text_size(ports));
+        }
+    }
+    for p in &task.inputs {
+        let _ = writeln!(
+            out,
+            "    graph_take(&channel[{}], {1}, {2});\n    graph_text(read, sizeof read, {1}, {2});",
+            p.channel,
+            param(p, true),
+            p.rate
+        );
+    }
+    for p in &task.outputs {
+        let _ = writeln!(
+            out,
+            "    for (unsigned long k = 0; k < {}; k++)\n        semo_value_set_int(&{}[k], 0);",
+            p.rate,
+            param(p, false)
+        );
+    }
+    let mut args: Vec<String> = ports.iter().map(|(p, input)| param(p, *input)).collect();
+    if exit_of.is_some() {
+        args.insert(0, "iteration".into());
+        let _ = writeln!(out, "    bool exit = work_{name}({});", args.join(", "));
+    } else {
+        let _ = writeln!(out, "    work_{name}({});", args.join(", "));
+    }
+    for p in &task.outputs {
+        let _ = writeln!(
+            out,
+            "    graph_text(wrote, sizeof wrote, {}, {});",
+            param(p, false),
+            p.rate
+        );
+    }
+    let text_of = |field: &str, ports: &[PortUse]| {
+        if ports.is_empty() {
+            "\"\"".to_string()
+        } else {
+            field.to_string()
+        }
+    };
+    let _ = writeln!(
+        out,
+        "    semo_trace(\"graph_fire\", \"graph\", {graph}, \"task\", {}, \"read\", {}, \"wrote\", {}, NULL);",
+        c::string(&task.path),
+        text_of("read", &task.inputs),
+        text_of("wrote", &task.outputs)
+    );
+    for p in &task.outputs {
+        let _ = writeln!(
+            out,
+            "    graph_put(&channel[{}], {}, {});",
+            p.channel,
+            param(p, false),
+            p.rate
+        );
+    }
+    if exit_of.is_some() {
+        out.push_str("    return exit;\n");
+    }
+    out.push_str("}\n\n");
 }
 
 fn has_loop_nodes(steps: &[GraphStep]) -> bool {
@@ -102,21 +354,22 @@ fn has_loop_nodes(steps: &[GraphStep]) -> bool {
     })
 }
 
-/// Every inner task fired, in first-firing order, and the exit tasks with
-/// their loop's path.
-fn collect<'s>(
-    steps: &'s [GraphStep],
-    fired: &mut Vec<&'s str>,
-    exits: &mut Vec<(&'s str, &'s str)>,
-) {
+fn has_loop_outputs(steps: &[GraphStep]) -> bool {
+    steps.iter().any(|s| match s {
+        GraphStep::Fire { .. } => false,
+        GraphStep::Repeat { body, .. } => has_loop_outputs(body),
+        GraphStep::Loop { ports, body, .. } => {
+            ports.iter().any(|p| !p.input) || has_loop_outputs(body)
+        }
+    })
+}
+
+/// The exit tasks of convergent loops, with their loop's path.
+fn collect_exits<'s>(steps: &'s [GraphStep], exits: &mut Vec<(&'s str, &'s str)>) {
     for step in steps {
         match step {
-            GraphStep::Fire { task, .. } => {
-                if !fired.contains(&task.as_str()) {
-                    fired.push(task);
-                }
-            }
-            GraphStep::Repeat { body, .. } => collect(body, fired, exits),
+            GraphStep::Fire { .. } => {}
+            GraphStep::Repeat { body, .. } => collect_exits(body, exits),
             GraphStep::Loop {
                 path,
                 exit_task,
@@ -127,16 +380,27 @@ fn collect<'s>(
                 if let (true, Some(exit)) = (*convergent, exit_task) {
                     exits.push((exit, path));
                 }
-                collect(body, fired, exits);
+                collect_exits(body, exits);
             }
         }
     }
+}
+
+/// The C name of inner task `path`'s firing function.
+fn firing(service: &GraphService, path: &str) -> String {
+    let index = service
+        .tasks
+        .iter()
+        .position(|t| t.path == path)
+        .unwrap_or(usize::MAX); // refinement lists every task it fires
+    format!("inner_{index}_{}", c::ident(path))
 }
 
 /// The statements of `steps` at `indent` levels; `exit` names the flag of
 /// the innermost convergent loop and its exit task.
 fn steps(
     out: &mut String,
+    service: &GraphService,
     steps_of: &[GraphStep],
     indent: usize,
     depth: &mut usize,
@@ -146,12 +410,12 @@ fn steps(
     for step in steps_of {
         match step {
             GraphStep::Fire { task, count } => {
+                let function = firing(service, task);
                 let call = match exit {
-                    Some((exit_task, d)) if exit_task == task => format!(
-                        "if (inner_{}(n{d}))\n{pad}    exit_flag{d} = true;",
-                        c::ident(task)
-                    ),
-                    _ => format!("inner_{}();", c::ident(task)),
+                    Some((exit_task, d)) if exit_task == task => {
+                        format!("if ({function}(n{d}))\n{pad}    exit_flag{d} = true;")
+                    }
+                    _ => format!("{function}();"),
                 };
                 if *count == 1 {
                     let _ = writeln!(out, "{pad}{call}");
@@ -172,7 +436,7 @@ fn steps(
                     out,
                     "{pad}for (unsigned long {i} = 0; {i} < {count}; {i}++) {{"
                 );
-                self::steps(out, body, indent + 1, depth, exit);
+                self::steps(out, service, body, indent + 1, depth, exit);
                 let _ = writeln!(out, "{pad}}}");
             }
             GraphStep::Loop {
@@ -180,12 +444,14 @@ fn steps(
                 convergent,
                 loop_count,
                 exit_task,
+                ports,
                 body,
             } => {
                 *depth += 1;
                 let d = *depth;
                 let kind = if *convergent { "C-type" } else { "D-type" };
                 let _ = writeln!(out, "{pad}{{ /* {kind} loop `{}` */", c::comment(path));
+                loop_start(out, &pad, d, ports);
                 let inner_exit = match (convergent, exit_task) {
                     (true, Some(e)) => {
                         let _ = writeln!(out, "{pad}    bool exit_flag{d} = false;");
@@ -202,13 +468,66 @@ fn steps(
                     out,
                     "{pad}    unsigned long n{d} = 0;\n{pad}    while (n{d} < {loop_count}{until}) {{\n{pad}        n{d}++;"
                 );
-                self::steps(out, body, indent + 2, depth, inner_exit);
+                iteration_inputs(out, &pad, d, ports);
+                self::steps(out, service, body, indent + 2, depth, inner_exit);
+                for (j, p) in ports.iter().enumerate().filter(|(_, p)| !p.input) {
+                    let _ = writeln!(
+                        out,
+                        "{pad}        graph_keep(&channel[{}], loop{d}_port{j}, {}, &held{d}_port{j}, {});",
+                        p.inner, p.outer_rate, p.inner_rate
+                    );
+                }
                 let _ = writeln!(
                     out,
-                    "{pad}    }}\n{pad}    loop_ended({}, n{d});\n{pad}}}",
+                    "{pad}    }}\n{pad}    loop_ended({}, n{d});",
                     c::string(path)
                 );
+                for (j, p) in ports.iter().enumerate().filter(|(_, p)| !p.input) {
+                    let _ = writeln!(
+                        out,
+                        "{pad}    graph_put(&channel[{}], loop{d}_port{j}, {});",
+                        p.outer, p.outer_rate
+                    );
+                }
+                let _ = writeln!(out, "{pad}}}");
             }
         }
+    }
+}
+
+/// A loop node's start: its inputs' tokens taken, room for its outputs'.
+fn loop_start(out: &mut String, pad: &str, d: usize, ports: &[LoopPort]) {
+    for (j, p) in ports.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "{pad}    semo_value loop{d}_port{j}[{}]; /* {} */",
+            p.outer_rate,
+            c::comment(&p.port)
+        );
+        if p.input {
+            let _ = writeln!(
+                out,
+                "{pad}    graph_take(&channel[{}], loop{d}_port{j}, {});",
+                p.outer, p.outer_rate
+            );
+        } else {
+            let _ = writeln!(out, "{pad}    unsigned long held{d}_port{j} = 0;");
+        }
+    }
+}
+
+/// Each input's tokens for iteration `n{d}` (from 1).
+fn iteration_inputs(out: &mut String, pad: &str, d: usize, ports: &[LoopPort]) {
+    for (j, p) in ports.iter().enumerate().filter(|(_, p)| p.input) {
+        let index = if p.distributing {
+            format!("((n{d} - 1) * {} + k) % {}", p.inner_rate, p.outer_rate)
+        } else {
+            format!("k % {}", p.outer_rate)
+        };
+        let _ = writeln!(
+            out,
+            "{pad}        for (unsigned long k = 0; k < {}; k++)\n{pad}            graph_put(&channel[{}], &loop{d}_port{j}[{index}], 1);",
+            p.inner_rate, p.inner
+        );
     }
 }

@@ -22,8 +22,10 @@ mod control;
 pub use control::listen_ms;
 pub(crate) mod files;
 mod loops;
+pub use loops::GRAPH_TEXT_MAX;
 pub mod output;
 mod schedule;
+mod shared;
 mod target;
 mod values;
 
@@ -260,15 +262,19 @@ pub enum Emit {
 
 /// The files of one robot's folder. `sources` names the input files for the
 /// header of every generated file; `scenario` is the world compiled into a
-/// target that [`Target::needs_scenario`] (ignored by the others).
+/// target that [`Target::needs_scenario`] (ignored by the others). With them,
+/// the words its code asked the word table for and it lacked (each refuses
+/// the build: `missing_word_errors`).
 pub fn generate(
     program: &RobotProgram,
     target: Target,
     emit: Emit,
     sources: &[String],
     scenario: Option<&CompiledScenario>,
-) -> RobotOutput {
+) -> (RobotOutput, Vec<String>) {
     let header = header(program, target, sources);
+    // One word table for every file: the words it lacked refuse the build.
+    let words = values::Words::of(program);
     let mut files = Vec::new();
     let mut push = |path: &str, text: String, owner: Owner| {
         files.push(GeneratedFile {
@@ -290,11 +296,12 @@ pub fn generate(
         Owner::Generated,
     );
     if emit == Emit::TaskGraph {
-        return RobotOutput {
+        let output = RobotOutput {
             team: program.team.clone(),
             robot: program.robot.clone(),
             files,
         };
+        return (output, Vec::new());
     }
     let mut sources_c = vec![
         "main.c".to_string(),
@@ -308,7 +315,7 @@ pub fn generate(
     );
     push(
         "main.c",
-        files::main_c(program, target, &header),
+        files::main_c(program, &words, target, &header),
         Owner::Generated,
     );
     push(
@@ -318,7 +325,7 @@ pub fn generate(
     );
     push(
         "control_task.c",
-        control::control_task(program, &header),
+        control::control_task(program, &words, &header),
         Owner::Generated,
     );
     let comm = program
@@ -328,12 +335,12 @@ pub fn generate(
     if comm {
         push(
             "comm_task.c",
-            files::comm_task_c(program, target, &header),
+            files::comm_task_c(program, &words, target, &header),
             Owner::Generated,
         );
         sources_c.push("comm_task.c".into());
     }
-    if let Some((name, text)) = files::library_c(program, target, &header) {
+    if let Some((name, text)) = shared::library_c(program, target, &header) {
         push(&name, text, Owner::Generated);
         sources_c.push(name);
     }
@@ -378,11 +385,12 @@ pub fn generate(
         text: makefile,
         owner: Owner::Generated,
     });
-    RobotOutput {
+    let output = RobotOutput {
         team: program.team.clone(),
         robot: program.robot.clone(),
         files,
-    }
+    };
+    (output, words.missing())
 }
 
 /// Bytes of the longest value the program holds that is known at build
@@ -494,11 +502,12 @@ pub fn build_refined(
             diagnostics,
         };
     }
-    let robots: Vec<RobotOutput> = programs
-        .iter()
-        .enumerate()
-        .map(|(i, p)| generate(p, target, emit, &sources, scenarios.get(i)))
-        .collect();
+    let mut robots: Vec<RobotOutput> = Vec::new();
+    for (i, program) in programs.iter().enumerate() {
+        let (robot, missing) = generate(program, target, emit, &sources, scenarios.get(i));
+        diagnostics.extend(missing_word_errors(build, program, &missing));
+        robots.push(robot);
+    }
     diagnostics.extend(
         programs
             .iter()
@@ -515,6 +524,32 @@ pub fn build_refined(
         robots,
         diagnostics,
     }
+}
+
+/// The words generation asked the program's word table for and it lacked
+/// (`values::Words::index`): each an internal error (E102), never written
+/// as another word.
+fn missing_word_errors(
+    build: &BuildInput<'_>,
+    program: &crate::refine::RobotProgram,
+    missing: &[String],
+) -> Vec<crate::diag::Diagnostic> {
+    use crate::diag::{Code, Diagnostic};
+    let span = robot_span(build, &program.robot);
+    missing
+        .iter()
+        .map(|word| {
+            Diagnostic::new(
+                Code::CodegenInternal,
+                build.mission,
+                span,
+                format!(
+                    "the code generated for robot `{}` uses the word `{word}`, which its word table lacks",
+                    program.robot
+                ),
+            )
+        })
+        .collect()
 }
 
 /// Each robot's `taskgraph.xml` read back by the task-graph loader, as a user
@@ -564,6 +599,15 @@ pub struct Refined {
 /// strategies) refuses, as do problems found while refining and names that
 /// cannot be files or C identifiers (E101).
 pub fn refine_checked(build: &BuildInput<'_>) -> Refined {
+    refine_checked_robots(build, crate::refine::Robots::All)
+}
+
+/// [`refine_checked`] of the robots `robots` selects. With
+/// [`Robots::OnePerDeclaration`](crate::refine::Robots) it refuses exactly
+/// when `refine_checked` does: the other robots of a declaration differ
+/// only by the number ending their name, and the one refined has the
+/// longest (E101 bounds a name's length).
+pub fn refine_checked_robots(build: &BuildInput<'_>, robots: crate::refine::Robots) -> Refined {
     use crate::diag::{Code, Diagnostic};
     let mut diagnostics: Vec<Diagnostic> = build.diagnostics.to_vec();
     let refused = |diagnostics| Refined {
@@ -587,7 +631,7 @@ pub fn refine_checked(build: &BuildInput<'_>) -> Refined {
         links: build.links,
         service_graphs: build.service_graphs,
     };
-    let (programs, found) = crate::refine::refine(&input);
+    let (programs, found) = crate::refine::refine_robots(&input, robots);
     diagnostics.extend(found);
     // Names become folders, files and C identifiers: only plain identifiers.
     for program in &programs {

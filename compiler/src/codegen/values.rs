@@ -5,11 +5,17 @@
 
 use super::c;
 use crate::refine::{Expr, Operand, RobotProgram, StateKind, Value, ValueKind};
+use std::cell::RefCell;
 use std::collections::BTreeSet;
 
 /// The words a program uses: its word literals and the domains of its
-/// enumerated values, sorted.
-pub struct Words(Vec<String>);
+/// enumerated values, sorted. A word asked for that the table lacks is
+/// recorded (`missing`): generation then refuses the program with an
+/// internal error (E102) instead of writing another word's index.
+pub struct Words {
+    list: Vec<String>,
+    missing: RefCell<BTreeSet<String>>,
+}
 
 impl Words {
     pub fn of(program: &RobotProgram) -> Words {
@@ -24,18 +30,32 @@ impl Words {
                 words.insert(w.clone());
             }
         });
-        Words(words.into_iter().collect())
+        Words {
+            list: words.into_iter().collect(),
+            missing: RefCell::new(BTreeSet::new()),
+        }
     }
 
     pub fn list(&self) -> &[String] {
-        &self.0
+        &self.list
     }
 
+    /// The index of `word` in the table. `of` collects every word the
+    /// program holds, so a miss is a generator bug: it is recorded for
+    /// [`Words::missing`] and the index returned is past the table's end
+    /// (the program is refused, never written with it).
     pub(super) fn index(&self, word: &str) -> usize {
-        // Every word literal was collected by `of`.
-        self.0
+        self.list
             .binary_search_by(|w| w.as_str().cmp(word))
-            .unwrap_or(0)
+            .unwrap_or_else(|_| {
+                self.missing.borrow_mut().insert(word.to_string());
+                self.list.len()
+            })
+    }
+
+    /// The words asked for that the table lacks, sorted.
+    pub fn missing(&self) -> Vec<String> {
+        self.missing.borrow().iter().cloned().collect()
     }
 
     /// A literal as a `const semo_value *` expression.
@@ -124,5 +144,39 @@ fn operands(e: &Expr, f: &mut dyn FnMut(&Operand)) {
         }
         Expr::Truthy(o) => f(o),
         Expr::Bool(_) => {}
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(words: &[&str]) -> Words {
+        Words {
+            list: words.iter().map(|w| w.to_string()).collect(),
+            missing: RefCell::new(BTreeSet::new()),
+        }
+    }
+
+    #[test]
+    fn a_word_in_the_table_is_its_index_and_nothing_is_missing() {
+        let words = table(&["east", "north", "west"]);
+        assert_eq!(words.index("north"), 1);
+        assert_eq!(
+            words.literal(&Value::Word("west".into())),
+            "SEMO_LIT_WORD(2) /* west */"
+        );
+        assert!(words.missing().is_empty());
+    }
+
+    /// A word the table lacks is never another word's index (word 0 was
+    /// the old fallback): it is recorded, and generation refuses (E102).
+    #[test]
+    fn a_word_the_table_lacks_is_recorded_as_missing_not_word_zero() {
+        let words = table(&["east", "north"]);
+        let index = words.index("south");
+        assert!(index >= words.list().len(), "{index}");
+        words.literal(&Value::Word("up".into()));
+        assert_eq!(words.missing(), vec!["south".to_string(), "up".to_string()]);
     }
 }

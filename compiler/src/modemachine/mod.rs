@@ -8,7 +8,7 @@ mod svg;
 #[cfg(test)]
 mod tests;
 
-use crate::sema::Mission;
+use crate::sema::{Mission, ModeId};
 use crate::syntax::ast::Name;
 
 pub use svg::to_svg;
@@ -54,14 +54,14 @@ pub fn machines(mission: &Mission) -> Vec<ModeMachine> {
         .filter(|team| !team.modes.is_empty())
         .map(|team| {
             let modes: Vec<Name> = team.modes.iter().map(|m| m.name.clone()).collect();
-            let valid = |i: u32| (i as usize) < modes.len();
+            let valid = |i: ModeId| i.index() < modes.len();
             let mut changes: Vec<ModeChange> = Vec::new();
             let main = team.main.as_ref();
             for t in main.iter().flat_map(|m| &m.transitions) {
                 if !valid(t.from) || !valid(t.to) {
                     continue;
                 }
-                let (from, to) = (t.from as usize, t.to as usize);
+                let (from, to) = (t.from.index(), t.to.index());
                 let change = match changes.iter().position(|c| c.from == from && c.to == to) {
                     Some(i) => &mut changes[i],
                     None => {
@@ -86,12 +86,12 @@ pub fn machines(mission: &Mission) -> Vec<ModeMachine> {
                 default: main
                     .and_then(|m| m.default)
                     .filter(|&d| valid(d))
-                    .map(|d| d as usize),
+                    .map(|d| d.index()),
                 unreachable: main
                     .iter()
                     .flat_map(|m| &m.unreachable)
                     .filter(|&&i| valid(i))
-                    .map(|&i| i as usize)
+                    .map(|&i| i.index())
                     .collect(),
                 modes,
                 changes,

@@ -51,10 +51,32 @@ pub struct ServiceGraph {
     pub graph: std::sync::Arc<crate::taskgraph::TaskGraph>,
 }
 
+/// Which robots [`refine_robots`] refines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Robots {
+    /// Every robot: what code generation and the simulator run.
+    All,
+    /// One robot of each declaration (`name[N]` is one, see
+    /// [`crate::sema::Team::declarations`]): its last, whose name is the
+    /// longest. The robots of a declaration are refined alike but for their
+    /// names and their place among the peers, so what depends on neither
+    /// (the dataflow warnings, whether refinement finds an error) is found
+    /// from one of them: the cost is per declaration, not per robot.
+    OnePerDeclaration,
+}
+
 /// One program per robot of the mission, in formation order, and the
 /// diagnostics that stop generation (constructs code generation does not
 /// support yet, inconsistent refined graphs).
 pub fn refine(input: &RefineInput<'_>) -> (Vec<RobotProgram>, Vec<Diagnostic>) {
+    refine_robots(input, Robots::All)
+}
+
+/// [`refine`] of the robots `robots` selects, in formation order.
+pub fn refine_robots(
+    input: &RefineInput<'_>,
+    robots: Robots,
+) -> (Vec<RobotProgram>, Vec<Diagnostic>) {
     let lines = LineIndex::new(input.text);
     let mission = &input.analysis.mission;
     let peers: Vec<(String, String)> = mission
@@ -69,20 +91,62 @@ pub fn refine(input: &RefineInput<'_>) -> (Vec<RobotProgram>, Vec<Diagnostic>) {
     let mut programs = Vec::new();
     let mut diagnostics = Vec::new();
     for (team_index, team) in mission.teams.iter().enumerate() {
-        for (robot_index, _) in team.robots.iter().enumerate() {
+        let selected: Vec<crate::sema::RobotId> = match robots {
+            Robots::All => team.robot_ids().collect(),
+            Robots::OnePerDeclaration => team
+                .declarations()
+                .iter()
+                .filter_map(|d| d.last().copied())
+                .collect(),
+        };
+        // W130 for a team: what every one of its robots gives.
+        let mut names_no_task: Vec<Vec<Diagnostic>> = Vec::new();
+        for robot in selected {
             let (program, found) = robot::refine_robot(
                 input,
                 &lines,
                 &peers,
                 crate::sema::TeamId(team_index as u32),
-                robot_index,
+                robot.index(),
             );
+            let (warned, found): (Vec<Diagnostic>, Vec<Diagnostic>) = found
+                .into_iter()
+                .partition(|d| d.code == diag::Code::BatteryPolicyNamesNoTask);
+            names_no_task.push(warned);
             diagnostics.extend(found);
             programs.extend(program);
         }
+        robot::shared::owners_of_team(&mut programs, &team.name);
+        if let Some((first, others)) = names_no_task.split_first() {
+            diagnostics.extend(
+                first
+                    .iter()
+                    .filter(|d| others.iter().all(|o| o.contains(d)))
+                    .cloned(),
+            );
+        }
     }
+    assign_groups(&mut programs);
     diag::sort_and_dedup(&mut diagnostics);
     (programs, diagnostics)
+}
+
+/// Each team's group (`<GroupService>`): the robots whose refined programs
+/// call one of the team's group services, given to each of them.
+fn assign_groups(programs: &mut [RobotProgram]) {
+    let mut groups: std::collections::BTreeMap<String, Vec<usize>> = Default::default();
+    for p in programs.iter() {
+        if !p.control.group_services.is_empty() {
+            groups.entry(p.team.clone()).or_default().push(p.self_peer);
+        }
+    }
+    for p in programs.iter_mut() {
+        if !p.control.group_services.is_empty() {
+            let mut members = groups[&p.team].clone();
+            members.sort_unstable();
+            p.control.group = members;
+        }
+    }
 }
 
 #[cfg(test)]

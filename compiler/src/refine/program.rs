@@ -7,8 +7,25 @@
 //! entry's action machine (bottom).
 
 use super::value::{Value, ValueKind};
+use crate::index::newtype_index;
 use crate::span::Span;
 use crate::taskgraph::TaskGraph;
+
+newtype_index! {
+    /// A state of its service machine: an index into [`ServiceMachine::states`]
+    /// (the generated C's `pc`).
+    pub struct StateId;
+}
+
+newtype_index! {
+    /// A value of the control machine: an index into [`ControlMachine::slots`]
+    /// (the generated C's `slot[]`).
+    pub struct SlotId;
+}
+
+/// The robot's battery level, a catalog value: what a strategy's battery
+/// condition reads (`Battery`), and what the robot's status reports.
+pub const BATTERY_VALUE: &str = "BATTERY";
 
 /// One robot's refined program.
 #[derive(Clone, Debug)]
@@ -49,6 +66,59 @@ pub struct GraphService {
     /// inconsistent or deadlocks, which the dataflow warnings report on the
     /// call; code generation refuses it, E100).
     pub steps: Result<Vec<GraphStep>, String>,
+    /// Every channel of every level (empty without steps), the index a
+    /// [`PortUse`] or [`LoopPort`] names.
+    pub channels: Vec<GraphChannel>,
+    /// The inner tasks fired (loop nodes are steps), in first-firing order.
+    pub tasks: Vec<InnerTask>,
+}
+
+/// A channel between inner tasks: a bounded FIFO of tokens. `capacity` is
+/// the analysis's buffer bound (`taskgraph::analysis::buffers`) for the
+/// order in which the service task runs its level: a loop body's boundary
+/// feeds the inputs first and takes the outputs last.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GraphChannel {
+    /// `Converge: ReplaceCenter.fb → Select.prev` (the level below the graph).
+    pub label: String,
+    pub capacity: u64,
+    /// Tokens held before the first iteration (each the integer 0).
+    pub initial_tokens: u64,
+}
+
+/// An inner task: the channels its data ports read and write, in the
+/// order its ports are declared (a port no channel joins is left out).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct InnerTask {
+    /// Its path below the graph, as in [`GraphStep::Fire`].
+    pub path: String,
+    pub inputs: Vec<PortUse>,
+    pub outputs: Vec<PortUse>,
+}
+
+/// A data port of an inner task: `rate` tokens per firing on `channel`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PortUse {
+    pub port: String,
+    pub channel: usize,
+    pub rate: u64,
+}
+
+/// A data port of an SDF/L loop node: an input takes `outer_rate` tokens
+/// from `outer` when the loop starts and gives each iteration `inner_rate`
+/// of them on `inner` (distributing: the iteration's share, in order;
+/// broadcasting: the same first ones); an output takes `inner_rate` from
+/// `inner` after each iteration and, when the loop ends, puts the last
+/// `outer_rate` taken on `outer`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LoopPort {
+    pub port: String,
+    pub input: bool,
+    pub distributing: bool,
+    pub outer_rate: u64,
+    pub inner_rate: u64,
+    pub outer: usize,
+    pub inner: usize,
 }
 
 /// A term of a service graph's looped schedule, loop nodes opened.
@@ -67,6 +137,8 @@ pub enum GraphStep {
         convergent: bool,
         loop_count: u64,
         exit_task: Option<String>,
+        /// Its data ports, in declaration order.
+        ports: Vec<LoopPort>,
         body: Vec<GraphStep>,
     },
 }
@@ -102,6 +174,14 @@ pub struct ControlMachine {
     /// The group statements this robot synchronizes at (`GroupSync`), by
     /// their offset in the mission: what a sync announcement names.
     pub sync_points: Vec<usize>,
+    /// The group services (`<GroupService>`, by the catalog's name) this
+    /// robot calls: non-empty makes it a member of its team's group.
+    pub group_services: Vec<String>,
+    /// The team's group (peer indices, in formation order): the robots whose
+    /// programs call any of the team's group services; empty when this robot
+    /// is not one of them. Each member's rank is its place among the live
+    /// members (this robot, or heard from within three heartbeats).
+    pub group: Vec<usize>,
     /// Adaptive resource management: the team strategy's battery policies,
     /// checked at every firing against the robot's `BATTERY` value.
     pub battery: Vec<BatteryPolicy>,
@@ -258,7 +338,7 @@ pub enum StateKind {
     /// Read the latest published value of a group into its slot.
     Subscribe {
         group: usize,
-        slot: usize,
+        slot: SlotId,
     },
     Throw {
         event: String,
@@ -286,7 +366,7 @@ pub enum StateKind {
     LeaderBranch {
         candidates: Vec<usize>,
         algorithm: LeaderAlgorithm,
-        others_at: usize,
+        others_at: StateId,
     },
     /// The start of a group statement when the team's strategy has
     /// `<GroupSync timeout>`: tell the team this robot has arrived (its
@@ -305,23 +385,23 @@ pub enum StateKind {
     /// Continue at `else_to` unless the condition holds.
     Branch {
         condition: Expr,
-        else_to: usize,
+        else_to: StateId,
     },
     Jump {
-        to: usize,
+        to: StateId,
     },
     /// Head of `loop(period?, condition?)`: leave to `exit_to` when the
     /// condition fails; mark the iteration's start.
     LoopHead {
         condition: Option<Expr>,
-        exit_to: usize,
+        exit_to: StateId,
         mark: usize,
     },
     /// End of a loop body: wait for the period (from the mark), then `to`.
     LoopTail {
         period_ms: Option<i64>,
         mark: usize,
-        to: usize,
+        to: StateId,
     },
     /// After the body: `repeat(period?, condition?)`; `forever` for `repeat()`;
     /// neither means the service runs once.
@@ -339,7 +419,7 @@ pub struct SendItem {
     pub message: usize,
     pub value: Operand,
     /// `send(T, T.X = v)`: the shared slot `v` is stored in first.
-    pub store: Option<usize>,
+    pub store: Option<SlotId>,
     /// A publication of a value this robot also subscribes to: the index into
     /// [`ControlMachine::subscribed`] of the group it is written to at once,
     /// since the latest value team T published includes the robot's own.
@@ -355,7 +435,7 @@ pub struct ActionMachine {
     pub actions: Vec<ActionState>,
     pub initial: usize,
     /// Slots of the `variable` parameters set from the call's arguments, in order.
-    pub arguments: Vec<usize>,
+    pub arguments: Vec<SlotId>,
 }
 
 #[derive(Clone, Debug)]
@@ -404,7 +484,7 @@ pub struct OutgoingMessage {
 pub struct IncomingMessage {
     pub from_team: String,
     pub key: String,
-    pub slot: usize,
+    pub slot: SlotId,
     pub port: String,
 }
 
@@ -414,6 +494,37 @@ pub struct SharedLibrary {
     pub name: String,
     /// Slot keys it holds a getter and a setter for.
     pub attributes: Vec<String>,
+    /// Who holds the globally shared attributes (`docs/shared-information.md`);
+    /// `None` when every attribute is a local copy (the team has one robot,
+    /// or the library holds only other teams' values and multicast values).
+    pub ownership: Option<Ownership>,
+}
+
+/// The globally shared attributes of a team's library and the robots that
+/// own them in turn: the first live robot of `owners` holds them, the others
+/// set them through messages to it and read what it last told them.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Ownership {
+    /// The globally shared attributes.
+    pub global: Vec<GlobalValue>,
+    /// Peer indices (into `RobotProgram::peers`) of the team's robots in the
+    /// order ownership passes when an owner is lost; the first is the owner
+    /// at start.
+    pub owners: Vec<usize>,
+}
+
+/// One globally shared attribute of a library.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GlobalValue {
+    /// Its index in [`SharedLibrary::attributes`].
+    pub at: usize,
+    /// The type of its values (its shared slot's): a value of another type
+    /// received is refused.
+    pub kind: ValueKind,
+    /// The key of a write sent to the owner (`Team.__set.X`).
+    pub set_key: String,
+    /// The key of the owner's value told to the team (`Team.__value.X`).
+    pub value_key: String,
 }
 
 /// A non-control task of the robot and its job.
@@ -459,7 +570,7 @@ pub enum Expr {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Operand {
-    Slot(usize),
+    Slot(SlotId),
     /// A literal, typed as written: a whole number an integer, another number
     /// a real, a string text, `true`/`false` a truth value, a symbolic
     /// constant a word.

@@ -5,7 +5,7 @@ use super::program::*;
 use super::value::{Value, ValueKind};
 use crate::catalog::{Implementation, RobotType};
 use crate::diag::{Code, Diagnostic};
-use crate::sema::{Compared, Symbol, Team, TeamId};
+use crate::sema::{Compared, ServiceId, Symbol, Team, TeamId};
 use crate::span::Span;
 use crate::strategy::{DataCharacteristic, ServiceEntry, Strategy, TaskUseKind};
 use crate::syntax::ast::{self, ExprKind, StmtKind};
@@ -14,6 +14,7 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 mod battery;
 mod loops;
+pub(super) mod shared;
 
 #[cfg(test)]
 pub(super) use loops::steps_of;
@@ -66,16 +67,7 @@ pub(super) fn refine_robot(
     } = builder;
     separate_sensor_tasks(&mut machine, &mut sensors, &services);
     link_own_publications(&mut machine);
-    let shared: Vec<String> = machine
-        .slots
-        .iter()
-        .filter(|s| s.source == SlotSource::Shared)
-        .map(|s| s.key.clone())
-        .collect();
-    let library = (!shared.is_empty()).then(|| SharedLibrary {
-        name: format!("{}Shared", team.name),
-        attributes: shared,
-    });
+    let library = shared::library(team, self_peer - robot_index, &mut machine);
     let mut tasks: Vec<TaskRole> = sensors
         .into_iter()
         .map(|(task, values)| TaskRole {
@@ -143,18 +135,18 @@ struct Builder<'a, 'i> {
     robot_index: usize,
     robot_type: &'a RobotType,
     machine: ControlMachine,
-    slot_index: HashMap<(String, bool), usize>,
+    slot_index: HashMap<(String, bool), SlotId>,
     /// Sensor task → the values it provides.
     sensors: BTreeMap<String, BTreeSet<String>>,
     /// Service task → the services or actuator commands it runs.
     services: BTreeMap<String, BTreeSet<String>>,
-    /// Team service index → machine index.
-    service_machines: HashMap<u32, usize>,
+    /// Team service → machine index.
+    service_machines: HashMap<ServiceId, usize>,
     /// (strategy file, entry index) → action machine index.
     action_machines: HashMap<(u32, usize), usize>,
     /// The team service whose machine is being built (for the strategy's
     /// leader selection scoped to a composite service).
-    current_service: Option<u32>,
+    current_service: Option<ServiceId>,
     diagnostics: Vec<Diagnostic>,
 }
 
@@ -245,7 +237,7 @@ impl Builder<'_, '_> {
                 };
                 let machine = self.service_machine(service);
                 regions.push(Region {
-                    plan: team.plans[plan as usize].name.to_string(),
+                    plan: team.plans[plan.index()].name.to_string(),
                     service: machine,
                     timeout_ms: set.timeout_ms.map(|t| t.round() as i64),
                 });
@@ -258,28 +250,28 @@ impl Builder<'_, '_> {
             });
         }
         if let Some(main) = &team.main {
-            self.machine.default_mode = main.default.map(|d| d as usize);
+            self.machine.default_mode = main.default.map(|d| d.index());
             for t in &main.transitions {
                 let line = self.line(t.span);
                 self.machine.transitions.push(ModeTransition {
-                    from: t.from as usize,
+                    from: t.from.index(),
                     event: t.event.to_string(),
-                    to: t.to as usize,
+                    to: t.to.index(),
                     line,
                 });
             }
         }
     }
 
-    fn service_machine(&mut self, service: u32) -> usize {
+    fn service_machine(&mut self, service: ServiceId) -> usize {
         if let Some(&m) = self.service_machines.get(&service) {
             return m;
         }
-        let info = &self.team.services[service as usize];
+        let info = &self.team.services[service.index()];
         let index = self.machine.services.len();
         self.service_machines.insert(service, index);
         self.machine.services.push(ServiceMachine {
-            plan: self.team.plans[info.plan as usize].name.to_string(),
+            plan: self.team.plans[info.plan.index()].name.to_string(),
             name: info.name.to_string(),
             line: self.line(info.name_span),
             states: Vec::new(),
@@ -389,7 +381,7 @@ impl Builder<'_, '_> {
             },
             span,
         );
-        states[state].text = "GroupSync: the group meets here".into();
+        states[state.index()].text = "GroupSync: the group meets here".into();
     }
 
     /// The strategy's leader selection for an election in the service being
@@ -397,13 +389,11 @@ impl Builder<'_, '_> {
     /// service or names this one; its algorithm (default lowest id) and its
     /// heartbeat period (mission ms, if given).
     fn leader_selection(&self) -> (LeaderAlgorithm, Option<i64>) {
-        let service = self
-            .current_service
-            .map(|s| &self.team.services[s as usize]);
+        let service = self.current_service.map(|s| &self.team.services[s.index()]);
         let applies = |l: &crate::strategy::LeaderSelection| match (&l.plan, &l.service, service) {
             (Some(plan), Some(cs), Some(s)) => {
                 cs.name == s.name.as_str()
-                    && plan.name == self.team.plans[s.plan as usize].name.as_str()
+                    && plan.name == self.team.plans[s.plan.index()].name.as_str()
             }
             (Some(_), Some(_), None) => false,
             _ => true,
@@ -433,70 +423,76 @@ impl Builder<'_, '_> {
         }
     }
 
-    fn push(&self, states: &mut Vec<State>, kind: StateKind, span: Span) -> usize {
+    fn push(&self, states: &mut Vec<State>, kind: StateKind, span: Span) -> StateId {
         states.push(State {
             kind,
             line: self.line(span),
             span,
             text: self.excerpt(span),
         });
-        states.len() - 1
+        StateId::new(states.len() - 1)
+    }
+
+    /// Pushes a state that jumps forward past a block not refined yet
+    /// (`Branch`, `Jump`, `LoopHead`, `LeaderBranch`): `make` builds it with
+    /// its target, which is the state itself until [`land`] sets it.
+    fn push_forward(
+        &self,
+        states: &mut Vec<State>,
+        span: Span,
+        make: impl FnOnce(StateId) -> StateKind,
+    ) -> Forward {
+        let at = StateId::new(states.len());
+        Forward(self.push(states, make(at), span))
     }
 
     fn stmt(&mut self, stmt: &ast::Stmt, states: &mut Vec<State>, marks: &mut usize, depth: usize) {
         match &stmt.kind {
             StmtKind::If(i) => {
                 let condition = self.condition(&i.condition);
-                let branch = self.push(
-                    states,
-                    StateKind::Branch {
-                        condition,
-                        else_to: usize::MAX,
-                    },
-                    stmt.span,
-                );
+                let branch = self.push_forward(states, stmt.span, |else_to| StateKind::Branch {
+                    condition,
+                    else_to,
+                });
                 self.block(&i.then_block, states, marks, depth);
                 match &i.else_branch {
-                    None => patch(states, branch),
+                    None => land(states, branch),
                     Some(else_branch) => {
-                        let jump = self.push(states, StateKind::Jump { to: usize::MAX }, stmt.span);
-                        states[jump].text = "end of the `if` branch".into();
-                        patch(states, branch);
+                        let jump =
+                            self.push_forward(states, stmt.span, |to| StateKind::Jump { to });
+                        states[jump.0.index()].text = "end of the `if` branch".into();
+                        land(states, branch);
                         match else_branch.as_ref() {
                             ast::Else::If(s) => self.stmt(s, states, marks, depth),
                             ast::Else::Block(b) => self.block(b, states, marks, depth),
                         }
-                        patch(states, jump);
+                        land(states, jump);
                     }
                 }
             }
             StmtKind::Loop(l) => {
                 let mark = next_mark(marks);
                 let condition = l.condition.as_ref().map(|c| self.condition(c));
-                let head = self.push(
-                    states,
-                    StateKind::LoopHead {
-                        condition,
-                        exit_to: usize::MAX,
-                        mark,
-                    },
-                    stmt.span,
-                );
+                let head = self.push_forward(states, stmt.span, |exit_to| StateKind::LoopHead {
+                    condition,
+                    exit_to,
+                    mark,
+                });
                 self.block(&l.body, states, marks, depth);
                 let tail = self.push(
                     states,
                     StateKind::LoopTail {
                         period_ms: l.period.as_ref().and_then(period_ms),
                         mark,
-                        to: head,
+                        to: head.0,
                     },
                     stmt.span,
                 );
-                states[tail].text = "end of the loop body".into();
+                states[tail.index()].text = "end of the loop body".into();
                 if let Some(period) = &l.period {
-                    states[tail].span = period.span;
+                    states[tail.index()].span = period.span;
                 }
-                patch(states, head);
+                land(states, head);
             }
             StmtKind::Group(g) => {
                 self.group_sync(g, stmt.span, states, marks);
@@ -517,23 +513,22 @@ impl Builder<'_, '_> {
                         let candidates = candidates.iter().map(|i| first_peer + i).collect();
                         let (algorithm, heartbeat_ms) = self.leader_selection();
                         self.need_heartbeat(heartbeat_ms.unwrap_or(HEARTBEAT_MS));
-                        let branch = self.push(
-                            states,
+                        let branch = self.push_forward(states, stmt.span, |others_at| {
                             StateKind::LeaderBranch {
                                 candidates,
                                 algorithm,
-                                others_at: usize::MAX,
-                            },
-                            stmt.span,
-                        );
+                                others_at,
+                            }
+                        });
                         self.block(body, states, marks, depth);
-                        let jump = self.push(states, StateKind::Jump { to: usize::MAX }, stmt.span);
-                        states[jump].text = "end of the leader's block".into();
-                        patch(states, branch);
+                        let jump =
+                            self.push_forward(states, stmt.span, |to| StateKind::Jump { to });
+                        states[jump.0.index()].text = "end of the leader's block".into();
+                        land(states, branch);
                         if let Some(others) = others {
                             self.block(others, states, marks, depth);
                         }
-                        patch(states, jump);
+                        land(states, jump);
                     }
                 }
             }
@@ -616,7 +611,7 @@ impl Builder<'_, '_> {
                 .runs
                 .iter()
                 .filter(|r| r.team == Some(self.team_id))
-                .flat_map(|r| r.robots.iter().map(|&i| i as usize))
+                .flat_map(|r| r.robots.iter().map(|&i| i.index()))
                 .collect(),
         )
     }
@@ -732,6 +727,7 @@ impl Builder<'_, '_> {
             return;
         };
         let service = def.name.clone();
+        self.note_group_service(&service);
         let mark = next_mark(marks);
         if let Some(machine) = self.strategy_machine(call.name.span, &service) {
             self.push(
@@ -764,6 +760,38 @@ impl Builder<'_, '_> {
             },
             span,
         );
+    }
+
+    /// A call of a service the team's strategy declares a group service
+    /// (`<GroupService>`: the catalog's name, in its plan when it names one)
+    /// makes this robot a member of the team's group ([`ControlMachine::group`],
+    /// filled in once every robot is refined): it then sends heartbeats, whose
+    /// absence tells the other members it failed.
+    fn note_group_service(&mut self, service: &str) {
+        let team = self.team;
+        let plan = self
+            .current_service
+            .map(|s| team.plan(team.service(s).plan).name.as_str());
+        let robot_type = self.robot_type;
+        let declared = self
+            .team_strategies()
+            .filter_map(|s| s.grouping.as_ref())
+            .flat_map(|g| &g.group_services)
+            .any(|g| {
+                g.name
+                    .as_ref()
+                    .and_then(|n| robot_type.service(&n.name))
+                    .is_some_and(|d| d.name == service)
+                    && g.plan
+                        .as_ref()
+                        .is_none_or(|p| Some(p.name.as_str()) == plan)
+            });
+        if !declared || self.machine.group_services.iter().any(|s| s == service) {
+            return;
+        }
+        self.machine.group_services.push(service.to_string());
+        let (_, heartbeat_ms) = self.leader_selection();
+        self.need_heartbeat(heartbeat_ms.unwrap_or(HEARTBEAT_MS));
     }
 
     fn request_task(&mut self, task: &str) {
@@ -1104,7 +1132,7 @@ impl Builder<'_, '_> {
             .unwrap_or_else(|| name.to_string())
     }
 
-    fn slot(&mut self, key: &str, source: SlotSource, kind: ValueKind) -> usize {
+    fn slot(&mut self, key: &str, source: SlotSource, kind: ValueKind) -> SlotId {
         let sensor = matches!(source, SlotSource::Sensor { .. });
         if let Some(&i) = self.slot_index.get(&(key.to_string(), sensor)) {
             return i;
@@ -1114,14 +1142,14 @@ impl Builder<'_, '_> {
             source,
             kind,
         });
-        let i = self.machine.slots.len() - 1;
+        let i = SlotId::new(self.machine.slots.len() - 1);
         self.slot_index.insert((key.to_string(), sensor), i);
         i
     }
 
     /// The team's shared slot of the attribute (a value received, sent or
     /// published, or a team variable), typed as the checker resolved it.
-    fn shared_slot(&mut self, attr: &ast::Attr) -> usize {
+    fn shared_slot(&mut self, attr: &ast::Attr) -> SlotId {
         let key = self.attr_key(attr);
         if let Some(&i) = self.slot_index.get(&(key.clone(), false)) {
             return i;
@@ -1190,12 +1218,12 @@ impl Builder<'_, '_> {
 
     /// The robot's own value `name`, read from the task that implements it
     /// (the strategy's `ValueInfo` first, else the catalog).
-    fn sensor_slot(&mut self, name: &str, span: Span) -> usize {
+    fn sensor_slot(&mut self, name: &str, span: Span) -> SlotId {
         let task = self.value_task(name);
         self.sensor_slot_with_task(name, &task, span)
     }
 
-    fn sensor_slot_with_task(&mut self, value: &str, task: &str, span: Span) -> usize {
+    fn sensor_slot_with_task(&mut self, value: &str, task: &str, span: Span) -> SlotId {
         let key = format!("{}.{value}", self.team.name);
         if let Some(&i) = self.slot_index.get(&(key.clone(), true)) {
             return i;
@@ -1391,14 +1419,21 @@ fn next_mark(marks: &mut usize) -> usize {
     *marks - 1
 }
 
-fn patch(states: &mut [State], at: usize) {
-    let target = states.len();
-    match &mut states[at].kind {
-        StateKind::Branch { else_to, .. } => *else_to = target,
-        StateKind::Jump { to } => *to = target,
-        StateKind::LoopHead { exit_to, .. } => *exit_to = target,
-        StateKind::LeaderBranch { others_at, .. } => *others_at = target,
-        _ => {}
+/// A state pushed by [`Builder::push_forward`] whose target is the state
+/// after a block still being refined: [`land`] sets it once that block is.
+#[must_use = "a forward state must land, or it jumps to itself"]
+struct Forward(StateId);
+
+/// Sets the target of `forward` to the next state to be pushed.
+fn land(states: &mut [State], forward: Forward) {
+    let target = StateId::new(states.len());
+    match &mut states[forward.0.index()].kind {
+        StateKind::Branch { else_to: to, .. }
+        | StateKind::Jump { to }
+        | StateKind::LoopHead { exit_to: to, .. }
+        | StateKind::LeaderBranch { others_at: to, .. } => *to = target,
+        // `push_forward` is only given the four kinds above.
+        other => unreachable!("a forward state cannot be {other:?}"),
     }
 }
 

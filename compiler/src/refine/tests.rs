@@ -169,7 +169,7 @@ fn battery_requirements_become_policies_over_the_robots_own_tasks() {
     };
     assert_eq!(limit, &crate::refine::Value::Int(30));
     assert!(matches!(
-        &master.control.slots[*slot].source,
+        &master.control.slots[slot.index()].source,
         SlotSource::Sensor { port, .. } if port == "BATTERY"
     ));
     assert!(task_names(master).contains(&"battery"));
@@ -306,6 +306,7 @@ fn comparisons_carry_the_checkers_typing() {
 #[test]
 fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
     use crate::refine::GraphStep::{Fire, Loop};
+    use crate::refine::LoopPort;
     let fire = |task: &str| Fire {
         task: task.to_string(),
         count: 1,
@@ -316,9 +317,20 @@ fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
             .0
             .unwrap()
     };
-    // `A 10(B C) D`: the D-type loop node is the `10(...)`.
+    // `A 10(B C) D`: the D-type loop node is the `10(...)`, its ports
+    // joining the channels outside (0, 1) to those of its body (2, 4).
+    let data_loop = robot::steps_of(&load("data_loop")).unwrap();
+    let port = |port: &str, input, distributing, outer, inner| LoopPort {
+        port: port.into(),
+        input,
+        distributing,
+        outer_rate: 10,
+        inner_rate: 1,
+        outer,
+        inner,
+    };
     assert_eq!(
-        robot::steps_of(&load("data_loop")).unwrap(),
+        data_loop.steps,
         [
             fire("A"),
             Loop {
@@ -326,13 +338,44 @@ fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
                 convergent: false,
                 loop_count: 10,
                 exit_task: None,
+                ports: vec![
+                    port("in", true, true, 0, 2),
+                    port("out", false, false, 1, 4)
+                ],
                 body: vec![fire("L/B"), fire("L/C")],
             },
             fire("D"),
         ]
     );
+    // Each channel bounded by the analysis for the order it runs in: ten
+    // tokens outside the loop, one per iteration inside.
+    let bounded: Vec<(&str, u64)> = data_loop
+        .channels
+        .iter()
+        .map(|c| (c.label.as_str(), c.capacity))
+        .collect();
+    assert_eq!(
+        bounded,
+        [
+            ("A.o → L.in", 10),
+            ("L.out → D.i", 10),
+            ("L: L.in → B.i", 1),
+            ("L: B.o → C.i", 1),
+            ("L: C.o → L.out", 1),
+        ]
+    );
+    let b = data_loop.tasks.iter().find(|t| t.path == "L/B").unwrap();
+    assert_eq!(
+        (
+            &b.inputs[0].port,
+            b.inputs[0].channel,
+            &b.outputs[0].port,
+            b.outputs[0].channel
+        ),
+        (&"i".to_string(), 2, &"o".to_string(), 3)
+    );
     // k-means: a C-type loop (exit task ReplaceCenter) around a D-type one.
-    let kmeans = robot::steps_of(&load("kmeans")).unwrap();
+    let kmeans = robot::steps_of(&load("kmeans")).unwrap().steps;
     let Loop {
         convergent: true,
         loop_count: 500,

@@ -39,10 +39,10 @@ impl<'a> Checker<'a> {
     }
 
     /// The team and mode index of a mode definition, unless it was rejected.
-    fn declared_mode(&self, m: &ast::ModeDef) -> Option<(TeamId, Index)> {
+    fn declared_mode(&self, m: &ast::ModeDef) -> Option<(TeamId, ModeId)> {
         let team = self.team_id(&m.team.name)?;
         let mode = self.team(team).mode_by_name(&m.name.name)?;
-        (self.team(team).modes[mode as usize].span == m.span).then_some((team, mode))
+        (self.team(team).modes[mode.index()].span == m.span).then_some((team, mode))
     }
 
     fn mode_sets(&mut self, m: &ast::ModeDef) {
@@ -102,25 +102,25 @@ impl<'a> Checker<'a> {
             });
         }
         match mode {
-            Some(mode) => self.team_mut(team).modes[mode as usize].sets = sets,
+            Some(mode) => self.team_mut(team).modes[mode.index()].sets = sets,
             None => self
                 .set_by_duplicate_modes
                 .extend(sets.iter().filter_map(|s| s.service).map(|s| (team, s))),
         }
     }
 
-    fn set_target(&mut self, team: TeamId, plan: Index, name: &ast::Ident) -> Option<Index> {
+    fn set_target(&mut self, team: TeamId, plan: PlanId, name: &ast::Ident) -> Option<ServiceId> {
         let t = self.team(team);
         if let Some(service) = t.service_in_plan(plan, &name.name) {
             self.occurrence(name.span, Symbol::Service { team, service }, false);
             return Some(service);
         }
-        let plan_name = &t.plans[plan as usize].name;
+        let plan_name = &t.plans[plan.index()].name;
         let elsewhere = t
             .services
             .iter()
             .find(|s| s.name == name.name)
-            .map(|s| t.plans[s.plan as usize].name.clone());
+            .map(|s| t.plans[s.plan.index()].name.clone());
         let in_plan: Vec<&str> = t
             .services
             .iter()
@@ -145,7 +145,7 @@ impl<'a> Checker<'a> {
     }
 
     /// Resolves a mode name in a main block, reporting it if undefined.
-    fn mode_ref(&mut self, team: TeamId, name: &ast::Ident) -> Option<Index> {
+    fn mode_ref(&mut self, team: TeamId, name: &ast::Ident) -> Option<ModeId> {
         let mode = self.lookup_mode_ref(team, name);
         if mode.is_none() {
             self.mains_with_unknown_modes.insert(team);
@@ -153,7 +153,7 @@ impl<'a> Checker<'a> {
         mode
     }
 
-    fn lookup_mode_ref(&mut self, team: TeamId, name: &ast::Ident) -> Option<Index> {
+    fn lookup_mode_ref(&mut self, team: TeamId, name: &ast::Ident) -> Option<ModeId> {
         match self.team(team).mode_by_name(&name.name) {
             Some(mode) => {
                 self.occurrence(name.span, Symbol::Mode { team, mode }, false);
@@ -201,7 +201,7 @@ impl<'a> Checker<'a> {
             }
         };
         let mut transitions = Vec::new();
-        let mut cased: Vec<(Index, crate::span::Span)> = Vec::new();
+        let mut cased: Vec<(ModeId, crate::span::Span)> = Vec::new();
         for case in &m.cases {
             let from = self.mode_ref(team, &case.mode);
             if let Some(from) = from {
@@ -309,12 +309,12 @@ impl<'a> Checker<'a> {
         let mut findings = Vec::new();
         let mut never_thrown = Vec::new();
         for (i, tr) in main.transitions.iter().enumerate() {
-            let mode = &t.modes[tr.from as usize];
+            let mode = &t.modes[tr.from.index()];
             let thrown = mode
                 .sets
                 .iter()
                 .filter_map(|s| s.service)
-                .any(|s| t.services[s as usize].throws.contains(&tr.event));
+                .any(|s| t.services[s.index()].throws.contains(&tr.event));
             if !thrown {
                 never_thrown.push(i);
                 findings.push((
@@ -362,16 +362,14 @@ impl<'a> Checker<'a> {
                 }
             }
         }
-        let default_name = t.modes[*start as usize].name.clone();
-        let unreachable: Vec<Index> = (0..t.modes.len() as Index)
-            .filter(|i| !reached.contains(i))
-            .collect();
+        let default_name = t.modes[start.index()].name.clone();
+        let unreachable: Vec<ModeId> = t.mode_ids().filter(|i| !reached.contains(i)).collect();
         let findings: Vec<(crate::span::Span, Name)> = unreachable
             .iter()
             .map(|&i| {
                 (
-                    t.modes[i as usize].name_span,
-                    t.modes[i as usize].name.clone(),
+                    t.modes[i.index()].name_span,
+                    t.modes[i.index()].name.clone(),
                 )
             })
             .collect();
@@ -389,14 +387,15 @@ impl<'a> Checker<'a> {
 
     fn services_never_set(&mut self, team: TeamId) {
         let t = self.team(team);
-        let set: FastSet<Index> = t
+        let set: FastSet<ServiceId> = t
             .modes
             .iter()
             .flat_map(|m| m.sets.iter().filter_map(|s| s.service))
             .collect();
-        let unused: Vec<(crate::span::Span, String)> = (0..t.services.len() as Index)
+        let unused: Vec<(crate::span::Span, String)> = t
+            .service_ids()
             .filter(|s| !set.contains(s) && !self.set_by_duplicate_modes.contains(&(team, *s)))
-            .map(|s| (t.services[s as usize].name_span, t.service_path(s)))
+            .map(|s| (t.services[s.index()].name_span, t.service_path(s)))
             .collect();
         for (span, path) in unused {
             self.diagnostics.report(

@@ -23,9 +23,9 @@ pub(super) type TypeList = Rc<[(RobotTypeId, Vec<Name>)]>;
 pub(super) struct Scope {
     /// `None` inside a function that no service calls: robots are unknown.
     team: Option<TeamId>,
-    service: Option<Index>,
-    /// Indices into the team's robots that run the statement.
-    robots: Vec<Index>,
+    service: Option<ServiceId>,
+    /// The team's robots that run the statement.
+    robots: Vec<RobotId>,
     /// The known robot types among `robots`, with those robots' names: computed
     /// once per scope, read by every call and value in it.
     types: TypeList,
@@ -176,25 +176,25 @@ impl<'a> Checker<'a> {
         self.team_types = (0..self.mission.teams.len())
             .map(|t| {
                 let team = TeamId(t as u32);
-                let all: Vec<Index> = (0..self.team(team).robots.len() as Index).collect();
+                let all: Vec<RobotId> = self.team(team).robot_ids().collect();
                 self.types_of(team, &all)
             })
             .collect();
         for t in 0..self.mission.teams.len() {
             let team = TeamId(t as u32);
-            let all: Vec<Index> = (0..self.team(team).robots.len() as Index).collect();
+            let all: Vec<RobotId> = self.team(team).robot_ids().collect();
             for s in 0..self.service_syntax[t].len() {
                 let syntax = self.service_syntax[t][s];
                 let scope = Scope {
                     team: Some(team),
-                    service: Some(s as Index),
+                    service: Some(ServiceId::new(s)),
                     robots: all.clone(),
                     types: self.team_types[t].clone(),
                     inlining: Vec::new(),
                 };
                 let kind = ScopeKind::Service {
                     team,
-                    service: s as Index,
+                    service: ServiceId::new(s),
                 };
                 self.record_scope(syntax.span, kind, &scope);
                 self.block(&syntax.body, &scope);
@@ -211,8 +211,8 @@ impl<'a> Checker<'a> {
         // Rejected definitions: checked with their team's robots, but belonging
         // to no service (they send, receive and run nothing).
         for (team, body) in std::mem::take(&mut self.rejected_bodies) {
-            let robots: Vec<Index> = match team {
-                Some(t) => (0..self.team(t).robots.len() as Index).collect(),
+            let robots: Vec<RobotId> = match team {
+                Some(t) => self.team(t).robot_ids().collect(),
                 None => Vec::new(),
             };
             let scope = Scope {
@@ -313,7 +313,7 @@ impl<'a> Checker<'a> {
         let t = self.team_mut(team);
         t.event_mut(&event.name).thrown_at.push(event.span);
         if let Some(service) = scope.service {
-            let throws = &mut t.services[service as usize].throws;
+            let throws = &mut t.services[service.index()].throws;
             if !throws.contains(&event.name) {
                 throws.push(event.name.clone());
             }
@@ -374,7 +374,7 @@ impl<'a> Checker<'a> {
     }
 
     /// The same scope, run by fewer robots (inside a group).
-    fn narrowed(&self, scope: &Scope, robots: Vec<Index>) -> Scope {
+    fn narrowed(&self, scope: &Scope, robots: Vec<RobotId>) -> Scope {
         let types = match scope.team {
             Some(team) => self.types_of(team, &robots),
             None => Rc::new([]),
@@ -387,11 +387,11 @@ impl<'a> Checker<'a> {
     }
 
     /// The known robot types among `robots` of `team`, each with its robots' names.
-    fn types_of(&self, team: TeamId, robots: &[Index]) -> TypeList {
+    fn types_of(&self, team: TeamId, robots: &[RobotId]) -> TypeList {
         let mut types: Vec<(RobotTypeId, Vec<Name>)> = Vec::new();
         let t = self.team(team);
         for &r in robots {
-            let robot = &t.robots[r as usize];
+            let robot = &t.robots[r.index()];
             let Some(ty) = robot.robot_type else { continue };
             match types.iter_mut().find(|(id, _)| *id == ty) {
                 Some((_, names)) => names.push(robot.name.clone()),
@@ -965,7 +965,7 @@ impl<'a> Checker<'a> {
 
     /// The robots of `scope` that meet a group condition, and whether every name
     /// in the condition is known (an unknown one is reported here).
-    fn group_members(&mut self, cond: &ast::GroupCond, scope: &Scope) -> (Vec<Index>, bool) {
+    fn group_members(&mut self, cond: &ast::GroupCond, scope: &Scope) -> (Vec<RobotId>, bool) {
         let catalog = self.catalog;
         let mut types = Vec::new();
         let mut all_known = true;
@@ -1006,7 +1006,7 @@ impl<'a> Checker<'a> {
             .iter()
             .copied()
             .filter(|&r| {
-                let Some(ty) = t.robots[r as usize].robot_type else {
+                let Some(ty) = t.robots[r.index()].robot_type else {
                     return false;
                 };
                 match cond.kind {
@@ -1022,7 +1022,7 @@ impl<'a> Checker<'a> {
     }
 
     fn group(&mut self, g: &'a ast::GroupStmt, scope: &Scope) {
-        let mut taken: Vec<Index> = Vec::new();
+        let mut taken: Vec<RobotId> = Vec::new();
         let checkable = scope.team.is_some() && !scope.robots.is_empty();
         for arm in &g.arms {
             let (members, all_known) = self.group_members(&arm.condition, scope);
@@ -1046,7 +1046,7 @@ impl<'a> Checker<'a> {
                     ),
                 );
             }
-            let overlap: Vec<Index> = members
+            let overlap: Vec<RobotId> = members
                 .iter()
                 .copied()
                 .filter(|r| taken.contains(r))
@@ -1062,7 +1062,7 @@ impl<'a> Checker<'a> {
                     ),
                 );
             }
-            let runners: Vec<Index> = match arm.kind {
+            let runners: Vec<RobotId> = match arm.kind {
                 ArmKind::Group => members
                     .iter()
                     .copied()
@@ -1089,7 +1089,7 @@ impl<'a> Checker<'a> {
             }
         }
         if let Some(others) = &g.others {
-            let rest: Vec<Index> = scope
+            let rest: Vec<RobotId> = scope
                 .robots
                 .iter()
                 .copied()
@@ -1111,14 +1111,14 @@ impl<'a> Checker<'a> {
         }
     }
 
-    fn robot_names(&self, scope: &Scope, robots: &[Index]) -> String {
+    fn robot_names(&self, scope: &Scope, robots: &[RobotId]) -> String {
         let Some(team) = scope.team else {
             return String::new();
         };
         let t = self.team(team);
         let names: Vec<&str> = robots
             .iter()
-            .map(|&r| t.robots[r as usize].name.as_str())
+            .map(|&r| t.robots[r.index()].name.as_str())
             .collect();
         names.join(", ")
     }

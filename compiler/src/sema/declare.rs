@@ -94,7 +94,7 @@ impl<'a> Checker<'a> {
                     robot.name.span,
                     Symbol::Robot {
                         team: id,
-                        robot: robots.len() as Index,
+                        robot: RobotId::new(robots.len()),
                     },
                     true,
                 );
@@ -213,13 +213,13 @@ impl<'a> Checker<'a> {
                     name: s.plan.name.clone(),
                     span: s.plan.span,
                 });
-                let plan = t.plans.len() as Index - 1;
+                let plan = PlanId::new(t.plans.len() - 1);
                 self.occurrence(s.plan.span, Symbol::Plan { team, plan }, true);
                 plan
             }
         };
         if let Some(existing) = self.team(team).service_in_plan(plan, &s.name.name) {
-            let first = self.team(team).services[existing as usize].name_span;
+            let first = self.team(team).services[existing.index()].name_span;
             self.diagnostics
                 .report(
                     Code::DuplicateService,
@@ -243,7 +243,7 @@ impl<'a> Checker<'a> {
             item,
             throws: Vec::new(),
         });
-        let service = t.services.len() as Index - 1;
+        let service = ServiceId::new(t.services.len() - 1);
         self.occurrence(s.name.span, Symbol::Service { team, service }, true);
     }
 
@@ -252,7 +252,7 @@ impl<'a> Checker<'a> {
             return;
         };
         if let Some(existing) = self.team(team).mode_by_name(&m.name.name) {
-            let first = self.team(team).modes[existing as usize].name_span;
+            let first = self.team(team).modes[existing.index()].name_span;
             self.diagnostics
                 .report(
                     Code::DuplicateMode,
@@ -272,7 +272,7 @@ impl<'a> Checker<'a> {
             span: m.span,
             sets: Vec::new(),
         });
-        let mode = t.modes.len() as Index - 1;
+        let mode = ModeId::new(t.modes.len() - 1);
         self.occurrence(m.name.span, Symbol::Mode { team, mode }, true);
     }
 

@@ -5,6 +5,7 @@
 
 use crate::catalog::RobotTypeId;
 use crate::diag::FileId;
+use crate::index::newtype_index;
 use crate::span::Span;
 use crate::syntax::ast::{self, Name};
 
@@ -14,8 +15,27 @@ pub struct TeamId(pub u32);
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct FunctionId(pub u32);
 
-/// Index of a plan, service, mode or robot inside its team.
-pub type Index = u32;
+newtype_index! {
+    /// A plan of its team: an index into [`Team::plans`].
+    pub struct PlanId;
+}
+
+newtype_index! {
+    /// A service of its team: an index into [`Team::services`].
+    pub struct ServiceId;
+}
+
+newtype_index! {
+    /// A mode of its team: an index into [`Team::modes`].
+    pub struct ModeId;
+}
+
+newtype_index! {
+    /// A robot of its team: an index into [`Team::robots`] (`name[N]`
+    /// declares N of them). Not the robot's number in the generated
+    /// programs, which counts across teams.
+    pub struct RobotId;
+}
 
 #[derive(Clone, Debug, Default)]
 pub struct Mission {
@@ -86,7 +106,7 @@ pub struct Plan {
 pub struct Service {
     pub name: Name,
     pub name_span: Span,
-    pub plan: Index,
+    pub plan: PlanId,
     pub span: Span,
     /// Index of the service's item in the file's syntax tree: its body and
     /// `repeat` are read from there ([`crate::Analysis::service_syntax`]).
@@ -105,9 +125,9 @@ pub struct Mode {
 
 #[derive(Clone, Debug)]
 pub struct ModeSet {
-    pub plan: Option<Index>,
+    pub plan: Option<PlanId>,
     /// `None` for `OFF` (or a service that does not exist, already reported).
-    pub service: Option<Index>,
+    pub service: Option<ServiceId>,
     pub timeout_ms: Option<f64>,
     pub span: Span,
 }
@@ -115,21 +135,21 @@ pub struct ModeSet {
 #[derive(Clone, Debug)]
 pub struct Main {
     pub span: Span,
-    pub default: Option<Index>,
+    pub default: Option<ModeId>,
     pub transitions: Vec<Transition>,
     /// The modes no catch leads to from the default mode (W002), in order;
     /// empty when that was not decided (no default, or a catch naming an
     /// unknown mode).
-    pub unreachable: Vec<Index>,
+    pub unreachable: Vec<ModeId>,
 }
 
 /// `case (from): catch (event): mode = to`.
 #[derive(Clone, Debug)]
 pub struct Transition {
-    pub from: Index,
+    pub from: ModeId,
     pub event: Name,
     pub event_span: Span,
-    pub to: Index,
+    pub to: ModeId,
     pub span: Span,
     /// No service that the `from` mode runs throws the event, so the catch
     /// never fires there (W009).
@@ -179,7 +199,7 @@ pub struct Message {
     pub kind: ast::CommKind,
     /// The team whose service runs the statement.
     pub team: TeamId,
-    pub service: Index,
+    pub service: ServiceId,
     pub peer: Peer,
     pub value: AttrKey,
     pub span: Span,
@@ -192,21 +212,21 @@ pub enum Symbol {
     User,
     Robot {
         team: TeamId,
-        robot: Index,
+        robot: RobotId,
     },
     RobotType(Name),
     Capability(Name),
     Plan {
         team: TeamId,
-        plan: Index,
+        plan: PlanId,
     },
     Service {
         team: TeamId,
-        service: Index,
+        service: ServiceId,
     },
     Mode {
         team: TeamId,
-        mode: Index,
+        mode: ModeId,
     },
     Event {
         team: TeamId,
@@ -247,7 +267,7 @@ pub struct RobotScope {
 pub enum ScopeKind {
     Service {
         team: TeamId,
-        service: Index,
+        service: ServiceId,
     },
     Function(FunctionId),
     /// The body of `group(cond)` or `leader(cond)`; `condition` is `cond`'s range.
@@ -270,7 +290,7 @@ pub enum ScopeKind {
 pub struct Runners {
     pub team: Option<TeamId>,
     /// Indices into the team's robots.
-    pub robots: Vec<Index>,
+    pub robots: Vec<RobotId>,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -348,33 +368,76 @@ impl Team {
         &mut self.events[index]
     }
 
-    pub fn plan_by_name(&self, name: &str) -> Option<Index> {
+    pub fn plan(&self, plan: PlanId) -> &Plan {
+        &self.plans[plan.index()]
+    }
+
+    pub fn service(&self, service: ServiceId) -> &Service {
+        &self.services[service.index()]
+    }
+
+    pub fn mode(&self, mode: ModeId) -> &Mode {
+        &self.modes[mode.index()]
+    }
+
+    pub fn robot(&self, robot: RobotId) -> &Robot {
+        &self.robots[robot.index()]
+    }
+
+    /// The team's robots by declaration, in order: `name[N]` declares N
+    /// robots (sharing one `name_span`) that the checker treats alike: of
+    /// one type, they run the same scopes and join the same groups.
+    pub fn declarations(&self) -> Vec<Vec<RobotId>> {
+        let mut declarations: Vec<Vec<RobotId>> = Vec::new();
+        for (id, robot) in self.robot_ids().zip(&self.robots) {
+            match declarations.last_mut() {
+                Some(last) if self.robot(last[0]).name_span == robot.name_span => last.push(id),
+                _ => declarations.push(vec![id]),
+            }
+        }
+        declarations
+    }
+
+    pub fn plan_ids(&self) -> impl DoubleEndedIterator<Item = PlanId> + Clone + use<> {
+        PlanId::all(self.plans.len())
+    }
+
+    pub fn service_ids(&self) -> impl DoubleEndedIterator<Item = ServiceId> + Clone + use<> {
+        ServiceId::all(self.services.len())
+    }
+
+    pub fn mode_ids(&self) -> impl DoubleEndedIterator<Item = ModeId> + Clone + use<> {
+        ModeId::all(self.modes.len())
+    }
+
+    pub fn robot_ids(&self) -> impl DoubleEndedIterator<Item = RobotId> + Clone + use<> {
+        RobotId::all(self.robots.len())
+    }
+
+    pub fn plan_by_name(&self, name: &str) -> Option<PlanId> {
         self.plans
             .iter()
             .position(|p| p.name == name)
-            .map(|i| i as Index)
+            .map(PlanId::new)
     }
 
-    pub fn mode_by_name(&self, name: &str) -> Option<Index> {
+    pub fn mode_by_name(&self, name: &str) -> Option<ModeId> {
         self.modes
             .iter()
             .position(|m| m.name == name)
-            .map(|i| i as Index)
+            .map(ModeId::new)
     }
 
-    pub fn service_in_plan(&self, plan: Index, name: &str) -> Option<Index> {
+    pub fn service_in_plan(&self, plan: PlanId, name: &str) -> Option<ServiceId> {
         self.services
             .iter()
             .position(|s| s.plan == plan && s.name == name)
-            .map(|i| i as Index)
+            .map(ServiceId::new)
     }
 
     /// `Team.Plan.Service`, for messages.
-    pub fn service_path(&self, service: Index) -> String {
-        let s = &self.services[service as usize];
-        format!(
-            "{}.{}.{}",
-            self.name, self.plans[s.plan as usize].name, s.name
-        )
+    pub fn service_path(&self, service: ServiceId) -> String {
+        let s = self.service(service);
+        format!("{}.{}.{}", self.name, self.plan(s.plan).name, s.name)
     }
 }

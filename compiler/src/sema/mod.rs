@@ -98,7 +98,7 @@ pub(crate) fn is_user(name: &str) -> bool {
 }
 
 /// A function body checked for a (function, team, service, robots running it).
-type InlinedBody = (FunctionId, Option<TeamId>, Option<Index>, Vec<Index>);
+type InlinedBody = (FunctionId, Option<TeamId>, Option<ServiceId>, Vec<RobotId>);
 
 pub(crate) struct Checker<'a> {
     /// The syntax of each team's services, parallel to `Team::services`, and of
@@ -115,7 +115,7 @@ pub(crate) struct Checker<'a> {
     variables: FastMap<Name, Vec<Option<TeamId>>>,
     /// Services named by the `set`s of a mode defined twice (already reported):
     /// they are not "never set".
-    set_by_duplicate_modes: FastSet<(TeamId, Index)>,
+    set_by_duplicate_modes: FastSet<(TeamId, ServiceId)>,
     /// Teams whose main block names an undefined mode (already reported): which
     /// modes it can reach is unknown.
     mains_with_unknown_modes: FastSet<TeamId>,

@@ -1,16 +1,19 @@
 //! The dataflow warnings of a mission ([`crate::dataflow`]) over the
 //! workspace: refined by refinement's public entry point
-//! (`codegen::refine_checked`, from [`Analysis::build_input`]), with the
-//! service graphs the workspace holds, analysed as [`Analysis::graph`]
-//! analyses them.
+//! (`codegen::refine_checked_robots`, from [`Analysis::build_input`]), one
+//! robot of each declaration (`name[N]` is one: its robots are refined
+//! alike, so the cost is per declaration, not per robot), with the service
+//! graphs the workspace holds, analysed as [`Analysis::graph`] analyses
+//! them.
 //!
-//! This is slower than checking (it refines every robot), so it is not part
-//! of [`Analysis::diagnostics`]: the doors ask for it apart (the language
+//! This is slower than checking (it refines), so it is not part of
+//! [`Analysis::diagnostics`]: the doors ask for it apart (the language
 //! server in the background, after the keystroke's diagnostics).
 
 use super::{Analysis, Key, drop_later, fresh, lock};
 use crate::dataflow::{self, DataflowInput, MissionDataflow};
-use crate::diag::FileId;
+use crate::diag::{self, FileId};
+use crate::refine::Robots;
 use crate::taskgraph::subgraph;
 use crate::workspace::{FileKind, GraphRun};
 use std::path::Path;
@@ -29,7 +32,9 @@ impl Analysis {
         }
         let build = self.build_input(mission)?;
         let input = build.input();
-        let refined = crate::codegen::refine_checked(&input);
+        // One robot per declaration: the warnings and each robot's period
+        // are its declaration's (`dataflow::analyze`).
+        let refined = crate::codegen::refine_checked_robots(&input, Robots::OnePerDeclaration);
         let found = if refined.diagnostics.iter().any(|d| d.is_error()) {
             MissionDataflow::default()
         } else {
@@ -43,6 +48,15 @@ impl Analysis {
             })
         };
         let mut found = found;
+        // Refinement's own warnings (W130: it reads the strategies as the
+        // robots run them), after the input's diagnostics in `refined`.
+        found.diagnostics.extend(
+            refined.diagnostics[input.diagnostics.len().min(refined.diagnostics.len())..]
+                .iter()
+                .filter(|d| !d.is_error())
+                .cloned(),
+        );
+        diag::sort_and_dedup(&mut found.diagnostics);
         self.apply_lints(mission, &mut found.diagnostics);
         let found = Arc::new(found);
         let old = lock(&self.memo.dataflow).insert(mission, (key, found.clone()));

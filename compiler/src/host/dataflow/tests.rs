@@ -5,6 +5,7 @@
 
 use crate::diag::{Code, Diagnostic, FileId};
 use crate::host::{AnalysisHost, Roots};
+use crate::refine::Robots;
 use crate::taskgraph::analysis::ratio::Ratio;
 use crate::workspace::FileKind;
 use std::path::PathBuf;
@@ -290,4 +291,76 @@ fn a_team_without_timed_service_graphs_gets_no_period_section() {
         analysis.dataflow(MISSION_ID)
     });
     assert_eq!(periods, None);
+}
+
+#[test]
+fn a_declaration_of_many_robots_is_analysed_once_with_the_same_answer_as_each_robot() {
+    // `r[3]` and `t[2]` are refined once each (one robot per declaration):
+    // the warning is still reported once, on the mission line, and every
+    // robot has its period under its own name, in formation order.
+    let text = "{ T: Rover r[3], Rover s, Rover t[2] }\nT.P.S { scan() } repeat(40 MSEC)\nT.M { set(P, S) }\nT.main { default: mode = M }\n";
+    let w = Workspace::new("declarations", text, TIMED);
+    let found = w.warnings();
+    assert_eq!(codes(&found), [Code::DataflowTooSlow], "{found:#?}");
+    assert_eq!(w.text_at(text, &found[0]), "40 MSEC");
+    let analysis = w.host.analysis();
+    let dataflow = analysis.dataflow(MISSION_ID).unwrap();
+    let fifty = Ratio::new(50, 1);
+    let periods: Vec<(&str, Option<Ratio>)> = dataflow
+        .robots
+        .iter()
+        .map(|r| (r.robot.as_str(), r.period))
+        .collect();
+    assert_eq!(
+        periods,
+        [
+            ("r_0", fifty),
+            ("r_1", fifty),
+            ("r_2", fifty),
+            ("s", fifty),
+            ("t_0", fifty),
+            ("t_1", fifty)
+        ]
+    );
+    // Exactly what analysing every robot's own program gives.
+    let build = analysis.build_input(MISSION_ID).unwrap();
+    let every_robot = crate::codegen::refine_checked(&build.input());
+    assert_eq!(every_robot.programs.len(), 6);
+    let service_graph = |catalog: FileId, path: &str| analysis.service_graph(catalog, path);
+    let from_every_robot = crate::dataflow::analyze(&crate::dataflow::DataflowInput {
+        file: MISSION_ID,
+        mission: &build.analysis.mission,
+        catalog: &build.unit.catalog.catalog,
+        programs: &every_robot.programs,
+        service_graph: &service_graph,
+    });
+    assert_eq!(from_every_robot.diagnostics, dataflow.diagnostics);
+    assert_eq!(from_every_robot.robots, dataflow.robots);
+    assert_eq!(from_every_robot.graphs, dataflow.graphs);
+    let refined = crate::codegen::refine_checked_robots(&build.input(), Robots::OnePerDeclaration);
+    let names: Vec<&str> = refined.programs.iter().map(|p| p.robot.as_str()).collect();
+    assert_eq!(names, ["r_2", "s", "t_1"]);
+}
+
+#[test]
+fn a_declaration_refused_for_its_last_robots_name_gives_no_dataflow() {
+    // `x…x_9` is 64 characters, `x…x_10` 65: too long for a C identifier
+    // (E101), which only the declaration's last robot shows.
+    let base = "x".repeat(62);
+    let text = mission("T.P.S { scan() } repeat(40 MSEC)").replace("r[2]", &format!("{base}[11]"));
+    let w = Workspace::new("long-name", &text, TIMED);
+    assert_eq!(w.warnings(), Vec::new());
+    let analysis = w.host.analysis();
+    assert!(analysis.dataflow(MISSION_ID).unwrap().robots.is_empty());
+    let build = analysis.build_input(MISSION_ID).unwrap();
+    let refused = crate::codegen::refine_checked(&build.input());
+    assert!(refused.programs.is_empty());
+    assert!(
+        refused
+            .diagnostics
+            .iter()
+            .any(|d| d.code == Code::OutputNameEscapes),
+        "{:#?}",
+        refused.diagnostics
+    );
 }

@@ -12,7 +12,7 @@
 use crate::catalog::Catalog;
 use crate::diag::{Code, Diagnostic};
 pub use crate::edit::{CodeAction, TextEdit};
-use crate::sema::{Analysis, Index, Team, TeamId};
+use crate::sema::{Analysis, ModeId, PlanId, Team, TeamId};
 use crate::span::Span;
 use crate::syntax::ast::{self, Item, SetTarget};
 
@@ -191,7 +191,7 @@ impl Fixes<'_> {
         let path = format!("{}.{}.{}", t.name, set.plan.name, service.name);
         let definition = format!("{path}{{\n  # what the robots do\n}} repeat()");
         // After the plan's last service, else the team's, else before the mode.
-        let services = |plan: Option<Index>| {
+        let services = |plan: Option<PlanId>| {
             t.services
                 .iter()
                 .filter(move |s| plan.is_none_or(|p| s.plan == p))
@@ -294,11 +294,12 @@ impl Fixes<'_> {
             return Vec::new();
         };
         // The modes that run a service throwing the event, else the default.
-        let mut modes: Vec<Index> = (0..t.modes.len() as Index)
+        let mut modes: Vec<ModeId> = t
+            .mode_ids()
             .filter(|&m| {
-                t.modes[m as usize].sets.iter().any(|s| {
+                t.modes[m.index()].sets.iter().any(|s| {
                     s.service
-                        .is_some_and(|s| t.services[s as usize].throws.iter().any(|e| e == event))
+                        .is_some_and(|s| t.services[s.index()].throws.iter().any(|e| e == event))
                 })
             })
             .collect();
@@ -322,16 +323,16 @@ impl Fixes<'_> {
         t: &Team,
         main: &ast::MainDef,
         event: &str,
-        mode: Index,
+        mode: ModeId,
     ) -> Option<CodeAction> {
-        let from = t.modes.get(mode as usize)?.name.as_str();
+        let from = t.modes.get(mode.index())?.name.as_str();
         let default = t
             .main
             .as_ref()
             .and_then(|m| m.default)
             .filter(|&d| d != mode);
-        let other = (0..t.modes.len() as Index).find(|&m| m != mode);
-        let to = t.modes[default.or(other).unwrap_or(mode) as usize]
+        let other = t.mode_ids().find(|&m| m != mode);
+        let to = t.modes[default.or(other).unwrap_or(mode).index()]
             .name
             .as_str();
         let catch = format!("catch ({event}): mode = {to}");

@@ -14,7 +14,7 @@ use super::robots::{self, RobotsHere};
 use super::snippets::{self, Snippet};
 use crate::catalog::{Catalog, ValueDef, ValueType};
 use crate::ide::{CompletionConfig, CompletionItem, CompletionKind};
-use crate::sema::{Analysis, Index, Mission, ScopeKind, Team, TeamId, is_user};
+use crate::sema::{Analysis, Mission, ModeId, PlanId, ScopeKind, ServiceId, Team, TeamId, is_user};
 use crate::span::Span;
 use crate::syntax::ast::{self, Name};
 use crate::syntax::token::Token;
@@ -316,7 +316,7 @@ impl<'a> Completions<'a> {
             return;
         };
         for (i, p) in t.plans.iter().enumerate() {
-            let doc = docs::plan(self.text, t, i as Index);
+            let doc = docs::plan(self.text, t, PlanId::new(i));
             self.add(
                 EXACT,
                 CompletionKind::Plan,
@@ -886,7 +886,7 @@ impl<'a> Completions<'a> {
                 CompletionKind::Plan,
                 p.name.as_str(),
                 Some(format!("plan of {}", t.name)),
-                Some(docs::plan(self.text, t, i as Index)),
+                Some(docs::plan(self.text, t, PlanId::new(i))),
             );
         }
     }
@@ -909,14 +909,14 @@ impl<'a> Completions<'a> {
                 s.name.as_str(),
                 Some(format!(
                     "{} {}",
-                    t.service_path(i as Index),
+                    t.service_path(ServiceId::new(i)),
                     docs::schedule(self.text, syntax)
                 )),
                 Some(docs::composite_service(
                     self.analysis,
                     self.text,
                     team,
-                    i as Index,
+                    ServiceId::new(i),
                 )),
             );
         }
@@ -945,7 +945,7 @@ impl<'a> Completions<'a> {
                 CompletionKind::Mode,
                 m.name.as_str(),
                 Some(format!("mode of {}", t.name)),
-                Some(docs::mode(self.text, t, i as Index)),
+                Some(docs::mode(self.text, t, ModeId::new(i))),
             );
         }
     }
@@ -960,7 +960,7 @@ impl<'a> Completions<'a> {
                 CompletionKind::Mode,
                 m.name.as_str(),
                 Some(format!("mode of {}", t.name)),
-                Some(docs::mode(self.text, t, i as Index)),
+                Some(docs::mode(self.text, t, ModeId::new(i))),
             );
         }
     }
@@ -974,11 +974,11 @@ impl<'a> Completions<'a> {
         let thrown_here: Vec<&Name> = mode
             .and_then(|m| t.mode_by_name(m))
             .map(|m| {
-                t.modes[m as usize]
+                t.modes[m.index()]
                     .sets
                     .iter()
                     .filter_map(|s| s.service)
-                    .flat_map(|s| &t.services[s as usize].throws)
+                    .flat_map(|s| &t.services[s.index()].throws)
                     .collect()
             })
             .unwrap_or_default();

@@ -1,7 +1,7 @@
 //! Markdown descriptions of what names mean, shared by hover and completion.
 
 use crate::catalog::{Catalog, RobotType, RobotTypeId, ServiceDef, ValueDef};
-use crate::sema::{Analysis, Index, Mission, ModeSet, Team, TeamId};
+use crate::sema::{Analysis, Mission, ModeId, ModeSet, PlanId, ServiceId, Team, TeamId};
 use crate::syntax::ast;
 use std::fmt::Write;
 
@@ -231,10 +231,10 @@ pub(crate) fn composite_service(
     analysis: &Analysis,
     text: &str,
     team: TeamId,
-    service: Index,
+    service: ServiceId,
 ) -> String {
     let t = analysis.mission.team(team);
-    let Some(s) = t.services.get(service as usize) else {
+    let Some(s) = t.services.get(service.index()) else {
         return String::new();
     };
     let syntax = analysis.service_syntax(s);
@@ -292,8 +292,8 @@ fn plural(n: usize) -> &'static str {
 }
 
 /// A plan: the services it can run, and which one each mode runs.
-pub(crate) fn plan(text: &str, t: &Team, plan: Index) -> String {
-    let Some(p) = t.plans.get(plan as usize) else {
+pub(crate) fn plan(text: &str, t: &Team, plan: PlanId) -> String {
+    let Some(p) = t.plans.get(plan.index()) else {
         return String::new();
     };
     let mut out = format!("**plan** `{}` of team `{}`", p.name, t.name);
@@ -310,7 +310,7 @@ pub(crate) fn plan(text: &str, t: &Team, plan: Index) -> String {
         let what = match set {
             Some(ModeSet {
                 service: Some(s), ..
-            }) => format!("`{}`", t.services[*s as usize].name),
+            }) => format!("`{}`", t.services[s.index()].name),
             Some(set) => unset(text, set),
             None => "nothing".to_string(),
         };
@@ -323,18 +323,18 @@ pub(crate) fn plan(text: &str, t: &Team, plan: Index) -> String {
 }
 
 /// A mode: what each plan runs, and where its events lead.
-pub(crate) fn mode(text: &str, t: &Team, mode: Index) -> String {
-    let Some(m) = t.modes.get(mode as usize) else {
+pub(crate) fn mode(text: &str, t: &Team, mode: ModeId) -> String {
+    let Some(m) = t.modes.get(mode.index()) else {
         return String::new();
     };
     let mut out = format!("**mode** `{}` of team `{}`", m.name, t.name);
     let mut lines = Vec::new();
     for (i, p) in t.plans.iter().enumerate() {
-        let set = m.sets.iter().find(|s| s.plan == Some(i as Index));
+        let set = m.sets.iter().find(|s| s.plan == Some(PlanId::new(i)));
         let line = match set {
             Some(s) => match s.service {
                 Some(svc) => {
-                    let mut l = format!("- `{}` runs `{}`", p.name, t.services[svc as usize].name);
+                    let mut l = format!("- `{}` runs `{}`", p.name, t.services[svc.index()].name);
                     if let Some(ms) = s.timeout_ms {
                         write!(l, " (at most {})", millis_text(ms)).ok();
                     }
@@ -362,7 +362,7 @@ pub(crate) fn mode(text: &str, t: &Team, mode: Index) -> String {
             .transitions
             .iter()
             .filter(|tr| tr.from == mode)
-            .map(|tr| format!("`{}` → `{}`", tr.event, t.modes[tr.to as usize].name))
+            .map(|tr| format!("`{}` → `{}`", tr.event, t.modes[tr.to.index()].name))
             .collect();
         if !leaves.is_empty() {
             write!(out, "\n\nOn {}.", leaves.join(", ")).ok();
@@ -401,7 +401,7 @@ pub(crate) fn event(t: &Team, name: &str) -> String {
         .iter()
         .enumerate()
         .filter(|(_, s)| s.throws.iter().any(|e| e == name))
-        .map(|(i, _)| format!("`{}`", t.service_path(i as Index)))
+        .map(|(i, _)| format!("`{}`", t.service_path(ServiceId::new(i))))
         .collect();
     if throwers.is_empty() {
         out.push_str("\n\nNo service throws it.");
@@ -416,7 +416,8 @@ pub(crate) fn event(t: &Team, name: &str) -> String {
         .map(|tr| {
             format!(
                 "`{}` → `{}`",
-                t.modes[tr.from as usize].name, t.modes[tr.to as usize].name
+                t.modes[tr.from.index()].name,
+                t.modes[tr.to.index()].name
             )
         })
         .collect();

@@ -43,7 +43,7 @@ pub fn hover(
         }
         Symbol::Robot { team, robot } => {
             let t = mission.team(*team);
-            let r = t.robots.get(*robot as usize)?;
+            let r = t.robots.get(robot.index())?;
             let mut out = docs::code(&format!("{} {}", r.type_name, r.name));
             write!(out, "\n\nA robot of team `{}`.", t.name).ok();
             if let Some(ty) = r.robot_type {

@@ -4,27 +4,10 @@
 
 use super::docs;
 use crate::catalog::Catalog;
+pub use crate::ide::{InlayHint, InlayKind};
 use crate::sema::{Analysis, Runners, ScopeKind};
 use crate::span::Span;
 use crate::syntax::ast::{self, ArmKind, SetTarget};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum InlayKind {
-    /// The robots a group arm selects.
-    Robots,
-    /// How the service a mode sets runs.
-    Schedule,
-}
-
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct InlayHint {
-    /// Where the hint shows (before the character at this offset).
-    pub offset: usize,
-    pub label: String,
-    pub kind: InlayKind,
-    /// Markdown.
-    pub tooltip: Option<String>,
-}
 
 /// The hints whose position lies in `range`.
 pub fn inlay_hints(
@@ -93,7 +76,7 @@ fn robot_names(analysis: &Analysis, runs: &[Runners]) -> String {
         let robots: Vec<&str> = r
             .robots
             .iter()
-            .filter_map(|&i| t.robots.get(i as usize))
+            .filter_map(|&i| t.robots.get(i.index()))
             .map(|robot| robot.name.as_str())
             .collect();
         let part = match (teams.len(), robots.is_empty()) {
@@ -144,7 +127,7 @@ fn set_hints(analysis: &Analysis, text: &str, range: Span, hints: &mut Vec<Inlay
             let Some(service) = t.service_in_plan(plan, &name.name) else {
                 continue;
             };
-            let syntax = analysis.service_syntax(&t.services[service as usize]);
+            let syntax = analysis.service_syntax(&t.services[service.index()]);
             hints.push(InlayHint {
                 offset: name.span.end,
                 label: format!(": {}", docs::schedule(text, syntax)),

@@ -173,7 +173,7 @@ fn clash(
             Some(format!("there is already a team `{}`", other.1.name))
         }
         Symbol::Robot { team, robot } => {
-            let decl = team_of(*team)?.robots.get(*robot as usize)?.name_span;
+            let decl = team_of(*team)?.robots.get(robot.index())?.name_span;
             let written = text.get(decl.range())?;
             // `tb[3]` declares tb_0, tb_1, tb_2: they become new_0, new_1, new_2.
             let renamed: Vec<String> = mission
@@ -199,12 +199,13 @@ fn clash(
             let other = t.plan_by_name(new).filter(|p| p != plan)?;
             Some(format!(
                 "team {} already has a plan `{}`",
-                t.name, t.plans[other as usize].name
+                t.name,
+                t.plans[other.index()].name
             ))
         }
         Symbol::Service { team, service } => {
             let t = team_of(*team)?;
-            let plan = t.services.get(*service as usize)?.plan;
+            let plan = t.services.get(service.index())?.plan;
             let other = t.service_in_plan(plan, new).filter(|s| s != service)?;
             Some(format!(
                 "there is already a composite service `{}`",
@@ -216,7 +217,8 @@ fn clash(
             let other = t.mode_by_name(new).filter(|m| m != mode)?;
             Some(format!(
                 "team {} already has a mode `{}`",
-                t.name, t.modes[other as usize].name
+                t.name,
+                t.modes[other.index()].name
             ))
         }
         Symbol::Event { team, name } => {

@@ -2,12 +2,12 @@
 //! share: the services and values that are valid there.
 
 use crate::catalog::{Catalog, RobotTypeId, ServiceDef, ValueDef};
-use crate::sema::{Analysis, Index, Mission, Occurrence, ScopeKind, TeamId};
+use crate::sema::{Analysis, Mission, Occurrence, RobotId, ScopeKind, TeamId};
 
 /// The robots that run the statements at a place, by team.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct RobotsHere {
-    pub runs: Vec<(TeamId, Vec<Index>)>,
+    pub runs: Vec<(TeamId, Vec<RobotId>)>,
     /// The scope the place is in, if the checker recorded one.
     pub kind: Option<ScopeKind>,
 }
@@ -32,7 +32,7 @@ impl RobotsHere {
         let team = fallback_team.and_then(|t| mission.team_by_name(t));
         RobotsHere {
             runs: team
-                .map(|t| (t, (0..mission.team(t).robots.len() as Index).collect()))
+                .map(|t| (t, mission.team(t).robot_ids().collect()))
                 .into_iter()
                 .collect(),
             kind: None,
@@ -68,7 +68,7 @@ impl RobotsHere {
         for (team, robots) in &self.runs {
             let t = mission.team(*team);
             for &r in robots {
-                if let Some(ty) = t.robots.get(r as usize).and_then(|r| r.robot_type) {
+                if let Some(ty) = t.robots.get(r.index()).and_then(|r| r.robot_type) {
                     if !types.contains(&ty) {
                         types.push(ty);
                     }
@@ -84,7 +84,7 @@ impl RobotsHere {
         for (team, robots) in &self.runs {
             let t = mission.team(*team);
             for &r in robots {
-                if let Some(robot) = t.robots.get(r as usize)
+                if let Some(robot) = t.robots.get(r.index())
                     && robot.robot_type == Some(ty)
                 {
                     names.push(robot.name.to_string());

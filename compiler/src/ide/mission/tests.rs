@@ -96,7 +96,7 @@ fn scopes_nest_and_give_the_robots_of_each_place() {
                 let t = mission.team(r.team.unwrap());
                 r.robots
                     .iter()
-                    .map(|&i| t.robots[i as usize].name.to_string())
+                    .map(|&i| t.robots[i.index()].name.to_string())
             })
             .collect();
         names.sort();

@@ -183,7 +183,7 @@ pub fn create_entry(
     {
         return None;
     }
-    let plan = &team.plans[call.plan as usize].name;
+    let plan = &team.plans[call.plan.index()].name;
     let mut types: Vec<&str> = Vec::new();
     for robot in &team.robots {
         let provides = robot

@@ -205,7 +205,7 @@ fn values(
                     let services: Vec<&str> = team
                         .services
                         .iter()
-                        .filter(|s| s.plan as usize == index)
+                        .filter(|s| s.plan.index() == index)
                         .map(|s| s.name.as_str())
                         .collect();
                     out.push(item(&plan.name, K::Plan).detail(format!(
@@ -223,13 +223,13 @@ fn values(
             let mut out = Vec::new();
             for (_, _, team) in file.teams() {
                 for (index, service) in team.services.iter().enumerate() {
-                    let plan_name = &team.plans[service.plan as usize].name;
+                    let plan_name = &team.plans[service.plan.index()].name;
                     if plan.is_some_and(|p| p != plan_name.as_str()) {
                         continue;
                     }
                     out.push(
                         item(&service.name, K::BuiltinService)
-                            .detail(team.service_path(index as crate::sema::Index)),
+                            .detail(team.service_path(crate::sema::ServiceId::new(index))),
                     );
                 }
             }
@@ -318,7 +318,7 @@ fn services(file: &StrategyFile<'_>, tag: &RawTag<'_>, replace: Span) -> Vec<Com
     let mut out: Vec<CompletionItem> = Vec::new();
     for (analysis, id, team) in file.teams() {
         for call in team_calls(analysis, id) {
-            let plan_name = &team.plans[call.plan as usize].name;
+            let plan_name = &team.plans[call.plan.index()].name;
             if plan.is_some_and(|p| p != plan_name.as_str()) {
                 continue;
             }

@@ -150,7 +150,7 @@ fn refers_to(
             let mut callers: Vec<String> = Vec::new();
             for (analysis, id, team) in file.teams() {
                 for call in team_calls(analysis, id) {
-                    let in_plan = plan.is_none_or(|p| team.plans[call.plan as usize].name == p);
+                    let in_plan = plan.is_none_or(|p| team.plans[call.plan.index()].name == p);
                     let path = team.service_path(call.service);
                     if in_plan && call.name == service.name && !callers.contains(&path) {
                         callers.push(path);

@@ -109,7 +109,7 @@ fn plans(file: &StrategyFile<'_>, plan: &str) -> Vec<NavigationTarget> {
             let index = team.plan_by_name(plan)?;
             Some(NavigationTarget {
                 file: a.mission.file,
-                span: team.plans[index as usize].span,
+                span: team.plans[index.index()].span,
             })
         })
         .collect()

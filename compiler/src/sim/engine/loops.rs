@@ -1,13 +1,30 @@
 //! A service task that runs a task graph, as `codegen/loops.rs` generates
-//! it: when the call starts, one iteration of the graph's looped schedule,
-//! every inner firing traced (`graph_fire`) and every SDF/L loop's end with
-//! its iterations (`graph_loop`); a convergent loop stops after the
+//! it for `linux-sim`: when the call starts, one iteration of the graph's
+//! looped schedule. Its channels are FIFOs of tokens kept from call to call
+//! (initial tokens are 0); an inner firing takes its inputs, writes each
+//! output token `k` as `(sum of the tokens read + k + 1) mod 1000`, is
+//! traced (`graph_fire`, with the tokens read and written) and puts its
+//! outputs; a loop node takes its inputs when it starts, gives each
+//! iteration its share (distributing) or the same tokens (broadcasting),
+//! keeps the last outputs its iterations gave and puts them when it ends
+//! (`graph_loop`, with its iterations); a convergent loop stops after the
 //! iteration in which its exit task sets the exit flag (the scenario's
-//! `loops`), at most `loop_count` iterations.
+//! `loops`), at most `loop_count` iterations. A channel short of tokens or
+//! over its bound is traced (`graph_error`) and ends the run, where the
+//! generated program aborts.
 
 use super::Sim;
-use crate::refine::GraphStep;
+use crate::codegen::GRAPH_TEXT_MAX;
+use crate::refine::{GraphService, GraphStep, LoopPort};
+use std::collections::{HashMap, VecDeque};
 use std::rc::Rc;
+
+/// One robot's service graph channels, by service task.
+#[derive(Debug, Default)]
+pub(super) struct GraphChannels(HashMap<String, Vec<VecDeque<i64>>>);
+
+/// A channel that is short of tokens or full: the run stops.
+struct Broken;
 
 impl Sim<'_> {
     /// `run_graph` of service task `task`, if it runs a graph.
@@ -31,13 +48,31 @@ impl Sim<'_> {
             .find(|w| w.robot == program.robot)
             .map(|w| w.loops.clone())
             .unwrap_or_default();
+        let mut channels = self.robots[r]
+            .graph_channels
+            .0
+            .remove(task)
+            .unwrap_or_else(|| {
+                service
+                    .channels
+                    .iter()
+                    .map(|c| std::iter::repeat_n(0, c.initial_tokens as usize).collect())
+                    .collect()
+            });
         let mut run = GraphRun {
             sim: self,
             robot: r,
             graph,
+            service,
             exits: &exits,
+            channels: &mut channels,
         };
-        run.steps(steps, None);
+        // A broken channel was traced; the generated program aborts there.
+        let _ = run.steps(steps, None);
+        self.robots[r]
+            .graph_channels
+            .0
+            .insert(task.to_string(), channels);
     }
 }
 
@@ -45,7 +80,9 @@ struct GraphRun<'s, 'p> {
     sim: &'s mut Sim<'p>,
     robot: usize,
     graph: Rc<str>,
+    service: &'p GraphService,
     exits: &'s [(String, u64)],
+    channels: &'s mut Vec<VecDeque<i64>>,
 }
 
 /// The innermost convergent loop: its exit task, iteration and flag.
@@ -56,18 +93,97 @@ struct Exit<'a> {
     flag: bool,
 }
 
+/// Tokens as a trace field: comma separated, cut as the generated
+/// `graph_text` cuts them.
+fn text(tokens: &[i64]) -> Rc<str> {
+    let mut out = tokens
+        .iter()
+        .map(i64::to_string)
+        .collect::<Vec<_>>()
+        .join(",");
+    out.truncate(GRAPH_TEXT_MAX as usize - 1);
+    out.into()
+}
+
 impl GraphRun<'_, '_> {
-    fn fire(&mut self, task: &str) {
-        let fields = vec![("graph", self.graph.clone()), ("task", Rc::from(task))];
-        self.sim.emit(self.robot, "graph_fire", fields);
+    fn broken(&mut self, channel: usize, what: &str) -> Broken {
+        let label = self.service.channels[channel].label.as_str();
+        let fields = vec![
+            ("graph", self.graph.clone()),
+            ("channel", Rc::from(label)),
+            ("error", Rc::from(what)),
+        ];
+        self.sim.emit(self.robot, "graph_error", fields);
+        Broken
     }
 
-    fn steps(&mut self, steps: &[GraphStep], mut exit: Option<&mut Exit<'_>>) {
+    fn take(&mut self, channel: usize, n: u64, into: &mut Vec<i64>) -> Result<(), Broken> {
+        for _ in 0..n {
+            match self.channels[channel].pop_front() {
+                Some(token) => into.push(token),
+                None => return Err(self.broken(channel, "is empty")),
+            }
+        }
+        Ok(())
+    }
+
+    fn put(&mut self, channel: usize, tokens: &[i64]) -> Result<(), Broken> {
+        let capacity = self.service.channels[channel].capacity as usize;
+        for &token in tokens {
+            if self.channels[channel].len() >= capacity {
+                return Err(self.broken(channel, "is full"));
+            }
+            self.channels[channel].push_back(token);
+        }
+        Ok(())
+    }
+
+    fn fire(&mut self, path: &str) -> Result<(), Broken> {
+        let service = self.service;
+        // Refinement lists every task it fires.
+        let Some(task) = service.tasks.iter().find(|t| t.path == path) else {
+            return Ok(());
+        };
+        let mut read = Vec::new();
+        for port in &task.inputs {
+            self.take(port.channel, port.rate, &mut read)?;
+        }
+        let sum = read
+            .iter()
+            .fold(0i64, |sum, t| (sum + t.rem_euclid(1000)) % 1000);
+        let written: Vec<Vec<i64>> = task
+            .outputs
+            .iter()
+            .map(|port| {
+                (0..port.rate)
+                    .map(|k| (sum + (k % 1000) as i64 + 1) % 1000)
+                    .collect()
+            })
+            .collect();
+        let wrote: Vec<i64> = written.iter().flatten().copied().collect();
+        let fields = vec![
+            ("graph", self.graph.clone()),
+            ("task", Rc::from(path)),
+            ("read", text(&read)),
+            ("wrote", text(&wrote)),
+        ];
+        self.sim.emit(self.robot, "graph_fire", fields);
+        for (port, tokens) in task.outputs.iter().zip(&written) {
+            self.put(port.channel, tokens)?;
+        }
+        Ok(())
+    }
+
+    fn steps(
+        &mut self,
+        steps: &[GraphStep],
+        mut exit: Option<&mut Exit<'_>>,
+    ) -> Result<(), Broken> {
         for step in steps {
             match step {
                 GraphStep::Fire { task, count } => {
                     for _ in 0..*count {
-                        self.fire(task);
+                        self.fire(task)?;
                         if let Some(e) = exit.as_deref_mut()
                             && e.task == task
                             && e.at > 0
@@ -79,7 +195,7 @@ impl GraphRun<'_, '_> {
                 }
                 GraphStep::Repeat { count, body } => {
                     for _ in 0..*count {
-                        self.steps(body, exit.as_deref_mut());
+                        self.steps(body, exit.as_deref_mut())?;
                     }
                 }
                 GraphStep::Loop {
@@ -87,6 +203,7 @@ impl GraphRun<'_, '_> {
                     convergent,
                     loop_count,
                     exit_task,
+                    ports,
                     body,
                 } => {
                     let at = self
@@ -98,25 +215,41 @@ impl GraphRun<'_, '_> {
                                 == Some(path.as_str())
                         })
                         .map_or(0, |(_, n)| *n);
-                    let mut n = 0;
-                    match (convergent, exit_task) {
-                        (true, Some(task)) => {
-                            let mut own = Exit {
-                                task,
-                                iteration: 0,
-                                at,
-                                flag: false,
-                            };
-                            while n < *loop_count && !own.flag {
-                                n += 1;
-                                own.iteration = n;
-                                self.steps(body, Some(&mut own));
-                            }
+                    let mut staged: Vec<Vec<i64>> = Vec::with_capacity(ports.len());
+                    for port in ports {
+                        let mut tokens = Vec::new();
+                        if port.input {
+                            self.take(port.outer, port.outer_rate, &mut tokens)?;
                         }
-                        _ => {
-                            while n < *loop_count {
-                                n += 1;
-                                self.steps(body, exit.as_deref_mut());
+                        staged.push(tokens);
+                    }
+                    let mut n = 0;
+                    let mut own = match (convergent, exit_task) {
+                        (true, Some(task)) => Some(Exit {
+                            task,
+                            iteration: 0,
+                            at,
+                            flag: false,
+                        }),
+                        _ => None,
+                    };
+                    while n < *loop_count && !own.as_ref().is_some_and(|e| e.flag) {
+                        n += 1;
+                        self.iteration_inputs(ports, &staged, n)?;
+                        match own.as_mut() {
+                            Some(e) => {
+                                e.iteration = n;
+                                self.steps(body, Some(e))?;
+                            }
+                            None => self.steps(body, exit.as_deref_mut())?,
+                        }
+                        for (port, kept) in ports.iter().zip(&mut staged) {
+                            if !port.input {
+                                let mut tokens = Vec::new();
+                                self.take(port.inner, port.inner_rate, &mut tokens)?;
+                                kept.extend(tokens);
+                                let over = kept.len().saturating_sub(port.outer_rate as usize);
+                                kept.drain(..over);
                             }
                         }
                     }
@@ -126,8 +259,35 @@ impl GraphRun<'_, '_> {
                         ("iterations", Rc::from(n.to_string().as_str())),
                     ];
                     self.sim.emit(self.robot, "graph_loop", fields);
+                    for (port, kept) in ports.iter().zip(&staged) {
+                        if !port.input {
+                            self.put(port.outer, kept)?;
+                        }
+                    }
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Each input's tokens for iteration `n` (from 1), as the generated
+    /// loop gives them.
+    fn iteration_inputs(
+        &mut self,
+        ports: &[LoopPort],
+        staged: &[Vec<i64>],
+        n: u64,
+    ) -> Result<(), Broken> {
+        for (port, tokens) in ports.iter().zip(staged).filter(|(p, _)| p.input) {
+            for k in 0..port.inner_rate {
+                let index = if port.distributing {
+                    ((n - 1) * port.inner_rate + k) % port.outer_rate
+                } else {
+                    k % port.outer_rate
+                };
+                self.put(port.inner, &[tokens[index as usize]])?;
+            }
+        }
+        Ok(())
     }
 }
