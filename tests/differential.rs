@@ -94,6 +94,8 @@ struct Behaviour {
     services: BTreeMap<String, Runs<String>>,
     catches: Runs<(String, String)>,
     leaders: Runs<String>,
+    /// The owners of the team's globally shared values it changed to.
+    owners: Runs<String>,
     sent: BTreeSet<(String, String)>,
     received: BTreeSet<(String, String)>,
     /// Adaptive resource management: the battery policies that start and
@@ -137,6 +139,7 @@ fn behaviour(events: &[&Event]) -> Behaviour {
                 .map(|e| (field(e, "name").to_string(), field(e, "mode").to_string())),
         ),
         leaders: runs(of(events, "leader").map(|e| field(e, "leader").to_string())),
+        owners: runs(of(events, "shared_owner").map(|e| field(e, "owner").to_string())),
         sent: of(events, "send")
             .map(|e| (field(e, "to").to_string(), field(e, "key").to_string()))
             .collect(),
@@ -434,6 +437,24 @@ fn a_restarted_leader_comes_back_the_same_way_in_c_and_in_the_simulator() {
             "faults": [{"at": 1200, "kill": "tb_0"}, {"at": 2200, "restart": "tb_0"}]}"#,
         10,
     );
+}
+
+/// Globally shared information (`docs/shared-information.md`): the owner
+/// `a` killed, `b` takes over and a write of `c` reaches it, in both; what
+/// each reads shows in its modes (`tests/fixtures/shared`).
+#[test]
+fn a_killed_owner_of_shared_values_is_replaced_the_same_way_in_c_and_in_the_simulator() {
+    let fixture = repo_root().join("tests/fixtures/shared");
+    let scenario = std::fs::read_to_string(fixture.join("shared.scenario.json")).unwrap();
+    let (processes, _) = compare("shared", &fixture.join("shared.mission"), &scenario, 20);
+    for robot in ["b", "c"] {
+        let owners: Vec<&str> = processes[robot]
+            .iter()
+            .filter(|e| field(e, "event") == "shared_owner")
+            .map(|e| field(e, "owner"))
+            .collect();
+        assert_eq!(owners, ["b"], "{robot}");
+    }
 }
 
 /// Link faults in both: the master hears nothing from ti for two seconds,

@@ -701,10 +701,23 @@ fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
             modes(events).last().map(String::as_str),
             "{robot}: {status}"
         );
+        // The scenario gives no battery and no robot reads one: absent.
+        assert_eq!(status.get("battery"), None, "{robot}: {status}");
     }
     // A robot killed while running: the broker publishes its last will.
+    // Its scenario gives it a battery level of 80: its status says so.
+    let mut with_battery: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scenario()).unwrap()).unwrap();
+    with_battery["robots"]["irobot"]["battery"] = serde_json::json!([{"at": 0, "level": 80}]);
+    let battery_scenario = fleet.out.join("battery.scenario.json");
+    std::fs::write(&battery_scenario, with_battery.to_string()).unwrap();
     let irobot = folder_of(&folders, "irobot");
-    let killed = fleet.spawn(&irobot, &scenario(), "killed", &["--duration", "1000000"]);
+    let killed = fleet.spawn(
+        &irobot,
+        &battery_scenario,
+        "killed",
+        &["--duration", "1000000"],
+    );
     let mut running = None;
     for _ in 0..50 {
         // Running, and past its first firing: a service in each plan.
@@ -720,6 +733,7 @@ fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
         std::thread::sleep(std::time::Duration::from_millis(100));
     }
     let running = running.expect("the running robot's status names the service each plan runs");
+    assert_eq!(running["battery"], "80", "{running}");
     assert!(
         running["mode"]
             .as_str()
@@ -1703,4 +1717,115 @@ fn group_sync_over_mqtt_waits_for_the_live_members() {
         assert_eq!(at(robot, "timeout"), None, "{robot}");
     }
     assert_eq!(at("tb_1", "group_sync"), None);
+}
+
+/// Group services (tests/fixtures/group_service: `move` is one, heartbeats
+/// every 200 ms), every robot a process over a private broker: each member
+/// traces its rank among the live members and their number; tb_1 is killed
+/// and tb_0 and tb_2 re-divide (tb_2 moves up to rank 1 of 2); tb_1 is
+/// restarted and they change back (2 of 3), the restarted tb_1 with them.
+#[test]
+fn group_service_over_mqtt_redivides_when_a_member_fails_and_returns() {
+    let Some(mut fleet) = Fleet::start("mqtt-group-service") else {
+        return;
+    };
+    let folders = support::mqtt::build(
+        &repo_root().join("tests/fixtures/group_service/sweep.mission"),
+        &fleet.out,
+        &[],
+    );
+    let scenario = fleet.out.join("sweep.scenario.json");
+    std::fs::write(&scenario, r#"{"time_scale": 1, "duration": 6000}"#).unwrap();
+    // tb_1 is dead three heartbeats (600 ms) after it is killed.
+    const KILL_AT: i64 = 1500;
+    const RESTART_AT: i64 = 3500;
+    let (t0, start_at) = support::robots::start_barrier(folders.len());
+    let start_at = start_at.to_string();
+    let barrier = ["--start-at", start_at.as_str()];
+    let mut lives: Vec<Started> = folders
+        .iter()
+        .map(|f| fleet.spawn(f, &scenario, "first", &barrier))
+        .collect();
+    let first_tb_1 = lives.iter().position(|s| s.robot == "tb_1").unwrap();
+    sleep_until(t0, KILL_AT);
+    fleet.processes.kill(lives[first_tb_1].index);
+    sleep_until(t0, RESTART_AT);
+    lives.push(fleet.spawn(&folder_of(&folders, "tb_1"), &scenario, "second", &barrier));
+    let traces: Vec<(String, Vec<Event>)> = lives
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let events = if i == first_tb_1 {
+                read_trace(&s.trace)
+            } else {
+                fleet.finish(s, "group service")
+            };
+            (s.robot.clone(), events)
+        })
+        .collect();
+    // (t, rank, size) of each `group` event of one life.
+    let groups = |events: &[Event]| -> Vec<(i64, String, String)> {
+        events
+            .iter()
+            .filter(|e| field(e, "event") == "group")
+            .map(|e| {
+                let t = e["t"].as_i64().unwrap();
+                (
+                    t,
+                    field(e, "rank").to_string(),
+                    field(e, "size").to_string(),
+                )
+            })
+            .collect()
+    };
+    let of = |robot: &str| groups(&traces.iter().rev().find(|(r, _)| r == robot).unwrap().1);
+    let rank_at = |list: &[(i64, String, String)], t: i64| -> (String, String) {
+        list.iter()
+            .filter(|(at, _, _)| *at <= t)
+            .map(|(_, rank, size)| (rank.clone(), size.clone()))
+            .next_back()
+            .unwrap_or_default()
+    };
+    let pair = |rank: &str, size: &str| (rank.to_string(), size.to_string());
+    let (tb_0, tb_2) = (of("tb_0"), of("tb_2"));
+    // Before the kill: the whole group; between the failure's detection
+    // and the restart: two; at the end: three again.
+    let detected = KILL_AT + 4 * 200 + 400;
+    for (robot, list, rank_before, rank_between) in
+        [("tb_0", &tb_0, "0", "0"), ("tb_2", &tb_2, "2", "1")]
+    {
+        assert_eq!(
+            rank_at(list, KILL_AT - 100),
+            pair(rank_before, "3"),
+            "{robot}: {list:?}"
+        );
+        assert_eq!(
+            rank_at(list, detected),
+            pair(rank_between, "2"),
+            "{robot}: {list:?}"
+        );
+        assert_eq!(
+            rank_at(list, RESTART_AT - 100),
+            pair(rank_between, "2"),
+            "{robot}: {list:?}"
+        );
+        assert_eq!(
+            rank_at(list, i64::MAX),
+            pair(rank_before, "3"),
+            "{robot}: {list:?}"
+        );
+    }
+    // tb_1: rank 1 of 3 in both lives.
+    let first_life = groups(&traces[first_tb_1].1);
+    assert_eq!(
+        rank_at(&first_life, KILL_AT - 100),
+        pair("1", "3"),
+        "{first_life:?}"
+    );
+    let second_life = of("tb_1");
+    assert_eq!(
+        rank_at(&second_life, i64::MAX),
+        pair("1", "3"),
+        "{second_life:?}"
+    );
 }

@@ -360,6 +360,15 @@ fn tasks_channels_control_timers_and_trace_escaping() {
             "quote\" backslash\\ newline\n tab\t ctl\u{1} é bad\u{fffd}\u{fffd} end"
         );
         assert_eq!(notes[1]["text"], Value::Null);
+        // semo_group_set traces a change only.
+        let groups: Vec<(&Value, &Value)> = events(&trace, "group")
+            .iter()
+            .map(|e| (&e["rank"], &e["size"]))
+            .collect();
+        assert_eq!(
+            groups,
+            [(&"2".into(), &"3".into()), (&"1".into(), &"2".into())]
+        );
         let sends = events(&trace, "send");
         assert_eq!(sends[0]["to"], "USER");
         assert_eq!(sends[0]["key"], "Team.STATUS");

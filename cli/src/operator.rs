@@ -246,7 +246,7 @@ fn describe(topic: &str, payload: &[u8], printed: &mut BTreeMap<String, String>)
         "status" => {
             let status = Status::decode(last, payload)?;
             let line = format!(
-                "status {last}: {} {}{}{}",
+                "status {last}: {} {}{}{}{}",
                 status.state,
                 status.mode,
                 match status.services_text().as_str() {
@@ -256,6 +256,10 @@ fn describe(topic: &str, payload: &[u8], printed: &mut BTreeMap<String, String>)
                 match status.leader.as_str() {
                     "" => String::new(),
                     l => format!(" leader {l}"),
+                },
+                match status.battery {
+                    Some(level) => format!(" battery {level}"),
+                    None => String::new(),
                 }
             );
             (printed.get(last) != Some(&line)).then(|| {

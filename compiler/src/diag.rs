@@ -187,6 +187,11 @@ codes! {
     DeployUnknownName = "E121", Error, "a deployment file naming a robot or team that the mission does not have";
     DeployBadBroker = "E122", Error, "a broker address that is not `mqtt://HOST[:PORT]` or `mqtts://HOST[:PORT]`";
     DeployMissingFile = "E123", Error, "a deployment file naming a password, CA, certificate or key file that does not exist";
+    // Group services (`<GroupService>` in a strategy's `<GroupingInfo>`).
+    GroupServiceNotCalled = "E124", Error, "a `GroupService` naming a built-in service that the team does not call (in that plan): no robot would be in the group";
+    GroupServiceDuplicate = "E125", Error, "a service declared a group service twice (for the same plan)";
+    // Refinement of strategies into the robots' programs.
+    BatteryPolicyNamesNoTask = "W130", Warning, "a battery policy's sensor or actuator that names no task of any robot of its team, or a policy that names none: it changes nothing";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

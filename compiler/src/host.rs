@@ -1003,3 +1003,4 @@ pub use disk::{
     CheckRun, ProjectInputs, STDIN_NAME, load_build, load_check, load_check_stdin, project_inputs,
 };
 pub use dropper::{Dropper, drop_later};
+pub use ide::{PictureError, WORKSPACE_SYMBOL_LIMIT};

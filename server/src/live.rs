@@ -55,7 +55,11 @@ impl Status {
             mode: text("mode"),
             leader: text("leader"),
             services,
-            battery: object.get("battery").and_then(serde_json::Value::as_f64),
+            // The runtime writes trace fields as text (`"battery":"87"`).
+            battery: object.get("battery").and_then(|v| {
+                v.as_f64()
+                    .or_else(|| v.as_str().and_then(|s| s.parse().ok()))
+            }),
             t: object.get("t").and_then(serde_json::Value::as_i64),
         })
     }
@@ -141,6 +145,14 @@ mod tests {
             Status::decode("r", br#"{"state":"running","battery":42.5}"#)
                 .map(|s| (s.robot, s.battery)),
             Some(("r".to_string(), Some(42.5)))
+        );
+        assert_eq!(
+            Status::decode("r", br#"{"state":"running","battery":"87"}"#).map(|s| s.battery),
+            Some(Some(87.0))
+        );
+        assert_eq!(
+            Status::decode("r", br#"{"state":"running","battery":"none"}"#).map(|s| s.battery),
+            Some(None)
         );
         assert_eq!(Status::decode("r", b"[1]"), None);
         assert_eq!(Status::decode("r", b"\xff"), None);

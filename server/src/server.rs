@@ -534,11 +534,13 @@ impl LanguageServer for Backend {
 
     async fn code_action(&self, p: CodeActionParams) -> Result<Option<CodeActionResponse>> {
         let uri = p.text_document.uri.clone();
-        let strategies = self.state.world().strategies();
-        self.on_snapshot(&uri, move |s| {
-            handlers::code_actions::code_actions(s, &strategies, &p)
-        })
-        .await
+        let found = self
+            .on_query(&uri, move |s, w| {
+                handlers::code_actions::code_actions(s, w, &p)
+            })
+            .await?;
+        let world = self.state.world();
+        Ok(Some(found.response(|id| world.uri_of(id).cloned())))
     }
 
     // Navigation and structure.
@@ -624,9 +626,13 @@ impl LanguageServer for Backend {
     }
 
     async fn symbol(&self, p: WorkspaceSymbolParams) -> Result<Option<WorkspaceSymbolResponse>> {
-        let snapshots: Vec<Arc<Snapshot>> = self.state.world().snapshots().cloned().collect();
+        let (workspace, encoding, uris) = {
+            let world = self.state.world();
+            (world.analysis(), world.encoding, world.file_uris())
+        };
         let found = tokio::task::spawn_blocking(move || {
-            handlers::workspace_symbol::workspace_symbol(&snapshots, &p.query)
+            let uri_of = |id: semo::diag::FileId| uris.get(id.0 as usize).cloned();
+            handlers::workspace_symbol::workspace_symbol(&workspace, encoding, uri_of, &p.query)
         })
         .await
         .map_err(|_| Error::internal_error())?;

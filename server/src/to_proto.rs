@@ -2,12 +2,16 @@
 //! one place that knows both. Handlers ask the workspace analysis
 //! (`Snapshot::host`) and hand its answers here.
 
-use crate::encoding::LineMap;
+use crate::encoding::{Encoding, LineMap};
 use crate::world::Snapshot;
 use semo::diag::FileId;
 use semo::host::Analysis;
-use semo::ide::{self, CompletionKind, HoverResult, NavigationTarget, SourceChange};
-use semo::text::LineIndex;
+use semo::ide::{
+    self, Access, CompletionKind, Fold, FoldKind, HighlightToken, HoverResult, InlayKind,
+    NavigationTarget, Reference, SourceChange, StructureNode, TokenKind,
+};
+use semo::span::Span;
+use semo::text::{ColumnUnit, LineIndex};
 use std::collections::HashMap;
 use tower_lsp_server::ls_types::*;
 
@@ -139,4 +143,251 @@ pub fn target_ranges(
             Some((t.file, map.range(t.span)))
         })
         .collect()
+}
+
+/// The library's quick fixes as protocol actions: each an edit of the file
+/// (`uri`), attached to the client's copy of the diagnostic it fixes when
+/// the request carries it (same code and range), else to the diagnostic as
+/// published (`published`, in the order of `Analysis::diagnostics`).
+pub fn quick_fixes(
+    uri: &Uri,
+    lines: &LineMap<'_>,
+    published: &[Diagnostic],
+    from_client: &[Diagnostic],
+    actions: Vec<ide::CodeAction>,
+) -> Vec<CodeActionOrCommand> {
+    actions
+        .into_iter()
+        .filter_map(|action| {
+            let ours = published.get(action.diagnostic)?;
+            let diagnostic = from_client
+                .iter()
+                .find(|d| d.range == ours.range && d.code == ours.code)
+                .unwrap_or(ours)
+                .clone();
+            let edits = text_edits(action.edits, lines);
+            Some(CodeActionOrCommand::CodeAction(CodeAction {
+                title: action.title,
+                kind: Some(CodeActionKind::QUICKFIX),
+                diagnostics: Some(vec![diagnostic]),
+                edit: Some(WorkspaceEdit {
+                    changes: Some(HashMap::from([(uri.clone(), edits)])),
+                    ..WorkspaceEdit::default()
+                }),
+                is_preferred: Some(action.preferred),
+                ..CodeAction::default()
+            }))
+        })
+        .collect()
+}
+
+/// An assist (`ide::Assist`) whose edits are in protocol ranges and named files.
+pub fn assist(title: String, changes: HashMap<Uri, Vec<TextEdit>>) -> CodeActionOrCommand {
+    CodeActionOrCommand::CodeAction(CodeAction {
+        title,
+        kind: Some(CodeActionKind::REFACTOR),
+        edit: Some(WorkspaceEdit {
+            changes: Some(changes),
+            ..WorkspaceEdit::default()
+        }),
+        ..CodeAction::default()
+    })
+}
+
+/// Edits of the file `lines` maps.
+pub fn text_edits(edits: Vec<ide::TextEdit>, lines: &LineMap<'_>) -> Vec<TextEdit> {
+    edits
+        .into_iter()
+        .map(|e| TextEdit::new(lines.range(e.span), e.new_text))
+        .collect()
+}
+
+pub fn highlights(found: Vec<Reference>, lines: &LineMap<'_>) -> Vec<DocumentHighlight> {
+    found
+        .into_iter()
+        .map(|r| DocumentHighlight {
+            range: lines.range(r.span),
+            kind: Some(match r.access {
+                Access::Write => DocumentHighlightKind::WRITE,
+                Access::Read => DocumentHighlightKind::READ,
+            }),
+        })
+        .collect()
+}
+
+pub fn symbol_kind(kind: ide::SymbolKind) -> SymbolKind {
+    use ide::SymbolKind as K;
+    match kind {
+        K::Team => SymbolKind::CLASS,
+        K::Robot | K::Value => SymbolKind::FIELD,
+        K::Plan => SymbolKind::NAMESPACE,
+        K::Service | K::Function => SymbolKind::FUNCTION,
+        K::Mode | K::Action => SymbolKind::ENUM_MEMBER,
+        K::Main => SymbolKind::EVENT,
+    }
+}
+
+/// An outline, nested.
+pub fn document_symbols(
+    outline: Vec<StructureNode>,
+    lines: &LineMap<'_>,
+) -> DocumentSymbolResponse {
+    DocumentSymbolResponse::Nested(outline.iter().map(|s| document_symbol(s, lines)).collect())
+}
+
+fn document_symbol(symbol: &StructureNode, lines: &LineMap<'_>) -> DocumentSymbol {
+    #[allow(deprecated)] // `deprecated` must be written, even as None
+    DocumentSymbol {
+        name: symbol.name.clone(),
+        detail: symbol.detail.clone(),
+        kind: symbol_kind(symbol.kind),
+        tags: None,
+        deprecated: None,
+        range: lines.range(symbol.span),
+        selection_range: lines.range(symbol.name_span),
+        children: (!symbol.children.is_empty()).then(|| {
+            symbol
+                .children
+                .iter()
+                .map(|c| document_symbol(c, lines))
+                .collect()
+        }),
+    }
+}
+
+/// A workspace-search result at `location` (its name).
+pub fn symbol_information(symbol: ide::WorkspaceSymbol, location: Location) -> SymbolInformation {
+    #[allow(deprecated)] // `deprecated` must be written, even as None
+    SymbolInformation {
+        name: symbol.name,
+        kind: symbol_kind(symbol.kind),
+        tags: None,
+        deprecated: None,
+        location,
+        container_name: symbol.container,
+    }
+}
+
+/// Folds as whole lines (no column to count in the client's encoding); a
+/// fold within one line, or on the same lines as the one before it, is left
+/// out (editors show one fold per line).
+pub fn folding_ranges(folds: Vec<Fold>, lines: &LineMap<'_>) -> Vec<FoldingRange> {
+    let line = |offset| {
+        lines
+            .index
+            .line_col(lines.text, offset, ColumnUnit::Utf8)
+            .line
+    };
+    let mut ranges: Vec<FoldingRange> = Vec::new();
+    for fold in folds {
+        let (start_line, end_line) = (line(fold.span.start), line(fold.span.end));
+        let duplicate = ranges
+            .iter()
+            .rev()
+            .take_while(|r| r.start_line == start_line)
+            .any(|r| r.end_line == end_line);
+        if end_line <= start_line || duplicate {
+            continue;
+        }
+        ranges.push(FoldingRange {
+            start_line,
+            end_line,
+            kind: match fold.kind {
+                FoldKind::Comment => Some(FoldingRangeKind::Comment),
+                FoldKind::Block => None,
+            },
+            ..FoldingRange::default()
+        });
+    }
+    ranges
+}
+
+pub fn inlay_hint(hint: ide::InlayHint, lines: &LineMap<'_>) -> InlayHint {
+    InlayHint {
+        position: lines.position(hint.offset),
+        label: InlayHintLabel::String(hint.label),
+        kind: Some(match hint.kind {
+            InlayKind::Robots => InlayHintKind::PARAMETER,
+            InlayKind::Schedule | InlayKind::Repetitions => InlayHintKind::TYPE,
+        }),
+        text_edits: None,
+        tooltip: hint
+            .tooltip
+            .map(|value| InlayHintTooltip::MarkupContent(markdown(value))),
+        // A repetition count follows a quoted name: apart from it.
+        padding_left: Some(hint.kind == InlayKind::Repetitions),
+        padding_right: Some(false),
+        data: None,
+    }
+}
+
+/// The semantic-token legend announced at `initialize`: token types in
+/// [`TokenKind::ALL`] order, modifiers in [`ide::TOKEN_MODIFIERS`] order
+/// (the bit order of `HighlightToken::modifiers`).
+pub fn semantic_tokens_legend() -> SemanticTokensLegend {
+    SemanticTokensLegend {
+        token_types: TokenKind::ALL
+            .iter()
+            .map(|k| SemanticTokenType::new(k.name()))
+            .collect(),
+        token_modifiers: ide::TOKEN_MODIFIERS
+            .iter()
+            .map(|m| SemanticTokenModifier::new(m))
+            .collect(),
+    }
+}
+
+/// Sorted tokens in the protocol's relative encoding.
+pub fn semantic_tokens(tokens: &[HighlightToken], lines: &LineMap<'_>) -> SemanticTokens {
+    SemanticTokens {
+        result_id: None,
+        data: encode_tokens(lines.text, lines.index, lines.encoding, tokens),
+    }
+}
+
+/// The relative encoding in one pass over the sorted tokens: the column is
+/// carried forward along a line instead of recounted from its start.
+fn encode_tokens(
+    text: &str,
+    index: &LineIndex,
+    encoding: Encoding,
+    tokens: &[HighlightToken],
+) -> Vec<SemanticToken> {
+    let units = |s: &str| -> u32 {
+        match encoding {
+            Encoding::Utf8 => s.len() as u32,
+            Encoding::Utf16 => s.chars().map(|c| c.len_utf16() as u32).sum(),
+        }
+    };
+    let slice = |span: Span| text.get(span.range()).unwrap_or("");
+    let mut data = Vec::with_capacity(tokens.len());
+    let (mut prev_line, mut prev_col) = (0u32, 0u32);
+    let (mut line, mut next_line_start) = (0u32, index.line_start(1));
+    // Where the column was last counted, and the column there.
+    let (mut counted_to, mut col) = (0usize, 0u32);
+    for token in tokens {
+        let start = token.span.start.min(text.len());
+        if start >= next_line_start || start < counted_to {
+            line = index.line_col(text, start, ColumnUnit::Utf8).line;
+            next_line_start = index.line_start(line as usize + 1);
+            counted_to = index.line_start(line as usize);
+            col = 0;
+        }
+        col += units(slice(Span::new(counted_to, start)));
+        counted_to = start;
+        let length = units(slice(token.span));
+        data.push(SemanticToken {
+            delta_line: line.saturating_sub(prev_line),
+            delta_start: if line == prev_line {
+                col.saturating_sub(prev_col)
+            } else {
+                col
+            },
+            length,
+            token_type: token.kind.index(),
+            token_modifiers_bitset: token.modifiers,
+        });
+        (prev_line, prev_col) = (line, col);
+    }
+    data
 }

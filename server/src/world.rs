@@ -15,7 +15,6 @@ use semo::diag::{Diagnostic, FileId};
 use semo::host::{self, AnalysisHost, CatalogResult, Dropper, Roots};
 use semo::ide::FilePosition;
 use semo::sema::Analysis;
-use semo::strategy::{Strategy, StrategyLinks};
 use semo::text::LineIndex;
 use semo::workspace::{FileKind, GraphRun};
 use std::collections::HashMap;
@@ -59,8 +58,6 @@ pub struct Snapshot {
     pub text: Arc<str>,
     pub catalog: Arc<CatalogState>,
     pub encoding: Encoding,
-    /// For a strategy file: the missions that see it (and it is checked against).
-    pub missions: Vec<Arc<Snapshot>>,
     /// The workspace as it was when this snapshot was taken.
     host: host::Analysis,
     analysis: OnceLock<Arc<FileAnalysis>>,
@@ -72,10 +69,6 @@ pub struct FileAnalysis {
     diagnostics: Vec<Diagnostic>,
     pub mission: Option<Arc<Analysis>>,
     pub graph: Option<Arc<GraphRun>>,
-    pub strategy: Option<Strategy>,
-    /// For a strategy file: the calls of the missions that see it refined by
-    /// its entries and the others they see.
-    pub strategy_links: StrategyLinks,
 }
 
 impl FileAnalysis {
@@ -101,11 +94,6 @@ impl Snapshot {
             diagnostics: host.diagnostics(self.id),
             mission: host.mission(self.id),
             graph: host.graph(self.id),
-            strategy: host.strategy(self.id).and_then(|s| s.strategy.clone()),
-            strategy_links: match self.kind {
-                FileKind::Strategy => host.strategy_links(self.id),
-                _ => StrategyLinks::default(),
-            },
         }
     }
 
@@ -216,6 +204,12 @@ impl World {
         self.uris.get(id.0 as usize)
     }
 
+    /// Every file's URI, `FileId(i)`'s at `i` (for answers naming files
+    /// computed outside the lock).
+    pub fn file_uris(&self) -> Vec<Uri> {
+        self.uris.clone()
+    }
+
     pub fn snapshot(&self, uri: &Uri) -> Option<Arc<Snapshot>> {
         self.files.get(uri).map(|f| f.snapshot.clone())
     }
@@ -238,16 +232,6 @@ impl World {
     /// The current snapshot of every file the server knows.
     pub fn snapshots(&self) -> impl Iterator<Item = &Arc<Snapshot>> {
         self.files.values().map(|f| &f.snapshot)
-    }
-
-    /// The current snapshot of every strategy file (for features of missions
-    /// that lead into strategies).
-    pub fn strategies(&self) -> Vec<Arc<Snapshot>> {
-        self.files
-            .values()
-            .filter(|f| f.kind == FileKind::Strategy)
-            .map(|f| f.snapshot.clone())
-            .collect()
     }
 
     /// The workspace folders: a file sees the catalog and strategy files up
@@ -464,8 +448,7 @@ impl World {
         if let Some(old) = old {
             retire_to(&self.dropper, old.snapshot);
         }
-        // Renewed with the others, in order: a strategy's snapshot holds the
-        // current snapshots of its missions.
+        // Renewed with the others (the snapshot just made is already current).
         if !affected.contains(&id) {
             affected.push(id);
         }
@@ -481,17 +464,6 @@ impl World {
         text: Arc<str>,
     ) -> Snapshot {
         let analysis = self.host.analysis();
-        let missions = if kind == FileKind::Strategy {
-            analysis
-                .missions_seeing(id)
-                .into_iter()
-                .filter_map(|m| self.uri_of(m))
-                .filter_map(|m| self.files.get(m))
-                .map(|f| f.snapshot.clone())
-                .collect()
-        } else {
-            Vec::new()
-        };
         Snapshot {
             uri: uri.clone(),
             id,
@@ -504,7 +476,6 @@ impl World {
                 built: OnceLock::new(),
             }),
             encoding: self.encoding,
-            missions,
             host: analysis,
             analysis: OnceLock::new(),
         }
@@ -520,8 +491,8 @@ impl World {
     }
 
     /// New snapshots (same text, the current workspace) for the files `ids`;
-    /// the old ones are retired. Missions first: strategy snapshots hold the
-    /// missions' current snapshots.
+    /// the old ones are retired; listed in a fixed order by kind, missions
+    /// first.
     fn renew(&mut self, ids: &[FileId]) -> Changed {
         let mut uris: Vec<Uri> = ids
             .iter()

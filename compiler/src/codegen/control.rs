@@ -10,7 +10,8 @@ use super::c;
 use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::{
-    ActionMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, SlotSource, State, StateKind,
+    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, SlotSource, State,
+    StateKind,
 };
 use crate::sema::Compared;
 use crate::syntax::ast::CmpOp;
@@ -38,6 +39,25 @@ pub fn listen_ms(heartbeat_ms: i64) -> i64 {
 /// the claimant gives way at its own next election, so that two robots never
 /// both lead after a restart.
 const ELECTION_C: &str = "/* Leader elections: each `leader(...)` arm's candidates (peer indices, in\n * formation order) and algorithm. A candidate is alive when it is this\n * robot or was heard from within three heartbeats. lowest_id: the first\n * alive; bully: the last alive (the highest id); highest_battery: the\n * highest battery level its heartbeat said (unknown counts lowest; ties: the\n * first), after every robot has listened at start. A robot that joined the\n * mission under way (restarted) listens too, and while another live robot\n * claims leadership it follows that one instead of claiming. A change of\n * leader is traced. Returns 1 (this robot leads), 0, or -1 while listening. */\nenum { ELECT_LOWEST_ID, ELECT_HIGHEST_BATTERY, ELECT_BULLY };\nstatic int elected(const size_t *candidates, size_t n, int algorithm, long *last)\n{\n    static int rejoining = -1;\n    const semo_program_desc *p = semo_program();\n    int64_t now = semo_now_ms();\n    if (rejoining < 0)\n        rejoining = semo_joined_ms() > @HB@ || semo_session_resumed();\n    if ((rejoining || algorithm == ELECT_HIGHEST_BATTERY) && now - semo_joined_ms() < @LISTEN@) {\n        wake_at(semo_joined_ms() + @LISTEN@);\n        return -1;\n    }\n    size_t leader = p->self;\n    bool found = false;\n    long best = -1;\n    for (size_t k = 0; k < n; k++) {\n        size_t c = candidates[algorithm == ELECT_BULLY ? n - 1 - k : k];\n        comm_heartbeat h = comm_heard(c);\n        if (c != p->self && now - h.seen > 3 * @HB@)\n            continue;\n        long level = c == p->self ? own_battery() : h.battery;\n        if (!found || (algorithm == ELECT_HIGHEST_BATTERY && level > best)) {\n            leader = c;\n            best = level;\n            found = true;\n        }\n        if (algorithm != ELECT_HIGHEST_BATTERY)\n            break;\n    }\n    if (rejoining && leader == p->self) {\n        for (size_t i = 0; i < p->peer_count; i++) {\n            comm_heartbeat h = comm_heard(i);\n            if (i != p->self && h.leads && now - h.seen <= 3 * @HB@) {\n                leader = i;\n                break;\n            }\n        }\n        if (leader == p->self)\n            rejoining = 0;\n    }\n    leading = leader == p->self;\n    if ((long)leader != *last) {\n        *last = (long)leader;\n        semo_trace(\"leader\", \"leader\", p->peers[leader].robot, NULL);\n    }\n    return leading;\n}\n";
+
+/// At each heartbeat of a member of its team's group (group services,
+/// `docs/groups.md`): its rank among the live members (formation order) and
+/// their number, for `semo_group_rank()`/`semo_group_size()`. A member is
+/// alive when it is this robot or was heard from within three heartbeats
+/// (counted from when this robot joined: until then it had no chance to
+/// hear, so a robot starting or restarting counts every member alive).
+fn group_update(m: &ControlMachine) -> String {
+    if m.group.is_empty() {
+        return String::new();
+    }
+    let list: Vec<String> = m.group.iter().map(|i| i.to_string()).collect();
+    format!(
+        "        static const size_t members[] = {{{list}}};\n        const semo_program_desc *p = semo_program();\n        int rank = 0, size = 0;\n        for (size_t k = 0; k < {count}; k++) {{\n            comm_heartbeat h = comm_heard(members[k]);\n            int64_t seen = h.seen > semo_joined_ms() ? h.seen : semo_joined_ms();\n            if (members[k] != p->self && last_heartbeat - seen > 3 * {hb})\n                continue; /* failed: silent for three heartbeats */\n            if (members[k] == p->self)\n                rank = size;\n            size++;\n        }}\n        semo_group_set(rank, size);\n",
+        list = list.join(", "),
+        count = m.group.len(),
+        hb = m.heartbeat_ms,
+    )
+}
 
 /// This robot's battery level for its heartbeats: the scenario's (in
 /// simulation), else unknown (-1).
@@ -236,11 +256,15 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
     let mut sensor = 0;
     for (i, s) in m.slots.iter().enumerate() {
         match &s.source {
-            SlotSource::Sensor { .. } => {
+            SlotSource::Sensor { port, .. } => {
                 let _ = writeln!(
                     out,
                     "    while (UFPort_GetNumOfAvailableData(sensor_port[{sensor}]) > 0)\n        UFPort_ReadFromQueue(sensor_port[{sensor}], &slot[{i}], sizeof slot[{i}]);"
                 );
+                if port == crate::refine::BATTERY_VALUE {
+                    // The robot's status carries the level it read.
+                    let _ = writeln!(out, "    semo_battery_report(&slot[{i}]);");
+                }
                 sensor += 1;
             }
             SlotSource::Shared => {
@@ -767,10 +791,11 @@ fn emit_task(out: &mut String, program: &RobotProgram) {
         // Tell the team this robot is alive, for leader elections.
         let _ = writeln!(
             out,
-            "    static int64_t last_heartbeat = -{hb};\n    if (semo_now_ms() - last_heartbeat >= {hb}) {{\n        semo_value alive;\n        char text[32];\n        long battery = own_battery();\n        last_heartbeat = semo_now_ms();\n        if (battery < 0)\n            snprintf(text, sizeof text, \"%s -\", leading ? \"leader\" : \"member\");\n        else\n            snprintf(text, sizeof text, \"%s %ld\", leading ? \"leader\" : \"member\", battery);\n        semo_value_set(&alive, text);\n        semo_comm_send({team}, SEMO_MSG_PUBLISH, {key}, &alive);\n    }}\n    wake_at(last_heartbeat + {hb});",
+            "    static int64_t last_heartbeat = -{hb};\n    if (semo_now_ms() - last_heartbeat >= {hb}) {{\n        semo_value alive;\n        char text[32];\n        long battery = own_battery();\n        last_heartbeat = semo_now_ms();\n        if (battery < 0)\n            snprintf(text, sizeof text, \"%s -\", leading ? \"leader\" : \"member\");\n        else\n            snprintf(text, sizeof text, \"%s %ld\", leading ? \"leader\" : \"member\", battery);\n        semo_value_set(&alive, text);\n        semo_comm_send({team}, SEMO_MSG_PUBLISH, {key}, &alive);\n{group}    }}\n    wake_at(last_heartbeat + {hb});",
             hb = m.heartbeat_ms,
             team = c::string(&program.team),
             key = c::string(&super::files::alive_key(program)),
+            group = group_update(m),
         );
     }
     match default {

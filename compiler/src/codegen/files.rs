@@ -4,7 +4,7 @@
 use super::c;
 use super::values::Words;
 use super::{CompiledScenario, Platform, Target};
-use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK, getter, setter};
+use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK};
 use crate::refine::{RobotProgram, RoleKind, ValueKind};
 use crate::taskgraph::Trigger;
 use std::fmt::Write;
@@ -59,22 +59,7 @@ pub fn program_h(program: &RobotProgram, header: &str) -> String {
             out.push_str("/* The last pass of a robot through sync point `point` (an index into\n * the program's sync points) that it announced; 0 before any. */\nlong comm_sync_arrived(size_t peer, size_t point);\n");
         }
     }
-    if let Some(lib) = &program.library {
-        let _ = writeln!(
-            out,
-            "\n/* Library task {}: the team's shared information. */",
-            lib.name
-        );
-        for key in &lib.attributes {
-            let prefix = c::ident(&lib.name);
-            let _ = writeln!(
-                out,
-                "LIBFUNC(semo_value, {prefix}_{}, (void));\nLIBFUNC(void, {prefix}_{}, (const semo_value *value));",
-                getter(key),
-                setter(key)
-            );
-        }
-    }
+    out.push_str(&super::shared::declarations(program));
     let _ = writeln!(
         out,
         "\n/* The task graph's channels (channels.c). */\n#define SEMO_CHANNEL_COUNT {}\nextern const semo_channel_desc semo_program_channels[];",
@@ -230,7 +215,7 @@ pub fn main_c(program: &RobotProgram, target: Target, header: &str) -> String {
 /// The lock of state shared between tasks: a mutex on threads, nothing on
 /// the static schedule (one task runs at a time). `(include, declare, lock,
 /// unlock)` for a lock named `name`.
-fn lock(target: Target, name: &str) -> (&'static str, String, String, String) {
+pub(super) fn lock(target: Target, name: &str) -> (&'static str, String, String, String) {
     match target.platform() {
         Platform::Threads => (
             "#include <pthread.h>\n",
@@ -374,6 +359,9 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         if !m.sync_points.is_empty() {
             out.push_str("    if (heard_sync(&m))\n        return;\n");
         }
+        if let Some(dispatch) = super::shared::comm_dispatch(program) {
+            out.push_str(&dispatch);
+        }
         if !m.subscribed.is_empty() {
             let _ = writeln!(
                 out,
@@ -394,30 +382,6 @@ pub fn comm_task_c(program: &RobotProgram, target: Target, header: &str) -> Stri
         );
     }
     out
-}
-
-pub fn library_c(program: &RobotProgram, target: Target, header: &str) -> Option<(String, String)> {
-    let lib = program.library.as_ref()?;
-    let prefix = c::ident(&lib.name);
-    let mut out = String::from(header);
-    let (include, declare, lock, unlock) = lock(target, "lock");
-    let _ = write!(out, "#include \"program.h\"\n{include}\n");
-    let _ = writeln!(
-        out,
-        "/* Library task {}: the team's shared information, one value per attribute,\n * read and written by its getters and setters under one lock. */\n{declare}static semo_value value[{}];\n",
-        c::comment(&lib.name),
-        lib.attributes.len()
-    );
-    for (i, key) in lib.attributes.iter().enumerate() {
-        let _ = writeln!(
-            out,
-            "/* {} */\nLIBFUNC(semo_value, {prefix}_{}, (void))\n{{\n    {lock}\n    semo_value v = value[{i}];\n    {unlock}\n    return v;\n}}\n\nLIBFUNC(void, {prefix}_{}, (const semo_value *v))\n{{\n    {lock}\n    value[{i}] = *v;\n    {unlock}\n}}\n",
-            c::comment(key),
-            getter(key),
-            setter(key)
-        );
-    }
-    Some((format!("lib_{prefix}.c"), out))
 }
 
 /// `tasks/<task>.c`: the simulation's own body for `linux-sim`; for `linux`

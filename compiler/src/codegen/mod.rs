@@ -24,6 +24,7 @@ pub(crate) mod files;
 mod loops;
 pub mod output;
 mod schedule;
+mod shared;
 mod target;
 mod values;
 
@@ -333,7 +334,7 @@ pub fn generate(
         );
         sources_c.push("comm_task.c".into());
     }
-    if let Some((name, text)) = files::library_c(program, target, &header) {
+    if let Some((name, text)) = shared::library_c(program, target, &header) {
         push(&name, text, Owner::Generated);
         sources_c.push(name);
     }

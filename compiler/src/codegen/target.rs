@@ -157,6 +157,11 @@ fn peer_messages(program: &RobotProgram) -> Option<String> {
     if let Some(g) = m.subscribed.first() {
         return Some(format!("subscribe to `{g}`"));
     }
+    if let Some(service) = m.group_services.first() {
+        return Some(format!(
+            "share the group service `{service}` with the team (heartbeats)"
+        ));
+    }
     if m.heartbeat {
         return Some("elect a leader among the team (heartbeats)".to_string());
     }

@@ -88,6 +88,22 @@ pub fn files(
         if program.control.heartbeat {
             rights.write.insert(topics::heartbeats(program));
         }
+        // The owner protocol of globally shared values: the owner tells the
+        // team, a writer tells whichever teammate owns (any may, in turn).
+        let ownership = program.library.as_ref().and_then(|l| l.ownership.as_ref());
+        for global in ownership.map_or(&[][..], |o| &o.global) {
+            rights
+                .write
+                .insert(topics::to_team(&mission, &program.team, &global.value_key));
+            for &owner in ownership.map_or(&[][..], |o| &o.owners) {
+                let (team, robot) = &program.peers[owner];
+                if *robot != program.robot {
+                    rights
+                        .write
+                        .insert(topics::to_robot(&mission, team, robot, &global.set_key));
+                }
+            }
+        }
         if !program.control.sync_points.is_empty() {
             let key = crate::codegen::files::sync_key(program);
             rights

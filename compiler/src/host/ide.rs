@@ -10,11 +10,10 @@
 
 use super::Analysis;
 use crate::diag::FileId;
-use crate::ide::mission::rename::RenameError;
-use crate::ide::mission::signature_help::SignatureHelp;
 use crate::ide::{
-    self, CompletionConfig, CompletionItem, CompletionKind, FilePosition, HoverResult,
-    NavigationTarget, SourceChange, TextEdit, strategy::StrategyFile,
+    self, CompletionConfig, CompletionItem, CompletionKind, FilePosition, Fold, HoverResult,
+    NavigationTarget, Reference, RenameError, SignatureHelp, SourceChange, TextEdit,
+    strategy::StrategyFile,
 };
 use crate::sema;
 use crate::workspace::FileKind;
@@ -237,11 +236,9 @@ impl Analysis {
         out
     }
 
-    /// Runs `f` on the strategy file `file` as its features read it: its
-    /// text and model, the missions that see it (checked), its catalog.
     /// The ranges a file folds into (blocks, `case`s, group statements,
     /// comment banners); empty for other kinds of files.
-    pub fn folding_ranges(&self, file: FileId) -> Vec<ide::mission::folding::Fold> {
+    pub fn folding_ranges(&self, file: FileId) -> Vec<Fold> {
         match self.mission_of_kind(file) {
             Some((mission, text)) => ide::mission::folding::folding_ranges(&mission, text),
             None => Vec::new(),
@@ -262,7 +259,7 @@ impl Analysis {
 
     /// The names in the file meaning the symbol at `position`, each a read
     /// or a write (definitions, throws, assigned team variables).
-    pub fn highlights(&self, position: FilePosition) -> Vec<ide::mission::navigation::Reference> {
+    pub fn highlights(&self, position: FilePosition) -> Vec<Reference> {
         let FilePosition { file, offset } = position;
         match self.mission_of_kind(file) {
             Some((mission, _)) => ide::mission::navigation::references(&mission, offset),
@@ -271,11 +268,13 @@ impl Analysis {
     }
 
     /// A mission file's checked mission and text; `None` for other files.
-    fn mission_of_kind(&self, file: FileId) -> Option<(Arc<sema::Analysis>, &str)> {
+    pub(super) fn mission_of_kind(&self, file: FileId) -> Option<(Arc<sema::Analysis>, &str)> {
         let source = self.file(file).filter(|f| f.kind == FileKind::Mission)?;
         Some((self.mission(file)?, &source.text))
     }
 
+    /// Runs `f` on the strategy file `file` as its features read it: its
+    /// text and model, the missions that see it (checked), its catalog.
     fn with_strategy<T: Default>(&self, file: FileId, f: impl FnOnce(&StrategyFile<'_>) -> T) -> T {
         let Some(source) = self.file(file) else {
             return T::default();
@@ -297,8 +296,12 @@ impl Analysis {
     }
 }
 
+mod edits;
+mod structure;
 #[cfg(test)]
 mod tests;
+
+pub use structure::{PictureError, WORKSPACE_SYMBOL_LIMIT};
 
 /// A `semo.toml` completion in the editor vocabulary.
 fn project_completion(item: crate::project::Completion) -> CompletionItem {

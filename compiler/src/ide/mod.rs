@@ -23,6 +23,11 @@ use crate::diag::FileId;
 use crate::span::Span;
 
 pub use crate::edit::{CodeAction, TextEdit};
+pub use mission::folding::{Fold, FoldKind};
+pub use mission::navigation::{Access, Reference};
+pub use mission::rename::RenameError;
+pub use mission::semantic_tokens::{HighlightToken, MODIFIERS as TOKEN_MODIFIERS, TokenKind};
+pub use mission::signature_help::SignatureHelp;
 
 /// A byte offset in one file of the workspace: what every position query asks
 /// about.
@@ -164,4 +169,80 @@ impl CompletionItem {
 pub struct CompletionConfig {
     /// Whether the editor understands snippets (`${1:goal}`).
     pub snippets: bool,
+}
+
+/// A refactoring offered at a place (not a fix of a diagnostic): its edits
+/// may reach other files (an entry created in a strategy file from the
+/// mission call at the cursor).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Assist {
+    pub title: String,
+    pub change: SourceChange,
+}
+
+/// What an outline entry or a workspace-search result is; one list for every
+/// kind of file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SymbolKind {
+    Team,
+    Robot,
+    Plan,
+    /// A composite service of a mission, or a strategy file's `<Service>`.
+    Service,
+    Mode,
+    Main,
+    Function,
+    /// A strategy file's `<Value>`.
+    Value,
+    /// An action of a strategy service.
+    Action,
+}
+
+/// One entry of a file's outline (document symbols), with the entries inside it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StructureNode {
+    pub name: String,
+    pub detail: Option<String>,
+    pub kind: SymbolKind,
+    /// The whole definition (for a team or a plan: from its first to its
+    /// last item; in XML the whole element).
+    pub span: Span,
+    /// The name to select, inside `span`.
+    pub name_span: Span,
+    pub children: Vec<StructureNode>,
+}
+
+/// A symbol found by a workspace search.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WorkspaceSymbol {
+    pub name: String,
+    pub kind: SymbolKind,
+    /// `Team` for a mode, `Team.Plan` for a service.
+    pub container: Option<String>,
+    /// Its name.
+    pub target: NavigationTarget,
+    /// How well the name matches the query; lower is better
+    /// (`mission::symbols::match_score`).
+    pub score: u32,
+}
+
+/// What an inlay hint shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InlayKind {
+    /// The robots a mission's group arm selects.
+    Robots,
+    /// How the service a mission's mode sets runs.
+    Schedule,
+    /// A task graph's repetition count after a task's name.
+    Repetitions,
+}
+
+/// A hint shown inside the text, before the character at `offset`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct InlayHint {
+    pub offset: usize,
+    pub label: String,
+    pub kind: InlayKind,
+    /// Markdown.
+    pub tooltip: Option<String>,
 }

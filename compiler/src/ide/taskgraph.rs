@@ -4,7 +4,7 @@
 //! `task.port` names inside a channel's `src`/`dst`. Plain data with byte
 //! ranges; the language server turns it into protocol types.
 
-use crate::ide::{CompletionItem, CompletionKind, HoverResult};
+use crate::ide::{CompletionItem, CompletionKind, HoverResult, InlayHint, InlayKind};
 use crate::span::Span;
 use crate::taskgraph::analysis::{GraphReport, LevelReport};
 use crate::taskgraph::model::{
@@ -214,23 +214,20 @@ fn channel_doc(level: &LevelRef<'_>, report: &GraphReport, channel: &Channel) ->
     md
 }
 
-/// A repetition count shown after a task's name.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct InlayHint {
-    /// Byte offset the hint is shown at (the end of the name's value).
-    pub offset: usize,
-    pub label: String,
-}
-
-/// `×N` after the name of every task of a consistent level.
+/// `×N` after the name of every task of a consistent level (after the
+/// value's closing quote).
 pub fn inlay_hints(graph: &TaskGraph, report: &GraphReport) -> Vec<InlayHint> {
     let mut hints = Vec::new();
     for level in graph.levels() {
         for task in &level.graph.tasks {
             if let Some(n) = repetition(report, &level.path, &task.name.name) {
                 hints.push(InlayHint {
-                    offset: task.name.span.end,
+                    offset: task.name.span.end + 1,
                     label: format!("×{n}"),
+                    kind: InlayKind::Repetitions,
+                    tooltip: Some(
+                        "firings per iteration of this level (repetition vector)".to_string(),
+                    ),
                 });
             }
         }
@@ -424,7 +421,7 @@ mod tests {
         let hints: Vec<(String, String)> = inlay_hints(&graph, &report)
             .into_iter()
             .map(|h| {
-                let before = &DATA_LOOP[..h.offset];
+                let before = &DATA_LOOP[..h.offset - 1];
                 let name = before.rsplit('"').next().unwrap().to_string();
                 (name, h.label)
             })

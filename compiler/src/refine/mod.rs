@@ -61,7 +61,9 @@ pub enum Robots {
     /// longest. The robots of a declaration are refined alike but for their
     /// names and their place among the peers, so what depends on neither
     /// (the dataflow warnings, whether refinement finds an error) is found
-    /// from one of them: the cost is per declaration, not per robot.
+    /// from one of them: the cost is per declaration, not per robot. What
+    /// joins the robots of a team (shared information's owners, a group's
+    /// members) then lists only the robots refined.
     OnePerDeclaration,
 }
 
@@ -99,6 +101,8 @@ pub fn refine_robots(
                 .filter_map(|d| d.last().copied())
                 .collect(),
         };
+        // W130 for a team: what every one of its robots gives.
+        let mut names_no_task: Vec<Vec<Diagnostic>> = Vec::new();
         for robot in selected {
             let (program, found) = robot::refine_robot(
                 input,
@@ -107,12 +111,44 @@ pub fn refine_robots(
                 crate::sema::TeamId(team_index as u32),
                 robot.index(),
             );
+            let (warned, found): (Vec<Diagnostic>, Vec<Diagnostic>) = found
+                .into_iter()
+                .partition(|d| d.code == diag::Code::BatteryPolicyNamesNoTask);
+            names_no_task.push(warned);
             diagnostics.extend(found);
             programs.extend(program);
         }
+        robot::shared::owners_of_team(&mut programs, &team.name);
+        if let Some((first, others)) = names_no_task.split_first() {
+            diagnostics.extend(
+                first
+                    .iter()
+                    .filter(|d| others.iter().all(|o| o.contains(d)))
+                    .cloned(),
+            );
+        }
     }
+    assign_groups(&mut programs);
     diag::sort_and_dedup(&mut diagnostics);
     (programs, diagnostics)
+}
+
+/// Each team's group (`<GroupService>`): the robots whose refined programs
+/// call one of the team's group services, given to each of them.
+fn assign_groups(programs: &mut [RobotProgram]) {
+    let mut groups: std::collections::BTreeMap<String, Vec<usize>> = Default::default();
+    for p in programs.iter() {
+        if !p.control.group_services.is_empty() {
+            groups.entry(p.team.clone()).or_default().push(p.self_peer);
+        }
+    }
+    for p in programs.iter_mut() {
+        if !p.control.group_services.is_empty() {
+            let mut members = groups[&p.team].clone();
+            members.sort_unstable();
+            p.control.group = members;
+        }
+    }
 }
 
 #[cfg(test)]

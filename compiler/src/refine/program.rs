@@ -23,6 +23,10 @@ newtype_index! {
     pub struct SlotId;
 }
 
+/// The robot's battery level, a catalog value: what a strategy's battery
+/// condition reads (`Battery`), and what the robot's status reports.
+pub const BATTERY_VALUE: &str = "BATTERY";
+
 /// One robot's refined program.
 #[derive(Clone, Debug)]
 pub struct RobotProgram {
@@ -115,6 +119,14 @@ pub struct ControlMachine {
     /// The group statements this robot synchronizes at (`GroupSync`), by
     /// their offset in the mission: what a sync announcement names.
     pub sync_points: Vec<usize>,
+    /// The group services (`<GroupService>`, by the catalog's name) this
+    /// robot calls: non-empty makes it a member of its team's group.
+    pub group_services: Vec<String>,
+    /// The team's group (peer indices, in formation order): the robots whose
+    /// programs call any of the team's group services; empty when this robot
+    /// is not one of them. Each member's rank is its place among the live
+    /// members (this robot, or heard from within three heartbeats).
+    pub group: Vec<usize>,
     /// Adaptive resource management: the team strategy's battery policies,
     /// checked at every firing against the robot's `BATTERY` value.
     pub battery: Vec<BatteryPolicy>,
@@ -427,6 +439,37 @@ pub struct SharedLibrary {
     pub name: String,
     /// Slot keys it holds a getter and a setter for.
     pub attributes: Vec<String>,
+    /// Who holds the globally shared attributes (`docs/shared-information.md`);
+    /// `None` when every attribute is a local copy (the team has one robot,
+    /// or the library holds only other teams' values and multicast values).
+    pub ownership: Option<Ownership>,
+}
+
+/// The globally shared attributes of a team's library and the robots that
+/// own them in turn: the first live robot of `owners` holds them, the others
+/// set them through messages to it and read what it last told them.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Ownership {
+    /// The globally shared attributes.
+    pub global: Vec<GlobalValue>,
+    /// Peer indices (into `RobotProgram::peers`) of the team's robots in the
+    /// order ownership passes when an owner is lost; the first is the owner
+    /// at start.
+    pub owners: Vec<usize>,
+}
+
+/// One globally shared attribute of a library.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GlobalValue {
+    /// Its index in [`SharedLibrary::attributes`].
+    pub at: usize,
+    /// The type of its values (its shared slot's): a value of another type
+    /// received is refused.
+    pub kind: ValueKind,
+    /// The key of a write sent to the owner (`Team.__set.X`).
+    pub set_key: String,
+    /// The key of the owner's value told to the team (`Team.__value.X`).
+    pub value_key: String,
 }
 
 /// A non-control task of the robot and its job.

@@ -14,6 +14,7 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 mod battery;
 mod loops;
+pub(super) mod shared;
 
 #[cfg(test)]
 pub(super) use loops::steps_of;
@@ -66,16 +67,7 @@ pub(super) fn refine_robot(
     } = builder;
     separate_sensor_tasks(&mut machine, &mut sensors, &services);
     link_own_publications(&mut machine);
-    let shared: Vec<String> = machine
-        .slots
-        .iter()
-        .filter(|s| s.source == SlotSource::Shared)
-        .map(|s| s.key.clone())
-        .collect();
-    let library = (!shared.is_empty()).then(|| SharedLibrary {
-        name: format!("{}Shared", team.name),
-        attributes: shared,
-    });
+    let library = shared::library(team, self_peer - robot_index, &mut machine);
     let mut tasks: Vec<TaskRole> = sensors
         .into_iter()
         .map(|(task, values)| TaskRole {
@@ -735,6 +727,7 @@ impl Builder<'_, '_> {
             return;
         };
         let service = def.name.clone();
+        self.note_group_service(&service);
         let mark = next_mark(marks);
         if let Some(machine) = self.strategy_machine(call.name.span, &service) {
             self.push(
@@ -767,6 +760,38 @@ impl Builder<'_, '_> {
             },
             span,
         );
+    }
+
+    /// A call of a service the team's strategy declares a group service
+    /// (`<GroupService>`: the catalog's name, in its plan when it names one)
+    /// makes this robot a member of the team's group ([`ControlMachine::group`],
+    /// filled in once every robot is refined): it then sends heartbeats, whose
+    /// absence tells the other members it failed.
+    fn note_group_service(&mut self, service: &str) {
+        let team = self.team;
+        let plan = self
+            .current_service
+            .map(|s| team.plan(team.service(s).plan).name.as_str());
+        let robot_type = self.robot_type;
+        let declared = self
+            .team_strategies()
+            .filter_map(|s| s.grouping.as_ref())
+            .flat_map(|g| &g.group_services)
+            .any(|g| {
+                g.name
+                    .as_ref()
+                    .and_then(|n| robot_type.service(&n.name))
+                    .is_some_and(|d| d.name == service)
+                    && g.plan
+                        .as_ref()
+                        .is_none_or(|p| Some(p.name.as_str()) == plan)
+            });
+        if !declared || self.machine.group_services.iter().any(|s| s == service) {
+            return;
+        }
+        self.machine.group_services.push(service.to_string());
+        let (_, heartbeat_ms) = self.leader_selection();
+        self.need_heartbeat(heartbeat_ms.unwrap_or(HEARTBEAT_MS));
     }
 
     fn request_task(&mut self, task: &str) {

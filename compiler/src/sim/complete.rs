@@ -58,6 +58,47 @@ pub struct ScenarioCompletion {
     pub insert: String,
 }
 
+/// The completions at byte `offset` of the scenario `text` in the editor's
+/// vocabulary, against the refined programs of `mission` as `analysis` has
+/// it (open documents as typed); none when there is no mission or it does not
+/// refine (it has errors: they are shown on it).
+pub fn editor_completions(
+    analysis: &crate::host::Analysis,
+    mission: Option<crate::diag::FileId>,
+    text: &str,
+    offset: usize,
+) -> Vec<crate::ide::CompletionItem> {
+    let programs = mission
+        .and_then(|id| analysis.build_input(id))
+        .map(|build| crate::codegen::refine_checked(&build.input()))
+        .filter(|refined| !refined.diagnostics.iter().any(|d| d.is_error()))
+        .map(|refined| refined.programs)
+        .unwrap_or_default();
+    completions(text, offset, &programs)
+        .into_iter()
+        .map(ScenarioCompletion::into_item)
+        .collect()
+}
+
+impl ScenarioCompletion {
+    /// The item in the editor vocabulary.
+    fn into_item(self) -> crate::ide::CompletionItem {
+        use crate::ide::CompletionKind as E;
+        let kind = match self.kind {
+            ScenarioCompletionKind::Robot => E::Robot,
+            ScenarioCompletionKind::Team => E::Team,
+            ScenarioCompletionKind::Value => E::Value,
+            ScenarioCompletionKind::Service => E::Service,
+            ScenarioCompletionKind::Mode => E::Mode,
+            ScenarioCompletionKind::Command => E::Event,
+            ScenarioCompletionKind::Constant => E::Constant,
+        };
+        crate::ide::CompletionItem::new(self.label, kind, self.replace)
+            .detail(self.detail)
+            .insert(self.insert)
+    }
+}
+
 /// The completions at byte `offset` of `text`, against the mission's programs.
 pub fn completions(
     text: &str,

@@ -44,6 +44,7 @@ use std::rc::Rc;
 
 mod battery;
 mod loops;
+mod shared;
 
 /// The sensor tasks' period (refinement's `SENSOR_PERIOD_MS`).
 const SENSOR_PERIOD_MS: i64 = 100;
@@ -234,6 +235,9 @@ struct Robot<'p> {
     library: Vec<Held>,
     /// Per slot: its value's place in `library` (shared slots only).
     library_index: Vec<Option<usize>>,
+    /// The owner of the library's globally shared values now (a peer index;
+    /// `shared.rs`).
+    owner: usize,
     /// Per incoming message: the channel to the control task (capacity).
     inbox: Vec<(VecDeque<Held>, usize)>,
     /// Per subscribed group: the latest value.
@@ -256,6 +260,9 @@ struct Robot<'p> {
     sync_arrived: HashMap<(usize, usize), i64>,
     /// The last leader each `LeaderBranch` state saw, by (service, pc).
     leaders: HashMap<(usize, usize), usize>,
+    /// The last (rank, size) in the team's group this robot traced
+    /// (`semo_group_set`); `None` before its first heartbeat.
+    group: Option<(usize, usize)>,
     /// Service tasks by name (the `request_tasks` and those of action commands).
     tasks: Vec<(String, TaskState)>,
     has_receiver: bool,
@@ -368,6 +375,11 @@ impl<'p> Robot<'p> {
                         .flatten()
                 })
                 .collect(),
+            owner: program
+                .library
+                .as_ref()
+                .and_then(|l| l.ownership.as_ref())
+                .map_or(program.self_peer, |o| o.owners[0]),
             inbox,
             groups: vec![None; m.subscribed.len()],
             regions: vec![
@@ -396,6 +408,7 @@ impl<'p> Robot<'p> {
             sync_pass: HashMap::new(),
             sync_arrived: HashMap::new(),
             leaders: HashMap::new(),
+            group: None,
             tasks,
             has_receiver: !m.incoming.is_empty() || !m.subscribed.is_empty() || m.heartbeat,
             sensor_series,
@@ -732,10 +745,14 @@ impl<'p> Sim<'p> {
     fn store(&mut self, r: usize, slot: SlotId, value: Held) {
         let robot = &mut self.robots[r];
         robot.progressed = true;
-        if let Some(k) = robot.library_index[slot.index()] {
+        let library = robot.library_index[slot.index()];
+        if let Some(k) = library {
             robot.library[k].clone_from(&value);
         }
-        robot.slots[slot.index()] = value;
+        robot.slots[slot.index()].clone_from(&value);
+        if let Some(k) = library {
+            self.shared_set(r, k, &value);
+        }
     }
 
     /// Reads the latest sensor samples (the scenario's latest value at the
@@ -743,6 +760,8 @@ impl<'p> Sim<'p> {
     /// slots (`read_inputs`); a slot is written only when its value changed.
     fn read_inputs(&mut self, r: usize) {
         let now = self.now;
+        // The getters of globally shared values ask who owns them first.
+        self.current_owner(r);
         let robot = &mut self.robots[r];
         let program = robot.program;
         robot.resources.advance(now);
@@ -895,6 +914,9 @@ impl<'p> Sim<'p> {
             value: Some(("value", message.value.0.clone())),
             sent_at: Some(message.sent_at),
         });
+        if self.shared_heard(r, message) {
+            return;
+        }
         let robot = &mut self.robots[r];
         let m = &robot.program.control;
         if m.heartbeat && message.publish && message.key == self.names[r].alive_key {
@@ -1152,6 +1174,7 @@ impl<'p> Sim<'p> {
                 Some(Value::text(&value)),
             );
             self.comm_send(r, team, true, key, value);
+            self.group_update(r);
         }
         if self.robots[r].current_mode.is_none() {
             match m.default_mode {
@@ -1264,6 +1287,9 @@ impl<'p> Sim<'p> {
         let mut at_least = |t: i64| at = Some(at.map_or(t, |a| a.min(t)));
         if m.heartbeat {
             at_least(robot.last_heartbeat + m.heartbeat_ms);
+        }
+        if let Some(t) = self.owner_lost_at(r) {
+            at_least(t);
         }
         for region in &robot.regions {
             let Some(service) = region.service.filter(|_| !region.done) else {
@@ -1750,6 +1776,41 @@ fn heartbeat_value(leading: bool, battery: Option<i64>) -> String {
     match battery {
         Some(level) => format!("{role} {level}"),
         None => format!("{role} -"),
+    }
+}
+
+impl Sim<'_> {
+    /// At a heartbeat of a member of its team's group (`group_update` in
+    /// `codegen/control.rs`): its rank among the live members (formation
+    /// order) and their number, traced when they change. A member is alive
+    /// when it is this robot or was heard from within three heartbeats,
+    /// counted from when this robot joined.
+    fn group_update(&mut self, r: usize) {
+        let robot = &self.robots[r];
+        let m = &robot.program.control;
+        if m.group.is_empty() {
+            return;
+        }
+        let me = robot.program.self_peer;
+        let now = self.now;
+        let alive = |peer: usize| {
+            peer == me || now - robot.heard[peer].seen.max(robot.started_at) <= 3 * m.heartbeat_ms
+        };
+        let live: Vec<usize> = m.group.iter().copied().filter(|&p| alive(p)).collect();
+        let rank = live.iter().position(|&p| p == me).unwrap_or(0);
+        let now_group = (rank, live.len());
+        if self.robots[r].group == Some(now_group) {
+            return;
+        }
+        self.robots[r].group = Some(now_group);
+        self.emit(
+            r,
+            "group",
+            vec![
+                ("rank", rank.to_string().into()),
+                ("size", live.len().to_string().into()),
+            ],
+        );
     }
 }
 

@@ -19,7 +19,11 @@
 //!   plan, directly or through functions (E091); every such call is linked to
 //!   the entry ([`StrategyLinks`]);
 //! - a leader selection's `plan_name`/`cs_name` name a composite service of
-//!   the team that elects a leader (E092).
+//!   the team that elects a leader (E092);
+//! - a `GroupService` names a built-in service the team calls (in that plan,
+//!   when it names one) (E124).
+//!
+//! In the file alone: a service declared a group service twice (E125).
 //!
 //! A team declared by several missions of the check is checked against each.
 //! An entry refined in two strategy files of the same team is E085.
@@ -411,11 +415,46 @@ impl Cross<'_> {
             .collect()
     }
 
+    /// E125: the same service (and plan) declared a group service twice.
+    fn duplicate_group_services(&mut self, strategy: &Strategy) {
+        let declared: Vec<&GroupService> = strategy
+            .grouping
+            .iter()
+            .flat_map(|g| &g.group_services)
+            .collect();
+        for (i, later) in declared.iter().enumerate() {
+            let Some(name) = &later.name else {
+                continue;
+            };
+            let plan_of = |g: &GroupService| g.plan.as_ref().map(|p| p.name.clone());
+            let Some(first) = declared[..i].iter().find(|earlier| {
+                earlier.name.as_ref().is_some_and(|n| n.name == name.name)
+                    && plan_of(earlier) == plan_of(later)
+            }) else {
+                continue;
+            };
+            let message = format!("`{}` is already declared a group service", name.name);
+            self.report(
+                Code::GroupServiceDuplicate,
+                strategy.file,
+                later.span,
+                message,
+            )
+            .related
+            .push(Related {
+                file: strategy.file,
+                span: first.span,
+                message: "first declared here".to_string(),
+            });
+        }
+    }
+
     // --- against the catalog ---------------------------------------------------
 
     fn against_catalog(&mut self, strategy: &Strategy) {
         let file = strategy.file;
         let catalog = self.catalog;
+        self.duplicate_group_services(strategy);
         for name in all_targets(strategy) {
             if catalog.lookup(&name.name).is_none() {
                 let guess = did_you_mean(&name.name, catalog.names());
@@ -724,6 +763,84 @@ impl Cross<'_> {
         {
             self.leader_service(file, summary, team_id, plan, service);
         }
+
+        // Group services: built-in services the team calls.
+        let group_services = strategy.grouping.iter().flat_map(|g| &g.group_services);
+        for declared in group_services {
+            self.group_service(file, summary, team_id, declared);
+        }
+    }
+
+    /// E124 unless the team calls `declared`'s service (in its plan, if it
+    /// names one): the robots that run those calls are the group.
+    fn group_service(
+        &mut self,
+        file: FileId,
+        summary: &MissionSummary<'_>,
+        team_id: TeamId,
+        declared: &GroupService,
+    ) {
+        let mission = summary.mission();
+        let team = mission.team(team_id);
+        let Some(name) = &declared.name else {
+            return;
+        };
+        let plan = match &declared.plan {
+            None => None,
+            Some(plan) => match team.plan_by_name(&plan.name) {
+                Some(index) => Some(index),
+                None => {
+                    self.no_plan(Code::GroupServiceNotCalled, file, mission, team, plan);
+                    return;
+                }
+            },
+        };
+        let calls = &summary.calls[team_id.0 as usize];
+        let in_plan = |c: &&BuiltinCall| plan.is_none_or(|p| c.plan == p);
+        // The catalog's name of the service (`stand_by` is `standby`).
+        let catalog_name = self
+            .catalog
+            .types()
+            .find_map(|(_, r)| r.service(&name.name))
+            .map(|s| s.name.as_str());
+        if calls
+            .iter()
+            .filter(in_plan)
+            .any(|c| Some(c.name.as_str()) == catalog_name)
+        {
+            return;
+        }
+        let mut called: Vec<&str> = calls
+            .iter()
+            .filter(in_plan)
+            .map(|c| c.name.as_str())
+            .collect();
+        called.sort_unstable();
+        called.dedup();
+        let place = match &declared.plan {
+            Some(plan) => format!(" in plan {}", plan.name),
+            None => String::new(),
+        };
+        let calls_instead = if called.is_empty() {
+            "it calls no built-in service there".to_string()
+        } else {
+            format!("it calls {}", list(&called, 12))
+        };
+        let message = format!(
+            "team {} never calls `{}`{place}, so no robot would be in its group ({calls_instead})",
+            team.name, name.name,
+        );
+        let related = Self::team_related(mission, team);
+        self.report_unknown(
+            Code::GroupServiceNotCalled,
+            file,
+            name.span,
+            &name.name,
+            &called,
+            message,
+        )
+        .related
+        .push(related);
     }
 
     fn leader_service(

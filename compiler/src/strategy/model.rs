@@ -271,6 +271,22 @@ pub struct Grouping {
     /// `<GroupSync timeout="5 SEC"/>`: how long the robots of a group wait for
     /// each other at the start of a group statement.
     pub sync_timeout: Option<Duration>,
+    /// `<GroupService name="search"/>`s, in file order.
+    pub group_services: Vec<GroupService>,
+    pub span: Span,
+}
+
+/// `<GroupService name="search" plan_name="Explore"/>`: the built-in service
+/// `name` (called in plan `plan_name`, or in any plan without it) is a group
+/// service. The robots of the team that run any of its group services form
+/// the team's group: each live member learns its rank among the live members
+/// and their number (`semo_group_rank()`, `semo_group_size()`), recomputed
+/// when a member fails or returns (`docs/groups.md`, "Group services").
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroupService {
+    /// The built-in service, as the catalog or the mission names it.
+    pub name: Option<Named>,
+    pub plan: Option<Named>,
     pub span: Span,
 }
 

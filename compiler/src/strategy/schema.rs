@@ -21,6 +21,7 @@ pub(crate) const TRANSITION_ATTRS: &[&str] = &["srcId", "dstId"];
 pub(crate) const CONDITION_ATTRS: &[&str] = &["cond"];
 pub(crate) const LEADER_ATTRS: &[&str] = &["algorithm", "heartbeatPeriod", "plan_name", "cs_name"];
 pub(crate) const SYNC_ATTRS: &[&str] = &["timeout"];
+pub(crate) const GROUP_SERVICE_ATTRS: &[&str] = &["name", "plan_name"];
 pub(crate) const SENSOR_ATTRS: &[&str] = &["name", "periodLevel"];
 pub(crate) const ACTUATOR_ATTRS: &[&str] = &["name", "speedLevel"];
 
@@ -70,7 +71,7 @@ pub const ELEMENTS: &[ElementInfo] = &[
         "GroupingInfo",
         &[],
         &[],
-        "How groups form: the leader-selection algorithm and the synchronization timeout at the start of a group.",
+        "How groups form: the leader-selection algorithm, the synchronization timeout at the start of a group, and the group services.",
     ),
     element(
         "NonFunctionalInfo",
@@ -163,6 +164,12 @@ pub const ELEMENTS: &[ElementInfo] = &[
         "How long the robots of a group wait for each other at the start of a group statement.",
     ),
     element(
+        "GroupService",
+        GROUP_SERVICE_ATTRS,
+        &["name"],
+        "A group service: the robots of the team that run it form the team's group; each live member learns its rank and the number of live members (`semo_group_rank()`, `semo_group_size()`), recomputed when a member fails or returns.",
+    ),
+    element(
         "BatteryRequirement",
         &[],
         &[],
@@ -213,7 +220,7 @@ pub fn children(parent: Option<&str>, grandparent: Option<&str>) -> &'static [&'
         Some("CheckSensor" | "ExecuteActuator" | "ExecuteAlgorithm") => &["Parameter"],
         Some("TransitionInfo") => &["Transition"],
         Some("Transition") => &["Condition"],
-        Some("GroupingInfo") => &["LeaderSelectionInfo", "GroupSync"],
+        Some("GroupingInfo") => &["LeaderSelectionInfo", "GroupSync", "GroupService"],
         Some("NonFunctionalInfo") => &["BatteryRequirement"],
         Some("BatteryRequirement") => &["Condition"],
         Some("Condition") if grandparent == Some("BatteryRequirement") => &["Sensor", "Actuator"],
@@ -280,6 +287,12 @@ pub fn attribute_doc(element: &str, attribute: &str) -> Option<&'static str> {
         }
         ("GroupSync", "timeout") => {
             "How long the robots of a group wait for each other, e.g. `5 SEC`."
+        }
+        ("GroupService", "name") => {
+            "The built-in service whose robots form the team's group (e.g. `search`)."
+        }
+        ("GroupService", "plan_name") => {
+            "The plan whose calls of the service count; without it, calls in any plan."
         }
         ("Sensor", "name") => "The sensor whose period is lowered.",
         ("Sensor", "periodLevel") => {

@@ -360,3 +360,23 @@ fn a_team_with_a_robot_of_unknown_type_is_not_blamed_for_its_targets() {
     assert_eq!(diags[0].related[0].file, MISSION);
     assert_eq!(at(SMALL, diags[0].related[0].span), "T");
 }
+
+#[test]
+fn group_services_are_read_with_their_positions() {
+    let text = r#"<Strategy name="T"><GroupingInfo>
+<GroupService name="search" plan_name="Explore"/>
+<GroupService name="move"/>
+<GroupService plan_name="Explore" nmae="x"/>
+</GroupingInfo></Strategy>"#;
+    let (s, diags) = load(text);
+    let declared = &s.grouping.as_ref().unwrap().group_services;
+    assert_eq!(declared.len(), 3);
+    let first = &declared[0];
+    assert_eq!(at(text, first.name.as_ref().unwrap().span), "search");
+    assert_eq!(at(text, first.plan.as_ref().unwrap().span), "Explore");
+    assert!(declared[1].plan.is_none());
+    // The third lacks `name` (E083) and misspells it (W080).
+    assert!(declared[2].name.is_none());
+    assert_eq!(codes(&diags), ["E083", "W080"]);
+    assert!(at(text, diags[0].span).starts_with("<GroupService plan_name"));
+}

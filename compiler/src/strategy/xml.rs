@@ -73,6 +73,7 @@ const ELEMENTS: &[(&str, &str)] = &[
     ),
     ("LeaderSelectionInfo", "inside `<GroupingInfo>`"),
     ("GroupSync", "inside `<GroupingInfo>`"),
+    ("GroupService", "inside `<GroupingInfo>`"),
     ("BatteryRequirement", "inside `<NonFunctionalInfo>`"),
     (
         "Sensor",
@@ -635,7 +636,7 @@ impl Reader<'_> {
 
     fn grouping(&mut self, e: &Elem) -> Grouping {
         self.check_attributes(e, &[]);
-        let children = self.children(e, &["LeaderSelectionInfo", "GroupSync"]);
+        let children = self.children(e, &["LeaderSelectionInfo", "GroupSync", "GroupService"]);
         let leader = self.at_most_one(&children, "LeaderSelectionInfo");
         let sync = self.at_most_one(&children, "GroupSync");
         let leader_selection = leader.map(|l| {
@@ -670,9 +671,26 @@ impl Reader<'_> {
             let timeout = self.required(s, "timeout");
             self.duration(timeout)
         });
+        let group_services = children
+            .iter()
+            .filter(|c| c.local == "GroupService")
+            .map(|g| {
+                self.leaf(g, GROUP_SERVICE_ATTRS);
+                let name = self.required(g, "name");
+                let name = self.ident(name);
+                let plan = self.optional(g, "plan_name");
+                let plan = self.ident(plan);
+                GroupService {
+                    name,
+                    plan,
+                    span: g.span,
+                }
+            })
+            .collect();
         Grouping {
             leader_selection,
             sync_timeout,
+            group_services,
             span: e.span,
         }
     }

@@ -1,101 +1,74 @@
-//! `textDocument/codeAction`: the quick fixes of [`semo::ide::mission::code_actions`],
-//! each attached to the diagnostic it fixes.
-//!
-//! Fixes are computed from the snapshot's own diagnostics (so that their
-//! edits match the text the server has); each is attached to the client's
-//! copy of its diagnostic when the request carries it (same code and range),
-//! else to the diagnostic as the server publishes it. In a mission, a
-//! `refactor` action also creates the strategy entry of the built-in call at
-//! the cursor (see [`super::strategy::create_entries`]).
+//! `textDocument/codeAction`: the workspace analysis' quick fixes
+//! ([`semo::host::Analysis::code_actions`]), each attached to the diagnostic
+//! it fixes, then its assists ([`semo::host::Analysis::assists`]: in a
+//! mission, creating the strategy entry of the built-in call at the cursor).
+//! The caller names the files of the assists' edits.
 
 use crate::diagnostics;
-use crate::world::{FileAnalysis, Snapshot};
-use semo::workspace::FileKind;
+use crate::to_proto::{self, FileEdits};
+use crate::world::Snapshot;
+use semo::diag::FileId;
+use semo::host::Analysis;
 use std::collections::HashMap;
-use std::sync::Arc;
 use tower_lsp_server::ls_types::*;
 
-pub fn code_actions(
-    snapshot: &Snapshot,
-    strategies: &[Arc<Snapshot>],
-    params: &CodeActionParams,
-) -> Option<CodeActionResponse> {
+/// The actions found, before the files of the assists are named.
+pub struct Found {
+    fixes: Vec<CodeActionOrCommand>,
+    assists: Vec<(String, FileEdits)>,
+}
+
+impl Found {
+    /// The response, with each assist's files named by `uri_of` (a file it
+    /// cannot name is left out of the edit).
+    pub fn response(self, uri_of: impl Fn(FileId) -> Option<Uri>) -> CodeActionResponse {
+        let assists = self.assists.into_iter().map(|(title, edits)| {
+            let changes = edits
+                .into_iter()
+                .filter_map(|(file, edits)| Some((uri_of(file)?, edits)))
+                .collect();
+            to_proto::assist(title, changes)
+        });
+        self.fixes.into_iter().chain(assists).collect()
+    }
+}
+
+pub fn code_actions(snapshot: &Snapshot, workspace: &Analysis, params: &CodeActionParams) -> Found {
     let wanted = |kind: &CodeActionKind| {
         params.context.only.as_ref().is_none_or(|only| {
             only.iter()
                 .any(|k| k.as_str().is_empty() || kind.as_str().starts_with(k.as_str()))
         })
     };
-    let mut assists = Vec::new();
-    if wanted(&CodeActionKind::REFACTOR) && snapshot.kind == FileKind::Mission {
-        assists = super::strategy::create_entries(snapshot, strategies, params.range);
-    }
-    if !wanted(&CodeActionKind::QUICKFIX) {
-        return Some(assists);
-    }
-    if snapshot.kind == FileKind::Strategy {
-        return Some(super::strategy::code_actions(snapshot, params));
-    }
     let analysis = snapshot.analysis();
-    let Some(mission) = analysis.mission.as_ref() else {
-        return Some(assists);
-    };
     let lines = snapshot.line_map(&analysis);
-    let span = lines.span(params.range);
-    let catalog = snapshot.catalog.catalog();
-    let actions =
-        semo::ide::mission::code_actions::code_actions(mission, catalog, &snapshot.text, span);
-    if actions.is_empty() {
-        return Some(assists);
+    let mut found = Found {
+        fixes: Vec::new(),
+        assists: Vec::new(),
+    };
+    if wanted(&CodeActionKind::QUICKFIX) {
+        let actions = workspace.code_actions(snapshot.id, lines.span(params.range));
+        if !actions.is_empty() {
+            let published = diagnostics::to_lsp(snapshot, &analysis, &HashMap::new());
+            found.fixes = to_proto::quick_fixes(
+                &snapshot.uri,
+                &lines,
+                &published,
+                &params.context.diagnostics,
+                actions,
+            );
+        }
     }
-    let response = quick_fixes(snapshot, &analysis, params, actions)
-        .into_iter()
-        .chain(assists)
-        .collect();
-    Some(response)
-}
-
-/// The library's fixes as protocol actions: each edit of the snapshot's text,
-/// attached to the client's copy of the diagnostic it fixes when the request
-/// carries it (same code and range), else to the diagnostic as published.
-pub fn quick_fixes(
-    snapshot: &Snapshot,
-    analysis: &FileAnalysis,
-    params: &CodeActionParams,
-    actions: Vec<semo::ide::mission::code_actions::CodeAction>,
-) -> Vec<CodeActionOrCommand> {
-    let lines = snapshot.line_map(analysis);
-    let published = diagnostics::to_lsp(snapshot, analysis, &HashMap::new());
-    actions
-        .into_iter()
-        .filter_map(|action| {
-            let ours = published.get(action.diagnostic)?;
-            let diagnostic = params
-                .context
-                .diagnostics
-                .iter()
-                .find(|d| d.range == ours.range && d.code == ours.code)
-                .unwrap_or(ours)
-                .clone();
-            let edits = action
-                .edits
-                .into_iter()
-                .map(|e| TextEdit {
-                    range: lines.range(e.span),
-                    new_text: e.new_text,
-                })
-                .collect();
-            Some(CodeActionOrCommand::CodeAction(CodeAction {
-                title: action.title,
-                kind: Some(CodeActionKind::QUICKFIX),
-                diagnostics: Some(vec![diagnostic]),
-                edit: Some(WorkspaceEdit {
-                    changes: Some(HashMap::from([(snapshot.uri.clone(), edits)])),
-                    ..WorkspaceEdit::default()
-                }),
-                is_preferred: Some(action.preferred),
-                ..CodeAction::default()
-            }))
-        })
-        .collect()
+    if wanted(&CodeActionKind::REFACTOR) {
+        let at = snapshot.position(&lines, params.range.start);
+        found.assists = workspace
+            .assists(at)
+            .into_iter()
+            .map(|a| {
+                let edits = to_proto::source_change(snapshot, workspace, &lines, a.change);
+                (a.title, edits)
+            })
+            .collect();
+    }
+    found
 }

@@ -1,41 +1,23 @@
-//! `textDocument/inlayHint`: [`semo::ide::mission::inlay_hints`] in protocol types.
+//! `textDocument/inlayHint`: [`semo::host::Analysis::inlay_hints`] (a
+//! mission's group arms and set services, a task graph's repetition counts)
+//! in protocol types.
 
+use crate::to_proto;
 use crate::world::Snapshot;
-use semo::ide::mission::inlay_hints::InlayKind;
-use tower_lsp_server::ls_types::*;
+use semo::workspace::FileKind;
+use tower_lsp_server::ls_types::{InlayHint, Range};
 
 pub fn inlay_hints(snapshot: &Snapshot, range: Range) -> Option<Vec<InlayHint>> {
-    let analysis = snapshot.analysis();
-    if analysis.graph.is_some() {
-        return Some(super::taskgraph::inlay_hints(snapshot, &analysis, range));
+    if !matches!(snapshot.kind, FileKind::Mission | FileKind::TaskGraph) {
+        return None;
     }
-    let mission = analysis.mission.as_ref()?;
+    let analysis = snapshot.analysis();
     let lines = snapshot.line_map(&analysis);
-    let span = lines.span(range);
-    let catalog = snapshot.catalog.catalog();
-    let hints =
-        semo::ide::mission::inlay_hints::inlay_hints(mission, catalog, &snapshot.text, span);
+    let hints = snapshot.host().inlay_hints(snapshot.id, lines.span(range));
     Some(
         hints
             .into_iter()
-            .map(|h| InlayHint {
-                position: lines.position(h.offset),
-                label: InlayHintLabel::String(h.label),
-                kind: Some(match h.kind {
-                    InlayKind::Robots => InlayHintKind::PARAMETER,
-                    InlayKind::Schedule => InlayHintKind::TYPE,
-                }),
-                text_edits: None,
-                tooltip: h.tooltip.map(|value| {
-                    InlayHintTooltip::MarkupContent(MarkupContent {
-                        kind: MarkupKind::Markdown,
-                        value,
-                    })
-                }),
-                padding_left: Some(false),
-                padding_right: Some(false),
-                data: None,
-            })
+            .map(|h| to_proto::inlay_hint(h, &lines))
             .collect(),
     )
 }

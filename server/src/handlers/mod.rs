@@ -22,8 +22,6 @@ pub mod selection_range;
 pub mod semantic_tokens;
 pub mod signature_help;
 pub mod simulate;
-pub mod strategy;
-pub mod taskgraph;
 pub mod workspace_symbol;
 
 use crate::encoding::{Encoding, LineMap};
@@ -77,7 +75,7 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
         workspace_symbol_provider: Some(OneOf::Left(true)),
         semantic_tokens_provider: Some(SemanticTokensServerCapabilities::SemanticTokensOptions(
             SemanticTokensOptions {
-                legend: semantic_tokens::legend(),
+                legend: crate::to_proto::semantic_tokens_legend(),
                 range: Some(true),
                 full: Some(SemanticTokensFullOptions::Bool(true)),
                 ..Default::default()

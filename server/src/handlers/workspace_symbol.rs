@@ -1,42 +1,40 @@
 //! `workspace/symbol`: the teams, composite services, modes and functions of
 //! every mission the server knows (open, or indexed from the workspace
-//! folders) whose name matches the query, best matches first.
+//! folders) whose name matches the query, best matches first
+//! ([`semo::host::Analysis::workspace_symbols`]); the caller names the files.
 
-use crate::world::Snapshot;
-use semo::workspace::FileKind;
-use std::sync::Arc;
-use tower_lsp_server::ls_types::{Location, SymbolInformation};
+use crate::encoding::{Encoding, LineMap};
+use semo::diag::FileId;
+use semo::host::Analysis;
+use semo::text::LineIndex;
+use std::collections::HashMap;
+use tower_lsp_server::ls_types::{Location, SymbolInformation, Uri};
 
-/// At most this many symbols are returned (the client asks again as the
-/// query grows).
-pub const LIMIT: usize = 128;
-
-pub fn workspace_symbol(snapshots: &[Arc<Snapshot>], query: &str) -> Vec<SymbolInformation> {
-    let mut found: Vec<(u32, SymbolInformation)> = Vec::new();
-    for snapshot in snapshots.iter().filter(|s| s.kind == FileKind::Mission) {
-        super::with_mission(snapshot, |analysis, lines| {
-            for symbol in semo::ide::mission::symbols::workspace_symbols(analysis, query) {
-                #[allow(deprecated)] // `deprecated` must be written, even as None
-                let info = SymbolInformation {
-                    name: symbol.name,
-                    kind: super::document_symbol::kind(symbol.kind),
-                    tags: None,
-                    deprecated: None,
-                    location: Location::new(snapshot.uri.clone(), lines.range(symbol.name_span)),
-                    container_name: symbol.container,
-                };
-                found.push((symbol.score, info));
-            }
-        });
+pub fn workspace_symbol(
+    workspace: &Analysis,
+    encoding: Encoding,
+    uri_of: impl Fn(FileId) -> Option<Uri>,
+    query: &str,
+) -> Vec<SymbolInformation> {
+    let mut indexes: HashMap<FileId, LineIndex> = HashMap::new();
+    let mut out = Vec::new();
+    for symbol in workspace.workspace_symbols(query) {
+        let file = symbol.target.file;
+        let (Some(uri), Some(source)) = (uri_of(file), workspace.file(file)) else {
+            continue;
+        };
+        let text = &*source.text;
+        let index = indexes.entry(file).or_insert_with(|| LineIndex::new(text));
+        let lines = LineMap {
+            text,
+            index,
+            encoding,
+        };
+        let range = lines.range(symbol.target.span);
+        out.push(crate::to_proto::symbol_information(
+            symbol,
+            Location::new(uri, range),
+        ));
     }
-    found.sort_by(|(a, x), (b, y)| {
-        (a, &x.name, x.location.uri.as_str(), x.location.range.start).cmp(&(
-            b,
-            &y.name,
-            y.location.uri.as_str(),
-            y.location.range.start,
-        ))
-    });
-    found.truncate(LIMIT);
-    found.into_iter().map(|(_, info)| info).collect()
+    out
 }

@@ -10,6 +10,7 @@
 #include "semo_internal.h"
 
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <string.h>
 
 /* ----------------------------------------------------------------- numbers */
@@ -581,6 +582,61 @@ void semo_trace_value(const char *event, const char *value_key, const semo_value
     va_start(args, value);
     semo__trace_emit(event, value_key, value, args);
     va_end(args);
+}
+
+/* ---------------------------------------------------------- group services */
+
+/* Written by the control task, read by any task: atomics, no lock (the
+ * static schedule has no threads; on POSIX a task reads the latest pair the
+ * control task set, each half atomically). */
+static atomic_int g_group_rank = -1;
+static atomic_int g_group_size = 0;
+
+int semo_group_rank(void)
+{
+    return atomic_load(&g_group_rank);
+}
+
+int semo_group_size(void)
+{
+    return atomic_load(&g_group_size);
+}
+
+void semo_group_set(int rank, int size)
+{
+    if (atomic_load(&g_group_rank) == rank && atomic_load(&g_group_size) == size)
+        return;
+    atomic_store(&g_group_rank, rank);
+    atomic_store(&g_group_size, size);
+    char rank_text[24], size_text[24];
+    semo__format_i64(rank_text, rank);
+    semo__format_i64(size_text, size);
+    semo_trace("group", "rank", rank_text, "size", size_text, NULL);
+}
+
+/* ---------------------------------------------------------------- battery */
+
+/* The robot's battery level as its control task last read its `BATTERY`
+ * sensor value (semo_battery_report), for the status operators see. A
+ * `long`: lock-free on cortex-m too, where 64-bit atomics need libatomic. */
+static atomic_long g_battery_level;
+static atomic_bool g_battery_known;
+
+void semo_battery_report(const semo_value *level)
+{
+    double x;
+    if (!as_number(level, &x) || x != x || x > 1e9 || x < -1e9)
+        return;
+    atomic_store(&g_battery_level, (long)(x < 0 ? x - 0.5 : x + 0.5));
+    atomic_store(&g_battery_known, true);
+}
+
+bool semo__battery(long long *level)
+{
+    if (!atomic_load(&g_battery_known))
+        return false;
+    *level = atomic_load(&g_battery_level);
+    return true;
 }
 
 /* ------------------------------------------------- channels and the inbox */

@@ -30,6 +30,9 @@ void semo__trace_emit(const char *event, const char *value_key, const semo_value
 /* `n` in decimal into `out` (at least 21 bytes); returns its length. No
  * printf: newlib-nano's has no `%lld`. */
 size_t semo__format_i64(char *out, int64_t n);
+/* The battery level the control task last reported (semo_battery_report),
+ * rounded; false before the first report. */
+bool semo__battery(long long *level);
 
 /* Waits until mission time `deadline_ms`; false when the program stopped first. */
 bool semo__wait_until(int64_t deadline_ms);

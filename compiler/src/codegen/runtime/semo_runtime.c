@@ -723,7 +723,8 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
  * on every change through the transport's `status` (MQTT: retained on
  * semo/<mission>/status/<robot>) as one JSON line of the trace's form:
  * {"t":..,"robot":..,"event":"status","state":..,"mode":..,"leader":..,
- * "services":"Plan=Service,..."}. */
+ * "services":"Plan=Service,...","battery":"87"} (`battery` only when the
+ * robot knows its level). */
 #define STATUS_PLANS 16
 #define STATUS_NAME 64
 static struct {
@@ -735,6 +736,8 @@ static struct {
         char plan[STATUS_NAME], service[STATUS_NAME];
     } running[STATUS_PLANS];
     size_t running_count;
+    bool battery_known;
+    long long battery;
 } g_status = {.lock = PTHREAD_MUTEX_INITIALIZER};
 
 typedef struct {
@@ -815,6 +818,20 @@ static void observe_status(const char *event, va_list args)
     } else {
         changed = false;
     }
+    /* The battery: what the control task last read of its BATTERY value;
+     * in simulation without one, the scenario's level. A new level is
+     * published with the next event traced. */
+    long long level = 0;
+    bool known = semo__battery(&level);
+#ifdef SEMO_SIM
+    if (!known)
+        known = semo_sim_battery(&level);
+#endif
+    if (known != g_status.battery_known || (known && level != g_status.battery)) {
+        g_status.battery_known = known;
+        g_status.battery = level;
+        changed = true;
+    }
     if (changed) {
         char services[STATUS_PLANS * 2 * STATUS_NAME + STATUS_PLANS * 2] = "";
         size_t at = 0;
@@ -823,8 +840,11 @@ static void observe_status(const char *event, va_list args)
                 at += (size_t)snprintf(services + at, sizeof services - at, "%s%s=%s", at ? "," : "",
                                        g_status.running[i].plan, g_status.running[i].service);
         status_buffer line = {.len = 0};
+        char battery[24];
+        semo__format_i64(battery, g_status.battery);
+        /* Without a level the list ends before `battery`: the field is absent. */
         status_line(&line, "status", "state", g_status.state, "mode", g_status.mode, "leader", g_status.leader,
-                    "services", services, NULL);
+                    "services", services, g_status.battery_known ? "battery" : NULL, battery, NULL);
         if (line.len > 0 && line.text[line.len - 1] == '\n')
             line.text[--line.len] = '\0'; /* one JSON object, not a line */
         transport->status(line.text, line.len);

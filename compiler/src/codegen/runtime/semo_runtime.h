@@ -354,6 +354,27 @@ extern const semo_transport semo_udp_transport;
 extern const semo_transport semo_mqtt_transport;
 #endif
 
+/* ---------------------------------------------------------- group services */
+
+/* For task code (docs/groups.md, "Group services"): this robot's rank among
+ * the live members of its team's group (0, 1, ...: the live members in
+ * ascending robot id, formation order) and the number of live members. A
+ * robot in no group (its strategy declares no group service it calls) has
+ * rank -1 and size 0. Both change when a member fails (no heartbeat for
+ * three periods) or returns; read them each time work is divided. */
+int semo_group_rank(void);
+int semo_group_size(void);
+/* For the generated control task: the rank and size it computed at a
+ * heartbeat; a change is traced as {"event":"group","rank":..,"size":..}. */
+void semo_group_set(int rank, int size);
+
+/* ---------------------------------------------------------------- battery */
+
+/* For the generated control task: the robot's `BATTERY` sensor value as it
+ * read it (a number; anything else is ignored). The robot's status carries
+ * the latest one (`battery`, docs/deployment.md). */
+void semo_battery_report(const semo_value *level);
+
 /* ----------------------------------------------------------------- traces */
 
 /* Appends one JSON line `{"t":<mission ms>,"robot":"<robot>","event":"<event>",

@@ -12,7 +12,7 @@
 
 use super::{Analysis, Key, drop_later, fresh, lock};
 use crate::dataflow::{self, DataflowInput, MissionDataflow};
-use crate::diag::FileId;
+use crate::diag::{self, FileId};
 use crate::refine::Robots;
 use crate::taskgraph::subgraph;
 use crate::workspace::{FileKind, GraphRun};
@@ -48,6 +48,15 @@ impl Analysis {
             })
         };
         let mut found = found;
+        // Refinement's own warnings (W130: it reads the strategies as the
+        // robots run them), after the input's diagnostics in `refined`.
+        found.diagnostics.extend(
+            refined.diagnostics[input.diagnostics.len().min(refined.diagnostics.len())..]
+                .iter()
+                .filter(|d| !d.is_error())
+                .cloned(),
+        );
+        diag::sort_and_dedup(&mut found.diagnostics);
         self.apply_lints(mission, &mut found.diagnostics);
         let found = Arc::new(found);
         let old = lock(&self.memo.dataflow).insert(mission, (key, found.clone()));

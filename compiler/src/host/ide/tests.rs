@@ -294,3 +294,218 @@ fn structure_queries_answer_for_missions_and_nothing_for_other_files() {
     assert!(analysis.selection_ranges(strategy).is_empty());
     assert!(analysis.folding_ranges(FileId(2)).is_empty());
 }
+
+/// `path:line:col label` of each hint.
+fn show_hints(w: &Workspace, hints: &[crate::ide::InlayHint], file: FileId) -> String {
+    let targets: Vec<NavigationTarget> = hints
+        .iter()
+        .map(|h| NavigationTarget {
+            file,
+            span: crate::span::Span::new(h.offset, h.offset),
+        })
+        .collect();
+    w.show(&targets)
+        .lines()
+        .zip(hints)
+        .map(|(place, h)| format!("{place}{} {:?}", h.label, h.kind))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn a_quick_fix_points_at_the_diagnostic_as_published() {
+    // A mission and a strategy file: the fix of the mission's did-you-mean
+    // names its diagnostic among the file's published diagnostics.
+    let w = workspace(&format!(
+        "{}{CATALOG}{STRATEGY}",
+        MISSION.replace("{ dig() }", "{ $0dgi() }")
+    ));
+    let analysis = w.host.analysis();
+    let file = w.cursor.file;
+    let at = crate::span::Span::new(w.cursor.offset, w.cursor.offset);
+    let actions = analysis.code_actions(file, at);
+    assert!(!actions.is_empty(), "a fix for `dgi`");
+    let published = analysis.diagnostics(file);
+    for action in &actions {
+        let d = &published[action.diagnostic];
+        assert!(d.span.touches(w.cursor.offset), "{d:?} for {action:?}");
+    }
+    assert!(
+        actions.iter().any(|a| a.edits[0].new_text == "dig"),
+        "{actions:?}"
+    );
+    // A strategy file: its own fixes (a misspelt element).
+    let w = workspace(&format!(
+        "{MISSION}{CATALOG}{}",
+        STRATEGY.replace("<TargetRobot", "<$0TargetRobt")
+    ));
+    let analysis = w.host.analysis();
+    let at = crate::span::Span::new(w.cursor.offset, w.cursor.offset + 1);
+    let actions = analysis.code_actions(w.cursor.file, at);
+    let published = analysis.diagnostics(w.cursor.file);
+    assert!(!actions.is_empty(), "{published:?}");
+    assert!(actions.iter().all(|a| a.diagnostic < published.len()));
+}
+
+#[test]
+fn the_entry_of_a_call_is_created_in_each_strategy_file_the_mission_sees() {
+    let bare = STRATEGY.replace(
+        r#"    <Service plan_name="P" name="dig">
+      <TargetRobot name="Rover"/>
+    </Service>
+"#,
+        "",
+    );
+    let w = workspace(&format!(
+        "{}{CATALOG}{bare}{}",
+        MISSION.replace("{ dig() }", "{ d$0ig() }"),
+        bare.replace("/w/a/", "/w/b/")
+    ));
+    let assists = w.host.analysis().assists(w.cursor);
+    let [assist] = &assists[..] else {
+        panic!("one assist, in the strategy file beside the mission: {assists:?}");
+    };
+    let [(file, edits)] = &assist.change.edits[..] else {
+        panic!("one file: {assist:?}");
+    };
+    assert_eq!(w.paths[file.0 as usize], "/w/a/A.strategy.xml");
+    assert!(edits[0].new_text.contains("name=\"dig\""), "{edits:?}");
+    // Refined already: nothing to create.
+    let w = workspace(&format!(
+        "{}{CATALOG}{STRATEGY}",
+        MISSION.replace("{ dig() }", "{ d$0ig() }")
+    ));
+    assert_eq!(w.host.analysis().assists(w.cursor), Vec::new());
+}
+
+#[test]
+fn the_outline_of_a_mission_and_of_a_strategy_file() {
+    let w = workspace(&format!(
+        "{CATALOG}{STRATEGY}{}",
+        MISSION.replace("{ A", "{$0 A")
+    ));
+    let analysis = w.host.analysis();
+    let show = |nodes: &[crate::ide::StructureNode]| {
+        fn walk(nodes: &[crate::ide::StructureNode], depth: usize, out: &mut String) {
+            for n in nodes {
+                out.push_str(&format!("{}{:?} {}\n", "  ".repeat(depth), n.kind, n.name));
+                walk(&n.children, depth + 1, out);
+            }
+        }
+        let mut out = String::new();
+        walk(nodes, 0, &mut out);
+        out
+    };
+    insta::assert_snapshot!(show(&analysis.document_symbols(w.cursor.file)), @r"
+    Team A
+      Robot r
+      Plan P
+        Service S
+      Mode M
+      Main main
+    ");
+    insta::assert_snapshot!(show(&analysis.document_symbols(FileId(1))), @"Service P.dig");
+    assert_eq!(analysis.document_symbols(FileId(0)), Vec::new());
+}
+
+#[test]
+fn workspace_symbols_search_every_mission() {
+    let other = MISSION
+        .replace("/w/a/m.mission", "/w/b/n.mission")
+        .replace("A.", "B.")
+        .replace("{ A:", "{ B:");
+    let w = workspace(&format!(
+        "{CATALOG}{other}{}",
+        MISSION.replace("{ A", "{$0 A")
+    ));
+    let found = w.host.analysis().workspace_symbols("m");
+    let targets: Vec<NavigationTarget> = found.iter().map(|s| s.target).collect();
+    insta::assert_snapshot!(w.show(&targets), @r"
+    /w/a/m.mission:3:3 M
+    /w/b/n.mission:3:3 M
+    ");
+}
+
+#[test]
+fn inlay_hints_in_a_mission_and_a_task_graph() {
+    let w = workspace(&format!("{CATALOG}{}", MISSION.replace("{ A", "{$0 A")));
+    let all = crate::span::Span::new(0, w.texts[1].len());
+    let hints = w.host.analysis().inlay_hints(w.cursor.file, all);
+    insta::assert_snapshot!(show_hints(&w, &hints, w.cursor.file), @"/w/a/m.mission:3:15 : repeat(1 SEC) Schedule");
+    let w = workspace(
+        r#"//- /w/g.taskgraph.xml
+<TaskGraph name="g" xmlns="urn:semo:taskgraph:1">
+  <Task name="A$0"><Port name="o" dir="out" rate="2"/></Task>
+  <Task name="B"><Port name="i" dir="in"/></Task>
+  <Channel src="A.o" dst="B.i"/>
+</TaskGraph>
+"#,
+    );
+    let all = crate::span::Span::new(0, w.texts[0].len());
+    let hints = w.host.analysis().inlay_hints(w.cursor.file, all);
+    insta::assert_snapshot!(show_hints(&w, &hints, w.cursor.file), @r"
+    /w/g.taskgraph.xml:2:17 ×1 Repetitions
+    /w/g.taskgraph.xml:3:17 ×2 Repetitions
+    ");
+    // Only those in the range asked for.
+    let first_line = crate::span::Span::new(0, w.cursor.offset + 2);
+    assert_eq!(
+        w.host
+            .analysis()
+            .inlay_hints(w.cursor.file, first_line)
+            .len(),
+        1
+    );
+}
+
+#[test]
+fn semantic_tokens_formatting_and_prepare_rename_are_for_missions() {
+    let w = workspace(&format!(
+        "{CATALOG}{}",
+        MISSION.replace("A.M { set", "A.$0M  { set")
+    ));
+    let analysis = w.host.analysis();
+    let mission = w.cursor.file;
+    let text = &w.texts[mission.0 as usize];
+    let tokens = analysis.semantic_tokens(mission, None).expect("a mission");
+    assert!(
+        tokens.iter().any(|t| &text[t.span.range()] == "M"),
+        "{tokens:?}"
+    );
+    assert_eq!(analysis.semantic_tokens(FileId(0), None), None);
+    let edits = analysis
+        .formatting(mission)
+        .expect("a mission")
+        .expect("formats");
+    let mut formatted = text.clone();
+    for e in edits.iter().rev() {
+        formatted.replace_range(e.span.range(), &e.new_text);
+    }
+    assert!(formatted.contains("A.M {"), "{formatted}");
+    assert_eq!(analysis.formatting(FileId(0)), None);
+    let span = analysis
+        .prepare_rename(w.cursor)
+        .expect("a mission")
+        .expect("a mode");
+    assert_eq!(&text[span.range()], "M");
+    let on_catalog_name = FilePosition {
+        file: mission,
+        offset: text.find("Rover").unwrap(),
+    };
+    assert!(matches!(
+        analysis.prepare_rename(on_catalog_name),
+        Some(Err(_))
+    ));
+}
+
+#[test]
+fn a_picture_for_task_graphs_and_missions_only() {
+    let w = workspace(&format!("{CATALOG}{}", MISSION.replace("{ A", "{$0 A")));
+    let analysis = w.host.analysis();
+    let svg = analysis.picture(w.cursor.file, None).expect("modes");
+    assert!(svg.starts_with("<svg") && svg.contains(">M<"), "{svg}");
+    assert!(analysis.picture(w.cursor.file, Some("A")).is_ok());
+    let refused = analysis.picture(w.cursor.file, Some("Z")).unwrap_err();
+    assert_eq!(refused.0, "no team `Z` with modes in this mission");
+    assert!(analysis.picture(FileId(0), None).is_err());
+}

@@ -4,27 +4,10 @@
 
 use super::docs;
 use crate::catalog::Catalog;
+pub use crate::ide::{InlayHint, InlayKind};
 use crate::sema::{Analysis, Runners, ScopeKind};
 use crate::span::Span;
 use crate::syntax::ast::{self, ArmKind, SetTarget};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum InlayKind {
-    /// The robots a group arm selects.
-    Robots,
-    /// How the service a mode sets runs.
-    Schedule,
-}
-
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct InlayHint {
-    /// Where the hint shows (before the character at this offset).
-    pub offset: usize,
-    pub label: String,
-    pub kind: InlayKind,
-    /// Markdown.
-    pub tooltip: Option<String>,
-}
 
 /// The hints whose position lies in `range`.
 pub fn inlay_hints(

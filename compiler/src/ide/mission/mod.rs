@@ -11,6 +11,7 @@ pub mod completion;
 mod context;
 mod docs;
 pub mod folding;
+pub mod formatting;
 pub mod hover;
 pub mod inlay_hints;
 pub mod navigation;

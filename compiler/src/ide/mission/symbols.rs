@@ -7,36 +7,12 @@
 //! reported by the checker) are not in it.
 
 use crate::Analysis;
+use crate::ide::{NavigationTarget, StructureNode, SymbolKind, WorkspaceSymbol};
 use crate::sema::Team;
-use crate::span::Span;
 use crate::syntax::ast::{self, Item};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SymbolKind {
-    Team,
-    Robot,
-    Plan,
-    Service,
-    Mode,
-    Main,
-    Function,
-}
-
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct DocumentSymbol {
-    pub name: String,
-    pub detail: Option<String>,
-    pub kind: SymbolKind,
-    /// The whole definition (for a team or a plan: from its first to its
-    /// last item).
-    pub span: Span,
-    /// The name, inside `span`.
-    pub name_span: Span,
-    pub children: Vec<DocumentSymbol>,
-}
-
 /// The outline of the mission, in file order.
-pub fn document_symbols(analysis: &Analysis, text: &str) -> Vec<DocumentSymbol> {
+pub fn document_symbols(analysis: &Analysis, text: &str) -> Vec<StructureNode> {
     let mission = &analysis.mission;
     let decls: Vec<&ast::TeamDecl> = analysis
         .syntax
@@ -57,7 +33,7 @@ pub fn document_symbols(analysis: &Analysis, text: &str) -> Vec<DocumentSymbol> 
             _ => None,
         })
         .collect();
-    let mut symbols: Vec<DocumentSymbol> = mission
+    let mut symbols: Vec<StructureNode> = mission
         .teams
         .iter()
         .filter_map(|team| {
@@ -66,7 +42,7 @@ pub fn document_symbols(analysis: &Analysis, text: &str) -> Vec<DocumentSymbol> 
         })
         .collect();
     symbols.extend(mission.functions.iter().map(|f| {
-        DocumentSymbol {
+        StructureNode {
             name: f.name.to_string(),
             detail: None,
             kind: SymbolKind::Function,
@@ -86,7 +62,7 @@ fn team_symbol(
     decl: &ast::TeamDecl,
     mains: &[&ast::MainDef],
     text: &str,
-) -> DocumentSymbol {
+) -> StructureNode {
     let mut children = Vec::new();
     for robot in &decl.robots {
         if !team.robots.iter().any(|r| r.name_span == robot.name.span) {
@@ -100,7 +76,7 @@ fn team_symbol(
                 .to_string(),
             None => robot.name.name.to_string(),
         };
-        children.push(DocumentSymbol {
+        children.push(StructureNode {
             name,
             detail: Some(robot.robot_type.name.to_string()),
             kind: SymbolKind::Robot,
@@ -110,11 +86,11 @@ fn team_symbol(
         });
     }
     for (p, plan) in team.plans.iter().enumerate() {
-        let services: Vec<DocumentSymbol> = team
+        let services: Vec<StructureNode> = team
             .services
             .iter()
             .filter(|s| s.plan.index() == p)
-            .map(|s| DocumentSymbol {
+            .map(|s| StructureNode {
                 name: s.name.to_string(),
                 detail: Some(format!("{}.{}.{}", team.name, plan.name, s.name)),
                 kind: SymbolKind::Service,
@@ -126,7 +102,7 @@ fn team_symbol(
         let span = services
             .iter()
             .fold(plan.span, |span, s| span.cover(s.span));
-        children.push(DocumentSymbol {
+        children.push(StructureNode {
             name: plan.name.to_string(),
             detail: None,
             kind: SymbolKind::Plan,
@@ -148,7 +124,7 @@ fn team_symbol(
                 Some(format!("{plan}: {service}"))
             })
             .collect();
-        children.push(DocumentSymbol {
+        children.push(StructureNode {
             name: mode.name.to_string(),
             detail: (!sets.is_empty()).then(|| sets.join(", ")),
             kind: SymbolKind::Mode,
@@ -164,7 +140,7 @@ fn team_symbol(
             .default
             .and_then(|m| team.modes.get(m.index()))
             .map(|m| format!("default: {}", m.name));
-        children.push(DocumentSymbol {
+        children.push(StructureNode {
             name: "main".to_string(),
             detail: default,
             kind: SymbolKind::Main,
@@ -177,7 +153,7 @@ fn team_symbol(
         .iter()
         .fold(decl.span, |span, c| span.cover(c.span));
     let robots = team.robots.len();
-    DocumentSymbol {
+    StructureNode {
         name: team.name.to_string(),
         detail: Some(format!(
             "{robots} robot{}",
@@ -188,18 +164,6 @@ fn team_symbol(
         name_span: team.name_span,
         children,
     }
-}
-
-/// A symbol found by a workspace search.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct WorkspaceSymbol {
-    pub name: String,
-    pub kind: SymbolKind,
-    /// `Team` for a mode, `Team.Plan` for a service.
-    pub container: Option<String>,
-    pub name_span: Span,
-    /// How well the name matches the query; lower is better (see [`match_score`]).
-    pub score: u32,
 }
 
 /// The teams, composite services, modes and functions of the mission whose
@@ -213,7 +177,10 @@ pub fn workspace_symbols(analysis: &Analysis, query: &str) -> Vec<WorkspaceSymbo
                 name: name.to_string(),
                 kind,
                 container,
-                name_span,
+                target: NavigationTarget {
+                    file: mission.file,
+                    span: name_span,
+                },
                 score,
             });
         }
@@ -240,7 +207,7 @@ pub fn workspace_symbols(analysis: &Analysis, query: &str) -> Vec<WorkspaceSymbo
     for f in &mission.functions {
         add(&f.name, SymbolKind::Function, None, f.name_span);
     }
-    found.sort_by(|a, b| (a.score, &a.name, a.name_span).cmp(&(b.score, &b.name, b.name_span)));
+    found.sort_by(|a, b| (a.score, &a.name, a.target).cmp(&(b.score, &b.name, b.target)));
     found
 }
 
@@ -298,7 +265,7 @@ Guards.main { case (GO): catch (alarm): mode = GO default: mode = GO }
 Nobody.Plan.Lost { standby() }
 "#;
 
-    fn outline(f: &Fixture, symbols: &[DocumentSymbol], depth: usize, out: &mut String) {
+    fn outline(f: &Fixture, symbols: &[StructureNode], depth: usize, out: &mut String) {
         for s in symbols {
             let (line, _) = f.line_col(s.span.start);
             let (end, _) = f.line_col(s.span.end);

@@ -1,27 +1,9 @@
 //! The outline of a strategy file: its values, and its services with their
 //! actions.
 
+use crate::ide::{StructureNode, SymbolKind};
 use crate::span::Span;
 use crate::strategy::model::{Named, Strategy, TargetRobot};
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SymbolKind {
-    Value,
-    Service,
-    Action,
-}
-
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Symbol {
-    pub name: String,
-    pub detail: Option<String>,
-    pub kind: SymbolKind,
-    /// The whole element.
-    pub span: Span,
-    /// The name to select (the start tag when the name is missing).
-    pub name_span: Span,
-    pub children: Vec<Symbol>,
-}
 
 fn name_of(named: &Option<Named>, fallback: &str) -> (String, Option<Span>) {
     match named {
@@ -40,11 +22,11 @@ fn targets(targets: &[TargetRobot]) -> Option<String> {
     (!names.is_empty()).then(|| format!("for {}", names.join(", ")))
 }
 
-pub fn document_symbols(strategy: &Strategy) -> Vec<Symbol> {
+pub fn document_symbols(strategy: &Strategy) -> Vec<StructureNode> {
     let mut out = Vec::new();
     for value in &strategy.values {
         let (name, span) = name_of(&value.name, "(value)");
-        out.push(Symbol {
+        out.push(StructureNode {
             name,
             detail: targets(&value.targets),
             kind: SymbolKind::Value,
@@ -74,7 +56,7 @@ pub fn document_symbols(strategy: &Strategy) -> Vec<Symbol> {
                 if action.is_final.is_yes() {
                     detail.push("final".to_string());
                 }
-                Symbol {
+                StructureNode {
                     name,
                     detail: (!detail.is_empty()).then(|| detail.join(", ")),
                     kind: SymbolKind::Action,
@@ -84,7 +66,7 @@ pub fn document_symbols(strategy: &Strategy) -> Vec<Symbol> {
                 }
             })
             .collect();
-        out.push(Symbol {
+        out.push(StructureNode {
             name,
             detail: targets(&service.targets),
             kind: SymbolKind::Service,

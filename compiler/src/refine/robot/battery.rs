@@ -8,17 +8,18 @@
 //! strategy reads from (writes to), and a task of that name (any case).
 //! Names that mean no task of this robot are left out: a strategy serves
 //! every robot type of the team, and a robot without a camera has nothing to
-//! slow down. The policy reads the robot's own `BATTERY` value, so a robot
+//! slow down; a name that means no task of any robot of the team, or a
+//! policy naming nothing, is warned about (W130, at the strategy's name). The policy reads the robot's own `BATTERY` value, so a robot
 //! with policies samples it (its sensor task is added to the graph).
 
 use super::{Builder, convert};
+use crate::diag::{Code, Diagnostic};
 use crate::refine::program::{BatteryPolicy, Operand};
 use crate::sema::Compared;
 use crate::strategy::{Strategy, TaskUseKind};
 use crate::syntax::ast::ExprKind;
 
-/// The mission value a battery condition reads (`Battery` in the strategy).
-pub(crate) const BATTERY_VALUE: &str = "BATTERY";
+use crate::refine::program::BATTERY_VALUE;
 
 impl Builder<'_, '_> {
     /// The policies of every strategy of the robot's team, in file order.
@@ -66,6 +67,16 @@ impl Builder<'_, '_> {
                     _ => Compared::Words,
                 };
                 let condition_expr = convert(expr, &mut resolve, &mut compare_as);
+                if rule.sensors.is_empty() && rule.actuators.is_empty() {
+                    self.names_no_task(
+                        strategy,
+                        rule.span,
+                        format!(
+                            "the battery policy `{}` names no sensor and no actuator: it changes nothing",
+                            condition.text
+                        ),
+                    );
+                }
                 let mut policy = BatteryPolicy {
                     text: condition.text.clone(),
                     condition: condition_expr,
@@ -86,7 +97,22 @@ impl Builder<'_, '_> {
                             self.internal_error(self.team.name_span, &what);
                             continue;
                         }
-                        for task in self.tasks_named(strategy, &name.name, kind) {
+                        let tasks = self.tasks_named(strategy, &name.name, kind);
+                        if tasks.is_empty() {
+                            let what = match kind {
+                                TaskUseKind::CheckSensor => "sensor",
+                                _ => "actuator",
+                            };
+                            self.names_no_task(
+                                strategy,
+                                name.span,
+                                format!(
+                                    "the battery policy `{}` names {what} `{}`, which is no task of any robot of team `{}`: it changes nothing there",
+                                    condition.text, name.name, self.team.name
+                                ),
+                            );
+                        }
+                        for task in tasks {
                             let list = match kind {
                                 TaskUseKind::CheckSensor => &mut policy.sensors,
                                 _ => &mut policy.actuators,
@@ -101,6 +127,17 @@ impl Builder<'_, '_> {
             }
         }
         policies
+    }
+
+    /// W130 for this robot: kept by `refine` only when every robot of the
+    /// team gives it (a name may mean tasks of some robot types only).
+    fn names_no_task(&mut self, strategy: &Strategy, span: crate::span::Span, message: String) {
+        self.diagnostics.push(Diagnostic::new(
+            Code::BatteryPolicyNamesNoTask,
+            strategy.file,
+            span,
+            message,
+        ));
     }
 
     /// The tasks of this robot a policy's sensor (or actuator) `name` means.

@@ -85,7 +85,7 @@ impl<'g> Level<'g> {
             }
             (inputs, inputs + 1)
         });
-        let index: std::collections::HashMap<&str, usize> = graph
+        let index: crate::fasthash::FastMap<&str, usize> = graph
             .tasks
             .iter()
             .enumerate()

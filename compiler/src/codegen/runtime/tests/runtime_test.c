@@ -334,6 +334,14 @@ static void control_go(void)
     check_timers_and_time();
     semo_trace("note", "text", "quote\" backslash\\ newline\n tab\t ctl\x01 \xc3\xa9 bad\xff\xc3 end", NULL);
     semo_trace("note", "text", NULL);
+    /* Group services: no group until the control task sets one; a change is
+     * traced once. */
+    CHECK(semo_group_rank() == -1 && semo_group_size() == 0);
+    semo_group_set(2, 3);
+    semo_group_set(2, 3);
+    CHECK(semo_group_rank() == 2 && semo_group_size() == 3);
+    semo_group_set(1, 2);
+    CHECK(semo_group_rank() == 1 && semo_group_size() == 2);
     CHECK(semo_comm_send("USER", SEMO_MSG_SEND, "Team.STATUS", SEMO_LIT("ok")) == 1);
     /* Words: indices into the program's table, compared by identity, a word
      * and a text by their text; traced and sent as their text. */

@@ -1,0 +1,93 @@
+//! Globally shared information (`docs/shared-information.md`) in the
+//! generated programs, as a user runs them: `tests/fixtures/shared` built
+//! with `semo build` for `linux-sim`, the three scouts started as processes
+//! over MQTT (a private `mosquitto` broker, `tests/support/mqtt.rs`), the
+//! owner `a` killed while the others run. Checked from the traces: what `a`
+//! writes, `b` and `c` get from it; after the kill `b` owns the value, `c`'s
+//! write reaches it and `b` reads it. (The same run over UDP is compared
+//! with the simulator in `tests/differential.rs`.)
+//!
+//! Needs `mosquitto` and `libmosquitto-dev` (Debian). Skipped with a message
+//! when the broker is missing, unless `SEMO_MQTT_TESTS=require` (CI).
+
+mod support;
+
+use std::path::PathBuf;
+use support::mqtt::{Fleet, folder_of};
+use support::repo_root;
+use support::robots::{Event, PEDANTIC, field, make, modes, robot_folders};
+
+fn fixture(name: &str) -> PathBuf {
+    repo_root().join("tests/fixtures/shared").join(name)
+}
+
+/// `(field values)` of a robot's events of one kind.
+fn of(events: &[Event], event: &str, fields: &[&str]) -> Vec<Vec<String>> {
+    events
+        .iter()
+        .filter(|e| field(e, "event") == event)
+        .map(|e| fields.iter().map(|f| field(e, f).to_string()).collect())
+        .collect()
+}
+
+#[test]
+fn a_shared_value_lives_on_its_owner_and_moves_when_the_owner_is_killed_over_mqtt() {
+    let Some(mut fleet) = Fleet::start("shared-mqtt") else {
+        return;
+    };
+    let folders = support::mqtt::build(&fixture("shared.mission"), &fleet.out, &[]);
+    let scenario = fixture("shared.scenario.json");
+    let (t0, start_at) = support::robots::start_barrier(folders.len());
+    let start_at = start_at.to_string();
+    let started: Vec<_> = ["a", "b", "c"]
+        .into_iter()
+        .map(|robot| {
+            let folder = folder_of(&folders, robot);
+            fleet.spawn(&folder, &scenario, "shared", &["--start-at", &start_at])
+        })
+        .collect();
+    // The scenario's kill of `a` at 1500 mission ms, at its time scale 0.2.
+    let kill_at = t0 + std::time::Duration::from_millis(300);
+    if let Some(left) = kill_at.checked_duration_since(std::time::Instant::now()) {
+        std::thread::sleep(left);
+    }
+    fleet.processes.kill(started[0].index);
+    let b = fleet.finish(&started[1], "shared");
+    let c = fleet.finish(&started[2], "shared");
+
+    // Before the kill: `a` owned and told both; each read it.
+    for (robot, events) in [("b", &b), ("c", &c)] {
+        let told = of(events, "shared_value", &["key", "from"]);
+        assert!(
+            told.contains(&vec!["Scouts.NEAR".into(), "a".into()]),
+            "{robot}: {told:?}"
+        );
+        assert_eq!(modes(events)[..2], ["FAR", "NEAR_MODE"], "{robot}");
+        // After it: `b` owns.
+        let owners = of(events, "shared_owner", &["owner", "lost"]);
+        assert_eq!(owners, [["b", "a"]], "{robot}");
+    }
+    // `c` wrote to `b`, which took the write and read it.
+    assert!(of(&c, "shared_set", &["owner"]).contains(&vec!["b".into()]));
+    assert!(of(&b, "shared_set", &["owner", "from"]).contains(&vec!["b".into(), "c".into()]));
+    assert_eq!(modes(&b), ["FAR", "NEAR_MODE", "CLOSER"]);
+}
+
+/// The library task with an owner compiles at `-Wpedantic -Werror` with
+/// gcc and clang, for `linux` and `linux-sim`.
+#[test]
+fn the_shared_library_compiles_with_gcc_and_clang() {
+    for target in ["linux", "linux-sim"] {
+        for cc in support::robots::compilers() {
+            let out = support::robots::scratch(&format!("shared-compile-{target}-{cc}"));
+            let built = support::robots::build(&fixture("shared.mission"), target, &out);
+            assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+            for folder in robot_folders(&out) {
+                let library = folder.join("lib_ScoutsShared.c");
+                let text = std::fs::read_to_string(&library).unwrap();
+                assert!(text.contains("current_owner"), "{}", library.display());
+                make(&folder, cc, PEDANTIC).unwrap_or_else(|e| panic!("{target} {cc}: {e}"));
+            }
+        }
+    }
+}
