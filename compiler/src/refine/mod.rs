@@ -61,7 +61,9 @@ pub enum Robots {
     /// longest. The robots of a declaration are refined alike but for their
     /// names and their place among the peers, so what depends on neither
     /// (the dataflow warnings, whether refinement finds an error) is found
-    /// from one of them: the cost is per declaration, not per robot.
+    /// from one of them: the cost is per declaration, not per robot. What
+    /// joins the robots of a team (shared information's owners, a group's
+    /// members) then lists only the robots refined.
     OnePerDeclaration,
 }
 
