@@ -1358,6 +1358,61 @@ fn mission_ms(t0: std::time::Instant) -> i64 {
     }
 }
 
+/// What [`kill_and_restart`] saw: each life's trace in start order (the
+/// restarted life last), the killed life's place among them, and the
+/// mission times the kill and the restart really came.
+struct KillRestart {
+    traces: Vec<(String, Vec<Event>)>,
+    killed: usize,
+    killed_at: i64,
+    restarted_at: i64,
+}
+
+/// Runs every robot of `folders` behind one start barrier (time scale 1),
+/// kills `robot` at mission time `kill_at` and starts it again at
+/// `restart_at`; `what` names the run in a robot's failure.
+fn kill_and_restart(
+    fleet: &mut Fleet,
+    folders: &[PathBuf],
+    scenario: &Path,
+    robot: &str,
+    (kill_at, restart_at): (i64, i64),
+    what: &str,
+) -> KillRestart {
+    let (t0, start_at) = support::robots::start_barrier(folders.len());
+    let start_at = start_at.to_string();
+    let barrier = ["--start-at", start_at.as_str()];
+    let mut lives: Vec<Started> = folders
+        .iter()
+        .map(|f| fleet.spawn(f, scenario, "first", &barrier))
+        .collect();
+    let killed = lives.iter().position(|s| s.robot == robot).unwrap();
+    sleep_until(t0, kill_at);
+    fleet.processes.kill(lives[killed].index);
+    let killed_at = mission_ms(t0);
+    sleep_until(t0, restart_at);
+    let restarted_at = mission_ms(t0);
+    lives.push(fleet.spawn(&folder_of(folders, robot), scenario, "second", &barrier));
+    let traces = lives
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let events = if i == killed {
+                read_trace(&s.trace)
+            } else {
+                fleet.finish(s, what)
+            };
+            (s.robot.clone(), events)
+        })
+        .collect();
+    KillRestart {
+        traces,
+        killed,
+        killed_at,
+        restarted_at,
+    }
+}
+
 /// Sleeps until mission time `at` (time scale 1) of a run whose mission
 /// time 0 is the instant `t0`.
 fn sleep_until(t0: std::time::Instant, at: i64) {
@@ -1396,32 +1451,19 @@ fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
     // second): the restart comes after that.
     const KILL_AT: i64 = 3500;
     const RESTART_AT: i64 = 6000;
-    let (t0, start_at) = support::robots::start_barrier(folders.len());
-    let start_at = start_at.to_string();
-    let barrier = ["--start-at", start_at.as_str()];
-    let mut lives: Vec<Started> = folders
-        .iter()
-        .map(|f| fleet.spawn(f, &scenario, "first", &barrier))
-        .collect();
-    let first_tb_0 = lives.iter().position(|s| s.robot == "tb_0").unwrap();
-    sleep_until(t0, KILL_AT);
-    fleet.processes.kill(lives[first_tb_0].index);
-    let killed_at = mission_ms(t0);
-    sleep_until(t0, RESTART_AT);
-    let restarted_at = mission_ms(t0);
-    lives.push(fleet.spawn(&folder_of(&folders, "tb_0"), &scenario, "second", &barrier));
-    let traces: Vec<(String, Vec<Event>)> = lives
-        .iter()
-        .enumerate()
-        .map(|(i, s)| {
-            let events = if i == first_tb_0 {
-                read_trace(&s.trace)
-            } else {
-                fleet.finish(s, "patrol_groups")
-            };
-            (s.robot.clone(), events)
-        })
-        .collect();
+    let KillRestart {
+        traces,
+        killed: first_tb_0,
+        killed_at,
+        restarted_at,
+    } = kill_and_restart(
+        &mut fleet,
+        &folders,
+        &scenario,
+        "tb_0",
+        (KILL_AT, RESTART_AT),
+        "patrol_groups",
+    );
     let of =
         |robot: &str| -> &Vec<Event> { &traces.iter().rev().find(|(r, _)| r == robot).unwrap().1 };
 
@@ -1739,30 +1781,18 @@ fn group_service_over_mqtt_redivides_when_a_member_fails_and_returns() {
     // tb_1 is dead three heartbeats (600 ms) after it is killed.
     const KILL_AT: i64 = 1500;
     const RESTART_AT: i64 = 3500;
-    let (t0, start_at) = support::robots::start_barrier(folders.len());
-    let start_at = start_at.to_string();
-    let barrier = ["--start-at", start_at.as_str()];
-    let mut lives: Vec<Started> = folders
-        .iter()
-        .map(|f| fleet.spawn(f, &scenario, "first", &barrier))
-        .collect();
-    let first_tb_1 = lives.iter().position(|s| s.robot == "tb_1").unwrap();
-    sleep_until(t0, KILL_AT);
-    fleet.processes.kill(lives[first_tb_1].index);
-    sleep_until(t0, RESTART_AT);
-    lives.push(fleet.spawn(&folder_of(&folders, "tb_1"), &scenario, "second", &barrier));
-    let traces: Vec<(String, Vec<Event>)> = lives
-        .iter()
-        .enumerate()
-        .map(|(i, s)| {
-            let events = if i == first_tb_1 {
-                read_trace(&s.trace)
-            } else {
-                fleet.finish(s, "group service")
-            };
-            (s.robot.clone(), events)
-        })
-        .collect();
+    let KillRestart {
+        traces,
+        killed: first_tb_1,
+        ..
+    } = kill_and_restart(
+        &mut fleet,
+        &folders,
+        &scenario,
+        "tb_1",
+        (KILL_AT, RESTART_AT),
+        "group service",
+    );
     // (t, rank, size) of each `group` event of one life.
     let groups = |events: &[Event]| -> Vec<(i64, String, String)> {
         events
