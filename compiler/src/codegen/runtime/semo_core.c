@@ -624,10 +624,24 @@ static atomic_bool g_battery_known;
 
 void semo_battery_report(const semo_value *level)
 {
-    double x;
-    if (!as_number(level, &x) || x != x || x > 1e9 || x < -1e9)
+    long rounded;
+    if (level->type == SEMO_INT) {
+        if (level->i > 1000000000 || level->i < -1000000000)
+            return;
+        rounded = (long)level->i;
+    }
+#if REALS /* a program without reals has no real level to read */
+    else if (level->type == SEMO_REAL) {
+        double x = level->r;
+        if (x != x || x > 1e9 || x < -1e9)
+            return;
+        rounded = (long)(x < 0 ? x - 0.5 : x + 0.5);
+    }
+#endif
+    else {
         return;
-    atomic_store(&g_battery_level, (long)(x < 0 ? x - 0.5 : x + 0.5));
+    }
+    atomic_store(&g_battery_level, rounded);
     atomic_store(&g_battery_known, true);
 }
 
