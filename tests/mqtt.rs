@@ -362,18 +362,6 @@ fn broker_config_for(dir: &Path, mission: &Path, deploy: &Path) -> PathBuf {
     config
 }
 
-/// A `USER` command as the runtime's datagram (`semo::deploy::datagram`):
-/// from team `USER`, robot `operator`, the value as text.
-fn user_command(key: &str, value: &str) -> Vec<u8> {
-    semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
-        publish: false,
-        team: "USER".into(),
-        robot: "operator".into(),
-        key: key.into(),
-        value: Some(semo::refine::Value::text(value)),
-    })
-}
-
 /// Publishes `datagram` to `topic` with `mosquitto_pub` every 100 ms (as
 /// `user`, or anonymously) until `stop` is set. Returns how many publishes
 /// the broker accepted at the protocol level (exit status 0).
@@ -420,7 +408,11 @@ fn run_while_forging(
     processes: &mut Processes,
 ) -> BTreeMap<String, Vec<Event>> {
     let datagram = out.join("forged.bin");
-    std::fs::write(&datagram, user_command("USER.RC_CMD", "RC_MODE")).unwrap();
+    std::fs::write(
+        &datagram,
+        semo_server::live::operator_datagram("USER.RC_CMD", "RC_MODE"),
+    )
+    .unwrap();
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
     let threads: Vec<_> = forgers
         .iter()
