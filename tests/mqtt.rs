@@ -308,25 +308,33 @@ fn scouting_deployment(dir: &Path, port: u16, tls: bool) -> PathBuf {
         ("operator", "operator-secret"),
     ];
     password_files(dir, &users);
-    let (scheme, tls_top, tls_broker, tls_irobot) = if tls {
-        (
-            "mqtts",
-            "ca = \"ca.crt\"\n",
-            "cert = \"server.crt\"\nkey = \"server.key\"\n",
-            "cert = \"irobot.crt\"\nkey = \"irobot.key\"\n",
-        )
-    } else {
-        ("mqtt", "", "", "")
-    };
     let file = dir.join("scouting.deploy.toml");
-    std::fs::write(
-        &file,
-        format!(
-            "# The scouting robots on a private broker (tests/mqtt.rs).\nbroker = \"{scheme}://127.0.0.1:{port}\"\n{tls_top}\n[broker_config]\npassword_file = \"passwd\"\n{tls_broker}\n[operator]\nuser = \"operator\"\npassword_file = \"operator.pw\"\n\n[teams.SlaveTeam]\nuser = \"slaves\"\npassword_file = \"slaves.pw\"\n\n[robots.irobot]\nuser = \"irobot\"\npassword_file = \"irobot.pw\"\n{tls_irobot}"
-        ),
-    )
-    .unwrap();
+    std::fs::write(&file, scouting_deployment_text(port, tls)).unwrap();
     file
+}
+
+/// The text of [`scouting_deployment`]'s file. With TLS every client (the
+/// master, the slaves' team, the operator) has a client certificate, so the
+/// broker requires one.
+fn scouting_deployment_text(port: u16, tls: bool) -> String {
+    let client = |name: &str| {
+        if tls {
+            format!("cert = \"{name}.crt\"\nkey = \"{name}.key\"\n")
+        } else {
+            String::new()
+        }
+    };
+    let (scheme, tls_top, tls_broker) = if tls {
+        ("mqtts", "ca = \"ca.crt\"\n", client("server"))
+    } else {
+        ("mqtt", "", String::new())
+    };
+    format!(
+        "# The scouting robots on a private broker (tests/mqtt.rs).\nbroker = \"{scheme}://127.0.0.1:{port}\"\n{tls_top}\n[broker_config]\npassword_file = \"passwd\"\n{tls_broker}\n[operator]\nuser = \"operator\"\npassword_file = \"operator.pw\"\n{}\n[teams.SlaveTeam]\nuser = \"slaves\"\npassword_file = \"slaves.pw\"\n{}\n[robots.irobot]\nuser = \"irobot\"\npassword_file = \"irobot.pw\"\n{}",
+        client("operator"),
+        client("slaves"),
+        client("irobot")
+    )
 }
 
 /// `semo deploy broker-config` into `dir/broker`, run as this user, logging
@@ -535,39 +543,59 @@ fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
     );
 }
 
+/// `openssl ARGS` in `dir`; a failure fails the test.
+fn openssl(dir: &Path, args: &[&str]) {
+    let out = Command::new("openssl")
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("openssl runs");
+    assert!(
+        out.status.success(),
+        "openssl {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// A throwaway CA in `dir` (`ca.crt`, `ca.key`), made with `openssl`.
+fn certificate_authority(dir: &Path) {
+    openssl(
+        dir,
+        &[
+            "req",
+            "-x509",
+            "-newkey",
+            "rsa:2048",
+            "-nodes",
+            "-days",
+            "2",
+            "-subj",
+            "/CN=semo test CA",
+            "-keyout",
+            "ca.key",
+            "-out",
+            "ca.crt",
+        ],
+    );
+}
+
 /// A throwaway CA in `dir` (`ca.crt`), the broker's certificate for
-/// 127.0.0.1 (`server.crt`/`server.key`) and a client certificate for the
-/// master (`irobot.crt`/`irobot.key`), made with `openssl`.
+/// 127.0.0.1 (`server.crt`/`server.key`) and client certificates for the
+/// master, the slaves' team and the operator (`irobot`, `slaves`,
+/// `operator` `.crt`/`.key`), made with `openssl`.
 fn tls_files(dir: &Path) {
-    let openssl = |args: &[&str]| {
-        let out = Command::new("openssl")
-            .args(args)
-            .current_dir(dir)
-            .output()
-            .expect("openssl runs");
-        assert!(
-            out.status.success(),
-            "openssl {args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-    };
-    openssl(&[
-        "req",
-        "-x509",
-        "-newkey",
-        "rsa:2048",
-        "-nodes",
-        "-days",
-        "2",
-        "-subj",
-        "/CN=semo test CA",
-        "-keyout",
-        "ca.key",
-        "-out",
-        "ca.crt",
-    ]);
+    let openssl = |args: &[&str]| openssl(dir, args);
+    certificate_authority(dir);
+    // X.509 v3 certificates (an extension makes `openssl x509` write v3; a
+    // v1 certificate is refused by rustls, as by most modern TLS stacks).
     std::fs::write(dir.join("server.ext"), "subjectAltName = IP:127.0.0.1\n").unwrap();
-    for (name, extensions) in [("server", Some("server.ext")), ("irobot", None)] {
+    std::fs::write(dir.join("client.ext"), "extendedKeyUsage = clientAuth\n").unwrap();
+    for (name, extensions) in [
+        ("server", Some("server.ext")),
+        ("irobot", Some("client.ext")),
+        ("slaves", Some("client.ext")),
+        ("operator", Some("client.ext")),
+    ] {
         let (key, csr, crt) = (
             format!("{name}.key"),
             format!("{name}.csr"),
@@ -616,8 +644,10 @@ fn robots_run_over_tls_with_client_certificates() {
     let config = out.join("broker/mosquitto.conf");
     let conf = std::fs::read_to_string(&config).unwrap();
     assert!(
-        conf.contains("certfile ") && conf.contains("cafile "),
-        "{conf}"
+        conf.contains("certfile ")
+            && conf.contains("cafile ")
+            && conf.contains("require_certificate true"),
+        "every client has a certificate, so the broker requires one: {conf}"
     );
     let folders = build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
     let traces = run_together(
@@ -644,8 +674,9 @@ fn robots_run_over_tls_with_client_certificates() {
             "the master hears {slave} over TLS"
         );
     }
-    // The broker speaks only TLS: a plain connection with a slave's
-    // credentials is refused, so the robots above did use TLS.
+    // The broker speaks only TLS: a plain connection with the slaves'
+    // credentials is refused, so the robots above did use TLS. (A robot
+    // program cannot try: its baked client certificate needs mqtts://.)
     let nxt = folders.iter().find(|f| robot_name(f) == "nxt").unwrap();
     let (code, stderr) = run_with(
         nxt,
@@ -658,7 +689,18 @@ fn robots_run_over_tls_with_client_certificates() {
             "100",
         ],
     );
-    assert_eq!(code, Some(1), "{stderr}");
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(
+        stderr.contains("a client certificate needs an mqtts:// broker"),
+        "{stderr}"
+    );
+    let plain = Command::new("mosquitto_pub")
+        .args(["-h", "127.0.0.1", "-p", &port.to_string()])
+        .args(["-u", "slaves", "-P", "slaves-secret"])
+        .args(["-t", "semo/scouting/SlaveTeam/x", "-m", "x"])
+        .output()
+        .expect("mosquitto_pub runs (Debian mosquitto-clients)");
+    assert!(!plain.status.success(), "{plain:?}");
 }
 
 /// The retained status of `robot` on the broker at `port` (anonymous), as
@@ -888,7 +930,23 @@ fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
 
 #[test]
 fn the_operator_console_drives_scouting_to_finish() {
-    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-operator", false) else {
+    operator_console_drives_scouting_to_finish("mqtt-operator", false);
+}
+
+/// The same over `mqtts://`: the console checks the broker with the
+/// deployment's CA and presents the operator's client certificate (the
+/// broker requires one: every client has one).
+#[test]
+fn the_operator_console_drives_scouting_to_finish_over_tls() {
+    operator_console_drives_scouting_to_finish("mqtt-operator-tls", true);
+}
+
+/// `semo operator` as a process, with the scouting deployment (`tls` or
+/// not): it shows the master waiting, the operator sends it home, every
+/// robot finishes; the console printed the command, what the master sent
+/// the operator and its final status.
+fn operator_console_drives_scouting_to_finish(name: &str, tls: bool) {
+    let Some((mut fleet, deploy)) = deployed_fleet(name, tls) else {
         return;
     };
     let out = fleet.out.clone();
@@ -931,6 +989,11 @@ fn the_operator_console_drives_scouting_to_finish() {
         .recv_timeout(std::time::Duration::from_secs(30))
         .expect("the console says what it can send");
     assert!(first.contains("RC_CMD (to MasterTeam)"), "{first}");
+    let scheme = if tls { "mqtts" } else { "mqtt" };
+    assert!(
+        first.starts_with(&format!("operator on {scheme}://127.0.0.1:")),
+        "{first}"
+    );
 
     let mut started = Vec::new();
     for folder in &folders {
@@ -1068,9 +1131,19 @@ async fn start_monitor(
 
 #[test]
 fn the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost() {
+    editor_monitor_shows_the_running_robots_and_a_killed_one_lost("mqtt-monitor", false);
+}
+
+/// The same over `mqtts://` with the operator's client certificate.
+#[test]
+fn the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost_over_tls() {
+    editor_monitor_shows_the_running_robots_and_a_killed_one_lost("mqtt-monitor-tls", true);
+}
+
+fn editor_monitor_shows_the_running_robots_and_a_killed_one_lost(name: &str, tls: bool) {
     // The broker of the deployment file with its ACL: the monitor finds it
     // through the project's semo.toml and connects as the operator.
-    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-monitor", false) else {
+    let Some((mut fleet, deploy)) = deployed_fleet(name, tls) else {
         return;
     };
     let (out, port) = (fleet.out.clone(), fleet.port);
@@ -1101,7 +1174,8 @@ fn the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost() {
         .unwrap();
     runtime.block_on(async {
         let (mut client, uri, answer) = start_monitor(&workspace, "scouting.mission").await;
-        assert_eq!(answer["broker"], format!("mqtt://127.0.0.1:{port}"));
+        let scheme = if tls { "mqtts" } else { "mqtt" };
+        assert_eq!(answer["broker"], format!("{scheme}://127.0.0.1:{port}"));
         let view = monitor_view(&mut client, |p| p["connection"] == "connected").await;
         let names: Vec<String> = folders.iter().map(|f| robot_name(f)).collect();
         for robot in &names {
@@ -1164,6 +1238,146 @@ fn the_editor_monitor_shows_the_running_robots_and_a_killed_one_lost() {
             .await
             .unwrap();
         assert_eq!(stopped["stopped"], true);
+        client.shutdown().await;
+    });
+}
+
+/// `semo operator` on scouting with `deploy`, as a process whose standard
+/// input stays open (so only a refusal ends it): its exit code and stderr.
+/// One that does not end fails the test rather than hanging it.
+fn operator_refused(deploy: &Path) -> (Option<i32>, String) {
+    let mut console = Command::new(env!("CARGO_BIN_EXE_semo"))
+        .arg("operator")
+        .arg(examples().join("scouting/scouting.mission"))
+        .arg("--deploy")
+        .arg(deploy)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("semo operator starts");
+    let stdin = console.stdin.take();
+    let stderr = console.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut text = String::new();
+        use std::io::Read;
+        let _ = std::io::BufReader::new(stderr).read_to_string(&mut text);
+        text
+    });
+    for _ in 0..600 {
+        if let Some(status) = console.try_wait().unwrap() {
+            drop(stdin);
+            return (status.code(), reader.join().unwrap());
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    let _ = console.kill();
+    let _ = console.wait();
+    panic!(
+        "semo operator kept trying a broker it cannot reach this way: {}",
+        reader.join().unwrap()
+    );
+}
+
+#[test]
+fn a_broker_the_operator_cannot_trust_or_that_refuses_it_is_said_at_once() {
+    let Some((fleet, _deploy)) = deployed_fleet("mqtt-tls-refused", true) else {
+        return;
+    };
+    let (out, port) = (fleet.out.clone(), fleet.port);
+    let text = scouting_deployment_text(port, true);
+    let variant = |name: &str, from: &str, to: &str| {
+        assert!(text.contains(from), "{from}");
+        let file = out.join(name);
+        std::fs::write(&file, text.replace(from, to)).unwrap();
+        file
+    };
+    // The operator trusts another CA than the one that signed the broker.
+    let other = out.join("other");
+    std::fs::create_dir_all(&other).unwrap();
+    certificate_authority(&other);
+    let wrong_ca = variant(
+        "wrong-ca.deploy.toml",
+        "ca = \"ca.crt\"",
+        "ca = \"other/ca.crt\"",
+    );
+    let (code, stderr) = operator_refused(&wrong_ca);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(
+        stderr.contains("the broker's certificate is not trusted: the CA ")
+            && stderr.contains("other/ca.crt"),
+        "{stderr}"
+    );
+    // The broker requires a client certificate; without one the operator
+    // is refused (so the console over TLS did present its own).
+    let operator_cert = "cert = \"operator.crt\"\nkey = \"operator.key\"\n";
+    let no_cert = variant("no-cert.deploy.toml", operator_cert, "");
+    let (code, stderr) = operator_refused(&no_cert);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(stderr.contains("client certificate"), "{stderr}");
+    // A CA file that is no certificate: positioned in the deployment file
+    // before anything connects.
+    std::fs::write(out.join("note.crt"), "ask the lab for the CA\n").unwrap();
+    let not_pem = variant(
+        "not-pem.deploy.toml",
+        "ca = \"ca.crt\"",
+        "ca = \"note.crt\"",
+    );
+    let (code, stderr) = operator_refused(&not_pem);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("E126") && stderr.contains("not-pem.deploy.toml:3:"),
+        "{stderr}"
+    );
+
+    // The editor's monitor says the same: connection down, the reason, no
+    // robot shown as anything but waiting; a bad file refuses the start.
+    let files = [
+        examples().join("scouting/scouting.mission"),
+        examples().join("scouting/MasterTeam.strategy.xml"),
+    ];
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let workspace = monitor_workspace(&out.join("wrong-ca"), &wrong_ca, &files);
+        let (mut client, _, answer) = start_monitor(&workspace, "scouting.mission").await;
+        assert_eq!(answer["broker"], format!("mqtts://127.0.0.1:{port}"));
+        let view = monitor_view(&mut client, |p| p["connection"] == "disconnected").await;
+        assert!(
+            view["error"]
+                .as_str()
+                .is_some_and(|e| e.contains("the broker's certificate is not trusted")),
+            "{view}"
+        );
+        assert_eq!(shown(&view, "irobot")["state"], "waiting");
+        client.shutdown().await;
+
+        let workspace = monitor_workspace(&out.join("not-pem"), &not_pem, &files);
+        let mut client = semo_server::harness::TestClient::start();
+        client
+            .initialize_with(
+                serde_json::json!({}),
+                Some(&format!("file://{}", workspace.display())),
+            )
+            .await;
+        let mission = workspace.join("scouting.mission");
+        let uri = format!("file://{}", mission.display());
+        client
+            .open(&uri, &std::fs::read_to_string(&mission).unwrap())
+            .await;
+        client.diagnostics(&uri, Some(1)).await;
+        let refused = client
+            .request("semo/monitor/start", serde_json::json!({ "uri": uri }))
+            .await
+            .expect_err("a CA file that is no certificate refuses the monitor");
+        let message = refused["message"].as_str().unwrap_or("");
+        assert!(
+            message.contains("not-pem.deploy.toml:3:") && message.contains("[E126]"),
+            "{message}"
+        );
         client.shutdown().await;
     });
 }

@@ -1,5 +1,6 @@
 //! `semo operator MISSION --broker URL`: the operator console on a live
-//! mission (rumqttc). It sends the `USER` commands the mission receives
+//! mission (rumqttc; `mqtt://`, or `mqtts://` with the deployment's CA and
+//! the operator's client certificate, through `semo_server::live::BrokerAccess`). It sends the `USER` commands the mission receives
 //! (one per line on standard input: `RC_CMD RETURN_MODE`), prints what the
 //! robots `send(USER, …)`, and prints each robot's status whenever it
 //! changes (the retained `semo/<mission>/status/<robot>` topics). It ends
@@ -13,7 +14,7 @@
 use semo::codegen;
 use semo::deploy::topics;
 use semo::host;
-use semo_server::live::{DEFAULT_BROKER, Status, datagram_fields, mqtt_address, operator_datagram};
+use semo_server::live::{BrokerAccess, DEFAULT_BROKER, Status, datagram_fields, operator_datagram};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::{BufRead, Write};
 use std::path::PathBuf;
@@ -93,36 +94,19 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         (None, Some(d)) => d.broker.url.clone(),
         (None, None) => DEFAULT_BROKER.to_string(),
     };
-    let Some((host_name, port)) = mqtt_address(&url) else {
-        eprintln!(
-            "error: the broker must be mqtt://HOST[:PORT] (the console has no TLS), not {url:?}"
-        );
-        return 2;
-    };
-    let mut mqtt = rumqttc::MqttOptions::new(
-        format!("semo-operator-{}-{}", mission_topic, std::process::id()),
-        host_name,
-        port,
-    );
-    mqtt.set_keep_alive(std::time::Duration::from_secs(10));
-    if let Some(credentials) = deployment.as_ref().map(|d| d.operator_credentials()) {
-        if let Some(user) = credentials.user {
-            let password = match &credentials.password_file {
-                None => String::new(),
-                Some(path) => match std::fs::read_to_string(path) {
-                    Ok(text) => text.lines().next().unwrap_or("").to_string(),
-                    Err(e) => {
-                        eprintln!(
-                            "error: cannot read the operator's password file {}: {e}",
-                            path.display()
-                        );
-                        return 2;
-                    }
-                },
-            };
-            mqtt.set_credentials(user, password);
+    let access = match BrokerAccess::new(&url, deployment.as_ref()) {
+        Ok(access) => access,
+        Err(why) => {
+            eprintln!("error: {why}");
+            return 2;
         }
-    }
+    };
+    let mut mqtt = access.options(format!(
+        "semo-operator-{}-{}",
+        mission_topic,
+        std::process::id()
+    ));
+    mqtt.set_keep_alive(std::time::Duration::from_secs(10));
     let (client, mut connection) = rumqttc::Client::new(mqtt, 64);
     let level = topics::level(&mission_topic);
     for topic in [
@@ -159,6 +143,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         Broker(String),
         Line(String),
         End,
+        /// The broker cannot be reached this way (its certificate is not
+        /// trusted, it refused ours): retrying would only hang.
+        Refused(String),
     }
     let (tx, rx) = std::sync::mpsc::channel();
     let listener = {
@@ -175,7 +162,15 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
                     Ok(rumqttc::Event::Outgoing(rumqttc::Outgoing::Disconnect)) => break,
                     Ok(_) => {}
                     Err(e) => {
-                        eprintln!("operator: connection to the broker: {e} (retrying)");
+                        let failure = access.failure(&e);
+                        if failure.permanent {
+                            let _ = tx.send(Input::Refused(failure.message));
+                            break;
+                        }
+                        eprintln!(
+                            "operator: connection to the broker: {} (retrying)",
+                            failure.message
+                        );
                         std::thread::sleep(std::time::Duration::from_secs(1));
                     }
                 }
@@ -200,6 +195,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
                 continue;
             }
             Input::End => break,
+            Input::Refused(why) => {
+                eprintln!("error: cannot connect to {url}: {why}");
+                status = 2;
+                break;
+            }
             Input::Line(line) => line,
         };
         let line = line.trim();

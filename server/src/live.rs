@@ -5,7 +5,12 @@
 //! `observe_status` and `semo_mqtt.c`'s last will) and of the runtime's
 //! datagram (`semo_core.c`'s `semo__encode_message`, through
 //! `semo::deploy::datagram`), so that both read the
-//! same thing the same way.
+//! same thing the same way. And how both reach the broker (`connect`:
+//! `mqtt://` or `mqtts://`, the deployment's operator).
+
+mod connect;
+
+pub use connect::{BrokerAccess, Failure};
 
 /// A robot's status message on `semo/<mission>/status/<robot>`.
 #[derive(Clone, Debug, PartialEq)]
@@ -71,18 +76,6 @@ impl Status {
             .map(|(plan, service)| format!("{plan}={service}"))
             .collect::<Vec<_>>()
             .join(",")
-    }
-}
-
-/// `mqtt://HOST[:PORT]` (1883 by default) as host and port; `None` for
-/// anything else (the live doors speak no TLS).
-pub fn mqtt_address(url: &str) -> Option<(String, u16)> {
-    let rest = url.strip_prefix("mqtt://")?;
-    let rest = rest.strip_suffix('/').unwrap_or(rest);
-    match rest.rsplit_once(':') {
-        Some((host, port)) if !host.is_empty() => Some((host.to_string(), port.parse().ok()?)),
-        None if !rest.is_empty() => Some((rest.to_string(), 1883)),
-        _ => None,
     }
 }
 
@@ -171,9 +164,5 @@ mod tests {
             ])
         );
         assert_eq!(datagram_fields(&d[..d.len() - 1]), None);
-        assert_eq!(mqtt_address("mqtt://h:99"), Some(("h".into(), 99)));
-        assert_eq!(mqtt_address("mqtt://h"), Some(("h".into(), 1883)));
-        assert_eq!(mqtt_address("mqtts://h"), None);
-        assert_eq!(mqtt_address("mqtt://:1"), None);
     }
 }

@@ -300,7 +300,8 @@ async fn an_unreachable_broker_is_shown_and_bad_requests_are_refused() {
             json!({ "uri": uri, "broker": "mqtts://127.0.0.1:8883" }),
         )
         .await;
-    assert!(refused(tls).contains("mqtt://HOST[:PORT]"));
+    // A TLS broker without a deployment file: no CA to check it with.
+    assert!(refused(tls).contains("is a TLS broker"));
     let elsewhere = client
         .request(
             "semo/monitor/start",

@@ -205,13 +205,15 @@ pub fn files(
                 "an mqtts:// broker needs its certificate and key ([broker_config] `cert`, `key`) and the `ca` at the top".into(),
             )]);
         };
+        // The operator (`semo operator`, the editor's monitor) is a client too.
         let every_client_has_a_certificate = programs.iter().all(|p| {
             deployment
                 .robot(&p.team, &p.robot)
                 .credentials
                 .cert
                 .is_some()
-        });
+        }) && (deployment.operator.is_none()
+            || deployment.operator_credentials().cert.is_some());
         config.push_str(&format!(
             "cafile {}\ncertfile {}\nkeyfile {}\nrequire_certificate {every_client_has_a_certificate}\n",
             ca.display(),

@@ -23,7 +23,7 @@ use crate::sema::Mission;
 use crate::span::Span;
 use std::path::{Path, PathBuf};
 
-pub use parse::parse;
+pub use parse::{BrokerAddress, broker_address, parse};
 
 /// A deployment file, read and checked on its own. Paths are absolute
 /// (relative ones are resolved against the file's folder).
@@ -212,6 +212,14 @@ pub fn check(deployment: &Deployment, mission: &Mission) -> Vec<Diagnostic> {
         }
     }
     if deployment.broker.tls {
+        if deployment.operator.is_some() && deployment.operator_credentials().ca.is_none() {
+            found.push(Diagnostic::new(
+                Code::DeployInvalid,
+                deployment.file,
+                deployment.broker.span,
+                "the operator connects with TLS (mqtts://) but has no `ca` to check the broker with: give `ca` at the top or in [operator]".to_string(),
+            ));
+        }
         for (team, robot) in &robots {
             if deployment.robot(team, robot).credentials.ca.is_none() {
                 found.push(Diagnostic::new(

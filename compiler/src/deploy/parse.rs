@@ -55,7 +55,7 @@ pub fn parse(text: &str, file: FileId, base: &Path) -> Result<Deployment, Vec<Di
             .string(item, "broker")
             .and_then(|(url, at)| reader.broker_url(&url, at)),
     };
-    let ca = reader.path_of(top, "ca", true);
+    let ca = reader.tls_file(top, "ca", Pem::Certificates);
     let broker_config = match reader.table(top, "broker_config") {
         Some(table) => {
             reader.known_keys(table, BROKER_SIDE, "[broker_config]");
@@ -248,9 +248,9 @@ impl Reader<'_> {
         let credentials = Credentials {
             user,
             password_file: self.path_of(table, "password_file", true),
-            ca: self.path_of(table, "ca", true),
-            cert: self.path_of(table, "cert", true),
-            key: self.path_of(table, "key", true),
+            ca: self.tls_file(table, "ca", Pem::Certificates),
+            cert: self.tls_file(table, "cert", Pem::Certificates),
+            key: self.tls_file(table, "key", Pem::PrivateKey),
         };
         if credentials.password_file.is_some() && credentials.user.is_none() {
             self.key_error(
@@ -304,48 +304,124 @@ impl Reader<'_> {
         Some(path)
     }
 
+    /// A CA, certificate or key file a client reads: it must exist (E123)
+    /// and hold what its key says in PEM (E126), so that a robot or the
+    /// operator does not find out only when it connects.
+    fn tls_file(&mut self, table: &dyn TableLike, key: &str, holds: Pem) -> Option<PathBuf> {
+        let path = self.path_of(table, key, true)?;
+        let at = Self::item_span(table.get(key)?);
+        if path.is_file() {
+            if let Err(why) = holds.check(&path) {
+                self.error(
+                    Code::DeployBadTlsFile,
+                    at,
+                    format!("`{key}`: {} {why}", path.display()),
+                );
+            }
+        }
+        Some(path)
+    }
+
     /// `mqtt://HOST[:PORT]` or `mqtts://HOST[:PORT]`.
     fn broker_url(&mut self, url: &str, at: Span) -> Option<BrokerUrl> {
-        let (tls, rest) = if let Some(rest) = url.strip_prefix("mqtts://") {
-            (true, rest)
-        } else if let Some(rest) = url.strip_prefix("mqtt://") {
-            (false, rest)
-        } else {
-            self.error(
-                Code::DeployBadBroker,
-                at,
-                format!(
-                    "the broker must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT], not {url:?}"
-                ),
-            );
-            return None;
-        };
-        let default_port = if tls { 8883 } else { 1883 };
-        let (host, port) = match rest.rsplit_once(':') {
-            Some((host, port)) => (host, port.parse::<u16>().ok().filter(|p| *p > 0)),
-            None => (rest, Some(default_port)),
-        };
-        let bad_host =
-            host.is_empty() || host.len() > 255 || host.contains(['/', '@', '?', '#', ' ']);
-        match port {
-            Some(port) if !bad_host => Some(BrokerUrl {
+        match broker_address(url) {
+            Ok(address) => Some(BrokerUrl {
                 url: url.to_string(),
-                tls,
-                host: host.to_string(),
-                port,
+                tls: address.tls,
+                host: address.host,
+                port: address.port,
                 span: at,
             }),
-            _ => {
-                self.error(
-                    Code::DeployBadBroker,
-                    at,
-                    format!(
-                        "the broker must be {}://HOST[:PORT] with a host name or address and a port from 1 to 65535, not {url:?}",
-                        if tls { "mqtts" } else { "mqtt" }
-                    ),
-                );
+            Err(message) => {
+                self.error(Code::DeployBadBroker, at, message);
                 None
             }
         }
+    }
+}
+
+/// Where a broker URL points: the one reading of `mqtt://HOST[:PORT]` and
+/// `mqtts://HOST[:PORT]` (deployment files, `semo operator --broker`, the
+/// editor's monitor).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BrokerAddress {
+    pub tls: bool,
+    pub host: String,
+    pub port: u16,
+}
+
+/// Reads a broker URL (ports 1883 and 8883 when left out); the error says
+/// what a broker URL must be.
+pub fn broker_address(url: &str) -> Result<BrokerAddress, String> {
+    let (tls, rest) = if let Some(rest) = url.strip_prefix("mqtts://") {
+        (true, rest)
+    } else if let Some(rest) = url.strip_prefix("mqtt://") {
+        (false, rest)
+    } else {
+        return Err(format!(
+            "the broker must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT], not {url:?}"
+        ));
+    };
+    let rest = rest.strip_suffix('/').unwrap_or(rest);
+    let default_port = if tls { 8883 } else { 1883 };
+    let (host, port) = match rest.rsplit_once(':') {
+        Some((host, port)) => (host, port.parse::<u16>().ok().filter(|p| *p > 0)),
+        None => (rest, Some(default_port)),
+    };
+    let bad_host = host.is_empty() || host.len() > 255 || host.contains(['/', '@', '?', '#', ' ']);
+    match port {
+        Some(port) if !bad_host => Ok(BrokerAddress {
+            tls,
+            host: host.to_string(),
+            port,
+        }),
+        _ => Err(format!(
+            "the broker must be {}://HOST[:PORT] with a host name or address and a port from 1 to 65535, not {url:?}",
+            if tls { "mqtts" } else { "mqtt" }
+        )),
+    }
+}
+
+/// What a client's TLS file must hold.
+#[derive(Clone, Copy)]
+enum Pem {
+    /// One or more certificates (a CA bundle, or a certificate and its chain).
+    Certificates,
+    /// A private key (PKCS #8, PKCS #1 or SEC1).
+    PrivateKey,
+}
+
+/// The largest TLS file read (a system CA bundle is about 200 KB).
+const MAX_PEM_BYTES: u64 = 4 * 1024 * 1024;
+
+impl Pem {
+    /// Why the file at `path` does not hold what it should, as the end of a
+    /// sentence starting with its path.
+    fn check(self, path: &Path) -> Result<(), String> {
+        use rustls_pki_types::pem::PemObject;
+        use rustls_pki_types::{CertificateDer, PrivateKeyDer};
+        let text = crate::fsread::read_text_limited(path, MAX_PEM_BYTES)
+            .map_err(|e| format!("cannot be read: {e}"))?;
+        match self {
+            Pem::Certificates => {
+                let mut found = 0;
+                for certificate in CertificateDer::pem_slice_iter(text.as_bytes()) {
+                    certificate.map_err(|e| format!("is not valid PEM: {e}"))?;
+                    found += 1;
+                }
+                if found == 0 {
+                    return Err("holds no PEM certificate (`-----BEGIN CERTIFICATE-----`)".into());
+                }
+            }
+            Pem::PrivateKey => {
+                PrivateKeyDer::from_pem_slice(text.as_bytes()).map_err(|e| match e {
+                    rustls_pki_types::pem::Error::NoItemsFound => {
+                        "holds no PEM private key (`-----BEGIN PRIVATE KEY-----`)".to_string()
+                    }
+                    e => format!("is not valid PEM: {e}"),
+                })?;
+            }
+        }
+        Ok(())
     }
 }

@@ -3,11 +3,24 @@
 use super::*;
 use crate::diag::FileId;
 
-/// A folder with the files a deployment names.
+/// A certificate and a private key as PEM (what is checked of them: the
+/// PEM framing and its base64, not the DER inside).
+const PEM_CERTIFICATE: &str = "-----BEGIN CERTIFICATE-----\nMIIBAA==\n-----END CERTIFICATE-----\n";
+const PEM_KEY: &str = "-----BEGIN PRIVATE KEY-----\nMIIBAA==\n-----END PRIVATE KEY-----\n";
+
+/// A folder with the files a deployment names: `*.crt` a PEM certificate,
+/// `*.key` a PEM private key, the others a line of text.
 fn folder(files: &[&str]) -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     for name in files {
-        std::fs::write(dir.path().join(name), "x\n").unwrap();
+        let text = if name.ends_with(".crt") {
+            PEM_CERTIFICATE
+        } else if name.ends_with(".key") {
+            PEM_KEY
+        } else {
+            "x\n"
+        };
+        std::fs::write(dir.path().join(name), text).unwrap();
     }
     dir
 }
@@ -152,8 +165,8 @@ fn mistakes_are_positioned() {
     );
     assert_eq!(
         mistakes(
-            "broker = \"mqtt://x\"\n[robots.ti]\ncert = \"c\"\nid = 4\n",
-            &["c"]
+            "broker = \"mqtt://x\"\n[robots.ti]\ncert = \"c.crt\"\nid = 4\n",
+            &["c.crt"]
         ),
         [
             "E120 '4': `id` must be a string",
@@ -173,11 +186,71 @@ fn mistakes_are_positioned() {
 }
 
 #[test]
+fn a_tls_file_that_holds_no_pem_certificate_or_key_is_positioned() {
+    // A certificate where the key should be, text where the CA should be,
+    // broken base64: each refused at the value that names the file.
+    let found = mistakes(
+        "broker = \"mqtts://x\"\nca = \"ca.txt\"\n[operator]\nuser = \"op\"\ncert = \"op.crt\"\nkey = \"op-key.crt\"\n",
+        &["ca.txt", "op.crt", "op-key.crt"],
+    );
+    assert_eq!(found.len(), 2, "{found:?}");
+    assert!(
+        found[0].starts_with("E126 '\"ca.txt\"': `ca`: /")
+            && found[0]
+                .ends_with("ca.txt holds no PEM certificate (`-----BEGIN CERTIFICATE-----`)"),
+        "{found:?}"
+    );
+    assert!(
+        found[1].starts_with("E126 '\"op-key.crt\"': `key`: /")
+            && found[1].ends_with("holds no PEM private key (`-----BEGIN PRIVATE KEY-----`)"),
+        "{found:?}"
+    );
+    let dir = folder(&[]);
+    std::fs::write(
+        dir.path().join("bad.crt"),
+        "-----BEGIN CERTIFICATE-----\n%%%\n-----END CERTIFICATE-----\n",
+    )
+    .unwrap();
+    let found = parse(
+        "broker = \"mqtts://x\"\nca = \"bad.crt\"\n",
+        FileId(0),
+        dir.path(),
+    )
+    .unwrap_err();
+    assert_eq!(found.len(), 1);
+    assert_eq!(found[0].code, Code::DeployBadTlsFile);
+    assert!(
+        found[0].message.contains("is not valid PEM"),
+        "{}",
+        found[0].message
+    );
+}
+
+#[test]
+fn a_broker_url_reads_the_same_everywhere() {
+    let address = |url: &str| broker_address(url).map(|a| (a.tls, a.host, a.port));
+    assert_eq!(address("mqtt://h:99"), Ok((false, "h".into(), 99)));
+    assert_eq!(address("mqtt://h/"), Ok((false, "h".into(), 1883)));
+    assert_eq!(
+        address("mqtts://10.0.0.2"),
+        Ok((true, "10.0.0.2".into(), 8883))
+    );
+    assert!(address("mqtt://:1").is_err());
+    assert!(address("mqtts://h:0").is_err());
+    assert!(
+        address("tcp://h")
+            .unwrap_err()
+            .contains("mqtt://HOST[:PORT]")
+    );
+}
+
+#[test]
 fn names_are_checked_against_the_mission() {
     let text = "{\n  MasterTeam: iRobotCreate irobot\n}\nMasterTeam.main {\n  default: mode = A\n}\nMasterTeam.A {\n}\n";
     let catalog = crate::catalog::builtin_catalog();
     let analysis = crate::sema::check_source(FileId(0), text, &catalog);
-    let deploy = "broker = \"mqtts://x\"\n[teams.MasterTeem]\n[robots.irobt]\n";
+    let deploy =
+        "broker = \"mqtts://x\"\n[operator]\nuser = \"op\"\n[teams.MasterTeem]\n[robots.irobt]\n";
     let d = parse(deploy, FileId(1), std::path::Path::new("/")).unwrap();
     let found: Vec<String> = check(&d, &analysis.mission)
         .iter()
@@ -195,6 +268,7 @@ fn names_are_checked_against_the_mission() {
         [
             "E121 'MasterTeem': the mission has no team `MasterTeem` (did you mean `MasterTeam`?)",
             "E121 'irobt': the mission has no robot `irobt` (did you mean `irobot`?)",
+            "E120 '\"mqtts://x\"': the operator connects with TLS (mqtts://) but has no `ca` to check the broker with: give `ca` at the top or in [operator]",
             "E120 '\"mqtts://x\"': robot `irobot` connects with TLS (mqtts://) but has no `ca` to check the broker with: give `ca` at the top, in [teams.MasterTeam] or in [robots.irobot]"
         ]
     );

@@ -91,8 +91,9 @@ pub fn plan(job: &Job) -> Result<Plan, String> {
         Some(path) => Some(
             semo::deploy::load(path, semo::diag::FileId(u32::MAX)).map_err(|found| {
                 let first = found.iter().find(|d| d.is_error()).or(found.first());
+                let at = first.map_or(String::new(), |d| position(path, d.span.start));
                 format!(
-                    "cannot monitor: the deployment file {} is wrong: {}",
+                    "cannot monitor: the deployment file {}{at} is wrong: {}",
                     path.display(),
                     first.map_or(String::new(), |d| format!(
                         "[{}] {}",
@@ -108,33 +109,8 @@ pub fn plan(job: &Job) -> Result<Plan, String> {
         (None, Some(d)) => d.broker.url.clone(),
         (None, None) => live::DEFAULT_BROKER.to_string(),
     };
-    let (host, port) = live::mqtt_address(&broker).ok_or_else(|| {
-        format!("cannot monitor: the broker must be mqtt://HOST[:PORT] (the monitor has no TLS), not {broker:?}")
-    })?;
-    let credentials = match deployment.as_ref().map(|d| d.operator_credentials()) {
-        Some(semo::deploy::Credentials {
-            user: Some(user),
-            password_file,
-            ..
-        }) => {
-            let password = match password_file {
-                None => String::new(),
-                Some(path) => std::fs::read_to_string(&path)
-                    .map_err(|e| {
-                        format!(
-                            "cannot monitor: cannot read the operator's password file {}: {e}",
-                            path.display()
-                        )
-                    })?
-                    .lines()
-                    .next()
-                    .unwrap_or("")
-                    .to_string(),
-            };
-            Some((user, password))
-        }
-        _ => None,
-    };
+    let access = live::BrokerAccess::new(&broker, deployment.as_ref())
+        .map_err(|why| format!("cannot monitor: {why}"))?;
     let members = refined
         .programs
         .iter()
@@ -151,12 +127,24 @@ pub fn plan(job: &Job) -> Result<Plan, String> {
         uri: job.uri.as_str().to_string(),
         mission: semo::deploy::topics::mission(&refined.programs[0].mission),
         broker,
-        host,
-        port,
-        credentials,
+        access,
         members,
         heartbeat_ms: semo::refine::HEARTBEAT_MS,
     })
+}
+
+/// `:LINE:COLUMN` (from 1) of byte `offset` in the file at `path`, as a
+/// refusal names a deployment file's mistake; empty when it cannot be read.
+fn position(path: &std::path::Path, offset: usize) -> String {
+    let Ok(text) = semo::workspace::read_text(path) else {
+        return String::new();
+    };
+    let at = semo::text::LineIndex::new(&text).line_col(
+        &text,
+        offset.min(text.len()),
+        semo::text::ColumnUnit::Utf8,
+    );
+    format!(":{}:{}", at.line + 1, at.col + 1)
 }
 
 /// The answer to `semo/monitor/start`.

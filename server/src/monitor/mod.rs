@@ -28,10 +28,9 @@ pub struct Plan {
     /// The mission's name in topics.
     pub mission: String,
     pub broker: String,
-    pub host: String,
-    pub port: u16,
-    /// The operator's user and password (from the deployment file).
-    pub credentials: Option<(String, String)>,
+    /// How to reach it: address, the operator's user and password and TLS
+    /// configuration (from the deployment file).
+    pub access: crate::live::BrokerAccess,
     pub members: Vec<Member>,
     pub heartbeat_ms: i64,
 }
@@ -99,16 +98,13 @@ async fn run(plan: Plan, mut stopped: oneshot::Receiver<()>, notify: mpsc::Unbou
     use rumqttc::{Event, Packet, QoS};
     static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
     let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let mut options = rumqttc::MqttOptions::new(
-        format!("semo-monitor-{}-{}-{n}", plan.mission, std::process::id()),
-        plan.host.clone(),
-        plan.port,
-    );
+    let mut options = plan.access.options(format!(
+        "semo-monitor-{}-{}-{n}",
+        plan.mission,
+        std::process::id()
+    ));
     options.set_keep_alive(Duration::from_secs(5));
     options.set_clean_session(true);
-    if let Some((user, password)) = &plan.credentials {
-        options.set_credentials(user.clone(), password.clone());
-    }
     let (client, mut eventloop) = rumqttc::AsyncClient::new(options, 64);
     // The event loop is polled without interruption on its own task (a
     // poll cancelled half-way through a connection would start it over);
@@ -177,7 +173,9 @@ async fn run(plan: Plan, mut stopped: oneshot::Receiver<()>, notify: mpsc::Unbou
                 Some(Ok(_)) => {}
                 Some(Err(e)) => {
                     link = Link::Disconnected;
-                    error = Some(e.to_string());
+                    // A certificate the CA does not vouch for is said so
+                    // (and retried: the files may be fixed meanwhile).
+                    error = Some(plan.access.failure(&e).message);
                 }
             },
             _ = tick.tick() => roster.tick(now()),
