@@ -14,7 +14,8 @@ mod support;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
-use support::mqtt::{Fleet, Processes, Started, folder_of, free_port, read_trace, robot_name};
+use support::mosquitto::free_port;
+use support::mqtt::{Fleet, Processes, Started, folder_of, read_trace, robot_name};
 use support::robots::{
     Event, PEDANTIC, build, field, modes, robot_command, robot_folders, scratch,
 };
@@ -363,7 +364,7 @@ fn broker_config_for(dir: &Path, mission: &Path, deploy: &Path) -> PathBuf {
     let mut text = std::fs::read_to_string(&config).unwrap();
     text.push_str(&format!(
         "user {}\nlog_dest file {}\n",
-        support::mqtt::current_user(),
+        support::mosquitto::current_user(),
         out.join("mosquitto.log").display()
     ));
     std::fs::write(&config, text).unwrap();

@@ -3,6 +3,7 @@
 
 pub mod cc;
 pub mod missiongen;
+pub mod mosquitto;
 pub mod mqtt;
 pub mod robots;
 

@@ -9,19 +9,12 @@
 
 use super::robots::{Event, PEDANTIC, events, robot_command, robot_folders, scratch};
 use super::{repo_root, semo_in};
-use std::net::{TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
 /// The `mosquitto` binary (Debian puts it in /usr/sbin, often not on PATH).
 pub fn mosquitto() -> Option<PathBuf> {
-    let on_path = std::env::var_os("PATH")
-        .into_iter()
-        .flat_map(|p| std::env::split_paths(&p).collect::<Vec<_>>());
-    on_path
-        .chain([PathBuf::from("/usr/sbin"), PathBuf::from("/usr/local/sbin")])
-        .map(|dir| dir.join("mosquitto"))
-        .find(|path| path.is_file())
+    super::mosquitto::binary()
 }
 
 /// The broker, or None (after saying why) when the test must be skipped.
@@ -93,38 +86,19 @@ impl Drop for Processes {
     }
 }
 
-/// A free port of 127.0.0.1 (free when asked).
-pub fn free_port() -> u16 {
-    TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port()
-}
-
-/// The user we are: started as root, mosquitto drops to the `mosquitto`
-/// user, which cannot read or write our folders; `user <us>` keeps it us (no
-/// effect otherwise).
-pub fn current_user() -> String {
-    let whoami = Command::new("id").arg("-un").output().expect("id runs");
-    String::from_utf8_lossy(&whoami.stdout).trim().to_string()
-}
+use super::mosquitto::free_port;
 
 /// A private broker's configuration in `dir` for `port`: anonymous clients,
 /// TCP_NODELAY, persistence (a restarted broker keeps sessions), a log.
 pub fn plain_config(dir: &Path, port: u16) -> PathBuf {
-    let config = dir.join("mosquitto.conf");
-    std::fs::write(
-        &config,
-        format!(
-            "user {}\nlistener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\npersistence true\npersistence_location {}/\nlog_dest file {}\n",
-            current_user(),
-            dir.display(),
-            dir.join("mosquitto.log").display()
-        ),
+    super::mosquitto::write_config(
+        dir,
+        port,
+        super::mosquitto::Keeps {
+            persistence: true,
+            log: true,
+        },
     )
-    .unwrap();
-    config
 }
 
 /// Starts mosquitto with `config` (which listens on `port` of 127.0.0.1)
@@ -136,24 +110,12 @@ pub fn start_broker_with(
     port: u16,
     processes: &mut Processes,
 ) -> usize {
-    let child = Command::new(binary)
-        .arg("-c")
-        .arg(config)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("mosquitto starts");
-    let index = processes.push(child);
-    // Ready when it accepts a connection; a broker that never does (the port
-    // taken meanwhile) fails the test after many tries rather than hanging.
-    for _ in 0..500 {
-        if TcpStream::connect(("127.0.0.1", port)).is_ok() {
-            return index;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(10));
+    let index = processes.push(super::mosquitto::spawn(binary, config));
+    if !super::mosquitto::listening(port) {
+        let log = std::fs::read_to_string(dir.join("mosquitto.log")).unwrap_or_default();
+        panic!("mosquitto did not listen on port {port}: {log}");
     }
-    let log = std::fs::read_to_string(dir.join("mosquitto.log")).unwrap_or_default();
-    panic!("mosquitto did not listen on port {port}: {log}");
+    index
 }
 
 /// `semo build MISSION --target linux-sim -o OUT EXTRA...`, each robot made

@@ -5,25 +5,16 @@
 //! libmosquitto-dev or a C compiler is missing: a bench measures nothing
 //! rather than failing on a machine without them.
 
-use std::net::{TcpListener, TcpStream};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+#[path = "../../../tests/support/mosquitto.rs"]
+mod mosquitto;
 
-fn mosquitto() -> Option<PathBuf> {
-    [
-        "/usr/sbin/mosquitto",
-        "/usr/local/sbin/mosquitto",
-        "/usr/bin/mosquitto",
-    ]
-    .into_iter()
-    .map(PathBuf::from)
-    .find(|p| p.is_file())
-}
+use std::path::Path;
+use std::process::Command;
 
 /// What the program `benches/NAME.c` printed on stdout, as numbers, when it
 /// succeeded with `args` after the broker's port; on failure, what it said.
 pub fn run(name: &str, args: &[String]) -> Option<Result<Vec<f64>, String>> {
-    let Some(broker) = mosquitto() else {
+    let Some(broker) = mosquitto::binary() else {
         eprintln!("{name}: `mosquitto` is not installed; nothing measured");
         return None;
     };
@@ -47,33 +38,13 @@ pub fn run(name: &str, args: &[String]) -> Option<Result<Vec<f64>, String>> {
         );
         return None;
     }
-    let port = TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
-    let user = Command::new("id").arg("-un").output().expect("id runs");
-    let config = dir.path().join("mosquitto.conf");
-    std::fs::write(
-        &config,
-        format!(
-            "user {}\nlistener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\n",
-            String::from_utf8_lossy(&user.stdout).trim()
-        ),
-    )
-    .unwrap();
-    let mut broker = Command::new(broker)
-        .arg("-c")
-        .arg(&config)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("mosquitto starts");
-    for _ in 0..500 {
-        if TcpStream::connect(("127.0.0.1", port)).is_ok() {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(10));
+    let port = mosquitto::free_port();
+    let config = mosquitto::write_config(dir.path(), port, mosquitto::Keeps::default());
+    let mut broker = mosquitto::spawn(&broker, &config);
+    if !mosquitto::listening(port) {
+        let _ = broker.kill();
+        let _ = broker.wait();
+        return Some(Err(format!("mosquitto did not listen on port {port}")));
     }
     let run = Command::new(&program)
         .arg(port.to_string())

@@ -1,21 +1,19 @@
-//! A private `mosquitto` for the monitor's tests and benchmark: its
-//! configuration and log in a temporary folder, on a free loopback port.
+//! A private `mosquitto` for the monitor's tests and benchmark, on a free
+//! loopback port, its configuration and log in a temporary folder (written
+//! by the one broker set-up of every crate's tests, `tests/support/mosquitto.rs`).
 
-use std::net::{TcpListener, TcpStream};
+#[path = "../../../tests/support/mosquitto.rs"]
+mod mosquitto;
+
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::time::Duration;
+use std::process::Child;
 
-/// The `mosquitto` binary (Debian puts it in /usr/sbin), or None after
-/// saying so; a missing broker fails under `SEMO_MQTT_TESTS=require` (CI).
+pub use mosquitto::free_port;
+
+/// The `mosquitto` binary, or None after saying so; a missing broker fails
+/// under `SEMO_MQTT_TESTS=require` (CI).
 pub fn mosquitto() -> Option<PathBuf> {
-    let on_path = std::env::var_os("PATH")
-        .into_iter()
-        .flat_map(|p| std::env::split_paths(&p).collect::<Vec<_>>());
-    let found = on_path
-        .chain([PathBuf::from("/usr/sbin"), PathBuf::from("/usr/local/sbin")])
-        .map(|dir| dir.join("mosquitto"))
-        .find(|path| path.is_file());
+    let found = mosquitto::binary();
     if found.is_none() {
         assert!(
             std::env::var("SEMO_MQTT_TESTS").as_deref() != Ok("require"),
@@ -37,36 +35,24 @@ impl Broker {
     pub fn start(binary: &Path) -> Broker {
         let dir = tempfile::tempdir().unwrap();
         let port = free_port();
-        let whoami = Command::new("id").arg("-un").output().expect("id runs");
-        let config = dir.path().join("mosquitto.conf");
-        std::fs::write(
-            &config,
-            format!(
-                "user {}\nlistener {port} 127.0.0.1\nallow_anonymous true\nset_tcp_nodelay true\nlog_dest file {}\n",
-                String::from_utf8_lossy(&whoami.stdout).trim(),
-                dir.path().join("mosquitto.log").display()
-            ),
-        )
-        .unwrap();
-        let child = Command::new(binary)
-            .arg("-c")
-            .arg(&config)
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("mosquitto starts");
+        let config = mosquitto::write_config(
+            dir.path(),
+            port,
+            mosquitto::Keeps {
+                persistence: false,
+                log: true,
+            },
+        );
         let broker = Broker {
-            child,
+            child: mosquitto::spawn(binary, &config),
             port,
             _dir: dir,
         };
-        for _ in 0..500 {
-            if TcpStream::connect(("127.0.0.1", port)).is_ok() {
-                return broker;
-            }
-            std::thread::sleep(Duration::from_millis(10));
-        }
-        panic!("mosquitto did not listen on port {port}");
+        assert!(
+            mosquitto::listening(port),
+            "mosquitto did not listen on port {port}"
+        );
+        broker
     }
 
     pub fn url(&self) -> String {
@@ -79,12 +65,4 @@ impl Drop for Broker {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
-}
-
-pub fn free_port() -> u16 {
-    TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port()
 }
