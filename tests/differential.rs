@@ -463,6 +463,33 @@ fn a_killed_owner_of_shared_values_is_replaced_the_same_way_in_c_and_in_the_simu
     }
 }
 
+/// The owner the strategy names (`<SharedOwner>`, `tests/fixtures/shared_named`:
+/// `b`) and the team's leader as owner (`bully`, `tests/fixtures/shared_bully`:
+/// `c`; `highest_battery`, `tests/fixtures/shared_battery`: `a` at start),
+/// each killed: ownership moves to `a` (the first live robot of the
+/// formation order), to `b` (the next leader) and to `c` (the fullest live
+/// robot) the same way in both.
+#[test]
+fn the_named_owner_and_the_leader_owner_are_replaced_the_same_way_in_c_and_in_the_simulator() {
+    for (fixture, readers, next) in [
+        ("shared_named", ["a", "c"], "a"),
+        ("shared_bully", ["a", "b"], "b"),
+        ("shared_battery", ["b", "c"], "c"),
+    ] {
+        let dir = repo_root().join("tests/fixtures").join(fixture);
+        let scenario = std::fs::read_to_string(dir.join("shared.scenario.json")).unwrap();
+        let (processes, _) = compare(fixture, &dir.join("shared.mission"), &scenario, 20);
+        for robot in readers {
+            let owners: Vec<&str> = processes[robot]
+                .iter()
+                .filter(|e| field(e, "event") == "shared_owner")
+                .map(|e| field(e, "owner"))
+                .collect();
+            assert_eq!(owners, [next], "{fixture}: {robot}");
+        }
+    }
+}
+
 /// A group service (tests/fixtures/group_service: `move`, heartbeats every
 /// 200 ms) with tb_1 killed and restarted: the others' ranks and sizes
 /// change the same way in both (2 of 3 → 1 of 2 → 2 of 3 for tb_2), and

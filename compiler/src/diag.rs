@@ -193,6 +193,10 @@ codes! {
     GroupServiceDuplicate = "E125", Error, "a service declared a group service twice (for the same plan)";
     // Refinement of strategies into the robots' programs.
     BatteryPolicyNamesNoTask = "W130", Warning, "a battery policy's sensor or actuator that names no task of any robot of its team, or a policy that names none: it changes nothing";
+    // The owner of a library's globally shared values (`<SharedOwner>` in a strategy's `<GroupingInfo>`).
+    SharedOwnerUnknownLibrary = "E130", Error, "a `SharedOwner` naming a library task that is not its team's (`<Team>Shared`)";
+    SharedOwnerUnknownRobot = "E131", Error, "a `SharedOwner` naming a robot that is not a robot of its team";
+    SharedOwnerHoldsNone = "W131", Warning, "a `SharedOwner` naming a robot that holds none of the team's globally shared values (it runs none of the statements using them): it cannot own them, the team's leader does";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

@@ -121,7 +121,11 @@ pub fn refine_robots(
             diagnostics.extend(found);
             programs.extend(program);
         }
-        robot::shared::owners_of_team(&mut programs, &team.name);
+        diagnostics.extend(robot::shared::owners_of_team(
+            &mut programs,
+            &team.name,
+            input.strategies,
+        ));
         if let Some((first, others)) = names_no_task.split_first() {
             diagnostics.extend(
                 first

@@ -537,16 +537,44 @@ pub struct SharedLibrary {
 }
 
 /// The globally shared attributes of a team's library and the robots that
-/// own them in turn: the first live robot of `owners` holds them, the others
-/// set them through messages to it and read what it last told them.
+/// own them in turn: one robot of `owners` holds them, the others set them
+/// through messages to it and read what it last told them.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Ownership {
     /// The globally shared attributes.
     pub global: Vec<GlobalValue>,
-    /// Peer indices (into `RobotProgram::peers`) of the team's robots in the
-    /// order ownership passes when an owner is lost; the first is the owner
-    /// at start.
+    /// Peer indices (into `RobotProgram::peers`) of the team's robots that
+    /// may own them, in the order ownership passes when an owner is lost;
+    /// the first is the owner at start: the strategy's `<SharedOwner>` and
+    /// then the others in formation order, else the team's leader order
+    /// (`lowest_id`, `highest_battery`: formation order; `bully`: the
+    /// reverse).
     pub owners: Vec<usize>,
+    /// Who follows a lost owner.
+    pub rule: OwnerRule,
+}
+
+/// How the owner of a team's globally shared values is chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OwnerRule {
+    /// The strategy's `<SharedOwner>` first, then the first live robot of
+    /// the owner order.
+    Named,
+    /// The team's leader by its leader selection (`LeaderSelectionInfo`
+    /// without a composite service, else `lowest_id`) over the robots that
+    /// hold the values: `lowest_id` and `bully` the first live robot of the
+    /// owner order (formation order, reversed for `bully`);
+    /// `highest_battery` the live one whose last heartbeat said the highest
+    /// battery level (the first of equals; unknown counts lowest), the first
+    /// of the order at start, when no level has been heard yet.
+    Leader(LeaderAlgorithm),
+}
+
+impl OwnerRule {
+    /// A lost owner is followed by the live robot with the highest battery.
+    pub fn by_battery(self) -> bool {
+        self == OwnerRule::Leader(LeaderAlgorithm::HighestBattery)
+    }
 }
 
 /// One globally shared attribute of a library.
