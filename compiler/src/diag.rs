@@ -175,6 +175,7 @@ codes! {
     OutputNameEscapes = "E101", Error, "a name that cannot become a file or C identifier of the generated code (it could write outside the output folder, or clashes with a generated task)";
     CodegenInternal = "E102", Error, "an internal error of refinement or code generation: something the checker should have excluded (please report it)";
     TargetUnsupported = "E103", Error, "a robot the chosen target cannot run as written: on `cortex-m` a robot that messages other robots (no transport there yet) or whose service runs a task graph, or `cortex-m-sim` without `--scenario`";
+    ServiceSubgraphUnusable = "E135", Error, "a service implemented by a task graph whose sub-graph references cannot be used (a file that cannot be read, has errors, leads back to itself or whose open ports do not match the task's): the service cannot run";
     // The project file (`semo.toml`).
     ProjectSyntax = "E110", Error, "a project file (`semo.toml`) that is not valid TOML";
     ProjectBadValue = "E111", Error, "a project-file value of the wrong type or form (a folder list that is not a list of strings, an unknown target or lint level, a format version this semo does not read)";

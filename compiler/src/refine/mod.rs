@@ -49,6 +49,9 @@ pub struct ServiceGraph {
     pub catalog: FileId,
     pub path: String,
     pub graph: std::sync::Arc<crate::taskgraph::TaskGraph>,
+    /// The sub-graph files its tasks reference, resolved as the workspace
+    /// resolved them (their problems are the graph file's diagnostics).
+    pub hierarchy: std::sync::Arc<crate::taskgraph::subgraph::Hierarchy>,
 }
 
 /// Which robots [`refine_robots`] refines.
