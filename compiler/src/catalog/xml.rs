@@ -177,6 +177,15 @@ struct Reader<'t, 'p> {
 impl Reader<'_, '_> {
     // --- the walk ------------------------------------------------------------
 
+    fn vocabulary(&self) -> Vocabulary<'static> {
+        Vocabulary {
+            file: self.sink.file(),
+            unknown_attribute: Code::CatalogUnknownAttribute,
+            unknown_element: Code::CatalogUnknownElement,
+            elements: &schema::PLACES,
+        }
+    }
+
     fn root(&mut self, e: &Elem) {
         if e.local != "Catalog" {
             let message = format!(
@@ -196,12 +205,7 @@ impl Reader<'_, '_> {
     /// reported (E051) and their content skipped.
     fn content<'e>(&mut self, e: &'e Elem, mut read: impl FnMut(&mut Self, &'e Elem)) {
         let allowed = schema::element(&e.local).map_or(&[][..], |info| info.children);
-        let vocabulary = Vocabulary {
-            file: self.sink.file(),
-            unknown_attribute: Code::CatalogUnknownAttribute,
-            unknown_element: Code::CatalogUnknownElement,
-            elements: &schema::PLACES,
-        };
+        let vocabulary = self.vocabulary();
         let mut texts = e.texts.iter().peekable();
         for child in &e.children {
             while let Some(&text) = texts.next_if(|t| t.start < child.tag.start) {
@@ -232,12 +236,7 @@ impl Reader<'_, '_> {
     /// W050 for attributes that the element does not have.
     fn check_attributes(&mut self, e: &Elem) {
         let allowed = schema::element(&e.local).map_or(&[][..], |info| info.attributes);
-        let vocabulary = Vocabulary {
-            file: self.sink.file(),
-            unknown_attribute: Code::CatalogUnknownAttribute,
-            unknown_element: Code::CatalogUnknownElement,
-            elements: &schema::PLACES,
-        };
+        let vocabulary = self.vocabulary();
         vocabulary.check_attributes(&mut self.sink, e, allowed, |_| None);
     }
 
