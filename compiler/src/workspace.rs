@@ -336,25 +336,26 @@ pub fn analyze_graph_as(
 /// The one reader of referenced sub-graph files, for every door: a file the
 /// caller holds (the check's files, the host's documents) keeps its id and
 /// text; any other is read from the disk once and given a fresh id.
-pub struct FileResolver {
+pub struct FileResolver<'f> {
     known: std::collections::HashMap<PathBuf, SubgraphSource>,
+    /// The caller's files by normalized path, their texts shared (copied
+    /// into `known`) only when a reference names one: the CLI's one file
+    /// may be large, and is rarely referenced.
+    held: std::collections::HashMap<PathBuf, (FileId, &'f str)>,
     next: u32,
     /// Fresh ids count down from `next` (below ids in use) or up from it.
     downward: bool,
 }
 
-impl FileResolver {
+impl<'f> FileResolver<'f> {
     /// For the CLI: the check's files; fresh ids after theirs.
-    pub fn new(files: &Files) -> FileResolver {
-        let known = files.iter().map(|f| {
-            let source = SubgraphSource {
-                file: f.id,
-                text: f.text.as_str().into(),
-            };
-            (subgraph::normalize(&f.path), source)
-        });
+    pub fn new(files: &'f Files) -> FileResolver<'f> {
+        let held = files
+            .iter()
+            .map(|f| (subgraph::normalize(&f.path), (f.id, f.text.as_str())));
         FileResolver {
-            known: known.collect(),
+            known: std::collections::HashMap::new(),
+            held: held.collect(),
             next: files.iter().count() as u32,
             downward: false,
         }
@@ -369,6 +370,7 @@ impl FileResolver {
     ) -> Self {
         FileResolver {
             known: known.into_iter().collect(),
+            held: std::collections::HashMap::new(),
             next: below.0,
             downward: true,
         }
@@ -385,10 +387,18 @@ impl FileResolver {
     }
 }
 
-impl Resolver for FileResolver {
+impl Resolver for FileResolver<'_> {
     fn read(&mut self, path: &Path) -> Result<SubgraphSource, String> {
         if let Some(source) = self.known.get(path) {
             return Ok(source.clone());
+        }
+        if let Some(&(file, text)) = self.held.get(path) {
+            let source = SubgraphSource {
+                file,
+                text: text.into(),
+            };
+            self.known.insert(path.to_path_buf(), source.clone());
+            return Ok(source);
         }
         let text = read_text(path).map_err(|e| match e.kind() {
             std::io::ErrorKind::NotFound => format!("there is no file {}", path.display()),

@@ -1023,6 +1023,122 @@ fn mutate(base: &str, edits: Vec<(prop::sample::Index, u8, u8)>) -> String {
     String::from_utf8_lossy(&bytes).into_owned()
 }
 
+/// The clean SDF3 reader on `text`, against the full reader: it declines
+/// exactly the files the full reader reports something in (or that hold an
+/// entity, which it leaves to the full reader), and gives the full reader's
+/// graph on every other.
+fn assert_clean_reader_agrees(text: &str, times: ExecutionTimes) {
+    let clean = sdf3_clean::read(FILE, text, times);
+    let (full, diags) = load_fully(FILE, text, times);
+    let full_is_clean = diags.is_empty() && full.is_some();
+    let is_sdf3 = detect_format(text) == Some(GraphFormat::Sdf3);
+    match clean {
+        Some(graph) => {
+            assert!(
+                full_is_clean,
+                "accepted, but the full reader says:\n{}",
+                listing(&diags)
+            );
+            assert_eq!(Some(graph), full);
+        }
+        None => assert!(
+            !full_is_clean || !is_sdf3 || text.contains('&'),
+            "declined a file the full reader reads silently"
+        ),
+    }
+}
+
+#[test]
+fn the_clean_sdf3_reader_reads_every_sdf3_graph_as_the_full_reader_does() {
+    let mut files = files_in(SDF3, ".xml");
+    files.extend(files_in(&format!("{SDF3}/generated"), ".xml"));
+    assert!(files.len() > 40, "{files:?}");
+    for path in files {
+        let text = std::fs::read_to_string(&path).unwrap();
+        for times in [ExecutionTimes::FileDefault, ExecutionTimes::Sdf3Compat] {
+            let clean = sdf3_clean::read(FILE, &text, times);
+            let (full, diags) = load_fully(FILE, &text, times);
+            assert!(diags.is_empty(), "{}:\n{}", path.display(), listing(&diags));
+            assert!(clean.is_some(), "{} was declined", path.display());
+            assert_eq!(clean, full, "{}", path.display());
+        }
+    }
+}
+
+#[test]
+fn the_clean_sdf3_reader_declines_what_the_full_reader_reports() {
+    let graph = |actors: &str, channels: &str, properties: &str| {
+        format!(
+            r#"<?xml version="1.0"?>
+<sdf3 type="sdf" version="1.0"><applicationGraph name="app"><sdf name="g" type="G">
+{actors}
+{channels}
+</sdf><sdfProperties>{properties}</sdfProperties></applicationGraph></sdf3>"#
+        )
+    };
+    let actors = r#"<actor name="a" type="A"><port name="o" type="out" rate="2"/><port name="i" type="in" rate="1"/></actor>
+<actor name="b" type="B"><port name="i" type="in" rate="1"/><port name="o" type="out"/></actor>"#;
+    let channels = r#"<channel name="c0" srcActor="a" srcPort="o" dstActor="b" dstPort="i"/>
+<channel name="c1" srcActor="b" srcPort="o" dstActor="a" dstPort="i" initialTokens="1"/>"#;
+    let properties = r#"<actorProperties actor="a"><processor type="p1" default="true"><executionTime time="3"/></processor></actorProperties>
+<actorProperties actor="b"><processor type="p1"><executionTime time="5"/></processor><processor type="p2" default="false"><executionTime time="7"/></processor></actorProperties>"#;
+    let clean = graph(actors, channels, properties);
+    for times in [ExecutionTimes::FileDefault, ExecutionTimes::Sdf3Compat] {
+        assert_clean_reader_agrees(&clean, times);
+        assert!(sdf3_clean::read(FILE, &clean, times).is_some());
+    }
+    let g = sdf3_clean::read(FILE, &clean, ExecutionTimes::Sdf3Compat).unwrap();
+    assert_eq!(g.tasks[1].wcet, Some(7));
+    // Elements SDF3's reading does not use are ignored silently by both.
+    let other = clean.replace("<sdf name", "<other x=\"1\"><port/></other><sdf name");
+    assert!(sdf3_clean::read(FILE, &other, ExecutionTimes::FileDefault).is_some());
+    assert_clean_reader_agrees(&other, ExecutionTimes::FileDefault);
+    // One change each, every one reported by the full reader (or an entity).
+    let broken = [
+        clean.replace("type=\"sdf\"", "type=\"csdf\""),
+        clean.replace(" type=\"sdf\"", ""),
+        clean.replace("name=\"b\" type", "name=\"a\" type"),
+        clean.replace("name=\"b\" type", "type"),
+        clean.replace("name=\"o\" type=\"out\"/>", "name=\"i\" type=\"out\"/>"),
+        clean.replace(
+            "type=\"in\" rate=\"1\"/></actor>\n",
+            "type=\"inout\" rate=\"1\"/></actor>\n",
+        ),
+        clean.replace("rate=\"2\"", "rate=\"0\""),
+        clean.replace("rate=\"2\"", "rate=\" 2x\""),
+        clean.replace("rate=\"2\"", "rate=\"99999999999999999999999\""),
+        clean.replace("dstPort=\"i\"/>", "dstPort=\"x\"/>"),
+        clean.replace("dstActor=\"b\"", "dstActor=\"c\""),
+        clean.replace(
+            "srcPort=\"o\" dstActor=\"b\"",
+            "srcPort=\"i\" dstActor=\"b\"",
+        ),
+        clean.replace("initialTokens=\"1\"", "initialTokens=\"-1\""),
+        clean.replace("time=\"3\"", "time=\"\""),
+        clean.replace("srcActor=\"a\"", "srcActor=\" \""),
+        clean.replace("name=\"app\"", "name=\"a&amp;b\""),
+        clean.replace("name=\"app\"", "name=\"a<b\""),
+        clean.replace("name=\"app\"", "name=\"app\" name=\"x\""),
+        clean.replace("</sdf>", ""),
+        clean.replace("<?xml version=\"1.0\"?>", "text"),
+        format!("{clean}<sdf3 type=\"sdf\"/>"),
+        graph(actors, channels, properties)
+            .replace("<sdf name=\"g\" type=\"G\">", "<sdfx>")
+            .replace("</sdf>", "</sdfx>"),
+    ];
+    for (i, text) in broken.iter().enumerate() {
+        for times in [ExecutionTimes::FileDefault, ExecutionTimes::Sdf3Compat] {
+            assert!(
+                sdf3_clean::read(FILE, text, times).is_none(),
+                "case {i}:\n{text}"
+            );
+            assert_clean_reader_agrees(text, times);
+        }
+    }
+    // Our format and other roots are never read by it.
+    assert!(sdf3_clean::read(FILE, VALID, ExecutionTimes::FileDefault).is_none());
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(1500))]
 
@@ -1040,6 +1156,16 @@ proptest! {
     ) {
         let text = mutate(H263, edits);
         load(&text);
+    }
+
+    #[test]
+    fn the_clean_sdf3_reader_agrees_with_the_full_reader_on_mutations(
+        edits in proptest::collection::vec((any::<prop::sample::Index>(), any::<u8>(), 0u8..4), 1..4),
+        compat in any::<bool>(),
+    ) {
+        let times = if compat { ExecutionTimes::Sdf3Compat } else { ExecutionTimes::FileDefault };
+        assert_clean_reader_agrees(&mutate(H263, edits.clone()), times);
+        assert_clean_reader_agrees(&mutate(MODEM, edits), times);
     }
 
     #[test]
