@@ -626,3 +626,58 @@ fn a_received_word_of_another_enumeration_is_refused() {
         "{events:#?}"
     );
 }
+
+/// `semo build` prints every warning `semo check` gives for the mission (one
+/// source: the host's diagnostics with the mission's dataflow and
+/// refinement's warnings), in a JSON document and for people, and still
+/// builds: W130 (a battery policy naming no task, found by refinement) and a
+/// dataflow warning (W072).
+#[test]
+fn build_prints_every_warning_check_gives() {
+    let fixtures = repo_root().join("tests/fixtures/diagnostics");
+    for (fixture, mission, code) in [
+        (
+            "W130_battery_policy_names_no_task",
+            "scouts.mission",
+            "W130",
+        ),
+        ("W072_dataflow_buffer_too_small", "scan.mission", "W072"),
+    ] {
+        let dir = fixtures.join(fixture);
+        let mission = dir.join(mission).display().to_string();
+        let (checked, from_check) = support::check_json_in(&dir, &[&mission]);
+        assert_eq!(checked, 0, "{fixture}: it has warnings only");
+        assert!(
+            from_check.iter().any(|d| d.code == code),
+            "{fixture}: {}",
+            support::listing(&from_check)
+        );
+        let out = scratch(&format!("warnings-{code}"));
+        let out_arg = out.display().to_string();
+        let json = semo_in(
+            &dir,
+            &["build", &mission, "--format", "json", "-o", &out_arg],
+        );
+        assert_eq!(json.code, 0, "{fixture}: {}", json.stderr);
+        assert_eq!(
+            support::listing(&support::parse_json_report(&json.stdout)),
+            support::listing(&from_check),
+            "{fixture}: build and check"
+        );
+        let human = semo_in(
+            &dir,
+            &["build", &mission, "-o", &out_arg, "--color", "never"],
+        );
+        assert_eq!(human.code, 0, "{fixture}: {}", human.stderr);
+        for d in &from_check {
+            assert!(
+                human.stderr.contains(&format!("[{}]", d.code))
+                    && human.stderr.contains(&d.message),
+                "{fixture}: {} missing from\n{}",
+                d.code,
+                human.stderr
+            );
+        }
+        assert!(!robot_folders(&out).is_empty(), "{fixture}: it is built");
+    }
+}

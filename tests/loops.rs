@@ -7,8 +7,9 @@
 //! `wrote`). Checked
 //! from the trace of the generated `linux-sim` program and of `semo
 //! simulate`, on `tests/fixtures/loops/` (the thesis's k-means graph and the
-//! two loop examples, copied from `examples/taskgraphs/`), compiled with gcc
-//! and clang at `-Wpedantic -Werror`.
+//! two loop examples, copied from `examples/taskgraphs/`; a tracking graph
+//! whose task stands for a sub-graph file), compiled with gcc and clang at
+//! `-Wpedantic -Werror`.
 
 mod support;
 
@@ -191,15 +192,72 @@ fn a_convergent_loop_without_an_exit_stops_at_its_loop_count() {
     assert_eq!(nearest, 500 * 16);
 }
 
+/// `semo simulate`'s trace of `mission` with `scenario` (fixtures).
+fn simulate(mission: &str, scenario: &str) -> Vec<String> {
+    let simulated = semo_in(
+        &repo_root(),
+        &[
+            "simulate",
+            &fixture(mission).display().to_string(),
+            "--scenario",
+            &fixture(scenario).display().to_string(),
+            "--trace",
+            "-",
+        ],
+    );
+    assert_eq!(simulated.code, 0, "{}", simulated.stderr);
+    simulated.stdout.lines().map(str::to_string).collect()
+}
+
+/// A task standing for a sub-graph file fires as one iteration of the
+/// sub-graph's schedule: `track`'s `Detect Filter Steer` is
+/// `Detect 2(Predict) Update Steer`, the sub-graph's tasks named below
+/// `Filter`, its boundary passing Detect's two tokens to Predict's `in` and
+/// Update's `out` to Steer, in `linux-sim` and in the simulator alike.
+#[test]
+fn a_sub_graph_task_runs_one_iteration_of_its_sub_graph_in_the_looped_schedule() {
+    let scenario = std::fs::read_to_string(fixture("tracking.scenario.json")).unwrap();
+    let out = scratch("loops/tracking");
+    let traces = run_in_simulation(&fixture("tracking.mission"), &out, &scenario);
+    let c = events(&traces["c"]);
+    let expected = [
+        "track/Detect",
+        "track/Filter/Predict",
+        "track/Filter/Predict",
+        "track/Filter/Update",
+        "track/Steer",
+    ];
+    assert_eq!(graph_events(&c), expected, "linux-sim");
+    // Detect writes 1,2 (nothing read); each Predict reads one of them;
+    // Update reads both predictions (2+3) and writes 6, which Steer reads.
+    let data = graph_data(&c);
+    assert_eq!(
+        data,
+        [
+            "track/Detect →1,2",
+            "track/Filter/Predict 1→2",
+            "track/Filter/Predict 2→3",
+            "track/Filter/Update 2,3→6",
+            "track/Steer 6→",
+        ]
+    );
+    let simulated = events(&simulate("tracking.mission", "tracking.scenario.json"));
+    assert_eq!(graph_events(&simulated), expected, "semo simulate");
+    assert_eq!(graph_data(&simulated), data, "semo simulate");
+}
+
 #[test]
 fn graph_services_compile_pedantically_with_gcc_and_clang() {
     for target in ["linux", "linux-sim"] {
         for cc in compilers() {
-            let out = scratch(&format!("loops/compile-{target}-{cc}"));
-            let built = build(&fixture("loops.mission"), target, &out);
-            assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
-            for folder in robot_folders(&out) {
-                make(&folder, cc, PEDANTIC).unwrap_or_else(|e| panic!("{target} {cc}: {e}"));
+            for mission in ["loops.mission", "tracking.mission"] {
+                let out = scratch(&format!("loops/compile-{target}-{cc}-{mission}"));
+                let built = build(&fixture(mission), target, &out);
+                assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+                for folder in robot_folders(&out) {
+                    make(&folder, cc, PEDANTIC)
+                        .unwrap_or_else(|e| panic!("{mission} {target} {cc}: {e}"));
+                }
             }
         }
     }
@@ -217,4 +275,69 @@ fn a_graph_service_on_cortex_m_is_refused() {
         "{}",
         built.stderr
     );
+}
+
+/// A sub-graph reference the workspace cannot follow refuses the build on
+/// the service's call (E135), pointing at the graph file's own diagnostic:
+/// a missing file (E067), a file leading back to the graph (E069) or one
+/// whose open ports do not match the task's (E078). Nothing is written.
+#[test]
+fn a_service_graph_whose_sub_graph_cannot_be_used_is_refused_on_the_call() {
+    let track = std::fs::read_to_string(fixture("graphs/track.taskgraph.xml")).unwrap();
+    let filter = std::fs::read_to_string(fixture("graphs/filter.taskgraph.xml")).unwrap();
+    let cases = [
+        ("missing", None, "E067"),
+        // filter.taskgraph.xml's Predict stands for track.taskgraph.xml again.
+        (
+            "cycle",
+            Some(filter.replace(
+                "<Task name=\"Predict\">",
+                "<Task name=\"Predict\" subgraph=\"track.taskgraph.xml\">",
+            )),
+            "E069",
+        ),
+        (
+            "ports",
+            Some(filter.replace("name=\"out\"", "name=\"estimate\"")),
+            "E078",
+        ),
+    ];
+    for (name, sub, code) in cases {
+        let dir = scratch(&format!("loops/unusable-{name}"));
+        std::fs::create_dir_all(dir.join("graphs")).unwrap();
+        for file in ["tracking.mission", "clusterer.robot.xml"] {
+            std::fs::copy(fixture(file), dir.join(file)).unwrap();
+        }
+        for graph in ["kmeans", "data_loop", "convergent_loop"] {
+            let file = format!("graphs/{graph}.taskgraph.xml");
+            std::fs::copy(fixture(&file), dir.join(&file)).unwrap();
+        }
+        std::fs::write(dir.join("graphs/track.taskgraph.xml"), &track).unwrap();
+        if let Some(sub) = &sub {
+            std::fs::write(dir.join("graphs/filter.taskgraph.xml"), sub).unwrap();
+        }
+        let out = dir.join("out");
+        let built = semo_in(
+            &dir,
+            &[
+                "build",
+                "tracking.mission",
+                "--target",
+                "linux-sim",
+                "-o",
+                &out.display().to_string(),
+                "--format",
+                "json",
+            ],
+        );
+        assert_eq!(built.code, 1, "{name}: {}", built.stderr);
+        let json: serde_json::Value = serde_json::from_str(&built.stdout)
+            .unwrap_or_else(|e| panic!("{name}: {e}: {}", built.stdout));
+        let text = json.to_string();
+        assert!(
+            text.contains("\"E135\"") && text.contains(code),
+            "{name}: {text}"
+        );
+        assert!(robot_folders(&out).is_empty(), "{name}: nothing is written");
+    }
 }

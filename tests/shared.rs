@@ -4,8 +4,9 @@
 //! over MQTT (a private `mosquitto` broker, `tests/support/mqtt.rs`), the
 //! owner `a` killed while the others run. Checked from the traces: what `a`
 //! writes, `b` and `c` get from it; after the kill `b` owns the value, `c`'s
-//! write reaches it and `b` reads it. (The same run over UDP is compared
-//! with the simulator in `tests/differential.rs`.)
+//! write reaches it and `b` reads it. The same with the owner the strategy
+//! names (`tests/fixtures/shared_named`). (The same runs over UDP are
+//! compared with the simulator in `tests/differential.rs`.)
 //!
 //! Needs `mosquitto` and `libmosquitto-dev` (Debian). Skipped with a message
 //! when the broker is missing, unless `SEMO_MQTT_TESTS=require` (CI).
@@ -19,6 +20,38 @@ use support::robots::{Event, PEDANTIC, field, make, modes, robot_folders};
 
 fn fixture(name: &str) -> PathBuf {
     repo_root().join("tests/fixtures/shared").join(name)
+}
+
+/// Starts the three scouts of `folder`'s fixture over MQTT behind one start
+/// barrier, kills `victim` at 1500 mission ms (300 ms at the scenario's time
+/// scale 0.2) and returns the traces of the others.
+fn run_killing(fleet: &mut Fleet, folder: &str, victim: &str) -> Vec<(String, Vec<Event>)> {
+    let dir = repo_root().join("tests/fixtures").join(folder);
+    let folders = support::mqtt::build(&dir.join("shared.mission"), &fleet.out, &[]);
+    let scenario = dir.join("shared.scenario.json");
+    let (t0, start_at) = support::robots::start_barrier(folders.len());
+    let start_at = start_at.to_string();
+    let started: Vec<_> = ["a", "b", "c"]
+        .into_iter()
+        .map(|robot| {
+            let folder = folder_of(&folders, robot);
+            (
+                robot,
+                fleet.spawn(&folder, &scenario, "shared", &["--start-at", &start_at]),
+            )
+        })
+        .collect();
+    let kill_at = t0 + std::time::Duration::from_millis(300);
+    if let Some(left) = kill_at.checked_duration_since(std::time::Instant::now()) {
+        std::thread::sleep(left);
+    }
+    let (_, killed) = started.iter().find(|(r, _)| *r == victim).unwrap();
+    fleet.processes.kill(killed.index);
+    started
+        .iter()
+        .filter(|(r, _)| *r != victim)
+        .map(|(robot, process)| (robot.to_string(), fleet.finish(process, "shared")))
+        .collect()
 }
 
 /// `(field values)` of a robot's events of one kind.
@@ -73,14 +106,51 @@ fn a_shared_value_lives_on_its_owner_and_moves_when_the_owner_is_killed_over_mqt
     assert_eq!(modes(&b), ["FAR", "NEAR_MODE", "CLOSER"]);
 }
 
+/// The owner the strategy names (`tests/fixtures/shared_named`: `b`) holds
+/// the value: `a`'s write reaches `b`, which tells `a` and `c`; `b` killed,
+/// `a` (the first live robot of the formation order) owns, `c`'s write
+/// reaches it and both read it.
+#[test]
+fn the_owner_the_strategy_names_holds_the_value_and_is_replaced_when_killed_over_mqtt() {
+    let Some(mut fleet) = Fleet::start("shared-named-mqtt") else {
+        return;
+    };
+    let traces = run_killing(&mut fleet, "shared_named", "b");
+    let (a, c) = (&traces[0].1, &traces[1].1);
+    assert!(of(a, "shared_set", &["owner"]).contains(&vec!["b".into()]));
+    for (robot, events) in [("a", a), ("c", c)] {
+        let told = of(events, "shared_value", &["key", "from"]);
+        assert!(
+            told.contains(&vec!["Scouts.NEAR".into(), "b".into()]),
+            "{robot}: {told:?}"
+        );
+        let owners = of(events, "shared_owner", &["owner", "lost"]);
+        assert_eq!(owners, [["a", "b"]], "{robot}");
+        assert_eq!(modes(events), ["FAR", "NEAR_MODE", "CLOSER"], "{robot}");
+    }
+    assert!(of(c, "shared_set", &["owner"]).contains(&vec!["a".into()]));
+    assert!(of(a, "shared_set", &["owner", "from"]).contains(&vec!["a".into(), "c".into()]));
+}
+
 /// The library task with an owner compiles at `-Wpedantic -Werror` with
-/// gcc and clang, for `linux` and `linux-sim`.
+/// gcc and clang, for `linux` and `linux-sim`, with either way of following
+/// a lost owner.
 #[test]
 fn the_shared_library_compiles_with_gcc_and_clang() {
-    for target in ["linux", "linux-sim"] {
+    // `shared_battery`: a lost owner followed by battery level.
+    for (fixture, target) in [
+        ("shared", "linux"),
+        ("shared", "linux-sim"),
+        ("shared_battery", "linux"),
+        ("shared_battery", "linux-sim"),
+    ] {
+        let mission = repo_root()
+            .join("tests/fixtures")
+            .join(fixture)
+            .join("shared.mission");
         for cc in support::robots::compilers() {
-            let out = support::robots::scratch(&format!("shared-compile-{target}-{cc}"));
-            let built = support::robots::build(&fixture("shared.mission"), target, &out);
+            let out = support::robots::scratch(&format!("{fixture}-compile-{target}-{cc}"));
+            let built = support::robots::build(&mission, target, &out);
             assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
             for folder in robot_folders(&out) {
                 let library = folder.join("lib_ScoutsShared.c");

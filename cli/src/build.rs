@@ -138,7 +138,10 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         },
     };
     if result.refused() {
-        run.diagnostics = result.diagnostics;
+        // What `semo check` gives for the mission and what generation adds,
+        // each once.
+        run.diagnostics.extend(result.diagnostics);
+        semo::diag::sort_and_dedup(&mut run.diagnostics);
         let reported = match options.format {
             Format::Human => super::render::human(&run, options.color, &mut std::io::stderr()),
             format => output::report(
@@ -168,6 +171,20 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         }
     }
     let human = options.format == Format::Human;
+    // The mission builds: its warnings are what `semo check` gives for it
+    // (the host's diagnostics and dataflow, refinement's W130 among them),
+    // printed before anything is written.
+    if human {
+        let shown = super::render::diagnostics(
+            &run.files,
+            &run.diagnostics,
+            options.color,
+            &mut std::io::stderr(),
+        );
+        if let Err(code) = output::written(shown) {
+            return code;
+        }
+    }
     let mut robots_json = Vec::new();
     let generated = started.elapsed();
     let mut transaction = match Transaction::begin(&out_dir, || {
@@ -254,7 +271,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             options.format,
             "build",
             &run.files,
-            &[],
+            &run.diagnostics,
             options.color,
             serde_json::json!({ "target": target.name(), "robots": robots_json }),
             out,

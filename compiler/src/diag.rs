@@ -175,6 +175,7 @@ codes! {
     OutputNameEscapes = "E101", Error, "a name that cannot become a file or C identifier of the generated code (it could write outside the output folder, or clashes with a generated task)";
     CodegenInternal = "E102", Error, "an internal error of refinement or code generation: something the checker should have excluded (please report it)";
     TargetUnsupported = "E103", Error, "a robot the chosen target cannot run as written: on `cortex-m` a robot that messages other robots (no transport there yet) or whose service runs a task graph, or `cortex-m-sim` without `--scenario`";
+    ServiceSubgraphUnusable = "E135", Error, "a service implemented by a task graph whose sub-graph references cannot be used (a file that cannot be read, has errors, leads back to itself or whose open ports do not match the task's): the service cannot run";
     // The project file (`semo.toml`).
     ProjectSyntax = "E110", Error, "a project file (`semo.toml`) that is not valid TOML";
     ProjectBadValue = "E111", Error, "a project-file value of the wrong type or form (a folder list that is not a list of strings, an unknown target or lint level, a format version this semo does not read)";
@@ -192,6 +193,10 @@ codes! {
     GroupServiceDuplicate = "E125", Error, "a service declared a group service twice (for the same plan)";
     // Refinement of strategies into the robots' programs.
     BatteryPolicyNamesNoTask = "W130", Warning, "a battery policy's sensor or actuator that names no task of any robot of its team, or a policy that names none: it changes nothing";
+    // The owner of a library's globally shared values (`<SharedOwner>` in a strategy's `<GroupingInfo>`).
+    SharedOwnerUnknownLibrary = "E130", Error, "a `SharedOwner` naming a library task that is not its team's (`<Team>Shared`)";
+    SharedOwnerUnknownRobot = "E131", Error, "a `SharedOwner` naming a robot that is not a robot of its team";
+    SharedOwnerHoldsNone = "W131", Warning, "a `SharedOwner` naming a robot that holds none of the team's globally shared values (it runs none of the statements using them): it cannot own them, the team's leader does";
     // Warnings (mission scripts).
     EventNeverCaught = "W001", Warning, "an event that is thrown but no mode of its team catches";
     UnreachableMode = "W002", Warning, "a mode that cannot be reached from the default mode";

@@ -852,11 +852,14 @@ impl Analysis {
                     continue;
                 }
                 let loaded = self.service_graph(def.origin.file, path);
-                if let Some(graph) = loaded.and_then(|run| run.graph.clone()) {
+                if let Some(run) = loaded
+                    && let Some(graph) = run.graph.clone()
+                {
                     service_graphs.push(crate::refine::ServiceGraph {
                         catalog: def.origin.file,
                         path: path.clone(),
                         graph: Arc::new(graph),
+                        hierarchy: Arc::new(run.hierarchy.clone()),
                     });
                 }
             }

@@ -1,5 +1,6 @@
-//! Byte positions for XML read with quick-xml, shared by the catalog and the
-//! task-graph loaders. The reader borrows the text (`Reader::from_str`), so every
+//! Byte positions for XML read with quick-xml, under the positioned element
+//! tree of [`crate::xmltree`] that the catalog, strategy and task-graph loaders
+//! read, and the readers' shared attribute helpers. The reader borrows the text (`Reader::from_str`), so every
 //! name and attribute value it hands out is a slice of the text and its range is
 //! found by pointer arithmetic ([`slice_span`]).
 
@@ -293,21 +294,10 @@ fn lt_span(text: &str, at: usize, fallback: Span) -> Span {
     }
 }
 
-/// The attributes of a start tag (`tag` is its range), with their ranges. A
+/// The attributes of a start tag (`tag` is its range), with their ranges,
+/// into `out` (emptied first: a reader of many elements reuses one list). A
 /// malformed attribute list gives the range and message of the first error; a
 /// `<` inside a value is such an error.
-pub(crate) fn read_attributes(
-    text: &str,
-    e: &BytesStart<'_>,
-    tag: Span,
-    decoder: Decoder,
-) -> Result<Vec<Attr>, (Span, String)> {
-    let mut attrs = Vec::new();
-    read_attributes_into(text, e, tag, decoder, &mut attrs).map(|()| attrs)
-}
-
-/// [`read_attributes`] into `out` (emptied first): a reader of many elements
-/// reuses one list.
 pub(crate) fn read_attributes_into(
     text: &str,
     e: &BytesStart<'_>,
@@ -322,7 +312,7 @@ pub(crate) fn read_attributes_into(
     }
 }
 
-/// As [`read_attributes`], except that a `<` inside a value (which quick-xml
+/// As [`read_attributes_into`], except that a `<` inside a value (which quick-xml
 /// reads as part of the value, and XML forbids) is kept: the byte position of
 /// every such `<` is returned, for formats that report it
 /// and read on. When the attribute list is malformed after such a `<`, the

@@ -1,6 +1,7 @@
 //! A positioned XML element tree, read with quick-xml: every element, attribute
-//! and attribute value keeps its byte range. The task-graph and strategy loaders
-//! read a file into this tree first, then read the tree as their model. The
+//! and attribute value keeps its byte range. The catalog, task-graph and
+//! strategy loaders read a file into this tree first, then read the tree as
+//! their model. The
 //! walk under the tree ([`walk`], [`Visit`]) is for a loader that reads the
 //! elements as they come instead (SDF3 graphs, large ones): the same
 //! well-formedness checks and positions without holding the tree.
@@ -222,32 +223,53 @@ impl Vocabulary<'_> {
         for c in &e.children {
             if allowed.contains(&c.local.as_str()) {
                 children.push(c);
-                continue;
-            }
-            match self.elements.iter().find(|(name, _)| *name == c.local) {
-                Some((name, belongs)) => {
-                    let message = format!(
-                        "`<{name}>` is not allowed inside `<{}>`: it goes {belongs}",
-                        e.local
-                    );
-                    out.push(one_line_diagnostic(code, self.file, c.name_span, message));
-                }
-                None => {
-                    let message = if allowed.is_empty() {
-                        format!(
-                            "unknown element `<{}>`: `<{}>` cannot contain elements",
-                            c.qname, e.local
-                        )
-                    } else {
-                        format!("unknown element `<{}>` inside `<{}>`", c.qname, e.local)
-                    };
-                    let mut d = one_line_diagnostic(code, self.file, c.name_span, message);
-                    d.suggest(xmlpos::suggest(&c.local, allowed));
-                    out.push(d);
-                }
+            } else {
+                self.misplaced(out, e, c, allowed);
             }
         }
         children
+    }
+
+    /// Reports `child`, an element of `parent` not among `allowed`: a known
+    /// element written in the wrong place, or an unknown one.
+    pub fn misplaced(
+        &self,
+        out: &mut Vec<Diagnostic>,
+        parent: &Elem,
+        child: &Elem,
+        allowed: &[&str],
+    ) {
+        let code = self.unknown_element;
+        match self.elements.iter().find(|(name, _)| *name == child.local) {
+            Some((name, belongs)) => {
+                let message = format!(
+                    "`<{name}>` is not allowed inside `<{}>`: it goes {belongs}",
+                    parent.local
+                );
+                out.push(one_line_diagnostic(
+                    code,
+                    self.file,
+                    child.name_span,
+                    message,
+                ));
+            }
+            None => {
+                let message = if allowed.is_empty() {
+                    format!(
+                        "unknown element `<{}>`: `<{}>` cannot contain elements",
+                        child.qname, parent.local
+                    )
+                } else {
+                    format!(
+                        "unknown element `<{}>` inside `<{}>`",
+                        child.qname, parent.local
+                    )
+                };
+                let mut d = one_line_diagnostic(code, self.file, child.name_span, message);
+                d.suggest(xmlpos::suggest(&child.local, allowed));
+                out.push(d);
+            }
+        }
     }
 }
 

@@ -4,6 +4,7 @@
 //! type name. See `shared/spec/catalog.md`.
 
 mod builtin;
+mod schema;
 mod xml;
 
 pub use builtin::{BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE, builtin_catalog};

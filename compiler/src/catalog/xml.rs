@@ -1,22 +1,22 @@
 //! Reading one `*.robot.xml` catalog file into robot types, with positioned
-//! diagnostics (E050–E056, W050). The reader borrows the text, so every element,
-//! attribute and attribute value gets its exact byte range.
+//! diagnostics (E050–E056, W050). The file is first read into the positioned
+//! element tree of [`crate::xmltree`], then the tree is walked against the
+//! format's table ([`super::schema`]).
 //!
-//! Malformed XML (E050) stops the file: robots completely read before the error
-//! are kept. Every other problem is reported and reading goes on; a broken entry
-//! (a value without a name, a duplicate robot type) is left out of the result.
+//! Malformed XML (E050) stops the first step: robots completely read before the
+//! error are kept, the robot cut short is not. Every other problem is reported
+//! and reading goes on; a broken entry (a value without a name, a duplicate
+//! robot type) is left out of the result. Diagnostics come in document order,
+//! the malformed XML (where reading stopped) last.
 
+use super::schema::{self, TYPE_NAMES};
 use super::{
     Implementation, Origin, ParamDef, Platform, RobotType, ServiceDef, ValueDef, ValueType,
 };
 use crate::diag::{Code, Diagnostic, FileId, Sink};
 use crate::span::Span;
-use crate::xmlpos::{
-    self, Attr, StartTag, get, is_ident, is_namespace_attribute, read_attributes,
-    resolve_reference, suggest, trim_span, xml_error_message,
-};
-use quick_xml::encoding::Decoder;
-use quick_xml::events::{BytesEnd, BytesStart, Event};
+use crate::xmlpos::{Attr, get, is_ident, suggest};
+use crate::xmltree::{Elem, TreeFormat, Vocabulary, read_tree};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -56,127 +56,30 @@ pub struct ParsedRobot {
 
 /// Reads one catalog file, keeping the operator console and name positions.
 pub fn parse_catalog(file: FileId, text: &str, base_dir: Option<&Path>) -> ParsedCatalog {
-    let mut parser = Parser {
+    let (root, malformed) = read_tree(
+        text,
+        TreeFormat {
+            file,
+            xml_code: Code::CatalogXml,
+            empty_message: "this catalog file is empty: it needs a `<Catalog>` element",
+            raw_lt: None,
+        },
+    );
+    let mut reader = Reader {
         text,
         base_dir,
         sink: Sink::new(file),
-        out_robots: Vec::new(),
-        operator: None,
-        stack: Vec::new(),
         robot_names: HashMap::new(),
-        seen_root: false,
-        robot: None,
-        value: None,
-        service: None,
-        doc: None,
+        out: ParsedCatalog::default(),
     };
-    parser.run();
-    ParsedCatalog {
-        robots: parser.out_robots,
-        operator: parser.operator,
-        diagnostics: parser.sink.into_vec(),
+    if let Some(root) = &root {
+        reader.root(root);
     }
+    let mut out = reader.out;
+    out.diagnostics = reader.sink.into_vec();
+    out.diagnostics.extend(malformed);
+    out
 }
-
-/// The value types, for messages and did-you-mean.
-const TYPE_NAMES: &[&str] = &[
-    "int", "float", "bool", "string", "location", "image", "enum",
-];
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Kind {
-    Catalog,
-    Robot,
-    Operator,
-    Doc,
-    Platform,
-    Capability,
-    Value,
-    Service,
-    Param,
-    /// An element that was reported (or sits inside one): its content is skipped.
-    Skip,
-}
-
-impl Kind {
-    const KNOWN: &'static [Kind] = &[
-        Kind::Catalog,
-        Kind::Robot,
-        Kind::Operator,
-        Kind::Doc,
-        Kind::Platform,
-        Kind::Capability,
-        Kind::Value,
-        Kind::Service,
-        Kind::Param,
-    ];
-
-    fn tag(self) -> &'static str {
-        match self {
-            Kind::Catalog => "Catalog",
-            Kind::Robot => "Robot",
-            Kind::Operator => "Operator",
-            Kind::Doc => "Doc",
-            Kind::Platform => "Platform",
-            Kind::Capability => "Capability",
-            Kind::Value => "Value",
-            Kind::Service => "Service",
-            Kind::Param => "Param",
-            Kind::Skip => "?",
-        }
-    }
-
-    fn from_tag(name: &str) -> Option<Kind> {
-        Kind::KNOWN.iter().copied().find(|k| k.tag() == name)
-    }
-
-    /// The elements allowed directly inside this one.
-    fn children(self) -> &'static [Kind] {
-        match self {
-            Kind::Catalog => &[Kind::Robot, Kind::Operator],
-            Kind::Robot | Kind::Operator => &[
-                Kind::Doc,
-                Kind::Platform,
-                Kind::Capability,
-                Kind::Value,
-                Kind::Service,
-            ],
-            Kind::Value => &[Kind::Doc],
-            Kind::Service => &[Kind::Doc, Kind::Param],
-            _ => &[],
-        }
-    }
-
-    /// Where this element belongs, for "not allowed here" messages.
-    fn belongs(self) -> &'static str {
-        match self {
-            Kind::Catalog => "once, around the whole file",
-            Kind::Robot | Kind::Operator => "directly inside `<Catalog>`",
-            Kind::Doc => "inside `<Robot>`, `<Value>` or `<Service>`",
-            Kind::Param => "inside `<Service>`",
-            _ => "inside `<Robot>`",
-        }
-    }
-
-    fn attributes(self) -> &'static [&'static str] {
-        match self {
-            Kind::Robot | Kind::Operator => &["type", "aliases"],
-            Kind::Platform => &["os", "cpu", "cores", "clockMHz", "memoryKB", "note"],
-            Kind::Capability => &["name"],
-            Kind::Value => &[
-                "name", "type", "domain", "unit", "task", "graph", "doc", "aliases",
-            ],
-            Kind::Service => &["name", "task", "graph", "doc", "aliases"],
-            Kind::Param => &["name", "type", "optional", "domain"],
-            Kind::Catalog | Kind::Doc | Kind::Skip => &[],
-        }
-    }
-}
-
-/// Malformed XML: stop reading the file.
-struct Stop;
-
-type Flow = Result<(), Stop>;
 
 /// E053 with a pointer at the first definition.
 fn duplicate(sink: &mut Sink, span: Span, first: Span, message: impl Into<String>) {
@@ -204,14 +107,30 @@ fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
-struct Open {
-    qname: String,
-    kind: Kind,
-    tag: Span,
+/// Whether the markup between two pieces of a `<Doc>`'s text separates words:
+/// whitespace, or a character reference that the tree left out as blank
+/// (`&#32;`); comments and processing instructions do not.
+fn separates_words(mut gap: &str) -> bool {
+    loop {
+        let (open, close) = match (gap.find("<!--"), gap.find("<?")) {
+            (Some(c), Some(p)) if p < c => (p, "?>"),
+            (Some(c), _) => (c, "-->"),
+            (None, Some(p)) => (p, "?>"),
+            (None, None) => break,
+        };
+        if gap[..open].contains(|c: char| c.is_whitespace() || c == '&') {
+            return true;
+        }
+        match gap[open..].find(close) {
+            Some(end) => gap = &gap[open + end + close.len()..],
+            None => return false,
+        }
+    }
+    gap.contains(|c: char| c.is_whitespace() || c == '&')
 }
 
+/// A robot type being read, with the names used in it so far.
 struct RobotBuild {
-    operator: bool,
     /// False when the robot is left out (no type, duplicate type): its content is
     /// still checked.
     valid: bool,
@@ -224,6 +143,7 @@ struct RobotBuild {
     service_names: HashMap<String, Span>,
 }
 
+/// A value or service being read.
 struct ItemBuild<T> {
     /// `None` when the entry is left out (missing name, duplicate).
     def: Option<T>,
@@ -245,295 +165,425 @@ impl<T> ItemBuild<T> {
     }
 }
 
-struct DocBuild {
-    target: Kind,
-    text: String,
-}
-
-struct Parser<'t, 'p> {
+struct Reader<'t, 'p> {
     text: &'t str,
     base_dir: Option<&'p Path>,
     sink: Sink,
-    out_robots: Vec<ParsedRobot>,
-    operator: Option<ParsedRobot>,
-    stack: Vec<Open>,
     /// Robot type names and aliases of this file, to where they are first written.
     robot_names: HashMap<String, Span>,
-    seen_root: bool,
-    robot: Option<RobotBuild>,
-    value: Option<ItemBuild<ValueDef>>,
-    service: Option<ItemBuild<ServiceDef>>,
-    doc: Option<DocBuild>,
+    out: ParsedCatalog,
 }
 
-impl Parser<'_, '_> {
-    fn run(&mut self) {
-        let mut reader = xmlpos::reader(self.text);
-        let decoder = reader.decoder();
-        loop {
-            let event = reader.read_event();
-            let end = (reader.buffer_position() as usize).min(self.text.len());
-            let flow = match event {
-                Err(err) => {
-                    let pos = (reader.error_position() as usize).min(self.text.len());
-                    self.xml_error(&err, pos);
-                    Err(Stop)
-                }
-                Ok(Event::Eof) => {
-                    self.eof();
-                    break;
-                }
-                Ok(Event::Start(e)) => self.start(&e, end, false, decoder),
-                Ok(Event::Empty(e)) => self.start(&e, end, true, decoder),
-                Ok(Event::End(e)) => self.end(&e, end),
-                Ok(Event::Text(t)) => {
-                    let span = self.slice_span(&t).unwrap_or(Span::new(end, end));
-                    match t.decode() {
-                        Ok(s) => self.text_content(&s, span),
-                        Err(_) => self.malformed(span, "this text is not valid UTF-8"),
-                    }
-                }
-                Ok(Event::CData(t)) => {
-                    let span = self.slice_span(&t).unwrap_or(Span::new(end, end));
-                    match t.decode() {
-                        Ok(s) => self.text_content(&s, span),
-                        Err(_) => self.malformed(span, "this text is not valid UTF-8"),
-                    }
-                }
-                Ok(Event::GeneralRef(r)) => {
-                    let (span, resolved) = resolve_reference(self.text, &r, end);
-                    match resolved {
-                        Ok(s) => self.text_content(&s, span),
-                        Err(message) => self.malformed(span, message),
-                    }
-                }
-                Ok(Event::Comment(_) | Event::Decl(_) | Event::PI(_) | Event::DocType(_)) => Ok(()),
-            };
-            if flow.is_err() {
-                break;
-            }
+impl Reader<'_, '_> {
+    // --- the walk ------------------------------------------------------------
+
+    fn vocabulary(&self) -> Vocabulary<'static> {
+        Vocabulary {
+            file: self.sink.file(),
+            unknown_attribute: Code::CatalogUnknownAttribute,
+            unknown_element: Code::CatalogUnknownElement,
+            elements: &schema::PLACES,
         }
     }
 
-    /// The byte range of `slice` if it borrows from the text.
-    fn slice_span(&self, slice: &[u8]) -> Option<Span> {
-        xmlpos::slice_span(self.text, slice)
-    }
-
-    /// A short range at `pos` for an error position: the word starting there.
-    fn word_at(&self, pos: usize) -> Span {
-        xmlpos::word_at(self.text, pos)
-    }
-
-    /// E050: reports malformed XML; reading stops.
-    fn malformed(&mut self, span: Span, message: impl Into<String>) -> Flow {
-        Err(self.fail(span, message))
-    }
-
-    fn fail(&mut self, span: Span, message: impl Into<String>) -> Stop {
-        self.sink.report(Code::CatalogXml, span, message);
-        Stop
-    }
-
-    fn xml_error(&mut self, err: &quick_xml::Error, pos: usize) {
-        let span = self.word_at(pos);
-        self.sink
-            .report(Code::CatalogXml, span, xml_error_message(err));
-    }
-
-    fn eof(&mut self) {
-        if let Some(open) = self.stack.last() {
-            let (tag, message) = (open.tag, xmlpos::never_closed(&open.qname));
-            self.sink.report(Code::CatalogXml, tag, message);
-        } else if !self.seen_root {
-            let end = self.text.len();
-            self.sink.report(
-                Code::CatalogXml,
-                Span::new(end, end),
-                "this catalog file is empty: it needs a `<Catalog>` element",
+    fn root(&mut self, e: &Elem) {
+        if e.local != "Catalog" {
+            let message = format!(
+                "a catalog file must start with `<Catalog>`, not `<{}>`",
+                e.qname
             );
-        }
-    }
-
-    fn text_content(&mut self, s: &str, span: Span) -> Flow {
-        let top = self.stack.last().map(|o| o.kind);
-        if top == Some(Kind::Doc) {
-            if let Some(doc) = self.doc.as_mut() {
-                doc.text.push_str(s);
-            }
-            return Ok(());
-        }
-        if s.trim().is_empty() {
-            return Ok(());
-        }
-        let span = trim_span(s, span);
-        match top {
-            None => self.malformed(
-                span,
-                "text outside the `<Catalog>` element: only comments may go there",
-            ),
-            Some(Kind::Skip) => Ok(()),
-            Some(kind) => {
-                self.sink.report(
-                    Code::CatalogUnknownElement,
-                    span,
-                    format!(
-                        "text is not allowed inside `<{}>`: put descriptions in a `<Doc>` element",
-                        kind.tag()
-                    ),
-                );
-                Ok(())
-            }
-        }
-    }
-
-    fn attributes(
-        &mut self,
-        e: &BytesStart<'_>,
-        tag: Span,
-        decoder: Decoder,
-    ) -> Result<Vec<Attr>, Stop> {
-        read_attributes(self.text, e, tag, decoder)
-            .map_err(|(span, message)| self.fail(span, message))
-    }
-
-    /// W050 for attributes that `kind` does not have.
-    fn check_attributes(&mut self, kind: Kind, attrs: &[Attr]) {
-        let allowed = kind.attributes();
-        for a in attrs {
-            // Namespace declarations and prefixed attributes (xsi:...) are allowed.
-            if is_namespace_attribute(&a.key) || allowed.contains(&a.key.as_str()) {
-                continue;
-            }
             self.sink
-                .report(
-                    Code::CatalogUnknownAttribute,
-                    a.key_span,
-                    format!(
-                        "`<{}>` has no attribute `{}`; it is ignored",
-                        kind.tag(),
-                        a.key
-                    ),
-                )
-                .suggest(suggest(&a.key, allowed));
+                .report(Code::CatalogUnknownElement, e.name_span, message);
+            return;
+        }
+        self.check_attributes(e);
+        self.content(e, |r, robot| r.robot(robot));
+    }
+
+    /// Reads the content of `e` in document order: each child the schema
+    /// allows there is read by `read`; text and the other children are
+    /// reported (E051) and their content skipped.
+    fn content<'e>(&mut self, e: &'e Elem, mut read: impl FnMut(&mut Self, &'e Elem)) {
+        let allowed = schema::element(&e.local).map_or(&[][..], |info| info.children);
+        let vocabulary = self.vocabulary();
+        let mut texts = e.texts.iter().peekable();
+        for child in &e.children {
+            while let Some(&text) = texts.next_if(|t| t.start < child.tag.start) {
+                self.stray_text(e, text);
+            }
+            if allowed.contains(&child.local.as_str()) {
+                read(self, child);
+            } else {
+                vocabulary.misplaced(&mut self.sink, e, child, allowed);
+            }
+        }
+        for &text in texts {
+            self.stray_text(e, text);
         }
     }
 
-    fn start(&mut self, e: &BytesStart<'_>, tag_end: usize, empty: bool, decoder: Decoder) -> Flow {
-        let StartTag {
-            qname,
-            local,
-            name_span,
-            tag,
-        } = match xmlpos::start_tag(self.text, e, tag_end) {
-            Ok(start) => start,
-            Err((span, message)) => return self.malformed(span, message),
+    fn stray_text(&mut self, e: &Elem, text: Span) {
+        if e.local == "Doc" {
+            return;
+        }
+        let message = format!(
+            "text is not allowed inside `<{}>`: put descriptions in a `<Doc>` element",
+            e.local
+        );
+        self.sink.report(Code::CatalogUnknownElement, text, message);
+    }
+
+    /// W050 for attributes that the element does not have.
+    fn check_attributes(&mut self, e: &Elem) {
+        let allowed = schema::element(&e.local).map_or(&[][..], |info| info.attributes);
+        let vocabulary = self.vocabulary();
+        vocabulary.check_attributes(&mut self.sink, e, allowed, |_| None);
+    }
+
+    /// An element without content of its own: its attributes are checked by
+    /// the caller, text and children are reported.
+    fn leaf(&mut self, e: &Elem) {
+        self.content(e, |_, _| {});
+    }
+
+    fn origin(&self, e: &Elem) -> Origin {
+        Origin {
+            file: self.sink.file(),
+            span: e.tag,
+        }
+    }
+
+    fn robot(&mut self, e: &Elem) {
+        self.check_attributes(e);
+        let operator = e.local == "Operator";
+        let mut build = RobotBuild {
+            valid: false,
+            robot: RobotType {
+                name: String::new(),
+                aliases: Vec::new(),
+                doc: String::new(),
+                platform: Platform::default(),
+                capabilities: Vec::new(),
+                values: Vec::new(),
+                services: Vec::new(),
+                origin: self.origin(e),
+            },
+            names: Vec::new(),
+            doc_at: None,
+            platform_at: None,
+            capabilities: HashMap::new(),
+            value_names: HashMap::new(),
+            service_names: HashMap::new(),
         };
-        let attrs = self.attributes(e, tag, decoder)?;
-        let parent = self.stack.last().map(|o| o.kind);
-        let kind = match parent {
-            None => {
-                if self.seen_root {
-                    return self.malformed(
-                        name_span,
-                        format!(
-                            "`<{qname}>` comes after the end of `<Catalog>`: a catalog file has a single `<Catalog>` element"
-                        ),
+        if let Some((name, span)) = self.name_attr(e, "type") {
+            if operator && name != "USER" {
+                self.sink.report(
+                    Code::CatalogBadAttribute,
+                    span,
+                    format!("the operator console is always called `USER`, not `{name}`"),
+                );
+            } else if let Some(&first) = self.robot_names.get(&name) {
+                duplicate(
+                    &mut self.sink,
+                    span,
+                    first,
+                    format!("robot type `{name}` is defined twice in this file"),
+                );
+            } else {
+                self.robot_names.insert(name.clone(), span);
+                build.names.push((name.clone(), span));
+                build.robot.name = name;
+                build.valid = true;
+            }
+        }
+        let aliases = self.aliases(e);
+        if build.valid {
+            for (alias, span) in aliases {
+                if let Some(&first) = self.robot_names.get(&alias) {
+                    duplicate(
+                        &mut self.sink,
+                        span,
+                        first,
+                        format!("`{alias}` is already the name of a robot type in this file"),
                     );
+                    continue;
                 }
-                self.seen_root = true;
-                if local == "Catalog" {
-                    Kind::Catalog
-                } else {
-                    self.sink.report(
-                        Code::CatalogUnknownElement,
-                        name_span,
-                        format!("a catalog file must start with `<Catalog>`, not `<{qname}>`"),
-                    );
-                    Kind::Skip
+                self.robot_names.insert(alias.clone(), span);
+                build.names.push((alias.clone(), span));
+                build.robot.aliases.push(alias);
+            }
+        }
+        let target = if operator { "Operator" } else { "Robot" };
+        self.content(e, |r, c| match c.local.as_str() {
+            "Doc" => r.doc(c, target, &mut build.doc_at, &mut build.robot.doc),
+            "Platform" => r.platform(c, &mut build),
+            "Capability" => r.capability(c, &mut build),
+            "Value" => r.value(c, &mut build),
+            "Service" => r.service(c, &mut build),
+            // The schema allows nothing else inside a robot.
+            _ => {}
+        });
+        // A robot cut short by malformed XML is left out.
+        if !build.valid || !e.complete {
+            return;
+        }
+        let parsed = ParsedRobot {
+            robot: build.robot,
+            names: build.names,
+        };
+        if operator {
+            self.out.operator = Some(parsed);
+        } else {
+            self.out.robots.push(parsed);
+        }
+    }
+
+    /// A `<Doc>` of `target`: its text, unless the target is already documented.
+    fn doc(&mut self, e: &Elem, target: &str, doc_at: &mut Option<Span>, doc: &mut String) {
+        self.check_attributes(e);
+        match *doc_at {
+            Some(first) => duplicate(
+                &mut self.sink,
+                e.tag,
+                first,
+                format!("this `<{target}>` is already documented"),
+            ),
+            None => {
+                *doc_at = Some(e.tag);
+                *doc = self.doc_text(e);
+            }
+        }
+        self.leaf(e);
+    }
+
+    /// The text of a `<Doc>` on one line, with its references and CDATA
+    /// sections read (the tree keeps the positions of the non-blank pieces).
+    fn doc_text(&self, e: &Elem) -> String {
+        let mut text = String::new();
+        let mut previous_end = None;
+        for &piece in &e.texts {
+            if let Some(end) = previous_end {
+                // The markup between the pieces, without the (reported) elements in it.
+                let mut from = end;
+                let mut gap = String::new();
+                for child in e
+                    .children
+                    .iter()
+                    .filter(|c| end <= c.span.start && c.span.end <= piece.start)
+                {
+                    gap.push_str(&self.text[from..child.span.start]);
+                    from = child.span.end;
+                }
+                gap.push_str(&self.text[from..piece.start]);
+                if separates_words(&gap) {
+                    text.push(' ');
                 }
             }
-            Some(Kind::Skip) => Kind::Skip,
-            Some(parent) => match Kind::from_tag(&local) {
-                Some(k) if parent.children().contains(&k) => k,
-                Some(k) => {
-                    self.sink.report(
-                        Code::CatalogUnknownElement,
-                        name_span,
-                        format!(
-                            "`<{}>` is not allowed inside `<{}>`: it goes {}",
-                            k.tag(),
-                            parent.tag(),
-                            k.belongs()
-                        ),
-                    );
-                    Kind::Skip
+            let raw = &self.text[piece.range()];
+            let in_cdata = self.text[..piece.start].trim_end().ends_with("<![CDATA[");
+            match quick_xml::escape::unescape(raw) {
+                Ok(resolved) if !in_cdata => text.push_str(&resolved),
+                _ => text.push_str(raw),
+            }
+            previous_end = Some(piece.end);
+        }
+        one_line(&text)
+    }
+
+    fn platform(&mut self, e: &Elem, robot: &mut RobotBuild) {
+        self.check_attributes(e);
+        if let Some(first) = robot.platform_at {
+            duplicate(
+                &mut self.sink,
+                e.tag,
+                first,
+                "this robot already has a `<Platform>`",
+            );
+        } else {
+            robot.platform_at = Some(e.tag);
+            let text = |key: &str| {
+                get(&e.attrs, key)
+                    .map(|a| one_line(&a.value))
+                    .unwrap_or_default()
+            };
+            let mut number = |key: &str, example: &str| -> Option<u64> {
+                let a = get(&e.attrs, key)?;
+                match a.trimmed().parse::<u64>() {
+                    Ok(n) if n <= u64::from(u32::MAX) || key == "memoryKB" => Some(n),
+                    _ => {
+                        self.sink.report(
+                            Code::CatalogBadAttribute,
+                            a.span,
+                            format!("`{key}` must be a whole number, like {key}=\"{example}\""),
+                        );
+                        None
+                    }
                 }
-                None => {
-                    let candidates: Vec<&str> = parent.children().iter().map(|k| k.tag()).collect();
-                    let message = if parent.children().is_empty() {
-                        format!(
-                            "unknown element `<{qname}>`: `<{}>` cannot contain elements",
-                            parent.tag()
-                        )
-                    } else {
-                        format!("unknown element `<{qname}>` inside `<{}>`", parent.tag())
-                    };
-                    self.sink
-                        .report(Code::CatalogUnknownElement, name_span, message)
-                        .suggest(suggest(&local, &candidates));
-                    Kind::Skip
+            };
+            robot.robot.platform = Platform {
+                cores: number("cores", "4").map(|n| n as u32),
+                clock_mhz: number("clockMHz", "900").map(|n| n as u32),
+                memory_kb: number("memoryKB", "1048576"),
+                os: text("os"),
+                cpu: text("cpu"),
+                note: text("note"),
+            };
+        }
+        self.leaf(e);
+    }
+
+    fn capability(&mut self, e: &Elem, robot: &mut RobotBuild) {
+        self.check_attributes(e);
+        if let Some((name, span)) = self.name_attr(e, "name") {
+            if let Some(&first) = robot.capabilities.get(&name) {
+                duplicate(
+                    &mut self.sink,
+                    span,
+                    first,
+                    format!("capability `{name}` is listed twice for this robot"),
+                );
+            } else {
+                robot.capabilities.insert(name.clone(), span);
+                robot.robot.capabilities.push(name);
+            }
+        }
+        self.leaf(e);
+    }
+
+    fn value(&mut self, e: &Elem, robot: &mut RobotBuild) {
+        self.check_attributes(e);
+        let name = self.name_attr(e, "name");
+        let ty = self.required(e, "type").map(|t| self.value_type(t, e));
+        let implementation = self.implementation(e);
+        let aliases = self.aliases(e);
+        let (doc, doc_at) = doc_attr(e);
+        let unit = get(&e.attrs, "unit")
+            .map(|u| u.trimmed().to_string())
+            .filter(|u| !u.is_empty());
+        let def = match (name, ty) {
+            (Some(name), Some(ty)) => self
+                .register_item(&mut robot.value_names, "value", &name, aliases)
+                .map(|aliases| ValueDef {
+                    name: name.0,
+                    aliases,
+                    ty,
+                    unit,
+                    doc,
+                    implementation,
+                    origin: self.origin(e),
+                }),
+            _ => None,
+        };
+        let mut item = ItemBuild::new(def, doc_at);
+        self.content(e, |r, c| r.item_doc(c, "Value", &mut item));
+        if let Some(def) = item.def {
+            robot.robot.values.push(def);
+        }
+    }
+
+    fn service(&mut self, e: &Elem, robot: &mut RobotBuild) {
+        self.check_attributes(e);
+        let name = self.name_attr(e, "name");
+        let implementation = self.implementation(e);
+        let aliases = self.aliases(e);
+        let (doc, doc_at) = doc_attr(e);
+        let def = name.and_then(|name| {
+            self.register_item(&mut robot.service_names, "service", &name, aliases)
+                .map(|aliases| ServiceDef {
+                    name: name.0,
+                    aliases,
+                    params: Vec::new(),
+                    doc,
+                    implementation,
+                    origin: self.origin(e),
+                })
+        });
+        let mut item = ItemBuild::new(def, doc_at);
+        self.content(e, |r, c| match c.local.as_str() {
+            "Param" => r.param(c, &mut item),
+            _ => r.item_doc(c, "Service", &mut item),
+        });
+        if let Some(def) = item.def {
+            robot.robot.services.push(def);
+        }
+    }
+
+    /// The `<Doc>` of a value or service (kept only when the entry is).
+    fn item_doc<T: Documented>(&mut self, e: &Elem, target: &str, item: &mut ItemBuild<T>) {
+        let mut left_out = String::new();
+        let doc = item.def.as_mut().map_or(&mut left_out, T::doc_mut);
+        self.doc(e, target, &mut item.doc_at, doc);
+    }
+
+    fn param(&mut self, e: &Elem, service: &mut ItemBuild<ServiceDef>) {
+        self.check_attributes(e);
+        let name = self.name_attr(e, "name");
+        let ty = self.required(e, "type").map(|t| self.value_type(t, e));
+        let optional = match get(&e.attrs, "optional") {
+            None => false,
+            Some(a) => match a.trimmed() {
+                "true" => true,
+                "false" => false,
+                other => {
+                    self.sink.report(
+                        Code::CatalogBadAttribute,
+                        a.span,
+                        format!("`optional` must be true or false, not `{other}`"),
+                    );
+                    false
                 }
             },
         };
-        if kind != Kind::Skip {
-            self.check_attributes(kind, &attrs);
+        if let (Some((name, span)), Some(ty)) = (name, ty) {
+            self.add_param(service, name, span, ty, optional);
         }
-        self.open(kind, parent, tag, &attrs);
-        if empty {
-            self.finish(kind);
-        } else {
-            self.stack.push(Open {
-                qname: qname.into(),
-                kind,
-                tag,
-            });
-        }
-        Ok(())
+        self.leaf(e);
     }
 
-    fn end(&mut self, e: &BytesEnd<'_>, tag_end: usize) -> Flow {
-        let (span, name) = xmlpos::end_tag(self.text, e, tag_end);
-        match self.stack.pop() {
-            None => self.malformed(span, xmlpos::unopened_close(&name)),
-            Some(open) if open.qname != name => {
-                let (message, opened) = xmlpos::mismatched_close(&name, &open.qname);
-                self.sink
-                    .report(Code::CatalogXml, span, message)
-                    .relate(open.tag, opened);
-                Err(Stop)
-            }
-            Some(open) => {
-                self.finish(open.kind);
-                Ok(())
-            }
+    fn add_param(
+        &mut self,
+        service: &mut ItemBuild<ServiceDef>,
+        name: String,
+        span: Span,
+        ty: ValueType,
+        optional: bool,
+    ) {
+        if let Some(&first) = service.param_names.get(&name) {
+            duplicate(
+                &mut self.sink,
+                span,
+                first,
+                format!("this service already has a parameter `{name}`"),
+            );
+            return;
+        }
+        service.param_names.insert(name.clone(), span);
+        if optional {
+            service.optional_seen = true;
+        } else if service.optional_seen {
+            self.sink.report(
+                Code::CatalogBadAttribute,
+                span,
+                format!(
+                    "parameter `{name}` is required but comes after an optional one: put required parameters first"
+                ),
+            );
+        }
+        if let Some(def) = service.def.as_mut() {
+            def.params.push(ParamDef { name, ty, optional });
         }
     }
+
+    // --- attributes ----------------------------------------------------------
 
     /// Required attribute: E052 when missing, E056 when empty.
-    fn required<'a>(
-        &mut self,
-        attrs: &'a [Attr],
-        key: &str,
-        kind: Kind,
-        tag: Span,
-    ) -> Option<&'a Attr> {
-        match get(attrs, key) {
+    fn required<'e>(&mut self, e: &'e Elem, key: &str) -> Option<&'e Attr> {
+        match get(&e.attrs, key) {
             None => {
                 self.sink.report(
                     Code::CatalogMissingAttribute,
-                    tag,
-                    format!("this `<{}>` needs a `{key}` attribute", kind.tag()),
+                    e.tag,
+                    format!("this `<{}>` needs a `{key}` attribute", e.local),
                 );
                 None
             }
@@ -564,23 +614,16 @@ impl Parser<'_, '_> {
         false
     }
 
-    /// The value's name from a required attribute, checked.
-    fn name_attr(
-        &mut self,
-        attrs: &[Attr],
-        key: &str,
-        kind: Kind,
-        tag: Span,
-    ) -> Option<(String, Span)> {
-        let a = self.required(attrs, key, kind, tag)?;
+    /// The name from a required attribute, checked.
+    fn name_attr(&mut self, e: &Elem, key: &str) -> Option<(String, Span)> {
+        let a = self.required(e, key)?;
         let name = a.trimmed().to_string();
-        let span = a.span;
-        self.check_name(&name, span).then_some((name, span))
+        self.check_name(&name, a.span).then_some((name, a.span))
     }
 
     /// The aliases of a robot, value or service, checked as names.
-    fn aliases(&mut self, attrs: &[Attr]) -> Vec<(String, Span)> {
-        let Some(a) = get(attrs, "aliases") else {
+    fn aliases(&mut self, e: &Elem) -> Vec<(String, Span)> {
+        let Some(a) = get(&e.attrs, "aliases") else {
             return Vec::new();
         };
         a.words()
@@ -589,11 +632,47 @@ impl Parser<'_, '_> {
             .collect()
     }
 
+    /// E053 for a value or service name (or alias) already used in this robot.
+    /// Returns the aliases that are free.
+    fn register_item(
+        &mut self,
+        names: &mut HashMap<String, Span>,
+        what: &str,
+        name: &(String, Span),
+        aliases: Vec<(String, Span)>,
+    ) -> Option<Vec<String>> {
+        if let Some(&first) = names.get(&name.0) {
+            duplicate(
+                &mut self.sink,
+                name.1,
+                first,
+                format!("this robot already has a {what} `{}`", name.0),
+            );
+            return None;
+        }
+        names.insert(name.0.clone(), name.1);
+        let mut kept = Vec::new();
+        for (alias, span) in aliases {
+            if let Some(&first) = names.get(&alias) {
+                duplicate(
+                    &mut self.sink,
+                    span,
+                    first,
+                    format!("this robot already has a {what} `{alias}`"),
+                );
+                continue;
+            }
+            names.insert(alias.clone(), span);
+            kept.push(alias);
+        }
+        Some(kept)
+    }
+
     /// The type of a value or parameter (`type=` and `domain=`). Falls back to
     /// `string` after an error so that missions using it are not flooded.
-    fn value_type(&mut self, ty: &Attr, attrs: &[Attr]) -> ValueType {
+    fn value_type(&mut self, ty: &Attr, e: &Elem) -> ValueType {
         let name = ty.trimmed();
-        let domain = get(attrs, "domain");
+        let domain = get(&e.attrs, "domain");
         if name == "enum" {
             let words = domain.map(Attr::words).unwrap_or_default();
             if words.is_empty() {
@@ -611,11 +690,11 @@ impl Parser<'_, '_> {
                 if !self.check_name(w, *span) {
                     continue;
                 }
-                if let Some(first) = seen.get(w.as_str()) {
+                if let Some(&first) = seen.get(w.as_str()) {
                     duplicate(
                         &mut self.sink,
                         *span,
-                        *first,
+                        first,
                         format!("`{w}` is listed twice in the domain"),
                     );
                     continue;
@@ -642,9 +721,9 @@ impl Parser<'_, '_> {
     }
 
     /// `task=` or `graph=`.
-    fn implementation(&mut self, attrs: &[Attr]) -> Implementation {
-        let task = get(attrs, "task");
-        let graph = get(attrs, "graph");
+    fn implementation(&mut self, e: &Elem) -> Implementation {
+        let task = get(&e.attrs, "task");
+        let graph = get(&e.attrs, "graph");
         if let (Some(_), Some(g)) = (task, graph) {
             self.sink.report(
                 Code::CatalogBadAttribute,
@@ -680,393 +759,30 @@ impl Parser<'_, '_> {
         }
         Implementation::Unspecified
     }
+}
 
-    fn doc_attr(attrs: &[Attr]) -> (String, Option<Span>) {
-        match get(attrs, "doc") {
-            Some(a) => (one_line(&a.value), Some(a.span)),
-            None => (String::new(), None),
-        }
+/// `doc=` of a value or service, and where it is written.
+fn doc_attr(e: &Elem) -> (String, Option<Span>) {
+    match get(&e.attrs, "doc") {
+        Some(a) => (one_line(&a.value), Some(a.span)),
+        None => (String::new(), None),
     }
+}
 
-    fn open(&mut self, kind: Kind, parent: Option<Kind>, tag: Span, attrs: &[Attr]) {
-        let origin = Origin {
-            file: self.sink.file(),
-            span: tag,
-        };
-        match kind {
-            Kind::Catalog | Kind::Skip => {}
-            Kind::Robot | Kind::Operator => self.open_robot(kind, tag, origin, attrs),
-            Kind::Doc => self.open_doc(parent.unwrap_or(Kind::Skip), tag),
-            Kind::Platform => self.open_platform(tag, attrs),
-            Kind::Capability => {
-                let Some((name, span)) = self.name_attr(attrs, "name", kind, tag) else {
-                    return;
-                };
-                let Some(robot) = self.robot.as_mut() else {
-                    return;
-                };
-                if let Some(first) = robot.capabilities.get(&name) {
-                    let first = *first;
-                    duplicate(
-                        &mut self.sink,
-                        span,
-                        first,
-                        format!("capability `{name}` is listed twice for this robot"),
-                    );
-                } else {
-                    robot.capabilities.insert(name.clone(), span);
-                    robot.robot.capabilities.push(name);
-                }
-            }
-            Kind::Value => self.open_value(tag, origin, attrs),
-            Kind::Service => self.open_service(tag, origin, attrs),
-            Kind::Param => self.open_param(tag, attrs),
-        }
+/// A catalog entry with a doc text.
+trait Documented {
+    fn doc_mut(&mut self) -> &mut String;
+}
+
+impl Documented for ValueDef {
+    fn doc_mut(&mut self) -> &mut String {
+        &mut self.doc
     }
+}
 
-    fn open_robot(&mut self, kind: Kind, tag: Span, origin: Origin, attrs: &[Attr]) {
-        let mut build = RobotBuild {
-            operator: kind == Kind::Operator,
-            valid: false,
-            robot: RobotType {
-                name: String::new(),
-                aliases: Vec::new(),
-                doc: String::new(),
-                platform: Platform::default(),
-                capabilities: Vec::new(),
-                values: Vec::new(),
-                services: Vec::new(),
-                origin,
-            },
-            names: Vec::new(),
-            doc_at: None,
-            platform_at: None,
-            capabilities: HashMap::new(),
-            value_names: HashMap::new(),
-            service_names: HashMap::new(),
-        };
-        if let Some((name, span)) = self.name_attr(attrs, "type", kind, tag) {
-            if kind == Kind::Operator && name != "USER" {
-                self.sink.report(
-                    Code::CatalogBadAttribute,
-                    span,
-                    format!("the operator console is always called `USER`, not `{name}`"),
-                );
-            } else if let Some(first) = self.robot_names.get(&name) {
-                let first = *first;
-                duplicate(
-                    &mut self.sink,
-                    span,
-                    first,
-                    format!("robot type `{name}` is defined twice in this file"),
-                );
-            } else {
-                self.robot_names.insert(name.clone(), span);
-                build.names.push((name.clone(), span));
-                build.robot.name = name;
-                build.valid = true;
-            }
-        }
-        let aliases = self.aliases(attrs);
-        if build.valid {
-            for (alias, span) in aliases {
-                if let Some(first) = self.robot_names.get(&alias) {
-                    let first = *first;
-                    duplicate(
-                        &mut self.sink,
-                        span,
-                        first,
-                        format!("`{alias}` is already the name of a robot type in this file"),
-                    );
-                    continue;
-                }
-                self.robot_names.insert(alias.clone(), span);
-                build.names.push((alias.clone(), span));
-                build.robot.aliases.push(alias);
-            }
-        }
-        self.robot = Some(build);
-    }
-
-    fn open_doc(&mut self, target: Kind, tag: Span) {
-        let first = match target {
-            Kind::Robot | Kind::Operator => self.robot.as_mut().map(|r| &mut r.doc_at),
-            Kind::Value => self.value.as_mut().map(|v| &mut v.doc_at),
-            Kind::Service => self.service.as_mut().map(|s| &mut s.doc_at),
-            _ => None,
-        };
-        let Some(slot) = first else {
-            return;
-        };
-        match *slot {
-            Some(first) => {
-                duplicate(
-                    &mut self.sink,
-                    tag,
-                    first,
-                    format!("this `<{}>` is already documented", target.tag()),
-                );
-                self.doc = None;
-            }
-            None => {
-                *slot = Some(tag);
-                self.doc = Some(DocBuild {
-                    target,
-                    text: String::new(),
-                });
-            }
-        }
-    }
-
-    fn open_platform(&mut self, tag: Span, attrs: &[Attr]) {
-        let Some(robot) = self.robot.as_mut() else {
-            return;
-        };
-        if let Some(first) = robot.platform_at {
-            duplicate(
-                &mut self.sink,
-                tag,
-                first,
-                "this robot already has a `<Platform>`",
-            );
-            return;
-        }
-        robot.platform_at = Some(tag);
-        let mut platform = Platform::default();
-        let text = |key: &str| {
-            get(attrs, key)
-                .map(|a| one_line(&a.value))
-                .unwrap_or_default()
-        };
-        platform.os = text("os");
-        platform.cpu = text("cpu");
-        platform.note = text("note");
-        let mut number = |key: &str, example: &str| -> Option<u64> {
-            let a = get(attrs, key)?;
-            match a.trimmed().parse::<u64>() {
-                Ok(n) if n <= u64::from(u32::MAX) || key == "memoryKB" => Some(n),
-                _ => {
-                    self.sink.report(
-                        Code::CatalogBadAttribute,
-                        a.span,
-                        format!("`{key}` must be a whole number, like {key}=\"{example}\""),
-                    );
-                    None
-                }
-            }
-        };
-        platform.cores = number("cores", "4").map(|n| n as u32);
-        platform.clock_mhz = number("clockMHz", "900").map(|n| n as u32);
-        platform.memory_kb = number("memoryKB", "1048576");
-        if let Some(robot) = self.robot.as_mut() {
-            robot.robot.platform = platform;
-        }
-    }
-
-    /// E053 for a value or service name (or alias) already used in this robot.
-    /// Returns the aliases that are free.
-    fn register_item(
-        &mut self,
-        service: bool,
-        name: &(String, Span),
-        aliases: Vec<(String, Span)>,
-    ) -> Option<Vec<String>> {
-        let what = if service { "service" } else { "value" };
-        let robot = self.robot.as_mut()?;
-        let names = if service {
-            &mut robot.service_names
-        } else {
-            &mut robot.value_names
-        };
-        if let Some(first) = names.get(&name.0) {
-            let first = *first;
-            duplicate(
-                &mut self.sink,
-                name.1,
-                first,
-                format!("this robot already has a {what} `{}`", name.0),
-            );
-            return None;
-        }
-        names.insert(name.0.clone(), name.1);
-        let mut kept = Vec::new();
-        for (alias, span) in aliases {
-            if let Some(first) = names.get(&alias) {
-                let first = *first;
-                duplicate(
-                    &mut self.sink,
-                    span,
-                    first,
-                    format!("this robot already has a {what} `{alias}`"),
-                );
-                continue;
-            }
-            names.insert(alias.clone(), span);
-            kept.push(alias);
-        }
-        Some(kept)
-    }
-
-    fn open_value(&mut self, tag: Span, origin: Origin, attrs: &[Attr]) {
-        let name = self.name_attr(attrs, "name", Kind::Value, tag);
-        let ty = self
-            .required(attrs, "type", Kind::Value, tag)
-            .map(|t| self.value_type(t, attrs));
-        let implementation = self.implementation(attrs);
-        let aliases = self.aliases(attrs);
-        let (doc, doc_at) = Self::doc_attr(attrs);
-        let unit = get(attrs, "unit")
-            .map(|u| u.trimmed().to_string())
-            .filter(|u| !u.is_empty());
-        let def = match (name, ty) {
-            (Some(name), Some(ty)) => {
-                self.register_item(false, &name, aliases)
-                    .map(|aliases| ValueDef {
-                        name: name.0,
-                        aliases,
-                        ty,
-                        unit,
-                        doc,
-                        implementation,
-                        origin,
-                    })
-            }
-            _ => None,
-        };
-        self.value = Some(ItemBuild::new(def, doc_at));
-    }
-
-    fn open_service(&mut self, tag: Span, origin: Origin, attrs: &[Attr]) {
-        let name = self.name_attr(attrs, "name", Kind::Service, tag);
-        let implementation = self.implementation(attrs);
-        let aliases = self.aliases(attrs);
-        let (doc, doc_at) = Self::doc_attr(attrs);
-        let def = name.and_then(|name| {
-            self.register_item(true, &name, aliases)
-                .map(|aliases| ServiceDef {
-                    name: name.0,
-                    aliases,
-                    params: Vec::new(),
-                    doc,
-                    implementation,
-                    origin,
-                })
-        });
-        self.service = Some(ItemBuild::new(def, doc_at));
-    }
-
-    fn open_param(&mut self, tag: Span, attrs: &[Attr]) {
-        let name = self.name_attr(attrs, "name", Kind::Param, tag);
-        let ty = self
-            .required(attrs, "type", Kind::Param, tag)
-            .map(|t| self.value_type(t, attrs));
-        let optional = match get(attrs, "optional") {
-            None => false,
-            Some(a) => match a.trimmed() {
-                "true" => true,
-                "false" => false,
-                other => {
-                    self.sink.report(
-                        Code::CatalogBadAttribute,
-                        a.span,
-                        format!("`optional` must be true or false, not `{other}`"),
-                    );
-                    false
-                }
-            },
-        };
-        let (Some((name, span)), Some(ty)) = (name, ty) else {
-            return;
-        };
-        let Some(service) = self.service.as_mut() else {
-            return;
-        };
-        if let Some(first) = service.param_names.get(&name) {
-            let first = *first;
-            duplicate(
-                &mut self.sink,
-                span,
-                first,
-                format!("this service already has a parameter `{name}`"),
-            );
-            return;
-        }
-        service.param_names.insert(name.clone(), span);
-        if optional {
-            service.optional_seen = true;
-        } else if service.optional_seen {
-            self.sink.report(
-                Code::CatalogBadAttribute,
-                span,
-                format!(
-                    "parameter `{name}` is required but comes after an optional one: put required parameters first"
-                ),
-            );
-        }
-        if let Some(def) = service.def.as_mut() {
-            def.params.push(ParamDef { name, ty, optional });
-        }
-    }
-
-    fn finish(&mut self, kind: Kind) {
-        match kind {
-            Kind::Doc => {
-                let Some(doc) = self.doc.take() else {
-                    return;
-                };
-                let text = one_line(&doc.text);
-                match doc.target {
-                    Kind::Robot | Kind::Operator => {
-                        if let Some(r) = self.robot.as_mut() {
-                            r.robot.doc = text;
-                        }
-                    }
-                    Kind::Value => {
-                        if let Some(def) = self.value.as_mut().and_then(|v| v.def.as_mut()) {
-                            def.doc = text;
-                        }
-                    }
-                    Kind::Service => {
-                        if let Some(def) = self.service.as_mut().and_then(|s| s.def.as_mut()) {
-                            def.doc = text;
-                        }
-                    }
-                    _ => {}
-                }
-            }
-            Kind::Value => {
-                if let (Some(def), Some(robot)) =
-                    (self.value.take().and_then(|v| v.def), self.robot.as_mut())
-                {
-                    robot.robot.values.push(def);
-                }
-            }
-            Kind::Service => {
-                if let (Some(def), Some(robot)) =
-                    (self.service.take().and_then(|s| s.def), self.robot.as_mut())
-                {
-                    robot.robot.services.push(def);
-                }
-            }
-            Kind::Robot | Kind::Operator => {
-                let Some(build) = self.robot.take() else {
-                    return;
-                };
-                if !build.valid {
-                    return;
-                }
-                let parsed = ParsedRobot {
-                    robot: build.robot,
-                    names: build.names,
-                };
-                if build.operator {
-                    self.operator = Some(parsed);
-                } else {
-                    self.out_robots.push(parsed);
-                }
-            }
-            Kind::Catalog | Kind::Platform | Kind::Capability | Kind::Param | Kind::Skip => {}
-        }
+impl Documented for ServiceDef {
+    fn doc_mut(&mut self) -> &mut String {
+        &mut self.doc
     }
 }
 

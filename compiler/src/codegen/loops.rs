@@ -16,6 +16,17 @@
 //! port is `(sum of the tokens read + k + 1) mod 1000`; for `linux` its body
 //! is the user's (the service task file is created once).
 //!
+//! A task standing for a sub-graph file fires as one iteration of the
+//! sub-graph's schedule: its inputs' tokens move to the channels joining
+//! the sub-graph's open ports of the same names before it, its outputs'
+//! back after it (`graph_move`); the sub-graph's tasks are inner tasks like
+//! the others (`graph_fire`, their path below the task: `Track/Predict`).
+//!
+//! Port arrays (a firing's tokens, a loop's staged tokens) are static:
+//! each is no larger than the channel it fills or drains ([`check`]), and
+//! refinement bounds the channels' tokens (`MAX_GRAPH_TOKENS`), so the
+//! service task's stack does not grow with the graph's rates.
+//!
 //! D-type loops repeat their body exactly `loop_count` times; C-type loops
 //! repeat it until their exit task sets the exit flag (checked after each
 //! iteration, so the exit task's iteration completes), at most `loop_count`
@@ -28,7 +39,7 @@
 //! (`semo_sim_loop_exit`).
 
 use super::c;
-use crate::refine::{GraphService, GraphStep, InnerTask, LoopPort, PortUse};
+use crate::refine::{GraphService, GraphStep, InnerTask, LoopPort, PortUse, SubgraphPort};
 use std::fmt::Write;
 
 /// Characters of a `graph_fire` trace's `read` or `wrote` field, at most
@@ -48,7 +59,7 @@ pub(super) fn graph_runner(service: &GraphService, simulated: bool) -> String {
     let Ok(steps_of) = &service.steps else {
         return out;
     };
-    let mut exits: Vec<(&str, &str)> = Vec::new();
+    let mut exits: Vec<(usize, &str)> = Vec::new();
     collect_exits(steps_of, &mut exits);
     let graph = c::string(&service.graph);
     let has_loops = has_loop_nodes(steps_of);
@@ -72,9 +83,16 @@ pub(super) fn graph_runner(service: &GraphService, simulated: bool) -> String {
         out.push_str("#include <string.h>\n");
     }
     out.push('\n');
-    channels(&mut out, service, &graph, any_port, keeps);
+    channels(
+        &mut out,
+        service,
+        &graph,
+        any_port,
+        keeps,
+        has_subgraphs(steps_of),
+    );
     for (index, task) in service.tasks.iter().enumerate() {
-        let exit_of = exits.iter().find(|(t, _)| *t == task.path).map(|(_, l)| *l);
+        let exit_of = exits.iter().find(|(t, _)| *t == index).map(|(_, l)| *l);
         inner_task(&mut out, service, index, task, exit_of, simulated, &graph);
     }
     if has_loops {
@@ -95,7 +113,14 @@ pub(super) fn graph_runner(service: &GraphService, simulated: bool) -> String {
 
 /// The channel rings and the helpers that move tokens (each written only
 /// when used: an unused static function fails -Werror).
-fn channels(out: &mut String, service: &GraphService, graph: &str, any_port: bool, keeps: bool) {
+fn channels(
+    out: &mut String,
+    service: &GraphService,
+    graph: &str,
+    any_port: bool,
+    keeps: bool,
+    moves: bool,
+) {
     if service.channels.is_empty() {
         return;
     }
@@ -135,6 +160,9 @@ fn channels(out: &mut String, service: &GraphService, graph: &str, any_port: boo
     );
     out.push_str("static void graph_take(graph_channel *c, semo_value *out, unsigned long n)\n{\n    for (unsigned long k = 0; k < n; k++) {\n        if (c->count == 0)\n            graph_broken(c, \"is empty\");\n        out[k] = c->token[c->head];\n        c->head = (c->head + 1) % c->capacity;\n        c->count--;\n    }\n}\n\n");
     out.push_str("static void graph_put(graph_channel *c, const semo_value *in, unsigned long n)\n{\n    for (unsigned long k = 0; k < n; k++) {\n        if (c->count == c->capacity)\n            graph_broken(c, \"is full\");\n        c->token[(c->head + c->count) % c->capacity] = in[k];\n        c->count++;\n    }\n}\n\n");
+    if moves {
+        out.push_str("/* Moves `n` tokens between a sub-graph task's channel and its sub-graph's. */\nstatic void graph_move(graph_channel *from, graph_channel *to, unsigned long n)\n{\n    for (unsigned long k = 0; k < n; k++) {\n        semo_value v;\n        graph_take(from, &v, 1);\n        graph_put(to, &v, 1);\n    }\n}\n\n");
+    }
     if any_port {
         let _ = writeln!(
             out,
@@ -276,8 +304,17 @@ fn inner_task(
             "void"
         }
     );
+    // Static, not on the stack: a port array is no larger than its
+    // channel, and refinement bounds the channels' tokens
+    // (`MAX_GRAPH_TOKENS`); the one service task runs its graph, never
+    // re-entered.
     for (p, input) in &ports {
-        let _ = writeln!(out, "    semo_value {}[{}];", param(p, *input), p.rate);
+        let _ = writeln!(
+            out,
+            "    static semo_value {}[{}];",
+            param(p, *input),
+            p.rate
+        );
     }
     let texts = [("read", &task.inputs), ("wrote", &task.outputs)];
     for (field, ports) in texts {
@@ -346,30 +383,113 @@ fn inner_task(
     out.push_str("}\n\n");
 }
 
+/// What generation relies on in a graph refinement opened: every step
+/// names a task it lists, every port array fits the channel it fills or
+/// drains (a failure is an internal error, E102).
+pub(super) fn check(service: &GraphService) -> Result<(), String> {
+    let Ok(steps_of) = &service.steps else {
+        return Ok(());
+    };
+    let capacity = |channel: usize| service.channels.get(channel).map(|c| c.capacity);
+    for task in &service.tasks {
+        for p in task.inputs.iter().chain(&task.outputs) {
+            if capacity(p.channel).is_none_or(|c| p.rate > c) {
+                return Err(format!(
+                    "port `{}.{}` takes {} tokens from channel {} that holds fewer",
+                    task.path, p.port, p.rate, p.channel
+                ));
+            }
+        }
+    }
+    fn walk(
+        steps: &[GraphStep],
+        tasks: usize,
+        capacity: &dyn Fn(usize) -> Option<u64>,
+    ) -> Result<(), String> {
+        for step in steps {
+            match step {
+                GraphStep::Fire { task, .. } if *task >= tasks => {
+                    return Err(format!("a firing names task {task} of {tasks}"));
+                }
+                GraphStep::Fire { .. } => {}
+                GraphStep::Repeat { body, .. } => walk(body, tasks, capacity)?,
+                GraphStep::Loop {
+                    path,
+                    exit_task,
+                    ports,
+                    body,
+                    ..
+                } => {
+                    if exit_task.is_some_and(|e| e >= tasks) {
+                        return Err(format!("loop `{path}` names exit task out of {tasks}"));
+                    }
+                    for p in ports {
+                        let fits = capacity(p.outer).is_some_and(|c| p.outer_rate <= c)
+                            && capacity(p.inner).is_some_and(|c| p.inner_rate <= c);
+                        if !fits {
+                            return Err(format!(
+                                "loop port `{path}.{}` overflows its channels",
+                                p.port
+                            ));
+                        }
+                    }
+                    walk(body, tasks, capacity)?;
+                }
+                GraphStep::Subgraph { path, ports, body } => {
+                    for p in ports {
+                        let fits = [p.outer, p.inner]
+                            .iter()
+                            .all(|&c| capacity(c).is_some_and(|c| p.rate <= c));
+                        if !fits {
+                            return Err(format!(
+                                "sub-graph port `{path}.{}` overflows its channels",
+                                p.port
+                            ));
+                        }
+                    }
+                    walk(body, tasks, capacity)?;
+                }
+            }
+        }
+        Ok(())
+    }
+    walk(steps_of, service.tasks.len(), &capacity)
+}
+
 fn has_loop_nodes(steps: &[GraphStep]) -> bool {
     steps.iter().any(|s| match s {
         GraphStep::Fire { .. } => false,
-        GraphStep::Repeat { body, .. } => has_loop_nodes(body),
+        GraphStep::Repeat { body, .. } | GraphStep::Subgraph { body, .. } => has_loop_nodes(body),
         GraphStep::Loop { .. } => true,
+    })
+}
+
+fn has_subgraphs(steps: &[GraphStep]) -> bool {
+    steps.iter().any(|s| match s {
+        GraphStep::Fire { .. } => false,
+        GraphStep::Repeat { body, .. } | GraphStep::Loop { body, .. } => has_subgraphs(body),
+        GraphStep::Subgraph { .. } => true,
     })
 }
 
 fn has_loop_outputs(steps: &[GraphStep]) -> bool {
     steps.iter().any(|s| match s {
         GraphStep::Fire { .. } => false,
-        GraphStep::Repeat { body, .. } => has_loop_outputs(body),
+        GraphStep::Repeat { body, .. } | GraphStep::Subgraph { body, .. } => has_loop_outputs(body),
         GraphStep::Loop { ports, body, .. } => {
             ports.iter().any(|p| !p.input) || has_loop_outputs(body)
         }
     })
 }
 
-/// The exit tasks of convergent loops, with their loop's path.
-fn collect_exits<'s>(steps: &'s [GraphStep], exits: &mut Vec<(&'s str, &'s str)>) {
+/// The exit tasks of convergent loops (their index), with their loop's path.
+fn collect_exits<'s>(steps: &'s [GraphStep], exits: &mut Vec<(usize, &'s str)>) {
     for step in steps {
         match step {
             GraphStep::Fire { .. } => {}
-            GraphStep::Repeat { body, .. } => collect_exits(body, exits),
+            GraphStep::Repeat { body, .. } | GraphStep::Subgraph { body, .. } => {
+                collect_exits(body, exits)
+            }
             GraphStep::Loop {
                 path,
                 exit_task,
@@ -378,7 +498,7 @@ fn collect_exits<'s>(steps: &'s [GraphStep], exits: &mut Vec<(&'s str, &'s str)>
                 ..
             } => {
                 if let (true, Some(exit)) = (*convergent, exit_task) {
-                    exits.push((exit, path));
+                    exits.push((*exit, path));
                 }
                 collect_exits(body, exits);
             }
@@ -386,13 +506,11 @@ fn collect_exits<'s>(steps: &'s [GraphStep], exits: &mut Vec<(&'s str, &'s str)>
     }
 }
 
-/// The C name of inner task `path`'s firing function.
-fn firing(service: &GraphService, path: &str) -> String {
-    let index = service
-        .tasks
-        .iter()
-        .position(|t| t.path == path)
-        .unwrap_or(usize::MAX); // refinement lists every task it fires
+/// The C name of inner task `index`'s firing function (refinement lists
+/// every task it fires: `target::check` refuses a graph that names another
+/// as an internal error before generation).
+fn firing(service: &GraphService, index: usize) -> String {
+    let path = service.tasks.get(index).map_or("", |t| t.path.as_str());
     format!("inner_{index}_{}", c::ident(path))
 }
 
@@ -404,15 +522,15 @@ fn steps(
     steps_of: &[GraphStep],
     indent: usize,
     depth: &mut usize,
-    exit: Option<(&str, usize)>,
+    exit: Option<(usize, usize)>,
 ) {
     let pad = "    ".repeat(indent);
     for step in steps_of {
         match step {
             GraphStep::Fire { task, count } => {
-                let function = firing(service, task);
+                let function = firing(service, *task);
                 let call = match exit {
-                    Some((exit_task, d)) if exit_task == task => {
+                    Some((exit_task, d)) if exit_task == *task => {
                         format!("if ({function}(n{d}))\n{pad}    exit_flag{d} = true;")
                     }
                     _ => format!("{function}();"),
@@ -455,7 +573,7 @@ fn steps(
                 let inner_exit = match (convergent, exit_task) {
                     (true, Some(e)) => {
                         let _ = writeln!(out, "{pad}    bool exit_flag{d} = false;");
-                        Some((e.as_str(), d))
+                        Some((*e, d))
                     }
                     _ => exit,
                 };
@@ -491,16 +609,41 @@ fn steps(
                 }
                 let _ = writeln!(out, "{pad}}}");
             }
+            GraphStep::Subgraph { path, ports, body } => {
+                let _ = writeln!(out, "{pad}{{ /* sub-graph `{}` */", c::comment(path));
+                subgraph_moves(out, &pad, ports, true);
+                self::steps(out, service, body, indent + 1, depth, exit);
+                subgraph_moves(out, &pad, ports, false);
+                let _ = writeln!(out, "{pad}}}");
+            }
         }
+    }
+}
+
+/// A sub-graph task's inputs' tokens moved in, or its outputs' out.
+fn subgraph_moves(out: &mut String, pad: &str, ports: &[SubgraphPort], input: bool) {
+    for p in ports.iter().filter(|p| p.input == input) {
+        let (from, to) = if input {
+            (p.outer, p.inner)
+        } else {
+            (p.inner, p.outer)
+        };
+        let _ = writeln!(
+            out,
+            "{pad}    graph_move(&channel[{from}], &channel[{to}], {}); /* {} */",
+            p.rate,
+            c::comment(&p.port)
+        );
     }
 }
 
 /// A loop node's start: its inputs' tokens taken, room for its outputs'.
 fn loop_start(out: &mut String, pad: &str, d: usize, ports: &[LoopPort]) {
     for (j, p) in ports.iter().enumerate() {
+        // Static as the firings' port arrays are (`inner_task`).
         let _ = writeln!(
             out,
-            "{pad}    semo_value loop{d}_port{j}[{}]; /* {} */",
+            "{pad}    static semo_value loop{d}_port{j}[{}]; /* {} */",
             p.outer_rate,
             c::comment(&p.port)
         );

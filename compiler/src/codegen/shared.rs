@@ -12,7 +12,7 @@ use super::files::lock;
 use super::values::Words;
 use super::{Platform, Target};
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
-use crate::refine::{Ownership, RobotProgram, SharedLibrary, ValueKind};
+use crate::refine::{OwnerRule, Ownership, RobotProgram, SharedLibrary, ValueKind};
 use std::fmt::Write;
 
 /// The C prefix of the library's functions.
@@ -177,9 +177,26 @@ fn owner_protocol(
     let hb = program.control.heartbeat_ms;
     let _ = writeln!(
         out,
-        "/* Tells the owner `to` of a write of global value `k`, or the team when\n * this robot owns it. */\nstatic void tell(size_t k, size_t to, const semo_value *v)\n{{\n    const semo_program_desc *p = semo_program();\n    if (to == p->self)\n        semo_comm_send(p->team, SEMO_MSG_SEND, told_key[k], v);\n    else\n        semo_comm_send(p->peers[to].robot, SEMO_MSG_SEND, set_key[k], v);\n}}\n\n/* The owner now: the owner stays while it lives (this robot, or heard from\n * within three heartbeats); a lost one is followed by the first live robot\n * of `owners`. A change is traced; a robot that becomes the owner tells the\n * team the values it last saw. */\nstatic size_t current_owner(void)\n{{\n    const semo_program_desc *p = semo_program();\n    int64_t now = semo_now_ms();\n    {lock}\n    size_t was = owner;\n    if (was != p->self && now - comm_heard(was).seen > 3 * {hb}) {{\n        for (size_t k = 0; k < sizeof owners / sizeof owners[0]; k++) {{\n            size_t c = owners[k];\n            if (c == p->self || now - comm_heard(c).seen <= 3 * {hb}) {{\n                owner = c;\n                break;\n            }}\n        }}\n    }}\n    size_t now_owner = owner;\n    {unlock}\n    if (now_owner == was)\n        return was;\n    semo_trace(\"shared_owner\", \"library\", {name}, \"owner\", p->peers[now_owner].robot, \"lost\", p->peers[was].robot, NULL);\n    if (now_owner == p->self)\n        for (size_t k = 0; k < sizeof global_at / sizeof global_at[0]; k++) {{\n            {lock}\n            semo_value v = value[global_at[k]];\n            {unlock}\n            if (v.type != SEMO_NONE)\n                tell(k, now_owner, &v);\n        }}\n    return now_owner;\n}}\n",
+        "/* Tells the owner `to` of a write of global value `k`, or the team when\n * this robot owns it. */\nstatic void tell(size_t k, size_t to, const semo_value *v)\n{{\n    const semo_program_desc *p = semo_program();\n    if (to == p->self)\n        semo_comm_send(p->team, SEMO_MSG_SEND, told_key[k], v);\n    else\n        semo_comm_send(p->peers[to].robot, SEMO_MSG_SEND, set_key[k], v);\n}}\n\n/* The owner now: the owner stays while it lives (this robot, or heard from\n * within three heartbeats); a lost one is followed by the first live robot\n * of `owners`. A change is traced; a robot that becomes the owner tells the\n * team the values it last saw. */\nstatic size_t current_owner(void)\n{{\n    const semo_program_desc *p = semo_program();\n    int64_t now = semo_now_ms();\n    {lock}\n    size_t was = owner;\n    if (was != p->self && now - comm_heard(was).seen > 3 * {hb}) {{\n{follow}    }}\n    size_t now_owner = owner;\n    {unlock}\n    if (now_owner == was)\n        return was;\n    semo_trace(\"shared_owner\", \"library\", {name}, \"owner\", p->peers[now_owner].robot, \"lost\", p->peers[was].robot, NULL);\n    if (now_owner == p->self)\n        for (size_t k = 0; k < sizeof global_at / sizeof global_at[0]; k++) {{\n            {lock}\n            semo_value v = value[global_at[k]];\n            {unlock}\n            if (v.type != SEMO_NONE)\n                tell(k, now_owner, &v);\n        }}\n    return now_owner;\n}}\n",
         name = c::string(&lib.name),
+        follow = follower(ownership.rule, hb),
     );
+}
+
+/// The loop of `current_owner` choosing who follows a lost owner among the
+/// live robots of `owners` (this robot, or heard from within three
+/// heartbeats): the first, or by the team's `highest_battery` leader
+/// selection the one whose heartbeat said the highest level (the first of
+/// equals; unknown counts lowest; this robot's own level in simulation).
+fn follower(rule: OwnerRule, hb: i64) -> String {
+    if !rule.by_battery() {
+        return format!(
+            "        for (size_t k = 0; k < sizeof owners / sizeof owners[0]; k++) {{\n            size_t c = owners[k];\n            if (c == p->self || now - comm_heard(c).seen <= 3 * {hb}) {{\n                owner = c;\n                break;\n            }}\n        }}\n"
+        );
+    }
+    format!(
+        "        bool found = false;\n        long best = -1;\n        for (size_t k = 0; k < sizeof owners / sizeof owners[0]; k++) {{\n            size_t c = owners[k];\n            comm_heartbeat h = comm_heard(c);\n            if (c != p->self && now - h.seen > 3 * {hb})\n                continue;\n            long level = h.battery;\n            if (c == p->self) {{\n                level = -1;\n#ifdef SEMO_SIM\n                long long own;\n                if (semo_sim_battery(&own))\n                    level = (long)own;\n#endif\n            }}\n            if (!found || level > best) {{\n                owner = c;\n                best = level;\n                found = true;\n            }}\n        }}\n"
+    )
 }
 
 /// `<prefix>_heard`: a write sent to this robot (taken when it owns the

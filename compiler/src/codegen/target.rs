@@ -43,13 +43,19 @@ pub fn check(
     // warnings say why on the call).
     for program in programs {
         for graph in &program.graph_services {
-            if let Err(why) = &graph.steps {
+            if let Err(why) = super::loops::check(graph) {
                 found.push(Diagnostic::new(
-                    Code::CodegenUnsupported,
+                    Code::CodegenInternal,
                     build.mission,
                     graph.call,
-                    format!("code generation does not support {why} yet"),
+                    format!("task graph `{}`: {why}", graph.graph),
                 ));
+            }
+            if let Err(refused) = &graph.steps {
+                let mut d =
+                    Diagnostic::new(refused.code, build.mission, graph.call, &refused.message);
+                d.related.extend(refused.related.iter().cloned());
+                found.push(d);
             }
         }
     }

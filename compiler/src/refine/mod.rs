@@ -49,6 +49,9 @@ pub struct ServiceGraph {
     pub catalog: FileId,
     pub path: String,
     pub graph: std::sync::Arc<crate::taskgraph::TaskGraph>,
+    /// The sub-graph files its tasks reference, resolved as the workspace
+    /// resolved them (their problems are the graph file's diagnostics).
+    pub hierarchy: std::sync::Arc<crate::taskgraph::subgraph::Hierarchy>,
 }
 
 /// Which robots [`refine_robots`] refines.
@@ -118,7 +121,11 @@ pub fn refine_robots(
             diagnostics.extend(found);
             programs.extend(program);
         }
-        robot::shared::owners_of_team(&mut programs, &team.name);
+        diagnostics.extend(robot::shared::owners_of_team(
+            &mut programs,
+            &team.name,
+            input.strategies,
+        ));
         if let Some((first, others)) = names_no_task.split_first() {
             diagnostics.extend(
                 first

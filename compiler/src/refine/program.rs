@@ -64,13 +64,25 @@ pub struct GraphService {
     pub call: Span,
     /// One iteration of the top level, or why the graph has none (it is
     /// inconsistent or deadlocks, which the dataflow warnings report on the
-    /// call; code generation refuses it, E100).
-    pub steps: Result<Vec<GraphStep>, String>,
+    /// call, or a sub-graph it references cannot be used); code generation
+    /// refuses it with the refusal's code on the call.
+    pub steps: Result<Vec<GraphStep>, GraphRefused>,
     /// Every channel of every level (empty without steps), the index a
     /// [`PortUse`] or [`LoopPort`] names.
     pub channels: Vec<GraphChannel>,
     /// The inner tasks fired (loop nodes are steps), in first-firing order.
     pub tasks: Vec<InnerTask>,
+}
+
+/// Why a service graph cannot run: a diagnostic for its call.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GraphRefused {
+    /// `E100` (no schedule, a construct not supported) or `E135` (a
+    /// sub-graph reference that cannot be followed).
+    pub code: crate::diag::Code,
+    pub message: String,
+    /// Where in the graph files the reason lies.
+    pub related: Vec<crate::diag::Related>,
 }
 
 /// A channel between inner tasks: a bounded FIFO of tokens. `capacity` is
@@ -90,7 +102,8 @@ pub struct GraphChannel {
 /// order its ports are declared (a port no channel joins is left out).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct InnerTask {
-    /// Its path below the graph, as in [`GraphStep::Fire`].
+    /// Its path below the graph (`Converge/Assign/Nearest`; a sub-graph's
+    /// task below the task standing for it: `Track/Predict`).
     pub path: String,
     pub inputs: Vec<PortUse>,
     pub outputs: Vec<PortUse>,
@@ -124,23 +137,46 @@ pub struct LoopPort {
 /// A term of a service graph's looped schedule, loop nodes opened.
 #[derive(Clone, Debug, PartialEq)]
 pub enum GraphStep {
-    /// `count` firings of an inner task; `task` is its path below the graph
-    /// (`Converge/Assign/Nearest`).
-    Fire { task: String, count: u64 },
+    /// `count` firings of inner task `task`, an index in
+    /// [`GraphService::tasks`].
+    Fire { task: usize, count: u64 },
     /// A loop of the schedule: `body` `count` times.
     Repeat { count: u64, body: Vec<GraphStep> },
     /// An SDF/L loop node (`path` as for tasks): its body's schedule,
     /// exactly `loop_count` times (D-type) or until its exit task sets the
-    /// exit flag, at most `loop_count` times (C-type, `exit_task` the path).
+    /// exit flag, at most `loop_count` times (C-type, `exit_task` its index
+    /// in [`GraphService::tasks`]).
     Loop {
         path: String,
         convergent: bool,
         loop_count: u64,
-        exit_task: Option<String>,
+        exit_task: Option<usize>,
         /// Its data ports, in declaration order.
         ports: Vec<LoopPort>,
         body: Vec<GraphStep>,
     },
+    /// A firing of a task standing for a sub-graph file (`subgraph=`, path
+    /// as for tasks): one iteration of the sub-graph's looped schedule,
+    /// `body`. Its inputs' tokens move to the sub-graph's side before it,
+    /// its outputs' back after it.
+    Subgraph {
+        path: String,
+        /// Its data ports that a channel joins outside, in declaration order.
+        ports: Vec<SubgraphPort>,
+        body: Vec<GraphStep>,
+    },
+}
+
+/// A data port of a task standing for a sub-graph: `rate` tokens per
+/// firing between the channel `outer` joining the task and the channel
+/// `inner` joining the sub-graph's open port of the same name.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SubgraphPort {
+    pub port: String,
+    pub input: bool,
+    pub rate: u64,
+    pub outer: usize,
+    pub inner: usize,
 }
 
 /// The control task's machine.
@@ -501,16 +537,44 @@ pub struct SharedLibrary {
 }
 
 /// The globally shared attributes of a team's library and the robots that
-/// own them in turn: the first live robot of `owners` holds them, the others
-/// set them through messages to it and read what it last told them.
+/// own them in turn: one robot of `owners` holds them, the others set them
+/// through messages to it and read what it last told them.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Ownership {
     /// The globally shared attributes.
     pub global: Vec<GlobalValue>,
-    /// Peer indices (into `RobotProgram::peers`) of the team's robots in the
-    /// order ownership passes when an owner is lost; the first is the owner
-    /// at start.
+    /// Peer indices (into `RobotProgram::peers`) of the team's robots that
+    /// may own them, in the order ownership passes when an owner is lost;
+    /// the first is the owner at start: the strategy's `<SharedOwner>` and
+    /// then the others in formation order, else the team's leader order
+    /// (`lowest_id`, `highest_battery`: formation order; `bully`: the
+    /// reverse).
     pub owners: Vec<usize>,
+    /// Who follows a lost owner.
+    pub rule: OwnerRule,
+}
+
+/// How the owner of a team's globally shared values is chosen.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OwnerRule {
+    /// The strategy's `<SharedOwner>` first, then the first live robot of
+    /// the owner order.
+    Named,
+    /// The team's leader by its leader selection (`LeaderSelectionInfo`
+    /// without a composite service, else `lowest_id`) over the robots that
+    /// hold the values: `lowest_id` and `bully` the first live robot of the
+    /// owner order (formation order, reversed for `bully`);
+    /// `highest_battery` the live one whose last heartbeat said the highest
+    /// battery level (the first of equals; unknown counts lowest), the first
+    /// of the order at start, when no level has been heard yet.
+    Leader(LeaderAlgorithm),
+}
+
+impl OwnerRule {
+    /// A lost owner is followed by the live robot with the highest battery.
+    pub fn by_battery(self) -> bool {
+        self == OwnerRule::Leader(LeaderAlgorithm::HighestBattery)
+    }
 }
 
 /// One globally shared attribute of a library.

@@ -58,6 +58,7 @@ pub(super) fn refine_robot(
     builder.machine.battery = builder.battery_policies();
     let graph_services = builder.graph_services();
     let self_peer = builder.first_peer() + robot_index;
+    let team_leader = builder.team_leader_algorithm();
     let Builder {
         mut machine,
         mut sensors,
@@ -67,7 +68,7 @@ pub(super) fn refine_robot(
     } = builder;
     separate_sensor_tasks(&mut machine, &mut sensors, &services);
     link_own_publications(&mut machine);
-    let library = shared::library(team, self_peer - robot_index, &mut machine);
+    let library = shared::library(team, self_peer - robot_index, team_leader, &mut machine);
     let mut tasks: Vec<TaskRole> = sensors
         .into_iter()
         .map(|(task, values)| TaskRole {
@@ -409,6 +410,17 @@ impl Builder<'_, '_> {
             ),
             None => (LeaderAlgorithm::LowestId, None),
         }
+    }
+
+    /// The team's leader selection algorithm: its `LeaderSelectionInfo`
+    /// that names no composite service, else `lowest_id` (who owns the
+    /// team's globally shared values, `shared::owners_of_team`).
+    fn team_leader_algorithm(&self) -> LeaderAlgorithm {
+        self.team_strategies()
+            .filter_map(|s| s.grouping.as_ref()?.leader_selection.as_ref())
+            .find(|l| l.plan.is_none() && l.service.is_none())
+            .and_then(|l| l.algorithm)
+            .unwrap_or(LeaderAlgorithm::LowestId)
     }
 
     fn block(

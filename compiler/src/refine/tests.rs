@@ -307,10 +307,8 @@ fn comparisons_carry_the_checkers_typing() {
 fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
     use crate::refine::GraphStep::{Fire, Loop};
     use crate::refine::LoopPort;
-    let fire = |task: &str| Fire {
-        task: task.to_string(),
-        count: 1,
-    };
+    use crate::taskgraph::subgraph::Hierarchy;
+    let fire = |task: usize| Fire { task, count: 1 };
     let load = |name: &str| {
         let text = shared(&format!("taskgraphs/{name}.taskgraph.xml"));
         crate::taskgraph::load_task_graph(FileId(9), &text)
@@ -319,7 +317,8 @@ fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
     };
     // `A 10(B C) D`: the D-type loop node is the `10(...)`, its ports
     // joining the channels outside (0, 1) to those of its body (2, 4).
-    let data_loop = robot::steps_of(&load("data_loop")).unwrap();
+    let none = Hierarchy::default();
+    let data_loop = robot::steps_of(&load("data_loop"), &none).unwrap();
     let port = |port: &str, input, distributing, outer, inner| LoopPort {
         port: port.into(),
         input,
@@ -332,7 +331,7 @@ fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
     assert_eq!(
         data_loop.steps,
         [
-            fire("A"),
+            fire(0),
             Loop {
                 path: "L".into(),
                 convergent: false,
@@ -342,9 +341,9 @@ fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
                     port("in", true, true, 0, 2),
                     port("out", false, false, 1, 4)
                 ],
-                body: vec![fire("L/B"), fire("L/C")],
+                body: vec![fire(1), fire(2)],
             },
-            fire("D"),
+            fire(3),
         ]
     );
     // Each channel bounded by the analysis for the order it runs in: ten
@@ -375,7 +374,9 @@ fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
         (&"i".to_string(), 2, &"o".to_string(), 3)
     );
     // k-means: a C-type loop (exit task ReplaceCenter) around a D-type one.
-    let kmeans = robot::steps_of(&load("kmeans")).unwrap().steps;
+    let kmeans = robot::steps_of(&load("kmeans"), &none).unwrap();
+    let paths: Vec<&str> = kmeans.tasks.iter().map(|t| t.path.as_str()).collect();
+    let kmeans = kmeans.steps;
     let Loop {
         convergent: true,
         loop_count: 500,
@@ -386,12 +387,12 @@ fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
     else {
         panic!("{kmeans:?}");
     };
-    assert_eq!(exit, "Converge/ReplaceCenter");
+    assert_eq!(paths[*exit], "Converge/ReplaceCenter");
     assert!(
         matches!(&body[1], Loop { path, loop_count: 16, convergent: false, .. } if path == "Converge/Assign")
     );
     // No schedule, no program: a deadlocked graph is refused.
-    assert!(robot::steps_of(&load("deadlock")).is_err());
+    assert!(robot::steps_of(&load("deadlock"), &none).is_err());
 }
 
 /// Slots carry the catalog's type of their value (a team variable has
@@ -409,4 +410,89 @@ fn slots_and_literals_are_typed_as_the_catalog_declares() {
     let states = format!("{:?}", m.services);
     assert!(states.contains("Literal(Real(2.5))"), "{states}");
     assert!(states.contains("Literal(Text(\"5,5\"))"), "{states}");
+}
+
+/// A task standing for a sub-graph file is one step running the
+/// sub-graph's level once: its ports join the channels outside to the
+/// sub-graph's boundary channels by port name, the sub-graph's tasks are
+/// inner tasks below it, and the steps name tasks by index.
+#[test]
+fn a_sub_graph_reference_opens_into_a_step_running_its_schedule_once() {
+    use crate::refine::GraphStep::{Fire, Subgraph};
+    use crate::refine::SubgraphPort;
+    use crate::taskgraph::subgraph::{SubgraphSource, resolve};
+    use std::path::Path;
+    let fixture = |name: &str| {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../tests/fixtures/loops/graphs")
+            .join(name);
+        std::fs::read_to_string(&path).unwrap()
+    };
+    let (track, diags) =
+        crate::taskgraph::load_task_graph(FileId(1), &fixture("track.taskgraph.xml"));
+    assert!(diags.is_empty(), "{diags:?}");
+    let track = track.unwrap();
+    let filter = fixture("filter.taskgraph.xml");
+    let mut files = |path: &Path| -> Result<SubgraphSource, String> {
+        match path == Path::new("/g/filter.taskgraph.xml") {
+            true => Ok(SubgraphSource {
+                file: FileId(2),
+                text: filter.as_str().into(),
+            }),
+            false => Err("absent".into()),
+        }
+    };
+    let hierarchy = resolve(
+        &track,
+        Some(Path::new("/g/track.taskgraph.xml")),
+        &mut files,
+    );
+    assert!(
+        hierarchy.diagnostics.is_empty(),
+        "{:?}",
+        hierarchy.diagnostics
+    );
+    let opened = robot::steps_of(&track, &hierarchy).unwrap();
+    let paths: Vec<&str> = opened.tasks.iter().map(|t| t.path.as_str()).collect();
+    assert_eq!(
+        paths,
+        ["Detect", "Filter/Predict", "Filter/Update", "Steer"]
+    );
+    let port = |port: &str, input, rate, outer, inner| SubgraphPort {
+        port: port.into(),
+        input,
+        rate,
+        outer,
+        inner,
+    };
+    assert_eq!(
+        opened.steps,
+        [
+            Fire { task: 0, count: 1 },
+            Subgraph {
+                path: "Filter".into(),
+                ports: vec![port("in", true, 2, 0, 3), port("out", false, 1, 1, 4)],
+                body: vec![Fire { task: 1, count: 2 }, Fire { task: 2, count: 1 }],
+            },
+            Fire { task: 3, count: 1 },
+        ]
+    );
+    let bounded: Vec<(&str, u64)> = opened
+        .channels
+        .iter()
+        .map(|c| (c.label.as_str(), c.capacity))
+        .collect();
+    assert_eq!(
+        bounded,
+        [
+            ("Detect.o → Filter.in", 2),
+            ("Filter.out → Steer.i", 1),
+            ("Filter: Predict.p → Update.i", 2),
+            ("Filter: Filter.in → Predict.in", 2),
+            ("Filter: Update.out → Filter.out", 1),
+        ]
+    );
+    // Predict reads the boundary channel of `in`, Update writes that of `out`.
+    assert_eq!(opened.tasks[1].inputs[0].channel, 3);
+    assert_eq!(opened.tasks[2].outputs[0].channel, 4);
 }

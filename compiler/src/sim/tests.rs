@@ -579,3 +579,111 @@ fn globally_shared_values_live_on_the_owner_and_move_when_it_is_lost() {
     assert!(b_takes.iter().any(|(_, f)| f == &["b", "c"]), "{b_takes:?}");
     assert_eq!(modes(&run_, "b"), ["FAR", "NEAR_MODE", "CLOSER"]);
 }
+
+/// `tests/fixtures/shared_named`: the strategy names `b` the owner
+/// (`<SharedOwner>`): `a`'s write goes to `b`, which tells the team; when `b`
+/// is killed the first live robot of the formation order, `a`, owns, and
+/// `c`'s write reaches it.
+#[test]
+fn the_owner_the_strategy_names_holds_the_values_until_it_is_lost() {
+    let programs = programs("tests/fixtures/shared_named/shared.mission");
+    let scenario =
+        std::fs::read_to_string(repo("tests/fixtures/shared_named/shared.scenario.json")).unwrap();
+    let (run_, _) = run(&programs, &scenario, 0);
+    let a_sets = events(&run_, "a", "shared_set", &["owner"]);
+    assert!(
+        a_sets.iter().any(|(t, f)| *t < 1500 && f == &["b"]),
+        "{a_sets:?}"
+    );
+    let b_takes = events(&run_, "b", "shared_set", &["owner", "from"]);
+    assert!(b_takes.iter().any(|(_, f)| f == &["b", "a"]), "{b_takes:?}");
+    for reader in ["a", "c"] {
+        let got = events(&run_, reader, "shared_value", &["from"]);
+        assert!(
+            got.iter().any(|(t, f)| *t < 1500 && f == &["b"]),
+            "{reader}: {got:?}"
+        );
+        let owners = events(&run_, reader, "shared_owner", &["owner", "lost"]);
+        assert_eq!(owners.len(), 1, "{reader}: {owners:?}");
+        assert_eq!(owners[0].1, ["a", "b"], "{reader}");
+    }
+    let c_sets = events(&run_, "c", "shared_set", &["owner"]);
+    assert!(
+        c_sets.iter().any(|(t, f)| *t >= 3000 && f == &["a"]),
+        "{c_sets:?}"
+    );
+    let a_takes = events(&run_, "a", "shared_set", &["owner", "from"]);
+    assert!(a_takes.iter().any(|(_, f)| f == &["a", "c"]), "{a_takes:?}");
+    assert_eq!(modes(&run_, "a"), ["FAR", "NEAR_MODE", "CLOSER"]);
+    assert_eq!(modes(&run_, "c"), ["FAR", "NEAR_MODE", "CLOSER"]);
+}
+
+/// `tests/fixtures/shared_bully`: no `<SharedOwner>`, the team elects by
+/// `bully`: its leader, the last robot `c`, owns; killed, the next leader
+/// `b` owns and its own write is read by `a`.
+#[test]
+fn without_a_named_owner_the_teams_leader_owns_and_failover_follows_the_leader() {
+    let programs = programs("tests/fixtures/shared_bully/shared.mission");
+    let ownership = programs[0]
+        .library
+        .as_ref()
+        .and_then(|l| l.ownership.as_ref())
+        .unwrap();
+    assert_eq!(
+        ownership.rule,
+        crate::refine::OwnerRule::Leader(crate::refine::LeaderAlgorithm::Bully)
+    );
+    let scenario =
+        std::fs::read_to_string(repo("tests/fixtures/shared_bully/shared.scenario.json")).unwrap();
+    let (run_, _) = run(&programs, &scenario, 0);
+    let a_sets = events(&run_, "a", "shared_set", &["owner"]);
+    assert!(
+        a_sets.iter().any(|(t, f)| *t < 1500 && f == &["c"]),
+        "{a_sets:?}"
+    );
+    for robot in ["a", "b"] {
+        let owners = events(&run_, robot, "shared_owner", &["owner", "lost"]);
+        assert_eq!(owners.len(), 1, "{robot}: {owners:?}");
+        assert_eq!(owners[0].1, ["b", "c"], "{robot}");
+    }
+    let b_sets = events(&run_, "b", "shared_set", &["owner"]);
+    assert!(
+        b_sets.iter().any(|(t, f)| *t >= 3000 && f == &["b"]),
+        "{b_sets:?}"
+    );
+    let got = events(&run_, "a", "shared_value", &["from"]);
+    assert!(
+        got.iter().any(|(t, f)| *t >= 3000 && f == &["b"]),
+        "{got:?}"
+    );
+    assert_eq!(modes(&run_, "a"), ["FAR", "NEAR_MODE", "CLOSER"]);
+}
+
+/// `tests/fixtures/shared_battery`: the team elects by `highest_battery`:
+/// `a` owns at start (no level heard yet); killed, `c` (70 %) follows it,
+/// not `b` (40 %, the next in formation order), and `b`'s write reaches it.
+#[test]
+fn a_lost_owner_is_followed_by_the_fullest_robot_when_the_team_elects_by_battery() {
+    let programs = programs("tests/fixtures/shared_battery/shared.mission");
+    let scenario =
+        std::fs::read_to_string(repo("tests/fixtures/shared_battery/shared.scenario.json"))
+            .unwrap();
+    let (run_, _) = run(&programs, &scenario, 0);
+    let a_sets = events(&run_, "a", "shared_set", &["owner"]);
+    assert!(
+        a_sets.iter().any(|(t, f)| *t < 1500 && f == &["a"]),
+        "{a_sets:?}"
+    );
+    for robot in ["b", "c"] {
+        let owners = events(&run_, robot, "shared_owner", &["owner", "lost"]);
+        assert_eq!(owners.len(), 1, "{robot}: {owners:?}");
+        assert_eq!(owners[0].1, ["c", "a"], "{robot}");
+        assert_eq!(
+            modes(&run_, robot),
+            ["FAR", "NEAR_MODE", "CLOSER"],
+            "{robot}"
+        );
+    }
+    let c_takes = events(&run_, "c", "shared_set", &["owner", "from"]);
+    assert!(c_takes.iter().any(|(_, f)| f == &["c", "b"]), "{c_takes:?}");
+}

@@ -769,6 +769,62 @@ impl Cross<'_> {
         for declared in group_services {
             self.group_service(file, summary, team_id, declared);
         }
+
+        // The owner of the shared values: the team's library, one of its robots.
+        let owner = strategy
+            .grouping
+            .as_ref()
+            .and_then(|g| g.shared_owner.as_ref());
+        if let Some(owner) = owner {
+            self.shared_owner(file, mission, team, owner);
+        }
+    }
+
+    /// E130 unless `owner` names the team's library task (`<Team>Shared`),
+    /// E131 unless it names a robot of the team.
+    fn shared_owner(&mut self, file: FileId, mission: &Mission, team: &Team, owner: &SharedOwner) {
+        let library = format!("{}Shared", team.name);
+        if let Some(named) = owner.library.as_ref().filter(|l| l.name != library) {
+            let message = format!(
+                "`{}` is not the library task of team {}: its shared information is in `{library}`",
+                named.name, team.name
+            );
+            let related = Self::team_related(mission, team);
+            self.report_unknown(
+                Code::SharedOwnerUnknownLibrary,
+                file,
+                named.span,
+                &named.name,
+                &[library.as_str()],
+                message,
+            )
+            .related
+            .push(related);
+        }
+        let Some(robot) = &owner.robot else {
+            return;
+        };
+        let robots: Vec<&str> = team.robots.iter().map(|r| r.name.as_str()).collect();
+        if robots.contains(&robot.name.as_str()) {
+            return;
+        }
+        let message = format!(
+            "team {} has no robot `{}` (its robots: {})",
+            team.name,
+            robot.name,
+            list(&robots, 12)
+        );
+        let related = Self::team_related(mission, team);
+        self.report_unknown(
+            Code::SharedOwnerUnknownRobot,
+            file,
+            robot.span,
+            &robot.name,
+            &robots,
+            message,
+        )
+        .related
+        .push(related);
     }
 
     /// E124 unless the team calls `declared`'s service (in its plan, if it

@@ -273,6 +273,21 @@ pub struct Grouping {
     pub sync_timeout: Option<Duration>,
     /// `<GroupService name="search"/>`s, in file order.
     pub group_services: Vec<GroupService>,
+    /// `<SharedOwner library="ScoutsShared" robot="b"/>`: the robot that
+    /// owns the library's globally shared values at start.
+    pub shared_owner: Option<SharedOwner>,
+    pub span: Span,
+}
+
+/// `<SharedOwner library="ScoutsShared" robot="b"/>`: robot `robot` of the
+/// team owns the globally shared values of its library task (`<Team>Shared`)
+/// at start; when it is lost, the next robot of the formation order that
+/// lives does (`docs/shared-information.md`). Without it the team's leader
+/// owns them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SharedOwner {
+    pub library: Option<Named>,
+    pub robot: Option<Named>,
     pub span: Span,
 }
 

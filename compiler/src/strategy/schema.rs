@@ -22,6 +22,7 @@ pub(crate) const CONDITION_ATTRS: &[&str] = &["cond"];
 pub(crate) const LEADER_ATTRS: &[&str] = &["algorithm", "heartbeatPeriod", "plan_name", "cs_name"];
 pub(crate) const SYNC_ATTRS: &[&str] = &["timeout"];
 pub(crate) const GROUP_SERVICE_ATTRS: &[&str] = &["name", "plan_name"];
+pub(crate) const SHARED_OWNER_ATTRS: &[&str] = &["library", "robot"];
 pub(crate) const SENSOR_ATTRS: &[&str] = &["name", "periodLevel"];
 pub(crate) const ACTUATOR_ATTRS: &[&str] = &["name", "speedLevel"];
 
@@ -170,6 +171,12 @@ pub const ELEMENTS: &[ElementInfo] = &[
         "A group service: the robots of the team that run it form the team's group; each live member learns its rank and the number of live members (`semo_group_rank()`, `semo_group_size()`), recomputed when a member fails or returns.",
     ),
     element(
+        "SharedOwner",
+        SHARED_OWNER_ATTRS,
+        &["library", "robot"],
+        "The robot that owns the library task's globally shared values at start (the next live robot in formation order when it is lost); without it the team's leader owns them.",
+    ),
+    element(
         "BatteryRequirement",
         &[],
         &[],
@@ -220,7 +227,12 @@ pub fn children(parent: Option<&str>, grandparent: Option<&str>) -> &'static [&'
         Some("CheckSensor" | "ExecuteActuator" | "ExecuteAlgorithm") => &["Parameter"],
         Some("TransitionInfo") => &["Transition"],
         Some("Transition") => &["Condition"],
-        Some("GroupingInfo") => &["LeaderSelectionInfo", "GroupSync", "GroupService"],
+        Some("GroupingInfo") => &[
+            "LeaderSelectionInfo",
+            "GroupSync",
+            "GroupService",
+            "SharedOwner",
+        ],
         Some("NonFunctionalInfo") => &["BatteryRequirement"],
         Some("BatteryRequirement") => &["Condition"],
         Some("Condition") if grandparent == Some("BatteryRequirement") => &["Sensor", "Actuator"],
@@ -293,6 +305,12 @@ pub fn attribute_doc(element: &str, attribute: &str) -> Option<&'static str> {
         }
         ("GroupService", "plan_name") => {
             "The plan whose calls of the service count; without it, calls in any plan."
+        }
+        ("SharedOwner", "library") => {
+            "The team's library task, `<Team>Shared` (e.g. `ScoutsShared`), whose globally shared values the robot owns."
+        }
+        ("SharedOwner", "robot") => {
+            "The robot of the team (its name in the mission, e.g. `b` or `tb_1`) that owns them at start."
         }
         ("Sensor", "name") => "The sensor whose period is lowered.",
         ("Sensor", "periodLevel") => {

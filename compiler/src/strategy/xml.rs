@@ -74,6 +74,7 @@ const ELEMENTS: &[(&str, &str)] = &[
     ("LeaderSelectionInfo", "inside `<GroupingInfo>`"),
     ("GroupSync", "inside `<GroupingInfo>`"),
     ("GroupService", "inside `<GroupingInfo>`"),
+    ("SharedOwner", "inside `<GroupingInfo>`"),
     ("BatteryRequirement", "inside `<NonFunctionalInfo>`"),
     (
         "Sensor",
@@ -636,9 +637,30 @@ impl Reader<'_> {
 
     fn grouping(&mut self, e: &Elem) -> Grouping {
         self.check_attributes(e, &[]);
-        let children = self.children(e, &["LeaderSelectionInfo", "GroupSync", "GroupService"]);
+        let children = self.children(
+            e,
+            &[
+                "LeaderSelectionInfo",
+                "GroupSync",
+                "GroupService",
+                "SharedOwner",
+            ],
+        );
         let leader = self.at_most_one(&children, "LeaderSelectionInfo");
         let sync = self.at_most_one(&children, "GroupSync");
+        let owner = self.at_most_one(&children, "SharedOwner");
+        let shared_owner = owner.map(|o| {
+            self.leaf(o, SHARED_OWNER_ATTRS);
+            let library = self.required(o, "library");
+            let library = self.ident(library);
+            let robot = self.required(o, "robot");
+            let robot = self.ident(robot);
+            SharedOwner {
+                library,
+                robot,
+                span: o.span,
+            }
+        });
         let leader_selection = leader.map(|l| {
             self.leaf(l, LEADER_ATTRS);
             let algorithm = self
@@ -691,6 +713,7 @@ impl Reader<'_> {
             leader_selection,
             sync_timeout,
             group_services,
+            shared_owner,
             span: e.span,
         }
     }

@@ -231,6 +231,18 @@ fn doc_entities_and_cdata() {
 }
 
 #[test]
+fn doc_text_is_read_as_written_around_comments_and_stray_elements() {
+    // Comments join words; whitespace and a blank reference separate them; an
+    // element inside `<Doc>` is reported and its place joins words.
+    let text =
+        "<Catalog><Robot type=\"A\"><Doc>a<!-- c -->b &#32;c<X>no</X>d</Doc></Robot></Catalog>";
+    let parsed = parse(text);
+    assert_eq!(codes(text), ["E051"]);
+    assert_eq!(&text[parsed.diagnostics[0].span.range()], "X");
+    assert_eq!(parsed.robots[0].robot.doc, "ab cd");
+}
+
+#[test]
 fn unknown_element() {
     let text = wrap("<Valeu name=\"X\" type=\"int\"/>");
     let (d, at) = only(&text);

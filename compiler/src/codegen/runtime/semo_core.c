@@ -787,8 +787,64 @@ bool semo__inbox_waiting(void)
  * transport for ever. */
 #define INBOX_UNPOLLED_WAIT_MS 1000
 
+/* ---------------------------------------------------------- task control */
+
+typedef enum { CONTROL_RUN, CONTROL_CALL, CONTROL_STOP, CONTROL_SUSPEND, CONTROL_RESUME } control_op;
+
+/* The one switch of task control, over the platform's record of the task. */
+static int control(const char *name, control_op op)
+{
+    semo__task_control *c = semo__control_begin(name);
+    if (!c)
+        return -1;
+    switch (op) {
+    case CONTROL_RUN:
+        c->repeat = true;
+        c->stop_requested = false;
+        if (c->state == SEMO_TASK_IDLE)
+            c->state = SEMO_TASK_RUNNING;
+        break;
+    case CONTROL_CALL:
+        if (c->state == SEMO_TASK_IDLE || !c->repeat) {
+            c->repeat = false;
+            c->calls++;
+            c->stop_requested = false;
+            if (c->state == SEMO_TASK_IDLE)
+                c->state = SEMO_TASK_RUNNING;
+        }
+        break;
+    case CONTROL_STOP:
+        if (c->state != SEMO_TASK_IDLE)
+            c->stop_requested = true;
+        break;
+    case CONTROL_SUSPEND:
+        if (c->state == SEMO_TASK_RUNNING)
+            c->state = SEMO_TASK_SUSPENDED;
+        break;
+    case CONTROL_RESUME:
+        if (c->state == SEMO_TASK_SUSPENDED)
+            c->state = SEMO_TASK_RUNNING;
+        break;
+    }
+    semo__control_end(c);
+    return 0;
+}
+
+int UFControl_RunTask(const char *task) { return control(task, CONTROL_RUN); }
+int UFControl_CallTask(const char *task) { return control(task, CONTROL_CALL); }
+int UFControl_StopTask(const char *task) { return control(task, CONTROL_STOP); }
+int UFControl_SuspendTask(const char *task) { return control(task, CONTROL_SUSPEND); }
+int UFControl_ResumeTask(const char *task) { return control(task, CONTROL_RESUME); }
+
+/* -------------------------------------------------------------- messages */
+
 void semo__deliver(const semo_message *msg)
 {
+    /* A robot whose mission has finished (or that is stopping) takes no
+     * more messages, as the simulator's stopped robot hears none: what
+     * arrives after the control task's `finish` is not queued. */
+    if (!semo_running())
+        return;
     semo__queue_lock(SEMO__INBOX);
     /* A full inbox holds back the deliverer, and through it the transport
      * (MQTT: the broker keeps the rest of a burst, such as what it queued
@@ -818,7 +874,8 @@ int semo_comm_poll(semo_message *out, int64_t timeout_ms)
     while (g_inbox_state.count == 0 && semo_running() && (deadline < 0 || semo_now_ms() < deadline) &&
            semo__queue_wait(SEMO__INBOX, deadline))
         ;
-    bool got = ring_take(&g_inbox_ring, out);
+    /* Once finished, what is still queued is not taken either. */
+    bool got = semo_running() && ring_take(&g_inbox_ring, out);
     semo__queue_unlock(SEMO__INBOX);
     if (got)
         semo__queue_written(SEMO__INBOX); /* room for a held-back delivery */

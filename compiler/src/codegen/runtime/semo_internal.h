@@ -79,6 +79,23 @@ size_t semo__encode_message(const semo_message *m, unsigned char *out);
 /* False for anything else (the message is then unspecified). */
 bool semo__decode_message(const unsigned char *in, size_t len, semo_message *m);
 
+/* Task control (UFControl_RunTask, CallTask, StopTask, SuspendTask,
+ * ResumeTask) is the core's: one switch over the part of a task's record it
+ * changes, which every platform's task record holds. */
+typedef struct {
+    semo_task_state state;
+    bool repeat;    /* RunTask; otherwise `calls` firings are owed */
+    unsigned calls;
+    bool stop_requested;
+} semo__task_control;
+/* Platform: task `name`'s control record with whatever guards it held
+ * (POSIX: the task's lock); NULL for an unknown task. */
+semo__task_control *semo__control_begin(const char *name);
+/* Platform: after the core changed the record: the task that controls it
+ * noted, the task woken (its own semo_next_firing hint is void), the guard
+ * released. */
+void semo__control_end(semo__task_control *control);
+
 /* Queues a message as if it had arrived over the transport. */
 void semo__deliver(const semo_message *msg);
 /* Empties the inbox (start-up, shut-down). */

@@ -307,10 +307,7 @@ typedef struct task_s {
     bool started;
     pthread_mutex_t lock;
     pthread_cond_t changed; /* any field below changed */
-    semo_task_state state;
-    bool repeat;         /* RunTask; otherwise `calls` firings are owed */
-    unsigned calls;
-    bool stop_requested;
+    semo__task_control control; /* changed by UFControl_* (the core's switch) */
     param *params;
     /* semo_next_firing: a time-driven task that said when its next firing
      * is needed sleeps until then, or until `woken` by what it may wait
@@ -391,10 +388,10 @@ static void *task_thread(void *arg)
     g_current = t;
     pthread_mutex_lock(&t->lock);
     while (semo_running()) {
-        if (t->stop_requested && t->state != SEMO_TASK_IDLE) {
-            t->state = SEMO_TASK_IDLE;
-            t->stop_requested = false;
-            t->calls = 0;
+        if (t->control.stop_requested && t->control.state != SEMO_TASK_IDLE) {
+            t->control.state = SEMO_TASK_IDLE;
+            t->control.stop_requested = false;
+            t->control.calls = 0;
             pthread_cond_broadcast(&t->changed);
             task *controller = t->controller;
             pthread_mutex_unlock(&t->lock);
@@ -402,7 +399,7 @@ static void *task_thread(void *arg)
             pthread_mutex_lock(&t->lock);
             continue;
         }
-        if (t->state != SEMO_TASK_RUNNING) {
+        if (t->control.state != SEMO_TASK_RUNNING) {
             pthread_cond_wait(&t->changed, &t->lock);
             continue;
         }
@@ -425,9 +422,9 @@ static void *task_thread(void *arg)
         if (d->go)
             d->go();
         pthread_mutex_lock(&t->lock);
-        bool went_idle = !t->repeat && t->calls > 0 && --t->calls == 0;
+        bool went_idle = !t->control.repeat && t->control.calls > 0 && --t->control.calls == 0;
         if (went_idle)
-            t->state = SEMO_TASK_IDLE;
+            t->control.state = SEMO_TASK_IDLE;
         pthread_cond_broadcast(&t->changed);
         if (went_idle) {
             task *controller = t->controller;
@@ -440,56 +437,26 @@ static void *task_thread(void *arg)
     return NULL;
 }
 
-typedef enum { CONTROL_RUN, CONTROL_CALL, CONTROL_STOP, CONTROL_SUSPEND, CONTROL_RESUME } control_op;
-
-static int control(const char *name, control_op op)
+/* Task control hooks (the switch is the core's, semo__control): the
+ * record is changed under the task's lock, and the task is woken. */
+semo__task_control *semo__control_begin(const char *name)
 {
     task *t = find_task(name);
     if (!t)
-        return -1;
+        return NULL;
     pthread_mutex_lock(&t->lock);
-    switch (op) {
-    case CONTROL_RUN:
-        t->repeat = true;
-        t->stop_requested = false;
-        if (t->state == SEMO_TASK_IDLE)
-            t->state = SEMO_TASK_RUNNING;
-        break;
-    case CONTROL_CALL:
-        if (t->state == SEMO_TASK_IDLE || !t->repeat) {
-            t->repeat = false;
-            t->calls++;
-            t->stop_requested = false;
-            if (t->state == SEMO_TASK_IDLE)
-                t->state = SEMO_TASK_RUNNING;
-        }
-        break;
-    case CONTROL_STOP:
-        if (t->state != SEMO_TASK_IDLE)
-            t->stop_requested = true;
-        break;
-    case CONTROL_SUSPEND:
-        if (t->state == SEMO_TASK_RUNNING)
-            t->state = SEMO_TASK_SUSPENDED;
-        break;
-    case CONTROL_RESUME:
-        if (t->state == SEMO_TASK_SUSPENDED)
-            t->state = SEMO_TASK_RUNNING;
-        break;
-    }
+    return &t->control;
+}
+
+void semo__control_end(semo__task_control *control)
+{
+    task *t = (task *)((char *)control - offsetof(task, control));
     if (g_current && g_current != t)
         t->controller = g_current;
     t->woken = true; /* its own hint is void: it was told what to do */
     pthread_cond_broadcast(&t->changed);
     pthread_mutex_unlock(&t->lock);
-    return 0;
 }
-
-int UFControl_RunTask(const char *task) { return control(task, CONTROL_RUN); }
-int UFControl_CallTask(const char *task) { return control(task, CONTROL_CALL); }
-int UFControl_StopTask(const char *task) { return control(task, CONTROL_STOP); }
-int UFControl_SuspendTask(const char *task) { return control(task, CONTROL_SUSPEND); }
-int UFControl_ResumeTask(const char *task) { return control(task, CONTROL_RESUME); }
 
 semo_task_state UFControl_GetTaskState(const char *name)
 {
@@ -497,7 +464,7 @@ semo_task_state UFControl_GetTaskState(const char *name)
     if (!t)
         return SEMO_TASK_IDLE;
     pthread_mutex_lock(&t->lock);
-    semo_task_state state = t->state;
+    semo_task_state state = t->control.state;
     pthread_mutex_unlock(&t->lock);
     return state;
 }
@@ -509,9 +476,9 @@ bool UFControl_WaitIdle(const char *name, int64_t timeout_ms)
         return false;
     int64_t deadline = timeout_ms < 0 ? -1 : semo_now_ms() + timeout_ms;
     pthread_mutex_lock(&t->lock);
-    while (t->state != SEMO_TASK_IDLE && semo_running() && (deadline < 0 || semo_now_ms() < deadline))
+    while (t->control.state != SEMO_TASK_IDLE && semo_running() && (deadline < 0 || semo_now_ms() < deadline))
         wait_until(&t->changed, &t->lock, deadline);
-    bool idle = t->state == SEMO_TASK_IDLE;
+    bool idle = t->control.state == SEMO_TASK_IDLE;
     pthread_mutex_unlock(&t->lock);
     return idle;
 }
@@ -522,9 +489,9 @@ bool UFControl_WaitStop(const char *name, int64_t until_ms)
     if (!t)
         return !semo_running();
     pthread_mutex_lock(&t->lock);
-    while (!t->stop_requested && semo_running() && semo_now_ms() < until_ms)
+    while (!t->control.stop_requested && semo_running() && semo_now_ms() < until_ms)
         wait_until(&t->changed, &t->lock, until_ms);
-    bool stop = t->stop_requested || !semo_running();
+    bool stop = t->control.stop_requested || !semo_running();
     pthread_mutex_unlock(&t->lock);
     return stop;
 }
@@ -537,7 +504,7 @@ bool UFControl_StopRequested(const char *name)
     if (!t)
         return false;
     pthread_mutex_lock(&t->lock);
-    bool stop = t->stop_requested;
+    bool stop = t->control.stop_requested;
     pthread_mutex_unlock(&t->lock);
     return stop;
 }
@@ -1293,8 +1260,8 @@ static bool allocate_program_state(const semo_program_desc *p)
         task *t = &g_tasks[i];
         t->desc = &p->tasks[i];
         bool starts = t->desc->trigger != SEMO_TRIGGER_CONTROL;
-        t->state = starts ? SEMO_TASK_RUNNING : SEMO_TASK_IDLE;
-        t->repeat = starts;
+        t->control.state = starts ? SEMO_TASK_RUNNING : SEMO_TASK_IDLE;
+        t->control.repeat = starts;
         pthread_mutex_init(&t->lock, NULL);
         init_cond(&t->changed);
     }

@@ -157,10 +157,7 @@ int UFMulticast_Read(const char *name, void *buf, size_t size)
 
 typedef struct task_s task;
 struct task_s {
-    semo_task_state state;
-    bool repeat; /* RunTask; otherwise `calls` firings are owed */
-    unsigned calls;
-    bool stop_requested;
+    semo__task_control control; /* changed by UFControl_* (the core's switch) */
     bool in_firing; /* a body said semo_firing_continues */
     int64_t next_release;
     /* semo_next_firing, as on POSIX: not needed before `hint_ms` unless
@@ -234,14 +231,14 @@ static void fire_if_due(size_t i)
 {
     task *t = &g_tasks[i];
     const semo_task_desc *d = &g_prog->tasks[i];
-    if (t->stop_requested && t->state != SEMO_TASK_IDLE && !t->in_firing) {
-        t->state = SEMO_TASK_IDLE;
-        t->stop_requested = false;
-        t->calls = 0;
+    if (t->control.stop_requested && t->control.state != SEMO_TASK_IDLE && !t->in_firing) {
+        t->control.state = SEMO_TASK_IDLE;
+        t->control.stop_requested = false;
+        t->control.calls = 0;
         wake_task(t->controller);
         return;
     }
-    if (t->state != SEMO_TASK_RUNNING && !t->in_firing)
+    if (t->control.state != SEMO_TASK_RUNNING && !t->in_firing)
         return;
     int64_t now = semo_now_ms();
     bool hint_holds = t->hinted && !t->woken;
@@ -261,64 +258,32 @@ static void fire_if_due(size_t i)
     t->in_firing = g_continues && g_running;
     if (t->in_firing)
         return;
-    if (t->stop_requested) {
-        t->state = SEMO_TASK_IDLE;
-        t->stop_requested = false;
-        t->calls = 0;
+    if (t->control.stop_requested) {
+        t->control.state = SEMO_TASK_IDLE;
+        t->control.stop_requested = false;
+        t->control.calls = 0;
         wake_task(t->controller);
-    } else if (!t->repeat && t->calls > 0 && --t->calls == 0) {
-        t->state = SEMO_TASK_IDLE;
+    } else if (!t->control.repeat && t->control.calls > 0 && --t->control.calls == 0) {
+        t->control.state = SEMO_TASK_IDLE;
         wake_task(t->controller);
     }
 }
 
-typedef enum { CONTROL_RUN, CONTROL_CALL, CONTROL_STOP, CONTROL_SUSPEND, CONTROL_RESUME } control_op;
-
-static int control(const char *name, control_op op)
+/* Task control hooks (the switch is the core's, semo__control): nothing
+ * else runs meanwhile, so no lock. */
+semo__task_control *semo__control_begin(const char *name)
 {
     task *t = find_task(name);
-    if (!t)
-        return -1;
-    switch (op) {
-    case CONTROL_RUN:
-        t->repeat = true;
-        t->stop_requested = false;
-        if (t->state == SEMO_TASK_IDLE)
-            t->state = SEMO_TASK_RUNNING;
-        break;
-    case CONTROL_CALL:
-        if (t->state == SEMO_TASK_IDLE || !t->repeat) {
-            t->repeat = false;
-            t->calls++;
-            t->stop_requested = false;
-            if (t->state == SEMO_TASK_IDLE)
-                t->state = SEMO_TASK_RUNNING;
-        }
-        break;
-    case CONTROL_STOP:
-        if (t->state != SEMO_TASK_IDLE)
-            t->stop_requested = true;
-        break;
-    case CONTROL_SUSPEND:
-        if (t->state == SEMO_TASK_RUNNING)
-            t->state = SEMO_TASK_SUSPENDED;
-        break;
-    case CONTROL_RESUME:
-        if (t->state == SEMO_TASK_SUSPENDED)
-            t->state = SEMO_TASK_RUNNING;
-        break;
-    }
+    return t ? &t->control : NULL;
+}
+
+void semo__control_end(semo__task_control *control)
+{
+    task *t = (task *)((char *)control - offsetof(task, control));
     if (g_current && g_current != t)
         t->controller = g_current;
     t->woken = true; /* its own hint is void: it was told what to do */
-    return 0;
 }
-
-int UFControl_RunTask(const char *task) { return control(task, CONTROL_RUN); }
-int UFControl_CallTask(const char *task) { return control(task, CONTROL_CALL); }
-int UFControl_StopTask(const char *task) { return control(task, CONTROL_STOP); }
-int UFControl_SuspendTask(const char *task) { return control(task, CONTROL_SUSPEND); }
-int UFControl_ResumeTask(const char *task) { return control(task, CONTROL_RESUME); }
 
 semo_task_state UFControl_GetTaskState(const char *name)
 {
@@ -326,7 +291,7 @@ semo_task_state UFControl_GetTaskState(const char *name)
     if (!t)
         return SEMO_TASK_IDLE;
     /* A firing still going on keeps the task busy. */
-    return t->in_firing && t->state == SEMO_TASK_IDLE ? SEMO_TASK_RUNNING : t->state;
+    return t->in_firing && t->control.state == SEMO_TASK_IDLE ? SEMO_TASK_RUNNING : t->control.state;
 }
 
 /* Nothing else runs while this waits: only an idle task (or no time) succeeds. */
@@ -348,7 +313,7 @@ bool UFControl_StopRequested(const char *name)
     task *t = find_task(name);
     if (!g_running)
         return true;
-    return t && t->stop_requested;
+    return t && t->control.stop_requested;
 }
 
 static struct {
@@ -540,15 +505,15 @@ static int64_t next_due(int64_t now)
         if (t->in_firing) {
             /* A firing that goes on without naming when: as with a clock tick. */
             due = hint_holds ? t->hint_ms : t->hinted ? now : now + 1;
-        } else if (t->stop_requested && t->state != SEMO_TASK_IDLE) {
+        } else if (t->control.stop_requested && t->control.state != SEMO_TASK_IDLE) {
             due = now;
-        } else if (t->state != SEMO_TASK_RUNNING) {
+        } else if (t->control.state != SEMO_TASK_RUNNING) {
             continue;
         } else if (g_prog->tasks[i].trigger == SEMO_TRIGGER_TIME) {
             due = t->next_release;
             if (hint_holds && t->hint_ms > due)
                 due = t->hint_ms;
-        } else if ((!t->repeat && t->calls > 0) || input_waiting(i) || semo__inbox_waiting()) {
+        } else if ((!t->control.repeat && t->control.calls > 0) || input_waiting(i) || semo__inbox_waiting()) {
             due = now;
         }
         if (due < next)
@@ -596,9 +561,10 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
                 c->state->reader = (unsigned short)k;
     }
     for (size_t i = 0; i < program->task_count; i++)
-        g_tasks[i] = (task){.state = program->tasks[i].trigger == SEMO_TRIGGER_CONTROL ? SEMO_TASK_IDLE
-                                                                                        : SEMO_TASK_RUNNING,
-                            .repeat = true};
+        g_tasks[i] = (task){.control = {.state = program->tasks[i].trigger == SEMO_TRIGGER_CONTROL
+                                                         ? SEMO_TASK_IDLE
+                                                         : SEMO_TASK_RUNNING,
+                                        .repeat = true}};
     semo__inbox_reset();
     g_start_ms = semo__board_now_ms();
     g_running = true;

@@ -1,29 +1,37 @@
 //! Services implemented by task graphs (`graph=` in the catalog): the
-//! graph's looped schedule, SDF/L loop nodes opened, as [`GraphStep`]s the
-//! service task runs per call (`codegen/loops.rs`, `sim/engine/loops.rs`),
-//! with the graph's channels ([`GraphChannel`]: every level's, numbered in
-//! level order, each bounded by the analysis's buffer bound) and the
-//! channels each inner task's and loop node's ports join. A port joined by
-//! more than one channel, a loop port without a channel on both sides, or a
-//! loop output that cannot give its outer rate when the loop stops refuses
-//! the graph like a missing schedule.
+//! graph's looped schedule, SDF/L loop nodes and sub-graph references
+//! opened, as [`GraphStep`]s the service task runs per call
+//! (`codegen/loops.rs`, `sim/engine/loops.rs`), with the graph's channels
+//! ([`GraphChannel`]: every level's, numbered in level order, each bounded
+//! by the analysis's buffer bound) and the channels each inner task's, loop
+//! node's and sub-graph task's ports join. A port joined by more than one
+//! channel, a loop port without a channel on both sides, or a loop output
+//! that cannot give its outer rate when the loop stops refuses the graph
+//! like a missing schedule.
 //!
-//! The schedule is the analysis's own (`taskgraph::analysis::schedule`, per
-//! hierarchy level: a loop node's body is the level at its path). A graph
-//! without one (inconsistent, deadlocked, no single-appearance schedule)
-//! or with sub-graph references keeps the reason: the dataflow warnings
-//! (W070, W071) name it on the call, and code generation refuses it (E100),
-//! never giving a stub instead.
+//! The levels are the analysis's own (`Level::all_with`: a loop node's body
+//! is the level at its path, a sub-graph's top level the level at the path
+//! of the task standing for it, its boundary edges joining the task's ports
+//! by name), and so is each level's schedule
+//! (`taskgraph::analysis::schedule`). A graph without one (inconsistent,
+//! deadlocked, no single-appearance schedule) keeps the reason: the
+//! dataflow warnings (W070, W071) name it on the call, and code generation
+//! refuses it (E100), never giving a stub instead. A sub-graph reference
+//! the workspace could not follow (E067, E068, E069, E078 in the graph
+//! file) refuses it with E135 on the call, pointing at the reference.
 
 use super::{Builder, implementing_task};
 use crate::catalog::Implementation;
+use crate::diag::{Code, Related};
 use crate::refine::program::{
-    GraphChannel, GraphService, GraphStep, InnerTask, LoopPort, PortUse, StateKind,
+    GraphChannel, GraphRefused, GraphService, GraphStep, InnerTask, LoopPort, PortUse, StateKind,
+    SubgraphPort,
 };
 use crate::span::Span;
 use crate::taskgraph::TaskGraph;
 use crate::taskgraph::analysis::{buffers, consistency, level::Level, schedule};
 use crate::taskgraph::model::{Direction, LoopNode, LoopType, PortKind, Task};
+use crate::taskgraph::subgraph::{Hierarchy, PortLink};
 use std::collections::HashMap;
 
 impl Builder<'_, '_> {
@@ -57,8 +65,15 @@ impl Builder<'_, '_> {
                 if found.iter().any(|g: &GraphService| g.task == task) {
                     continue;
                 }
-                let opened = steps_of(&loaded.graph)
-                    .map_err(|why| format!("the task graph of `{service}` ({path}), which {why},"));
+                let opened = unusable_subgraphs(&service, path, &loaded.hierarchy).and_then(|()| {
+                    steps_of(&loaded.graph, &loaded.hierarchy).map_err(|why| GraphRefused {
+                        code: Code::CodegenUnsupported,
+                        message: format!(
+                            "code generation does not support the task graph of `{service}` ({path}), which {why}, yet"
+                        ),
+                        related: Vec::new(),
+                    })
+                });
                 let (steps, channels, tasks) = match opened {
                     Ok(o) => (Ok(o.steps), o.channels, o.tasks),
                     Err(why) => (Err(why), Vec::new(), Vec::new()),
@@ -87,6 +102,41 @@ impl Builder<'_, '_> {
     }
 }
 
+/// E135 when the workspace could not follow one of the graph's sub-graph
+/// references (its problems are the graph file's own diagnostics: each is
+/// related here, where the graph is run).
+fn unusable_subgraphs(
+    service: &str,
+    path: &str,
+    hierarchy: &Hierarchy,
+) -> Result<(), GraphRefused> {
+    let problems: Vec<Related> = hierarchy
+        .diagnostics
+        .iter()
+        .filter(|d| d.is_error())
+        .map(|d| Related {
+            file: d.file,
+            span: d.span,
+            message: format!("{} {}", d.code, d.message),
+        })
+        .collect();
+    let Some(first) = problems.first() else {
+        return Ok(());
+    };
+    Err(GraphRefused {
+        code: Code::ServiceSubgraphUnusable,
+        message: format!(
+            "the task graph of `{service}` ({path}) cannot run: a sub-graph it references cannot be used ({}{})",
+            first.message,
+            match problems.len() {
+                1 => String::new(),
+                n => format!("; and {} more", n - 1),
+            }
+        ),
+        related: problems,
+    })
+}
+
 /// A service graph opened: one iteration of its top level as steps, its
 /// channels and its inner tasks.
 #[derive(Debug)]
@@ -100,18 +150,18 @@ pub(crate) struct Opened {
 /// expands (beyond, the graph is refused).
 const MAX_LEVEL_FIRINGS: u64 = 1 << 20;
 
-/// `graph` opened, or why it cannot run.
-pub(crate) fn steps_of(graph: &TaskGraph) -> Result<Opened, String> {
-    if graph
-        .levels()
-        .iter()
-        .any(|l| l.graph.tasks.iter().any(|t| t.subgraph.is_some()))
-    {
-        return Err("references sub-graph files".into());
-    }
-    let levels = Level::all(graph);
+/// `graph` opened, with the sub-graphs its tasks reference (`hierarchy`,
+/// resolved without errors), or why it cannot run.
+pub(crate) fn steps_of(graph: &TaskGraph, hierarchy: &Hierarchy) -> Result<Opened, String> {
+    let levels: Vec<Level<'_>> = Level::all_with(graph, hierarchy)
+        .into_iter()
+        .map(|h| h.level)
+        .collect();
+    let mut stands_for = HashMap::new();
+    sub_graph_tasks(graph, &graph.name, hierarchy, &mut stands_for);
     let mut opener = Opener {
         levels: &levels,
+        stands_for,
         channels: Vec::new(),
         ends: HashMap::new(),
         tasks: Vec::new(),
@@ -120,11 +170,79 @@ pub(crate) fn steps_of(graph: &TaskGraph) -> Result<Opened, String> {
         opener.channels_of(index)?;
     }
     let steps = opener.level_steps(0)?;
+    let tokens: u64 = opener.channels.iter().map(|c| c.capacity).sum();
+    if tokens > MAX_GRAPH_TOKENS {
+        return Err(format!(
+            "needs {tokens} tokens in its channels, more than {MAX_GRAPH_TOKENS}"
+        ));
+    }
     Ok(Opened {
         steps,
         channels: opener.channels,
         tasks: opener.tasks,
     })
+}
+
+/// Tokens a graph's channels hold, at most: the generated program keeps
+/// them, and each firing's port arrays (no larger than a channel), in
+/// static storage.
+pub const MAX_GRAPH_TOKENS: u64 = 1 << 16;
+
+/// The task each sub-graph's top level stands for, with its port links, by
+/// the level's path (`kmeans/Track`), as `Level::all_with` paths them.
+fn sub_graph_tasks<'g>(
+    graph: &'g TaskGraph,
+    prefix: &str,
+    hierarchy: &'g Hierarchy,
+    out: &mut HashMap<String, (&'g Task, &'g [PortLink])>,
+) {
+    let levels = graph.levels();
+    for s in &hierarchy.subgraphs {
+        let Some(task) = levels
+            .iter()
+            .find(|l| l.path == s.level)
+            .and_then(|l| l.graph.tasks.get(s.task))
+        else {
+            continue;
+        };
+        let level = format!(
+            "{prefix}{}",
+            &s.level[graph.name.len().min(s.level.len())..]
+        );
+        let path = format!("{level}/{}", task.name.name);
+        out.insert(path.clone(), (task, s.links.as_slice()));
+        sub_graph_tasks(&s.graph, &path, &s.nested, out);
+    }
+}
+
+/// The (task's, sub-graph's) port names of boundary edge `edge` of a
+/// sub-graph level, the next of `links` that joins ports: checked against
+/// the edge's ends.
+fn boundary_ports<'g>(
+    level: &Level<'g>,
+    edge: &crate::taskgraph::analysis::level::Edge,
+    task: &Task,
+    links: &mut std::slice::Iter<'_, PortLink>,
+) -> Option<(String, String)> {
+    let (inputs, outputs) = level.boundary?;
+    let link = links.find(|l| {
+        let outer = task.ports.get(l.outer);
+        let inner = level
+            .graph
+            .tasks
+            .get(l.inner_task)
+            .and_then(|t| t.ports.get(l.inner_port));
+        outer
+            .zip(inner)
+            .is_some_and(|(o, i)| o.rate > 0 && i.rate > 0)
+    })?;
+    let outer = &task.ports[link.outer];
+    let inner = &level.graph.tasks[link.inner_task].ports[link.inner_port];
+    let ends = match outer.dir {
+        Direction::In => (inputs, link.inner_task),
+        Direction::Out => (link.inner_task, outputs),
+    };
+    (ends == (edge.src, edge.dst)).then(|| (outer.name.name.clone(), inner.name.name.clone()))
 }
 
 /// Which side of a task's port a channel joins: a loop node's port has a
@@ -137,6 +255,9 @@ enum Side {
 
 struct Opener<'l, 'g> {
     levels: &'l [Level<'g>],
+    /// A sub-graph's top level's path → the task it stands for, and how
+    /// the task's ports link to the sub-graph's open ports.
+    stands_for: HashMap<String, (&'g Task, &'g [PortLink])>,
     channels: Vec<GraphChannel>,
     /// (task path below the graph, port, side) → the channels joining it.
     ends: HashMap<(String, String, Side), Vec<usize>>,
@@ -179,7 +300,36 @@ impl Opener<'_, '_> {
         order.extend(level.boundary.map(|(_, outputs)| outputs));
         let bounds = buffers::buffer_bounds(level, &order);
         let at = self.below(&level.path);
+        // A sub-graph's boundary edges join no channel of its file: they
+        // are the links of the task's ports, in order (`Level::subgraph`).
+        let mut links = self
+            .stands_for
+            .get(&level.path)
+            .map(|&(task, links)| (task, links.iter()));
         for (edge, bound) in level.edges.iter().zip(bounds) {
+            let (src_port, dst_port) = if edge.channel == usize::MAX {
+                let Some((task, links)) = links.as_mut() else {
+                    return Err(format!("has an edge `{}` outside its channels", edge.label));
+                };
+                let Some((outer, inner)) = boundary_ports(level, edge, task, links) else {
+                    return Err(format!(
+                        "has sub-graph edge `{}` that no port of `{}` links",
+                        edge.label, task.name.name
+                    ));
+                };
+                // An open port of the task (the graph's interface) leaves
+                // the sub-graph's port open too.
+                if self.end(&at, &outer, Side::Outer)?.is_none() {
+                    continue;
+                }
+                match edge.src == level.boundary.map_or(usize::MAX, |(inputs, _)| inputs) {
+                    true => (outer, inner),
+                    false => (inner, outer),
+                }
+            } else {
+                let c = &level.graph.channels[edge.channel];
+                (c.src.port.clone(), c.dst.port.clone())
+            };
             let channel = self.channels.len();
             self.channels.push(GraphChannel {
                 label: if at.is_empty() {
@@ -192,19 +342,18 @@ impl Opener<'_, '_> {
                 capacity: bound.max(1),
                 initial_tokens: edge.initial_tokens,
             });
-            let c = &level.graph.channels[edge.channel];
-            for (node, port) in [(edge.src, &c.src.port), (edge.dst, &c.dst.port)] {
+            for (node, port) in [(edge.src, src_port), (edge.dst, dst_port)] {
                 let key = match level.nodes[node].task {
                     Some(t) => (
                         self.below(&format!(
                             "{}/{}",
                             level.path, level.graph.tasks[t].name.name
                         )),
-                        port.clone(),
+                        port,
                         Side::Outer,
                     ),
-                    // The enclosing loop node's boundary.
-                    None => (at.clone(), port.clone(), Side::Inner),
+                    // The enclosing loop node's or sub-graph task's boundary.
+                    None => (at.clone(), port, Side::Inner),
                 };
                 self.ends.entry(key).or_default().push(channel);
             }
@@ -227,9 +376,11 @@ impl Opener<'_, '_> {
         }
     }
 
-    fn inner_task(&mut self, path: &str, task: &Task) -> Result<(), String> {
-        if self.tasks.iter().any(|t| t.path == path) {
-            return Ok(());
+    /// The index of inner task `path` in [`Opened::tasks`], listed at its
+    /// first firing.
+    fn inner_task(&mut self, path: &str, task: &Task) -> Result<usize, String> {
+        if let Some(index) = self.tasks.iter().position(|t| t.path == path) {
+            return Ok(index);
         }
         let mut inputs = Vec::new();
         let mut outputs = Vec::new();
@@ -252,7 +403,33 @@ impl Opener<'_, '_> {
             inputs,
             outputs,
         });
-        Ok(())
+        Ok(self.tasks.len() - 1)
+    }
+
+    /// The ports of task `path` standing for a sub-graph that a channel
+    /// joins outside, each with the channel joining the sub-graph's open
+    /// port of its name.
+    fn subgraph_ports(&self, path: &str, task: &Task) -> Result<Vec<SubgraphPort>, String> {
+        let mut out = Vec::new();
+        for port in &task.ports {
+            let name = &port.name.name;
+            let Some(outer) = self.end(path, name, Side::Outer)? else {
+                continue; // an open port: the graph's interface
+            };
+            let Some(inner) = self.end(path, name, Side::Inner)? else {
+                return Err(format!(
+                    "has sub-graph port `{path}.{name}` that no open port of its sub-graph takes"
+                ));
+            };
+            out.push(SubgraphPort {
+                port: name.clone(),
+                input: port.dir == Direction::In,
+                rate: port.rate,
+                outer,
+                inner,
+            });
+        }
+        Ok(out)
     }
 
     fn loop_ports(
@@ -330,13 +507,28 @@ impl Opener<'_, '_> {
                     let full = format!("{}/{}", level.path, task.name.name);
                     let path = self.below(&full);
                     let step = match &task.loop_node {
-                        None => {
-                            self.inner_task(&path, task)?;
-                            GraphStep::Fire {
-                                task: path,
-                                count: *count,
+                        None if task.subgraph.is_some() => {
+                            // The sub-graph's top level, at the task's path.
+                            let inner = levels
+                                .iter()
+                                .position(|l| l.path == full)
+                                .ok_or_else(|| format!("has no sub-graph level for `{full}`"))?;
+                            let ports = self.subgraph_ports(&path, task)?;
+                            let body = self.level_steps(inner)?;
+                            let once = GraphStep::Subgraph { path, ports, body };
+                            if *count == 1 {
+                                once
+                            } else {
+                                GraphStep::Repeat {
+                                    count: *count,
+                                    body: vec![once],
+                                }
                             }
                         }
+                        None => GraphStep::Fire {
+                            task: self.inner_task(&path, task)?,
+                            count: *count,
+                        },
                         Some(node) => {
                             let inner = levels
                                 .iter()
@@ -344,13 +536,26 @@ impl Opener<'_, '_> {
                                 .ok_or_else(|| format!("has no level for `{full}`"))?;
                             let ports = self.loop_ports(&path, task, node)?;
                             let body = self.level_steps(inner)?;
+                            let exit_task = match &node.exit_task {
+                                None => None,
+                                Some(e) => {
+                                    let exit = format!("{path}/{}", e.name);
+                                    let index = self
+                                        .tasks
+                                        .iter()
+                                        .position(|t| t.path == exit)
+                                        .ok_or_else(|| {
+                                            format!(
+                                                "has exit task `{exit}` that its loop never fires"
+                                            )
+                                        })?;
+                                    Some(index)
+                                }
+                            };
                             let looped = GraphStep::Loop {
                                 convergent: node.loop_type == LoopType::C,
                                 loop_count: node.loop_count,
-                                exit_task: node
-                                    .exit_task
-                                    .as_ref()
-                                    .map(|e| format!("{path}/{}", e.name)),
+                                exit_task,
                                 ports,
                                 body,
                                 path,

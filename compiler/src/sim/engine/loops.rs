@@ -9,7 +9,10 @@
 //! keeps the last outputs its iterations gave and puts them when it ends
 //! (`graph_loop`, with its iterations); a convergent loop stops after the
 //! iteration in which its exit task sets the exit flag (the scenario's
-//! `loops`), at most `loop_count` iterations. A channel short of tokens or
+//! `loops`), at most `loop_count` iterations; a task standing for a
+//! sub-graph moves its inputs' tokens to the sub-graph's channels, runs one
+//! iteration of the sub-graph's schedule and moves its outputs' back. A
+//! channel short of tokens or
 //! over its bound is traced (`graph_error`) and ends the run, where the
 //! generated program aborts.
 
@@ -86,8 +89,9 @@ struct GraphRun<'s, 'p> {
 }
 
 /// The innermost convergent loop: its exit task, iteration and flag.
-struct Exit<'a> {
-    task: &'a str,
+struct Exit {
+    /// An index in the service's tasks.
+    task: usize,
     iteration: u64,
     at: u64,
     flag: bool,
@@ -138,12 +142,14 @@ impl GraphRun<'_, '_> {
         Ok(())
     }
 
-    fn fire(&mut self, path: &str) -> Result<(), Broken> {
+    fn fire(&mut self, index: usize) -> Result<(), Broken> {
         let service = self.service;
-        // Refinement lists every task it fires.
-        let Some(task) = service.tasks.iter().find(|t| t.path == path) else {
+        // Refinement lists every task it fires (code generation checks it,
+        // `codegen::loops::check`).
+        let Some(task) = service.tasks.get(index) else {
             return Ok(());
         };
+        let path = task.path.as_str();
         let mut read = Vec::new();
         for port in &task.inputs {
             self.take(port.channel, port.rate, &mut read)?;
@@ -174,18 +180,14 @@ impl GraphRun<'_, '_> {
         Ok(())
     }
 
-    fn steps(
-        &mut self,
-        steps: &[GraphStep],
-        mut exit: Option<&mut Exit<'_>>,
-    ) -> Result<(), Broken> {
+    fn steps(&mut self, steps: &[GraphStep], mut exit: Option<&mut Exit>) -> Result<(), Broken> {
         for step in steps {
             match step {
                 GraphStep::Fire { task, count } => {
                     for _ in 0..*count {
-                        self.fire(task)?;
+                        self.fire(*task)?;
                         if let Some(e) = exit.as_deref_mut()
-                            && e.task == task
+                            && e.task == *task
                             && e.at > 0
                             && e.iteration >= e.at
                         {
@@ -226,7 +228,7 @@ impl GraphRun<'_, '_> {
                     let mut n = 0;
                     let mut own = match (convergent, exit_task) {
                         (true, Some(task)) => Some(Exit {
-                            task,
+                            task: *task,
                             iteration: 0,
                             at,
                             flag: false,
@@ -265,7 +267,27 @@ impl GraphRun<'_, '_> {
                         }
                     }
                 }
+                GraphStep::Subgraph { ports, body, .. } => {
+                    for port in ports.iter().filter(|p| p.input) {
+                        self.move_tokens(port.outer, port.inner, port.rate)?;
+                    }
+                    self.steps(body, exit.as_deref_mut())?;
+                    for port in ports.iter().filter(|p| !p.input) {
+                        self.move_tokens(port.inner, port.outer, port.rate)?;
+                    }
+                }
             }
+        }
+        Ok(())
+    }
+
+    /// `n` tokens from channel `from` to `to`, one at a time as the
+    /// generated `graph_move` moves them.
+    fn move_tokens(&mut self, from: usize, to: usize, n: u64) -> Result<(), Broken> {
+        for _ in 0..n {
+            let mut token = Vec::with_capacity(1);
+            self.take(from, 1, &mut token)?;
+            self.put(to, &token)?;
         }
         Ok(())
     }

@@ -44,7 +44,27 @@ impl Sim<'_> {
         if lives(was) {
             return was;
         }
-        let Some(&next) = ownership.owners.iter().find(|&&c| lives(c)) else {
+        // The first live robot of the order, or by `highest_battery` the
+        // live one with the highest level its heartbeat said (the first of
+        // equals; unknown counts lowest; its own level for itself).
+        let level = |peer: usize| {
+            if peer == program.self_peer {
+                super::own_battery(robot, self.now)
+            } else {
+                robot.heard[peer].battery
+            }
+            .unwrap_or(-1)
+        };
+        let mut live = ownership.owners.iter().copied().filter(|&c| lives(c));
+        let chosen = if ownership.rule.by_battery() {
+            live.fold(None, |best: Option<usize>, c| match best {
+                Some(b) if level(c) <= level(b) => Some(b),
+                _ => Some(c),
+            })
+        } else {
+            live.next()
+        };
+        let Some(next) = chosen else {
             return was;
         };
         self.robots[r].owner = next;
