@@ -19,9 +19,10 @@ use crate::taskgraph::model::*;
 use crate::xmlpos::{Attr, get, shown};
 use crate::xmltree::{Elem, Visit};
 
-/// What an open element is to the graph.
+/// What an open element is to the graph (both readers of SDF3 files use it:
+/// this one and [`super::sdf3_clean`]).
 #[derive(Clone, Copy, PartialEq, Eq)]
-enum Role {
+pub(super) enum Role {
     Root,
     ApplicationGraph,
     Sdf,
@@ -34,6 +35,28 @@ enum Role {
     ExecutionTime,
     /// Not read, nor anything inside it.
     Ignored,
+}
+
+impl Role {
+    /// The role of an element named `local` inside one of this role. The
+    /// graph reads only the first `<applicationGraph>`, `<sdf>` and
+    /// `<sdfProperties>`: `first(role)` says whether one of that role may
+    /// still open (a later one is ignored).
+    pub(super) fn child(self, local: &[u8], first: impl Fn(Role) -> bool) -> Role {
+        let once = |role| if first(role) { role } else { Role::Ignored };
+        match (self, local) {
+            (Role::Root, b"applicationGraph") => once(Role::ApplicationGraph),
+            (Role::ApplicationGraph, b"sdf") => once(Role::Sdf),
+            (Role::ApplicationGraph, b"sdfProperties") => once(Role::Properties),
+            (Role::Sdf, b"actor") => Role::Actor,
+            (Role::Sdf, b"channel") => Role::Channel,
+            (Role::Actor, b"port") => Role::Port,
+            (Role::Properties, b"actorProperties") => Role::ActorProperties,
+            (Role::ActorProperties, b"processor") => Role::Processor,
+            (Role::Processor, b"executionTime") => Role::ExecutionTime,
+            _ => Role::Ignored,
+        }
+    }
 }
 
 /// One `<processor>` of the `<actorProperties>` being read.
@@ -70,6 +93,16 @@ pub(super) struct Sdf3Reader<'s> {
 }
 
 impl<'s> Sdf3Reader<'s> {
+    /// Whether an element of a read-once `role` is the first of its kind.
+    fn first(&self, role: Role) -> bool {
+        match role {
+            Role::ApplicationGraph => !self.application_graph_seen,
+            Role::Sdf => self.sdf.is_none(),
+            Role::Properties => !self.properties_seen,
+            _ => true,
+        }
+    }
+
     pub(super) fn new(loader: Loader<'s>) -> Self {
         Sdf3Reader {
             loader,
@@ -283,43 +316,35 @@ fn named(a: &Attr) -> Named {
 impl Visit for Sdf3Reader<'_> {
     fn open(&mut self, e: &Elem) {
         let parent = self.open.last().copied();
-        let role = match (parent, e.local.as_str()) {
-            (None, _) => {
+        let role = match parent {
+            None => {
                 self.root(e);
                 Role::Root
             }
-            _ if self.other_type => Role::Ignored,
-            (Some(Role::Root), "applicationGraph") if !self.application_graph_seen => {
+            Some(_) if self.other_type => Role::Ignored,
+            Some(parent) => parent.child(e.local.as_bytes(), |role| self.first(role)),
+        };
+        match role {
+            Role::ApplicationGraph => {
                 self.application_graph_seen = true;
                 self.application_graph_name =
                     get(&e.attrs, "name").map(|a| a.trimmed().to_string());
-                Role::ApplicationGraph
             }
-            (Some(Role::ApplicationGraph), "sdf") if self.sdf.is_none() => {
+            Role::Sdf => {
                 let name = get(&e.attrs, "name").map(|a| a.trimmed().to_string());
                 self.sdf = Some((name, e.tag, false));
-                Role::Sdf
             }
-            (Some(Role::ApplicationGraph), "sdfProperties") if !self.properties_seen => {
-                self.properties_seen = true;
-                Role::Properties
-            }
-            (Some(Role::Sdf), "actor") => Role::Actor,
-            (Some(Role::Sdf), "channel") => Role::Channel,
-            (Some(Role::Actor), "port") => Role::Port,
-            (Some(Role::Properties), "actorProperties") => Role::ActorProperties,
-            (Some(Role::ActorProperties), "processor") => {
+            Role::Properties => self.properties_seen = true,
+            Role::Processor => {
                 let trimmed = |key| get(&e.attrs, key).map(|a| a.trimmed().to_string());
                 self.processors.push(Processor {
                     kind: trimmed("type"),
                     default: trimmed("default"),
                     time: None,
                 });
-                Role::Processor
             }
-            (Some(Role::Processor), "executionTime") => Role::ExecutionTime,
-            _ => Role::Ignored,
-        };
+            _ => {}
+        }
         self.open.push(role);
     }
 

@@ -18,6 +18,7 @@
 //! (`taskgraph::xml::tests::the_clean_sdf3_reader_*`).
 
 use super::ExecutionTimes;
+use super::sdf3::Role;
 use crate::diag::FileId;
 use crate::fasthash::FastMap as HashMap;
 use crate::span::Span;
@@ -30,42 +31,24 @@ struct Decline;
 
 type Read<T> = Result<T, Decline>;
 
-/// What an open element is to the graph (as in [`super::sdf3`]).
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Role {
-    Root,
-    ApplicationGraph,
-    Sdf,
-    Actor,
-    Port,
-    Channel,
-    Properties,
-    ActorProperties,
-    Processor,
-    ExecutionTime,
-    Ignored,
-}
-
-impl Role {
-    /// The attributes an element of this role is read for, in the order of
-    /// [`Open::attrs`].
-    fn keys(self) -> &'static [&'static [u8]] {
-        match self {
-            Role::Root => &[b"type"],
-            Role::ApplicationGraph | Role::Sdf | Role::Actor => &[b"name"],
-            Role::Port => &[b"name", b"type", b"rate"],
-            Role::Channel => &[
-                b"srcActor",
-                b"srcPort",
-                b"dstActor",
-                b"dstPort",
-                b"initialTokens",
-            ],
-            Role::ActorProperties => &[b"actor"],
-            Role::Processor => &[b"type", b"default"],
-            Role::ExecutionTime => &[b"time"],
-            Role::Properties | Role::Ignored => &[],
-        }
+/// The attributes an element of each role is read for, in the order of
+/// [`Open::attrs`].
+fn keys(role: Role) -> &'static [&'static [u8]] {
+    match role {
+        Role::Root => &[b"type"],
+        Role::ApplicationGraph | Role::Sdf | Role::Actor => &[b"name"],
+        Role::Port => &[b"name", b"type", b"rate"],
+        Role::Channel => &[
+            b"srcActor",
+            b"srcPort",
+            b"dstActor",
+            b"dstPort",
+            b"initialTokens",
+        ],
+        Role::ActorProperties => &[b"actor"],
+        Role::Processor => &[b"type", b"default"],
+        Role::ExecutionTime => &[b"time"],
+        Role::Properties | Role::Ignored => &[],
     }
 }
 
@@ -245,26 +228,18 @@ impl<'t> State<'t> {
             None if self.root_seen => return Err(Decline),
             None => None,
         };
-        let role = match (parent, local) {
-            (None, b"sdf3") => Role::Root,
+        let role = match parent {
+            None if local == b"sdf3" => Role::Root,
             // Not an SDF3 graph.
-            (None, _) => return Err(Decline),
-            (Some(Role::Root), b"applicationGraph") if !self.application_graph_seen => {
-                Role::ApplicationGraph
-            }
-            (Some(Role::ApplicationGraph), b"sdf") if self.sdf.is_none() => Role::Sdf,
-            (Some(Role::ApplicationGraph), b"sdfProperties") if !self.properties_seen => {
-                Role::Properties
-            }
-            (Some(Role::Sdf), b"actor") => Role::Actor,
-            (Some(Role::Sdf), b"channel") => Role::Channel,
-            (Some(Role::Actor), b"port") => Role::Port,
-            (Some(Role::Properties), b"actorProperties") => Role::ActorProperties,
-            (Some(Role::ActorProperties), b"processor") => Role::Processor,
-            (Some(Role::Processor), b"executionTime") => Role::ExecutionTime,
-            _ => Role::Ignored,
+            None => return Err(Decline),
+            Some(parent) => parent.child(local, |role| match role {
+                Role::ApplicationGraph => !self.application_graph_seen,
+                Role::Sdf => self.sdf.is_none(),
+                Role::Properties => !self.properties_seen,
+                _ => true,
+            }),
         };
-        let attrs = self.attributes(e, role.keys())?;
+        let attrs = self.attributes(e, keys(role))?;
         match role {
             Role::Root => {
                 self.root_seen = true;
