@@ -153,12 +153,10 @@ const MAX_LEVEL_FIRINGS: u64 = 1 << 20;
 /// `graph` opened, with the sub-graphs its tasks reference (`hierarchy`,
 /// resolved without errors), or why it cannot run.
 pub(crate) fn steps_of(graph: &TaskGraph, hierarchy: &Hierarchy) -> Result<Opened, String> {
-    let levels: Vec<Level<'_>> = Level::all_with(graph, hierarchy)
+    let (levels, stands_for): (Vec<Level<'_>>, Vec<_>) = Level::all_with(graph, hierarchy)
         .into_iter()
-        .map(|h| h.level)
-        .collect();
-    let mut stands_for = HashMap::new();
-    sub_graph_tasks(graph, &graph.name, hierarchy, &mut stands_for);
+        .map(|h| (h.level, h.entered_through))
+        .unzip();
     let mut opener = Opener {
         levels: &levels,
         stands_for,
@@ -187,33 +185,6 @@ pub(crate) fn steps_of(graph: &TaskGraph, hierarchy: &Hierarchy) -> Result<Opene
 /// them, and each firing's port arrays (no larger than a channel), in
 /// static storage.
 pub const MAX_GRAPH_TOKENS: u64 = 1 << 16;
-
-/// The task each sub-graph's top level stands for, with its port links, by
-/// the level's path (`kmeans/Track`), as `Level::all_with` paths them.
-fn sub_graph_tasks<'g>(
-    graph: &'g TaskGraph,
-    prefix: &str,
-    hierarchy: &'g Hierarchy,
-    out: &mut HashMap<String, (&'g Task, &'g [PortLink])>,
-) {
-    let levels = graph.levels();
-    for s in &hierarchy.subgraphs {
-        let Some(task) = levels
-            .iter()
-            .find(|l| l.path == s.level)
-            .and_then(|l| l.graph.tasks.get(s.task))
-        else {
-            continue;
-        };
-        let level = format!(
-            "{prefix}{}",
-            &s.level[graph.name.len().min(s.level.len())..]
-        );
-        let path = format!("{level}/{}", task.name.name);
-        out.insert(path.clone(), (task, s.links.as_slice()));
-        sub_graph_tasks(&s.graph, &path, &s.nested, out);
-    }
-}
 
 /// The (task's, sub-graph's) port names of boundary edge `edge` of a
 /// sub-graph level, the next of `links` that joins ports: checked against
@@ -255,9 +226,10 @@ enum Side {
 
 struct Opener<'l, 'g> {
     levels: &'l [Level<'g>],
-    /// A sub-graph's top level's path → the task it stands for, and how
-    /// the task's ports link to the sub-graph's open ports.
-    stands_for: HashMap<String, (&'g Task, &'g [PortLink])>,
+    /// Per level: in a sub-graph's top level, the task it stands for and
+    /// how the task's ports link to the sub-graph's open ports
+    /// (`HierarchyLevel::entered_through`).
+    stands_for: Vec<Option<(&'g Task, &'g [PortLink])>>,
     channels: Vec<GraphChannel>,
     /// (task path below the graph, port, side) → the channels joining it.
     ends: HashMap<(String, String, Side), Vec<usize>>,
@@ -302,12 +274,12 @@ impl Opener<'_, '_> {
         let at = self.below(&level.path);
         // A sub-graph's boundary edges join no channel of its file: they
         // are the links of the task's ports, in order (`Level::subgraph`).
-        let mut links = self
-            .stands_for
-            .get(&level.path)
-            .map(|&(task, links)| (task, links.iter()));
+        let mut links = self.stands_for[index].map(|(task, links)| (task, links.iter()));
         for (edge, bound) in level.edges.iter().zip(bounds) {
-            let (src_port, dst_port) = if edge.channel == usize::MAX {
+            let (src_port, dst_port) = if let Some(channel) = edge.channel {
+                let c = &level.graph.channels[channel];
+                (c.src.port.clone(), c.dst.port.clone())
+            } else {
                 let Some((task, links)) = links.as_mut() else {
                     return Err(format!("has an edge `{}` outside its channels", edge.label));
                 };
@@ -322,13 +294,10 @@ impl Opener<'_, '_> {
                 if self.end(&at, &outer, Side::Outer)?.is_none() {
                     continue;
                 }
-                match edge.src == level.boundary.map_or(usize::MAX, |(inputs, _)| inputs) {
+                match level.boundary.is_some_and(|(inputs, _)| edge.src == inputs) {
                     true => (outer, inner),
                     false => (inner, outer),
                 }
-            } else {
-                let c = &level.graph.channels[edge.channel];
-                (c.src.port.clone(), c.dst.port.clone())
             };
             let channel = self.channels.len();
             self.channels.push(GraphChannel {

@@ -45,7 +45,7 @@ pub fn capacity_warnings(level: &Level<'_>, bounds: &[u64]) -> Vec<Diagnostic> {
         .iter()
         .zip(bounds)
         .filter_map(|(e, &bound)| {
-            let capacity = level.graph.channels.get(e.channel)?.capacity?;
+            let capacity = level.graph.channels.get(e.channel?)?.capacity?;
             (capacity < bound).then(|| {
                 Diagnostic::new(
                     Code::BufferTooSmall,

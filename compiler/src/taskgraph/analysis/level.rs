@@ -28,8 +28,10 @@ pub struct Edge {
     /// Samples consumed per firing of `dst`.
     pub consume: u64,
     pub initial_tokens: u64,
-    /// Index of the channel in the graph.
-    pub channel: usize,
+    /// Index of the channel in the graph; `None` for a sub-graph's boundary
+    /// edge, which is one of the standing-for task's port links
+    /// ([`HierarchyLevel::entered_through`]), not a channel of the file.
+    pub channel: Option<usize>,
     pub span: Span,
     /// `A.o → B.i`, for messages.
     pub label: String,
@@ -55,6 +57,10 @@ pub struct Level<'g> {
 pub struct HierarchyLevel<'g> {
     pub level: Level<'g>,
     pub under: Option<usize>,
+    /// In a sub-graph's top level: the task it stands for and how the task's
+    /// ports link to the sub-graph's open ports (the level's boundary edges
+    /// are these links, in order).
+    pub entered_through: Option<(&'g Task, &'g [PortLink])>,
 }
 
 impl<'g> Level<'g> {
@@ -128,7 +134,7 @@ impl<'g> Level<'g> {
                 produce,
                 consume,
                 initial_tokens: c.initial_tokens,
-                channel,
+                channel: Some(channel),
                 span: c.span,
                 label: format!(
                     "{}.{} → {}.{}",
@@ -214,8 +220,7 @@ impl<'g> Level<'g> {
                 produce,
                 consume,
                 initial_tokens: 0,
-                // No channel of the graph.
-                channel: usize::MAX,
+                channel: None,
                 span: inner.name.span,
                 label,
             });
@@ -243,7 +248,7 @@ impl<'g> Level<'g> {
 fn collect<'g>(
     graph: &'g TaskGraph,
     prefix: &str,
-    boundary: Option<(&Task, &[PortLink])>,
+    boundary: Option<(&'g Task, &'g [PortLink])>,
     hierarchy: &'g Hierarchy,
     under: Option<usize>,
     out: &mut Vec<HierarchyLevel<'g>>,
@@ -252,11 +257,16 @@ fn collect<'g>(
     let repath = |path: &str| format!("{prefix}{}", &path[graph.name.len().min(path.len())..]);
     for l in &levels {
         let path = repath(&l.path);
-        let level = match (l.enclosing, boundary) {
-            (None, Some((task, links))) => Level::subgraph(l.graph, task, links, path),
-            _ => Level::build(l.graph, l.enclosing, path),
+        let entered_through = boundary.filter(|_| l.enclosing.is_none());
+        let level = match entered_through {
+            Some((task, links)) => Level::subgraph(l.graph, task, links, path),
+            None => Level::build(l.graph, l.enclosing, path),
         };
-        out.push(HierarchyLevel { level, under });
+        out.push(HierarchyLevel {
+            level,
+            under,
+            entered_through,
+        });
     }
     for (i, s) in hierarchy.subgraphs.iter().enumerate() {
         let Some(task) = levels

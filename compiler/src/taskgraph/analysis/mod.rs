@@ -241,7 +241,11 @@ fn analyze_level(
                     .iter()
                     .map(|&n| level.nodes[n].name.clone())
                     .collect(),
-                channels: b.edges.iter().map(|&e| level.edges[e].channel).collect(),
+                channels: b
+                    .edges
+                    .iter()
+                    .filter_map(|&e| level.edges[e].channel)
+                    .collect(),
             });
             level_report.repetition = Some(counts);
         }
