@@ -13,14 +13,9 @@
 
 mod support;
 
-use std::path::PathBuf;
 use support::mqtt::{Fleet, folder_of};
 use support::repo_root;
 use support::robots::{Event, PEDANTIC, field, make, modes, robot_folders};
-
-fn fixture(name: &str) -> PathBuf {
-    repo_root().join("tests/fixtures/shared").join(name)
-}
 
 /// Starts the three scouts of `folder`'s fixture over MQTT behind one start
 /// barrier, kills `victim` at 1500 mission ms (300 ms at the scenario's time
@@ -68,28 +63,12 @@ fn a_shared_value_lives_on_its_owner_and_moves_when_the_owner_is_killed_over_mqt
     let Some(mut fleet) = Fleet::start("shared-mqtt") else {
         return;
     };
-    let folders = support::mqtt::build(&fixture("shared.mission"), &fleet.out, &[]);
-    let scenario = fixture("shared.scenario.json");
-    let (t0, start_at) = support::robots::start_barrier(folders.len());
-    let start_at = start_at.to_string();
-    let started: Vec<_> = ["a", "b", "c"]
-        .into_iter()
-        .map(|robot| {
-            let folder = folder_of(&folders, robot);
-            fleet.spawn(&folder, &scenario, "shared", &["--start-at", &start_at])
-        })
-        .collect();
-    // The scenario's kill of `a` at 1500 mission ms, at its time scale 0.2.
-    let kill_at = t0 + std::time::Duration::from_millis(300);
-    if let Some(left) = kill_at.checked_duration_since(std::time::Instant::now()) {
-        std::thread::sleep(left);
-    }
-    fleet.processes.kill(started[0].index);
-    let b = fleet.finish(&started[1], "shared");
-    let c = fleet.finish(&started[2], "shared");
+    // The scenario's kill of `a` at 1500 mission ms.
+    let traces = run_killing(&mut fleet, "shared", "a");
+    let (b, c) = (&traces[0].1, &traces[1].1);
 
     // Before the kill: `a` owned and told both; each read it.
-    for (robot, events) in [("b", &b), ("c", &c)] {
+    for (robot, events) in [("b", b), ("c", c)] {
         let told = of(events, "shared_value", &["key", "from"]);
         assert!(
             told.contains(&vec!["Scouts.NEAR".into(), "a".into()]),
@@ -101,9 +80,9 @@ fn a_shared_value_lives_on_its_owner_and_moves_when_the_owner_is_killed_over_mqt
         assert_eq!(owners, [["b", "a"]], "{robot}");
     }
     // `c` wrote to `b`, which took the write and read it.
-    assert!(of(&c, "shared_set", &["owner"]).contains(&vec!["b".into()]));
-    assert!(of(&b, "shared_set", &["owner", "from"]).contains(&vec!["b".into(), "c".into()]));
-    assert_eq!(modes(&b), ["FAR", "NEAR_MODE", "CLOSER"]);
+    assert!(of(c, "shared_set", &["owner"]).contains(&vec!["b".into()]));
+    assert!(of(b, "shared_set", &["owner", "from"]).contains(&vec!["b".into(), "c".into()]));
+    assert_eq!(modes(b), ["FAR", "NEAR_MODE", "CLOSER"]);
 }
 
 /// The owner the strategy names (`tests/fixtures/shared_named`: `b`) holds
