@@ -107,6 +107,14 @@ pub struct InnerTask {
     pub path: String,
     pub inputs: Vec<PortUse>,
     pub outputs: Vec<PortUse>,
+    /// A time-triggered task's period (`trigger="time" period=…`), in whole
+    /// mission milliseconds: it fires at most once per period. Its first
+    /// firing in the robot's life starts when the schedule reaches it; each
+    /// later one waits until the previous firing's start + `period_ms` (a
+    /// firing reached later starts at once), however many calls apart, so
+    /// the call running it waits too. `None`: a data-triggered task, fired
+    /// when the schedule reaches it.
+    pub period_ms: Option<u64>,
 }
 
 /// A data port of an inner task: `rate` tokens per firing on `channel`.

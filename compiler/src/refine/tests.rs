@@ -496,3 +496,47 @@ fn a_sub_graph_reference_opens_into_a_step_running_its_schedule_once() {
     assert_eq!(opened.tasks[1].inputs[0].channel, 3);
     assert_eq!(opened.tasks[2].outputs[0].channel, 4);
 }
+
+/// A time-triggered inner task carries its period, from the checked model,
+/// in whole milliseconds; a period the service task's clock cannot count
+/// (a fraction of a millisecond) and a time-triggered task standing for a
+/// sub-graph refuse the graph instead of firing it as a data task.
+#[test]
+fn a_time_triggered_inner_task_carries_its_period() {
+    use crate::taskgraph::subgraph::Hierarchy;
+    let none = Hierarchy::default();
+    let kmeans =
+        crate::taskgraph::load_task_graph(FileId(9), &shared("taskgraphs/kmeans.taskgraph.xml"))
+            .0
+            .unwrap();
+    let opened = robot::steps_of(&kmeans, &none).unwrap();
+    let periods: Vec<(&str, Option<u64>)> = opened
+        .tasks
+        .iter()
+        .map(|t| (t.path.as_str(), t.period_ms))
+        .collect();
+    assert_eq!(periods[0], ("ReadPoints", Some(1000)));
+    assert!(periods[1..].iter().all(|(_, p)| p.is_none()), "{periods:?}");
+    let graph = |period: &str, subgraph: &str| {
+        let text = format!(
+            r#"<TaskGraph name="g" xmlns="urn:semo:taskgraph:1">
+  <Task name="A" trigger="time" period="{period}"{subgraph}><Port name="o" dir="out"/></Task>
+  <Task name="B"><Port name="i" dir="in"/></Task>
+  <Channel src="A.o" dst="B.i"/>
+</TaskGraph>"#
+        );
+        let (graph, diagnostics) = crate::taskgraph::load_task_graph(FileId(9), &text);
+        assert!(diagnostics.is_empty(), "{diagnostics:?}");
+        graph.unwrap()
+    };
+    let opened = robot::steps_of(&graph("2 SEC", ""), &none).unwrap();
+    assert_eq!(opened.tasks[0].period_ms, Some(2000));
+    let refused = robot::steps_of(&graph("0.5 MSEC", ""), &none).unwrap_err();
+    assert!(
+        refused.contains("`A` with a period of 0.5 ms, not a whole number"),
+        "{refused}"
+    );
+    let refused =
+        robot::steps_of(&graph("1 SEC", r#" subgraph="s.taskgraph.xml""#), &none).unwrap_err();
+    assert!(refused.contains("standing for a sub-graph"), "{refused}");
+}

@@ -30,7 +30,7 @@ use crate::refine::program::{
 use crate::span::Span;
 use crate::taskgraph::TaskGraph;
 use crate::taskgraph::analysis::{buffers, consistency, level::Level, schedule};
-use crate::taskgraph::model::{Direction, LoopNode, LoopType, PortKind, Task};
+use crate::taskgraph::model::{Direction, LoopNode, LoopType, PortKind, Task, Trigger};
 use crate::taskgraph::subgraph::{Hierarchy, PortLink};
 use std::collections::HashMap;
 
@@ -179,6 +179,23 @@ pub(crate) fn steps_of(graph: &TaskGraph, hierarchy: &Hierarchy) -> Result<Opene
         channels: opener.channels,
         tasks: opener.tasks,
     })
+}
+
+/// The longest period of a time-triggered inner task (about 31 years):
+/// release times stay far inside the generated program's `int64_t`
+/// milliseconds.
+pub const MAX_INNER_PERIOD_MS: u64 = 1_000_000_000_000;
+
+/// Inner task `path`'s period as the service task's clock counts it: whole
+/// milliseconds (the checked model's period is positive and finite), else
+/// why the graph cannot run.
+fn whole_period(path: &str, period_ms: f64) -> Result<u64, String> {
+    if period_ms.fract() != 0.0 || !(1.0..=MAX_INNER_PERIOD_MS as f64).contains(&period_ms) {
+        return Err(format!(
+            "has time-triggered task `{path}` with a period of {period_ms} ms, not a whole number of milliseconds from 1 to {MAX_INNER_PERIOD_MS} (the service task's clock counts whole milliseconds)"
+        ));
+    }
+    Ok(period_ms as u64)
 }
 
 /// Tokens a graph's channels hold, at most: the generated program keeps
@@ -367,10 +384,15 @@ impl Opener<'_, '_> {
                 Direction::Out => outputs.push(used),
             }
         }
+        let period_ms = match task.trigger {
+            Trigger::Time { period_ms } => Some(whole_period(path, period_ms)?),
+            Trigger::Data | Trigger::Control => None,
+        };
         self.tasks.push(InnerTask {
             path: path.to_string(),
             inputs,
             outputs,
+            period_ms,
         });
         Ok(self.tasks.len() - 1)
     }
@@ -477,6 +499,13 @@ impl Opener<'_, '_> {
                     let path = self.below(&full);
                     let step = match &task.loop_node {
                         None if task.subgraph.is_some() => {
+                            // Its firing is a whole iteration of another
+                            // graph: no inner task to hold its period.
+                            if let Trigger::Time { period_ms } = task.trigger {
+                                return Err(format!(
+                                    "has time-triggered task `{path}` (every {period_ms} ms) standing for a sub-graph"
+                                ));
+                            }
                             // The sub-graph's top level, at the task's path.
                             let inner = levels
                                 .iter()
