@@ -246,11 +246,82 @@ fn a_sub_graph_task_runs_one_iteration_of_its_sub_graph_in_the_looped_schedule()
     assert_eq!(graph_data(&simulated), data, "semo simulate");
 }
 
+/// How much later than the simulator's a `linux-sim` release may be (mission
+/// ms), as `tests/differential.rs` bounds its times: each release waits from
+/// the previous one's actual start, so a thread woken late delays the ones
+/// after it too (at `time_scale` 0.2 a wall ms is 5 mission ms).
+const LATE_MS: i64 = 500;
+/// How much earlier: never, but for the start barrier (the robots of a run
+/// start within 3 mission ms of each other, `tests/differential.rs`).
+const EARLY_MS: i64 = 10;
+
+/// The releases of `task`'s firings in a trace (`graph_fire`'s `release`),
+/// each checked against the line's own time (a firing is traced after it
+/// starts).
+fn releases(events: &[support::robots::Event], task: &str) -> Vec<i64> {
+    events
+        .iter()
+        .filter(|e| field(e, "event") == "graph_fire" && field(e, "task") == task)
+        .map(|e| {
+            let release: i64 = field(e, "release")
+                .parse()
+                .unwrap_or_else(|_| panic!("no release: {e:?}"));
+            let t = e["t"].as_i64().unwrap();
+            assert!(t >= release, "traced before its release: {e:?}");
+            release
+        })
+        .collect()
+}
+
+/// A time-triggered inner task (`sampler`'s Sample, every 200 ms, twice per
+/// call of `sample()`, which `repeat()` calls again as soon as one ends)
+/// fires at most once per period across calls, in the `linux-sim` program
+/// as in `semo simulate`: its releases are at least 200 ms apart (exactly
+/// 200 in the simulator, which has no late threads), the C ones never
+/// earlier than the simulator's and at most [`LATE_MS`] later, and the
+/// graph's firings come in the same order (the C run, later, may end with
+/// fewer of them).
+#[test]
+fn a_time_triggered_inner_task_fires_once_per_period_in_linux_sim_and_the_simulator() {
+    let scenario = std::fs::read_to_string(fixture("periodic.scenario.json")).unwrap();
+    let out = scratch("loops/periodic");
+    let traces = run_in_simulation(&fixture("periodic.mission"), &out, &scenario);
+    let c = events(&traces["c"]);
+    let simulated = events(&simulate("periodic.mission", "periodic.scenario.json"));
+    let (c_releases, sim_releases) = (releases(&c, "Sample"), releases(&simulated, "Sample"));
+    assert!(c_releases.len() >= 4, "{c_releases:?}");
+    for (name, releases) in [("linux-sim", &c_releases), ("semo simulate", &sim_releases)] {
+        assert!(
+            releases.windows(2).all(|w| w[1] - w[0] >= 200),
+            "{name}: {releases:?}"
+        );
+    }
+    assert!(
+        sim_releases.windows(2).all(|w| w[1] - w[0] == 200),
+        "{sim_releases:?}"
+    );
+    for (k, (c, sim)) in c_releases.iter().zip(&sim_releases).enumerate() {
+        assert!(
+            (sim - EARLY_MS..=sim + LATE_MS).contains(c),
+            "release {k}: linux-sim {c}, simulator {sim}\n{c_releases:?}\n{sim_releases:?}"
+        );
+    }
+    let (c_order, sim_order) = (graph_events(&c), graph_events(&simulated));
+    assert!(
+        sim_order.starts_with(&c_order),
+        "linux-sim {c_order:?}\nsemo simulate {sim_order:?}"
+    );
+    assert_eq!(
+        c_order[..3],
+        ["sampler/Sample", "sampler/Sample", "sampler/Average"]
+    );
+}
+
 #[test]
 fn graph_services_compile_pedantically_with_gcc_and_clang() {
     for target in ["linux", "linux-sim"] {
         for cc in compilers() {
-            for mission in ["loops.mission", "tracking.mission"] {
+            for mission in ["loops.mission", "tracking.mission", "periodic.mission"] {
                 let out = scratch(&format!("loops/compile-{target}-{cc}-{mission}"));
                 let built = build(&fixture(mission), target, &out);
                 assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
@@ -308,7 +379,7 @@ fn a_service_graph_whose_sub_graph_cannot_be_used_is_refused_on_the_call() {
         for file in ["tracking.mission", "clusterer.robot.xml"] {
             std::fs::copy(fixture(file), dir.join(file)).unwrap();
         }
-        for graph in ["kmeans", "data_loop", "convergent_loop"] {
+        for graph in ["kmeans", "data_loop", "convergent_loop", "sampler"] {
             let file = format!("graphs/{graph}.taskgraph.xml");
             std::fs::copy(fixture(&file), dir.join(&file)).unwrap();
         }

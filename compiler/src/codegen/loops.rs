@@ -22,6 +22,16 @@
 //! back after it (`graph_move`); the sub-graph's tasks are inner tasks like
 //! the others (`graph_fire`, their path below the task: `Track/Predict`).
 //!
+//! A time-triggered inner task ([`InnerTask::period_ms`]) fires at most
+//! once per period: before each of its firings the service task waits
+//! (`release_<n>`) until its previous firing's start + the period, the
+//! first firing in the program's life at once, and traces the firing's
+//! start (`graph_fire`'s `release`); so a call waits as long as its
+//! iteration's firings need. A stop request does not cut an iteration (its
+//! channels must hold the next call's tokens): the call ends when the
+//! iteration does, without its service time; the program stopping abandons
+//! it. `sim/engine/loops.rs` times the firings by the same rule.
+//!
 //! Port arrays (a firing's tokens, a loop's staged tokens) are static:
 //! each is no larger than the channel it fills or drains ([`check`]), and
 //! refinement bounds the channels' tokens (`MAX_GRAPH_TOKENS`), so the
@@ -73,7 +83,8 @@ pub(super) fn graph_runner(service: &GraphService, simulated: bool) -> String {
         "/* Task graph `{}`, run by this service task: one iteration per call. */",
         c::comment(&service.graph)
     );
-    if has_loops || !service.channels.is_empty() {
+    let periodic = service.tasks.iter().any(|t| t.period_ms.is_some());
+    if has_loops || periodic || !service.channels.is_empty() {
         out.push_str("#include <stdio.h>\n");
     }
     if !service.channels.is_empty() {
@@ -93,6 +104,9 @@ pub(super) fn graph_runner(service: &GraphService, simulated: bool) -> String {
     );
     for (index, task) in service.tasks.iter().enumerate() {
         let exit_of = exits.iter().find(|(t, _)| *t == index).map(|(_, l)| *l);
+        if let Some(period) = task.period_ms {
+            release(&mut out, index, task, period);
+        }
         inner_task(&mut out, service, index, task, exit_of, simulated, &graph);
     }
     if has_loops {
@@ -190,6 +204,22 @@ fn text_size(ports: &[PortUse]) -> u64 {
         .saturating_mul(TOKEN_TEXT)
         .saturating_add(1)
         .min(GRAPH_TEXT_MAX)
+}
+
+/// The release of time-triggered inner task `task` (`release_<n>`, called
+/// before each of its firings): its first firing in the program's life
+/// starts at once, each later one no earlier than `period` ms after the
+/// previous one's start; the start is kept for the trace (`release`). A stop
+/// request does not cut the wait (an iteration is never left half run: its
+/// channels would not hold the next call's tokens); the program stopping
+/// does, and the iteration is abandoned (false).
+fn release(out: &mut String, index: usize, task: &InnerTask, period: u64) {
+    let name = format!("{index}_{}", c::ident(&task.path));
+    let _ = writeln!(
+        out,
+        "/* Inner task `{}` is time-triggered: it fires at most once every {period} ms. */\nstatic int64_t start_{name}; /* its last firing's start, mission ms */\n\nstatic bool release_{name}(void)\n{{\n    static bool fired;\n    if (fired && !semo_sleep_until(start_{name} + {period}))\n        return false;\n    start_{name} = semo_now_ms();\n    fired = true;\n    return true;\n}}\n",
+        c::comment(&task.path)
+    );
 }
 
 /// The work function of inner task `task` and its firing, `inner_<n>`.
@@ -361,9 +391,19 @@ fn inner_task(
             field.to_string()
         }
     };
+    let released = match task.period_ms {
+        Some(_) => {
+            let _ = writeln!(
+                out,
+                "    char released[24];\n    snprintf(released, sizeof released, \"%lld\", (long long)start_{name});"
+            );
+            ", \"release\", released"
+        }
+        None => "",
+    };
     let _ = writeln!(
         out,
-        "    semo_trace(\"graph_fire\", \"graph\", {graph}, \"task\", {}, \"read\", {}, \"wrote\", {}, NULL);",
+        "    semo_trace(\"graph_fire\", \"graph\", {graph}, \"task\", {}, \"read\", {}, \"wrote\", {}{released}, NULL);",
         c::string(&task.path),
         text_of("read", &task.inputs),
         text_of("wrote", &task.outputs)
@@ -529,21 +569,37 @@ fn steps(
         match step {
             GraphStep::Fire { task, count } => {
                 let function = firing(service, *task);
-                let call = match exit {
+                let mut call = match exit {
                     Some((exit_task, d)) if exit_task == *task => {
                         format!("if ({function}(n{d}))\n{pad}    exit_flag{d} = true;")
                     }
                     _ => format!("{function}();"),
                 };
+                // A time-triggered task waits for its release; the program
+                // stopping abandons the iteration.
+                let periodic = service
+                    .tasks
+                    .get(*task)
+                    .is_some_and(|t| t.period_ms.is_some());
+                if periodic {
+                    call = format!(
+                        "if (!release_{}())\n{pad}    return;\n{pad}{call}",
+                        function.trim_start_matches("inner_")
+                    );
+                }
                 if *count == 1 {
                     let _ = writeln!(out, "{pad}{call}");
                 } else {
                     *depth += 1;
                     let i = format!("i{depth}");
                     let call = call.replace('\n', "\n    ");
+                    let (open, close) = match periodic {
+                        true => (" {", format!("\n{pad}}}")),
+                        false => ("", String::new()),
+                    };
                     let _ = writeln!(
                         out,
-                        "{pad}for (unsigned long {i} = 0; {i} < {count}; {i}++)\n{pad}    {call}"
+                        "{pad}for (unsigned long {i} = 0; {i} < {count}; {i}++){open}\n{pad}    {call}{close}"
                     );
                 }
             }

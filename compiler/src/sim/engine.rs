@@ -99,6 +99,12 @@ enum Event {
         /// Shared by every robot the message goes to.
         message: Rc<Message>,
     },
+    /// The trace lines of a service graph's iteration under way that are
+    /// due now (`loops.rs`: its time-triggered tasks wait for their periods).
+    GraphTrace {
+        robot: usize,
+        epoch: u32,
+    },
     ServiceDone {
         robot: usize,
         task: usize,
@@ -118,10 +124,11 @@ impl Event {
     fn order(&self) -> u8 {
         match self {
             Event::Deliver { .. } => 0,
-            Event::ServiceDone { .. } => 1,
-            Event::Fault(_) => 2,
-            Event::Operator(_) => 3,
-            Event::Fire { .. } => 4,
+            Event::GraphTrace { .. } => 1,
+            Event::ServiceDone { .. } => 2,
+            Event::Fault(_) => 3,
+            Event::Operator(_) => 4,
+            Event::Fire { .. } => 5,
         }
     }
 }
@@ -221,6 +228,10 @@ struct TaskState {
     service: String,
     /// Invalidates the completion of a call that was stopped.
     generation: u64,
+    /// When the service graph's iteration the call runs ends (its
+    /// time-triggered tasks wait for their periods): a stop ends the call
+    /// then, not before.
+    graph_until: i64,
 }
 
 /// One robot's running program (one process of `linux-sim`).
@@ -283,8 +294,9 @@ struct Robot<'p> {
     progressed: bool,
     /// The battery policies' state: levels and levelled sensors' samples.
     resources: battery::Resources,
-    /// The channels of the service graphs run so far (`loops.rs`).
-    graph_channels: loops::GraphChannels,
+    /// The channels, time-triggered tasks' starts and due trace lines of
+    /// the service graphs run so far (`loops.rs`).
+    graphs: loops::GraphState,
 }
 
 pub struct Sim<'p> {
@@ -423,7 +435,7 @@ impl<'p> Robot<'p> {
             fire_token: 0,
             progressed: false,
             resources: battery::Resources::new(program, at),
-            graph_channels: loops::GraphChannels::default(),
+            graphs: loops::GraphState::default(),
         }
     }
 
@@ -605,6 +617,12 @@ impl<'p> Sim<'p> {
                             None => self.robots[robot].next_fire = None,
                         }
                     }
+                }
+            }
+            Event::GraphTrace { robot, epoch } => {
+                let r = &self.robots[robot];
+                if r.alive && r.epoch == epoch {
+                    self.graph_trace(robot);
                 }
             }
             Event::ServiceDone {
@@ -1045,9 +1063,11 @@ impl<'p> Sim<'p> {
                 sent_at: None,
             });
         }
-        self.run_graph(r, task);
+        // The service's time counts from the end of the graph's iteration.
+        let until = self.run_graph(r, task);
+        self.robots[r].tasks[t].1.graph_until = until;
         self.schedule(
-            self.now + ms,
+            until + ms,
             Event::ServiceDone {
                 robot: r,
                 task: t,
@@ -1067,10 +1087,26 @@ impl<'p> Sim<'p> {
         self.emit(r, "call_end", fields);
     }
 
-    /// `UFControl_StopTask`: the call ends now.
+    /// `UFControl_StopTask`: the call ends now, or when its graph's
+    /// iteration ends (a stop does not cut one: `codegen/loops.rs`).
     fn stop_task(&mut self, r: usize, task: &str) {
         let t = self.robots[r].task_index(task);
-        if self.robots[r].tasks[t].1.busy {
+        let state = &mut self.robots[r].tasks[t].1;
+        if !state.busy {
+            return;
+        }
+        if state.graph_until > self.now {
+            state.generation += 1;
+            let (at, generation) = (state.graph_until, state.generation);
+            self.schedule(
+                at,
+                Event::ServiceDone {
+                    robot: r,
+                    task: t,
+                    generation,
+                },
+            );
+        } else {
             self.end_call(r, t);
         }
     }

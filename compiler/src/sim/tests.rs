@@ -687,3 +687,57 @@ fn a_lost_owner_is_followed_by_the_fullest_robot_when_the_team_elects_by_battery
     let c_takes = events(&run_, "c", "shared_set", &["owner", "from"]);
     assert!(c_takes.iter().any(|(_, f)| f == &["c", "b"]), "{c_takes:?}");
 }
+
+/// A time-triggered inner task of a service graph fires at most once per
+/// period, counted across calls (tests/fixtures/loops/periodic.mission:
+/// `sampler`'s Sample every 200 ms, twice per call, `2(Sample) Average`):
+/// its first firing in the robot's life at the first call's start, each
+/// later one exactly 200 ms after the previous one's start (`release`, the
+/// line's time), so the second call waits for its first Sample; the call's
+/// service time (50 ms) counts from the iteration's end, and the trace
+/// stays in time order. All read from the trace: no wall clock.
+#[test]
+fn a_time_triggered_inner_task_fires_once_per_period_across_calls() {
+    let programs = programs("tests/fixtures/loops/periodic.mission");
+    let scenario =
+        std::fs::read_to_string(repo("tests/fixtures/loops/periodic.scenario.json")).unwrap();
+    let (run, _) = run(&programs, &scenario, 0);
+    let at = |event: &str, task: Option<&str>| -> Vec<i64> {
+        run.trace
+            .iter()
+            .filter(|e| e.event == event && task.is_none_or(|t| e.field("task") == Some(t)))
+            .map(|e| e.t)
+            .collect()
+    };
+    let samples = at("graph_fire", Some("Sample"));
+    let releases: Vec<i64> = run
+        .trace
+        .iter()
+        .filter(|e| e.event == "graph_fire" && e.field("task") == Some("Sample"))
+        .map(|e| e.field("release").unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(samples, releases, "a firing is traced at its release");
+    let starts = at("call_start", None);
+    let ends = at("call_end", None);
+    let averages = at("graph_fire", Some("Average"));
+    assert!(samples.len() >= 6, "{samples:?}");
+    let first = starts[0];
+    let expected: Vec<i64> = (0..samples.len() as i64).map(|k| first + 200 * k).collect();
+    assert_eq!(samples, expected);
+    // Each call: its Samples, then Average with the second; its end 50 ms on.
+    for (call, end) in ends.iter().enumerate() {
+        assert_eq!(averages[call], samples[2 * call + 1]);
+        assert_eq!(*end, averages[call] + 50);
+    }
+    // The second call starts before Sample is due again, and waits.
+    assert!(starts[1] < samples[2], "{starts:?} {samples:?}");
+    // Average reads the two samples of its call (1 each: nothing read).
+    let read: Vec<&str> = run
+        .trace
+        .iter()
+        .filter(|e| e.event == "graph_fire" && e.field("task") == Some("Average"))
+        .filter_map(|e| e.field("read"))
+        .collect();
+    assert!(read.iter().all(|r| *r == "1,1"), "{read:?}");
+    assert!(run.trace.windows(2).all(|w| w[0].t <= w[1].t));
+}

@@ -145,6 +145,11 @@ void semo_sleep_ms(int64_t ms)
         semo__wait_until(semo_now_ms() + ms);
 }
 
+bool semo_sleep_until(int64_t at_ms)
+{
+    return semo__wait_until(at_ms);
+}
+
 /* ----------------------------------------------------------------- traces */
 
 static FILE *g_trace;

@@ -96,6 +96,10 @@ bool semo_value_truthy(const semo_value *v);
 
 int64_t semo_now_ms(void);         /* mission time since start */
 void semo_sleep_ms(int64_t ms);    /* mission ms; returns early when the program stops */
+/* Waits until mission time `at_ms` (no earlier; at once when it is past);
+ * false when the program stops first. A service task's time-triggered inner
+ * task waits for its period with it. POSIX only. */
+bool semo_sleep_until(int64_t at_ms);
 
 /* -------------------------------------------------------- program tables */
 

@@ -15,23 +15,41 @@
 //! channel short of tokens or
 //! over its bound is traced (`graph_error`) and ends the run, where the
 //! generated program aborts.
+//!
+//! A time-triggered inner task fires at most once per period, as the
+//! generated `release_<n>` waits: its first firing in the robot's life
+//! (a restart is a new life) starts when the iteration reaches it, each
+//! later one at `max(reached, previous start + period)`, the iteration's
+//! clock moving on to that start. The iteration is still computed when the
+//! call starts (nothing outside the service task sees its channels), its
+//! trace lines put out when due (`Event::GraphTrace`; `graph_fire`'s
+//! `release` is the start), and the call's service time counts from the
+//! iteration's end; a stop ends the call then (`Sim::stop_task`).
 
-use super::Sim;
+use super::{Event, Sim};
 use crate::codegen::GRAPH_TEXT_MAX;
 use crate::refine::{GraphService, GraphStep, LoopPort};
+use crate::sim::trace::TraceEvent;
 use std::collections::{HashMap, VecDeque};
 use std::rc::Rc;
 
-/// One robot's service graph channels, by service task.
+/// One robot's service graphs: channels by service task, the last start
+/// of each time-triggered task by (service task, inner task), and the
+/// trace lines of an iteration under way not yet due, in time order.
 #[derive(Debug, Default)]
-pub(super) struct GraphChannels(HashMap<String, Vec<VecDeque<i64>>>);
+pub(super) struct GraphState {
+    channels: HashMap<String, Vec<VecDeque<i64>>>,
+    starts: HashMap<(String, usize), i64>,
+    due: VecDeque<TraceEvent>,
+}
 
 /// A channel that is short of tokens or full: the run stops.
 struct Broken;
 
 impl Sim<'_> {
-    /// `run_graph` of service task `task`, if it runs a graph.
-    pub(super) fn run_graph(&mut self, r: usize, task: &str) {
+    /// `run_graph` of service task `task`, if it runs a graph: when its
+    /// iteration ends (now, unless a time-triggered task waited).
+    pub(super) fn run_graph(&mut self, r: usize, task: &str) -> i64 {
         let program = self.robots[r].program;
         // A graph without a schedule: warned on the call (W070, W071) and
         // refused by code generation; simulated as its call's time alone.
@@ -41,7 +59,7 @@ impl Sim<'_> {
             .find(|g| g.task == task)
             .and_then(|g| Some((g, g.steps.as_ref().ok()?)))
         else {
-            return;
+            return self.now;
         };
         let graph: Rc<str> = service.graph.as_str().into();
         let exits: Vec<(String, u64)> = self
@@ -52,8 +70,8 @@ impl Sim<'_> {
             .map(|w| w.loops.clone())
             .unwrap_or_default();
         let mut channels = self.robots[r]
-            .graph_channels
-            .0
+            .graphs
+            .channels
             .remove(task)
             .unwrap_or_else(|| {
                 service
@@ -63,8 +81,11 @@ impl Sim<'_> {
                     .collect()
             });
         let mut run = GraphRun {
+            clock: self.now,
+            scheduled: None,
             sim: self,
             robot: r,
+            task,
             graph,
             service,
             exits: &exits,
@@ -72,16 +93,36 @@ impl Sim<'_> {
         };
         // A broken channel was traced; the generated program aborts there.
         let _ = run.steps(steps, None);
+        let until = run.clock;
         self.robots[r]
-            .graph_channels
-            .0
+            .graphs
+            .channels
             .insert(task.to_string(), channels);
+        until
+    }
+
+    /// `Event::GraphTrace`: the graph lines due by now.
+    pub(super) fn graph_trace(&mut self, r: usize) {
+        let now = self.now;
+        let due = &mut self.robots[r].graphs.due;
+        while due.front().is_some_and(|e| e.t <= now) {
+            if let Some(line) = due.pop_front() {
+                self.trace.push(line);
+            }
+        }
     }
 }
 
 struct GraphRun<'s, 'p> {
     sim: &'s mut Sim<'p>,
     robot: usize,
+    /// The service task running the graph.
+    task: &'s str,
+    /// The iteration's time: the call's start, moved on by the waits of
+    /// time-triggered tasks.
+    clock: i64,
+    /// The last time a `GraphTrace` event was scheduled for.
+    scheduled: Option<i64>,
     graph: Rc<str>,
     service: &'p GraphService,
     exits: &'s [(String, u64)],
@@ -110,6 +151,38 @@ fn text(tokens: &[i64]) -> Rc<str> {
 }
 
 impl GraphRun<'_, '_> {
+    /// A trace line at the iteration's time: now, or when it is due.
+    fn emit(&mut self, event: &'static str, fields: Vec<(&'static str, Rc<str>)>) {
+        let line = TraceEvent {
+            t: self.clock,
+            robot: self.robot,
+            event,
+            fields,
+            value: None,
+            sent_at: None,
+        };
+        if self.clock <= self.sim.now {
+            self.sim.trace.push(line);
+            return;
+        }
+        // In time order with the lines of the robot's other graph services
+        // (after those due at the same time).
+        let due = &mut self.sim.robots[self.robot].graphs.due;
+        let at = due.partition_point(|e| e.t <= line.t);
+        due.insert(at, line);
+        if self.scheduled != Some(self.clock) {
+            self.scheduled = Some(self.clock);
+            let epoch = self.sim.robots[self.robot].epoch;
+            self.sim.schedule(
+                self.clock,
+                Event::GraphTrace {
+                    robot: self.robot,
+                    epoch,
+                },
+            );
+        }
+    }
+
     fn broken(&mut self, channel: usize, what: &str) -> Broken {
         let label = self.service.channels[channel].label.as_str();
         let fields = vec![
@@ -117,7 +190,7 @@ impl GraphRun<'_, '_> {
             ("channel", Rc::from(label)),
             ("error", Rc::from(what)),
         ];
-        self.sim.emit(self.robot, "graph_error", fields);
+        self.emit("graph_error", fields);
         Broken
     }
 
@@ -150,6 +223,20 @@ impl GraphRun<'_, '_> {
             return Ok(());
         };
         let path = task.path.as_str();
+        // A time-triggered task waits for its period (`release_<n>`).
+        let release = task.period_ms.map(|period| {
+            let key = (self.task.to_string(), index);
+            let starts = &mut self.sim.robots[self.robot].graphs.starts;
+            let start = match starts.get(&key) {
+                Some(last) => self
+                    .clock
+                    .max(last.saturating_add(i64::try_from(period).unwrap_or(i64::MAX))),
+                None => self.clock,
+            };
+            starts.insert(key, start);
+            self.clock = start;
+            start
+        });
         let mut read = Vec::new();
         for port in &task.inputs {
             self.take(port.channel, port.rate, &mut read)?;
@@ -167,13 +254,16 @@ impl GraphRun<'_, '_> {
             })
             .collect();
         let wrote: Vec<i64> = written.iter().flatten().copied().collect();
-        let fields = vec![
+        let mut fields = vec![
             ("graph", self.graph.clone()),
             ("task", Rc::from(path)),
             ("read", text(&read)),
             ("wrote", text(&wrote)),
         ];
-        self.sim.emit(self.robot, "graph_fire", fields);
+        if let Some(start) = release {
+            fields.push(("release", Rc::from(start.to_string().as_str())));
+        }
+        self.emit("graph_fire", fields);
         for (port, tokens) in task.outputs.iter().zip(&written) {
             self.put(port.channel, tokens)?;
         }
@@ -260,7 +350,7 @@ impl GraphRun<'_, '_> {
                         ("loop", Rc::from(path.as_str())),
                         ("iterations", Rc::from(n.to_string().as_str())),
                     ];
-                    self.sim.emit(self.robot, "graph_loop", fields);
+                    self.emit("graph_loop", fields);
                     for (port, kept) in ports.iter().zip(&staged) {
                         if !port.input {
                             self.put(port.outer, kept)?;
