@@ -19,7 +19,11 @@
 //!   `loop(P)` holding it): the robot cannot keep up.
 //!
 //! Execution times (`wcet`) of the service graphs count milliseconds of
-//! mission time, the unit a mission's periods are compared in.
+//! mission time, the unit a mission's periods are compared in. A
+//! time-triggered task fires at most once per period, so a graph's
+//! iteration period is also at least, for each of them, its firings per
+//! iteration × its period (`taskgraph::analysis::triggers`): the period
+//! W073 and the hover use is the larger of that bound and the throughput's.
 //!
 //! A robot's iteration period is that of the slowest service graph it
 //! calls: the graphs only meet at the control task, which takes no time, so
@@ -37,6 +41,7 @@ use crate::refine::{RobotProgram, State, StateKind};
 use crate::sema::Mission;
 use crate::span::Span;
 use crate::taskgraph::analysis::ratio::Ratio;
+use crate::taskgraph::analysis::triggers::{self, TimeBound};
 use crate::workspace::GraphRun;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -58,7 +63,8 @@ pub struct RobotDataflow {
     pub team: String,
     pub robot: String,
     /// Milliseconds per iteration, exact; `None` when no service graph the
-    /// robot calls has execution times (nothing bounds it).
+    /// robot calls has execution times or a time-triggered task (nothing
+    /// bounds it).
     pub period: Option<Ratio>,
     /// The service whose graph bounds the period, and that graph as the
     /// catalog names it.
@@ -154,7 +160,7 @@ pub fn team_periods_at(
                 format!("\n- `{}`: {p} ms (`{service}`: `{graph}`)", r.robot)
             }
             _ => format!(
-                "\n- `{}`: not bounded (it calls no service graph with execution times)",
+                "\n- `{}`: not bounded (it calls no service graph with execution times or time-triggered tasks)",
                 r.robot
             ),
         };
@@ -189,7 +195,14 @@ fn robot(
     for call in graph_calls(input, program, robot_type) {
         graphs.extend(call.run.graph.as_ref().map(|g| g.file));
         diagnostics.extend(graph_problems(input.file, &call));
-        let Some(period) = iteration_period(&call.run) else {
+        let throughput = iteration_period(&call.run);
+        let timed = time_bound(&call.run);
+        // The time-triggered tasks bound it when the throughput does not
+        // say more.
+        let by_time = timed
+            .as_ref()
+            .filter(|b| throughput.is_none_or(|p| b.period > p));
+        let Some(period) = by_time.map(|b| b.period).or(throughput) else {
             continue;
         };
         if found.period.is_none_or(|p| period > p) {
@@ -200,20 +213,37 @@ fn robot(
             && let Ok(asked_ms) = u64::try_from(asked)
             && period > Ratio::new(asked_ms, 1).unwrap_or(Ratio::ONE)
         {
+            let why = match by_time {
+                Some(b) => format!(
+                    "at least {} ms per iteration (its time-triggered task `{}` fires {} time{} per iteration, at most once every {} ms)",
+                    b.period,
+                    b.task,
+                    b.firings,
+                    if b.firings == 1 { "" } else { "s" },
+                    b.period_ms
+                ),
+                None => format!("{period} ms per iteration (its throughput)"),
+            };
             let mut d = Diagnostic::new(
                 Code::DataflowTooSlow,
                 input.file,
                 span,
                 format!(
-                    "the task graph `{}` of `{}` takes {} ms per iteration (its throughput), longer than the {asked} ms period asked for here: the robots running it cannot keep up",
-                    call.path, call.service, period
+                    "the task graph `{}` of `{}` takes {why}, longer than the {asked} ms period asked for here: the robots running it cannot keep up",
+                    call.path, call.service
                 ),
             );
             d.relate(
                 call.state.span,
                 format!("`{}` is called here", call.service),
             );
-            if let Some(graph) = &call.run.graph {
+            if let Some(b) = by_time {
+                d.related.push(Related {
+                    file: b.file,
+                    span: b.span,
+                    message: format!("`{}` bounds the period", b.task),
+                });
+            } else if let Some(graph) = &call.run.graph {
                 for task in critical_tasks(&call.run) {
                     if let Some(t) = graph.tasks.iter().find(|t| t.name.name == *task) {
                         d.related.push(Related {
@@ -297,6 +327,12 @@ fn asked_period(states: &[State], index: usize) -> Option<(i64, Span)> {
 fn iteration_period(run: &GraphRun) -> Option<Ratio> {
     let period = run.report.levels.first()?.throughput.as_ref()?.period;
     (period.num > 0).then_some(period)
+}
+
+/// The bound the graph's time-triggered tasks put on its period.
+fn time_bound(run: &GraphRun) -> Option<TimeBound> {
+    let graph = run.graph.as_ref()?;
+    triggers::time_bound(graph, &run.hierarchy, &run.report)
 }
 
 /// The tasks around the cycle that bounds the graph's period.

@@ -364,3 +364,82 @@ fn a_declaration_refused_for_its_last_robots_name_gives_no_dataflow() {
         refused.diagnostics
     );
 }
+
+/// `A` is time-triggered every 30 ms and fires twice per iteration (`B`
+/// takes two samples); no execution times: only the period bounds it.
+const TIME_TRIGGERED: &str = r#"<TaskGraph name="scan" xmlns="urn:semo:taskgraph:1">
+  <Task name="A" trigger="time" period="30 MSEC"><Port name="o" dir="out"/></Task>
+  <Task name="B"><Port name="i" dir="in" rate="2"/></Task>
+  <Channel src="A.o" dst="B.i"/>
+</TaskGraph>
+"#;
+
+/// The same task inside a D-type loop of 4 iterations, with `B` taking
+/// 50 ms: 4 × 30 = 120 ms beats the throughput's 50.
+const TIME_TRIGGERED_IN_A_LOOP: &str = r#"<TaskGraph name="scan" xmlns="urn:semo:taskgraph:1">
+  <Loop name="L" type="D" loopCount="4">
+    <Port name="o" dir="out" outerRate="4" innerRate="1"/>
+    <TaskGraph name="L_body">
+      <Task name="A" trigger="time" period="30 MSEC"><Port name="o" dir="out"/></Task>
+      <Channel src="A.o" dst="L.o"/>
+    </TaskGraph>
+  </Loop>
+  <Task name="B" wcet="50"><Port name="i" dir="in" rate="4"/></Task>
+  <Channel src="L.o" dst="B.i"/>
+</TaskGraph>
+"#;
+
+#[test]
+fn a_repeat_shorter_than_a_time_triggered_tasks_firings_times_its_period_is_reported() {
+    let text = mission("T.P.S { scan() } repeat(40 MSEC)");
+    let w = Workspace::new("time-triggered", &text, TIME_TRIGGERED);
+    let found = w.warnings();
+    assert_eq!(codes(&found), [Code::DataflowTooSlow], "{found:#?}");
+    assert_eq!(w.text_at(&text, &found[0]), "40 MSEC");
+    assert!(
+        found[0].message.contains(
+            "takes at least 60 ms per iteration (its time-triggered task `A` fires 2 times per iteration, at most once every 30 ms)"
+        ),
+        "{}",
+        found[0].message
+    );
+    // It points at the task in the graph.
+    let task = &found[0].related[1];
+    assert_eq!(
+        (task.file, &TIME_TRIGGERED[task.span.range()]),
+        (GRAPH_ID, "A")
+    );
+    // 60 ms is enough: no warning, and the robots' period is the bound.
+    let text = mission("T.P.S { scan() } repeat(60 MSEC)");
+    let w = Workspace::new("time-triggered-enough", &text, TIME_TRIGGERED);
+    assert_eq!(w.warnings(), Vec::new());
+    let dataflow = w.host.analysis().dataflow(MISSION_ID).unwrap();
+    assert_eq!(dataflow.robots[0].period, Ratio::new(60, 1));
+}
+
+#[test]
+fn a_time_triggered_task_in_a_loop_counts_every_iteration() {
+    let text = mission("T.P.S { scan() } repeat(100 MSEC)");
+    let w = Workspace::new("time-triggered-loop", &text, TIME_TRIGGERED_IN_A_LOOP);
+    let found = w.warnings();
+    assert_eq!(codes(&found), [Code::DataflowTooSlow], "{found:#?}");
+    assert!(
+        found[0]
+            .message
+            .contains("at least 120 ms per iteration (its time-triggered task `L/A` fires 4 times"),
+        "{}",
+        found[0].message
+    );
+    let analysis = w.host.analysis();
+    let mission = analysis.mission(MISSION_ID).unwrap();
+    let periods =
+        crate::dataflow::team_periods_at(&mission.mission, text.find("T:").unwrap(), || {
+            analysis.dataflow(MISSION_ID)
+        });
+    assert!(
+        periods
+            .as_deref()
+            .is_some_and(|p| p.contains("`r_0`: 120 ms (`scan`")),
+        "{periods:?}"
+    );
+}

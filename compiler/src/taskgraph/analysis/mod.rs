@@ -12,6 +12,7 @@ pub mod rules;
 pub mod schedule;
 pub mod throughput;
 pub mod tradeoff;
+pub mod triggers;
 
 use crate::diag::{Code, Diagnostic};
 use crate::taskgraph::model::TaskGraph;
