@@ -317,6 +317,54 @@ fn a_time_triggered_inner_task_fires_once_per_period_in_linux_sim_and_the_simula
     );
 }
 
+/// A stop does not cut an iteration: `periodic_timeout.mission`'s call times
+/// out at 100 ms while Sample waits for its period (due at 200 ms), and the
+/// `linux-sim` program, like the simulator, still fires the second Sample
+/// and Average before it ends the call. Run at `time_scale` 1, so the
+/// timeout (control thread) comes 90 wall ms before the second Sample.
+#[test]
+fn a_stop_ends_a_graph_call_when_its_iteration_ends_in_linux_sim_and_the_simulator() {
+    let scenario =
+        r#"{"time_scale": 1, "duration": 700, "robots": {"c": {"services": {"sample": 50}}}}"#;
+    let out = scratch("loops/periodic-timeout");
+    let traces = run_in_simulation(&fixture("periodic_timeout.mission"), &out, scenario);
+    let first_call = |events: &[support::robots::Event]| -> Vec<String> {
+        events
+            .iter()
+            .map(|e| match field(e, "event") {
+                "graph_fire" => format!("{}/{}", field(e, "graph"), field(e, "task")),
+                other => other.to_string(),
+            })
+            .skip_while(|e| e != "call_start")
+            .take(6)
+            .collect()
+    };
+    let expected = [
+        "call_start",
+        "sampler/Sample",
+        "timeout",
+        "sampler/Sample",
+        "sampler/Average",
+        "call_end",
+    ];
+    assert_eq!(first_call(&events(&traces["c"])), expected, "linux-sim");
+    std::fs::write(out.join("scenario.json"), scenario).unwrap();
+    let simulated = semo_in(
+        &repo_root(),
+        &[
+            "simulate",
+            &fixture("periodic_timeout.mission").display().to_string(),
+            "--scenario",
+            &out.join("scenario.json").display().to_string(),
+            "--trace",
+            "-",
+        ],
+    );
+    assert_eq!(simulated.code, 0, "{}", simulated.stderr);
+    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
+    assert_eq!(first_call(&events(&lines)), expected, "semo simulate");
+}
+
 #[test]
 fn graph_services_compile_pedantically_with_gcc_and_clang() {
     for target in ["linux", "linux-sim"] {

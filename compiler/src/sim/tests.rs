@@ -741,3 +741,50 @@ fn a_time_triggered_inner_task_fires_once_per_period_across_calls() {
     assert!(read.iter().all(|r| *r == "1,1"), "{read:?}");
     assert!(run.trace.windows(2).all(|w| w[0].t <= w[1].t));
 }
+
+/// A stop does not cut a service graph's iteration (its channels must hold
+/// the next call's tokens): a call timed out at 100 ms while its Sample
+/// waits for its period ends when the iteration does (the second Sample and
+/// Average at 200 ms), without its service time, and the next call waits
+/// for it (tests/fixtures/loops/periodic_timeout.mission).
+#[test]
+fn a_stop_ends_a_graph_call_when_its_iteration_ends() {
+    let programs = programs("tests/fixtures/loops/periodic_timeout.mission");
+    let scenario =
+        std::fs::read_to_string(repo("tests/fixtures/loops/periodic.scenario.json")).unwrap();
+    let (run, _) = run(&programs, &scenario, 0);
+    let lines: Vec<(i64, &str, &str)> = run
+        .trace
+        .iter()
+        .filter(|e| e.event != "start")
+        .take(9)
+        .map(|e| {
+            (
+                e.t,
+                e.event,
+                e.field("task").or(e.field("service")).unwrap_or(""),
+            )
+        })
+        .collect();
+    assert_eq!(
+        lines,
+        [
+            (0, "mode", ""),
+            (0, "service_start", "S"),
+            (0, "call_start", "sampler"),
+            (0, "graph_fire", "Sample"),
+            (110, "timeout", "sample"),
+            (200, "graph_fire", "Sample"),
+            (200, "graph_fire", "Average"),
+            (200, "call_end", "sampler"),
+            (200, "call_start", "sampler"),
+        ]
+    );
+    let samples: Vec<i64> = run
+        .trace
+        .iter()
+        .filter(|e| e.event == "graph_fire" && e.field("task") == Some("Sample"))
+        .map(|e| e.t)
+        .collect();
+    assert_eq!(samples[..4], [0, 200, 400, 600]);
+}
