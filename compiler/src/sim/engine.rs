@@ -11,7 +11,9 @@
 //! - a sensor task every `SENSOR_PERIOD_MS`, writing the scenario's latest
 //!   value → the value as of the robot's last sensor period ([`Sim::sensor`]);
 //! - a service task called with `UFControl_CallTask`, busy for the
-//!   scenario's duration → [`Sim::request`] and a `ServiceDone` event;
+//!   scenario's duration → [`Sim::request`] and a `ServiceDone` event (a
+//!   graph service's iteration first, its time-triggered tasks' waits
+//!   traced when due by `GraphTrace` events: `engine/loops.rs`);
 //! - `semo_comm_send` → [`Sim::comm_send`] (the network: latency, loss and
 //!   link faults), the receive task's routing → [`Sim::deliver`];
 //! - `comm_heard` and `elected` → `heard` and [`Sim::elected`];
