@@ -539,4 +539,16 @@ fn a_time_triggered_inner_task_carries_its_period() {
     let refused =
         robot::steps_of(&graph("1 SEC", r#" subgraph="s.taskgraph.xml""#), &none).unwrap_err();
     assert!(refused.contains("standing for a sub-graph"), "{refused}");
+    let control = crate::taskgraph::load_task_graph(
+        FileId(9),
+        r#"<TaskGraph name="g" xmlns="urn:semo:taskgraph:1">
+  <Task name="A" trigger="control"><Port name="o" dir="out"/></Task>
+  <Task name="B"><Port name="i" dir="in"/></Task>
+  <Channel src="A.o" dst="B.i"/>
+</TaskGraph>"#,
+    )
+    .0
+    .unwrap();
+    let refused = robot::steps_of(&control, &none).unwrap_err();
+    assert!(refused.contains("control-triggered task `A`"), "{refused}");
 }

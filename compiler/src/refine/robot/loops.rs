@@ -386,7 +386,15 @@ impl Opener<'_, '_> {
         }
         let period_ms = match task.trigger {
             Trigger::Time { period_ms } => Some(whole_period(path, period_ms)?),
-            Trigger::Data | Trigger::Control => None,
+            Trigger::Data => None,
+            // The service task runs every inner task as its schedule
+            // reaches it; no control task runs inside a service graph, so
+            // firing it as a data task would quietly mean something else.
+            Trigger::Control => {
+                return Err(format!(
+                    "has control-triggered task `{path}` (inside a service graph only the schedule runs tasks)"
+                ));
+            }
         };
         self.tasks.push(InnerTask {
             path: path.to_string(),
