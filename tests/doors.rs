@@ -265,19 +265,39 @@ fn dataflow_from_server(dir: &Path, mission: &Path, code: &str) -> BTreeSet<Prob
 #[test]
 fn dataflow_warnings_are_the_same_at_every_door() {
     let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
-    for code in ["W070", "W071", "W072", "W073"] {
-        let dir = std::fs::read_dir(&fixtures)
+    // Every fixture of every dataflow warning (W073 has more than one), in
+    // a fixed order; each folder holds one mission.
+    let mut dirs: Vec<(String, PathBuf)> = std::fs::read_dir(&fixtures)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter_map(|p| {
+            let name = p.file_name()?.to_string_lossy().into_owned();
+            let code = ["W070", "W071", "W072", "W073"]
+                .into_iter()
+                .find(|c| name.starts_with(c))?;
+            Some((code.to_string(), p))
+        })
+        .collect();
+    dirs.sort();
+    let codes: BTreeSet<&str> = dirs.iter().map(|(c, _)| c.as_str()).collect();
+    assert_eq!(
+        codes.len(),
+        4,
+        "a fixture for each dataflow warning: {dirs:?}"
+    );
+    for (code, dir) in &dirs {
+        let code = code.as_str();
+        let mission = std::fs::read_dir(dir)
             .unwrap()
             .map(|e| e.unwrap().path())
-            .find(|p| p.file_name().unwrap().to_string_lossy().starts_with(code))
-            .unwrap();
-        let mission = dir.join("scan.mission");
+            .find(|p| p.extension().is_some_and(|e| e == "mission"))
+            .unwrap_or_else(|| panic!("{}: no mission", dir.display()));
         let name = mission.display().to_string();
         let in_mission = |problems: BTreeSet<Problem>| -> BTreeSet<Problem> {
             problems.into_iter().filter(|p| p.0 == name).collect()
         };
-        let (_, single) = from_check(&dir, &[name.as_str()]);
-        let (_, whole) = from_check(&dir, &["."]);
+        let (_, single) = from_check(dir, &[name.as_str()]);
+        let (_, whole) = from_check(dir, &["."]);
         let single = in_mission(single);
         assert!(single.iter().any(|p| p.1 == code), "{}", listing(&single));
         assert_eq!(
@@ -287,7 +307,7 @@ fn dataflow_warnings_are_the_same_at_every_door() {
         );
         assert_eq!(
             listing(&single),
-            listing(&dataflow_from_server(&dir, &mission, code)),
+            listing(&dataflow_from_server(dir, &mission, code)),
             "{code}: check and the editor"
         );
         // Warnings: the mission builds.
