@@ -66,7 +66,13 @@ struct Value<'t> {
 impl<'t> Value<'t> {
     /// The value `raw`, written at `span`.
     fn new(raw: &'t str, span: Span) -> Value<'t> {
-        let text = raw.trim();
+        // Nothing to trim when it starts and ends with a visible ASCII
+        // character (an ASCII byte is a whole character, and none of those
+        // is white space): the common case, without `trim`'s decoding.
+        let text = match (raw.as_bytes().first(), raw.as_bytes().last()) {
+            (Some(first), Some(last)) if first.is_ascii_graphic() && last.is_ascii_graphic() => raw,
+            _ => raw.trim(),
+        };
         if text.is_empty() {
             return Value { text, span };
         }
@@ -157,6 +163,72 @@ pub(super) fn read(file: FileId, text: &str, times: ExecutionTimes) -> Option<Ta
     state.run().ok()?;
     state.finish(file).ok()
 }
+
+/// Calls `f` with the name and the value (between its quotes) of each
+/// attribute of a start tag, `raw` its text after the element's name (as
+/// quick-xml's `attributes_raw` gives it). It reads strictly: each attribute
+/// is XML blanks, a name of ASCII letters, digits and `_:.-`, `=` (blanks
+/// around it allowed) and a value in double or single quotes; anything else
+/// declines. So it takes only attributes quick-xml's own reader takes, with
+/// the same names and values, but without the list of names that reader
+/// allocates per element for its duplicate check, nor its state machine (a
+/// fifth of reading a large graph).
+fn each_attribute<'a>(
+    raw: &'a [u8],
+    mut f: impl FnMut(&'a [u8], &'a [u8]) -> Read<()>,
+) -> Read<()> {
+    let n = raw.len();
+    // The end of the run of bytes of `class` from `at`.
+    let run = |mut at: usize, class: u8| {
+        while at < n && CLASS[usize::from(raw[at])] == class {
+            at += 1;
+        }
+        at
+    };
+    let mut at = 0;
+    loop {
+        let key_start = run(at, BLANK);
+        if key_start == n {
+            return Ok(());
+        }
+        // A blank before each name, and a name.
+        let key_end = run(key_start, NAME);
+        if key_start == at || key_end == key_start {
+            return Err(Decline);
+        }
+        let equals = run(key_end, BLANK);
+        if raw.get(equals) != Some(&b'=') {
+            return Err(Decline);
+        }
+        let open = run(equals + 1, BLANK);
+        let quote = match raw.get(open) {
+            Some(&q) if q == b'"' || q == b'\'' => q,
+            _ => return Err(Decline),
+        };
+        let value = &raw[open + 1..];
+        let len = value.iter().position(|&b| b == quote).ok_or(Decline)?;
+        f(&raw[key_start..key_end], &value[..len])?;
+        at = open + 1 + len + 1;
+    }
+}
+
+/// The bytes of [`each_attribute`]'s names, its blanks, and the others.
+const NAME: u8 = 1;
+const BLANK: u8 = 2;
+const CLASS: [u8; 256] = {
+    let mut class = [0; 256];
+    let mut b = 0;
+    while b < 256 {
+        let c = b as u8;
+        if c.is_ascii_alphanumeric() || matches!(c, b'_' | b':' | b'.' | b'-') {
+            class[b] = NAME;
+        } else if matches!(c, b' ' | b'\r' | b'\n' | b'\t') {
+            class[b] = BLANK;
+        }
+        b += 1;
+    }
+    class
+};
 
 struct State<'t> {
     text: &'t str,
@@ -299,36 +371,30 @@ impl<'t> State<'t> {
     ) -> Read<[Option<Value<'t>>; MAX_KEYS]> {
         let text = self.text;
         let mut found = [None; MAX_KEYS];
-        // quick-xml's own duplicate check allocates a list of names per
-        // element (a third of the allocations of reading a large graph):
-        // the names seen so far are kept here instead, and an element with
-        // more attributes than that is left to the full reader.
+        // The names seen so far, for the duplicate check: an element with
+        // more attributes than this is left to the full reader.
         let mut seen: [&[u8]; MAX_ATTRIBUTES] = [&[]; MAX_ATTRIBUTES];
         let mut count = 0;
-        let mut attributes = e.attributes();
-        attributes.with_checks(false);
-        for attr in attributes {
-            let attr = attr.map_err(|_| Decline)?;
-            let key = attr.key.into_inner();
+        each_attribute(e.attributes_raw(), |key, raw| {
             if count == MAX_ATTRIBUTES || seen[..count].contains(&key) {
                 return Err(Decline);
             }
             seen[count] = key;
             count += 1;
-            let raw: &[u8] = &attr.value;
             if raw.iter().any(|&b| b == b'<' || b == b'&') {
                 return Err(Decline);
             }
-            let Some(i) = keys.iter().position(|k| *k == attr.key.as_ref()) else {
-                continue;
+            let Some(i) = keys.iter().position(|k| *k == key) else {
+                return Ok(());
             };
             if found[i].is_some() {
-                continue;
+                return Ok(());
             }
             let span = slice_span(text, raw).ok_or(Decline)?;
             let value = text.get(span.range()).ok_or(Decline)?;
             found[i] = Some(Value::new(value, span));
-        }
+            Ok(())
+        })?;
         Ok(found)
     }
 
@@ -490,5 +556,79 @@ impl<'t> State<'t> {
             channels: self.channels,
             libraries: Vec::new(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The attributes `each_attribute` reads from `raw`, `None` if it declines.
+    fn strict(raw: &[u8]) -> Option<Vec<(Vec<u8>, Vec<u8>)>> {
+        let mut out = Vec::new();
+        each_attribute(raw, |key, value| {
+            out.push((key.to_vec(), value.to_vec()));
+            Ok(())
+        })
+        .ok()?;
+        Some(out)
+    }
+
+    /// quick-xml's attributes of the start tag `<e{raw}>`, `None` on an error.
+    fn quick(raw: &[u8]) -> Option<Vec<(Vec<u8>, Vec<u8>)>> {
+        let tag = [b"e".as_slice(), raw].concat();
+        let start = BytesStart::from_content(String::from_utf8(tag).ok()?, 1);
+        start
+            .attributes()
+            .with_checks(false)
+            .map(|a| a.ok().map(|a| (a.key.as_ref().to_vec(), a.value.to_vec())))
+            .collect()
+    }
+
+    #[test]
+    fn attributes_are_read_as_quick_xml_reads_them_or_declined() {
+        let read = [
+            (r#""#, vec![]),
+            (r#" name="a""#, vec![("name", "a")]),
+            (" a = 'x y'\n\tb=\"\" ", vec![("a", "x y"), ("b", "")]),
+            (
+                r#" xmlns:xsi="u" c.d-e_f="1""#,
+                vec![("xmlns:xsi", "u"), ("c.d-e_f", "1")],
+            ),
+        ];
+        for (raw, want) in read {
+            let want: Vec<(Vec<u8>, Vec<u8>)> = want
+                .into_iter()
+                .map(|(k, v)| (k.as_bytes().to_vec(), v.as_bytes().to_vec()))
+                .collect();
+            assert_eq!(strict(raw.as_bytes()), Some(want.clone()), "{raw:?}");
+            assert_eq!(quick(raw.as_bytes()), Some(want), "{raw:?}");
+        }
+        // Declined: no blank before a name, no `=`, no quotes, an unclosed
+        // value, a stray `/`, a name quick-xml would take but this does not.
+        for raw in [
+            r#" a="1"b="2""#,
+            " a",
+            " a=1",
+            r#" a="1"#,
+            r#" a="1" /"#,
+            r#" é="1""#,
+        ] {
+            assert_eq!(strict(raw.as_bytes()), None, "{raw:?}");
+        }
+    }
+
+    proptest! {
+        /// Whatever `each_attribute` accepts, quick-xml reads without an
+        /// error and to the same names and values.
+        #[test]
+        fn accepted_attributes_agree_with_quick_xml(
+            raw in "([ \t\n]{0,2}[a-z:é/\"'=]{0,3}[ ]?=?[ ]?[\"']?[a-z <&\"'=]{0,3}[\"']?){0,3}[ /]?"
+        ) {
+            if let Some(attributes) = strict(raw.as_bytes()) {
+                prop_assert_eq!(quick(raw.as_bytes()), Some(attributes));
+            }
+        }
     }
 }
