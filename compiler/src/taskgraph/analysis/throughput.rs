@@ -404,13 +404,18 @@ fn max_cycle_ratio(g: &Hsdf) -> Option<(Ratio, Vec<usize>)> {
         if !changed {
             for v in 0..n {
                 let l = lambda[v];
+                // `step`'s first term, the same for every edge of `v` (and
+                // computed by it at least once: `v`'s policy edge leads to
+                // its own λ).
+                let w = i128::from(g.weight[v]).checked_mul(i128::from(l.den))?;
                 let mut best = (x[v], policy[v]);
                 for e in g.out(v) {
                     let u = g.head[e];
-                    if lambda[u] != l {
+                    if !one_ratio && lambda[u] != l {
                         continue;
                     }
-                    let value = step(g.weight[v], g.tokens[e], l)?.checked_add(x[u])?;
+                    let t = i128::from(l.num).checked_mul(i128::from(g.tokens[e]))?;
+                    let value = w.checked_sub(t)?.checked_add(x[u])?;
                     if value > best.0 {
                         best = (value, e);
                     }
