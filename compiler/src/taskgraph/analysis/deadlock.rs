@@ -31,6 +31,7 @@ fn execute(
         tokens[e] = tokens[e].saturating_add(add);
     }
     let (inputs, outputs) = level.adjacency();
+    let (inputs, outputs) = (inputs.slices(), outputs.slices());
     let mut remaining = counts.to_vec();
     let mut queued = vec![true; n];
     let mut queue: VecDeque<usize> = (0..n).collect();
@@ -39,7 +40,7 @@ fn execute(
         // Fire as many times as the inputs allow at once; a self-loop returns
         // what it takes (consistent rates), so it allows one firing at a time.
         let mut k = remaining[v];
-        for &i in &inputs[v] {
+        for &i in inputs[v] {
             let e = &level.edges[i];
             let allowed = if e.src == v {
                 u64::from(tokens[i] >= e.consume)
@@ -51,10 +52,10 @@ fn execute(
         if k == 0 {
             continue;
         }
-        for &i in &inputs[v] {
+        for &i in inputs[v] {
             tokens[i] -= k * level.edges[i].consume;
         }
-        for &i in &outputs[v] {
+        for &i in outputs[v] {
             let e = &level.edges[i];
             tokens[i] = tokens[i].saturating_add(k.saturating_mul(e.produce));
             if !queued[e.dst] {

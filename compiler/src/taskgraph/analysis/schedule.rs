@@ -579,8 +579,9 @@ pub fn expand(schedule: &[Schedule], limit: u64) -> Option<Vec<usize>> {
 pub fn valid(level: &Level<'_>, firings: &[usize]) -> bool {
     let mut tokens: Vec<u64> = level.edges.iter().map(|e| e.initial_tokens).collect();
     let (inputs, outputs) = adjacency(level);
+    let (inputs, outputs) = (inputs.slices(), outputs.slices());
     for &v in firings {
-        let (Some(ins), Some(outs)) = (inputs.get(v), outputs.get(v)) else {
+        let (Some(&ins), Some(&outs)) = (inputs.get(v), outputs.get(v)) else {
             return false;
         };
         for &i in ins {
@@ -626,6 +627,7 @@ pub fn flat_schedule(level: &Level<'_>, counts: &[u64]) -> Option<Vec<usize>> {
     for (r, &v) in order.iter().enumerate() {
         rank[v] = r;
     }
+    let (inputs, outputs) = (inputs.slices(), outputs.slices());
     let mut tokens: Vec<u64> = level.edges.iter().map(|e| e.initial_tokens).collect();
     let mut remaining = counts.to_vec();
     let can_fire = |v: usize, tokens: &[u64], remaining: &[u64]| {
@@ -654,10 +656,10 @@ pub fn flat_schedule(level: &Level<'_>, counts: &[u64]) -> Option<Vec<usize>> {
     while let Some(r) = ready.pop() {
         let v = order[r];
         waiting[v] = false;
-        for &i in &inputs[v] {
+        for &i in inputs[v] {
             tokens[i] -= level.edges[i].consume;
         }
-        for &i in &outputs[v] {
+        for &i in outputs[v] {
             tokens[i] = tokens[i].saturating_add(level.edges[i].produce);
         }
         remaining[v] -= 1;
@@ -665,7 +667,7 @@ pub fn flat_schedule(level: &Level<'_>, counts: &[u64]) -> Option<Vec<usize>> {
         if can_fire(v, &tokens, &remaining) {
             make_ready(v, &mut ready, &mut waiting);
         }
-        for &i in &outputs[v] {
+        for &i in outputs[v] {
             let d = level.edges[i].dst;
             if can_fire(d, &tokens, &remaining) {
                 make_ready(d, &mut ready, &mut waiting);
