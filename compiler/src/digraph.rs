@@ -2,7 +2,7 @@
 //! one routine (petgraph's Tarjan) that the task-graph schedule and the
 //! layered drawing both use, rather than each its own copy.
 
-use petgraph::algo::tarjan_scc;
+use petgraph::algo::TarjanScc;
 use petgraph::graph::{DiGraph, NodeIndex};
 
 /// The strongly connected component of each node `0..n` of the graph with
@@ -20,14 +20,17 @@ pub fn components(
     for (a, b) in edges {
         graph.add_edge(NodeIndex::new(a), NodeIndex::new(b), ());
     }
-    let found = tarjan_scc(&graph);
+    // Numbered as they are found (as `tarjan_scc` lists them), without a
+    // vector per component.
     let mut component = vec![0; n];
-    for (number, members) in found.iter().enumerate() {
+    let mut count = 0;
+    TarjanScc::new().run(&graph, |members| {
         for v in members {
-            component[v.index()] = number;
+            component[v.index()] = count;
         }
-    }
-    (component, found.len())
+        count += 1;
+    });
+    (component, count)
 }
 
 #[cfg(test)]

@@ -15,8 +15,9 @@ pub fn buffer_bounds(level: &Level<'_>, firings: &[usize]) -> Vec<u64> {
     let mut tokens: Vec<u64> = level.edges.iter().map(|e| e.initial_tokens).collect();
     let mut most = tokens.clone();
     let (inputs, outputs) = adjacency(level);
+    let (inputs, outputs) = (inputs.slices(), outputs.slices());
     for &v in firings {
-        let (Some(ins), Some(outs)) = (inputs.get(v), outputs.get(v)) else {
+        let (Some(&ins), Some(&outs)) = (inputs.get(v), outputs.get(v)) else {
             continue;
         };
         for &i in ins {

@@ -2,7 +2,7 @@
 //! balance equations γ(src)·produce = γ(dst)·consume of every edge, per
 //! connected component. Linear in the size of the level.
 
-use super::level::Level;
+use super::level::{Level, Lists};
 use super::ratio::{Ratio, gcd, lcm};
 
 /// Why a level has no repetition vector.
@@ -25,13 +25,13 @@ pub enum RateProblem {
 /// The repetition vector of `level` (one count per node), or the first problem.
 pub fn repetition_vector(level: &Level<'_>) -> Result<Vec<u64>, RateProblem> {
     let n = level.nodes.len();
-    let mut adjacent: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for (i, e) in level.edges.iter().enumerate() {
-        adjacent[e.src].push(i);
-        if e.dst != e.src {
-            adjacent[e.dst].push(i);
-        }
-    }
+    // Each node's edges, either way (a self-loop once).
+    let adjacent = Lists::new(n, || {
+        level.edges.iter().enumerate().flat_map(|(i, e)| {
+            let other = (e.dst != e.src).then_some((e.dst, i));
+            std::iter::once((e.src, i)).chain(other)
+        })
+    });
     let mut ratio: Vec<Option<Ratio>> = vec![None; n];
     let mut counts = vec![0u64; n];
     // Breadth-first in file order: a contradiction is found on the channel

@@ -30,12 +30,8 @@ fn execute(
     if let Some((e, add)) = extra {
         tokens[e] = tokens[e].saturating_add(add);
     }
-    let mut inputs: Vec<Vec<usize>> = vec![Vec::new(); n];
-    let mut outputs: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for (i, e) in level.edges.iter().enumerate() {
-        inputs[e.dst].push(i);
-        outputs[e.src].push(i);
-    }
+    let (inputs, outputs) = level.adjacency();
+    let (inputs, outputs) = (inputs.slices(), outputs.slices());
     let mut remaining = counts.to_vec();
     let mut queued = vec![true; n];
     let mut queue: VecDeque<usize> = (0..n).collect();
@@ -44,7 +40,7 @@ fn execute(
         // Fire as many times as the inputs allow at once; a self-loop returns
         // what it takes (consistent rates), so it allows one firing at a time.
         let mut k = remaining[v];
-        for &i in &inputs[v] {
+        for &i in inputs[v] {
             let e = &level.edges[i];
             let allowed = if e.src == v {
                 u64::from(tokens[i] >= e.consume)
@@ -56,10 +52,10 @@ fn execute(
         if k == 0 {
             continue;
         }
-        for &i in &inputs[v] {
+        for &i in inputs[v] {
             tokens[i] -= k * level.edges[i].consume;
         }
-        for &i in &outputs[v] {
+        for &i in outputs[v] {
             let e = &level.edges[i];
             tokens[i] = tokens[i].saturating_add(k.saturating_mul(e.produce));
             if !queued[e.dst] {
@@ -85,12 +81,7 @@ pub fn find_deadlock(level: &Level<'_>, counts: &[u64]) -> Option<Blocked> {
     let (remaining, tokens) = execute(level, counts, None).err()?;
     // Each node's input edges, in edge order: a walk along a long chain of
     // waits reads each node's inputs, not every edge, per step.
-    let mut inputs: Vec<Vec<usize>> = vec![Vec::new(); level.nodes.len()];
-    for (i, e) in level.edges.iter().enumerate() {
-        if let Some(list) = inputs.get_mut(e.dst) {
-            list.push(i);
-        }
-    }
+    let (inputs, _) = level.adjacency();
     // Each blocked node waits on an input edge short of samples whose source
     // is blocked too; following these waits must come back round to a node.
     let waits_for = |v: usize| {

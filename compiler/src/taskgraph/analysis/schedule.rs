@@ -36,7 +36,7 @@
 //! equal the counts, and (when one iteration has at most [`MAX_FIRINGS`]
 //! firings) replaying it must never read a channel short of samples.
 
-use super::level::Level;
+use super::level::{Level, Lists};
 use super::ratio::gcd;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -220,7 +220,7 @@ pub fn balanced(level: &Level<'_>, counts: &[u64]) -> bool {
 /// scratch array, all `usize::MAX` between uses.
 struct Frames<'l, 'g> {
     level: &'l Level<'g>,
-    outputs: Vec<Vec<usize>>,
+    outputs: Lists,
     scratch: Vec<usize>,
 }
 
@@ -283,7 +283,7 @@ impl<'l, 'g> Frames<'l, 'g> {
                 .map(|(c, body)| wrap(c, body));
         }
         let mut clusters = Vec::with_capacity(components.len());
-        for component in &components {
+        for component in components.iter() {
             clusters.push(self.schedule_component(component, q)?);
         }
         Some(factor(self, &components, &clusters, q))
@@ -342,7 +342,7 @@ fn wrap(count: u64, body: Vec<Schedule>) -> Vec<Schedule> {
 /// documentation).
 fn factor(
     frames: &mut Frames<'_, '_>,
-    components: &[Vec<usize>],
+    components: &Lists,
     clusters: &[(u64, Vec<Schedule>)],
     q: &[u64],
 ) -> Vec<Schedule> {
@@ -455,55 +455,62 @@ fn build(
 /// level's.
 fn ordered_components(
     level: &Level<'_>,
-    outputs: &[Vec<usize>],
+    outputs: &Lists,
     local: &mut [usize],
     members: &[usize],
     keep: &dyn Fn(&super::level::Edge) -> bool,
-) -> Vec<Vec<usize>> {
+) -> Lists {
     for (i, &v) in members.iter().enumerate() {
         local[v] = i;
     }
     let m = members.len();
-    let mut succ: Vec<Vec<usize>> = vec![Vec::new(); m];
-    for (a, &v) in members.iter().enumerate() {
-        for &i in &outputs[v] {
-            let e = &level.edges[i];
-            let b = local[e.dst];
-            if b != usize::MAX && a != b && keep(e) {
-                succ[a].push(b);
-            }
-        }
-    }
+    let succ = {
+        let local = &*local;
+        Lists::new(m, || {
+            members.iter().enumerate().flat_map(move |(a, &v)| {
+                outputs[v].iter().filter_map(move |&i| {
+                    let e = &level.edges[i];
+                    let b = local[e.dst];
+                    (b != usize::MAX && a != b && keep(e)).then_some((a, b))
+                })
+            })
+        })
+    };
     for &v in members {
         local[v] = usize::MAX;
     }
     let (comp, ncomp) =
         crate::digraph::components(m, (0..m).flat_map(|a| succ[a].iter().map(move |&b| (a, b))));
-    let mut components: Vec<Vec<usize>> = vec![Vec::new(); ncomp];
-    for (i, &c) in comp.iter().enumerate() {
-        components[c].push(members[i]);
-    }
-    for c in &mut components {
-        c.sort_unstable();
+    let mut components = Lists::new(ncomp, || {
+        comp.iter().enumerate().map(|(i, &c)| (c, members[i]))
+    });
+    for c in 0..ncomp {
+        if let Some(members) = components.get_mut(c) {
+            members.sort_unstable();
+        }
     }
     // Kahn over the condensation, smallest first node first.
     let mut indegree = vec![0usize; ncomp];
-    let mut csucc: Vec<Vec<usize>> = vec![Vec::new(); ncomp];
-    for a in 0..m {
-        for &b in &succ[a] {
-            if comp[a] != comp[b] {
-                csucc[comp[a]].push(comp[b]);
-                indegree[comp[b]] += 1;
-            }
-        }
+    let (succ, comp) = (&succ, &comp);
+    let crossing = || {
+        (0..m).flat_map(|a| {
+            succ[a]
+                .iter()
+                .filter(move |&&b| comp[a] != comp[b])
+                .map(move |&b| (comp[a], comp[b]))
+        })
+    };
+    for (_, d) in crossing() {
+        indegree[d] += 1;
     }
+    let csucc = Lists::new(ncomp, crossing);
     let mut ready: BinaryHeap<Reverse<(usize, usize)>> = (0..ncomp)
         .filter(|&c| indegree[c] == 0)
         .map(|c| Reverse((components[c][0], c)))
         .collect();
     let mut order = Vec::with_capacity(ncomp);
     while let Some(Reverse((_, c))) = ready.pop() {
-        order.push(std::mem::take(&mut components[c]));
+        order.push(c);
         for &d in &csucc[c] {
             indegree[d] -= 1;
             if indegree[d] == 0 {
@@ -511,7 +518,13 @@ fn ordered_components(
             }
         }
     }
-    order
+    let components = &components;
+    Lists::new(order.len(), || {
+        order
+            .iter()
+            .enumerate()
+            .flat_map(|(k, &c)| components[c].iter().map(move |&v| (k, v)))
+    })
 }
 
 /// Firings per node of a looped schedule, `None` on overflow or a bad node.
@@ -566,8 +579,9 @@ pub fn expand(schedule: &[Schedule], limit: u64) -> Option<Vec<usize>> {
 pub fn valid(level: &Level<'_>, firings: &[usize]) -> bool {
     let mut tokens: Vec<u64> = level.edges.iter().map(|e| e.initial_tokens).collect();
     let (inputs, outputs) = adjacency(level);
+    let (inputs, outputs) = (inputs.slices(), outputs.slices());
     for &v in firings {
-        let (Some(ins), Some(outs)) = (inputs.get(v), outputs.get(v)) else {
+        let (Some(&ins), Some(&outs)) = (inputs.get(v), outputs.get(v)) else {
             return false;
         };
         for &i in ins {
@@ -584,17 +598,8 @@ pub fn valid(level: &Level<'_>, firings: &[usize]) -> bool {
 }
 
 /// Each node's input edges and output edges.
-pub(super) fn adjacency(level: &Level<'_>) -> (Vec<Vec<usize>>, Vec<Vec<usize>>) {
-    let n = level.nodes.len();
-    let mut inputs: Vec<Vec<usize>> = vec![Vec::new(); n];
-    let mut outputs: Vec<Vec<usize>> = vec![Vec::new(); n];
-    for (i, e) in level.edges.iter().enumerate() {
-        if e.src < n && e.dst < n {
-            inputs[e.dst].push(i);
-            outputs[e.src].push(i);
-        }
-    }
-    (inputs, outputs)
+pub(super) fn adjacency(level: &Level<'_>) -> (Lists, Lists) {
+    level.adjacency()
 }
 
 /// A valid sequence of one iteration's firings, found by executing it
@@ -616,13 +621,13 @@ pub fn flat_schedule(level: &Level<'_>, counts: &[u64]) -> Option<Vec<usize>> {
     let (inputs, outputs) = adjacency(level);
     let order: Vec<usize> =
         ordered_components(level, &outputs, &mut vec![usize::MAX; n], &all, &|_| true)
-            .into_iter()
-            .flatten()
-            .collect();
+            .items()
+            .to_vec();
     let mut rank = vec![0usize; n];
     for (r, &v) in order.iter().enumerate() {
         rank[v] = r;
     }
+    let (inputs, outputs) = (inputs.slices(), outputs.slices());
     let mut tokens: Vec<u64> = level.edges.iter().map(|e| e.initial_tokens).collect();
     let mut remaining = counts.to_vec();
     let can_fire = |v: usize, tokens: &[u64], remaining: &[u64]| {
@@ -651,10 +656,10 @@ pub fn flat_schedule(level: &Level<'_>, counts: &[u64]) -> Option<Vec<usize>> {
     while let Some(r) = ready.pop() {
         let v = order[r];
         waiting[v] = false;
-        for &i in &inputs[v] {
+        for &i in inputs[v] {
             tokens[i] -= level.edges[i].consume;
         }
-        for &i in &outputs[v] {
+        for &i in outputs[v] {
             tokens[i] = tokens[i].saturating_add(level.edges[i].produce);
         }
         remaining[v] -= 1;
@@ -662,7 +667,7 @@ pub fn flat_schedule(level: &Level<'_>, counts: &[u64]) -> Option<Vec<usize>> {
         if can_fire(v, &tokens, &remaining) {
             make_ready(v, &mut ready, &mut waiting);
         }
-        for &i in &outputs[v] {
+        for &i in outputs[v] {
             let d = level.edges[i].dst;
             if can_fire(d, &tokens, &remaining) {
                 make_ready(d, &mut ready, &mut waiting);

@@ -381,29 +381,41 @@ fn max_cycle_ratio(g: &Hsdf) -> Option<(Ratio, Vec<usize>)> {
     let mut x = vec![0i128; n];
     loop {
         let cycles = evaluate(g, &policy, &mut lambda, &mut x)?;
+        // Every node's λ is the ratio of the cycle its policy leads to: when
+        // all the cycles have one ratio, no edge leads to a larger λ, and the
+        // pass looking for one is skipped (most of the passes, on a strongly
+        // connected graph).
+        let one_ratio = cycles.windows(2).all(|pair| pair[0].0 == pair[1].0);
         let mut changed = false;
-        for v in 0..n {
-            let mut best = (lambda[v], policy[v]);
-            for e in g.out(v) {
-                if lambda[g.head[e]] > best.0 {
-                    best = (lambda[g.head[e]], e);
+        if !one_ratio {
+            for v in 0..n {
+                let mut best = (lambda[v], policy[v]);
+                for e in g.out(v) {
+                    if lambda[g.head[e]] > best.0 {
+                        best = (lambda[g.head[e]], e);
+                    }
                 }
-            }
-            if best.1 != policy[v] {
-                policy[v] = best.1;
-                changed = true;
+                if best.1 != policy[v] {
+                    policy[v] = best.1;
+                    changed = true;
+                }
             }
         }
         if !changed {
             for v in 0..n {
                 let l = lambda[v];
+                // `step`'s first term, the same for every edge of `v` (and
+                // computed by it at least once: `v`'s policy edge leads to
+                // its own λ).
+                let w = i128::from(g.weight[v]).checked_mul(i128::from(l.den))?;
                 let mut best = (x[v], policy[v]);
                 for e in g.out(v) {
                     let u = g.head[e];
-                    if lambda[u] != l {
+                    if !one_ratio && lambda[u] != l {
                         continue;
                     }
-                    let value = step(g.weight[v], g.tokens[e], l)?.checked_add(x[u])?;
+                    let t = i128::from(l.num).checked_mul(i128::from(g.tokens[e]))?;
+                    let value = w.checked_sub(t)?.checked_add(x[u])?;
                     if value > best.0 {
                         best = (value, e);
                     }
