@@ -313,7 +313,7 @@ fn dataflow_warnings_are_the_same_at_every_door() {
         // Warnings: the mission builds.
         let out = std::env::temp_dir().join(format!("semo-doors-{code}-{}", std::process::id()));
         let build = semo_in(
-            &dir,
+            dir,
             &[
                 "build",
                 &name,
