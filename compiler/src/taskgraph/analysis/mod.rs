@@ -227,12 +227,26 @@ fn analyze_level(
     let mut sas = None;
     match repetition_vector(level) {
         Ok(counts) => {
-            let blocked = find_deadlock(level, &counts);
+            // The flat schedule is one whole iteration executed: where there
+            // is one the level cannot deadlock, and only without one (a
+            // deadlock, or more than `MAX_FIRINGS` firings) is the iteration
+            // executed again to find the blocked cycle.
+            let flat = schedule::flat_schedule(level, &counts);
+            let blocked = match flat {
+                Some(_) => None,
+                None => find_deadlock(level, &counts),
+            };
             match &blocked {
                 Some(b) => diagnostics.push(deadlock_diagnostic(level, b)),
                 None => {
-                    sas =
-                        schedule_level(level, &counts, concurrency, &mut level_report, diagnostics)
+                    sas = schedule_level(
+                        level,
+                        &counts,
+                        flat,
+                        concurrency,
+                        &mut level_report,
+                        diagnostics,
+                    )
                 }
             }
             level_report.deadlock_free = Some(blocked.is_none());
@@ -350,6 +364,7 @@ fn at_reference(
 fn schedule_level(
     level: &Level<'_>,
     counts: &[u64],
+    flat: Option<Vec<usize>>,
     concurrency: Concurrency,
     report: &mut LevelReport,
     diagnostics: &mut Vec<Diagnostic>,
@@ -367,9 +382,9 @@ fn schedule_level(
             });
     }
     let single_appearance = schedule::single_appearance(level, counts);
-    // The flat (sample-frugal) schedule: the buffer bounds are measured under
-    // it, and it is the level's schedule where no single-appearance one exists.
-    let flat = schedule::flat_schedule(level, counts);
+    // `flat`, the flat (sample-frugal) schedule: the buffer bounds are
+    // measured under it, and it is the level's schedule where no
+    // single-appearance one exists.
     report.schedule = match (&single_appearance, &flat) {
         (Some(s), _) => Some(schedule::render(level, s)),
         (None, Some(firings)) => {
