@@ -41,7 +41,6 @@ use crate::refine::{RobotProgram, State, StateKind};
 use crate::sema::Mission;
 use crate::span::Span;
 use crate::taskgraph::analysis::ratio::Ratio;
-use crate::taskgraph::analysis::triggers::{self, TimeBound};
 use crate::workspace::GraphRun;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -196,10 +195,12 @@ fn robot(
         graphs.extend(call.run.graph.as_ref().map(|g| g.file));
         diagnostics.extend(graph_problems(input.file, &call));
         let throughput = iteration_period(&call.run);
-        let timed = time_bound(&call.run);
         // The time-triggered tasks bound it when the throughput does not
         // say more.
-        let by_time = timed
+        let by_time = call
+            .run
+            .report
+            .time_bound
             .as_ref()
             .filter(|b| throughput.is_none_or(|p| b.period > p));
         let Some(period) = by_time.map(|b| b.period).or(throughput) else {
@@ -327,12 +328,6 @@ fn asked_period(states: &[State], index: usize) -> Option<(i64, Span)> {
 fn iteration_period(run: &GraphRun) -> Option<Ratio> {
     let period = run.report.levels.first()?.throughput.as_ref()?.period;
     (period.num > 0).then_some(period)
-}
-
-/// The bound the graph's time-triggered tasks put on its period.
-fn time_bound(run: &GraphRun) -> Option<TimeBound> {
-    let graph = run.graph.as_ref()?;
-    triggers::time_bound(graph, &run.hierarchy, &run.report)
 }
 
 /// The tasks around the cycle that bounds the graph's period.

@@ -83,6 +83,9 @@ pub struct GraphReport {
     /// The whole hierarchy as one looped schedule (`A 10(B C) D`), where every
     /// level has a single-appearance schedule.
     pub looped_schedule: Option<String>,
+    /// The least iteration period the time-triggered tasks allow, where the
+    /// graph has any (`triggers`).
+    pub time_bound: Option<triggers::TimeBound>,
     pub diagnostics: Vec<Diagnostic>,
 }
 
@@ -92,6 +95,7 @@ impl Default for GraphReport {
             concurrency: Concurrency::Single,
             levels: Vec::new(),
             looped_schedule: None,
+            time_bound: None,
             diagnostics: Vec::new(),
         }
     }
@@ -183,6 +187,7 @@ pub fn analyze_as(
         report.levels.push(level_report);
     }
     report.looped_schedule = schedule::render_hierarchy(&levels, &single_appearance);
+    report.time_bound = triggers::time_bound(&levels, &report.levels);
     report
 }
 

@@ -8,13 +8,12 @@
 //! C-type loop's at most that many, counted as [`super::analyze_as`] counts
 //! its time), up to the top.
 
-use super::GraphReport;
+use super::LevelReport;
 use super::level::Level;
 use super::ratio::Ratio;
 use crate::diag::FileId;
 use crate::span::Span;
-use crate::taskgraph::model::{TaskGraph, Trigger};
-use crate::taskgraph::subgraph::Hierarchy;
+use crate::taskgraph::model::Trigger;
 
 /// The time-triggered task that bounds a graph's iteration the most.
 #[derive(Clone, Debug, PartialEq)]
@@ -33,19 +32,12 @@ pub struct TimeBound {
     pub span: Span,
 }
 
-/// The largest `firings × period` of `graph`'s time-triggered tasks, its
-/// sub-graphs' (`hierarchy`) included; `None` when it has none, or when a
-/// level holding one has no repetition vector in `report` (the analysis of
-/// the same graph and hierarchy).
-pub fn time_bound(
-    graph: &TaskGraph,
-    hierarchy: &Hierarchy,
-    report: &GraphReport,
-) -> Option<TimeBound> {
-    let levels: Vec<Level<'_>> = Level::all_with(graph, hierarchy)
-        .into_iter()
-        .map(|h| h.level)
-        .collect();
+/// The largest `firings × period` of the time-triggered tasks of `levels`
+/// (a graph's levels, its sub-graphs' included, top first, as
+/// [`super::analyze_as`] analyses them; `reports` their reports, in the same
+/// order); `None` when there are none, or when a level holding one, or one
+/// above it, has no repetition vector.
+pub(super) fn time_bound(levels: &[Level<'_>], reports: &[LevelReport]) -> Option<TimeBound> {
     let top = levels.first()?.path.clone();
     // Parents before children: a level's path extends its parent's.
     let mut order: Vec<usize> = (0..levels.len()).collect();
@@ -55,17 +47,14 @@ pub fn time_bound(
     let mut found: Option<TimeBound> = None;
     for i in order {
         let level = &levels[i];
-        let repetition = report
-            .levels
-            .get(i)
-            .filter(|r| r.path == level.path)
-            .and_then(|r| r.repetition.as_ref());
         runs[i] = if i == 0 {
             Some(1)
         } else {
-            enclosing_runs(&levels, &runs, report, i)
+            enclosing_runs(levels, &runs, reports, i)
         };
-        let (Some(repetition), Some(level_runs)) = (repetition, runs[i]) else {
+        let (Some(repetition), Some(level_runs)) =
+            (reports.get(i).and_then(|r| r.repetition.as_ref()), runs[i])
+        else {
             continue;
         };
         for (node, count) in level.nodes.iter().zip(repetition) {
@@ -107,7 +96,7 @@ pub fn time_bound(
 fn enclosing_runs(
     levels: &[Level<'_>],
     runs: &[Option<u64>],
-    report: &GraphReport,
+    reports: &[LevelReport],
     i: usize,
 ) -> Option<u64> {
     let path = &levels[i].path;
@@ -115,7 +104,7 @@ fn enclosing_runs(
         let name = path.strip_prefix(&parent.path)?.strip_prefix('/')?;
         let k = parent.nodes.iter().position(|n| n.name == name)?;
         let task = parent.graph.tasks.get(parent.nodes[k].task?)?;
-        let count = *report.levels.get(j)?.repetition.as_ref()?.get(k)?;
+        let count = *reports.get(j)?.repetition.as_ref()?.get(k)?;
         let iterations = task.loop_node.as_ref().map_or(1, |l| l.loop_count);
         Some(runs[j]?.saturating_mul(count).saturating_mul(iterations))
     })
