@@ -105,7 +105,7 @@ pub(super) fn graph_runner(service: &GraphService, simulated: bool) -> String {
     for (index, task) in service.tasks.iter().enumerate() {
         let exit_of = exits.iter().find(|(t, _)| *t == index).map(|(_, l)| *l);
         if let Some(period) = task.period_ms {
-            release(&mut out, index, task, period);
+            release(&mut out, service, index, task, period);
         }
         inner_task(&mut out, service, index, task, exit_of, simulated, &graph);
     }
@@ -213,8 +213,8 @@ fn text_size(ports: &[PortUse]) -> u64 {
 /// request does not cut the wait (an iteration is never left half run: its
 /// channels would not hold the next call's tokens); the program stopping
 /// does, and the iteration is abandoned (false).
-fn release(out: &mut String, index: usize, task: &InnerTask, period: u64) {
-    let name = format!("{index}_{}", c::ident(&task.path));
+fn release(out: &mut String, service: &GraphService, index: usize, task: &InnerTask, period: u64) {
+    let name = task_name(service, index);
     let _ = writeln!(
         out,
         "/* Inner task `{}` is time-triggered: it fires at most once every {period} ms. */\nstatic int64_t start_{name}; /* its last firing's start, mission ms */\n\nstatic bool release_{name}(void)\n{{\n    static bool fired;\n    if (fired && !semo_sleep_until(start_{name} + {period}))\n        return false;\n    start_{name} = semo_now_ms();\n    fired = true;\n    return true;\n}}\n",
@@ -232,7 +232,7 @@ fn inner_task(
     simulated: bool,
     graph: &str,
 ) {
-    let name = format!("{index}_{}", c::ident(&task.path));
+    let name = task_name(service, index);
     let ports: Vec<(&PortUse, bool)> = task
         .inputs
         .iter()
@@ -550,8 +550,14 @@ fn collect_exits<'s>(steps: &'s [GraphStep], exits: &mut Vec<(usize, &'s str)>) 
 /// every task it fires: `target::check` refuses a graph that names another
 /// as an internal error before generation).
 fn firing(service: &GraphService, index: usize) -> String {
+    format!("inner_{}", task_name(service, index))
+}
+
+/// The name inner task `index` goes by in C (`<n>_<path>`): its firing is
+/// `inner_<name>`, a time-triggered one's release `release_<name>`.
+fn task_name(service: &GraphService, index: usize) -> String {
     let path = service.tasks.get(index).map_or("", |t| t.path.as_str());
-    format!("inner_{index}_{}", c::ident(path))
+    format!("{index}_{}", c::ident(path))
 }
 
 /// The statements of `steps` at `indent` levels; `exit` names the flag of
@@ -584,7 +590,7 @@ fn steps(
                 if periodic {
                     call = format!(
                         "if (!release_{}())\n{pad}    return;\n{pad}{call}",
-                        function.trim_start_matches("inner_")
+                        task_name(service, *task)
                     );
                 }
                 if *count == 1 {
