@@ -284,3 +284,78 @@ fn components(level: &Level<'_>) -> Vec<Vec<usize>> {
     }
     parts
 }
+
+/// A random consistent level: a ring through all nodes plus `extra`
+/// channels, repetition counts `gamma`, rates a multiple of what the
+/// counts need, initial samples from `fill`, and a self-loop channel with
+/// 1 or 2 samples on the nodes `looped` says.
+#[derive(Debug, Clone)]
+pub(crate) struct RandomLevel {
+    pub(crate) gamma: Vec<u64>,
+    pub(crate) wcet: Vec<u64>,
+    pub(crate) extra: Vec<(usize, usize, u64, u64)>,
+    pub(crate) ring: Vec<(u64, u64)>,
+    pub(crate) looped: Vec<u64>,
+}
+
+impl RandomLevel {
+    pub(crate) fn graph(&self) -> TaskGraph {
+        let n = self.gamma.len();
+        let mut tasks: Vec<Task> = (0..n)
+            .map(|v| Task {
+                wcet: Some(self.wcet[v]),
+                ..task(&format!("T{v}"), &[])
+            })
+            .collect();
+        let mut channels = Vec::new();
+        let ring = (0..n).map(|i| (i, (i + 1) % n, self.ring[i].0, self.ring[i].1));
+        let extra = self.extra.iter().map(|&(s, d, m, f)| (s % n, d % n, m, f));
+        for (i, (s, d, m, fill)) in ring.chain(extra).enumerate() {
+            let (gs, gd) = (self.gamma[s], self.gamma[d]);
+            let l = super::ratio::lcm(gs, gd).unwrap() * m;
+            let (p, c) = (l / gs, l / gd);
+            tasks[s].ports.push(port(&format!("o{i}>{p}")));
+            tasks[d].ports.push(port(&format!("i{i}<{c}")));
+            let tokens = fill % (2 * l + 1);
+            channels.push(channel(
+                &format!("T{s}.o{i}"),
+                &format!("T{d}.i{i}"),
+                tokens,
+                0,
+            ));
+        }
+        for (v, &samples) in self.looped.iter().enumerate().take(n) {
+            if samples > 0 {
+                tasks[v].ports.push(port("so>1"));
+                tasks[v].ports.push(port("si<1"));
+                channels.push(channel(
+                    &format!("T{v}.so"),
+                    &format!("T{v}.si"),
+                    samples,
+                    0,
+                ));
+            }
+        }
+        graph("g", tasks, channels)
+    }
+}
+
+pub(crate) fn random_level() -> impl proptest::strategy::Strategy<Value = RandomLevel> {
+    use proptest::prelude::*;
+    (2usize..6).prop_flat_map(|n| {
+        (
+            proptest::collection::vec(1u64..4, n),
+            proptest::collection::vec(1u64..7, n),
+            proptest::collection::vec((0usize..6, 0usize..6, 1u64..3, 0u64..40), 0..4),
+            proptest::collection::vec((1u64..3, 0u64..40), n),
+            proptest::collection::vec(0u64..3, n),
+        )
+            .prop_map(|(gamma, wcet, extra, ring, looped)| RandomLevel {
+                gamma,
+                wcet,
+                extra,
+                ring,
+                looped,
+            })
+    })
+}

@@ -13,10 +13,17 @@
 //! level's channels (a self-loop channel among them) bound it, and a level
 //! without a cycle has period 0 (no bound on its throughput).
 //!
-//! Method: the level is expanded to its HSDF (when every repetition count is
-//! 1 the level already is one, and only its edges are read, no firing is
-//! copied), then Howard's policy iteration finds the maximum cycle ratio
-//! (execution time over initial samples) in exact arithmetic.
+//! Method: the level is split into its strongly connected parts, each
+//! analysed on its own with its own repetition vector (the level's counts
+//! divided by their gcd over the part), since every cycle lies within one
+//! part and the channels between parts are unbounded; the largest period,
+//! scaled back by that gcd, bounds the level (ties: the part with the
+//! first-declared node). A part is expanded to its HSDF (when every
+//! repetition count is 1 it already is one, and only its edges are read, no
+//! firing is copied), or executed symbolically for one iteration where that
+//! costs less ([`symbolic`]), then Howard's policy iteration finds the
+//! maximum cycle ratio (execution time over initial samples) in exact
+//! arithmetic.
 //!
 //! Complexity: the HSDF has N = Σγ nodes and M ≤ N + Σ γ(dst)·min(⌈c/p⌉+1,
 //! γ(src)) edges (summed over the level's edges); building it is O(N + M).
@@ -86,15 +93,121 @@ pub fn throughput(
     counts: &[u64],
     concurrency: Concurrency,
 ) -> Option<Throughput> {
-    if level.nodes.is_empty() || counts.len() != level.nodes.len() {
+    let n = level.nodes.len();
+    if n == 0 || counts.len() != n {
         return None;
     }
-    let wcet: Vec<u64> = level.nodes.iter().map(|n| n.wcet.unwrap_or(0)).collect();
-    let chained = chained(level, concurrency);
-    let direct =
-        counts.iter().all(|&c| c == 1) && level.edges.iter().all(|e| e.produce == e.consume);
-    if !direct && symbolic_is_cheaper(level, counts, &chained) {
-        if let Some((period, critical_cycle)) = symbolic::period(level, counts, &wcet, &chained) {
+    let wcet: Vec<u64> = level
+        .nodes
+        .iter()
+        .map(|node| node.wcet.unwrap_or(0))
+        .collect();
+    let sdf = Sdf::of(level);
+    let chained = chained(&sdf, concurrency);
+    let (part, parts) = crate::digraph::components(n, sdf.edges.iter().map(|e| (e.src, e.dst)));
+    if parts == 1 {
+        return period(&sdf, counts, &wcet, &chained);
+    }
+    // Each strongly connected part on its own: every cycle lies within one,
+    // and between parts the channels are unbounded, so a part's throughput
+    // does not depend on the others (`mp3playback`: three parts of 5, 12 and
+    // 2 × 5,292 firings, whose own iterations have 1, 1 and 2). A part's
+    // period per iteration of the level is its own period times the gcd of
+    // its nodes' counts (the level's iteration runs its own that many times).
+    // The largest bounds the level; ties: the part with the first-declared
+    // node.
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); parts];
+    for v in 0..n {
+        members[part[v]].push(v);
+    }
+    members.sort_unstable_by_key(|m| m[0]);
+    let mut local = vec![usize::MAX; n];
+    let mut edges_of: Vec<Vec<Rates>> = vec![Vec::new(); parts];
+    for e in &sdf.edges {
+        if part[e.src] == part[e.dst] {
+            edges_of[part[e.src]].push(*e);
+        }
+    }
+    let mut best: Option<Throughput> = None;
+    for nodes in &members {
+        let edges = std::mem::take(&mut edges_of[part[nodes[0]]]);
+        if edges.is_empty() && !chained[nodes[0]] {
+            continue; // a single node on no cycle
+        }
+        for (i, &v) in nodes.iter().enumerate() {
+            local[v] = i;
+        }
+        let gcd = nodes
+            .iter()
+            .fold(0, |g, &v| super::ratio::gcd(g, counts[v]));
+        let own = Sdf {
+            nodes: nodes.len(),
+            edges: edges
+                .into_iter()
+                .map(|e| Rates {
+                    src: local[e.src],
+                    dst: local[e.dst],
+                    ..e
+                })
+                .collect(),
+        };
+        let pick = |values: &[u64]| nodes.iter().map(|&v| values[v]).collect::<Vec<u64>>();
+        let own_counts: Vec<u64> = nodes.iter().map(|&v| counts[v] / gcd).collect();
+        let own_chained: Vec<bool> = nodes.iter().map(|&v| chained[v]).collect();
+        let t = period(&own, &own_counts, &pick(&wcet), &own_chained)?;
+        let period = t.period.scale(gcd, 1)?;
+        if best.as_ref().is_none_or(|b| period > b.period) {
+            best = Some(Throughput {
+                period,
+                critical_cycle: t.critical_cycle.iter().map(|&i| nodes[i]).collect(),
+            });
+        }
+    }
+    Some(best.unwrap_or(Throughput {
+        period: Ratio { num: 0, den: 1 },
+        critical_cycle: Vec::new(),
+    }))
+}
+
+/// What the engines read of a level: its rates and samples, no names, so
+/// that a strongly connected part is a graph of its own without copying the
+/// level.
+struct Sdf {
+    nodes: usize,
+    edges: Vec<Rates>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Rates {
+    src: usize,
+    dst: usize,
+    produce: u64,
+    consume: u64,
+    initial_tokens: u64,
+}
+
+impl Sdf {
+    fn of(level: &Level<'_>) -> Sdf {
+        let edges = level.edges.iter().map(|e| Rates {
+            src: e.src,
+            dst: e.dst,
+            produce: e.produce,
+            consume: e.consume,
+            initial_tokens: e.initial_tokens,
+        });
+        Sdf {
+            nodes: level.nodes.len(),
+            edges: edges.collect(),
+        }
+    }
+}
+
+/// [`throughput`] of a graph of one strongly connected part (or of a level
+/// as a whole), by whichever engine costs less.
+fn period(sdf: &Sdf, counts: &[u64], wcet: &[u64], chained: &[bool]) -> Option<Throughput> {
+    let direct = counts.iter().all(|&c| c == 1) && sdf.edges.iter().all(|e| e.produce == e.consume);
+    if !direct && symbolic_is_cheaper(sdf, counts, chained) {
+        if let Some((period, critical_cycle)) = symbolic::period(sdf, counts, wcet, chained) {
             return Some(Throughput {
                 period,
                 critical_cycle,
@@ -102,9 +215,9 @@ pub fn throughput(
         }
     }
     let hsdf = if direct {
-        Hsdf::direct(level, wcet, &chained)
+        Hsdf::direct(sdf, wcet.to_vec(), chained)
     } else {
-        Hsdf::expand(level, counts, &wcet, &chained)?
+        Hsdf::expand(sdf, counts, wcet, chained)?
     };
     let Some(hsdf) = hsdf.on_cycles() else {
         return Some(Throughput {
@@ -128,9 +241,9 @@ pub fn throughput(
 /// keeps the work of `Single` at `Auto`'s on graphs that limit every node so
 /// (`mp3playback`: the symbolic iteration follows the file's 6 samples, not
 /// 10).
-fn chained(level: &Level<'_>, concurrency: Concurrency) -> Vec<bool> {
-    let mut chained = vec![concurrency == Concurrency::Single; level.nodes.len()];
-    for e in &level.edges {
+fn chained(sdf: &Sdf, concurrency: Concurrency) -> Vec<bool> {
+    let mut chained = vec![concurrency == Concurrency::Single; sdf.nodes];
+    for e in &sdf.edges {
         let one_at_a_time = e.src == e.dst
             && e.produce == e.consume
             && e.produce <= e.initial_tokens
@@ -146,11 +259,11 @@ fn chained(level: &Level<'_>, concurrency: Concurrency) -> Vec<bool> {
 /// expansion. Its steps (a max over D integers) are several times cheaper
 /// than the expansion's (edges sorted, then policy iterations in exact
 /// ratios), hence the factor.
-fn symbolic_is_cheaper(level: &Level<'_>, counts: &[u64], chained: &[bool]) -> bool {
+fn symbolic_is_cheaper(sdf: &Sdf, counts: &[u64], chained: &[bool]) -> bool {
     const STEP_RATIO: u64 = 8;
     match (
-        symbolic::cost(level, counts, chained),
-        Hsdf::expanded_size(level, counts),
+        symbolic::cost(sdf, counts, chained),
+        Hsdf::expanded_size(sdf, counts),
     ) {
         (Some(symbolic), Some(hsdf)) => symbolic <= hsdf.saturating_mul(STEP_RATIO),
         _ => false,
@@ -217,9 +330,9 @@ impl Hsdf {
     /// rates): the level is its own HSDF. An edge with `d` samples and rate
     /// `p` lets a firing depend on the firing `⌊d/p⌋` iterations earlier.
     /// `chained`: each of those nodes also waits for its own previous firing.
-    fn direct(level: &Level<'_>, weight: Vec<u64>, chained: &[bool]) -> Hsdf {
-        let n = level.nodes.len();
-        let edges = level
+    fn direct(sdf: &Sdf, weight: Vec<u64>, chained: &[bool]) -> Hsdf {
+        let n = sdf.nodes;
+        let edges = sdf
             .edges
             .iter()
             .map(|e| (e.src, e.dst, e.initial_tokens / e.produce))
@@ -229,10 +342,10 @@ impl Hsdf {
     }
 
     /// At most how many nodes plus edges [`Hsdf::expand`] makes.
-    fn expanded_size(level: &Level<'_>, counts: &[u64]) -> Option<u64> {
+    fn expanded_size(sdf: &Sdf, counts: &[u64]) -> Option<u64> {
         let total = counts.iter().try_fold(0u64, |s, &c| s.checked_add(c))?;
         let mut size = total.checked_mul(2)?;
-        for e in &level.edges {
+        for e in &sdf.edges {
             let per = (e.consume.div_ceil(e.produce).saturating_add(1)).min(counts[e.src]);
             size = size.checked_add(counts[e.dst].checked_mul(per)?)?;
         }
@@ -248,8 +361,8 @@ impl Hsdf {
     /// many samples. Of several dependencies on the same source firing only
     /// the nearest iteration matters, so j runs over at most γ(src) values.
     /// `chained`: firing k of such a node also waits for its firing k - 1.
-    fn expand(level: &Level<'_>, counts: &[u64], wcet: &[u64], chained: &[bool]) -> Option<Hsdf> {
-        let n = level.nodes.len();
+    fn expand(sdf: &Sdf, counts: &[u64], wcet: &[u64], chained: &[bool]) -> Option<Hsdf> {
+        let n = sdf.nodes;
         let mut offset = Vec::with_capacity(n + 1);
         let mut total = 0u64;
         offset.push(0usize);
@@ -260,7 +373,7 @@ impl Hsdf {
             total = total.checked_add(c)?;
             offset.push(usize::try_from(total).ok()?);
         }
-        if Hsdf::expanded_size(level, counts)? > MAX_HSDF {
+        if Hsdf::expanded_size(sdf, counts)? > MAX_HSDF {
             return None;
         }
         let mut weight = Vec::with_capacity(offset[n]);
@@ -280,7 +393,7 @@ impl Hsdf {
                 edges.push((offset[v] + k, next, u64::from(k + 1 == g)));
             }
         }
-        for e in &level.edges {
+        for e in &sdf.edges {
             let (p, c, d) = (
                 i128::from(e.produce),
                 i128::from(e.consume),
@@ -541,7 +654,7 @@ mod tests {
     use crate::taskgraph::model::*;
     use proptest::prelude::*;
 
-    use crate::taskgraph::analysis::testing::{self, port, simulated_period};
+    use crate::taskgraph::analysis::testing::{self, port, random_level, simulated_period};
 
     fn task(name: &str, wcet: u64, ports: &[&str]) -> Task {
         Task {
@@ -755,71 +868,6 @@ mod tests {
         assert!(checked > 100, "{checked}");
     }
 
-    /// A random consistent level: a ring through all nodes plus `extra`
-    /// channels, repetition counts `gamma`, rates a multiple of what the
-    /// counts need, initial samples from `fill`, and a self-loop channel with
-    /// 1 or 2 samples on the nodes `looped` says.
-    #[derive(Debug, Clone)]
-    struct RandomLevel {
-        gamma: Vec<u64>,
-        wcet: Vec<u64>,
-        extra: Vec<(usize, usize, u64, u64)>,
-        ring: Vec<(u64, u64)>,
-        looped: Vec<u64>,
-    }
-
-    impl RandomLevel {
-        fn graph(&self) -> TaskGraph {
-            let n = self.gamma.len();
-            let mut tasks: Vec<Task> = (0..n)
-                .map(|v| task(&format!("T{v}"), self.wcet[v], &[]))
-                .collect();
-            let mut channels = Vec::new();
-            let ring = (0..n).map(|i| (i, (i + 1) % n, self.ring[i].0, self.ring[i].1));
-            let extra = self.extra.iter().map(|&(s, d, m, f)| (s % n, d % n, m, f));
-            for (i, (s, d, m, fill)) in ring.chain(extra).enumerate() {
-                let (gs, gd) = (self.gamma[s], self.gamma[d]);
-                let l = super::super::ratio::lcm(gs, gd).unwrap() * m;
-                let (p, c) = (l / gs, l / gd);
-                tasks[s].ports.push(port(&format!("o{i}>{p}")));
-                tasks[d].ports.push(port(&format!("i{i}<{c}")));
-                let tokens = fill % (2 * l + 1);
-                channels.push(channel(
-                    &format!("T{s}.o{i}"),
-                    &format!("T{d}.i{i}"),
-                    tokens,
-                ));
-            }
-            for (v, &samples) in self.looped.iter().enumerate().take(n) {
-                if samples > 0 {
-                    tasks[v].ports.push(port("so>1"));
-                    tasks[v].ports.push(port("si<1"));
-                    channels.push(channel(&format!("T{v}.so"), &format!("T{v}.si"), samples));
-                }
-            }
-            graph(tasks, channels)
-        }
-    }
-
-    fn random_level() -> impl Strategy<Value = RandomLevel> {
-        (2usize..6).prop_flat_map(|n| {
-            (
-                proptest::collection::vec(1u64..4, n),
-                proptest::collection::vec(1u64..7, n),
-                proptest::collection::vec((0usize..6, 0usize..6, 1u64..3, 0u64..40), 0..4),
-                proptest::collection::vec((1u64..3, 0u64..40), n),
-                proptest::collection::vec(0u64..3, n),
-            )
-                .prop_map(|(gamma, wcet, extra, ring, looped)| RandomLevel {
-                    gamma,
-                    wcet,
-                    extra,
-                    ring,
-                    looped,
-                })
-        })
-    }
-
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(400))]
 
@@ -843,8 +891,9 @@ mod tests {
                 prop_assert_eq!(t.critical_cycle.is_empty(), t.period.num == 0);
                 // The symbolic iteration, whichever engine `throughput` chose.
                 let wcet: Vec<u64> = level.nodes.iter().map(|n| n.wcet.unwrap_or(0)).collect();
-                let chained = chained(&level, concurrency);
-                let (period, cycle) = symbolic::period(&level, &counts, &wcet, &chained).unwrap();
+                let sdf = Sdf::of(&level);
+                let chained = chained(&sdf, concurrency);
+                let (period, cycle) = symbolic::period(&sdf, &counts, &wcet, &chained).unwrap();
                 prop_assert_eq!(period, t.period, "symbolic, {:?}", concurrency);
                 prop_assert_eq!(cycle.is_empty(), period.num == 0);
                 prop_assert!(cycle.iter().all(|&v| v < level.nodes.len()));
@@ -859,6 +908,81 @@ mod tests {
                 throughput(&level, &counts, Concurrency::Single).map(|t| t.period)
             );
         }
+    }
+
+    /// Two random levels joined by one channel from `a`'s first node to
+    /// `b`'s (`b`'s nodes renamed `U…`): a level of at least two strongly
+    /// connected parts, where `b`'s repetition counts have a gcd of 3 or
+    /// more.
+    fn joined(a: &TaskGraph, b: &TaskGraph) -> TaskGraph {
+        let first_count = |g: &TaskGraph| {
+            let level = Level::build(g, None, "g".into());
+            repetition_vector(&level).unwrap()[0]
+        };
+        let (qa, qb) = (first_count(a), first_count(b));
+        let rename = |name: &str| name.replacen('T', "U", 1);
+        let mut tasks = a.tasks.clone();
+        let mut channels = a.channels.clone();
+        for t in &b.tasks {
+            let mut t = t.clone();
+            t.name.name = rename(&t.name.name);
+            tasks.push(t);
+        }
+        for c in &b.channels {
+            let mut c = c.clone();
+            c.src.task = rename(&c.src.task);
+            c.dst.task = rename(&c.dst.task);
+            channels.push(c);
+        }
+        let b0 = a.tasks.len();
+        // `b` runs its own iteration three times per iteration of the whole.
+        tasks[0].ports.push(port(&format!("jo>{}", 3 * qb)));
+        tasks[b0].ports.push(port(&format!("ji<{qa}")));
+        channels.push(channel("T0.jo", "U0.ji", 0));
+        graph(tasks, channels)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+
+        /// A level of several strongly connected parts, each analysed on
+        /// its own: the period is still the simulated one, and it is the
+        /// larger of the two levels' periods (scaled to the joined level's
+        /// iteration).
+        #[test]
+        fn joined_levels_have_the_simulated_period(a in random_level(), b in random_level()) {
+            let g = joined(&a.graph(), &b.graph());
+            let level = Level::build(&g, None, "g".into());
+            let counts = repetition_vector(&level).unwrap();
+            prop_assume!(find_deadlock(&level, &counts).is_none());
+            for concurrency in [Concurrency::Auto, Concurrency::Single] {
+                let t = throughput(&level, &counts, concurrency).unwrap();
+                prop_assert_eq!(
+                    t.period,
+                    simulated_period(&level, &counts, concurrency),
+                    "{:?}", concurrency
+                );
+                prop_assert!(t.critical_cycle.iter().all(|&v| v < level.nodes.len()));
+            }
+        }
+    }
+
+    #[test]
+    fn parts_that_tie_name_the_first_declared() {
+        // A fires twice for each firing of B: 2 × 2 = 1 × 4.
+        let g = graph(
+            vec![task("A", 2, &["o>1"]), task("B", 4, &["i<2"])],
+            vec![channel("A.o", "B.i", 0)],
+        );
+        let t = analyze(&g);
+        assert_eq!(t.period, ratio(4, 1));
+        assert_eq!(t.critical_cycle, [0]);
+        // B slower: B.
+        let g = graph(
+            vec![task("A", 2, &["o>1"]), task("B", 5, &["i<2"])],
+            vec![channel("A.o", "B.i", 0)],
+        );
+        assert_eq!(analyze(&g).critical_cycle, [1]);
     }
 
     const SDF3: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sdf3");
@@ -991,6 +1115,30 @@ mod tests {
         let g = graph(
             vec![task("A", 1, &["o>1000000000"]), task("B", 1, &["i<1"])],
             vec![channel("A.o", "B.i", 0)],
+        );
+        let level = Level::build(&g, None, "g".into());
+        let counts = repetition_vector(&level).unwrap();
+        assert_eq!(counts, [1, 1_000_000_000]);
+        // Two parts, each of one node firing once per iteration of its own:
+        // no expansion, B's 10^9 firings back to back bound it.
+        assert_eq!(
+            throughput(&level, &counts, Concurrency::Single),
+            Some(Throughput {
+                period: ratio(1_000_000_000, 1),
+                critical_cycle: vec![1],
+            })
+        );
+        // One part of 10^9 + 1 firings with 10^9 initial samples: too big
+        // for both engines.
+        let g = graph(
+            vec![
+                task("A", 1, &["o>1000000000", "i<1000000000"]),
+                task("B", 1, &["i<1", "o>1"]),
+            ],
+            vec![
+                channel("A.o", "B.i", 0),
+                channel("B.o", "A.i", 1_000_000_000),
+            ],
         );
         let level = Level::build(&g, None, "g".into());
         let counts = repetition_vector(&level).unwrap();

@@ -23,8 +23,7 @@
 //! The critical cycle is traced back through the firings: each vector entry
 //! remembers which input gave its max.
 
-use super::{Hsdf, level_cycle, max_cycle_ratio};
-use crate::taskgraph::analysis::level::Level;
+use super::{Hsdf, Rates, Sdf, level_cycle, max_cycle_ratio};
 use crate::taskgraph::analysis::ratio::Ratio;
 use std::collections::VecDeque;
 
@@ -33,50 +32,27 @@ const NEG_INF: i64 = i64::MIN;
 /// Initial samples beyond which the vectors cost more than they save.
 const MAX_SAMPLES: u64 = 4096;
 
-struct Channel {
-    src: usize,
-    dst: usize,
-    produce: u64,
-    consume: u64,
-    tokens: u64,
-}
-
-fn channels(level: &Level<'_>, chained: &[bool]) -> Vec<Channel> {
-    let mut out: Vec<Channel> = level
-        .edges
-        .iter()
-        .map(|e| Channel {
-            src: e.src,
-            dst: e.dst,
-            produce: e.produce,
-            consume: e.consume,
-            tokens: e.initial_tokens,
-        })
-        .collect();
-    {
-        out.extend(
-            (0..level.nodes.len())
-                .filter(|&v| chained[v])
-                .map(|v| Channel {
-                    src: v,
-                    dst: v,
-                    produce: 1,
-                    consume: 1,
-                    tokens: 1,
-                }),
-        );
-    }
-    out
+/// The level's channels and, for each chained node, a self-loop of one
+/// sample.
+fn channels(sdf: &Sdf, chained: &[bool]) -> Vec<Rates> {
+    let loops = (0..sdf.nodes).filter(|&v| chained[v]).map(|v| Rates {
+        src: v,
+        dst: v,
+        produce: 1,
+        consume: 1,
+        initial_tokens: 1,
+    });
+    sdf.edges.iter().copied().chain(loops).collect()
 }
 
 /// D·(Σγ + Σ over channels of γ(src) + γ(dst)): the work of [`period`], to
 /// compare with the HSDF's size. `None` when it does not apply (too many
 /// initial samples, vectors beyond the HSDF's memory budget, overflow).
-pub(super) fn cost(level: &Level<'_>, counts: &[u64], chained: &[bool]) -> Option<u64> {
-    let channels = channels(level, chained);
+pub(super) fn cost(sdf: &Sdf, counts: &[u64], chained: &[bool]) -> Option<u64> {
+    let channels = channels(sdf, chained);
     let samples = channels
         .iter()
-        .try_fold(0u64, |sum, c| sum.checked_add(c.tokens))?;
+        .try_fold(0u64, |sum, c| sum.checked_add(c.initial_tokens))?;
     if samples > MAX_SAMPLES {
         return None;
     }
@@ -101,20 +77,20 @@ type Origin = usize;
 /// before [`level_cycle`]); `None` on overflow or when the iteration cannot
 /// complete (the caller then uses the HSDF).
 pub(super) fn period(
-    level: &Level<'_>,
+    sdf: &Sdf,
     counts: &[u64],
     wcet: &[u64],
     chained: &[bool],
 ) -> Option<(Ratio, Vec<usize>)> {
     // Within the bounds (samples, memory) whatever the caller checked.
-    cost(level, counts, chained)?;
-    let n = level.nodes.len();
-    let channels = channels(level, chained);
+    cost(sdf, counts, chained)?;
+    let n = sdf.nodes;
+    let channels = channels(sdf, chained);
     let mut base = Vec::with_capacity(channels.len());
     let mut d = 0usize;
     for c in &channels {
         base.push(d);
-        d = d.checked_add(usize::try_from(c.tokens).ok()?)?;
+        d = d.checked_add(usize::try_from(c.initial_tokens).ok()?)?;
     }
     let mut inputs = vec![Vec::new(); n];
     let mut outputs = vec![Vec::new(); n];
@@ -125,9 +101,9 @@ pub(super) fn period(
     let mut queues: Vec<VecDeque<(Origin, u64)>> = channels
         .iter()
         .zip(&base)
-        .map(|(c, &b)| (b..b + c.tokens as usize).map(|o| (o, 1)).collect())
+        .map(|(c, &b)| (b..b + c.initial_tokens as usize).map(|o| (o, 1)).collect())
         .collect();
-    let mut available: Vec<u64> = channels.iter().map(|c| c.tokens).collect();
+    let mut available: Vec<u64> = channels.iter().map(|c| c.initial_tokens).collect();
     let mut remaining = counts.to_vec();
     let total = usize::try_from(counts.iter().try_fold(0u64, |s, &c| s.checked_add(c))?).ok()?;
     // Per firing: its actor and which origin gave each entry of its vector
