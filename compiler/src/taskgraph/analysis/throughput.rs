@@ -520,14 +520,14 @@ fn max_cycle_ratio(g: &Hsdf) -> Option<(Ratio, Vec<usize>)> {
                 // `step`'s first term, the same for every edge of `v` (and
                 // computed by it at least once: `v`'s policy edge leads to
                 // its own λ).
-                let w = i128::from(g.weight[v]).checked_mul(i128::from(l.den))?;
+                let w = product(g.weight[v], l.den)?;
                 let mut best = (x[v], policy[v]);
                 for e in g.out(v) {
                     let u = g.head[e];
                     if !one_ratio && lambda[u] != l {
                         continue;
                     }
-                    let t = i128::from(l.num).checked_mul(i128::from(g.tokens[e]))?;
+                    let t = product(l.num, g.tokens[e])?;
                     let value = w.checked_sub(t)?.checked_add(x[u])?;
                     if value > best.0 {
                         best = (value, e);
@@ -552,10 +552,18 @@ fn max_cycle_ratio(g: &Hsdf) -> Option<(Ratio, Vec<usize>)> {
     }
 }
 
+/// `a·b` as an `i128`: the product of two `u64`s always fits a `u128`, and
+/// checking that it fits an `i128` is a comparison, where `i128`'s checked
+/// multiplication is a call into the runtime (a sixth of the policy
+/// iteration on `random_1000`).
+fn product(a: u64, b: u64) -> Option<i128> {
+    i128::try_from(u128::from(a) * u128::from(b)).ok()
+}
+
 /// `(w - λ·t)·den` for λ = num/den.
 fn step(w: u64, t: u64, l: Ratio) -> Option<i128> {
-    let a = i128::from(w).checked_mul(i128::from(l.den))?;
-    let b = i128::from(l.num).checked_mul(i128::from(t))?;
+    let a = product(w, l.den)?;
+    let b = product(l.num, t)?;
     a.checked_sub(b)
 }
 
