@@ -753,13 +753,20 @@ mod tests {
         assert_eq!(t.critical_cycle, [0, 1, 2]);
     }
 
+    /// A → B, A taking `a` and B `b`, B consuming `rate` samples a firing.
+    fn chain(a: u64, b: u64, rate: u64) -> TaskGraph {
+        graph(
+            vec![
+                task("A", a, &["o>1"]),
+                task("B", b, &[&format!("i<{rate}")]),
+            ],
+            vec![channel("A.o", "B.i", 0)],
+        )
+    }
+
     #[test]
     fn an_acyclic_chain_is_bounded_by_its_slowest_node() {
-        let g = graph(
-            vec![task("A", 2, &["o>1"]), task("B", 7, &["i<1"])],
-            vec![channel("A.o", "B.i", 0)],
-        );
-        let t = analyze(&g);
+        let t = analyze(&chain(2, 7, 1));
         assert_eq!(t.period, ratio(7, 1));
         assert_eq!(t.critical_cycle, [1]);
     }
@@ -876,6 +883,23 @@ mod tests {
         assert!(checked > 100, "{checked}");
     }
 
+    /// The throughput of `level`, its period checked against the self-timed
+    /// simulation.
+    fn simulated(
+        level: &Level<'_>,
+        counts: &[u64],
+        concurrency: Concurrency,
+    ) -> Result<Throughput, TestCaseError> {
+        let t = throughput(level, counts, concurrency).unwrap();
+        prop_assert_eq!(
+            t.period,
+            simulated_period(level, counts, concurrency),
+            "{:?}",
+            concurrency
+        );
+        Ok(t)
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(400))]
 
@@ -890,12 +914,7 @@ mod tests {
             let counts = repetition_vector(&level).unwrap();
             prop_assume!(find_deadlock(&level, &counts).is_none());
             for concurrency in [Concurrency::Auto, Concurrency::Single] {
-                let t = throughput(&level, &counts, concurrency).unwrap();
-                prop_assert_eq!(
-                    t.period,
-                    simulated_period(&level, &counts, concurrency),
-                    "{:?}", concurrency
-                );
+                let t = simulated(&level, &counts, concurrency)?;
                 prop_assert_eq!(t.critical_cycle.is_empty(), t.period.num == 0);
                 // The symbolic iteration, whichever engine `throughput` chose.
                 let wcet: Vec<u64> = level.nodes.iter().map(|n| n.wcet.unwrap_or(0)).collect();
@@ -954,9 +973,7 @@ mod tests {
         #![proptest_config(ProptestConfig::with_cases(200))]
 
         /// A level of several strongly connected parts, each analysed on
-        /// its own: the period is still the simulated one, and it is the
-        /// larger of the two levels' periods (scaled to the joined level's
-        /// iteration).
+        /// its own: the period is still the simulated one.
         #[test]
         fn joined_levels_have_the_simulated_period(a in random_level(), b in random_level()) {
             let g = joined(&a.graph(), &b.graph());
@@ -964,12 +981,7 @@ mod tests {
             let counts = repetition_vector(&level).unwrap();
             prop_assume!(find_deadlock(&level, &counts).is_none());
             for concurrency in [Concurrency::Auto, Concurrency::Single] {
-                let t = throughput(&level, &counts, concurrency).unwrap();
-                prop_assert_eq!(
-                    t.period,
-                    simulated_period(&level, &counts, concurrency),
-                    "{:?}", concurrency
-                );
+                let t = simulated(&level, &counts, concurrency)?;
                 prop_assert!(t.critical_cycle.iter().all(|&v| v < level.nodes.len()));
             }
         }
@@ -978,19 +990,11 @@ mod tests {
     #[test]
     fn parts_that_tie_name_the_first_declared() {
         // A fires twice for each firing of B: 2 × 2 = 1 × 4.
-        let g = graph(
-            vec![task("A", 2, &["o>1"]), task("B", 4, &["i<2"])],
-            vec![channel("A.o", "B.i", 0)],
-        );
-        let t = analyze(&g);
+        let t = analyze(&chain(2, 4, 2));
         assert_eq!(t.period, ratio(4, 1));
         assert_eq!(t.critical_cycle, [0]);
         // B slower: B.
-        let g = graph(
-            vec![task("A", 2, &["o>1"]), task("B", 5, &["i<2"])],
-            vec![channel("A.o", "B.i", 0)],
-        );
-        assert_eq!(analyze(&g).critical_cycle, [1]);
+        assert_eq!(analyze(&chain(2, 5, 2)).critical_cycle, [1]);
     }
 
     const SDF3: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/sdf3");
