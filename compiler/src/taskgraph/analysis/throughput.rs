@@ -94,8 +94,8 @@ pub fn throughput(
     concurrency: Concurrency,
 ) -> Option<Throughput> {
     let n = level.nodes.len();
-    if n == 0 || counts.len() != n {
-        return None;
+    if n == 0 || counts.len() != n || counts.contains(&0) {
+        return None; // no level, or not a repetition vector of it
     }
     let wcet: Vec<u64> = level
         .nodes
@@ -134,23 +134,10 @@ pub fn throughput(
         if edges.is_empty() && !chained[nodes[0]] {
             continue; // a single node on no cycle
         }
-        for (i, &v) in nodes.iter().enumerate() {
-            local[v] = i;
-        }
+        let own = Sdf::part(nodes, edges, &mut local);
         let gcd = nodes
             .iter()
             .fold(0, |g, &v| super::ratio::gcd(g, counts[v]));
-        let own = Sdf {
-            nodes: nodes.len(),
-            edges: edges
-                .into_iter()
-                .map(|e| Rates {
-                    src: local[e.src],
-                    dst: local[e.dst],
-                    ..e
-                })
-                .collect(),
-        };
         let pick = |values: &[u64]| nodes.iter().map(|&v| values[v]).collect::<Vec<u64>>();
         let own_counts: Vec<u64> = nodes.iter().map(|&v| counts[v] / gcd).collect();
         let own_chained: Vec<bool> = nodes.iter().map(|&v| chained[v]).collect();
@@ -197,6 +184,24 @@ impl Sdf {
         });
         Sdf {
             nodes: level.nodes.len(),
+            edges: edges.collect(),
+        }
+    }
+
+    /// The graph of one strongly connected part: its `nodes` (ascending)
+    /// numbered from 0 in that order, and the `edges` between them.
+    /// `local` is scratch indexed by level node.
+    fn part(nodes: &[usize], edges: Vec<Rates>, local: &mut [usize]) -> Sdf {
+        for (i, &v) in nodes.iter().enumerate() {
+            local[v] = i;
+        }
+        let edges = edges.into_iter().map(|e| Rates {
+            src: local[e.src],
+            dst: local[e.dst],
+            ..e
+        });
+        Sdf {
+            nodes: nodes.len(),
             edges: edges.collect(),
         }
     }
@@ -1161,5 +1166,14 @@ mod tests {
             None,
             "counts of another level"
         );
+        let g = chain(1, 1, 1);
+        let level = Level::build(&g, None, "g".into());
+        for concurrency in [Concurrency::Auto, Concurrency::Single] {
+            assert_eq!(
+                throughput(&level, &[0, 0], concurrency),
+                None,
+                "zero counts"
+            );
+        }
     }
 }
