@@ -532,7 +532,11 @@ fn max_cycle_ratio(g: &Hsdf) -> Option<(Ratio, Vec<usize>)> {
                     if !one_ratio && lambda[u] != l {
                         continue;
                     }
-                    let t = product(l.num, g.tokens[e])?;
+                    // Most HSDF edges carry no sample: no product.
+                    let t = match g.tokens[e] {
+                        0 => 0,
+                        tokens => product(l.num, tokens)?,
+                    };
                     let value = w.checked_sub(t)?.checked_add(x[u])?;
                     if value > best.0 {
                         best = (value, e);
