@@ -3,7 +3,6 @@
 //! smaller.
 
 use super::level::Level;
-use super::schedule::adjacency;
 use crate::diag::{Code, Diagnostic};
 
 /// For each edge of `level`, the most samples it holds while the firings
@@ -14,7 +13,7 @@ use crate::diag::{Code, Diagnostic};
 pub fn buffer_bounds(level: &Level<'_>, firings: &[usize]) -> Vec<u64> {
     let mut tokens: Vec<u64> = level.edges.iter().map(|e| e.initial_tokens).collect();
     let mut most = tokens.clone();
-    let (inputs, outputs) = adjacency(level);
+    let (inputs, outputs) = level.adjacency();
     let (inputs, outputs) = (inputs.slices(), outputs.slices());
     for &v in firings {
         let (Some(&ins), Some(&outs)) = (inputs.get(v), outputs.get(v)) else {

@@ -296,7 +296,7 @@ impl<'l, 'g> Frames<'l, 'g> {
     fn new(level: &'l Level<'g>) -> Frames<'l, 'g> {
         Frames {
             level,
-            outputs: adjacency(level).1,
+            outputs: level.adjacency().1,
             scratch: vec![usize::MAX; level.nodes.len()],
         }
     }
@@ -518,7 +518,7 @@ fn build(
 /// The strongly connected components of the sub-graph of `members` through
 /// the edges that `keep` accepts, in topological order (ties: the component
 /// with the smallest node first), each sorted. `outputs` are each node's
-/// outgoing edges ([`adjacency`]); `local` is node-indexed scratch, all
+/// outgoing edges ([`Level::adjacency`]); `local` is node-indexed scratch, all
 /// `usize::MAX` before and after: the cost is the members' edges, not the
 /// level's.
 fn ordered_components(
@@ -646,7 +646,7 @@ pub fn expand(schedule: &[Schedule], limit: u64) -> Option<Vec<usize>> {
 /// Whether `firings` never reads a channel short of samples.
 pub fn valid(level: &Level<'_>, firings: &[usize]) -> bool {
     let mut tokens: Vec<u64> = level.edges.iter().map(|e| e.initial_tokens).collect();
-    let (inputs, outputs) = adjacency(level);
+    let (inputs, outputs) = level.adjacency();
     let (inputs, outputs) = (inputs.slices(), outputs.slices());
     for &v in firings {
         let (Some(&ins), Some(&outs)) = (inputs.get(v), outputs.get(v)) else {
@@ -665,11 +665,6 @@ pub fn valid(level: &Level<'_>, firings: &[usize]) -> bool {
     true
 }
 
-/// Each node's input edges and output edges.
-pub(super) fn adjacency(level: &Level<'_>) -> (Lists, Lists) {
-    level.adjacency()
-}
-
 /// A valid sequence of one iteration's firings, found by executing it
 /// symbolically: among the nodes that can fire and have firings left, the one
 /// latest in topological order (ties: file order) fires first, which drains
@@ -686,7 +681,7 @@ pub fn flat_schedule(level: &Level<'_>, counts: &[u64]) -> Option<Vec<usize>> {
         return None;
     }
     let all: Vec<usize> = (0..n).collect();
-    let (inputs, outputs) = adjacency(level);
+    let (inputs, outputs) = level.adjacency();
     let order: Vec<usize> =
         ordered_components(level, &outputs, &mut vec![usize::MAX; n], &all, &|_| true)
             .items()
@@ -789,7 +784,7 @@ pub fn multicore(
         offset[v + 1] = offset[v] + usize::try_from(counts[v]).ok()?;
         owner.extend(std::iter::repeat_n(v, usize::try_from(counts[v]).ok()?));
     }
-    let (inputs, _) = adjacency(level);
+    let (inputs, _) = level.adjacency();
     let mut preds: Vec<Vec<usize>> = vec![Vec::new(); total];
     let mut succs: Vec<Vec<usize>> = vec![Vec::new(); total];
     for v in 0..n {
