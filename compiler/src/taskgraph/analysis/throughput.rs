@@ -13,17 +13,17 @@
 //! level's channels (a self-loop channel among them) bound it, and a level
 //! without a cycle has period 0 (no bound on its throughput).
 //!
-//! Method: the level is split into its strongly connected parts, each
-//! analysed on its own with its own repetition vector (the level's counts
-//! divided by their gcd over the part), since every cycle lies within one
-//! part and the channels between parts are unbounded; the largest period,
-//! scaled back by that gcd, bounds the level (ties: the part with the
-//! first-declared node). A part is expanded to its HSDF (when every
-//! repetition count is 1 it already is one, and only its edges are read, no
-//! firing is copied), or executed symbolically for one iteration where that
-//! costs less ([`symbolic`]), then Howard's policy iteration finds the
-//! maximum cycle ratio (execution time over initial samples) in exact
-//! arithmetic.
+//! Method: the level's strongly connected parts are analysed side by side,
+//! without the channels between them (every cycle lies within one part, and
+//! those channels are unbounded), each part at its own repetition vector
+//! (the level's counts divided by their gcd over the part) with its
+//! execution times multiplied by that gcd, so that its period counts per
+//! iteration of the level; the largest bounds the level. They are expanded
+//! to their HSDF (when every repetition count is 1 they already are one,
+//! and only their edges are read, no firing is copied), or executed
+//! symbolically for one iteration where that costs less ([`symbolic`]), then
+//! Howard's policy iteration finds the maximum cycle ratio (execution time
+//! over initial samples) in exact arithmetic.
 //!
 //! Complexity: the HSDF has N = Σγ nodes and M ≤ N + Σ γ(dst)·min(⌈c/p⌉+1,
 //! γ(src)) edges (summed over the level's edges); building it is O(N + M).
@@ -104,61 +104,39 @@ pub fn throughput(
         .collect();
     let sdf = Sdf::of(level);
     let chained = chained(&sdf, concurrency);
+    // The strongly connected parts at their own rates: every cycle lies
+    // within one part, and the channels between parts are unbounded, so they
+    // bound nothing and are left out. Each part then runs its own iteration
+    // (the level's counts divided by their gcd g over the part:
+    // `mp3playback`'s 10,601 firings per iteration become parts of 1, 1 and
+    // 2), which the level's iteration runs g times; a period is linear in
+    // the execution times, so taking each node's time g times over gives
+    // the part's period per iteration of the level. One run of an engine on
+    // the parts side by side gives the largest. Of parts that tie, the
+    // policy iteration names the cycle it meets first: on the HSDF, the
+    // part's with the first-declared node; on the symbolic iteration's
+    // matrix, the part's with the first initial samples.
     let (part, parts) = crate::digraph::components(n, sdf.edges.iter().map(|e| (e.src, e.dst)));
-    if parts == 1 {
-        return period(&sdf, counts, &wcet, &chained);
+    let mut gcd = vec![0; parts];
+    for (v, &count) in counts.iter().enumerate() {
+        gcd[part[v]] = super::ratio::gcd(gcd[part[v]], count);
     }
-    // Each strongly connected part on its own: every cycle lies within one,
-    // and between parts the channels are unbounded, so a part's throughput
-    // does not depend on the others (`mp3playback`: three parts of 5, 12 and
-    // 2 × 5,292 firings, whose own iterations have 1, 1 and 2). A part's
-    // period per iteration of the level is its own period times the gcd of
-    // its nodes' counts (the level's iteration runs its own that many times).
-    // The largest bounds the level; ties: the part with the first-declared
-    // node.
-    let mut members: Vec<Vec<usize>> = vec![Vec::new(); parts];
-    for v in 0..n {
-        members[part[v]].push(v);
-    }
-    members.sort_unstable_by_key(|m| m[0]);
-    let mut local = vec![usize::MAX; n];
-    let mut edges_of: Vec<Vec<Rates>> = vec![Vec::new(); parts];
-    for e in &sdf.edges {
-        if part[e.src] == part[e.dst] {
-            edges_of[part[e.src]].push(*e);
-        }
-    }
-    let mut best: Option<Throughput> = None;
-    for nodes in &members {
-        let edges = std::mem::take(&mut edges_of[part[nodes[0]]]);
-        if edges.is_empty() && !chained[nodes[0]] {
-            continue; // a single node on no cycle
-        }
-        let own = Sdf::part(nodes, edges, &mut local);
-        let gcd = nodes
-            .iter()
-            .fold(0, |g, &v| super::ratio::gcd(g, counts[v]));
-        let pick = |values: &[u64]| nodes.iter().map(|&v| values[v]).collect::<Vec<u64>>();
-        let own_counts: Vec<u64> = nodes.iter().map(|&v| counts[v] / gcd).collect();
-        let own_chained: Vec<bool> = nodes.iter().map(|&v| chained[v]).collect();
-        let t = period(&own, &own_counts, &pick(&wcet), &own_chained)?;
-        let period = t.period.scale(gcd, 1)?;
-        if best.as_ref().is_none_or(|b| period > b.period) {
-            best = Some(Throughput {
-                period,
-                critical_cycle: t.critical_cycle.iter().map(|&i| nodes[i]).collect(),
-            });
-        }
-    }
-    Some(best.unwrap_or(Throughput {
-        period: Ratio { num: 0, den: 1 },
-        critical_cycle: Vec::new(),
-    }))
+    let own_counts: Vec<u64> = (0..n).map(|v| counts[v] / gcd[part[v]]).collect();
+    let times = (0..n)
+        .map(|v| wcet[v].checked_mul(gcd[part[v]]))
+        .collect::<Option<Vec<u64>>>()?;
+    let parts = Sdf {
+        nodes: n,
+        edges: sdf
+            .edges
+            .into_iter()
+            .filter(|e| part[e.src] == part[e.dst])
+            .collect(),
+    };
+    period(&parts, &own_counts, &times, &chained)
 }
 
-/// What the engines read of a level: its rates and samples, no names, so
-/// that a strongly connected part is a graph of its own without copying the
-/// level.
+/// What the engines read of a level: its rates and samples, no names.
 struct Sdf {
     nodes: usize,
     edges: Vec<Rates>,
@@ -187,28 +165,10 @@ impl Sdf {
             edges: edges.collect(),
         }
     }
-
-    /// The graph of one strongly connected part: its `nodes` (ascending)
-    /// numbered from 0 in that order, and the `edges` between them.
-    /// `local` is scratch indexed by level node.
-    fn part(nodes: &[usize], edges: Vec<Rates>, local: &mut [usize]) -> Sdf {
-        for (i, &v) in nodes.iter().enumerate() {
-            local[v] = i;
-        }
-        let edges = edges.into_iter().map(|e| Rates {
-            src: local[e.src],
-            dst: local[e.dst],
-            ..e
-        });
-        Sdf {
-            nodes: nodes.len(),
-            edges: edges.collect(),
-        }
-    }
 }
 
-/// [`throughput`] of a graph of one strongly connected part (or of a level
-/// as a whole), by whichever engine costs less.
+/// [`throughput`] of the level's parts at their own rates, by whichever
+/// engine costs less.
 fn period(sdf: &Sdf, counts: &[u64], wcet: &[u64], chained: &[bool]) -> Option<Throughput> {
     let direct = counts.iter().all(|&c| c == 1) && sdf.edges.iter().all(|e| e.produce == e.consume);
     if !direct && symbolic_is_cheaper(sdf, counts, chained) {
