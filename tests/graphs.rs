@@ -366,6 +366,29 @@ fn throughput_names_the_period_and_critical_cycle() {
     assert_eq!(t["critical_cycle"], cycle);
 }
 
+/// A graph of several strongly connected parts is bounded by its slowest
+/// part, each at its own rate; of parts that tie, the first-declared task's
+/// is named.
+#[test]
+fn the_slowest_part_bounds_the_period() {
+    let says = |dir: &std::path::Path, file: &str, line: &str| {
+        let out = semo_in(dir, &["graph", "analyze", file]);
+        assert_eq!(out.code, 0, "{}", out.stderr);
+        assert!(out.stdout.contains(line), "{}", out.stdout);
+    };
+    says(
+        &sdf3(),
+        "mp3playback.xml",
+        "iteration period: 120000 (bounded by src alone)",
+    );
+    // filter fires twice at 2, merge once at 4: a tie.
+    says(
+        &subgraph_fixtures(),
+        "detect.taskgraph.xml",
+        "iteration period: 4 (bounded by filter alone)",
+    );
+}
+
 /// `semo graph analyze --sdf3-compat` gives SDF3's iteration period on every
 /// SDF3 benchmark graph (the table in `tests/data/sdf3/README.md`: SDF3's
 /// `sdf3analysis-sdf --algo throughput`, the period its inverse).
