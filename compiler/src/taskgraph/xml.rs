@@ -9,7 +9,8 @@
 //! they come ([`sdf3`]), with the same positions and checks: its files are
 //! large, and the tree was most of the time of analysing one. Before that, a
 //! clean SDF3 file (nothing to report, no entity) is read straight from
-//! quick-xml's events into the graph ([`sdf3_clean`]), with the same result;
+//! quick-xml's events ([`tags`]) into the graph ([`sdf3_clean`]), with the
+//! same result;
 //! any other file goes to the full reader. Malformed XML
 //! (E060) stops reading; what was read before the error is still read as a
 //! graph, and channel ends are not checked in a graph level that was cut
@@ -1174,5 +1175,6 @@ fn flip(d: Direction) -> Direction {
 
 mod sdf3;
 mod sdf3_clean;
+mod tags;
 #[cfg(test)]
 mod tests;

@@ -1,7 +1,8 @@
-//! The direct reading of a clean SDF3 file: quick-xml's events straight into
-//! the graph, with no element, attribute list or owned string on the way (the
-//! attribute values are slices of the text, their ranges found by pointer
-//! arithmetic, and only the model's own names are copied). On a 1,000-actor
+//! The direct reading of a clean SDF3 file: quick-xml's events (found by
+//! [`super::tags`]) straight into the graph, with no element, attribute list
+//! or owned string on the way (the attribute values are slices of the text,
+//! their ranges found by pointer arithmetic, and only the model's own names
+//! are copied). On a 1,000-actor
 //! graph this reading takes a fraction of the time of the full reader
 //! ([`super::sdf3`] over [`crate::xmltree::walk`]), which was most of the time
 //! of analysing one.
@@ -14,16 +15,18 @@
 //! reader, which reports it. It keeps the full reader's meaning element for
 //! element (the same roles, first-of-a-kind rules and execution-time choice),
 //! so the two give the same graph on every file this one accepts and this one
-//! declines only files the full reader reports or that hold an entity
+//! declines only files the full reader reports, that hold an entity or that
+//! start with a byte-order mark
 //! (`taskgraph::xml::tests::the_clean_sdf3_reader_*`).
 
 use super::ExecutionTimes;
 use super::sdf3::Role;
+use super::tags::Tags;
 use crate::diag::FileId;
 use crate::fasthash::FastMap as HashMap;
 use crate::span::Span;
 use crate::taskgraph::model::*;
-use crate::xmlpos::{end_tag_span, reader, slice_span, start_tag_spans};
+use crate::xmlpos::{end_tag_span, slice_span, start_tag_spans};
 use quick_xml::events::{BytesStart, Event};
 
 /// The file needs the full reader (it has something to report, or an entity).
@@ -120,10 +123,6 @@ impl<'t> Value<'t> {
 /// The most attributes a role reads.
 const MAX_KEYS: usize = 5;
 
-/// How many attribute names of one element are kept without allocating, for
-/// the duplicate check (SDF3's elements have at most six attributes).
-const SEEN: usize = 16;
-
 /// One open element.
 struct Open<'t> {
     role: Role,
@@ -164,46 +163,6 @@ pub(super) fn read(file: FileId, text: &str, times: ExecutionTimes) -> Option<Ta
     state.finish(file).ok()
 }
 
-/// Calls `f` with the name and the value (between its quotes) of each
-/// attribute of a start tag, `raw` its text after the element's name (as
-/// quick-xml's `attributes_raw` gives it), and declines where quick-xml's
-/// attribute reader would give an error. It follows that reader's grammar
-/// step by step (blanks; a name: its first byte whatever it is, then up to
-/// `=` or a blank; blanks, `=`, blanks; a value in double or single quotes),
-/// so it reads the same names and values from the same tags, but without
-/// the reader's state machine and the list of names it allocates per
-/// element for its duplicate check (a fifth of reading a large graph).
-fn each_attribute<'a>(
-    raw: &'a [u8],
-    mut f: impl FnMut(&'a [u8], &'a [u8]) -> Read<()>,
-) -> Read<()> {
-    fn blank(b: u8) -> bool {
-        matches!(b, b' ' | b'\r' | b'\n' | b'\t')
-    }
-    /// The first position from `from` whose byte `is` accepts.
-    fn find(raw: &[u8], from: usize, is: impl Fn(u8) -> bool) -> Option<usize> {
-        let skipped = raw.get(from..)?.iter().position(|&b| is(b))?;
-        Some(from + skipped)
-    }
-    let mut at = 0;
-    while let Some(key_start) = find(raw, at, |b| !blank(b)) {
-        let key_end = find(raw, key_start + 1, |b| b == b'=' || blank(b)).ok_or(Decline)?;
-        let equals = find(raw, key_end, |b| !blank(b)).ok_or(Decline)?;
-        if raw[equals] != b'=' {
-            return Err(Decline);
-        }
-        let open = find(raw, equals + 1, |b| !blank(b)).ok_or(Decline)?;
-        let quote = raw[open];
-        if quote != b'"' && quote != b'\'' {
-            return Err(Decline);
-        }
-        let close = find(raw, open + 1, |b| b == quote).ok_or(Decline)?;
-        f(&raw[key_start..key_end], &raw[open + 1..close])?;
-        at = close + 1;
-    }
-    Ok(())
-}
-
 /// Whether two attribute names are the same. SDF3's names of one length
 /// mostly differ in their first byte (`name`, `type`, `rate`; `srcActor`,
 /// `dstActor`): compared first, it spares most of the calls to `memcmp`
@@ -234,13 +193,12 @@ struct State<'t> {
 impl<'t> State<'t> {
     fn run(&mut self) -> Read<()> {
         let text = self.text;
-        let mut reader = reader(text);
+        let mut tags = Tags::new(text).ok_or(Decline)?;
         loop {
-            let event = reader.read_event().map_err(|_| Decline)?;
-            let end = (reader.buffer_position() as usize).min(text.len());
+            let (event, end) = tags.next().ok_or(Decline)?;
             match event {
-                Event::Start(e) => self.start(&e, end, false)?,
-                Event::Empty(e) => self.start(&e, end, true)?,
+                Event::Start(e) => self.start(&e, tags.attributes(), end, false)?,
+                Event::Empty(e) => self.start(&e, tags.attributes(), end, true)?,
                 Event::End(e) => {
                     let name = e.name();
                     let open = self.open.pop().ok_or(Decline)?;
@@ -280,7 +238,15 @@ impl<'t> State<'t> {
         if blank { Ok(()) } else { Err(Decline) }
     }
 
-    fn start(&mut self, e: &BytesStart<'t>, tag_end: usize, empty: bool) -> Read<()> {
+    /// A start tag and its attributes (names and values), as [`Tags`] reads
+    /// them.
+    fn start(
+        &mut self,
+        e: &BytesStart<'t>,
+        attributes: &[(&'t [u8], &'t [u8])],
+        tag_end: usize,
+        empty: bool,
+    ) -> Read<()> {
         let text = self.text;
         let (name_span, tag) = start_tag_spans(text, e, tag_end);
         let qname = text
@@ -308,7 +274,7 @@ impl<'t> State<'t> {
                 _ => true,
             }),
         };
-        let attrs = self.attributes(e, keys(role))?;
+        let attrs = self.attributes(attributes, keys(role))?;
         match role {
             Role::Root => {
                 self.root_seen = true;
@@ -343,45 +309,33 @@ impl<'t> State<'t> {
         }
     }
 
-    /// Every attribute of `e` checked as the full reader checks it (its
-    /// syntax, no duplicate name, no `<` and, here, no entity in a value),
-    /// and the first value of each of `keys`.
+    /// Every attribute checked as the full reader checks it (no duplicate
+    /// name, no `<` and, here, no entity in a value; [`Tags`] has checked
+    /// their syntax), and the first value of each of `keys`.
     fn attributes(
         &self,
-        e: &BytesStart<'t>,
+        attributes: &[(&'t [u8], &'t [u8])],
         keys: &[&[u8]],
     ) -> Read<[Option<Value<'t>>; MAX_KEYS]> {
         let text = self.text;
         let mut found = [None; MAX_KEYS];
-        // The names seen so far, for the duplicate check: in an array (no
-        // allocation), past its size in a vector.
-        let mut seen: [&[u8]; SEEN] = [&[]; SEEN];
-        let mut more = Vec::new();
-        let mut count = 0;
-        each_attribute(e.attributes_raw(), |key, raw| {
-            let known = |names: &[&[u8]]| names.iter().any(|s| same(s, key));
-            if known(&seen[..count.min(SEEN)]) || known(&more) {
+        for (index, &(key, raw)) in attributes.iter().enumerate() {
+            if attributes[..index].iter().any(|&(seen, _)| same(seen, key)) {
                 return Err(Decline);
             }
-            match seen.get_mut(count) {
-                Some(slot) => *slot = key,
-                None => more.push(key),
-            }
-            count += 1;
             if raw.iter().any(|&b| b == b'<' || b == b'&') {
                 return Err(Decline);
             }
             let Some(i) = keys.iter().position(|k| same(k, key)) else {
-                return Ok(());
+                continue;
             };
             if found[i].is_some() {
-                return Ok(());
+                continue;
             }
             let span = slice_span(text, raw).ok_or(Decline)?;
             let value = text.get(span.range()).ok_or(Decline)?;
             found[i] = Some(Value::new(value, span));
-            Ok(())
-        })?;
+        }
         Ok(found)
     }
 
@@ -543,76 +497,5 @@ impl<'t> State<'t> {
             channels: self.channels,
             libraries: Vec::new(),
         })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use proptest::prelude::*;
-
-    /// The attributes `each_attribute` reads from `raw`, `None` if it declines.
-    fn strict(raw: &[u8]) -> Option<Vec<(Vec<u8>, Vec<u8>)>> {
-        let mut out = Vec::new();
-        each_attribute(raw, |key, value| {
-            out.push((key.to_vec(), value.to_vec()));
-            Ok(())
-        })
-        .ok()?;
-        Some(out)
-    }
-
-    /// quick-xml's attributes of the start tag `<e{raw}>`, `None` on an error.
-    fn quick(raw: &[u8]) -> Option<Vec<(Vec<u8>, Vec<u8>)>> {
-        let tag = [b"e".as_slice(), raw].concat();
-        let start = BytesStart::from_content(String::from_utf8(tag).ok()?, 1);
-        start
-            .attributes()
-            .with_checks(false)
-            .map(|a| a.ok().map(|a| (a.key.as_ref().to_vec(), a.value.to_vec())))
-            .collect()
-    }
-
-    #[test]
-    fn attributes_are_read_as_quick_xml_reads_them_or_declined() {
-        let read = [
-            (r#""#, vec![]),
-            (r#" name="a""#, vec![("name", "a")]),
-            (" a = 'x y'\n\tb=\"\" ", vec![("a", "x y"), ("b", "")]),
-            (
-                r#" xmlns:xsi="u" é="1""#,
-                vec![("xmlns:xsi", "u"), ("é", "1")],
-            ),
-            // quick-xml's grammar: no blank needed between attributes, and a
-            // name's first byte may be anything but a blank.
-            (
-                r#" a="1"b='2' =="3""#,
-                vec![("a", "1"), ("b", "2"), ("=", "3")],
-            ),
-        ];
-        for (raw, want) in read {
-            let want: Vec<(Vec<u8>, Vec<u8>)> = want
-                .into_iter()
-                .map(|(k, v)| (k.as_bytes().to_vec(), v.as_bytes().to_vec()))
-                .collect();
-            assert_eq!(strict(raw.as_bytes()), Some(want.clone()), "{raw:?}");
-            assert_eq!(quick(raw.as_bytes()), Some(want), "{raw:?}");
-        }
-        // No `=`, no value, no quotes, an unclosed value, a stray `/`.
-        for raw in [" a", " a ", " a=", " a=1", r#" a="1"#, r#" a="1" /"#] {
-            assert_eq!(strict(raw.as_bytes()), None, "{raw:?}");
-            assert_eq!(quick(raw.as_bytes()), None, "{raw:?}");
-        }
-    }
-
-    proptest! {
-        /// `each_attribute` reads what quick-xml reads, and declines where
-        /// quick-xml gives an error.
-        #[test]
-        fn attributes_agree_with_quick_xml(
-            raw in "([ \t\n]{0,2}[a-z:é/\"'=]{0,3}[ ]?=?[ ]?[\"']?[a-z <&\"'=]{0,3}[\"']?){0,3}[ /]?"
-        ) {
-            prop_assert_eq!(strict(raw.as_bytes()), quick(raw.as_bytes()));
-        }
     }
 }
