@@ -444,7 +444,7 @@ impl Hsdf {
 /// Potentials are exact: with λ = num/den, x·den is an integer (equal λs
 /// have equal denominators since ratios are reduced), kept in an `i64`, or
 /// where that would overflow in an `i128` from the start again (the same
-/// steps, so the same answer; the `i64`s take a fifth less time).
+/// steps, so the same answer; a machine word in the common case).
 /// Returns the ratio and the HSDF nodes of a cycle attaining it, in flow order.
 fn max_cycle_ratio(g: &Hsdf) -> Option<(Ratio, Vec<usize>)> {
     policy_iteration::<i64>(g).or_else(|| policy_iteration::<i128>(g))
@@ -525,8 +525,7 @@ fn policy_iteration<P: Potential>(g: &Hsdf) -> Option<(Ratio, Vec<usize>)> {
                 // its own λ).
                 let w = P::product(g.weight[v], l.den)?;
                 let mut best = (x[v], policy[v]);
-                // The edges as slices: no bounds check per edge (a fifth of
-                // this loop).
+                // The edges as slices: no bounds check per edge.
                 let out = g.out(v);
                 let edges = g.head[out.clone()].iter().zip(&g.tokens[out.clone()]);
                 for (e, (&u, &tokens)) in out.zip(edges) {
