@@ -179,7 +179,7 @@ impl<'g> Level<'g> {
             .map(|(i, t)| (t.name.name.as_str(), i))
             .collect();
         let task_index = |name: &str| index.get(name).copied();
-        let mut edges = Vec::new();
+        let mut edges = Vec::with_capacity(graph.channels.len());
         for (channel, c) in graph.channels.iter().enumerate() {
             let src = match (task_index(&c.src.task), enclosing, boundary) {
                 (Some(t), _, _) => graph.tasks[t]
