@@ -33,7 +33,7 @@ fn task_functions(program: &RobotProgram) -> Vec<(String, String)> {
         .iter()
         .map(|t| {
             (
-                t.name.name.clone(),
+                t.name.name.to_string(),
                 format!("task_{}", c::ident(&t.name.name)),
             )
         })

@@ -38,7 +38,7 @@ pub fn setter(key: &str) -> String {
 
 fn named(name: &str) -> Named {
     Named {
-        name: name.to_string(),
+        name: name.into(),
         span: Span::default(),
     }
 }
@@ -83,8 +83,8 @@ fn task(name: &str, kind: TaskKind, trigger: Trigger) -> Task {
 
 fn channel(src: (&str, &str), dst: (&str, &str), capacity: u64) -> Channel {
     let end = |(task, port): (&str, &str)| Endpoint {
-        task: task.to_string(),
-        port: port.to_string(),
+        task: task.into(),
+        port: port.into(),
         span: Span::default(),
     };
     Channel {

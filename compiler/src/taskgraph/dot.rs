@@ -68,7 +68,7 @@ fn level(out: &mut String, graph: &TaskGraph, prefix: &str, depth: usize) {
                 };
                 let mut label = match task.wcet {
                     Some(w) => format!("{name}\\n{w}"),
-                    None => name.clone(),
+                    None => name.to_string(),
                 };
                 // A sub-graph is not drawn inside its task: the task names
                 // its file (`semo graph dot` on that file draws it).

@@ -5,11 +5,14 @@
 
 use crate::diag::FileId;
 use crate::span::Span;
+use smol_str::SmolStr;
 
-/// A name with the range it was written at.
+/// A name with the range it was written at. Names are short: a
+/// [`SmolStr`] keeps them inline, without an allocation each (a large SDF3
+/// graph has tens of thousands).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Named {
-    pub name: String,
+    pub name: SmolStr,
     pub span: Span,
 }
 
@@ -165,8 +168,8 @@ pub struct LoopNode {
 /// `task.port` at one end of a channel.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Endpoint {
-    pub task: String,
-    pub port: String,
+    pub task: SmolStr,
+    pub port: SmolStr,
     /// The attribute value (`camera.out`).
     pub span: Span,
 }

@@ -356,7 +356,7 @@ impl Loader<'_> {
     fn name(&mut self, e: &Elem, key: &str) -> Option<Named> {
         let a = self.required(e, key)?;
         let named = Named {
-            name: a.trimmed().to_string(),
+            name: a.trimmed().into(),
             span: a.trimmed_span(),
         };
         self.check_ident(&named, key);
@@ -458,14 +458,14 @@ impl Loader<'_> {
         named: &Named,
         message: impl FnOnce() -> String,
     ) -> bool {
-        if let Some(first) = names.get(&named.name) {
+        if let Some(first) = names.get(named.name.as_str()) {
             let first = *first;
             self.sink
                 .report(Code::GraphDuplicateName, named.span, message())
                 .relate(first, "first defined here");
             return false;
         }
-        names.insert(named.name.clone(), named.span);
+        names.insert(named.name.to_string(), named.span);
         true
     }
 
@@ -500,7 +500,9 @@ impl Loader<'_> {
             ..LevelBuild::default()
         };
         if let Some(l) = enclosing {
-            level.task_names.insert(l.name.name.clone(), l.name.span);
+            level
+                .task_names
+                .insert(l.name.name.to_string(), l.name.span);
         }
         let children = self.children(e, &["Task", "Loop", "Library", "Channel"]);
         for c in children {
@@ -608,7 +610,7 @@ impl Loader<'_> {
         let wcet = self.opt_number(e, "wcet", Min::Zero).unwrap_or(None);
         let source = get(&e.attrs, "source").map(|a| a.trimmed().to_string());
         let subgraph = get(&e.attrs, "subgraph").map(|a| Named {
-            name: a.trimmed().to_string(),
+            name: a.trimmed().into(),
             span: a.trimmed_span(),
         });
         let children = self.children(
@@ -766,7 +768,7 @@ impl Loader<'_> {
             return;
         }
         let (Some(dir), Ok(rate), Ok(inner_rate)) = (dir, rate, inner_rate) else {
-            build.broken.insert(name.name);
+            build.broken.insert(name.name.to_string());
             return;
         };
         build.ports.push(Port {
@@ -791,7 +793,10 @@ impl Loader<'_> {
         if master {
             if let Some(a) = get(&e.attrs, "calls") {
                 for (word, span) in a.words() {
-                    let named = Named { name: word, span };
+                    let named = Named {
+                        name: word.into(),
+                        span,
+                    };
                     self.check_ident(&named, "calls");
                     calls.push(named);
                 }
@@ -808,7 +813,7 @@ impl Loader<'_> {
         let (Some(name), Some(library)) = (name, library) else {
             if let Some(name) = self.name_silently(e) {
                 if self.register_port(build, &name) {
-                    build.broken.insert(name.name);
+                    build.broken.insert(name.name.to_string());
                 }
             }
             return;
@@ -830,7 +835,7 @@ impl Loader<'_> {
         get(&e.attrs, "name")
             .filter(|a| !a.trimmed().is_empty())
             .map(|a| Named {
-                name: a.trimmed().to_string(),
+                name: a.trimmed().into(),
                 span: a.trimmed_span(),
             })
     }
@@ -841,7 +846,7 @@ impl Loader<'_> {
         let name = self.name(e, "name");
         let dir = self.direction(e);
         let group = self.required(e, "group").map(|a| Named {
-            name: a.trimmed().to_string(),
+            name: a.trimmed().into(),
             span: a.trimmed_span(),
         });
         let Some(name) = name else {
@@ -851,7 +856,7 @@ impl Loader<'_> {
             return;
         }
         let (Some(dir), Some(group)) = (dir, group) else {
-            build.broken.insert(name.name);
+            build.broken.insert(name.name.to_string());
             return;
         };
         build.multicast_ports.push(MulticastPort {
@@ -885,7 +890,7 @@ impl Loader<'_> {
                 };
                 let message = format!("this function already has a parameter `{}`", pname.name);
                 if self.register(&mut param_names, &pname, || message) {
-                    params.push((pname.name, ty));
+                    params.push((pname.name.to_string(), ty));
                 }
             }
             let Some(fname) = fname else {
@@ -920,7 +925,7 @@ impl Loader<'_> {
             .required(e, "loopCount")
             .and_then(|a| self.number(a, Min::One).ok());
         let exit_task = get(&e.attrs, "exitTask").map(|a| Named {
-            name: a.trimmed().to_string(),
+            name: a.trimmed().into(),
             span: a.trimmed_span(),
         });
         let children = self.children(e, &["Port", "TaskGraph"]);
@@ -941,7 +946,7 @@ impl Loader<'_> {
         }
         let mut task = Task {
             name: name.clone().unwrap_or(Named {
-                name: String::new(),
+                name: Default::default(),
                 span: e.tag,
             }),
             span: e.span,
@@ -976,7 +981,7 @@ impl Loader<'_> {
             }
         };
         let (Some(name), Some(loop_type), Some(loop_count)) = (name, loop_type, loop_count) else {
-            return LoopRead::Broken(self.name_silently(e).map(|n| n.name));
+            return LoopRead::Broken(self.name_silently(e).map(|n| n.name.to_string()));
         };
         task.name = name;
         task.loop_node = Some(Box::new(LoopNode {
@@ -1036,8 +1041,8 @@ impl Loader<'_> {
         let port_span = a.sub_span(port_start, port_start + port.len());
         Some((
             Endpoint {
-                task: task.to_string(),
-                port: port.to_string(),
+                task: task.into(),
+                port: port.into(),
                 span: a.trimmed_span(),
             },
             (task_span, port_span),
@@ -1070,7 +1075,7 @@ impl Loader<'_> {
         (task_span, port_span): (Span, Span),
         want: Direction,
     ) {
-        if level.broken_tasks.contains(&end.task) {
+        if level.broken_tasks.contains(end.task.as_str()) {
             return;
         }
         let (task, broken, inside) = match (index.get(end.task.as_str()).copied(), enclosing) {
@@ -1090,7 +1095,7 @@ impl Loader<'_> {
                 return;
             }
         };
-        if broken.is_some_and(|b| b.contains(&end.port)) {
+        if broken.is_some_and(|b| b.contains(end.port.as_str())) {
             return;
         }
         let Some(port) = task.port(&end.port) else {

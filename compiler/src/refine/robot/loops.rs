@@ -230,7 +230,8 @@ fn boundary_ports<'g>(
         Direction::In => (inputs, link.inner_task),
         Direction::Out => (link.inner_task, outputs),
     };
-    (ends == (edge.src, edge.dst)).then(|| (outer.name.name.clone(), inner.name.name.clone()))
+    (ends == (edge.src, edge.dst))
+        .then(|| (outer.name.name.to_string(), inner.name.name.to_string()))
 }
 
 /// Which side of a task's port a channel joins: a loop node's port has a
@@ -295,7 +296,7 @@ impl Opener<'_, '_> {
         for (edge, bound) in level.edges.iter().zip(bounds) {
             let (src_port, dst_port) = if let Some(channel) = edge.channel {
                 let c = &level.graph.channels[channel];
-                (c.src.port.clone(), c.dst.port.clone())
+                (c.src.port.to_string(), c.dst.port.to_string())
             } else {
                 let Some((task, links)) = links.as_mut() else {
                     return Err(format!("has an edge `{}` outside its channels", edge.label));
@@ -375,7 +376,7 @@ impl Opener<'_, '_> {
                 continue; // an open port: the graph's interface
             };
             let used = PortUse {
-                port: port.name.name.clone(),
+                port: port.name.name.to_string(),
                 channel,
                 rate: port.rate,
             };
@@ -421,7 +422,7 @@ impl Opener<'_, '_> {
                 ));
             };
             out.push(SubgraphPort {
-                port: name.clone(),
+                port: name.to_string(),
                 input: port.dir == Direction::In,
                 rate: port.rate,
                 outer,
@@ -465,7 +466,7 @@ impl Opener<'_, '_> {
                 ));
             }
             out.push(LoopPort {
-                port: name.clone(),
+                port: name.to_string(),
                 input,
                 distributing: port.kind == Some(PortKind::Distributing),
                 outer_rate: port.rate,

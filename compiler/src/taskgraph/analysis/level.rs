@@ -6,10 +6,13 @@
 use crate::span::Span;
 use crate::taskgraph::model::{Direction, Endpoint, Task, TaskGraph};
 use crate::taskgraph::subgraph::{Hierarchy, PortLink};
+use smol_str::SmolStr;
 
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Node {
-    pub name: String,
+    /// The task's name (a copy of a small string kept inline, as
+    /// [`crate::taskgraph::model::Named`] keeps it), or a boundary node's.
+    pub name: SmolStr,
     /// The task of the graph, or `None` for a loop boundary node.
     pub task: Option<usize>,
     pub span: Span,
@@ -164,7 +167,7 @@ impl<'g> Level<'g> {
             let inputs = nodes.len();
             for side in ["inputs", "outputs"] {
                 nodes.push(Node {
-                    name: format!("{} ({side})", l.name.name),
+                    name: format!("{} ({side})", l.name.name).into(),
                     task: None,
                     span: l.name.span,
                     wcet: None,
@@ -269,7 +272,7 @@ impl<'g> Level<'g> {
         let inputs = level.nodes.len();
         for side in ["inputs", "outputs"] {
             level.nodes.push(Node {
-                name: format!("{} ({side})", task.name.name),
+                name: format!("{} ({side})", task.name.name).into(),
                 task: None,
                 span: graph.span,
                 wcet: None,
@@ -320,7 +323,7 @@ impl<'g> Level<'g> {
             });
         }
         level.boundary = Some((inputs, outputs));
-        level.stands_for = Some(task.name.name.clone());
+        level.stands_for = Some(task.name.name.to_string());
         level
     }
 

@@ -218,7 +218,7 @@ fn analyze_level(
     concurrency: Concurrency,
     diagnostics: &mut Vec<Diagnostic>,
 ) -> (LevelReport, Option<Vec<schedule::Schedule>>) {
-    let nodes = level.nodes.iter().map(|n| n.name.clone()).collect();
+    let nodes = level.nodes.iter().map(|n| n.name.to_string()).collect();
     let mut level_report = LevelReport {
         path: level.path.clone(),
         nodes,
@@ -259,7 +259,7 @@ fn analyze_level(
                 nodes: b
                     .nodes
                     .iter()
-                    .map(|&n| level.nodes[n].name.clone())
+                    .map(|&n| level.nodes[n].name.to_string())
                     .collect(),
                 channels: b
                     .edges
@@ -382,7 +382,7 @@ fn schedule_level(
                 critical_cycle: t
                     .critical_cycle
                     .iter()
-                    .map(|&n| level.nodes[n].name.clone())
+                    .map(|&n| level.nodes[n].name.to_string())
                     .collect(),
             });
     }

@@ -55,7 +55,7 @@ fn level<'g>(
             library_port(graph, &libraries, port, out);
         }
         for port in &task.multicast_ports {
-            let group = groups.entry(port.group.name.clone()).or_default();
+            let group = groups.entry(port.group.name.to_string()).or_default();
             match port.dir {
                 Direction::Out => group.writers.push(port.group.span),
                 Direction::In => group.readers.push(port.group.span),

@@ -86,7 +86,7 @@ fn render_with(
                     None => {
                         let plain = !n.name.starts_with(|c: char| c.is_ascii_digit())
                             && !n.name.contains(char::is_whitespace);
-                        (n.name.clone(), plain)
+                        (n.name.to_string(), plain)
                     }
                 };
                 terms.push(match (*count, plain) {

@@ -11,7 +11,7 @@ use std::collections::HashMap;
 
 pub(crate) fn named(name: &str) -> Named {
     Named {
-        name: name.to_string(),
+        name: name.into(),
         span: Span::default(),
     }
 }

@@ -953,13 +953,13 @@ mod tests {
         let mut channels = a.channels.clone();
         for t in &b.tasks {
             let mut t = t.clone();
-            t.name.name = rename(&t.name.name);
+            t.name.name = rename(&t.name.name).into();
             tasks.push(t);
         }
         for c in &b.channels {
             let mut c = c.clone();
-            c.src.task = rename(&c.src.task);
-            c.dst.task = rename(&c.dst.task);
+            c.src.task = rename(&c.src.task).into();
+            c.dst.task = rename(&c.dst.task).into();
             channels.push(c);
         }
         let b0 = a.tasks.len();

@@ -214,9 +214,13 @@ impl<'r> Builder<'r> {
                 }
             };
             self.tasks
-                .entry(task.name.name.clone())
+                .entry(task.name.name.to_string())
                 .or_insert((index, t));
-            if blocked.is_some_and(|b| b.nodes.contains(&task.name.name)) {
+            if blocked.is_some_and(|b| {
+                b.nodes
+                    .iter()
+                    .any(|n| n.as_str() == task.name.name.as_str())
+            }) {
                 self.level.deadlocked_nodes.insert(index);
             }
         }
@@ -224,14 +228,14 @@ impl<'r> Builder<'r> {
             let node = Node {
                 path: format!("{}library {}", self.prefix, library.name.name),
                 shape: Shape::Library,
-                lines: vec![library.name.name.clone()],
+                lines: vec![library.name.name.to_string()],
                 tooltip: library_tooltip(library),
                 side: None,
                 cluster: None,
             };
             let index = self.add(node);
             self.libraries
-                .entry(library.name.name.clone())
+                .entry(library.name.name.to_string())
                 .or_insert(index);
         }
         for (c, channel) in graph.channels.iter().enumerate() {
@@ -248,7 +252,7 @@ impl<'r> Builder<'r> {
             self.edge_with_rates(from, to, Style::Data, tail, head, mid);
         }
         for task in &graph.tasks {
-            let Some(&(index, _)) = self.tasks.get(&task.name.name) else {
+            let Some(&(index, _)) = self.tasks.get(task.name.name.as_str()) else {
                 continue;
             };
             let here = End {
@@ -256,18 +260,18 @@ impl<'r> Builder<'r> {
                 port: None,
             };
             for port in &task.library_ports {
-                let library = Ext::Library(port.library.name.clone());
+                let library = Ext::Library(port.library.name.to_string());
                 let name = port.name.name.clone();
                 if port.master {
                     let to = self.external(library, Side::Right);
-                    self.edge(here, to, Style::Call, name);
+                    self.edge(here, to, Style::Call, name.to_string());
                 } else {
                     let from = self.external(library, Side::Left);
-                    self.edge(from, here, Style::Serve, name);
+                    self.edge(from, here, Style::Serve, name.to_string());
                 }
             }
             for port in &task.multicast_ports {
-                let group = Ext::Group(port.group.name.clone());
+                let group = Ext::Group(port.group.name.to_string());
                 match port.dir {
                     Direction::Out => {
                         let to = self.external(group, Side::Right);
@@ -320,7 +324,7 @@ impl<'r> Builder<'r> {
                     Direction::In => Side::Left,
                     Direction::Out => Side::Right,
                 };
-                (p.name.name.clone(), side, Some(p))
+                (p.name.name.to_string(), side, Some(p))
             })
             .collect();
         let inside = l.body.channels.iter().flat_map(|c| {
@@ -358,7 +362,7 @@ impl<'r> Builder<'r> {
             by_name.entry(port.clone()).or_insert((index, outer));
             from_inside.entry(port).or_insert((index, inner_rate));
         }
-        inner.enclosing = Some((name.clone(), from_inside));
+        inner.enclosing = Some((name.to_string(), from_inside));
         inner.fill(&l.body);
         let kind = match l.loop_type {
             LoopType::D => "D",
@@ -396,9 +400,9 @@ impl<'r> Builder<'r> {
 
     /// Where a channel end attaches, and the rate written next to it.
     fn channel_end(&mut self, graph: &TaskGraph, end: &Endpoint) -> (End, String) {
-        if let Some(&(node, t)) = self.tasks.get(&end.task) {
+        if let Some(&(node, t)) = self.tasks.get(end.task.as_str()) {
             if let Some(ports) = self.cluster_ports.get(&node) {
-                let (port, rate) = match ports.get(&end.port) {
+                let (port, rate) = match ports.get(end.port.as_str()) {
                     Some((p, rate)) => (Some(*p), rate.clone()),
                     None => (None, "?".to_string()),
                 };
@@ -411,7 +415,7 @@ impl<'r> Builder<'r> {
         }
         if let Some((name, ports)) = &self.enclosing
             && *name == end.task
-            && let Some((node, rate)) = ports.get(&end.port)
+            && let Some((node, rate)) = ports.get(end.port.as_str())
         {
             return (
                 End {
@@ -421,19 +425,19 @@ impl<'r> Builder<'r> {
                 rate.clone(),
             );
         }
-        let node = match self.missing.get(&end.task) {
+        let node = match self.missing.get(end.task.as_str()) {
             Some(&n) => n,
             None => {
                 let node = Node {
                     path: format!("{}{}", self.prefix, end.task),
                     shape: Shape::Missing,
-                    lines: vec![end.task.clone()],
+                    lines: vec![end.task.to_string()],
                     tooltip: format!("{}: no such task in this graph", end.task),
                     side: None,
                     cluster: None,
                 };
                 let n = self.add(node);
-                self.missing.insert(end.task.clone(), n);
+                self.missing.insert(end.task.to_string(), n);
                 n
             }
         };
@@ -544,7 +548,7 @@ fn task_node(task: &Task, path: String) -> Node {
     if let Some(sub) = &task.subgraph {
         tooltip.push_str(&format!(", subgraph {}", sub.name));
     }
-    let mut lines = vec![name.clone()];
+    let mut lines = vec![name.to_string()];
     if !detail.is_empty() {
         lines.push(detail.join(" · "));
     }

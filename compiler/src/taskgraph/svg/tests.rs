@@ -278,7 +278,7 @@ fn task_paths(graph: &TaskGraph, prefix: &str, out: &mut Vec<(String, String, bo
         let path = format!("{prefix}{}", task.name.name);
         out.push((
             path.clone(),
-            task.name.name.clone(),
+            task.name.name.to_string(),
             task.loop_node.is_some(),
         ));
         if let Some(l) = &task.loop_node {

@@ -142,7 +142,7 @@ impl<'s> Sdf3Reader<'s> {
         }
         let mut tasks = self.level.tasks;
         for task in &mut tasks {
-            task.wcet = self.times.get(&task.name.name).copied();
+            task.wcet = self.times.get(task.name.name.as_str()).copied();
         }
         Some(TaskGraph {
             name: name.or(self.application_graph_name).unwrap_or_default(),
@@ -224,7 +224,7 @@ impl<'s> Sdf3Reader<'s> {
             return;
         }
         let (Some(dir), Ok(rate)) = (dir, rate) else {
-            self.ports.broken.insert(name.name);
+            self.ports.broken.insert(name.name.to_string());
             return;
         };
         self.ports.ports.push(Port {
@@ -249,8 +249,8 @@ impl<'s> Sdf3Reader<'s> {
             let (a_span, p_span) = (a.trimmed_span(), p.trimmed_span());
             Some((
                 Endpoint {
-                    task: a.trimmed().to_string(),
-                    port: p.trimmed().to_string(),
+                    task: a.trimmed().into(),
+                    port: p.trimmed().into(),
                     span: a_span.cover(p_span),
                 },
                 (a_span, p_span),
@@ -308,7 +308,7 @@ impl<'s> Sdf3Reader<'s> {
 
 fn named(a: &Attr) -> Named {
     Named {
-        name: a.trimmed().to_string(),
+        name: a.trimmed().into(),
         span: a.trimmed_span(),
     }
 }

@@ -102,7 +102,7 @@ impl<'t> Value<'t> {
 
     fn named(self) -> Named {
         Named {
-            name: self.trimmed().to_string(),
+            name: self.trimmed().into(),
             span: self.trimmed_span(),
         }
     }
@@ -421,8 +421,8 @@ impl<'t> State<'t> {
         let end = |actor: Option<Value<'t>>, port: Option<Value<'t>>| -> Read<Endpoint> {
             let (actor, port) = (Value::required(actor)?, Value::required(port)?);
             Ok(Endpoint {
-                task: actor.trimmed().to_string(),
-                port: port.trimmed().to_string(),
+                task: actor.trimmed().into(),
+                port: port.trimmed().into(),
                 span: actor.trimmed_span().cover(port.trimmed_span()),
             })
         };
