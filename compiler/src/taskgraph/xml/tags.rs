@@ -36,7 +36,8 @@ pub(super) struct Tags<'t> {
     attributes: Vec<(&'t [u8], &'t [u8])>,
 }
 
-/// The way quick-xml's attribute reader would not read a tag: an error.
+/// A start tag quick-xml would give an error on: its attributes break the
+/// attribute reader's grammar, or it never ends.
 struct Malformed;
 
 impl<'t> Tags<'t> {
