@@ -691,3 +691,33 @@ fn buffers_give_the_trade_off_and_a_chosen_point() {
         out.stderr
     );
 }
+
+/// A file starting with a byte-order mark (as some Windows editors save it)
+/// gets its diagnostics where they are: the mark is one column, and every
+/// range, to the end of the element, is one column on from the same file
+/// without it.
+#[test]
+fn a_byte_order_mark_leaves_diagnostics_in_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let graph = r#"<sdf3 type="sdf" version="1.0"><applicationGraph name="app"><sdf name="g" type="G"><actor name="a" type="A"><port name="o" type="out" rate="2"/><port name="i" type="in" rate="1"/></actor><actor name="b" type="B"><port name="i" type="in" rate="1"/><port name="o" type="out" rate="1"/></actor><channel name="c0" srcActor="a" srcPort="o" dstActor="b" dstPort="i"/><channel name="c1" srcActor="b" srcPort="o" dstActor="a" dstPort="i" initialTokens="1"/></sdf></applicationGraph></sdf3>"#;
+    std::fs::write(dir.path().join("plain.xml"), graph).unwrap();
+    std::fs::write(dir.path().join("marked.xml"), format!("\u{feff}{graph}")).unwrap();
+    let range = |file: &str| {
+        let (code, json) = analyze_json(dir.path(), file);
+        assert_eq!(code, 1, "{json}");
+        let d = &json["diagnostics"][0];
+        assert_eq!(d["code"], "E070", "{json}");
+        (
+            d["start"]["column"].as_u64().unwrap(),
+            d["end"]["column"].as_u64().unwrap(),
+        )
+    };
+    let (start, end) = range("plain.xml");
+    // The whole `<channel name="c1" .../>` element.
+    let c1 = graph.find(r#"<channel name="c1""#).unwrap();
+    assert_eq!(
+        (start, end),
+        (c1 as u64 + 1, graph.find("</sdf>").unwrap() as u64 + 1)
+    );
+    assert_eq!(range("marked.xml"), (start + 1, end + 1));
+}

@@ -93,8 +93,19 @@ pub(crate) fn end_tag_span(text: &str, name: &[u8], tag_end: usize) -> Span {
     )
 }
 
+/// Where `position`, a position of [`reader`]`(text)`, lies in `text`: the
+/// reader skips a byte-order mark at the start without counting its three
+/// bytes, so every position it gives after one is three bytes short.
+pub(crate) fn offset(text: &str, position: u64) -> usize {
+    let mark = if text.starts_with('\u{feff}') { 3 } else { 0 };
+    usize::try_from(position)
+        .map_or(text.len(), |p| p.saturating_add(mark))
+        .min(text.len())
+}
+
 /// A quick-xml reader over `text` that leaves end tags to be matched by the
-/// caller (to report them with both positions) and keeps text untrimmed.
+/// caller (to report them with both positions) and keeps text untrimmed. Its
+/// positions are offsets in `text` through [`offset`].
 pub(crate) fn reader(text: &str) -> Reader<&[u8]> {
     let mut reader = Reader::from_str(text);
     let config = reader.config_mut();

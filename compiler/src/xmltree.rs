@@ -298,12 +298,12 @@ impl<V: Visit> Walker<'_, '_, '_, V> {
         let mut reader = xmlpos::reader(text);
         let decoder = reader.decoder();
         loop {
-            let before = (reader.buffer_position() as usize).min(text.len());
+            let before = xmlpos::offset(text, reader.buffer_position());
             let event = reader.read_event();
-            let end = (reader.buffer_position() as usize).min(text.len());
+            let end = xmlpos::offset(text, reader.buffer_position());
             let flow = match event {
                 Err(err) => {
-                    let pos = (reader.error_position() as usize).min(text.len());
+                    let pos = xmlpos::offset(text, reader.error_position());
                     let unclosed =
                         matches!(err, quick_xml::Error::Syntax(SyntaxError::UnclosedTag));
                     let (span, message) = match xmlpos::lt_in_unclosed_tag(text, pos) {

@@ -15,8 +15,7 @@
 //! reader, which reports it. It keeps the full reader's meaning element for
 //! element (the same roles, first-of-a-kind rules and execution-time choice),
 //! so the two give the same graph on every file this one accepts and this one
-//! declines only files the full reader reports, that hold an entity or that
-//! start with a byte-order mark
+//! declines only files the full reader reports or that hold an entity
 //! (`taskgraph::xml::tests::the_clean_sdf3_reader_*`).
 
 use super::ExecutionTimes;
@@ -193,7 +192,7 @@ struct State<'t> {
 impl<'t> State<'t> {
     fn run(&mut self) -> Read<()> {
         let text = self.text;
-        let mut tags = Tags::new(text).ok_or(Decline)?;
+        let mut tags = Tags::new(text);
         loop {
             let (event, end) = tags.next().ok_or(Decline)?;
             match event {

@@ -12,10 +12,11 @@
 //! attributes and its end.
 //!
 //! What holds: on any text, [`Tags`] gives quick-xml's events with quick-xml's
-//! positions, and the attributes of each start tag, or stops (`None`) where
-//! quick-xml gives an error (its reader's, or its attribute reader's on a
-//! start tag), at a general reference (`&`), or at a byte-order mark (whose
-//! three bytes quick-xml leaves out of its positions). The grammar followed
+//! positions (as offsets in the text, [`crate::xmlpos::offset`]), and the
+//! attributes of each start tag, or stops (`None`) where quick-xml gives an
+//! error (its reader's, or its attribute reader's on a start tag) or at a
+//! general reference (`&`). Like quick-xml, it skips a byte-order mark at
+//! the start. The grammar followed
 //! is quick-xml 0.38's. Text runs to the next `<` or `&`. After `<`, a `/`
 //! starts an end tag, `!` and `?` what quick-xml reads, anything else a start
 //! tag. A tag runs to the first `>` outside quotes (a `"` or `'` opens a
@@ -41,13 +42,17 @@ pub(super) struct Tags<'t> {
 struct Malformed;
 
 impl<'t> Tags<'t> {
-    /// `None` when the text starts with a byte-order mark.
-    pub(super) fn new(text: &'t str) -> Option<Tags<'t>> {
-        (!text.starts_with('\u{feff}')).then_some(Tags {
+    pub(super) fn new(text: &'t str) -> Tags<'t> {
+        let mark = '\u{feff}';
+        Tags {
             text,
-            at: 0,
+            at: if text.starts_with(mark) {
+                mark.len_utf8()
+            } else {
+                0
+            },
             attributes: Vec::new(),
-        })
+        }
     }
 
     /// The next event and the position after it; `None` where the reading
@@ -86,6 +91,7 @@ impl<'t> Tags<'t> {
         let from = lt + 1;
         match bytes.get(from)? {
             b'!' | b'?' => {
+                // From `<` on: no byte-order mark to skip.
                 let mut quick = reader(text.get(lt..)?);
                 let event = quick.read_event().ok()?;
                 let end = lt + usize::try_from(quick.buffer_position()).ok()?;
@@ -97,7 +103,8 @@ impl<'t> Tags<'t> {
                 self.at = gt + 1;
                 let content = text.get(from + 1..gt)?;
                 // All blank: quick-xml keeps the content as it is.
-                let name = match content.trim_end_matches(is_blank) {
+                let name = match content.trim_end_matches(|c: char| c.is_ascii() && blank(c as u8))
+                {
                     "" => content,
                     name => name,
                 };
@@ -112,7 +119,7 @@ impl<'t> Tags<'t> {
                 };
                 self.at = gt + 1;
                 let content = text.get(from..gt - usize::from(empty))?;
-                let start = BytesStart::from_content(content, name_len(content));
+                let start = BytesStart::from_content(content, name_len(content.as_bytes()));
                 let event = if empty {
                     Event::Empty(start)
                 } else {
@@ -131,7 +138,7 @@ impl<'t> Tags<'t> {
         let content = &bytes[from..gt];
         let empty = content.last() == Some(&b'/');
         let content = &content[..content.len() - usize::from(empty)];
-        let raw = &content[name_len_bytes(content)..];
+        let raw = &content[name_len(content)..];
         self.attributes.clear();
         let attributes = &mut self.attributes;
         each_attribute(raw, |key, value| {
@@ -144,20 +151,12 @@ impl<'t> Tags<'t> {
 }
 
 /// XML's blanks, as quick-xml's `is_whitespace`.
-fn is_blank(c: char) -> bool {
-    matches!(c, ' ' | '\r' | '\n' | '\t')
-}
-
 fn blank(b: u8) -> bool {
-    is_blank(char::from(b))
+    matches!(b, b' ' | b'\r' | b'\n' | b'\t')
 }
 
 /// The length of a tag's name: up to its first blank.
-fn name_len(content: &str) -> usize {
-    name_len_bytes(content.as_bytes())
-}
-
-fn name_len_bytes(content: &[u8]) -> usize {
+fn name_len(content: &[u8]) -> usize {
     content
         .iter()
         .position(|&b| blank(b))
@@ -316,9 +315,7 @@ mod tests {
     /// stopped.
     fn ours(text: &str) -> (Vec<String>, bool) {
         let mut out = Vec::new();
-        let Some(mut tags) = Tags::new(text) else {
-            return (out, true);
-        };
+        let mut tags = Tags::new(text);
         loop {
             match tags.next() {
                 None => return (out, true),
@@ -342,17 +339,14 @@ mod tests {
     }
 
     /// quick-xml's events of `text` up to the end or the first error (of
-    /// the reader, or of the attribute reader on a start tag), general
-    /// reference or byte-order mark, and whether it stopped.
+    /// the reader, or of the attribute reader on a start tag) or general
+    /// reference, and whether it stopped.
     fn quick(text: &str) -> (Vec<String>, bool) {
         let mut out = Vec::new();
-        if text.starts_with('\u{feff}') {
-            return (out, true);
-        }
         let mut r = reader(text);
         loop {
             let event = r.read_event();
-            let end = r.buffer_position() as usize;
+            let end = crate::xmlpos::offset(text, r.buffer_position());
             match event {
                 Err(_) | Ok(Event::GeneralRef(_)) => return (out, true),
                 Ok(Event::Eof) => {
@@ -429,6 +423,7 @@ mod tests {
             "<!-x>",
             "<?x",
             "\u{feff}<a/>",
+            "\u{feff} <a b='1'>t</a>",
             "<é/><a é='é'/>é",
             // quick-xml's attribute grammar: no blank needed between
             // attributes, and a name's first byte may be anything but a
