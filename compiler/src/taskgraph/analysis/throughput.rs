@@ -442,9 +442,11 @@ impl Hsdf {
 /// a strictly larger ratio, so the (λ, x) pairs only grow and it terminates.
 ///
 /// Potentials are exact: with λ = num/den, x·den is an integer (equal λs
-/// have equal denominators since ratios are reduced), kept in an `i64`, or
-/// where that would overflow in an `i128` from the start again (the same
-/// steps, so the same answer; a machine word in the common case).
+/// have equal denominators since ratios are reduced), kept in an `i64`; where
+/// the `i64` run gives no answer, an `i128` run from the start again (the
+/// same steps, so the same answer where both give one). Only an overflow of
+/// the `i64`s needs that second run: the analyses find deadlocks (a cycle
+/// without samples, the other `None`) before they ask for a period.
 /// Returns the ratio and the HSDF nodes of a cycle attaining it, in flow order.
 fn max_cycle_ratio(g: &Hsdf) -> Option<(Ratio, Vec<usize>)> {
     policy_iteration::<i64>(g).or_else(|| policy_iteration::<i128>(g))
