@@ -61,6 +61,7 @@ use crate::xmlpos::{Attr, get, is_ident, shown, suggest};
 use crate::xmltree::{Elem, TreeCollector, TreeFormat, Visit, Vocabulary, walk};
 use quick_xml::Reader;
 use quick_xml::events::Event;
+use smol_str::SmolStr;
 
 /// The two file formats a task graph can be read from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -276,13 +277,13 @@ enum Min {
 struct LevelBuild {
     tasks: Vec<Task>,
     /// Per task: the names of its ports that were left out after an error.
-    broken_ports: Vec<HashSet<String>>,
+    broken_ports: Vec<HashSet<SmolStr>>,
     /// Tasks and loops left out after an error (channels to them are dropped).
-    broken_tasks: HashSet<String>,
+    broken_tasks: HashSet<SmolStr>,
     /// Inside a loop body: the enclosing loop's ports that were left out.
-    enclosing_broken: HashSet<String>,
-    task_names: HashMap<String, Span>,
-    library_names: HashMap<String, Span>,
+    enclosing_broken: HashSet<SmolStr>,
+    task_names: HashMap<SmolStr, Span>,
+    library_names: HashMap<SmolStr, Span>,
     libraries: Vec<Library>,
     channels: Vec<Channel>,
     /// For each kept channel, the ranges of the task and port parts of its ends.
@@ -295,8 +296,8 @@ struct PortsBuild {
     ports: Vec<Port>,
     library_ports: Vec<LibraryPort>,
     multicast_ports: Vec<MulticastPort>,
-    names: HashMap<String, Span>,
-    broken: HashSet<String>,
+    names: HashMap<SmolStr, Span>,
+    broken: HashSet<SmolStr>,
 }
 
 struct Loader<'s> {
@@ -454,7 +455,7 @@ impl Loader<'_> {
     /// E063 unless `named` is new in `names` (the message is made only then).
     fn register(
         &mut self,
-        names: &mut HashMap<String, Span>,
+        names: &mut HashMap<SmolStr, Span>,
         named: &Named,
         message: impl FnOnce() -> String,
     ) -> bool {
@@ -465,7 +466,7 @@ impl Loader<'_> {
                 .relate(first, "first defined here");
             return false;
         }
-        names.insert(named.name.to_string(), named.span);
+        names.insert(named.name.clone(), named.span);
         true
     }
 
@@ -482,7 +483,7 @@ impl Loader<'_> {
         &mut self,
         e: &Elem,
         enclosing: Option<&Task>,
-        enclosing_broken: HashSet<String>,
+        enclosing_broken: HashSet<SmolStr>,
     ) -> TaskGraph {
         self.check_attributes(e, GRAPH_ATTRS);
         let name = match enclosing {
@@ -500,9 +501,7 @@ impl Loader<'_> {
             ..LevelBuild::default()
         };
         if let Some(l) = enclosing {
-            level
-                .task_names
-                .insert(l.name.name.to_string(), l.name.span);
+            level.task_names.insert(l.name.name.clone(), l.name.span);
         }
         let children = self.children(e, &["Task", "Loop", "Library", "Channel"]);
         for c in children {
@@ -559,7 +558,7 @@ impl Loader<'_> {
         &mut self,
         level: &mut LevelBuild,
         task: Task,
-        broken: HashSet<String>,
+        broken: HashSet<SmolStr>,
         enclosing: Option<&Task>,
     ) {
         let what = if task.kind == TaskKind::Loop {
@@ -587,7 +586,7 @@ impl Loader<'_> {
 
     /// A `<Task>`: `None` without a usable name. Also returns the names of the
     /// ports that were left out.
-    fn task(&mut self, e: &Elem) -> Option<(Task, HashSet<String>)> {
+    fn task(&mut self, e: &Elem) -> Option<(Task, HashSet<SmolStr>)> {
         self.check_attributes(e, TASK_ATTRS);
         let name = self.name(e, "name");
         let kind = match get(&e.attrs, "kind") {
@@ -768,7 +767,7 @@ impl Loader<'_> {
             return;
         }
         let (Some(dir), Ok(rate), Ok(inner_rate)) = (dir, rate, inner_rate) else {
-            build.broken.insert(name.name.to_string());
+            build.broken.insert(name.name);
             return;
         };
         build.ports.push(Port {
@@ -813,7 +812,7 @@ impl Loader<'_> {
         let (Some(name), Some(library)) = (name, library) else {
             if let Some(name) = self.name_silently(e) {
                 if self.register_port(build, &name) {
-                    build.broken.insert(name.name.to_string());
+                    build.broken.insert(name.name);
                 }
             }
             return;
@@ -856,7 +855,7 @@ impl Loader<'_> {
             return;
         }
         let (Some(dir), Some(group)) = (dir, group) else {
-            build.broken.insert(name.name.to_string());
+            build.broken.insert(name.name);
             return;
         };
         build.multicast_ports.push(MulticastPort {
@@ -981,7 +980,7 @@ impl Loader<'_> {
             }
         };
         let (Some(name), Some(loop_type), Some(loop_count)) = (name, loop_type, loop_count) else {
-            return LoopRead::Broken(self.name_silently(e).map(|n| n.name.to_string()));
+            return LoopRead::Broken(self.name_silently(e).map(|n| n.name));
         };
         task.name = name;
         task.loop_node = Some(Box::new(LoopNode {
@@ -1166,9 +1165,9 @@ impl Loader<'_> {
 
 enum LoopRead {
     /// The loop node (a task of kind `Loop`) and its left-out port names.
-    Kept(Box<Task>, HashSet<String>),
+    Kept(Box<Task>, HashSet<SmolStr>),
     /// Left out after an error; its name, if it has one.
-    Broken(Option<String>),
+    Broken(Option<SmolStr>),
 }
 
 fn flip(d: Direction) -> Direction {

@@ -224,7 +224,7 @@ impl<'s> Sdf3Reader<'s> {
             return;
         }
         let (Some(dir), Ok(rate)) = (dir, rate) else {
-            self.ports.broken.insert(name.name.to_string());
+            self.ports.broken.insert(name.name);
             return;
         };
         self.ports.ports.push(Port {
