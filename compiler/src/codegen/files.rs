@@ -183,7 +183,7 @@ pub fn main_c(program: &RobotProgram, words: &Words, target: Target, header: &st
         out.push_str("};\n\n");
     }
     out.push_str("/* Every robot of the mission: robot i listens on UDP port base + i. */\nstatic const semo_peer peers[] = {\n");
-    for (team, robot) in &program.peers {
+    for (team, robot) in program.peers.iter() {
         let _ = writeln!(out, "    {{{}, {}}},", c::string(team), c::string(robot));
     }
     out.push_str("};\n\n");

@@ -84,7 +84,7 @@ pub fn refine_robots(
 ) -> (Vec<RobotProgram>, Vec<Diagnostic>) {
     let lines = LineIndex::new(input.text);
     let mission = &input.analysis.mission;
-    let peers: Vec<(String, String)> = mission
+    let peers: std::sync::Arc<[(String, String)]> = mission
         .teams
         .iter()
         .flat_map(|t| {
@@ -95,6 +95,9 @@ pub fn refine_robots(
         .collect();
     let mut programs = Vec::new();
     let mut diagnostics = Vec::new();
+    // The peer index of each team's first robot, counted as the teams go
+    // (not summed again per robot: refinement stays linear in teams).
+    let mut first_peer = 0;
     for (team_index, team) in mission.teams.iter().enumerate() {
         let selected: Vec<crate::sema::RobotId> = match robots {
             Robots::All => team.robot_ids().collect(),
@@ -106,12 +109,14 @@ pub fn refine_robots(
         };
         // W130 for a team: what every one of its robots gives.
         let mut names_no_task: Vec<Vec<Diagnostic>> = Vec::new();
+        let mut team_programs = Vec::new();
         for robot in selected {
             let (program, found) = robot::refine_robot(
                 input,
                 &lines,
                 &peers,
                 crate::sema::TeamId(team_index as u32),
+                first_peer,
                 robot.index(),
             );
             let (warned, found): (Vec<Diagnostic>, Vec<Diagnostic>) = found
@@ -119,13 +124,17 @@ pub fn refine_robots(
                 .partition(|d| d.code == diag::Code::BatteryPolicyNamesNoTask);
             names_no_task.push(warned);
             diagnostics.extend(found);
-            programs.extend(program);
+            team_programs.extend(program);
         }
+        // Only this team's programs: the owners are the team's business, and
+        // passing the whole fleet would make refinement quadratic in teams.
         diagnostics.extend(robot::shared::owners_of_team(
-            &mut programs,
+            &mut team_programs,
             &team.name,
             input.strategies,
         ));
+        programs.append(&mut team_programs);
+        first_peer += team.robots.len();
         if let Some((first, others)) = names_no_task.split_first() {
             diagnostics.extend(
                 first

@@ -10,6 +10,7 @@ use super::value::{Value, ValueKind};
 use crate::index::newtype_index;
 use crate::span::Span;
 use crate::taskgraph::TaskGraph;
+use std::sync::Arc;
 
 newtype_index! {
     /// A state of its service machine: an index into [`ServiceMachine::states`]
@@ -41,8 +42,10 @@ pub struct RobotProgram {
     pub control: ControlMachine,
     /// The non-control tasks of `graph` and what each one does.
     pub tasks: Vec<TaskRole>,
-    /// Every robot of the mission, in formation order: (team, robot).
-    pub peers: Vec<(String, String)>,
+    /// Every robot of the mission, in formation order: (team, robot). One
+    /// table shared by every program of a refinement, so a fleet's programs
+    /// cost memory linear in its robots, not quadratic.
+    pub peers: Arc<[(String, String)]>,
     /// This robot's index in `peers`.
     pub self_peer: usize,
     /// The team's shared information, held by the library task.

@@ -28,8 +28,9 @@ const MAX_INLINE_DEPTH: usize = 32;
 pub(super) fn refine_robot(
     input: &RefineInput<'_>,
     lines: &LineIndex,
-    peers: &[(String, String)],
+    peers: &std::sync::Arc<[(String, String)]>,
     team_id: TeamId,
+    first_peer: usize,
     robot_index: usize,
 ) -> (Option<RobotProgram>, Vec<Diagnostic>) {
     let mission = &input.analysis.mission;
@@ -43,6 +44,7 @@ pub(super) fn refine_robot(
         lines,
         team_id,
         team,
+        first_peer,
         robot_index,
         robot_type,
         machine: ControlMachine::default(),
@@ -113,7 +115,7 @@ pub(super) fn refine_robot(
         },
         control: machine,
         tasks,
-        peers: peers.to_vec(),
+        peers: std::sync::Arc::clone(peers),
         self_peer,
         library,
         graph_services,
@@ -133,6 +135,8 @@ struct Builder<'a, 'i> {
     lines: &'a LineIndex,
     team_id: TeamId,
     team: &'a Team,
+    /// The peer index of the team's first robot (peers are in formation order).
+    first_peer: usize,
     robot_index: usize,
     robot_type: &'a RobotType,
     machine: ControlMachine,
@@ -187,11 +191,7 @@ impl Builder<'_, '_> {
 
     /// The peer index of the team's first robot (peers are in formation order).
     fn first_peer(&self) -> usize {
-        let mission = &self.input.analysis.mission;
-        mission.teams[..self.team_id.0 as usize]
-            .iter()
-            .map(|t| t.robots.len())
-            .sum()
+        self.first_peer
     }
 
     /// A condition the checker should have excluded: refinement refuses
