@@ -173,12 +173,13 @@ fn write_to(path: &Path, text: &str, out: &mut impl Write) -> i32 {
 
 /// `--format json`: one object with each robot's modes and every expectation.
 fn json_summary(run: &sim::Run, verdicts: &[sim::Verdict]) -> String {
+    let modes = sim::expect::modes_of_every_robot(run);
     let robots: Vec<serde_json::Value> = run
         .robots
         .iter()
-        .enumerate()
-        .map(|(r, (team, robot))| {
-            let modes: Vec<serde_json::Value> = sim::expect::modes(run, r)
+        .zip(modes)
+        .map(|((team, robot), modes)| {
+            let modes: Vec<serde_json::Value> = modes
                 .into_iter()
                 .map(|(t, mode)| serde_json::json!({"t": t, "mode": mode}))
                 .collect();

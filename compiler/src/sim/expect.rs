@@ -26,6 +26,19 @@ pub fn modes(run: &Run, robot: usize) -> Vec<(i64, &str)> {
         .collect()
 }
 
+/// [`modes`] of every robot, indexed by robot, in one pass over the trace
+/// (asking [`modes`] robot by robot reads the trace once per robot: a
+/// thousand robots' summary took ten times as long as their simulation).
+pub fn modes_of_every_robot(run: &Run) -> Vec<Vec<(i64, &str)>> {
+    let mut modes = vec![Vec::new(); run.robots.len()];
+    for e in run.trace.iter().filter(|e| e.event == "mode") {
+        if let (Some(of), Some(mode)) = (modes.get_mut(e.robot), e.field("mode")) {
+            of.push((e.t, mode));
+        }
+    }
+    modes
+}
+
 pub fn judge(run: &Run, expectations: &[Expectation]) -> Vec<Verdict> {
     expectations
         .iter()
@@ -94,8 +107,9 @@ fn judge_one(run: &Run, kind: &ExpectKind) -> (bool, String) {
         }
         ExpectKind::AllEndIn { mode } => {
             let mut wrong = Vec::new();
-            for (r, (_, robot)) in run.robots.iter().enumerate() {
-                let last = modes(run, r).last().map(|(_, m)| *m);
+            let every = modes_of_every_robot(run);
+            for ((_, robot), modes) in run.robots.iter().zip(&every) {
+                let last = modes.last().map(|(_, m)| *m);
                 if last != Some(mode.as_str()) {
                     wrong.push(format!("{robot} ends in {}", last.unwrap_or("no mode")));
                 }

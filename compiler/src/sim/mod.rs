@@ -60,24 +60,10 @@ pub fn summary(run: &Run, verdicts: &[Verdict]) -> String {
         run.end_ms,
         run.events
     );
-    for (r, (team, robot)) in run.robots.iter().enumerate() {
-        let modes: Vec<String> = expect::modes(run, r)
-            .iter()
-            .map(|(t, m)| format!("{m}@{t}"))
-            .collect();
-        // The robot's last word: finished, killed, or still running.
-        let end = run
-            .trace
-            .iter()
-            .rev()
-            .filter(|e| e.robot == r)
-            .find_map(|e| match (e.event, e.field("fault")) {
-                ("finish", _) => Some(format!("finished at {} ms", e.t)),
-                ("fault", Some("kill")) => Some(format!("killed at {} ms", e.t)),
-                ("start", _) => Some(format!("running at {} ms", run.end_ms)),
-                _ => None,
-            })
-            .unwrap_or_default();
+    let modes = expect::modes_of_every_robot(run);
+    let ends = last_words(run);
+    for (((team, robot), modes), end) in run.robots.iter().zip(&modes).zip(&ends) {
+        let modes: Vec<String> = modes.iter().map(|(t, m)| format!("{m}@{t}")).collect();
         let _ = writeln!(
             out,
             "  {team}/{robot}: {} ({end})",
@@ -102,6 +88,31 @@ pub fn summary(run: &Run, verdicts: &[Verdict]) -> String {
         }
     }
     out
+}
+
+/// Each robot's last word, indexed by robot: finished, killed, or still
+/// running; found in one pass over the trace, from its end.
+fn last_words(run: &Run) -> Vec<String> {
+    let mut words: Vec<Option<String>> = vec![None; run.robots.len()];
+    let mut missing = words.len();
+    for e in run.trace.iter().rev() {
+        if missing == 0 {
+            break;
+        }
+        let Some(word @ None) = words.get_mut(e.robot) else {
+            continue;
+        };
+        *word = match (e.event, e.field("fault")) {
+            ("finish", _) => Some(format!("finished at {} ms", e.t)),
+            ("fault", Some("kill")) => Some(format!("killed at {} ms", e.t)),
+            ("start", _) => Some(format!("running at {} ms", run.end_ms)),
+            _ => None,
+        };
+        if word.is_some() {
+            missing -= 1;
+        }
+    }
+    words.into_iter().map(Option::unwrap_or_default).collect()
 }
 
 #[cfg(test)]
