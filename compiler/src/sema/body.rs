@@ -4,6 +4,7 @@
 //! their body is checked at every call, with the caller's robots.
 
 use super::ir::*;
+use super::values::{Literal, VariableTest, VariableWrite};
 use super::{Checker, is_user, suggestion};
 use crate::catalog::{RobotTypeId, ServiceDef, ValueType};
 use crate::diag::Code;
@@ -601,7 +602,15 @@ impl<'a> Checker<'a> {
             op,
             ast::CmpOp::Lt | ast::CmpOp::Le | ast::CmpOp::Gt | ast::CmpOp::Ge
         );
-        self.comparison(span, compared(&lt, &rt, ordering));
+        let how = compared(&lt, &rt, ordering);
+        self.comparison(span, how);
+        if matches!(op, ast::CmpOp::Eq | ast::CmpOp::Ne) {
+            let sides = [(lhs, (rhs, &rt)), (rhs, (lhs, &lt))];
+            for (variable, (other, other_type)) in sides {
+                let constant = literal(other, other_type).map(|c| (c, other.span));
+                self.record_variable_test(variable, constant, op, how, scope);
+            }
+        }
         if ordering {
             for (ty, side) in [(&lt, lhs), (&rt, rhs)] {
                 if !ty.is_numeric() {
@@ -646,6 +655,40 @@ impl<'a> Checker<'a> {
                     .suggest(guess);
             }
         }
+    }
+
+    /// Records `T.X == C` or `T.X != C` for the value flow (`values.rs`):
+    /// `variable` a team variable, `constant` the literal on the other side
+    /// and its range.
+    fn record_variable_test(
+        &mut self,
+        variable: &Expr,
+        constant: Option<(Literal, Span)>,
+        op: ast::CmpOp,
+        compared: Compared,
+        scope: &Scope,
+    ) {
+        let (ExprKind::Attr(attr), Some((constant, span))) = (&variable.kind, constant) else {
+            return;
+        };
+        let Resolution::Variable {
+            team: Some(team),
+            name,
+        } = self.resolve_attr(attr, scope)
+        else {
+            return;
+        };
+        let key = AttrKey {
+            owner: self.team(team).name.clone(),
+            name,
+        };
+        self.variable_tests.push(VariableTest {
+            key,
+            equal: op == ast::CmpOp::Eq,
+            constant,
+            compared,
+            span,
+        });
     }
 
     /// The robot types whose values `T.X` (or bare `X`) reads: those running
@@ -1153,11 +1196,25 @@ impl<'a> Checker<'a> {
             None
         };
         for item in &comm.items {
-            if let Some(value) = &item.value {
-                self.expr(value, scope, true);
-            }
+            let written = item
+                .value
+                .as_ref()
+                .map(|value| literal(value, &self.expr(value, scope, true)));
             let resolution = self.resolve_attr(&item.attr, scope);
             let key = self.attr_key(&item.attr, &resolution, scope);
+            if let Some(key) = &key {
+                // What the team variable can hold: a literal set here, or
+                // anything the operator sends.
+                let from_operator =
+                    !comm.kind.is_outgoing() && peer == Some(Peer::User) && !is_user(&key.owner);
+                if comm.kind.is_outgoing() && written.is_some() || from_operator {
+                    self.variable_writes.push(VariableWrite {
+                        key: key.clone(),
+                        value: written.clone().flatten(),
+                        span: item.attr.span,
+                    });
+                }
+            }
             if comm.kind.is_outgoing() && item.value.is_some() {
                 // `T.X = e` declares the team variable here.
                 let team = match item.attr.segments.as_slice() {
@@ -1232,6 +1289,17 @@ fn describe_param(ty: &ValueType) -> String {
         ValueType::Enum(domain) => format!("one of {}", domain.join(", ")),
         ValueType::Location => "a location such as \"5,5\"".into(),
         other => format!("a {}", other.name()),
+    }
+}
+
+/// The literal `e` is, as a comparison reads it (`ty`: its checked type):
+/// a string, a number, or a symbolic constant.
+fn literal(e: &Expr, ty: &Type) -> Option<Literal> {
+    match (&e.kind, ty) {
+        (ExprKind::Str(s), _) => Some(Literal::Word(s.clone())),
+        (ExprKind::Number(n), _) => n.parse().ok().map(Literal::Number),
+        (ExprKind::Attr(_), Type::Constant(c)) => Some(Literal::Word(c.to_string())),
+        _ => None,
     }
 }
 

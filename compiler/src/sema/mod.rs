@@ -9,6 +9,8 @@
 //! 3. [`behaviour`]: modes and main blocks: `set` targets, transitions,
 //!    reachability, uncaught events, unused services and functions.
 //! 4. [`comm`]: every receive/subscribe matched with a send/publish, and back.
+//! 5. [`values`]: value flow: what each team variable can hold, and the
+//!    comparisons with it that decide the same way at every run.
 //!
 //! Sema never reads files and never panics. [`lookup`] answers "which
 //! symbols are written here" by binary search in the IR's sorted occurrences,
@@ -20,6 +22,7 @@ mod comm;
 mod declare;
 pub mod ir;
 pub(crate) mod lookup;
+mod values;
 
 pub use ir::*;
 
@@ -89,6 +92,7 @@ pub fn check<'a>(
     checker.check_bodies();
     checker.check_behaviour(source);
     checker.check_communication();
+    checker.check_values();
     checker.finish()
 }
 
@@ -141,6 +145,10 @@ pub(crate) struct Checker<'a> {
     scope_index: FastMap<Span, usize>,
     /// Where each comparison of `mission.comparisons` is, by its range.
     comparison_index: FastMap<Span, usize>,
+    /// Every write of a team variable and every comparison of one with a
+    /// literal, for the value flow (`values.rs`).
+    variable_writes: Vec<values::VariableWrite>,
+    variable_tests: Vec<values::VariableTest>,
 }
 
 impl<'a> Checker<'a> {
@@ -167,6 +175,8 @@ impl<'a> Checker<'a> {
             rejected_bodies: Vec::new(),
             scope_index: FastMap::default(),
             comparison_index: FastMap::default(),
+            variable_writes: Vec::new(),
+            variable_tests: Vec::new(),
         }
     }
 
