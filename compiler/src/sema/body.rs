@@ -1175,6 +1175,15 @@ impl<'a> Checker<'a> {
                     Symbol::TeamVariable { team, name },
                     true,
                 );
+            } else if !comm.kind.is_outgoing()
+                && matches!(
+                    resolution,
+                    Resolution::TooLong | Resolution::NotATeam { .. }
+                )
+            {
+                // No message: the name is no key a robot could send.
+                self.unreceivable(comm.kind, &item.attr, &resolution);
+                continue;
             } else {
                 // The team's own value, received from its other robots.
                 let receiver = scope.team.map(|t| self.team(t).name.clone());
@@ -1204,6 +1213,37 @@ impl<'a> Checker<'a> {
                 _ => {}
             }
         }
+    }
+
+    /// E040: a received name that is not a value (`USER.RC.CMD`, `Nope.X`).
+    /// A warning would let the mission build, but a message carries a value
+    /// of a team, `USER` or the robot's own, which the name is none of: the
+    /// robot could not be refined.
+    fn unreceivable(&mut self, kind: ast::CommKind, attr: &ast::Attr, resolution: &Resolution) {
+        let written = attr.dotted();
+        let verb = kind.as_str();
+        let (message, guess) = match resolution {
+            Resolution::NotATeam { team } => (
+                format!(
+                    "`{verb}` takes a value, but `{written}` is none: `{team}` is not a team (write `Team.VALUE`, `USER.VALUE` or `VALUE`)"
+                ),
+                suggestion(team, self.team_names().iter().map(String::as_str)),
+            ),
+            _ => (
+                format!(
+                    "`{verb}` takes a value, but `{written}` is none: a value's name has one or two parts (`Team.VALUE`, `USER.VALUE` or `VALUE`)"
+                ),
+                None,
+            ),
+        };
+        self.diagnostics
+            .report(Code::ReceivedNotAValue, attr.span, message)
+            .suggest(guess);
+        self.occurrence(
+            attr.last().span,
+            Symbol::Constant(Name::new(&written)),
+            false,
+        );
     }
 
     /// `COLOR` written in SlaveTeam and `SlaveTeam.COLOR` are the same value.
