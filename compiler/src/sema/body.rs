@@ -578,10 +578,42 @@ impl<'a> Checker<'a> {
             ExprKind::Bool(_) => Type::Bool,
             ExprKind::Attr(attr) => {
                 let resolution = self.resolve_attr(attr, scope);
+                if bare_is_constant {
+                    self.word_or_value(attr, &resolution);
+                }
                 self.record_attr(attr, resolution, bare_is_constant)
             }
             ExprKind::Error => Type::Unknown,
         }
+    }
+
+    /// E041: a bare name where a word may stand (an argument, a value sent,
+    /// the other side of `==`) that is also a value the robots running the
+    /// statement read. The reading would win without a word said, and the
+    /// user may well have meant the word (`publish(T, T.Alarm = FIRE)` with a
+    /// `FIRE` sensor): each meaning has its own spelling, `"FIRE"` and
+    /// `T.FIRE`, and the checker asks for one.
+    fn word_or_value(&mut self, attr: &ast::Attr, resolution: &Resolution) {
+        let [word] = attr.segments.as_slice() else {
+            return;
+        };
+        let team = match resolution {
+            Resolution::Value {
+                owner: Some(team), ..
+            } => self.team(*team).name.clone(),
+            Resolution::PartialValue {
+                team, none: false, ..
+            } => team.clone(),
+            _ => return,
+        };
+        let word = &word.name;
+        self.diagnostics.report(
+            Code::WordIsAValue,
+            attr.span,
+            format!(
+                "`{word}` is both a word and the value `{word}` of team {team}'s robots: write `\"{word}\"` for the word or `{team}.{word}` for the value"
+            ),
+        );
     }
 
     fn compare(&mut self, span: Span, lhs: &Expr, op: ast::CmpOp, rhs: &Expr, scope: &Scope) {
