@@ -215,6 +215,49 @@ fn a_request_stopped_before_its_task_fired_does_not_survive_a_mode_change() {
     }
 }
 
+/// The arguments each `call_start` of `task` gave it, in a trace.
+fn arguments_given(trace: &[String], task: &str) -> Vec<String> {
+    events(trace)
+        .iter()
+        .filter(|e| field(e, "event") == "call_start" && field(e, "task") == task)
+        .map(|e| field(e, "arg").to_string())
+        .collect()
+}
+
+/// A strategy's algorithm is given the argument of the call it refines
+/// (`search(ROOM2)`), through the action's variable named in `value` and
+/// through the catalog's name of the service's parameter: once `"room"` and
+/// `""` were passed instead, and `semo check` said nothing.
+#[test]
+fn a_strategy_algorithm_is_given_the_calls_argument_in_the_simulator_and_in_c() {
+    let mission = fixture("strategy_argument/finders.mission");
+    let out = scratch("semantics/strategy-argument");
+    let scenario = out.join("short.scenario.json");
+    std::fs::write(&scenario, SHORT_RUN).unwrap();
+    let trace = out.join("simulated.jsonl");
+    let simulated = semo(&[
+        "simulate",
+        &mission.display().to_string(),
+        "--scenario",
+        &scenario.display().to_string(),
+        "--trace",
+        &trace.display().to_string(),
+    ]);
+    assert_eq!(
+        simulated.code, 0,
+        "{}{}",
+        simulated.stdout, simulated.stderr
+    );
+    let simulated: Vec<String> = std::fs::read_to_string(&trace)
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect();
+    assert_eq!(arguments_given(&simulated, "search"), ["ROOM2", "ROOM2"]);
+    let traces = run_in_simulation(&mission, &out.join("linux-sim"), SHORT_RUN);
+    assert_eq!(arguments_given(&traces["ti"], "search"), ["ROOM2", "ROOM2"]);
+}
+
 /// The values a robot sent (`send` events), in order.
 fn values_sent(trace: &[String]) -> Vec<String> {
     events(trace)
