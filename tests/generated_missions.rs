@@ -91,6 +91,74 @@ fn the_generator_is_deterministic_and_varied() {
     assert!(mixed_team, "a team mixes robot types");
 }
 
+/// Whatever `semo check` accepts builds: over missions with odd name shapes
+/// (`missiongen::odd_mission`), each one check accepts without an error is
+/// built for every target, which may refuse it only with a positioned
+/// diagnostic of its own (a target's limits, E103), never an internal error
+/// (E102, something the checker should have refused).
+#[test]
+fn what_check_accepts_in_odd_missions_builds_for_every_target() {
+    odd_missions_build("odd", 0..60);
+}
+
+#[test]
+#[ignore = "thousands of missions: run on demand"]
+fn thousands_of_odd_missions_build_when_checked() {
+    let count = std::env::var("SEMO_MISSIONS")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(2000);
+    odd_missions_build("odd-many", 1000..1000 + count);
+}
+
+fn odd_missions_build(name: &str, seeds: std::ops::Range<u64>) {
+    let catalog = builtin_catalog();
+    let root = scratch(name);
+    let mut accepted = 0;
+    for seed in seeds.clone() {
+        let text = missiongen::odd_mission(seed, &catalog);
+        let dir = root.join(format!("m{seed}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("odd.mission"), &text).unwrap();
+        let (code, _) = support::check_json_in(&dir, &["odd.mission"]);
+        if code != 0 {
+            continue;
+        }
+        accepted += 1;
+        for target in ["linux", "linux-sim", "cortex-m"] {
+            let out = dir.join(target).display().to_string();
+            let args = [
+                "build",
+                "odd.mission",
+                "--target",
+                target,
+                "-o",
+                &out,
+                "--format",
+                "json",
+            ];
+            let built = semo_in(&dir, &args);
+            let diags = support::parse_json_report(&built.stdout);
+            let errors: Vec<_> = diags.iter().filter(|d| d.severity == "error").collect();
+            let internal = errors.iter().any(|d| d.code == "E102");
+            let unplaced = errors.iter().any(|d| d.start.0 == 0 || d.file.is_empty());
+            assert!(
+                (built.code == 0 && errors.is_empty())
+                    || (built.code == 1 && !errors.is_empty() && !internal && !unplaced),
+                "seed {seed}: `semo check` accepts it, `semo build --target {target}` exits {}:\n{text}\n{}{}",
+                built.code,
+                support::listing(&diags),
+                built.stderr
+            );
+        }
+    }
+    // The shapes are odd, not hopeless: many missions still check.
+    assert!(
+        accepted * 4 >= seeds.count(),
+        "only {accepted} odd missions pass `semo check`"
+    );
+}
+
 /// The property over the missions of `seeds`.
 fn pipeline_holds(name: &str, seeds: std::ops::Range<u64>) {
     let catalog = builtin_catalog();

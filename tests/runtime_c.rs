@@ -13,6 +13,7 @@
 
 mod support;
 
+use proptest::prelude::*;
 use serde_json::Value;
 use std::collections::HashMap;
 use std::net::UdpSocket;
@@ -340,6 +341,73 @@ fn fixture(name: &str) -> String {
 fn values_are_typed_and_compare_as_the_checker_typed_them() {
     for flavor in flavors() {
         program(flavor).run_ok(&["values"]);
+    }
+}
+
+/// A real worth printing, and whether the format promises that it reads
+/// back as itself: any bit pattern (every exponent alike, so huge, tiny,
+/// subnormal, zero, infinite and NaN all come; promised from 2^33 to 1e15,
+/// where six decimals are finer than the double's own steps), the nearest
+/// double to a decimal with six decimals below 1e15, or to fifteen
+/// significant digits and an exponent (both promised).
+fn real_bits() -> impl Strategy<Value = (u64, bool)> {
+    prop_oneof![
+        any::<u64>().prop_map(|bits| {
+            let magnitude = f64::from_bits(bits).abs();
+            (bits, (8_589_934_592.0..1e15).contains(&magnitude))
+        }),
+        (any::<bool>(), 0u64..1_000_000_000_000_000, 0u32..1_000_000).prop_map(
+            |(negative, whole, micros)| {
+                let sign = if negative { "-" } else { "" };
+                let x: f64 = format!("{sign}{whole}.{micros:06}").parse().unwrap();
+                (x.to_bits(), true)
+            }
+        ),
+        (100_000_000_000_000u64..1_000_000_000_000_000, 1u32..294).prop_map(
+            |(digits, exponent)| {
+                let x: f64 = format!("{digits}e{exponent}").parse().unwrap();
+                (x.to_bits(), true)
+            }
+        ),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// The runtime prints every double as the simulator does, byte for byte
+    /// (compiled with gcc, and under UBSan: an overflow in the arithmetic
+    /// fails there even where the digits happen to agree), as a JSON number
+    /// (`null` for what JSON has no number for), reading back as the same
+    /// double wherever the format promises it.
+    #[test]
+    fn reals_print_the_same_in_c_and_in_the_simulator(batch in proptest::collection::vec(real_bits(), 500)) {
+        let args: Vec<String> = std::iter::once("reals".to_string())
+            .chain(batch.iter().map(|(bits, _)| format!("{bits:016x}")))
+            .collect();
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        for flavor in [Flavor::Plain { cc: "gcc", sim: false }, Flavor::AsanUbsan] {
+            let run = program(flavor).run_ok(&args);
+            let lines: Vec<&str> = run.stdout.lines().collect();
+            prop_assert_eq!(lines.len(), batch.len());
+            for ((bits, promised), c) in batch.iter().zip(lines) {
+                let x = f64::from_bits(*bits);
+                let mut simulator = String::new();
+                semo::sim::trace::write_value(&mut simulator, Some(&semo::refine::Value::Real(x)));
+                prop_assert_eq!(c, simulator.as_str(), "{:e} ({:016x}) in {}", x, bits, flavor.name());
+                let json: Value = serde_json::from_str(c)
+                    .unwrap_or_else(|e| panic!("{c} is not JSON: {e}"));
+                if !x.is_finite() {
+                    prop_assert!(json.is_null());
+                    continue;
+                }
+                let back = json.as_f64().unwrap_or_else(|| panic!("{c} is not a number"));
+                prop_assert_eq!(back.is_sign_negative(), x.is_sign_negative(), "{}", c);
+                if *promised {
+                    prop_assert_eq!(back.to_bits(), x.to_bits(), "{} does not read back as {:e}", c, x);
+                }
+            }
+        }
     }
 }
 

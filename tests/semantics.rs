@@ -214,3 +214,134 @@ fn a_request_stopped_before_its_task_fired_does_not_survive_a_mode_change() {
         assert!(goals.len() <= 2, "run {run}: {goals:?}");
     }
 }
+
+/// The arguments each `call_start` of `task` gave it, in a trace.
+fn arguments_given(trace: &[String], task: &str) -> Vec<String> {
+    events(trace)
+        .iter()
+        .filter(|e| field(e, "event") == "call_start" && field(e, "task") == task)
+        .map(|e| field(e, "arg").to_string())
+        .collect()
+}
+
+/// A strategy's algorithm is given the argument of the call it refines
+/// (`search(ROOM2)`), through the action's variable named in `value` and
+/// through the catalog's name of the service's parameter: once `"room"` and
+/// `""` were passed instead, and `semo check` said nothing.
+#[test]
+fn a_strategy_algorithm_is_given_the_calls_argument_in_the_simulator_and_in_c() {
+    let mission = fixture("strategy_argument/finders.mission");
+    let out = scratch("semantics/strategy-argument");
+    let scenario = out.join("short.scenario.json");
+    std::fs::write(&scenario, SHORT_RUN).unwrap();
+    let trace = out.join("simulated.jsonl");
+    let simulated = semo(&[
+        "simulate",
+        &mission.display().to_string(),
+        "--scenario",
+        &scenario.display().to_string(),
+        "--trace",
+        &trace.display().to_string(),
+    ]);
+    assert_eq!(
+        simulated.code, 0,
+        "{}{}",
+        simulated.stdout, simulated.stderr
+    );
+    let simulated: Vec<String> = std::fs::read_to_string(&trace)
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect();
+    assert_eq!(arguments_given(&simulated, "search"), ["ROOM2", "ROOM2"]);
+    let traces = run_in_simulation(&mission, &out.join("linux-sim"), SHORT_RUN);
+    assert_eq!(arguments_given(&traces["ti"], "search"), ["ROOM2", "ROOM2"]);
+}
+
+/// The values a robot sent (`send` events), in order.
+fn values_sent(trace: &[String]) -> Vec<String> {
+    events(trace)
+        .iter()
+        .filter(|e| field(e, "event") == "send")
+        .map(|e| field(e, "value").to_string())
+        .collect()
+}
+
+/// `FIRE` is a word and a guard's smoke detector: `semo check` refuses the
+/// bare name (E041; once the reading was sent without a word said), and
+/// each quick fix the editor offers means what it says, in the simulator
+/// and in the generated robot alike: `"FIRE"` sends the word, `Guards.FIRE`
+/// the reading.
+#[test]
+fn each_fix_of_a_word_that_is_also_a_value_builds_and_simulates_as_it_says() {
+    use semo::diag::FileId;
+    use semo::host::{AnalysisHost, Roots};
+    use semo::span::Span;
+    use semo::workspace::FileKind;
+    let folder = fixture("word_or_value");
+    let (code, diags) = support::check_json_in(&folder, &["alarm.mission"]);
+    assert_eq!(code, 1);
+    let codes: Vec<_> = diags.iter().map(|d| (d.code.as_str(), d.start)).collect();
+    assert_eq!(codes, [("E041", (7, 29))]);
+    let mission = std::fs::read_to_string(folder.join("alarm.mission")).unwrap();
+    let catalog = std::fs::read_to_string(folder.join("firebot.robot.xml")).unwrap();
+    // The fixes as the editor gets them: through the workspace analysis.
+    let mut host = AnalysisHost::new(Roots {
+        roots: vec![folder.clone()],
+        seen_by_all: Vec::new(),
+    });
+    for (id, name, text) in [
+        (0, "alarm.mission", &mission),
+        (1, "firebot.robot.xml", &catalog),
+    ] {
+        let path = folder.join(name);
+        let kind = FileKind::of(&path).unwrap();
+        host.set_file(FileId(id), Some(path), kind, text.as_str().into());
+    }
+    let at = mission.find("= FIRE").unwrap() + 2;
+    let actions = host.analysis().code_actions(FileId(0), Span::new(at, at));
+    let offered: Vec<&str> = actions
+        .iter()
+        .map(|a| a.edits[0].new_text.as_str())
+        .collect();
+    assert_eq!(offered, ["\"FIRE\"", "Guards.FIRE"]);
+    let scenario = r#"{"time_scale": 0.2, "duration": 1400,
+        "robots": {"g": {"sensors": [{"at": 0, "value": "FIRE", "is": "smoke"}]}}}"#;
+    for (action, meant) in actions.iter().zip(["FIRE", "smoke"]) {
+        let edit = &action.edits[0];
+        let fixed = format!(
+            "{}{}{}",
+            &mission[..edit.span.start],
+            edit.new_text,
+            &mission[edit.span.end..]
+        );
+        let out = scratch(&format!("semantics/word-or-value-{meant}"));
+        std::fs::write(out.join("alarm.mission"), &fixed).unwrap();
+        std::fs::write(out.join("firebot.robot.xml"), &catalog).unwrap();
+        std::fs::write(out.join("alarm.scenario.json"), scenario).unwrap();
+        let simulated = semo_in(
+            &out,
+            &[
+                "simulate",
+                "alarm.mission",
+                "--scenario",
+                "alarm.scenario.json",
+                "--trace",
+                "simulated.jsonl",
+            ],
+        );
+        assert_eq!(
+            simulated.code, 0,
+            "{}{}",
+            simulated.stdout, simulated.stderr
+        );
+        let simulated: Vec<String> = std::fs::read_to_string(out.join("simulated.jsonl"))
+            .unwrap()
+            .lines()
+            .map(str::to_string)
+            .collect();
+        assert_eq!(values_sent(&simulated), [meant; 3], "{}", edit.new_text);
+        let traces = run_in_simulation(&out.join("alarm.mission"), &out.join("robots"), scenario);
+        assert_eq!(values_sent(&traces["g"]), [meant; 3], "{}", edit.new_text);
+    }
+}

@@ -108,6 +108,9 @@ codes! {
     ValueNotProvided = "E033", Error, "a robot value that some robot reading it lacks";
     InvalidPeriod = "E034", Error, "a period or timeout that is not positive";
     OrderingNotNumeric = "E035", Error, "`<`, `<=`, `>` or `>=` with an operand that is not a number (a word, a string, a text value)";
+    ReceivedNotAValue = "E040", Error, "a receive or subscribe of a name that is not a value: neither `Team.VALUE`, `USER.VALUE` nor `VALUE`";
+    WordIsAValue = "E041", Error, "a bare word where a word may stand that is also a value the robots read: write `\"WORD\"` for the word or `Team.WORD` for the value";
+    StrategyPassesNothing = "E042", Error, "an actuator's or algorithm's parameter without a `value` whose name is no parameter of the strategy's actions nor of the service: its task would get nothing";
     // Catalog files (*.robot.xml).
     CatalogXml = "E050", Error, "a catalog file that is not well-formed XML";
     CatalogUnknownElement = "E051", Error, "an element that the catalog format does not have";

@@ -15,6 +15,12 @@
 //! run it, narrowed inside group arms exactly as the checker narrows them, so
 //! it calls only services and reads only values that all of them have.
 //!
+//! [`odd_mission`] writes the same missions with some statements whose names
+//! have odd shapes (three or four parts, unknown teams, `USER` values the
+//! console lacks, catalog values where words may stand, dotted keys sent and
+//! received, operators and peers mixed): `semo check` may refuse those, and
+//! what it accepts must build.
+//!
 //! Reusable by other tests (the simulator's differential tests): depends only
 //! on `semo::catalog`.
 
@@ -73,6 +79,8 @@ const PLAN_NAMES: [&str; 2] = ["Act", "Talk"];
 
 struct Generator<'c> {
     rng: Rng,
+    /// Whether some statements get odd name shapes ([`odd_mission`]).
+    odd: bool,
     types: Vec<&'c RobotType>,
     teams: Vec<TeamPlan>,
     functions: Vec<String>,
@@ -82,9 +90,20 @@ struct Generator<'c> {
 /// A random mission that `semo check` accepts against `catalog` (the
 /// built-in catalog: every robot type there is used as it is described).
 pub fn mission(seed: u64, catalog: &Catalog) -> String {
+    generate(seed, catalog, false)
+}
+
+/// A random mission like [`mission`]'s, some of whose statements name
+/// things in odd shapes: `semo check` may refuse it.
+pub fn odd_mission(seed: u64, catalog: &Catalog) -> String {
+    generate(seed, catalog, true)
+}
+
+fn generate(seed: u64, catalog: &Catalog, odd: bool) -> String {
     let types: Vec<&RobotType> = catalog.types().map(|(_, t)| t).collect();
     let mut g = Generator {
         rng: Rng::new(seed),
+        odd,
         types,
         teams: Vec::new(),
         functions: Vec::new(),
@@ -271,6 +290,11 @@ impl Generator<'_> {
         let types = self.types_of(t, robots);
         let pad = "  ".repeat(indent);
         let nested = depth < 2;
+        // Only odd missions draw this number: the others stay as they were.
+        if self.odd && self.rng.chance(12) {
+            self.odd_statement(t, &types, out, indent);
+            return;
+        }
         match self.rng.below(if nested { 10 } else { 6 }) {
             0 | 1 => self.call(&types, out, indent),
             2 => {
@@ -551,6 +575,135 @@ impl Generator<'_> {
             _ => {
                 let _ = writeln!(out, "{pad}receive(USER, USER.RC_CMD), timeout = 1 SEC");
             }
+        }
+    }
+}
+
+impl Generator<'_> {
+    /// A statement naming things in an odd shape, for robots of `types` in
+    /// team `t`: a communication, a condition or a call argument.
+    fn odd_statement(&mut self, t: usize, types: &[usize], out: &mut String, indent: usize) {
+        let pad = "  ".repeat(indent);
+        let verb = *self
+            .rng
+            .pick(&["receive", "subscribe", "send", "publish", "if", "call"]);
+        let line = match verb {
+            "receive" | "subscribe" | "send" | "publish" => {
+                let peer = self.odd_peer(t);
+                let items = (0..1 + self.rng.below(2))
+                    .map(|_| {
+                        let name = self.odd_name(t, types);
+                        if matches!(verb, "send" | "publish") {
+                            match self.rng.below(3) {
+                                0 => name,
+                                _ => format!("{name} = {}", self.odd_operand(t, types)),
+                            }
+                        } else {
+                            name
+                        }
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                let timeout = if verb == "receive" && self.rng.chance(30) {
+                    ", timeout = 1 SEC"
+                } else {
+                    ""
+                };
+                format!("{verb}({peer}, {items}){timeout}")
+            }
+            "if" => {
+                let event = self.rng.pick(&self.teams[t].events).clone();
+                let op = *self.rng.pick(&["==", "!=", "==", "!=", "<"]);
+                let (a, b) = (self.odd_name(t, types), self.odd_operand(t, types));
+                format!("if({a} {op} {b}) throw {event}")
+            }
+            _ => {
+                let first = self.types[types[0]];
+                let one_param: Vec<&semo::catalog::ServiceDef> = first
+                    .services
+                    .iter()
+                    .filter(|s| !s.params.is_empty())
+                    .filter(|s| {
+                        types
+                            .iter()
+                            .all(|&ty| self.types[ty].service(&s.name).is_some())
+                    })
+                    .collect();
+                if one_param.is_empty() {
+                    let event = self.rng.pick(&self.teams[t].events).clone();
+                    format!("throw {event}")
+                } else {
+                    let service = self.rng.pick(&one_param).name.clone();
+                    format!("{service}({})", self.odd_name(t, types))
+                }
+            }
+        };
+        let _ = writeln!(out, "{pad}{line}");
+    }
+
+    /// Whom a communication names: a team of the mission, `USER`, or a
+    /// misspelt team.
+    fn odd_peer(&mut self, t: usize) -> String {
+        match self.rng.below(10) {
+            0 | 1 => "USER".into(),
+            2 | 3 => self.teams[t].name.clone(),
+            4 => "Nobody".into(),
+            _ => self.teams[self.rng.below(self.teams.len())].name.clone(),
+        }
+    }
+
+    /// A name in one of the shapes a user may write, right or wrong.
+    fn odd_name(&mut self, t: usize, types: &[usize]) -> String {
+        let me = self.teams[t].name.clone();
+        let other = self.teams[self.rng.below(self.teams.len())].name.clone();
+        let value = self.some_value(types);
+        let variable = self
+            .teams
+            .iter()
+            .flat_map(|team| {
+                team.variables
+                    .iter()
+                    .map(move |v| (team.name.clone(), v.clone()))
+            })
+            .collect::<Vec<_>>();
+        let variable = match variable.is_empty() {
+            true => (me.clone(), "V9".to_string()),
+            false => self.rng.pick(&variable).clone(),
+        };
+        match self.rng.below(14) {
+            0 => "USER.RC.CMD".into(),
+            1 => "USER.RC_CMD".into(),
+            2 => "USER.NOTHING".into(),
+            3 => format!("{me}.{value}.X"),
+            4 => format!("{other}.{}.{}", variable.0, variable.1),
+            5 => format!("{}.{}.part", variable.0, variable.1),
+            6 => format!("{me}.A.B.C"),
+            7 => format!("Nobody.{value}"),
+            8 => value,
+            9 => format!("{other}.{value}"),
+            10 => format!("{}.{}", variable.0, variable.1),
+            11 => "WORD".into(),
+            12 => format!("{me}.{}", self.some_value(types)),
+            _ => format!("{other}.V9"),
+        }
+    }
+
+    /// An operand: an odd name, a number, a string or a truth value.
+    fn odd_operand(&mut self, t: usize, types: &[usize]) -> String {
+        match self.rng.below(6) {
+            0 => self.rng.below(100).to_string(),
+            1 => "\"text\"".into(),
+            2 => "true".into(),
+            _ => self.odd_name(t, types),
+        }
+    }
+
+    /// A value some of `types` have (`COLOR` when none has any).
+    fn some_value(&mut self, types: &[usize]) -> String {
+        let ty = self.types[*self.rng.pick(types)];
+        match ty.values.is_empty() {
+            true => "COLOR".into(),
+            false => self.rng.pick(&ty.values).name.clone(),
         }
     }
 }

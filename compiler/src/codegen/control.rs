@@ -485,9 +485,13 @@ fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize
                     c::string(service)
                 );
             }
+            // An action taken (STEP_NEXT) enters the next action at the next
+            // firing, as in the simulator, where a firing that progressed is
+            // followed by the next: named here, since nothing else may wake
+            // the machine (an action whose commands' task just went idle).
             let _ = writeln!(
                 out,
-                "        if (actions_{machine}(r) != STEP_DONE)\n            return STEP_WAIT;\n        semo_trace(\"actions_end\", \"service\", {}, NULL);\n        r->phase = 0;\n        r->pc = {next};\n        return STEP_NEXT;",
+                "        {{\n            int acted = actions_{machine}(r);\n            if (acted == STEP_NEXT)\n                wake_at(semo_now_ms());\n            if (acted != STEP_DONE)\n                return STEP_WAIT;\n        }}\n        semo_trace(\"actions_end\", \"service\", {}, NULL);\n        r->phase = 0;\n        r->pc = {next};\n        return STEP_NEXT;",
                 c::string(service)
             );
         }
@@ -635,10 +639,10 @@ fn emit_action_machine(
                 let port = request_index(program, task);
                 let _ = writeln!(
                     out,
-                    "            if (!request(request_port[{port}], {}, {}, 1, (const semo_value *const[]){{{}}}))\n                return STEP_WAIT;",
+                    "            if (!request(request_port[{port}], {}, {}, 1, {}))\n                return STEP_WAIT;",
                     c::string(task),
                     c::string(&actuator_name(program, task)),
-                    words.literal(command)
+                    args_array(std::slice::from_ref(command), words)
                 );
             }
             out.push_str("            r->phase = 2;\n            return STEP_WAIT;\n        }\n");

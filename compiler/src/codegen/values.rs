@@ -120,7 +120,7 @@ fn each_literal(program: &RobotProgram, f: &mut dyn FnMut(&Value)) {
     }
     for action in m.actions.iter().flat_map(|a| &a.actions) {
         for (_, command) in &action.commands {
-            add(&Operand::Literal(command.clone()));
+            add(command);
         }
         for (condition, _) in action.transitions.iter() {
             if let Some(c) = condition {

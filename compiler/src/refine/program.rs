@@ -490,8 +490,9 @@ pub struct ActionState {
     pub name: String,
     pub id: u64,
     pub is_final: bool,
-    /// Actuator commands issued on entry: (task, command value).
-    pub commands: Vec<(String, Value)>,
+    /// Actuator and algorithm commands issued on entry: (task, what it is
+    /// given: a value as written, a sensor reading, the call's argument).
+    pub commands: Vec<(String, Operand)>,
     /// Checked in order; the first that holds is taken. `None` = always.
     pub transitions: Vec<(Option<Expr>, usize)>,
 }

@@ -7,7 +7,7 @@ use crate::catalog::{Implementation, RobotType};
 use crate::diag::{Code, Diagnostic};
 use crate::sema::{Compared, ServiceId, Symbol, Team, TeamId};
 use crate::span::Span;
-use crate::strategy::{DataCharacteristic, ServiceEntry, Strategy, TaskUseKind};
+use crate::strategy::{DataCharacteristic, Parameter, Passed, ServiceEntry, Strategy, TaskUseKind};
 use crate::syntax::ast::{self, ExprKind, StmtKind};
 use crate::text::LineIndex;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -928,7 +928,7 @@ impl Builder<'_, '_> {
                         .as_ref()
                         .map(|t| t.name.clone())
                         .unwrap_or_else(|| actuator.to_lowercase());
-                    let command = Value::strategy(p.value.as_ref().map_or("", |v| &v.name));
+                    let command = self.passed(entry, p, service, &names, &mut arguments, call);
                     self.services
                         .entry(task.clone())
                         .or_default()
@@ -986,6 +986,46 @@ impl Builder<'_, '_> {
             actions,
             initial,
             arguments,
+        }
+    }
+
+    /// What a parameter of an actuator or algorithm passes to its task
+    /// (`ServiceEntry::passed`, the rule the strategy checker applies): a
+    /// parameter of the entry, the call's argument (its slot, one per
+    /// position, so that every argument up to it is stored), or a value as
+    /// written. Nothing at all the checker refuses (E042).
+    fn passed(
+        &mut self,
+        entry: &ServiceEntry,
+        parameter: &Parameter,
+        service: &str,
+        names: &HashMap<String, Operand>,
+        arguments: &mut Vec<SlotId>,
+        call: Span,
+    ) -> Operand {
+        let service_params: Vec<&str> = self
+            .robot_type
+            .service(service)
+            .map(|def| def.params.iter().map(|p| p.name.as_str()).collect())
+            .unwrap_or_default();
+        match entry.passed(parameter, &service_params) {
+            Passed::Named(name) => names[name].clone(),
+            Passed::Argument(index) => {
+                while arguments.len() <= index {
+                    let position = arguments.len();
+                    let kind = self.parameter_kind(service, position, call);
+                    let key = format!("{service}.{}", service_params[position]);
+                    arguments.push(self.slot(&key, SlotSource::Local, kind));
+                }
+                Operand::Slot(arguments[index])
+            }
+            Passed::Literal(text) => Operand::Literal(Value::strategy(text)),
+            Passed::Nothing => {
+                let what =
+                    format!("a parameter of `{service}`'s strategy passes nothing to its task",);
+                self.internal_error(call, &what);
+                Operand::Literal(Value::text(""))
+            }
         }
     }
 

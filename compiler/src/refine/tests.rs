@@ -22,9 +22,13 @@ fn programs(text: &str, strategies: &[&str]) -> Vec<RobotProgram> {
     let strategies: Vec<_> = strategies
         .iter()
         .enumerate()
-        .filter_map(|(i, s)| load_strategy(FileId(1 + i as u32), s).0)
+        .filter_map(|(i, s)| {
+            let (strategy, diagnostics) = load_strategy(FileId(1 + i as u32), s);
+            assert!(diagnostics.is_empty(), "{diagnostics:#?}");
+            strategy
+        })
         .collect();
-    let (links, _) = if strategies.is_empty() {
+    let (links, cross) = if strategies.is_empty() {
         (StrategyLinks::default(), Vec::new())
     } else {
         cross_check(
@@ -33,6 +37,11 @@ fn programs(text: &str, strategies: &[&str]) -> Vec<RobotProgram> {
             &catalog,
         )
     };
+    let errors: Vec<_> = cross
+        .iter()
+        .filter(|d| d.severity == crate::diag::Severity::Error)
+        .collect();
+    assert!(errors.is_empty(), "{errors:#?}");
     let names: Vec<_> = strategies
         .iter()
         .map(|s| (s.file, "strategy.xml".to_string()))
@@ -79,6 +88,108 @@ fn task_names(program: &RobotProgram) -> Vec<&str> {
         .iter()
         .map(|t| t.name.name.as_str())
         .collect()
+}
+
+/// A strategy refining `search(ROOM2)` by an algorithm: what each of its
+/// parameters gives the `search` task, `room` declared as the action's
+/// variable (so the call's first argument) and `target` the catalog's own
+/// name of `search`'s parameter.
+fn searching_strategy(parameters: &str) -> String {
+    format!(
+        r#"<Strategy name="Finders" xmlns="urn:semo:strategy:1">
+  <ServiceInfo>
+    <Service plan_name="Act" name="search">
+      <TargetRobot name="TIEvalbot"/>
+      <ActionInfo>
+        <Action name="Search" initial="Yes" actionId="0">
+          <Parameter name="room" type="string" dataCharacteristic="variable"/>
+          <ExecuteAlgorithm name="Search">
+            {parameters}
+          </ExecuteAlgorithm>
+          <TransitionInfo><Transition srcId="0" dstId="1"/></TransitionInfo>
+        </Action>
+        <Action name="Done" final="Yes" actionId="1"/>
+      </ActionInfo>
+    </Service>
+  </ServiceInfo>
+</Strategy>"#
+    )
+}
+
+const SEARCHING_MISSION: &str = "{ Finders: TIEvalbot ti }
+Finders.Act.Look{ search(ROOM2) }
+Finders.LOOK{ set(Act, Look) }
+Finders.main{ default: mode = LOOK }
+";
+
+/// What the `search` task is given, per command of the action machine.
+fn algorithm_inputs(parameters: &str) -> Vec<Operand> {
+    let programs = programs(SEARCHING_MISSION, &[&searching_strategy(parameters)]);
+    let machine = &program(&programs, "ti").control.actions[0];
+    let commands = &machine.actions[0].commands;
+    assert!(
+        commands.iter().all(|(task, _)| task == "search"),
+        "{commands:?}"
+    );
+    commands.iter().map(|(_, given)| given.clone()).collect()
+}
+
+#[test]
+fn an_algorithm_is_given_the_call_argument_its_parameter_names() {
+    let refined = programs(
+        SEARCHING_MISSION,
+        &[&searching_strategy(
+            r#"<Parameter name="where" type="string" value="room" dataCharacteristic="sysRequest" dstTask="search"/>"#,
+        )],
+    );
+    let ti = program(&refined, "ti");
+    let machine = &ti.control.actions[0];
+    let room = machine.arguments[0];
+    // The call stores ROOM2 in the argument's slot; the algorithm reads it.
+    let args = ti
+        .control
+        .services
+        .iter()
+        .flat_map(|s| &s.states)
+        .find_map(|s| match &s.kind {
+            StateKind::RunActions { args, .. } => Some(args.clone()),
+            _ => None,
+        });
+    assert_eq!(
+        args,
+        Some(vec![Operand::Literal(Value::Word("ROOM2".into()))])
+    );
+    assert_eq!(
+        machine.actions[0].commands,
+        [("search".to_string(), Operand::Slot(room))]
+    );
+    // The service's own parameter by its catalog name is the same argument;
+    // a value naming nothing is the word as written.
+    let given = algorithm_inputs(
+        r#"<Parameter name="target" type="string" dataCharacteristic="sysRequest" dstTask="search"/>
+           <Parameter name="mode" type="string" value="fast" dataCharacteristic="sysRequest" dstTask="search"/>"#,
+    );
+    assert_eq!(
+        given,
+        [
+            Operand::Slot(room),
+            Operand::Literal(Value::Word("fast".into()))
+        ]
+    );
+    // Without the variable, the catalog's name alone binds the argument.
+    let given = programs(
+        SEARCHING_MISSION,
+        &[&searching_strategy(
+            r#"<Parameter name="target" type="string" dataCharacteristic="sysRequest" dstTask="search"/>"#,
+        )
+        .replace(r#"<Parameter name="room" type="string" dataCharacteristic="variable"/>"#, "")],
+    );
+    let machine = &program(&given, "ti").control.actions[0];
+    assert_eq!(machine.arguments.len(), 1);
+    assert_eq!(
+        machine.actions[0].commands,
+        [("search".to_string(), Operand::Slot(machine.arguments[0]))]
+    );
 }
 
 #[test]
@@ -128,7 +239,7 @@ fn the_strategy_refines_the_masters_move_only() {
         actions.actions[2].commands,
         [(
             "wheel".to_string(),
-            crate::refine::Value::Word("Forward".into())
+            Operand::Literal(crate::refine::Value::Word("Forward".into()))
         )]
     );
     // The slaves have no strategy: their move calls the implementing task.

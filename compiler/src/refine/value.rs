@@ -245,29 +245,68 @@ pub fn parse_real(text: &str) -> Option<f64> {
     text.parse::<f64>().ok().filter(|d| !d.is_nan())
 }
 
-/// A finite real as the runtime prints it (`semo__format_real`): up to six
-/// decimals, trailing zeros dropped, at least one (`2.0`, `0.125`); from
-/// 1e15 on, digits and an exponent (`1.5e20` is `150000000000000e6`). The
-/// same arithmetic on both sides, so that traces agree to the byte.
+/// A real as the runtime prints it (`format_real` in `semo_core.c`), from
+/// its exact binary value, so that traces agree to the byte: below 1e15 in
+/// magnitude, rounded half up to six decimals, trailing zeros dropped but
+/// one (`2.0`, `0.125`, `0.333333`); from 1e15 on, the first fifteen
+/// significant digits rounded half up and an exponent (`1.5e20` is
+/// `150000000000000e6`); a set sign bit is a `-` (`-0.0`). Not a number in
+/// JSON: `inf`, `-inf`, `nan` (the trace writes those as `null`).
 pub fn format_real(r: f64) -> String {
+    if r.is_nan() {
+        return "nan".into();
+    }
     let mut out = String::new();
-    let negative = r < 0.0;
-    let mut x = r.abs();
-    if negative {
+    if r.is_sign_negative() {
         out.push('-');
     }
-    if x >= 1e15 {
-        let mut exponent = 0;
-        while x >= 1e15 {
-            x /= 10.0;
+    let x = r.abs();
+    if x.is_infinite() {
+        out.push_str("inf");
+    } else if x >= 1e15 {
+        push_scientific(&mut out, x);
+    } else {
+        push_fixed(&mut out, x);
+    }
+    out
+}
+
+/// `digits` e `exponent`: the first fifteen significant digits of `x`'s
+/// integer part (at least 10^15 here), rounded half up on the sixteenth.
+fn push_scientific(out: &mut String, x: f64) {
+    // A whole f64 prints exactly with no decimals: every digit of it.
+    let whole = format!("{:.0}", x.trunc());
+    let (kept, rest) = whole.split_at(15);
+    let mut digits: u64 = kept.parse().expect("decimal digits");
+    let mut exponent = rest.len();
+    if rest.as_bytes()[0] >= b'5' {
+        digits += 1;
+        if digits == 1_000_000_000_000_000 {
+            digits /= 10;
             exponent += 1;
         }
-        let _ = write!(out, "{}e{exponent}", (x + 0.5) as i64);
-        return out;
     }
-    // Half up by adding 0.5, as the runtime does without libm.
-    let scaled = (x * 1e6 + 0.5) as i64;
-    let (whole, mut fraction) = (scaled / 1_000_000, scaled % 1_000_000);
+    let _ = write!(out, "{digits}e{exponent}");
+}
+
+/// `whole`.`fraction` of `x` (below 10^15), rounded half up to six decimals.
+fn push_fixed(out: &mut String, x: f64) {
+    let (mantissa, shift) = binary_parts(x);
+    let (mut whole, fraction_bits) = match shift {
+        0..64 => (mantissa >> shift, mantissa & ((1u64 << shift) - 1)),
+        _ => (0, mantissa),
+    };
+    // Seven decimals of fraction_bits / 2^shift, cut: the seventh rounds.
+    // fraction_bits * 10^7 < 2^77, so a shift of 128 or more leaves nothing.
+    let seven = match shift {
+        0..128 => ((u128::from(fraction_bits) * 10_000_000) >> shift) as u64,
+        _ => 0,
+    };
+    let mut fraction = seven / 10 + u64::from(seven % 10 >= 5);
+    if fraction == 1_000_000 {
+        fraction = 0;
+        whole += 1;
+    }
     let _ = write!(out, "{whole}.");
     let mut digits = 6;
     while digits > 1 && fraction % 10 == 0 {
@@ -275,7 +314,23 @@ pub fn format_real(r: f64) -> String {
         digits -= 1;
     }
     let _ = write!(out, "{fraction:0digits$}");
-    out
+}
+
+/// A finite, non-negative `x` below 10^15 as `mantissa` / 2^`shift`
+/// exactly (a whole number's shift is 0).
+fn binary_parts(x: f64) -> (u64, u32) {
+    let bits = x.to_bits();
+    let biased = (bits >> 52) as i32; // the sign bit is clear
+    let fraction = bits & ((1 << 52) - 1);
+    let (mantissa, exponent) = match biased {
+        0 => (fraction, -1074),
+        _ => (fraction | 1 << 52, biased - 1075),
+    };
+    match u32::try_from(-exponent) {
+        Ok(shift) => (mantissa, shift),
+        // Below 10^15 < 2^50: the shifted mantissa fits.
+        Err(_) => (mantissa << exponent, 0),
+    }
 }
 
 #[cfg(test)]
@@ -289,6 +344,117 @@ mod tests {
         assert_eq!(format_real(-2.5), "-2.5");
         assert_eq!(format_real(1.0 / 3.0), "0.333333");
         assert_eq!(format_real(1.5e20), "150000000000000e6");
+    }
+
+    #[test]
+    fn reals_print_over_the_whole_range() {
+        // Between 2^63 / 10^6 and 10^15 the scaled value once overflowed.
+        assert_eq!(format_real(9.3e12), "9300000000000.0");
+        assert_eq!(format_real(-123456789012345.67), "-123456789012345.671875");
+        assert_eq!(format_real(999999999999999.9), "999999999999999.875");
+        assert_eq!(format_real(1e15), "100000000000000e1");
+        assert_eq!(format_real(f64::MAX), "179769313486232e294");
+        assert_eq!(format_real(1e300), "100000000000000e286");
+        assert_eq!(format_real(0.0078125), "0.007813"); // a tie, rounded up
+        assert_eq!(format_real(0.00000049999999999999), "0.0");
+        assert_eq!(format_real(f64::MIN_POSITIVE), "0.0");
+        assert_eq!(format_real(-5e-324), "-0.0");
+        assert_eq!(format_real(-0.0), "-0.0");
+        assert_eq!(format_real(0.9999996), "1.0");
+        assert_eq!(format_real(f64::INFINITY), "inf");
+        assert_eq!(format_real(f64::NEG_INFINITY), "-inf");
+        assert_eq!(format_real(f64::NAN), "nan");
+    }
+
+    /// What `format_real` should print, from `x`'s exact decimal expansion
+    /// (Rust prints an f64 exactly given enough decimals: a double has at
+    /// most 1074), rounded half up as text.
+    fn exact_rounding(x: f64) -> String {
+        let sign = if x.is_sign_negative() { "-" } else { "" };
+        let exact = format!("{:.1074}", x.abs());
+        let (whole, decimals) = exact.split_once('.').unwrap();
+        let (mut kept, next, exponent) = if x.abs() >= 1e15 {
+            (
+                whole[..15].to_string(),
+                whole.as_bytes()[15],
+                Some(whole.len() - 15),
+            )
+        } else {
+            (
+                format!("{whole}{}", &decimals[..6]),
+                decimals.as_bytes()[6],
+                None,
+            )
+        };
+        if next >= b'5' {
+            kept = increment(&kept);
+        }
+        match exponent {
+            Some(e) if kept.len() > 15 => format!("{sign}{}e{}", &kept[..15], e + 1),
+            Some(e) => format!("{sign}{kept}e{e}"),
+            None => {
+                let (whole, decimals) = kept.split_at(kept.len() - 6);
+                let decimals = decimals.trim_end_matches('0');
+                let decimals = if decimals.is_empty() { "0" } else { decimals };
+                let whole = whole.trim_start_matches('0');
+                let whole = if whole.is_empty() { "0" } else { whole };
+                format!("{sign}{whole}.{decimals}")
+            }
+        }
+    }
+
+    /// A decimal numeral plus one, as text.
+    fn increment(digits: &str) -> String {
+        let mut bytes = digits.as_bytes().to_vec();
+        for b in bytes.iter_mut().rev() {
+            if *b == b'9' {
+                *b = b'0';
+            } else {
+                *b += 1;
+                return String::from_utf8(bytes).unwrap();
+            }
+        }
+        format!("1{}", String::from_utf8(bytes).unwrap())
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(4000))]
+
+        #[test]
+        fn every_finite_real_prints_its_exact_value_rounded(bits in proptest::prelude::any::<u64>()) {
+            let x = f64::from_bits(bits);
+            proptest::prop_assume!(x.is_finite());
+            proptest::prop_assert_eq!(format_real(x), exact_rounding(x));
+        }
+
+        /// A decimal with at most six decimals below 1e15 reads back as
+        /// the same double, and prints as written where a double holds six
+        /// decimals (below 2^33).
+        #[test]
+        fn six_decimals_read_back_the_same(negative: bool, whole in 0u64..1_000_000_000_000_000, micros in 0u32..1_000_000) {
+            let sign = if negative { "-" } else { "" };
+            let decimals = format!("{micros:06}");
+            let decimals = match decimals.trim_end_matches('0') {
+                "" => "0",
+                trimmed => trimmed,
+            };
+            let written = format!("{sign}{whole}.{decimals}");
+            let x: f64 = written.parse().unwrap();
+            let printed = format_real(x);
+            proptest::prop_assert_eq!(printed.parse::<f64>().unwrap().to_bits(), x.to_bits());
+            if x.abs() < 8_589_934_592.0 {
+                proptest::prop_assert_eq!(printed, written);
+            }
+        }
+
+        /// Fifteen significant digits and an exponent print as written and
+        /// read back as the same double.
+        #[test]
+        fn fifteen_digits_read_back_the_same(digits in 100_000_000_000_000u64..1_000_000_000_000_000, exponent in 1u32..294) {
+            let written = format!("{digits}e{exponent}");
+            let x: f64 = written.parse().unwrap();
+            proptest::prop_assert_eq!(format_real(x), written);
+        }
     }
 
     #[test]

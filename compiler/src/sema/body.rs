@@ -579,10 +579,42 @@ impl<'a> Checker<'a> {
             ExprKind::Bool(_) => Type::Bool,
             ExprKind::Attr(attr) => {
                 let resolution = self.resolve_attr(attr, scope);
+                if bare_is_constant {
+                    self.word_or_value(attr, &resolution);
+                }
                 self.record_attr(attr, resolution, bare_is_constant)
             }
             ExprKind::Error => Type::Unknown,
         }
+    }
+
+    /// E041: a bare name where a word may stand (an argument, a value sent,
+    /// the other side of `==`) that is also a value the robots running the
+    /// statement read. The reading would win without a word said, and the
+    /// user may well have meant the word (`publish(T, T.Alarm = FIRE)` with a
+    /// `FIRE` sensor): each meaning has its own spelling, `"FIRE"` and
+    /// `T.FIRE`, and the checker asks for one.
+    fn word_or_value(&mut self, attr: &ast::Attr, resolution: &Resolution) {
+        let [word] = attr.segments.as_slice() else {
+            return;
+        };
+        let team = match resolution {
+            Resolution::Value {
+                owner: Some(team), ..
+            } => self.team(*team).name.clone(),
+            Resolution::PartialValue {
+                team, none: false, ..
+            } => team.clone(),
+            _ => return,
+        };
+        let word = &word.name;
+        self.diagnostics.report(
+            Code::WordIsAValue,
+            attr.span,
+            format!(
+                "`{word}` is both a word and the value `{word}` of team {team}'s robots: write `\"{word}\"` for the word or `{team}.{word}` for the value"
+            ),
+        );
     }
 
     fn compare(&mut self, span: Span, lhs: &Expr, op: ast::CmpOp, rhs: &Expr, scope: &Scope) {
@@ -1232,6 +1264,15 @@ impl<'a> Checker<'a> {
                     Symbol::TeamVariable { team, name },
                     true,
                 );
+            } else if !comm.kind.is_outgoing()
+                && matches!(
+                    resolution,
+                    Resolution::TooLong | Resolution::NotATeam { .. }
+                )
+            {
+                // No message: the name is no key a robot could send.
+                self.unreceivable(comm.kind, &item.attr, &resolution);
+                continue;
             } else {
                 // The team's own value, received from its other robots.
                 let receiver = scope.team.map(|t| self.team(t).name.clone());
@@ -1261,6 +1302,37 @@ impl<'a> Checker<'a> {
                 _ => {}
             }
         }
+    }
+
+    /// E040: a received name that is not a value (`USER.RC.CMD`, `Nope.X`).
+    /// A warning would let the mission build, but a message carries a value
+    /// of a team, `USER` or the robot's own, which the name is none of: the
+    /// robot could not be refined.
+    fn unreceivable(&mut self, kind: ast::CommKind, attr: &ast::Attr, resolution: &Resolution) {
+        let written = attr.dotted();
+        let verb = kind.as_str();
+        let (message, guess) = match resolution {
+            Resolution::NotATeam { team } => (
+                format!(
+                    "`{verb}` takes a value, but `{written}` is none: `{team}` is not a team (write `Team.VALUE`, `USER.VALUE` or `VALUE`)"
+                ),
+                suggestion(team, self.team_names().iter().map(String::as_str)),
+            ),
+            _ => (
+                format!(
+                    "`{verb}` takes a value, but `{written}` is none: a value's name has one or two parts (`Team.VALUE`, `USER.VALUE` or `VALUE`)"
+                ),
+                None,
+            ),
+        };
+        self.diagnostics
+            .report(Code::ReceivedNotAValue, attr.span, message)
+            .suggest(guess);
+        self.occurrence(
+            attr.last().span,
+            Symbol::Constant(Name::new(&written)),
+            false,
+        );
     }
 
     /// `COLOR` written in SlaveTeam and `SlaveTeam.COLOR` are the same value.

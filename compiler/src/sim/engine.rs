@@ -1695,7 +1695,8 @@ impl<'p> Sim<'p> {
             if self.robots[r].regions[i].phase == 1 {
                 for (task, command) in &action.commands {
                     let name = actuator_name(self.robots[r].program, task);
-                    if !self.request(r, task, &name, vec![Some(command.clone())]) {
+                    let given = self.value(r, command);
+                    if !self.request(r, task, &name, vec![given]) {
                         return Step::Wait;
                     }
                 }

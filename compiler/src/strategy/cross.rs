@@ -514,6 +514,57 @@ impl Cross<'_> {
                 );
             }
             self.tasks(file, service.parameters(), &targets);
+            self.passed(file, service, &targets);
+        }
+    }
+
+    /// E042: a parameter of an actuator or algorithm that passes its task
+    /// nothing (`ServiceEntry::passed`, the rule refinement applies) for a
+    /// target's service, or any type's that provides it when none is named.
+    fn passed(&mut self, file: FileId, entry: &ServiceEntry, targets: &[(&Named, RobotTypeId)]) {
+        let Some(service) = &entry.name else { return };
+        let catalog = self.catalog;
+        let types: Vec<&RobotType> = match targets.is_empty() {
+            true => catalog.types().map(|(_, r)| r).collect(),
+            false => targets.iter().map(|(_, id)| catalog.get(*id)).collect(),
+        };
+        let params: Vec<Vec<&str>> = types
+            .iter()
+            .filter_map(|r| r.service(&service.name))
+            .map(|def| def.params.iter().map(|p| p.name.as_str()).collect())
+            .collect();
+        let commands = entry
+            .actions
+            .iter()
+            .flat_map(|a| &a.tasks)
+            .filter(|t| t.kind != TaskUseKind::CheckSensor)
+            .flat_map(|t| t.parameters.iter().map(move |p| (t, p)));
+        for (task_use, p) in commands {
+            if !params
+                .iter()
+                .any(|ps| entry.passed(p, ps) == Passed::Nothing)
+            {
+                continue;
+            }
+            let what = task_use
+                .name
+                .as_ref()
+                .map_or(String::new(), |n| format!(" `{}`", n.name));
+            let message = match &p.name {
+                Some(name) => format!(
+                    "`{}` gives {}{what} nothing: it has no `value`, and no parameter of the service `{}` or of its actions is named `{}` (write `value=\"...\"`, or name the variable or the service's parameter it passes)",
+                    name.name,
+                    task_use.kind.tag(),
+                    service.name,
+                    name.name
+                ),
+                None => format!(
+                    "this parameter gives {}{what} nothing: it has neither a `name` nor a `value`",
+                    task_use.kind.tag()
+                ),
+            };
+            let span = p.name.as_ref().map_or(p.span, |n| n.span);
+            self.report(Code::StrategyPassesNothing, file, span, message);
         }
     }
 

@@ -163,12 +163,69 @@ impl ServiceEntry {
         self.actions.iter().flat_map(Action::parameters)
     }
 
+    /// Whether `name` is a parameter the entry's conditions and commands read
+    /// by name: a sensor reading (a `CheckSensor`'s), or an action's own
+    /// variable (set from the call's argument in its position) or fixed
+    /// value.
+    pub fn reads(&self, name: &str) -> bool {
+        self.actions.iter().any(|action| {
+            let sensed = action
+                .tasks
+                .iter()
+                .filter(|t| t.kind == TaskUseKind::CheckSensor)
+                .flat_map(|t| &t.parameters);
+            let own = action
+                .parameters
+                .iter()
+                .filter(|p| p.value.is_some() || p.data == Some(DataCharacteristic::Variable));
+            sensed
+                .chain(own)
+                .any(|p| p.name.as_ref().is_some_and(|n| n.name == name))
+        })
+    }
+
+    /// What a parameter of an `ExecuteActuator` or `ExecuteAlgorithm` of this
+    /// entry passes to its task: its `value`, else its own name, read as a
+    /// parameter of the entry ([`ServiceEntry::reads`]), else as one of the
+    /// refined service's (`service_params`, the catalog's, in order: the
+    /// call's argument in that position), else (a `value` only) as written.
+    pub fn passed<'p>(&self, parameter: &'p Parameter, service_params: &[&str]) -> Passed<'p> {
+        let Some(said) = parameter.value.as_ref().or(parameter.name.as_ref()) else {
+            return Passed::Nothing;
+        };
+        let said = said.name.as_str();
+        if self.reads(said) {
+            Passed::Named(said)
+        } else if let Some(index) = service_params.iter().position(|p| *p == said) {
+            Passed::Argument(index)
+        } else if parameter.value.is_some() {
+            Passed::Literal(said)
+        } else {
+            Passed::Nothing
+        }
+    }
+
     /// The action whose `actionId` is `id` (the first one, if given twice).
     pub fn action_by_id(&self, id: u64) -> Option<&Action> {
         self.actions
             .iter()
             .find(|a| a.id.as_ref().is_some_and(|i| i.value == id))
     }
+}
+
+/// What a task use's parameter passes to its task ([`ServiceEntry::passed`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Passed<'p> {
+    /// The entry's parameter of this name (a sensor reading, a variable, a
+    /// fixed value).
+    Named(&'p str),
+    /// The call's argument in this position.
+    Argument(usize),
+    /// The `value` as written: a word or a number.
+    Literal(&'p str),
+    /// No `value`, and its name is no parameter of the entry nor of the
+    /// service (E042).
+    Nothing,
 }
 
 /// An `actionId`, `srcId` or `dstId` with its range.

@@ -35,31 +35,159 @@ size_t semo__format_i64(char *out, int64_t n)
 }
 
 #ifndef SEMO_NO_REALS
-/* A finite real as `refine::value::format_real` prints it: up to six
- * decimals, trailing zeros dropped, at least one; from 1e15 on, digits and an
- * exponent. No printf: newlib-nano's has no floating point. `out` holds at
- * least 32 bytes. */
-static size_t format_real(char *out, double x)
+/* Reals print from their exact binary value, as `refine::value::format_real`
+ * does (the same digits, so traces agree to the byte): below 1e15 in
+ * magnitude, rounded half up to six decimals with trailing zeros dropped
+ * but one kept (`2.0`, `0.125`, `0.333333`); from 1e15 on, the first fifteen
+ * significant digits rounded half up and an exponent (`1.5e20` is
+ * `150000000000000e6`); a set sign bit is a `-` (`-0.0`); `inf`, `-inf` and
+ * `nan` otherwise (never in JSON: `put_json_value` writes those as null).
+ * Integer arithmetic only, on a few 32-bit words: no printf (newlib-nano's
+ * has no floating point), no libm, no 128-bit integers (32-bit targets). */
+
+/* A natural number below 2^1120, least significant word first: room for a
+ * double's integer part (below 2^1024) and for a subnormal fraction's bits
+ * times 10^7 (below 2^1098). */
+#define BIG_WORDS 35
+typedef struct {
+    uint32_t word[BIG_WORDS];
+    size_t len; /* words in use; the top one is not zero */
+} big;
+
+static void big_set(big *b, uint64_t n)
 {
-    size_t len = 0;
-    if (x < 0) {
-        out[len++] = '-';
-        x = -x;
+    b->word[0] = (uint32_t)n;
+    b->word[1] = (uint32_t)(n >> 32);
+    b->len = n == 0 ? 0 : n >> 32 ? 2 : 1;
+}
+
+static void big_trim(big *b)
+{
+    while (b->len > 0 && b->word[b->len - 1] == 0)
+        b->len--;
+}
+
+static void big_mul_small(big *b, uint32_t factor)
+{
+    uint64_t carry = 0;
+    for (size_t i = 0; i < b->len; i++) {
+        carry += (uint64_t)b->word[i] * factor;
+        b->word[i] = (uint32_t)carry;
+        carry >>= 32;
     }
-    if (x >= 1e15) {
-        int exponent = 0;
-        while (x >= 1e15) {
-            x /= 10.0;
-            exponent++;
-        }
-        len += semo__format_i64(out + len, (int64_t)(x + 0.5));
-        out[len++] = 'e';
-        return len + semo__format_i64(out + len, exponent);
+    if (carry)
+        b->word[b->len++] = (uint32_t)carry;
+}
+
+/* b /= divisor, rounded down. */
+static void big_div_small(big *b, uint32_t divisor)
+{
+    uint64_t rest = 0;
+    for (size_t i = b->len; i-- > 0;) {
+        rest = rest << 32 | b->word[i];
+        b->word[i] = (uint32_t)(rest / divisor);
+        rest %= divisor;
     }
-    /* Rounded half up by adding 0.5 (no libm: `round` is not linked). */
-    int64_t scaled = (int64_t)(x * 1e6 + 0.5);
-    int64_t whole = scaled / 1000000, fraction = scaled % 1000000;
-    len += semo__format_i64(out + len, whole);
+    big_trim(b);
+}
+
+static void big_shift_left(big *b, unsigned bits)
+{
+    size_t words = bits / 32, len = b->len;
+    unsigned rest = bits % 32;
+    if (len == 0)
+        return;
+    b->word[len + words] = 0;
+    for (size_t i = len; i-- > 0;) {
+        b->word[i + words + 1] |= rest ? b->word[i] >> (32 - rest) : 0;
+        b->word[i + words] = b->word[i] << rest;
+    }
+    for (size_t i = 0; i < words; i++)
+        b->word[i] = 0;
+    b->len = len + words + 1;
+    big_trim(b);
+}
+
+static void big_shift_right(big *b, unsigned bits)
+{
+    size_t words = bits / 32;
+    unsigned rest = bits % 32;
+    if (words >= b->len) {
+        b->len = 0;
+        return;
+    }
+    size_t len = b->len - words;
+    for (size_t i = 0; i < len; i++) {
+        uint32_t high = i + words + 1 < b->len && rest ? b->word[i + words + 1] << (32 - rest) : 0;
+        b->word[i] = b->word[i + words] >> rest | high;
+    }
+    b->len = len;
+    big_trim(b);
+}
+
+/* The value, when it is below 2^64. */
+static bool big_small(const big *b, uint64_t *out)
+{
+    if (b->len > 2)
+        return false;
+    *out = (b->len > 1 ? (uint64_t)b->word[1] << 32 : 0) | (b->len > 0 ? b->word[0] : 0);
+    return true;
+}
+
+static size_t put_text_at(char *out, const char *text)
+{
+    size_t len = strlen(text);
+    memcpy(out, text, len + 1);
+    return len;
+}
+
+/* `digits` e `exponent`: the first fifteen significant digits of the
+ * integer `whole` (at least 10^15) rounded half up. */
+static size_t format_scientific(char *out, big *whole)
+{
+    const uint64_t sixteen_digits = 10000000000000000ull;
+    int exponent = 0;
+    uint64_t top;
+    /* Four words or more is at least 2^96 > 10^25: nine digits can go at once. */
+    while (whole->len >= 4) {
+        big_div_small(whole, 1000000000u);
+        exponent += 9;
+    }
+    while (!big_small(whole, &top) || top >= sixteen_digits) {
+        big_div_small(whole, 10);
+        exponent++;
+    }
+    /* `top` has sixteen digits: the last one rounds. */
+    uint64_t digits = top / 10 + (top % 10 >= 5);
+    exponent++;
+    if (digits == 1000000000000000ull) {
+        digits /= 10;
+        exponent++;
+    }
+    size_t len = semo__format_i64(out, (int64_t)digits);
+    out[len++] = 'e';
+    return len + semo__format_i64(out + len, exponent);
+}
+
+/* `whole`.`fraction`: the real `mantissa` / 2^`shift` (below 10^15), rounded
+ * half up to six decimals, trailing zeros dropped but one. */
+static size_t format_fixed(char *out, uint64_t mantissa, unsigned shift)
+{
+    uint64_t whole = shift < 64 ? mantissa >> shift : 0;
+    uint64_t bits = shift < 64 ? mantissa & ((1ull << shift) - 1) : mantissa;
+    /* Seven decimals of bits / 2^shift, cut: the seventh rounds. */
+    big seven;
+    big_set(&seven, bits);
+    big_mul_small(&seven, 10000000u);
+    big_shift_right(&seven, shift);
+    uint64_t decimals = 0;
+    big_small(&seven, &decimals); /* below 10^7: always small */
+    int64_t fraction = (int64_t)(decimals / 10 + (decimals % 10 >= 5));
+    if (fraction == 1000000) {
+        fraction = 0;
+        whole++;
+    }
+    size_t len = semo__format_i64(out, (int64_t)whole);
     out[len++] = '.';
     int digits = 6;
     while (digits > 1 && fraction % 10 == 0) {
@@ -71,6 +199,36 @@ static size_t format_real(char *out, double x)
     len += (size_t)digits;
     out[len] = '\0';
     return len;
+}
+
+/* `out` holds at least 32 bytes. */
+static size_t format_real(char *out, double x)
+{
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    unsigned biased = (unsigned)(bits >> 52 & 0x7ff);
+    uint64_t mantissa = bits & ((1ull << 52) - 1);
+    size_t len = 0;
+    if (biased == 0x7ff)
+        return put_text_at(out, mantissa ? "nan" : bits >> 63 ? "-inf" : "inf");
+    if (bits >> 63)
+        out[len++] = '-';
+    /* |x| = mantissa * 2^exponent exactly. */
+    int exponent = biased == 0 ? -1074 : (int)biased - 1075;
+    if (biased != 0)
+        mantissa |= 1ull << 52;
+    if (x >= 1e15 || x <= -1e15) {
+        big whole;
+        big_set(&whole, mantissa);
+        if (exponent >= 0)
+            big_shift_left(&whole, (unsigned)exponent);
+        else
+            big_shift_right(&whole, (unsigned)-exponent);
+        return len + format_scientific(out + len, &whole);
+    }
+    if (exponent >= 0) /* below 10^15: a whole number that fits */
+        return len + format_fixed(out + len, mantissa << exponent, 0);
+    return len + format_fixed(out + len, mantissa, (unsigned)-exponent);
 }
 
 #endif

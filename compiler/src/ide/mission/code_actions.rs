@@ -7,12 +7,15 @@
 //!   service (`T.P.S{ } repeat()`), which also creates a missing plan;
 //! - E018, a main block without `default`: add `default: mode = M`;
 //! - W001, an event no mode catches: add `catch (E): mode = M` to the case of
-//!   a mode that runs a service throwing it.
+//!   a mode that runs a service throwing it;
+//! - E041, a bare word that is also a value the robots read: one fix for each
+//!   meaning, the word as a string (`"FIRE"`) and the value with its team
+//!   (`T.FIRE`), neither preferred (only the user knows which was meant).
 
 use crate::catalog::Catalog;
 use crate::diag::{Code, Diagnostic};
 pub use crate::edit::{CodeAction, TextEdit};
-use crate::sema::{Analysis, ModeId, PlanId, Team, TeamId};
+use crate::sema::{Analysis, ModeId, PlanId, Symbol, Team, TeamId};
 use crate::span::Span;
 use crate::syntax::ast::{self, Item, SetTarget};
 
@@ -65,6 +68,7 @@ impl Fixes<'_> {
             Code::ServiceNotInPlan => self.create_service(),
             Code::MissingDefault => self.add_default(),
             Code::EventNeverCaught => self.add_catches(),
+            Code::WordIsAValue => self.word_or_value(),
             _ => Vec::new(),
         };
         let did_you_mean = self.did_you_mean();
@@ -103,6 +107,41 @@ impl Fixes<'_> {
             vec![TextEdit { span, new_text }],
             true,
         ))
+    }
+
+    /// E041: `"FIRE"` (the word) or `T.FIRE` (the value of team `T`, the
+    /// one the checker resolved the bare name to).
+    fn word_or_value(&self) -> Vec<CodeAction> {
+        let span = self.diagnostic.span;
+        let Some(word) = self.text.get(span.range()) else {
+            return Vec::new();
+        };
+        let team = self
+            .analysis
+            .mission
+            .occurrence_at(span.start)
+            .and_then(|o| match &o.symbol {
+                Symbol::Value {
+                    owner: Some(team), ..
+                } => Some(&self.team(*team).name),
+                _ => None,
+            });
+        let Some(team) = team else {
+            return Vec::new();
+        };
+        [
+            (format!("\"{word}\""), "the word"),
+            (format!("{team}.{word}"), "the robots' value"),
+        ]
+        .into_iter()
+        .map(|(new_text, meaning)| {
+            self.action(
+                format!("Write `{new_text}`: {meaning}"),
+                vec![TextEdit { span, new_text }],
+                false,
+            )
+        })
+        .collect()
     }
 
     /// The team of the main block whose range holds the diagnostic.

@@ -291,6 +291,42 @@ fn did_you_mean_of_a_string_keeps_the_quotes() {
     assert_eq!(&text[actions[0].edits[0].span.range()], "\"GREN\"");
 }
 
+#[test]
+fn a_word_that_is_also_a_value_is_fixed_either_way() {
+    let catalog = builtin();
+    let text = "{ Scouts: TIEvalbot ti }\nScouts.Report.Alarm{\n  send(USER, Scouts.Found = COLOR)\n} repeat(1 SEC)\nScouts.REPORT{ set(Report, Alarm) }\nScouts.main{ default: mode = REPORT }\n";
+    let analysis = crate::check_source(FileId(0), text, catalog);
+    let at = text.find("= COLOR").unwrap() + 2;
+    let actions = code_actions(&analysis, catalog, text, Span::new(at, at));
+    let fixes: Vec<(&str, &str, bool)> = actions
+        .iter()
+        .map(|a| (a.title.as_str(), a.edits[0].new_text.as_str(), a.preferred))
+        .collect();
+    assert_eq!(
+        fixes,
+        [
+            ("Write `\"COLOR\"`: the word", "\"COLOR\"", false),
+            (
+                "Write `Scouts.COLOR`: the robots' value",
+                "Scouts.COLOR",
+                false
+            ),
+        ]
+    );
+    for action in &actions {
+        let edit = &action.edits[0];
+        assert_eq!(&text[edit.span.range()], "COLOR");
+        let fixed = format!(
+            "{}{}{}",
+            &text[..edit.span.start],
+            edit.new_text,
+            &text[edit.span.end..]
+        );
+        let checked = crate::check_source(FileId(0), &fixed, catalog);
+        assert!(!checked.has_errors(), "{fixed}: {:#?}", checked.diagnostics);
+    }
+}
+
 /// Every `ide` function at `offset` of `text`: nothing panics, and every
 /// range returned lies in the text, on character boundaries.
 fn every_feature_at(text: &str, analysis: &Analysis, offset: usize) {

@@ -4,7 +4,7 @@
  *
  *   runtime_test MODE [runtime options...]
  *
- * MODE: values | tasks | minimal | udp-a | udp-b | sim (sim: -DSEMO_SIM builds).
+ * MODE: values | tasks | minimal | wake | reals | udp-a | udp-b | sim (sim: -DSEMO_SIM builds).
  * Exit status: the runtime's, or 1 when a check failed (each failure is
  * printed as "FAIL file:line: condition").
  */
@@ -14,6 +14,7 @@
 
 #include <stdatomic.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static atomic_int failures;
@@ -75,6 +76,8 @@ static int run_values(void)
     CHECK(semo_value_json(&b, json, sizeof json) > 0 && strcmp(json, "2.0") == 0);
     semo_value_set_real(&b, 1.0 / 3.0);
     CHECK(semo_value_json(&b, json, sizeof json) > 0 && strcmp(json, "0.333333") == 0);
+    semo_value_set_real(&b, 9.3e12); /* scaled by 10^6, beyond int64 */
+    CHECK(semo_value_json(&b, json, sizeof json) > 0 && strcmp(json, "9300000000000.0") == 0);
     semo_value_set_real(&b, -1.5e20);
     CHECK(semo_value_json(&b, json, sizeof json) > 0 && strcmp(json, "-150000000000000e6") == 0);
     semo_value_set_real(&b, 1.0 / 0.0);
@@ -641,6 +644,30 @@ static int run_sim(int argc, char **argv)
 }
 #endif
 
+/* ----------------------------------------------------------------- reals */
+
+/* Each argument a double's bits in hexadecimal; prints each as a value's
+ * JSON, one a line (tests/runtime_c.rs compares them with the simulator's). */
+static int run_reals(int argc, char **argv)
+{
+    for (int i = 1; i < argc; i++) {
+        char *end;
+        uint64_t bits = strtoull(argv[i], &end, 16);
+        if (*end != '\0') {
+            fprintf(stderr, "not hexadecimal bits: %s\n", argv[i]);
+            return 64;
+        }
+        double x;
+        memcpy(&x, &bits, sizeof x);
+        semo_value v;
+        semo_value_set_real(&v, x);
+        char json[64];
+        semo_value_json(&v, json, sizeof json);
+        printf("%s\n", json);
+    }
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     const char *mode = argc > 1 ? argv[1] : "";
@@ -652,12 +679,14 @@ int main(int argc, char **argv)
         return run_minimal(argc - 1, argv + 1);
     if (strcmp(mode, "wake") == 0)
         return run_wake(argc - 1, argv + 1);
+    if (strcmp(mode, "reals") == 0)
+        return run_reals(argc - 1, argv + 1);
     if (strcmp(mode, "udp-a") == 0 || strcmp(mode, "udp-b") == 0)
         return run_udp(argc - 1, argv + 1, mode[4] == 'a');
 #ifdef SEMO_SIM
     if (strcmp(mode, "sim") == 0)
         return run_sim(argc - 1, argv + 1);
 #endif
-    fprintf(stderr, "usage: runtime_test values|tasks|minimal|wake|udp-a|udp-b|sim [options]\n");
+    fprintf(stderr, "usage: runtime_test values|tasks|minimal|wake|reals|udp-a|udp-b|sim [options]\n");
     return 64;
 }
