@@ -1,9 +1,11 @@
 //! `semo deploy broker-config`: a mosquitto configuration and its ACL from
 //! a deployment and the mission's refined programs. Each robot's user may
-//! write only the topics its program sends and publishes on (and its own
-//! status) and read only its team's and its own topics; only the operator's
-//! user may write the `USER` commands the mission receives; anonymous
-//! clients are refused. The topics are `topics.rs`'s, as the runtime uses.
+//! write only the topics its program sends and publishes on, each naming
+//! that robot as the sender (and its own status), and read only its team's
+//! and its own topics; only the operator's user may write the `USER`
+//! commands the mission receives (topics whose sender is `USER/operator`);
+//! anonymous clients are refused. The topics are `topics.rs`'s, as the
+//! runtime uses.
 
 use super::{Deployment, topics};
 use crate::diag::{Code, Diagnostic};
@@ -68,39 +70,45 @@ pub fn files(
             )));
             continue;
         };
+        // Every topic a robot writes names it as the sender: its user can
+        // speak for its own robots only.
+        let me = topics::Sender::of(program);
         let rights = users.entry(user).or_default();
         for out in &program.control.outgoing {
-            if teams.contains(out.to_team.as_str()) {
+            if teams.contains(out.to_team.as_str()) || out.to_team == "USER" {
+                // A team, or what the robot tells the operator consoles.
                 rights
                     .write
-                    .insert(topics::to_team(&mission, &out.to_team, &out.key));
+                    .insert(topics::to_team(&mission, &out.to_team, &out.key, me));
             } else if let Some(team) = team_of(&out.to_team) {
                 rights
                     .write
-                    .insert(topics::to_robot(&mission, team, &out.to_team, &out.key));
-            } else if out.to_team == "USER" {
-                // What the robot tells the operator consoles.
-                rights
-                    .write
-                    .insert(topics::to_team(&mission, "USER", &out.key));
+                    .insert(topics::to_robot(&mission, team, &out.to_team, &out.key, me));
             }
         }
         if program.control.heartbeat {
-            rights.write.insert(topics::heartbeats(program));
+            rights.write.insert(topics::heartbeat(program));
         }
         // The owner protocol of globally shared values: the owner tells the
         // team, a writer tells whichever teammate owns (any may, in turn).
         let ownership = program.library.as_ref().and_then(|l| l.ownership.as_ref());
         for global in ownership.map_or(&[][..], |o| &o.global) {
-            rights
-                .write
-                .insert(topics::to_team(&mission, &program.team, &global.value_key));
+            rights.write.insert(topics::to_team(
+                &mission,
+                &program.team,
+                &global.value_key,
+                me,
+            ));
             for &owner in ownership.map_or(&[][..], |o| &o.owners) {
                 let (team, robot) = &program.peers[owner];
                 if *robot != program.robot {
-                    rights
-                        .write
-                        .insert(topics::to_robot(&mission, team, robot, &global.set_key));
+                    rights.write.insert(topics::to_robot(
+                        &mission,
+                        team,
+                        robot,
+                        &global.set_key,
+                        me,
+                    ));
                 }
             }
         }
@@ -108,23 +116,18 @@ pub fn files(
             let key = crate::codegen::files::sync_key(program);
             rights
                 .write
-                .insert(topics::to_team(&mission, &program.team, &key));
+                .insert(topics::to_team(&mission, &program.team, &key, me));
         }
         rights
             .write
             .insert(topics::status(&mission, &program.robot));
         // Exactly the runtime's two subscriptions.
-        rights.read.insert(format!(
-            "semo/{}/{}/+",
-            topics::level(&mission),
-            topics::level(&program.team)
-        ));
-        rights.read.insert(format!(
-            "semo/{}/{}/{}/+",
-            topics::level(&mission),
-            topics::level(&program.team),
-            topics::level(&program.robot)
-        ));
+        rights
+            .read
+            .insert(topics::team_inbox(&mission, &program.team));
+        rights
+            .read
+            .insert(topics::robot_inbox(&mission, &program.team, &program.robot));
     }
     let operator = deployment.operator_credentials().user;
     if let Some(user) = &operator {
@@ -141,33 +144,33 @@ pub fn files(
                 .iter()
                 .filter(|i| i.from_team == "USER")
             {
-                rights
-                    .write
-                    .insert(topics::to_team(&mission, &program.team, &incoming.key));
+                rights.write.insert(topics::to_team(
+                    &mission,
+                    &program.team,
+                    &incoming.key,
+                    topics::OPERATOR,
+                ));
                 rights.write.insert(topics::to_robot(
                     &mission,
                     &program.team,
                     &program.robot,
                     &incoming.key,
+                    topics::OPERATOR,
                 ));
             }
         }
-        rights
-            .read
-            .insert(format!("semo/{}/status/+", topics::level(&mission)));
-        rights
-            .read
-            .insert(format!("semo/{}/USER/+", topics::level(&mission)));
+        rights.read.insert(topics::statuses(&mission));
+        rights.read.insert(topics::team_inbox(&mission, "USER"));
         // The editor's robot monitor tells a robot that stops heart-beating.
         for program in programs.iter().filter(|p| p.control.heartbeat) {
-            rights.read.insert(topics::heartbeats(program));
+            rights.read.insert(topics::heartbeat(program));
         }
     }
     if !found.is_empty() {
         return Err(found);
     }
     let mut acl = format!(
-        "# The ACL of mission {mission}, written by `semo deploy broker-config` from {source}.\n# Each robot's user writes only what its program sends and publishes (and its\n# status) and reads only its team's and its own topics; {}.\n",
+        "# The ACL of mission {mission}, written by `semo deploy broker-config` from {source}.\n# Each robot's user writes only what its program sends and publishes, on\n# topics naming that robot as the sender (and its status), and reads only its\n# team's and its own topics; {}.\n",
         match &operator {
             Some(user) => format!("only `{user}` (the operator) writes USER commands"),
             None => "no operator is deployed: nobody writes USER commands".into(),

@@ -832,7 +832,9 @@ static void *receiver_thread(void *arg)
         /* No timeout: semo_stop_program interrupts the wait. */
         int n = g_transport->recv(buf, sizeof buf, -1);
         semo_message m;
-        if (n < 0) {
+        if (n == SEMO_RECV_REFUSED) {
+            semo_trace("reject", "reason", "sender not its topic", NULL);
+        } else if (n < 0) {
             semo_trace("comm_error", "reason", "receive failed", NULL);
             semo_sleep_ms(RECV_ERROR_PAUSE_MS); /* a failing socket must not spin */
         } else if (n > 0 && semo__decode_message(buf, (size_t)n, &m)) {

@@ -332,6 +332,10 @@ typedef struct {
     const char *cert, *key;    /* TLS: the client's certificate and key */
 } semo_transport_config;
 
+/* What recv returns for a message whose sender the transport does not
+ * vouch for: counted and traced (`reject`), never delivered. */
+#define SEMO_RECV_REFUSED (-2)
+
 /* The transport interface: loopback UDP (`semo_udp.c`) and MQTT
  * (`semo_mqtt.c`, with -DSEMO_MQTT). */
 typedef struct {
@@ -342,8 +346,11 @@ typedef struct {
     /* To every other robot of a team, or to the robot of that name, at once
      * (a broker fans out); NULL when the transport has send. */
     int (*send_to)(const char *to, const void *data, size_t len);
-    /* Bytes received, 0 on timeout or interrupt, -1 on error; timeout_ms < 0
-     * waits until a datagram arrives or `interrupt` is called. */
+    /* Bytes received, 0 on timeout or interrupt, -1 on error,
+     * SEMO_RECV_REFUSED for a message the transport refused (MQTT: its
+     * datagram names another sender or key than the topic it came on);
+     * timeout_ms < 0 waits until a datagram arrives or `interrupt` is
+     * called. */
     int (*recv)(void *data, size_t cap, int timeout_ms);
     /* Makes a recv under way, and every later one, return 0 at once (the
      * program is stopping); safe from any thread. */
