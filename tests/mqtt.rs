@@ -362,7 +362,14 @@ fn broker_config_for(dir: &Path, mission: &Path, deploy: &Path) -> PathBuf {
     );
     assert_eq!(written.code, 0, "{}{}", written.stdout, written.stderr);
     let config = out.join("mosquitto.conf");
-    let mut text = std::fs::read_to_string(&config).unwrap();
+    let text = std::fs::read_to_string(&config).unwrap();
+    // The tests' broker runs as the user running them, whoever that is,
+    // and logs into their folder.
+    let mut text: String = text
+        .lines()
+        .filter(|line| !line.starts_with("user "))
+        .map(|line| format!("{line}\n"))
+        .collect();
     text.push_str(&format!(
         "user {}\nlog_dest file {}\n",
         support::mosquitto::current_user(),
@@ -628,6 +635,147 @@ fn robots_take_messages_only_from_the_sender_their_topic_names_and_the_acl_lets(
             .iter()
             .any(|v| v == "RC_MODE"),
         "the master took the operator's command"
+    );
+}
+
+/// `mosquitto_sub` as the operator with the persistent session `semo-root-
+/// test` on the operator consoles' topics, with `args`; its output.
+fn operator_session(port: u16, args: &[&str]) -> std::process::Output {
+    Command::new("mosquitto_sub")
+        .args(["-h", "127.0.0.1", "-p", &port.to_string(), "-q", "1", "-c"])
+        .args([
+            "-i",
+            "semo-root-test",
+            "-u",
+            "operator",
+            "-P",
+            "operator-secret",
+        ])
+        .args(["-t", &topics::team_inbox("scouting", "USER")])
+        .args(args)
+        .output()
+        .expect("mosquitto_sub runs (Debian mosquitto-clients)")
+}
+
+/// Started as root, the broker of the generated configuration runs as its
+/// `user` (`mosquitto`). With the password file and the persistence folder
+/// given to that user as `semo deploy broker-config` says (and
+/// `docs/deployment.md`), it starts, and a QoS 1 message for a session that
+/// is away survives a restart of the broker. Needs root and the `mosquitto`
+/// account (CI); skipped otherwise.
+#[test]
+fn the_generated_broker_started_as_root_keeps_qos1_messages_across_a_restart() {
+    let Some(binary) = support::mqtt::broker_or_skip("root broker") else {
+        return;
+    };
+    let account = Command::new("id")
+        .arg("mosquitto")
+        .output()
+        .expect("id runs");
+    if support::mosquitto::current_user() != "root" || !account.status.success() {
+        eprintln!("skipping: needs root and the `mosquitto` account");
+        return;
+    }
+    // Its own folder under the system's temporary folder: every folder on
+    // the way must be searchable by the broker's account (a build folder
+    // may not be).
+    let dir = tempfile::Builder::new()
+        .prefix("semo-root-broker")
+        .tempdir()
+        .unwrap();
+    let reachable = Command::new("chmod")
+        .arg("0755")
+        .arg(dir.path())
+        .status()
+        .unwrap();
+    assert!(reachable.success());
+    let dir = dir.path();
+    let port = free_port();
+    let deploy = scouting_deployment(dir, port, false);
+    let passwd = dir.join("passwd");
+    let chmod = Command::new("chmod")
+        .arg("0600")
+        .arg(&passwd)
+        .status()
+        .unwrap();
+    assert!(chmod.success());
+    let out = dir.join("broker");
+    let written = support::semo_in(
+        dir,
+        &[
+            "deploy",
+            "broker-config",
+            &examples()
+                .join("scouting/scouting.mission")
+                .display()
+                .to_string(),
+            "--deploy",
+            &deploy.display().to_string(),
+            "-o",
+            &out.display().to_string(),
+        ],
+    );
+    assert_eq!(written.code, 0, "{}", written.stderr);
+    let persistence = out.join("persistence");
+    let told = format!(
+        "`chown mosquitto {} {}`",
+        persistence.display(),
+        passwd.display()
+    );
+    assert!(written.stdout.contains(&told), "{}", written.stdout);
+    let config = std::fs::read_to_string(out.join("mosquitto.conf")).unwrap();
+    assert!(config.contains("\nuser mosquitto\n"), "{config}");
+    // What it says to do.
+    let chown = Command::new("chown")
+        .arg("mosquitto")
+        .args([&persistence, &passwd])
+        .status()
+        .unwrap();
+    assert!(chown.success());
+
+    let mut processes = Processes::default();
+    let start = |processes: &mut Processes, run: &str| {
+        let log = std::fs::File::create(dir.join(format!("mosquitto.{run}.log"))).unwrap();
+        let child = Command::new(&binary)
+            .arg("-c")
+            .arg(out.join("mosquitto.conf"))
+            .stderr(log)
+            .spawn()
+            .expect("mosquitto starts");
+        let index = processes.push(child);
+        let log = || std::fs::read_to_string(dir.join(format!("mosquitto.{run}.log"))).unwrap();
+        assert!(support::mosquitto::listening(port), "{}", log());
+        index
+    };
+    let broker = start(&mut processes, "first");
+    let subscribed = operator_session(port, &["-E"]);
+    assert!(subscribed.status.success(), "{subscribed:?}");
+    let irobot = topics::Sender {
+        team: "MasterTeam",
+        robot: "irobot",
+    };
+    let published = Command::new("mosquitto_pub")
+        .args(["-h", "127.0.0.1", "-p", &port.to_string(), "-q", "1"])
+        .args(["-u", "irobot", "-P", "irobot-secret", "-m", "kept"])
+        .args([
+            "-t",
+            &topics::to_team("scouting", "USER", "MasterTeam.CAMERA", irobot),
+        ])
+        .output()
+        .expect("mosquitto_pub runs");
+    assert!(published.status.success(), "{published:?}");
+    processes.terminate(broker);
+    assert!(
+        persistence.join("mosquitto.db").is_file(),
+        "the broker kept its state in {}",
+        persistence.display()
+    );
+    start(&mut processes, "second");
+    let kept = operator_session(port, &["-C", "1", "-W", "5"]);
+    assert_eq!(
+        String::from_utf8_lossy(&kept.stdout).trim(),
+        "kept",
+        "{kept:?}"
     );
 }
 
