@@ -605,6 +605,7 @@ static void mqtt_close(void)
 
 const semo_transport semo_mqtt_transport = {
     .name = "mqtt",
+    .refusal = "sender not its topic",
     .open = mqtt_open,
     .send_to = mqtt_send_to,
     .recv = mqtt_recv,
