@@ -11,6 +11,7 @@
 
 mod support;
 
+use semo::deploy::topics;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -361,7 +362,14 @@ fn broker_config_for(dir: &Path, mission: &Path, deploy: &Path) -> PathBuf {
     );
     assert_eq!(written.code, 0, "{}{}", written.stdout, written.stderr);
     let config = out.join("mosquitto.conf");
-    let mut text = std::fs::read_to_string(&config).unwrap();
+    let text = std::fs::read_to_string(&config).unwrap();
+    // The tests' broker runs as the user running them, whoever that is,
+    // and logs into their folder.
+    let mut text: String = text
+        .lines()
+        .filter(|line| !line.starts_with("user "))
+        .map(|line| format!("{line}\n"))
+        .collect();
     text.push_str(&format!(
         "user {}\nlog_dest file {}\n",
         support::mosquitto::current_user(),
@@ -371,69 +379,95 @@ fn broker_config_for(dir: &Path, mission: &Path, deploy: &Path) -> PathBuf {
     config
 }
 
-/// Publishes `datagram` to `topic` with `mosquitto_pub` every 100 ms (as
-/// `user`, or anonymously) until `stop` is set. Returns how many publishes
-/// the broker accepted at the protocol level (exit status 0).
-fn keep_publishing(
+/// The topics the ACL file `acl` lets `user` write.
+fn writable(acl: &str, user: &str) -> Vec<String> {
+    let mut current = None;
+    let mut topics = Vec::new();
+    for line in acl.lines() {
+        if let Some(name) = line.strip_prefix("user ") {
+            current = Some(name);
+        } else if let Some(topic) = line.strip_prefix("topic write ") {
+            if current == Some(user) {
+                topics.push(topic.to_string());
+            }
+        }
+    }
+    topics
+}
+
+/// An attacker holding `user`'s credentials (rumqttc): publishes `datagram`
+/// at QoS 1 on each of `topics` in turn, a round every 20 ms, until `stop`
+/// is set. Returns how many publishes it made (mosquitto acknowledges one
+/// its ACL denies too: MQTT 3.1.1 has no way to say no).
+fn forge(
     port: u16,
-    topic: String,
-    datagram: PathBuf,
-    user: Option<(&'static str, &'static str)>,
+    (user, password): (&'static str, &'static str),
+    topics: Vec<String>,
+    datagram: Vec<u8>,
     stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
 ) -> std::thread::JoinHandle<usize> {
     std::thread::spawn(move || {
-        let mut accepted = 0;
-        while !stop.load(std::sync::atomic::Ordering::SeqCst) {
-            let mut command = Command::new("mosquitto_pub");
-            command
-                .args(["-h", "127.0.0.1", "-p", &port.to_string(), "-q", "1"])
-                .args(["-t", &topic])
-                .arg("-f")
-                .arg(&datagram);
-            if let Some((user, password)) = user {
-                command.args(["-u", user, "-P", password]);
+        let mut options = rumqttc::MqttOptions::new(format!("forger-{user}"), "127.0.0.1", port);
+        options.set_credentials(user, password);
+        let (client, mut connection) = rumqttc::Client::new(options, 256);
+        let network = std::thread::spawn(move || {
+            for event in connection.iter() {
+                if matches!(
+                    event,
+                    Ok(rumqttc::Event::Outgoing(rumqttc::Outgoing::Disconnect)) | Err(_)
+                ) {
+                    break;
+                }
             }
-            let status = command
-                .stdout(Stdio::null())
-                .stderr(Stdio::null())
-                .status()
-                .expect("mosquitto_pub runs (Debian mosquitto-clients)");
-            accepted += usize::from(status.success());
-            std::thread::sleep(std::time::Duration::from_millis(100));
+        });
+        let mut made = 0;
+        while !stop.load(std::sync::atomic::Ordering::SeqCst) {
+            for topic in &topics {
+                let sent =
+                    client.publish(topic, rumqttc::QoS::AtLeastOnce, false, datagram.clone());
+                made += usize::from(sent.is_ok());
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
         }
-        accepted
+        let _ = client.disconnect();
+        network.join().unwrap();
+        made
     })
 }
 
+/// A datagram as `team`/`robot` with `key` and a text value.
+fn datagram_from(team: &str, robot: &str, key: &str, value: &str, publish: bool) -> Vec<u8> {
+    semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+        publish,
+        team: team.into(),
+        robot: robot.into(),
+        key: key.into(),
+        value: Some(semo::refine::Value::text(value)),
+    })
+}
+
+/// An attack: whose credentials, on which topics, which datagram.
+struct Forgery {
+    user: (&'static str, &'static str),
+    topics: Vec<String>,
+    datagram: Vec<u8>,
+}
+
 /// Runs the scouting robots (built with the deployment: no --broker, the
-/// baked defaults connect them) while `forgers` publish `RC_CMD = RC_MODE`
-/// to the master as USER commands; returns the traces.
+/// baked defaults connect them) while each of `forgeries` goes on; returns
+/// the traces and how many publishes each forgery made.
 fn run_while_forging(
     folders: &[PathBuf],
     out: &Path,
     tag: &str,
     port: u16,
-    forgers: &[Option<(&'static str, &'static str)>],
+    forgeries: Vec<Forgery>,
     processes: &mut Processes,
-) -> BTreeMap<String, Vec<Event>> {
-    let datagram = out.join("forged.bin");
-    std::fs::write(
-        &datagram,
-        semo_server::live::operator_datagram("USER.RC_CMD", "RC_MODE"),
-    )
-    .unwrap();
+) -> (BTreeMap<String, Vec<Event>>, Vec<usize>) {
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let threads: Vec<_> = forgers
-        .iter()
-        .map(|user| {
-            keep_publishing(
-                port,
-                "semo/scouting/MasterTeam/USER.RC_CMD".into(),
-                datagram.clone(),
-                *user,
-                stop.clone(),
-            )
-        })
+    let threads: Vec<_> = forgeries
+        .into_iter()
+        .map(|f| forge(port, f.user, f.topics, f.datagram, stop.clone()))
         .collect();
     let traces = run_together(
         folders,
@@ -443,10 +477,17 @@ fn run_while_forging(
         processes,
     );
     stop.store(true, std::sync::atomic::Ordering::SeqCst);
-    for thread in threads {
-        thread.join().unwrap();
-    }
-    traces
+    let made = threads.into_iter().map(|t| t.join().unwrap()).collect();
+    (traces, made)
+}
+
+/// How many messages a robot refused because their datagram named another
+/// sender or key than their topic.
+fn refused(events: &[Event]) -> usize {
+    events
+        .iter()
+        .filter(|e| field(e, "event") == "reject" && field(e, "reason") == "sender not its topic")
+        .count()
 }
 
 /// A fleet whose broker runs the configuration `semo deploy broker-config`
@@ -470,7 +511,7 @@ fn deployed_fleet(name: &str, tls: bool) -> Option<(Fleet, PathBuf)> {
 }
 
 #[test]
-fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
+fn robots_take_messages_only_from_the_sender_their_topic_names_and_the_acl_lets() {
     let Some((mut fleet, deploy)) = deployed_fleet("mqtt-acl", false) else {
         return;
     };
@@ -497,13 +538,32 @@ fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
         "the password file's path, not the password: {header}"
     );
 
-    // Anonymous clients and the slaves' credentials cannot command the master.
-    let forged = run_while_forging(
+    // The slaves' credentials cannot command the master: the operator's
+    // datagram ("from USER, RC_CMD = RC_MODE") on every topic their ACL lets
+    // them write, and on the operator's own command topic. Nor can the
+    // master's credentials keep slave ti alive: ti's heartbeat (battery
+    // 777, which ti never says) on every topic the master may write.
+    let operator_topic = topics::to_team("scouting", "MasterTeam", "USER.RC_CMD", topics::OPERATOR);
+    let mut slave_topics = writable(&acl, "slaves");
+    slave_topics.push(operator_topic.clone());
+    let forgeries = vec![
+        Forgery {
+            user: ("slaves", "slaves-secret"),
+            topics: slave_topics,
+            datagram: semo_server::live::operator_datagram("USER.RC_CMD", "RC_MODE"),
+        },
+        Forgery {
+            user: ("irobot", "irobot-secret"),
+            topics: writable(&acl, "irobot"),
+            datagram: datagram_from("SlaveTeam", "ti", "SlaveTeam.__alive", "leader 777", true),
+        },
+    ];
+    let (forged, made) = run_while_forging(
         &folders,
         &out,
         "forged",
         port,
-        &[None, Some(("slaves", "slaves-secret"))],
+        forgeries,
         &mut fleet.processes,
     );
     for (robot, events) in &forged {
@@ -514,11 +574,34 @@ fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
             modes(events)
         );
     }
+    let commands_taken = received_from(&forged["irobot"], "operator", "USER.RC_CMD").len();
+    let heartbeats_taken = received_from(&forged["nxt"], "ti", "SlaveTeam.__alive")
+        .iter()
+        .filter(|v| v.contains("777"))
+        .count();
+    eprintln!(
+        "forged: {} RC_CMD publishes with the slaves' credentials, {} taken, {} refused by irobot; {} heartbeat publishes with irobot's, {} taken, {} refused by nxt",
+        made[0],
+        commands_taken,
+        refused(&forged["irobot"]),
+        made[1],
+        heartbeats_taken,
+        refused(&forged["nxt"])
+    );
     assert!(
-        !modes(&forged["irobot"]).iter().any(|m| m == "RC_MODE"),
-        "a forged USER command switched the master: {:?}",
+        made.iter().all(|&n| n > 0),
+        "the forgers published: {made:?}"
+    );
+    assert!(
+        !modes(&forged["irobot"]).iter().any(|m| m == "RC_MODE") && commands_taken == 0,
+        "a forged USER command reached the master: {:?}",
         modes(&forged["irobot"])
     );
+    assert_eq!(heartbeats_taken, 0, "a forged heartbeat of ti reached nxt");
+    // The broker delivered forgeries on topics the forgers may write, and
+    // the robots refused them: the ACL alone would not have stopped them.
+    assert!(refused(&forged["irobot"]) > 0, "irobot refused none");
+    assert!(refused(&forged["nxt"]) > 0, "nxt refused none");
     for slave in ["ti", "nxt"] {
         assert!(
             received_from(&forged["irobot"], slave, "SlaveTeam.COLOR")
@@ -527,20 +610,172 @@ fn the_generated_acl_lets_only_the_operator_switch_a_robots_mode() {
             "the master hears {slave} through the ACL"
         );
     }
-    // The same command from the operator's user does switch it: the
-    // forgeries above failed because of the ACL, not for another reason.
-    let commanded = run_while_forging(
+    // The same command from the operator's user on its topic does switch
+    // it: the forgeries above failed because of who sent them, not for
+    // another reason.
+    let (commanded, _) = run_while_forging(
         &folders,
         &out,
         "operator",
         port,
-        &[Some(("operator", "operator-secret"))],
+        vec![Forgery {
+            user: ("operator", "operator-secret"),
+            topics: vec![operator_topic],
+            datagram: semo_server::live::operator_datagram("USER.RC_CMD", "RC_MODE"),
+        }],
         &mut fleet.processes,
     );
     assert!(
         modes(&commanded["irobot"]).iter().any(|m| m == "RC_MODE"),
         "the operator's USER command switches the master: {:?}",
         modes(&commanded["irobot"])
+    );
+    assert!(
+        received_from(&commanded["irobot"], "operator", "USER.RC_CMD")
+            .iter()
+            .any(|v| v == "RC_MODE"),
+        "the master took the operator's command"
+    );
+}
+
+/// `mosquitto_sub` as the operator with the persistent session `semo-root-
+/// test` on the operator consoles' topics, with `args`; its output.
+fn operator_session(port: u16, args: &[&str]) -> std::process::Output {
+    Command::new("mosquitto_sub")
+        .args(["-h", "127.0.0.1", "-p", &port.to_string(), "-q", "1", "-c"])
+        .args([
+            "-i",
+            "semo-root-test",
+            "-u",
+            "operator",
+            "-P",
+            "operator-secret",
+        ])
+        .args(["-t", &topics::team_inbox("scouting", "USER")])
+        .args(args)
+        .output()
+        .expect("mosquitto_sub runs (Debian mosquitto-clients)")
+}
+
+/// Started as root, the broker of the generated configuration runs as its
+/// `user` (`mosquitto`). With the password file and the persistence folder
+/// given to that user as `semo deploy broker-config` says (and
+/// `docs/deployment.md`), it starts, and a QoS 1 message for a session that
+/// is away survives a restart of the broker. Needs root and the `mosquitto`
+/// account (CI); skipped otherwise.
+#[test]
+fn the_generated_broker_started_as_root_keeps_qos1_messages_across_a_restart() {
+    let Some(binary) = support::mqtt::broker_or_skip("root broker") else {
+        return;
+    };
+    let account = Command::new("id")
+        .arg("mosquitto")
+        .output()
+        .expect("id runs");
+    if support::mosquitto::current_user() != "root" || !account.status.success() {
+        eprintln!("skipping: needs root and the `mosquitto` account");
+        return;
+    }
+    // Its own folder under the system's temporary folder: every folder on
+    // the way must be searchable by the broker's account (a build folder
+    // may not be).
+    let dir = tempfile::Builder::new()
+        .prefix("semo-root-broker")
+        .tempdir()
+        .unwrap();
+    let reachable = Command::new("chmod")
+        .arg("0755")
+        .arg(dir.path())
+        .status()
+        .unwrap();
+    assert!(reachable.success());
+    let dir = dir.path();
+    let port = free_port();
+    let deploy = scouting_deployment(dir, port, false);
+    let passwd = dir.join("passwd");
+    let chmod = Command::new("chmod")
+        .arg("0600")
+        .arg(&passwd)
+        .status()
+        .unwrap();
+    assert!(chmod.success());
+    let out = dir.join("broker");
+    let written = support::semo_in(
+        dir,
+        &[
+            "deploy",
+            "broker-config",
+            &examples()
+                .join("scouting/scouting.mission")
+                .display()
+                .to_string(),
+            "--deploy",
+            &deploy.display().to_string(),
+            "-o",
+            &out.display().to_string(),
+        ],
+    );
+    assert_eq!(written.code, 0, "{}", written.stderr);
+    let persistence = out.join("persistence");
+    let told = format!(
+        "`chown mosquitto {} {}`",
+        persistence.display(),
+        passwd.display()
+    );
+    assert!(written.stdout.contains(&told), "{}", written.stdout);
+    let config = std::fs::read_to_string(out.join("mosquitto.conf")).unwrap();
+    assert!(config.contains("\nuser mosquitto\n"), "{config}");
+    // What it says to do.
+    let chown = Command::new("chown")
+        .arg("mosquitto")
+        .args([&persistence, &passwd])
+        .status()
+        .unwrap();
+    assert!(chown.success());
+
+    let mut processes = Processes::default();
+    let start = |processes: &mut Processes, run: &str| {
+        let log = std::fs::File::create(dir.join(format!("mosquitto.{run}.log"))).unwrap();
+        let child = Command::new(&binary)
+            .arg("-c")
+            .arg(out.join("mosquitto.conf"))
+            .stderr(log)
+            .spawn()
+            .expect("mosquitto starts");
+        let index = processes.push(child);
+        let log = || std::fs::read_to_string(dir.join(format!("mosquitto.{run}.log"))).unwrap();
+        assert!(support::mosquitto::listening(port), "{}", log());
+        index
+    };
+    let broker = start(&mut processes, "first");
+    let subscribed = operator_session(port, &["-E"]);
+    assert!(subscribed.status.success(), "{subscribed:?}");
+    let irobot = topics::Sender {
+        team: "MasterTeam",
+        robot: "irobot",
+    };
+    let published = Command::new("mosquitto_pub")
+        .args(["-h", "127.0.0.1", "-p", &port.to_string(), "-q", "1"])
+        .args(["-u", "irobot", "-P", "irobot-secret", "-m", "kept"])
+        .args([
+            "-t",
+            &topics::to_team("scouting", "USER", "MasterTeam.CAMERA", irobot),
+        ])
+        .output()
+        .expect("mosquitto_pub runs");
+    assert!(published.status.success(), "{published:?}");
+    processes.terminate(broker);
+    assert!(
+        persistence.join("mosquitto.db").is_file(),
+        "the broker kept its state in {}",
+        persistence.display()
+    );
+    start(&mut processes, "second");
+    let kept = operator_session(port, &["-C", "1", "-W", "5"]);
+    assert_eq!(
+        String::from_utf8_lossy(&kept.stdout).trim(),
+        "kept",
+        "{kept:?}"
     );
 }
 
@@ -1434,7 +1669,7 @@ fn the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor() {
     let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
     assert!(
         acl.contains("user operator\n")
-            && acl.contains("topic read semo/patrol_groups/Guards/Guards.__alive\n"),
+            && acl.contains("topic read semo/patrol_groups/Guards/Guards.__alive/Guards/tb_0\n"),
         "{acl}"
     );
     let folders =

@@ -227,9 +227,9 @@ impl Program {
         cmd
     }
 
-    fn spawn(&self, args: &[&str]) -> (Child, Instant) {
+    fn spawn(&self, args: &[&str], env: &[(&str, &str)]) -> (Child, Instant) {
         let child = self
-            .command(args, &[])
+            .command(args, env)
             .spawn()
             .unwrap_or_else(|e| panic!("{} starts: {e}", self.exe.display()));
         (child, Instant::now())
@@ -537,7 +537,8 @@ fn two_robots_exchange_messages_over_udp_and_reject_malformed_datagrams() {
             ]
         };
         let b_args = args("udp-b", &trace_b);
-        let (mut b, b_started) = p.spawn(&b_args.iter().map(String::as_str).collect::<Vec<_>>());
+        let (mut b, b_started) =
+            p.spawn(&b_args.iter().map(String::as_str).collect::<Vec<_>>(), &[]);
         wait_for_start(&trace_b, &mut b);
         send_datagrams_to(base.parse::<u16>().unwrap() + 1);
         let a_args = args("udp-a", &trace_a);
@@ -570,6 +571,106 @@ fn two_robots_exchange_messages_over_udp_and_reject_malformed_datagrams() {
         assert!(received.iter().any(|e| e["key"] == "Alpha.BYE"));
         assert_eq!(events(&b_trace, "reject").len(), 9, "{b_trace:#?}");
     }
+}
+
+/// A message from robot `a` of team Alpha with `key` and a text value.
+fn note(key: &str, value: &str) -> Vec<u8> {
+    semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+        publish: false,
+        team: "Alpha".into(),
+        robot: "a".into(),
+        key: key.into(),
+        value: Some(semo::refine::Value::text(value)),
+    })
+}
+
+/// With a run key (`$SEMO_UDP_KEY`), robots that share it talk as before,
+/// and a datagram from a local process that does not know it (unsigned, or
+/// signed with another key, or altered) is refused and traced; one signed
+/// with the key (by `semo::deploy::datagram::sign`, which holds the C side
+/// to the Rust one: a short datagram and one longer than a SHA-256 block) is
+/// taken.
+#[test]
+fn with_a_run_key_a_datagram_without_its_signature_is_refused() {
+    const KEY: &str = "000102030405060708090a0b0c0d0e0f101112131415161718191a1b1c1d1e1f";
+    let key: Vec<u8> = (0..32).collect();
+    // Text values are shorter than SEMO_TEXT_MAX (64): with its fields, a
+    // datagram of 86 bytes, past a SHA-256 block.
+    let long = "x".repeat(60);
+    for flavor in flavors() {
+        let p = program(flavor);
+        let base = free_port_pair().to_string();
+        let (trace_a, trace_b) = (
+            trace_path("udp-key-a", flavor),
+            trace_path("udp-key-b", flavor),
+        );
+        let args = |mode: &'static str, trace: &Path| {
+            vec![
+                mode.to_string(),
+                "--trace".into(),
+                trace.display().to_string(),
+                format!("--port-base={base}"),
+                "--duration".into(),
+                "20000".into(),
+            ]
+        };
+        let env = [("SEMO_UDP_KEY", KEY)];
+        let b_args = args("udp-b", &trace_b);
+        let (mut b, b_started) =
+            p.spawn(&b_args.iter().map(String::as_str).collect::<Vec<_>>(), &env);
+        wait_for_start(&trace_b, &mut b);
+        let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
+        let port = base.parse::<u16>().unwrap() + 1;
+        let mut altered = semo::deploy::datagram::sign(&key, &note("Alpha.NOTE", "forged"));
+        altered[12] ^= 1;
+        let wrong_key = [7u8; 32];
+        for datagram in [
+            note("Alpha.NOTE", "unsigned"),
+            semo::deploy::datagram::sign(&wrong_key, &note("Alpha.NOTE", "other key")),
+            altered,
+            semo::deploy::datagram::sign(&key, &note("Alpha.NOTE", "hi")),
+            semo::deploy::datagram::sign(&key, &note("Alpha.NOTE", &long)),
+        ] {
+            socket.send_to(&datagram, ("127.0.0.1", port)).unwrap();
+        }
+        let a_args = args("udp-a", &trace_a);
+        let a = p.run(&a_args.iter().map(String::as_str).collect::<Vec<_>>(), &env);
+        let b = finish(b, b_started, "udp-b");
+        p.assert_clean(&a, &["udp-a"]);
+        p.assert_clean(&b, &["udp-b"]);
+
+        let a_trace = read_trace(&trace_a, "a");
+        let b_trace = read_trace(&trace_b, "b");
+        assert!(
+            events(&a_trace, "receive")
+                .iter()
+                .any(|e| e["key"] == "Beta.PONG"),
+            "robots with the key talk"
+        );
+        let notes: Vec<&Value> = events(&b_trace, "receive")
+            .into_iter()
+            .filter(|e| e["key"] == "Alpha.NOTE")
+            .collect();
+        assert_eq!(notes.len(), 2, "{notes:#?}");
+        assert_eq!(notes[0]["value"], "hi");
+        assert_eq!(notes[1]["value"], long.as_str());
+        let rejects = events(&b_trace, "reject");
+        assert_eq!(rejects.len(), 3, "{rejects:#?}");
+        assert!(
+            rejects
+                .iter()
+                .all(|e| e["reason"] == "not signed with the run's key")
+        );
+    }
+    // A key that is no key stops the program before it starts.
+    let p = program(flavors()[0]);
+    let run = p.run(&["udp-a"], &[("SEMO_UDP_KEY", "abc")]);
+    assert_eq!(run.code, 2, "{}", run.stderr);
+    assert!(
+        run.stderr.contains("SEMO_UDP_KEY must be"),
+        "{}",
+        run.stderr
+    );
 }
 
 #[test]
@@ -746,13 +847,16 @@ fn sigterm_stops_the_program_cleanly() {
         let p = program(flavor);
         let trace = trace_path("sigterm", flavor);
         let base = free_port_pair().to_string();
-        let (mut child, started) = p.spawn(&[
-            "minimal",
-            "--port-base",
-            &base,
-            "--trace",
-            trace.to_str().unwrap(),
-        ]);
+        let (mut child, started) = p.spawn(
+            &[
+                "minimal",
+                "--port-base",
+                &base,
+                "--trace",
+                trace.to_str().unwrap(),
+            ],
+            &[],
+        );
         wait_for_start(&trace, &mut child);
         let killed = Command::new("kill")
             .args(["-TERM", &child.id().to_string()])

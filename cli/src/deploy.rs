@@ -108,24 +108,38 @@ pub fn broker_config(
     let files = match broker::files(&deployment, &refined.programs, &out_dir, &source) {
         Ok(files) if !found.iter().any(|d| d.is_error()) => files,
         Ok(_) => return refuse(&mut run, found, Format::Human, color, out),
-        Err(more) => {
+        Err(broker::Refusal::Deployment(more)) => {
             found.extend(more);
             return refuse(&mut run, found, Format::Human, color, out);
         }
+        Err(broker::Refusal::Unwritable(why)) => {
+            eprintln!("error: refused: {why}");
+            return 1;
+        }
     };
-    let written = std::fs::create_dir_all(&out_dir)
+    let persistence = out_dir.join(broker::PERSISTENCE_DIR);
+    let written = std::fs::create_dir_all(&persistence)
         .and_then(|()| write_file(&out_dir.join(broker::ACL_FILE), &files.acl))
         .and_then(|()| write_file(&out_dir.join(broker::CONFIG_FILE), &files.config));
     if let Err(e) = written {
         eprintln!("error: cannot write into {}: {e}", out_dir.display());
         return 2;
     }
+    let config = out_dir.join(broker::CONFIG_FILE);
+    let user = deployment.broker_config.run_as();
     let _ = writeln!(
         out,
-        "wrote {} and {} (start the broker with `mosquitto -c {}`)",
-        out_dir.join(broker::CONFIG_FILE).display(),
+        "wrote {} and {} (start the broker with `mosquitto -c {}`; started as root it runs as `{user}`, which must own {} and read the password file: `chown {user} {} {}`)",
+        config.display(),
         out_dir.join(broker::ACL_FILE).display(),
-        out_dir.join(broker::CONFIG_FILE).display()
+        config.display(),
+        persistence.display(),
+        persistence.display(),
+        deployment
+            .broker_config
+            .password_file
+            .as_ref()
+            .map_or(String::new(), |p| p.display().to_string()),
     );
     0
 }

@@ -108,10 +108,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     ));
     mqtt.set_keep_alive(std::time::Duration::from_secs(10));
     let (client, mut connection) = rumqttc::Client::new(mqtt, 64);
-    let level = topics::level(&mission_topic);
     for topic in [
-        format!("semo/{level}/status/+"),
-        format!("semo/{level}/USER/+"),
+        topics::statuses(&mission_topic),
+        topics::team_inbox(&mission_topic, "USER"),
     ] {
         if let Err(e) = client.subscribe(topic, rumqttc::QoS::AtLeastOnce) {
             eprintln!("error: {e}");
@@ -150,13 +149,21 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let (tx, rx) = std::sync::mpsc::channel();
     let listener = {
         let tx = tx.clone();
+        let mission_topic = mission_topic.clone();
         std::thread::spawn(move || {
             let mut printed = BTreeMap::new();
             for event in connection.iter() {
                 match event {
                     Ok(rumqttc::Event::Incoming(rumqttc::Packet::Publish(p))) => {
-                        if let Some(line) = describe(&p.topic, &p.payload, &mut printed) {
-                            let _ = tx.send(Input::Broker(line));
+                        match describe(&mission_topic, &p.topic, &p.payload, &mut printed) {
+                            Heard::Line(line) => {
+                                let _ = tx.send(Input::Broker(line));
+                            }
+                            Heard::Refused => eprintln!(
+                                "operator: refused a message on {}: not a runtime message from the sender its topic names",
+                                p.topic
+                            ),
+                            Heard::Nothing => {}
                         }
                     }
                     Ok(rumqttc::Event::Outgoing(rumqttc::Outgoing::Disconnect)) => break,
@@ -218,7 +225,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         };
         let payload = operator_datagram(&command.key, value.trim());
         for team in &command.teams {
-            let topic = topics::to_team(&mission_topic, team, &command.key);
+            let topic = topics::to_team(&mission_topic, team, &command.key, topics::OPERATOR);
             if let Err(e) = client.publish(topic, rumqttc::QoS::AtLeastOnce, false, payload.clone())
             {
                 eprintln!("operator: {e}");
@@ -233,40 +240,110 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     status
 }
 
-/// The line to print for a message: a robot's `send(USER, …)`, or its
-/// status when it changed.
-fn describe(topic: &str, payload: &[u8], printed: &mut BTreeMap<String, String>) -> Option<String> {
-    let mut levels = topic.rsplit('/');
-    let last = levels.next()?;
-    match levels.next()? {
-        "USER" => {
-            let [_, robot, key, value] = datagram_fields(payload)?;
-            Some(format!("{robot}: send(USER, {key}) = {value}"))
+/// What a message from the broker comes to.
+enum Heard {
+    /// A line to print.
+    Line(String),
+    /// A message whose payload claims another sender than its topic: the
+    /// broker vouches only for the topic, so it is said and dropped.
+    Refused,
+    /// Nothing new (a status unchanged, a topic we do not read).
+    Nothing,
+}
+
+/// The line to print for a message of mission `mission` (its topic name):
+/// a robot's `send(USER, …)`, or its status when it changed.
+fn describe(
+    mission: &str,
+    topic: &str,
+    payload: &[u8],
+    printed: &mut BTreeMap<String, String>,
+) -> Heard {
+    let status_prefix = topics::statuses(mission);
+    let status_prefix = status_prefix.trim_end_matches('+');
+    let Some(last) = topic.strip_prefix(status_prefix) else {
+        return match datagram_fields(topic, mission, "USER", payload) {
+            Some([_, robot, key, value]) => {
+                Heard::Line(format!("{robot}: send(USER, {key}) = {value}"))
+            }
+            None => Heard::Refused,
+        };
+    };
+    let Some(status) = Status::decode(last, payload) else {
+        return Heard::Refused;
+    };
+    let line = format!(
+        "status {last}: {} {}{}{}{}",
+        status.state,
+        status.mode,
+        match status.services_text().as_str() {
+            "" => String::new(),
+            s => format!(" [{s}]"),
+        },
+        match status.leader.as_str() {
+            "" => String::new(),
+            l => format!(" leader {l}"),
+        },
+        match status.battery {
+            Some(level) => format!(" battery {level}"),
+            None => String::new(),
         }
-        "status" => {
-            let status = Status::decode(last, payload)?;
-            let line = format!(
-                "status {last}: {} {}{}{}{}",
-                status.state,
-                status.mode,
-                match status.services_text().as_str() {
-                    "" => String::new(),
-                    s => format!(" [{s}]"),
-                },
-                match status.leader.as_str() {
-                    "" => String::new(),
-                    l => format!(" leader {l}"),
-                },
-                match status.battery {
-                    Some(level) => format!(" battery {level}"),
-                    None => String::new(),
-                }
-            );
-            (printed.get(last) != Some(&line)).then(|| {
-                printed.insert(last.to_string(), line.clone());
-                line
-            })
+    );
+    if printed.get(last) == Some(&line) {
+        return Heard::Nothing;
+    }
+    printed.insert(last.to_string(), line.clone());
+    Heard::Line(line)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn heard(topic: &str, payload: &[u8], printed: &mut BTreeMap<String, String>) -> String {
+        match describe("scouting", topic, payload, printed) {
+            Heard::Line(line) => line,
+            Heard::Refused => "refused".into(),
+            Heard::Nothing => "nothing".into(),
         }
-        _ => None,
+    }
+
+    #[test]
+    fn a_message_is_printed_only_from_the_sender_its_topic_names() {
+        let irobot = topics::Sender {
+            team: "MasterTeam",
+            robot: "irobot",
+        };
+        let told = semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+            publish: false,
+            team: "MasterTeam".into(),
+            robot: "irobot".into(),
+            key: "MasterTeam.DISTANCE".into(),
+            value: Some(semo::refine::Value::Int(50)),
+        });
+        let own = topics::to_team("scouting", "USER", "MasterTeam.DISTANCE", irobot);
+        let printed = &mut BTreeMap::new();
+        assert_eq!(
+            heard(&own, &told, printed),
+            "irobot: send(USER, MasterTeam.DISTANCE) = 50"
+        );
+        // The same datagram on a topic the slaves' user may write.
+        let ti = topics::Sender {
+            team: "SlaveTeam",
+            robot: "ti",
+        };
+        let slaves = topics::to_team("scouting", "USER", "MasterTeam.DISTANCE", ti);
+        assert_eq!(heard(&slaves, &told, printed), "refused");
+        let status = br#"{"robot":"irobot","state":"running","mode":"WAIT_MODE"}"#;
+        assert_eq!(
+            heard("semo/scouting/status/irobot", status, printed),
+            "status irobot: running WAIT_MODE"
+        );
+        assert_eq!(
+            heard("semo/scouting/status/irobot", status, printed),
+            "nothing"
+        );
+        // Another robot's status on ti's topic is nobody's.
+        assert_eq!(heard("semo/scouting/status/ti", status, printed), "refused");
     }
 }

@@ -192,6 +192,7 @@ codes! {
     DeployBadBroker = "E122", Error, "a broker address that is not `mqtt://HOST[:PORT]` or `mqtts://HOST[:PORT]`";
     DeployMissingFile = "E123", Error, "a deployment file naming a password, CA, certificate or key file that does not exist";
     DeployBadTlsFile = "E126", Error, "a deployment file naming a CA or client certificate file that holds no PEM certificate, or a key file that holds no PEM private key (or that cannot be read)";
+    DeployUnwritableValue = "E127", Error, "a deployment value that the broker's files cannot carry as it is (a user name or a path of the broker's configuration with a control character such as a line break, a space at an end, or a user name with `:`): written, it would be read back as another value or another directive";
     // Group services (`<GroupService>` in a strategy's `<GroupingInfo>`).
     GroupServiceNotCalled = "E124", Error, "a `GroupService` naming a built-in service that the team does not call (in that plan): no robot would be in the group";
     GroupServiceDuplicate = "E125", Error, "a service declared a group service twice (for the same plan)";

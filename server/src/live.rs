@@ -33,7 +33,9 @@ pub struct Status {
 impl Status {
     /// Reads a status payload; `robot` is the topic's last level, used
     /// when the payload does not name the robot. `None` for anything that
-    /// is not a JSON object.
+    /// is not a JSON object, and for a status naming another robot than its
+    /// topic: only the robot's user may write its topic, so the topic says
+    /// whose status it is, never the payload.
     pub fn decode(robot: &str, payload: &[u8]) -> Option<Status> {
         let value: serde_json::Value = serde_json::from_slice(payload).ok()?;
         let object = value.as_object()?;
@@ -51,10 +53,15 @@ impl Status {
                 Some((plan.to_string(), service.to_string()))
             })
             .collect();
+        let named = text("robot");
+        if !named.is_empty() && semo::deploy::topics::level(&named) != robot {
+            return None;
+        }
         Some(Status {
-            robot: match text("robot") {
-                named if !named.is_empty() => named,
-                _ => robot.to_string(),
+            robot: if named.is_empty() {
+                robot.to_string()
+            } else {
+                named
             },
             state: text("state"),
             mode: text("mode"),
@@ -83,23 +90,30 @@ impl Status {
 pub const DEFAULT_BROKER: &str = "mqtt://127.0.0.1:1883";
 
 /// A `send` from the operator as the runtime's datagram
-/// (`semo::deploy::datagram`, the bytes `semo_core.c` reads): team `USER`,
-/// robot `operator`, the value as text (the robot reads it as the type its
-/// mission declares for the key).
+/// (`semo::deploy::datagram`, the bytes `semo_core.c` reads): from
+/// `topics::OPERATOR` (team `USER`, robot `operator`), the value as text
+/// (the robot reads it as the type its mission declares for the key).
 pub fn operator_datagram(key: &str, value: &str) -> Vec<u8> {
+    let operator = semo::deploy::topics::OPERATOR;
     semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
         publish: false,
-        team: "USER".into(),
-        robot: "operator".into(),
+        team: operator.team.into(),
+        robot: operator.robot.into(),
         key: key.into(),
         value: Some(semo::refine::Value::text(value)),
     })
 }
 
-/// The fields of a runtime datagram: (team, robot, key, value), the value
-/// as text (`(none)` for a value never set).
-pub fn datagram_fields(data: &[u8]) -> Option<[String; 4]> {
+/// The fields of a runtime datagram to team `to` of mission `mission` (its
+/// topic name) that came on `topic`: (team, robot, key, value), the value
+/// as text (`(none)` for a value never set). `None` for anything else, and
+/// for a datagram whose sender or key is not its topic's
+/// (`topics::carries`): the broker vouches for the topic only.
+pub fn datagram_fields(topic: &str, mission: &str, to: &str, data: &[u8]) -> Option<[String; 4]> {
     let d = semo::deploy::datagram::decode(data)?;
+    if !semo::deploy::topics::carries(topic, mission, to, &d) {
+        return None;
+    }
     let value = d.value.map_or_else(|| "(none)".into(), |v| v.as_text());
     Some([d.team, d.robot, d.key, value])
 }
@@ -125,7 +139,7 @@ mod tests {
         assert_eq!((status.t, status.battery), (Some(5230), None));
         // The last will names only the robot and the state.
         let will = Status::decode(
-            "x",
+            "irobot",
             br#"{"robot":"irobot","event":"status","state":"lost"}"#,
         )
         .unwrap();
@@ -148,14 +162,21 @@ mod tests {
             Some(None)
         );
         assert_eq!(Status::decode("r", b"[1]"), None);
+        // Another robot's status on r's topic is nobody's.
+        assert_eq!(
+            Status::decode("r", br#"{"robot":"s","state":"running"}"#),
+            None
+        );
         assert_eq!(Status::decode("r", b"\xff"), None);
     }
 
     #[test]
-    fn a_command_is_the_runtimes_datagram_and_reads_back() {
+    fn a_command_is_the_runtimes_datagram_and_reads_back_on_its_topic_only() {
+        use semo::deploy::topics::{self, OPERATOR};
         let d = operator_datagram("USER.RC_CMD", "RETURN_MODE");
+        let topic = topics::to_team("m", "MasterTeam", "USER.RC_CMD", OPERATOR);
         assert_eq!(
-            datagram_fields(&d),
+            datagram_fields(&topic, "m", "MasterTeam", &d),
             Some([
                 "USER".into(),
                 "operator".into(),
@@ -163,6 +184,16 @@ mod tests {
                 "RETURN_MODE".into()
             ])
         );
-        assert_eq!(datagram_fields(&d[..d.len() - 1]), None);
+        assert_eq!(
+            datagram_fields(&topic, "m", "MasterTeam", &d[..d.len() - 1]),
+            None
+        );
+        // The same datagram on a topic another user may write.
+        let slaves = topics::Sender {
+            team: "SlaveTeam",
+            robot: "ti",
+        };
+        let elsewhere = topics::to_team("m", "MasterTeam", "SlaveTeam.COLOR", slaves);
+        assert_eq!(datagram_fields(&elsewhere, "m", "MasterTeam", &d), None);
     }
 }

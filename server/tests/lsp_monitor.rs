@@ -80,9 +80,13 @@ impl FakeRobot {
             key: "Guards.__alive".into(),
             value: Some(semo::refine::Value::text("member -")),
         });
+        let sender = semo::deploy::topics::Sender {
+            team: "Guards",
+            robot: &self.robot,
+        };
         self.client
             .publish(
-                "semo/patrol_groups/Guards/Guards.__alive",
+                semo::deploy::topics::to_team("patrol_groups", "Guards", "Guards.__alive", sender),
                 QoS::AtMostOnce,
                 false,
                 datagram,

@@ -31,7 +31,8 @@ pub fn build(mission: &Path, target: &str, out: &Path) -> Output {
     )
 }
 
-/// Every robot folder under an output folder, sorted.
+/// Every robot folder under an output folder (one generation wrote: it
+/// has its `.semo-manifest`; a broker's folder beside them is not), sorted.
 pub fn robot_folders(out: &Path) -> Vec<PathBuf> {
     let mut folders = Vec::new();
     let Ok(teams) = std::fs::read_dir(out) else {
@@ -49,7 +50,7 @@ pub fn robot_folders(out: &Path) -> Vec<PathBuf> {
                 .unwrap()
                 .to_string_lossy()
                 .starts_with('.');
-            if robot.is_dir() && !hidden {
+            if robot.is_dir() && !hidden && robot.join(".semo-manifest").is_file() {
                 folders.push(robot);
             }
         }

@@ -70,6 +70,42 @@ pub fn encode(d: &Datagram) -> Vec<u8> {
     out
 }
 
+/// The bytes of a SHA-256 digest: the tag a signed datagram ends with.
+pub const TAG_LEN: usize = 32;
+
+/// `datagram` signed with a `linux-sim` run's key (`$SEMO_UDP_KEY`, 16 to
+/// 64 bytes): the datagram and its HMAC-SHA256 under the key (RFC 2104),
+/// as `semo_udp.c` sends and checks them. HMAC is the formula over `sha2`
+/// rather than another crate: the C side carries its own SHA-256 anyway
+/// (robots link nothing but libc), and both are held to RFC 4231's vectors.
+pub fn sign(key: &[u8], datagram: &[u8]) -> Vec<u8> {
+    let mut out = datagram.to_vec();
+    out.extend_from_slice(&hmac_sha256(key, datagram));
+    out
+}
+
+/// HMAC-SHA256 for a key of at most one block (64 bytes).
+fn hmac_sha256(key: &[u8], data: &[u8]) -> [u8; TAG_LEN] {
+    use sha2::{Digest, Sha256};
+    assert!(key.len() <= 64, "a run key is at most 64 bytes");
+    let mut pad = [0x36u8; 64];
+    for (p, k) in pad.iter_mut().zip(key) {
+        *p ^= k;
+    }
+    let inner = Sha256::new()
+        .chain_update(pad)
+        .chain_update(data)
+        .finalize();
+    for p in &mut pad {
+        *p ^= 0x36 ^ 0x5c;
+    }
+    Sha256::new()
+        .chain_update(pad)
+        .chain_update(inner)
+        .finalize()
+        .into()
+}
+
 /// The datagram, or `None` for anything else.
 pub fn decode(data: &[u8]) -> Option<Datagram> {
     let rest = data.strip_prefix(MAGIC)?;
@@ -145,6 +181,22 @@ mod tests {
             assert_eq!(decode(&encode(&d)), Some(d));
         }
         assert_eq!(decode(b"SEMO\x01sabc"), None);
+    }
+
+    /// RFC 4231's test cases 1 and 2 (the C side is held to the same
+    /// function by `tests/runtime_c.rs`, which signs with `sign`).
+    #[test]
+    fn the_tag_is_hmac_sha256() {
+        let hex = |bytes: &[u8]| bytes.iter().map(|b| format!("{b:02x}")).collect::<String>();
+        assert_eq!(
+            hex(&hmac_sha256(&[0x0b; 20], b"Hi There")),
+            "b0344c61d8db38535ca8afceaf0bf12b881dc200c9833da726e9376c2e32cff7"
+        );
+        let signed = sign(b"Jefe", b"what do ya want for nothing?");
+        assert_eq!(
+            hex(&signed[signed.len() - TAG_LEN..]),
+            "5bdcc146bf60754e6a042426089575c75a003f089d2739839dec58b964ec3843"
+        );
     }
 
     /// The bytes `semo_core.c` writes for an integer (the C side is held to

@@ -10,10 +10,12 @@
 //! - `check`: its names against the checked mission (unknown robots and
 //!   teams, a TLS robot without a CA).
 //! - `topics`: the topic scheme of `semo_mqtt.c`, written once on this side.
+//! - `lines`: what a line of the broker's files can carry.
 //! - `datagram`: the runtime's datagram, for the operator console and tests.
 
 pub mod broker;
 pub mod datagram;
+pub mod lines;
 mod parse;
 pub mod topics;
 
@@ -53,13 +55,23 @@ pub struct BrokerUrl {
     pub span: Span,
 }
 
-/// The broker's side: its password file (made with `mosquitto_passwd`) and,
-/// for `mqtts://`, its certificate and key.
+/// The broker's side: its password file (made with `mosquitto_passwd`),
+/// the account it runs as when started as root (`user`, default
+/// `broker::DEFAULT_BROKER_USER`) and, for `mqtts://`, its certificate and
+/// key.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct BrokerSide {
     pub password_file: Option<PathBuf>,
+    pub user: Option<String>,
     pub cert: Option<PathBuf>,
     pub key: Option<PathBuf>,
+}
+
+impl BrokerSide {
+    /// The account mosquitto runs as when started as root.
+    pub fn run_as(&self) -> &str {
+        self.user.as_deref().unwrap_or(broker::DEFAULT_BROKER_USER)
+    }
 }
 
 /// Who a client is at the broker. The password is never in the deployment

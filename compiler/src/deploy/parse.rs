@@ -18,7 +18,7 @@ const TOP: &[&str] = &[
 ];
 const CREDENTIALS: &[&str] = &["user", "password_file", "ca", "cert", "key"];
 const ROBOT: &[&str] = &["id", "user", "password_file", "ca", "cert", "key"];
-const BROKER_SIDE: &[&str] = &["password_file", "cert", "key"];
+const BROKER_SIDE: &[&str] = &["password_file", "user", "cert", "key"];
 
 /// Parses a deployment file's `text`; relative paths are resolved against
 /// `base` (the file's folder) and files a robot reads must exist.
@@ -55,13 +55,21 @@ pub fn parse(text: &str, file: FileId, base: &Path) -> Result<Deployment, Vec<Di
             .string(item, "broker")
             .and_then(|(url, at)| reader.broker_url(&url, at)),
     };
-    let ca = reader.tls_file(top, "ca", Pem::Certificates);
+    // The CA goes into the broker's configuration too (`cafile`).
+    let ca = reader
+        .broker_line_path(top, "ca")
+        .then(|| reader.tls_file(top, "ca", Pem::Certificates))
+        .flatten();
     let broker_config = match reader.table(top, "broker_config") {
         Some(table) => {
             reader.known_keys(table, BROKER_SIDE, "[broker_config]");
+            for key in ["password_file", "cert", "key"] {
+                reader.broker_line_path(table, key);
+            }
             BrokerSide {
                 // The broker's files are on the broker's machine: not checked here.
                 password_file: reader.path_of(table, "password_file", false),
+                user: reader.broker_line_value(table, "user", super::lines::value_problem),
                 cert: reader.path_of(table, "cert", false),
                 key: reader.path_of(table, "key", false),
             }
@@ -241,10 +249,8 @@ impl Reader<'_> {
     }
 
     fn credentials(&mut self, table: &dyn TableLike, within: &str) -> Credentials {
-        let user = table
-            .get("user")
-            .and_then(|item| self.string(item, "user"))
-            .map(|(user, _)| user);
+        // Every user is a line of the broker's ACL and of its password file.
+        let user = self.broker_line_value(table, "user", super::lines::user_problem);
         let credentials = Credentials {
             user,
             password_file: self.path_of(table, "password_file", true),
@@ -272,6 +278,52 @@ impl Reader<'_> {
             );
         }
         credentials
+    }
+
+    /// A string value written as it is into a line of the broker's files
+    /// (its configuration, its ACL): one that `problem` finds cannot be is
+    /// reported at its position (E127), the file then refused.
+    fn broker_line_value(
+        &mut self,
+        table: &dyn TableLike,
+        key: &str,
+        problem: fn(&str) -> Option<String>,
+    ) -> Option<String> {
+        let (value, at) = self.string(table.get(key)?, key)?;
+        if let Some(why) = problem(&value) {
+            self.error(
+                Code::DeployUnwritableValue,
+                at,
+                format!("`{key}` {value:?} cannot be written into the broker's files: {why}"),
+            );
+        }
+        Some(value)
+    }
+
+    /// The same for a path the broker's configuration names (its own
+    /// files, the CA), resolved against the deployment's folder as it will
+    /// be written; false when reported (or not a string: `path_of` says so).
+    fn broker_line_path(&mut self, table: &dyn TableLike, key: &str) -> bool {
+        let Some((text, at)) = table
+            .get(key)
+            .and_then(|item| item.as_str().map(|t| (t, item)))
+        else {
+            return true;
+        };
+        let path =
+            std::path::absolute(self.base.join(text)).unwrap_or_else(|_| self.base.join(text));
+        if let Some(why) = super::lines::path_problem(&path) {
+            self.error(
+                Code::DeployUnwritableValue,
+                Self::item_span(at),
+                format!(
+                    "`{key}` {:?} cannot be written into the broker's configuration: {why}",
+                    path.display().to_string()
+                ),
+            );
+            return false;
+        }
+        true
     }
 
     fn key_error(&mut self, table: &dyn TableLike, key: &str, message: String) {
@@ -368,7 +420,12 @@ pub fn broker_address(url: &str) -> Result<BrokerAddress, String> {
         Some((host, port)) => (host, port.parse::<u16>().ok().filter(|p| *p > 0)),
         None => (rest, Some(default_port)),
     };
-    let bad_host = host.is_empty() || host.len() > 255 || host.contains(['/', '@', '?', '#', ' ']);
+    // Nothing a line of the broker's configuration could not carry either
+    // (`listener PORT HOST`).
+    let bad_host = host.is_empty()
+        || host.len() > 255
+        || host.contains(['/', '@', '?', '#'])
+        || host.chars().any(|c| c.is_control() || c.is_whitespace());
     match port {
         Some(port) if !bad_host => Ok(BrokerAddress {
             tls,

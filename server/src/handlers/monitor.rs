@@ -120,7 +120,7 @@ pub fn plan(job: &Job) -> Result<Plan, String> {
             heartbeat_topic: p
                 .control
                 .heartbeat
-                .then(|| semo::deploy::topics::heartbeats(p)),
+                .then(|| semo::deploy::topics::heartbeat(p)),
         })
         .collect();
     Ok(Plan {

@@ -19,7 +19,7 @@ pub struct Member {
     pub robot: String,
     pub team: String,
     /// Whether it publishes heartbeats (its team elects a leader), on
-    /// `heartbeat_topic`.
+    /// `heartbeat_topic` (`topics::heartbeat`: its own).
     pub heartbeat_topic: Option<String>,
 }
 
@@ -33,6 +33,8 @@ struct Robot {
 }
 
 pub struct Roster {
+    /// The mission's topic name.
+    mission: String,
     status_prefix: String,
     robots: Vec<Robot>,
     silent_after_ms: i64,
@@ -43,7 +45,8 @@ impl Roster {
     /// `heartbeat_ms` the runtime's heartbeat period.
     pub fn new(mission: &str, members: Vec<Member>, heartbeat_ms: i64) -> Roster {
         Roster {
-            status_prefix: format!("semo/{}/status/", topics::level(mission)),
+            mission: mission.to_string(),
+            status_prefix: topics::statuses(mission).trim_end_matches('+').to_string(),
             robots: members
                 .into_iter()
                 .map(|member| Robot {
@@ -58,7 +61,7 @@ impl Roster {
     }
 
     /// The topics to subscribe to: every status, and the heartbeats of the
-    /// teams that elect a leader.
+    /// robots whose teams elect a leader.
     pub fn topics(&self) -> Vec<String> {
         let mut topics = vec![format!("{}+", self.status_prefix)];
         for robot in &self.robots {
@@ -72,7 +75,9 @@ impl Roster {
     }
 
     /// A message from the broker at time `now`; messages of robots that
-    /// are not in the mission, and anything unreadable, are ignored.
+    /// are not in the mission, anything unreadable, and a payload naming
+    /// another robot or key than its topic (the broker vouches only for the
+    /// topic) are ignored.
     pub fn message(&mut self, topic: &str, payload: &[u8], now: i64) {
         if let Some(level) = topic.strip_prefix(&self.status_prefix) {
             let Some(status) = Status::decode(level, payload) else {
@@ -88,13 +93,14 @@ impl Roster {
             }
             return;
         }
-        let Some([_, from, _, _]) = crate::live::datagram_fields(payload) else {
-            return;
-        };
-        if let Some(robot) = self
+        let Some(robot) = self
             .robots
             .iter_mut()
-            .find(|r| r.member.robot == from && r.member.heartbeat_topic.as_deref() == Some(topic))
+            .find(|r| r.member.heartbeat_topic.as_deref() == Some(topic))
+        else {
+            return;
+        };
+        if crate::live::datagram_fields(topic, &self.mission, &robot.member.team, payload).is_some()
         {
             robot.heard_at = Some(now);
             robot.silent = false;
@@ -178,7 +184,9 @@ impl Robot {
 mod tests {
     use super::*;
 
-    const ALIVE: &str = "semo/m/Team/Team.__alive";
+    fn alive(robot: &str) -> String {
+        format!("semo/m/Team/Team.__alive/Team/{robot}")
+    }
 
     fn roster() -> Roster {
         Roster::new(
@@ -187,12 +195,12 @@ mod tests {
                 Member {
                     robot: "a".into(),
                     team: "Team".into(),
-                    heartbeat_topic: Some(ALIVE.into()),
+                    heartbeat_topic: Some(alive("a")),
                 },
                 Member {
                     robot: "b".into(),
                     team: "Team".into(),
-                    heartbeat_topic: Some(ALIVE.into()),
+                    heartbeat_topic: Some(alive("b")),
                 },
                 Member {
                     robot: "c".into(),
@@ -235,7 +243,7 @@ mod tests {
     #[test]
     fn every_robot_waits_until_its_status_comes() {
         let mut r = roster();
-        assert_eq!(r.topics(), ["semo/m/status/+", ALIVE]);
+        assert_eq!(r.topics(), ["semo/m/status/+", &alive("a"), &alive("b")]);
         assert_eq!(states(&r), ["a=waiting", "b=waiting", "c=waiting"]);
         r.message("semo/m/status/a", RUNNING_A, 0);
         r.message("semo/m/status/stranger", RUNNING_A, 0);
@@ -270,13 +278,13 @@ mod tests {
         // whose ACL hides the heartbeats from the monitor).
         r.tick(10_000);
         assert_eq!(states(&r)[0], "a=running");
-        r.message(ALIVE, &heartbeat("a"), 10_000);
+        r.message(&alive("a"), &heartbeat("a"), 10_000);
         r.tick(10_600);
         assert_eq!(states(&r)[0], "a=running");
         r.tick(10_601);
         assert_eq!(states(&r)[0], "a=lost");
         assert_eq!(r.view()[0]["lostBecause"], "silent");
-        r.message(ALIVE, &heartbeat("a"), 10_700);
+        r.message(&alive("a"), &heartbeat("a"), 10_700);
         assert_eq!(states(&r)[0], "a=running");
         // A stopped robot stops heart-beating: it is not lost.
         r.message(
@@ -287,7 +295,12 @@ mod tests {
         r.tick(20_000);
         assert_eq!(states(&r)[0], "a=stopped");
         // A heartbeat on another team's topic is not this robot's.
-        r.message("semo/m/Other/Other.__alive", &heartbeat("b"), 20_000);
+        r.message("semo/m/Other/Other.__alive/Team/b", &heartbeat("b"), 20_000);
         assert_eq!(r.robots[1].heard_at, None);
+        // Nor is one on its topic that names another robot: whoever may
+        // write a's topic cannot keep b alive.
+        r.message(&alive("a"), &heartbeat("b"), 20_000);
+        assert_eq!(r.robots[1].heard_at, None);
+        assert_eq!(r.robots[0].heard_at, Some(10_800));
     }
 }

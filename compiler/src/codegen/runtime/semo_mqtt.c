@@ -2,15 +2,26 @@
  * -DSEMO_MQTT (the Makefile's TRANSPORT=mqtt, which also links -lmosquitto);
  * without it this file is empty.
  *
- * Topics: a message to a team goes to `semo/<mission>/<team>/<key>`, one to a
- * single robot to `semo/<mission>/<team>/<robot>/<key>`; every robot
- * subscribes to both levels of its own team and robot. The payload is the
- * runtime's datagram unchanged. `send` messages travel at QoS 1 and the
- * session is persistent (clean_session false, client id
- * `semo-<mission>-<robot>`), so a robot that was away gets what was sent
- * meanwhile; `publish` messages at QoS 0, retained, so a robot that joins
- * gets the latest value. TCP_NODELAY is set: without it a QoS 1 round trip
- * on loopback waits for Nagle's algorithm (tens of ms instead of 0.1 ms).
+ * Topics name the receiver and the sender: a message to a team goes to
+ * `semo/<mission>/<team>/<key>/<from team>/<from robot>`, one to a single
+ * robot to `semo/<mission>/<team>/<robot>/<key>/<from team>/<from robot>`
+ * (six and seven levels: a team's subscription never matches a robot's
+ * topic); every robot subscribes to both levels of its own team and robot.
+ * The payload is the runtime's datagram unchanged. Who sent a message is
+ * what the broker vouches for, never what the payload says: the broker's
+ * ACL (`semo deploy broker-config`) lets each user write only topics whose
+ * sender levels are its own robots, and a message whose datagram names
+ * another sender or key than its topic is refused here (recv returns
+ * SEMO_RECV_REFUSED, which the runtime traces as a `reject`).
+ * `compiler/src/deploy/topics.rs` mirrors these topics for the ACL, the
+ * operator console and the editor's monitor.
+ *
+ * `send` messages travel at QoS 1 and the session is persistent
+ * (clean_session false, client id `semo-<mission>-<robot>`), so a robot
+ * that was away gets what was sent meanwhile; `publish` messages at QoS 0,
+ * retained, so a robot that joins gets the latest value of each publisher.
+ * TCP_NODELAY is set: without it a QoS 1 round trip on loopback waits for
+ * Nagle's algorithm (tens of ms instead of 0.1 ms).
  */
 #ifdef SEMO_MQTT
 #define _POSIX_C_SOURCE 200809L
@@ -30,7 +41,9 @@
  * spare byte: a longer payload arrives truncated and is rejected as
  * malformed by the runtime. */
 #define MQTT_PAYLOAD_MAX (SEMO__DATAGRAM_MAX + 1)
-#define MQTT_TOPIC_MAX 512
+/* Room for the longest topic: "semo", the mission (63 bytes) and five
+ * levels of at most 255 bytes (datagram fields), each after its `/`. */
+#define MQTT_TOPIC_MAX 1600
 #define MQTT_KEEPALIVE_S 10
 /* How long open waits for the broker's CONNACK and SUBACK, and close for
  * the acknowledgements of QoS 1 messages still in flight (wall ms). */
@@ -50,6 +63,7 @@ static pthread_cond_t g_changed; /* monotonic clock; every state change below */
 static mqtt_payload g_queue[MQTT_QUEUE];
 static size_t g_head, g_count;
 static bool g_interrupted;
+static unsigned long g_refused; /* messages refused and not yet told to recv */
 static bool g_subscribed;
 static int g_connect_refused; /* the broker's CONNACK code when it refused */
 static bool g_connected_once, g_session_present; /* the first CONNACK's session-present flag */
@@ -83,30 +97,50 @@ static void append_level(char *topic, size_t cap, const char *name)
     topic[at] = '\0';
 }
 
-/* The mission's name for topics: the file name without `.mission`. */
+/* The mission's name for topics: the file name without `.mission`, cut to
+ * the buffer never inside a UTF-8 character (a topic must be UTF-8). */
 static void mission_name(const char *mission)
 {
-    snprintf(g_mission, sizeof g_mission, "%s", mission && *mission ? mission : "mission");
+    const char *name = mission && *mission ? mission : "mission";
+    size_t n = strlen(name);
+    if (n >= sizeof g_mission) {
+        n = sizeof g_mission - 1;
+        while (n > 0 && ((unsigned char)name[n] & 0xC0) == 0x80)
+            n--;
+    }
+    memcpy(g_mission, name, n);
+    g_mission[n] = '\0';
     char *dot = strstr(g_mission, ".mission");
     if (dot && dot != g_mission && dot[8] == '\0')
         *dot = '\0';
 }
 
-static void topic_of(char *topic, size_t cap, const char *team, const char *robot, const char *key)
+/* semo/<mission>/<team>[/<robot>]/<key>/<from team>/<from robot>; without
+ * a key, our subscription to every key from every sender. False when the
+ * topic does not fit (it never is cut short: a cut topic could name
+ * another sender). */
+static bool topic_of(char *topic, size_t cap, const char *team, const char *robot, const char *key,
+                     const char *from_team, const char *from_robot)
 {
     snprintf(topic, cap, "semo");
     append_level(topic, cap, g_mission);
     append_level(topic, cap, team);
     if (robot)
         append_level(topic, cap, robot);
-    if (key)
-        append_level(topic, cap, key);
-    else
-        snprintf(topic + strlen(topic), cap - strlen(topic), "/+"); /* a subscription: any key */
+    if (!key) {
+        snprintf(topic + strlen(topic), cap - strlen(topic), "/+/+/+");
+        return true;
+    }
+    append_level(topic, cap, key);
+    append_level(topic, cap, from_team);
+    append_level(topic, cap, from_robot);
+    return strlen(topic) + 1 < cap;
 }
 
 /* The datagram's fields after "SEMO" 0x02 <kind> (semo_internal.h): each a length byte and
- * that many bytes. Copies field `index` (0 team, 1 robot, 2 key) into `out`. */
+ * that many bytes. Copies field `index` (0 team, 1 robot, 2 key) into `out`;
+ * false where the runtime's decoder refuses the field too (cut short, or
+ * with a NUL byte), so that what is checked here is what it reads. */
 static bool datagram_field(const unsigned char *data, size_t len, int index, char *out, size_t cap)
 {
     size_t at = 6;
@@ -115,7 +149,7 @@ static bool datagram_field(const unsigned char *data, size_t len, int index, cha
         if (at + n > len)
             return false;
         if (i == index) {
-            if (n >= cap)
+            if (n >= cap || memchr(data + at, '\0', n))
                 return false;
             memcpy(out, data + at, n);
             out[n] = '\0';
@@ -170,8 +204,8 @@ static void on_connect(struct mosquitto *mosq, void *obj, int rc, int flags)
     }
     const semo_peer *self = &g_program->peers[g_program->self];
     char team[MQTT_TOPIC_MAX], robot[MQTT_TOPIC_MAX];
-    topic_of(team, sizeof team, self->team, NULL, NULL);
-    topic_of(robot, sizeof robot, self->team, self->robot, NULL);
+    topic_of(team, sizeof team, self->team, NULL, NULL, NULL, NULL);
+    topic_of(robot, sizeof robot, self->team, self->robot, NULL, NULL, NULL);
     char *topics[] = {team, robot};
     int mid;
     if (mosquitto_subscribe_multiple(mosq, &mid, 2, topics, 1, 0, NULL) == MOSQ_ERR_SUCCESS) {
@@ -208,6 +242,19 @@ static void on_publish(struct mosquitto *mosq, void *obj, int mid)
     pthread_mutex_unlock(&g_lock);
 }
 
+/* Whether `topic` is where the sender and key that the datagram claims
+ * would send it to us (to our team or to us alone): the broker lets only
+ * that sender's user write there. */
+static bool sent_on_its_topic(const char *topic, const char *team, const char *robot, const char *key)
+{
+    const semo_peer *self = &g_program->peers[g_program->self];
+    char expected[MQTT_TOPIC_MAX];
+    if (topic_of(expected, sizeof expected, self->team, NULL, key, team, robot) && strcmp(topic, expected) == 0)
+        return true;
+    return topic_of(expected, sizeof expected, self->team, self->robot, key, team, robot) &&
+           strcmp(topic, expected) == 0;
+}
+
 static void on_message(struct mosquitto *mosq, void *obj, const struct mosquitto_message *msg)
 {
     (void)mosq;
@@ -215,12 +262,24 @@ static void on_message(struct mosquitto *mosq, void *obj, const struct mosquitto
     const semo_peer *self = &g_program->peers[g_program->self];
     const unsigned char *data = msg->payload;
     size_t len = msg->payloadlen > 0 ? (size_t)msg->payloadlen : 0;
+    char team[256], robot[256], key[256];
+    /* A payload that is no datagram goes on: the runtime rejects it as malformed. */
+    bool claims = datagram_field(data, len, 0, team, sizeof team) &&
+                  datagram_field(data, len, 1, robot, sizeof robot) && datagram_field(data, len, 2, key, sizeof key);
     /* A message to our team that we sent ourselves: UDP never sends to self. */
-    char team[256], robot[256];
-    if (datagram_field(data, len, 0, team, sizeof team) && datagram_field(data, len, 1, robot, sizeof robot) &&
-        strcmp(team, self->team) == 0 && strcmp(robot, self->robot) == 0)
+    if (claims && strcmp(team, self->team) == 0 && strcmp(robot, self->robot) == 0 &&
+        sent_on_its_topic(msg->topic, team, robot, key))
         return;
+    bool refused = claims && !sent_on_its_topic(msg->topic, team, robot, key);
     pthread_mutex_lock(&g_lock);
+    if (refused) {
+        /* Told to recv, which the runtime traces; never delivered. */
+        if (!g_interrupted)
+            g_refused++;
+        pthread_cond_broadcast(&g_changed);
+        pthread_mutex_unlock(&g_lock);
+        return;
+    }
     /* A full queue holds back the network thread (and so the broker's
      * acknowledgement) rather than losing a message. */
     while (g_count == MQTT_QUEUE && !g_interrupted)
@@ -290,6 +349,7 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     mission_name(program->mission);
     g_head = g_count = 0;
     g_interrupted = g_subscribed = false;
+    g_refused = 0;
     g_connect_refused = 0;
     g_subscribe_mid = -1;
     g_unacked = 0;
@@ -424,6 +484,9 @@ static int mqtt_send_to(const char *to, const void *data, size_t len)
     char key[256];
     if (!datagram_field(data, len, 2, key, sizeof key))
         return -1;
+    /* The sender levels are ours, whatever the datagram says: the broker
+     * lets our user write only those. */
+    const semo_peer *self = &g_program->peers[g_program->self];
     char topic[MQTT_TOPIC_MAX];
     bool team = false;
     const semo_peer *robot = NULL;
@@ -433,11 +496,14 @@ static int mqtt_send_to(const char *to, const void *data, size_t len)
         else if (strcmp(g_program->peers[i].robot, to) == 0)
             robot = &g_program->peers[i];
     }
+    bool fits;
     if (team || strcmp(to, "USER") == 0) /* USER: every operator console */
-        topic_of(topic, sizeof topic, to, NULL, key);
+        fits = topic_of(topic, sizeof topic, to, NULL, key, self->team, self->robot);
     else if (robot)
-        topic_of(topic, sizeof topic, robot->team, robot->robot, key);
+        fits = topic_of(topic, sizeof topic, robot->team, robot->robot, key, self->team, self->robot);
     else
+        return -1;
+    if (!fits)
         return -1;
     bool is_send = ((const unsigned char *)data)[5] == SEMO_MSG_SEND;
     if (!is_send) {
@@ -460,14 +526,17 @@ static int mqtt_recv(void *data, size_t cap, int timeout_ms)
     struct timespec deadline = deadline_after(timeout_ms < 0 ? 0 : timeout_ms);
     pthread_mutex_lock(&g_lock);
     int waited = 0;
-    while (g_count == 0 && !g_interrupted && waited == 0) {
+    while (g_count == 0 && g_refused == 0 && !g_interrupted && waited == 0) {
         if (timeout_ms < 0)
             pthread_cond_wait(&g_changed, &g_lock);
         else
             waited = pthread_cond_timedwait(&g_changed, &g_lock, &deadline);
     }
     int n = 0;
-    if (g_count > 0 && !g_interrupted) {
+    if (g_refused > 0 && !g_interrupted) {
+        g_refused--;
+        n = SEMO_RECV_REFUSED;
+    } else if (g_count > 0 && !g_interrupted) {
         mqtt_payload *slot = &g_queue[g_head];
         n = (int)(slot->len < cap ? slot->len : cap);
         memcpy(data, slot->data, (size_t)n);
@@ -536,6 +605,7 @@ static void mqtt_close(void)
 
 const semo_transport semo_mqtt_transport = {
     .name = "mqtt",
+    .refusal = "sender not its topic",
     .open = mqtt_open,
     .send_to = mqtt_send_to,
     .recv = mqtt_recv,

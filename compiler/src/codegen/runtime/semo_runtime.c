@@ -832,7 +832,9 @@ static void *receiver_thread(void *arg)
         /* No timeout: semo_stop_program interrupts the wait. */
         int n = g_transport->recv(buf, sizeof buf, -1);
         semo_message m;
-        if (n < 0) {
+        if (n == SEMO_RECV_REFUSED) {
+            semo_trace("reject", "reason", g_transport->refusal, NULL);
+        } else if (n < 0) {
             semo_trace("comm_error", "reason", "receive failed", NULL);
             semo_sleep_ms(RECV_ERROR_PAUSE_MS); /* a failing socket must not spin */
         } else if (n > 0 && semo__decode_message(buf, (size_t)n, &m)) {
@@ -907,6 +909,8 @@ typedef struct {
     double time_scale;
     bool time_scale_given;
     long start_at_ms; /* --start-at: Unix ms of mission time 0; 0: when the program starts */
+    unsigned char udp_key[SEMO_UDP_KEY_MAX]; /* $SEMO_UDP_KEY; udp_key_len 0: none */
+    size_t udp_key_len;
 } options;
 
 /* The latest --start-at (the year 2096): keeps the clock's arithmetic in 64 bits. */
@@ -923,7 +927,9 @@ static void usage(FILE *f, const char *prog)
             "\n"
             "  --trace FILE      write a JSON-lines trace to FILE (\"-\": standard output)\n"
             "  --transport T     udp (loopback) or mqtt (default %s, or $SEMO_TRANSPORT)\n"
-            "  --port-base N     udp: robot i uses UDP port N+i on 127.0.0.1 (default %d, or $SEMO_PORT_BASE)\n"
+            "  --port-base N     udp: robot i uses UDP port N+i on 127.0.0.1 (default %d, or $SEMO_PORT_BASE);\n"
+            "                    $SEMO_UDP_KEY (hex, 16 to 64 bytes, the same for every robot of the run):\n"
+            "                    datagrams are signed with it, and one not signed with it is refused\n"
             "  --broker URL      mqtt: the broker, mqtt://HOST[:PORT] or mqtts://HOST[:PORT] (TLS)\n"
             "                    (default " DEFAULT_BROKER ", or $SEMO_BROKER); who the robot is there:\n"
             "                    $SEMO_MQTT_CLIENT_ID, $SEMO_MQTT_USER, $SEMO_MQTT_PASSWORD_FILE, $SEMO_MQTT_CA,\n"
@@ -1054,6 +1060,30 @@ static bool mqtt_identity(const char *prog, options *o)
     return !problem;
 }
 
+/* $SEMO_UDP_KEY, hexadecimal, into `o->udp_key`; false when it is not 16
+ * to 64 bytes of hexadecimal digits. */
+static bool parse_udp_key(const char *hex, options *o)
+{
+    size_t digits = strlen(hex);
+    if (digits % 2 != 0 || digits < 32 || digits > 2 * SEMO_UDP_KEY_MAX)
+        return false;
+    for (size_t i = 0; i < digits; i++) {
+        char c = hex[i];
+        int v = -1;
+        if (c >= '0' && c <= '9')
+            v = c - '0';
+        else if (c >= 'a' && c <= 'f')
+            v = c - 'a' + 10;
+        else if (c >= 'A' && c <= 'F')
+            v = c - 'A' + 10;
+        if (v < 0)
+            return false;
+        o->udp_key[i / 2] = (unsigned char)(i % 2 == 0 ? v << 4 : o->udp_key[i / 2] | v);
+    }
+    o->udp_key_len = digits / 2;
+    return true;
+}
+
 /* 0: run; 1: help printed; 2: bad command line (message printed). */
 static int parse_options(int argc, char **argv, options *o)
 {
@@ -1074,6 +1104,11 @@ static int parse_options(int argc, char **argv, options *o)
     env = getenv("SEMO_TRANSPORT");
     if (!parse_transport(prog, env && *env ? env : DEFAULT_TRANSPORT, &o->transport))
         return 2;
+    env = getenv("SEMO_UDP_KEY");
+    if (env && *env && !parse_udp_key(env, o)) {
+        fprintf(stderr, "%s: SEMO_UDP_KEY must be 32 to 128 hexadecimal digits (16 to 64 bytes), such as `od -An -N32 -tx1 /dev/urandom | tr -d ' \\n'` writes\n", prog);
+        return 2;
+    }
     env = getenv("SEMO_BROKER");
     if (!parse_broker(prog, env && *env ? env : DEFAULT_BROKER, o))
         return 2;
@@ -1358,6 +1393,8 @@ static int run(const options *o)
         net.port_base = o->port_base;
         net.broker_host = o->broker_host;
         net.broker_port = o->broker_port;
+        net.udp_key = o->udp_key;
+        net.udp_key_len = o->udp_key_len;
         if (o->transport->open(p, &net) != 0) {
             if (o->transport == &semo_udp_transport)
                 fprintf(stderr, "semo runtime: cannot open the udp transport on port %ld\n", o->port_base + (long)p->self);

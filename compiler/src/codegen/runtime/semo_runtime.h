@@ -330,20 +330,39 @@ typedef struct {
     const char *password_file; /* its first line is the password */
     const char *ca;            /* TLS: the CA that signed the broker's certificate */
     const char *cert, *key;    /* TLS: the client's certificate and key */
+    /* udp: the run's key ($SEMO_UDP_KEY): every datagram carries its
+     * HMAC-SHA256 under it, and one without the right one is refused;
+     * udp_key_len 0: none, every local process is trusted. */
+    const unsigned char *udp_key;
+    size_t udp_key_len;
 } semo_transport_config;
+
+/* The longest run key (bytes; a longer HMAC key would be hashed first). */
+#define SEMO_UDP_KEY_MAX 64
+
+/* What recv returns for a message whose sender the transport does not
+ * vouch for (MQTT: not its topic's; UDP with a run key: not signed with
+ * it): counted and traced (`reject`), never delivered. */
+#define SEMO_RECV_REFUSED (-2)
 
 /* The transport interface: loopback UDP (`semo_udp.c`) and MQTT
  * (`semo_mqtt.c`, with -DSEMO_MQTT). */
 typedef struct {
     const char *name;
+    /* Why recv refuses a message (SEMO_RECV_REFUSED), as the trace says it. */
+    const char *refusal;
     int (*open)(const semo_program_desc *program, const semo_transport_config *config);
     /* To one robot of the peer table; NULL when the transport has send_to. */
     int (*send)(size_t peer, const void *data, size_t len);
     /* To every other robot of a team, or to the robot of that name, at once
      * (a broker fans out); NULL when the transport has send. */
     int (*send_to)(const char *to, const void *data, size_t len);
-    /* Bytes received, 0 on timeout or interrupt, -1 on error; timeout_ms < 0
-     * waits until a datagram arrives or `interrupt` is called. */
+    /* Bytes received, 0 on timeout or interrupt, -1 on error,
+     * SEMO_RECV_REFUSED for a message the transport refused (MQTT: its
+     * datagram names another sender or key than the topic it came on; UDP
+     * with a run key: not signed with it);
+     * timeout_ms < 0 waits until a datagram arrives or `interrupt` is
+     * called. */
     int (*recv)(void *data, size_t cap, int timeout_ms);
     /* Makes a recv under way, and every later one, return 0 at once (the
      * program is stopping); safe from any thread. */

@@ -1,10 +1,16 @@
 /* semo_udp.c: the loopback transport. Robot i of the mission's peer table
  * owns UDP port `port_base + i` on 127.0.0.1; a message to a robot is one
- * datagram to its port. Only local processes can reach a loopback port.
+ * datagram to its port. Only local processes can reach a loopback port, and
+ * without a run key every one of them is trusted. With one ($SEMO_UDP_KEY,
+ * the same for every robot of a run) each datagram carries its HMAC-SHA256
+ * under that key (RFC 2104, its 32 bytes after the runtime's datagram), and
+ * recv refuses one whose tag is not right (SEMO_RECV_REFUSED): a process
+ * that does not know the key can neither forge nor alter a message (it can
+ * replay one). `semo::deploy::datagram::sign` is the same on the Rust side.
  */
 #define _POSIX_C_SOURCE 200809L
 
-#include "semo_runtime.h"
+#include "semo_internal.h"
 
 #include <arpa/inet.h>
 #include <errno.h>
@@ -23,6 +29,141 @@ static int g_fd = -1;
 static int g_wake[2] = {-1, -1};
 static int g_port_base;
 static size_t g_peer_count;
+/* The run key (none: g_key_len 0). */
+static unsigned char g_key[SEMO_UDP_KEY_MAX];
+static size_t g_key_len;
+
+/* ----------------------------------------------------------- HMAC-SHA256 */
+
+#define SHA256_BLOCK 64
+#define UDP_TAG 32 /* a SHA-256 digest */
+
+typedef struct {
+    uint32_t h[8];
+    unsigned char block[SHA256_BLOCK];
+    size_t used;     /* bytes in block */
+    uint64_t length; /* bytes hashed */
+} sha256;
+
+static const uint32_t sha256_k[64] = {
+    0x428a2f98, 0x71374491, 0xb5c0fbcf, 0xe9b5dba5, 0x3956c25b, 0x59f111f1, 0x923f82a4, 0xab1c5ed5,
+    0xd807aa98, 0x12835b01, 0x243185be, 0x550c7dc3, 0x72be5d74, 0x80deb1fe, 0x9bdc06a7, 0xc19bf174,
+    0xe49b69c1, 0xefbe4786, 0x0fc19dc6, 0x240ca1cc, 0x2de92c6f, 0x4a7484aa, 0x5cb0a9dc, 0x76f988da,
+    0x983e5152, 0xa831c66d, 0xb00327c8, 0xbf597fc7, 0xc6e00bf3, 0xd5a79147, 0x06ca6351, 0x14292967,
+    0x27b70a85, 0x2e1b2138, 0x4d2c6dfc, 0x53380d13, 0x650a7354, 0x766a0abb, 0x81c2c92e, 0x92722c85,
+    0xa2bfe8a1, 0xa81a664b, 0xc24b8b70, 0xc76c51a3, 0xd192e819, 0xd6990624, 0xf40e3585, 0x106aa070,
+    0x19a4c116, 0x1e376c08, 0x2748774c, 0x34b0bcb5, 0x391c0cb3, 0x4ed8aa4a, 0x5b9cca4f, 0x682e6ff3,
+    0x748f82ee, 0x78a5636f, 0x84c87814, 0x8cc70208, 0x90befffa, 0xa4506ceb, 0xbef9a3f7, 0xc67178f2,
+};
+
+static uint32_t rotr(uint32_t x, int n) { return (x >> n) | (x << (32 - n)); }
+
+static void sha256_block(sha256 *s, const unsigned char *p)
+{
+    uint32_t w[64];
+    for (int i = 0; i < 16; i++)
+        w[i] = (uint32_t)p[4 * i] << 24 | (uint32_t)p[4 * i + 1] << 16 | (uint32_t)p[4 * i + 2] << 8 | p[4 * i + 3];
+    for (int i = 16; i < 64; i++) {
+        uint32_t s0 = rotr(w[i - 15], 7) ^ rotr(w[i - 15], 18) ^ (w[i - 15] >> 3);
+        uint32_t s1 = rotr(w[i - 2], 17) ^ rotr(w[i - 2], 19) ^ (w[i - 2] >> 10);
+        w[i] = w[i - 16] + s0 + w[i - 7] + s1;
+    }
+    uint32_t a = s->h[0], b = s->h[1], c = s->h[2], d = s->h[3], e = s->h[4], f = s->h[5], g = s->h[6],
+             h = s->h[7];
+    for (int i = 0; i < 64; i++) {
+        uint32_t t1 = h + (rotr(e, 6) ^ rotr(e, 11) ^ rotr(e, 25)) + ((e & f) ^ (~e & g)) + sha256_k[i] + w[i];
+        uint32_t t2 = (rotr(a, 2) ^ rotr(a, 13) ^ rotr(a, 22)) + ((a & b) ^ (a & c) ^ (b & c));
+        h = g;
+        g = f;
+        f = e;
+        e = d + t1;
+        d = c;
+        c = b;
+        b = a;
+        a = t1 + t2;
+    }
+    s->h[0] += a;
+    s->h[1] += b;
+    s->h[2] += c;
+    s->h[3] += d;
+    s->h[4] += e;
+    s->h[5] += f;
+    s->h[6] += g;
+    s->h[7] += h;
+}
+
+static void sha256_init(sha256 *s)
+{
+    static const uint32_t h0[8] = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
+                                   0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
+    memcpy(s->h, h0, sizeof h0);
+    s->used = 0;
+    s->length = 0;
+}
+
+static void sha256_add(sha256 *s, const unsigned char *p, size_t n)
+{
+    s->length += n;
+    while (n > 0) {
+        size_t take = SHA256_BLOCK - s->used < n ? SHA256_BLOCK - s->used : n;
+        memcpy(s->block + s->used, p, take);
+        s->used += take;
+        p += take;
+        n -= take;
+        if (s->used == SHA256_BLOCK) {
+            sha256_block(s, s->block);
+            s->used = 0;
+        }
+    }
+}
+
+static void sha256_end(sha256 *s, unsigned char out[UDP_TAG])
+{
+    uint64_t bits = s->length * 8;
+    unsigned char pad[SHA256_BLOCK + 8] = {0x80};
+    size_t zeros = (s->used < 56 ? 56 : 120) - s->used;
+    for (int i = 0; i < 8; i++)
+        pad[zeros + (size_t)i] = (unsigned char)(bits >> (56 - 8 * i));
+    sha256_add(s, pad, zeros + 8);
+    for (int i = 0; i < 8; i++)
+        for (int j = 0; j < 4; j++)
+            out[4 * i + j] = (unsigned char)(s->h[i] >> (24 - 8 * j));
+}
+
+/* HMAC-SHA256 of `data` under the run key (shorter than a block). */
+static void udp_tag(const unsigned char *data, size_t len, unsigned char tag[UDP_TAG])
+{
+    unsigned char pad[SHA256_BLOCK];
+    sha256 s;
+    memset(pad, 0x36, sizeof pad);
+    for (size_t i = 0; i < g_key_len; i++)
+        pad[i] ^= g_key[i];
+    sha256_init(&s);
+    sha256_add(&s, pad, sizeof pad);
+    sha256_add(&s, data, len);
+    unsigned char inner[UDP_TAG];
+    sha256_end(&s, inner);
+    for (size_t i = 0; i < sizeof pad; i++)
+        pad[i] ^= 0x36 ^ 0x5c;
+    sha256_init(&s);
+    sha256_add(&s, pad, sizeof pad);
+    sha256_add(&s, inner, sizeof inner);
+    sha256_end(&s, tag);
+}
+
+/* Whether the last UDP_TAG bytes of `data` are its tag, compared in time
+ * that does not depend on where they differ. */
+static bool udp_tag_right(const unsigned char *data, size_t len)
+{
+    if (len < UDP_TAG)
+        return false;
+    unsigned char tag[UDP_TAG];
+    udp_tag(data, len - UDP_TAG, tag);
+    unsigned char differ = 0;
+    for (size_t i = 0; i < UDP_TAG; i++)
+        differ |= (unsigned char)(tag[i] ^ data[len - UDP_TAG + i]);
+    return differ == 0;
+}
 
 static struct sockaddr_in loopback(int port)
 {
@@ -57,6 +198,9 @@ static int udp_open(const semo_program_desc *program, const semo_transport_confi
     g_fd = fd;
     g_port_base = (int)port_base;
     g_peer_count = program->peer_count;
+    g_key_len = config->udp_key_len <= sizeof g_key ? config->udp_key_len : 0;
+    if (g_key_len > 0)
+        memcpy(g_key, config->udp_key, g_key_len);
     return 0;
 }
 
@@ -64,6 +208,15 @@ static int udp_send(size_t peer, const void *data, size_t len)
 {
     if (g_fd < 0 || peer >= g_peer_count)
         return -1;
+    unsigned char signed_data[SEMO__DATAGRAM_MAX + UDP_TAG];
+    if (g_key_len > 0) {
+        if (len > SEMO__DATAGRAM_MAX)
+            return -1;
+        memcpy(signed_data, data, len);
+        udp_tag(data, len, signed_data + len);
+        data = signed_data;
+        len += UDP_TAG;
+    }
     struct sockaddr_in to = loopback(g_port_base + (int)peer);
     ssize_t n;
     do
@@ -84,10 +237,19 @@ static int udp_recv(void *data, size_t cap, int timeout_ms)
         return errno == EINTR ? 0 : -1;
     if (ready == 0 || pfd[1].revents != 0)
         return 0;
-    ssize_t n = recv(g_fd, data, cap, 0);
+    /* With a key, the datagram and its tag, and a spare byte (a longer one
+     * is cut short, and then its tag is wrong). */
+    unsigned char wire[SEMO__DATAGRAM_MAX + UDP_TAG + 1];
+    ssize_t n = recv(g_fd, g_key_len > 0 ? wire : data, g_key_len > 0 ? sizeof wire : cap, 0);
     if (n < 0)
         return errno == EINTR || errno == EAGAIN || errno == EWOULDBLOCK || errno == ECONNREFUSED ? 0 : -1;
-    return (int)n;
+    if (g_key_len == 0)
+        return (int)n;
+    if (!udp_tag_right(wire, (size_t)n))
+        return SEMO_RECV_REFUSED;
+    size_t len = (size_t)n - UDP_TAG;
+    memcpy(data, wire, len < cap ? len : cap);
+    return (int)(len < cap ? len : cap);
 }
 
 static void udp_interrupt(void)
@@ -113,6 +275,7 @@ static void udp_close(void)
 
 const semo_transport semo_udp_transport = {
     .name = "udp",
+    .refusal = "not signed with the run's key",
     .open = udp_open,
     .send = udp_send,
     .recv = udp_recv,
