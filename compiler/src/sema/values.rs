@@ -207,7 +207,7 @@ mod tests {
 
     #[test]
     fn a_variable_any_writer_sets_from_a_reading_may_hold_anything() {
-        let sends = "  send(G, S.V = SUGGEST_HIDE)\n  send(G, S.V = LOCATION)";
+        let sends = "  send(G, S.V = SUGGEST_HIDE)\n  send(G, S.V = S.LOCATION)";
         assert!(findings(sends, "S.V == CMD_HIDE").is_empty());
     }
 }
