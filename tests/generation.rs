@@ -697,3 +697,54 @@ fn junk_gets_a_bounded_number_of_diagnostics() {
     let (_, diags) = support::check_json_in(&dir, &["nul.mission"]);
     assert_eq!(diags.iter().filter(|d| d.code == "E001").count(), 1);
 }
+
+/// How many `write` calls `semo ARGS` makes in `dir` (all its threads),
+/// counted by strace; `None` where strace is not installed.
+fn writes_of(dir: &Path, args: &[&str]) -> Option<u64> {
+    let counts = dir.join("strace.txt");
+    let semo = env!("CARGO_BIN_EXE_semo");
+    let out = Command::new("strace")
+        .args(["-f", "-c", "-e", "trace=write", "-o"])
+        .arg(&counts)
+        .arg(semo)
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .ok()?;
+    assert!(out.status.code().is_some(), "{out:?}");
+    let table = std::fs::read_to_string(&counts).unwrap();
+    // `% time  seconds  usecs/call  calls  [errors]  syscall`
+    let row = table
+        .lines()
+        .find(|l| l.split_whitespace().last() == Some("write"))
+        .unwrap_or_else(|| panic!("no write row in:\n{table}"));
+    let calls = row.split_whitespace().nth(3).unwrap();
+    Some(calls.parse().unwrap())
+}
+
+/// A line of 400,000 NULs is shown for people in a few writes per
+/// diagnostic: each report goes to the unbuffered standard error at once
+/// (ariadne's pieces once made 650,000 writes of it).
+#[test]
+fn junk_is_shown_for_people_in_a_few_writes() {
+    let dir = scratch("junk-writes");
+    std::fs::write(dir.join("nul.mission"), vec![0u8; 400_000]).unwrap();
+    let (_, diags) = support::check_json_in(&dir, &["nul.mission"]);
+    let Some(writes) = writes_of(&dir, &["check", "--color", "never", "nul.mission"]) else {
+        eprintln!(
+            "note: strace is not installed here; the writes were not counted (CI installs it)"
+        );
+        return;
+    };
+    // One per report, the summary line and a few of the process's own,
+    // and as many more as a pipe takes a long report in (64 KiB at a time
+    // on Linux; 4 KiB allowed).
+    let shown = semo_in(&dir, &["check", "--color", "never", "nul.mission"]);
+    let bound = diags.len() as u64 + shown.stderr.len() as u64 / 4096 + 8;
+    assert!(
+        writes <= bound,
+        "{writes} writes for {} diagnostics in {} bytes",
+        diags.len(),
+        shown.stderr.len()
+    );
+}
