@@ -273,7 +273,11 @@ fn kill_after_every_operation(name: &str, env: &[(&str, &str)]) -> u64 {
             had_leftovers,
             "after operation {n}: {stdout}"
         );
-        assert_eq!(leftovers(&out), Vec::<PathBuf>::new(), "after operation {n}");
+        assert_eq!(
+            leftovers(&out),
+            Vec::<PathBuf>::new(),
+            "after operation {n}"
+        );
         let recovered = contents(&out);
         for folder in &folders {
             let mine = part(&recovered, folder);
@@ -744,7 +748,12 @@ fn junk_gets_a_bounded_number_of_diagnostics() {
 /// `semo build ARGS` paused after its `step`th file operation
 /// (`SEMO_PAUSE_AFTER_FS_OPS`, through the FIFO `fifo`): `during` runs while
 /// it waits, then it goes on. Its exit code and standard error.
-fn build_paused(args: &[&str], step: u64, fifo: &Path, during: impl FnOnce()) -> (Option<i32>, String) {
+fn build_paused(
+    args: &[&str],
+    step: u64,
+    fifo: &Path,
+    during: impl FnOnce(),
+) -> (Option<i32>, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_semo"))
         .args(args)
         .env("SEMO_PAUSE_AFTER_FS_OPS", step.to_string())
@@ -893,7 +902,8 @@ fn what_the_user_saves_during_a_generation_stays_at_every_step() {
         match code {
             Some(0) => {}
             Some(1) => assert!(
-                stderr.contains("changed while semo was") || stderr.contains("created while semo was"),
+                stderr.contains("changed while semo was")
+                    || stderr.contains("created while semo was"),
                 "step {step}: {stderr}"
             ),
             other => panic!("step {step}: {other:?}: {stderr}"),
@@ -930,7 +940,10 @@ fn no_link_swapped_in_during_a_generation_is_followed_out_of_the_output_folder()
                     std::os::unix::fs::symlink(outside.join("create1"), &robot).unwrap();
                 }
             });
-            assert!(matches!(code, Some(0..=2)), "step {step}: {code:?}: {stderr}");
+            assert!(
+                matches!(code, Some(0..=2)),
+                "step {step}: {code:?}: {stderr}"
+            );
             assert_eq!(
                 contents(&outside).into_keys().collect::<Vec<_>>(),
                 vec![PathBuf::from("create1")],
@@ -954,8 +967,16 @@ fn a_backup_folder_that_is_a_link_is_refused_and_a_linked_output_folder_works() 
     let forced = build(&mission, &out, &["--force"]);
     assert_eq!(forced.code, 2, "{}", forced.stderr);
     assert!(forced.stderr.contains(".semo-backup"), "{}", forced.stderr);
-    assert!(forced.stderr.contains("is a symbolic link"), "{}", forced.stderr);
-    assert_eq!(contents(&outside).len(), 0, "nothing written through the link");
+    assert!(
+        forced.stderr.contains("is a symbolic link"),
+        "{}",
+        forced.stderr
+    );
+    assert_eq!(
+        contents(&outside).len(),
+        0,
+        "nothing written through the link"
+    );
     assert_eq!(std::fs::read_to_string(&main).unwrap(), "my change");
     assert_eq!(leftovers(&out), Vec::<PathBuf>::new());
     // An output folder given as a link is the folder it leads to, from the
@@ -987,8 +1008,15 @@ fn a_build_syncs_twice_whatever_the_number_of_robots() {
     let mut syncs = Vec::new();
     for robots in [1, 12] {
         let mission = dir.join(format!("march{robots}.mission"));
-        std::fs::write(&mission, text.replace("quad[5]", &format!("quad[{robots}]"))).unwrap();
-        let (mission, out) = (mission.display().to_string(), dir.join(format!("out{robots}")));
+        std::fs::write(
+            &mission,
+            text.replace("quad[5]", &format!("quad[{robots}]")),
+        )
+        .unwrap();
+        let (mission, out) = (
+            mission.display().to_string(),
+            dir.join(format!("out{robots}")),
+        );
         let out = out.display().to_string();
         let fresh = operations(&["build", &mission, "-o", &out], &log);
         assert!(fresh["write"] > 5 * robots, "{fresh:?}");

@@ -314,7 +314,9 @@ impl Backend {
         };
         if !kept.is_empty() {
             let message = format!("SeMo: {}", output::kept_message(&kept));
-            self.client.show_message(MessageType::WARNING, &message).await;
+            self.client
+                .show_message(MessageType::WARNING, &message)
+                .await;
         }
         if let Some(p) = progress {
             p.finish_with_message(format!("{} robot(s)", robots.len()))

@@ -220,8 +220,7 @@ fn why_not_a_folder(path: &Path, e: &io::Error) -> Option<&'static str> {
     }
 }
 
-const LINK: &str =
-    "it is a symbolic link; generation never follows links out of the output folder";
+const LINK: &str = "it is a symbolic link; generation never follows links out of the output folder";
 
 /// One generation into an output folder, holding its lock until dropped.
 /// Robots are staged ([`Transaction::stage_robot`]) then all replaced at
@@ -325,7 +324,11 @@ impl Transaction {
     }
 
     fn stop_if_cancelled(&mut self) -> Result<(), OutputError> {
-        if self.cancel.as_ref().is_some_and(|f| f.load(Ordering::SeqCst)) {
+        if self
+            .cancel
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::SeqCst))
+        {
             self.discard()?;
             return Err(OutputError::Cancelled);
         }
@@ -346,7 +349,11 @@ impl Transaction {
         Ok(all)
     }
 
-    fn plan<'r>(&self, robot: &'r RobotOutput, target: Target) -> Result<plan::Plan<'r>, OutputError> {
+    fn plan<'r>(
+        &self,
+        robot: &'r RobotOutput,
+        target: Target,
+    ) -> Result<plan::Plan<'r>, OutputError> {
         let backup = self.out.join(BACKUP_FOLDER).join(&self.stamp);
         plan::Plan::new(self.dir.as_fd(), &self.out, &backup, robot, target)
     }
@@ -400,7 +407,12 @@ impl Transaction {
         match fsops::stat(self.dir.as_fd(), Path::new(BACKUP_FOLDER)).map_err(at(&path))? {
             Some(stat) if !is_dir(&stat) => Err(OutputError::Unsafe(
                 path,
-                if is_link(&stat) { LINK } else { "it is not a folder" }.into(),
+                if is_link(&stat) {
+                    LINK
+                } else {
+                    "it is not a folder"
+                }
+                .into(),
             )),
             _ => Ok(()),
         }
@@ -433,8 +445,12 @@ impl Transaction {
         };
         let journal_path = self.out.join(WORK_FOLDER).join(journal::FILE_NAME);
         let work = self.work()?;
-        fsops::write_new(work, Path::new(journal::FILE_NAME), journal.to_text().as_bytes())
-            .map_err(at(&journal_path))?;
+        fsops::write_new(
+            work,
+            Path::new(journal::FILE_NAME),
+            journal.to_text().as_bytes(),
+        )
+        .map_err(at(&journal_path))?;
         // The staged files and the journal on disk before anything is replaced.
         fsops::sync(self.dir.as_fd()).map_err(at(&self.out))?;
         self.entries = journal.entries;
@@ -489,20 +505,33 @@ impl Transaction {
     /// One entry of the journal: the old entry set aside and checked, the
     /// new file put in its place. Resumable: after a crash it goes on from
     /// wherever the entry's names show it stopped.
-    fn replace(&self, entry: &Entry, folders: &mut Folders) -> Result<Option<Conflict>, OutputError> {
+    fn replace(
+        &self,
+        entry: &Entry,
+        folders: &mut Folders,
+    ) -> Result<Option<Conflict>, OutputError> {
         let target = self.out.join(&entry.path);
-        let conflict = |why: &str| Ok(Some(Conflict { path: target.clone(), why: why.to_string() }));
+        let conflict = |why: &str| {
+            Ok(Some(Conflict {
+                path: target.clone(),
+                why: why.to_string(),
+            }))
+        };
         let (parent_rel, name) = split(&entry.path);
         let parent = match folders.open(self.dir.as_fd(), &self.out, parent_rel, true) {
             Ok(fd) => fd,
             Err(why) => return conflict(&why),
         };
-        let work = self.work.as_ref().expect("a journal has its work folder").as_fd();
+        let work = self
+            .work
+            .as_ref()
+            .expect("a journal has its work folder")
+            .as_fd();
         let staged = entry.staged();
         let staged = Path::new(&staged);
-        let is_staged = entry.new.is_some()
-            && fsops::stat(work, staged).map_err(at(&target))?.is_some();
-        if entry.new.is_some() && is_staged && same_entry(work, staged, parent.as_fd(), name)? {
+        let is_staged =
+            entry.new.is_some() && fsops::stat(work, staged).map_err(at(&target))?.is_some();
+        if is_staged && same_entry(work, staged, parent.as_fd(), name)? {
             // A `link` + `unlink` move that was interrupted.
             fsops::remove_file(work, staged).map_err(at(&target))?;
             return Ok(None);
@@ -513,26 +542,36 @@ impl Transaction {
         if entry.old != Old::Absent {
             let aside = self.aside(entry, folders)?;
             let (aside_dir, aside_name) = (aside.0.as_fd(), aside.1.as_path());
-            let was_set_aside = fsops::stat(aside_dir, aside_name).map_err(at(&target))?.is_some();
+            let was_set_aside = fsops::stat(aside_dir, aside_name)
+                .map_err(at(&target))?
+                .is_some();
             if !was_set_aside {
                 match self.matches(parent.as_fd(), name, &entry.old)? {
-                    Seen::Other => return conflict(
-                        "changed while semo was generating; left as it is (generate again to replace it)",
-                    ),
+                    Seen::Other => {
+                        return conflict(
+                            "changed while semo was generating; left as it is (generate again to replace it)",
+                        );
+                    }
                     // Removed meanwhile: nothing of the user's to keep.
                     Seen::Gone => {}
-                    Seen::Same => match fsops::rename_no_replace(parent.as_fd(), name, aside_dir, aside_name) {
-                        Ok(true) => {}
-                        Err(e) if e.kind() == io::ErrorKind::NotFound => {}
-                        Ok(false) => {
-                            let taken = io::Error::other("the name to set it aside under is taken");
-                            return Err(OutputError::Io(target, taken));
+                    Seen::Same => {
+                        match fsops::rename_no_replace(parent.as_fd(), name, aside_dir, aside_name)
+                        {
+                            Ok(true) => {}
+                            Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+                            Ok(false) => {
+                                let taken =
+                                    io::Error::other("the name to set it aside under is taken");
+                                return Err(OutputError::Io(target, taken));
+                            }
+                            Err(e) => return Err(OutputError::Io(target, e)),
                         }
-                        Err(e) => return Err(OutputError::Io(target, e)),
-                    },
+                    }
                 }
             }
-            let moved = fsops::stat(aside_dir, aside_name).map_err(at(&target))?.is_some();
+            let moved = fsops::stat(aside_dir, aside_name)
+                .map_err(at(&target))?
+                .is_some();
             if moved {
                 if same_entry(aside_dir, aside_name, parent.as_fd(), name)? {
                     // A `link` + `unlink` move that was interrupted.
@@ -546,7 +585,9 @@ impl Transaction {
         if entry.new.is_some()
             && !fsops::rename_no_replace(work, staged, parent.as_fd(), name).map_err(at(&target))?
         {
-            return conflict("created while semo was generating; left as it is (generate again to replace it)");
+            return conflict(
+                "created while semo was generating; left as it is (generate again to replace it)",
+            );
         }
         Ok(None)
     }
@@ -579,8 +620,17 @@ impl Transaction {
 
     /// Moves a set-aside entry from the work folder under the backup folder
     /// (where it stays); its path there.
-    fn rescue(&self, entry: &Entry, dir: BorrowedFd<'_>, name: &Path) -> Result<PathBuf, OutputError> {
-        let saved = self.out.join(BACKUP_FOLDER).join(&self.stamp).join(&entry.path);
+    fn rescue(
+        &self,
+        entry: &Entry,
+        dir: BorrowedFd<'_>,
+        name: &Path,
+    ) -> Result<PathBuf, OutputError> {
+        let saved = self
+            .out
+            .join(BACKUP_FOLDER)
+            .join(&self.stamp)
+            .join(&entry.path);
         if entry.aside == Aside::Backup {
             return Ok(saved);
         }
@@ -597,11 +647,18 @@ impl Transaction {
     /// (else it is kept under the backup folder); a staged file a conflict
     /// left goes too.
     fn clear(&self, entry: &Entry) -> Result<Option<Conflict>, OutputError> {
-        let work = self.work.as_ref().expect("a journal has its work folder").as_fd();
+        let work = self
+            .work
+            .as_ref()
+            .expect("a journal has its work folder")
+            .as_fd();
         let target = self.out.join(&entry.path);
         if entry.new.is_some() {
             let staged = entry.staged();
-            if fsops::stat(work, Path::new(&staged)).map_err(at(&target))?.is_some() {
+            if fsops::stat(work, Path::new(&staged))
+                .map_err(at(&target))?
+                .is_some()
+            {
                 fsops::remove_file(work, Path::new(&staged)).map_err(at(&target))?;
             }
         }
@@ -628,7 +685,11 @@ impl Transaction {
     }
 
     /// Where `entry`'s old entry is set aside: a folder and a name in it.
-    fn aside(&self, entry: &Entry, folders: &mut Folders) -> Result<(OwnedFd, PathBuf), OutputError> {
+    fn aside(
+        &self,
+        entry: &Entry,
+        folders: &mut Folders,
+    ) -> Result<(OwnedFd, PathBuf), OutputError> {
         match entry.aside {
             Aside::Work => {
                 let work = self.work.as_ref().expect("a journal has its work folder");
@@ -683,10 +744,14 @@ impl Transaction {
     fn recover(&mut self) -> Result<(), OutputError> {
         self.recover_swapped_folders()?;
         let path = self.out.join(WORK_FOLDER);
-        if fsops::stat(self.dir.as_fd(), Path::new(WORK_FOLDER)).map_err(at(&path))?.is_none() {
+        if fsops::stat(self.dir.as_fd(), Path::new(WORK_FOLDER))
+            .map_err(at(&path))?
+            .is_none()
+        {
             return Ok(());
         }
-        let work = fsops::open_dir(self.dir.as_fd(), Path::new(WORK_FOLDER)).map_err(not_a_folder(&path))?;
+        let work = fsops::open_dir(self.dir.as_fd(), Path::new(WORK_FOLDER))
+            .map_err(not_a_folder(&path))?;
         let journal = fsops::read_regular(work.as_fd(), Path::new(journal::FILE_NAME), 16 << 20)
             .map_err(at(&path))?
             .and_then(|bytes| Journal::parse(&String::from_utf8_lossy(&bytes)));
@@ -731,10 +796,12 @@ impl Transaction {
         begun
             || journal.entries.iter().all(|e| match &e.new {
                 None => true,
-                Some(sha) => fsops::read_regular(work, Path::new(&e.staged()), crate::fsread::MAX_FILE_BYTES)
-                    .ok()
-                    .flatten()
-                    .is_some_and(|bytes| manifest::sha256(&bytes) == *sha),
+                Some(sha) => {
+                    fsops::read_regular(work, Path::new(&e.staged()), crate::fsread::MAX_FILE_BYTES)
+                        .ok()
+                        .flatten()
+                        .is_some_and(|bytes| manifest::sha256(&bytes) == *sha)
+                }
             })
     }
 
@@ -811,8 +878,15 @@ enum Seen {
 
 /// Whether two names are one entry (same inode): a `link` + `unlink` move
 /// interrupted between the two.
-fn same_entry(a: BorrowedFd<'_>, a_name: &Path, b: BorrowedFd<'_>, b_name: &Path) -> Result<bool, OutputError> {
-    let stat = |dir, name: &Path| fsops::stat(dir, name).map_err(|e| OutputError::Io(name.to_path_buf(), e));
+fn same_entry(
+    a: BorrowedFd<'_>,
+    a_name: &Path,
+    b: BorrowedFd<'_>,
+    b_name: &Path,
+) -> Result<bool, OutputError> {
+    let stat = |dir, name: &Path| {
+        fsops::stat(dir, name).map_err(|e| OutputError::Io(name.to_path_buf(), e))
+    };
     Ok(match (stat(a, a_name)?, stat(b, b_name)?) {
         (Some(x), Some(y)) => x.st_dev == y.st_dev && x.st_ino == y.st_ino,
         _ => false,
@@ -857,7 +931,13 @@ struct Folders {
 impl Folders {
     /// The folder `rel` (`/`-separated) of the output folder `out`, made if
     /// `make`; why not, when a folder on the way is a link or not a folder.
-    fn open(&mut self, out: BorrowedFd<'_>, out_path: &Path, rel: &str, make: bool) -> Result<OwnedFd, String> {
+    fn open(
+        &mut self,
+        out: BorrowedFd<'_>,
+        out_path: &Path,
+        rel: &str,
+        make: bool,
+    ) -> Result<OwnedFd, String> {
         if let Some(fd) = self.open.get(rel) {
             return fd.try_clone().map_err(|e| e.to_string());
         }

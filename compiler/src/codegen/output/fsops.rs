@@ -86,7 +86,9 @@ fn pauses() -> &'static [u64] {
         let Ok(list) = std::env::var("SEMO_PAUSE_AFTER_FS_OPS") else {
             return Vec::new();
         };
-        list.split(',').filter_map(|n| n.trim().parse().ok()).collect()
+        list.split(',')
+            .filter_map(|n| n.trim().parse().ok())
+            .collect()
     })
 }
 
@@ -327,4 +329,3 @@ pub fn remove_tree(path: &Path) -> io::Result<()> {
     }
     Ok(())
 }
-

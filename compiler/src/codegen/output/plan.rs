@@ -79,9 +79,8 @@ impl<'r> Plan<'r> {
             if !seen.insert(file.path.as_str()) {
                 continue;
             }
-            safe_relative(&file.path).map_err(|e| {
-                OutputError::Unsafe(folder.path.join(&file.path), e.to_string())
-            })?;
+            safe_relative(&file.path)
+                .map_err(|e| OutputError::Unsafe(folder.path.join(&file.path), e.to_string()))?;
             let look = folder.look(&file.path)?;
             if let Some(entry) = plan.decide(&folder, file, look)? {
                 manifest.files.insert(file.path.clone(), entry);
@@ -107,7 +106,10 @@ impl<'r> Plan<'r> {
     ) -> Result<Option<Entry>, OutputError> {
         let look = match look {
             Look::InTheWay(at, blocking) => {
-                let why = format!("is {}, where generation needs a folder", describe(&blocking));
+                let why = format!(
+                    "is {}, where generation needs a folder",
+                    describe(&blocking)
+                );
                 let old = old_of(&blocking);
                 if !self.changes.iter().any(|c| c.rel == at) {
                     self.conflict(folder, &at, why, None, old);
@@ -117,8 +119,16 @@ impl<'r> Plan<'r> {
             look => look,
         };
         let new = file.text.as_bytes();
-        let recorded = folder.previous.as_ref().and_then(|m| m.files.get(&file.path));
-        let written_by = |kind| Some(Entry { kind, sha256: manifest::sha256(new) });
+        let recorded = folder
+            .previous
+            .as_ref()
+            .and_then(|m| m.files.get(&file.path));
+        let written_by = |kind| {
+            Some(Entry {
+                kind,
+                sha256: manifest::sha256(new),
+            })
+        };
         let unchanged = |bytes: &[u8]| {
             bytes == new || recorded.is_some_and(|e| e.sha256 == manifest::sha256(bytes))
         };
@@ -139,7 +149,13 @@ impl<'r> Plan<'r> {
                 // becomes this target's template; otherwise it is the user's.
                 let was_generated = recorded.is_some_and(|e| e.kind == Kind::Generated);
                 if was_generated && unchanged(&bytes) {
-                    self.write(&file.path, new, Old::File { sha256: manifest::sha256(&bytes) });
+                    self.write(
+                        &file.path,
+                        new,
+                        Old::File {
+                            sha256: manifest::sha256(&bytes),
+                        },
+                    );
                     return Ok(written_by(self.count(Owner::User)));
                 }
                 self.written.kept += 1;
@@ -153,7 +169,9 @@ impl<'r> Plan<'r> {
                 // Earlier versions wrote no manifest: their generated files
                 // are theirs, except task files, which may have been a user's.
                 let legacy = folder.previous.is_none() && !file.path.starts_with("tasks/");
-                let old = Old::File { sha256: manifest::sha256(&bytes) };
+                let old = Old::File {
+                    sha256: manifest::sha256(&bytes),
+                };
                 if legacy || unchanged(&bytes) {
                     self.write(&file.path, new, old);
                 } else {
@@ -207,7 +225,14 @@ impl<'r> Plan<'r> {
 
     /// `rel` is in the way: a conflict, and (if forced) a change that moves
     /// it under the backup folder.
-    fn conflict(&mut self, folder: &Folder, rel: &str, why: String, new: Option<&'r [u8]>, old: Old) {
+    fn conflict(
+        &mut self,
+        folder: &Folder,
+        rel: &str,
+        why: String,
+        new: Option<&'r [u8]>,
+        old: Old,
+    ) {
         self.conflicts.push(Conflict {
             path: folder.path.join(rel),
             why,
@@ -227,12 +252,22 @@ impl<'r> Plan<'r> {
         let old = match folder.look(manifest::FILE_NAME)? {
             Look::File(bytes) if bytes == text => return Ok(()),
             Look::Absent => Old::Absent,
-            Look::File(bytes) => Old::File { sha256: manifest::sha256(&bytes) },
+            Look::File(bytes) => Old::File {
+                sha256: manifest::sha256(&bytes),
+            },
             other => {
-                let why = format!("is {}, where generation keeps its manifest", describe(&other));
+                let why = format!(
+                    "is {}, where generation keeps its manifest",
+                    describe(&other)
+                );
                 let old = old_of(&other);
-                self.conflicts.push(Conflict { path: folder.path.join(manifest::FILE_NAME), why });
-                self.written.backed_up.push(folder.backup.join(manifest::FILE_NAME));
+                self.conflicts.push(Conflict {
+                    path: folder.path.join(manifest::FILE_NAME),
+                    why,
+                });
+                self.written
+                    .backed_up
+                    .push(folder.backup.join(manifest::FILE_NAME));
                 self.changes.push(Change {
                     rel: manifest::FILE_NAME.to_string(),
                     bytes: Some(Cow::Owned(text)),
@@ -288,9 +323,13 @@ fn open_robot_folder(
     }
     let previous = match &dir {
         None => None,
-        Some(d) => fsops::read_regular(d.as_fd(), Path::new(manifest::FILE_NAME), MAX_MANIFEST_BYTES)
-            .map_err(at(&path))?
-            .and_then(|bytes| Manifest::parse(&String::from_utf8_lossy(&bytes))),
+        Some(d) => fsops::read_regular(
+            d.as_fd(),
+            Path::new(manifest::FILE_NAME),
+            MAX_MANIFEST_BYTES,
+        )
+        .map_err(at(&path))?
+        .and_then(|bytes| Manifest::parse(&String::from_utf8_lossy(&bytes))),
     };
     Ok(Folder {
         dir,
@@ -325,7 +364,9 @@ impl Folder {
             let kind = rustix::fs::FileType::from_raw_mode(stat.st_mode);
             let look = match kind {
                 rustix::fs::FileType::RegularFile => {
-                    match fsops::read_regular(here, name, crate::fsread::MAX_FILE_BYTES).map_err(err)? {
+                    match fsops::read_regular(here, name, crate::fsread::MAX_FILE_BYTES)
+                        .map_err(err)?
+                    {
                         Some(bytes) => Look::File(bytes),
                         None => Look::Other(stat),
                     }
@@ -352,7 +393,10 @@ fn specials(folder: &Folder) -> Result<Vec<PathBuf>, OutputError> {
         return Ok(Vec::new());
     }
     let mut found = Vec::new();
-    for entry in walkdir::WalkDir::new(&folder.path).min_depth(1).follow_links(false) {
+    for entry in walkdir::WalkDir::new(&folder.path)
+        .min_depth(1)
+        .follow_links(false)
+    {
         let entry = entry.map_err(|e| OutputError::Io(folder.path.clone(), e.into()))?;
         let t = entry.file_type();
         if !t.is_file() && !t.is_dir() && !t.is_symlink() {
@@ -365,9 +409,14 @@ fn specials(folder: &Folder) -> Result<Vec<PathBuf>, OutputError> {
 fn old_of(look: &Look) -> Old {
     match look {
         Look::Absent => Old::Absent,
-        Look::File(bytes) => Old::File { sha256: manifest::sha256(bytes) },
+        Look::File(bytes) => Old::File {
+            sha256: manifest::sha256(bytes),
+        },
         Look::InTheWay(_, blocking) => old_of(blocking),
-        Look::Other(stat) => Old::Other { dev: stat.st_dev, ino: stat.st_ino },
+        Look::Other(stat) => Old::Other {
+            dev: stat.st_dev,
+            ino: stat.st_ino,
+        },
     }
 }
 
