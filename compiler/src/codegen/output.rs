@@ -1131,6 +1131,29 @@ mod tests {
     }
 
     #[test]
+    fn an_output_folder_opened_inside_a_workspace_never_goes_through_a_link() {
+        let root = std::env::temp_dir().join(format!("semo-inside-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        let (ws, outside) = (root.join("ws"), root.join("outside"));
+        std::fs::create_dir_all(&ws).unwrap();
+        std::fs::create_dir_all(&outside).unwrap();
+        // What `confine` resolved may have been swapped for a link since.
+        std::os::unix::fs::symlink(&outside, ws.join("gen")).unwrap();
+        let refused = Transaction::begin_inside(&ws, Path::new("gen/out"), || {});
+        let Err(OutputError::Unsafe(path, why)) = refused else {
+            panic!("not refused");
+        };
+        assert_eq!(path, ws.join("gen"));
+        assert!(why.contains("symbolic link"), "{why}");
+        assert_eq!(std::fs::read_dir(&outside).unwrap().count(), 0);
+        let made = Transaction::begin_inside(&ws, Path::new("new/out"), || {}).unwrap();
+        assert_eq!(made.out(), ws.join("new/out"));
+        assert!(ws.join("new/out/.semo.lock").is_file());
+        drop(made);
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+
+    #[test]
     fn confinement_resolves_dots_and_links() {
         let root = std::env::temp_dir().join(format!("semo-confine-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&root);
