@@ -206,25 +206,21 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             eprintln!("recovered: {line}");
         }
     }
-    if !options.force {
-        match transaction.conflicts(&result.robots, target) {
-            Ok(conflicts) if conflicts.is_empty() => {}
-            Ok(conflicts) => {
-                eprintln!("error: {}", OutputError::Conflicts(conflicts));
-                return 1;
-            }
-            Err(e) => {
-                eprintln!("error: {e}");
-                return 2;
-            }
-        }
-    }
     let mut staged = Vec::new();
-    for robot in &result.robots {
+    for (i, robot) in result.robots.iter().enumerate() {
         match transaction.stage_robot(robot, target, options.force) {
             Ok(written) => staged.push((robot, written)),
-            Err(e @ OutputError::Conflicts(_)) => {
-                eprintln!("error: {e}");
+            Err(OutputError::Conflicts(mut conflicts)) => {
+                // All robots' files in the way at once; nothing is written
+                // (the transaction drops what it staged).
+                match transaction.conflicts(&result.robots[i + 1..], target) {
+                    Ok(more) => conflicts.extend(more),
+                    Err(e) => {
+                        eprintln!("error: {e}");
+                        return 2;
+                    }
+                }
+                eprintln!("error: {}", OutputError::Conflicts(conflicts));
                 return 1;
             }
             Err(e) => {

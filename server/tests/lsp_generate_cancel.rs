@@ -132,15 +132,21 @@ async fn a_cancelled_generation_leaves_the_output_folder_as_it_was() {
     let cancelled = client.response(id).await.unwrap_err();
     assert_eq!(cancelled["code"], -32800, "{cancelled}");
     go.send(()).unwrap();
-    // Once the generation has let the folder go, it is as it was.
-    let lock = std::fs::File::open(out.join(".semo.lock")).unwrap();
-    tokio::task::block_in_place(|| lock.lock()).unwrap();
+    // Once the generation has let the folder go (its lock, waited for by
+    // util-linux's `flock`), it is as it was.
+    let released = tokio::task::block_in_place(|| {
+        std::process::Command::new("flock")
+            .arg(out.join(".semo.lock"))
+            .arg("true")
+            .status()
+            .unwrap()
+    });
+    assert!(released.success());
     assert_eq!(
         contents(&out).keys().collect::<Vec<_>>(),
         before.keys().collect::<Vec<_>>()
     );
     assert!(contents(&out) == before, "a robot folder changed");
-    drop(lock);
     // The server goes on generating.
     let id = client
         .send_request("workspace/executeCommand", generate("linux-sim"))
