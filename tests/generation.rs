@@ -88,13 +88,14 @@ fn contents(dir: &Path) -> BTreeMap<PathBuf, Content> {
     found
 }
 
-/// Hidden entries generation leaves only while it runs (or after a crash).
+/// Hidden entries generation leaves only while it runs (or after a crash):
+/// its work folder, and the folders earlier versions swapped in.
 fn leftovers(out: &Path) -> Vec<PathBuf> {
     contents(out)
         .into_keys()
         .filter(|p| {
             let name = p.file_name().unwrap().to_string_lossy();
-            name.ends_with(".semo-new") || name.ends_with(".semo-old")
+            name == ".semo-work" || name.ends_with(".semo-new") || name.ends_with(".semo-old")
         })
         .collect()
 }
@@ -176,10 +177,28 @@ fn concurrent_generations_over_edited_task_files_lose_nothing() {
     }
 }
 
+/// The entries of `all` under `folder`.
+fn part(all: &BTreeMap<PathBuf, Content>, folder: &Path) -> BTreeMap<PathBuf, Content> {
+    all.iter()
+        .filter(|(p, _)| p.starts_with(folder))
+        .map(|(p, c)| (p.clone(), c.clone()))
+        .collect()
+}
+
+/// The user's entries that `kill_after_every_operation` puts in robot folders.
+fn is_users(path: &Path) -> bool {
+    let name = path.file_name().unwrap().to_string_lossy();
+    ["NOTES.txt", "link", "fifo"].contains(&name.as_ref())
+}
+
 /// Kills `semo build` right after its 1st, 2nd, ... file operation until a
-/// run completes; after each kill every robot folder is the old one or the
-/// new one, and the next run recovers, says so, and ends as a clean run.
-fn kill_after_every_operation(name: &str, env: &[(&str, &str)], with_journal: bool) -> u64 {
+/// run completes. After each kill every file of a robot folder is its old or
+/// its new version (a generated one may be missing, set aside in the work
+/// folder between two renames) and the user's entries are all there; a run
+/// that only recovers (killed as it begins generating) reports what it did
+/// and leaves each robot folder the old or the new one whole; the next run
+/// ends as a clean run.
+fn kill_after_every_operation(name: &str, env: &[(&str, &str)]) -> u64 {
     let dir = scratch(name);
     let mission = copy_example("scouting", "scouting.mission", &dir);
     let before = dir.join("before");
@@ -205,63 +224,91 @@ fn kill_after_every_operation(name: &str, env: &[(&str, &str)], with_journal: bo
     assert_eq!(build(&mission, &after, &[]).code, 0);
     let (old, new) = (contents(&before), contents(&after));
     let folders = robot_folders(&before);
-    let part = |all: &BTreeMap<PathBuf, Content>, folder: &Path| -> BTreeMap<PathBuf, Content> {
-        all.iter()
-            .filter(|(p, _)| p.starts_with(folder))
-            .map(|(p, c)| (p.clone(), c.clone()))
-            .collect()
-    };
     for folder in &folders {
         assert_ne!(part(&old, folder), part(&new, folder), "{folder:?} changes");
     }
     let (mission_arg, out) = (mission.display().to_string(), dir.join("out"));
     let out_arg = out.display().to_string();
     let args = ["build", mission_arg.as_str(), "-o", out_arg.as_str()];
-    for n in 1.. {
+    // The operations of a run; a kill right after a check (a read) is one
+    // right after the operation before it, so those are not repeated.
+    copy_tree(&before, &out);
+    let log = dir.join("ops.log");
+    let steps = logged_operations(&args, env, &log);
+    assert_eq!(contents(&out), new, "a run that was not killed");
+    for (n, kind) in (1..).zip(&steps) {
+        if kind == "check" {
+            continue;
+        }
         let _ = std::fs::remove_dir_all(&out);
         copy_tree(&before, &out);
         let fault = n.to_string();
         let mut with_fault = env.to_vec();
         with_fault.push(("SEMO_FAULT_AFTER_FS_OPS", &fault));
         let (code, _, stderr) = semo_env(&args, &with_fault);
-        if code == Some(0) {
-            assert_eq!(contents(&out), new, "a run that was not killed");
-            return n;
-        }
         assert_eq!(code, None, "killed after operation {n}: {stderr}");
         let now = contents(&out);
         for folder in &folders {
-            let mine = part(&now, folder);
-            // Without an exchange, between the two renames the old folder
-            // is whole under its journal name, and the next run restores it.
-            let journal = {
-                let name = folder.file_name().unwrap().to_string_lossy();
-                let aside = folder.with_file_name(format!(".{name}.semo-old"));
-                let moved: BTreeMap<PathBuf, Content> = part(&now, &aside)
-                    .into_iter()
-                    .map(|(p, c)| (folder.join(p.strip_prefix(&aside).unwrap()), c))
-                    .collect();
-                with_journal && mine.is_empty() && moved == part(&old, folder)
-            };
-            assert!(
-                mine == part(&old, folder) || mine == part(&new, folder) || journal,
-                "killed after operation {n}: {folder:?} is neither the old nor the new folder"
-            );
+            let (mine, was, will) = (part(&now, folder), part(&old, folder), part(&new, folder));
+            for (path, content) in &mine {
+                assert!(
+                    was.get(path) == Some(content) || will.get(path) == Some(content),
+                    "killed after operation {n}: {path:?} is neither its old nor its new version"
+                );
+            }
+            for path in was.keys().chain(will.keys()) {
+                assert!(
+                    mine.contains_key(path) || !is_users(path),
+                    "killed after operation {n}: {path:?} is missing"
+                );
+            }
         }
         let had_leftovers = !leftovers(&out).is_empty();
-        let (code, stdout, stderr) = semo_env(&args, env);
-        assert_eq!(code, Some(0), "the run after operation {n}: {stderr}");
+        let mut recovering = env.to_vec();
+        recovering.push(("SEMO_FAULT_AFTER_RECOVERY", "1"));
+        let (code, stdout, stderr) = semo_env(&args, &recovering);
+        assert_eq!(code, None, "the recovery after operation {n}: {stderr}");
         assert_eq!(
             stdout.contains("recovered: "),
             had_leftovers,
             "after operation {n}: {stdout}"
         );
-        let mut recovered = contents(&out);
+        assert_eq!(
+            leftovers(&out),
+            Vec::<PathBuf>::new(),
+            "after operation {n}"
+        );
+        let recovered = contents(&out);
+        for folder in &folders {
+            let mine = part(&recovered, folder);
+            assert!(
+                mine == part(&old, folder) || mine == part(&new, folder),
+                "recovered after operation {n}: {folder:?} is neither the old nor the new folder"
+            );
+        }
+        let (code, _, stderr) = semo_env(&args, env);
+        assert_eq!(code, Some(0), "the run after operation {n}: {stderr}");
+        let mut finished = contents(&out);
         // Backups and the lock are not robot folders.
-        recovered.retain(|p, _| !p.starts_with(".semo-backup"));
-        assert_eq!(recovered, new, "the run after operation {n}");
+        finished.retain(|p, _| !p.starts_with(".semo-backup"));
+        assert_eq!(finished, new, "the run after operation {n}");
     }
-    unreachable!()
+    steps.len() as u64
+}
+
+/// The kinds of the file operations `semo ARGS` does, in order
+/// (`SEMO_FS_OPS_LOG`).
+fn logged_operations(args: &[&str], env: &[(&str, &str)], log: &Path) -> Vec<String> {
+    let _ = std::fs::remove_file(log);
+    let log_arg = log.display().to_string();
+    let mut logged = env.to_vec();
+    logged.push(("SEMO_FS_OPS_LOG", &log_arg));
+    let (code, _, stderr) = semo_env(args, &logged);
+    assert_eq!(code, Some(0), "{stderr}");
+    let text = std::fs::read_to_string(log).unwrap_or_default();
+    text.lines()
+        .map(|line| line.split_once(' ').unwrap().1.to_string())
+        .collect()
 }
 
 fn copy_tree(from: &Path, to: &Path) {
@@ -276,14 +323,14 @@ fn copy_tree(from: &Path, to: &Path) {
 
 #[test]
 fn a_kill_after_any_file_operation_leaves_old_or_new_and_the_next_run_recovers() {
-    let operations = kill_after_every_operation("kill-exchange", &[], false);
+    let operations = kill_after_every_operation("kill-no-replace", &[]);
     assert!(operations > 30, "{operations} operations");
 }
 
 #[test]
-fn without_rename_exchange_the_journal_of_names_recovers_too() {
+fn without_rename_noreplace_the_link_and_unlink_fallback_recovers_too() {
     let operations =
-        kill_after_every_operation("kill-fallback", &[("SEMO_NO_RENAME_EXCHANGE", "1")], true);
+        kill_after_every_operation("kill-fallback", &[("SEMO_NO_RENAME_NOREPLACE", "1")]);
     assert!(operations > 30, "{operations} operations");
 }
 
@@ -747,4 +794,285 @@ fn junk_is_shown_for_people_in_a_few_writes() {
         diags.len(),
         shown.stderr.len()
     );
+/// `semo build ARGS` paused after its `step`th file operation
+/// (`SEMO_PAUSE_AFTER_FS_OPS`, through the FIFO `fifo`): `during` runs while
+/// it waits, then it goes on. Its exit code and standard error.
+fn build_paused(
+    args: &[&str],
+    step: u64,
+    fifo: &Path,
+    during: impl FnOnce(),
+) -> (Option<i32>, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_semo"))
+        .args(args)
+        .env("SEMO_PAUSE_AFTER_FS_OPS", step.to_string())
+        .env("SEMO_PAUSE_FIFO", fifo)
+        .env("NO_COLOR", "1")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let paused = read_pause(&mut child, fifo);
+    assert!(paused.starts_with(&format!("paused {step} ")), "{paused}");
+    during();
+    resume(&mut child, fifo);
+    let done = child.wait_with_output().unwrap();
+    (
+        done.status.code(),
+        String::from_utf8_lossy(&done.stderr).into_owned(),
+    )
+}
+
+fn nonblocking() -> i32 {
+    rustix::fs::OFlags::NONBLOCK.bits() as i32
+}
+
+/// The line a paused generation writes to the FIFO (it then waits).
+fn read_pause(child: &mut std::process::Child, fifo: &Path) -> String {
+    use std::io::Read;
+    use std::os::unix::fs::OpenOptionsExt;
+    let mut reader = std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(nonblocking())
+        .open(fifo)
+        .unwrap();
+    let mut line = Vec::new();
+    loop {
+        let mut buf = [0u8; 128];
+        match reader.read(&mut buf) {
+            // End of file once the line is written: the writer has closed it.
+            Ok(0) if line.ends_with(b"\n") => return String::from_utf8(line).unwrap(),
+            Ok(n) => line.extend_from_slice(&buf[..n]),
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+            Err(e) => panic!("{e}"),
+        }
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("the generation ended ({status}) before it paused");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+}
+
+/// Lets a paused generation go on.
+fn resume(child: &mut std::process::Child, fifo: &Path) {
+    use std::io::Write;
+    use std::os::unix::fs::OpenOptionsExt;
+    loop {
+        // Without a reader yet, opening to write fails (ENXIO) rather than waits.
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .custom_flags(nonblocking())
+            .open(fifo)
+        {
+            Ok(mut writer) => {
+                writer.write_all(b"go\n").unwrap();
+                return;
+            }
+            Err(_) => {
+                if let Some(status) = child.try_wait().unwrap() {
+                    panic!("the generation ended ({status}) while paused");
+                }
+                std::thread::sleep(std::time::Duration::from_millis(1));
+            }
+        }
+    }
+}
+
+fn make_fifo(path: &Path) {
+    let _ = std::fs::remove_file(path);
+    assert!(Command::new("mkfifo").arg(path).status().unwrap().success());
+}
+
+/// How many file operations (`SEMO_FS_OPS_LOG`) of each kind `semo ARGS` does.
+fn operations(args: &[&str], log: &Path) -> BTreeMap<String, usize> {
+    let mut kinds = BTreeMap::new();
+    for kind in logged_operations(args, &[], log) {
+        *kinds.entry(kind).or_insert(0) += 1;
+    }
+    kinds
+}
+
+/// Saves `text` as editors that write a new file and rename it over the old do.
+fn rename_save(path: &Path, text: &str) {
+    let temp = path.with_file_name(".editor-save.tmp");
+    std::fs::write(&temp, text).unwrap();
+    std::fs::rename(&temp, path).unwrap();
+}
+
+/// A previous generation of `follow` in `<dir>/before`, and the arguments of
+/// a new one (its mission renamed, so every generated file changes) into
+/// `<dir>/out`.
+fn follow_regenerated(dir: &Path) -> (PathBuf, Vec<String>) {
+    let mission = copy_example("follow", "follow.mission", dir);
+    let before = dir.join("before");
+    assert_eq!(build(&mission, &before, &[]).code, 0);
+    let renamed = dir.join("renamed.mission");
+    std::fs::rename(&mission, &renamed).unwrap();
+    let out = dir.join("out");
+    let args = vec![
+        "build".to_string(),
+        renamed.display().to_string(),
+        "-o".to_string(),
+        out.display().to_string(),
+    ];
+    (before, args)
+}
+
+#[test]
+fn what_the_user_saves_during_a_generation_stays_at_every_step() {
+    let dir = scratch("during");
+    let (before, args) = follow_regenerated(&dir);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = dir.join("out");
+    copy_tree(&before, &out);
+    let steps: usize = operations(&args, &dir.join("ops.log")).values().sum();
+    assert!(steps > 10, "{steps} operations");
+    let fifo = dir.join("pause");
+    make_fifo(&fifo);
+    let folder = out.join("Team1/create1");
+    for step in 1..=steps as u64 {
+        let _ = std::fs::remove_dir_all(&out);
+        copy_tree(&before, &out);
+        let made = format!("made at step {step}\n");
+        let task = format!("{MY_TASK}/* saved at step {step} */\n");
+        let main = format!("/* main.c edited at step {step} */\n");
+        let header = format!("/* program.h edited in place at step {step} */\n");
+        let (code, stderr) = build_paused(&args, step, &fifo, || {
+            std::fs::write(folder.join("made-during.txt"), &made).unwrap();
+            rename_save(&folder.join("tasks/follow.c"), &task);
+            rename_save(&folder.join("main.c"), &main);
+            std::fs::write(folder.join("program.h"), &header).unwrap();
+        });
+        let read = |name: &str| std::fs::read_to_string(folder.join(name)).unwrap();
+        assert_eq!(read("made-during.txt"), made, "step {step}: {stderr}");
+        assert_eq!(read("tasks/follow.c"), task, "step {step}: {stderr}");
+        assert_eq!(read("main.c"), main, "step {step}: {stderr}");
+        assert_eq!(read("program.h"), header, "step {step}: {stderr}");
+        match code {
+            Some(0) => {}
+            Some(1) => assert!(
+                stderr.contains("changed while semo was")
+                    || stderr.contains("created while semo was"),
+                "step {step}: {stderr}"
+            ),
+            other => panic!("step {step}: {other:?}: {stderr}"),
+        }
+        assert_eq!(leftovers(&out), Vec::<PathBuf>::new(), "step {step}");
+    }
+}
+
+#[test]
+fn no_link_swapped_in_during_a_generation_is_followed_out_of_the_output_folder() {
+    let dir = scratch("swapped");
+    let (before, args) = follow_regenerated(&dir);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = dir.join("out");
+    copy_tree(&before, &out);
+    let steps: usize = operations(&args, &dir.join("ops.log")).values().sum();
+    let fifo = dir.join("pause");
+    make_fifo(&fifo);
+    let outside = dir.join("outside");
+    for step in 1..=steps as u64 {
+        for swap_output_folder in [false, true] {
+            let _ = std::fs::remove_dir_all(&out);
+            let _ = std::fs::remove_dir_all(dir.join("moved"));
+            let _ = std::fs::remove_dir_all(&outside);
+            std::fs::create_dir_all(outside.join("create1")).unwrap();
+            copy_tree(&before, &out);
+            let (code, stderr) = build_paused(&args, step, &fifo, || {
+                if swap_output_folder {
+                    std::fs::rename(&out, dir.join("moved")).unwrap();
+                    std::os::unix::fs::symlink(&outside, &out).unwrap();
+                } else {
+                    let robot = out.join("Team1/create1");
+                    std::fs::rename(&robot, out.join("Team1/moved")).unwrap();
+                    std::os::unix::fs::symlink(outside.join("create1"), &robot).unwrap();
+                }
+            });
+            assert!(
+                matches!(code, Some(0..=2)),
+                "step {step}: {code:?}: {stderr}"
+            );
+            assert_eq!(
+                contents(&outside).into_keys().collect::<Vec<_>>(),
+                vec![PathBuf::from("create1")],
+                "step {step} (output folder swapped: {swap_output_folder}): written through the link: {stderr}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_backup_folder_that_is_a_link_is_refused_and_a_linked_output_folder_works() {
+    let dir = scratch("backup-link");
+    let mission = copy_example("follow", "follow.mission", &dir);
+    let outside = dir.join("outside");
+    std::fs::create_dir_all(&outside).unwrap();
+    let out = dir.join("out");
+    assert_eq!(build(&mission, &out, &[]).code, 0);
+    let main = out.join("Team1/create1/main.c");
+    std::fs::write(&main, "my change").unwrap();
+    std::os::unix::fs::symlink(&outside, out.join(".semo-backup")).unwrap();
+    let forced = build(&mission, &out, &["--force"]);
+    assert_eq!(forced.code, 2, "{}", forced.stderr);
+    assert!(forced.stderr.contains(".semo-backup"), "{}", forced.stderr);
+    assert!(
+        forced.stderr.contains("is a symbolic link"),
+        "{}",
+        forced.stderr
+    );
+    assert_eq!(
+        contents(&outside).len(),
+        0,
+        "nothing written through the link"
+    );
+    assert_eq!(std::fs::read_to_string(&main).unwrap(), "my change");
+    assert_eq!(leftovers(&out), Vec::<PathBuf>::new());
+    // An output folder given as a link is the folder it leads to, from the
+    // first run on, backups included.
+    let real = dir.join("real");
+    std::fs::create_dir_all(&real).unwrap();
+    let linked = dir.join("linked-out");
+    std::os::unix::fs::symlink(&real, &linked).unwrap();
+    let first = build(&mission, &linked, &[]);
+    assert_eq!(first.code, 0, "{}", first.stderr);
+    assert!(real.join("Team1/create1/main.c").is_file());
+    std::fs::write(real.join("Team1/create1/main.c"), "mine").unwrap();
+    let forced = build(&mission, &linked, &["--force"]);
+    assert_eq!(forced.code, 0, "{}", forced.stderr);
+    let saved: Vec<_> = contents(&real.join(".semo-backup"))
+        .into_iter()
+        .filter(|(p, _)| p.ends_with("Team1/create1/main.c"))
+        .collect();
+    assert_eq!(saved.len(), 1, "{saved:?}");
+    assert!(std::fs::symlink_metadata(&linked).unwrap().is_symlink());
+}
+
+#[test]
+fn a_build_syncs_twice_whatever_the_number_of_robots() {
+    let dir = scratch("syncs");
+    let text = std::fs::read_to_string(examples().join("swarm/march.mission")).unwrap();
+    assert!(text.contains("quad[5]"));
+    let log = dir.join("ops.log");
+    let mut syncs = Vec::new();
+    for robots in [1, 12] {
+        let mission = dir.join(format!("march{robots}.mission"));
+        std::fs::write(
+            &mission,
+            text.replace("quad[5]", &format!("quad[{robots}]")),
+        )
+        .unwrap();
+        let (mission, out) = (
+            mission.display().to_string(),
+            dir.join(format!("out{robots}")),
+        );
+        let out = out.display().to_string();
+        let fresh = operations(&["build", &mission, "-o", &out], &log);
+        assert!(fresh["write"] > 5 * robots, "{fresh:?}");
+        syncs.push(fresh["sync"]);
+        // Nothing changed: nothing written, nothing synced.
+        let again = operations(&["build", &mission, "-o", &out], &log);
+        assert_eq!(again, BTreeMap::new(), "{robots} robot(s)");
+    }
+    assert_eq!(syncs, [2, 2]);
 }

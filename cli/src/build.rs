@@ -206,59 +206,22 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             eprintln!("recovered: {line}");
         }
     }
-    if !options.force {
-        match transaction.conflicts(&result.robots, target) {
-            Ok(conflicts) if conflicts.is_empty() => {}
-            Ok(conflicts) => {
+    let mut staged = Vec::new();
+    for (i, robot) in result.robots.iter().enumerate() {
+        match transaction.stage_robot(robot, target, options.force) {
+            Ok(written) => staged.push((robot, written)),
+            Err(OutputError::Conflicts(mut conflicts)) => {
+                // All robots' files in the way at once; nothing is written
+                // (the transaction drops what it staged).
+                match transaction.conflicts(&result.robots[i + 1..], target) {
+                    Ok(more) => conflicts.extend(more),
+                    Err(e) => {
+                        eprintln!("error: {e}");
+                        return 2;
+                    }
+                }
                 eprintln!("error: {}", OutputError::Conflicts(conflicts));
                 return 1;
-            }
-            Err(e) => {
-                eprintln!("error: {e}");
-                return 2;
-            }
-        }
-    }
-    for robot in &result.robots {
-        match transaction.write_robot(robot, target, options.force) {
-            Ok(written) => {
-                let (generated, user) = robot.line_counts();
-                let share = if generated + user == 0 {
-                    100.0
-                } else {
-                    100.0 * generated as f64 / (generated + user) as f64
-                };
-                robots_json.push(serde_json::json!({
-                    "team": robot.team,
-                    "robot": robot.robot,
-                    "folder": written.folder.display().to_string(),
-                    "generated_files": written.generated,
-                    "task_files_created": written.created,
-                    "task_files_kept": written.kept,
-                }));
-                if !human {
-                    continue;
-                }
-                let _ = writeln!(
-                    out,
-                    "{}/{}: {} ({} generated files; {} task files created, {} kept; {generated} lines generated, {user} in task files: {share:.0}% generated)",
-                    robot.team,
-                    robot.robot,
-                    written.folder.display(),
-                    written.generated,
-                    written.created,
-                    written.kept,
-                );
-                for saved in &written.backed_up {
-                    let _ = writeln!(out, "  saved the file in the way as {}", saved.display());
-                }
-                for special in &written.left_alone {
-                    let _ = writeln!(
-                        out,
-                        "  left alone (not a regular file, not opened): {}",
-                        special.display()
-                    );
-                }
             }
             Err(e) => {
                 eprintln!("error: cannot write {}/{}: {e}", robot.team, robot.robot);
@@ -266,6 +229,56 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             }
         }
     }
+    let kept = match transaction.commit() {
+        Ok(kept) => kept,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    for (robot, written) in &staged {
+        let (generated, user) = robot.line_counts();
+        let share = if generated + user == 0 {
+            100.0
+        } else {
+            100.0 * generated as f64 / (generated + user) as f64
+        };
+        robots_json.push(serde_json::json!({
+            "team": robot.team,
+            "robot": robot.robot,
+            "folder": written.folder.display().to_string(),
+            "generated_files": written.generated,
+            "task_files_created": written.created,
+            "task_files_kept": written.kept,
+        }));
+        if !human {
+            continue;
+        }
+        let _ = writeln!(
+            out,
+            "{}/{}: {} ({} generated files; {} task files created, {} kept; {generated} lines generated, {user} in task files: {share:.0}% generated)",
+            robot.team,
+            robot.robot,
+            written.folder.display(),
+            written.generated,
+            written.created,
+            written.kept,
+        );
+        for saved in &written.backed_up {
+            let _ = writeln!(out, "  saved the file in the way as {}", saved.display());
+        }
+        for special in &written.left_alone {
+            let _ = writeln!(
+                out,
+                "  left alone (not a regular file, not opened): {}",
+                special.display()
+            );
+        }
+    }
+    if !kept.is_empty() {
+        eprintln!("error: {}", semo::codegen::output::kept_message(&kept));
+    }
+    let failed = if kept.is_empty() { 0 } else { 1 };
     if !human {
         let reported = output::report(
             options.format,
@@ -273,10 +286,17 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             &run.files,
             &run.diagnostics,
             options.color,
-            serde_json::json!({ "target": target.name(), "robots": robots_json }),
+            serde_json::json!({
+                "target": target.name(),
+                "robots": robots_json,
+                "kept": kept
+                    .iter()
+                    .map(|c| serde_json::json!({ "path": c.path.display().to_string(), "why": c.why }))
+                    .collect::<Vec<_>>(),
+            }),
             out,
         );
-        return output::written(reported).err().unwrap_or(0);
+        return output::written(reported).err().unwrap_or(failed);
     }
     let _ = writeln!(
         out,
@@ -286,7 +306,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         started.elapsed().as_secs_f64() * 1000.0,
         generated.as_secs_f64() * 1000.0
     );
-    0
+    failed
 }
 
 /// A scenario's error for people (`scenario FILE:LINE:COL: message`, on

@@ -43,9 +43,11 @@ fn build(mission: &Path, target: Target, out: &Path) {
     let mut transaction = output::Transaction::begin(out, || {}).expect("the output folder");
     for robot in &result.robots {
         transaction
-            .write_robot(robot, target, false)
-            .expect("written");
+            .stage_robot(robot, target, false)
+            .expect("staged");
     }
+    let kept = transaction.commit().expect("written");
+    assert!(kept.is_empty(), "{kept:?}");
 }
 
 fn main() {

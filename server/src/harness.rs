@@ -70,10 +70,22 @@ impl TestClient {
 
     /// Sends a request and waits for its response: `Ok(result)` or `Err(error)`.
     pub async fn request(&mut self, method: &str, params: Value) -> Result<Value, Value> {
+        let id = self.send_request(method, params).await;
+        self.response(id).await
+    }
+
+    /// Sends a request without waiting for its response; its id (for
+    /// [`TestClient::response`], or to cancel it).
+    pub async fn send_request(&mut self, method: &str, params: Value) -> i64 {
         self.next_id += 1;
         let id = self.next_id;
         self.send(&json!({ "jsonrpc": "2.0", "id": id, "method": method, "params": params }))
             .await;
+        id
+    }
+
+    /// Waits for the response to the request `id`.
+    pub async fn response(&mut self, id: i64) -> Result<Value, Value> {
         loop {
             let msg = self.read_message().await.expect("the server answers");
             if msg.get("id") == Some(&json!(id)) && msg.get("method").is_none() {

@@ -6,13 +6,14 @@ use crate::encoding::Encoding;
 use crate::handlers;
 use crate::world::{self, Snapshot};
 use crate::{State, diagnostics};
+use semo::codegen::output;
 use semo::host;
 use semo::ide::CompletionConfig;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use tower_lsp_server::jsonrpc::{Error, Result};
 use tower_lsp_server::ls_types::*;
-use tower_lsp_server::{Client, LanguageServer};
+use tower_lsp_server::{Bounded, Client, LanguageServer, NotCancellable, OngoingProgress};
 
 pub struct Backend {
     client: Client,
@@ -255,6 +256,9 @@ impl Backend {
         };
         let total = result.robots.len().max(1);
         let mut robots = Vec::new();
+        // Set when this future is dropped (the request cancelled): the
+        // blocking work then stops before its next robot and writes nothing.
+        let cancelled = CancelOnDrop::default();
         let (work, all) = (job.clone(), Arc::new(result.robots));
         let robots_of = all.clone();
         let begun = tokio::task::spawn_blocking(move || generate::begin(&work, &robots_of))
@@ -274,6 +278,7 @@ impl Backend {
                 });
             }
         };
+        transaction.cancel_with(cancelled.0.clone());
         let recovered = transaction.recovered.clone();
         for line in &recovered {
             let message = format!("SeMo: recovered: {line}");
@@ -289,7 +294,7 @@ impl Backend {
             }
             let (target, force, robots_of) = (job.target, job.force, all.clone());
             let (back, written) = tokio::task::spawn_blocking(move || {
-                let written = transaction.write_robot(&robots_of[i], target, force);
+                let written = transaction.stage_robot(&robots_of[i], target, force);
                 (transaction, written)
             })
             .await
@@ -297,17 +302,22 @@ impl Backend {
             transaction = back;
             match written {
                 Ok(w) => robots.push(generate::robot_summary(&all[i], &w)),
-                Err(e) => {
-                    if let Some(p) = progress {
-                        p.finish_with_message("failed").await;
-                    }
-                    let message = format!("SeMo: cannot write the generated code: {e}");
-                    self.client.show_message(MessageType::ERROR, &message).await;
-                    return Err(handlers::request_failed(message));
-                }
+                Err(e) => return Err(self.generation_failed(progress, e).await),
             }
         }
-        drop(transaction);
+        let kept = match tokio::task::spawn_blocking(move || transaction.commit())
+            .await
+            .map_err(|_| Error::internal_error())?
+        {
+            Ok(kept) => kept,
+            Err(e) => return Err(self.generation_failed(progress, e).await),
+        };
+        if !kept.is_empty() {
+            let message = format!("SeMo: {}", output::kept_message(&kept));
+            self.client
+                .show_message(MessageType::WARNING, &message)
+                .await;
+        }
         if let Some(p) = progress {
             p.finish_with_message(format!("{} robot(s)", robots.len()))
                 .await;
@@ -316,16 +326,34 @@ impl Backend {
             "SeMo: generated code for {} robot(s) ({}) in {}",
             robots.len(),
             job.target.name(),
-            job.out.display()
+            job.out.path().display()
         );
         self.client.show_message(MessageType::INFO, &message).await;
         Ok(serde_json::json!({
             "refused": false,
-            "outputFolder": job.out.display().to_string(),
+            "outputFolder": job.out.path().display().to_string(),
+            "kept": kept
+                .iter()
+                .map(|c| serde_json::json!({ "path": c.path.display().to_string(), "why": c.why }))
+                .collect::<Vec<_>>(),
             "target": job.target.name(),
             "robots": robots,
             "recovered": recovered,
         }))
+    }
+
+    /// Ends the progress and tells the user why the generation stopped.
+    async fn generation_failed(
+        &self,
+        progress: Option<OngoingProgress<Bounded, NotCancellable>>,
+        error: output::OutputError,
+    ) -> Error {
+        if let Some(p) = progress {
+            p.finish_with_message("failed").await;
+        }
+        let message = format!("SeMo: cannot write the generated code: {error}");
+        self.client.show_message(MessageType::ERROR, &message).await;
+        handlers::request_failed(message)
     }
 
     async fn register_watchers(&self) {
@@ -704,5 +732,17 @@ fn unknown_document(uri: &Uri) -> Error {
         code: tower_lsp_server::jsonrpc::ErrorCode::InvalidParams,
         message: format!("unknown document {}", uri.as_str()).into(),
         data: None,
+    }
+}
+
+/// Sets its flag when dropped: held by a request's future, it tells the
+/// blocking work that the request was cancelled (the server drops the
+/// future of a cancelled request).
+#[derive(Default)]
+struct CancelOnDrop(Arc<AtomicBool>);
+
+impl Drop for CancelOnDrop {
+    fn drop(&mut self) {
+        self.0.store(true, Ordering::SeqCst);
     }
 }

@@ -1,72 +1,121 @@
-//! Writing robot folders (codegen.md §5) as a transaction that never loses
-//! what the user has there.
+//! Writing robot folders (codegen.md §5) as a transaction that owns only
+//! its own files, and only while it holds the output folder.
 //!
 //! - **One generation per output folder at a time.** [`Transaction::begin`]
 //!   takes an exclusive lock on `<out>/.semo.lock` (an OS file lock, so the
 //!   CLI and the server, and two requests of one server, exclude each other);
 //!   a second generation waits for it, and gives up with a clear message
 //!   after [`LOCK_WAIT`].
-//! - **Old or new, never a mix.** A robot folder `<out>/<team>/<robot>` is
-//!   filled as `.<robot>.semo-new` beside it, then swapped in with one
-//!   `renameat2(RENAME_EXCHANGE)`; where the filesystem refuses that, the old
-//!   folder is renamed to `.<robot>.semo-old` first. Those two names are the
-//!   journal: [`Transaction::begin`] restores `.<robot>.semo-old` when the
-//!   robot folder is missing, removes every other leftover, and reports what it
-//!   did ([`Transaction::recovered`]). A crash at any point thus leaves the old
-//!   or the new folder.
-//! - **User files are sacred.** Each folder holds a manifest
+//! - **Only its own files.** Each robot folder holds a manifest
 //!   ([`manifest::FILE_NAME`]) of the files generation wrote, with their
-//!   target and SHA-256. Generation replaces only files it wrote that are
-//!   unchanged since; a generated file the user edited, a task file the user
-//!   filled that the new target generates (`linux` → `linux-sim`), or anything
-//!   else in the way is a [`Conflict`]: the generation is refused, naming the
-//!   files, unless forced, which first saves them under
-//!   `<out>/.semo-backup/<UTC time>/<team>/<robot>/`. Every other entry of the
-//!   folder is carried over into the new one (hard-linked: never opened).
-//! - **Confined.** Nothing follows a symbolic link: a team or robot folder
-//!   that is a link is refused, links inside a robot folder are carried over
-//!   as links, and FIFOs, sockets and devices are carried over unopened and
-//!   reported ([`Written::left_alone`]). The server's output folder must lie
-//!   in the workspace ([`confine`]).
-//! - **Durable.** Every file written is synced; the new robot folder is synced
-//!   whole before the swap, the team folder after every rename, exchange and
-//!   removal, backups before what they save is replaced (all through
-//!   `fsops`, counted steps). After a power cut each robot folder is thus
-//!   the old or the new one, or the old one under its journal name (restored
-//!   by the next run); only the interrupted generation itself may be lost.
+//!   target and SHA-256. Generation replaces a file only if the manifest says
+//!   it wrote it and its bytes are still the ones it wrote (or an earlier
+//!   version without a manifest wrote it, outside `tasks/`); it creates a
+//!   file only where there is none. A generated file the user edited, a task
+//!   file the user filled that the new target generates (`linux` →
+//!   `linux-sim`), or anything else in the way is a [`Conflict`]: the
+//!   generation is refused before anything is written, naming the files,
+//!   unless forced, which moves them under
+//!   `<out>/.semo-backup/<UTC time>/<team>/<robot>/` instead of discarding
+//!   them. Every other entry of a robot folder is never opened, moved or
+//!   removed: files the user creates while a generation runs, and edits
+//!   saved by writing a new file and renaming it over the old, stay.
+//!   Unchanged generated files are not rewritten.
+//! - **Edits racing a generation are kept.** All robots are staged first in
+//!   `<out>/.semo-work/` (nothing in the robot folders changes); then each
+//!   file is replaced on its own: its bytes checked against what generation
+//!   saw, the old file renamed aside, its bytes checked again (an edit
+//!   between the check and the rename is caught here), the new file renamed
+//!   in with `RENAME_NOREPLACE` (a file the user saved there meanwhile
+//!   stays). A file found changed is put back and reported at the end as a
+//!   conflict ([`Transaction::commit`]); the set-aside old files are checked
+//!   once more before they are removed, and one that a program still holding
+//!   it open changed meanwhile is moved under the backup folder and reported.
+//!   What is left: a write through a descriptor opened before the generation
+//!   set the file aside, landing between that last check and the removal (a
+//!   window of one `unlink`); and on a file system with neither
+//!   `RENAME_NOREPLACE` nor hard links, a file created between a check of
+//!   the name and the rename over it.
+//! - **Confined.** Everything is done relative to the output folder's
+//!   descriptor, opened once, one name at a time with `O_NOFOLLOW`: a team
+//!   or robot folder that is a link is refused, `.semo-backup` that is a link
+//!   is refused, a folder turned into a link during the generation stops
+//!   what would go through it (a conflict), and links, FIFOs, sockets and
+//!   devices in a robot folder are never opened (those in the way of a
+//!   generated file are conflicts; the others are reported,
+//!   [`Written::left_alone`]). The output folder named on the command line
+//!   may itself be (or lie under) a link: it is the folder the link leads
+//!   to, resolved once at the start, and swapping the link afterwards does
+//!   not move the generation. The server's output folder must lie in the
+//!   workspace ([`confine`]) and is opened from the workspace folder down,
+//!   one name at a time without following links
+//!   ([`Transaction::begin_inside`]).
+//! - **Cancellable.** A generation stops before its next robot, or before it
+//!   replaces the first file, once its cancel flag is set
+//!   ([`Transaction::cancel_with`]); so does one dropped before
+//!   [`Transaction::commit`]: the staged files are removed and the robot
+//!   folders are as they were.
+//! - **A crash leaves old files or new ones, and the next run finishes.**
+//!   The journal (`.semo-work/journal`, [`journal`]) names every file the
+//!   generation replaces, with the hashes of the old and new bytes, before
+//!   the first is replaced. After a crash, [`Transaction::begin`] finishes
+//!   a generation whose journal is complete (each file found new is left, each
+//!   found old is replaced as above, set-aside files removed) and removes a
+//!   staging area without one; it reports what it did
+//!   ([`Transaction::recovered`]). After the recovery each robot folder is
+//!   the old or the new one (less any conflict it reports); between the two,
+//!   each generated file is its old or its new version, or missing for the
+//!   instant between the two renames, its old version then in the work
+//!   folder.
+//! - **Durable, in two syncs.** Files are written without `fsync`. One
+//!   `syncfs` on the output folder's file system after staging (and the
+//!   journal) makes everything durable before the first rename publishes
+//!   anything; one after the renames, before the journal and the set-aside
+//!   files go. After a power cut the journal thus either is incomplete (no
+//!   rename happened: the staging area is removed) or names files whose new
+//!   bytes are on disk (the generation is finished). Two syncs per
+//!   generation, whatever the number of robots and files (all through
+//!   `fsops`, counted steps).
 
 mod fsops;
+mod journal;
 pub mod manifest;
+mod plan;
 
-use super::{Owner, RobotOutput, Target};
-use manifest::{Entry, Kind, Manifest};
-use std::collections::{BTreeMap, BTreeSet};
+use super::{RobotOutput, Target};
+use journal::{Aside, Entry, Journal, Old};
+use std::collections::HashMap;
 use std::fs::File;
 use std::io;
+use std::os::fd::{AsFd, BorrowedFd, OwnedFd};
 use std::path::{Component, Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// The lock file in the output folder.
 pub const LOCK_FILE: &str = ".semo.lock";
 /// Where forced generations save the files they replace.
 pub const BACKUP_FOLDER: &str = ".semo-backup";
+/// Where a generation stages its files and keeps its journal while it runs.
+pub const WORK_FOLDER: &str = ".semo-work";
 /// How long a generation waits for another one on the same folder.
 pub const LOCK_WAIT: Duration = Duration::from_secs(120);
 
-/// What writing one robot's folder did.
+/// What staging one robot's folder will do once committed.
 #[derive(Debug, Default)]
 pub struct Written {
     pub folder: PathBuf,
-    /// Generated files written.
+    /// Generated files (written, or already as generation would write them).
     pub generated: usize,
     /// User files created from their template.
     pub created: usize,
     /// User files left as they were.
     pub kept: usize,
-    /// Files saved under the backup folder before being replaced (forced).
+    /// Where the files in the way are moved (forced).
     pub backed_up: Vec<PathBuf>,
     /// Entries that are neither regular files, folders nor links (FIFOs,
-    /// sockets, devices): carried over without being opened.
+    /// sockets, devices): never opened.
     pub left_alone: Vec<PathBuf>,
 }
 
@@ -85,6 +134,8 @@ pub enum OutputError {
     Conflicts(Vec<Conflict>),
     /// A folder generation would write through is a link or not a folder.
     Unsafe(PathBuf, String),
+    /// The generation was cancelled before it replaced anything.
+    Cancelled,
     Io(PathBuf, io::Error),
 }
 
@@ -115,6 +166,9 @@ impl std::fmt::Display for OutputError {
             OutputError::Unsafe(path, why) => {
                 write!(f, "refusing to write through {}: {why}", path.display())
             }
+            OutputError::Cancelled => {
+                write!(f, "the generation was cancelled; nothing was written")
+            }
             OutputError::Io(path, e) => write!(f, "{}: {e}", path.display()),
         }
     }
@@ -122,43 +176,137 @@ impl std::fmt::Display for OutputError {
 
 impl std::error::Error for OutputError {}
 
+/// What a commit's conflicts say to the user: the files changed while the
+/// generation ran, kept as they are.
+pub fn kept_message(kept: &[Conflict]) -> String {
+    let mut text = format!(
+        "{} file(s) changed while semo was generating; they were kept as they are:",
+        kept.len()
+    );
+    for c in kept {
+        text.push_str(&format!("\n  {}: {}", c.path.display(), c.why));
+    }
+    text.push_str(
+        "\nthe rest was generated; generate again to replace them (they are conflicts now, \
+         which --force saves under .semo-backup/ first)",
+    );
+    text
+}
+
 fn at(path: &Path) -> impl FnOnce(io::Error) -> OutputError + '_ {
     move |e| OutputError::Io(path.to_path_buf(), e)
 }
 
+/// A folder that is a link or not a folder, as the error for `path`;
+/// other errors as they are.
+fn not_a_folder(path: &Path) -> impl FnOnce(io::Error) -> OutputError + '_ {
+    move |e| match why_not_a_folder(path, &e) {
+        Some(why) => OutputError::Unsafe(path.to_path_buf(), why.into()),
+        None => OutputError::Io(path.to_path_buf(), e),
+    }
+}
+
+/// Why opening `path` as a folder without following links failed, when it
+/// is a link or not a folder (`O_DIRECTORY | O_NOFOLLOW` says `ENOTDIR` or
+/// `ELOOP` for a link, so the name is looked at again for the message).
+fn why_not_a_folder(path: &Path, e: &io::Error) -> Option<&'static str> {
+    use rustix::io::Errno;
+    match Errno::from_io_error(e)? {
+        Errno::LOOP | Errno::NOTDIR => {
+            let link = std::fs::symlink_metadata(path).is_ok_and(|m| m.is_symlink());
+            Some(if link { LINK } else { "it is not a folder" })
+        }
+        _ => None,
+    }
+}
+
+const LINK: &str = "it is a symbolic link; generation never follows links out of the output folder";
+
 /// One generation into an output folder, holding its lock until dropped.
+/// Robots are staged ([`Transaction::stage_robot`]) then all replaced at
+/// once ([`Transaction::commit`]); dropped before, it leaves the folder as
+/// it was.
 pub struct Transaction {
     out: PathBuf,
+    dir: OwnedFd,
     _lock: File,
     /// What was repaired after an interrupted generation, one line each.
     pub recovered: Vec<String>,
-    backup: PathBuf,
+    stamp: String,
+    /// The work folder, once the first file is staged.
+    work: Option<OwnedFd>,
+    entries: Vec<Entry>,
+    cancel: Option<Arc<AtomicBool>>,
+    /// The journal is written: from here on the generation is finished, by
+    /// this run or the next.
+    committed: bool,
+    generating: bool,
 }
 
 impl Transaction {
-    /// Creates the output folder if needed, takes its lock (waiting up to
-    /// [`LOCK_WAIT`]; `on_wait` is called once if it has to), and recovers
-    /// what an interrupted generation left.
+    /// Creates the output folder if needed (following links in `out`: the
+    /// folder the user named), takes its lock (waiting up to [`LOCK_WAIT`];
+    /// `on_wait` is called once if it has to), and recovers what an
+    /// interrupted generation left.
     pub fn begin(out: &Path, on_wait: impl FnOnce()) -> Result<Transaction, OutputError> {
+        fsops::restart_count();
         std::fs::create_dir_all(out).map_err(at(out))?;
+        let dir = fsops::open_dir_path(out).map_err(at(out))?;
+        Transaction::locked(out.to_path_buf(), dir, on_wait)
+    }
+
+    /// [`Transaction::begin`] on `root/rel`, with `rel`'s folders opened (or
+    /// created) one by one from `root` without following a link: a folder of
+    /// `rel` turned into a link is refused, whatever it points to.
+    pub fn begin_inside(
+        root: &Path,
+        rel: &Path,
+        on_wait: impl FnOnce(),
+    ) -> Result<Transaction, OutputError> {
+        fsops::restart_count();
+        let mut dir = fsops::open_dir_path(root).map_err(at(root))?;
+        let mut path = root.to_path_buf();
+        for component in rel.components() {
+            let Component::Normal(name) = component else {
+                return Err(OutputError::Unsafe(
+                    root.join(rel),
+                    "it is not a plain folder path inside the workspace".into(),
+                ));
+            };
+            path.push(name);
+            dir = open_or_make_dir(dir.as_fd(), Path::new(name)).map_err(not_a_folder(&path))?;
+        }
+        Transaction::locked(path, dir, on_wait)
+    }
+
+    fn locked(
+        out: PathBuf,
+        dir: OwnedFd,
+        on_wait: impl FnOnce(),
+    ) -> Result<Transaction, OutputError> {
         let lock_path = out.join(LOCK_FILE);
-        let lock = fsops::open_lock(&lock_path).map_err(at(&lock_path))?;
+        let lock = fsops::open_lock(dir.as_fd(), Path::new(LOCK_FILE)).map_err(at(&lock_path))?;
         if !fsops::try_lock(&lock).map_err(at(&lock_path))? {
             on_wait();
             let deadline = std::time::Instant::now() + LOCK_WAIT;
             while !fsops::try_lock(&lock).map_err(at(&lock_path))? {
                 if std::time::Instant::now() >= deadline {
-                    return Err(OutputError::Busy(out.to_path_buf()));
+                    return Err(OutputError::Busy(out));
                 }
                 std::thread::sleep(Duration::from_millis(20));
             }
         }
-        let backup = out.join(BACKUP_FOLDER).join(utc_stamp());
         let mut transaction = Transaction {
-            out: out.to_path_buf(),
+            out,
+            dir,
             _lock: lock,
             recovered: Vec::new(),
-            backup,
+            stamp: utc_stamp(),
+            work: None,
+            entries: Vec::new(),
+            cancel: None,
+            committed: false,
+            generating: false,
         };
         transaction.recover()?;
         Ok(transaction)
@@ -168,10 +316,502 @@ impl Transaction {
         &self.out
     }
 
-    /// Restores or removes what interrupted generations left in each team
-    /// folder (see the module's documentation).
+    /// Once `flag` is set, the generation stops before its next robot or
+    /// before it replaces anything, whichever comes first, and leaves the
+    /// folder as it was ([`OutputError::Cancelled`]).
+    pub fn cancel_with(&mut self, flag: Arc<AtomicBool>) {
+        self.cancel = Some(flag);
+    }
+
+    fn stop_if_cancelled(&mut self) -> Result<(), OutputError> {
+        if self
+            .cancel
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::SeqCst))
+        {
+            self.discard()?;
+            return Err(OutputError::Cancelled);
+        }
+        Ok(())
+    }
+
+    /// The files that writing `robots` for `target` would replace against
+    /// the user's will, over all robots: checked before staging any.
+    pub fn conflicts(
+        &self,
+        robots: &[RobotOutput],
+        target: Target,
+    ) -> Result<Vec<Conflict>, OutputError> {
+        let mut all = Vec::new();
+        for robot in robots {
+            all.extend(self.plan(robot, target)?.conflicts);
+        }
+        Ok(all)
+    }
+
+    fn plan<'r>(
+        &self,
+        robot: &'r RobotOutput,
+        target: Target,
+    ) -> Result<plan::Plan<'r>, OutputError> {
+        let backup = self.out.join(BACKUP_FOLDER).join(&self.stamp);
+        plan::Plan::new(self.dir.as_fd(), &self.out, &backup, robot, target)
+    }
+
+    /// Stages `robot`'s files for `target` in the work folder; nothing in the
+    /// robot folder changes until [`Transaction::commit`]. Refused with
+    /// [`OutputError::Conflicts`] unless `force`, which moves the files in
+    /// the way under the backup folder instead of discarding them.
+    pub fn stage_robot(
+        &mut self,
+        robot: &RobotOutput,
+        target: Target,
+        force: bool,
+    ) -> Result<Written, OutputError> {
+        self.stop_if_cancelled()?;
+        if !self.generating {
+            self.generating = true;
+            fsops::generation_begins();
+        }
+        let plan = self.plan(robot, target)?;
+        if !plan.conflicts.is_empty() {
+            if !force {
+                return Err(OutputError::Conflicts(plan.conflicts));
+            }
+            self.check_backup_folder()?;
+        }
+        for change in plan.changes {
+            let index = self.entries.len();
+            let entry = Entry {
+                index,
+                path: format!("{}/{}/{}", robot.team, robot.robot, change.rel),
+                new: change.bytes.as_deref().map(manifest::sha256),
+                old: change.old,
+                aside: change.aside,
+            };
+            if let Some(bytes) = &change.bytes {
+                let staged = entry.staged();
+                let work = self.work()?;
+                fsops::write_new(work, Path::new(&staged), bytes)
+                    .map_err(at(&self.out.join(WORK_FOLDER).join(&staged)))?;
+            }
+            self.entries.push(entry);
+        }
+        Ok(plan.written)
+    }
+
+    /// A forced generation moves files under `.semo-backup`: a link there
+    /// would take them out of the output folder.
+    fn check_backup_folder(&self) -> Result<(), OutputError> {
+        let path = self.out.join(BACKUP_FOLDER);
+        match fsops::stat(self.dir.as_fd(), Path::new(BACKUP_FOLDER)).map_err(at(&path))? {
+            Some(stat) if !is_dir(&stat) => Err(OutputError::Unsafe(
+                path,
+                if is_link(&stat) {
+                    LINK
+                } else {
+                    "it is not a folder"
+                }
+                .into(),
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    /// The work folder, made on first use.
+    fn work(&mut self) -> Result<BorrowedFd<'_>, OutputError> {
+        if self.work.is_none() {
+            let path = self.out.join(WORK_FOLDER);
+            fsops::make_dir(self.dir.as_fd(), Path::new(WORK_FOLDER)).map_err(at(&path))?;
+            let work = fsops::open_dir(self.dir.as_fd(), Path::new(WORK_FOLDER))
+                .map_err(not_a_folder(&path))?;
+            self.work = Some(work);
+        }
+        Ok(self.work.as_ref().expect("made above").as_fd())
+    }
+
+    /// Replaces the staged files (see the module's documentation). The files
+    /// found changed on the way are kept as they are and returned: conflicts
+    /// for the user, as are the generated files they stand for from now on.
+    pub fn commit(mut self) -> Result<Vec<Conflict>, OutputError> {
+        self.stop_if_cancelled()?;
+        if self.entries.is_empty() {
+            self.discard()?;
+            return Ok(Vec::new());
+        }
+        let journal = Journal {
+            stamp: self.stamp.clone(),
+            entries: std::mem::take(&mut self.entries),
+        };
+        let journal_path = self.out.join(WORK_FOLDER).join(journal::FILE_NAME);
+        let work = self.work()?;
+        fsops::write_new(
+            work,
+            Path::new(journal::FILE_NAME),
+            journal.to_text().as_bytes(),
+        )
+        .map_err(at(&journal_path))?;
+        // The staged files and the journal on disk before anything is replaced.
+        fsops::sync(self.dir.as_fd()).map_err(at(&self.out))?;
+        self.entries = journal.entries;
+        // The last moment a cancel undoes everything.
+        self.stop_if_cancelled()?;
+        self.committed = true;
+        self.finish()
+    }
+
+    /// Replaces every entry of the journal, makes that durable, and clears
+    /// the work folder away; the conflicts met on the way.
+    fn finish(&mut self) -> Result<Vec<Conflict>, OutputError> {
+        let mut folders = Folders::default();
+        let mut conflicts = Vec::new();
+        for entry in &self.entries {
+            conflicts.extend(self.replace(entry, &mut folders)?);
+        }
+        // Replaced on disk before the journal that would finish it goes.
+        fsops::sync(self.dir.as_fd()).map_err(at(&self.out))?;
+        for entry in &self.entries {
+            conflicts.extend(self.clear(entry)?);
+        }
+        self.remove_work()?;
+        self.entries.clear();
+        Ok(conflicts)
+    }
+
+    /// Removes the work folder and everything in it (files generation made).
+    fn discard(&mut self) -> Result<(), OutputError> {
+        self.entries.clear();
+        if self.work.is_none() {
+            return Ok(());
+        }
+        self.remove_work()
+    }
+
+    fn remove_work(&mut self) -> Result<(), OutputError> {
+        let path = self.out.join(WORK_FOLDER);
+        let Some(work) = self.work.take() else {
+            return Ok(());
+        };
+        // The journal first: a crash while this runs leaves no journal that
+        // would finish what is being taken away.
+        let mut names = fsops::names(work.as_fd()).map_err(at(&path))?;
+        names.sort_by_key(|n| n != journal::FILE_NAME);
+        for name in names {
+            fsops::remove_file(work.as_fd(), Path::new(&name)).map_err(at(&path.join(&name)))?;
+        }
+        fsops::remove_dir(self.dir.as_fd(), Path::new(WORK_FOLDER)).map_err(at(&path))
+    }
+
+    /// One entry of the journal: the old entry set aside and checked, the
+    /// new file put in its place. Resumable: after a crash it goes on from
+    /// wherever the entry's names show it stopped.
+    fn replace(
+        &self,
+        entry: &Entry,
+        folders: &mut Folders,
+    ) -> Result<Option<Conflict>, OutputError> {
+        let target = self.out.join(&entry.path);
+        let conflict = |why: &str| {
+            Ok(Some(Conflict {
+                path: target.clone(),
+                why: why.to_string(),
+            }))
+        };
+        let (parent_rel, name) = split(&entry.path);
+        let parent = match folders.open(self.dir.as_fd(), &self.out, parent_rel, true) {
+            Ok(fd) => fd,
+            Err(why) => return conflict(&why),
+        };
+        let work = self
+            .work
+            .as_ref()
+            .expect("a journal has its work folder")
+            .as_fd();
+        let staged = entry.staged();
+        let staged = Path::new(&staged);
+        let is_staged =
+            entry.new.is_some() && fsops::stat(work, staged).map_err(at(&target))?.is_some();
+        if is_staged && same_entry(work, staged, parent.as_fd(), name)? {
+            // A `link` + `unlink` move that was interrupted.
+            fsops::remove_file(work, staged).map_err(at(&target))?;
+            return Ok(None);
+        }
+        if entry.new.is_some() && !is_staged {
+            return Ok(None);
+        }
+        if entry.old != Old::Absent {
+            let aside = self.aside(entry, folders)?;
+            let (aside_dir, aside_name) = (aside.0.as_fd(), aside.1.as_path());
+            let was_set_aside = fsops::stat(aside_dir, aside_name)
+                .map_err(at(&target))?
+                .is_some();
+            if !was_set_aside {
+                match self.matches(parent.as_fd(), name, &entry.old)? {
+                    Seen::Other => {
+                        return conflict(
+                            "changed while semo was generating; left as it is (generate again to replace it)",
+                        );
+                    }
+                    // Removed meanwhile: nothing of the user's to keep.
+                    Seen::Gone => {}
+                    Seen::Same => {
+                        match fsops::rename_no_replace(parent.as_fd(), name, aside_dir, aside_name)
+                        {
+                            Ok(true) => {}
+                            Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+                            Ok(false) => {
+                                let taken =
+                                    io::Error::other("the name to set it aside under is taken");
+                                return Err(OutputError::Io(target, taken));
+                            }
+                            Err(e) => return Err(OutputError::Io(target, e)),
+                        }
+                    }
+                }
+            }
+            let moved = fsops::stat(aside_dir, aside_name)
+                .map_err(at(&target))?
+                .is_some();
+            if moved {
+                if same_entry(aside_dir, aside_name, parent.as_fd(), name)? {
+                    // A `link` + `unlink` move that was interrupted.
+                    fsops::remove_file(parent.as_fd(), name).map_err(at(&target))?;
+                }
+                if self.matches(aside_dir, aside_name, &entry.old)? != Seen::Same {
+                    return self.put_back(entry, (aside_dir, aside_name), (parent.as_fd(), name));
+                }
+            }
+        }
+        if entry.new.is_some()
+            && !fsops::rename_no_replace(work, staged, parent.as_fd(), name).map_err(at(&target))?
+        {
+            return conflict(
+                "created while semo was generating; left as it is (generate again to replace it)",
+            );
+        }
+        Ok(None)
+    }
+
+    /// The old entry, found changed once set aside (an edit between the
+    /// check and the rename), back in its place; else (the user saved a new
+    /// one there meanwhile) kept under the backup folder.
+    fn put_back(
+        &self,
+        entry: &Entry,
+        (aside_dir, aside_name): (BorrowedFd<'_>, &Path),
+        (parent, name): (BorrowedFd<'_>, &Path),
+    ) -> Result<Option<Conflict>, OutputError> {
+        let target = self.out.join(&entry.path);
+        if fsops::rename_no_replace(aside_dir, aside_name, parent, name).map_err(at(&target))? {
+            return Ok(Some(Conflict {
+                path: target,
+                why: "changed while semo was replacing it; your version is back in place (generate again to replace it)".into(),
+            }));
+        }
+        let saved = self.rescue(entry, aside_dir, aside_name)?;
+        Ok(Some(Conflict {
+            path: target,
+            why: format!(
+                "changed twice while semo was replacing it; the newer version is in place, the other saved as {}",
+                saved.display()
+            ),
+        }))
+    }
+
+    /// Moves a set-aside entry from the work folder under the backup folder
+    /// (where it stays); its path there.
+    fn rescue(
+        &self,
+        entry: &Entry,
+        dir: BorrowedFd<'_>,
+        name: &Path,
+    ) -> Result<PathBuf, OutputError> {
+        let saved = self
+            .out
+            .join(BACKUP_FOLDER)
+            .join(&self.stamp)
+            .join(&entry.path);
+        if entry.aside == Aside::Backup {
+            return Ok(saved);
+        }
+        let mut folders = Folders::default();
+        let backup = self.backup_folder(entry, &mut folders)?;
+        let (_, last) = split(&entry.path);
+        if !fsops::rename_no_replace(dir, name, backup.as_fd(), last).map_err(at(&saved))? {
+            return Err(OutputError::Io(saved, io::Error::other("already exists")));
+        }
+        Ok(saved)
+    }
+
+    /// After the sync: a set-aside old file goes, once checked unchanged
+    /// (else it is kept under the backup folder); a staged file a conflict
+    /// left goes too.
+    fn clear(&self, entry: &Entry) -> Result<Option<Conflict>, OutputError> {
+        let work = self
+            .work
+            .as_ref()
+            .expect("a journal has its work folder")
+            .as_fd();
+        let target = self.out.join(&entry.path);
+        if entry.new.is_some() {
+            let staged = entry.staged();
+            if fsops::stat(work, Path::new(&staged))
+                .map_err(at(&target))?
+                .is_some()
+            {
+                fsops::remove_file(work, Path::new(&staged)).map_err(at(&target))?;
+            }
+        }
+        if entry.aside != Aside::Work || entry.old == Old::Absent {
+            return Ok(None);
+        }
+        let aside = entry.set_aside();
+        let aside = Path::new(&aside);
+        if fsops::stat(work, aside).map_err(at(&target))?.is_none() {
+            return Ok(None);
+        }
+        if self.matches(work, aside, &entry.old)? == Seen::Same {
+            fsops::remove_file(work, aside).map_err(at(&target))?;
+            return Ok(None);
+        }
+        let saved = self.rescue(entry, work, aside)?;
+        Ok(Some(Conflict {
+            path: target,
+            why: format!(
+                "the old version was changed after semo had replaced it (a program still had it open); saved as {}",
+                saved.display()
+            ),
+        }))
+    }
+
+    /// Where `entry`'s old entry is set aside: a folder and a name in it.
+    fn aside(
+        &self,
+        entry: &Entry,
+        folders: &mut Folders,
+    ) -> Result<(OwnedFd, PathBuf), OutputError> {
+        match entry.aside {
+            Aside::Work => {
+                let work = self.work.as_ref().expect("a journal has its work folder");
+                let work = work.try_clone().map_err(at(&self.out.join(WORK_FOLDER)))?;
+                Ok((work, PathBuf::from(entry.set_aside())))
+            }
+            Aside::Backup => {
+                let folder = self.backup_folder(entry, folders)?;
+                Ok((folder, PathBuf::from(split(&entry.path).1)))
+            }
+        }
+    }
+
+    /// `.semo-backup/<stamp>/<team>/<robot>/...`: the folder `entry`'s old
+    /// entry is saved in, made if needed, never through a link.
+    fn backup_folder(&self, entry: &Entry, folders: &mut Folders) -> Result<OwnedFd, OutputError> {
+        let (parent, _) = split(&entry.path);
+        let rel = format!("{BACKUP_FOLDER}/{}/{parent}", self.stamp);
+        folders
+            .open(self.dir.as_fd(), &self.out, &rel, true)
+            .map_err(|why| OutputError::Unsafe(self.out.join(&rel), why))
+    }
+
+    /// Whether the entry `name` in `dir` is still `old` (a counted check).
+    fn matches(&self, dir: BorrowedFd<'_>, name: &Path, old: &Old) -> Result<Seen, OutputError> {
+        let err = |e| OutputError::Io(self.out.join(name), e);
+        let seen = match old {
+            Old::Absent => match fsops::stat(dir, name).map_err(err)? {
+                None => Seen::Same,
+                Some(_) => Seen::Other,
+            },
+            Old::File { sha256 } => match fsops::stat(dir, name).map_err(err)? {
+                None => Seen::Gone,
+                Some(_) => match fsops::read_regular(dir, name, crate::fsread::MAX_FILE_BYTES)
+                    .map_err(|e| OutputError::Io(self.out.join(name), e))?
+                {
+                    Some(bytes) if manifest::sha256(&bytes) == *sha256 => Seen::Same,
+                    _ => Seen::Other,
+                },
+            },
+            Old::Other { dev, ino } => match fsops::stat(dir, name).map_err(err)? {
+                None => Seen::Gone,
+                Some(st) if st.st_dev == *dev && st.st_ino == *ino => Seen::Same,
+                Some(_) => Seen::Other,
+            },
+        };
+        fsops::checked(Ok(seen)).map_err(|e| OutputError::Io(self.out.join(name), e))
+    }
+
+    /// Finishes or removes what an interrupted generation left (see the
+    /// module's documentation).
     fn recover(&mut self) -> Result<(), OutputError> {
+        self.recover_swapped_folders()?;
+        let path = self.out.join(WORK_FOLDER);
+        if fsops::stat(self.dir.as_fd(), Path::new(WORK_FOLDER))
+            .map_err(at(&path))?
+            .is_none()
+        {
+            return Ok(());
+        }
+        let work = fsops::open_dir(self.dir.as_fd(), Path::new(WORK_FOLDER))
+            .map_err(not_a_folder(&path))?;
+        let journal = fsops::read_regular(work.as_fd(), Path::new(journal::FILE_NAME), 16 << 20)
+            .map_err(at(&path))?
+            .and_then(|bytes| Journal::parse(&String::from_utf8_lossy(&bytes)));
+        self.work = Some(work);
+        let Some(journal) = journal.filter(|j| self.journal_holds(j)) else {
+            self.discard()?;
+            self.recovered.push(format!(
+                "removed the files an interrupted generation had staged in {} (it had not begun replacing files)",
+                path.display()
+            ));
+            return Ok(());
+        };
+        let stamp = std::mem::replace(&mut self.stamp, journal.stamp);
+        self.entries = journal.entries;
+        let count = self.entries.len();
+        self.committed = true;
+        let conflicts = self.finish()?;
+        self.committed = false;
+        self.stamp = stamp;
+        self.recovered.push(format!(
+            "finished a generation that was interrupted while replacing {count} file(s) in {}",
+            self.out.display()
+        ));
+        for c in conflicts {
+            self.recovered
+                .push(format!("kept {}: {}", c.path.display(), c.why));
+        }
+        Ok(())
+    }
+
+    /// Whether a complete journal can be finished: once it has begun (a
+    /// staged file gone, an old one set aside), the sync before the first
+    /// rename made every staged file whole; before, each must be checked (a
+    /// power cut may have kept the journal but not all of them).
+    fn journal_holds(&self, journal: &Journal) -> bool {
+        let work = self.work.as_ref().expect("set by recover").as_fd();
+        let exists = |name: String| fsops::stat(work, Path::new(&name)).ok().flatten().is_some();
+        let begun = journal.entries.iter().any(|e| {
+            (e.new.is_some() && !exists(e.staged()))
+                || (e.aside == Aside::Work && e.old != Old::Absent && exists(e.set_aside()))
+        });
+        begun
+            || journal.entries.iter().all(|e| match &e.new {
+                None => true,
+                Some(sha) => {
+                    fsops::read_regular(work, Path::new(&e.staged()), crate::fsread::MAX_FILE_BYTES)
+                        .ok()
+                        .flatten()
+                        .is_some_and(|bytes| manifest::sha256(&bytes) == *sha)
+                }
+            })
+    }
+
+    /// What versions before the journal left: `.<robot>.semo-new` and
+    /// `.<robot>.semo-old` folders beside a robot folder (they swapped whole
+    /// folders). An old folder is restored when the robot folder is missing;
+    /// the rest goes.
+    fn recover_swapped_folders(&mut self) -> Result<(), OutputError> {
         let out = self.out.clone();
+        let mut changed = false;
         for team in read_dir_sorted(&out)? {
             let is_team = team.file_type().is_ok_and(|t| t.is_dir())
                 && !team.file_name().to_string_lossy().starts_with('.');
@@ -188,11 +828,10 @@ impl Transaction {
                     is_dir.then(|| (e.path(), robot.to_string(), old))
                 })
                 .collect();
-            // Old folders first: one is the robot folder when that is missing.
             for (path, robot, _) in leftovers.iter().filter(|l| l.2) {
                 let folder = team_dir.join(robot);
                 if std::fs::symlink_metadata(&folder).is_err() {
-                    fsops::rename(path, &folder).map_err(at(path))?;
+                    fsops::rename_path(path, &folder).map_err(at(path))?;
                     self.recovered.push(format!(
                         "restored {} from {} (a generation was interrupted while replacing it)",
                         folder.display(),
@@ -209,118 +848,122 @@ impl Transaction {
                     ));
                 }
             }
-            if !leftovers.is_empty() {
-                fsops::sync_dir(&team_dir).map_err(at(&team_dir))?;
-            }
+            changed |= !leftovers.is_empty();
+        }
+        if changed {
+            fsops::sync(self.dir.as_fd()).map_err(at(&out))?;
         }
         Ok(())
     }
+}
 
-    /// The files that writing `robots` for `target` would replace against
-    /// the user's will, over all robots: checked before writing any.
-    pub fn conflicts(
-        &self,
-        robots: &[RobotOutput],
-        target: Target,
-    ) -> Result<Vec<Conflict>, OutputError> {
-        let mut all = Vec::new();
-        for robot in robots {
-            let folder = self.robot_folder(robot)?;
-            all.extend(Plan::new(&folder, robot, target)?.conflicts);
+impl Drop for Transaction {
+    /// An uncommitted generation (cancelled, failed, or its caller gone)
+    /// takes its staged files away; a committed one that failed half-way
+    /// leaves its journal for the next run to finish.
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = self.discard();
         }
-        Ok(all)
     }
+}
 
-    /// Writes `robot`'s folder for `target`. Refused with
-    /// [`OutputError::Conflicts`] unless `force`, which saves the files in
-    /// the way under the backup folder first.
-    pub fn write_robot(
+/// What a check found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Seen {
+    Same,
+    Gone,
+    Other,
+}
+
+/// Whether two names are one entry (same inode): a `link` + `unlink` move
+/// interrupted between the two.
+fn same_entry(
+    a: BorrowedFd<'_>,
+    a_name: &Path,
+    b: BorrowedFd<'_>,
+    b_name: &Path,
+) -> Result<bool, OutputError> {
+    let stat = |dir, name: &Path| {
+        fsops::stat(dir, name).map_err(|e| OutputError::Io(name.to_path_buf(), e))
+    };
+    Ok(match (stat(a, a_name)?, stat(b, b_name)?) {
+        (Some(x), Some(y)) => x.st_dev == y.st_dev && x.st_ino == y.st_ino,
+        _ => false,
+    })
+}
+
+/// `team/robot/tasks/a.c` → (`team/robot/tasks`, `a.c`).
+fn split(path: &str) -> (&str, &Path) {
+    let (parent, name) = path.rsplit_once('/').unwrap_or(("", path));
+    (parent, Path::new(name))
+}
+
+fn is_dir(stat: &rustix::fs::Stat) -> bool {
+    rustix::fs::FileType::from_raw_mode(stat.st_mode) == rustix::fs::FileType::Directory
+}
+
+fn is_link(stat: &rustix::fs::Stat) -> bool {
+    rustix::fs::FileType::from_raw_mode(stat.st_mode) == rustix::fs::FileType::Symlink
+}
+
+/// Opens `name` in `dir` as a folder, making it if it is missing.
+fn open_or_make_dir(dir: BorrowedFd<'_>, name: &Path) -> io::Result<OwnedFd> {
+    match fsops::open_dir(dir, name) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            match fsops::make_dir(dir, name) {
+                Err(e) if e.kind() != io::ErrorKind::AlreadyExists => return Err(e),
+                _ => {}
+            }
+            fsops::open_dir(dir, name)
+        }
+        opened => opened,
+    }
+}
+
+/// The folders of the output folder a commit works in, opened once each
+/// from the output folder down, never through a link.
+#[derive(Default)]
+struct Folders {
+    open: HashMap<String, OwnedFd>,
+}
+
+impl Folders {
+    /// The folder `rel` (`/`-separated) of the output folder `out`, made if
+    /// `make`; why not, when a folder on the way is a link or not a folder.
+    fn open(
         &mut self,
-        robot: &RobotOutput,
-        target: Target,
-        force: bool,
-    ) -> Result<Written, OutputError> {
-        let folder = self.robot_folder(robot)?;
-        let plan = Plan::new(&folder, robot, target)?;
-        if !plan.conflicts.is_empty() && !force {
-            return Err(OutputError::Conflicts(plan.conflicts));
+        out: BorrowedFd<'_>,
+        out_path: &Path,
+        rel: &str,
+        make: bool,
+    ) -> Result<OwnedFd, String> {
+        if let Some(fd) = self.open.get(rel) {
+            return fd.try_clone().map_err(|e| e.to_string());
         }
-        let mut written = Written {
-            folder: folder.clone(),
-            ..Written::default()
+        let (dir, name) = match rel.rsplit_once('/') {
+            Some((parent, name)) => (Some(self.open(out, out_path, parent, make)?), name),
+            None if rel.is_empty() => return out.try_clone_to_owned().map_err(|e| e.to_string()),
+            None => (None, rel),
         };
-        for conflict in &plan.conflicts {
-            let rel = conflict
-                .path
-                .strip_prefix(&folder)
-                .unwrap_or(&conflict.path);
-            let saved = self.backup.join(&robot.team).join(&robot.robot).join(rel);
-            let kind = plan.old.get(rel).copied().unwrap_or(EntryKind::File);
-            save(&conflict.path, &saved, kind, &plan.old, rel).map_err(at(&saved))?;
-            written.backed_up.push(saved);
-        }
-        if !plan.conflicts.is_empty() {
-            // The saved copies are on disk before anything they save goes.
-            fsops::sync_tree(&self.backup).map_err(at(&self.backup))?;
-            for folder in self.backup.ancestors().skip(1).take(2) {
-                fsops::sync_dir(folder).map_err(at(folder))?;
+        let parent = dir.as_ref().map_or(out, |d| d.as_fd());
+        let name = Path::new(name);
+        let opened = if make {
+            open_or_make_dir(parent, name)
+        } else {
+            fsops::open_dir(parent, name)
+        };
+        let fd = opened.map_err(|e| {
+            let path = out_path.join(rel);
+            match why_not_a_folder(&path, &e) {
+                Some(why) => format!("{}: {why}; left as it is", path.display()),
+                None => format!("{}: {e}", path.display()),
             }
-        }
-        let temp = sibling(&folder, "semo-new");
-        if std::fs::symlink_metadata(&temp).is_ok() {
-            fsops::remove_tree(&temp).map_err(at(&temp))?;
-        }
-        plan.fill(&temp, &folder, &mut written).map_err(at(&temp))?;
-        // The new folder whole on disk before it replaces the old one.
-        fsops::sync_tree(&temp).map_err(at(&temp))?;
-        swap(&temp, &folder)?;
-        Ok(written)
+        })?;
+        let kept = fd.try_clone().map_err(|e| e.to_string())?;
+        self.open.insert(rel.to_string(), kept);
+        Ok(fd)
     }
-
-    /// `<out>/<team>/<robot>`, after checking that the team folder is a real
-    /// folder (created if missing) and the robot folder, if any, too.
-    fn robot_folder(&self, robot: &RobotOutput) -> Result<PathBuf, OutputError> {
-        for name in [&robot.team, &robot.robot] {
-            safe_relative(name)
-                .map_err(|e| OutputError::Unsafe(self.out.join(name), e.to_string()))?;
-        }
-        let team_dir = self.out.join(&robot.team);
-        match std::fs::symlink_metadata(&team_dir) {
-            Err(e) if e.kind() == io::ErrorKind::NotFound => {
-                fsops::create_dir(&team_dir).map_err(at(&team_dir))?;
-                fsops::sync_dir(&self.out).map_err(at(&self.out))?
-            }
-            Err(e) => return Err(OutputError::Io(team_dir, e)),
-            Ok(m) => check_real_dir(&team_dir, &m)?,
-        }
-        let folder = team_dir.join(&robot.robot);
-        if let Ok(m) = std::fs::symlink_metadata(&folder) {
-            check_real_dir(&folder, &m)?;
-        }
-        Ok(folder)
-    }
-}
-
-fn check_real_dir(path: &Path, meta: &std::fs::Metadata) -> Result<(), OutputError> {
-    if meta.file_type().is_symlink() {
-        Err(OutputError::Unsafe(
-            path.to_path_buf(),
-            "it is a symbolic link; generation never follows links out of the output folder".into(),
-        ))
-    } else if !meta.is_dir() {
-        Err(OutputError::Unsafe(
-            path.to_path_buf(),
-            "it is not a folder".into(),
-        ))
-    } else {
-        Ok(())
-    }
-}
-
-/// `.<robot>.semo-new` and the like beside `folder`.
-fn sibling(folder: &Path, suffix: &str) -> PathBuf {
-    let name = folder.file_name().unwrap_or_default().to_string_lossy();
-    folder.with_file_name(format!(".{name}.{suffix}"))
 }
 
 /// The robot named by a leftover's name, and whether it holds an old folder.
@@ -345,343 +988,6 @@ fn leftover(name: &str) -> Option<(&str, bool)> {
     } else {
         None
     }
-}
-
-/// Swaps the filled `temp` in as `folder`; then the old folder goes. The
-/// team folder is synced after each change of its names, so that after a
-/// power cut it holds what the journal says (see the module's documentation).
-fn swap(temp: &Path, folder: &Path) -> Result<(), OutputError> {
-    let parent = folder.parent().unwrap_or(Path::new("."));
-    let sync = || fsops::sync_dir(parent).map_err(at(parent));
-    if std::fs::symlink_metadata(folder).is_err() {
-        fsops::rename(temp, folder).map_err(at(folder))?;
-        return sync();
-    }
-    if fsops::exchange(temp, folder).map_err(at(folder))? {
-        sync()?;
-        // `temp` now holds the old folder.
-        fsops::remove_tree(temp).map_err(at(temp))?;
-        return sync();
-    }
-    let old = sibling(folder, "semo-old");
-    if std::fs::symlink_metadata(&old).is_ok() {
-        fsops::remove_tree(&old).map_err(at(&old))?;
-        sync()?;
-    }
-    fsops::rename(folder, &old).map_err(at(folder))?;
-    sync()?;
-    fsops::rename(temp, folder).map_err(at(folder))?;
-    sync()?;
-    fsops::remove_tree(&old).map_err(at(&old))?;
-    sync()
-}
-
-/// What an entry of the old folder is (without following links).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum EntryKind {
-    File,
-    Dir,
-    Symlink,
-    /// FIFO, socket or device.
-    Special,
-}
-
-impl EntryKind {
-    fn of(t: std::fs::FileType) -> EntryKind {
-        if t.is_symlink() {
-            EntryKind::Symlink
-        } else if t.is_dir() {
-            EntryKind::Dir
-        } else if t.is_file() {
-            EntryKind::File
-        } else {
-            EntryKind::Special
-        }
-    }
-}
-
-/// What to do with one robot folder, decided before touching anything.
-struct Plan<'r> {
-    robot: &'r RobotOutput,
-    target: Target,
-    /// Every entry of the old folder, relative, links not followed.
-    old: BTreeMap<PathBuf, EntryKind>,
-    manifest: Option<Manifest>,
-    /// New files written, by index into `robot.files`.
-    write: Vec<usize>,
-    /// Old entries not carried over (replaced by a new file, or a build product).
-    replaced: BTreeSet<PathBuf>,
-    conflicts: Vec<Conflict>,
-}
-
-impl<'r> Plan<'r> {
-    fn new(folder: &Path, robot: &'r RobotOutput, target: Target) -> Result<Plan<'r>, OutputError> {
-        let mut old = BTreeMap::new();
-        if std::fs::symlink_metadata(folder).is_ok() {
-            for entry in walkdir::WalkDir::new(folder)
-                .min_depth(1)
-                .follow_links(false)
-            {
-                let entry = entry.map_err(|e| OutputError::Io(folder.to_path_buf(), e.into()))?;
-                let rel = entry.path().strip_prefix(folder).expect("under the folder");
-                old.insert(rel.to_path_buf(), EntryKind::of(entry.file_type()));
-            }
-        }
-        let manifest = Manifest::read(folder);
-        let mut plan = Plan {
-            robot,
-            target,
-            old,
-            manifest,
-            write: Vec::new(),
-            replaced: BTreeSet::new(),
-            conflicts: Vec::new(),
-        };
-        plan.replaced.insert(PathBuf::from(manifest::FILE_NAME));
-        let mut seen = BTreeSet::new();
-        for (i, file) in robot.files.iter().enumerate() {
-            // A task two roles run is listed once per role: written once.
-            if !seen.insert(file.path.as_str()) {
-                continue;
-            }
-            let rel = safe_relative(&file.path)
-                .map_err(|e| OutputError::Unsafe(folder.join(&file.path), e.to_string()))?;
-            plan.decide(folder, i, rel);
-        }
-        // Build products of generated sources are left behind, so `make`
-        // rebuilds everything. (Files an earlier generation wrote that this
-        // one does not, say with `--emit taskgraph`, stay, still recorded.)
-        for (rel, kind) in &plan.old {
-            let text = rel.to_string_lossy();
-            if *kind == EntryKind::File && (text.ends_with(".o") || text == robot.robot.as_str()) {
-                plan.replaced.insert(rel.clone());
-            }
-        }
-        Ok(plan)
-    }
-
-    fn decide(&mut self, folder: &Path, index: usize, rel: &Path) {
-        let file = &self.robot.files[index];
-        let conflict = |why: String| Conflict {
-            path: folder.join(rel),
-            why,
-        };
-        // A folder on the way that is a link or a file is in the way.
-        for ancestor in rel
-            .ancestors()
-            .skip(1)
-            .filter(|a| !a.as_os_str().is_empty())
-        {
-            match self.old.get(ancestor) {
-                None | Some(EntryKind::Dir) => {}
-                Some(kind) => {
-                    let c = Conflict {
-                        path: folder.join(ancestor),
-                        why: format!("is {}, where generation needs a folder", describe(*kind)),
-                    };
-                    if !self.conflicts.contains(&c) {
-                        self.conflicts.push(c);
-                    }
-                    self.replaced.insert(ancestor.to_path_buf());
-                }
-            }
-        }
-        let Some(kind) = self.old.get(rel).copied() else {
-            self.write.push(index);
-            return;
-        };
-        let recorded = self.manifest.as_ref().and_then(|m| m.files.get(&file.path));
-        let unchanged = || {
-            kind == EntryKind::File
-                && read_bounded(&folder.join(rel)).is_some_and(|bytes| {
-                    bytes == file.text.as_bytes()
-                        || recorded.is_some_and(|e| e.sha256 == manifest::sha256(&bytes))
-                })
-        };
-        match file.owner {
-            Owner::User => {
-                // A file generated for the previous target and unchanged
-                // becomes this target's template; otherwise it is the user's.
-                let was_generated = recorded.is_some_and(|e| e.kind == Kind::Generated);
-                if was_generated && unchanged() {
-                    self.write.push(index);
-                    self.replaced.insert(rel.to_path_buf());
-                }
-            }
-            Owner::Generated => {
-                // Earlier versions wrote no manifest: their generated files
-                // are theirs, except task files, which may have been a user's.
-                let legacy = self.manifest.is_none()
-                    && kind == EntryKind::File
-                    && !file.path.starts_with("tasks/");
-                if legacy || unchanged() {
-                    self.write.push(index);
-                    self.replaced.insert(rel.to_path_buf());
-                    return;
-                }
-                let why = match (kind, recorded) {
-                    (EntryKind::File, Some(e)) if e.kind == Kind::Generated => {
-                        "was edited since semo generated it".to_string()
-                    }
-                    (EntryKind::File, Some(_)) => format!(
-                        "is a task file you filled in (target {}); target {} generates it",
-                        self.manifest.as_ref().map_or("?", |m| m.target.as_str()),
-                        self.target.name()
-                    ),
-                    (EntryKind::File, None) => format!(
-                        "is not a file semo generated (target {} generates it)",
-                        self.target.name()
-                    ),
-                    (other, _) => format!("is {}, where generation writes a file", describe(other)),
-                };
-                self.conflicts.push(conflict(why));
-                self.write.push(index);
-                self.replaced.insert(rel.to_path_buf());
-            }
-        }
-    }
-
-    /// Writes the new folder at `temp`: the new files, then every old entry
-    /// not replaced, then the manifest.
-    fn fill(&self, temp: &Path, folder: &Path, written: &mut Written) -> io::Result<()> {
-        fsops::create_dir(temp)?;
-        let mut manifest = Manifest {
-            target: self.target.name().to_string(),
-            files: BTreeMap::new(),
-        };
-        let mut made = BTreeSet::new();
-        for &i in &self.write {
-            let file = &self.robot.files[i];
-            let rel = Path::new(&file.path);
-            make_parents(temp, rel, &mut made)?;
-            fsops::write_new(&temp.join(rel), file.text.as_bytes())?;
-            let kind = match file.owner {
-                Owner::Generated => {
-                    written.generated += 1;
-                    Kind::Generated
-                }
-                Owner::User => {
-                    written.created += 1;
-                    Kind::Template
-                }
-            };
-            let sha256 = manifest::sha256(file.text.as_bytes());
-            manifest
-                .files
-                .insert(file.path.clone(), Entry { kind, sha256 });
-        }
-        let previous = self.manifest.as_ref();
-        for (rel, kind) in &self.old {
-            if self.replaced.iter().any(|r| rel.starts_with(r)) {
-                continue;
-            }
-            let (from, to) = (folder.join(rel), temp.join(rel));
-            match kind {
-                EntryKind::Dir => {
-                    if made.insert(rel.clone()) {
-                        fsops::create_dir(&to)?;
-                    }
-                    continue;
-                }
-                EntryKind::File => {
-                    if fsops::hard_link(&from, &to).is_err() {
-                        fsops::copy_regular(&from, &to)?;
-                    }
-                }
-                EntryKind::Symlink => {
-                    if fsops::hard_link(&from, &to).is_err() {
-                        fsops::copy_symlink(&from, &to)?;
-                    }
-                }
-                EntryKind::Special => {
-                    fsops::hard_link(&from, &to)?;
-                    written.left_alone.push(from.clone());
-                }
-            }
-            let text = rel.to_string_lossy().replace('\\', "/");
-            if self.robot.files.iter().any(|f| f.path == text) {
-                written.kept += 1;
-            }
-            // A kept template stays recorded as one, so a later target
-            // switch still knows whether the user changed it.
-            if let Some(entry) = previous.and_then(|m| m.files.get(&text)) {
-                manifest.files.insert(text, entry.clone());
-            }
-        }
-        fsops::write_new(
-            &temp.join(manifest::FILE_NAME),
-            manifest.to_text().as_bytes(),
-        )
-    }
-}
-
-fn describe(kind: EntryKind) -> &'static str {
-    match kind {
-        EntryKind::File => "a file",
-        EntryKind::Dir => "a folder",
-        EntryKind::Symlink => "a symbolic link",
-        EntryKind::Special => "a FIFO, socket or device",
-    }
-}
-
-/// Creates the folders of `rel` under `root` that `made` does not hold yet.
-fn make_parents(root: &Path, rel: &Path, made: &mut BTreeSet<PathBuf>) -> io::Result<()> {
-    let mut parents: Vec<&Path> = rel
-        .ancestors()
-        .skip(1)
-        .filter(|a| !a.as_os_str().is_empty())
-        .collect();
-    parents.reverse();
-    for parent in parents {
-        if made.insert(parent.to_path_buf()) {
-            fsops::create_dir(&root.join(parent))?;
-        }
-    }
-    Ok(())
-}
-
-/// Saves the old entry `from` (of kind `kind`, at `rel` in the old folder)
-/// at `to` without opening it: hard links, folders recreated.
-fn save(
-    from: &Path,
-    to: &Path,
-    kind: EntryKind,
-    old: &BTreeMap<PathBuf, EntryKind>,
-    rel: &Path,
-) -> io::Result<()> {
-    if let Some(parent) = to.parent() {
-        std::fs::create_dir_all(parent)?;
-    }
-    match kind {
-        EntryKind::Dir => {
-            fsops::create_dir(to)?;
-            for (inner, inner_kind) in old.range(rel.to_path_buf()..) {
-                let Ok(tail) = inner.strip_prefix(rel) else {
-                    break;
-                };
-                if tail.as_os_str().is_empty() {
-                    continue;
-                }
-                let (src, dst) = (from.join(tail), to.join(tail));
-                if *inner_kind == EntryKind::Dir {
-                    fsops::create_dir(&dst)?;
-                } else {
-                    fsops::hard_link(&src, &dst)?;
-                }
-            }
-            Ok(())
-        }
-        EntryKind::File => fsops::hard_link(from, to).or_else(|_| fsops::copy_regular(from, to)),
-        _ => fsops::hard_link(from, to),
-    }
-}
-
-/// A regular file's bytes, if it is one and not larger than any file
-/// generation writes could be (a larger one is the user's).
-fn read_bounded(path: &Path) -> Option<Vec<u8>> {
-    crate::fsread::read_text_limited(path, crate::fsread::MAX_FILE_BYTES)
-        .ok()
-        .map(String::into_bytes)
 }
 
 fn read_dir_sorted(dir: &Path) -> Result<Vec<std::fs::DirEntry>, OutputError> {
@@ -732,10 +1038,25 @@ fn utc_stamp() -> String {
     )
 }
 
+/// The editor's output folder, checked to lie in the workspace: the
+/// workspace folder (resolved) it lies in, and the path from there (for
+/// [`Transaction::begin_inside`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Confined {
+    pub root: PathBuf,
+    pub rel: PathBuf,
+}
+
+impl Confined {
+    pub fn path(&self) -> PathBuf {
+        self.root.join(&self.rel)
+    }
+}
+
 /// The output folder the editor asked for, resolved (`..` and symbolic
 /// links) and checked to lie inside one of `allowed` (the workspace folders,
 /// or the mission's folder when there is none).
-pub fn confine(requested: &Path, allowed: &[PathBuf]) -> Result<PathBuf, String> {
+pub fn confine(requested: &Path, allowed: &[PathBuf]) -> Result<Confined, String> {
     let resolved = resolve(requested).map_err(|e| {
         format!(
             "the output folder {} cannot be used: {e}",
@@ -745,18 +1066,19 @@ pub fn confine(requested: &Path, allowed: &[PathBuf]) -> Result<PathBuf, String>
     let inside = allowed
         .iter()
         .filter_map(|root| std::fs::canonicalize(root).ok())
-        .any(|root| resolved.starts_with(&root));
-    if inside {
-        Ok(resolved)
-    } else {
+        .find_map(|root| {
+            let rel = resolved.strip_prefix(&root).ok()?.to_path_buf();
+            Some(Confined { root, rel })
+        });
+    inside.ok_or_else(|| {
         let roots: Vec<String> = allowed.iter().map(|r| r.display().to_string()).collect();
-        Err(format!(
+        format!(
             "the output folder {} (resolved to {}) is outside the workspace ({}): choose a folder inside it",
             requested.display(),
             resolved.display(),
             roots.join(", ")
-        ))
-    }
+        )
+    })
 }
 
 /// `path` with `..` and symbolic links resolved, component by component:
@@ -806,6 +1128,29 @@ mod tests {
         assert_eq!(&stamp[4..5], "-");
         assert_eq!(&stamp[10..11], "T");
         assert!(stamp[..4].parse::<u32>().unwrap() >= 2024, "{stamp}");
+    }
+
+    #[test]
+    fn an_output_folder_opened_inside_a_workspace_never_goes_through_a_link() {
+        let root = std::env::temp_dir().join(format!("semo-inside-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        let (ws, outside) = (root.join("ws"), root.join("outside"));
+        std::fs::create_dir_all(&ws).unwrap();
+        std::fs::create_dir_all(&outside).unwrap();
+        // What `confine` resolved may have been swapped for a link since.
+        std::os::unix::fs::symlink(&outside, ws.join("gen")).unwrap();
+        let refused = Transaction::begin_inside(&ws, Path::new("gen/out"), || {});
+        let Err(OutputError::Unsafe(path, why)) = refused else {
+            panic!("not refused");
+        };
+        assert_eq!(path, ws.join("gen"));
+        assert!(why.contains("symbolic link"), "{why}");
+        assert_eq!(std::fs::read_dir(&outside).unwrap().count(), 0);
+        let made = Transaction::begin_inside(&ws, Path::new("new/out"), || {}).unwrap();
+        assert_eq!(made.out(), ws.join("new/out"));
+        assert!(ws.join("new/out/.semo.lock").is_file());
+        drop(made);
+        std::fs::remove_dir_all(&root).unwrap();
     }
 
     #[test]

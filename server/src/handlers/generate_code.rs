@@ -13,8 +13,15 @@
 //! [{ "path", "why" }] }`, so that an editor can offer to force.
 //!
 //! The output folder, with `..` and symbolic links resolved, must lie inside
-//! a workspace folder (the mission's folder when there is none): the editor's
-//! request cannot make the server write anywhere else.
+//! a workspace folder (the mission's folder when there is none), and is
+//! opened from that folder down without following links: the editor's
+//! request, or a link swapped in meanwhile, cannot make the server write
+//! anywhere else.
+//!
+//! Cancelling the request (`$/cancelRequest`) stops the generation before
+//! its next robot, or before it replaces the first file: the folder stays
+//! as it was. Files changed while it ran are kept and listed in the
+//! result's `kept` (`[{ "path", "why" }]`).
 
 use crate::encoding::LineMap;
 use crate::world::{Snapshot, World};
@@ -65,7 +72,7 @@ pub struct Job {
     /// The workspace as it was when the command came.
     pub analysis: semo::host::Analysis,
     pub mission: FileId,
-    pub out: PathBuf,
+    pub out: output::Confined,
     pub target: Target,
     pub team: Option<String>,
     pub force: bool,
@@ -212,7 +219,8 @@ pub fn begin(job: &Job, robots: &[codegen::RobotOutput]) -> Result<output::Trans
         message: e.to_string(),
         data: None,
     };
-    let transaction = output::Transaction::begin(&job.out, || {}).map_err(failed)?;
+    let transaction =
+        output::Transaction::begin_inside(&job.out.root, &job.out.rel, || {}).map_err(failed)?;
     if !job.force {
         let conflicts = transaction.conflicts(robots, job.target).map_err(failed)?;
         if !conflicts.is_empty() {

@@ -12,9 +12,6 @@ use std::collections::BTreeMap;
 
 pub const FILE_NAME: &str = ".semo-manifest";
 
-/// The largest manifest read back (a folder's list of files is a few KB).
-const MAX_BYTES: u64 = 1 << 20;
-
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
     /// Rewritten by every generation of this target.
@@ -86,13 +83,6 @@ impl Manifest {
             manifest.files.insert(path.to_string(), entry);
         }
         Some(manifest)
-    }
-
-    /// The manifest in `folder`, if there is a readable one (a regular file
-    /// of sane size in the format above).
-    pub fn read(folder: &std::path::Path) -> Option<Manifest> {
-        let text = crate::fsread::read_text_limited(&folder.join(FILE_NAME), MAX_BYTES).ok()?;
-        Manifest::parse(&text)
     }
 }
 

@@ -1,0 +1,161 @@
+//! Cancelling `semo.generateCode` (issue 33): the generation stops before
+//! its next robot and leaves the output folder as it was. A test binary of
+//! its own: it pauses the server's generations through the hidden
+//! `SEMO_PAUSE_AFTER_FS_OPS` / `SEMO_PAUSE_FIFO`, which hold for the whole
+//! process.
+
+use serde_json::{Value, json};
+use std::collections::BTreeMap;
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+
+fn example(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples")
+        .join(path)
+}
+
+fn uri(path: &Path) -> String {
+    format!("file://{}", path.display())
+}
+
+/// Every entry under `dir` with its bytes (links and folders as such).
+fn contents(dir: &Path) -> BTreeMap<PathBuf, Option<Vec<u8>>> {
+    walk(dir, dir)
+}
+
+fn walk(root: &Path, dir: &Path) -> BTreeMap<PathBuf, Option<Vec<u8>>> {
+    let mut found = BTreeMap::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let meta = std::fs::symlink_metadata(&path).unwrap();
+        let rel = path.strip_prefix(root).unwrap().to_path_buf();
+        if meta.is_dir() {
+            found.extend(walk(root, &path));
+            found.insert(rel, None);
+        } else {
+            found.insert(rel, Some(std::fs::read(&path).unwrap()));
+        }
+    }
+    found
+}
+
+/// Answers the generations' pauses: each paused step's line goes to the
+/// test, which lets it go on by sending `()`.
+fn pause_answerer(fifo: PathBuf) -> (mpsc::Receiver<String>, mpsc::Sender<()>) {
+    let (paused_tx, paused_rx) = mpsc::channel();
+    let (go_tx, go_rx) = mpsc::channel::<()>();
+    std::thread::spawn(move || {
+        loop {
+            let mut line = String::new();
+            if std::fs::File::open(&fifo)
+                .and_then(|mut f| f.read_to_string(&mut line))
+                .is_err()
+                || paused_tx.send(line).is_err()
+                || go_rx.recv().is_err()
+            {
+                return;
+            }
+            let mut to_server = std::fs::OpenOptions::new().write(true).open(&fifo).unwrap();
+            to_server.write_all(b"go\n").unwrap();
+        }
+    });
+    (paused_rx, go_tx)
+}
+
+/// The line of the next paused generation.
+fn next_pause(paused: &mpsc::Receiver<String>) -> String {
+    tokio::task::block_in_place(|| paused.recv().unwrap())
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_cancelled_generation_leaves_the_output_folder_as_it_was() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("lsp_generate_cancel");
+    let _ = std::fs::remove_dir_all(&dir);
+    let ws = dir.join("ws");
+    std::fs::create_dir_all(&ws).unwrap();
+    for file in ["scouting.mission", "MasterTeam.strategy.xml"] {
+        std::fs::copy(example(&format!("scouting/{file}")), ws.join(file)).unwrap();
+    }
+    let fifo = dir.join("pause");
+    assert!(
+        std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success()
+    );
+    // Every generation pauses after its first file operation (the first
+    // file staged for its first robot).
+    // SAFETY: set before the server starts; no other thread reads the
+    // environment yet.
+    unsafe {
+        std::env::set_var("SEMO_PAUSE_AFTER_FS_OPS", "1");
+        std::env::set_var("SEMO_PAUSE_FIFO", &fifo);
+    }
+    let (paused, go) = pause_answerer(fifo);
+    let mut client = semo_server::harness::TestClient::start();
+    client.initialize_with(json!({}), Some(&uri(&ws))).await;
+    let mission = ws.join("scouting.mission");
+    let mission_uri = uri(&mission);
+    client
+        .open(&mission_uri, &std::fs::read_to_string(&mission).unwrap())
+        .await;
+    client.diagnostics(&mission_uri, Some(1)).await;
+    let generate = |target: &str| {
+        json!({
+            "command": "semo.generateCode",
+            "arguments": [{ "uri": mission_uri, "target": target }],
+        })
+    };
+    // A first generation, let through.
+    let id = client
+        .send_request("workspace/executeCommand", generate("linux"))
+        .await;
+    let line = next_pause(&paused);
+    assert!(line.starts_with("paused 1 "), "{line}");
+    go.send(()).unwrap();
+    let first = client.response(id).await.unwrap();
+    assert_eq!(first["refused"], false, "{first}");
+    assert_eq!(first["robots"].as_array().unwrap().len(), 3, "{first}");
+    let out = ws.join("out");
+    let before = contents(&out);
+    // A second one, for another target (every file changes), cancelled
+    // while it stages its first robot.
+    let id = client
+        .send_request("workspace/executeCommand", generate("linux-sim"))
+        .await;
+    let line = next_pause(&paused);
+    assert!(line.starts_with("paused 1 "), "{line}");
+    client.notify("$/cancelRequest", json!({ "id": id })).await;
+    let cancelled = client.response(id).await.unwrap_err();
+    assert_eq!(cancelled["code"], -32800, "{cancelled}");
+    go.send(()).unwrap();
+    // Once the generation has let the folder go (its lock, waited for by
+    // util-linux's `flock`), it is as it was.
+    let released = tokio::task::block_in_place(|| {
+        std::process::Command::new("flock")
+            .arg(out.join(".semo.lock"))
+            .arg("true")
+            .status()
+            .unwrap()
+    });
+    assert!(released.success());
+    assert_eq!(
+        contents(&out).keys().collect::<Vec<_>>(),
+        before.keys().collect::<Vec<_>>()
+    );
+    assert!(contents(&out) == before, "a robot folder changed");
+    // The server goes on generating.
+    let id = client
+        .send_request("workspace/executeCommand", generate("linux-sim"))
+        .await;
+    let line = next_pause(&paused);
+    assert!(line.starts_with("paused 1 "), "{line}");
+    go.send(()).unwrap();
+    let done: Value = client.response(id).await.unwrap();
+    assert_eq!(done["target"], "linux-sim", "{done}");
+    assert!(contents(&out) != before);
+    client.shutdown().await;
+}
