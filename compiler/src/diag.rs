@@ -108,6 +108,7 @@ codes! {
     ValueNotProvided = "E033", Error, "a robot value that some robot reading it lacks";
     InvalidPeriod = "E034", Error, "a period or timeout that is not positive";
     OrderingNotNumeric = "E035", Error, "`<`, `<=`, `>` or `>=` with an operand that is not a number (a word, a string, a text value)";
+    TooManyRobots = "E036", Error, "`name[N]` with N above 4096, or a mission with more than 4096 robots in all";
     // Catalog files (*.robot.xml).
     CatalogXml = "E050", Error, "a catalog file that is not well-formed XML";
     CatalogUnknownElement = "E051", Error, "an element that the catalog format does not have";
