@@ -168,6 +168,8 @@ codes! {
     UnreachableAction = "W081", Warning, "an action that cannot be reached from the initial action";
     NoFinalAction = "W082", Warning, "an action machine in which no final action can be reached: the service never ends";
     FinalWithTransitions = "E096", Error, "a final action with outgoing transitions: the service ends there, so they are never taken";
+    // Every XML file (catalogs, task graphs, strategy files).
+    XmlTooDeep = "E097", Error, "an XML file whose elements are nested more than 256 deep: reading stops at the element past the limit";
     UncoveredGuards = "W083", Warning, "an action whose transition conditions leave some values of the variable they compare uncovered: the action waits there for ever";
     GuardNeverHolds = "W084", Warning, "a transition condition that no value of its variable satisfies";
     OverlappingGuards = "W085", Warning, "two transitions of one action that can be taken at once: the machine is not deterministic";
