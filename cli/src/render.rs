@@ -63,7 +63,9 @@ pub fn diagnostics(
     let builtin = files.get(semo::catalog::BUILTIN_FILE);
     sources.push((builtin.path.display().to_string(), builtin.text.clone()));
     let mut cache = ariadne::sources(sources);
-
+    // ariadne writes a snippet a few characters at a time: unbuffered, a
+    // diagnostic on a megabyte-long line was a million writes.
+    let mut out = io::BufWriter::new(out);
     for d in diagnostics {
         let path = path_of(files, d);
         let range = safe_range(&files.get(d.file).text, d.span);
@@ -91,7 +93,7 @@ pub fn diagnostics(
             report = report.with_help(format!("did you mean `{s}`?"));
         }
         if colored || d.severity != Severity::Hint {
-            report.finish().write(&mut cache, &mut *out)?;
+            report.finish().write(&mut cache, &mut out)?;
         } else {
             // ariadne colours a custom kind's header ("Hint") even with
             // colour off: written aside and its escape sequences dropped.
@@ -100,7 +102,7 @@ pub fn diagnostics(
             out.write_all(&without_escapes(&text))?;
         }
     }
-    Ok(())
+    out.flush()
 }
 
 /// `bytes` without ANSI escape sequences (`ESC [ … letter`).
