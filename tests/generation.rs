@@ -794,6 +794,8 @@ fn junk_is_shown_for_people_in_a_few_writes() {
         diags.len(),
         shown.stderr.len()
     );
+}
+
 /// `semo build ARGS` paused after its `step`th file operation
 /// (`SEMO_PAUSE_AFTER_FS_OPS`, through the FIFO `fifo`): `during` runs while
 /// it waits, then it goes on. Its exit code and standard error.

@@ -94,8 +94,10 @@ impl Content {
         {
             return Content::Scenario;
         }
+        // Whatever its first line looks like (`[lints]`, `[[ group(…) ]]`),
+        // a text is a project file only when it is TOML: no mission is.
         if !text.starts_with('<') {
-            return match looks_like_toml(text) {
+            return match semo::project::is_toml(text) {
                 true => Content::Project,
                 false => Content::Mission,
             };
@@ -120,27 +122,6 @@ impl Content {
             Content::OtherXml => "an XML file SeMo does not read",
         }
     }
-}
-
-/// Whether the first line that is not blank or a `#` comment (both
-/// languages have those) is a TOML table header or `key = value`, which no
-/// mission line is.
-fn looks_like_toml(text: &str) -> bool {
-    let Some(line) = text
-        .lines()
-        .map(str::trim)
-        .find(|l| !l.is_empty() && !l.starts_with('#'))
-    else {
-        return false;
-    };
-    line.starts_with('[')
-        || line.split_once('=').is_some_and(|(key, _)| {
-            let key = key.trim();
-            !key.is_empty()
-                && key
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || "_-.\"".contains(c))
-        })
 }
 
 /// The local name of an XML text's root element, past the declaration,
@@ -188,36 +169,36 @@ impl Content {
     }
 
     /// Whether a file holding this can be read as `wanted`: the same kind,
-    /// or XML of no known kind where XML is wanted (its reader then points
-    /// at the root element, with a did-you-mean).
+    /// XML of no known kind where XML is wanted (its reader then points
+    /// at the root element, with a did-you-mean), or text that is not TOML
+    /// where the project file is (its reader then says where, E110).
     fn fits(self, wanted: Content) -> bool {
-        self == wanted || (self == Content::OtherXml && wanted.is_xml())
+        self == wanted
+            || (self == Content::OtherXml && wanted.is_xml())
+            || (self == Content::Mission && wanted == Content::Project)
     }
 }
 
-/// For `semo check`, which knows a file by its name: whether a file named on
-/// the command line holds what its name makes it; if not, prints the one
-/// line that says so. Folders, `-` and unreadable files pass (the check
+/// For `semo check`, which knows a file by its name: why a file named on
+/// the command line does not hold what its name makes it, in one line;
+/// `None` when it does. Folders, `-` and unreadable files pass (the check
 /// reports the latter).
-pub fn named_file_fits_its_name(path: &Path) -> bool {
+pub fn named_file_misfit(path: &Path) -> Option<String> {
     if is_stdin(path) || path.is_dir() {
-        return true;
+        return None;
     }
-    let Ok(text) = semo::workspace::read_text(path) else {
-        return true;
-    };
+    let text = semo::workspace::read_text(path).ok()?;
     let wanted = Content::of_kind(FileKind::named_explicitly(path));
     let found = Content::of(&text);
     if found.fits(wanted) {
-        return true;
+        return None;
     }
-    eprintln!(
-        "error: {} is {}, but its name makes it {}: `semo check` knows a file by its name (*.mission, *.robot.xml, *.strategy.xml, *.taskgraph.xml, another *.xml is a task graph)",
+    Some(format!(
+        "{} is {}, but its name makes it {}: `semo check` knows a file by its name (*.mission, *.robot.xml, *.strategy.xml, *.taskgraph.xml, another *.xml is a task graph)",
         path.display(),
         found.words(),
         wanted.words()
-    );
-    false
+    ))
 }
 
 /// Whether `text` (of `path`) holds what `command` takes; if not, prints
@@ -270,6 +251,14 @@ mod tests {
             ("\u{feff}<s:Strategy name=\"T\">", Content::Strategy),
             ("<!DOCTYPE html><html>", Content::OtherXml),
             ("<!-- never closed", Content::OtherXml),
+            // TOML, and text whose first line only looks like it.
+            ("[project]\nname = \"x\"\n", Content::Project),
+            ("# lints\n[lints]\nW001 = \"allow\"\n", Content::Project),
+            ("version = 1\n", Content::Project),
+            ("[lints]\n{ T: x a }\n", Content::Mission),
+            ("[[ group(instance of X) { stop() } ]]\n", Content::Mission),
+            ("[T]\nT.main { default: mode = M }\n", Content::Mission),
+            ("# only a comment\n", Content::Mission),
         ];
         for (text, want) in cases {
             assert_eq!(Content::of(text), want, "{text}");

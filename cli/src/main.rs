@@ -656,26 +656,9 @@ fn check(
     } else {
         paths
     };
-    if !paths.iter().all(|p| input::named_file_fits_its_name(p)) {
-        return 2;
-    }
-    let loaded = if paths.iter().any(|p| p.as_os_str() == "-") {
-        if paths.len() > 1 {
-            eprintln!(
-                "error: `-` (a mission on standard input) cannot be checked with other paths"
-            );
-            return 2;
-        }
-        input::read_stdin().map(semo::host::load_check_stdin)
-    } else {
-        semo::host::load_check(&paths).map_err(|e| e.to_string())
-    };
-    let run = match loaded {
+    let run = match load_for_check(&paths) {
         Ok(run) => run,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
+        Err((path, message)) => return output::refused(format, "check", &path, &message, out),
     };
     let written = match format {
         // The report for people, summary included, is diagnostics: stderr.
@@ -706,6 +689,27 @@ fn check(
     } else {
         0
     }
+}
+
+/// The files `semo check PATHS` reports on, loaded; or the path that
+/// stopped it and why.
+fn load_for_check(paths: &[PathBuf]) -> Result<semo::host::CheckRun, (PathBuf, String)> {
+    for path in paths {
+        if let Some(message) = input::named_file_misfit(path) {
+            return Err((path.clone(), message));
+        }
+    }
+    if paths.iter().any(|p| input::is_stdin(p)) {
+        if paths.len() > 1 {
+            let message =
+                "`-` (a mission on standard input) cannot be checked with other paths".to_string();
+            return Err((PathBuf::from(input::STDIN_NAME), message));
+        }
+        return input::read_stdin()
+            .map(semo::host::load_check_stdin)
+            .map_err(|message| (PathBuf::from(input::STDIN_NAME), message));
+    }
+    semo::host::load_check(paths).map_err(|e| (e.path.clone(), e.to_string()))
 }
 
 fn explain(code: Option<&str>, out: &mut impl Write) -> i32 {

@@ -271,6 +271,32 @@ pub fn report(
     }
 }
 
+/// A command that stops before it has diagnostics (a file it cannot read,
+/// or of the wrong kind): the one line for people on standard error, and in
+/// JSON or SARIF the document all the same, its one diagnostic the refusal
+/// (no code, at the start of `file`), so that a reader of the document
+/// always gets one. Gives the exit status, 2.
+pub fn refused(
+    format: Format,
+    command: &str,
+    file: &Path,
+    message: &str,
+    out: &mut impl Write,
+) -> i32 {
+    eprintln!("error: {message}");
+    let records = [Record::uncoded_error(file, 1, 1, message.to_string())];
+    let written = match format {
+        Format::Human => Ok(()),
+        Format::Json => write_json(
+            out,
+            &json_document(command, &records, serde_json::json!({})),
+        ),
+        Format::Sarif => write_json(out, &sarif(&records)),
+    };
+    let _ = self::written(written);
+    2
+}
+
 /// What a failed write of a report means: a reader that went away (`semo
 /// check | head`) is no problem; anything else is exit status 2.
 pub fn written(result: io::Result<()>) -> Result<(), i32> {

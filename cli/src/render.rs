@@ -63,7 +63,6 @@ pub fn diagnostics(
     let builtin = files.get(semo::catalog::BUILTIN_FILE);
     sources.push((builtin.path.display().to_string(), builtin.text.clone()));
     let mut cache = ariadne::sources(sources);
-
     for d in diagnostics {
         let path = path_of(files, d);
         let range = safe_range(&files.get(d.file).text, d.span);
@@ -103,7 +102,7 @@ pub fn diagnostics(
         }
         out.write_all(&text)?;
     }
-    Ok(())
+    out.flush()
 }
 
 /// `bytes` without ANSI escape sequences (`ESC [ … letter`).

@@ -111,6 +111,7 @@ codes! {
     ReceivedNotAValue = "E040", Error, "a receive or subscribe of a name that is not a value: neither `Team.VALUE`, `USER.VALUE` nor `VALUE`";
     WordIsAValue = "E041", Error, "a bare word where a word may stand that is also a value the robots read: write `\"WORD\"` for the word or `Team.WORD` for the value";
     StrategyPassesNothing = "E042", Error, "an actuator's or algorithm's parameter without a `value` whose name is no parameter of the strategy's actions nor of the service: its task would get nothing";
+    TooManyRobots = "E036", Error, "`name[N]` with N above 4096, or a mission with more than 4096 robots in all";
     // Catalog files (*.robot.xml).
     CatalogXml = "E050", Error, "a catalog file that is not well-formed XML";
     CatalogUnknownElement = "E051", Error, "an element that the catalog format does not have";
@@ -170,6 +171,8 @@ codes! {
     UnreachableAction = "W081", Warning, "an action that cannot be reached from the initial action";
     NoFinalAction = "W082", Warning, "an action machine in which no final action can be reached: the service never ends";
     FinalWithTransitions = "E096", Error, "a final action with outgoing transitions: the service ends there, so they are never taken";
+    // Every XML file (catalogs, task graphs, strategy files).
+    XmlTooDeep = "E097", Error, "an XML file whose elements are nested more than 256 deep: reading stops at the element past the limit";
     UncoveredGuards = "W083", Warning, "an action whose transition conditions leave some values of the variable they compare uncovered: the action waits there for ever";
     GuardNeverHolds = "W084", Warning, "a transition condition that no value of its variable satisfies";
     OverlappingGuards = "W085", Warning, "two transitions of one action that can be taken at once: the machine is not deterministic";

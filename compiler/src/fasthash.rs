@@ -18,6 +18,8 @@ pub struct FastHasher {
 }
 
 const SEED: u64 = 0x51_7c_c1_b7_27_22_0a_95;
+/// 2^64 divided by the golden ratio, odd.
+const FINISH: u64 = 0x9e_37_79_b9_7f_4a_7c_15;
 
 impl FastHasher {
     #[inline]
@@ -69,9 +71,16 @@ impl Hasher for FastHasher {
         self.add(i as u64);
     }
 
+    /// The state mixed by one folded multiplication (the 128-bit product's
+    /// halves xored, as foldhash and wyhash finish): a product's low bits
+    /// depend only on its factors' low bits, and a table picks its bucket
+    /// by the hash's low bits, so without it names differing only in their
+    /// last characters (`a0` … `a99999`, generated names) share a few
+    /// buckets and every lookup compares them all.
     #[inline]
     fn finish(&self) -> u64 {
-        self.hash
+        let product = u128::from(self.hash) * u128::from(FINISH);
+        (product as u64) ^ ((product >> 64) as u64)
     }
 }
 
@@ -97,5 +106,28 @@ mod tests {
             map.insert(n, i);
         }
         assert!(names.iter().enumerate().all(|(i, n)| map[n.as_str()] == i));
+    }
+
+    /// A table picks its bucket by the hash's low bits: names that differ
+    /// only at their end must spread over them, or every lookup compares
+    /// them all (quadratic: a catalog element with 100,000 attributes took
+    /// seconds to check for repeated names).
+    #[test]
+    fn names_differing_at_their_end_spread_over_the_low_bits() {
+        let n = 1 << 16;
+        for prefix in ["a", "S", "robot_", "a_rather_long_name_"] {
+            let low: HashSet<u64> = (0..n)
+                .map(|i| hash(format!("{prefix}{i}")) & 0xffff)
+                .collect();
+            assert!(low.len() > n / 2, "{prefix}: {} buckets of {n}", low.len());
+            let bytes: HashSet<u64> = (0..n)
+                .map(|i| hash(format!("{prefix}{i}").as_bytes()) & 0xffff)
+                .collect();
+            assert!(
+                bytes.len() > n / 2,
+                "{prefix}: {} buckets of {n}",
+                bytes.len()
+            );
+        }
     }
 }

@@ -4,6 +4,7 @@
 //! name and attribute value it hands out is a slice of the text and its range is
 //! found by pointer arithmetic ([`slice_span`]).
 
+use crate::fasthash::FastSet;
 use crate::span::Span;
 use crate::suggest::{did_you_mean, edit_distance};
 use quick_xml::Reader;
@@ -343,10 +344,28 @@ pub(crate) fn read_attributes_keeping_lt_into(
     };
     // Attribute error positions count from the byte after `<`.
     let content_start = tag.start + 1;
-    for attr in e.attributes() {
+    // quick-xml's own check for a repeated name compares each name with every
+    // one before it: quadratic in a tag's attributes. [`first_repeated`] is
+    // linear, and runs where quick-xml's would have stopped: at the end, or
+    // before the first malformed attribute.
+    let repeated = |out: &[Attr], raw_lt: &[usize]| {
+        let i = first_repeated(out, |a| a.key.as_bytes())?;
+        let key = out[i].key_span;
+        let lt_before: Vec<usize> = raw_lt
+            .iter()
+            .copied()
+            .filter(|&at| at < key.start)
+            .collect();
+        let message = "this attribute is given twice on the same element".to_string();
+        Some(fail(&lt_before, word_at(text, key.start), message))
+    };
+    for attr in e.attributes().with_checks(false) {
         let attr = match attr {
             Ok(a) => a,
             Err(err) => {
+                if let Some(error) = repeated(out, &raw_lt) {
+                    return Err(error);
+                }
                 let (pos, message) = match err {
                     AttrError::ExpectedEq(p) => (
                         p,
@@ -367,6 +386,7 @@ pub(crate) fn read_attributes_keeping_lt_into(
                             q as char
                         ),
                     ),
+                    // Not checked by quick-xml (see above).
                     AttrError::Duplicated(p, _) => (
                         p,
                         "this attribute is given twice on the same element".to_string(),
@@ -415,7 +435,24 @@ pub(crate) fn read_attributes_keeping_lt_into(
             exact,
         });
     }
-    Ok(raw_lt)
+    match repeated(out, &raw_lt) {
+        Some(error) => Err(error),
+        None => Ok(raw_lt),
+    }
+}
+
+/// The index of the first of `items` whose key is that of an item before it,
+/// in linear time: a scan while there are few (most elements have a handful
+/// of attributes), a hash set past that.
+pub(crate) fn first_repeated<T>(items: &[T], key: impl Fn(&T) -> &[u8]) -> Option<usize> {
+    const SCAN: usize = 16;
+    if items.len() <= SCAN {
+        return (1..items.len())
+            .find(|&i| items[..i].iter().any(|seen| key(seen) == key(&items[i])));
+    }
+    let mut seen = FastSet::default();
+    seen.reserve(items.len());
+    items.iter().position(|item| !seen.insert(key(item)))
 }
 
 /// For each byte offset of `attr.value` (and one past its end), the byte
@@ -586,6 +623,56 @@ impl std::fmt::Display for Escaped<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `first_repeated` reads each key a bounded number of times, however
+    /// many there are: counted, not timed.
+    #[test]
+    fn a_repeated_key_is_found_in_linear_work() {
+        for n in [2, 16, 17, 1_000, 100_000] {
+            let mut keys: Vec<String> = (0..n).map(|i| format!("a{i}")).collect();
+            let reads = std::cell::Cell::new(0);
+            let counted = first_repeated(&keys, |k| {
+                reads.set(reads.get() + 1);
+                k.as_bytes()
+            });
+            assert_eq!(counted, None);
+            assert!(reads.get() <= 16 * n, "{n} keys read {} times", reads.get());
+            keys.push(format!("a{}", n / 2));
+            assert_eq!(first_repeated(&keys, |k| k.as_bytes()), Some(n));
+        }
+    }
+
+    #[test]
+    fn a_repeated_attribute_is_malformed_xml_at_its_second_name() {
+        use quick_xml::events::Event;
+        for (text, second) in [
+            (r#"<a x="1" y="2" x="3"/>"#, 15),
+            // Before a malformed attribute after it, as quick-xml found it.
+            (r#"<a x="1" x="2" y=3/>"#, 9),
+        ] {
+            let mut reader = reader(text);
+            let Ok(Event::Empty(e)) = reader.read_event() else {
+                panic!("{text}");
+            };
+            let tag = Span::new(0, text.len());
+            let mut out = Vec::new();
+            let (span, message) =
+                read_attributes_into(text, &e, tag, reader.decoder(), &mut out).unwrap_err();
+            assert_eq!(span.start, second, "{text}: {message}");
+        }
+        // Many attributes: found all the same, past the short scan.
+        let many: String = (0..100).map(|i| format!(" a{i}=\"v\"")).collect();
+        let text = format!("<a{many} a50=\"again\"/>");
+        let mut reader = reader(&text);
+        let Ok(quick_xml::events::Event::Empty(e)) = reader.read_event() else {
+            panic!("{text}");
+        };
+        let mut out = Vec::new();
+        let tag = Span::new(0, text.len());
+        let (span, message) =
+            read_attributes_into(&text, &e, tag, reader.decoder(), &mut out).unwrap_err();
+        assert_eq!(span.start, text.rfind("a50").unwrap(), "{message}");
+    }
 
     #[test]
     fn xml_comments_cannot_end_early() {

@@ -19,6 +19,13 @@ use quick_xml::encoding::Decoder;
 use quick_xml::errors::SyntaxError;
 use quick_xml::events::{BytesEnd, BytesStart, Event};
 
+/// The deepest an element may be nested, the root being at depth 1 (E097):
+/// libxml2's default. SeMo's formats need a few levels (a loop body's
+/// `<TaskGraph>` inside its `<Loop>` adds two per loop), and what the
+/// loaders build from the tree, its own drop included, recurses on its
+/// depth: bounded here, it stays far from any thread's stack.
+pub const MAX_DEPTH: usize = 256;
+
 /// One element as written.
 #[derive(Debug)]
 pub(crate) struct Elem {
@@ -449,6 +456,9 @@ impl<V: Visit> Walker<'_, '_, '_, V> {
             Ok(start) => start,
             Err((span, message)) => return self.malformed(span, message),
         };
+        if self.stack.len() == MAX_DEPTH {
+            return self.too_deep(name_span, &qname);
+        }
         let attrs = self.attributes(e, tag, decoder)?;
         if self.stack.is_empty() {
             if let Some(root) = &self.root {
@@ -477,6 +487,18 @@ impl<V: Visit> Walker<'_, '_, '_, V> {
             self.stack.push(elem);
         }
         Ok(())
+    }
+
+    /// An element nested deeper than [`MAX_DEPTH`]: reading stops there, the
+    /// elements around it closed as incomplete.
+    fn too_deep(&mut self, name_span: Span, qname: &str) -> Flow {
+        let message = format!(
+            "`<{qname}>` is nested {} elements deep; SeMo reads XML nested at most {MAX_DEPTH} deep, and stops reading here",
+            MAX_DEPTH + 1
+        );
+        self.diagnostics
+            .report(Code::XmlTooDeep, name_span, message);
+        Err(Stop)
     }
 
     fn end(&mut self, e: &BytesEnd<'_>, tag_end: usize) -> Flow {
@@ -557,6 +579,35 @@ mod tests {
                 assert_eq!(diags[0].span.start, text.find("x<").unwrap() + 1);
             }
         }
+    }
+
+    /// `<r>` and `levels` nested `<x>`, closed.
+    fn nested(levels: usize) -> String {
+        ["<r>", &"<x>".repeat(levels), &"</x>".repeat(levels), "</r>"].concat()
+    }
+
+    #[test]
+    fn nesting_past_the_limit_stops_reading_at_the_element_past_it() {
+        let (root, diags) = read_tree(&nested(MAX_DEPTH - 1), format(None));
+        assert!(diags.is_empty(), "{diags:#?}");
+        assert!(root.unwrap().complete);
+        // A million levels: one diagnostic, on the name of the element past
+        // the limit, and a tree as deep as the limit, dropped without
+        // recursing past it.
+        let text = nested(1_000_000);
+        let (root, diags) = read_tree(&text, format(None));
+        assert_eq!(diags.len(), 1, "{diags:#?}");
+        assert_eq!(diags[0].code, Code::XmlTooDeep);
+        let name = "<r>".len() + (MAX_DEPTH - 1) * "<x>".len() + 1;
+        assert_eq!(diags[0].span, Span::new(name, name + 1));
+        let mut depth = 0;
+        let mut elem = root.as_ref();
+        while let Some(e) = elem {
+            assert!(!e.complete);
+            depth += 1;
+            elem = e.children.first();
+        }
+        assert_eq!(depth, MAX_DEPTH);
     }
 
     #[test]

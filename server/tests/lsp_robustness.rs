@@ -170,3 +170,111 @@ async fn a_ten_megabyte_document_is_checked_and_its_diagnostics_capped() {
     still_serves(&mut client).await;
     client.shutdown().await;
 }
+
+/// The diagnostic codes of `diagnostics`.
+fn codes(diagnostics: &[Value]) -> Vec<&str> {
+    diagnostics
+        .iter()
+        .filter_map(|d| d["code"].as_str())
+        .collect()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_robot_count_past_the_limit_is_an_error_and_the_folder_still_checks() {
+    let swarm = "file:///t/swarm/swarm.mission";
+    let other = "file:///t/swarm/other.mission";
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], None).await;
+    // What took 51 GB before the limit.
+    let text = "{ S: Ev3_Robot ev[2147483648] }\nS.Action.Go { move(\"5,5\") } repeat()\nS.GO { set(Action, Go) }\nS.main { default: mode = GO }\n";
+    client.open(swarm, text).await;
+    let diagnostics = client.diagnostics(swarm, Some(1)).await;
+    assert_eq!(codes(&diagnostics), ["E036"], "{diagnostics:?}");
+    let range = &diagnostics[0]["range"];
+    assert_eq!(support::text_at(text, range), "2147483648");
+    // A mission beside it is checked as ever.
+    let clean = "{ T: Ev3_Robot ev[1000] }\nT.Action.Go { move(\"5,5\") } repeat()\nT.GO { set(Action, Go) }\nT.main { default: mode = GO }\n";
+    client.open(other, clean).await;
+    let diagnostics = client.diagnostics(other, Some(1)).await;
+    assert!(diagnostics.is_empty(), "{diagnostics:?}");
+    still_serves(&mut client).await;
+    client.shutdown().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn xml_nested_a_million_deep_is_an_error_on_the_servers_threads() {
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], None).await;
+    for (uri, open, close) in [
+        (
+            "file:///t/deep/deep.robot.xml",
+            "<Catalog xmlns=\"urn:semo:catalog:1\">",
+            "</Catalog>",
+        ),
+        (
+            "file:///t/deep/deep.strategy.xml",
+            "<Strategy name=\"T\">",
+            "</Strategy>",
+        ),
+        (
+            "file:///t/deep/deep.taskgraph.xml",
+            "<TaskGraph name=\"g\">",
+            "</TaskGraph>",
+        ),
+        (
+            "file:///t/deep/sdf3.taskgraph.xml",
+            "<sdf3 type=\"sdf\" version=\"1.0\">",
+            "</sdf3>",
+        ),
+    ] {
+        // 1,000,000 levels: the server's threads overflowed at about 50,000.
+        let levels = 1_000_000;
+        let text = [open, &"<x>".repeat(levels), &"</x>".repeat(levels), close].concat();
+        client.open(uri, &text).await;
+        let diagnostics = client.diagnostics(uri, Some(1)).await;
+        assert!(
+            codes(&diagnostics).contains(&"E097"),
+            "{uri}: {diagnostics:?}"
+        );
+        // The element past the limit: the 256th `<x>` below the root.
+        let e097 = diagnostics.iter().find(|d| d["code"] == "E097").unwrap();
+        let column = open.len() + 255 * "<x>".len() + 1;
+        assert_eq!(
+            e097["range"]["start"],
+            json!({ "line": 0, "character": column })
+        );
+        // Editor features on the file answer too.
+        let hover = client
+            .request(
+                "textDocument/hover",
+                json!({ "textDocument": { "uri": uri }, "position": { "line": 0, "character": column } }),
+            )
+            .await;
+        assert!(hover.is_ok(), "{uri}: {hover:?}");
+    }
+    still_serves(&mut client).await;
+    client.shutdown().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn loops_nested_to_the_xml_limit_are_analysed_and_drawn_on_the_servers_threads() {
+    // 126 loops, the innermost `<Port>` 255 deep: the loader, the analyses
+    // and the picture walk the nesting on the server's 2 MiB threads.
+    let text = include_str!("../../tests/fixtures/limits/nested_loops.taskgraph.xml");
+    let uri = "file:///t/nest/nested_loops.taskgraph.xml";
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], None).await;
+    client.open(uri, text).await;
+    let diagnostics = client.diagnostics(uri, Some(1)).await;
+    assert!(diagnostics.is_empty(), "{diagnostics:?}");
+    let picture = client
+        .request("semo/graphSvg", json!({ "textDocument": { "uri": uri } }))
+        .await
+        .unwrap();
+    assert!(
+        picture["svg"].as_str().unwrap().contains("L126"),
+        "{picture}"
+    );
+    still_serves(&mut client).await;
+    client.shutdown().await;
+}

@@ -250,6 +250,13 @@ fn normalize(path: &Path) -> PathBuf {
     out
 }
 
+/// Whether `text` is a TOML document with at least one key or table: a
+/// project file, and never a mission (whose text opens with `{`, which TOML
+/// does not allow there), whatever its first line looks like.
+pub fn is_toml(text: &str) -> bool {
+    toml_edit::Document::parse(text).is_ok_and(|document| !document.as_table().is_empty())
+}
+
 /// Reads the project file `text` of the project at `root` (the folder
 /// holding it), with its diagnostics (see the module documentation).
 pub fn parse(file: FileId, root: &Path, text: &str) -> (Project, Vec<Diagnostic>) {

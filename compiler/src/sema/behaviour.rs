@@ -5,9 +5,11 @@
 use super::ir::*;
 use super::{Checker, suggestion};
 use crate::diag::{Code, Severity};
-use crate::fasthash::FastSet;
+use crate::fasthash::{FastMap, FastSet};
+use crate::span::Span;
 use crate::syntax::ast::Name;
 use crate::syntax::ast::{self, Item, SetTarget};
+use std::collections::hash_map::Entry;
 
 impl<'a> Checker<'a> {
     pub(super) fn check_behaviour(&mut self, source: &'a ast::SourceFile) {
@@ -53,6 +55,8 @@ impl<'a> Checker<'a> {
         // are still checked.
         let mode = self.declared_mode(m).map(|(_, mode)| mode);
         let mut sets: Vec<ModeSet> = Vec::new();
+        // Where each plan is first set, without scanning `sets`.
+        let mut first_sets: FastMap<PlanId, Span> = FastMap::default();
         for set in &m.sets {
             if let Some(p) = &set.timeout {
                 self.period(p);
@@ -79,8 +83,14 @@ impl<'a> Checker<'a> {
                         .suggest(guess);
                 }
             }
-            if let Some(first) = sets.iter().find(|s| plan.is_some() && s.plan == plan) {
-                let first = first.span;
+            let first = plan.and_then(|plan| match first_sets.entry(plan) {
+                Entry::Occupied(first) => Some(*first.get()),
+                Entry::Vacant(at) => {
+                    at.insert(set.span);
+                    None
+                }
+            });
+            if let Some(first) = first {
                 self.diagnostics
                     .report(
                         Code::PlanSetTwice,
@@ -201,11 +211,13 @@ impl<'a> Checker<'a> {
             }
         };
         let mut transitions = Vec::new();
-        let mut cased: Vec<(ModeId, crate::span::Span)> = Vec::new();
+        // The first case of each mode, and below the first catch of each
+        // event, by hash: a main may have thousands.
+        let mut cased: FastMap<ModeId, Span> = FastMap::default();
         for case in &m.cases {
             let from = self.mode_ref(team, &case.mode);
             if let Some(from) = from {
-                if let Some(&(_, first)) = cased.iter().find(|(f, _)| *f == from) {
+                if let Some(&first) = cased.get(&from) {
                     self.diagnostics
                         .report(
                             Code::DuplicateCase,
@@ -214,14 +226,13 @@ impl<'a> Checker<'a> {
                         )
                         .relate(first, "first case here");
                 } else {
-                    cased.push((from, case.mode.span));
+                    cased.insert(from, case.mode.span);
                 }
             }
-            let mut caught: Vec<&ast::Ident> = Vec::new();
+            let mut caught: FastMap<&Name, Span> = FastMap::default();
             for catch in &case.catches {
                 self.caught(team, &catch.event);
-                if let Some(first) = caught.iter().find(|e| e.name == catch.event.name) {
-                    let first = first.span;
+                if let Some(&first) = caught.get(&catch.event.name) {
                     self.diagnostics
                         .report(
                             Code::DuplicateCatch,
@@ -230,7 +241,7 @@ impl<'a> Checker<'a> {
                         )
                         .relate(first, "first caught here");
                 } else {
-                    caught.push(&catch.event);
+                    caught.insert(&catch.event.name, catch.event.span);
                 }
                 let to = self.mode_ref(team, &catch.target);
                 if let (Some(from), Some(to)) = (from, to) {
@@ -308,14 +319,18 @@ impl<'a> Checker<'a> {
         let t = self.team(team);
         let mut findings = Vec::new();
         let mut never_thrown = Vec::new();
+        // The events each mode's services throw, gathered once per mode: a
+        // mode may have many catches.
+        let mut thrown_in: FastMap<ModeId, FastSet<&Name>> = FastMap::default();
         for (i, tr) in main.transitions.iter().enumerate() {
             let mode = &t.modes[tr.from.index()];
-            let thrown = mode
-                .sets
-                .iter()
-                .filter_map(|s| s.service)
-                .any(|s| t.services[s.index()].throws.contains(&tr.event));
-            if !thrown {
+            let thrown = thrown_in.entry(tr.from).or_insert_with(|| {
+                let services = mode.sets.iter().filter_map(|s| s.service);
+                services
+                    .flat_map(|s| &t.services[s.index()].throws)
+                    .collect()
+            });
+            if !thrown.contains(&tr.event) {
                 never_thrown.push(i);
                 findings.push((
                     tr.event_span,
@@ -353,12 +368,16 @@ impl<'a> Checker<'a> {
         else {
             return;
         };
+        let mut leaving: FastMap<ModeId, Vec<ModeId>> = FastMap::default();
+        for tr in transitions {
+            leaving.entry(tr.from).or_default().push(tr.to);
+        }
         let mut reached = FastSet::from_iter([*start]);
         let mut queue = vec![*start];
         while let Some(mode) = queue.pop() {
-            for tr in transitions.iter().filter(|tr| tr.from == mode) {
-                if reached.insert(tr.to) {
-                    queue.push(tr.to);
+            for &to in leaving.get(&mode).into_iter().flatten() {
+                if reached.insert(to) {
+                    queue.push(to);
                 }
             }
         }

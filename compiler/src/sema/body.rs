@@ -11,6 +11,7 @@ use crate::diag::Code;
 use crate::span::Span;
 use crate::syntax::ast::{self, Arg, ArmKind, CondKind, Expr, ExprKind, Name, StmtKind};
 use std::rc::Rc;
+use std::sync::Arc;
 
 /// Deeper chains of function calls are refused: they are surely a mistake, and
 /// the checker's recursion must stay bounded.
@@ -19,14 +20,58 @@ const MAX_INLINING_DEPTH: usize = 64;
 /// Robot types, each with the names of the robots of that type.
 pub(super) type TypeList = Rc<[(RobotTypeId, Vec<Name>)]>;
 
+/// The robots running a scope, shared ([`Checker::shared_robots`]): equal
+/// sets are one list, so equality and hashing are by identity, not by the
+/// thousands of robots a team may have.
+#[derive(Clone, Debug)]
+pub(super) struct Robots(Arc<[RobotId]>);
+
+impl std::ops::Deref for Robots {
+    type Target = [RobotId];
+
+    fn deref(&self) -> &[RobotId] {
+        &self.0
+    }
+}
+
+impl PartialEq for Robots {
+    fn eq(&self, other: &Robots) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+impl Eq for Robots {}
+
+impl std::hash::Hash for Robots {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        std::ptr::hash(Arc::as_ptr(&self.0), state);
+    }
+}
+
+/// The most robot names a message lists; the others are counted.
+const NAMES_LISTED: usize = 8;
+
+/// `names` (`count` of them) for a message: the first few, then how many
+/// more, so that a message stays short whatever the team's size.
+fn some_names<'n>(names: impl Iterator<Item = &'n str>, count: usize) -> String {
+    let listed: Vec<&str> = names.take(NAMES_LISTED).collect();
+    match count.checked_sub(listed.len()) {
+        Some(more @ 1..) => format!("{} and {more} more", listed.join(", ")),
+        _ => listed.join(", "),
+    }
+}
+
 /// Who runs the statements being checked.
 #[derive(Clone, Debug)]
 pub(super) struct Scope {
     /// `None` inside a function that no service calls: robots are unknown.
     team: Option<TeamId>,
     service: Option<ServiceId>,
-    /// The team's robots that run the statement.
-    robots: Vec<RobotId>,
+    /// The team's robots that run the statement: one shared list per set
+    /// of robots ([`Checker::shared_robots`]), however many statements and
+    /// scopes it runs (a team of thousands of robots and a file of
+    /// thousands of statements would otherwise hold their product).
+    robots: Robots,
     /// The known robot types among `robots`, with those robots' names: computed
     /// once per scope, read by every call and value in it.
     types: TypeList,
@@ -183,7 +228,7 @@ impl<'a> Checker<'a> {
             .collect();
         for t in 0..self.mission.teams.len() {
             let team = TeamId(t as u32);
-            let all: Vec<RobotId> = self.team(team).robot_ids().collect();
+            let all = self.shared_robots(self.team(team).robot_ids().collect());
             for s in 0..self.service_syntax[t].len() {
                 let syntax = self.service_syntax[t][s];
                 let scope = Scope {
@@ -212,10 +257,11 @@ impl<'a> Checker<'a> {
         // Rejected definitions: checked with their team's robots, but belonging
         // to no service (they send, receive and run nothing).
         for (team, body) in std::mem::take(&mut self.rejected_bodies) {
-            let robots: Vec<RobotId> = match team {
+            let robots = match team {
                 Some(t) => self.team(t).robot_ids().collect(),
                 None => Vec::new(),
             };
+            let robots = self.shared_robots(robots);
             let scope = Scope {
                 team,
                 service: None,
@@ -233,7 +279,7 @@ impl<'a> Checker<'a> {
                 let scope = Scope {
                     team: None,
                     service: None,
-                    robots: Vec::new(),
+                    robots: self.shared_robots(Vec::new()),
                     types: Rc::new([]),
                     inlining: vec![FunctionId(f as u32)],
                 };
@@ -259,7 +305,7 @@ impl<'a> Checker<'a> {
     fn record_scope(&mut self, span: Span, kind: ScopeKind, scope: &Scope) {
         let runners = Runners {
             team: scope.team,
-            robots: scope.robots.clone(),
+            robots: scope.robots.0.clone(),
         };
         self.scope(span, kind, runners);
     }
@@ -313,11 +359,12 @@ impl<'a> Checker<'a> {
         self.event_occurrence(team, event);
         let t = self.team_mut(team);
         t.event_mut(&event.name).thrown_at.push(event.span);
-        if let Some(service) = scope.service {
-            let throws = &mut t.services[service.index()].throws;
-            if !throws.contains(&event.name) {
-                throws.push(event.name.clone());
-            }
+        if let Some(service) = scope.service
+            && self.thrown.insert((team, service, event.name.clone()))
+        {
+            self.team_mut(team).services[service.index()]
+                .throws
+                .push(event.name.clone());
         }
     }
 
@@ -375,15 +422,28 @@ impl<'a> Checker<'a> {
     }
 
     /// The same scope, run by fewer robots (inside a group).
-    fn narrowed(&self, scope: &Scope, robots: Vec<RobotId>) -> Scope {
+    fn narrowed(&mut self, scope: &Scope, robots: Vec<RobotId>) -> Scope {
         let types = match scope.team {
             Some(team) => self.types_of(team, &robots),
             None => Rc::new([]),
         };
         Scope {
-            robots,
+            robots: self.shared_robots(robots),
             types,
             ..scope.clone()
+        }
+    }
+
+    /// `robots` as the one shared list of that set: equal sets are one
+    /// list, so that a scope's robots are compared and hashed by identity.
+    fn shared_robots(&mut self, robots: Vec<RobotId>) -> Robots {
+        let robots: Arc<[RobotId]> = robots.into();
+        match self.robot_sets.get(&robots) {
+            Some(shared) => Robots(shared.clone()),
+            None => {
+                self.robot_sets.insert(robots.clone());
+                Robots(robots)
+            }
         }
     }
 
@@ -402,10 +462,16 @@ impl<'a> Checker<'a> {
         types.into()
     }
 
-    fn describe_types(&self, types: &[(RobotTypeId, Vec<Name>)]) -> String {
+    fn describe_types<'t>(
+        &self,
+        types: impl IntoIterator<Item = &'t (RobotTypeId, Vec<Name>)>,
+    ) -> String {
         let parts: Vec<String> = types
-            .iter()
-            .map(|(ty, names)| format!("{} ({})", self.catalog.get(*ty).name, names.join(", ")))
+            .into_iter()
+            .map(|(ty, names)| {
+                let names = some_names(names.iter().map(Name::as_str), names.len());
+                format!("{} ({names})", self.catalog.get(*ty).name)
+            })
             .collect();
         parts.join(", ")
     }
@@ -453,10 +519,9 @@ impl<'a> Checker<'a> {
             false,
         );
         if providers < types.len() {
-            let lacking: Vec<(RobotTypeId, Vec<Name>)> = types
+            let lacking: Vec<&(RobotTypeId, Vec<Name>)> = types
                 .iter()
                 .filter(|(ty, _)| catalog.get(*ty).service(name).is_none())
-                .cloned()
                 .collect();
             let having: Vec<&str> = catalog
                 .types()
@@ -490,7 +555,7 @@ impl<'a> Checker<'a> {
             };
             let message = format!(
                 "`{name}` is not a service of {} in team {team}; {advice}",
-                self.describe_types(&lacking)
+                self.describe_types(lacking)
             );
             self.diagnostics
                 .report(Code::ServiceNotProvided, call.name.span, message);
@@ -879,15 +944,13 @@ impl<'a> Checker<'a> {
         advice: String,
         none: bool,
     ) -> Resolution {
-        let lacking: Vec<_> = types
+        let lacking = types
             .iter()
-            .filter(|(ty, _)| self.catalog.get(*ty).value(name).is_none())
-            .cloned()
-            .collect();
+            .filter(|(ty, _)| self.catalog.get(*ty).value(name).is_none());
         Resolution::PartialValue {
             name: Name::new(name),
             team: self.team(team).name.clone(),
-            lacking: self.describe_types(&lacking),
+            lacking: self.describe_types(lacking),
             advice,
             none,
         }
@@ -1097,7 +1160,10 @@ impl<'a> Checker<'a> {
     }
 
     fn group(&mut self, g: &'a ast::GroupStmt, scope: &Scope) {
-        let mut taken: Vec<RobotId> = Vec::new();
+        // Per robot of the team, whether an earlier arm took it.
+        let robot_count = scope.team.map_or(0, |t| self.team(t).robots.len());
+        let mut taken = vec![false; robot_count];
+        let is_taken = |taken: &[bool], r: &RobotId| taken.get(r.index()).copied().unwrap_or(false);
         let checkable = scope.team.is_some() && !scope.robots.is_empty();
         for arm in &g.arms {
             let (members, all_known) = self.group_members(&arm.condition, scope);
@@ -1124,7 +1190,7 @@ impl<'a> Checker<'a> {
             let overlap: Vec<RobotId> = members
                 .iter()
                 .copied()
-                .filter(|r| taken.contains(r))
+                .filter(|r| is_taken(&taken, r))
                 .collect();
             if arm.kind == ArmKind::Group && !overlap.is_empty() {
                 let names = self.robot_names(scope, &overlap);
@@ -1141,7 +1207,7 @@ impl<'a> Checker<'a> {
                 ArmKind::Group => members
                     .iter()
                     .copied()
-                    .filter(|r| !taken.contains(r))
+                    .filter(|r| !is_taken(&taken, r))
                     .collect(),
                 ArmKind::Leader => members.clone(),
             };
@@ -1160,7 +1226,9 @@ impl<'a> Checker<'a> {
             // A leader is one robot among the members: the others may still run
             // `others`, unless the leader is the only candidate.
             if arm.kind == ArmKind::Group || members.len() == 1 {
-                taken.extend(members);
+                for r in members {
+                    taken[r.index()] = true;
+                }
             }
         }
         if let Some(others) = &g.others {
@@ -1168,7 +1236,7 @@ impl<'a> Checker<'a> {
                 .robots
                 .iter()
                 .copied()
-                .filter(|r| !taken.contains(r))
+                .filter(|r| !is_taken(&taken, r))
                 .collect();
             if checkable && rest.is_empty() {
                 self.diagnostics.report(
@@ -1191,11 +1259,8 @@ impl<'a> Checker<'a> {
             return String::new();
         };
         let t = self.team(team);
-        let names: Vec<&str> = robots
-            .iter()
-            .map(|&r| t.robots[r.index()].name.as_str())
-            .collect();
-        names.join(", ")
+        let names = robots.iter().map(|&r| t.robots[r.index()].name.as_str());
+        some_names(names, robots.len())
     }
 
     // ----- communication -----

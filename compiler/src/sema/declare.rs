@@ -3,9 +3,9 @@
 //! communication statements introduce.
 
 use super::ir::*;
-use super::{Checker, is_user, suggestion};
+use super::{Checker, MAX_ROBOTS_PER_DECLARATION, MAX_ROBOTS_PER_MISSION, is_user, suggestion};
 use crate::diag::Code;
-use crate::fasthash::FastMap;
+use crate::fasthash::{FastMap, FastSet};
 use crate::span::Span;
 use crate::syntax::ast::{self, Item, Name};
 
@@ -64,19 +64,14 @@ impl<'a> Checker<'a> {
         let mut robots = Vec::new();
         for robot in &decl.robots {
             let robot_type = self.resolve_robot_type(&robot.robot_type);
+            let Some(count) = self.robot_count(robot, robot_names.len()) else {
+                continue;
+            };
             let names: Vec<Name> = match robot.count {
                 None => vec![robot.name.name.clone()],
-                Some(ast::Count { value: Some(n), .. }) if n >= 1 => (0..n)
+                Some(_) => (0..count)
                     .map(|i| Name::new(format!("{}_{i}", robot.name.name)))
                     .collect(),
-                Some(count) => {
-                    self.diagnostics.report(
-                        Code::EmptyRobotGroup,
-                        count.span,
-                        "the number of robots must be a whole number of at least 1",
-                    );
-                    Vec::new()
-                }
             };
             for robot_name in names {
                 if let Some(&first) = robot_names.get(&robot_name) {
@@ -109,17 +104,58 @@ impl<'a> Checker<'a> {
             }
         }
         self.service_syntax.push(Vec::new());
-        self.mission.teams.push(Team {
-            name: name.name.clone(),
-            name_span: name.span,
-            robots,
-            plans: Vec::new(),
-            services: Vec::new(),
-            modes: Vec::new(),
-            main: None,
-            events: Vec::new(),
-            variables: Vec::new(),
-        });
+        self.mission
+            .teams
+            .push(Team::new(name.name.clone(), name.span, robots));
+    }
+
+    /// How many robots `robot` declares, checked against the limits before
+    /// any of them is made: `None` (reported) for a count below one, above
+    /// [`MAX_ROBOTS_PER_DECLARATION`], or taking the mission, which has
+    /// `declared` robots so far, past [`MAX_ROBOTS_PER_MISSION`] (reported
+    /// once: every later declaration is left out too).
+    fn robot_count(&mut self, robot: &ast::RobotDecl, declared: usize) -> Option<usize> {
+        if self.robots_full {
+            return None;
+        }
+        let (count, span) = match robot.count {
+            None => (1, robot.name.span),
+            Some(ast::Count {
+                value: Some(n @ 1..),
+                span,
+            }) => (n, span),
+            Some(count) => {
+                self.diagnostics.report(
+                    Code::EmptyRobotGroup,
+                    count.span,
+                    "the number of robots must be a whole number of at least 1",
+                );
+                return None;
+            }
+        };
+        if count > MAX_ROBOTS_PER_DECLARATION {
+            self.diagnostics.report(
+                Code::TooManyRobots,
+                span,
+                format!(
+                    "a declaration may have at most {MAX_ROBOTS_PER_DECLARATION} robots: declare fewer, or split them among declarations"
+                ),
+            );
+            return None;
+        }
+        let count = count as usize;
+        if declared + count > MAX_ROBOTS_PER_MISSION {
+            self.robots_full = true;
+            self.diagnostics.report(
+                Code::TooManyRobots,
+                span,
+                format!(
+                    "this declaration takes the mission past {MAX_ROBOTS_PER_MISSION} robots, the most a mission may have (it has {declared} before it); it and the declarations after it are left out"
+                ),
+            );
+            return None;
+        }
+        Some(count)
     }
 
     /// Looks a robot type (or alias) up in the catalog, reporting it if unknown.
@@ -208,12 +244,10 @@ impl<'a> Checker<'a> {
                 plan
             }
             None => {
-                let t = self.team_mut(team);
-                t.plans.push(Plan {
+                let plan = self.team_mut(team).add_plan(Plan {
                     name: s.plan.name.clone(),
                     span: s.plan.span,
                 });
-                let plan = PlanId::new(t.plans.len() - 1);
                 self.occurrence(s.plan.span, Symbol::Plan { team, plan }, true);
                 plan
             }
@@ -234,8 +268,7 @@ impl<'a> Checker<'a> {
             return;
         }
         self.service_syntax[team.0 as usize].push(s);
-        let t = self.team_mut(team);
-        t.services.push(Service {
+        let service = self.team_mut(team).add_service(Service {
             name: s.name.name.clone(),
             name_span: s.name.span,
             plan,
@@ -243,7 +276,6 @@ impl<'a> Checker<'a> {
             item,
             throws: Vec::new(),
         });
-        let service = ServiceId::new(t.services.len() - 1);
         self.occurrence(s.name.span, Symbol::Service { team, service }, true);
     }
 
@@ -265,14 +297,12 @@ impl<'a> Checker<'a> {
                 .relate(first, "first defined here");
             return;
         }
-        let t = self.team_mut(team);
-        t.modes.push(Mode {
+        let mode = self.team_mut(team).add_mode(Mode {
             name: m.name.name.clone(),
             name_span: m.name.span,
             span: m.span,
             sets: Vec::new(),
         });
-        let mode = ModeId::new(t.modes.len() - 1);
         self.occurrence(m.name.span, Symbol::Mode { team, mode }, true);
     }
 
@@ -310,17 +340,19 @@ impl<'a> Checker<'a> {
         for function in &self.function_syntax {
             visit(None, &function.body, &self.teams_by_name);
         }
+        // Each (team, name) once, in the order found, without scanning the
+        // lists (a mission may name thousands of variables).
+        let mut seen = FastSet::default();
         for (team, name) in found {
+            if !seen.insert((team, name.clone())) {
+                continue;
+            }
             if let Some(t) = team {
-                let vars = &mut self.mission.teams[t.0 as usize].variables;
-                if !vars.contains(&name) {
-                    vars.push(name.clone());
-                }
+                self.mission.teams[t.0 as usize]
+                    .variables
+                    .push(name.clone());
             }
-            let teams = self.variables.entry(name).or_default();
-            if !teams.contains(&team) {
-                teams.push(team);
-            }
+            self.variables.entry(name).or_default().push(team);
         }
     }
 }

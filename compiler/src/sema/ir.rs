@@ -5,6 +5,7 @@
 
 use crate::catalog::RobotTypeId;
 use crate::diag::FileId;
+use crate::fasthash::FastMap;
 use crate::index::newtype_index;
 use crate::span::Span;
 use crate::syntax::ast::{self, Name};
@@ -82,6 +83,18 @@ pub struct Team {
     pub events: Vec<Event>,
     /// Team variables (`T.X` assigned in send/publish, or received).
     pub variables: Vec<Name>,
+    /// Its plans, services, modes and events by name: a mission may have
+    /// hundreds of thousands, and a lookup must not scan them.
+    names: Names,
+}
+
+/// A team's name indexes, kept by the `add_*` methods.
+#[derive(Clone, Debug, Default)]
+struct Names {
+    plans: FastMap<Name, PlanId>,
+    services: FastMap<(PlanId, Name), ServiceId>,
+    modes: FastMap<Name, ModeId>,
+    events: FastMap<Name, usize>,
 }
 
 /// One robot. `name[N]` declares N robots `name_0` .. `name_{N-1}`.
@@ -289,8 +302,9 @@ pub enum ScopeKind {
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Runners {
     pub team: Option<TeamId>,
-    /// Indices into the team's robots.
-    pub robots: Vec<RobotId>,
+    /// Indices into the team's robots (shared by every scope the same
+    /// robots run).
+    pub robots: std::sync::Arc<[RobotId]>,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -353,13 +367,56 @@ impl Mission {
 }
 
 impl Team {
+    /// A team of `robots`, with no plan, service, mode, main or event yet.
+    pub fn new(name: Name, name_span: Span, robots: Vec<Robot>) -> Team {
+        Team {
+            name,
+            name_span,
+            robots,
+            plans: Vec::new(),
+            services: Vec::new(),
+            modes: Vec::new(),
+            main: None,
+            events: Vec::new(),
+            variables: Vec::new(),
+            names: Names::default(),
+        }
+    }
+
+    /// Adds `plan` (whose name the team does not have yet).
+    pub fn add_plan(&mut self, plan: Plan) -> PlanId {
+        let id = PlanId::new(self.plans.len());
+        self.names.plans.insert(plan.name.clone(), id);
+        self.plans.push(plan);
+        id
+    }
+
+    /// Adds `service` (whose name its plan does not have yet).
+    pub fn add_service(&mut self, service: Service) -> ServiceId {
+        let id = ServiceId::new(self.services.len());
+        let key = (service.plan, service.name.clone());
+        self.names.services.insert(key, id);
+        self.services.push(service);
+        id
+    }
+
+    /// Adds `mode` (whose name the team does not have yet).
+    pub fn add_mode(&mut self, mode: Mode) -> ModeId {
+        let id = ModeId::new(self.modes.len());
+        self.names.modes.insert(mode.name.clone(), id);
+        self.modes.push(mode);
+        id
+    }
+
     /// The event named `name`, added (neither thrown nor caught yet) if new.
     pub fn event_mut(&mut self, name: &str) -> &mut Event {
-        let index = match self.events.iter().position(|e| e.name == name) {
-            Some(i) => i,
+        let index = match self.names.events.get(name) {
+            Some(&i) => i,
             None => {
+                let name = Name::new(name);
+                self.names.events.insert(name.clone(), self.events.len());
                 self.events.push(Event {
-                    name: Name::new(name),
+                    name,
                     ..Event::default()
                 });
                 self.events.len() - 1
@@ -415,24 +472,15 @@ impl Team {
     }
 
     pub fn plan_by_name(&self, name: &str) -> Option<PlanId> {
-        self.plans
-            .iter()
-            .position(|p| p.name == name)
-            .map(PlanId::new)
+        self.names.plans.get(name).copied()
     }
 
     pub fn mode_by_name(&self, name: &str) -> Option<ModeId> {
-        self.modes
-            .iter()
-            .position(|m| m.name == name)
-            .map(ModeId::new)
+        self.names.modes.get(name).copied()
     }
 
     pub fn service_in_plan(&self, plan: PlanId, name: &str) -> Option<ServiceId> {
-        self.services
-            .iter()
-            .position(|s| s.plan == plan && s.name == name)
-            .map(ServiceId::new)
+        self.names.services.get(&(plan, Name::new(name))).copied()
     }
 
     /// `Team.Plan.Service`, for messages.

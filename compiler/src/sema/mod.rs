@@ -32,6 +32,17 @@ use crate::fasthash::{FastMap, FastSet};
 use crate::span::Span;
 use crate::syntax::{self, ast, ast::Name};
 
+/// The most robots one `name[N]` declaration may declare (E036). The
+/// checker keeps per-robot facts (names, which statements each robot runs),
+/// so the number written is checked before any robot is made: a swarm of a
+/// thousand robots is checked in well under a second, and a typo of a few
+/// more digits is a positioned error instead of gigabytes.
+pub const MAX_ROBOTS_PER_DECLARATION: u32 = 4096;
+
+/// The most robots a mission may declare in all its teams (E036, on the
+/// declaration that goes past it).
+pub const MAX_ROBOTS_PER_MISSION: usize = 4096;
+
 /// Everything known about one mission file after checking.
 #[derive(Clone, Debug)]
 pub struct Analysis {
@@ -102,7 +113,7 @@ pub(crate) fn is_user(name: &str) -> bool {
 }
 
 /// A function body checked for a (function, team, service, robots running it).
-type InlinedBody = (FunctionId, Option<TeamId>, Option<ServiceId>, Vec<RobotId>);
+type InlinedBody = (FunctionId, Option<TeamId>, Option<ServiceId>, body::Robots);
 
 pub(crate) struct Checker<'a> {
     /// The syntax of each team's services, parallel to `Team::services`, and of
@@ -149,6 +160,14 @@ pub(crate) struct Checker<'a> {
     /// literal, for the value flow (`values.rs`).
     variable_writes: Vec<values::VariableWrite>,
     variable_tests: Vec<values::VariableTest>,
+    /// Every set of robots running a scope, once ([`Checker::shared_robots`]).
+    robot_sets: FastSet<std::sync::Arc<[RobotId]>>,
+    /// The events each service throws, as in its `throws` list: a service
+    /// may throw thousands.
+    thrown: FastSet<(TeamId, ServiceId, Name)>,
+    /// The mission went past [`MAX_ROBOTS_PER_MISSION`] (reported once):
+    /// no further robot is declared.
+    robots_full: bool,
 }
 
 impl<'a> Checker<'a> {
@@ -177,6 +196,9 @@ impl<'a> Checker<'a> {
             comparison_index: FastMap::default(),
             variable_writes: Vec::new(),
             variable_tests: Vec::new(),
+            robot_sets: FastSet::default(),
+            thrown: FastSet::default(),
+            robots_full: false,
         }
     }
 

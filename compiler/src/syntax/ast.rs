@@ -84,7 +84,8 @@ pub struct RobotDecl {
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Count {
-    /// `None` when the number is not a whole number that fits.
+    /// `None` when the number is not a whole number; `u32::MAX` when it is
+    /// one too large for `u32`.
     pub value: Option<u32>,
     pub span: Span,
 }

@@ -453,6 +453,17 @@ where
     })
 }
 
+/// The number of `name[N]`: a whole number too large for `u32` is
+/// `u32::MAX`, which is too many robots all the same (the checker says so,
+/// instead of calling it not a number).
+fn count_value(written: &str) -> Option<u32> {
+    match written.parse() {
+        Ok(n) => Some(n),
+        Err(_) if written.bytes().all(|b| b.is_ascii_digit()) => Some(u32::MAX),
+        Err(_) => None,
+    }
+}
+
 /// Parses the items of one chunk.
 pub fn items<'t, 's: 't, I, E>() -> impl Parser<'t, I, Vec<Item>, extra::Err<E>>
 where
@@ -462,7 +473,7 @@ where
     let semis = tok(Token::Semi).repeated();
 
     let count =
-        select! { Token::Number(n) = e => Count { value: n.parse().ok(), span: sp(e.span()) } }
+        select! { Token::Number(n) = e => Count { value: count_value(n), span: sp(e.span()) } }
             .delimited_by(tok(Token::LBracket), tok(Token::RBracket));
     let robot = name()
         .labelled("a robot type")

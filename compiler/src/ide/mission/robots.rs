@@ -3,11 +3,12 @@
 
 use crate::catalog::{Catalog, RobotTypeId, ServiceDef, ValueDef};
 use crate::sema::{Analysis, Mission, Occurrence, RobotId, ScopeKind, TeamId};
+use std::sync::Arc;
 
 /// The robots that run the statements at a place, by team.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct RobotsHere {
-    pub runs: Vec<(TeamId, Vec<RobotId>)>,
+    pub runs: Vec<(TeamId, Arc<[RobotId]>)>,
     /// The scope the place is in, if the checker recorded one.
     pub kind: Option<ScopeKind>,
 }
@@ -32,7 +33,7 @@ impl RobotsHere {
         let team = fallback_team.and_then(|t| mission.team_by_name(t));
         RobotsHere {
             runs: team
-                .map(|t| (t, mission.team(t).robot_ids().collect()))
+                .map(|t| (t, mission.team(t).robot_ids().collect::<Arc<[RobotId]>>()))
                 .into_iter()
                 .collect(),
             kind: None,
@@ -67,7 +68,7 @@ impl RobotsHere {
         let mut types = Vec::new();
         for (team, robots) in &self.runs {
             let t = mission.team(*team);
-            for &r in robots {
+            for &r in robots.iter() {
                 if let Some(ty) = t.robots.get(r.index()).and_then(|r| r.robot_type) {
                     if !types.contains(&ty) {
                         types.push(ty);
@@ -83,7 +84,7 @@ impl RobotsHere {
         let mut names = Vec::new();
         for (team, robots) in &self.runs {
             let t = mission.team(*team);
-            for &r in robots {
+            for &r in robots.iter() {
                 if let Some(robot) = t.robots.get(r.index())
                     && robot.robot_type == Some(ty)
                 {

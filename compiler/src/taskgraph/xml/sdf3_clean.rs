@@ -25,7 +25,8 @@ use crate::diag::FileId;
 use crate::fasthash::FastMap as HashMap;
 use crate::span::Span;
 use crate::taskgraph::model::*;
-use crate::xmlpos::{end_tag_span, slice_span, start_tag_spans};
+use crate::xmlpos::{end_tag_span, first_repeated, slice_span, start_tag_spans};
+use crate::xmltree::MAX_DEPTH;
 use quick_xml::events::{BytesStart, Event};
 
 /// The file needs the full reader (it has something to report, or an entity).
@@ -257,6 +258,10 @@ impl<'t> State<'t> {
         if local.is_empty() || name_span.is_empty() {
             return Err(Decline);
         }
+        // Past the depth the full reader reads, it reports E097.
+        if self.open.len() == MAX_DEPTH {
+            return Err(Decline);
+        }
         let parent = match self.open.last() {
             Some(open) => Some(open.role),
             None if self.root_seen => return Err(Decline),
@@ -318,10 +323,10 @@ impl<'t> State<'t> {
     ) -> Read<[Option<Value<'t>>; MAX_KEYS]> {
         let text = self.text;
         let mut found = [None; MAX_KEYS];
-        for (index, &(key, raw)) in attributes.iter().enumerate() {
-            if attributes[..index].iter().any(|&(seen, _)| same(seen, key)) {
-                return Err(Decline);
-            }
+        if first_repeated(attributes, |&(key, _)| key).is_some() {
+            return Err(Decline);
+        }
+        for &(key, raw) in attributes {
             if raw.iter().any(|&b| b == b'<' || b == b'&') {
                 return Err(Decline);
             }

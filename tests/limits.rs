@@ -1,0 +1,433 @@
+//! The tools' limits (`docs/limits.md`), through the `semo` binary: an input
+//! past one is refused with a positioned error at once and in bounded memory
+//! (robot counts, XML nesting), an input within them costs in proportion to
+//! its size (many services, many attributes), and a mission is read as a
+//! mission whatever its first line looks like.
+//!
+//! "At once and in bounded memory" is held by running `semo` under `ulimit`
+//! bounds far above what any check needs and far below what these inputs took
+//! before their limits (gigabytes, minutes): past a bound the process is
+//! killed, and the test sees it. "In proportion" compares the CPU time of two
+//! sizes ten times apart, best of three, against a bound of thirty: a
+//! quadratic path costs a hundred times more there, a linear one ten.
+
+mod support;
+
+use std::path::Path;
+use support::{Diag, Output, parse_json_report, repo_root};
+
+/// The address space a check may take here (`ulimit -v`), in KiB: a check of
+/// any input below uses a small part of it.
+const MEMORY_KIB: u64 = 1536 * 1024;
+/// The CPU time a check may take here (`ulimit -t`), in seconds.
+const CPU_SECONDS: u64 = 120;
+
+/// Runs `semo ARGS` in `dir` under [`MEMORY_KIB`] and [`CPU_SECONDS`].
+fn semo_bounded(dir: &Path, args: &[&str]) -> Output {
+    let script =
+        format!("ulimit -v {MEMORY_KIB} && ulimit -t {CPU_SECONDS} && exec \"$@\" || exit 99");
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(script)
+        .arg("sh")
+        .arg(env!("CARGO_BIN_EXE_semo"))
+        .args(args)
+        .current_dir(dir)
+        .env("NO_COLOR", "1")
+        .output()
+        .expect("sh runs");
+    Output {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+/// `semo check --format json PATHS` in `dir`, bounded, parsed; the exit
+/// status must be 0 or 1 (a check, not a crash).
+fn check_bounded(dir: &Path, paths: &[&str]) -> (i32, Vec<Diag>) {
+    let mut args = vec!["check", "--format", "json"];
+    args.extend_from_slice(paths);
+    let out = semo_bounded(dir, &args);
+    assert!(
+        out.code == 0 || out.code == 1,
+        "{paths:?}: exit {} (killed past the bounds?): {}",
+        out.code,
+        out.stderr
+    );
+    (out.code, parse_json_report(&out.stdout))
+}
+
+/// The CPU time (user and system, seconds) of `semo ARGS` in `dir`, the
+/// best of three runs: the shell's `times` reports its children's.
+fn cpu_seconds(dir: &Path, args: &[&str]) -> f64 {
+    let script = "\"$@\" >/dev/null 2>&1; times";
+    (0..3)
+        .map(|_| {
+            let out = std::process::Command::new("sh")
+                .arg("-c")
+                .arg(script)
+                .arg("sh")
+                .arg(env!("CARGO_BIN_EXE_semo"))
+                .args(args)
+                .current_dir(dir)
+                .output()
+                .expect("sh runs");
+            let times = String::from_utf8_lossy(&out.stdout).into_owned();
+            // Two lines, the shell's own times then its children's:
+            // `0m1.250s 0m0.031s`.
+            let children = times.lines().nth(1).expect("the children's times");
+            children.split_whitespace().map(minutes_seconds).sum()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// `1m2.500s` in seconds.
+fn minutes_seconds(time: &str) -> f64 {
+    let (minutes, seconds) = time
+        .trim_end_matches('s')
+        .split_once('m')
+        .expect("a time like 0m1.250s");
+    minutes.parse::<f64>().unwrap() * 60.0 + seconds.parse::<f64>().unwrap()
+}
+
+/// Asserts that `semo ARGS` on the input `write(dir, n)` makes costs in
+/// proportion to `n`: ten times the input, at most thirty times the time.
+fn scales_linearly(what: &str, n: usize, args: &[&str], write: impl Fn(&Path, usize)) {
+    let small = tempfile::tempdir().unwrap();
+    let large = tempfile::tempdir().unwrap();
+    write(small.path(), n);
+    write(large.path(), 10 * n);
+    let small_seconds = cpu_seconds(small.path(), args);
+    let large_seconds = cpu_seconds(large.path(), args);
+    // Below a hundredth of a second the clock says nothing.
+    let ratio = large_seconds / small_seconds.max(0.01);
+    eprintln!("{what}: {n} in {small_seconds:.3} s, ten times as many in {large_seconds:.3} s");
+    assert!(
+        ratio <= 30.0,
+        "{what}: {n} took {small_seconds:.3} s, {} took {large_seconds:.3} s (×{ratio:.1})",
+        10 * n
+    );
+}
+
+fn copy_example(path: &str, dir: &Path) {
+    let from = repo_root().join("examples").join(path);
+    let name = from.file_name().unwrap();
+    std::fs::copy(&from, dir.join(name)).unwrap();
+}
+
+// ---------------------------------------------------------------------------
+// Robots.
+
+/// `patrol_groups.mission` with `ev[count]` for its Ev3 robots.
+fn swarm(count: &str) -> String {
+    let text = std::fs::read_to_string(repo_root().join("examples/swarm/patrol_groups.mission"))
+        .expect("the example");
+    assert!(text.contains("ev[2]"));
+    text.replace("ev[2]", &format!("ev[{count}]"))
+}
+
+/// The one-based line and column of the first `needle` in `text`.
+fn line_column(text: &str, needle: &str) -> (u64, u64) {
+    let at = text.find(needle).expect("the needle is in the text");
+    let line = text[..at].matches('\n').count() as u64 + 1;
+    let column = text[..at].rsplit('\n').next().unwrap().chars().count() as u64 + 1;
+    (line, column)
+}
+
+#[test]
+fn a_robot_count_past_the_limit_is_an_error_on_the_count_at_once() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    copy_example("follow/follow.mission", dir);
+    // Past the limit; what took 4.6 GB and a minute; what took 51 GB;
+    // more than 32 bits.
+    for count in ["4097", "10000000", "2147483648", "99999999999999999999"] {
+        let text = swarm(count);
+        std::fs::write(dir.join("swarm.mission"), &text).unwrap();
+        let (code, diags) = check_bounded(dir, &["swarm.mission"]);
+        assert_eq!(code, 1);
+        let e036: Vec<&Diag> = diags.iter().filter(|d| d.code == "E036").collect();
+        assert_eq!(e036.len(), 1, "{count}: {}", support::listing(&diags));
+        assert_eq!(e036[0].start, line_column(&text, count), "{count}");
+        assert!(e036[0].message.contains("at most 4096"), "{:?}", e036[0]);
+        // The other mission of the folder is checked, cleanly, alone and
+        // with the folder.
+        let (code, diags) = check_bounded(dir, &["follow.mission"]);
+        assert_eq!((code, diags.len()), (0, 0), "{}", support::listing(&diags));
+        let (_, diags) = check_bounded(dir, &["."]);
+        assert!(
+            diags.iter().all(|d| d.file.ends_with("swarm.mission")),
+            "{}",
+            support::listing(&diags)
+        );
+        assert!(diags.iter().any(|d| d.code == "E036"));
+    }
+}
+
+#[test]
+fn a_mission_past_the_robot_limit_is_an_error_on_the_declaration_that_crosses_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let text = swarm("4000").replace(
+        "Ev3_Robot ev[4000]",
+        "Ev3_Robot ev[4000], Ev3_Robot more[90], Ev3_Robot last[9]",
+    );
+    std::fs::write(dir.join("swarm.mission"), &text).unwrap();
+    let (code, diags) = check_bounded(dir, &["swarm.mission"]);
+    assert_eq!(code, 1);
+    let e036: Vec<&Diag> = diags.iter().filter(|d| d.code == "E036").collect();
+    // 1 + 3 + 4000 + 90 fit; `last[9]` crosses 4096, reported once.
+    assert_eq!(e036.len(), 1, "{}", support::listing(&diags));
+    let (line, column) = line_column(&text, "last[9]");
+    assert_eq!(e036[0].start, (line, column + "last[".len() as u64));
+    assert!(e036[0].message.contains("4096"), "{:?}", e036[0]);
+}
+
+#[test]
+fn a_swarm_of_a_thousand_robots_and_one_at_the_limit_check_cleanly() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    // The example's other robots are four: 4092 more make 4096.
+    for count in ["1000", "4092"] {
+        std::fs::write(dir.join("swarm.mission"), swarm(count)).unwrap();
+        let (code, diags) = check_bounded(dir, &["swarm.mission"]);
+        assert_eq!(code, 0, "{count}: {}", support::listing(&diags));
+    }
+}
+
+#[test]
+fn a_team_at_the_robot_limit_costs_little_per_statement() {
+    // Every statement is checked with the robots that run it, and each of
+    // these is an E033 naming the robots lacking the value: thousands of
+    // statements run by thousands of robots once held their product (ids
+    // per scope, every name in every message: gigabytes here).
+    let tmp = tempfile::tempdir().unwrap();
+    let mut text = String::from("{ T: Turtlebot3_Burger tb, Ev3_Robot ev[4095] }\n");
+    let statements = 40_000;
+    for i in 0..statements {
+        text.push_str(&format!("T.P.S{i} {{ if (LIGHTNESS < 3) stop() }}\n"));
+    }
+    text.push_str("T.M { set(P, S0) }\nT.main { default: mode = M }\n");
+    std::fs::write(tmp.path().join("m.mission"), &text).unwrap();
+    let (code, diags) = check_bounded(tmp.path(), &["m.mission"]);
+    assert_eq!(code, 1);
+    let e033 = diags.iter().find(|d| d.code == "E033").expect("an E033");
+    assert!(
+        e033.message.contains("ev_7 and 4087 more"),
+        "{}",
+        e033.message
+    );
+}
+
+// ---------------------------------------------------------------------------
+// XML nesting.
+
+/// A root of each XML kind SeMo reads, opened and closed, with the name of
+/// its file.
+const XML_KINDS: &[(&str, &str, &str)] = &[
+    (
+        "deep.robot.xml",
+        "<Catalog xmlns=\"urn:semo:catalog:1\">",
+        "</Catalog>",
+    ),
+    ("deep.strategy.xml", "<Strategy name=\"T\">", "</Strategy>"),
+    (
+        "deep.taskgraph.xml",
+        "<TaskGraph name=\"g\">",
+        "</TaskGraph>",
+    ),
+    ("deep.xml", "<sdf3 type=\"sdf\" version=\"1.0\">", "</sdf3>"),
+];
+
+/// `open`, `levels` nested `<x>` elements, their ends and `close`: the root
+/// at depth 1, the last `<x>` at depth `levels + 1`.
+fn nested(open: &str, close: &str, levels: usize) -> String {
+    [open, &"<x>".repeat(levels), &"</x>".repeat(levels), close].concat()
+}
+
+#[test]
+fn xml_nested_a_million_deep_is_an_error_at_the_element_past_the_limit() {
+    for &(name, open, close) in XML_KINDS {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        copy_example("follow/follow.mission", dir);
+        let text = nested(open, close, 1_000_000);
+        std::fs::write(dir.join(name), &text).unwrap();
+        let (code, diags) = check_bounded(dir, &[name]);
+        assert_eq!(code, 1, "{name}");
+        let e097: Vec<&Diag> = diags.iter().filter(|d| d.code == "E097").collect();
+        assert_eq!(e097.len(), 1, "{name}: {}", support::listing(&diags));
+        // The 257th element is the 256th `<x>`: its name is at this column.
+        let column = open.len() + 255 * "<x>".len() + 2;
+        assert_eq!(e097[0].start, (1, column as u64), "{name}");
+        // The mission beside it is checked (its catalog's error is reported
+        // with it).
+        let (_, diags) = check_bounded(dir, &["follow.mission"]);
+        assert!(
+            diags.iter().all(|d| d.file.ends_with(name)),
+            "{name}: {}",
+            support::listing(&diags)
+        );
+    }
+}
+
+#[test]
+fn xml_nested_to_the_limit_is_read_without_e097() {
+    for &(name, open, close) in XML_KINDS {
+        let tmp = tempfile::tempdir().unwrap();
+        let text = nested(open, close, 255);
+        std::fs::write(tmp.path().join(name), &text).unwrap();
+        let (_, diags) = check_bounded(tmp.path(), &[name]);
+        assert!(
+            diags.iter().all(|d| d.code != "E097"),
+            "{name}: {}",
+            support::listing(&diags)
+        );
+    }
+}
+
+#[test]
+fn loops_nested_to_the_xml_limit_are_loaded_analysed_and_drawn() {
+    // 126 loops: the innermost `<Port>` is 255 deep. Loading, the analyses
+    // and the picture all walk the nesting.
+    let dir = repo_root().join("tests/fixtures/limits");
+    let name = "nested_loops.taskgraph.xml";
+    let (code, diags) = check_bounded(&dir, &[name]);
+    assert_eq!(code, 0, "{}", support::listing(&diags));
+    for command in ["analyze", "schedule", "svg"] {
+        let out = semo_bounded(&dir, &["graph", command, name]);
+        assert_eq!(out.code, 0, "{command}: {}", out.stderr);
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Costs in proportion to the input.
+
+#[test]
+fn many_services_in_one_plan_cost_in_proportion() {
+    scales_linearly(
+        "services in one plan",
+        3_000,
+        &["check", "--format", "json", "m.mission"],
+        |dir, n| {
+            let mut text = String::from("{ T: iRobotCreate a }\n");
+            for i in 0..n {
+                text.push_str(&format!("T.P.S{i} {{ throw e{i} }}\n"));
+            }
+            text.push_str("T.M { set(P, S0) }\nT.main { default: mode = M }\n");
+            std::fs::write(dir.join("m.mission"), text).unwrap();
+        },
+    );
+}
+
+#[test]
+fn many_modes_cases_and_catches_cost_in_proportion() {
+    scales_linearly(
+        "modes, cases and catches",
+        2_000,
+        &["check", "--format", "json", "m.mission"],
+        |dir, n| {
+            let mut text = String::from("{ T: iRobotCreate a }\nT.P.S { throw e }\n");
+            for i in 0..n {
+                text.push_str(&format!("T.M{i} {{ set(P, S) }}\n"));
+            }
+            text.push_str("T.main {\n");
+            for i in 0..n {
+                text.push_str(&format!(
+                    "  case (M{i}): catch (e): mode = M{}\n",
+                    (i + 1) % n
+                ));
+            }
+            text.push_str("  default: mode = M0\n}\n");
+            std::fs::write(dir.join("m.mission"), text).unwrap();
+        },
+    );
+}
+
+#[test]
+fn many_attributes_on_one_element_cost_in_proportion() {
+    scales_linearly(
+        "attributes on one element",
+        10_000,
+        &["check", "--format", "json", "many.robot.xml"],
+        |dir, n| {
+            let attributes: String = (0..n).map(|i| format!(" a{i}=\"v\"")).collect();
+            let text = format!("<Catalog xmlns=\"urn:semo:catalog:1\"{attributes}/>");
+            std::fs::write(dir.join("many.robot.xml"), text).unwrap();
+        },
+    );
+    scales_linearly(
+        "attributes on one SDF3 element",
+        10_000,
+        &["graph", "analyze", "--format", "json", "many.xml"],
+        |dir, n| {
+            let attributes: String = (0..n).map(|i| format!(" a{i}=\"v\"")).collect();
+            let text = std::fs::read_to_string(support::sdf3().join("h263decoder.xml"))
+                .expect("an SDF3 graph")
+                .replacen("<sdf3 ", &format!("<sdf3{attributes} "), 1);
+            std::fs::write(dir.join("many.xml"), text).unwrap();
+        },
+    );
+}
+
+// ---------------------------------------------------------------------------
+// A mission's first line.
+
+#[test]
+fn a_mission_whose_first_line_starts_with_a_bracket_is_checked_as_a_mission() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    for text in [
+        "[[ group(instance of Ev3_Robot) { stop() } ]]\n{ T: Ev3_Robot a }\n",
+        "[lints]\n{ T: Ev3_Robot a }\n",
+        "# a comment\n[T]\nT.main { default: mode = M }\n",
+    ] {
+        std::fs::write(dir.join("m.mission"), text).unwrap();
+        let out = semo_bounded(dir, &["check", "--format", "json", "m.mission"]);
+        assert_eq!(out.code, 1, "{text}: {}", out.stderr);
+        let diags = parse_json_report(&out.stdout);
+        assert!(
+            diags.iter().any(|d| d.code == "E003"),
+            "{text}: {}",
+            support::listing(&diags)
+        );
+    }
+}
+
+#[test]
+fn check_prints_its_json_document_even_when_it_refuses_a_file() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    // TOML named as a mission, a task graph named as a mission, a path
+    // that does not exist.
+    std::fs::write(dir.join("toml.mission"), "[project]\nname = \"x\"\n").unwrap();
+    std::fs::copy(
+        repo_root().join("examples/taskgraphs/kmeans.taskgraph.xml"),
+        dir.join("graph.mission"),
+    )
+    .unwrap();
+    for path in ["toml.mission", "graph.mission", "missing.mission"] {
+        let out = semo_bounded(dir, &["check", "--format", "json", path]);
+        assert_eq!(out.code, 2, "{path}");
+        let document: serde_json::Value = serde_json::from_str(&out.stdout)
+            .unwrap_or_else(|e| panic!("{path}: not one JSON document ({e}): {}", out.stdout));
+        assert_eq!(document["command"], "check");
+        let diagnostics = document["diagnostics"].as_array().unwrap();
+        assert_eq!(diagnostics.len(), 1, "{document}");
+        assert_eq!(diagnostics[0]["code"], serde_json::Value::Null);
+        assert_eq!(diagnostics[0]["severity"], "error");
+        assert_eq!(diagnostics[0]["file"], path);
+        // The one line for people is on standard error, as without JSON.
+        assert_eq!(out.stderr.lines().count(), 1, "{}", out.stderr);
+    }
+    // A broken project file is the project file its name says: E110.
+    std::fs::write(dir.join("semo.toml"), "[lints\n").unwrap();
+    let (code, diags) = check_bounded(dir, &["semo.toml"]);
+    assert_eq!(code, 1);
+    assert!(
+        diags.iter().any(|d| d.code == "E110"),
+        "{}",
+        support::listing(&diags)
+    );
+}
