@@ -3,9 +3,11 @@
 //! Services: signature, doc, and which robot types provide them (of this team,
 //! where the name is used in a statement); values: type, unit, doc, providers;
 //! teams: their robots; modes: what each plan runs; events: who throws them
-//! and who catches them.
+//! and who catches them; keywords: their entry of the language reference
+//! ([`keywords`]).
 
 use super::docs::{self, list};
+use super::keywords;
 use super::robots::{self, RobotsHere};
 use crate::catalog::{Catalog, RobotTypeId};
 use crate::ide::HoverResult;
@@ -20,7 +22,9 @@ pub fn hover(
     offset: usize,
 ) -> Option<HoverResult> {
     let mission = &analysis.mission;
-    let occurrence = robots::occurrence_at(mission, offset.min(text.len()))?;
+    let Some(occurrence) = robots::occurrence_at(mission, offset.min(text.len())) else {
+        return keywords::hover(&analysis.syntax, text, offset);
+    };
     let range = occurrence.span;
     let markdown = match &occurrence.symbol {
         Symbol::Team(t) => docs::team(catalog, mission.team(*t)),

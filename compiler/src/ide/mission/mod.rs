@@ -14,6 +14,7 @@ pub mod folding;
 pub mod formatting;
 pub mod hover;
 pub mod inlay_hints;
+pub mod keywords;
 pub mod navigation;
 pub mod rename;
 mod robots;
