@@ -681,3 +681,88 @@ fn build_prints_every_warning_check_gives() {
         assert!(!robot_folders(&out).is_empty(), "{fixture}: it is built");
     }
 }
+
+/// How many events of `kind` a trace holds, and how many `drop` or
+/// `dropped` lines (a message lost in the robot).
+fn count_events(lines: &[String], kind: &str) -> (usize, usize) {
+    let events = support::robots::events(lines);
+    let of = |k: &str| {
+        events
+            .iter()
+            .filter(|e| support::robots::field(e, "event") == k)
+            .count()
+    };
+    (of(kind), of("drop") + of("dropped"))
+}
+
+/// A service body that sends twenty messages at once (more than a message
+/// channel holds, 16) loses none of them, on the way out (the control
+/// task's sends wait for room in the channel to its send task) nor on the
+/// way in (the listener's receive task waits for room in the channel to
+/// its control task), as `semo simulate` delivers them all: every send is
+/// received, pass after pass. Counted on the traces, whatever the timing.
+#[test]
+fn twenty_sends_in_one_firing_all_reach_the_listener() {
+    let fixture = repo_root().join("tests/fixtures/messages");
+    let mission = fixture.join("burst.mission");
+    let scenario = std::fs::read_to_string(fixture.join("burst.scenario.json")).unwrap();
+
+    let sim_trace = scratch("burst-simulated").join("trace.jsonl");
+    let simulated = semo_in(
+        &repo_root(),
+        &[
+            "simulate",
+            &mission.display().to_string(),
+            "--scenario",
+            &fixture.join("burst.scenario.json").display().to_string(),
+            "--trace",
+            &sim_trace.display().to_string(),
+        ],
+    );
+    assert_eq!(
+        simulated.code, 0,
+        "{}{}",
+        simulated.stdout, simulated.stderr
+    );
+    let sim_lines: Vec<String> = std::fs::read_to_string(&sim_trace)
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect();
+    let robot = |robot: &str| -> Vec<String> {
+        sim_lines
+            .iter()
+            .filter(|l| l.contains(&format!("\"robot\":\"{robot}\"")))
+            .cloned()
+            .collect()
+    };
+    let (sim_sent, sim_lost) = count_events(&robot("talker"), "send");
+    let (sim_received, sim_dropped) = count_events(&robot("listener"), "receive");
+    assert!(
+        sim_sent >= 40,
+        "the simulator's talker makes passes: {sim_sent}"
+    );
+    assert_eq!(
+        (sim_received, sim_lost + sim_dropped),
+        (sim_sent, 0),
+        "the simulator delivers every send"
+    );
+
+    let traces =
+        support::robots::run_in_simulation(&mission, &scratch("burst-linux-sim"), &scenario);
+    let talker = support::robots::events(&traces["talker"]);
+    let passes = support::robots::calls(&talker).len();
+    let (sent, lost) = count_events(&traces["talker"], "send");
+    let (received, dropped) = count_events(&traces["listener"], "receive");
+    assert!(passes >= 2, "the talker makes passes: {passes}");
+    assert_eq!(
+        (sent, lost),
+        (20 * passes, 0),
+        "every pass's twenty sends leave the talker"
+    );
+    assert_eq!(
+        (received, dropped),
+        (sent, 0),
+        "the listener receives every send and drops none"
+    );
+}

@@ -394,7 +394,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize
                 };
                 let _ = writeln!(
                     out,
-                    "        UFPort_WriteToQueue(out_port[{}], {sent}, sizeof(semo_value)); /* {} */",
+                    "        semo_port_send(out_port[{}], {sent}, sizeof(semo_value)); /* {} */",
                     item.message,
                     c::comment(&m.outgoing[item.message].key)
                 );

@@ -369,7 +369,7 @@ pub fn comm_task_c(program: &RobotProgram, words: &Words, target: Target, header
         if n > 0 {
             let _ = writeln!(
                 out,
-                "    for (int i = 0; i < {n}; i++) {{\n        if (strcmp(incoming[i].from_team, m.from_team) != 0 || strcmp(incoming[i].key, m.key) != 0)\n            continue;\n        semo_value v = m.value;\n        if (semo_value_coerce(&v, incoming[i].type) && semo_value_in(&v, incoming[i].domain, incoming[i].domain_len))\n            UFPort_WriteToQueue(incoming_port[i], &v, sizeof v);\n        else\n            semo_trace(\"reject\", \"key\", m.key, \"reason\", \"not a value of its type\", NULL);\n    }}"
+                "    for (int i = 0; i < {n}; i++) {{\n        if (strcmp(incoming[i].from_team, m.from_team) != 0 || strcmp(incoming[i].key, m.key) != 0)\n            continue;\n        semo_value v = m.value;\n        if (semo_value_coerce(&v, incoming[i].type) && semo_value_in(&v, incoming[i].domain, incoming[i].domain_len)) {{\n            if (!semo_port_offer(incoming_port[i], &v, sizeof v))\n                semo_trace(\"drop\", \"from\", m.from_team, \"key\", m.key, \"reason\", semo_running() ? \"channel full\" : \"stopping\", NULL);\n        }} else\n            semo_trace(\"reject\", \"key\", m.key, \"reason\", \"not a value of its type\", NULL);\n    }}"
             );
         }
         let _ = writeln!(out, "}}\n\nvoid task_{recv}_wrapup(void)\n{{\n}}");

@@ -135,6 +135,19 @@ impl Event {
     }
 }
 
+/// A received message waiting for room in its channels into the control
+/// task, as the runtime's CommReceive waits (`semo_port_offer`): until the
+/// control task takes from the channel, or until a control firing begun
+/// after `mark` (the firings begun when it started waiting) ends without
+/// making room; it is then dropped.
+struct Holding {
+    /// The channels still to write, with the value for each.
+    pending: VecDeque<(usize, Held)>,
+    mark: u64,
+    from: Rc<str>,
+    key: Rc<str>,
+}
+
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
 struct Message {
     publish: bool,
@@ -253,6 +266,16 @@ struct Robot<'p> {
     owner: usize,
     /// Per incoming message: the channel to the control task (capacity).
     inbox: Vec<(VecDeque<Held>, usize)>,
+    /// The receive task held up by a full channel ([`Holding`]), and the
+    /// messages behind it, not yet taken from the transport.
+    holding: Option<Holding>,
+    behind: VecDeque<Message>,
+    /// Per incoming message: its channel is stalled (the receive task gave
+    /// up waiting for room in it; until the control task next takes from
+    /// it, a message that finds it full is dropped at once).
+    stalled: Vec<bool>,
+    /// Control firings begun.
+    firings: u64,
     /// Per subscribed group: the latest value.
     groups: Vec<Option<Held>>,
     regions: Vec<Region>,
@@ -397,6 +420,10 @@ impl<'p> Robot<'p> {
                 .and_then(|l| l.ownership.as_ref())
                 .map_or(program.self_peer, |o| o.owners[0]),
             inbox,
+            holding: None,
+            behind: VecDeque::new(),
+            stalled: vec![false; m.incoming.len()],
+            firings: 0,
             groups: vec![None; m.subscribed.len()],
             regions: vec![
                 Region {
@@ -604,6 +631,7 @@ impl<'p> Sim<'p> {
                 if r.alive && r.epoch == epoch && r.fire_token == token {
                     self.last_fire = (self.now, r.chain);
                     self.robots[robot].progressed = false;
+                    self.robots[robot].firings += 1;
                     let traced = self.trace.len();
                     self.fire(robot);
                     if self.robots[robot].alive {
@@ -618,6 +646,7 @@ impl<'p> Sim<'p> {
                             Some(at) => self.schedule_fire(robot, at),
                             None => self.robots[robot].next_fire = None,
                         }
+                        self.release(robot, true);
                     }
                 }
             }
@@ -919,12 +948,79 @@ impl<'p> Sim<'p> {
         Some(latency)
     }
 
-    /// The receive task: traced, then a heartbeat, a published value for a
-    /// group, or a sample for the control task's port.
+    /// A message reaches the robot: the receive task takes it, unless it is
+    /// held up by a full channel (then it waits behind, in order).
     fn deliver(&mut self, r: usize, message: &Message) {
         if !self.robots[r].has_receiver {
             return; // no receive task reads the inbox
         }
+        if self.robots[r].holding.is_some() {
+            self.robots[r].behind.push_back(message.clone());
+            return;
+        }
+        self.take_in(r, message);
+        self.release(r, false);
+    }
+
+    /// The receive task held up: writes what now fits into the channels
+    /// and, at the end of a control firing (`firing_ended`) begun since it
+    /// started waiting, drops what does not (a `drop` event; the channel
+    /// is then stalled, and drops at once until its next take); then takes
+    /// the messages behind, in order, until one is held up again. Waiting
+    /// wakes the control task, as `semo_port_offer` does.
+    fn release(&mut self, r: usize, firing_ended: bool) {
+        loop {
+            let robot = &mut self.robots[r];
+            let Some(holding) = &mut robot.holding else {
+                return;
+            };
+            let give_up = firing_ended && robot.firings > holding.mark;
+            let (mut queued, mut dropped) = (false, false);
+            while let Some((channel, _)) = holding.pending.front() {
+                let (queue, capacity) = &mut robot.inbox[*channel];
+                if queue.len() < *capacity {
+                    let (_, value) = holding.pending.pop_front().expect("a front");
+                    queue.push_back(value);
+                    queued = true;
+                } else if give_up || robot.stalled[*channel] {
+                    robot.stalled[*channel] = true;
+                    holding.pending.pop_front();
+                    dropped = true;
+                } else {
+                    break;
+                }
+            }
+            let (from, key) = (holding.from.clone(), holding.key.clone());
+            let waits = !holding.pending.is_empty();
+            if dropped {
+                let fields = vec![
+                    ("from", from),
+                    ("key", key),
+                    ("reason", "channel full".into()),
+                ];
+                self.emit(r, "drop", fields);
+            }
+            // Only a `receive` waits for a message: waking it also lets a
+            // waiting writer's decisive firing come at once.
+            if queued || waits {
+                self.wake(r);
+            }
+            if waits {
+                return;
+            }
+            let robot = &mut self.robots[r];
+            robot.holding = None;
+            let Some(next) = robot.behind.pop_front() else {
+                return;
+            };
+            self.take_in(r, &next);
+        }
+    }
+
+    /// The receive task: traced, then a heartbeat, a published value for a
+    /// group, or a message for the control task's channels (held up while
+    /// one is full: [`Sim::release`]).
+    fn take_in(&mut self, r: usize, message: &Message) {
         self.trace.push(TraceEvent {
             t: self.now,
             robot: r,
@@ -987,10 +1083,9 @@ impl<'p> Sim<'p> {
             }
             return;
         }
-        // A full channel drops the sample (the runtime counts it).
         // A value of another type than the key's is refused
         // (`semo_value_coerce`); text is read as the type.
-        let mut queued = false;
+        let mut pending = VecDeque::new();
         let mut rejected = false;
         for (i, incoming) in m.incoming.iter().enumerate() {
             if *incoming.from_team == *message.from_team && *incoming.key == *message.key {
@@ -1002,12 +1097,16 @@ impl<'p> Sim<'p> {
                     rejected = true;
                     continue;
                 };
-                let (queue, capacity) = &mut robot.inbox[i];
-                if queue.len() < *capacity {
-                    queue.push_back(value);
-                    queued = true;
-                }
+                pending.push_back((i, value));
             }
+        }
+        if !pending.is_empty() {
+            robot.holding = Some(Holding {
+                pending,
+                mark: robot.firings,
+                from: message.from_team.clone(),
+                key: message.key.clone(),
+            });
         }
         if rejected {
             let fields = vec![
@@ -1015,11 +1114,6 @@ impl<'p> Sim<'p> {
                 ("reason", "not a value of its type".into()),
             ];
             self.emit(r, "reject", fields);
-        }
-        // Only a `receive` waits for a message: heartbeats and published
-        // values are read on the way through a state, never waited for.
-        if queued {
-            self.wake(r);
         }
     }
 
@@ -1440,9 +1534,12 @@ impl<'p> Sim<'p> {
                 }
                 for &k in messages {
                     if let Some(v) = self.robots[r].inbox[k].0.pop_front() {
+                        self.robots[r].stalled[k] = false;
                         self.store(r, m.incoming[k].slot, v);
                     }
                 }
+                // Room for a message the receive task holds up.
+                self.release(r, false);
                 self.region(r, i).pc = next;
                 Step::Next
             }

@@ -825,6 +825,7 @@ static bool ring_take(const semo__ring *r, void *out)
     memcpy(out, r->storage + r->state->head * r->sample_size, r->sample_size);
     r->state->head = (r->state->head + 1) % r->capacity;
     r->state->count--;
+    r->state->stalled = false; /* its reader takes again */
     return true;
 }
 
@@ -866,6 +867,8 @@ int UFPort_ReadFromQueue(int port, void *buf, size_t size)
         ;
     bool read = ring_take(&r, buf);
     semo__queue_unlock(port);
+    if (read)
+        semo__queue_taken(port);
     return read ? (int)size : 0;
 }
 
@@ -880,6 +883,36 @@ int UFPort_WriteToQueue(int port, const void *buf, size_t size)
     if (written)
         semo__queue_written(port);
     return written ? (int)size : 0;
+}
+
+/* A message channel's write: waits for room as `room` says (semo_runtime.h). */
+static int write_waiting(int port, const void *buf, size_t size, bool patient)
+{
+    semo__ring r;
+    if (!semo__channel_ring(port, &r) || !buf || size != r.sample_size)
+        return 0;
+    semo__room_wait room = {patient, false, 0};
+    semo__queue_lock(port);
+    bool waits = patient || !r.state->stalled;
+    while (r.state->count == r.capacity && semo_running() && waits && semo__queue_wait_room(port, &room))
+        ;
+    if (r.state->count == r.capacity && !patient && semo_running())
+        r.state->stalled = true; /* its reader is not taking: the next ones do not wait */
+    bool written = ring_put(&r, buf);
+    semo__queue_unlock(port);
+    if (written)
+        semo__queue_written(port);
+    return written ? (int)size : 0;
+}
+
+int semo_port_send(int port, const void *buf, size_t size)
+{
+    return write_waiting(port, buf, size, true);
+}
+
+int semo_port_offer(int port, const void *buf, size_t size)
+{
+    return write_waiting(port, buf, size, false);
 }
 
 int UFPort_GetNumOfAvailableData(int port)

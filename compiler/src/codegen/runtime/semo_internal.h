@@ -67,6 +67,23 @@ bool semo__queue_wait(int queue, int64_t deadline_ms);
 /* Platform, after the lock is released: something was added to the queue;
  * wakes its reader (and tasks sleeping on a semo_next_firing hint). */
 void semo__queue_written(int queue);
+/* A writer waiting for room in a full message channel (semo_port_send:
+ * `patient`; semo_port_offer: not). `marked`/`mark` are the platform's,
+ * zero at the first call. */
+typedef struct {
+    bool patient;
+    bool marked;
+    unsigned long mark;
+} semo__room_wait;
+/* Platform, with the lock held, the channel full: waits until something is
+ * taken from it, the program stops, or (not patient) the reader ends a
+ * firing begun since the first call (the caller looks again); false when
+ * the writer must give up: such a firing has ended, or the platform cannot
+ * make room. */
+bool semo__queue_wait_room(int port, semo__room_wait *room);
+/* Platform, after the lock is released: something was taken from the
+ * channel; wakes a writer waiting for room. */
+void semo__queue_taken(int port);
 
 /* The datagram of a message (the one wire format of every transport): "SEMO"
  * 0x02 <kind>, then from_team, from_robot and key, each a length byte and

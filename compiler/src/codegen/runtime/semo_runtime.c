@@ -187,8 +187,9 @@ typedef struct {
     semo__ring ring;
     semo_channel_state state;
     pthread_mutex_t lock;
-    pthread_cond_t readable;
+    pthread_cond_t readable; /* a write for the reader; a take or a reader's firing for a writer */
     struct task_s *reader; /* the task reading it, woken by a write */
+    atomic_int room_waiters; /* writers waiting for room (semo__queue_wait_room) */
 } channel;
 
 static void wake_task(struct task_s *t);
@@ -245,6 +246,17 @@ void semo__queue_written(int queue)
     } else {
         pthread_cond_signal(&g_channels[queue].readable);
         wake_task(g_channels[queue].reader);
+    }
+}
+
+/* Only a writer waits on a channel that has just been taken from. */
+void semo__queue_taken(int queue)
+{
+    channel *c = channel_at(queue);
+    if (c && atomic_load(&c->room_waiters) > 0) {
+        pthread_mutex_lock(&c->lock);
+        pthread_cond_broadcast(&c->readable);
+        pthread_mutex_unlock(&c->lock);
     }
 }
 
@@ -323,6 +335,9 @@ typedef struct task_s {
     int64_t hint_ms;
     struct task_s *controller; /* the task that last ran, called or stopped it */
     atomic_bool reads_groups;  /* it has called UFMulticast_Read */
+    /* Firings begun and ended: a writer that waits for room in one of its
+     * channels gives up once a firing begun after it has ended. */
+    atomic_ulong firings_begun, firings_ended;
 } task;
 
 static task *g_tasks;
@@ -355,6 +370,48 @@ static void mark_group_reader(void)
 {
     if (g_current)
         atomic_store(&g_current->reads_groups, true);
+}
+
+/* The writer waits on the channel's condition variable, which a take and
+ * the end of a firing of its reader broadcast (the counts are read under
+ * the channel's lock, and changed before the lock is taken to broadcast:
+ * no wake-up is missed). The first call wakes the reader, so that the
+ * firing that decides comes at once: it takes, or the writer gives up. */
+bool semo__queue_wait_room(int queue, semo__room_wait *room)
+{
+    channel *c = channel_at(queue);
+    if (!c)
+        return false;
+    task *reader = c->reader;
+    if (!room->patient) {
+        if (!reader)
+            return false;
+        if (!room->marked) {
+            room->marked = true;
+            room->mark = atomic_load(&reader->firings_begun);
+            wake_task(reader);
+        }
+    }
+    atomic_fetch_add(&c->room_waiters, 1);
+    bool wait = room->patient || atomic_load(&reader->firings_ended) <= room->mark;
+    if (wait)
+        wait_until(&c->readable, &c->lock, -1);
+    atomic_fetch_sub(&c->room_waiters, 1);
+    return wait;
+}
+
+/* After a firing of `t`: writers waiting for room in its channels look again. */
+static void firing_ended(task *t)
+{
+    atomic_fetch_add(&t->firings_ended, 1);
+    for (size_t i = 0; g_prog && i < g_prog->channel_count; i++) {
+        channel *c = &g_channels[i];
+        if (c->reader == t && atomic_load(&c->room_waiters) > 0) {
+            pthread_mutex_lock(&c->lock);
+            pthread_cond_broadcast(&c->readable);
+            pthread_mutex_unlock(&c->lock);
+        }
+    }
 }
 
 void semo_next_firing(int64_t at_ms)
@@ -424,8 +481,10 @@ static void *task_thread(void *arg)
             t->hinted = t->woken = false;
         }
         pthread_mutex_unlock(&t->lock);
+        atomic_fetch_add(&t->firings_begun, 1);
         if (d->go)
             d->go();
+        firing_ended(t);
         pthread_mutex_lock(&t->lock);
         bool went_idle = !t->control.repeat && t->control.calls > 0 && --t->control.calls == 0;
         if (went_idle)

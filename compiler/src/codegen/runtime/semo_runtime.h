@@ -120,6 +120,7 @@ typedef struct {
     size_t head, count;
     unsigned long dropped;
     unsigned short reader; /* index of the task reading it (set at start) */
+    bool stalled; /* semo_port_offer gave up; until the next take, it waits no more */
 } semo_channel_state;
 
 /* A FIFO channel of the task graph: a bounded ring buffer of fixed-size samples. */
@@ -226,6 +227,21 @@ int UFPort_ReadFromQueue(int port, void *buf, size_t size);
 int UFPort_WriteToQueue(int port, const void *buf, size_t size);
 /* Samples waiting in the channel; never blocks. -1 for a bad id. */
 int UFPort_GetNumOfAvailableData(int port);
+/* The message channels (the control task's sends to CommSend, and what
+ * CommReceive hands the control task) never drop a message for want of room
+ * where the simulator would deliver it: the writer waits for room instead.
+ * semo_port_send waits until there is room (its reader, CommSend, takes
+ * every message and never waits on its writer); 0 only when the program is
+ * stopping or `size` is wrong. */
+int semo_port_send(int port, const void *buf, size_t size);
+/* semo_port_offer waits for room too, waking the reader (the control task),
+ * until a firing of the reader that began after the wait has ended without
+ * taking from the channel: that reader is not taking this message now (it
+ * waits for another one), and holding it would hold every message behind
+ * it. It is then dropped and counted, and 0 returned; until the reader
+ * next takes from the channel, a message that finds it full is dropped at
+ * once (the channel is stalled). The simulator does the same. */
+int semo_port_offer(int port, const void *buf, size_t size);
 
 /* ------------------------------------------------------------- multicast */
 

@@ -197,6 +197,31 @@ static void wake_reader(int port)
         wake_task(&g_tasks[reader]);
 }
 
+/* Nothing else runs while a writer waits: a full message channel makes
+ * room by firing its reader at once, as the control task's last firing
+ * does (CommSend takes every message and only sends them on); a second
+ * call, or a writer that may give up (CommReceive, never here), gives up. */
+bool semo__queue_wait_room(int port, semo__room_wait *room)
+{
+    unsigned short reader = g_prog->channels[port].state->reader;
+    if (!room->patient || room->marked || reader >= g_prog->task_count || &g_tasks[reader] == g_current ||
+        !g_prog->tasks[reader].go)
+        return false;
+    room->marked = true;
+    task *writer = g_current;
+    bool continues = g_continues;
+    g_current = &g_tasks[reader];
+    g_prog->tasks[reader].go();
+    g_current = writer;
+    g_continues = continues;
+    return true;
+}
+
+void semo__queue_taken(int port)
+{
+    (void)port;
+}
+
 static void wake_group_readers(void)
 {
     for (size_t i = 0; g_prog && i < g_prog->task_count; i++)
