@@ -219,7 +219,7 @@ codes! {
     TeamWithoutMain = "W011", Warning, "a team without a main block: its robots do nothing";
     EmptyOthers = "W012", Warning, "an `others` block that no robot is left to run";
     ComparisonNeverHolds = "W020", Warning, "a comparison of a team variable with a value it is never set to: it never holds";
-    ComparisonAlwaysHolds = "W021", Warning, "`!=` between a team variable and a value it is never set to: it always holds";
+    ComparisonAlwaysHolds = "W021", Warning, "`!=` between a team variable and a value it is never set to: it holds whenever the variable has a value";
 }
 
 impl fmt::Display for Code {

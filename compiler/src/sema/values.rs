@@ -2,8 +2,9 @@
 //! with `T.X = ...`) holds only what its writers put in it: when every
 //! writer puts a literal (a word, a string, a number), its possible values
 //! are known, and a comparison with a constant outside them decides the
-//! same way at every run: `T.X == C` never holds (W020), `T.X != C` always
-//! does (W021). Both name the writers as related information.
+//! same way at every run: `T.X == C` never holds (W020), `T.X != C` holds
+//! whenever `T.X` has a value (W021: a comparison with a variable not yet
+//! set is false, `!=` too). Both name the writers as related information.
 //!
 //! The facts are under-approximations: a variable with any writer whose
 //! value is not a literal (a sensor reading, another variable), or that
@@ -100,7 +101,7 @@ impl Checker<'_> {
             let (code, op, verdict) = if test.equal {
                 (Code::ComparisonNeverHolds, "==", "never holds")
             } else {
-                (Code::ComparisonAlwaysHolds, "!=", "always holds")
+                (Code::ComparisonAlwaysHolds, "!=", "holds whenever it has a value")
             };
             let guess = suggestion(&constant, possible.iter().map(String::as_str));
             let diagnostic = self
