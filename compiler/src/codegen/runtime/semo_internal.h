@@ -150,6 +150,9 @@ bool semo__start_thread(pthread_t *thread, void *(*body)(void *), void *arg);
  * Every wait of the runtime is semo__ls_wait on some key (a condition's
  * address), every signal semo__ls_wake on it. */
 bool semo__ls_on(void);
+/* Whether the threads take turns (from the connection until the coordinator
+ * goes; the clock stays virtual after). */
+bool semo__ls_turns(void);
 int64_t semo__ls_now(void);
 /* Connects as peer `self`, takes the starting time, and starts the link
  * thread; the calling (main) thread holds the first turn. */

@@ -57,7 +57,8 @@ typedef struct ls_datagram {
 } ls_datagram;
 
 static struct {
-    atomic_bool on;
+    atomic_bool on;    /* mission time is the coordinator's */
+    atomic_bool turns; /* the threads take turns (until the coordinator goes) */
     pthread_mutex_t lock; /* everything below but the queue */
     pthread_cond_t idle;  /* the link thread waits for the robot to be idle */
     ls_thread **threads;  /* in the order they were started */
@@ -89,6 +90,11 @@ static _Thread_local ls_thread *g_self;
 bool semo__ls_on(void)
 {
     return atomic_load(&g_ls.on);
+}
+
+bool semo__ls_turns(void)
+{
+    return atomic_load(&g_ls.turns);
 }
 
 int64_t semo__ls_now(void)
@@ -403,12 +409,15 @@ static void grant(int64_t now)
     pthread_mutex_unlock(&g_ls.lock);
 }
 
-/* The coordinator is gone (it ended the run, or died): every wait returns
- * and the program stops. */
+/* The coordinator is gone (it ended the run, or died): the threads stop
+ * taking turns (the runtime's waits and wake-ups are its plain ones again:
+ * a thread that only looked again at once would spin and starve the
+ * others of their locks), time stays where it was, and the program stops. */
 static void link_lost(void)
 {
     pthread_mutex_lock(&g_ls.lock);
     g_ls.lost = true;
+    atomic_store(&g_ls.turns, false);
     for (size_t i = 0; i < g_ls.count; i++)
         pthread_cond_signal(&g_ls.threads[i]->turn);
     pthread_mutex_unlock(&g_ls.lock);
@@ -492,6 +501,7 @@ int semo__ls_connect(const char *path, size_t self)
     if (!g_self)
         return -1;
     atomic_store(&g_ls.on, true);
+    atomic_store(&g_ls.turns, true);
     if (pthread_create(&g_ls.link, NULL, link_thread, NULL) != 0) {
         fprintf(stderr, "semo runtime: cannot start the lock-step link\n");
         return -1;
@@ -507,6 +517,7 @@ void semo__ls_close(void)
     if (g_ls.link_started) {
         pthread_mutex_lock(&g_ls.lock);
         g_ls.lost = true;
+        atomic_store(&g_ls.turns, false);
         pthread_cond_signal(&g_ls.idle);
         pthread_mutex_unlock(&g_ls.lock);
         pthread_join(g_ls.link, NULL);

@@ -114,7 +114,7 @@ static struct timespec wall_deadline(int64_t mission_ms)
 static void wait_until(pthread_cond_t *cond, pthread_mutex_t *lock, int64_t deadline_ms)
 {
 #ifdef SEMO_SIM
-    if (semo__ls_on()) {
+    if (semo__ls_turns()) {
         semo__ls_wait(cond, lock, deadline_ms);
         return;
     }
@@ -132,7 +132,7 @@ static void wait_until(pthread_cond_t *cond, pthread_mutex_t *lock, int64_t dead
 static void cond_signal(pthread_cond_t *cond)
 {
 #ifdef SEMO_SIM
-    if (semo__ls_on()) {
+    if (semo__ls_turns()) {
         semo__ls_wake(cond, false);
         return;
     }
@@ -143,7 +143,7 @@ static void cond_signal(pthread_cond_t *cond)
 static void cond_broadcast(pthread_cond_t *cond)
 {
 #ifdef SEMO_SIM
-    if (semo__ls_on()) {
+    if (semo__ls_turns()) {
         semo__ls_wake(cond, true);
         return;
     }
@@ -1449,7 +1449,7 @@ static bool start_thread(pthread_t *thread, void *(*body)(void *), void *arg, bo
     pthread_attr_init(&attr);
     pthread_attr_setstacksize(&attr, SEMO_STACK_BYTES);
 #ifdef SEMO_SIM
-    bool ok = (takes_turns && semo__ls_on() ? semo__ls_create(thread, &attr, body, arg)
+    bool ok = (takes_turns && semo__ls_turns() ? semo__ls_create(thread, &attr, body, arg)
                                               : pthread_create(thread, &attr, body, arg)) == 0;
 #else
     (void)takes_turns;
