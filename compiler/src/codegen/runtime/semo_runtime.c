@@ -294,7 +294,7 @@ void semo__queue_taken(int queue)
     channel *c = channel_at(queue);
     if (c && atomic_load(&c->room_waiters) > 0) {
         pthread_mutex_lock(&c->lock);
-        pthread_cond_broadcast(&c->readable);
+        cond_broadcast(&c->readable);
         pthread_mutex_unlock(&c->lock);
     }
 }
@@ -447,7 +447,7 @@ static void firing_ended(task *t)
         channel *c = &g_channels[i];
         if (c->reader == t && atomic_load(&c->room_waiters) > 0) {
             pthread_mutex_lock(&c->lock);
-            pthread_cond_broadcast(&c->readable);
+            cond_broadcast(&c->readable);
             pthread_mutex_unlock(&c->lock);
         }
     }
