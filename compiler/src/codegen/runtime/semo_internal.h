@@ -164,6 +164,9 @@ void semo__ls_wake(const void *key, bool all);
 int semo__ls_create(pthread_t *thread, const pthread_attr_t *attr, void *(*body)(void *), void *arg);
 /* The calling thread takes no more turns (it ends, or only joins others). */
 void semo__ls_leave(void);
+/* The program stopped: it wants no more time (what is left is its threads
+ * ending, at the instant it stopped, which its `stop` line shows). */
+void semo__ls_stopping(void);
 /* Ends the link (the program is over). */
 void semo__ls_close(void);
 extern const semo_transport semo_lockstep_transport;

@@ -65,6 +65,7 @@ static struct {
     size_t count, cap;
     ls_thread *running;   /* the thread holding the turn; NULL: idle */
     bool lost;            /* the coordinator went away: nothing waits any more */
+    bool stopping;        /* the program stopped: its time no longer moves */
     _Atomic int_least64_t now;
     int fd;
     pthread_mutex_t write_lock;
@@ -240,6 +241,13 @@ int semo__ls_create(pthread_t *thread, const pthread_attr_t *attr, void *(*body)
     return err;
 }
 
+void semo__ls_stopping(void)
+{
+    pthread_mutex_lock(&g_ls.lock);
+    g_ls.stopping = true;
+    pthread_mutex_unlock(&g_ls.lock);
+}
+
 void semo__ls_leave(void)
 {
     ls_thread *me = g_self;
@@ -363,6 +371,8 @@ static bool idle_locked(void)
 static int64_t next_wake_locked(void)
 {
     int64_t next = -1;
+    if (g_ls.stopping)
+        return next;
     for (size_t i = 0; i < g_ls.count; i++) {
         const ls_thread *t = g_ls.threads[i];
         if (t->state == LS_BLOCKED && t->deadline >= 0 && (next < 0 || t->deadline < next))
@@ -397,7 +407,7 @@ static void enqueue(unsigned char *data, size_t len)
 static void grant(int64_t now)
 {
     pthread_mutex_lock(&g_ls.lock);
-    if (now > semo__ls_now())
+    if (now > semo__ls_now() && !g_ls.stopping)
         atomic_store(&g_ls.now, now);
     for (size_t i = 0; i < g_ls.count; i++) {
         ls_thread *t = g_ls.threads[i];

@@ -1575,7 +1575,9 @@ static int run(const options *o)
 stop:
     semo_stop_program();
 #ifdef SEMO_SIM
-    /* The main thread only joins from here: the others take the turns. */
+    /* The main thread only joins from here: the others take the turns, at
+     * the instant the program stopped. */
+    semo__ls_stopping();
     semo__ls_leave();
 #endif
     for (size_t i = 0; i < p->task_count; i++)
