@@ -160,6 +160,7 @@ fn compile(flavor: Flavor) -> Program {
             "semo_runtime.c",
             "semo_udp.c",
             "semo_sim.c",
+            "semo_lockstep.c",
             "-o",
         ])
         .arg(&partial)

@@ -8,6 +8,7 @@ mod fmt;
 mod graph;
 mod init;
 mod input;
+mod lockstep;
 mod operator;
 mod output;
 mod render;
@@ -224,6 +225,11 @@ enum Command {
         trace: Option<PathBuf>,
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
+        /// What runs the robots: `sim`, the simulator, or `c`, the generated
+        /// `linux-sim` programs (built with make, run as processes in
+        /// lock-step virtual time: the same trace format).
+        #[arg(long, value_enum, default_value_t = simulate::Engine::Sim)]
+        engine: simulate::Engine,
     },
     /// Analyse task graphs (`*.taskgraph.xml` or SDF3 files).
     #[command(subcommand)]
@@ -565,6 +571,7 @@ fn run() -> i32 {
             svg,
             trace,
             color,
+            engine,
         } => simulate::run(
             simulate::Options {
                 mission,
@@ -576,6 +583,7 @@ fn run() -> i32 {
                 svg,
                 trace,
                 color: use_color(color),
+                engine,
             },
             &mut out,
         ),

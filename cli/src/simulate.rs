@@ -19,6 +19,17 @@ pub struct Options {
     pub svg: Option<PathBuf>,
     pub trace: Option<PathBuf>,
     pub color: bool,
+    pub engine: Engine,
+}
+
+/// What runs the robots.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Engine {
+    /// The simulator (`semo::sim`): the reference meaning.
+    Sim,
+    /// The generated `linux-sim` C programs, built with `make` and run as
+    /// processes in lock-step virtual time (`lockstep.rs`).
+    C,
 }
 
 /// `--until`: mission time as `10min`, `90s`, `500ms`, `1h` or plain milliseconds.
@@ -100,8 +111,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         eprintln!("error: cannot simulate: fix the errors above first");
         return 2;
     }
-    let programs = refined.programs;
-    let scenario = match scenario::parse(&scenario_text, &programs) {
+    let scenario = match scenario::parse(&scenario_text, &refined.programs) {
         Ok(s) => s,
         Err(e) => {
             let (line, col) = e.line_col(&scenario_text);
@@ -123,6 +133,10 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     };
+    if options.engine == Engine::C {
+        return run_generated(&options, &build.input(), refined, &scenario, &scenario_text, out);
+    }
+    let programs = refined.programs;
     let run = sim::simulate(
         &programs,
         &scenario,
@@ -206,4 +220,52 @@ fn json_summary(run: &sim::Run, verdicts: &[sim::Verdict]) -> String {
     let mut text = output::json_document("simulate", &[], data).to_string();
     text.push('\n');
     text
+}
+
+/// `--engine c`: the generated programs run the scenario in lock-step; the
+/// trace is theirs, merged in time order (robots in peer order at one instant).
+fn run_generated(
+    options: &Options,
+    input: &semo::codegen::BuildInput<'_>,
+    refined: semo::codegen::Refined,
+    scenario: &scenario::Scenario,
+    scenario_text: &str,
+    out: &mut impl Write,
+) -> i32 {
+    if options.json || options.svg.is_some() {
+        eprintln!("error: --engine c writes the trace (--trace) and a text summary; --format json and --svg need --engine sim");
+        return 2;
+    }
+    if !scenario.expect.is_empty() {
+        eprintln!("note: --engine c does not judge the scenario's expectations; --engine sim does");
+    }
+    let until_ms = options
+        .until_ms
+        .or(scenario.duration_ms)
+        .unwrap_or(sim::DEFAULT_UNTIL_MS);
+    let robots = match super::lockstep::simulate(input, refined, scenario, scenario_text, until_ms) {
+        Ok(robots) => robots,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let trace = super::lockstep::merged(&robots);
+    if let Some(path) = &options.trace
+        && write_to(path, &trace, out) != 0
+    {
+        return 2;
+    }
+    if options.trace.as_deref() != Some(Path::new("-")) {
+        let lines = trace.lines().count();
+        let mut summary = format!(
+            "{} robots ran their generated programs in lock-step: {lines} trace events\n",
+            robots.len()
+        );
+        for (robot, text) in &robots {
+            summary.push_str(&format!("  {robot}: {} events\n", text.lines().count()));
+        }
+        let _ = out.write_all(summary.as_bytes());
+    }
+    0
 }

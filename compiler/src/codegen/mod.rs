@@ -113,6 +113,7 @@ const POSIX: (&str, &str) = ("semo_runtime.c", include_str!("runtime/semo_runtim
 const UDP: (&str, &str) = ("semo_udp.c", include_str!("runtime/semo_udp.c"));
 const MQTT: (&str, &str) = ("semo_mqtt.c", include_str!("runtime/semo_mqtt.c"));
 const POSIX_SIM: (&str, &str) = ("semo_sim.c", include_str!("runtime/semo_sim.c"));
+const LOCKSTEP: (&str, &str) = ("semo_lockstep.c", include_str!("runtime/semo_lockstep.c"));
 const STATIC: (&str, &str) = ("semo_static.c", include_str!("runtime/semo_static.c"));
 const LM3S6965: (&str, &str) = ("semo_lm3s6965.c", include_str!("runtime/semo_lm3s6965.c"));
 const LM3S6965_LD: (&str, &str) = ("lm3s6965.ld", include_str!("runtime/lm3s6965.ld"));
@@ -132,7 +133,7 @@ pub const TARGETS: &[TargetInfo] = &[
         platform: Platform::Threads,
         simulated: true,
         transport: Some(Transport::Udp),
-        runtime: &[API, INTERNAL, CORE, POSIX, UDP, MQTT, POSIX_SIM],
+        runtime: &[API, INTERNAL, CORE, POSIX, UDP, MQTT, POSIX_SIM, LOCKSTEP],
     },
     TargetInfo {
         target: Target::CortexM,

@@ -137,10 +137,39 @@ void semo__trace_dropped_samples(void);
 #if defined(SEMO_SIM) && !defined(SEMO_STATIC)
 #include <pthread.h>
 
-/* A condition variable on the runtime's clock, and a wait on it until woken
- * or mission time `deadline_ms` (< 0: no limit). */
+/* A condition variable on the runtime's clock, a wait on it until woken
+ * or mission time `deadline_ms` (< 0: no limit), and its signal. */
 void semo__cond_init(pthread_cond_t *cond);
 void semo__cond_wait_until(pthread_cond_t *cond, pthread_mutex_t *lock, int64_t deadline_ms);
+void semo__cond_signal(pthread_cond_t *cond);
+/* Starts a thread of the program (in lock-step, one that takes turns). */
+bool semo__start_thread(pthread_t *thread, void *(*body)(void *), void *arg);
+
+/* Lock-step virtual time (semo_lockstep.c, `--lockstep SOCKET`): mission
+ * time is granted by a coordinator, and the program's threads take turns.
+ * Every wait of the runtime is semo__ls_wait on some key (a condition's
+ * address), every signal semo__ls_wake on it. */
+bool semo__ls_on(void);
+/* Whether the threads take turns (from the connection until the coordinator
+ * goes; the clock stays virtual after). */
+bool semo__ls_turns(void);
+int64_t semo__ls_now(void);
+/* Connects as peer `self`, takes the starting time, and starts the link
+ * thread; the calling (main) thread holds the first turn. */
+int semo__ls_connect(const char *path, size_t self);
+/* Called with `lock` held, returns with it held. */
+void semo__ls_wait(const void *key, pthread_mutex_t *lock, int64_t deadline_ms);
+void semo__ls_wake(const void *key, bool all);
+/* pthread_create for a thread that takes turns (numbered now). */
+int semo__ls_create(pthread_t *thread, const pthread_attr_t *attr, void *(*body)(void *), void *arg);
+/* The calling thread takes no more turns (it ends, or only joins others). */
+void semo__ls_leave(void);
+/* The program stopped: it wants no more time (what is left is its threads
+ * ending, at the instant it stopped, which its `stop` line shows). */
+void semo__ls_stopping(void);
+/* Ends the link (the program is over). */
+void semo__ls_close(void);
+extern const semo_transport semo_lockstep_transport;
 /* The scenario's link faults on a message from this robot to `peer` sent
  * now: false when it is lost, else the extra delay (ms, 0: none). */
 bool semo__sim_link(size_t peer, int64_t *delay_ms);

@@ -81,6 +81,10 @@ const semo_program_desc *semo_program(void)
 
 int64_t semo_now_ms(void)
 {
+#ifdef SEMO_SIM
+    if (semo__ls_on())
+        return semo__ls_now();
+#endif
     struct timespec now;
     clock_gettime(CLOCK_MONOTONIC, &now);
     double wall_ns = (double)(now.tv_sec - g_t0.tv_sec) * 1e9 + (double)(now.tv_nsec - g_t0.tv_nsec);
@@ -109,6 +113,12 @@ static struct timespec wall_deadline(int64_t mission_ms)
 /* Waits on `cond` until woken or mission time `deadline_ms` (< 0: no limit). */
 static void wait_until(pthread_cond_t *cond, pthread_mutex_t *lock, int64_t deadline_ms)
 {
+#ifdef SEMO_SIM
+    if (semo__ls_turns()) {
+        semo__ls_wait(cond, lock, deadline_ms);
+        return;
+    }
+#endif
     if (deadline_ms < 0) {
         pthread_cond_wait(cond, lock);
     } else {
@@ -117,7 +127,36 @@ static void wait_until(pthread_cond_t *cond, pthread_mutex_t *lock, int64_t dead
     }
 }
 
+/* Every signal of a condition the runtime waits on goes through these, so
+ * that lock-step knows who may run. */
+static void cond_signal(pthread_cond_t *cond)
+{
 #ifdef SEMO_SIM
+    if (semo__ls_turns()) {
+        semo__ls_wake(cond, false);
+        return;
+    }
+#endif
+    pthread_cond_signal(cond);
+}
+
+static void cond_broadcast(pthread_cond_t *cond)
+{
+#ifdef SEMO_SIM
+    if (semo__ls_turns()) {
+        semo__ls_wake(cond, true);
+        return;
+    }
+#endif
+    pthread_cond_broadcast(cond);
+}
+
+#ifdef SEMO_SIM
+void semo__cond_signal(pthread_cond_t *cond)
+{
+    cond_signal(cond);
+}
+
 void semo__cond_init(pthread_cond_t *cond)
 {
     init_cond(cond);
@@ -242,9 +281,9 @@ void semo__queue_written(int queue)
 {
     if (queue == SEMO__INBOX) {
         /* Both a poller and a held-back delivery may wait on the inbox. */
-        pthread_cond_broadcast(&g_inbox_cond);
+        cond_broadcast(&g_inbox_cond);
     } else {
-        pthread_cond_signal(&g_channels[queue].readable);
+        cond_signal(&g_channels[queue].readable);
         wake_task(g_channels[queue].reader);
     }
 }
@@ -255,7 +294,7 @@ void semo__queue_taken(int queue)
     channel *c = channel_at(queue);
     if (c && atomic_load(&c->room_waiters) > 0) {
         pthread_mutex_lock(&c->lock);
-        pthread_cond_broadcast(&c->readable);
+        cond_broadcast(&c->readable);
         pthread_mutex_unlock(&c->lock);
     }
 }
@@ -354,7 +393,7 @@ static void wake_task(task *t)
      * must not sleep through it. */
     t->woken = true;
     if (t->hinted)
-        pthread_cond_broadcast(&t->changed);
+        cond_broadcast(&t->changed);
     pthread_mutex_unlock(&t->lock);
 }
 
@@ -408,7 +447,7 @@ static void firing_ended(task *t)
         channel *c = &g_channels[i];
         if (c->reader == t && atomic_load(&c->room_waiters) > 0) {
             pthread_mutex_lock(&c->lock);
-            pthread_cond_broadcast(&c->readable);
+            cond_broadcast(&c->readable);
             pthread_mutex_unlock(&c->lock);
         }
     }
@@ -454,7 +493,7 @@ static void *task_thread(void *arg)
             t->control.state = SEMO_TASK_IDLE;
             t->control.stop_requested = false;
             t->control.calls = 0;
-            pthread_cond_broadcast(&t->changed);
+            cond_broadcast(&t->changed);
             task *controller = t->controller;
             pthread_mutex_unlock(&t->lock);
             wake_task(controller); /* the control task waits for idle tasks */
@@ -462,7 +501,7 @@ static void *task_thread(void *arg)
             continue;
         }
         if (t->control.state != SEMO_TASK_RUNNING) {
-            pthread_cond_wait(&t->changed, &t->lock);
+            wait_until(&t->changed, &t->lock, -1);
             continue;
         }
         if (d->trigger == SEMO_TRIGGER_TIME) {
@@ -489,7 +528,7 @@ static void *task_thread(void *arg)
         bool went_idle = !t->control.repeat && t->control.calls > 0 && --t->control.calls == 0;
         if (went_idle)
             t->control.state = SEMO_TASK_IDLE;
-        pthread_cond_broadcast(&t->changed);
+        cond_broadcast(&t->changed);
         if (went_idle) {
             task *controller = t->controller;
             pthread_mutex_unlock(&t->lock);
@@ -518,7 +557,7 @@ void semo__control_end(semo__task_control *control)
     if (g_current && g_current != t)
         t->controller = g_current;
     t->woken = true; /* its own hint is void: it was told what to do */
-    pthread_cond_broadcast(&t->changed);
+    cond_broadcast(&t->changed);
     pthread_mutex_unlock(&t->lock);
 }
 
@@ -914,19 +953,19 @@ void semo_stop_program(void)
     /* Every waiter re-checks semo_running() under its own lock, so taking
      * each lock before broadcasting means no one can miss the news. */
     pthread_mutex_lock(&g_run_lock);
-    pthread_cond_broadcast(&g_run_cond);
+    cond_broadcast(&g_run_cond);
     pthread_mutex_unlock(&g_run_lock);
     pthread_mutex_lock(&g_inbox_lock);
-    pthread_cond_broadcast(&g_inbox_cond);
+    cond_broadcast(&g_inbox_cond);
     pthread_mutex_unlock(&g_inbox_lock);
     for (size_t i = 0; g_channels && i < g_prog->channel_count; i++) {
         pthread_mutex_lock(&g_channels[i].lock);
-        pthread_cond_broadcast(&g_channels[i].readable);
+        cond_broadcast(&g_channels[i].readable);
         pthread_mutex_unlock(&g_channels[i].lock);
     }
     for (size_t i = 0; g_tasks && i < g_prog->task_count; i++) {
         pthread_mutex_lock(&g_tasks[i].lock);
-        pthread_cond_broadcast(&g_tasks[i].changed);
+        cond_broadcast(&g_tasks[i].changed);
         pthread_mutex_unlock(&g_tasks[i].lock);
     }
     /* The receiver waits on the socket without a timeout. */
@@ -968,6 +1007,7 @@ typedef struct {
     double time_scale;
     bool time_scale_given;
     long start_at_ms; /* --start-at: Unix ms of mission time 0; 0: when the program starts */
+    const char *lockstep; /* --lockstep: the coordinator's socket; NULL: real time */
     unsigned char udp_key[SEMO_UDP_KEY_MAX]; /* $SEMO_UDP_KEY; udp_key_len 0: none */
     size_t udp_key_len;
 } options;
@@ -981,7 +1021,7 @@ static void usage(FILE *f, const char *prog)
             "usage: %s [--trace FILE] [--transport udp|mqtt] [--port-base N] [--broker URL] [--duration MS]"
             " [--start-at UNIX_MS]"
 #ifdef SEMO_SIM
-            " [--scenario FILE] [--time-scale X]"
+            " [--scenario FILE] [--time-scale X] [--lockstep PATH]"
 #endif
             "\n"
             "  --trace FILE      write a JSON-lines trace to FILE (\"-\": standard output)\n"
@@ -999,6 +1039,9 @@ static void usage(FILE *f, const char *prog)
 #ifdef SEMO_SIM
             "  --scenario FILE   the simulation scenario (JSON)\n"
             "  --time-scale X    wall ms per mission ms (0.1: ten times faster; default 1)\n"
+            "  --lockstep PATH   virtual time: mission time and messages come from the coordinator on\n"
+            "                    the Unix socket PATH (`semo simulate --engine c`); --start-at, --time-scale,\n"
+            "                    --transport and --port-base do not apply\n"
 #endif
             ,
             prog, DEFAULT_TRANSPORT, DEFAULT_PORT_BASE);
@@ -1178,7 +1221,8 @@ static int parse_options(int argc, char **argv, options *o)
             return 1;
         }
         static const char *const names[] = {"--trace",      "--port-base", "--duration", "--scenario",
-                                            "--time-scale", "--transport", "--broker",  "--start-at"};
+                                            "--time-scale", "--transport", "--broker",  "--start-at",
+                                            "--lockstep"};
         size_t which = sizeof names / sizeof names[0];
         const char *value = NULL;
         for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
@@ -1189,7 +1233,7 @@ static int parse_options(int argc, char **argv, options *o)
             }
         }
 #ifndef SEMO_SIM
-        if (which >= 3 && which < 5) {
+        if ((which >= 3 && which < 5) || which == 8) {
             fprintf(stderr, "%s: %s needs a simulation build (-DSEMO_SIM)\n", prog, names[which]);
             return 2;
         }
@@ -1251,6 +1295,9 @@ static int parse_options(int argc, char **argv, options *o)
                 fprintf(stderr, "%s: --start-at must be a time in ms since 1970, not \"%s\"\n", prog, value);
                 return 2;
             }
+            break;
+        case 8:
+            o->lockstep = value;
             break;
         }
     }
@@ -1394,19 +1441,33 @@ static void close_trace(void)
     pthread_mutex_unlock(&g_trace_lock);
 }
 
-static bool start_thread(pthread_t *thread, void *(*body)(void *), void *arg)
+/* `takes_turns`: in lock-step, a thread of the program (not the signal
+ * watcher, which only waits for signals). */
+static bool start_thread(pthread_t *thread, void *(*body)(void *), void *arg, bool takes_turns)
 {
     pthread_attr_t attr;
     pthread_attr_init(&attr);
     pthread_attr_setstacksize(&attr, SEMO_STACK_BYTES);
+#ifdef SEMO_SIM
+    bool ok = (takes_turns && semo__ls_turns() ? semo__ls_create(thread, &attr, body, arg)
+                                              : pthread_create(thread, &attr, body, arg)) == 0;
+#else
+    (void)takes_turns;
     bool ok = pthread_create(thread, &attr, body, arg) == 0;
+#endif
     pthread_attr_destroy(&attr);
     if (!ok)
         fprintf(stderr, "semo runtime: cannot start a thread\n");
     return ok;
 }
 
-/* Starts everything, waits for the end, stops everything; 0 or 1. */
+#ifdef SEMO_SIM
+bool semo__start_thread(pthread_t *thread, void *(*body)(void *), void *arg)
+{
+    return start_thread(thread, body, arg, true);
+}
+#endif
+
 /* Mission time 0: now, or the wall-clock instant `start_at_ms` (Unix ms),
  * as a monotonic instant (in the future: the start barrier; in the past: a
  * restarted robot continues its mission's time). */
@@ -1427,6 +1488,7 @@ static void start_clock(long start_at_ms)
     }
 }
 
+/* Starts everything, waits for the end, stops everything; 0 or 1. */
 static int run(const options *o)
 {
     const semo_program_desc *p = g_prog;
@@ -1446,8 +1508,19 @@ static int run(const options *o)
 
     start_clock(o->start_at_ms);
     atomic_store(&g_running, true);
+#ifdef SEMO_SIM
+    /* Lock-step: the coordinator is the clock and the network. */
+    if (o->lockstep) {
+        if (semo__ls_connect(o->lockstep, p->self) != 0) {
+            status = 1;
+            goto stop;
+        }
+        if (p->peer_count > 1)
+            g_transport = &semo_lockstep_transport;
+    }
+#endif
     /* A robot alone in its mission has no one to hear from: no port, no receiver. */
-    if (p->peer_count > 1) {
+    if (p->peer_count > 1 && !g_transport) {
         semo_transport_config net = o->identity;
         net.port_base = o->port_base;
         net.broker_host = o->broker_host;
@@ -1471,7 +1544,7 @@ static int run(const options *o)
         }
 #endif
     }
-    signals_started = start_thread(&signals, signal_thread, NULL);
+    signals_started = start_thread(&signals, signal_thread, NULL, false);
     /* The start barrier: the transport is open (a robot's messages reach the
      * others from the first), the clock starts at the agreed instant. */
     if (!semo__wait_until(0))
@@ -1483,14 +1556,14 @@ static int run(const options *o)
         if (p->tasks[initialized].init)
             p->tasks[initialized].init();
     if (g_transport)
-        receiver_started = start_thread(&receiver, receiver_thread, NULL);
+        receiver_started = start_thread(&receiver, receiver_thread, NULL, true);
 #ifdef SEMO_SIM
     sim_started = semo__sim_start() == 0;
     if (!sim_started)
         status = 1;
 #endif
     for (size_t i = 0; i < p->task_count && status == 0; i++) {
-        g_tasks[i].started = start_thread(&g_tasks[i].thread, task_thread, &g_tasks[i]);
+        g_tasks[i].started = start_thread(&g_tasks[i].thread, task_thread, &g_tasks[i], true);
         if (!g_tasks[i].started)
             status = 1;
     }
@@ -1501,6 +1574,12 @@ static int run(const options *o)
         semo__wait_until(o->duration_ms > 0 ? o->duration_ms : INT64_MAX);
 stop:
     semo_stop_program();
+#ifdef SEMO_SIM
+    /* The main thread only joins from here: the others take the turns, at
+     * the instant the program stopped. */
+    semo__ls_stopping();
+    semo__ls_leave();
+#endif
     for (size_t i = 0; i < p->task_count; i++)
         if (g_tasks[i].started)
             pthread_join(g_tasks[i].thread, NULL);
@@ -1523,6 +1602,9 @@ stop:
     if (g_transport)
         g_transport->close();
     g_transport = NULL;
+#ifdef SEMO_SIM
+    semo__ls_close();
+#endif
     pthread_sigmask(SIG_SETMASK, &old_mask, NULL);
     return status;
 }

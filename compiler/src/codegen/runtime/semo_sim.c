@@ -984,7 +984,7 @@ void semo__sim_send_later(const semo_transport *transport, size_t peer, const vo
     g_late.transport = transport;
     d->next = g_late.queue;
     g_late.queue = d;
-    pthread_cond_signal(&g_late.changed);
+    semo__cond_signal(&g_late.changed);
     pthread_mutex_unlock(&g_late.lock);
 }
 
@@ -1028,7 +1028,7 @@ int semo__sim_start(void)
     if (has_delays()) {
         semo__cond_init(&g_late.changed);
         g_late.stopping = false;
-        if (pthread_create(&g_late.thread, NULL, late_thread, NULL) != 0) {
+        if (!semo__start_thread(&g_late.thread, late_thread, NULL)) {
             fprintf(stderr, "semo runtime: cannot start the simulated network\n");
             pthread_cond_destroy(&g_late.changed);
             return -1;
@@ -1037,7 +1037,7 @@ int semo__sim_start(void)
     }
     if (g_sim.command_count == 0)
         return 0;
-    if (pthread_create(&g_operator, NULL, operator_thread, NULL) != 0) {
+    if (!semo__start_thread(&g_operator, operator_thread, NULL)) {
         fprintf(stderr, "semo runtime: cannot start the simulated operator\n");
         return -1;
     }
@@ -1053,7 +1053,7 @@ void semo__sim_stop(void)
     if (g_late.started) {
         pthread_mutex_lock(&g_late.lock);
         g_late.stopping = true;
-        pthread_cond_signal(&g_late.changed);
+        semo__cond_signal(&g_late.changed);
         pthread_mutex_unlock(&g_late.lock);
         pthread_join(g_late.thread, NULL);
         pthread_cond_destroy(&g_late.changed);

@@ -1,0 +1,562 @@
+//! The lock-step coordinator of `semo simulate --engine c`: it runs the
+//! built `linux-sim` programs of a mission as processes, each with
+//! `--lockstep SOCKET`, and is their clock and their network
+//! (`codegen/runtime/semo_lockstep.c` says the robot's side and the frames).
+//!
+//! Mission time moves only when every robot is idle (each has said so with
+//! the earliest time it wants to wake at), to the earliest of those times,
+//! of the messages' arrivals and of the scenario's process faults. Messages
+//! arrive after the scenario's network latency, delivered in the order of
+//! their senders' peer indices, each sender's in the order it sent them. A
+//! run is then a function of the programs and the scenario: no clock is read
+//! and the machine's load changes nothing but how long it takes.
+
+use std::collections::BTreeMap;
+use std::io::{self, Read, Write};
+use std::os::unix::net::{UnixListener, UnixStream};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+
+/// A built robot program of the run.
+pub struct Robot {
+    /// Its name (its trace files are named after it).
+    pub name: String,
+    /// The program (`<folder>/<robot>`).
+    pub exe: PathBuf,
+}
+
+/// What happens to a process from outside, at a mission time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProcessFault {
+    Kill,
+    Restart,
+}
+
+pub struct Run<'a> {
+    /// In peer order (the programs' peer tables).
+    pub robots: &'a [Robot],
+    pub scenario: &'a Path,
+    /// (at, peer, fault), in time order.
+    pub faults: Vec<(i64, usize, ProcessFault)>,
+    /// The latency of a message from one peer to another (mission ms).
+    pub latency: &'a dyn Fn(usize, usize) -> i64,
+    /// Mission time after which the run ends (the robots are stopped).
+    pub until_ms: i64,
+    /// Where the socket, the traces and the robots' error output go.
+    pub work: &'a Path,
+}
+
+/// Each robot's trace (its incarnations' in order), in peer order.
+pub fn run(run: &Run<'_>) -> Result<Vec<String>, String> {
+    let socket = run.work.join("lockstep.sock");
+    let listener = UnixListener::bind(&socket)
+        .map_err(|e| format!("cannot listen on {}: {e}", socket.display()))?;
+    let mut coordinator = Coordinator::new(run, listener);
+    let result = coordinator.drive();
+    coordinator.stop_all();
+    result?;
+    let mut traces = Vec::new();
+    for (peer, robot) in run.robots.iter().enumerate() {
+        let mut text = String::new();
+        for incarnation in 0..coordinator.incarnations[peer] {
+            let path = trace_path(run.work, robot, incarnation);
+            text.push_str(&std::fs::read_to_string(&path).unwrap_or_default());
+        }
+        traces.push(text);
+    }
+    Ok(traces)
+}
+
+fn trace_path(work: &Path, robot: &Robot, incarnation: u32) -> PathBuf {
+    work.join(format!("{}.{incarnation}.jsonl", robot.name))
+}
+
+/// What a robot's stream brought.
+enum Frame {
+    /// Idle until the given time (`None`: until a message or for ever).
+    Idle(Option<i64>),
+    /// A datagram for a peer.
+    Message { to: usize, datagram: Vec<u8> },
+    /// The stream ended (the process ended or was killed), broke, or
+    /// brought a frame no robot sends.
+    End,
+}
+
+struct Live {
+    child: Child,
+    stream: UnixStream,
+    incarnation: u32,
+    idle: bool,
+    wakes_at: Option<i64>,
+}
+
+struct Coordinator<'r, 'a> {
+    run: &'r Run<'a>,
+    listener: UnixListener,
+    live: Vec<Option<Live>>,
+    incarnations: Vec<u32>,
+    frames: mpsc::Receiver<(usize, u32, Frame)>,
+    frames_to: mpsc::Sender<(usize, u32, Frame)>,
+    now: i64,
+    /// (arrival, sender, sequence) → (receiver, datagram): the delivery order.
+    in_flight: BTreeMap<(i64, usize, u64), (usize, Vec<u8>)>,
+    sent: u64,
+}
+
+impl<'r, 'a> Coordinator<'r, 'a> {
+    fn new(run: &'r Run<'a>, listener: UnixListener) -> Self {
+        let (frames_to, frames) = mpsc::channel();
+        Coordinator {
+            run,
+            listener,
+            live: run.robots.iter().map(|_| None).collect(),
+            incarnations: vec![0; run.robots.len()],
+            frames,
+            frames_to,
+            now: 0,
+            in_flight: BTreeMap::new(),
+            sent: 0,
+        }
+    }
+
+    fn drive(&mut self) -> Result<(), String> {
+        for peer in 0..self.run.robots.len() {
+            self.start(peer)?;
+        }
+        let mut faults = self.run.faults.iter().copied().peekable();
+        loop {
+            self.wait_until_all_idle()?;
+            if self.live.iter().all(Option::is_none) {
+                return Ok(());
+            }
+            let next_wake = self.live.iter().flatten().filter_map(|l| l.wakes_at).min();
+            let next_arrival = self.in_flight.keys().next().map(|k| k.0);
+            let next_fault = faults.peek().map(|f| f.0);
+            let Some(next) = [next_wake, next_arrival, next_fault]
+                .into_iter()
+                .flatten()
+                .min()
+            else {
+                return Ok(()); // every robot waits for a message no one will send
+            };
+            if next > self.run.until_ms {
+                return Ok(());
+            }
+            self.now = self.now.max(next);
+            while let Some(&(at, peer, fault)) = faults.peek() {
+                if at > self.now {
+                    break;
+                }
+                faults.next();
+                match fault {
+                    ProcessFault::Kill => self.kill(peer),
+                    ProcessFault::Restart => {
+                        self.kill(peer);
+                        self.start(peer)?;
+                    }
+                }
+            }
+            self.deliver_due()?;
+            for peer in 0..self.live.len() {
+                let due = self.live[peer]
+                    .as_ref()
+                    .is_some_and(|l| l.idle && l.wakes_at.is_some_and(|t| t <= self.now));
+                if due {
+                    self.grant(peer)?;
+                }
+            }
+        }
+    }
+
+    /// Starts the robot `peer` at the current time.
+    fn start(&mut self, peer: usize) -> Result<(), String> {
+        let robot = &self.run.robots[peer];
+        let incarnation = self.incarnations[peer];
+        self.incarnations[peer] += 1;
+        let errors = std::fs::File::create(
+            self.run
+                .work
+                .join(format!("{}.{incarnation}.stderr", robot.name)),
+        )
+        .map_err(|e| format!("{}: {e}", self.run.work.display()))?;
+        let mut child = Command::new(&robot.exe)
+            .arg("--scenario")
+            .arg(self.run.scenario)
+            .arg("--trace")
+            .arg(trace_path(self.run.work, robot, incarnation))
+            .arg("--lockstep")
+            .arg(self.run.work.join("lockstep.sock"))
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(errors)
+            .spawn()
+            .map_err(|e| format!("cannot start {}: {e}", robot.exe.display()))?;
+        let (stream, who) = match self.accept(&mut child) {
+            Ok(accepted) => accepted,
+            Err(e) => {
+                let _ = child.kill();
+                let _ = child.wait();
+                return Err(format!("robot {}: {e}", robot.name));
+            }
+        };
+        if who != peer {
+            let _ = child.kill();
+            let _ = child.wait();
+            return Err(format!(
+                "robot {} says it is peer {who}, not {peer}: the programs are not of one build",
+                robot.name
+            ));
+        }
+        let reader = stream
+            .try_clone()
+            .map_err(|e| format!("robot {}: {e}", robot.name))?;
+        let frames = self.frames_to.clone();
+        std::thread::spawn(move || read_frames(reader, peer, incarnation, frames));
+        let mut live = Live {
+            child,
+            stream,
+            incarnation,
+            idle: false,
+            wakes_at: None,
+        };
+        write_frame(&mut live.stream, b'G', &self.now.to_le_bytes())
+            .map_err(|e| format!("robot {}: {e}", robot.name))?;
+        self.live[peer] = Some(live);
+        Ok(())
+    }
+
+    /// The robot's connection and the peer index it says it is, or why not:
+    /// it ended first. No timeout: a robot that starts connects at once.
+    fn accept(&self, child: &mut Child) -> Result<(UnixStream, usize), String> {
+        self.listener
+            .set_nonblocking(true)
+            .map_err(|e| e.to_string())?;
+        let mut stream = loop {
+            match self.listener.accept() {
+                Ok((stream, _)) => break stream,
+                Err(e) if e.kind() == io::ErrorKind::WouldBlock => {
+                    if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
+                        return Err(format!("ended before it connected ({status}); its errors are beside its trace"));
+                    }
+                    std::thread::sleep(std::time::Duration::from_millis(1));
+                }
+                Err(e) => return Err(e.to_string()),
+            }
+        };
+        stream.set_nonblocking(false).map_err(|e| e.to_string())?;
+        match read_frame(&mut stream) {
+            Ok((b'H', payload)) if payload.len() == 4 => {
+                let who = u32::from_le_bytes(payload[..4].try_into().expect("four bytes"));
+                Ok((stream, who as usize))
+            }
+            Ok(_) => Err("did not say who it is".to_string()),
+            Err(e) => Err(e.to_string()),
+        }
+    }
+
+    fn kill(&mut self, peer: usize) {
+        if let Some(mut live) = self.live[peer].take() {
+            let _ = live.child.kill();
+            let _ = live.child.wait();
+        }
+    }
+
+    /// Reads the robots' frames until every live robot is idle.
+    fn wait_until_all_idle(&mut self) -> Result<(), String> {
+        while self.live.iter().flatten().any(|l| !l.idle) {
+            let (peer, incarnation, frame) = self
+                .frames
+                .recv()
+                .map_err(|_| "internal error: the robots' frames stopped".to_string())?;
+            let Some(live) = self.live[peer]
+                .as_mut()
+                .filter(|l| l.incarnation == incarnation)
+            else {
+                continue; // from a process killed since
+            };
+            match frame {
+                Frame::Idle(wakes_at) => {
+                    live.idle = true;
+                    live.wakes_at = wakes_at;
+                }
+                Frame::Message { to, datagram } => {
+                    if to >= self.live.len() {
+                        return Err(format!(
+                            "robot {} sent a message to peer {to}, which does not exist",
+                            self.run.robots[peer].name
+                        ));
+                    }
+                    let arrival = self.now + (self.run.latency)(peer, to);
+                    self.in_flight
+                        .insert((arrival, peer, self.sent), (to, datagram));
+                    self.sent += 1;
+                }
+                Frame::End => {
+                    if let Some(mut live) = self.live[peer].take() {
+                        let _ = live.child.wait();
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Delivers every message due by now; the robots that got one are
+    /// granted the time (they run what the messages wake).
+    fn deliver_due(&mut self) -> Result<(), String> {
+        let mut woken = vec![false; self.live.len()];
+        while let Some(entry) = self.in_flight.first_entry() {
+            if entry.key().0 > self.now {
+                break;
+            }
+            let (to, datagram) = entry.remove();
+            // A message for a robot that is not running is lost.
+            if let Some(live) = self.live[to].as_mut()
+                && write_frame(&mut live.stream, b'D', &datagram).is_ok()
+            {
+                woken[to] = true;
+            }
+        }
+        for (peer, woken) in woken.into_iter().enumerate() {
+            if woken {
+                self.grant(peer)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn grant(&mut self, peer: usize) -> Result<(), String> {
+        let now = self.now;
+        let Some(live) = self.live[peer].as_mut() else {
+            return Ok(());
+        };
+        if !live.idle {
+            return Ok(()); // granted already at this instant
+        }
+        live.idle = false;
+        if write_frame(&mut live.stream, b'G', &now.to_le_bytes()).is_err() {
+            // It ended: its reader reports the end.
+            live.idle = true;
+            live.wakes_at = None;
+        }
+        Ok(())
+    }
+
+    /// Ends the run: a robot whose coordinator is gone stops (its wrap-ups
+    /// run and its trace is closed).
+    fn stop_all(&mut self) {
+        for live in self.live.iter_mut().filter_map(Option::take) {
+            let Live {
+                mut child, stream, ..
+            } = live;
+            let _ = stream.shutdown(std::net::Shutdown::Both);
+            drop(stream);
+            let _ = child.wait();
+        }
+    }
+}
+
+/// The frames of one robot's stream, to the coordinator, until it ends.
+fn read_frames(
+    mut stream: UnixStream,
+    peer: usize,
+    incarnation: u32,
+    to: mpsc::Sender<(usize, u32, Frame)>,
+) {
+    loop {
+        let frame = match read_frame(&mut stream) {
+            Ok((b'I', payload)) if payload.len() == 8 => {
+                let at = i64::from_le_bytes(payload[..8].try_into().expect("eight bytes"));
+                Frame::Idle((at >= 0).then_some(at))
+            }
+            Ok((b'M', payload)) if payload.len() >= 4 => Frame::Message {
+                to: u32::from_le_bytes(payload[..4].try_into().expect("four bytes")) as usize,
+                datagram: payload[4..].to_vec(),
+            },
+            Ok(_) | Err(_) => Frame::End,
+        };
+        let ended = matches!(frame, Frame::End);
+        if to.send((peer, incarnation, frame)).is_err() || ended {
+            return;
+        }
+    }
+}
+
+/// The longest payload a robot may send: a datagram and its peer index.
+const FRAME_MAX: usize = 64 * 1024;
+
+fn read_frame(stream: &mut UnixStream) -> io::Result<(u8, Vec<u8>)> {
+    let mut header = [0u8; 5];
+    stream.read_exact(&mut header)?;
+    let len = u32::from_le_bytes(header[1..].try_into().expect("four bytes")) as usize;
+    if len > FRAME_MAX {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidData,
+            format!("a frame of {len} bytes"),
+        ));
+    }
+    let mut payload = vec![0u8; len];
+    stream.read_exact(&mut payload)?;
+    Ok((header[0], payload))
+}
+
+fn write_frame(stream: &mut UnixStream, kind: u8, payload: &[u8]) -> io::Result<()> {
+    let mut frame = Vec::with_capacity(5 + payload.len());
+    frame.push(kind);
+    frame.extend_from_slice(&(payload.len() as u32).to_le_bytes());
+    frame.extend_from_slice(payload);
+    stream.write_all(&frame)
+}
+
+/// Builds the mission's `linux-sim` programs in a private folder, makes
+/// them, and runs them on the scenario until `until_ms`: each robot's name
+/// and trace, in peer order.
+pub fn simulate(
+    input: &semo::codegen::BuildInput<'_>,
+    refined: semo::codegen::Refined,
+    scenario: &semo::sim::scenario::Scenario,
+    scenario_text: &str,
+    until_ms: i64,
+) -> Result<Vec<(String, String)>, String> {
+    use semo::sim::scenario::FaultKind;
+    let network = &scenario.network;
+    if network.loss > 0.0 || network.links.iter().any(|l| l.loss.unwrap_or(0.0) > 0.0) {
+        return Err(
+            "--engine c does not model the scenario's random message loss yet (`loss`); use --engine sim"
+                .to_string(),
+        );
+    }
+    let peers: Vec<(String, usize)> = refined
+        .programs
+        .iter()
+        .map(|p| (p.robot.clone(), p.self_peer))
+        .collect();
+    let built = semo::codegen::build_refined(
+        input,
+        refined,
+        semo::codegen::Target::LinuxSim,
+        semo::codegen::Emit::All,
+        &[],
+    );
+    if built.refused() {
+        let why: Vec<String> = built
+            .diagnostics
+            .iter()
+            .filter(|d| d.is_error())
+            .map(|d| format!("{}: {}", d.code.as_str(), d.message))
+            .collect();
+        return Err(format!(
+            "the mission cannot be built for linux-sim:\n  {}",
+            why.join("\n  ")
+        ));
+    }
+    let work = tempfile::Builder::new()
+        .prefix("semo-lockstep-")
+        .tempdir()
+        .map_err(|e| format!("cannot make a work folder: {e}"))?;
+    let scenario_path = work.path().join("scenario.json");
+    std::fs::write(&scenario_path, scenario_text)
+        .map_err(|e| format!("{}: {e}", scenario_path.display()))?;
+    let mut robots: Vec<Option<Robot>> = peers.iter().map(|_| None).collect();
+    for output in &built.robots {
+        let folder = work.path().join(&output.team).join(&output.robot);
+        for file in &output.files {
+            let path = folder.join(&file.path);
+            if let Some(parent) = path.parent() {
+                std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
+            }
+            std::fs::write(&path, &file.text).map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+        make(&folder)?;
+        let Some(&(_, peer)) = peers.iter().find(|(name, _)| *name == output.robot) else {
+            return Err(format!("internal error: robot {} is not in the peer table", output.robot));
+        };
+        robots[peer] = Some(Robot {
+            name: output.robot.clone(),
+            exe: folder.join(&output.robot),
+        });
+    }
+    let robots: Vec<Robot> = robots
+        .into_iter()
+        .collect::<Option<_>>()
+        .ok_or("internal error: a peer has no program")?;
+    let peer_of = |name: &str| robots.iter().position(|r| r.name == name);
+    let mut faults = Vec::new();
+    for fault in &scenario.faults {
+        let (robot, at, kind) = match &fault.kind {
+            FaultKind::Kill { robot, at } => (robot, *at, ProcessFault::Kill),
+            FaultKind::Restart { robot, at } => (robot, *at, ProcessFault::Restart),
+            _ => continue, // the programs act on link faults themselves
+        };
+        let peer = peer_of(robot)
+            .ok_or_else(|| format!("internal error: the scenario's robot {robot} has no program"))?;
+        faults.push((at, peer, kind));
+    }
+    faults.sort_by_key(|f| f.0);
+    let names: Vec<&str> = robots.iter().map(|r| r.name.as_str()).collect();
+    let latency = |a: usize, b: usize| {
+        let pair = |(x, y): &(String, String)| {
+            (x == names[a] && y == names[b]) || (x == names[b] && y == names[a])
+        };
+        network
+            .links
+            .iter()
+            .find(|l| pair(&l.between))
+            .and_then(|l| l.latency_ms)
+            .unwrap_or(network.latency_ms)
+    };
+    let traces = run(&Run {
+        robots: &robots,
+        scenario: &scenario_path,
+        faults,
+        latency: &latency,
+        until_ms,
+        work: work.path(),
+    })?;
+    Ok(robots.iter().map(|r| r.name.clone()).zip(traces).collect())
+}
+
+/// `make` in a robot's folder (quiet; its errors are shown).
+fn make(folder: &Path) -> Result<(), String> {
+    let made = Command::new("make")
+        .arg("-s")
+        .current_dir(folder)
+        .output()
+        .map_err(|e| format!("cannot run make (is it installed?): {e}"))?;
+    if made.status.success() {
+        Ok(())
+    } else {
+        Err(format!(
+            "make failed in {}:\n{}",
+            folder.display(),
+            String::from_utf8_lossy(&made.stderr)
+        ))
+    }
+}
+
+/// The robots' traces as one, in time order; at one instant, robots in
+/// peer order, each robot's lines in its order.
+pub fn merged(robots: &[(String, String)]) -> String {
+    let mut lines: Vec<(i64, usize, usize, &str)> = Vec::new();
+    for (peer, (_, text)) in robots.iter().enumerate() {
+        for (i, line) in text.lines().enumerate() {
+            lines.push((time_of(line), peer, i, line));
+        }
+    }
+    lines.sort_unstable_by_key(|&(t, peer, i, _)| (t, peer, i));
+    let mut out = String::new();
+    for (_, _, _, line) in lines {
+        out.push_str(line);
+        out.push('\n');
+    }
+    out
+}
+
+/// A trace line's `t` (every line starts `{"t":<ms>,`).
+fn time_of(line: &str) -> i64 {
+    line.strip_prefix("{\"t\":")
+        .and_then(|rest| rest.split(',').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or(i64::MAX)
+}
