@@ -165,7 +165,14 @@ fn every_sdf3_benchmark_is_consistent_and_deadlock_free() {
         }
         let text = std::fs::read_to_string(&path).unwrap();
         let (graph, diags) = load_task_graph(FileId(0), &text);
-        assert!(diags.is_empty(), "{}: {diags:#?}", path.display());
+        // Four of SDF3's files mark two processors of some actors default.
+        assert!(
+            diags
+                .iter()
+                .all(|d| d.code == semo::diag::Code::Sdf3TwoDefaultProcessors),
+            "{}: {diags:#?}",
+            path.display()
+        );
         let graph = graph.unwrap();
         let report = analysis::analyze(&graph);
         assert!(
@@ -720,4 +727,99 @@ fn a_byte_order_mark_leaves_diagnostics_in_place() {
         (c1 as u64 + 1, graph.find("</sdf>").unwrap() as u64 + 1)
     );
     assert_eq!(range("marked.xml"), (start + 1, end + 1));
+}
+
+/// The first level's period, or why there is none, of `text` written to a
+/// file `name` and analysed with `flags`: the human line about the period
+/// and the JSON `no_period` reason (both exit 0: the analysis is complete).
+fn period_or_why(name: &str, text: &str, flags: &[&str]) -> (String, serde_json::Value) {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join(name), text).unwrap();
+    let run = |format: &str| {
+        let mut args = vec!["graph", "analyze", "--format", format];
+        args.extend(flags);
+        args.push(name);
+        let out = semo_in(dir.path(), &args);
+        assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+        out.stdout
+    };
+    let human = run("human");
+    let line = human
+        .lines()
+        .find(|l| l.contains("iteration period"))
+        .unwrap_or_else(|| panic!("no period line: {human}"))
+        .trim()
+        .to_string();
+    let json: serde_json::Value = serde_json::from_str(&run("json")).unwrap();
+    let level = &json["levels"][0];
+    assert!(
+        level["throughput"].is_null() != level["no_period"].is_null(),
+        "a period or a reason: {level}"
+    );
+    (line, level["no_period"].clone())
+}
+
+/// A period is never silently missing: without execution times, on
+/// overflow, with an expansion too large, and under `--sdf3-compat` with no
+/// processor marked default, the text and the JSON say why.
+#[test]
+fn a_missing_period_says_why() {
+    let untimed = r#"<TaskGraph name="g" xmlns="urn:semo:taskgraph:1">
+  <Task name="A"><Port name="o" dir="out"/></Task>
+  <Task name="B"><Port name="i" dir="in"/></Task>
+  <Channel src="A.o" dst="B.i"/>
+</TaskGraph>"#;
+    let (line, why) = period_or_why("g.taskgraph.xml", untimed, &[]);
+    assert_eq!(
+        line,
+        "iteration period: none: no task has an execution time above 0"
+    );
+    assert_eq!(why["reason"], "untimed");
+    let huge = untimed
+        .replace(r#"name="A""#, r#"name="A" wcet="18446744073709551615""#)
+        .replace(r#"name="B""#, r#"name="B" wcet="18446744073709551615""#)
+        .replace(
+            r#"<Port name="o" dir="out"/></Task>"#,
+            r#"<Port name="o" dir="out"/><Port name="back" dir="in"/></Task>"#,
+        )
+        .replace(
+            r#"<Port name="i" dir="in"/></Task>"#,
+            r#"<Port name="i" dir="in"/><Port name="back" dir="out"/></Task>"#,
+        )
+        .replace(
+            "</TaskGraph>",
+            r#"<Channel src="B.back" dst="A.back" initialTokens="1"/></TaskGraph>"#,
+        );
+    let (line, why) = period_or_why("g.taskgraph.xml", &huge, &[]);
+    assert!(line.contains("overflows"), "{line}");
+    assert_eq!(why["reason"], "overflow");
+    // 10^9 + 1 firings per iteration on a cycle: too large to expand.
+    let expansion = r#"<TaskGraph name="g" xmlns="urn:semo:taskgraph:1">
+  <Task name="A" wcet="1"><Port name="o" dir="out" rate="1000000000"/><Port name="i" dir="in" rate="1000000000"/></Task>
+  <Task name="B" wcet="1"><Port name="i" dir="in"/><Port name="o" dir="out"/></Task>
+  <Channel src="A.o" dst="B.i"/>
+  <Channel src="B.o" dst="A.i" initialTokens="1000000000"/>
+</TaskGraph>"#;
+    let (line, why) = period_or_why("g.taskgraph.xml", expansion, &[]);
+    assert!(line.contains("too many firings"), "{line}");
+    assert_eq!(why["reason"], "too_large");
+    let no_default = r#"<?xml version="1.0"?>
+<sdf3 type="sdf" version="1.0"><applicationGraph name="g"><sdf name="g" type="G">
+  <actor name="a" type="A"><port name="o" type="out" rate="1"/><port name="i" type="in" rate="1"/></actor>
+  <channel name="l" srcActor="a" srcPort="o" dstActor="a" dstPort="i" initialTokens="1"/>
+</sdf><sdfProperties><actorProperties actor="a">
+  <processor type="p"><executionTime time="5"/></processor>
+</actorProperties></sdfProperties></applicationGraph></sdf3>"#;
+    // The file's reading takes the only processor; SDF3's takes none.
+    let (line, _) = period_or_why("g.xml", no_default, &[]);
+    assert_eq!(line, "iteration period: 5 (bounded by a alone)");
+    let (line, why) = period_or_why("g.xml", no_default, &["--sdf3-compat"]);
+    assert!(line.contains("--sdf3-compat"), "{line}");
+    assert_eq!(why["reason"], "untimed");
+    assert!(
+        why["message"]
+            .as_str()
+            .unwrap()
+            .contains("marked `default`")
+    );
 }

@@ -6,6 +6,7 @@ use super::input::{self, Content};
 use super::output::{self, Format};
 use super::render;
 use semo::diag::Diagnostic;
+use semo::taskgraph::analysis::NoPeriod;
 use semo::taskgraph::analysis::ratio::Ratio;
 use semo::workspace::{
     FileKind, FileResolver, Files, GraphReading, GraphRun, analyze_graph, analyze_graph_as,
@@ -191,14 +192,14 @@ pub fn analyze(
             color,
             &mut std::io::stderr().lock(),
         )
-        .and_then(|()| write_human(&run, out)),
+        .and_then(|()| write_human(&run, reading, out)),
         Format::Json => output::report(
             format,
             "graph analyze",
             &files,
             &run.diagnostics,
             color,
-            analysis_json(&run),
+            analysis_json(&run, reading),
             out,
         ),
         Format::Sarif => output::report(
@@ -222,8 +223,25 @@ pub fn analyze(
     code
 }
 
+/// Why a level has no period, in words: the analysis's reason, and under
+/// `--sdf3-compat` where the times come from.
+fn no_period_words(why: NoPeriod, reading: GraphReading) -> String {
+    let compat = reading.times == semo::taskgraph::ExecutionTimes::Sdf3Compat;
+    match why {
+        NoPeriod::Untimed if compat => format!(
+            "{} (with --sdf3-compat an actor's time comes only from a processor marked `default`)",
+            why.why()
+        ),
+        _ => why.why().to_string(),
+    }
+}
+
 /// The analysis for people (its diagnostics went to standard error).
-fn write_human(run: &semo::workspace::GraphRun, out: &mut impl Write) -> std::io::Result<()> {
+fn write_human(
+    run: &semo::workspace::GraphRun,
+    reading: GraphReading,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
     use std::fmt::Write as _;
     if !run.report.levels.is_empty() {
         let meaning = match run.report.concurrency {
@@ -268,13 +286,22 @@ fn write_human(run: &semo::workspace::GraphRun, out: &mut impl Write) -> std::io
         if let Some(schedule) = &level.schedule {
             writeln!(out, "  schedule: {schedule}")?;
         }
-        if let Some(t) = &level.throughput {
-            let cycle = match t.critical_cycle.as_slice() {
-                [] => "no cycle: unbounded throughput".to_string(),
-                [one] => format!("bounded by {one} alone"),
-                many => format!("bounded by {} → {}", many.join(" → "), many[0]),
-            };
-            writeln!(out, "  iteration period: {} ({cycle})", t.period)?;
+        match &level.throughput {
+            Ok(t) => {
+                let cycle = match t.critical_cycle.as_slice() {
+                    [] => "no cycle: unbounded throughput".to_string(),
+                    [one] => format!("bounded by {one} alone"),
+                    many => format!("bounded by {} → {}", many.join(" → "), many[0]),
+                };
+                writeln!(out, "  iteration period: {} ({cycle})", t.period)?;
+            }
+            // The state line above already says these.
+            Err(NoPeriod::Inconsistent | NoPeriod::Deadlock) => {}
+            Err(why) => writeln!(
+                out,
+                "  iteration period: none: {}",
+                no_period_words(*why, reading)
+            )?,
         }
         if !level.buffers.is_empty() {
             let mut line = String::from("  buffers: ");
@@ -295,7 +322,7 @@ fn write_human(run: &semo::workspace::GraphRun, out: &mut impl Write) -> std::io
 }
 
 /// The analysis's own fields of the JSON document.
-fn analysis_json(run: &semo::workspace::GraphRun) -> serde_json::Value {
+fn analysis_json(run: &semo::workspace::GraphRun, reading: GraphReading) -> serde_json::Value {
     let levels: Vec<serde_json::Value> = run
         .report
         .levels
@@ -321,9 +348,13 @@ fn analysis_json(run: &semo::workspace::GraphRun) -> serde_json::Value {
                 "repetition": repetition,
                 "schedule": level.schedule,
                 "buffers": buffers,
-                "throughput": level.throughput.as_ref().map(|t| serde_json::json!({
+                "throughput": level.throughput.as_ref().ok().map(|t| serde_json::json!({
                     "period": t.period.to_string(),
                     "critical_cycle": t.critical_cycle,
+                })),
+                "no_period": level.throughput.as_ref().err().map(|&why| serde_json::json!({
+                    "reason": why.as_str(),
+                    "message": no_period_words(why, reading),
                 })),
             })
         })

@@ -59,6 +59,9 @@ mod tests {
         let n = 1_000_000;
         let (of, count) = components(n, (1..n).map(|v| (v - 1, v)));
         assert_eq!(count, n);
-        assert!(of.windows(2).all(|w| w[0] > w[1]), "edges go to lower numbers");
+        assert!(
+            of.windows(2).all(|w| w[0] > w[1]),
+            "edges go to lower numbers"
+        );
     }
 }

@@ -178,7 +178,7 @@ impl Search<'_, '_> {
                 .collect();
             return Some(Outcome::Blocked(space));
         }
-        let t = throughput(&with_space, &self.counts, self.concurrency)?;
+        let t = throughput(&with_space, &self.counts, self.concurrency).ok()?;
         // Space edges joining consecutive nodes of the critical cycle (a
         // self-loop's when the cycle is one node).
         // (As sets: on a large level the cycle can have thousands of nodes.)
@@ -207,7 +207,7 @@ impl Search<'_, '_> {
 /// cannot be computed (see [`throughput`]).
 pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff> {
     let counts = repetition_vector(level).ok()?;
-    let max_period = throughput(level, &counts, concurrency)?.period;
+    let max_period = throughput(level, &counts, concurrency).ok()?.period;
     let cost = evaluation_cost(level, &counts);
     let mut search = Search {
         level,
