@@ -672,7 +672,7 @@ fn buffers_give_the_trade_off_and_a_chosen_point() {
     assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
     assert!(
         out.stdout
-            .contains("smallest total size for the maximal throughput: between 2907 and 2918"),
+            .contains("smallest total size for the maximal throughput: between 2908 and 2916"),
         "{}",
         out.stdout
     );
@@ -821,5 +821,129 @@ fn a_missing_period_says_why() {
             .as_str()
             .unwrap()
             .contains("marked `default`")
+    );
+}
+
+/// An SDF3 chain of tasks of time 3 with channels of the given rates.
+fn sdf3_chain(rates: &[(u64, u64)]) -> String {
+    let mut actors = String::new();
+    let mut properties = String::new();
+    for v in 0..=rates.len() {
+        let mut ports = String::new();
+        if v > 0 {
+            let rate = rates[v - 1].1;
+            ports.push_str(&format!(r#"<port name="i" type="in" rate="{rate}"/>"#));
+        }
+        if let Some((rate, _)) = rates.get(v) {
+            ports.push_str(&format!(r#"<port name="o" type="out" rate="{rate}"/>"#));
+        }
+        actors.push_str(&format!(
+            "<actor name=\"t{v}\" type=\"T\">{ports}</actor>\n"
+        ));
+        properties.push_str(&format!(
+            r#"<actorProperties actor="t{v}"><processor type="p" default="true"><executionTime time="3"/></processor></actorProperties>"#
+        ));
+    }
+    let channels: String = (0..rates.len())
+        .map(|k| {
+            format!(
+                r#"<channel name="c{k}" srcActor="t{k}" srcPort="o" dstActor="t{}" dstPort="i"/>"#,
+                k + 1
+            )
+        })
+        .collect();
+    format!(
+        r#"<?xml version="1.0"?>
+<sdf3 type="sdf" version="1.0"><applicationGraph name="chain"><sdf name="chain" type="G">
+{actors}{channels}
+</sdf><sdfProperties>{properties}</sdfProperties></applicationGraph></sdf3>"#
+    )
+}
+
+/// `graph buffers` on an acyclic pipeline under auto-concurrency (SDF3's
+/// meaning): nothing but the buffers bounds its throughput, so it says at
+/// once that no finite distribution reaches the maximal one (it printed
+/// 500,003 lines for two tasks), and sizes the buffers for a period asked.
+#[test]
+fn buffers_of_an_unbounded_throughput_say_so_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("pipe.xml"), sdf3_chain(&[(1, 1)])).unwrap();
+    let out = semo_in(dir.path(), &["graph", "buffers", "pipe.xml"]);
+    assert_eq!(out.code, 1, "{}{}", out.stdout, out.stderr);
+    assert_eq!(out.stdout.lines().count(), 2, "{}", out.stdout);
+    assert!(
+        out.stdout.contains("the throughput is unbounded"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stderr
+            .contains("no finite buffer distribution reaches it"),
+        "{}",
+        out.stderr
+    );
+    let out = semo_in(
+        dir.path(),
+        &["graph", "buffers", "--format", "json", "pipe.xml"],
+    );
+    assert_eq!(out.code, 1, "{}{}", out.stdout, out.stderr);
+    let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    assert_eq!(v["unbounded_throughput"], true);
+    assert_eq!(v["max_period"], "0");
+    assert_eq!(v["points"], serde_json::json!([]));
+    assert!(v["chosen"].is_null());
+    assert!(v["message"].as_str().unwrap().contains("unbounded"), "{v}");
+    // A period asked for: the smallest distribution found reaching it.
+    let out = semo_in(
+        dir.path(),
+        &["graph", "buffers", "--throughput", "1/1", "pipe.xml"],
+    );
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout
+            .contains("channel sizes for period at most 1 (6 → 1):"),
+        "{}",
+        out.stdout
+    );
+}
+
+/// Chains with rates 2^20: one evaluation of a distribution is beyond the
+/// search's work budget, so the search makes none and says so, at once.
+#[test]
+fn buffers_of_large_rates_stop_at_the_work_budget() {
+    let r = 1u64 << 20;
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("rates.xml"),
+        sdf3_chain(&[(r, 1), (1, r), (r, 1)]),
+    )
+    .unwrap();
+    let args = ["graph", "buffers", "--concurrency", "single", "rates.xml"];
+    let out = semo_in(dir.path(), &args);
+    assert_eq!(out.code, 1, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout.contains("maximal throughput: period 3145728"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stdout
+            .contains("more than the search's budget of 6000000"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stderr.contains("stopped at its work budget"),
+        "{}",
+        out.stderr
+    );
+    let mut json = args.to_vec();
+    json.splice(2..2, ["--format", "json"]);
+    let v: serde_json::Value = serde_json::from_str(&semo_in(dir.path(), &json).stdout).unwrap();
+    assert_eq!(v["budget"]["exhausted"], true);
+    assert_eq!(v["budget"]["work"], 0);
+    assert!(
+        v["budget"]["per_evaluation"].as_u64().unwrap() > 6_000_000,
+        "{v}"
     );
 }

@@ -507,7 +507,7 @@ pub fn buffers(
     };
     let concurrency = run.report.concurrency;
     let level = Level::build(graph, None, graph.name.clone());
-    let Some(found) = tradeoff::trade_off(&level, concurrency) else {
+    let Some(found) = tradeoff::trade_off_towards(&level, concurrency, bound) else {
         eprintln!(
             "error: {}: the period of this graph cannot be computed (too large an expansion or overflow)",
             path.display()
@@ -529,11 +529,42 @@ pub fn buffers(
         eprintln!("error: cannot write the report: {e}");
         return 2;
     }
+    if found.unbounded_throughput() && bound.is_none() {
+        eprintln!(
+            "error: {}: {UNBOUNDED}: ask for a period with --throughput",
+            path.display()
+        );
+        return 1;
+    }
     if chosen.is_none() {
-        eprintln!("error: no buffer distribution found reaches that throughput");
+        let why = if found.budget_exhausted {
+            " (the search stopped at its work budget)"
+        } else {
+            ""
+        };
+        eprintln!("error: no buffer distribution found reaches that throughput{why}");
         return 1;
     }
     0
+}
+
+/// What `graph buffers` says of a level whose throughput nothing but the
+/// buffers bounds.
+const UNBOUNDED: &str = "the throughput is unbounded (no cycle bounds the period; every larger buffer raises it): no finite buffer distribution reaches it";
+
+/// The sentence saying that the work budget stopped the search.
+fn budget_words(found: &semo::taskgraph::analysis::tradeoff::TradeOff) -> String {
+    use semo::taskgraph::analysis::tradeoff::MAX_WORK;
+    if found.evaluations == 1 {
+        return format!(
+            "no distribution evaluated: one evaluation takes {} work units (firings plus dependencies of one iteration), more than the search's budget of {MAX_WORK}",
+            found.evaluation_cost
+        );
+    }
+    format!(
+        "the search stopped at its work budget ({} work units of {MAX_WORK}, {} evaluations of {} each): the points are distributions found, the bounds hold",
+        found.work, found.evaluations, found.evaluation_cost
+    )
 }
 
 fn minimum_words(found: &semo::taskgraph::analysis::tradeoff::TradeOff) -> String {
@@ -544,8 +575,8 @@ fn minimum_words(found: &semo::taskgraph::analysis::tradeoff::TradeOff) -> Strin
             found.lower_bound, p.size, p.size, found.lower_bound
         ),
         None => format!(
-            "at least {} (the search stopped after {} evaluations before reaching it)",
-            found.lower_bound, found.evaluations
+            "at least {} (no distribution found reaches it)",
+            found.lower_bound
         ),
     }
 }
@@ -559,11 +590,18 @@ fn buffers_human(
     out: &mut impl Write,
 ) -> std::io::Result<()> {
     writeln!(out, "concurrency: {}", concurrency.as_str())?;
-    writeln!(
-        out,
-        "maximal throughput: period {} (unbounded buffers)",
-        found.max_period
-    )?;
+    if found.unbounded_throughput() {
+        writeln!(out, "maximal throughput: {UNBOUNDED}")?;
+        if bound.is_none() {
+            return Ok(());
+        }
+    } else {
+        writeln!(
+            out,
+            "maximal throughput: period {} (unbounded buffers)",
+            found.max_period
+        )?;
+    }
     writeln!(
         out,
         "trade-off (total buffer size → period; each point a distribution found):"
@@ -571,11 +609,16 @@ fn buffers_human(
     for p in &found.points {
         writeln!(out, "  {} → {}", p.size, p.period)?;
     }
-    writeln!(
-        out,
-        "smallest total size for the maximal throughput: {}",
-        minimum_words(found)
-    )?;
+    if !found.unbounded_throughput() {
+        writeln!(
+            out,
+            "smallest total size for the maximal throughput: {}",
+            minimum_words(found)
+        )?;
+    }
+    if found.budget_exhausted {
+        writeln!(out, "{}", budget_words(found))?;
+    }
     match chosen {
         Some(p) => {
             let what = match bound {
@@ -616,10 +659,24 @@ fn buffers_json(
         "concurrency": concurrency.as_str(),
         "max_period": found.max_period.to_string(),
         "points": points,
+        "unbounded_throughput": found.unbounded_throughput(),
         "minimal_size": {
             "lower_bound": found.lower_bound,
             "found": found.for_max_throughput().map(|p| p.size),
             "exact": found.exact(),
+        },
+        "budget": {
+            "work": found.work,
+            "limit": semo::taskgraph::analysis::tradeoff::MAX_WORK,
+            "per_evaluation": found.evaluation_cost,
+            "exhausted": found.budget_exhausted,
+        },
+        "message": if found.unbounded_throughput() {
+            Some(UNBOUNDED.to_string())
+        } else if found.budget_exhausted {
+            Some(budget_words(found))
+        } else {
+            None
         },
         "chosen": chosen.map(|p| serde_json::json!({
             "size": p.size,
