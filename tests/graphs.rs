@@ -947,3 +947,48 @@ fn buffers_of_large_rates_stop_at_the_work_budget() {
         "{v}"
     );
 }
+
+/// The longest chain of tasks `semo` reads (a file of at most 16 MiB: about
+/// 144,000 tasks), analysed, scheduled and checked through the CLI: the
+/// analyses walk graphs without recursion (a 139,000-task chain overflowed
+/// the stack in all three). A million tasks, beyond the file size, are
+/// analysed in-process by `compiler/tests/chain_scaling.rs`.
+#[test]
+fn the_longest_chain_a_file_can_hold_is_analysed() {
+    let limit = usize::try_from(semo::fsread::MAX_FILE_BYTES).unwrap();
+    let head = "<TaskGraph name=\"chain\" xmlns=\"urn:semo:taskgraph:1\">\n";
+    let tail = "</TaskGraph>\n";
+    let (mut tasks, mut channels) = (String::new(), String::new());
+    let mut n = 0;
+    loop {
+        let task = format!(
+            "<Task name=\"t{n}\"><Port name=\"i\" dir=\"in\"/><Port name=\"o\" dir=\"out\"/></Task>\n"
+        );
+        let channel = format!("<Channel src=\"t{n}.o\" dst=\"t{}.i\"/>\n", n + 1);
+        if head.len() + tasks.len() + channels.len() + task.len() + channel.len() + tail.len()
+            > limit
+        {
+            break;
+        }
+        tasks.push_str(&task);
+        channels.push_str(&channel);
+        n += 1;
+    }
+    // The last task's output closes no channel: an unconnected port.
+    let text = format!("{head}{tasks}{channels}{tail}").replace(
+        &format!("<Channel src=\"t{}.o\" dst=\"t{n}.i\"/>\n", n - 1),
+        "",
+    );
+    assert!(n > 139_000, "{n} tasks");
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("chain.taskgraph.xml"), text).unwrap();
+    let (code, v) = analyze_json(dir.path(), "chain.taskgraph.xml");
+    assert_eq!(code, 0);
+    assert_eq!(v["levels"][0]["deadlock_free"], true);
+    assert_eq!(v["levels"][0]["repetition"].as_object().unwrap().len(), n);
+    let out = semo_in(dir.path(), &["graph", "schedule", "chain.taskgraph.xml"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(out.stdout.starts_with("t0 t1 t2 "), "{}", &out.stdout[..40]);
+    let out = semo_in(dir.path(), &["check", "chain.taskgraph.xml"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+}
