@@ -25,7 +25,7 @@ fn peak_bytes_of_check(teams: usize) -> usize {
     let path = folder.path().join("swarm.mission");
     let (run, peak, _) = counting::measure(|| {
         std::fs::write(&path, text).expect("write the mission");
-        semo::host::load_check(&[path.clone()]).expect("the mission loads")
+        semo::host::load_check(std::slice::from_ref(&path)).expect("the mission loads")
     });
     assert_eq!(run.error_count(), 0, "the generated mission is valid");
     drop(run);

@@ -92,10 +92,11 @@ pub struct TradeOff {
 }
 
 impl TradeOff {
-    /// Whether nothing but the buffers bounds the throughput (period 0): no
-    /// finite distribution reaches the maximal throughput.
+    /// Whether nothing but the buffers bounds the throughput (period 0,
+    /// which no finite distribution reaches: the level's cycles through
+    /// its buffers take time).
     pub fn unbounded_throughput(&self) -> bool {
-        self.max_period.num == 0
+        self.max_period.num == 0 && self.for_max_throughput().is_none() && !self.budget_exhausted
     }
 
     /// The smallest distribution found that reaches the maximal throughput.
@@ -279,12 +280,11 @@ pub fn trade_off_towards(
         evaluation_cost: search.cost,
         budget_exhausted: search.exhausted,
     };
-    // The period the search grows towards.
+    // The period the search grows towards: on a level whose throughput
+    // only the buffers bound, the goal, if any.
     let target = match goal {
-        _ if max_period.num > 0 => max_period,
-        Some(goal) if goal.num > 0 => goal,
-        // Every growth lowers the period, none reaches 0: nothing to find.
-        _ => return Some(nothing(&search)),
+        Some(goal) if max_period.num == 0 && goal.num > 0 => goal,
+        _ => max_period,
     };
     // Large rates make one evaluation large: past the budget, none is made.
     if !search.within(MAX_WORK) {
@@ -324,6 +324,13 @@ pub fn trade_off_towards(
                 if *period <= target {
                     complete = true;
                     break;
+                }
+                if target.num == 0 {
+                    // A live distribution whose period is not 0 has a cycle
+                    // of tasks that take time, which every larger one keeps:
+                    // none reaches period 0 (only a level whose cycles take
+                    // no time does, at its first live distribution).
+                    return Some(nothing(&search));
                 }
                 on_cycle.clone()
             }

@@ -309,9 +309,11 @@ fn chain(rates: &[(u64, u64)]) -> TaskGraph {
 
 /// An acyclic pipeline under auto-concurrency: only the buffers bound its
 /// throughput, so no finite distribution reaches the maximal one. The search
-/// says so after the one evaluation of the maximal throughput (it used to
-/// grow the buffers for its whole budget, 500,000 points for two tasks), and
-/// grows towards a period only when one is asked for.
+/// says so after the evaluations of the maximal throughput and of the
+/// smallest distribution (it used to grow the buffers for its whole budget,
+/// 500,000 points for two tasks), and grows towards a period only when one
+/// is asked for. Without execution times the smallest live distribution
+/// reaches period 0.
 #[test]
 fn an_unbounded_throughput_is_answered_at_once() {
     let g = chain(&[(1, 1)]);
@@ -319,7 +321,7 @@ fn an_unbounded_throughput_is_answered_at_once() {
     let found = trade_off(&level, Concurrency::Auto).unwrap();
     assert!(found.unbounded_throughput());
     assert!(found.points.is_empty() && !found.complete);
-    assert_eq!((found.evaluations, found.work), (1, 0));
+    assert_eq!(found.evaluations, 2);
     assert!(found.for_max_throughput().is_none());
     // Towards period 1 (each firing takes 3): three firings of each task
     // at once, a sample's place held from its producer's start to its
@@ -328,6 +330,13 @@ fn an_unbounded_throughput_is_answered_at_once() {
     check_points(&level, &found, Concurrency::Auto);
     let reached = found.for_period(ratio(1, 1)).expect("period 1 reached");
     assert_eq!((reached.size, reached.period), (6, ratio(1, 1)));
+    let mut g = chain(&[(1, 1)]);
+    g.tasks.iter_mut().for_each(|t| t.wcet = None);
+    let level = Level::build(&g, None, g.name.clone());
+    let found = trade_off(&level, Concurrency::Auto).unwrap();
+    assert!(!found.unbounded_throughput());
+    let reached = found.for_max_throughput().expect("period 0 reached");
+    assert_eq!((reached.size, reached.period), (1, ratio(0, 1)));
 }
 
 /// Chains of four tasks with large rates (2^13 to 2^20): one evaluation
