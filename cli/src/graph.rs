@@ -6,6 +6,7 @@ use super::input::{self, Content};
 use super::output::{self, Format};
 use super::render;
 use semo::diag::Diagnostic;
+use semo::taskgraph::analysis::NoPeriod;
 use semo::taskgraph::analysis::ratio::Ratio;
 use semo::workspace::{
     FileKind, FileResolver, Files, GraphReading, GraphRun, analyze_graph, analyze_graph_as,
@@ -191,14 +192,14 @@ pub fn analyze(
             color,
             &mut std::io::stderr().lock(),
         )
-        .and_then(|()| write_human(&run, out)),
+        .and_then(|()| write_human(&run, reading, out)),
         Format::Json => output::report(
             format,
             "graph analyze",
             &files,
             &run.diagnostics,
             color,
-            analysis_json(&run),
+            analysis_json(&run, reading),
             out,
         ),
         Format::Sarif => output::report(
@@ -222,8 +223,25 @@ pub fn analyze(
     code
 }
 
+/// Why a level has no period, in words: the analysis's reason, and under
+/// `--sdf3-compat` where the times come from.
+fn no_period_words(why: NoPeriod, reading: GraphReading) -> String {
+    let compat = reading.times == semo::taskgraph::ExecutionTimes::Sdf3Compat;
+    match why {
+        NoPeriod::Untimed if compat => format!(
+            "{} (with --sdf3-compat an actor's time comes only from a processor marked `default`)",
+            why.why()
+        ),
+        _ => why.why().to_string(),
+    }
+}
+
 /// The analysis for people (its diagnostics went to standard error).
-fn write_human(run: &semo::workspace::GraphRun, out: &mut impl Write) -> std::io::Result<()> {
+fn write_human(
+    run: &semo::workspace::GraphRun,
+    reading: GraphReading,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
     use std::fmt::Write as _;
     if !run.report.levels.is_empty() {
         let meaning = match run.report.concurrency {
@@ -268,13 +286,22 @@ fn write_human(run: &semo::workspace::GraphRun, out: &mut impl Write) -> std::io
         if let Some(schedule) = &level.schedule {
             writeln!(out, "  schedule: {schedule}")?;
         }
-        if let Some(t) = &level.throughput {
-            let cycle = match t.critical_cycle.as_slice() {
-                [] => "no cycle: unbounded throughput".to_string(),
-                [one] => format!("bounded by {one} alone"),
-                many => format!("bounded by {} → {}", many.join(" → "), many[0]),
-            };
-            writeln!(out, "  iteration period: {} ({cycle})", t.period)?;
+        match &level.throughput {
+            Ok(t) => {
+                let cycle = match t.critical_cycle.as_slice() {
+                    [] => "no cycle: unbounded throughput".to_string(),
+                    [one] => format!("bounded by {one} alone"),
+                    many => format!("bounded by {} → {}", many.join(" → "), many[0]),
+                };
+                writeln!(out, "  iteration period: {} ({cycle})", t.period)?;
+            }
+            // The state line above already says these.
+            Err(NoPeriod::Inconsistent | NoPeriod::Deadlock) => {}
+            Err(why) => writeln!(
+                out,
+                "  iteration period: none: {}",
+                no_period_words(*why, reading)
+            )?,
         }
         if !level.buffers.is_empty() {
             let mut line = String::from("  buffers: ");
@@ -295,7 +322,7 @@ fn write_human(run: &semo::workspace::GraphRun, out: &mut impl Write) -> std::io
 }
 
 /// The analysis's own fields of the JSON document.
-fn analysis_json(run: &semo::workspace::GraphRun) -> serde_json::Value {
+fn analysis_json(run: &semo::workspace::GraphRun, reading: GraphReading) -> serde_json::Value {
     let levels: Vec<serde_json::Value> = run
         .report
         .levels
@@ -321,9 +348,13 @@ fn analysis_json(run: &semo::workspace::GraphRun) -> serde_json::Value {
                 "repetition": repetition,
                 "schedule": level.schedule,
                 "buffers": buffers,
-                "throughput": level.throughput.as_ref().map(|t| serde_json::json!({
+                "throughput": level.throughput.as_ref().ok().map(|t| serde_json::json!({
                     "period": t.period.to_string(),
                     "critical_cycle": t.critical_cycle,
+                })),
+                "no_period": level.throughput.as_ref().err().map(|&why| serde_json::json!({
+                    "reason": why.as_str(),
+                    "message": no_period_words(why, reading),
                 })),
             })
         })
@@ -476,7 +507,7 @@ pub fn buffers(
     };
     let concurrency = run.report.concurrency;
     let level = Level::build(graph, None, graph.name.clone());
-    let Some(found) = tradeoff::trade_off(&level, concurrency) else {
+    let Some(found) = tradeoff::trade_off_towards(&level, concurrency, bound) else {
         eprintln!(
             "error: {}: the period of this graph cannot be computed (too large an expansion or overflow)",
             path.display()
@@ -498,11 +529,42 @@ pub fn buffers(
         eprintln!("error: cannot write the report: {e}");
         return 2;
     }
+    if found.unbounded_throughput() && bound.is_none() {
+        eprintln!(
+            "error: {}: {UNBOUNDED}: ask for a period with --throughput",
+            path.display()
+        );
+        return 1;
+    }
     if chosen.is_none() {
-        eprintln!("error: no buffer distribution found reaches that throughput");
+        let why = if found.budget_exhausted {
+            " (the search stopped at its work budget)"
+        } else {
+            ""
+        };
+        eprintln!("error: no buffer distribution found reaches that throughput{why}");
         return 1;
     }
     0
+}
+
+/// What `graph buffers` says of a level whose throughput nothing but the
+/// buffers bounds.
+const UNBOUNDED: &str = "the throughput is unbounded (no cycle bounds the period; every larger buffer raises it): no finite buffer distribution reaches it";
+
+/// The sentence saying that the work budget stopped the search.
+fn budget_words(found: &semo::taskgraph::analysis::tradeoff::TradeOff) -> String {
+    use semo::taskgraph::analysis::tradeoff::MAX_WORK;
+    if found.evaluations == 1 {
+        return format!(
+            "no distribution evaluated: one evaluation takes {} work units (firings plus dependencies of one iteration), more than the search's budget of {MAX_WORK}",
+            found.evaluation_cost
+        );
+    }
+    format!(
+        "the search stopped at its work budget ({} work units of {MAX_WORK}, {} evaluations of {} each): the points are distributions found, the bounds hold",
+        found.work, found.evaluations, found.evaluation_cost
+    )
 }
 
 fn minimum_words(found: &semo::taskgraph::analysis::tradeoff::TradeOff) -> String {
@@ -513,8 +575,8 @@ fn minimum_words(found: &semo::taskgraph::analysis::tradeoff::TradeOff) -> Strin
             found.lower_bound, p.size, p.size, found.lower_bound
         ),
         None => format!(
-            "at least {} (the search stopped after {} evaluations before reaching it)",
-            found.lower_bound, found.evaluations
+            "at least {} (no distribution found reaches it)",
+            found.lower_bound
         ),
     }
 }
@@ -528,11 +590,18 @@ fn buffers_human(
     out: &mut impl Write,
 ) -> std::io::Result<()> {
     writeln!(out, "concurrency: {}", concurrency.as_str())?;
-    writeln!(
-        out,
-        "maximal throughput: period {} (unbounded buffers)",
-        found.max_period
-    )?;
+    if found.unbounded_throughput() {
+        writeln!(out, "maximal throughput: {UNBOUNDED}")?;
+        if bound.is_none() {
+            return Ok(());
+        }
+    } else {
+        writeln!(
+            out,
+            "maximal throughput: period {} (unbounded buffers)",
+            found.max_period
+        )?;
+    }
     writeln!(
         out,
         "trade-off (total buffer size → period; each point a distribution found):"
@@ -540,11 +609,16 @@ fn buffers_human(
     for p in &found.points {
         writeln!(out, "  {} → {}", p.size, p.period)?;
     }
-    writeln!(
-        out,
-        "smallest total size for the maximal throughput: {}",
-        minimum_words(found)
-    )?;
+    if !found.unbounded_throughput() {
+        writeln!(
+            out,
+            "smallest total size for the maximal throughput: {}",
+            minimum_words(found)
+        )?;
+    }
+    if found.budget_exhausted {
+        writeln!(out, "{}", budget_words(found))?;
+    }
     match chosen {
         Some(p) => {
             let what = match bound {
@@ -585,10 +659,24 @@ fn buffers_json(
         "concurrency": concurrency.as_str(),
         "max_period": found.max_period.to_string(),
         "points": points,
+        "unbounded_throughput": found.unbounded_throughput(),
         "minimal_size": {
             "lower_bound": found.lower_bound,
             "found": found.for_max_throughput().map(|p| p.size),
             "exact": found.exact(),
+        },
+        "budget": {
+            "work": found.work,
+            "limit": semo::taskgraph::analysis::tradeoff::MAX_WORK,
+            "per_evaluation": found.evaluation_cost,
+            "exhausted": found.budget_exhausted,
+        },
+        "message": if found.unbounded_throughput() {
+            Some(UNBOUNDED.to_string())
+        } else if found.budget_exhausted {
+            Some(budget_words(found))
+        } else {
+            None
         },
         "chosen": chosen.map(|p| serde_json::json!({
             "size": p.size,

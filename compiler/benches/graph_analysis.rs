@@ -107,7 +107,7 @@ fn main() {
             black_box(deadlock::find_deadlock(black_box(&level), &counts));
         });
         let period = fastest(budget, || {
-            black_box(throughput::throughput(
+            let _ = black_box(throughput::throughput(
                 black_box(&level),
                 &counts,
                 throughput::Concurrency::Single,

@@ -326,7 +326,7 @@ fn asked_period(states: &[State], index: usize) -> Option<(i64, Span)> {
 
 /// The period of the graph's top level, when it has execution times.
 fn iteration_period(run: &GraphRun) -> Option<Ratio> {
-    let period = run.report.levels.first()?.throughput.as_ref()?.period;
+    let period = run.report.levels.first()?.throughput.as_ref().ok()?.period;
     (period.num > 0).then_some(period)
 }
 
@@ -335,7 +335,7 @@ fn critical_tasks(run: &GraphRun) -> &[String] {
     run.report
         .levels
         .first()
-        .and_then(|l| l.throughput.as_ref())
+        .and_then(|l| l.throughput.as_ref().ok())
         .map_or(&[], |t| &t.critical_cycle)
 }
 

@@ -129,6 +129,8 @@ codes! {
     GraphUnknownEndpoint = "E064", Error, "a channel end that names no task or port";
     GraphBadAttribute = "E065", Error, "a task-graph attribute value of the wrong form";
     GraphPortDirection = "E066", Error, "a channel from an input port or into an output port";
+    GraphPortTwoChannels = "E098", Error, "a port joined by more than one channel: a port is the end of one channel (SDF3 refuses it too)";
+    Sdf3TwoDefaultProcessors = "W086", Warning, "an SDF3 actor with more than one processor marked `default=\"true\"`: which one gives its time is ambiguous (semo takes the first, `--sdf3-compat` the last as SDF3 does)";
     SubgraphUnreadable = "E067", Error, "a task's `subgraph` file that cannot be found or read";
     SubgraphHasErrors = "E068", Error, "a task's `subgraph` file that has errors of its own";
     SubgraphCycle = "E069", Error, "`subgraph` references that lead back to a file on the way (a → b → a), or nest too deep";

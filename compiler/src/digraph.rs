@@ -1,8 +1,13 @@
 //! Strongly connected components of a graph over node indices `0..n`: the
-//! one routine (petgraph's Tarjan) that the task-graph schedule and the
-//! layered drawing both use, rather than each its own copy.
+//! one routine (petgraph's Kosaraju) that the task-graph analyses and the
+//! layered drawing all use, rather than each its own copy.
+//!
+//! Kosaraju, not Tarjan: petgraph's `TarjanScc` recurses once per node on a
+//! path, so a chain of 139,000 tasks overflowed the main thread's stack;
+//! `kosaraju_scc` walks with explicit stacks (`Dfs`, `DfsPostOrder`), its
+//! depth bounded by nothing but memory, linear in the graph.
 
-use petgraph::algo::TarjanScc;
+use petgraph::algo::kosaraju_scc;
 use petgraph::graph::{DiGraph, NodeIndex};
 
 /// The strongly connected component of each node `0..n` of the graph with
@@ -20,17 +25,15 @@ pub fn components(
     for (a, b) in edges {
         graph.add_edge(NodeIndex::new(a), NodeIndex::new(b), ());
     }
-    // Numbered as they are found (as `tarjan_scc` lists them), without a
-    // vector per component.
+    // Numbered as `kosaraju_scc` lists them: sinks of the condensation first.
+    let found = kosaraju_scc(&graph);
     let mut component = vec![0; n];
-    let mut count = 0;
-    TarjanScc::new().run(&graph, |members| {
+    for (number, members) in found.iter().enumerate() {
         for v in members {
-            component[v.index()] = count;
+            component[v.index()] = number;
         }
-        count += 1;
-    });
-    (component, count)
+    }
+    (component, found.len())
 }
 
 #[cfg(test)]
@@ -47,5 +50,18 @@ mod tests {
         assert!(of[2] > of[3], "an edge goes to a lower number: {of:?}");
         assert_ne!(of[4], of[0]);
         assert_eq!(components(0, []), (Vec::new(), 0));
+    }
+
+    #[test]
+    fn a_long_chain_needs_no_deep_stack() {
+        // A recursive walk overflowed a 2 MiB test thread's stack far below
+        // this; each node is its own component, the last one a sink.
+        let n = 1_000_000;
+        let (of, count) = components(n, (1..n).map(|v| (v - 1, v)));
+        assert_eq!(count, n);
+        assert!(
+            of.windows(2).all(|w| w[0] > w[1]),
+            "edges go to lower numbers"
+        );
     }
 }

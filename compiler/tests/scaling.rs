@@ -11,66 +11,23 @@
 #[path = "../benches/common/mission.rs"]
 mod mission;
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-/// Live bytes and their peak since the last [`reset_peak`].
-struct Counting;
-
-static LIVE: AtomicUsize = AtomicUsize::new(0);
-static PEAK: AtomicUsize = AtomicUsize::new(0);
-
-fn grew(by: usize) {
-    let live = LIVE.fetch_add(by, Ordering::Relaxed) + by;
-    PEAK.fetch_max(live, Ordering::Relaxed);
-}
-
-// SAFETY: every call is forwarded to the system allocator unchanged; the
-// counters only observe the sizes.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
-            grew(layout.size());
-        }
-        p
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) };
-        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        let p = unsafe { System.realloc(ptr, layout, new_size) };
-        if !p.is_null() {
-            LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
-            grew(new_size);
-        }
-        p
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Counting = Counting;
-
-/// One measurement at a time: the counters are the process's.
-static MEASURING: Mutex<()> = Mutex::new(());
+#[path = "support/counting.rs"]
+mod counting;
 
 /// The peak of live bytes above the start while `semo check FILE` checks a
 /// generated mission of `teams` teams (six robots each), which must be valid.
 fn peak_bytes_of_check(teams: usize) -> usize {
     let text = mission::generate(teams);
-    let _one = MEASURING.lock().unwrap_or_else(|e| e.into_inner());
-    let base = LIVE.load(Ordering::Relaxed);
-    PEAK.store(base, Ordering::Relaxed);
+    let _one = counting::MEASURING
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
     let folder = tempfile::tempdir().expect("a temporary folder");
     let path = folder.path().join("swarm.mission");
-    std::fs::write(&path, text).expect("write the mission");
-    let run = semo::host::load_check(&[path]).expect("the mission loads");
+    let (run, peak, _) = counting::measure(|| {
+        std::fs::write(&path, text).expect("write the mission");
+        semo::host::load_check(std::slice::from_ref(&path)).expect("the mission loads")
+    });
     assert_eq!(run.error_count(), 0, "the generated mission is valid");
-    let peak = PEAK.load(Ordering::Relaxed) - base;
     drop(run);
     peak
 }

@@ -5,6 +5,7 @@
 //! task standing for a sub-graph file is a box naming the file (`⤷ file`).
 
 use super::model::*;
+use crate::fasthash::FastMap;
 use std::fmt::Write;
 
 /// The DOT text of `graph`.
@@ -116,8 +117,17 @@ fn level(out: &mut String, graph: &TaskGraph, prefix: &str, depth: usize) {
             quote(&library.name.name)
         );
     }
+    // Looked up twice per channel: an index keeps a long chain linear (a
+    // search per end took minutes on 139,000 tasks).
+    let index: FastMap<&str, usize> = graph
+        .tasks
+        .iter()
+        .enumerate()
+        .map(|(i, t)| (t.name.name.as_str(), i))
+        .collect();
+    let task_index = |name: &str| index.get(name).copied();
     for c in &graph.channels {
-        let end = |e: &Endpoint| match graph.task_index(&e.task) {
+        let end = |e: &Endpoint| match task_index(&e.task) {
             Some(t) if graph.tasks[t].loop_node.is_some() => id(
                 &format!("{prefix}{}/", e.task),
                 &format!("{}.{}", e.task, e.port),
@@ -127,7 +137,7 @@ fn level(out: &mut String, graph: &TaskGraph, prefix: &str, depth: usize) {
             None => id(prefix, &format!("{}.{}", e.task, e.port)),
         };
         let rate = |e: &Endpoint, dir| {
-            let task = graph.task_index(&e.task).map(|t| &graph.tasks[t]);
+            let task = task_index(&e.task).map(|t| &graph.tasks[t]);
             task.and_then(|t| {
                 t.ports
                     .iter()

@@ -1057,14 +1057,49 @@ impl Loader<'_> {
             .enumerate()
             .map(|(i, t)| (t.name.name.as_str(), i))
             .collect();
+        // Per port joined so far: the channel end that joined it first.
+        let mut joined: HashMap<(&str, &str), Span> = HashMap::default();
         for (c, parts) in level.channels.iter().zip(&level.channel_parts) {
-            self.check_end(level, &index, enclosing, &c.src, parts[0], Direction::Out);
-            self.check_end(level, &index, enclosing, &c.dst, parts[1], Direction::In);
+            for (end, part, want) in [
+                (&c.src, parts[0], Direction::Out),
+                (&c.dst, parts[1], Direction::In),
+            ] {
+                if self.check_end(level, &index, enclosing, end, part, want) {
+                    self.check_joined_once(&mut joined, end);
+                }
+            }
         }
+    }
+
+    /// E098 on a channel end at a port that an earlier channel of the level
+    /// already joins: a port is the end of one channel (a sample goes to one
+    /// consumer; the analyses and the build read one channel per port).
+    fn check_joined_once<'e>(
+        &mut self,
+        joined: &mut HashMap<(&'e str, &'e str), Span>,
+        end: &'e Endpoint,
+    ) {
+        use std::collections::hash_map::Entry;
+        let first = match joined.entry((end.task.as_str(), end.port.as_str())) {
+            Entry::Vacant(slot) => {
+                slot.insert(end.span);
+                return;
+            }
+            Entry::Occupied(slot) => *slot.get(),
+        };
+        let what = if self.sdf3 { "actor port" } else { "port" };
+        let message = format!(
+            "{what} `{}.{}` is already joined by another channel: a port is the end of one channel (give each channel its own port)",
+            end.task, end.port
+        );
+        self.sink
+            .report(Code::GraphPortTwoChannels, end.span, message)
+            .relate(first, "the channel that joins it first");
     }
 
     /// One end of a channel; `want` is the direction of the port at a task
     /// (the enclosing loop's ports are seen from the inside: reversed).
+    /// Whether the end is a port of the right direction.
     fn check_end(
         &mut self,
         level: &LevelBuild,
@@ -1073,9 +1108,9 @@ impl Loader<'_> {
         end: &Endpoint,
         (task_span, port_span): (Span, Span),
         want: Direction,
-    ) {
+    ) -> bool {
         if level.broken_tasks.contains(end.task.as_str()) {
-            return;
+            return false;
         }
         let (task, broken, inside) = match (index.get(end.task.as_str()).copied(), enclosing) {
             (Some(i), _) => (&level.tasks[i], Some(&level.broken_ports[i]), false),
@@ -1091,11 +1126,11 @@ impl Loader<'_> {
                 self.sink
                     .report(Code::GraphUnknownEndpoint, task_span, message)
                     .suggest(did_you_mean(&end.task, candidates));
-                return;
+                return false;
             }
         };
         if broken.is_some_and(|b| b.contains(end.port.as_str())) {
-            return;
+            return false;
         }
         let Some(port) = task.port(&end.port) else {
             let what = match (inside, self.sdf3) {
@@ -1129,11 +1164,11 @@ impl Loader<'_> {
             self.sink
                 .report(Code::GraphUnknownEndpoint, port_span, message)
                 .suggest(suggestion);
-            return;
+            return false;
         };
         let needed = if inside { flip(want) } else { want };
         if port.dir == needed {
-            return;
+            return true;
         }
         let message = match (inside, want) {
             (false, Direction::Out) => format!(
@@ -1160,6 +1195,7 @@ impl Loader<'_> {
         self.sink
             .report(Code::GraphPortDirection, span, message)
             .relate(port.name.span, "the port is declared here");
+        false
     }
 }
 

@@ -21,7 +21,7 @@ use consistency::{RateProblem, repetition_vector};
 use deadlock::find_deadlock;
 use level::Level;
 use std::collections::HashMap;
-pub use throughput::Concurrency;
+pub use throughput::{Concurrency, NoPeriod};
 
 /// What the analyses found about one hierarchy level.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -41,8 +41,9 @@ pub struct LevelReport {
     pub schedule: Option<String>,
     /// Per edge of the level: the most samples it holds under that schedule.
     pub buffers: Vec<BufferBound>,
-    /// The self-timed iteration period, when execution times are known.
-    pub throughput: Option<ThroughputReport>,
+    /// The self-timed iteration period, or why there is none (never
+    /// missing without a reason).
+    pub throughput: Result<ThroughputReport, NoPeriod>,
 }
 
 /// A cycle of a level whose tasks wait for each other, so that one iteration
@@ -227,7 +228,7 @@ fn analyze_level(
         blocked: None,
         schedule: None,
         buffers: Vec::new(),
-        throughput: None,
+        throughput: Err(NoPeriod::Inconsistent),
     };
     let mut sas = None;
     match repetition_vector(level) {
@@ -253,6 +254,9 @@ fn analyze_level(
                         diagnostics,
                     )
                 }
+            }
+            if blocked.is_some() {
+                level_report.throughput = Err(NoPeriod::Deadlock);
             }
             level_report.deadlock_free = Some(blocked.is_none());
             level_report.blocked = blocked.map(|b| BlockedCycle {
@@ -375,17 +379,18 @@ fn schedule_level(
     diagnostics: &mut Vec<Diagnostic>,
 ) -> Option<Vec<schedule::Schedule>> {
     let timed = level.nodes.iter().any(|n| n.wcet.is_some_and(|w| w > 0));
-    if timed {
-        report.throughput =
-            throughput::throughput(level, counts, concurrency).map(|t| ThroughputReport {
-                period: t.period,
-                critical_cycle: t
-                    .critical_cycle
-                    .iter()
-                    .map(|&n| level.nodes[n].name.to_string())
-                    .collect(),
-            });
-    }
+    report.throughput = if timed {
+        throughput::throughput(level, counts, concurrency).map(|t| ThroughputReport {
+            period: t.period,
+            critical_cycle: t
+                .critical_cycle
+                .iter()
+                .map(|&n| level.nodes[n].name.to_string())
+                .collect(),
+        })
+    } else {
+        Err(NoPeriod::Untimed)
+    };
     let single_appearance = schedule::single_appearance(level, counts);
     // `flat`, the flat (sample-frugal) schedule: the buffer bounds are
     // measured under it, and it is the level's schedule where no

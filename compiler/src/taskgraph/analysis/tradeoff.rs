@@ -32,9 +32,17 @@
 //! channels at once, which no budget of a second allows).
 //!
 //! Cost: each step evaluates one period per candidate channel (at most
-//! [`MAX_CANDIDATES`] tried one by one; beyond, all are grown together), and
-//! the search stops after [`MAX_EVALUATIONS`] periods with what it has found,
-//! stating the bounds.
+//! [`MAX_CANDIDATES`] tried one by one; beyond, all are grown together).
+//! Every evaluation is counted in work units (the size of the HSDF it
+//! expands) and none starts that would take the work past [`MAX_WORK`]:
+//! the budget is checked before each one, inside every loop, so a level
+//! with large rates (where one evaluation is large) stops after a few with
+//! what it has found, stating the bounds and that the budget stopped it.
+//!
+//! A level whose throughput only the buffers bound (period 0: an acyclic
+//! level under auto-concurrency) has no finite distribution reaching its
+//! maximal throughput: the search answers that at once, and grows only
+//! towards a period the caller asks for ([`trade_off_towards`]).
 
 use super::consistency::repetition_vector;
 use super::level::{Edge, Level};
@@ -48,7 +56,7 @@ const MAX_CANDIDATES: usize = 8;
 /// the level's firings plus edges (an evaluation is linear in the HSDF per
 /// policy iteration); half of it for the trade-off, the rest for the lower
 /// bound. Beyond it, the search stops with what it has and says so.
-const MAX_WORK: u64 = 6_000_000;
+pub const MAX_WORK: u64 = 6_000_000;
 
 /// One distribution of buffer capacities and the period it reaches.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -74,9 +82,23 @@ pub struct TradeOff {
     pub complete: bool,
     /// Periods evaluated.
     pub evaluations: usize,
+    /// Work units of the evaluations after the maximal throughput's own
+    /// (see [`MAX_WORK`]): with it, at most `MAX_WORK`.
+    pub work: u64,
+    /// Work units of one evaluation of a distribution.
+    pub evaluation_cost: u64,
+    /// Whether the work budget stopped some part of the search.
+    pub budget_exhausted: bool,
 }
 
 impl TradeOff {
+    /// Whether nothing but the buffers bounds the throughput (period 0,
+    /// which no finite distribution reaches: the level's cycles through
+    /// its buffers take time).
+    pub fn unbounded_throughput(&self) -> bool {
+        self.max_period.num == 0 && self.for_max_throughput().is_none() && !self.budget_exhausted
+    }
+
     /// The smallest distribution found that reaches the maximal throughput.
     pub fn for_max_throughput(&self) -> Option<&Point> {
         self.points
@@ -143,6 +165,8 @@ struct Search<'l, 'g> {
     work: u64,
     /// [`evaluation_cost`] of the level, which the search does not change.
     cost: u64,
+    /// Whether [`Search::within`] said no once.
+    exhausted: bool,
 }
 
 /// The work of one evaluation: the size of the HSDF with space edges (as
@@ -158,8 +182,21 @@ fn evaluation_cost(level: &Level<'_>, g: &[u64]) -> u64 {
 }
 
 impl Search<'_, '_> {
-    fn within(&self, budget: u64) -> bool {
-        self.work.saturating_add(self.cost) <= budget
+    /// Whether one more evaluation fits `budget` (remembered when not).
+    fn within(&mut self, budget: u64) -> bool {
+        let fits = self.work.saturating_add(self.cost) <= budget;
+        self.exhausted |= !fits;
+        fits
+    }
+
+    /// The period of the distribution `caps` (every channel bounded), if
+    /// it is live.
+    fn period_of(&mut self, caps: &[u64]) -> Option<Ratio> {
+        let all: Vec<Option<u64>> = caps.iter().map(|&c| Some(c)).collect();
+        match self.evaluate(&all)? {
+            Outcome::Period(period, _) => Some(period),
+            Outcome::Blocked(_) => None,
+        }
     }
 
     fn evaluate(&mut self, caps: &[Option<u64>]) -> Option<Outcome> {
@@ -178,7 +215,7 @@ impl Search<'_, '_> {
                 .collect();
             return Some(Outcome::Blocked(space));
         }
-        let t = throughput(&with_space, &self.counts, self.concurrency)?;
+        let t = throughput(&with_space, &self.counts, self.concurrency).ok()?;
         // Space edges joining consecutive nodes of the critical cycle (a
         // self-loop's when the cycle is one node).
         // (As sets: on a large level the cycle can have thousands of nodes.)
@@ -206,8 +243,20 @@ impl Search<'_, '_> {
 /// under `concurrency`; `None` when the level is inconsistent or its period
 /// cannot be computed (see [`throughput`]).
 pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff> {
+    trade_off_towards(level, concurrency, None)
+}
+
+/// [`trade_off`], which on a level whose throughput is unbounded (period 0)
+/// searches for a distribution reaching `goal` (a period) instead of the
+/// maximal throughput, which no finite one reaches; without a goal it
+/// returns at once, with no point. On other levels `goal` changes nothing.
+pub fn trade_off_towards(
+    level: &Level<'_>,
+    concurrency: Concurrency,
+    goal: Option<Ratio>,
+) -> Option<TradeOff> {
     let counts = repetition_vector(level).ok()?;
-    let max_period = throughput(level, &counts, concurrency)?.period;
+    let max_period = throughput(level, &counts, concurrency).ok()?.period;
     let cost = evaluation_cost(level, &counts);
     let mut search = Search {
         level,
@@ -216,13 +265,37 @@ pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff
         evaluations: 1,
         work: cost,
         cost,
+        exhausted: false,
     };
+    let minimal: Vec<u64> = level.edges.iter().map(minimal_capacity).collect();
+    // Nothing found: SDF3's per-channel bounds hold for any positive
+    // throughput.
+    let nothing = |search: &Search<'_, '_>| TradeOff {
+        max_period,
+        points: Vec::new(),
+        lower_bound: minimal.iter().sum(),
+        complete: false,
+        evaluations: search.evaluations,
+        work: search.work - search.cost,
+        evaluation_cost: search.cost,
+        budget_exhausted: search.exhausted,
+    };
+    // The period the search grows towards: on a level whose throughput
+    // only the buffers bound, the goal, if any.
+    let target = match goal {
+        Some(goal) if max_period.num == 0 && goal.num > 0 => goal,
+        _ => max_period,
+    };
+    // Large rates make one evaluation large: past the budget, none is made.
+    if !search.within(MAX_WORK) {
+        return Some(nothing(&search));
+    }
     let steps: Vec<u64> = level
         .edges
         .iter()
         .map(|e| gcd(e.produce, e.consume).max(1))
         .collect();
-    let mut caps: Vec<u64> = level.edges.iter().map(minimal_capacity).collect();
+    let mut caps = minimal.clone();
 
     let mut points: Vec<Point> = Vec::new();
     let mut complete = false;
@@ -248,9 +321,16 @@ pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff
                         capacities: caps.clone(),
                     });
                 }
-                if *period <= max_period {
+                if *period <= target {
                     complete = true;
                     break;
+                }
+                if target.num == 0 {
+                    // A live distribution whose period is not 0 has a cycle
+                    // of tasks that take time, which every larger one keeps:
+                    // none reaches period 0 (only a level whose cycles take
+                    // no time does, at its first live distribution).
+                    return Some(nothing(&search));
                 }
                 on_cycle.clone()
             }
@@ -281,6 +361,9 @@ pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff
         let mut best: Option<(Ratio, Vec<u64>, Outcome)> = None;
         if grow.len() <= MAX_CANDIDATES {
             for &i in &grow {
+                if !search.within(MAX_WORK / 3) {
+                    break;
+                }
                 let mut trial = caps.clone();
                 trial[i] = trial[i].saturating_add(steps[i]);
                 let Some(outcome) = search.evaluate(&bounded_caps(&trial)) else {
@@ -300,6 +383,7 @@ pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff
         }
         let (trial, outcome) = match best {
             Some((_, trial, outcome)) => (trial, outcome),
+            None if !search.within(MAX_WORK / 3) => break,
             None => {
                 let mut trial = caps.clone();
                 for &i in &grow {
@@ -312,25 +396,27 @@ pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff
         caps = trial;
         current = outcome;
     }
-    let minimal: Vec<u64> = level.edges.iter().map(minimal_capacity).collect();
     let reaching = if complete {
         Some(caps.clone())
-    } else if max_period.num == 0 {
-        // Nothing bounds the throughput but the buffers: no finite
-        // distribution reaches it.
-        None
     } else {
-        grown(&mut search, &caps, &steps, max_period)
+        grown(&mut search, &caps, &steps, target)
     };
     if let Some(reaching) = reaching {
         // Each channel alone brought down as far as the others allow.
-        let caps = shrink(&mut search, reaching, &minimal, max_period);
+        let caps = shrink(&mut search, reaching, &minimal, target);
         let size: u64 = caps.iter().sum();
         // The points grown from below that are no smaller are dominated.
-        points.retain(|p| p.size < size && p.period > max_period);
+        points.retain(|p| p.size < size && p.period > target);
+        // Shrinking keeps the period at most the target: a goal above the
+        // maximal throughput may be passed, so the period is evaluated.
+        let period = if target == max_period || !search.within(MAX_WORK) {
+            target // (an upper bound when the budget is spent)
+        } else {
+            search.period_of(&caps).unwrap_or(target)
+        };
         points.push(Point {
             size,
-            period: max_period,
+            period,
             capacities: caps,
         });
         complete = true;
@@ -339,13 +425,22 @@ pub fn trade_off(level: &Level<'_>, concurrency: Concurrency) -> Option<TradeOff
         .last()
         .filter(|p| complete && p.period == max_period)
         .map(|p| p.capacities.clone());
-    let lower_bound = lower_bound(&mut search, max_period, reached.as_deref());
+    // Towards a goal, SDF3's per-channel bounds (they hold for any
+    // positive throughput): the search's bound is for the maximal one.
+    let lower_bound = if target == max_period {
+        lower_bound(&mut search, max_period, reached.as_deref())
+    } else {
+        minimal.iter().sum()
+    };
     Some(TradeOff {
         max_period,
         points,
         lower_bound,
         complete,
         evaluations: search.evaluations,
+        work: search.work - search.cost,
+        evaluation_cost: search.cost,
+        budget_exhausted: search.exhausted,
     })
 }
 

@@ -63,8 +63,8 @@ impl Role {
 struct Processor {
     /// `type`, trimmed.
     kind: Option<String>,
-    /// `default`, trimmed.
-    default: Option<String>,
+    /// `default`, trimmed, and where it is written.
+    default: Option<(String, Span)>,
     /// The `time` of its first `<executionTime>` (`None` inside when that
     /// one has no `time`).
     time: Option<Option<Attr>>,
@@ -274,6 +274,35 @@ impl<'s> Sdf3Reader<'s> {
         self.level.channel_parts.push([src_parts, dst_parts]);
     }
 
+    /// W086 on each processor of `actor` marked `default="true"` after the
+    /// first: which one's time is the actor's is then a matter of reading
+    /// (SDF3's own benchmarks `h263encoder` and the mp3 decoders have such
+    /// actors, and their periods differ by the reading).
+    fn check_one_default(&mut self, actor: &str, processors: &[Processor]) {
+        let mut defaults = processors.iter().filter(|p| p.is_default());
+        let Some(first) = defaults.next() else {
+            return;
+        };
+        let kind = |p: &Processor| p.kind.clone().unwrap_or_default();
+        for other in defaults {
+            let Some((_, span)) = &other.default else {
+                continue;
+            };
+            let message = format!(
+                "actor `{actor}` has a second processor marked default=\"true\" (`{}`, after `{}`): semo takes the first one's time, --sdf3-compat the time SDF3 takes (of the last one marked default)",
+                shown(&kind(other)),
+                shown(&kind(first)),
+            );
+            let diagnostic =
+                self.loader
+                    .sink
+                    .report(Code::Sdf3TwoDefaultProcessors, *span, message);
+            if let Some((_, first_span)) = &first.default {
+                diagnostic.relate(*first_span, "the first processor marked default");
+            }
+        }
+    }
+
     /// The end of an `<actorProperties>`: its actor's time, from the
     /// processor [`ExecutionTimes`] chooses (the first entry for an actor
     /// counts).
@@ -282,10 +311,11 @@ impl<'s> Sdf3Reader<'s> {
         let Some(actor) = get(&e.attrs, "actor") else {
             return;
         };
+        self.check_one_default(actor.trimmed(), &processors);
         let chosen = match self.loader.times {
             ExecutionTimes::FileDefault => processors
                 .iter()
-                .find(|p| p.default.as_deref() == Some("true"))
+                .find(|p| p.is_default())
                 .or(processors.first()),
             ExecutionTimes::Sdf3Compat => {
                 // SDF3 keeps the type of the last processor marked `default`
@@ -303,6 +333,14 @@ impl<'s> Sdf3Reader<'s> {
                 self.times.entry(actor.trimmed().to_string()).or_insert(n);
             }
         }
+    }
+}
+
+impl Processor {
+    fn is_default(&self) -> bool {
+        self.default
+            .as_ref()
+            .is_some_and(|(value, _)| value == "true")
     }
 }
 
@@ -339,7 +377,8 @@ impl Visit for Sdf3Reader<'_> {
                 let trimmed = |key| get(&e.attrs, key).map(|a| a.trimmed().to_string());
                 self.processors.push(Processor {
                     kind: trimmed("type"),
-                    default: trimmed("default"),
+                    default: get(&e.attrs, "default")
+                        .map(|a| (a.trimmed().to_string(), a.trimmed_span())),
                     time: None,
                 });
             }

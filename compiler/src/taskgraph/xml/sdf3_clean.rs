@@ -10,8 +10,9 @@
 //! It reads only files it can read completely and silently: at the first
 //! thing that would need a diagnostic (malformed XML, an entity, text outside
 //! the root, a missing or bad attribute, a second actor or port of one name,
-//! a channel end that does not resolve, a root that is not `<sdf3
-//! type="sdf">`) it declines, and the caller reads the file with the full
+//! a channel end that does not resolve, a port joined by two channels, an
+//! actor with two processors marked `default="true"`, a root that is not
+//! `<sdf3 type="sdf">`) it declines, and the caller reads the file with the full
 //! reader, which reports it. It keeps the full reader's meaning element for
 //! element (the same roles, first-of-a-kind rules and execution-time choice),
 //! so the two give the same graph on every file this one accepts and this one
@@ -453,6 +454,10 @@ impl<'t> State<'t> {
         let Some(actor) = actor else {
             return Ok(());
         };
+        let defaults = processors.iter().filter(|p| p.default == Some("true"));
+        if defaults.count() > 1 {
+            return Err(Decline); // W086
+        }
         let chosen = match self.times {
             ExecutionTimes::FileDefault => processors
                 .iter()
@@ -481,9 +486,16 @@ impl<'t> State<'t> {
             let task = &self.tasks[*self.task_index.get(end.task.as_str())?];
             task.port(&end.port).map(|p| p.dir)
         };
+        // Each port the end of one channel (E098 otherwise).
+        let mut joined = crate::fasthash::FastSet::default();
         for c in &self.channels {
             if port(&c.src) != Some(Direction::Out) || port(&c.dst) != Some(Direction::In) {
                 return Err(Decline);
+            }
+            for end in [&c.src, &c.dst] {
+                if !joined.insert((end.task.as_str(), end.port.as_str())) {
+                    return Err(Decline);
+                }
             }
         }
         let mut tasks = self.tasks;
