@@ -54,7 +54,6 @@ const START_MS: i64 = 100;
 
 type Event = serde_json::Map<String, serde_json::Value>;
 
-
 fn scratch(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("differential")

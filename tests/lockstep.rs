@@ -63,7 +63,11 @@ fn scouting_runs_the_same_way_twice_in_lock_step() {
     let counts = kinds(&first);
     for robot in ["irobot", "ti", "nxt"] {
         for edge in ["start", "stop"] {
-            assert_eq!(counts.get(&(robot.into(), edge.into())), Some(&1), "{robot} {edge}");
+            assert_eq!(
+                counts.get(&(robot.into(), edge.into())),
+                Some(&1),
+                "{robot} {edge}"
+            );
         }
     }
     let simulated = kinds(&trace(&mission, &scenario, "sim"));
@@ -94,7 +98,11 @@ fn a_killed_and_restarted_leader_runs_the_same_way_twice_in_lock_step() {
         .filter(|e| e["robot"] == "tb_0" && e["event"] == "start")
         .map(|e| e["t"].as_i64().unwrap())
         .collect();
-    assert_eq!(starts, [0, 2200], "tb_0 starts at 0 and again when restarted");
+    assert_eq!(
+        starts,
+        [0, 2200],
+        "tb_0 starts at 0 and again when restarted"
+    );
     let after_kill = first.lines().any(|l| {
         let e: serde_json::Value = serde_json::from_str(l).unwrap();
         e["robot"] == "tb_0" && (1200..2200).contains(&e["t"].as_i64().unwrap())

@@ -237,7 +237,9 @@ impl<'r, 'a> Coordinator<'r, 'a> {
                 Ok((stream, _)) => break stream,
                 Err(e) if e.kind() == io::ErrorKind::WouldBlock => {
                     if let Some(status) = child.try_wait().map_err(|e| e.to_string())? {
-                        return Err(format!("ended before it connected ({status}); its errors are beside its trace"));
+                        return Err(format!(
+                            "ended before it connected ({status}); its errors are beside its trace"
+                        ));
                     }
                     std::thread::sleep(std::time::Duration::from_millis(1));
                 }
@@ -464,13 +466,17 @@ pub fn simulate(
         for file in &output.files {
             let path = folder.join(&file.path);
             if let Some(parent) = path.parent() {
-                std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
+                std::fs::create_dir_all(parent)
+                    .map_err(|e| format!("{}: {e}", parent.display()))?;
             }
             std::fs::write(&path, &file.text).map_err(|e| format!("{}: {e}", path.display()))?;
         }
         make(&folder)?;
         let Some(&(_, peer)) = peers.iter().find(|(name, _)| *name == output.robot) else {
-            return Err(format!("internal error: robot {} is not in the peer table", output.robot));
+            return Err(format!(
+                "internal error: robot {} is not in the peer table",
+                output.robot
+            ));
         };
         robots[peer] = Some(Robot {
             name: output.robot.clone(),
@@ -489,8 +495,9 @@ pub fn simulate(
             FaultKind::Restart { robot, at } => (robot, *at, ProcessFault::Restart),
             _ => continue, // the programs act on link faults themselves
         };
-        let peer = peer_of(robot)
-            .ok_or_else(|| format!("internal error: the scenario's robot {robot} has no program"))?;
+        let peer = peer_of(robot).ok_or_else(|| {
+            format!("internal error: the scenario's robot {robot} has no program")
+        })?;
         faults.push((at, peer, kind));
     }
     faults.sort_by_key(|f| f.0);

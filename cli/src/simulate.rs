@@ -134,7 +134,14 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         }
     };
     if options.engine == Engine::C {
-        return run_generated(&options, &build.input(), refined, &scenario, &scenario_text, out);
+        return run_generated(
+            &options,
+            &build.input(),
+            refined,
+            &scenario,
+            &scenario_text,
+            out,
+        );
     }
     let programs = refined.programs;
     let run = sim::simulate(
@@ -233,7 +240,9 @@ fn run_generated(
     out: &mut impl Write,
 ) -> i32 {
     if options.json || options.svg.is_some() {
-        eprintln!("error: --engine c writes the trace (--trace) and a text summary; --format json and --svg need --engine sim");
+        eprintln!(
+            "error: --engine c writes the trace (--trace) and a text summary; --format json and --svg need --engine sim"
+        );
         return 2;
     }
     if !scenario.expect.is_empty() {
@@ -243,7 +252,8 @@ fn run_generated(
         .until_ms
         .or(scenario.duration_ms)
         .unwrap_or(sim::DEFAULT_UNTIL_MS);
-    let robots = match super::lockstep::simulate(input, refined, scenario, scenario_text, until_ms) {
+    let robots = match super::lockstep::simulate(input, refined, scenario, scenario_text, until_ms)
+    {
         Ok(robots) => robots,
         Err(e) => {
             eprintln!("error: {e}");

@@ -101,7 +101,11 @@ impl Checker<'_> {
             let (code, op, verdict) = if test.equal {
                 (Code::ComparisonNeverHolds, "==", "never holds")
             } else {
-                (Code::ComparisonAlwaysHolds, "!=", "holds whenever it has a value")
+                (
+                    Code::ComparisonAlwaysHolds,
+                    "!=",
+                    "holds whenever it has a value",
+                )
             };
             let guess = suggestion(&constant, possible.iter().map(String::as_str));
             let diagnostic = self
