@@ -31,6 +31,9 @@
 
 #include "semo_internal.h"
 
+/* Only simulation builds (-DSEMO_SIM) have lock-step. */
+#if defined(SEMO_SIM) && !defined(SEMO_STATIC)
+
 #include <errno.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -606,3 +609,8 @@ const semo_transport semo_lockstep_transport = {
     .status = NULL,
     .close = ls_transport_close,
 };
+
+#else
+/* ISO C wants a translation unit to declare something. */
+typedef int semo__no_lockstep;
+#endif
