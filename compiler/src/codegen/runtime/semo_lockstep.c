@@ -296,33 +296,19 @@ static int read_all(void *data, size_t len)
     return 0;
 }
 
-static void put_u32(unsigned char *out, uint32_t v)
+/* Little-endian fields of `bytes` bytes (4 or 8). */
+static void put_le(unsigned char *out, uint64_t v, int bytes)
 {
-    for (int i = 0; i < 4; i++)
+    for (int i = 0; i < bytes; i++)
         out[i] = (unsigned char)(v >> (8 * i));
 }
 
-static uint32_t get_u32(const unsigned char *in)
+static uint64_t get_le(const unsigned char *in, int bytes)
 {
-    uint32_t v = 0;
-    for (int i = 0; i < 4; i++)
-        v |= (uint32_t)in[i] << (8 * i);
+    uint64_t v = 0;
+    for (int i = 0; i < bytes; i++)
+        v |= (uint64_t)in[i] << (8 * i);
     return v;
-}
-
-static void put_i64(unsigned char *out, int64_t v)
-{
-    uint64_t u = (uint64_t)v;
-    for (int i = 0; i < 8; i++)
-        out[i] = (unsigned char)(u >> (8 * i));
-}
-
-static int64_t get_i64(const unsigned char *in)
-{
-    uint64_t u = 0;
-    for (int i = 0; i < 8; i++)
-        u |= (uint64_t)in[i] << (8 * i);
-    return (int64_t)u;
 }
 
 /* One frame: `head` (a peer index for `M`) then `body`. */
@@ -330,7 +316,7 @@ static int write_frame(char kind, const void *head, size_t head_len, const void 
 {
     unsigned char header[5];
     header[0] = (unsigned char)kind;
-    put_u32(header + 1, (uint32_t)(head_len + body_len));
+    put_le(header + 1, (uint32_t)(head_len + body_len), 4);
     pthread_mutex_lock(&g_ls.write_lock);
     int result = write_all(header, sizeof header) == 0 && write_all(head, head_len) == 0 &&
                          (body_len == 0 || write_all(body, body_len) == 0)
@@ -348,7 +334,7 @@ static int read_frame(char *kind, unsigned char **out, size_t *len)
     if (read_all(header, sizeof header) != 0)
         return -1;
     *kind = (char)header[0];
-    *len = get_u32(header + 1);
+    *len = (uint32_t)get_le(header + 1, 4);
     if (*len > SEMO__DATAGRAM_MAX + 8)
         return -1;
     *out = malloc(*len ? *len : 1);
@@ -450,7 +436,7 @@ static void *link_thread(void *arg)
         if (lost)
             return NULL;
         unsigned char payload[8];
-        put_i64(payload, next);
+        put_le(payload, (uint64_t)next, 8);
         if (write_frame('I', payload, sizeof payload, NULL, 0) != 0)
             break;
         for (;;) {
@@ -465,7 +451,7 @@ static void *link_thread(void *arg)
                 continue;
             }
             bool granted = kind == 'G' && len == 8;
-            int64_t now = granted ? get_i64(data) : 0;
+            int64_t now = granted ? (int64_t)get_le(data, 8) : 0;
             free(data);
             if (!granted)
                 goto lost; /* a frame this robot does not know */
@@ -494,7 +480,7 @@ int semo__ls_connect(const char *path, size_t self)
         return -1;
     }
     unsigned char who[4];
-    put_u32(who, (uint32_t)self);
+    put_le(who, (uint32_t)self, 4);
     char kind;
     unsigned char *data = NULL;
     size_t len;
@@ -504,7 +490,7 @@ int semo__ls_connect(const char *path, size_t self)
         fprintf(stderr, "semo runtime: the lock-step coordinator at %s did not start the robot\n", path);
         return -1;
     }
-    atomic_store(&g_ls.now, get_i64(data));
+    atomic_store(&g_ls.now, (int64_t)get_le(data, 8));
     free(data);
     /* The main thread is the first to run. */
     pthread_mutex_lock(&g_ls.lock);
@@ -553,7 +539,7 @@ static int ls_open(const semo_program_desc *program, const semo_transport_config
 static int ls_send(size_t peer, const void *data, size_t len)
 {
     unsigned char to[4];
-    put_u32(to, (uint32_t)peer);
+    put_le(to, (uint32_t)peer, 4);
     return write_frame('M', to, sizeof to, data, len);
 }
 
