@@ -232,28 +232,13 @@ fn compare_with_linux_sim(name: &str, mission: &Path, scenario: &Path, robot: &s
     same_behaviour(robot, &qemu, &linux, duration, 500);
 
     // And the simulator's (`semo simulate`), the reference of linux-sim.
-    let trace = out.join("simulated.jsonl");
-    let simulated = support::semo_in(
-        &support::repo_root(),
-        &[
-            "simulate",
-            &mission.display().to_string(),
-            "--scenario",
-            &scenario.display().to_string(),
-            "--trace",
-            &trace.display().to_string(),
-        ],
-    );
+    let simulated = support::simulate_trace(mission, scenario, "sim");
     assert_eq!(
         simulated.code, 0,
         "{}{}",
         simulated.stdout, simulated.stderr
     );
-    let lines: Vec<String> = std::fs::read_to_string(&trace)
-        .unwrap()
-        .lines()
-        .map(str::to_string)
-        .collect();
+    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
     let simulated: Vec<Event> = events(&lines)
         .into_iter()
         .filter(|e| field(e, "robot") == robot)

@@ -228,19 +228,7 @@ fn simulate(mission: &Path, scenario: &Path) -> Vec<Event> {
 
 /// The trace of `semo simulate` with `engine`.
 fn run_engine(mission: &Path, scenario: &Path, engine: &str) -> Vec<Event> {
-    let out = semo_in(
-        &repo_root(),
-        &[
-            "simulate",
-            &mission.display().to_string(),
-            "--scenario",
-            &scenario.display().to_string(),
-            "--engine",
-            engine,
-            "--trace",
-            "-",
-        ],
-    );
+    let out = support::simulate_trace(mission, scenario, engine);
     assert!(out.code <= 1, "{engine}: {}{}", out.stdout, out.stderr);
     parse_trace(&out.stdout)
 }

@@ -14,19 +14,7 @@ fn trace(mission: &Path, scenario: &str, engine: &str) -> String {
     let dir = tempfile::tempdir().unwrap();
     let scenario_path = dir.path().join("scenario.json");
     std::fs::write(&scenario_path, scenario).unwrap();
-    let out = semo_in(
-        &repo_root(),
-        &[
-            "simulate",
-            &mission.display().to_string(),
-            "--scenario",
-            &scenario_path.display().to_string(),
-            "--engine",
-            engine,
-            "--trace",
-            "-",
-        ],
-    );
+    let out = support::simulate_trace(mission, &scenario_path, engine);
     assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
     out.stdout
 }

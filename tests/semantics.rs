@@ -234,25 +234,13 @@ fn a_strategy_algorithm_is_given_the_calls_argument_in_the_simulator_and_in_c() 
     let out = scratch("semantics/strategy-argument");
     let scenario = out.join("short.scenario.json");
     std::fs::write(&scenario, SHORT_RUN).unwrap();
-    let trace = out.join("simulated.jsonl");
-    let simulated = semo(&[
-        "simulate",
-        &mission.display().to_string(),
-        "--scenario",
-        &scenario.display().to_string(),
-        "--trace",
-        &trace.display().to_string(),
-    ]);
+    let simulated = support::simulate_trace(&mission, &scenario, "sim");
     assert_eq!(
         simulated.code, 0,
         "{}{}",
         simulated.stdout, simulated.stderr
     );
-    let simulated: Vec<String> = std::fs::read_to_string(&trace)
-        .unwrap()
-        .lines()
-        .map(str::to_string)
-        .collect();
+    let simulated: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
     assert_eq!(arguments_given(&simulated, "search"), ["ROOM2", "ROOM2"]);
     let traces = run_in_simulation(&mission, &out.join("linux-sim"), SHORT_RUN);
     assert_eq!(arguments_given(&traces["ti"], "search"), ["ROOM2", "ROOM2"]);

@@ -50,6 +50,25 @@ pub fn semo_in(dir: &Path, args: &[&str]) -> Output {
     }
 }
 
+/// `semo simulate MISSION --scenario SCENARIO --engine ENGINE --trace -`
+/// (`sim`: the simulator; `c`: the generated programs in lock-step): the
+/// run, its trace on standard output.
+pub fn simulate_trace(mission: &Path, scenario: &Path, engine: &str) -> Output {
+    semo_in(
+        &repo_root(),
+        &[
+            "simulate",
+            &mission.display().to_string(),
+            "--scenario",
+            &scenario.display().to_string(),
+            "--engine",
+            engine,
+            "--trace",
+            "-",
+        ],
+    )
+}
+
 /// Runs `semo ARGS` in `dir` with `input` on its standard input.
 pub fn semo_with_stdin(dir: &Path, args: &[&str], input: &str) -> Output {
     use std::io::Write;

@@ -266,11 +266,11 @@ void semo__ls_leave(void)
 
 /* ---------------------------------------------------------------- frames */
 
-static int write_all(const void *data, size_t len)
+/* All `len` bytes sent (`out`) or received; -1 when the stream ended or broke. */
+static int transfer(unsigned char *p, size_t len, bool out)
 {
-    const unsigned char *p = data;
     while (len > 0) {
-        ssize_t n = send(g_ls.fd, p, len, MSG_NOSIGNAL);
+        ssize_t n = out ? send(g_ls.fd, p, len, MSG_NOSIGNAL) : recv(g_ls.fd, p, len, 0);
         if (n < 0 && errno == EINTR)
             continue;
         if (n <= 0)
@@ -281,19 +281,15 @@ static int write_all(const void *data, size_t len)
     return 0;
 }
 
+/* send() only reads the bytes. */
+static int write_all(const void *data, size_t len)
+{
+    return transfer((unsigned char *)(uintptr_t)data, len, true);
+}
+
 static int read_all(void *data, size_t len)
 {
-    unsigned char *p = data;
-    while (len > 0) {
-        ssize_t n = recv(g_ls.fd, p, len, 0);
-        if (n < 0 && errno == EINTR)
-            continue;
-        if (n <= 0)
-            return -1;
-        p += n;
-        len -= (size_t)n;
-    }
-    return 0;
+    return transfer(data, len, false);
 }
 
 /* Little-endian fields of `bytes` bytes (4 or 8). */
