@@ -209,9 +209,15 @@ fn received_all_from(events: &[Event], robot: &str) -> Vec<(String, String)> {
 
 /// Runs a robot program with `args` and returns its exit code and stderr.
 fn run_with(folder: &Path, args: &[&str]) -> (Option<i32>, String) {
+    run_with_env(folder, args, &[])
+}
+
+/// The same with environment variables `env`.
+fn run_with_env(folder: &Path, args: &[&str], env: &[(&str, &str)]) -> (Option<i32>, String) {
     let mut processes = Processes::default();
     let child = Command::new(folder.join(robot_name(folder)))
         .args(args)
+        .envs(env.iter().copied())
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
@@ -263,6 +269,48 @@ fn transport_options_are_checked_and_an_unreachable_broker_is_reported() {
         stderr.contains(&format!("cannot reach the MQTT broker at 127.0.0.1:{port}")),
         "{stderr}"
     );
+    // A run id (`--run`, `$SEMO_RUN`) is refused as `topics::RunId` refuses
+    // it: never a topic level of several, a wildcard, or a name a file
+    // system gives a meaning to. One that is fine goes on to the broker.
+    let (long, too_long) = ("x".repeat(63), "x".repeat(64));
+    for id in [
+        "r1",
+        "2024-05-01.b",
+        &long,
+        "a/b",
+        "+",
+        "#",
+        "a+",
+        ".",
+        "..",
+        "-x",
+        "a b",
+        "é",
+        &too_long,
+    ] {
+        let fine = topics::RunId::parse(id).is_ok();
+        for (args, env, name) in [
+            (&["--run", id][..], &[][..], "--run"),
+            (&[][..], &[("SEMO_RUN", id)][..], "SEMO_RUN"),
+        ] {
+            let args = [&["--transport", "mqtt", "--broker", &broker][..], args].concat();
+            let (code, stderr) = run_with_env(irobot, &args, env);
+            assert_eq!(
+                code,
+                Some(if fine { 1 } else { 2 }),
+                "{name} {id:?}: {stderr}"
+            );
+            assert_eq!(
+                stderr.contains(&format!(
+                    "{name} must be 1 to 63 letters, digits, '-', '_' and '.', starting with a letter or a digit"
+                )),
+                !fine,
+                "{name} {id:?}: {stderr}"
+            );
+        }
+    }
+    let (code, stderr) = run_with(irobot, &["--run", ""]);
+    assert_eq!(code, Some(2), "{stderr}");
     // Built with the default of linux-sim (udp only), mqtt is not there.
     let udp_only = scratch("mqtt-options-udp");
     let built = build(
@@ -383,8 +431,14 @@ fn broker_config_for(dir: &Path, mission: &Path, deploy: &Path) -> PathBuf {
     config
 }
 
-/// The topics the ACL file `acl` lets `user` write.
-fn writable(acl: &str, user: &str) -> Vec<String> {
+/// The scouting mission's topics in run `run`.
+fn scouting_run(run: &str) -> topics::Scope {
+    topics::Scope::run("scouting", &topics::RunId::parse(run).unwrap())
+}
+
+/// The topics the ACL file `acl` lets `user` write in run `run` (the ACL
+/// names them in every run: `+` at the run's level).
+fn writable(acl: &str, user: &str, run: &str) -> Vec<String> {
     let mut current = None;
     let mut topics = Vec::new();
     for line in acl.lines() {
@@ -392,7 +446,10 @@ fn writable(acl: &str, user: &str) -> Vec<String> {
             current = Some(name);
         } else if let Some(topic) = line.strip_prefix("topic write ") {
             if current == Some(user) {
-                topics.push(topic.to_string());
+                let mut levels: Vec<&str> = topic.split('/').collect();
+                assert_eq!(levels[2], "+", "{topic}: every run");
+                levels[2] = run;
+                topics.push(levels.join("/"));
             }
         }
     }
@@ -457,9 +514,14 @@ struct Forgery {
     datagram: Vec<u8>,
 }
 
+/// The run of the robots [`run_while_forging`] runs: the ACL lets their
+/// users work in any run.
+const FORGED_RUN: &str = "acl-7";
+
 /// Runs the scouting robots (built with the deployment: no --broker, the
-/// baked defaults connect them) while each of `forgeries` goes on; returns
-/// the traces and how many publishes each forgery made.
+/// baked defaults connect them) in run [`FORGED_RUN`] while each of
+/// `forgeries` goes on; returns the traces and how many publishes each
+/// forgery made.
 fn run_while_forging(
     folders: &[PathBuf],
     out: &Path,
@@ -477,7 +539,12 @@ fn run_while_forging(
         folders,
         out,
         tag,
-        &["--transport".into(), "mqtt".into()],
+        &[
+            "--transport".into(),
+            "mqtt".into(),
+            "--run".into(),
+            FORGED_RUN.into(),
+        ],
         processes,
     );
     stop.store(true, std::sync::atomic::Ordering::SeqCst);
@@ -547,8 +614,13 @@ fn robots_take_messages_only_from_the_sender_their_topic_names_and_the_acl_lets(
     // them write, and on the operator's own command topic. Nor can the
     // master's credentials keep slave ti alive: ti's heartbeat (battery
     // 777, which ti never says) on every topic the master may write.
-    let operator_topic = topics::to_team("scouting", "MasterTeam", "USER.RC_CMD", topics::OPERATOR);
-    let mut slave_topics = writable(&acl, "slaves");
+    let operator_topic = topics::to_team(
+        &scouting_run(FORGED_RUN),
+        "MasterTeam",
+        "USER.RC_CMD",
+        topics::OPERATOR,
+    );
+    let mut slave_topics = writable(&acl, "slaves", FORGED_RUN);
     slave_topics.push(operator_topic.clone());
     let forgeries = vec![
         Forgery {
@@ -558,7 +630,7 @@ fn robots_take_messages_only_from_the_sender_their_topic_names_and_the_acl_lets(
         },
         Forgery {
             user: ("irobot", "irobot-secret"),
-            topics: writable(&acl, "irobot"),
+            topics: writable(&acl, "irobot", FORGED_RUN),
             datagram: datagram_from("SlaveTeam", "ti", "SlaveTeam.__alive", "leader 777", true),
         },
     ];
@@ -655,7 +727,7 @@ fn operator_session(port: u16, args: &[&str]) -> std::process::Output {
             "-P",
             "operator-secret",
         ])
-        .args(["-t", &topics::team_inbox("scouting", "USER")])
+        .args(["-t", &topics::team_inbox(&scouting_run("default"), "USER")])
         .args(args)
         .output()
         .expect("mosquitto_sub runs (Debian mosquitto-clients)")
@@ -763,7 +835,12 @@ fn the_generated_broker_started_as_root_keeps_qos1_messages_across_a_restart() {
         .args(["-u", "irobot", "-P", "irobot-secret", "-m", "kept"])
         .args([
             "-t",
-            &topics::to_team("scouting", "USER", "MasterTeam.CAMERA", irobot),
+            &topics::to_team(
+                &scouting_run("default"),
+                "USER",
+                "MasterTeam.CAMERA",
+                irobot,
+            ),
         ])
         .output()
         .expect("mosquitto_pub runs");
@@ -937,7 +1014,7 @@ fn robots_run_over_tls_with_client_certificates() {
     let plain = Command::new("mosquitto_pub")
         .args(["-h", "127.0.0.1", "-p", &port.to_string()])
         .args(["-u", "slaves", "-P", "slaves-secret"])
-        .args(["-t", "semo/scouting/SlaveTeam/x", "-m", "x"])
+        .args(["-t", "semo/scouting/default/SlaveTeam/x", "-m", "x"])
         .output()
         .expect("mosquitto_pub runs (Debian mosquitto-clients)");
     assert!(!plain.status.success(), "{plain:?}");
@@ -948,7 +1025,7 @@ fn robots_run_over_tls_with_client_certificates() {
 fn retained_status(port: u16, robot: &str) -> Option<serde_json::Value> {
     let out = Command::new("mosquitto_sub")
         .args(["-h", "127.0.0.1", "-p", &port.to_string()])
-        .args(["-t", &format!("semo/scouting/status/{robot}")])
+        .args(["-t", &format!("semo/scouting/default/status/{robot}")])
         .args(["-C", "1", "-W", "3", "--retained-only"])
         .output()
         .expect("mosquitto_sub runs (Debian mosquitto-clients)");
@@ -977,6 +1054,13 @@ fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
         );
         // The scenario gives no battery and no robot reads one: absent.
         assert_eq!(status.get("battery"), None, "{robot}: {status}");
+        // When its mission time 0 was (Unix ms): which run is the newest.
+        assert!(
+            status["started"]
+                .as_str()
+                .is_some_and(|t| t.parse::<u64>().is_ok()),
+            "{robot}: {status}"
+        );
     }
     // A robot killed while running: the broker publishes its last will.
     // Its scenario gives it a battery level of 80: its status says so.
@@ -1023,7 +1107,8 @@ fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
         }
         std::thread::sleep(std::time::Duration::from_millis(100));
     }
-    assert!(lost.is_some(), "the killed robot's status says lost");
+    let lost = lost.expect("the killed robot's status says lost");
+    assert_eq!(lost["started"], running["started"], "{lost}");
 }
 
 /// The burst mission (`tests/fixtures/messages`: twenty sends at once, pass
@@ -1194,6 +1279,93 @@ fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
                 .iter()
                 .any(|e| field(e, "event") == "comm_error"),
             "{slave} never fails to send"
+        );
+    }
+}
+
+/// The two-runs mission (`tests/fixtures/messages`) built into the
+/// fleet's folder.
+fn build_two_runs(fleet: &Fleet) -> Vec<PathBuf> {
+    let mission = repo_root().join("tests/fixtures/messages/two_runs.mission");
+    support::mqtt::build(&mission, &fleet.out, &[])
+}
+
+/// Its run `n`'s scenario: the boss's COLOR is `run N` until 800 ms, then
+/// `done` (the worker finishes on it); its DISTANCE is N.
+fn two_runs_scenario(fleet: &Fleet, n: i64) -> PathBuf {
+    let fixture = repo_root().join("tests/fixtures/messages/two_runs.scenario.json");
+    let mut scenario: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(fixture).unwrap()).unwrap();
+    let sensors = &mut scenario["robots"]["boss"]["sensors"];
+    sensors[0]["is"] = format!("run {n}").into();
+    sensors[1]["is"] = n.to_string().into();
+    let path = fleet.out.join(format!("two_runs.{n}.scenario.json"));
+    std::fs::write(&path, scenario.to_string()).unwrap();
+    path
+}
+
+/// The values (set) of `key` a robot received, in order.
+fn values_received(events: &[Event], key: &str) -> Vec<serde_json::Value> {
+    events
+        .iter()
+        .filter(|e| field(e, "event") == "receive" && field(e, "key") == key)
+        .map(|e| e["value"].clone())
+        .filter(|v| !v.is_null())
+        .collect()
+}
+
+/// One mission run twice on one broker, each run with its own id (`--run`,
+/// then `$SEMO_RUN`): the second hears nothing of the first. Without run
+/// ids, the worker of the second run got at once the `done` the first run
+/// left retained, and the boss's sends made after the first run's worker
+/// had finished (its persistent session kept them).
+#[test]
+fn a_second_run_on_the_same_broker_hears_nothing_of_the_first() {
+    let Some(mut fleet) = Fleet::start("mqtt-two-runs") else {
+        return;
+    };
+    let runs: [(i64, &[&str], &[(&str, &str)]); 2] = [
+        (1, &["--run", "first"], &[]),
+        (2, &[], &[("SEMO_RUN", "second")]),
+    ];
+    let folders = build_two_runs(&fleet);
+    for (n, args, env) in runs {
+        let scenario = two_runs_scenario(&fleet, n);
+        // Started together, the worker's subscription stands before the
+        // boss's first publication.
+        let (_, start_at) = support::robots::start_barrier(folders.len());
+        let start_at = start_at.to_string();
+        let args = [args, &["--start-at", &start_at]].concat();
+        let tag = format!("run{n}");
+        let started: Vec<Started> = folders
+            .iter()
+            .map(|folder| fleet.spawn_with(folder, &scenario, &tag, &args, env))
+            .collect();
+        let traces: BTreeMap<String, Vec<Event>> = started
+            .iter()
+            .map(|s| (s.robot.clone(), fleet.finish(s, &tag)))
+            .collect();
+        let worker = &traces["worker"];
+        let colors = values_received(worker, "Boss.COLOR");
+        assert_eq!(
+            colors.first(),
+            Some(&serde_json::json!(format!("run {n}"))),
+            "run {n}: the worker first hears its own run's boss: {colors:?}"
+        );
+        assert!(
+            colors.contains(&serde_json::json!("done")),
+            "run {n}: the boss says done: {colors:?}"
+        );
+        let distances = values_received(worker, "Boss.DISTANCE");
+        assert!(
+            !distances.is_empty() && distances.iter().all(|d| *d == serde_json::json!(n)),
+            "run {n}: every send the worker takes is its own run's: {distances:?}"
+        );
+        assert_eq!(modes(worker), ["WORK", "FINISH"], "run {n}");
+        assert_eq!(
+            refused(worker),
+            0,
+            "run {n}: nothing of another run is refused"
         );
     }
 }
@@ -1476,6 +1648,8 @@ fn editor_monitor_shows_the_running_robots_and_a_killed_one_lost(name: &str, tls
             })
         })
         .await;
+        // The robots were given no run: the default one, the newest.
+        assert_eq!(view["run"], "default", "{view}");
         let master = shown(&view, "irobot");
         assert_eq!(master["team"], "MasterTeam");
         assert!(
@@ -1703,7 +1877,7 @@ fn the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor() {
     let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
     assert!(
         acl.contains("user operator\n")
-            && acl.contains("topic read semo/patrol_groups/Guards/Guards.__alive/Guards/tb_0\n"),
+            && acl.contains("topic read semo/patrol_groups/+/Guards/Guards.__alive/Guards/tb_0\n"),
         "{acl}"
     );
     let folders =

@@ -2,7 +2,7 @@
  * processes, each opening the runtime's MQTT transport (semo_mqtt.c,
  * unchanged) as one robot of a team of ROBOTS, publish to their team at
  * RATE Hz for SECONDS (a `publish`: QoS 0, retained, to
- * semo/<mission>/<team>/<key>/<team>/<robot>, which the broker fans out to every other
+ * semo/<mission>/<run>/<team>/<key>/<team>/<robot>, which the broker fans out to every other
  * robot), and count what their transport hands them from the others.
  *
  * usage: mqtt_throughput PORT ROBOTS RATE SECONDS

@@ -178,6 +178,10 @@ enum Command {
         /// A deployment file: the operator's credentials (and broker).
         #[arg(long, value_name = "FILE")]
         deploy: Option<PathBuf>,
+        /// The run to show and command (the robots' `--run`); default: the
+        /// newest, followed as newer runs start.
+        #[arg(long, value_name = "ID")]
+        run: Option<String>,
         /// More strategy (and catalog) files or folders to read.
         #[arg(long)]
         strategy: Vec<PathBuf>,
@@ -535,6 +539,7 @@ fn run() -> i32 {
             mission,
             broker,
             deploy,
+            run,
             strategy,
             color,
         } => operator::run(
@@ -543,6 +548,7 @@ fn run() -> i32 {
                 strategy,
                 broker,
                 deploy,
+                run,
                 color: use_color(color),
             },
             &mut out,

@@ -3,7 +3,9 @@
 //! the operator's client certificate, through `semo_server::live::BrokerAccess`). It sends the `USER` commands the mission receives
 //! (one per line on standard input: `RC_CMD RETURN_MODE`), prints what the
 //! robots `send(USER, …)`, and prints each robot's status whenever it
-//! changes (the retained `semo/<mission>/status/<robot>` topics). It ends
+//! changes (the retained `semo/<mission>/<run>/status/<robot>` topics). All
+//! of it in one run of the mission: `--run ID`, else the newest
+//! (`semo_server::live::RunChoice`), followed as newer ones start. It ends
 //! when standard input does.
 //!
 //! The commands and their receivers come from the refined programs (each
@@ -12,9 +14,12 @@
 //! written by `semo_server::live`, which the editor's monitor shares).
 
 use semo::codegen;
-use semo::deploy::topics;
+use semo::deploy::topics::{self, RunId, Scope};
 use semo::host;
-use semo_server::live::{BrokerAccess, DEFAULT_BROKER, Status, datagram_fields, operator_datagram};
+use semo_server::live::{
+    BrokerAccess, DEFAULT_BROKER, RunChoice, Status, datagram_fields, operator_datagram,
+    status_topic,
+};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::{BufRead, Write};
 use std::path::PathBuf;
@@ -24,6 +29,8 @@ pub struct Options {
     pub strategy: Vec<PathBuf>,
     pub broker: Option<String>,
     pub deploy: Option<PathBuf>,
+    /// The run to show and command; None: the newest.
+    pub run: Option<String>,
     pub color: bool,
 }
 
@@ -34,6 +41,13 @@ struct Command {
 }
 
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
+    let given_run = match options.run.as_deref().map(RunId::parse).transpose() {
+        Ok(run) => run,
+        Err(why) => {
+            eprintln!("error: --run: {why}");
+            return 2;
+        }
+    };
     let (run, mission) = match host::load_build(&options.mission, &options.strategy) {
         Ok(loaded) => loaded,
         Err(e) => {
@@ -108,10 +122,13 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     ));
     mqtt.set_keep_alive(std::time::Duration::from_secs(10));
     let (client, mut connection) = rumqttc::Client::new(mqtt, 64);
-    for topic in [
-        topics::statuses(&mission_topic),
-        topics::team_inbox(&mission_topic, "USER"),
-    ] {
+    let mut view = View {
+        mission: mission_topic.clone(),
+        run: RunChoice::new(given_run.clone()),
+        printed: BTreeMap::new(),
+    };
+    let scope = view.run.scope(&mission_topic);
+    for topic in [topics::statuses(&scope), topics::team_inbox(&scope, "USER")] {
         if let Err(e) = client.subscribe(topic, rumqttc::QoS::AtLeastOnce) {
             eprintln!("error: {e}");
             return 2;
@@ -128,7 +145,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         .collect();
     let _ = writeln!(
         out,
-        "operator on {url}, mission {mission_topic}; commands: {}; type `NAME VALUE` per line",
+        "operator on {url}, mission {mission_topic}, {}; commands: {}; type `NAME VALUE` per line",
+        match &given_run {
+            Some(run) => format!("run {run}"),
+            None => "the newest run".to_string(),
+        },
         if listing.is_empty() {
             "none".to_string()
         } else {
@@ -139,7 +160,10 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     // The broker's messages and the operator's lines come to this thread
     // (which holds standard output) as they arrive.
     enum Input {
-        Broker(String),
+        Broker {
+            topic: String,
+            payload: Vec<u8>,
+        },
         Line(String),
         End,
         /// The broker cannot be reached this way (its certificate is not
@@ -149,22 +173,14 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let (tx, rx) = std::sync::mpsc::channel();
     let listener = {
         let tx = tx.clone();
-        let mission_topic = mission_topic.clone();
         std::thread::spawn(move || {
-            let mut printed = BTreeMap::new();
             for event in connection.iter() {
                 match event {
                     Ok(rumqttc::Event::Incoming(rumqttc::Packet::Publish(p))) => {
-                        match describe(&mission_topic, &p.topic, &p.payload, &mut printed) {
-                            Heard::Line(line) => {
-                                let _ = tx.send(Input::Broker(line));
-                            }
-                            Heard::Refused => eprintln!(
-                                "operator: refused a message on {}: not a runtime message from the sender its topic names",
-                                p.topic
-                            ),
-                            Heard::Nothing => {}
-                        }
+                        let _ = tx.send(Input::Broker {
+                            topic: p.topic,
+                            payload: p.payload.to_vec(),
+                        });
                     }
                     Ok(rumqttc::Event::Outgoing(rumqttc::Outgoing::Disconnect)) => break,
                     Ok(_) => {}
@@ -196,9 +212,18 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let mut status = 0;
     for input in rx.iter() {
         let line = match input {
-            Input::Broker(line) => {
-                let _ = writeln!(out, "{line}");
-                let _ = out.flush();
+            Input::Broker { topic, payload } => {
+                match view.message(&topic, &payload) {
+                    Heard::Lines(lines) => {
+                        for line in lines {
+                            let _ = writeln!(out, "{line}");
+                        }
+                        let _ = out.flush();
+                    }
+                    Heard::Refused => eprintln!(
+                        "operator: refused a message on {topic}: not a runtime message from the sender its topic names"
+                    ),
+                }
                 continue;
             }
             Input::End => break,
@@ -223,9 +248,17 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             status = 1;
             continue;
         };
+        let Some(run) = view.run.run() else {
+            eprintln!(
+                "operator: no run of mission {mission_topic} is known yet (no robot's status has come): wait for one, or give --run"
+            );
+            status = 1;
+            continue;
+        };
+        let scope = Scope::run(&mission_topic, run);
         let payload = operator_datagram(&command.key, value.trim());
         for team in &command.teams {
-            let topic = topics::to_team(&mission_topic, team, &command.key, topics::OPERATOR);
+            let topic = topics::to_team(&scope, team, &command.key, topics::OPERATOR);
             if let Err(e) = client.publish(topic, rumqttc::QoS::AtLeastOnce, false, payload.clone())
             {
                 eprintln!("operator: {e}");
@@ -242,38 +275,68 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
 
 /// What a message from the broker comes to.
 enum Heard {
-    /// A line to print.
-    Line(String),
+    /// Lines to print (none: nothing new, a status unchanged, another
+    /// run's message).
+    Lines(Vec<String>),
     /// A message whose payload claims another sender than its topic: the
     /// broker vouches only for the topic, so it is said and dropped.
     Refused,
-    /// Nothing new (a status unchanged, a topic we do not read).
-    Nothing,
 }
 
-/// The line to print for a message of mission `mission` (its topic name):
-/// a robot's `send(USER, …)`, or its status when it changed.
-fn describe(
-    mission: &str,
-    topic: &str,
-    payload: &[u8],
-    printed: &mut BTreeMap<String, String>,
-) -> Heard {
-    let status_prefix = topics::statuses(mission);
-    let status_prefix = status_prefix.trim_end_matches('+');
-    let Some(last) = topic.strip_prefix(status_prefix) else {
-        return match datagram_fields(topic, mission, "USER", payload) {
+/// What the console shows: the run, and each robot's status line last
+/// printed.
+struct View {
+    /// The mission's topic name.
+    mission: String,
+    run: RunChoice,
+    printed: BTreeMap<String, String>,
+}
+
+impl View {
+    /// The lines to print for a message: a robot's `send(USER, …)`, or its
+    /// status when it changed, of the run shown; a newer run's status (when
+    /// no run is given) is said and followed.
+    fn message(&mut self, topic: &str, payload: &[u8]) -> Heard {
+        let Some((run, robot)) = status_topic(&self.mission, topic) else {
+            return self.sent(topic, payload);
+        };
+        let Some(status) = Status::decode(&robot, payload) else {
+            return Heard::Refused;
+        };
+        let mut lines = Vec::new();
+        if self.run.heard(&run, status.started) {
+            self.printed.clear();
+            lines.push(format!("following run {run} (the newest)"));
+        }
+        if self.run.run() == Some(&run) {
+            let line = status_line(&robot, &status);
+            if self.printed.get(&robot) != Some(&line) {
+                self.printed.insert(robot, line.clone());
+                lines.push(line);
+            }
+        }
+        Heard::Lines(lines)
+    }
+
+    /// A robot's `send(USER, …)` of the run shown.
+    fn sent(&self, topic: &str, payload: &[u8]) -> Heard {
+        let run = topics::run_of(&self.mission, topic);
+        let Some(run) = run.filter(|r| self.run.run() == Some(r)) else {
+            return Heard::Lines(Vec::new());
+        };
+        match datagram_fields(topic, &Scope::run(&self.mission, &run), "USER", payload) {
             Some([_, robot, key, value]) => {
-                Heard::Line(format!("{robot}: send(USER, {key}) = {value}"))
+                Heard::Lines(vec![format!("{robot}: send(USER, {key}) = {value}")])
             }
             None => Heard::Refused,
-        };
-    };
-    let Some(status) = Status::decode(last, payload) else {
-        return Heard::Refused;
-    };
-    let line = format!(
-        "status {last}: {} {}{}{}{}",
+        }
+    }
+}
+
+/// `status ROBOT: STATE MODE [SERVICES] leader L battery B`.
+fn status_line(robot: &str, status: &Status) -> String {
+    format!(
+        "status {robot}: {} {}{}{}{}",
         status.state,
         status.mode,
         match status.services_text().as_str() {
@@ -288,25 +351,35 @@ fn describe(
             Some(level) => format!(" battery {level}"),
             None => String::new(),
         }
-    );
-    if printed.get(last) == Some(&line) {
-        return Heard::Nothing;
-    }
-    printed.insert(last.to_string(), line.clone());
-    Heard::Line(line)
+    )
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn heard(topic: &str, payload: &[u8], printed: &mut BTreeMap<String, String>) -> String {
-        match describe("scouting", topic, payload, printed) {
-            Heard::Line(line) => line,
+    fn heard(view: &mut View, topic: &str, payload: &[u8]) -> String {
+        match view.message(topic, payload) {
+            Heard::Lines(lines) if lines.is_empty() => "nothing".into(),
+            Heard::Lines(lines) => lines.join("\n"),
             Heard::Refused => "refused".into(),
-            Heard::Nothing => "nothing".into(),
         }
     }
+
+    fn view(run: Option<&str>) -> View {
+        View {
+            mission: "scouting".into(),
+            run: RunChoice::new(run.map(|r| RunId::parse(r).unwrap())),
+            printed: BTreeMap::new(),
+        }
+    }
+
+    fn scope(run: &str) -> Scope {
+        Scope::run("scouting", &RunId::parse(run).unwrap())
+    }
+
+    const WAITING: &[u8] =
+        br#"{"robot":"irobot","state":"running","started":"1000","mode":"WAIT_MODE"}"#;
 
     #[test]
     fn a_message_is_printed_only_from_the_sender_its_topic_names() {
@@ -321,10 +394,11 @@ mod tests {
             key: "MasterTeam.DISTANCE".into(),
             value: Some(semo::refine::Value::Int(50)),
         });
-        let own = topics::to_team("scouting", "USER", "MasterTeam.DISTANCE", irobot);
-        let printed = &mut BTreeMap::new();
+        let r1 = scope("r1");
+        let own = topics::to_team(&r1, "USER", "MasterTeam.DISTANCE", irobot);
+        let view = &mut view(Some("r1"));
         assert_eq!(
-            heard(&own, &told, printed),
+            heard(view, &own, &told),
             "irobot: send(USER, MasterTeam.DISTANCE) = 50"
         );
         // The same datagram on a topic the slaves' user may write.
@@ -332,18 +406,52 @@ mod tests {
             team: "SlaveTeam",
             robot: "ti",
         };
-        let slaves = topics::to_team("scouting", "USER", "MasterTeam.DISTANCE", ti);
-        assert_eq!(heard(&slaves, &told, printed), "refused");
-        let status = br#"{"robot":"irobot","state":"running","mode":"WAIT_MODE"}"#;
+        let slaves = topics::to_team(&r1, "USER", "MasterTeam.DISTANCE", ti);
+        assert_eq!(heard(view, &slaves, &told), "refused");
         assert_eq!(
-            heard("semo/scouting/status/irobot", status, printed),
+            heard(view, "semo/scouting/r1/status/irobot", WAITING),
             "status irobot: running WAIT_MODE"
         );
         assert_eq!(
-            heard("semo/scouting/status/irobot", status, printed),
+            heard(view, "semo/scouting/r1/status/irobot", WAITING),
             "nothing"
         );
         // Another robot's status on ti's topic is nobody's.
-        assert_eq!(heard("semo/scouting/status/ti", status, printed), "refused");
+        assert_eq!(
+            heard(view, "semo/scouting/r1/status/ti", WAITING),
+            "refused"
+        );
+    }
+
+    /// Without a run given, the console follows the newest: a newer run's
+    /// status is said and shown, an older run's messages are not.
+    #[test]
+    fn the_console_follows_the_newest_run() {
+        let view = &mut view(None);
+        assert_eq!(
+            heard(view, "semo/scouting/r2/status/irobot", WAITING),
+            "following run r2 (the newest)\nstatus irobot: running WAIT_MODE"
+        );
+        let older = br#"{"robot":"ti","state":"stopped","started":"500","mode":"FINISH"}"#;
+        assert_eq!(heard(view, "semo/scouting/r1/status/ti", older), "nothing");
+        let told = semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+            publish: false,
+            team: "MasterTeam".into(),
+            robot: "irobot".into(),
+            key: "MasterTeam.DISTANCE".into(),
+            value: Some(semo::refine::Value::Int(50)),
+        });
+        let irobot = topics::Sender {
+            team: "MasterTeam",
+            robot: "irobot",
+        };
+        let old = topics::to_team(&scope("r1"), "USER", "MasterTeam.DISTANCE", irobot);
+        assert_eq!(heard(view, &old, &told), "nothing");
+        let newer = br#"{"robot":"irobot","state":"running","started":"2000","mode":"AUTO_MODE"}"#;
+        assert_eq!(
+            heard(view, "semo/scouting/r3/status/irobot", newer),
+            "following run r3 (the newest)\nstatus irobot: running AUTO_MODE"
+        );
+        assert_eq!(view.run.run().map(RunId::as_str), Some("r3"));
     }
 }

@@ -64,7 +64,7 @@ async fn run(port: u16, url: String) {
         let sent = Instant::now();
         robot
             .publish(
-                "semo/follow/status/create1",
+                "semo/follow/default/status/create1",
                 QoS::AtLeastOnce,
                 true,
                 payload.to_string(),

@@ -5,14 +5,16 @@
 //! `observe_status` and `semo_mqtt.c`'s last will) and of the runtime's
 //! datagram (`semo_core.c`'s `semo__encode_message`, through
 //! `semo::deploy::datagram`), so that both read the
-//! same thing the same way. And how both reach the broker (`connect`:
+//! same thing the same way. Which run both show ([`RunChoice`]: the one
+//! given, else the newest). And how both reach the broker (`connect`:
 //! `mqtt://` or `mqtts://`, the deployment's operator).
 
 mod connect;
 
 pub use connect::{BrokerAccess, Failure};
+use semo::deploy::topics::{self, RunId, Scope};
 
-/// A robot's status message on `semo/<mission>/status/<robot>`.
+/// A robot's status message on `semo/<mission>/<run>/status/<robot>`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Status {
     pub robot: String,
@@ -28,6 +30,9 @@ pub struct Status {
     pub battery: Option<f64>,
     /// The robot's mission time of the change (ms), when given.
     pub t: Option<i64>,
+    /// The wall-clock instant of the robot's mission time 0 (Unix ms),
+    /// when given: which run is the newest.
+    pub started: Option<i64>,
 }
 
 impl Status {
@@ -54,7 +59,7 @@ impl Status {
             })
             .collect();
         let named = text("robot");
-        if !named.is_empty() && semo::deploy::topics::level(&named) != robot {
+        if !named.is_empty() && topics::level(&named) != robot {
             return None;
         }
         Some(Status {
@@ -73,6 +78,10 @@ impl Status {
                     .or_else(|| v.as_str().and_then(|s| s.parse().ok()))
             }),
             t: object.get("t").and_then(serde_json::Value::as_i64),
+            started: object.get("started").and_then(|v| {
+                v.as_i64()
+                    .or_else(|| v.as_str().and_then(|s| s.parse().ok()))
+            }),
         })
     }
 
@@ -84,6 +93,67 @@ impl Status {
             .collect::<Vec<_>>()
             .join(",")
     }
+}
+
+/// Which run of a mission a console shows: the one it was given, else the
+/// newest it has heard of, the run of the status with the latest `started`
+/// (its robots' mission time 0 came last; a status without one counts
+/// oldest). The broker hands the retained statuses of every run in no
+/// order of time, so arrival cannot say which run is the newest.
+#[derive(Clone, Debug)]
+pub struct RunChoice {
+    given: bool,
+    /// The run shown, and the latest `started` heard of it.
+    shown: Option<(RunId, i64)>,
+}
+
+impl RunChoice {
+    /// `Some(run)`: that run only; `None`: the newest.
+    pub fn new(given: Option<RunId>) -> RunChoice {
+        RunChoice {
+            given: given.is_some(),
+            shown: given.map(|run| (run, i64::MIN)),
+        }
+    }
+
+    /// The run shown; None until a status of a run is heard.
+    pub fn run(&self) -> Option<&RunId> {
+        self.shown.as_ref().map(|(run, _)| run)
+    }
+
+    /// Where to subscribe: the given run's topics, else every run's.
+    pub fn scope(&self, mission: &str) -> Scope {
+        match (&self.shown, self.given) {
+            (Some((run, _)), true) => Scope::run(mission, run),
+            _ => Scope::every_run(mission),
+        }
+    }
+
+    /// A status of `run` whose robot started at `started`: whether the
+    /// run shown changed (to this newer one).
+    pub fn heard(&mut self, run: &RunId, started: Option<i64>) -> bool {
+        let started = started.unwrap_or(i64::MIN);
+        match &mut self.shown {
+            Some((shown, latest)) if shown == run => {
+                *latest = (*latest).max(started);
+                false
+            }
+            Some((_, latest)) if self.given || started <= *latest => false,
+            _ => {
+                self.shown = Some((run.clone(), started));
+                true
+            }
+        }
+    }
+}
+
+/// The run and robot of a status topic of mission `mission` (its topic
+/// name), `semo/<mission>/<run>/status/<robot>`; None for any other topic.
+pub fn status_topic(mission: &str, topic: &str) -> Option<(RunId, String)> {
+    let run = topics::run_of(mission, topic)?;
+    let statuses = topics::statuses(&Scope::run(mission, &run));
+    let robot = topic.strip_prefix(statuses.trim_end_matches('+'))?;
+    (!robot.is_empty() && !robot.contains('/')).then(|| (run, robot.to_string()))
 }
 
 /// The broker a robot uses when nothing says otherwise.
@@ -104,14 +174,14 @@ pub fn operator_datagram(key: &str, value: &str) -> Vec<u8> {
     })
 }
 
-/// The fields of a runtime datagram to team `to` of mission `mission` (its
-/// topic name) that came on `topic`: (team, robot, key, value), the value
-/// as text (`(none)` for a value never set). `None` for anything else, and
-/// for a datagram whose sender or key is not its topic's
-/// (`topics::carries`): the broker vouches for the topic only.
-pub fn datagram_fields(topic: &str, mission: &str, to: &str, data: &[u8]) -> Option<[String; 4]> {
+/// The fields of a runtime datagram to team `to` of the run `scope` that
+/// came on `topic`: (team, robot, key, value), the value as text (`(none)`
+/// for a value never set). `None` for anything else, and for a datagram
+/// whose sender or key is not its topic's (`topics::carries`): the broker
+/// vouches for the topic only.
+pub fn datagram_fields(topic: &str, scope: &Scope, to: &str, data: &[u8]) -> Option<[String; 4]> {
     let d = semo::deploy::datagram::decode(data)?;
-    if !semo::deploy::topics::carries(topic, mission, to, &d) {
+    if !topics::carries(topic, scope, to, &d) {
         return None;
     }
     let value = d.value.map_or_else(|| "(none)".into(), |v| v.as_text());
@@ -137,6 +207,12 @@ mod tests {
         );
         assert_eq!(status.services_text(), "Listen=ReportStatus,Action=Wait");
         assert_eq!((status.t, status.battery), (Some(5230), None));
+        assert_eq!(status.started, None);
+        assert_eq!(
+            Status::decode("r", br#"{"state":"lost","started":"1700000000123"}"#)
+                .map(|s| s.started),
+            Some(Some(1_700_000_000_123))
+        );
         // The last will names only the robot and the state.
         let will = Status::decode(
             "irobot",
@@ -170,13 +246,56 @@ mod tests {
         assert_eq!(Status::decode("r", b"\xff"), None);
     }
 
+    fn run(id: &str) -> RunId {
+        RunId::parse(id).unwrap()
+    }
+
+    #[test]
+    fn the_newest_run_is_the_one_whose_robots_started_last() {
+        let mut choice = RunChoice::new(None);
+        assert_eq!(choice.run(), None);
+        assert_eq!(choice.scope("m").as_str(), "semo/m/+");
+        assert!(choice.heard(&run("b"), Some(200)));
+        // An older run's status, whenever it comes, does not take over.
+        assert!(!choice.heard(&run("a"), Some(100)));
+        assert!(!choice.heard(&run("a"), None));
+        assert!(!choice.heard(&run("b"), Some(150)));
+        assert_eq!(choice.run(), Some(&run("b")));
+        assert!(choice.heard(&run("c"), Some(300)));
+        assert_eq!(choice.run(), Some(&run("c")));
+        assert_eq!(choice.scope("m").as_str(), "semo/m/+");
+        // A run given is the only one shown.
+        let mut given = RunChoice::new(Some(run("a")));
+        assert!(!given.heard(&run("c"), Some(300)));
+        assert_eq!(given.run(), Some(&run("a")));
+        assert_eq!(given.scope("m").as_str(), "semo/m/a");
+    }
+
+    #[test]
+    fn a_status_topic_says_its_run_and_robot() {
+        assert_eq!(
+            status_topic("m", "semo/m/r1/status/irobot"),
+            Some((run("r1"), "irobot".into()))
+        );
+        for other in [
+            "semo/m/r1/status/",
+            "semo/m/r1/status/a/b",
+            "semo/m/r1/T/status/a",
+            "semo/n/r1/status/a",
+            "semo/m/+/status/a",
+        ] {
+            assert_eq!(status_topic("m", other), None, "{other}");
+        }
+    }
+
     #[test]
     fn a_command_is_the_runtimes_datagram_and_reads_back_on_its_topic_only() {
-        use semo::deploy::topics::{self, OPERATOR};
+        use semo::deploy::topics::OPERATOR;
         let d = operator_datagram("USER.RC_CMD", "RETURN_MODE");
-        let topic = topics::to_team("m", "MasterTeam", "USER.RC_CMD", OPERATOR);
+        let m = Scope::run("m", &run("r1"));
+        let topic = topics::to_team(&m, "MasterTeam", "USER.RC_CMD", OPERATOR);
         assert_eq!(
-            datagram_fields(&topic, "m", "MasterTeam", &d),
+            datagram_fields(&topic, &m, "MasterTeam", &d),
             Some([
                 "USER".into(),
                 "operator".into(),
@@ -185,15 +304,18 @@ mod tests {
             ])
         );
         assert_eq!(
-            datagram_fields(&topic, "m", "MasterTeam", &d[..d.len() - 1]),
+            datagram_fields(&topic, &m, "MasterTeam", &d[..d.len() - 1]),
             None
         );
+        // The same command read as another run's.
+        let other = Scope::run("m", &run("r2"));
+        assert_eq!(datagram_fields(&topic, &other, "MasterTeam", &d), None);
         // The same datagram on a topic another user may write.
         let slaves = topics::Sender {
             team: "SlaveTeam",
             robot: "ti",
         };
-        let elsewhere = topics::to_team("m", "MasterTeam", "SlaveTeam.COLOR", slaves);
-        assert_eq!(datagram_fields(&elsewhere, "m", "MasterTeam", &d), None);
+        let elsewhere = topics::to_team(&m, "MasterTeam", "SlaveTeam.COLOR", slaves);
+        assert_eq!(datagram_fields(&elsewhere, &m, "MasterTeam", &d), None);
     }
 }

@@ -4,8 +4,9 @@
 //! (retained status with its last will, heartbeats as datagrams), and the
 //! `semo/monitor` notifications read back: every robot of the mission
 //! waiting at first, then its mode, services and leader; lost when its last
-//! will arrives or when it stops heart-beating. (`tests/mqtt.rs` does the
-//! same with real generated robot processes.)
+//! will arrives or when it stops heart-beating; the newest run, or the one
+//! asked for. (`tests/mqtt.rs` does the same with real generated robot
+//! processes.)
 //!
 //! Needs `mosquitto` (Debian). Skipped with a message when it is missing,
 //! unless `SEMO_MQTT_TESTS=require` (CI).
@@ -24,16 +25,29 @@ use support::broker::{Broker, free_port, mosquitto};
 struct FakeRobot {
     client: AsyncClient,
     robot: String,
+    /// Its run, and when its mission time 0 was (Unix ms).
+    run: String,
+    started: i64,
     poller: tokio::task::JoinHandle<()>,
 }
 
 impl FakeRobot {
+    /// In the run of a robot program given none.
     fn connect(port: u16, robot: &str) -> FakeRobot {
-        let mut options =
-            MqttOptions::new(format!("semo-patrol_groups-{robot}"), "127.0.0.1", port);
+        FakeRobot::connect_in(port, robot, "default", 1)
+    }
+
+    fn connect_in(port: u16, robot: &str, run: &str, started: i64) -> FakeRobot {
+        let mut options = MqttOptions::new(
+            format!("semo-patrol_groups-{run}-{robot}"),
+            "127.0.0.1",
+            port,
+        );
         options.set_last_will(LastWill::new(
-            status_topic(robot),
-            format!(r#"{{"robot":"{robot}","event":"status","state":"lost"}}"#),
+            status_topic(run, robot),
+            format!(
+                r#"{{"robot":"{robot}","event":"status","state":"lost","started":"{started}"}}"#
+            ),
             QoS::AtLeastOnce,
             true,
         ));
@@ -48,19 +62,37 @@ impl FakeRobot {
         FakeRobot {
             client,
             robot: robot.to_string(),
+            run: run.to_string(),
+            started,
             poller,
         }
     }
 
     /// The status the runtime publishes (`docs/deployment.md`).
     async fn status(&self, state: &str, mode: &str, leader: &str, services: &str) {
+        let (robot, run) = (&self.robot, &self.run);
+        self.status_of(robot, run, self.started, [state, mode, leader, services])
+            .await;
+    }
+
+    /// The status of `robot` of run `run` that started at `started`, on
+    /// this connection (after what it published before): `[state, mode,
+    /// leader, services]`.
+    async fn status_of(
+        &self,
+        robot: &str,
+        run: &str,
+        started: i64,
+        [state, mode, leader, services]: [&str; 4],
+    ) {
         let payload = json!({
-            "t": 1, "robot": self.robot, "event": "status", "state": state,
+            "t": 1, "robot": robot, "event": "status", "state": state,
+            "started": started.to_string(),
             "mode": mode, "leader": leader, "services": services,
         });
         self.client
             .publish(
-                status_topic(&self.robot),
+                status_topic(run, robot),
                 QoS::AtLeastOnce,
                 true,
                 payload.to_string(),
@@ -84,9 +116,11 @@ impl FakeRobot {
             team: "Guards",
             robot: &self.robot,
         };
+        let run = semo::deploy::topics::RunId::parse(&self.run).unwrap();
+        let scope = semo::deploy::topics::Scope::run("patrol_groups", &run);
         self.client
             .publish(
-                semo::deploy::topics::to_team("patrol_groups", "Guards", "Guards.__alive", sender),
+                semo::deploy::topics::to_team(&scope, "Guards", "Guards.__alive", sender),
                 QoS::AtMostOnce,
                 false,
                 datagram,
@@ -100,8 +134,8 @@ impl FakeRobot {
     }
 }
 
-fn status_topic(robot: &str) -> String {
-    format!("semo/patrol_groups/status/{robot}")
+fn status_topic(run: &str, robot: &str) -> String {
+    format!("semo/patrol_groups/{run}/status/{robot}")
 }
 
 /// A workspace with the patrol_groups example (team Guards elects a leader).
@@ -266,6 +300,83 @@ async fn robots_appear_with_their_modes_and_a_killed_or_silent_one_is_lost() {
         "closing the mission ended its monitor"
     );
     tb_1.kill();
+    client.shutdown().await;
+}
+
+/// Without a run asked for, the monitor shows the newest: the run whose
+/// robots started last, whatever order the broker hands the statuses in;
+/// asked for a run, it shows that one.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_monitor_shows_the_newest_run_or_the_one_asked_for() {
+    let Some(binary) = mosquitto() else { return };
+    let broker = Broker::start(&binary);
+    let (dir, uri, text) = workspace();
+    let mut client = TestClient::start();
+    started(&mut client, dir.path(), &uri, &text).await;
+    let answer = client
+        .request(
+            "semo/monitor/start",
+            json!({ "uri": uri, "broker": broker.url() }),
+        )
+        .await
+        .expect("the monitor starts");
+    assert_eq!(answer["run"], Value::Null);
+    let first = FakeRobot::connect_in(broker.port, "tb_0", "r1", 1000);
+    first.status("running", "PATROL", "tb_0", "").await;
+    let view = view_where(&mut client, |p| p["robots"][1]["state"] == "running").await;
+    assert_eq!(view["run"], "r1");
+    // A newer run: the picture starts over with it.
+    let second = FakeRobot::connect_in(broker.port, "tb_1", "r2", 2000);
+    second.status("running", "HIDE", "tb_1", "").await;
+    let view = view_where(&mut client, |p| p["robots"][2]["state"] == "running").await;
+    assert_eq!(view["run"], "r2");
+    assert_eq!(state(&view, "tb_0"), "waiting", "{view}");
+    // The older run's robots no longer count (tb_2's status of run r1 comes
+    // before tb_1's new mode: one connection).
+    second
+        .status_of("tb_2", "r1", 1000, ["running", "PATROL", "tb_0", ""])
+        .await;
+    second.status("running", "PATROL", "tb_1", "").await;
+    let view = view_where(&mut client, |p| p["robots"][2]["mode"] == "PATROL").await;
+    assert_eq!(state(&view, "tb_2"), "waiting", "{view}");
+    client
+        .request("semo/monitor/stop", json!({ "uri": uri }))
+        .await
+        .unwrap();
+    // Asked for the older run: its retained statuses only.
+    let answer = client
+        .request(
+            "semo/monitor/start",
+            json!({ "uri": uri, "broker": broker.url(), "run": "r1" }),
+        )
+        .await
+        .expect("the monitor starts");
+    assert_eq!(answer["run"], "r1");
+    let view = view_where(&mut client, |p| {
+        p["robots"][1]["state"] == "running" && p["robots"][3]["state"] == "running"
+    })
+    .await;
+    assert_eq!(view["run"], "r1");
+    assert_eq!(state(&view, "tb_1"), "waiting", "{view}");
+    // A run id that is not one topic level is refused.
+    for bad in ["a/b", "#", "+"] {
+        let refused = client
+            .request(
+                "semo/monitor/start",
+                json!({ "uri": uri, "broker": broker.url(), "run": bad }),
+            )
+            .await
+            .expect_err("refused");
+        assert!(
+            refused["message"]
+                .as_str()
+                .is_some_and(|m| m.contains("cannot monitor: a run id is")),
+            "{refused}"
+        );
+    }
+    for robot in [first, second] {
+        robot.kill();
+    }
     client.shutdown().await;
 }
 

@@ -5,8 +5,9 @@
 //! and its own topics; only the operator's user may write the `USER`
 //! commands the mission receives (topics whose sender is `USER/operator`);
 //! anonymous clients are refused. The topics are `topics.rs`'s, as the
-//! runtime uses; why this is enough to trust a topic's sender is
-//! `docs/security.md`. Every value written is one mosquitto reads back as
+//! runtime uses, in every run (`+` at the run's level: the credentials do
+//! not depend on the run, the topics' other levels still do); why this is
+//! enough to trust a topic's sender is `docs/security.md`. Every value written is one mosquitto reads back as
 //! it is (`lines.rs`); anything else is refused, never written.
 
 use super::{Deployment, lines, topics};
@@ -70,7 +71,8 @@ pub fn files(
             "the mission's name {mission:?} (its file name) cannot be written into the broker's ACL: {why}; rename the mission file"
         )));
     }
-    let users = rights(deployment, programs, &mission).map_err(Refusal::Deployment)?;
+    let users = rights(deployment, programs, &topics::Scope::every_run(&mission))
+        .map_err(Refusal::Deployment)?;
     let acl = acl(&mission, source, deployment, &users)?;
     let config = config(&mission, source, deployment, programs, out)?;
     Ok(BrokerFiles { config, acl })
@@ -86,11 +88,12 @@ fn mistake(deployment: &Deployment, message: String) -> Diagnostic {
     )
 }
 
-/// Each user's rights: its robots' topics, and the operator's.
+/// Each user's rights: its robots' topics in `scope` (every run), and the
+/// operator's.
 fn rights(
     deployment: &Deployment,
     programs: &[RobotProgram],
-    mission: &str,
+    scope: &topics::Scope,
 ) -> Result<BTreeMap<String, Rights>, Vec<Diagnostic>> {
     let mut found = Vec::new();
     let error = |message: String| mistake(deployment, message);
@@ -120,36 +123,29 @@ fn rights(
                 // A team, or what the robot tells the operator consoles.
                 rights
                     .write
-                    .insert(topics::to_team(mission, &out.to_team, &out.key, me));
+                    .insert(topics::to_team(scope, &out.to_team, &out.key, me));
             } else if let Some(team) = team_of(&out.to_team) {
                 rights
                     .write
-                    .insert(topics::to_robot(mission, team, &out.to_team, &out.key, me));
+                    .insert(topics::to_robot(scope, team, &out.to_team, &out.key, me));
             }
         }
         if program.control.heartbeat {
-            rights.write.insert(topics::heartbeat(program));
+            rights.write.insert(topics::heartbeat(scope, program));
         }
         // The owner protocol of globally shared values: the owner tells the
         // team, a writer tells whichever teammate owns (any may, in turn).
         let ownership = program.library.as_ref().and_then(|l| l.ownership.as_ref());
         for global in ownership.map_or(&[][..], |o| &o.global) {
-            rights.write.insert(topics::to_team(
-                mission,
-                &program.team,
-                &global.value_key,
-                me,
-            ));
+            rights
+                .write
+                .insert(topics::to_team(scope, &program.team, &global.value_key, me));
             for &owner in ownership.map_or(&[][..], |o| &o.owners) {
                 let (team, robot) = &program.peers[owner];
                 if *robot != program.robot {
-                    rights.write.insert(topics::to_robot(
-                        mission,
-                        team,
-                        robot,
-                        &global.set_key,
-                        me,
-                    ));
+                    rights
+                        .write
+                        .insert(topics::to_robot(scope, team, robot, &global.set_key, me));
                 }
             }
         }
@@ -157,16 +153,14 @@ fn rights(
             let key = crate::codegen::files::sync_key(program);
             rights
                 .write
-                .insert(topics::to_team(mission, &program.team, &key, me));
+                .insert(topics::to_team(scope, &program.team, &key, me));
         }
-        rights.write.insert(topics::status(mission, &program.robot));
+        rights.write.insert(topics::status(scope, &program.robot));
         // Exactly the runtime's two subscriptions.
+        rights.read.insert(topics::team_inbox(scope, &program.team));
         rights
             .read
-            .insert(topics::team_inbox(mission, &program.team));
-        rights
-            .read
-            .insert(topics::robot_inbox(mission, &program.team, &program.robot));
+            .insert(topics::robot_inbox(scope, &program.team, &program.robot));
     }
     let operator = deployment.operator_credentials().user;
     if let Some(user) = &operator {
@@ -184,13 +178,13 @@ fn rights(
                 .filter(|i| i.from_team == "USER")
             {
                 rights.write.insert(topics::to_team(
-                    mission,
+                    scope,
                     &program.team,
                     &incoming.key,
                     topics::OPERATOR,
                 ));
                 rights.write.insert(topics::to_robot(
-                    mission,
+                    scope,
                     &program.team,
                     &program.robot,
                     &incoming.key,
@@ -198,11 +192,11 @@ fn rights(
                 ));
             }
         }
-        rights.read.insert(topics::statuses(mission));
-        rights.read.insert(topics::team_inbox(mission, "USER"));
+        rights.read.insert(topics::statuses(scope));
+        rights.read.insert(topics::team_inbox(scope, "USER"));
         // The editor's robot monitor tells a robot that stops heart-beating.
         for program in programs.iter().filter(|p| p.control.heartbeat) {
-            rights.read.insert(topics::heartbeat(program));
+            rights.read.insert(topics::heartbeat(scope, program));
         }
     }
     if !found.is_empty() {
@@ -220,7 +214,7 @@ fn acl(
 ) -> Result<String, Refusal> {
     let operator = deployment.operator_credentials().user;
     let mut acl = format!(
-        "# The ACL of mission {}, written by `semo deploy broker-config` from\n# {}.\n# Each robot's user writes only what its program sends and publishes, on\n# topics naming that robot as the sender (and its status), and reads only its\n# team's and its own topics; {}.\n",
+        "# The ACL of mission {}, written by `semo deploy broker-config` from\n# {}.\n# Each robot's user writes only what its program sends and publishes, on\n# topics naming that robot as the sender (and its status), and reads only its\n# team's and its own topics, in every run of the mission (the `+` after its\n# name); {}.\n",
         lines::comment(mission),
         lines::comment(source),
         match &operator {

@@ -468,10 +468,11 @@ fn expected_config(v: &Values, out: &Path) -> Vec<(String, String)> {
 }
 
 /// Checks the ACL as mosquitto reads it: exactly the deployment's users,
-/// each followed only by `topic read|write` lines of the mission's topics.
+/// each followed only by `topic read|write` lines of the mission's topics,
+/// in every run.
 fn check_acl(acl: &str, v: &Values) -> Result<(), String> {
     let mission = crate::deploy::topics::level(&crate::deploy::topics::mission(&v.mission_file));
-    let prefix = format!("semo/{mission}/");
+    let prefix = format!("semo/{mission}/+/");
     let mut users = BTreeSet::new();
     for (keyword, value) in as_mosquitto_reads(acl) {
         match keyword.as_str() {
@@ -551,11 +552,11 @@ fn the_broker_files_read_back_as_written() {
     .acl;
     // Each user writes only topics naming its own robot as the sender.
     assert!(
-        acl.contains("user base\ntopic write semo/pair/Rover/Base.LOCATION/Base/base\n"),
+        acl.contains("user base\ntopic write semo/pair/+/Rover/Base.LOCATION/Base/base\n"),
         "{acl}"
     );
     assert!(
-        acl.contains("user operator\ntopic write semo/pair/Base/USER.GO/USER/operator\n"),
+        acl.contains("user operator\ntopic write semo/pair/+/Base/USER.GO/USER/operator\n"),
         "{acl}"
     );
 }

@@ -15,6 +15,7 @@ use crate::live;
 use crate::monitor::Plan;
 use crate::monitor::roster::Member;
 use crate::world::World;
+use semo::deploy::topics::RunId;
 use semo::workspace::FileKind;
 use serde::Deserialize;
 use serde_json::{Value, json};
@@ -38,6 +39,9 @@ pub struct StartParams {
     pub uri: Uri,
     /// `mqtt://HOST[:PORT]`; empty or absent: the deployment's, else the default.
     pub broker: Option<String>,
+    /// The run to show (`semo::deploy::topics::RunId`); empty or absent:
+    /// the newest.
+    pub run: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -51,6 +55,7 @@ pub struct Job {
     analysis: semo::host::Analysis,
     mission: semo::diag::FileId,
     broker: Option<String>,
+    run: Option<RunId>,
     deployment: Option<PathBuf>,
 }
 
@@ -59,6 +64,10 @@ pub fn job(world: &World, params: StartParams) -> Result<Job, String> {
         .snapshot(&params.uri)
         .filter(|s| s.kind == FileKind::Mission)
         .ok_or_else(|| format!("{} is not a mission the server knows", params.uri.as_str()))?;
+    let run = match params.run.as_deref().map(str::trim) {
+        None | Some("") => None,
+        Some(run) => Some(RunId::parse(run).map_err(|why| format!("cannot monitor: {why}"))?),
+    };
     let analysis = world.analysis();
     let deployment = analysis
         .project(mission.id)
@@ -68,6 +77,7 @@ pub fn job(world: &World, params: StartParams) -> Result<Job, String> {
         analysis,
         mission: mission.id,
         broker: params.broker.filter(|b| !b.trim().is_empty()),
+        run,
         deployment,
     })
 }
@@ -117,15 +127,16 @@ pub fn plan(job: &Job) -> Result<Plan, String> {
         .map(|p| Member {
             robot: p.robot.clone(),
             team: p.team.clone(),
-            heartbeat_topic: p
+            heartbeat_key: p
                 .control
                 .heartbeat
-                .then(|| semo::deploy::topics::heartbeat(p)),
+                .then(|| semo::deploy::topics::heartbeat_key(p)),
         })
         .collect();
     Ok(Plan {
         uri: job.uri.as_str().to_string(),
         mission: semo::deploy::topics::mission(&refined.programs[0].mission),
+        run: job.run.clone(),
         broker,
         access,
         members,
@@ -151,6 +162,7 @@ fn position(path: &std::path::Path, offset: usize) -> String {
 pub fn started(plan: &Plan) -> Value {
     json!({
         "mission": plan.mission,
+        "run": plan.run.as_ref().map(|r| r.as_str()),
         "broker": plan.broker,
         "robots": plan.members.iter().map(|m| json!({ "robot": m.robot, "team": m.team })).collect::<Vec<_>>(),
     })

@@ -4,7 +4,8 @@
 //! (rumqttc), so that nothing of the server waits on the network and no
 //! lock is held while the broker is slow or away.
 //!
-//! A session subscribes to the mission's statuses and heartbeats, keeps the
+//! A session subscribes to the mission's statuses and heartbeats (of the
+//! run it is given, else of every run: it shows the newest), keeps the
 //! [`roster::Roster`] and sends its view whenever it changes (a message,
 //! the connection coming or going, a robot falling silent) through a
 //! channel to the server's task that writes notifications. It ends when its
@@ -27,6 +28,8 @@ pub struct Plan {
     pub uri: String,
     /// The mission's name in topics.
     pub mission: String,
+    /// The run to show; None: the newest (`live::RunChoice`).
+    pub run: Option<semo::deploy::topics::RunId>,
     pub broker: String,
     /// How to reach it: address, the operator's user and password and TLS
     /// configuration (from the deployment file).
@@ -123,7 +126,12 @@ async fn run(plan: Plan, mut stopped: oneshot::Receiver<()>, notify: mpsc::Unbou
             }
         }
     });
-    let mut roster = Roster::new(&plan.mission, plan.members.clone(), plan.heartbeat_ms);
+    let mut roster = Roster::new(
+        &plan.mission,
+        plan.members.clone(),
+        plan.heartbeat_ms,
+        crate::live::RunChoice::new(plan.run.clone()),
+    );
     let topics = roster.topics();
     let clock = Instant::now();
     let now = || clock.elapsed().as_millis() as i64;
@@ -136,6 +144,7 @@ async fn run(plan: Plan, mut stopped: oneshot::Receiver<()>, notify: mpsc::Unbou
         let view = json!({
             "uri": plan.uri,
             "mission": plan.mission,
+            "run": roster.run().map(|r| r.as_str()),
             "broker": plan.broker,
             "connection": match link {
                 Link::Connecting => "connecting",

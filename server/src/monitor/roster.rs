@@ -1,11 +1,13 @@
-//! The monitor's picture of a mission's robots, from what the broker
-//! delivers: every robot of the checked mission, `waiting` until its first
-//! status, then its state, mode, services and leader, and `lost` when its
-//! last will arrives or when it stops heart-beating. Pure: the time is the
-//! monitor's clock in ms, passed in, so the rules are tested without one.
+//! The monitor's picture of a mission's robots in one run, from what the
+//! broker delivers: every robot of the checked mission, `waiting` until
+//! its first status, then its state, mode, services and leader, and `lost`
+//! when its last will arrives or when it stops heart-beating. The run is
+//! the one given, else the newest heard of (`live::RunChoice`): a newer
+//! run's status starts the picture over. Pure: the time is the monitor's
+//! clock in ms, passed in, so the rules are tested without one.
 
-use crate::live::Status;
-use semo::deploy::topics;
+use crate::live::{RunChoice, Status};
+use semo::deploy::topics::{self, Scope};
 use serde_json::{Value, json};
 
 /// A robot is lost when a robot that heart-beats has not been heard from
@@ -18,9 +20,22 @@ pub const SILENT_PERIODS: i64 = 3;
 pub struct Member {
     pub robot: String,
     pub team: String,
-    /// Whether it publishes heartbeats (its team elects a leader), on
-    /// `heartbeat_topic` (`topics::heartbeat`: its own).
-    pub heartbeat_topic: Option<String>,
+    /// Whether it publishes heartbeats (its team elects a leader), with
+    /// this key (`codegen::files::alive_key`) on its own topic
+    /// (`topics::heartbeat`).
+    pub heartbeat_key: Option<String>,
+}
+
+impl Member {
+    /// Its heartbeats' topic in `scope`.
+    fn heartbeat_topic(&self, scope: &Scope) -> Option<String> {
+        let me = topics::Sender {
+            team: &self.team,
+            robot: &self.robot,
+        };
+        let key = self.heartbeat_key.as_ref()?;
+        Some(topics::to_team(scope, &self.team, key, me))
+    }
 }
 
 struct Robot {
@@ -35,54 +50,62 @@ struct Robot {
 pub struct Roster {
     /// The mission's topic name.
     mission: String,
-    status_prefix: String,
+    run: RunChoice,
     robots: Vec<Robot>,
     silent_after_ms: i64,
 }
 
 impl Roster {
-    /// `mission` is the mission's topic name (`topics::mission`);
-    /// `heartbeat_ms` the runtime's heartbeat period.
-    pub fn new(mission: &str, members: Vec<Member>, heartbeat_ms: i64) -> Roster {
+    /// `mission` is the mission's topic name (`topics::mission`); `run`
+    /// the run to show; `heartbeat_ms` the runtime's heartbeat period.
+    pub fn new(mission: &str, members: Vec<Member>, heartbeat_ms: i64, run: RunChoice) -> Roster {
         Roster {
             mission: mission.to_string(),
-            status_prefix: topics::statuses(mission).trim_end_matches('+').to_string(),
-            robots: members
-                .into_iter()
-                .map(|member| Robot {
-                    member,
-                    status: None,
-                    heard_at: None,
-                    silent: false,
-                })
-                .collect(),
+            run,
+            robots: members.into_iter().map(Robot::waiting).collect(),
             silent_after_ms: SILENT_PERIODS * heartbeat_ms,
         }
     }
 
+    /// The run shown, once known.
+    pub fn run(&self) -> Option<&topics::RunId> {
+        self.run.run()
+    }
+
     /// The topics to subscribe to: every status, and the heartbeats of the
-    /// robots whose teams elect a leader.
+    /// robots whose teams elect a leader, of the run given, else of every
+    /// run (the newest may change).
     pub fn topics(&self) -> Vec<String> {
-        let mut topics = vec![format!("{}+", self.status_prefix)];
+        let scope = self.run.scope(&self.mission);
+        let mut topics = vec![topics::statuses(&scope)];
         for robot in &self.robots {
-            if let Some(topic) = &robot.member.heartbeat_topic {
-                if !topics.contains(topic) {
-                    topics.push(topic.clone());
+            if let Some(topic) = robot.member.heartbeat_topic(&scope) {
+                if !topics.contains(&topic) {
+                    topics.push(topic);
                 }
             }
         }
         topics
     }
 
-    /// A message from the broker at time `now`; messages of robots that
-    /// are not in the mission, anything unreadable, and a payload naming
-    /// another robot or key than its topic (the broker vouches only for the
-    /// topic) are ignored.
+    /// A message from the broker at time `now`; messages of another run
+    /// than the one shown, of robots that are not in the mission, anything
+    /// unreadable, and a payload naming another robot or key than its
+    /// topic (the broker vouches only for the topic) are ignored. A status
+    /// of a newer run (when none is given) starts the picture over.
     pub fn message(&mut self, topic: &str, payload: &[u8], now: i64) {
-        if let Some(level) = topic.strip_prefix(&self.status_prefix) {
-            let Some(status) = Status::decode(level, payload) else {
+        if let Some((run, level)) = crate::live::status_topic(&self.mission, topic) {
+            let Some(status) = Status::decode(&level, payload) else {
                 return;
             };
+            if self.run.heard(&run, status.started) {
+                for robot in &mut self.robots {
+                    *robot = Robot::waiting(robot.member.clone());
+                }
+            }
+            if self.run.run() != Some(&run) {
+                return;
+            }
             if let Some(robot) = self
                 .robots
                 .iter_mut()
@@ -93,15 +116,18 @@ impl Roster {
             }
             return;
         }
+        let Some(run) = self.run.run() else {
+            return;
+        };
+        let scope = Scope::run(&self.mission, run);
         let Some(robot) = self
             .robots
             .iter_mut()
-            .find(|r| r.member.heartbeat_topic.as_deref() == Some(topic))
+            .find(|r| r.member.heartbeat_topic(&scope).as_deref() == Some(topic))
         else {
             return;
         };
-        if crate::live::datagram_fields(topic, &self.mission, &robot.member.team, payload).is_some()
-        {
+        if crate::live::datagram_fields(topic, &scope, &robot.member.team, payload).is_some() {
             robot.heard_at = Some(now);
             robot.silent = false;
         }
@@ -128,6 +154,15 @@ impl Roster {
 }
 
 impl Robot {
+    fn waiting(member: Member) -> Robot {
+        Robot {
+            member,
+            status: None,
+            heard_at: None,
+            silent: false,
+        }
+    }
+
     fn heard(&mut self, now: i64) {
         if self.heard_at.is_some() {
             self.heard_at = Some(now);
@@ -185,30 +220,36 @@ mod tests {
     use super::*;
 
     fn alive(robot: &str) -> String {
-        format!("semo/m/Team/Team.__alive/Team/{robot}")
+        format!("semo/m/r1/Team/Team.__alive/Team/{robot}")
     }
 
     fn roster() -> Roster {
+        roster_of(None)
+    }
+
+    fn roster_of(run: Option<&str>) -> Roster {
+        let run = run.map(|r| topics::RunId::parse(r).unwrap());
         Roster::new(
             "m",
             vec![
                 Member {
                     robot: "a".into(),
                     team: "Team".into(),
-                    heartbeat_topic: Some(alive("a")),
+                    heartbeat_key: Some("Team.__alive".into()),
                 },
                 Member {
                     robot: "b".into(),
                     team: "Team".into(),
-                    heartbeat_topic: Some(alive("b")),
+                    heartbeat_key: Some("Team.__alive".into()),
                 },
                 Member {
                     robot: "c".into(),
                     team: "Solo".into(),
-                    heartbeat_topic: None,
+                    heartbeat_key: None,
                 },
             ],
             200,
+            RunChoice::new(run),
         )
     }
 
@@ -238,15 +279,22 @@ mod tests {
         })
     }
 
-    const RUNNING_A: &[u8] = br#"{"t":1,"robot":"a","event":"status","state":"running","mode":"M","leader":"a","services":"P=S"}"#;
+    const RUNNING_A: &[u8] = br#"{"t":1,"robot":"a","event":"status","state":"running","started":"1000","mode":"M","leader":"a","services":"P=S"}"#;
 
     #[test]
     fn every_robot_waits_until_its_status_comes() {
         let mut r = roster();
-        assert_eq!(r.topics(), ["semo/m/status/+", &alive("a"), &alive("b")]);
+        assert_eq!(
+            r.topics(),
+            [
+                "semo/m/+/status/+",
+                "semo/m/+/Team/Team.__alive/Team/a",
+                "semo/m/+/Team/Team.__alive/Team/b"
+            ]
+        );
         assert_eq!(states(&r), ["a=waiting", "b=waiting", "c=waiting"]);
-        r.message("semo/m/status/a", RUNNING_A, 0);
-        r.message("semo/m/status/stranger", RUNNING_A, 0);
+        r.message("semo/m/r1/status/a", RUNNING_A, 0);
+        r.message("semo/m/r1/status/stranger", RUNNING_A, 0);
         assert_eq!(states(&r), ["a=running", "b=waiting", "c=waiting"]);
         let a = &r.view()[0];
         assert_eq!(a["mode"], "M");
@@ -257,9 +305,9 @@ mod tests {
     #[test]
     fn the_last_will_makes_a_robot_lost() {
         let mut r = roster();
-        r.message("semo/m/status/c", RUNNING_A, 0);
+        r.message("semo/m/r1/status/c", RUNNING_A, 0);
         r.message(
-            "semo/m/status/c",
+            "semo/m/r1/status/c",
             br#"{"robot":"c","event":"status","state":"lost"}"#,
             5,
         );
@@ -273,7 +321,7 @@ mod tests {
     #[test]
     fn a_running_robot_silent_for_three_heartbeats_is_lost_until_heard_again() {
         let mut r = roster();
-        r.message("semo/m/status/a", RUNNING_A, 0);
+        r.message("semo/m/r1/status/a", RUNNING_A, 0);
         // Without any heartbeat heard its silence means nothing (a broker
         // whose ACL hides the heartbeats from the monitor).
         r.tick(10_000);
@@ -288,19 +336,62 @@ mod tests {
         assert_eq!(states(&r)[0], "a=running");
         // A stopped robot stops heart-beating: it is not lost.
         r.message(
-            "semo/m/status/a",
+            "semo/m/r1/status/a",
             br#"{"robot":"a","state":"stopped","mode":"M"}"#,
             10_800,
         );
         r.tick(20_000);
         assert_eq!(states(&r)[0], "a=stopped");
         // A heartbeat on another team's topic is not this robot's.
-        r.message("semo/m/Other/Other.__alive/Team/b", &heartbeat("b"), 20_000);
+        r.message(
+            "semo/m/r1/Other/Other.__alive/Team/b",
+            &heartbeat("b"),
+            20_000,
+        );
         assert_eq!(r.robots[1].heard_at, None);
         // Nor is one on its topic that names another robot: whoever may
         // write a's topic cannot keep b alive.
         r.message(&alive("a"), &heartbeat("b"), 20_000);
         assert_eq!(r.robots[1].heard_at, None);
         assert_eq!(r.robots[0].heard_at, Some(10_800));
+    }
+
+    #[test]
+    fn a_newer_run_starts_the_picture_over_and_an_older_one_is_ignored() {
+        let mut r = roster();
+        r.message("semo/m/r1/status/a", RUNNING_A, 0);
+        r.message(&alive("a"), &heartbeat("a"), 0);
+        assert_eq!(r.run().map(|r| r.as_str()), Some("r1"));
+        let newer = br#"{"robot":"b","state":"running","started":"2000","mode":"N"}"#;
+        r.message("semo/m/r2/status/b", newer, 10);
+        assert_eq!(r.run().map(|r| r.as_str()), Some("r2"));
+        assert_eq!(states(&r), ["a=waiting", "b=running", "c=waiting"]);
+        assert_eq!(r.robots[0].heard_at, None);
+        // The older run's status and heartbeats no longer count.
+        r.message("semo/m/r1/status/c", RUNNING_A, 20);
+        r.message(&alive("a"), &heartbeat("a"), 20);
+        assert_eq!(states(&r), ["a=waiting", "b=running", "c=waiting"]);
+        assert_eq!(r.robots[0].heard_at, None);
+        // A topic whose run level no run can have is nobody's.
+        r.message("semo/m/+/status/a", RUNNING_A, 30);
+        assert_eq!(states(&r)[0], "a=waiting");
+    }
+
+    #[test]
+    fn a_given_run_is_the_only_one_shown() {
+        let mut r = roster_of(Some("r1"));
+        assert_eq!(
+            r.topics(),
+            [
+                "semo/m/r1/status/+",
+                "semo/m/r1/Team/Team.__alive/Team/a",
+                "semo/m/r1/Team/Team.__alive/Team/b"
+            ]
+        );
+        let newer = br#"{"robot":"a","state":"running","started":"9000","mode":"N"}"#;
+        r.message("semo/m/r2/status/a", newer, 0);
+        assert_eq!(states(&r)[0], "a=waiting");
+        r.message("semo/m/r1/status/a", RUNNING_A, 0);
+        assert_eq!(states(&r)[0], "a=running");
     }
 }

@@ -236,7 +236,8 @@ void semo__board_exit(int status);
 
 #ifdef SEMO_MQTT
 /* Whether the broker still held this robot's session at the first
- * connection (CONNACK's session-present flag): the robot was restarted. */
+ * connection (CONNACK's session-present flag): the robot was restarted in
+ * its run (the default client id names the run). */
 bool semo__mqtt_session_present(void);
 #endif
 

@@ -2,11 +2,14 @@
  * -DSEMO_MQTT (the Makefile's TRANSPORT=mqtt, which also links -lmosquitto);
  * without it this file is empty.
  *
- * Topics name the receiver and the sender: a message to a team goes to
- * `semo/<mission>/<team>/<key>/<from team>/<from robot>`, one to a single
- * robot to `semo/<mission>/<team>/<robot>/<key>/<from team>/<from robot>`
- * (six and seven levels: a team's subscription never matches a robot's
- * topic); every robot subscribes to both levels of its own team and robot.
+ * Every topic starts with the run's scope, `semo/<mission>/<run>` (`--run`,
+ * else $SEMO_RUN, else `default`): a run never hears another, not even the
+ * values an earlier one left retained on the broker. Topics then name the
+ * receiver and the sender: a message to a team goes to
+ * `<scope>/<team>/<key>/<from team>/<from robot>`, one to a single robot to
+ * `<scope>/<team>/<robot>/<key>/<from team>/<from robot>` (seven and eight
+ * levels: a team's subscription never matches a robot's topic); every robot
+ * subscribes to both levels of its own team and robot.
  * The payload is the runtime's datagram unchanged. Who sent a message is
  * what the broker vouches for, never what the payload says: the broker's
  * ACL (`semo deploy broker-config`) lets each user write only topics whose
@@ -17,9 +20,12 @@
  * operator console and the editor's monitor.
  *
  * `send` messages travel at QoS 1 and the session is persistent
- * (clean_session false, client id `semo-<mission>-<robot>`), so a robot
- * that was away gets what was sent meanwhile; `publish` messages at QoS 0,
- * retained, so a robot that joins gets the latest value of each publisher.
+ * (clean_session false, client id `semo-<mission>-<run>-<robot>`: one
+ * session per run), so a robot that was away gets what was sent meanwhile;
+ * `publish` messages at QoS 0, retained, so a robot that joins gets the
+ * latest value of each publisher. A session kept over runs (a client id
+ * given by the deployment) may bring messages of an earlier run: they are
+ * another run's, and dropped unseen.
  * TCP_NODELAY is set: without it a QoS 1 round trip on loopback waits for
  * Nagle's algorithm (tens of ms instead of 0.1 ms).
  */
@@ -41,8 +47,9 @@
  * spare byte: a longer payload arrives truncated and is rejected as
  * malformed by the runtime. */
 #define MQTT_PAYLOAD_MAX (SEMO__DATAGRAM_MAX + 1)
-/* Room for the longest topic: "semo", the mission (63 bytes) and five
- * levels of at most 255 bytes (datagram fields), each after its `/`. */
+/* Room for the longest topic: "semo", the mission (63 bytes), the run (63)
+ * and five levels of at most 255 bytes (datagram fields), each after its
+ * `/`. */
 #define MQTT_TOPIC_MAX 1600
 #define MQTT_KEEPALIVE_S 10
 /* How long open waits for the broker's CONNACK and SUBACK, and close for
@@ -58,6 +65,9 @@ typedef struct {
 static struct mosquitto *g_mosq;
 static const semo_program_desc *g_program;
 static char g_mission[64];
+static char g_run[SEMO_RUN_MAX];
+/* `semo/<mission>/<run>/`: where every topic of this run starts. */
+static char g_run_prefix[MQTT_TOPIC_MAX];
 static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t g_changed; /* monotonic clock; every state change below */
 static mqtt_payload g_queue[MQTT_QUEUE];
@@ -115,15 +125,22 @@ static void mission_name(const char *mission)
         *dot = '\0';
 }
 
-/* semo/<mission>/<team>[/<robot>]/<key>/<from team>/<from robot>; without
- * a key, our subscription to every key from every sender. False when the
- * topic does not fit (it never is cut short: a cut topic could name
- * another sender). */
-static bool topic_of(char *topic, size_t cap, const char *team, const char *robot, const char *key,
-                     const char *from_team, const char *from_robot)
+/* `semo/<mission>/<run>`: the run's scope, where every topic starts. */
+static void scope_of(char *topic, size_t cap)
 {
     snprintf(topic, cap, "semo");
     append_level(topic, cap, g_mission);
+    append_level(topic, cap, g_run);
+}
+
+/* <scope>/<team>[/<robot>]/<key>/<from team>/<from robot>; without a key,
+ * our subscription to every key from every sender. False when the topic
+ * does not fit (it never is cut short: a cut topic could name another
+ * sender). */
+static bool topic_of(char *topic, size_t cap, const char *team, const char *robot, const char *key,
+                     const char *from_team, const char *from_robot)
+{
+    scope_of(topic, cap);
     append_level(topic, cap, team);
     if (robot)
         append_level(topic, cap, robot);
@@ -259,6 +276,9 @@ static void on_message(struct mosquitto *mosq, void *obj, const struct mosquitto
 {
     (void)mosq;
     (void)obj;
+    /* Another run's message (a session kept over runs) is none of ours. */
+    if (strncmp(msg->topic, g_run_prefix, strlen(g_run_prefix)) != 0)
+        return;
     const semo_peer *self = &g_program->peers[g_program->self];
     const unsigned char *data = msg->payload;
     size_t len = msg->payloadlen > 0 ? (size_t)msg->payloadlen : 0;
@@ -347,6 +367,10 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
         return -1;
     g_program = program;
     mission_name(program->mission);
+    /* Checked by the options (`parse_run`): a topic level as it is. */
+    snprintf(g_run, sizeof g_run, "%s", config->run && *config->run ? config->run : SEMO_RUN_DEFAULT);
+    scope_of(g_run_prefix, sizeof g_run_prefix);
+    snprintf(g_run_prefix + strlen(g_run_prefix), sizeof g_run_prefix - strlen(g_run_prefix), "/");
     g_head = g_count = 0;
     g_interrupted = g_subscribed = false;
     g_refused = 0;
@@ -365,7 +389,7 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     if (config->client_id)
         snprintf(client_id, sizeof client_id, "%s", config->client_id);
     else
-        snprintf(client_id, sizeof client_id, "semo-%s-%s", g_mission, program->peers[program->self].robot);
+        snprintf(client_id, sizeof client_id, "semo-%s-%s-%s", g_mission, g_run, program->peers[program->self].robot);
     g_mosq = mosquitto_new(client_id, false, NULL);
     if (!g_mosq) {
         mosquitto_lib_cleanup();
@@ -381,8 +405,9 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     /* If we vanish without disconnecting, the broker says so on our status. */
     char will_topic[MQTT_TOPIC_MAX], will[MQTT_TOPIC_MAX];
     status_topic(will_topic, sizeof will_topic);
-    int will_len = snprintf(will, sizeof will, "{\"robot\":\"%s\",\"event\":\"status\",\"state\":\"lost\"}",
-                            program->peers[program->self].robot);
+    int will_len = snprintf(will, sizeof will,
+                            "{\"robot\":\"%s\",\"event\":\"status\",\"state\":\"lost\",\"started\":\"%lld\"}",
+                            program->peers[program->self].robot, config->started_unix_ms);
     mosquitto_will_set(g_mosq, will_topic, will_len, will, 1, true);
     mosquitto_connect_with_flags_callback_set(g_mosq, on_connect);
     mosquitto_subscribe_callback_set(g_mosq, on_subscribe);
@@ -548,11 +573,10 @@ static int mqtt_recv(void *data, size_t cap, int timeout_ms)
     return n;
 }
 
-/* semo/<mission>/status/<robot>. */
+/* <scope>/status/<robot>. */
 static void status_topic(char *topic, size_t cap)
 {
-    snprintf(topic, cap, "semo");
-    append_level(topic, cap, g_mission);
+    scope_of(topic, cap);
     append_level(topic, cap, "status");
     append_level(topic, cap, g_program->peers[g_program->self].robot);
 }

@@ -791,12 +791,16 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
  * something else): its state (running, finished, stopped; the broker's last
  * will says lost), mode, leader and the service each plan runs. Published
  * on every change through the transport's `status` (MQTT: retained on
- * semo/<mission>/status/<robot>) as one JSON line of the trace's form:
- * {"t":..,"robot":..,"event":"status","state":..,"mode":..,"leader":..,
- * "services":"Plan=Service,...","battery":"87"} (`battery` only when the
- * robot knows its level). */
+ * semo/<mission>/<run>/status/<robot>) as one JSON line of the trace's form:
+ * {"t":..,"robot":..,"event":"status","state":..,"started":"<Unix ms>",
+ * "mode":..,"leader":..,"services":"Plan=Service,...","battery":"87"}
+ * (`battery` only when the robot knows its level). */
 #define STATUS_PLANS 16
 #define STATUS_NAME 64
+/* Mission time 0 on the wall clock (Unix ms): the robot's status says it,
+ * so that a console can tell the newest run. */
+static int64_t g_started_unix_ms;
+
 static struct {
     pthread_mutex_t lock;
     char state[16];
@@ -910,11 +914,12 @@ static void observe_status(const char *event, va_list args)
                 at += (size_t)snprintf(services + at, sizeof services - at, "%s%s=%s", at ? "," : "",
                                        g_status.running[i].plan, g_status.running[i].service);
         status_buffer line = {.len = 0};
-        char battery[24];
+        char battery[24], started[24];
         semo__format_i64(battery, g_status.battery);
+        semo__format_i64(started, g_started_unix_ms);
         /* Without a level the list ends before `battery`: the field is absent. */
-        status_line(&line, "status", "state", g_status.state, "mode", g_status.mode, "leader", g_status.leader,
-                    "services", services, g_status.battery_known ? "battery" : NULL, battery, NULL);
+        status_line(&line, "status", "state", g_status.state, "started", started, "mode", g_status.mode, "leader",
+                    g_status.leader, "services", services, g_status.battery_known ? "battery" : NULL, battery, NULL);
         if (line.len > 0 && line.text[line.len - 1] == '\n')
             line.text[--line.len] = '\0'; /* one JSON object, not a line */
         transport->status(line.text, line.len);
@@ -999,6 +1004,7 @@ typedef struct {
     char broker_host[256];
     int broker_port;
     bool broker_tls;
+    char run[SEMO_RUN_MAX]; /* --run, $SEMO_RUN: the run the MQTT topics are of */
     semo_transport_config identity; /* mqtt: who the robot is at the broker */
     long port_base;
     int64_t duration_ms;
@@ -1018,8 +1024,8 @@ typedef struct {
 static void usage(FILE *f, const char *prog)
 {
     fprintf(f,
-            "usage: %s [--trace FILE] [--transport udp|mqtt] [--port-base N] [--broker URL] [--duration MS]"
-            " [--start-at UNIX_MS]"
+            "usage: %s [--trace FILE] [--transport udp|mqtt] [--port-base N] [--broker URL] [--run ID]"
+            " [--duration MS] [--start-at UNIX_MS]"
 #ifdef SEMO_SIM
             " [--scenario FILE] [--time-scale X] [--lockstep PATH]"
 #endif
@@ -1033,6 +1039,9 @@ static void usage(FILE *f, const char *prog)
             "                    (default " DEFAULT_BROKER ", or $SEMO_BROKER); who the robot is there:\n"
             "                    $SEMO_MQTT_CLIENT_ID, $SEMO_MQTT_USER, $SEMO_MQTT_PASSWORD_FILE, $SEMO_MQTT_CA,\n"
             "                    $SEMO_MQTT_CERT, $SEMO_MQTT_KEY (defaults from semo build --deploy)\n"
+            "  --run ID          mqtt: the run this robot takes part in (default \"" SEMO_RUN_DEFAULT "\", or $SEMO_RUN):\n"
+            "                    its topics are semo/<mission>/ID/..., so that a run hears nothing of\n"
+            "                    another; every robot of a run is given the same ID\n"
             "  --duration MS     stop after MS mission milliseconds (0: run until stopped)\n"
             "  --start-at T      mission time 0 is the wall-clock instant T (ms since 1970, or $SEMO_START_AT):\n"
             "                    robots given the same T start together; a T passed continues its mission time\n"
@@ -1103,6 +1112,33 @@ static bool parse_broker(const char *prog, const char *url, options *o)
     o->broker_host[host_len] = '\0';
     o->broker_port = (int)port;
     o->broker_tls = tls;
+    return true;
+}
+
+static bool ascii_alnum(char c)
+{
+    return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z');
+}
+
+/* A run id, checked as `semo::deploy::topics::RunId::parse` does: 1 to
+ * SEMO_RUN_MAX - 1 ASCII letters, digits, `-`, `_` and `.`, starting with a
+ * letter or a digit. It becomes a topic level and part of the client id as
+ * it is, so nothing MQTT gives a meaning to (`/`, `+`, `#`) gets in, nor a
+ * name a file system does (`.`, `..`). Copied into `o->run`. */
+static bool parse_run(const char *prog, const char *from, const char *id, options *o)
+{
+    size_t n = strlen(id);
+    bool fits = n > 0 && n < sizeof o->run && ascii_alnum(id[0]);
+    for (size_t i = 0; fits && i < n; i++)
+        fits = ascii_alnum(id[i]) || id[i] == '-' || id[i] == '_' || id[i] == '.';
+    if (!fits) {
+        fprintf(stderr,
+                "%s: %s must be 1 to %d letters, digits, '-', '_' and '.', starting with a letter or a digit, not "
+                "\"%s\"\n",
+                prog, from, SEMO_RUN_MAX - 1, id);
+        return false;
+    }
+    memcpy(o->run, id, n + 1);
     return true;
 }
 
@@ -1214,6 +1250,9 @@ static int parse_options(int argc, char **argv, options *o)
     env = getenv("SEMO_BROKER");
     if (!parse_broker(prog, env && *env ? env : DEFAULT_BROKER, o))
         return 2;
+    env = getenv("SEMO_RUN");
+    if (!parse_run(prog, "SEMO_RUN", env && *env ? env : SEMO_RUN_DEFAULT, o))
+        return 2;
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         if (strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0) {
@@ -1222,7 +1261,7 @@ static int parse_options(int argc, char **argv, options *o)
         }
         static const char *const names[] = {"--trace",      "--port-base", "--duration", "--scenario",
                                             "--time-scale", "--transport", "--broker",  "--start-at",
-                                            "--lockstep"};
+                                            "--lockstep",   "--run"};
         size_t which = sizeof names / sizeof names[0];
         const char *value = NULL;
         for (size_t k = 0; k < sizeof names / sizeof names[0]; k++) {
@@ -1298,6 +1337,10 @@ static int parse_options(int argc, char **argv, options *o)
             break;
         case 8:
             o->lockstep = value;
+            break;
+        case 9:
+            if (!parse_run(prog, "--run", value, o))
+                return 2;
             break;
         }
     }
@@ -1474,10 +1517,11 @@ bool semo__start_thread(pthread_t *thread, void *(*body)(void *), void *arg)
 static void start_clock(long start_at_ms)
 {
     clock_gettime(CLOCK_MONOTONIC, &g_t0);
-    if (start_at_ms <= 0)
-        return;
     struct timespec real;
     clock_gettime(CLOCK_REALTIME, &real);
+    g_started_unix_ms = start_at_ms > 0 ? start_at_ms : (int64_t)real.tv_sec * 1000 + real.tv_nsec / 1000000;
+    if (start_at_ms <= 0)
+        return;
     long long ahead_ns = ((long long)start_at_ms - (long long)real.tv_sec * 1000LL) * 1000000LL - real.tv_nsec;
     long long t0_ns = (long long)g_t0.tv_nsec + ahead_ns % 1000000000LL;
     g_t0.tv_sec += (time_t)(ahead_ns / 1000000000LL) + (time_t)(t0_ns / 1000000000LL);
@@ -1525,6 +1569,8 @@ static int run(const options *o)
         net.port_base = o->port_base;
         net.broker_host = o->broker_host;
         net.broker_port = o->broker_port;
+        net.run = o->run;
+        net.started_unix_ms = g_started_unix_ms;
         net.udp_key = o->udp_key;
         net.udp_key_len = o->udp_key_len;
         if (o->transport->open(p, &net) != 0) {

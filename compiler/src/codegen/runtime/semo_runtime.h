@@ -341,7 +341,9 @@ typedef struct {
     const char *broker_host; /* mqtt */
     int broker_port;
     bool broker_tls;         /* mqtts:// */
-    const char *client_id;   /* default semo-<mission>-<robot> */
+    const char *run;         /* mqtt: the run's id (`--run`), a checked topic level */
+    long long started_unix_ms; /* mqtt: mission time 0 on the wall clock, for the last will */
+    const char *client_id;   /* default semo-<mission>-<run>-<robot> */
     const char *user;
     const char *password_file; /* its first line is the password */
     const char *ca;            /* TLS: the CA that signed the broker's certificate */
@@ -355,6 +357,13 @@ typedef struct {
 
 /* The longest run key (bytes; a longer HMAC key would be hashed first). */
 #define SEMO_UDP_KEY_MAX 64
+
+/* Room for a run id (`--run`, `$SEMO_RUN`) and its NUL: 1 to 63 ASCII
+ * letters, digits, `-`, `_` and `.`, starting with a letter or a digit
+ * (`semo::deploy::topics::RunId`). */
+#define SEMO_RUN_MAX 64
+/* The run of a program given none. */
+#define SEMO_RUN_DEFAULT "default"
 
 /* What recv returns for a message whose sender the transport does not
  * vouch for (MQTT: not its topic's; UDP with a run key: not signed with

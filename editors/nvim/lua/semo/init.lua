@@ -211,7 +211,8 @@ end
 function M.monitor_table(view)
   local error = present(view.error)
   local lines = {
-    string.format('%s on %s: %s%s', view.mission, view.broker, view.connection,
+    string.format('%s%s on %s: %s%s', view.mission,
+      present(view.run) and (' (run ' .. view.run .. ')') or '', view.broker, view.connection,
       error and (' (' .. error .. ')') or ''),
   }
   for _, robot in ipairs(view.robots) do
