@@ -1324,22 +1324,24 @@ fn a_second_run_on_the_same_broker_hears_nothing_of_the_first() {
     let Some(mut fleet) = Fleet::start("mqtt-two-runs") else {
         return;
     };
-    let runs: [(i64, &[&str], &[(&str, &str)]); 2] = [
-        (1, &["--run", "first"], &[]),
-        (2, &[], &[("SEMO_RUN", "second")]),
-    ];
     let folders = build_two_runs(&fleet);
-    for (n, args, env) in runs {
+    for (n, run) in [(1, "first"), (2, "second")] {
         let scenario = two_runs_scenario(&fleet, n);
         // Started together, the worker's subscription stands before the
         // boss's first publication.
         let (_, start_at) = support::robots::start_barrier(folders.len());
         let start_at = start_at.to_string();
-        let args = [args, &["--start-at", &start_at]].concat();
+        let mut args = vec!["--start-at", start_at.as_str()];
+        let mut env = Vec::new();
+        if n == 1 {
+            args.extend(["--run", run]);
+        } else {
+            env.push(("SEMO_RUN", run));
+        }
         let tag = format!("run{n}");
         let started: Vec<Started> = folders
             .iter()
-            .map(|folder| fleet.spawn_with(folder, &scenario, &tag, &args, env))
+            .map(|folder| fleet.spawn_with(folder, &scenario, &tag, &args, &env))
             .collect();
         let traces: BTreeMap<String, Vec<Event>> = started
             .iter()
