@@ -1499,6 +1499,85 @@ fn operator_console_drives_scouting_to_finish(name: &str, tls: bool) {
     );
 }
 
+/// `semo operator` on scouting with `args`, `input` on its standard input
+/// (then its end): its exit code, standard output and standard error.
+fn operator_with(args: &[&str], input: &str) -> (Option<i32>, String, String) {
+    let mut console = Command::new(env!("CARGO_BIN_EXE_semo"))
+        .arg("operator")
+        .arg(examples().join("scouting/scouting.mission"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("semo operator starts");
+    use std::io::Write;
+    let mut stdin = console.stdin.take().unwrap();
+    // A console refused at once has closed its input already.
+    let _ = stdin.write_all(input.as_bytes());
+    drop(stdin);
+    let out = console.wait_with_output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// The console commands one run: a run id that is not one is refused at
+/// once; without one, a command has nowhere to go until a robot's status
+/// names the newest run; given one, the command goes to that run's topic.
+#[test]
+fn the_operator_console_commands_one_run() {
+    let (code, _, stderr) = operator_with(&["--run", "a/b"], "");
+    assert_eq!(code, Some(2), "{stderr}");
+    assert!(
+        stderr.contains("--run: a run id is 1 to 63 letters"),
+        "{stderr}"
+    );
+    let Some(fleet) = Fleet::start("mqtt-operator-run") else {
+        return;
+    };
+    let url = fleet.url();
+    let (code, _, stderr) = operator_with(&["--broker", &url], "RC_CMD RETURN_MODE\n");
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("no run of mission scouting is known yet"),
+        "{stderr}"
+    );
+    // A persistent session on run r1's command topic keeps what comes.
+    let topic = topics::to_team(
+        &scouting_run("r1"),
+        "MasterTeam",
+        "USER.RC_CMD",
+        topics::OPERATOR,
+    );
+    let session = |args: &[&str]| {
+        Command::new("mosquitto_sub")
+            .args(["-h", "127.0.0.1", "-p", &fleet.port.to_string()])
+            .args(["-q", "1", "-c", "-i", "run-r1-listener", "-t", &topic])
+            .args(args)
+            .output()
+            .expect("mosquitto_sub runs (Debian mosquitto-clients)")
+    };
+    assert!(session(&["-E"]).status.success());
+    let (code, stdout, stderr) =
+        operator_with(&["--broker", &url, "--run", "r1"], "RC_CMD RETURN_MODE\n");
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.contains(", run r1;"), "{stdout}");
+    assert!(
+        stdout.contains("sent USER.RC_CMD = RETURN_MODE"),
+        "{stdout}"
+    );
+    let kept = session(&["-C", "1", "-W", "10"]);
+    let datagram = semo_server::live::operator_datagram("USER.RC_CMD", "RETURN_MODE");
+    assert_eq!(
+        kept.stdout.strip_suffix(b"\n"),
+        Some(&datagram[..]),
+        "{kept:?}"
+    );
+}
+
 /// The `semo/monitor` notification of the server behind `client` whose
 /// robots satisfy `wanted`; one that never comes fails the test.
 async fn monitor_view(

@@ -205,8 +205,9 @@ void semo_firing_continues(void);
  * later for a robot restarted into a mission under way (`--start-at` in the
  * past). Leader elections use it: a restarted robot listens first. */
 int64_t semo_joined_ms(void);
-/* Whether the transport found this robot's session from an earlier run (the
- * MQTT broker still held it: the robot was restarted); false on UDP. */
+/* Whether the transport found this robot's session from an earlier start in
+ * its run (the MQTT broker still held it, under the client id that names the
+ * run: the robot was restarted); false on UDP. */
 bool semo_session_resumed(void);
 
 /* Ends the program (from any task). */
