@@ -243,7 +243,16 @@ pub fn build(program: &RobotProgram) -> TaskGraph {
             group: named(&machine.subscribed[g]),
         });
     }
-    tasks.insert(0, control);
+    // The control task comes after every task that feeds it and before
+    // the sender it feeds: in lock-step the threads of one instant take
+    // turns in this order, so a firing sees every sensor sample, call end
+    // and message of its instant (as the simulator's firing does), and its
+    // sends leave in the same instant.
+    tasks.push(control);
+    if let Some(at) = tasks.iter().position(|t| t.name.name == COMM_SEND) {
+        let sender = tasks.remove(at);
+        tasks.push(sender);
+    }
     TaskGraph {
         name: program.robot.clone(),
         file: program.graph.file,

@@ -297,15 +297,17 @@ fn the_task_graph_has_sensor_service_and_communication_tasks() {
     let programs = programs(&shared("scouting/scouting.mission"), &[]);
     assert_eq!(
         task_names(program(&programs, "ti")),
+        // The control task after the tasks that feed it, before the one
+        // it feeds (in lock-step, the order of one instant's turns).
         [
-            "ControlTask",
             "color",
             "odometry",
             "remote_control",
             "search",
             "wheel",
-            "CommSend",
-            "CommReceive"
+            "CommReceive",
+            "ControlTask",
+            "CommSend"
         ]
     );
     let ti = program(&programs, "ti");
