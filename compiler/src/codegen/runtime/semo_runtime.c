@@ -479,13 +479,25 @@ void semo_wake(const char *task_name)
     wake_task(find_task(task_name));
 }
 
+/* The first instant at or after `at` of the grid of `period_ms` that
+ * starts at `first` (INT64_MAX stays: no time). */
+static int64_t on_grid(int64_t at, int64_t first, int64_t period_ms)
+{
+    if (at == INT64_MAX || at <= first || period_ms <= 0)
+        return at;
+    int64_t periods = (at - first) / period_ms + ((at - first) % period_ms != 0);
+    if (periods > (INT64_MAX - first) / period_ms)
+        return INT64_MAX;
+    return first + periods * period_ms;
+}
+
 /* Time- and data-driven tasks start running; control-driven ones wait
  * for the control task. All of them obey UFControl_*. */
 static void *task_thread(void *arg)
 {
     task *t = arg;
     const semo_task_desc *d = t->desc;
-    int64_t next_release = 0;
+    int64_t next_release = 0, first_release = -1;
     g_current = t;
     pthread_mutex_lock(&t->lock);
     while (semo_running()) {
@@ -506,17 +518,24 @@ static void *task_thread(void *arg)
         }
         if (d->trigger == SEMO_TRIGGER_TIME) {
             int64_t now = semo_now_ms();
+            if (first_release < 0)
+                first_release = now;
             /* The period is the shortest gap; a task that gave a hint sleeps
              * until it unless something it may wait for happens first. */
             int64_t due = next_release;
             if (t->hinted && !t->woken && t->hint_ms > due)
                 due = t->hint_ms;
+            /* Firings keep to the period's grid from the first one: a task
+             * woken or due between two grid points fires at the next (as
+             * the simulator's control task fires every period from its
+             * start, and only then). */
+            due = on_grid(due > now ? due : now, first_release, d->period_ms);
             if (now < due) {
                 /* Woken early by a state change, an event or the end of the program. */
                 wait_until(&t->changed, &t->lock, due == INT64_MAX ? -1 : due);
                 continue;
             }
-            next_release = now + d->period_ms;
+            next_release = on_grid(now + 1, first_release, d->period_ms);
             t->hinted = t->woken = false;
         }
         pthread_mutex_unlock(&t->lock);
