@@ -993,9 +993,11 @@ static void *late_thread(void *arg)
     (void)arg;
     pthread_mutex_lock(&g_late.lock);
     while (!g_late.stopping) {
+        /* The earliest due; of equals the one sent first (the queue is
+         * newest first), so that delayed messages keep their order. */
         late_datagram **first = NULL;
         for (late_datagram **d = &g_late.queue; *d; d = &(*d)->next)
-            if (!first || (*d)->due < (*first)->due)
+            if (!first || (*d)->due <= (*first)->due)
                 first = d;
         if (!first) {
             semo__cond_wait_until(&g_late.changed, &g_late.lock, -1);
