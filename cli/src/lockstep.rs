@@ -62,6 +62,9 @@ pub fn run(run: &Run<'_>) -> Result<Vec<String>, String> {
         for incarnation in 0..coordinator.incarnations[peer] {
             let path = trace_path(run.work, robot, incarnation);
             text.push_str(&std::fs::read_to_string(&path).unwrap_or_default());
+            if let Some(faults) = coordinator.faults_after[peer].get(&incarnation) {
+                text.push_str(faults);
+            }
         }
         traces.push(text);
     }
@@ -102,6 +105,10 @@ struct Coordinator<'r, 'a> {
     /// (arrival, sender, sequence) → (receiver, datagram): the delivery order.
     in_flight: BTreeMap<(i64, usize, u64), (usize, Vec<u8>)>,
     sent: u64,
+    /// Per peer, by incarnation: the trace lines of the faults done to it
+    /// after that incarnation's own lines (a killed process writes nothing
+    /// more; the simulator traces the same `fault` events).
+    faults_after: Vec<BTreeMap<u32, String>>,
 }
 
 impl<'r, 'a> Coordinator<'r, 'a> {
@@ -117,6 +124,7 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             now: 0,
             in_flight: BTreeMap::new(),
             sent: 0,
+            faults_after: vec![BTreeMap::new(); run.robots.len()],
         }
     }
 
@@ -149,12 +157,19 @@ impl<'r, 'a> Coordinator<'r, 'a> {
                     break;
                 }
                 faults.next();
+                // As the simulator: a kill of a robot that is not running
+                // and a restart of one that is are no faults at all.
+                let running = self.live[peer].is_some();
                 match fault {
-                    ProcessFault::Kill => self.kill(peer),
-                    ProcessFault::Restart => {
+                    ProcessFault::Kill if running => {
+                        self.trace_fault(peer, "kill");
                         self.kill(peer);
+                    }
+                    ProcessFault::Restart if !running => {
+                        self.trace_fault(peer, "restart");
                         self.start(peer)?;
                     }
+                    ProcessFault::Kill | ProcessFault::Restart => {}
                 }
             }
             self.deliver_due()?;
@@ -255,6 +270,20 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             Ok(_) => Err("did not say who it is".to_string()),
             Err(e) => Err(e.to_string()),
         }
+    }
+
+    /// The `fault` line of the robot's trace, after its last incarnation's.
+    fn trace_fault(&mut self, peer: usize, fault: &str) {
+        let line = serde_json::json!({
+            "t": self.now,
+            "robot": self.run.robots[peer].name,
+            "event": "fault",
+            "fault": fault,
+        });
+        let last = self.incarnations[peer].saturating_sub(1);
+        let after = self.faults_after[peer].entry(last).or_default();
+        after.push_str(&line.to_string());
+        after.push('\n');
     }
 
     fn kill(&mut self, peer: usize) {
