@@ -90,9 +90,12 @@ enum Step {
     Done,
 }
 
-/// An event of the queue; at equal times deliveries come first, then
-/// service completions, faults, operator commands, and control firings last
-/// (a control firing sees everything that arrived by its time).
+/// An event of the queue; at equal times faults come first (a robot killed
+/// at an instant does nothing in it, one restarted runs in it: the
+/// coordinator of `--engine c` kills and starts processes before it grants
+/// the instant), then deliveries, service completions, operator commands,
+/// and control firings last (a control firing sees everything that arrived
+/// by its time).
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
 enum Event {
     Deliver {
@@ -125,10 +128,10 @@ enum Event {
 impl Event {
     fn order(&self) -> u8 {
         match self {
-            Event::Deliver { .. } => 0,
-            Event::GraphTrace { .. } => 1,
-            Event::ServiceDone { .. } => 2,
-            Event::Fault(_) => 3,
+            Event::Fault(_) => 0,
+            Event::Deliver { .. } => 1,
+            Event::GraphTrace { .. } => 2,
+            Event::ServiceDone { .. } => 3,
             Event::Operator(_) => 4,
             Event::Fire { .. } => 5,
         }
@@ -240,6 +243,11 @@ struct Region {
 #[derive(Clone, Debug, Default)]
 struct TaskState {
     busy: bool,
+    /// The call's request, written in the firing under way and not yet
+    /// taken by the task (`take_requests`): a stop before then cancels it
+    /// unseen, as the generated control task's `request` drops a request
+    /// still queued when its task was stopped before it fired.
+    untaken: Option<Vec<Held>>,
     service: String,
     /// Invalidates the completion of a call that was stopped.
     generation: u64,
@@ -274,8 +282,13 @@ struct Robot<'p> {
     /// up waiting for room in it; until the control task next takes from
     /// it, a message that finds it full is dropped at once).
     stalled: Vec<bool>,
+    /// Per incoming message: the messages its channel dropped, reported when
+    /// the robot stops (the runtime's `dropped` summary).
+    dropped: Vec<u64>,
     /// Control firings begun.
     firings: u64,
+    /// A task's request waits to be taken ([`TaskState::untaken`]).
+    has_untaken: bool,
     /// Per subscribed group: the latest value.
     groups: Vec<Option<Held>>,
     regions: Vec<Region>,
@@ -423,7 +436,9 @@ impl<'p> Robot<'p> {
             holding: None,
             behind: VecDeque::new(),
             stalled: vec![false; m.incoming.len()],
+            dropped: vec![0; m.incoming.len()],
             firings: 0,
+            has_untaken: false,
             groups: vec![None; m.subscribed.len()],
             regions: vec![
                 Region {
@@ -576,7 +591,10 @@ impl<'p> Sim<'p> {
         self.schedule_fire(r, self.now);
     }
 
-    /// Runs until `until` mission ms or until every robot has stopped.
+    /// Runs until `until` mission ms or until every robot has stopped. The
+    /// run is the instants before `until`: at `until` the robots still
+    /// alive stop before anything else of that instant happens (as the
+    /// generated program's main thread, first in the turns, stops it).
     pub fn run(mut self, options: &Options) -> Run {
         let until = options
             .until_ms
@@ -584,7 +602,7 @@ impl<'p> Sim<'p> {
             .unwrap_or(DEFAULT_UNTIL_MS);
         let mut events = 0u64;
         while let Some(Reverse((t, _, _, event))) = self.queue.pop() {
-            if t > until {
+            if t >= until {
                 break;
             }
             self.now = t;
@@ -635,6 +653,7 @@ impl<'p> Sim<'p> {
                     let traced = self.trace.len();
                     self.fire(robot);
                     if self.robots[robot].alive {
+                        self.take_requests(robot);
                         let idle = !self.every_firing
                             && !self.robots[robot].progressed
                             && self.trace.len() == traced;
@@ -735,9 +754,47 @@ impl<'p> Sim<'p> {
         self.programs.iter().position(|p| p.robot == robot)
     }
 
+    /// The robot stops (its mission ended, or the run did): the calls under
+    /// way end with it, as the runtime's task threads end them.
     fn stop(&mut self, r: usize) {
+        for t in 0..self.robots[r].tasks.len() {
+            let state = &mut self.robots[r].tasks[t].1;
+            if state.untaken.take().is_some() {
+                state.busy = false;
+            } else if state.busy {
+                self.end_call(r, t);
+            }
+        }
         self.robots[r].alive = false;
+        self.trace_dropped(r);
         self.emit(r, "stop", Vec::new());
+    }
+
+    /// The runtime's summary at stop (`semo__trace_dropped_samples`): per
+    /// channel into the control task, in the graph's order, how many
+    /// messages it dropped.
+    fn trace_dropped(&mut self, r: usize) {
+        let program = self.robots[r].program;
+        let incoming = &program.control.incoming;
+        for c in &program.graph.channels {
+            let Some(i) = incoming.iter().position(|m| {
+                c.dst.task == crate::refine::graph::CONTROL_TASK && c.dst.port == m.port
+            }) else {
+                continue;
+            };
+            let count = self.robots[r].dropped[i];
+            if count > 0 {
+                let channel = format!(
+                    "{}.{}->{}.{}",
+                    c.src.task, c.src.port, c.dst.task, c.dst.port
+                );
+                let fields = vec![
+                    ("channel", channel.into()),
+                    ("count", count.to_string().into()),
+                ];
+                self.emit(r, "dropped", fields);
+            }
+        }
     }
 
     // ------------------------------------------------------------ values
@@ -984,6 +1041,7 @@ impl<'p> Sim<'p> {
                     queued = true;
                 } else if give_up || robot.stalled[*channel] {
                     robot.stalled[*channel] = true;
+                    robot.dropped[*channel] += 1;
                     holding.pending.pop_front();
                     dropped = true;
                 } else {
@@ -1125,21 +1183,44 @@ impl<'p> Sim<'p> {
         if self.robots[r].tasks[t].1.busy {
             return false;
         }
+        let state = &mut self.robots[r].tasks[t].1;
+        state.busy = true;
+        state.untaken = Some(args);
+        state.service = service.to_string();
+        state.generation += 1;
+        self.robots[r].has_untaken = true;
+        true
+    }
+
+    /// After a firing: the tasks it called take their requests (the C
+    /// task's thread runs after the control task's firing), trace the
+    /// call and start the service.
+    fn take_requests(&mut self, r: usize) {
+        if !std::mem::take(&mut self.robots[r].has_untaken) {
+            return;
+        }
+        for t in 0..self.robots[r].tasks.len() {
+            if let Some(args) = self.robots[r].tasks[t].1.untaken.take() {
+                self.take(r, t, args);
+            }
+        }
+    }
+
+    fn take(&mut self, r: usize, t: usize, args: Vec<Held>) {
+        let (task, state) = &self.robots[r].tasks[t];
+        let (task, service, generation) = (task.clone(), state.service.clone(), state.generation);
         let arg = match args.first() {
             Some(v) => v.clone(),
             None => Some(Value::text("")),
         };
+        let service = service.as_str();
+        let task = task.as_str();
         let ms = self.robots[r]
             .service_ms
             .get(service)
             .copied()
             .unwrap_or(DEFAULT_SERVICE_MS)
             * self.robots[r].speed_scale(task);
-        let state = &mut self.robots[r].tasks[t].1;
-        state.busy = true;
-        state.service = service.to_string();
-        state.generation += 1;
-        let generation = state.generation;
         let task_name: Rc<str> = task.into();
         self.trace.push(TraceEvent {
             t: self.now,
@@ -1170,7 +1251,6 @@ impl<'p> Sim<'p> {
                 generation,
             },
         );
-        true
     }
 
     fn end_call(&mut self, r: usize, t: usize) {
@@ -1189,6 +1269,10 @@ impl<'p> Sim<'p> {
         let t = self.robots[r].task_index(task);
         let state = &mut self.robots[r].tasks[t].1;
         if !state.busy {
+            return;
+        }
+        if state.untaken.take().is_some() {
+            state.busy = false;
             return;
         }
         if state.graph_until > self.now {

@@ -165,7 +165,9 @@ fn a_killed_leader_is_replaced_and_a_restarted_one_leads_again() {
 
     let (run_, _) = run(
         &programs,
-        r#"{"duration": 5000, "faults": [{"at": 1200, "kill": "tb_0"}, {"at": 3000, "restart": "tb_0"}]}"#,
+        // Past 5 s: the restarted tb_0 claims at its pass at 5 s (a run
+        // ends before its last instant).
+        r#"{"duration": 5100, "faults": [{"at": 1200, "kill": "tb_0"}, {"at": 3000, "restart": "tb_0"}]}"#,
         0,
     );
     assert_eq!(leaders(&run_, "tb_1"), ["tb_0", "tb_1", "tb_0"]);
@@ -724,7 +726,10 @@ fn a_time_triggered_inner_task_fires_once_per_period_across_calls() {
     let first = starts[0];
     let expected: Vec<i64> = (0..samples.len() as i64).map(|k| first + 200 * k).collect();
     assert_eq!(samples, expected);
-    // Each call: its Samples, then Average with the second; its end 50 ms on.
+    // Each call: its Samples, then Average with the second; its end 50 ms on
+    // (but the last one's, which the end of the run cuts short).
+    let (cut, ends) = ends.split_last().expect("calls");
+    assert_eq!(*cut, run.end_ms, "the call under way ends with the run");
     for (call, end) in ends.iter().enumerate() {
         assert_eq!(averages[call], samples[2 * call + 1]);
         assert_eq!(*end, averages[call] + 50);
