@@ -65,6 +65,9 @@ fn init_writes_a_project_that_check_and_build_accept() {
     // Accepted as written: no error, no warning, in the folder or by file.
     assert_eq!(codes(&project, &["."]), (0, vec![]));
     assert_eq!(codes(&project, &["main.mission"]), (0, vec![]));
+    // Written in the canonical layout, as the user's own missions will be.
+    let fmt = semo_in(&project, &["fmt", "--check"]);
+    assert_eq!(fmt.code, 0, "{}{}", fmt.stdout, fmt.stderr);
     // The project's output folder and target.
     let build = semo_in(&project, &["build", "main.mission", "--emit", "taskgraph"]);
     assert_eq!(build.code, 0, "{}{}", build.stdout, build.stderr);
