@@ -68,8 +68,9 @@ fn init_writes_a_project_that_check_and_build_accept() {
     // Written in the canonical layout, as the user's own missions will be.
     let fmt = semo_in(&project, &["fmt", "--check"]);
     assert_eq!(fmt.code, 0, "{}{}", fmt.stdout, fmt.stderr);
-    // The project's output folder and target.
-    let build = semo_in(&project, &["build", "main.mission", "--emit", "taskgraph"]);
+    // The project's one mission, output folder and target, from anywhere
+    // in the project.
+    let build = semo_in(&project.join("robots"), &["build", "--emit", "taskgraph"]);
     assert_eq!(build.code, 0, "{}{}", build.stdout, build.stderr);
     assert!(
         build.stdout.contains("for target linux"),
@@ -77,6 +78,82 @@ fn init_writes_a_project_that_check_and_build_accept() {
         build.stdout
     );
     assert!(project.join("out/Rovers/rover_0/taskgraph.xml").is_file());
+}
+
+/// A scenario of `ROVER_MISSION` whose one expectation holds or not.
+fn rover_scenario(holds: bool) -> String {
+    let expect = if holds { "enters" } else { "never_enters" };
+    format!("{{\"duration\": 1000, \"expect\": [{{\"robot\": \"r\", \"{expect}\": \"M\"}}]}}\n")
+}
+
+#[test]
+fn build_and_simulate_take_the_projects_one_mission_and_its_scenario() {
+    let dir = workspace();
+    let root = dir.path();
+    write(&root.join("semo.toml"), "[project]\nversion = 1\n");
+    write(&root.join("robots/rover.robot.xml"), ROVER);
+    let missions = root.join("missions");
+    write(&missions.join("a.mission"), ROVER_MISSION);
+    // Its own scenario first, as the editors offer it, over another one
+    // named after it (whose expectation fails).
+    write(&missions.join("a.scenario.json"), &rover_scenario(true));
+    write(
+        &missions.join("a.slow.scenario.json"),
+        &rover_scenario(false),
+    );
+    let simulated = semo_in(root, &["simulate"]);
+    assert_eq!(
+        simulated.code, 0,
+        "{}{}",
+        simulated.stdout, simulated.stderr
+    );
+    assert!(
+        simulated.stdout.contains("A/r: M@0"),
+        "{}",
+        simulated.stdout
+    );
+    // Without it, the only scenario named after the mission.
+    std::fs::remove_file(missions.join("a.scenario.json")).unwrap();
+    let simulated = semo_in(&missions, &["simulate"]);
+    assert_eq!(
+        simulated.code, 1,
+        "{}{}",
+        simulated.stdout, simulated.stderr
+    );
+    // Two of them: which one is the user's to say.
+    write(
+        &missions.join("a.fast.scenario.json"),
+        &rover_scenario(true),
+    );
+    let ambiguous = semo_in(&missions, &["simulate", "a.mission"]);
+    assert_eq!(ambiguous.code, 2, "{}", ambiguous.stderr);
+    assert_eq!(
+        ambiguous.stderr.trim_end(),
+        "error: 2 scenarios for a.mission, which one? a.fast.scenario.json, \
+         a.slow.scenario.json (name it with --scenario FILE)"
+    );
+    let built = semo_in(&missions, &["build", "--emit", "taskgraph"]);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    assert!(missions.join("out/A/r/taskgraph.xml").is_file());
+    // Two missions in the project: named, in one line, and in the JSON
+    // document as its one diagnostic.
+    write(&root.join("b.mission"), ROVER_MISSION);
+    let ambiguous = semo_in(&missions, &["build", "--format", "json"]);
+    assert_eq!(ambiguous.code, 2, "{}", ambiguous.stderr);
+    let message = "2 missions in the project (..), which one? ../b.mission, \
+                   ../missions/a.mission (`semo build MISSION`)";
+    assert_eq!(ambiguous.stderr.trim_end(), format!("error: {message}"));
+    let document: serde_json::Value = serde_json::from_str(&ambiguous.stdout).unwrap();
+    assert_eq!(document["diagnostics"][0]["message"], message, "{document}");
+    // Without a project file, the missions under the current folder.
+    std::fs::remove_file(root.join("semo.toml")).unwrap();
+    let ambiguous = semo_in(root, &["simulate"]);
+    assert_eq!(ambiguous.code, 2, "{}", ambiguous.stderr);
+    assert_eq!(
+        ambiguous.stderr.trim_end(),
+        "error: 2 missions in this folder (.), which one? b.mission, missions/a.mission \
+         (`semo simulate MISSION`)"
+    );
 }
 
 #[test]

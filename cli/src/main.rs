@@ -3,6 +3,7 @@
 //! 1 errors found, 2 usage or I/O problem.
 
 mod build;
+mod defaults;
 mod deploy;
 mod fmt;
 mod graph;
@@ -112,8 +113,10 @@ enum Command {
     )]
     Build {
         /// The mission script (a file: its folder holds the catalog and
-        /// strategy files it reads, so not `-`).
-        mission: PathBuf,
+        /// strategy files it reads, so not `-`). Default: the one mission
+        /// of the project (under its `semo.toml`, else under the current
+        /// folder).
+        mission: Option<PathBuf>,
         /// More strategy (and catalog) files or folders to read (not `-`:
         /// they are seen by their paths).
         #[arg(long)]
@@ -202,11 +205,15 @@ enum Command {
     )]
     Simulate {
         /// The mission script (a file: its folder holds the catalog and
-        /// strategy files it reads, so not `-`).
-        mission: PathBuf,
+        /// strategy files it reads, so not `-`). Default: the one mission
+        /// of the project (under its `semo.toml`, else under the current
+        /// folder).
+        mission: Option<PathBuf>,
         /// The scenario file (`*.scenario.json`; `-`: standard input).
+        /// Default: `<mission>.scenario.json` beside the mission, else the
+        /// only `<mission>.*.scenario.json` there.
         #[arg(long)]
-        scenario: PathBuf,
+        scenario: Option<PathBuf>,
         /// More strategy (and catalog) files or folders to read (not `-`:
         /// they are seen by their paths).
         #[arg(long)]

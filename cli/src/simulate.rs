@@ -10,8 +10,10 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 pub struct Options {
-    pub mission: PathBuf,
-    pub scenario: PathBuf,
+    /// Else the project's one mission (`defaults::mission`).
+    pub mission: Option<PathBuf>,
+    /// Else the mission's own scenario (`defaults::scenario`).
+    pub scenario: Option<PathBuf>,
     pub strategy: Vec<PathBuf>,
     pub until_ms: Option<i64>,
     pub seed: u64,
@@ -61,7 +63,14 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     } else {
         Format::Human
     };
-    if input::is_stdin(&options.mission) {
+    let mission_file = match options.mission.clone() {
+        Some(named) => named,
+        None => match super::defaults::mission("`semo simulate MISSION`") {
+            Ok(found) => found,
+            Err(e) => return output::refused(format, "simulate", &e.folder, &e.message, out),
+        },
+    };
+    if input::is_stdin(&mission_file) {
         eprintln!(
             "error: `semo simulate` reads the mission's folder (its catalog and strategy files): give the mission's file, not `-` (the scenario may be `-`)"
         );
@@ -70,17 +79,24 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     if !input::strategy_paths_are_files(&options.strategy) {
         return 2;
     }
-    if !input::file_is_kind(&options.mission, Content::Mission, SIMULATE) {
+    if !input::file_is_kind(&mission_file, Content::Mission, SIMULATE) {
         return 2;
     }
-    let (mut check, mission) = match semo::host::load_build(&options.mission, &options.strategy) {
+    let (mut check, mission) = match semo::host::load_build(&mission_file, &options.strategy) {
         Ok(loaded) => loaded,
         Err(e) => {
             eprintln!("error: {e}");
             return 2;
         }
     };
-    let Some((scenario_name, scenario_text)) = input::read(&options.scenario) else {
+    let scenario_file = match options.scenario.clone() {
+        Some(named) => named,
+        None => match super::defaults::scenario(&mission_file) {
+            Ok(found) => found,
+            Err(e) => return output::refused(format, "simulate", &e.folder, &e.message, out),
+        },
+    };
+    let Some((scenario_name, scenario_text)) = input::read(&scenario_file) else {
         return 2;
     };
     if !input::is_kind(&scenario_name, &scenario_text, Content::Scenario, SIMULATE) {
