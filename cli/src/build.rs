@@ -316,10 +316,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
 fn report_scenario(record: &Record, format: Format, out: &mut impl Write) {
     let written = match format {
         Format::Human => {
-            eprintln!(
-                "scenario {}:{}:{}: {}",
-                record.file, record.start.line, record.start.column, record.message
-            );
+            eprintln!("{}", record.scenario_line());
             Ok(())
         }
         Format::Json => output::write_json(
@@ -352,10 +349,14 @@ fn build_with_scenario(
             &[],
         ));
     }
-    let scenario = semo::sim::scenario::parse(text, &refined.programs).map_err(|e| {
-        let (line, col) = e.line_col(text);
-        Box::new(Record::uncoded_error(path, line, col, e.message))
-    })?;
+    let scenario = semo::sim::scenario::parse(text, &refined.programs)
+        .map_err(|e| Box::new(Record::scenario(path, text, e, semo::diag::Severity::Error)))?;
+    // For people, whatever the format: the build's document has no place
+    // for a scenario's warnings.
+    for warning in &scenario.warnings {
+        let record = Record::scenario(path, text, warning.clone(), semo::diag::Severity::Warning);
+        eprintln!("{}", record.scenario_line());
+    }
     let worlds: Vec<_> = refined
         .programs
         .iter()

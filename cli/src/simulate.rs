@@ -5,6 +5,7 @@
 
 use super::input::{self, Content};
 use super::output::{self, Format, Record};
+use semo::diag::Severity;
 use semo::sim::{self, scenario};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -130,14 +131,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let scenario = match scenario::parse(&scenario_text, &refined.programs) {
         Ok(s) => s,
         Err(e) => {
-            let (line, col) = e.line_col(&scenario_text);
-            let record = Record::uncoded_error(&scenario_name, line, col, e.message);
+            let record = Record::scenario(&scenario_name, &scenario_text, e, Severity::Error);
             if format == Format::Human {
-                eprintln!(
-                    "scenario {}:{line}:{col}: {}",
-                    scenario_name.display(),
-                    record.message
-                );
+                eprintln!("{}", record.scenario_line());
             } else {
                 let document = output::json_document(
                     "simulate",
@@ -149,6 +145,16 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     };
+    let warnings: Vec<Record> = scenario
+        .warnings
+        .iter()
+        .map(|w| Record::scenario(&scenario_name, &scenario_text, w.clone(), Severity::Warning))
+        .collect();
+    if !options.json {
+        for warning in &warnings {
+            eprintln!("{}", warning.scenario_line());
+        }
+    }
     if options.engine == Engine::C {
         return run_generated(
             &options,
@@ -184,7 +190,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let writes_stdout = |p: &Option<PathBuf>| p.as_deref() == Some(Path::new("-"));
     if !writes_stdout(&options.trace) && !writes_stdout(&options.svg) {
         let report = if options.json {
-            json_summary(&run, &verdicts)
+            json_summary(&run, &verdicts, &warnings)
         } else {
             sim::summary(&run, &verdicts)
         };
@@ -209,7 +215,7 @@ fn write_to(path: &Path, text: &str, out: &mut impl Write) -> i32 {
 }
 
 /// `--format json`: one object with each robot's modes and every expectation.
-fn json_summary(run: &sim::Run, verdicts: &[sim::Verdict]) -> String {
+fn json_summary(run: &sim::Run, verdicts: &[sim::Verdict], warnings: &[Record]) -> String {
     let modes = sim::expect::modes_of_every_robot(run);
     let robots: Vec<serde_json::Value> = run
         .robots
@@ -240,7 +246,7 @@ fn json_summary(run: &sim::Run, verdicts: &[sim::Verdict]) -> String {
         "expectations": expectations,
         "ok": verdicts.iter().all(|v| v.met),
     });
-    let mut text = output::json_document("simulate", &[], data).to_string();
+    let mut text = output::json_document("simulate", warnings, data).to_string();
     text.push('\n');
     text
 }
