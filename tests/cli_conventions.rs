@@ -409,6 +409,17 @@ fn every_commands_json_is_one_document_with_one_diagnostic_shape() {
     let (value, diags) = document(&out.stdout, "simulate");
     assert!(diags.is_empty());
     assert_eq!(value["ok"], true);
+    // catalog: the built-in types (no catalog file in the folder).
+    let out = support::semo_in(&dir, &["catalog", "--format", "json"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let (value, diags) = document(&out.stdout, "catalog");
+    assert!(diags.is_empty(), "{diags:?}");
+    assert_eq!(value["robots"][0]["name"], "iRobotCreate");
+    // ... and a refusal is its document's one diagnostic.
+    let out = support::semo_in(&dir, &["catalog", "NoSuchType", "--format", "json"]);
+    assert_eq!(out.code, 2);
+    let (_, diags) = document(&out.stdout, "catalog");
+    assert_eq!(diags.len(), 1);
 }
 
 /// The official SARIF 2.1.0 schema (tests/data/sarif/README.md says where

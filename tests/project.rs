@@ -157,6 +157,87 @@ fn build_and_simulate_take_the_projects_one_mission_and_its_scenario() {
 }
 
 #[test]
+fn catalog_lists_the_built_in_types_and_the_projects_own() {
+    let dir = workspace();
+    let root = dir.path();
+    write(
+        &root.join("semo.toml"),
+        "[project]\nversion = 1\ncatalogs = [\"robots\"]\n",
+    );
+    write(&root.join("robots/rover.robot.xml"), ROVER);
+    // Not in a catalog folder of the project: not the project's.
+    write(
+        &root.join("missions/stray.robot.xml"),
+        &ROVER.replace("Rover", "Stray"),
+    );
+    let missions = root.join("missions");
+    let listed = semo_in(&missions, &["catalog"]);
+    assert_eq!(listed.code, 0, "{}{}", listed.stdout, listed.stderr);
+    assert!(listed.stderr.is_empty(), "{}", listed.stderr);
+    let text = &listed.stdout;
+    for expected in [
+        "iRobotCreate (built-in)\n",
+        "    move(goal?: location)       Drive to a goal position",
+        "    DISTANCE: int (cm)      Distance to the nearest obstacle ahead, in centimetres.\n",
+        "Rover (../robots/rover.robot.xml)\n  services:\n    beep()\n",
+        "USER: the operator console, not a robot type (built-in; also: user)\n",
+        "    RC_CMD: string (also: cmd)  The latest remote-control command",
+    ] {
+        assert!(text.contains(expected), "{expected:?} in:\n{text}");
+    }
+    assert!(!text.contains("Stray"), "{text}");
+    // One type, by name or alias; a misspelt one gets a did-you-mean.
+    let one = semo_in(&missions, &["catalog", "lego_robot"]);
+    assert_eq!(one.code, 0, "{}", one.stderr);
+    assert!(
+        one.stdout
+            .starts_with("NXTLego (built-in; also: lego_robot)\n"),
+        "{}",
+        one.stdout
+    );
+    assert!(!one.stdout.contains("iRobotCreate"), "{}", one.stdout);
+    let unknown = semo_in(&missions, &["catalog", "Rovr"]);
+    assert_eq!(unknown.code, 2, "{}", unknown.stderr);
+    assert!(
+        unknown.stderr.contains("no robot type `Rovr`")
+            && unknown.stderr.contains("(did you mean `Rover`?)"),
+        "{}",
+        unknown.stderr
+    );
+    // JSON: one document; USER is the operator, not among the robots.
+    let json = semo_in(&missions, &["catalog", "--format", "json"]);
+    assert_eq!(json.code, 0, "{}", json.stderr);
+    let document: serde_json::Value = serde_json::from_str(&json.stdout).expect(&json.stdout);
+    assert_eq!(document["command"], "catalog");
+    let robots = document["robots"].as_array().unwrap();
+    let names: Vec<&str> = robots.iter().map(|r| r["name"].as_str().unwrap()).collect();
+    assert!(
+        names.contains(&"TIEvalbot") && names.contains(&"Rover"),
+        "{names:?}"
+    );
+    assert!(!names.contains(&"USER"), "{names:?}");
+    let rover = robots.iter().find(|r| r["name"] == "Rover").unwrap();
+    assert_eq!(rover["source"], "../robots/rover.robot.xml");
+    assert_eq!(rover["services"][0]["signature"], "beep()");
+    assert_eq!(document["operator"]["name"], "USER");
+    assert_eq!(document["operator"]["values"][0]["type"], "string");
+    // A broken catalog file: its errors, and what loaded still listed.
+    write(&root.join("robots/broken.robot.xml"), BROKEN_CATALOG);
+    let broken = semo_in(&missions, &["catalog"]);
+    assert_eq!(broken.code, 1, "{}", broken.stderr);
+    assert!(
+        broken.stderr.contains("broken.robot.xml"),
+        "{}",
+        broken.stderr
+    );
+    assert!(
+        broken.stdout.contains("Rover (../robots/rover.robot.xml)"),
+        "{}",
+        broken.stdout
+    );
+}
+
+#[test]
 fn init_refuses_to_overwrite_and_writes_nothing() {
     let dir = workspace();
     let mine = "# my own mission\n";

@@ -30,7 +30,7 @@ pub struct NoChoice {
 pub fn mission(usage: &str) -> Result<PathBuf, NoChoice> {
     let here = PathBuf::from(".");
     let (root, place, depth) = match semo::project::find(&here) {
-        Some(root) => (shown(&root), "the project", PROJECT_DEPTH),
+        Some(root) => (from_here(&root), "the project", PROJECT_DEPTH),
         None => (here, "this folder", semo::host::SEEN_DEPTH),
     };
     let no_choice = |message: String| NoChoice {
@@ -131,15 +131,32 @@ fn listed(paths: &[PathBuf]) -> String {
     text
 }
 
-/// `root` (absolute, the folder of a project file found from the current
-/// folder) as the user would write it there: `.`, `..`, `../..`, …
-fn shown(root: &Path) -> PathBuf {
-    let up = std::env::current_dir()
-        .ok()
-        .and_then(|here| Some(here.strip_prefix(root).ok()?.components().count()));
-    match up {
-        Some(0) => PathBuf::from("."),
-        Some(levels) => std::iter::repeat_n("..", levels).collect(),
-        None => root.to_path_buf(),
+/// `path` (absolute) as the user would write it from the current folder:
+/// `.`, `..`, `../robots/rover.robot.xml`, …; as it is when the two share
+/// no folder but the root.
+pub fn from_here(path: &Path) -> PathBuf {
+    let Ok(here) = std::env::current_dir() else {
+        return path.to_path_buf();
+    };
+    let shared = here
+        .components()
+        .zip(path.components())
+        .take_while(|(a, b)| a == b)
+        .count();
+    if shared <= 1 {
+        return path.to_path_buf();
+    }
+    let up = here.components().count() - shared;
+    let relative: PathBuf = std::iter::repeat_n(Path::new(".."), up)
+        .chain(
+            path.components()
+                .skip(shared)
+                .map(|c| Path::new(c.as_os_str())),
+        )
+        .collect();
+    if relative.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        relative
     }
 }
