@@ -409,6 +409,17 @@ fn every_commands_json_is_one_document_with_one_diagnostic_shape() {
     let (value, diags) = document(&out.stdout, "simulate");
     assert!(diags.is_empty());
     assert_eq!(value["ok"], true);
+    // catalog: the built-in types (no catalog file in the folder).
+    let out = support::semo_in(&dir, &["catalog", "--format", "json"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let (value, diags) = document(&out.stdout, "catalog");
+    assert!(diags.is_empty(), "{diags:?}");
+    assert_eq!(value["robots"][0]["name"], "iRobotCreate");
+    // ... and a refusal is its document's one diagnostic.
+    let out = support::semo_in(&dir, &["catalog", "NoSuchType", "--format", "json"]);
+    assert_eq!(out.code, 2);
+    let (_, diags) = document(&out.stdout, "catalog");
+    assert_eq!(diags.len(), 1);
 }
 
 /// The official SARIF 2.1.0 schema (tests/data/sarif/README.md says where
@@ -766,7 +777,7 @@ fn a_file_of_the_wrong_kind_is_refused_in_one_line_and_nothing_is_written() {
 }
 
 #[test]
-fn check_watch_checks_again_when_a_file_changes() {
+fn check_watch_checks_again_only_when_a_file_changes() {
     use std::io::BufRead;
     use std::process::Stdio;
     use std::time::Duration;
@@ -794,14 +805,29 @@ fn check_watch_checks_again_when_a_file_changes() {
     let first = next().expect("the first report");
     let (_, diags) = document(&first, "check");
     assert!(diags.is_empty(), "{diags:?}");
-    std::fs::write(&mission, fixture("E015_unknown_team.mission")).unwrap();
+    // Reading the files is no change (the check reads them too): spread
+    // over a second, so that a watcher taking reads for changes would have
+    // checked again before the change below. What is asserted is the
+    // number of reports, not a time.
+    for _ in 0..5 {
+        std::fs::read_to_string(&mission).unwrap();
+        std::fs::read_dir(&dir).unwrap().for_each(drop);
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    // One change, made as editors save: written aside, renamed over.
+    let aside = dir.join("m.mission.new");
+    std::fs::write(&aside, fixture("E015_unknown_team.mission")).unwrap();
+    std::fs::rename(&aside, &mission).unwrap();
     let second = next().expect("a report after the change");
-    let (_, diags) = document(&second, "check");
     child.kill().unwrap();
     child.wait().unwrap();
+    let after: Vec<String> = reports.iter().collect();
+    assert!(after.is_empty(), "checked again with no change: {after:?}");
+    let (_, diags) = document(&second, "check");
     assert!(
         diags.iter().any(|d| d.code.as_deref() == Some("E015")),
-        "{diags:?}"
+        "the report after the first one is not the change's: the reads were checked again: \
+         {diags:?}"
     );
 }
 

@@ -1578,6 +1578,24 @@ fn the_operator_console_commands_one_run() {
     );
 }
 
+/// A command typed while nothing listens on the broker's port is not sent,
+/// and the console says so (exit 1), never "sent"; it ends when its input
+/// does, its connection still failing.
+#[test]
+fn the_operator_console_says_a_command_was_not_sent_without_a_broker() {
+    let url = format!("mqtt://127.0.0.1:{}", free_port());
+    let (code, stdout, stderr) =
+        operator_with(&["--broker", &url, "--run", "r1"], "RC_CMD RETURN_MODE\n");
+    assert_eq!(code, Some(1), "{stdout}{stderr}");
+    assert!(!stdout.contains("sent"), "{stdout}");
+    assert!(
+        stderr.contains(&format!(
+            "operator: not sent: USER.RC_CMD = RETURN_MODE: no connection to the broker {url} ("
+        )),
+        "{stderr}"
+    );
+}
+
 /// The `semo/monitor` notification of the server behind `client` whose
 /// robots satisfy `wanted`; one that never comes fails the test.
 async fn monitor_view(

@@ -65,8 +65,12 @@ fn init_writes_a_project_that_check_and_build_accept() {
     // Accepted as written: no error, no warning, in the folder or by file.
     assert_eq!(codes(&project, &["."]), (0, vec![]));
     assert_eq!(codes(&project, &["main.mission"]), (0, vec![]));
-    // The project's output folder and target.
-    let build = semo_in(&project, &["build", "main.mission", "--emit", "taskgraph"]);
+    // Written in the canonical layout, as the user's own missions will be.
+    let fmt = semo_in(&project, &["fmt", "--check"]);
+    assert_eq!(fmt.code, 0, "{}{}", fmt.stdout, fmt.stderr);
+    // The project's one mission, output folder and target, from anywhere
+    // in the project.
+    let build = semo_in(&project.join("robots"), &["build", "--emit", "taskgraph"]);
     assert_eq!(build.code, 0, "{}{}", build.stdout, build.stderr);
     assert!(
         build.stdout.contains("for target linux"),
@@ -74,6 +78,163 @@ fn init_writes_a_project_that_check_and_build_accept() {
         build.stdout
     );
     assert!(project.join("out/Rovers/rover_0/taskgraph.xml").is_file());
+}
+
+/// A scenario of `ROVER_MISSION` whose one expectation holds or not.
+fn rover_scenario(holds: bool) -> String {
+    let expect = if holds { "enters" } else { "never_enters" };
+    format!("{{\"duration\": 1000, \"expect\": [{{\"robot\": \"r\", \"{expect}\": \"M\"}}]}}\n")
+}
+
+#[test]
+fn build_and_simulate_take_the_projects_one_mission_and_its_scenario() {
+    let dir = workspace();
+    let root = dir.path();
+    write(&root.join("semo.toml"), "[project]\nversion = 1\n");
+    write(&root.join("robots/rover.robot.xml"), ROVER);
+    let missions = root.join("missions");
+    write(&missions.join("a.mission"), ROVER_MISSION);
+    // Its own scenario first, as the editors offer it, over another one
+    // named after it (whose expectation fails).
+    write(&missions.join("a.scenario.json"), &rover_scenario(true));
+    write(
+        &missions.join("a.slow.scenario.json"),
+        &rover_scenario(false),
+    );
+    let simulated = semo_in(root, &["simulate"]);
+    assert_eq!(
+        simulated.code, 0,
+        "{}{}",
+        simulated.stdout, simulated.stderr
+    );
+    assert!(
+        simulated.stdout.contains("A/r: M@0"),
+        "{}",
+        simulated.stdout
+    );
+    // Without it, the only scenario named after the mission.
+    std::fs::remove_file(missions.join("a.scenario.json")).unwrap();
+    let simulated = semo_in(&missions, &["simulate"]);
+    assert_eq!(
+        simulated.code, 1,
+        "{}{}",
+        simulated.stdout, simulated.stderr
+    );
+    // Two of them: which one is the user's to say.
+    write(
+        &missions.join("a.fast.scenario.json"),
+        &rover_scenario(true),
+    );
+    let ambiguous = semo_in(&missions, &["simulate", "a.mission"]);
+    assert_eq!(ambiguous.code, 2, "{}", ambiguous.stderr);
+    assert_eq!(
+        ambiguous.stderr.trim_end(),
+        "error: 2 scenarios for a.mission, which one? a.fast.scenario.json, \
+         a.slow.scenario.json (name it with --scenario FILE)"
+    );
+    let built = semo_in(&missions, &["build", "--emit", "taskgraph"]);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    assert!(missions.join("out/A/r/taskgraph.xml").is_file());
+    // Two missions in the project: named, in one line, and in the JSON
+    // document as its one diagnostic.
+    write(&root.join("b.mission"), ROVER_MISSION);
+    let ambiguous = semo_in(&missions, &["build", "--format", "json"]);
+    assert_eq!(ambiguous.code, 2, "{}", ambiguous.stderr);
+    let message = "2 missions in the project (..), which one? ../b.mission, \
+                   ../missions/a.mission (`semo build MISSION`)";
+    assert_eq!(ambiguous.stderr.trim_end(), format!("error: {message}"));
+    let document: serde_json::Value = serde_json::from_str(&ambiguous.stdout).unwrap();
+    assert_eq!(document["diagnostics"][0]["message"], message, "{document}");
+    // Without a project file, the missions under the current folder.
+    std::fs::remove_file(root.join("semo.toml")).unwrap();
+    let ambiguous = semo_in(root, &["simulate"]);
+    assert_eq!(ambiguous.code, 2, "{}", ambiguous.stderr);
+    assert_eq!(
+        ambiguous.stderr.trim_end(),
+        "error: 2 missions in this folder (.), which one? b.mission, missions/a.mission \
+         (`semo simulate MISSION`)"
+    );
+}
+
+#[test]
+fn catalog_lists_the_built_in_types_and_the_projects_own() {
+    let dir = workspace();
+    let root = dir.path();
+    write(
+        &root.join("semo.toml"),
+        "[project]\nversion = 1\ncatalogs = [\"robots\"]\n",
+    );
+    write(&root.join("robots/rover.robot.xml"), ROVER);
+    // Not in a catalog folder of the project: not the project's.
+    write(
+        &root.join("missions/stray.robot.xml"),
+        &ROVER.replace("Rover", "Stray"),
+    );
+    let missions = root.join("missions");
+    let listed = semo_in(&missions, &["catalog"]);
+    assert_eq!(listed.code, 0, "{}{}", listed.stdout, listed.stderr);
+    assert!(listed.stderr.is_empty(), "{}", listed.stderr);
+    let text = &listed.stdout;
+    for expected in [
+        "iRobotCreate (built-in)\n",
+        "    move(goal?: location)       Drive to a goal position",
+        "    DISTANCE: int (cm)      Distance to the nearest obstacle ahead, in centimetres.\n",
+        "Rover (../robots/rover.robot.xml)\n  services:\n    beep()\n",
+        "USER: the operator console, not a robot type (built-in; also: user)\n",
+        "    RC_CMD: string (also: cmd)  The latest remote-control command",
+    ] {
+        assert!(text.contains(expected), "{expected:?} in:\n{text}");
+    }
+    assert!(!text.contains("Stray"), "{text}");
+    // One type, by name or alias; a misspelt one gets a did-you-mean.
+    let one = semo_in(&missions, &["catalog", "lego_robot"]);
+    assert_eq!(one.code, 0, "{}", one.stderr);
+    assert!(
+        one.stdout
+            .starts_with("NXTLego (built-in; also: lego_robot)\n"),
+        "{}",
+        one.stdout
+    );
+    assert!(!one.stdout.contains("iRobotCreate"), "{}", one.stdout);
+    let unknown = semo_in(&missions, &["catalog", "Rovr"]);
+    assert_eq!(unknown.code, 2, "{}", unknown.stderr);
+    assert!(
+        unknown.stderr.contains("no robot type `Rovr`")
+            && unknown.stderr.contains("(did you mean `Rover`?)"),
+        "{}",
+        unknown.stderr
+    );
+    // JSON: one document; USER is the operator, not among the robots.
+    let json = semo_in(&missions, &["catalog", "--format", "json"]);
+    assert_eq!(json.code, 0, "{}", json.stderr);
+    let document: serde_json::Value = serde_json::from_str(&json.stdout).expect(&json.stdout);
+    assert_eq!(document["command"], "catalog");
+    let robots = document["robots"].as_array().unwrap();
+    let names: Vec<&str> = robots.iter().map(|r| r["name"].as_str().unwrap()).collect();
+    assert!(
+        names.contains(&"TIEvalbot") && names.contains(&"Rover"),
+        "{names:?}"
+    );
+    assert!(!names.contains(&"USER"), "{names:?}");
+    let rover = robots.iter().find(|r| r["name"] == "Rover").unwrap();
+    assert_eq!(rover["source"], "../robots/rover.robot.xml");
+    assert_eq!(rover["services"][0]["signature"], "beep()");
+    assert_eq!(document["operator"]["name"], "USER");
+    assert_eq!(document["operator"]["values"][0]["type"], "string");
+    // A broken catalog file: its errors, and what loaded still listed.
+    write(&root.join("robots/broken.robot.xml"), BROKEN_CATALOG);
+    let broken = semo_in(&missions, &["catalog"]);
+    assert_eq!(broken.code, 1, "{}", broken.stderr);
+    assert!(
+        broken.stderr.contains("broken.robot.xml"),
+        "{}",
+        broken.stderr
+    );
+    assert!(
+        broken.stdout.contains("Rover (../robots/rover.robot.xml)"),
+        "{}",
+        broken.stdout
+    );
 }
 
 #[test]

@@ -130,6 +130,10 @@ fn a_bad_scenario_exits_2_with_its_position() {
             "{\"faults\": [{\"at\": 10, \"kill\": \"r2d2\"}]}",
             ":1:32: robot \"r2d2\" is not in the mission (robots: irobot, ti, nxt)",
         ),
+        (
+            "{\"faults\": [{\"at\": 10, \"kill\": \"irobt\"}]}",
+            ":1:32: robot \"irobt\" is not in the mission (robots: irobot, ti, nxt) (did you mean \"irobot\"?)",
+        ),
     ] {
         let scenario = write(&dir, "bad.scenario.json", text);
         let out = semo(&["simulate", &scouting(), "--scenario", &scenario]);
@@ -141,6 +145,25 @@ fn a_bad_scenario_exits_2_with_its_position() {
         );
         assert!(out.stdout.is_empty());
     }
+    let document = |out: &support::Output| -> serde_json::Value {
+        serde_json::from_str(&out.stdout).expect(&out.stdout)
+    };
+    // The did-you-mean is the JSON diagnostic's suggestion too.
+    let scenario = write(
+        &dir,
+        "bad.scenario.json",
+        "{\"faults\": [{\"at\": 10, \"kill\": \"irobt\"}]}",
+    );
+    let out = semo(&[
+        "simulate",
+        &scouting(),
+        "--scenario",
+        &scenario,
+        "--format",
+        "json",
+    ]);
+    assert_eq!(out.code, 2, "{}", out.stderr);
+    assert_eq!(document(&out)["diagnostics"][0]["suggestion"], "irobot");
     let missing = semo(&[
         "simulate",
         &scouting(),
@@ -157,6 +180,64 @@ fn a_bad_scenario_exits_2_with_its_position() {
         "5 parsecs",
     ]);
     assert_eq!(until.code, 2, "{}", until.stderr);
+}
+
+/// A sensor value no sensor task of the robot samples is read by nobody:
+/// the run goes on (a scenario may serve variants of a mission), with a
+/// positioned warning and a did-you-mean, never in silence.
+#[test]
+fn a_misspelt_sensor_value_is_a_warning_with_a_did_you_mean() {
+    let dir = scratch("unsampled");
+    let scenario = write(
+        &dir,
+        "colour.scenario.json",
+        "{\"robots\": {\"ti\": {\"sensors\": [{\"at\": 0, \"value\": \"COLOUR\", \"is\": \"RED\"}]}}}",
+    );
+    let message = "robot ti samples no sensor value \"COLOUR\": nothing reads this entry \
+                   (it samples: COLOR, LOCATION) (did you mean \"COLOR\"?)";
+    let out = semo(&[
+        "simulate",
+        &scouting(),
+        "--scenario",
+        &scenario,
+        "--until",
+        "1s",
+    ]);
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    assert_eq!(
+        out.stderr.trim_end(),
+        format!("scenario {scenario}:1:51: warning: {message}")
+    );
+    let out = semo(&[
+        "simulate",
+        &scouting(),
+        "--scenario",
+        &scenario,
+        "--until",
+        "1s",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    assert!(out.stderr.is_empty(), "{}", out.stderr);
+    let document: serde_json::Value = serde_json::from_str(&out.stdout).expect(&out.stdout);
+    let warning = &document["diagnostics"][0];
+    assert_eq!(
+        (
+            &warning["severity"],
+            &warning["message"],
+            &warning["suggestion"],
+            &warning["start"]
+        ),
+        (
+            &serde_json::json!("warning"),
+            &serde_json::json!(message),
+            &serde_json::json!("COLOR"),
+            &serde_json::json!({"line": 1, "column": 51})
+        ),
+        "{document}"
+    );
+    assert_eq!(document["ok"], true, "{document}");
 }
 
 #[test]

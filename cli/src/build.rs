@@ -10,7 +10,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 pub struct Options {
-    pub mission: PathBuf,
+    /// Else the project's one mission (`defaults::mission`).
+    pub mission: Option<PathBuf>,
     pub strategy: Vec<PathBuf>,
     /// Else the project file's `[build] output`, else `out` beside the mission.
     pub out: Option<PathBuf>,
@@ -31,7 +32,14 @@ const BUILD: &str = "semo build";
 
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let started = std::time::Instant::now();
-    if input::is_stdin(&options.mission) {
+    let mission_file = match options.mission.clone() {
+        Some(named) => named,
+        None => match super::defaults::mission("`semo build MISSION`") {
+            Ok(found) => found,
+            Err(e) => return output::refused(options.format, "build", &e.folder, &e.message, out),
+        },
+    };
+    if input::is_stdin(&mission_file) {
         eprintln!(
             "error: `semo build` reads the mission's folder (its catalog and strategy files, `out/` beside it): give the mission's file, not `-`"
         );
@@ -40,7 +48,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     if !input::strategy_paths_are_files(&options.strategy) {
         return 2;
     }
-    if !input::file_is_kind(&options.mission, Content::Mission, BUILD) {
+    if !input::file_is_kind(&mission_file, Content::Mission, BUILD) {
         return 2;
     }
     // Read before anything else, so that a wrong file stops the build
@@ -54,7 +62,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             _ => return 2,
         },
     };
-    let (mut run, mission) = match host::load_build(&options.mission, &options.strategy) {
+    let (mut run, mission) = match host::load_build(&mission_file, &options.strategy) {
         Ok(loaded) => loaded,
         Err(e) => {
             eprintln!("error: {e}");
@@ -76,13 +84,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
                 .and_then(|p| p.output.as_ref())
                 .map(|o| o.path.clone())
         })
-        .unwrap_or_else(|| {
-            options
-                .mission
-                .parent()
-                .unwrap_or(Path::new("."))
-                .join("out")
-        });
+        .unwrap_or_else(|| mission_file.parent().unwrap_or(Path::new(".")).join("out"));
     if options.scenario.is_some() != target.needs_scenario() {
         eprintln!(
             "error: {}",
@@ -314,10 +316,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
 fn report_scenario(record: &Record, format: Format, out: &mut impl Write) {
     let written = match format {
         Format::Human => {
-            eprintln!(
-                "scenario {}:{}:{}: {}",
-                record.file, record.start.line, record.start.column, record.message
-            );
+            eprintln!("{}", record.scenario_line());
             Ok(())
         }
         Format::Json => output::write_json(
@@ -350,10 +349,14 @@ fn build_with_scenario(
             &[],
         ));
     }
-    let scenario = semo::sim::scenario::parse(text, &refined.programs).map_err(|e| {
-        let (line, col) = e.line_col(text);
-        Box::new(Record::uncoded_error(path, line, col, e.message))
-    })?;
+    let scenario = semo::sim::scenario::parse(text, &refined.programs)
+        .map_err(|e| Box::new(Record::scenario(path, text, e, semo::diag::Severity::Error)))?;
+    // For people, whatever the format: the build's document has no place
+    // for a scenario's warnings.
+    for warning in &scenario.warnings {
+        let record = Record::scenario(path, text, warning.clone(), semo::diag::Severity::Warning);
+        eprintln!("{}", record.scenario_line());
+    }
     let worlds: Vec<_> = refined
         .programs
         .iter()

@@ -1,5 +1,6 @@
 //! `semo init [DIR]`: a new project: `semo.toml`, a first mission and a
-//! catalog with one robot type, which `semo check` accepts as they are. It
+//! catalog with one robot type, which `semo check` accepts as they are (and
+//! `semo fmt --check`: the mission is in the canonical layout). It
 //! writes nothing if any of them is already there (nothing the user wrote is
 //! overwritten), and each file is created new, never opened for writing if
 //! it appeared meanwhile.
@@ -14,12 +15,15 @@ const MISSION: &str = "\
   Rovers: Rover rover[2]
 }
 
-Rovers.Work.Beep{
+Rovers.Work.Beep {
   beep()
 } repeat(1 SEC)
 
-Rovers.WORK{ set(Work, Beep) }
-Rovers.main{
+Rovers.WORK {
+  set(Work, Beep)
+}
+
+Rovers.main {
   default: mode = WORK
 }
 ";

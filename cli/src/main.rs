@@ -3,6 +3,8 @@
 //! 1 errors found, 2 usage or I/O problem.
 
 mod build;
+mod catalog;
+mod defaults;
 mod deploy;
 mod fmt;
 mod graph;
@@ -29,8 +31,9 @@ use std::path::PathBuf;
                   one plus any *.robot.xml files) and strategy files (`semo check`), lays them \
                   out canonically (`semo fmt`), refines them into one task graph and C program \
                   per robot (`semo build`), runs them together in virtual time (`semo simulate`), \
-                  analyses and draws task graphs and mode machines (`semo graph`), explains \
-                  diagnostic codes (`semo explain`) and serves editors (`semo lsp`).\n\n\
+                  analyses and draws task graphs and mode machines (`semo graph`), lists the \
+                  robot types missions may use (`semo catalog`), explains diagnostic codes \
+                  (`semo explain`) and serves editors (`semo lsp`).\n\n\
                   Colour: --color, else NO_COLOR turns it off, CLICOLOR_FORCE on, TERM=dumb \
                   off, and otherwise it is on only on a terminal.\n\nExit status: 0 when no \
                   errors were found, 1 when errors were found, 2 for a usage or I/O problem."
@@ -112,8 +115,10 @@ enum Command {
     )]
     Build {
         /// The mission script (a file: its folder holds the catalog and
-        /// strategy files it reads, so not `-`).
-        mission: PathBuf,
+        /// strategy files it reads, so not `-`). Default: the one mission
+        /// of the project (under its `semo.toml`, else under the current
+        /// folder).
+        mission: Option<PathBuf>,
         /// More strategy (and catalog) files or folders to read (not `-`:
         /// they are seen by their paths).
         #[arg(long)]
@@ -202,11 +207,15 @@ enum Command {
     )]
     Simulate {
         /// The mission script (a file: its folder holds the catalog and
-        /// strategy files it reads, so not `-`).
-        mission: PathBuf,
+        /// strategy files it reads, so not `-`). Default: the one mission
+        /// of the project (under its `semo.toml`, else under the current
+        /// folder).
+        mission: Option<PathBuf>,
         /// The scenario file (`*.scenario.json`; `-`: standard input).
+        /// Default: `<mission>.scenario.json` beside the mission, else the
+        /// only `<mission>.*.scenario.json` there.
         #[arg(long)]
-        scenario: PathBuf,
+        scenario: Option<PathBuf>,
         /// More strategy (and catalog) files or folders to read (not `-`:
         /// they are seen by their paths).
         #[arg(long)]
@@ -257,6 +266,30 @@ enum Command {
     Init {
         /// The project's folder.
         dir: Option<PathBuf>,
+    },
+    /// List the robot types missions may use: their services (with
+    /// signatures) and values (with types), from the built-in catalog and
+    /// the project's catalog files.
+    #[command(
+        long_about = "List the robot types missions may use, with their services (signatures) \
+        and values (types and units): the built-in catalog, and the project's own catalog \
+        files (*.robot.xml under the catalog folders of the semo.toml above the current \
+        folder, else under the current folder), which add types or replace built-in ones. \
+        Each type says where it is written. The operator console, USER, is listed apart: it \
+        is no robot type; its values are what missions receive from it.\n\n\
+        Exit status: 0, 1 when a catalog file has errors (listed on standard error; the \
+        types that loaded are still shown), 2 for an unknown TYPE or an I/O problem."
+    )]
+    Catalog {
+        /// One robot type, by name or alias (`USER`: the operator console).
+        #[arg(value_name = "TYPE")]
+        robot_type: Option<String>,
+        /// `human` (the listing on standard output) or `json` (one
+        /// document: the catalog files' diagnostics, `robots` and `operator`).
+        #[arg(long, value_enum, default_value_t = DataFormat::Human)]
+        format: DataFormat,
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
     },
     /// Explain a diagnostic code (e.g. `semo explain E019`): what it means,
     /// a wrong and a right example; with no code, list them all.
@@ -594,6 +627,16 @@ fn run() -> i32 {
             &mut out,
         ),
         Command::Explain { code } => explain(code.as_deref(), &mut out),
+        Command::Catalog {
+            robot_type,
+            format,
+            color,
+        } => catalog::run(
+            robot_type.as_deref(),
+            format == DataFormat::Json,
+            use_color(color),
+            &mut out,
+        ),
         Command::Init { dir } => init::run(dir, &mut out),
         Command::Lsp { stdio: _ } => {
             // The protocol owns stdout from here on.

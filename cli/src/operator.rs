@@ -12,6 +12,10 @@
 //! robot's incoming messages from `USER`); the topics and the datagram are
 //! the runtime's (`deploy::topics`; the status and the datagram read and
 //! written by `semo_server::live`, which the editor's monitor shares).
+//!
+//! A command is said to be sent when the broker has acknowledged it (QoS 1);
+//! one typed while the broker cannot be reached is not sent, and said so
+//! (exit status 1), never queued to go out later.
 
 use semo::codegen;
 use semo::deploy::topics::{self, RunId, Scope};
@@ -20,7 +24,7 @@ use semo_server::live::{
     BrokerAccess, DEFAULT_BROKER, RunChoice, Status, datagram_fields, operator_datagram,
     status_topic,
 };
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::io::{BufRead, Write};
 use std::path::PathBuf;
 
@@ -166,6 +170,12 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         },
         Line(String),
         End,
+        /// The broker accepted the connection.
+        Connected,
+        /// The connection failed or was lost (retried): why.
+        Lost(String),
+        /// The broker acknowledged a command (QoS 1: in the order sent).
+        Acked,
         /// The broker cannot be reached this way (its certificate is not
         /// trusted, it refused ours): retrying would only hang.
         Refused(String),
@@ -182,6 +192,12 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
                             payload: p.payload.to_vec(),
                         });
                     }
+                    Ok(rumqttc::Event::Incoming(rumqttc::Packet::ConnAck(_))) => {
+                        let _ = tx.send(Input::Connected);
+                    }
+                    Ok(rumqttc::Event::Incoming(rumqttc::Packet::PubAck(_))) => {
+                        let _ = tx.send(Input::Acked);
+                    }
                     Ok(rumqttc::Event::Outgoing(rumqttc::Outgoing::Disconnect)) => break,
                     Ok(_) => {}
                     Err(e) => {
@@ -194,6 +210,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
                             "operator: connection to the broker: {} (retrying)",
                             failure.message
                         );
+                        // Nobody listens any more: the console has ended
+                        // without a connection to close.
+                        if tx.send(Input::Lost(failure.message)).is_err() {
+                            break;
+                        }
                         std::thread::sleep(std::time::Duration::from_secs(1));
                     }
                 }
@@ -209,68 +230,209 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         }
         let _ = tx.send(Input::End);
     });
+    let console = Console {
+        mission: &mission_topic,
+        commands: &commands,
+        client: &client,
+    };
+    let mut sending = Sending::default();
     let mut status = 0;
+    let mut ended = false;
     for input in rx.iter() {
-        let line = match input {
+        let typed = match input {
             Input::Broker { topic, payload } => {
                 match view.message(&topic, &payload) {
                     Heard::Lines(lines) => {
                         for line in lines {
                             let _ = writeln!(out, "{line}");
                         }
-                        let _ = out.flush();
                     }
                     Heard::Refused => eprintln!(
                         "operator: refused a message on {topic}: not a runtime message from the sender its topic names"
                     ),
                 }
-                continue;
+                Vec::new()
             }
-            Input::End => break,
+            Input::Connected => sending.link_is(Link::Up),
+            Input::Lost(why) => sending.link_is(Link::Down(why)),
+            Input::Acked => {
+                if let Some(command) = sending.acknowledged() {
+                    let _ = writeln!(out, "sent {command}");
+                }
+                Vec::new()
+            }
+            // Typed before the connection's first outcome: held until it
+            // says whether the line can go.
+            Input::Line(line) if sending.link == Link::Connecting => {
+                sending.held.push(line);
+                Vec::new()
+            }
+            Input::Line(line) => vec![line],
+            Input::End => {
+                ended = true;
+                Vec::new()
+            }
             Input::Refused(why) => {
                 eprintln!("error: cannot connect to {url}: {why}");
                 status = 2;
                 break;
             }
-            Input::Line(line) => line,
         };
-        let line = line.trim();
-        if line.is_empty() {
-            continue;
-        }
-        let (name, value) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
-        let name = name.strip_prefix("USER.").unwrap_or(name);
-        let Some(command) = commands.get(name) else {
-            eprintln!(
-                "operator: the mission receives no USER command `{name}` (it receives: {})",
-                commands.keys().cloned().collect::<Vec<_>>().join(", ")
-            );
-            status = 1;
-            continue;
-        };
-        let Some(run) = view.run.run() else {
-            eprintln!(
-                "operator: no run of mission {mission_topic} is known yet (no robot's status has come): wait for one, or give --run"
-            );
-            status = 1;
-            continue;
-        };
-        let scope = Scope::run(&mission_topic, run);
-        let payload = operator_datagram(&command.key, value.trim());
-        for team in &command.teams {
-            let topic = topics::to_team(&scope, team, &command.key, topics::OPERATOR);
-            if let Err(e) = client.publish(topic, rumqttc::QoS::AtLeastOnce, false, payload.clone())
-            {
-                eprintln!("operator: {e}");
-                status = 1;
+        for line in typed {
+            match console.command(&line, view.run.run(), &sending.link) {
+                Typed::Nothing => {}
+                Typed::Refused => status = 1,
+                Typed::Published {
+                    command,
+                    messages,
+                    missed,
+                } => {
+                    sending.unacknowledged.push_back((command, messages));
+                    if missed {
+                        status = 1;
+                    }
+                }
             }
         }
-        let _ = writeln!(out, "sent {} = {}", command.key, value.trim());
         let _ = out.flush();
+        if ended && sending.settled() {
+            break;
+        }
     }
+    for (command, _) in &sending.unacknowledged {
+        eprintln!(
+            "operator: not confirmed: {command}: the broker did not acknowledge it before the connection was lost"
+        );
+        status = 1;
+    }
+    drop(rx);
     let _ = client.disconnect();
     let _ = listener.join();
     status
+}
+
+/// The console's connection to the broker.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+enum Link {
+    /// No outcome yet.
+    #[default]
+    Connecting,
+    Up,
+    /// Failed or lost (retried): why.
+    Down(String),
+}
+
+/// Where the operator's commands stand: the link, the lines typed before
+/// its first outcome, and the commands published and not yet acknowledged,
+/// each with the number of its messages (one per receiving team) the
+/// broker has still to acknowledge (QoS 1, in the order received). A
+/// command is said to be sent only once all its messages are acknowledged.
+#[derive(Default)]
+struct Sending {
+    link: Link,
+    held: Vec<String>,
+    unacknowledged: VecDeque<(String, usize)>,
+}
+
+impl Sending {
+    /// The link's new state; gives the lines held for it.
+    fn link_is(&mut self, link: Link) -> Vec<String> {
+        self.link = link;
+        std::mem::take(&mut self.held)
+    }
+
+    /// One acknowledgement: the command it completes, if it does.
+    fn acknowledged(&mut self) -> Option<String> {
+        let (_, left) = self.unacknowledged.front_mut()?;
+        *left = left.saturating_sub(1);
+        match left {
+            0 => self.unacknowledged.pop_front().map(|(command, _)| command),
+            _ => None,
+        }
+    }
+
+    /// Whether nothing typed is still on its way: no line held, and every
+    /// command acknowledged unless the link is down (then it cannot be).
+    fn settled(&self) -> bool {
+        self.held.is_empty()
+            && (self.unacknowledged.is_empty() || matches!(self.link, Link::Down(_)))
+    }
+}
+
+/// What the operator's lines are read against and published with.
+struct Console<'a> {
+    mission: &'a str,
+    commands: &'a BTreeMap<String, Command>,
+    client: &'a rumqttc::Client,
+}
+
+/// What became of a line the operator typed.
+enum Typed {
+    /// An empty line.
+    Nothing,
+    /// Not sent, and said why.
+    Refused,
+    /// Published as `messages` messages (one per receiving team), to be
+    /// acknowledged: `command` is `KEY = VALUE`; `missed`: not to every
+    /// team (said).
+    Published {
+        command: String,
+        messages: usize,
+        missed: bool,
+    },
+}
+
+impl Console<'_> {
+    /// Reads `NAME VALUE` and publishes the command to every team that
+    /// receives it in `run`, if the link is up.
+    fn command(&self, line: &str, run: Option<&RunId>, link: &Link) -> Typed {
+        let line = line.trim();
+        if line.is_empty() {
+            return Typed::Nothing;
+        }
+        let (name, value) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
+        let name = name.strip_prefix("USER.").unwrap_or(name);
+        let Some(command) = self.commands.get(name) else {
+            eprintln!(
+                "operator: the mission receives no USER command `{name}` (it receives: {})",
+                self.commands.keys().cloned().collect::<Vec<_>>().join(", ")
+            );
+            return Typed::Refused;
+        };
+        let Some(run) = run else {
+            eprintln!(
+                "operator: no run of mission {} is known yet (no robot's status has come): wait for one, or give --run",
+                self.mission
+            );
+            return Typed::Refused;
+        };
+        let said = format!("{} = {}", command.key, value.trim());
+        if let Link::Down(why) = link {
+            eprintln!("operator: not sent: {said}: no connection to the broker {why}");
+            return Typed::Refused;
+        }
+        let scope = Scope::run(self.mission, run);
+        let payload = operator_datagram(&command.key, value.trim());
+        let mut messages = 0;
+        for team in &command.teams {
+            let topic = topics::to_team(&scope, team, &command.key, topics::OPERATOR);
+            match self
+                .client
+                .publish(topic, rumqttc::QoS::AtLeastOnce, false, payload.clone())
+            {
+                Ok(()) => messages += 1,
+                Err(e) => eprintln!("operator: not sent to {team}: {said}: {e}"),
+            }
+        }
+        match messages {
+            0 => Typed::Refused,
+            _ => Typed::Published {
+                command: said,
+                messages,
+                missed: messages < command.teams.len(),
+            },
+        }
+    }
 }
 
 /// What a message from the broker comes to.

@@ -92,6 +92,34 @@ impl Record {
         }
     }
 
+    /// A mistake (`Severity::Error`) or a warning of the scenario `text`
+    /// read from `file`, with its did-you-mean.
+    pub fn scenario(
+        file: &Path,
+        text: &str,
+        mistake: semo::sim::ScenarioError,
+        severity: Severity,
+    ) -> Record {
+        let (line, column) = mistake.line_col(text);
+        Record {
+            severity: severity.as_str(),
+            suggestion: mistake.suggestion,
+            ..Record::uncoded_error(file, line, column, mistake.message)
+        }
+    }
+
+    /// The record for people: `scenario FILE:LINE:COL: [warning: ]MESSAGE`.
+    pub fn scenario_line(&self) -> String {
+        let severity = match self.severity {
+            "error" => String::new(),
+            other => format!("{other}: "),
+        };
+        format!(
+            "scenario {}:{}:{}: {severity}{}",
+            self.file, self.start.line, self.start.column, self.message
+        )
+    }
+
     /// An error at one point of a file that has no code (a scenario's).
     pub fn uncoded_error(file: &Path, line: u32, column: u32, message: String) -> Record {
         let at = Position { line, column };

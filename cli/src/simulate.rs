@@ -5,13 +5,16 @@
 
 use super::input::{self, Content};
 use super::output::{self, Format, Record};
+use semo::diag::Severity;
 use semo::sim::{self, scenario};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 pub struct Options {
-    pub mission: PathBuf,
-    pub scenario: PathBuf,
+    /// Else the project's one mission (`defaults::mission`).
+    pub mission: Option<PathBuf>,
+    /// Else the mission's own scenario (`defaults::scenario`).
+    pub scenario: Option<PathBuf>,
     pub strategy: Vec<PathBuf>,
     pub until_ms: Option<i64>,
     pub seed: u64,
@@ -61,7 +64,14 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     } else {
         Format::Human
     };
-    if input::is_stdin(&options.mission) {
+    let mission_file = match options.mission.clone() {
+        Some(named) => named,
+        None => match super::defaults::mission("`semo simulate MISSION`") {
+            Ok(found) => found,
+            Err(e) => return output::refused(format, "simulate", &e.folder, &e.message, out),
+        },
+    };
+    if input::is_stdin(&mission_file) {
         eprintln!(
             "error: `semo simulate` reads the mission's folder (its catalog and strategy files): give the mission's file, not `-` (the scenario may be `-`)"
         );
@@ -70,17 +80,24 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     if !input::strategy_paths_are_files(&options.strategy) {
         return 2;
     }
-    if !input::file_is_kind(&options.mission, Content::Mission, SIMULATE) {
+    if !input::file_is_kind(&mission_file, Content::Mission, SIMULATE) {
         return 2;
     }
-    let (mut check, mission) = match semo::host::load_build(&options.mission, &options.strategy) {
+    let (mut check, mission) = match semo::host::load_build(&mission_file, &options.strategy) {
         Ok(loaded) => loaded,
         Err(e) => {
             eprintln!("error: {e}");
             return 2;
         }
     };
-    let Some((scenario_name, scenario_text)) = input::read(&options.scenario) else {
+    let scenario_file = match options.scenario.clone() {
+        Some(named) => named,
+        None => match super::defaults::scenario(&mission_file) {
+            Ok(found) => found,
+            Err(e) => return output::refused(format, "simulate", &e.folder, &e.message, out),
+        },
+    };
+    let Some((scenario_name, scenario_text)) = input::read(&scenario_file) else {
         return 2;
     };
     if !input::is_kind(&scenario_name, &scenario_text, Content::Scenario, SIMULATE) {
@@ -114,14 +131,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let scenario = match scenario::parse(&scenario_text, &refined.programs) {
         Ok(s) => s,
         Err(e) => {
-            let (line, col) = e.line_col(&scenario_text);
-            let record = Record::uncoded_error(&scenario_name, line, col, e.message);
+            let record = Record::scenario(&scenario_name, &scenario_text, e, Severity::Error);
             if format == Format::Human {
-                eprintln!(
-                    "scenario {}:{line}:{col}: {}",
-                    scenario_name.display(),
-                    record.message
-                );
+                eprintln!("{}", record.scenario_line());
             } else {
                 let document = output::json_document(
                     "simulate",
@@ -133,6 +145,16 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     };
+    let warnings: Vec<Record> = scenario
+        .warnings
+        .iter()
+        .map(|w| Record::scenario(&scenario_name, &scenario_text, w.clone(), Severity::Warning))
+        .collect();
+    if !options.json {
+        for warning in &warnings {
+            eprintln!("{}", warning.scenario_line());
+        }
+    }
     if options.engine == Engine::C {
         return run_generated(
             &options,
@@ -168,7 +190,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let writes_stdout = |p: &Option<PathBuf>| p.as_deref() == Some(Path::new("-"));
     if !writes_stdout(&options.trace) && !writes_stdout(&options.svg) {
         let report = if options.json {
-            json_summary(&run, &verdicts)
+            json_summary(&run, &verdicts, &warnings)
         } else {
             sim::summary(&run, &verdicts)
         };
@@ -193,7 +215,7 @@ fn write_to(path: &Path, text: &str, out: &mut impl Write) -> i32 {
 }
 
 /// `--format json`: one object with each robot's modes and every expectation.
-fn json_summary(run: &sim::Run, verdicts: &[sim::Verdict]) -> String {
+fn json_summary(run: &sim::Run, verdicts: &[sim::Verdict], warnings: &[Record]) -> String {
     let modes = sim::expect::modes_of_every_robot(run);
     let robots: Vec<serde_json::Value> = run
         .robots
@@ -224,7 +246,7 @@ fn json_summary(run: &sim::Run, verdicts: &[sim::Verdict]) -> String {
         "expectations": expectations,
         "ok": verdicts.iter().all(|v| v.met),
     });
-    let mut text = output::json_document("simulate", &[], data).to_string();
+    let mut text = output::json_document("simulate", warnings, data).to_string();
     text.push('\n');
     text
 }

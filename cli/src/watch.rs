@@ -1,15 +1,19 @@
 //! `semo check --watch`: check, then check again whenever a SeMo file under
 //! the checked paths changes. File events come from the platform's watcher
-//! (inotify, FSEvents, …) through `notify`, debounced so that an editor's
-//! save (often a write, a rename and a metadata change) gives one re-check.
+//! (inotify, FSEvents, …) through `notify`; only changes count (a file
+//! written, created, removed or renamed), never a file being opened or read,
+//! or the check's own reading would start the next check. The changes of one
+//! save (often a write, a rename and a metadata change) are gathered into
+//! one re-check.
 
-use notify_debouncer_mini::notify::RecursiveMode;
-use notify_debouncer_mini::{DebounceEventResult, new_debouncer};
+use notify::event::ModifyKind;
+use notify::{Event, EventKind, RecommendedWatcher, RecursiveMode, Watcher};
 use std::path::{Path, PathBuf};
-use std::sync::mpsc;
+use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::Duration;
 
-/// How long the events of one save are gathered before checking again.
+/// How long after a change further changes are gathered into the same
+/// re-check (the rest of an editor's save).
 const DEBOUNCE: Duration = Duration::from_millis(200);
 
 /// The folders whose changes matter: a folder given, or a named file's
@@ -39,6 +43,19 @@ fn watched(paths: &[PathBuf]) -> Vec<PathBuf> {
     folders
 }
 
+/// Whether an event says something changed: a file written, created,
+/// removed or renamed, or the watcher lost events and the folder must be
+/// looked at again. Opening, reading and closing a file change nothing, nor
+/// do metadata changes (the check's reads may touch access times).
+fn is_change(event: &Event) -> bool {
+    event.need_rescan()
+        || match event.kind {
+            EventKind::Create(_) | EventKind::Remove(_) => true,
+            EventKind::Modify(kind) => !matches!(kind, ModifyKind::Metadata(_)),
+            EventKind::Access(_) | EventKind::Any | EventKind::Other => false,
+        }
+}
+
 /// Whether a changed path can change the report: a file of a SeMo kind
 /// (by name: the generated `out/…/taskgraph.xml` is not one), or a path
 /// the user named.
@@ -49,6 +66,46 @@ fn matters(changed: &Path, named: &[PathBuf]) -> bool {
         })
 }
 
+/// What the watcher said since the last look.
+enum Watched {
+    /// Something that matters changed.
+    Changed,
+    /// The watcher stopped (it can only stop with the process).
+    Stopped,
+    /// The watcher failed.
+    Failed(notify::Error),
+}
+
+/// Waits for a change that matters, then gathers the changes that follow
+/// it within `DEBOUNCE` of each other.
+fn next_change(events: &Receiver<notify::Result<Event>>, named: &[PathBuf]) -> Watched {
+    let matters_now = |event: notify::Result<Event>| match event {
+        Ok(event) => Ok(is_change(&event) && event.paths.iter().any(|p| matters(p, named))),
+        Err(e) => Err(Watched::Failed(e)),
+    };
+    loop {
+        let Ok(event) = events.recv() else {
+            return Watched::Stopped;
+        };
+        match matters_now(event) {
+            Ok(true) => break,
+            Ok(false) => {}
+            Err(failed) => return failed,
+        }
+    }
+    loop {
+        match events.recv_timeout(DEBOUNCE) {
+            Ok(event) => {
+                if let Err(failed) = matters_now(event) {
+                    return failed;
+                }
+            }
+            Err(RecvTimeoutError::Timeout) => return Watched::Changed,
+            Err(RecvTimeoutError::Disconnected) => return Watched::Stopped,
+        }
+    }
+}
+
 /// Runs `check` now and after every change that matters, until the
 /// process is stopped; gives 2 when the paths cannot be watched.
 pub fn run(paths: &[PathBuf], mut check: impl FnMut() -> i32) -> i32 {
@@ -56,34 +113,30 @@ pub fn run(paths: &[PathBuf], mut check: impl FnMut() -> i32) -> i32 {
         eprintln!("error: --watch watches files and folders: standard input (`-`) cannot change");
         return 2;
     }
-    let (events, changes) = mpsc::channel::<DebounceEventResult>();
-    let mut debouncer = match new_debouncer(DEBOUNCE, events) {
-        Ok(d) => d,
+    let (sender, events) = mpsc::channel::<notify::Result<Event>>();
+    let mut watcher = match RecommendedWatcher::new(sender, notify::Config::default()) {
+        Ok(w) => w,
         Err(e) => {
             eprintln!("error: cannot watch files: {e}");
             return 2;
         }
     };
     for folder in watched(paths) {
-        if let Err(e) = debouncer.watcher().watch(&folder, RecursiveMode::Recursive) {
+        if let Err(e) = watcher.watch(&folder, RecursiveMode::Recursive) {
             eprintln!("error: cannot watch {}: {e}", folder.display());
             return 2;
         }
     }
-    check();
-    eprintln!("watching for changes (stop with Ctrl-C)");
-    for batch in changes {
-        match batch {
-            Ok(events) if events.iter().any(|e| matters(&e.path, paths)) => {
-                check();
-                eprintln!("watching for changes (stop with Ctrl-C)");
-            }
-            Ok(_) => {}
-            Err(e) => {
+    loop {
+        check();
+        eprintln!("watching for changes (stop with Ctrl-C)");
+        match next_change(&events, paths) {
+            Watched::Changed => {}
+            Watched::Stopped => return 0,
+            Watched::Failed(e) => {
                 eprintln!("error: watching files: {e}");
                 return 2;
             }
         }
     }
-    0
 }

@@ -1003,7 +1003,8 @@ mod tests;
 mod view;
 
 pub use disk::{
-    CheckRun, ProjectInputs, STDIN_NAME, load_build, load_check, load_check_stdin, project_inputs,
+    CheckRun, MAX_ENTRIES, ProjectInputs, STDIN_NAME, load_build, load_check, load_check_stdin,
+    project_inputs,
 };
 pub use dropper::{Dropper, drop_later};
 pub use ide::{PictureError, WORKSPACE_SYMBOL_LIMIT};

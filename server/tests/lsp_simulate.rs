@@ -148,6 +148,33 @@ async fn the_open_mission_is_simulated_with_its_scenario() {
         json!({"line": 1, "character": 14}),
         "{diagnostics:?}"
     );
+
+    // A sensor value no robot samples: simulated, and a warning at it.
+    std::fs::write(
+        dir.join("colour.scenario.json"),
+        "{\"robots\": {\"ti\": {\"sensors\": [{\"at\": 0, \"value\": \"COLOUR\", \"is\": \"RED\"}]}}}\n",
+    )
+    .unwrap();
+    simulate(&mut client, &mission_uri, "colour.scenario.json")
+        .await
+        .unwrap();
+    let diagnostics = client
+        .diagnostics(&uri(&dir.join("colour.scenario.json")), None)
+        .await;
+    let warning = diagnostics
+        .iter()
+        .find(|d| d["severity"] == 2)
+        .unwrap_or_else(|| panic!("a warning: {diagnostics:?}"));
+    assert_eq!(
+        (&warning["range"]["start"], &warning["message"]),
+        (
+            &json!({"line": 0, "character": 50}),
+            &json!(
+                "robot ti samples no sensor value \"COLOUR\": nothing reads this entry (it samples: COLOR, LOCATION) (did you mean \"COLOR\"?)"
+            )
+        ),
+        "{diagnostics:?}"
+    );
     client.shutdown().await;
 }
 

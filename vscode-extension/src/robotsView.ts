@@ -90,7 +90,7 @@ export class RobotsView implements vscode.TreeDataProvider<TreeNode>, vscode.Dis
     const collapsed =
       node.children.length === 0
         ? vscode.TreeItemCollapsibleState.None
-        : node.kind === 'robot'
+        : node.kind === 'robot' || node.kind === 'operator'
           ? vscode.TreeItemCollapsibleState.Collapsed
           : vscode.TreeItemCollapsibleState.Expanded;
     const item = new vscode.TreeItem(node.label, collapsed);
@@ -100,9 +100,13 @@ export class RobotsView implements vscode.TreeDataProvider<TreeNode>, vscode.Dis
       item.tooltip = new vscode.MarkdownString(node.tooltip);
     }
     item.iconPath = new vscode.ThemeIcon(
-      { robot: 'hubot', section: 'folder', service: 'symbol-method', value: 'symbol-field' }[
-        node.kind
-      ],
+      {
+        robot: 'hubot',
+        operator: 'account',
+        section: 'folder',
+        service: 'symbol-method',
+        value: 'symbol-field',
+      }[node.kind],
     );
     item.contextValue = node.kind;
     if (node.insert) {

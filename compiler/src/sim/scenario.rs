@@ -29,6 +29,9 @@ pub struct Scenario {
     pub network: Network,
     pub faults: Vec<Fault>,
     pub expect: Vec<Expectation>,
+    /// What the file says that has no effect on the run, likely a typo (a
+    /// sensor value the robot does not sample): positioned as errors are.
+    pub warnings: Vec<ScenarioError>,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -184,11 +187,14 @@ impl std::fmt::Display for ExpectKind {
     }
 }
 
-/// A mistake in the scenario, at a byte offset of its text.
+/// A mistake in the scenario (or a warning), at a byte offset of its text.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScenarioError {
     pub at: usize,
+    /// What is wrong, a did-you-mean included.
     pub message: String,
+    /// The name the user most likely meant, for an unknown one close to it.
+    pub suggestion: Option<String>,
 }
 
 impl ScenarioError {
@@ -219,7 +225,27 @@ fn fail<T>(v: &Value, message: impl Into<String>) -> Result<T> {
     Err(ScenarioError {
         at: v.at,
         message: message.into(),
+        suggestion: None,
     })
+}
+
+/// [`fail`] about the unknown `name`, with a did-you-mean ([`suggesting`]).
+fn fail_suggesting<T>(v: &Value, message: String, name: &str, known: &[&str]) -> Result<T> {
+    Err(suggesting(v, message, name, known))
+}
+
+/// `message` at `v` about the unknown `name`, with the known name closest
+/// to it as a did-you-mean when one is close enough to be a typo.
+fn suggesting(v: &Value, message: String, name: &str, known: &[&str]) -> ScenarioError {
+    let suggestion = crate::suggest::did_you_mean(name, known.iter().copied());
+    ScenarioError {
+        at: v.at,
+        message: match &suggestion {
+            Some(close) => format!("{message} (did you mean \"{close}\"?)"),
+            None => message,
+        },
+        suggestion,
+    }
 }
 
 impl Scenario {
@@ -253,6 +279,7 @@ pub fn parse(text: &str, programs: &[RobotProgram]) -> Result<Scenario> {
     let root = json::parse(text).map_err(|e| ScenarioError {
         at: e.at,
         message: e.message,
+        suggestion: None,
     })?;
     Reader { programs }.scenario(&root)
 }
@@ -338,17 +365,21 @@ fn probability(v: &Value, key: &str) -> Result<f64> {
 impl Reader<'_> {
     fn robot(&self, v: &Value, key: &str) -> Result<String> {
         let robot = name(v, key)?;
+        self.known_robot(v, robot)?;
+        Ok(robot.to_string())
+    }
+
+    /// Fails at `v` unless `robot` is a robot of the mission.
+    fn known_robot(&self, v: &Value, robot: &str) -> Result<()> {
         if self.programs.iter().any(|p| p.robot == robot) {
-            return Ok(robot.to_string());
+            return Ok(());
         }
         let known: Vec<&str> = self.programs.iter().map(|p| p.robot.as_str()).collect();
-        fail(
-            v,
-            format!(
-                "robot \"{robot}\" is not in the mission (robots: {})",
-                known.join(", ")
-            ),
-        )
+        let message = format!(
+            "robot \"{robot}\" is not in the mission (robots: {})",
+            known.join(", ")
+        );
+        fail_suggesting(v, message, robot, &known)
     }
 
     fn robot_or_team(&self, v: &Value, key: &str) -> Result<String> {
@@ -356,10 +387,46 @@ impl Reader<'_> {
         if self.programs.iter().any(|p| p.robot == to || p.team == to) {
             return Ok(to.to_string());
         }
-        fail(
-            v,
-            format!("\"{to}\" is neither a robot nor a team of the mission"),
-        )
+        let known: Vec<&str> = self
+            .programs
+            .iter()
+            .flat_map(|p| [p.robot.as_str(), p.team.as_str()])
+            .collect();
+        let message = format!("\"{to}\" is neither a robot nor a team of the mission");
+        fail_suggesting(v, message, to, &known)
+    }
+
+    /// A warning at `v` unless `robot`'s program samples the sensor value
+    /// `value` (one of its sensor tasks' values): nobody would read it. A
+    /// warning, not an error: one scenario may serve variants of a mission,
+    /// not all of which read every value.
+    fn unsampled(&self, v: &Value, robot: &str, value: &str) -> Option<ScenarioError> {
+        let mut sampled: Vec<&str> = self
+            .programs
+            .iter()
+            .filter(|p| p.robot == robot)
+            .flat_map(|p| &p.tasks)
+            .filter_map(|t| match &t.kind {
+                crate::refine::RoleKind::Sensor { values, .. } => Some(values),
+                _ => None,
+            })
+            .flatten()
+            .map(String::as_str)
+            .collect();
+        if sampled.contains(&value) {
+            return None;
+        }
+        sampled.sort_unstable();
+        sampled.dedup();
+        let listed = if sampled.is_empty() {
+            "none".to_string()
+        } else {
+            sampled.join(", ")
+        };
+        let message = format!(
+            "robot {robot} samples no sensor value \"{value}\": nothing reads this entry (it samples: {listed})"
+        );
+        Some(suggesting(v, message, value, &sampled))
     }
 
     /// A mode of `robot`'s team (or of any team when `robot` is `None`).
@@ -382,6 +449,8 @@ impl Reader<'_> {
             .collect();
         known.sort_unstable();
         known.dedup();
+        // No did-you-mean: modes share their `_MODE` endings, so the
+        // closest one is often another mode, not the one meant.
         fail(
             v,
             format!(
@@ -434,7 +503,8 @@ impl Reader<'_> {
                 return fail(robots, "expected an object of robots {\"name\": {...}}");
             };
             for (robot, v) in members {
-                scenario.robots.push(self.robot_world(robot, v)?);
+                let world = self.robot_world(robot, v, &mut scenario.warnings)?;
+                scenario.robots.push(world);
             }
         }
         if let Some(commands) = root.member("operator") {
@@ -458,17 +528,13 @@ impl Reader<'_> {
         Ok(scenario)
     }
 
-    fn robot_world(&self, robot: &str, v: &Value) -> Result<RobotWorld> {
-        if !self.programs.iter().any(|p| p.robot == robot) {
-            let known: Vec<&str> = self.programs.iter().map(|p| p.robot.as_str()).collect();
-            return fail(
-                v,
-                format!(
-                    "robot \"{robot}\" is not in the mission (robots: {})",
-                    known.join(", ")
-                ),
-            );
-        }
+    fn robot_world(
+        &self,
+        robot: &str,
+        v: &Value,
+        warnings: &mut Vec<ScenarioError>,
+    ) -> Result<RobotWorld> {
+        self.known_robot(v, robot)?;
         object(
             v,
             "a robot {\"sensors\": [...], \"services\": {...}, \"battery\": [...], \"loops\": {...}}",
@@ -486,7 +552,9 @@ impl Reader<'_> {
                     &["at", "value", "is"],
                 )?;
                 let at = ms(require(entry, "at")?, "at", 0)?;
-                let value = name(require(entry, "value")?, "value")?.to_string();
+                let value_at = require(entry, "value")?;
+                let value = name(value_at, "value")?.to_string();
+                warnings.extend(self.unsampled(value_at, robot, &value));
                 let is_value = require(entry, "is")?;
                 let is = value_text(is_value)?;
                 // Read as the catalog's type of the value, as the sensor task

@@ -334,13 +334,40 @@ fn link_faults_lose_and_delay_messages() {
 }
 
 #[test]
+fn a_sensor_value_no_task_samples_is_a_positioned_warning_with_a_did_you_mean() {
+    let programs = programs("examples/scouting/scouting.mission");
+    let text =
+        "{\"robots\": {\"nxt\": {\"sensors\": [{\"at\": 0, \"value\": \"LOCATOIN\", \"is\": 1}]}}}";
+    let scenario = scenario::parse(text, &programs).unwrap();
+    let warnings: Vec<_> = scenario
+        .warnings
+        .iter()
+        .map(|w| {
+            (
+                w.line_col(text),
+                w.message.as_str(),
+                w.suggestion.as_deref(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        warnings,
+        [(
+            (1, 52),
+            "robot nxt samples no sensor value \"LOCATOIN\": nothing reads this entry (it samples: COLOR, LOCATION) (did you mean \"LOCATION\"?)",
+            Some("LOCATION")
+        )]
+    );
+}
+
+#[test]
 fn scenario_mistakes_point_at_the_value() {
     let programs = programs("examples/scouting/scouting.mission");
     for (text, line_col, message) in [
         (
             "{\n  \"robots\": {\"robot9\": {}}\n}",
             (2, 24),
-            "robot \"robot9\" is not in the mission (robots: irobot, ti, nxt)",
+            "robot \"robot9\" is not in the mission (robots: irobot, ti, nxt) (did you mean \"irobot\"?)",
         ),
         (
             "{\"expect\": [{\"robot\": \"ti\", \"enters\": \"WAIT_MODE\"}]}",

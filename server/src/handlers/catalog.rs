@@ -21,7 +21,9 @@ pub fn catalog(catalog: &Catalog) -> Value {
     })
 }
 
-fn robot(r: &RobotType) -> Value {
+/// One robot type (or the operator console) as `semo/catalog` gives it;
+/// `semo catalog --format json` gives the same shape.
+pub fn robot(r: &RobotType) -> Value {
     json!({
         "name": r.name,
         "aliases": r.aliases,

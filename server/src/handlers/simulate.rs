@@ -9,8 +9,9 @@
 //! prints), "svg" (the timeline), "expectations": [{ "expectation", "met",
 //! "why", "range" (the expectation in the scenario file) }] }`. A mission with
 //! errors or a bad scenario is refused with the reason (the scenario's line
-//! and column). The failed expectations, or the scenario's mistake, are
-//! published as the scenario file's diagnostics.
+//! and column). The failed expectations and the scenario's warnings (a
+//! sensor value no robot samples), or the scenario's mistake, are published
+//! as the scenario file's diagnostics.
 
 use crate::world::World;
 use semo::sim;
@@ -105,17 +106,22 @@ pub fn simulate(job: &Job) -> Outcome {
         )
     };
     let (answer, diagnostics) = match run(job, &text) {
-        Ok((answer, failed)) => {
-            let diagnostics = failed
-                .iter()
-                .map(|v| {
-                    diagnostic(
-                        at(v.expectation.at_offset),
-                        format!("expectation failed: {}: {}", v.expectation.kind, v.why),
-                    )
-                })
-                .collect();
-            (Ok(answer), diagnostics)
+        Ok(Ran {
+            answer,
+            failed,
+            warnings,
+        }) => {
+            let failed = failed.iter().map(|v| {
+                diagnostic(
+                    at(v.expectation.at_offset),
+                    format!("expectation failed: {}: {}", v.expectation.kind, v.why),
+                )
+            });
+            let warnings = warnings.into_iter().map(|w| Diagnostic {
+                severity: Some(DiagnosticSeverity::WARNING),
+                ..diagnostic(at(w.at), w.message)
+            });
+            (Ok(answer), failed.chain(warnings).collect())
         }
         Err(Refusal::Scenario(e)) => {
             let (line, col) = e.line_col(&text);
@@ -149,8 +155,15 @@ enum Refusal {
     Scenario(sim::ScenarioError),
 }
 
-/// The answer and the failed expectations.
-fn run(job: &Job, text: &str) -> Result<(Value, Vec<sim::Verdict>), Refusal> {
+/// A simulation's answer, its failed expectations and the scenario's
+/// warnings.
+struct Ran {
+    answer: Value,
+    failed: Vec<sim::Verdict>,
+    warnings: Vec<sim::ScenarioError>,
+}
+
+fn run(job: &Job, text: &str) -> Result<Ran, Refusal> {
     let build = job.analysis.build_input(job.mission).ok_or_else(|| {
         Refusal::Mission("internal error: the mission is not in the workspace analysis".into())
     })?;
@@ -195,5 +208,9 @@ fn run(job: &Job, text: &str) -> Result<(Value, Vec<sim::Verdict>), Refusal> {
         "svg": sim::svg::to_svg(&result, &programs, &scenario),
         "expectations": expectations,
     });
-    Ok((answer, verdicts.into_iter().filter(|v| !v.met).collect()))
+    Ok(Ran {
+        answer,
+        failed: verdicts.into_iter().filter(|v| !v.met).collect(),
+        warnings: scenario.warnings,
+    })
 }

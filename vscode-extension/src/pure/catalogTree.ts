@@ -1,5 +1,6 @@
 // The Robots panel's tree, built from the server's `semo/catalog` answer:
-// robot types → "services" (with parameters) and "values" (with types).
+// robot types → "services" (with parameters) and "values" (with types), and
+// the operator console (`USER`) last, shown as what it is: no robot type.
 // Pure data (no VS Code types) so that it is tested on its own; the view
 // turns each node into a TreeItem.
 
@@ -39,7 +40,7 @@ export type Insertion = { snippet: string } | { text: string };
 export interface TreeNode {
   /** Unique within the tree (robot/section/name), stable across refreshes. */
   id: string;
-  kind: 'robot' | 'section' | 'service' | 'value';
+  kind: 'robot' | 'operator' | 'section' | 'service' | 'value';
   label: string;
   /** Shown greyed beside the label. */
   description?: string;
@@ -151,8 +152,24 @@ function robotNode(robot: CatalogRobot): TreeNode {
   };
 }
 
+/** The operator console: its values are what missions receive from it. */
+function operatorNode(user: CatalogRobot): TreeNode {
+  return {
+    ...robotNode(user),
+    kind: 'operator',
+    description: 'operator console, not a robot type',
+    tooltip: [
+      `**${user.name}**: the operator console, not a robot type`,
+      'Missions receive its values from it (`USER.RC_CMD`); no robot is of this type.',
+      user.doc ?? '',
+    ]
+      .filter((l) => l !== '')
+      .join('\n\n'),
+  };
+}
+
 /**
- * The tree: robot types by name, the operator pseudo-robot last. Tolerates
+ * The tree: robot types by name, the operator console last. Tolerates
  * a malformed answer (anything not shaped like a catalog gives no nodes),
  * since a panel must never throw.
  */
@@ -164,7 +181,7 @@ export function buildTree(result: unknown): TreeNode[] {
   const robots = Array.isArray(catalog.robots) ? catalog.robots.filter(isRobot) : [];
   const nodes = [...robots].sort((a, b) => a.name.localeCompare(b.name)).map(robotNode);
   if (catalog.user && isRobot(catalog.user) && !robots.some((r) => r.name === catalog.user!.name)) {
-    nodes.push(robotNode(catalog.user));
+    nodes.push(operatorNode(catalog.user));
   }
   return nodes;
 }

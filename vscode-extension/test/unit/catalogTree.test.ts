@@ -63,10 +63,21 @@ test('robot types by name, their services with parameters and values with types'
     '    move — (distance: number, speed?: number) ⇒ move(${1:distance})$0',
     '  values — 1',
     '    COLOR — string ⇒ COLOR',
-    'USER',
+    'USER — operator console, not a robot type',
     '  services — 1',
     '    notify — (text: string) ⇒ notify(${1:text})$0',
   ]);
+});
+
+test('the operator console is not listed as a robot type', () => {
+  const tree = buildTree(CATALOG);
+  assert.deepEqual(
+    tree.filter((n) => n.kind === 'robot').map((n) => n.label),
+    ['Drone', 'TIEvalbot'],
+  );
+  const user = tree[tree.length - 1];
+  assert.equal(user.kind, 'operator');
+  assert.match(user.tooltip!, /not a robot type/);
 });
 
 test('tooltips carry the signature and the doc', () => {
