@@ -2,55 +2,28 @@
 //! mission runs on the same scenario through `semo simulate` and as the
 //! generated `linux-sim` programs (`semo simulate --engine c`: one process
 //! per robot, in lock-step virtual time, the coordinator their clock and
-//! network), and per robot the two traces must show the same behaviour: the
-//! sequence of modes, of services started per plan, of caught events, of
-//! leaders; the same messages sent (to, key) and received (from robot, key);
-//! and each mode entered at about the same mission time.
+//! network), and the two traces must be the same event for event: per robot
+//! and per mission instant the same events (modes, services started and
+//! ended, calls with their arguments, sends and receives with their values,
+//! throws and catches, leaders, owners, groups, battery policies, drops,
+//! faults), with no tolerance and no window left out. Any difference is a
+//! bug in one of the two.
+//!
+//! Within one instant the events are compared as a set: the order in which
+//! a robot's threads write the lines of one instant (a send is written by
+//! the sender task after the control task's firing, a call's start by the
+//! control task) is not part of the meaning; which instant each happens in is.
 //!
 //! The scenarios include faults: kill and restart (done by the coordinator
 //! at their mission time), link faults (drop, delay, partition: the
 //! runtime's send path) and battery levels (the runtime's `BATTERY` value);
 //! the random missions get random ones (`missiongen::scenario`).
-//!
-//! In lock-step no clock is read: a run is the same on a loaded machine,
-//! and what is left of the differences in time is the two's different step
-//! rules, the same in every run (the simulator's control task fires on a
-//! 10 ms grid, the C one when woken: a call started after another ends comes
-//! 10 ms later in C, and such steps add up along a chain). Until the two
-//! agree event for event (issue "One exact meaning"), the times are compared
-//! one-sided, within bounds measured when they ran on the wall clock:
-//!
-//! - never earlier than the simulator's by more than [`EARLY_MS`] (210 ms:
-//!   a race at one instant resolved the other way costs one period of the
-//!   service polling for it, 200 ms for march's `Watch`, and one control
-//!   period, 10 ms);
-//! - never later by more than [`LATE_MS`] (500 ms): a sensor-driven change
-//!   waits for the next sample (100 ms) and the call under way (100 ms + 10
-//!   ms), and every step of a chain adds up.
-//!
-//! Differences beyond them, or in any sequence, are a bug in one of the two.
 
 mod support;
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use support::{examples, repo_root, semo_in};
-
-const EARLY_MS: i64 = 210;
-const LATE_MS: i64 = 500;
-
-/// The start-up window of a random mission's run, whose receptions are not
-/// compared. This and the other windows ([`HEAL_MS`], [`finishing`]) were
-/// measured when the robots ran on the wall clock; they stay until the exact
-/// comparison replaces these checks (in lock-step the same instants are
-/// ordered one fixed way by each engine, not always the same way by both).
-/// On the wall clock: behind the barrier every port is open from mission time 0, but
-/// each process's first control firing still comes when its threads get the
-/// cores (measured up to 38 mission ms after 0 at `time_scale` 0.2), so a
-/// robot that finishes at its first firing (random seed 6) may hear the
-/// others' first messages in C and not in the simulator, where every robot
-/// fires at 0 and a message takes 1 ms. Before the barrier: 250 ms.
-const START_MS: i64 = 100;
 
 type Event = serde_json::Map<String, serde_json::Value>;
 
@@ -73,86 +46,6 @@ fn parse_trace(text: &str) -> Vec<Event> {
         .collect()
 }
 
-/// What is compared of one robot's trace. The sequences are compared as
-/// runs of equal items (the item, and whether it repeats): a mode that
-/// catches its own event is entered again at every control firing it keeps
-/// up with, a rate that a loaded machine lowers in C (random seed 11 at
-/// `time_scale` 0.2 fired 115 times in C, 200 in the simulator), while a
-/// different event, mode, service or leader, another order, or a repetition
-/// on one side only is still a difference.
-#[derive(Debug, PartialEq, Eq)]
-struct Behaviour {
-    modes: Runs<String>,
-    services: BTreeMap<String, Runs<String>>,
-    catches: Runs<(String, String)>,
-    leaders: Runs<String>,
-    /// The owners of the team's globally shared values it changed to.
-    owners: Runs<String>,
-    /// Group services: (rank, size) as each change was traced.
-    groups: Runs<(String, String)>,
-    sent: BTreeSet<(String, String)>,
-    received: BTreeSet<(String, String)>,
-    /// Adaptive resource management: the battery policies that start and
-    /// stop holding and the levels they give (`resources`).
-    resources: Vec<(String, String, String)>,
-}
-
-/// A sequence as runs of equal consecutive items: (item, repeated).
-type Runs<T> = Vec<(T, bool)>;
-
-fn runs<T: PartialEq>(items: impl IntoIterator<Item = T>) -> Runs<T> {
-    let mut out: Runs<T> = Vec::new();
-    for item in items {
-        match out.last_mut() {
-            Some((last, repeated)) if *last == item => *repeated = true,
-            _ => out.push((item, false)),
-        }
-    }
-    out
-}
-
-fn behaviour(events: &[&Event]) -> Behaviour {
-    fn of<'a>(events: &'a [&'a Event], kind: &'a str) -> impl Iterator<Item = &'a &'a Event> {
-        events.iter().filter(move |e| field(e, "event") == kind)
-    }
-    let mut services: BTreeMap<String, Vec<String>> = BTreeMap::new();
-    for e in of(events, "service_start") {
-        services
-            .entry(field(e, "plan").to_string())
-            .or_default()
-            .push(field(e, "service").to_string());
-    }
-    Behaviour {
-        modes: runs(of(events, "mode").map(|e| field(e, "mode").to_string())),
-        services: services
-            .into_iter()
-            .map(|(plan, list)| (plan, runs(list)))
-            .collect(),
-        catches: runs(
-            of(events, "catch")
-                .map(|e| (field(e, "name").to_string(), field(e, "mode").to_string())),
-        ),
-        leaders: runs(of(events, "leader").map(|e| field(e, "leader").to_string())),
-        owners: runs(of(events, "shared_owner").map(|e| field(e, "owner").to_string())),
-        groups: runs(
-            of(events, "group")
-                .map(|e| (field(e, "rank").to_string(), field(e, "size").to_string())),
-        ),
-        sent: of(events, "send")
-            .map(|e| (field(e, "to").to_string(), field(e, "key").to_string()))
-            .collect(),
-        received: of(events, "receive")
-            .map(|e| {
-                (
-                    field(e, "from_robot").to_string(),
-                    field(e, "key").to_string(),
-                )
-            })
-            .collect(),
-        resources: resources(events).into_iter().map(|(_, r)| r).collect(),
-    }
-}
-
 /// The resource manager's events: (time, (event, the policy's condition or
 /// the task, whether it holds or the level)).
 fn resources(events: &[&Event]) -> Vec<(i64, (String, String, String))> {
@@ -171,19 +64,6 @@ fn resources(events: &[&Event]) -> Vec<(i64, (String, String, String))> {
             ))
         })
         .collect()
-}
-
-/// When each run of modes began (see [`Behaviour`]).
-fn mode_times(events: &[&Event]) -> Vec<i64> {
-    let mut times = Vec::new();
-    let mut last = None;
-    for e in events.iter().filter(|e| field(e, "event") == "mode") {
-        if last != Some(field(e, "mode")) {
-            times.push(e["t"].as_i64().unwrap());
-            last = Some(field(e, "mode"));
-        }
-    }
-    times
 }
 
 /// The robots of `mission`, in peer order (`semo build --target linux-sim`,
@@ -233,7 +113,73 @@ fn run_engine(mission: &Path, scenario: &Path, engine: &str) -> Vec<Event> {
     parse_trace(&out.stdout)
 }
 
-/// Compares the two runs and returns them: the C traces by robot, and the
+/// Each robot's events by mission instant, every event as canonical JSON
+/// (its fields in name order), the events of one instant sorted.
+fn by_instant<'e>(events: impl Iterator<Item = &'e Event>) -> BTreeMap<i64, Vec<String>> {
+    let mut instants: BTreeMap<i64, Vec<String>> = BTreeMap::new();
+    for e in events {
+        let canonical: BTreeMap<&String, &serde_json::Value> = e.iter().collect();
+        instants
+            .entry(e["t"].as_i64().expect("every trace line has its time"))
+            .or_default()
+            .push(serde_json::to_string(&canonical).unwrap());
+    }
+    for events in instants.values_mut() {
+        events.sort_unstable();
+    }
+    instants
+}
+
+/// The differences between `robot`'s events in C and in the simulator: the
+/// first few instants at which they differ, with the events of each side
+/// that the other lacks.
+fn differences(robot: &str, c: &[Event], sim: &[Event]) -> Vec<String> {
+    let (c, sim) = (
+        by_instant(c.iter()),
+        by_instant(sim.iter().filter(|e| field(e, "robot") == robot)),
+    );
+    let mut instants: Vec<i64> = c.keys().chain(sim.keys()).copied().collect();
+    instants.sort_unstable();
+    instants.dedup();
+    let none = Vec::new();
+    let mut out = Vec::new();
+    for t in instants {
+        let (in_c, in_sim) = (c.get(&t).unwrap_or(&none), sim.get(&t).unwrap_or(&none));
+        if in_c == in_sim {
+            continue;
+        }
+        let mut text = format!("{robot} at {t} ms:");
+        for (side, events, other) in [("C  ", in_c, in_sim), ("sim", in_sim, in_c)] {
+            for e in events.iter().filter(|e| !other.contains(e)) {
+                text.push_str(&format!("\n  only in {side}: {e}"));
+            }
+        }
+        out.push(text);
+        if out.len() == 5 {
+            out.push(format!("{robot}: more instants differ"));
+            break;
+        }
+    }
+    out
+}
+
+/// The differences of a whole run: per robot, as [`differences`]; a robot
+/// with events on one side only counts too.
+fn run_differences(c: &BTreeMap<String, Vec<Event>>, sim: &[Event]) -> Vec<String> {
+    let mut robots: Vec<&str> = c.keys().map(String::as_str).collect();
+    for e in sim {
+        if !robots.contains(&field(e, "robot")) {
+            robots.push(field(e, "robot"));
+        }
+    }
+    robots
+        .into_iter()
+        .flat_map(|robot| differences(robot, c.get(robot).map_or(&[][..], |v| v), sim))
+        .collect()
+}
+
+/// Runs `mission` on the scenario both ways, asserts the two traces are the
+/// same event for event, and returns them: the C traces by robot, and the
 /// simulator's trace.
 fn compare(
     name: &str,
@@ -245,61 +191,12 @@ fn compare(
     std::fs::write(&scenario, scenario_text).unwrap();
     let reference: Vec<Event> = simulate(mission, &scenario);
     let processes = lock_step(mission, &scenario);
-    let mut problems = Vec::new();
-    for (robot, events) in &processes {
-        let c: Vec<&Event> = events.iter().collect();
-        let s: Vec<&Event> = reference
-            .iter()
-            .filter(|e| field(e, "robot") == robot)
-            .collect();
-        let (bc, bs) = (behaviour(&c), behaviour(&s));
-        if bc != bs {
-            problems.push(format!("{robot}:\n  C:   {bc:?}\n  sim: {bs:?}"));
-            continue;
-        }
-        let worst = mode_times(&c)
-            .into_iter()
-            .zip(mode_times(&s))
-            .map(|(tc, ts)| tc - ts)
-            .max_by_key(|d| d.abs())
-            .unwrap_or(0);
-        eprintln!(
-            "{name}/{robot}: {} modes, {} catches, {} leaders, {} kinds of message sent, {} received; C mode times differ by up to {worst:+} ms",
-            bs.modes.len(),
-            bs.catches.len(),
-            bs.leaders.len(),
-            bs.sent.len(),
-            bs.received.len()
-        );
-        let policy_times = |events: &[&Event]| -> Vec<i64> {
-            resources(events)
-                .into_iter()
-                .filter(|(_, (kind, _, _))| kind == "battery_policy")
-                .map(|(t, _)| t)
-                .collect()
-        };
-        for (tc, ts) in policy_times(&c).into_iter().zip(policy_times(&s)) {
-            if tc - ts < -EARLY_MS || tc - ts > LATE_MS {
-                problems.push(format!(
-                    "{robot}: battery policies changed at {:?} (C) and {:?} (sim)",
-                    policy_times(&c),
-                    policy_times(&s)
-                ));
-                break;
-            }
-        }
-        for (tc, ts) in mode_times(&c).into_iter().zip(mode_times(&s)) {
-            if tc - ts < -EARLY_MS || tc - ts > LATE_MS {
-                problems.push(format!(
-                    "{robot}: modes entered at {:?} (C) and {:?} (sim)",
-                    mode_times(&c),
-                    mode_times(&s)
-                ));
-                break;
-            }
-        }
-    }
+    let problems = run_differences(&processes, &reference);
     assert!(problems.is_empty(), "{name}:\n{}", problems.join("\n"));
+    eprintln!(
+        "{name}: {} events the same in C and in the simulator",
+        reference.len()
+    );
     (processes, reference)
 }
 
@@ -327,9 +224,9 @@ fn a_killed_leader_is_replaced_the_same_way_in_c_and_in_the_simulator() {
 
 /// The leader killed and restarted: the new process starts from the default
 /// mode, on the mission's clock, listens, follows tb_1 until it gives way
-/// and takes the lead back (docs/groups.md): at 3.2 s or 4.2 s, as tb_1's
-/// heartbeat saying it gave way arrives before tb_0's pass at 3.2 s or just
-/// after it (a real-time race), so the run goes on to 5 s.
+/// and takes the lead back (docs/groups.md): tb_1 and tb_2 follow tb_0 again
+/// at 3 s, and tb_0 sees itself lead at its pass at 4.2 s, so the run goes
+/// on to 5 s.
 #[test]
 fn a_restarted_leader_comes_back_the_same_way_in_c_and_in_the_simulator() {
     compare(
@@ -499,8 +396,8 @@ fn battery_policies_change_periods_and_speeds_the_same_in_c_and_in_the_simulator
                             t - start
                         );
                         slow_calls += 1;
-                    } else if side == "sim" && t < on {
-                        assert_eq!(t - start, 100, "sim: a call at speed level 1");
+                    } else if t < on {
+                        assert_eq!(t - start, 100, "{side}: a call at speed level 1");
                     }
                 }
                 _ => {}
@@ -536,121 +433,9 @@ fn the_other_examples_behave_the_same_in_c_and_in_the_simulator() {
     );
 }
 
-/// The events without the receptions of the start-up window ([`START_MS`]).
-fn settled<'e>(events: &[&'e Event]) -> Vec<&'e Event> {
-    events
-        .iter()
-        .copied()
-        .filter(|e| field(e, "event") != "receive" || e["t"].as_i64().unwrap() >= START_MS)
-        .collect()
-}
-
-/// One heartbeat period of the generated missions (200 ms): after a link
-/// fault ends, which of two robots leads is decided by whether one's
-/// heartbeat or the other's message (each every 200 ms, a few ms apart)
-/// arrives first; within the simulator's link latency that is a race in real
-/// time (random seed 14: a leader's publish 2 ms after the heartbeat that
-/// ends its leadership).
-const HEAL_MS: i64 = 200;
-
-/// The events without the receptions of the heartbeat period after each
-/// link fault of `scenario` ends ([`HEAL_MS`]).
-fn healed<'e>(events: &[&'e Event], scenario: &str) -> Vec<&'e Event> {
-    let scenario: serde_json::Value = serde_json::from_str(scenario).unwrap();
-    let ends: Vec<i64> = scenario["faults"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .filter(|f| {
-            ["drop", "delay", "partition"]
-                .iter()
-                .any(|k| f.get(k).is_some())
-        })
-        .filter_map(|f| f["until"].as_i64())
-        .collect();
-    events
-        .iter()
-        .copied()
-        .filter(|e| {
-            let t = e["t"].as_i64().unwrap();
-            field(e, "event") != "receive"
-                || !ends.iter().any(|&end| (end..end + HEAL_MS).contains(&t))
-        })
-        .collect()
-}
-
-/// `robot`'s events without the receptions of what the simulator
-/// (`reference`) shows sent to it (to it or to its team) at the mission
-/// instant it finished. A robot that finishes takes no more messages, in C
-/// (`semo_core.c`) as in the simulator; but when others send at the very
-/// instant it finishes, the simulator orders the finish first (a message
-/// takes 1 ms), while in C each process's firing of that instant runs when
-/// it gets a core: random seed 29, where three robots of a team finish at
-/// mission time 100 in the simulator, two of them telling the third (the
-/// owner of their globally shared value) their last write; in C their
-/// firings ran at 107–109 and the owner's at 120, so it heard both writes
-/// before it finished. That race is real, and only that one is left out.
-fn finishing<'e>(events: &[&'e Event], reference: &[Event], robot: &str) -> Vec<&'e Event> {
-    let of_robot = |e: &&Event| field(e, "robot") == robot;
-    let Some(finish) = reference
-        .iter()
-        .filter(of_robot)
-        .find(|e| field(e, "event") == "finish")
-        .map(|e| e["t"].as_i64().unwrap())
-    else {
-        return events.to_vec();
-    };
-    let team = reference
-        .iter()
-        .filter(of_robot)
-        .find(|e| field(e, "event") == "start")
-        .map_or("", |e| field(e, "team"));
-    let contested: BTreeSet<(&str, &str)> = reference
-        .iter()
-        .filter(|e| field(e, "event") == "send" && e["t"].as_i64().unwrap() == finish)
-        .filter(|e| field(e, "robot") != robot && [robot, team].contains(&field(e, "to")))
-        .map(|e| (field(e, "robot"), field(e, "key")))
-        .collect();
-    events
-        .iter()
-        .copied()
-        .filter(|e| {
-            field(e, "event") != "receive"
-                || !contested.contains(&(field(e, "from_robot"), field(e, "key")))
-        })
-        .collect()
-}
-
-/// The events up to `until` mission ms.
-fn until<'e>(events: &[&'e Event], until: i64) -> Vec<&'e Event> {
-    events
-        .iter()
-        .copied()
-        .filter(|e| e["t"].as_i64().unwrap() <= until)
-        .collect()
-}
-
-/// `early` (one run's sequence up to a time both runs certainly reached) is
-/// where `all` (the other run's whole sequence) begins; its last run may
-/// have been cut before it repeated.
-fn starts<T: PartialEq>(early: &[(T, bool)], all: &[(T, bool)]) -> bool {
-    let Some(((last, repeated), before)) = early.split_last() else {
-        return true;
-    };
-    all.len() >= early.len()
-        && all[..before.len()] == *before
-        && all[before.len()].0 == *last
-        && (!repeated || all[before.len()].1)
-}
-
 /// Random valid missions (the generator of `support/missiongen.rs`) on
-/// random scenarios (battery levels, link faults): the same checks as for the examples, except that a run
-/// ends at a cut-off one of the two may reach a little earlier, so each
-/// run's behaviour up to [`LATE_MS`] before the end must begin the
-/// other's; receptions of the start-up window ([`START_MS`]) and of the
-/// heartbeat period after a link fault ends ([`HEAL_MS`]) are left out, and
-/// of what others send at the instant a robot finishes ([`finishing`]): a
-/// robot that finishes takes no more messages, in C as in the simulator.
+/// random scenarios (battery levels, link faults): the same exact
+/// comparison as for the examples.
 fn random_missions(seeds: std::ops::Range<u64>) {
     let catalog = semo::catalog::builtin_catalog();
     let duration = 2000;
@@ -665,36 +450,8 @@ fn random_missions(seeds: std::ops::Range<u64>) {
         std::fs::write(&scenario_path, &scenario).unwrap();
         let reference = simulate(&mission, &scenario_path);
         let processes = lock_step(&mission, &scenario_path);
-        for (robot, c_events) in &processes {
-            let c: Vec<&Event> = c_events.iter().collect();
-            let s: Vec<&Event> = reference
-                .iter()
-                .filter(|e| field(e, "robot") == robot)
-                .collect();
-            let (c, s) = (settled(&c), settled(&s));
-            let (c, s) = (healed(&c, &scenario), healed(&s, &scenario));
-            let (c, s) = (
-                finishing(&c, &reference, robot),
-                finishing(&s, &reference, robot),
-            );
-            let cut = duration - LATE_MS;
-            let (c_early, s_early) = (behaviour(&until(&c, cut)), behaviour(&until(&s, cut)));
-            let (c_all, s_all) = (behaviour(&c), behaviour(&s));
-            let agree = |a: &Behaviour, b: &Behaviour| {
-                starts(&a.modes, &b.modes)
-                    && starts(&a.catches, &b.catches)
-                    && starts(&a.leaders, &b.leaders)
-                    && a.services.iter().all(|(plan, list)| {
-                        starts(list, b.services.get(plan).map_or(&[][..], |l| l))
-                    })
-                    && a.sent.is_subset(&b.sent)
-                    && a.received.is_subset(&b.received)
-            };
-            if !agree(&c_early, &s_all) || !agree(&s_early, &c_all) {
-                problems.push(format!(
-                    "seed {seed}, {robot}:\n  C:   {c_all:?}\n  sim: {s_all:?}"
-                ));
-            }
+        for problem in run_differences(&processes, &reference) {
+            problems.push(format!("seed {seed}: {problem}"));
         }
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
