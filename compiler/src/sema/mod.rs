@@ -107,6 +107,8 @@ pub fn check<'a>(
     checker.check_bodies();
     checker.check_behaviour(source);
     checker.check_communication();
+    // Sorted now: the value flow looks names up.
+    checker.sort_occurrences();
     checker.check_values(!parse.diagnostics.iter().any(Diagnostic::is_error));
     checker.finish()
 }
@@ -285,9 +287,13 @@ impl<'a> Checker<'a> {
         }
     }
 
-    fn finish(mut self) -> (Mission, Vec<Diagnostic>) {
+    /// Sorts the occurrences by position, once every name is recorded.
+    fn sort_occurrences(&mut self) {
         self.mission.occurrences =
             sorted_occurrences(std::mem::take(&mut self.mission.occurrences));
+    }
+
+    fn finish(mut self) -> (Mission, Vec<Diagnostic>) {
         nest_scopes(&mut self.mission.scopes);
         self.mission
             .comparisons

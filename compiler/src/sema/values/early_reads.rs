@@ -18,9 +18,8 @@ use super::timeline::Timeline;
 use super::{Finding, some};
 use crate::diag::Code;
 use crate::fasthash::{FastMap, FastSet};
-use crate::sema::Checker;
 use crate::sema::ir::{AttrKey, ModeId, Peer, ServiceId, Symbol, TeamId};
-use crate::span::Span;
+use crate::sema::{Checker, lookup};
 use crate::syntax::ast::{self, Arg, CommKind, Expr, ExprKind, StmtKind};
 
 /// A value read in the opening of a service that starts once, at the
@@ -34,11 +33,17 @@ struct OpeningRead<'a> {
 
 impl<'a> Checker<'a> {
     pub(super) fn early_reads(&self, timeline: &Timeline) -> Vec<Finding> {
-        let reads = self.opening_reads(timeline);
+        let reads: Vec<(OpeningRead, AttrKey)> = self
+            .opening_reads(timeline)
+            .into_iter()
+            .filter_map(|read| {
+                let key = self.received_key(&read)?;
+                Some((read, key))
+            })
+            .collect();
         if reads.is_empty() {
             return Vec::new();
         }
-        let keys = self.keys_read(&reads);
         let senders = self.senders_to_teams();
         let set_in_team: FastSet<(TeamId, &AttrKey)> = self
             .variable_writes
@@ -50,8 +55,7 @@ impl<'a> Checker<'a> {
         let mut verdicts: FastMap<(TeamId, &AttrKey), Option<&[usize]>> = FastMap::default();
         let mut reported: FastSet<(TeamId, ServiceId, &AttrKey)> = FastSet::default();
         let mut findings = Vec::new();
-        for (read, key) in reads.iter().zip(&keys) {
-            let Some(key) = key else { continue };
+        for (read, key) in &reads {
             let late_senders = *verdicts.entry((read.team, key)).or_insert_with(|| {
                 if set_in_team.contains(&(read.team, key)) {
                     return None;
@@ -155,38 +159,24 @@ impl<'a> Checker<'a> {
         }
     }
 
-    /// The key of each read that is a value of another team than the
-    /// reading one (what its robots received of it), from the occurrences.
-    fn keys_read(&self, reads: &[OpeningRead]) -> Vec<Option<AttrKey>> {
-        let at: FastMap<Span, usize> = reads
-            .iter()
-            .enumerate()
-            .map(|(i, r)| (r.attr.last().span, i))
-            .collect();
-        let mut keys = vec![None; reads.len()];
-        for occurrence in &self.mission.occurrences {
-            let Some(&i) = at.get(&occurrence.span) else {
-                continue;
-            };
-            let (owner, name) = match &occurrence.symbol {
-                Symbol::Value {
-                    owner: Some(owner),
-                    name,
-                }
-                | Symbol::TeamVariable {
-                    team: Some(owner),
-                    name,
-                } => (*owner, name),
-                _ => continue,
-            };
-            if owner != reads[i].team {
-                keys[i] = Some(AttrKey {
-                    owner: self.team(owner).name.clone(),
-                    name: name.clone(),
-                });
+    /// The key of a read that is a value of another team than the reading
+    /// one (what its robots received of it).
+    fn received_key(&self, read: &OpeningRead) -> Option<AttrKey> {
+        let occurrences = lookup::with_span(&self.mission, read.attr.last().span);
+        occurrences.iter().find_map(|o| match &o.symbol {
+            Symbol::Value {
+                owner: Some(owner),
+                name,
             }
-        }
-        keys
+            | Symbol::TeamVariable {
+                team: Some(owner),
+                name,
+            } if *owner != read.team => Some(AttrKey {
+                owner: self.team(*owner).name.clone(),
+                name: name.clone(),
+            }),
+            _ => None,
+        })
     }
 
     /// The sends and publishes to each team, by (team, value): indices

@@ -42,23 +42,25 @@ impl<'a> Checker<'a> {
         if once.is_empty() {
             return Vec::new();
         }
+        // Of another team's or the operator's value: what the robot
+        // received (its own values are readings or variables it sets).
+        let candidates: Vec<usize> = (self.mission.messages.iter().enumerate())
+            .filter(|(_, m)| m.kind.is_outgoing() && once.contains(&m.span))
+            .filter(|(_, m)| m.value.owner != self.team(m.team).name)
+            .map(|(i, _)| i)
+            .collect();
+        if candidates.is_empty() {
+            return Vec::new();
+        }
         let traffic = self.traffic();
-        let sets: usize = self
-            .mission
-            .teams
-            .iter()
+        let sets: usize = (self.mission.teams.iter())
             .flat_map(|t| &t.modes)
             .map(|m| m.sets.len())
             .sum();
         let mut budget = WORK_PER_ITEM * (self.mission.messages.len() + sets + 1);
         let mut findings = Vec::new();
-        for (i, m) in self.mission.messages.iter().enumerate() {
-            if !m.kind.is_outgoing() || !once.contains(&m.span) {
-                continue;
-            }
-            if m.value.owner == self.team(m.team).name {
-                continue; // its own value: a reading, or a variable it sets
-            }
+        for i in candidates {
+            let m = &self.mission.messages[i];
             let modes = timeline.modes(m.team, m.service);
             let mut receivers = Vec::with_capacity(modes.len());
             for &mode in modes {

@@ -19,12 +19,11 @@
 use super::Finding;
 use super::timeline::Timeline;
 use crate::diag::Code;
-use crate::fasthash::FastMap;
+use crate::fasthash::{FastMap, FastSet};
 use crate::sema::Checker;
 use crate::sema::ir::{AttrKey, Peer, RobotId, TeamId};
 use crate::span::Span;
 use crate::syntax::ast::CommKind;
-use std::collections::hash_map::Entry;
 
 /// Who can feed the receives of one (kind, sending team, receiving team,
 /// value).
@@ -55,51 +54,52 @@ impl Checker<'_> {
             }
         }
         // Per (receive or subscribe, team, team, value): who can feed it.
-        let mut feeds: FastMap<Channel, (Feed, Vec<usize>)> = FastMap::default();
-        // Per receive as written: the first of its messages, while none
-        // of them is fed. A receive in a function has one message per
-        // caller, and is reported only when no caller's robots are fed.
-        let mut written: FastMap<Span, Option<(usize, Channel)>> = FastMap::default();
-        let mut order = Vec::new();
+        let mut feeds: FastMap<Channel, Feed> = FastMap::default();
+        // The receives no robot feeds, and where the others are written: a
+        // receive in a function has one message per caller, and is
+        // reported only when no caller's robots are fed.
+        let (mut unfed, mut fed) = (Vec::new(), Vec::new());
         for (i, m) in self.mission.messages.iter().enumerate() {
             let Peer::Team(from) = m.peer else { continue };
             if m.kind.is_outgoing() || !timeline.runs(m.team, m.service) {
                 continue;
             }
             let channel = (m.kind, from, m.team, &m.value);
-            let (feed, _) = feeds.entry(channel).or_insert_with(|| {
-                let sends = feeders(&written_to, channel);
-                (self.feed(&sends, timeline), sends)
-            });
-            let unfed = match feed {
+            let feed = feeds
+                .entry(channel)
+                .or_insert_with(|| self.feed(feeders(&written_to, channel), timeline));
+            let never_fed = match feed {
                 Feed::Never => true,
                 Feed::OnlyBy(robot) => {
                     m.kind == CommKind::Receive && *self.message_robots[i] == [*robot]
                 }
                 Feed::Fed | Feed::Unwritten => false,
             };
-            match written.entry(m.span) {
-                Entry::Vacant(at) => {
-                    at.insert(unfed.then_some((i, channel)));
-                    order.push(m.span);
-                }
-                Entry::Occupied(mut at) if !unfed => *at.get_mut() = None,
-                Entry::Occupied(_) => {}
+            if never_fed {
+                unfed.push((i, channel));
+            } else {
+                fed.push(m.span);
             }
         }
-        order
+        if unfed.is_empty() {
+            return Vec::new();
+        }
+        let mut seen: FastSet<Span> = fed.into_iter().collect();
+        unfed
             .into_iter()
-            .filter_map(|span| written[&span])
-            .map(|(i, channel)| self.unfed_finding(i, channel, &feeds[&channel].1, timeline))
+            .filter(|(i, _)| seen.insert(self.mission.messages[*i].span))
+            .map(|(i, channel)| {
+                self.unfed_finding(i, channel, feeders(&written_to, channel), timeline)
+            })
             .collect()
     }
 
-    fn feed(&self, sends: &[usize], timeline: &Timeline) -> Feed {
-        if sends.is_empty() {
+    fn feed(&self, sends: [&[usize]; 2], timeline: &Timeline) -> Feed {
+        if sends[0].is_empty() {
             return Feed::Unwritten;
         }
         let mut only: Option<RobotId> = None;
-        for &s in sends {
+        for &s in sends.iter().copied().flatten() {
             let send = &self.mission.messages[s];
             if !timeline.runs(send.team, send.service) {
                 continue;
@@ -123,7 +123,7 @@ impl Checker<'_> {
         &self,
         i: usize,
         channel: Channel,
-        sends: &[usize],
+        sends: [&[usize]; 2],
         timeline: &Timeline,
     ) -> Finding {
         let m = &self.mission.messages[i];
@@ -140,8 +140,7 @@ impl Checker<'_> {
                 "`{path}` subscribes to `{value}` from {from} here, but no robot can ever publish it: the value stays as it was"
             )
         };
-        let related = sends
-            .iter()
+        let related = (sends.iter().copied().flatten())
             .map(|&s| (self.mission.messages[s].span, self.why_not_fed(s, timeline)))
             .collect();
         Finding {
@@ -181,11 +180,14 @@ impl Checker<'_> {
 }
 
 /// The sends and publishes that may feed the receives or subscribes of
-/// `channel`: none when none of its own kind is written (W004). A
-/// publication reaches a `receive` too, on a robot that subscribes to
-/// nothing (the simulator's and the runtime's receive task), so both feed a
-/// receive; only publications set what `subscribe` reads.
-fn feeders(written_to: &FastMap<Channel, Vec<usize>>, channel: Channel) -> Vec<usize> {
+/// `channel`: the statements of its own kind (none: W004 says so), then the
+/// others that reach it. A publication reaches a `receive` too, on a robot
+/// that subscribes to nothing (the simulator's and the runtime's receive
+/// task); only publications set what `subscribe` reads.
+fn feeders<'w>(
+    written_to: &'w FastMap<Channel, Vec<usize>>,
+    channel: Channel<'w>,
+) -> [&'w [usize]; 2] {
     let (kind, from, to, value) = channel;
     let of = |kind| {
         written_to
@@ -193,10 +195,7 @@ fn feeders(written_to: &FastMap<Channel, Vec<usize>>, channel: Channel) -> Vec<u
             .map_or(&[][..], Vec::as_slice)
     };
     match kind {
-        CommKind::Receive if !of(CommKind::Send).is_empty() => {
-            [of(CommKind::Send), of(CommKind::Publish)].concat()
-        }
-        CommKind::Subscribe => of(CommKind::Publish).to_vec(),
-        _ => Vec::new(),
+        CommKind::Receive => [of(CommKind::Send), of(CommKind::Publish)],
+        _ => [of(CommKind::Publish), &[]],
     }
 }
