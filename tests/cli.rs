@@ -17,11 +17,11 @@ fn every_reference_example_checks_without_errors() {
 }
 
 #[test]
-fn scouting_gives_exactly_the_unmatched_receive_warning() {
+fn scouting_gives_exactly_its_two_warnings() {
     let (_, diags) = check_json_in(&examples().join("scouting"), &["scouting.mission"]);
     let warnings: Vec<_> = diags.iter().filter(|d| d.severity != "hint").collect();
-    assert_eq!(warnings.len(), 1, "{warnings:#?}");
-    let w = warnings[0];
+    assert_eq!(warnings.len(), 2, "{warnings:#?}");
+    let w = warnings[1];
     assert_eq!(w.code, "W004");
     assert_eq!(w.severity, "warning");
     assert!(
@@ -36,6 +36,18 @@ fn scouting_gives_exactly_the_unmatched_receive_warning() {
     );
     // `receive(SlaveTeam, SlaveTeam.COLOR)`: the range is the value received.
     assert_eq!((w.start, w.end), ((126, 22), (126, 37)));
+    // The master forwards the operator's command to the slaves once, when
+    // RC_MODE starts, while its plan Listen takes the next ones (issue 31's
+    // first defect): `send(SlaveTeam, USER.RC_CMD)`, the value sent.
+    let w = warnings[0];
+    assert_eq!(w.code, "W023");
+    assert!(
+        w.message
+            .contains("`MasterTeam.Listen.ReceiveCmd` keeps receiving it"),
+        "{}",
+        w.message
+    );
+    assert_eq!((w.start, w.end), ((36, 19), (36, 30)));
 }
 
 #[test]
@@ -55,7 +67,7 @@ fn human_output_shows_the_source_line_and_a_summary() {
     );
     assert!(
         out.stderr.contains(
-            "checked 1 mission and 0 catalog files, 1 strategy file: 0 errors, 1 warning, 2 hints"
+            "checked 1 mission and 0 catalog files, 1 strategy file: 0 errors, 2 warnings, 2 hints"
         ),
         "{}",
         out.stderr

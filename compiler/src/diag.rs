@@ -222,6 +222,9 @@ codes! {
     EmptyOthers = "W012", Warning, "an `others` block that no robot is left to run";
     ComparisonNeverHolds = "W020", Warning, "a comparison of a team variable with a value it is never set to: it never holds";
     ComparisonAlwaysHolds = "W021", Warning, "`!=` between a team variable and a value it is never set to: it holds whenever the variable has a value";
+    ReadBeforeSent = "W022", Warning, "a value read once, when the mission starts, before any robot can have sent it: it reads none, and nothing sent later is read there";
+    ForwardedOnce = "W023", Warning, "a received value sent on once each time its mode starts while another plan of the mode keeps receiving it: what comes later is never sent on";
+    ReceiveNeverFed = "W024", Warning, "a receive or subscribe that no robot can ever feed: its sends or publishes never run, or run only on the receiving robot itself";
 }
 
 impl fmt::Display for Code {

@@ -47,6 +47,10 @@ where
             0
         } else if length >= 3 && cand_lower.starts_with(&lower) {
             1
+        } else if cand.chars().count().abs_diff(length) > limit {
+            // Each edit changes the length by one at most: too far, and
+            // known without the distance (a check reports thousands).
+            continue;
         } else {
             edit_distance(name, cand)
         };
@@ -91,5 +95,18 @@ mod tests {
         );
         assert_eq!(did_you_mean("x", ["y", "X"]).as_deref(), Some("X"));
         assert_eq!(did_you_mean("x", ["y", "ab"]), None);
+    }
+
+    proptest::proptest! {
+        /// What lets `did_you_mean` skip a candidate without the distance:
+        /// it is never less than the difference of the lengths.
+        #[test]
+        fn the_distance_is_at_least_the_difference_of_the_lengths(
+            a in "[a-cé]{0,8}",
+            b in "[a-cé]{0,8}",
+        ) {
+            let lengths = a.chars().count().abs_diff(b.chars().count());
+            proptest::prop_assert!(edit_distance(&a, &b) >= lengths);
+        }
     }
 }

@@ -1309,6 +1309,7 @@ impl<'a> Checker<'a> {
                         key: key.clone(),
                         value: written.clone().flatten(),
                         span: item.attr.span,
+                        team: scope.team,
                     });
                 }
             }
@@ -1360,6 +1361,7 @@ impl<'a> Checker<'a> {
                         value,
                         span: item.attr.span,
                     });
+                    self.message_robots.push(scope.robots.0.clone());
                 }
                 (Some(team), _, None, Some(value)) => {
                     self.comms_with_unknown_team.push((comm.kind, team, value));

@@ -10,7 +10,9 @@
 //!    reachability, uncaught events, unused services and functions.
 //! 4. [`comm`]: every receive/subscribe matched with a send/publish, and back.
 //! 5. [`values`]: value flow: what each team variable can hold, and the
-//!    comparisons with it that decide the same way at every run.
+//!    comparisons with it that decide the same way at every run; when a
+//!    received value can have been sent: read before any robot can have
+//!    sent it, sent on once while it keeps coming, never fed.
 //!
 //! Sema never reads files and never panics. [`lookup`] answers "which
 //! symbols are written here" by binary search in the IR's sorted occurrences,
@@ -82,7 +84,7 @@ pub fn check_source(file: FileId, text: &str, catalog: &Catalog) -> Analysis {
 /// Checks a mission script already parsed (by [`syntax::parse`] or
 /// [`syntax::parse_incremental`]): the same analysis as [`check_source`].
 pub fn check_parsed(file: FileId, parse: syntax::Parse, catalog: &Catalog) -> Analysis {
-    let (mission, mut diagnostics) = check(file, &parse.file, catalog);
+    let (mission, mut diagnostics) = check(file, &parse, catalog);
     diagnostics.extend(parse.diagnostics);
     diag::sort_and_dedup(&mut diagnostics);
     Analysis {
@@ -92,18 +94,22 @@ pub fn check_parsed(file: FileId, parse: syntax::Parse, catalog: &Catalog) -> An
     }
 }
 
-/// Checks a parsed mission script.
+/// Checks a parsed mission script: its tree, and whether the parse dropped
+/// a line (a syntax error), which some checks must know.
 pub fn check<'a>(
     file: FileId,
-    source: &'a ast::SourceFile,
+    parse: &'a syntax::Parse,
     catalog: &'a Catalog,
 ) -> (Mission, Vec<Diagnostic>) {
+    let source = &parse.file;
     let mut checker = Checker::new(file, catalog);
     checker.declare(source);
     checker.check_bodies();
     checker.check_behaviour(source);
     checker.check_communication();
-    checker.check_values();
+    // Sorted now: the value flow looks names up.
+    checker.sort_occurrences();
+    checker.check_values(!parse.diagnostics.iter().any(Diagnostic::is_error));
     checker.finish()
 }
 
@@ -160,6 +166,8 @@ pub(crate) struct Checker<'a> {
     /// literal, for the value flow (`values.rs`).
     variable_writes: Vec<values::VariableWrite>,
     variable_tests: Vec<values::VariableTest>,
+    /// The robots that run each of `mission.messages`, in the same order.
+    message_robots: Vec<std::sync::Arc<[RobotId]>>,
     /// Every set of robots running a scope, once ([`Checker::shared_robots`]).
     robot_sets: FastSet<std::sync::Arc<[RobotId]>>,
     /// The events each service throws, as in its `throws` list: a service
@@ -196,6 +204,7 @@ impl<'a> Checker<'a> {
             comparison_index: FastMap::default(),
             variable_writes: Vec::new(),
             variable_tests: Vec::new(),
+            message_robots: Vec::new(),
             robot_sets: FastSet::default(),
             thrown: FastSet::default(),
             robots_full: false,
@@ -278,9 +287,13 @@ impl<'a> Checker<'a> {
         }
     }
 
-    fn finish(mut self) -> (Mission, Vec<Diagnostic>) {
+    /// Sorts the occurrences by position, once every name is recorded.
+    fn sort_occurrences(&mut self) {
         self.mission.occurrences =
             sorted_occurrences(std::mem::take(&mut self.mission.occurrences));
+    }
+
+    fn finish(mut self) -> (Mission, Vec<Diagnostic>) {
         nest_scopes(&mut self.mission.scopes);
         self.mission
             .comparisons

@@ -10,7 +10,10 @@
 //!   a mode that runs a service throwing it;
 //! - E041, a bare word that is also a value the robots read: one fix for each
 //!   meaning, the word as a string (`"FIRE"`) and the value with its team
-//!   (`T.FIRE`), neither preferred (only the user knows which was meant).
+//!   (`T.FIRE`), neither preferred (only the user knows which was meant);
+//! - W022, a value read once at the start before any robot can have sent
+//!   it: add `repeat()` to the service that reads it, which then reads it
+//!   again until it comes.
 
 use crate::catalog::Catalog;
 use crate::diag::{Code, Diagnostic};
@@ -69,6 +72,7 @@ impl Fixes<'_> {
             Code::MissingDefault => self.add_default(),
             Code::EventNeverCaught => self.add_catches(),
             Code::WordIsAValue => self.word_or_value(),
+            Code::ReadBeforeSent => self.add_repeat(),
             _ => Vec::new(),
         };
         let did_you_mean = self.did_you_mean();
@@ -142,6 +146,40 @@ impl Fixes<'_> {
             )
         })
         .collect()
+    }
+
+    /// W022: `repeat()` after the composite service that holds the read.
+    fn add_repeat(&self) -> Vec<CodeAction> {
+        let span = self.diagnostic.span;
+        let service = self
+            .analysis
+            .syntax
+            .items
+            .iter()
+            .find_map(|item| match item {
+                Item::Service(s)
+                    if s.body.span.start <= span.start && span.end <= s.body.span.end =>
+                {
+                    Some(s)
+                }
+                _ => None,
+            });
+        let Some(service) = service.filter(|s| s.repeat.is_none()) else {
+            return Vec::new();
+        };
+        let end = service.body.span.end;
+        let path = format!(
+            "{}.{}.{}",
+            service.team.name, service.plan.name, service.name.name
+        );
+        vec![self.action(
+            format!("Add `repeat()` to `{path}`: read it again until it comes"),
+            vec![TextEdit {
+                span: Span::new(end, end),
+                new_text: " repeat()".to_string(),
+            }],
+            true,
+        )]
     }
 
     /// The team of the main block whose range holds the diagnostic.

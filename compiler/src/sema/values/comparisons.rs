@@ -1,26 +1,27 @@
-//! Phase 5: value flow. A team variable (`T.X`, set by `send`/`publish`
-//! with `T.X = ...`) holds only what its writers put in it: when every
-//! writer puts a literal (a word, a string, a number), its possible values
-//! are known, and a comparison with a constant outside them decides the
-//! same way at every run: `T.X == C` never holds (W020), `T.X != C` holds
-//! whenever `T.X` has a value (W021: a comparison with a variable not yet
-//! set is false, `!=` too). Both name the writers as related information.
+//! Comparisons that decide the same way at every run. A team variable
+//! holds only what its writers put in it: when every writer puts a literal
+//! (a word, a string, a number), its possible values are known, and a
+//! comparison with a constant outside them decides the same way at every
+//! run: `T.X == C` never holds (W020), `T.X != C` holds whenever `T.X` has
+//! a value (W021: a comparison with a variable not yet set is false, `!=`
+//! too). Both name the writers as related information.
 //!
-//! The facts are under-approximations: a variable with any writer whose
-//! value is not a literal (a sensor reading, another variable), or that
-//! the operator may send, has unknown values and is never reported.
+//! A variable with any writer whose value is not a literal (a sensor
+//! reading, another variable), or that the operator may send, has unknown
+//! values and is never reported.
 
-use super::Checker;
-use super::ir::{AttrKey, Compared};
-use super::suggestion;
+use super::{RELATED, VariableWrite, list};
 use crate::diag::Code;
 use crate::fasthash::FastMap;
+use crate::sema::Checker;
+use crate::sema::ir::{AttrKey, Compared};
+use crate::sema::suggestion;
 use crate::span::Span;
 
 /// A literal as a comparison reads it: words and strings by their text,
 /// numbers by their value.
 #[derive(Clone, Debug, PartialEq)]
-pub(super) enum Literal {
+pub(in crate::sema) enum Literal {
     Word(String),
     Number(f64),
 }
@@ -42,19 +43,10 @@ impl Literal {
     }
 }
 
-/// A write of a team variable: `T.X = value` (`None`: not a literal, or
-/// from the operator).
-#[derive(Clone, Debug)]
-pub(super) struct VariableWrite {
-    pub key: AttrKey,
-    pub value: Option<Literal>,
-    pub span: Span,
-}
-
 /// A comparison of a team variable with a literal: `T.X == C` (`equal`) or
 /// `T.X != C`.
 #[derive(Clone, Debug)]
-pub(super) struct VariableTest {
+pub(in crate::sema) struct VariableTest {
     pub key: AttrKey,
     pub equal: bool,
     pub constant: Literal,
@@ -63,11 +55,8 @@ pub(super) struct VariableTest {
     pub span: Span,
 }
 
-/// Writers named in a finding's related information, at most.
-const RELATED_WRITERS: usize = 8;
-
 impl Checker<'_> {
-    pub(super) fn check_values(&mut self) {
+    pub(super) fn check_comparisons(&mut self) {
         let mut writes: FastMap<&AttrKey, Vec<&VariableWrite>> = FastMap::default();
         for write in &self.variable_writes {
             writes.entry(&write.key).or_default().push(write);
@@ -126,20 +115,10 @@ impl Checker<'_> {
                 .collect();
             related.sort_by_key(|(span, _)| span.start);
             related.dedup_by_key(|(span, _)| *span);
-            for (span, message) in related.into_iter().take(RELATED_WRITERS) {
+            for (span, message) in related.into_iter().take(RELATED) {
                 diagnostic.relate(span, message);
             }
         }
-    }
-}
-
-/// `a`, `a or b`, `a, b or c`, each quoted.
-fn list(values: &[String]) -> String {
-    let quoted: Vec<String> = values.iter().map(|v| format!("`{v}`")).collect();
-    match quoted.split_last() {
-        Some((last, [])) => last.clone(),
-        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
-        None => String::new(),
     }
 }
 
