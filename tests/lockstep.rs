@@ -91,9 +91,20 @@ fn a_killed_and_restarted_leader_runs_the_same_way_twice_in_lock_step() {
         [0, 2200],
         "tb_0 starts at 0 and again when restarted"
     );
-    let after_kill = first.lines().any(|l| {
-        let e: serde_json::Value = serde_json::from_str(l).unwrap();
-        e["robot"] == "tb_0" && (1200..2200).contains(&e["t"].as_i64().unwrap())
+    let events: Vec<serde_json::Value> = first
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .filter(|e: &serde_json::Value| e["robot"] == "tb_0")
+        .collect();
+    // The coordinator traces the faults it does, as the simulator does.
+    let faults: Vec<(i64, &str)> = events
+        .iter()
+        .filter(|e| e["event"] == "fault")
+        .map(|e| (e["t"].as_i64().unwrap(), e["fault"].as_str().unwrap()))
+        .collect();
+    assert_eq!(faults, [(1200, "kill"), (2200, "restart")]);
+    let after_kill = events.iter().any(|e| {
+        e["event"] != "fault" && (1200..2200).contains(&e["t"].as_i64().unwrap())
     });
     assert!(!after_kill, "tb_0 traced something while killed");
 }
