@@ -497,7 +497,7 @@ static void *task_thread(void *arg)
 {
     task *t = arg;
     const semo_task_desc *d = t->desc;
-    int64_t next_release = 0, first_release = -1;
+    int64_t next_release = 0, first_release = -1, woken_release = -1;
     g_current = t;
     pthread_mutex_lock(&t->lock);
     while (semo_running()) {
@@ -526,15 +526,22 @@ static void *task_thread(void *arg)
             if (t->hinted && !t->woken && t->hint_ms > due)
                 due = t->hint_ms;
             /* Firings keep to the period's grid from the first one: a task
-             * woken or due between two grid points fires at the next (as
-             * the simulator's control task fires every period from its
-             * start, and only then). */
-            due = on_grid(due > now ? due : now, first_release, d->period_ms);
+             * due, or woken by an event, between two grid points fires at
+             * the next (as the simulator's control task fires every period
+             * from its start, and only then). The instant is kept once
+             * chosen: on the wall clock a wait ends a little after it. */
+            due = on_grid(due, first_release, d->period_ms);
+            if (t->woken && due < now) {
+                if (woken_release < 0)
+                    woken_release = on_grid(now, first_release, d->period_ms);
+                due = woken_release;
+            }
             if (now < due) {
                 /* Woken early by a state change, an event or the end of the program. */
                 wait_until(&t->changed, &t->lock, due == INT64_MAX ? -1 : due);
                 continue;
             }
+            woken_release = -1;
             next_release = on_grid(now + 1, first_release, d->period_ms);
             t->hinted = t->woken = false;
         }
