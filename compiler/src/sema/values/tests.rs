@@ -2,22 +2,31 @@
 //! where it holds, and each condition it rests on shown to matter.
 
 use crate::catalog::builtin_catalog;
-use crate::diag::{Code, FileId};
+use crate::diag::{Code, Diagnostic, FileId};
 
-/// The W022-W024 findings of `text` (which must check without errors), as
-/// (code, the text at the finding, the lines of its related places).
-fn findings(text: &str) -> Vec<(Code, String, Vec<usize>)> {
+/// The diagnostics of `text` (which must check without errors) that have
+/// one of `codes`.
+pub(super) fn diagnostics_with(text: &str, codes: &[Code]) -> Vec<Diagnostic> {
     let analysis = crate::check_source(FileId(0), text, &builtin_catalog());
     assert!(!analysis.has_errors(), "{:#?}", analysis.diagnostics);
     analysis
         .diagnostics
         .iter()
-        .filter(|d| {
-            matches!(
-                d.code,
-                Code::ReadBeforeSent | Code::ForwardedOnce | Code::ReceiveNeverFed
-            )
-        })
+        .filter(|d| codes.contains(&d.code))
+        .cloned()
+        .collect()
+}
+
+/// The W022-W024 findings of `text` (which must check without errors), as
+/// (code, the text at the finding, the lines of its related places).
+fn findings(text: &str) -> Vec<(Code, String, Vec<usize>)> {
+    let codes = [
+        Code::ReadBeforeSent,
+        Code::ForwardedOnce,
+        Code::ReceiveNeverFed,
+    ];
+    diagnostics_with(text, &codes)
+        .iter()
         .map(|d| {
             let line = |offset: usize| text[..offset].matches('\n').count() + 1;
             let related = d.related.iter().map(|r| line(r.span.start)).collect();
