@@ -237,6 +237,25 @@ fn a_restarted_leader_comes_back_the_same_way_in_c_and_in_the_simulator() {
     );
 }
 
+/// A leader killed after the operator's commands (`tests/fixtures/semantics/
+/// leader_commands.mission`): the new leader drops the commands sent before
+/// it led, in both, at the same instant (`docs/groups.md`).
+#[test]
+fn a_new_leader_drops_the_commands_sent_before_it_led_the_same_way_in_c_and_in_the_simulator() {
+    let fixture = repo_root().join("tests/fixtures/semantics");
+    let scenario = std::fs::read_to_string(fixture.join("leader_commands.scenario.json")).unwrap();
+    let (processes, _) = compare(
+        "leader_commands",
+        &fixture.join("leader_commands.mission"),
+        &scenario,
+    );
+    let dropped = processes["tb_1"]
+        .iter()
+        .filter(|e| field(e, "event") == "drop")
+        .count();
+    assert_eq!(dropped, 2, "both commands sent before tb_1 led");
+}
+
 /// Globally shared information (`docs/shared-information.md`): the owner
 /// `a` killed, `b` takes over and a write of `c` reaches it, in both; what
 /// each reads shows in its modes (`tests/fixtures/shared`).

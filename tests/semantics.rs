@@ -8,7 +8,7 @@ mod support;
 
 use std::path::PathBuf;
 use support::robots::{
-    PEDANTIC, build, calls, compilers, events, field, make, modes, robot_folders,
+    Event, PEDANTIC, build, calls, compilers, events, field, make, modes, robot_folders,
     run_in_simulation, scratch,
 };
 use support::{examples, repo_root, semo, semo_in};
@@ -332,4 +332,45 @@ fn each_fix_of_a_word_that_is_also_a_value_builds_and_simulates_as_it_says() {
         let traces = run_in_simulation(&out.join("alarm.mission"), &out.join("robots"), scenario);
         assert_eq!(values_sent(&traces["g"]), [meant; 3], "{}", edit.new_text);
     }
+}
+
+/// A robot that becomes the leader acts only on the operator's commands
+/// sent while it leads (`docs/groups.md`): tb_0 leads and is switched to
+/// remote control and back (0.5 s, 1.5 s); killed at 2 s, tb_1 takes over
+/// and drops both commands (traced), where it once switched to remote
+/// control and back on its own. The same run in C: `tests/differential.rs`.
+#[test]
+fn a_new_leader_does_not_act_on_commands_sent_before_it_led() {
+    let mission = fixture("leader_commands.mission");
+    let scenario = fixture("leader_commands.scenario.json");
+    let simulated = support::simulate_trace(&mission, &scenario, "sim");
+    assert_eq!(
+        simulated.code, 0,
+        "{}{}",
+        simulated.stdout, simulated.stderr
+    );
+    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
+    let all = events(&lines);
+    let of = |robot: &str| -> Vec<Event> {
+        all.iter()
+            .filter(|e| field(e, "robot") == robot)
+            .cloned()
+            .collect()
+    };
+    let (tb_0, tb_1) = (of("tb_0"), of("tb_1"));
+    assert_eq!(modes(&tb_0), ["AUTO_MODE", "RC_MODE", "AUTO_MODE"]);
+    let leaders: Vec<&str> = tb_1
+        .iter()
+        .filter(|e| field(e, "event") == "leader")
+        .map(|e| field(e, "leader"))
+        .collect();
+    assert_eq!(leaders, ["tb_0", "tb_1"], "tb_1 takes over");
+    assert_eq!(modes(&tb_1), ["AUTO_MODE"], "no stale command acted on");
+    let dropped: Vec<(&str, &str)> = tb_1
+        .iter()
+        .filter(|e| field(e, "event") == "drop")
+        .map(|e| (field(e, "key"), field(e, "reason")))
+        .collect();
+    let before = ("USER.RC_CMD", semo::codegen::UNLED_REASON);
+    assert_eq!(dropped, [before, before]);
 }

@@ -30,6 +30,17 @@ pub fn listen_ms(heartbeat_ms: i64) -> i64 {
     heartbeat_ms + heartbeat_ms / 2
 }
 
+/// The `reason` of the `drop` event of a message dropped because it arrived
+/// before its robot became the leader of the `leader(...)` arm whose block
+/// receives it (`drop_unled`). The simulator uses the same.
+pub const UNLED_REASON: &str = "arrived before it led";
+
+/// Drops what a channel holds now, oldest first, each traced: a robot that
+/// has just become the leader drops the messages waiting for its leader's
+/// block (`StateKind::LeaderBranch`). Only the count seen first: a message
+/// the receive task writes meanwhile arrived after.
+const DROP_UNLED_C: &str = "/* Drops the messages a channel holds now (they arrived before this robot\n * led), oldest first, each traced; one the receive task writes meanwhile stays. */\nstatic void drop_unled(int port, const char *from, const char *key)\n{\n    semo_value stale;\n    for (int n = UFPort_GetNumOfAvailableData(port); n > 0; n--)\n        if (UFPort_ReadFromQueue(port, &stale, sizeof stale) > 0)\n            semo_trace(\"drop\", \"from\", from, \"key\", key, \"reason\", @REASON@, NULL);\n}\n\n";
+
 /// Leader elections (`@HB@`: the heartbeat period, `@LISTEN@`: [`listen_ms`]).
 /// `leading` is what this robot's heartbeats say: whether the last election
 /// it decided named it. A robot that joined a mission under way (restarted:
@@ -321,6 +332,10 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
         out.push('\n');
     }
 
+    if uses("drop_unled") {
+        out.push_str(&DROP_UNLED_C.replace("@REASON@", &c::string(UNLED_REASON)));
+    }
+
     if uses("request") {
         out.push_str("/* Writes a service request to the task's queue and starts one firing of it. */\nstatic bool request(int port, const char *task, const char *service, int argc, const semo_value *const *args)\n{\n    semo_request req;\n    memset(&req, 0, sizeof req);\n    strncpy(req.service, service, sizeof req.service - 1);\n    for (int i = 0; i < argc && i < SEMO_MAX_ARGS; i++)\n        req.args[i] = *args[i];\n    req.argc = argc < SEMO_MAX_ARGS ? argc : SEMO_MAX_ARGS;\n    if (UFControl_GetTaskState(task) != SEMO_TASK_IDLE)\n        return false;\n    /* The task is idle: a request still queued was stopped before its task\n     * fired (a mode change, a timeout) and must not run now. */\n    semo_request stale;\n    while (UFPort_GetNumOfAvailableData(port) > 0)\n        UFPort_ReadFromQueue(port, &stale, sizeof stale);\n    if (UFPort_WriteToQueue(port, &req, sizeof req) == 0)\n        return false;\n    UFControl_CallTask(task);\n    return true;\n}\n\n");
     }
@@ -341,6 +356,25 @@ fn args_array(args: &[Operand], words: &Words) -> String {
     }
     let items: Vec<String> = args.iter().map(|a| operand(a, words)).collect();
     format!("(const semo_value *const[]){{{}}}", items.join(", "))
+}
+
+/// A robot that has just become the leader here (`led`: the leader before)
+/// drops what waits for the receives of the leader's block (`receives`).
+fn emit_drop_unled(out: &mut String, program: &RobotProgram, receives: &[usize]) {
+    if receives.is_empty() {
+        return;
+    }
+    out.push_str("        if (chosen && led != leader) { /* it leads from now on */\n");
+    for &k in receives {
+        let incoming = &program.control.incoming[k];
+        let _ = writeln!(
+            out,
+            "            drop_unled(in_port[{k}], {}, {});",
+            c::string(&incoming.from_team),
+            c::string(&incoming.key)
+        );
+    }
+    out.push_str("        }\n");
 }
 
 fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize, state: &State) {
@@ -504,6 +538,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize
             candidates,
             algorithm,
             others_at,
+            receives,
         } => {
             let list: Vec<String> = candidates.iter().map(|c| c.to_string()).collect();
             let algorithm = match algorithm {
@@ -513,9 +548,14 @@ fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize
             };
             let _ = writeln!(
                 out,
-                "    {{\n        static const size_t candidates[] = {{{}}};\n        static long leader = -1; /* the last leader seen (control thread only) */\n        int chosen = elected(candidates, {}, {algorithm}, &leader);\n        if (chosen < 0)\n            return STEP_WAIT; /* still listening */\n        r->pc = chosen ? {next} : {others_at};\n        return STEP_NEXT;\n    }}",
+                "    {{\n        static const size_t candidates[] = {{{}}};\n        static long leader = -1; /* the last leader seen (control thread only) */\n        long led = leader;\n        int chosen = elected(candidates, {}, {algorithm}, &leader);\n        if (chosen < 0)\n            return STEP_WAIT; /* still listening */",
                 list.join(", "),
                 candidates.len()
+            );
+            emit_drop_unled(out, program, receives);
+            let _ = writeln!(
+                out,
+                "        r->pc = chosen ? {next} : {others_at};\n        return STEP_NEXT;\n    }}"
             );
         }
         StateKind::GroupSync {

@@ -410,10 +410,18 @@ pub enum StateKind {
     /// leader's block) if `algorithm` chooses this robot among the live
     /// `candidates` (peer indices, in formation order), else go to
     /// `others_at`.
+    ///
+    /// `receives`: the incoming messages the leader's block receives. When
+    /// this robot becomes the leader here (the last leader this state chose
+    /// was another robot, or none yet), the messages waiting in their
+    /// channels arrived before it led and are dropped: a leader-only
+    /// `receive` takes only what arrived while this robot leads
+    /// (`docs/groups.md`).
     LeaderBranch {
         candidates: Vec<usize>,
         algorithm: LeaderAlgorithm,
         others_at: StateId,
+        receives: Vec<usize>,
     },
     /// The start of a group statement when the team's strategy has
     /// `<GroupSync timeout>`: tell the team this robot has arrived (its

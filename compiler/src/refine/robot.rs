@@ -530,9 +530,17 @@ impl Builder<'_, '_> {
                                 candidates,
                                 algorithm,
                                 others_at,
+                                receives: Vec::new(),
                             }
                         });
                         self.block(body, states, marks, depth);
+                        let body_states = &states[branch.0.index() + 1..];
+                        let received = received_in(body_states);
+                        if let StateKind::LeaderBranch { receives, .. } =
+                            &mut states[branch.0.index()].kind
+                        {
+                            *receives = received;
+                        }
                         let jump =
                             self.push_forward(states, stmt.span, |to| StateKind::Jump { to });
                         states[jump.0.index()].text = "end of the leader's block".into();
@@ -1475,6 +1483,22 @@ fn next_mark(marks: &mut usize) -> usize {
 /// after a block still being refined: [`land`] sets it once that block is.
 #[must_use = "a forward state must land, or it jumps to itself"]
 struct Forward(StateId);
+
+/// The incoming messages the `Receive` states of `states` take, each once,
+/// in index order (a leader's block: [`StateKind::LeaderBranch`]).
+fn received_in(states: &[State]) -> Vec<usize> {
+    let mut messages: Vec<usize> = states
+        .iter()
+        .filter_map(|s| match &s.kind {
+            StateKind::Receive { messages, .. } => Some(messages.iter().copied()),
+            _ => None,
+        })
+        .flatten()
+        .collect();
+    messages.sort_unstable();
+    messages.dedup();
+    messages
+}
 
 /// Sets the target of `forward` to the next state to be pushed.
 fn land(states: &mut [State], forward: Forward) {

@@ -1737,13 +1737,20 @@ impl<'p> Sim<'p> {
                 candidates,
                 algorithm,
                 others_at,
-            } => match self.elected(r, (service, pc), candidates, *algorithm) {
-                None => Step::Wait, // still listening
-                Some(elected) => {
-                    self.region(r, i).pc = if elected { next } else { others_at.index() };
-                    Step::Next
+                receives,
+            } => {
+                let led = self.robots[r].leaders.get(&(service, pc)) == Some(&program.self_peer);
+                match self.elected(r, (service, pc), candidates, *algorithm) {
+                    None => Step::Wait, // still listening
+                    Some(elected) => {
+                        if elected && !led {
+                            self.drop_unled(r, receives);
+                        }
+                        self.region(r, i).pc = if elected { next } else { others_at.index() };
+                        Step::Next
+                    }
                 }
-            },
+            }
             StateKind::GroupSync {
                 members,
                 point,
@@ -1899,6 +1906,42 @@ impl<'p> Sim<'p> {
             }
         }
         Step::Wait
+    }
+
+    /// This robot has just become the leader at a `leader(...)` arm: the
+    /// messages waiting for the receives of the leader's block (`messages`)
+    /// arrived before it led, and are dropped, each traced. Only those in
+    /// the channels now, oldest first, as the C's `drop_unled` takes them;
+    /// a message the receive task holds up then finds room, as after a
+    /// `receive`.
+    fn drop_unled(&mut self, r: usize, messages: &[usize]) {
+        let mut took = false;
+        for &k in messages {
+            let robot = &mut self.robots[r];
+            let waiting = robot.inbox[k].0.len();
+            if waiting == 0 {
+                continue;
+            }
+            robot.inbox[k].0.clear();
+            robot.stalled[k] = false;
+            took = true;
+            let incoming = &robot.program.control.incoming[k];
+            let (from, key): (Rc<str>, Rc<str>) = (
+                incoming.from_team.as_str().into(),
+                incoming.key.as_str().into(),
+            );
+            for _ in 0..waiting {
+                let fields = vec![
+                    ("from", from.clone()),
+                    ("key", key.clone()),
+                    ("reason", crate::codegen::UNLED_REASON.into()),
+                ];
+                self.emit(r, "drop", fields);
+            }
+        }
+        if took {
+            self.release(r, false);
+        }
     }
 
     /// `elected` (`codegen/control.rs`'s `ELECTION_C`): among the live
