@@ -548,9 +548,15 @@ fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize
             };
             let _ = writeln!(
                 out,
-                "    {{\n        static const size_t candidates[] = {{{}}};\n        static long leader = -1; /* the last leader seen (control thread only) */\n        long led = leader;\n        int chosen = elected(candidates, {}, {algorithm}, &leader);\n        if (chosen < 0)\n            return STEP_WAIT; /* still listening */",
+                "    {{\n        static const size_t candidates[] = {{{}}};\n        static long leader = -1; /* the last leader seen (control thread only) */{led}\n        int chosen = elected(candidates, {}, {algorithm}, &leader);\n        if (chosen < 0)\n            return STEP_WAIT; /* still listening */",
                 list.join(", "),
-                candidates.len()
+                candidates.len(),
+                // The leader before this election, for `emit_drop_unled`.
+                led = if receives.is_empty() {
+                    ""
+                } else {
+                    "\n        long led = leader;"
+                },
             );
             emit_drop_unled(out, program, receives);
             let _ = writeln!(
