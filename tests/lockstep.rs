@@ -103,9 +103,9 @@ fn a_killed_and_restarted_leader_runs_the_same_way_twice_in_lock_step() {
         .map(|e| (e["t"].as_i64().unwrap(), e["fault"].as_str().unwrap()))
         .collect();
     assert_eq!(faults, [(1200, "kill"), (2200, "restart")]);
-    let after_kill = events.iter().any(|e| {
-        e["event"] != "fault" && (1200..2200).contains(&e["t"].as_i64().unwrap())
-    });
+    let after_kill = events
+        .iter()
+        .any(|e| e["event"] != "fault" && (1200..2200).contains(&e["t"].as_i64().unwrap()));
     assert!(!after_kill, "tb_0 traced something while killed");
 }
 
