@@ -543,19 +543,24 @@ mod tests {
     const WAITING: &[u8] =
         br#"{"robot":"irobot","state":"running","started":"1000","mode":"WAIT_MODE"}"#;
 
+    /// irobot's datagram sending `MasterTeam.DISTANCE = 50`.
+    fn irobot_tells_distance() -> Vec<u8> {
+        semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+            publish: false,
+            team: "MasterTeam".into(),
+            robot: "irobot".into(),
+            key: "MasterTeam.DISTANCE".into(),
+            value: Some(semo::refine::Value::Int(50)),
+        })
+    }
+
     #[test]
     fn a_message_is_printed_only_from_the_sender_its_topic_names() {
         let irobot = topics::Sender {
             team: "MasterTeam",
             robot: "irobot",
         };
-        let told = semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
-            publish: false,
-            team: "MasterTeam".into(),
-            robot: "irobot".into(),
-            key: "MasterTeam.DISTANCE".into(),
-            value: Some(semo::refine::Value::Int(50)),
-        });
+        let told = irobot_tells_distance();
         let r1 = scope("r1");
         let own = topics::to_team(&r1, "USER", "MasterTeam.DISTANCE", irobot);
         let view = &mut view(Some("r1"));
@@ -596,13 +601,7 @@ mod tests {
         );
         let older = br#"{"robot":"ti","state":"stopped","started":"500","mode":"FINISH"}"#;
         assert_eq!(heard(view, "semo/scouting/r1/status/ti", older), "nothing");
-        let told = semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
-            publish: false,
-            team: "MasterTeam".into(),
-            robot: "irobot".into(),
-            key: "MasterTeam.DISTANCE".into(),
-            value: Some(semo::refine::Value::Int(50)),
-        });
+        let told = irobot_tells_distance();
         let irobot = topics::Sender {
             team: "MasterTeam",
             robot: "irobot",
