@@ -293,7 +293,11 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
     if let Some(lib) = program.library.as_ref().filter(|l| l.ownership.is_some()) {
         // The getters ask who owns the values when they are read; the
         // firing that finds a lost owner comes when it is lost.
-        let _ = writeln!(out, "    wake_at({}_owner_lost_at());", c::ident(&lib.name));
+        let _ = writeln!(
+            out,
+            "    wake_at({}_owner_lost_at());",
+            super::shared::prefix(lib)
+        );
     }
     out.push_str("}\n\n");
 

@@ -16,7 +16,7 @@ use crate::refine::{OwnerRule, Ownership, RobotProgram, SharedLibrary, ValueKind
 use std::fmt::Write;
 
 /// The C prefix of the library's functions.
-fn prefix(lib: &SharedLibrary) -> String {
+pub(super) fn prefix(lib: &SharedLibrary) -> String {
     c::ident(&lib.name)
 }
 

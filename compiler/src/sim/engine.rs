@@ -287,8 +287,6 @@ struct Robot<'p> {
     dropped: Vec<u64>,
     /// Control firings begun.
     firings: u64,
-    /// A task's request waits to be taken ([`TaskState::untaken`]).
-    has_untaken: bool,
     /// Per subscribed group: the latest value.
     groups: Vec<Option<Held>>,
     regions: Vec<Region>,
@@ -399,10 +397,13 @@ impl<'p> Robot<'p> {
         }
         let regions = m.region_count();
         let marks = m.mark_count();
-        let inbox = m
-            .incoming
-            .iter()
-            .map(|i| (VecDeque::new(), channel_capacity(program, &i.port)))
+        // Each channel's capacity: the buffer analysis's bound, at least one.
+        let inbox = inbox_channels(program)
+            .into_iter()
+            .map(|c| {
+                let capacity = c.and_then(|c| program.capacities.get(c)).copied();
+                (VecDeque::new(), capacity.map_or(1, |c| c.max(1) as usize))
+            })
             .collect();
         // One value per shared key, as the library task holds them.
         let mut library_keys: Vec<&str> = Vec::new();
@@ -438,7 +439,6 @@ impl<'p> Robot<'p> {
             stalled: vec![false; m.incoming.len()],
             dropped: vec![0; m.incoming.len()],
             firings: 0,
-            has_untaken: false,
             groups: vec![None; m.subscribed.len()],
             regions: vec![
                 Region {
@@ -491,16 +491,23 @@ impl<'p> Robot<'p> {
     }
 }
 
-/// The capacity of the channel into the control task's port `port`
-/// (the buffer analysis's bound), at least one sample.
-fn channel_capacity(program: &RobotProgram, port: &str) -> usize {
-    program
+/// Per incoming message of `program`'s control task: the graph channel
+/// that carries it into the control task (by its port), if any.
+fn inbox_channels(program: &RobotProgram) -> Vec<Option<usize>> {
+    let into_control: HashMap<&str, usize> = program
         .graph
         .channels
         .iter()
-        .zip(&program.capacities)
-        .find(|(c, _)| c.dst.task == crate::refine::graph::CONTROL_TASK && c.dst.port == port)
-        .map_or(1, |(_, cap)| (*cap).max(1) as usize)
+        .enumerate()
+        .filter(|(_, c)| c.dst.task == crate::refine::graph::CONTROL_TASK)
+        .map(|(i, c)| (c.dst.port.as_str(), i))
+        .collect();
+    program
+        .control
+        .incoming
+        .iter()
+        .map(|m| into_control.get(m.port.as_str()).copied())
+        .collect()
 }
 
 impl<'p> Sim<'p> {
@@ -775,25 +782,23 @@ impl<'p> Sim<'p> {
     /// messages it dropped.
     fn trace_dropped(&mut self, r: usize) {
         let program = self.robots[r].program;
-        let incoming = &program.control.incoming;
-        for c in &program.graph.channels {
-            let Some(i) = incoming.iter().position(|m| {
-                c.dst.task == crate::refine::graph::CONTROL_TASK && c.dst.port == m.port
-            }) else {
-                continue;
-            };
-            let count = self.robots[r].dropped[i];
-            if count > 0 {
-                let channel = format!(
-                    "{}.{}->{}.{}",
-                    c.src.task, c.src.port, c.dst.task, c.dst.port
-                );
-                let fields = vec![
-                    ("channel", channel.into()),
-                    ("count", count.to_string().into()),
-                ];
-                self.emit(r, "dropped", fields);
-            }
+        let mut dropped: Vec<(usize, u64)> = inbox_channels(program)
+            .into_iter()
+            .zip(&self.robots[r].dropped)
+            .filter_map(|(c, &count)| Some((c?, count)).filter(|_| count > 0))
+            .collect();
+        dropped.sort_unstable();
+        for (c, count) in dropped {
+            let c = &program.graph.channels[c];
+            let channel = format!(
+                "{}.{}->{}.{}",
+                c.src.task, c.src.port, c.dst.task, c.dst.port
+            );
+            let fields = vec![
+                ("channel", channel.into()),
+                ("count", count.to_string().into()),
+            ];
+            self.emit(r, "dropped", fields);
         }
     }
 
@@ -1188,7 +1193,6 @@ impl<'p> Sim<'p> {
         state.untaken = Some(args);
         state.service = service.to_string();
         state.generation += 1;
-        self.robots[r].has_untaken = true;
         true
     }
 
@@ -1196,9 +1200,6 @@ impl<'p> Sim<'p> {
     /// task's thread runs after the control task's firing), trace the
     /// call and start the service.
     fn take_requests(&mut self, r: usize) {
-        if !std::mem::take(&mut self.robots[r].has_untaken) {
-            return;
-        }
         for t in 0..self.robots[r].tasks.len() {
             if let Some(args) = self.robots[r].tasks[t].1.untaken.take() {
                 self.take(r, t, args);
