@@ -1405,16 +1405,7 @@ fn operator_console_drives_scouting_to_finish(name: &str, tls: bool) {
     let alone = out.join("no-operator.scenario.json");
     std::fs::write(&alone, world.to_string()).unwrap();
 
-    let mut console = Command::new(env!("CARGO_BIN_EXE_semo"))
-        .args(["operator"])
-        .arg(examples().join("scouting/scouting.mission"))
-        .arg("--deploy")
-        .arg(&deploy)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("semo operator starts");
+    let mut console = operator_console([std::ffi::OsStr::new("--deploy"), deploy.as_os_str()]);
     let mut stdin = console.stdin.take().unwrap();
     let stdout = console.stdout.take().unwrap();
     let (lines_tx, lines) = std::sync::mpsc::channel::<String>();
@@ -1499,10 +1490,10 @@ fn operator_console_drives_scouting_to_finish(name: &str, tls: bool) {
     );
 }
 
-/// `semo operator` on scouting with `args`, `input` on its standard input
-/// (then its end): its exit code, standard output and standard error.
-fn operator_with(args: &[&str], input: &str) -> (Option<i32>, String, String) {
-    let mut console = Command::new(env!("CARGO_BIN_EXE_semo"))
+/// `semo operator` on scouting with `args`, started with piped standard
+/// streams.
+fn operator_console<A: AsRef<std::ffi::OsStr>>(args: impl IntoIterator<Item = A>) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_semo"))
         .arg("operator")
         .arg(examples().join("scouting/scouting.mission"))
         .args(args)
@@ -1510,7 +1501,13 @@ fn operator_with(args: &[&str], input: &str) -> (Option<i32>, String, String) {
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
-        .expect("semo operator starts");
+        .expect("semo operator starts")
+}
+
+/// `semo operator` on scouting with `args`, `input` on its standard input
+/// (then its end): its exit code, standard output and standard error.
+fn operator_with(args: &[&str], input: &str) -> (Option<i32>, String, String) {
+    let mut console = operator_console(args);
     use std::io::Write;
     let mut stdin = console.stdin.take().unwrap();
     // A console refused at once has closed its input already.
