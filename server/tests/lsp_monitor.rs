@@ -157,6 +157,17 @@ async fn started(client: &mut TestClient, root: &Path, uri: &str, text: &str) {
     client.diagnostics(uri, Some(1)).await;
 }
 
+/// `semo/monitor/start` on `uri` with `broker`: the monitor's answer.
+async fn monitor_start(client: &mut TestClient, uri: &str, broker: &str) -> Value {
+    client
+        .request(
+            "semo/monitor/start",
+            json!({ "uri": uri, "broker": broker }),
+        )
+        .await
+        .expect("the monitor starts")
+}
+
 /// The next `semo/monitor` notification whose robots satisfy `wanted`; a
 /// monitor that never sends it fails the test instead of hanging it.
 async fn view_where(client: &mut TestClient, wanted: impl Fn(&Value) -> bool) -> Value {
@@ -202,13 +213,7 @@ async fn robots_appear_with_their_modes_and_a_killed_or_silent_one_is_lost() {
     let mut client = TestClient::start();
     started(&mut client, dir.path(), &uri, &text).await;
 
-    let answer = client
-        .request(
-            "semo/monitor/start",
-            json!({ "uri": uri, "broker": broker.url() }),
-        )
-        .await
-        .expect("the monitor starts");
+    let answer = monitor_start(&mut client, &uri, &broker.url()).await;
     assert_eq!(answer["mission"], "patrol_groups");
     assert_eq!(answer["broker"], broker.url());
     let names: Vec<&str> = answer["robots"]
@@ -275,13 +280,7 @@ async fn robots_appear_with_their_modes_and_a_killed_or_silent_one_is_lost() {
         .await
         .unwrap();
     assert_eq!(stopped["stopped"], true);
-    client
-        .request(
-            "semo/monitor/start",
-            json!({ "uri": uri, "broker": broker.url() }),
-        )
-        .await
-        .expect("the monitor starts again");
+    monitor_start(&mut client, &uri, &broker.url()).await;
     // Retained statuses come with the subscription: tb_1 is known at once.
     let view = view_where(&mut client, |p| p["robots"][2]["state"] == "running").await;
     assert_eq!(robot(&view, "tb_0")["lostBecause"], "lastWill");
@@ -313,13 +312,7 @@ async fn the_monitor_shows_the_newest_run_or_the_one_asked_for() {
     let (dir, uri, text) = workspace();
     let mut client = TestClient::start();
     started(&mut client, dir.path(), &uri, &text).await;
-    let answer = client
-        .request(
-            "semo/monitor/start",
-            json!({ "uri": uri, "broker": broker.url() }),
-        )
-        .await
-        .expect("the monitor starts");
+    let answer = monitor_start(&mut client, &uri, &broker.url()).await;
     assert_eq!(answer["run"], Value::Null);
     let first = FakeRobot::connect_in(broker.port, "tb_0", "r1", 1000);
     first.status("running", "PATROL", "tb_0", "").await;
