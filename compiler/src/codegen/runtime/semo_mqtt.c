@@ -22,8 +22,9 @@
  * `send` messages travel at QoS 1 and the session is persistent
  * (clean_session false, client id `semo-<mission>-<run>-<robot>`: one
  * session per run), so a robot that was away gets what was sent meanwhile;
- * `publish` messages at QoS 0, retained, so a robot that joins gets the
- * latest value of each publisher. A session kept over runs (a client id
+ * `publish` messages at QoS 0, not retained: as over UDP and in the
+ * simulator, a robot that joins (or restarts) hears the publishes made from
+ * then on, never an earlier one the broker kept. A session kept over runs (a client id
  * given by the deployment) may bring messages of an earlier run: they are
  * another run's, and dropped unseen.
  * TCP_NODELAY is set: without it a QoS 1 round trip on loopback waits for
@@ -533,8 +534,10 @@ static int mqtt_send_to(const char *to, const void *data, size_t len)
     bool is_send = ((const unsigned char *)data)[5] == SEMO_MSG_SEND;
     if (!is_send) {
         /* A publish while disconnected is lost, as on UDP: the next one
-         * carries the latest value. */
-        int rc = publish(topic, data, len, 0, true);
+         * carries the latest value. Not retained: a robot that joins later
+         * would otherwise read each publisher's last value at once, which
+         * no other engine gives it (one meaning). */
+        int rc = publish(topic, data, len, 0, false);
         return rc == MOSQ_ERR_SUCCESS || rc == MOSQ_ERR_NO_CONN ? 0 : -1;
     }
     /* A send is never lost: while the broker is away (libmosquitto refuses
