@@ -15,6 +15,7 @@ mod operator;
 mod output;
 mod render;
 mod simulate;
+mod verify;
 mod watch;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -243,6 +244,50 @@ enum Command {
         /// lock-step virtual time: the same trace format).
         #[arg(long, value_enum, default_value_t = simulate::Engine::Sim)]
         engine: simulate::Engine,
+    },
+    /// Explore everything a mission's team can do (on the simulator's
+    /// semantics) and report what no single run shows.
+    #[command(
+        long_about = "Explore everything a mission's team can do: the refined programs `semo \
+        simulate` runs, under every choice of the world (each sensor value a robot compares, \
+        in each class its comparisons tell apart; each operator command a robot reads), one \
+        choice per step of the world's clock. States met before are not explored again, so \
+        a mission that repeats itself is explored completely (a proof for those choices), \
+        else up to --horizon or --max-states (bounded; the report says which). Reports a \
+        mode no robot of its team ever enters (V001) and a robot that can reach a state \
+        from which it never finishes though it finishes in other behaviours (V002). --counterexamples DIR writes, per finding, the \
+        scenario `semo simulate` replays to it (see docs/verify.md).\n\n\
+        Exit status: 0 nothing found, 1 a finding, 2 bad input (mission errors, options)."
+    )]
+    Verify {
+        /// The mission script (a file: its folder holds the catalog and
+        /// strategy files it reads). Default: the project's one mission.
+        mission: Option<PathBuf>,
+        /// More strategy (and catalog) files or folders to read.
+        #[arg(long)]
+        strategy: Vec<PathBuf>,
+        /// How to report: `human`, `json` (one document, docs/diagnostics-json.md)
+        /// or `sarif`.
+        #[arg(long, value_enum, default_value_t = Format::Human)]
+        format: Format,
+        /// The world's clock: it may make one choice every STEP (a multiple of 100ms).
+        #[arg(long, value_parser = simulate::parse_duration, default_value = "500ms")]
+        step: i64,
+        /// Mission time beyond which nothing is explored.
+        #[arg(long, value_parser = simulate::parse_duration, default_value = "2min")]
+        horizon: i64,
+        /// States beyond which the search stops.
+        #[arg(long, default_value_t = 50_000)]
+        max_states: usize,
+        /// How many times after the start the world may choose along one
+        /// behaviour (a sensor value into another class, an operator command).
+        #[arg(long, default_value_t = 2)]
+        changes: u32,
+        /// Write each finding's counterexample into DIR as a scenario file.
+        #[arg(long, value_name = "DIR")]
+        counterexamples: Option<PathBuf>,
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
     },
     /// Analyse task graphs (`*.taskgraph.xml` or SDF3 files).
     #[command(subcommand)]
@@ -623,6 +668,32 @@ fn run() -> i32 {
                 trace,
                 color: use_color(color),
                 engine,
+            },
+            &mut out,
+        ),
+        Command::Verify {
+            mission,
+            strategy,
+            format,
+            step,
+            horizon,
+            max_states,
+            changes,
+            counterexamples,
+            color,
+        } => verify::run(
+            verify::Options {
+                mission,
+                strategy,
+                format,
+                color: use_color(color),
+                search: semo::verify::Options {
+                    step_ms: step,
+                    horizon_ms: horizon,
+                    max_states,
+                    changes,
+                },
+                counterexamples,
             },
             &mut out,
         ),

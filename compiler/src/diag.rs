@@ -225,6 +225,8 @@ codes! {
     ReadBeforeSent = "W022", Warning, "a value read once, when the mission starts, before any robot can have sent it: it reads none, and nothing sent later is read there";
     ForwardedOnce = "W023", Warning, "a received value sent on once each time its mode starts while another plan of the mode keeps receiving it: what comes later is never sent on";
     ReceiveNeverFed = "W024", Warning, "a receive or subscribe that no robot can ever feed: its sends or publishes never run, or run only on the receiving robot itself";
+    ModeNeverEntered = "V001", Warning, "`semo verify`: a mode no robot of its team enters in any behaviour";
+    NeverFinishes = "V002", Warning, "`semo verify`: a robot that finishes in some behaviours can reach a state from which it never finishes";
 }
 
 impl fmt::Display for Code {

@@ -42,6 +42,7 @@ pub mod suggest;
 pub mod syntax;
 pub mod taskgraph;
 pub mod text;
+pub mod verify;
 pub mod workspace;
 /// Byte positions of XML elements and attributes, shared by the XML loaders.
 mod xmlpos;

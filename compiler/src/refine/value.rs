@@ -192,6 +192,38 @@ pub fn compare_numbers(a: Option<&Value>, b: Option<&Value>) -> Option<std::cmp:
 /// negation, words are never ordered). Words by identity, a word and a text
 /// by their text, numbers by value, truth values by value, no value only as
 /// no value; values of other types differ.
+/// Whether `a op b` holds, compared as the checker typed the comparison
+/// (`semo_value_numbers`, `semo_value_words`): numbers by value, false when
+/// a side is not a number; words by identity, never ordered.
+pub fn holds(
+    a: Option<&Value>,
+    op: crate::syntax::ast::CmpOp,
+    b: Option<&Value>,
+    compared: crate::sema::Compared,
+) -> bool {
+    use crate::sema::Compared;
+    use crate::syntax::ast::CmpOp;
+    use std::cmp::Ordering::*;
+    let ord = match compared {
+        Compared::Numbers => compare_numbers(a, b),
+        Compared::Words => match op {
+            CmpOp::Eq | CmpOp::Ne => Some(if words_equal(a, b) { Equal } else { Less }),
+            _ => None,
+        },
+    };
+    let Some(ord) = ord else {
+        return false;
+    };
+    match op {
+        CmpOp::Eq => ord == Equal,
+        CmpOp::Ne => ord != Equal,
+        CmpOp::Lt => ord == Less,
+        CmpOp::Le => ord != Greater,
+        CmpOp::Gt => ord == Greater,
+        CmpOp::Ge => ord != Less,
+    }
+}
+
 pub fn words_equal(a: Option<&Value>, b: Option<&Value>) -> bool {
     let (a, b) = match (a, b) {
         (Some(a), Some(b)) => (a, b),

@@ -36,8 +36,6 @@ use crate::refine::{
     ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, RoleKind, SlotId,
     SlotSource, StateKind,
 };
-use crate::sema::Compared;
-use crate::syntax::ast::CmpOp;
 use rand_core::{Rng, SeedableRng};
 use rand_xorshift::XorShiftRng;
 use std::cmp::Reverse;
@@ -45,6 +43,7 @@ use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
 
 mod battery;
+mod explore;
 mod loops;
 mod shared;
 
@@ -143,6 +142,7 @@ impl Event {
 /// control task takes from the channel, or until a control firing begun
 /// after `mark` (the firings begun when it started waiting) ends without
 /// making room; it is then dropped.
+#[derive(Clone)]
 struct Holding {
     /// The channels still to write, with the value for each.
     pending: VecDeque<(usize, Held)>,
@@ -258,6 +258,7 @@ struct TaskState {
 }
 
 /// One robot's running program (one process of `linux-sim`).
+#[derive(Clone)]
 struct Robot<'p> {
     program: &'p RobotProgram,
     alive: bool,
@@ -335,6 +336,8 @@ struct Robot<'p> {
     graphs: loops::GraphState,
 }
 
+/// Cloned by `semo verify` to branch on the world's choices (`explore.rs`).
+#[derive(Clone)]
 pub struct Sim<'p> {
     programs: &'p [RobotProgram],
     scenario: &'p Scenario,
@@ -346,11 +349,15 @@ pub struct Sim<'p> {
     trace: Vec<TraceEvent>,
     /// Next occurrence of each operator command.
     operator_next: Vec<i64>,
+    /// Operator commands given while running (`semo verify`'s choices),
+    /// numbered after the scenario's: each one as a scenario command given
+    /// once at that instant.
+    commands: Vec<Command>,
     /// The robots a message to a team or robot name goes to (`semo_comm_send`'s
     /// peer loop, computed once).
-    recipients: HashMap<String, Rc<[usize]>>,
+    recipients: Rc<HashMap<String, Rc<[usize]>>>,
     /// Per robot (program).
-    names: Vec<Names>,
+    names: Rc<[Names]>,
     /// The last control firing handled: (time, chain).
     last_fire: (i64, u64),
     every_firing: bool,
@@ -525,7 +532,8 @@ impl<'p> Sim<'p> {
             rng: XorShiftRng::seed_from_u64(options.seed),
             trace: Vec::new(),
             operator_next: scenario.operator.iter().map(|c| c.first).collect(),
-            recipients: recipients(programs),
+            commands: Vec::new(),
+            recipients: Rc::new(recipients(programs)),
             names: programs.iter().map(Names::new).collect(),
             last_fire: (-1, 0),
             every_firing: options.every_firing,
@@ -607,18 +615,7 @@ impl<'p> Sim<'p> {
             .until_ms
             .or(self.scenario.duration_ms)
             .unwrap_or(DEFAULT_UNTIL_MS);
-        let mut events = 0u64;
-        while let Some(Reverse((t, _, _, event))) = self.queue.pop() {
-            if t >= until {
-                break;
-            }
-            self.now = t;
-            events += 1;
-            self.handle(event);
-            if self.robots.iter().all(|r| !r.alive) && !self.restart_pending() {
-                break;
-            }
-        }
+        let events = self.advance(until);
         if self.robots.iter().any(|r| r.alive) {
             self.now = until;
             for r in 0..self.robots.len() {
@@ -637,6 +634,27 @@ impl<'p> Sim<'p> {
             trace: self.trace,
             events,
         }
+    }
+
+    /// Handles the events of the instants before `until`, or until every
+    /// robot has stopped for good; returns how many it handled.
+    fn advance(&mut self, until: i64) -> u64 {
+        let mut events = 0u64;
+        while let Some(Reverse((t, ..))) = self.queue.peek() {
+            if *t >= until {
+                break;
+            }
+            let Some(Reverse((t, _, _, event))) = self.queue.pop() else {
+                break;
+            };
+            self.now = t;
+            events += 1;
+            self.handle(event);
+            if self.robots.iter().all(|r| !r.alive) && !self.restart_pending() {
+                break;
+            }
+        }
+        events
     }
 
     fn restart_pending(&self) -> bool {
@@ -703,8 +721,17 @@ impl<'p> Sim<'p> {
         }
     }
 
+    /// Operator command `i`: the scenario's, then those given while running.
+    fn command(&self, i: usize) -> &Command {
+        let given = self.scenario.operator.len();
+        self.scenario
+            .operator
+            .get(i)
+            .unwrap_or_else(|| &self.commands[i - given])
+    }
+
     fn operator(&mut self, i: usize) {
-        let command: &Command = &self.scenario.operator[i];
+        let command = self.command(i).clone();
         let message = Message {
             publish: false,
             from_team: "USER".into(),
@@ -824,33 +851,7 @@ impl<'p> Sim<'p> {
             Expr::Bool(b) => *b,
             Expr::Truthy(o) => value::truthy(self.value_ref(r, o)),
             Expr::Compare(a, op, b, compared) => {
-                let (a, b) = (self.value_ref(r, a), self.value_ref(r, b));
-                // As the checker typed it (`semo_value_numbers`,
-                // `semo_value_words`): numbers by value, false when a side is
-                // not a number; words by identity, never ordered.
-                let ord = match compared {
-                    Compared::Numbers => value::compare_numbers(a, b),
-                    Compared::Words => match op {
-                        CmpOp::Eq | CmpOp::Ne => Some(if value::words_equal(a, b) {
-                            std::cmp::Ordering::Equal
-                        } else {
-                            std::cmp::Ordering::Less
-                        }),
-                        _ => None,
-                    },
-                };
-                let Some(ord) = ord else {
-                    return false;
-                };
-                use std::cmp::Ordering::*;
-                match op {
-                    CmpOp::Eq => ord == Equal,
-                    CmpOp::Ne => ord != Equal,
-                    CmpOp::Lt => ord == Less,
-                    CmpOp::Le => ord != Greater,
-                    CmpOp::Gt => ord == Greater,
-                    CmpOp::Ge => ord != Less,
-                }
+                value::holds(self.value_ref(r, a), *op, self.value_ref(r, b), *compared)
             }
         }
     }

@@ -820,3 +820,46 @@ fn a_stop_ends_a_graph_call_when_its_iteration_ends() {
         .collect();
     assert_eq!(samples[..4], [0, 200, 400, 600]);
 }
+
+/// `semo verify`'s choices made while running (`Sim::set_sensor`,
+/// `Sim::give_command`) are exactly the scenario entries its counterexamples
+/// write: the same trace, event for event, as the scenario run.
+#[test]
+fn choices_made_while_running_are_the_scenario_entries_they_replay_as() {
+    let programs = programs("examples/scouting/scouting.mission");
+    let with_entries = r#"{"duration": 6000,
+        "robots": {"ti": {"sensors": [{"at": 0, "value": "LOCATION", "is": "OTHER"},
+                                      {"at": 1500, "value": "LOCATION", "is": "5,5"}]},
+                   "irobot": {"sensors": [{"at": 500, "value": "LOCATION", "is": "5,5"}]}},
+        "operator": [{"at": 3000, "to": "MasterTeam", "value": "RC_CMD", "is": "RC_MODE"}]}"#;
+    let (reference, _) = run(&programs, with_entries, 0);
+    let empty = Scenario::default();
+    let mut sim = Sim::new(&programs, &empty, &Options::default());
+    let ti = programs.iter().position(|p| p.robot == "ti").unwrap();
+    let irobot = programs.iter().position(|p| p.robot == "irobot").unwrap();
+    let mut trace = Vec::new();
+    sim.set_sensor(ti, "LOCATION", "OTHER");
+    for (at, choice) in [(500, 0), (1500, 1), (3000, 2), (6000, 3)] {
+        sim.run_to(at);
+        trace.extend(sim.take_trace());
+        match choice {
+            0 => sim.set_sensor(irobot, "LOCATION", "5,5"),
+            1 => sim.set_sensor(ti, "LOCATION", "5,5"),
+            2 => sim.give_command("MasterTeam", "USER.RC_CMD", "RC_MODE"),
+            _ => {}
+        }
+    }
+    // The reference run stops the robots at its end; compare before that.
+    let lines = |events: &[TraceEvent]| -> Vec<String> {
+        events
+            .iter()
+            .filter(|e| e.t < 6000)
+            .map(|e| e.to_json(&reference.robots[e.robot].1))
+            .collect()
+    };
+    assert!(trace.iter().any(|e| e.event == "receive"));
+    assert_eq!(lines(&trace), lines(&reference.trace));
+    // A clone is the same state.
+    let copy = sim.clone();
+    assert_eq!(copy.fingerprint(5000), sim.fingerprint(5000));
+}

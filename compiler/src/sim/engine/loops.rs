@@ -36,7 +36,7 @@ use std::rc::Rc;
 /// One robot's service graphs: channels by service task, the last start
 /// of each time-triggered task by (service task, inner task), and the
 /// trace lines of an iteration under way not yet due, in time order.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub(super) struct GraphState {
     channels: HashMap<String, Vec<VecDeque<i64>>>,
     starts: HashMap<(String, usize), i64>,

@@ -1,0 +1,202 @@
+//! `semo verify`: everything a mission's team can do, explored on the
+//! simulator's step semantics (`semo::verify`); findings as diagnostics on
+//! the mission's lines, each with the scenario that replays it. Exit
+//! status: 0 nothing found, 1 a finding, 2 bad input (mission errors,
+//! options).
+
+use super::input::{self, Content};
+use super::output::{self, Format};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+pub struct Options {
+    /// Else the project's one mission (`defaults::mission`).
+    pub mission: Option<PathBuf>,
+    pub strategy: Vec<PathBuf>,
+    pub format: Format,
+    pub color: bool,
+    pub search: semo::verify::Options,
+    /// Write each finding's counterexample here as a scenario file.
+    pub counterexamples: Option<PathBuf>,
+}
+
+const VERIFY: &str = "semo verify";
+
+pub fn run(options: Options, out: &mut impl Write) -> i32 {
+    let format = options.format;
+    if options.search.step_ms <= 0 || options.search.step_ms % 100 != 0 {
+        eprintln!(
+            "error: --step must be a positive multiple of 100ms (the sensors' period), not {}ms",
+            options.search.step_ms
+        );
+        return 2;
+    }
+    let mission_file = match options.mission.clone() {
+        Some(named) => named,
+        None => match super::defaults::mission("`semo verify MISSION`") {
+            Ok(found) => found,
+            Err(e) => return output::refused(format, "verify", &e.folder, &e.message, out),
+        },
+    };
+    if input::is_stdin(&mission_file) {
+        eprintln!(
+            "error: `semo verify` reads the mission's folder (its catalog and strategy files): give the mission's file, not `-`"
+        );
+        return 2;
+    }
+    if !input::strategy_paths_are_files(&options.strategy)
+        || !input::file_is_kind(&mission_file, Content::Mission, VERIFY)
+    {
+        return 2;
+    }
+    let (mut check, mission) = match semo::host::load_build(&mission_file, &options.strategy) {
+        Ok(loaded) => loaded,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let build = match super::build_files(&check.analysis(), mission) {
+        Ok(files) => files,
+        Err(code) => return code,
+    };
+    let refined = semo::codegen::refine_checked(&build.input());
+    if refined.diagnostics.iter().any(|d| d.is_error()) {
+        check.diagnostics = refined.diagnostics;
+        let reported = match format {
+            Format::Human => {
+                super::render::human(&check, options.color, &mut std::io::stderr().lock())
+            }
+            _ => output::report(
+                format,
+                "verify",
+                &check.files,
+                &check.diagnostics,
+                options.color,
+                serde_json::json!({}),
+                out,
+            ),
+        };
+        let _ = output::written(reported);
+        eprintln!("error: cannot verify: fix the errors above first");
+        return 2;
+    }
+    let text = check.files.get(mission).text.clone();
+    let report = semo::verify::verify(&refined.programs, mission, &text, &options.search);
+    let mut written_files = Vec::new();
+    if let Some(dir) = &options.counterexamples {
+        match write_counterexamples(dir, &mission_file, &report, &refined.programs) {
+            Ok(files) => written_files = files,
+            Err(e) => {
+                eprintln!("error: {}: {e}", dir.display());
+                return 2;
+            }
+        }
+    }
+    let data = serde_json::json!({
+        "exhaustive": report.exhaustive,
+        "states": report.states,
+        "transitions": report.transitions,
+        "explored_ms": report.reached_ms,
+        "counterexamples": written_files
+            .iter()
+            .map(|f| f.as_ref().map(|p: &PathBuf| p.display().to_string()))
+            .collect::<Vec<_>>(),
+    });
+    let reported = match format {
+        Format::Human => {
+            let mut err = std::io::stderr().lock();
+            let written =
+                super::render::diagnostics(&check.files, &report.findings, options.color, &mut err);
+            let _ = writeln!(
+                out,
+                "{} {} state(s), {} transition(s): {}",
+                if report.exhaustive {
+                    "explored every behaviour:"
+                } else {
+                    "explored (bounded):"
+                },
+                report.states,
+                report.transitions,
+                if report.exhaustive {
+                    "a proof for the choices explored".to_string()
+                } else {
+                    format!("the first {} ms", report.reached_ms)
+                }
+            );
+            for s in &report.inputs.sensors {
+                let _ = writeln!(
+                    out,
+                    "  sensor {}.{}: {}",
+                    s.robot_name,
+                    s.port,
+                    s.values.join(" | ")
+                );
+            }
+            for c in &report.inputs.commands {
+                let _ = writeln!(
+                    out,
+                    "  command {} USER.{}: {}",
+                    c.to,
+                    c.value,
+                    c.values.join(" | ")
+                );
+            }
+            for (finding, file) in report.findings.iter().zip(&written_files) {
+                if let Some(file) = file {
+                    let _ = writeln!(
+                        out,
+                        "  {}: replay with `semo simulate {} --scenario {}`",
+                        finding.code,
+                        mission_file.display(),
+                        file.display()
+                    );
+                }
+            }
+            written
+        }
+        _ => output::report(
+            format,
+            "verify",
+            &check.files,
+            &report.findings,
+            options.color,
+            data,
+            out,
+        ),
+    };
+    if let Err(code) = output::written(reported) {
+        return code;
+    }
+    i32::from(!report.findings.is_empty())
+}
+
+/// Writes each finding's counterexample as `<mission>.<code>-<n>.scenario.json`
+/// in `dir`; per finding, the file written, if it has one.
+fn write_counterexamples(
+    dir: &Path,
+    mission: &Path,
+    report: &semo::verify::Report,
+    programs: &[semo::refine::RobotProgram],
+) -> std::io::Result<Vec<Option<PathBuf>>> {
+    std::fs::create_dir_all(dir)?;
+    let stem = mission
+        .file_stem()
+        .map_or("mission".into(), |s| s.to_string_lossy().into_owned());
+    let mut written = Vec::new();
+    for (n, (finding, way)) in report
+        .findings
+        .iter()
+        .zip(&report.counterexamples)
+        .enumerate()
+    {
+        let Some(way) = way else {
+            written.push(None);
+            continue;
+        };
+        let path = dir.join(format!("{stem}.{}-{}.scenario.json", finding.code, n + 1));
+        std::fs::write(&path, way.scenario_json(programs))?;
+        written.push(Some(path));
+    }
+    Ok(written)
+}

@@ -1,0 +1,354 @@
+//! What `semo verify` asks of the engine: run to an instant, let the world
+//! choose there (a sensor value, an operator command) exactly as a scenario
+//! entry at that instant would, and say when two runs are in the same
+//! state. The run is the simulator's own: verification has no second
+//! meaning of a mission.
+//!
+//! Two states are the same when everything that decides what happens next
+//! is equal: every robot's slots, regions, channels, elections and pending
+//! events, with each time taken relative to now. A time further in the past
+//! than `memory` (longer than every period, timeout and heartbeat the
+//! programs compare against) is the same as any older one, so a mission
+//! that repeats itself reaches a state it has been in before and the search
+//! ends. What only the trace shows (how many messages a channel dropped,
+//! the ids of events) is left out.
+
+use super::{Event, Held, Message, Robot, Sim};
+use crate::refine::SlotSource;
+use crate::sim::scenario::Command;
+use crate::sim::trace::{TraceEvent, write_value};
+use std::cmp::Reverse;
+use std::hash::{DefaultHasher, Hasher};
+
+impl<'p> Sim<'p> {
+    /// Runs the instants before `until`; the robots still alive then go on
+    /// at `until`, where the world may choose before anything happens.
+    pub fn run_to(&mut self, until: i64) {
+        self.advance(until);
+        self.now = self.now.max(until);
+    }
+
+    /// Mission ms now.
+    pub fn now(&self) -> i64 {
+        self.now
+    }
+
+    /// The sensor value `port` of robot `r` becomes `text` now: as the
+    /// scenario entry `{"at": now, "value": port, "is": text}` would make it.
+    pub fn set_sensor(&mut self, r: usize, port: &str, text: &str) {
+        let now = self.now;
+        let robot = &mut self.robots[r];
+        let mut first_sample: Option<i64> = None;
+        for (i, slot) in robot.program.control.slots.iter().enumerate() {
+            let (SlotSource::Sensor { port: p, task }, Some(series)) =
+                (&slot.source, robot.sensor_series[i].as_mut())
+            else {
+                continue;
+            };
+            if p != port {
+                continue;
+            }
+            series.push((now, slot.kind.parse(text)));
+            let at = robot.sample_at_or_after(task, now);
+            first_sample = Some(first_sample.map_or(at, |f| f.min(at)));
+        }
+        // An idle robot fires when the sample brings the value, as it
+        // would have planned had the entry been in the scenario.
+        if let Some(at) = first_sample
+            && self.robots[r].alive
+            && !self.every_firing
+        {
+            let at = self.grid_at_or_after(r, at);
+            if self.robots[r].next_fire.is_none_or(|next| at < next) {
+                self.schedule_fire(r, at);
+            }
+        }
+    }
+
+    /// The operator sends `key` = `value` to `to` (a robot or a team) now:
+    /// the scenario command `{"at": now, "to": to, "value": key, "is": value}`.
+    pub fn give_command(&mut self, to: &str, key: &str, value: &str) {
+        self.commands.push(Command {
+            to: to.to_string(),
+            key: key.to_string(),
+            value: value.to_string(),
+            first: self.now,
+            every: None,
+            until: self.now,
+        });
+        let i = self.scenario.operator.len() + self.commands.len() - 1;
+        self.schedule(self.now, Event::Operator(i));
+    }
+
+    /// The trace written since the last call.
+    pub fn take_trace(&mut self) -> Vec<TraceEvent> {
+        std::mem::take(&mut self.trace)
+    }
+
+    /// How many robots the mission has.
+    pub fn robot_count(&self) -> usize {
+        self.robots.len()
+    }
+
+    /// Whether robot `r` runs (it has neither finished nor been killed).
+    pub fn is_running(&self, r: usize) -> bool {
+        self.robots[r].alive
+    }
+
+    /// The mode robot `r` is in: an index into its program's modes.
+    pub fn mode_of(&self, r: usize) -> Option<usize> {
+        self.robots[r].current_mode
+    }
+
+    /// The state, as a 128-bit hash of what decides the rest of the run
+    /// (see the module's comment): equal states give equal fingerprints.
+    pub fn fingerprint(&self, memory: i64) -> u128 {
+        let mut fp = Fingerprint::new(self.now, memory);
+        fp.time(self.last_fire.0);
+        fp.int(self.last_fire.1 as i64);
+        for robot in &self.robots {
+            fp.robot(robot);
+        }
+        // The events still to come, in the order they will be handled;
+        // those a robot will ignore (an earlier life's, a firing moved
+        // earlier, a stopped call's end) are left out.
+        let mut queue: Vec<_> = self.queue.iter().map(|Reverse(e)| e).collect();
+        queue.sort_unstable();
+        for (t, order, _, event) in queue {
+            let live = match event {
+                Event::Fire {
+                    robot,
+                    epoch,
+                    token,
+                } => {
+                    let r = &self.robots[*robot];
+                    r.alive && r.epoch == *epoch && r.fire_token == *token
+                }
+                Event::Deliver { to: r, epoch, .. } | Event::GraphTrace { robot: r, epoch } => {
+                    self.robots[*r].alive && self.robots[*r].epoch == *epoch
+                }
+                Event::ServiceDone {
+                    robot,
+                    task,
+                    generation,
+                } => {
+                    let state = &self.robots[*robot].tasks[*task].1;
+                    self.robots[*robot].alive && state.busy && state.generation == *generation
+                }
+                Event::Fault(_) | Event::Operator(_) => true,
+            };
+            if !live {
+                continue;
+            }
+            fp.time(*t);
+            fp.int(*order as i64);
+            match event {
+                Event::Fire { robot, .. } | Event::GraphTrace { robot, .. } => {
+                    fp.int(*robot as i64)
+                }
+                Event::Deliver { to, message, .. } => {
+                    fp.int(*to as i64);
+                    fp.message(message);
+                }
+                Event::ServiceDone { robot, task, .. } => {
+                    fp.int(*robot as i64);
+                    fp.int(*task as i64);
+                }
+                Event::Fault(i) => fp.int(*i as i64),
+                Event::Operator(i) => {
+                    let c = self.command(*i);
+                    fp.text(&c.to);
+                    fp.text(&c.key);
+                    fp.text(&c.value);
+                    fp.int(c.every.unwrap_or(-1));
+                    fp.time(c.until);
+                }
+            }
+        }
+        fp.finish()
+    }
+}
+
+/// Two hashers with different starts: 128 bits, so that two different
+/// states of a search of millions share a fingerprint with a chance of
+/// about 2^-88.
+struct Fingerprint {
+    a: DefaultHasher,
+    b: DefaultHasher,
+    now: i64,
+    memory: i64,
+}
+
+impl Fingerprint {
+    fn new(now: i64, memory: i64) -> Fingerprint {
+        let mut b = DefaultHasher::new();
+        b.write_u64(0x5e30_7e21_f1ed_0001);
+        Fingerprint {
+            a: DefaultHasher::new(),
+            b,
+            now,
+            memory,
+        }
+    }
+
+    fn int(&mut self, v: i64) {
+        self.a.write_i64(v);
+        self.b.write_i64(v);
+    }
+
+    /// A mission time, relative to now; anything older than `memory` as
+    /// the same "long ago".
+    fn time(&mut self, t: i64) {
+        self.int((t - self.now).max(-self.memory));
+    }
+
+    fn text(&mut self, s: &str) {
+        self.int(s.len() as i64);
+        self.a.write(s.as_bytes());
+        self.b.write(s.as_bytes());
+    }
+
+    fn held(&mut self, v: &Held) {
+        let mut out = String::new();
+        write_value(&mut out, v.as_ref());
+        self.text(&out);
+    }
+
+    fn message(&mut self, m: &Message) {
+        self.int(m.publish as i64);
+        self.text(&m.from_team);
+        self.text(&m.from_robot);
+        self.int(m.from_peer.map_or(-1, |p| p as i64));
+        self.text(&m.key);
+        self.held(&m.value.0);
+        self.time(m.sent_at);
+    }
+
+    fn robot(&mut self, robot: &Robot) {
+        self.int(robot.alive as i64);
+        if !robot.alive {
+            return;
+        }
+        self.time(robot.started_at);
+        // The grids of its firings and samples run from its start.
+        self.int((self.now - robot.started_at).rem_euclid(1000));
+        for v in robot.slots.iter().chain(&robot.library) {
+            self.held(v);
+        }
+        self.int(robot.owner as i64);
+        for (queue, _) in &robot.inbox {
+            self.int(queue.len() as i64);
+            for v in queue {
+                self.held(v);
+            }
+        }
+        match &robot.holding {
+            None => self.int(-1),
+            Some(h) => {
+                self.int(robot.firings as i64 - h.mark as i64);
+                for (c, v) in &h.pending {
+                    self.int(*c as i64);
+                    self.held(v);
+                }
+                self.text(&h.from);
+                self.text(&h.key);
+            }
+        }
+        for m in &robot.behind {
+            self.message(m);
+        }
+        for s in &robot.stalled {
+            self.int(*s as i64);
+        }
+        for g in &robot.groups {
+            match g {
+                None => self.int(-1),
+                Some(v) => self.held(v),
+            }
+        }
+        for region in &robot.regions {
+            self.int(region.service.map_or(-1, |s| s as i64));
+            self.int(region.pc as i64);
+            self.int(region.phase as i64);
+            self.int(region.action as i64);
+            self.int(region.done as i64);
+            self.time(region.started);
+            self.time(region.pass_start);
+            self.int(region.timeout_ms);
+            for m in &region.marks {
+                self.time(*m);
+            }
+            self.text(&region.plan);
+        }
+        self.int(robot.current_mode.map_or(-1, |m| m as i64));
+        self.int(robot.pending_mode.map_or(-1, |m| m as i64));
+        self.time(robot.last_heartbeat);
+        for h in &robot.heard {
+            self.time(h.seen);
+            self.int(h.leads as i64);
+            self.int(h.battery.unwrap_or(i64::MIN));
+        }
+        self.int(robot.leading as i64);
+        self.int(robot.rejoining as i64);
+        for map in [&robot.sync_pass, &robot.sync_arrived] {
+            let mut entries: Vec<_> = map.iter().collect();
+            entries.sort_unstable();
+            for ((a, b), v) in entries {
+                self.int(*a as i64);
+                self.int(*b as i64);
+                self.int(*v);
+            }
+        }
+        let mut leaders: Vec<_> = robot.leaders.iter().collect();
+        leaders.sort_unstable();
+        for ((a, b), v) in leaders {
+            self.int(*a as i64);
+            self.int(*b as i64);
+            self.int(*v as i64);
+        }
+        match robot.group {
+            None => self.int(-1),
+            Some((rank, size)) => {
+                self.int(rank as i64);
+                self.int(size as i64);
+            }
+        }
+        for (name, task) in &robot.tasks {
+            self.text(name);
+            self.int(task.busy as i64);
+            match &task.untaken {
+                None => self.int(-1),
+                Some(args) => {
+                    for v in args {
+                        self.held(v);
+                    }
+                }
+            }
+            self.text(&task.service);
+            self.time(task.graph_until);
+        }
+        // The sensor values: the latest entry and when it came (a sample
+        // may not have read it yet).
+        for series in robot.sensor_series.iter().flatten() {
+            match series.last() {
+                None => self.int(-1),
+                Some((at, v)) => {
+                    // Once a sample period has passed, every sample reads it.
+                    self.int((at - self.now).max(-2 * super::SENSOR_PERIOD_MS));
+                    self.held(v);
+                }
+            }
+        }
+        self.int(robot.chain as i64);
+        self.int(robot.next_fire.map_or(i64::MIN, |t| t - self.now));
+        self.int(robot.progressed as i64);
+        // Battery policies and service graphs keep absolute times: states
+        // of different instants then never merge, which costs states, not
+        // soundness (without either, the text holds no time).
+        self.text(&format!("{:?}{:?}", robot.resources, robot.graphs));
+    }
+
+    fn finish(self) -> u128 {
+        ((self.a.finish() as u128) << 64) | self.b.finish() as u128
+    }
+}

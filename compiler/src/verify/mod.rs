@@ -1,0 +1,281 @@
+//! `semo verify`: everything the team can do, explored on the simulator's
+//! own step semantics (the refined programs `semo build` turns into C, run
+//! by [`crate::sim::Sim`]; no second meaning), with nothing for the user to
+//! write.
+//!
+//! - `inputs.rs`: the world's choices, from the programs' comparisons.
+//! - `search.rs`: the breadth-first search over the fleet's states.
+//!
+//! Properties checked, only when the search is exhaustive (a bounded one
+//! proves neither): every mode is entered in some behaviour (V001); a
+//! robot that finishes in some behaviour can finish from every state it
+//! can reach (V002), with the shortest way to such a state as a scenario
+//! `semo simulate` replays.
+
+mod inputs;
+mod search;
+
+pub use inputs::{CommandInput, Inputs, SensorInput};
+
+use crate::diag::{Code, Diagnostic, FileId};
+use crate::refine::RobotProgram;
+use crate::span::Span;
+use std::fmt::Write;
+
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// The world's clock: it may choose every `step_ms` (a multiple of the
+    /// sensors' 100 ms period).
+    pub step_ms: i64,
+    /// Mission ms beyond which no state is explored.
+    pub horizon_ms: i64,
+    /// States beyond which the search stops (bounded).
+    pub max_states: usize,
+    /// How many times after the start the world may choose (a sensor
+    /// value into another class, an operator command) along one behaviour.
+    pub changes: u32,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            step_ms: 500,
+            horizon_ms: 120_000,
+            max_states: 50_000,
+            changes: 2,
+        }
+    }
+}
+
+/// One choice of the world.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Choice {
+    /// At the start: the class of each sensor input.
+    Start(Vec<usize>),
+    Nothing,
+    Sensor {
+        input: usize,
+        value: usize,
+    },
+    Command {
+        input: usize,
+        value: usize,
+    },
+}
+
+/// A way to a finding: the world's choices, as a scenario.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Counterexample {
+    /// (at, robot, sensor value, value).
+    pub sensors: Vec<(i64, String, String, String)>,
+    /// (at, to, command, value).
+    pub commands: Vec<(i64, String, String, String)>,
+    /// The mission ms the finding shows at: the scenario's duration.
+    pub end_ms: i64,
+}
+
+/// What a search found and how far it looked.
+pub struct Report {
+    pub findings: Vec<Diagnostic>,
+    /// Per finding (same order): the way to it, if it has one.
+    pub counterexamples: Vec<Option<Counterexample>>,
+    pub states: usize,
+    pub transitions: u64,
+    pub exhaustive: bool,
+    pub reached_ms: i64,
+    pub inputs: Inputs,
+}
+
+/// Explores `programs` (refined from the mission `text`, which is `file`).
+pub fn verify(programs: &[RobotProgram], file: FileId, text: &str, options: &Options) -> Report {
+    let inputs = inputs::derive(programs);
+    let explored = search::explore(programs, &inputs, options);
+    let mut findings = Vec::new();
+    let mut counterexamples = Vec::new();
+    // V001: per team, each mode in the order written; only after an
+    // exhaustive search (a bounded one may stop before a mode's turn).
+    let mut judged: Vec<(&str, &str)> = Vec::new();
+    for program in programs.iter().filter(|_| explored.exhaustive) {
+        for mode in &program.control.modes {
+            if judged.contains(&(&program.team, &mode.name)) {
+                continue;
+            }
+            judged.push((&program.team, &mode.name));
+            if !explored
+                .entered
+                .contains(&(program.team.clone(), mode.name.clone()))
+            {
+                findings.push(Diagnostic::new(
+                    Code::ModeNeverEntered,
+                    file,
+                    line_span(text, mode.line),
+                    format!(
+                        "no robot of {} enters mode {} in any behaviour",
+                        program.team, mode.name
+                    ),
+                ));
+                counterexamples.push(None);
+            }
+        }
+    }
+    for (r, way, mode) in &explored.stuck {
+        let program = &programs[*r];
+        let mode = mode.and_then(|m| program.control.modes.get(m));
+        let (span, in_mode) = match mode {
+            Some(m) => (line_span(text, m.line), format!(" in mode {}", m.name)),
+            None => (Span { start: 0, end: 0 }, String::new()),
+        };
+        findings.push(Diagnostic::new(
+            Code::NeverFinishes,
+            file,
+            span,
+            format!(
+                "{} finishes in some behaviours, but{in_mode} at {} ms it can no longer finish in any",
+                program.robot, way.end_ms
+            ),
+        ));
+        counterexamples.push(Some(way.clone()));
+    }
+    Report {
+        findings,
+        counterexamples,
+        states: explored.states,
+        transitions: explored.transitions,
+        exhaustive: explored.exhaustive,
+        reached_ms: explored.reached_ms,
+        inputs,
+    }
+}
+
+/// Line `line` (1-based) of `text`, without its indentation.
+fn line_span(text: &str, line: u32) -> Span {
+    let mut start = 0;
+    for (n, l) in text.split_inclusive('\n').enumerate() {
+        if n + 1 == line as usize {
+            let body = l.trim_end();
+            let indent = body.len() - body.trim_start().len();
+            return Span {
+                start: start + indent,
+                end: start + body.len(),
+            };
+        }
+        start += l.len();
+    }
+    Span {
+        start: text.len(),
+        end: text.len(),
+    }
+}
+
+impl Counterexample {
+    /// The choices of a path, each with the mission ms it was made at.
+    fn from_choices(path: &[(i64, Choice)], end_ms: i64, inputs: &Inputs) -> Counterexample {
+        let mut way = Counterexample {
+            sensors: Vec::new(),
+            commands: Vec::new(),
+            end_ms,
+        };
+        for (at, choice) in path {
+            match choice {
+                Choice::Start(classes) => {
+                    for (s, &v) in classes.iter().enumerate() {
+                        way.sensors.push(sensor_entry(inputs, *at, s, v));
+                    }
+                }
+                Choice::Nothing => {}
+                Choice::Sensor { input, value } => {
+                    way.sensors.push(sensor_entry(inputs, *at, *input, *value))
+                }
+                Choice::Command { input, value } => {
+                    let c = &inputs.commands[*input];
+                    way.commands.push((
+                        *at,
+                        c.to.clone(),
+                        c.value.clone(),
+                        c.values[*value].clone(),
+                    ));
+                }
+            }
+        }
+        way
+    }
+
+    /// The scenario (`docs/scenario-and-trace.md`) that replays the way:
+    /// `semo simulate` on it shows the finding at its end.
+    pub fn scenario_json(&self, robots: &[RobotProgram]) -> String {
+        let mut out = String::new();
+        let _ = write!(
+            out,
+            "{{\n  \"duration\": {},\n  \"robots\": {{",
+            self.end_ms
+        );
+        let mut first_robot = true;
+        for program in robots {
+            let entries: Vec<_> = self
+                .sensors
+                .iter()
+                .filter(|(_, r, ..)| *r == program.robot)
+                .collect();
+            if entries.is_empty() {
+                continue;
+            }
+            let _ = write!(
+                out,
+                "{}\n    {}: {{\"sensors\": [",
+                if first_robot { "" } else { "," },
+                json_string(&program.robot)
+            );
+            first_robot = false;
+            for (i, (at, _, value, is)) in entries.iter().enumerate() {
+                let _ = write!(
+                    out,
+                    "{}\n      {{\"at\": {at}, \"value\": {}, \"is\": {}}}",
+                    if i == 0 { "" } else { "," },
+                    json_string(value),
+                    json_string(is)
+                );
+            }
+            out.push_str("\n    ]}");
+        }
+        out.push_str(if first_robot { "},\n" } else { "\n  },\n" });
+        out.push_str("  \"operator\": [");
+        for (i, (at, to, value, is)) in self.commands.iter().enumerate() {
+            let _ = write!(
+                out,
+                "{}\n    {{\"at\": {at}, \"to\": {}, \"value\": {}, \"is\": {}}}",
+                if i == 0 { "" } else { "," },
+                json_string(to),
+                json_string(value),
+                json_string(is)
+            );
+        }
+        out.push_str(if self.commands.is_empty() {
+            "]\n}\n"
+        } else {
+            "\n  ]\n}\n"
+        });
+        out
+    }
+}
+
+fn sensor_entry(
+    inputs: &Inputs,
+    at: i64,
+    input: usize,
+    value: usize,
+) -> (i64, String, String, String) {
+    let s = &inputs.sensors[input];
+    (
+        at,
+        s.robot_name.clone(),
+        s.port.clone(),
+        s.values[value].clone(),
+    )
+}
+
+/// `text` as a JSON string.
+fn json_string(text: &str) -> String {
+    let mut out = String::new();
+    crate::sim::trace::json_string(&mut out, text);
+    out
+}

@@ -1,0 +1,335 @@
+//! The breadth-first search over everything the team can do: from each
+//! state, at each step of the world's clock, the world keeps still or makes
+//! one choice (a sensor value into another class, an operator command),
+//! and the simulator runs the robots to the next step. States are told
+//! apart by [`Sim::fingerprint`]; a state met before is not explored again,
+//! so a mission that repeats itself is explored to the end (exhaustive),
+//! else up to the horizon or the state budget (bounded).
+
+use super::inputs::Inputs;
+use super::{Choice, Counterexample, Options};
+use crate::refine::{RobotProgram, StateKind};
+use crate::sim::{self, Scenario, Sim};
+use std::collections::{HashMap, HashSet};
+
+/// What the search saw, for the properties to judge.
+pub struct Explored {
+    pub states: usize,
+    pub transitions: u64,
+    /// Every successor of every state was explored: a proof, not a sample.
+    pub exhaustive: bool,
+    /// How far in mission time the deepest state explored lies.
+    pub reached_ms: i64,
+    /// (team, mode) entered in some behaviour.
+    pub entered: HashSet<(String, String)>,
+    /// Per robot that finishes in some behaviour but can reach a state from
+    /// which it never does (only when exhaustive): the shortest way there
+    /// and the mode it is in then.
+    pub stuck: Vec<(usize, Counterexample, Option<usize>)>,
+}
+
+struct Node {
+    parent: Option<u32>,
+    choice: Choice,
+    /// Mission ms the choice was made at.
+    at: i64,
+    /// Per robot: it has finished.
+    finished: Box<[bool]>,
+    /// Per robot: the mode it is in (an index into its program's modes).
+    modes: Box<[Option<u16>]>,
+}
+
+pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) -> Explored {
+    let scenario = Scenario::default();
+    let memory = memory_ms(programs);
+    let root = Sim::new(programs, &scenario, &sim::Options::default());
+    let mut explored = Explored {
+        states: 0,
+        transitions: 0,
+        exhaustive: false,
+        reached_ms: 0,
+        entered: HashSet::new(),
+        stuck: Vec::new(),
+    };
+    let mut nodes: Vec<Node> = Vec::new();
+    let mut seen: HashMap<u128, u32> = HashMap::new();
+    let mut edges: Vec<(u32, u32)> = Vec::new();
+    // Each state with the class of each sensor input in it and the
+    // changes the world has left.
+    let mut frontier: Vec<(u32, Sim, Vec<usize>, u32)> = Vec::new();
+    let mut over_budget = false;
+    for start in initial_classes(inputs) {
+        if nodes.len() >= options.max_states {
+            over_budget = true;
+            break;
+        }
+        let mut sim = root.clone();
+        for (s, &v) in start.iter().enumerate() {
+            let input = &inputs.sensors[s];
+            sim.set_sensor(input.robot, &input.port, &input.values[v]);
+        }
+        let choice = Choice::Start(start.clone());
+        let fp = with_changes(sim.fingerprint(memory), options.changes);
+        if !seen.contains_key(&fp) {
+            let id = admit(&mut nodes, &mut seen, fp, &sim, None, choice, 0);
+            frontier.push((id, sim, start, options.changes));
+        }
+    }
+    let mut t = 0;
+    while !frontier.is_empty() && !over_budget {
+        if t >= options.horizon_ms {
+            break;
+        }
+        let next_t = t + options.step_ms;
+        let mut next = Vec::new();
+        for (id, sim, classes, changes) in std::mem::take(&mut frontier) {
+            if nodes[id as usize].finished.iter().all(|f| *f) {
+                continue;
+            }
+            for choice in choices(inputs, &classes, changes) {
+                let changes = changes - u32::from(choice != Choice::Nothing);
+                if nodes.len() >= options.max_states {
+                    over_budget = true;
+                    break;
+                }
+                let mut child = sim.clone();
+                let mut child_classes = classes.clone();
+                apply(&mut child, &mut child_classes, inputs, &choice);
+                child.run_to(next_t);
+                explored.transitions += 1;
+                for e in child.take_trace() {
+                    if e.event == "mode"
+                        && let Some(mode) = e.field("mode")
+                    {
+                        let team = &programs[e.robot].team;
+                        if !explored.entered.contains(&(team.clone(), mode.to_string())) {
+                            explored.entered.insert((team.clone(), mode.to_string()));
+                        }
+                    }
+                }
+                let fp = with_changes(child.fingerprint(memory), changes);
+                let child_id = match seen.get(&fp) {
+                    Some(&known) => {
+                        edges.push((id, known));
+                        None
+                    }
+                    None => {
+                        let new = admit(
+                            &mut nodes,
+                            &mut seen,
+                            fp,
+                            &child,
+                            Some(id),
+                            choice.clone(),
+                            t,
+                        );
+                        edges.push((id, new));
+                        Some(new)
+                    }
+                };
+                if let Some(child_id) = child_id {
+                    next.push((child_id, child, child_classes, changes));
+                    explored.reached_ms = next_t;
+                }
+            }
+            if over_budget {
+                break;
+            }
+        }
+        frontier = next;
+        t = next_t;
+    }
+    explored.states = nodes.len();
+    explored.exhaustive = frontier.is_empty() && !over_budget;
+    if explored.exhaustive {
+        explored.stuck = stuck(programs.len(), &nodes, &edges, inputs, options.step_ms);
+    }
+    explored
+}
+
+/// Records a new state, reached by `choice` made at `at`; its id.
+fn admit(
+    nodes: &mut Vec<Node>,
+    seen: &mut HashMap<u128, u32>,
+    fingerprint: u128,
+    sim: &Sim,
+    parent: Option<u32>,
+    choice: Choice,
+    at: i64,
+) -> u32 {
+    let id = nodes.len() as u32;
+    seen.insert(fingerprint, id);
+    let robots = 0..sim.robot_count();
+    let finished = robots.clone().map(|r| !sim.is_running(r)).collect();
+    let modes = robots
+        .map(|r| sim.mode_of(r).and_then(|m| u16::try_from(m).ok()))
+        .collect();
+    nodes.push(Node {
+        parent,
+        choice,
+        at,
+        finished,
+        modes,
+    });
+    id
+}
+
+/// Every combination of the sensor inputs' first classes, the first
+/// combination first.
+fn initial_classes(inputs: &Inputs) -> Vec<Vec<usize>> {
+    let mut all: Vec<Vec<usize>> = vec![Vec::new()];
+    for input in &inputs.sensors {
+        all = all
+            .into_iter()
+            .flat_map(|prefix| {
+                (0..input.values.len()).map(move |v| {
+                    let mut next = prefix.clone();
+                    next.push(v);
+                    next
+                })
+            })
+            .collect();
+    }
+    all
+}
+
+/// A state's fingerprint with the changes the world has left in it.
+fn with_changes(fingerprint: u128, changes: u32) -> u128 {
+    fingerprint ^ (u128::from(changes) << 96).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+}
+
+/// What the world may do at a step: nothing, or with a change left, one
+/// sensor input into another class or one operator command.
+fn choices(inputs: &Inputs, classes: &[usize], changes: u32) -> Vec<Choice> {
+    let mut all = vec![Choice::Nothing];
+    if changes == 0 {
+        return all;
+    }
+    for (s, input) in inputs.sensors.iter().enumerate() {
+        for v in 0..input.values.len() {
+            if v != classes[s] {
+                all.push(Choice::Sensor { input: s, value: v });
+            }
+        }
+    }
+    for (c, input) in inputs.commands.iter().enumerate() {
+        for v in 0..input.values.len() {
+            all.push(Choice::Command { input: c, value: v });
+        }
+    }
+    all
+}
+
+fn apply(sim: &mut Sim, classes: &mut [usize], inputs: &Inputs, choice: &Choice) {
+    match *choice {
+        Choice::Nothing | Choice::Start(_) => {}
+        Choice::Sensor { input, value } => {
+            let s = &inputs.sensors[input];
+            sim.set_sensor(s.robot, &s.port, &s.values[value]);
+            classes[input] = value;
+        }
+        Choice::Command { input, value } => {
+            let c = &inputs.commands[input];
+            sim.give_command(&c.to, &format!("USER.{}", c.value), &c.values[value]);
+        }
+    }
+}
+
+/// The choices from the start to node `id`, then `last` at `at`, the run
+/// ending at `end`.
+fn counterexample(
+    nodes: &[Node],
+    id: u32,
+    last: &Choice,
+    at: i64,
+    end: i64,
+    inputs: &Inputs,
+) -> Counterexample {
+    let mut path = vec![(at, last.clone())];
+    let mut here = Some(id);
+    while let Some(n) = here {
+        let node = &nodes[n as usize];
+        path.push((node.at, node.choice.clone()));
+        here = node.parent;
+    }
+    path.reverse();
+    Counterexample::from_choices(&path, end, inputs)
+}
+
+/// Per robot that finishes in some state: the first state (the shallowest)
+/// from which no state where it has finished can be reached.
+fn stuck(
+    robots: usize,
+    nodes: &[Node],
+    edges: &[(u32, u32)],
+    inputs: &Inputs,
+    step_ms: i64,
+) -> Vec<(usize, Counterexample, Option<usize>)> {
+    let mut into: Vec<Vec<u32>> = vec![Vec::new(); nodes.len()];
+    for &(from, to) in edges {
+        into[to as usize].push(from);
+    }
+    let mut found = Vec::new();
+    for r in 0..robots {
+        // Backwards from every state where it has finished.
+        let mut can_finish = vec![false; nodes.len()];
+        let mut work: Vec<u32> = (0..nodes.len() as u32)
+            .filter(|&n| nodes[n as usize].finished[r])
+            .collect();
+        if work.is_empty() {
+            continue;
+        }
+        for &n in &work {
+            can_finish[n as usize] = true;
+        }
+        while let Some(n) = work.pop() {
+            for &p in &into[n as usize] {
+                if !can_finish[p as usize] {
+                    can_finish[p as usize] = true;
+                    work.push(p);
+                }
+            }
+        }
+        if let Some(n) = can_finish.iter().position(|c| !c) {
+            let node = &nodes[n];
+            let (parent, at) = (node.parent, node.at);
+            let path = match parent {
+                Some(p) => counterexample(nodes, p, &node.choice, at, at + step_ms, inputs),
+                None => Counterexample::from_choices(&[(0, node.choice.clone())], step_ms, inputs),
+            };
+            found.push((r, path, node.modes[r].map(usize::from)));
+        }
+    }
+    found
+}
+
+/// How long ago a time can still matter: longer than every period,
+/// timeout and heartbeat the programs compare against.
+fn memory_ms(programs: &[RobotProgram]) -> i64 {
+    let mut longest = 1000;
+    for program in programs {
+        let m = &program.control;
+        longest = longest.max(4 * m.heartbeat_ms);
+        for mode in &m.modes {
+            for region in &mode.regions {
+                longest = longest.max(region.timeout_ms.unwrap_or(0));
+            }
+        }
+        for service in &m.services {
+            for state in &service.states {
+                let t = match &state.kind {
+                    StateKind::Receive { timeout_ms, .. }
+                    | StateKind::Call { timeout_ms, .. }
+                    | StateKind::RunActions { timeout_ms, .. } => timeout_ms.unwrap_or(0),
+                    StateKind::GroupSync { timeout_ms, .. } => *timeout_ms,
+                    StateKind::LoopTail { period_ms, .. } | StateKind::Repeat { period_ms, .. } => {
+                        period_ms.unwrap_or(0)
+                    }
+                    _ => 0,
+                };
+                longest = longest.max(t);
+            }
+        }
+    }
+    2 * longest + 1000
+}
