@@ -737,6 +737,40 @@ fn build_files(
     })
 }
 
+/// The refined programs of a loaded mission, for the commands that run
+/// them (`simulate`, `verify`); on errors, they are reported in `format`
+/// and the exit status (2) is returned.
+fn refine_or_report(
+    check: &mut semo::host::CheckRun,
+    mission: semo::diag::FileId,
+    format: Format,
+    color: bool,
+    command: &str,
+    out: &mut impl Write,
+) -> Result<(semo::host::BuildFiles, semo::codegen::Refined), i32> {
+    let build = build_files(&check.analysis(), mission)?;
+    let refined = semo::codegen::refine_checked(&build.input());
+    if refined.diagnostics.iter().any(|d| d.is_error()) {
+        check.diagnostics = refined.diagnostics;
+        let reported = match format {
+            Format::Human => render::human(check, color, &mut std::io::stderr().lock()),
+            _ => output::report(
+                format,
+                command,
+                &check.files,
+                &check.diagnostics,
+                color,
+                serde_json::json!({}),
+                out,
+            ),
+        };
+        let _ = output::written(reported);
+        eprintln!("error: cannot {command}: fix the errors above first");
+        return Err(2);
+    }
+    Ok((build, refined))
+}
+
 fn parse_target(name: &str) -> Result<semo::codegen::Target, String> {
     semo::codegen::Target::from_name(name).ok_or_else(|| {
         let names: Vec<&str> = semo::codegen::TARGETS.iter().map(|t| t.name).collect();

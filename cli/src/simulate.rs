@@ -103,31 +103,17 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     if !input::is_kind(&scenario_name, &scenario_text, Content::Scenario, SIMULATE) {
         return 2;
     }
-    let build = match super::build_files(&check.analysis(), mission) {
-        Ok(files) => files,
+    let (build, refined) = match super::refine_or_report(
+        &mut check,
+        mission,
+        format,
+        options.color,
+        "simulate",
+        out,
+    ) {
+        Ok(refined) => refined,
         Err(code) => return code,
     };
-    let refined = semo::codegen::refine_checked(&build.input());
-    if refined.diagnostics.iter().any(|d| d.is_error()) {
-        check.diagnostics = refined.diagnostics;
-        let reported = match format {
-            Format::Human => {
-                super::render::human(&check, options.color, &mut std::io::stderr().lock())
-            }
-            _ => output::report(
-                format,
-                "simulate",
-                &check.files,
-                &check.diagnostics,
-                options.color,
-                serde_json::json!({}),
-                out,
-            ),
-        };
-        let _ = output::written(reported);
-        eprintln!("error: cannot simulate: fix the errors above first");
-        return 2;
-    }
     let scenario = match scenario::parse(&scenario_text, &refined.programs) {
         Ok(s) => s,
         Err(e) => {

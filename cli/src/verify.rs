@@ -56,31 +56,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     };
-    let build = match super::build_files(&check.analysis(), mission) {
-        Ok(files) => files,
-        Err(code) => return code,
-    };
-    let refined = semo::codegen::refine_checked(&build.input());
-    if refined.diagnostics.iter().any(|d| d.is_error()) {
-        check.diagnostics = refined.diagnostics;
-        let reported = match format {
-            Format::Human => {
-                super::render::human(&check, options.color, &mut std::io::stderr().lock())
-            }
-            _ => output::report(
-                format,
-                "verify",
-                &check.files,
-                &check.diagnostics,
-                options.color,
-                serde_json::json!({}),
-                out,
-            ),
+    let refined =
+        match super::refine_or_report(&mut check, mission, format, options.color, "verify", out) {
+            Ok((_, refined)) => refined,
+            Err(code) => return code,
         };
-        let _ = output::written(reported);
-        eprintln!("error: cannot verify: fix the errors above first");
-        return 2;
-    }
     let text = check.files.get(mission).text.clone();
     let report = semo::verify::verify(&refined.programs, mission, &text, &options.search);
     let mut written_files = Vec::new();
