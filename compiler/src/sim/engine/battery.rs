@@ -52,6 +52,16 @@ impl Resources {
         }
     }
 
+    /// The state as numbers, its times relative to `now` (`explore.rs`).
+    pub(super) fn relative(&self, now: i64) -> Vec<i64> {
+        let mut out: Vec<i64> = self.holds.iter().map(|h| *h as i64).collect();
+        out.extend(self.levels.iter().map(|l| *l as i64));
+        for s in &self.sampling {
+            out.extend([s.last - now, s.next - now, s.level as i64]);
+        }
+        out
+    }
+
     /// The sensor task's sampling, when a policy names it.
     fn sampling(&self, task: &str) -> Option<&Sampling> {
         self.sampling.iter().find(|s| s.task == task)

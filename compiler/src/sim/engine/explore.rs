@@ -14,7 +14,7 @@
 //! the ids of events) is left out.
 
 use super::{Event, Held, Message, Robot, Sim};
-use crate::refine::SlotSource;
+use crate::refine::{SlotSource, StateKind};
 use crate::sim::scenario::Command;
 use crate::sim::trace::{TraceEvent, write_value};
 use std::cmp::Reverse;
@@ -103,9 +103,9 @@ impl<'p> Sim<'p> {
     /// The state, as a 128-bit hash of what decides the rest of the run
     /// (see the module's comment): equal states give equal fingerprints.
     pub fn fingerprint(&self, memory: i64) -> u128 {
+        // The last firing handled (`last_fire`) is left out: it decides
+        // only a firing at its own instant, which is past at a step.
         let mut fp = Fingerprint::new(self.now, memory);
-        fp.time(self.last_fire.0);
-        fp.int(self.last_fire.1 as i64);
         for robot in &self.robots {
             fp.robot(robot);
         }
@@ -166,6 +166,38 @@ impl<'p> Sim<'p> {
             }
         }
         fp.finish()
+    }
+}
+
+/// Which times of a region running a service are compared with a period
+/// or a timeout.
+#[derive(Default)]
+struct Timed {
+    /// The start of its pass (`repeat(P)`).
+    pass: bool,
+    /// Its marks (`loop(P)`, `receive`/calls with a timeout, group syncs).
+    marks: bool,
+}
+
+impl Timed {
+    fn of(service: &crate::refine::ServiceMachine) -> Timed {
+        let mut timed = Timed::default();
+        for state in &service.states {
+            match &state.kind {
+                StateKind::Repeat {
+                    period_ms: Some(_), ..
+                } => timed.pass = true,
+                StateKind::LoopTail {
+                    period_ms: Some(_), ..
+                }
+                | StateKind::GroupSync { .. } => timed.marks = true,
+                StateKind::Receive { timeout_ms, .. }
+                | StateKind::Call { timeout_ms, .. }
+                | StateKind::RunActions { timeout_ms, .. } => timed.marks |= timeout_ms.is_some(),
+                _ => {}
+            }
+        }
+        timed
     }
 }
 
@@ -272,11 +304,24 @@ impl Fingerprint {
             self.int(region.phase as i64);
             self.int(region.action as i64);
             self.int(region.done as i64);
-            self.time(region.started);
-            self.time(region.pass_start);
+            // A time only a period or a timeout reads: otherwise when a
+            // pass started changes nothing, and hashing it would tell apart
+            // states that differ only in the phase of their passes.
+            if region.timeout_ms > 0 {
+                self.time(region.started);
+            }
+            let timed = region
+                .service
+                .map(|s| Timed::of(&robot.program.control.services[s]))
+                .unwrap_or_default();
+            if timed.pass {
+                self.time(region.pass_start);
+            }
             self.int(region.timeout_ms);
-            for m in &region.marks {
-                self.time(*m);
+            if timed.marks {
+                for m in &region.marks {
+                    self.time(*m);
+                }
             }
             self.text(&region.plan);
         }
@@ -325,7 +370,8 @@ impl Fingerprint {
                 }
             }
             self.text(&task.service);
-            self.time(task.graph_until);
+            // Read only while the graph's iteration is under way.
+            self.int((task.graph_until - self.now).max(0));
         }
         // The sensor values: the latest entry and when it came (a sample
         // may not have read it yet).
@@ -342,10 +388,10 @@ impl Fingerprint {
         self.int(robot.chain as i64);
         self.int(robot.next_fire.map_or(i64::MIN, |t| t - self.now));
         self.int(robot.progressed as i64);
-        // Battery policies and service graphs keep absolute times: states
-        // of different instants then never merge, which costs states, not
-        // soundness (without either, the text holds no time).
-        self.text(&format!("{:?}{:?}", robot.resources, robot.graphs));
+        for v in robot.resources.relative(self.now) {
+            self.int(v);
+        }
+        self.text(&robot.graphs.relative(self.now));
     }
 
     fn finish(self) -> u128 {

@@ -43,6 +43,26 @@ pub(super) struct GraphState {
     due: VecDeque<TraceEvent>,
 }
 
+impl GraphState {
+    /// The state as text, its times relative to `now` (`explore.rs`).
+    pub(super) fn relative(&self, now: i64) -> String {
+        let mut channels: Vec<_> = self.channels.iter().collect();
+        channels.sort_unstable_by(|a, b| a.0.cmp(b.0));
+        let mut starts: Vec<_> = self
+            .starts
+            .iter()
+            .map(|(k, t)| (k.clone(), t - now))
+            .collect();
+        starts.sort_unstable();
+        let due: Vec<_> = self
+            .due
+            .iter()
+            .map(|e| (e.t - now, e.robot, e.event, format!("{:?}", e.fields)))
+            .collect();
+        format!("{channels:?}{starts:?}{due:?}")
+    }
+}
+
 /// A channel that is short of tokens or full: the run stops.
 struct Broken;
 
