@@ -99,3 +99,196 @@ fn a_step_off_the_sensors_period_is_bad_input() {
     assert_eq!(out.code, 2, "{}", out.stderr);
     assert!(out.stderr.contains("multiple of 100ms"), "{}", out.stderr);
 }
+
+/// The refined programs of mission `text`, written as `dir/main.mission`
+/// (None when the mission has errors), and the mission's file id.
+fn refined(
+    dir: &std::path::Path,
+    text: &str,
+) -> Option<(Vec<semo::refine::RobotProgram>, semo::diag::FileId)> {
+    let path = dir.join("main.mission");
+    std::fs::write(&path, text).unwrap();
+    let (run, id) = semo::host::load_build(&path, &[]).ok()?;
+    let build = run.analysis().build_input(id)?;
+    let refined = semo::codegen::refine_checked(&build.input());
+    (!refined.diagnostics.iter().any(|d| d.is_error())).then_some((refined.programs, id))
+}
+
+/// One random behaviour of the world `semo verify` explores: `choices`
+/// made so far (from the start, or after `prefix`), then at each step a
+/// random one of those the search could make, up to `until`. The modes
+/// entered and, per robot, whether it finished.
+fn random_behaviour(
+    programs: &[semo::refine::RobotProgram],
+    inputs: &semo::verify::Inputs,
+    options: &semo::verify::Options,
+    prefix: &[(i64, semo::verify::Choice)],
+    rng: &mut support::missiongen::Rng,
+) -> (Vec<(String, String)>, Vec<bool>) {
+    use semo::verify::Choice;
+    let empty = semo::sim::Scenario::default();
+    let mut sim = semo::sim::Sim::new(programs, &empty, &semo::sim::Options::default());
+    let mut classes = vec![0; inputs.sensors.len()];
+    let mut changes = options.changes;
+    let mut entered = Vec::new();
+    let mut note = |sim: &mut semo::sim::Sim, entered: &mut Vec<(String, String)>| {
+        for e in sim.take_trace() {
+            if let (true, Some(mode)) = (e.event == "mode", e.field("mode")) {
+                entered.push((programs[e.robot].team.clone(), mode.to_string()));
+            }
+        }
+    };
+    let mut t = 0;
+    if prefix.is_empty() {
+        let starts = semo::verify::start_classes(inputs);
+        let start = Choice::Start(starts[rng.below(starts.len())].clone());
+        semo::verify::apply(&mut sim, &mut classes, inputs, &start);
+    }
+    for (at, choice) in prefix {
+        sim.run_to(*at);
+        note(&mut sim, &mut entered);
+        changes -= u32::from(!matches!(choice, Choice::Nothing | Choice::Start(_)));
+        semo::verify::apply(&mut sim, &mut classes, inputs, choice);
+        t = *at;
+    }
+    if !prefix.is_empty() {
+        t += options.step_ms;
+        sim.run_to(t);
+        note(&mut sim, &mut entered);
+    }
+    while t < options.horizon_ms {
+        let all = semo::verify::choices(inputs, &classes, changes);
+        // Mostly still, as most steps of a run are.
+        let choice = if rng.chance(80) {
+            Choice::Nothing
+        } else {
+            all[rng.below(all.len())].clone()
+        };
+        changes -= u32::from(choice != Choice::Nothing);
+        semo::verify::apply(&mut sim, &mut classes, inputs, &choice);
+        t += options.step_ms;
+        sim.run_to(t);
+        note(&mut sim, &mut entered);
+    }
+    let finished = (0..programs.len()).map(|r| !sim.is_running(r)).collect();
+    (entered, finished)
+}
+
+/// Soundness of the search and its merged states, over random missions: a
+/// mode V001 says no robot enters is entered in no random behaviour of the
+/// same world, and a robot V002 says can no longer finish finishes in no
+/// random continuation of its counterexample.
+#[test]
+fn findings_on_random_missions_hold_in_random_behaviours() {
+    use semo::verify::Claim;
+    let catalog = semo::catalog::builtin_catalog();
+    let dir = support::robots::scratch("verify-random");
+    let options = semo::verify::Options {
+        step_ms: 500,
+        horizon_ms: 20_000,
+        max_states: 4_000,
+        changes: 2,
+        merge_in_time: true,
+        observe: false,
+    };
+    let mut rng = support::missiongen::Rng::new(7);
+    let (mut exhaustive, mut held, mut missions) = (0, 0, 0);
+    for seed in 0..30 {
+        let text = support::missiongen::mission(seed, &catalog);
+        let Some((programs, id)) = refined(&dir, &text) else {
+            continue;
+        };
+        missions += 1;
+        let report = semo::verify::verify(&programs, id, &text, &options);
+        exhaustive += usize::from(report.exhaustive);
+        for (claim, way) in report.claims.iter().zip(&report.counterexamples) {
+            for _ in 0..4 {
+                match claim {
+                    Claim::NeverEntered { team, mode } => {
+                        let (entered, _) =
+                            random_behaviour(&programs, &report.inputs, &options, &[], &mut rng);
+                        assert!(
+                            !entered.contains(&(team.clone(), mode.clone())),
+                            "seed {seed}: {team} entered {mode}\n{text}"
+                        );
+                    }
+                    Claim::NeverFinishes { robot } => {
+                        let way = way.as_ref().expect("V002 has a counterexample");
+                        let (_, finished) = random_behaviour(
+                            &programs,
+                            &report.inputs,
+                            &options,
+                            &way.choices,
+                            &mut rng,
+                        );
+                        assert!(
+                            !finished[*robot],
+                            "seed {seed}: {} finished\n{text}",
+                            programs[*robot].robot
+                        );
+                    }
+                }
+            }
+            held += 1;
+        }
+    }
+    eprintln!("{missions} missions, {exhaustive} explored exhaustively, {held} findings held");
+    assert!(exhaustive >= 6, "only {exhaustive} exhaustive searches");
+}
+
+/// The reduction is sound: over random missions, merging a state with one
+/// met at an earlier instant (times relative to now) sees every event (a
+/// mode entered, a call, a message, without its time) that the unreduced
+/// search (only states of one instant merge) sees within the same
+/// horizon, and no other: a later state's future is the earlier one's,
+/// shifted.
+#[test]
+fn merging_states_across_instants_finds_what_the_unreduced_search_finds() {
+    let catalog = semo::catalog::builtin_catalog();
+    let dir = support::robots::scratch("verify-reduction");
+    let reduced = semo::verify::Options {
+        step_ms: 500,
+        horizon_ms: 6_000,
+        max_states: 20_000,
+        changes: 1,
+        merge_in_time: true,
+        observe: true,
+    };
+    let unreduced = semo::verify::Options {
+        merge_in_time: false,
+        ..reduced.clone()
+    };
+    let (mut compared, mut saved) = (0, 0);
+    for seed in 100..118 {
+        let text = support::missiongen::mission(seed, &catalog);
+        let Some((programs, id)) = refined(&dir, &text) else {
+            continue;
+        };
+        let full = semo::verify::verify(&programs, id, &text, &unreduced);
+        if full.over_budget {
+            continue;
+        }
+        let merged = semo::verify::verify(&programs, id, &text, &reduced);
+        assert!(!merged.over_budget, "seed {seed}");
+        assert_eq!(merged.entered, full.entered, "seed {seed}\n{text}");
+        let only = |a: &[String], b: &[String]| -> Vec<String> {
+            a.iter()
+                .filter(|x| b.binary_search(x).is_err())
+                .cloned()
+                .collect()
+        };
+        assert_eq!(
+            (
+                only(&merged.observed, &full.observed),
+                only(&full.observed, &merged.observed)
+            ),
+            (Vec::new(), Vec::new()),
+            "seed {seed}: events seen by one search only\n{text}"
+        );
+        compared += 1;
+        saved += full.states - merged.states;
+    }
+    eprintln!("{compared} missions compared; merging saved {saved} states");
+    assert!(compared >= 8, "only {compared} missions compared");
+    assert!(saved > 0, "merging never merged");
+}

@@ -692,6 +692,8 @@ fn run() -> i32 {
                     horizon_ms: horizon,
                     max_states,
                     changes,
+                    merge_in_time: true,
+                    observe: false,
                 },
                 counterexamples,
             },

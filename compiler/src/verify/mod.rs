@@ -16,6 +16,7 @@ mod inputs;
 mod search;
 
 pub use inputs::{CommandInput, Inputs, SensorInput};
+pub use search::{apply, choices, start_classes};
 
 use crate::diag::{Code, Diagnostic, FileId};
 use crate::refine::RobotProgram;
@@ -34,6 +35,13 @@ pub struct Options {
     /// How many times after the start the world may choose (a sensor
     /// value into another class, an operator command) along one behaviour.
     pub changes: u32,
+    /// Merge a state with one met at another instant when they would go on
+    /// alike (the reduction); without it only states of one instant merge,
+    /// the reference the reduction is tested against.
+    pub merge_in_time: bool,
+    /// Keep every trace event seen, without its times (`Report::observed`:
+    /// what the reduction is tested on).
+    pub observe: bool,
 }
 
 impl Default for Options {
@@ -43,6 +51,8 @@ impl Default for Options {
             horizon_ms: 120_000,
             max_states: 50_000,
             changes: 2,
+            merge_in_time: true,
+            observe: false,
         }
     }
 }
@@ -72,6 +82,18 @@ pub struct Counterexample {
     pub commands: Vec<(i64, String, String, String)>,
     /// The mission ms the finding shows at: the scenario's duration.
     pub end_ms: i64,
+    /// The choices themselves, each with the mission ms it was made at.
+    pub choices: Vec<(i64, Choice)>,
+}
+
+/// What a finding claims, for tests that hold it to the simulator.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Claim {
+    /// No robot of `team` enters `mode` in any behaviour.
+    NeverEntered { team: String, mode: String },
+    /// From the counterexample's state, robot `robot` (an index into the
+    /// programs) never finishes.
+    NeverFinishes { robot: usize },
 }
 
 /// What a search found and how far it looked.
@@ -79,11 +101,21 @@ pub struct Report {
     pub findings: Vec<Diagnostic>,
     /// Per finding (same order): the way to it, if it has one.
     pub counterexamples: Vec<Option<Counterexample>>,
+    /// Per finding (same order): what it claims.
+    pub claims: Vec<Claim>,
     pub states: usize,
     pub transitions: u64,
     pub exhaustive: bool,
+    /// The state budget stopped the search (else every state up to the
+    /// horizon was explored).
+    pub over_budget: bool,
     pub reached_ms: i64,
     pub inputs: Inputs,
+    /// (team, mode) entered in some behaviour explored, sorted.
+    pub entered: Vec<(String, String)>,
+    /// With `Options::observe`: each trace event of a behaviour explored,
+    /// without its times, sorted.
+    pub observed: Vec<String>,
 }
 
 /// Explores `programs` (refined from the mission `text`, which is `file`).
@@ -92,6 +124,7 @@ pub fn verify(programs: &[RobotProgram], file: FileId, text: &str, options: &Opt
     let explored = search::explore(programs, &inputs, options);
     let mut findings = Vec::new();
     let mut counterexamples = Vec::new();
+    let mut claims = Vec::new();
     // V001: per team, each mode in the order written; only after an
     // exhaustive search (a bounded one may stop before a mode's turn).
     let mut judged: Vec<(&str, &str)> = Vec::new();
@@ -115,6 +148,10 @@ pub fn verify(programs: &[RobotProgram], file: FileId, text: &str, options: &Opt
                     ),
                 ));
                 counterexamples.push(None);
+                claims.push(Claim::NeverEntered {
+                    team: program.team.clone(),
+                    mode: mode.name.clone(),
+                });
             }
         }
     }
@@ -135,15 +172,28 @@ pub fn verify(programs: &[RobotProgram], file: FileId, text: &str, options: &Opt
             ),
         ));
         counterexamples.push(Some(way.clone()));
+        claims.push(Claim::NeverFinishes { robot: *r });
     }
     Report {
         findings,
         counterexamples,
+        claims,
         states: explored.states,
         transitions: explored.transitions,
         exhaustive: explored.exhaustive,
+        over_budget: explored.over_budget,
         reached_ms: explored.reached_ms,
         inputs,
+        observed: {
+            let mut observed: Vec<_> = explored.observed.into_iter().collect();
+            observed.sort();
+            observed
+        },
+        entered: {
+            let mut entered: Vec<_> = explored.entered.into_iter().collect();
+            entered.sort();
+            entered
+        },
     }
 }
 
@@ -174,6 +224,7 @@ impl Counterexample {
             sensors: Vec::new(),
             commands: Vec::new(),
             end_ms,
+            choices: path.to_vec(),
         };
         for (at, choice) in path {
             match choice {

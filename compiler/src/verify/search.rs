@@ -22,6 +22,11 @@ pub struct Explored {
     pub reached_ms: i64,
     /// (team, mode) entered in some behaviour.
     pub entered: HashSet<(String, String)>,
+    /// The state budget stopped the search.
+    pub over_budget: bool,
+    /// With `Options::observe`: every trace event of every behaviour
+    /// explored, without its times.
+    pub observed: HashSet<String>,
     /// Per robot that finishes in some behaviour but can reach a state from
     /// which it never does (only when exhaustive): the shortest way there
     /// and the mode it is in then.
@@ -49,6 +54,8 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
         exhaustive: false,
         reached_ms: 0,
         entered: HashSet::new(),
+        over_budget: false,
+        observed: HashSet::new(),
         stuck: Vec::new(),
     };
     let mut nodes: Vec<Node> = Vec::new();
@@ -58,18 +65,15 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
     // changes the world has left.
     let mut frontier: Vec<(u32, Sim, Vec<usize>, u32)> = Vec::new();
     let mut over_budget = false;
-    for start in initial_classes(inputs) {
+    for start in start_classes(inputs) {
         if nodes.len() >= options.max_states {
             over_budget = true;
             break;
         }
         let mut sim = root.clone();
-        for (s, &v) in start.iter().enumerate() {
-            let input = &inputs.sensors[s];
-            sim.set_sensor(input.robot, &input.port, &input.values[v]);
-        }
         let choice = Choice::Start(start.clone());
-        let fp = with_changes(sim.fingerprint(memory), options.changes);
+        apply(&mut sim, &mut start.clone(), inputs, &choice);
+        let fp = key(sim.fingerprint(memory), options.changes, 0, options);
         if !seen.contains_key(&fp) {
             let id = admit(&mut nodes, &mut seen, fp, &sim, None, choice, 0);
             frontier.push((id, sim, start, options.changes));
@@ -98,6 +102,13 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
                 child.run_to(next_t);
                 explored.transitions += 1;
                 for e in child.take_trace() {
+                    if options.observe {
+                        // The event without its times: what happened, not when.
+                        explored.observed.insert(format!(
+                            "{} {} {:?} {:?}",
+                            e.robot, e.event, e.fields, e.value
+                        ));
+                    }
                     if e.event == "mode"
                         && let Some(mode) = e.field("mode")
                     {
@@ -107,7 +118,7 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
                         }
                     }
                 }
-                let fp = with_changes(child.fingerprint(memory), changes);
+                let fp = key(child.fingerprint(memory), changes, next_t, options);
                 let child_id = match seen.get(&fp) {
                     Some(&known) => {
                         edges.push((id, known));
@@ -141,6 +152,7 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
     }
     explored.states = nodes.len();
     explored.exhaustive = frontier.is_empty() && !over_budget;
+    explored.over_budget = over_budget;
     if explored.exhaustive {
         explored.stuck = stuck(programs.len(), &nodes, &edges, inputs, options.step_ms);
     }
@@ -176,7 +188,7 @@ fn admit(
 
 /// Every combination of the sensor inputs' first classes, the first
 /// combination first.
-fn initial_classes(inputs: &Inputs) -> Vec<Vec<usize>> {
+pub fn start_classes(inputs: &Inputs) -> Vec<Vec<usize>> {
     let mut all: Vec<Vec<usize>> = vec![Vec::new()];
     for input in &inputs.sensors {
         all = all
@@ -193,14 +205,23 @@ fn initial_classes(inputs: &Inputs) -> Vec<Vec<usize>> {
     all
 }
 
-/// A state's fingerprint with the changes the world has left in it.
-fn with_changes(fingerprint: u128, changes: u32) -> u128 {
-    fingerprint ^ (u128::from(changes) << 96).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+/// What tells states apart: the fingerprint, the changes the world has
+/// left, and without `merge_in_time` the mission time too (then only
+/// states of one instant merge: the unreduced search).
+fn key(fingerprint: u128, changes: u32, now: i64, options: &Options) -> u128 {
+    let now = if options.merge_in_time {
+        0
+    } else {
+        now as u128 + 1
+    };
+    fingerprint
+        ^ (u128::from(changes) << 96).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        ^ now.wrapping_mul(0xd6e8_feb8_6659_fd93_a5a1_ee3b_8f1c_2d4b)
 }
 
 /// What the world may do at a step: nothing, or with a change left, one
 /// sensor input into another class or one operator command.
-fn choices(inputs: &Inputs, classes: &[usize], changes: u32) -> Vec<Choice> {
+pub fn choices(inputs: &Inputs, classes: &[usize], changes: u32) -> Vec<Choice> {
     let mut all = vec![Choice::Nothing];
     if changes == 0 {
         return all;
@@ -220,9 +241,17 @@ fn choices(inputs: &Inputs, classes: &[usize], changes: u32) -> Vec<Choice> {
     all
 }
 
-fn apply(sim: &mut Sim, classes: &mut [usize], inputs: &Inputs, choice: &Choice) {
+/// Makes `choice` in `sim` now, keeping `classes`, the class of each sensor input, up to date.
+pub fn apply(sim: &mut Sim, classes: &mut [usize], inputs: &Inputs, choice: &Choice) {
     match *choice {
-        Choice::Nothing | Choice::Start(_) => {}
+        Choice::Nothing => {}
+        Choice::Start(ref start) => {
+            for (s, &v) in start.iter().enumerate() {
+                let input = &inputs.sensors[s];
+                sim.set_sensor(input.robot, &input.port, &input.values[v]);
+                classes[s] = v;
+            }
+        }
         Choice::Sensor { input, value } => {
             let s = &inputs.sensors[input];
             sim.set_sensor(s.robot, &s.port, &s.values[value]);
