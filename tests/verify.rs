@@ -131,7 +131,7 @@ fn random_behaviour(
     let mut classes = vec![0; inputs.sensors.len()];
     let mut changes = options.changes;
     let mut entered = Vec::new();
-    let mut note = |sim: &mut semo::sim::Sim, entered: &mut Vec<(String, String)>| {
+    let note = |sim: &mut semo::sim::Sim, entered: &mut Vec<(String, String)>| {
         for e in sim.take_trace() {
             if let (true, Some(mode)) = (e.event == "mode", e.field("mode")) {
                 entered.push((programs[e.robot].team.clone(), mode.to_string()));
