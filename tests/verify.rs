@@ -190,6 +190,7 @@ fn findings_on_random_missions_hold_in_random_behaviours() {
         changes: 2,
         merge_in_time: true,
         observe: false,
+        cancel: None,
     };
     let mut rng = support::missiongen::Rng::new(7);
     let (mut exhaustive, mut held, mut missions) = (0, 0, 0);
@@ -253,6 +254,7 @@ fn merging_states_across_instants_finds_what_the_unreduced_search_finds() {
         changes: 1,
         merge_in_time: true,
         observe: true,
+        cancel: None,
     };
     let unreduced = semo::verify::Options {
         merge_in_time: false,

@@ -694,6 +694,7 @@ fn run() -> i32 {
                     changes,
                     merge_in_time: true,
                     observe: false,
+                    cancel: None,
                 },
                 counterexamples,
             },

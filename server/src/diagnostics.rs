@@ -9,6 +9,8 @@
 //! already knows them for this snapshot; else a background task waits
 //! [`DATAFLOW_DEBOUNCE`] (an edit meanwhile drops it), computes them, and
 //! if there are any, publishes both again if the snapshot is still current.
+//! A saved mission's `semo verify` findings (`verify.rs`) join them once
+//! its search has ended, for that text only.
 
 use crate::State;
 use crate::encoding::LineMap;
@@ -89,6 +91,8 @@ async fn publish(state: &Arc<State>, client: &Client, uri: Uri) {
     // the dataflow warnings are at most a few per service call.
     let mut diagnostics = to_lsp(&snapshot, &analysis, &others);
     diagnostics.extend(dataflow_to_lsp(state, &snapshot, &analysis, extra));
+    let verified = state.verified.findings(&snapshot);
+    diagnostics.extend(convert_all(&snapshot, &analysis, &verified, &others));
     let version = snapshot.version;
     drop(analysis);
     if later {
@@ -136,6 +140,8 @@ async fn publish_dataflow(state: Arc<State>, client: Client, snapshot: Weak<Snap
     }
     let mut diagnostics = to_lsp(&snapshot, &analysis, &others);
     diagnostics.extend(dataflow_to_lsp(&state, &snapshot, &analysis, extra));
+    let verified = state.verified.findings(&snapshot);
+    diagnostics.extend(convert_all(&snapshot, &analysis, &verified, &others));
     let (uri, version) = (snapshot.uri.clone(), snapshot.version);
     drop(analysis);
     retire(snapshot);

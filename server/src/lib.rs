@@ -22,6 +22,7 @@ pub mod monitor;
 pub mod server;
 pub mod to_proto;
 pub mod transport;
+pub mod verify;
 pub mod world;
 
 use std::sync::{Mutex, MutexGuard};
@@ -33,6 +34,8 @@ use tower_lsp_server::{LspService, Server};
 pub struct State {
     world: Mutex<world::World>,
     pub queue: diagnostics::Queue,
+    /// `semo verify`'s findings of saved missions (`verify.rs`).
+    pub verified: verify::Verified,
 }
 
 impl State {

@@ -466,6 +466,7 @@ impl LanguageServer for Backend {
 
     async fn did_change(&self, p: DidChangeTextDocumentParams) {
         let d = p.text_document;
+        self.state.verified.forget(&d.uri);
         let changed = self
             .state
             .world()
@@ -474,12 +475,15 @@ impl LanguageServer for Backend {
     }
 
     async fn did_save(&self, p: DidSaveTextDocumentParams) {
-        // The text is already current; re-publishing confirms the saved state.
+        // The text is already current; re-publishing confirms the saved
+        // state, and a saved mission's behaviours are explored.
+        crate::verify::after_save(&self.state, &p.text_document.uri);
         self.state.queue.push([p.text_document.uri]);
     }
 
     async fn did_close(&self, p: DidCloseTextDocumentParams) {
         self.monitors.stop(p.text_document.uri.as_str());
+        self.state.verified.forget(&p.text_document.uri);
         let changed = self.state.world().close(&p.text_document.uri);
         self.state.queue.push(changed.files);
     }

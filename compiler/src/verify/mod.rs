@@ -42,6 +42,9 @@ pub struct Options {
     /// Keep every trace event seen, without its times (`Report::observed`:
     /// what the reduction is tested on).
     pub observe: bool,
+    /// Set by another thread to stop the search at its next state (the
+    /// editor's run after a save, when the mission changes again).
+    pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl Default for Options {
@@ -53,6 +56,7 @@ impl Default for Options {
             changes: 2,
             merge_in_time: true,
             observe: false,
+            cancel: None,
         }
     }
 }
@@ -107,8 +111,9 @@ pub struct Report {
     pub transitions: u64,
     pub exhaustive: bool,
     /// The state budget stopped the search (else every state up to the
-    /// horizon was explored).
+    /// horizon was explored), or it was cancelled.
     pub over_budget: bool,
+    pub cancelled: bool,
     pub reached_ms: i64,
     pub inputs: Inputs,
     /// (team, mode) entered in some behaviour explored, sorted.
@@ -182,6 +187,7 @@ pub fn verify(programs: &[RobotProgram], file: FileId, text: &str, options: &Opt
         transitions: explored.transitions,
         exhaustive: explored.exhaustive,
         over_budget: explored.over_budget,
+        cancelled: explored.cancelled,
         reached_ms: explored.reached_ms,
         inputs,
         observed: {

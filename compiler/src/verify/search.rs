@@ -22,8 +22,9 @@ pub struct Explored {
     pub reached_ms: i64,
     /// (team, mode) entered in some behaviour.
     pub entered: HashSet<(String, String)>,
-    /// The state budget stopped the search.
+    /// The state budget stopped the search, or it was cancelled.
     pub over_budget: bool,
+    pub cancelled: bool,
     /// With `Options::observe`: every trace event of every behaviour
     /// explored, without its times.
     pub observed: HashSet<String>,
@@ -55,6 +56,7 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
         reached_ms: 0,
         entered: HashSet::new(),
         over_budget: false,
+        cancelled: false,
         observed: HashSet::new(),
         stuck: Vec::new(),
     };
@@ -92,7 +94,7 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
             }
             for choice in choices(inputs, &classes, changes) {
                 let changes = changes - u32::from(choice != Choice::Nothing);
-                if nodes.len() >= options.max_states {
+                if nodes.len() >= options.max_states || cancelled(options) {
                     over_budget = true;
                     break;
                 }
@@ -153,6 +155,7 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
     explored.states = nodes.len();
     explored.exhaustive = frontier.is_empty() && !over_budget;
     explored.over_budget = over_budget;
+    explored.cancelled = cancelled(options);
     if explored.exhaustive {
         explored.stuck = stuck(programs.len(), &nodes, &edges, inputs, options.step_ms);
     }
@@ -203,6 +206,13 @@ pub fn start_classes(inputs: &Inputs) -> Vec<Vec<usize>> {
             .collect();
     }
     all
+}
+
+fn cancelled(options: &Options) -> bool {
+    options
+        .cancel
+        .as_ref()
+        .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
 }
 
 /// What tells states apart: the fingerprint, the changes the world has

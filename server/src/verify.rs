@@ -1,0 +1,121 @@
+//! `semo verify` in the editor: after a mission is saved, its behaviours
+//! are explored in the background (the library's `semo::verify`, the call
+//! `semo verify` makes, with a budget the editor can afford) and the
+//! findings join the mission's diagnostics while that saved text is the
+//! current one. An edit, a close or the next save cancels a search under
+//! way (its flag is checked at every state) and drops its findings, so a
+//! search never delays typing and never shows findings of another text.
+
+use crate::State;
+use crate::world::Snapshot;
+use semo::workspace::FileKind;
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use tower_lsp_server::ls_types::Uri;
+
+/// The editor's search: a minute of mission time, twenty thousand states.
+fn options(cancel: Arc<AtomicBool>) -> semo::verify::Options {
+    semo::verify::Options {
+        horizon_ms: 60_000,
+        max_states: 20_000,
+        cancel: Some(cancel),
+        ..semo::verify::Options::default()
+    }
+}
+
+/// Per mission: the search under way, or the findings of the text saved.
+#[derive(Default)]
+pub struct Verified {
+    missions: Mutex<HashMap<Uri, Entry>>,
+}
+
+struct Entry {
+    cancel: Arc<AtomicBool>,
+    /// The snapshot searched.
+    snapshot: std::sync::Weak<Snapshot>,
+    /// Once the search has ended.
+    findings: Option<Vec<semo::diag::Diagnostic>>,
+}
+
+impl Verified {
+    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<Uri, Entry>> {
+        self.missions.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The mission changed or closed: stop its search, forget its findings.
+    pub fn forget(&self, uri: &Uri) {
+        if let Some(entry) = self.lock().remove(uri) {
+            entry.cancel.store(true, Ordering::Relaxed);
+        }
+    }
+
+    /// The findings of `snapshot`, once its search has ended.
+    pub fn findings(&self, snapshot: &Arc<Snapshot>) -> Vec<semo::diag::Diagnostic> {
+        self.lock()
+            .get(&snapshot.uri)
+            .filter(|e| std::ptr::eq(e.snapshot.as_ptr(), Arc::as_ptr(snapshot)))
+            .and_then(|e| e.findings.clone())
+            .unwrap_or_default()
+    }
+}
+
+/// After a save: search the mission's current text in the background; when
+/// the search ends and the text is still current, publish again.
+pub fn after_save(state: &Arc<State>, uri: &Uri) {
+    let Some(snapshot) = state.world().snapshot(uri) else {
+        return;
+    };
+    if snapshot.kind != FileKind::Mission {
+        return;
+    }
+    let cancel = Arc::new(AtomicBool::new(false));
+    {
+        let mut missions = state.verified.lock();
+        if let Some(old) = missions.insert(
+            uri.clone(),
+            Entry {
+                cancel: cancel.clone(),
+                snapshot: Arc::downgrade(&snapshot),
+                findings: None,
+            },
+        ) {
+            old.cancel.store(true, Ordering::Relaxed);
+        }
+    }
+    let state = state.clone();
+    tokio::spawn(async move {
+        let searched = snapshot.clone();
+        let flag = cancel.clone();
+        let Ok(Some(findings)) = tokio::task::spawn_blocking(move || search(&searched, flag)).await
+        else {
+            return;
+        };
+        if cancel.load(Ordering::Relaxed) || !state.world().is_current(&snapshot) {
+            return;
+        }
+        if let Some(entry) = state.verified.lock().get_mut(&snapshot.uri)
+            && Arc::ptr_eq(&entry.cancel, &cancel)
+        {
+            entry.findings = Some(findings);
+        }
+        state.queue.push([snapshot.uri.clone()]);
+    });
+}
+
+/// The findings of a search of the snapshot's mission; `None` when it has
+/// errors (nothing to run) or the search was cancelled.
+fn search(snapshot: &Snapshot, cancel: Arc<AtomicBool>) -> Option<Vec<semo::diag::Diagnostic>> {
+    let build = snapshot.host().build_input(snapshot.id)?;
+    let refined = semo::codegen::refine_checked(&build.input());
+    if refined.diagnostics.iter().any(|d| d.is_error()) {
+        return None;
+    }
+    let report = semo::verify::verify(
+        &refined.programs,
+        snapshot.id,
+        &snapshot.text,
+        &options(cancel),
+    );
+    (!report.cancelled).then_some(report.findings)
+}

@@ -1,0 +1,78 @@
+//! `semo verify` through the protocol: a saved mission's findings join its
+//! diagnostics once the background search ends, on the saved text only;
+//! an edit drops them and typing never waits for a search.
+
+use semo_server::harness::TestClient;
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures/verify")
+        .join(name)
+}
+
+fn uri(path: &Path) -> String {
+    let path: PathBuf = path.components().collect();
+    format!("file://{}", path.display())
+}
+
+fn codes(diagnostics: &Value) -> Vec<String> {
+    diagnostics
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d["code"].as_str().unwrap_or("").to_string())
+        .collect()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_saved_mission_gets_its_verify_findings_and_an_edit_drops_them() {
+    let dir = fixture("never_finishes");
+    let mission = dir.join("main.mission");
+    let text = std::fs::read_to_string(&mission).unwrap();
+    let mission = uri(&mission);
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], Some(&uri(&dir))).await;
+    client.open(&mission, &text).await;
+    // Opened: the check's diagnostics, no search yet.
+    let opened = client.diagnostics(&mission, Some(1)).await;
+    assert!(!codes(&json!(opened)).contains(&"V002".to_string()));
+    client
+        .notify(
+            "textDocument/didSave",
+            json!({ "textDocument": { "uri": mission } }),
+        )
+        .await;
+    let found = client
+        .notification("textDocument/publishDiagnostics", |p| {
+            p["uri"] == mission.as_str() && codes(&p["diagnostics"]).contains(&"V002".to_string())
+        })
+        .await;
+    let v002: Vec<&Value> = found["diagnostics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|d| d["code"] == "V002")
+        .collect();
+    assert_eq!(v002.len(), 1, "{found:#}");
+    // On the line of the mode the robot is stuck in (0-based 17).
+    assert_eq!(v002[0]["range"]["start"]["line"], 17, "{found:#}");
+    assert!(v002[0]["message"].as_str().unwrap().contains("WANDER"));
+    // An edit: the findings were of the saved text, and go.
+    client
+        .notify(
+            "textDocument/didChange",
+            json!({
+                "textDocument": { "uri": mission, "version": 2 },
+                "contentChanges": [{ "text": format!("{text}\n") }]
+            }),
+        )
+        .await;
+    let edited = client.diagnostics(&mission, Some(2)).await;
+    assert!(
+        !codes(&json!(edited)).contains(&"V002".to_string()),
+        "{edited:#?}"
+    );
+    client.shutdown().await;
+}
