@@ -73,6 +73,24 @@ fn a_mode_with_no_way_out_is_found_and_its_counterexample_replays() {
 }
 
 #[test]
+fn two_robots_that_each_wait_for_the_other_wait_for_ever() {
+    let dir = support::robots::scratch("verify-waits");
+    let dir_text = dir.to_string_lossy().to_string();
+    let mission = "tests/fixtures/verify/waits_for_ever/main.mission";
+    let (code, findings, data) = verify(mission, &["--counterexamples", &dir_text]);
+    assert_eq!(code, 1);
+    assert_eq!(data["exhaustive"], true, "{data}");
+    let found: Vec<(&str, u64)> = findings.iter().map(|(c, l, _)| (c.as_str(), *l)).collect();
+    // On each robot's first `receive`.
+    assert_eq!(found, [("V003", 7), ("V003", 12)], "{findings:?}");
+    // The replay ends with both waiting: the leader never sent.
+    let scenario = data["counterexamples"][0].as_str().unwrap().to_string();
+    let out = semo(&["simulate", mission, "--scenario", &scenario, "--trace", "-"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(!out.stdout.contains("\"event\":\"send\""), "{}", out.stdout);
+}
+
+#[test]
 fn the_repaired_missions_and_the_small_examples_have_no_finding() {
     for (mission, exhaustive) in [
         ("tests/fixtures/verify/clean/main.mission", true),
@@ -114,27 +132,48 @@ fn refined(
     (!refined.diagnostics.iter().any(|d| d.is_error())).then_some((refined.programs, id))
 }
 
-/// One random behaviour of the world `semo verify` explores: `choices`
-/// made so far (from the start, or after `prefix`), then at each step a
-/// random one of those the search could make, up to `until`. The modes
-/// entered and, per robot, whether it finished.
+/// What a random behaviour showed.
+struct Behaviour {
+    /// (team, mode) entered.
+    entered: Vec<(String, String)>,
+    /// Per robot: it has finished by the end.
+    finished: Vec<bool>,
+    /// Per robot: it acted (called, sent, threw, changed mode, finished)
+    /// after the prefix.
+    acted: Vec<bool>,
+    /// Per robot: the `receive` states it waits in at the end.
+    waiting: Vec<Vec<(usize, usize)>>,
+}
+
+/// One random behaviour of the world `semo verify` explores: the choices
+/// of `prefix` (else a random start), then at each step a random one of
+/// those the search could make, up to the horizon.
 fn random_behaviour(
     programs: &[semo::refine::RobotProgram],
     inputs: &semo::verify::Inputs,
     options: &semo::verify::Options,
     prefix: &[(i64, semo::verify::Choice)],
     rng: &mut support::missiongen::Rng,
-) -> (Vec<(String, String)>, Vec<bool>) {
+) -> Behaviour {
     use semo::verify::Choice;
     let empty = semo::sim::Scenario::default();
     let mut sim = semo::sim::Sim::new(programs, &empty, &semo::sim::Options::default());
     let mut classes = vec![0; inputs.sensors.len()];
     let mut changes = options.changes;
-    let mut entered = Vec::new();
-    let note = |sim: &mut semo::sim::Sim, entered: &mut Vec<(String, String)>| {
+    let mut seen = Behaviour {
+        entered: Vec::new(),
+        finished: Vec::new(),
+        acted: vec![false; programs.len()],
+        waiting: Vec::new(),
+    };
+    let note = |sim: &mut semo::sim::Sim, seen: &mut Behaviour, after_prefix: bool| {
         for e in sim.take_trace() {
             if let (true, Some(mode)) = (e.event == "mode", e.field("mode")) {
-                entered.push((programs[e.robot].team.clone(), mode.to_string()));
+                seen.entered
+                    .push((programs[e.robot].team.clone(), mode.to_string()));
+            }
+            if after_prefix && matches!(e.event, "call" | "send" | "throw" | "mode" | "finish") {
+                seen.acted[e.robot] = true;
             }
         }
     };
@@ -146,7 +185,7 @@ fn random_behaviour(
     }
     for (at, choice) in prefix {
         sim.run_to(*at);
-        note(&mut sim, &mut entered);
+        note(&mut sim, &mut seen, false);
         changes -= u32::from(!matches!(choice, Choice::Nothing | Choice::Start(_)));
         semo::verify::apply(&mut sim, &mut classes, inputs, choice);
         t = *at;
@@ -154,7 +193,7 @@ fn random_behaviour(
     if !prefix.is_empty() {
         t += options.step_ms;
         sim.run_to(t);
-        note(&mut sim, &mut entered);
+        note(&mut sim, &mut seen, false);
     }
     while t < options.horizon_ms {
         let all = semo::verify::choices(inputs, &classes, changes);
@@ -168,16 +207,21 @@ fn random_behaviour(
         semo::verify::apply(&mut sim, &mut classes, inputs, &choice);
         t += options.step_ms;
         sim.run_to(t);
-        note(&mut sim, &mut entered);
+        note(&mut sim, &mut seen, true);
     }
-    let finished = (0..programs.len()).map(|r| !sim.is_running(r)).collect();
-    (entered, finished)
+    seen.finished = (0..programs.len()).map(|r| !sim.is_running(r)).collect();
+    seen.waiting = (0..programs.len())
+        .map(|r| sim.waiting_receives(r))
+        .collect();
+    seen
 }
 
 /// Soundness of the search and its merged states, over random missions: a
 /// mode V001 says no robot enters is entered in no random behaviour of the
-/// same world, and a robot V002 says can no longer finish finishes in no
-/// random continuation of its counterexample.
+/// same world, a robot V002 says can no longer finish finishes in no
+/// random continuation of its counterexample, and one V003 says waits for
+/// ever in a `receive` still waits there, having done nothing, at the end
+/// of every random continuation.
 #[test]
 fn findings_on_random_missions_hold_in_random_behaviours() {
     use semo::verify::Claim;
@@ -204,30 +248,27 @@ fn findings_on_random_missions_hold_in_random_behaviours() {
         exhaustive += usize::from(report.exhaustive);
         for (claim, way) in report.claims.iter().zip(&report.counterexamples) {
             for _ in 0..4 {
+                let way = way.as_ref().map_or(&[][..], |w| &w.choices[..]);
+                let seen = random_behaviour(&programs, &report.inputs, &options, way, &mut rng);
                 match claim {
-                    Claim::NeverEntered { team, mode } => {
-                        let (entered, _) =
-                            random_behaviour(&programs, &report.inputs, &options, &[], &mut rng);
-                        assert!(
-                            !entered.contains(&(team.clone(), mode.clone())),
-                            "seed {seed}: {team} entered {mode}\n{text}"
-                        );
-                    }
-                    Claim::NeverFinishes { robot } => {
-                        let way = way.as_ref().expect("V002 has a counterexample");
-                        let (_, finished) = random_behaviour(
-                            &programs,
-                            &report.inputs,
-                            &options,
-                            &way.choices,
-                            &mut rng,
-                        );
-                        assert!(
-                            !finished[*robot],
-                            "seed {seed}: {} finished\n{text}",
-                            programs[*robot].robot
-                        );
-                    }
+                    Claim::NeverEntered { team, mode } => assert!(
+                        !seen.entered.contains(&(team.clone(), mode.clone())),
+                        "seed {seed}: {team} entered {mode}\n{text}"
+                    ),
+                    Claim::NeverFinishes { robot } => assert!(
+                        !seen.finished[*robot],
+                        "seed {seed}: {} finished\n{text}",
+                        programs[*robot].robot
+                    ),
+                    Claim::WaitsForEver {
+                        robot,
+                        service,
+                        state,
+                    } => assert!(
+                        !seen.acted[*robot] && seen.waiting[*robot].contains(&(*service, *state)),
+                        "seed {seed}: {} left its receive\n{text}",
+                        programs[*robot].robot
+                    ),
                 }
             }
             held += 1;

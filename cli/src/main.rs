@@ -254,8 +254,9 @@ enum Command {
         choice per step of the world's clock. States met before are not explored again, so \
         a mission that repeats itself is explored completely (a proof for those choices), \
         else up to --horizon or --max-states (bounded; the report says which). Reports a \
-        mode no robot of its team ever enters (V001) and a robot that can reach a state \
-        from which it never finishes though it finishes in other behaviours (V002). --counterexamples DIR writes, per finding, the \
+        mode no robot of its team ever enters (V001), a robot that can reach a state \
+        from which it never finishes though it finishes in other behaviours (V002), and a \
+        robot that can reach a `receive` where it waits for ever (V003). --counterexamples DIR writes, per finding, the \
         scenario `semo simulate` replays to it (see docs/verify.md).\n\n\
         Exit status: 0 nothing found, 1 a finding, 2 bad input (mission errors, options)."
     )]

@@ -227,6 +227,7 @@ codes! {
     ReceiveNeverFed = "W024", Warning, "a receive or subscribe that no robot can ever feed: its sends or publishes never run, or run only on the receiving robot itself";
     ModeNeverEntered = "V001", Warning, "`semo verify`: a mode no robot of its team enters in any behaviour";
     NeverFinishes = "V002", Warning, "`semo verify`: a robot that finishes in some behaviours can reach a state from which it never finishes";
+    WaitsForEver = "V003", Warning, "`semo verify`: a robot can reach a `receive` where it waits for ever, whatever the world does";
 }
 
 impl fmt::Display for Code {

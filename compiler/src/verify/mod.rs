@@ -9,8 +9,9 @@
 //! Properties checked, only when the search is exhaustive (a bounded one
 //! proves neither): every mode is entered in some behaviour (V001); a
 //! robot that finishes in some behaviour can finish from every state it
-//! can reach (V002), with the shortest way to such a state as a scenario
-//! `semo simulate` replays.
+//! can reach (V002); a robot never waits in a `receive` from which no
+//! behaviour frees it (V003); V002 and V003 with the shortest way to such
+//! a state as a scenario `semo simulate` replays.
 
 mod inputs;
 mod search;
@@ -98,6 +99,13 @@ pub enum Claim {
     /// From the counterexample's state, robot `robot` (an index into the
     /// programs) never finishes.
     NeverFinishes { robot: usize },
+    /// From the counterexample's state, robot `robot` waits for ever in
+    /// state `state` of service `service`.
+    WaitsForEver {
+        robot: usize,
+        service: usize,
+        state: usize,
+    },
 }
 
 /// What a search found and how far it looked.
@@ -178,6 +186,27 @@ pub fn verify(programs: &[RobotProgram], file: FileId, text: &str, options: &Opt
         ));
         counterexamples.push(Some(way.clone()));
         claims.push(Claim::NeverFinishes { robot: *r });
+    }
+    for ((r, service, state), way) in &explored.waits_for_ever {
+        let program = &programs[*r];
+        let statement = &program.control.services[*service].states[*state];
+        findings.push(Diagnostic::new(
+            Code::WaitsForEver,
+            file,
+            statement.span,
+            format!(
+                "{} waits here for ever from {} ms on: no behaviour brings what `{}` waits for",
+                program.robot,
+                way.end_ms,
+                statement.text.trim()
+            ),
+        ));
+        counterexamples.push(Some(way.clone()));
+        claims.push(Claim::WaitsForEver {
+            robot: *r,
+            service: *service,
+            state: *state,
+        });
     }
     Report {
         findings,

@@ -32,6 +32,10 @@ pub struct Explored {
     /// which it never does (only when exhaustive): the shortest way there
     /// and the mode it is in then.
     pub stuck: Vec<(usize, Counterexample, Option<usize>)>,
+    /// Per `receive` (robot, service, state) that a robot can reach and
+    /// then wait in for ever, whatever the world does (only when
+    /// exhaustive): the shortest way there.
+    pub waits_for_ever: Vec<((usize, usize, usize), Counterexample)>,
 }
 
 struct Node {
@@ -43,6 +47,11 @@ struct Node {
     finished: Box<[bool]>,
     /// Per robot: the mode it is in (an index into its program's modes).
     modes: Box<[Option<u16>]>,
+    /// The `receive` states robots wait in: (robot, service, state).
+    waiting: Box<[(u32, u32, u32)]>,
+    /// The robots that act (call, send, throw, change mode, finish) in
+    /// some step out of this state.
+    moved: Vec<u32>,
 }
 
 pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) -> Explored {
@@ -59,6 +68,7 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
         cancelled: false,
         observed: HashSet::new(),
         stuck: Vec::new(),
+        waits_for_ever: Vec::new(),
     };
     let mut nodes: Vec<Node> = Vec::new();
     let mut seen: HashMap<u128, u32> = HashMap::new();
@@ -104,6 +114,14 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
                 child.run_to(next_t);
                 explored.transitions += 1;
                 for e in child.take_trace() {
+                    // What a robot does (not what merely reaches it): it
+                    // left any `receive` it waited in, or works beside it.
+                    let moved = &mut nodes[id as usize].moved;
+                    if matches!(e.event, "call" | "send" | "throw" | "mode" | "finish")
+                        && !moved.contains(&(e.robot as u32))
+                    {
+                        moved.push(e.robot as u32);
+                    }
                     if options.observe {
                         // The event without its times: what happened, not when.
                         explored.observed.insert(format!(
@@ -158,6 +176,7 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
     explored.cancelled = cancelled(options);
     if explored.exhaustive {
         explored.stuck = stuck(programs.len(), &nodes, &edges, inputs, options.step_ms);
+        explored.waits_for_ever = waits_for_ever(&nodes, &edges, inputs, options.step_ms);
     }
     explored
 }
@@ -179,12 +198,21 @@ fn admit(
     let modes = robots
         .map(|r| sim.mode_of(r).and_then(|m| u16::try_from(m).ok()))
         .collect();
+    let waiting = (0..sim.robot_count())
+        .flat_map(|r| {
+            sim.waiting_receives(r)
+                .into_iter()
+                .map(move |(service, state)| (r as u32, service as u32, state as u32))
+        })
+        .collect();
     nodes.push(Node {
         parent,
         choice,
         at,
         finished,
         modes,
+        waiting,
+        moved: Vec::new(),
     });
     id
 }
@@ -337,6 +365,64 @@ fn stuck(
                 None => Counterexample::from_choices(&[(0, node.choice.clone())], step_ms, inputs),
             };
             found.push((r, path, node.modes[r].map(usize::from)));
+        }
+    }
+    found
+}
+
+/// The states from which some state in `target` can be reached, over the
+/// state graph's edges reversed.
+fn can_reach(into: &[Vec<u32>], target: impl Fn(usize) -> bool) -> Vec<bool> {
+    let mut reached: Vec<bool> = (0..into.len()).map(&target).collect();
+    let mut work: Vec<u32> = (0..into.len() as u32)
+        .filter(|&n| reached[n as usize])
+        .collect();
+    while let Some(n) = work.pop() {
+        for &p in &into[n as usize] {
+            if !reached[p as usize] {
+                reached[p as usize] = true;
+                work.push(p);
+            }
+        }
+    }
+    reached
+}
+
+/// Per `receive` a robot waits in in some state: the first state (the
+/// shallowest) from which it waits there for ever, if any.
+fn waits_for_ever(
+    nodes: &[Node],
+    edges: &[(u32, u32)],
+    inputs: &Inputs,
+    step_ms: i64,
+) -> Vec<((usize, usize, usize), Counterexample)> {
+    let mut into: Vec<Vec<u32>> = vec![Vec::new(); nodes.len()];
+    for &(from, to) in edges {
+        into[to as usize].push(from);
+    }
+    let mut receives: Vec<(u32, u32, u32)> = nodes
+        .iter()
+        .flat_map(|n| n.waiting.iter().copied())
+        .collect();
+    receives.sort_unstable();
+    receives.dedup();
+    let mut found = Vec::new();
+    for w in receives {
+        // It leaves from a state where it does not wait there, or from
+        // which it acts in some step (the step may take it through the
+        // `receive` and back between two looks).
+        let leaves = can_reach(&into, |n| {
+            !nodes[n].waiting.contains(&w) || nodes[n].moved.contains(&w.0)
+        });
+        if let Some(n) = (0..nodes.len()).find(|&n| !leaves[n]) {
+            let node = &nodes[n];
+            let way = match node.parent {
+                Some(p) => {
+                    counterexample(nodes, p, &node.choice, node.at, node.at + step_ms, inputs)
+                }
+                None => Counterexample::from_choices(&[(0, node.choice.clone())], step_ms, inputs),
+            };
+            found.push(((w.0 as usize, w.1 as usize, w.2 as usize), way));
         }
     }
     found

@@ -95,6 +95,26 @@ impl<'p> Sim<'p> {
         self.robots[r].alive
     }
 
+    /// The `receive` states robot `r` waits in: (service, state) of each
+    /// region of its mode that is at one and has not taken its messages.
+    pub fn waiting_receives(&self, r: usize) -> Vec<(usize, usize)> {
+        let robot = &self.robots[r];
+        if !robot.alive {
+            return Vec::new();
+        }
+        let services = &robot.program.control.services;
+        robot
+            .regions
+            .iter()
+            .filter(|region| !region.done)
+            .filter_map(|region| {
+                let s = region.service?;
+                let state = services[s].states.get(region.pc)?;
+                matches!(state.kind, StateKind::Receive { .. }).then_some((s, region.pc))
+            })
+            .collect()
+    }
+
     /// The mode robot `r` is in: an index into its program's modes.
     pub fn mode_of(&self, r: usize) -> Option<usize> {
         self.robots[r].current_mode
