@@ -56,6 +56,9 @@ fn a_mode_with_no_way_out_is_found_and_its_counterexample_replays() {
     assert_eq!((code.as_str(), *line), ("V002", 18), "{message}");
     assert!(message.contains("WANDER"), "{message}");
     let scenario = data["counterexamples"][0].as_str().unwrap().to_string();
+    // Its timeline beside it.
+    let svg = std::fs::read_to_string(scenario.replace(".scenario.json", ".svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("WANDER"), "{svg}");
     // The replay ends with the robot in WANDER, not finished.
     let out = semo(&[
         "simulate",

@@ -152,7 +152,8 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
 }
 
 /// Writes each finding's counterexample as `<mission>.<code>-<n>.scenario.json`
-/// in `dir`; per finding, the file written, if it has one.
+/// in `dir`, with the timeline of its replay beside it (`….svg`); per
+/// finding, the scenario written, if it has one.
 fn write_counterexamples(
     dir: &Path,
     mission: &Path,
@@ -174,8 +175,19 @@ fn write_counterexamples(
             written.push(None);
             continue;
         };
-        let path = dir.join(format!("{stem}.{}-{}.scenario.json", finding.code, n + 1));
-        std::fs::write(&path, way.scenario_json(programs))?;
+        let name = format!("{stem}.{}-{}", finding.code, n + 1);
+        let path = dir.join(format!("{name}.scenario.json"));
+        let text = way.scenario_json(programs);
+        std::fs::write(&path, &text)?;
+        // Its timeline, as `semo simulate --svg` draws the replay.
+        let scenario = semo::sim::scenario::parse(&text, programs).map_err(|e| {
+            std::io::Error::other(format!(
+                "internal error: a counterexample does not read back: {e:?}"
+            ))
+        })?;
+        let run = semo::sim::simulate(programs, &scenario, &semo::sim::Options::default());
+        let picture = semo::sim::svg::to_svg(&run, programs, &scenario);
+        std::fs::write(dir.join(format!("{name}.svg")), picture)?;
         written.push(Some(path));
     }
     Ok(written)

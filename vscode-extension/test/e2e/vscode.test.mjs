@@ -324,11 +324,13 @@ test('Robots (live): the robots of a running mission from its broker', { timeout
   }
 });
 
-/** Publishes what a robot of `rovers` publishes: its retained status. */
+/** Publishes what a robot of `rovers` publishes in the run `default`
+ * started at Unix ms 1000: its retained status. */
 function publishStatus(robot, status) {
   execFileSync('mosquitto_pub', [
     '-h', '127.0.0.1', '-p', String(process.env.SEMO_E2E_MQTT_PORT), '-q', '1', '-r',
-    '-t', `semo/rovers/status/${robot}`, '-m', JSON.stringify({ robot, event: 'status', ...status }),
+    '-t', `semo/rovers/default/status/${robot}`,
+    '-m', JSON.stringify({ robot, event: 'status', started: '1000', ...status }),
   ]);
 }
 
