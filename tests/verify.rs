@@ -109,6 +109,30 @@ fn the_repaired_missions_and_the_small_examples_have_no_finding() {
     }
 }
 
+/// The project's `[lints]` apply to the findings: allowed, a finding is
+/// not reported; denied, it is an error.
+#[test]
+fn lint_levels_of_the_project_apply_to_the_findings() {
+    let dir = support::robots::scratch("verify-lints");
+    let mission = std::fs::read_to_string(
+        support::repo_root().join("tests/fixtures/verify/never_entered/main.mission"),
+    )
+    .unwrap();
+    std::fs::write(dir.join("main.mission"), mission).unwrap();
+    let path = dir.join("main.mission").to_string_lossy().to_string();
+    for (level, expected) in [("allow", (0, None)), ("deny", (1, Some("error")))] {
+        std::fs::write(
+            dir.join("semo.toml"),
+            format!("[lints]\nV001 = \"{level}\"\n"),
+        )
+        .unwrap();
+        let out = semo(&["verify", &path, "--format", "json"]);
+        let document: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+        let severity = document["diagnostics"][0]["severity"].as_str();
+        assert_eq!((out.code, severity), expected, "{level}: {}", out.stdout);
+    }
+}
+
 #[test]
 fn a_step_off_the_sensors_period_is_bad_input() {
     let out = semo(&[

@@ -62,7 +62,10 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             Err(code) => return code,
         };
     let text = check.files.get(mission).text.clone();
-    let report = semo::verify::verify(&refined.programs, mission, &text, &options.search);
+    let mut report = semo::verify::verify(&refined.programs, mission, &text, &options.search);
+    if let Some(project) = check.analysis().project(mission) {
+        report.apply_lints(&project.project);
+    }
     let mut written_files = Vec::new();
     if let Some(dir) = &options.counterexamples {
         match write_counterexamples(dir, &mission_file, &report, &refined.programs) {

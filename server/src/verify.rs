@@ -111,11 +111,14 @@ fn search(snapshot: &Snapshot, cancel: Arc<AtomicBool>) -> Option<Vec<semo::diag
     if refined.diagnostics.iter().any(|d| d.is_error()) {
         return None;
     }
-    let report = semo::verify::verify(
+    let mut report = semo::verify::verify(
         &refined.programs,
         snapshot.id,
         &snapshot.text,
         &options(cancel),
     );
+    if let Some(project) = snapshot.host().project(snapshot.id) {
+        report.apply_lints(&project.project);
+    }
     (!report.cancelled).then_some(report.findings)
 }

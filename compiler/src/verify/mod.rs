@@ -131,6 +131,25 @@ pub struct Report {
     pub observed: Vec<String>,
 }
 
+impl Report {
+    /// The findings at the levels of the project's `[lints]`: allowed ones
+    /// dropped (with their counterexamples and claims), denied ones errors.
+    pub fn apply_lints(&mut self, project: &crate::project::Project) {
+        let findings = std::mem::take(&mut self.findings);
+        let counterexamples = std::mem::take(&mut self.counterexamples);
+        let claims = std::mem::take(&mut self.claims);
+        for ((finding, way), claim) in findings.into_iter().zip(counterexamples).zip(claims) {
+            let mut one = vec![finding];
+            project.apply_lints(&mut one);
+            if let Some(finding) = one.pop() {
+                self.findings.push(finding);
+                self.counterexamples.push(way);
+                self.claims.push(claim);
+            }
+        }
+    }
+}
+
 /// Explores `programs` (refined from the mission `text`, which is `file`).
 pub fn verify(programs: &[RobotProgram], file: FileId, text: &str, options: &Options) -> Report {
     let inputs = inputs::derive(programs);
