@@ -231,7 +231,9 @@ fn completion_offers_tables_keys_codes_and_values() {
         ]
     );
     let codes = offered("[project]\nversion = 1\n[lints]\nW0$0");
-    assert_eq!(codes[0], "W001→W001 = ");
+    // Warnings by code: `semo verify`'s V… before the checker's W….
+    assert_eq!(codes[0], "V001→V001 = ");
+    assert!(codes.contains(&"W001→W001 = ".to_string()));
     assert!(codes.contains(&"W007→W007 = ".to_string()));
     // Errors after warnings and hints.
     let first_error = codes.iter().position(|c| c.starts_with('E')).unwrap();
