@@ -21,6 +21,22 @@ pub struct NoChoice {
     pub message: String,
 }
 
+/// The mission a command runs: the one `named`, else the project's
+/// ([`mission`]); when there is no one mission, the refusal is reported in
+/// `format` for `command` and its exit status returned.
+pub fn mission_or_refuse(
+    named: Option<PathBuf>,
+    command: &str,
+    format: super::output::Format,
+    out: &mut impl std::io::Write,
+) -> Result<PathBuf, i32> {
+    match named {
+        Some(named) => Ok(named),
+        None => mission(&format!("`semo {command} MISSION`"))
+            .map_err(|e| super::output::refused(format, command, &e.folder, &e.message, out)),
+    }
+}
+
 /// The one mission of the project around the current folder: every
 /// `*.mission` under the project's root (the folder holding the nearest
 /// `semo.toml`, down to `PROJECT_DEPTH` folders), or without a project file

@@ -64,12 +64,14 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     } else {
         Format::Human
     };
-    let mission_file = match options.mission.clone() {
-        Some(named) => named,
-        None => match super::defaults::mission("`semo simulate MISSION`") {
-            Ok(found) => found,
-            Err(e) => return output::refused(format, "simulate", &e.folder, &e.message, out),
-        },
+    let mission_file = match super::defaults::mission_or_refuse(
+        options.mission.clone(),
+        "simulate",
+        format,
+        out,
+    ) {
+        Ok(found) => found,
+        Err(code) => return code,
     };
     if input::is_stdin(&mission_file) {
         eprintln!(

@@ -31,13 +31,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         );
         return 2;
     }
-    let mission_file = match options.mission.clone() {
-        Some(named) => named,
-        None => match super::defaults::mission("`semo verify MISSION`") {
+    let mission_file =
+        match super::defaults::mission_or_refuse(options.mission.clone(), "verify", format, out) {
             Ok(found) => found,
-            Err(e) => return output::refused(format, "verify", &e.folder, &e.message, out),
-        },
-    };
+            Err(code) => return code,
+        };
     if input::is_stdin(&mission_file) {
         eprintln!(
             "error: `semo verify` reads the mission's folder (its catalog and strategy files): give the mission's file, not `-`"
