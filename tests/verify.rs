@@ -133,6 +133,57 @@ fn lint_levels_of_the_project_apply_to_the_findings() {
     }
 }
 
+/// What a person reads: the findings on standard error, and on standard
+/// output how far the search looked, the world's choices and how to
+/// replay each counterexample.
+#[test]
+fn the_human_report_names_the_choices_and_how_to_replay() {
+    let dir = support::robots::scratch("verify-human");
+    let dir_text = dir.to_string_lossy().to_string();
+    let mission = "tests/fixtures/verify/never_finishes/main.mission";
+    let out = semo(&["verify", mission, "--counterexamples", &dir_text]);
+    assert_eq!(out.code, 1, "{}", out.stderr);
+    assert!(out.stderr.contains("[V002]"), "{}", out.stderr);
+    assert!(
+        out.stdout.starts_with("explored every behaviour:"),
+        "{}",
+        out.stdout
+    );
+    assert!(
+        out.stdout.contains("  sensor ti.LOCATION: 5,5 | OTHER\n"),
+        "{}",
+        out.stdout
+    );
+    let replay = format!(
+        "  V002: replay with `semo simulate {mission} --scenario {dir_text}/main.V002-1.scenario.json`"
+    );
+    assert!(out.stdout.contains(&replay), "{}", out.stdout);
+}
+
+/// The start's combinations of sensor classes are exponential in the
+/// robots (two classes each: 2^40 for forty robots); they are made one at
+/// a time, so the budget bounds the search however many robots there are,
+/// and doubling the swarm keeps it within the budget.
+#[test]
+fn a_swarm_with_more_start_combinations_than_the_budget_stops_at_the_budget() {
+    let dir = support::robots::scratch("verify-swarm");
+    for robots in [20, 40] {
+        let mission = dir.join(format!("swarm{robots}.mission"));
+        std::fs::write(
+            &mission,
+            format!(
+                "{{\n  Scouts: TIEvalbot s[{robots}]\n}}\n\nScouts.Action.Go {{\n  if (LOCATION == \"5,5\")\n    throw ARRIVED\n}} repeat(1 SEC)\n\nScouts.GO {{ set(Action, Go) }}\nScouts.DONE {{ set(Action, OFF) }}\n\nScouts.main {{\n  case (GO):\n    catch (ARRIVED): mode = DONE\n  default: mode = GO\n}}\n"
+            ),
+        )
+        .unwrap();
+        let path = mission.to_string_lossy().to_string();
+        let (code, findings, data) = verify(&path, &["--max-states", "300"]);
+        assert_eq!((code, &findings), (0, &Vec::new()), "{robots}");
+        assert_eq!(data["exhaustive"], false, "{robots}: {data}");
+        assert_eq!(data["states"], 300, "{robots}: {data}");
+    }
+}
+
 #[test]
 fn a_step_off_the_sensors_period_is_bad_input() {
     let out = semo(&[
@@ -145,18 +196,35 @@ fn a_step_off_the_sensors_period_is_bad_input() {
     assert!(out.stderr.contains("multiple of 100ms"), "{}", out.stderr);
 }
 
-/// The refined programs of mission `text`, written as `dir/main.mission`
-/// (None when the mission has errors), and the mission's file id.
-fn refined(
-    dir: &std::path::Path,
-    text: &str,
-) -> Option<(Vec<semo::refine::RobotProgram>, semo::diag::FileId)> {
-    let path = dir.join("main.mission");
-    std::fs::write(&path, text).unwrap();
-    let (run, id) = semo::host::load_build(&path, &[]).ok()?;
-    let build = run.analysis().build_input(id)?;
-    let refined = semo::codegen::refine_checked(&build.input());
-    (!refined.diagnostics.iter().any(|d| d.is_error())).then_some((refined.programs, id))
+/// The random missions of `seeds` (`support/missiongen.rs`) that refine
+/// without errors, each written in turn as `main.mission` in the scratch
+/// folder `scratch`: (seed, text, refined programs, the mission's file id).
+fn random_missions(
+    scratch: &str,
+    seeds: std::ops::Range<u64>,
+) -> impl Iterator<
+    Item = (
+        u64,
+        String,
+        Vec<semo::refine::RobotProgram>,
+        semo::diag::FileId,
+    ),
+> {
+    let catalog = semo::catalog::builtin_catalog();
+    let path = support::robots::scratch(scratch).join("main.mission");
+    seeds.filter_map(move |seed| {
+        let text = support::missiongen::mission(seed, &catalog);
+        std::fs::write(&path, &text).unwrap();
+        let (run, id) = semo::host::load_build(&path, &[]).ok()?;
+        let build = run.analysis().build_input(id)?;
+        let refined = semo::codegen::refine_checked(&build.input());
+        (!refined.diagnostics.iter().any(|d| d.is_error())).then_some((
+            seed,
+            text,
+            refined.programs,
+            id,
+        ))
+    })
 }
 
 /// What a random behaviour showed.
@@ -206,9 +274,10 @@ fn random_behaviour(
     };
     let mut t = 0;
     if prefix.is_empty() {
-        let starts = semo::verify::start_classes(inputs);
-        let start = Choice::Start(starts[rng.below(starts.len())].clone());
-        semo::verify::apply(&mut sim, &mut classes, inputs, &start);
+        let start = (inputs.sensors.iter())
+            .map(|s| rng.below(s.values.len()))
+            .collect();
+        semo::verify::apply(&mut sim, &mut classes, inputs, &Choice::Start(start));
     }
     for (at, choice) in prefix {
         sim.run_to(*at);
@@ -252,26 +321,16 @@ fn random_behaviour(
 #[test]
 fn findings_on_random_missions_hold_in_random_behaviours() {
     use semo::verify::Claim;
-    let catalog = semo::catalog::builtin_catalog();
-    let dir = support::robots::scratch("verify-random");
     let options = semo::verify::Options {
-        step_ms: 500,
         horizon_ms: 20_000,
         max_states: 4_000,
-        changes: 2,
-        merge_in_time: true,
-        observe: false,
-        cancel: None,
+        ..semo::verify::Options::default()
     };
     let mut rng = support::missiongen::Rng::new(7);
     let (mut exhaustive, mut held, mut missions) = (0, 0, 0);
-    for seed in 0..30 {
-        let text = support::missiongen::mission(seed, &catalog);
-        let Some((programs, id)) = refined(&dir, &text) else {
-            continue;
-        };
+    for (seed, text, programs, id) in random_missions("verify-random", 0..30) {
         missions += 1;
-        let report = semo::verify::verify(&programs, id, &text, &options);
+        let report = semo::verify::verify(&programs, id, &text, &options).unwrap();
         exhaustive += usize::from(report.exhaustive);
         for (claim, way) in report.claims.iter().zip(&report.counterexamples) {
             for _ in 0..4 {
@@ -313,32 +372,24 @@ fn findings_on_random_missions_hold_in_random_behaviours() {
 /// shifted.
 #[test]
 fn merging_states_across_instants_finds_what_the_unreduced_search_finds() {
-    let catalog = semo::catalog::builtin_catalog();
-    let dir = support::robots::scratch("verify-reduction");
     let reduced = semo::verify::Options {
-        step_ms: 500,
         horizon_ms: 6_000,
         max_states: 20_000,
         changes: 1,
-        merge_in_time: true,
         observe: true,
-        cancel: None,
+        ..semo::verify::Options::default()
     };
     let unreduced = semo::verify::Options {
         merge_in_time: false,
         ..reduced.clone()
     };
     let (mut compared, mut saved) = (0, 0);
-    for seed in 100..118 {
-        let text = support::missiongen::mission(seed, &catalog);
-        let Some((programs, id)) = refined(&dir, &text) else {
-            continue;
-        };
-        let full = semo::verify::verify(&programs, id, &text, &unreduced);
+    for (seed, text, programs, id) in random_missions("verify-reduction", 100..118) {
+        let full = semo::verify::verify(&programs, id, &text, &unreduced).unwrap();
         if full.over_budget {
             continue;
         }
-        let merged = semo::verify::verify(&programs, id, &text, &reduced);
+        let merged = semo::verify::verify(&programs, id, &text, &reduced).unwrap();
         assert!(!merged.over_budget, "seed {seed}");
         assert_eq!(merged.entered, full.entered, "seed {seed}\n{text}");
         let only = |a: &[String], b: &[String]| -> Vec<String> {

@@ -32,17 +32,16 @@ const BUILD: &str = "semo build";
 
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let started = std::time::Instant::now();
-    let mission_file = match options.mission.clone() {
-        Some(named) => named,
-        None => match super::defaults::mission("`semo build MISSION`") {
-            Ok(found) => found,
-            Err(e) => return output::refused(options.format, "build", &e.folder, &e.message, out),
-        },
+    let mission_file = match super::defaults::mission_or_refuse(
+        options.mission.clone(),
+        "build",
+        options.format,
+        out,
+    ) {
+        Ok(found) => found,
+        Err(code) => return code,
     };
-    if input::is_stdin(&mission_file) {
-        eprintln!(
-            "error: `semo build` reads the mission's folder (its catalog and strategy files, `out/` beside it): give the mission's file, not `-`"
-        );
+    if !input::mission_is_a_file(&mission_file, "build", ", `out/` beside it", "") {
         return 2;
     }
     if !input::strategy_paths_are_files(&options.strategy) {

@@ -14,6 +14,19 @@ pub fn is_stdin(path: &Path) -> bool {
     path.as_os_str() == "-"
 }
 
+/// A command that reads the mission's folder (its catalog and strategy
+/// files, and `also` there) cannot take the mission on standard input:
+/// says so in one line, with `note` after it.
+pub fn mission_is_a_file(mission: &Path, command: &str, also: &str, note: &str) -> bool {
+    if is_stdin(mission) {
+        eprintln!(
+            "error: `semo {command}` reads the mission's folder (its catalog and strategy files{also}): give the mission's file, not `-`{note}"
+        );
+        return false;
+    }
+    true
+}
+
 /// `--strategy` paths are seen by path (by the files under the same
 /// roots), so standard input cannot be one: says so in one line.
 pub fn strategy_paths_are_files(paths: &[PathBuf]) -> bool {

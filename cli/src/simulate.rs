@@ -73,10 +73,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         Ok(found) => found,
         Err(code) => return code,
     };
-    if input::is_stdin(&mission_file) {
-        eprintln!(
-            "error: `semo simulate` reads the mission's folder (its catalog and strategy files): give the mission's file, not `-` (the scenario may be `-`)"
-        );
+    if !input::mission_is_a_file(&mission_file, "simulate", "", " (the scenario may be `-`)") {
         return 2;
     }
     if !input::strategy_paths_are_files(&options.strategy) {

@@ -24,11 +24,8 @@ const VERIFY: &str = "semo verify";
 
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let format = options.format;
-    if options.search.step_ms <= 0 || options.search.step_ms % 100 != 0 {
-        eprintln!(
-            "error: --step must be a positive multiple of 100ms (the sensors' period), not {}ms",
-            options.search.step_ms
-        );
+    if let Some(problem) = options.search.problem() {
+        eprintln!("error: --step: {problem}");
         return 2;
     }
     let mission_file =
@@ -36,10 +33,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             Ok(found) => found,
             Err(code) => return code,
         };
-    if input::is_stdin(&mission_file) {
-        eprintln!(
-            "error: `semo verify` reads the mission's folder (its catalog and strategy files): give the mission's file, not `-`"
-        );
+    if !input::mission_is_a_file(&mission_file, "verify", "", "") {
         return 2;
     }
     if !input::strategy_paths_are_files(&options.strategy)
@@ -60,7 +54,14 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             Err(code) => return code,
         };
     let text = check.files.get(mission).text.clone();
-    let mut report = semo::verify::verify(&refined.programs, mission, &text, &options.search);
+    let mut report = match semo::verify::verify(&refined.programs, mission, &text, &options.search)
+    {
+        Ok(report) => report,
+        Err(problem) => {
+            eprintln!("internal error: options checked above were refused: {problem}");
+            return 2;
+        }
+    };
     if let Some(project) = check.analysis().project(mission) {
         report.apply_lints(&project.project);
     }
@@ -105,23 +106,16 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
                     format!("the first {} ms", report.reached_ms)
                 }
             );
-            for s in &report.inputs.sensors {
-                let _ = writeln!(
-                    out,
-                    "  sensor {}.{}: {}",
-                    s.robot_name,
-                    s.port,
-                    s.values.join(" | ")
-                );
-            }
-            for c in &report.inputs.commands {
-                let _ = writeln!(
-                    out,
-                    "  command {} USER.{}: {}",
-                    c.to,
-                    c.value,
-                    c.values.join(" | ")
-                );
+            // The world's choices: each input with its values.
+            let sensors = report
+                .inputs
+                .sensors
+                .iter()
+                .map(|s| (format!("sensor {}.{}", s.robot_name, s.port), &s.values));
+            let commands = (report.inputs.commands.iter())
+                .map(|c| (format!("command {} USER.{}", c.to, c.value), &c.values));
+            for (input, values) in sensors.chain(commands) {
+                let _ = writeln!(out, "  {input}: {}", values.join(" | "));
             }
             for (finding, file) in report.findings.iter().zip(&written_files) {
                 if let Some(file) = file {
@@ -178,7 +172,7 @@ fn write_counterexamples(
         };
         let name = format!("{stem}.{}-{}", finding.code, n + 1);
         let path = dir.join(format!("{name}.scenario.json"));
-        let text = way.scenario_json(programs);
+        let text = way.scenario_json(&report.inputs, programs);
         std::fs::write(&path, &text)?;
         // Its timeline, as `semo simulate --svg` draws the replay.
         let scenario = semo::sim::scenario::parse(&text, programs).map_err(|e| {

@@ -36,7 +36,8 @@ fn main() {
                 ..semo::verify::Options::default()
             };
             let start = Instant::now();
-            let report = semo::verify::verify(&programs, id, &text, &options);
+            let report =
+                semo::verify::verify(&programs, id, &text, &options).expect("valid options");
             let took = start.elapsed().as_secs_f64();
             println!(
                 "verify {example}{}: {} ({} states, {} transitions, {} ms of mission time) in {:.2} s: {:.0} transitions/s, {} finding(s)",

@@ -111,12 +111,20 @@ fn search(snapshot: &Snapshot, cancel: Arc<AtomicBool>) -> Option<Vec<semo::diag
     if refined.diagnostics.iter().any(|d| d.is_error()) {
         return None;
     }
-    let mut report = semo::verify::verify(
+    let search = semo::verify::verify(
         &refined.programs,
         snapshot.id,
         &snapshot.text,
         &options(cancel),
     );
+    let mut report = match search {
+        Ok(report) => report,
+        Err(problem) => {
+            // The editor's options are fixed: refusing them is a bug.
+            eprintln!("semo-server: internal error: verify refused its options: {problem}");
+            return None;
+        }
+    };
     if let Some(project) = snapshot.host().project(snapshot.id) {
         report.apply_lints(&project.project);
     }

@@ -2,20 +2,12 @@
 //! diagnostics once the background search ends, on the saved text only;
 //! an edit drops them and typing never waits for a search.
 
+mod support;
+
 use semo_server::harness::TestClient;
 use serde_json::{Value, json};
-use std::path::{Path, PathBuf};
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../tests/fixtures/verify")
-        .join(name)
-}
-
-fn uri(path: &Path) -> String {
-    let path: PathBuf = path.components().collect();
-    format!("file://{}", path.display())
-}
+use std::path::Path;
+use support::render::file_uri;
 
 fn codes(diagnostics: &Value) -> Vec<String> {
     diagnostics
@@ -28,12 +20,12 @@ fn codes(diagnostics: &Value) -> Vec<String> {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_saved_mission_gets_its_verify_findings_and_an_edit_drops_them() {
-    let dir = fixture("never_finishes");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/verify/never_finishes");
     let mission = dir.join("main.mission");
     let text = std::fs::read_to_string(&mission).unwrap();
-    let mission = uri(&mission);
+    let mission = file_uri(&mission);
     let mut client = TestClient::start();
-    client.initialize(&["utf-16"], Some(&uri(&dir))).await;
+    client.initialize(&["utf-16"], Some(&file_uri(&dir))).await;
     client.open(&mission, &text).await;
     // Opened: the check's diagnostics, no search yet.
     let opened = client.diagnostics(&mission, Some(1)).await;

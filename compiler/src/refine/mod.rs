@@ -19,6 +19,7 @@ mod robot;
 pub mod value;
 
 pub use program::*;
+pub use robot::SENSOR_PERIOD_MS;
 pub use value::{Value, ValueKind};
 
 use crate::Analysis;

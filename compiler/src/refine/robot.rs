@@ -20,7 +20,7 @@ pub(super) mod shared;
 pub(super) use loops::steps_of;
 
 /// How often sensor tasks sample, in mission milliseconds.
-pub(super) const SENSOR_PERIOD_MS: i64 = 100;
+pub const SENSOR_PERIOD_MS: i64 = 100;
 /// How deep function calls may nest before refinement gives up (sema
 /// already rejects recursion; this only bounds the work).
 const MAX_INLINE_DEPTH: usize = 32;

@@ -30,6 +30,7 @@
 
 use super::scenario::{Command, DEFAULT_SERVICE_MS, FaultKind, Scenario};
 use super::trace::TraceEvent;
+use crate::refine::SENSOR_PERIOD_MS;
 use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
 use crate::refine::{
@@ -47,8 +48,8 @@ mod explore;
 mod loops;
 mod shared;
 
-/// The sensor tasks' period (refinement's `SENSOR_PERIOD_MS`).
-const SENSOR_PERIOD_MS: i64 = 100;
+pub use explore::Memory;
+
 /// State transitions a region may take in one firing (`control.rs`).
 const STEPS_PER_FIRING: usize = 64;
 /// What a slot, a channel sample or a message holds: a typed value, or none

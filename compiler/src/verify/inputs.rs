@@ -45,19 +45,21 @@ pub fn derive(programs: &[RobotProgram]) -> Inputs {
     for (r, program) in programs.iter().enumerate() {
         let m = &program.control;
         let tests = tests_by_slot(m);
+        // This robot's inputs start here (a value two slots read is one).
+        let first = inputs.sensors.len();
         for (i, slot) in m.slots.iter().enumerate() {
             let SlotSource::Sensor { port, .. } = &slot.source else {
                 continue;
             };
-            if tests[i].is_empty() || port == crate::refine::BATTERY_VALUE {
+            if tests[i].is_empty()
+                || port == crate::refine::BATTERY_VALUE
+                || inputs.sensors[first..].iter().any(|s| &s.port == port)
+            {
                 continue;
             }
             let values = classes(&tests[i], |text| slot.kind.parse(text));
-            if inputs
-                .sensors
-                .iter()
-                .any(|s| s.robot == r && &s.port == port)
-            {
+            if values.is_empty() {
+                // No value reads as the slot's type: nothing to choose.
                 continue;
             }
             inputs.sensors.push(SensorInput {

@@ -17,11 +17,13 @@ mod inputs;
 mod search;
 
 pub use inputs::{CommandInput, Inputs, SensorInput};
-pub use search::{apply, choices, start_classes};
+pub use search::{apply, choices};
 
 use crate::diag::{Code, Diagnostic, FileId};
-use crate::refine::RobotProgram;
+use crate::refine::{RobotProgram, SENSOR_PERIOD_MS};
 use crate::span::Span;
+use crate::text::LineIndex;
+use std::collections::HashSet;
 use std::fmt::Write;
 
 #[derive(Clone, Debug)]
@@ -62,6 +64,18 @@ impl Default for Options {
     }
 }
 
+impl Options {
+    /// Why these options cannot run a search, if they cannot.
+    pub fn problem(&self) -> Option<String> {
+        (self.step_ms <= 0 || self.step_ms % SENSOR_PERIOD_MS != 0).then(|| {
+            format!(
+                "the world's step must be a positive multiple of {SENSOR_PERIOD_MS}ms (the sensors' period), not {}ms",
+                self.step_ms
+            )
+        })
+    }
+}
+
 /// One choice of the world.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Choice {
@@ -78,17 +92,13 @@ pub enum Choice {
     },
 }
 
-/// A way to a finding: the world's choices, as a scenario.
+/// A way to a finding: the world's choices, each with the mission ms it
+/// was made at, written as a scenario by [`Counterexample::scenario_json`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Counterexample {
-    /// (at, robot, sensor value, value).
-    pub sensors: Vec<(i64, String, String, String)>,
-    /// (at, to, command, value).
-    pub commands: Vec<(i64, String, String, String)>,
+    pub choices: Vec<(i64, Choice)>,
     /// The mission ms the finding shows at: the scenario's duration.
     pub end_ms: i64,
-    /// The choices themselves, each with the mission ms it was made at.
-    pub choices: Vec<(i64, Choice)>,
 }
 
 /// What a finding claims, for tests that hold it to the simulator.
@@ -150,22 +160,31 @@ impl Report {
     }
 }
 
-/// Explores `programs` (refined from the mission `text`, which is `file`).
-pub fn verify(programs: &[RobotProgram], file: FileId, text: &str, options: &Options) -> Report {
+/// Explores `programs` (refined from the mission `text`, which is `file`);
+/// options that cannot run a search are refused with the reason.
+pub fn verify(
+    programs: &[RobotProgram],
+    file: FileId,
+    text: &str,
+    options: &Options,
+) -> Result<Report, String> {
+    if let Some(problem) = options.problem() {
+        return Err(problem);
+    }
     let inputs = inputs::derive(programs);
     let explored = search::explore(programs, &inputs, options);
     let mut findings = Vec::new();
     let mut counterexamples = Vec::new();
     let mut claims = Vec::new();
+    let lines = LineIndex::new(text);
     // V001: per team, each mode in the order written; only after an
     // exhaustive search (a bounded one may stop before a mode's turn).
-    let mut judged: Vec<(&str, &str)> = Vec::new();
+    let mut judged: HashSet<(&str, &str)> = HashSet::new();
     for program in programs.iter().filter(|_| explored.exhaustive) {
         for mode in &program.control.modes {
-            if judged.contains(&(&program.team, &mode.name)) {
+            if !judged.insert((&program.team, &mode.name)) {
                 continue;
             }
-            judged.push((&program.team, &mode.name));
             if !explored
                 .entered
                 .contains(&(program.team.clone(), mode.name.clone()))
@@ -173,7 +192,7 @@ pub fn verify(programs: &[RobotProgram], file: FileId, text: &str, options: &Opt
                 findings.push(Diagnostic::new(
                     Code::ModeNeverEntered,
                     file,
-                    line_span(text, mode.line),
+                    line_span(text, &lines, mode.line),
                     format!(
                         "no robot of {} enters mode {} in any behaviour",
                         program.team, mode.name
@@ -191,7 +210,10 @@ pub fn verify(programs: &[RobotProgram], file: FileId, text: &str, options: &Opt
         let program = &programs[*r];
         let mode = mode.and_then(|m| program.control.modes.get(m));
         let (span, in_mode) = match mode {
-            Some(m) => (line_span(text, m.line), format!(" in mode {}", m.name)),
+            Some(m) => (
+                line_span(text, &lines, m.line),
+                format!(" in mode {}", m.name),
+            ),
             None => (Span { start: 0, end: 0 }, String::new()),
         };
         findings.push(Diagnostic::new(
@@ -227,7 +249,7 @@ pub fn verify(programs: &[RobotProgram], file: FileId, text: &str, options: &Opt
             state: *state,
         });
     }
-    Report {
+    Ok(Report {
         findings,
         counterexamples,
         claims,
@@ -248,66 +270,47 @@ pub fn verify(programs: &[RobotProgram], file: FileId, text: &str, options: &Opt
             entered.sort();
             entered
         },
-    }
+    })
 }
 
 /// Line `line` (1-based) of `text`, without its indentation.
-fn line_span(text: &str, line: u32) -> Span {
-    let mut start = 0;
-    for (n, l) in text.split_inclusive('\n').enumerate() {
-        if n + 1 == line as usize {
-            let body = l.trim_end();
-            let indent = body.len() - body.trim_start().len();
-            return Span {
-                start: start + indent,
-                end: start + body.len(),
-            };
-        }
-        start += l.len();
-    }
+fn line_span(text: &str, lines: &LineIndex, line: u32) -> Span {
+    let start = lines.line_start((line as usize).saturating_sub(1));
+    let end = lines.line_start(line as usize).min(text.len());
+    let body = &text[start..end];
+    let indent = body.len() - body.trim_start().len();
     Span {
-        start: text.len(),
-        end: text.len(),
+        start: start + indent.min(body.trim_end().len()),
+        end: start + body.trim_end().len(),
     }
 }
 
 impl Counterexample {
-    /// The choices of a path, each with the mission ms it was made at.
-    fn from_choices(path: &[(i64, Choice)], end_ms: i64, inputs: &Inputs) -> Counterexample {
-        let mut way = Counterexample {
-            sensors: Vec::new(),
-            commands: Vec::new(),
-            end_ms,
-            choices: path.to_vec(),
-        };
-        for (at, choice) in path {
+    /// The scenario (`docs/scenario-and-trace.md`) that replays the way:
+    /// `semo simulate` on it shows the finding at its end.
+    pub fn scenario_json(&self, inputs: &Inputs, robots: &[RobotProgram]) -> String {
+        // The sensor entries per robot, and the operator's commands, in
+        // the order the choices were made.
+        let mut sensors: Vec<Vec<(i64, &SensorInput, usize)>> = vec![Vec::new(); robots.len()];
+        let mut commands = Vec::new();
+        for (at, choice) in &self.choices {
+            let mut sensor = |s: usize, v: usize| {
+                let input = &inputs.sensors[s];
+                sensors[input.robot].push((*at, input, v));
+            };
             match choice {
                 Choice::Start(classes) => {
                     for (s, &v) in classes.iter().enumerate() {
-                        way.sensors.push(sensor_entry(inputs, *at, s, v));
+                        sensor(s, v);
                     }
                 }
-                Choice::Nothing => {}
-                Choice::Sensor { input, value } => {
-                    way.sensors.push(sensor_entry(inputs, *at, *input, *value))
-                }
+                Choice::Sensor { input, value } => sensor(*input, *value),
                 Choice::Command { input, value } => {
-                    let c = &inputs.commands[*input];
-                    way.commands.push((
-                        *at,
-                        c.to.clone(),
-                        c.value.clone(),
-                        c.values[*value].clone(),
-                    ));
+                    commands.push((*at, &inputs.commands[*input], *value))
                 }
+                Choice::Nothing => {}
             }
         }
-        way
-    }
-
-    /// The scenario (`docs/scenario-and-trace.md`) that replays the way:
-    /// `semo simulate` on it shows the finding at its end.
-    pub fn scenario_json(&self, robots: &[RobotProgram]) -> String {
         let mut out = String::new();
         let _ = write!(
             out,
@@ -315,12 +318,7 @@ impl Counterexample {
             self.end_ms
         );
         let mut first_robot = true;
-        for program in robots {
-            let entries: Vec<_> = self
-                .sensors
-                .iter()
-                .filter(|(_, r, ..)| *r == program.robot)
-                .collect();
+        for (program, entries) in robots.iter().zip(&sensors) {
             if entries.is_empty() {
                 continue;
             }
@@ -331,51 +329,36 @@ impl Counterexample {
                 json_string(&program.robot)
             );
             first_robot = false;
-            for (i, (at, _, value, is)) in entries.iter().enumerate() {
+            for (i, (at, input, v)) in entries.iter().enumerate() {
                 let _ = write!(
                     out,
                     "{}\n      {{\"at\": {at}, \"value\": {}, \"is\": {}}}",
                     if i == 0 { "" } else { "," },
-                    json_string(value),
-                    json_string(is)
+                    json_string(&input.port),
+                    json_string(&input.values[*v])
                 );
             }
             out.push_str("\n    ]}");
         }
         out.push_str(if first_robot { "},\n" } else { "\n  },\n" });
         out.push_str("  \"operator\": [");
-        for (i, (at, to, value, is)) in self.commands.iter().enumerate() {
+        for (i, (at, command, v)) in commands.iter().enumerate() {
             let _ = write!(
                 out,
                 "{}\n    {{\"at\": {at}, \"to\": {}, \"value\": {}, \"is\": {}}}",
                 if i == 0 { "" } else { "," },
-                json_string(to),
-                json_string(value),
-                json_string(is)
+                json_string(&command.to),
+                json_string(&command.value),
+                json_string(&command.values[*v])
             );
         }
-        out.push_str(if self.commands.is_empty() {
+        out.push_str(if commands.is_empty() {
             "]\n}\n"
         } else {
             "\n  ]\n}\n"
         });
         out
     }
-}
-
-fn sensor_entry(
-    inputs: &Inputs,
-    at: i64,
-    input: usize,
-    value: usize,
-) -> (i64, String, String, String) {
-    let s = &inputs.sensors[input];
-    (
-        at,
-        s.robot_name.clone(),
-        s.port.clone(),
-        s.values[value].clone(),
-    )
 }
 
 /// `text` as a JSON string.

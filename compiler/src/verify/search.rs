@@ -8,8 +8,8 @@
 
 use super::inputs::Inputs;
 use super::{Choice, Counterexample, Options};
-use crate::refine::{RobotProgram, StateKind};
-use crate::sim::{self, Scenario, Sim};
+use crate::refine::RobotProgram;
+use crate::sim::{self, Memory, Scenario, Sim};
 use std::collections::{HashMap, HashSet};
 
 /// What the search saw, for the properties to judge.
@@ -56,7 +56,7 @@ struct Node {
 
 pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) -> Explored {
     let scenario = Scenario::default();
-    let memory = memory_ms(programs);
+    let memory = Memory::of(programs);
     let root = Sim::new(programs, &scenario, &sim::Options::default());
     let mut explored = Explored {
         states: 0,
@@ -85,7 +85,7 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
         let mut sim = root.clone();
         let choice = Choice::Start(start.clone());
         apply(&mut sim, &mut start.clone(), inputs, &choice);
-        let fp = key(sim.fingerprint(memory), options.changes, 0, options);
+        let fp = key(sim.fingerprint(&memory), options.changes, 0, options);
         if !seen.contains_key(&fp) {
             let id = admit(&mut nodes, &mut seen, fp, &sim, None, choice, 0);
             frontier.push((id, sim, start, options.changes));
@@ -133,12 +133,10 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
                         && let Some(mode) = e.field("mode")
                     {
                         let team = &programs[e.robot].team;
-                        if !explored.entered.contains(&(team.clone(), mode.to_string())) {
-                            explored.entered.insert((team.clone(), mode.to_string()));
-                        }
+                        explored.entered.insert((team.clone(), mode.to_string()));
                     }
                 }
-                let fp = key(child.fingerprint(memory), changes, next_t, options);
+                let fp = key(child.fingerprint(&memory), changes, next_t, options);
                 let child_id = match seen.get(&fp) {
                     Some(&known) => {
                         edges.push((id, known));
@@ -175,8 +173,13 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
     explored.over_budget = over_budget;
     explored.cancelled = cancelled(options);
     if explored.exhaustive {
-        explored.stuck = stuck(programs.len(), &nodes, &edges, inputs, options.step_ms);
-        explored.waits_for_ever = waits_for_ever(&nodes, &edges, inputs, options.step_ms);
+        let graph = Graph {
+            nodes: &nodes,
+            into: reversed(nodes.len(), &edges),
+            step_ms: options.step_ms,
+        };
+        explored.stuck = graph.stuck(programs.len());
+        explored.waits_for_ever = graph.waits_for_ever();
     }
     explored
 }
@@ -217,23 +220,25 @@ fn admit(
     id
 }
 
-/// Every combination of the sensor inputs' first classes, the first
-/// combination first.
-pub fn start_classes(inputs: &Inputs) -> Vec<Vec<usize>> {
-    let mut all: Vec<Vec<usize>> = vec![Vec::new()];
-    for input in &inputs.sensors {
-        all = all
-            .into_iter()
-            .flat_map(|prefix| {
-                (0..input.values.len()).map(move |v| {
-                    let mut next = prefix.clone();
-                    next.push(v);
-                    next
-                })
-            })
-            .collect();
-    }
-    all
+/// Every combination of the sensor inputs' classes, the first classes
+/// first, made one at a time (there are exponentially many: the search
+/// takes what its budget allows).
+fn start_classes(inputs: &Inputs) -> impl Iterator<Item = Vec<usize>> + '_ {
+    let mut next = Some(vec![0; inputs.sensors.len()]);
+    std::iter::from_fn(move || {
+        let current = next.take()?;
+        // An odometer whose last input turns fastest.
+        let mut following = current.clone();
+        for s in (0..following.len()).rev() {
+            following[s] += 1;
+            if following[s] < inputs.sensors[s].values.len() {
+                next = Some(following);
+                break;
+            }
+            following[s] = 0;
+        }
+        Some(current)
+    })
 }
 
 fn cancelled(options: &Options) -> bool {
@@ -304,157 +309,106 @@ pub fn apply(sim: &mut Sim, classes: &mut [usize], inputs: &Inputs, choice: &Cho
 
 /// The choices from the start to node `id`, then `last` at `at`, the run
 /// ending at `end`.
-fn counterexample(
-    nodes: &[Node],
-    id: u32,
-    last: &Choice,
-    at: i64,
-    end: i64,
-    inputs: &Inputs,
-) -> Counterexample {
-    let mut path = vec![(at, last.clone())];
+fn counterexample(nodes: &[Node], id: u32, last: &Choice, at: i64, end: i64) -> Counterexample {
+    let mut choices = vec![(at, last.clone())];
     let mut here = Some(id);
     while let Some(n) = here {
         let node = &nodes[n as usize];
-        path.push((node.at, node.choice.clone()));
+        choices.push((node.at, node.choice.clone()));
         here = node.parent;
     }
-    path.reverse();
-    Counterexample::from_choices(&path, end, inputs)
+    choices.reverse();
+    Counterexample {
+        choices,
+        end_ms: end,
+    }
 }
 
-/// Per robot that finishes in some state: the first state (the shallowest)
-/// from which no state where it has finished can be reached.
-fn stuck(
-    robots: usize,
-    nodes: &[Node],
-    edges: &[(u32, u32)],
-    inputs: &Inputs,
-    step_ms: i64,
-) -> Vec<(usize, Counterexample, Option<usize>)> {
-    let mut into: Vec<Vec<u32>> = vec![Vec::new(); nodes.len()];
+/// Per state: the states with a step into it.
+fn reversed(states: usize, edges: &[(u32, u32)]) -> Vec<Vec<u32>> {
+    let mut into = vec![Vec::new(); states];
     for &(from, to) in edges {
         into[to as usize].push(from);
     }
-    let mut found = Vec::new();
-    for r in 0..robots {
-        // Backwards from every state where it has finished.
-        let mut can_finish = vec![false; nodes.len()];
-        let mut work: Vec<u32> = (0..nodes.len() as u32)
-            .filter(|&n| nodes[n as usize].finished[r])
+    into
+}
+
+/// The state graph of an exhaustive search, for the properties judged on
+/// every state's future.
+struct Graph<'a> {
+    nodes: &'a [Node],
+    /// Per state: the states with a step into it.
+    into: Vec<Vec<u32>>,
+    step_ms: i64,
+}
+
+impl Graph<'_> {
+    /// The states from which some state in `target` can be reached.
+    fn can_reach(&self, target: impl Fn(&Node) -> bool) -> Vec<bool> {
+        let mut reached: Vec<bool> = self.nodes.iter().map(target).collect();
+        let mut work: Vec<u32> = (0..self.nodes.len() as u32)
+            .filter(|&n| reached[n as usize])
             .collect();
-        if work.is_empty() {
-            continue;
-        }
-        for &n in &work {
-            can_finish[n as usize] = true;
-        }
         while let Some(n) = work.pop() {
-            for &p in &into[n as usize] {
-                if !can_finish[p as usize] {
-                    can_finish[p as usize] = true;
+            for &p in &self.into[n as usize] {
+                if !reached[p as usize] {
+                    reached[p as usize] = true;
                     work.push(p);
                 }
             }
         }
-        if let Some(n) = can_finish.iter().position(|c| !c) {
-            let node = &nodes[n];
-            let (parent, at) = (node.parent, node.at);
-            let path = match parent {
-                Some(p) => counterexample(nodes, p, &node.choice, at, at + step_ms, inputs),
-                None => Counterexample::from_choices(&[(0, node.choice.clone())], step_ms, inputs),
-            };
-            found.push((r, path, node.modes[r].map(usize::from)));
+        reached
+    }
+
+    /// The shortest way to state `n` (its state shows at the end).
+    fn way_to(&self, n: usize) -> Counterexample {
+        let node = &self.nodes[n];
+        match node.parent {
+            Some(p) => counterexample(self.nodes, p, &node.choice, node.at, node.at + self.step_ms),
+            None => Counterexample {
+                choices: vec![(0, node.choice.clone())],
+                end_ms: self.step_ms,
+            },
         }
     }
-    found
-}
 
-/// The states from which some state in `target` can be reached, over the
-/// state graph's edges reversed.
-fn can_reach(into: &[Vec<u32>], target: impl Fn(usize) -> bool) -> Vec<bool> {
-    let mut reached: Vec<bool> = (0..into.len()).map(&target).collect();
-    let mut work: Vec<u32> = (0..into.len() as u32)
-        .filter(|&n| reached[n as usize])
-        .collect();
-    while let Some(n) = work.pop() {
-        for &p in &into[n as usize] {
-            if !reached[p as usize] {
-                reached[p as usize] = true;
-                work.push(p);
+    /// Per robot that finishes in some state: the first state (the
+    /// shallowest) from which no state where it has finished can be reached.
+    fn stuck(&self, robots: usize) -> Vec<(usize, Counterexample, Option<usize>)> {
+        let mut found = Vec::new();
+        for r in 0..robots {
+            if !self.nodes.iter().any(|n| n.finished[r]) {
+                continue;
+            }
+            let can_finish = self.can_reach(|n| n.finished[r]);
+            if let Some(n) = can_finish.iter().position(|c| !c) {
+                let mode = self.nodes[n].modes[r].map(usize::from);
+                found.push((r, self.way_to(n), mode));
             }
         }
+        found
     }
-    reached
-}
 
-/// Per `receive` a robot waits in in some state: the first state (the
-/// shallowest) from which it waits there for ever, if any.
-fn waits_for_ever(
-    nodes: &[Node],
-    edges: &[(u32, u32)],
-    inputs: &Inputs,
-    step_ms: i64,
-) -> Vec<((usize, usize, usize), Counterexample)> {
-    let mut into: Vec<Vec<u32>> = vec![Vec::new(); nodes.len()];
-    for &(from, to) in edges {
-        into[to as usize].push(from);
-    }
-    let mut receives: Vec<(u32, u32, u32)> = nodes
-        .iter()
-        .flat_map(|n| n.waiting.iter().copied())
-        .collect();
-    receives.sort_unstable();
-    receives.dedup();
-    let mut found = Vec::new();
-    for w in receives {
-        // It leaves from a state where it does not wait there, or from
-        // which it acts in some step (the step may take it through the
-        // `receive` and back between two looks).
-        let leaves = can_reach(&into, |n| {
-            !nodes[n].waiting.contains(&w) || nodes[n].moved.contains(&w.0)
-        });
-        if let Some(n) = (0..nodes.len()).find(|&n| !leaves[n]) {
-            let node = &nodes[n];
-            let way = match node.parent {
-                Some(p) => {
-                    counterexample(nodes, p, &node.choice, node.at, node.at + step_ms, inputs)
-                }
-                None => Counterexample::from_choices(&[(0, node.choice.clone())], step_ms, inputs),
-            };
-            found.push(((w.0 as usize, w.1 as usize, w.2 as usize), way));
-        }
-    }
-    found
-}
-
-/// How long ago a time can still matter: longer than every period,
-/// timeout and heartbeat the programs compare against.
-fn memory_ms(programs: &[RobotProgram]) -> i64 {
-    let mut longest = 1000;
-    for program in programs {
-        let m = &program.control;
-        longest = longest.max(4 * m.heartbeat_ms);
-        for mode in &m.modes {
-            for region in &mode.regions {
-                longest = longest.max(region.timeout_ms.unwrap_or(0));
+    /// Per `receive` a robot waits in in some state: the first state (the
+    /// shallowest) from which it waits there for ever, if any.
+    fn waits_for_ever(&self) -> Vec<((usize, usize, usize), Counterexample)> {
+        let mut receives: Vec<(u32, u32, u32)> = self
+            .nodes
+            .iter()
+            .flat_map(|n| n.waiting.iter().copied())
+            .collect();
+        receives.sort_unstable();
+        receives.dedup();
+        let mut found = Vec::new();
+        for w in receives {
+            // It leaves from a state where it does not wait there, or from
+            // which it acts in some step (the step may take it through the
+            // `receive` and back between two looks).
+            let leaves = self.can_reach(|n| !n.waiting.contains(&w) || n.moved.contains(&w.0));
+            if let Some(n) = leaves.iter().position(|l| !l) {
+                found.push(((w.0 as usize, w.1 as usize, w.2 as usize), self.way_to(n)));
             }
         }
-        for service in &m.services {
-            for state in &service.states {
-                let t = match &state.kind {
-                    StateKind::Receive { timeout_ms, .. }
-                    | StateKind::Call { timeout_ms, .. }
-                    | StateKind::RunActions { timeout_ms, .. } => timeout_ms.unwrap_or(0),
-                    StateKind::GroupSync { timeout_ms, .. } => *timeout_ms,
-                    StateKind::LoopTail { period_ms, .. } | StateKind::Repeat { period_ms, .. } => {
-                        period_ms.unwrap_or(0)
-                    }
-                    _ => 0,
-                };
-                longest = longest.max(t);
-            }
-        }
+        found
     }
-    2 * longest + 1000
 }

@@ -7,16 +7,18 @@
 //! Two states are the same when everything that decides what happens next
 //! is equal: every robot's slots, regions, channels, elections and pending
 //! events, with each time taken relative to now. A time further in the past
-//! than `memory` (longer than every period, timeout and heartbeat the
-//! programs compare against) is the same as any older one, so a mission
-//! that repeats itself reaches a state it has been in before and the search
-//! ends. What only the trace shows (how many messages a channel dropped,
-//! the ids of events) is left out.
+//! than [`Memory`] says (longer than every period, timeout and heartbeat the
+//! programs compare against) is the same as any older one, and a time no
+//! period or timeout reads is left out, so a mission that repeats itself
+//! reaches a state it has been in before and the search ends. What only the
+//! trace shows (how many messages a channel dropped, the ids of events) is
+//! left out too.
 
-use super::{Event, Held, Message, Robot, Sim};
-use crate::refine::{SlotSource, StateKind};
+use super::{Event, Held, Message, Robot, SENSOR_PERIOD_MS, Sim};
+use crate::refine::value::Value;
+use crate::refine::{RobotProgram, ServiceMachine, SlotSource, StateKind};
 use crate::sim::scenario::Command;
-use crate::sim::trace::{TraceEvent, write_value};
+use crate::sim::trace::TraceEvent;
 use std::cmp::Reverse;
 use std::hash::{DefaultHasher, Hasher};
 
@@ -122,12 +124,12 @@ impl<'p> Sim<'p> {
 
     /// The state, as a 128-bit hash of what decides the rest of the run
     /// (see the module's comment): equal states give equal fingerprints.
-    pub fn fingerprint(&self, memory: i64) -> u128 {
+    pub fn fingerprint(&self, memory: &Memory) -> u128 {
         // The last firing handled (`last_fire`) is left out: it decides
         // only a firing at its own instant, which is past at a step.
-        let mut fp = Fingerprint::new(self.now, memory);
-        for robot in &self.robots {
-            fp.robot(robot);
+        let mut fp = Fingerprint::new(self.now, memory.ms);
+        for (robot, timed) in self.robots.iter().zip(&memory.timed) {
+            fp.robot(robot, timed);
         }
         // The events still to come, in the order they will be handled;
         // those a robot will ignore (an earlier life's, a firing moved
@@ -189,9 +191,52 @@ impl<'p> Sim<'p> {
     }
 }
 
+/// Which times of a run the programs read, computed once for a search (the
+/// fingerprint is taken at every step of it).
+pub struct Memory {
+    /// How long ago a time can still matter: longer than every period,
+    /// timeout and heartbeat the programs compare against.
+    ms: i64,
+    /// Per robot, per service of its program: the times its regions read.
+    timed: Vec<Vec<Timed>>,
+}
+
+impl Memory {
+    pub fn of(programs: &[RobotProgram]) -> Memory {
+        let mut longest = 1000;
+        for program in programs {
+            let m = &program.control;
+            longest = longest.max(4 * m.heartbeat_ms);
+            for region in m.modes.iter().flat_map(|mode| &mode.regions) {
+                longest = longest.max(region.timeout_ms.unwrap_or(0));
+            }
+            for state in m.services.iter().flat_map(|s| &s.states) {
+                let t = match &state.kind {
+                    StateKind::Receive { timeout_ms, .. }
+                    | StateKind::Call { timeout_ms, .. }
+                    | StateKind::RunActions { timeout_ms, .. } => timeout_ms.unwrap_or(0),
+                    StateKind::GroupSync { timeout_ms, .. } => *timeout_ms,
+                    StateKind::LoopTail { period_ms, .. } | StateKind::Repeat { period_ms, .. } => {
+                        period_ms.unwrap_or(0)
+                    }
+                    _ => 0,
+                };
+                longest = longest.max(t);
+            }
+        }
+        Memory {
+            ms: 2 * longest + 1000,
+            timed: programs
+                .iter()
+                .map(|p| p.control.services.iter().map(Timed::of).collect())
+                .collect(),
+        }
+    }
+}
+
 /// Which times of a region running a service are compared with a period
 /// or a timeout.
-#[derive(Default)]
+#[derive(Clone, Copy, Default)]
 struct Timed {
     /// The start of its pass (`repeat(P)`).
     pass: bool,
@@ -200,7 +245,7 @@ struct Timed {
 }
 
 impl Timed {
-    fn of(service: &crate::refine::ServiceMachine) -> Timed {
+    fn of(service: &ServiceMachine) -> Timed {
         let mut timed = Timed::default();
         for state in &service.states {
             match &state.kind {
@@ -260,10 +305,32 @@ impl Fingerprint {
         self.b.write(s.as_bytes());
     }
 
+    /// A value by its kind and content (no text made: this runs for every
+    /// value at every step).
     fn held(&mut self, v: &Held) {
-        let mut out = String::new();
-        write_value(&mut out, v.as_ref());
-        self.text(&out);
+        match v {
+            None => self.int(-1),
+            Some(Value::Int(i)) => {
+                self.int(0);
+                self.int(*i);
+            }
+            Some(Value::Real(r)) => {
+                self.int(1);
+                self.int(r.to_bits() as i64);
+            }
+            Some(Value::Bool(b)) => {
+                self.int(2);
+                self.int(*b as i64);
+            }
+            Some(Value::Word(w)) => {
+                self.int(3);
+                self.text(w);
+            }
+            Some(Value::Text(t)) => {
+                self.int(4);
+                self.text(t);
+            }
+        }
     }
 
     fn message(&mut self, m: &Message) {
@@ -276,14 +343,16 @@ impl Fingerprint {
         self.time(m.sent_at);
     }
 
-    fn robot(&mut self, robot: &Robot) {
+    /// Robot `robot`, whose services read the times `timed` says.
+    fn robot(&mut self, robot: &Robot, timed: &[Timed]) {
         self.int(robot.alive as i64);
         if !robot.alive {
             return;
         }
         self.time(robot.started_at);
-        // The grids of its firings and samples run from its start.
-        self.int((self.now - robot.started_at).rem_euclid(1000));
+        // The grids of its firings (10 ms) and samples (100 ms) run from
+        // its start: where now falls on them.
+        self.int((self.now - robot.started_at).rem_euclid(SENSOR_PERIOD_MS));
         for v in robot.slots.iter().chain(&robot.library) {
             self.held(v);
         }
@@ -330,10 +399,7 @@ impl Fingerprint {
             if region.timeout_ms > 0 {
                 self.time(region.started);
             }
-            let timed = region
-                .service
-                .map(|s| Timed::of(&robot.program.control.services[s]))
-                .unwrap_or_default();
+            let timed = region.service.map(|s| timed[s]).unwrap_or_default();
             if timed.pass {
                 self.time(region.pass_start);
             }
@@ -400,7 +466,7 @@ impl Fingerprint {
                 None => self.int(-1),
                 Some((at, v)) => {
                     // Once a sample period has passed, every sample reads it.
-                    self.int((at - self.now).max(-2 * super::SENSOR_PERIOD_MS));
+                    self.int((at - self.now).max(-2 * SENSOR_PERIOD_MS));
                     self.held(v);
                 }
             }
