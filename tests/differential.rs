@@ -237,6 +237,26 @@ fn a_restarted_leader_comes_back_the_same_way_in_c_and_in_the_simulator() {
     );
 }
 
+/// The leader cut off from the majority (a partition, applied on the UDP
+/// send path in C): tb_0 is fenced while tb_1 and tb_2 elect tb_1, then
+/// healed it follows tb_1 until tb_1 gives way (docs/groups.md, "Fencing"),
+/// in both, at the same instants.
+#[test]
+fn a_leader_cut_off_is_fenced_the_same_way_in_c_and_in_the_simulator() {
+    let (processes, _) = compare(
+        "patrol_groups_partition",
+        &examples().join("swarm/patrol_groups.mission"),
+        r#"{"time_scale": 1, "duration": 6000,
+            "faults": [{"from": 1200, "until": 3000, "partition": [["tb_0"], ["tb_1", "tb_2", "ev_0", "ev_1"]]}]}"#,
+    );
+    let fenced: Vec<&str> = processes["tb_0"]
+        .iter()
+        .filter(|e| field(e, "event") == "fenced")
+        .map(|e| field(e, "heard"))
+        .collect();
+    assert_eq!(fenced, ["1 of 3"]);
+}
+
 /// A leader killed after the operator's commands (`tests/fixtures/semantics/
 /// leader_commands.mission`): the new leader drops the commands sent before
 /// it led, in both, at the same instant (`docs/groups.md`).

@@ -5,6 +5,7 @@ pub mod cc;
 pub mod missiongen;
 pub mod mosquitto;
 pub mod mqtt;
+pub mod proxy;
 pub mod robots;
 
 use std::path::{Path, PathBuf};

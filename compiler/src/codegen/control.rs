@@ -30,6 +30,22 @@ pub fn listen_ms(heartbeat_ms: i64) -> i64 {
     heartbeat_ms + heartbeat_ms / 2
 }
 
+/// A leader's lease (`docs/groups.md`, "Fencing"): a robot the election
+/// would choose leads only while it has heard a strict majority of the
+/// candidates, itself included, within the last two heartbeat periods. Two
+/// is less than the three silent periods after which the others count it
+/// lost, so a leader cut off from the majority steps down at its first
+/// election after its lease lapsed, before they elect another (at their
+/// first election after three). The simulator uses the same.
+pub fn lease_ms(heartbeat_ms: i64) -> i64 {
+    2 * heartbeat_ms
+}
+
+/// The `heard` field of the `fenced` event: "2 of 5".
+pub fn fenced_heard(heard: usize, candidates: usize) -> String {
+    format!("{heard} of {candidates}")
+}
+
 /// The `reason` of the `drop` event of a message dropped because it arrived
 /// before its robot became the leader of the `leader(...)` arm whose block
 /// receives it (`drop_unled`). The simulator uses the same.
@@ -49,7 +65,7 @@ const DROP_UNLED_C: &str = "/* Drops the messages a channel holds now (they arri
 /// live robot claims leadership it follows that robot instead of claiming:
 /// the claimant gives way at its own next election, so that two robots never
 /// both lead after a restart.
-const ELECTION_C: &str = "/* Leader elections: each `leader(...)` arm's candidates (peer indices, in\n * formation order) and algorithm. A candidate is alive when it is this\n * robot or was heard from within three heartbeats. lowest_id: the first\n * alive; bully: the last alive (the highest id); highest_battery: the\n * highest battery level its heartbeat said (unknown counts lowest; ties: the\n * first), after every robot has listened at start. A robot that joined the\n * mission under way (restarted) listens too, and while another live robot\n * claims leadership it follows that one instead of claiming. A change of\n * leader is traced. Returns 1 (this robot leads), 0, or -1 while listening. */\nenum { ELECT_LOWEST_ID, ELECT_HIGHEST_BATTERY, ELECT_BULLY };\nstatic int elected(const size_t *candidates, size_t n, int algorithm, long *last)\n{\n    static int rejoining = -1;\n    const semo_program_desc *p = semo_program();\n    int64_t now = semo_now_ms();\n    if (rejoining < 0)\n        rejoining = semo_joined_ms() > @HB@ || semo_session_resumed();\n    if ((rejoining || algorithm == ELECT_HIGHEST_BATTERY) && now - semo_joined_ms() < @LISTEN@) {\n        wake_at(semo_joined_ms() + @LISTEN@);\n        return -1;\n    }\n    size_t leader = p->self;\n    bool found = false;\n    long best = -1;\n    for (size_t k = 0; k < n; k++) {\n        size_t c = candidates[algorithm == ELECT_BULLY ? n - 1 - k : k];\n        comm_heartbeat h = comm_heard(c);\n        if (c != p->self && now - h.seen > 3 * @HB@)\n            continue;\n        long level = c == p->self ? own_battery() : h.battery;\n        if (!found || (algorithm == ELECT_HIGHEST_BATTERY && level > best)) {\n            leader = c;\n            best = level;\n            found = true;\n        }\n        if (algorithm != ELECT_HIGHEST_BATTERY)\n            break;\n    }\n    if (rejoining && leader == p->self) {\n        for (size_t i = 0; i < p->peer_count; i++) {\n            comm_heartbeat h = comm_heard(i);\n            if (i != p->self && h.leads && now - h.seen <= 3 * @HB@) {\n                leader = i;\n                break;\n            }\n        }\n        if (leader == p->self)\n            rejoining = 0;\n    }\n    leading = leader == p->self;\n    if ((long)leader != *last) {\n        *last = (long)leader;\n        semo_trace(\"leader\", \"leader\", p->peers[leader].robot, NULL);\n    }\n    return leading;\n}\n";
+const ELECTION_C: &str = "/* Leader elections: each `leader(...)` arm's candidates (peer indices, in\n * formation order) and algorithm. A candidate is alive when it is this\n * robot or was heard from within three heartbeats. lowest_id: the first\n * alive; bully: the last alive (the highest id); highest_battery: the\n * highest battery level its heartbeat said (unknown counts lowest; ties: the\n * first), after every robot has listened at start. A robot that joined the\n * mission under way (restarted) listens too, and while another live robot\n * claims leadership it follows that one instead of claiming. A change of\n * leader is traced. Fencing: a robot the election would choose leads only\n * while its lease holds, a strict majority of the candidates (itself\n * included) heard from within the lease; without one it is fenced (traced\n * once), waits, and then rejoins as a restarted robot does. Returns 1 (this\n * robot leads), 0, or -1 while listening or fenced. */\nenum { ELECT_LOWEST_ID, ELECT_HIGHEST_BATTERY, ELECT_BULLY };\n/* `*last` of an arm whose robot is fenced (no robot has index -2). */\n#define ELECT_FENCED (-2L)\nstatic int elected(const size_t *candidates, size_t n, int algorithm, long *last)\n{\n    static int rejoining = -1;\n    const semo_program_desc *p = semo_program();\n    int64_t now = semo_now_ms();\n    if (rejoining < 0)\n        rejoining = semo_joined_ms() > @HB@ || semo_session_resumed();\n    if ((rejoining || algorithm == ELECT_HIGHEST_BATTERY) && now - semo_joined_ms() < @LISTEN@) {\n        wake_at(semo_joined_ms() + @LISTEN@);\n        return -1;\n    }\n    size_t leader = p->self;\n    bool found = false;\n    long best = -1;\n    for (size_t k = 0; k < n; k++) {\n        size_t c = candidates[algorithm == ELECT_BULLY ? n - 1 - k : k];\n        comm_heartbeat h = comm_heard(c);\n        if (c != p->self && now - h.seen > 3 * @HB@)\n            continue;\n        long level = c == p->self ? own_battery() : h.battery;\n        if (!found || (algorithm == ELECT_HIGHEST_BATTERY && level > best)) {\n            leader = c;\n            best = level;\n            found = true;\n        }\n        if (algorithm != ELECT_HIGHEST_BATTERY)\n            break;\n    }\n    if (rejoining && leader == p->self) {\n        for (size_t i = 0; i < p->peer_count; i++) {\n            comm_heartbeat h = comm_heard(i);\n            if (i != p->self && h.leads && now - h.seen <= 3 * @HB@) {\n                leader = i;\n                break;\n            }\n        }\n    }\n    if (leader == p->self) {\n        size_t heard = 0;\n        for (size_t k = 0; k < n; k++)\n            if (candidates[k] == p->self || now - comm_heard(candidates[k]).seen <= @LEASE@)\n                heard++;\n        if (2 * heard <= n) {\n            leading = false;\n            rejoining = 1;\n            if (*last != ELECT_FENCED) {\n                char counted[48];\n                snprintf(counted, sizeof counted, \"%lu of %lu\", (unsigned long)heard, (unsigned long)n);\n                *last = ELECT_FENCED;\n                semo_trace(\"fenced\", \"heard\", counted, NULL);\n            }\n            /* Heartbeats heard wake nothing: ask again at the next firing\n             * of the period, as the simulator does at a waiting election. */\n            wake_at(now + 1);\n            return -1;\n        }\n        rejoining = 0;\n    }\n    leading = leader == p->self;\n    if ((long)leader != *last) {\n        *last = (long)leader;\n        semo_trace(\"leader\", \"leader\", p->peers[leader].robot, NULL);\n    }\n    return leading;\n}\n";
 
 /// At each heartbeat of a member of its team's group (group services,
 /// `docs/groups.md`): its rank among the live members (formation order) and
@@ -331,7 +347,8 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
         out.push_str(
             &ELECTION_C
                 .replace("@HB@", &m.heartbeat_ms.to_string())
-                .replace("@LISTEN@", &listen_ms(m.heartbeat_ms).to_string()),
+                .replace("@LISTEN@", &listen_ms(m.heartbeat_ms).to_string())
+                .replace("@LEASE@", &lease_ms(m.heartbeat_ms).to_string()),
         );
         out.push('\n');
     }

@@ -19,7 +19,7 @@
 mod battery;
 mod c;
 mod control;
-pub use control::{UNLED_REASON, listen_ms};
+pub use control::{UNLED_REASON, fenced_heard, lease_ms, listen_ms};
 pub(crate) mod files;
 mod loops;
 pub use loops::GRAPH_TEXT_MAX;

@@ -1951,8 +1951,10 @@ impl<'p> Sim<'p> {
     /// candidates (this robot, or heard from within three heartbeats) the
     /// algorithm's choice; a robot that must listen first (restarted, or a
     /// `highest_battery` election) answers `None` until it has; a rejoining
-    /// robot follows a live claimant instead of claiming. A change of leader
-    /// is traced.
+    /// robot follows a live claimant instead of claiming. Fenced: a robot
+    /// the election would choose that has not heard a majority of the
+    /// candidates within its lease ([`crate::codegen::lease_ms`]) answers
+    /// `None`, traced once, and rejoins after. A change of leader is traced.
     fn elected(
         &mut self,
         r: usize,
@@ -1989,17 +1991,34 @@ impl<'p> Sim<'p> {
             }
         };
         let mut leader = chosen.unwrap_or(me);
-        let mut rejoining = robot.rejoining;
-        if rejoining && leader == me {
+        if robot.rejoining && leader == me {
             let claimant = (0..robot.heard.len())
                 .find(|&i| i != me && robot.heard[i].leads && now - robot.heard[i].seen <= 3 * hb);
-            match claimant {
-                Some(c) => leader = c,
-                None => rejoining = false,
+            if let Some(c) = claimant {
+                leader = c;
             }
         }
+        if leader == me {
+            // Fencing: without a majority heard within its lease this robot
+            // may be the one cut off; it waits, and rejoins after.
+            let lease = crate::codegen::lease_ms(hb);
+            let heard = candidates
+                .iter()
+                .filter(|&&c| c == me || now - robot.heard[c].seen <= lease)
+                .count();
+            let robot = &mut self.robots[r];
+            robot.leading = false;
+            if 2 * heard <= candidates.len() {
+                robot.rejoining = true;
+                if robot.leaders.insert(state, FENCED) != Some(FENCED) {
+                    let counted = crate::codegen::fenced_heard(heard, candidates.len());
+                    self.emit(r, "fenced", vec![("heard", counted.into())]);
+                }
+                return None;
+            }
+            robot.rejoining = false;
+        }
         let robot = &mut self.robots[r];
-        robot.rejoining = rejoining;
         robot.leading = leader == me;
         if robot.leaders.get(&state) != Some(&leader) {
             robot.leaders.insert(state, leader);
@@ -2009,6 +2028,10 @@ impl<'p> Sim<'p> {
         Some(leader == me)
     }
 }
+
+/// The last leader of an arm whose robot is fenced (`ELECT_FENCED` in the C):
+/// no peer has this index.
+const FENCED: usize = usize::MAX;
 
 /// What a robot's last heartbeat said (`comm_heartbeat` in the C).
 #[derive(Clone, Copy, Debug)]

@@ -187,17 +187,106 @@ fn a_killed_leader_is_replaced_and_a_restarted_one_leads_again() {
     assert!(claimed >= 3000 + listen, "claimed at {claimed}");
 }
 
+#[test]
+fn a_leader_cut_off_from_the_majority_steps_down_before_the_others_elect() {
+    let programs = programs("examples/swarm/patrol_groups.mission");
+    let hb = crate::refine::HEARTBEAT_MS;
+    // tb_0 leads; from 1200 to 3000 ms it reaches none of the others.
+    let (run_, _) = run(
+        &programs,
+        r#"{"duration": 6000, "faults": [{"from": 1200, "until": 3000, "partition": [["tb_0"], ["tb_1", "tb_2", "ev_0", "ev_1"]]}]}"#,
+        0,
+    );
+    let at = |robot: &str, event: &str, leader: Option<&str>| {
+        let r = run_.robots.iter().position(|(_, n)| n == robot).unwrap();
+        run_.trace
+            .iter()
+            .find(|e| {
+                e.robot == r
+                    && e.event == event
+                    && (leader.is_none() || e.field("leader") == leader)
+            })
+            .map(|e| e.t)
+    };
+    let fenced = at("tb_0", "fenced", None).expect("tb_0 steps down");
+    let took_over = at("tb_1", "leader", Some("tb_1")).expect("tb_1 takes over");
+    // tb_0's lease lapses two heartbeats after the last it heard; the
+    // others count it lost after three.
+    assert!(
+        fenced > 1200 + crate::codegen::lease_ms(hb) - hb,
+        "fenced at {fenced}"
+    );
+    assert!(
+        fenced <= took_over,
+        "fenced at {fenced}, tb_1 led at {took_over}"
+    );
+    assert!(took_over > 1200 + 3 * hb - hb, "took over at {took_over}");
+    let tb_0 = run_.robots.iter().position(|(_, n)| n == "tb_0").unwrap();
+    let heard = run_
+        .trace
+        .iter()
+        .find(|e| e.robot == tb_0 && e.event == "fenced");
+    assert_eq!(heard.and_then(|e| e.field("heard")), Some("1 of 3"));
+    // Healed, tb_0 follows tb_1 until tb_1 gives way, then leads again.
+    assert_eq!(leaders(&run_, "tb_0"), ["tb_0", "tb_1", "tb_0"]);
+    assert_eq!(leaders(&run_, "tb_1"), ["tb_0", "tb_1", "tb_0"]);
+    assert_eq!(two_leaders(&run_), None);
+
+    // Without fencing (the lease as long as the others' patience) tb_0
+    // would have kept leading while tb_1 led: the check above can fail.
+    let lights = |robot: &str, from: i64, until: i64| {
+        let r = run_.robots.iter().position(|(_, n)| n == robot).unwrap();
+        run_.trace
+            .iter()
+            .filter(|e| e.robot == r && e.event == "call_start" && (from..until).contains(&e.t))
+            .filter(|e| e.field("service") == Some("light_on"))
+            .count()
+    };
+    assert_eq!(
+        lights("tb_0", fenced, 3000),
+        0,
+        "a fenced robot runs no leader's block"
+    );
+    assert!(lights("tb_1", took_over, 3000) >= 1);
+}
+
+#[test]
+fn a_robot_left_alone_of_three_candidates_never_leads() {
+    // Two of patrol_groups' three TurtleBots are killed: the survivor hears
+    // one of three and never leads (it cannot tell whether it is the one
+    // cut off).
+    let programs = programs("examples/swarm/patrol_groups.mission");
+    let (run_, _) = run(
+        &programs,
+        r#"{"duration": 3000, "faults": [{"at": 1000, "kill": "tb_1"}, {"at": 1000, "kill": "tb_0"}]}"#,
+        0,
+    );
+    let tb_2 = run_.robots.iter().position(|(_, n)| n == "tb_2").unwrap();
+    let fenced: Vec<_> = run_
+        .trace
+        .iter()
+        .filter(|e| e.robot == tb_2 && e.event == "fenced")
+        .map(|e| e.field("heard").unwrap().to_string())
+        .collect();
+    assert_eq!(fenced, ["1 of 3"]);
+    assert_eq!(leaders(&run_, "tb_2"), ["tb_0"]);
+}
+
 /// The first instant two live robots both lead by their own traces (a
-/// robot leads from its `leader` event naming itself until another one, or
-/// until it is killed), with the two robots.
+/// robot leads from its `leader` event naming itself until another one, a
+/// `fenced`, or until it is killed), with the two robots. Judged at the end
+/// of each instant: within one, the robots' events have no order.
 fn two_leaders(run: &Run) -> Option<(i64, String, String)> {
     let mut leading: Vec<bool> = vec![false; run.robots.len()];
-    for e in &run.trace {
+    for (i, e) in run.trace.iter().enumerate() {
         let me = &run.robots[e.robot].1;
         match e.event {
             "leader" => leading[e.robot] = e.field("leader") == Some(me.as_str()),
-            "fault" | "start" => leading[e.robot] = false,
-            _ => continue,
+            "fault" | "start" | "fenced" => leading[e.robot] = false,
+            _ => {}
+        }
+        if run.trace.get(i + 1).is_some_and(|next| next.t == e.t) {
+            continue;
         }
         let both: Vec<&String> = (0..leading.len())
             .filter(|&r| leading[r])

@@ -903,6 +903,8 @@ static void observe_status(const char *event, va_list args)
         copy_name(g_status.mode, pair_value(args, "mode"));
     } else if (strcmp(event, "leader") == 0) {
         copy_name(g_status.leader, pair_value(args, "leader"));
+    } else if (strcmp(event, "fenced") == 0) {
+        g_status.leader[0] = '\0'; /* it knows no leader until it hears a majority */
     } else if (strcmp(event, "service_start") == 0 || strcmp(event, "service_end") == 0) {
         const char *plan = pair_value(args, "plan");
         size_t i = 0;
