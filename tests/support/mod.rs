@@ -36,6 +36,17 @@ pub struct Output {
     pub stderr: String,
 }
 
+impl Output {
+    /// A finished process's status and output, as text.
+    fn of(out: std::process::Output) -> Output {
+        Output {
+            code: out.status.code().unwrap_or(-1),
+            stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+            stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+        }
+    }
+}
+
 /// Runs `semo ARGS` in `dir`.
 pub fn semo_in(dir: &Path, args: &[&str]) -> Output {
     let out = Command::new(env!("CARGO_BIN_EXE_semo"))
@@ -44,30 +55,28 @@ pub fn semo_in(dir: &Path, args: &[&str]) -> Output {
         .env("NO_COLOR", "1")
         .output()
         .expect("the semo binary runs");
-    Output {
-        code: out.status.code().unwrap_or(-1),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
+    Output::of(out)
 }
 
 /// `semo simulate MISSION --scenario SCENARIO --engine ENGINE --trace -`
 /// (`sim`: the simulator; `c`: the generated programs in lock-step): the
-/// run, its trace on standard output.
+/// run, its trace on standard output. The C is compiled at `-O1` (the
+/// Makefile's `CFLAGS`), not the default `-O2`: what these tests compare is
+/// the programs' meaning, which no optimization level may change, and `-O1`
+/// halves gcc's time, most of theirs. `tests/build.rs` compiles every
+/// example at the default level with warnings as errors, and the
+/// sanitizer tests run optimized programs.
 pub fn simulate_trace(mission: &Path, scenario: &Path, engine: &str) -> Output {
-    semo_in(
-        &repo_root(),
-        &[
-            "simulate",
-            &mission.display().to_string(),
-            "--scenario",
-            &scenario.display().to_string(),
-            "--engine",
-            engine,
-            "--trace",
-            "-",
-        ],
-    )
+    let out = Command::new(env!("CARGO_BIN_EXE_semo"))
+        .args(["simulate", &mission.display().to_string()])
+        .args(["--scenario", &scenario.display().to_string()])
+        .args(["--engine", engine, "--trace", "-"])
+        .current_dir(repo_root())
+        .env("NO_COLOR", "1")
+        .env("CFLAGS", "-std=c11 -Wall -Wextra -O1")
+        .output()
+        .expect("the semo binary runs");
+    Output::of(out)
 }
 
 /// Runs `semo ARGS` in `dir` with `input` on its standard input.
@@ -95,11 +104,7 @@ pub fn semo_with_stdin(dir: &Path, args: &[&str], input: &str) -> Output {
         written => written.expect("write stdin"),
     }
     let out = child.wait_with_output().expect("semo finishes");
-    Output {
-        code: out.status.code().unwrap_or(-1),
-        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-    }
+    Output::of(out)
 }
 
 pub fn semo(args: &[&str]) -> Output {
