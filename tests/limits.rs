@@ -7,9 +7,10 @@
 //! "At once and in bounded memory" is held by running `semo` under `ulimit`
 //! bounds far above what any check needs and far below what these inputs took
 //! before their limits (gigabytes, minutes): past a bound the process is
-//! killed, and the test sees it. "In proportion" compares the CPU time of two
-//! sizes ten times apart, best of three, against a bound of thirty: a
-//! quadratic path costs a hundred times more there, a linear one ten.
+//! killed, and the test sees it. "In proportion" counts the instructions
+//! (valgrind's callgrind) that two sizes ten times apart add to the empty
+//! input's, against a bound of twelve: a quadratic path adds a hundred
+//! times more there, a linear one ten.
 
 mod support;
 
@@ -58,54 +59,63 @@ fn check_bounded(dir: &Path, paths: &[&str]) -> (i32, Vec<Diag>) {
     (out.code, parse_json_report(&out.stdout))
 }
 
-/// The CPU time (user and system, seconds) of `semo ARGS` in `dir`, the
-/// best of three runs: the shell's `times` reports its children's.
-fn cpu_seconds(dir: &Path, args: &[&str]) -> f64 {
-    let script = "\"$@\" >/dev/null 2>&1; times";
-    (0..3)
-        .map(|_| {
-            let out = std::process::Command::new("sh")
-                .arg("-c")
-                .arg(script)
-                .arg("sh")
-                .arg(env!("CARGO_BIN_EXE_semo"))
-                .args(args)
-                .current_dir(dir)
-                .output()
-                .expect("sh runs");
-            let times = String::from_utf8_lossy(&out.stdout).into_owned();
-            // Two lines, the shell's own times then its children's:
-            // `0m1.250s 0m0.031s`.
-            let children = times.lines().nth(1).expect("the children's times");
-            children.split_whitespace().map(minutes_seconds).sum()
-        })
-        .fold(f64::INFINITY, f64::min)
+/// The instructions `semo ARGS` runs in `dir`, counted by valgrind's
+/// callgrind: a count of work that no clock, load or cache disturbs. `None`
+/// when valgrind is missing (skipped with a message unless
+/// `SEMO_VALGRIND_TESTS=require`, as CI sets).
+fn instructions(dir: &Path, args: &[&str]) -> Option<u64> {
+    let out = std::process::Command::new("valgrind")
+        .args(["--tool=callgrind", "--callgrind-out-file=/dev/null"])
+        .arg(env!("CARGO_BIN_EXE_semo"))
+        .args(args)
+        .current_dir(dir)
+        .output();
+    let out = match out {
+        Ok(out) => out,
+        Err(e) if std::env::var("SEMO_VALGRIND_TESTS").as_deref() == Ok("require") => {
+            panic!("valgrind is required (SEMO_VALGRIND_TESTS=require): {e}")
+        }
+        Err(e) => {
+            eprintln!("skipped: valgrind cannot run ({e}); install Debian's valgrind");
+            return None;
+        }
+    };
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    // `==123== Collected : 87021202`
+    let collected = stderr
+        .lines()
+        .find_map(|line| line.split_once("Collected :"))
+        .map(|(_, n)| n.trim().parse().expect("a count"));
+    Some(collected.unwrap_or_else(|| panic!("no count from callgrind: {stderr}")))
 }
 
-/// `1m2.500s` in seconds.
-fn minutes_seconds(time: &str) -> f64 {
-    let (minutes, seconds) = time
-        .trim_end_matches('s')
-        .split_once('m')
-        .expect("a time like 0m1.250s");
-    minutes.parse::<f64>().unwrap() * 60.0 + seconds.parse::<f64>().unwrap()
-}
-
-/// Asserts that `semo ARGS` on the input `write(dir, n)` makes costs in
-/// proportion to `n`: ten times the input, at most thirty times the time.
+/// Asserts that `semo ARGS` on the input `write(dir, n)` costs in
+/// proportion to `n`: what ten times the input adds to the empty input's
+/// cost (`write(dir, 0)`: start-up, the built-in catalog) is at most twelve
+/// times what `n` adds. A quadratic path adds a hundred times more there, a
+/// linear one ten.
 fn scales_linearly(what: &str, n: usize, args: &[&str], write: impl Fn(&Path, usize)) {
-    let small = tempfile::tempdir().unwrap();
-    let large = tempfile::tempdir().unwrap();
-    write(small.path(), n);
-    write(large.path(), 10 * n);
-    let small_seconds = cpu_seconds(small.path(), args);
-    let large_seconds = cpu_seconds(large.path(), args);
-    // Below a hundredth of a second the clock says nothing.
-    let ratio = large_seconds / small_seconds.max(0.01);
-    eprintln!("{what}: {n} in {small_seconds:.3} s, ten times as many in {large_seconds:.3} s");
+    let mut counts = Vec::new();
+    for size in [0, n, 10 * n] {
+        let dir = tempfile::tempdir().unwrap();
+        write(dir.path(), size);
+        let Some(count) = instructions(dir.path(), args) else {
+            return;
+        };
+        counts.push(count);
+    }
+    let [empty, small, large] = counts[..] else {
+        unreachable!()
+    };
+    let (small_adds, large_adds) = (small.saturating_sub(empty), large.saturating_sub(empty));
+    let ratio = large_adds as f64 / small_adds.max(1) as f64;
+    eprintln!(
+        "{what}: none {empty}, {n} add {small_adds}, {} add {large_adds} instructions (x{ratio:.2})",
+        10 * n
+    );
     assert!(
-        ratio <= 30.0,
-        "{what}: {n} took {small_seconds:.3} s, {} took {large_seconds:.3} s (×{ratio:.1})",
+        ratio <= 12.0,
+        "{what}: {n} add {small_adds} instructions, {} add {large_adds} (x{ratio:.1})",
         10 * n
     );
 }
@@ -308,7 +318,7 @@ fn loops_nested_to_the_xml_limit_are_loaded_analysed_and_drawn() {
 fn many_services_in_one_plan_cost_in_proportion() {
     scales_linearly(
         "services in one plan",
-        3_000,
+        300,
         &["check", "--format", "json", "m.mission"],
         |dir, n| {
             let mut text = String::from("{ T: iRobotCreate a }\n");
@@ -325,7 +335,7 @@ fn many_services_in_one_plan_cost_in_proportion() {
 fn many_modes_cases_and_catches_cost_in_proportion() {
     scales_linearly(
         "modes, cases and catches",
-        2_000,
+        200,
         &["check", "--format", "json", "m.mission"],
         |dir, n| {
             let mut text = String::from("{ T: iRobotCreate a }\nT.P.S { throw e }\n");
@@ -349,7 +359,7 @@ fn many_modes_cases_and_catches_cost_in_proportion() {
 fn many_attributes_on_one_element_cost_in_proportion() {
     scales_linearly(
         "attributes on one element",
-        10_000,
+        2_000,
         &["check", "--format", "json", "many.robot.xml"],
         |dir, n| {
             let attributes: String = (0..n).map(|i| format!(" a{i}=\"v\"")).collect();
@@ -359,7 +369,7 @@ fn many_attributes_on_one_element_cost_in_proportion() {
     );
     scales_linearly(
         "attributes on one SDF3 element",
-        10_000,
+        2_000,
         &["graph", "analyze", "--format", "json", "many.xml"],
         |dir, n| {
             let attributes: String = (0..n).map(|i| format!(" a{i}=\"v\"")).collect();
