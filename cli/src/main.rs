@@ -256,7 +256,10 @@ enum Command {
         else up to --horizon or --max-states (bounded; the report says which). Reports a \
         mode no robot of its team ever enters (V001), a robot that can reach a state \
         from which it never finishes though it finishes in other behaviours (V002), and a \
-        robot that can reach a `receive` where it waits for ever (V003). --counterexamples DIR writes, per finding, the \
+        robot that can reach a `receive` where it waits for ever (V003). With --faults N the \
+        world may also kill, restart or cut off robots, up to N times along a behaviour, and \
+        two robots leading one `leader(...)` statement at once is reported (V004). \
+        --counterexamples DIR writes, per finding, the \
         scenario `semo simulate` replays to it (see docs/verify.md).\n\n\
         Exit status: 0 nothing found, 1 a finding, 2 bad input (mission errors, options)."
     )]
@@ -284,6 +287,11 @@ enum Command {
         /// behaviour (a sensor value into another class, an operator command).
         #[arg(long, default_value_t = 2)]
         changes: u32,
+        /// How many faults the world may make along one behaviour: kill a
+        /// running robot, restart a killed one, cut one robot off from the
+        /// others, heal the cut.
+        #[arg(long, default_value_t = 0)]
+        faults: u32,
         /// Write each finding's counterexample into DIR as a scenario file.
         #[arg(long, value_name = "DIR")]
         counterexamples: Option<PathBuf>,
@@ -680,6 +688,7 @@ fn run() -> i32 {
             horizon,
             max_states,
             changes,
+            faults,
             counterexamples,
             color,
         } => verify::run(
@@ -693,6 +702,7 @@ fn run() -> i32 {
                     horizon_ms: horizon,
                     max_states,
                     changes,
+                    faults,
                     merge_in_time: true,
                     observe: false,
                     cancel: None,

@@ -362,6 +362,9 @@ pub struct Sim<'p> {
     /// The last control firing handled: (time, chain).
     last_fire: (i64, u64),
     every_firing: bool,
+    /// A robot cut off from every other now (`semo verify`'s choice): as
+    /// the scenario's partition `[[robot]]` from now on.
+    isolated: Option<usize>,
 }
 
 impl<'p> Robot<'p> {
@@ -538,6 +541,7 @@ impl<'p> Sim<'p> {
             names: programs.iter().map(Names::new).collect(),
             last_fire: (-1, 0),
             every_firing: options.every_firing,
+            isolated: None,
         };
         for r in 0..programs.len() {
             sim.start(r);
@@ -760,28 +764,35 @@ impl<'p> Sim<'p> {
     fn fault(&mut self, i: usize) {
         match &self.scenario.faults[i].kind {
             FaultKind::Kill { robot, .. } => {
-                let Some(r) = self.index_of(robot) else {
-                    return;
-                };
-                if self.robots[r].alive {
-                    // Killed without a word: no `stop`, calls end with it.
-                    self.robots[r].alive = false;
-                    self.emit(r, "fault", vec![("fault", "kill".into())]);
+                if let Some(r) = self.index_of(robot) {
+                    self.kill(r);
                 }
             }
             FaultKind::Restart { robot, .. } => {
-                let Some(r) = self.index_of(robot) else {
-                    return;
-                };
-                if !self.robots[r].alive {
-                    let epoch = self.robots[r].epoch + 1;
-                    self.robots[r] =
-                        Robot::new(self.robots[r].program, self.scenario, self.now, epoch);
-                    self.emit(r, "fault", vec![("fault", "restart".into())]);
-                    self.start(r);
+                if let Some(r) = self.index_of(robot) {
+                    self.restart(r);
                 }
             }
             _ => {}
+        }
+    }
+
+    /// Robot `r` is killed now, if it runs: without a word (no `stop`).
+    pub(crate) fn kill(&mut self, r: usize) {
+        if self.robots[r].alive {
+            self.robots[r].alive = false;
+            self.emit(r, "fault", vec![("fault", "kill".into())]);
+        }
+    }
+
+    /// Robot `r` starts again now, if it does not run: a new process, from
+    /// its default mode.
+    pub(crate) fn restart(&mut self, r: usize) {
+        if !self.robots[r].alive {
+            let epoch = self.robots[r].epoch + 1;
+            self.robots[r] = Robot::new(self.robots[r].program, self.scenario, self.now, epoch);
+            self.emit(r, "fault", vec![("fault", "restart".into())]);
+            self.start(r);
         }
     }
 
@@ -977,6 +988,9 @@ impl<'p> Sim<'p> {
             .unwrap_or(network.latency_ms);
         let loss = link.and_then(|l| l.loss).unwrap_or(network.loss);
         let now = self.now;
+        if self.isolated.is_some_and(|i| i == a || i == b) {
+            return None;
+        }
         for fault in &self.scenario.faults {
             match &fault.kind {
                 FaultKind::Drop {

@@ -11,7 +11,10 @@
 //! robot that finishes in some behaviour can finish from every state it
 //! can reach (V002); a robot never waits in a `receive` from which no
 //! behaviour frees it (V003); V002 and V003 with the shortest way to such
-//! a state as a scenario `semo simulate` replays.
+//! a state as a scenario `semo simulate` replays. With faults (`--faults
+//! N`: kills, restarts, a robot cut off), also: no two robots lead one
+//! `leader(...)` statement at once (V004), judged on every state seen (a
+//! state found is a witness, bounded search or not).
 
 mod inputs;
 mod search;
@@ -38,6 +41,10 @@ pub struct Options {
     /// How many times after the start the world may choose (a sensor
     /// value into another class, an operator command) along one behaviour.
     pub changes: u32,
+    /// How many faults the world may make along one behaviour: kill a
+    /// running robot, restart a killed one, cut one robot off from the
+    /// others, heal the cut (0: none, the default).
+    pub faults: u32,
     /// Merge a state with one met at another instant when they would go on
     /// alike (the reduction); without it only states of one instant merge,
     /// the reference the reduction is tested against.
@@ -57,6 +64,7 @@ impl Default for Options {
             horizon_ms: 120_000,
             max_states: 50_000,
             changes: 2,
+            faults: 0,
             merge_in_time: true,
             observe: false,
             cancel: None,
@@ -90,6 +98,48 @@ pub enum Choice {
         input: usize,
         value: usize,
     },
+    /// A fault: the robot (an index into the programs) is killed.
+    Kill {
+        robot: usize,
+    },
+    /// A fault: the killed robot starts again.
+    Restart {
+        robot: usize,
+    },
+    /// A fault: the robot reaches no other robot and no other reaches it.
+    Isolate {
+        robot: usize,
+    },
+    /// The cut robot reaches the others again.
+    Heal,
+}
+
+/// What the world has set and what it may still do along one behaviour.
+#[derive(Clone, Debug, PartialEq)]
+pub struct World {
+    /// Per sensor input: its class now.
+    pub classes: Vec<usize>,
+    /// Sensor changes and operator commands left.
+    pub changes: u32,
+    /// Faults left.
+    pub faults: u32,
+    /// Per robot: killed and not restarted.
+    pub down: Vec<bool>,
+    /// The robot cut off from the others now.
+    pub isolated: Option<usize>,
+}
+
+impl World {
+    /// At the start: every class the first, every budget full.
+    pub fn new(inputs: &Inputs, options: &Options, robots: usize) -> World {
+        World {
+            classes: vec![0; inputs.sensors.len()],
+            changes: options.changes,
+            faults: options.faults,
+            down: vec![false; robots],
+            isolated: None,
+        }
+    }
 }
 
 /// A way to a finding: the world's choices, each with the mission ms it
@@ -115,6 +165,13 @@ pub enum Claim {
         robot: usize,
         service: usize,
         state: usize,
+    },
+    /// At the counterexample's end, robots `robots` (indices into the
+    /// programs) of `team` both lead the `leader(...)` statement at `line`.
+    TwoLeaders {
+        team: String,
+        line: u32,
+        robots: (usize, usize),
     },
 }
 
@@ -221,8 +278,10 @@ pub fn verify(
             file,
             span,
             format!(
-                "{} finishes in some behaviours, but{in_mode} at {} ms it can no longer finish in any",
-                program.robot, way.end_ms
+                "{} finishes in some behaviours, but{in_mode} at {} ms it can no longer finish in any{}",
+                program.robot,
+                way.end_ms,
+                faults_aside(way, programs)
             ),
         ));
         counterexamples.push(Some(way.clone()));
@@ -236,10 +295,11 @@ pub fn verify(
             file,
             statement.span,
             format!(
-                "{} waits here for ever from {} ms on: no behaviour brings what `{}` waits for",
+                "{} waits here for ever from {} ms on: no behaviour brings what `{}` waits for{}",
                 program.robot,
                 way.end_ms,
-                statement.text.trim()
+                statement.text.trim(),
+                faults_aside(way, programs)
             ),
         ));
         counterexamples.push(Some(way.clone()));
@@ -247,6 +307,27 @@ pub fn verify(
             robot: *r,
             service: *service,
             state: *state,
+        });
+    }
+    for ((team, line), (a, b), way) in &explored.two_leaders {
+        findings.push(Diagnostic::new(
+            Code::TwoLeaders,
+            file,
+            line_span(text, &lines, *line),
+            format!(
+                "{} and {} of {team} both lead here at {} ms: {}",
+                programs[*a].robot,
+                programs[*b].robot,
+                way.end_ms,
+                way.faults_said(programs)
+                    .unwrap_or_else(|| "with no fault".to_string())
+            ),
+        ));
+        counterexamples.push(Some(way.clone()));
+        claims.push(Claim::TwoLeaders {
+            team: team.clone(),
+            line: *line,
+            robots: (*a, *b),
         });
     }
     Ok(Report {
@@ -273,6 +354,12 @@ pub fn verify(
     })
 }
 
+/// " (after help killed at 0 ms)" when the way has faults, else nothing.
+fn faults_aside(way: &Counterexample, programs: &[RobotProgram]) -> String {
+    way.faults_said(programs)
+        .map_or(String::new(), |said| format!(" ({said})"))
+}
+
 /// Line `line` (1-based) of `text`, without its indentation.
 fn line_span(text: &str, lines: &LineIndex, line: u32) -> Span {
     let start = lines.line_start((line as usize).saturating_sub(1));
@@ -286,6 +373,26 @@ fn line_span(text: &str, lines: &LineIndex, line: u32) -> Span {
 }
 
 impl Counterexample {
+    /// The faults on the way, for a finding's message: "after tb_0 cut off
+    /// at 1500 ms"; `None` without one.
+    pub fn faults_said(&self, robots: &[RobotProgram]) -> Option<String> {
+        let said: Vec<String> = self
+            .choices
+            .iter()
+            .filter_map(|(at, choice)| {
+                let (robot, what) = match choice {
+                    Choice::Kill { robot } => (robot, "killed"),
+                    Choice::Restart { robot } => (robot, "restarted"),
+                    Choice::Isolate { robot } => (robot, "cut off"),
+                    Choice::Heal => return Some(format!("the cut healed at {at} ms")),
+                    _ => return None,
+                };
+                Some(format!("{} {what} at {at} ms", robots[*robot].robot))
+            })
+            .collect();
+        (!said.is_empty()).then(|| format!("after {}", said.join(", ")))
+    }
+
     /// The scenario (`docs/scenario-and-trace.md`) that replays the way:
     /// `semo simulate` on it shows the finding at its end.
     pub fn scenario_json(&self, inputs: &Inputs, robots: &[RobotProgram]) -> String {
@@ -293,6 +400,16 @@ impl Counterexample {
         // the order the choices were made.
         let mut sensors: Vec<Vec<(i64, &SensorInput, usize)>> = vec![Vec::new(); robots.len()];
         let mut commands = Vec::new();
+        // Each fault as a scenario entry; a cut runs to its heal, else to
+        // the end.
+        let mut faults: Vec<String> = Vec::new();
+        let mut cut: Option<(i64, usize)> = None;
+        let partition = |from: i64, until: i64, robot: usize| {
+            format!(
+                "{{\"from\": {from}, \"until\": {until}, \"partition\": [[{}]]}}",
+                json_string(&robots[robot].robot)
+            )
+        };
         for (at, choice) in &self.choices {
             let mut sensor = |s: usize, v: usize| {
                 let input = &inputs.sensors[s];
@@ -308,8 +425,28 @@ impl Counterexample {
                 Choice::Command { input, value } => {
                     commands.push((*at, &inputs.commands[*input], *value))
                 }
+                Choice::Kill { robot } | Choice::Restart { robot } => {
+                    let kind = if matches!(choice, Choice::Kill { .. }) {
+                        "kill"
+                    } else {
+                        "restart"
+                    };
+                    faults.push(format!(
+                        "{{\"at\": {at}, \"{kind}\": {}}}",
+                        json_string(&robots[*robot].robot)
+                    ));
+                }
+                Choice::Isolate { robot } => cut = Some((*at, *robot)),
+                Choice::Heal => {
+                    if let Some((from, robot)) = cut.take() {
+                        faults.push(partition(from, *at, robot));
+                    }
+                }
                 Choice::Nothing => {}
             }
+        }
+        if let Some((from, robot)) = cut {
+            faults.push(partition(from, self.end_ms.max(from + 1), robot));
         }
         let mut out = String::new();
         let _ = write!(
@@ -352,11 +489,13 @@ impl Counterexample {
                 json_string(&command.values[*v])
             );
         }
-        out.push_str(if commands.is_empty() {
-            "]\n}\n"
-        } else {
-            "\n  ]\n}\n"
-        });
+        out.push_str(if commands.is_empty() { "]" } else { "\n  ]" });
+        if !faults.is_empty() {
+            out.push_str(",\n  \"faults\": [\n    ");
+            out.push_str(&faults.join(",\n    "));
+            out.push_str("\n  ]");
+        }
+        out.push_str("\n}\n");
         out
     }
 }

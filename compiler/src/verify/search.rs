@@ -7,7 +7,7 @@
 //! else up to the horizon or the state budget (bounded).
 
 use super::inputs::Inputs;
-use super::{Choice, Counterexample, Options};
+use super::{Choice, Counterexample, Options, World};
 use crate::refine::RobotProgram;
 use crate::sim::{self, Memory, Scenario, Sim};
 use std::collections::{HashMap, HashSet};
@@ -36,15 +36,28 @@ pub struct Explored {
     /// then wait in for ever, whatever the world does (only when
     /// exhaustive): the shortest way there.
     pub waits_for_ever: Vec<((usize, usize, usize), Counterexample)>,
+    /// Per `leader(...)` statement (team, mission line) that two robots
+    /// lead at once in some state: the two, and the shortest way there.
+    /// A state seen is a witness: judged bounded or not.
+    pub two_leaders: Vec<TwoLeaders>,
 }
+
+/// A `leader(...)` statement (team, mission line), the two robots that
+/// lead it at once, and the shortest way there.
+pub type TwoLeaders = ((String, u32), (usize, usize), Counterexample);
+
+/// A (service, state) of a robot's program.
+type StateAt = (usize, usize);
 
 struct Node {
     parent: Option<u32>,
     choice: Choice,
     /// Mission ms the choice was made at.
     at: i64,
-    /// Per robot: it has finished.
+    /// Per robot: it has finished (not killed: it ended its mission).
     finished: Box<[bool]>,
+    /// Per robot: the world killed it and has not restarted it.
+    down: Box<[bool]>,
     /// Per robot: the mode it is in (an index into its program's modes).
     modes: Box<[Option<u16>]>,
     /// The `receive` states robots wait in: (robot, service, state).
@@ -69,13 +82,14 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
         observed: HashSet::new(),
         stuck: Vec::new(),
         waits_for_ever: Vec::new(),
+        two_leaders: Vec::new(),
     };
     let mut nodes: Vec<Node> = Vec::new();
     let mut seen: HashMap<u128, u32> = HashMap::new();
     let mut edges: Vec<(u32, u32)> = Vec::new();
-    // Each state with the class of each sensor input in it and the
-    // changes the world has left.
-    let mut frontier: Vec<(u32, Sim, Vec<usize>, u32)> = Vec::new();
+    let mut leaders = Leaders::new(programs);
+    // Each state with what the world has set and has left to do.
+    let mut frontier: Vec<(u32, Sim, World)> = Vec::new();
     let mut over_budget = false;
     for start in start_classes(inputs) {
         if nodes.len() >= options.max_states {
@@ -83,12 +97,22 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
             break;
         }
         let mut sim = root.clone();
-        let choice = Choice::Start(start.clone());
-        apply(&mut sim, &mut start.clone(), inputs, &choice);
-        let fp = key(sim.fingerprint(&memory), options.changes, 0, options);
+        let mut world = World::new(inputs, options, programs.len());
+        apply(&mut sim, &mut world, inputs, &Choice::Start(start.clone()));
+        let fp = key(sim.fingerprint(&memory), &world, 0, options);
         if !seen.contains_key(&fp) {
-            let id = admit(&mut nodes, &mut seen, fp, &sim, None, choice, 0);
-            frontier.push((id, sim, start, options.changes));
+            let id = admit(
+                &mut nodes,
+                &mut seen,
+                fp,
+                &sim,
+                &world,
+                None,
+                Choice::Start(start),
+                0,
+            );
+            leaders.look(&sim, id);
+            frontier.push((id, sim, world));
         }
     }
     let mut t = 0;
@@ -98,19 +122,19 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
         }
         let next_t = t + options.step_ms;
         let mut next = Vec::new();
-        for (id, sim, classes, changes) in std::mem::take(&mut frontier) {
-            if nodes[id as usize].finished.iter().all(|f| *f) {
+        for (id, sim, world) in std::mem::take(&mut frontier) {
+            let node = &nodes[id as usize];
+            if (0..node.finished.len()).all(|r| node.finished[r] || node.down[r]) {
                 continue;
             }
-            for choice in choices(inputs, &classes, changes) {
-                let changes = changes - u32::from(choice != Choice::Nothing);
+            for choice in choices(inputs, &world) {
                 if nodes.len() >= options.max_states || cancelled(options) {
                     over_budget = true;
                     break;
                 }
                 let mut child = sim.clone();
-                let mut child_classes = classes.clone();
-                apply(&mut child, &mut child_classes, inputs, &choice);
+                let mut child_world = world.clone();
+                apply(&mut child, &mut child_world, inputs, &choice);
                 child.run_to(next_t);
                 explored.transitions += 1;
                 for e in child.take_trace() {
@@ -136,7 +160,7 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
                         explored.entered.insert((team.clone(), mode.to_string()));
                     }
                 }
-                let fp = key(child.fingerprint(&memory), changes, next_t, options);
+                let fp = key(child.fingerprint(&memory), &child_world, next_t, options);
                 let child_id = match seen.get(&fp) {
                     Some(&known) => {
                         edges.push((id, known));
@@ -148,16 +172,18 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
                             &mut seen,
                             fp,
                             &child,
+                            &child_world,
                             Some(id),
                             choice.clone(),
                             t,
                         );
                         edges.push((id, new));
+                        leaders.look(&child, new);
                         Some(new)
                     }
                 };
                 if let Some(child_id) = child_id {
-                    next.push((child_id, child, child_classes, changes));
+                    next.push((child_id, child, child_world));
                     explored.reached_ms = next_t;
                 }
             }
@@ -172,6 +198,14 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
     explored.exhaustive = frontier.is_empty() && !over_budget;
     explored.over_budget = over_budget;
     explored.cancelled = cancelled(options);
+    explored.two_leaders = leaders
+        .found
+        .into_iter()
+        .map(|(statement, (n, pair))| {
+            (statement, pair, way_to(&nodes, n as usize, options.step_ms))
+        })
+        .collect();
+    explored.two_leaders.sort_by(|a, b| a.0.cmp(&b.0));
     if explored.exhaustive {
         let graph = Graph {
             nodes: &nodes,
@@ -184,12 +218,75 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
     explored
 }
 
+/// The `leader(...)` statements two robots lead at once, met while
+/// exploring: the first state (the shallowest) of each.
+struct Leaders {
+    /// Per robot: its team and, per (service, state) of its program, the
+    /// statement's mission line.
+    statements: Vec<(String, HashMap<StateAt, u32>)>,
+    /// (team, line) → (state, the two robots).
+    found: HashMap<(String, u32), (u32, (usize, usize))>,
+}
+
+impl Leaders {
+    fn new(programs: &[RobotProgram]) -> Leaders {
+        let statements = programs
+            .iter()
+            .map(|p| {
+                let lines = p
+                    .control
+                    .services
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(s, service)| {
+                        service
+                            .states
+                            .iter()
+                            .enumerate()
+                            .filter_map(move |(pc, state)| {
+                                matches!(state.kind, crate::refine::StateKind::LeaderBranch { .. })
+                                    .then_some(((s, pc), state.line))
+                            })
+                    });
+                (p.team.clone(), lines.collect())
+            })
+            .collect();
+        Leaders {
+            statements,
+            found: HashMap::new(),
+        }
+    }
+
+    /// Notes state `id` if two robots lead one statement in it.
+    fn look(&mut self, sim: &Sim, id: u32) {
+        let mut leading: HashMap<(&str, u32), usize> = HashMap::new();
+        for r in 0..sim.robot_count() {
+            let (team, lines) = &self.statements[r];
+            for state in sim.leads(r) {
+                let Some(&line) = lines.get(&state) else {
+                    continue;
+                };
+                match leading.insert((team, line), r) {
+                    Some(other) if other != r => {
+                        self.found
+                            .entry((team.clone(), line))
+                            .or_insert((id, (other, r)));
+                    }
+                    _ => {}
+                }
+            }
+        }
+    }
+}
+
 /// Records a new state, reached by `choice` made at `at`; its id.
+#[allow(clippy::too_many_arguments)]
 fn admit(
     nodes: &mut Vec<Node>,
     seen: &mut HashMap<u128, u32>,
     fingerprint: u128,
     sim: &Sim,
+    world: &World,
     parent: Option<u32>,
     choice: Choice,
     at: i64,
@@ -197,7 +294,10 @@ fn admit(
     let id = nodes.len() as u32;
     seen.insert(fingerprint, id);
     let robots = 0..sim.robot_count();
-    let finished = robots.clone().map(|r| !sim.is_running(r)).collect();
+    let finished = robots
+        .clone()
+        .map(|r| !sim.is_running(r) && !world.down[r])
+        .collect();
     let modes = robots
         .map(|r| sim.mode_of(r).and_then(|m| u16::try_from(m).ok()))
         .collect();
@@ -213,6 +313,7 @@ fn admit(
         choice,
         at,
         finished,
+        down: world.down.clone().into_boxed_slice(),
         modes,
         waiting,
         moved: Vec::new(),
@@ -248,61 +349,114 @@ fn cancelled(options: &Options) -> bool {
         .is_some_and(|c| c.load(std::sync::atomic::Ordering::Relaxed))
 }
 
-/// What tells states apart: the fingerprint, the changes the world has
-/// left, and without `merge_in_time` the mission time too (then only
-/// states of one instant merge: the unreduced search).
-fn key(fingerprint: u128, changes: u32, now: i64, options: &Options) -> u128 {
+/// What tells states apart: the fingerprint, what the world has left to
+/// do and which robots it killed, and without `merge_in_time` the mission
+/// time too (then only states of one instant merge: the unreduced search).
+fn key(fingerprint: u128, world: &World, now: i64, options: &Options) -> u128 {
     let now = if options.merge_in_time {
         0
     } else {
         now as u128 + 1
     };
+    let mut down: u128 = 0;
+    for (r, &d) in world.down.iter().enumerate() {
+        if d {
+            down = down.rotate_left(7) ^ (r as u128 + 1);
+        }
+    }
     fingerprint
-        ^ (u128::from(changes) << 96).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        ^ (u128::from(world.changes) << 96).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        ^ (u128::from(world.faults) << 64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f)
+        ^ down.wrapping_mul(0x1656_67b1_9e37_79f9_85eb_ca77_c2b2_ae63)
         ^ now.wrapping_mul(0xd6e8_feb8_6659_fd93_a5a1_ee3b_8f1c_2d4b)
 }
 
-/// What the world may do at a step: nothing, or with a change left, one
-/// sensor input into another class or one operator command.
-pub fn choices(inputs: &Inputs, classes: &[usize], changes: u32) -> Vec<Choice> {
+/// What the world may do at a step: nothing; with a change left, one
+/// sensor input into another class or one operator command; with a fault
+/// left, kill a running robot, restart a killed one, cut one off from
+/// the others or heal the cut.
+pub fn choices(inputs: &Inputs, world: &World) -> Vec<Choice> {
     let mut all = vec![Choice::Nothing];
-    if changes == 0 {
-        return all;
-    }
-    for (s, input) in inputs.sensors.iter().enumerate() {
-        for v in 0..input.values.len() {
-            if v != classes[s] {
-                all.push(Choice::Sensor { input: s, value: v });
+    if world.changes > 0 {
+        for (s, input) in inputs.sensors.iter().enumerate() {
+            for v in 0..input.values.len() {
+                if v != world.classes[s] {
+                    all.push(Choice::Sensor { input: s, value: v });
+                }
+            }
+        }
+        for (c, input) in inputs.commands.iter().enumerate() {
+            for v in 0..input.values.len() {
+                all.push(Choice::Command { input: c, value: v });
             }
         }
     }
-    for (c, input) in inputs.commands.iter().enumerate() {
-        for v in 0..input.values.len() {
-            all.push(Choice::Command { input: c, value: v });
+    if world.faults > 0 {
+        for (robot, &down) in world.down.iter().enumerate() {
+            all.push(if down {
+                Choice::Restart { robot }
+            } else {
+                Choice::Kill { robot }
+            });
+        }
+        match world.isolated {
+            Some(_) => all.push(Choice::Heal),
+            None => all.extend((0..world.down.len()).map(|robot| Choice::Isolate { robot })),
         }
     }
     all
 }
 
-/// Makes `choice` in `sim` now, keeping `classes`, the class of each sensor input, up to date.
-pub fn apply(sim: &mut Sim, classes: &mut [usize], inputs: &Inputs, choice: &Choice) {
+/// Makes `choice` in `sim` now, keeping `world` (what is set, what is
+/// left) up to date.
+pub fn apply(sim: &mut Sim, world: &mut World, inputs: &Inputs, choice: &Choice) {
+    match *choice {
+        Choice::Nothing | Choice::Start(_) => {}
+        Choice::Sensor { .. } | Choice::Command { .. } => world.changes -= 1,
+        Choice::Kill { .. } | Choice::Restart { .. } | Choice::Isolate { .. } | Choice::Heal => {
+            world.faults -= 1
+        }
+    }
     match *choice {
         Choice::Nothing => {}
         Choice::Start(ref start) => {
             for (s, &v) in start.iter().enumerate() {
                 let input = &inputs.sensors[s];
                 sim.set_sensor(input.robot, &input.port, &input.values[v]);
-                classes[s] = v;
+                world.classes[s] = v;
             }
         }
         Choice::Sensor { input, value } => {
             let s = &inputs.sensors[input];
             sim.set_sensor(s.robot, &s.port, &s.values[value]);
-            classes[input] = value;
+            world.classes[input] = value;
         }
         Choice::Command { input, value } => {
             let c = &inputs.commands[input];
             sim.give_command(&c.to, &format!("USER.{}", c.value), &c.values[value]);
+        }
+        Choice::Kill { robot } => {
+            sim.kill(robot);
+            world.down[robot] = true;
+        }
+        Choice::Restart { robot } => {
+            sim.restart(robot);
+            world.down[robot] = false;
+            // A new process reads the world as it is now (a replay's
+            // scenario holds every value set so far).
+            for (s, input) in inputs.sensors.iter().enumerate() {
+                if input.robot == robot {
+                    sim.set_sensor(robot, &input.port, &input.values[world.classes[s]]);
+                }
+            }
+        }
+        Choice::Isolate { robot } => {
+            sim.isolate(Some(robot));
+            world.isolated = Some(robot);
+        }
+        Choice::Heal => {
+            sim.isolate(None);
+            world.isolated = None;
         }
     }
 }
@@ -321,6 +475,18 @@ fn counterexample(nodes: &[Node], id: u32, last: &Choice, at: i64, end: i64) -> 
     Counterexample {
         choices,
         end_ms: end,
+    }
+}
+
+/// The shortest way to state `n` (its state shows at the end).
+fn way_to(nodes: &[Node], n: usize, step_ms: i64) -> Counterexample {
+    let node = &nodes[n];
+    match node.parent {
+        Some(p) => counterexample(nodes, p, &node.choice, node.at, node.at + step_ms),
+        None => Counterexample {
+            choices: vec![(0, node.choice.clone())],
+            end_ms: step_ms,
+        },
     }
 }
 
@@ -360,16 +526,8 @@ impl Graph<'_> {
         reached
     }
 
-    /// The shortest way to state `n` (its state shows at the end).
     fn way_to(&self, n: usize) -> Counterexample {
-        let node = &self.nodes[n];
-        match node.parent {
-            Some(p) => counterexample(self.nodes, p, &node.choice, node.at, node.at + self.step_ms),
-            None => Counterexample {
-                choices: vec![(0, node.choice.clone())],
-                end_ms: self.step_ms,
-            },
-        }
+        way_to(self.nodes, n, self.step_ms)
     }
 
     /// Per robot that finishes in some state: the first state (the
@@ -381,7 +539,9 @@ impl Graph<'_> {
                 continue;
             }
             let can_finish = self.can_reach(|n| n.finished[r]);
-            if let Some(n) = can_finish.iter().position(|c| !c) {
+            // A robot the world killed is not stuck: it is gone.
+            let stuck = (0..self.nodes.len()).find(|&n| !can_finish[n] && !self.nodes[n].down[r]);
+            if let Some(n) = stuck {
                 let mode = self.nodes[n].modes[r].map(usize::from);
                 found.push((r, self.way_to(n), mode));
             }

@@ -117,6 +117,31 @@ impl<'p> Sim<'p> {
             .collect()
     }
 
+    /// From now on robot `r` reaches no other robot and no other robot
+    /// reaches it (`None`: every link as the scenario says), as a scenario
+    /// partition `[[r]]` from now; messages already under way arrive.
+    pub fn isolate(&mut self, r: Option<usize>) {
+        self.isolated = r;
+    }
+
+    /// The `leader(...)` statements robot `r` leads now, as (service,
+    /// state) of its program: it runs and its last election there chose it.
+    pub fn leads(&self, r: usize) -> Vec<(usize, usize)> {
+        let robot = &self.robots[r];
+        if !robot.alive {
+            return Vec::new();
+        }
+        let me = robot.program.self_peer;
+        let mut led: Vec<(usize, usize)> = robot
+            .leaders
+            .iter()
+            .filter(|(_, leader)| **leader == me)
+            .map(|(state, _)| *state)
+            .collect();
+        led.sort_unstable();
+        led
+    }
+
     /// The mode robot `r` is in: an index into its program's modes.
     pub fn mode_of(&self, r: usize) -> Option<usize> {
         self.robots[r].current_mode
@@ -131,6 +156,7 @@ impl<'p> Sim<'p> {
         for (robot, timed) in self.robots.iter().zip(&memory.timed) {
             fp.robot(robot, timed);
         }
+        fp.int(self.isolated.map_or(-1, |r| r as i64));
         // The events still to come, in the order they will be handled;
         // those a robot will ignore (an earlier life's, a firing moved
         // earlier, a stopped call's end) are left out.
