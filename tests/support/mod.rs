@@ -67,13 +67,18 @@ pub fn semo_in(dir: &Path, args: &[&str]) -> Output {
 /// example at the default level with warnings as errors, and the
 /// sanitizer tests run optimized programs.
 pub fn simulate_trace(mission: &Path, scenario: &Path, engine: &str) -> Output {
+    simulate_trace_with(mission, scenario, engine, "-std=c11 -Wall -Wextra -O1")
+}
+
+/// [`simulate_trace`] with the C compiled with `cflags`.
+pub fn simulate_trace_with(mission: &Path, scenario: &Path, engine: &str, cflags: &str) -> Output {
     let out = Command::new(env!("CARGO_BIN_EXE_semo"))
         .args(["simulate", &mission.display().to_string()])
         .args(["--scenario", &scenario.display().to_string()])
         .args(["--engine", engine, "--trace", "-"])
         .current_dir(repo_root())
         .env("NO_COLOR", "1")
-        .env("CFLAGS", "-std=c11 -Wall -Wextra -O1")
+        .env("CFLAGS", cflags)
         .output()
         .expect("the semo binary runs");
     Output::of(out)

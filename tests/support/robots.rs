@@ -121,9 +121,11 @@ pub fn compilers() -> Vec<&'static str> {
     found
 }
 
-/// Builds `mission` for `linux-sim` into `out`, compiles every robot with gcc,
-/// runs them together with `scenario` (JSON text) and returns each robot's
-/// trace lines as written.
+/// Builds `mission` for `linux-sim` into `out` and compiles every robot
+/// with gcc (pedantic, warnings as errors), then runs the generated robots
+/// together on `scenario` (JSON text) in lock-step virtual time (`semo
+/// simulate --engine c`, compiled with the same flags): no clock, so the
+/// machine's load changes nothing. Each robot's trace lines, in its order.
 pub fn run_in_simulation(
     mission: &Path,
     out: &Path,
@@ -131,41 +133,26 @@ pub fn run_in_simulation(
 ) -> BTreeMap<String, Vec<String>> {
     let built = build(mission, "linux-sim", out);
     assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
-    let folders = robot_folders(out);
-    for folder in &folders {
+    for folder in &robot_folders(out) {
         make(folder, "gcc", PEDANTIC).unwrap_or_else(|e| panic!("{e}"));
     }
     let scenario_path = out.join("scenario.json");
     std::fs::write(&scenario_path, scenario).unwrap();
-    // Each run gets its own ports (below the ephemeral range), so runs in
-    // parallel do not hear each other: a block of 40 per test process, 4 per
-    // run in it (no mission run here has more robots).
-    static RUNS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-    let run = RUNS.fetch_add(1, std::sync::atomic::Ordering::Relaxed) % 10;
-    let port_base = 24000 + (std::process::id() % 200) * 40 + run * 4;
-    let mut children = Vec::new();
-    let (_, start_at) = start_barrier(folders.len());
-    for folder in folders {
-        let robot = folder.file_name().unwrap().to_string_lossy().into_owned();
-        let trace = out.join(format!("{robot}.jsonl"));
-        let child = robot_command(&folder, &scenario_path, &trace, port_base)
-            .args(["--start-at", &start_at.to_string()])
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .expect("the robot program starts");
-        children.push((robot, trace, child));
-    }
-    let mut traces = BTreeMap::new();
-    for (robot, trace, child) in children {
-        let output = child.wait_with_output().unwrap();
-        assert!(
-            output.status.success(),
-            "{robot} exited with {:?}: {}",
-            output.status,
-            String::from_utf8_lossy(&output.stderr)
-        );
-        let text = std::fs::read_to_string(&trace).unwrap_or_default();
-        traces.insert(robot, text.lines().map(str::to_string).collect());
+    let run = super::simulate_trace_with(mission, &scenario_path, "c", PEDANTIC);
+    assert!(run.code <= 1, "{}{}", run.stdout, run.stderr);
+    let mut traces: BTreeMap<String, Vec<String>> = robot_folders(out)
+        .iter()
+        .map(|f| {
+            (
+                f.file_name().unwrap().to_string_lossy().into_owned(),
+                Vec::new(),
+            )
+        })
+        .collect();
+    for line in run.stdout.lines() {
+        let event: Event = serde_json::from_str(line).unwrap_or_else(|e| panic!("{e}: {line}"));
+        let robot = event["robot"].as_str().expect("a robot").to_string();
+        traces.entry(robot).or_default().push(line.to_string());
     }
     traces
 }
