@@ -170,7 +170,7 @@ fn write_counterexamples(
             written.push(None);
             continue;
         };
-        let name = format!("{stem}.{}-{}", finding.code, n + 1);
+        let name = semo::verify::counterexample_name(&stem, finding.code, n + 1);
         let path = dir.join(format!("{name}.scenario.json"));
         let text = way.scenario_json(&report.inputs, programs);
         std::fs::write(&path, &text)?;

@@ -566,13 +566,23 @@ impl LanguageServer for Backend {
 
     async fn code_action(&self, p: CodeActionParams) -> Result<Option<CodeActionResponse>> {
         let uri = p.text_document.uri.clone();
+        let asked = p.context.diagnostics.clone();
+        let quick_fixes = p.context.only.as_ref().is_none_or(|only| {
+            only.iter()
+                .any(|k| CodeActionKind::QUICKFIX.as_str().starts_with(k.as_str()))
+        });
         let found = self
             .on_query(&uri, move |s, w| {
                 handlers::code_actions::code_actions(s, w, &p)
             })
             .await?;
         let world = self.state.world();
-        Ok(Some(found.response(|id| world.uri_of(id).cloned())))
+        let mut response = found.response(|id| world.uri_of(id).cloned());
+        // `semo verify`'s findings: write the scenario that shows each.
+        if let Some(snapshot) = world.snapshot(&uri).filter(|_| quick_fixes) {
+            response.extend(self.state.verified.scenario_actions(&snapshot, &asked));
+        }
+        Ok(Some(response))
     }
 
     // Navigation and structure.

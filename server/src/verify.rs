@@ -12,7 +12,7 @@ use semo::workspace::FileKind;
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
-use tower_lsp_server::ls_types::Uri;
+use tower_lsp_server::ls_types::{self as lsp, Uri};
 
 /// The editor's search: a minute of mission time, twenty thousand states.
 fn options(cancel: Arc<AtomicBool>) -> semo::verify::Options {
@@ -35,7 +35,15 @@ struct Entry {
     /// The snapshot searched.
     snapshot: std::sync::Weak<Snapshot>,
     /// Once the search has ended.
-    findings: Option<Vec<semo::diag::Diagnostic>>,
+    findings: Option<Vec<Finding>>,
+}
+
+/// A finding, and the scenario that replays its counterexample when it has
+/// one (`semo verify --counterexamples` writes the same text).
+#[derive(Clone)]
+struct Finding {
+    diagnostic: semo::diag::Diagnostic,
+    scenario: Option<String>,
 }
 
 impl Verified {
@@ -52,11 +60,90 @@ impl Verified {
 
     /// The findings of `snapshot`, once its search has ended.
     pub fn findings(&self, snapshot: &Arc<Snapshot>) -> Vec<semo::diag::Diagnostic> {
+        self.found(snapshot)
+            .into_iter()
+            .map(|f| f.diagnostic)
+            .collect()
+    }
+
+    fn found(&self, snapshot: &Arc<Snapshot>) -> Vec<Finding> {
         self.lock()
             .get(&snapshot.uri)
             .filter(|e| std::ptr::eq(e.snapshot.as_ptr(), Arc::as_ptr(snapshot)))
             .and_then(|e| e.findings.clone())
             .unwrap_or_default()
+    }
+
+    /// `textDocument/codeAction` on findings of `snapshot` (those of
+    /// `asked` the search made): per finding with a counterexample, an
+    /// action that writes its scenario beside the mission, as `semo verify
+    /// --counterexamples` names it. The file is created, never overwritten
+    /// (a file of that name stays as it is: the editor refuses the edit).
+    pub fn scenario_actions(
+        &self,
+        snapshot: &Arc<Snapshot>,
+        asked: &[lsp::Diagnostic],
+    ) -> Vec<lsp::CodeActionOrCommand> {
+        let found = self.found(snapshot);
+        if found.is_empty() {
+            return Vec::new();
+        }
+        let Some(path) = snapshot.uri.to_file_path() else {
+            return Vec::new();
+        };
+        let stem = path
+            .file_stem()
+            .map_or("mission".into(), |s| s.to_string_lossy().into_owned());
+        let analysis = snapshot.analysis();
+        let lines = snapshot.line_map(&analysis);
+        let mut actions = Vec::new();
+        for (n, finding) in found.iter().enumerate() {
+            let d = &finding.diagnostic;
+            let range = lines.range(d.span);
+            let Some(diagnostic) = asked.iter().find(|a| {
+                a.range == range
+                    && a.code == Some(lsp::NumberOrString::String(d.code.as_str().into()))
+            }) else {
+                continue;
+            };
+            let Some(scenario) = &finding.scenario else {
+                continue;
+            };
+            let name = semo::verify::counterexample_name(&stem, d.code, n + 1);
+            let file = path.with_file_name(format!("{name}.scenario.json"));
+            let Some(uri) = Uri::from_file_path(&file) else {
+                continue;
+            };
+            let create =
+                lsp::DocumentChangeOperation::Op(lsp::ResourceOp::Create(lsp::CreateFile {
+                    uri: uri.clone(),
+                    options: Some(lsp::CreateFileOptions {
+                        overwrite: Some(false),
+                        ignore_if_exists: Some(false),
+                    }),
+                    annotation_id: None,
+                }));
+            let write = lsp::DocumentChangeOperation::Edit(lsp::TextDocumentEdit {
+                text_document: lsp::OptionalVersionedTextDocumentIdentifier { uri, version: None },
+                edits: vec![lsp::OneOf::Left(lsp::TextEdit {
+                    range: lsp::Range::default(),
+                    new_text: scenario.clone(),
+                })],
+            });
+            actions.push(lsp::CodeActionOrCommand::CodeAction(lsp::CodeAction {
+                title: format!(
+                    "Write the scenario that shows this ({name}.scenario.json; semo simulate replays it)"
+                ),
+                kind: Some(lsp::CodeActionKind::QUICKFIX),
+                diagnostics: Some(vec![diagnostic.clone()]),
+                edit: Some(lsp::WorkspaceEdit {
+                    document_changes: Some(lsp::DocumentChanges::Operations(vec![create, write])),
+                    ..lsp::WorkspaceEdit::default()
+                }),
+                ..lsp::CodeAction::default()
+            }));
+        }
+        actions
     }
 }
 
@@ -105,7 +192,7 @@ pub fn after_save(state: &Arc<State>, uri: &Uri) {
 
 /// The findings of a search of the snapshot's mission; `None` when it has
 /// errors (nothing to run) or the search was cancelled.
-fn search(snapshot: &Snapshot, cancel: Arc<AtomicBool>) -> Option<Vec<semo::diag::Diagnostic>> {
+fn search(snapshot: &Snapshot, cancel: Arc<AtomicBool>) -> Option<Vec<Finding>> {
     let build = snapshot.host().build_input(snapshot.id)?;
     let refined = semo::codegen::refine_checked(&build.input());
     if refined.diagnostics.iter().any(|d| d.is_error()) {
@@ -128,5 +215,23 @@ fn search(snapshot: &Snapshot, cancel: Arc<AtomicBool>) -> Option<Vec<semo::diag
     if let Some(project) = snapshot.host().project(snapshot.id) {
         report.apply_lints(&project.project);
     }
-    (!report.cancelled).then_some(report.findings)
+    if report.cancelled {
+        return None;
+    }
+    let scenarios = report.counterexamples.iter().map(|way| {
+        way.as_ref()
+            .map(|w| w.scenario_json(&report.inputs, &refined.programs))
+    });
+    Some(
+        report
+            .findings
+            .iter()
+            .cloned()
+            .zip(scenarios)
+            .map(|(diagnostic, scenario)| Finding {
+                diagnostic,
+                scenario,
+            })
+            .collect(),
+    )
 }

@@ -1,6 +1,7 @@
 //! `semo verify` through the protocol: a saved mission's findings join its
-//! diagnostics once the background search ends, on the saved text only;
-//! an edit drops them and typing never waits for a search.
+//! diagnostics once the background search ends, on the saved text only,
+//! each with an action that writes the scenario showing it; an edit drops
+//! them and typing never waits for a search.
 
 mod support;
 
@@ -51,6 +52,45 @@ async fn a_saved_mission_gets_its_verify_findings_and_an_edit_drops_them() {
     // On the line of the mode the robot is stuck in (0-based 17).
     assert_eq!(v002[0]["range"]["start"]["line"], 17, "{found:#}");
     assert!(v002[0]["message"].as_str().unwrap().contains("WANDER"));
+    // The finding's action writes the scenario that shows it beside the
+    // mission, named as `semo verify --counterexamples` names it, created
+    // and never overwritten.
+    let actions = client
+        .request(
+            "textDocument/codeAction",
+            json!({
+                "textDocument": { "uri": mission },
+                "range": v002[0]["range"],
+                "context": { "diagnostics": [v002[0]] }
+            }),
+        )
+        .await
+        .unwrap();
+    let write: Vec<&Value> = actions
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|a| {
+            a["title"]
+                .as_str()
+                .unwrap()
+                .starts_with("Write the scenario")
+        })
+        .collect();
+    assert_eq!(write.len(), 1, "{actions:#}");
+    let changes = write[0]["edit"]["documentChanges"].as_array().unwrap();
+    let scenario_uri = format!("{}/main.V002-1.scenario.json", file_uri(&dir));
+    assert_eq!(changes[0]["kind"], "create", "{changes:#?}");
+    assert_eq!(changes[0]["uri"], scenario_uri.as_str());
+    assert_eq!(changes[0]["options"]["overwrite"], false);
+    assert_eq!(changes[1]["textDocument"]["uri"], scenario_uri.as_str());
+    let scenario: Value =
+        serde_json::from_str(changes[1]["edits"][0]["newText"].as_str().unwrap()).unwrap();
+    assert!(scenario["duration"].as_i64().unwrap() > 0, "{scenario:#}");
+    assert!(
+        scenario["robots"]["ti"]["sensors"].is_array(),
+        "{scenario:#}"
+    );
     // An edit: the findings were of the saved text, and go.
     client
         .notify(

@@ -500,6 +500,14 @@ impl Counterexample {
     }
 }
 
+/// The name of finding `n`'s (1-based, among a report's findings)
+/// counterexample of a mission whose file stem is `stem`, without an
+/// extension: `main.V002-1`; its scenario is `main.V002-1.scenario.json`.
+/// The CLI's `--counterexamples` and the editor's action write these.
+pub fn counterexample_name(stem: &str, code: Code, n: usize) -> String {
+    format!("{stem}.{code}-{n}")
+}
+
 /// `text` as a JSON string.
 fn json_string(text: &str) -> String {
     let mut out = String::new();
