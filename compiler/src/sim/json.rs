@@ -145,6 +145,14 @@ impl Reader<'_> {
         }
         let text = &self.text[start..self.pos];
         let value: f64 = text.parse().map_err(|_| malformed)?;
+        // `1e400` reads as infinity: refused, as the runtime's reader
+        // refuses it (`semo_sim.c`), rather than taken for a number.
+        if !value.is_finite() {
+            return Err(JsonError {
+                at: start,
+                message: "number out of range".into(),
+            });
+        }
         Ok(Kind::Number(value, text.to_string()))
     }
 
@@ -307,6 +315,8 @@ mod tests {
             ("[01]", 1, "malformed number"),
             ("{} x", 3, "unexpected text after the scenario object"),
             ("\"abc", 4, "unterminated string"),
+            ("[0, 1e400]", 4, "number out of range"),
+            ("{\"a\": -1E+309}", 6, "number out of range"),
         ] {
             let e = parse(text).unwrap_err();
             assert_eq!((e.at, e.message.as_str()), (at, message), "{text}");
