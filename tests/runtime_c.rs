@@ -1003,6 +1003,10 @@ fn bad_scenarios_are_refused_with_line_and_column() {
             "1:50: \"level\" must be a number",
         ),
         (
+            "{\"robots\": {\"x\": {\"battery\": [{\"at\": 0, \"level\": 1e300}]}}}",
+            "1:50: \"level\" must be between -1e15 and 1e15",
+        ),
+        (
             "{\"faults\": [{\"at\": 1}]}",
             "1:13: a fault is exactly one of \"kill\", \"restart\", \"drop\", \"delay\", \"partition\"",
         ),

@@ -18,6 +18,9 @@ pub const VERSION: i64 = 1;
 pub const DEFAULT_SERVICE_MS: i64 = 100;
 /// Longest time the scenario may name (the runtime's `MAX_MS`).
 const MAX_MS: f64 = 1e15;
+/// Largest battery level in size (the runtime's `MAX_LEVEL`): it and its
+/// rounding fit an integer exactly.
+const MAX_LEVEL: f64 = 1e15;
 
 #[derive(Clone, Debug, Default)]
 pub struct Scenario {
@@ -630,6 +633,11 @@ impl Reader<'_> {
                 let Kind::Number(n, _) = level.kind else {
                     return fail(level, "\"level\" must be a number");
                 };
+                // As the runtime's reader: a level that rounds to an
+                // integer exactly (heartbeats carry it as one).
+                if n.abs() > MAX_LEVEL {
+                    return fail(level, "\"level\" must be between -1e15 and 1e15");
+                }
                 world.battery.push((at, n));
             }
         }

@@ -485,6 +485,13 @@ fn scenario_mistakes_point_at_the_value() {
         ),
         ("{\"version\": 2}", (1, 13), "\"version\" must be 1"),
         (
+            // The runtime's reader refuses it too (tests/runtime_c.rs): its
+            // rounding would not fit an integer.
+            "{\"robots\": {\"ti\": {\"battery\": [{\"at\": 0, \"level\": 1e300}]}}}",
+            (1, 51),
+            "\"level\" must be between -1e15 and 1e15",
+        ),
+        (
             "{\"colour\": 2}",
             (1, 12),
             "unknown key \"colour\" in a scenario object {\"robots\": ..., \"operator\": ...} (expected one of: version, time_scale, duration, robots, operator, network, faults, expect)",

@@ -31,6 +31,7 @@
 #define NAME_MAX_BYTES 48 /* sensor, service and command names */
 #define DEFAULT_SERVICE_MS 100
 #define MAX_MS 1000000000000000LL /* 31 000 years: keeps sums far from overflow */
+#define MAX_LEVEL 1e15 /* a battery level's size: its rounding fits a long long */
 
 /* ------------------------------------------------------------------ JSON */
 
@@ -546,6 +547,9 @@ static bool read_battery(reader *r, const json *v, bool keep)
         last = e.at;
         if (level->kind != J_NUMBER)
             return fail_at(r, level->line, level->col, "\"level\" must be a number");
+        /* Its rounding must fit a long long (the simulator's bound too). */
+        if (level->number > MAX_LEVEL || level->number < -MAX_LEVEL)
+            return fail_at(r, level->line, level->col, "\"level\" must be between -1e15 and 1e15");
         e.level = level->number;
         if (keep) {
             if (!grow(r, (void **)&g_sim.battery, g_sim.battery_count, sizeof e))
