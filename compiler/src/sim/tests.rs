@@ -44,7 +44,7 @@ fn run(programs: &[RobotProgram], scenario: &str, seed: u64) -> (Run, Vec<Verdic
 }
 
 fn modes(run: &Run, robot: &str) -> Vec<String> {
-    let r = run.robots.iter().position(|(_, n)| n == robot).unwrap();
+    let r = index_of(run, robot);
     expect::modes(run, r)
         .into_iter()
         .map(|(_, m)| m.to_string())
@@ -126,8 +126,13 @@ fn the_trace_is_the_runtime_schema_and_the_same_for_a_seed() {
     assert!(a.trace.windows(2).all(|w| w[0].t <= w[1].t));
 }
 
+/// The index of robot `robot` in the run.
+fn index_of(run: &Run, robot: &str) -> usize {
+    run.robots.iter().position(|(_, n)| n == robot).unwrap()
+}
+
 fn leaders(run: &Run, robot: &str) -> Vec<String> {
-    let r = run.robots.iter().position(|(_, n)| n == robot).unwrap();
+    let r = index_of(run, robot);
     run.trace
         .iter()
         .filter(|e| e.robot == r && e.event == "leader")
@@ -146,7 +151,7 @@ fn a_killed_leader_is_replaced_and_a_restarted_one_leads_again() {
     assert_eq!(leaders(&run_, "tb_1"), ["tb_0", "tb_1"]);
     assert_eq!(leaders(&run_, "tb_2"), ["tb_0", "tb_1"]);
     assert!(leaders(&run_, "ev_0").is_empty());
-    let tb_1 = run_.robots.iter().position(|(_, n)| n == "tb_1").unwrap();
+    let tb_1 = index_of(&run_, "tb_1");
     let took_over = run_
         .trace
         .iter()
@@ -176,7 +181,7 @@ fn a_killed_leader_is_replaced_and_a_restarted_one_leads_again() {
     // (tb_0's trace: before the kill, then after the restart.)
     assert_eq!(leaders(&run_, "tb_0"), ["tb_0", "tb_1", "tb_0"]);
     assert_eq!(two_leaders(&run_), None);
-    let tb_0 = run_.robots.iter().position(|(_, n)| n == "tb_0").unwrap();
+    let tb_0 = index_of(&run_, "tb_0");
     let claimed = run_
         .trace
         .iter()
@@ -198,7 +203,7 @@ fn a_leader_cut_off_from_the_majority_steps_down_before_the_others_elect() {
         0,
     );
     let at = |robot: &str, event: &str, leader: Option<&str>| {
-        let r = run_.robots.iter().position(|(_, n)| n == robot).unwrap();
+        let r = index_of(&run_, robot);
         run_.trace
             .iter()
             .find(|e| {
@@ -221,7 +226,7 @@ fn a_leader_cut_off_from_the_majority_steps_down_before_the_others_elect() {
         "fenced at {fenced}, tb_1 led at {took_over}"
     );
     assert!(took_over > 1200 + 3 * hb - hb, "took over at {took_over}");
-    let tb_0 = run_.robots.iter().position(|(_, n)| n == "tb_0").unwrap();
+    let tb_0 = index_of(&run_, "tb_0");
     let heard = run_
         .trace
         .iter()
@@ -235,7 +240,7 @@ fn a_leader_cut_off_from_the_majority_steps_down_before_the_others_elect() {
     // Without fencing (the lease as long as the others' patience) tb_0
     // would have kept leading while tb_1 led: the check above can fail.
     let lights = |robot: &str, from: i64, until: i64| {
-        let r = run_.robots.iter().position(|(_, n)| n == robot).unwrap();
+        let r = index_of(&run_, robot);
         run_.trace
             .iter()
             .filter(|e| e.robot == r && e.event == "call_start" && (from..until).contains(&e.t))
@@ -261,7 +266,7 @@ fn a_robot_left_alone_of_three_candidates_never_leads() {
         r#"{"duration": 3000, "faults": [{"at": 1000, "kill": "tb_1"}, {"at": 1000, "kill": "tb_0"}]}"#,
         0,
     );
-    let tb_2 = run_.robots.iter().position(|(_, n)| n == "tb_2").unwrap();
+    let tb_2 = index_of(&run_, "tb_2");
     let fenced: Vec<_> = run_
         .trace
         .iter()
@@ -366,7 +371,7 @@ fn highest_battery_elects_by_the_levels_heartbeats_carry() {
 
 /// The heartbeat period of a robot's program in a run, from its sends.
 fn programs_heartbeat(run: &Run, robot: &str) -> i64 {
-    let r = run.robots.iter().position(|(_, n)| n == robot).unwrap();
+    let r = index_of(run, robot);
     let sends: Vec<i64> = run
         .trace
         .iter()
@@ -525,7 +530,7 @@ fn group_sync(moves: [i64; 3], faults: &str) -> Run {
 
 /// When `robot` passed the group statement's start, and how.
 fn synced(run: &Run, robot: &str) -> Option<(i64, &'static str)> {
-    let r = run.robots.iter().position(|(_, n)| n == robot).unwrap();
+    let r = index_of(run, robot);
     run.trace
         .iter()
         .find(|e| {
@@ -584,7 +589,7 @@ fn groups(run: &Run, robot: &str) -> Vec<(i64, String, String)> {
 
 /// The events of one kind of a robot, as `(t, field values)`.
 fn events(run: &Run, robot: &str, event: &str, fields: &[&str]) -> Vec<(i64, Vec<String>)> {
-    let r = run.robots.iter().position(|(_, n)| n == robot).unwrap();
+    let r = index_of(run, robot);
     run.trace
         .iter()
         .filter(|e| e.robot == r && e.event == event)
