@@ -35,12 +35,17 @@ impl TestClient {
 
     /// `initialize` + `initialized`. `encodings` are the position encodings
     /// the client offers (e.g. `["utf-8", "utf-16"]`); `root` a workspace folder.
-    /// The client takes snippets in completion items.
+    /// The client takes snippets in completion items and applies edits
+    /// that create, rename and delete files (as VS Code and Neovim do).
     pub async fn initialize(&mut self, encodings: &[&str], root: Option<&str>) -> Value {
         let capabilities = json!({
             "general": { "positionEncodings": encodings },
             "workspace": {
-                "didChangeWatchedFiles": { "dynamicRegistration": true }
+                "didChangeWatchedFiles": { "dynamicRegistration": true },
+                "workspaceEdit": {
+                    "documentChanges": true,
+                    "resourceOperations": ["create", "rename", "delete"]
+                }
             },
             "textDocument": {
                 "completion": { "completionItem": { "snippetSupport": true } }

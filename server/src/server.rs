@@ -24,6 +24,9 @@ pub struct Backend {
     snippets: AtomicBool,
     /// Whether the client shows `$/progress` (`window.workDoneProgress`).
     progress: AtomicBool,
+    /// Whether the client applies edits that create files
+    /// (`workspace.workspaceEdit`: document changes with `create`).
+    creates_files: AtomicBool,
     /// The live robot monitors, one per mission document.
     monitors: crate::monitor::Monitors,
 }
@@ -39,6 +42,7 @@ impl Backend {
             can_watch: Default::default(),
             snippets: AtomicBool::new(false),
             progress: AtomicBool::new(false),
+            creates_files: AtomicBool::new(false),
             monitors: Default::default(),
         }
     }
@@ -425,6 +429,18 @@ impl LanguageServer for Backend {
             .and_then(|w| w.work_done_progress)
             .unwrap_or(false);
         self.progress.store(progress, Ordering::Relaxed);
+        let edits = params
+            .capabilities
+            .workspace
+            .as_ref()
+            .and_then(|w| w.workspace_edit.as_ref());
+        let creates_files = edits.is_some_and(|e| {
+            e.document_changes == Some(true)
+                && e.resource_operations
+                    .as_ref()
+                    .is_some_and(|ops| ops.contains(&ResourceOperationKind::Create))
+        });
+        self.creates_files.store(creates_files, Ordering::Relaxed);
         let snippets = handlers::completion::snippet_support(&params.capabilities);
         self.snippets.store(snippets, Ordering::Relaxed);
         {
@@ -578,8 +594,13 @@ impl LanguageServer for Backend {
             .await?;
         let world = self.state.world();
         let mut response = found.response(|id| world.uri_of(id).cloned());
-        // `semo verify`'s findings: write the scenario that shows each.
-        if let Some(snapshot) = world.snapshot(&uri).filter(|_| quick_fixes) {
+        // `semo verify`'s findings: write the scenario that shows each (a
+        // new file: only for a client that creates files).
+        let creates_files = self.creates_files.load(Ordering::Relaxed);
+        if let Some(snapshot) = world
+            .snapshot(&uri)
+            .filter(|_| quick_fixes && creates_files)
+        {
             response.extend(self.state.verified.scenario_actions(&snapshot, &asked));
         }
         Ok(Some(response))

@@ -108,3 +108,59 @@ async fn a_saved_mission_gets_its_verify_findings_and_an_edit_drops_them() {
     );
     client.shutdown().await;
 }
+
+/// A client that cannot create files (no `create` resource operation) is
+/// offered no action that would need one.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_client_that_cannot_create_files_gets_no_scenario_action() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/verify/never_finishes");
+    let mission = dir.join("main.mission");
+    let text = std::fs::read_to_string(&mission).unwrap();
+    let mission = file_uri(&mission);
+    let mut client = TestClient::start();
+    // The harness's usual client, less the file operations of its edits.
+    let plain = json!({
+        "general": { "positionEncodings": ["utf-16"] },
+        "workspace": { "didChangeWatchedFiles": { "dynamicRegistration": true } },
+    });
+    client.initialize_with(plain, Some(&file_uri(&dir))).await;
+    client.open(&mission, &text).await;
+    client.diagnostics(&mission, Some(1)).await;
+    client
+        .notify(
+            "textDocument/didSave",
+            json!({ "textDocument": { "uri": mission } }),
+        )
+        .await;
+    let found = client
+        .notification("textDocument/publishDiagnostics", |p| {
+            p["uri"] == mission.as_str() && codes(&p["diagnostics"]).contains(&"V002".to_string())
+        })
+        .await;
+    let v002 = found["diagnostics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|d| d["code"] == "V002")
+        .unwrap()
+        .clone();
+    let actions = client
+        .request(
+            "textDocument/codeAction",
+            json!({
+                "textDocument": { "uri": mission },
+                "range": v002["range"],
+                "context": { "diagnostics": [v002] }
+            }),
+        )
+        .await
+        .unwrap();
+    let titles: Vec<&str> = (actions.as_array().unwrap().iter())
+        .map(|a| a["title"].as_str().unwrap())
+        .collect();
+    assert!(
+        !titles.iter().any(|t| t.starts_with("Write the scenario")),
+        "{titles:?}"
+    );
+    client.shutdown().await;
+}
