@@ -303,6 +303,10 @@ struct Robot<'p> {
     /// Joined the mission under way (restarted after one heartbeat period):
     /// listens first, and follows a live claimant instead of claiming.
     rejoining: bool,
+    /// Fenced at an election since it last led (`Some`), with when it heard
+    /// a majority again (`Some(Some(t))`: it listens until `t` + the
+    /// listening time before it claims).
+    fenced: Option<Option<i64>>,
     /// How often this robot reached each `GroupSync` state, by (service, pc).
     sync_pass: HashMap<(usize, usize), i64>,
     /// The last pass each (peer, sync point) announced (`comm_sync_arrived`).
@@ -474,6 +478,7 @@ impl<'p> Robot<'p> {
             ],
             leading: false,
             rejoining: m.heartbeat && at > m.heartbeat_ms,
+            fenced: None,
             sync_pass: HashMap::new(),
             sync_arrived: HashMap::new(),
             leaders: HashMap::new(),
@@ -2024,15 +2029,30 @@ impl<'p> Sim<'p> {
             robot.leading = false;
             if 2 * heard <= candidates.len() {
                 robot.rejoining = true;
+                robot.fenced = Some(None);
                 if robot.leaders.insert(state, FENCED) != Some(FENCED) {
                     let counted = crate::codegen::fenced_heard(heard, candidates.len());
                     self.emit(r, "fenced", vec![("heard", counted.into())]);
                 }
                 return None;
             }
+            if let Some(regained) = robot.fenced {
+                // A majority again: listen before claiming, so that the
+                // heartbeat of a robot leading meanwhile has come.
+                let regained = regained.unwrap_or(now);
+                if now - regained < crate::codegen::listen_ms(hb) {
+                    robot.fenced = Some(Some(regained));
+                    return None;
+                }
+                robot.fenced = None;
+            }
             robot.rejoining = false;
         }
         let robot = &mut self.robots[r];
+        if leader != me {
+            // It follows a live robot: it has heard the team again.
+            robot.fenced = None;
+        }
         robot.leading = leader == me;
         if robot.leaders.get(&state) != Some(&leader) {
             robot.leaders.insert(state, leader);

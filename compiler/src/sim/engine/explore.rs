@@ -447,6 +447,11 @@ impl Fingerprint {
         }
         self.int(robot.leading as i64);
         self.int(robot.rejoining as i64);
+        match robot.fenced {
+            None => self.int(-1),
+            Some(None) => self.int(-2),
+            Some(Some(t)) => self.time(t),
+        }
         for map in [&robot.sync_pass, &robot.sync_arrived] {
             let mut entries: Vec<_> = map.iter().collect();
             entries.sort_unstable();
