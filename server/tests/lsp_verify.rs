@@ -19,6 +19,23 @@ fn codes(diagnostics: &Value) -> Vec<String> {
         .collect()
 }
 
+/// Saves `mission` and waits for the publication with the search's
+/// findings among its diagnostics: those diagnostics.
+async fn saved_and_verified(client: &mut TestClient, mission: &str) -> Value {
+    client
+        .notify(
+            "textDocument/didSave",
+            json!({ "textDocument": { "uri": mission } }),
+        )
+        .await;
+    let found = client
+        .notification("textDocument/publishDiagnostics", |p| {
+            p["uri"] == mission && codes(&p["diagnostics"]).contains(&"V002".to_string())
+        })
+        .await;
+    found["diagnostics"].clone()
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_saved_mission_gets_its_verify_findings_and_an_edit_drops_them() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/verify/never_finishes");
@@ -31,18 +48,8 @@ async fn a_saved_mission_gets_its_verify_findings_and_an_edit_drops_them() {
     // Opened: the check's diagnostics, no search yet.
     let opened = client.diagnostics(&mission, Some(1)).await;
     assert!(!codes(&json!(opened)).contains(&"V002".to_string()));
-    client
-        .notify(
-            "textDocument/didSave",
-            json!({ "textDocument": { "uri": mission } }),
-        )
-        .await;
-    let found = client
-        .notification("textDocument/publishDiagnostics", |p| {
-            p["uri"] == mission.as_str() && codes(&p["diagnostics"]).contains(&"V002".to_string())
-        })
-        .await;
-    let v002: Vec<&Value> = found["diagnostics"]
+    let found = saved_and_verified(&mut client, &mission).await;
+    let v002: Vec<&Value> = found
         .as_array()
         .unwrap()
         .iter()
@@ -126,18 +133,8 @@ async fn a_client_that_cannot_create_files_gets_no_scenario_action() {
     client.initialize_with(plain, Some(&file_uri(&dir))).await;
     client.open(&mission, &text).await;
     client.diagnostics(&mission, Some(1)).await;
-    client
-        .notify(
-            "textDocument/didSave",
-            json!({ "textDocument": { "uri": mission } }),
-        )
-        .await;
-    let found = client
-        .notification("textDocument/publishDiagnostics", |p| {
-            p["uri"] == mission.as_str() && codes(&p["diagnostics"]).contains(&"V002".to_string())
-        })
-        .await;
-    let v002 = found["diagnostics"]
+    let found = saved_and_verified(&mut client, &mission).await;
+    let v002 = found
         .as_array()
         .unwrap()
         .iter()

@@ -259,6 +259,10 @@ impl Leaders {
 
     /// Notes state `id` if two robots lead one statement in it.
     fn look(&mut self, sim: &Sim, id: u32) {
+        // Most missions elect no one: nothing to look at in any state.
+        if self.statements.iter().all(|(_, lines)| lines.is_empty()) {
+            return;
+        }
         let mut leading: HashMap<(&str, u32), usize> = HashMap::new();
         for r in 0..sim.robot_count() {
             let (team, lines) = &self.statements[r];
