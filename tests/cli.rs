@@ -343,6 +343,36 @@ fn fmt_check_lists_the_files_that_would_change_and_writes_nothing() {
 }
 
 #[test]
+fn fmt_diff_prints_a_patch_that_formats_the_file_and_writes_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(dir.join("a.mission"), UNFORMATTED).unwrap();
+    std::fs::write(dir.join("c.mission"), FORMATTED).unwrap();
+    let out = semo_in(dir, &["fmt", "--diff", "a.mission", "c.mission"]);
+    assert_eq!(out.code, 1, "{}", out.stderr);
+    assert!(
+        out.stdout
+            .starts_with("--- a/a.mission\n+++ b/a.mission\n@@ "),
+        "{}",
+        out.stdout
+    );
+    assert!(!out.stdout.contains("c.mission"), "{}", out.stdout);
+    assert_eq!(read(&dir.join("a.mission")), UNFORMATTED);
+    assert_eq!(names(dir), ["a.mission", "c.mission"]);
+    // The patch is the formatting: applied, the file is the formatted text.
+    std::fs::write(dir.join("fmt.patch"), &out.stdout).unwrap();
+    let applied = std::process::Command::new("git")
+        .args(["apply", "fmt.patch"])
+        .current_dir(dir)
+        .output()
+        .expect("git runs");
+    assert!(applied.status.success(), "{applied:?}");
+    assert_eq!(read(&dir.join("a.mission")), FORMATTED);
+    let out = semo_in(dir, &["fmt", "--diff", "a.mission", "c.mission"]);
+    assert_eq!((out.code, out.stdout.as_str()), (0, ""));
+}
+
+#[test]
 fn fmt_leaves_a_file_with_syntax_errors_as_it_is_and_says_where() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();

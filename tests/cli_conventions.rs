@@ -943,3 +943,91 @@ fn explain_gives_every_code_a_wrong_example_that_has_it_and_a_right_one_that_doe
     let all = semo(&["explain"]);
     assert_eq!(all.stdout.lines().count(), semo::diag::Code::ALL.len());
 }
+
+#[test]
+fn completions_complete_commands_and_option_values_in_a_real_bash() {
+    let script = semo(&["completions", "bash"]);
+    assert_eq!(script.code, 0, "{}", script.stderr);
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("semo.bash"), &script.stdout).unwrap();
+    // What bash offers after the words typed so far, as a user's Tab would.
+    let offered = |words: &[&str]| -> Vec<String> {
+        let words_array = words
+            .iter()
+            .map(|w| format!("'{w}'"))
+            .collect::<Vec<_>>()
+            .join(" ");
+        let program = format!(
+            "source semo.bash; COMP_WORDS=({words_array}); COMP_CWORD={}; \
+             _semo semo '{}' '{}'; printf '%s\\n' \"${{COMPREPLY[@]}}\"",
+            words.len() - 1,
+            words[words.len() - 1],
+            words[words.len() - 2],
+        );
+        let out = Command::new("bash")
+            .args(["--norc", "-c", &program])
+            .current_dir(dir.path())
+            .output()
+            .expect("bash runs");
+        assert!(out.status.success(), "{out:?}");
+        String::from_utf8(out.stdout)
+            .unwrap()
+            .lines()
+            .map(str::to_string)
+            .collect()
+    };
+    assert_eq!(offered(&["semo", "ver"]), ["verify"]);
+    let formats = offered(&["semo", "check", "--format", ""]);
+    for format in ["human", "json", "sarif"] {
+        assert!(formats.iter().any(|f| f == format), "{formats:?}");
+    }
+    // The other shells' scripts come from the same definition.
+    let zsh = semo(&["completions", "zsh"]);
+    assert!(zsh.stdout.starts_with("#compdef semo"), "{}", zsh.stdout);
+    let fish = semo(&["completions", "fish"]);
+    assert!(
+        fish.stdout.contains("complete -c semo") && fish.stdout.contains("verify"),
+        "{}",
+        fish.stdout
+    );
+    let unknown = semo(&["completions", "tcsh"]);
+    assert_eq!(unknown.code, 2, "{}", unknown.stderr);
+}
+
+#[test]
+fn man_prints_semo_1_and_writes_a_page_per_command() {
+    let page = semo(&["man"]);
+    assert_eq!(page.code, 0, "{}", page.stderr);
+    assert!(page.stdout.contains(".TH semo 1"), "{}", page.stdout);
+    for command in ["check", "fmt", "build", "simulate", "verify", "completions"] {
+        assert!(page.stdout.contains(command), "{command} not in semo(1)");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let out = semo(&["man", "-o", &dir.path().join("man1").display().to_string()]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let check = std::fs::read_to_string(dir.path().join("man1/semo-check.1")).unwrap();
+    assert!(check.contains(".TH semo-check 1"), "{check}");
+    assert!(check.contains("deny"), "{check}");
+    assert!(dir.path().join("man1/semo-graph-analyze.1").is_file());
+}
+
+#[test]
+fn version_names_the_commit_it_was_built_from() {
+    let out = semo(&["--version"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    // Built from a git checkout (as every test run is): `semo 0.1.0 (1a2b3c4d5e6f 2026-11-29)`.
+    let head = Command::new("git")
+        .args(["log", "-1", "--format=%h %cs", "--abbrev=12"])
+        .current_dir(repo_root())
+        .output()
+        .expect("git runs");
+    let head = String::from_utf8(head.stdout).unwrap();
+    if head.trim().is_empty() {
+        eprintln!("skipping the commit: not a git checkout");
+        return;
+    }
+    assert_eq!(
+        out.stdout.trim(),
+        format!("semo {} ({})", env!("CARGO_PKG_VERSION"), head.trim())
+    );
+}

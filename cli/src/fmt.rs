@@ -19,6 +19,8 @@ pub enum Mode {
     Check,
     /// Print the formatted text.
     Stdout,
+    /// Write nothing; print a unified diff of what would change.
+    Diff,
 }
 
 /// Where a mission comes from.
@@ -116,6 +118,10 @@ fn one(input: &Input, mode: Mode, out: &mut impl Write) -> i32 {
     let written = match (mode, input) {
         (Mode::Check, _) if changed => writeln!(out, "{name}").map(|()| 1),
         (Mode::Check, _) => Ok(0),
+        (Mode::Diff, _) if changed => out
+            .write_all(unified_diff(&name, &text, &formatted).as_bytes())
+            .map(|()| 1),
+        (Mode::Diff, _) => Ok(0),
         (Mode::Stdout, _) | (Mode::InPlace, Input::Stdin) => {
             out.write_all(formatted.as_bytes()).map(|()| 0)
         }
@@ -139,6 +145,22 @@ fn one(input: &Input, mode: Mode, out: &mut impl Write) -> i32 {
     }
 }
 
+/// What formatting changes, as `git apply` and `patch -p1` read it: the old
+/// text under `a/NAME`, the new under `b/NAME` (an absolute NAME as it is),
+/// three lines of context.
+fn unified_diff(name: &str, old: &str, new: &str) -> String {
+    let (old_name, new_name) = if name.starts_with('/') {
+        (name.to_string(), name.to_string())
+    } else {
+        (format!("a/{name}"), format!("b/{name}"))
+    };
+    similar::TextDiff::from_lines(old, new)
+        .unified_diff()
+        .context_radius(3)
+        .header(&old_name, &new_name)
+        .to_string()
+}
+
 /// `file:line:column: reason`, the position counted in characters from 1.
 fn describe(name: &str, text: &str, refusal: &FormatRefusal) -> String {
     match refusal.span() {
@@ -154,7 +176,7 @@ fn describe(name: &str, text: &str, refusal: &FormatRefusal) -> String {
 /// link) by `text`: a temporary file in the same folder, with the original's
 /// permissions, renamed over it. Either the old text stays or the new one is
 /// there whole. A read-only file is not replaced.
-fn write_replacing(path: &Path, text: &str) -> io::Result<()> {
+pub fn write_replacing(path: &Path, text: &str) -> io::Result<()> {
     let target = std::fs::canonicalize(path)?;
     let permissions = std::fs::metadata(&target)?.permissions();
     if permissions.readonly() {

@@ -11,6 +11,7 @@ mod graph;
 mod init;
 mod input;
 mod lockstep;
+mod manual;
 mod operator;
 mod output;
 mod render;
@@ -18,7 +19,7 @@ mod simulate;
 mod verify;
 mod watch;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use output::Format;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -26,7 +27,7 @@ use std::path::PathBuf;
 #[derive(Parser, Debug)]
 #[command(
     name = "semo",
-    version,
+    version = env!("SEMO_VERSION"),
     about = "SeMo: mission scripts for teams of cooperating robots",
     long_about = "SeMo checks mission scripts (*.mission) against a robot catalog (the built-in \
                   one plus any *.robot.xml files) and strategy files (`semo check`), lays them \
@@ -86,7 +87,7 @@ enum Command {
         and `-` reads standard input and writes the result to standard output. With no \
         PATH, the current folder. A file is rewritten only when its layout changes; a file \
         with syntax errors is left as it is and reported.\n\n\
-        Exit status: 0 when all is formatted, 1 when a file was refused or (with --check) \
+        Exit status: 0 when all is formatted, 1 when a file was refused or (with --check or --diff) \
         is not formatted, 2 for a path or I/O problem."
     )]
     Fmt {
@@ -99,6 +100,10 @@ enum Command {
         /// Print the formatted text instead of rewriting the files.
         #[arg(long, conflicts_with = "check")]
         stdout: bool,
+        /// Write nothing; print a unified diff of what formatting would
+        /// change (`git apply` takes it), and exit with 1 if there is any.
+        #[arg(long, conflicts_with_all = ["check", "stdout"])]
+        diff: bool,
     },
     /// Generate the code of a mission: one folder per robot with its refined
     /// task graph and a C program that builds with `make`.
@@ -351,6 +356,30 @@ enum Command {
         /// A code such as E019; all codes when omitted.
         code: Option<String>,
     },
+    /// Print the shell completion script for SHELL on standard output.
+    #[command(
+        long_about = "Print the completion script of `semo` for SHELL on standard output: its \
+        commands, options and their values. For example `semo completions bash > \
+        ~/.local/share/bash-completion/completions/semo`, `semo completions zsh > \
+        ~/.zfunc/_semo` (with ~/.zfunc in fpath) or `semo completions fish > \
+        ~/.config/fish/completions/semo.fish`."
+    )]
+    Completions {
+        /// bash, zsh, fish, elvish or powershell.
+        shell: clap_complete::Shell,
+    },
+    /// Print the manual page of `semo` (roff), or with -o write one page
+    /// per command into a folder.
+    #[command(
+        long_about = "Print the manual page semo(1) in roff on standard output (`semo man | man \
+        -l -`), or with -o DIR write semo.1 and one page per command (semo-check.1, \
+        semo-build.1, …) into DIR, for example ~/.local/share/man/man1."
+    )]
+    Man {
+        /// The folder to write every page into (created if missing).
+        #[arg(long = "output", short = 'o', value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
 }
 
 #[derive(Subcommand, Debug)]
@@ -557,11 +586,13 @@ fn run() -> i32 {
             paths,
             check,
             stdout,
+            diff,
         } => {
-            let mode = match (check, stdout) {
-                (true, _) => fmt::Mode::Check,
-                (false, true) => fmt::Mode::Stdout,
-                (false, false) => fmt::Mode::InPlace,
+            let mode = match (check, stdout, diff) {
+                (true, _, _) => fmt::Mode::Check,
+                (_, true, _) => fmt::Mode::Stdout,
+                (_, _, true) => fmt::Mode::Diff,
+                _ => fmt::Mode::InPlace,
             };
             fmt::run(paths, mode, &mut out)
         }
@@ -712,6 +743,8 @@ fn run() -> i32 {
             &mut out,
         ),
         Command::Explain { code } => explain(code.as_deref(), &mut out),
+        Command::Completions { shell } => manual::completions(Cli::command(), shell, &mut out),
+        Command::Man { out: dir } => manual::man(Cli::command(), dir.as_deref(), &mut out),
         Command::Catalog {
             robot_type,
             format,
