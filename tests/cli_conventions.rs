@@ -1031,3 +1031,144 @@ fn version_names_the_commit_it_was_built_from() {
         format!("semo {} ({})", env!("CARGO_PKG_VERSION"), head.trim())
     );
 }
+
+/// A copy of `tests/fixtures/diagnostics` (every kind of file, most with
+/// problems) in a temporary folder.
+fn fixtures_copy() -> tempfile::TempDir {
+    let tmp = tempfile::tempdir().unwrap();
+    let from = repo_root().join("tests/fixtures/diagnostics");
+    for entry in walkdir::WalkDir::new(&from) {
+        let entry = entry.unwrap();
+        let to = tmp.path().join(entry.path().strip_prefix(&from).unwrap());
+        if entry.file_type().is_dir() {
+            std::fs::create_dir_all(&to).unwrap();
+        } else {
+            std::fs::copy(entry.path(), &to).unwrap();
+        }
+    }
+    tmp
+}
+
+/// Every file under `dir` with its text.
+fn contents(dir: &std::path::Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
+    let mut found: Vec<_> = walkdir::WalkDir::new(dir)
+        .into_iter()
+        .map(|e| e.unwrap())
+        .filter(|e| e.file_type().is_file())
+        .map(|e| (e.path().to_path_buf(), std::fs::read(e.path()).unwrap()))
+        .collect();
+    found.sort();
+    found
+}
+
+/// `semo check --statistics --format json` in `dir`: (code, count, fixable) per code.
+fn statistics_in(dir: &std::path::Path) -> Vec<(String, u64, u64)> {
+    let out = semo_in_dir(dir, &["check", "--statistics", "--format", "json", "."]);
+    let document: serde_json::Value = serde_json::from_str(&out.stdout).expect("one document");
+    document["statistics"]
+        .as_array()
+        .expect("statistics")
+        .iter()
+        .map(|s| {
+            (
+                s["code"].as_str().unwrap().to_string(),
+                s["count"].as_u64().unwrap(),
+                s["fixable"].as_u64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn check_fix_applies_every_preferred_fix_and_a_second_run_changes_nothing() {
+    let tmp = fixtures_copy();
+    let dir = tmp.path();
+    let before = statistics_in(dir);
+    let fixable: u64 = before.iter().map(|s| s.2).sum();
+    assert!(fixable >= 10, "{before:?}");
+    let out = semo_in_dir(dir, &["check", "--fix", "--format", "json", "."]);
+    let document: serde_json::Value = serde_json::from_str(&out.stdout).expect("one document");
+    let fixes = document["fixes"].as_array().expect("the fixes applied");
+    // A fix can uncover another: at least every one counted before is applied.
+    assert!(fixes.len() as u64 >= fixable, "{fixes:#?}");
+    for fix in fixes {
+        let file = dir.join(fix["file"].as_str().unwrap());
+        assert!(file.is_file(), "{fix}");
+        assert!(fix["code"].as_str().unwrap().len() == 4, "{fix}");
+    }
+    // Nothing fixable is left, and each code has at most as many problems.
+    let after = statistics_in(dir);
+    assert!(after.iter().all(|s| s.2 == 0), "{after:?}");
+    for (code, count, _) in &after {
+        let was = before.iter().find(|s| &s.0 == code).map_or(0, |s| s.1);
+        assert!(
+            *count <= was || code.starts_with('W'),
+            "{code}: {was} -> {count}"
+        );
+    }
+    let fixed = contents(dir);
+    let again = semo_in_dir(dir, &["check", "--fix", "."]);
+    assert!(!again.stderr.contains("fixed "), "{}", again.stderr);
+    assert!(contents(dir) == fixed, "a second --fix changed a file");
+}
+
+#[test]
+fn check_fix_of_standard_input_prints_the_fixed_mission() {
+    let mission = fixture("E017_unknown_mode.mission");
+    let out = semo_with_stdin(&repo_root(), &["check", "--fix", "-"], &mission);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert_eq!(
+        out.stdout,
+        mission.replace("mode = RETUN_MODE", "mode = RETURN_MODE")
+    );
+    assert!(
+        out.stderr
+            .contains("fixed <stdin>:21:29: [E017] Change `RETUN_MODE` to `RETURN_MODE`"),
+        "{}",
+        out.stderr
+    );
+}
+
+#[test]
+fn concise_gives_one_line_per_problem_and_statistics_count_them_by_code() {
+    let dir = repo_root().join("tests/fixtures/diagnostics");
+    let json = semo_in_dir(&dir, &["check", "--format", "json", "."]);
+    let diags = support::parse_json_report(&json.stdout);
+    let concise = semo_in_dir(&dir, &["check", "--format", "concise", "."]);
+    assert_eq!(concise.code, 1);
+    let line =
+        regex::Regex::new(r"^[^:]+:\d+:\d+: (error|warning|hint)\[[EW]\d{3}\]: .+$").unwrap();
+    let problems: Vec<&str> = concise
+        .stderr
+        .lines()
+        .filter(|l| !l.starts_with("checked ") && !l.contains("semo check --fix"))
+        .collect();
+    assert_eq!(problems.len(), diags.len(), "{}", concise.stderr);
+    for (text, d) in problems.iter().zip(&diags) {
+        assert!(line.is_match(text), "{text}");
+        let at = format!(
+            "{}:{}:{}: {}[{}]: ",
+            d.file, d.start.0, d.start.1, d.severity, d.code
+        );
+        assert!(text.starts_with(&at), "{text} is not {at}");
+    }
+    let statistics = statistics_in(&dir);
+    for (code, count, _) in &statistics {
+        let listed = diags.iter().filter(|d| &d.code == code).count() as u64;
+        assert_eq!(*count, listed, "{code}");
+    }
+    assert_eq!(
+        statistics.iter().map(|s| s.1).sum::<u64>(),
+        diags.len() as u64
+    );
+    let people = semo_in_dir(&dir, &["check", "--statistics", "."]);
+    let first = people.stderr.lines().next().unwrap_or_default();
+    let top = &statistics[0];
+    assert!(
+        first
+            .trim_start()
+            .starts_with(&format!("{}  {}", top.1, top.0)),
+        "{}",
+        people.stderr
+    );
+}

@@ -144,7 +144,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         run.diagnostics.extend(result.diagnostics);
         semo::diag::sort_and_dedup(&mut run.diagnostics);
         let reported = match options.format {
-            Format::Human => super::render::human(&run, options.color, &mut std::io::stderr()),
+            Format::Human | Format::Concise => {
+                super::render::human(&run, options.format, options.color, &mut std::io::stderr())
+            }
             format => output::report(
                 format,
                 "build",
@@ -171,12 +173,13 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     }
-    let human = options.format == Format::Human;
+    let human = options.format.for_people();
     // The mission builds: its warnings are what `semo check` gives for it
     // (the host's diagnostics and dataflow, refinement's W130 among them),
     // printed before anything is written.
     if human {
-        let shown = super::render::diagnostics(
+        let shown = super::render::people(
+            options.format,
             &run.files,
             &run.diagnostics,
             options.color,
@@ -314,7 +317,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
 /// standard error) or in a JSON document or SARIF log.
 fn report_scenario(record: &Record, format: Format, out: &mut impl Write) {
     let written = match format {
-        Format::Human => {
+        Format::Human | Format::Concise => {
             eprintln!("{}", record.scenario_line());
             Ok(())
         }

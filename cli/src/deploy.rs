@@ -98,7 +98,7 @@ pub fn broker_config(
     let refined = codegen::refine_checked(&input);
     if refined.programs.is_empty() {
         run.diagnostics = refined.diagnostics;
-        let _ = render::human(&run, color, &mut std::io::stderr());
+        let _ = render::human(&run, Format::Human, color, &mut std::io::stderr());
         eprintln!("error: refused: fix the errors above first");
         return 1;
     }

@@ -186,7 +186,8 @@ pub fn analyze(
         return 2;
     };
     let written = match format {
-        Format::Human => render::diagnostics(
+        Format::Human | Format::Concise => render::people(
+            format,
             &files,
             &run.diagnostics,
             color,

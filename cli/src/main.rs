@@ -4,8 +4,10 @@
 
 mod build;
 mod catalog;
+mod check;
 mod defaults;
 mod deploy;
+mod fix;
 mod fmt;
 mod graph;
 mod init;
@@ -75,8 +77,18 @@ enum Command {
         deny: Vec<Deny>,
         /// Check again whenever a mission, catalog, strategy or task-graph
         /// file under the paths changes, until stopped.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "fix")]
         watch: bool,
+        /// Apply the fix each problem prefers (the editor's quick fix: a
+        /// did-you-mean, a missing `default`, …) to the mission and strategy
+        /// files, list what was fixed, and report what is left. A mission on
+        /// standard input is printed fixed on standard output.
+        #[arg(long)]
+        fix: bool,
+        /// Instead of each problem, how many there are of each code (and how
+        /// many `--fix` would fix).
+        #[arg(long)]
+        statistics: bool,
     },
     /// Rewrite mission scripts in the canonical layout.
     #[command(
@@ -570,16 +582,24 @@ fn run() -> i32 {
             color,
             deny,
             watch,
+            fix,
+            statistics,
         } => {
-            let (color, deny) = (use_color(color), deny.contains(&Deny::Warnings));
+            let options = check::Options {
+                format,
+                color: use_color(color),
+                deny_warnings: deny.contains(&Deny::Warnings),
+                fix,
+                statistics,
+            };
             if watch {
                 watch::run(&paths, || {
-                    let code = check(paths.clone(), format, color, deny, &mut out);
+                    let code = check::run(paths.clone(), options, &mut out);
                     let _ = out.flush();
                     code
                 })
             } else {
-                check(paths, format, color, deny, &mut out)
+                check::run(paths, options, &mut out)
             }
         }
         Command::Fmt {
@@ -800,7 +820,9 @@ fn refine_or_report(
     if refined.diagnostics.iter().any(|d| d.is_error()) {
         check.diagnostics = refined.diagnostics;
         let reported = match format {
-            Format::Human => render::human(check, color, &mut std::io::stderr().lock()),
+            Format::Human | Format::Concise => {
+                render::human(check, format, color, &mut std::io::stderr().lock())
+            }
             _ => output::report(
                 format,
                 command,
@@ -851,74 +873,6 @@ fn colour_auto(
         ColorChoice::Never => false,
         ColorChoice::Auto => !no_color && (force || (!dumb && terminal)),
     }
-}
-
-fn check(
-    paths: Vec<PathBuf>,
-    format: Format,
-    color: bool,
-    deny_warnings: bool,
-    out: &mut impl Write,
-) -> i32 {
-    let paths = if paths.is_empty() {
-        vec![PathBuf::from(".")]
-    } else {
-        paths
-    };
-    let run = match load_for_check(&paths) {
-        Ok(run) => run,
-        Err((path, message)) => return output::refused(format, "check", &path, &message, out),
-    };
-    let written = match format {
-        // The report for people, summary included, is diagnostics: stderr.
-        Format::Human => render::human(&run, color, &mut std::io::stderr().lock()),
-        _ => output::report(
-            format,
-            "check",
-            &run.files,
-            &run.diagnostics,
-            color,
-            serde_json::json!({}),
-            out,
-        ),
-    };
-    if let Err(code) = output::written(written) {
-        return code;
-    }
-    let warnings = run
-        .diagnostics
-        .iter()
-        .filter(|d| d.severity == semo::diag::Severity::Warning)
-        .count();
-    if run.error_count() > 0 {
-        1
-    } else if deny_warnings && warnings > 0 {
-        eprintln!("error: {warnings} warning(s), denied by --deny warnings");
-        1
-    } else {
-        0
-    }
-}
-
-/// The files `semo check PATHS` reports on, loaded; or the path that
-/// stopped it and why.
-fn load_for_check(paths: &[PathBuf]) -> Result<semo::host::CheckRun, (PathBuf, String)> {
-    for path in paths {
-        if let Some(message) = input::named_file_misfit(path) {
-            return Err((path.clone(), message));
-        }
-    }
-    if paths.iter().any(|p| input::is_stdin(p)) {
-        if paths.len() > 1 {
-            let message =
-                "`-` (a mission on standard input) cannot be checked with other paths".to_string();
-            return Err((PathBuf::from(input::STDIN_NAME), message));
-        }
-        return input::read_stdin()
-            .map(semo::host::load_check_stdin)
-            .map_err(|message| (PathBuf::from(input::STDIN_NAME), message));
-    }
-    semo::host::load_check(paths).map_err(|e| (e.path.clone(), e.to_string()))
 }
 
 fn explain(code: Option<&str>, out: &mut impl Write) -> i32 {

@@ -83,7 +83,12 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let refined = codegen::refine_checked(&input);
     let Some(first) = refined.programs.first() else {
         run.diagnostics = refined.diagnostics;
-        let _ = super::render::human(&run, options.color, &mut std::io::stderr());
+        let _ = super::render::human(
+            &run,
+            super::output::Format::Human,
+            options.color,
+            &mut std::io::stderr(),
+        );
         eprintln!("error: refused: fix the errors above first");
         return 1;
     };

@@ -24,6 +24,17 @@ pub enum Format {
     Json,
     /// A SARIF 2.1.0 log on standard output (code-scanning tools).
     Sarif,
+    /// One line per problem on standard error (`FILE:LINE:COL: error[E017]:
+    /// message`), for grep, editors' error lists and CI logs.
+    Concise,
+}
+
+impl Format {
+    /// Whether the diagnostics are for people, on standard error (the
+    /// command's data then goes to standard output as text).
+    pub fn for_people(self) -> bool {
+        matches!(self, Format::Human | Format::Concise)
+    }
 }
 
 /// A 1-based line and column (columns in characters).
@@ -288,8 +299,8 @@ pub fn report(
     out: &mut impl Write,
 ) -> io::Result<()> {
     match format {
-        Format::Human => {
-            super::render::diagnostics(files, diagnostics, color, &mut io::stderr().lock())
+        Format::Human | Format::Concise => {
+            super::render::people(format, files, diagnostics, color, &mut io::stderr().lock())
         }
         Format::Json => write_json(
             out,
@@ -314,7 +325,7 @@ pub fn refused(
     eprintln!("error: {message}");
     let records = [Record::uncoded_error(file, 1, 1, message.to_string())];
     let written = match format {
-        Format::Human => Ok(()),
+        Format::Human | Format::Concise => Ok(()),
         Format::Json => write_json(
             out,
             &json_document(command, &records, serde_json::json!({})),

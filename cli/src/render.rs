@@ -1,6 +1,7 @@
-//! Rendering diagnostics for people: ariadne snippets and `semo check`'s
+//! Rendering diagnostics for people: ariadne snippets or one line each, and `semo check`'s
 //! summary line (machine shapes are in `output`).
 
+use crate::output::Format;
 use ariadne::{Color, Config, IndexType, Label, Report, ReportKind};
 use semo::diag::{Diagnostic, Severity};
 use semo::host::CheckRun;
@@ -124,9 +125,66 @@ fn without_escapes(bytes: &[u8]) -> Vec<u8> {
     out
 }
 
-/// `semo check`'s report: the diagnostics, then a one-line summary.
-pub fn human(run: &CheckRun, colored: bool, out: &mut impl Write) -> io::Result<()> {
-    diagnostics(&run.files, &run.diagnostics, colored, out)?;
+/// Diagnostics for people in `format` (which is `Human` or `Concise`):
+/// source snippets, or one line each.
+pub fn people(
+    format: Format,
+    files: &Files,
+    found: &[Diagnostic],
+    colored: bool,
+    out: &mut impl Write,
+) -> io::Result<()> {
+    match format {
+        Format::Concise => concise(files, found, out),
+        _ => diagnostics(files, found, colored, out),
+    }
+}
+
+/// One line per diagnostic, `FILE:LINE:COL: severity[CODE]: message`, the
+/// position of its start counted from 1 in characters; a did-you-mean the
+/// message does not name and the related places follow on the line.
+pub fn concise(files: &Files, found: &[Diagnostic], out: &mut impl Write) -> io::Result<()> {
+    let mut text = String::new();
+    for record in crate::output::records(files, found) {
+        let code = record.code.map_or("", |c| c.as_str());
+        text.push_str(&format!(
+            "{}:{}:{}: {}[{code}]: {}",
+            record.file, record.start.line, record.start.column, record.severity, record.message
+        ));
+        // Most messages name their did-you-mean already.
+        if let Some(s) = record
+            .suggestion
+            .as_ref()
+            .filter(|s| !record.message.contains(*s))
+        {
+            text.push_str(&format!(" (did you mean `{s}`?)"));
+        }
+        for related in &record.related {
+            text.push_str(&format!(
+                " [{}:{}:{}: {}]",
+                related.file, related.line, related.column, related.message
+            ));
+        }
+        text.push('\n');
+    }
+    out.write_all(text.as_bytes())?;
+    out.flush()
+}
+
+/// `semo check`'s report for people: the diagnostics in `format`, then a
+/// one-line summary.
+pub fn human(
+    run: &CheckRun,
+    format: Format,
+    colored: bool,
+    out: &mut impl Write,
+) -> io::Result<()> {
+    people(format, &run.files, &run.diagnostics, colored, out)?;
+    summary(run, out)
+}
+
+/// `checked 2 missions and 1 catalog file: 1 error, 0 warnings, 0 hints`.
+pub fn summary(run: &CheckRun, out: &mut impl Write) -> io::Result<()> {
     let count = |s: Severity| run.diagnostics.iter().filter(|d| d.severity == s).count();
     let plural = |n: usize, word: &str| format!("{n} {word}{}", if n == 1 { "" } else { "s" });
     let of_kind = |kind| {

@@ -86,10 +86,15 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             .collect::<Vec<_>>(),
     });
     let reported = match format {
-        Format::Human => {
+        Format::Human | Format::Concise => {
             let mut err = std::io::stderr().lock();
-            let written =
-                super::render::diagnostics(&check.files, &report.findings, options.color, &mut err);
+            let written = super::render::people(
+                format,
+                &check.files,
+                &report.findings,
+                options.color,
+                &mut err,
+            );
             let _ = writeln!(
                 out,
                 "{} {} state(s), {} transition(s): {}",
