@@ -190,7 +190,8 @@ enum Command {
     Deploy(DeployCommand),
     /// The operator console of a running mission: send the USER commands
     /// it receives (`NAME VALUE` per line on standard input), print what
-    /// robots send(USER, …) and each robot's status as it changes.
+    /// robots send(USER, …) and a robot's status when its state, mode or
+    /// leader changes.
     Operator {
         /// The mission script.
         mission: PathBuf,
