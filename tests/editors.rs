@@ -129,6 +129,7 @@ fn neovim_shows_the_diagnostic_completes_and_highlights_a_mission() {
         "simulate: IDLE@0 -> MOVING@1000, ok false",
         "scenario diagnostic: 4:13 expectation failed: r never enters IDLE: entered at 0 ms",
         "monitor: r          Rover        waiting",
+        "monitor window: r          Rover        waiting",
     ] {
         assert!(out.contains(expected), "missing {expected:?} in:\n{out}");
     }

@@ -186,6 +186,33 @@ local function run()
   check(vim.wait(10000, function() return stopped ~= nil end, 50), 'no answer to semo/monitor/stop')
   check(stopped.answer and stopped.answer.stopped == true, 'the monitor did not run: ' .. vim.inspect(stopped))
 
+  -- 7b. `:SemoMonitor` as a user types it: the table in a window of its own, rewritten in
+  -- place, and not one notification (it once printed every table through vim.notify).
+  local notified = 0
+  local notify = vim.notify
+  vim.notify = function(message, level)
+    notified = notified + 1
+    notify(message, level)
+  end
+  local windows = #vim.api.nvim_list_wins()
+  vim.cmd('SemoMonitor mqtt://127.0.0.1:1')
+  local monitor = vim.fn.bufnr('semo-monitor://drive.mission')
+  check(monitor ~= -1, 'no semo-monitor://drive.mission buffer')
+  check(#vim.api.nvim_list_wins() == windows + 1, 'the monitor has no window of its own')
+  check(vim.api.nvim_get_current_buf() == mission, 'the monitor took the cursor from the mission')
+  local function shown() return vim.api.nvim_buf_get_lines(monitor, 0, -1, false) end
+  check(vim.wait(30000, function() return shown()[1]:find('disconnected', 1, true) ~= nil end, 50),
+    'the monitor window never showed the disconnected table: ' .. vim.inspect(shown()))
+  check(#shown() == #vim.split(semo.monitor_table(seen), '\n'),
+    'the monitor window is not one table: ' .. vim.inspect(shown()))
+  report('monitor window: ' .. shown()[2])
+  vim.cmd('SemoMonitorStop')
+  check(vim.wait(10000, function() return shown()[1]:find('(monitor stopped)', 1, true) ~= nil end, 50),
+    'the monitor window does not say it stopped: ' .. vim.inspect(shown()))
+  vim.notify = notify
+  check(notified == 0, notified .. ' notification(s) from :SemoMonitor')
+  vim.cmd('only')
+
   -- 8. The scenario file (filetype json) gets the server, and completion of an expectation's
   -- mode offers the modes of its mission (drive.scenario.json belongs to drive.mission).
   vim.cmd('edit ' .. vim.fn.fnameescape(workspace .. '/drive.scenario.json'))

@@ -13,8 +13,9 @@
 -- Failed expectations appear as diagnostics on the scenario file.
 --
 -- `:SemoMonitor [BROKER]` in a mission watches its running robots on the MQTT broker (the
--- server's `semo/monitor`; default: the deployment file's broker) and prints the table of
--- robots, modes, services and leader whenever it changes; `:SemoMonitorStop` ends it.
+-- server's `semo/monitor`; default: the deployment file's broker) in a window of its own: the
+-- table of robots, modes, services and leader, rewritten in place as it changes (a buffer
+-- `semo-monitor://MISSION`); `:SemoMonitorStop` ends it (the last table stays, marked).
 local M = {}
 
 -- XML files that the server reads, and scenario files it completes; their filetype stays
@@ -231,6 +232,35 @@ function M.monitor_table(view)
   return table.concat(lines, '\n')
 end
 
+--- The scratch buffer showing the monitor of mission `uri` (created, and shown in a split
+--- below the current window, the first time).
+function M.monitor_buffer(uri)
+  local name = 'semo-monitor://' .. vim.fn.fnamemodify(vim.uri_to_fname(uri), ':t')
+  local buf = vim.fn.bufnr(name)
+  if buf == -1 then
+    buf = vim.api.nvim_create_buf(false, true)
+    vim.api.nvim_buf_set_name(buf, name)
+    vim.bo[buf].buftype = 'nofile'
+    vim.bo[buf].bufhidden = 'hide'
+    vim.bo[buf].swapfile = false
+  end
+  if vim.fn.bufwinid(buf) == -1 then
+    local current = vim.api.nvim_get_current_win()
+    vim.cmd('belowright split')
+    vim.api.nvim_win_set_buf(0, buf)
+    vim.api.nvim_win_set_height(0, 8)
+    vim.api.nvim_set_current_win(current)
+  end
+  return buf
+end
+
+--- Shows `text` (lines) in the monitor buffer `buf`, replacing what it showed.
+function M.monitor_show(buf, text)
+  vim.bo[buf].modifiable = true
+  vim.api.nvim_buf_set_lines(buf, 0, -1, false, vim.split(text, '\n'))
+  vim.bo[buf].modifiable = false
+end
+
 local function on_monitor_view(_, view)
   if type(view) ~= 'table' or view.uri == nil then
     return
@@ -296,13 +326,15 @@ function M.setup(opts)
   vim.lsp.handlers['semo/monitor'] = on_monitor_view
   vim.api.nvim_create_user_command('SemoMonitor', function(command)
     local broker = command.fargs[1]
-    local shown
-    M.monitor(vim.api.nvim_get_current_buf(), broker, function(view)
-      local table_text = M.monitor_table(view)
-      if table_text ~= shown then
-        shown = table_text
-        vim.schedule(function() vim.notify(table_text, vim.log.levels.INFO) end)
-      end
+    local mission = vim.api.nvim_get_current_buf()
+    local buf = M.monitor_buffer(vim.uri_from_bufnr(mission))
+    M.monitor_show(buf, 'connecting…')
+    M.monitor(mission, broker, function(view)
+      vim.schedule(function()
+        if vim.api.nvim_buf_is_valid(buf) then
+          M.monitor_show(buf, M.monitor_table(view))
+        end
+      end)
     end, function(err)
       if err then
         vim.schedule(function() vim.notify('semo: ' .. err, vim.log.levels.ERROR) end)
@@ -310,7 +342,17 @@ function M.setup(opts)
     end)
   end, { nargs = '?', desc = 'Show the live status of the mission\'s robots (semo/monitor)' })
   vim.api.nvim_create_user_command('SemoMonitorStop', function()
-    M.monitor_stop(vim.api.nvim_get_current_buf(), function() end)
+    local mission = vim.api.nvim_get_current_buf()
+    local buf = vim.fn.bufnr('semo-monitor://' .. vim.fn.expand('%:t'))
+    M.monitor_stop(mission, function()
+      vim.schedule(function()
+        if buf ~= -1 and vim.api.nvim_buf_is_valid(buf) then
+          local lines = vim.api.nvim_buf_get_lines(buf, 0, -1, false)
+          lines[1] = (lines[1] or '') .. ' (monitor stopped)'
+          M.monitor_show(buf, table.concat(lines, '\n'))
+        end
+      end)
+    end)
   end, { desc = 'Stop monitoring the mission\'s robots' })
   vim.api.nvim_create_autocmd('FileType', {
     group = group,
