@@ -56,6 +56,18 @@ impl TestClient {
 
     /// `initialize` + `initialized` with the given client capabilities.
     pub async fn initialize_with(&mut self, capabilities: Value, root: Option<&str>) -> Value {
+        self.initialize_with_options(capabilities, Value::Null, root)
+            .await
+    }
+
+    /// `initialize` + `initialized` with the given client capabilities and
+    /// `initializationOptions`.
+    pub async fn initialize_with_options(
+        &mut self,
+        capabilities: Value,
+        options: Value,
+        root: Option<&str>,
+    ) -> Value {
         let folders = root.map(|r| json!([{ "uri": r, "name": "workspace" }]));
         let result = self
             .request(
@@ -65,6 +77,7 @@ impl TestClient {
                     "rootUri": root,
                     "workspaceFolders": folders,
                     "capabilities": capabilities,
+                    "initializationOptions": options,
                 }),
             )
             .await

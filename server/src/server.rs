@@ -27,6 +27,12 @@ pub struct Backend {
     /// Whether the client applies edits that create files
     /// (`workspace.workspaceEdit`: document changes with `create`).
     creates_files: AtomicBool,
+    /// Whether the client tells the user itself how a `semo.generateCode`
+    /// ended, from its answer (`initializationOptions`:
+    /// `generateCodeOutcome: true`, as the VS Code extension says): the
+    /// server then shows no message of its own for it, so that one
+    /// generation is one notification.
+    client_tells_generation: AtomicBool,
     /// The live robot monitors, one per mission document.
     monitors: crate::monitor::Monitors,
 }
@@ -41,6 +47,7 @@ impl Backend {
             state,
             can_watch: Default::default(),
             snippets: AtomicBool::new(false),
+            client_tells_generation: AtomicBool::new(false),
             progress: AtomicBool::new(false),
             creates_files: AtomicBool::new(false),
             monitors: Default::default(),
@@ -224,7 +231,7 @@ impl Backend {
                 "SeMo: code generation refused: {errors} error(s) in {} (see Problems)",
                 job.mission_path.display()
             );
-            self.client.show_message(MessageType::ERROR, &message).await;
+            self.tell_generation(MessageType::ERROR, &message).await;
             let reasons: Vec<String> = result
                 .diagnostics
                 .iter()
@@ -275,7 +282,7 @@ impl Backend {
                     p.finish_with_message("refused").await;
                 }
                 let message = format!("SeMo: {}", refused.message);
-                self.client.show_message(MessageType::ERROR, &message).await;
+                self.tell_generation(MessageType::ERROR, &message).await;
                 return Err(Error {
                     data: refused.data,
                     ..handlers::request_failed(message)
@@ -286,9 +293,7 @@ impl Backend {
         let recovered = transaction.recovered.clone();
         for line in &recovered {
             let message = format!("SeMo: recovered: {line}");
-            self.client
-                .show_message(MessageType::WARNING, &message)
-                .await;
+            self.tell_generation(MessageType::WARNING, &message).await;
         }
         for i in 0..all.len() {
             if let Some(p) = &progress {
@@ -318,9 +323,7 @@ impl Backend {
         };
         if !kept.is_empty() {
             let message = format!("SeMo: {}", output::kept_message(&kept));
-            self.client
-                .show_message(MessageType::WARNING, &message)
-                .await;
+            self.tell_generation(MessageType::WARNING, &message).await;
         }
         if let Some(p) = progress {
             p.finish_with_message(format!("{} robot(s)", robots.len()))
@@ -332,7 +335,7 @@ impl Backend {
             job.target.name(),
             job.out.path().display()
         );
-        self.client.show_message(MessageType::INFO, &message).await;
+        self.tell_generation(MessageType::INFO, &message).await;
         Ok(serde_json::json!({
             "refused": false,
             "outputFolder": job.out.path().display().to_string(),
@@ -356,8 +359,16 @@ impl Backend {
             p.finish_with_message("failed").await;
         }
         let message = format!("SeMo: cannot write the generated code: {error}");
-        self.client.show_message(MessageType::ERROR, &message).await;
+        self.tell_generation(MessageType::ERROR, &message).await;
         handlers::request_failed(message)
+    }
+
+    /// A message about a code generation, unless the client tells the user
+    /// itself (`client_tells_generation`).
+    async fn tell_generation(&self, kind: MessageType, message: &str) {
+        if !self.client_tells_generation.load(Ordering::Relaxed) {
+            self.client.show_message(kind, message).await;
+        }
     }
 
     async fn register_watchers(&self) {
@@ -443,6 +454,13 @@ impl LanguageServer for Backend {
         self.creates_files.store(creates_files, Ordering::Relaxed);
         let snippets = handlers::completion::snippet_support(&params.capabilities);
         self.snippets.store(snippets, Ordering::Relaxed);
+        let tells = params
+            .initialization_options
+            .as_ref()
+            .and_then(|o| o.get("generateCodeOutcome"))
+            .and_then(serde_json::Value::as_bool)
+            .unwrap_or(false);
+        self.client_tells_generation.store(tells, Ordering::Relaxed);
         {
             let mut world = self.state.world();
             world.encoding = encoding;

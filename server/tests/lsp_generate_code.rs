@@ -33,8 +33,19 @@ async fn started(
     dir: &Path,
     capabilities: Value,
 ) -> (semo_server::harness::TestClient, String, String) {
+    started_with(dir, capabilities, Value::Null).await
+}
+
+/// [`started`] with `initializationOptions`.
+async fn started_with(
+    dir: &Path,
+    capabilities: Value,
+    options: Value,
+) -> (semo_server::harness::TestClient, String, String) {
     let mut client = semo_server::harness::TestClient::start();
-    client.initialize_with(capabilities, Some(&uri(dir))).await;
+    client
+        .initialize_with_options(capabilities, options, Some(&uri(dir)))
+        .await;
     let mission = dir.join("scouting.mission");
     let text = std::fs::read_to_string(&mission).unwrap();
     let mission_uri = uri(&mission);
@@ -304,5 +315,52 @@ async fn an_unsaved_mission_is_refused_and_nothing_is_written() {
     let cwd = std::env::current_dir().unwrap();
     assert!(!cwd.join("Untitled-1").exists() && !cwd.join("out").exists());
     assert!(!dir.join("out").exists(), "nothing written");
+    client.shutdown().await;
+}
+
+/// A client that tells the user itself how a generation ended (VS Code:
+/// `generateCodeOutcome`) gets no message from the server for it, so that
+/// one generation is one notification: neither for code written nor for a
+/// refusal. Others (Neovim) get the server's message, as above.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_client_that_tells_the_outcome_itself_gets_no_message() {
+    let dir = scouting_workspace("tells-itself");
+    let options = json!({ "generateCodeOutcome": true });
+    let (mut client, mission_uri, text) = started_with(&dir, json!({}), options).await;
+    let generate = json!({
+        "command": "semo.generateCode",
+        "arguments": [{ "uri": mission_uri, "outputFolder": "gen" }],
+    });
+    let messages = |client: &mut semo_server::harness::TestClient| -> Vec<Value> {
+        client
+            .take_unclaimed()
+            .into_iter()
+            .filter(|m| m["method"] == "window/showMessage")
+            .collect()
+    };
+    let result = client
+        .request("workspace/executeCommand", generate.clone())
+        .await
+        .unwrap();
+    assert_eq!(result["refused"], false, "{result}");
+    assert_eq!(messages(&mut client), Vec::<Value>::new());
+    // A mission with an error: refused, said in the answer only.
+    let broken = text.replacen("repeat()", "repeat(", 1);
+    client
+        .notify(
+            "textDocument/didChange",
+            json!({
+                "textDocument": { "uri": mission_uri, "version": 2 },
+                "contentChanges": [{ "text": broken }],
+            }),
+        )
+        .await;
+    client.diagnostics(&mission_uri, Some(2)).await;
+    let refused = client
+        .request("workspace/executeCommand", generate)
+        .await
+        .unwrap();
+    assert_eq!(refused["refused"], true, "{refused}");
+    assert_eq!(messages(&mut client), Vec::<Value>::new());
     client.shutdown().await;
 }

@@ -11,10 +11,20 @@ import {
   generateWithConsent,
 } from './pure/generate';
 import { missionTemplateSnippet } from './pure/template';
-import { Server } from './server';
+import { GENERATE_CODE_COMMAND, Server } from './server';
 
 /** The server's `workspace/executeCommand` name for code generation. */
-export const GENERATE_CODE = 'semo.generateCode';
+export const GENERATE_CODE = GENERATE_CODE_COMMAND;
+
+/** What the server answers to `semo.generateCode` (docs: the server's `generate_code`). */
+interface GenerateSummary {
+  refused?: boolean;
+  errors?: string[];
+  robots?: unknown[];
+  outputFolder?: string;
+  kept?: { path: string; why: string }[];
+  recovered?: string[];
+}
 
 /** "SeMo: New Mission from Template": an untitled mission holding the template. */
 export async function newMission(): Promise<void> {
@@ -58,10 +68,16 @@ function serverOffers(server: Server, command: string): boolean {
 /**
  * "SeMo: Generate Code": asks the server (`workspace/executeCommand`
  * `semo.generateCode` with `[{ uri, outputFolder }]`) to write the mission's
- * code, with a progress notification, then shows the output folder.
+ * code, with a progress notification, then shows the output folder. A code
+ * lens gives its own arguments (`{ uri, team }`): that mission, that team.
+ * The outcome is one notification (the server shows none: the client said
+ * `generateCodeOutcome` at start-up).
  */
-export async function generateCode(server: Server): Promise<void> {
-  const document = activeMission();
+export async function generateCode(server: Server, lens?: unknown): Promise<void> {
+  const fromLens = lens as Partial<GenerateArguments> | undefined;
+  const document = fromLens?.uri
+    ? await vscode.workspace.openTextDocument(vscode.Uri.parse(fromLens.uri))
+    : activeMission();
   if (!document) {
     void vscode.window.showWarningMessage('Open a mission (.mission) to generate its code.');
     return;
@@ -107,7 +123,7 @@ export async function generateCode(server: Server): Promise<void> {
   };
   const result = await generateWithConsent(
     send,
-    { uri: document.uri.toString(), outputFolder },
+    { uri: document.uri.toString(), outputFolder, ...(fromLens?.team ? { team: fromLens.team } : {}) },
     askToForce,
   );
   if (result.kind === 'declined') {
@@ -121,16 +137,25 @@ export async function generateCode(server: Server): Promise<void> {
       .then((c) => c && server.output.show());
     return;
   }
-  const summary = result.value as { refused?: boolean; errors?: string[]; robots?: unknown[] } | null;
+  const summary = result.value as GenerateSummary | null;
   if (summary?.refused) {
-    // The server has said why (a message, and the reasons as diagnostics).
-    server.output.appendLine(
-      `[info] code generation refused:\n  ${(summary.errors ?? []).join('\n  ')}`,
+    // The reasons are the mission's diagnostics: the Problems view shows them.
+    const errors = summary.errors ?? [];
+    server.output.appendLine(`[info] code generation refused:\n  ${errors.join('\n  ')}`);
+    void vscode.window.showErrorMessage(
+      `SeMo: code generation refused: ${errors.length} error(s) in ${path.basename(document.uri.path)} (see Problems)`,
     );
     void vscode.commands.executeCommand('workbench.actions.view.problems');
     return;
   }
-  server.output.appendLine(`[info] generated code in ${outputFolder}`);
+  const written = summary?.outputFolder ?? outputFolder;
+  for (const line of summary?.recovered ?? []) {
+    server.output.appendLine(`[warning] recovered: ${line}`);
+  }
+  for (const kept of summary?.kept ?? []) {
+    server.output.appendLine(`[warning] kept ${kept.path}: ${kept.why}`);
+  }
+  server.output.appendLine(`[info] generated code in ${written}`);
   const folderUri = vscode.Uri.file(outputFolder);
   try {
     await vscode.commands.executeCommand('revealInExplorer', folderUri);
@@ -138,8 +163,11 @@ export async function generateCode(server: Server): Promise<void> {
     // Outside the workspace the explorer cannot show it; the message below can.
   }
   const open = 'Open Folder in New Window';
+  const robots = summary?.robots?.length ?? 0;
+  const kept = summary?.kept?.length ?? 0;
+  const keptNote = kept > 0 ? ` (${kept} file(s) you edited kept: see the SeMo output)` : '';
   const choice = await vscode.window.showInformationMessage(
-    `SeMo: code generated in ${outputFolder}`,
+    `SeMo: code generated for ${robots} robot(s) in ${written}${keptNote}`,
     open,
   );
   if (choice === open) {

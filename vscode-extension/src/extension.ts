@@ -19,6 +19,7 @@ export async function activate(context: vscode.ExtensionContext): Promise<void> 
   const simulations = new SimulationViews(server);
   const live = new LiveRobotsView(server);
   const s = server;
+  s.onGenerateCode = (args) => generateCode(s, args);
   const robotsTree = vscode.window.createTreeView('semo.robots', { treeDataProvider: robots });
   robots.attach(robotsTree);
   const liveTree = vscode.window.createTreeView('semo.live', { treeDataProvider: live });

@@ -12,6 +12,9 @@ import {
 } from 'vscode-languageclient/node';
 import { DiscoveryEnv, findServer } from './pure/discovery';
 
+/** The server's `workspace/executeCommand` name for code generation. */
+export const GENERATE_CODE_COMMAND = 'semo.generateCode';
+
 /** The files the server handles: missions, and three kinds of XML by name. */
 export const DOCUMENT_SELECTOR = [
   { language: 'semo' },
@@ -45,6 +48,11 @@ export class Server implements vscode.Disposable {
   private readonly changed = new vscode.EventEmitter<void>();
   /** Fires when a client becomes ready (the robot panel refreshes then). */
   readonly onReady = this.changed.event;
+  /**
+   * Runs `semo.generateCode` for a code lens with its arguments (set by the
+   * extension to the palette's Generate Code flow).
+   */
+  onGenerateCode: ((args: unknown) => Promise<unknown>) | undefined;
 
   constructor(
     private readonly context: vscode.ExtensionContext,
@@ -103,6 +111,17 @@ export class Server implements vscode.Disposable {
     const clientOptions: LanguageClientOptions = {
       documentSelector: DOCUMENT_SELECTOR,
       outputChannel: this.output,
+      // This client tells the user how a generation ended (one notification
+      // per generation); the server then shows no message of its own for it.
+      initializationOptions: { generateCodeOutcome: true },
+      middleware: {
+        // A code lens's "Generate code for TEAM" runs the same flow as the
+        // palette's Generate Code (progress, the conflict modal, the outcome).
+        executeCommand: (command, args, next) =>
+          command === GENERATE_CODE_COMMAND && this.onGenerateCode
+            ? this.onGenerateCode(args[0])
+            : next(command, args),
+      },
       // `semo.trace.server` is read by the client because its id is `semo`.
       initializationFailedHandler: (error) => {
         this.setStatus('error', String(error));

@@ -155,6 +155,10 @@ async function userJourney() {
     /code generation refused|code generation failed/,
   );
   assert.match(await refused.evaluate((e) => e.textContent), /refused/);
+  // One notification for one generation: the server, told at start-up that
+  // this client shows the outcome, shows none of its own (it sends its
+  // messages before its answer, so one would be on screen by now).
+  assert.equal(await toastsMatching(/code generation refused/), 1, 'one refusal notification');
   await shot('generate-refused');
 
   // A mission without errors: its robots' folders are written.
@@ -169,7 +173,8 @@ async function userJourney() {
   // The new editor is focused once its text is laid out.
   await waitForText('.monaco-editor .view-lines', /Rovers\.Explore\.Wander/);
   await runCommand('SeMo: Generate Code');
-  await waitForText('.notifications-toasts .notification-list-item', /code generated in/);
+  await waitForText('.notifications-toasts .notification-list-item', /code generated for 2 robot\(s\) in/);
+  assert.equal(await toastsMatching(/generated/), 1, 'one notification for the generation');
   await shot('generate-code');
   const robot = join(workspace, 'generated', 'Rovers', 'r_0');
   assert.ok(existsSync(join(robot, 'control_task.c')), `control_task.c in ${robot}`);
@@ -193,6 +198,14 @@ async function userJourney() {
   await waitForText('.monaco-editor .view-lines', /#\s1\.\sTeam\sformation/);
   await waitForText('.statusbar-item', /SeMo Mission/);
   await shot('new-mission');
+}
+
+/** How many notification toasts on screen match `pattern`. */
+async function toastsMatching(pattern) {
+  const texts = await page.$$eval('.notifications-toasts .notification-list-item', (items) =>
+    items.map((e) => e.textContent ?? ''),
+  );
+  return texts.filter((t) => pattern.test(t)).length;
 }
 
 /** Waits until some frame (webviews nest two iframes deep) holds `pattern`. */
