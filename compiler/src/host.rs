@@ -1007,4 +1007,4 @@ pub use disk::{
     project_inputs,
 };
 pub use dropper::{Dropper, drop_later};
-pub use ide::{PictureError, WORKSPACE_SYMBOL_LIMIT};
+pub use ide::{PictureError, RobotPicture, WORKSPACE_SYMBOL_LIMIT};

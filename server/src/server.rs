@@ -128,11 +128,9 @@ impl Backend {
         &self,
         params: handlers::graph_svg::GraphSvgParams,
     ) -> Result<serde_json::Value> {
-        let team = params.team;
-        self.on_snapshot(&params.text_document.uri, move |s| {
-            handlers::graph_svg::graph_svg(s, team.as_deref())
-        })
-        .await?
+        let uri = params.text_document.uri.clone();
+        self.on_snapshot(&uri, move |s| handlers::graph_svg::graph_svg(s, &params))
+            .await?
     }
 
     /// `semo/monitor/start`: the mission's robots and broker; then the

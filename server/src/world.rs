@@ -184,6 +184,11 @@ impl World {
     pub fn kind_of(uri: &Uri, language_id: Option<&str>) -> Option<FileKind> {
         let path = uri.path().as_str();
         let name = path.rsplit('/').next().unwrap_or(path);
+        if name == "taskgraph.xml" {
+            // A generated robot's task graph (`semo build` names it so),
+            // opened: a task graph, though folder scans leave it out.
+            return Some(FileKind::TaskGraph);
+        }
         FileKind::of(Path::new(name)).or(match language_id {
             Some("mission" | "semo") => Some(FileKind::Mission),
             _ => None,

@@ -143,3 +143,76 @@ async fn refusals_say_why() {
     assert!(graph_svg(&mut client, mission, None).await.is_ok());
     client.shutdown().await;
 }
+
+/// What `semo/graphSvg` answers for a mission with `kind` and `robot`.
+async fn robot_svg(
+    client: &mut semo_server::harness::TestClient,
+    uri: &str,
+    robot: Option<&str>,
+) -> Result<Value, Value> {
+    let mut params = json!({ "textDocument": { "uri": uri }, "kind": "taskgraph" });
+    if let Some(robot) = robot {
+        params["robot"] = json!(robot);
+    }
+    client.request("semo/graphSvg", params).await
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_missions_robot_is_drawn_as_its_generated_task_graph() {
+    let text = shared("swarm/march.mission");
+    let uri = "file:///m/march.mission";
+    let mut client = semo_server::harness::TestClient::start();
+    client.initialize(&["utf-16"], None).await;
+    client.open(uri, &text).await;
+    let first = robot_svg(&mut client, uri, None).await.unwrap();
+    let robots: Vec<&str> = first["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r.as_str().unwrap())
+        .collect();
+    assert!(robots.len() > 1, "{first}");
+    assert_eq!(first["robot"], robots[0]);
+    let last = robots[robots.len() - 1].to_string();
+    let chosen = robot_svg(&mut client, uri, Some(&last)).await.unwrap();
+    assert_eq!(chosen["robot"], last.as_str());
+    // The picture is the written taskgraph.xml's, as `semo graph svg` draws it.
+    for answer in [&first, &chosen] {
+        let svg = answer["svg"].as_str().unwrap();
+        assert!(svg.starts_with("<svg"), "{svg}");
+        assert!(svg.contains("class=\"node task"), "{svg}");
+    }
+    let unknown = robot_svg(&mut client, uri, Some("nobody"))
+        .await
+        .unwrap_err();
+    let message = unknown["message"].as_str().unwrap();
+    assert!(message.contains("no robot `nobody`"), "{message}");
+    assert!(message.contains(&last), "{message}");
+    // The same robot's taskgraph.xml, opened from a generated folder: drawn too.
+    let graph = format!(
+        "file:///out/{}/{last}/taskgraph.xml",
+        chosen["team"].as_str().unwrap()
+    );
+    let written = generated_taskgraph(&text, &last);
+    client.open(&graph, &written).await;
+    let opened = graph_svg(&mut client, &graph, None).await.unwrap();
+    assert_eq!(opened["svg"], chosen["svg"]);
+    client.shutdown().await;
+}
+
+/// The `taskgraph.xml` `semo build --emit taskgraph` writes for `robot` of
+/// `mission` (built-in catalog), through the library as the CLI calls it.
+fn generated_taskgraph(mission: &str, robot: &str) -> String {
+    let mut host = semo::host::AnalysisHost::default();
+    let id = semo::diag::FileId(0);
+    let path = Some(std::path::PathBuf::from("/m/march.mission"));
+    host.set_file(id, path, semo::workspace::FileKind::Mission, mission.into());
+    let build = host.analysis().build_input(id).expect("a mission");
+    let refined = semo::codegen::refine_checked(&build.input());
+    let program = refined
+        .programs
+        .iter()
+        .find(|p| p.robot == robot)
+        .expect("the robot");
+    semo::taskgraph::write::to_xml(&program.graph, "test")
+}

@@ -1,6 +1,9 @@
 // "SeMo: Show Task Graph" and "SeMo: Show Mode Machine": a webview with the
 // SVG the server draws (`semo/graphSvg`, the same picture as `semo graph svg`
 // and `semo graph modes`). The picture follows the document as it changes.
+// Show Task Graph takes a task graph file (`*.taskgraph.xml`, or a generated
+// robot's `taskgraph.xml`) or a mission: then a robot's refined task graph,
+// the robot picked from the mission's robots.
 
 import * as path from 'path';
 import * as vscode from 'vscode';
@@ -8,6 +11,9 @@ import { Server } from './server';
 
 interface GraphSvgResult {
   svg: string;
+  /** For a mission's robot: the robot drawn and every robot of the mission. */
+  robot?: string;
+  robots?: string[];
 }
 
 type Kind = 'taskgraph' | 'modes';
@@ -16,12 +22,17 @@ const TITLES: Record<Kind, string> = { taskgraph: 'Task Graph', modes: 'Mode Mac
 
 function documentFor(kind: Kind): vscode.TextDocument | undefined {
   const fits = (d: vscode.TextDocument) =>
-    kind === 'taskgraph' ? d.fileName.endsWith('.taskgraph.xml') : d.languageId === 'semo';
+    d.languageId === 'semo' || (kind === 'taskgraph' && isTaskGraphFile(d.fileName));
   const active = vscode.window.activeTextEditor?.document;
   if (active && fits(active)) {
     return active;
   }
   return vscode.window.visibleTextEditors.map((e) => e.document).find(fits);
+}
+
+/** `*.taskgraph.xml`, or `taskgraph.xml` as `semo build` names a robot's. */
+export function isTaskGraphFile(fileName: string): boolean {
+  return path.basename(fileName) === 'taskgraph.xml' || fileName.endsWith('.taskgraph.xml');
 }
 
 function escapeHtml(text: string): string {
@@ -45,6 +56,11 @@ export function page(title: string, body: string): string {
 <body>${body}</body></html>`;
 }
 
+function titleOf(kind: Kind, document: vscode.TextDocument, robot?: string): string {
+  const name = path.basename(document.uri.path);
+  return robot ? `${TITLES[kind]}: ${robot} (${name})` : `${TITLES[kind]}: ${name}`;
+}
+
 export class GraphViews implements vscode.Disposable {
   private readonly panels = new Map<string, vscode.WebviewPanel>();
   private readonly disposables: vscode.Disposable[] = [];
@@ -59,16 +75,24 @@ export class GraphViews implements vscode.Disposable {
   async show(kind: Kind): Promise<void> {
     const document = documentFor(kind);
     if (!document) {
-      const what = kind === 'taskgraph' ? 'a task graph (.taskgraph.xml)' : 'a mission (.mission)';
+      const what =
+        kind === 'taskgraph' ? 'a task graph (.taskgraph.xml) or a mission' : 'a mission (.mission)';
       void vscode.window.showWarningMessage(`Open ${what} first.`);
       return;
     }
-    const key = `${kind}:${document.uri.toString()}`;
+    let robot: string | undefined;
+    if (kind === 'taskgraph' && document.languageId === 'semo') {
+      robot = await this.pickRobot(document);
+      if (robot === undefined) {
+        return;
+      }
+    }
+    const key = `${kind}:${document.uri.toString()}${robot ? `#${robot}` : ''}`;
     let panel = this.panels.get(key);
     if (!panel) {
       panel = vscode.window.createWebviewPanel(
         'semo.graph',
-        `${TITLES[kind]}: ${path.basename(document.uri.path)}`,
+        titleOf(kind, document, robot),
         { viewColumn: vscode.ViewColumn.Beside, preserveFocus: true },
         { enableScripts: false, retainContextWhenHidden: false },
       );
@@ -77,23 +101,60 @@ export class GraphViews implements vscode.Disposable {
     } else {
       panel.reveal(vscode.ViewColumn.Beside, true);
     }
-    await this.draw(kind, document, panel);
+    await this.draw(kind, document, panel, robot);
   }
 
-  private redrawSoon(document: vscode.TextDocument): void {
-    for (const kind of ['taskgraph', 'modes'] as Kind[]) {
-      const key = `${kind}:${document.uri.toString()}`;
-      const panel = this.panels.get(key);
-      if (!panel) {
-        continue;
+  /**
+   * The robot of a mission whose task graph to draw: the only one, or the
+   * one picked among the mission's robots; undefined when the pick is
+   * dismissed or the server cannot say (then it says why).
+   */
+  private async pickRobot(document: vscode.TextDocument): Promise<string | undefined> {
+    const client = this.server.running();
+    if (!client) {
+      return undefined;
+    }
+    try {
+      const first = await client.sendRequest<GraphSvgResult>('semo/graphSvg', {
+        textDocument: { uri: document.uri.toString() },
+        kind: 'taskgraph',
+      });
+      const robots = first.robots ?? [];
+      if (robots.length <= 1) {
+        return first.robot;
       }
-      clearTimeout(this.timers.get(key));
-      this.timers.set(key, setTimeout(() => void this.draw(kind, document, panel), 500));
+      return await vscode.window.showQuickPick(robots, {
+        title: `Task graph of which robot of ${path.basename(document.uri.path)}?`,
+      });
+    } catch (e) {
+      const message = e instanceof Error ? e.message : String(e);
+      void vscode.window.showErrorMessage(`SeMo: ${message}`);
+      return undefined;
     }
   }
 
-  private async draw(kind: Kind, document: vscode.TextDocument, panel: vscode.WebviewPanel) {
-    const title = `${TITLES[kind]}: ${path.basename(document.uri.path)}`;
+  private redrawSoon(document: vscode.TextDocument): void {
+    const prefix = (kind: Kind) => `${kind}:${document.uri.toString()}`;
+    for (const [key, panel] of this.panels) {
+      const kind = (['taskgraph', 'modes'] as Kind[]).find(
+        (k) => key === prefix(k) || key.startsWith(`${prefix(k)}#`),
+      );
+      if (!kind) {
+        continue;
+      }
+      const robot = key.includes('#') ? key.slice(key.indexOf('#') + 1) : undefined;
+      clearTimeout(this.timers.get(key));
+      this.timers.set(key, setTimeout(() => void this.draw(kind, document, panel, robot), 500));
+    }
+  }
+
+  private async draw(
+    kind: Kind,
+    document: vscode.TextDocument,
+    panel: vscode.WebviewPanel,
+    robot?: string,
+  ) {
+    const title = titleOf(kind, document, robot);
     const client = this.server.client;
     if (!client || !client.isRunning()) {
       panel.webview.html = page(title, '<p class="error">The SeMo server is not running.</p>');
@@ -102,6 +163,7 @@ export class GraphViews implements vscode.Disposable {
     try {
       const result = await client.sendRequest<GraphSvgResult>('semo/graphSvg', {
         textDocument: { uri: document.uri.toString() },
+        ...(robot ? { kind: 'taskgraph', robot } : {}),
       });
       panel.webview.html = page(title, result.svg);
     } catch (e) {

@@ -21,6 +21,8 @@ export const DOCUMENT_SELECTOR = [
   { language: 'xml', pattern: '**/*.strategy.xml' },
   { language: 'xml', pattern: '**/*.robot.xml' },
   { language: 'xml', pattern: '**/*.taskgraph.xml' },
+  // A generated robot's task graph (`semo build` writes OUT/TEAM/ROBOT/taskgraph.xml).
+  { language: 'xml', pattern: '**/taskgraph.xml' },
   // Scenario files: completion of the names of their mission.
   { language: 'json', pattern: '**/*.scenario.json' },
   // The project file, whatever language an installed extension gives TOML.

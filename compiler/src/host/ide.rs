@@ -301,7 +301,7 @@ mod structure;
 #[cfg(test)]
 mod tests;
 
-pub use structure::{PictureError, WORKSPACE_SYMBOL_LIMIT};
+pub use structure::{PictureError, RobotPicture, WORKSPACE_SYMBOL_LIMIT};
 
 /// A `semo.toml` completion in the editor vocabulary.
 fn project_completion(item: crate::project::Completion) -> CompletionItem {

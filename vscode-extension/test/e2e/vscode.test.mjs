@@ -180,6 +180,17 @@ async function userJourney() {
   assert.ok(existsSync(join(robot, 'control_task.c')), `control_task.c in ${robot}`);
   assert.ok(existsSync(join(robot, 'Makefile')), `Makefile in ${robot}`);
 
+  // Show Task Graph on the mission: its robots offered, the one picked drawn
+  // (its refined task graph, the generated taskgraph.xml's picture).
+  await page.click('.monaco-editor .view-lines');
+  await runCommand('SeMo: Show Task Graph');
+  await waitForText('.quick-input-list .monaco-list-row', /r_1/);
+  await page.keyboard.type('r_1');
+  await page.keyboard.press('Enter');
+  await waitForText('.tabs-container .tab', /Task Graph: r_1 \(rovers\.mission\)/);
+  assert.ok(await waitForFrameContent(/ControlTask/, 60000), 'the robot task graph webview shows its control task');
+  await shot('robot-task-graph');
+
   // A task graph's picture: open it from the explorer, then the palette.
   await page.keyboard.down('Control');
   await page.keyboard.down('Shift');

@@ -155,4 +155,57 @@ impl Analysis {
             )),
         }
     }
+
+    /// A robot's refined task graph as SVG (`semo build`'s `taskgraph.xml`,
+    /// drawn as `semo graph svg` draws it, with its analysis): `robot`, or
+    /// the mission's first robot when `None`. Refused, with the reason, when
+    /// the file is no mission, the mission does not refine (its errors), or
+    /// no robot has that name (the robots named).
+    pub fn robot_picture(
+        &self,
+        mission: FileId,
+        robot: Option<&str>,
+    ) -> Result<RobotPicture, PictureError> {
+        let build = self
+            .build_input(mission)
+            .ok_or_else(|| PictureError("only a mission has robots to draw".to_string()))?;
+        let refined = crate::codegen::refine_checked(&build.input());
+        if refined.programs.is_empty() {
+            let errors = refined.diagnostics.iter().filter(|d| d.is_error()).count();
+            return Err(PictureError(format!(
+                "the mission does not refine into robots: {errors} error(s) (see Problems)"
+            )));
+        }
+        let robots: Vec<String> = refined.programs.iter().map(|p| p.robot.clone()).collect();
+        let program = match robot {
+            None => &refined.programs[0],
+            Some(name) => refined
+                .programs
+                .iter()
+                .find(|p| p.robot == name)
+                .ok_or_else(|| {
+                    PictureError(format!(
+                        "the mission has no robot `{name}` (robots: {})",
+                        robots.join(", ")
+                    ))
+                })?,
+        };
+        let report = crate::taskgraph::analysis::analyze(&program.graph);
+        Ok(RobotPicture {
+            svg: crate::taskgraph::to_svg_analyzed(&program.graph, &report),
+            robot: program.robot.clone(),
+            team: program.team.clone(),
+            robots,
+        })
+    }
+}
+
+/// A robot's refined task graph drawn ([`Analysis::robot_picture`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RobotPicture {
+    pub svg: String,
+    pub robot: String,
+    pub team: String,
+    /// Every robot of the mission, in formation order.
+    pub robots: Vec<String>,
 }
