@@ -426,6 +426,63 @@ fn the_timeline_has_a_lane_per_robot_with_its_modes_and_services() {
     assert_eq!(ys.len(), 3);
     ys.sort_by(f64::total_cmp);
     assert!(ys.windows(2).all(|w| w[1] - w[0] >= 12.0), "{ys:?}");
+
+    // Each plan has its colour, the same in every lane, and the legend says which.
+    let mut plan_fill = std::collections::BTreeMap::new();
+    for bar in &bars {
+        let (plan, fill) = (attr(bar, "data-plan").unwrap(), attr(bar, "fill").unwrap());
+        assert_eq!(*plan_fill.entry(plan).or_insert(fill), fill, "plan {plan}");
+    }
+    let fills: std::collections::BTreeSet<_> = plan_fill.values().collect();
+    assert_eq!(fills.len(), plan_fill.len(), "{plan_fill:?}");
+    let legend = |kind: &str| -> std::collections::BTreeSet<&str> {
+        class("legend-entry")
+            .iter()
+            .filter(|a| attr(a, "data-kind") == Some(kind))
+            .map(|a| attr(a, "data-name").unwrap())
+            .collect()
+    };
+    assert_eq!(legend("plans"), plan_fill.keys().copied().collect());
+    // Messages: coloured by key, each key in the legend, and not a solid
+    // block (one arrow per key and pair every 6 pixels of sending and arrival).
+    let messages = class("message");
+    let keys: std::collections::BTreeSet<&str> = messages
+        .iter()
+        .map(|m| attr(m, "data-key").unwrap())
+        .collect();
+    assert_eq!(legend("messages"), keys);
+    let mut seen = std::collections::HashSet::new();
+    for m in &messages {
+        let bucket =
+            |end: &str| (attr(m, end).unwrap().parse::<f64>().unwrap() / 6.0).floor() as i64;
+        let at = (
+            attr(m, "data-key"),
+            attr(m, "data-from"),
+            attr(m, "data-to"),
+            bucket("x1"),
+            bucket("x2"),
+        );
+        assert!(seen.insert(at), "two arrows within 6 px: {at:?}");
+    }
+    // Services are named on their bars (where wide enough), and every
+    // label comes after the arrows, so none is hidden under them.
+    let text = std::fs::read_to_string(&svg).unwrap();
+    let service_labels = text.matches("class=\"service-label\"").count();
+    assert!(service_labels >= 12, "{service_labels}");
+    for service in ["ReceiveCmd", "CheckStatus", "AutonomousReturn"] {
+        assert!(
+            text.contains(&format!(">{service}</text>")),
+            "{service} is not named"
+        );
+    }
+    let labels_at = text.find("<g class=\"labels\">").unwrap();
+    assert!(text.find("<g class=\"messages\"").unwrap() < labels_at);
+    // How each robot's run ended is marked (the scenario stops them).
+    let ends: Vec<&str> = class("end")
+        .iter()
+        .map(|a| attr(a, "data-why").unwrap())
+        .collect();
+    assert_eq!(ends.len(), 3, "{ends:?}");
 }
 
 /// The refined programs of a mission text, as `semo simulate` gets them.

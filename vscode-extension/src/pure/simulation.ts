@@ -52,6 +52,8 @@ export function simulationPage(title: string, summary: string, svg: string, nonc
   body { background: #fff; color: #222; margin: 0; padding: 12px; font-family: sans-serif; }
   pre { font-size: 12px; }
   [data-line]:not([data-line="0"]) { cursor: pointer; }
+  /* The timeline fits the view's width (it was clipped on the right); its viewBox scales it. */
+  svg { max-width: 100%; height: auto; }
 </style></head>
 <body><pre class="summary">${escapeHtml(summary)}</pre>
 ${svg}

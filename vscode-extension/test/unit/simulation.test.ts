@@ -31,4 +31,6 @@ test('the page escapes the summary, keeps the SVG and allows only its own script
   assert.ok(page.includes("script-src 'nonce-N0NCE'"));
   assert.equal(page.match(/<script/g)?.length, 1);
   assert.ok(page.includes('<script nonce="N0NCE">'));
+  // The timeline scales to the view's width instead of being clipped.
+  assert.match(page, /svg \{ max-width: 100%; height: auto; \}/);
 });
