@@ -130,6 +130,7 @@ fn neovim_shows_the_diagnostic_completes_and_highlights_a_mission() {
         "scenario diagnostic: 4:13 expectation failed: r never enters IDLE: entered at 0 ms",
         "monitor: r          Rover        waiting",
         "monitor window: r          Rover        waiting",
+        "marks: ◀ in this mode: r",
     ] {
         assert!(out.contains(expected), "missing {expected:?} in:\n{out}");
     }

@@ -211,6 +211,32 @@ local function run()
     'the monitor window does not say it stopped: ' .. vim.inspect(shown()))
   vim.notify = notify
   check(notified == 0, notified .. ' notification(s) from :SemoMonitor')
+
+  -- 7c. The running robots on the mission text: a view as the server sends it (r in MOVING,
+  -- running Drive) marks the mode's line and the service's; a lost robot marks nothing.
+  local lines = vim.api.nvim_buf_get_lines(mission, 0, -1, false)
+  local function line_of(pattern)
+    for i, text in ipairs(lines) do
+      if text:find(pattern) then return i end
+    end
+    fail('no line matches ' .. pattern)
+  end
+  local mode_line, service_line = line_of('%.MOVING%s*{'), line_of('%.Drive%s*{')
+  local view = { robots = { { robot = 'r', team = 'Rover', state = 'running', lost = false,
+    mode = 'MOVING', modeLine = mode_line,
+    services = { { plan = 'Motion', service = 'Drive', line = service_line } } } } }
+  semo.monitor_marks(mission, view)
+  local ns = vim.api.nvim_create_namespace('semo-monitor')
+  local marks = vim.api.nvim_buf_get_extmarks(mission, ns, 0, -1, { details = true })
+  check(#marks == 2, 'expected 2 marks, got ' .. vim.inspect(marks))
+  local texts = {}
+  for _, m in ipairs(marks) do texts[m[2] + 1] = m[4].virt_text[1][1] end
+  check(texts[mode_line] == '◀ in this mode: r', 'mode mark: ' .. vim.inspect(texts))
+  check(texts[service_line] == '▶ running: r', 'service mark: ' .. vim.inspect(texts))
+  report('marks: ' .. texts[mode_line])
+  view.robots[1].lost = true
+  semo.monitor_marks(mission, view)
+  check(#vim.api.nvim_buf_get_extmarks(mission, ns, 0, -1, {}) == 0, 'a lost robot is still marked')
   vim.cmd('only')
 
   -- 8. The scenario file (filetype json) gets the server, and completion of an expectation's

@@ -15,9 +15,9 @@ export async function activate(context: vscode.ExtensionContext): Promise<void> 
   const output = vscode.window.createOutputChannel('SeMo');
   server = new Server(context, output);
   const robots = new RobotsView(server);
-  const graphs = new GraphViews(server);
   const simulations = new SimulationViews(server);
   const live = new LiveRobotsView(server);
+  const graphs = new GraphViews(server, live.onView);
   const s = server;
   s.onGenerateCode = (args) => generateCode(s, args);
   const robotsTree = vscode.window.createTreeView('semo.robots', { treeDataProvider: robots });

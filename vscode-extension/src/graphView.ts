@@ -7,6 +7,7 @@
 
 import * as path from 'path';
 import * as vscode from 'vscode';
+import { MonitorView, modeCaption, modeHighlightCss } from './pure/liveRobots';
 import { Server } from './server';
 
 interface GraphSvgResult {
@@ -43,7 +44,15 @@ function escapeHtml(text: string): string {
  * The page: the SVG inline, no scripts (the content security policy allows
  * none), on a light background since the drawing uses dark strokes.
  */
-export function page(title: string, body: string): string {
+export function page(title: string, body: string, live?: MonitorView): string {
+  // A running mission's robots (the live monitor): their modes marked in
+  // the picture, and a line per robot above it.
+  const liveCss = live ? modeHighlightCss(live) : '';
+  const caption = live
+    ? `<ul class="live">${modeCaption(live)
+        .map((line) => `<li>${escapeHtml(line)}</li>`)
+        .join('')}</ul>`
+    : '';
   return `<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <meta http-equiv="Content-Security-Policy" content="default-src 'none'; style-src 'unsafe-inline'; img-src data:;">
@@ -51,9 +60,11 @@ export function page(title: string, body: string): string {
 <style>
   body { background: #fff; color: #222; margin: 0; padding: 12px; font-family: sans-serif; }
   .error { color: #a00; white-space: pre-wrap; }
+  .live { margin: 0 0 8px 0; padding-left: 16px; font-size: 12px; color: #d62728; }
   svg { max-width: none; }
+${liveCss}
 </style></head>
-<body>${body}</body></html>`;
+<body>${caption}${body}</body></html>`;
 }
 
 function titleOf(kind: Kind, document: vscode.TextDocument, robot?: string): string {
@@ -65,11 +76,39 @@ export class GraphViews implements vscode.Disposable {
   private readonly panels = new Map<string, vscode.WebviewPanel>();
   private readonly disposables: vscode.Disposable[] = [];
   private timers = new Map<string, NodeJS.Timeout>();
+  /** The last picture of each panel, redrawn at once as the robots move. */
+  private readonly drawn = new Map<string, { title: string; svg: string }>();
+  /** The live monitor's latest view (its mission's mode machine shows it). */
+  private live: MonitorView | undefined;
 
-  constructor(private readonly server: Server) {
+  constructor(
+    private readonly server: Server,
+    liveViews?: vscode.Event<MonitorView | undefined>,
+  ) {
     this.disposables.push(
       vscode.workspace.onDidChangeTextDocument((e) => this.redrawSoon(e.document)),
     );
+    if (liveViews) {
+      this.disposables.push(liveViews((view) => this.showLive(view)));
+    }
+  }
+
+  /** The robots of a monitored mission on its mode machine panel, if open. */
+  private showLive(view: MonitorView | undefined): void {
+    const previous = this.live?.uri;
+    this.live = view;
+    for (const uri of new Set([previous, view?.uri])) {
+      const key = `modes:${uri}`;
+      const panel = this.panels.get(key);
+      const drawn = this.drawn.get(key);
+      if (uri && panel && drawn) {
+        panel.webview.html = page(drawn.title, drawn.svg, this.liveFor(uri));
+      }
+    }
+  }
+
+  private liveFor(uri: string): MonitorView | undefined {
+    return this.live?.uri === uri ? this.live : undefined;
   }
 
   async show(kind: Kind): Promise<void> {
@@ -97,7 +136,10 @@ export class GraphViews implements vscode.Disposable {
         { enableScripts: false, retainContextWhenHidden: false },
       );
       this.panels.set(key, panel);
-      panel.onDidDispose(() => this.panels.delete(key));
+      panel.onDidDispose(() => {
+        this.panels.delete(key);
+        this.drawn.delete(key);
+      });
     } else {
       panel.reveal(vscode.ViewColumn.Beside, true);
     }
@@ -161,11 +203,16 @@ export class GraphViews implements vscode.Disposable {
       return;
     }
     try {
+      const uri = document.uri.toString();
       const result = await client.sendRequest<GraphSvgResult>('semo/graphSvg', {
-        textDocument: { uri: document.uri.toString() },
+        textDocument: { uri },
         ...(robot ? { kind: 'taskgraph', robot } : {}),
       });
-      panel.webview.html = page(title, result.svg);
+      const live = kind === 'modes' ? this.liveFor(uri) : undefined;
+      if (kind === 'modes') {
+        this.drawn.set(`modes:${uri}`, { title, svg: result.svg });
+      }
+      panel.webview.html = page(title, result.svg, live);
     } catch (e) {
       const message = e instanceof Error ? e.message : String(e);
       panel.webview.html = page(title, `<p class="error">${escapeHtml(message)}</p>`);

@@ -5,7 +5,7 @@
 // "SeMo: Stop Monitoring" ends it.
 
 import * as vscode from 'vscode';
-import { buildLiveTree, isMonitorView, LiveNode, MonitorView } from './pure/liveRobots';
+import { buildLiveTree, isMonitorView, liveMarks, LiveNode, MonitorView } from './pure/liveRobots';
 import { Server } from './server';
 
 export class LiveRobotsView implements vscode.TreeDataProvider<LiveNode>, vscode.Disposable {
@@ -16,10 +16,26 @@ export class LiveRobotsView implements vscode.TreeDataProvider<LiveNode>, vscode
   readonly onDidChangeTreeData = this.changed.event;
   private readonly disposables: vscode.Disposable[] = [];
   private listener: vscode.Disposable | undefined;
+  private readonly viewed = new vscode.EventEmitter<MonitorView | undefined>();
+  /** Every view of the monitored mission as it comes (undefined: monitoring ended). */
+  readonly onView = this.viewed.event;
+  /** The mission's lines where robots are: their mode's, their services'. */
+  private readonly modeMark = vscode.window.createTextEditorDecorationType({
+    isWholeLine: true,
+    backgroundColor: new vscode.ThemeColor('editor.rangeHighlightBackground'),
+    after: { margin: '0 0 0 2em', color: new vscode.ThemeColor('editorCodeLens.foreground') },
+  });
+  private readonly serviceMark = vscode.window.createTextEditorDecorationType({
+    after: { margin: '0 0 0 2em', color: new vscode.ThemeColor('editorCodeLens.foreground') },
+  });
 
   constructor(private readonly server: Server) {
     this.disposables.push(
       this.changed,
+      this.viewed,
+      this.modeMark,
+      this.serviceMark,
+      vscode.window.onDidChangeVisibleTextEditors(() => this.mark()),
       // Closing the mission ends its monitor in the server too.
       vscode.workspace.onDidCloseTextDocument((d) => {
         if (d.uri.toString() === this.monitored) {
@@ -50,6 +66,8 @@ export class LiveRobotsView implements vscode.TreeDataProvider<LiveNode>, vscode
       if (isMonitorView(params) && params.uri === this.monitored) {
         this.view = params;
         this.changed.fire(undefined);
+        this.viewed.fire(params);
+        this.mark();
       }
     });
   }
@@ -96,12 +114,39 @@ export class LiveRobotsView implements vscode.TreeDataProvider<LiveNode>, vscode
     }
   }
 
+  /** The latest view of the monitored mission, if any. */
+  latest(): MonitorView | undefined {
+    return this.view;
+  }
+
+  /**
+   * Marks, in every editor of the monitored mission, the line of each
+   * running robot's mode and of each service it runs (cleared elsewhere).
+   */
+  private mark(): void {
+    const marks = this.view ? liveMarks(this.view) : [];
+    for (const editor of vscode.window.visibleTextEditors) {
+      const ours = editor.document.uri.toString() === this.monitored;
+      const of = (kind: 'mode' | 'service') =>
+        (ours ? marks : [])
+          .filter((m) => m.kind === kind && m.line <= editor.document.lineCount)
+          .map((m) => ({
+            range: editor.document.lineAt(m.line - 1).range,
+            renderOptions: { after: { contentText: m.text } },
+          }));
+      editor.setDecorations(this.modeMark, of('mode'));
+      editor.setDecorations(this.serviceMark, of('service'));
+    }
+  }
+
   /** SeMo: Stop Monitoring. */
   async stop(): Promise<void> {
     const uri = this.monitored;
     this.monitored = undefined;
     this.view = undefined;
     this.changed.fire(undefined);
+    this.viewed.fire(undefined);
+    this.mark();
     await vscode.commands.executeCommand('setContext', 'semo.monitoring', false);
     const client = this.server.client;
     if (uri && client && client.isRunning()) {

@@ -13,7 +13,7 @@
 
 use crate::live;
 use crate::monitor::Plan;
-use crate::monitor::roster::Member;
+use crate::monitor::roster::{Member, MissionLines};
 use crate::world::World;
 use semo::deploy::topics::RunId;
 use semo::workspace::FileKind;
@@ -131,6 +131,17 @@ pub fn plan(job: &Job) -> Result<Plan, String> {
                 .control
                 .heartbeat
                 .then(|| semo::deploy::topics::heartbeat_key(p)),
+            lines: std::sync::Arc::new(MissionLines {
+                modes: p
+                    .control
+                    .modes
+                    .iter()
+                    .map(|m| (m.name.clone(), m.line))
+                    .collect(),
+                services: (p.control.services.iter())
+                    .map(|s| ((s.plan.clone(), s.name.clone()), s.line))
+                    .collect(),
+            }),
         })
         .collect();
     Ok(Plan {

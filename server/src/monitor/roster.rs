@@ -24,6 +24,17 @@ pub struct Member {
     /// this key (`codegen::files::alive_key`) on its own topic
     /// (`topics::heartbeat`).
     pub heartbeat_key: Option<String>,
+    /// Where its modes and services are written in the mission, so that an
+    /// editor can mark the lines a running robot is at.
+    pub lines: std::sync::Arc<MissionLines>,
+}
+
+/// The mission lines (1-based) of a team's modes and services.
+#[derive(Clone, Debug, Default)]
+pub struct MissionLines {
+    pub modes: std::collections::HashMap<String, u32>,
+    /// By (plan, service).
+    pub services: std::collections::HashMap<(String, String), u32>,
 }
 
 impl Member {
@@ -178,6 +189,7 @@ impl Robot {
                 "state": "waiting",
                 "lost": false,
                 "mode": null,
+                "modeLine": null,
                 "services": [],
                 "leader": null,
                 "isLeader": false,
@@ -192,10 +204,14 @@ impl Robot {
         } else {
             None
         };
+        let lines = &self.member.lines;
         let services: Vec<Value> = status
             .services
             .iter()
-            .map(|(plan, service)| json!({ "plan": plan, "service": service }))
+            .map(|(plan, service)| {
+                let line = lines.services.get(&(plan.clone(), service.clone()));
+                json!({ "plan": plan, "service": service, "line": line })
+            })
             .collect();
         let mut view = json!({
             "robot": self.member.robot,
@@ -203,6 +219,7 @@ impl Robot {
             "state": if lost_because.is_some() { "lost" } else { status.state.as_str() },
             "lost": lost_because.is_some(),
             "mode": (!status.mode.is_empty()).then_some(&status.mode),
+            "modeLine": lines.modes.get(&status.mode),
             "services": services,
             "leader": (!status.leader.is_empty()).then_some(&status.leader),
             "isLeader": status.leader == self.member.robot,
@@ -227,6 +244,14 @@ mod tests {
         roster_of(None)
     }
 
+    /// Team's mode M at line 7, its service P.S at line 3.
+    fn team_lines() -> std::sync::Arc<MissionLines> {
+        std::sync::Arc::new(MissionLines {
+            modes: [("M".to_string(), 7)].into(),
+            services: [(("P".to_string(), "S".to_string()), 3)].into(),
+        })
+    }
+
     fn roster_of(run: Option<&str>) -> Roster {
         let run = run.map(|r| topics::RunId::parse(r).unwrap());
         Roster::new(
@@ -236,16 +261,19 @@ mod tests {
                     robot: "a".into(),
                     team: "Team".into(),
                     heartbeat_key: Some("Team.__alive".into()),
+                    lines: team_lines(),
                 },
                 Member {
                     robot: "b".into(),
                     team: "Team".into(),
                     heartbeat_key: Some("Team.__alive".into()),
+                    lines: team_lines(),
                 },
                 Member {
                     robot: "c".into(),
                     team: "Solo".into(),
                     heartbeat_key: None,
+                    lines: Default::default(),
                 },
             ],
             200,
@@ -299,7 +327,13 @@ mod tests {
         let a = &r.view()[0];
         assert_eq!(a["mode"], "M");
         assert_eq!(a["isLeader"], true);
-        assert_eq!(a["services"], json!([{ "plan": "P", "service": "S" }]));
+        assert_eq!(
+            a["services"],
+            json!([{ "plan": "P", "service": "S", "line": 3 }])
+        );
+        // The lines an editor marks: the mode's and each service's.
+        assert_eq!(a["modeLine"], 7);
+        assert_eq!(r.view()[1]["modeLine"], Value::Null);
     }
 
     #[test]

@@ -11,7 +11,9 @@ export interface LiveRobot {
   lost: boolean;
   lostBecause?: 'lastWill' | 'silent';
   mode: string | null;
-  services: { plan: string; service: string }[];
+  /** The mission line (1-based) where its mode is written. */
+  modeLine?: number | null;
+  services: { plan: string; service: string; line?: number | null }[];
   leader: string | null;
   isLeader: boolean;
   battery: number | null;
@@ -125,4 +127,87 @@ export function buildLiveTree(view: MonitorView): LiveNode[] {
 export function isMonitorView(params: unknown): params is MonitorView {
   const p = params as MonitorView | undefined;
   return !!p && typeof p.uri === 'string' && Array.isArray(p.robots);
+}
+
+/** A mark on a mission line: the robots in the mode written there, or running the service. */
+export interface LiveMark {
+  /** 1-based. */
+  line: number;
+  kind: 'mode' | 'service';
+  text: string;
+}
+
+/** Robots still taking part: neither lost nor waiting for their first status. */
+function active(view: MonitorView): LiveRobot[] {
+  return view.robots.filter((r) => !r.lost && r.state !== 'waiting');
+}
+
+/**
+ * Where the running robots are in the mission text: each mode's line with
+ * the robots in that mode, each service's line with the robots running it,
+ * in line order (one mark per line and kind).
+ */
+export function liveMarks(view: MonitorView): LiveMark[] {
+  const marks = new Map<string, { line: number; kind: 'mode' | 'service'; robots: string[] }>();
+  const add = (line: number | null | undefined, kind: 'mode' | 'service', robot: string) => {
+    if (typeof line !== 'number') {
+      return;
+    }
+    const key = `${kind}:${line}`;
+    const mark = marks.get(key) ?? { line, kind, robots: [] };
+    mark.robots.push(robot);
+    marks.set(key, mark);
+  };
+  for (const robot of active(view)) {
+    add(robot.modeLine, 'mode', robot.robot);
+    for (const s of robot.services) {
+      add(s.line, 'service', robot.robot);
+    }
+  }
+  return [...marks.values()]
+    .sort((a, b) => a.line - b.line || a.kind.localeCompare(b.kind))
+    .map((m) => ({
+      line: m.line,
+      kind: m.kind,
+      text: `${m.kind === 'mode' ? '◀ in this mode' : '▶ running'}: ${m.robots.join(', ')}`,
+    }));
+}
+
+/** `text` as a CSS string's content (quotes and backslashes escaped). */
+function cssString(text: string): string {
+  return `"${text.replace(/[\\"]/g, (c) => `\\${c}`).replace(/[\n\r]/g, ' ')}"`;
+}
+
+/**
+ * CSS that marks in the mode machine picture (`semo graph modes`: a
+ * `g.team[data-team]` per team, a `g.mode[data-mode]` per mode) the mode
+ * each running robot is in.
+ */
+export function modeHighlightCss(view: MonitorView): string {
+  const rules = new Set<string>();
+  for (const robot of active(view)) {
+    if (robot.mode) {
+      rules.add(
+        `g.team[data-team=${cssString(robot.team)}] g[data-mode=${cssString(robot.mode)}] rect ` +
+          '{ stroke: #d62728; stroke-width: 3px; }',
+      );
+    }
+  }
+  return [...rules].join('\n');
+}
+
+/** One line per robot for the picture's caption: robot, team, state, mode, services. */
+export function modeCaption(view: MonitorView): string[] {
+  return view.robots.map((r) => {
+    const state = r.lost ? 'LOST' : r.state;
+    const services = r.services.map((s) => `${s.plan}=${s.service}`).join(', ');
+    return [
+      `${r.robot}${r.isLeader ? ' ★' : ''} (${r.team})`,
+      state,
+      r.mode ?? '',
+      services ? `[${services}]` : '',
+    ]
+      .filter((p) => p !== '')
+      .join(' · ');
+  });
 }

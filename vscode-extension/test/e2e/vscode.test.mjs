@@ -372,6 +372,26 @@ async function liveJourney() {
   await waitForText(rows, /r_0\s*running · SEARCH/);
   await waitForText(rows, /Explore\s*Wander/);
   await shot('robots-live');
+  // The robot on the pictures: the mission's SEARCH line and Wander's line
+  // marked in the editor, and its mode marked in the mode machine.
+  await page.waitForFunction(
+    () => [...document.styleSheets].some((sheet) => {
+      try {
+        return [...sheet.cssRules].some((rule) => rule.cssText.includes('in this mode: r_0'));
+      } catch {
+        return false;
+      }
+    }),
+    { timeout: 30000, polling: 250 },
+  );
+  await openFile('rovers.mission');
+  await runCommand('SeMo: Show Mode Machine');
+  assert.ok(
+    await waitForFrameContent(/r_0 \(Rovers\) · running · SEARCH · \[Explore=Wander\]/, 60000),
+    'the mode machine shows r_0 in SEARCH',
+  );
+  assert.ok(await waitForFrameContent(/data-mode="SEARCH"\] rect/, 10000), 'SEARCH is marked');
+  await shot('mode-machine-live');
   publishStatus('r_0', { state: 'lost' });
   await waitForText(rows, /r_0\s*LOST/);
   await waitForText(rows, /r_1\s*waiting/);

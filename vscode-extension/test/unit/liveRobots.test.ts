@@ -1,6 +1,13 @@
 import { strict as assert } from 'node:assert';
 import { test } from 'node:test';
-import { buildLiveTree, isMonitorView, MonitorView } from '../../src/pure/liveRobots';
+import {
+  buildLiveTree,
+  isMonitorView,
+  liveMarks,
+  modeCaption,
+  modeHighlightCss,
+  MonitorView,
+} from '../../src/pure/liveRobots';
 
 /** A `semo/monitor` notification shaped as server/src/monitor/roster.rs writes it. */
 const VIEW: MonitorView = {
@@ -107,4 +114,46 @@ test('only monitor views are taken', () => {
   assert.ok(isMonitorView(VIEW));
   assert.ok(!isMonitorView({ uri: 'x' }));
   assert.ok(!isMonitorView(null));
+});
+
+/** Two running robots of one team in one mode, one lost, one waiting: with the mission lines. */
+const LINED: MonitorView = {
+  ...VIEW,
+  robots: [
+    { ...VIEW.robots[0], modeLine: 30, services: [{ plan: 'Action', service: 'Patrol', line: 12 }] },
+    {
+      ...VIEW.robots[0],
+      robot: 'tb_2',
+      isLeader: false,
+      modeLine: 30,
+      services: [{ plan: 'Action', service: 'Patrol', line: 12 }],
+    },
+    { ...VIEW.robots[1], modeLine: 30 },
+    { ...VIEW.robots[0], robot: 'tb_3', state: 'waiting', mode: null, modeLine: null, services: [] },
+  ],
+};
+
+test('the mission lines say which running robots are in a mode or run a service', () => {
+  assert.deepEqual(liveMarks(LINED), [
+    { line: 12, kind: 'service', text: '▶ running: tb_0, tb_2' },
+    { line: 30, kind: 'mode', text: '◀ in this mode: tb_0, tb_2' },
+  ]);
+  // A view from an older server (no lines) marks nothing.
+  assert.deepEqual(liveMarks(VIEW), []);
+});
+
+test('the mode machine marks the modes running robots are in, by team', () => {
+  const css = modeHighlightCss(LINED);
+  assert.equal(css.split('\n').length, 1);
+  assert.match(css, /^g\.team\[data-team="Guards"\] g\[data-mode="PATROL"\] rect \{/);
+  // Names are CSS strings: a quote cannot end the selector.
+  const odd = modeHighlightCss({
+    ...LINED,
+    robots: [{ ...VIEW.robots[0], team: 'A"] * {x', mode: 'M' }],
+  });
+  assert.ok(odd.includes('data-team="A\\"] * {x"'), odd);
+  assert.deepEqual(modeCaption(LINED).slice(0, 2), [
+    'tb_0 ★ (Guards) · running · PATROL · [Action=Patrol]',
+    'tb_2 (Guards) · running · PATROL · [Action=Patrol]',
+  ]);
 });

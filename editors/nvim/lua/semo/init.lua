@@ -15,7 +15,8 @@
 -- `:SemoMonitor [BROKER]` in a mission watches its running robots on the MQTT broker (the
 -- server's `semo/monitor`; default: the deployment file's broker) in a window of its own: the
 -- table of robots, modes, services and leader, rewritten in place as it changes (a buffer
--- `semo-monitor://MISSION`); `:SemoMonitorStop` ends it (the last table stays, marked).
+-- `semo-monitor://MISSION`), and marks in the mission the line of each running robot's mode
+-- and services (virtual text); `:SemoMonitorStop` ends it (the last table stays, marked).
 local M = {}
 
 -- XML files that the server reads, and scenario files it completes; their filetype stays
@@ -254,6 +255,48 @@ function M.monitor_buffer(uri)
   return buf
 end
 
+local marks_namespace = vim.api.nvim_create_namespace('semo-monitor')
+
+--- Marks in the mission buffer `bufnr` where a monitor view's running robots are: at the
+--- end of each mode's line the robots in that mode, at each service's line the robots
+--- running it (virtual text; the marks of the previous view are cleared first). A view
+--- without lines (an older server) or nil clears them.
+function M.monitor_marks(bufnr, view)
+  vim.api.nvim_buf_clear_namespace(bufnr, marks_namespace, 0, -1)
+  if view == nil then
+    return
+  end
+  local marks, order = {}, {}
+  local function add(line, kind, robot)
+    line = present(line)
+    if type(line) ~= 'number' or line < 1 or line > vim.api.nvim_buf_line_count(bufnr) then
+      return
+    end
+    local key = kind .. ':' .. line
+    if marks[key] == nil then
+      marks[key] = { line = line, kind = kind, robots = {} }
+      table.insert(order, key)
+    end
+    table.insert(marks[key].robots, robot)
+  end
+  for _, robot in ipairs(view.robots) do
+    if not robot.lost and robot.state ~= 'waiting' then
+      add(robot.modeLine, 'mode', robot.robot)
+      for _, s in ipairs(robot.services) do
+        add(s.line, 'service', robot.robot)
+      end
+    end
+  end
+  for _, key in ipairs(order) do
+    local mark = marks[key]
+    local text = (mark.kind == 'mode' and '◀ in this mode: ' or '▶ running: ')
+      .. table.concat(mark.robots, ', ')
+    vim.api.nvim_buf_set_extmark(bufnr, marks_namespace, mark.line - 1, 0, {
+      virt_text = { { text, mark.kind == 'mode' and 'DiagnosticInfo' or 'Comment' } },
+    })
+  end
+end
+
 --- Shows `text` (lines) in the monitor buffer `buf`, replacing what it showed.
 function M.monitor_show(buf, text)
   vim.bo[buf].modifiable = true
@@ -334,6 +377,9 @@ function M.setup(opts)
         if vim.api.nvim_buf_is_valid(buf) then
           M.monitor_show(buf, M.monitor_table(view))
         end
+        if vim.api.nvim_buf_is_valid(mission) then
+          M.monitor_marks(mission, view)
+        end
       end)
     end, function(err)
       if err then
@@ -346,6 +392,9 @@ function M.setup(opts)
     local buf = vim.fn.bufnr('semo-monitor://' .. vim.fn.expand('%:t'))
     M.monitor_stop(mission, function()
       vim.schedule(function()
+        if vim.api.nvim_buf_is_valid(mission) then
+          M.monitor_marks(mission, nil)
+        end
         if buf ~= -1 and vim.api.nvim_buf_is_valid(buf) then
           local lines = vim.api.nvim_buf_get_lines(buf, 0, -1, false)
           lines[1] = (lines[1] or '') .. ' (monitor stopped)'
