@@ -248,11 +248,13 @@ async fn robots_appear_with_their_modes_and_a_killed_or_silent_one_is_lost() {
     assert_eq!(
         shown["services"],
         json!([
-            {"plan": "Action", "service": "Patrol"},
-            {"plan": "Report", "service": "ToBase"},
-            {"plan": "Listen", "service": "Hear"},
+            {"plan": "Action", "service": "Patrol", "line": 40},
+            {"plan": "Report", "service": "ToBase", "line": 55},
+            {"plan": "Listen", "service": "Hear", "line": 64},
         ])
     );
+    // Where the mission writes them (examples/swarm/patrol_groups.mission).
+    assert_eq!(shown["modeLine"], 84);
     assert_eq!(state(&view, "tb_1"), "waiting");
 
     // Killed: the broker publishes its last will.
