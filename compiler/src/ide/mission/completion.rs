@@ -12,7 +12,7 @@ use super::context::{self, Head, Lt, Paren, Place, Scan};
 use super::docs;
 use super::robots::{self, RobotsHere};
 use super::snippets::{self, Snippet};
-use crate::catalog::{Catalog, ValueDef, ValueType};
+use crate::catalog::{Catalog, RobotTypeId, ValueDef, ValueType};
 use crate::ide::{CompletionConfig, CompletionItem, CompletionKind};
 use crate::sema::{Analysis, Mission, ModeId, PlanId, ScopeKind, ServiceId, Team, TeamId, is_user};
 use crate::span::Span;
@@ -703,8 +703,18 @@ impl<'a> Completions<'a> {
         );
     }
 
-    fn add_team_variables(&mut self, rank: u8, t: &Team) {
+    /// The team's variables, but for those named as a value of `types` (the
+    /// robots the checker reads the name on): `COLOR` received is then the
+    /// robots' value, as the checker reads it, and is offered once, as that.
+    fn add_team_variables(&mut self, rank: u8, team: TeamId, types: &[RobotTypeId]) {
+        let t = self.mission.team(team);
         for var in &t.variables {
+            if types
+                .iter()
+                .any(|ty| self.catalog.get(*ty).value(var).is_some())
+            {
+                continue;
+            }
             self.add(
                 rank,
                 CompletionKind::TeamVariable,
@@ -774,7 +784,7 @@ impl<'a> Completions<'a> {
             self.add_value(LIKELY, v, None);
         }
         for team in here.teams() {
-            self.add_team_variables(LIKELY, self.mission.team(team));
+            self.add_team_variables(LIKELY, team, &types);
         }
         for t in &self.mission.teams {
             self.add_team(OTHER, t);
@@ -804,15 +814,17 @@ impl<'a> Completions<'a> {
         let here = self.robots_here();
         // A team's own values must be had by every robot running the
         // statement; another team's by some of its robots.
-        let values = if here.teams() == [team] {
-            robots::shared_values(self.catalog, &here.types(self.mission))
+        let (values, types) = if here.teams() == [team] {
+            let types = here.types(self.mission);
+            (robots::shared_values(self.catalog, &types), types)
         } else {
-            robots::any_values(self.catalog, &robots::team_types(self.mission, team))
+            let types = robots::team_types(self.mission, team);
+            (robots::any_values(self.catalog, &types), types)
         };
         for v in values {
             self.add_value(EXACT, v, Some(&t.name));
         }
-        self.add_team_variables(EXACT, t);
+        self.add_team_variables(EXACT, team, &types);
     }
 
     /// The type of the value an attribute names, if it is a catalog value.

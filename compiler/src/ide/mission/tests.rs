@@ -279,6 +279,38 @@ fn constants_of_an_enumeration_after_a_comparison() {
     assert_eq!(blink.detail.as_deref(), Some("blink(times: int)"));
 }
 
+/// Scouts that receive their own COLOR (so COLOR is also a team variable
+/// of theirs) and compare it with words and strings; Phase is a team
+/// variable set to words.
+const SCOUTS: &str = "{ S: TIEvalbot ti, NXTLego nxt }
+S.Look.Share{
+  receive(S, S.COLOR)
+  if(COLOR == \"RGB\") send(S, S.Phase = DONE)
+  if(S.Phase != WAITING) stop()
+  CURSOR
+} repeat(COLOR != RED)
+S.M{ set(Look, Share) }
+S.main{ default: mode = M }
+";
+
+fn complete_scouts(line: &str) -> Vec<CompletionItem> {
+    complete_with(&SCOUTS.replace("CURSOR", line), builtin())
+}
+
+#[test]
+fn a_received_value_is_offered_once() {
+    for line in ["send(S, $0)", "if(S.$0)", "if($0)"] {
+        let items = complete_scouts(line);
+        let colors = items.iter().filter(|i| i.label == "COLOR").count();
+        assert_eq!(colors, 1, "{line}: {items:#?}");
+        let mut labels: Vec<&str> = items.iter().map(|i| i.label.as_str()).collect();
+        let count = labels.len();
+        labels.sort_unstable();
+        labels.dedup();
+        assert_eq!(labels.len(), count, "{line}: a label twice");
+    }
+}
+
 #[test]
 fn did_you_mean_of_a_string_keeps_the_quotes() {
     let catalog = enum_catalog();
