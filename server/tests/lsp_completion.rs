@@ -2,7 +2,8 @@
 //! holds a mission with `$0` cursors; the snapshot lists, for each cursor,
 //! the items offered there in the server's order (most specific first):
 //! label, kind, detail, and the text inserted when it differs from the label,
-//! then the documentation of the first item.
+//! then the documentation of the first item. No label is offered twice at a
+//! place.
 
 mod support;
 
@@ -47,8 +48,14 @@ fn render(session: &mut Session, doc: &support::ide::Doc) -> String {
             out.push_str(&format!("replacing `{replaced}`:\n"));
         }
         let mut sort_texts = Vec::new();
+        let mut labels = std::collections::HashSet::new();
         for item in &items {
             let label = item["label"].as_str().unwrap();
+            // A name means one thing at a place: it is offered once.
+            assert!(
+                labels.insert(label),
+                "`{label}` is offered twice: {items:#?}"
+            );
             let insert = item["textEdit"]["newText"].as_str().unwrap();
             let mut line = format!(
                 "{label:<22} {:<11} {}",

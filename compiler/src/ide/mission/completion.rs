@@ -12,9 +12,12 @@ use super::context::{self, Head, Lt, Paren, Place, Scan};
 use super::docs;
 use super::robots::{self, RobotsHere};
 use super::snippets::{self, Snippet};
-use crate::catalog::{Catalog, ValueDef, ValueType};
+use super::values;
+use crate::catalog::{Catalog, RobotTypeId, ValueDef, ValueType};
 use crate::ide::{CompletionConfig, CompletionItem, CompletionKind};
-use crate::sema::{Analysis, Mission, ModeId, PlanId, ScopeKind, ServiceId, Team, TeamId, is_user};
+use crate::sema::{
+    Analysis, Mission, ModeId, PlanId, ScopeKind, ServiceId, Symbol, Team, TeamId, is_user,
+};
 use crate::span::Span;
 use crate::syntax::ast::{self, Name};
 use crate::syntax::token::Token;
@@ -197,10 +200,8 @@ impl<'a> Completions<'a> {
             Place::ArmCapabilities => self.arm_capabilities(),
             Place::Throw => self.throw_events(),
             Place::CommTeam => self.comm_teams(),
-            Place::Expr {
-                qualifier,
-                compared,
-            } => self.expression(qualifier.as_ref(), compared.as_deref()),
+            Place::Expr { qualifier } => self.expression(qualifier.as_ref()),
+            Place::Compared { attr, words } => self.compared(attr.as_deref(), *words),
             Place::AfterOperand => {
                 for word in ["and", "or"] {
                     self.add(KEYWORD, CompletionKind::Keyword, word, None, None);
@@ -703,8 +704,18 @@ impl<'a> Completions<'a> {
         );
     }
 
-    fn add_team_variables(&mut self, rank: u8, t: &Team) {
+    /// The team's variables, but for those named as a value of `types` (the
+    /// robots the checker reads the name on): `COLOR` received is then the
+    /// robots' value, as the checker reads it, and is offered once, as that.
+    fn add_team_variables(&mut self, rank: u8, team: TeamId, types: &[RobotTypeId]) {
+        let t = self.mission.team(team);
         for var in &t.variables {
+            if types
+                .iter()
+                .any(|ty| self.catalog.get(*ty).value(var).is_some())
+            {
+                continue;
+            }
             self.add(
                 rank,
                 CompletionKind::TeamVariable,
@@ -743,38 +754,17 @@ impl<'a> Completions<'a> {
 
     // ----- values -----
 
-    fn expression(&mut self, qualifier: Option<&Name>, compared: Option<&[Name]>) {
+    fn expression(&mut self, qualifier: Option<&Name>) {
         if let Some(q) = qualifier {
             return self.member(q);
         }
         let here = self.robots_here();
-        if let Some(attr) = compared {
-            match self.value_type(attr, &here) {
-                Some(ValueType::Enum(domain)) => {
-                    for d in domain {
-                        self.add(
-                            EXACT,
-                            CompletionKind::Constant,
-                            d.as_str(),
-                            Some(format!("a value of {}", attr.join("."))),
-                            None,
-                        );
-                    }
-                }
-                Some(ValueType::Bool) => {
-                    for b in ["true", "false"] {
-                        self.add(EXACT, CompletionKind::Keyword, b, None, None);
-                    }
-                }
-                _ => {}
-            }
-        }
         let types = here.types(self.mission);
         for v in robots::shared_values(self.catalog, &types) {
             self.add_value(LIKELY, v, None);
         }
         for team in here.teams() {
-            self.add_team_variables(LIKELY, self.mission.team(team));
+            self.add_team_variables(LIKELY, team, &types);
         }
         for t in &self.mission.teams {
             self.add_team(OTHER, t);
@@ -783,6 +773,57 @@ impl<'a> Completions<'a> {
         for word in ["true", "false", "not"] {
             self.add(KEYWORD, CompletionKind::Keyword, word, None, None);
         }
+    }
+
+    /// The right side of a comparison: after `==` or `!=`, first the
+    /// constants the value on the left can hold (its enumeration, `true`
+    /// and `false`, the words and literals the mission compares it with or
+    /// sets it to); then the teams and `USER`, whose values are written
+    /// qualified here (a bare value on the right is E041).
+    fn compared(&mut self, attr: Option<&[Name]>, words: bool) {
+        if words && let Some(attr) = attr {
+            let here = self.robots_here();
+            let what = attr.iter().map(Name::as_str).collect::<Vec<_>>().join(".");
+            let (symbol, ty) = self.compared_value(attr, &here);
+            match ty {
+                Some(ValueType::Enum(domain)) => {
+                    for d in &domain {
+                        let detail = format!("a value of {what}");
+                        self.add(
+                            EXACT,
+                            CompletionKind::Constant,
+                            d.as_str(),
+                            Some(detail),
+                            None,
+                        );
+                    }
+                }
+                Some(ValueType::Bool) => {
+                    for b in ["true", "false"] {
+                        self.add(
+                            EXACT,
+                            CompletionKind::Constant,
+                            b,
+                            Some(format!("a value of {what}")),
+                            None,
+                        );
+                    }
+                }
+                _ => {
+                    let written = symbol
+                        .map(|s| values::constants_of(self.analysis, self.text, &s))
+                        .unwrap_or_default();
+                    for c in written {
+                        let detail = format!("{what} is {} with it in this mission", c.how);
+                        self.add(EXACT, CompletionKind::Constant, c.text, Some(detail), None);
+                    }
+                }
+            }
+        }
+        for t in &self.mission.teams {
+            self.add_team(OTHER, t);
+        }
+        self.add_user(OTHER);
     }
 
     /// After `Team.` or `USER.`: the team's values and variables.
@@ -804,34 +845,82 @@ impl<'a> Completions<'a> {
         let here = self.robots_here();
         // A team's own values must be had by every robot running the
         // statement; another team's by some of its robots.
-        let values = if here.teams() == [team] {
-            robots::shared_values(self.catalog, &here.types(self.mission))
+        let (values, types) = if here.teams() == [team] {
+            let types = here.types(self.mission);
+            (robots::shared_values(self.catalog, &types), types)
         } else {
-            robots::any_values(self.catalog, &robots::team_types(self.mission, team))
+            let types = robots::team_types(self.mission, team);
+            (robots::any_values(self.catalog, &types), types)
         };
         for v in values {
             self.add_value(EXACT, v, Some(&t.name));
         }
-        self.add_team_variables(EXACT, t);
+        self.add_team_variables(EXACT, team, &types);
     }
 
-    /// The type of the value an attribute names, if it is a catalog value.
-    fn value_type(&self, attr: &[Name], here: &RobotsHere) -> Option<ValueType> {
-        let (types, name) = match attr {
-            [name] => (here.types(self.mission), name),
-            [team, name] if is_user(team) => {
-                return self.catalog.user()?.value(name).map(|v| v.ty.clone());
-            }
-            [team, name] => {
-                let (id, _) = self.team(team)?;
-                (robots::team_types(self.mission, id), name)
-            }
-            _ => return None,
+    /// What the dotted name on the left of a comparison reads, as the
+    /// checker records it (`Symbol::Value` or `Symbol::TeamVariable`), and
+    /// its catalog type when it is a catalog value.
+    fn compared_value(
+        &self,
+        attr: &[Name],
+        here: &RobotsHere,
+    ) -> (Option<Symbol>, Option<ValueType>) {
+        let catalog_value = |owner: TeamId, types: &[RobotTypeId], name: &Name| {
+            let def = types
+                .iter()
+                .find_map(|ty| self.catalog.get(*ty).value(name))?;
+            let symbol = Symbol::Value {
+                owner: Some(owner),
+                name: name.clone(),
+            };
+            Some((Some(symbol), Some(def.ty.clone())))
         };
-        types
-            .iter()
-            .find_map(|ty| self.catalog.get(*ty).value(name))
-            .map(|v| v.ty.clone())
+        match attr {
+            // A bare name: a value of the robots running the statement.
+            [name] => {
+                let team = match here.teams().as_slice() {
+                    [team] => Some(*team),
+                    [] => self.head_team().map(|(id, _)| id),
+                    _ => None,
+                };
+                let Some(team) = team else {
+                    return (None, None);
+                };
+                let mut types = here.types(self.mission);
+                if types.is_empty() {
+                    types = robots::team_types(self.mission, team);
+                }
+                catalog_value(team, &types, name).unwrap_or((None, None))
+            }
+            [user, name] if is_user(user) => {
+                let ty = self
+                    .catalog
+                    .user()
+                    .and_then(|u| u.value(name))
+                    .map(|v| v.ty.clone());
+                let symbol = Symbol::Value {
+                    owner: None,
+                    name: name.clone(),
+                };
+                (Some(symbol), ty)
+            }
+            // `Team.NAME`: a value of its robots, else a team variable.
+            [team, name] => {
+                let Some((id, _)) = self.team(team) else {
+                    return (None, None);
+                };
+                let types = robots::team_types(self.mission, id);
+                catalog_value(id, &types, name).unwrap_or_else(|| {
+                    let symbol = Symbol::TeamVariable {
+                        team: Some(id),
+                        name: name.clone(),
+                    };
+                    (Some(symbol), None)
+                })
+            }
+            _ => (None, None),
+        }
     }
 
     // ----- modes and main blocks -----

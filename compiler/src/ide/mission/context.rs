@@ -466,10 +466,15 @@ pub(crate) enum Place {
     /// `send(|`: a team or USER.
     CommTeam,
     /// A value: in a condition, argument or communicated item. `qualifier`:
-    /// after `Team.`; `compared`: the attribute on the other side of `==`.
-    Expr {
-        qualifier: Option<Name>,
-        compared: Option<Vec<Name>>,
+    /// after `Team.`.
+    Expr { qualifier: Option<Name> },
+    /// The right side of a comparison (`COLOR == |`): `attr` is the dotted
+    /// name on its left, if it is one; `words`: the operator is `==` or
+    /// `!=`, which compare words and strings too. A bare value may not
+    /// stand here (E041: a bare name on the right is a word).
+    Compared {
+        attr: Option<Vec<Name>>,
+        words: bool,
     },
     /// After a complete operand in a condition: `and`, `or`.
     AfterOperand,
@@ -548,31 +553,18 @@ fn expression(ts: &[Lt<'_>], words: bool) -> Place {
         Some(Token::Dot) => match (last(2), last(3)) {
             (Some(Token::Ident(q)), third) if third != Some(Token::Dot) => Place::Expr {
                 qualifier: Some(Name::new(q)),
-                compared: None,
             },
             _ => Place::Nothing,
         },
-        Some(t) if is_comparison(t) => Place::Expr {
-            qualifier: None,
-            compared: trailing_attr(&ts[..ts.len() - 1]),
+        Some(t) if is_comparison(t) => Place::Compared {
+            attr: trailing_attr(&ts[..ts.len() - 1]),
+            words: matches!(t, Token::EqEq | Token::NotEq),
         },
-        None if ts.is_empty() => Place::Expr {
-            qualifier: None,
-            compared: None,
-        },
-        Some(Token::Assign | Token::Comma) => Place::Expr {
-            qualifier: None,
-            compared: None,
-        },
-        Some(t) if is_operator(t) => Place::Expr {
-            qualifier: None,
-            compared: None,
-        },
+        None if ts.is_empty() => Place::Expr { qualifier: None },
+        Some(Token::Assign | Token::Comma) => Place::Expr { qualifier: None },
+        Some(t) if is_operator(t) => Place::Expr { qualifier: None },
         // After a complete operand: `move(Paris |` may go on with words.
-        Some(Token::Ident(_) | Token::Kw(_)) if words => Place::Expr {
-            qualifier: None,
-            compared: None,
-        },
+        Some(Token::Ident(_) | Token::Kw(_)) if words => Place::Expr { qualifier: None },
         Some(Token::Ident(_) | Token::Kw(Kw::True | Kw::False) | Token::Str(_)) => {
             Place::AfterOperand
         }

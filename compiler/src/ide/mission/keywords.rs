@@ -1,7 +1,9 @@
 //! Hover on a keyword: its entry of the language reference. The entries are
 //! the `` ## `keyword` `` sections of `docs/language/keywords.md`, built into
-//! the library: the reference is their one source, and a keyword of the lexer
-//! without an entry fails this module's tests.
+//! the library: the reference is their one source. This module's tests fail
+//! for a keyword of the lexer without an entry, an entry without an example
+//! line that is a line of a checked example of `docs/language/`, and a link
+//! that leads to no page or heading there.
 
 use crate::ide::HoverResult;
 use crate::span::Span;
@@ -56,8 +58,9 @@ fn sections(page: &str) -> Vec<(String, String)> {
 }
 
 /// A section as the editor shows it: the keyword, its syntax as code of the
-/// language, and its text with each link written as the page it leads to
-/// (the reference's relative links lead nowhere from an editor).
+/// language, its text and example, with each link written as the page and
+/// heading it leads to in the repository (the reference's relative links
+/// lead nowhere from an editor).
 fn hover_markdown(word: &str, body: &[&str]) -> String {
     let mut out = format!("**`{word}`** (keyword)\n\n");
     for line in body {
@@ -71,7 +74,7 @@ fn hover_markdown(word: &str, body: &[&str]) -> String {
     out.trim_end().to_string()
 }
 
-/// `[Control flow](control-flow.md#repeat)` → ``Control flow (`docs/language/control-flow.md`)``.
+/// `[Control flow](control-flow.md#repeat)` → ``Control flow (`docs/language/control-flow.md#repeat`)``.
 fn plain_links(line: &str) -> String {
     let mut out = String::new();
     let mut rest = line;
@@ -81,9 +84,8 @@ fn plain_links(line: &str) -> String {
             rest = &rest[open + 1..];
             continue;
         };
-        let page = target.split('#').next().unwrap_or(target);
-        let page = page.strip_prefix("../").map_or_else(
-            || format!("{REFERENCE_DIR}{page}"),
+        let page = target.strip_prefix("../").map_or_else(
+            || format!("{REFERENCE_DIR}{target}"),
             |up| format!("docs/{up}"),
         );
         out.push_str(&rest[..open]);
@@ -192,7 +194,7 @@ mod tests {
     fn links_become_the_pages_they_lead_to() {
         assert_eq!(
             plain_links("See [Control flow](control-flow.md#repeat) and [groups](../groups.md)."),
-            "See Control flow (`docs/language/control-flow.md`) and groups (`docs/groups.md`)."
+            "See Control flow (`docs/language/control-flow.md#repeat`) and groups (`docs/groups.md`)."
         );
         assert_eq!(plain_links("`[[ a ]]` [x"), "`[[ a ]]` [x");
     }
@@ -210,7 +212,12 @@ mod tests {
         let found = hover_at(text, "repeat(1", 3).expect("a hover on repeat");
         assert_eq!(&text[found.range.start..found.range.end], "repeat");
         assert!(found.markdown.starts_with("**`repeat`** (keyword)"));
-        assert!(found.markdown.contains("(`docs/language/control-flow.md`)"));
+        assert!(
+            found
+                .markdown
+                .contains("(`docs/language/control-flow.md#repeat`)")
+        );
+        assert!(found.markdown.contains("\nExample: `} repeat("));
         // Touching its end still hovers it.
         assert!(hover_at(text, "send(", 4).is_some());
         // A word of a bare-word argument, a comment, a string: no keyword.
@@ -219,5 +226,108 @@ mod tests {
         assert!(hover_at(text, "loop\"", 1).is_none());
         // Past the end and on a lone line: nothing, and no panic.
         assert!(hover(&ast::SourceFile::default(), text, text.len() + 5).is_none());
+    }
+
+    /// The repository's `docs/` folder, read by the tests only (the entries
+    /// themselves are built in).
+    fn docs_dir() -> std::path::PathBuf {
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs")
+    }
+
+    /// The lines of the examples of `docs/language/` that the reference's
+    /// test checks clean (` ```semo ` without `expect=`), comments cut.
+    fn checked_example_lines() -> Vec<String> {
+        let mut lines = Vec::new();
+        let dir = docs_dir().join("language");
+        for entry in std::fs::read_dir(&dir).expect("docs/language") {
+            let path = entry.expect("a page").path();
+            if path.extension().is_none_or(|e| e != "md") {
+                continue;
+            }
+            let page = std::fs::read_to_string(&path).expect("a page's text");
+            let mut inside = false;
+            for line in page.lines() {
+                if let Some(fence) = line.strip_prefix("```") {
+                    inside = !inside && fence.trim() == "semo";
+                    continue;
+                }
+                if inside {
+                    let code = line.split('#').next().unwrap_or(line).trim();
+                    lines.push(code.to_string());
+                }
+            }
+        }
+        lines
+    }
+
+    #[test]
+    fn every_entry_has_an_example_line_of_a_checked_example() {
+        let examples = checked_example_lines();
+        for kw in Kw::ALL {
+            let word = kw.as_str();
+            let entry = entry(*kw).expect("an entry");
+            let example = entry
+                .lines()
+                .find_map(|l| l.strip_prefix("Example: `")?.strip_suffix('`'))
+                .unwrap_or_else(|| panic!("the entry of `{word}` has no `Example: `...`` line"));
+            let uses = token::lex(example)
+                .iter()
+                .any(|(tok, _)| *tok == Token::Kw(*kw));
+            assert!(uses, "the example of `{word}` does not use it: {example}");
+            assert!(
+                examples.iter().any(|l| l == example),
+                "the example of `{word}` is no line of a checked example of docs/language: {example}"
+            );
+        }
+    }
+
+    /// A heading's anchor as GitHub makes it (as `tests/language_reference.rs`
+    /// checks the reference's own links).
+    fn slug(heading: &str) -> String {
+        heading
+            .trim()
+            .to_lowercase()
+            .chars()
+            .filter(|c| c.is_alphanumeric() || *c == ' ' || *c == '-' || *c == '_')
+            .map(|c| if c == ' ' { '-' } else { c })
+            .collect()
+    }
+
+    #[test]
+    fn every_link_of_an_entry_leads_to_a_page_and_heading() {
+        let mut links = 0;
+        for kw in Kw::ALL {
+            let entry = entry(*kw).expect("an entry");
+            assert!(
+                entry.contains("(`docs/"),
+                "the entry of `{}` links to no page",
+                kw.as_str()
+            );
+            for (at, _) in entry.match_indices("(`docs/") {
+                let rest = &entry[at + 2..];
+                let target = &rest[..rest.find('`').unwrap_or(rest.len())];
+                let (page, anchor) = target.split_once('#').unwrap_or((target, ""));
+                let path = docs_dir().join(page.strip_prefix("docs/").expect("under docs/"));
+                let text = std::fs::read_to_string(&path).unwrap_or_else(|_| {
+                    panic!("`{}` links to {page}, which is no file", kw.as_str())
+                });
+                let mut in_code = false;
+                let headings: Vec<String> = text
+                    .lines()
+                    .filter(|l| {
+                        in_code ^= l.starts_with("```");
+                        !in_code && l.starts_with('#')
+                    })
+                    .map(|l| slug(l.trim_start_matches('#')))
+                    .collect();
+                assert!(
+                    anchor.is_empty() || headings.iter().any(|h| h == anchor),
+                    "`{}` links to {page}#{anchor}, which has no such heading",
+                    kw.as_str()
+                );
+                links += 1;
+            }
+        }
+        assert!(links >= Kw::ALL.len());
     }
 }

@@ -23,6 +23,7 @@ pub mod semantic_tokens;
 pub mod signature_help;
 pub mod snippets;
 pub mod symbols;
+mod values;
 
 #[cfg(test)]
 mod testing;

@@ -144,26 +144,19 @@ fn places_in_half_typed_text() {
         ("{ T: A $0", Place::Nothing),
         ("T: A a\n$0", Place::Item),
         ("T.P.S{ st$0", Place::Statement),
-        (
-            "T.P.S{ move($0",
-            Place::Expr {
-                qualifier: None,
-                compared: None,
-            },
-        ),
+        ("T.P.S{ move($0", Place::Expr { qualifier: None }),
         ("T.P.S{ move(\n  $0", Place::Statement),
         (
             "T.P.S{ if(T.$0",
             Place::Expr {
                 qualifier: Some("T".into()),
-                compared: None,
             },
         ),
         (
             "T.P.S{ if(T.COLOR == $0",
-            Place::Expr {
-                qualifier: None,
-                compared: Some(vec!["T".into(), "COLOR".into()]),
+            Place::Compared {
+                attr: Some(vec!["T".into(), "COLOR".into()]),
+                words: true,
             },
         ),
         ("T.P.S{ throw $0", Place::Throw),
@@ -178,13 +171,7 @@ fn places_in_half_typed_text() {
         ("T.P.S{ [[ group($0", Place::ArmCondition),
         ("T.P.S{ [[ group(instance of A, $0", Place::ArmTypes),
         ("T.P.S{ [[ group(capable of $0", Place::ArmCapabilities),
-        (
-            "T.P.S{ x() } repeat($0",
-            Place::Expr {
-                qualifier: None,
-                compared: None,
-            },
-        ),
+        ("T.P.S{ x() } repeat($0", Place::Expr { qualifier: None }),
         (
             "T.P.S{ x() } repeat(2 $0",
             Place::Unit {
@@ -277,6 +264,77 @@ fn constants_of_an_enumeration_after_a_comparison() {
     let blink = items.iter().find(|i| i.label == "blink").unwrap();
     assert_eq!(blink.insert, "blink(${1:times})$0");
     assert_eq!(blink.detail.as_deref(), Some("blink(times: int)"));
+}
+
+/// Scouts that receive their own COLOR (so COLOR is also a team variable
+/// of theirs) and compare it with words and strings; Phase is a team
+/// variable set to words.
+const SCOUTS: &str = "{ S: TIEvalbot ti, NXTLego nxt }
+S.Look.Share{
+  receive(S, S.COLOR)
+  if(COLOR == \"RGB\") send(S, S.Phase = DONE)
+  if(S.Phase != WAITING) stop()
+  CURSOR
+} repeat(COLOR != RED)
+S.M{ set(Look, Share) }
+S.main{ default: mode = M }
+";
+
+fn complete_scouts(line: &str) -> Vec<CompletionItem> {
+    complete_with(&SCOUTS.replace("CURSOR", line), builtin())
+}
+
+#[test]
+fn constants_after_a_comparison_are_those_the_mission_writes_with_the_value() {
+    for (line, constants) in [
+        ("if(COLOR == $0)", vec!["RED", "\"RGB\""]),
+        ("if(S.COLOR != $0)", vec!["RED", "\"RGB\""]),
+        ("if(S.Phase == $0)", vec!["DONE", "WAITING"]),
+    ] {
+        let items = complete_scouts(line);
+        let first: Vec<&str> = items
+            .iter()
+            .take_while(|i| i.kind == CompletionKind::Constant)
+            .map(|i| i.label.as_str())
+            .collect();
+        assert_eq!(first, constants, "{line}: the constants first");
+        // A bare value on the right of `==` is E041: none is offered.
+        assert_eq!(
+            labels_of(&items, CompletionKind::Value),
+            Vec::<String>::new(),
+            "{line}"
+        );
+        assert_eq!(
+            labels_of(&items, CompletionKind::TeamVariable),
+            Vec::<String>::new(),
+            "{line}"
+        );
+        assert!(labels_of(&items, CompletionKind::Team).contains(&"S".to_string()));
+    }
+    // `<` compares numbers: no words, no bare values.
+    let items = complete_scouts("if(DISTANCE < $0)");
+    assert_eq!(
+        labels_of(&items, CompletionKind::Constant),
+        Vec::<String>::new()
+    );
+    assert_eq!(
+        labels_of(&items, CompletionKind::Value),
+        Vec::<String>::new()
+    );
+}
+
+#[test]
+fn a_received_value_is_offered_once() {
+    for line in ["send(S, $0)", "if(S.$0)", "if($0)"] {
+        let items = complete_scouts(line);
+        let colors = items.iter().filter(|i| i.label == "COLOR").count();
+        assert_eq!(colors, 1, "{line}: {items:#?}");
+        let mut labels: Vec<&str> = items.iter().map(|i| i.label.as_str()).collect();
+        let count = labels.len();
+        labels.sort_unstable();
+        labels.dedup();
+        assert_eq!(labels.len(), count, "{line}: a label twice");
+    }
 }
 
 #[test]
