@@ -423,3 +423,90 @@ fn a_project_files_folders_and_levels_are_the_same_at_every_door() {
     assert_eq!(build.code, 1, "{}{}", build.stdout, build.stderr);
     assert!(!out.exists());
 }
+
+/// Every file under `dir` (relative path → bytes).
+fn tree(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    walkdir::WalkDir::new(dir)
+        .into_iter()
+        .map(|e| e.unwrap())
+        .filter(|e| e.file_type().is_file())
+        .map(|e| {
+            let relative = e.path().strip_prefix(dir).unwrap().display().to_string();
+            (relative, std::fs::read(e.path()).unwrap())
+        })
+        .collect()
+}
+
+/// A project whose `semo.toml` says where and for what to build.
+fn planned_project(dir: &Path) {
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::create_dir_all(dir.join(".git")).unwrap();
+    std::fs::write(
+        dir.join("semo.toml"),
+        "[build]\noutput = \"build\"\ntarget = \"linux-sim\"\n",
+    )
+    .unwrap();
+    std::fs::copy(
+        examples().join("follow/follow.mission"),
+        dir.join("follow.mission"),
+    )
+    .unwrap();
+}
+
+/// `semo build` and the editor's Generate Code (no folder or target asked)
+/// build the same plan for the same project: the project file's target and
+/// folder, and the same files written.
+#[test]
+fn the_cli_and_the_editor_build_the_project_files_plan() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (cli, editor) = (tmp.path().join("cli"), tmp.path().join("editor"));
+    planned_project(&cli);
+    planned_project(&editor);
+    let built = semo_in(&cli, &["build"]);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    let answer = runtime.block_on(async {
+        let mut client = TestClient::start();
+        let root = format!("file://{}", editor.display());
+        client.initialize(&["utf-16"], Some(&root)).await;
+        let mission = editor.join("follow.mission");
+        let uri = format!("file://{}", mission.display());
+        client
+            .open(&uri, &std::fs::read_to_string(&mission).unwrap())
+            .await;
+        client.diagnostics(&uri, Some(1)).await;
+        let answer = client
+            .request(
+                "workspace/executeCommand",
+                serde_json::json!({ "command": "semo.generateCode", "arguments": [{ "uri": uri }] }),
+            )
+            .await
+            .expect("generated");
+        client.shutdown().await;
+        answer
+    });
+    assert_eq!(answer["target"], "linux-sim", "{answer}");
+    assert_eq!(
+        answer["outputFolder"],
+        editor.join("build").display().to_string()
+    );
+    let (from_cli, from_editor) = (tree(&cli.join("build")), tree(&editor.join("build")));
+    assert!(
+        from_cli.contains_key("Team1/create1/main.c"),
+        "{:?}",
+        from_cli.keys()
+    );
+    assert_eq!(
+        from_cli.keys().collect::<Vec<_>>(),
+        from_editor.keys().collect::<Vec<_>>()
+    );
+    for (file, bytes) in &from_cli {
+        assert!(from_editor[file] == *bytes, "{file} differs");
+    }
+    assert!(!cli.join("out").exists() && !editor.join("out").exists());
+}

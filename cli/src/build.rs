@@ -68,22 +68,18 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     };
-    // What the command line does not say, the project file does.
-    let project = run.analysis().project(mission);
-    let project = project.as_ref().map(|p| &p.project);
-    let target = options
-        .target
-        .or(project.and_then(|p| p.target))
-        .unwrap_or(Target::Linux);
-    let out_dir = options
-        .out
-        .clone()
-        .or_else(|| {
-            project
-                .and_then(|p| p.output.as_ref())
-                .map(|o| o.path.clone())
-        })
-        .unwrap_or_else(|| mission_file.parent().unwrap_or(Path::new(".")).join("out"));
+    // What the command line does not say, the project file does (the plan
+    // the editor's Generate Code asks for too).
+    let plan = run.analysis().build_plan(
+        mission,
+        &mission_file,
+        host::PlanRequest {
+            target: options.target,
+            output: options.out.clone(),
+            deployment: options.deploy.clone(),
+        },
+    );
+    let (target, out_dir) = (plan.target, plan.output);
     if options.scenario.is_some() != target.needs_scenario() {
         eprintln!(
             "error: {}",
@@ -102,11 +98,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         return 2;
     }
     // The deployment file: the command line's, else the project file's.
-    let deploy_path = options.deploy.clone().or_else(|| {
-        project
-            .and_then(|p| p.deployment.as_ref())
-            .map(|d| d.path.clone())
-    });
+    let deploy_path = plan.deployment;
     let deployment = match &deploy_path {
         None => None,
         Some(path) => {

@@ -998,6 +998,7 @@ mod dataflow;
 mod disk;
 mod dropper;
 mod ide;
+mod plan;
 #[cfg(test)]
 mod tests;
 mod view;
@@ -1008,3 +1009,4 @@ pub use disk::{
 };
 pub use dropper::{Dropper, drop_later};
 pub use ide::{PictureError, RobotPicture, WORKSPACE_SYMBOL_LIMIT};
+pub use plan::{BuildPlan, DEFAULT_OUTPUT, PlanRequest};

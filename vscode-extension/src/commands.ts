@@ -43,11 +43,20 @@ function activeMission(): vscode.TextDocument | undefined {
   return vscode.window.visibleTextEditors.find((e) => e.document.languageId === 'semo')?.document;
 }
 
-/** The output folder setting made absolute against the mission's workspace folder. */
-export function outputFolderFor(document: vscode.TextDocument): string {
-  const setting =
-    vscode.workspace.getConfiguration('semo', document.uri).get<string>('codegen.outputFolder') ||
-    'generated';
+/**
+ * The output folder setting made absolute against the mission's workspace
+ * folder; undefined when it is not set, so that the server decides as
+ * `semo build` does (the project file's `[build] output`, else `out` beside
+ * the mission).
+ */
+export function outputFolderFor(document: vscode.TextDocument): string | undefined {
+  const setting = vscode.workspace
+    .getConfiguration('semo', document.uri)
+    .get<string>('codegen.outputFolder', '')
+    .trim();
+  if (!setting) {
+    return undefined;
+  }
   if (path.isAbsolute(setting)) {
     return setting;
   }
@@ -123,7 +132,11 @@ export async function generateCode(server: Server, lens?: unknown): Promise<void
   };
   const result = await generateWithConsent(
     send,
-    { uri: document.uri.toString(), outputFolder, ...(fromLens?.team ? { team: fromLens.team } : {}) },
+    {
+      uri: document.uri.toString(),
+      ...(outputFolder ? { outputFolder } : {}),
+      ...(fromLens?.team ? { team: fromLens.team } : {}),
+    },
     askToForce,
   );
   if (result.kind === 'declined') {
@@ -149,6 +162,10 @@ export async function generateCode(server: Server, lens?: unknown): Promise<void
     return;
   }
   const written = summary?.outputFolder ?? outputFolder;
+  if (!written) {
+    server.output.appendLine(`[error] ${GENERATE_CODE}: the answer names no output folder`);
+    return;
+  }
   for (const line of summary?.recovered ?? []) {
     server.output.appendLine(`[warning] recovered: ${line}`);
   }
@@ -156,7 +173,7 @@ export async function generateCode(server: Server, lens?: unknown): Promise<void
     server.output.appendLine(`[warning] kept ${kept.path}: ${kept.why}`);
   }
   server.output.appendLine(`[info] generated code in ${written}`);
-  const folderUri = vscode.Uri.file(outputFolder);
+  const folderUri = vscode.Uri.file(written);
   try {
     await vscode.commands.executeCommand('revealInExplorer', folderUri);
   } catch {

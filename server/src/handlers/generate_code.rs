@@ -6,9 +6,12 @@
 //! robot.
 //!
 //! Arguments: one object `{ "uri": mission, "outputFolder"?: path (relative
-//! to the mission's folder; default `out` beside it), "target"?: "linux" |
-//! "linux-sim", "team"?: only this team's robots, "force"?: replace files in
-//! the way, saved first (as `semo build --force`) }`, or just the URI.
+//! to the mission's folder), "target"?: "linux" | "linux-sim", "team"?: only
+//! this team's robots, "force"?: replace files in the way, saved first (as
+//! `semo build --force`) }`, or just the URI. What the arguments do not say
+//! the mission's project file does, as for `semo build`: both ask the host's
+//! one [`semo::host::Analysis::build_plan`] (target, output folder, and the
+//! deployment whose broker and credentials are baked into the robots).
 //! Refused over files in the way, the error's `data` is `{ "conflicts":
 //! [{ "path", "why" }] }`, so that an editor can offer to force.
 //!
@@ -74,6 +77,8 @@ pub struct Job {
     pub mission: FileId,
     pub out: output::Confined,
     pub target: Target,
+    /// The deployment file to bake into the robots (`semo build --deploy`'s).
+    pub deployment: Option<PathBuf>,
     pub team: Option<String>,
     pub force: bool,
 }
@@ -81,8 +86,10 @@ pub struct Job {
 /// The mission and the workspace as they are now.
 pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
     let target = match params.target.as_deref() {
-        None => Target::Linux,
-        Some(name) => Target::from_name(name).ok_or_else(|| format!("unknown target `{name}`"))?,
+        None => None,
+        Some(name) => {
+            Some(Target::from_name(name).ok_or_else(|| format!("unknown target `{name}`"))?)
+        }
     };
     let mission = world
         .snapshot(&params.uri)
@@ -94,10 +101,17 @@ pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
         .parent()
         .unwrap_or(Path::new("."))
         .to_path_buf();
-    let requested = match params.output_folder {
-        Some(f) => folder.join(f),
-        None => folder.join("out"),
-    };
+    let analysis = world.analysis();
+    let plan = analysis.build_plan(
+        mission.id,
+        &mission_path,
+        semo::host::PlanRequest {
+            target,
+            output: params.output_folder.map(|f| folder.join(f)),
+            deployment: None,
+        },
+    );
+    let requested = plan.output;
     let allowed = if world.roots().is_empty() {
         std::slice::from_ref(&folder)
     } else {
@@ -107,10 +121,11 @@ pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
     Ok(Job {
         mission_uri: params.uri,
         mission_path,
-        analysis: world.analysis(),
+        analysis,
         mission: mission.id,
         out,
-        target,
+        target: plan.target,
+        deployment: plan.deployment,
         team: params.team,
         force: params.force,
     })
@@ -122,13 +137,32 @@ fn path_of(snapshot: &Snapshot) -> Option<PathBuf> {
 
 /// Checks, refines and generates (no writing yet); the mission's text too,
 /// for positions.
-pub fn generate(job: &Job) -> Result<(BuildResult, String), &'static str> {
+pub fn generate(job: &Job) -> Result<(BuildResult, String), String> {
     let build = job
         .analysis
         .build_input(job.mission)
         .ok_or("internal error: the mission is not in the workspace analysis")?;
     let text = build.file.text.to_string();
     let mut result = codegen::build(&build.input(), job.target, Emit::All);
+    // The project's deployment, baked in as `semo build` does.
+    if let (Some(path), false) = (&job.deployment, result.refused()) {
+        let deployment = semo::deploy::load(path, FileId(u32::MAX)).map_err(|found| {
+            let first = found
+                .first()
+                .map_or(String::new(), |d| format!(": {}", d.message));
+            format!(
+                "the project's deployment file {} has {} problem(s){first} (see `semo build`)",
+                path.display(),
+                found.len()
+            )
+        })?;
+        if !semo::deploy::bake(&deployment, &mut result) {
+            return Err(format!(
+                "target {} has no network transport to deploy",
+                job.target.name()
+            ));
+        }
+    }
     if let Some(team) = &job.team {
         result.robots.retain(|r| &r.team == team);
     }

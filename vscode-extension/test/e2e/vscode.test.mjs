@@ -176,7 +176,8 @@ async function userJourney() {
   await waitForText('.notifications-toasts .notification-list-item', /code generated for 2 robot\(s\) in/);
   assert.equal(await toastsMatching(/generated/), 1, 'one notification for the generation');
   await shot('generate-code');
-  const robot = join(workspace, 'generated', 'Rovers', 'r_0');
+  // No output folder setting: where `semo build` writes, `out` beside the mission.
+  const robot = join(workspace, 'out', 'Rovers', 'r_0');
   assert.ok(existsSync(join(robot, 'control_task.c')), `control_task.c in ${robot}`);
   assert.ok(existsSync(join(robot, 'Makefile')), `Makefile in ${robot}`);
 
