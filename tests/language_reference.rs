@@ -244,17 +244,8 @@ fn links(text: &str) -> Vec<(String, Option<String>)> {
     out
 }
 
-/// A heading's anchor as GitHub makes it: lower case, punctuation dropped,
-/// spaces as dashes.
-fn slug(heading: &str) -> String {
-    heading
-        .trim()
-        .to_lowercase()
-        .chars()
-        .filter(|c| c.is_alphanumeric() || *c == ' ' || *c == '-' || *c == '_')
-        .map(|c| if c == ' ' { '-' } else { c })
-        .collect()
-}
+/// A heading's anchor as GitHub makes it.
+use semo::ide::mission::keywords::heading_anchor as slug;
 
 fn anchors(text: &str) -> BTreeSet<String> {
     text.lines()

@@ -167,6 +167,19 @@ pub(crate) fn hover(syntax: &ast::SourceFile, text: &str, offset: usize) -> Opti
     })
 }
 
+/// A heading's anchor as GitHub makes it: lower case, punctuation dropped,
+/// spaces as dashes (the reference's links and the hovers' lead there;
+/// `tests/language_reference.rs` checks them with it).
+pub fn heading_anchor(heading: &str) -> String {
+    heading
+        .trim()
+        .to_lowercase()
+        .chars()
+        .filter(|c| c.is_alphanumeric() || *c == ' ' || *c == '-' || *c == '_')
+        .map(|c| if c == ' ' { '-' } else { c })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -281,17 +294,7 @@ mod tests {
         }
     }
 
-    /// A heading's anchor as GitHub makes it (as `tests/language_reference.rs`
-    /// checks the reference's own links).
-    fn slug(heading: &str) -> String {
-        heading
-            .trim()
-            .to_lowercase()
-            .chars()
-            .filter(|c| c.is_alphanumeric() || *c == ' ' || *c == '-' || *c == '_')
-            .map(|c| if c == ' ' { '-' } else { c })
-            .collect()
-    }
+    use super::heading_anchor as slug;
 
     #[test]
     fn every_link_of_an_entry_leads_to_a_page_and_heading() {
