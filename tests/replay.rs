@@ -263,3 +263,160 @@ fn bad_lines_and_unknown_robots_are_errors_at_their_place() {
     let out = semo(&["replay", "--mission", &text(&scouting())]);
     assert_eq!(out.code, 2, "{}", out.stderr);
 }
+
+/// What the reference Python reader (PyPI `mcap`, `tests/mcap/read.py`)
+/// finds in an MCAP file.
+fn read_mcap(file: &Path) -> serde_json::Value {
+    let python = support::python::venv_with("mcap-venv", "mcap", &["mcap>=1.1,<2"]);
+    let out = std::process::Command::new(python)
+        .arg(repo_root().join("tests/mcap/read.py"))
+        .arg(file)
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .output()
+        .expect("python runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("the reader prints one JSON object")
+}
+
+#[test]
+fn runs_are_written_as_mcap_files_the_reference_reader_reads() {
+    let dir = scratch("mcap");
+    let (_, trace, _) = simulated(&dir);
+    let simulated_mcap = dir.join("simulated.mcap");
+    let out = semo(&[
+        "simulate",
+        &text(&scouting()),
+        "--scenario",
+        &text(&scouting_scenario()),
+        "--mcap",
+        &text(&simulated_mcap),
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let replayed_mcap = dir.join("replayed.mcap");
+    let out = replay(
+        std::slice::from_ref(&trace),
+        &["--mcap", &text(&replayed_mcap)],
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let lines: Vec<serde_json::Value> = std::fs::read_to_string(&trace)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let robots = [
+        ("MasterTeam", "irobot"),
+        ("SlaveTeam", "ti"),
+        ("SlaveTeam", "nxt"),
+    ];
+    let kinds = ["modes", "services", "messages", "values", "events"];
+    let mut read = Vec::new();
+    for file in [&simulated_mcap, &replayed_mcap] {
+        let found = read_mcap(file);
+        // A channel per robot and kind, JSON messages with a JSON Schema.
+        let channels = found["channels"].as_array().unwrap();
+        let topics: Vec<&str> = channels
+            .iter()
+            .map(|c| c["topic"].as_str().unwrap())
+            .collect();
+        let expected: Vec<String> = robots
+            .iter()
+            .flat_map(|(team, robot)| kinds.iter().map(move |k| format!("/{team}/{robot}/{k}")))
+            .collect();
+        assert_eq!(topics, expected);
+        let mut validators = std::collections::HashMap::new();
+        for c in channels {
+            assert_eq!(c["message_encoding"], "json");
+            let schema = &found["schemas"][c["schema"].as_str().unwrap()];
+            assert_eq!(schema["encoding"], "jsonschema");
+            let validator = jsonschema::validator_for(&schema["data"]).expect("a JSON Schema");
+            validators.insert(c["topic"].as_str().unwrap().to_string(), validator);
+            let topic = c["topic"].as_str().unwrap();
+            assert!(topic.starts_with(&format!(
+                "/{}/{}/",
+                c["metadata"]["team"].as_str().unwrap(),
+                c["metadata"]["robot"].as_str().unwrap()
+            )));
+        }
+        // Every trace line is one message, on its robot's channel of its
+        // kind, at its mission time in nanoseconds, valid for its schema.
+        let messages = found["messages"].as_array().unwrap();
+        assert_eq!(messages.len(), lines.len());
+        assert_eq!(found["message_count"], lines.len());
+        let mut sequences: std::collections::HashMap<&str, u64> = Default::default();
+        for m in messages {
+            let data = &m["data"];
+            let topic = m["topic"].as_str().unwrap();
+            let (team, robot) = robots
+                .iter()
+                .find(|(_, r)| data["robot"] == *r)
+                .expect("a robot of the mission");
+            let kind = match data["event"].as_str().unwrap() {
+                "mode" => "modes",
+                "send" | "receive" => "messages",
+                "service_start" | "service_end" | "call_start" | "call_end" => "services",
+                "actuate" => "values",
+                "start" | "stop" | "throw" | "catch" | "drop" | "finish" => "events",
+                _ => topic.rsplit('/').next().unwrap(),
+            };
+            assert_eq!(topic, format!("/{team}/{robot}/{kind}"), "{data}");
+            let nanoseconds = data["t"].as_u64().unwrap() * 1_000_000;
+            assert_eq!(m["log_time"], nanoseconds);
+            assert_eq!(m["publish_time"], nanoseconds);
+            assert!(validators[topic].is_valid(data), "{topic}: {data}");
+            let next = sequences.entry(topic).or_default();
+            assert_eq!(m["sequence"], *next, "{topic}");
+            *next += 1;
+        }
+        // Per channel, as many messages as the trace has lines of its kind.
+        for (team, robot) in robots {
+            let count = |events: &[&str]| {
+                lines
+                    .iter()
+                    .filter(|l| {
+                        l["robot"] == robot && events.contains(&l["event"].as_str().unwrap())
+                    })
+                    .count() as u64
+            };
+            let of = |kind: &str| sequences[format!("/{team}/{robot}/{kind}").as_str()];
+            assert_eq!(of("modes"), count(&["mode"]), "{robot}");
+            assert_eq!(of("messages"), count(&["send", "receive"]), "{robot}");
+            assert_eq!(
+                of("values"),
+                count(&["actuate", "shared_set", "shared_value"]),
+                "{robot}"
+            );
+        }
+        // The payloads are the trace lines themselves.
+        let mut payloads: Vec<String> = messages.iter().map(|m| m["data"].to_string()).collect();
+        let mut written: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+        payloads.sort();
+        written.sort();
+        assert_eq!(payloads, written);
+        let irobot_modes: Vec<(u64, &str)> = messages
+            .iter()
+            .filter(|m| m["topic"] == "/MasterTeam/irobot/modes")
+            .map(|m| {
+                (
+                    m["data"]["t"].as_u64().unwrap(),
+                    m["data"]["mode"].as_str().unwrap(),
+                )
+            })
+            .collect();
+        assert_eq!(
+            irobot_modes,
+            [
+                (0, "AUTO_MODE"),
+                (1050, "WAIT_MODE"),
+                (6000, "RETURN_MODE"),
+                (9010, "FINISH")
+            ]
+        );
+        read.push(found["messages"].clone());
+    }
+    // The simulated run and its replay are the same file to a reader.
+    assert_eq!(read[0], read[1]);
+}

@@ -11,6 +11,7 @@ mod graph;
 mod init;
 mod input;
 mod lockstep;
+mod mcap;
 mod operator;
 mod output;
 mod render;
@@ -238,6 +239,11 @@ enum Command {
         /// Write the trace (JSON lines) to this file (`-`: standard output).
         #[arg(long, value_name = "FILE")]
         trace: Option<PathBuf>,
+        /// Write the run as an MCAP file (`-`: standard output): a channel
+        /// per robot and kind, `/<team>/<robot>/modes` ... (see
+        /// docs/scenario-and-trace.md).
+        #[arg(long, value_name = "FILE")]
+        mcap: Option<PathBuf>,
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
         /// What runs the robots: `sim`, the simulator, or `c`, the generated
@@ -286,6 +292,10 @@ enum Command {
         /// Write the timeline picture (SVG) to this file (`-`: standard output).
         #[arg(long, value_name = "OUT")]
         svg: Option<PathBuf>,
+        /// Write the run as an MCAP file (`-`: standard output), as
+        /// `semo simulate --mcap` does.
+        #[arg(long, value_name = "FILE")]
+        mcap: Option<PathBuf>,
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
     },
@@ -707,6 +717,7 @@ fn run() -> i32 {
             format,
             svg,
             trace,
+            mcap,
             color,
             engine,
         } => simulate::run(
@@ -719,6 +730,7 @@ fn run() -> i32 {
                 json: format == SummaryFormat::Json,
                 svg,
                 trace,
+                mcap,
                 color: use_color(color),
                 engine,
             },
@@ -731,6 +743,7 @@ fn run() -> i32 {
             strategy,
             format,
             svg,
+            mcap,
             color,
         } => replay::run(
             replay::Options {
@@ -740,6 +753,7 @@ fn run() -> i32 {
                 strategy,
                 json: format == DataFormat::Json,
                 svg,
+                mcap,
                 color: use_color(color),
             },
             &mut out,

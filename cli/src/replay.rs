@@ -23,6 +23,7 @@ pub struct Options {
     pub strategy: Vec<PathBuf>,
     pub json: bool,
     pub svg: Option<PathBuf>,
+    pub mcap: Option<PathBuf>,
     pub color: bool,
 }
 
@@ -121,8 +122,13 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     }
+    if let Some(path) = &options.mcap
+        && super::mcap::write(path, &run, &programs, out) != 0
+    {
+        return 2;
+    }
     let writes_stdout = |p: &Option<PathBuf>| p.as_deref() == Some(Path::new("-"));
-    if !writes_stdout(&options.svg) {
+    if !writes_stdout(&options.svg) && !writes_stdout(&options.mcap) {
         let report = if options.json {
             simulate::json_summary("replay", &run, &verdicts, &warnings)
         } else {

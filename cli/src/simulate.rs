@@ -21,6 +21,7 @@ pub struct Options {
     pub json: bool,
     pub svg: Option<PathBuf>,
     pub trace: Option<PathBuf>,
+    pub mcap: Option<PathBuf>,
     pub color: bool,
     pub engine: Engine,
 }
@@ -155,8 +156,16 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     }
+    if let Some(path) = &options.mcap
+        && super::mcap::write(path, &run, &programs, out) != 0
+    {
+        return 2;
+    }
     let writes_stdout = |p: &Option<PathBuf>| p.as_deref() == Some(Path::new("-"));
-    if !writes_stdout(&options.trace) && !writes_stdout(&options.svg) {
+    if [&options.trace, &options.svg, &options.mcap]
+        .iter()
+        .all(|p| !writes_stdout(p))
+    {
         let report = if options.json {
             json_summary("simulate", &run, &verdicts, &warnings)
         } else {
@@ -276,9 +285,9 @@ fn run_generated(
     scenario_text: &str,
     out: &mut impl Write,
 ) -> i32 {
-    if options.json || options.svg.is_some() {
+    if options.json || options.svg.is_some() || options.mcap.is_some() {
         eprintln!(
-            "error: --engine c writes the trace (--trace) and a text summary; --format json and --svg need --engine sim"
+            "error: --engine c writes the trace (--trace) and a text summary; --format json, --svg and --mcap need --engine sim (or `semo replay` of its trace)"
         );
         return 2;
     }
