@@ -14,9 +14,11 @@ mod init;
 mod input;
 mod lockstep;
 mod manual;
+mod mcap;
 mod operator;
 mod output;
 mod render;
+mod replay;
 mod simulate;
 mod verify;
 mod watch;
@@ -255,6 +257,11 @@ enum Command {
         /// Write the trace (JSON lines) to this file (`-`: standard output).
         #[arg(long, value_name = "FILE")]
         trace: Option<PathBuf>,
+        /// Write the run as an MCAP file (`-`: standard output): a channel
+        /// per robot and kind, `/<team>/<robot>/modes` ... (see
+        /// docs/scenario-and-trace.md).
+        #[arg(long, value_name = "FILE")]
+        mcap: Option<PathBuf>,
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
         /// What runs the robots: `sim`, the simulator, or `c`, the generated
@@ -262,6 +269,53 @@ enum Command {
         /// lock-step virtual time: the same trace format).
         #[arg(long, value_enum, default_value_t = simulate::Engine::Sim)]
         engine: simulate::Engine,
+    },
+    /// Read back the traces of a run (each robot's `--trace` file, or one
+    /// merged file), merged by time: the summary and timeline `semo
+    /// simulate` gives, and the scenario's expectations checked on the
+    /// recorded run.
+    #[command(
+        long_about = "Read back the traces of a real run: each robot's `--trace` file of the \
+        generated programs (or one merged file, or `semo simulate --trace`), merged by time and \
+        checked line by line against the mission (a malformed line or a robot the mission does \
+        not have is an error at its line and column). Prints the per-robot summary `semo \
+        simulate` prints, draws the same timeline (--svg), and checks the scenario's \
+        expectations on the recorded run, with the simulator's own checks.\n\n\
+        Exit status: 0 every expectation holds, 1 one fails, 2 bad input (mission errors, a \
+        bad scenario or trace line, options)."
+    )]
+    Replay {
+        /// The trace files (JSON lines; `-`: standard input), in any number:
+        /// their lines are merged by time.
+        #[arg(required = true, value_name = "TRACE")]
+        traces: Vec<PathBuf>,
+        /// The mission script the run ran (a file). Default: the one mission
+        /// of the project (under its `semo.toml`, else under the current
+        /// folder).
+        #[arg(long, value_name = "M")]
+        mission: Option<PathBuf>,
+        /// The scenario whose expectations are checked (`*.scenario.json`;
+        /// `-`: standard input). Default: `<mission>.scenario.json` beside
+        /// the mission, else the only `<mission>.*.scenario.json` there;
+        /// without one, nothing is expected.
+        #[arg(long, value_name = "S")]
+        scenario: Option<PathBuf>,
+        /// More strategy (and catalog) files or folders to read (not `-`).
+        #[arg(long)]
+        strategy: Vec<PathBuf>,
+        /// `human` (modes per robot, expectations) or `json` (one object,
+        /// as `semo simulate --format json`).
+        #[arg(long, value_enum, default_value_t = DataFormat::Human)]
+        format: DataFormat,
+        /// Write the timeline picture (SVG) to this file (`-`: standard output).
+        #[arg(long, value_name = "OUT")]
+        svg: Option<PathBuf>,
+        /// Write the run as an MCAP file (`-`: standard output), as
+        /// `semo simulate --mcap` does.
+        #[arg(long, value_name = "FILE")]
+        mcap: Option<PathBuf>,
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
     },
     /// Explore everything a mission's team can do (on the simulator's
     /// semantics) and report what no single run shows.
@@ -715,6 +769,7 @@ fn run() -> i32 {
             format,
             svg,
             trace,
+            mcap,
             color,
             engine,
         } => simulate::run(
@@ -727,8 +782,31 @@ fn run() -> i32 {
                 json: format == SummaryFormat::Json,
                 svg,
                 trace,
+                mcap,
                 color: use_color(color),
                 engine,
+            },
+            &mut out,
+        ),
+        Command::Replay {
+            traces,
+            mission,
+            scenario,
+            strategy,
+            format,
+            svg,
+            mcap,
+            color,
+        } => replay::run(
+            replay::Options {
+                traces,
+                mission,
+                scenario,
+                strategy,
+                json: format == DataFormat::Json,
+                svg,
+                mcap,
+                color: use_color(color),
             },
             &mut out,
         ),

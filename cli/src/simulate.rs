@@ -21,6 +21,7 @@ pub struct Options {
     pub json: bool,
     pub svg: Option<PathBuf>,
     pub trace: Option<PathBuf>,
+    pub mcap: Option<PathBuf>,
     pub color: bool,
     pub engine: Engine,
 }
@@ -113,33 +114,16 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         Ok(refined) => refined,
         Err(code) => return code,
     };
-    let scenario = match scenario::parse(&scenario_text, &refined.programs) {
-        Ok(s) => s,
-        Err(e) => {
-            let record = Record::scenario(&scenario_name, &scenario_text, e, Severity::Error);
-            if format == Format::Human {
-                eprintln!("{}", record.scenario_line());
-            } else {
-                let document = output::json_document(
-                    "simulate",
-                    std::slice::from_ref(&record),
-                    serde_json::json!({}),
-                );
-                let _ = output::written(output::write_json(out, &document));
-            }
-            return 2;
-        }
+    let Some((scenario, warnings)) = read_scenario(
+        &scenario_name,
+        &scenario_text,
+        &refined.programs,
+        format,
+        "simulate",
+        out,
+    ) else {
+        return 2;
     };
-    let warnings: Vec<Record> = scenario
-        .warnings
-        .iter()
-        .map(|w| Record::scenario(&scenario_name, &scenario_text, w.clone(), Severity::Warning))
-        .collect();
-    if !options.json {
-        for warning in &warnings {
-            eprintln!("{}", warning.scenario_line());
-        }
-    }
     if options.engine == Engine::C {
         return run_generated(
             &options,
@@ -172,10 +156,18 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     }
+    if let Some(path) = &options.mcap
+        && super::mcap::write(path, &run, &programs, out) != 0
+    {
+        return 2;
+    }
     let writes_stdout = |p: &Option<PathBuf>| p.as_deref() == Some(Path::new("-"));
-    if !writes_stdout(&options.trace) && !writes_stdout(&options.svg) {
+    if [&options.trace, &options.svg, &options.mcap]
+        .iter()
+        .all(|p| !writes_stdout(p))
+    {
         let report = if options.json {
-            json_summary(&run, &verdicts, &warnings)
+            json_summary("simulate", &run, &verdicts, &warnings)
         } else {
             sim::summary(&run, &verdicts)
         };
@@ -184,8 +176,49 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     if verdicts.iter().all(|v| v.met) { 0 } else { 1 }
 }
 
+/// The scenario read against the mission's programs, its warnings printed
+/// for people (and returned as records for `--format json`); a mistake is
+/// reported in `format` for `command`, and `None` returned (exit status 2).
+pub fn read_scenario(
+    name: &Path,
+    text: &str,
+    programs: &[semo::refine::RobotProgram],
+    format: Format,
+    command: &str,
+    out: &mut impl Write,
+) -> Option<(scenario::Scenario, Vec<Record>)> {
+    let scenario = match scenario::parse(text, programs) {
+        Ok(s) => s,
+        Err(e) => {
+            let record = Record::scenario(name, text, e, Severity::Error);
+            if format == Format::Human {
+                eprintln!("{}", record.scenario_line());
+            } else {
+                let document = output::json_document(
+                    command,
+                    std::slice::from_ref(&record),
+                    serde_json::json!({}),
+                );
+                let _ = output::written(output::write_json(out, &document));
+            }
+            return None;
+        }
+    };
+    let warnings: Vec<Record> = scenario
+        .warnings
+        .iter()
+        .map(|w| Record::scenario(name, text, w.clone(), Severity::Warning))
+        .collect();
+    if format == Format::Human {
+        for warning in &warnings {
+            eprintln!("{}", warning.scenario_line());
+        }
+    }
+    Some((scenario, warnings))
+}
+
 /// Writes `text` to a file, or to standard output for `-`.
-fn write_to(path: &Path, text: &str, out: &mut impl Write) -> i32 {
+pub fn write_to(path: &Path, text: &str, out: &mut impl Write) -> i32 {
     if path == Path::new("-") {
         let _ = out.write_all(text.as_bytes());
         return 0;
@@ -199,8 +232,14 @@ fn write_to(path: &Path, text: &str, out: &mut impl Write) -> i32 {
     }
 }
 
-/// `--format json`: one object with each robot's modes and every expectation.
-fn json_summary(run: &sim::Run, verdicts: &[sim::Verdict], warnings: &[Record]) -> String {
+/// `--format json`: one object with each robot's modes and every
+/// expectation (`semo simulate`'s and `semo replay`'s, as `command`).
+pub fn json_summary(
+    command: &str,
+    run: &sim::Run,
+    verdicts: &[sim::Verdict],
+    warnings: &[Record],
+) -> String {
     let modes = sim::expect::modes_of_every_robot(run);
     let robots: Vec<serde_json::Value> = run
         .robots
@@ -231,7 +270,7 @@ fn json_summary(run: &sim::Run, verdicts: &[sim::Verdict], warnings: &[Record]) 
         "expectations": expectations,
         "ok": verdicts.iter().all(|v| v.met),
     });
-    let mut text = output::json_document("simulate", warnings, data).to_string();
+    let mut text = output::json_document(command, warnings, data).to_string();
     text.push('\n');
     text
 }
@@ -246,9 +285,9 @@ fn run_generated(
     scenario_text: &str,
     out: &mut impl Write,
 ) -> i32 {
-    if options.json || options.svg.is_some() {
+    if options.json || options.svg.is_some() || options.mcap.is_some() {
         eprintln!(
-            "error: --engine c writes the trace (--trace) and a text summary; --format json and --svg need --engine sim"
+            "error: --engine c writes the trace (--trace) and a text summary; --format json, --svg and --mcap need --engine sim (or `semo replay` of its trace)"
         );
         return 2;
     }

@@ -6,6 +6,7 @@ pub mod missiongen;
 pub mod mosquitto;
 pub mod mqtt;
 pub mod proxy;
+pub mod python;
 pub mod robots;
 
 use std::path::{Path, PathBuf};

@@ -2,6 +2,8 @@
 
 use super::engine::Run;
 use super::scenario::{ExpectKind, Expectation};
+use super::trace::TraceEvent;
+use crate::fasthash::FastMap;
 
 /// One expectation and whether the run met it, with the evidence.
 #[derive(Clone, Debug)]
@@ -11,10 +13,6 @@ pub struct Verdict {
     /// What the run showed: when the mode was entered, the robot's last
     /// mode, the messages received, ...
     pub why: String,
-}
-
-fn robot_index(run: &Run, robot: &str) -> Option<usize> {
-    run.robots.iter().position(|(_, r)| r == robot)
 }
 
 /// The modes a robot entered, with their times.
@@ -39,11 +37,16 @@ pub fn modes_of_every_robot(run: &Run) -> Vec<Vec<(i64, &str)>> {
     modes
 }
 
+/// Every expectation judged on the run, in order: the one judgement of a
+/// simulated run (`semo simulate`) and a recorded one (`semo replay`,
+/// [`super::replay`]). The trace is read once for every robot's modes and
+/// once for the messages received, whatever the number of expectations.
 pub fn judge(run: &Run, expectations: &[Expectation]) -> Vec<Verdict> {
+    let facts = Facts::of(run);
     expectations
         .iter()
         .map(|x| {
-            let (met, why) = judge_one(run, &x.kind);
+            let (met, why) = judge_one(run, &facts, &x.kind);
             Verdict {
                 expectation: x.clone(),
                 met,
@@ -53,17 +56,49 @@ pub fn judge(run: &Run, expectations: &[Expectation]) -> Vec<Verdict> {
         .collect()
 }
 
-fn judge_one(run: &Run, kind: &ExpectKind) -> (bool, String) {
+/// What the expectations read, gathered in one pass each.
+struct Facts<'r> {
+    robot_of: FastMap<&'r str, usize>,
+    /// Per robot, the modes it entered with their times.
+    modes: Vec<Vec<(i64, &'r str)>>,
+    /// Per (robot, key), its `receive` lines in order.
+    received: FastMap<(usize, &'r str), Vec<&'r TraceEvent>>,
+}
+
+impl<'r> Facts<'r> {
+    fn of(run: &'r Run) -> Self {
+        let mut received: FastMap<(usize, &str), Vec<&TraceEvent>> = FastMap::default();
+        for e in run.trace.iter().filter(|e| e.event == "receive") {
+            if let Some(key) = e.field("key") {
+                received.entry((e.robot, key)).or_default().push(e);
+            }
+        }
+        Facts {
+            robot_of: run
+                .robots
+                .iter()
+                .enumerate()
+                .map(|(i, (_, r))| (r.as_str(), i))
+                .collect(),
+            modes: modes_of_every_robot(run),
+            received,
+        }
+    }
+}
+
+fn judge_one(run: &Run, facts: &Facts, kind: &ExpectKind) -> (bool, String) {
+    let robot_index = |robot: &str| facts.robot_of.get(robot).copied();
+    let modes = |r: usize| facts.modes[r].iter().copied();
     match kind {
         ExpectKind::Enters {
             robot,
             mode,
             before,
         } => {
-            let Some(r) = robot_index(run, robot) else {
+            let Some(r) = robot_index(robot) else {
                 return (false, format!("no robot {robot}"));
             };
-            match modes(run, r).into_iter().find(|(_, m)| m == mode) {
+            match modes(r).find(|(_, m)| m == mode) {
                 Some((t, _)) if before.is_none_or(|b| t <= b) => {
                     (true, format!("entered at {t} ms"))
                 }
@@ -72,10 +107,10 @@ fn judge_one(run: &Run, kind: &ExpectKind) -> (bool, String) {
             }
         }
         ExpectKind::NeverEnters { robot, mode } => {
-            let Some(r) = robot_index(run, robot) else {
+            let Some(r) = robot_index(robot) else {
                 return (false, format!("no robot {robot}"));
             };
-            match modes(run, r).into_iter().find(|(_, m)| m == mode) {
+            match modes(r).find(|(_, m)| m == mode) {
                 Some((t, _)) => (false, format!("entered at {t} ms")),
                 None => (true, "never entered".into()),
             }
@@ -86,17 +121,18 @@ fn judge_one(run: &Run, kind: &ExpectKind) -> (bool, String) {
             from,
             before,
         } => {
-            let Some(r) = robot_index(run, robot) else {
+            let Some(r) = robot_index(robot) else {
                 return (false, format!("no robot {robot}"));
             };
-            let received = run.trace.iter().find(|e| {
-                e.robot == r
-                    && e.event == "receive"
-                    && e.field("key") == Some(key)
-                    && from
-                        .as_deref()
+            let received = facts
+                .received
+                .get(&(r, key.as_str()))
+                .into_iter()
+                .flatten()
+                .find(|e| {
+                    from.as_deref()
                         .is_none_or(|f| e.field("from_robot") == Some(f))
-            });
+                });
             match received {
                 Some(e) if before.is_none_or(|b| e.t <= b) => {
                     (true, format!("received at {} ms: {}", e.t, e.value_json()))
@@ -107,8 +143,7 @@ fn judge_one(run: &Run, kind: &ExpectKind) -> (bool, String) {
         }
         ExpectKind::AllEndIn { mode } => {
             let mut wrong = Vec::new();
-            let every = modes_of_every_robot(run);
-            for ((_, robot), modes) in run.robots.iter().zip(&every) {
+            for ((_, robot), modes) in run.robots.iter().zip(&facts.modes) {
                 let last = modes.last().map(|(_, m)| *m);
                 if last != Some(mode.as_str()) {
                     wrong.push(format!("{robot} ends in {}", last.unwrap_or("no mode")));

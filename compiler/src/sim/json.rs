@@ -44,6 +44,15 @@ pub struct JsonError {
 }
 
 pub fn parse(text: &str) -> Result<Value, JsonError> {
+    parse_one(text, "unexpected text after the scenario object")
+}
+
+/// One line of a trace (`sim::replay`): one JSON value, nothing after it.
+pub fn parse_line(text: &str) -> Result<Value, JsonError> {
+    parse_one(text, "unexpected text after the trace line's object")
+}
+
+fn parse_one(text: &str, after: &str) -> Result<Value, JsonError> {
     let mut reader = Reader {
         s: text.as_bytes(),
         text,
@@ -52,10 +61,14 @@ pub fn parse(text: &str) -> Result<Value, JsonError> {
     let value = reader.value(0)?;
     reader.space();
     if reader.pos < reader.s.len() {
-        return Err(reader.fail("unexpected text after the scenario object"));
+        return Err(reader.fail(after));
     }
     Ok(value)
 }
+
+/// Objects with more members than this find a repeated key by hash rather
+/// than by comparing it with every key before it (linear in the object).
+const FEW_KEYS: usize = 16;
 
 struct Reader<'a> {
     s: &'a [u8],
@@ -253,6 +266,7 @@ impl Reader<'_> {
     fn object(&mut self, depth: usize) -> Result<Kind, JsonError> {
         self.pos += 1;
         let mut members: Vec<(String, Value)> = Vec::new();
+        let mut keys: crate::fasthash::FastSet<String> = Default::default();
         self.space();
         if self.s.get(self.pos) == Some(&b'}') {
             self.pos += 1;
@@ -265,7 +279,15 @@ impl Reader<'_> {
             }
             let key_at = self.pos;
             let key = self.string()?;
-            if members.iter().any(|(k, _)| *k == key) {
+            let repeated = if members.len() < FEW_KEYS {
+                members.iter().any(|(k, _)| *k == key)
+            } else {
+                if keys.is_empty() {
+                    keys.extend(members.iter().map(|(k, _)| k.clone()));
+                }
+                !keys.insert(key.clone())
+            };
+            if repeated {
                 return Err(JsonError {
                     at: key_at,
                     message: format!("duplicate key \"{key}\""),
@@ -321,6 +343,15 @@ mod tests {
             let e = parse(text).unwrap_err();
             assert_eq!((e.at, e.message.as_str()), (at, message), "{text}");
         }
+        // Past a few keys, a repeated one is found by hash: still at its place.
+        let many: Vec<String> = (0..40).map(|i| format!("\"k{i}\": {i}")).collect();
+        let text = format!("{{{}, \"k3\": 0}}", many.join(", "));
+        let e = parse(&text).unwrap_err();
+        assert_eq!(
+            (e.at, e.message.as_str()),
+            (text.rfind("\"k3\"").unwrap(), "duplicate key \"k3\"")
+        );
+        assert!(parse(&format!("{{{}}}", many.join(", "))).is_ok());
         let deep = "[".repeat(40);
         assert!(parse(&deep).unwrap_err().message.contains("nesting"));
     }

@@ -10,6 +10,9 @@
 //!   the runtime.
 //! - `trace.rs`: trace events, written as `linux-sim` writes them.
 //! - `expect.rs`: expectations judged on the trace.
+//! - `replay.rs`: a recorded trace read back into a [`Run`] (`semo replay`),
+//!   so that the summary, the picture and the expectations are these
+//!   same functions on a field run.
 //! - `svg.rs`: the timeline picture.
 //! - `complete.rs`: completion in scenario files, and which mission a
 //!   scenario belongs to.
@@ -21,6 +24,7 @@ pub mod complete;
 mod engine;
 pub mod expect;
 mod json;
+pub mod replay;
 pub mod scenario;
 pub mod svg;
 pub mod trace;
@@ -52,14 +56,31 @@ impl Run {
 
 /// The text summary: each robot's modes in order, then every expectation.
 pub fn summary(run: &Run, verdicts: &[Verdict]) -> String {
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "simulated {} robot(s) for {} ms of mission time ({} events)",
+    let mut out = format!(
+        "simulated {} robot(s) for {} ms of mission time ({} events)\n",
         run.robots.len(),
         run.end_ms,
         run.events
     );
+    robots_and_verdicts(&mut out, run, verdicts);
+    out
+}
+
+/// [`summary`] of a recorded run ([`replay`]): the same lines under a
+/// heading that says where they come from.
+pub fn replay_summary(run: &Run, verdicts: &[Verdict], files: usize) -> String {
+    let mut out = format!(
+        "replayed {} robot(s) from {files} trace file(s): {} lines to {} ms of mission time\n",
+        run.robots.len(),
+        run.events,
+        run.end_ms
+    );
+    robots_and_verdicts(&mut out, run, verdicts);
+    out
+}
+
+/// Each robot's modes in order with its last word, then every expectation.
+fn robots_and_verdicts(out: &mut String, run: &Run, verdicts: &[Verdict]) {
     let modes = expect::modes_of_every_robot(run);
     let ends = last_words(run);
     for (((team, robot), modes), end) in run.robots.iter().zip(&modes).zip(&ends) {
@@ -87,17 +108,23 @@ pub fn summary(run: &Run, verdicts: &[Verdict]) -> String {
             );
         }
     }
-    out
 }
 
-/// Each robot's last word, indexed by robot: finished, killed, or still
-/// running; found in one pass over the trace, from its end.
+/// Each robot's last word, indexed by robot: finished, killed, still
+/// running, or (a recorded run) no trace line at all; found in one pass
+/// over the trace, from its end.
 fn last_words(run: &Run) -> Vec<String> {
     let mut words: Vec<Option<String>> = vec![None; run.robots.len()];
+    // The time of each robot's last line, for one whose start is not in
+    // a recorded trace.
+    let mut last: Vec<Option<i64>> = vec![None; run.robots.len()];
     let mut missing = words.len();
     for e in run.trace.iter().rev() {
         if missing == 0 {
             break;
+        }
+        if let Some(t @ None) = last.get_mut(e.robot) {
+            *t = Some(e.t);
         }
         let Some(word @ None) = words.get_mut(e.robot) else {
             continue;
@@ -112,7 +139,15 @@ fn last_words(run: &Run) -> Vec<String> {
             missing -= 1;
         }
     }
-    words.into_iter().map(Option::unwrap_or_default).collect()
+    words
+        .into_iter()
+        .zip(last)
+        .map(|(word, last)| match (word, last) {
+            (Some(word), _) => word,
+            (None, Some(t)) => format!("last line at {t} ms"),
+            (None, None) => "no trace line".to_string(),
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -11,6 +11,8 @@
 
 use super::engine::Run;
 use super::scenario::{FaultKind, Scenario};
+use super::trace::TraceEvent;
+use crate::fasthash::FastMap;
 use crate::refine::RobotProgram;
 use crate::xmlpos::escape;
 use std::fmt::Write;
@@ -134,8 +136,15 @@ pub fn to_svg(run: &Run, programs: &[RobotProgram], scenario: &Scenario) -> Stri
     let mut plan_colours = Legend::new(&PLAN_COLOURS);
     let mut key_colours = Legend::new(&KEY_COLOURS);
 
-    for (r, (program, lane)) in programs.iter().zip(&lanes).enumerate() {
-        let events: Vec<_> = run.trace.iter().filter(|e| e.robot == r).collect();
+    // Each robot's events, in one pass over the trace (every cost below is
+    // in proportion to the trace: a recorded run may be long).
+    let mut of_robot: Vec<Vec<&TraceEvent>> = vec![Vec::new(); programs.len()];
+    for e in &run.trace {
+        if let Some(events) = of_robot.get_mut(e.robot) {
+            events.push(e);
+        }
+    }
+    for ((program, lane), events) in programs.iter().zip(&lanes).zip(&of_robot) {
         let robot_end = events.last().map_or(run.end_ms, |e| e.t);
         let _ = writeln!(
             body,
@@ -165,15 +174,23 @@ pub fn to_svg(run: &Run, programs: &[RobotProgram], scenario: &Scenario) -> Stri
                 escape(plan)
             );
         }
-        // Modes: from each `mode` event to the next, or to the robot's end.
+        // Modes: from each `mode` event to the next, or to the robot's end
+        // (its first `stop` or `fault` at or after the mode's start: the
+        // modes and those come in time order, so one cursor finds each).
         let modes: Vec<_> = events.iter().filter(|e| e.event == "mode").collect();
+        let stops: Vec<i64> = events
+            .iter()
+            .filter(|f| matches!(f.event, "stop" | "fault"))
+            .map(|f| f.t)
+            .collect();
+        let mut stop = 0;
         for (k, e) in modes.iter().enumerate() {
             let name = e.field("mode").unwrap_or_default();
             let next_mode = modes.get(k + 1).map_or(robot_end, |n| n.t);
-            let ended = events
-                .iter()
-                .find(|f| f.t >= e.t && matches!(f.event, "stop" | "fault"))
-                .map_or(robot_end, |f| f.t);
+            while stops.get(stop).is_some_and(|&t| t < e.t) {
+                stop += 1;
+            }
+            let ended = stops.get(stop).copied().unwrap_or(robot_end);
             let until = next_mode.min(ended);
             let line = program
                 .control
@@ -205,20 +222,40 @@ pub fn to_svg(run: &Run, programs: &[RobotProgram], scenario: &Scenario) -> Stri
                 );
             }
         }
-        // Service runs: `service_start` to the matching `service_end` of the plan.
+        // Service runs: `service_start` to the next `service_end` of the
+        // plan (or `stop`, `fault`), found in one walk with the runs open
+        // per plan.
+        let mut ends: Vec<Option<i64>> = vec![None; events.len()];
+        let mut open: FastMap<&str, Vec<usize>> = FastMap::default();
+        for (k, e) in events.iter().enumerate() {
+            match e.event {
+                "service_start" => {
+                    let plan = e.field("plan").unwrap_or_default();
+                    open.entry(plan).or_default().push(k);
+                }
+                "service_end" => {
+                    let plan = e.field("plan").unwrap_or_default();
+                    for started in open.remove(plan).unwrap_or_default() {
+                        ends[started] = Some(e.t);
+                    }
+                }
+                "stop" | "fault" => {
+                    for (_, runs) in open.drain() {
+                        for started in runs {
+                            ends[started] = Some(e.t);
+                        }
+                    }
+                }
+                _ => {}
+            }
+        }
         for (k, e) in events.iter().enumerate() {
             if e.event != "service_start" {
                 continue;
             }
             let plan = e.field("plan").unwrap_or_default();
             let service = e.field("service").unwrap_or_default();
-            let until = events[k + 1..]
-                .iter()
-                .find(|f| {
-                    (f.event == "service_end" && f.field("plan") == Some(plan))
-                        || matches!(f.event, "stop" | "fault")
-                })
-                .map_or(robot_end, |f| f.t);
+            let until = ends[k].unwrap_or(robot_end);
             let row = lane.plans.iter().position(|p| p == plan).unwrap_or(0);
             let line = program
                 .control
@@ -253,7 +290,7 @@ pub fn to_svg(run: &Run, programs: &[RobotProgram], scenario: &Scenario) -> Stri
             }
         }
         // Throws and catches.
-        for e in &events {
+        for e in events.iter() {
             let (class, shape) = match e.event {
                 "throw" => ("throw", "M-3,0 L0,-4 L3,0 L0,4 z"),
                 "catch" => ("catch", "M-3,-3 L3,3 M-3,3 L3,-3"),
@@ -301,6 +338,11 @@ pub fn to_svg(run: &Run, programs: &[RobotProgram], scenario: &Scenario) -> Stri
     // rest), one arrow per key and pair every ARROW_SPACING pixels.
     body.push_str("<g class=\"messages\" stroke-width=\"0.8\" marker-end=\"url(#arrow)\">\n");
     let mut drawn = std::collections::HashSet::new();
+    let lane_of_robot: FastMap<&str, usize> = programs
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (p.robot.as_str(), i))
+        .collect();
     for e in &run.trace {
         if e.event != "receive" {
             continue;
@@ -310,7 +352,7 @@ pub fn to_svg(run: &Run, programs: &[RobotProgram], scenario: &Scenario) -> Stri
             continue;
         }
         let from = e.field("from_robot").unwrap_or_default();
-        let Some(sender) = programs.iter().position(|p| p.robot == from) else {
+        let Some(&sender) = lane_of_robot.get(from) else {
             continue; // the operator
         };
         let sent = e.sent_at.unwrap_or(e.t);
