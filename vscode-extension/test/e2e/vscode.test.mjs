@@ -385,7 +385,8 @@ async function liveJourney() {
     }),
     { timeout: 30000, polling: 250 },
   );
-  await openFile('rovers.mission');
+  // rovers.mission is still the visible editor (opening it again would
+  // switch the side bar away from the Robots (live) view).
   await runCommand('SeMo: Show Mode Machine');
   assert.ok(
     await waitForFrameContent(/r_0 \(Rovers\) · running · SEARCH · \[Explore=Wander\]/, 60000),
