@@ -257,6 +257,7 @@ fn a_killed_leader_is_replaced() {
         .display()
         .to_string();
     let trace = dir.join("trace.jsonl");
+    let svg = dir.join("kill.svg");
     let out = semo(&[
         "simulate",
         &mission,
@@ -264,8 +265,19 @@ fn a_killed_leader_is_replaced() {
         &scenario,
         "--trace",
         &trace.display().to_string(),
+        "--svg",
+        &svg.display().to_string(),
     ]);
     assert!(out.code <= 1, "{}{}", out.stdout, out.stderr);
+    // The timeline marks the killed robot's end, and no end of the robots
+    // still running when the run ends.
+    let elements = svg_elements(&std::fs::read_to_string(&svg).unwrap());
+    let ends: Vec<(&str, &str)> = elements
+        .iter()
+        .filter(|(_, a)| attr(a, "class") == Some("end"))
+        .map(|(_, a)| (attr(a, "data-why").unwrap(), attr(a, "data-t").unwrap()))
+        .collect();
+    assert_eq!(ends, [("killed", "1200")]);
     assert!(
         out.stdout.contains("kill at 1200 ms") || out.stdout.contains("killed at 1200 ms"),
         "{}",
@@ -477,12 +489,12 @@ fn the_timeline_has_a_lane_per_robot_with_its_modes_and_services() {
     }
     let labels_at = text.find("<g class=\"labels\">").unwrap();
     assert!(text.find("<g class=\"messages\"").unwrap() < labels_at);
-    // How each robot's run ended is marked (the scenario stops them).
+    // How each robot's run ended is marked: all three finish (FINISH).
     let ends: Vec<&str> = class("end")
         .iter()
         .map(|a| attr(a, "data-why").unwrap())
         .collect();
-    assert_eq!(ends.len(), 3, "{ends:?}");
+    assert_eq!(ends, ["finished", "finished", "finished"]);
 }
 
 /// The refined programs of a mission text, as `semo simulate` gets them.

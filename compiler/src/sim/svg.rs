@@ -307,13 +307,22 @@ pub fn to_svg(run: &Run, programs: &[RobotProgram], scenario: &Scenario) -> Stri
                 e.t
             );
         }
-        // How the robot's run ended, where it ended before the run did.
-        let ending = events.last().and_then(|e| match e.event {
-            "finish" => Some(("finished", e.t)),
-            "stop" => Some(("stopped", e.t)),
-            "fault" if e.field("fault") == Some("kill") => Some(("killed", e.t)),
-            _ => None,
-        });
+        // How the robot's run ended: its latest finish or kill (a restart
+        // after a kill runs it again), else a stop before the run's end; a
+        // robot still running when the run ends is not marked.
+        let latest = events
+            .iter()
+            .rev()
+            .find(|e| matches!(e.event, "finish" | "fault"));
+        let ending = match latest {
+            Some(e) if e.event == "finish" => Some(("finished", e.t)),
+            Some(e) if e.field("fault") == Some("kill") => Some(("killed", e.t)),
+            _ => events
+                .iter()
+                .rev()
+                .find(|e| e.event == "stop" && e.t < run.end_ms)
+                .map(|e| ("stopped", e.t)),
+        };
         if let Some((why, at)) = ending {
             let _ = writeln!(
                 body,

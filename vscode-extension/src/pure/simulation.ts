@@ -52,11 +52,13 @@ export function simulationPage(title: string, summary: string, svg: string, nonc
   body { background: #fff; color: #222; margin: 0; padding: 12px; font-family: sans-serif; }
   pre { font-size: 12px; }
   [data-line]:not([data-line="0"]) { cursor: pointer; }
-  /* The timeline fits the view's width (it was clipped on the right); its viewBox scales it. */
-  svg { max-width: 100%; height: auto; }
+  /* The timeline fits the view's width (it was clipped on the right), its viewBox scaling it,
+     down to a width that stays readable; narrower, it scrolls. */
+  .timeline { overflow-x: auto; }
+  .timeline svg { width: 100%; min-width: 900px; height: auto; }
 </style></head>
 <body><pre class="summary">${escapeHtml(summary)}</pre>
-${svg}
+<div class="timeline">${svg}</div>
 <script nonce="${nonce}">
   const vscode = acquireVsCodeApi();
   document.addEventListener('click', (event) => {

@@ -192,6 +192,24 @@ async function userJourney() {
   assert.ok(await waitForFrameContent(/ControlTask/, 60000), 'the robot task graph webview shows its control task');
   await shot('robot-task-graph');
 
+  // Simulate Mission: the timeline of rovers.scenario.json, both robots'
+  // lanes, scaled to the view and scrolled to its right end, none of it
+  // clipped (it was cut off on the right).
+  await page.click('.monaco-editor .view-lines');
+  await runCommand('SeMo: Simulate Mission');
+  assert.ok(await waitForFrameContent(/data-robot="r_1"/, 60000), 'the timeline shows r_1');
+  const fits = await inFrameWith(/data-end-ms=/, () => {
+    const timeline = document.querySelector('.timeline');
+    const svg = document.querySelector('.timeline svg');
+    if (!timeline || !svg) {
+      return false;
+    }
+    timeline.scrollLeft = timeline.scrollWidth;
+    return svg.getBoundingClientRect().right <= document.documentElement.clientWidth + 1;
+  });
+  assert.equal(fits, true, 'the timeline fits the view');
+  await shot('simulation');
+
   // A task graph's picture: open it from the explorer, then the palette.
   await page.keyboard.down('Control');
   await page.keyboard.down('Shift');
@@ -210,6 +228,21 @@ async function userJourney() {
   await waitForText('.monaco-editor .view-lines', /#\s1\.\sTeam\sformation/);
   await waitForText('.statusbar-item', /SeMo Mission/);
   await shot('new-mission');
+}
+
+/** Runs `fn` in the first frame whose HTML matches `pattern` (undefined if none). */
+async function inFrameWith(pattern, fn) {
+  for (const frame of page.frames()) {
+    try {
+      const html = await frame.evaluate(() => document.documentElement.outerHTML);
+      if (pattern.test(html)) {
+        return await frame.evaluate(fn);
+      }
+    } catch {
+      // A frame navigating away; try the next.
+    }
+  }
+  return undefined;
 }
 
 /** How many notification toasts on screen match `pattern`. */

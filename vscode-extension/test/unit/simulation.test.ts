@@ -31,6 +31,9 @@ test('the page escapes the summary, keeps the SVG and allows only its own script
   assert.ok(page.includes("script-src 'nonce-N0NCE'"));
   assert.equal(page.match(/<script/g)?.length, 1);
   assert.ok(page.includes('<script nonce="N0NCE">'));
-  // The timeline scales to the view's width instead of being clipped.
-  assert.match(page, /svg \{ max-width: 100%; height: auto; \}/);
+  // The timeline scales to the view's width, and scrolls below a readable width, instead of
+  // being clipped.
+  assert.ok(page.includes('<div class="timeline"><svg data-end-ms="1"></svg></div>'));
+  assert.match(page, /\.timeline \{ overflow-x: auto; \}/);
+  assert.match(page, /\.timeline svg \{ width: 100%; min-width: 900px; height: auto; \}/);
 });
