@@ -32,24 +32,17 @@ const BUILD: &str = "semo build";
 
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let started = std::time::Instant::now();
-    let mission_file = match super::defaults::mission_or_refuse(
+    let mission_file = match super::defaults::mission_file(
         options.mission.clone(),
+        &options.strategy,
         "build",
+        (", `out/` beside it", ""),
         options.format,
         out,
     ) {
         Ok(found) => found,
         Err(code) => return code,
     };
-    if !input::mission_is_a_file(&mission_file, "build", ", `out/` beside it", "") {
-        return 2;
-    }
-    if !input::strategy_paths_are_files(&options.strategy) {
-        return 2;
-    }
-    if !input::file_is_kind(&mission_file, Content::Mission, BUILD) {
-        return 2;
-    }
     // Read before anything else, so that a wrong file stops the build
     // before the output folder is touched (`-`: standard input).
     let scenario = match &options.scenario {
@@ -61,12 +54,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             _ => return 2,
         },
     };
-    let (mut run, mission) = match host::load_build(&mission_file, &options.strategy) {
+    let (mut run, mission) = match super::defaults::load(&mission_file, &options.strategy) {
         Ok(loaded) => loaded,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
+        Err(code) => return code,
     };
     // What the command line does not say, the project file does (the plan
     // the editor's Generate Code asks for too).

@@ -158,6 +158,9 @@ fn fixable(run: &CheckRun) -> HashSet<(FileId, Code, Span)> {
             continue;
         }
         let published = analysis.diagnostics(id);
+        if published.is_empty() {
+            continue; // nothing to fix: no quick fixes asked for
+        }
         for action in analysis.code_actions(id, Span::new(0, file.text.len())) {
             if let Some(d) = published
                 .get(action.diagnostic)

@@ -37,6 +37,39 @@ pub fn mission_or_refuse(
     }
 }
 
+/// What a command that reads a mission's folder (`build`, `simulate`,
+/// `replay`, `verify`) works on: [`mission_or_refuse`], then refused in one
+/// line unless it is a mission file (not `-`; `also` and `note` as
+/// [`input::mission_is_a_file`](super::input::mission_is_a_file) says them)
+/// and the `--strategy` paths are files. Gives the file, or the exit status.
+pub fn mission_file(
+    named: Option<PathBuf>,
+    strategy: &[PathBuf],
+    command: &str,
+    (also, note): (&str, &str),
+    format: super::output::Format,
+    out: &mut impl std::io::Write,
+) -> Result<PathBuf, i32> {
+    use super::input::{self, Content};
+    let file = mission_or_refuse(named, command, format, out)?;
+    let fits = input::mission_is_a_file(&file, command, also, note)
+        && input::strategy_paths_are_files(strategy)
+        && input::file_is_kind(&file, Content::Mission, &format!("semo {command}"));
+    if fits { Ok(file) } else { Err(2) }
+}
+
+/// The mission file loaded with what it reads (`host::load_build`), or the
+/// exit status (2) after saying why.
+pub fn load(
+    mission: &Path,
+    strategy: &[PathBuf],
+) -> Result<(semo::host::CheckRun, semo::diag::FileId), i32> {
+    semo::host::load_build(mission, strategy).map_err(|e| {
+        eprintln!("error: {e}");
+        2
+    })
+}
+
 /// The one mission of the project around the current folder: every
 /// `*.mission` under the project's root (the folder holding the nearest
 /// `semo.toml`, down to `PROJECT_DEPTH` folders), or without a project file

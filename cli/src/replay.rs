@@ -39,26 +39,20 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         eprintln!("error: standard input (`-`) can be only one of the trace files");
         return 2;
     }
-    let mission_file =
-        match super::defaults::mission_or_refuse(options.mission.clone(), "replay", format, out) {
-            Ok(found) => found,
-            Err(code) => return code,
-        };
-    if !input::mission_is_a_file(&mission_file, "replay", "", "") {
-        return 2;
-    }
-    if !input::strategy_paths_are_files(&options.strategy) {
-        return 2;
-    }
-    if !input::file_is_kind(&mission_file, Content::Mission, REPLAY) {
-        return 2;
-    }
-    let (mut check, mission) = match semo::host::load_build(&mission_file, &options.strategy) {
+    let mission_file = match super::defaults::mission_file(
+        options.mission.clone(),
+        &options.strategy,
+        "replay",
+        ("", ""),
+        format,
+        out,
+    ) {
+        Ok(found) => found,
+        Err(code) => return code,
+    };
+    let (mut check, mission) = match super::defaults::load(&mission_file, &options.strategy) {
         Ok(loaded) => loaded,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
+        Err(code) => return code,
     };
     let (_build, refined) =
         match super::refine_or_report(&mut check, mission, format, options.color, "replay", out) {

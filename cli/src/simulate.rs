@@ -65,30 +65,20 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     } else {
         Format::Human
     };
-    let mission_file = match super::defaults::mission_or_refuse(
+    let mission_file = match super::defaults::mission_file(
         options.mission.clone(),
+        &options.strategy,
         "simulate",
+        ("", " (the scenario may be `-`)"),
         format,
         out,
     ) {
         Ok(found) => found,
         Err(code) => return code,
     };
-    if !input::mission_is_a_file(&mission_file, "simulate", "", " (the scenario may be `-`)") {
-        return 2;
-    }
-    if !input::strategy_paths_are_files(&options.strategy) {
-        return 2;
-    }
-    if !input::file_is_kind(&mission_file, Content::Mission, SIMULATE) {
-        return 2;
-    }
-    let (mut check, mission) = match semo::host::load_build(&mission_file, &options.strategy) {
+    let (mut check, mission) = match super::defaults::load(&mission_file, &options.strategy) {
         Ok(loaded) => loaded,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
+        Err(code) => return code,
     };
     let scenario_file = match options.scenario.clone() {
         Some(named) => named,

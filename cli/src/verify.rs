@@ -4,7 +4,6 @@
 //! status: 0 nothing found, 1 a finding, 2 bad input (mission errors,
 //! options).
 
-use super::input::{self, Content};
 use super::output::{self, Format};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -20,33 +19,26 @@ pub struct Options {
     pub counterexamples: Option<PathBuf>,
 }
 
-const VERIFY: &str = "semo verify";
-
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let format = options.format;
     if let Some(problem) = options.search.problem() {
         eprintln!("error: --step: {problem}");
         return 2;
     }
-    let mission_file =
-        match super::defaults::mission_or_refuse(options.mission.clone(), "verify", format, out) {
-            Ok(found) => found,
-            Err(code) => return code,
-        };
-    if !input::mission_is_a_file(&mission_file, "verify", "", "") {
-        return 2;
-    }
-    if !input::strategy_paths_are_files(&options.strategy)
-        || !input::file_is_kind(&mission_file, Content::Mission, VERIFY)
-    {
-        return 2;
-    }
-    let (mut check, mission) = match semo::host::load_build(&mission_file, &options.strategy) {
+    let mission_file = match super::defaults::mission_file(
+        options.mission.clone(),
+        &options.strategy,
+        "verify",
+        ("", ""),
+        format,
+        out,
+    ) {
+        Ok(found) => found,
+        Err(code) => return code,
+    };
+    let (mut check, mission) = match super::defaults::load(&mission_file, &options.strategy) {
         Ok(loaded) => loaded,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
+        Err(code) => return code,
     };
     let refined =
         match super::refine_or_report(&mut check, mission, format, options.color, "verify", out) {

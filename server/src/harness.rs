@@ -175,6 +175,19 @@ impl TestClient {
         msg["diagnostics"].as_array().cloned().unwrap_or_default()
     }
 
+    /// `textDocument/didChange` replacing the whole text of `uri` with
+    /// `text` at `version`.
+    pub async fn change(&mut self, uri: &str, version: i64, text: &str) {
+        self.notify(
+            "textDocument/didChange",
+            json!({
+                "textDocument": { "uri": uri, "version": version },
+                "contentChanges": [{ "text": text }],
+            }),
+        )
+        .await;
+    }
+
     /// Waits for a notification whose params satisfy `wanted`; the ones
     /// skipped are dropped.
     pub async fn notification(&mut self, method: &str, wanted: impl Fn(&Value) -> bool) -> Value {

@@ -178,15 +178,7 @@ async fn a_mission_with_errors_is_refused_with_its_reasons() {
     // An unsaved edit that breaks the mission: the server generates from what
     // the user sees, so it refuses.
     let broken = text.replace("standby()", "standbye()");
-    client
-        .notify(
-            "textDocument/didChange",
-            json!({
-                "textDocument": { "uri": mission_uri, "version": 2 },
-                "contentChanges": [{ "text": broken }],
-            }),
-        )
-        .await;
+    client.change(&mission_uri, 2, &broken).await;
     let result = client
         .request(
             "workspace/executeCommand",
@@ -346,15 +338,7 @@ async fn a_client_that_tells_the_outcome_itself_gets_no_message() {
     assert_eq!(messages(&mut client), Vec::<Value>::new());
     // A mission with an error: refused, said in the answer only.
     let broken = text.replacen("repeat()", "repeat(", 1);
-    client
-        .notify(
-            "textDocument/didChange",
-            json!({
-                "textDocument": { "uri": mission_uri, "version": 2 },
-                "contentChanges": [{ "text": broken }],
-            }),
-        )
-        .await;
+    client.change(&mission_uri, 2, &broken).await;
     client.diagnostics(&mission_uri, Some(2)).await;
     let refused = client
         .request("workspace/executeCommand", generate)

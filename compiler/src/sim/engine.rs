@@ -83,6 +83,21 @@ pub struct Run {
     pub events: u64,
 }
 
+impl Run {
+    /// The run of `programs`' robots: its trace, end and event count.
+    pub fn of(programs: &[RobotProgram], trace: Vec<TraceEvent>, end_ms: i64, events: u64) -> Run {
+        Run {
+            robots: programs
+                .iter()
+                .map(|p| (p.team.clone(), p.robot.clone()))
+                .collect(),
+            trace,
+            end_ms,
+            events,
+        }
+    }
+}
+
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Step {
     Next,
@@ -634,16 +649,7 @@ impl<'p> Sim<'p> {
                 }
             }
         }
-        Run {
-            robots: self
-                .programs
-                .iter()
-                .map(|p| (p.team.clone(), p.robot.clone()))
-                .collect(),
-            end_ms: self.now,
-            trace: self.trace,
-            events,
-        }
+        Run::of(self.programs, self.trace, self.now, events)
     }
 
     /// Handles the events of the instants before `until`, or until every

@@ -390,16 +390,8 @@ impl<'p> Replay<'p> {
         for (k, t) in sent_at {
             trace[k].sent_at = Some(t);
         }
-        Run {
-            robots: self
-                .programs
-                .iter()
-                .map(|p| (p.team.clone(), p.robot.clone()))
-                .collect(),
-            end_ms: trace.last().map_or(0, |e| e.t),
-            trace,
-            events: self.lines,
-        }
+        let end_ms = trace.last().map_or(0, |e| e.t);
+        Run::of(self.programs, trace, end_ms, self.lines)
     }
 }
 
