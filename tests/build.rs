@@ -817,3 +817,102 @@ fn twenty_sends_in_one_firing_all_reach_the_listener() {
         "the listener receives every send and drops none"
     );
 }
+
+/// The object files under the runtime's `obj/` folder, by key folder, with
+/// the moment each was last written.
+fn runtime_objects(out: &Path) -> BTreeMap<String, BTreeMap<String, std::time::SystemTime>> {
+    let mut keys = BTreeMap::new();
+    for key in std::fs::read_dir(out.join("semo-runtime/obj")).unwrap() {
+        let key = key.unwrap().path();
+        let objects = std::fs::read_dir(&key)
+            .unwrap()
+            .map(|o| o.unwrap())
+            .map(|o| {
+                let written = o.metadata().unwrap().modified().unwrap();
+                (o.file_name().to_string_lossy().into_owned(), written)
+            })
+            .collect();
+        keys.insert(
+            key.file_name().unwrap().to_string_lossy().into_owned(),
+            objects,
+        );
+    }
+    keys
+}
+
+/// The runtime is written once per build, beside the team folders, not
+/// copied into each robot's; the robots built with the same compiler and
+/// flags compile it once, others get their own objects; a robot folder
+/// copied elsewhere builds with `make RUNTIME=...`.
+#[test]
+fn the_runtime_is_written_once_and_compiled_once_per_compiler_and_flags() {
+    let out = scratch("shared-runtime");
+    let built = build(&example("scouting/scouting.mission"), "linux-sim", &out);
+    assert_eq!(built.code, 0, "{}", built.stderr);
+    assert!(built.stdout.contains("semo-runtime"), "{}", built.stdout);
+    let runtime = out.join("semo-runtime");
+    let sources: Vec<String> = std::fs::read_dir(&runtime)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|name| name.ends_with(".c"))
+        .collect();
+    assert_eq!(sources.len(), 6, "{sources:?}");
+    let folders = robot_folders(&out);
+    assert_eq!(folders.len(), 3, "{folders:?}");
+    for folder in &folders {
+        let copies: Vec<_> = std::fs::read_dir(folder)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|name| name.starts_with("semo_") && name != "semo_deploy.h")
+            .collect();
+        assert!(copies.is_empty(), "{}: {copies:?}", folder.display());
+    }
+    make(&folders[0], "gcc", STRICT).unwrap();
+    let first = runtime_objects(&out);
+    assert_eq!(first.len(), 1, "{first:?}");
+    assert_eq!(
+        first.values().next().unwrap().len(),
+        sources.len(),
+        "{first:?}"
+    );
+    for folder in &folders[1..] {
+        make(folder, "gcc", STRICT).unwrap();
+        assert!(folder.join(folder.file_name().unwrap()).is_file());
+    }
+    assert_eq!(
+        runtime_objects(&out),
+        first,
+        "compiled again for the same flags"
+    );
+    // Other flags: objects of their own, the first ones untouched.
+    make(&folders[1], "gcc", "-std=c11 -Wall -Wextra -Werror -O0").unwrap();
+    let both = runtime_objects(&out);
+    assert_eq!(both.len(), 2, "{both:?}");
+    assert!(
+        both.iter()
+            .any(|(key, objects)| first.get(key) == Some(objects))
+    );
+    // A robot folder copied elsewhere names the runtime's folder.
+    let copy = scratch("shared-runtime-copy").join("irobot");
+    let status = Command::new("cp")
+        .args([
+            "-r",
+            &folders[0].display().to_string(),
+            &copy.display().to_string(),
+        ])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let made = Command::new("make")
+        .args(["-s", "clean", "all"])
+        .arg(format!("RUNTIME={}", runtime.display()))
+        .current_dir(&copy)
+        .output()
+        .unwrap();
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    assert!(copy.join("irobot").is_file());
+}

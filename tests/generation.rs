@@ -100,11 +100,14 @@ fn leftovers(out: &Path) -> Vec<PathBuf> {
         .collect()
 }
 
-fn robot_folders(out: &Path) -> Vec<PathBuf> {
+/// The folders a generation writes under `out`, relative: the robot folders
+/// (`<team>/<robot>`, sorted) and then the runtime's (`semo-runtime`).
+fn generated_folders(out: &Path) -> Vec<PathBuf> {
     let mut folders = Vec::new();
     for team in std::fs::read_dir(out).unwrap() {
         let team = team.unwrap().path();
-        if team.file_name().unwrap().to_string_lossy().starts_with('.') || !team.is_dir() {
+        let name = team.file_name().unwrap().to_string_lossy().into_owned();
+        if name.starts_with('.') || name == RUNTIME || !team.is_dir() {
             continue;
         }
         for robot in std::fs::read_dir(&team).unwrap() {
@@ -120,8 +123,14 @@ fn robot_folders(out: &Path) -> Vec<PathBuf> {
         }
     }
     folders.sort();
+    if out.join(RUNTIME).is_dir() {
+        folders.push(PathBuf::from(RUNTIME));
+    }
     folders
 }
+
+/// The runtime's folder, beside the team folders.
+const RUNTIME: &str = "semo-runtime";
 
 fn hash(bytes: &[u8]) -> u64 {
     use std::hash::{Hash, Hasher};
@@ -204,10 +213,11 @@ fn kill_after_every_operation(name: &str, env: &[(&str, &str)]) -> u64 {
     let before = dir.join("before");
     assert_eq!(build(&mission, &before, &[]).code, 0);
     // The user's work in every robot folder, and in one a FIFO and a link.
-    for robot in robot_folders(&before) {
-        std::fs::write(before.join(&robot).join("NOTES.txt"), "mine").unwrap();
+    let folders = generated_folders(&before);
+    for folder in &folders {
+        std::fs::write(before.join(folder).join("NOTES.txt"), "mine").unwrap();
     }
-    let first = before.join(&robot_folders(&before)[0]);
+    let first = before.join(&folders[0]);
     std::os::unix::fs::symlink("/nonexistent/elsewhere", first.join("link")).unwrap();
     let status = Command::new("mkfifo")
         .arg(first.join("fifo"))
@@ -223,8 +233,8 @@ fn kill_after_every_operation(name: &str, env: &[(&str, &str)]) -> u64 {
     copy_tree(&before, &after);
     assert_eq!(build(&mission, &after, &[]).code, 0);
     let (old, new) = (contents(&before), contents(&after));
-    let folders = robot_folders(&before);
-    for folder in &folders {
+    // The runtime does not name the mission: the same.
+    for folder in folders.iter().filter(|f| *f != Path::new(RUNTIME)) {
         assert_ne!(part(&old, folder), part(&new, folder), "{folder:?} changes");
     }
     let (mission_arg, out) = (mission.display().to_string(), dir.join("out"));
@@ -402,6 +412,68 @@ fn switching_target_keeps_edited_task_files() {
         std::fs::read_to_string(folder.join("main.c")).unwrap(),
         "my change"
     );
+}
+
+/// The SHA-256 of a file, in hex, as the manifest records it.
+fn sha256_of(path: &Path) -> String {
+    let out = Command::new("sha256sum").arg(path).output().unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    text.split(' ').next().unwrap().to_string()
+}
+
+/// Robot folders an earlier version generated held copies of the runtime,
+/// which would shadow the shared one: a build removes the copies unchanged
+/// since, and one the user edited stops it (forced: saved under the backup
+/// folder).
+#[test]
+fn runtime_copies_an_earlier_version_left_in_a_robot_folder_go() {
+    let dir = scratch("retired");
+    let mission = copy_example("follow", "follow.mission", &dir);
+    let out = dir.join("out");
+    assert_eq!(build(&mission, &out, &["--target", "linux-sim"]).code, 0);
+    let folder = out.join("Team1/create1");
+    // What an earlier version left: the runtime's files in the robot
+    // folder, recorded as generated.
+    let mut manifest = std::fs::read_to_string(folder.join(".semo-manifest")).unwrap();
+    for name in ["semo_runtime.h", "semo_core.c", "semo_udp.c"] {
+        let copy = folder.join(name);
+        std::fs::copy(out.join("semo-runtime").join(name), &copy).unwrap();
+        manifest.push_str(&format!("generated {} {name}\n", sha256_of(&copy)));
+    }
+    std::fs::write(folder.join(".semo-manifest"), manifest).unwrap();
+    let edited = folder.join("semo_udp.c");
+    std::fs::write(&edited, "/* my fix */\n").unwrap();
+    let before = contents(&out);
+    let refused = build(&mission, &out, &["--target", "linux-sim"]);
+    assert_eq!(refused.code, 1, "{}", refused.stdout);
+    assert!(
+        refused.stderr.contains(
+            "semo_udp.c: was edited since semo generated it; the runtime is no longer copied"
+        ),
+        "{}",
+        refused.stderr
+    );
+    assert!(
+        !refused.stderr.contains("semo_core.c"),
+        "{}",
+        refused.stderr
+    );
+    assert_eq!(contents(&out), before);
+    let forced = build(&mission, &out, &["--target", "linux-sim", "--force"]);
+    assert_eq!(forced.code, 0, "{}", forced.stderr);
+    for name in ["semo_runtime.h", "semo_core.c", "semo_udp.c"] {
+        assert!(!folder.join(name).exists(), "{name}");
+    }
+    let manifest = std::fs::read_to_string(folder.join(".semo-manifest")).unwrap();
+    for name in [" semo_runtime.h", " semo_core.c", " semo_udp.c"] {
+        assert!(!manifest.contains(name), "{manifest}");
+    }
+    let saved: Vec<_> = contents(&out.join(".semo-backup"))
+        .into_iter()
+        .filter(|(p, _)| p.ends_with("Team1/create1/semo_udp.c"))
+        .collect();
+    assert_eq!(saved.len(), 1, "{saved:?}");
+    assert_eq!(saved[0].1, Content::File(hash(b"/* my fix */\n")));
 }
 
 #[test]
@@ -797,27 +869,28 @@ fn junk_is_shown_for_people_in_a_few_writes() {
 }
 
 /// `semo build ARGS` paused after its `step`th file operation
-/// (`SEMO_PAUSE_AFTER_FS_OPS`, through the FIFO `fifo`): `during` runs while
-/// it waits, then it goes on. Its exit code and standard error.
+/// (`SEMO_PAUSE_AFTER_FS_OPS`, through a connection to `pauses`): `during`
+/// runs while it waits, then it goes on. Its exit code and standard error.
 fn build_paused(
     args: &[&str],
     step: u64,
-    fifo: &Path,
+    pauses: &Pauses,
     during: impl FnOnce(),
 ) -> (Option<i32>, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_semo"))
         .args(args)
         .env("SEMO_PAUSE_AFTER_FS_OPS", step.to_string())
-        .env("SEMO_PAUSE_FIFO", fifo)
+        .env("SEMO_PAUSE_SOCKET", &pauses.path)
         .env("NO_COLOR", "1")
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let paused = read_pause(&mut child, fifo);
-    assert!(paused.starts_with(&format!("paused {step} ")), "{paused}");
+    let (paused, line) = pauses.next(&mut child);
+    assert!(line.starts_with(&format!("paused {step} ")), "{line}");
     during();
-    resume(&mut child, fifo);
+    // Closing the connection lets the generation go on.
+    drop(paused);
     let done = child.wait_with_output().unwrap();
     (
         done.status.code(),
@@ -825,64 +898,44 @@ fn build_paused(
     )
 }
 
-fn nonblocking() -> i32 {
-    rustix::fs::OFlags::NONBLOCK.bits() as i32
+/// The Unix socket paused generations connect to (`SEMO_PAUSE_SOCKET`).
+struct Pauses {
+    path: PathBuf,
+    listener: std::os::unix::net::UnixListener,
 }
 
-/// The line a paused generation writes to the FIFO (it then waits).
-fn read_pause(child: &mut std::process::Child, fifo: &Path) -> String {
-    use std::io::Read;
-    use std::os::unix::fs::OpenOptionsExt;
-    let mut reader = std::fs::OpenOptions::new()
-        .read(true)
-        .custom_flags(nonblocking())
-        .open(fifo)
-        .unwrap();
-    let mut line = Vec::new();
-    loop {
-        let mut buf = [0u8; 128];
-        match reader.read(&mut buf) {
-            // End of file once the line is written: the writer has closed it.
-            Ok(0) if line.ends_with(b"\n") => return String::from_utf8(line).unwrap(),
-            Ok(n) => line.extend_from_slice(&buf[..n]),
-            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {}
-            Err(e) => panic!("{e}"),
-        }
-        if let Some(status) = child.try_wait().unwrap() {
-            panic!("the generation ended ({status}) before it paused");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(1));
+impl Pauses {
+    fn at(path: PathBuf) -> Pauses {
+        let _ = std::fs::remove_file(&path);
+        let listener = std::os::unix::net::UnixListener::bind(&path).unwrap();
+        // Accepting never blocks: a generation that ends without pausing is seen.
+        listener.set_nonblocking(true).unwrap();
+        Pauses { path, listener }
     }
-}
 
-/// Lets a paused generation go on.
-fn resume(child: &mut std::process::Child, fifo: &Path) {
-    use std::io::Write;
-    use std::os::unix::fs::OpenOptionsExt;
-    loop {
-        // Without a reader yet, opening to write fails (ENXIO) rather than waits.
-        match std::fs::OpenOptions::new()
-            .write(true)
-            .custom_flags(nonblocking())
-            .open(fifo)
-        {
-            Ok(mut writer) => {
-                writer.write_all(b"go\n").unwrap();
-                return;
-            }
-            Err(_) => {
-                if let Some(status) = child.try_wait().unwrap() {
-                    panic!("the generation ended ({status}) while paused");
+    /// The connection of `child`'s pause and the line it wrote (it then
+    /// waits for the connection to close).
+    fn next(&self, child: &mut std::process::Child) -> (std::os::unix::net::UnixStream, String) {
+        use std::io::BufRead;
+        loop {
+            match self.listener.accept() {
+                Ok((stream, _)) => {
+                    stream.set_nonblocking(false).unwrap();
+                    let mut line = String::new();
+                    std::io::BufReader::new(&stream)
+                        .read_line(&mut line)
+                        .unwrap();
+                    return (stream, line);
                 }
-                std::thread::sleep(std::time::Duration::from_millis(1));
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+                Err(e) => panic!("{e}"),
             }
+            if let Some(status) = child.try_wait().unwrap() {
+                panic!("the generation ended ({status}) before it paused");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(1));
         }
     }
-}
-
-fn make_fifo(path: &Path) {
-    let _ = std::fs::remove_file(path);
-    assert!(Command::new("mkfifo").arg(path).status().unwrap().success());
 }
 
 /// How many file operations (`SEMO_FS_OPS_LOG`) of each kind `semo ARGS` does.
@@ -929,8 +982,7 @@ fn what_the_user_saves_during_a_generation_stays_at_every_step() {
     copy_tree(&before, &out);
     let steps: usize = operations(&args, &dir.join("ops.log")).values().sum();
     assert!(steps > 10, "{steps} operations");
-    let fifo = dir.join("pause");
-    make_fifo(&fifo);
+    let pauses = Pauses::at(dir.join("pause"));
     let folder = out.join("Team1/create1");
     for step in 1..=steps as u64 {
         let _ = std::fs::remove_dir_all(&out);
@@ -939,7 +991,7 @@ fn what_the_user_saves_during_a_generation_stays_at_every_step() {
         let task = format!("{MY_TASK}/* saved at step {step} */\n");
         let main = format!("/* main.c edited at step {step} */\n");
         let header = format!("/* program.h edited in place at step {step} */\n");
-        let (code, stderr) = build_paused(&args, step, &fifo, || {
+        let (code, stderr) = build_paused(&args, step, &pauses, || {
             std::fs::write(folder.join("made-during.txt"), &made).unwrap();
             rename_save(&folder.join("tasks/follow.c"), &task);
             rename_save(&folder.join("main.c"), &main);
@@ -971,8 +1023,7 @@ fn no_link_swapped_in_during_a_generation_is_followed_out_of_the_output_folder()
     let out = dir.join("out");
     copy_tree(&before, &out);
     let steps: usize = operations(&args, &dir.join("ops.log")).values().sum();
-    let fifo = dir.join("pause");
-    make_fifo(&fifo);
+    let pauses = Pauses::at(dir.join("pause"));
     let outside = dir.join("outside");
     for step in 1..=steps as u64 {
         for swap_output_folder in [false, true] {
@@ -981,7 +1032,7 @@ fn no_link_swapped_in_during_a_generation_is_followed_out_of_the_output_folder()
             let _ = std::fs::remove_dir_all(&outside);
             std::fs::create_dir_all(outside.join("create1")).unwrap();
             copy_tree(&before, &out);
-            let (code, stderr) = build_paused(&args, step, &fifo, || {
+            let (code, stderr) = build_paused(&args, step, &pauses, || {
                 if swap_output_folder {
                     std::fs::rename(&out, dir.join("moved")).unwrap();
                     std::os::unix::fs::symlink(&outside, &out).unwrap();

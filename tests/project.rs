@@ -338,7 +338,7 @@ fn build_takes_target_and_output_from_the_project_unless_given() {
     );
     let robot = root.join("gen/A/r");
     assert!(
-        robot.join("semo_sim.c").is_file(),
+        root.join("gen/semo-runtime/semo_sim.c").is_file() && robot.join("main.c").is_file(),
         "linux-sim runtime in gen/"
     );
     assert!(!root.join("out").exists());

@@ -192,26 +192,20 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             eprintln!("recovered: {line}");
         }
     }
+    let runtime = match transaction.stage_runtime(&result.runtime, target, options.force) {
+        Ok(written) => written,
+        Err(e) => {
+            let folder = semo::codegen::RUNTIME_FOLDER;
+            return refuse(&transaction, e, folder, &result.robots, target);
+        }
+    };
     let mut staged = Vec::new();
     for (i, robot) in result.robots.iter().enumerate() {
         match transaction.stage_robot(robot, target, options.force) {
             Ok(written) => staged.push((robot, written)),
-            Err(OutputError::Conflicts(mut conflicts)) => {
-                // All robots' files in the way at once; nothing is written
-                // (the transaction drops what it staged).
-                match transaction.conflicts(&result.robots[i + 1..], target) {
-                    Ok(more) => conflicts.extend(more),
-                    Err(e) => {
-                        eprintln!("error: {e}");
-                        return 2;
-                    }
-                }
-                eprintln!("error: {}", OutputError::Conflicts(conflicts));
-                return 1;
-            }
             Err(e) => {
-                eprintln!("error: cannot write {}/{}: {e}", robot.team, robot.robot);
-                return 2;
+                let folder = format!("{}/{}", robot.team, robot.robot);
+                return refuse(&transaction, e, &folder, &result.robots[i + 1..], target);
             }
         }
     }
@@ -275,6 +269,10 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             serde_json::json!({
                 "target": target.name(),
                 "robots": robots_json,
+                "runtime": (!result.runtime.is_empty()).then(|| serde_json::json!({
+                    "folder": runtime.folder.display().to_string(),
+                    "generated_files": runtime.generated,
+                })),
                 "kept": kept
                     .iter()
                     .map(|c| serde_json::json!({ "path": c.path.display().to_string(), "why": c.why }))
@@ -283,6 +281,17 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             out,
         );
         return output::written(reported).err().unwrap_or(failed);
+    }
+    if !result.runtime.is_empty() {
+        let _ = writeln!(
+            out,
+            "the runtime the robots share: {} ({} generated files)",
+            runtime.folder.display(),
+            runtime.generated
+        );
+        for saved in &runtime.backed_up {
+            let _ = writeln!(out, "  saved the file in the way as {}", saved.display());
+        }
     }
     let _ = writeln!(
         out,
@@ -353,4 +362,33 @@ fn build_with_scenario(
         options.emit,
         &worlds,
     ))
+}
+
+/// A folder that could not be staged: files in the way are listed with those
+/// of the folders not yet staged (`rest`), all at once; nothing is written
+/// (the transaction drops what it staged). The exit status.
+fn refuse(
+    transaction: &Transaction,
+    error: OutputError,
+    folder: &str,
+    rest: &[semo::codegen::RobotOutput],
+    target: semo::codegen::Target,
+) -> i32 {
+    match error {
+        OutputError::Conflicts(mut conflicts) => {
+            match transaction.conflicts(rest, &[], target) {
+                Ok(more) => conflicts.extend(more),
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return 2;
+                }
+            }
+            eprintln!("error: {}", OutputError::Conflicts(conflicts));
+            1
+        }
+        e => {
+            eprintln!("error: cannot write {folder}: {e}");
+            2
+        }
+    }
 }

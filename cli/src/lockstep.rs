@@ -489,17 +489,12 @@ pub fn simulate(
     let scenario_path = work.path().join("scenario.json");
     std::fs::write(&scenario_path, scenario_text)
         .map_err(|e| format!("{}: {e}", scenario_path.display()))?;
+    let runtime = work.path().join(semo::codegen::RUNTIME_FOLDER);
+    write_files(&runtime, &built.runtime)?;
     let mut robots: Vec<Option<Robot>> = peers.iter().map(|_| None).collect();
     for output in &built.robots {
         let folder = work.path().join(&output.team).join(&output.robot);
-        for file in &output.files {
-            let path = folder.join(&file.path);
-            if let Some(parent) = path.parent() {
-                std::fs::create_dir_all(parent)
-                    .map_err(|e| format!("{}: {e}", parent.display()))?;
-            }
-            std::fs::write(&path, &file.text).map_err(|e| format!("{}: {e}", path.display()))?;
-        }
+        write_files(&folder, &output.files)?;
         make(&folder)?;
         let Some(&(_, peer)) = peers.iter().find(|(name, _)| *name == output.robot) else {
             return Err(format!(
@@ -551,6 +546,18 @@ pub fn simulate(
         work: work.path(),
     })?;
     Ok(robots.iter().map(|r| r.name.clone()).zip(traces).collect())
+}
+
+/// `files` written into `folder` (a work folder of this run's own).
+fn write_files(folder: &Path, files: &[semo::codegen::GeneratedFile]) -> Result<(), String> {
+    for file in files {
+        let path = folder.join(&file.path);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
+        }
+        std::fs::write(&path, &file.text).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    Ok(())
 }
 
 /// `make` in a robot's folder (quiet; its errors are shown).

@@ -41,6 +41,9 @@ fn build(mission: &Path, target: Target, out: &Path) {
     let result = codegen::build(&build.input(), target, Emit::All);
     assert!(!result.refused(), "{:#?}", result.diagnostics);
     let mut transaction = output::Transaction::begin(out, || {}).expect("the output folder");
+    transaction
+        .stage_runtime(&result.runtime, target, false)
+        .expect("staged");
     for robot in &result.robots {
         transaction
             .stage_robot(robot, target, false)

@@ -268,11 +268,14 @@ impl Backend {
         // Set when this future is dropped (the request cancelled): the
         // blocking work then stops before its next robot and writes nothing.
         let cancelled = CancelOnDrop::default();
-        let (work, all) = (job.clone(), Arc::new(result.robots));
-        let robots_of = all.clone();
-        let begun = tokio::task::spawn_blocking(move || generate::begin(&work, &robots_of))
-            .await
-            .map_err(|_| Error::internal_error())?;
+        let work = job.clone();
+        let (begun, result) = tokio::task::spawn_blocking(move || {
+            let begun = generate::begin(&work, &result);
+            (begun, result)
+        })
+        .await
+        .map_err(|_| Error::internal_error())?;
+        let all = Arc::new(result.robots);
         let mut transaction = match begun {
             Ok(t) => t,
             Err(refused) => {

@@ -1,12 +1,12 @@
 //! Cancelling `semo.generateCode` (issue 33): the generation stops before
 //! its next robot and leaves the output folder as it was. A test binary of
 //! its own: it pauses the server's generations through the hidden
-//! `SEMO_PAUSE_AFTER_FS_OPS` / `SEMO_PAUSE_FIFO`, which hold for the whole
+//! `SEMO_PAUSE_AFTER_FS_OPS` / `SEMO_PAUSE_SOCKET`, which hold for the whole
 //! process.
 
 use serde_json::{Value, json};
 use std::collections::BTreeMap;
-use std::io::{Read, Write};
+use std::io::BufRead;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 
@@ -43,22 +43,23 @@ fn walk(root: &Path, dir: &Path) -> BTreeMap<PathBuf, Option<Vec<u8>>> {
 
 /// Answers the generations' pauses: each paused step's line goes to the
 /// test, which lets it go on by sending `()`.
-fn pause_answerer(fifo: PathBuf) -> (mpsc::Receiver<String>, mpsc::Sender<()>) {
+fn pause_answerer(socket: PathBuf) -> (mpsc::Receiver<String>, mpsc::Sender<()>) {
     let (paused_tx, paused_rx) = mpsc::channel();
     let (go_tx, go_rx) = mpsc::channel::<()>();
+    let listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
     std::thread::spawn(move || {
-        loop {
+        // One connection per pause; closing it lets the generation go on.
+        for paused in listener.incoming() {
+            let Ok(paused) = paused else { return };
             let mut line = String::new();
-            if std::fs::File::open(&fifo)
-                .and_then(|mut f| f.read_to_string(&mut line))
+            if std::io::BufReader::new(&paused)
+                .read_line(&mut line)
                 .is_err()
                 || paused_tx.send(line).is_err()
                 || go_rx.recv().is_err()
             {
                 return;
             }
-            let mut to_server = std::fs::OpenOptions::new().write(true).open(&fifo).unwrap();
-            to_server.write_all(b"go\n").unwrap();
         }
     });
     (paused_rx, go_tx)
@@ -78,23 +79,16 @@ async fn a_cancelled_generation_leaves_the_output_folder_as_it_was() {
     for file in ["scouting.mission", "MasterTeam.strategy.xml"] {
         std::fs::copy(example(&format!("scouting/{file}")), ws.join(file)).unwrap();
     }
-    let fifo = dir.join("pause");
-    assert!(
-        std::process::Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .unwrap()
-            .success()
-    );
+    let socket = dir.join("pause");
     // Every generation pauses after its first file operation (the first
     // file staged for its first robot).
     // SAFETY: set before the server starts; no other thread reads the
     // environment yet.
     unsafe {
         std::env::set_var("SEMO_PAUSE_AFTER_FS_OPS", "1");
-        std::env::set_var("SEMO_PAUSE_FIFO", &fifo);
+        std::env::set_var("SEMO_PAUSE_SOCKET", &socket);
     }
-    let (paused, go) = pause_answerer(fifo);
+    let (paused, go) = pause_answerer(socket);
     let mut client = semo_server::harness::TestClient::start();
     client.initialize_with(json!({}), Some(&uri(&ws))).await;
     let mission = ws.join("scouting.mission");

@@ -1,5 +1,5 @@
 //! Compiling many generated robot folders quickly and strictly: the runtime
-//! (the same in every folder of a target) once per compiler and target, each
+//! (the output folder's `semo-runtime`) once per compiler and target, each
 //! robot's own files at `-O0` linked against it, on a pool bounded by the
 //! machine's cores. Every warning is a failure (`PEDANTIC`).
 
@@ -14,7 +14,9 @@ struct Sources {
     /// Generated files (`main.c`, ...) and task files, each with the extra
     /// flags it is compiled with.
     own: Vec<(String, Vec<String>)>,
+    /// The runtime's sources, in `runtime_dir`.
     runtime: Vec<String>,
+    runtime_dir: PathBuf,
     flags: Vec<String>,
 }
 
@@ -29,10 +31,13 @@ fn makefile_sources(folder: &Path) -> Sources {
             .map(str::to_string)
             .collect()
     };
-    let (runtime, mut own): (Vec<String>, Vec<String>) = line("SOURCES = ")
+    let runtime_dir = folder
+        .join("../..")
+        .join(line("RUNTIME ?= ../../").concat());
+    let mut own: Vec<(String, Vec<String>)> = line("SOURCES = ")
         .into_iter()
-        .partition(|s| s.starts_with("semo_"));
-    let mut own: Vec<(String, Vec<String>)> = own.drain(..).map(|s| (s, Vec::new())).collect();
+        .map(|s| (s, Vec::new()))
+        .collect();
     for task in line("TASKS = ") {
         let stem = Path::new(&task)
             .file_stem()
@@ -41,10 +46,15 @@ fn makefile_sources(folder: &Path) -> Sources {
             .into_owned();
         own.push((task, vec![format!("-DSEMO_TASK=task_{stem}")]));
     }
+    let runtime_flag = runtime_dir.display().to_string();
     Sources {
         own,
-        runtime,
-        flags: line("SEMO_CFLAGS = "),
+        runtime: line("RUNTIME_SOURCES = "),
+        flags: line("SEMO_CFLAGS = ")
+            .into_iter()
+            .map(|flag| flag.replace("$(RUNTIME)", &runtime_flag))
+            .collect(),
+        runtime_dir,
     }
 }
 
@@ -106,7 +116,7 @@ pub fn compile_all<L: std::fmt::Display>(
                 args.extend(sources.flags.iter().cloned());
                 args.extend([
                     "-c".into(),
-                    first.join(file).display().to_string(),
+                    sources.runtime_dir.join(file).display().to_string(),
                     "-o".into(),
                     object.display().to_string(),
                 ]);

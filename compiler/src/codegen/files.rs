@@ -187,9 +187,13 @@ pub fn main_c(program: &RobotProgram, words: &Words, target: Target, header: &st
         let _ = writeln!(out, "    {{{}, {}}},", c::string(team), c::string(robot));
     }
     out.push_str("};\n\n");
+    let threads = target.platform() == Platform::Threads;
+    if threads {
+        out.push_str(DEPLOY_DEFAULTS);
+    }
     let _ = writeln!(
         out,
-        "static const semo_program_desc program = {{\n    .mission = {},\n    .team = {},\n    .robot = {},\n    .robot_type = {},\n    .tasks = tasks,\n    .task_count = sizeof tasks / sizeof tasks[0],\n    .channels = semo_program_channels,\n    .channel_count = SEMO_CHANNEL_COUNT,\n    .groups = {},\n    .group_count = {},\n    .peers = peers,\n    .peer_count = sizeof peers / sizeof peers[0],\n    .self = {},\n{}{}}};\n\nint main(int argc, char **argv)\n{{\n    return semo_main(argc, argv, &program);\n}}",
+        "static const semo_program_desc program = {{\n    .mission = {},\n    .team = {},\n    .robot = {},\n    .robot_type = {},\n    .tasks = tasks,\n    .task_count = sizeof tasks / sizeof tasks[0],\n    .channels = semo_program_channels,\n    .channel_count = SEMO_CHANNEL_COUNT,\n    .groups = {},\n    .group_count = {},\n    .peers = peers,\n    .peer_count = sizeof peers / sizeof peers[0],\n    .self = {},\n{}{}{}}};\n\nint main(int argc, char **argv)\n{{\n    return semo_main(argc, argv, &program);\n}}",
         c::string(&program.mission),
         c::string(&program.team),
         c::string(&program.robot),
@@ -206,10 +210,20 @@ pub fn main_c(program: &RobotProgram, words: &Words, target: Target, header: &st
             ""
         } else {
             "    .words = words,\n    .word_count = sizeof words / sizeof words[0],\n"
+        },
+        if threads {
+            "    .deploy = &deploy,\n"
+        } else {
+            ""
         }
     );
     out
 }
+
+/// The connection defaults of a threads robot, read from its own
+/// `semo_deploy.h` here (the runtime every robot of a build shares cannot
+/// include one robot's header).
+const DEPLOY_DEFAULTS: &str = "/* The connection defaults `semo build --deploy` baked into semo_deploy.h;\n * NULL where it gave none. */\n#include \"semo_deploy.h\"\n#ifndef SEMO_DEPLOY_BROKER\n#define SEMO_DEPLOY_BROKER NULL\n#endif\n#ifndef SEMO_DEPLOY_CLIENT_ID\n#define SEMO_DEPLOY_CLIENT_ID NULL\n#endif\n#ifndef SEMO_DEPLOY_USER\n#define SEMO_DEPLOY_USER NULL\n#endif\n#ifndef SEMO_DEPLOY_PASSWORD_FILE\n#define SEMO_DEPLOY_PASSWORD_FILE NULL\n#endif\n#ifndef SEMO_DEPLOY_CA\n#define SEMO_DEPLOY_CA NULL\n#endif\n#ifndef SEMO_DEPLOY_CERT\n#define SEMO_DEPLOY_CERT NULL\n#endif\n#ifndef SEMO_DEPLOY_KEY\n#define SEMO_DEPLOY_KEY NULL\n#endif\nstatic const semo_deploy_defaults deploy = {\n    .broker = SEMO_DEPLOY_BROKER,\n    .client_id = SEMO_DEPLOY_CLIENT_ID,\n    .user = SEMO_DEPLOY_USER,\n    .password_file = SEMO_DEPLOY_PASSWORD_FILE,\n    .ca = SEMO_DEPLOY_CA,\n    .cert = SEMO_DEPLOY_CERT,\n    .key = SEMO_DEPLOY_KEY,\n};\n\n";
 
 /// The lock of state shared between tasks: a mutex on threads, nothing on
 /// the static schedule (one task runs at a time). `(include, declare, lock,
@@ -564,11 +578,18 @@ impl StaticSizes {
     }
 }
 
+/// The sources a robot's Makefile compiles: the robot's own (in its folder),
+/// its task files, and the runtime's (in the shared runtime folder).
+pub struct MakeSources<'a> {
+    pub robot: &'a [String],
+    pub tasks: &'a [String],
+    pub runtime: &'a [&'a str],
+}
+
 pub fn makefile(
     program: &RobotProgram,
     target: Target,
-    sources: &[String],
-    tasks: &[String],
+    sources: &MakeSources<'_>,
     header: &str,
     sizes: &StaticSizes,
 ) -> String {
@@ -583,10 +604,27 @@ pub fn makefile(
             let _ = writeln!(out, "# {text}");
         }
     }
+    let runtime = format!(
+        "# The runtime this robot shares with the others of the build: another\n# folder with `make RUNTIME=...` (robot folders copied elsewhere).\nRUNTIME ?= ../../{folder}\nRUNTIME_SOURCES = {sources}\n",
+        folder = super::RUNTIME_FOLDER,
+        sources = sources.runtime.join(" "),
+    );
+    let common = format!(
+        "PROGRAM = {robot}{elf}\nSOURCES = {sources}\nTASKS = {tasks}\nOBJECTS = $(SOURCES:.c=.o) $(TASKS:.c=.o)\ninclude $(RUNTIME)/semo_runtime.mk\n",
+        robot = program.robot,
+        elf = if target.platform() == Platform::Static {
+            ".elf"
+        } else {
+            ""
+        },
+        sources = sources.robot.join(" "),
+        tasks = sources.tasks.join(" "),
+    );
+    let rules = "# Objects depend on the Makefile too: a new generation (another target, a\n# deployment baked in) rebuilds them.\n\ntasks/%.o: tasks/%.c $(HEADERS) Makefile\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -DSEMO_TASK=task_$* -c $< -o $@\n\n%.o: %.c $(HEADERS) Makefile\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -c $< -o $@\n";
     if target.platform() == Platform::Static {
         let _ = writeln!(
             out,
-            "\n# `make` builds `{robot}.elf` for target {target} (TI Stellaris LM3S6965, a\n# Cortex-M3) with arm-none-eabi-gcc and newlib-nano; `make size` prints its\n# flash and RAM, `make run` runs it in QEMU (UART0 on standard output{exit}).\n# CFLAGS may be overridden; the runtime's static tables (sized from the task\n# graph) and the stack with\n# make variables (`make SEMO_STACK_BYTES=4096`).\nCC = arm-none-eabi-gcc\nSIZE = arm-none-eabi-size\nQEMU = qemu-system-arm\nCFLAGS ?= -std=c11 -Wall -Wextra -Os\nARCH = -mcpu=cortex-m3 -mthumb\nSEMO_STACK_BYTES ?= 2048\nSEMO_TEXT_MAX ?= {value_bytes}\nSEMO_MAX_TASKS ?= {task_count}\nSEMO_MAX_GROUPS ?= {groups}\nSEMO_INBOX ?= {inbox}\nSIZES = -DSEMO_STACK_BYTES=$(SEMO_STACK_BYTES) -DSEMO_TEXT_MAX=$(SEMO_TEXT_MAX) -DSEMO_MAX_TASKS=$(SEMO_MAX_TASKS) -DSEMO_MAX_GROUPS=$(SEMO_MAX_GROUPS) -DSEMO_INBOX=$(SEMO_INBOX)\nSEMO_CFLAGS = -std=c11 $(ARCH) -ffunction-sections -fdata-sections -DSEMO_STATIC{sim}{no_reals} $(SIZES) -I.\nLDFLAGS += $(ARCH) -nostartfiles --specs=nano.specs -T lm3s6965.ld -Wl,--gc-sections\n\nPROGRAM = {robot}.elf\nSOURCES = {sources}\nTASKS = {tasks}\nOBJECTS = $(SOURCES:.c=.o) $(TASKS:.c=.o)\nHEADERS = program.h semo_runtime.h semo_internal.h\n# Objects depend on the Makefile too: a new generation (another target, a\n# deployment baked in) rebuilds them.\n\nall: $(PROGRAM)\n\n$(PROGRAM): $(OBJECTS) lm3s6965.ld\n\t$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(OBJECTS) $(LDLIBS)\n\ntasks/%.o: tasks/%.c $(HEADERS) Makefile\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -DSEMO_TASK=task_$* -c $< -o $@\n\n%.o: %.c $(HEADERS) Makefile\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -c $< -o $@\n\nsize: $(PROGRAM)\n\t$(SIZE) $(PROGRAM)\n\nrun: $(PROGRAM)\n\t$(QEMU) -M lm3s6965evb -nographic -semihosting -kernel $(PROGRAM)\n\nclean:\n\trm -f $(PROGRAM) $(OBJECTS)\n\n.PHONY: all size run clean",
+            "\n# `make` builds `{robot}.elf` for target {target} (TI Stellaris LM3S6965, a\n# Cortex-M3) with arm-none-eabi-gcc and newlib-nano; `make size` prints its\n# flash and RAM, `make run` runs it in QEMU (UART0 on standard output{exit}).\n# CFLAGS may be overridden; the runtime's static tables (sized from the task\n# graph) and the stack with\n# make variables (`make SEMO_STACK_BYTES=4096`).\n{runtime}CC = arm-none-eabi-gcc\nSIZE = arm-none-eabi-size\nQEMU = qemu-system-arm\nCFLAGS ?= -std=c11 -Wall -Wextra -Os\nARCH = -mcpu=cortex-m3 -mthumb\nSEMO_STACK_BYTES ?= 2048\nSEMO_TEXT_MAX ?= {value_bytes}\nSEMO_MAX_TASKS ?= {task_count}\nSEMO_MAX_GROUPS ?= {groups}\nSEMO_INBOX ?= {inbox}\nSIZES = -DSEMO_STACK_BYTES=$(SEMO_STACK_BYTES) -DSEMO_TEXT_MAX=$(SEMO_TEXT_MAX) -DSEMO_MAX_TASKS=$(SEMO_MAX_TASKS) -DSEMO_MAX_GROUPS=$(SEMO_MAX_GROUPS) -DSEMO_INBOX=$(SEMO_INBOX)\nSEMO_CFLAGS = -std=c11 $(ARCH) -ffunction-sections -fdata-sections -DSEMO_STATIC{sim}{no_reals} $(SIZES) -I. -I$(RUNTIME)\nLDFLAGS += $(ARCH) -nostartfiles --specs=nano.specs -T $(RUNTIME)/lm3s6965.ld -Wl,--gc-sections\n\n{common}HEADERS = program.h $(RUNTIME_HEADERS)\n\nall: $(PROGRAM)\n\n$(PROGRAM): $(OBJECTS) $(RUNTIME_OBJECTS) $(RUNTIME)/lm3s6965.ld\n\t$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(OBJECTS) $(RUNTIME_OBJECTS) $(LDLIBS)\n\n{rules}\nsize: $(PROGRAM)\n\t$(SIZE) $(PROGRAM)\n\nrun: $(PROGRAM)\n\t$(QEMU) -M lm3s6965evb -nographic -semihosting -kernel $(PROGRAM)\n\nclean:\n\trm -f $(PROGRAM) $(OBJECTS)\n\n.PHONY: all size run clean",
             robot = program.robot,
             target = target.name(),
             value_bytes = sizes.value_bytes,
@@ -604,14 +642,12 @@ pub fn makefile(
             } else {
                 ""
             },
-            sources = sources.join(" "),
-            tasks = tasks.join(" "),
         );
         return out;
     }
     let _ = writeln!(
         out,
-        "\n# `make` builds the program `{robot}` for target {target}; CC and CFLAGS may be\n# overridden (`make CC=clang CFLAGS=\"-O1 -fsanitize=thread\"`). `make STATIC=1`\n# links statically with musl (Debian musl-tools) and 64 KiB thread stacks: the\n# smallest footprint (`make clean` first when switching). TRANSPORT is the\n# default transport, udp (loopback) or mqtt (links libmosquitto, Debian\n# libmosquitto-dev; the program's --transport chooses among those built in;\n# musl has no libmosquitto: `make STATIC=1 TRANSPORT=udp`).\nCFLAGS ?= -std=c11 -Wall -Wextra -O2\nTRANSPORT ?= {transport}\nSEMO_CFLAGS = -std=c11 -D_POSIX_C_SOURCE=200809L{sim} -DSEMO_DEPLOY -I.\nLDLIBS += -lpthread -lm\nifeq ($(TRANSPORT),mqtt)\nSEMO_CFLAGS += -DSEMO_MQTT\nLDLIBS += -lmosquitto\nendif\nifeq ($(STATIC),1)\nCC = musl-gcc\nLDFLAGS += -static\nSEMO_CFLAGS += -DSEMO_STACK_BYTES=65536\nendif\n\nPROGRAM = {robot}\nSOURCES = {sources}\nTASKS = {tasks}\nOBJECTS = $(SOURCES:.c=.o) $(TASKS:.c=.o)\nHEADERS = program.h semo_runtime.h semo_deploy.h\n# Objects depend on the Makefile too: a new generation (another target, a\n# deployment baked in) rebuilds them.\n\nall: $(PROGRAM)\n\n$(PROGRAM): $(OBJECTS)\n\t$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(OBJECTS) $(LDLIBS)\n\ntasks/%.o: tasks/%.c $(HEADERS) Makefile\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -DSEMO_TASK=task_$* -c $< -o $@\n\n%.o: %.c $(HEADERS) Makefile\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -c $< -o $@\n\nclean:\n\trm -f $(PROGRAM) $(OBJECTS)\n\n.PHONY: all clean",
+        "\n# `make` builds the program `{robot}` for target {target}; CC and CFLAGS may be\n# overridden (`make CC=clang CFLAGS=\"-O1 -fsanitize=thread\"`). `make STATIC=1`\n# links statically with musl (Debian musl-tools) and 64 KiB thread stacks: the\n# smallest footprint (`make clean` first when switching). TRANSPORT is the\n# default transport, udp (loopback) or mqtt (links libmosquitto, Debian\n# libmosquitto-dev; the program's --transport chooses among those built in;\n# musl has no libmosquitto: `make STATIC=1 TRANSPORT=udp`).\n{runtime}CFLAGS ?= -std=c11 -Wall -Wextra -O2\nTRANSPORT ?= {transport}\nSEMO_CFLAGS = -std=c11 -D_POSIX_C_SOURCE=200809L{sim} -I. -I$(RUNTIME)\nLDLIBS += -lpthread -lm\nifeq ($(TRANSPORT),mqtt)\nSEMO_CFLAGS += -DSEMO_MQTT\nLDLIBS += -lmosquitto\nendif\nifeq ($(STATIC),1)\nCC = musl-gcc\nLDFLAGS += -static\nSEMO_CFLAGS += -DSEMO_STACK_BYTES=65536\nendif\n\n{common}HEADERS = program.h {deploy} $(RUNTIME_HEADERS)\n\nall: $(PROGRAM)\n\n$(PROGRAM): $(OBJECTS) $(RUNTIME_OBJECTS)\n\t$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(OBJECTS) $(RUNTIME_OBJECTS) $(LDLIBS)\n\n{rules}\nclean:\n\trm -f $(PROGRAM) $(OBJECTS)\n\n.PHONY: all clean",
         robot = program.robot,
         target = target.name(),
         transport = target.transport().map_or("udp", |t| t.name()),
@@ -620,8 +656,7 @@ pub fn makefile(
         } else {
             ""
         },
-        sources = sources.join(" "),
-        tasks = tasks.join(" "),
+        deploy = super::DEPLOY_HEADER,
     );
     out
 }

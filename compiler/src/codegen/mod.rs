@@ -8,9 +8,11 @@
 //!   file the user owns.
 //! - `schedule.rs`: the static schedule's firing order from the SDF analysis.
 //! - `target.rs`: what a target refuses (inter-robot messages on bare metal).
-//! - `runtime/`: the hand-written C runtime copied into every folder: the
-//!   portable core and a platform layer (POSIX threads or a static schedule
-//!   with a board file).
+//! - `runtime/`: the hand-written C runtime, written once per build into
+//!   [`RUNTIME_FOLDER`] beside the team folders, which every robot's
+//!   Makefile compiles (`semo_runtime.mk`: objects shared by the robots built
+//!   with the same compiler and flags): the portable core and a platform
+//!   layer (POSIX threads or a static schedule with a board file).
 //!
 //! Targets are data: a target is a row of [`TARGETS`] (its platform, whether
 //! it simulates, its runtime files); the generated code differs only where
@@ -117,6 +119,52 @@ const LOCKSTEP: (&str, &str) = ("semo_lockstep.c", include_str!("runtime/semo_lo
 const STATIC: (&str, &str) = ("semo_static.c", include_str!("runtime/semo_static.c"));
 const LM3S6965: (&str, &str) = ("semo_lm3s6965.c", include_str!("runtime/semo_lm3s6965.c"));
 const LM3S6965_LD: (&str, &str) = ("lm3s6965.ld", include_str!("runtime/lm3s6965.ld"));
+/// The make rules every robot's Makefile includes to compile the runtime.
+const MAKE_RULES: (&str, &str) = ("semo_runtime.mk", include_str!("runtime/semo_runtime.mk"));
+
+/// Every file of the runtime, whatever the target.
+const RUNTIME_FILES: &[(&str, &str)] = &[
+    API,
+    INTERNAL,
+    CORE,
+    POSIX,
+    UDP,
+    MQTT,
+    POSIX_SIM,
+    LOCKSTEP,
+    STATIC,
+    LM3S6965,
+    LM3S6965_LD,
+    MAKE_RULES,
+];
+
+/// The folder under the output folder that holds the runtime, once per
+/// build, beside the team folders (never a team's: team names are C
+/// identifiers). Each robot's Makefile names it `RUNTIME` (`../../` + this).
+pub const RUNTIME_FOLDER: &str = "semo-runtime";
+
+/// Whether `name` is a file of the runtime: earlier versions copied the
+/// runtime into every robot folder, and a copy left there would shadow the
+/// shared one.
+pub fn is_runtime_file(name: &str) -> bool {
+    RUNTIME_FILES.iter().any(|(file, _)| *file == name)
+}
+
+/// The files of [`RUNTIME_FOLDER`] for a build for `target`: its runtime
+/// and the make rules.
+pub fn runtime_files(target: Target) -> Vec<GeneratedFile> {
+    target
+        .info()
+        .runtime
+        .iter()
+        .chain([&MAKE_RULES])
+        .map(|(path, text)| GeneratedFile {
+            path: path.to_string(),
+            text: text.to_string(),
+            owner: Owner::Generated,
+        })
+        .collect()
+}
 
 pub const TARGETS: &[TargetInfo] = &[
     TargetInfo {
@@ -374,14 +422,25 @@ pub fn generate(
             Owner::Generated,
         );
     }
-    for (name, text) in target.info().runtime {
-        push(name, text.to_string(), Owner::Generated);
-        if name.ends_with(".c") {
-            sources_c.push(name.to_string());
-        }
-    }
+    let runtime_c: Vec<&str> = target
+        .info()
+        .runtime
+        .iter()
+        .map(|(name, _)| *name)
+        .filter(|name| name.ends_with(".c"))
+        .collect();
     let sizes = files::StaticSizes::of(program, longest_value(&files, scenario));
-    let makefile = files::makefile(program, target, &sources_c, &tasks, &header, &sizes);
+    let makefile = files::makefile(
+        program,
+        target,
+        &files::MakeSources {
+            robot: &sources_c,
+            tasks: &tasks,
+            runtime: &runtime_c,
+        },
+        &header,
+        &sizes,
+    );
     files.push(GeneratedFile {
         path: "Makefile".to_string(),
         text: makefile,
@@ -439,12 +498,23 @@ fn file_header(program: &RobotProgram, target: Target, sources: &[String], owner
 pub struct BuildResult {
     /// One folder per robot, in formation order; empty when generation was refused.
     pub robots: Vec<RobotOutput>,
+    /// The files of [`RUNTIME_FOLDER`] the robots compile; empty when
+    /// generation was refused or writes only task graphs.
+    pub runtime: Vec<GeneratedFile>,
     /// Why generation was refused (check errors, unsupported constructs,
     /// unsafe names, failing refined graphs), with the check's warnings.
     pub diagnostics: Vec<crate::diag::Diagnostic>,
 }
 
 impl BuildResult {
+    fn refused_with(diagnostics: Vec<crate::diag::Diagnostic>) -> BuildResult {
+        BuildResult {
+            robots: Vec::new(),
+            runtime: Vec::new(),
+            diagnostics,
+        }
+    }
+
     pub fn refused(&self) -> bool {
         self.diagnostics
             .iter()
@@ -496,10 +566,7 @@ pub fn build_refined(
         sources,
     } = refined;
     if programs.is_empty() {
-        return BuildResult {
-            robots: Vec::new(),
-            diagnostics,
-        };
+        return BuildResult::refused_with(diagnostics);
     }
     diagnostics.extend(target::check(
         build,
@@ -510,10 +577,7 @@ pub fn build_refined(
     ));
     crate::diag::sort_and_dedup(&mut diagnostics);
     if diagnostics.iter().any(crate::diag::Diagnostic::is_error) {
-        return BuildResult {
-            robots: Vec::new(),
-            diagnostics,
-        };
+        return BuildResult::refused_with(diagnostics);
     }
     let mut robots: Vec<RobotOutput> = Vec::new();
     for (i, program) in programs.iter().enumerate() {
@@ -528,13 +592,15 @@ pub fn build_refined(
             .flat_map(|(program, robot)| written_graph_errors(build, program, robot)),
     );
     if diagnostics.iter().any(crate::diag::Diagnostic::is_error) {
-        return BuildResult {
-            robots: Vec::new(),
-            diagnostics,
-        };
+        return BuildResult::refused_with(diagnostics);
     }
+    let runtime = match emit {
+        Emit::All => runtime_files(target),
+        Emit::TaskGraph => Vec::new(),
+    };
     BuildResult {
         robots,
+        runtime,
         diagnostics,
     }
 }

@@ -82,7 +82,7 @@ mod journal;
 pub mod manifest;
 mod plan;
 
-use super::{RobotOutput, Target};
+use super::{GeneratedFile, RUNTIME_FOLDER, RobotOutput, Target};
 use journal::{Aside, Entry, Journal, Old};
 use std::collections::HashMap;
 use std::fs::File;
@@ -117,6 +117,35 @@ pub struct Written {
     /// Entries that are neither regular files, folders nor links (FIFOs,
     /// sockets, devices): never opened.
     pub left_alone: Vec<PathBuf>,
+}
+
+/// A folder generation writes: its path under the output folder, one name
+/// at a time, its files, and the names of files an earlier version of semo
+/// generated there that this one no longer does and removes (unchanged).
+pub(crate) struct FolderFiles<'r> {
+    pub names: Vec<&'r str>,
+    pub files: &'r [GeneratedFile],
+    pub retired: fn(&str) -> bool,
+}
+
+/// `<team>/<robot>/`: its files; the runtime's files that earlier versions
+/// copied into it are retired, so that no stale copy of a runtime header
+/// shadows the shared one.
+fn robot_folder(robot: &RobotOutput) -> FolderFiles<'_> {
+    FolderFiles {
+        names: vec![&robot.team, &robot.robot],
+        files: &robot.files,
+        retired: super::is_runtime_file,
+    }
+}
+
+/// [`RUNTIME_FOLDER`]: the runtime's files.
+fn runtime_folder(files: &[GeneratedFile]) -> FolderFiles<'_> {
+    FolderFiles {
+        names: vec![RUNTIME_FOLDER],
+        files,
+        retired: |_| false,
+    }
 }
 
 /// A file generation would replace although the user changed it or owns it.
@@ -340,22 +369,26 @@ impl Transaction {
     pub fn conflicts(
         &self,
         robots: &[RobotOutput],
+        runtime: &[GeneratedFile],
         target: Target,
     ) -> Result<Vec<Conflict>, OutputError> {
         let mut all = Vec::new();
+        if !runtime.is_empty() {
+            all.extend(self.plan(&runtime_folder(runtime), target)?.conflicts);
+        }
         for robot in robots {
-            all.extend(self.plan(robot, target)?.conflicts);
+            all.extend(self.plan(&robot_folder(robot), target)?.conflicts);
         }
         Ok(all)
     }
 
     fn plan<'r>(
         &self,
-        robot: &'r RobotOutput,
+        folder: &FolderFiles<'r>,
         target: Target,
     ) -> Result<plan::Plan<'r>, OutputError> {
         let backup = self.out.join(BACKUP_FOLDER).join(&self.stamp);
-        plan::Plan::new(self.dir.as_fd(), &self.out, &backup, robot, target)
+        plan::Plan::new(self.dir.as_fd(), &self.out, &backup, folder, target)
     }
 
     /// Stages `robot`'s files for `target` in the work folder; nothing in the
@@ -368,23 +401,44 @@ impl Transaction {
         target: Target,
         force: bool,
     ) -> Result<Written, OutputError> {
+        self.stage(&robot_folder(robot), target, force)
+    }
+
+    /// Stages the runtime's folder ([`RUNTIME_FOLDER`]) the robots of the
+    /// build compile, as [`Transaction::stage_robot`] stages a robot's.
+    pub fn stage_runtime(
+        &mut self,
+        runtime: &[GeneratedFile],
+        target: Target,
+        force: bool,
+    ) -> Result<Written, OutputError> {
+        self.stage(&runtime_folder(runtime), target, force)
+    }
+
+    fn stage(
+        &mut self,
+        folder: &FolderFiles<'_>,
+        target: Target,
+        force: bool,
+    ) -> Result<Written, OutputError> {
         self.stop_if_cancelled()?;
         if !self.generating {
             self.generating = true;
             fsops::generation_begins();
         }
-        let plan = self.plan(robot, target)?;
+        let plan = self.plan(folder, target)?;
         if !plan.conflicts.is_empty() {
             if !force {
                 return Err(OutputError::Conflicts(plan.conflicts));
             }
             self.check_backup_folder()?;
         }
+        let prefix = folder.names.join("/");
         for change in plan.changes {
             let index = self.entries.len();
             let entry = Entry {
                 index,
-                path: format!("{}/{}/{}", robot.team, robot.robot, change.rel),
+                path: format!("{prefix}/{}", change.rel),
                 new: change.bytes.as_deref().map(manifest::sha256),
                 old: change.old,
                 aside: change.aside,

@@ -247,16 +247,19 @@ pub struct NotBegun {
 
 /// Takes the output folder's lock (waiting for another generation) and
 /// recovers what an interrupted one left; then checks, unless forced, that no
-/// robot folder holds files in the way. Blocking: run off the async threads.
-pub fn begin(job: &Job, robots: &[codegen::RobotOutput]) -> Result<output::Transaction, NotBegun> {
+/// robot folder (nor the runtime's) holds files in the way, and stages the
+/// runtime's folder the robots share. Blocking: run off the async threads.
+pub fn begin(job: &Job, build: &codegen::BuildResult) -> Result<output::Transaction, NotBegun> {
     let failed = |e: output::OutputError| NotBegun {
         message: e.to_string(),
         data: None,
     };
-    let transaction =
+    let mut transaction =
         output::Transaction::begin_inside(&job.out.root, &job.out.rel, || {}).map_err(failed)?;
     if !job.force {
-        let conflicts = transaction.conflicts(robots, job.target).map_err(failed)?;
+        let conflicts = transaction
+            .conflicts(&build.robots, &build.runtime, job.target)
+            .map_err(failed)?;
         if !conflicts.is_empty() {
             let data = json!({
                 "conflicts": conflicts
@@ -270,5 +273,8 @@ pub fn begin(job: &Job, robots: &[codegen::RobotOutput]) -> Result<output::Trans
             });
         }
     }
+    transaction
+        .stage_runtime(&build.runtime, job.target, job.force)
+        .map_err(failed)?;
     Ok(transaction)
 }

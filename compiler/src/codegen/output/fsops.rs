@@ -23,10 +23,13 @@
 //! - `SEMO_FAULT_AFTER_RECOVERY=1` aborts when a generation proper begins,
 //!   after recovering what an interrupted one left (and after the caller
 //!   reported it).
-//! - `SEMO_PAUSE_AFTER_FS_OPS=N[,M...]` with `SEMO_PAUSE_FIFO=PATH` pauses
-//!   after those steps: the process writes `paused N KIND` to the FIFO, then
-//!   reads it to its end, so the test does something at that exact point
-//!   and lets it go on by writing to the FIFO and closing it.
+//! - `SEMO_PAUSE_AFTER_FS_OPS=N[,M...]` with `SEMO_PAUSE_SOCKET=PATH` pauses
+//!   after those steps: the process connects to the Unix socket the test
+//!   listens on at PATH, writes `paused N KIND` and reads until the test
+//!   closes the connection, so the test does something at that exact point
+//!   and lets it go on. One connection per pause: two pauses (of two
+//!   generations of a server) never read each other's answer, as they could
+//!   through one FIFO.
 //! - `SEMO_FS_OPS_LOG=PATH` appends `N KIND` per step to PATH.
 //! - `SEMO_NO_RENAME_NOREPLACE=1` behaves as on a file system that refuses
 //!   `renameat2(RENAME_NOREPLACE)`, so the `link` + `unlink` fallback is
@@ -129,16 +132,14 @@ fn step<T>(op: Op, result: io::Result<T>) -> io::Result<T> {
     result
 }
 
-/// The pause handshake through `SEMO_PAUSE_FIFO` (see the module's doc).
+/// The pause handshake through `SEMO_PAUSE_SOCKET` (see the module's doc).
 fn pause(done: u64, op: Op) {
-    let Some(fifo) = std::env::var_os("SEMO_PAUSE_FIFO") else {
+    let Some(socket) = std::env::var_os("SEMO_PAUSE_SOCKET") else {
         return;
     };
-    if let Ok(mut to_test) = OpenOptions::new().write(true).open(&fifo) {
-        let _ = writeln!(to_test, "paused {done} {}", op.name());
-    }
-    if let Ok(mut from_test) = File::open(&fifo) {
-        let _ = io::copy(&mut from_test, &mut io::sink());
+    if let Ok(mut test) = std::os::unix::net::UnixStream::connect(&socket) {
+        let _ = writeln!(test, "paused {done} {}", op.name());
+        let _ = io::copy(&mut test, &mut io::sink());
     }
 }
 

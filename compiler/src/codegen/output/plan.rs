@@ -5,8 +5,8 @@
 
 use super::journal::{Aside, Old};
 use super::manifest::{self, Entry, Kind, Manifest};
-use super::{Conflict, OutputError, Written, at, fsops, not_a_folder, safe_relative};
-use crate::codegen::{GeneratedFile, Owner, RobotOutput, Target};
+use super::{Conflict, FolderFiles, OutputError, Written, at, fsops, not_a_folder, safe_relative};
+use crate::codegen::{GeneratedFile, Owner, Target};
 use std::borrow::Cow;
 use std::collections::BTreeSet;
 use std::os::fd::{AsFd, BorrowedFd, OwnedFd};
@@ -56,10 +56,10 @@ impl<'r> Plan<'r> {
         out: BorrowedFd<'_>,
         out_path: &Path,
         backup: &Path,
-        robot: &'r RobotOutput,
+        files: &FolderFiles<'r>,
         target: Target,
     ) -> Result<Plan<'r>, OutputError> {
-        let folder = open_robot_folder(out, out_path, robot, backup, target)?;
+        let folder = open_folder(out, out_path, &files.names, backup, target)?;
         let mut plan = Plan {
             changes: Vec::new(),
             conflicts: Vec::new(),
@@ -74,7 +74,7 @@ impl<'r> Plan<'r> {
             files: Default::default(),
         };
         let mut seen = BTreeSet::new();
-        for file in &robot.files {
+        for file in files.files {
             // A task two roles run is listed once per role: written once.
             if !seen.insert(file.path.as_str()) {
                 continue;
@@ -87,10 +87,17 @@ impl<'r> Plan<'r> {
             }
         }
         // Files an earlier generation wrote that this one does not (say with
-        // `--emit taskgraph`) stay, still recorded.
+        // `--emit taskgraph`) stay, still recorded; retired ones go.
         for (path, entry) in folder.previous.iter().flat_map(|m| &m.files) {
-            if !seen.contains(path.as_str()) && matches!(folder.look(path)?, Look::File(_)) {
-                manifest.files.insert(path.clone(), entry.clone());
+            if seen.contains(path.as_str()) {
+                continue;
+            }
+            if let Look::File(bytes) = folder.look(path)? {
+                if (files.retired)(path) {
+                    plan.retire(&folder, path, entry, bytes);
+                } else {
+                    manifest.files.insert(path.clone(), entry.clone());
+                }
             }
         }
         plan.record(&folder, manifest)?;
@@ -201,6 +208,29 @@ impl<'r> Plan<'r> {
         }
     }
 
+    /// A file an earlier version generated at `rel` and this one no longer
+    /// does: removed if unchanged since, else in the way (the user's edit is
+    /// kept, under the backup folder when forced).
+    fn retire(&mut self, folder: &Folder, rel: &str, recorded: &Entry, bytes: Vec<u8>) {
+        let old = Old::File {
+            sha256: manifest::sha256(&bytes),
+        };
+        if recorded.kind == Kind::Generated && recorded.sha256 == manifest::sha256(&bytes) {
+            self.changes.push(Change {
+                rel: rel.to_string(),
+                bytes: None,
+                old,
+                aside: Aside::Work,
+            });
+        } else {
+            let why = format!(
+                "was edited since semo generated it; the runtime is no longer copied into robot folders (it is in `{}`)",
+                crate::codegen::RUNTIME_FOLDER
+            );
+            self.conflict(folder, rel, why, None, old);
+        }
+    }
+
     fn count(&mut self, owner: Owner) -> Kind {
         match owner {
             Owner::Generated => {
@@ -287,19 +317,19 @@ impl<'r> Plan<'r> {
     }
 }
 
-/// `<out>/<team>/<robot>`, opened if it exists, after checking that the team
-/// and robot folders are real folders.
-fn open_robot_folder(
+/// `<out>/<names...>` (`<team>/<robot>`), opened if it exists, after
+/// checking that each folder on the way is a real folder.
+fn open_folder(
     out: BorrowedFd<'_>,
     out_path: &Path,
-    robot: &RobotOutput,
+    names: &[&str],
     backup: &Path,
     target: Target,
 ) -> Result<Folder, OutputError> {
     let mut path = out_path.to_path_buf();
     let mut dir: Option<OwnedFd> = None;
     let mut missing = false;
-    for name in [&robot.team, &robot.robot] {
+    for name in names {
         let single = safe_relative(name).is_ok_and(|p| p.components().count() == 1);
         if !single {
             return Err(OutputError::Unsafe(
@@ -333,7 +363,7 @@ fn open_robot_folder(
     };
     Ok(Folder {
         dir,
-        backup: backup.join(&robot.team).join(&robot.robot),
+        backup: names.iter().fold(backup.to_path_buf(), |b, n| b.join(n)),
         path,
         previous,
         target,

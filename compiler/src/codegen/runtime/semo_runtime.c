@@ -30,16 +30,7 @@
 #endif
 #define RECV_ERROR_PAUSE_MS 50
 #define DEFAULT_PORT_BASE 47000
-/* The deployment baked in by `semo build --deploy` (the generated Makefile
- * defines SEMO_DEPLOY; without a deployment the header defines nothing). */
-#ifdef SEMO_DEPLOY
-#include "semo_deploy.h"
-#endif
-#ifdef SEMO_DEPLOY_BROKER
-#define DEFAULT_BROKER SEMO_DEPLOY_BROKER
-#else
 #define DEFAULT_BROKER "mqtt://127.0.0.1:1883"
-#endif
 /* The target's transport (the Makefile's TRANSPORT); MQTT is compiled in
  * only where it is the default, as only then is libmosquitto linked. */
 #ifdef SEMO_MQTT
@@ -1049,6 +1040,21 @@ typedef struct {
 /* The latest --start-at (the year 2096): keeps the clock's arithmetic in 64 bits. */
 #define START_AT_MAX 4000000000000L
 
+/* The program's connection defaults (`semo build --deploy`); none when the
+ * program has no deployment. */
+static const semo_deploy_defaults *deployed(void)
+{
+    static const semo_deploy_defaults none = {0};
+    return g_prog->deploy ? g_prog->deploy : &none;
+}
+
+/* The broker used when neither --broker nor $SEMO_BROKER names one. */
+static const char *default_broker(void)
+{
+    const char *broker = deployed()->broker;
+    return broker ? broker : DEFAULT_BROKER;
+}
+
 static void usage(FILE *f, const char *prog)
 {
     fprintf(f,
@@ -1064,7 +1070,7 @@ static void usage(FILE *f, const char *prog)
             "                    $SEMO_UDP_KEY (hex, 16 to 64 bytes, the same for every robot of the run):\n"
             "                    datagrams are signed with it, and one not signed with it is refused\n"
             "  --broker URL      mqtt: the broker, mqtt://HOST[:PORT] or mqtts://HOST[:PORT] (TLS)\n"
-            "                    (default " DEFAULT_BROKER ", or $SEMO_BROKER); who the robot is there:\n"
+            "                    (default %s, or $SEMO_BROKER); who the robot is there:\n"
             "                    $SEMO_MQTT_CLIENT_ID, $SEMO_MQTT_USER, $SEMO_MQTT_PASSWORD_FILE, $SEMO_MQTT_CA,\n"
             "                    $SEMO_MQTT_CERT, $SEMO_MQTT_KEY (defaults from semo build --deploy)\n"
             "  --run ID          mqtt: the run this robot takes part in (default \"" SEMO_RUN_DEFAULT "\", or $SEMO_RUN):\n"
@@ -1081,7 +1087,7 @@ static void usage(FILE *f, const char *prog)
             "                    --transport and --port-base do not apply\n"
 #endif
             ,
-            prog, DEFAULT_TRANSPORT, DEFAULT_PORT_BASE);
+            prog, DEFAULT_TRANSPORT, DEFAULT_PORT_BASE, default_broker());
 }
 
 static bool parse_long(const char *s, long min, long max, long *out)
@@ -1178,25 +1184,6 @@ static const char *setting(const char *env_name, const char *deployed)
     return env && *env ? env : deployed;
 }
 
-#ifndef SEMO_DEPLOY_CLIENT_ID
-#define SEMO_DEPLOY_CLIENT_ID NULL
-#endif
-#ifndef SEMO_DEPLOY_USER
-#define SEMO_DEPLOY_USER NULL
-#endif
-#ifndef SEMO_DEPLOY_PASSWORD_FILE
-#define SEMO_DEPLOY_PASSWORD_FILE NULL
-#endif
-#ifndef SEMO_DEPLOY_CA
-#define SEMO_DEPLOY_CA NULL
-#endif
-#ifndef SEMO_DEPLOY_CERT
-#define SEMO_DEPLOY_CERT NULL
-#endif
-#ifndef SEMO_DEPLOY_KEY
-#define SEMO_DEPLOY_KEY NULL
-#endif
-
 /* Who the robot is at the broker, into `o->identity`; with the MQTT
  * transport chosen, false (the problem printed) when the settings do not fit
  * together. */
@@ -1204,12 +1191,13 @@ static bool mqtt_identity(const char *prog, options *o)
 {
     semo_transport_config *net = &o->identity;
     net->broker_tls = o->broker_tls;
-    net->client_id = setting("SEMO_MQTT_CLIENT_ID", SEMO_DEPLOY_CLIENT_ID);
-    net->user = setting("SEMO_MQTT_USER", SEMO_DEPLOY_USER);
-    net->password_file = setting("SEMO_MQTT_PASSWORD_FILE", SEMO_DEPLOY_PASSWORD_FILE);
-    net->ca = setting("SEMO_MQTT_CA", SEMO_DEPLOY_CA);
-    net->cert = setting("SEMO_MQTT_CERT", SEMO_DEPLOY_CERT);
-    net->key = setting("SEMO_MQTT_KEY", SEMO_DEPLOY_KEY);
+    const semo_deploy_defaults *d = deployed();
+    net->client_id = setting("SEMO_MQTT_CLIENT_ID", d->client_id);
+    net->user = setting("SEMO_MQTT_USER", d->user);
+    net->password_file = setting("SEMO_MQTT_PASSWORD_FILE", d->password_file);
+    net->ca = setting("SEMO_MQTT_CA", d->ca);
+    net->cert = setting("SEMO_MQTT_CERT", d->cert);
+    net->key = setting("SEMO_MQTT_KEY", d->key);
     const char *problem = NULL;
     if (net->password_file && !net->user)
         problem = "a password file needs a user ($SEMO_MQTT_USER)";
@@ -1276,7 +1264,7 @@ static int parse_options(int argc, char **argv, options *o)
         return 2;
     }
     env = getenv("SEMO_BROKER");
-    if (!parse_broker(prog, env && *env ? env : DEFAULT_BROKER, o))
+    if (!parse_broker(prog, env && *env ? env : default_broker(), o))
         return 2;
     env = getenv("SEMO_RUN");
     if (!parse_run(prog, "SEMO_RUN", env && *env ? env : SEMO_RUN_DEFAULT, o))

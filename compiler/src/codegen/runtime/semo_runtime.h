@@ -155,6 +155,21 @@ typedef struct {
     const char *robot;
 } semo_peer;
 
+/* A threads robot's connection defaults, baked in by `semo build --deploy`
+ * (its `semo_deploy.h`, which the robot's generated main.c reads): the
+ * broker URL, and who the robot is there. NULL where the deployment gives
+ * none; options and environment variables override each. Kept out of the
+ * runtime's own sources, which every robot of a build shares. */
+typedef struct {
+    const char *broker;
+    const char *client_id;
+    const char *user;
+    const char *password_file;
+    const char *ca;
+    const char *cert;
+    const char *key;
+} semo_deploy_defaults;
+
 typedef struct {
     const char *mission; /* file name, for traces */
     const char *team;
@@ -175,6 +190,8 @@ typedef struct {
     /* The words of the program (SEMO_WORD values are indices into it). */
     const char *const *words;
     size_t word_count;
+    /* Threads targets: the connection defaults (NULL: none). */
+    const semo_deploy_defaults *deploy;
 } semo_program_desc;
 
 /* Runs the program: parses the command line (`--trace FILE`,
