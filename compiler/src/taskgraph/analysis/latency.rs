@@ -59,7 +59,7 @@
 //! in the level plus the firings under way and the source iterations whose
 //! sink firing has not ended yet.
 
-use super::level::{Lists, Level};
+use super::level::{Level, Lists};
 use super::ratio::Ratio;
 use super::throughput::{Concurrency, NoPeriod, throughput};
 use std::cmp::Reverse;
@@ -159,7 +159,9 @@ pub enum NoSelfTimed {
     },
     /// `node` fires without end at one instant (period 0: auto-concurrency
     /// without a cycle bounding it, or a cycle taking no time).
-    NoPace { node: usize },
+    NoPace {
+        node: usize,
+    },
     /// The period of a part could not be computed.
     Period(NoPeriod),
     /// More than [`MAX_WORK`] work units before the state repeated.
@@ -189,11 +191,11 @@ impl NoSelfTimed {
                 slowest_period,
                 source_period,
             } => format!(
-                "it grows without bound: `{}` takes {slowest_period} per iteration, but the source starts one every {source_period}, so samples pile up before it",
+                "`{}` takes {slowest_period} per iteration, but the source starts one every {source_period}: samples pile up before it and the latency grows every iteration",
                 name(*slowest)
             ),
             NoSelfTimed::RunsAhead { edge, ahead, pace } => format!(
-                "samples pile up on channel {}: `{}` runs ahead (one iteration every {ahead}, the sink's pace is {pace}), so the self-timed execution never repeats",
+                "samples pile up on channel {}: `{}` runs ahead (an iteration every {ahead}, where the sink's pace is {pace}), so the self-timed execution never repeats",
                 level.edges[*edge].label,
                 name(level.edges[*edge].src)
             ),
@@ -415,7 +417,9 @@ fn paces(
         .collect();
     let (part, parts) = crate::digraph::components(
         n,
-        edges.iter().map(|&i| (level.edges[i].src, level.edges[i].dst)),
+        edges
+            .iter()
+            .map(|&i| (level.edges[i].src, level.edges[i].dst)),
     );
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); parts];
     for v in (0..n).filter(|&v| inside[v]) {
@@ -683,7 +687,10 @@ impl<'n> Run<'n> {
         if net.single && !self.running[v].is_empty() {
             return false;
         }
-        if self.held.is_some_and(|(h, most)| h == v && self.started[v] >= most) {
+        if self
+            .held
+            .is_some_and(|(h, most)| h == v && self.started[v] >= most)
+        {
             return false;
         }
         net.inputs[v]
@@ -786,10 +793,8 @@ impl<'n> Watch<'n> {
         let (mut since, mut power) = (0u64, 1u64);
         let mut repeat: Option<(u64, u64)> = None; // (periodic_from, cycle)
         loop {
-            let (source_before, sink_before) = (
-                self.run.started[self.source],
-                self.run.completed[self.sink],
-            );
+            let (source_before, sink_before) =
+                (self.run.started[self.source], self.run.completed[self.sink]);
             self.run.instant()?;
             self.record(source_before, sink_before);
             if repeat.is_none() && self.run.started[self.source] > source_before {

@@ -157,7 +157,10 @@ fn a_faster_task_beside_the_source_runs_ahead() {
     // Z's samples are there when S's come: S 0–3, K 3–4.
     assert_eq!(l.minimal, 4);
     let why = l.self_timed.unwrap_err();
-    assert!(matches!(why, NoSelfTimed::RunsAhead { edge: 0, .. }), "{why:?}");
+    assert!(
+        matches!(why, NoSelfTimed::RunsAhead { edge: 0, .. }),
+        "{why:?}"
+    );
     let g2 = g.clone();
     assert!(
         why.describe(&level(&g2)).contains("Z.o → K.z"),
@@ -429,9 +432,8 @@ fn random_level() -> impl Strategy<Value = Random> {
             prop::collection::vec(0u64..=2, n - 1),
         )
             .prop_map(move |(gamma, wcet, extra, chain_tokens)| {
-                let mut edges: Vec<(usize, usize, u64, u64)> = (1..n)
-                    .map(|v| (v - 1, v, 1, chain_tokens[v - 1]))
-                    .collect();
+                let mut edges: Vec<(usize, usize, u64, u64)> =
+                    (1..n).map(|v| (v - 1, v, 1, chain_tokens[v - 1])).collect();
                 edges.extend(extra);
                 Random { gamma, wcet, edges }
             })
