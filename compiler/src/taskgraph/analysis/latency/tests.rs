@@ -281,6 +281,33 @@ impl<'l> Stepper<'l> {
         }
     }
 
+    fn can_start(&self, v: usize) -> bool {
+        let busy = self.running.iter().any(|&(u, _)| u == v);
+        let inputs_ok = self
+            .level
+            .edges
+            .iter()
+            .enumerate()
+            .all(|(i, e)| e.dst != v || self.tokens[i] >= e.consume);
+        !(self.single && busy) && inputs_ok && self.started[v] < self.most[v]
+    }
+
+    fn start(&mut self, v: usize) {
+        for (i, e) in self.level.edges.iter().enumerate() {
+            if e.dst == v {
+                self.tokens[i] -= e.consume;
+            }
+        }
+        self.started[v] += 1;
+        self.starts[v].push(self.time);
+        let wcet = self.level.nodes[v].wcet.unwrap_or(0);
+        if wcet == 0 {
+            self.end(v);
+        } else {
+            self.running.push((v, self.time + wcet));
+        }
+    }
+
     fn step(&mut self) {
         let now = self.time;
         let due: Vec<usize> = self
@@ -297,36 +324,12 @@ impl<'l> Stepper<'l> {
         let mut fired = vec![0; self.level.nodes.len()];
         loop {
             let mut any = false;
-            for v in 0..self.level.nodes.len() {
-                let busy = self.running.iter().any(|&(u, _)| u == v);
-                let inputs_ok = self
-                    .level
-                    .edges
-                    .iter()
-                    .enumerate()
-                    .all(|(i, e)| e.dst != v || self.tokens[i] >= e.consume);
-                if (self.single && busy)
-                    || !inputs_ok
-                    || self.started[v] >= self.most[v]
-                    || fired[v] >= burst
-                {
-                    continue;
+            for (v, count) in fired.iter_mut().enumerate() {
+                if *count < burst && self.can_start(v) {
+                    self.start(v);
+                    *count += 1;
+                    any = true;
                 }
-                for (i, e) in self.level.edges.iter().enumerate() {
-                    if e.dst == v {
-                        self.tokens[i] -= e.consume;
-                    }
-                }
-                fired[v] += 1;
-                self.started[v] += 1;
-                self.starts[v].push(now);
-                let wcet = self.level.nodes[v].wcet.unwrap_or(0);
-                if wcet == 0 {
-                    self.end(v);
-                } else {
-                    self.running.push((v, now + wcet));
-                }
-                any = true;
             }
             if !any {
                 break;
