@@ -584,6 +584,21 @@ fn every_file_argument_accepts_dash_for_standard_input() {
         assert!(!out.stdout.is_empty(), "{command:?}");
         assert_eq!(out.stdout, expected.stdout, "{command:?}");
     }
+    let tasks = ["--from", "A", "--to", "D"];
+    let file = [
+        "graph",
+        "latency",
+        "examples/taskgraphs/consistent.taskgraph.xml",
+    ];
+    let expected = semo(&[&file[..], &tasks].concat());
+    let out = semo_with_stdin(
+        &root,
+        &[&["graph", "latency", "-"][..], &tasks].concat(),
+        &graph,
+    );
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(out.stdout.contains("minimal latency: 0"), "{}", out.stdout);
+    assert_eq!(out.stdout, expected.stdout);
     // A graph's diagnostics name standard input.
     let out = semo_with_stdin(
         &root,
@@ -719,6 +734,11 @@ fn a_file_of_the_wrong_kind_is_refused_in_one_line_and_nothing_is_written() {
             "a task graph",
         );
     }
+    refused(
+        &["graph", "latency", &mission, "--from", "A", "--to", "B"],
+        "a mission script",
+        "a task graph",
+    );
     refused(
         &["graph", "analyze", &strategy],
         "a strategy file",

@@ -1,6 +1,7 @@
-//! `semo graph analyze|schedule|dot|svg`: a task graph's repetition vectors
-//! and deadlock freedom level by level with its diagnostics, its schedules,
-//! and pictures of it; `semo graph modes`: a mission's mode machines.
+//! `semo graph analyze|schedule|buffers|latency|dot|svg`: a task graph's
+//! repetition vectors and deadlock freedom level by level with its
+//! diagnostics, its schedules, buffer sizes and latencies, and pictures of
+//! it; `semo graph modes`: a mission's mode machines.
 
 use super::input::{self, Content};
 use super::output::{self, Format};
@@ -245,15 +246,11 @@ fn write_human(
 ) -> std::io::Result<()> {
     use std::fmt::Write as _;
     if !run.report.levels.is_empty() {
-        let meaning = match run.report.concurrency {
-            semo::taskgraph::analysis::Concurrency::Auto => {
-                "auto (a task fires concurrently with itself unless a self-loop channel limits it)"
-            }
-            semo::taskgraph::analysis::Concurrency::Single => {
-                "single (one firing of a task at a time)"
-            }
-        };
-        writeln!(out, "concurrency: {meaning}")?;
+        writeln!(
+            out,
+            "concurrency: {}",
+            concurrency_words(run.report.concurrency)
+        )?;
     }
     for level in &run.report.levels {
         let state = match (&level.repetition, level.deadlock_free) {
@@ -686,4 +683,220 @@ fn buffers_json(
         })),
     });
     output::write_json(out, &output::json_document("graph buffers", &[], data))
+}
+
+/// `semo graph latency`: the minimal and self-timed latency from one task of
+/// the graph's top level to another.
+pub fn latency(
+    path: &Path,
+    reading: GraphReading,
+    from: &str,
+    to: &str,
+    json: bool,
+    out: &mut impl Write,
+) -> i32 {
+    use semo::taskgraph::analysis::{hierarchy_levels, latency};
+    const COMMAND: &str = "graph latency";
+    let format = if json { Format::Json } else { Format::Human };
+    let Some((files, run)) = read_and_analyze(path, reading, "semo graph latency") else {
+        return 2;
+    };
+    let top = run.report.levels.first();
+    let counts = top
+        .filter(|l| l.deadlock_free == Some(true))
+        .and_then(|l| l.repetition.as_ref());
+    let (Some(graph), Some(counts), false) = (
+        run.graph.as_ref(),
+        counts,
+        run.diagnostics.iter().any(Diagnostic::is_error),
+    ) else {
+        let reported = output::report(
+            format,
+            COMMAND,
+            &files,
+            &run.diagnostics,
+            false,
+            serde_json::json!({ "error": { "reason": "errors", "message": "the graph has errors" } }),
+            out,
+        );
+        if let Err(code) = output::written(reported) {
+            return code;
+        }
+        let why = match top {
+            Some(l) if l.repetition.is_none() => "its rates are inconsistent",
+            Some(l) if l.deadlock_free == Some(false) => "an iteration deadlocks",
+            _ => "the file has errors",
+        };
+        eprintln!("error: {}: no latency: {why} (see above)", path.display());
+        return 1;
+    };
+    // The report's levels are these, in the same order; the top level's
+    // tasks standing for sub-graphs take their sub-graph's time.
+    let levels = hierarchy_levels(graph, &run.hierarchy);
+    let level = &levels[0];
+    let (source, sink) = match (task_node(level, from), task_node(level, to)) {
+        (Ok(s), Ok(k)) => (s, k),
+        (Err(message), _) | (_, Err(message)) => {
+            return output::refused(format, COMMAND, path, &message, out);
+        }
+    };
+    let concurrency = run.report.concurrency;
+    let found = latency::latency(level, counts, source, sink, concurrency);
+    let written = if json {
+        let data = latency_json(level, from, to, concurrency, &found);
+        let records = output::records(&files, &run.diagnostics);
+        output::write_json(out, &output::json_document(COMMAND, &records, data))
+    } else {
+        render::people(
+            Format::Human,
+            &files,
+            &run.diagnostics,
+            false,
+            &mut std::io::stderr().lock(),
+        )
+        .and_then(|()| latency_human(level, from, to, concurrency, &found, out))
+    };
+    if let Err(code) = output::written(written) {
+        return code;
+    }
+    match found {
+        Ok(_) => 0,
+        Err(why) => {
+            eprintln!(
+                "error: {}: no latency from `{from}` to `{to}`: {}",
+                path.display(),
+                why.why()
+            );
+            1
+        }
+    }
+}
+
+/// The node of the task named `name` in the top level, else why not.
+fn task_node(
+    level: &semo::taskgraph::analysis::level::Level<'_>,
+    name: &str,
+) -> Result<usize, String> {
+    if let Some(v) = level.nodes.iter().position(|n| n.name == name) {
+        return Ok(v);
+    }
+    let names = level.nodes.iter().map(|n| n.name.as_str());
+    let mut message = format!("no task `{name}` in the graph's top level");
+    if let Some(close) = semo::suggest::did_you_mean(name, names.clone()) {
+        message.push_str(&format!(" (did you mean `{close}`?)"));
+    } else if level.nodes.len() <= 12 {
+        let all: Vec<&str> = names.collect();
+        message.push_str(&format!(" (tasks: {})", all.join(", ")));
+    }
+    Err(message)
+}
+
+/// `S`'s firing `2k + 1`: which firing of a task with `count` firings per
+/// iteration starts or ends iteration `k`, `offset` after its first.
+fn firing_of_iteration(count: u64, offset: u64) -> String {
+    let k = if count == 1 {
+        "k".to_string()
+    } else {
+        format!("{count}k")
+    };
+    if offset == 0 {
+        k
+    } else {
+        format!("{k} + {offset}")
+    }
+}
+
+fn concurrency_words(concurrency: semo::taskgraph::analysis::Concurrency) -> &'static str {
+    match concurrency {
+        semo::taskgraph::analysis::Concurrency::Auto => {
+            "auto (a task fires concurrently with itself unless a self-loop channel limits it)"
+        }
+        semo::taskgraph::analysis::Concurrency::Single => "single (one firing of a task at a time)",
+    }
+}
+
+fn latency_human(
+    level: &semo::taskgraph::analysis::level::Level<'_>,
+    from: &str,
+    to: &str,
+    concurrency: semo::taskgraph::analysis::Concurrency,
+    found: &Result<
+        semo::taskgraph::analysis::latency::Latency,
+        semo::taskgraph::analysis::latency::NoLatency,
+    >,
+    out: &mut impl Write,
+) -> std::io::Result<()> {
+    use semo::taskgraph::analysis::latency::NoSelfTimed;
+    writeln!(out, "concurrency: {}", concurrency_words(concurrency))?;
+    let Ok(l) = found else {
+        return Ok(());
+    };
+    writeln!(
+        out,
+        "iteration k: from the start of {from}'s firing {} to the end of {to}'s firing {} ({to} fires {} time{} before {from} first does)",
+        firing_of_iteration(l.source_firings, 0),
+        firing_of_iteration(l.sink_firings, l.offset),
+        l.sink_firings_before,
+        if l.sink_firings_before == 1 { "" } else { "s" },
+    )?;
+    writeln!(out, "minimal latency: {}", l.minimal)?;
+    match &l.self_timed {
+        Ok(st) => writeln!(
+            out,
+            "self-timed latency: {} (the largest, first at iteration {}; the latencies repeat every {} iteration{} from iteration {} on at the latest)",
+            st.latency,
+            st.worst_iteration,
+            st.cycle,
+            if st.cycle == 1 { "" } else { "s" },
+            st.periodic_from,
+        ),
+        Err(why @ NoSelfTimed::Unbounded { .. }) => writeln!(
+            out,
+            "self-timed latency: unbounded: {}",
+            why.describe(level)
+        ),
+        Err(why) => writeln!(out, "self-timed latency: none: {}", why.describe(level)),
+    }
+}
+
+fn latency_json(
+    level: &semo::taskgraph::analysis::level::Level<'_>,
+    from: &str,
+    to: &str,
+    concurrency: semo::taskgraph::analysis::Concurrency,
+    found: &Result<
+        semo::taskgraph::analysis::latency::Latency,
+        semo::taskgraph::analysis::latency::NoLatency,
+    >,
+) -> serde_json::Value {
+    let mut data = serde_json::json!({
+        "from": from,
+        "to": to,
+        "concurrency": concurrency.as_str(),
+    });
+    let fields = match found {
+        Ok(l) => serde_json::json!({
+            "firings": { "from": l.source_firings, "to": l.sink_firings },
+            "sink_firings_before": l.sink_firings_before,
+            "offset": l.offset,
+            "minimal": l.minimal,
+            "self_timed": l.self_timed.as_ref().ok().map(|st| serde_json::json!({
+                "latency": st.latency,
+                "worst_iteration": st.worst_iteration,
+                "periodic_from": st.periodic_from,
+                "cycle": st.cycle,
+            })),
+            "no_self_timed": l.self_timed.as_ref().err().map(|why| serde_json::json!({
+                "reason": why.as_str(),
+                "message": why.describe(level),
+            })),
+        }),
+        Err(why) => serde_json::json!({
+            "error": { "reason": why.as_str(), "message": why.why() },
+        }),
+    };
+    if let (Some(all), serde_json::Value::Object(more)) = (data.as_object_mut(), fields) {
+        all.extend(more);
+    }
+    data
 }

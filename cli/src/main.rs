@@ -517,6 +517,24 @@ enum GraphCommand {
         #[command(flatten)]
         reading: ReadingArgs,
     },
+    /// The latency from one task of the graph's top level to another: the
+    /// minimal and the self-timed latency, as SDF3 defines them.
+    #[command(long_about = LATENCY_HELP)]
+    Latency {
+        /// A `*.taskgraph.xml` file or an SDF3 graph (`-`: standard input).
+        file: PathBuf,
+        /// The source task (a sensor's, say).
+        #[arg(long, value_name = "TASK")]
+        from: String,
+        /// The sink task (the actuator's command it causes).
+        #[arg(long, value_name = "TASK")]
+        to: String,
+        /// `human` or `json` (one document: diagnostics and the latencies).
+        #[arg(long, value_enum, default_value_t = DataFormat::Human)]
+        format: DataFormat,
+        #[command(flatten)]
+        reading: ReadingArgs,
+    },
     /// Print the graph in Graphviz DOT: tasks, loop nodes as clusters, rates
     /// and initial samples on channels (`semo graph dot g.taskgraph.xml | dot -Tsvg`).
     Dot {
@@ -549,6 +567,31 @@ enum GraphCommand {
         output: Option<PathBuf>,
     },
 }
+
+/// `semo graph latency --help`: the definitions computed.
+const LATENCY_HELP: &str = "The latency from one task of the graph's top level (--from, the \
+source) to another (--to, the sink), as SDF3 defines it (Stuijk et al.), the graph executed as \
+its throughput is: unbounded channels, each task firing as soon as its input samples are there \
+(--concurrency). Firings are numbered from 0; gamma is the repetition vector.
+
+Offset: with the source held back, the sink completes d firings fed by initial samples alone; \
+the source's iteration k (its firing gamma(source)*k) is closed by the sink's firing \
+gamma(sink)*k + delta, delta = floor(d/gamma(sink))*gamma(sink) + gamma(sink) - 1.
+
+Minimal latency: from that held-back state (everything idle), the source let go for one \
+iteration at time 0, the time at which the sink's firing delta ends, every firing as early as \
+possible: one iteration alone in an idle graph.
+
+Self-timed latency: in the self-timed execution from the initial samples, the largest, over \
+every iteration k, of the end of the sink's firing gamma(sink)*k + delta minus the start of the \
+source's firing gamma(source)*k (the transient included). It is unbounded where a task before \
+the sink is slower than the source; it is not computed where a task the source does not feed \
+runs ahead of the sink's pace (its samples pile up) or nothing bounds the pace.
+
+Only tasks the sink depends on count (for the minimal latency, those the source also feeds); \
+on a strongly connected graph this is SDF3's definition exactly. Exit status: 0 with a minimal \
+latency, 1 when there is none (no path from the source to the sink, a graph with errors, an \
+inconsistent or deadlocking graph, the work budget), 2 for an unknown task or file.";
 
 /// How an analysed graph file is read: its concurrency and, for SDF3 files,
 /// which execution time an actor has.
@@ -696,6 +739,20 @@ fn run() -> i32 {
             &file,
             reading.reading(),
             &throughput,
+            format == DataFormat::Json,
+            &mut out,
+        ),
+        Command::Graph(GraphCommand::Latency {
+            file,
+            from,
+            to,
+            format,
+            reading,
+        }) => graph::latency(
+            &file,
+            reading.reading(),
+            &from,
+            &to,
             format == DataFormat::Json,
             &mut out,
         ),

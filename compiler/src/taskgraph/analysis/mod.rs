@@ -6,6 +6,7 @@
 pub mod buffers;
 pub mod consistency;
 pub mod deadlock;
+pub mod latency;
 pub mod level;
 pub mod ratio;
 pub mod rules;
