@@ -165,7 +165,7 @@ impl Sim<'_> {
         }) else {
             return false;
         };
-        let Some(value) = (match &message.value.0 {
+        let Some(value) = (match &message.value {
             Some(v) => g.kind.coerce(v).map(Some),
             None => Some(None),
         }) else {
