@@ -330,7 +330,7 @@ struct Robot<'p> {
     pending_mode: Option<usize>,
     last_heartbeat: i64,
     /// Per peer: what its last heartbeat said (`comm_heard`).
-    heard: Vec<Heard>,
+    heard: Hearing,
     /// Whether the last election this robot decided named it (what its
     /// heartbeats say).
     leading: bool,
@@ -509,16 +509,7 @@ impl<'p> Robot<'p> {
             current_mode: None,
             pending_mode: None,
             last_heartbeat: at - m.heartbeat_ms,
-            // As the C's static table: heard at mission time 0, claiming
-            // nothing, battery unknown.
-            heard: vec![
-                Heard {
-                    seen: 0,
-                    leads: false,
-                    battery: None,
-                };
-                program.peers.len()
-            ],
+            heard: Hearing::new(team_peers(program)),
             leading: false,
             rejoining: m.heartbeat && at > m.heartbeat_ms,
             fenced: None,
@@ -1195,7 +1186,7 @@ impl<'p> Sim<'p> {
             };
             let heard = Heard::parse(self.now, text);
             if let Some(peer) = sender_peer(robot.program, message) {
-                robot.heard[peer] = heard;
+                robot.heard.set(peer, heard);
             }
             return;
         }
@@ -1864,7 +1855,7 @@ impl<'p> Sim<'p> {
                             .copied()
                             .unwrap_or(0)
                             < pass
-                        && now - robot.heard[peer].seen <= 3 * hb
+                        && now - robot.heard.get(peer).seen <= 3 * hb
                 });
                 let started = robot.regions[i].marks[*mark];
                 if waiting && now - started <= *timeout_ms {
@@ -2050,12 +2041,12 @@ impl<'p> Sim<'p> {
             return None;
         }
         let me = robot.program.self_peer;
-        let alive = |c: usize| c == me || now - robot.heard[c].seen <= 3 * hb;
+        let alive = |c: usize| c == me || now - robot.heard.get(c).seen <= 3 * hb;
         let level = |c: usize| {
             if c == me {
                 own_battery(robot, now)
             } else {
-                robot.heard[c].battery
+                robot.heard.get(c).battery
             }
         };
         let mut live = candidates.iter().copied().filter(|&c| alive(c));
@@ -2072,8 +2063,11 @@ impl<'p> Sim<'p> {
         };
         let mut leader = chosen.unwrap_or(me);
         if robot.rejoining && leader == me {
-            let claimant = (0..robot.heard.len())
-                .find(|&i| i != me && robot.heard[i].leads && now - robot.heard[i].seen <= 3 * hb);
+            let claimant = robot
+                .heard
+                .iter()
+                .find(|&(i, h)| i != me && h.leads && now - h.seen <= 3 * hb)
+                .map(|(i, _)| i);
             if let Some(c) = claimant {
                 leader = c;
             }
@@ -2084,7 +2078,7 @@ impl<'p> Sim<'p> {
             let lease = crate::codegen::lease_ms(hb);
             let heard = candidates
                 .iter()
-                .filter(|&&c| c == me || now - robot.heard[c].seen <= lease)
+                .filter(|&&c| c == me || now - robot.heard.get(c).seen <= lease)
                 .count();
             let robot = &mut self.robots[r];
             robot.leading = false;
@@ -2128,6 +2122,76 @@ impl<'p> Sim<'p> {
 /// no peer has this index.
 const FENCED: usize = usize::MAX;
 
+/// What each peer's last heartbeat said, kept for the peers of the robot's
+/// team, the only robots whose heartbeats reach it (published to the team
+/// under its alive key), so that each robot of a swarm does not hold a
+/// table of the whole swarm; a peer of another team heard is kept aside.
+/// A peer never heard reads as the C's static table: heard at mission
+/// time 0, claiming nothing, battery unknown.
+#[derive(Clone, Debug)]
+struct Hearing {
+    /// The peer index of `team[0]`.
+    first: usize,
+    team: Vec<Heard>,
+    /// Other peers heard, by peer index.
+    others: Vec<(usize, Heard)>,
+}
+
+impl Hearing {
+    fn new(team: std::ops::Range<usize>) -> Hearing {
+        Hearing {
+            first: team.start,
+            team: vec![Heard::NEVER; team.len()],
+            others: Vec::new(),
+        }
+    }
+
+    fn get(&self, peer: usize) -> Heard {
+        match self.team.get(peer.wrapping_sub(self.first)) {
+            Some(heard) => *heard,
+            None => self
+                .others
+                .binary_search_by_key(&peer, |(p, _)| *p)
+                .map_or(Heard::NEVER, |i| self.others[i].1),
+        }
+    }
+
+    fn set(&mut self, peer: usize, heard: Heard) {
+        if let Some(h) = self.team.get_mut(peer.wrapping_sub(self.first)) {
+            *h = heard;
+            return;
+        }
+        match self.others.binary_search_by_key(&peer, |(p, _)| *p) {
+            Ok(i) => self.others[i].1 = heard,
+            Err(i) => self.others.insert(i, (peer, heard)),
+        }
+    }
+
+    /// Every peer kept, in peer order (a peer not kept was never heard).
+    fn iter(&self) -> impl Iterator<Item = (usize, Heard)> + '_ {
+        let (first, end) = (self.first, self.first + self.team.len());
+        let before = self.others.iter().filter(move |(p, _)| *p < first);
+        let after = self.others.iter().filter(move |(p, _)| *p >= end);
+        before
+            .copied()
+            .chain((first..).zip(self.team.iter().copied()))
+            .chain(after.copied())
+    }
+}
+
+/// The peers of `program`'s team: its run of peers (teams are in
+/// formation order), found from its own place.
+fn team_peers(program: &RobotProgram) -> std::ops::Range<usize> {
+    let (peers, me) = (&program.peers, program.self_peer);
+    let same = |p: &usize| peers[*p].0 == program.team;
+    let start = (0..me).rev().take_while(same).last().unwrap_or(me);
+    let end = (me..peers.len())
+        .take_while(same)
+        .last()
+        .map_or(me, |p| p + 1);
+    start..end
+}
+
 /// What a robot's last heartbeat said (`comm_heartbeat` in the C).
 #[derive(Clone, Copy, Debug)]
 struct Heard {
@@ -2139,6 +2203,12 @@ struct Heard {
 }
 
 impl Heard {
+    const NEVER: Heard = Heard {
+        seen: 0,
+        leads: false,
+        battery: None,
+    };
+
     /// `heard_alive`: `leader 87` or `member -`.
     fn parse(now: i64, value: &str) -> Heard {
         let battery = value
@@ -2181,7 +2251,8 @@ impl Sim<'_> {
         let me = robot.program.self_peer;
         let now = self.now;
         let alive = |peer: usize| {
-            peer == me || now - robot.heard[peer].seen.max(robot.started_at) <= 3 * m.heartbeat_ms
+            peer == me
+                || now - robot.heard.get(peer).seen.max(robot.started_at) <= 3 * m.heartbeat_ms
         };
         let live: Vec<usize> = m.group.iter().copied().filter(|&p| alive(p)).collect();
         let rank = live.iter().position(|&p| p == me).unwrap_or(0);

@@ -440,7 +440,8 @@ impl Fingerprint {
         self.int(robot.current_mode.map_or(-1, |m| m as i64));
         self.int(robot.pending_mode.map_or(-1, |m| m as i64));
         self.time(robot.last_heartbeat);
-        for h in &robot.heard {
+        for (peer, h) in robot.heard.iter() {
+            self.int(peer as i64);
             self.time(h.seen);
             self.int(h.leads as i64);
             self.int(h.battery.unwrap_or(i64::MIN));
