@@ -109,7 +109,8 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         }
     }
     let run = replay.finish();
-    let verdicts = sim::expect::judge(&run, &scenario.expect);
+    let digest = sim::Digest::of(&run, &scenario.expect);
+    let verdicts = digest.verdicts();
     if let Some(path) = &options.svg {
         let picture = sim::svg::to_svg(&run, &programs, &scenario);
         if simulate::write_to(path, &picture, out) != 0 {
@@ -124,7 +125,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let writes_stdout = |p: &Option<PathBuf>| p.as_deref() == Some(Path::new("-"));
     if !writes_stdout(&options.svg) && !writes_stdout(&options.mcap) {
         let report = if options.json {
-            simulate::json_summary("replay", &run, &verdicts, &warnings)
+            simulate::json_summary("replay", &run, &digest, &verdicts, &warnings)
         } else {
             sim::replay_summary(&run, &verdicts, options.traces.len())
         };

@@ -125,7 +125,17 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         );
     }
     let programs = refined.programs;
-    let run = sim::simulate(
+    let robots = sim::Run::robots_of(&programs);
+    let mut digest = sim::Digest::new(&robots, &scenario.expect);
+    let mut trace = match TraceOut::open(options.trace.as_deref()) {
+        Ok(trace) => trace,
+        Err(code) => return code,
+    };
+    // The picture and the MCAP file read the whole trace; the summary, the
+    // expectations and the trace file take each event as it is made.
+    let keep = options.svg.is_some() || options.mcap.is_some();
+    let mut kept = Vec::new();
+    let mut run = sim::simulate_into(
         &programs,
         &scenario,
         &sim::Options {
@@ -133,13 +143,19 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             seed: options.seed,
             ..sim::Options::default()
         },
+        &mut |e| {
+            digest.see(&e);
+            trace.write(&e, &robots[e.robot].1, out);
+            if keep {
+                kept.push(e);
+            }
+        },
     );
-    let verdicts = sim::expect::judge(&run, &scenario.expect);
-    if let Some(path) = &options.trace
-        && write_to(path, &run.trace_lines(), out) != 0
-    {
+    run.trace = kept;
+    if trace.finish() != 0 {
         return 2;
     }
+    let verdicts = digest.verdicts();
     if let Some(path) = &options.svg {
         let picture = sim::svg::to_svg(&run, &programs, &scenario);
         if write_to(path, &picture, out) != 0 {
@@ -157,9 +173,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         .all(|p| !writes_stdout(p))
     {
         let report = if options.json {
-            json_summary("simulate", &run, &verdicts, &warnings)
+            json_summary("simulate", &run, &digest, &verdicts, &warnings)
         } else {
-            sim::summary(&run, &verdicts)
+            sim::summary_of(&run, &digest, &verdicts)
         };
         let _ = out.write_all(report.as_bytes());
     }
@@ -207,6 +223,81 @@ pub fn read_scenario(
     Some((scenario, warnings))
 }
 
+/// Where `--trace` writes the trace as the run makes it: a file (opened
+/// before the run, so that a bad path costs no simulation), standard
+/// output (`-`), or nowhere.
+enum TraceOut {
+    Nowhere,
+    Stdout,
+    File {
+        path: PathBuf,
+        file: std::io::BufWriter<std::fs::File>,
+        /// The first failed write, reported at the end.
+        failed: Option<std::io::Error>,
+    },
+}
+
+impl TraceOut {
+    fn open(path: Option<&Path>) -> Result<TraceOut, i32> {
+        match path {
+            None => Ok(TraceOut::Nowhere),
+            Some(path) if path == Path::new("-") => Ok(TraceOut::Stdout),
+            Some(path) => match std::fs::File::create(path) {
+                Ok(file) => Ok(TraceOut::File {
+                    path: path.to_path_buf(),
+                    file: std::io::BufWriter::new(file),
+                    failed: None,
+                }),
+                Err(e) => {
+                    eprintln!("error: {}: {e}", path.display());
+                    Err(2)
+                }
+            },
+        }
+    }
+
+    /// One event as its JSON line.
+    fn write(&mut self, e: &sim::TraceEvent, robot: &str, out: &mut impl Write) {
+        let line = |e: &sim::TraceEvent| {
+            let mut line = e.to_json(robot);
+            line.push('\n');
+            line
+        };
+        match self {
+            TraceOut::Nowhere => {}
+            TraceOut::Stdout => {
+                let _ = out.write_all(line(e).as_bytes());
+            }
+            TraceOut::File { file, failed, .. } => {
+                if failed.is_none()
+                    && let Err(error) = file.write_all(line(e).as_bytes())
+                {
+                    *failed = Some(error);
+                }
+            }
+        }
+    }
+
+    /// 0 when every line was written, else 2 with the error said.
+    fn finish(self) -> i32 {
+        let TraceOut::File {
+            path,
+            mut file,
+            failed,
+        } = self
+        else {
+            return 0;
+        };
+        match failed.map_or_else(|| file.flush(), Err) {
+            Ok(()) => 0,
+            Err(e) => {
+                eprintln!("error: {}: {e}", path.display());
+                2
+            }
+        }
+    }
+}
+
 /// Writes `text` to a file, or to standard output for `-`.
 pub fn write_to(path: &Path, text: &str, out: &mut impl Write) -> i32 {
     if path == Path::new("-") {
@@ -227,18 +318,18 @@ pub fn write_to(path: &Path, text: &str, out: &mut impl Write) -> i32 {
 pub fn json_summary(
     command: &str,
     run: &sim::Run,
+    digest: &sim::Digest,
     verdicts: &[sim::Verdict],
     warnings: &[Record],
 ) -> String {
-    let modes = sim::expect::modes_of_every_robot(run);
     let robots: Vec<serde_json::Value> = run
         .robots
         .iter()
-        .zip(modes)
+        .zip(digest.modes())
         .map(|((team, robot), modes)| {
             let modes: Vec<serde_json::Value> = modes
-                .into_iter()
-                .map(|(t, mode)| serde_json::json!({"t": t, "mode": mode}))
+                .iter()
+                .map(|(t, mode)| serde_json::json!({"t": t, "mode": &**mode}))
                 .collect();
             serde_json::json!({"team": team, "robot": robot, "modes": modes})
         })

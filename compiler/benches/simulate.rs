@@ -1,10 +1,13 @@
 //! The simulator (`semo simulate`): the scouting scenario (about 9 s of
 //! mission time until every robot finished, 3 robots; goal under 20 ms of
-//! wall time) and 102 robots of the generated benchmark mission for 10
-//! minutes of mission time (goal under 1 s), each with the cost per
-//! simulated event. Each is measured also with every control firing
-//! simulated (`Options::every_firing`), which skipping idle firings
-//! replaces. Run with `cargo bench --bench simulate`.
+//! wall time) and the generated benchmark mission for 10 minutes of
+//! mission time with 102 robots (goal under 1 s) and 1,002 robots (goal
+//! under 10 s), each with the cost per simulated event. The swarms run as
+//! `semo simulate` runs them: the trace streamed into the summary's digest
+//! (`sim::simulate_into`), not kept; the 1,002 robots once (a run takes
+//! tens of seconds). Scouting and the 102 robots are measured also with
+//! every control firing simulated (`Options::every_firing`), which skipping
+//! idle firings replaces. Run with `cargo bench --bench simulate`.
 
 mod common;
 use common::fastest;
@@ -12,7 +15,7 @@ use common::fastest;
 use semo::refine::RobotProgram;
 use semo::sim::{self, scenario};
 use std::path::Path;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 fn programs(files: semo::workspace::Files, id: semo::diag::FileId) -> Vec<RobotProgram> {
     let mut host = semo::host::AnalysisHost::default();
@@ -52,19 +55,66 @@ fn measure_once(
         seed: 1,
         every_firing,
     };
-    let run = sim::simulate(programs, &scenario, &options);
+    let (run, lines) = streamed(programs, &scenario, &options);
     let best = fastest(Duration::from_secs(3), || {
-        std::hint::black_box(sim::simulate(programs, &scenario, &options).events);
+        std::hint::black_box(streamed(programs, &scenario, &options));
     });
+    report(name, programs, &run, lines, best);
+}
+
+/// A run as `semo simulate` makes it without `--svg` or `--mcap`: each
+/// trace event into the digest of the summary and the expectations; the
+/// run and how many trace lines it made.
+fn streamed(
+    programs: &[RobotProgram],
+    scenario: &scenario::Scenario,
+    options: &sim::Options,
+) -> (sim::Run, usize) {
+    let robots = sim::Run::robots_of(programs);
+    let mut digest = sim::Digest::new(&robots, &scenario.expect);
+    let mut lines = 0;
+    let run = sim::simulate_into(programs, scenario, options, &mut |e| {
+        digest.see(&e);
+        lines += 1;
+    });
+    std::hint::black_box(sim::summary_of(&run, &digest, &digest.verdicts()));
+    (run, lines)
+}
+
+/// One streamed run of a long mission, timed once.
+fn measure_long(name: &str, programs: &[RobotProgram], until_ms: i64) {
+    let scenario = scenario::parse("{}", programs).expect("the scenario reads");
+    let options = sim::Options {
+        until_ms: Some(until_ms),
+        seed: 1,
+        every_firing: false,
+    };
+    let start = Instant::now();
+    let (run, lines) = streamed(programs, &scenario, &options);
+    report(name, programs, &run, lines, start.elapsed());
+}
+
+fn report(name: &str, programs: &[RobotProgram], run: &sim::Run, lines: usize, took: Duration) {
     println!(
-        "simulate {name}: {} robots, {} ms of mission time, {} events, {} trace lines: {:.2} ms ({:.0} ns per event)",
+        "simulate {name}: {} robots, {} ms of mission time, {} events, {lines} trace lines: {:.2} ms ({:.0} ns per event)",
         programs.len(),
         run.end_ms,
         run.events,
-        run.trace.len(),
-        best.as_secs_f64() * 1e3,
-        best.as_secs_f64() * 1e9 / run.events.max(1) as f64
+        took.as_secs_f64() * 1e3,
+        took.as_secs_f64() * 1e9 / run.events.max(1) as f64
     );
+}
+
+/// The generated benchmark mission of `teams` teams of six robots, each
+/// talking to its neighbouring teams.
+fn swarm(teams: usize) -> Vec<RobotProgram> {
+    let mut files = semo::workspace::Files::default();
+    let id = files.add(
+        "swarm.mission".into(),
+        semo::workspace::FileKind::Mission,
+        common::mission::generate(teams),
+    );
+    programs(files, id)
 }
 
 fn main() {
@@ -77,13 +127,7 @@ fn main() {
             .expect("the scenario fixture");
     measure("scouting", &scouting, &scenario, None);
 
-    // 17 teams of 6: 102 robots talking to their neighbouring teams.
-    let mut files = semo::workspace::Files::default();
-    let id = files.add(
-        "swarm.mission".into(),
-        semo::workspace::FileKind::Mission,
-        common::mission::generate(17),
-    );
-    let swarm = programs(files, id);
-    measure("swarm", &swarm, "{}", Some(10 * 60 * 1000));
+    let ten_minutes = 10 * 60 * 1000;
+    measure("swarm", &swarm(17), "{}", Some(ten_minutes));
+    measure_long("swarm of 1,002", &swarm(167), ten_minutes);
 }

@@ -39,7 +39,6 @@ use crate::refine::{
 };
 use rand_core::{Rng, SeedableRng};
 use rand_xorshift::XorShiftRng;
-use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
 
@@ -77,7 +76,8 @@ pub struct Run {
     /// Every robot, in formation order: (team, robot).
     pub robots: Vec<(String, String)>,
     pub trace: Vec<TraceEvent>,
-    /// When the run ended (every robot stopped, or the time limit).
+    /// When the run ended: when its last robot stopped for good (none
+    /// running and no restart to come), else the time limit.
     pub end_ms: i64,
     /// Events the engine processed (for the cost per event).
     pub events: u64,
@@ -87,14 +87,19 @@ impl Run {
     /// The run of `programs`' robots: its trace, end and event count.
     pub fn of(programs: &[RobotProgram], trace: Vec<TraceEvent>, end_ms: i64, events: u64) -> Run {
         Run {
-            robots: programs
-                .iter()
-                .map(|p| (p.team.clone(), p.robot.clone()))
-                .collect(),
+            robots: Run::robots_of(programs),
             trace,
             end_ms,
             events,
         }
+    }
+
+    /// The robots of a run of `programs`, in formation order: (team, robot).
+    pub fn robots_of(programs: &[RobotProgram]) -> Vec<(String, String)> {
+        programs
+            .iter()
+            .map(|p| (p.team.clone(), p.robot.clone()))
+            .collect()
     }
 }
 
@@ -111,7 +116,7 @@ enum Step {
 /// the instant), then deliveries, service completions, operator commands,
 /// and control firings last (a control firing sees everything that arrived
 /// by its time).
-#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Debug)]
 enum Event {
     Deliver {
         to: usize,
@@ -140,6 +145,54 @@ enum Event {
     },
 }
 
+/// An event in the queue under its place in the order: (time, kind, tie)
+/// packed into one number, so that the queue compares numbers only.
+#[derive(Clone, Debug)]
+struct Queued {
+    key: u128,
+    event: Event,
+}
+
+impl Queued {
+    fn new(at: i64, event: Event, tie: u64) -> Queued {
+        debug_assert!(tie < 1 << 56, "ties are counted from 0 by one");
+        // The time's sign bit flipped: times order as their numbers do.
+        let time = (at as u64 ^ 1 << 63) as u128;
+        let key = time << 64 | (event.order() as u128) << 56 | tie as u128;
+        Queued { key, event }
+    }
+
+    fn time(&self) -> i64 {
+        ((self.key >> 64) as u64 ^ 1 << 63) as i64
+    }
+
+    fn order(&self) -> u8 {
+        (self.key >> 56) as u8
+    }
+}
+
+/// The queue's order is the reverse of the keys' (`BinaryHeap` takes the
+/// greatest first).
+impl Ord for Queued {
+    fn cmp(&self, other: &Queued) -> std::cmp::Ordering {
+        other.key.cmp(&self.key)
+    }
+}
+
+impl PartialOrd for Queued {
+    fn partial_cmp(&self, other: &Queued) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl PartialEq for Queued {
+    fn eq(&self, other: &Queued) -> bool {
+        self.key == other.key
+    }
+}
+
+impl Eq for Queued {}
+
 impl Event {
     fn order(&self) -> u8 {
         match self {
@@ -167,7 +220,7 @@ struct Holding {
     key: Rc<str>,
 }
 
-#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Debug)]
 struct Message {
     publish: bool,
     from_team: Rc<str>,
@@ -175,42 +228,8 @@ struct Message {
     /// Index of the sender in the peers (operator: `None`).
     from_peer: Option<usize>,
     key: Rc<str>,
-    value: Payload,
+    value: Held,
     sent_at: i64,
-}
-
-/// A message's value. Events are ordered by (time, kind, sequence number),
-/// never by their payload, but the queue's element type needs an order:
-/// this one compares the value's JSON.
-#[derive(Clone, Debug)]
-struct Payload(Held);
-
-impl Payload {
-    fn key(&self) -> String {
-        let mut out = String::new();
-        super::trace::write_value(&mut out, self.0.as_ref());
-        out
-    }
-}
-
-impl PartialEq for Payload {
-    fn eq(&self, other: &Payload) -> bool {
-        self.key() == other.key()
-    }
-}
-
-impl Eq for Payload {}
-
-impl PartialOrd for Payload {
-    fn partial_cmp(&self, other: &Payload) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Payload {
-    fn cmp(&self, other: &Payload) -> std::cmp::Ordering {
-        self.key().cmp(&other.key())
-    }
 }
 
 /// A robot's names as its messages and trace carry them, shared rather
@@ -264,7 +283,7 @@ struct TaskState {
     /// unseen, as the generated control task's `request` drops a request
     /// still queued when its task was stopped before it fired.
     untaken: Option<Vec<Held>>,
-    service: String,
+    service: Rc<str>,
     /// Invalidates the completion of a call that was stopped.
     generation: u64,
     /// When the service graph's iteration the call runs ends (its
@@ -294,7 +313,7 @@ struct Robot<'p> {
     /// The receive task held up by a full channel ([`Holding`]), and the
     /// messages behind it, not yet taken from the transport.
     holding: Option<Holding>,
-    behind: VecDeque<Message>,
+    behind: VecDeque<Rc<Message>>,
     /// Per incoming message: its channel is stalled (the receive task gave
     /// up waiting for room in it; until the control task next takes from
     /// it, a message that finds it full is dropped at once).
@@ -311,7 +330,7 @@ struct Robot<'p> {
     pending_mode: Option<usize>,
     last_heartbeat: i64,
     /// Per peer: what its last heartbeat said (`comm_heard`).
-    heard: Vec<Heard>,
+    heard: Hearing,
     /// Whether the last election this robot decided named it (what its
     /// heartbeats say).
     leading: bool,
@@ -332,14 +351,15 @@ struct Robot<'p> {
     /// (`semo_group_set`); `None` before its first heartbeat.
     group: Option<(usize, usize)>,
     /// Service tasks by name (the `request_tasks` and those of action commands).
-    tasks: Vec<(String, TaskState)>,
+    tasks: Vec<(Rc<str>, TaskState)>,
     has_receiver: bool,
     /// Per slot fed by a sensor: its value's entries (at, value read as the
     /// sensor's type; `None` when the text is not one, which the sensor
     /// task skips: `semo_sim_sensor` is false), by time.
     sensor_series: Vec<Option<SensorSeries>>,
     battery: Vec<(i64, f64)>,
-    service_ms: HashMap<String, i64>,
+    /// The scenario's time of each service (the last entry of a name counts).
+    service_ms: Vec<(String, i64)>,
     /// Orders the control firings of robots at the same time: robots that
     /// started earlier fire first, as each firing schedules the next.
     chain: u64,
@@ -362,7 +382,7 @@ pub struct Sim<'p> {
     programs: &'p [RobotProgram],
     scenario: &'p Scenario,
     robots: Vec<Robot<'p>>,
-    queue: BinaryHeap<Reverse<(i64, u8, u64, Event)>>,
+    queue: BinaryHeap<Queued>,
     seq: u64,
     now: i64,
     rng: XorShiftRng,
@@ -384,6 +404,14 @@ pub struct Sim<'p> {
     /// A robot cut off from every other now (`semo verify`'s choice): as
     /// the scenario's partition `[[robot]]` from now on.
     isolated: Option<usize>,
+    /// How many robots run now (the run ends when none does and no restart
+    /// is to come): counted, so that no event asks every robot.
+    running: usize,
+    /// The scenario's restarts still in the queue.
+    restarts_due: usize,
+    /// The reason of a `drop` for a full channel, made once (a swarm drops
+    /// often).
+    channel_full: Rc<str>,
 }
 
 impl<'p> Robot<'p> {
@@ -411,16 +439,16 @@ impl<'p> Robot<'p> {
                 _ => None,
             })
             .collect();
-        let mut tasks: Vec<(String, TaskState)> = m
+        let mut tasks: Vec<(Rc<str>, TaskState)> = m
             .request_tasks
             .iter()
-            .map(|t| (t.clone(), TaskState::default()))
+            .map(|t| (t.as_str().into(), TaskState::default()))
             .collect();
         for am in &m.actions {
             for action in &am.actions {
                 for (task, _) in &action.commands {
-                    if !tasks.iter().any(|(t, _)| t == task) {
-                        tasks.push((task.clone(), TaskState::default()));
+                    if !tasks.iter().any(|(t, _)| **t == **task) {
+                        tasks.push((task.as_str().into(), TaskState::default()));
                     }
                 }
             }
@@ -481,16 +509,7 @@ impl<'p> Robot<'p> {
             current_mode: None,
             pending_mode: None,
             last_heartbeat: at - m.heartbeat_ms,
-            // As the C's static table: heard at mission time 0, claiming
-            // nothing, battery unknown.
-            heard: vec![
-                Heard {
-                    seen: 0,
-                    leads: false,
-                    battery: None,
-                };
-                program.peers.len()
-            ],
+            heard: Hearing::new(team_peers(program)),
             leading: false,
             rejoining: m.heartbeat && at > m.heartbeat_ms,
             fenced: None,
@@ -502,9 +521,7 @@ impl<'p> Robot<'p> {
             has_receiver: !m.incoming.is_empty() || !m.subscribed.is_empty() || m.heartbeat,
             sensor_series,
             battery: world.map(|w| w.battery.clone()).unwrap_or_default(),
-            service_ms: world
-                .map(|w| w.services.iter().cloned().collect())
-                .unwrap_or_default(),
+            service_ms: world.map(|w| w.services.clone()).unwrap_or_default(),
             chain: 0,
             next_fire: None,
             fire_token: 0,
@@ -517,8 +534,20 @@ impl<'p> Robot<'p> {
     fn task_index(&self, task: &str) -> usize {
         self.tasks
             .iter()
-            .position(|(t, _)| t == task)
+            .position(|(t, _)| **t == *task)
             .expect("every called task is listed when the robot starts")
+    }
+}
+
+/// The sender of `message` among `program`'s peers (robot names are unique
+/// in a mission): the sender's own index when the peers are the same
+/// mission's, found without reading every robot's name (a heartbeat is
+/// heard by the whole team, so a scan made a swarm's run quadratic).
+fn sender_peer(program: &RobotProgram, message: &Message) -> Option<usize> {
+    let named = |p: usize| *program.peers[p].1 == *message.from_robot;
+    match message.from_peer {
+        Some(p) if p < program.peers.len() && named(p) => Some(p),
+        _ => (0..program.peers.len()).find(|&p| named(p)),
     }
 }
 
@@ -562,6 +591,9 @@ impl<'p> Sim<'p> {
             last_fire: (-1, 0),
             every_firing: options.every_firing,
             isolated: None,
+            running: programs.len(),
+            restarts_due: 0,
+            channel_full: "channel full".into(),
         };
         for r in 0..programs.len() {
             sim.start(r);
@@ -575,6 +607,9 @@ impl<'p> Sim<'p> {
             if let FaultKind::Kill { at, .. } | FaultKind::Restart { at, .. } = fault.kind {
                 sim.schedule(at, Event::Fault(i));
             }
+            if let FaultKind::Restart { .. } = fault.kind {
+                sim.restarts_due += 1;
+            }
         }
         sim
     }
@@ -585,7 +620,7 @@ impl<'p> Sim<'p> {
             Event::Fire { robot, .. } => self.robots[robot].chain,
             _ => self.seq,
         };
-        self.queue.push(Reverse((at, event.order(), tie, event)));
+        self.queue.push(Queued::new(at, event, tie));
     }
 
     /// Puts robot `r`'s next control firing at `at` (a time of its grid).
@@ -621,9 +656,9 @@ impl<'p> Sim<'p> {
             r,
             "start",
             vec![
-                ("team", p.team.clone().into()),
-                ("type", p.robot_type.clone().into()),
-                ("mission", p.mission.clone().into()),
+                ("team", p.team.as_str().into()),
+                ("type", p.robot_type.as_str().into()),
+                ("mission", p.mission.as_str().into()),
             ],
         );
         self.seq += 1;
@@ -635,48 +670,59 @@ impl<'p> Sim<'p> {
     /// run is the instants before `until`: at `until` the robots still
     /// alive stop before anything else of that instant happens (as the
     /// generated program's main thread, first in the turns, stops it).
-    pub fn run(mut self, options: &Options) -> Run {
+    pub fn run(self, options: &Options) -> Run {
+        let mut trace = Vec::new();
+        let mut run = self.run_into(options, &mut |e| trace.push(e));
+        run.trace = trace;
+        run
+    }
+
+    /// [`Sim::run`] giving each trace event to `sink` as it is made, in
+    /// the trace's order, and keeping none: the run's `trace` is empty, so
+    /// that a run's memory follows its robots, not its length.
+    pub fn run_into(mut self, options: &Options, sink: &mut dyn FnMut(TraceEvent)) -> Run {
         let until = options
             .until_ms
             .or(self.scenario.duration_ms)
             .unwrap_or(DEFAULT_UNTIL_MS);
-        let events = self.advance(until);
-        if self.robots.iter().any(|r| r.alive) {
+        let events = self.advance(until, Some(sink));
+        if self.running > 0 || self.restarts_due > 0 {
+            // Still running, or every robot down with a restart to come
+            // after the run's end: the run lasted to its end.
             self.now = until;
-            for r in 0..self.robots.len() {
-                if self.robots[r].alive {
-                    self.stop(r);
-                }
+        }
+        for r in 0..self.robots.len() {
+            if self.robots[r].alive {
+                self.stop(r);
             }
         }
-        Run::of(self.programs, self.trace, self.now, events)
+        self.trace.drain(..).for_each(&mut *sink);
+        Run::of(self.programs, Vec::new(), self.now, events)
     }
 
     /// Handles the events of the instants before `until`, or until every
-    /// robot has stopped for good; returns how many it handled.
-    fn advance(&mut self, until: i64) -> u64 {
+    /// robot has stopped for good; returns how many it handled. With a
+    /// `sink`, the trace each event makes goes to it after the event.
+    fn advance(&mut self, until: i64, mut sink: Option<&mut dyn FnMut(TraceEvent)>) -> u64 {
         let mut events = 0u64;
-        while let Some(Reverse((t, ..))) = self.queue.peek() {
-            if *t >= until {
+        while let Some(t) = self.queue.peek().map(Queued::time) {
+            if t >= until {
                 break;
             }
-            let Some(Reverse((t, _, _, event))) = self.queue.pop() else {
+            let Some(Queued { event, .. }) = self.queue.pop() else {
                 break;
             };
             self.now = t;
             events += 1;
             self.handle(event);
-            if self.robots.iter().all(|r| !r.alive) && !self.restart_pending() {
+            if let Some(sink) = sink.as_mut() {
+                self.trace.drain(..).for_each(&mut **sink);
+            }
+            if self.running == 0 && self.restarts_due == 0 {
                 break;
             }
         }
         events
-    }
-
-    fn restart_pending(&self) -> bool {
-        self.queue.iter().any(|Reverse((_, _, _, e))| {
-            matches!(e, Event::Fault(i) if matches!(self.scenario.faults[*i].kind, FaultKind::Restart { .. }))
-        })
     }
 
     fn handle(&mut self, event: Event) {
@@ -748,15 +794,15 @@ impl<'p> Sim<'p> {
 
     fn operator(&mut self, i: usize) {
         let command = self.command(i).clone();
-        let message = Message {
+        let message = Rc::new(Message {
             publish: false,
             from_team: "USER".into(),
             from_robot: "USER".into(),
             from_peer: None,
             key: command.key.as_str().into(),
-            value: Payload(Some(Value::text(&command.value))),
+            value: Some(Value::text(&command.value)),
             sent_at: self.now,
-        };
+        });
         for r in 0..self.robots.len() {
             let p = self.robots[r].program;
             if (p.robot == command.to || p.team == command.to) && self.robots[r].alive {
@@ -780,6 +826,7 @@ impl<'p> Sim<'p> {
                 }
             }
             FaultKind::Restart { robot, .. } => {
+                self.restarts_due -= 1;
                 if let Some(r) = self.index_of(robot) {
                     self.restart(r);
                 }
@@ -792,6 +839,7 @@ impl<'p> Sim<'p> {
     pub(crate) fn kill(&mut self, r: usize) {
         if self.robots[r].alive {
             self.robots[r].alive = false;
+            self.running -= 1;
             self.emit(r, "fault", vec![("fault", "kill".into())]);
         }
     }
@@ -802,6 +850,7 @@ impl<'p> Sim<'p> {
         if !self.robots[r].alive {
             let epoch = self.robots[r].epoch + 1;
             self.robots[r] = Robot::new(self.robots[r].program, self.scenario, self.now, epoch);
+            self.running += 1;
             self.emit(r, "fault", vec![("fault", "restart".into())]);
             self.start(r);
         }
@@ -823,6 +872,7 @@ impl<'p> Sim<'p> {
             }
         }
         self.robots[r].alive = false;
+        self.running -= 1;
         self.trace_dropped(r);
         self.emit(r, "stop", Vec::new());
     }
@@ -966,7 +1016,7 @@ impl<'p> Sim<'p> {
             from_robot: self.names[r].heartbeat.clone(),
             from_peer: Some(program.self_peer),
             key,
-            value: Payload(value),
+            value,
             sent_at: self.now,
         });
         for &dst in targets.iter() {
@@ -1039,7 +1089,7 @@ impl<'p> Sim<'p> {
 
     /// A message reaches the robot: the receive task takes it, unless it is
     /// held up by a full channel (then it waits behind, in order).
-    fn deliver(&mut self, r: usize, message: &Message) {
+    fn deliver(&mut self, r: usize, message: &Rc<Message>) {
         if !self.robots[r].has_receiver {
             return; // no receive task reads the inbox
         }
@@ -1086,7 +1136,7 @@ impl<'p> Sim<'p> {
                 let fields = vec![
                     ("from", from),
                     ("key", key),
-                    ("reason", "channel full".into()),
+                    ("reason", self.channel_full.clone()),
                 ];
                 self.emit(r, "drop", fields);
             }
@@ -1120,7 +1170,7 @@ impl<'p> Sim<'p> {
                 ("from_robot", message.from_robot.clone()),
                 ("key", message.key.clone()),
             ],
-            value: Some(("value", message.value.0.clone())),
+            value: Some(("value", message.value.clone())),
             sent_at: Some(message.sent_at),
         });
         if self.shared_heard(r, message) {
@@ -1130,33 +1180,27 @@ impl<'p> Sim<'p> {
         let m = &robot.program.control;
         if m.heartbeat && message.publish && message.key == self.names[r].alive_key {
             // A heartbeat's value is text ("leader 80"); anything else says nothing.
-            let text = match &message.value.0 {
+            let text = match &message.value {
                 Some(Value::Text(t)) => t.as_str(),
                 _ => "",
             };
             let heard = Heard::parse(self.now, text);
-            for (i, (_, name)) in robot.program.peers.iter().enumerate() {
-                if **name == *message.from_robot {
-                    robot.heard[i] = heard;
-                }
+            if let Some(peer) = sender_peer(robot.program, message) {
+                robot.heard.set(peer, heard);
             }
             return;
         }
         // `heard_sync`: an arrival at a group statement; wakes the control task.
         if !m.sync_points.is_empty() && message.key == self.names[r].sync_key {
             // Its value is text ("<point> <pass>"); anything else says nothing.
-            let text = match &message.value.0 {
+            let text = match &message.value {
                 Some(Value::Text(t)) => t.as_str(),
                 _ => "",
             };
             let mut words = text.split(' ');
             let number = |w: Option<&str>| w.and_then(|w| w.parse::<i64>().ok()).unwrap_or(0);
             let (offset, pass) = (number(words.next()), number(words.next()));
-            let peer = robot
-                .program
-                .peers
-                .iter()
-                .position(|(_, name)| **name == *message.from_robot);
+            let peer = sender_peer(robot.program, message);
             let point = m.sync_points.iter().position(|&p| p as i64 == offset);
             if let (Some(peer), Some(point)) = (peer, point) {
                 let last = robot.sync_arrived.entry((peer, point)).or_insert(0);
@@ -1168,7 +1212,7 @@ impl<'p> Sim<'p> {
         if !m.subscribed.is_empty() && message.publish {
             for (i, g) in m.subscribed.iter().enumerate() {
                 if **g == *message.key {
-                    robot.groups[i] = Some(message.value.0.clone());
+                    robot.groups[i] = Some(message.value.clone());
                 }
             }
             return;
@@ -1180,7 +1224,7 @@ impl<'p> Sim<'p> {
         for (i, incoming) in m.incoming.iter().enumerate() {
             if *incoming.from_team == *message.from_team && *incoming.key == *message.key {
                 let kind = &m.slots[incoming.slot.index()].kind;
-                let Some(value) = (match &message.value.0 {
+                let Some(value) = (match &message.value {
                     Some(v) => kind.coerce(v).map(Some),
                     None => Some(None),
                 }) else {
@@ -1218,7 +1262,9 @@ impl<'p> Sim<'p> {
         let state = &mut self.robots[r].tasks[t].1;
         state.busy = true;
         state.untaken = Some(args);
-        state.service = service.to_string();
+        if *state.service != *service {
+            state.service = service.into();
+        }
         state.generation += 1;
         true
     }
@@ -1241,20 +1287,19 @@ impl<'p> Sim<'p> {
             Some(v) => v.clone(),
             None => Some(Value::text("")),
         };
-        let service = service.as_str();
-        let task = task.as_str();
-        let ms = self.robots[r]
+        let robot = &self.robots[r];
+        let ms = robot
             .service_ms
-            .get(service)
-            .copied()
-            .unwrap_or(DEFAULT_SERVICE_MS)
-            * self.robots[r].speed_scale(task);
-        let task_name: Rc<str> = task.into();
+            .iter()
+            .rev()
+            .find(|(s, _)| **s == *service)
+            .map_or(DEFAULT_SERVICE_MS, |(_, ms)| *ms)
+            * robot.speed_scale(&task);
         self.trace.push(TraceEvent {
             t: self.now,
             robot: r,
             event: "call_start",
-            fields: vec![("task", task_name.clone()), ("service", service.into())],
+            fields: vec![("task", task.clone()), ("service", service)],
             value: Some(("arg", arg.clone())),
             sent_at: None,
         });
@@ -1263,13 +1308,13 @@ impl<'p> Sim<'p> {
                 t: self.now,
                 robot: r,
                 event: "actuate",
-                fields: vec![("task", task_name)],
+                fields: vec![("task", task.clone())],
                 value: Some(("value", arg)),
                 sent_at: None,
             });
         }
         // The service's time counts from the end of the graph's iteration.
-        let until = self.run_graph(r, task);
+        let until = self.run_graph(r, &task);
         self.robots[r].tasks[t].1.graph_until = until;
         self.schedule(
             until + ms,
@@ -1284,10 +1329,7 @@ impl<'p> Sim<'p> {
     fn end_call(&mut self, r: usize, t: usize) {
         let (task, state) = &mut self.robots[r].tasks[t];
         state.busy = false;
-        let fields = vec![
-            ("task", task.as_str().into()),
-            ("service", state.service.as_str().into()),
-        ];
+        let fields = vec![("task", task.clone()), ("service", state.service.clone())];
         self.emit(r, "call_end", fields);
     }
 
@@ -1327,7 +1369,7 @@ impl<'p> Sim<'p> {
     // -------------------------------------------------------- the machine
 
     fn throw_event(&mut self, r: usize, event: &str) {
-        self.emit(r, "throw", vec![("name", event.to_string().into())]);
+        self.emit(r, "throw", vec![("name", event.into())]);
         let robot = &self.robots[r];
         let m = &robot.program.control;
         let Some(current) = robot.current_mode else {
@@ -1346,7 +1388,7 @@ impl<'p> Sim<'p> {
             self.emit(
                 r,
                 "catch",
-                vec![("name", event.to_string().into()), ("mode", mode.into())],
+                vec![("name", event.into()), ("mode", mode.into())],
             );
         }
     }
@@ -1358,7 +1400,11 @@ impl<'p> Sim<'p> {
             region.done = true;
         }
         self.robots[r].current_mode = Some(mode);
-        self.emit(r, "mode", vec![("mode", m.modes[mode].name.clone().into())]);
+        self.emit(
+            r,
+            "mode",
+            vec![("mode", m.modes[mode].name.as_str().into())],
+        );
         for (i, region) in m.modes[mode].regions.iter().enumerate() {
             let slot = &mut self.robots[r].regions[i];
             slot.service = Some(region.service);
@@ -1709,7 +1755,7 @@ impl<'p> Sim<'p> {
                     timeout_ms.is_some_and(|t| now - self.robots[r].regions[i].marks[*mark] > t);
                 if timed_out {
                     self.stop_task(r, task);
-                    self.emit(r, "timeout", vec![("service", service.clone().into())]);
+                    self.emit(r, "timeout", vec![("service", service.as_str().into())]);
                 } else if self.busy(r, task) {
                     return Step::Wait;
                 }
@@ -1740,13 +1786,13 @@ impl<'p> Sim<'p> {
                     self.emit(
                         r,
                         "actions_start",
-                        vec![("service", service.clone().into())],
+                        vec![("service", service.as_str().into())],
                     );
                 }
                 if let Some(t) = timeout_ms
                     && now - self.robots[r].regions[i].marks[*mark] > *t
                 {
-                    self.emit(r, "timeout", vec![("service", service.clone().into())]);
+                    self.emit(r, "timeout", vec![("service", service.as_str().into())]);
                     let region = self.region(r, i);
                     region.phase = 0;
                     region.pc = next;
@@ -1755,7 +1801,7 @@ impl<'p> Sim<'p> {
                 if self.actions(r, i, am) != Step::Done {
                     return Step::Wait;
                 }
-                self.emit(r, "actions_end", vec![("service", service.clone().into())]);
+                self.emit(r, "actions_end", vec![("service", service.as_str().into())]);
                 let region = self.region(r, i);
                 region.phase = 0;
                 region.pc = next;
@@ -1809,7 +1855,7 @@ impl<'p> Sim<'p> {
                             .copied()
                             .unwrap_or(0)
                             < pass
-                        && now - robot.heard[peer].seen <= 3 * hb
+                        && now - robot.heard.get(peer).seen <= 3 * hb
                 });
                 let started = robot.regions[i].marks[*mark];
                 if waiting && now - started <= *timeout_ms {
@@ -1995,12 +2041,12 @@ impl<'p> Sim<'p> {
             return None;
         }
         let me = robot.program.self_peer;
-        let alive = |c: usize| c == me || now - robot.heard[c].seen <= 3 * hb;
+        let alive = |c: usize| c == me || now - robot.heard.get(c).seen <= 3 * hb;
         let level = |c: usize| {
             if c == me {
                 own_battery(robot, now)
             } else {
-                robot.heard[c].battery
+                robot.heard.get(c).battery
             }
         };
         let mut live = candidates.iter().copied().filter(|&c| alive(c));
@@ -2017,8 +2063,11 @@ impl<'p> Sim<'p> {
         };
         let mut leader = chosen.unwrap_or(me);
         if robot.rejoining && leader == me {
-            let claimant = (0..robot.heard.len())
-                .find(|&i| i != me && robot.heard[i].leads && now - robot.heard[i].seen <= 3 * hb);
+            let claimant = robot
+                .heard
+                .iter()
+                .find(|&(i, h)| i != me && h.leads && now - h.seen <= 3 * hb)
+                .map(|(i, _)| i);
             if let Some(c) = claimant {
                 leader = c;
             }
@@ -2029,7 +2078,7 @@ impl<'p> Sim<'p> {
             let lease = crate::codegen::lease_ms(hb);
             let heard = candidates
                 .iter()
-                .filter(|&&c| c == me || now - robot.heard[c].seen <= lease)
+                .filter(|&&c| c == me || now - robot.heard.get(c).seen <= lease)
                 .count();
             let robot = &mut self.robots[r];
             robot.leading = false;
@@ -2073,6 +2122,76 @@ impl<'p> Sim<'p> {
 /// no peer has this index.
 const FENCED: usize = usize::MAX;
 
+/// What each peer's last heartbeat said, kept for the peers of the robot's
+/// team, the only robots whose heartbeats reach it (published to the team
+/// under its alive key), so that each robot of a swarm does not hold a
+/// table of the whole swarm; a peer of another team heard is kept aside.
+/// A peer never heard reads as the C's static table: heard at mission
+/// time 0, claiming nothing, battery unknown.
+#[derive(Clone, Debug)]
+struct Hearing {
+    /// The peer index of `team[0]`.
+    first: usize,
+    team: Vec<Heard>,
+    /// Other peers heard, by peer index.
+    others: Vec<(usize, Heard)>,
+}
+
+impl Hearing {
+    fn new(team: std::ops::Range<usize>) -> Hearing {
+        Hearing {
+            first: team.start,
+            team: vec![Heard::NEVER; team.len()],
+            others: Vec::new(),
+        }
+    }
+
+    fn get(&self, peer: usize) -> Heard {
+        match self.team.get(peer.wrapping_sub(self.first)) {
+            Some(heard) => *heard,
+            None => self
+                .others
+                .binary_search_by_key(&peer, |(p, _)| *p)
+                .map_or(Heard::NEVER, |i| self.others[i].1),
+        }
+    }
+
+    fn set(&mut self, peer: usize, heard: Heard) {
+        if let Some(h) = self.team.get_mut(peer.wrapping_sub(self.first)) {
+            *h = heard;
+            return;
+        }
+        match self.others.binary_search_by_key(&peer, |(p, _)| *p) {
+            Ok(i) => self.others[i].1 = heard,
+            Err(i) => self.others.insert(i, (peer, heard)),
+        }
+    }
+
+    /// Every peer kept, in peer order (a peer not kept was never heard).
+    fn iter(&self) -> impl Iterator<Item = (usize, Heard)> + '_ {
+        let (first, end) = (self.first, self.first + self.team.len());
+        let before = self.others.iter().filter(move |(p, _)| *p < first);
+        let after = self.others.iter().filter(move |(p, _)| *p >= end);
+        before
+            .copied()
+            .chain((first..).zip(self.team.iter().copied()))
+            .chain(after.copied())
+    }
+}
+
+/// The peers of `program`'s team: its run of peers (teams are in
+/// formation order), found from its own place.
+fn team_peers(program: &RobotProgram) -> std::ops::Range<usize> {
+    let (peers, me) = (&program.peers, program.self_peer);
+    let same = |p: &usize| peers[*p].0 == program.team;
+    let start = (0..me).rev().take_while(same).last().unwrap_or(me);
+    let end = (me..peers.len())
+        .take_while(same)
+        .last()
+        .map_or(me, |p| p + 1);
+    start..end
+}
+
 /// What a robot's last heartbeat said (`comm_heartbeat` in the C).
 #[derive(Clone, Copy, Debug)]
 struct Heard {
@@ -2084,6 +2203,12 @@ struct Heard {
 }
 
 impl Heard {
+    const NEVER: Heard = Heard {
+        seen: 0,
+        leads: false,
+        battery: None,
+    };
+
     /// `heard_alive`: `leader 87` or `member -`.
     fn parse(now: i64, value: &str) -> Heard {
         let battery = value
@@ -2126,7 +2251,8 @@ impl Sim<'_> {
         let me = robot.program.self_peer;
         let now = self.now;
         let alive = |peer: usize| {
-            peer == me || now - robot.heard[peer].seen.max(robot.started_at) <= 3 * m.heartbeat_ms
+            peer == me
+                || now - robot.heard.get(peer).seen.max(robot.started_at) <= 3 * m.heartbeat_ms
         };
         let live: Vec<usize> = m.group.iter().copied().filter(|&p| alive(p)).collect();
         let rank = live.iter().position(|&p| p == me).unwrap_or(0);

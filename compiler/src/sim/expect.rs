@@ -4,6 +4,7 @@ use super::engine::Run;
 use super::scenario::{ExpectKind, Expectation};
 use super::trace::TraceEvent;
 use crate::fasthash::FastMap;
+use std::rc::Rc;
 
 /// One expectation and whether the run met it, with the evidence.
 #[derive(Clone, Debug)]
@@ -24,135 +25,220 @@ pub fn modes(run: &Run, robot: usize) -> Vec<(i64, &str)> {
         .collect()
 }
 
-/// [`modes`] of every robot, indexed by robot, in one pass over the trace
-/// (asking [`modes`] robot by robot reads the trace once per robot: a
-/// thousand robots' summary took ten times as long as their simulation).
-pub fn modes_of_every_robot(run: &Run) -> Vec<Vec<(i64, &str)>> {
-    let mut modes = vec![Vec::new(); run.robots.len()];
-    for e in run.trace.iter().filter(|e| e.event == "mode") {
-        if let (Some(of), Some(mode)) = (modes.get_mut(e.robot), e.field("mode")) {
-            of.push((e.t, mode));
-        }
-    }
-    modes
-}
-
 /// Every expectation judged on the run, in order: the one judgement of a
 /// simulated run (`semo simulate`) and a recorded one (`semo replay`,
-/// [`super::replay`]). The trace is read once for every robot's modes and
-/// once for the messages received, whatever the number of expectations.
+/// [`super::replay`]), on the run's [`Digest`].
 pub fn judge(run: &Run, expectations: &[Expectation]) -> Vec<Verdict> {
-    let facts = Facts::of(run);
-    expectations
-        .iter()
-        .map(|x| {
-            let (met, why) = judge_one(run, &facts, &x.kind);
-            Verdict {
-                expectation: x.clone(),
-                met,
-                why,
-            }
-        })
-        .collect()
+    Digest::of(run, expectations).verdicts()
 }
 
-/// What the expectations read, gathered in one pass each.
-struct Facts<'r> {
-    robot_of: FastMap<&'r str, usize>,
+/// What the summary and the expectations read of a run, gathered from its
+/// trace one event at a time ([`Digest::see`]), so that a run written
+/// straight to a file is judged without keeping its trace: per robot its
+/// modes and its last word, and per `receives` expectation the first
+/// `receive` it names. Its size follows the robots, their modes and the
+/// expectations, not the trace.
+pub struct Digest<'a> {
+    robots: &'a [(String, String)],
+    expectations: &'a [Expectation],
+    robot_of: FastMap<&'a str, usize>,
     /// Per robot, the modes it entered with their times.
-    modes: Vec<Vec<(i64, &'r str)>>,
-    /// Per (robot, key), its `receive` lines in order.
-    received: FastMap<(usize, &'r str), Vec<&'r TraceEvent>>,
+    modes: Vec<Vec<(i64, Rc<str>)>>,
+    /// Per robot, its latest start, finish or kill.
+    words: Vec<Option<Word>>,
+    /// Per robot, the time of its latest trace line.
+    last_line: Vec<Option<i64>>,
+    /// Per robot, the `receives` expectations naming it.
+    receivers: Vec<Vec<usize>>,
+    /// Per expectation, the first receive it names: (time, value JSON).
+    received: Vec<Option<(i64, String)>>,
 }
 
-impl<'r> Facts<'r> {
-    fn of(run: &'r Run) -> Self {
-        let mut received: FastMap<(usize, &str), Vec<&TraceEvent>> = FastMap::default();
-        for e in run.trace.iter().filter(|e| e.event == "receive") {
-            if let Some(key) = e.field("key") {
-                received.entry((e.robot, key)).or_default().push(e);
+/// A robot's last word in the summary.
+#[derive(Clone, Copy)]
+enum Word {
+    Finished(i64),
+    Killed(i64),
+    Running,
+}
+
+impl<'a> Digest<'a> {
+    /// An empty digest of a run of `robots` judged on `expectations`.
+    pub fn new(robots: &'a [(String, String)], expectations: &'a [Expectation]) -> Digest<'a> {
+        let robot_of: FastMap<&str, usize> = robots
+            .iter()
+            .enumerate()
+            .map(|(i, (_, r))| (r.as_str(), i))
+            .collect();
+        let mut receivers = vec![Vec::new(); robots.len()];
+        for (x, expectation) in expectations.iter().enumerate() {
+            if let ExpectKind::Receives { robot, .. } = &expectation.kind
+                && let Some(&r) = robot_of.get(robot.as_str())
+            {
+                receivers[r].push(x);
             }
         }
-        Facts {
-            robot_of: run
-                .robots
-                .iter()
-                .enumerate()
-                .map(|(i, (_, r))| (r.as_str(), i))
-                .collect(),
-            modes: modes_of_every_robot(run),
-            received,
+        Digest {
+            robots,
+            expectations,
+            robot_of,
+            modes: vec![Vec::new(); robots.len()],
+            words: vec![None; robots.len()],
+            last_line: vec![None; robots.len()],
+            receivers,
+            received: vec![None; expectations.len()],
         }
     }
-}
 
-fn judge_one(run: &Run, facts: &Facts, kind: &ExpectKind) -> (bool, String) {
-    let robot_index = |robot: &str| facts.robot_of.get(robot).copied();
-    let modes = |r: usize| facts.modes[r].iter().copied();
-    match kind {
-        ExpectKind::Enters {
-            robot,
-            mode,
-            before,
-        } => {
-            let Some(r) = robot_index(robot) else {
-                return (false, format!("no robot {robot}"));
-            };
-            match modes(r).find(|(_, m)| m == mode) {
-                Some((t, _)) if before.is_none_or(|b| t <= b) => {
-                    (true, format!("entered at {t} ms"))
-                }
-                Some((t, _)) => (false, format!("entered only at {t} ms")),
-                None => (false, "never entered".into()),
-            }
+    /// The digest of a whole run's trace.
+    pub fn of(run: &'a Run, expectations: &'a [Expectation]) -> Digest<'a> {
+        let mut digest = Digest::new(&run.robots, expectations);
+        for e in &run.trace {
+            digest.see(e);
         }
-        ExpectKind::NeverEnters { robot, mode } => {
-            let Some(r) = robot_index(robot) else {
-                return (false, format!("no robot {robot}"));
-            };
-            match modes(r).find(|(_, m)| m == mode) {
-                Some((t, _)) => (false, format!("entered at {t} ms")),
-                None => (true, "never entered".into()),
-            }
+        digest
+    }
+
+    /// The next event of the trace.
+    pub fn see(&mut self, e: &TraceEvent) {
+        let r = e.robot;
+        if r >= self.robots.len() {
+            return;
         }
-        ExpectKind::Receives {
-            robot,
-            key,
-            from,
-            before,
-        } => {
-            let Some(r) = robot_index(robot) else {
-                return (false, format!("no robot {robot}"));
-            };
-            let received = facts
-                .received
-                .get(&(r, key.as_str()))
-                .into_iter()
-                .flatten()
-                .find(|e| {
-                    from.as_deref()
-                        .is_none_or(|f| e.field("from_robot") == Some(f))
-                });
-            match received {
-                Some(e) if before.is_none_or(|b| e.t <= b) => {
-                    (true, format!("received at {} ms: {}", e.t, e.value_json()))
-                }
-                Some(e) => (false, format!("received only at {} ms", e.t)),
-                None => (false, "never received".into()),
-            }
-        }
-        ExpectKind::AllEndIn { mode } => {
-            let mut wrong = Vec::new();
-            for ((_, robot), modes) in run.robots.iter().zip(&facts.modes) {
-                let last = modes.last().map(|(_, m)| *m);
-                if last != Some(mode.as_str()) {
-                    wrong.push(format!("{robot} ends in {}", last.unwrap_or("no mode")));
+        self.last_line[r] = Some(e.t);
+        match (e.event, e.field("fault")) {
+            ("mode", _) => {
+                if let Some((_, mode)) = e.fields.iter().find(|(k, _)| *k == "mode") {
+                    self.modes[r].push((e.t, mode.clone()));
                 }
             }
-            if wrong.is_empty() {
-                (true, format!("every robot ends in {mode}"))
-            } else {
-                (false, wrong.join(", "))
+            ("receive", _) => self.receive(e),
+            ("finish", _) => self.words[r] = Some(Word::Finished(e.t)),
+            ("fault", Some("kill")) => self.words[r] = Some(Word::Killed(e.t)),
+            ("start", _) => self.words[r] = Some(Word::Running),
+            _ => {}
+        }
+    }
+
+    /// A `receive`: the first that each expectation on its robot names.
+    fn receive(&mut self, e: &TraceEvent) {
+        let Some(key) = e.field("key") else {
+            return;
+        };
+        for &x in &self.receivers[e.robot] {
+            let ExpectKind::Receives {
+                key: wanted, from, ..
+            } = &self.expectations[x].kind
+            else {
+                continue;
+            };
+            let sender = from.as_deref();
+            if self.received[x].is_none()
+                && wanted == key
+                && sender.is_none_or(|f| e.field("from_robot") == Some(f))
+            {
+                self.received[x] = Some((e.t, e.value_json()));
+            }
+        }
+    }
+
+    /// Each robot's modes in order, with their times, indexed by robot.
+    pub fn modes(&self) -> &[Vec<(i64, Rc<str>)>] {
+        &self.modes
+    }
+
+    /// Each robot's last word, indexed by robot, for a run that ended at
+    /// `end_ms`: finished, killed, still running, or (a recorded run) no
+    /// trace line at all.
+    pub fn last_words(&self, end_ms: i64) -> Vec<String> {
+        self.words
+            .iter()
+            .zip(&self.last_line)
+            .map(|(word, last)| match (word, last) {
+                (Some(Word::Finished(t)), _) => format!("finished at {t} ms"),
+                (Some(Word::Killed(t)), _) => format!("killed at {t} ms"),
+                (Some(Word::Running), _) => format!("running at {end_ms} ms"),
+                (None, Some(t)) => format!("last line at {t} ms"),
+                (None, None) => "no trace line".to_string(),
+            })
+            .collect()
+    }
+
+    /// Every expectation judged, in order.
+    pub fn verdicts(&self) -> Vec<Verdict> {
+        self.expectations
+            .iter()
+            .enumerate()
+            .map(|(x, expectation)| {
+                let (met, why) = self.judge_one(x, &expectation.kind);
+                Verdict {
+                    expectation: expectation.clone(),
+                    met,
+                    why,
+                }
+            })
+            .collect()
+    }
+
+    fn judge_one(&self, x: usize, kind: &ExpectKind) -> (bool, String) {
+        let robot_index = |robot: &str| self.robot_of.get(robot).copied();
+        let entered = |r: usize, mode: &str| {
+            self.modes[r]
+                .iter()
+                .find(|(_, m)| **m == *mode)
+                .map(|(t, _)| *t)
+        };
+        match kind {
+            ExpectKind::Enters {
+                robot,
+                mode,
+                before,
+            } => {
+                let Some(r) = robot_index(robot) else {
+                    return (false, format!("no robot {robot}"));
+                };
+                match entered(r, mode) {
+                    Some(t) if before.is_none_or(|b| t <= b) => {
+                        (true, format!("entered at {t} ms"))
+                    }
+                    Some(t) => (false, format!("entered only at {t} ms")),
+                    None => (false, "never entered".into()),
+                }
+            }
+            ExpectKind::NeverEnters { robot, mode } => {
+                let Some(r) = robot_index(robot) else {
+                    return (false, format!("no robot {robot}"));
+                };
+                match entered(r, mode) {
+                    Some(t) => (false, format!("entered at {t} ms")),
+                    None => (true, "never entered".into()),
+                }
+            }
+            ExpectKind::Receives { robot, before, .. } => {
+                if robot_index(robot).is_none() {
+                    return (false, format!("no robot {robot}"));
+                }
+                match &self.received[x] {
+                    Some((t, value)) if before.is_none_or(|b| *t <= b) => {
+                        (true, format!("received at {t} ms: {value}"))
+                    }
+                    Some((t, _)) => (false, format!("received only at {t} ms")),
+                    None => (false, "never received".into()),
+                }
+            }
+            ExpectKind::AllEndIn { mode } => {
+                let mut wrong = Vec::new();
+                for ((_, robot), modes) in self.robots.iter().zip(&self.modes) {
+                    let last = modes.last().map(|(_, m)| &**m);
+                    if last != Some(mode.as_str()) {
+                        wrong.push(format!("{robot} ends in {}", last.unwrap_or("no mode")));
+                    }
+                }
+                if wrong.is_empty() {
+                    (true, format!("every robot ends in {mode}"))
+                } else {
+                    (false, wrong.join(", "))
+                }
             }
         }
     }

@@ -30,7 +30,7 @@ pub mod svg;
 pub mod trace;
 
 pub use engine::{DEFAULT_UNTIL_MS, Memory, Options, Run, Sim};
-pub use expect::Verdict;
+pub use expect::{Digest, Verdict};
 pub use scenario::{Scenario, ScenarioError};
 pub use trace::TraceEvent;
 
@@ -40,6 +40,19 @@ use std::fmt::Write;
 /// Runs every program on the scenario.
 pub fn simulate(programs: &[RobotProgram], scenario: &Scenario, options: &Options) -> Run {
     engine::Sim::new(programs, scenario, options).run(options)
+}
+
+/// [`simulate`] giving each trace event to `sink` as it is made, keeping
+/// none (the run's `trace` is empty): a long run's memory follows its
+/// robots, not its trace. Feed a [`Digest`] for the summary and the
+/// expectations.
+pub fn simulate_into(
+    programs: &[RobotProgram],
+    scenario: &Scenario,
+    options: &Options,
+    sink: &mut dyn FnMut(TraceEvent),
+) -> Run {
+    engine::Sim::new(programs, scenario, options).run_into(options, sink)
 }
 
 impl Run {
@@ -56,13 +69,19 @@ impl Run {
 
 /// The text summary: each robot's modes in order, then every expectation.
 pub fn summary(run: &Run, verdicts: &[Verdict]) -> String {
+    summary_of(run, &Digest::of(run, &[]), verdicts)
+}
+
+/// [`summary`] of a run whose trace went elsewhere as it was made
+/// ([`simulate_into`]), from its [`Digest`].
+pub fn summary_of(run: &Run, digest: &Digest, verdicts: &[Verdict]) -> String {
     let mut out = format!(
         "simulated {} robot(s) for {} ms of mission time ({} events)\n",
         run.robots.len(),
         run.end_ms,
         run.events
     );
-    robots_and_verdicts(&mut out, run, verdicts);
+    robots_and_verdicts(&mut out, run, digest, verdicts);
     out
 }
 
@@ -75,15 +94,14 @@ pub fn replay_summary(run: &Run, verdicts: &[Verdict], files: usize) -> String {
         run.events,
         run.end_ms
     );
-    robots_and_verdicts(&mut out, run, verdicts);
+    robots_and_verdicts(&mut out, run, &Digest::of(run, &[]), verdicts);
     out
 }
 
 /// Each robot's modes in order with its last word, then every expectation.
-fn robots_and_verdicts(out: &mut String, run: &Run, verdicts: &[Verdict]) {
-    let modes = expect::modes_of_every_robot(run);
-    let ends = last_words(run);
-    for (((team, robot), modes), end) in run.robots.iter().zip(&modes).zip(&ends) {
+fn robots_and_verdicts(out: &mut String, run: &Run, digest: &Digest, verdicts: &[Verdict]) {
+    let ends = digest.last_words(run.end_ms);
+    for (((team, robot), modes), end) in run.robots.iter().zip(digest.modes()).zip(&ends) {
         let modes: Vec<String> = modes.iter().map(|(t, m)| format!("{m}@{t}")).collect();
         let _ = writeln!(
             out,
@@ -108,46 +126,6 @@ fn robots_and_verdicts(out: &mut String, run: &Run, verdicts: &[Verdict]) {
             );
         }
     }
-}
-
-/// Each robot's last word, indexed by robot: finished, killed, still
-/// running, or (a recorded run) no trace line at all; found in one pass
-/// over the trace, from its end.
-fn last_words(run: &Run) -> Vec<String> {
-    let mut words: Vec<Option<String>> = vec![None; run.robots.len()];
-    // The time of each robot's last line, for one whose start is not in
-    // a recorded trace.
-    let mut last: Vec<Option<i64>> = vec![None; run.robots.len()];
-    let mut missing = words.len();
-    for e in run.trace.iter().rev() {
-        if missing == 0 {
-            break;
-        }
-        if let Some(t @ None) = last.get_mut(e.robot) {
-            *t = Some(e.t);
-        }
-        let Some(word @ None) = words.get_mut(e.robot) else {
-            continue;
-        };
-        *word = match (e.event, e.field("fault")) {
-            ("finish", _) => Some(format!("finished at {} ms", e.t)),
-            ("fault", Some("kill")) => Some(format!("killed at {} ms", e.t)),
-            ("start", _) => Some(format!("running at {} ms", run.end_ms)),
-            _ => None,
-        };
-        if word.is_some() {
-            missing -= 1;
-        }
-    }
-    words
-        .into_iter()
-        .zip(last)
-        .map(|(word, last)| match (word, last) {
-            (Some(word), _) => word,
-            (None, Some(t)) => format!("last line at {t} ms"),
-            (None, None) => "no trace line".to_string(),
-        })
-        .collect()
 }
 
 #[cfg(test)]

@@ -965,3 +965,109 @@ fn choices_made_while_running_are_the_scenario_entries_they_replay_as() {
     let memory = Memory::of(&programs);
     assert_eq!(copy.fingerprint(&memory), sim.fingerprint(&memory));
 }
+
+/// Robot crashes, a restart after every robot is down, and link faults.
+const FAULTS: &str = r#"{
+  "network": {"latency": 5, "loss": 0.1},
+  "faults": [
+    {"from": 300, "until": 1500, "drop": ["irobot", "ti"]},
+    {"from": 400, "until": 1100, "delay": ["irobot", "nxt"], "by": 120},
+    {"from": 600, "until": 900, "partition": [["ti"], ["nxt"]]},
+    {"at": 700, "kill": "nxt"},
+    {"at": 1000, "kill": "irobot"},
+    {"at": 1000, "kill": "ti"},
+    {"at": 1300, "restart": "nxt"},
+    {"at": 1600, "kill": "nxt"},
+    {"at": 3000, "restart": "ti"}
+  ]
+}"#;
+
+#[test]
+fn a_run_cut_by_until_is_the_start_of_the_whole_run_with_faults() {
+    let programs = programs("examples/scouting/scouting.mission");
+    let scenario = scenario::parse(FAULTS, &programs).unwrap();
+    let options = |until_ms: i64, every_firing: bool| Options {
+        until_ms: Some(until_ms),
+        seed: 3,
+        every_firing,
+    };
+    let whole = simulate(&programs, &scenario, &options(6000, false));
+    for until in [
+        300, 700, 701, 1000, 1001, 1300, 1600, 1601, 2000, 2999, 3000, 3001, 4500,
+    ] {
+        let cut = simulate(&programs, &scenario, &options(until, false));
+        let before = |run: &Run| -> Vec<String> {
+            run.trace
+                .iter()
+                .filter(|e| e.t < until)
+                .map(|e| e.to_json(&run.robots[e.robot].1))
+                .collect()
+        };
+        assert_eq!(before(&cut), before(&whole), "until {until}");
+        // At its end the robots still running stop, and nothing else happens.
+        assert!(
+            cut.trace
+                .iter()
+                .filter(|e| e.t >= until)
+                .all(|e| e.t == until && ["call_end", "dropped", "stop"].contains(&e.event)),
+            "until {until}"
+        );
+        // Every robot down with a restart to come still lasts the run to
+        // its end (it ended at whatever stale event came last).
+        assert_eq!(cut.end_ms, until, "until {until}");
+        let every = simulate(&programs, &scenario, &options(until, true));
+        assert_eq!(every.trace_lines(), cut.trace_lines(), "until {until}");
+        assert_eq!(every.end_ms, cut.end_ms, "until {until}");
+    }
+    // With no restart to come, a run ends when its last robot is down.
+    let no_restart = FAULTS.replace(
+        r#"{"at": 3000, "restart": "ti"}"#,
+        r#"{"at": 3000, "kill": "ti"}"#,
+    );
+    let scenario = scenario::parse(&no_restart, &programs).unwrap();
+    let run = simulate(&programs, &scenario, &options(6000, false));
+    assert_eq!(run.end_ms, 1600);
+}
+
+#[test]
+fn a_streamed_run_is_the_kept_run_and_its_digest_judges_it_alike() {
+    let programs = programs("examples/scouting/scouting.mission");
+    let expectations = r#""expect": [
+        {"robot": "ti", "enters": "RETURN_MODE", "before": 1000},
+        {"robot": "nxt", "never_enters": "FINISH"},
+        {"robot": "ti", "receives": "USER.RC_CMD", "before": 5},
+        {"robot": "ti", "receives": "USER.RC_CMD", "from": "irobot"},"#;
+    let scouting = scouting_scenario().replacen(r#""expect": ["#, expectations, 1);
+    let faults = FAULTS.replacen(
+        '{',
+        &format!("{{{expectations} {{\"all_end_in\": \"FINISH\"}}],"),
+        1,
+    );
+    for text in [scouting, faults] {
+        let scenario = scenario::parse(&text, &programs).unwrap_or_else(|e| panic!("{e:?}"));
+        let options = Options::default();
+        let kept = simulate(&programs, &scenario, &options);
+        let robots = Run::robots_of(&programs);
+        let mut digest = Digest::new(&robots, &scenario.expect);
+        let mut lines = String::new();
+        let streamed = simulate_into(&programs, &scenario, &options, &mut |e| {
+            digest.see(&e);
+            lines.push_str(&e.to_json(&robots[e.robot].1));
+            lines.push('\n');
+        });
+        assert!(streamed.trace.is_empty(), "nothing kept");
+        assert_eq!(lines, kept.trace_lines());
+        assert_eq!(
+            (streamed.end_ms, streamed.events),
+            (kept.end_ms, kept.events)
+        );
+        let verdicts = expect::judge(&kept, &scenario.expect);
+        let why = |v: &[Verdict]| v.iter().map(|v| (v.met, v.why.clone())).collect::<Vec<_>>();
+        assert_eq!(why(&digest.verdicts()), why(&verdicts));
+        assert!(verdicts.iter().any(|v| v.met) && verdicts.iter().any(|v| !v.met));
+        assert_eq!(
+            summary_of(&streamed, &digest, &verdicts),
+            summary(&kept, &verdicts)
+        );
+    }
+}

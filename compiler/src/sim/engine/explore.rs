@@ -14,19 +14,18 @@
 //! trace shows (how many messages a channel dropped, the ids of events) is
 //! left out too.
 
-use super::{Event, Held, Message, Robot, SENSOR_PERIOD_MS, Sim};
+use super::{Event, Held, Message, Queued, Robot, SENSOR_PERIOD_MS, Sim};
 use crate::refine::value::Value;
 use crate::refine::{RobotProgram, ServiceMachine, SlotSource, StateKind};
 use crate::sim::scenario::Command;
 use crate::sim::trace::TraceEvent;
-use std::cmp::Reverse;
 use std::hash::{DefaultHasher, Hasher};
 
 impl<'p> Sim<'p> {
     /// Runs the instants before `until`; the robots still alive then go on
     /// at `until`, where the world may choose before anything happens.
     pub fn run_to(&mut self, until: i64) {
-        self.advance(until);
+        self.advance(until, None);
         self.now = self.now.max(until);
     }
 
@@ -160,9 +159,10 @@ impl<'p> Sim<'p> {
         // The events still to come, in the order they will be handled;
         // those a robot will ignore (an earlier life's, a firing moved
         // earlier, a stopped call's end) are left out.
-        let mut queue: Vec<_> = self.queue.iter().map(|Reverse(e)| e).collect();
-        queue.sort_unstable();
-        for (t, order, _, event) in queue {
+        let mut queue: Vec<&Queued> = self.queue.iter().collect();
+        queue.sort_unstable_by_key(|q| q.key);
+        for queued in queue {
+            let (t, order, event) = (queued.time(), queued.order(), &queued.event);
             let live = match event {
                 Event::Fire {
                     robot,
@@ -188,8 +188,8 @@ impl<'p> Sim<'p> {
             if !live {
                 continue;
             }
-            fp.time(*t);
-            fp.int(*order as i64);
+            fp.time(t);
+            fp.int(order as i64);
             match event {
                 Event::Fire { robot, .. } | Event::GraphTrace { robot, .. } => {
                     fp.int(*robot as i64)
@@ -365,7 +365,7 @@ impl Fingerprint {
         self.text(&m.from_robot);
         self.int(m.from_peer.map_or(-1, |p| p as i64));
         self.text(&m.key);
-        self.held(&m.value.0);
+        self.held(&m.value);
         self.time(m.sent_at);
     }
 
@@ -440,7 +440,8 @@ impl Fingerprint {
         self.int(robot.current_mode.map_or(-1, |m| m as i64));
         self.int(robot.pending_mode.map_or(-1, |m| m as i64));
         self.time(robot.last_heartbeat);
-        for h in &robot.heard {
+        for (peer, h) in robot.heard.iter() {
+            self.int(peer as i64);
             self.time(h.seen);
             self.int(h.leads as i64);
             self.int(h.battery.unwrap_or(i64::MIN));

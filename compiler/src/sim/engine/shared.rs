@@ -38,7 +38,7 @@ impl Sim<'_> {
         };
         let lost_after = 3 * program.control.heartbeat_ms;
         let lives = |peer: usize| {
-            peer == program.self_peer || self.now - robot.heard[peer].seen <= lost_after
+            peer == program.self_peer || self.now - robot.heard.get(peer).seen <= lost_after
         };
         let was = robot.owner;
         if lives(was) {
@@ -51,7 +51,7 @@ impl Sim<'_> {
             if peer == program.self_peer {
                 super::own_battery(robot, self.now)
             } else {
-                robot.heard[peer].battery
+                robot.heard.get(peer).battery
             }
             .unwrap_or(-1)
         };
@@ -94,7 +94,7 @@ impl Sim<'_> {
         let program = robot.program;
         program.library.as_ref()?.ownership.as_ref()?;
         (robot.owner != program.self_peer)
-            .then(|| robot.heard[robot.owner].seen + 3 * program.control.heartbeat_ms + 1)
+            .then(|| robot.heard.get(robot.owner).seen + 3 * program.control.heartbeat_ms + 1)
     }
 
     /// `tell`: a write of global value `k` to the owner `to`, or to the team
@@ -165,7 +165,7 @@ impl Sim<'_> {
         }) else {
             return false;
         };
-        let Some(value) = (match &message.value.0 {
+        let Some(value) = (match &message.value {
             Some(v) => g.kind.coerce(v).map(Some),
             None => Some(None),
         }) else {
