@@ -815,15 +815,18 @@ fn concurrency_words(concurrency: semo::taskgraph::analysis::Concurrency) -> &'s
     }
 }
 
+/// What `graph latency` found between its two tasks.
+type LatencyFound = Result<
+    semo::taskgraph::analysis::latency::Latency,
+    semo::taskgraph::analysis::latency::NoLatency,
+>;
+
 fn latency_human(
     level: &semo::taskgraph::analysis::level::Level<'_>,
     from: &str,
     to: &str,
     concurrency: semo::taskgraph::analysis::Concurrency,
-    found: &Result<
-        semo::taskgraph::analysis::latency::Latency,
-        semo::taskgraph::analysis::latency::NoLatency,
-    >,
+    found: &LatencyFound,
     out: &mut impl Write,
 ) -> std::io::Result<()> {
     use semo::taskgraph::analysis::latency::NoSelfTimed;
@@ -864,10 +867,7 @@ fn latency_json(
     from: &str,
     to: &str,
     concurrency: semo::taskgraph::analysis::Concurrency,
-    found: &Result<
-        semo::taskgraph::analysis::latency::Latency,
-        semo::taskgraph::analysis::latency::NoLatency,
-    >,
+    found: &LatencyFound,
 ) -> serde_json::Value {
     let mut data = serde_json::json!({
         "from": from,

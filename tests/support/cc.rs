@@ -31,9 +31,8 @@ fn makefile_sources(folder: &Path) -> Sources {
             .map(str::to_string)
             .collect()
     };
-    let runtime_dir = folder
-        .join("../..")
-        .join(line("RUNTIME ?= ../../").concat());
+    // `RUNTIME ?= ../../semo-runtime`, relative to the robot folder.
+    let runtime_dir = folder.join(line("RUNTIME ?= ").concat());
     let mut own: Vec<(String, Vec<String>)> = line("SOURCES = ")
         .into_iter()
         .map(|s| (s, Vec::new()))
