@@ -93,6 +93,52 @@ fn two_robots_that_each_wait_for_the_other_wait_for_ever() {
     assert!(!out.stdout.contains("\"event\":\"send\""), "{}", out.stdout);
 }
 
+/// Two plans of one mode get their messages in one instant: the first
+/// throws and ends the mode before the second passes a value on (V005, on
+/// the throw, the send as related information), so the carrier waits for
+/// it for ever (V003). The counterexample replayed: the base throws and
+/// never sends to the carriers.
+#[test]
+fn a_throw_that_ends_the_mode_before_another_plan_sends_is_a_race() {
+    let dir = support::robots::scratch("verify-race");
+    let dir_text = dir.to_string_lossy().to_string();
+    let mission = "tests/fixtures/verify/plans_race/main.mission";
+    let (code, findings, data) = verify(mission, &["--counterexamples", &dir_text]);
+    assert_eq!(code, 1);
+    assert_eq!(data["exhaustive"], true, "{data}");
+    let found: Vec<(&str, u64)> = findings.iter().map(|(c, l, _)| (c.as_str(), *l)).collect();
+    assert_eq!(found, [("V003", 30), ("V005", 17)], "{findings:?}");
+    let race = &data["diagnostics"][1];
+    let message = race["message"].as_str().unwrap();
+    assert!(
+        message.contains("plan Listen") && message.contains("plan Forward"),
+        "{message}"
+    );
+    assert_eq!(race["related"][0]["line"], 22, "{race}");
+    // The replay: the base throws `located` and never sends the colour on.
+    let scenario = data["counterexamples"][1].as_str().unwrap().to_string();
+    assert!(
+        scenario.ends_with("main.V005-2.scenario.json"),
+        "{scenario}"
+    );
+    let out = semo(&["simulate", mission, "--scenario", &scenario, "--trace", "-"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let base: Vec<&str> = (out.stdout.lines())
+        .filter(|l| l.contains("\"robot\":\"base\""))
+        .collect();
+    assert!(
+        base.iter().any(|l| l.contains("\"name\":\"located\"")),
+        "{base:?}"
+    );
+    assert!(
+        !base.iter().any(|l| l.contains("\"to\":\"Carriers\"")),
+        "{base:?}"
+    );
+    // The cure of `semo explain V005`: one plan relays, then throws.
+    let (code, findings, _) = verify("tests/fixtures/verify/clean_relay/main.mission", &[]);
+    assert_eq!((code, findings), (0, Vec::new()));
+}
+
 #[test]
 fn the_repaired_missions_and_the_small_examples_have_no_finding() {
     for (mission, exhaustive) in [
@@ -473,6 +519,32 @@ fn random_findings_hold(
                 eprintln!("seed {seed}: V004 on line {line} replayed");
                 continue;
             }
+            if let Claim::Race {
+                robot,
+                thrower,
+                lost,
+            } = claim
+            {
+                let way = way.as_ref().expect("V005 has its way");
+                let scenario = way.scenario_json(&report.inputs, &programs);
+                let scenario = semo::sim::scenario::parse(&scenario, &programs).unwrap();
+                let mut sim =
+                    semo::sim::Sim::new(&programs, &scenario, &semo::sim::Options::default());
+                sim.watch_races();
+                sim.run_to(way.end_ms);
+                let races = sim.take_races();
+                assert!(
+                    races
+                        .iter()
+                        .any(|race| (race.robot, race.thrower, race.lost)
+                            == (*robot, *thrower, *lost)),
+                    "seed {seed}: the race of {} is not replayed by {races:?}\n{text}",
+                    programs[*robot].robot
+                );
+                held += 1;
+                eprintln!("seed {seed}: V005 replayed");
+                continue;
+            }
             for _ in 0..4 {
                 let way = way.as_ref().map_or(&[][..], |w| &w.choices[..]);
                 let seen = random_behaviour(&programs, &report.inputs, options, way, &mut rng);
@@ -495,7 +567,9 @@ fn random_findings_hold(
                         "seed {seed}: {} left its receive\n{text}",
                         programs[*robot].robot
                     ),
-                    Claim::TwoLeaders { .. } => unreachable!("replayed above"),
+                    Claim::TwoLeaders { .. } | Claim::Race { .. } => {
+                        unreachable!("replayed above")
+                    }
                 }
             }
             held += 1;

@@ -330,7 +330,9 @@ enum Command {
         from which it never finishes though it finishes in other behaviours (V002), and a \
         robot that can reach a `receive` where it waits for ever (V003). With --faults N the \
         world may also kill, restart or cut off robots, up to N times along a behaviour, and \
-        two robots leading one `leader(...)` statement at once is reported (V004). \
+        two robots leading one `leader(...)` statement at once is reported (V004). A \
+        plan's `throw` that ends its mode in the instant another plan of the mode would \
+        send or throw is reported too (V005: the plans' order decides a race). \
         --counterexamples DIR writes, per finding, the \
         scenario `semo simulate` replays to it (see docs/verify.md).\n\n\
         Exit status: 0 nothing found, 1 a finding, 2 bad input (mission errors, options)."

@@ -45,7 +45,10 @@ use std::rc::Rc;
 mod battery;
 mod explore;
 mod loops;
+mod races;
 mod shared;
+
+pub use races::Race;
 
 pub use explore::Memory;
 
@@ -412,6 +415,8 @@ pub struct Sim<'p> {
     /// The reason of a `drop` for a full channel, made once (a swarm drops
     /// often).
     channel_full: Rc<str>,
+    /// `semo verify`'s races, when it watches for them ([`Sim::watch_races`]).
+    races: Option<Vec<Race>>,
 }
 
 impl<'p> Robot<'p> {
@@ -594,6 +599,7 @@ impl<'p> Sim<'p> {
             running: programs.len(),
             restarts_due: 0,
             channel_full: "channel full".into(),
+            races: None,
         };
         for r in 0..programs.len() {
             sim.start(r);
@@ -1504,12 +1510,19 @@ impl<'p> Sim<'p> {
             }
             let mut result = Step::Next;
             let mut n = 0;
+            let mut pc = self.robots[r].regions[i].pc;
             while n < STEPS_PER_FIRING
                 && result == Step::Next
                 && self.robots[r].pending_mode.is_none()
             {
+                pc = self.robots[r].regions[i].pc;
                 result = self.step(r, i, service);
                 n += 1;
+            }
+            if self.robots[r].pending_mode.is_some() {
+                // This plan's throw ends the mode: the later plans do not
+                // run in this firing.
+                self.look_for_races(r, i, pc);
             }
             if result == Step::Done {
                 let region = &mut self.robots[r].regions[i];

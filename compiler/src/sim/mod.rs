@@ -29,7 +29,7 @@ pub mod scenario;
 pub mod svg;
 pub mod trace;
 
-pub use engine::{DEFAULT_UNTIL_MS, Memory, Options, Run, Sim};
+pub use engine::{DEFAULT_UNTIL_MS, Memory, Options, Race, Run, Sim};
 pub use expect::{Digest, Verdict};
 pub use scenario::{Scenario, ScenarioError};
 pub use trace::TraceEvent;

@@ -1071,3 +1071,49 @@ fn a_streamed_run_is_the_kept_run_and_its_digest_judges_it_alike() {
         );
     }
 }
+
+/// Races between plans (`semo verify`'s V005): the base's `Listen` throws
+/// in the instant its `Forward` would send the colour on; watching for
+/// races notes exactly that one and changes nothing of the run. With one
+/// plan relaying and then throwing, there is none.
+#[test]
+fn a_throw_that_ends_the_mode_before_a_later_plan_sends_is_noted_as_a_race() {
+    let races_of = |mission: &str| {
+        let programs = programs(mission);
+        let scenario = Scenario::default();
+        let mut watched = Sim::new(&programs, &scenario, &Options::default());
+        watched.watch_races();
+        watched.run_to(2_000);
+        let mut plain = Sim::new(&programs, &scenario, &Options::default());
+        plain.run_to(2_000);
+        let lines = |sim: &mut Sim| -> Vec<String> {
+            sim.take_trace().iter().map(|e| format!("{e:?}")).collect()
+        };
+        assert_eq!(lines(&mut watched), lines(&mut plain), "{mission}");
+        let said: Vec<String> = watched
+            .take_races()
+            .iter()
+            .map(|race| {
+                let m = &programs[race.robot].control;
+                let state = |(s, pc): (usize, usize)| m.services[s].states[pc].text.clone();
+                format!(
+                    "{} at {} in {}: {} before {}",
+                    programs[race.robot].robot,
+                    race.at,
+                    m.modes[race.mode].name,
+                    state(race.thrower),
+                    state(race.lost)
+                )
+            })
+            .collect();
+        said
+    };
+    assert_eq!(
+        races_of("tests/fixtures/verify/plans_race/main.mission"),
+        ["base at 10 in RELAY: throw located before send(Carriers, Scouts.COLOR)"]
+    );
+    assert_eq!(
+        races_of("tests/fixtures/verify/clean_relay/main.mission"),
+        Vec::<String>::new()
+    );
+}

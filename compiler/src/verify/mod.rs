@@ -14,7 +14,10 @@
 //! a state as a scenario `semo simulate` replays. With faults (`--faults
 //! N`: kills, restarts, a robot cut off), also: no two robots lead one
 //! `leader(...)` statement at once (V004), judged on every state seen (a
-//! state found is a witness, bounded search or not).
+//! state found is a witness, bounded search or not). And on every step:
+//! a plan's `throw` never ends its mode in the instant another plan of the
+//! mode would send or throw (V005, a race the plans' order decides:
+//! `sim::Race`).
 
 mod inputs;
 mod search;
@@ -173,6 +176,14 @@ pub enum Claim {
         line: u32,
         robots: (usize, usize),
     },
+    /// At the counterexample's last instants, robot `robot`'s throw at
+    /// (service, state) `thrower` ends its mode in the instant its send or
+    /// throw at `lost` would have run.
+    Race {
+        robot: usize,
+        thrower: (usize, usize),
+        lost: (usize, usize),
+    },
 }
 
 /// What a search found and how far it looked.
@@ -328,6 +339,46 @@ pub fn verify(
             team: team.clone(),
             line: *line,
             robots: (*a, *b),
+        });
+    }
+    for (race, way) in &explored.races {
+        let program = &programs[race.robot];
+        let m = &program.control;
+        let plan = |service: usize| {
+            m.modes[race.mode]
+                .regions
+                .iter()
+                .find(|region| region.service == service)
+                .map_or_else(|| m.services[service].name.clone(), |r| r.plan.clone())
+        };
+        let thrower = &m.services[race.thrower.0].states[race.thrower.1];
+        let lost = &m.services[race.lost.0].states[race.lost.1];
+        let mut finding = Diagnostic::new(
+            Code::PlansRace,
+            file,
+            thrower.span,
+            format!(
+                "at {} ms {}'s plan {} ends mode {} here, in the instant its plan {} would run `{}` (line {}), which so never runs: the plans of a mode run in the order of its `set`s, and that order alone decides which happens{}",
+                race.at,
+                program.robot,
+                plan(race.thrower.0),
+                m.modes[race.mode].name,
+                plan(race.lost.0),
+                lost.text.trim(),
+                lost.line,
+                faults_aside(way, programs)
+            ),
+        );
+        finding.relate(
+            lost.span,
+            format!("this does not run at {} ms: the mode ends first", race.at),
+        );
+        findings.push(finding);
+        counterexamples.push(Some(way.clone()));
+        claims.push(Claim::Race {
+            robot: race.robot,
+            thrower: race.thrower,
+            lost: race.lost,
         });
     }
     Ok(Report {

@@ -9,7 +9,7 @@
 use super::inputs::Inputs;
 use super::{Choice, Counterexample, Options, World};
 use crate::refine::RobotProgram;
-use crate::sim::{self, Memory, Scenario, Sim};
+use crate::sim::{self, Memory, Race, Scenario, Sim};
 use std::collections::{HashMap, HashSet};
 
 /// What the search saw, for the properties to judge.
@@ -40,6 +40,10 @@ pub struct Explored {
     /// lead at once in some state: the two, and the shortest way there.
     /// A state seen is a witness: judged bounded or not.
     pub two_leaders: Vec<TwoLeaders>,
+    /// Per race between two plans of one mode (the team and the two
+    /// statements): its first instant met and the shortest way there. A
+    /// race seen is a witness: judged bounded or not.
+    pub races: Vec<(Race, Counterexample)>,
 }
 
 /// A `leader(...)` statement (team, mission line), the two robots that
@@ -70,7 +74,8 @@ struct Node {
 pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) -> Explored {
     let scenario = Scenario::default();
     let memory = Memory::of(programs);
-    let root = Sim::new(programs, &scenario, &sim::Options::default());
+    let mut root = Sim::new(programs, &scenario, &sim::Options::default());
+    root.watch_races();
     let mut explored = Explored {
         states: 0,
         transitions: 0,
@@ -83,7 +88,10 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
         stuck: Vec::new(),
         waits_for_ever: Vec::new(),
         two_leaders: Vec::new(),
+        races: Vec::new(),
     };
+    // (team, thrower's statement, lost statement) → the race.
+    let mut races: HashMap<(&str, u32, u32), (Race, Counterexample)> = HashMap::new();
     let mut nodes: Vec<Node> = Vec::new();
     let mut seen: HashMap<u128, u32> = HashMap::new();
     let mut edges: Vec<(u32, u32)> = Vec::new();
@@ -137,6 +145,22 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
                 apply(&mut child, &mut child_world, inputs, &choice);
                 child.run_to(next_t);
                 explored.transitions += 1;
+                for race in child.take_races() {
+                    let statement = |(service, state): (usize, usize)| {
+                        programs[race.robot].control.services[service].states[state]
+                            .span
+                            .start as u32
+                    };
+                    let at = (
+                        programs[race.robot].team.as_str(),
+                        statement(race.thrower),
+                        statement(race.lost),
+                    );
+                    // Breadth first: the first met is the shallowest.
+                    races
+                        .entry(at)
+                        .or_insert_with(|| (race, counterexample(&nodes, id, &choice, t, next_t)));
+                }
                 for e in child.take_trace() {
                     // What a robot does (not what merely reaches it): it
                     // left any `receive` it waited in, or works beside it.
@@ -206,6 +230,10 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
         })
         .collect();
     explored.two_leaders.sort_by(|a, b| a.0.cmp(&b.0));
+    explored.races = races.into_values().collect();
+    explored
+        .races
+        .sort_by_key(|(race, _)| (race.robot, race.thrower, race.lost));
     if explored.exhaustive {
         let graph = Graph {
             nodes: &nodes,
