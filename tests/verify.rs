@@ -139,6 +139,81 @@ fn a_throw_that_ends_the_mode_before_another_plan_sends_is_a_race() {
     assert_eq!((code, findings), (0, Vec::new()));
 }
 
+/// The user's properties (a scenario's `expect`: `always`, `eventually`,
+/// `leads_to` and the one-run expectations without a deadline), judged
+/// over every behaviour: each broken one with a scenario whose replay by
+/// `semo simulate` breaks the same property; the repaired mission keeps
+/// what the race broke. A deadline is refused at its position.
+#[test]
+fn the_users_properties_are_judged_over_every_behaviour_and_broken_ones_replay() {
+    let properties = "tests/fixtures/verify/plans_race/properties.json";
+    for (mission, verdicts) in [
+        (
+            "tests/fixtures/verify/plans_race/main.mission",
+            ["broken", "broken", "broken", "holds", "broken"],
+        ),
+        (
+            "tests/fixtures/verify/clean_relay/main.mission",
+            ["holds", "holds", "broken", "holds", "broken"],
+        ),
+    ] {
+        let dir = support::robots::scratch("verify-properties");
+        let dir_text = dir.to_string_lossy().to_string();
+        let (code, _, data) = verify(
+            mission,
+            &["--expect", properties, "--counterexamples", &dir_text],
+        );
+        assert_eq!(code, 1, "{data}");
+        let judged = data["properties"].as_array().unwrap();
+        let said: Vec<&str> = judged
+            .iter()
+            .map(|p| p["verdict"].as_str().unwrap())
+            .collect();
+        assert_eq!(said, verdicts, "{mission}: {data}");
+        for property in judged {
+            // Exhaustive: a proof either way.
+            assert_eq!(property["proof"], true, "{property}");
+            let Some(scenario) = property["counterexample"].as_str() else {
+                assert_eq!(property["verdict"], "holds", "{property}");
+                continue;
+            };
+            let out = semo(&[
+                "simulate",
+                mission,
+                "--scenario",
+                scenario,
+                "--format",
+                "json",
+            ]);
+            assert_eq!(out.code, 1, "{}{}", out.stdout, out.stderr);
+            let run: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+            let replayed = &run["expectations"][0];
+            assert_eq!(replayed["expectation"], property["expectation"], "{run}");
+            assert_eq!(replayed["met"], false, "{run}");
+        }
+    }
+    let dir = support::robots::scratch("verify-properties-refused");
+    let deadline = dir.join("deadline.json");
+    std::fs::write(
+        &deadline,
+        "{\"expect\": [\n  {\"robot\": \"base\", \"enters\": \"DONE\", \"before\": 100}\n]}",
+    )
+    .unwrap();
+    let out = semo(&[
+        "verify",
+        "tests/fixtures/verify/plans_race/main.mission",
+        "--expect",
+        &deadline.to_string_lossy(),
+    ]);
+    assert_eq!(out.code, 2, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stderr
+            .contains("deadline.json:2:3: a deadline (\"before\")"),
+        "{}",
+        out.stderr
+    );
+}
+
 #[test]
 fn the_repaired_missions_and_the_small_examples_have_no_finding() {
     for (mission, exhaustive) in [
@@ -375,6 +450,18 @@ fn random_behaviour(
     prefix: &[(i64, semo::verify::Choice)],
     rng: &mut support::missiongen::Rng,
 ) -> Behaviour {
+    random_behaviour_seen(programs, inputs, options, prefix, rng, &mut |_| {})
+}
+
+/// [`random_behaviour`], each trace event also given to `see`.
+fn random_behaviour_seen(
+    programs: &[semo::refine::RobotProgram],
+    inputs: &semo::verify::Inputs,
+    options: &semo::verify::Options,
+    prefix: &[(i64, semo::verify::Choice)],
+    rng: &mut support::missiongen::Rng,
+    see: &mut dyn FnMut(&semo::sim::TraceEvent),
+) -> Behaviour {
     use semo::verify::Choice;
     let empty = semo::sim::Scenario::default();
     let mut sim = semo::sim::Sim::new(programs, &empty, &semo::sim::Options::default());
@@ -385,8 +472,9 @@ fn random_behaviour(
         acted: vec![false; programs.len()],
         waiting: Vec::new(),
     };
-    let note = |sim: &mut semo::sim::Sim, seen: &mut Behaviour, after_prefix: bool| {
+    let mut note = |sim: &mut semo::sim::Sim, seen: &mut Behaviour, after_prefix: bool| {
         for e in sim.take_trace() {
+            see(&e);
             if let (true, Some(mode)) = (e.event == "mode", e.field("mode")) {
                 seen.entered
                     .push((programs[e.robot].team.clone(), mode.to_string()));
@@ -576,6 +664,127 @@ fn random_findings_hold(
         }
     }
     (missions, exhaustive, held)
+}
+
+/// The user's properties over random missions: random `always`,
+/// `eventually` and `leads_to` about the missions' robots and modes. Each
+/// broken one's scenario, replayed by the simulator, breaks it (the same
+/// judgement `semo simulate` makes); each `always` that holds holds in
+/// random behaviours of the same world too.
+#[test]
+fn properties_on_random_missions_replay_broken_and_hold_in_random_behaviours() {
+    use semo::sim::scenario::{Condition, ExpectKind, Expectation};
+    let options = semo::verify::Options {
+        horizon_ms: 10_000,
+        max_states: 3_000,
+        changes: 1,
+        ..semo::verify::Options::default()
+    };
+    let mut rng = support::missiongen::Rng::new(11);
+    let (mut broken, mut held, mut proved) = (0, 0, 0);
+    for (seed, text, programs, id) in random_missions("verify-properties-random", 200..216) {
+        if programs.iter().any(|p| p.control.modes.is_empty()) {
+            continue;
+        }
+        let some_mode = |rng: &mut support::missiongen::Rng| {
+            let p = &programs[rng.below(programs.len())];
+            let m = &p.control.modes[rng.below(p.control.modes.len())];
+            (p.robot.clone(), m.name.clone())
+        };
+        let (r1, m1) = some_mode(&mut rng);
+        let (r2, m2) = some_mode(&mut rng);
+        let (r3, m3) = some_mode(&mut rng);
+        let kinds = [
+            ExpectKind::Always(Condition::Not(Box::new(Condition::In {
+                robot: r1.clone(),
+                mode: m1.clone(),
+            }))),
+            ExpectKind::Eventually(Condition::Enters {
+                robot: r2.clone(),
+                mode: m2.clone(),
+            }),
+            ExpectKind::LeadsTo(
+                Condition::Enters {
+                    robot: r1,
+                    mode: m1,
+                },
+                Condition::Any(vec![
+                    Condition::In {
+                        robot: r2,
+                        mode: m2,
+                    },
+                    Condition::Enters {
+                        robot: r3,
+                        mode: m3,
+                    },
+                ]),
+            ),
+        ];
+        let expect: Vec<Expectation> = kinds
+            .iter()
+            .map(|kind| Expectation {
+                at_offset: 0,
+                kind: kind.clone(),
+            })
+            .collect();
+        let properties = semo::verify::properties_of(&expect).unwrap();
+        let report =
+            semo::verify::verify_expecting(&programs, id, &text, &options, properties).unwrap();
+        for (property, outcome) in &report.properties {
+            let kind = &property.expectation.kind;
+            match outcome {
+                semo::verify::Outcome::Broken { way, .. } => {
+                    let scenario =
+                        way.scenario_json_expecting(&report.inputs, &programs, Some(kind));
+                    let scenario = semo::sim::scenario::parse(&scenario, &programs).unwrap();
+                    let run =
+                        semo::sim::simulate(&programs, &scenario, &semo::sim::Options::default());
+                    let verdicts = semo::sim::expect::judge(&run, &scenario.expect);
+                    assert!(
+                        !verdicts[0].met,
+                        "seed {seed}: `{kind}` broken, but its replay meets it: {}\n{text}",
+                        verdicts[0].why
+                    );
+                    broken += 1;
+                }
+                semo::verify::Outcome::Holds { proof } => {
+                    proved += usize::from(*proof);
+                    if !matches!(kind, ExpectKind::Always(_)) {
+                        continue;
+                    }
+                    for _ in 0..3 {
+                        let robots: Vec<&str> = programs.iter().map(|p| p.robot.as_str()).collect();
+                        let mut timeline = semo::sim::temporal::Timeline::new(
+                            robots,
+                            [kind],
+                            vec![None; programs.len()],
+                        );
+                        random_behaviour_seen(
+                            &programs,
+                            &report.inputs,
+                            &options,
+                            &[],
+                            &mut rng,
+                            &mut |e| timeline.see(e),
+                        );
+                        timeline.close_instant();
+                        let (_, status) = timeline.status().next().unwrap();
+                        assert_eq!(
+                            status.broken_at, None,
+                            "seed {seed}: `{kind}` broken in a random behaviour\n{text}"
+                        );
+                    }
+                    held += 1;
+                }
+                semo::verify::Outcome::NotJudged => {}
+            }
+        }
+    }
+    eprintln!(
+        "{broken} broken properties replayed, {held} `always` held in random behaviours, {proved} proved"
+    );
+    assert!(broken >= 5, "only {broken} broken properties");
+    assert!(held >= 3, "only {held} `always` held");
 }
 
 /// The reduction is sound: over random missions, merging a state with one

@@ -330,7 +330,9 @@ enum Command {
         from which it never finishes though it finishes in other behaviours (V002), and a \
         robot that can reach a `receive` where it waits for ever (V003). With --faults N the \
         world may also kill, restart or cut off robots, up to N times along a behaviour, and \
-        two robots leading one `leader(...)` statement at once is reported (V004). A \
+        two robots leading one `leader(...)` statement at once is reported (V004). \
+        --expect SCENARIO checks that scenario's `expect` list over every behaviour (`always`, \
+        `eventually`, `leads_to`; a broken one exits 1 with a scenario that replays it). A \
         plan's `throw` that ends its mode in the instant another plan of the mode would \
         send or throw is reported too (V005: the plans' order decides a race). \
         --counterexamples DIR writes, per finding, the \
@@ -369,6 +371,11 @@ enum Command {
         /// Write each finding's counterexample into DIR as a scenario file.
         #[arg(long, value_name = "DIR")]
         counterexamples: Option<PathBuf>,
+        /// Check the `expect` list of this scenario file over every
+        /// behaviour (`always`, `eventually`, `leads_to`, `enters`,
+        /// `never_enters`, `receives`); the rest of the file is not read.
+        #[arg(long, value_name = "SCENARIO")]
+        expect: Option<PathBuf>,
         #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
         color: ColorChoice,
     },
@@ -879,6 +886,7 @@ fn run() -> i32 {
             changes,
             faults,
             counterexamples,
+            expect,
             color,
         } => verify::run(
             verify::Options {
@@ -897,6 +905,7 @@ fn run() -> i32 {
                     cancel: None,
                 },
                 counterexamples,
+                expect,
             },
             &mut out,
         ),

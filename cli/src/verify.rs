@@ -17,6 +17,8 @@ pub struct Options {
     pub search: semo::verify::Options,
     /// Write each finding's counterexample here as a scenario file.
     pub counterexamples: Option<PathBuf>,
+    /// A scenario file whose `expect` list is checked over every behaviour.
+    pub expect: Option<PathBuf>,
 }
 
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
@@ -46,8 +48,20 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             Err(code) => return code,
         };
     let text = check.files.get(mission).text.clone();
-    let mut report = match semo::verify::verify(&refined.programs, mission, &text, &options.search)
-    {
+    let properties = match &options.expect {
+        Some(file) => match read_properties(file, &refined.programs, format, out) {
+            Some(properties) => properties,
+            None => return 2,
+        },
+        None => Vec::new(),
+    };
+    let mut report = match semo::verify::verify_expecting(
+        &refined.programs,
+        mission,
+        &text,
+        &options.search,
+        properties,
+    ) {
         Ok(report) => report,
         Err(problem) => {
             eprintln!("internal error: options checked above were refused: {problem}");
@@ -58,15 +72,25 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         report.apply_lints(&project.project);
     }
     let mut written_files = Vec::new();
+    let mut property_files = vec![None; report.properties.len()];
     if let Some(dir) = &options.counterexamples {
-        match write_counterexamples(dir, &mission_file, &report, &refined.programs) {
-            Ok(files) => written_files = files,
+        let written = write_counterexamples(dir, &mission_file, &report, &refined.programs)
+            .and_then(|files| {
+                written_files = files;
+                write_property_counterexamples(dir, &mission_file, &report, &refined.programs)
+            });
+        match written {
+            Ok(files) => property_files = files,
             Err(e) => {
                 eprintln!("error: {}: {e}", dir.display());
                 return 2;
             }
         }
     }
+    let broken = report
+        .properties
+        .iter()
+        .any(|(_, outcome)| matches!(outcome, semo::verify::Outcome::Broken { .. }));
     let data = serde_json::json!({
         "exhaustive": report.exhaustive,
         "states": report.states,
@@ -75,6 +99,12 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         "counterexamples": written_files
             .iter()
             .map(|f| f.as_ref().map(|p: &PathBuf| p.display().to_string()))
+            .collect::<Vec<_>>(),
+        "properties": report
+            .properties
+            .iter()
+            .zip(&property_files)
+            .map(|((property, outcome), file)| property_json(property, outcome, file.as_deref()))
             .collect::<Vec<_>>(),
     });
     let reported = match format {
@@ -114,6 +144,13 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             for (input, values) in sensors.chain(commands) {
                 let _ = writeln!(out, "  {input}: {}", values.join(" | "));
             }
+            for ((property, outcome), file) in report.properties.iter().zip(&property_files) {
+                let _ = writeln!(
+                    out,
+                    "{}",
+                    property_said(property, outcome, &mission_file, file.as_deref())
+                );
+            }
             for (finding, file) in report.findings.iter().zip(&written_files) {
                 if let Some(file) = file {
                     let _ = writeln!(
@@ -140,7 +177,153 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     if let Err(code) = output::written(reported) {
         return code;
     }
-    i32::from(!report.findings.is_empty())
+    i32::from(!report.findings.is_empty() || broken)
+}
+
+/// The properties of the scenario `file`'s `expect` list; a mistake is
+/// reported (exit status 2) and `None` returned.
+fn read_properties(
+    file: &Path,
+    programs: &[semo::refine::RobotProgram],
+    format: Format,
+    out: &mut impl Write,
+) -> Option<Vec<semo::verify::Property>> {
+    let text = match std::fs::read_to_string(file) {
+        Ok(text) => text,
+        Err(e) => {
+            eprintln!("error: {}: {e}", file.display());
+            return None;
+        }
+    };
+    let (scenario, _) =
+        super::simulate::read_scenario(file, &text, programs, format, "verify", out)?;
+    if !(scenario.robots.is_empty() && scenario.operator.is_empty() && scenario.faults.is_empty()) {
+        eprintln!(
+            "note: {}: `semo verify` makes the world's choices itself; of this scenario only `expect` is read",
+            file.display()
+        );
+    }
+    match semo::verify::properties_of(&scenario.expect) {
+        Ok(properties) => Some(properties),
+        Err(mistake) => {
+            let record =
+                output::Record::scenario(file, &text, mistake, semo::diag::Severity::Error);
+            if format == Format::Human {
+                eprintln!("{}", record.scenario_line());
+            } else {
+                let document = output::json_document(
+                    "verify",
+                    std::slice::from_ref(&record),
+                    serde_json::json!({}),
+                );
+                let _ = output::written(output::write_json(out, &document));
+            }
+            None
+        }
+    }
+}
+
+/// A property and what became of it, for people.
+fn property_said(
+    property: &semo::verify::Property,
+    outcome: &semo::verify::Outcome,
+    mission: &Path,
+    file: Option<&Path>,
+) -> String {
+    use semo::verify::Outcome;
+    let said = property.expectation.kind.to_string();
+    match outcome {
+        Outcome::Holds { proof: true } => format!("  property `{said}`: holds in every behaviour"),
+        Outcome::Holds { proof: false } => {
+            format!("  property `{said}`: holds as far as the search looked (bounded)")
+        }
+        Outcome::NotJudged => format!(
+            "  property `{said}`: not judged: the search was bounded, and only an exhaustive one proves it"
+        ),
+        Outcome::Broken { why, .. } => match file {
+            Some(file) => format!(
+                "  property `{said}`: broken: {why}; replay with `semo simulate {} --scenario {}`",
+                mission.display(),
+                file.display()
+            ),
+            None => format!(
+                "  property `{said}`: broken: {why} (--counterexamples DIR writes the scenario that replays it)"
+            ),
+        },
+    }
+}
+
+/// A property and what became of it, for `--format json`.
+fn property_json(
+    property: &semo::verify::Property,
+    outcome: &semo::verify::Outcome,
+    file: Option<&Path>,
+) -> serde_json::Value {
+    use semo::verify::Outcome;
+    let (verdict, proof, why) = match outcome {
+        Outcome::Holds { proof } => ("holds", *proof, None),
+        Outcome::NotJudged => ("not judged", false, None),
+        Outcome::Broken { why, .. } => ("broken", true, Some(why.as_str())),
+    };
+    serde_json::json!({
+        "expectation": property.expectation.kind.to_string(),
+        "verdict": verdict,
+        "proof": proof,
+        "why": why,
+        "counterexample": file.map(|f| f.display().to_string()),
+    })
+}
+
+/// Writes each broken property's counterexample as
+/// `<mission>.property-<n>.scenario.json` in `dir` (its `expect` the
+/// property, so the replay says it breaks), with its timeline beside it.
+fn write_property_counterexamples(
+    dir: &Path,
+    mission: &Path,
+    report: &semo::verify::Report,
+    programs: &[semo::refine::RobotProgram],
+) -> std::io::Result<Vec<Option<PathBuf>>> {
+    let stem = stem_of(mission);
+    let mut written = Vec::new();
+    for (n, (property, outcome)) in report.properties.iter().enumerate() {
+        let semo::verify::Outcome::Broken { way, .. } = outcome else {
+            written.push(None);
+            continue;
+        };
+        let name = format!("{stem}.property-{}", n + 1);
+        let text =
+            way.scenario_json_expecting(&report.inputs, programs, Some(&property.expectation.kind));
+        written.push(Some(write_replay(dir, &name, &text, programs)?));
+    }
+    Ok(written)
+}
+
+fn stem_of(mission: &Path) -> String {
+    mission
+        .file_stem()
+        .map_or("mission".into(), |s| s.to_string_lossy().into_owned())
+}
+
+/// Writes the scenario `text` as `<name>.scenario.json` in `dir`, and the
+/// timeline of its replay as `<name>.svg`; the scenario's path.
+fn write_replay(
+    dir: &Path,
+    name: &str,
+    text: &str,
+    programs: &[semo::refine::RobotProgram],
+) -> std::io::Result<PathBuf> {
+    let path = dir.join(format!("{name}.scenario.json"));
+    std::fs::write(&path, text)?;
+    // Its timeline, as `semo simulate --svg` draws the replay.
+    let scenario = semo::sim::scenario::parse(text, programs).map_err(|e| {
+        std::io::Error::other(format!(
+            "internal error: a counterexample does not read back: {e:?}"
+        ))
+    })?;
+    let run = semo::sim::simulate(programs, &scenario, &semo::sim::Options::default());
+    let picture = semo::sim::svg::to_svg(&run, programs, &scenario);
+    std::fs::write(dir.join(format!("{name}.svg")), picture)?;
+    Ok(path)
 }
 
 /// Writes each finding's counterexample as `<mission>.<code>-<n>.scenario.json`
@@ -153,9 +336,7 @@ fn write_counterexamples(
     programs: &[semo::refine::RobotProgram],
 ) -> std::io::Result<Vec<Option<PathBuf>>> {
     std::fs::create_dir_all(dir)?;
-    let stem = mission
-        .file_stem()
-        .map_or("mission".into(), |s| s.to_string_lossy().into_owned());
+    let stem = stem_of(mission);
     let mut written = Vec::new();
     for (n, (finding, way)) in report
         .findings
@@ -168,19 +349,8 @@ fn write_counterexamples(
             continue;
         };
         let name = semo::verify::counterexample_name(&stem, finding.code, n + 1);
-        let path = dir.join(format!("{name}.scenario.json"));
         let text = way.scenario_json(&report.inputs, programs);
-        std::fs::write(&path, &text)?;
-        // Its timeline, as `semo simulate --svg` draws the replay.
-        let scenario = semo::sim::scenario::parse(&text, programs).map_err(|e| {
-            std::io::Error::other(format!(
-                "internal error: a counterexample does not read back: {e:?}"
-            ))
-        })?;
-        let run = semo::sim::simulate(programs, &scenario, &semo::sim::Options::default());
-        let picture = semo::sim::svg::to_svg(&run, programs, &scenario);
-        std::fs::write(dir.join(format!("{name}.svg")), picture)?;
-        written.push(Some(path));
+        written.push(Some(write_replay(dir, &name, &text, programs)?));
     }
     Ok(written)
 }

@@ -144,6 +144,22 @@ pub fn completions(
         (["expect", "[]", "enters" | "never_enters"], false) => names.modes(sibling("robot")),
         (["expect", "[]", "all_end_in"], false) => names.modes(None),
         (["expect", "[]", "receives"], false) => names.received(sibling("robot")),
+        // A condition of a property, however deep in `not`, `all`, `any`.
+        (
+            [
+                "expect",
+                "[]",
+                "always" | "eventually" | "leads_to",
+                ..,
+                last,
+            ],
+            false,
+        ) => match *last {
+            "robot" | "from" => names.robots(),
+            "in" | "enters" => names.modes(sibling("robot")),
+            "receives" => names.received(sibling("robot")),
+            _ => Vec::new(),
+        },
         _ => Vec::new(),
     };
     let mut seen = std::collections::HashSet::new();

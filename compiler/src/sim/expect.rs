@@ -2,6 +2,7 @@
 
 use super::engine::Run;
 use super::scenario::{ExpectKind, Expectation};
+use super::temporal::Timeline;
 use super::trace::TraceEvent;
 use crate::fasthash::FastMap;
 use std::rc::Rc;
@@ -52,6 +53,9 @@ pub struct Digest<'a> {
     receivers: Vec<Vec<usize>>,
     /// Per expectation, the first receive it names: (time, value JSON).
     received: Vec<Option<(i64, String)>>,
+    /// The `always`, `eventually` and `leads_to` expectations, instant by
+    /// instant.
+    timeline: Timeline<'a>,
 }
 
 /// A robot's last word in the summary.
@@ -78,7 +82,13 @@ impl<'a> Digest<'a> {
                 receivers[r].push(x);
             }
         }
+        let timeline = Timeline::new(
+            robots.iter().map(|(_, r)| r.as_str()).collect(),
+            expectations.iter().map(|e| &e.kind),
+            vec![None; robots.len()],
+        );
         Digest {
+            timeline,
             robots,
             expectations,
             robot_of,
@@ -106,6 +116,7 @@ impl<'a> Digest<'a> {
             return;
         }
         self.last_line[r] = Some(e.t);
+        self.timeline.see(e);
         match (e.event, e.field("fault")) {
             ("mode", _) => {
                 if let Some((_, mode)) = e.fields.iter().find(|(k, _)| *k == "mode") {
@@ -166,11 +177,17 @@ impl<'a> Digest<'a> {
 
     /// Every expectation judged, in order.
     pub fn verdicts(&self) -> Vec<Verdict> {
+        // The last instant, judged on a copy: the digest may see more.
+        let mut timeline = self.timeline.clone();
+        timeline.close_instant();
         self.expectations
             .iter()
             .enumerate()
             .map(|(x, expectation)| {
-                let (met, why) = self.judge_one(x, &expectation.kind);
+                let (met, why) = match timeline.status_of(x) {
+                    Some(status) => temporal_verdict(&expectation.kind, status),
+                    None => self.judge_one(x, &expectation.kind),
+                };
                 Verdict {
                     expectation: expectation.clone(),
                     met,
@@ -226,6 +243,9 @@ impl<'a> Digest<'a> {
                     None => (false, "never received".into()),
                 }
             }
+            ExpectKind::Always(_) | ExpectKind::Eventually(_) | ExpectKind::LeadsTo(..) => {
+                unreachable!("judged by the timeline")
+            }
             ExpectKind::AllEndIn { mode } => {
                 let mut wrong = Vec::new();
                 for ((_, robot), modes) in self.robots.iter().zip(&self.modes) {
@@ -241,5 +261,23 @@ impl<'a> Digest<'a> {
                 }
             }
         }
+    }
+}
+
+/// A property's verdict on one run, from how far it got.
+pub fn temporal_verdict(kind: &ExpectKind, status: super::temporal::Status) -> (bool, String) {
+    match (kind, status.broken_at, status.held_at, status.pending_since) {
+        (ExpectKind::Always(_), Some(t), _, _) => (false, format!("broken at {t} ms")),
+        (ExpectKind::Always(_), None, _, _) => (true, "held at every instant".into()),
+        (ExpectKind::Eventually(_), _, Some(t), _) => (true, format!("held at {t} ms")),
+        (ExpectKind::Eventually(_), _, None, _) => (false, "never held".into()),
+        (_, _, _, Some(t)) => (
+            false,
+            format!("the first condition held at {t} ms, and the second never after"),
+        ),
+        (_, _, _, None) => (
+            true,
+            "the first condition was followed by the second each time".into(),
+        ),
     }
 }

@@ -10,6 +10,8 @@
 //!   the runtime.
 //! - `trace.rs`: trace events, written as `linux-sim` writes them.
 //! - `expect.rs`: expectations judged on the trace.
+//! - `temporal.rs`: `always`, `eventually`, `leads_to` judged instant by
+//!   instant (for a run, and for each step `semo verify` explores).
 //! - `replay.rs`: a recorded trace read back into a [`Run`] (`semo replay`),
 //!   so that the summary, the picture and the expectations are these
 //!   same functions on a field run.
@@ -27,6 +29,7 @@ mod json;
 pub mod replay;
 pub mod scenario;
 pub mod svg;
+pub mod temporal;
 pub mod trace;
 
 pub use engine::{DEFAULT_UNTIL_MS, Memory, Options, Race, Run, Sim};

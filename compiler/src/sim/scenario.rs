@@ -153,6 +153,148 @@ pub enum ExpectKind {
     AllEndIn {
         mode: String,
     },
+    /// The condition holds at every instant of the run.
+    Always(Condition),
+    /// The condition holds at some instant of the run.
+    Eventually(Condition),
+    /// Each instant at which the first condition holds is followed, at that
+    /// instant or a later one, by one at which the second does.
+    LeadsTo(Condition, Condition),
+}
+
+impl ExpectKind {
+    /// The expectation as a scenario's `expect` entry (what `parse` reads
+    /// back to the same expectation).
+    pub fn to_json(&self) -> String {
+        let text = |s: &str| {
+            let mut out = String::new();
+            super::trace::json_string(&mut out, s);
+            out
+        };
+        let robot_and = |robot: &str, key: &str, value: &str| {
+            format!("{{\"robot\": {}, \"{key}\": {}", text(robot), text(value))
+        };
+        let before = |b: &Option<i64>| b.map_or(String::new(), |b| format!(", \"before\": {b}"));
+        match self {
+            ExpectKind::Enters {
+                robot,
+                mode,
+                before: b,
+            } => format!("{}{}}}", robot_and(robot, "enters", mode), before(b)),
+            ExpectKind::NeverEnters { robot, mode } => {
+                format!("{}}}", robot_and(robot, "never_enters", mode))
+            }
+            ExpectKind::Receives {
+                robot,
+                key,
+                from,
+                before: b,
+            } => format!(
+                "{}{}{}}}",
+                robot_and(robot, "receives", key),
+                from.as_ref()
+                    .map_or(String::new(), |f| format!(", \"from\": {}", text(f))),
+                before(b)
+            ),
+            ExpectKind::AllEndIn { mode } => format!("{{\"all_end_in\": {}}}", text(mode)),
+            ExpectKind::Always(c) => format!("{{\"always\": {}}}", c.to_json()),
+            ExpectKind::Eventually(c) => format!("{{\"eventually\": {}}}", c.to_json()),
+            ExpectKind::LeadsTo(a, b) => {
+                format!("{{\"leads_to\": [{}, {}]}}", a.to_json(), b.to_json())
+            }
+        }
+    }
+}
+
+impl Condition {
+    /// The condition as a scenario's JSON.
+    pub fn to_json(&self) -> String {
+        let text = |s: &str| {
+            let mut out = String::new();
+            super::trace::json_string(&mut out, s);
+            out
+        };
+        let list = |all: &[Condition]| {
+            all.iter()
+                .map(Condition::to_json)
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        match self {
+            Condition::In { robot, mode } => {
+                format!("{{\"robot\": {}, \"in\": {}}}", text(robot), text(mode))
+            }
+            Condition::Enters { robot, mode } => {
+                format!("{{\"robot\": {}, \"enters\": {}}}", text(robot), text(mode))
+            }
+            Condition::Receives { robot, key, from } => format!(
+                "{{\"robot\": {}, \"receives\": {}{}}}",
+                text(robot),
+                text(key),
+                from.as_ref()
+                    .map_or(String::new(), |f| format!(", \"from\": {}", text(f)))
+            ),
+            Condition::Not(c) => format!("{{\"not\": {}}}", c.to_json()),
+            Condition::All(all) => format!("{{\"all\": [{}]}}", list(all)),
+            Condition::Any(any) => format!("{{\"any\": [{}]}}", list(any)),
+        }
+    }
+}
+
+/// What holds or not at an instant of a run (`temporal.rs`): the instant's
+/// happenings and, at its end, each robot's mode.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Condition {
+    /// The robot is in the mode (running or finished in it; a killed robot
+    /// is in none until it enters one again).
+    In {
+        robot: String,
+        mode: String,
+    },
+    /// The robot enters the mode at this instant.
+    Enters {
+        robot: String,
+        mode: String,
+    },
+    /// The robot takes a message of `key` (from robot `from`) at this
+    /// instant.
+    Receives {
+        robot: String,
+        key: String,
+        from: Option<String>,
+    },
+    Not(Box<Condition>),
+    All(Vec<Condition>),
+    Any(Vec<Condition>),
+}
+
+impl std::fmt::Display for Condition {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let joined = |f: &mut std::fmt::Formatter<'_>, all: &[Condition], word: &str| {
+            write!(f, "(")?;
+            for (i, c) in all.iter().enumerate() {
+                if i > 0 {
+                    write!(f, " {word} ")?;
+                }
+                write!(f, "{c}")?;
+            }
+            write!(f, ")")
+        };
+        match self {
+            Condition::In { robot, mode } => write!(f, "{robot} in {mode}"),
+            Condition::Enters { robot, mode } => write!(f, "{robot} enters {mode}"),
+            Condition::Receives { robot, key, from } => {
+                write!(f, "{robot} receives {key}")?;
+                match from {
+                    Some(from) => write!(f, " from {from}"),
+                    None => Ok(()),
+                }
+            }
+            Condition::Not(c) => write!(f, "not {c}"),
+            Condition::All(all) => joined(f, all, "and"),
+            Condition::Any(any) => joined(f, any, "or"),
+        }
+    }
 }
 
 impl std::fmt::Display for ExpectKind {
@@ -186,6 +328,9 @@ impl std::fmt::Display for ExpectKind {
                 Ok(())
             }
             ExpectKind::AllEndIn { mode } => write!(f, "all robots end in {mode}"),
+            ExpectKind::Always(c) => write!(f, "always {c}"),
+            ExpectKind::Eventually(c) => write!(f, "eventually {c}"),
+            ExpectKind::LeadsTo(a, b) => write!(f, "{a} leads to {b}"),
         }
     }
 }
@@ -803,6 +948,33 @@ impl Reader<'_> {
     }
 
     fn expectation(&self, v: &Value) -> Result<Expectation> {
+        const TEMPORAL: [&str; 3] = ["always", "eventually", "leads_to"];
+        if TEMPORAL.iter().any(|k| v.member(k).is_some()) {
+            object(
+                v,
+                "a property {\"always\"|\"eventually\": CONDITION} or {\"leads_to\": [CONDITION, CONDITION]}",
+                &TEMPORAL,
+            )?;
+            let given = one_of(v, "a property", &TEMPORAL)?;
+            let value = require(v, given)?;
+            let kind = match given {
+                "always" => ExpectKind::Always(self.condition(value)?),
+                "eventually" => ExpectKind::Eventually(self.condition(value)?),
+                _ => match array(value, "[CONDITION, CONDITION]")? {
+                    [from, to] => ExpectKind::LeadsTo(self.condition(from)?, self.condition(to)?),
+                    _ => {
+                        return fail(
+                            value,
+                            "\"leads_to\" takes two conditions: [CONDITION, CONDITION]",
+                        );
+                    }
+                },
+            };
+            return Ok(Expectation {
+                at_offset: v.at,
+                kind,
+            });
+        }
         object(
             v,
             "an expectation {\"robot\", \"enters\"|\"never_enters\"|\"receives\", ...} or {\"all_end_in\"}",
@@ -872,6 +1044,66 @@ impl Reader<'_> {
         Ok(Expectation {
             at_offset: v.at,
             kind,
+        })
+    }
+
+    /// A condition of `always`, `eventually` or `leads_to` (nesting is
+    /// bounded by the JSON reader's depth).
+    fn condition(&self, v: &Value) -> Result<Condition> {
+        const KINDS: [&str; 6] = ["in", "enters", "receives", "not", "all", "any"];
+        object(
+            v,
+            "a condition {\"robot\", \"in\"|\"enters\"|\"receives\", \"from\"?} or {\"not\"|\"all\"|\"any\"}",
+            &[
+                "robot", "in", "enters", "receives", "from", "not", "all", "any",
+            ],
+        )?;
+        let given = one_of(v, "a condition", &KINDS)?;
+        let about_robot = matches!(given, "in" | "enters" | "receives");
+        if !about_robot && let Some(extra) = v.member("robot").or(v.member("from")) {
+            return fail(
+                extra,
+                format!("\"{given}\" combines conditions: no \"robot\" or \"from\" beside it"),
+            );
+        }
+        if given != "receives"
+            && let Some(from) = v.member("from")
+        {
+            return fail(from, "\"from\" goes with \"receives\"");
+        }
+        let value = require(v, given)?;
+        let several = |what: &str| -> Result<Vec<Condition>> {
+            let items = array(value, "an array of conditions")?;
+            if items.is_empty() {
+                return fail(value, format!("\"{what}\" needs at least one condition"));
+            }
+            items.iter().map(|c| self.condition(c)).collect()
+        };
+        Ok(match given {
+            "not" => Condition::Not(Box::new(self.condition(value)?)),
+            "all" => Condition::All(several("all")?),
+            "any" => Condition::Any(several("any")?),
+            _ => {
+                let robot = self.robot(require(v, "robot")?, "robot")?;
+                match given {
+                    "in" => Condition::In {
+                        mode: self.mode(value, "in", Some(&robot))?,
+                        robot,
+                    },
+                    "enters" => Condition::Enters {
+                        mode: self.mode(value, "enters", Some(&robot))?,
+                        robot,
+                    },
+                    _ => Condition::Receives {
+                        key: name(value, "receives")?.to_string(),
+                        from: v
+                            .member("from")
+                            .map(|f| self.robot(f, "from"))
+                            .transpose()?,
+                        robot,
+                    },
+                }
+            }
         })
     }
 }

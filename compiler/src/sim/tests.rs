@@ -502,6 +502,31 @@ fn scenario_mistakes_point_at_the_value() {
             "unknown key \"colour\" in a scenario object {\"robots\": ..., \"operator\": ...} (expected one of: version, time_scale, duration, robots, operator, network, faults, expect)",
         ),
         ("{\"robots\": {}", (1, 14), "expected ',' or '}'"),
+        (
+            "{\"expect\": [{\"eventually\": {\"robot\": \"ti\", \"in\": \"WAIT\"}}]}",
+            (1, 50),
+            "no mode \"WAIT\" for robot ti (modes: AUTO_MODE, FINISH, RC_MODE, RETURN_MODE, SEARCH_MODE)",
+        ),
+        (
+            "{\"expect\": [{\"always\": {\"not\": {\"robot\": \"ti\", \"in\": \"FINISH\"}, \"robot\": \"ti\"}}]}",
+            (1, 74),
+            "\"not\" combines conditions: no \"robot\" or \"from\" beside it",
+        ),
+        (
+            "{\"expect\": [{\"leads_to\": [{\"robot\": \"ti\", \"enters\": \"FINISH\"}]}]}",
+            (1, 26),
+            "\"leads_to\" takes two conditions: [CONDITION, CONDITION]",
+        ),
+        (
+            "{\"expect\": [{\"always\": {\"any\": []}}]}",
+            (1, 32),
+            "\"any\" needs at least one condition",
+        ),
+        (
+            "{\"expect\": [{\"eventually\": {\"robot\": \"ti\", \"in\": \"FINISH\"}, \"always\": {\"robot\": \"ti\", \"in\": \"FINISH\"}}]}",
+            (1, 13),
+            "a property is exactly one of \"always\", \"eventually\", \"leads_to\"",
+        ),
     ] {
         let e = scenario::parse(text, &programs).unwrap_err();
         assert_eq!(
@@ -1115,5 +1140,70 @@ fn a_throw_that_ends_the_mode_before_a_later_plan_sends_is_noted_as_a_race() {
     assert_eq!(
         races_of("tests/fixtures/verify/clean_relay/main.mission"),
         Vec::<String>::new()
+    );
+}
+
+/// `always`, `eventually` and `leads_to` on one run of scouting, judged
+/// instant by instant (beside the scenario's own expectations), each
+/// verdict with its instant; and each written back as JSON reads back the
+/// same.
+#[test]
+fn temporal_expectations_are_judged_instant_by_instant() {
+    let programs = programs("examples/scouting/scouting.mission");
+    let text = scouting_scenario();
+    let expect = r#"
+        {"eventually": {"robot": "irobot", "in": "WAIT_MODE"}},
+        {"always": {"not": {"all": [{"robot": "ti", "in": "RETURN_MODE"}, {"robot": "irobot", "in": "AUTO_MODE"}]}}},
+        {"always": {"robot": "irobot", "in": "AUTO_MODE"}},
+        {"leads_to": [{"robot": "irobot", "enters": "WAIT_MODE"}, {"robot": "ti", "enters": "SEARCH_MODE"}]},
+        {"leads_to": [{"robot": "ti", "enters": "SEARCH_MODE"}, {"robot": "ti", "enters": "RC_MODE"}]},
+        {"eventually": {"any": [{"robot": "nxt", "receives": "USER.RC_CMD", "from": "irobot"}, {"robot": "ti", "in": "RC_MODE"}]}},"#;
+    let with = text.replacen("\"expect\": [", &format!("\"expect\": [{expect}"), 1);
+    let (run, verdicts) = run(&programs, &with, 1);
+    let said: Vec<(bool, String)> = verdicts
+        .iter()
+        .map(|v| (v.met, format!("{}: {}", v.expectation.kind, v.why)))
+        .collect();
+    insta::assert_debug_snapshot!(said);
+    assert!(run.end_ms > 0);
+    // Written back, each reads back the same.
+    let scenario = scenario::parse(&with, &programs).unwrap();
+    for e in &scenario.expect {
+        let again = format!("{{\"expect\": [{}]}}", e.kind.to_json());
+        let read = scenario::parse(&again, &programs).unwrap();
+        assert_eq!(read.expect[0].kind, e.kind, "{again}");
+    }
+}
+
+/// Completion inside a property's conditions, however deep: the modes of
+/// the condition's robot, the robots, the keys it receives.
+#[test]
+fn a_propertys_conditions_complete_the_missions_names() {
+    let programs = programs("examples/scouting/scouting.mission");
+    let labels = |text: &str| -> Vec<String> {
+        let offset = text.find('|').unwrap();
+        let text = text.replacen('|', "", 1);
+        complete::completions(&text, offset, &programs)
+            .into_iter()
+            .map(|c| c.label)
+            .collect()
+    };
+    assert_eq!(
+        labels(r#"{"expect": [{"always": {"not": {"all": [{"robot": "ti", "in": "S|"}]}}}]}"#),
+        [
+            "AUTO_MODE",
+            "SEARCH_MODE",
+            "RC_MODE",
+            "RETURN_MODE",
+            "FINISH"
+        ]
+    );
+    assert_eq!(
+        labels(r#"{"expect": [{"leads_to": [{"robot": "|"}]}]}"#),
+        ["irobot", "ti", "nxt"]
+    );
+    assert!(
+        labels(r#"{"expect": [{"eventually": {"robot": "irobot", "receives": "|"}}]}"#)
+            .contains(&"SlaveTeam.COLOR".to_string())
     );
 }

@@ -5,6 +5,8 @@
 //!
 //! - `inputs.rs`: the world's choices, from the programs' comparisons.
 //! - `search.rs`: the breadth-first search over the fleet's states.
+//! - `properties.rs`: the user's properties (a scenario's `expect`, with
+//!   `always`, `eventually`, `leads_to`) judged over every behaviour.
 //!
 //! Properties checked, only when the search is exhaustive (a bounded one
 //! proves neither): every mode is entered in some behaviour (V001); a
@@ -20,9 +22,11 @@
 //! `sim::Race`).
 
 mod inputs;
+mod properties;
 mod search;
 
 pub use inputs::{CommandInput, Inputs, SensorInput};
+pub use properties::{MAX_PROPERTIES, Outcome, Property, properties_of};
 pub use search::{apply, choices};
 
 use crate::diag::{Code, Diagnostic, FileId};
@@ -207,6 +211,8 @@ pub struct Report {
     /// With `Options::observe`: each trace event of a behaviour explored,
     /// without its times, sorted.
     pub observed: Vec<String>,
+    /// The user's properties, each with what became of it.
+    pub properties: Vec<(Property, Outcome)>,
 }
 
 impl Report {
@@ -236,11 +242,27 @@ pub fn verify(
     text: &str,
     options: &Options,
 ) -> Result<Report, String> {
+    verify_expecting(programs, file, text, options, Vec::new())
+}
+
+/// [`verify`], judging the user's `properties` ([`properties_of`]) over
+/// every behaviour too.
+pub fn verify_expecting(
+    programs: &[RobotProgram],
+    file: FileId,
+    text: &str,
+    options: &Options,
+    properties: Vec<Property>,
+) -> Result<Report, String> {
     if let Some(problem) = options.problem() {
         return Err(problem);
     }
+    if properties.len() > MAX_PROPERTIES {
+        return Err(format!("at most {MAX_PROPERTIES} properties at once"));
+    }
     let inputs = inputs::derive(programs);
-    let explored = search::explore(programs, &inputs, options);
+    let mut explored = search::explore(programs, &inputs, options, &properties);
+    let outcomes = std::mem::take(&mut explored.properties);
     let mut findings = Vec::new();
     let mut counterexamples = Vec::new();
     let mut claims = Vec::new();
@@ -402,6 +424,7 @@ pub fn verify(
             entered.sort();
             entered
         },
+        properties: properties.into_iter().zip(outcomes).collect(),
     })
 }
 
@@ -447,6 +470,17 @@ impl Counterexample {
     /// The scenario (`docs/scenario-and-trace.md`) that replays the way:
     /// `semo simulate` on it shows the finding at its end.
     pub fn scenario_json(&self, inputs: &Inputs, robots: &[RobotProgram]) -> String {
+        self.scenario_json_expecting(inputs, robots, None)
+    }
+
+    /// [`Counterexample::scenario_json`] with `expect` as the scenario's one
+    /// expectation: a property the replay breaks, as `semo simulate` says.
+    pub fn scenario_json_expecting(
+        &self,
+        inputs: &Inputs,
+        robots: &[RobotProgram],
+        expect: Option<&crate::sim::scenario::ExpectKind>,
+    ) -> String {
         // The sensor entries per robot, and the operator's commands, in
         // the order the choices were made.
         let mut sensors: Vec<Vec<(i64, &SensorInput, usize)>> = vec![Vec::new(); robots.len()];
@@ -545,6 +579,9 @@ impl Counterexample {
             out.push_str(",\n  \"faults\": [\n    ");
             out.push_str(&faults.join(",\n    "));
             out.push_str("\n  ]");
+        }
+        if let Some(expect) = expect {
+            let _ = write!(out, ",\n  \"expect\": [\n    {}\n  ]", expect.to_json());
         }
         out.push_str("\n}\n");
         out

@@ -7,6 +7,7 @@
 //! else up to the horizon or the state budget (bounded).
 
 use super::inputs::Inputs;
+use super::properties::{self, Label, Outcome, Property};
 use super::{Choice, Counterexample, Options, World};
 use crate::refine::RobotProgram;
 use crate::sim::{self, Memory, Race, Scenario, Sim};
@@ -44,6 +45,8 @@ pub struct Explored {
     /// statements): its first instant met and the shortest way there. A
     /// race seen is a witness: judged bounded or not.
     pub races: Vec<(Race, Counterexample)>,
+    /// Per property of the user's (same order): what became of it.
+    pub properties: Vec<Outcome>,
 }
 
 /// A `leader(...)` statement (team, mission line), the two robots that
@@ -71,7 +74,12 @@ struct Node {
     moved: Vec<u32>,
 }
 
-pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) -> Explored {
+pub fn explore(
+    programs: &[RobotProgram],
+    inputs: &Inputs,
+    options: &Options,
+    properties: &[Property],
+) -> Explored {
     let scenario = Scenario::default();
     let memory = Memory::of(programs);
     let mut root = Sim::new(programs, &scenario, &sim::Options::default());
@@ -89,7 +97,9 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
         waits_for_ever: Vec::new(),
         two_leaders: Vec::new(),
         races: Vec::new(),
+        properties: Vec::new(),
     };
+    let mut judge = Judge::new(programs, properties);
     // (team, thrower's statement, lost statement) → the race.
     let mut races: HashMap<(&str, u32, u32), (Race, Counterexample)> = HashMap::new();
     let mut nodes: Vec<Node> = Vec::new();
@@ -145,6 +155,8 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
                 apply(&mut child, &mut child_world, inputs, &choice);
                 child.run_to(next_t);
                 explored.transitions += 1;
+                let trace = child.take_trace();
+                let label = judge.label(&nodes[id as usize], &trace);
                 for race in child.take_races() {
                     let statement = |(service, state): (usize, usize)| {
                         programs[race.robot].control.services[service].states[state]
@@ -161,7 +173,7 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
                         .entry(at)
                         .or_insert_with(|| (race, counterexample(&nodes, id, &choice, t, next_t)));
                 }
-                for e in child.take_trace() {
+                for e in trace {
                     // What a robot does (not what merely reaches it): it
                     // left any `receive` it waited in, or works beside it.
                     let moved = &mut nodes[id as usize].moved;
@@ -185,9 +197,14 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
                     }
                 }
                 let fp = key(child.fingerprint(&memory), &child_world, next_t, options);
+                if judge.always_broken(label) {
+                    let way = || counterexample(&nodes, id, &choice, t, next_t);
+                    judge.witness(label, way);
+                }
                 let child_id = match seen.get(&fp) {
                     Some(&known) => {
                         edges.push((id, known));
+                        judge.step(id, known, &choice, label);
                         None
                     }
                     None => {
@@ -202,6 +219,7 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
                             t,
                         );
                         edges.push((id, new));
+                        judge.step(id, new, &choice, label);
                         leaders.look(&child, new);
                         Some(new)
                     }
@@ -234,6 +252,7 @@ pub fn explore(programs: &[RobotProgram], inputs: &Inputs, options: &Options) ->
     explored
         .races
         .sort_by_key(|(race, _)| (race.robot, race.thrower, race.lost));
+    explored.properties = judge.outcomes(&nodes, explored.exhaustive, options.step_ms);
     if explored.exhaustive {
         let graph = Graph {
             nodes: &nodes,
@@ -602,5 +621,131 @@ impl Graph<'_> {
             }
         }
         found
+    }
+}
+
+/// The user's properties through the search: each step's label, the
+/// steps themselves (kept only when there are properties), and the first
+/// witness of each broken `always`.
+struct Judge<'a> {
+    properties: &'a [Property],
+    robots: Vec<&'a str>,
+    /// Per robot: its modes' names, shared by every step's timeline.
+    modes: Vec<Vec<std::rc::Rc<str>>>,
+    steps: Vec<(u32, u32, Choice, Label)>,
+    /// Per property: the first way to a step that breaks it (`always`).
+    witnesses: Vec<Option<Counterexample>>,
+    /// The bits of the `always` properties in a label.
+    always: Label,
+}
+
+impl<'a> Judge<'a> {
+    fn new(programs: &'a [RobotProgram], properties: &'a [Property]) -> Judge<'a> {
+        let always = (0..properties.len())
+            .filter(|&p| {
+                matches!(
+                    properties[p].judged,
+                    crate::sim::scenario::ExpectKind::Always(_)
+                )
+            })
+            .fold(0, |bits, p| bits | 1 << (2 * p));
+        Judge {
+            properties,
+            robots: programs.iter().map(|p| p.robot.as_str()).collect(),
+            modes: programs
+                .iter()
+                .map(|p| {
+                    p.control
+                        .modes
+                        .iter()
+                        .map(|m| m.name.as_str().into())
+                        .collect()
+                })
+                .collect(),
+            steps: Vec::new(),
+            witnesses: vec![None; properties.len()],
+            always,
+        }
+    }
+
+    /// The label of the step out of `from` whose trace is `trace`.
+    fn label(&self, from: &Node, trace: &[crate::sim::TraceEvent]) -> Label {
+        if self.properties.is_empty() {
+            return 0;
+        }
+        // Each robot's mode when the step starts; a killed one is in none.
+        let modes = (0..self.robots.len())
+            .map(|r| match (from.down[r], from.modes[r]) {
+                (false, Some(m)) => self.modes[r].get(usize::from(m)).cloned(),
+                _ => None,
+            })
+            .collect();
+        let mut timeline = crate::sim::temporal::Timeline::new(
+            self.robots.clone(),
+            self.properties.iter().map(|p| &p.judged),
+            modes,
+        );
+        for e in trace {
+            timeline.see(e);
+        }
+        timeline.close_instant();
+        properties::label_of(self.properties, timeline.status())
+    }
+
+    fn always_broken(&self, label: Label) -> bool {
+        label & self.always != 0
+    }
+
+    /// Keeps the way (made only if needed) as the witness of each `always`
+    /// the step breaks that has none yet (breadth first: the shallowest).
+    fn witness(&mut self, label: Label, way: impl Fn() -> Counterexample) {
+        for p in 0..self.properties.len() {
+            if label & self.always & (1 << (2 * p)) != 0 && self.witnesses[p].is_none() {
+                self.witnesses[p] = Some(way());
+            }
+        }
+    }
+
+    fn step(&mut self, from: u32, to: u32, choice: &Choice, label: Label) {
+        if !self.properties.is_empty() {
+            self.steps.push((from, to, choice.clone(), label));
+        }
+    }
+
+    /// What became of each property.
+    fn outcomes(&mut self, nodes: &[Node], exhaustive: bool, step_ms: i64) -> Vec<Outcome> {
+        if self.properties.is_empty() {
+            return Vec::new();
+        }
+        let tree: Vec<(Option<u32>, Choice, i64)> = nodes
+            .iter()
+            .map(|n| (n.parent, n.choice.clone(), n.at))
+            .collect();
+        let steps = properties::Steps {
+            tree: &tree,
+            steps: &self.steps,
+            step_ms,
+        };
+        let broken = |way: Counterexample, why: &str| Outcome::Broken {
+            why: why.to_string(),
+            way,
+        };
+        (0..self.properties.len())
+            .map(|p| match &self.properties[p].judged {
+                crate::sim::scenario::ExpectKind::Always(_) => match self.witnesses[p].take() {
+                    Some(way) => broken(way, "a behaviour reaches an instant where it does not hold"),
+                    None => Outcome::Holds { proof: exhaustive },
+                },
+                _ if !exhaustive => Outcome::NotJudged,
+                crate::sim::scenario::ExpectKind::Eventually(_) => match steps.eventually_broken(p) {
+                    Some(way) => broken(way, "a behaviour never reaches an instant where it holds: it ends, or goes round for ever, without one"),
+                    None => Outcome::Holds { proof: true },
+                },
+                _ => match steps.leads_to_broken(p) {
+                    Some(way) => broken(way, "after an instant where the first condition holds, a behaviour never reaches one where the second does"),
+                    None => Outcome::Holds { proof: true },
+                },
+            })
+            .collect()
     }
 }

@@ -59,10 +59,23 @@ test('the mistakes the simulator refuses are refused', () => {
     { operator: [{ at: 1, every: 5, to: 'a', value: 'X', is: 1 }] },
     { network: { loss: 1.5 } },
     { expect: [{ robot: 'a' }] },
+    { expect: [{ leads_to: [{ robot: 'a', in: 'M' }] }] },
+    { expect: [{ always: { not: { robot: 'a', in: 'M' }, robot: 'a' } }] },
+    { expect: [{ eventually: { any: [] } }] },
     { robots: { a: { sensors: [{ at: 0, value: 'X' }] } } },
   ];
   for (const scenario of wrong) {
     assert.equal(valid(scenario), false, JSON.stringify(scenario));
   }
   assert.ok(valid({ expect: [{ robot: 'a', receives: 'T.K', from: 'b', before: 10 }] }));
+  assert.ok(
+    valid({
+      expect: [
+        { always: { not: { all: [{ robot: 'a', in: 'M' }, { robot: 'b', in: 'N' }] } } },
+        { eventually: { robot: 'a', enters: 'M' } },
+        { leads_to: [{ robot: 'a', enters: 'M' }, { any: [{ robot: 'b', receives: 'T.K', from: 'a' }] }] },
+      ],
+    }),
+    JSON.stringify(validate.errors),
+  );
 });
