@@ -382,8 +382,15 @@ fn events_of<'e>(events: &'e [Event], robot: &str, kind: &str) -> Vec<&'e Event>
 fn a_broadcast_event_to_the_team_acts_the_same_in_c_and_in_the_simulator() {
     let fixtures = repo_root().join("tests/fixtures/broadcast");
     let scenario = std::fs::read_to_string(fixtures.join("march.scenario.json")).unwrap();
-    let (_, sim) = compare("broadcast_march", &fixtures.join("march.mission"), &scenario);
-    let throws: Vec<_> = sim.iter().filter(|e| field(e, "event") == "throw").collect();
+    let (_, sim) = compare(
+        "broadcast_march",
+        &fixtures.join("march.mission"),
+        &scenario,
+    );
+    let throws: Vec<_> = sim
+        .iter()
+        .filter(|e| field(e, "event") == "throw")
+        .collect();
     assert_eq!(throws.len(), 1, "one throw, at the thrower: {throws:?}");
     assert_eq!(field(throws[0], "broadcast"), "true");
     for robot in ["quad_0", "quad_1", "quad_3", "quad_4"] {
@@ -406,8 +413,14 @@ fn a_broadcast_event_to_a_group_acts_the_same_in_c_and_in_the_simulator() {
     let dropped = events_of(&sim, "tb_1", "drop");
     assert_eq!(dropped.len(), 1, "{dropped:?}");
     assert_eq!(field(dropped[0], "reason"), "not caught");
-    assert!(events_of(&sim, "ev", "receive").is_empty(), "ev is in no group");
-    assert!(events_of(&sim, "tb_2", "catch").is_empty(), "tb_2 was killed");
+    assert!(
+        events_of(&sim, "ev", "receive").is_empty(),
+        "ev is in no group"
+    );
+    assert!(
+        events_of(&sim, "tb_2", "catch").is_empty(),
+        "tb_2 was killed"
+    );
     let modes: Vec<&str> = events_of(&sim, "tb_0", "mode")
         .iter()
         .map(|e| field(e, "mode"))

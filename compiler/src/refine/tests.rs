@@ -704,7 +704,11 @@ fn a_broadcast_goes_to_the_throwers_group_as_the_checker_recorded_it() {
         [vec!["near", "tb_0", "tb_2"], vec!["all", "T"]],
         "tb_1"
     );
-    assert_eq!(told(by_robot[3].1), [vec!["all", "T"]], "ev runs no group arm");
+    assert_eq!(
+        told(by_robot[3].1),
+        [vec!["all", "T"]],
+        "ev runs no group arm"
+    );
     assert_eq!(by_robot[0].1.control.events_heard, ["all", "near"]);
     assert_eq!(by_robot[3].1.control.events_heard, ["all"]);
     assert!(by_robot[3].1.control.has_receiver());

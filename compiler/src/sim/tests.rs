@@ -1078,9 +1078,16 @@ fn broadcast_lines(run: &Run) -> Vec<String> {
     run.trace_lines()
         .lines()
         .filter(|l| {
-            ["\"throw\"", "\"catch\"", "\"drop\"", "\"mode\"", "\"fault\"", "__event"]
-                .iter()
-                .any(|k| l.contains(k))
+            [
+                "\"throw\"",
+                "\"catch\"",
+                "\"drop\"",
+                "\"mode\"",
+                "\"fault\"",
+                "__event",
+            ]
+            .iter()
+            .any(|k| l.contains(k))
         })
         .map(str::to_string)
         .collect()

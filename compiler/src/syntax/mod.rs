@@ -499,10 +499,7 @@ mod tests {
                 other => panic!("{other:?}"),
             })
             .collect();
-        assert_eq!(
-            throws,
-            [("go", Some(Span::new(17, 26))), ("stay", None)]
-        );
+        assert_eq!(throws, [("go", Some(Span::new(17, 26))), ("stay", None)]);
         // `broadcast` is a keyword: it is no event name.
         let p = parse(FileId(0), "T.A.S { throw broadcast } repeat()");
         assert_eq!(p.diagnostics[0].code, Code::SyntaxError);
