@@ -366,6 +366,68 @@ fn link_faults_and_battery_act_the_same_in_c_and_in_the_simulator() {
     );
 }
 
+/// The events of one robot's run of `kind`, as (time, event fields that
+/// say what happened): the check that a test's run did what it is about.
+fn events_of<'e>(events: &'e [Event], robot: &str, kind: &str) -> Vec<&'e Event> {
+    events
+        .iter()
+        .filter(|e| field(e, "robot") == robot && field(e, "event") == kind)
+        .collect()
+}
+
+/// `throw avoid broadcast` to the whole team (issue 36): one message to the
+/// team, and each other quadruped catches it at its next firing, naming the
+/// thrower, in both engines.
+#[test]
+fn a_broadcast_event_to_the_team_acts_the_same_in_c_and_in_the_simulator() {
+    let fixtures = repo_root().join("tests/fixtures/broadcast");
+    let scenario = std::fs::read_to_string(fixtures.join("march.scenario.json")).unwrap();
+    let (_, sim) = compare(
+        "broadcast_march",
+        &fixtures.join("march.mission"),
+        &scenario,
+    );
+    let throws: Vec<_> = sim
+        .iter()
+        .filter(|e| field(e, "event") == "throw")
+        .collect();
+    assert_eq!(throws.len(), 1, "one throw, at the thrower: {throws:?}");
+    assert_eq!(field(throws[0], "broadcast"), "true");
+    for robot in ["quad_0", "quad_1", "quad_3", "quad_4"] {
+        let caught = events_of(&sim, robot, "catch");
+        assert_eq!(caught.len(), 1, "{robot}: {caught:?}");
+        assert_eq!(field(caught[0], "from"), "quad_2");
+        assert_eq!(caught[0]["t"], 610, "{robot} catches at its next firing");
+    }
+}
+
+/// `throw E broadcast` inside a `group` arm: one message to each other
+/// TurtleBot, none to the Ev3 robot that runs `others`; a TurtleBot whose
+/// mode does not catch the event drops it (traced), a killed one misses it,
+/// in both engines.
+#[test]
+fn a_broadcast_event_to_a_group_acts_the_same_in_c_and_in_the_simulator() {
+    let fixtures = repo_root().join("tests/fixtures/broadcast");
+    let scenario = std::fs::read_to_string(fixtures.join("crew.scenario.json")).unwrap();
+    let (_, sim) = compare("broadcast_crew", &fixtures.join("crew.mission"), &scenario);
+    let dropped = events_of(&sim, "tb_1", "drop");
+    assert_eq!(dropped.len(), 1, "{dropped:?}");
+    assert_eq!(field(dropped[0], "reason"), "not caught");
+    assert!(
+        events_of(&sim, "ev", "receive").is_empty(),
+        "ev is in no group"
+    );
+    assert!(
+        events_of(&sim, "tb_2", "catch").is_empty(),
+        "tb_2 was killed"
+    );
+    let modes: Vec<&str> = events_of(&sim, "tb_0", "mode")
+        .iter()
+        .map(|e| field(e, "mode"))
+        .collect();
+    assert_eq!(modes, ["GO", "HOLD", "GO"], "tb_0 is told `ping` by tb_1");
+}
+
 /// Adaptive resource management (the strategy's `BatteryRequirement`:
 /// below 30 % the camera and ultrasonic sample every 200 ms and the wheels
 /// run at half speed): irobot's battery drains from 100 % to 20 % by 3 s

@@ -220,6 +220,7 @@ codes! {
     FunctionNeverCalled = "W010", Warning, "a function that is never called";
     TeamWithoutMain = "W011", Warning, "a team without a main block: its robots do nothing";
     EmptyOthers = "W012", Warning, "an `others` block that no robot is left to run";
+    BroadcastToNoOne = "W013", Hint, "a `throw E broadcast` that only one robot runs: its group (or team) has no one else to tell";
     ComparisonNeverHolds = "W020", Warning, "a comparison of a team variable with a value it is never set to: it never holds";
     ComparisonAlwaysHolds = "W021", Warning, "`!=` between a team variable and a value it is never set to: it holds whenever the variable has a value";
     ReadBeforeSent = "W022", Warning, "a value read once, when the mission starts, before any robot can have sent it: it reads none, and nothing sent later is read there";

@@ -42,7 +42,7 @@ Set it before loading eglot (or this file) if `semo' is not on the PATH."
   "An identifier.")
 
 (defconst semo-keywords
-  '("if" "else" "loop" "repeat" "throw" "send" "receive" "publish" "subscribe" "set" "def"
+  '("if" "else" "loop" "repeat" "throw" "broadcast" "send" "receive" "publish" "subscribe" "set" "def"
     "main" "case" "catch" "default" "mode" "group" "leader" "others" "instance" "of" "capable"
     "timeout" "and" "or" "not")
   "Reserved words of the mission language (besides `true', `false' and `OFF').")

@@ -175,7 +175,11 @@ module.exports = grammar({
       field('condition', $._expression),
     ),
 
-    throw_statement: $ => seq('throw', field('event', $.identifier)),
+    throw_statement: $ => seq(
+      'throw',
+      field('event', $.identifier),
+      optional(field('broadcast', 'broadcast')),
+    ),
 
     call: $ => seq(
       field('function', $.identifier),

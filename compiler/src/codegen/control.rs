@@ -256,6 +256,44 @@ pub(super) fn expr(e: &Expr, words: &Words) -> String {
     }
 }
 
+/// A program that broadcasts or hears events: `catch_event` (the current
+/// mode's catch, with the thrower of a broadcast one), the throws `body`
+/// uses, and `take_events` (the broadcast events received since the last
+/// firing, `comm_event_take`) when it hears any. A program without either
+/// keeps `throw_event` as it always was.
+fn emit_catch_event(out: &mut String, program: &RobotProgram, throws: bool, broadcasts: bool) {
+    let m = &program.control;
+    out.push_str("/* The current mode's `catch` of `event` asks for its mode change, unless one\n * is asked for already: whether it did. `from`: the robot that broadcast the\n * event, or NULL for this robot's own throw. */\nstatic bool catch_event(const char *event, const char *from)\n{\n    switch (current_mode) {\n");
+    for (from, mode) in m.modes.iter().enumerate() {
+        let catches: Vec<_> = m.transitions.iter().filter(|t| t.from == from).collect();
+        if catches.is_empty() {
+            continue;
+        }
+        let _ = writeln!(out, "    case MODE_{}:", c::ident(&mode.name));
+        for t in catches {
+            let _ = writeln!(
+                out,
+                "        if (strcmp(event, {}) == 0 && pending_mode < 0) {{ /* {}:{} */\n            pending_mode = MODE_{};\n            semo_trace(\"catch\", \"name\", event, \"mode\", mode_name[pending_mode], from ? \"from\" : NULL, from, NULL);\n            return true;\n        }}",
+                c::string(&t.event),
+                c::comment(&program.mission),
+                t.line,
+                c::ident(&m.modes[t.to].name)
+            );
+        }
+        out.push_str("        break;\n");
+    }
+    out.push_str("    default:\n        break;\n    }\n    return false;\n}\n\n");
+    if throws {
+        out.push_str("/* `throw`: asks for the mode change that the current mode's `catch` names. */\nstatic void throw_event(const char *event)\n{\n    semo_trace(\"throw\", \"name\", event, NULL);\n    catch_event(event, NULL);\n}\n\n");
+    }
+    if broadcasts {
+        out.push_str("/* `throw E broadcast`, once the others of the group are told: acts here as\n * `throw E` does. */\nstatic void throw_broadcast(const char *event)\n{\n    semo_trace(\"throw\", \"name\", event, \"broadcast\", \"true\", NULL);\n    catch_event(event, NULL);\n}\n\n");
+    }
+    if !m.events_heard.is_empty() {
+        out.push_str("/* At the start of a firing, in its mode: each broadcast event received since\n * the last one, in order, handled as this robot's own throw would be; one\n * the mode does not catch (or after a caught one) is dropped. */\nstatic void take_events(void)\n{\n    size_t from;\n    const char *event;\n    while (comm_event_take(&from, &event)) {\n        const char *robot = semo_program()->peers[from].robot;\n        if (!catch_event(event, robot))\n            semo_trace(\"drop\", \"from\", robot, \"name\", event, \"reason\", \"not caught\", NULL);\n    }\n}\n\n");
+    }
+}
+
 /// The helpers `body` calls: `store`, `read_inputs`, `throw_event`, `request`.
 fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
     let m = &program.control;
@@ -317,7 +355,10 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
     }
     out.push_str("}\n\n");
 
-    if uses("throw_event") {
+    let broadcasts = uses("throw_broadcast") || !m.events_heard.is_empty();
+    if broadcasts {
+        emit_catch_event(out, program, uses("throw_event"), uses("throw_broadcast"));
+    } else if uses("throw_event") {
         out.push_str("/* `throw`: asks for the mode change that the current mode's `catch` names. */\nstatic void throw_event(const char *event)\n{\n    semo_trace(\"throw\", \"name\", event, NULL);\n    switch (current_mode) {\n");
         for (from, mode) in m.modes.iter().enumerate() {
             let catches: Vec<_> = m.transitions.iter().filter(|t| t.from == from).collect();
@@ -476,10 +517,34 @@ fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize
                 c::string(&m.subscribed[*group])
             );
         }
-        StateKind::Throw { event } => {
+        StateKind::Throw {
+            event,
+            broadcast: None,
+        } => {
             let _ = writeln!(
                 out,
                 "        throw_event({});\n        r->pc = {next};\n        return STEP_NEXT;",
+                c::string(event)
+            );
+        }
+        StateKind::Throw {
+            event,
+            broadcast: Some(messages),
+        } => {
+            // The others of the group are told before the event acts here
+            // (a caught event ends the firing's steps).
+            for &message in messages {
+                let _ = writeln!(
+                    out,
+                    "        {{\n            semo_value told;\n            semo_value_set(&told, {});\n            semo_port_send(out_port[{message}], &told, sizeof told); /* {} to {} */\n        }}",
+                    c::string(event),
+                    c::comment(&m.outgoing[message].key),
+                    c::comment(&m.outgoing[message].to_team)
+                );
+            }
+            let _ = writeln!(
+                out,
+                "        throw_broadcast({});\n        r->pc = {next};\n        return STEP_NEXT;",
                 c::string(event)
             );
         }
@@ -878,6 +943,9 @@ fn emit_task(out: &mut String, program: &RobotProgram) {
             let _ = writeln!(out, "    if (current_mode < 0)\n        enter_mode({d});");
         }
         None => out.push_str("    if (current_mode < 0) {\n        semo_trace(\"finish\", \"why\", \"no default mode\", NULL);\n        semo_stop_program();\n        return;\n    }\n"),
+    }
+    if !m.events_heard.is_empty() {
+        out.push_str("    take_events();\n");
     }
     // Messages written in the last firing go out before the program ends
     // (the communication task would otherwise be stopped first).

@@ -59,6 +59,9 @@ pub fn program_h(program: &RobotProgram, header: &str) -> String {
             out.push_str("/* The last pass of a robot through sync point `point` (an index into\n * the program's sync points) that it announced; 0 before any. */\nlong comm_sync_arrived(size_t peer, size_t point);\n");
         }
     }
+    if !program.control.events_heard.is_empty() {
+        out.push_str("\n/* The next broadcast event received (comm_task.c), in arrival order: the\n * thrower's peer index and the event's name; false when none waits. */\nbool comm_event_take(size_t *from, const char **event);\n");
+    }
     out.push_str(&super::shared::declarations(program));
     let _ = writeln!(
         out,
@@ -303,7 +306,10 @@ pub fn comm_task_c(program: &RobotProgram, words: &Words, target: Target, header
             control = c::string(CONTROL_TASK),
         );
     }
-    if !m.incoming.is_empty() || !m.subscribed.is_empty() || m.heartbeat {
+    if !m.events_heard.is_empty() {
+        comm_events(&mut out, program, target);
+    }
+    if m.has_receiver() {
         out.push_str("/* CommReceive: each message received goes to the control task's port for\n * it (sends) or to its multicast group (publishes). */\n");
         let n = m.incoming.len();
         if n > 0 {
@@ -371,6 +377,9 @@ pub fn comm_task_c(program: &RobotProgram, words: &Words, target: Target, header
         if !m.sync_points.is_empty() {
             out.push_str("    if (heard_sync(&m))\n        return;\n");
         }
+        if !m.events_heard.is_empty() {
+            out.push_str("    if (heard_event(&m))\n        return;\n");
+        }
         if let Some(dispatch) = super::shared::comm_dispatch(program) {
             out.push_str(&dispatch);
         }
@@ -388,12 +397,32 @@ pub fn comm_task_c(program: &RobotProgram, words: &Words, target: Target, header
         }
         let _ = writeln!(out, "}}\n\nvoid task_{recv}_wrapup(void)\n{{\n}}");
     }
-    if m.outgoing.is_empty() && m.incoming.is_empty() && m.subscribed.is_empty() && !m.heartbeat {
+    if m.outgoing.is_empty() && !m.has_receiver() {
         out.push_str(
             "/* This robot exchanges no messages. */\ntypedef int semo_no_communication;\n",
         );
     }
     out
+}
+
+/// The broadcast events the team's robots tell this one (`throw E
+/// broadcast`, key `Team.__event`): queued in arrival order for the control
+/// task (`comm_event_take`), as the simulator's `hear_event` does.
+fn comm_events(out: &mut String, program: &RobotProgram, target: Target) {
+    let m = &program.control;
+    let (include, declare, lock, unlock) = lock(target, "event_lock");
+    let names: Vec<String> = m.events_heard.iter().map(|e| c::string(e)).collect();
+    let _ = writeln!(
+        out,
+        "{include}/* Broadcast events (`throw E broadcast`: key `{key_comment}`, the event's name\n * as text) that the team's robots tell this one, queued in arrival order\n * until the control task takes them at its next firing; one arriving while\n * {cap} wait is dropped. */\nstatic const char *const event_heard[] = {{{list}}};\n#define EVENT_KINDS {n}\n#define EVENT_QUEUE {cap}\n{declare}static struct {{\n    size_t from;\n    size_t event;\n}} event_queue[EVENT_QUEUE];\nstatic size_t event_first, event_count;\n\nbool comm_event_take(size_t *from, const char **event)\n{{\n    bool taken = false;\n    {lock}\n    if (event_count > 0) {{\n        *from = event_queue[event_first].from;\n        *event = event_heard[event_queue[event_first].event];\n        event_first = (event_first + 1) % EVENT_QUEUE;\n        event_count--;\n        taken = true;\n    }}\n    {unlock}\n    return taken;\n}}\n\nstatic bool heard_event(const semo_message *m)\n{{\n    if (m->kind != SEMO_MSG_SEND || strcmp(m->key, {key}) != 0 || strcmp(m->from_team, {team}) != 0)\n        return false;\n    const semo_program_desc *p = semo_program();\n    size_t from = p->peer_count, event = EVENT_KINDS;\n    for (size_t i = 0; i < p->peer_count && from == p->peer_count; i++)\n        if (strcmp(p->peers[i].robot, m->from_robot) == 0)\n            from = i;\n    /* The value is the event's name as text; anything else names none. */\n    for (size_t k = 0; k < EVENT_KINDS && m->value.type == SEMO_TEXT && event == EVENT_KINDS; k++)\n        if (strcmp(event_heard[k], m->value.text) == 0)\n            event = k;\n    if (from == p->peer_count || event == EVENT_KINDS) {{\n        semo_trace(\"reject\", \"key\", m->key, \"reason\", \"not an event it hears\", NULL);\n        return true;\n    }}\n    {lock}\n    bool room = event_count < EVENT_QUEUE;\n    if (room) {{\n        size_t at = (event_first + event_count) % EVENT_QUEUE;\n        event_queue[at].from = from;\n        event_queue[at].event = event;\n        event_count++;\n    }}\n    {unlock}\n    if (!room) {{\n        semo_trace(\"drop\", \"from\", m->from_robot, \"name\", event_heard[event], \"reason\", \"too many events\", NULL);\n        return true;\n    }}\n    semo_wake({control});\n    return true;\n}}\n",
+        key_comment = c::comment(&crate::refine::event_key(&program.team)),
+        list = names.join(", "),
+        n = names.len(),
+        cap = crate::refine::EVENT_QUEUE,
+        key = c::string(&crate::refine::event_key(&program.team)),
+        team = c::string(&program.team),
+        control = c::string(CONTROL_TASK),
+    );
 }
 
 /// `tasks/<task>.c`: the simulation's own body for `linux-sim`; for `linux`

@@ -219,3 +219,13 @@ fn long_expression_chains_need_no_recursion() {
         Err(FormatRefusal::SyntaxErrors(_))
     ));
 }
+
+#[test]
+fn a_broadcast_throw_keeps_its_keyword_on_the_statement() {
+    assert_eq!(
+        fmt(
+            "{T:iRobotCreate a[2]} T.A.S{throw   go\n   broadcast;if(DISTANCE<5)throw near broadcast}repeat()"
+        ),
+        "{\n  T: iRobotCreate a[2]\n}\n\nT.A.S {\n  throw go broadcast;\n  if(DISTANCE < 5)\n    throw near broadcast\n} repeat()\n"
+    );
+}

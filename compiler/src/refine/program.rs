@@ -232,7 +232,30 @@ pub struct ControlMachine {
     /// Adaptive resource management: the team strategy's battery policies,
     /// checked at every firing against the robot's `BATTERY` value.
     pub battery: Vec<BatteryPolicy>,
+    /// The events another robot of its group may broadcast to this one
+    /// (`throw E broadcast` that this robot and another run), sorted: its
+    /// receive task takes a message of key [`event_key`] naming one of
+    /// them into the event queue its control task reads at the start of
+    /// each firing; empty when no one can tell it anything.
+    pub events_heard: Vec<String>,
 }
+
+/// The key of the messages that carry a team's broadcast events
+/// (`throw E broadcast`; the value is the event's name as text), beside the
+/// heartbeats' `Team.__alive` and the group statements' `Team.__sync`.
+pub fn event_key(team: &str) -> String {
+    format!("{team}.__event")
+}
+
+/// The longest name of a broadcast event: its message carries the name as a
+/// text value, which the runtime bounds (`SEMO_TEXT_MAX` - 1 bytes).
+pub const MAX_EVENT_NAME_BYTES: usize = 63;
+
+/// The most broadcast events a robot keeps between two control firings;
+/// one more arriving before the control task takes them is dropped (trace
+/// `drop`, reason `too many events`), in the generated C and the simulator
+/// alike.
+pub const EVENT_QUEUE: usize = 16;
 
 impl ControlMachine {
     /// The most plans any mode runs at once (at least 1): the size of the
@@ -244,6 +267,15 @@ impl ControlMachine {
             .max()
             .unwrap_or(0)
             .max(1)
+    }
+
+    /// Whether the robot has a receive task: it receives values, a group's
+    /// publications, heartbeats or broadcast events.
+    pub fn has_receiver(&self) -> bool {
+        !self.incoming.is_empty()
+            || !self.subscribed.is_empty()
+            || self.heartbeat
+            || !self.events_heard.is_empty()
     }
 
     /// The most marks any service machine uses (at least 1).
@@ -387,8 +419,15 @@ pub enum StateKind {
         group: usize,
         slot: SlotId,
     },
+    /// `throw E`: the current mode's catch of E asks for a mode change.
+    /// With `broadcast` (`throw E broadcast`), the messages (indices into
+    /// [`ControlMachine::outgoing`], key [`event_key`], the event's name as
+    /// text) that tell the others of the thrower's group first: one to the
+    /// team when the group is the whole team, else one to each other robot
+    /// of it; empty when the thrower is the group's only robot.
     Throw {
         event: String,
+        broadcast: Option<Vec<usize>>,
     },
     /// Call the task implementing a built-in service and wait until it is idle.
     Call {

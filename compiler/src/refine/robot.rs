@@ -58,6 +58,7 @@ pub(super) fn refine_robot(
     };
     builder.build_modes();
     builder.machine.battery = builder.battery_policies();
+    builder.machine.events_heard = builder.events_heard();
     let graph_services = builder.graph_services();
     let self_peer = builder.first_peer() + robot_index;
     let team_leader = builder.team_leader_algorithm();
@@ -93,7 +94,7 @@ pub(super) fn refine_robot(
             kind: RoleKind::CommSend,
         });
     }
-    if !machine.incoming.is_empty() || !machine.subscribed.is_empty() || machine.heartbeat {
+    if machine.has_receiver() {
         tasks.push(TaskRole {
             task: graph::COMM_RECEIVE.into(),
             kind: RoleKind::CommReceive,
@@ -553,11 +554,25 @@ impl Builder<'_, '_> {
                 }
             }
             StmtKind::Comm(c) => self.comm(c, stmt.span, states, marks),
-            StmtKind::Throw(event) => {
+            StmtKind::Throw(throw) => {
+                let broadcast = match throw.broadcast {
+                    Some(_) => match self.broadcast_messages(&throw.event) {
+                        Some(messages) => Some(messages),
+                        None => {
+                            self.internal_error(
+                                stmt.span,
+                                "the checker recorded no robots for this broadcast",
+                            );
+                            return;
+                        }
+                    },
+                    None => None,
+                };
                 self.push(
                     states,
                     StateKind::Throw {
-                        event: event.name.to_string(),
+                        event: throw.event.name.to_string(),
+                        broadcast,
                     },
                     stmt.span,
                 );
@@ -1364,6 +1379,50 @@ impl Builder<'_, '_> {
             port,
         });
         self.machine.outgoing.len() - 1
+    }
+
+    /// The messages that tell the others of the thrower's group of a
+    /// `throw E broadcast` (the group the checker recorded): one to the team
+    /// when it is the whole team, else one to each other robot of it.
+    /// `None` when the checker recorded no broadcast there.
+    fn broadcast_messages(&mut self, event: &ast::Ident) -> Option<Vec<usize>> {
+        let team = self.team;
+        let receivers = team.broadcast_at(event.span)?.receivers.clone();
+        if event.name.len() > MAX_EVENT_NAME_BYTES {
+            self.unsupported(
+                event.span,
+                &format!(
+                    "a broadcast event whose name is longer than {MAX_EVENT_NAME_BYTES} bytes (the runtime's text values carry no more)"
+                ),
+            );
+        }
+        let key = event_key(&team.name);
+        if receivers.len() == team.robots.len() && receivers.len() > 1 {
+            return Some(vec![self.outgoing(&team.name, false, &key)]);
+        }
+        let others = receivers.iter().filter(|r| r.index() != self.robot_index);
+        let names: Vec<String> = others
+            .map(|r| team.robots[r.index()].name.to_string())
+            .collect();
+        Some(
+            names
+                .iter()
+                .map(|name| self.outgoing(name, false, &key))
+                .collect(),
+        )
+    }
+
+    /// The events another robot may tell this one (`events_heard`).
+    fn events_heard(&self) -> Vec<String> {
+        let mine = |b: &&crate::sema::Broadcast| {
+            b.receivers.len() > 1 && b.receivers.iter().any(|r| r.index() == self.robot_index)
+        };
+        let mut events: Vec<String> = (self.team.broadcasts.iter().filter(mine))
+            .map(|b| b.event.to_string())
+            .collect();
+        events.sort_unstable();
+        events.dedup();
+        events
     }
 
     fn incoming(&mut self, from_team: &str, attr: &ast::Attr) -> usize {

@@ -373,7 +373,10 @@ fn control_structures_become_states_with_jumps() {
             StateKind::Call { service, .. } => service.clone(),
             StateKind::Branch { else_to, .. } => format!("branch else {else_to}"),
             StateKind::Jump { to } => format!("jump {to}"),
-            StateKind::Throw { event } => format!("throw {event}"),
+            StateKind::Throw {
+                event,
+                broadcast: None,
+            } => format!("throw {event}"),
             StateKind::Repeat { period_ms, .. } => format!("repeat {period_ms:?}"),
             other => format!("{other:?}"),
         })
@@ -664,4 +667,49 @@ fn a_time_triggered_inner_task_carries_its_period() {
     .unwrap();
     let refused = robot::steps_of(&control, &none).unwrap_err();
     assert!(refused.contains("control-triggered task `A`"), "{refused}");
+}
+
+/// `throw E broadcast` is told to the robots the checker recorded: one
+/// message to the team when they are the whole team, else one to each other
+/// robot of the group; each of them hears the event, the others do not.
+#[test]
+fn a_broadcast_goes_to_the_throwers_group_as_the_checker_recorded_it() {
+    let text = "{ T: Turtlebot3_Burger tb[3], Ev3_Robot ev }\nT.A.S{\n [[ group(instance of Turtlebot3_Burger) { scatter() throw near broadcast } ]]\n throw all broadcast\n} repeat(1 SEC)\nT.M{ set(A, S) }\nT.N{ set(A, OFF) }\nT.main{ case (M): catch (near): mode = N\n catch (all): mode = N\n default: mode = M }\n";
+    let programs = programs(text, &[]);
+    let told = |p: &RobotProgram| -> Vec<Vec<String>> {
+        p.control.services[0]
+            .states
+            .iter()
+            .filter_map(|s| match &s.kind {
+                StateKind::Throw {
+                    event,
+                    broadcast: Some(messages),
+                } => Some(
+                    std::iter::once(event.clone())
+                        .chain(messages.iter().map(|&m| {
+                            let o = &p.control.outgoing[m];
+                            assert_eq!((o.key.as_str(), o.publish), ("T.__event", false));
+                            o.to_team.clone()
+                        }))
+                        .collect(),
+                ),
+                _ => None,
+            })
+            .collect()
+    };
+    let by_robot: Vec<(&str, &RobotProgram)> =
+        programs.iter().map(|p| (p.robot.as_str(), p)).collect();
+    assert_eq!(
+        told(by_robot[1].1),
+        [vec!["near", "tb_0", "tb_2"], vec!["all", "T"]],
+        "tb_1"
+    );
+    assert_eq!(
+        told(by_robot[3].1),
+        [vec!["all", "T"]],
+        "ev runs no group arm"
+    );
+    assert_eq!(by_robot[0].1.control.events_heard, ["all", "near"]);
+    assert_eq!(by_robot[3].1.control.events_heard, ["all"]);
+    assert!(by_robot[3].1.control.has_receiver());
 }

@@ -322,6 +322,8 @@ impl<'a> Checker<'a> {
         // The events each mode's services throw, gathered once per mode: a
         // mode may have many catches.
         let mut thrown_in: FastMap<ModeId, FastSet<&Name>> = FastMap::default();
+        // An event another robot broadcasts may come in any mode.
+        let told: FastSet<&Name> = t.events_told().collect();
         for (i, tr) in main.transitions.iter().enumerate() {
             let mode = &t.modes[tr.from.index()];
             let thrown = thrown_in.entry(tr.from).or_insert_with(|| {
@@ -330,7 +332,7 @@ impl<'a> Checker<'a> {
                     .flat_map(|s| &t.services[s.index()].throws)
                     .collect()
             });
-            if !thrown.contains(&tr.event) {
+            if !thrown.contains(&tr.event) && !told.contains(&tr.event) {
                 never_thrown.push(i);
                 findings.push((
                     tr.event_span,

@@ -273,6 +273,7 @@ impl<'a> Checker<'a> {
             self.block(body, &scope);
         }
         self.report_lacking_values();
+        self.finish_broadcasts();
         // Functions nobody calls are still checked, as far as possible without robots.
         for f in 0..self.function_syntax.len() {
             if !self.mission.functions[f].called {
@@ -338,7 +339,7 @@ impl<'a> Checker<'a> {
             }
             StmtKind::Group(g) => self.group(g, scope),
             StmtKind::Comm(c) => self.comm(c, scope),
-            StmtKind::Throw(event) => self.throw(event, scope),
+            StmtKind::Throw(throw) => self.throw(throw, scope),
             StmtKind::Call(c) => self.call(c, scope),
             StmtKind::Error => {}
         }
@@ -354,9 +355,13 @@ impl<'a> Checker<'a> {
         }
     }
 
-    fn throw(&mut self, event: &ast::Ident, scope: &Scope) {
+    fn throw(&mut self, throw: &ast::Throw, scope: &Scope) {
         let Some(team) = scope.team else { return };
+        let event = &throw.event;
         self.event_occurrence(team, event);
+        if let Some(keyword) = throw.broadcast {
+            self.broadcast(team, event, keyword, &scope.robots);
+        }
         let t = self.team_mut(team);
         t.event_mut(&event.name).thrown_at.push(event.span);
         if let Some(service) = scope.service
@@ -365,6 +370,66 @@ impl<'a> Checker<'a> {
             self.team_mut(team).services[service.index()]
                 .throws
                 .push(event.name.clone());
+        }
+    }
+
+    /// Records who a `throw E broadcast` goes to: the robots running it
+    /// here, added to those of its other callers' walks.
+    fn broadcast(&mut self, team: TeamId, event: &ast::Ident, keyword: Span, robots: &Robots) {
+        if robots.is_empty() {
+            return; // no robot runs it: it tells no one
+        }
+        match self.broadcast_index.get(&(team, event.span)) {
+            Some(&i) => {
+                let known = &self.team(team).broadcasts[i].receivers;
+                if Arc::ptr_eq(known, &robots.0) {
+                    return;
+                }
+                let mut all: Vec<RobotId> = known.iter().chain(robots.iter()).copied().collect();
+                all.sort_unstable();
+                all.dedup();
+                let all = self.shared_robots(all).0;
+                self.team_mut(team).broadcasts[i].receivers = all;
+            }
+            None => {
+                let t = self.team_mut(team);
+                t.broadcasts.push(Broadcast {
+                    event: event.name.clone(),
+                    span: event.span,
+                    keyword,
+                    receivers: robots.0.clone(),
+                });
+                let i = t.broadcasts.len() - 1;
+                self.broadcast_index.insert((team, event.span), i);
+            }
+        }
+    }
+
+    /// Sorts each team's broadcasts by position (for `Team::broadcast_at`)
+    /// and gives W013 on each that only one robot runs.
+    fn finish_broadcasts(&mut self) {
+        for t in 0..self.mission.teams.len() {
+            let team = TeamId(t as u32);
+            let mut broadcasts = std::mem::take(&mut self.team_mut(team).broadcasts);
+            broadcasts.sort_by_key(|b| (b.span.start, b.span.end));
+            for b in broadcasts.iter().filter(|b| b.receivers.len() == 1) {
+                let t = self.team(team);
+                let robot = &t.robots[b.receivers[0].index()].name;
+                let message = if t.robots.len() == 1 {
+                    format!(
+                        "{robot} is the only robot of team {}: `broadcast` tells no one else",
+                        t.name
+                    )
+                } else {
+                    format!(
+                        "only {robot} runs this `throw`: its group has no one else to tell, so `broadcast` changes nothing"
+                    )
+                };
+                self.diagnostics
+                    .report(Code::BroadcastToNoOne, b.keyword, message)
+                    .severity = crate::diag::Severity::Hint;
+            }
+            self.team_mut(team).broadcasts = broadcasts;
         }
     }
 

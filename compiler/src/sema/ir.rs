@@ -81,6 +81,9 @@ pub struct Team {
     pub main: Option<Main>,
     /// Events its services throw or its main catches.
     pub events: Vec<Event>,
+    /// Its `throw E broadcast` statements, sorted by position: see
+    /// [`Team::broadcast_at`].
+    pub broadcasts: Vec<Broadcast>,
     /// Team variables (`T.X` assigned in send/publish, or received).
     pub variables: Vec<Name>,
     /// Its plans, services, modes and events by name: a mission may have
@@ -174,6 +177,24 @@ pub struct Event {
     pub name: Name,
     pub thrown_at: Vec<Span>,
     pub caught_at: Vec<Span>,
+}
+
+/// `throw E broadcast` in a service of the team (or a function its
+/// services call): who the event goes to.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Broadcast {
+    pub event: Name,
+    /// The range of the event's name in the statement (one per statement).
+    pub span: Span,
+    /// The range of the word `broadcast`.
+    pub keyword: Span,
+    /// The thrower's group: the team's robots that run the statement, as
+    /// the checker walked it (inside a `group`/`leader` arm or `others`,
+    /// the robots that run that arm; outside any, the whole team; in a
+    /// function called from several places, the robots of every one of
+    /// them), in formation order. Any of them may throw it; each of them
+    /// receives it, the thrower included.
+    pub receivers: std::sync::Arc<[RobotId]>,
 }
 
 #[derive(Clone, Debug)]
@@ -378,6 +399,7 @@ impl Team {
             modes: Vec::new(),
             main: None,
             events: Vec::new(),
+            broadcasts: Vec::new(),
             variables: Vec::new(),
             names: Names::default(),
         }
@@ -406,6 +428,26 @@ impl Team {
         self.names.modes.insert(mode.name.clone(), id);
         self.modes.push(mode);
         id
+    }
+
+    /// The broadcast whose event is named at `span` (the event's range in
+    /// its `throw ... broadcast` statement).
+    pub fn broadcast_at(&self, span: Span) -> Option<&Broadcast> {
+        let i = self
+            .broadcasts
+            .binary_search_by(|b| (b.span.start, b.span.end).cmp(&(span.start, span.end)))
+            .ok()?;
+        Some(&self.broadcasts[i])
+    }
+
+    /// The events that some robot of the team may receive from another one
+    /// (`throw E broadcast` run by at least two of its robots): a robot in
+    /// any mode may then catch them.
+    pub fn events_told(&self) -> impl Iterator<Item = &Name> {
+        self.broadcasts
+            .iter()
+            .filter(|b| b.receivers.len() > 1)
+            .map(|b| &b.event)
     }
 
     /// The event named `name`, added (neither thrown nor caught yet) if new.

@@ -173,6 +173,10 @@ pub(crate) struct Checker<'a> {
     /// The events each service throws, as in its `throws` list: a service
     /// may throw thousands.
     thrown: FastSet<(TeamId, ServiceId, Name)>,
+    /// Where each team's `Team::broadcasts` entry of a statement is, by the
+    /// range of its event name: a function's statement walked for several
+    /// callers is one entry with the robots of all.
+    broadcast_index: FastMap<(TeamId, Span), usize>,
     /// The mission went past [`MAX_ROBOTS_PER_MISSION`] (reported once):
     /// no further robot is declared.
     robots_full: bool,
@@ -207,6 +211,7 @@ impl<'a> Checker<'a> {
             message_robots: Vec::new(),
             robot_sets: FastSet::default(),
             thrown: FastSet::default(),
+            broadcast_index: FastMap::default(),
             robots_full: false,
         }
     }

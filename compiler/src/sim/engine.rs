@@ -243,6 +243,8 @@ struct Names {
     heartbeat: Rc<str>,
     alive_key: Rc<str>,
     sync_key: Rc<str>,
+    /// The key of its team's broadcast events (`refine::event_key`).
+    event_key: Rc<str>,
     /// Per outgoing message: (to, key).
     outgoing: Vec<(Rc<str>, Rc<str>)>,
 }
@@ -254,6 +256,7 @@ impl Names {
             heartbeat: program.robot.as_str().into(),
             alive_key: crate::codegen::files::alive_key(program).into(),
             sync_key: crate::codegen::files::sync_key(program).into(),
+            event_key: crate::refine::event_key(&program.team).into(),
             outgoing: program
                 .control
                 .outgoing
@@ -331,6 +334,10 @@ struct Robot<'p> {
     regions: Vec<Region>,
     current_mode: Option<usize>,
     pending_mode: Option<usize>,
+    /// Broadcast events received and not yet looked at by the control task:
+    /// (the thrower's peer index, the event's index in `events_heard`), in
+    /// arrival order, at most `EVENT_QUEUE` (`comm_event_take`).
+    events: VecDeque<(usize, usize)>,
     last_heartbeat: i64,
     /// Per peer: what its last heartbeat said (`comm_heard`).
     heard: Hearing,
@@ -513,6 +520,7 @@ impl<'p> Robot<'p> {
             ],
             current_mode: None,
             pending_mode: None,
+            events: VecDeque::new(),
             last_heartbeat: at - m.heartbeat_ms,
             heard: Hearing::new(team_peers(program)),
             leading: false,
@@ -523,7 +531,7 @@ impl<'p> Robot<'p> {
             leaders: HashMap::new(),
             group: None,
             tasks,
-            has_receiver: !m.incoming.is_empty() || !m.subscribed.is_empty() || m.heartbeat,
+            has_receiver: m.has_receiver(),
             sensor_series,
             battery: world.map(|w| w.battery.clone()).unwrap_or_default(),
             service_ms: world.map(|w| w.services.clone()).unwrap_or_default(),
@@ -1215,6 +1223,15 @@ impl<'p> Sim<'p> {
             self.wake(r);
             return;
         }
+        // `heard_event`: a broadcast event of its team.
+        if !m.events_heard.is_empty()
+            && !message.publish
+            && *message.key == *self.names[r].event_key
+            && *message.from_team == *self.names[r].team
+        {
+            self.hear_event(r, message);
+            return;
+        }
         if !m.subscribed.is_empty() && message.publish {
             for (i, g) in m.subscribed.iter().enumerate() {
                 if **g == *message.key {
@@ -1376,26 +1393,106 @@ impl<'p> Sim<'p> {
 
     fn throw_event(&mut self, r: usize, event: &str) {
         self.emit(r, "throw", vec![("name", event.into())]);
+        self.catch_event(r, event);
+    }
+
+    /// `throw E broadcast` (`throw_broadcast`): traced once, the others of
+    /// the thrower's group told (the event's name as text, key
+    /// `Team.__event`), then caught here as `throw E` is.
+    fn throw_broadcast(&mut self, r: usize, event: &str, messages: &[usize]) {
+        let fields = vec![("name", event.into()), ("broadcast", "true".into())];
+        self.emit(r, "throw", fields);
+        for &message in messages {
+            let (to, key) = self.names[r].outgoing[message].clone();
+            self.comm_send(r, to, false, key, Some(Value::text(event)));
+        }
+        self.catch_event(r, event);
+    }
+
+    /// The current mode's catch of `event`, unless a mode change is asked
+    /// for already: whether it was caught.
+    fn catch_event(&mut self, r: usize, event: &str) -> bool {
+        self.catch_event_from(r, event, None)
+    }
+
+    /// [`Sim::catch_event`], for an event told by `from` (a broadcast: the
+    /// `catch` names its thrower).
+    fn catch_event_from(&mut self, r: usize, event: &str, from: Option<Rc<str>>) -> bool {
         let robot = &self.robots[r];
         let m = &robot.program.control;
         let Some(current) = robot.current_mode else {
-            return;
+            return false;
         };
         if robot.pending_mode.is_some() {
-            return;
+            return false;
         }
-        if let Some(t) = m
+        let Some(t) = m
             .transitions
             .iter()
             .find(|t| t.from == current && t.event == event)
-        {
-            self.robots[r].pending_mode = Some(t.to);
-            let mode = m.modes[t.to].name.clone();
-            self.emit(
-                r,
-                "catch",
-                vec![("name", event.into()), ("mode", mode.into())],
-            );
+        else {
+            return false;
+        };
+        self.robots[r].pending_mode = Some(t.to);
+        let mode = m.modes[t.to].name.clone();
+        let mut fields = vec![("name", event.into()), ("mode", mode.into())];
+        if let Some(from) = from {
+            fields.push(("from", from));
+        }
+        self.emit(r, "catch", fields);
+        true
+    }
+
+    /// The receive task's `heard_event`: a broadcast event of its team
+    /// queued for the control task, which it wakes; an event this robot
+    /// hears of no one (`events_heard`) is refused, one past the queue's
+    /// room dropped.
+    fn hear_event(&mut self, r: usize, message: &Message) {
+        let robot = &self.robots[r];
+        let heard = &robot.program.control.events_heard;
+        let event = match &message.value {
+            Some(Value::Text(t)) => heard.binary_search_by(|e| e.as_str().cmp(t.as_str())).ok(),
+            _ => None,
+        };
+        let (Some(event), Some(peer)) = (event, sender_peer(robot.program, message)) else {
+            let fields = vec![
+                ("key", message.key.clone()),
+                ("reason", "not an event it hears".into()),
+            ];
+            self.emit(r, "reject", fields);
+            return;
+        };
+        if robot.events.len() >= crate::refine::EVENT_QUEUE {
+            let fields = vec![
+                ("from", message.from_robot.clone()),
+                ("name", heard[event].as_str().into()),
+                ("reason", "too many events".into()),
+            ];
+            self.emit(r, "drop", fields);
+            return;
+        }
+        self.robots[r].events.push_back((peer, event));
+        self.wake(r);
+    }
+
+    /// At the start of a control firing, in its mode (`comm_event_take`):
+    /// each broadcast event received since the last one, in order, handled
+    /// as its own `throw` would be, but traced as a `catch` naming the
+    /// thrower, or a `drop` (`not caught`) when the mode does not catch it
+    /// or a mode change is asked for already.
+    fn take_events(&mut self, r: usize) {
+        while let Some((peer, event)) = self.robots[r].events.pop_front() {
+            let program = self.robots[r].program;
+            let name = program.control.events_heard[event].as_str();
+            let from: Rc<str> = program.peers[peer].1.as_str().into();
+            if !self.catch_event_from(r, name, Some(from.clone())) {
+                let fields = vec![
+                    ("from", from),
+                    ("name", name.into()),
+                    ("reason", "not caught".into()),
+                ];
+                self.emit(r, "drop", fields);
+            }
         }
     }
 
@@ -1485,6 +1582,7 @@ impl<'p> Sim<'p> {
                 }
             }
         }
+        self.take_events(r);
         let mut running = false;
         for i in 0..self.robots[r].regions.len() {
             if self.robots[r].pending_mode.is_some() {
@@ -1742,8 +1840,11 @@ impl<'p> Sim<'p> {
                 self.region(r, i).pc = next;
                 Step::Next
             }
-            StateKind::Throw { event } => {
-                self.throw_event(r, event);
+            StateKind::Throw { event, broadcast } => {
+                match broadcast {
+                    None => self.throw_event(r, event),
+                    Some(messages) => self.throw_broadcast(r, event, messages),
+                }
                 self.region(r, i).pc = next;
                 Step::Next
             }

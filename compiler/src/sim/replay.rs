@@ -80,6 +80,7 @@ pub const FIELDS: &[&str] = &[
     "task",
     "statement",
     "name",
+    "broadcast",
     "leader",
     "heard",
     "line",

@@ -289,9 +289,13 @@ pub fn to_svg(run: &Run, programs: &[RobotProgram], scenario: &Scenario) -> Stri
                 );
             }
         }
-        // Throws and catches.
+        // Throws and catches (a broadcast is one throw at its thrower, and
+        // a catch at each robot it changed the mode of).
         for e in events.iter() {
             let (class, shape) = match e.event {
+                "throw" if e.field("broadcast").is_some() => {
+                    ("throw broadcast", "M-4,0 L0,-5 L4,0 L0,5 z")
+                }
                 "throw" => ("throw", "M-3,0 L0,-4 L3,0 L0,4 z"),
                 "catch" => ("catch", "M-3,-3 L3,3 M-3,3 L3,-3"),
                 _ => continue,

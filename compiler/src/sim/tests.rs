@@ -1206,4 +1206,80 @@ fn a_propertys_conditions_complete_the_missions_names() {
         labels(r#"{"expect": [{"eventually": {"robot": "irobot", "receives": "|"}}]}"#)
             .contains(&"SlaveTeam.COLOR".to_string())
     );
+
+/// The lines of a run that say what a broadcast did: the throws, catches,
+/// drops, modes and faults, and the messages that carry the events.
+fn broadcast_lines(run: &Run) -> Vec<String> {
+    run.trace_lines()
+        .lines()
+        .filter(|l| {
+            [
+                "\"throw\"",
+                "\"catch\"",
+                "\"drop\"",
+                "\"mode\"",
+                "\"fault\"",
+                "__event",
+            ]
+            .iter()
+            .any(|k| l.contains(k))
+        })
+        .map(str::to_string)
+        .collect()
+}
+
+/// `throw E broadcast` in a group arm (`tests/fixtures/broadcast/crew`):
+/// one `throw` at the thrower, one message to each other robot of its
+/// group, each receiver's `catch` (naming the thrower) or `drop` at its next
+/// firing; the Ev3 robot, in no group, and the killed tb_2 hear nothing.
+#[test]
+fn a_broadcast_tells_the_throwers_group_as_the_trace_fixture_says() {
+    let programs = programs("tests/fixtures/broadcast/crew.mission");
+    let scenario =
+        std::fs::read_to_string(repo("tests/fixtures/broadcast/crew.scenario.json")).unwrap();
+    let (run, _) = run(&programs, &scenario, 0);
+    let expected =
+        std::fs::read_to_string(repo("tests/fixtures/broadcast/crew.trace.jsonl")).unwrap();
+    let expected: Vec<&str> = expected.lines().collect();
+    assert_eq!(broadcast_lines(&run), expected);
+}
+
+/// Eighteen robots broadcast at one instant: each hears seventeen events
+/// before its next firing; its queue holds `EVENT_QUEUE` (16), so the last
+/// is dropped at once, and the sixteen taken find the robot already in the
+/// mode its own throw chose, so they are dropped as not caught.
+#[test]
+fn broadcast_events_past_the_queue_are_dropped() {
+    let programs = programs("tests/fixtures/broadcast/crowd.mission");
+    let scenario =
+        std::fs::read_to_string(repo("tests/fixtures/broadcast/crowd.scenario.json")).unwrap();
+    let (run, _) = run(&programs, &scenario, 0);
+    let lines = run.trace_lines();
+    for robot in 0..18 {
+        let of = |reason: &str| {
+            let needle = format!("\"robot\":\"tb_{robot}\",\"event\":\"drop\"");
+            lines
+                .lines()
+                .filter(|l| l.contains(&needle) && l.contains(reason))
+                .count()
+        };
+        assert_eq!(of("too many events"), 1, "tb_{robot}");
+        assert_eq!(of("not caught"), crate::refine::EVENT_QUEUE, "tb_{robot}");
+        assert_eq!(modes(&run, &format!("tb_{robot}")), ["GO", "HOLD"]);
+    }
+}
+
+/// A robot cut off by a partition when the event is thrown misses it: a
+/// broadcast is not sent again.
+#[test]
+fn a_partitioned_robot_misses_a_broadcast() {
+    let programs = programs("tests/fixtures/broadcast/march.mission");
+    let scenario = r#"{"duration": 1500,
+        "robots": {"quad_2": {"sensors": [{"at": 600, "value": "obstacle", "is": "true"}]}},
+        "faults": [{"from": 500, "until": 700, "partition": [["quad_4"]]}]}"#;
+    let (run, _) = run(&programs, scenario, 0);
+    for robot in ["quad_0", "quad_1", "quad_2", "quad_3"] {
+        assert_eq!(modes(&run, robot), ["MARCH", "AVOID"], "{robot}");
+    }
+    assert_eq!(modes(&run, "quad_4"), ["MARCH"]);
 }

@@ -185,10 +185,19 @@ pub enum StmtKind {
     Loop(Loop),
     Group(GroupStmt),
     Comm(Comm),
-    Throw(Ident),
+    Throw(Throw),
     Call(Call),
     /// A statement that could not be parsed; its syntax error is already reported.
     Error,
+}
+
+/// `throw E` or `throw E broadcast`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Throw {
+    pub event: Ident,
+    /// The range of `broadcast`: the event goes to every robot of the
+    /// thrower's group (its team outside any group), the thrower included.
+    pub broadcast: Option<Span>,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -483,6 +483,30 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_throw_keeps_where_broadcast_is_written() {
+        let text = "T.A.S { throw go broadcast\n throw stay } repeat()";
+        let p = parse(FileId(0), text);
+        assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);
+        let ast::Item::Service(service) = &p.file.items[0] else {
+            panic!("{:?}", p.file.items)
+        };
+        let throws: Vec<(&str, Option<Span>)> = service
+            .body
+            .stmts
+            .iter()
+            .map(|s| match &s.kind {
+                ast::StmtKind::Throw(t) => (t.event.name.as_str(), t.broadcast),
+                other => panic!("{other:?}"),
+            })
+            .collect();
+        assert_eq!(throws, [("go", Some(Span::new(17, 26))), ("stay", None)]);
+        // `broadcast` is a keyword: it is no event name.
+        let p = parse(FileId(0), "T.A.S { throw broadcast } repeat()");
+        assert_eq!(p.diagnostics[0].code, Code::SyntaxError);
+        assert_eq!(p.diagnostics[0].span, Span::new(14, 23));
+    }
+
+    #[test]
     fn a_standalone_expression_is_positioned_from_its_base() {
         let p = parse_expr(FileId(2), "distance > 20 and not stop", 100);
         assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);

@@ -302,7 +302,8 @@ where
 
         let throw = kw(Kw::Throw)
             .ignore_then(name().labelled("an event name"))
-            .map(StmtKind::Throw);
+            .then(kw(Kw::Broadcast).map(sp).or_not())
+            .map(|(event, broadcast)| StmtKind::Throw(Throw { event, broadcast }));
 
         let comm_kind = select! {
             Token::Kw(Kw::Send) => CommKind::Send,

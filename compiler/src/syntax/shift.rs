@@ -278,7 +278,12 @@ impl Shift for StmtKind {
             StmtKind::Loop(l) => l.shift(delta),
             StmtKind::Group(g) => g.shift(delta),
             StmtKind::Comm(c) => c.shift(delta),
-            StmtKind::Throw(event) => event.shift(delta),
+            StmtKind::Throw(Throw { event, broadcast }) => {
+                event.shift(delta);
+                if let Some(b) = broadcast {
+                    b.shift(delta);
+                }
+            }
             StmtKind::Call(c) => c.shift(delta),
             StmtKind::Error => {}
         }

@@ -29,6 +29,7 @@
 
 [
   "throw"
+  "broadcast"
   "catch"
 ] @keyword.exception
 

@@ -161,7 +161,7 @@ impl<'a> Node<'a> {
                     out.extend(c.items.iter().map(Node::CommItem));
                     out.extend(c.timeout.as_ref().map(|p| Node::Leaf(p.span)));
                 }
-                StmtKind::Throw(event) => out.push(Node::Ident(event)),
+                StmtKind::Throw(t) => out.push(Node::Ident(&t.event)),
                 StmtKind::Call(c) => {
                     out.push(Node::Ident(&c.name));
                     out.push(Node::Leaf(c.args_span));

@@ -439,6 +439,11 @@ impl Fingerprint {
         }
         self.int(robot.current_mode.map_or(-1, |m| m as i64));
         self.int(robot.pending_mode.map_or(-1, |m| m as i64));
+        self.int(robot.events.len() as i64);
+        for &(peer, event) in &robot.events {
+            self.int(peer as i64);
+            self.int(event as i64);
+        }
         self.time(robot.last_heartbeat);
         for (peer, h) in robot.heard.iter() {
             self.int(peer as i64);

@@ -90,7 +90,7 @@ impl Sim<'_> {
                         let message = &m.outgoing[item.message];
                         !message.publish && message.to_team != "USER"
                     }),
-                    StateKind::Throw { event } => caught(event),
+                    StateKind::Throw { event, .. } => caught(event),
                     _ => false,
                 };
                 if alone.step(r, j, service) != Step::Next {
