@@ -1206,6 +1206,7 @@ fn a_propertys_conditions_complete_the_missions_names() {
         labels(r#"{"expect": [{"eventually": {"robot": "irobot", "receives": "|"}}]}"#)
             .contains(&"SlaveTeam.COLOR".to_string())
     );
+}
 
 /// The lines of a run that say what a broadcast did: the throws, catches,
 /// drops, modes and faults, and the messages that carry the events.
