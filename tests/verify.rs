@@ -563,6 +563,25 @@ fn findings_with_faults_on_random_missions_hold_in_random_behaviours() {
     assert!(exhaustive >= 3, "only {exhaustive} exhaustive searches");
 }
 
+/// The same with the network losing or delaying one step's messages
+/// between two robots once along each behaviour.
+#[test]
+fn findings_with_network_faults_on_random_missions_hold_in_random_behaviours() {
+    let options = semo::verify::Options {
+        horizon_ms: 10_000,
+        max_states: 4_000,
+        changes: 1,
+        network: 1,
+        ..semo::verify::Options::default()
+    };
+    let (missions, exhaustive, held) =
+        random_findings_hold("verify-random-network", 40..56, &options);
+    eprintln!(
+        "{missions} missions with network faults, {exhaustive} explored exhaustively, {held} findings held"
+    );
+    assert!(exhaustive >= 3, "only {exhaustive} exhaustive searches");
+}
+
 /// Runs `semo verify` with `options` on the random missions of `seeds` and
 /// holds each claim to random behaviours: (missions, exhaustive searches,
 /// findings held).
@@ -664,6 +683,108 @@ fn random_findings_hold(
         }
     }
     (missions, exhaustive, held)
+}
+
+/// A message lost over the network (`--network 1`): the helper, told its
+/// goal once, waits for ever (V003) and never finishes (V002), each message
+/// naming the loss; the counterexample's `drop` fault replays it. Without
+/// a network fault the mission has no finding.
+#[test]
+fn a_message_the_network_loses_leaves_its_receiver_waiting_for_ever() {
+    let mission = "tests/fixtures/verify/message_lost/main.mission";
+    let (code, findings, _) = verify(mission, &[]);
+    assert_eq!((code, findings), (0, Vec::new()));
+    let dir = support::robots::scratch("verify-message-lost");
+    let dir_text = dir.to_string_lossy().to_string();
+    let (code, findings, data) =
+        verify(mission, &["--network", "1", "--counterexamples", &dir_text]);
+    assert_eq!(code, 1);
+    assert_eq!(data["exhaustive"], true, "{data}");
+    let found: Vec<(&str, u64)> = findings.iter().map(|(c, l, _)| (c.as_str(), *l)).collect();
+    assert_eq!(found, [("V002", 18), ("V003", 13)], "{findings:?}");
+    for (_, _, message) in &findings {
+        assert!(
+            message.contains("the messages between lead and help lost from 0 ms to 500 ms"),
+            "{message}"
+        );
+    }
+    let scenario = data["counterexamples"][1].as_str().unwrap().to_string();
+    let text = std::fs::read_to_string(&scenario).unwrap();
+    assert!(text.contains("\"drop\": [\"lead\", \"help\"]"), "{text}");
+    let out = semo(&["simulate", mission, "--scenario", &scenario, "--trace", "-"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    assert!(
+        !out.stdout
+            .contains("\"robot\":\"help\",\"event\":\"receive\""),
+        "{}",
+        out.stdout
+    );
+}
+
+/// Every choice the search makes is written into its counterexamples as
+/// the scenario entry that makes the same run: over random missions,
+/// random behaviours with sensor changes, operator commands, faults and
+/// network losses and delays, run live by `verify::apply` and replayed
+/// from `Counterexample::scenario_json`, give the same trace.
+#[test]
+fn a_counterexample_scenario_replays_the_run_its_choices_made() {
+    use semo::verify::{Choice, Counterexample};
+    let options = semo::verify::Options {
+        changes: 2,
+        faults: 2,
+        network: 3,
+        ..semo::verify::Options::default()
+    };
+    let mut rng = support::missiongen::Rng::new(5);
+    let (mut compared, mut network) = (0, 0);
+    for (seed, text, programs, _) in random_missions("verify-replay-choices", 300..316) {
+        let inputs = semo::verify::Inputs::derive(&programs);
+        let empty = semo::sim::Scenario::default();
+        let mut live = semo::sim::Sim::new(&programs, &empty, &semo::sim::Options::default());
+        let mut world = semo::verify::World::new(&inputs, &options, programs.len());
+        let start = (inputs.sensors.iter())
+            .map(|s| rng.below(s.values.len()))
+            .collect();
+        let mut made = vec![(0, Choice::Start(start))];
+        semo::verify::apply(&mut live, &mut world, &inputs, &made[0].1);
+        let mut trace = Vec::new();
+        let mut t = 0;
+        while t < 8_000 {
+            let all = semo::verify::choices(&inputs, &world);
+            let choice = all[rng.below(all.len())].clone();
+            network += usize::from(matches!(choice, Choice::Lose { .. } | Choice::Delay { .. }));
+            semo::verify::apply(&mut live, &mut world, &inputs, &choice);
+            made.push((t, choice));
+            t += options.step_ms;
+            live.run_to(t);
+            trace.extend(live.take_trace().iter().map(|e| format!("{e:?}")));
+        }
+        let way = Counterexample {
+            choices: made,
+            end_ms: t,
+            step_ms: options.step_ms,
+        };
+        let scenario = way.scenario_json(&inputs, &programs);
+        let parsed = semo::sim::scenario::parse(&scenario, &programs)
+            .unwrap_or_else(|e| panic!("seed {seed}: {e:?}\n{scenario}"));
+        let mut replay = semo::sim::Sim::new(&programs, &parsed, &semo::sim::Options::default());
+        replay.run_to(t);
+        let replayed: Vec<String> = replay
+            .take_trace()
+            .iter()
+            .map(|e| format!("{e:?}"))
+            .collect();
+        assert!(
+            replayed == trace,
+            "seed {seed}: the replay differs\n{scenario}\n{text}"
+        );
+        compared += 1;
+    }
+    eprintln!("{compared} random behaviours replayed, {network} network choices among them");
+    assert!(
+        compared >= 8 && network >= 10,
+        "{compared} compared, {network} network choices"
+    );
 }
 
 /// The user's properties over random missions: random `always`,

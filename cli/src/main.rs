@@ -330,8 +330,9 @@ enum Command {
         from which it never finishes though it finishes in other behaviours (V002), and a \
         robot that can reach a `receive` where it waits for ever (V003). With --faults N the \
         world may also kill, restart or cut off robots, up to N times along a behaviour, and \
-        two robots leading one `leader(...)` statement at once is reported (V004). \
-        --expect SCENARIO checks that scenario's `expect` list over every behaviour (`always`, \
+        two robots leading one `leader(...)` statement at once is reported (V004); with \
+        --network N the network may lose or delay the messages of two robots for a step, up \
+        to N times. --expect SCENARIO checks that scenario's `expect` list over every behaviour (`always`, \
         `eventually`, `leads_to`; a broken one exits 1 with a scenario that replays it). A \
         plan's `throw` that ends its mode in the instant another plan of the mode would \
         send or throw is reported too (V005: the plans' order decides a race). \
@@ -368,6 +369,11 @@ enum Command {
         /// others, heal the cut.
         #[arg(long, default_value_t = 0)]
         faults: u32,
+        /// How many times the network may misbehave along one behaviour:
+        /// lose, or delay by one step, the messages two robots exchange
+        /// during one step.
+        #[arg(long, default_value_t = 0)]
+        network: u32,
         /// Write each finding's counterexample into DIR as a scenario file.
         #[arg(long, value_name = "DIR")]
         counterexamples: Option<PathBuf>,
@@ -885,6 +891,7 @@ fn run() -> i32 {
             max_states,
             changes,
             faults,
+            network,
             counterexamples,
             expect,
             color,
@@ -900,6 +907,7 @@ fn run() -> i32 {
                     max_states,
                     changes,
                     faults,
+                    network,
                     merge_in_time: true,
                     observe: false,
                     cancel: None,

@@ -386,6 +386,17 @@ struct Robot<'p> {
     graphs: loops::GraphState,
 }
 
+/// A link `semo verify` disturbs ([`Sim::disturb`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Disturbance {
+    pub a: usize,
+    pub b: usize,
+    /// Messages sent before this mission ms are disturbed.
+    pub until: i64,
+    /// `None`: lost; else delayed by this many ms.
+    pub delay: Option<i64>,
+}
+
 /// Cloned by `semo verify` to branch on the world's choices (`explore.rs`).
 #[derive(Clone)]
 pub struct Sim<'p> {
@@ -414,6 +425,10 @@ pub struct Sim<'p> {
     /// A robot cut off from every other now (`semo verify`'s choice): as
     /// the scenario's partition `[[robot]]` from now on.
     isolated: Option<usize>,
+    /// Links `semo verify` disturbs now: the messages between robots `a`
+    /// and `b` sent before `until` are lost, or take `delay` ms longer (as
+    /// the scenario's `drop` and `delay` faults from the instant chosen).
+    disturbed: Vec<Disturbance>,
     /// How many robots run now (the run ends when none does and no restart
     /// is to come): counted, so that no event asks every robot.
     running: usize,
@@ -604,6 +619,7 @@ impl<'p> Sim<'p> {
             last_fire: (-1, 0),
             every_firing: options.every_firing,
             isolated: None,
+            disturbed: Vec::new(),
             running: programs.len(),
             restarts_due: 0,
             channel_full: "channel full".into(),
@@ -1065,6 +1081,14 @@ impl<'p> Sim<'p> {
         let now = self.now;
         if self.isolated.is_some_and(|i| i == a || i == b) {
             return None;
+        }
+        for d in &self.disturbed {
+            if ((d.a, d.b) == (a, b) || (d.a, d.b) == (b, a)) && now < d.until {
+                match d.delay {
+                    None => return None,
+                    Some(by) => latency += by,
+                }
+            }
         }
         for fault in &self.scenario.faults {
             match &fault.kind {

@@ -34,11 +34,23 @@ pub struct CommandInput {
 pub struct Inputs {
     pub sensors: Vec<SensorInput>,
     pub commands: Vec<CommandInput>,
+    /// The pairs of robots (indices, the lower first) that may exchange a
+    /// message: one sends or publishes to the other's team or name, or
+    /// they share a team whose robots send heartbeats. Only their links
+    /// are lost or delayed (`--network`).
+    pub links: Vec<(usize, usize)>,
 }
 
 /// A comparison of a slot with a constant: (operator with the slot on the
 /// left, the constant, how it compares).
 type Test = (CmpOp, Value, Compared);
+
+impl Inputs {
+    /// The world's choices for `programs` (what `semo verify` explores).
+    pub fn derive(programs: &[RobotProgram]) -> Inputs {
+        derive(programs)
+    }
+}
 
 pub fn derive(programs: &[RobotProgram]) -> Inputs {
     let mut inputs = Inputs::default();
@@ -94,7 +106,28 @@ pub fn derive(programs: &[RobotProgram]) -> Inputs {
             }
         }
     }
+    inputs.links = links(programs);
     inputs
+}
+
+/// [`Inputs::links`].
+fn links(programs: &[RobotProgram]) -> Vec<(usize, usize)> {
+    let tells = |a: &RobotProgram, b: &RobotProgram| {
+        a.control
+            .outgoing
+            .iter()
+            .any(|o| o.to_team == b.team || o.to_team == b.robot)
+            || (a.team == b.team && (a.control.heartbeat || b.control.heartbeat))
+    };
+    let mut links = Vec::new();
+    for (a, pa) in programs.iter().enumerate() {
+        for (b, pb) in programs.iter().enumerate().skip(a + 1) {
+            if tells(pa, pb) || tells(pb, pa) {
+                links.push((a, b));
+            }
+        }
+    }
+    links
 }
 
 /// Per slot of `m`: the constants its conditions compare it with.

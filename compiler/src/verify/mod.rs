@@ -52,6 +52,10 @@ pub struct Options {
     /// running robot, restart a killed one, cut one robot off from the
     /// others, heal the cut (0: none, the default).
     pub faults: u32,
+    /// How many times the network may misbehave along one behaviour: lose
+    /// the messages between two robots for one step, or delay them by one
+    /// step (0: never, the default).
+    pub network: u32,
     /// Merge a state with one met at another instant when they would go on
     /// alike (the reduction); without it only states of one instant merge,
     /// the reference the reduction is tested against.
@@ -72,6 +76,7 @@ impl Default for Options {
             max_states: 50_000,
             changes: 2,
             faults: 0,
+            network: 0,
             merge_in_time: true,
             observe: false,
             cancel: None,
@@ -119,6 +124,18 @@ pub enum Choice {
     },
     /// The cut robot reaches the others again.
     Heal,
+    /// The network: the messages between robots `a` and `b` sent in the
+    /// next step are lost.
+    Lose {
+        a: usize,
+        b: usize,
+    },
+    /// The network: the messages between robots `a` and `b` sent in the
+    /// next step arrive one step later than they would.
+    Delay {
+        a: usize,
+        b: usize,
+    },
 }
 
 /// What the world has set and what it may still do along one behaviour.
@@ -130,6 +147,11 @@ pub struct World {
     pub changes: u32,
     /// Faults left.
     pub faults: u32,
+    /// Losses and delays left.
+    pub network: u32,
+    /// The world's step (ms): how long a loss or delay lasts, and by how
+    /// much a delay delays.
+    pub step_ms: i64,
     /// Per robot: killed and not restarted.
     pub down: Vec<bool>,
     /// The robot cut off from the others now.
@@ -143,6 +165,8 @@ impl World {
             classes: vec![0; inputs.sensors.len()],
             changes: options.changes,
             faults: options.faults,
+            network: options.network,
+            step_ms: options.step_ms,
             down: vec![false; robots],
             isolated: None,
         }
@@ -156,6 +180,8 @@ pub struct Counterexample {
     pub choices: Vec<(i64, Choice)>,
     /// The mission ms the finding shows at: the scenario's duration.
     pub end_ms: i64,
+    /// The world's step: how long a loss or delay lasts.
+    pub step_ms: i64,
 }
 
 /// What a finding claims, for tests that hold it to the simulator.
@@ -459,6 +485,19 @@ impl Counterexample {
                     Choice::Restart { robot } => (robot, "restarted"),
                     Choice::Isolate { robot } => (robot, "cut off"),
                     Choice::Heal => return Some(format!("the cut healed at {at} ms")),
+                    Choice::Lose { a, b } | Choice::Delay { a, b } => {
+                        let what = if matches!(choice, Choice::Lose { .. }) {
+                            "lost"
+                        } else {
+                            "delayed"
+                        };
+                        return Some(format!(
+                            "the messages between {} and {} {what} from {at} ms to {} ms",
+                            robots[*a].robot,
+                            robots[*b].robot,
+                            at + self.step_ms
+                        ));
+                    }
                     _ => return None,
                 };
                 Some(format!("{} {what} at {at} ms", robots[*robot].robot))
@@ -522,6 +561,23 @@ impl Counterexample {
                     ));
                 }
                 Choice::Isolate { robot } => cut = Some((*at, *robot)),
+                Choice::Lose { a, b } | Choice::Delay { a, b } => {
+                    let pair = format!(
+                        "[{}, {}]",
+                        json_string(&robots[*a].robot),
+                        json_string(&robots[*b].robot)
+                    );
+                    let until = at + self.step_ms;
+                    faults.push(match choice {
+                        Choice::Lose { .. } => {
+                            format!("{{\"from\": {at}, \"until\": {until}, \"drop\": {pair}}}")
+                        }
+                        _ => format!(
+                            "{{\"from\": {at}, \"until\": {until}, \"delay\": {pair}, \"by\": {}}}",
+                            self.step_ms
+                        ),
+                    });
+                }
                 Choice::Heal => {
                     if let Some((from, robot)) = cut.take() {
                         faults.push(partition(from, *at, robot));

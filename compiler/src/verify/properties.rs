@@ -254,6 +254,7 @@ impl Steps<'_> {
         Counterexample {
             choices,
             end_ms: time + self.step_ms,
+            step_ms: self.step_ms,
         }
     }
 

@@ -169,9 +169,12 @@ pub fn explore(
                         statement(race.lost),
                     );
                     // Breadth first: the first met is the shallowest.
-                    races
-                        .entry(at)
-                        .or_insert_with(|| (race, counterexample(&nodes, id, &choice, t, next_t)));
+                    races.entry(at).or_insert_with(|| {
+                        (
+                            race,
+                            counterexample(&nodes, id, &choice, t, options.step_ms),
+                        )
+                    });
                 }
                 for e in trace {
                     // What a robot does (not what merely reaches it): it
@@ -198,7 +201,7 @@ pub fn explore(
                 }
                 let fp = key(child.fingerprint(&memory), &child_world, next_t, options);
                 if judge.always_broken(label) {
-                    let way = || counterexample(&nodes, id, &choice, t, next_t);
+                    let way = || counterexample(&nodes, id, &choice, t, options.step_ms);
                     judge.witness(label, way);
                 }
                 let child_id = match seen.get(&fp) {
@@ -418,6 +421,7 @@ fn key(fingerprint: u128, world: &World, now: i64, options: &Options) -> u128 {
     fingerprint
         ^ (u128::from(world.changes) << 96).wrapping_mul(0x9e37_79b9_7f4a_7c15)
         ^ (u128::from(world.faults) << 64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f)
+        ^ (u128::from(world.network) << 80).wrapping_mul(0x27d4_eb2f_1656_67c5)
         ^ down.wrapping_mul(0x1656_67b1_9e37_79f9_85eb_ca77_c2b2_ae63)
         ^ now.wrapping_mul(0xd6e8_feb8_6659_fd93_a5a1_ee3b_8f1c_2d4b)
 }
@@ -439,6 +443,15 @@ pub fn choices(inputs: &Inputs, world: &World) -> Vec<Choice> {
         for (c, input) in inputs.commands.iter().enumerate() {
             for v in 0..input.values.len() {
                 all.push(Choice::Command { input: c, value: v });
+            }
+        }
+    }
+    if world.network > 0 {
+        // Each pair of robots that may exchange a message, both alive now.
+        for &(a, b) in &inputs.links {
+            if !world.down[a] && !world.down[b] {
+                all.push(Choice::Lose { a, b });
+                all.push(Choice::Delay { a, b });
             }
         }
     }
@@ -464,6 +477,7 @@ pub fn apply(sim: &mut Sim, world: &mut World, inputs: &Inputs, choice: &Choice)
     match *choice {
         Choice::Nothing | Choice::Start(_) => {}
         Choice::Sensor { .. } | Choice::Command { .. } => world.changes -= 1,
+        Choice::Lose { .. } | Choice::Delay { .. } => world.network -= 1,
         Choice::Kill { .. } | Choice::Restart { .. } | Choice::Isolate { .. } | Choice::Heal => {
             world.faults -= 1
         }
@@ -509,12 +523,14 @@ pub fn apply(sim: &mut Sim, world: &mut World, inputs: &Inputs, choice: &Choice)
             sim.isolate(None);
             world.isolated = None;
         }
+        Choice::Lose { a, b } => sim.disturb(a, b, sim.now() + world.step_ms, None),
+        Choice::Delay { a, b } => sim.disturb(a, b, sim.now() + world.step_ms, Some(world.step_ms)),
     }
 }
 
 /// The choices from the start to node `id`, then `last` at `at`, the run
-/// ending at `end`.
-fn counterexample(nodes: &[Node], id: u32, last: &Choice, at: i64, end: i64) -> Counterexample {
+/// ending a step (`step_ms`) later.
+fn counterexample(nodes: &[Node], id: u32, last: &Choice, at: i64, step_ms: i64) -> Counterexample {
     let mut choices = vec![(at, last.clone())];
     let mut here = Some(id);
     while let Some(n) = here {
@@ -525,7 +541,8 @@ fn counterexample(nodes: &[Node], id: u32, last: &Choice, at: i64, end: i64) -> 
     choices.reverse();
     Counterexample {
         choices,
-        end_ms: end,
+        end_ms: at + step_ms,
+        step_ms,
     }
 }
 
@@ -533,10 +550,11 @@ fn counterexample(nodes: &[Node], id: u32, last: &Choice, at: i64, end: i64) -> 
 fn way_to(nodes: &[Node], n: usize, step_ms: i64) -> Counterexample {
     let node = &nodes[n];
     match node.parent {
-        Some(p) => counterexample(nodes, p, &node.choice, node.at, node.at + step_ms),
+        Some(p) => counterexample(nodes, p, &node.choice, node.at, step_ms),
         None => Counterexample {
             choices: vec![(0, node.choice.clone())],
             end_ms: step_ms,
+            step_ms,
         },
     }
 }

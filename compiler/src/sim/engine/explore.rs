@@ -123,6 +123,16 @@ impl<'p> Sim<'p> {
         self.isolated = r;
     }
 
+    /// From now until `until`, the messages between robots `a` and `b` are
+    /// lost (`delay` `None`) or take `delay` ms longer: the scenario's
+    /// `drop` or `delay` fault `[now, until)` of that pair.
+    pub fn disturb(&mut self, a: usize, b: usize, until: i64, delay: Option<i64>) {
+        let now = self.now;
+        self.disturbed.retain(|d| d.until > now);
+        self.disturbed
+            .push(super::Disturbance { a, b, until, delay });
+    }
+
     /// The `leader(...)` statements robot `r` leads now, as (service,
     /// state) of its program: it runs and its last election there chose it.
     pub fn leads(&self, r: usize) -> Vec<(usize, usize)> {
@@ -156,6 +166,15 @@ impl<'p> Sim<'p> {
             fp.robot(robot, timed);
         }
         fp.int(self.isolated.map_or(-1, |r| r as i64));
+        // The disturbances still under way, their ends relative to now.
+        let now = self.now;
+        fp.int(self.disturbed.iter().filter(|d| d.until > now).count() as i64);
+        for d in self.disturbed.iter().filter(|d| d.until > now) {
+            fp.int(d.a as i64);
+            fp.int(d.b as i64);
+            fp.int(d.until - self.now);
+            fp.int(d.delay.unwrap_or(-1));
+        }
         // The events still to come, in the order they will be handled;
         // those a robot will ignore (an earlier life's, a firing moved
         // earlier, a stopped call's end) are left out.
