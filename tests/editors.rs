@@ -128,6 +128,8 @@ fn neovim_shows_the_diagnostic_completes_and_highlights_a_mission() {
         "plain.xml: filetype xml, 0 semo client(s)",
         "simulate: IDLE@0 -> MOVING@1000, ok false",
         "scenario diagnostic: 4:13 expectation failed: r never enters IDLE: entered at 0 ms",
+        "verify: explored every behaviour: 542 state(s), 1130 transition(s): a proof for the choices explored; eventually r in MOVING: broken",
+        "verify quickfix: 1 finding(s)",
         "monitor: r          Rover        waiting",
         "monitor window: r          Rover        waiting",
         "marks: ◀ in this mode: r",

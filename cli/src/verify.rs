@@ -117,22 +117,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
                 options.color,
                 &mut err,
             );
-            let _ = writeln!(
-                out,
-                "{} {} state(s), {} transition(s): {}",
-                if report.exhaustive {
-                    "explored every behaviour:"
-                } else {
-                    "explored (bounded):"
-                },
-                report.states,
-                report.transitions,
-                if report.exhaustive {
-                    "a proof for the choices explored".to_string()
-                } else {
-                    format!("the first {} ms", report.reached_ms)
-                }
-            );
+            let _ = writeln!(out, "{}", report.headline());
             // The world's choices: each input with its values.
             let sensors = report
                 .inputs
@@ -230,26 +215,21 @@ fn property_said(
     mission: &Path,
     file: Option<&Path>,
 ) -> String {
-    use semo::verify::Outcome;
-    let said = property.expectation.kind.to_string();
-    match outcome {
-        Outcome::Holds { proof: true } => format!("  property `{said}`: holds in every behaviour"),
-        Outcome::Holds { proof: false } => {
-            format!("  property `{said}`: holds as far as the search looked (bounded)")
-        }
-        Outcome::NotJudged => format!(
-            "  property `{said}`: not judged: the search was bounded, and only an exhaustive one proves it"
+    let said = format!(
+        "  property `{}`: {}",
+        property.expectation.kind,
+        outcome.said()
+    );
+    match (outcome, file) {
+        (semo::verify::Outcome::Broken { .. }, Some(file)) => format!(
+            "{said}; replay with `semo simulate {} --scenario {}`",
+            mission.display(),
+            file.display()
         ),
-        Outcome::Broken { why, .. } => match file {
-            Some(file) => format!(
-                "  property `{said}`: broken: {why}; replay with `semo simulate {} --scenario {}`",
-                mission.display(),
-                file.display()
-            ),
-            None => format!(
-                "  property `{said}`: broken: {why} (--counterexamples DIR writes the scenario that replays it)"
-            ),
-        },
+        (semo::verify::Outcome::Broken { .. }, None) => {
+            format!("{said} (--counterexamples DIR writes the scenario that replays it)")
+        }
+        _ => said,
     }
 }
 
@@ -260,14 +240,14 @@ fn property_json(
     file: Option<&Path>,
 ) -> serde_json::Value {
     use semo::verify::Outcome;
-    let (verdict, proof, why) = match outcome {
-        Outcome::Holds { proof } => ("holds", *proof, None),
-        Outcome::NotJudged => ("not judged", false, None),
-        Outcome::Broken { why, .. } => ("broken", true, Some(why.as_str())),
+    let (proof, why) = match outcome {
+        Outcome::Holds { proof } => (*proof, None),
+        Outcome::NotJudged => (false, None),
+        Outcome::Broken { why, .. } => (true, Some(why.as_str())),
     };
     serde_json::json!({
         "expectation": property.expectation.kind.to_string(),
-        "verdict": verdict,
+        "verdict": outcome.verdict(),
         "proof": proof,
         "why": why,
         "counterexample": file.map(|f| f.display().to_string()),

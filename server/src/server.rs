@@ -197,6 +197,24 @@ impl Backend {
         outcome.answer.map_err(handlers::request_failed)
     }
 
+    /// `semo.verify`: the mission's behaviours explored on demand; a
+    /// cancelled request stops the search at its next state.
+    async fn verify(&self, arguments: &[serde_json::Value]) -> Result<serde_json::Value> {
+        use handlers::verify_mission;
+        let params = verify_mission::params(arguments).map_err(Error::invalid_params)?;
+        let cancel = CancelOnDrop::default();
+        let job = {
+            let world = self.state.world();
+            verify_mission::job(&world, params, cancel.0.clone())
+                .map_err(handlers::request_failed)?
+        };
+        let answer = tokio::task::spawn_blocking(move || verify_mission::verify(&job))
+            .await
+            .map_err(|_| Error::internal_error())?;
+        drop(cancel);
+        answer.map_err(handlers::request_failed)
+    }
+
     /// `semo.generateCode`: generates the code of a mission, reporting each
     /// robot as `$/progress`; a refusal publishes its reasons as the mission's
     /// diagnostics and is shown to the user.
@@ -776,6 +794,7 @@ impl LanguageServer for Backend {
                 .await
                 .map(Some),
             handlers::simulate::COMMAND => self.simulate(&p.arguments).await.map(Some),
+            handlers::verify_mission::COMMAND => self.verify(&p.arguments).await.map(Some),
             other => Err(Error::invalid_params(format!("unknown command `{other}`"))),
         }
     }

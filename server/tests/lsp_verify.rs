@@ -161,3 +161,81 @@ async fn a_client_that_cannot_create_files_gets_no_scenario_action() {
     );
     client.shutdown().await;
 }
+
+/// `semo.verify` on demand (VS Code's "Verify Mission", Neovim's
+/// `:SemoVerify`): the findings with their ranges and counterexample
+/// scenarios, the properties of an expectations file judged over every
+/// behaviour, the summary `semo verify` prints; a bad expectations file is
+/// refused with its line and column.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_verify_command_answers_findings_and_the_users_properties() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/verify/plans_race");
+    let mission = dir.join("main.mission");
+    let text = std::fs::read_to_string(&mission).unwrap();
+    let mission = file_uri(&mission);
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], Some(&file_uri(&dir))).await;
+    client.open(&mission, &text).await;
+    let answer = client
+        .request(
+            "workspace/executeCommand",
+            json!({"command": "semo.verify",
+                   "arguments": [{"uri": mission, "expect": "properties.json"}]}),
+        )
+        .await
+        .unwrap();
+    assert_eq!(answer["exhaustive"], true, "{answer:#}");
+    let found: Vec<(String, u64)> = answer["findings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            (
+                f["code"].as_str().unwrap().to_string(),
+                f["range"]["start"]["line"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        found,
+        [("V003".to_string(), 29), ("V005".to_string(), 16)],
+        "{answer:#}"
+    );
+    let race = &answer["findings"][1]["scenario"];
+    assert!(race.as_str().unwrap().contains("\"duration\""), "{race}");
+    let verdicts: Vec<&str> = answer["properties"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["verdict"].as_str().unwrap())
+        .collect();
+    assert_eq!(verdicts, ["broken", "broken", "broken", "holds", "broken"]);
+    let broken = answer["properties"][0]["scenario"].as_str().unwrap();
+    assert!(broken.contains("\"eventually\""), "{broken}");
+    let summary = answer["summary"].as_str().unwrap();
+    assert!(
+        summary.starts_with("explored every behaviour:")
+            && summary.contains("V005 line 17: at 10 ms base's plan Listen"),
+        "{summary}"
+    );
+    // A deadline is one run's: refused where it is written.
+    let bad = std::env::temp_dir().join(format!("semo-verify-bad-{}.json", std::process::id()));
+    std::fs::write(
+        &bad,
+        "{\"expect\": [{\"robot\": \"base\", \"enters\": \"DONE\", \"before\": 5}]}",
+    )
+    .unwrap();
+    let refused = client
+        .request(
+            "workspace/executeCommand",
+            json!({"command": "semo.verify",
+                   "arguments": [{"uri": mission, "expect": file_uri(&bad)}]}),
+        )
+        .await
+        .unwrap_err();
+    std::fs::remove_file(&bad).unwrap();
+    assert!(
+        refused.to_string().contains(":1:13: a deadline"),
+        "{refused}"
+    );
+}

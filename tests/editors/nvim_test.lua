@@ -170,6 +170,25 @@ local function run()
   local failed = vim.diagnostic.get(scenario)[1]
   report(string.format('scenario diagnostic: %d:%d %s', failed.lnum + 1, failed.col + 1, failed.message))
 
+  -- 6b. `:SemoVerify`'s function on the same mission with a property of its own: the search's
+  -- headline and the property's verdict; then the command as a user types it, which fills
+  -- the quickfix list.
+  vim.fn.writefile({ '{"expect": [{"eventually": {"robot": "r", "in": "MOVING"}}]}' },
+    workspace .. '/drive.properties.json')
+  check(vim.fn.exists(':SemoVerify') == 2, 'no :SemoVerify command')
+  local verified
+  semo.verify(mission, 'drive.properties.json', function(err, answer) verified = { err = err, answer = answer } end)
+  check(vim.wait(60000, function() return verified ~= nil end, 50), 'no verify answer within 60 s')
+  check(verified.err == nil, 'the search was refused: ' .. tostring(verified.err))
+  local property = verified.answer.properties[1]
+  report('verify: ' .. vim.split(verified.answer.summary, '\n')[1] .. '; ' .. property.expectation
+    .. ': ' .. property.verdict)
+  vim.fn.setqflist({}, ' ', { title = 'none yet', items = {} })
+  vim.cmd('SemoVerify')
+  check(vim.wait(60000, function() return vim.fn.getqflist({ title = 0 }).title == 'semo verify' end, 50),
+    ':SemoVerify did not fill the quickfix list')
+  report('verify quickfix: ' .. #vim.fn.getqflist() .. ' finding(s)')
+
   -- 7. `:SemoMonitor`'s function on the mission with a broker nobody listens on: every robot
   -- waiting, the connection shown down; stopping it answers that it ran.
   check(vim.fn.exists(':SemoMonitor') == 2, 'no :SemoMonitor command')

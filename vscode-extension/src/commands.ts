@@ -11,6 +11,7 @@ import {
   generateWithConsent,
 } from './pure/generate';
 import { missionTemplateSnippet } from './pure/template';
+import { VERIFY_COMMAND, VerifyAnswer, verifyMessage } from './pure/verify';
 import { GENERATE_CODE_COMMAND, Server } from './server';
 
 /** The server's `workspace/executeCommand` name for code generation. */
@@ -190,6 +191,58 @@ export async function generateCode(server: Server, lens?: unknown): Promise<void
   if (choice === open) {
     await vscode.commands.executeCommand('vscode.openFolder', folderUri, { forceNewWindow: true });
   }
+}
+
+/**
+ * "SeMo: Verify Mission": asks the server (`workspace/executeCommand`
+ * `semo.verify` with `[{ uri }]`) to explore everything the mission's team
+ * can do, as `semo verify` does, with a cancellable progress notification;
+ * writes the summary to the SeMo output and sums it up in one notification.
+ * The findings are also the mission's diagnostics after each save.
+ */
+export async function verifyMission(server: Server): Promise<void> {
+  const document = activeMission();
+  if (!document) {
+    void vscode.window.showWarningMessage('Open a mission (.mission) to verify it.');
+    return;
+  }
+  const client = server.running();
+  if (!client) {
+    return;
+  }
+  if (!serverOffers(server, VERIFY_COMMAND)) {
+    void vscode.window.showErrorMessage(
+      `This semo server cannot verify (it offers no "${VERIFY_COMMAND}" command). ` +
+        'Update semo, or point semo.server.path to a newer build.',
+    );
+    return;
+  }
+  const mission = path.basename(document.uri.path);
+  let answer: VerifyAnswer;
+  try {
+    answer = await vscode.window.withProgress(
+      {
+        location: vscode.ProgressLocation.Notification,
+        title: `SeMo: exploring everything ${mission} can do`,
+        cancellable: true,
+      },
+      (_progress, token) =>
+        client.sendRequest(
+          ExecuteCommandRequest.type,
+          { command: VERIFY_COMMAND, arguments: [{ uri: document.uri.toString() }] },
+          token,
+        ),
+    );
+  } catch (error) {
+    const message = error instanceof Error ? error.message : String(error);
+    server.output.appendLine(`[error] ${VERIFY_COMMAND}: ${message}`);
+    void vscode.window.showErrorMessage(`SeMo: verify failed: ${message}`);
+    return;
+  }
+  server.output.appendLine(`[info] semo verify ${mission}:\n  ${answer.summary.split('\n').join('\n  ')}`);
+  const { level, text } = verifyMessage(mission, answer);
+  const show = level === 'info' ? vscode.window.showInformationMessage : vscode.window.showWarningMessage;
+  void show(text, 'Show Output').then((c) => c && server.output.show());
 }
 
 /**

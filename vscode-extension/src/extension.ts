@@ -2,7 +2,7 @@
 // (live) view, and the palette's commands. Each part lives in its own module.
 
 import * as vscode from 'vscode';
-import { checkWorkspace, generateCode, newMission } from './commands';
+import { checkWorkspace, generateCode, newMission, verifyMission } from './commands';
 import { GraphViews } from './graphView';
 import { LiveRobotsView } from './liveRobotsView';
 import { insertNode, RobotsView } from './robotsView';
@@ -40,6 +40,7 @@ export async function activate(context: vscode.ExtensionContext): Promise<void> 
     vscode.commands.registerCommand('semo.showModeMachine', () => graphs.show('modes')),
     vscode.commands.registerCommand('semo.checkWorkspace', () => checkWorkspace(s)),
     vscode.commands.registerCommand('semo.simulateMission', () => simulations.simulate()),
+    vscode.commands.registerCommand('semo.verifyMission', () => verifyMission(s)),
     vscode.commands.registerCommand('semo.robots.refresh', () => robots.refresh()),
     vscode.commands.registerCommand('semo.robots.insert', insertNode),
     vscode.commands.registerCommand('semo.monitorRobots', () => live.start()),

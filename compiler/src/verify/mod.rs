@@ -242,6 +242,27 @@ pub struct Report {
 }
 
 impl Report {
+    /// How far the search looked, in one line: `explored every behaviour: N
+    /// state(s), M transition(s): a proof for the choices explored`, or
+    /// `explored (bounded): ...: the first T ms`.
+    pub fn headline(&self) -> String {
+        format!(
+            "{} {} state(s), {} transition(s): {}",
+            if self.exhaustive {
+                "explored every behaviour:"
+            } else {
+                "explored (bounded):"
+            },
+            self.states,
+            self.transitions,
+            if self.exhaustive {
+                "a proof for the choices explored".to_string()
+            } else {
+                format!("the first {} ms", self.reached_ms)
+            }
+        )
+    }
+
     /// The findings at the levels of the project's `[lints]`: allowed ones
     /// dropped (with their counterexamples and claims), denied ones errors.
     pub fn apply_lints(&mut self, project: &crate::project::Project) {

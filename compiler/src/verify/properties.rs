@@ -47,6 +47,32 @@ pub enum Outcome {
     NotJudged,
 }
 
+impl Outcome {
+    /// The verdict's word: `holds`, `broken` or `not judged`.
+    pub fn verdict(&self) -> &'static str {
+        match self {
+            Outcome::Holds { .. } => "holds",
+            Outcome::Broken { .. } => "broken",
+            Outcome::NotJudged => "not judged",
+        }
+    }
+
+    /// The verdict for people, without the way to it.
+    pub fn said(&self) -> String {
+        match self {
+            Outcome::Holds { proof: true } => "holds in every behaviour".to_string(),
+            Outcome::Holds { proof: false } => {
+                "holds as far as the search looked (bounded)".to_string()
+            }
+            Outcome::NotJudged => {
+                "not judged: the search was bounded, and only an exhaustive one proves it"
+                    .to_string()
+            }
+            Outcome::Broken { why, .. } => format!("broken: {why}"),
+        }
+    }
+}
+
 /// The properties of a scenario's expectations, each in the form judged
 /// over every behaviour; one that only a single run can judge (a deadline,
 /// `all_end_in`) is refused at its position.

@@ -22,6 +22,7 @@ pub mod selection_range;
 pub mod semantic_tokens;
 pub mod signature_help;
 pub mod simulate;
+pub mod verify_mission;
 pub mod workspace_symbol;
 
 use crate::encoding::{Encoding, LineMap};
@@ -91,6 +92,7 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
             commands: vec![
                 generate_code::COMMAND.to_string(),
                 simulate::COMMAND.to_string(),
+                verify_mission::COMMAND.to_string(),
             ],
             work_done_progress_options: WorkDoneProgressOptions {
                 work_done_progress: Some(true),

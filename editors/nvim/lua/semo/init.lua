@@ -12,6 +12,11 @@
 -- shows the summary and writes the timeline SVG (default: the scenario's name, `.svg`).
 -- Failed expectations appear as diagnostics on the scenario file.
 --
+-- `:SemoVerify [EXPECT]` in a mission explores everything its team can do through the
+-- server's `semo.verify` (as `semo verify` does; EXPECT: a scenario file whose `expect` list
+-- is checked over every behaviour), shows the summary and puts the findings in the quickfix
+-- list.
+--
 -- `:SemoMonitor [BROKER]` in a mission watches its running robots on the MQTT broker (the
 -- server's `semo/monitor`; default: the deployment file's broker) in a window of its own: the
 -- table of robots, modes, services and leader, rewritten in place as it changes (a buffer
@@ -196,6 +201,42 @@ function M.simulate(bufnr, scenario, svg, done)
   end, bufnr)
 end
 
+--- Explores the mission of `bufnr` (`expect`: a scenario whose `expect` list is checked too,
+--- relative to the mission's folder); `done(err, answer)` gets the server's answer
+--- (`summary`, `findings`, `properties`, ...) or the reason it refused.
+function M.verify(bufnr, expect, done)
+  local client = client_of(bufnr)
+  if client == nil then
+    return done('no semo server is attached to this buffer')
+  end
+  local argument = { uri = vim.uri_from_bufnr(bufnr) }
+  if expect ~= nil and expect ~= '' then
+    if expect:sub(1, 1) ~= '/' then
+      expect = vim.fn.fnamemodify(vim.api.nvim_buf_get_name(bufnr), ':p:h') .. '/' .. expect
+    end
+    argument.expect = vim.uri_from_fname(expect)
+  end
+  local params = { command = 'semo.verify', arguments = { argument } }
+  client.request('workspace/executeCommand', params, function(err, answer)
+    done(err and (err.message or tostring(err)), answer)
+  end, bufnr)
+end
+
+--- The quickfix entries of a `semo.verify` answer's findings in the mission of `bufnr`.
+function M.verify_quickfix(bufnr, answer)
+  local items = {}
+  for _, finding in ipairs(answer.findings) do
+    table.insert(items, {
+      bufnr = bufnr,
+      lnum = finding.range.start.line + 1,
+      col = finding.range.start.character + 1,
+      text = finding.code .. ': ' .. finding.message,
+      type = 'W',
+    })
+  end
+  return items
+end
+
 -- The live robot monitor: the last `semo/monitor` view of each mission URI, and who wants it.
 M.monitor_views = {}
 local monitor_listeners = {}
@@ -366,6 +407,25 @@ function M.setup(opts)
       end)
     end)
   end, { nargs = '*', complete = 'file', desc = 'Simulate the mission on a scenario (semo.simulate)' })
+  vim.api.nvim_create_user_command('SemoVerify', function(command)
+    local mission = vim.api.nvim_get_current_buf()
+    vim.notify('semo: verifying…', vim.log.levels.INFO)
+    M.verify(mission, command.fargs[1], function(err, answer)
+      vim.schedule(function()
+        if err then
+          vim.notify('semo: ' .. err, vim.log.levels.ERROR)
+          return
+        end
+        local items = M.verify_quickfix(mission, answer)
+        vim.fn.setqflist({}, ' ', { title = 'semo verify', items = items })
+        local broken = false
+        for _, property in ipairs(answer.properties) do
+          broken = broken or property.verdict == 'broken'
+        end
+        vim.notify(answer.summary, (#items > 0 or broken) and vim.log.levels.WARN or vim.log.levels.INFO)
+      end)
+    end)
+  end, { nargs = '?', complete = 'file', desc = 'Explore everything the mission can do (semo.verify)' })
   vim.lsp.handlers['semo/monitor'] = on_monitor_view
   vim.api.nvim_create_user_command('SemoMonitor', function(command)
     local broker = command.fargs[1]
