@@ -263,26 +263,13 @@ pub(super) fn expr(e: &Expr, words: &Words) -> String {
 /// keeps `throw_event` as it always was.
 fn emit_catch_event(out: &mut String, program: &RobotProgram, throws: bool, broadcasts: bool) {
     let m = &program.control;
-    out.push_str("/* The current mode's `catch` of `event` asks for its mode change, unless one\n * is asked for already: whether it did. `from`: the robot that broadcast the\n * event, or NULL for this robot's own throw. */\nstatic bool catch_event(const char *event, const char *from)\n{\n    switch (current_mode) {\n");
-    for (from, mode) in m.modes.iter().enumerate() {
-        let catches: Vec<_> = m.transitions.iter().filter(|t| t.from == from).collect();
-        if catches.is_empty() {
-            continue;
-        }
-        let _ = writeln!(out, "    case MODE_{}:", c::ident(&mode.name));
-        for t in catches {
-            let _ = writeln!(
-                out,
-                "        if (strcmp(event, {}) == 0 && pending_mode < 0) {{ /* {}:{} */\n            pending_mode = MODE_{};\n            semo_trace(\"catch\", \"name\", event, \"mode\", mode_name[pending_mode], from ? \"from\" : NULL, from, NULL);\n            return true;\n        }}",
-                c::string(&t.event),
-                c::comment(&program.mission),
-                t.line,
-                c::ident(&m.modes[t.to].name)
-            );
-        }
-        out.push_str("        break;\n");
-    }
-    out.push_str("    default:\n        break;\n    }\n    return false;\n}\n\n");
+    out.push_str("/* The current mode's `catch` of `event` asks for its mode change, unless one\n * is asked for already: whether it did. `from`: the robot that broadcast the\n * event, or NULL for this robot's own throw. */\nstatic bool catch_event(const char *event, const char *from)\n{\n");
+    emit_catches(
+        out,
+        program,
+        "semo_trace(\"catch\", \"name\", event, \"mode\", mode_name[pending_mode], from ? \"from\" : NULL, from, NULL);\n            return true;",
+    );
+    out.push_str("    return false;\n}\n\n");
     if throws {
         out.push_str("/* `throw`: asks for the mode change that the current mode's `catch` names. */\nstatic void throw_event(const char *event)\n{\n    semo_trace(\"throw\", \"name\", event, NULL);\n    catch_event(event, NULL);\n}\n\n");
     }
@@ -292,6 +279,33 @@ fn emit_catch_event(out: &mut String, program: &RobotProgram, throws: bool, broa
     if !m.events_heard.is_empty() {
         out.push_str("/* At the start of a firing, in its mode: each broadcast event received since\n * the last one, in order, handled as this robot's own throw would be; one\n * the mode does not catch (or after a caught one) is dropped. */\nstatic void take_events(void)\n{\n    size_t from;\n    const char *event;\n    while (comm_event_take(&from, &event)) {\n        const char *robot = semo_program()->peers[from].robot;\n        if (!catch_event(event, robot))\n            semo_trace(\"drop\", \"from\", robot, \"name\", event, \"reason\", \"not caught\", NULL);\n    }\n}\n\n");
     }
+}
+
+/// The `switch` on the current mode of `throw_event` and `catch_event`: per
+/// mode with catches, per catch of `event`, the mode change asked for and
+/// then `caught` (C statements, indented for the case).
+fn emit_catches(out: &mut String, program: &RobotProgram, caught: &str) {
+    let m = &program.control;
+    out.push_str("    switch (current_mode) {\n");
+    for (from, mode) in m.modes.iter().enumerate() {
+        let catches: Vec<_> = m.transitions.iter().filter(|t| t.from == from).collect();
+        if catches.is_empty() {
+            continue;
+        }
+        let _ = writeln!(out, "    case MODE_{}:", c::ident(&mode.name));
+        for t in catches {
+            let _ = writeln!(
+                out,
+                "        if (strcmp(event, {}) == 0 && pending_mode < 0) {{ /* {}:{} */\n            pending_mode = MODE_{};\n            {caught}\n        }}",
+                c::string(&t.event),
+                c::comment(&program.mission),
+                t.line,
+                c::ident(&m.modes[t.to].name)
+            );
+        }
+        out.push_str("        break;\n");
+    }
+    out.push_str("    default:\n        break;\n    }\n");
 }
 
 /// The helpers `body` calls: `store`, `read_inputs`, `throw_event`, `request`.
@@ -359,26 +373,13 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
     if broadcasts {
         emit_catch_event(out, program, uses("throw_event"), uses("throw_broadcast"));
     } else if uses("throw_event") {
-        out.push_str("/* `throw`: asks for the mode change that the current mode's `catch` names. */\nstatic void throw_event(const char *event)\n{\n    semo_trace(\"throw\", \"name\", event, NULL);\n    switch (current_mode) {\n");
-        for (from, mode) in m.modes.iter().enumerate() {
-            let catches: Vec<_> = m.transitions.iter().filter(|t| t.from == from).collect();
-            if catches.is_empty() {
-                continue;
-            }
-            let _ = writeln!(out, "    case MODE_{}:", c::ident(&mode.name));
-            for t in catches {
-                let _ = writeln!(
-                    out,
-                    "        if (strcmp(event, {}) == 0 && pending_mode < 0) {{ /* {}:{} */\n            pending_mode = MODE_{};\n            semo_trace(\"catch\", \"name\", event, \"mode\", mode_name[pending_mode], NULL);\n        }}",
-                    c::string(&t.event),
-                    c::comment(&program.mission),
-                    t.line,
-                    c::ident(&m.modes[t.to].name)
-                );
-            }
-            out.push_str("        break;\n");
-        }
-        out.push_str("    default:\n        break;\n    }\n}\n\n");
+        out.push_str("/* `throw`: asks for the mode change that the current mode's `catch` names. */\nstatic void throw_event(const char *event)\n{\n    semo_trace(\"throw\", \"name\", event, NULL);\n");
+        emit_catches(
+            out,
+            program,
+            "semo_trace(\"catch\", \"name\", event, \"mode\", mode_name[pending_mode], NULL);",
+        );
+        out.push_str("}\n\n");
     }
 
     if m.heartbeat {
