@@ -1175,39 +1175,6 @@ fn temporal_expectations_are_judged_instant_by_instant() {
     }
 }
 
-/// Completion inside a property's conditions, however deep: the modes of
-/// the condition's robot, the robots, the keys it receives.
-#[test]
-fn a_propertys_conditions_complete_the_missions_names() {
-    let programs = programs("examples/scouting/scouting.mission");
-    let labels = |text: &str| -> Vec<String> {
-        let offset = text.find('|').unwrap();
-        let text = text.replacen('|', "", 1);
-        complete::completions(&text, offset, &programs)
-            .into_iter()
-            .map(|c| c.label)
-            .collect()
-    };
-    assert_eq!(
-        labels(r#"{"expect": [{"always": {"not": {"all": [{"robot": "ti", "in": "S|"}]}}}]}"#),
-        [
-            "AUTO_MODE",
-            "SEARCH_MODE",
-            "RC_MODE",
-            "RETURN_MODE",
-            "FINISH"
-        ]
-    );
-    assert_eq!(
-        labels(r#"{"expect": [{"leads_to": [{"robot": "|"}]}]}"#),
-        ["irobot", "ti", "nxt"]
-    );
-    assert!(
-        labels(r#"{"expect": [{"eventually": {"robot": "irobot", "receives": "|"}}]}"#)
-            .contains(&"SlaveTeam.COLOR".to_string())
-    );
-}
-
 /// The lines of a run that say what a broadcast did: the throws, catches,
 /// drops, modes and faults, and the messages that carry the events.
 fn broadcast_lines(run: &Run) -> Vec<String> {

@@ -91,6 +91,30 @@ fn modes_are_the_named_robots_and_receives_its_incoming_keys() {
     );
 }
 
+/// Inside a property's conditions, however deep: the modes of the
+/// condition's robot, the robots, the keys it receives.
+#[test]
+fn a_propertys_conditions_complete_the_missions_names() {
+    assert_eq!(
+        labels_at(r#"{"expect": [{"always": {"not": {"all": [{"robot": "ti", "in": "S$0"}]}}}]}"#),
+        [
+            "AUTO_MODE",
+            "SEARCH_MODE",
+            "RC_MODE",
+            "RETURN_MODE",
+            "FINISH"
+        ]
+    );
+    assert_eq!(
+        labels_at(r#"{"expect": [{"leads_to": [{"robot": "$0"}]}]}"#),
+        ["irobot", "ti", "nxt"]
+    );
+    assert_eq!(
+        labels_at(r#"{"expect": [{"eventually": {"robot": "irobot", "receives": "$0"}}]}"#),
+        ["USER.RC_CMD", "SlaveTeam.COLOR", "SlaveTeam.LOCATION"]
+    );
+}
+
 #[test]
 fn a_string_is_replaced_inside_its_quotes_and_a_bare_place_gets_quotes() {
     let text = r#"{"expect": [{"robot": "ir", "enters": "X"}]}"#;
