@@ -133,7 +133,7 @@ pub fn check(
             build.mission,
             span,
             format!(
-                "{who} {}: {}: {why}, but {} has no transport to other robots yet: build {} for linux, or message only USER",
+                "{who} {} {}: {why}, but {} has no transport to other robots yet: build {} for linux, or message only USER",
                 if robots.len() == 1 { "is" } else { "are" },
                 built_for(chosen),
                 chosen.target.name(),
