@@ -471,14 +471,22 @@ fn a_mixed_fleet_builds_each_robot_for_its_own_platform_and_both_make() {
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
-    assert_eq!(objects.len(), 2, "one object folder per compiler and flags: {objects:?}");
+    assert_eq!(
+        objects.len(),
+        2,
+        "one object folder per compiler and flags: {objects:?}"
+    );
     // The board robot runs the scenario in QEMU as the simulator runs it.
     let lines = run_in_qemu(&elf);
     let qemu = events(&lines);
     assert_eq!(field(qemu.last().unwrap(), "event"), "stop", "{lines:?}");
     assert_eq!(modes(&qemu), ["SEARCH", "FOUND"]);
     let simulated = support::simulate_trace(&mission, &scenario, "sim");
-    assert_eq!(simulated.code, 0, "{}{}", simulated.stdout, simulated.stderr);
+    assert_eq!(
+        simulated.code, 0,
+        "{}{}",
+        simulated.stdout, simulated.stderr
+    );
     let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
     let simulated: Vec<Event> = events(&lines)
         .into_iter()

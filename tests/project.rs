@@ -511,7 +511,8 @@ fn one_build_gives_each_robot_the_platform_its_type_names() {
         "the board's memory from the platform table: {ld}"
     );
     assert!(
-        read(&runtime.join(".semo-manifest")).starts_with("semo-manifest 1 target linux and cortex-m\n")
+        read(&runtime.join(".semo-manifest"))
+            .starts_with("semo-manifest 1 target linux and cortex-m\n")
     );
     // The JSON document says each robot's target and who chose it.
     let json = semo_in(root, &["build", "--format", "json"]);
@@ -526,14 +527,18 @@ fn one_build_gives_each_robot_the_platform_its_type_names() {
     );
     let document: serde_json::Value = serde_json::from_str(&json.stdout).unwrap();
     assert_eq!(document["target"], serde_json::Value::Null);
-    assert_eq!(document["targets"], serde_json::json!(["linux", "cortex-m"]));
+    assert_eq!(
+        document["targets"],
+        serde_json::json!(["linux", "cortex-m"])
+    );
     // `--sim`: each platform's simulation (cortex-m-sim compiles the
     // scenario in, so it needs one).
     let sim = semo_in(root, &["build", "--sim", "--format", "json"]);
     assert_eq!(sim.code, 2, "{}{}", sim.stdout, sim.stderr);
     assert!(
-        sim.stderr
-            .contains("target cortex-m-sim compiles a scenario into each robot (ev): give --scenario FILE"),
+        sim.stderr.contains(
+            "target cortex-m-sim compiles a scenario into each robot (ev): give --scenario FILE"
+        ),
         "{}",
         sim.stderr
     );
@@ -604,8 +609,16 @@ fn the_project_file_gives_a_team_or_a_robot_its_own_target() {
     assert_eq!(w["code"], "W110");
     assert!(w["file"].as_str().unwrap().ends_with("semo.toml"), "{w}");
     let written = read(&root.join("semo.toml"));
-    let line = written.lines().position(|l| l.starts_with("Scuots")).unwrap() as u64 + 1;
-    assert_eq!((&w["start"]["line"], &w["start"]["column"]), (&line.into(), &1.into()), "{w}");
+    let line = written
+        .lines()
+        .position(|l| l.starts_with("Scuots"))
+        .unwrap() as u64
+        + 1;
+    assert_eq!(
+        (&w["start"]["line"], &w["start"]["column"]),
+        (&line.into(), &1.into()),
+        "{w}"
+    );
     assert_eq!(
         w["message"],
         "`[build.targets]` names `Scuots`, which is no team or robot of fleet.mission: its target is not used (did you mean `Scouts`?)"
@@ -614,7 +627,9 @@ fn the_project_file_gives_a_team_or_a_robot_its_own_target() {
     let human = semo_in(root, &["build"]);
     assert_eq!(human.code, 0, "{}", human.stderr);
     assert!(
-        human.stderr.contains("[W110] Warning: `[build.targets]` names `Scuots`")
+        human
+            .stderr
+            .contains("[W110] Warning: `[build.targets]` names `Scuots`")
             && human.stderr.contains(&format!("semo.toml:{line}:1")),
         "{}",
         human.stderr
@@ -637,7 +652,12 @@ fn the_project_file_gives_a_team_or_a_robot_its_own_target() {
     );
     let (code, found) = codes(root, &["."]);
     assert_eq!(code, 1, "{found:?}");
-    assert!(found.iter().any(|c| c.starts_with("E111 error") && c.ends_with("semo.toml")), "{found:?}");
+    assert!(
+        found
+            .iter()
+            .any(|c| c.starts_with("E111 error") && c.ends_with("semo.toml")),
+        "{found:?}"
+    );
     let (_, diags) = check_json_in(root, &["."]);
     let e111 = diags.iter().find(|d| d.code == "E111").unwrap();
     assert_eq!(e111.suggestion.as_deref(), Some("cortex-m"));
@@ -671,15 +691,25 @@ fn a_talking_robot_on_a_board_is_refused_naming_its_platform_and_where_it_is_cho
         d["message"],
         "robot `ev` (team `Scouts`) is built for cortex-m, the platform its type `Evalbot` names in the catalog: send `Scouts.DISTANCE` to team `Base`, but cortex-m has no transport to other robots yet: build it for linux, or message only USER"
     );
-    assert!(d["file"].as_str().unwrap().ends_with("fleet.mission"), "{d}");
+    assert!(
+        d["file"].as_str().unwrap().ends_with("fleet.mission"),
+        "{d}"
+    );
     let related = &d["related"][0];
     assert!(
-        related["file"].as_str().unwrap().ends_with("robots/fleet.robot.xml"),
+        related["file"]
+            .as_str()
+            .unwrap()
+            .ends_with("robots/fleet.robot.xml"),
         "{d}"
     );
     assert_eq!(related["message"], "cortex-m is chosen here");
     let catalog = read(&root.join("robots/fleet.robot.xml"));
-    let at = catalog.lines().position(|l| l.contains("target=\"cortex-m\"")).unwrap() as u64 + 1;
+    let at = catalog
+        .lines()
+        .position(|l| l.contains("target=\"cortex-m\""))
+        .unwrap() as u64
+        + 1;
     assert_eq!(related["line"], at, "{d}");
     assert!(!root.join("out").exists(), "nothing is written");
     // The project file builds it for linux instead.
