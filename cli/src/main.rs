@@ -170,7 +170,9 @@ enum Command {
         #[arg(long)]
         sim: bool,
         /// The scenario (`*.scenario.json`; `-`: standard input) compiled
-        /// into each robot: needed by, and only by, `--target cortex-m-sim`.
+        /// into each robot built for `cortex-m-sim` (`--target
+        /// cortex-m-sim`, or `--sim` with a cortex-m robot): needed by, and
+        /// only by, such a build.
         #[arg(long)]
         scenario: Option<PathBuf>,
         /// `all` (C code, Makefile and task graph) or `taskgraph` (only the
