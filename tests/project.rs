@@ -645,6 +645,22 @@ fn the_project_file_gives_a_team_or_a_robot_its_own_target() {
         "{}",
         human.stdout
     );
+    // Denied, it refuses the build, and nothing is written.
+    write(
+        &root.join("semo.toml"),
+        &format!("{written}\n[lints]\nW110 = \"deny\"\n"),
+    );
+    std::fs::remove_dir_all(root.join("out")).unwrap();
+    let denied = semo_in(root, &["build"]);
+    assert_eq!(denied.code, 1, "{}{}", denied.stdout, denied.stderr);
+    assert!(
+        denied
+            .stderr
+            .contains("[W110] Error: `[build.targets]` names `Scuots`"),
+        "{}",
+        denied.stderr
+    );
+    assert!(!root.join("out").exists());
     // An unknown target is E111 with a did-you-mean, and refuses the check.
     write(
         &root.join("semo.toml"),

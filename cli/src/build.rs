@@ -135,6 +135,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             }
         },
     };
+    // A plan finding the project denies (`[lints] W110 = "deny"`) refuses
+    // the build as generation's errors do.
+    result
+        .diagnostics
+        .extend(plan.diagnostics.iter().filter(|d| d.is_error()).cloned());
     if result.refused() {
         // What `semo check` gives for the mission and what generation adds,
         // each once.
