@@ -384,3 +384,113 @@ fn robots_fit_the_flash_and_ram_budgets() {
         );
     }
 }
+
+/// Every file under `dir` but the build products (relative path → bytes).
+fn sources(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(folder) = stack.pop() {
+        for entry in std::fs::read_dir(&folder).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+                continue;
+            }
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            let product = name.ends_with(".o") || name.ends_with(".elf") || !name.contains('.');
+            if !product || name == "Makefile" {
+                let relative = path.strip_prefix(dir).unwrap().display().to_string();
+                out.insert(relative, std::fs::read(&path).unwrap());
+            }
+        }
+    }
+    out
+}
+
+/// One build of a mixed fleet (`tests/fixtures/mixed_fleet`: its Evalbot's
+/// catalog names cortex-m, its iRobot Creates nothing, so linux) with
+/// `--sim`: the Evalbot's folder for cortex-m-sim, the Creates' for
+/// linux-sim, from the same output folder `make` builds both (each with its
+/// own compiler, on the one runtime folder), the Evalbot runs in QEMU as the
+/// simulator runs it, and a Linux robot's folder is byte for byte what a
+/// build of every robot for linux-sim writes.
+#[test]
+fn a_mixed_fleet_builds_each_robot_for_its_own_platform_and_both_make() {
+    if !tools_present("a_mixed_fleet_builds_each_robot_for_its_own_platform_and_both_make") {
+        return;
+    }
+    let project = support::repo_root().join("tests/fixtures/mixed_fleet");
+    let (mission, scenario) = (
+        project.join("fleet.mission"),
+        project.join("fleet.scenario.json"),
+    );
+    let out = scratch("cortex-m-mixed");
+    let mixed = out.join("mixed");
+    let (mission_arg, scenario_arg, mixed_arg) = (
+        mission.display().to_string(),
+        scenario.display().to_string(),
+        mixed.display().to_string(),
+    );
+    let built = support::semo_in(
+        &project,
+        &[
+            "build",
+            &mission_arg,
+            "--sim",
+            "--scenario",
+            &scenario_arg,
+            "-o",
+            &mixed_arg,
+        ],
+    );
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    assert!(
+        built
+            .stdout
+            .contains("built 3 robot(s) for targets linux-sim (2), cortex-m-sim (1)"),
+        "{}",
+        built.stdout
+    );
+    let (ev, a) = (mixed.join("Scouts/ev"), mixed.join("Base/a"));
+    let makefile = std::fs::read_to_string(ev.join("Makefile")).unwrap();
+    assert!(makefile.contains("target cortex-m-sim"), "{makefile}");
+    // A Linux robot's folder is what a build of every robot for linux-sim
+    // writes (the board robot alone could not be: its team's fellows talk).
+    let hosted = out.join("linux-sim");
+    build_for(&mission, "linux-sim", None, &hosted);
+    let (mixed_a, alone_a) = (sources(&a), sources(&hosted.join("Base/a")));
+    assert!(mixed_a.contains_key("main.c") && mixed_a.contains_key("Makefile"));
+    assert_eq!(mixed_a, alone_a, "a");
+    // `make` from the one output folder: arm-none-eabi-gcc for the board,
+    // gcc for the Linux robot, each on the shared runtime folder.
+    let elf = make(&ev);
+    robots::make(&a, "gcc", "-std=c11 -Wall -Wextra -Wpedantic -Werror -O1")
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert!(a.join("a").is_file(), "the Linux robot's program");
+    let objects: Vec<String> = std::fs::read_dir(mixed.join("semo-runtime/obj"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        objects.len(),
+        2,
+        "one object folder per compiler and flags: {objects:?}"
+    );
+    // The board robot runs the scenario in QEMU as the simulator runs it.
+    let lines = run_in_qemu(&elf);
+    let qemu = events(&lines);
+    assert_eq!(field(qemu.last().unwrap(), "event"), "stop", "{lines:?}");
+    assert_eq!(modes(&qemu), ["SEARCH", "FOUND"]);
+    let simulated = support::simulate_trace(&mission, &scenario, "sim");
+    assert_eq!(
+        simulated.code, 0,
+        "{}{}",
+        simulated.stdout, simulated.stderr
+    );
+    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
+    let simulated: Vec<Event> = events(&lines)
+        .into_iter()
+        .filter(|e| field(e, "robot") == "ev")
+        .collect();
+    same_behaviour("ev", &qemu, &simulated, 2000, 500);
+}

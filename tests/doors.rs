@@ -510,3 +510,86 @@ fn the_cli_and_the_editor_build_the_project_files_plan() {
     }
     assert!(!cli.join("out").exists() && !editor.join("out").exists());
 }
+
+/// `tests/fixtures/mixed_fleet` (its Evalbot's catalog platform is
+/// cortex-m, its iRobot Creates are linux) copied to `dir`, a repository root.
+fn mixed_fleet(dir: &Path) {
+    let fixture = support::repo_root().join("tests/fixtures/mixed_fleet");
+    for file in ["semo.toml", "fleet.mission", "robots/fleet.robot.xml"] {
+        let to = dir.join(file);
+        std::fs::create_dir_all(to.parent().unwrap()).unwrap();
+        std::fs::copy(fixture.join(file), to).unwrap();
+    }
+    std::fs::create_dir_all(dir.join(".git")).unwrap();
+}
+
+/// A mixed fleet: `semo build` and the editor's Generate Code read the same
+/// plan, so each robot gets the same target at both doors (the Evalbot
+/// cortex-m from its catalog, the Creates linux) and the same files, the
+/// runtime folder with both targets' files included.
+#[test]
+fn the_cli_and_the_editor_build_a_mixed_fleet_alike() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (cli, editor) = (tmp.path().join("cli"), tmp.path().join("editor"));
+    mixed_fleet(&cli);
+    mixed_fleet(&editor);
+    let built = semo_in(&cli, &["build"]);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    let answer = runtime.block_on(async {
+        let mut client = TestClient::start();
+        let root = format!("file://{}", editor.display());
+        client.initialize(&["utf-16"], Some(&root)).await;
+        let mission = editor.join("fleet.mission");
+        let uri = format!("file://{}", mission.display());
+        client
+            .open(&uri, &std::fs::read_to_string(&mission).unwrap())
+            .await;
+        client.diagnostics(&uri, Some(1)).await;
+        let answer = client
+            .request(
+                "workspace/executeCommand",
+                serde_json::json!({ "command": "semo.generateCode", "arguments": [{ "uri": uri }] }),
+            )
+            .await
+            .expect("generated");
+        client.shutdown().await;
+        answer
+    });
+    assert_eq!(answer["target"], Value::Null, "{answer}");
+    assert_eq!(
+        answer["targets"],
+        serde_json::json!(["linux", "cortex-m"]),
+        "{answer}"
+    );
+    let targets: Vec<(&str, &str)> = answer["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| (r["robot"].as_str().unwrap(), r["target"].as_str().unwrap()))
+        .collect();
+    assert_eq!(
+        targets,
+        [("ev", "cortex-m"), ("a", "linux"), ("b", "linux")]
+    );
+    let (from_cli, from_editor) = (tree(&cli.join("out")), tree(&editor.join("out")));
+    assert!(
+        from_cli.contains_key("Scouts/ev/Makefile")
+            && from_cli.contains_key("semo-runtime/semo_lm3s6965.c")
+            && from_cli.contains_key("semo-runtime/semo_runtime.c"),
+        "{:?}",
+        from_cli.keys()
+    );
+    assert_eq!(
+        from_cli.keys().collect::<Vec<_>>(),
+        from_editor.keys().collect::<Vec<_>>()
+    );
+    for (file, bytes) in &from_cli {
+        assert!(from_editor[file] == *bytes, "{file} differs");
+    }
+}

@@ -405,3 +405,343 @@ fn without_a_project_file_the_search_beside_a_mission_is_bounded() {
     );
     assert_eq!(codes(root, &["m.mission"]), (0, vec![]));
 }
+
+/// `tests/fixtures/mixed_fleet` copied into a fresh repository root: a
+/// project whose catalog puts its Evalbot on `cortex-m`, with two iRobot
+/// Creates (built-in, no platform named: `linux`).
+fn mixed_fleet() -> tempfile::TempDir {
+    let dir = workspace();
+    let fixture = support::repo_root().join("tests/fixtures/mixed_fleet");
+    for file in [
+        "semo.toml",
+        "fleet.mission",
+        "fleet.scenario.json",
+        "robots/fleet.robot.xml",
+    ] {
+        let text = std::fs::read_to_string(fixture.join(file)).unwrap();
+        write(&dir.path().join(file), &text);
+    }
+    dir
+}
+
+/// `robot → target` of each robot of a `semo build --format json` document,
+/// with who chose it.
+fn planned(stdout: &str) -> Vec<String> {
+    let document: serde_json::Value = serde_json::from_str(stdout).expect(stdout);
+    document["robots"]
+        .as_array()
+        .expect("robots")
+        .iter()
+        .map(|r| {
+            let sim = if r["simulated"] == true { " sim" } else { "" };
+            format!(
+                "{} {} ({}{sim})",
+                r["robot"].as_str().unwrap(),
+                r["target"].as_str().unwrap(),
+                r["chosen_by"].as_str().unwrap()
+            )
+        })
+        .collect()
+}
+
+fn read(path: &Path) -> String {
+    std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// One `semo build` writes each robot for the platform its type names: the
+/// Evalbot's folder for cortex-m, the Creates' for linux, each with its
+/// Makefile, and the runtime folder with what both need.
+#[test]
+fn one_build_gives_each_robot_the_platform_its_type_names() {
+    let dir = mixed_fleet();
+    let root = dir.path();
+    let built = semo_in(root, &["build"]);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    let lines: Vec<&str> = built.stdout.lines().collect();
+    assert!(
+        lines[0].starts_with("Scouts/ev: ")
+            && lines[0].contains("(target cortex-m, its type `Evalbot`'s platform; "),
+        "{}",
+        built.stdout
+    );
+    assert!(
+        lines[1].starts_with("Base/a: ") && lines[1].contains("(target linux; "),
+        "{}",
+        built.stdout
+    );
+    assert!(
+        built
+            .stdout
+            .contains("built 3 robot(s) for targets linux (2), cortex-m (1) in"),
+        "{}",
+        built.stdout
+    );
+    let out = root.join("out");
+    let ev = read(&out.join("Scouts/ev/Makefile"));
+    assert!(
+        ev.contains("for target cortex-m (TI Stellaris LM3S6965, a\n# Cortex-M3)")
+            && ev.contains("\nCC = arm-none-eabi-gcc\n")
+            && ev.contains("-T $(RUNTIME)/lm3s6965.ld"),
+        "{ev}"
+    );
+    let a = read(&out.join("Base/a/Makefile"));
+    assert!(
+        a.contains("for target linux;") && a.contains("\nTRANSPORT ?= mqtt\n"),
+        "{a}"
+    );
+    assert!(!a.contains("arm-none-eabi"), "{a}");
+    // One runtime folder: the threads layer and the board, no simulation.
+    let runtime = out.join("semo-runtime");
+    for file in [
+        "semo_core.c",
+        "semo_runtime.c",
+        "semo_mqtt.c",
+        "semo_static.c",
+        "semo_lm3s6965.c",
+        "lm3s6965.ld",
+        "semo_runtime.mk",
+    ] {
+        assert!(runtime.join(file).is_file(), "{file} in the runtime folder");
+    }
+    assert!(!runtime.join("semo_sim.c").exists());
+    let ld = read(&runtime.join("lm3s6965.ld"));
+    assert!(
+        ld.contains("FLASH (rx) : ORIGIN = 0x00000000, LENGTH = 256K")
+            && ld.contains("RAM (rwx)  : ORIGIN = 0x20000000, LENGTH = 64K"),
+        "the board's memory from the platform table: {ld}"
+    );
+    assert!(
+        read(&runtime.join(".semo-manifest"))
+            .starts_with("semo-manifest 1 target linux and cortex-m\n")
+    );
+    // The JSON document says each robot's target and who chose it.
+    let json = semo_in(root, &["build", "--format", "json"]);
+    assert_eq!(json.code, 0, "{}", json.stderr);
+    assert_eq!(
+        planned(&json.stdout),
+        [
+            "ev cortex-m (catalog)",
+            "a linux (default)",
+            "b linux (default)"
+        ]
+    );
+    let document: serde_json::Value = serde_json::from_str(&json.stdout).unwrap();
+    assert_eq!(document["target"], serde_json::Value::Null);
+    assert_eq!(
+        document["targets"],
+        serde_json::json!(["linux", "cortex-m"])
+    );
+    // `--sim`: each platform's simulation (cortex-m-sim compiles the
+    // scenario in, so it needs one).
+    let sim = semo_in(root, &["build", "--sim", "--format", "json"]);
+    assert_eq!(sim.code, 2, "{}{}", sim.stdout, sim.stderr);
+    assert!(
+        sim.stderr.contains(
+            "target cortex-m-sim compiles a scenario into each robot (ev): give --scenario FILE"
+        ),
+        "{}",
+        sim.stderr
+    );
+    let sim = semo_in(
+        root,
+        &[
+            "build",
+            "--sim",
+            "--scenario",
+            "fleet.scenario.json",
+            "--format",
+            "json",
+        ],
+    );
+    assert_eq!(sim.code, 0, "{}{}", sim.stdout, sim.stderr);
+    assert_eq!(
+        planned(&sim.stdout),
+        [
+            "ev cortex-m-sim (catalog sim)",
+            "a linux-sim (default sim)",
+            "b linux-sim (default sim)"
+        ]
+    );
+    assert!(out.join("Scouts/ev/scenario.c").is_file());
+    assert!(runtime.join("semo_sim.c").is_file());
+    // `--target` is every robot's, whatever the catalog says.
+    let linux = semo_in(root, &["build", "--target", "linux", "--format", "json"]);
+    assert_eq!(linux.code, 0, "{}{}", linux.stdout, linux.stderr);
+    assert_eq!(
+        planned(&linux.stdout),
+        [
+            "ev linux (command line)",
+            "a linux (command line)",
+            "b linux (command line)"
+        ]
+    );
+    assert!(read(&out.join("Scouts/ev/Makefile")).contains("for target linux;"));
+}
+
+/// `[build.targets]` gives a team or a robot its own target, over the
+/// catalog's and `[build] target`; a name the mission lacks is W110 where
+/// it is written, with a did-you-mean, and the robots keep their target.
+#[test]
+fn the_project_file_gives_a_team_or_a_robot_its_own_target() {
+    let dir = mixed_fleet();
+    let root = dir.path();
+    let project = read(&root.join("semo.toml"));
+    write(
+        &root.join("semo.toml"),
+        &format!(
+            "{project}\n[build]\ntarget = \"linux-sim\"\n\n[build.targets]\nScouts = \"linux\"\nev = \"cortex-m\"\na = \"linux\"\nScuots = \"linux\"\n"
+        ),
+    );
+    let built = semo_in(root, &["build", "--format", "json"]);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    assert_eq!(
+        planned(&built.stdout),
+        [
+            "ev cortex-m (project file)",
+            "a linux (project file)",
+            "b linux-sim (project file)"
+        ]
+    );
+    let document: serde_json::Value = serde_json::from_str(&built.stdout).unwrap();
+    let warnings = document["diagnostics"].as_array().unwrap();
+    assert_eq!(warnings.len(), 1, "{document}");
+    let w = &warnings[0];
+    assert_eq!(w["code"], "W110");
+    assert!(w["file"].as_str().unwrap().ends_with("semo.toml"), "{w}");
+    let written = read(&root.join("semo.toml"));
+    let line = written
+        .lines()
+        .position(|l| l.starts_with("Scuots"))
+        .unwrap() as u64
+        + 1;
+    assert_eq!(
+        (&w["start"]["line"], &w["start"]["column"]),
+        (&line.into(), &1.into()),
+        "{w}"
+    );
+    assert_eq!(
+        w["message"],
+        "`[build.targets]` names `Scuots`, which is no team or robot of fleet.mission: its target is not used (did you mean `Scouts`?)"
+    );
+    // For people: on standard error, positioned in semo.toml.
+    let human = semo_in(root, &["build"]);
+    assert_eq!(human.code, 0, "{}", human.stderr);
+    assert!(
+        human
+            .stderr
+            .contains("[W110] Warning: `[build.targets]` names `Scuots`")
+            && human.stderr.contains(&format!("semo.toml:{line}:1")),
+        "{}",
+        human.stderr
+    );
+    assert!(
+        human.stdout.contains("Scouts/ev: ")
+            && human
+                .stdout
+                .contains("(target cortex-m from semo.toml's `[build.targets] ev`; ")
+            && human
+                .stdout
+                .contains("(target linux-sim from semo.toml's `[build] target`; "),
+        "{}",
+        human.stdout
+    );
+    // Denied, it refuses the build, and nothing is written.
+    write(
+        &root.join("semo.toml"),
+        &format!("{written}\n[lints]\nW110 = \"deny\"\n"),
+    );
+    std::fs::remove_dir_all(root.join("out")).unwrap();
+    let denied = semo_in(root, &["build"]);
+    assert_eq!(denied.code, 1, "{}{}", denied.stdout, denied.stderr);
+    assert!(
+        denied
+            .stderr
+            .contains("[W110] Error: `[build.targets]` names `Scuots`"),
+        "{}",
+        denied.stderr
+    );
+    assert!(!root.join("out").exists());
+    // An unknown target is E111 with a did-you-mean, and refuses the check.
+    write(
+        &root.join("semo.toml"),
+        &format!("{project}\n[build.targets]\nScouts = \"cortx-m\"\n"),
+    );
+    let (code, found) = codes(root, &["."]);
+    assert_eq!(code, 1, "{found:?}");
+    assert!(
+        found
+            .iter()
+            .any(|c| c.starts_with("E111 error") && c.ends_with("semo.toml")),
+        "{found:?}"
+    );
+    let (_, diags) = check_json_in(root, &["."]);
+    let e111 = diags.iter().find(|d| d.code == "E111").unwrap();
+    assert_eq!(e111.suggestion.as_deref(), Some("cortex-m"));
+}
+
+/// A robot whose type's platform cannot run it (a cortex-m robot that
+/// talks to another robot) is refused, naming the robot, the platform and
+/// why, pointing at the catalog's `target=`: never built for linux behind
+/// the user's back. The project file can then build it for linux.
+#[test]
+fn a_talking_robot_on_a_board_is_refused_naming_its_platform_and_where_it_is_chosen() {
+    let dir = mixed_fleet();
+    let root = dir.path();
+    let mission = read(&root.join("fleet.mission")).replace(
+        "  send(USER, Scouts.DISTANCE)\n",
+        "  send(USER, Scouts.DISTANCE)\n  send(Base, Scouts.DISTANCE)\n",
+    );
+    write(&root.join("fleet.mission"), &mission);
+    let built = semo_in(root, &["build", "--format", "json"]);
+    assert_eq!(built.code, 1, "{}{}", built.stdout, built.stderr);
+    let document: serde_json::Value = serde_json::from_str(&built.stdout).unwrap();
+    let e103: Vec<&serde_json::Value> = document["diagnostics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|d| d["code"] == "E103")
+        .collect();
+    assert_eq!(e103.len(), 1, "{document}");
+    let d = e103[0];
+    assert_eq!(
+        d["message"],
+        "robot `ev` (team `Scouts`) is built for cortex-m, the platform its type `Evalbot` names in the catalog: send `Scouts.DISTANCE` to team `Base`, but cortex-m has no transport to other robots yet: build it for linux, or message only USER"
+    );
+    assert!(
+        d["file"].as_str().unwrap().ends_with("fleet.mission"),
+        "{d}"
+    );
+    let related = &d["related"][0];
+    assert!(
+        related["file"]
+            .as_str()
+            .unwrap()
+            .ends_with("robots/fleet.robot.xml"),
+        "{d}"
+    );
+    assert_eq!(related["message"], "cortex-m is chosen here");
+    let catalog = read(&root.join("robots/fleet.robot.xml"));
+    let at = catalog
+        .lines()
+        .position(|l| l.contains("target=\"cortex-m\""))
+        .unwrap() as u64
+        + 1;
+    assert_eq!(related["line"], at, "{d}");
+    assert!(!root.join("out").exists(), "nothing is written");
+    // The project file builds it for linux instead.
+    let project = read(&root.join("semo.toml"));
+    write(
+        &root.join("semo.toml"),
+        &format!("{project}\n[build.targets]\nev = \"linux\"\n"),
+    );
+    let built = semo_in(root, &["build", "--format", "json"]);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    assert_eq!(
+        planned(&built.stdout),
+        [
+            "ev linux (project file)",
+            "a linux (default)",
+            "b linux (default)"
+        ]
+    );
+}

@@ -4,7 +4,7 @@
 use super::input::{self, Content};
 use super::output::{self, Format, Record};
 use semo::codegen::output::{OutputError, Transaction};
-use semo::codegen::{self, Emit, Target};
+use semo::codegen::{self, Chosen, Emit, Reason, Target};
 use semo::host;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -15,9 +15,12 @@ pub struct Options {
     pub strategy: Vec<PathBuf>,
     /// Else the project file's `[build] output`, else `out` beside the mission.
     pub out: Option<PathBuf>,
-    /// Else the project file's `[build] target`, else `linux`.
+    /// Every robot's target; else each robot's own (the build plan:
+    /// the project file, the robot type's platform, `linux`).
     pub target: Option<Target>,
-    /// Compiled into each robot (targets that need it: `cortex-m-sim`).
+    /// Each robot built for its platform's simulation.
+    pub sim: bool,
+    /// Compiled into each robot whose target needs it (`cortex-m-sim`).
     pub scenario: Option<PathBuf>,
     pub emit: Emit,
     pub format: Format,
@@ -65,30 +68,41 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         &mission_file,
         host::PlanRequest {
             target: options.target,
+            sim: options.sim,
             output: options.out.clone(),
             deployment: options.deploy.clone(),
         },
     );
-    let (target, out_dir) = (plan.target, plan.output);
-    if options.scenario.is_some() != target.needs_scenario() {
+    let targets = plan.distinct_targets();
+    let out_dir = plan.output.clone();
+    // The plan's findings in the project file (a `[build.targets]` name the
+    // mission does not have) are printed with the mission's.
+    run.diagnostics.extend(plan.diagnostics.iter().cloned());
+    let compiled_in: Vec<&host::PlannedRobot> = plan
+        .robots
+        .iter()
+        .filter(|r| r.chosen.target.needs_scenario())
+        .collect();
+    if options.scenario.is_some() == compiled_in.is_empty() {
         eprintln!(
             "error: {}",
-            if options.scenario.is_some() {
+            if compiled_in.is_empty() {
                 format!(
-                    "--scenario is compiled in only for target cortex-m-sim (target {} reads it at run time, if at all)",
-                    target.name()
+                    "--scenario is compiled in only for target cortex-m-sim, and no robot of this build is built for it (target {} reads a scenario at run time, if at all)",
+                    names(&targets)
                 )
             } else {
+                let robots: Vec<&str> = compiled_in.iter().map(|r| r.robot.as_str()).collect();
                 format!(
-                    "target {} compiles a scenario into each robot: give --scenario FILE",
-                    target.name()
+                    "target cortex-m-sim compiles a scenario into each robot ({}): give --scenario FILE",
+                    robots.join(", ")
                 )
             }
         );
         return 2;
     }
     // The deployment file: the command line's, else the project file's.
-    let deploy_path = plan.deployment;
+    let deploy_path = plan.deployment.clone();
     let deployment = match &deploy_path {
         None => None,
         Some(path) => {
@@ -110,9 +124,10 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return super::deploy::refuse(&mut run, found, options.format, options.color, out);
         }
     }
+    let chosen = plan.targets();
     let mut result = match &scenario {
-        None => codegen::build(&input, target, options.emit),
-        Some((name, text)) => match build_with_scenario(&input, name, text, target, &options) {
+        None => codegen::build_each(&input, &chosen, options.emit),
+        Some((name, text)) => match build_with_scenario(&input, name, text, &chosen, &options) {
             Ok(result) => result,
             Err(record) => {
                 report_scenario(&record, options.format, out);
@@ -120,6 +135,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             }
         },
     };
+    // A plan finding the project denies (`[lints] W110 = "deny"`) refuses
+    // the build as generation's errors do.
+    result
+        .diagnostics
+        .extend(plan.diagnostics.iter().filter(|d| d.is_error()).cloned());
     if result.refused() {
         // What `semo check` gives for the mission and what generation adds,
         // each once.
@@ -135,7 +155,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
                 &run.files,
                 &run.diagnostics,
                 options.color,
-                serde_json::json!({ "target": target.name(), "robots": [] }),
+                serde_json::json!({
+                    "target": single(&targets),
+                    "targets": names_json(&targets),
+                    "robots": [],
+                }),
                 out,
             ),
         };
@@ -150,7 +174,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         if !semo::deploy::bake(deployment, &mut result) {
             eprintln!(
                 "error: --deploy: target {} has no network transport to deploy",
-                target.name()
+                names(&targets)
             );
             return 2;
         }
@@ -192,20 +216,20 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             eprintln!("recovered: {line}");
         }
     }
-    let runtime = match transaction.stage_runtime(&result.runtime, target, options.force) {
+    let runtime = match transaction.stage_runtime(&result.runtime, &targets, options.force) {
         Ok(written) => written,
         Err(e) => {
             let folder = semo::codegen::RUNTIME_FOLDER;
-            return refuse(&transaction, e, folder, &result.robots, target);
+            return refuse(&transaction, e, folder, &result.robots);
         }
     };
     let mut staged = Vec::new();
     for (i, robot) in result.robots.iter().enumerate() {
-        match transaction.stage_robot(robot, target, options.force) {
+        match transaction.stage_robot(robot, options.force) {
             Ok(written) => staged.push((robot, written)),
             Err(e) => {
                 let folder = format!("{}/{}", robot.team, robot.robot);
-                return refuse(&transaction, e, &folder, &result.robots[i + 1..], target);
+                return refuse(&transaction, e, &folder, &result.robots[i + 1..]);
             }
         }
     }
@@ -223,9 +247,13 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         } else {
             100.0 * generated as f64 / (generated + user) as f64
         };
+        let chosen = plan.target_of(&robot.robot);
         robots_json.push(serde_json::json!({
             "team": robot.team,
             "robot": robot.robot,
+            "target": robot.target.name(),
+            "chosen_by": chosen.map(chosen_by),
+            "simulated": chosen.is_some_and(|c| c.simulated),
             "folder": written.folder.display().to_string(),
             "generated_files": written.generated,
             "task_files_created": written.created,
@@ -236,10 +264,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         }
         let _ = writeln!(
             out,
-            "{}/{}: {} ({} generated files; {} task files created, {} kept; {generated} lines generated, {user} in task files: {share:.0}% generated)",
+            "{}/{}: {} ({}; {} generated files; {} task files created, {} kept; {generated} lines generated, {user} in task files: {share:.0}% generated)",
             robot.team,
             robot.robot,
             written.folder.display(),
+            chosen.map_or_else(|| format!("target {}", robot.target), target_line),
             written.generated,
             written.created,
             written.kept,
@@ -267,7 +296,8 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             &run.diagnostics,
             options.color,
             serde_json::json!({
-                "target": target.name(),
+                "target": single(&targets),
+                "targets": names_json(&targets),
                 "robots": robots_json,
                 "runtime": (!result.runtime.is_empty()).then(|| serde_json::json!({
                     "folder": runtime.folder.display().to_string(),
@@ -295,9 +325,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     }
     let _ = writeln!(
         out,
-        "built {} robot(s) for target {} in {:.1} ms ({:.1} ms generating)",
+        "built {} robot(s) for {} in {:.1} ms ({:.1} ms generating)",
         result.robots.len(),
-        target.name(),
+        count_by_target(&result.robots),
         started.elapsed().as_secs_f64() * 1000.0,
         generated.as_secs_f64() * 1000.0
     );
@@ -321,23 +351,25 @@ fn report_scenario(record: &Record, format: Format, out: &mut impl Write) {
     let _ = output::written(written);
 }
 
-/// Builds for a target that compiles the scenario (`text`, read from
-/// `path`) in: the mission is refined first, since the scenario's names are
-/// checked against its programs. A scenario's mistake is given positioned.
+/// Builds robots of which some are for a target that compiles the scenario
+/// (`text`, read from `path`) in: the mission is refined first, since the
+/// scenario's names are checked against its programs (each robot gets its
+/// world; only those targets compile it). A scenario's mistake is given
+/// positioned.
 fn build_with_scenario(
     input: &codegen::BuildInput<'_>,
     path: &Path,
     text: &str,
-    target: Target,
+    targets: &codegen::Targets,
     options: &Options,
 ) -> Result<codegen::BuildResult, Box<Record>> {
     let refined = codegen::refine_checked(input);
     if refined.programs.is_empty() {
         // Refused: the mission's own errors come first.
-        return Ok(codegen::build_refined(
+        return Ok(codegen::build_refined_each(
             input,
             refined,
-            target,
+            targets,
             options.emit,
             &[],
         ));
@@ -355,10 +387,10 @@ fn build_with_scenario(
         .iter()
         .map(|p| scenario.compiled_for(p))
         .collect();
-    Ok(codegen::build_refined(
+    Ok(codegen::build_refined_each(
         input,
         refined,
-        target,
+        targets,
         options.emit,
         &worlds,
     ))
@@ -372,11 +404,10 @@ fn refuse(
     error: OutputError,
     folder: &str,
     rest: &[semo::codegen::RobotOutput],
-    target: semo::codegen::Target,
 ) -> i32 {
     match error {
         OutputError::Conflicts(mut conflicts) => {
-            match transaction.conflicts(rest, &[], target) {
+            match transaction.conflicts(rest, &[]) {
                 Ok(more) => conflicts.extend(more),
                 Err(e) => {
                     eprintln!("error: {e}");
@@ -389,6 +420,67 @@ fn refuse(
         e => {
             eprintln!("error: cannot write {folder}: {e}");
             2
+        }
+    }
+}
+
+/// `linux`, or `cortex-m and linux-sim`.
+fn names(targets: &[Target]) -> String {
+    if targets.is_empty() {
+        return "none".into();
+    }
+    let names: Vec<&str> = targets.iter().map(|t| t.name()).collect();
+    names.join(" and ")
+}
+
+/// The JSON document's `target`: the build's one target, else null.
+fn single(targets: &[Target]) -> serde_json::Value {
+    match targets {
+        [one] => serde_json::json!(one.name()),
+        _ => serde_json::Value::Null,
+    }
+}
+
+fn names_json(targets: &[Target]) -> Vec<&'static str> {
+    targets.iter().map(|t| t.name()).collect()
+}
+
+/// Who chose a robot's target, for the JSON document.
+fn chosen_by(chosen: &Chosen) -> &'static str {
+    match chosen.reason {
+        Reason::Asked => "command line",
+        Reason::Project { .. } => "project file",
+        Reason::Catalog { .. } => "catalog",
+        Reason::Default => "default",
+    }
+}
+
+/// A robot's target for people: `target cortex-m, its type `Evalbot`'s
+/// platform`.
+fn target_line(chosen: &Chosen) -> String {
+    let why = match &chosen.reason {
+        Reason::Asked | Reason::Default => String::new(),
+        Reason::Project { key, .. } => format!(" from semo.toml's `{key}`"),
+        Reason::Catalog { robot_type, .. } => format!(", its type `{robot_type}`'s platform"),
+    };
+    let sim = if chosen.simulated { " (--sim)" } else { "" };
+    format!("target {}{why}{sim}", chosen.target)
+}
+
+/// `target linux-sim`, or `targets cortex-m (1), linux-sim (2)`.
+fn count_by_target(robots: &[semo::codegen::RobotOutput]) -> String {
+    let targets = codegen::distinct(robots.iter().map(|r| r.target));
+    match targets.as_slice() {
+        [one] => format!("target {one}"),
+        _ => {
+            let counted: Vec<String> = targets
+                .iter()
+                .map(|t| {
+                    let n = robots.iter().filter(|r| r.target == *t).count();
+                    format!("{t} ({n})")
+                })
+                .collect();
+            format!("targets {}", counted.join(", "))
         }
     }
 }

@@ -33,6 +33,8 @@ const CATALOG: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
 <Catalog xmlns="urn:semo:catalog:1">
   <Robot type="Rover">
     <Doc>A robot type to start from: rename it and describe your robot.</Doc>
+    <!-- `semo build` builds its programs for this platform: linux or cortex-m. -->
+    <Platform target="linux" os="linux"/>
     <Capability name="buzzer"/>
     <Service name="beep" task="buzzer" doc="Sound the buzzer once."/>
   </Robot>
@@ -62,7 +64,10 @@ fn project_file(name: &str) -> String {
          \n\
          [build]\n\
          output = \"out\"\n\
-         target = \"linux\"\n\
+         # target = \"linux\"   (every robot; default: the platform its robot type names)\n\
+         \n\
+         # [build.targets]     (a team's or robot's own target)\n\
+         # Rovers = \"linux-sim\"\n\
          \n\
          [lints]\n\
          # W010 = \"allow\"   (allow, warn or deny a warning by its code; see `semo explain`)\n"

@@ -153,16 +153,26 @@ enum Command {
             value_name = "OUT"
         )]
         out: Option<PathBuf>,
-        /// `linux` (POSIX threads; you fill the task files), `linux-sim`
-        /// (sensors, actuators and the operator simulated from a scenario
-        /// file given at run time), `cortex-m` (bare-metal TI Stellaris
-        /// LM3S6965, a static schedule; you fill the task files) or
-        /// `cortex-m-sim` (the same with --scenario compiled in, for QEMU).
-        /// Default: the project file's `[build] target`, else `linux`.
+        /// Every robot's target: `linux` (POSIX threads; you fill the task
+        /// files), `linux-sim` (sensors, actuators and the operator
+        /// simulated from a scenario file given at run time), `cortex-m`
+        /// (bare-metal TI Stellaris LM3S6965, a static schedule; you fill
+        /// the task files) or `cortex-m-sim` (the same with --scenario
+        /// compiled in, for QEMU). Default: each robot's own, from the
+        /// project file (`[build.targets]` for its team or itself, `[build]
+        /// target` for all), else the platform its robot type names in the
+        /// catalog (`<Platform target="...">`), else `linux`.
         #[arg(long, value_parser = parse_target)]
         target: Option<semo::codegen::Target>,
+        /// Build each robot for its platform's simulation (`linux` →
+        /// `linux-sim`, `cortex-m` → `cortex-m-sim`): sensors, services and
+        /// the operator from a scenario, a trace written.
+        #[arg(long)]
+        sim: bool,
         /// The scenario (`*.scenario.json`; `-`: standard input) compiled
-        /// into each robot: needed by, and only by, `--target cortex-m-sim`.
+        /// into each robot built for `cortex-m-sim` (`--target
+        /// cortex-m-sim`, or `--sim` with a cortex-m robot): needed by, and
+        /// only by, such a build.
         #[arg(long)]
         scenario: Option<PathBuf>,
         /// `all` (C code, Makefile and task graph) or `taskgraph` (only the
@@ -776,6 +786,7 @@ fn run() -> i32 {
             strategy,
             out: out_dir,
             target,
+            sim,
             scenario,
             emit,
             format,
@@ -788,6 +799,7 @@ fn run() -> i32 {
                 strategy,
                 out: out_dir,
                 target,
+                sim,
                 scenario,
                 deploy,
                 emit: match emit {
@@ -997,7 +1009,7 @@ fn refine_or_report(
 
 fn parse_target(name: &str) -> Result<semo::codegen::Target, String> {
     semo::codegen::Target::from_name(name).ok_or_else(|| {
-        let names: Vec<&str> = semo::codegen::TARGETS.iter().map(|t| t.name).collect();
+        let names: Vec<&str> = semo::codegen::Target::names().collect();
         format!("unknown target `{name}` (targets: {})", names.join(", "))
     })
 }

@@ -42,12 +42,10 @@ fn build(mission: &Path, target: Target, out: &Path) {
     assert!(!result.refused(), "{:#?}", result.diagnostics);
     let mut transaction = output::Transaction::begin(out, || {}).expect("the output folder");
     transaction
-        .stage_runtime(&result.runtime, target, false)
+        .stage_runtime(&result.runtime, &[target], false)
         .expect("staged");
     for robot in &result.robots {
-        transaction
-            .stage_robot(robot, target, false)
-            .expect("staged");
+        transaction.stage_robot(robot, false).expect("staged");
     }
     let kept = transaction.commit().expect("written");
     assert!(kept.is_empty(), "{kept:?}");

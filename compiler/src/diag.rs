@@ -182,13 +182,13 @@ codes! {
     CodegenUnsupported = "E100", Error, "a construct that code generation does not support yet";
     OutputNameEscapes = "E101", Error, "a name that cannot become a file or C identifier of the generated code (it could write outside the output folder, or clashes with a generated task)";
     CodegenInternal = "E102", Error, "an internal error of refinement or code generation: something the checker should have excluded (please report it)";
-    TargetUnsupported = "E103", Error, "a robot the chosen target cannot run as written: on `cortex-m` a robot that messages other robots (no transport there yet) or whose service runs a task graph, or `cortex-m-sim` without `--scenario`";
+    TargetUnsupported = "E103", Error, "a robot its target cannot run as written (the target `--target`, the project file or its robot type's platform in the catalog chose): on `cortex-m` a robot that messages other robots (no transport there yet) or whose service runs a task graph, or `cortex-m-sim` without `--scenario`";
     ServiceSubgraphUnusable = "E135", Error, "a service implemented by a task graph whose sub-graph references cannot be used (a file that cannot be read, has errors, leads back to itself or whose open ports do not match the task's): the service cannot run";
     // The project file (`semo.toml`).
     ProjectSyntax = "E110", Error, "a project file (`semo.toml`) that is not valid TOML";
     ProjectBadValue = "E111", Error, "a project-file value of the wrong type or form (a folder list that is not a list of strings, an unknown target or lint level, a format version this semo does not read)";
     ProjectErrorAllowed = "E112", Error, "`[lints]` lowering an error code: only warnings and hints can be allowed or made warnings (an `E` code may only be `deny`)";
-    ProjectUnknownKey = "W110", Warning, "a key or table that the project file format does not have, or a lint naming no diagnostic code";
+    ProjectUnknownKey = "W110", Warning, "a key or table that the project file format does not have, a lint naming no diagnostic code, or a `[build.targets]` name that is no team or robot of the mission built";
     ProjectMissingPath = "W111", Warning, "a catalog, strategy or task-graph folder or a deployment file named in the project file that does not exist";
     SearchBounded = "W112", Warning, "without a project file, the search for the catalog and strategy files beside a mission stopped at its bound (too many entries): put a `semo.toml` at the project root";
     // Deployment files (`*.deploy.toml`, `semo build --deploy`, `semo deploy`).

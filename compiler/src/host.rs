@@ -1009,4 +1009,4 @@ pub use disk::{
 };
 pub use dropper::{Dropper, drop_later};
 pub use ide::{PictureError, RobotPicture, WORKSPACE_SYMBOL_LIMIT};
-pub use plan::{BuildPlan, DEFAULT_OUTPUT, PlanRequest};
+pub use plan::{BuildPlan, DEFAULT_OUTPUT, DEFAULT_TARGET, PlanRequest, PlannedRobot};

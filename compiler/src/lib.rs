@@ -3,7 +3,8 @@
 //! The modules are layered: each reads only the modules below it in the
 //! `## Layers` table of ARCHITECTURE.md, which `tests/layering.rs` checks
 //! against every `crate::` path. From the bottom: positions and diagnostics
-//! ([`span`], [`text`], [`diag`], [`edit`]); the languages ([`syntax`],
+//! ([`span`], [`text`], [`diag`], [`edit`]) and the platforms programs are
+//! built for ([`platform`], a data table); the languages ([`syntax`],
 //! [`format`], [`catalog`], [`sema`], [`taskgraph`], [`strategy`]); what is
 //! made of them ([`modemachine`], [`ide`], [`refine`], [`codegen`]);
 //! [`sim`], the simulator running the refined programs of a mission on a
@@ -32,6 +33,7 @@ mod index;
 /// Graph drawing shared by the task-graph and mode-machine pictures.
 mod layout;
 pub mod modemachine;
+pub mod platform;
 pub mod project;
 pub mod refine;
 pub mod sema;

@@ -320,9 +320,9 @@ impl Backend {
                 p.report_with_message(format!("{}/{}", all[i].team, all[i].robot), percent)
                     .await;
             }
-            let (target, force, robots_of) = (job.target, job.force, all.clone());
+            let (force, robots_of) = (job.force, all.clone());
             let (back, written) = tokio::task::spawn_blocking(move || {
-                let written = transaction.stage_robot(&robots_of[i], target, force);
+                let written = transaction.stage_robot(&robots_of[i], force);
                 (transaction, written)
             })
             .await
@@ -348,10 +348,23 @@ impl Backend {
             p.finish_with_message(format!("{} robot(s)", robots.len()))
                 .await;
         }
+        // What the plan found in the project file (a `[build.targets]` name
+        // the mission does not have): built anyway, said.
+        let warnings: Vec<String> = job
+            .plan
+            .diagnostics
+            .iter()
+            .map(|d| format!("[{}] {}", d.code.as_str(), d.message))
+            .collect();
+        for warning in &warnings {
+            let message = format!("SeMo: {}: {warning}", semo::project::FILE_NAME);
+            self.tell_generation(MessageType::WARNING, &message).await;
+        }
+        let targets = semo::codegen::distinct(all.iter().map(|r| r.target));
         let message = format!(
             "SeMo: generated code for {} robot(s) ({}) in {}",
             robots.len(),
-            job.target.name(),
+            generate::target_names(&targets),
             job.out.path().display()
         );
         self.tell_generation(MessageType::INFO, &message).await;
@@ -362,8 +375,14 @@ impl Backend {
                 .iter()
                 .map(|c| serde_json::json!({ "path": c.path.display().to_string(), "why": c.why }))
                 .collect::<Vec<_>>(),
-            "target": job.target.name(),
+            // The build's one target (else null: each robot's is in `robots`).
+            "target": match targets.as_slice() {
+                [one] => serde_json::json!(one.name()),
+                _ => serde_json::Value::Null,
+            },
+            "targets": targets.iter().map(|t| t.name()).collect::<Vec<_>>(),
             "robots": robots,
+            "warnings": warnings,
             "recovered": recovered,
         }))
     }

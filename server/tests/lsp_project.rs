@@ -103,7 +103,7 @@ async fn the_project_file_gets_positioned_diagnostics_and_completion() {
     // Tables on a header line, keys of the table the cursor is in.
     assert_eq!(
         labels(&mut client, &file, 3, 1).await,
-        ["project", "build", "lints"]
+        ["project", "build", "build.targets", "lints"]
     );
     let keys = labels(&mut client, &file, 2, 0).await;
     assert_eq!(keys, ["version", "name", "strategies", "task-graphs"]);

@@ -25,6 +25,8 @@ interface GenerateSummary {
   outputFolder?: string;
   kept?: { path: string; why: string }[];
   recovered?: string[];
+  /** The build plan's findings in semo.toml (built anyway). */
+  warnings?: string[];
 }
 
 /** "SeMo: New Mission from Template": an untitled mission holding the template. */
@@ -172,6 +174,9 @@ export async function generateCode(server: Server, lens?: unknown): Promise<void
   }
   for (const kept of summary?.kept ?? []) {
     server.output.appendLine(`[warning] kept ${kept.path}: ${kept.why}`);
+  }
+  for (const warning of summary?.warnings ?? []) {
+    server.output.appendLine(`[warning] semo.toml: ${warning}`);
   }
   server.output.appendLine(`[info] generated code in ${written}`);
   const folderUri = vscode.Uri.file(written);

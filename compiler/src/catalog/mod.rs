@@ -155,6 +155,10 @@ pub enum Implementation {
 
 #[derive(Clone, Debug, PartialEq, Eq, Default)]
 pub struct Platform {
+    /// The platform its programs are built for (`target="cortex-m"`), and
+    /// where that is written; `None`: not said (`semo build` then builds
+    /// for `linux`, unless told otherwise).
+    pub target: Option<(crate::platform::Target, Span)>,
     pub os: String,
     pub cpu: String,
     pub cores: Option<u32>,

@@ -44,7 +44,9 @@ pub(crate) const ELEMENTS: &[ElementInfo] = &[
     },
     ElementInfo {
         name: "Platform",
-        attributes: &["os", "cpu", "cores", "clockMHz", "memoryKB", "note"],
+        attributes: &[
+            "target", "os", "cpu", "cores", "clockMHz", "memoryKB", "note",
+        ],
         children: &[],
         belongs: IN_ROBOT,
     },

@@ -420,16 +420,48 @@ impl Reader<'_, '_> {
                     }
                 }
             };
+            let (cores, clock_mhz, memory_kb) = (
+                number("cores", "4").map(|n| n as u32),
+                number("clockMHz", "900").map(|n| n as u32),
+                number("memoryKB", "1048576"),
+            );
             robot.robot.platform = Platform {
-                cores: number("cores", "4").map(|n| n as u32),
-                clock_mhz: number("clockMHz", "900").map(|n| n as u32),
-                memory_kb: number("memoryKB", "1048576"),
+                target: self.build_target(e),
+                cores,
+                clock_mhz,
+                memory_kb,
                 os: text("os"),
                 cpu: text("cpu"),
                 note: text("note"),
             };
         }
         self.leaf(e);
+    }
+
+    /// `target="..."` of a `<Platform>`: a platform `semo build` knows
+    /// (its simulation is the build's choice, `--sim`, not the robot's).
+    fn build_target(&mut self, e: &Elem) -> Option<(crate::platform::Target, Span)> {
+        let a = get(&e.attrs, "target")?;
+        let name = a.trimmed();
+        if let Some(target) = crate::platform::platform_target(name) {
+            return Some((target, a.trimmed_span()));
+        }
+        let platforms: Vec<&str> = crate::platform::platform_names().collect();
+        let message = match crate::platform::Target::from_name(name) {
+            Some(sim) => format!(
+                "`{name}` is the simulation of {}: a robot type names the platform it runs on ({}); `semo build --sim` builds its simulation",
+                sim.platform().name,
+                platforms.join(", ")
+            ),
+            None => format!(
+                "unknown platform `{name}` (platforms: {})",
+                platforms.join(", ")
+            ),
+        };
+        self.sink
+            .report(Code::CatalogBadAttribute, a.trimmed_span(), message)
+            .suggest(suggest(name, &platforms));
+        None
     }
 
     fn capability(&mut self, e: &Elem, robot: &mut RobotBuild) {

@@ -3,7 +3,7 @@
 
 use super::c;
 use super::values::Words;
-use super::{CompiledScenario, Platform, Target};
+use super::{CompiledScenario, Layer, Target};
 use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK};
 use crate::refine::{RobotProgram, RoleKind, ValueKind};
 use crate::taskgraph::Trigger;
@@ -83,7 +83,7 @@ pub fn channels_c(program: &RobotProgram, target: Target, header: &str) -> Strin
         }
     };
     // Without a heap, every channel's ring is a static buffer of its own.
-    let fixed = target.platform() == Platform::Static;
+    let fixed = target.layer() == Layer::Static;
     if fixed {
         out.push_str("/* Each channel's samples and ring state (no heap on this target). */\n");
         for (i, (ch, capacity)) in program
@@ -134,9 +134,9 @@ pub fn channels_c(program: &RobotProgram, target: Target, header: &str) -> Strin
 
 pub fn main_c(program: &RobotProgram, words: &Words, target: Target, header: &str) -> String {
     let mut out = String::from(header);
-    out.push_str(match target.platform() {
-        Platform::Threads => "#include \"program.h\"\n\n/* Tasks: one thread each. */\nstatic const semo_task_desc tasks[] = {\n",
-        Platform::Static => "#include \"program.h\"\n\n/* Tasks: fired by Core_1_go in the order of `schedule`. */\nstatic const semo_task_desc tasks[] = {\n",
+    out.push_str(match target.layer() {
+        Layer::Threads => "#include \"program.h\"\n\n/* Tasks: one thread each. */\nstatic const semo_task_desc tasks[] = {\n",
+        Layer::Static => "#include \"program.h\"\n\n/* Tasks: fired by Core_1_go in the order of `schedule`. */\nstatic const semo_task_desc tasks[] = {\n",
     });
     for task in &program.graph.tasks {
         let prefix = format!("task_{}", c::ident(&task.name.name));
@@ -160,7 +160,7 @@ pub fn main_c(program: &RobotProgram, words: &Words, target: Target, header: &st
         }
         out.push_str("};\n\n");
     }
-    let static_schedule = target.platform() == Platform::Static;
+    let static_schedule = target.layer() == Layer::Static;
     if static_schedule {
         match super::schedule::firings(&program.graph) {
             Ok(firings) => {
@@ -190,7 +190,7 @@ pub fn main_c(program: &RobotProgram, words: &Words, target: Target, header: &st
         let _ = writeln!(out, "    {{{}, {}}},", c::string(team), c::string(robot));
     }
     out.push_str("};\n\n");
-    let threads = target.platform() == Platform::Threads;
+    let threads = target.layer() == Layer::Threads;
     if threads {
         out.push_str(DEPLOY_DEFAULTS);
     }
@@ -232,14 +232,14 @@ const DEPLOY_DEFAULTS: &str = "/* The connection defaults `semo build --deploy` 
 /// the static schedule (one task runs at a time). `(include, declare, lock,
 /// unlock)` for a lock named `name`.
 pub(super) fn lock(target: Target, name: &str) -> (&'static str, String, String, String) {
-    match target.platform() {
-        Platform::Threads => (
+    match target.layer() {
+        Layer::Threads => (
             "#include <pthread.h>\n",
             format!("static pthread_mutex_t {name} = PTHREAD_MUTEX_INITIALIZER;\n"),
             format!("pthread_mutex_lock(&{name});"),
             format!("pthread_mutex_unlock(&{name});"),
         ),
-        Platform::Static => (
+        Layer::Static => (
             "",
             String::new(),
             "/* no lock: one task runs at a time */".into(),
@@ -499,7 +499,7 @@ pub fn task_c(
             out.push_str("}\n\nTASK_WRAPUP\n{\n}\n");
         }
         (RoleKind::Service { services }, _)
-            if target.simulated() && target.platform() == Platform::Static =>
+            if target.simulated() && target.layer() == Layer::Static =>
         {
             let speed_scale = super::battery::actuator_speed_scale(program, &role.task);
             out.push_str(speed_scale.as_deref().unwrap_or_default());
@@ -538,8 +538,8 @@ pub fn task_c(
             } else {
                 ""
             };
-            match (target.simulated(), target.platform()) {
-                (true, Platform::Threads) => {
+            match (target.simulated(), target.layer()) {
+                (true, Layer::Threads) => {
                     let scale = match super::battery::actuator_speed_scale(program, &role.task) {
                         Some(function) => {
                             // Before the task's functions.
@@ -556,7 +556,7 @@ pub fn task_c(
                     out.push_str(");\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n");
                 }
                 // The static simulation's body is the arm above.
-                (true, Platform::Static) => {}
+                (true, Layer::Static) => {}
                 (false, _) => {
                     out.push_str(run_graph);
                     out.push_str("    /* TODO: perform the service; req.args[0 .. req.argc - 1] are its arguments.\n     * Check UFControl_StopRequested(TASK_NAME) during long work. */\n");
@@ -641,7 +641,7 @@ pub fn makefile(
     let common = format!(
         "PROGRAM = {robot}{elf}\nSOURCES = {sources}\nTASKS = {tasks}\nOBJECTS = $(SOURCES:.c=.o) $(TASKS:.c=.o)\ninclude $(RUNTIME)/semo_runtime.mk\n",
         robot = program.robot,
-        elf = if target.platform() == Platform::Static {
+        elf = if target.layer() == Layer::Static {
             ".elf"
         } else {
             ""
@@ -650,28 +650,13 @@ pub fn makefile(
         tasks = sources.tasks.join(" "),
     );
     let rules = "# Objects depend on the Makefile too: a new generation (another target, a\n# deployment baked in) rebuilds them.\n\ntasks/%.o: tasks/%.c $(HEADERS) Makefile\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -DSEMO_TASK=task_$* -c $< -o $@\n\n%.o: %.c $(HEADERS) Makefile\n\t$(CC) $(CFLAGS) $(SEMO_CFLAGS) -c $< -o $@\n";
-    if target.platform() == Platform::Static {
-        let _ = writeln!(
-            out,
-            "\n# `make` builds `{robot}.elf` for target {target} (TI Stellaris LM3S6965, a\n# Cortex-M3) with arm-none-eabi-gcc and newlib-nano; `make size` prints its\n# flash and RAM, `make run` runs it in QEMU (UART0 on standard output{exit}).\n# CFLAGS may be overridden; the runtime's static tables (sized from the task\n# graph) and the stack with\n# make variables (`make SEMO_STACK_BYTES=4096`).\n{runtime}CC = arm-none-eabi-gcc\nSIZE = arm-none-eabi-size\nQEMU = qemu-system-arm\nCFLAGS ?= -std=c11 -Wall -Wextra -Os\nARCH = -mcpu=cortex-m3 -mthumb\nSEMO_STACK_BYTES ?= 2048\nSEMO_TEXT_MAX ?= {value_bytes}\nSEMO_MAX_TASKS ?= {task_count}\nSEMO_MAX_GROUPS ?= {groups}\nSEMO_INBOX ?= {inbox}\nSIZES = -DSEMO_STACK_BYTES=$(SEMO_STACK_BYTES) -DSEMO_TEXT_MAX=$(SEMO_TEXT_MAX) -DSEMO_MAX_TASKS=$(SEMO_MAX_TASKS) -DSEMO_MAX_GROUPS=$(SEMO_MAX_GROUPS) -DSEMO_INBOX=$(SEMO_INBOX)\nSEMO_CFLAGS = -std=c11 $(ARCH) -ffunction-sections -fdata-sections -DSEMO_STATIC{sim}{no_reals} $(SIZES) -I. -I$(RUNTIME)\nLDFLAGS += $(ARCH) -nostartfiles --specs=nano.specs -T $(RUNTIME)/lm3s6965.ld -Wl,--gc-sections\n\n{common}HEADERS = program.h $(RUNTIME_HEADERS)\n\nall: $(PROGRAM)\n\n$(PROGRAM): $(OBJECTS) $(RUNTIME_OBJECTS) $(RUNTIME)/lm3s6965.ld\n\t$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(OBJECTS) $(RUNTIME_OBJECTS) $(LDLIBS)\n\n{rules}\nsize: $(PROGRAM)\n\t$(SIZE) $(PROGRAM)\n\nrun: $(PROGRAM)\n\t$(QEMU) -M lm3s6965evb -nographic -semihosting -kernel $(PROGRAM)\n\nclean:\n\trm -f $(PROGRAM) $(OBJECTS)\n\n.PHONY: all size run clean",
-            robot = program.robot,
-            target = target.name(),
-            value_bytes = sizes.value_bytes,
-            task_count = sizes.tasks,
-            groups = sizes.groups,
-            inbox = sizes.inbox,
-            no_reals = if sizes.reals { "" } else { " -DSEMO_NO_REALS" },
-            exit = if target.simulated() {
-                "; it exits when the scenario ends"
-            } else {
-                ""
-            },
-            sim = if target.simulated() {
-                " -DSEMO_SIM -DSEMO_SEMIHOSTING"
-            } else {
-                ""
-            },
-        );
+    if let Some(board) = &target.platform().board {
+        static_makefile(&mut out, program, target, board, &runtime, &common, sizes);
+        out.push_str(rules);
+        out.push_str(&format!(
+            "\nsize: $(PROGRAM)\n\t$(SIZE) $(PROGRAM)\n\nrun: $(PROGRAM)\n\t$(QEMU) -M {machine} -nographic -semihosting -kernel $(PROGRAM)\n\nclean:\n\trm -f $(PROGRAM) $(OBJECTS)\n\n.PHONY: all size run clean\n",
+            machine = board.machine,
+        ));
         return out;
     }
     let _ = writeln!(
@@ -688,6 +673,54 @@ pub fn makefile(
         deploy = super::DEPLOY_HEADER,
     );
     out
+}
+
+/// The head of a board's Makefile, down to its `all` rule: every fact of
+/// the board (toolchain, core, memory, link script, clock, timer, serial
+/// port, emulator) from its row of the platform table.
+fn static_makefile(
+    out: &mut String,
+    program: &RobotProgram,
+    target: Target,
+    board: &crate::platform::Board,
+    runtime: &str,
+    common: &str,
+    sizes: &StaticSizes,
+) {
+    let _ = writeln!(
+        out,
+        "\n# `make` builds `{robot}.elf` for target {target} ({board}, a\n# {cpu}) with {cc} and {libc}; `make size` prints its\n# flash and RAM, `make run` runs it in QEMU ({serial} on standard output{exit}).\n# CFLAGS may be overridden; the runtime's static tables (sized from the task\n# graph) and the stack with\n# make variables (`make SEMO_STACK_BYTES=4096`). Mission time is counted by\n# {timer} at the core clock, SEMO_CPU_HZ.\n{runtime}CC = {cc}\nSIZE = {size}\nQEMU = {emulator}\nCFLAGS ?= -std=c11 -Wall -Wextra -Os\nARCH = {arch}\nSEMO_STACK_BYTES ?= {stack}\nSEMO_CPU_HZ ?= {clock}\nSEMO_TEXT_MAX ?= {value_bytes}\nSEMO_MAX_TASKS ?= {task_count}\nSEMO_MAX_GROUPS ?= {groups}\nSEMO_INBOX ?= {inbox}\nSIZES = -DSEMO_STACK_BYTES=$(SEMO_STACK_BYTES) -DSEMO_CPU_HZ=$(SEMO_CPU_HZ)u -DSEMO_TEXT_MAX=$(SEMO_TEXT_MAX) -DSEMO_MAX_TASKS=$(SEMO_MAX_TASKS) -DSEMO_MAX_GROUPS=$(SEMO_MAX_GROUPS) -DSEMO_INBOX=$(SEMO_INBOX)\nSEMO_CFLAGS = -std=c11 $(ARCH) -ffunction-sections -fdata-sections -DSEMO_STATIC{sim}{no_reals} $(SIZES) -I. -I$(RUNTIME)\nLDFLAGS += $(ARCH) -nostartfiles --specs={specs} -T $(RUNTIME)/{ld} -Wl,--gc-sections\n\n{common}HEADERS = program.h $(RUNTIME_HEADERS)\n\nall: $(PROGRAM)\n\n$(PROGRAM): $(OBJECTS) $(RUNTIME_OBJECTS) $(RUNTIME)/{ld}\n\t$(CC) $(CFLAGS) $(LDFLAGS) -o $@ $(OBJECTS) $(RUNTIME_OBJECTS) $(LDLIBS)\n",
+        robot = program.robot,
+        target = target.name(),
+        board = board.name,
+        cpu = board.cpu,
+        cc = board.toolchain.cc,
+        size = board.toolchain.size,
+        libc = board.toolchain.libc,
+        specs = board.toolchain.specs,
+        serial = board.serial,
+        timer = board.timer,
+        emulator = board.emulator,
+        arch = board.arch,
+        stack = board.stack_bytes,
+        clock = board.clock_hz,
+        ld = board.link_script,
+        value_bytes = sizes.value_bytes,
+        task_count = sizes.tasks,
+        groups = sizes.groups,
+        inbox = sizes.inbox,
+        no_reals = if sizes.reals { "" } else { " -DSEMO_NO_REALS" },
+        exit = if target.simulated() {
+            "; it exits when the scenario ends"
+        } else {
+            ""
+        },
+        sim = if target.simulated() {
+            " -DSEMO_SIM -DSEMO_SEMIHOSTING"
+        } else {
+            ""
+        },
+    );
 }
 
 /// `scenario.c` of a static-schedule simulation: the robot's world from the

@@ -14,9 +14,13 @@
 //!   with the same compiler and flags): the portable core and a platform
 //!   layer (POSIX threads or a static schedule with a board file).
 //!
-//! Targets are data: a target is a row of [`TARGETS`] (its platform, whether
-//! it simulates, its runtime files); the generated code differs only where
-//! the platform does (locks, blocking, the schedule table, the Makefile).
+//! Targets are data: a target is a platform of [`crate::platform::PLATFORMS`]
+//! or its simulation (its runtime layer, transport, runtime files, and for a
+//! board its toolchain, memory and start-up); the generated code differs
+//! only where the platform does (locks, blocking, the schedule table, the
+//! Makefile). Each robot of a build has its own target ([`Targets`]: what
+//! the door asked, the project file or the robot type's platform); the
+//! runtime folder holds what every target used needs.
 
 mod battery;
 mod c;
@@ -46,67 +50,7 @@ pub fn c_string(text: &str) -> String {
     c::string(text)
 }
 
-/// A code-generation target.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Target {
-    /// POSIX threads on Linux; the user fills the task files.
-    Linux,
-    /// The same program with sensors, actuators and the operator simulated
-    /// from a scenario file, writing a trace.
-    LinuxSim,
-    /// Bare metal on a Cortex-M3 (TI Stellaris LM3S6965): a static schedule,
-    /// no threads, no heap; the user fills the task files.
-    CortexM,
-    /// The same with the scenario compiled in as tables (`semo build
-    /// --scenario FILE`), tracing on UART0 and exiting through semihosting,
-    /// so that a run in `qemu-system-arm -M lm3s6965evb` is a test.
-    CortexMSim,
-}
-
-/// How a target runs its tasks: the platform layer of the runtime.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Platform {
-    /// One POSIX thread per task (`semo_runtime.c`).
-    Threads,
-    /// One loop firing the tasks in the single-appearance schedule's order
-    /// (`semo_static.c` and a board file).
-    Static,
-}
-
-/// How a robot program reaches the other robots by default (overridable at
-/// run time with `--transport`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Transport {
-    /// UDP on 127.0.0.1, a port per robot (`semo_udp.c`): no broker needed.
-    Udp,
-    /// An MQTT broker through libmosquitto (`semo_mqtt.c`, `-lmosquitto`).
-    Mqtt,
-}
-
-impl Transport {
-    /// The name `--transport` and the Makefile's `TRANSPORT` take.
-    pub fn name(self) -> &'static str {
-        match self {
-            Transport::Udp => "udp",
-            Transport::Mqtt => "mqtt",
-        }
-    }
-}
-
-/// One row per target: its name, its platform, whether sensors and the
-/// operator are simulated, its default transport, and the runtime files its
-/// folder gets.
-pub struct TargetInfo {
-    pub target: Target,
-    pub name: &'static str,
-    pub platform: Platform,
-    /// Sensors, services and the operator come from a scenario: at run time
-    /// (`--scenario FILE`, POSIX) or compiled in (static, `scenario.c`).
-    pub simulated: bool,
-    /// None: the program talks only to the operator (static schedule, E103).
-    pub transport: Option<Transport>,
-    pub runtime: &'static [(&'static str, &'static str)],
-}
+pub use crate::platform::{Layer, Target, Transport};
 
 const API: (&str, &str) = ("semo_runtime.h", include_str!("runtime/semo_runtime.h"));
 const INTERNAL: (&str, &str) = ("semo_internal.h", include_str!("runtime/semo_internal.h"));
@@ -118,7 +62,7 @@ const POSIX_SIM: (&str, &str) = ("semo_sim.c", include_str!("runtime/semo_sim.c"
 const LOCKSTEP: (&str, &str) = ("semo_lockstep.c", include_str!("runtime/semo_lockstep.c"));
 const STATIC: (&str, &str) = ("semo_static.c", include_str!("runtime/semo_static.c"));
 const LM3S6965: (&str, &str) = ("semo_lm3s6965.c", include_str!("runtime/semo_lm3s6965.c"));
-const LM3S6965_LD: (&str, &str) = ("lm3s6965.ld", include_str!("runtime/lm3s6965.ld"));
+const LM3S6965_LD: (&str, &str) = ("lm3s6965.ld", include_str!("runtime/lm3s6965.ld.in"));
 /// The make rules every robot's Makefile includes to compile the runtime.
 const MAKE_RULES: (&str, &str) = ("semo_runtime.mk", include_str!("runtime/semo_runtime.mk"));
 
@@ -150,88 +94,39 @@ pub fn is_runtime_file(name: &str) -> bool {
     RUNTIME_FILES.iter().any(|(file, _)| *file == name)
 }
 
-/// The files of [`RUNTIME_FOLDER`] for a build for `target`: its runtime
-/// and the make rules.
-pub fn runtime_files(target: Target) -> Vec<GeneratedFile> {
-    target
-        .info()
-        .runtime
+/// The files of [`RUNTIME_FOLDER`] for a build whose robots are generated
+/// for `targets`: what each of them compiles, once, and the make rules. A
+/// board's link script is written from its row of the platform table.
+pub fn runtime_files(targets: &[Target]) -> Vec<GeneratedFile> {
+    let used = |name: &str| targets.iter().any(|t| t.runtime().any(|f| f == name));
+    RUNTIME_FILES
         .iter()
+        .filter(|(name, _)| used(name))
         .chain([&MAKE_RULES])
         .map(|(path, text)| GeneratedFile {
             path: path.to_string(),
-            text: text.to_string(),
+            text: board_file(targets, path, text),
             owner: Owner::Generated,
         })
         .collect()
 }
 
-pub const TARGETS: &[TargetInfo] = &[
-    TargetInfo {
-        target: Target::Linux,
-        name: "linux",
-        platform: Platform::Threads,
-        simulated: false,
-        transport: Some(Transport::Mqtt),
-        runtime: &[API, INTERNAL, CORE, POSIX, UDP, MQTT],
-    },
-    TargetInfo {
-        target: Target::LinuxSim,
-        name: "linux-sim",
-        platform: Platform::Threads,
-        simulated: true,
-        transport: Some(Transport::Udp),
-        runtime: &[API, INTERNAL, CORE, POSIX, UDP, MQTT, POSIX_SIM, LOCKSTEP],
-    },
-    TargetInfo {
-        target: Target::CortexM,
-        name: "cortex-m",
-        platform: Platform::Static,
-        simulated: false,
-        transport: None,
-        runtime: &[API, INTERNAL, CORE, STATIC, LM3S6965, LM3S6965_LD],
-    },
-    TargetInfo {
-        target: Target::CortexMSim,
-        name: "cortex-m-sim",
-        platform: Platform::Static,
-        simulated: true,
-        transport: None,
-        runtime: &[API, INTERNAL, CORE, STATIC, LM3S6965, LM3S6965_LD],
-    },
-];
-
-impl Target {
-    pub fn info(self) -> &'static TargetInfo {
-        TARGETS
-            .iter()
-            .find(|t| t.target == self)
-            .expect("every target has a row")
-    }
-
-    pub fn name(self) -> &'static str {
-        self.info().name
-    }
-
-    pub fn from_name(name: &str) -> Option<Target> {
-        TARGETS.iter().find(|t| t.name == name).map(|t| t.target)
-    }
-
-    pub fn platform(self) -> Platform {
-        self.info().platform
-    }
-
-    pub fn simulated(self) -> bool {
-        self.info().simulated
-    }
-
-    pub fn transport(self) -> Option<Transport> {
-        self.info().transport
-    }
-
-    /// The scenario is compiled into the program (`semo build --scenario`).
-    pub fn needs_scenario(self) -> bool {
-        self.simulated() && self.platform() == Platform::Static
+/// `text`, the runtime file `path`, with the facts of the board whose link
+/// script it is filled in (`@FLASH_ORIGIN@`, ...); other files as they are.
+fn board_file(targets: &[Target], path: &str, text: &str) -> String {
+    let board = targets
+        .iter()
+        .filter_map(|t| t.platform().board.as_ref())
+        .find(|b| b.link_script == path);
+    match board {
+        None => text.to_string(),
+        Some(board) => text
+            .replace("@BOARD@", board.name)
+            .replace("@MACHINE@", board.machine)
+            .replace("@FLASH_ORIGIN@", &format!("0x{:08X}", board.flash.origin))
+            .replace("@FLASH_KIB@", &board.flash.kib.to_string())
+            .replace("@RAM_ORIGIN@", &format!("0x{:08X}", board.ram.origin))
+            .replace("@RAM_KIB@", &board.ram.kib.to_string()),
     }
 }
 
@@ -283,6 +178,8 @@ pub struct GeneratedFile {
 pub struct RobotOutput {
     pub team: String,
     pub robot: String,
+    /// What its files were generated for.
+    pub target: Target,
     pub files: Vec<GeneratedFile>,
 }
 
@@ -348,6 +245,7 @@ pub fn generate(
         let output = RobotOutput {
             team: program.team.clone(),
             robot: program.robot.clone(),
+            target,
             files,
         };
         return (output, Vec::new());
@@ -415,7 +313,7 @@ pub fn generate(
         );
         sources_c.push("scenario.c".into());
     }
-    if target.platform() == Platform::Threads {
+    if target.layer() == Layer::Threads {
         push(
             DEPLOY_HEADER,
             "/* No deployment file was given (`semo build --deploy FILE`): the runtime's\n * defaults, options and environment variables decide the connection. */\n".into(),
@@ -423,10 +321,7 @@ pub fn generate(
         );
     }
     let runtime_c: Vec<&str> = target
-        .info()
-        .runtime
-        .iter()
-        .map(|(name, _)| *name)
+        .runtime()
         .filter(|name| name.ends_with(".c"))
         .collect();
     let sizes = files::StaticSizes::of(program, longest_value(&files, scenario));
@@ -449,6 +344,7 @@ pub fn generate(
     let output = RobotOutput {
         team: program.team.clone(),
         robot: program.robot.clone(),
+        target,
         files,
     };
     (output, words.missing())
@@ -496,10 +392,12 @@ fn file_header(program: &RobotProgram, target: Target, sources: &[String], owner
 
 /// The outcome of generating a mission's code.
 pub struct BuildResult {
-    /// One folder per robot, in formation order; empty when generation was refused.
+    /// One folder per robot, in formation order, each with its target;
+    /// empty when generation was refused.
     pub robots: Vec<RobotOutput>,
-    /// The files of [`RUNTIME_FOLDER`] the robots compile; empty when
-    /// generation was refused or writes only task graphs.
+    /// The files of [`RUNTIME_FOLDER`] the robots compile (what each of
+    /// their targets needs); empty when generation was refused or writes
+    /// only task graphs.
     pub runtime: Vec<GeneratedFile>,
     /// Why generation was refused (check errors, unsupported constructs,
     /// unsafe names, failing refined graphs), with the check's warnings.
@@ -519,6 +417,122 @@ impl BuildResult {
         self.diagnostics
             .iter()
             .any(crate::diag::Diagnostic::is_error)
+    }
+
+    /// The targets its robots were generated for, each once, in
+    /// [`Target::ALL`]'s order.
+    pub fn targets(&self) -> Vec<Target> {
+        distinct(self.robots.iter().map(|r| r.target))
+    }
+}
+
+/// `targets` each once, in [`Target::ALL`]'s order.
+pub fn distinct(targets: impl IntoIterator<Item = Target>) -> Vec<Target> {
+    let used: Vec<Target> = targets.into_iter().collect();
+    Target::ALL
+        .into_iter()
+        .filter(|t| used.contains(t))
+        .collect()
+}
+
+/// Why a robot is generated for its target: the messages of what the
+/// target refuses say it, and point at where it was said.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Reason {
+    /// The door's user asked it for every robot (`semo build --target`,
+    /// the editor's `target`).
+    Asked,
+    /// The project file says it (`[build] target` for every robot, or
+    /// `[build.targets]` for the robot or its team): the key as written,
+    /// and where its value is.
+    Project {
+        key: String,
+        at: crate::diag::FileId,
+        span: crate::span::Span,
+    },
+    /// The robot's type names its platform in the catalog (`<Platform
+    /// target="...">`), there.
+    Catalog {
+        robot_type: String,
+        at: crate::diag::FileId,
+        span: crate::span::Span,
+    },
+    /// Nobody said: the default platform, `linux`.
+    Default,
+}
+
+/// A robot's target and why; `simulated`: `--sim` turned the chosen
+/// platform into its simulation.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Chosen {
+    pub target: Target,
+    pub reason: Reason,
+    pub simulated: bool,
+}
+
+impl Chosen {
+    /// How the target came to be, for messages: `cortex-m, as its type
+    /// `Evalbot` says in the catalog`.
+    pub fn describe(&self) -> String {
+        let why = match &self.reason {
+            Reason::Asked => "as the build asked for every robot".to_string(),
+            Reason::Project { key, .. } => format!("as the project file's `{key}` says"),
+            Reason::Catalog { robot_type, .. } => {
+                format!("the platform its type `{robot_type}` names in the catalog")
+            }
+            Reason::Default => "the default platform".to_string(),
+        };
+        let sim = if self.simulated {
+            " (simulated: --sim)"
+        } else {
+            ""
+        };
+        format!("{}{sim}, {why}", self.target.name())
+    }
+
+    /// Where the target was written, if in a file.
+    pub fn written_at(&self) -> Option<(crate::diag::FileId, crate::span::Span)> {
+        match &self.reason {
+            Reason::Project { at, span, .. } | Reason::Catalog { at, span, .. } => {
+                Some((*at, *span))
+            }
+            Reason::Asked | Reason::Default => None,
+        }
+    }
+}
+
+/// The target of each robot of a build, by robot name (what the build plan
+/// decided, `host::Analysis::build_plan`); or one target for every robot.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Targets {
+    every: Option<Chosen>,
+    robots: std::collections::BTreeMap<String, Chosen>,
+}
+
+impl Targets {
+    /// `target` for every robot, as asked.
+    pub fn all(target: Target) -> Targets {
+        Targets {
+            every: Some(Chosen {
+                target,
+                reason: Reason::Asked,
+                simulated: false,
+            }),
+            robots: Default::default(),
+        }
+    }
+
+    /// Each robot's own (a robot not named has none: an internal error).
+    pub fn each(robots: impl IntoIterator<Item = (String, Chosen)>) -> Targets {
+        Targets {
+            every: None,
+            robots: robots.into_iter().collect(),
+        }
+    }
+
+    /// The target of robot `robot`.
+    pub fn of(&self, robot: &str) -> Option<&Chosen> {
+        self.robots.get(robot).or(self.every.as_ref())
     }
 }
 
@@ -542,11 +556,16 @@ pub struct BuildInput<'a> {
     pub service_graphs: &'a [crate::refine::ServiceGraph],
 }
 
-/// Generates the code of a mission: every error of the check (in the
-/// mission, the catalog or the strategies) refuses generation, as do problems
-/// found while refining.
+/// Generates the code of a mission for `target`: every error of the check
+/// (in the mission, the catalog or the strategies) refuses generation, as do
+/// problems found while refining.
 pub fn build(build: &BuildInput<'_>, target: Target, emit: Emit) -> BuildResult {
-    build_refined(build, refine_checked(build), target, emit, &[])
+    build_each(build, &Targets::all(target), emit)
+}
+
+/// [`build`] with each robot generated for its own target.
+pub fn build_each(build: &BuildInput<'_>, targets: &Targets, emit: Emit) -> BuildResult {
+    build_refined_each(build, refine_checked(build), targets, emit, &[])
 }
 
 /// Generates the code of refined programs (from [`refine_checked`]) for
@@ -560,6 +579,18 @@ pub fn build_refined(
     emit: Emit,
     scenarios: &[CompiledScenario],
 ) -> BuildResult {
+    build_refined_each(build, refined, &Targets::all(target), emit, scenarios)
+}
+
+/// [`build_refined`] with each robot generated for its own target: one
+/// build, the runtime folder holding what each target used needs.
+pub fn build_refined_each(
+    build: &BuildInput<'_>,
+    refined: Refined,
+    targets: &Targets,
+    emit: Emit,
+    scenarios: &[CompiledScenario],
+) -> BuildResult {
     let Refined {
         programs,
         mut diagnostics,
@@ -568,10 +599,29 @@ pub fn build_refined(
     if programs.is_empty() {
         return BuildResult::refused_with(diagnostics);
     }
+    let mut chosen = Vec::new();
+    for program in &programs {
+        match targets.of(&program.robot) {
+            Some(target) => chosen.push(target.clone()),
+            // The plan names every robot of the mission: never a default.
+            None => {
+                diagnostics.push(crate::diag::Diagnostic::new(
+                    crate::diag::Code::CodegenInternal,
+                    build.mission,
+                    robot_span(build, &program.robot),
+                    format!(
+                        "robot `{}` has no target in the build's plan",
+                        program.robot
+                    ),
+                ));
+                return BuildResult::refused_with(diagnostics);
+            }
+        }
+    }
     diagnostics.extend(target::check(
         build,
         &programs,
-        target,
+        &chosen,
         emit,
         scenarios.len() == programs.len(),
     ));
@@ -580,8 +630,8 @@ pub fn build_refined(
         return BuildResult::refused_with(diagnostics);
     }
     let mut robots: Vec<RobotOutput> = Vec::new();
-    for (i, program) in programs.iter().enumerate() {
-        let (robot, missing) = generate(program, target, emit, &sources, scenarios.get(i));
+    for (i, (program, chosen)) in programs.iter().zip(&chosen).enumerate() {
+        let (robot, missing) = generate(program, chosen.target, emit, &sources, scenarios.get(i));
         diagnostics.extend(missing_word_errors(build, program, &missing));
         robots.push(robot);
     }
@@ -595,7 +645,7 @@ pub fn build_refined(
         return BuildResult::refused_with(diagnostics);
     }
     let runtime = match emit {
-        Emit::All => runtime_files(target),
+        Emit::All => runtime_files(&distinct(chosen.iter().map(|c| c.target))),
         Emit::TaskGraph => Vec::new(),
     };
     BuildResult {

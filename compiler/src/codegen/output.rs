@@ -126,6 +126,10 @@ pub(crate) struct FolderFiles<'r> {
     pub names: Vec<&'r str>,
     pub files: &'r [GeneratedFile],
     pub retired: fn(&str) -> bool,
+    /// What the files are generated for: a robot's target, or the targets
+    /// of the robots the runtime folder serves (its manifest and messages
+    /// say it).
+    pub target: String,
 }
 
 /// `<team>/<robot>/`: its files; the runtime's files that earlier versions
@@ -136,15 +140,18 @@ fn robot_folder(robot: &RobotOutput) -> FolderFiles<'_> {
         names: vec![&robot.team, &robot.robot],
         files: &robot.files,
         retired: super::is_runtime_file,
+        target: robot.target.name().to_string(),
     }
 }
 
-/// [`RUNTIME_FOLDER`]: the runtime's files.
-fn runtime_folder(files: &[GeneratedFile]) -> FolderFiles<'_> {
+/// [`RUNTIME_FOLDER`]: the runtime's files, for robots of `targets`.
+fn runtime_folder<'r>(files: &'r [GeneratedFile], targets: &[Target]) -> FolderFiles<'r> {
+    let names: Vec<&str> = targets.iter().map(|t| t.name()).collect();
     FolderFiles {
         names: vec![RUNTIME_FOLDER],
         files,
         retired: |_| false,
+        target: names.join(" and "),
     }
 }
 
@@ -364,69 +371,61 @@ impl Transaction {
         Ok(())
     }
 
-    /// The files that writing `robots` for `target` would replace against
-    /// the user's will, over all robots: checked before staging any.
+    /// The files that writing `robots` (each for its target) and the
+    /// `runtime` they share would replace against the user's will, over all
+    /// of them: checked before staging any.
     pub fn conflicts(
         &self,
         robots: &[RobotOutput],
         runtime: &[GeneratedFile],
-        target: Target,
     ) -> Result<Vec<Conflict>, OutputError> {
         let mut all = Vec::new();
         if !runtime.is_empty() {
-            all.extend(self.plan(&runtime_folder(runtime), target)?.conflicts);
+            let targets = super::distinct(robots.iter().map(|r| r.target));
+            all.extend(self.plan(&runtime_folder(runtime, &targets))?.conflicts);
         }
         for robot in robots {
-            all.extend(self.plan(&robot_folder(robot), target)?.conflicts);
+            all.extend(self.plan(&robot_folder(robot))?.conflicts);
         }
         Ok(all)
     }
 
-    fn plan<'r>(
-        &self,
-        folder: &FolderFiles<'r>,
-        target: Target,
-    ) -> Result<plan::Plan<'r>, OutputError> {
+    fn plan<'r>(&self, folder: &FolderFiles<'r>) -> Result<plan::Plan<'r>, OutputError> {
         let backup = self.out.join(BACKUP_FOLDER).join(&self.stamp);
-        plan::Plan::new(self.dir.as_fd(), &self.out, &backup, folder, target)
+        plan::Plan::new(self.dir.as_fd(), &self.out, &backup, folder)
     }
 
-    /// Stages `robot`'s files for `target` in the work folder; nothing in the
-    /// robot folder changes until [`Transaction::commit`]. Refused with
-    /// [`OutputError::Conflicts`] unless `force`, which moves the files in
-    /// the way under the backup folder instead of discarding them.
+    /// Stages `robot`'s files (for its target) in the work folder; nothing
+    /// in the robot folder changes until [`Transaction::commit`]. Refused
+    /// with [`OutputError::Conflicts`] unless `force`, which moves the files
+    /// in the way under the backup folder instead of discarding them.
     pub fn stage_robot(
         &mut self,
         robot: &RobotOutput,
-        target: Target,
         force: bool,
     ) -> Result<Written, OutputError> {
-        self.stage(&robot_folder(robot), target, force)
+        self.stage(&robot_folder(robot), force)
     }
 
     /// Stages the runtime's folder ([`RUNTIME_FOLDER`]) the robots of the
-    /// build compile, as [`Transaction::stage_robot`] stages a robot's.
+    /// build compile (their targets: `targets`), as
+    /// [`Transaction::stage_robot`] stages a robot's.
     pub fn stage_runtime(
         &mut self,
         runtime: &[GeneratedFile],
-        target: Target,
+        targets: &[Target],
         force: bool,
     ) -> Result<Written, OutputError> {
-        self.stage(&runtime_folder(runtime), target, force)
+        self.stage(&runtime_folder(runtime, targets), force)
     }
 
-    fn stage(
-        &mut self,
-        folder: &FolderFiles<'_>,
-        target: Target,
-        force: bool,
-    ) -> Result<Written, OutputError> {
+    fn stage(&mut self, folder: &FolderFiles<'_>, force: bool) -> Result<Written, OutputError> {
         self.stop_if_cancelled()?;
         if !self.generating {
             self.generating = true;
             fsops::generation_begins();
         }
-        let plan = self.plan(folder, target)?;
+        let plan = self.plan(folder)?;
         if !plan.conflicts.is_empty() {
             if !force {
                 return Err(OutputError::Conflicts(plan.conflicts));

@@ -10,7 +10,7 @@
 use super::c;
 use super::files::lock;
 use super::values::Words;
-use super::{Platform, Target};
+use super::{Layer, Target};
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::{OwnerRule, Ownership, RobotProgram, SharedLibrary, ValueKind};
 use std::fmt::Write;
@@ -107,9 +107,9 @@ pub fn library_c(program: &RobotProgram, target: Target, header: &str) -> Option
     if lib.ownership.is_some() {
         // A value taken wakes the control task, which reads it at its next
         // firing (the static schedule fires it at every pass anyway).
-        let wake = match target.platform() {
-            Platform::Threads => format!("\n        semo_wake({});", c::string(CONTROL_TASK)),
-            Platform::Static => String::new(),
+        let wake = match target.layer() {
+            Layer::Threads => format!("\n        semo_wake({});", c::string(CONTROL_TASK)),
+            Layer::Static => String::new(),
         };
         heard(&mut out, &prefix, &lock, &unlock, &wake);
     }

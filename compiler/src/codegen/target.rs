@@ -1,4 +1,6 @@
-//! What a target refuses to generate: a static-schedule target has no
+//! What a target refuses to generate, robot by robot (each on the target
+//! the build's plan chose for it, named with why in the message and
+//! pointed at where it was written): a static-schedule target has no
 //! transport to other robots yet (a serial link to a gateway is a later
 //! step), so a robot that sends to, receives from, publishes to or
 //! subscribes to other robots is refused there (E103), never built with its
@@ -6,7 +8,7 @@
 //! stay: the trace is the operator console's record, and in simulation the
 //! operator's commands are compiled in.
 
-use super::{BuildInput, Emit, Platform, Target};
+use super::{BuildInput, Chosen, Emit, Layer};
 use crate::diag::{Code, Diagnostic};
 use crate::refine::RobotProgram;
 use crate::sema::Peer;
@@ -14,12 +16,13 @@ use crate::sema::Peer;
 /// The operator console's team name in messages.
 const USER: &str = "USER";
 
-/// The diagnostics that refuse `programs` on `target`. `has_scenarios`: a
-/// compiled world was given for every program.
+/// The diagnostics that refuse `programs`, each on its own target
+/// (`targets`, in the same order). `has_scenarios`: a compiled world was
+/// given for every program.
 pub fn check(
     build: &BuildInput<'_>,
     programs: &[RobotProgram],
-    target: Target,
+    targets: &[Chosen],
     emit: Emit,
     has_scenarios: bool,
 ) -> Vec<Diagnostic> {
@@ -27,17 +30,21 @@ pub fn check(
     if emit == Emit::TaskGraph {
         return found;
     }
-    if target.needs_scenario() && !has_scenarios {
-        found.push(Diagnostic::new(
-            Code::TargetUnsupported,
-            build.mission,
-            Default::default(),
-            format!(
-                "target {} compiles a scenario into each robot: build with `semo build --target {} --scenario FILE`",
-                target.name(),
-                target.name()
-            ),
-        ));
+    let mut scenario_asked = Vec::new();
+    for chosen in targets {
+        let target = chosen.target;
+        if target.needs_scenario() && !has_scenarios && !scenario_asked.contains(&target) {
+            scenario_asked.push(target);
+            found.push(Diagnostic::new(
+                Code::TargetUnsupported,
+                build.mission,
+                Default::default(),
+                format!(
+                    "target {} compiles a scenario into each robot: build with `semo build --scenario FILE`",
+                    target.name(),
+                ),
+            ));
+        }
     }
     // A service graph without a schedule cannot be run (the dataflow
     // warnings say why on the call).
@@ -59,69 +66,101 @@ pub fn check(
             }
         }
     }
-    if target.platform() == Platform::Static {
-        for program in programs {
-            if let Err(why) = super::schedule::firings(&program.graph) {
-                found.push(Diagnostic::new(
-                    Code::CodegenInternal,
-                    build.mission,
-                    robot_span(build, &program.robot),
-                    format!("robot `{}`: no static schedule: {why}", program.robot),
-                ));
-            }
-        }
-        // A task graph run inside a service task needs the hosted runtime
-        // (its loop ends are formatted with snprintf, its exit from the
-        // threads simulation's scenario).
-        for program in programs {
-            if let Some(graph) = program.graph_services.first() {
-                found.push(Diagnostic::new(
-                    Code::TargetUnsupported,
-                    build.mission,
-                    robot_span(build, &program.robot),
-                    format!(
-                        "robot `{}`: its service task `{}` runs task graph `{}`, which target {} cannot run yet: build for linux or linux-sim",
-                        program.robot,
-                        graph.task,
-                        graph.graph,
-                        target.name()
-                    ),
-                ));
-            }
-        }
-        // One diagnostic per team: its robots share the statements.
-        let mut teams: Vec<(&str, Vec<&str>, String, crate::span::Span)> = Vec::new();
-        for program in programs {
-            let Some(why) = peer_messages(program) else {
-                continue;
-            };
-            match teams.iter_mut().find(|(team, ..)| *team == program.team) {
-                Some((_, robots, ..)) => robots.push(&program.robot),
-                None => {
-                    let span = message_span(build, &program.team)
-                        .unwrap_or_else(|| robot_span(build, &program.robot));
-                    teams.push((&program.team, vec![&program.robot], why, span));
-                }
-            }
-        }
-        for (team, robots, why, span) in teams {
-            let who = if robots.len() == 1 {
-                format!("robot `{}`", robots[0])
-            } else {
-                format!("the robots of team `{team}` ({})", robots.join(", "))
-            };
+    let on_static = || {
+        programs
+            .iter()
+            .zip(targets)
+            .filter(|(_, chosen)| chosen.target.layer() == Layer::Static)
+    };
+    for (program, _) in on_static() {
+        if let Err(why) = super::schedule::firings(&program.graph) {
             found.push(Diagnostic::new(
-                Code::TargetUnsupported,
+                Code::CodegenInternal,
                 build.mission,
-                span,
-                format!(
-                    "{who}: {why}, but target {} has no transport to other robots yet: build for linux, or message only USER",
-                    target.name()
-                ),
+                robot_span(build, &program.robot),
+                format!("robot `{}`: no static schedule: {why}", program.robot),
             ));
         }
     }
+    // A task graph run inside a service task needs the hosted runtime
+    // (its loop ends are formatted with snprintf, its exit from the
+    // threads simulation's scenario).
+    for (program, chosen) in on_static() {
+        if let Some(graph) = program.graph_services.first() {
+            let mut d = Diagnostic::new(
+                Code::TargetUnsupported,
+                build.mission,
+                robot_span(build, &program.robot),
+                format!(
+                    "robot `{}` is built for {}: its service task `{}` runs task graph `{}`, which {} cannot run yet: build it for linux or linux-sim",
+                    program.robot,
+                    chosen.describe(),
+                    graph.task,
+                    graph.graph,
+                    chosen.target.name()
+                ),
+            );
+            relate_choice(&mut d, chosen);
+            found.push(d);
+        }
+    }
+    // One diagnostic per team and target: its robots share the statements.
+    let mut teams: Vec<(&str, &Chosen, Vec<&str>, String, crate::span::Span)> = Vec::new();
+    for (program, chosen) in on_static() {
+        let Some(why) = peer_messages(program) else {
+            continue;
+        };
+        let same = |(team, c, ..): &&mut (&str, &Chosen, Vec<&str>, String, _)| {
+            *team == program.team && *c == chosen
+        };
+        match teams.iter_mut().find(same) {
+            Some((_, _, robots, ..)) => robots.push(&program.robot),
+            None => {
+                let span = message_span(build, &program.team)
+                    .unwrap_or_else(|| robot_span(build, &program.robot));
+                teams.push((&program.team, chosen, vec![&program.robot], why, span));
+            }
+        }
+    }
+    for (team, chosen, robots, why, span) in teams {
+        let who = if robots.len() == 1 {
+            format!("robot `{}` (team `{team}`)", robots[0])
+        } else {
+            format!("the robots of team `{team}` ({})", robots.join(", "))
+        };
+        let mut d = Diagnostic::new(
+            Code::TargetUnsupported,
+            build.mission,
+            span,
+            format!(
+                "{who} {} {}: {why}, but {} has no transport to other robots yet: build {} for linux, or message only USER",
+                if robots.len() == 1 { "is" } else { "are" },
+                built_for(chosen),
+                chosen.target.name(),
+                if robots.len() == 1 { "it" } else { "them" },
+            ),
+        );
+        relate_choice(&mut d, chosen);
+        found.push(d);
+    }
     found
+}
+
+/// `built for cortex-m, the platform its type ... names`.
+fn built_for(chosen: &Chosen) -> String {
+    format!("built for {}", chosen.describe())
+}
+
+/// Points at where the target was chosen (the catalog's `target=`, the
+/// project file's key), when it was written in a file.
+fn relate_choice(diagnostic: &mut Diagnostic, chosen: &Chosen) {
+    if let Some((file, span)) = chosen.written_at() {
+        diagnostic.related.push(crate::diag::Related {
+            file,
+            span,
+            message: format!("{} is chosen here", chosen.target.name()),
+        });
+    }
 }
 
 /// Where the robot is declared (diagnostics about one robot point there).

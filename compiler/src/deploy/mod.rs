@@ -248,17 +248,22 @@ pub fn check(deployment: &Deployment, mission: &Mission) -> Vec<Diagnostic> {
     found
 }
 
-/// Bakes the deployment into every robot folder of a build: its
-/// `semo_deploy.h` names the broker, client id, user and the paths of the
-/// password file and TLS files (the runtime reads the password at start).
-/// Returns false when the target has no network transport (no such header).
+/// Bakes the deployment into every robot folder of a build whose target
+/// has a network transport: its `semo_deploy.h` names the broker, client
+/// id, user and the paths of the password file and TLS files (the runtime
+/// reads the password at start). A robot on a platform without one (a
+/// board: it talks to nobody, E103) has nothing to bake. Returns false when
+/// no robot of the build has a network transport.
 pub fn bake(deployment: &Deployment, result: &mut BuildResult) -> bool {
-    let mut baked = true;
+    let mut baked = false;
     for robot in &mut result.robots {
+        if robot.target.transport().is_none() {
+            continue;
+        }
         let connection = deployment.robot(&robot.team, &robot.robot);
-        match robot.files.iter_mut().find(|f| f.path == DEPLOY_HEADER) {
-            Some(file) => file.text = header(&connection),
-            None => baked = false,
+        if let Some(file) = robot.files.iter_mut().find(|f| f.path == DEPLOY_HEADER) {
+            file.text = header(&connection);
+            baked = true;
         }
     }
     baked

@@ -88,7 +88,7 @@ impl Analysis {
                 ))
             }
             FileKind::Project => Some(
-                crate::project::completions(&source.text, offset)
+                crate::project::completions(&source.text, offset, &self.project_names(file))
                     .into_iter()
                     .map(project_completion)
                     .collect(),

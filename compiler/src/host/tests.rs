@@ -283,3 +283,107 @@ fn the_view_agrees_with_the_rule_and_lives_as_long_as_the_layout() {
     host.set_file(FileId(99), Some(path), FileKind::Catalog, "".into());
     assert!(!Arc::ptr_eq(&kept, &host.analysis().view));
 }
+
+/// Each robot's target in the build plan: the door's for every robot, else
+/// the project file's for the robot (or its `name[N]` declaration), else for
+/// its team, else `[build] target`, else its robot type's platform, else
+/// linux; `sim` then simulates each; a `[build.targets]` name the mission
+/// lacks is W110 on the project file.
+#[test]
+fn the_build_plan_gives_each_robot_its_target_and_says_why() {
+    use crate::codegen::{Reason, Target};
+    use crate::host::PlanRequest;
+    let mut host = AnalysisHost::new(roots(&["/w"]));
+    let catalog = "<Catalog xmlns=\"urn:semo:catalog:1\">\n  <Robot type=\"Board\">\n    <Platform os=\"none\" target=\"cortex-m\"/>\n    <Service name=\"beep\" task=\"buzzer\"/>\n  </Robot>\n  <Robot type=\"Pc\">\n    <Service name=\"beep\" task=\"buzzer\"/>\n  </Robot>\n</Catalog>\n";
+    let mission = "{\n  A: Board a, Pc p, Board many[2]\n  B: Board b\n}\nA.P.S{ beep() } repeat(1 SEC)\nA.M{ set(P, S) }\nA.main{ default: mode = M }\nB.P.S{ beep() } repeat(1 SEC)\nB.M{ set(P, S) }\nB.main{ default: mode = M }\n";
+    let files: [(&str, FileKind, &str); 2] = [
+        ("/w/p/robots/r.robot.xml", FileKind::Catalog, catalog),
+        ("/w/p/m.mission", FileKind::Mission, mission),
+    ];
+    for (i, (path, kind, text)) in files.into_iter().enumerate() {
+        host.set_file(FileId(i as u32), Some(path.into()), kind, text.into());
+    }
+    let mission_id = FileId(1);
+    let plan = |host: &AnalysisHost, asked: PlanRequest| -> Vec<String> {
+        let analysis = host.analysis();
+        let plan = analysis.build_plan(mission_id, Path::new("/w/p/m.mission"), asked);
+        let mut out: Vec<String> = plan
+            .robots
+            .iter()
+            .map(|r| {
+                let why = match &r.chosen.reason {
+                    Reason::Asked => "asked".to_string(),
+                    Reason::Project { key, .. } => format!("project {key}"),
+                    Reason::Catalog { robot_type, .. } => format!("catalog {robot_type}"),
+                    Reason::Default => "default".to_string(),
+                };
+                let sim = if r.chosen.simulated { " sim" } else { "" };
+                format!("{}/{} {} ({why}{sim})", r.team, r.robot, r.chosen.target)
+            })
+            .collect();
+        out.extend(plan.diagnostics.iter().map(|d| {
+            let at = &analysis.file(d.file).unwrap().text[d.span.range()];
+            format!("{} '{at}' {}", d.code, d.message)
+        }));
+        out
+    };
+    // No project file: the catalog's platform, else linux.
+    assert_eq!(
+        plan(&host, PlanRequest::default()),
+        [
+            "A/a cortex-m (catalog Board)",
+            "A/p linux (default)",
+            "A/many_0 cortex-m (catalog Board)",
+            "A/many_1 cortex-m (catalog Board)",
+            "B/b cortex-m (catalog Board)",
+        ]
+    );
+    // `--sim`: each platform's simulation.
+    let sim = PlanRequest {
+        sim: true,
+        ..PlanRequest::default()
+    };
+    assert_eq!(
+        plan(&host, sim.clone()),
+        [
+            "A/a cortex-m-sim (catalog Board sim)",
+            "A/p linux-sim (default sim)",
+            "A/many_0 cortex-m-sim (catalog Board sim)",
+            "A/many_1 cortex-m-sim (catalog Board sim)",
+            "B/b cortex-m-sim (catalog Board sim)",
+        ]
+    );
+    let project = "[project]\ncatalogs = [\"robots\"]\n[build]\ntarget = \"linux-sim\"\n[build.targets]\nA = \"cortex-m\"\np = \"linux\"\nmany = \"linux-sim\"\nmanny = \"linux\"\n";
+    host.set_file(
+        FileId(2),
+        Some(PathBuf::from("/w/p/semo.toml")),
+        FileKind::Project,
+        project.into(),
+    );
+    // The robot (or its declaration) first, then its team, then every robot.
+    assert_eq!(
+        plan(&host, PlanRequest::default()),
+        [
+            "A/a cortex-m (project [build.targets] A)",
+            "A/p linux (project [build.targets] p)",
+            "A/many_0 linux-sim (project [build.targets] many)",
+            "A/many_1 linux-sim (project [build.targets] many)",
+            "B/b linux-sim (project [build] target)",
+            "W110 'manny' `[build.targets]` names `manny`, which is no team or robot of m.mission: its target is not used (did you mean `many`?)",
+        ]
+    );
+    // The door's target wins for every robot, and `sim` still applies.
+    let asked = PlanRequest {
+        target: Some(Target::CortexM),
+        sim: true,
+        ..PlanRequest::default()
+    };
+    let planned = plan(&host, asked);
+    assert_eq!(
+        planned[..2],
+        [
+            "A/a cortex-m-sim (asked sim)",
+            "A/p cortex-m-sim (asked sim)"
+        ]
+    );
+}

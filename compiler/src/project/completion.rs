@@ -1,13 +1,14 @@
 //! Completion in `semo.toml` (as taplo completes from a schema): on a
 //! header line the tables, at a key's place the keys of the table the
 //! cursor is in that it does not have yet (in `[lints]` every warning and
-//! hint code, and `E` codes, which may only be denied), after `=` the values
-//! a key takes (lint levels, target names). Read from the text around the cursor, so it works while
-//! the file does not parse.
+//! hint code, and `E` codes, which may only be denied; in `[build.targets]`
+//! the teams and robots of the project's missions), after `=` the values
+//! a key takes (lint levels, target names). Read from the text around the
+//! cursor, so it works while the file does not parse.
 
 use super::{BUILD_KEYS, Level, PROJECT_KEYS, TABLES};
-use crate::codegen::TARGETS;
 use crate::diag::{Code, Severity};
+use crate::platform::Target;
 use crate::span::Span;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,8 +35,17 @@ fn is_word(c: char) -> bool {
     c.is_ascii_alphanumeric() || c == '_' || c == '-'
 }
 
-/// The completions at `offset` in the project file `text`.
-pub fn completions(text: &str, offset: usize) -> Vec<Completion> {
+/// A team or robot a `[build.targets]` key may name, with what it is
+/// (`robot of team Scouts (TIEvalbot), scouting.mission`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Named {
+    pub name: String,
+    pub detail: String,
+}
+
+/// The completions at `offset` in the project file `text`; `named`: the
+/// teams and robots of the missions of the project.
+pub fn completions(text: &str, offset: usize, named: &[Named]) -> Vec<Completion> {
     let Some(before_cursor) = text.get(..offset) else {
         return Vec::new();
     };
@@ -86,9 +96,13 @@ pub fn completions(text: &str, offset: usize) -> Vec<Completion> {
                     .map(|l| value_item(l, level_detail(l)))
                     .collect()
             }
-            (Some("build"), "target") => TARGETS
+            (Some("build"), "target") => Target::ALL
                 .iter()
-                .map(|t| value_item(t.name, "a target of `semo build`"))
+                .map(|t| value_item(t.name(), &target_detail(*t, "every robot")))
+                .collect(),
+            (Some("build.targets"), _) => Target::ALL
+                .iter()
+                .map(|t| value_item(t.name(), &target_detail(*t, "its robots")))
                 .collect(),
             _ => Vec::new(),
         };
@@ -107,6 +121,14 @@ pub fn completions(text: &str, offset: usize) -> Vec<Completion> {
             .collect(),
         Some("project") => keys(PROJECT_KEYS),
         Some("build") => keys(BUILD_KEYS),
+        Some("build.targets") => named
+            .iter()
+            .filter(|n| !written.contains(&n.name))
+            .map(|n| {
+                let insert = format!("{} = ", key_text(&n.name));
+                item(CompletionKind::Key, &n.name, &n.detail, insert)
+            })
+            .collect(),
         Some("lints") => {
             // Warnings and hints first: those are the ones a project tunes.
             let mut codes: Vec<&Code> = Code::ALL.iter().collect();
@@ -121,6 +143,33 @@ pub fn completions(text: &str, offset: usize) -> Vec<Completion> {
                 .collect()
         }
         Some(_) => Vec::new(),
+    }
+}
+
+/// What building `who` for `target` means, for a value's detail.
+fn target_detail(target: Target, who: &str) -> String {
+    let platform = target.platform();
+    if target.simulated() {
+        format!(
+            "{who} on {}, simulated from a scenario ({})",
+            platform.name, platform.doc
+        )
+    } else {
+        format!("{who} on {}", platform.doc)
+    }
+}
+
+/// `name` as a TOML key: bare when it can be (team and robot names are
+/// identifiers), else quoted.
+fn key_text(name: &str) -> String {
+    let bare = !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+    if bare {
+        name.to_string()
+    } else {
+        format!("\"{}\"", name.replace('\\', "\\\\").replace('"', "\\\""))
     }
 }
 

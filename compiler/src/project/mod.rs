@@ -1,15 +1,19 @@
 //! The project file, `semo.toml`: one file at a project's root (found by
 //! walking up from a file, as Cargo finds `Cargo.toml`, see [`find`]) that
 //! says which catalog, strategy and task-graph folders the project's missions
-//! read, where `semo build` writes and for which target, which deployment
-//! file the project uses, and the level of each diagnostic code
+//! read, where `semo build` writes and for which target (every robot's,
+//! `[build] target`, or a team's or robot's, `[build.targets]`), which
+//! deployment file the project uses, and the level of each diagnostic code
 //! (`[lints]`). The format is documented in `docs/project-file.md`.
 //!
 //! [`parse`] reads it with positions (toml_edit keeps every key's and value's
 //! byte range), so each mistake is a diagnostic on the project file itself:
 //! invalid TOML (E110), a value of the wrong form (E111), an error code
 //! allowed (E112), an unknown key (W110, with a did-you-mean), a folder that
-//! does not exist ([`Project::missing_paths`], W111). Whatever is wrong, the
+//! does not exist ([`Project::missing_paths`], W111); a `[build.targets]`
+//! name that names no team or robot of the mission built is W110 when it
+//! is built ([`Project::unknown_names`]: one project serves several
+//! missions, so only a build knows which names it must have). Whatever is wrong, the
 //! rest of the file is still read. The host applies the project to the files
 //! under its root (`host::sees`, [`Project::apply_lints`]); `completion.rs`
 //! completes keys, tables, lint codes and values for the editor.
@@ -18,10 +22,10 @@ mod completion;
 #[cfg(test)]
 mod tests;
 
-pub use completion::{Completion, CompletionKind, completions};
+pub use completion::{Completion, CompletionKind, Named, completions};
 
-use crate::codegen::Target;
 use crate::diag::{Code, Diagnostic, FileId, Severity};
+use crate::platform::Target;
 use crate::span::Span;
 use crate::suggest::did_you_mean;
 use std::collections::BTreeMap;
@@ -70,6 +74,23 @@ pub struct ProjectPath {
     pub span: Span,
 }
 
+/// A target written in the project file, and where its value is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ProjectTarget {
+    pub target: Target,
+    pub span: Span,
+}
+
+/// `name = "target"` in `[build.targets]`: the robots of the team `name`,
+/// or the robot `name` (or the robots of its `name[N]` declaration), are
+/// built for `target`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct NamedTarget {
+    pub name: String,
+    pub name_span: Span,
+    pub target: ProjectTarget,
+}
+
 /// A project file read. Folders default to the whole project (its root).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Project {
@@ -81,8 +102,11 @@ pub struct Project {
     pub task_graphs: Vec<ProjectPath>,
     /// `semo build`'s output folder when `-o` is not given.
     pub output: Option<ProjectPath>,
-    /// `semo build`'s target when `--target` is not given.
-    pub target: Option<Target>,
+    /// `semo build`'s target for every robot when `--target` is not given
+    /// (`[build] target`).
+    pub target: Option<ProjectTarget>,
+    /// A team's or robot's target (`[build.targets]`), in file order.
+    pub targets: Vec<NamedTarget>,
     /// The deployment file (`*.deploy.toml`).
     pub deployment: Option<ProjectPath>,
     pub lints: BTreeMap<Code, Level>,
@@ -98,6 +122,10 @@ pub const TABLES: &[(&str, &str)] = &[
     (
         "build",
         "`semo build`'s output folder and target, the deployment file",
+    ),
+    (
+        "build.targets",
+        "a team's or robot's target: `Scouts = \"cortex-m\"`",
     ),
     ("lints", "the level of diagnostic codes: `W007 = \"allow\"`"),
 ];
@@ -124,7 +152,10 @@ pub const BUILD_KEYS: &[(&str, &str)] = &[
         "output",
         "the output folder of `semo build` (default: `out` beside the mission)",
     ),
-    ("target", "the target of `semo build` (default: linux)"),
+    (
+        "target",
+        "the target of every robot (default: each robot type's platform in the catalog, else linux)",
+    ),
     ("deployment", "the deployment file (*.deploy.toml)"),
 ];
 
@@ -146,6 +177,7 @@ impl Project {
             task_graphs: whole(),
             output: None,
             target: None,
+            targets: Vec::new(),
             deployment: None,
             lints: BTreeMap::new(),
         }
@@ -183,6 +215,30 @@ impl Project {
                 _ => true,
             }
         });
+    }
+
+    /// W110 for each `[build.targets]` name that names none of `known`
+    /// (the teams, robots and robot declarations of the mission `mission`
+    /// being built), with a did-you-mean among them: its robots would
+    /// silently keep another target.
+    pub fn unknown_names(&self, file: FileId, mission: &str, known: &[&str]) -> Vec<Diagnostic> {
+        self.targets
+            .iter()
+            .filter(|t| !known.contains(&t.name.as_str()))
+            .map(|t| {
+                let mut d = Diagnostic::new(
+                    Code::ProjectUnknownKey,
+                    file,
+                    t.name_span,
+                    format!(
+                        "`[build.targets]` names `{}`, which is no team or robot of {mission}: its target is not used",
+                        t.name
+                    ),
+                );
+                d.suggest(did_you_mean(&t.name, known.iter().copied()));
+                d
+            })
+            .collect()
     }
 
     /// W111 for each input folder or deployment file written in the file
@@ -306,6 +362,11 @@ fn names(keys: &[(&'static str, &str)]) -> impl Iterator<Item = &'static str> + 
     keys.iter().map(|(k, _)| *k)
 }
 
+/// The tables of the document itself (`build.targets` is inside `build`).
+fn top_tables() -> impl Iterator<Item = &'static str> + Clone {
+    names(TABLES).filter(|t| !t.contains('.'))
+}
+
 impl Reader<'_> {
     fn error(&mut self, code: Code, span: Span, message: String) {
         self.diagnostics
@@ -351,22 +412,22 @@ impl Reader<'_> {
                 continue;
             };
             let Some(inner) = item.as_table_like() else {
-                if names(TABLES).any(|t| t == name) {
+                if top_tables().any(|t| t == name) {
                     self.error(
                         Code::ProjectBadValue,
                         item_span(key, item),
                         format!("`{name}` must be a table (`[{name}]`)"),
                     );
                 } else {
-                    self.unknown_key(key, "table", names(TABLES));
+                    self.unknown_key(key, "table", top_tables());
                 }
                 continue;
             };
             match name {
                 "project" => self.entries(inner, PROJECT_KEYS, "key of [project]", Self::project),
-                "build" => self.entries(inner, BUILD_KEYS, "key of [build]", Self::build),
+                "build" => self.build_table(inner),
                 "lints" => self.lints(inner),
-                _ => self.unknown_key(key, "table", names(TABLES)),
+                _ => self.unknown_key(key, "table", top_tables()),
             }
         }
     }
@@ -466,6 +527,23 @@ impl Reader<'_> {
         }
     }
 
+    /// `[build]`: its keys, and its `targets` table.
+    fn build_table(&mut self, table: &dyn toml_edit::TableLike) {
+        for (name, item) in table.iter() {
+            let Some((key, _)) = table.get_key_value(name) else {
+                continue;
+            };
+            if name == "targets" {
+                self.targets(key, item);
+            } else if names(BUILD_KEYS).any(|k| k == name) {
+                self.build(name, key, item);
+            } else {
+                let known = names(BUILD_KEYS).chain(["targets"]);
+                self.unknown_key(key, "key of [build]", known);
+            }
+        }
+    }
+
     fn build(&mut self, name: &str, key: &toml_edit::Key, item: &toml_edit::Item) {
         let span = item_span(key, item);
         let Some(value) = item.as_str() else {
@@ -479,23 +557,60 @@ impl Reader<'_> {
         match name {
             "output" => self.project.output = Some(self.path(value, span)),
             "deployment" => self.project.deployment = Some(self.path(value, span)),
-            _ => match Target::from_name(value) {
-                Some(target) => self.project.target = Some(target),
-                None => {
-                    let targets = crate::codegen::TARGETS.iter().map(|t| t.name);
-                    let mut d = Diagnostic::new(
-                        Code::ProjectBadValue,
-                        self.file,
-                        span,
-                        format!(
-                            "unknown target `{value}` (targets: {})",
-                            targets.clone().collect::<Vec<_>>().join(", ")
-                        ),
-                    );
-                    d.suggest(did_you_mean(value, targets));
-                    self.diagnostics.push(d);
-                }
-            },
+            _ => self.project.target = self.target(value, span),
+        }
+    }
+
+    /// A target's name, else E111 with a did-you-mean.
+    fn target(&mut self, value: &str, span: Span) -> Option<ProjectTarget> {
+        if let Some(target) = Target::from_name(value) {
+            return Some(ProjectTarget { target, span });
+        }
+        let mut d = Diagnostic::new(
+            Code::ProjectBadValue,
+            self.file,
+            span,
+            format!(
+                "unknown target `{value}` (targets: {})",
+                Target::names().collect::<Vec<_>>().join(", ")
+            ),
+        );
+        d.suggest(did_you_mean(value, Target::names()));
+        self.diagnostics.push(d);
+        None
+    }
+
+    /// `[build.targets]` (or `targets = { ... }` in `[build]`): team and
+    /// robot names, each with its target.
+    fn targets(&mut self, key: &toml_edit::Key, item: &toml_edit::Item) {
+        let Some(table) = item.as_table_like() else {
+            self.error(
+                Code::ProjectBadValue,
+                item_span(key, item),
+                "`targets` must be a table of team and robot names, `[build.targets]` with `Scouts = \"cortex-m\"`".into(),
+            );
+            return;
+        };
+        for (name, item) in table.iter() {
+            let Some((key, _)) = table.get_key_value(name) else {
+                continue;
+            };
+            let span = item_span(key, item);
+            let Some(value) = item.as_str() else {
+                self.error(
+                    Code::ProjectBadValue,
+                    span,
+                    format!("the target of `{name}` must be a string, such as \"linux\""),
+                );
+                continue;
+            };
+            if let Some(target) = self.target(value, span) {
+                self.project.targets.push(NamedTarget {
+                    name: name.to_string(),
+                    name_span: span_of(key.span()),
+                    target,
+                });
+            }
         }
     }
 

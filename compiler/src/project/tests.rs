@@ -59,7 +59,10 @@ E019 = "deny"
         project.deployment.as_ref().unwrap().path,
         Path::new("/p/field.deploy.toml")
     );
-    assert_eq!(project.target, Some(crate::codegen::Target::LinuxSim));
+    assert_eq!(
+        project.target.map(|t| t.target),
+        Some(crate::platform::Target::LinuxSim)
+    );
     assert_eq!(project.level(Code::UnknownAttribute), Some(Level::Allow));
     assert_eq!(project.level(Code::EventNeverCaught), Some(Level::Deny));
     assert_eq!(project.level(Code::ServiceNotProvided), Some(Level::Deny));
@@ -195,9 +198,21 @@ fn tempfile_dir() -> std::path::PathBuf {
 
 /// The labels offered at `$0`.
 fn offered(text: &str) -> Vec<String> {
+    offered_with(text, &[])
+}
+
+/// The labels offered at `$0` in a project whose missions have `named`.
+fn offered_with(text: &str, named: &[(&str, &str)]) -> Vec<String> {
     let offset = text.find("$0").unwrap();
     let text = text.replace("$0", "");
-    completions(&text, offset)
+    let named: Vec<Named> = named
+        .iter()
+        .map(|(name, detail)| Named {
+            name: name.to_string(),
+            detail: detail.to_string(),
+        })
+        .collect();
+    completions(&text, offset, &named)
         .into_iter()
         .map(|c| format!("{}→{}", c.label, c.insert))
         .collect()
@@ -207,11 +222,21 @@ fn offered(text: &str) -> Vec<String> {
 fn completion_offers_tables_keys_codes_and_values() {
     assert_eq!(
         offered("$0"),
-        ["project→[project]", "build→[build]", "lints→[lints]"]
+        [
+            "project→[project]",
+            "build→[build]",
+            "build.targets→[build.targets]",
+            "lints→[lints]"
+        ]
     );
     assert_eq!(
         offered("[bu$0"),
-        ["project→project", "build→build", "lints→lints"]
+        [
+            "project→project",
+            "build→build",
+            "build.targets→build.targets",
+            "lints→lints"
+        ]
     );
     assert_eq!(
         offered("[build]\nta$0"),
@@ -257,6 +282,105 @@ fn completion_offers_tables_keys_codes_and_values() {
 #[test]
 fn completion_replaces_the_word_being_typed() {
     let text = "[lints]\nW00";
-    let all = completions(text, text.len());
+    let all = completions(text, text.len(), &[]);
     assert!(all.iter().all(|c| c.replace == Span::new(8, 11)));
+}
+
+#[test]
+fn build_targets_give_teams_and_robots_their_own_target() {
+    use crate::platform::Target;
+    let text = r#"[build]
+target = "linux-sim"
+
+[build.targets]
+Scouts = "cortex-m"
+"ti" = "linux"
+"#;
+    let (project, diagnostics) = read(text);
+    assert_eq!(listing(text, &diagnostics), Vec::<String>::new());
+    let written: Vec<(String, &str, Target, &str)> = project
+        .targets
+        .iter()
+        .map(|t| {
+            (
+                t.name.clone(),
+                &text[t.name_span.start..t.name_span.end],
+                t.target.target,
+                &text[t.target.span.start..t.target.span.end],
+            )
+        })
+        .collect();
+    assert_eq!(
+        written,
+        [
+            (
+                "Scouts".to_string(),
+                "Scouts",
+                Target::CortexM,
+                "\"cortex-m\""
+            ),
+            ("ti".to_string(), "\"ti\"", Target::Linux, "\"linux\""),
+        ]
+    );
+    // The same as an inline table of `[build]`.
+    let (inline, diagnostics) = read("[build]\ntargets = { Scouts = \"cortex-m\" }\n");
+    assert!(diagnostics.is_empty(), "{diagnostics:?}");
+    assert_eq!(inline.targets.len(), 1);
+}
+
+#[test]
+fn build_targets_mistakes_are_positioned_with_a_did_you_mean() {
+    let text = r#"[build]
+targets = "cortex-m"
+tagrets = 1
+"#;
+    let (_, diagnostics) = read(text);
+    insta::assert_snapshot!(listing(text, &diagnostics).join("\n"), @r#"
+    E111 '"cortex-m"' `targets` must be a table of team and robot names, `[build.targets]` with `Scouts = "cortex-m"`
+    W110 'tagrets' unknown key of [build] `tagrets` (known: output, target, deployment, targets) (did you mean `targets`?)
+    "#);
+    let text = r#"[build.targets]
+Scouts = "cortx-m"
+ti = 3
+"#;
+    let (project, diagnostics) = read(text);
+    insta::assert_snapshot!(listing(text, &diagnostics).join("\n"), @r#"
+    E111 '"cortx-m"' unknown target `cortx-m` (targets: linux, linux-sim, cortex-m, cortex-m-sim) (did you mean `cortex-m`?)
+    E111 '3' the target of `ti` must be a string, such as "linux"
+    "#);
+    assert!(project.targets.is_empty());
+}
+
+#[test]
+fn a_build_targets_name_the_mission_lacks_is_w110_with_a_did_you_mean() {
+    let text = "[build.targets]\nScouts = \"cortex-m\"\ntii = \"linux\"\n";
+    let (project, _) = read(text);
+    let found = project.unknown_names(FILE, "scouting.mission", &["Scouts", "ti", "irobot"]);
+    assert_eq!(
+        listing(text, &found),
+        [
+            "W110 'tii' `[build.targets]` names `tii`, which is no team or robot of scouting.mission: its target is not used (did you mean `ti`?)"
+        ]
+    );
+}
+
+#[test]
+fn completion_in_build_targets_offers_the_missions_names_and_the_targets() {
+    let named = [
+        ("Scouts", "team, m.mission"),
+        ("ti", "robot of team Scouts (TIEvalbot), m.mission"),
+    ];
+    assert_eq!(
+        offered_with("[build.targets]\nScouts = \"linux\"\n$0", &named),
+        ["ti→ti = "]
+    );
+    assert_eq!(
+        offered_with("[build.targets]\nti = $0", &named),
+        [
+            "linux→\"linux\"",
+            "linux-sim→\"linux-sim\"",
+            "cortex-m→\"cortex-m\"",
+            "cortex-m-sim→\"cortex-m-sim\""
+        ]
+    );
 }

@@ -670,12 +670,22 @@ where
         .repeated()
         .at_least(1)
         .map_with(|_, e| Item::Error(sp(e.span())));
-    choice((formation_block, service, main, mode, function, bare_team))
-        .then_ignore(semis)
-        .labelled("a team, service, mode, main or function")
-        .recover_with(via_parser(rest))
-        .repeated()
-        .collect::<Vec<_>>()
+    // Each item's parser boxed: the choice's type (and the drop glue's
+    // symbol, whose name spells it) stays small, instead of nesting every
+    // item's combinators into one name hundreds of kilobytes long.
+    choice((
+        formation_block.boxed(),
+        service.boxed(),
+        main.boxed(),
+        mode.boxed(),
+        function.boxed(),
+        bare_team.boxed(),
+    ))
+    .then_ignore(semis)
+    .labelled("a team, service, mode, main or function")
+    .recover_with(via_parser(rest))
+    .repeated()
+    .collect::<Vec<_>>()
 }
 
 #[derive(Clone)]

@@ -6,12 +6,15 @@
 //! robot.
 //!
 //! Arguments: one object `{ "uri": mission, "outputFolder"?: path (relative
-//! to the mission's folder), "target"?: "linux" | "linux-sim", "team"?: only
-//! this team's robots, "force"?: replace files in the way, saved first (as
-//! `semo build --force`) }`, or just the URI. What the arguments do not say
-//! the mission's project file does, as for `semo build`: both ask the host's
-//! one [`semo::host::Analysis::build_plan`] (target, output folder, and the
-//! deployment whose broker and credentials are baked into the robots).
+//! to the mission's folder), "target"?: every robot's target ("linux",
+//! "linux-sim", "cortex-m", "cortex-m-sim"), "sim"?: each robot's platform
+//! simulated (`semo build --sim`), "team"?: only this team's robots,
+//! "force"?: replace files in the way, saved first (as `semo build
+//! --force`) }`, or just the URI. What the arguments do not say the
+//! mission's project file and catalog do, as for `semo build`: both ask the
+//! host's one [`semo::host::Analysis::build_plan`] (each robot's target,
+//! the output folder, and the deployment whose broker and credentials are
+//! baked into the robots). The result names each robot's target.
 //! Refused over files in the way, the error's `data` is `{ "conflicts":
 //! [{ "path", "why" }] }`, so that an editor can offer to force.
 //!
@@ -30,6 +33,7 @@ use crate::encoding::LineMap;
 use crate::world::{Snapshot, World};
 use semo::codegen::{self, BuildResult, Emit, Target, output};
 use semo::diag::{Diagnostic, FileId};
+use semo::host::BuildPlan;
 use semo::text::LineIndex;
 use semo::workspace::FileKind;
 use serde::Deserialize;
@@ -45,6 +49,8 @@ pub struct GenerateParams {
     pub uri: Uri,
     pub output_folder: Option<String>,
     pub target: Option<String>,
+    #[serde(default)]
+    pub sim: bool,
     pub team: Option<String>,
     #[serde(default)]
     pub force: bool,
@@ -60,6 +66,7 @@ pub fn params(arguments: &[Value]) -> Result<GenerateParams, String> {
             uri: uri.parse().map_err(|_| format!("`{uri}` is not a URI"))?,
             output_folder: None,
             target: None,
+            sim: false,
             team: None,
             force: false,
         },
@@ -76,7 +83,9 @@ pub struct Job {
     pub analysis: semo::host::Analysis,
     pub mission: FileId,
     pub out: output::Confined,
-    pub target: Target,
+    /// Each robot's target (and the output folder and deployment, as
+    /// resolved).
+    pub plan: BuildPlan,
     /// The deployment file to bake into the robots (`semo build --deploy`'s).
     pub deployment: Option<PathBuf>,
     pub team: Option<String>,
@@ -107,11 +116,12 @@ pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
         &mission_path,
         semo::host::PlanRequest {
             target,
+            sim: params.sim,
             output: params.output_folder.map(|f| folder.join(f)),
             deployment: None,
         },
     );
-    let requested = plan.output;
+    let requested = plan.output.clone();
     let allowed = if world.roots().is_empty() {
         std::slice::from_ref(&folder)
     } else {
@@ -124,8 +134,8 @@ pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
         analysis,
         mission: mission.id,
         out,
-        target: plan.target,
-        deployment: plan.deployment,
+        deployment: plan.deployment.clone(),
+        plan,
         team: params.team,
         force: params.force,
     })
@@ -143,7 +153,11 @@ pub fn generate(job: &Job) -> Result<(BuildResult, String), String> {
         .build_input(job.mission)
         .ok_or("internal error: the mission is not in the workspace analysis")?;
     let text = build.file.text.to_string();
-    let mut result = codegen::build(&build.input(), job.target, Emit::All);
+    let mut result = codegen::build_each(&build.input(), &job.plan.targets(), Emit::All);
+    // The plan's findings in the project file, with generation's.
+    result
+        .diagnostics
+        .extend(job.plan.diagnostics.iter().cloned());
     // The project's deployment, baked in as `semo build` does.
     if let (Some(path), false) = (&job.deployment, result.refused()) {
         let deployment = semo::deploy::load(path, FileId(u32::MAX)).map_err(|found| {
@@ -159,12 +173,16 @@ pub fn generate(job: &Job) -> Result<(BuildResult, String), String> {
         if !semo::deploy::bake(&deployment, &mut result) {
             return Err(format!(
                 "target {} has no network transport to deploy",
-                job.target.name()
+                target_names(&result.targets())
             ));
         }
     }
     if let Some(team) = &job.team {
         result.robots.retain(|r| &r.team == team);
+        // The runtime the team's robots compile, not the others'.
+        if !result.runtime.is_empty() {
+            result.runtime = codegen::runtime_files(&result.targets());
+        }
     }
     Ok((result, text))
 }
@@ -203,6 +221,7 @@ pub fn robot_summary(robot: &codegen::RobotOutput, written: &output::Written) ->
         "leftAlone": paths(&written.left_alone),
         "team": robot.team,
         "robot": robot.robot,
+        "target": robot.target.name(),
         "folder": written.folder.display().to_string(),
         "generatedFiles": written.generated,
         "taskFilesCreated": written.created,
@@ -258,7 +277,7 @@ pub fn begin(job: &Job, build: &codegen::BuildResult) -> Result<output::Transact
         output::Transaction::begin_inside(&job.out.root, &job.out.rel, || {}).map_err(failed)?;
     if !job.force {
         let conflicts = transaction
-            .conflicts(&build.robots, &build.runtime, job.target)
+            .conflicts(&build.robots, &build.runtime)
             .map_err(failed)?;
         if !conflicts.is_empty() {
             let data = json!({
@@ -274,7 +293,13 @@ pub fn begin(job: &Job, build: &codegen::BuildResult) -> Result<output::Transact
         }
     }
     transaction
-        .stage_runtime(&build.runtime, job.target, job.force)
+        .stage_runtime(&build.runtime, &build.targets(), job.force)
         .map_err(failed)?;
     Ok(transaction)
+}
+
+/// `linux`, or `cortex-m and linux-sim`.
+pub fn target_names(targets: &[Target]) -> String {
+    let names: Vec<&str> = targets.iter().map(|t| t.name()).collect();
+    names.join(" and ")
 }

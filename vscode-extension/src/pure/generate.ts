@@ -20,7 +20,10 @@ export interface ConflictRefusal {
 export interface GenerateArguments {
   uri: string;
   outputFolder?: string;
+  /** Every robot's target; else each robot's own (the server's build plan). */
   target?: string;
+  /** Each robot's platform simulated (`semo build --sim`). */
+  sim?: boolean;
   team?: string;
   force?: boolean;
 }

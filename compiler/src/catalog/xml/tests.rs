@@ -519,3 +519,38 @@ proptest! {
         check_invariants(&text);
     }
 }
+
+#[test]
+fn a_platform_names_the_target_its_programs_are_built_for() {
+    use crate::platform::Target;
+    let text = wrap("<Platform os=\"none\" target=\" cortex-m \"/>");
+    let parsed = parse(&text);
+    assert!(parsed.diagnostics.is_empty(), "{:#?}", parsed.diagnostics);
+    let (target, span) = parsed.robots[0].robot.platform.target.expect("a target");
+    assert_eq!(target, Target::CortexM);
+    assert_eq!(&text[span.range()], "cortex-m");
+    // Not said: none (the build's default decides).
+    let parsed = parse(&wrap("<Platform os=\"linux\"/>"));
+    assert_eq!(parsed.robots[0].robot.platform.target, None);
+}
+
+#[test]
+fn a_platform_target_that_is_no_platform_is_positioned_with_a_did_you_mean() {
+    let text = wrap("<Platform target=\"cortx-m\"/>");
+    let (d, at) = only(&text);
+    assert_eq!((d.code, at), (Code::CatalogBadAttribute, "cortx-m"));
+    assert_eq!(
+        d.message,
+        "unknown platform `cortx-m` (platforms: linux, cortex-m) (did you mean `cortex-m`?)"
+    );
+    assert_eq!(d.suggestion.as_deref(), Some("cortex-m"));
+    // A simulation is the build's choice, not the robot's.
+    let text = wrap("<Platform target=\"linux-sim\"/>");
+    let (d, at) = only(&text);
+    assert_eq!((d.code, at), (Code::CatalogBadAttribute, "linux-sim"));
+    assert!(
+        d.message.contains("simulation of linux") && d.message.contains("--sim"),
+        "{}",
+        d.message
+    );
+}

@@ -6,7 +6,7 @@
 use super::journal::{Aside, Old};
 use super::manifest::{self, Entry, Kind, Manifest};
 use super::{Conflict, FolderFiles, OutputError, Written, at, fsops, not_a_folder, safe_relative};
-use crate::codegen::{GeneratedFile, Owner, Target};
+use crate::codegen::{GeneratedFile, Owner};
 use std::borrow::Cow;
 use std::collections::BTreeSet;
 use std::os::fd::{AsFd, BorrowedFd, OwnedFd};
@@ -48,7 +48,9 @@ struct Folder {
     path: PathBuf,
     backup: PathBuf,
     previous: Option<Manifest>,
-    target: Target,
+    /// What generation writes it for (a target's name, or the runtime
+    /// folder's targets).
+    target: String,
 }
 
 impl<'r> Plan<'r> {
@@ -57,9 +59,8 @@ impl<'r> Plan<'r> {
         out_path: &Path,
         backup: &Path,
         files: &FolderFiles<'r>,
-        target: Target,
     ) -> Result<Plan<'r>, OutputError> {
-        let folder = open_folder(out, out_path, &files.names, backup, target)?;
+        let folder = open_folder(out, out_path, &files.names, backup, &files.target)?;
         let mut plan = Plan {
             changes: Vec::new(),
             conflicts: Vec::new(),
@@ -70,7 +71,7 @@ impl<'r> Plan<'r> {
             },
         };
         let mut manifest = Manifest {
-            target: target.name().to_string(),
+            target: files.target.clone(),
             files: Default::default(),
         };
         let mut seen = BTreeSet::new();
@@ -189,11 +190,11 @@ impl<'r> Plan<'r> {
                         Some(_) => format!(
                             "is a task file you filled in (target {}); target {} generates it",
                             folder.previous.as_ref().map_or("?", |m| m.target.as_str()),
-                            folder.target.name()
+                            folder.target
                         ),
                         None => format!(
                             "is not a file semo generated (target {} generates it)",
-                            folder.target.name()
+                            folder.target
                         ),
                     };
                     self.conflict(folder, &file.path, why, Some(new), old);
@@ -324,7 +325,7 @@ fn open_folder(
     out_path: &Path,
     names: &[&str],
     backup: &Path,
-    target: Target,
+    target: &str,
 ) -> Result<Folder, OutputError> {
     let mut path = out_path.to_path_buf();
     let mut dir: Option<OwnedFd> = None;
@@ -366,7 +367,7 @@ fn open_folder(
         backup: names.iter().fold(backup.to_path_buf(), |b, n| b.join(n)),
         path,
         previous,
-        target,
+        target: target.to_string(),
     })
 }
 

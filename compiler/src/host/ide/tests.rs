@@ -173,6 +173,12 @@ fn completion_dispatches_by_kind_of_file() {
 "#,
     );
     assert_eq!(w.completion_labels(), vec!["A.o"]);
+    // A project file: in `[build.targets]`, the teams and robots of the
+    // missions under it (not of a mission of another project).
+    let w = workspace(&format!(
+        "{MISSION}{CATALOG}//- /w/a/semo.toml\n[build.targets]\n$0\n//- /w/b/n.mission\n{{ B: Rover q }}\n"
+    ));
+    assert_eq!(w.completion_labels(), vec!["A", "r"]);
     // A catalog file has none.
     let w = workspace(&CATALOG.replace("<Robot", "<$0Robot"));
     let config = CompletionConfig::default();

@@ -126,6 +126,9 @@ pub(crate) fn robot_type(robot: &RobotType) -> String {
     if !platform.is_empty() {
         write!(out, "\n\nPlatform: {}.", platform.join(", ")).ok();
     }
+    if let Some((target, _)) = p.target {
+        write!(out, "\n\n`semo build` builds it for `{target}`.").ok();
+    }
     if !robot.capabilities.is_empty() {
         write!(
             out,

@@ -542,3 +542,31 @@ fn completion_answers_all_over_a_large_mission() {
         assert!(!items.is_empty(), "no completion at {offset}");
     }
 }
+
+#[test]
+fn hover_on_a_robot_type_says_the_platform_semo_build_builds_it_for() {
+    let xml = r#"<Catalog>
+  <Robot type="Board">
+    <Platform target="cortex-m" cpu="LM3S6965"/>
+    <Service name="blink" doc="Blink."/>
+  </Robot>
+</Catalog>"#;
+    let (catalog, diags) = load_catalog(&[CatalogSource {
+        file: FileId(1),
+        text: xml,
+        base_dir: None,
+    }]);
+    assert!(diags.is_empty(), "{diags:#?}");
+    let text =
+        "{ B: Board b }\nB.A.Go{ blink() }\nB.M{ set(A, Go) }\nB.main{ default: mode = M }\n";
+    let analysis = crate::check_source(FileId(0), text, &catalog);
+    let hover = hover(&analysis, &catalog, text, text.find("Board").unwrap() + 1).unwrap();
+    assert!(
+        hover.markdown.contains("Platform: LM3S6965.")
+            && hover
+                .markdown
+                .contains("`semo build` builds it for `cortex-m`."),
+        "{}",
+        hover.markdown
+    );
+}

@@ -1,0 +1,355 @@
+//! The platforms robot programs are built for, as data: [`PLATFORMS`], one
+//! row per platform with every fact generation needs about it (the runtime
+//! layer, the default transport, the runtime files, and for a board its CPU,
+//! toolchain, memory, link script, start-up file, clock, timer and serial
+//! port). Code generation reads it for each robot's Makefile, the link
+//! script and the shared runtime folder; the catalog for a robot type's
+//! `<Platform target="...">`; the project file for `[build] target` and
+//! `[build.targets]`. A new board is a new row (and its board file in the
+//! runtime), not a change to the generator.
+//!
+//! A [`Target`] is a platform or its simulation: `linux` and `linux-sim`,
+//! `cortex-m` and `cortex-m-sim`. The simulation is the same program with
+//! sensors, services and the operator taken from a scenario and a trace
+//! written (`semo build --sim` picks it for every robot's platform).
+
+/// How a platform runs a robot's tasks: the runtime's platform layer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layer {
+    /// One POSIX thread per task (`semo_runtime.c`).
+    Threads,
+    /// One loop firing the tasks in the single-appearance schedule's order
+    /// (`semo_static.c` and the board's start-up file).
+    Static,
+}
+
+/// How a robot program reaches the other robots by default (overridable at
+/// run time with `--transport`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Transport {
+    /// UDP on 127.0.0.1, a port per robot (`semo_udp.c`): no broker needed.
+    Udp,
+    /// An MQTT broker through libmosquitto (`semo_mqtt.c`, `-lmosquitto`).
+    Mqtt,
+}
+
+impl Transport {
+    /// The name `--transport` and the Makefile's `TRANSPORT` take.
+    pub fn name(self) -> &'static str {
+        match self {
+            Transport::Udp => "udp",
+            Transport::Mqtt => "mqtt",
+        }
+    }
+}
+
+/// A platform: a row of [`PLATFORMS`].
+#[derive(Debug, PartialEq, Eq)]
+pub struct Platform {
+    /// Its target's name (`linux`); its simulation is `<name>-sim`.
+    pub name: &'static str,
+    /// One line for completion and messages.
+    pub doc: &'static str,
+    pub layer: Layer,
+    /// The program itself.
+    pub real: Variant,
+    /// Its simulation (a scenario's sensors, services and operator, a trace).
+    pub sim: Variant,
+    /// The board of a bare-metal platform; `None` on an operating system.
+    pub board: Option<Board>,
+}
+
+/// What differs between a platform's program and its simulation.
+#[derive(Debug, PartialEq, Eq)]
+pub struct Variant {
+    /// The default transport its Makefile builds in; `None`: the program
+    /// talks only to the operator (no link to other robots yet, E103).
+    pub transport: Option<Transport>,
+    /// The runtime files it compiles, in the runtime folder (for a board,
+    /// its start-up file and link script come after these).
+    pub runtime: &'static [&'static str],
+}
+
+/// A bare-metal board: everything its Makefile and link script say.
+#[derive(Debug, PartialEq, Eq)]
+pub struct Board {
+    /// The microcontroller (`TI Stellaris LM3S6965`).
+    pub name: &'static str,
+    /// Its core (`Cortex-M3`).
+    pub cpu: &'static str,
+    /// The compiler's and linker's flags for the core.
+    pub arch: &'static str,
+    pub toolchain: Toolchain,
+    pub flash: Memory,
+    pub ram: Memory,
+    /// The runtime file with the vector table, reset code, clock and serial
+    /// port (`semo_lm3s6965.c`).
+    pub startup: &'static str,
+    /// The link script in the runtime folder, written from
+    /// [`Board::flash`] and [`Board::ram`].
+    pub link_script: &'static str,
+    /// The main stack's default size (`make SEMO_STACK_BYTES=...`).
+    pub stack_bytes: u32,
+    /// The core clock the timer counts.
+    pub clock_hz: u32,
+    /// The timer the start-up file keeps mission time with.
+    pub timer: &'static str,
+    /// The serial port the trace goes to.
+    pub serial: &'static str,
+    /// The emulator `make run` starts, and its machine.
+    pub emulator: &'static str,
+    pub machine: &'static str,
+}
+
+/// The cross toolchain of a board.
+#[derive(Debug, PartialEq, Eq)]
+pub struct Toolchain {
+    pub cc: &'static str,
+    pub size: &'static str,
+    /// The C library, for people (`newlib-nano`), and the specs file that
+    /// links it.
+    pub libc: &'static str,
+    pub specs: &'static str,
+}
+
+/// A memory region of a board.
+#[derive(Debug, PartialEq, Eq)]
+pub struct Memory {
+    pub origin: u32,
+    pub kib: u32,
+}
+
+/// The runtime files every platform compiles: the API, what the runtime's
+/// files share and the portable core.
+const CORE: [&str; 3] = ["semo_runtime.h", "semo_internal.h", "semo_core.c"];
+
+/// Every platform, in the order targets are listed.
+pub const PLATFORMS: &[Platform] = &[
+    Platform {
+        name: "linux",
+        doc: "Linux: one POSIX thread per task",
+        layer: Layer::Threads,
+        real: Variant {
+            transport: Some(Transport::Mqtt),
+            runtime: &[
+                CORE[0],
+                CORE[1],
+                CORE[2],
+                "semo_runtime.c",
+                "semo_udp.c",
+                "semo_mqtt.c",
+            ],
+        },
+        sim: Variant {
+            transport: Some(Transport::Udp),
+            runtime: &[
+                CORE[0],
+                CORE[1],
+                CORE[2],
+                "semo_runtime.c",
+                "semo_udp.c",
+                "semo_mqtt.c",
+                "semo_sim.c",
+                "semo_lockstep.c",
+            ],
+        },
+        board: None,
+    },
+    Platform {
+        name: "cortex-m",
+        doc: "bare metal on a Cortex-M3 (TI Stellaris LM3S6965): a static schedule, no threads, no heap",
+        layer: Layer::Static,
+        real: Variant {
+            transport: None,
+            runtime: &[CORE[0], CORE[1], CORE[2], "semo_static.c"],
+        },
+        sim: Variant {
+            transport: None,
+            runtime: &[CORE[0], CORE[1], CORE[2], "semo_static.c"],
+        },
+        board: Some(Board {
+            name: "TI Stellaris LM3S6965",
+            cpu: "Cortex-M3",
+            arch: "-mcpu=cortex-m3 -mthumb",
+            toolchain: Toolchain {
+                cc: "arm-none-eabi-gcc",
+                size: "arm-none-eabi-size",
+                libc: "newlib-nano",
+                specs: "nano.specs",
+            },
+            flash: Memory {
+                origin: 0x0000_0000,
+                kib: 256,
+            },
+            ram: Memory {
+                origin: 0x2000_0000,
+                kib: 64,
+            },
+            startup: "semo_lm3s6965.c",
+            link_script: "lm3s6965.ld",
+            stack_bytes: 2048,
+            clock_hz: 12_000_000,
+            timer: "SysTick",
+            serial: "UART0",
+            emulator: "qemu-system-arm",
+            machine: "lm3s6965evb",
+        }),
+    },
+];
+
+/// A code-generation target: a platform, or its simulation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Target {
+    /// POSIX threads on Linux; the user fills the task files.
+    Linux,
+    /// The same program with sensors, actuators and the operator simulated
+    /// from a scenario file, writing a trace.
+    LinuxSim,
+    /// Bare metal on a Cortex-M3 (TI Stellaris LM3S6965): a static schedule,
+    /// no threads, no heap; the user fills the task files.
+    CortexM,
+    /// The same with the scenario compiled in as tables (`semo build
+    /// --scenario FILE`), tracing on the serial port and exiting through
+    /// semihosting, so that a run in the emulator is a test.
+    CortexMSim,
+}
+
+impl Target {
+    /// Every target, as listed to users.
+    pub const ALL: [Target; 4] = [
+        Target::Linux,
+        Target::LinuxSim,
+        Target::CortexM,
+        Target::CortexMSim,
+    ];
+
+    /// Its name: the platform's, `-sim` after it for the simulation.
+    pub fn name(self) -> &'static str {
+        match self {
+            Target::Linux => "linux",
+            Target::LinuxSim => "linux-sim",
+            Target::CortexM => "cortex-m",
+            Target::CortexMSim => "cortex-m-sim",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Target> {
+        Target::ALL.into_iter().find(|t| t.name() == name)
+    }
+
+    /// Every target's name, in order (for messages and completion).
+    pub fn names() -> impl Iterator<Item = &'static str> + Clone {
+        Target::ALL.into_iter().map(Target::name)
+    }
+
+    /// Its platform's row.
+    pub fn platform(self) -> &'static Platform {
+        let name = match self {
+            Target::Linux | Target::LinuxSim => "linux",
+            Target::CortexM | Target::CortexMSim => "cortex-m",
+        };
+        PLATFORMS
+            .iter()
+            .find(|p| p.name == name)
+            .expect("every target has its platform's row (tested)")
+    }
+
+    /// Sensors, services and the operator come from a scenario: at run time
+    /// (`--scenario FILE`, POSIX) or compiled in (static, `scenario.c`).
+    pub fn simulated(self) -> bool {
+        matches!(self, Target::LinuxSim | Target::CortexMSim)
+    }
+
+    /// The simulation of this target's platform (`semo build --sim`).
+    pub fn simulation(self) -> Target {
+        match self {
+            Target::Linux | Target::LinuxSim => Target::LinuxSim,
+            Target::CortexM | Target::CortexMSim => Target::CortexMSim,
+        }
+    }
+
+    fn variant(self) -> &'static Variant {
+        let platform = self.platform();
+        if self.simulated() {
+            &platform.sim
+        } else {
+            &platform.real
+        }
+    }
+
+    pub fn layer(self) -> Layer {
+        self.platform().layer
+    }
+
+    pub fn transport(self) -> Option<Transport> {
+        self.variant().transport
+    }
+
+    /// The runtime files its programs compile (a board's start-up file and
+    /// link script last).
+    pub fn runtime(self) -> impl Iterator<Item = &'static str> {
+        let board = self.platform().board.as_ref();
+        self.variant()
+            .runtime
+            .iter()
+            .copied()
+            .chain(board.map(|b| b.startup))
+            .chain(board.map(|b| b.link_script))
+    }
+
+    /// The scenario is compiled into the program (`semo build --scenario`).
+    pub fn needs_scenario(self) -> bool {
+        self.simulated() && self.layer() == Layer::Static
+    }
+}
+
+impl std::fmt::Display for Target {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The platform named `name` (a robot type's `<Platform target="...">`
+/// names one: the simulation is a build's choice, not the robot's).
+pub fn platform_target(name: &str) -> Option<Target> {
+    Target::from_name(name).filter(|t| !t.simulated())
+}
+
+/// The platforms' names (a robot type's `target=` takes one).
+pub fn platform_names() -> impl Iterator<Item = &'static str> + Clone {
+    PLATFORMS.iter().map(|p| p.name)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_target_is_a_platform_or_its_simulation_and_every_platform_has_both() {
+        for target in Target::ALL {
+            let platform = target.platform();
+            let expected = if target.simulated() {
+                format!("{}-sim", platform.name)
+            } else {
+                platform.name.to_string()
+            };
+            assert_eq!(target.name(), expected);
+            assert_eq!(Target::from_name(target.name()), Some(target));
+            assert!(target.simulation().simulated());
+            assert_eq!(target.simulation().platform(), platform);
+        }
+        for platform in PLATFORMS {
+            let real = platform_target(platform.name).expect("a target per platform");
+            assert_eq!(real.platform(), platform);
+            assert!(Target::from_name(&format!("{}-sim", platform.name)).is_some());
+            // A board runs a static schedule; an operating system threads.
+            assert_eq!(
+                platform.board.is_some(),
+                platform.layer == Layer::Static,
+                "{}",
+                platform.name
+            );
+        }
+        assert_eq!(platform_target("linux-sim"), None);
+    }
+}
