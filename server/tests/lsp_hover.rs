@@ -63,6 +63,7 @@ G.Work.Patrol {
   }
   [[ group(instance of Ev3_Robot) { move("1,1") } others { scatter() } ]]
   [[ leader(capable of led) { light_on() } others { standby() } ]]
+  throw tired broadcast
 } repeat(1 SEC)
 G.PATROL { set(Work, Patrol) }
 G.REST { set(Work, OFF) }
