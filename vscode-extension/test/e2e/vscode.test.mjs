@@ -210,6 +210,16 @@ async function userJourney() {
   assert.equal(fits, true, 'the timeline fits the view');
   await shot('simulation');
 
+  // Verify Mission: the search `semo verify` makes, summed up in one
+  // notification that names the mission.
+  await page.click('.monaco-editor .view-lines');
+  await runCommand('SeMo: Verify Mission');
+  await waitForText(
+    '.notifications-toasts .notification-list-item',
+    /SeMo: rovers\.mission: (nothing found|\d+ finding)/,
+  );
+  await shot('verify');
+
   // A task graph's picture: open it from the explorer, then the palette.
   await page.keyboard.down('Control');
   await page.keyboard.down('Shift');
