@@ -437,6 +437,51 @@ fn tree(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
         .collect()
 }
 
+/// The editor's Generate Code (no folder or target asked) of `mission` in
+/// the workspace `root`, as a user runs it once the mission is open: the
+/// server's answer.
+fn generate_in_editor(root: &Path, mission: &str) -> Value {
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    runtime.block_on(async {
+        let mut client = TestClient::start();
+        let workspace = format!("file://{}", root.display());
+        client.initialize(&["utf-16"], Some(&workspace)).await;
+        let mission = root.join(mission);
+        let uri = format!("file://{}", mission.display());
+        client
+            .open(&uri, &std::fs::read_to_string(&mission).unwrap())
+            .await;
+        client.diagnostics(&uri, Some(1)).await;
+        let answer = client
+            .request(
+                "workspace/executeCommand",
+                serde_json::json!({ "command": "semo.generateCode", "arguments": [{ "uri": uri }] }),
+            )
+            .await
+            .expect("generated");
+        client.shutdown().await;
+        answer
+    })
+}
+
+/// The two doors wrote the same files, byte for byte.
+fn same_files(
+    from_cli: &std::collections::BTreeMap<String, Vec<u8>>,
+    from_editor: &std::collections::BTreeMap<String, Vec<u8>>,
+) {
+    assert_eq!(
+        from_cli.keys().collect::<Vec<_>>(),
+        from_editor.keys().collect::<Vec<_>>()
+    );
+    for (file, bytes) in from_cli {
+        assert!(from_editor[file] == *bytes, "{file} differs");
+    }
+}
+
 /// A project whose `semo.toml` says where and for what to build.
 fn planned_project(dir: &Path) {
     std::fs::create_dir_all(dir).unwrap();
@@ -465,31 +510,7 @@ fn the_cli_and_the_editor_build_the_project_files_plan() {
     let built = semo_in(&cli, &["build"]);
     assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
 
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-        .unwrap();
-    let answer = runtime.block_on(async {
-        let mut client = TestClient::start();
-        let root = format!("file://{}", editor.display());
-        client.initialize(&["utf-16"], Some(&root)).await;
-        let mission = editor.join("follow.mission");
-        let uri = format!("file://{}", mission.display());
-        client
-            .open(&uri, &std::fs::read_to_string(&mission).unwrap())
-            .await;
-        client.diagnostics(&uri, Some(1)).await;
-        let answer = client
-            .request(
-                "workspace/executeCommand",
-                serde_json::json!({ "command": "semo.generateCode", "arguments": [{ "uri": uri }] }),
-            )
-            .await
-            .expect("generated");
-        client.shutdown().await;
-        answer
-    });
+    let answer = generate_in_editor(&editor, "follow.mission");
     assert_eq!(answer["target"], "linux-sim", "{answer}");
     assert_eq!(
         answer["outputFolder"],
@@ -501,13 +522,7 @@ fn the_cli_and_the_editor_build_the_project_files_plan() {
         "{:?}",
         from_cli.keys()
     );
-    assert_eq!(
-        from_cli.keys().collect::<Vec<_>>(),
-        from_editor.keys().collect::<Vec<_>>()
-    );
-    for (file, bytes) in &from_cli {
-        assert!(from_editor[file] == *bytes, "{file} differs");
-    }
+    same_files(&from_cli, &from_editor);
     assert!(!cli.join("out").exists() && !editor.join("out").exists());
 }
 
@@ -536,31 +551,7 @@ fn the_cli_and_the_editor_build_a_mixed_fleet_alike() {
     let built = semo_in(&cli, &["build"]);
     assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
 
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-        .unwrap();
-    let answer = runtime.block_on(async {
-        let mut client = TestClient::start();
-        let root = format!("file://{}", editor.display());
-        client.initialize(&["utf-16"], Some(&root)).await;
-        let mission = editor.join("fleet.mission");
-        let uri = format!("file://{}", mission.display());
-        client
-            .open(&uri, &std::fs::read_to_string(&mission).unwrap())
-            .await;
-        client.diagnostics(&uri, Some(1)).await;
-        let answer = client
-            .request(
-                "workspace/executeCommand",
-                serde_json::json!({ "command": "semo.generateCode", "arguments": [{ "uri": uri }] }),
-            )
-            .await
-            .expect("generated");
-        client.shutdown().await;
-        answer
-    });
+    let answer = generate_in_editor(&editor, "fleet.mission");
     assert_eq!(answer["target"], Value::Null, "{answer}");
     assert_eq!(
         answer["targets"],
@@ -585,11 +576,5 @@ fn the_cli_and_the_editor_build_a_mixed_fleet_alike() {
         "{:?}",
         from_cli.keys()
     );
-    assert_eq!(
-        from_cli.keys().collect::<Vec<_>>(),
-        from_editor.keys().collect::<Vec<_>>()
-    );
-    for (file, bytes) in &from_cli {
-        assert!(from_editor[file] == *bytes, "{file} differs");
-    }
+    same_files(&from_cli, &from_editor);
 }

@@ -19,6 +19,22 @@ fn codes(diagnostics: &Value) -> Vec<String> {
         .collect()
 }
 
+/// A client on the folder of `tests/fixtures/verify/<fixture>` with its
+/// `main.mission` open: the client, the mission's URI, the folder and the
+/// mission's text.
+async fn opened_fixture(fixture: &str) -> (TestClient, String, std::path::PathBuf, String) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures/verify")
+        .join(fixture);
+    let mission = dir.join("main.mission");
+    let text = std::fs::read_to_string(&mission).unwrap();
+    let mission = file_uri(&mission);
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], Some(&file_uri(&dir))).await;
+    client.open(&mission, &text).await;
+    (client, mission, dir, text)
+}
+
 /// Saves `mission` and waits for the publication with the search's
 /// findings among its diagnostics: those diagnostics.
 async fn saved_and_verified(client: &mut TestClient, mission: &str) -> Value {
@@ -38,13 +54,7 @@ async fn saved_and_verified(client: &mut TestClient, mission: &str) -> Value {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_saved_mission_gets_its_verify_findings_and_an_edit_drops_them() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/verify/never_finishes");
-    let mission = dir.join("main.mission");
-    let text = std::fs::read_to_string(&mission).unwrap();
-    let mission = file_uri(&mission);
-    let mut client = TestClient::start();
-    client.initialize(&["utf-16"], Some(&file_uri(&dir))).await;
-    client.open(&mission, &text).await;
+    let (mut client, mission, dir, text) = opened_fixture("never_finishes").await;
     // Opened: the check's diagnostics, no search yet.
     let opened = client.diagnostics(&mission, Some(1)).await;
     assert!(!codes(&json!(opened)).contains(&"V002".to_string()));
@@ -169,13 +179,7 @@ async fn a_client_that_cannot_create_files_gets_no_scenario_action() {
 /// refused with its line and column.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_verify_command_answers_findings_and_the_users_properties() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/fixtures/verify/plans_race");
-    let mission = dir.join("main.mission");
-    let text = std::fs::read_to_string(&mission).unwrap();
-    let mission = file_uri(&mission);
-    let mut client = TestClient::start();
-    client.initialize(&["utf-16"], Some(&file_uri(&dir))).await;
-    client.open(&mission, &text).await;
+    let (mut client, mission, ..) = opened_fixture("plans_race").await;
     let answer = client
         .request(
             "workspace/executeCommand",

@@ -237,6 +237,11 @@ fn enum_catalog() -> Catalog {
     <Service name="blink" doc="Blink."><Param name="times" type="int"/></Service>
   </Robot>
 </Catalog>"#;
+    catalog_of(xml)
+}
+
+/// The catalog of `xml`, which must load without a diagnostic.
+fn catalog_of(xml: &str) -> Catalog {
     let (catalog, diags) = load_catalog(&[CatalogSource {
         file: FileId(1),
         text: xml,
@@ -551,12 +556,7 @@ fn hover_on_a_robot_type_says_the_platform_semo_build_builds_it_for() {
     <Service name="blink" doc="Blink."/>
   </Robot>
 </Catalog>"#;
-    let (catalog, diags) = load_catalog(&[CatalogSource {
-        file: FileId(1),
-        text: xml,
-        base_dir: None,
-    }]);
-    assert!(diags.is_empty(), "{diags:#?}");
+    let catalog = catalog_of(xml);
     let text =
         "{ B: Board b }\nB.A.Go{ blink() }\nB.M{ set(A, Go) }\nB.main{ default: mode = M }\n";
     let analysis = crate::check_source(FileId(0), text, &catalog);
