@@ -190,37 +190,67 @@ pub fn after_save(state: &Arc<State>, uri: &Uri) {
     });
 }
 
-/// The findings of a search of the snapshot's mission; `None` when it has
-/// errors (nothing to run) or the search was cancelled.
-fn search(snapshot: &Snapshot, cancel: Arc<AtomicBool>) -> Option<Vec<Finding>> {
-    let build = snapshot.host().build_input(snapshot.id)?;
+/// Why a search of a snapshot gave no report.
+pub enum NoReport {
+    /// The mission has errors: there is nothing to run (its diagnostics say why).
+    Errors,
+    /// The expectations file, or the options, could not be used.
+    Refused(String),
+    Cancelled,
+}
+
+/// The snapshot's mission refined and explored with `options`, judging the
+/// properties `properties` reads against the refined programs, the
+/// project's lint levels applied: the one search of the background run
+/// after a save and of the `semo.verify` command.
+pub fn explore(
+    snapshot: &Snapshot,
+    options: &semo::verify::Options,
+    properties: impl FnOnce(
+        &[semo::refine::RobotProgram],
+    ) -> Result<Vec<semo::verify::Property>, String>,
+) -> Result<(semo::verify::Report, Vec<semo::refine::RobotProgram>), NoReport> {
+    let build = snapshot
+        .host()
+        .build_input(snapshot.id)
+        .ok_or(NoReport::Errors)?;
     let refined = semo::codegen::refine_checked(&build.input());
     if refined.diagnostics.iter().any(|d| d.is_error()) {
-        return None;
+        return Err(NoReport::Errors);
     }
-    let search = semo::verify::verify(
+    let properties = properties(&refined.programs).map_err(NoReport::Refused)?;
+    let mut report = semo::verify::verify_expecting(
         &refined.programs,
         snapshot.id,
         &snapshot.text,
-        &options(cancel),
-    );
-    let mut report = match search {
-        Ok(report) => report,
-        Err(problem) => {
+        options,
+        properties,
+    )
+    .map_err(NoReport::Refused)?;
+    if report.cancelled {
+        return Err(NoReport::Cancelled);
+    }
+    if let Some(project) = snapshot.host().project(snapshot.id) {
+        report.apply_lints(&project.project);
+    }
+    Ok((report, refined.programs))
+}
+
+/// The findings of a search of the snapshot's mission; `None` when it has
+/// errors (nothing to run) or the search was cancelled.
+fn search(snapshot: &Snapshot, cancel: Arc<AtomicBool>) -> Option<Vec<Finding>> {
+    let (report, programs) = match explore(snapshot, &options(cancel), |_| Ok(Vec::new())) {
+        Ok(found) => found,
+        Err(NoReport::Refused(problem)) => {
             // The editor's options are fixed: refusing them is a bug.
             eprintln!("semo-server: internal error: verify refused its options: {problem}");
             return None;
         }
+        Err(NoReport::Errors | NoReport::Cancelled) => return None,
     };
-    if let Some(project) = snapshot.host().project(snapshot.id) {
-        report.apply_lints(&project.project);
-    }
-    if report.cancelled {
-        return None;
-    }
     let scenarios = report.counterexamples.iter().map(|way| {
         way.as_ref()
-            .map(|w| w.scenario_json(&report.inputs, &refined.programs))
+            .map(|w| w.scenario_json(&report.inputs, &programs))
     });
     Some(
         report

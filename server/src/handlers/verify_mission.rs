@@ -82,19 +82,11 @@ pub fn job(world: &World, params: VerifyParams, cancel: Arc<AtomicBool>) -> Resu
     })
 }
 
-/// Refines, reads the expectations, searches.
+/// Refines, reads the expectations, searches (`crate::verify::explore`).
 pub fn verify(job: &Job) -> Result<Value, String> {
     let snapshot = &job.snapshot;
-    let build = snapshot
-        .host()
-        .build_input(snapshot.id)
-        .ok_or("the mission has errors: fix them to verify it")?;
-    let refined = semo::codegen::refine_checked(&build.input());
-    if refined.diagnostics.iter().any(|d| d.is_error()) {
-        return Err("the mission cannot be refined: see its diagnostics".into());
-    }
-    let properties = match &job.expect {
-        None => Vec::new(),
+    let expectations = |programs: &[semo::refine::RobotProgram]| match &job.expect {
+        None => Ok(Vec::new()),
         Some(file) => {
             let text =
                 semo::workspace::read_text(file).map_err(|e| format!("{}: {e}", file.display()))?;
@@ -102,27 +94,21 @@ pub fn verify(job: &Job) -> Result<Value, String> {
                 let (line, column) = e.line_col(&text);
                 format!("{}:{line}:{column}: {}", file.display(), e.message)
             };
-            let scenario =
-                semo::sim::scenario::parse(&text, &refined.programs).map_err(positioned)?;
-            semo::verify::properties_of(&scenario.expect).map_err(positioned)?
+            let scenario = semo::sim::scenario::parse(&text, programs).map_err(positioned)?;
+            semo::verify::properties_of(&scenario.expect).map_err(positioned)
         }
     };
-    let mut report = semo::verify::verify_expecting(
-        &refined.programs,
-        snapshot.id,
-        &snapshot.text,
-        &job.options,
-        properties,
-    )?;
-    if report.cancelled {
-        return Err("cancelled".into());
-    }
-    if let Some(project) = snapshot.host().project(snapshot.id) {
-        report.apply_lints(&project.project);
-    }
+    let (report, programs) =
+        crate::verify::explore(snapshot, &job.options, expectations).map_err(|why| match why {
+            crate::verify::NoReport::Errors => {
+                "the mission has errors: fix them to verify it".to_string()
+            }
+            crate::verify::NoReport::Refused(problem) => problem,
+            crate::verify::NoReport::Cancelled => "cancelled".to_string(),
+        })?;
     let analysis = snapshot.analysis();
     let lines = snapshot.line_map(&analysis);
-    let programs = &refined.programs;
+    let programs = &programs;
     let scenario_of = |way: Option<&semo::verify::Counterexample>,
                        expect: Option<&semo::sim::scenario::ExpectKind>| {
         way.map(|w| w.scenario_json_expecting(&report.inputs, programs, expect))
