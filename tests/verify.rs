@@ -212,6 +212,42 @@ fn the_users_properties_are_judged_over_every_behaviour_and_broken_ones_replay()
         "{}",
         out.stderr
     );
+    // A file that is not there: bad input, named.
+    let missing = dir.join("missing.json");
+    let out = semo(&[
+        "verify",
+        "tests/fixtures/verify/plans_race/main.mission",
+        "--expect",
+        &missing.to_string_lossy(),
+    ]);
+    assert_eq!(out.code, 2, "{}{}", out.stdout, out.stderr);
+    assert!(out.stderr.contains("missing.json"), "{}", out.stderr);
+    // A whole scenario: its world is the search's to choose, and the user
+    // is told that only its `expect` is read.
+    let scenario = dir.join("whole.scenario.json");
+    std::fs::write(
+        &scenario,
+        "{\"operator\": [{\"at\": 5, \"to\": \"base\", \"value\": \"RC_CMD\", \"is\": \"go\"}],\n \"expect\": [{\"eventually\": {\"robot\": \"base\", \"in\": \"DONE\"}}]}",
+    )
+    .unwrap();
+    let out = semo(&[
+        "verify",
+        "tests/fixtures/verify/plans_race/main.mission",
+        "--expect",
+        &scenario.to_string_lossy(),
+    ]);
+    assert!(
+        out.stderr
+            .contains("of this scenario only `expect` is read"),
+        "{}",
+        out.stderr
+    );
+    assert!(
+        out.stdout
+            .contains("property `eventually base in DONE`: holds in every behaviour"),
+        "{}",
+        out.stdout
+    );
 }
 
 #[test]

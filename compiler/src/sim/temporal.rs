@@ -38,8 +38,9 @@ pub struct Status {
 /// The properties of a scenario's `expect`, followed through a trace.
 #[derive(Clone)]
 pub struct Timeline<'a> {
-    /// The robots' indices by name.
-    robots: FastMap<&'a str, usize>,
+    /// The robots' indices by name (shared: `semo verify` makes a timeline
+    /// per step it explores).
+    robots: Rc<FastMap<&'a str, usize>>,
     /// The properties followed: (index in the expectations, the property).
     properties: Vec<(usize, &'a ExpectKind)>,
     /// Per robot: its mode now (none before its first, or once killed).
@@ -59,6 +60,26 @@ impl<'a> Timeline<'a> {
         expectations: impl IntoIterator<Item = &'a ExpectKind>,
         modes: Vec<Option<Rc<str>>>,
     ) -> Timeline<'a> {
+        Timeline::sharing(Timeline::index(robots), expectations, modes)
+    }
+
+    /// The robots' indices by name, for [`Timeline::sharing`].
+    pub fn index(robots: Vec<&'a str>) -> Rc<FastMap<&'a str, usize>> {
+        Rc::new(
+            robots
+                .into_iter()
+                .enumerate()
+                .map(|(i, r)| (r, i))
+                .collect(),
+        )
+    }
+
+    /// [`Timeline::new`] with the robots' index made once for many.
+    pub fn sharing(
+        robots: Rc<FastMap<&'a str, usize>>,
+        expectations: impl IntoIterator<Item = &'a ExpectKind>,
+        modes: Vec<Option<Rc<str>>>,
+    ) -> Timeline<'a> {
         let properties: Vec<(usize, &ExpectKind)> = expectations
             .into_iter()
             .enumerate()
@@ -66,11 +87,7 @@ impl<'a> Timeline<'a> {
             .collect();
         Timeline {
             status: vec![Status::default(); properties.len()],
-            robots: robots
-                .into_iter()
-                .enumerate()
-                .map(|(i, r)| (r, i))
-                .collect(),
+            robots,
             properties,
             modes,
             now: None,

@@ -647,7 +647,8 @@ impl Graph<'_> {
 /// witness of each broken `always`.
 struct Judge<'a> {
     properties: &'a [Property],
-    robots: Vec<&'a str>,
+    /// The robots' index by name, made once for every step's timeline.
+    robots: std::rc::Rc<crate::fasthash::FastMap<&'a str, usize>>,
     /// Per robot: its modes' names, shared by every step's timeline.
     modes: Vec<Vec<std::rc::Rc<str>>>,
     steps: Vec<(u32, u32, Choice, Label)>,
@@ -669,7 +670,9 @@ impl<'a> Judge<'a> {
             .fold(0, |bits, p| bits | 1 << (2 * p));
         Judge {
             properties,
-            robots: programs.iter().map(|p| p.robot.as_str()).collect(),
+            robots: crate::sim::temporal::Timeline::index(
+                programs.iter().map(|p| p.robot.as_str()).collect(),
+            ),
             modes: programs
                 .iter()
                 .map(|p| {
@@ -692,13 +695,13 @@ impl<'a> Judge<'a> {
             return 0;
         }
         // Each robot's mode when the step starts; a killed one is in none.
-        let modes = (0..self.robots.len())
+        let modes = (0..self.modes.len())
             .map(|r| match (from.down[r], from.modes[r]) {
                 (false, Some(m)) => self.modes[r].get(usize::from(m)).cloned(),
                 _ => None,
             })
             .collect();
-        let mut timeline = crate::sim::temporal::Timeline::new(
+        let mut timeline = crate::sim::temporal::Timeline::sharing(
             self.robots.clone(),
             self.properties.iter().map(|p| &p.judged),
             modes,

@@ -63,6 +63,17 @@ impl Sim<'_> {
                 .iter()
                 .any(|t| t.from == mode && t.event == event)
         };
+        // A send to another robot; not a publish (its latest value stands
+        // for the next one) and not a report to the operator's console,
+        // which the team does not act on. Or a throw the mode catches.
+        let acts = |state: &crate::refine::State| match &state.kind {
+            StateKind::Send { items } => items.iter().any(|item| {
+                let message = &m.outgoing[item.message];
+                !message.publish && message.to_team != "USER"
+            }),
+            StateKind::Throw { event, .. } => caught(event),
+            _ => false,
+        };
         let mut found = Vec::new();
         for j in thrower_region + 1..robot.regions.len() {
             let region = &robot.regions[j];
@@ -70,7 +81,9 @@ impl Sim<'_> {
                 continue;
             };
             let timed_out = region.timeout_ms > 0 && self.now - region.started > region.timeout_ms;
-            if region.done || timed_out {
+            // Copying the fleet's state costs in proportion to the fleet:
+            // only for a plan whose service can act at all.
+            if region.done || timed_out || !m.services[service].states.iter().any(acts) {
                 continue;
             }
             // The plan's turn as it would have come without the throw.
@@ -82,21 +95,11 @@ impl Sim<'_> {
                 let Some(state) = m.services[service].states.get(pc) else {
                     break;
                 };
-                let acts = match &state.kind {
-                    // A send to another robot; not a publish (its latest
-                    // value stands for the next one) and not a report to
-                    // the operator's console, which the team does not act on.
-                    StateKind::Send { items } => items.iter().any(|item| {
-                        let message = &m.outgoing[item.message];
-                        !message.publish && message.to_team != "USER"
-                    }),
-                    StateKind::Throw { event, .. } => caught(event),
-                    _ => false,
-                };
+                let acting = acts(state);
                 if alone.step(r, j, service) != Step::Next {
                     break;
                 }
-                if acts {
+                if acting {
                     found.push(Race {
                         robot: r,
                         at: self.now,
