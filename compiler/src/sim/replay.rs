@@ -109,6 +109,7 @@ pub const FIELDS: &[&str] = &[
     "reason",
     "count",
     "signal",
+    "time_scale",
 ];
 
 /// The keys that hold a mission value (typed: a number, `true`/`false`, a

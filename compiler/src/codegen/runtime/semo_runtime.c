@@ -1549,6 +1549,26 @@ static void start_clock(long start_at_ms)
 }
 
 /* Starts everything, waits for the end, stops everything; 0 or 1. */
+/* The first trace line. A simulated robot on the wall clock also says the
+ * speed it runs at (wall ms per mission ms), so a test or an operator reads
+ * the scale it applied instead of timing the run; in lock-step there is no
+ * wall clock to scale. */
+static void trace_start(const semo_program_desc *p, const options *o)
+{
+    const char *type = p->robot_type ? p->robot_type : "", *mission = p->mission ? p->mission : "";
+#ifdef SEMO_SIM
+    if (!o->lockstep) {
+        char scale[40];
+        semo_value_json(SEMO_LIT_REAL(g_scale), scale, sizeof scale);
+        semo_trace("start", "team", p->team, "type", type, "mission", mission, "time_scale", scale, NULL);
+        return;
+    }
+#else
+    (void)o;
+#endif
+    semo_trace("start", "team", p->team, "type", type, "mission", mission, NULL);
+}
+
 static int run(const options *o)
 {
     const semo_program_desc *p = g_prog;
@@ -1612,8 +1632,7 @@ static int run(const options *o)
     if (!semo__wait_until(0))
         goto stop;
     g_joined_at = semo_now_ms();
-    semo_trace("start", "team", p->team, "type", p->robot_type ? p->robot_type : "", "mission",
-               p->mission ? p->mission : "", NULL);
+    trace_start(p, o);
     for (; initialized < p->task_count; initialized++)
         if (p->tasks[initialized].init)
             p->tasks[initialized].init();
