@@ -366,6 +366,43 @@ fn link_faults_and_battery_act_the_same_in_c_and_in_the_simulator() {
     );
 }
 
+/// The scenario's random loss, on the network and on one link: the
+/// coordinator of the generated robots loses the very messages the
+/// simulator loses for the seed (`semo::sim::loss`).
+#[test]
+fn random_message_loss_loses_the_same_messages_in_c_and_in_the_simulator() {
+    let mut scenario: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(repo_root().join("tests/fixtures/build/scouting.scenario.json"))
+            .unwrap(),
+    )
+    .unwrap();
+    let received = |events: &[Event]| {
+        events
+            .iter()
+            .filter(|e| field(e, "event") == "receive")
+            .count()
+    };
+    let (_, lossless) = compare(
+        "scouting_lossless",
+        &examples().join("scouting/scouting.mission"),
+        &scenario.to_string(),
+    );
+    scenario["network"] = serde_json::json!({
+        "loss": 0.2,
+        "links": [{"between": ["irobot", "ti"], "loss": 0.5}]
+    });
+    let (_, lossy) = compare(
+        "scouting_lossy",
+        &examples().join("scouting/scouting.mission"),
+        &scenario.to_string(),
+    );
+    let (all, kept) = (received(&lossless), received(&lossy));
+    assert!(
+        kept < all * 9 / 10,
+        "the loss took messages: {kept} of {all} received"
+    );
+}
+
 /// The events of one robot's run of `kind`, as (time, event fields that
 /// say what happened): the check that a test's run did what it is about.
 fn events_of<'e>(events: &'e [Event], robot: &str, kind: &str) -> Vec<&'e Event> {
@@ -560,11 +597,11 @@ fn random_missions(seeds: std::ops::Range<u64>) {
 
 #[test]
 fn random_missions_behave_the_same_in_c_and_in_the_simulator() {
-    random_missions(0..30);
+    random_missions(0..50);
 }
 
 #[test]
 #[ignore = "long: many more random missions (cargo test --test differential -- --ignored)"]
 fn many_random_missions_behave_the_same_in_c_and_in_the_simulator() {
-    random_missions(30..300);
+    random_missions(50..300);
 }

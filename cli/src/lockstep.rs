@@ -18,6 +18,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 
+use semo::sim::loss::LossDraws;
+
 /// A built robot program of the run.
 pub struct Robot {
     /// Its name (its trace files are named after it).
@@ -39,8 +41,12 @@ pub struct Run<'a> {
     pub scenario: &'a Path,
     /// (at, peer, fault), in time order.
     pub faults: Vec<(i64, usize, ProcessFault)>,
-    /// The latency of a message from one peer to another (mission ms).
-    pub latency: &'a dyn Fn(usize, usize) -> i64,
+    /// The link from one peer to another: its latency (mission ms) and
+    /// the probability that a message on it is lost.
+    pub link: &'a dyn Fn(usize, usize) -> (i64, f64),
+    /// Seeds the losses: the simulator's draws for the same seed
+    /// (`semo::sim::loss`).
+    pub seed: u64,
     /// Mission time after which the run ends (the robots are stopped).
     pub until_ms: i64,
     /// Where the socket, the traces and the robots' error output go.
@@ -105,6 +111,7 @@ struct Coordinator<'r, 'a> {
     /// (arrival, sender, sequence) → (receiver, datagram): the delivery order.
     in_flight: BTreeMap<(i64, usize, u64), (usize, Vec<u8>)>,
     sent: u64,
+    losses: LossDraws,
     /// Per peer, by incarnation: the trace lines of the faults done to it
     /// after that incarnation's own lines (a killed process writes nothing
     /// more; the simulator traces the same `fault` events).
@@ -124,6 +131,7 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             now: 0,
             in_flight: BTreeMap::new(),
             sent: 0,
+            losses: LossDraws::new(run.seed),
             faults_after: vec![BTreeMap::new(); run.robots.len()],
         }
     }
@@ -318,7 +326,11 @@ impl<'r, 'a> Coordinator<'r, 'a> {
                             self.run.robots[peer].name
                         ));
                     }
-                    let arrival = self.now + (self.run.latency)(peer, to);
+                    let (latency, loss) = (self.run.link)(peer, to);
+                    if loss > 0.0 && self.lost(peer, to, &datagram, loss)? {
+                        continue;
+                    }
+                    let arrival = self.now + latency;
                     self.in_flight
                         .insert((arrival, peer, self.sent), (to, datagram));
                     self.sent += 1;
@@ -331,6 +343,19 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             }
         }
         Ok(())
+    }
+
+    /// Whether the scenario's random loss takes this message, drawn as the
+    /// simulator draws it: by sender, receiver and key.
+    fn lost(&mut self, from: usize, to: usize, datagram: &[u8], loss: f64) -> Result<bool, String> {
+        let names = |peer: usize| self.run.robots[peer].name.as_str();
+        let message = semo::deploy::datagram::decode(datagram).ok_or_else(|| {
+            format!(
+                "internal error: robot {} sent a datagram that is no message",
+                names(from)
+            )
+        })?;
+        Ok(self.losses.lost(names(from), names(to), &message.key, loss))
     }
 
     /// Delivers every message due by now; the robots that got one are
@@ -449,15 +474,10 @@ pub fn simulate(
     scenario: &semo::sim::scenario::Scenario,
     scenario_text: &str,
     until_ms: i64,
+    seed: u64,
 ) -> Result<Vec<(String, String)>, String> {
     use semo::sim::scenario::FaultKind;
     let network = &scenario.network;
-    if network.loss > 0.0 || network.links.iter().any(|l| l.loss.unwrap_or(0.0) > 0.0) {
-        return Err(
-            "--engine c does not model the scenario's random message loss yet (`loss`); use --engine sim"
-                .to_string(),
-        );
-    }
     let peers: Vec<(String, usize)> = refined
         .programs
         .iter()
@@ -526,22 +546,23 @@ pub fn simulate(
     }
     faults.sort_by_key(|f| f.0);
     let names: Vec<&str> = robots.iter().map(|r| r.name.as_str()).collect();
-    let latency = |a: usize, b: usize| {
+    let link = |a: usize, b: usize| {
         let pair = |(x, y): &(String, String)| {
             (x == names[a] && y == names[b]) || (x == names[b] && y == names[a])
         };
-        network
-            .links
-            .iter()
-            .find(|l| pair(&l.between))
-            .and_then(|l| l.latency_ms)
-            .unwrap_or(network.latency_ms)
+        let link = network.links.iter().find(|l| pair(&l.between));
+        (
+            link.and_then(|l| l.latency_ms)
+                .unwrap_or(network.latency_ms),
+            link.and_then(|l| l.loss).unwrap_or(network.loss),
+        )
     };
     let traces = run(&Run {
         robots: &robots,
         scenario: &scenario_path,
         faults,
-        latency: &latency,
+        link: &link,
+        seed,
         until_ms,
         work: work.path(),
     })?;

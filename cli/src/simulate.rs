@@ -379,8 +379,14 @@ fn run_generated(
         .until_ms
         .or(scenario.duration_ms)
         .unwrap_or(sim::DEFAULT_UNTIL_MS);
-    let robots = match super::lockstep::simulate(input, refined, scenario, scenario_text, until_ms)
-    {
+    let robots = match super::lockstep::simulate(
+        input,
+        refined,
+        scenario,
+        scenario_text,
+        until_ms,
+        options.seed,
+    ) {
         Ok(robots) => robots,
         Err(e) => {
             eprintln!("error: {e}");

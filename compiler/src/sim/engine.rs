@@ -28,6 +28,7 @@
 //! among robots as when every firing is simulated ([`Options::every_firing`],
 //! the reference the skipping is tested against), so the trace is the same.
 
+use super::loss::LossDraws;
 use super::scenario::{Command, DEFAULT_SERVICE_MS, FaultKind, Scenario};
 use super::trace::TraceEvent;
 use crate::refine::SENSOR_PERIOD_MS;
@@ -37,8 +38,6 @@ use crate::refine::{
     ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, RoleKind, SlotId,
     SlotSource, StateKind,
 };
-use rand_core::{Rng, SeedableRng};
-use rand_xorshift::XorShiftRng;
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
 
@@ -406,7 +405,7 @@ pub struct Sim<'p> {
     queue: BinaryHeap<Queued>,
     seq: u64,
     now: i64,
-    rng: XorShiftRng,
+    losses: LossDraws,
     trace: Vec<TraceEvent>,
     /// Next occurrence of each operator command.
     operator_next: Vec<i64>,
@@ -610,7 +609,7 @@ impl<'p> Sim<'p> {
             queue: BinaryHeap::new(),
             seq: 0,
             now: 0,
-            rng: XorShiftRng::seed_from_u64(options.seed),
+            losses: LossDraws::new(options.seed),
             trace: Vec::new(),
             operator_next: scenario.operator.iter().map(|c| c.first).collect(),
             commands: Vec::new(),
@@ -1053,7 +1052,7 @@ impl<'p> Sim<'p> {
             if dst == r {
                 continue;
             }
-            let Some(latency) = self.link(r, dst) else {
+            let Some(latency) = self.link(r, dst, &message.key) else {
                 continue;
             };
             let epoch = self.robots[dst].epoch;
@@ -1069,7 +1068,7 @@ impl<'p> Sim<'p> {
     }
 
     /// The latency of a message from `a` to `b` now, or `None` when it is lost.
-    fn link(&mut self, a: usize, b: usize) -> Option<i64> {
+    fn link(&mut self, a: usize, b: usize, key: &str) -> Option<i64> {
         let (na, nb) = (&self.programs[a].robot, &self.programs[b].robot);
         let pair = |(x, y): &(String, String)| (x == na && y == nb) || (x == nb && y == na);
         let network = &self.scenario.network;
@@ -1117,9 +1116,7 @@ impl<'p> Sim<'p> {
                 _ => {}
             }
         }
-        // Draw only when loss is possible, so that a lossless run does not
-        // depend on how many messages came before.
-        if loss > 0.0 && (self.rng.next_u64() as f64 / u64::MAX as f64) < loss {
+        if self.losses.lost(na, nb, key, loss) {
             return None;
         }
         Some(latency)

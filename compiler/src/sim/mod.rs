@@ -26,6 +26,7 @@ pub mod complete;
 mod engine;
 pub mod expect;
 mod json;
+pub mod loss;
 pub mod replay;
 pub mod scenario;
 pub mod svg;
