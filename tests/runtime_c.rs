@@ -677,7 +677,7 @@ fn simulation_feeds_scenario_sensors_and_operator_commands() {
     for flavor in flavors().into_iter().filter(|f| f.sim()) {
         let p = program(flavor);
         let trace = trace_path("sim", flavor);
-        let run = p.run_ok(&[
+        p.run_ok(&[
             "sim",
             "--trace",
             trace.to_str().unwrap(),
