@@ -642,11 +642,12 @@ fn buffers_give_the_trade_off_and_a_chosen_point() {
     assert_eq!(
         v["points"],
         serde_json::json!([
-            {"size": 70, "period": "32"},
-            {"size": 71, "period": "18"},
-            {"size": 72, "period": "16"}
+            {"size": 70, "period": "32", "proof": "exact"},
+            {"size": 71, "period": "18", "proof": "exact"},
+            {"size": 72, "period": "16", "proof": "exact"}
         ])
     );
+    assert_eq!(v["exact_front"], true);
     assert_eq!(
         v["minimal_size"],
         serde_json::json!({"lower_bound": 72, "found": 72, "exact": true})
@@ -667,9 +668,37 @@ fn buffers_give_the_trade_off_and_a_chosen_point() {
         "{}",
         out.stdout
     );
-    // Where the search cannot tell the minimum exactly, it says so.
+    // h263encoder at SDF3's period 226098: the exact front's 352, where
+    // the greedy search alone answered 401.
+    let out = semo_in(
+        &sdf3(),
+        &[
+            "graph",
+            "buffers",
+            "--sdf3-compat",
+            "--throughput",
+            "1/226098",
+            "h263encoder.xml",
+        ],
+    );
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout.contains("the exact Pareto front")
+            && out
+                .stdout
+                .contains("channel sizes for period at most 226098 (352 → 226098):"),
+        "{}",
+        out.stdout
+    );
+    // Where the search cannot tell the minimum exactly, it says so, and
+    // that its points are distributions found.
     let out = semo_in(&sdf3(), &["graph", "buffers", "mp3playback.xml"]);
     assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    assert!(
+        out.stdout.contains("each point a distribution found"),
+        "{}",
+        out.stdout
+    );
     assert!(
         out.stdout
             .contains("smallest total size for the maximal throughput: between 2908 and 2916"),

@@ -600,10 +600,17 @@ fn buffers_human(
             found.max_period
         )?;
     }
-    writeln!(
-        out,
-        "trade-off (total buffer size → period; each point a distribution found):"
-    )?;
+    if found.exact_front {
+        writeln!(
+            out,
+            "trade-off (total buffer size → period; the exact Pareto front: every point the smallest size for its period, none missing):"
+        )?;
+    } else {
+        writeln!(
+            out,
+            "trade-off (total buffer size → period; each point a distribution found that reaches its period, where a smaller one may too: the exact front was too large to explore within the budget):"
+        )?;
+    }
     for p in &found.points {
         writeln!(out, "  {} → {}", p.size, p.period)?;
     }
@@ -643,7 +650,13 @@ fn buffers_json(
     let points: Vec<serde_json::Value> = found
         .points
         .iter()
-        .map(|p| serde_json::json!({"size": p.size, "period": p.period.to_string()}))
+        .map(|p| {
+            serde_json::json!({
+                "size": p.size,
+                "period": p.period.to_string(),
+                "proof": if found.exact_front { "exact" } else { "bounded" },
+            })
+        })
         .collect();
     let channels = chosen.map(|p| {
         level
@@ -657,6 +670,7 @@ fn buffers_json(
         "concurrency": concurrency.as_str(),
         "max_period": found.max_period.to_string(),
         "points": points,
+        "exact_front": found.exact_front,
         "unbounded_throughput": found.unbounded_throughput(),
         "minimal_size": {
             "lower_bound": found.lower_bound,

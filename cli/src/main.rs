@@ -525,9 +525,11 @@ enum GraphCommand {
         cores: Option<usize>,
     },
     /// The buffer/throughput trade-off of the graph's top level (SDF3's buffer
-    /// sizing model): Pareto points (total buffer size → iteration period),
-    /// the smallest total size reaching the maximal throughput (exact, or
-    /// between stated bounds), and the channel sizes of a chosen point.
+    /// sizing model): the exact Pareto front (total buffer size → iteration
+    /// period) where its exploration fits the budget, else distributions
+    /// found (upper bounds), which the output says; the smallest total size
+    /// reaching the maximal throughput (exact, or between stated bounds),
+    /// and the channel sizes of a chosen point.
     Buffers {
         /// A `*.taskgraph.xml` file or an SDF3 graph (`-`: standard input).
         file: PathBuf,

@@ -50,6 +50,8 @@ use super::ratio::{Ratio, gcd};
 use super::throughput::{Concurrency, throughput};
 use crate::fasthash::FastSet;
 
+mod exact;
+
 /// Candidate channels tried one at a time per step; more are grown together.
 const MAX_CANDIDATES: usize = 8;
 /// The work the search may do, counted as Σ over evaluated distributions of
@@ -57,6 +59,12 @@ const MAX_CANDIDATES: usize = 8;
 /// policy iteration); half of it for the trade-off, the rest for the lower
 /// bound. Beyond it, the search stops with what it has and says so.
 pub const MAX_WORK: u64 = 6_000_000;
+/// The work the exact exploration may do before the greedy search takes
+/// over with its own [`MAX_WORK`].
+pub const EXACT_WORK: u64 = MAX_WORK;
+/// The exact exploration is not tried when its budget holds fewer
+/// evaluations than this: it could not finish.
+const MIN_EXACT_EVALUATIONS: u64 = 32;
 
 /// One distribution of buffer capacities and the period it reaches.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -89,6 +97,11 @@ pub struct TradeOff {
     pub evaluation_cost: u64,
     /// Whether the work budget stopped some part of the search.
     pub budget_exhausted: bool,
+    /// Whether `points` is the exact front: every Pareto point up to the
+    /// period searched for, each proven (the exploration of
+    /// [`exact::front`] finished); otherwise each point is a distribution
+    /// found, an upper bound on the smallest size for its period.
+    pub exact_front: bool,
 }
 
 impl TradeOff {
@@ -279,6 +292,7 @@ pub fn trade_off_towards(
         work: search.work - search.cost,
         evaluation_cost: search.cost,
         budget_exhausted: search.exhausted,
+        exact_front: false,
     };
     // The period the search grows towards: on a level whose throughput
     // only the buffers bound, the goal, if any.
@@ -295,6 +309,32 @@ pub fn trade_off_towards(
         .iter()
         .map(|e| gcd(e.produce, e.consume).max(1))
         .collect();
+    // Exact where the exploration fits its budget: every Pareto point.
+    if target.num > 0 && search.cost.saturating_mul(MIN_EXACT_EVALUATIONS) <= EXACT_WORK {
+        let before = search.work;
+        if let Some(points) =
+            exact::front(&mut search, &minimal, &steps, target, before + EXACT_WORK)
+        {
+            let lower_bound = match points.last() {
+                Some(last) if target == max_period => last.size,
+                _ => minimal.iter().sum(),
+            };
+            return Some(TradeOff {
+                max_period,
+                points,
+                lower_bound,
+                complete: true,
+                evaluations: search.evaluations,
+                work: search.work - search.cost,
+                evaluation_cost: search.cost,
+                budget_exhausted: false,
+                exact_front: true,
+            });
+        }
+        // Too large to finish: the greedy search, on its own budget.
+        search.work = before;
+        search.exhausted = false;
+    }
     let mut caps = minimal.clone();
 
     let mut points: Vec<Point> = Vec::new();
@@ -441,6 +481,7 @@ pub fn trade_off_towards(
         work: search.work - search.cost,
         evaluation_cost: search.cost,
         budget_exhausted: search.exhausted,
+        exact_front: false,
     })
 }
 

@@ -47,6 +47,11 @@ fn sdf3_buffer_fronts_are_found() {
         ("samplerate", &[(44, 1088), (45, 1029), (46, 960)]),
         ("random_200", &[(982, 203), (983, 181), (984, 170)]),
         ("satellite", &[(1586, 1320), (1588, 1056)]),
+        // The greedy search missed 241 → 106 (issue "SDF analyses beyond SDF3").
+        (
+            "random_50",
+            &[(234, 145), (235, 126), (236, 124), (241, 106), (242, 104)],
+        ),
     ];
     for &(name, front) in cases {
         let g = load(name);
@@ -55,9 +60,36 @@ fn sdf3_buffer_fronts_are_found() {
         let points: Vec<(u64, Ratio)> = found.points.iter().map(|p| (p.size, p.period)).collect();
         let expected: Vec<(u64, Ratio)> = front.iter().map(|&(s, p)| (s, ratio(p, 1))).collect();
         assert_eq!(points, expected, "{name}");
-        assert!(found.exact(), "{name}");
+        assert!(found.exact() && found.exact_front, "{name}");
         check_points(&level, &found, Concurrency::Auto);
     }
+    // h263encoder: SDF3's front from 335 on, 352 → 226098 included, which
+    // the greedy search missed (it answered 401 for that period); the
+    // exact front has 16 points before it.
+    let g = load("h263encoder");
+    let level = Level::build(&g, None, g.name.clone());
+    let found = trade_off(&level, Concurrency::Auto).unwrap();
+    assert!(found.exact_front);
+    let tail: Vec<(u64, Ratio)> = found
+        .points
+        .iter()
+        .rev()
+        .take(3)
+        .rev()
+        .map(|p| (p.size, p.period))
+        .collect();
+    assert_eq!(
+        tail,
+        [
+            (335, ratio(240771, 1)),
+            (352, ratio(226098, 1)),
+            (401, ratio(211425, 1))
+        ]
+    );
+    assert_eq!(found.points.len(), 19);
+    let for_period = found.for_period(ratio(226098, 1)).unwrap();
+    assert_eq!(for_period.size, 352);
+    check_points(&level, &found, Concurrency::Auto);
 }
 
 /// The smallest total size for the maximal throughput, against SDF3's on
@@ -207,6 +239,65 @@ proptest! {
             if found.exact() {
                 prop_assert_eq!(smallest, reached.size);
             }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// On small levels the exact front is the front of every distribution:
+    /// each capacity from its lower bound up to all the slack the largest
+    /// point leaves (off the steps' lattice too), the best period per total
+    /// size, and a point wherever it beats every smaller size.
+    #[test]
+    fn the_exact_front_is_the_front_of_every_distribution(g in small_level()) {
+        let level = Level::build(&g, None, "g".into());
+        let counts = repetition_vector(&level).unwrap();
+        prop_assume!(super::super::deadlock::find_deadlock(&level, &counts).is_none());
+        for concurrency in [Concurrency::Auto, Concurrency::Single] {
+            let found = trade_off(&level, concurrency).unwrap();
+            prop_assert!(found.exact_front, "a small level is explored exactly");
+            check_points(&level, &found, concurrency);
+            let largest = found.points.last().unwrap().size;
+            let minimal: Vec<u64> = level.edges.iter().map(minimal_capacity).collect();
+            let slack = largest - minimal.iter().sum::<u64>();
+            let tries = (slack + 1).pow(minimal.len() as u32);
+            prop_assume!(tries <= 20_000);
+            // The best period of each total size up to the largest point.
+            let mut best: std::collections::BTreeMap<u64, Ratio> = Default::default();
+            let mut extra = vec![0u64; minimal.len()];
+            'all: loop {
+                let added: u64 = extra.iter().sum();
+                if added <= slack {
+                    let caps: Vec<Option<u64>> = minimal.iter().zip(&extra).map(|(m, e)| Some(m + e)).collect();
+                    let with_space = bounded(&level, &caps);
+                    if super::super::deadlock::find_deadlock(&with_space, &counts).is_none() {
+                        let period = throughput(&with_space, &counts, concurrency).unwrap().period;
+                        let size = minimal.iter().sum::<u64>() + added;
+                        let entry = best.entry(size).or_insert(period);
+                        if period < *entry {
+                            *entry = period;
+                        }
+                    }
+                }
+                for e in extra.iter_mut() {
+                    if *e < slack {
+                        *e += 1;
+                        continue 'all;
+                    }
+                    *e = 0;
+                }
+                break;
+            }
+            let mut front: Vec<(u64, Ratio)> = Vec::new();
+            for (size, period) in best {
+                if front.last().is_none_or(|(_, p)| period < *p) {
+                    front.push((size, period));
+                }
+            }
+            let points: Vec<(u64, Ratio)> = found.points.iter().map(|p| (p.size, p.period)).collect();
+            prop_assert_eq!(points, front, "{:?}", concurrency);
         }
     }
 }
