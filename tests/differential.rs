@@ -257,6 +257,28 @@ fn a_leader_cut_off_is_fenced_the_same_way_in_c_and_in_the_simulator() {
     assert_eq!(fenced, ["1 of 3"]);
 }
 
+/// tb_0's link to tb_1 slowed by 1 s: tb_1 takes over under term 2 while
+/// tb_0 leads on under term 1, and tb_0, hearing term 2, is deposed and
+/// leads again under term 3 (docs/groups.md, "Terms"), in both, at the same
+/// instants, every heartbeat saying the same term.
+#[test]
+fn a_leader_that_hears_a_higher_term_steps_down_the_same_way_in_c_and_in_the_simulator() {
+    let (processes, _) = compare(
+        "patrol_groups_terms",
+        &examples().join("swarm/patrol_groups.mission"),
+        r#"{"time_scale": 1, "duration": 5000,
+            "faults": [{"from": 1000, "until": 3000, "delay": ["tb_0", "tb_1"], "by": 1000}]}"#,
+    );
+    let claims: Vec<&str> = processes["tb_0"]
+        .iter()
+        .filter(|e| field(e, "event") == "send" && field(e, "key") == "Guards.__alive")
+        .map(|e| field(e, "value"))
+        .filter(|v| v.starts_with("leader "))
+        .collect();
+    assert!(claims.iter().any(|v| v.ends_with(" 1")), "{claims:?}");
+    assert!(claims.iter().any(|v| v.ends_with(" 3")), "{claims:?}");
+}
+
 /// A leader killed after the operator's commands (`tests/fixtures/semantics/
 /// leader_commands.mission`): the new leader drops the commands sent before
 /// it led, in both, at the same instant (`docs/groups.md`).

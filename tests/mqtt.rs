@@ -631,7 +631,7 @@ fn robots_take_messages_only_from_the_sender_their_topic_names_and_the_acl_lets(
         Forgery {
             user: ("irobot", "irobot-secret"),
             topics: writable(&acl, "irobot", FORGED_RUN),
-            datagram: datagram_from("SlaveTeam", "ti", "SlaveTeam.__alive", "leader 777", true),
+            datagram: datagram_from("SlaveTeam", "ti", "SlaveTeam.__alive", "leader 777 9", true),
         },
     ];
     let (forged, made) = run_while_forging(
@@ -2467,8 +2467,9 @@ fn highest_battery_over_mqtt_elects_the_fullest_robot() {
         })
         .map(|e| field(e, "value").to_string())
         .collect();
-    assert!(heard.iter().any(|v| v == "member 90"), "{heard:?}");
-    assert!(heard.iter().any(|v| v == "leader 90"), "{heard:?}");
+    // Listening, tb_1 knows no term yet; then it leads under the first.
+    assert!(heard.iter().any(|v| v == "member 90 0"), "{heard:?}");
+    assert!(heard.iter().any(|v| v == "leader 90 1"), "{heard:?}");
     assert_eq!(two_leaders(&lives, &BTreeMap::new()), None);
 }
 

@@ -588,7 +588,9 @@ fn note(key: &str, value: &str) -> Vec<u8> {
 /// signed with another key, or altered) is refused and traced; one signed
 /// with the key (by `semo::deploy::datagram::sign`, which holds the C side
 /// to the Rust one: a short datagram and one longer than a SHA-256 block) is
-/// taken.
+/// taken. A replay is refused and traced: the same signed datagram again,
+/// one whose counter is older than the last from its sender, and a capture
+/// of robot `a` older than 5 s (as replayed to a robot restarted since).
 #[test]
 fn with_a_run_key_a_datagram_without_its_signature_is_refused() {
     const KEY: &str = "000102030405060708090a0b0c0d0e0f101112131415161718191a1b1c1d1e1f";
@@ -620,15 +622,22 @@ fn with_a_run_key_a_datagram_without_its_signature_is_refused() {
         wait_for_start(&trace_b, &mut b);
         let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
         let port = base.parse::<u16>().unwrap() + 1;
-        let mut altered = semo::deploy::datagram::sign(&key, &note("Alpha.NOTE", "forged"));
+        use semo::deploy::datagram::{OUTSIDER, counter_now, sign};
+        let at = counter_now();
+        let mut altered = sign(&key, OUTSIDER, at, &note("Alpha.NOTE", "forged"));
         altered[12] ^= 1;
         let wrong_key = [7u8; 32];
+        let hi = sign(&key, OUTSIDER, at + 1, &note("Alpha.NOTE", "hi"));
+        let stale = at.checked_sub(6_000_000_000).expect("up for 6 s");
         for datagram in [
             note("Alpha.NOTE", "unsigned"),
-            semo::deploy::datagram::sign(&wrong_key, &note("Alpha.NOTE", "other key")),
+            sign(&wrong_key, OUTSIDER, at, &note("Alpha.NOTE", "other key")),
             altered,
-            semo::deploy::datagram::sign(&key, &note("Alpha.NOTE", "hi")),
-            semo::deploy::datagram::sign(&key, &note("Alpha.NOTE", &long)),
+            hi.clone(),
+            sign(&key, OUTSIDER, at + 2, &note("Alpha.NOTE", &long)),
+            hi,
+            sign(&key, OUTSIDER, at + 1, &note("Alpha.NOTE", "older")),
+            sign(&key, 0, stale, &note("Alpha.NOTE", "captured")),
         ] {
             socket.send_to(&datagram, ("127.0.0.1", port)).unwrap();
         }
@@ -653,12 +662,16 @@ fn with_a_run_key_a_datagram_without_its_signature_is_refused() {
         assert_eq!(notes.len(), 2, "{notes:#?}");
         assert_eq!(notes[0]["value"], "hi");
         assert_eq!(notes[1]["value"], long.as_str());
-        let rejects = events(&b_trace, "reject");
-        assert_eq!(rejects.len(), 3, "{rejects:#?}");
-        assert!(
-            rejects
-                .iter()
-                .all(|e| e["reason"] == "not signed with the run's key")
+        let reasons: Vec<&Value> = events(&b_trace, "reject")
+            .into_iter()
+            .map(|e| &e["reason"])
+            .collect();
+        let unsigned = "not signed with the run's key";
+        let replayed = "replayed: not newer than the last from its sender";
+        assert_eq!(
+            reasons,
+            [unsigned, unsigned, unsigned, replayed, replayed, replayed],
+            "{b_trace:#?}"
         );
     }
     // A key that is no key stops the program before it starts.

@@ -25,7 +25,9 @@
 mod battery;
 mod c;
 mod control;
-pub use control::{UNLED_REASON, fenced_heard, lease_ms, listen_ms};
+pub use control::{
+    TERM_MAX, UNLED_REASON, fenced_heard, lease_ms, listen_ms, next_term, parse_term,
+};
 pub(crate) mod files;
 mod loops;
 pub use loops::GRAPH_TEXT_MAX;

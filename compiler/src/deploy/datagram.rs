@@ -73,14 +73,36 @@ pub fn encode(d: &Datagram) -> Vec<u8> {
 /// The bytes of a SHA-256 digest: the tag a signed datagram ends with.
 pub const TAG_LEN: usize = 32;
 
+/// The bytes between a signed datagram and its tag: the sender's peer index
+/// (u32) and its counter (u64), little-endian, signed with it.
+pub const STAMP_LEN: usize = 12;
+
+/// The sender index of a signer outside the mission's peer table (the
+/// operator's console, a test): every such signer shares one counter slot
+/// at each robot.
+pub const OUTSIDER: u32 = u32::MAX;
+
+/// A counter as `semo_udp.c` stamps one: the machine's monotonic clock
+/// (`CLOCK_MONOTONIC`, system-wide, never steps back) in ns. A robot takes
+/// from a sender only a counter later than the last it took from it and at
+/// most 5 s old, so a replayed datagram is refused.
+pub fn counter_now() -> u64 {
+    let now = rustix::time::clock_gettime(rustix::time::ClockId::Monotonic);
+    (now.tv_sec as u64) * 1_000_000_000 + now.tv_nsec as u64
+}
+
 /// `datagram` signed with a `linux-sim` run's key (`$SEMO_UDP_KEY`, 16 to
-/// 64 bytes): the datagram and its HMAC-SHA256 under the key (RFC 2104),
-/// as `semo_udp.c` sends and checks them. HMAC is the formula over `sha2`
-/// rather than another crate: the C side carries its own SHA-256 anyway
-/// (robots link nothing but libc), and both are held to RFC 4231's vectors.
-pub fn sign(key: &[u8], datagram: &[u8]) -> Vec<u8> {
+/// 64 bytes) as `semo_udp.c` sends and checks it: the datagram, the stamp
+/// (`sender`, `counter`: see [`STAMP_LEN`], [`counter_now`]) and the
+/// HMAC-SHA256 under the key (RFC 2104) of both. HMAC is the formula over
+/// `sha2` rather than another crate: the C side carries its own SHA-256
+/// anyway (robots link nothing but libc), and both are held to RFC 4231's
+/// vectors.
+pub fn sign(key: &[u8], sender: u32, counter: u64, datagram: &[u8]) -> Vec<u8> {
     let mut out = datagram.to_vec();
-    out.extend_from_slice(&hmac_sha256(key, datagram));
+    out.extend_from_slice(&sender.to_le_bytes());
+    out.extend_from_slice(&counter.to_le_bytes());
+    out.extend_from_slice(&hmac_sha256(key, &out));
     out
 }
 
@@ -192,11 +214,16 @@ mod tests {
             hex(&hmac_sha256(&[0x0b; 20], b"Hi There")),
             "b0344c61d8db38535ca8afceaf0bf12b881dc200c9833da726e9376c2e32cff7"
         );
-        let signed = sign(b"Jefe", b"what do ya want for nothing?");
         assert_eq!(
-            hex(&signed[signed.len() - TAG_LEN..]),
+            hex(&hmac_sha256(b"Jefe", b"what do ya want for nothing?")),
             "5bdcc146bf60754e6a042426089575c75a003f089d2739839dec58b964ec3843"
         );
+        // What `sign` adds: the stamp, then the tag of all before it.
+        let signed = sign(b"Jefe", 2, 0x0102, b"data");
+        let (body, tag) = signed.split_at(signed.len() - TAG_LEN);
+        assert_eq!(body, b"data\x02\0\0\0\x02\x01\0\0\0\0\0\0");
+        assert_eq!(body.len(), 4 + STAMP_LEN);
+        assert_eq!(tag, hmac_sha256(b"Jefe", body));
     }
 
     /// The bytes `semo_core.c` writes for an integer (the C side is held to

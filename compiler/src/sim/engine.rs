@@ -343,6 +343,12 @@ struct Robot<'p> {
     /// Whether the last election this robot decided named it (what its
     /// heartbeats say).
     leading: bool,
+    /// The highest term (leadership epoch, `docs/groups.md`, "Terms") this
+    /// robot knows: heard in a heartbeat, or its own.
+    term: i64,
+    /// The term it leads under (while `leading`): one past the highest it
+    /// knew when it began; a higher one heard since deposes it.
+    term_led: i64,
     /// Joined the mission under way (restarted after one heartbeat period):
     /// listens first, and follows a live claimant instead of claiming.
     rejoining: bool,
@@ -538,6 +544,8 @@ impl<'p> Robot<'p> {
             last_heartbeat: at - m.heartbeat_ms,
             heard: Hearing::new(team_peers(program)),
             leading: false,
+            term: 0,
+            term_led: 0,
             rejoining: m.heartbeat && at > m.heartbeat_ms,
             fenced: None,
             sync_pass: HashMap::new(),
@@ -1214,7 +1222,7 @@ impl<'p> Sim<'p> {
         let robot = &mut self.robots[r];
         let m = &robot.program.control;
         if m.heartbeat && message.publish && message.key == self.names[r].alive_key {
-            // A heartbeat's value is text ("leader 80"); anything else says nothing.
+            // A heartbeat's value is text ("leader 80 2"); anything else says nothing.
             let text = match &message.value {
                 Some(Value::Text(t)) => t.as_str(),
                 _ => "",
@@ -1222,6 +1230,7 @@ impl<'p> Sim<'p> {
             let heard = Heard::parse(self.now, text);
             if let Some(peer) = sender_peer(robot.program, message) {
                 robot.heard.set(peer, heard);
+                robot.term = robot.term.max(heard.term);
             }
             return;
         }
@@ -1583,7 +1592,12 @@ impl<'p> Sim<'p> {
         if m.heartbeat && self.now - self.robots[r].last_heartbeat >= m.heartbeat_ms {
             self.robots[r].last_heartbeat = self.now;
             let robot = &self.robots[r];
-            let value = heartbeat_value(robot.leading, own_battery(robot, self.now));
+            let term = if robot.leading {
+                robot.term_led
+            } else {
+                robot.term
+            };
+            let value = heartbeat_value(robot.leading, own_battery(robot, self.now), term);
             let names = &self.names[r];
             let (team, key, value) = (
                 names.team.clone(),
@@ -2197,11 +2211,19 @@ impl<'p> Sim<'p> {
             }
         };
         let mut leader = chosen.unwrap_or(me);
-        if robot.rejoining && leader == me {
+        // Terms: a leader that has heard a higher term than its own since it
+        // began is deposed, and like a rejoining robot it follows a live
+        // claimant; a claim counts only under the highest term known (an
+        // older one is stale).
+        let was_leading = robot.leading;
+        let deposed = was_leading && robot.term > robot.term_led;
+        if (robot.rejoining || deposed) && leader == me {
             let claimant = robot
                 .heard
                 .iter()
-                .find(|&(i, h)| i != me && h.leads && now - h.seen <= 3 * hb)
+                .find(|&(i, h)| {
+                    i != me && h.leads && h.term >= robot.term && now - h.seen <= 3 * hb
+                })
                 .map(|(i, _)| i);
             if let Some(c) = claimant {
                 leader = c;
@@ -2242,6 +2264,10 @@ impl<'p> Sim<'p> {
         if leader != me {
             // It follows a live robot: it has heard the team again.
             robot.fenced = None;
+        } else if !was_leading || deposed {
+            // It begins to lead (again, when deposed): under a new term.
+            robot.term = crate::codegen::next_term(robot.term);
+            robot.term_led = robot.term;
         }
         robot.leading = leader == me;
         if robot.leaders.get(&state) != Some(&leader) {
@@ -2335,6 +2361,8 @@ struct Heard {
     /// It claimed leadership.
     leads: bool,
     battery: Option<i64>,
+    /// The term it said: the one it leads under, or the highest it knows.
+    term: i64,
 }
 
 impl Heard {
@@ -2342,13 +2370,15 @@ impl Heard {
         seen: 0,
         leads: false,
         battery: None,
+        term: 0,
     };
 
-    /// `heard_alive`: `leader 87` or `member -`.
+    /// `heard_alive`: `leader 87 3` or `member - 2` (a missing or
+    /// malformed term is 0, a larger one [`crate::codegen::TERM_MAX`]).
     fn parse(now: i64, value: &str) -> Heard {
-        let battery = value
-            .split_once(' ')
-            .map(|(_, b)| b)
+        let mut words = value.split(' ').skip(1);
+        let battery = words
+            .next()
             .filter(|b| b.starts_with(|c: char| c.is_ascii_digit()))
             .and_then(|b| {
                 let digits: String = b.chars().take_while(char::is_ascii_digit).collect();
@@ -2358,16 +2388,18 @@ impl Heard {
             seen: now,
             leads: value.starts_with("leader "),
             battery,
+            term: crate::codegen::parse_term(words.next().unwrap_or("")),
         }
     }
 }
 
-/// A heartbeat's value: whether the robot claims leadership, and its battery.
-fn heartbeat_value(leading: bool, battery: Option<i64>) -> String {
+/// A heartbeat's value: whether the robot claims leadership, its battery,
+/// and its term (`docs/groups.md`, "Terms").
+fn heartbeat_value(leading: bool, battery: Option<i64>, term: i64) -> String {
     let role = if leading { "leader" } else { "member" };
     match battery {
-        Some(level) => format!("{role} {level}"),
-        None => format!("{role} -"),
+        Some(level) => format!("{role} {level} {term}"),
+        None => format!("{role} - {term}"),
     }
 }
 

@@ -362,11 +362,100 @@ fn highest_battery_elects_by_the_levels_heartbeats_carry() {
     assert!(
         matches!(
             heartbeat.value_json().as_str(),
-            r#""leader 90""# | r#""member 40""# | r#""member 60""#
+            r#""leader 90 1""# | r#""member 40 1""# | r#""member 60 1""#
         ),
         "{:?}",
         heartbeat.value
     );
+}
+
+/// The terms robots claimed leadership under, each claim once, in the
+/// order of its first heartbeat: (robot, term) from the `leader ...`
+/// heartbeats they sent.
+fn claims(run: &Run, alive_key: &str) -> Vec<(String, i64)> {
+    let mut out: Vec<(String, i64)> = Vec::new();
+    for e in run.trace.iter().filter(|e| e.event == "send") {
+        if e.field("key") != Some(alive_key) {
+            continue;
+        }
+        let value = e.value_json();
+        let words: Vec<&str> = value.trim_matches('"').split(' ').collect();
+        if let ["leader", _, term] = words.as_slice() {
+            let claim = (run.robots[e.robot].1.clone(), term.parse().unwrap());
+            if !out.contains(&claim) {
+                out.push(claim);
+            }
+        }
+    }
+    out
+}
+
+/// Terms (docs/groups.md): each robot that begins to lead does so under a
+/// term past every one it has heard, so the claims of a run, in order, have
+/// rising terms; the restarted tb_0 starts from 0, hears tb_1's term 2, and
+/// claims 3 once tb_1 gives way.
+#[test]
+fn every_new_leader_claims_a_higher_term() {
+    let programs = programs("examples/swarm/patrol_groups.mission");
+    let (run_, _) = run(
+        &programs,
+        r#"{"duration": 5500, "faults": [{"at": 1200, "kill": "tb_0"}, {"at": 3000, "restart": "tb_0"}]}"#,
+        0,
+    );
+    assert_eq!(
+        claims(&run_, "Guards.__alive"),
+        [("tb_0".into(), 1), ("tb_1".into(), 2), ("tb_0".into(), 3)]
+    );
+    assert_eq!(two_leaders(&run_), None);
+}
+
+/// A term heard that is higher than the one a leader leads under deposes
+/// it. tb_0's link to tb_1 is slowed by 1 s from 1 s on: tb_1 hears tb_0
+/// silent and takes over at its pass at 2 s under term 2 (it hears tb_2 and
+/// itself, a majority), while tb_0, which hears tb_2, leads on under term
+/// 1 (two leaders: a slow link is outside what fencing bounds). tb_2 learns
+/// term 2 from tb_1 and says it; at its pass at 3 s tb_0, deposed, finds no
+/// live claimant of term 2 (tb_1's claims are still on the slow link) and
+/// leads on only under a new term, 3, which tb_1 and tb_2 then say; tb_1
+/// gives way at its pass at 3 s (tb_0, the lowest id, is heard again).
+#[test]
+fn a_leader_that_hears_a_higher_term_steps_down() {
+    let programs = programs("examples/swarm/patrol_groups.mission");
+    let (run_, _) = run(
+        &programs,
+        r#"{"duration": 5000, "faults": [{"from": 1000, "until": 3000, "delay": ["tb_0", "tb_1"], "by": 1000}]}"#,
+        0,
+    );
+    assert_eq!(
+        claims(&run_, "Guards.__alive"),
+        [("tb_0".into(), 1), ("tb_1".into(), 2), ("tb_0".into(), 3)]
+    );
+    assert_eq!(leaders(&run_, "tb_1"), ["tb_0", "tb_1", "tb_0"]);
+    assert_eq!(leaders(&run_, "tb_2"), ["tb_0"]);
+    // Every robot's heartbeats say a term that never goes down, and all end
+    // on the last leader's.
+    for (r, (_, name)) in run_.robots.iter().enumerate() {
+        let terms: Vec<i64> = run_
+            .trace
+            .iter()
+            .filter(|e| e.robot == r && e.event == "send")
+            .filter(|e| e.field("key") == Some("Guards.__alive"))
+            .map(|e| {
+                let value = e.value_json();
+                value
+                    .trim_matches('"')
+                    .rsplit(' ')
+                    .next()
+                    .unwrap()
+                    .parse()
+                    .unwrap()
+            })
+            .collect();
+        assert!(terms.windows(2).all(|w| w[0] <= w[1]), "{name}: {terms:?}");
+        if name.starts_with("tb_") {
+            assert_eq!(terms.last(), Some(&3), "{name}");
+        }
+    }
 }
 
 /// The heartbeat period of a robot's program in a run, from its sends.

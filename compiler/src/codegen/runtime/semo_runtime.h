@@ -387,6 +387,12 @@ typedef struct {
  * vouch for (MQTT: not its topic's; UDP with a run key: not signed with
  * it): counted and traced (`reject`), never delivered. */
 #define SEMO_RECV_REFUSED (-2)
+/* What recv returns for a message the transport vouches for but has taken
+ * already, or one as old (UDP with a run key: its counter is no later than
+ * the last from its sender, or stale): a replay, traced (`reject`, reason
+ * SEMO_REPLAYED_REASON), never delivered. */
+#define SEMO_RECV_REPLAYED (-3)
+#define SEMO_REPLAYED_REASON "replayed: not newer than the last from its sender"
 
 /* The transport interface: loopback UDP (`semo_udp.c`) and MQTT
  * (`semo_mqtt.c`, with -DSEMO_MQTT). */
@@ -403,7 +409,8 @@ typedef struct {
     /* Bytes received, 0 on timeout or interrupt, -1 on error,
      * SEMO_RECV_REFUSED for a message the transport refused (MQTT: its
      * datagram names another sender or key than the topic it came on; UDP
-     * with a run key: not signed with it);
+     * with a run key: not signed with it), SEMO_RECV_REPLAYED for a
+     * replay;
      * timeout_ms < 0 waits until a datagram arrives or `interrupt` is
      * called. */
     int (*recv)(void *data, size_t cap, int timeout_ms);

@@ -5,8 +5,15 @@
  * the same for every robot of a run) each datagram carries its HMAC-SHA256
  * under that key (RFC 2104, its 32 bytes after the runtime's datagram), and
  * recv refuses one whose tag is not right (SEMO_RECV_REFUSED): a process
- * that does not know the key can neither forge nor alter a message (it can
- * replay one). `semo::deploy::datagram::sign` is the same on the Rust side.
+ * that does not know the key can neither forge nor alter a message. Nor
+ * replay one: between the datagram and its tag the sender writes its peer
+ * index and a counter (both under the tag), the machine's monotonic clock
+ * in ns when it sent, raised past the last it sent, and recv refuses
+ * (SEMO_RECV_REPLAYED) a counter no later than the last taken from that
+ * sender, or older than UDP_FRESH_NS (a capture replayed to a robot
+ * restarted since). Loopback peers share one clock (CLOCK_MONOTONIC is
+ * system-wide and never steps back). `semo::deploy::datagram::sign` is the
+ * same on the Rust side.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -17,9 +24,14 @@
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <pthread.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <time.h>
 #include <unistd.h>
+
+static void udp_close(void);
 
 /* Set by open before any thread uses the transport, cleared by close after
  * they are joined; the kernel serialises concurrent sendto/recv. */
@@ -29,14 +41,28 @@ static int g_fd = -1;
 static int g_wake[2] = {-1, -1};
 static int g_port_base;
 static size_t g_peer_count;
+static size_t g_self;
 /* The run key (none: g_key_len 0). */
 static unsigned char g_key[SEMO_UDP_KEY_MAX];
 static size_t g_key_len;
+/* With a key: the last counter taken from each robot of the peer table, and
+ * (the last slot) from senders outside it (the operator's console); the
+ * last this robot sent. Only the receive thread reads and writes g_last;
+ * g_sent is taken under g_sent_lock (every thread sends). */
+static uint64_t *g_last;
+static uint64_t g_sent;
+static pthread_mutex_t g_sent_lock = PTHREAD_MUTEX_INITIALIZER;
 
 /* ----------------------------------------------------------- HMAC-SHA256 */
 
 #define SHA256_BLOCK 64
 #define UDP_TAG 32 /* a SHA-256 digest */
+/* The sender's peer index (u32) and counter (u64), little-endian, signed
+ * with the datagram. */
+#define UDP_STAMP 12
+/* How old a counter may be when it arrives: far more than a datagram waits
+ * in a loopback socket, far less than a robot takes to restart. */
+#define UDP_FRESH_NS (5LL * 1000 * 1000 * 1000)
 
 typedef struct {
     uint32_t h[8];
@@ -165,6 +191,53 @@ static bool udp_tag_right(const unsigned char *data, size_t len)
     return differ == 0;
 }
 
+/* The machine's monotonic clock, ns: what a counter is. */
+static uint64_t udp_clock_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+/* The next counter this robot sends: the clock, or one past the last sent
+ * when the clock has not moved since. */
+static uint64_t udp_next_counter(void)
+{
+    uint64_t now = udp_clock_ns();
+    pthread_mutex_lock(&g_sent_lock);
+    g_sent = now > g_sent ? now : g_sent + 1;
+    uint64_t counter = g_sent;
+    pthread_mutex_unlock(&g_sent_lock);
+    return counter;
+}
+
+static void put_le(unsigned char *at, uint64_t v, int bytes)
+{
+    for (int i = 0; i < bytes; i++)
+        at[i] = (unsigned char)(v >> (8 * i));
+}
+
+static uint64_t get_le(const unsigned char *at, int bytes)
+{
+    uint64_t v = 0;
+    for (int i = 0; i < bytes; i++)
+        v |= (uint64_t)at[i] << (8 * i);
+    return v;
+}
+
+/* Whether a signed datagram's stamp (`stamp`, UDP_STAMP bytes) is newer
+ * than the last taken from its sender and fresh; if so it is the last now. */
+static bool udp_stamp_fresh(const unsigned char *stamp)
+{
+    uint64_t sender = get_le(stamp, 4), counter = get_le(stamp + 4, 8);
+    size_t slot = sender < g_peer_count ? (size_t)sender : g_peer_count;
+    uint64_t now = udp_clock_ns();
+    if (counter <= g_last[slot] || counter + UDP_FRESH_NS < now)
+        return false;
+    g_last[slot] = counter;
+    return true;
+}
+
 static struct sockaddr_in loopback(int port)
 {
     struct sockaddr_in addr;
@@ -198,9 +271,16 @@ static int udp_open(const semo_program_desc *program, const semo_transport_confi
     g_fd = fd;
     g_port_base = (int)port_base;
     g_peer_count = program->peer_count;
+    g_self = program->self;
     g_key_len = config->udp_key_len <= sizeof g_key ? config->udp_key_len : 0;
-    if (g_key_len > 0)
+    if (g_key_len > 0) {
         memcpy(g_key, config->udp_key, g_key_len);
+        g_last = calloc(g_peer_count + 1, sizeof *g_last);
+        if (g_last == NULL) {
+            udp_close();
+            return -1;
+        }
+    }
     return 0;
 }
 
@@ -208,12 +288,15 @@ static int udp_send(size_t peer, const void *data, size_t len)
 {
     if (g_fd < 0 || peer >= g_peer_count)
         return -1;
-    unsigned char signed_data[SEMO__DATAGRAM_MAX + UDP_TAG];
+    unsigned char signed_data[SEMO__DATAGRAM_MAX + UDP_STAMP + UDP_TAG];
     if (g_key_len > 0) {
         if (len > SEMO__DATAGRAM_MAX)
             return -1;
         memcpy(signed_data, data, len);
-        udp_tag(data, len, signed_data + len);
+        put_le(signed_data + len, g_self, 4);
+        put_le(signed_data + len + 4, udp_next_counter(), 8);
+        len += UDP_STAMP;
+        udp_tag(signed_data, len, signed_data + len);
         data = signed_data;
         len += UDP_TAG;
     }
@@ -237,17 +320,19 @@ static int udp_recv(void *data, size_t cap, int timeout_ms)
         return errno == EINTR ? 0 : -1;
     if (ready == 0 || pfd[1].revents != 0)
         return 0;
-    /* With a key, the datagram and its tag, and a spare byte (a longer one
-     * is cut short, and then its tag is wrong). */
-    unsigned char wire[SEMO__DATAGRAM_MAX + UDP_TAG + 1];
+    /* With a key, the datagram, its stamp and its tag, and a spare byte (a
+     * longer one is cut short, and then its tag is wrong). */
+    unsigned char wire[SEMO__DATAGRAM_MAX + UDP_STAMP + UDP_TAG + 1];
     ssize_t n = recv(g_fd, g_key_len > 0 ? wire : data, g_key_len > 0 ? sizeof wire : cap, 0);
     if (n < 0)
         return errno == EINTR || errno == EAGAIN || errno == EWOULDBLOCK || errno == ECONNREFUSED ? 0 : -1;
     if (g_key_len == 0)
         return (int)n;
-    if (!udp_tag_right(wire, (size_t)n))
+    if ((size_t)n < UDP_STAMP + UDP_TAG || !udp_tag_right(wire, (size_t)n))
         return SEMO_RECV_REFUSED;
-    size_t len = (size_t)n - UDP_TAG;
+    size_t len = (size_t)n - UDP_TAG - UDP_STAMP;
+    if (!udp_stamp_fresh(wire + len))
+        return SEMO_RECV_REPLAYED;
     memcpy(data, wire, len < cap ? len : cap);
     return (int)(len < cap ? len : cap);
 }
@@ -271,6 +356,8 @@ static void udp_close(void)
     }
     g_fd = -1;
     g_peer_count = 0;
+    free(g_last);
+    g_last = NULL;
 }
 
 const semo_transport semo_udp_transport = {

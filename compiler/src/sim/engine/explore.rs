@@ -469,8 +469,11 @@ impl Fingerprint {
             self.time(h.seen);
             self.int(h.leads as i64);
             self.int(h.battery.unwrap_or(i64::MIN));
+            self.int(h.term);
         }
         self.int(robot.leading as i64);
+        self.int(robot.term);
+        self.int(robot.term_led);
         self.int(robot.rejoining as i64);
         match robot.fenced {
             None => self.int(-1),
