@@ -1229,18 +1229,22 @@ impl<'a> Checker<'a> {
     }
 
     fn group(&mut self, g: &'a ast::GroupStmt, scope: &Scope) {
-        let counted = |arm: &ast::GroupArm| arm.condition.kind == CondKind::Counted;
+        // A condition that did not parse (reported by the parser) is empty.
+        let broken = |arm: &ast::GroupArm| {
+            arm.condition.kind == CondKind::Counted && arm.condition.names.is_empty()
+        };
+        let counted = |arm: &ast::GroupArm| arm.condition.counted_name().is_some();
         if g.arms.iter().any(counted) {
             let pure = g
                 .arms
                 .iter()
-                .all(|a| counted(a) && a.kind == ArmKind::Group);
+                .all(|a| (counted(a) || broken(a)) && a.kind == ArmKind::Group);
             if pure {
                 return self.counted_group(g, scope);
             }
             // Mixed: checked as the arms are written (a counted condition
             // meets every robot), after saying what is wrong.
-            for arm in &g.arms {
+            for arm in g.arms.iter().filter(|a| !broken(a)) {
                 let message = match (arm.kind, counted(arm)) {
                     (ArmKind::Leader, true) => {
                         "a `leader` arm takes `instance of` or `capable of`, not a count"
@@ -1290,7 +1294,8 @@ impl<'a> Checker<'a> {
                 .copied()
                 .filter(|r| is_taken(&taken, r))
                 .collect();
-            if arm.kind == ArmKind::Group && !overlap.is_empty() {
+            // A counted arm here is already an error (E043).
+            if arm.kind == ArmKind::Group && !overlap.is_empty() && !counted(arm) && !broken(arm) {
                 let names = self.robot_names(scope, &overlap);
                 self.diagnostics.report(
                     Code::AmbiguousGroup,

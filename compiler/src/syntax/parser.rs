@@ -408,7 +408,21 @@ where
         let group_cond = typed_cond
             .or(counted_cond)
             .delimited_by(tok(Token::LParen), tok(Token::RParen))
-            .labelled("`instance of ...`, `capable of ...` or `Name, min = N`");
+            .labelled("`instance of ...`, `capable of ...` or `Name, min = N`")
+            // A condition that does not parse is reported where it goes
+            // wrong, and the arm's block is still parsed: an empty counted
+            // condition (no name, no min) checks nothing more.
+            .recover_with(via_parser(nested_delimiters(
+                Token::LParen,
+                Token::RParen,
+                [(Token::GroupOpen, Token::GroupClose)],
+                |span| GroupCond {
+                    kind: CondKind::Counted,
+                    names: Vec::new(),
+                    min: None,
+                    span: sp(span),
+                },
+            )));
         let arm_kind = kw(Kw::Leader)
             .map(|s| (ArmKind::Leader, sp(s)))
             .or(kw(Kw::Group).map(|s| (ArmKind::Group, sp(s))));
