@@ -1385,6 +1385,17 @@ impl<'a> Checker<'a> {
                     None => first_named.push((name.as_str(), name.span)),
                 }
             }
+            if let (Some(team), Some(name), Some(min)) =
+                (scope.team, cond.counted_name(), &cond.min)
+            {
+                let symbol = Symbol::CountedGroup {
+                    team,
+                    name: name.name.clone(),
+                    min: min.count.value.unwrap_or(0),
+                    robots: robots as u32,
+                };
+                self.occurrence(name.span, symbol, true);
+            }
             if let Some(min) = &cond.min {
                 match min.count.value {
                     Some(n) if n > 0 => {
