@@ -624,3 +624,30 @@ fn counted_groups_are_allocated_the_same_way_in_c_and_in_the_simulator() {
         "tb_1 came back to Room1"
     );
 }
+
+/// Counted groups with `others` (`tests/fixtures/counted_groups/search.mission`:
+/// Room1 at least two, Room2 one, the spare stands by): tb_1 killed at 0.3 s,
+/// between the first allocation and the next pass, restarted at 1.7 s, tb_0
+/// killed at 3.1 s.
+/// Both engines agree at every instant; with four alive the spare runs
+/// `others`, with three alive every group has its minimum and nobody is
+/// left over.
+#[test]
+fn counted_groups_with_a_spare_are_allocated_the_same_way_in_c_and_in_the_simulator() {
+    let fixtures = repo_root().join("tests/fixtures/counted_groups");
+    let scenario = std::fs::read_to_string(fixtures.join("search.scenario.json")).unwrap();
+    let (_, sim) = compare(
+        "counted_search",
+        &fixtures.join("search.mission"),
+        &scenario,
+    );
+    let names = |t: i64| -> Vec<String> {
+        let mut names: Vec<String> = groups_at(&sim, t).into_values().collect();
+        names.sort();
+        names
+    };
+    assert_eq!(names(1000), ["Room1", "Room1", "Room2"], "tb_1 lost at 1 s");
+    assert_eq!(names(2000), ["Room1", "Room1", "Room2", "others"]);
+    assert_eq!(names(4000), ["Room1", "Room1", "Room2"], "tb_0 lost at 4 s");
+    assert_eq!(groups_at(&sim, 2000)["tb_3"], "others");
+}
