@@ -747,7 +747,10 @@ fn counted_allocation_fills_the_minimums_in_order_then_spares_go_to_others_or_ro
 fn counted_groups_put_every_arm_in_every_program_behind_one_allocation() {
     let text = "{ T: Turtlebot3_Burger tb[4], Ev3_Robot ev }\nT.A.S{ [[ group(instance of Turtlebot3_Burger) {\n  [[ group(Room1, min = 2) { scatter() }\n     group(Room2, min = 1) { standby() }\n     others { move(\"0,0\") } ]] }\n  others { move(\"1,1\") } ]] } repeat(1 SEC)\nT.M{ set(A, S) }\nT.main{ default: mode = M }\n";
     let programs = programs(text, &[]);
-    let allocations = |robot: &str| -> Vec<(Vec<usize>, Vec<(String, usize)>, bool)> {
+    // Per GroupAllocate state: its members, its groups (name, min), whether
+    // it has `others`.
+    type Allocation = (Vec<usize>, Vec<(String, usize)>, bool);
+    let allocations = |robot: &str| -> Vec<Allocation> {
         program(&programs, robot)
             .control
             .services
