@@ -627,3 +627,86 @@ fn random_missions_behave_the_same_in_c_and_in_the_simulator() {
 fn many_random_missions_behave_the_same_in_c_and_in_the_simulator() {
     random_missions(50..300);
 }
+
+/// Each live robot's group at instant `t` by the trace: its latest
+/// `allocated` up to `t`, for the robots not killed since they last started.
+fn groups_at(events: &[Event], t: i64) -> BTreeMap<String, String> {
+    let mut groups: BTreeMap<String, String> = BTreeMap::new();
+    for e in events.iter().filter(|e| e["t"].as_i64().unwrap() <= t) {
+        let robot = field(e, "robot").to_string();
+        match field(e, "event") {
+            "allocated" => {
+                groups.insert(robot, field(e, "name").to_string());
+            }
+            "fault" if field(e, "fault") == "kill" => {
+                groups.remove(&robot);
+            }
+            _ => {}
+        }
+    }
+    groups
+}
+
+/// Counted groups (issue 36, `tests/fixtures/counted_groups/rooms.mission`:
+/// Room1 and Room2, at least two each, five robots): tb_1 killed at 1 s (at
+/// the instant of a pass), tb_3 at 2.6 s (after the groups were re-made),
+/// tb_1 restarted at 4 s. Both engines give each robot the same group at
+/// the same instants; once the losses are known, every group has its
+/// minimum while four robots live, Room2 alone is short while three do,
+/// and every live robot is in exactly one group.
+#[test]
+fn counted_groups_are_allocated_the_same_way_in_c_and_in_the_simulator() {
+    let fixtures = repo_root().join("tests/fixtures/counted_groups");
+    let scenario = std::fs::read_to_string(fixtures.join("rooms.scenario.json")).unwrap();
+    let (_, sim) = compare("counted_rooms", &fixtures.join("rooms.mission"), &scenario);
+    let count = |groups: &BTreeMap<String, String>, name: &str| {
+        groups.values().filter(|g| g.as_str() == name).count()
+    };
+    for (t, live, room1, room2) in [
+        (0, 5, 3, 2),
+        (2000, 4, 2, 2),
+        (3900, 3, 2, 1),
+        (6000, 4, 2, 2),
+    ] {
+        let groups = groups_at(&sim, t);
+        assert_eq!(
+            groups.len(),
+            live,
+            "at {t} ms, each live robot once: {groups:?}"
+        );
+        assert_eq!(count(&groups, "Room1"), room1, "at {t} ms: {groups:?}");
+        assert_eq!(count(&groups, "Room2"), room2, "at {t} ms: {groups:?}");
+    }
+    assert_eq!(
+        groups_at(&sim, 6000)["tb_1"],
+        "Room1",
+        "tb_1 came back to Room1"
+    );
+}
+
+/// Counted groups with `others` (`tests/fixtures/counted_groups/search.mission`:
+/// Room1 at least two, Room2 one, the spare stands by): tb_1 killed at 0.3 s,
+/// between the first allocation and the next pass, restarted at 1.7 s, tb_0
+/// killed at 3.1 s.
+/// Both engines agree at every instant; with four alive the spare runs
+/// `others`, with three alive every group has its minimum and nobody is
+/// left over.
+#[test]
+fn counted_groups_with_a_spare_are_allocated_the_same_way_in_c_and_in_the_simulator() {
+    let fixtures = repo_root().join("tests/fixtures/counted_groups");
+    let scenario = std::fs::read_to_string(fixtures.join("search.scenario.json")).unwrap();
+    let (_, sim) = compare(
+        "counted_search",
+        &fixtures.join("search.mission"),
+        &scenario,
+    );
+    let names = |t: i64| -> Vec<String> {
+        let mut names: Vec<String> = groups_at(&sim, t).into_values().collect();
+        names.sort();
+        names
+    };
+    assert_eq!(names(1000), ["Room1", "Room1", "Room2"], "tb_1 lost at 1 s");
+    assert_eq!(names(2000), ["Room1", "Room1", "Room2", "others"]);
+    assert_eq!(names(4000), ["Room1", "Room1", "Room2"], "tb_0 lost at 4 s");
+    assert_eq!(groups_at(&sim, 2000)["tb_3"], "others");
+}

@@ -111,6 +111,10 @@ codes! {
     ReceivedNotAValue = "E040", Error, "a receive or subscribe of a name that is not a value: neither `Team.VALUE`, `USER.VALUE` nor `VALUE`";
     WordIsAValue = "E041", Error, "a bare word where a word may stand that is also a value the robots read: write `\"WORD\"` for the word or `Team.WORD` for the value";
     StrategyPassesNothing = "E042", Error, "an actuator's or algorithm's parameter without a `value` whose name is no parameter of the strategy's actions nor of the service: its task would get nothing";
+    CountedGroupMin = "E037", Error, "a counted group's `min` that is not a positive whole number";
+    DuplicateCountedGroup = "E038", Error, "two counted groups of one statement with the same name";
+    CountedGroupsTooLarge = "E039", Error, "counted groups whose minimums add up to more robots than run the statement: they can never all be met";
+    CountedGroupMixed = "E043", Error, "a counted group (`group(Name, min = N)`) beside an `instance of`/`capable of` group or a `leader` arm in one statement, or a `leader` arm with a count";
     TooManyRobots = "E036", Error, "`name[N]` with N above 4096, or a mission with more than 4096 robots in all";
     // Catalog files (*.robot.xml).
     CatalogXml = "E050", Error, "a catalog file that is not well-formed XML";
@@ -220,6 +224,7 @@ codes! {
     FunctionNeverCalled = "W010", Warning, "a function that is never called";
     TeamWithoutMain = "W011", Warning, "a team without a main block: its robots do nothing";
     EmptyOthers = "W012", Warning, "an `others` block that no robot is left to run";
+    CountedGroupsNoSpare = "W014", Hint, "counted groups whose minimums take every robot that runs the statement: a robot lost leaves a group short";
     BroadcastToNoOne = "W013", Hint, "a `throw E broadcast` that only one robot runs: its group (or team) has no one else to tell";
     ComparisonNeverHolds = "W020", Warning, "a comparison of a team variable with a value it is never set to: it never holds";
     ComparisonAlwaysHolds = "W021", Warning, "`!=` between a team variable and a value it is never set to: it holds whenever the variable has a value";

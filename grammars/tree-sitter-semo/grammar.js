@@ -225,11 +225,18 @@ module.exports = grammar({
 
     others_arm: $ => seq('others', field('body', $._body)),
 
-    _group_condition: $ => seq('(', field('condition', choice($.instance_of, $.capable_of)), ')'),
+    _group_condition: $ => seq(
+      '(',
+      field('condition', choice($.instance_of, $.capable_of, $.counted_group)),
+      ')',
+    ),
 
     instance_of: $ => seq('instance', 'of', commaSep1(field('type', $.identifier))),
 
     capable_of: $ => seq('capable', 'of', commaSep1(field('capability', $.identifier))),
+
+    /** `Room1, min = 2`: a group of at least two robots chosen at run time (`min` is a word only here). */
+    counted_group: $ => seq(field('name', $.identifier), ',', 'min', '=', field('min', $.number)),
 
     timeout: $ => seq('timeout', '=', field('period', $.period)),
 

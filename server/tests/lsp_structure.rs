@@ -467,7 +467,8 @@ async fn capabilities_are_announced() {
             "function",
             "variable",
             "value",
-            "constant"
+            "constant",
+            "group"
         ])
     );
     assert_eq!(

@@ -106,6 +106,11 @@ fn group_update(m: &ControlMachine) -> String {
     )
 }
 
+/// Counted groups (`StateKind::GroupAllocate`): the rule of
+/// `refine::counted_allocation` over the live members, as the simulator's
+/// `GroupAllocate` applies it.
+const GROUP_OF_C: &str = "/* Counted groups: this robot's group among `groups` (declaration order) from\n * the live `members` (peer indices, formation order; a member is alive when it\n * is this robot or was heard from within three heartbeats since this robot\n * joined). The live members in formation order fill the minimums in\n * declaration order; a spare goes to `others` (-1) when the statement has one,\n * else to the groups round-robin. `*alive`: how many were counted. */\nstatic long group_of(const size_t *members, size_t n, const size_t *mins, size_t groups, bool has_others, size_t *alive)\n{\n    const semo_program_desc *p = semo_program();\n    int64_t now = semo_now_ms();\n    size_t position = 0, live = 0;\n    for (size_t k = 0; k < n; k++) {\n        comm_heartbeat h = comm_heard(members[k]);\n        int64_t seen = h.seen > semo_joined_ms() ? h.seen : semo_joined_ms();\n        if (members[k] != p->self && now - seen > 3 * @HB@)\n            continue; /* lost: silent for three heartbeats */\n        if (members[k] == p->self)\n            position = live;\n        live++;\n    }\n    *alive = live;\n    size_t filled = 0;\n    for (size_t g = 0; g < groups; g++) {\n        filled += mins[g];\n        if (position < filled)\n            return (long)g;\n    }\n    if (has_others || groups == 0)\n        return -1;\n    return (long)((position - filled) % groups);\n}\n\n";
+
 /// This robot's battery level for its heartbeats: the scenario's (in
 /// simulation), else unknown (-1).
 const OWN_BATTERY_C: &str = "/* Whether the last election this robot decided named it (its heartbeats say so). */\nstatic bool leading;\n/* Terms (docs/groups.md): the highest this robot knows (heard, or its own),\n * and the one it leads under while `leading`. */\nstatic int64_t term_known, term_led;\n\n/* The highest term known now: its own, or one a heartbeat said. */\nstatic int64_t known_term(void)\n{\n    int64_t heard = comm_highest_term();\n    if (heard > term_known)\n        term_known = heard;\n    return term_known;\n}\n\n/* A term (at most 10^15) as decimal digits: not every target's printf\n * has %lld. */\nstatic void term_text(int64_t t, char out[24])\n{\n    char digits[24];\n    int n = 0;\n    do {\n        digits[n++] = (char)('0' + t % 10);\n        t /= 10;\n    } while (t > 0 && n < 23);\n    for (int i = 0; i < n; i++)\n        out[i] = digits[n - 1 - i];\n    out[n] = '\\0';\n}\n\n/* This robot's battery level for its heartbeats: the scenario's in\n * simulation, else unknown (-1). */\nstatic long own_battery(void)\n{\n#ifdef SEMO_SIM\n    long long level;\n    if (semo_sim_battery(&level))\n        return (long)level;\n#endif\n    return -1;\n}\n\n";
@@ -416,6 +421,10 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
         out.push('\n');
     }
 
+    if uses("group_of") {
+        out.push_str(&GROUP_OF_C.replace("@HB@", &m.heartbeat_ms.to_string()));
+    }
+
     if uses("drop_unled") {
         out.push_str(&DROP_UNLED_C.replace("@REASON@", &c::string(UNLED_REASON)));
     }
@@ -670,6 +679,25 @@ fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize
             let _ = writeln!(
                 out,
                 "        r->pc = chosen ? {next} : {others_at};\n        return STEP_NEXT;\n    }}"
+            );
+        }
+        StateKind::GroupAllocate {
+            members,
+            groups,
+            others_at,
+        } => {
+            let join = |items: Vec<String>| items.join(", ");
+            let members_list = join(members.iter().map(|c| c.to_string()).collect());
+            let mins = join(groups.iter().map(|g| g.min.to_string()).collect());
+            let names = join(groups.iter().map(|g| c::string(&g.name)).collect());
+            let at = join(groups.iter().map(|g| g.at.index().to_string()).collect());
+            let others = others_at.map_or(next, |o| o.index());
+            let _ = writeln!(
+                out,
+                "    {{\n        static const size_t members[] = {{{members_list}}};\n        static const size_t mins[] = {{{mins}}};\n        static const char *const names[] = {{{names}}};\n        static const int at[] = {{{at}}};\n        static long last = -2; /* the group last given, -1 others (control thread only) */\n        size_t alive;\n        long group = group_of(members, {}, mins, {}, {}, &alive);\n        if (group != last) {{\n            char counted[24];\n            snprintf(counted, sizeof counted, \"%lu\", (unsigned long)alive);\n            last = group;\n            semo_trace(\"allocated\", \"name\", group < 0 ? \"others\" : names[group], \"alive\", counted, NULL);\n        }}\n        r->pc = group < 0 ? {others} : at[group];\n        return STEP_NEXT;\n    }}",
+                members.len(),
+                groups.len(),
+                others_at.is_some(),
             );
         }
         StateKind::GroupSync {

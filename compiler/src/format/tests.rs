@@ -229,3 +229,13 @@ fn a_broadcast_throw_keeps_its_keyword_on_the_statement() {
         "{\n  T: iRobotCreate a[2]\n}\n\nT.A.S {\n  throw go broadcast;\n  if(DISTANCE < 5)\n    throw near broadcast\n} repeat()\n"
     );
 }
+
+#[test]
+fn a_counted_group_is_written_name_comma_min_equals() {
+    assert_eq!(
+        fmt(
+            "{T:iRobotCreate a[3]} T.A.S{[[group(  R1 ,min=2){x()}group(R2,min   = 1){y()}]]}repeat()"
+        ),
+        "{\n  T: iRobotCreate a[3]\n}\n\nT.A.S {\n  [[\n    group(R1, min = 2) {\n      x()\n    }\n    group(R2, min = 1) {\n      y()\n    }\n  ]]\n} repeat()\n"
+    );
+}

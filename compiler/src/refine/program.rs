@@ -462,6 +462,22 @@ pub enum StateKind {
         others_at: StateId,
         receives: Vec<usize>,
     },
+    /// `[[ group(Name, min = N) ... ]]` (counted groups): give this robot a
+    /// group from the `members` (peer indices, formation order: the robots
+    /// that run the statement, as the checker decided) it knows alive (itself,
+    /// and those heard from within three heartbeats since it joined). The
+    /// live members in formation order fill the groups up to their
+    /// minimums in declaration order; a live member beyond the sum of the
+    /// minimums (a spare) goes to `others_at` when the statement has
+    /// `others`, else to the groups round-robin in declaration order. With
+    /// fewer live members than the sum, the later groups are short
+    /// ([`counted_allocation`]). The robot continues at its group's `at`;
+    /// a change of its group is traced (`allocated`).
+    GroupAllocate {
+        members: Vec<usize>,
+        groups: Vec<CountedGroup>,
+        others_at: Option<StateId>,
+    },
     /// The start of a group statement when the team's strategy has
     /// `<GroupSync timeout>`: tell the team this robot has arrived (its
     /// pass through the statement: `Team.__sync` = `"<point> <pass>"`), then
@@ -504,6 +520,35 @@ pub enum StateKind {
         condition: Option<Expr>,
         forever: bool,
     },
+}
+
+/// One arm of a statement of counted groups ([`StateKind::GroupAllocate`]).
+#[derive(Clone, Debug)]
+pub struct CountedGroup {
+    pub name: String,
+    pub min: usize,
+    /// The first state of the arm's block.
+    pub at: StateId,
+}
+
+/// Where a statement of counted groups puts the live member at `position`
+/// (its place among the live members, formation order): `Some(k)`, the
+/// `k`-th group (declaration order), or `None`, `others`. The one rule the
+/// simulator and the generated C (`group_of` in `codegen/control.rs`)
+/// follow: the minimums are filled in declaration order; a spare goes to
+/// `others` when there is one (`has_others`), else round-robin.
+pub fn counted_allocation(mins: &[usize], has_others: bool, position: usize) -> Option<usize> {
+    let mut filled = 0usize;
+    for (k, &min) in mins.iter().enumerate() {
+        filled = filled.saturating_add(min);
+        if position < filled {
+            return Some(k);
+        }
+    }
+    if has_others || mins.is_empty() {
+        return None;
+    }
+    Some((position - filled) % mins.len())
 }
 
 /// One value of a `send`/`publish`.

@@ -512,6 +512,12 @@ impl Builder<'_, '_> {
                 // Group membership is static for a robot: its type and
                 // capabilities decide which arm it joins (the others are
                 // dropped from its program).
+                if g.arms
+                    .first()
+                    .is_some_and(|a| a.condition.kind == ast::CondKind::Counted)
+                {
+                    return self.counted_groups(g, stmt.span, states, marks, depth);
+                }
                 match self.chosen_arm(g) {
                     ArmChoice::Static(Some(body)) => self.block(body, states, marks, depth),
                     ArmChoice::Static(None) => {}
@@ -579,6 +585,84 @@ impl Builder<'_, '_> {
             }
             StmtKind::Call(call) => self.call(call, stmt.span, states, marks, depth),
             StmtKind::Error => {}
+        }
+    }
+
+    /// `[[ group(Name, min = N) ... ]]`: every arm is in the program (which
+    /// one this robot runs is decided at run time, `GroupAllocate`), each
+    /// ending in a jump past the others; `others` last. The members are the
+    /// robots the checker walked the statement with (every arm's runners).
+    fn counted_groups(
+        &mut self,
+        g: &ast::GroupStmt,
+        span: Span,
+        states: &mut Vec<State>,
+        marks: &mut usize,
+        depth: usize,
+    ) {
+        let Some(first) = g.arms.first() else {
+            return;
+        };
+        let Some(runners) = self.runners_of(first.body.span) else {
+            return;
+        };
+        if !runners.contains(&self.robot_index) {
+            return;
+        }
+        let first_peer = self.first_peer();
+        let members: Vec<usize> = runners.iter().map(|i| first_peer + i).collect();
+        let (_, heartbeat_ms) = self.leader_selection();
+        self.need_heartbeat(heartbeat_ms.unwrap_or(HEARTBEAT_MS));
+        let allocate = self.push(
+            states,
+            StateKind::GroupAllocate {
+                members,
+                groups: Vec::new(),
+                others_at: None,
+            },
+            span,
+        );
+        states[allocate.index()].text = "counted groups: this robot's group".into();
+        let mut groups = Vec::new();
+        let mut ends = Vec::new();
+        for arm in &g.arms {
+            let (Some(name), Some(min)) = (arm.condition.counted_name(), &arm.condition.min) else {
+                self.internal_error(
+                    arm.condition.span,
+                    "a counted group without its name or min",
+                );
+                return;
+            };
+            let Some(min) = min.count.value.filter(|&n| n > 0) else {
+                self.internal_error(min.count.span, "a counted group's min the checker refused");
+                return;
+            };
+            groups.push(CountedGroup {
+                name: name.name.to_string(),
+                min: min as usize,
+                at: StateId::new(states.len()),
+            });
+            self.block(&arm.body, states, marks, depth);
+            let jump = self.push_forward(states, span, |to| StateKind::Jump { to });
+            states[jump.0.index()].text = format!("end of group {}", name.name);
+            ends.push(jump);
+        }
+        let others_at = g.others.as_ref().map(|others| {
+            let at = StateId::new(states.len());
+            self.block(&others.body, states, marks, depth);
+            at
+        });
+        if let StateKind::GroupAllocate {
+            groups: g,
+            others_at: o,
+            ..
+        } = &mut states[allocate.index()].kind
+        {
+            *g = groups;
+            *o = others_at;
+        }
+        for jump in ends {
+            land(states, jump);
         }
     }
 

@@ -713,3 +713,73 @@ fn a_broadcast_goes_to_the_throwers_group_as_the_checker_recorded_it() {
     assert_eq!(by_robot[3].1.control.events_heard, ["all"]);
     assert!(by_robot[3].1.control.has_receiver());
 }
+
+#[test]
+fn counted_allocation_fills_the_minimums_in_order_then_spares_go_to_others_or_round_robin() {
+    // Room1 min 2, Room2 min 1: positions 0 and 1 to Room1, 2 to Room2.
+    let rooms = [2, 1];
+    let without: Vec<Option<usize>> = (0..7)
+        .map(|p| counted_allocation(&rooms, false, p))
+        .collect();
+    assert_eq!(
+        without,
+        [
+            Some(0),
+            Some(0),
+            Some(1),
+            Some(0),
+            Some(1),
+            Some(0),
+            Some(1)
+        ]
+    );
+    let with: Vec<Option<usize>> = (0..5)
+        .map(|p| counted_allocation(&rooms, true, p))
+        .collect();
+    assert_eq!(with, [Some(0), Some(0), Some(1), None, None]);
+    // Fewer alive than the sum: the first groups are filled, the later short.
+    assert_eq!(counted_allocation(&[3, 2], false, 2), Some(0));
+    // A minimum as large as the checker lets through does not overflow.
+    assert_eq!(counted_allocation(&[usize::MAX, 1], false, 5), Some(0));
+}
+
+#[test]
+fn counted_groups_put_every_arm_in_every_program_behind_one_allocation() {
+    let text = "{ T: Turtlebot3_Burger tb[4], Ev3_Robot ev }\nT.A.S{ [[ group(instance of Turtlebot3_Burger) {\n  [[ group(Room1, min = 2) { scatter() }\n     group(Room2, min = 1) { standby() }\n     others { move(\"0,0\") } ]] }\n  others { move(\"1,1\") } ]] } repeat(1 SEC)\nT.M{ set(A, S) }\nT.main{ default: mode = M }\n";
+    let programs = programs(text, &[]);
+    // Per GroupAllocate state: its members, its groups (name, min), whether
+    // it has `others`.
+    type Allocation = (Vec<usize>, Vec<(String, usize)>, bool);
+    let allocations = |robot: &str| -> Vec<Allocation> {
+        program(&programs, robot)
+            .control
+            .services
+            .iter()
+            .flat_map(|s| &s.states)
+            .filter_map(|s| match &s.kind {
+                StateKind::GroupAllocate {
+                    members,
+                    groups,
+                    others_at,
+                } => Some((
+                    members.clone(),
+                    groups.iter().map(|g| (g.name.clone(), g.min)).collect(),
+                    others_at.is_some(),
+                )),
+                _ => None,
+            })
+            .collect()
+    };
+    // The members are the TurtleBots (peers 0-3), as the checker walked the
+    // inner statement; the Ev3 robot has no allocation and no heartbeat.
+    let rooms = vec![("Room1".to_string(), 2), ("Room2".to_string(), 1)];
+    assert_eq!(allocations("tb_3"), [(vec![0, 1, 2, 3], rooms, true)]);
+    assert_eq!(
+        calls(program(&programs, "tb_3")),
+        ["scatter", "standby", "move"],
+        "every arm is in the program"
+    );
+    assert!(program(&programs, "tb_3").control.heartbeat);
+    assert!(allocations("ev").is_empty());
+    assert!(!program(&programs, "ev").control.heartbeat);
+}

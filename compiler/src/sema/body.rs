@@ -1178,6 +1178,9 @@ impl<'a> Checker<'a> {
                     Some(ty) => types.push(ty),
                     None => all_known = false,
                 },
+                // Every robot may be given a counted group (its name is no
+                // type or capability to look up).
+                CondKind::Counted => {}
                 CondKind::CapableOf => {
                     let known = catalog.types().any(|(_, r)| r.has_capability(&name.name));
                     if known {
@@ -1218,6 +1221,7 @@ impl<'a> Checker<'a> {
                         .names
                         .iter()
                         .all(|c| catalog.get(ty).has_capability(&c.name)),
+                    CondKind::Counted => true,
                 }
             })
             .collect();
@@ -1225,6 +1229,38 @@ impl<'a> Checker<'a> {
     }
 
     fn group(&mut self, g: &'a ast::GroupStmt, scope: &Scope) {
+        // A condition that did not parse (reported by the parser) is empty.
+        let broken = |arm: &ast::GroupArm| {
+            arm.condition.kind == CondKind::Counted && arm.condition.names.is_empty()
+        };
+        let counted = |arm: &ast::GroupArm| arm.condition.counted_name().is_some();
+        if g.arms.iter().any(counted) {
+            let pure = g
+                .arms
+                .iter()
+                .all(|a| (counted(a) || broken(a)) && a.kind == ArmKind::Group);
+            if pure {
+                return self.counted_group(g, scope);
+            }
+            // Mixed: checked as the arms are written (a counted condition
+            // meets every robot), after saying what is wrong.
+            for arm in g.arms.iter().filter(|a| !broken(a)) {
+                let message = match (arm.kind, counted(arm)) {
+                    (ArmKind::Leader, true) => {
+                        "a `leader` arm takes `instance of` or `capable of`, not a count"
+                    }
+                    (ArmKind::Leader, false) => {
+                        "a `leader` arm cannot share a statement with counted groups: write the election in its own `[[ ... ]]`"
+                    }
+                    (ArmKind::Group, false) => {
+                        "a group by type or capability cannot share a statement with counted groups: split the robots first, then count them inside an arm"
+                    }
+                    (ArmKind::Group, true) => continue,
+                };
+                self.diagnostics
+                    .report(Code::CountedGroupMixed, arm.condition.span, message);
+            }
+        }
         // Per robot of the team, whether an earlier arm took it.
         let robot_count = scope.team.map_or(0, |t| self.team(t).robots.len());
         let mut taken = vec![false; robot_count];
@@ -1241,6 +1277,7 @@ impl<'a> Checker<'a> {
                 let what = match arm.condition.kind {
                     CondKind::InstanceOf => "is an instance of",
                     CondKind::CapableOf => "is capable of",
+                    CondKind::Counted => "may join",
                 };
                 let names: Vec<&str> = arm.condition.names.iter().map(|n| n.as_str()).collect();
                 self.diagnostics.report(
@@ -1257,7 +1294,8 @@ impl<'a> Checker<'a> {
                 .copied()
                 .filter(|r| is_taken(&taken, r))
                 .collect();
-            if arm.kind == ArmKind::Group && !overlap.is_empty() {
+            // A counted arm here is already an error (E043).
+            if arm.kind == ArmKind::Group && !overlap.is_empty() && !counted(arm) && !broken(arm) {
                 let names = self.robot_names(scope, &overlap);
                 self.diagnostics.report(
                     Code::AmbiguousGroup,
@@ -1311,6 +1349,125 @@ impl<'a> Checker<'a> {
                 );
             }
             let inner = self.narrowed(scope, rest);
+            let kind = ScopeKind::Others {
+                keyword: others.keyword_span,
+            };
+            self.record_scope(others.body.span, kind, &inner);
+            self.block(&others.body, &inner);
+        }
+    }
+
+    /// A statement of counted groups (`group(Name, min = N)` arms only): every
+    /// robot that runs the statement may be given any group at run time, so
+    /// each arm, and `others` (the spares beyond the minimums), is checked
+    /// against all of them. Names are unique in the statement; the minimums
+    /// are positive whole numbers whose sum the robots can meet.
+    fn counted_group(&mut self, g: &'a ast::GroupStmt, scope: &Scope) {
+        let checkable = scope.team.is_some() && !scope.robots.is_empty();
+        let mut first_named: Vec<(&str, Span)> = Vec::new();
+        let mut sum: u64 = 0;
+        let mut all_valid = true;
+        let mut over_at = None;
+        let robots = scope.robots.len() as u64;
+        for arm in &g.arms {
+            let cond = &arm.condition;
+            if let Some(name) = cond.counted_name() {
+                match first_named.iter().find(|(n, _)| *n == name.as_str()) {
+                    Some(&(_, first)) => {
+                        self.diagnostics
+                            .report(
+                                Code::DuplicateCountedGroup,
+                                name.span,
+                                format!("a second group named `{}` in this statement", name.name),
+                            )
+                            .relate(first, "first named here");
+                    }
+                    None => first_named.push((name.as_str(), name.span)),
+                }
+            }
+            if let (Some(team), Some(name), Some(min)) =
+                (scope.team, cond.counted_name(), &cond.min)
+            {
+                let symbol = Symbol::CountedGroup {
+                    team,
+                    name: name.name.clone(),
+                    min: min.count.value.unwrap_or(0),
+                    robots: robots as u32,
+                };
+                self.occurrence(name.span, symbol, true);
+            }
+            if let Some(min) = &cond.min {
+                match min.count.value {
+                    Some(n) if n > 0 => {
+                        sum += u64::from(n);
+                        if sum > robots && over_at.is_none() {
+                            over_at = Some(min.count.span);
+                        }
+                    }
+                    _ => {
+                        all_valid = false;
+                        self.diagnostics.report(
+                            Code::CountedGroupMin,
+                            min.count.span,
+                            "a group's `min` is a positive whole number of robots",
+                        );
+                    }
+                }
+            }
+            let inner = scope.clone();
+            let kind = ScopeKind::Arm {
+                kind: arm.kind,
+                condition: cond.span,
+            };
+            self.record_scope(arm.body.span, kind, &inner);
+            self.block(&arm.body, &inner);
+        }
+        let team = scope
+            .team
+            .map(|t| self.team(t).name.to_string())
+            .unwrap_or_default();
+        let mins: Vec<Span> = g
+            .arms
+            .iter()
+            .filter_map(|a| a.condition.min.as_ref().map(|m| m.count.span))
+            .collect();
+        if checkable && all_valid {
+            if let Some(at) = over_at {
+                let names = self.robot_names(scope, &scope.robots);
+                let diagnostic = self.diagnostics.report(
+                    Code::CountedGroupsTooLarge,
+                    at,
+                    format!(
+                        "the groups' minimums add up to {sum}, but only {robots} robot{} of team {team} run{} this statement ({names}): they can never all be met",
+                        if robots == 1 { "" } else { "s" },
+                        if robots == 1 { "s" } else { "" },
+                    ),
+                );
+                for &span in mins.iter().filter(|&&s| s != at) {
+                    diagnostic.relate(span, "a minimum counted in the sum");
+                }
+            } else if sum == robots
+                && g.others.is_none()
+                && let Some(&last) = mins.last()
+            {
+                self.diagnostics.report(
+                    Code::CountedGroupsNoSpare,
+                    last,
+                    format!(
+                        "the groups' minimums take all {robots} robots of team {team} that run this statement: a robot lost leaves a group short"
+                    ),
+                );
+            }
+        }
+        if let Some(others) = &g.others {
+            if checkable && all_valid && sum >= robots {
+                self.diagnostics.report(
+                    Code::EmptyOthers,
+                    others.keyword_span,
+                    "the groups' minimums take every robot: no robot is left to run `others`",
+                );
+            }
+            let inner = scope.clone();
             let kind = ScopeKind::Others {
                 keyword: others.keyword_span,
             };

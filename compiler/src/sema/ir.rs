@@ -280,6 +280,16 @@ pub enum Symbol {
     },
     /// A symbolic constant such as `colored_paper`.
     Constant(Name),
+    /// The name of a counted group, `group(Name, min = N)`, where it is
+    /// written (its only occurrence: a group is named in its statement
+    /// alone): `min` its minimum, `robots` how many robots run the
+    /// statement (any may be given the group at run time).
+    CountedGroup {
+        team: TeamId,
+        name: Name,
+        min: u32,
+        robots: u32,
+    },
 }
 
 /// A part of the file whose statements some robots run, as the checker saw it:

@@ -36,7 +36,7 @@ use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
 use crate::refine::{
     ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, RoleKind, SlotId,
-    SlotSource, StateKind,
+    SlotSource, StateKind, counted_allocation,
 };
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
@@ -362,6 +362,9 @@ struct Robot<'p> {
     sync_arrived: HashMap<(usize, usize), i64>,
     /// The last leader each `LeaderBranch` state saw, by (service, pc).
     leaders: HashMap<(usize, usize), usize>,
+    /// The group each `GroupAllocate` state last gave this robot, by
+    /// (service, pc): its index, or [`OTHERS`].
+    allocated: HashMap<(usize, usize), usize>,
     /// The last (rank, size) in the team's group this robot traced
     /// (`semo_group_set`); `None` before its first heartbeat.
     group: Option<(usize, usize)>,
@@ -551,6 +554,7 @@ impl<'p> Robot<'p> {
             sync_pass: HashMap::new(),
             sync_arrived: HashMap::new(),
             leaders: HashMap::new(),
+            allocated: HashMap::new(),
             group: None,
             tasks,
             has_receiver: m.has_receiver(),
@@ -1974,6 +1978,39 @@ impl<'p> Sim<'p> {
                     }
                 }
             }
+            StateKind::GroupAllocate {
+                members,
+                groups,
+                others_at,
+            } => {
+                // `group_of` in the generated C: the live members (this
+                // robot, or heard within three heartbeats since it joined).
+                let robot = &self.robots[r];
+                let me = program.self_peer;
+                let hb = m.heartbeat_ms;
+                let alive = |peer: usize| {
+                    peer == me || now - robot.heard.get(peer).seen.max(robot.started_at) <= 3 * hb
+                };
+                let live: Vec<usize> = members.iter().copied().filter(|&p| alive(p)).collect();
+                let position = live.iter().position(|&p| p == me).unwrap_or(0);
+                let mins: Vec<usize> = groups.iter().map(|g| g.min).collect();
+                let chosen = counted_allocation(&mins, others_at.is_some(), position);
+                let (key, name, at) = match (chosen, others_at) {
+                    (Some(k), _) => (k, groups[k].name.as_str(), groups[k].at.index()),
+                    (None, Some(at)) => (OTHERS, "others", at.index()),
+                    (None, None) => (OTHERS, "others", next),
+                };
+                let robot = &mut self.robots[r];
+                if robot.allocated.insert((service, pc), key) != Some(key) {
+                    let fields = vec![
+                        ("name", name.into()),
+                        ("alive", live.len().to_string().into()),
+                    ];
+                    self.emit(r, "allocated", fields);
+                }
+                self.region(r, i).pc = at;
+                Step::Next
+            }
             StateKind::GroupSync {
                 members,
                 point,
@@ -2278,6 +2315,10 @@ impl<'p> Sim<'p> {
         Some(leader == me)
     }
 }
+
+/// What a `GroupAllocate` state last gave a robot sent to `others` (no group
+/// has this index).
+const OTHERS: usize = usize::MAX;
 
 /// The last leader of an arm whose robot is fenced (`ELECT_FENCED` in the C):
 /// no peer has this index.

@@ -325,13 +325,37 @@ pub enum CondKind {
     InstanceOf,
     /// `capable of capability, ...`
     CapableOf,
+    /// `Name, min = N`: a counted group, its robots chosen at run time
+    /// (`names` holds the group's name alone; `min` its minimum).
+    Counted,
 }
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct GroupCond {
     pub kind: CondKind,
     pub names: Vec<Ident>,
+    /// `min = N` of a [`CondKind::Counted`] condition; `None` otherwise.
+    pub min: Option<GroupMin>,
     pub span: Span,
+}
+
+/// `min = N` in `group(Name, min = N)`: the fewest robots the group is given
+/// when enough are alive.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GroupMin {
+    /// The word `min` (a contextual word: elsewhere it is a plain name).
+    pub keyword_span: Span,
+    pub count: Count,
+}
+
+impl GroupCond {
+    /// The counted group's name (`group(Name, min = N)`).
+    pub fn counted_name(&self) -> Option<&Ident> {
+        match self.kind {
+            CondKind::Counted => self.names.first(),
+            _ => None,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -507,6 +507,50 @@ mod tests {
     }
 
     #[test]
+    fn a_counted_group_keeps_its_name_and_min_positioned() {
+        let text = "T.A.S { [[ group(Room1, min = 2) { x() } others { y() } ]] } repeat()";
+        let p = parse(FileId(0), text);
+        assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);
+        let ast::Item::Service(service) = &p.file.items[0] else {
+            panic!("{:?}", p.file.items)
+        };
+        let ast::StmtKind::Group(g) = &service.body.stmts[0].kind else {
+            panic!("{:?}", service.body.stmts)
+        };
+        let cond = &g.arms[0].condition;
+        assert_eq!(cond.kind, ast::CondKind::Counted);
+        let name = cond.counted_name().unwrap();
+        assert_eq!((name.as_str(), name.span), ("Room1", Span::new(17, 22)));
+        let min = cond.min.as_ref().unwrap();
+        assert_eq!(min.keyword_span, Span::new(24, 27));
+        assert_eq!(min.count.value, Some(2));
+        assert_eq!(min.count.span, Span::new(30, 31));
+        assert!(g.others.is_some());
+        // `min` is a word only there: elsewhere it is a plain name.
+        let p = parse(FileId(0), "T.A.S { min(1) } repeat()");
+        assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);
+    }
+
+    #[test]
+    fn a_counted_group_without_min_is_a_positioned_syntax_error_and_the_next_line_parses() {
+        let text = "T.A.S { [[ group(Room1, 2) { x() } ]]\n throw go } repeat()";
+        let p = parse(FileId(0), text);
+        assert_eq!(p.diagnostics.len(), 1, "{:?}", p.diagnostics);
+        assert_eq!(p.diagnostics[0].code, Code::SyntaxError);
+        assert_eq!(p.diagnostics[0].span, Span::new(24, 25));
+        let ast::Item::Service(service) = &p.file.items[0] else {
+            panic!("{:?}", p.file.items)
+        };
+        assert!(
+            service.body.stmts.iter().any(
+                |s| matches!(&s.kind, ast::StmtKind::Throw(t) if t.event.name.as_str() == "go")
+            ),
+            "{:?}",
+            service.body.stmts
+        );
+    }
+
+    #[test]
     fn a_standalone_expression_is_positioned_from_its_base() {
         let p = parse_expr(FileId(2), "distance > 20 and not stop", 100);
         assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);

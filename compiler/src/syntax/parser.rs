@@ -378,15 +378,51 @@ where
             .then(kw(Kw::Of))
             .to(CondKind::InstanceOf)
             .or(kw(Kw::Capable).then(kw(Kw::Of)).to(CondKind::CapableOf));
-        let group_cond = cond_kind
+        let typed_cond = cond_kind
             .then(names)
             .map_with(|(kind, names), e| GroupCond {
                 kind,
                 names,
+                min: None,
                 span: sp(e.span()),
-            })
+            });
+        // `Room1, min = 2`: `min` is a word only here, not a keyword.
+        let min_word = select! { Token::Ident("min") = e => sp(e.span()) }.labelled("`min`");
+        let min_count =
+            select! { Token::Number(n) = e => Count { value: count_value(n), span: sp(e.span()) } }
+                .labelled("a whole number");
+        let counted_cond = name()
+            .then_ignore(tok(Token::Comma))
+            .then(min_word)
+            .then_ignore(tok(Token::Assign))
+            .then(min_count)
+            .map_with(|((name, keyword_span), count), e| GroupCond {
+                kind: CondKind::Counted,
+                names: vec![name],
+                min: Some(GroupMin {
+                    keyword_span,
+                    count,
+                }),
+                span: sp(e.span()),
+            });
+        let group_cond = typed_cond
+            .or(counted_cond)
             .delimited_by(tok(Token::LParen), tok(Token::RParen))
-            .labelled("`instance of ...` or `capable of ...`");
+            .labelled("`instance of ...`, `capable of ...` or `Name, min = N`")
+            // A condition that does not parse is reported where it goes
+            // wrong, and the arm's block is still parsed: an empty counted
+            // condition (no name, no min) checks nothing more.
+            .recover_with(via_parser(nested_delimiters(
+                Token::LParen,
+                Token::RParen,
+                [(Token::GroupOpen, Token::GroupClose)],
+                |span| GroupCond {
+                    kind: CondKind::Counted,
+                    names: Vec::new(),
+                    min: None,
+                    span: sp(span),
+                },
+            )));
         let arm_kind = kw(Kw::Leader)
             .map(|s| (ArmKind::Leader, sp(s)))
             .or(kw(Kw::Group).map(|s| (ArmKind::Group, sp(s))));

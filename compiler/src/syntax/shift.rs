@@ -410,10 +410,23 @@ impl Shift for GroupCond {
         let GroupCond {
             kind: _,
             names,
+            min,
             span,
         } = self;
         names.shift(delta);
+        min.shift(delta);
         span.shift(delta);
+    }
+}
+
+impl Shift for GroupMin {
+    fn shift(&mut self, delta: isize) {
+        let GroupMin {
+            keyword_span,
+            count,
+        } = self;
+        keyword_span.shift(delta);
+        count.shift(delta);
     }
 }
 

@@ -51,6 +51,7 @@
   "instance"
   "capable"
   "of"
+  "min"
 ] @keyword
 
 [
@@ -155,6 +156,9 @@
 
 (capable_of
   capability: (identifier) @attribute)
+
+(counted_group
+  name: (identifier) @label)
 
 ; `Team.VALUE`: a value (of the team named first); a bare `VALUE` is the robot's own.
 (attribute

@@ -7,16 +7,16 @@
 #endif
 
 #define LANGUAGE_VERSION 14
-#define STATE_COUNT 196
+#define STATE_COUNT 201
 #define LARGE_STATE_COUNT 2
-#define SYMBOL_COUNT 122
+#define SYMBOL_COUNT 124
 #define ALIAS_COUNT 0
-#define TOKEN_COUNT 59
+#define TOKEN_COUNT 60
 #define EXTERNAL_TOKEN_COUNT 0
-#define FIELD_COUNT 26
+#define FIELD_COUNT 27
 #define MAX_ALIAS_SEQUENCE_LENGTH 9
 #define MAX_RESERVED_WORD_SET_SIZE 0
-#define PRODUCTION_ID_COUNT 39
+#define PRODUCTION_ID_COUNT 40
 #define SUPERTYPE_COUNT 0
 
 enum ts_symbol_identifiers {
@@ -59,88 +59,90 @@ enum ts_symbol_identifiers {
   anon_sym_instance = 37,
   anon_sym_of = 38,
   anon_sym_capable = 39,
-  anon_sym_timeout = 40,
-  anon_sym_or = 41,
-  anon_sym_PIPE_PIPE = 42,
-  anon_sym_and = 43,
-  anon_sym_AMP_AMP = 44,
-  anon_sym_not = 45,
-  anon_sym_BANG = 46,
-  anon_sym_EQ_EQ = 47,
-  anon_sym_BANG_EQ = 48,
-  anon_sym_LT = 49,
-  anon_sym_LT_EQ = 50,
-  anon_sym_GT = 51,
-  anon_sym_GT_EQ = 52,
-  anon_sym_true = 53,
-  anon_sym_false = 54,
-  sym_time_unit = 55,
-  sym_number = 56,
-  sym_string = 57,
-  sym_comment = 58,
-  sym_source_file = 59,
-  sym__item = 60,
-  sym_formation = 61,
-  sym_team_declaration = 62,
-  sym_robot_declaration = 63,
-  sym_service_definition = 64,
-  sym_repeat_clause = 65,
-  sym_function_definition = 66,
-  sym_mode_definition = 67,
-  sym_mode_body = 68,
-  sym_set_statement = 69,
-  sym_main_definition = 70,
-  sym_main_body = 71,
-  sym_case_clause = 72,
-  sym_catch_clause = 73,
-  sym_default_clause = 74,
-  sym_mode_assignment = 75,
-  sym_block = 76,
-  sym__body = 77,
-  sym__statement = 78,
-  sym_if_statement = 79,
-  sym_loop_statement = 80,
-  sym__period_and_condition = 81,
-  sym_throw_statement = 82,
-  sym_call = 83,
-  sym_arguments = 84,
-  sym_communication = 85,
-  sym_message = 86,
-  sym_group_statement = 87,
-  sym_group_arm = 88,
-  sym_leader_arm = 89,
-  sym_others_arm = 90,
-  sym__group_condition = 91,
-  sym_instance_of = 92,
-  sym_capable_of = 93,
-  sym_timeout = 94,
-  sym__expression = 95,
-  sym_or_expression = 96,
-  sym__and_level = 97,
-  sym_and_expression = 98,
-  sym__not_level = 99,
-  sym_not_expression = 100,
-  sym__comparison_level = 101,
-  sym_comparison = 102,
-  sym__primary = 103,
-  sym_parenthesized_expression = 104,
-  sym_attribute = 105,
-  sym_boolean = 106,
-  sym_period = 107,
-  aux_sym_source_file_repeat1 = 108,
-  aux_sym_formation_repeat1 = 109,
-  aux_sym_team_declaration_repeat1 = 110,
-  aux_sym_team_declaration_repeat2 = 111,
-  aux_sym_mode_body_repeat1 = 112,
-  aux_sym_main_body_repeat1 = 113,
-  aux_sym_case_clause_repeat1 = 114,
-  aux_sym_block_repeat1 = 115,
-  aux_sym_arguments_repeat1 = 116,
-  aux_sym_communication_repeat1 = 117,
-  aux_sym_group_statement_repeat1 = 118,
-  aux_sym_instance_of_repeat1 = 119,
-  aux_sym_capable_of_repeat1 = 120,
-  aux_sym_attribute_repeat1 = 121,
+  anon_sym_min = 40,
+  anon_sym_timeout = 41,
+  anon_sym_or = 42,
+  anon_sym_PIPE_PIPE = 43,
+  anon_sym_and = 44,
+  anon_sym_AMP_AMP = 45,
+  anon_sym_not = 46,
+  anon_sym_BANG = 47,
+  anon_sym_EQ_EQ = 48,
+  anon_sym_BANG_EQ = 49,
+  anon_sym_LT = 50,
+  anon_sym_LT_EQ = 51,
+  anon_sym_GT = 52,
+  anon_sym_GT_EQ = 53,
+  anon_sym_true = 54,
+  anon_sym_false = 55,
+  sym_time_unit = 56,
+  sym_number = 57,
+  sym_string = 58,
+  sym_comment = 59,
+  sym_source_file = 60,
+  sym__item = 61,
+  sym_formation = 62,
+  sym_team_declaration = 63,
+  sym_robot_declaration = 64,
+  sym_service_definition = 65,
+  sym_repeat_clause = 66,
+  sym_function_definition = 67,
+  sym_mode_definition = 68,
+  sym_mode_body = 69,
+  sym_set_statement = 70,
+  sym_main_definition = 71,
+  sym_main_body = 72,
+  sym_case_clause = 73,
+  sym_catch_clause = 74,
+  sym_default_clause = 75,
+  sym_mode_assignment = 76,
+  sym_block = 77,
+  sym__body = 78,
+  sym__statement = 79,
+  sym_if_statement = 80,
+  sym_loop_statement = 81,
+  sym__period_and_condition = 82,
+  sym_throw_statement = 83,
+  sym_call = 84,
+  sym_arguments = 85,
+  sym_communication = 86,
+  sym_message = 87,
+  sym_group_statement = 88,
+  sym_group_arm = 89,
+  sym_leader_arm = 90,
+  sym_others_arm = 91,
+  sym__group_condition = 92,
+  sym_instance_of = 93,
+  sym_capable_of = 94,
+  sym_counted_group = 95,
+  sym_timeout = 96,
+  sym__expression = 97,
+  sym_or_expression = 98,
+  sym__and_level = 99,
+  sym_and_expression = 100,
+  sym__not_level = 101,
+  sym_not_expression = 102,
+  sym__comparison_level = 103,
+  sym_comparison = 104,
+  sym__primary = 105,
+  sym_parenthesized_expression = 106,
+  sym_attribute = 107,
+  sym_boolean = 108,
+  sym_period = 109,
+  aux_sym_source_file_repeat1 = 110,
+  aux_sym_formation_repeat1 = 111,
+  aux_sym_team_declaration_repeat1 = 112,
+  aux_sym_team_declaration_repeat2 = 113,
+  aux_sym_mode_body_repeat1 = 114,
+  aux_sym_main_body_repeat1 = 115,
+  aux_sym_case_clause_repeat1 = 116,
+  aux_sym_block_repeat1 = 117,
+  aux_sym_arguments_repeat1 = 118,
+  aux_sym_communication_repeat1 = 119,
+  aux_sym_group_statement_repeat1 = 120,
+  aux_sym_instance_of_repeat1 = 121,
+  aux_sym_capable_of_repeat1 = 122,
+  aux_sym_attribute_repeat1 = 123,
 };
 
 static const char * const ts_symbol_names[] = {
@@ -184,6 +186,7 @@ static const char * const ts_symbol_names[] = {
   [anon_sym_instance] = "instance",
   [anon_sym_of] = "of",
   [anon_sym_capable] = "capable",
+  [anon_sym_min] = "min",
   [anon_sym_timeout] = "timeout",
   [anon_sym_or] = "or",
   [anon_sym_PIPE_PIPE] = "||",
@@ -238,6 +241,7 @@ static const char * const ts_symbol_names[] = {
   [sym__group_condition] = "_group_condition",
   [sym_instance_of] = "instance_of",
   [sym_capable_of] = "capable_of",
+  [sym_counted_group] = "counted_group",
   [sym_timeout] = "timeout",
   [sym__expression] = "_expression",
   [sym_or_expression] = "or_expression",
@@ -309,6 +313,7 @@ static const TSSymbol ts_symbol_map[] = {
   [anon_sym_instance] = anon_sym_instance,
   [anon_sym_of] = anon_sym_of,
   [anon_sym_capable] = anon_sym_capable,
+  [anon_sym_min] = anon_sym_min,
   [anon_sym_timeout] = anon_sym_timeout,
   [anon_sym_or] = anon_sym_or,
   [anon_sym_PIPE_PIPE] = anon_sym_PIPE_PIPE,
@@ -363,6 +368,7 @@ static const TSSymbol ts_symbol_map[] = {
   [sym__group_condition] = sym__group_condition,
   [sym_instance_of] = sym_instance_of,
   [sym_capable_of] = sym_capable_of,
+  [sym_counted_group] = sym_counted_group,
   [sym_timeout] = sym_timeout,
   [sym__expression] = sym__expression,
   [sym_or_expression] = sym_or_expression,
@@ -551,6 +557,10 @@ static const TSSymbolMetadata ts_symbol_metadata[] = {
     .named = false,
   },
   [anon_sym_capable] = {
+    .visible = true,
+    .named = false,
+  },
+  [anon_sym_min] = {
     .visible = true,
     .named = false,
   },
@@ -770,6 +780,10 @@ static const TSSymbolMetadata ts_symbol_metadata[] = {
     .visible = true,
     .named = true,
   },
+  [sym_counted_group] = {
+    .visible = true,
+    .named = true,
+  },
   [sym_timeout] = {
     .visible = true,
     .named = true,
@@ -898,19 +912,20 @@ enum ts_field_identifiers {
   field_function = 11,
   field_kind = 12,
   field_left = 13,
-  field_mode = 14,
-  field_name = 15,
-  field_operand = 16,
-  field_operator = 17,
-  field_period = 18,
-  field_plan = 19,
-  field_repeat = 20,
-  field_right = 21,
-  field_service = 22,
-  field_team = 23,
-  field_type = 24,
-  field_unit = 25,
-  field_value = 26,
+  field_min = 14,
+  field_mode = 15,
+  field_name = 16,
+  field_operand = 17,
+  field_operator = 18,
+  field_period = 19,
+  field_plan = 20,
+  field_repeat = 21,
+  field_right = 22,
+  field_service = 23,
+  field_team = 24,
+  field_type = 25,
+  field_unit = 26,
+  field_value = 27,
 };
 
 static const char * const ts_field_names[] = {
@@ -928,6 +943,7 @@ static const char * const ts_field_names[] = {
   [field_function] = "function",
   [field_kind] = "kind",
   [field_left] = "left",
+  [field_min] = "min",
   [field_mode] = "mode",
   [field_name] = "name",
   [field_operand] = "operand",
@@ -981,7 +997,8 @@ static const TSMapSlice ts_field_map_slices[PRODUCTION_ID_COUNT] = {
   [35] = {.index = 67, .length = 2},
   [36] = {.index = 69, .length = 1},
   [37] = {.index = 70, .length = 2},
-  [38] = {.index = 72, .length = 1},
+  [38] = {.index = 72, .length = 2},
+  [39] = {.index = 74, .length = 1},
 };
 
 static const TSFieldMapEntry ts_field_map_entries[] = {
@@ -1095,6 +1112,9 @@ static const TSFieldMapEntry ts_field_map_entries[] = {
     {field_capability, 0, .inherited = true},
     {field_capability, 1, .inherited = true},
   [72] =
+    {field_min, 4},
+    {field_name, 0},
+  [74] =
     {field_event, 2},
 };
 
@@ -1174,8 +1194,8 @@ static const TSStateId ts_primary_state_ids[STATE_COUNT] = {
   [64] = 64,
   [65] = 65,
   [66] = 66,
-  [67] = 61,
-  [68] = 68,
+  [67] = 67,
+  [68] = 64,
   [69] = 69,
   [70] = 70,
   [71] = 71,
@@ -1303,6 +1323,11 @@ static const TSStateId ts_primary_state_ids[STATE_COUNT] = {
   [193] = 193,
   [194] = 194,
   [195] = 195,
+  [196] = 196,
+  [197] = 197,
+  [198] = 198,
+  [199] = 199,
+  [200] = 200,
 };
 
 static bool ts_lex(TSLexer *lexer, TSStateId state) {
@@ -1310,288 +1335,438 @@ static bool ts_lex(TSLexer *lexer, TSStateId state) {
   eof = lexer->eof(lexer);
   switch (state) {
     case 0:
-      if (eof) ADVANCE(16);
+      if (eof) ADVANCE(25);
       ADVANCE_MAP(
-        '!', 37,
-        '"', 3,
-        '#', 49,
-        '&', 4,
-        '(', 27,
-        ')', 28,
-        ',', 21,
-        '-', 11,
-        '.', 26,
-        ':', 20,
-        ';', 17,
-        '<', 40,
-        '=', 30,
-        '>', 42,
-        '[', 23,
-        ']', 25,
-        '{', 18,
-        '|', 9,
-        '}', 19,
+        '!', 46,
+        '"', 4,
+        '#', 67,
+        '&', 6,
+        '(', 36,
+        ')', 37,
+        ',', 30,
+        '-', 20,
+        '.', 35,
+        ':', 29,
+        ';', 26,
+        '<', 49,
+        '=', 39,
+        '>', 51,
+        '[', 32,
+        ']', 34,
+        '{', 27,
+        '|', 11,
+        '}', 28,
+        'H', 62,
+        'h', 62,
+        'M', 60,
+        'm', 60,
+        'S', 59,
+        's', 59,
       );
       if (('\t' <= lookahead && lookahead <= '\r') ||
           lookahead == ' ') SKIP(0);
-      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(44);
+      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(55);
       if (('A' <= lookahead && lookahead <= 'Z') ||
           lookahead == '_' ||
-          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(48);
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
       END_STATE();
     case 1:
       ADVANCE_MAP(
-        '!', 5,
-        '#', 49,
-        '&', 4,
-        ')', 28,
-        ',', 21,
-        '.', 26,
-        '<', 40,
-        '=', 30,
-        '>', 42,
-        '|', 9,
+        '!', 7,
+        '#', 67,
+        '&', 6,
+        ')', 37,
+        ',', 30,
+        '.', 35,
+        '<', 49,
+        '=', 39,
+        '>', 51,
+        '|', 11,
       );
       if (('\t' <= lookahead && lookahead <= '\r') ||
           lookahead == ' ') SKIP(1);
       if (('A' <= lookahead && lookahead <= 'Z') ||
           lookahead == '_' ||
-          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(48);
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
       END_STATE();
     case 2:
       ADVANCE_MAP(
-        '!', 36,
-        '"', 3,
-        '#', 49,
-        '(', 27,
-        ')', 28,
-        ',', 21,
-        '-', 11,
-        '=', 29,
-        ']', 24,
+        '!', 7,
+        '#', 67,
+        '&', 6,
+        ')', 37,
+        ',', 30,
+        '<', 49,
+        '=', 8,
+        '>', 51,
+        '|', 11,
+        'H', 62,
+        'h', 62,
+        'M', 60,
+        'm', 60,
+        'S', 59,
+        's', 59,
       );
       if (('\t' <= lookahead && lookahead <= '\r') ||
           lookahead == ' ') SKIP(2);
-      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(44);
       if (('A' <= lookahead && lookahead <= 'Z') ||
           lookahead == '_' ||
-          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(47);
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
       END_STATE();
     case 3:
-      if (lookahead == '"') ADVANCE(46);
-      if (lookahead == '\\') ADVANCE(13);
-      if (lookahead != 0 &&
-          lookahead != '\n') ADVANCE(3);
+      ADVANCE_MAP(
+        '!', 45,
+        '"', 4,
+        '#', 67,
+        '(', 36,
+        ')', 37,
+        ',', 30,
+        '-', 20,
+        '=', 38,
+        ']', 33,
+      );
+      if (('\t' <= lookahead && lookahead <= '\r') ||
+          lookahead == ' ') SKIP(3);
+      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(55);
+      if (('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(65);
       END_STATE();
     case 4:
-      if (lookahead == '&') ADVANCE(35);
+      if (lookahead == '"') ADVANCE(57);
+      if (lookahead == '\\') ADVANCE(22);
+      if (lookahead != 0 &&
+          lookahead != '\n') ADVANCE(4);
       END_STATE();
     case 5:
-      if (lookahead == '=') ADVANCE(39);
+      if (lookahead == '#') ADVANCE(67);
+      if (lookahead == 'H' ||
+          lookahead == 'h') ADVANCE(16);
+      if (lookahead == 'M' ||
+          lookahead == 'm') ADVANCE(14);
+      if (lookahead == 'S' ||
+          lookahead == 's') ADVANCE(13);
+      if (('\t' <= lookahead && lookahead <= '\r') ||
+          lookahead == ' ') SKIP(5);
       END_STATE();
     case 6:
-      if (lookahead == '=') ADVANCE(38);
+      if (lookahead == '&') ADVANCE(44);
       END_STATE();
     case 7:
-      if (lookahead == '[') ADVANCE(32);
+      if (lookahead == '=') ADVANCE(48);
       END_STATE();
     case 8:
-      if (lookahead == ']') ADVANCE(33);
+      if (lookahead == '=') ADVANCE(47);
       END_STATE();
     case 9:
-      if (lookahead == '|') ADVANCE(34);
+      if (lookahead == '[') ADVANCE(41);
       END_STATE();
     case 10:
-      if (('\t' <= lookahead && lookahead <= '\r') ||
-          lookahead == ' ') ADVANCE(10);
-      if (('A' <= lookahead && lookahead <= 'Z') ||
-          lookahead == '_' ||
-          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(31);
+      if (lookahead == ']') ADVANCE(42);
       END_STATE();
     case 11:
-      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(44);
+      if (lookahead == '|') ADVANCE(43);
       END_STATE();
     case 12:
-      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(45);
+      if (lookahead == 'C' ||
+          lookahead == 'c') ADVANCE(53);
       END_STATE();
     case 13:
-      if (lookahead != 0 &&
-          lookahead != '\n') ADVANCE(3);
+      if (lookahead == 'E' ||
+          lookahead == 'e') ADVANCE(12);
       END_STATE();
     case 14:
-      if (eof) ADVANCE(16);
-      ADVANCE_MAP(
-        '!', 5,
-        '#', 49,
-        '&', 4,
-        ')', 28,
-        ',', 21,
-        ';', 17,
-        '<', 40,
-        '=', 6,
-        '>', 42,
-        '[', 7,
-        ']', 8,
-        '{', 18,
-        '|', 9,
-        '}', 19,
-      );
-      if (('\t' <= lookahead && lookahead <= '\r') ||
-          lookahead == ' ') SKIP(14);
-      if (('A' <= lookahead && lookahead <= 'Z') ||
-          lookahead == '_' ||
-          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(48);
+      if (lookahead == 'I' ||
+          lookahead == 'i') ADVANCE(15);
+      if (lookahead == 'S' ||
+          lookahead == 's') ADVANCE(13);
       END_STATE();
     case 15:
-      if (eof) ADVANCE(16);
-      ADVANCE_MAP(
-        '!', 36,
-        '"', 3,
-        '#', 49,
-        '(', 27,
-        ')', 28,
-        ',', 21,
-        '-', 11,
-        ';', 17,
-        '[', 22,
-        '{', 18,
-        '}', 19,
-      );
-      if (('\t' <= lookahead && lookahead <= '\r') ||
-          lookahead == ' ') SKIP(15);
-      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(44);
-      if (('A' <= lookahead && lookahead <= 'Z') ||
-          lookahead == '_' ||
-          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(48);
+      if (lookahead == 'N' ||
+          lookahead == 'n') ADVANCE(53);
       END_STATE();
     case 16:
-      ACCEPT_TOKEN(ts_builtin_sym_end);
+      if (lookahead == 'O' ||
+          lookahead == 'o') ADVANCE(18);
       END_STATE();
     case 17:
-      ACCEPT_TOKEN(anon_sym_SEMI);
+      if (lookahead == 'R' ||
+          lookahead == 'r') ADVANCE(53);
       END_STATE();
     case 18:
-      ACCEPT_TOKEN(anon_sym_LBRACE);
+      if (lookahead == 'U' ||
+          lookahead == 'u') ADVANCE(17);
       END_STATE();
     case 19:
-      ACCEPT_TOKEN(anon_sym_RBRACE);
+      if (('\t' <= lookahead && lookahead <= '\r') ||
+          lookahead == ' ') ADVANCE(19);
+      if (('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(40);
       END_STATE();
     case 20:
-      ACCEPT_TOKEN(anon_sym_COLON);
+      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(55);
       END_STATE();
     case 21:
-      ACCEPT_TOKEN(anon_sym_COMMA);
+      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(56);
       END_STATE();
     case 22:
-      ACCEPT_TOKEN(anon_sym_LBRACK);
+      if (lookahead != 0 &&
+          lookahead != '\n') ADVANCE(4);
       END_STATE();
     case 23:
-      ACCEPT_TOKEN(anon_sym_LBRACK);
-      if (lookahead == '[') ADVANCE(32);
+      if (eof) ADVANCE(25);
+      ADVANCE_MAP(
+        '!', 7,
+        '"', 4,
+        '#', 67,
+        '&', 6,
+        '(', 36,
+        ')', 37,
+        ',', 30,
+        '-', 20,
+        ';', 26,
+        '<', 49,
+        '=', 8,
+        '>', 51,
+        '[', 9,
+        ']', 10,
+        '{', 27,
+        '|', 11,
+        '}', 28,
+      );
+      if (('\t' <= lookahead && lookahead <= '\r') ||
+          lookahead == ' ') SKIP(23);
+      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(55);
+      if (('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
       END_STATE();
     case 24:
-      ACCEPT_TOKEN(anon_sym_RBRACK);
+      if (eof) ADVANCE(25);
+      ADVANCE_MAP(
+        '!', 45,
+        '"', 4,
+        '#', 67,
+        '(', 36,
+        ')', 37,
+        ',', 30,
+        '-', 20,
+        ';', 26,
+        '[', 31,
+        '{', 27,
+        '}', 28,
+      );
+      if (('\t' <= lookahead && lookahead <= '\r') ||
+          lookahead == ' ') SKIP(24);
+      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(55);
+      if (('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
       END_STATE();
     case 25:
-      ACCEPT_TOKEN(anon_sym_RBRACK);
-      if (lookahead == ']') ADVANCE(33);
+      ACCEPT_TOKEN(ts_builtin_sym_end);
       END_STATE();
     case 26:
-      ACCEPT_TOKEN(anon_sym_DOT);
+      ACCEPT_TOKEN(anon_sym_SEMI);
       END_STATE();
     case 27:
-      ACCEPT_TOKEN(anon_sym_LPAREN);
+      ACCEPT_TOKEN(anon_sym_LBRACE);
       END_STATE();
     case 28:
-      ACCEPT_TOKEN(anon_sym_RPAREN);
+      ACCEPT_TOKEN(anon_sym_RBRACE);
       END_STATE();
     case 29:
-      ACCEPT_TOKEN(anon_sym_EQ);
+      ACCEPT_TOKEN(anon_sym_COLON);
       END_STATE();
     case 30:
-      ACCEPT_TOKEN(anon_sym_EQ);
-      if (lookahead == '=') ADVANCE(38);
+      ACCEPT_TOKEN(anon_sym_COMMA);
       END_STATE();
     case 31:
-      ACCEPT_TOKEN(sym_words);
-      if (('\t' <= lookahead && lookahead <= '\r') ||
-          lookahead == ' ') ADVANCE(10);
-      if (('0' <= lookahead && lookahead <= '9') ||
-          ('A' <= lookahead && lookahead <= 'Z') ||
-          lookahead == '_' ||
-          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(31);
+      ACCEPT_TOKEN(anon_sym_LBRACK);
       END_STATE();
     case 32:
-      ACCEPT_TOKEN(anon_sym_LBRACK_LBRACK);
+      ACCEPT_TOKEN(anon_sym_LBRACK);
+      if (lookahead == '[') ADVANCE(41);
       END_STATE();
     case 33:
-      ACCEPT_TOKEN(anon_sym_RBRACK_RBRACK);
+      ACCEPT_TOKEN(anon_sym_RBRACK);
       END_STATE();
     case 34:
-      ACCEPT_TOKEN(anon_sym_PIPE_PIPE);
+      ACCEPT_TOKEN(anon_sym_RBRACK);
+      if (lookahead == ']') ADVANCE(42);
       END_STATE();
     case 35:
-      ACCEPT_TOKEN(anon_sym_AMP_AMP);
+      ACCEPT_TOKEN(anon_sym_DOT);
       END_STATE();
     case 36:
-      ACCEPT_TOKEN(anon_sym_BANG);
+      ACCEPT_TOKEN(anon_sym_LPAREN);
       END_STATE();
     case 37:
-      ACCEPT_TOKEN(anon_sym_BANG);
-      if (lookahead == '=') ADVANCE(39);
+      ACCEPT_TOKEN(anon_sym_RPAREN);
       END_STATE();
     case 38:
-      ACCEPT_TOKEN(anon_sym_EQ_EQ);
+      ACCEPT_TOKEN(anon_sym_EQ);
       END_STATE();
     case 39:
-      ACCEPT_TOKEN(anon_sym_BANG_EQ);
+      ACCEPT_TOKEN(anon_sym_EQ);
+      if (lookahead == '=') ADVANCE(47);
       END_STATE();
     case 40:
-      ACCEPT_TOKEN(anon_sym_LT);
-      if (lookahead == '=') ADVANCE(41);
+      ACCEPT_TOKEN(sym_words);
+      if (('\t' <= lookahead && lookahead <= '\r') ||
+          lookahead == ' ') ADVANCE(19);
+      if (('0' <= lookahead && lookahead <= '9') ||
+          ('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(40);
       END_STATE();
     case 41:
-      ACCEPT_TOKEN(anon_sym_LT_EQ);
+      ACCEPT_TOKEN(anon_sym_LBRACK_LBRACK);
       END_STATE();
     case 42:
-      ACCEPT_TOKEN(anon_sym_GT);
-      if (lookahead == '=') ADVANCE(43);
+      ACCEPT_TOKEN(anon_sym_RBRACK_RBRACK);
       END_STATE();
     case 43:
-      ACCEPT_TOKEN(anon_sym_GT_EQ);
+      ACCEPT_TOKEN(anon_sym_PIPE_PIPE);
       END_STATE();
     case 44:
-      ACCEPT_TOKEN(sym_number);
-      if (lookahead == '.') ADVANCE(12);
-      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(44);
+      ACCEPT_TOKEN(anon_sym_AMP_AMP);
       END_STATE();
     case 45:
-      ACCEPT_TOKEN(sym_number);
-      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(45);
+      ACCEPT_TOKEN(anon_sym_BANG);
       END_STATE();
     case 46:
-      ACCEPT_TOKEN(sym_string);
+      ACCEPT_TOKEN(anon_sym_BANG);
+      if (lookahead == '=') ADVANCE(48);
       END_STATE();
     case 47:
-      ACCEPT_TOKEN(sym_identifier);
-      if (('\t' <= lookahead && lookahead <= '\r') ||
-          lookahead == ' ') ADVANCE(10);
-      if (('0' <= lookahead && lookahead <= '9') ||
-          ('A' <= lookahead && lookahead <= 'Z') ||
-          lookahead == '_' ||
-          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(47);
+      ACCEPT_TOKEN(anon_sym_EQ_EQ);
       END_STATE();
     case 48:
+      ACCEPT_TOKEN(anon_sym_BANG_EQ);
+      END_STATE();
+    case 49:
+      ACCEPT_TOKEN(anon_sym_LT);
+      if (lookahead == '=') ADVANCE(50);
+      END_STATE();
+    case 50:
+      ACCEPT_TOKEN(anon_sym_LT_EQ);
+      END_STATE();
+    case 51:
+      ACCEPT_TOKEN(anon_sym_GT);
+      if (lookahead == '=') ADVANCE(52);
+      END_STATE();
+    case 52:
+      ACCEPT_TOKEN(anon_sym_GT_EQ);
+      END_STATE();
+    case 53:
+      ACCEPT_TOKEN(sym_time_unit);
+      END_STATE();
+    case 54:
+      ACCEPT_TOKEN(sym_time_unit);
+      if (('0' <= lookahead && lookahead <= '9') ||
+          ('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
+      END_STATE();
+    case 55:
+      ACCEPT_TOKEN(sym_number);
+      if (lookahead == '.') ADVANCE(21);
+      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(55);
+      END_STATE();
+    case 56:
+      ACCEPT_TOKEN(sym_number);
+      if (('0' <= lookahead && lookahead <= '9')) ADVANCE(56);
+      END_STATE();
+    case 57:
+      ACCEPT_TOKEN(sym_string);
+      END_STATE();
+    case 58:
+      ACCEPT_TOKEN(sym_identifier);
+      if (lookahead == 'C' ||
+          lookahead == 'c') ADVANCE(54);
+      if (('0' <= lookahead && lookahead <= '9') ||
+          ('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
+      END_STATE();
+    case 59:
+      ACCEPT_TOKEN(sym_identifier);
+      if (lookahead == 'E' ||
+          lookahead == 'e') ADVANCE(58);
+      if (('0' <= lookahead && lookahead <= '9') ||
+          ('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
+      END_STATE();
+    case 60:
+      ACCEPT_TOKEN(sym_identifier);
+      if (lookahead == 'I' ||
+          lookahead == 'i') ADVANCE(61);
+      if (lookahead == 'S' ||
+          lookahead == 's') ADVANCE(59);
+      if (('0' <= lookahead && lookahead <= '9') ||
+          ('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
+      END_STATE();
+    case 61:
+      ACCEPT_TOKEN(sym_identifier);
+      if (lookahead == 'N' ||
+          lookahead == 'n') ADVANCE(54);
+      if (('0' <= lookahead && lookahead <= '9') ||
+          ('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
+      END_STATE();
+    case 62:
+      ACCEPT_TOKEN(sym_identifier);
+      if (lookahead == 'O' ||
+          lookahead == 'o') ADVANCE(64);
+      if (('0' <= lookahead && lookahead <= '9') ||
+          ('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
+      END_STATE();
+    case 63:
+      ACCEPT_TOKEN(sym_identifier);
+      if (lookahead == 'R' ||
+          lookahead == 'r') ADVANCE(54);
+      if (('0' <= lookahead && lookahead <= '9') ||
+          ('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
+      END_STATE();
+    case 64:
+      ACCEPT_TOKEN(sym_identifier);
+      if (lookahead == 'U' ||
+          lookahead == 'u') ADVANCE(63);
+      if (('0' <= lookahead && lookahead <= '9') ||
+          ('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
+      END_STATE();
+    case 65:
+      ACCEPT_TOKEN(sym_identifier);
+      if (('\t' <= lookahead && lookahead <= '\r') ||
+          lookahead == ' ') ADVANCE(19);
+      if (('0' <= lookahead && lookahead <= '9') ||
+          ('A' <= lookahead && lookahead <= 'Z') ||
+          lookahead == '_' ||
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(65);
+      END_STATE();
+    case 66:
       ACCEPT_TOKEN(sym_identifier);
       if (('0' <= lookahead && lookahead <= '9') ||
           ('A' <= lookahead && lookahead <= 'Z') ||
           lookahead == '_' ||
-          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(48);
+          ('a' <= lookahead && lookahead <= 'z')) ADVANCE(66);
       END_STATE();
-    case 49:
+    case 67:
       ACCEPT_TOKEN(sym_comment);
       if (lookahead != 0 &&
-          lookahead != '\n') ADVANCE(49);
+          lookahead != '\n') ADVANCE(67);
       END_STATE();
     default:
       return false;
@@ -1604,477 +1779,432 @@ static bool ts_lex_keywords(TSLexer *lexer, TSStateId state) {
   switch (state) {
     case 0:
       ADVANCE_MAP(
-        'M', 1,
-        'O', 2,
-        'S', 3,
-        'a', 4,
-        'b', 5,
-        'c', 6,
-        'd', 7,
-        'e', 8,
-        'f', 9,
-        'g', 10,
-        'i', 11,
-        'l', 12,
-        'm', 13,
-        'n', 14,
-        'o', 15,
-        'p', 16,
-        'r', 17,
-        's', 18,
-        't', 19,
-        'H', 20,
-        'h', 20,
+        'O', 1,
+        'a', 2,
+        'b', 3,
+        'c', 4,
+        'd', 5,
+        'e', 6,
+        'f', 7,
+        'g', 8,
+        'i', 9,
+        'l', 10,
+        'm', 11,
+        'n', 12,
+        'o', 13,
+        'p', 14,
+        'r', 15,
+        's', 16,
+        't', 17,
       );
       if (('\t' <= lookahead && lookahead <= '\r') ||
           lookahead == ' ') SKIP(0);
       END_STATE();
     case 1:
-      if (lookahead == 'I' ||
-          lookahead == 'i') ADVANCE(21);
-      if (lookahead == 'S' ||
-          lookahead == 's') ADVANCE(22);
+      if (lookahead == 'F') ADVANCE(18);
       END_STATE();
     case 2:
-      if (lookahead == 'F') ADVANCE(23);
+      if (lookahead == 'n') ADVANCE(19);
       END_STATE();
     case 3:
-      if (lookahead == 'E' ||
-          lookahead == 'e') ADVANCE(24);
+      if (lookahead == 'r') ADVANCE(20);
       END_STATE();
     case 4:
-      if (lookahead == 'n') ADVANCE(25);
+      if (lookahead == 'a') ADVANCE(21);
       END_STATE();
     case 5:
-      if (lookahead == 'r') ADVANCE(26);
+      if (lookahead == 'e') ADVANCE(22);
       END_STATE();
     case 6:
-      if (lookahead == 'a') ADVANCE(27);
+      if (lookahead == 'l') ADVANCE(23);
       END_STATE();
     case 7:
-      if (lookahead == 'e') ADVANCE(28);
+      if (lookahead == 'a') ADVANCE(24);
       END_STATE();
     case 8:
-      if (lookahead == 'l') ADVANCE(29);
+      if (lookahead == 'r') ADVANCE(25);
       END_STATE();
     case 9:
-      if (lookahead == 'a') ADVANCE(30);
+      if (lookahead == 'f') ADVANCE(26);
+      if (lookahead == 'n') ADVANCE(27);
       END_STATE();
     case 10:
-      if (lookahead == 'r') ADVANCE(31);
+      if (lookahead == 'e') ADVANCE(28);
+      if (lookahead == 'o') ADVANCE(29);
       END_STATE();
     case 11:
-      if (lookahead == 'f') ADVANCE(32);
-      if (lookahead == 'n') ADVANCE(33);
+      if (lookahead == 'a') ADVANCE(30);
+      if (lookahead == 'i') ADVANCE(31);
+      if (lookahead == 'o') ADVANCE(32);
       END_STATE();
     case 12:
-      if (lookahead == 'e') ADVANCE(34);
-      if (lookahead == 'o') ADVANCE(35);
+      if (lookahead == 'o') ADVANCE(33);
       END_STATE();
     case 13:
-      if (lookahead == 'a') ADVANCE(36);
-      if (lookahead == 'o') ADVANCE(37);
-      if (lookahead == 'I' ||
-          lookahead == 'i') ADVANCE(21);
-      if (lookahead == 'S' ||
-          lookahead == 's') ADVANCE(22);
+      if (lookahead == 'f') ADVANCE(34);
+      if (lookahead == 'r') ADVANCE(35);
+      if (lookahead == 't') ADVANCE(36);
       END_STATE();
     case 14:
-      if (lookahead == 'o') ADVANCE(38);
+      if (lookahead == 'u') ADVANCE(37);
       END_STATE();
     case 15:
-      if (lookahead == 'f') ADVANCE(39);
-      if (lookahead == 'r') ADVANCE(40);
-      if (lookahead == 't') ADVANCE(41);
+      if (lookahead == 'e') ADVANCE(38);
       END_STATE();
     case 16:
-      if (lookahead == 'u') ADVANCE(42);
+      if (lookahead == 'e') ADVANCE(39);
+      if (lookahead == 'u') ADVANCE(40);
       END_STATE();
     case 17:
-      if (lookahead == 'e') ADVANCE(43);
+      if (lookahead == 'h') ADVANCE(41);
+      if (lookahead == 'i') ADVANCE(42);
+      if (lookahead == 'r') ADVANCE(43);
       END_STATE();
     case 18:
-      if (lookahead == 'E') ADVANCE(24);
-      if (lookahead == 'e') ADVANCE(44);
-      if (lookahead == 'u') ADVANCE(45);
+      if (lookahead == 'F') ADVANCE(44);
       END_STATE();
     case 19:
-      if (lookahead == 'h') ADVANCE(46);
-      if (lookahead == 'i') ADVANCE(47);
-      if (lookahead == 'r') ADVANCE(48);
+      if (lookahead == 'd') ADVANCE(45);
       END_STATE();
     case 20:
-      if (lookahead == 'O' ||
-          lookahead == 'o') ADVANCE(49);
+      if (lookahead == 'o') ADVANCE(46);
       END_STATE();
     case 21:
-      if (lookahead == 'N' ||
-          lookahead == 'n') ADVANCE(50);
+      if (lookahead == 'p') ADVANCE(47);
+      if (lookahead == 's') ADVANCE(48);
+      if (lookahead == 't') ADVANCE(49);
       END_STATE();
     case 22:
-      if (lookahead == 'E' ||
-          lookahead == 'e') ADVANCE(51);
+      if (lookahead == 'f') ADVANCE(50);
       END_STATE();
     case 23:
-      if (lookahead == 'F') ADVANCE(52);
+      if (lookahead == 's') ADVANCE(51);
       END_STATE();
     case 24:
-      if (lookahead == 'C' ||
-          lookahead == 'c') ADVANCE(50);
+      if (lookahead == 'l') ADVANCE(52);
       END_STATE();
     case 25:
-      if (lookahead == 'd') ADVANCE(53);
+      if (lookahead == 'o') ADVANCE(53);
       END_STATE();
     case 26:
-      if (lookahead == 'o') ADVANCE(54);
-      END_STATE();
-    case 27:
-      if (lookahead == 'p') ADVANCE(55);
-      if (lookahead == 's') ADVANCE(56);
-      if (lookahead == 't') ADVANCE(57);
-      END_STATE();
-    case 28:
-      if (lookahead == 'f') ADVANCE(58);
-      END_STATE();
-    case 29:
-      if (lookahead == 's') ADVANCE(59);
-      END_STATE();
-    case 30:
-      if (lookahead == 'l') ADVANCE(60);
-      END_STATE();
-    case 31:
-      if (lookahead == 'o') ADVANCE(61);
-      END_STATE();
-    case 32:
       ACCEPT_TOKEN(anon_sym_if);
       END_STATE();
+    case 27:
+      if (lookahead == 's') ADVANCE(54);
+      END_STATE();
+    case 28:
+      if (lookahead == 'a') ADVANCE(55);
+      END_STATE();
+    case 29:
+      if (lookahead == 'o') ADVANCE(56);
+      END_STATE();
+    case 30:
+      if (lookahead == 'i') ADVANCE(57);
+      END_STATE();
+    case 31:
+      if (lookahead == 'n') ADVANCE(58);
+      END_STATE();
+    case 32:
+      if (lookahead == 'd') ADVANCE(59);
+      END_STATE();
     case 33:
-      if (lookahead == 's') ADVANCE(62);
+      if (lookahead == 't') ADVANCE(60);
       END_STATE();
     case 34:
-      if (lookahead == 'a') ADVANCE(63);
-      END_STATE();
-    case 35:
-      if (lookahead == 'o') ADVANCE(64);
-      END_STATE();
-    case 36:
-      if (lookahead == 'i') ADVANCE(65);
-      END_STATE();
-    case 37:
-      if (lookahead == 'd') ADVANCE(66);
-      END_STATE();
-    case 38:
-      if (lookahead == 't') ADVANCE(67);
-      END_STATE();
-    case 39:
       ACCEPT_TOKEN(anon_sym_of);
       END_STATE();
-    case 40:
+    case 35:
       ACCEPT_TOKEN(anon_sym_or);
       END_STATE();
+    case 36:
+      if (lookahead == 'h') ADVANCE(61);
+      END_STATE();
+    case 37:
+      if (lookahead == 'b') ADVANCE(62);
+      END_STATE();
+    case 38:
+      if (lookahead == 'c') ADVANCE(63);
+      if (lookahead == 'p') ADVANCE(64);
+      END_STATE();
+    case 39:
+      if (lookahead == 'n') ADVANCE(65);
+      if (lookahead == 't') ADVANCE(66);
+      END_STATE();
+    case 40:
+      if (lookahead == 'b') ADVANCE(67);
+      END_STATE();
     case 41:
-      if (lookahead == 'h') ADVANCE(68);
+      if (lookahead == 'r') ADVANCE(68);
       END_STATE();
     case 42:
-      if (lookahead == 'b') ADVANCE(69);
+      if (lookahead == 'm') ADVANCE(69);
       END_STATE();
     case 43:
-      if (lookahead == 'c') ADVANCE(70);
-      if (lookahead == 'p') ADVANCE(71);
+      if (lookahead == 'u') ADVANCE(70);
       END_STATE();
     case 44:
-      if (lookahead == 'n') ADVANCE(72);
-      if (lookahead == 't') ADVANCE(73);
-      if (lookahead == 'C' ||
-          lookahead == 'c') ADVANCE(50);
-      END_STATE();
-    case 45:
-      if (lookahead == 'b') ADVANCE(74);
-      END_STATE();
-    case 46:
-      if (lookahead == 'r') ADVANCE(75);
-      END_STATE();
-    case 47:
-      if (lookahead == 'm') ADVANCE(76);
-      END_STATE();
-    case 48:
-      if (lookahead == 'u') ADVANCE(77);
-      END_STATE();
-    case 49:
-      if (lookahead == 'U' ||
-          lookahead == 'u') ADVANCE(78);
-      END_STATE();
-    case 50:
-      ACCEPT_TOKEN(sym_time_unit);
-      END_STATE();
-    case 51:
-      if (lookahead == 'C' ||
-          lookahead == 'c') ADVANCE(50);
-      END_STATE();
-    case 52:
       ACCEPT_TOKEN(sym_off);
       END_STATE();
-    case 53:
+    case 45:
       ACCEPT_TOKEN(anon_sym_and);
       END_STATE();
+    case 46:
+      if (lookahead == 'a') ADVANCE(71);
+      END_STATE();
+    case 47:
+      if (lookahead == 'a') ADVANCE(72);
+      END_STATE();
+    case 48:
+      if (lookahead == 'e') ADVANCE(73);
+      END_STATE();
+    case 49:
+      if (lookahead == 'c') ADVANCE(74);
+      END_STATE();
+    case 50:
+      ACCEPT_TOKEN(anon_sym_def);
+      if (lookahead == 'a') ADVANCE(75);
+      END_STATE();
+    case 51:
+      if (lookahead == 'e') ADVANCE(76);
+      END_STATE();
+    case 52:
+      if (lookahead == 's') ADVANCE(77);
+      END_STATE();
+    case 53:
+      if (lookahead == 'u') ADVANCE(78);
+      END_STATE();
     case 54:
-      if (lookahead == 'a') ADVANCE(79);
+      if (lookahead == 't') ADVANCE(79);
       END_STATE();
     case 55:
-      if (lookahead == 'a') ADVANCE(80);
+      if (lookahead == 'd') ADVANCE(80);
       END_STATE();
     case 56:
-      if (lookahead == 'e') ADVANCE(81);
+      if (lookahead == 'p') ADVANCE(81);
       END_STATE();
     case 57:
-      if (lookahead == 'c') ADVANCE(82);
+      if (lookahead == 'n') ADVANCE(82);
       END_STATE();
     case 58:
-      ACCEPT_TOKEN(anon_sym_def);
-      if (lookahead == 'a') ADVANCE(83);
+      ACCEPT_TOKEN(anon_sym_min);
       END_STATE();
     case 59:
-      if (lookahead == 'e') ADVANCE(84);
+      if (lookahead == 'e') ADVANCE(83);
       END_STATE();
     case 60:
-      if (lookahead == 's') ADVANCE(85);
-      END_STATE();
-    case 61:
-      if (lookahead == 'u') ADVANCE(86);
-      END_STATE();
-    case 62:
-      if (lookahead == 't') ADVANCE(87);
-      END_STATE();
-    case 63:
-      if (lookahead == 'd') ADVANCE(88);
-      END_STATE();
-    case 64:
-      if (lookahead == 'p') ADVANCE(89);
-      END_STATE();
-    case 65:
-      if (lookahead == 'n') ADVANCE(90);
-      END_STATE();
-    case 66:
-      if (lookahead == 'e') ADVANCE(91);
-      END_STATE();
-    case 67:
       ACCEPT_TOKEN(anon_sym_not);
       END_STATE();
-    case 68:
-      if (lookahead == 'e') ADVANCE(92);
+    case 61:
+      if (lookahead == 'e') ADVANCE(84);
       END_STATE();
-    case 69:
-      if (lookahead == 'l') ADVANCE(93);
+    case 62:
+      if (lookahead == 'l') ADVANCE(85);
       END_STATE();
-    case 70:
-      if (lookahead == 'e') ADVANCE(94);
+    case 63:
+      if (lookahead == 'e') ADVANCE(86);
       END_STATE();
-    case 71:
-      if (lookahead == 'e') ADVANCE(95);
+    case 64:
+      if (lookahead == 'e') ADVANCE(87);
       END_STATE();
-    case 72:
-      if (lookahead == 'd') ADVANCE(96);
+    case 65:
+      if (lookahead == 'd') ADVANCE(88);
       END_STATE();
-    case 73:
+    case 66:
       ACCEPT_TOKEN(anon_sym_set);
       END_STATE();
-    case 74:
-      if (lookahead == 's') ADVANCE(97);
+    case 67:
+      if (lookahead == 's') ADVANCE(89);
       END_STATE();
-    case 75:
-      if (lookahead == 'o') ADVANCE(98);
+    case 68:
+      if (lookahead == 'o') ADVANCE(90);
       END_STATE();
-    case 76:
-      if (lookahead == 'e') ADVANCE(99);
+    case 69:
+      if (lookahead == 'e') ADVANCE(91);
       END_STATE();
-    case 77:
-      if (lookahead == 'e') ADVANCE(100);
+    case 70:
+      if (lookahead == 'e') ADVANCE(92);
       END_STATE();
-    case 78:
-      if (lookahead == 'R' ||
-          lookahead == 'r') ADVANCE(50);
+    case 71:
+      if (lookahead == 'd') ADVANCE(93);
       END_STATE();
-    case 79:
-      if (lookahead == 'd') ADVANCE(101);
+    case 72:
+      if (lookahead == 'b') ADVANCE(94);
       END_STATE();
-    case 80:
-      if (lookahead == 'b') ADVANCE(102);
-      END_STATE();
-    case 81:
+    case 73:
       ACCEPT_TOKEN(anon_sym_case);
       END_STATE();
-    case 82:
-      if (lookahead == 'h') ADVANCE(103);
+    case 74:
+      if (lookahead == 'h') ADVANCE(95);
       END_STATE();
-    case 83:
-      if (lookahead == 'u') ADVANCE(104);
+    case 75:
+      if (lookahead == 'u') ADVANCE(96);
       END_STATE();
-    case 84:
+    case 76:
       ACCEPT_TOKEN(anon_sym_else);
       END_STATE();
-    case 85:
-      if (lookahead == 'e') ADVANCE(105);
+    case 77:
+      if (lookahead == 'e') ADVANCE(97);
       END_STATE();
-    case 86:
-      if (lookahead == 'p') ADVANCE(106);
+    case 78:
+      if (lookahead == 'p') ADVANCE(98);
       END_STATE();
-    case 87:
-      if (lookahead == 'a') ADVANCE(107);
+    case 79:
+      if (lookahead == 'a') ADVANCE(99);
       END_STATE();
-    case 88:
-      if (lookahead == 'e') ADVANCE(108);
+    case 80:
+      if (lookahead == 'e') ADVANCE(100);
       END_STATE();
-    case 89:
+    case 81:
       ACCEPT_TOKEN(anon_sym_loop);
       END_STATE();
-    case 90:
+    case 82:
       ACCEPT_TOKEN(anon_sym_main);
       END_STATE();
-    case 91:
+    case 83:
       ACCEPT_TOKEN(anon_sym_mode);
       END_STATE();
-    case 92:
-      if (lookahead == 'r') ADVANCE(109);
+    case 84:
+      if (lookahead == 'r') ADVANCE(101);
       END_STATE();
-    case 93:
-      if (lookahead == 'i') ADVANCE(110);
+    case 85:
+      if (lookahead == 'i') ADVANCE(102);
       END_STATE();
-    case 94:
-      if (lookahead == 'i') ADVANCE(111);
+    case 86:
+      if (lookahead == 'i') ADVANCE(103);
       END_STATE();
-    case 95:
-      if (lookahead == 'a') ADVANCE(112);
+    case 87:
+      if (lookahead == 'a') ADVANCE(104);
       END_STATE();
-    case 96:
+    case 88:
       ACCEPT_TOKEN(anon_sym_send);
       END_STATE();
-    case 97:
-      if (lookahead == 'c') ADVANCE(113);
+    case 89:
+      if (lookahead == 'c') ADVANCE(105);
       END_STATE();
-    case 98:
-      if (lookahead == 'w') ADVANCE(114);
+    case 90:
+      if (lookahead == 'w') ADVANCE(106);
       END_STATE();
-    case 99:
-      if (lookahead == 'o') ADVANCE(115);
+    case 91:
+      if (lookahead == 'o') ADVANCE(107);
       END_STATE();
-    case 100:
+    case 92:
       ACCEPT_TOKEN(anon_sym_true);
       END_STATE();
-    case 101:
-      if (lookahead == 'c') ADVANCE(116);
+    case 93:
+      if (lookahead == 'c') ADVANCE(108);
       END_STATE();
-    case 102:
-      if (lookahead == 'l') ADVANCE(117);
+    case 94:
+      if (lookahead == 'l') ADVANCE(109);
       END_STATE();
-    case 103:
+    case 95:
       ACCEPT_TOKEN(anon_sym_catch);
       END_STATE();
-    case 104:
-      if (lookahead == 'l') ADVANCE(118);
+    case 96:
+      if (lookahead == 'l') ADVANCE(110);
       END_STATE();
-    case 105:
+    case 97:
       ACCEPT_TOKEN(anon_sym_false);
       END_STATE();
-    case 106:
+    case 98:
       ACCEPT_TOKEN(anon_sym_group);
       END_STATE();
-    case 107:
-      if (lookahead == 'n') ADVANCE(119);
+    case 99:
+      if (lookahead == 'n') ADVANCE(111);
       END_STATE();
-    case 108:
-      if (lookahead == 'r') ADVANCE(120);
+    case 100:
+      if (lookahead == 'r') ADVANCE(112);
       END_STATE();
-    case 109:
-      if (lookahead == 's') ADVANCE(121);
+    case 101:
+      if (lookahead == 's') ADVANCE(113);
       END_STATE();
-    case 110:
-      if (lookahead == 's') ADVANCE(122);
+    case 102:
+      if (lookahead == 's') ADVANCE(114);
       END_STATE();
-    case 111:
-      if (lookahead == 'v') ADVANCE(123);
+    case 103:
+      if (lookahead == 'v') ADVANCE(115);
       END_STATE();
-    case 112:
-      if (lookahead == 't') ADVANCE(124);
+    case 104:
+      if (lookahead == 't') ADVANCE(116);
       END_STATE();
-    case 113:
-      if (lookahead == 'r') ADVANCE(125);
+    case 105:
+      if (lookahead == 'r') ADVANCE(117);
       END_STATE();
-    case 114:
+    case 106:
       ACCEPT_TOKEN(anon_sym_throw);
       END_STATE();
-    case 115:
-      if (lookahead == 'u') ADVANCE(126);
+    case 107:
+      if (lookahead == 'u') ADVANCE(118);
       END_STATE();
-    case 116:
-      if (lookahead == 'a') ADVANCE(127);
+    case 108:
+      if (lookahead == 'a') ADVANCE(119);
       END_STATE();
-    case 117:
-      if (lookahead == 'e') ADVANCE(128);
+    case 109:
+      if (lookahead == 'e') ADVANCE(120);
       END_STATE();
-    case 118:
-      if (lookahead == 't') ADVANCE(129);
+    case 110:
+      if (lookahead == 't') ADVANCE(121);
       END_STATE();
-    case 119:
-      if (lookahead == 'c') ADVANCE(130);
+    case 111:
+      if (lookahead == 'c') ADVANCE(122);
       END_STATE();
-    case 120:
+    case 112:
       ACCEPT_TOKEN(anon_sym_leader);
       END_STATE();
-    case 121:
+    case 113:
       ACCEPT_TOKEN(anon_sym_others);
       END_STATE();
-    case 122:
-      if (lookahead == 'h') ADVANCE(131);
+    case 114:
+      if (lookahead == 'h') ADVANCE(123);
       END_STATE();
-    case 123:
-      if (lookahead == 'e') ADVANCE(132);
+    case 115:
+      if (lookahead == 'e') ADVANCE(124);
       END_STATE();
-    case 124:
+    case 116:
       ACCEPT_TOKEN(anon_sym_repeat);
       END_STATE();
-    case 125:
-      if (lookahead == 'i') ADVANCE(133);
+    case 117:
+      if (lookahead == 'i') ADVANCE(125);
       END_STATE();
-    case 126:
-      if (lookahead == 't') ADVANCE(134);
+    case 118:
+      if (lookahead == 't') ADVANCE(126);
       END_STATE();
-    case 127:
-      if (lookahead == 's') ADVANCE(135);
+    case 119:
+      if (lookahead == 's') ADVANCE(127);
       END_STATE();
-    case 128:
+    case 120:
       ACCEPT_TOKEN(anon_sym_capable);
       END_STATE();
-    case 129:
+    case 121:
       ACCEPT_TOKEN(anon_sym_default);
       END_STATE();
-    case 130:
-      if (lookahead == 'e') ADVANCE(136);
+    case 122:
+      if (lookahead == 'e') ADVANCE(128);
       END_STATE();
-    case 131:
+    case 123:
       ACCEPT_TOKEN(anon_sym_publish);
       END_STATE();
-    case 132:
+    case 124:
       ACCEPT_TOKEN(anon_sym_receive);
       END_STATE();
-    case 133:
-      if (lookahead == 'b') ADVANCE(137);
+    case 125:
+      if (lookahead == 'b') ADVANCE(129);
       END_STATE();
-    case 134:
+    case 126:
       ACCEPT_TOKEN(anon_sym_timeout);
       END_STATE();
-    case 135:
-      if (lookahead == 't') ADVANCE(138);
+    case 127:
+      if (lookahead == 't') ADVANCE(130);
       END_STATE();
-    case 136:
+    case 128:
       ACCEPT_TOKEN(anon_sym_instance);
       END_STATE();
-    case 137:
-      if (lookahead == 'e') ADVANCE(139);
+    case 129:
+      if (lookahead == 'e') ADVANCE(131);
       END_STATE();
-    case 138:
+    case 130:
       ACCEPT_TOKEN(anon_sym_broadcast);
       END_STATE();
-    case 139:
+    case 131:
       ACCEPT_TOKEN(anon_sym_subscribe);
       END_STATE();
     default:
@@ -2084,201 +2214,206 @@ static bool ts_lex_keywords(TSLexer *lexer, TSStateId state) {
 
 static const TSLexMode ts_lex_modes[STATE_COUNT] = {
   [0] = {.lex_state = 0},
-  [1] = {.lex_state = 0},
-  [2] = {.lex_state = 14},
-  [3] = {.lex_state = 2},
-  [4] = {.lex_state = 15},
-  [5] = {.lex_state = 15},
-  [6] = {.lex_state = 2},
-  [7] = {.lex_state = 15},
-  [8] = {.lex_state = 15},
-  [9] = {.lex_state = 15},
-  [10] = {.lex_state = 15},
-  [11] = {.lex_state = 14},
-  [12] = {.lex_state = 14},
-  [13] = {.lex_state = 14},
-  [14] = {.lex_state = 14},
-  [15] = {.lex_state = 14},
-  [16] = {.lex_state = 14},
-  [17] = {.lex_state = 14},
-  [18] = {.lex_state = 14},
-  [19] = {.lex_state = 14},
-  [20] = {.lex_state = 14},
-  [21] = {.lex_state = 15},
-  [22] = {.lex_state = 14},
-  [23] = {.lex_state = 14},
-  [24] = {.lex_state = 15},
-  [25] = {.lex_state = 14},
-  [26] = {.lex_state = 14},
-  [27] = {.lex_state = 14},
-  [28] = {.lex_state = 14},
-  [29] = {.lex_state = 14},
-  [30] = {.lex_state = 15},
-  [31] = {.lex_state = 14},
-  [32] = {.lex_state = 14},
-  [33] = {.lex_state = 14},
-  [34] = {.lex_state = 14},
-  [35] = {.lex_state = 14},
-  [36] = {.lex_state = 14},
-  [37] = {.lex_state = 14},
-  [38] = {.lex_state = 14},
-  [39] = {.lex_state = 14},
-  [40] = {.lex_state = 14},
-  [41] = {.lex_state = 14},
+  [1] = {.lex_state = 23},
+  [2] = {.lex_state = 23},
+  [3] = {.lex_state = 3},
+  [4] = {.lex_state = 24},
+  [5] = {.lex_state = 3},
+  [6] = {.lex_state = 24},
+  [7] = {.lex_state = 24},
+  [8] = {.lex_state = 24},
+  [9] = {.lex_state = 24},
+  [10] = {.lex_state = 24},
+  [11] = {.lex_state = 23},
+  [12] = {.lex_state = 23},
+  [13] = {.lex_state = 23},
+  [14] = {.lex_state = 23},
+  [15] = {.lex_state = 23},
+  [16] = {.lex_state = 24},
+  [17] = {.lex_state = 23},
+  [18] = {.lex_state = 23},
+  [19] = {.lex_state = 23},
+  [20] = {.lex_state = 23},
+  [21] = {.lex_state = 23},
+  [22] = {.lex_state = 23},
+  [23] = {.lex_state = 23},
+  [24] = {.lex_state = 24},
+  [25] = {.lex_state = 23},
+  [26] = {.lex_state = 23},
+  [27] = {.lex_state = 23},
+  [28] = {.lex_state = 24},
+  [29] = {.lex_state = 23},
+  [30] = {.lex_state = 23},
+  [31] = {.lex_state = 23},
+  [32] = {.lex_state = 23},
+  [33] = {.lex_state = 23},
+  [34] = {.lex_state = 23},
+  [35] = {.lex_state = 23},
+  [36] = {.lex_state = 23},
+  [37] = {.lex_state = 23},
+  [38] = {.lex_state = 23},
+  [39] = {.lex_state = 23},
+  [40] = {.lex_state = 23},
+  [41] = {.lex_state = 23},
   [42] = {.lex_state = 1},
   [43] = {.lex_state = 1},
   [44] = {.lex_state = 1},
   [45] = {.lex_state = 1},
-  [46] = {.lex_state = 0},
-  [47] = {.lex_state = 14},
-  [48] = {.lex_state = 0},
-  [49] = {.lex_state = 14},
-  [50] = {.lex_state = 14},
-  [51] = {.lex_state = 14},
-  [52] = {.lex_state = 14},
-  [53] = {.lex_state = 0},
-  [54] = {.lex_state = 14},
-  [55] = {.lex_state = 0},
-  [56] = {.lex_state = 0},
-  [57] = {.lex_state = 15},
-  [58] = {.lex_state = 14},
-  [59] = {.lex_state = 0},
-  [60] = {.lex_state = 0},
-  [61] = {.lex_state = 0},
-  [62] = {.lex_state = 0},
-  [63] = {.lex_state = 14},
-  [64] = {.lex_state = 0},
-  [65] = {.lex_state = 0},
-  [66] = {.lex_state = 0},
-  [67] = {.lex_state = 0},
-  [68] = {.lex_state = 0},
-  [69] = {.lex_state = 0},
-  [70] = {.lex_state = 0},
-  [71] = {.lex_state = 0},
-  [72] = {.lex_state = 0},
-  [73] = {.lex_state = 0},
-  [74] = {.lex_state = 0},
-  [75] = {.lex_state = 0},
-  [76] = {.lex_state = 0},
-  [77] = {.lex_state = 0},
-  [78] = {.lex_state = 0},
-  [79] = {.lex_state = 0},
-  [80] = {.lex_state = 0},
-  [81] = {.lex_state = 0},
-  [82] = {.lex_state = 0},
-  [83] = {.lex_state = 0},
-  [84] = {.lex_state = 0},
-  [85] = {.lex_state = 0},
-  [86] = {.lex_state = 0},
-  [87] = {.lex_state = 0},
-  [88] = {.lex_state = 0},
-  [89] = {.lex_state = 0},
-  [90] = {.lex_state = 0},
-  [91] = {.lex_state = 0},
-  [92] = {.lex_state = 0},
-  [93] = {.lex_state = 0},
-  [94] = {.lex_state = 0},
-  [95] = {.lex_state = 0},
-  [96] = {.lex_state = 0},
-  [97] = {.lex_state = 0},
-  [98] = {.lex_state = 0},
-  [99] = {.lex_state = 0},
-  [100] = {.lex_state = 0},
-  [101] = {.lex_state = 14},
-  [102] = {.lex_state = 14},
-  [103] = {.lex_state = 0},
-  [104] = {.lex_state = 0},
-  [105] = {.lex_state = 0},
-  [106] = {.lex_state = 0},
+  [46] = {.lex_state = 23},
+  [47] = {.lex_state = 23},
+  [48] = {.lex_state = 2},
+  [49] = {.lex_state = 23},
+  [50] = {.lex_state = 23},
+  [51] = {.lex_state = 23},
+  [52] = {.lex_state = 23},
+  [53] = {.lex_state = 23},
+  [54] = {.lex_state = 23},
+  [55] = {.lex_state = 23},
+  [56] = {.lex_state = 23},
+  [57] = {.lex_state = 23},
+  [58] = {.lex_state = 23},
+  [59] = {.lex_state = 24},
+  [60] = {.lex_state = 23},
+  [61] = {.lex_state = 23},
+  [62] = {.lex_state = 23},
+  [63] = {.lex_state = 23},
+  [64] = {.lex_state = 23},
+  [65] = {.lex_state = 23},
+  [66] = {.lex_state = 23},
+  [67] = {.lex_state = 23},
+  [68] = {.lex_state = 23},
+  [69] = {.lex_state = 23},
+  [70] = {.lex_state = 23},
+  [71] = {.lex_state = 23},
+  [72] = {.lex_state = 23},
+  [73] = {.lex_state = 23},
+  [74] = {.lex_state = 23},
+  [75] = {.lex_state = 23},
+  [76] = {.lex_state = 23},
+  [77] = {.lex_state = 23},
+  [78] = {.lex_state = 23},
+  [79] = {.lex_state = 23},
+  [80] = {.lex_state = 23},
+  [81] = {.lex_state = 23},
+  [82] = {.lex_state = 23},
+  [83] = {.lex_state = 23},
+  [84] = {.lex_state = 23},
+  [85] = {.lex_state = 23},
+  [86] = {.lex_state = 23},
+  [87] = {.lex_state = 23},
+  [88] = {.lex_state = 23},
+  [89] = {.lex_state = 23},
+  [90] = {.lex_state = 23},
+  [91] = {.lex_state = 23},
+  [92] = {.lex_state = 23},
+  [93] = {.lex_state = 23},
+  [94] = {.lex_state = 23},
+  [95] = {.lex_state = 23},
+  [96] = {.lex_state = 23},
+  [97] = {.lex_state = 23},
+  [98] = {.lex_state = 23},
+  [99] = {.lex_state = 23},
+  [100] = {.lex_state = 23},
+  [101] = {.lex_state = 23},
+  [102] = {.lex_state = 23},
+  [103] = {.lex_state = 23},
+  [104] = {.lex_state = 23},
+  [105] = {.lex_state = 23},
+  [106] = {.lex_state = 23},
   [107] = {.lex_state = 0},
-  [108] = {.lex_state = 0},
-  [109] = {.lex_state = 0},
+  [108] = {.lex_state = 23},
+  [109] = {.lex_state = 23},
   [110] = {.lex_state = 0},
-  [111] = {.lex_state = 0},
+  [111] = {.lex_state = 23},
   [112] = {.lex_state = 0},
-  [113] = {.lex_state = 0},
+  [113] = {.lex_state = 23},
   [114] = {.lex_state = 0},
-  [115] = {.lex_state = 2},
+  [115] = {.lex_state = 3},
   [116] = {.lex_state = 0},
-  [117] = {.lex_state = 0},
+  [117] = {.lex_state = 23},
   [118] = {.lex_state = 0},
   [119] = {.lex_state = 0},
   [120] = {.lex_state = 0},
-  [121] = {.lex_state = 0},
+  [121] = {.lex_state = 23},
   [122] = {.lex_state = 0},
   [123] = {.lex_state = 0},
   [124] = {.lex_state = 0},
-  [125] = {.lex_state = 0},
+  [125] = {.lex_state = 23},
   [126] = {.lex_state = 0},
   [127] = {.lex_state = 0},
-  [128] = {.lex_state = 0},
-  [129] = {.lex_state = 0},
+  [128] = {.lex_state = 23},
+  [129] = {.lex_state = 23},
   [130] = {.lex_state = 0},
   [131] = {.lex_state = 0},
-  [132] = {.lex_state = 0},
+  [132] = {.lex_state = 23},
   [133] = {.lex_state = 0},
   [134] = {.lex_state = 0},
   [135] = {.lex_state = 0},
   [136] = {.lex_state = 0},
-  [137] = {.lex_state = 0},
-  [138] = {.lex_state = 0},
+  [137] = {.lex_state = 23},
+  [138] = {.lex_state = 23},
   [139] = {.lex_state = 0},
   [140] = {.lex_state = 0},
   [141] = {.lex_state = 0},
-  [142] = {.lex_state = 0},
-  [143] = {.lex_state = 0},
-  [144] = {.lex_state = 0},
-  [145] = {.lex_state = 0},
-  [146] = {.lex_state = 0},
+  [142] = {.lex_state = 23},
+  [143] = {.lex_state = 23},
+  [144] = {.lex_state = 23},
+  [145] = {.lex_state = 23},
+  [146] = {.lex_state = 23},
   [147] = {.lex_state = 0},
   [148] = {.lex_state = 0},
   [149] = {.lex_state = 0},
   [150] = {.lex_state = 0},
-  [151] = {.lex_state = 0},
-  [152] = {.lex_state = 0},
-  [153] = {.lex_state = 0},
+  [151] = {.lex_state = 23},
+  [152] = {.lex_state = 23},
+  [153] = {.lex_state = 3},
   [154] = {.lex_state = 0},
   [155] = {.lex_state = 0},
   [156] = {.lex_state = 0},
-  [157] = {.lex_state = 0},
-  [158] = {.lex_state = 0},
-  [159] = {.lex_state = 14},
-  [160] = {.lex_state = 0},
+  [157] = {.lex_state = 23},
+  [158] = {.lex_state = 23},
+  [159] = {.lex_state = 5},
+  [160] = {.lex_state = 23},
   [161] = {.lex_state = 0},
-  [162] = {.lex_state = 0},
+  [162] = {.lex_state = 23},
   [163] = {.lex_state = 0},
-  [164] = {.lex_state = 2},
+  [164] = {.lex_state = 0},
   [165] = {.lex_state = 0},
-  [166] = {.lex_state = 0},
-  [167] = {.lex_state = 2},
+  [166] = {.lex_state = 3},
+  [167] = {.lex_state = 0},
   [168] = {.lex_state = 0},
   [169] = {.lex_state = 0},
-  [170] = {.lex_state = 0},
-  [171] = {.lex_state = 0},
-  [172] = {.lex_state = 0},
-  [173] = {.lex_state = 0},
-  [174] = {.lex_state = 0},
-  [175] = {.lex_state = 0},
+  [170] = {.lex_state = 23},
+  [171] = {.lex_state = 23},
+  [172] = {.lex_state = 23},
+  [173] = {.lex_state = 23},
+  [174] = {.lex_state = 23},
+  [175] = {.lex_state = 23},
   [176] = {.lex_state = 0},
   [177] = {.lex_state = 0},
-  [178] = {.lex_state = 0},
+  [178] = {.lex_state = 23},
   [179] = {.lex_state = 0},
-  [180] = {.lex_state = 0},
-  [181] = {.lex_state = 0},
-  [182] = {.lex_state = 0},
-  [183] = {.lex_state = 2},
+  [180] = {.lex_state = 3},
+  [181] = {.lex_state = 23},
+  [182] = {.lex_state = 3},
+  [183] = {.lex_state = 0},
   [184] = {.lex_state = 0},
   [185] = {.lex_state = 0},
   [186] = {.lex_state = 0},
-  [187] = {.lex_state = 0},
-  [188] = {.lex_state = 0},
+  [187] = {.lex_state = 23},
+  [188] = {.lex_state = 23},
   [189] = {.lex_state = 0},
-  [190] = {.lex_state = 14},
+  [190] = {.lex_state = 23},
   [191] = {.lex_state = 0},
   [192] = {.lex_state = 0},
-  [193] = {.lex_state = 0},
+  [193] = {.lex_state = 23},
   [194] = {.lex_state = 0},
-  [195] = {.lex_state = 0},
+  [195] = {.lex_state = 23},
+  [196] = {.lex_state = 0},
+  [197] = {.lex_state = 0},
+  [198] = {.lex_state = 0},
+  [199] = {.lex_state = 23},
+  [200] = {.lex_state = 23},
 };
 
 static const uint16_t ts_parse_table[LARGE_STATE_COUNT][SYMBOL_COUNT] = {
@@ -2322,6 +2457,7 @@ static const uint16_t ts_parse_table[LARGE_STATE_COUNT][SYMBOL_COUNT] = {
     [anon_sym_instance] = ACTIONS(1),
     [anon_sym_of] = ACTIONS(1),
     [anon_sym_capable] = ACTIONS(1),
+    [anon_sym_min] = ACTIONS(1),
     [anon_sym_timeout] = ACTIONS(1),
     [anon_sym_or] = ACTIONS(1),
     [anon_sym_PIPE_PIPE] = ACTIONS(1),
@@ -2343,15 +2479,15 @@ static const uint16_t ts_parse_table[LARGE_STATE_COUNT][SYMBOL_COUNT] = {
     [sym_comment] = ACTIONS(3),
   },
   [STATE(1)] = {
-    [sym_source_file] = STATE(173),
-    [sym__item] = STATE(48),
-    [sym_formation] = STATE(48),
-    [sym_team_declaration] = STATE(48),
-    [sym_service_definition] = STATE(48),
-    [sym_function_definition] = STATE(48),
-    [sym_mode_definition] = STATE(48),
-    [sym_main_definition] = STATE(48),
-    [aux_sym_source_file_repeat1] = STATE(48),
+    [sym_source_file] = STATE(163),
+    [sym__item] = STATE(46),
+    [sym_formation] = STATE(46),
+    [sym_team_declaration] = STATE(46),
+    [sym_service_definition] = STATE(46),
+    [sym_function_definition] = STATE(46),
+    [sym_mode_definition] = STATE(46),
+    [sym_main_definition] = STATE(46),
+    [aux_sym_source_file_repeat1] = STATE(46),
     [ts_builtin_sym_end] = ACTIONS(5),
     [sym_identifier] = ACTIONS(7),
     [anon_sym_SEMI] = ACTIONS(9),
@@ -2417,7 +2553,7 @@ static const uint16_t ts_small_parse_table[] = {
     ACTIONS(31), 2,
       anon_sym_true,
       anon_sym_false,
-    STATE(88), 2,
+    STATE(87), 2,
       sym__expression,
       sym_or_expression,
     STATE(50), 5,
@@ -2426,7 +2562,7 @@ static const uint16_t ts_small_parse_table[] = {
       sym_attribute,
       sym_boolean,
       sym_period,
-    STATE(68), 6,
+    STATE(75), 6,
       sym__and_level,
       sym_and_expression,
       sym__not_level,
@@ -2452,7 +2588,7 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_RPAREN,
     STATE(49), 1,
       sym_period,
-    STATE(162), 1,
+    STATE(165), 1,
       sym__period_and_condition,
     ACTIONS(31), 2,
       anon_sym_true,
@@ -2465,51 +2601,14 @@ static const uint16_t ts_small_parse_table[] = {
       sym_parenthesized_expression,
       sym_attribute,
       sym_boolean,
-    STATE(68), 6,
+    STATE(75), 6,
       sym__and_level,
       sym_and_expression,
       sym__not_level,
       sym_not_expression,
       sym__comparison_level,
       sym_comparison,
-  [140] = 13,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(19), 1,
-      sym_identifier,
-    ACTIONS(21), 1,
-      anon_sym_LPAREN,
-    ACTIONS(27), 1,
-      anon_sym_not,
-    ACTIONS(29), 1,
-      anon_sym_BANG,
-    ACTIONS(33), 1,
-      sym_number,
-    ACTIONS(35), 1,
-      sym_string,
-    STATE(49), 1,
-      sym_period,
-    STATE(170), 1,
-      sym__period_and_condition,
-    ACTIONS(31), 2,
-      anon_sym_true,
-      anon_sym_false,
-    STATE(109), 2,
-      sym__expression,
-      sym_or_expression,
-    STATE(50), 4,
-      sym__primary,
-      sym_parenthesized_expression,
-      sym_attribute,
-      sym_boolean,
-    STATE(68), 6,
-      sym__and_level,
-      sym_and_expression,
-      sym__not_level,
-      sym_not_expression,
-      sym__comparison_level,
-      sym_comparison,
-  [190] = 12,
+  [140] = 12,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(19), 1,
@@ -2529,7 +2628,7 @@ static const uint16_t ts_small_parse_table[] = {
     ACTIONS(31), 2,
       anon_sym_true,
       anon_sym_false,
-    STATE(98), 2,
+    STATE(101), 2,
       sym__expression,
       sym_or_expression,
     STATE(50), 5,
@@ -2538,7 +2637,44 @@ static const uint16_t ts_small_parse_table[] = {
       sym_attribute,
       sym_boolean,
       sym_period,
-    STATE(68), 6,
+    STATE(75), 6,
+      sym__and_level,
+      sym_and_expression,
+      sym__not_level,
+      sym_not_expression,
+      sym__comparison_level,
+      sym_comparison,
+  [188] = 13,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(19), 1,
+      sym_identifier,
+    ACTIONS(21), 1,
+      anon_sym_LPAREN,
+    ACTIONS(27), 1,
+      anon_sym_not,
+    ACTIONS(29), 1,
+      anon_sym_BANG,
+    ACTIONS(33), 1,
+      sym_number,
+    ACTIONS(35), 1,
+      sym_string,
+    STATE(49), 1,
+      sym_period,
+    STATE(197), 1,
+      sym__period_and_condition,
+    ACTIONS(31), 2,
+      anon_sym_true,
+      anon_sym_false,
+    STATE(109), 2,
+      sym__expression,
+      sym_or_expression,
+    STATE(50), 4,
+      sym__primary,
+      sym_parenthesized_expression,
+      sym_attribute,
+      sym_boolean,
+    STATE(75), 6,
       sym__and_level,
       sym_and_expression,
       sym__not_level,
@@ -2563,7 +2699,7 @@ static const uint16_t ts_small_parse_table[] = {
     ACTIONS(31), 2,
       anon_sym_true,
       anon_sym_false,
-    STATE(128), 2,
+    STATE(121), 2,
       sym__expression,
       sym_or_expression,
     STATE(50), 5,
@@ -2572,7 +2708,7 @@ static const uint16_t ts_small_parse_table[] = {
       sym_attribute,
       sym_boolean,
       sym_period,
-    STATE(68), 6,
+    STATE(75), 6,
       sym__and_level,
       sym_and_expression,
       sym__not_level,
@@ -2580,40 +2716,6 @@ static const uint16_t ts_small_parse_table[] = {
       sym__comparison_level,
       sym_comparison,
   [283] = 11,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(19), 1,
-      sym_identifier,
-    ACTIONS(21), 1,
-      anon_sym_LPAREN,
-    ACTIONS(27), 1,
-      anon_sym_not,
-    ACTIONS(29), 1,
-      anon_sym_BANG,
-    ACTIONS(33), 1,
-      sym_number,
-    ACTIONS(35), 1,
-      sym_string,
-    ACTIONS(31), 2,
-      anon_sym_true,
-      anon_sym_false,
-    STATE(107), 2,
-      sym__expression,
-      sym_or_expression,
-    STATE(50), 5,
-      sym__primary,
-      sym_parenthesized_expression,
-      sym_attribute,
-      sym_boolean,
-      sym_period,
-    STATE(68), 6,
-      sym__and_level,
-      sym_and_expression,
-      sym__not_level,
-      sym_not_expression,
-      sym__comparison_level,
-      sym_comparison,
-  [328] = 11,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(19), 1,
@@ -2640,7 +2742,41 @@ static const uint16_t ts_small_parse_table[] = {
       sym_attribute,
       sym_boolean,
       sym_period,
-    STATE(68), 6,
+    STATE(75), 6,
+      sym__and_level,
+      sym_and_expression,
+      sym__not_level,
+      sym_not_expression,
+      sym__comparison_level,
+      sym_comparison,
+  [328] = 11,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(19), 1,
+      sym_identifier,
+    ACTIONS(21), 1,
+      anon_sym_LPAREN,
+    ACTIONS(27), 1,
+      anon_sym_not,
+    ACTIONS(29), 1,
+      anon_sym_BANG,
+    ACTIONS(33), 1,
+      sym_number,
+    ACTIONS(35), 1,
+      sym_string,
+    ACTIONS(31), 2,
+      anon_sym_true,
+      anon_sym_false,
+    STATE(108), 2,
+      sym__expression,
+      sym_or_expression,
+    STATE(50), 5,
+      sym__primary,
+      sym_parenthesized_expression,
+      sym_attribute,
+      sym_boolean,
+      sym_period,
+    STATE(75), 6,
       sym__and_level,
       sym_and_expression,
       sym__not_level,
@@ -2665,7 +2801,7 @@ static const uint16_t ts_small_parse_table[] = {
     ACTIONS(31), 2,
       anon_sym_true,
       anon_sym_false,
-    STATE(105), 2,
+    STATE(104), 2,
       sym__expression,
       sym_or_expression,
     STATE(50), 5,
@@ -2674,7 +2810,7 @@ static const uint16_t ts_small_parse_table[] = {
       sym_attribute,
       sym_boolean,
       sym_period,
-    STATE(68), 6,
+    STATE(75), 6,
       sym__and_level,
       sym_and_expression,
       sym__not_level,
@@ -2753,7 +2889,7 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_receive,
       anon_sym_publish,
       anon_sym_subscribe,
-    STATE(14), 8,
+    STATE(18), 8,
       sym__statement,
       sym_if_statement,
       sym_loop_statement,
@@ -2762,29 +2898,150 @@ static const uint16_t ts_small_parse_table[] = {
       sym_communication,
       sym_group_statement,
       aux_sym_block_repeat1,
-  [515] = 10,
+  [515] = 9,
     ACTIONS(3), 1,
       sym_comment,
+    ACTIONS(49), 1,
+      sym_identifier,
+    ACTIONS(55), 1,
+      anon_sym_if,
+    ACTIONS(57), 1,
+      anon_sym_loop,
+    ACTIONS(59), 1,
+      anon_sym_throw,
+    ACTIONS(63), 1,
+      anon_sym_LBRACK_LBRACK,
     ACTIONS(65), 1,
-      sym_identifier,
-    ACTIONS(68), 1,
-      anon_sym_SEMI,
-    ACTIONS(71), 1,
-      anon_sym_RBRACE,
-    ACTIONS(73), 1,
-      anon_sym_if,
-    ACTIONS(76), 1,
-      anon_sym_loop,
-    ACTIONS(79), 1,
-      anon_sym_throw,
-    ACTIONS(85), 1,
-      anon_sym_LBRACK_LBRACK,
-    ACTIONS(82), 4,
+      anon_sym_LBRACE,
+    ACTIONS(61), 4,
       anon_sym_send,
       anon_sym_receive,
       anon_sym_publish,
       anon_sym_subscribe,
-    STATE(14), 8,
+    STATE(105), 9,
+      sym_block,
+      sym__body,
+      sym__statement,
+      sym_if_statement,
+      sym_loop_statement,
+      sym_throw_statement,
+      sym_call,
+      sym_communication,
+      sym_group_statement,
+  [554] = 9,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(49), 1,
+      sym_identifier,
+    ACTIONS(55), 1,
+      anon_sym_if,
+    ACTIONS(57), 1,
+      anon_sym_loop,
+    ACTIONS(59), 1,
+      anon_sym_throw,
+    ACTIONS(63), 1,
+      anon_sym_LBRACK_LBRACK,
+    ACTIONS(65), 1,
+      anon_sym_LBRACE,
+    ACTIONS(61), 4,
+      anon_sym_send,
+      anon_sym_receive,
+      anon_sym_publish,
+      anon_sym_subscribe,
+    STATE(99), 9,
+      sym_block,
+      sym__body,
+      sym__statement,
+      sym_if_statement,
+      sym_loop_statement,
+      sym_throw_statement,
+      sym_call,
+      sym_communication,
+      sym_group_statement,
+  [593] = 10,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(19), 1,
+      sym_identifier,
+    ACTIONS(21), 1,
+      anon_sym_LPAREN,
+    ACTIONS(27), 1,
+      anon_sym_not,
+    ACTIONS(29), 1,
+      anon_sym_BANG,
+    ACTIONS(33), 1,
+      sym_number,
+    ACTIONS(35), 1,
+      sym_string,
+    ACTIONS(31), 2,
+      anon_sym_true,
+      anon_sym_false,
+    STATE(50), 5,
+      sym__primary,
+      sym_parenthesized_expression,
+      sym_attribute,
+      sym_boolean,
+      sym_period,
+    STATE(71), 6,
+      sym__and_level,
+      sym_and_expression,
+      sym__not_level,
+      sym_not_expression,
+      sym__comparison_level,
+      sym_comparison,
+  [634] = 9,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(49), 1,
+      sym_identifier,
+    ACTIONS(55), 1,
+      anon_sym_if,
+    ACTIONS(57), 1,
+      anon_sym_loop,
+    ACTIONS(59), 1,
+      anon_sym_throw,
+    ACTIONS(63), 1,
+      anon_sym_LBRACK_LBRACK,
+    ACTIONS(65), 1,
+      anon_sym_LBRACE,
+    ACTIONS(61), 4,
+      anon_sym_send,
+      anon_sym_receive,
+      anon_sym_publish,
+      anon_sym_subscribe,
+    STATE(181), 9,
+      sym_block,
+      sym__body,
+      sym__statement,
+      sym_if_statement,
+      sym_loop_statement,
+      sym_throw_statement,
+      sym_call,
+      sym_communication,
+      sym_group_statement,
+  [673] = 10,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(49), 1,
+      sym_identifier,
+    ACTIONS(55), 1,
+      anon_sym_if,
+    ACTIONS(57), 1,
+      anon_sym_loop,
+    ACTIONS(59), 1,
+      anon_sym_throw,
+    ACTIONS(63), 1,
+      anon_sym_LBRACK_LBRACK,
+    ACTIONS(67), 1,
+      anon_sym_SEMI,
+    ACTIONS(69), 1,
+      anon_sym_RBRACE,
+    ACTIONS(61), 4,
+      anon_sym_send,
+      anon_sym_receive,
+      anon_sym_publish,
+      anon_sym_subscribe,
+    STATE(20), 8,
       sym__statement,
       sym_if_statement,
       sym_loop_statement,
@@ -2793,127 +3050,6 @@ static const uint16_t ts_small_parse_table[] = {
       sym_communication,
       sym_group_statement,
       aux_sym_block_repeat1,
-  [556] = 10,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(49), 1,
-      sym_identifier,
-    ACTIONS(55), 1,
-      anon_sym_if,
-    ACTIONS(57), 1,
-      anon_sym_loop,
-    ACTIONS(59), 1,
-      anon_sym_throw,
-    ACTIONS(63), 1,
-      anon_sym_LBRACK_LBRACK,
-    ACTIONS(88), 1,
-      anon_sym_SEMI,
-    ACTIONS(90), 1,
-      anon_sym_RBRACE,
-    ACTIONS(61), 4,
-      anon_sym_send,
-      anon_sym_receive,
-      anon_sym_publish,
-      anon_sym_subscribe,
-    STATE(13), 8,
-      sym__statement,
-      sym_if_statement,
-      sym_loop_statement,
-      sym_throw_statement,
-      sym_call,
-      sym_communication,
-      sym_group_statement,
-      aux_sym_block_repeat1,
-  [597] = 9,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(49), 1,
-      sym_identifier,
-    ACTIONS(55), 1,
-      anon_sym_if,
-    ACTIONS(57), 1,
-      anon_sym_loop,
-    ACTIONS(59), 1,
-      anon_sym_throw,
-    ACTIONS(63), 1,
-      anon_sym_LBRACK_LBRACK,
-    ACTIONS(92), 1,
-      anon_sym_LBRACE,
-    ACTIONS(61), 4,
-      anon_sym_send,
-      anon_sym_receive,
-      anon_sym_publish,
-      anon_sym_subscribe,
-    STATE(101), 9,
-      sym_block,
-      sym__body,
-      sym__statement,
-      sym_if_statement,
-      sym_loop_statement,
-      sym_throw_statement,
-      sym_call,
-      sym_communication,
-      sym_group_statement,
-  [636] = 9,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(49), 1,
-      sym_identifier,
-    ACTIONS(55), 1,
-      anon_sym_if,
-    ACTIONS(57), 1,
-      anon_sym_loop,
-    ACTIONS(59), 1,
-      anon_sym_throw,
-    ACTIONS(63), 1,
-      anon_sym_LBRACK_LBRACK,
-    ACTIONS(92), 1,
-      anon_sym_LBRACE,
-    ACTIONS(61), 4,
-      anon_sym_send,
-      anon_sym_receive,
-      anon_sym_publish,
-      anon_sym_subscribe,
-    STATE(102), 9,
-      sym_block,
-      sym__body,
-      sym__statement,
-      sym_if_statement,
-      sym_loop_statement,
-      sym_throw_statement,
-      sym_call,
-      sym_communication,
-      sym_group_statement,
-  [675] = 9,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(49), 1,
-      sym_identifier,
-    ACTIONS(55), 1,
-      anon_sym_if,
-    ACTIONS(57), 1,
-      anon_sym_loop,
-    ACTIONS(59), 1,
-      anon_sym_throw,
-    ACTIONS(63), 1,
-      anon_sym_LBRACK_LBRACK,
-    ACTIONS(92), 1,
-      anon_sym_LBRACE,
-    ACTIONS(61), 4,
-      anon_sym_send,
-      anon_sym_receive,
-      anon_sym_publish,
-      anon_sym_subscribe,
-    STATE(35), 9,
-      sym_block,
-      sym__body,
-      sym__statement,
-      sym_if_statement,
-      sym_loop_statement,
-      sym_throw_statement,
-      sym_call,
-      sym_communication,
-      sym_group_statement,
   [714] = 9,
     ACTIONS(3), 1,
       sym_comment,
@@ -2927,7 +3063,7 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_throw,
     ACTIONS(63), 1,
       anon_sym_LBRACK_LBRACK,
-    ACTIONS(92), 1,
+    ACTIONS(65), 1,
       anon_sym_LBRACE,
     ACTIONS(61), 4,
       anon_sym_send,
@@ -2944,29 +3080,29 @@ static const uint16_t ts_small_parse_table[] = {
       sym_call,
       sym_communication,
       sym_group_statement,
-  [753] = 9,
+  [753] = 10,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(49), 1,
+    ACTIONS(71), 1,
       sym_identifier,
-    ACTIONS(55), 1,
+    ACTIONS(74), 1,
+      anon_sym_SEMI,
+    ACTIONS(77), 1,
+      anon_sym_RBRACE,
+    ACTIONS(79), 1,
       anon_sym_if,
-    ACTIONS(57), 1,
+    ACTIONS(82), 1,
       anon_sym_loop,
-    ACTIONS(59), 1,
+    ACTIONS(85), 1,
       anon_sym_throw,
-    ACTIONS(63), 1,
+    ACTIONS(91), 1,
       anon_sym_LBRACK_LBRACK,
-    ACTIONS(92), 1,
-      anon_sym_LBRACE,
-    ACTIONS(61), 4,
+    ACTIONS(88), 4,
       anon_sym_send,
       anon_sym_receive,
       anon_sym_publish,
       anon_sym_subscribe,
-    STATE(159), 9,
-      sym_block,
-      sym__body,
+    STATE(20), 8,
       sym__statement,
       sym_if_statement,
       sym_loop_statement,
@@ -2974,38 +3110,8 @@ static const uint16_t ts_small_parse_table[] = {
       sym_call,
       sym_communication,
       sym_group_statement,
-  [792] = 10,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(19), 1,
-      sym_identifier,
-    ACTIONS(21), 1,
-      anon_sym_LPAREN,
-    ACTIONS(27), 1,
-      anon_sym_not,
-    ACTIONS(29), 1,
-      anon_sym_BANG,
-    ACTIONS(33), 1,
-      sym_number,
-    ACTIONS(35), 1,
-      sym_string,
-    ACTIONS(31), 2,
-      anon_sym_true,
-      anon_sym_false,
-    STATE(50), 5,
-      sym__primary,
-      sym_parenthesized_expression,
-      sym_attribute,
-      sym_boolean,
-      sym_period,
-    STATE(70), 6,
-      sym__and_level,
-      sym_and_expression,
-      sym__not_level,
-      sym_not_expression,
-      sym__comparison_level,
-      sym_comparison,
-  [833] = 9,
+      aux_sym_block_repeat1,
+  [794] = 9,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(49), 1,
@@ -3018,7 +3124,7 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_throw,
     ACTIONS(63), 1,
       anon_sym_LBRACK_LBRACK,
-    ACTIONS(92), 1,
+    ACTIONS(65), 1,
       anon_sym_LBRACE,
     ACTIONS(61), 4,
       anon_sym_send,
@@ -3035,14 +3141,43 @@ static const uint16_t ts_small_parse_table[] = {
       sym_call,
       sym_communication,
       sym_group_statement,
-  [872] = 4,
+  [833] = 9,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(98), 1,
-      anon_sym_COMMA,
-    ACTIONS(96), 4,
+    ACTIONS(49), 1,
+      sym_identifier,
+    ACTIONS(55), 1,
+      anon_sym_if,
+    ACTIONS(57), 1,
+      anon_sym_loop,
+    ACTIONS(59), 1,
+      anon_sym_throw,
+    ACTIONS(63), 1,
+      anon_sym_LBRACK_LBRACK,
+    ACTIONS(65), 1,
+      anon_sym_LBRACE,
+    ACTIONS(61), 4,
+      anon_sym_send,
+      anon_sym_receive,
+      anon_sym_publish,
+      anon_sym_subscribe,
+    STATE(40), 9,
+      sym_block,
+      sym__body,
+      sym__statement,
+      sym_if_statement,
+      sym_loop_statement,
+      sym_throw_statement,
+      sym_call,
+      sym_communication,
+      sym_group_statement,
+  [872] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(96), 5,
       anon_sym_SEMI,
       anon_sym_RBRACE,
+      anon_sym_COMMA,
       anon_sym_LBRACK_LBRACK,
       anon_sym_RBRACK_RBRACK,
     ACTIONS(94), 12,
@@ -3058,7 +3193,7 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_leader,
       anon_sym_others,
       sym_identifier,
-  [899] = 10,
+  [897] = 10,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(19), 1,
@@ -3076,7 +3211,7 @@ static const uint16_t ts_small_parse_table[] = {
     ACTIONS(31), 2,
       anon_sym_true,
       anon_sym_false,
-    STATE(79), 4,
+    STATE(72), 4,
       sym__not_level,
       sym_not_expression,
       sym__comparison_level,
@@ -3087,16 +3222,17 @@ static const uint16_t ts_small_parse_table[] = {
       sym_attribute,
       sym_boolean,
       sym_period,
-  [938] = 3,
+  [936] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(102), 5,
+    ACTIONS(102), 1,
+      anon_sym_broadcast,
+    ACTIONS(100), 4,
       anon_sym_SEMI,
       anon_sym_RBRACE,
-      anon_sym_COMMA,
       anon_sym_LBRACK_LBRACK,
       anon_sym_RBRACK_RBRACK,
-    ACTIONS(100), 12,
+    ACTIONS(98), 12,
       anon_sym_if,
       anon_sym_else,
       anon_sym_loop,
@@ -3109,13 +3245,14 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_leader,
       anon_sym_others,
       sym_identifier,
-  [963] = 3,
+  [963] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(106), 5,
+    ACTIONS(108), 1,
+      anon_sym_COMMA,
+    ACTIONS(106), 4,
       anon_sym_SEMI,
       anon_sym_RBRACE,
-      anon_sym_COMMA,
       anon_sym_LBRACK_LBRACK,
       anon_sym_RBRACK_RBRACK,
     ACTIONS(104), 12,
@@ -3131,16 +3268,16 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_leader,
       anon_sym_others,
       sym_identifier,
-  [988] = 3,
+  [990] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(110), 5,
+    ACTIONS(112), 5,
       anon_sym_SEMI,
       anon_sym_RBRACE,
       anon_sym_COMMA,
       anon_sym_LBRACK_LBRACK,
       anon_sym_RBRACK_RBRACK,
-    ACTIONS(108), 12,
+    ACTIONS(110), 12,
       anon_sym_if,
       anon_sym_else,
       anon_sym_loop,
@@ -3153,53 +3290,7 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_leader,
       anon_sym_others,
       sym_identifier,
-  [1013] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(116), 1,
-      anon_sym_COMMA,
-    ACTIONS(114), 4,
-      anon_sym_SEMI,
-      anon_sym_RBRACE,
-      anon_sym_LBRACK_LBRACK,
-      anon_sym_RBRACK_RBRACK,
-    ACTIONS(112), 12,
-      anon_sym_if,
-      anon_sym_else,
-      anon_sym_loop,
-      anon_sym_throw,
-      anon_sym_send,
-      anon_sym_receive,
-      anon_sym_publish,
-      anon_sym_subscribe,
-      anon_sym_group,
-      anon_sym_leader,
-      anon_sym_others,
-      sym_identifier,
-  [1040] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(122), 1,
-      anon_sym_broadcast,
-    ACTIONS(120), 4,
-      anon_sym_SEMI,
-      anon_sym_RBRACE,
-      anon_sym_LBRACK_LBRACK,
-      anon_sym_RBRACK_RBRACK,
-    ACTIONS(118), 12,
-      anon_sym_if,
-      anon_sym_else,
-      anon_sym_loop,
-      anon_sym_throw,
-      anon_sym_send,
-      anon_sym_receive,
-      anon_sym_publish,
-      anon_sym_subscribe,
-      anon_sym_group,
-      anon_sym_leader,
-      anon_sym_others,
-      sym_identifier,
-  [1067] = 10,
+  [1015] = 10,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(19), 1,
@@ -3217,7 +3308,7 @@ static const uint16_t ts_small_parse_table[] = {
     ACTIONS(31), 2,
       anon_sym_true,
       anon_sym_false,
-    STATE(71), 4,
+    STATE(67), 4,
       sym__not_level,
       sym_not_expression,
       sym__comparison_level,
@@ -3228,14 +3319,58 @@ static const uint16_t ts_small_parse_table[] = {
       sym_attribute,
       sym_boolean,
       sym_period,
-  [1106] = 4,
+  [1054] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(128), 1,
+    ACTIONS(118), 1,
       anon_sym_COMMA,
-    ACTIONS(126), 4,
+    ACTIONS(116), 4,
       anon_sym_SEMI,
       anon_sym_RBRACE,
+      anon_sym_LBRACK_LBRACK,
+      anon_sym_RBRACK_RBRACK,
+    ACTIONS(114), 12,
+      anon_sym_if,
+      anon_sym_else,
+      anon_sym_loop,
+      anon_sym_throw,
+      anon_sym_send,
+      anon_sym_receive,
+      anon_sym_publish,
+      anon_sym_subscribe,
+      anon_sym_group,
+      anon_sym_leader,
+      anon_sym_others,
+      sym_identifier,
+  [1081] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(122), 5,
+      anon_sym_SEMI,
+      anon_sym_RBRACE,
+      anon_sym_COMMA,
+      anon_sym_LBRACK_LBRACK,
+      anon_sym_RBRACK_RBRACK,
+    ACTIONS(120), 12,
+      anon_sym_if,
+      anon_sym_else,
+      anon_sym_loop,
+      anon_sym_throw,
+      anon_sym_send,
+      anon_sym_receive,
+      anon_sym_publish,
+      anon_sym_subscribe,
+      anon_sym_group,
+      anon_sym_leader,
+      anon_sym_others,
+      sym_identifier,
+  [1106] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(126), 5,
+      anon_sym_SEMI,
+      anon_sym_RBRACE,
+      anon_sym_RPAREN,
       anon_sym_LBRACK_LBRACK,
       anon_sym_RBRACK_RBRACK,
     ACTIONS(124), 12,
@@ -3251,16 +3386,17 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_leader,
       anon_sym_others,
       sym_identifier,
-  [1133] = 3,
+  [1131] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(132), 5,
+    ACTIONS(132), 1,
+      anon_sym_COMMA,
+    ACTIONS(130), 4,
       anon_sym_SEMI,
       anon_sym_RBRACE,
-      anon_sym_RPAREN,
       anon_sym_LBRACK_LBRACK,
       anon_sym_RBRACK_RBRACK,
-    ACTIONS(130), 12,
+    ACTIONS(128), 12,
       anon_sym_if,
       anon_sym_else,
       anon_sym_loop,
@@ -3315,37 +3451,15 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_leader,
       anon_sym_others,
       sym_identifier,
-  [1206] = 4,
+  [1206] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(146), 1,
-      anon_sym_else,
     ACTIONS(144), 4,
       anon_sym_SEMI,
       anon_sym_RBRACE,
       anon_sym_LBRACK_LBRACK,
       anon_sym_RBRACK_RBRACK,
-    ACTIONS(142), 11,
-      anon_sym_if,
-      anon_sym_loop,
-      anon_sym_throw,
-      anon_sym_send,
-      anon_sym_receive,
-      anon_sym_publish,
-      anon_sym_subscribe,
-      anon_sym_group,
-      anon_sym_leader,
-      anon_sym_others,
-      sym_identifier,
-  [1232] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(150), 4,
-      anon_sym_SEMI,
-      anon_sym_RBRACE,
-      anon_sym_LBRACK_LBRACK,
-      anon_sym_RBRACK_RBRACK,
-    ACTIONS(148), 12,
+    ACTIONS(142), 12,
       anon_sym_if,
       anon_sym_else,
       anon_sym_loop,
@@ -3358,15 +3472,15 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_leader,
       anon_sym_others,
       sym_identifier,
-  [1256] = 3,
+  [1230] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(154), 4,
+    ACTIONS(148), 4,
       anon_sym_SEMI,
       anon_sym_RBRACE,
       anon_sym_LBRACK_LBRACK,
       anon_sym_RBRACK_RBRACK,
-    ACTIONS(152), 12,
+    ACTIONS(146), 12,
       anon_sym_if,
       anon_sym_else,
       anon_sym_loop,
@@ -3379,15 +3493,15 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_leader,
       anon_sym_others,
       sym_identifier,
-  [1280] = 3,
+  [1254] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(158), 4,
+    ACTIONS(152), 4,
       anon_sym_SEMI,
       anon_sym_RBRACE,
       anon_sym_LBRACK_LBRACK,
       anon_sym_RBRACK_RBRACK,
-    ACTIONS(156), 12,
+    ACTIONS(150), 12,
       anon_sym_if,
       anon_sym_else,
       anon_sym_loop,
@@ -3400,17 +3514,39 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_leader,
       anon_sym_others,
       sym_identifier,
-  [1304] = 3,
+  [1278] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(162), 4,
+    ACTIONS(156), 4,
       anon_sym_SEMI,
       anon_sym_RBRACE,
       anon_sym_LBRACK_LBRACK,
       anon_sym_RBRACK_RBRACK,
-    ACTIONS(160), 12,
+    ACTIONS(154), 12,
       anon_sym_if,
       anon_sym_else,
+      anon_sym_loop,
+      anon_sym_throw,
+      anon_sym_send,
+      anon_sym_receive,
+      anon_sym_publish,
+      anon_sym_subscribe,
+      anon_sym_group,
+      anon_sym_leader,
+      anon_sym_others,
+      sym_identifier,
+  [1302] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(162), 1,
+      anon_sym_else,
+    ACTIONS(160), 4,
+      anon_sym_SEMI,
+      anon_sym_RBRACE,
+      anon_sym_LBRACK_LBRACK,
+      anon_sym_RBRACK_RBRACK,
+    ACTIONS(158), 11,
+      anon_sym_if,
       anon_sym_loop,
       anon_sym_throw,
       anon_sym_send,
@@ -3551,17 +3687,17 @@ static const uint16_t ts_small_parse_table[] = {
   [1479] = 7,
     ACTIONS(3), 1,
       sym_comment,
+    ACTIONS(7), 1,
+      sym_identifier,
+    ACTIONS(11), 1,
+      anon_sym_LBRACE,
+    ACTIONS(13), 1,
+      anon_sym_def,
     ACTIONS(189), 1,
       ts_builtin_sym_end,
     ACTIONS(191), 1,
-      sym_identifier,
-    ACTIONS(194), 1,
       anon_sym_SEMI,
-    ACTIONS(197), 1,
-      anon_sym_LBRACE,
-    ACTIONS(200), 1,
-      anon_sym_def,
-    STATE(46), 8,
+    STATE(47), 8,
       sym__item,
       sym_formation,
       sym_team_declaration,
@@ -3570,15 +3706,37 @@ static const uint16_t ts_small_parse_table[] = {
       sym_mode_definition,
       sym_main_definition,
       aux_sym_source_file_repeat1,
-  [1508] = 4,
+  [1508] = 7,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(207), 1,
+    ACTIONS(193), 1,
+      ts_builtin_sym_end,
+    ACTIONS(195), 1,
+      sym_identifier,
+    ACTIONS(198), 1,
+      anon_sym_SEMI,
+    ACTIONS(201), 1,
+      anon_sym_LBRACE,
+    ACTIONS(204), 1,
+      anon_sym_def,
+    STATE(47), 8,
+      sym__item,
+      sym_formation,
+      sym_team_declaration,
+      sym_service_definition,
+      sym_function_definition,
+      sym_mode_definition,
+      sym_main_definition,
+      aux_sym_source_file_repeat1,
+  [1537] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(211), 1,
       sym_time_unit,
-    ACTIONS(205), 2,
+    ACTIONS(209), 2,
       anon_sym_LT,
       anon_sym_GT,
-    ACTIONS(203), 10,
+    ACTIONS(207), 10,
       anon_sym_COMMA,
       anon_sym_RPAREN,
       anon_sym_or,
@@ -3589,28 +3747,6 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_BANG_EQ,
       anon_sym_LT_EQ,
       anon_sym_GT_EQ,
-  [1531] = 7,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(7), 1,
-      sym_identifier,
-    ACTIONS(11), 1,
-      anon_sym_LBRACE,
-    ACTIONS(13), 1,
-      anon_sym_def,
-    ACTIONS(209), 1,
-      ts_builtin_sym_end,
-    ACTIONS(211), 1,
-      anon_sym_SEMI,
-    STATE(46), 8,
-      sym__item,
-      sym_formation,
-      sym_team_declaration,
-      sym_service_definition,
-      sym_function_definition,
-      sym_mode_definition,
-      sym_main_definition,
-      aux_sym_source_file_repeat1,
   [1560] = 5,
     ACTIONS(3), 1,
       sym_comment,
@@ -3618,10 +3754,10 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_COMMA,
     ACTIONS(215), 1,
       anon_sym_RPAREN,
-    ACTIONS(205), 2,
+    ACTIONS(209), 2,
       anon_sym_LT,
       anon_sym_GT,
-    ACTIONS(203), 8,
+    ACTIONS(207), 8,
       anon_sym_or,
       anon_sym_PIPE_PIPE,
       anon_sym_and,
@@ -3696,7 +3832,7 @@ static const uint16_t ts_small_parse_table[] = {
     ACTIONS(31), 2,
       anon_sym_true,
       anon_sym_false,
-    STATE(72), 5,
+    STATE(73), 5,
       sym__primary,
       sym_parenthesized_expression,
       sym_attribute,
@@ -3724,7 +3860,7 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_SEMI,
     ACTIONS(243), 1,
       anon_sym_COMMA,
-    STATE(56), 1,
+    STATE(57), 1,
       aux_sym_team_declaration_repeat1,
     STATE(65), 1,
       aux_sym_team_declaration_repeat2,
@@ -3742,9 +3878,9 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_COMMA,
     ACTIONS(249), 1,
       anon_sym_SEMI,
-    STATE(59), 1,
+    STATE(55), 1,
       aux_sym_team_declaration_repeat1,
-    STATE(66), 1,
+    STATE(60), 1,
       aux_sym_team_declaration_repeat2,
     ACTIONS(247), 2,
       anon_sym_def,
@@ -3753,11 +3889,95 @@ static const uint16_t ts_small_parse_table[] = {
       ts_builtin_sym_end,
       anon_sym_LBRACE,
       anon_sym_RBRACE,
-  [1741] = 4,
+  [1741] = 5,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(255), 1,
+      anon_sym_COMMA,
+    STATE(57), 1,
+      aux_sym_team_declaration_repeat1,
+    ACTIONS(253), 2,
+      anon_sym_def,
+      sym_identifier,
+    ACTIONS(251), 4,
+      ts_builtin_sym_end,
+      anon_sym_SEMI,
+      anon_sym_LBRACE,
+      anon_sym_RBRACE,
+  [1761] = 7,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(258), 1,
+      anon_sym_RBRACK_RBRACK,
+    ACTIONS(260), 1,
+      anon_sym_group,
+    ACTIONS(262), 1,
+      anon_sym_leader,
+    ACTIONS(264), 1,
+      anon_sym_others,
+    STATE(157), 1,
+      sym_others_arm,
+    STATE(62), 3,
+      sym_group_arm,
+      sym_leader_arm,
+      aux_sym_group_statement_repeat1,
+  [1785] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(270), 1,
       anon_sym_LBRACK,
+    ACTIONS(268), 2,
+      anon_sym_def,
+      sym_identifier,
+    ACTIONS(266), 5,
+      ts_builtin_sym_end,
+      anon_sym_SEMI,
+      anon_sym_LBRACE,
+      anon_sym_RBRACE,
+      anon_sym_COMMA,
+  [1803] = 5,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(272), 1,
+      anon_sym_SEMI,
+    STATE(64), 1,
+      aux_sym_team_declaration_repeat2,
+    ACTIONS(239), 2,
+      anon_sym_def,
+      sym_identifier,
+    ACTIONS(237), 3,
+      ts_builtin_sym_end,
+      anon_sym_LBRACE,
+      anon_sym_RBRACE,
+  [1822] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(276), 2,
+      anon_sym_def,
+      sym_identifier,
+    ACTIONS(274), 5,
+      ts_builtin_sym_end,
+      anon_sym_SEMI,
+      anon_sym_LBRACE,
+      anon_sym_RBRACE,
+      anon_sym_COMMA,
+  [1837] = 5,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(280), 1,
+      anon_sym_group,
+    ACTIONS(283), 1,
+      anon_sym_leader,
+    ACTIONS(278), 2,
+      anon_sym_RBRACK_RBRACK,
+      anon_sym_others,
+    STATE(62), 3,
+      sym_group_arm,
+      sym_leader_arm,
+      aux_sym_group_statement_repeat1,
+  [1856] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
     ACTIONS(253), 2,
       anon_sym_def,
       sym_identifier,
@@ -3767,229 +3987,133 @@ static const uint16_t ts_small_parse_table[] = {
       anon_sym_LBRACE,
       anon_sym_RBRACE,
       anon_sym_COMMA,
-  [1759] = 7,
+  [1871] = 5,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(257), 1,
-      anon_sym_RBRACK_RBRACK,
-    ACTIONS(259), 1,
-      anon_sym_group,
-    ACTIONS(261), 1,
-      anon_sym_leader,
-    ACTIONS(263), 1,
-      anon_sym_others,
-    STATE(190), 1,
-      sym_others_arm,
-    STATE(63), 3,
-      sym_group_arm,
-      sym_leader_arm,
-      aux_sym_group_statement_repeat1,
-  [1783] = 5,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(269), 1,
-      anon_sym_COMMA,
-    STATE(59), 1,
-      aux_sym_team_declaration_repeat1,
-    ACTIONS(267), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(265), 4,
-      ts_builtin_sym_end,
+    ACTIONS(290), 1,
       anon_sym_SEMI,
-      anon_sym_LBRACE,
-      anon_sym_RBRACE,
-  [1803] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(274), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(272), 5,
-      ts_builtin_sym_end,
-      anon_sym_SEMI,
-      anon_sym_LBRACE,
-      anon_sym_RBRACE,
-      anon_sym_COMMA,
-  [1818] = 5,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(280), 1,
-      anon_sym_SEMI,
-    STATE(61), 1,
+    STATE(64), 1,
       aux_sym_team_declaration_repeat2,
-    ACTIONS(278), 2,
+    ACTIONS(288), 2,
       anon_sym_def,
       sym_identifier,
-    ACTIONS(276), 3,
+    ACTIONS(286), 3,
       ts_builtin_sym_end,
       anon_sym_LBRACE,
       anon_sym_RBRACE,
-  [1837] = 5,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(287), 1,
-      anon_sym_repeat,
-    STATE(92), 1,
-      sym_repeat_clause,
-    ACTIONS(285), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(283), 3,
-      ts_builtin_sym_end,
-      anon_sym_SEMI,
-      anon_sym_LBRACE,
-  [1856] = 5,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(291), 1,
-      anon_sym_group,
-    ACTIONS(294), 1,
-      anon_sym_leader,
-    ACTIONS(289), 2,
-      anon_sym_RBRACK_RBRACK,
-      anon_sym_others,
-    STATE(63), 3,
-      sym_group_arm,
-      sym_leader_arm,
-      aux_sym_group_statement_repeat1,
-  [1875] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(267), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(265), 5,
-      ts_builtin_sym_end,
-      anon_sym_SEMI,
-      anon_sym_LBRACE,
-      anon_sym_RBRACE,
-      anon_sym_COMMA,
   [1890] = 5,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(297), 1,
+    ACTIONS(272), 1,
       anon_sym_SEMI,
-    STATE(61), 1,
+    STATE(64), 1,
       aux_sym_team_declaration_repeat2,
-    ACTIONS(247), 2,
+    ACTIONS(295), 2,
       anon_sym_def,
       sym_identifier,
-    ACTIONS(245), 3,
+    ACTIONS(293), 3,
       ts_builtin_sym_end,
       anon_sym_LBRACE,
       anon_sym_RBRACE,
   [1909] = 5,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(297), 1,
-      anon_sym_SEMI,
-    STATE(61), 1,
-      aux_sym_team_declaration_repeat2,
-    ACTIONS(301), 2,
+    ACTIONS(301), 1,
+      anon_sym_repeat,
+    STATE(84), 1,
+      sym_repeat_clause,
+    ACTIONS(299), 2,
       anon_sym_def,
       sym_identifier,
-    ACTIONS(299), 3,
+    ACTIONS(297), 3,
       ts_builtin_sym_end,
-      anon_sym_LBRACE,
-      anon_sym_RBRACE,
-  [1928] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(303), 1,
       anon_sym_SEMI,
-    STATE(67), 1,
-      aux_sym_team_declaration_repeat2,
-    ACTIONS(276), 4,
-      anon_sym_RBRACE,
-      anon_sym_case,
-      anon_sym_catch,
-      anon_sym_default,
-  [1944] = 3,
+      anon_sym_LBRACE,
+  [1928] = 2,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(308), 2,
-      anon_sym_and,
-      anon_sym_AMP_AMP,
-    ACTIONS(306), 4,
+    ACTIONS(303), 6,
       anon_sym_COMMA,
       anon_sym_RPAREN,
       anon_sym_or,
       anon_sym_PIPE_PIPE,
-  [1958] = 5,
+      anon_sym_and,
+      anon_sym_AMP_AMP,
+  [1940] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(310), 1,
+    ACTIONS(305), 1,
+      anon_sym_SEMI,
+    STATE(68), 1,
+      aux_sym_team_declaration_repeat2,
+    ACTIONS(286), 4,
       anon_sym_RBRACE,
-    ACTIONS(312), 1,
       anon_sym_case,
-    ACTIONS(314), 1,
+      anon_sym_catch,
       anon_sym_default,
-    STATE(76), 3,
+  [1956] = 5,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(308), 1,
+      anon_sym_RBRACE,
+    ACTIONS(310), 1,
+      anon_sym_case,
+    ACTIONS(312), 1,
+      anon_sym_default,
+    STATE(70), 3,
       sym_case_clause,
       sym_default_clause,
       aux_sym_main_body_repeat1,
-  [1976] = 3,
+  [1974] = 5,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(308), 2,
-      anon_sym_and,
-      anon_sym_AMP_AMP,
-    ACTIONS(316), 4,
-      anon_sym_COMMA,
-      anon_sym_RPAREN,
-      anon_sym_or,
-      anon_sym_PIPE_PIPE,
-  [1990] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(318), 6,
-      anon_sym_COMMA,
-      anon_sym_RPAREN,
-      anon_sym_or,
-      anon_sym_PIPE_PIPE,
-      anon_sym_and,
-      anon_sym_AMP_AMP,
-  [2002] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(320), 6,
-      anon_sym_COMMA,
-      anon_sym_RPAREN,
-      anon_sym_or,
-      anon_sym_PIPE_PIPE,
-      anon_sym_and,
-      anon_sym_AMP_AMP,
-  [2014] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(324), 1,
-      anon_sym_catch,
-    STATE(77), 2,
-      sym_catch_clause,
-      aux_sym_case_clause_repeat1,
-    ACTIONS(322), 3,
-      anon_sym_RBRACE,
-      anon_sym_case,
-      anon_sym_default,
-  [2030] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(326), 1,
-      anon_sym_SEMI,
-    STATE(78), 1,
-      aux_sym_team_declaration_repeat2,
-    ACTIONS(328), 4,
-      anon_sym_RBRACE,
-      anon_sym_case,
-      anon_sym_catch,
-      anon_sym_default,
-  [2046] = 5,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(312), 1,
-      anon_sym_case,
     ACTIONS(314), 1,
+      anon_sym_RBRACE,
+    ACTIONS(316), 1,
+      anon_sym_case,
+    ACTIONS(319), 1,
+      anon_sym_default,
+    STATE(70), 3,
+      sym_case_clause,
+      sym_default_clause,
+      aux_sym_main_body_repeat1,
+  [1992] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(324), 2,
+      anon_sym_and,
+      anon_sym_AMP_AMP,
+    ACTIONS(322), 4,
+      anon_sym_COMMA,
+      anon_sym_RPAREN,
+      anon_sym_or,
+      anon_sym_PIPE_PIPE,
+  [2006] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(326), 6,
+      anon_sym_COMMA,
+      anon_sym_RPAREN,
+      anon_sym_or,
+      anon_sym_PIPE_PIPE,
+      anon_sym_and,
+      anon_sym_AMP_AMP,
+  [2018] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(328), 6,
+      anon_sym_COMMA,
+      anon_sym_RPAREN,
+      anon_sym_or,
+      anon_sym_PIPE_PIPE,
+      anon_sym_and,
+      anon_sym_AMP_AMP,
+  [2030] = 5,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(310), 1,
+      anon_sym_case,
+    ACTIONS(312), 1,
       anon_sym_default,
     ACTIONS(330), 1,
       anon_sym_RBRACE,
@@ -3997,893 +4121,933 @@ static const uint16_t ts_small_parse_table[] = {
       sym_case_clause,
       sym_default_clause,
       aux_sym_main_body_repeat1,
-  [2064] = 5,
+  [2048] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(332), 1,
-      anon_sym_RBRACE,
-    ACTIONS(334), 1,
-      anon_sym_case,
-    ACTIONS(337), 1,
-      anon_sym_default,
-    STATE(76), 3,
-      sym_case_clause,
-      sym_default_clause,
-      aux_sym_main_body_repeat1,
-  [2082] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(324), 1,
-      anon_sym_catch,
-    STATE(80), 2,
-      sym_catch_clause,
-      aux_sym_case_clause_repeat1,
-    ACTIONS(340), 3,
-      anon_sym_RBRACE,
-      anon_sym_case,
-      anon_sym_default,
-  [2098] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(342), 1,
-      anon_sym_SEMI,
-    STATE(67), 1,
-      aux_sym_team_declaration_repeat2,
-    ACTIONS(344), 4,
-      anon_sym_RBRACE,
-      anon_sym_case,
-      anon_sym_catch,
-      anon_sym_default,
-  [2114] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(346), 6,
+    ACTIONS(324), 2,
+      anon_sym_and,
+      anon_sym_AMP_AMP,
+    ACTIONS(332), 4,
       anon_sym_COMMA,
       anon_sym_RPAREN,
       anon_sym_or,
       anon_sym_PIPE_PIPE,
-      anon_sym_and,
-      anon_sym_AMP_AMP,
-  [2126] = 4,
+  [2062] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(350), 1,
+    ACTIONS(336), 1,
       anon_sym_catch,
-    STATE(80), 2,
+    STATE(78), 2,
       sym_catch_clause,
       aux_sym_case_clause_repeat1,
-    ACTIONS(348), 3,
+    ACTIONS(334), 3,
       anon_sym_RBRACE,
       anon_sym_case,
       anon_sym_default,
-  [2142] = 3,
+  [2078] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(355), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(353), 3,
-      ts_builtin_sym_end,
+    ACTIONS(338), 1,
       anon_sym_SEMI,
-      anon_sym_LBRACE,
-  [2155] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(359), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(357), 3,
-      ts_builtin_sym_end,
-      anon_sym_SEMI,
-      anon_sym_LBRACE,
-  [2168] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(363), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(361), 3,
-      ts_builtin_sym_end,
-      anon_sym_SEMI,
-      anon_sym_LBRACE,
-  [2181] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(367), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(365), 3,
-      ts_builtin_sym_end,
-      anon_sym_SEMI,
-      anon_sym_LBRACE,
-  [2194] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(371), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(369), 3,
-      ts_builtin_sym_end,
-      anon_sym_SEMI,
-      anon_sym_LBRACE,
-  [2207] = 5,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(373), 1,
-      anon_sym_SEMI,
-    ACTIONS(375), 1,
+    STATE(79), 1,
+      aux_sym_team_declaration_repeat2,
+    ACTIONS(340), 4,
       anon_sym_RBRACE,
-    ACTIONS(377), 1,
+      anon_sym_case,
+      anon_sym_catch,
+      anon_sym_default,
+  [2094] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(336), 1,
+      anon_sym_catch,
+    STATE(81), 2,
+      sym_catch_clause,
+      aux_sym_case_clause_repeat1,
+    ACTIONS(342), 3,
+      anon_sym_RBRACE,
+      anon_sym_case,
+      anon_sym_default,
+  [2110] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(344), 1,
+      anon_sym_SEMI,
+    STATE(68), 1,
+      aux_sym_team_declaration_repeat2,
+    ACTIONS(346), 4,
+      anon_sym_RBRACE,
+      anon_sym_case,
+      anon_sym_catch,
+      anon_sym_default,
+  [2126] = 5,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(348), 1,
+      sym_identifier,
+    ACTIONS(350), 1,
+      anon_sym_instance,
+    ACTIONS(352), 1,
+      anon_sym_capable,
+    STATE(164), 3,
+      sym_instance_of,
+      sym_capable_of,
+      sym_counted_group,
+  [2144] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(356), 1,
+      anon_sym_catch,
+    STATE(81), 2,
+      sym_catch_clause,
+      aux_sym_case_clause_repeat1,
+    ACTIONS(354), 3,
+      anon_sym_RBRACE,
+      anon_sym_case,
+      anon_sym_default,
+  [2160] = 5,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(359), 1,
+      anon_sym_SEMI,
+    ACTIONS(362), 1,
+      anon_sym_RBRACE,
+    ACTIONS(364), 1,
       anon_sym_set,
-    STATE(94), 2,
+    STATE(82), 2,
       sym_set_statement,
       aux_sym_mode_body_repeat1,
-  [2224] = 3,
+  [2177] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(381), 2,
+    ACTIONS(369), 2,
       anon_sym_def,
       sym_identifier,
-    ACTIONS(379), 3,
+    ACTIONS(367), 3,
       ts_builtin_sym_end,
       anon_sym_SEMI,
       anon_sym_LBRACE,
-  [2237] = 5,
+  [2190] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(383), 1,
-      anon_sym_COMMA,
+    ACTIONS(373), 2,
+      anon_sym_def,
+      sym_identifier,
+    ACTIONS(371), 3,
+      ts_builtin_sym_end,
+      anon_sym_SEMI,
+      anon_sym_LBRACE,
+  [2203] = 5,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(375), 1,
+      anon_sym_SEMI,
+    ACTIONS(377), 1,
+      anon_sym_RBRACE,
+    ACTIONS(379), 1,
+      anon_sym_set,
+    STATE(82), 2,
+      sym_set_statement,
+      aux_sym_mode_body_repeat1,
+  [2220] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(383), 2,
+      anon_sym_def,
+      sym_identifier,
+    ACTIONS(381), 3,
+      ts_builtin_sym_end,
+      anon_sym_SEMI,
+      anon_sym_LBRACE,
+  [2233] = 5,
+    ACTIONS(3), 1,
+      sym_comment,
     ACTIONS(385), 1,
+      anon_sym_COMMA,
+    ACTIONS(387), 1,
       anon_sym_RPAREN,
     STATE(110), 1,
       aux_sym_arguments_repeat1,
-    ACTIONS(387), 2,
+    ACTIONS(389), 2,
       anon_sym_or,
       anon_sym_PIPE_PIPE,
-  [2254] = 3,
+  [2250] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(391), 2,
+    ACTIONS(393), 2,
       anon_sym_def,
       sym_identifier,
-    ACTIONS(389), 3,
+    ACTIONS(391), 3,
       ts_builtin_sym_end,
       anon_sym_SEMI,
       anon_sym_LBRACE,
-  [2267] = 5,
+  [2263] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(377), 1,
-      anon_sym_set,
-    ACTIONS(393), 1,
+    ACTIONS(397), 2,
+      anon_sym_def,
+      sym_identifier,
+    ACTIONS(395), 3,
+      ts_builtin_sym_end,
       anon_sym_SEMI,
-    ACTIONS(395), 1,
+      anon_sym_LBRACE,
+  [2276] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(401), 2,
+      anon_sym_def,
+      sym_identifier,
+    ACTIONS(399), 3,
+      ts_builtin_sym_end,
+      anon_sym_SEMI,
+      anon_sym_LBRACE,
+  [2289] = 5,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(379), 1,
+      anon_sym_set,
+    ACTIONS(403), 1,
+      anon_sym_SEMI,
+    ACTIONS(405), 1,
       anon_sym_RBRACE,
-    STATE(86), 2,
+    STATE(85), 2,
       sym_set_statement,
       aux_sym_mode_body_repeat1,
-  [2284] = 3,
+  [2306] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(399), 2,
+    ACTIONS(409), 2,
       anon_sym_def,
       sym_identifier,
-    ACTIONS(397), 3,
+    ACTIONS(407), 3,
       ts_builtin_sym_end,
       anon_sym_SEMI,
       anon_sym_LBRACE,
-  [2297] = 3,
+  [2319] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(403), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(401), 3,
-      ts_builtin_sym_end,
-      anon_sym_SEMI,
-      anon_sym_LBRACE,
-  [2310] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(407), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(405), 3,
-      ts_builtin_sym_end,
-      anon_sym_SEMI,
-      anon_sym_LBRACE,
-  [2323] = 5,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(409), 1,
-      anon_sym_SEMI,
-    ACTIONS(412), 1,
-      anon_sym_RBRACE,
-    ACTIONS(414), 1,
-      anon_sym_set,
-    STATE(94), 2,
-      sym_set_statement,
-      aux_sym_mode_body_repeat1,
-  [2340] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(419), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(417), 3,
-      ts_builtin_sym_end,
-      anon_sym_SEMI,
-      anon_sym_LBRACE,
-  [2353] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(423), 2,
-      anon_sym_def,
-      sym_identifier,
-    ACTIONS(421), 3,
-      ts_builtin_sym_end,
-      anon_sym_SEMI,
-      anon_sym_LBRACE,
-  [2366] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(259), 1,
+    ACTIONS(260), 1,
       anon_sym_group,
-    ACTIONS(261), 1,
+    ACTIONS(262), 1,
       anon_sym_leader,
     STATE(58), 3,
       sym_group_arm,
       sym_leader_arm,
       aux_sym_group_statement_repeat1,
-  [2381] = 3,
+  [2334] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(387), 2,
-      anon_sym_or,
-      anon_sym_PIPE_PIPE,
-    ACTIONS(425), 2,
-      anon_sym_COMMA,
-      anon_sym_RPAREN,
-  [2393] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(427), 1,
+    ACTIONS(413), 2,
+      anon_sym_def,
       sym_identifier,
-    ACTIONS(429), 1,
+    ACTIONS(411), 3,
+      ts_builtin_sym_end,
+      anon_sym_SEMI,
+      anon_sym_LBRACE,
+  [2347] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(417), 2,
+      anon_sym_def,
+      sym_identifier,
+    ACTIONS(415), 3,
+      ts_builtin_sym_end,
+      anon_sym_SEMI,
+      anon_sym_LBRACE,
+  [2360] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(421), 2,
+      anon_sym_def,
+      sym_identifier,
+    ACTIONS(419), 3,
+      ts_builtin_sym_end,
+      anon_sym_SEMI,
+      anon_sym_LBRACE,
+  [2373] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(425), 2,
+      anon_sym_def,
+      sym_identifier,
+    ACTIONS(423), 3,
+      ts_builtin_sym_end,
+      anon_sym_SEMI,
+      anon_sym_LBRACE,
+  [2386] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(429), 2,
+      anon_sym_def,
+      sym_identifier,
+    ACTIONS(427), 3,
+      ts_builtin_sym_end,
+      anon_sym_SEMI,
+      anon_sym_LBRACE,
+  [2399] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(431), 4,
+      anon_sym_RBRACK_RBRACK,
+      anon_sym_group,
+      anon_sym_leader,
+      anon_sym_others,
+  [2409] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(433), 1,
+      sym_identifier,
+    ACTIONS(436), 1,
       anon_sym_RBRACE,
-    STATE(104), 2,
+    STATE(100), 2,
       sym_team_declaration,
       aux_sym_formation_repeat1,
-  [2407] = 4,
+  [2423] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(431), 1,
-      anon_sym_instance,
-    ACTIONS(433), 1,
-      anon_sym_capable,
-    STATE(160), 2,
-      sym_instance_of,
-      sym_capable_of,
-  [2421] = 2,
+    ACTIONS(389), 2,
+      anon_sym_or,
+      anon_sym_PIPE_PIPE,
+    ACTIONS(438), 2,
+      anon_sym_COMMA,
+      anon_sym_RPAREN,
+  [2435] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(435), 4,
-      anon_sym_RBRACK_RBRACK,
-      anon_sym_group,
-      anon_sym_leader,
-      anon_sym_others,
-  [2431] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(437), 4,
-      anon_sym_RBRACK_RBRACK,
-      anon_sym_group,
-      anon_sym_leader,
-      anon_sym_others,
-  [2441] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(439), 1,
+    ACTIONS(440), 1,
       sym_identifier,
     ACTIONS(442), 1,
       anon_sym_RBRACE,
     STATE(103), 2,
       sym_team_declaration,
       aux_sym_formation_repeat1,
-  [2455] = 4,
+  [2449] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(427), 1,
+    ACTIONS(440), 1,
       sym_identifier,
     ACTIONS(444), 1,
       anon_sym_RBRACE,
-    STATE(103), 2,
+    STATE(100), 2,
       sym_team_declaration,
       aux_sym_formation_repeat1,
-  [2469] = 3,
+  [2463] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(387), 2,
+    ACTIONS(389), 2,
       anon_sym_or,
       anon_sym_PIPE_PIPE,
     ACTIONS(446), 2,
       anon_sym_COMMA,
       anon_sym_RPAREN,
-  [2481] = 2,
+  [2475] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(448), 4,
+      anon_sym_RBRACK_RBRACK,
+      anon_sym_group,
+      anon_sym_leader,
+      anon_sym_others,
+  [2485] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(450), 4,
       anon_sym_RBRACE,
       anon_sym_case,
       anon_sym_catch,
       anon_sym_default,
-  [2491] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(450), 1,
-      anon_sym_RPAREN,
-    ACTIONS(387), 2,
-      anon_sym_or,
-      anon_sym_PIPE_PIPE,
-  [2502] = 4,
+  [2495] = 4,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(452), 1,
+      anon_sym_COMMA,
+    ACTIONS(455), 1,
+      anon_sym_RPAREN,
+    STATE(107), 1,
+      aux_sym_instance_of_repeat1,
+  [2508] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(457), 1,
+      anon_sym_RPAREN,
+    ACTIONS(389), 2,
+      anon_sym_or,
+      anon_sym_PIPE_PIPE,
+  [2519] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(459), 1,
+      anon_sym_RPAREN,
+    ACTIONS(389), 2,
+      anon_sym_or,
+      anon_sym_PIPE_PIPE,
+  [2530] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(385), 1,
+      anon_sym_COMMA,
+    ACTIONS(461), 1,
+      anon_sym_RPAREN,
+    STATE(116), 1,
+      aux_sym_arguments_repeat1,
+  [2543] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(463), 3,
+      anon_sym_RBRACE,
+      anon_sym_case,
+      anon_sym_default,
+  [2552] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(385), 1,
+      anon_sym_COMMA,
+    ACTIONS(387), 1,
+      anon_sym_RPAREN,
+    STATE(110), 1,
+      aux_sym_arguments_repeat1,
+  [2565] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(465), 1,
+      anon_sym_RPAREN,
+    ACTIONS(389), 2,
+      anon_sym_or,
+      anon_sym_PIPE_PIPE,
+  [2576] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(467), 1,
+      anon_sym_COMMA,
+    ACTIONS(469), 1,
+      anon_sym_RPAREN,
+    STATE(118), 1,
+      aux_sym_communication_repeat1,
+  [2589] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(473), 1,
+      anon_sym_EQ,
+    ACTIONS(471), 2,
+      anon_sym_COMMA,
+      anon_sym_RPAREN,
+  [2600] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(438), 1,
+      anon_sym_RPAREN,
+    ACTIONS(475), 1,
+      anon_sym_COMMA,
+    STATE(116), 1,
+      aux_sym_arguments_repeat1,
+  [2613] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(478), 1,
       sym_identifier,
     STATE(114), 1,
       sym_message,
     STATE(115), 1,
       sym_attribute,
-  [2515] = 3,
+  [2626] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(454), 1,
-      anon_sym_RPAREN,
-    ACTIONS(387), 2,
-      anon_sym_or,
-      anon_sym_PIPE_PIPE,
-  [2526] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(383), 1,
+    ACTIONS(467), 1,
       anon_sym_COMMA,
-    ACTIONS(456), 1,
-      anon_sym_RPAREN,
-    STATE(116), 1,
-      aux_sym_arguments_repeat1,
-  [2539] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(458), 3,
-      anon_sym_RBRACE,
-      anon_sym_case,
-      anon_sym_default,
-  [2548] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(383), 1,
-      anon_sym_COMMA,
-    ACTIONS(385), 1,
-      anon_sym_RPAREN,
-    STATE(110), 1,
-      aux_sym_arguments_repeat1,
-  [2561] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(460), 1,
-      anon_sym_RPAREN,
-    ACTIONS(387), 2,
-      anon_sym_or,
-      anon_sym_PIPE_PIPE,
-  [2572] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(462), 1,
-      anon_sym_COMMA,
-    ACTIONS(464), 1,
-      anon_sym_RPAREN,
-    STATE(118), 1,
-      aux_sym_communication_repeat1,
-  [2585] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(468), 1,
-      anon_sym_EQ,
-    ACTIONS(466), 2,
-      anon_sym_COMMA,
-      anon_sym_RPAREN,
-  [2596] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(425), 1,
-      anon_sym_RPAREN,
-    ACTIONS(470), 1,
-      anon_sym_COMMA,
-    STATE(116), 1,
-      aux_sym_arguments_repeat1,
-  [2609] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(452), 1,
-      sym_identifier,
-    STATE(115), 1,
-      sym_attribute,
-    STATE(141), 1,
-      sym_message,
-  [2622] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(462), 1,
-      anon_sym_COMMA,
-    ACTIONS(473), 1,
-      anon_sym_RPAREN,
-    STATE(121), 1,
-      aux_sym_communication_repeat1,
-  [2635] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(475), 1,
-      anon_sym_COMMA,
-    ACTIONS(477), 1,
+    ACTIONS(480), 1,
       anon_sym_RPAREN,
     STATE(122), 1,
-      aux_sym_instance_of_repeat1,
-  [2648] = 4,
+      aux_sym_communication_repeat1,
+  [2639] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(479), 1,
+    ACTIONS(482), 1,
       anon_sym_COMMA,
-    ACTIONS(481), 1,
+    ACTIONS(484), 1,
       anon_sym_RPAREN,
     STATE(123), 1,
-      aux_sym_capable_of_repeat1,
-  [2661] = 4,
+      aux_sym_instance_of_repeat1,
+  [2652] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(483), 1,
-      anon_sym_COMMA,
     ACTIONS(486), 1,
-      anon_sym_RPAREN,
-    STATE(121), 1,
-      aux_sym_communication_repeat1,
-  [2674] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(475), 1,
       anon_sym_COMMA,
     ACTIONS(488), 1,
       anon_sym_RPAREN,
-    STATE(126), 1,
-      aux_sym_instance_of_repeat1,
-  [2687] = 4,
+    STATE(124), 1,
+      aux_sym_capable_of_repeat1,
+  [2665] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(479), 1,
-      anon_sym_COMMA,
     ACTIONS(490), 1,
       anon_sym_RPAREN,
-    STATE(127), 1,
-      aux_sym_capable_of_repeat1,
-  [2700] = 4,
+    ACTIONS(389), 2,
+      anon_sym_or,
+      anon_sym_PIPE_PIPE,
+  [2676] = 4,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(492), 1,
-      anon_sym_LBRACE,
-    ACTIONS(494), 1,
-      anon_sym_DOT,
-    STATE(93), 1,
-      sym_mode_body,
-  [2713] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(496), 3,
-      anon_sym_SEMI,
-      anon_sym_RBRACE,
-      anon_sym_set,
-  [2722] = 4,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(498), 1,
       anon_sym_COMMA,
-    ACTIONS(501), 1,
+    ACTIONS(495), 1,
       anon_sym_RPAREN,
-    STATE(126), 1,
-      aux_sym_instance_of_repeat1,
-  [2735] = 4,
+    STATE(122), 1,
+      aux_sym_communication_repeat1,
+  [2689] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(503), 1,
+    ACTIONS(482), 1,
       anon_sym_COMMA,
-    ACTIONS(506), 1,
+    ACTIONS(497), 1,
+      anon_sym_RPAREN,
+    STATE(107), 1,
+      aux_sym_instance_of_repeat1,
+  [2702] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(486), 1,
+      anon_sym_COMMA,
+    ACTIONS(499), 1,
       anon_sym_RPAREN,
     STATE(127), 1,
       aux_sym_capable_of_repeat1,
-  [2748] = 3,
+  [2715] = 2,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(508), 1,
-      anon_sym_RPAREN,
-    ACTIONS(387), 2,
-      anon_sym_or,
-      anon_sym_PIPE_PIPE,
-  [2759] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(510), 3,
+    ACTIONS(501), 3,
       anon_sym_SEMI,
       anon_sym_RBRACE,
       anon_sym_set,
-  [2768] = 3,
+  [2724] = 4,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(512), 1,
-      sym_identifier,
-    STATE(55), 1,
-      sym_robot_declaration,
-  [2778] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(512), 1,
-      sym_identifier,
-    STATE(64), 1,
-      sym_robot_declaration,
-  [2788] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(92), 1,
+    ACTIONS(503), 1,
       anon_sym_LBRACE,
-    STATE(84), 1,
-      sym_block,
-  [2798] = 3,
+    ACTIONS(505), 1,
+      anon_sym_DOT,
+    STATE(95), 1,
+      sym_mode_body,
+  [2737] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(507), 1,
+      anon_sym_COMMA,
+    ACTIONS(510), 1,
+      anon_sym_RPAREN,
+    STATE(127), 1,
+      aux_sym_capable_of_repeat1,
+  [2750] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(512), 3,
+      anon_sym_SEMI,
+      anon_sym_RBRACE,
+      anon_sym_set,
+  [2759] = 4,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(478), 1,
+      sym_identifier,
+    STATE(115), 1,
+      sym_attribute,
+    STATE(136), 1,
+      sym_message,
+  [2772] = 3,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(514), 1,
-      anon_sym_timeout,
-    STATE(34), 1,
-      sym_timeout,
-  [2808] = 2,
+      anon_sym_LPAREN,
+    STATE(14), 1,
+      sym__group_condition,
+  [2782] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(425), 2,
-      anon_sym_COMMA,
-      anon_sym_RPAREN,
-  [2816] = 3,
+    ACTIONS(65), 1,
+      anon_sym_LBRACE,
+    STATE(83), 1,
+      sym_block,
+  [2792] = 3,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(516), 1,
-      anon_sym_LPAREN,
-    STATE(17), 1,
-      sym__group_condition,
-  [2826] = 3,
+      sym_identifier,
+    STATE(56), 1,
+      sym_robot_declaration,
+  [2802] = 3,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(518), 1,
-      sym_number,
-    STATE(32), 1,
-      sym_period,
-  [2836] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(520), 2,
-      sym_off,
-      sym_identifier,
-  [2844] = 3,
+      anon_sym_COMMA,
+    ACTIONS(520), 1,
+      anon_sym_RPAREN,
+  [2812] = 3,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(522), 1,
-      anon_sym_mode,
-    STATE(111), 1,
-      sym_mode_assignment,
-  [2854] = 3,
+      anon_sym_LBRACE,
+    STATE(90), 1,
+      sym_main_body,
+  [2822] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(438), 2,
+      anon_sym_COMMA,
+      anon_sym_RPAREN,
+  [2830] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(495), 2,
+      anon_sym_COMMA,
+      anon_sym_RPAREN,
+  [2838] = 3,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(524), 1,
-      anon_sym_LBRACE,
-    STATE(87), 1,
-      sym_main_body,
-  [2864] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(526), 1,
-      anon_sym_COMMA,
-    ACTIONS(528), 1,
-      anon_sym_RPAREN,
-  [2874] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(486), 2,
-      anon_sym_COMMA,
-      anon_sym_RPAREN,
-  [2882] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(514), 1,
       anon_sym_timeout,
     STATE(41), 1,
       sym_timeout,
-  [2892] = 3,
+  [2848] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(92), 1,
+    ACTIONS(524), 1,
+      anon_sym_timeout,
+    STATE(37), 1,
+      sym_timeout,
+  [2858] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(514), 1,
+      anon_sym_LPAREN,
+    STATE(15), 1,
+      sym__group_condition,
+  [2868] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(526), 1,
+      sym_number,
+    STATE(31), 1,
+      sym_period,
+  [2878] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(65), 1,
       anon_sym_LBRACE,
-    STATE(62), 1,
+    STATE(66), 1,
       sym_block,
-  [2902] = 3,
+  [2888] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(524), 1,
+      anon_sym_timeout,
+    STATE(192), 1,
+      sym_timeout,
+  [2898] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(528), 2,
+      sym_off,
+      sym_identifier,
+  [2906] = 3,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(530), 1,
-      sym_identifier,
+      anon_sym_mode,
+    STATE(111), 1,
+      sym_mode_assignment,
+  [2916] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
     ACTIONS(532), 1,
-      anon_sym_main,
-  [2912] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(514), 1,
-      anon_sym_timeout,
-    STATE(187), 1,
-      sym_timeout,
-  [2922] = 3,
-    ACTIONS(3), 1,
-      sym_comment,
+      sym_identifier,
     ACTIONS(534), 1,
-      anon_sym_LPAREN,
-    STATE(28), 1,
-      sym_arguments,
-  [2932] = 3,
+      anon_sym_main,
+  [2926] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(514), 1,
+    ACTIONS(524), 1,
       anon_sym_timeout,
-    STATE(40), 1,
+    STATE(33), 1,
       sym_timeout,
-  [2942] = 2,
+  [2936] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(536), 2,
       anon_sym_COMMA,
       anon_sym_RPAREN,
-  [2950] = 3,
+  [2944] = 2,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(538), 1,
-      anon_sym_COLON,
-    ACTIONS(540), 1,
-      anon_sym_DOT,
-  [2960] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(542), 2,
+    ACTIONS(538), 2,
       anon_sym_COMMA,
       anon_sym_RPAREN,
-  [2968] = 3,
+  [2952] = 3,
     ACTIONS(3), 1,
       sym_comment,
-    ACTIONS(522), 1,
+    ACTIONS(540), 1,
+      anon_sym_LPAREN,
+    STATE(26), 1,
+      sym_arguments,
+  [2962] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(542), 1,
+      anon_sym_COLON,
+    ACTIONS(544), 1,
+      anon_sym_DOT,
+  [2972] = 3,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(530), 1,
       anon_sym_mode,
     STATE(106), 1,
       sym_mode_assignment,
-  [2978] = 3,
+  [2982] = 3,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(516), 1,
-      anon_sym_LPAREN,
-    STATE(16), 1,
-      sym__group_condition,
-  [2988] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(544), 1,
       sym_identifier,
-  [2995] = 2,
+    STATE(63), 1,
+      sym_robot_declaration,
+  [2992] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(546), 1,
-      sym_identifier,
-  [3002] = 2,
+      anon_sym_EQ,
+  [2999] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(548), 1,
-      anon_sym_RPAREN,
-  [3009] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(207), 1,
-      sym_time_unit,
-  [3016] = 2,
+      sym_number,
+  [3006] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(550), 1,
+      anon_sym_LPAREN,
+  [3013] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(542), 1,
       anon_sym_COLON,
-  [3023] = 2,
+  [3020] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(552), 1,
-      anon_sym_of,
-  [3030] = 2,
+      anon_sym_RBRACK_RBRACK,
+  [3027] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(554), 1,
-      anon_sym_RBRACK_RBRACK,
-  [3037] = 2,
+      anon_sym_of,
+  [3034] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(211), 1,
+      sym_time_unit,
+  [3041] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(556), 1,
-      anon_sym_RPAREN,
-  [3044] = 2,
+      sym_identifier,
+  [3048] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(558), 1,
-      anon_sym_LPAREN,
-  [3051] = 2,
+      anon_sym_COLON,
+  [3055] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(560), 1,
-      anon_sym_RPAREN,
-  [3058] = 2,
+      sym_identifier,
+  [3062] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(562), 1,
-      sym_identifier,
-  [3065] = 2,
+      ts_builtin_sym_end,
+  [3069] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(564), 1,
-      anon_sym_RBRACK,
-  [3072] = 2,
+      anon_sym_RPAREN,
+  [3076] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(566), 1,
-      sym_identifier,
-  [3079] = 2,
+      anon_sym_RPAREN,
+  [3083] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(568), 1,
-      sym_identifier,
-  [3086] = 2,
+      anon_sym_EQ,
+  [3090] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(570), 1,
-      anon_sym_EQ,
-  [3093] = 2,
+      anon_sym_LPAREN,
+  [3097] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(572), 1,
-      sym_identifier,
-  [3100] = 2,
+      anon_sym_COMMA,
+  [3104] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(574), 1,
-      anon_sym_of,
-  [3107] = 2,
+      anon_sym_LPAREN,
+  [3111] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(576), 1,
-      anon_sym_RPAREN,
-  [3114] = 2,
+      sym_identifier,
+  [3118] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(578), 1,
       sym_identifier,
-  [3121] = 2,
+  [3125] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(580), 1,
-      anon_sym_COMMA,
-  [3128] = 2,
+      sym_identifier,
+  [3132] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(582), 1,
-      ts_builtin_sym_end,
-  [3135] = 2,
+      anon_sym_of,
+  [3139] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(584), 1,
-      anon_sym_LPAREN,
-  [3142] = 2,
+      sym_identifier,
+  [3146] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(586), 1,
-      anon_sym_LPAREN,
-  [3149] = 2,
+      anon_sym_min,
+  [3153] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(588), 1,
-      anon_sym_COLON,
-  [3156] = 2,
+      sym_number,
+  [3160] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(590), 1,
-      sym_identifier,
-  [3163] = 2,
+      anon_sym_LPAREN,
+  [3167] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(592), 1,
-      anon_sym_LPAREN,
-  [3170] = 2,
+      sym_identifier,
+  [3174] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(594), 1,
-      anon_sym_LPAREN,
-  [3177] = 2,
+      anon_sym_RPAREN,
+  [3181] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(596), 1,
-      sym_identifier,
-  [3184] = 2,
+      anon_sym_EQ,
+  [3188] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(598), 1,
-      sym_identifier,
-  [3191] = 2,
+      anon_sym_RBRACK_RBRACK,
+  [3195] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(600), 1,
-      sym_identifier,
-  [3198] = 2,
+      anon_sym_RBRACK,
+  [3202] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(602), 1,
-      anon_sym_EQ,
-  [3205] = 2,
+      anon_sym_COMMA,
+  [3209] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(604), 1,
-      sym_number,
-  [3212] = 2,
+      anon_sym_LPAREN,
+  [3216] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(606), 1,
-      sym_identifier,
-  [3219] = 2,
+      anon_sym_COLON,
+  [3223] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(608), 1,
-      sym_identifier,
-  [3226] = 2,
+      anon_sym_LPAREN,
+  [3230] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(610), 1,
-      anon_sym_RPAREN,
-  [3233] = 2,
-    ACTIONS(3), 1,
-      sym_comment,
-    ACTIONS(538), 1,
-      anon_sym_COLON,
-  [3240] = 2,
+      sym_identifier,
+  [3237] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(612), 1,
-      anon_sym_RPAREN,
-  [3247] = 2,
+      sym_identifier,
+  [3244] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(614), 1,
-      anon_sym_RBRACK_RBRACK,
-  [3254] = 2,
+      anon_sym_RPAREN,
+  [3251] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(616), 1,
-      anon_sym_COLON,
-  [3261] = 2,
+      sym_identifier,
+  [3258] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(618), 1,
       anon_sym_LPAREN,
-  [3268] = 2,
+  [3265] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(620), 1,
-      anon_sym_COMMA,
-  [3275] = 2,
+      anon_sym_RPAREN,
+  [3272] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(622), 1,
       sym_identifier,
-  [3282] = 2,
+  [3279] = 2,
     ACTIONS(3), 1,
       sym_comment,
     ACTIONS(624), 1,
-      anon_sym_LPAREN,
+      anon_sym_RPAREN,
+  [3286] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(626), 1,
+      sym_identifier,
+  [3293] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(628), 1,
+      anon_sym_COLON,
+  [3300] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(630), 1,
+      anon_sym_RPAREN,
+  [3307] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(632), 1,
+      anon_sym_COMMA,
+  [3314] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(634), 1,
+      sym_identifier,
+  [3321] = 2,
+    ACTIONS(3), 1,
+      sym_comment,
+    ACTIONS(636), 1,
+      sym_identifier,
 };
 
 static const uint32_t ts_small_parse_table_map[] = {
@@ -4891,7 +5055,7 @@ static const uint32_t ts_small_parse_table_map[] = {
   [SMALL_STATE(3)] = 36,
   [SMALL_STATE(4)] = 87,
   [SMALL_STATE(5)] = 140,
-  [SMALL_STATE(6)] = 190,
+  [SMALL_STATE(6)] = 188,
   [SMALL_STATE(7)] = 238,
   [SMALL_STATE(8)] = 283,
   [SMALL_STATE(9)] = 328,
@@ -4900,31 +5064,31 @@ static const uint32_t ts_small_parse_table_map[] = {
   [SMALL_STATE(12)] = 446,
   [SMALL_STATE(13)] = 474,
   [SMALL_STATE(14)] = 515,
-  [SMALL_STATE(15)] = 556,
-  [SMALL_STATE(16)] = 597,
-  [SMALL_STATE(17)] = 636,
-  [SMALL_STATE(18)] = 675,
+  [SMALL_STATE(15)] = 554,
+  [SMALL_STATE(16)] = 593,
+  [SMALL_STATE(17)] = 634,
+  [SMALL_STATE(18)] = 673,
   [SMALL_STATE(19)] = 714,
   [SMALL_STATE(20)] = 753,
-  [SMALL_STATE(21)] = 792,
+  [SMALL_STATE(21)] = 794,
   [SMALL_STATE(22)] = 833,
   [SMALL_STATE(23)] = 872,
-  [SMALL_STATE(24)] = 899,
-  [SMALL_STATE(25)] = 938,
+  [SMALL_STATE(24)] = 897,
+  [SMALL_STATE(25)] = 936,
   [SMALL_STATE(26)] = 963,
-  [SMALL_STATE(27)] = 988,
-  [SMALL_STATE(28)] = 1013,
-  [SMALL_STATE(29)] = 1040,
-  [SMALL_STATE(30)] = 1067,
+  [SMALL_STATE(27)] = 990,
+  [SMALL_STATE(28)] = 1015,
+  [SMALL_STATE(29)] = 1054,
+  [SMALL_STATE(30)] = 1081,
   [SMALL_STATE(31)] = 1106,
-  [SMALL_STATE(32)] = 1133,
+  [SMALL_STATE(32)] = 1131,
   [SMALL_STATE(33)] = 1158,
   [SMALL_STATE(34)] = 1182,
   [SMALL_STATE(35)] = 1206,
-  [SMALL_STATE(36)] = 1232,
-  [SMALL_STATE(37)] = 1256,
-  [SMALL_STATE(38)] = 1280,
-  [SMALL_STATE(39)] = 1304,
+  [SMALL_STATE(36)] = 1230,
+  [SMALL_STATE(37)] = 1254,
+  [SMALL_STATE(38)] = 1278,
+  [SMALL_STATE(39)] = 1302,
   [SMALL_STATE(40)] = 1328,
   [SMALL_STATE(41)] = 1352,
   [SMALL_STATE(42)] = 1376,
@@ -4933,7 +5097,7 @@ static const uint32_t ts_small_parse_table_map[] = {
   [SMALL_STATE(45)] = 1457,
   [SMALL_STATE(46)] = 1479,
   [SMALL_STATE(47)] = 1508,
-  [SMALL_STATE(48)] = 1531,
+  [SMALL_STATE(48)] = 1537,
   [SMALL_STATE(49)] = 1560,
   [SMALL_STATE(50)] = 1584,
   [SMALL_STATE(51)] = 1606,
@@ -4943,144 +5107,149 @@ static const uint32_t ts_small_parse_table_map[] = {
   [SMALL_STATE(55)] = 1691,
   [SMALL_STATE(56)] = 1716,
   [SMALL_STATE(57)] = 1741,
-  [SMALL_STATE(58)] = 1759,
-  [SMALL_STATE(59)] = 1783,
+  [SMALL_STATE(58)] = 1761,
+  [SMALL_STATE(59)] = 1785,
   [SMALL_STATE(60)] = 1803,
-  [SMALL_STATE(61)] = 1818,
+  [SMALL_STATE(61)] = 1822,
   [SMALL_STATE(62)] = 1837,
   [SMALL_STATE(63)] = 1856,
-  [SMALL_STATE(64)] = 1875,
+  [SMALL_STATE(64)] = 1871,
   [SMALL_STATE(65)] = 1890,
   [SMALL_STATE(66)] = 1909,
   [SMALL_STATE(67)] = 1928,
-  [SMALL_STATE(68)] = 1944,
-  [SMALL_STATE(69)] = 1958,
-  [SMALL_STATE(70)] = 1976,
-  [SMALL_STATE(71)] = 1990,
-  [SMALL_STATE(72)] = 2002,
-  [SMALL_STATE(73)] = 2014,
+  [SMALL_STATE(68)] = 1940,
+  [SMALL_STATE(69)] = 1956,
+  [SMALL_STATE(70)] = 1974,
+  [SMALL_STATE(71)] = 1992,
+  [SMALL_STATE(72)] = 2006,
+  [SMALL_STATE(73)] = 2018,
   [SMALL_STATE(74)] = 2030,
-  [SMALL_STATE(75)] = 2046,
-  [SMALL_STATE(76)] = 2064,
-  [SMALL_STATE(77)] = 2082,
-  [SMALL_STATE(78)] = 2098,
-  [SMALL_STATE(79)] = 2114,
+  [SMALL_STATE(75)] = 2048,
+  [SMALL_STATE(76)] = 2062,
+  [SMALL_STATE(77)] = 2078,
+  [SMALL_STATE(78)] = 2094,
+  [SMALL_STATE(79)] = 2110,
   [SMALL_STATE(80)] = 2126,
-  [SMALL_STATE(81)] = 2142,
-  [SMALL_STATE(82)] = 2155,
-  [SMALL_STATE(83)] = 2168,
-  [SMALL_STATE(84)] = 2181,
-  [SMALL_STATE(85)] = 2194,
-  [SMALL_STATE(86)] = 2207,
-  [SMALL_STATE(87)] = 2224,
-  [SMALL_STATE(88)] = 2237,
-  [SMALL_STATE(89)] = 2254,
-  [SMALL_STATE(90)] = 2267,
-  [SMALL_STATE(91)] = 2284,
-  [SMALL_STATE(92)] = 2297,
-  [SMALL_STATE(93)] = 2310,
-  [SMALL_STATE(94)] = 2323,
-  [SMALL_STATE(95)] = 2340,
-  [SMALL_STATE(96)] = 2353,
-  [SMALL_STATE(97)] = 2366,
-  [SMALL_STATE(98)] = 2381,
-  [SMALL_STATE(99)] = 2393,
-  [SMALL_STATE(100)] = 2407,
-  [SMALL_STATE(101)] = 2421,
-  [SMALL_STATE(102)] = 2431,
-  [SMALL_STATE(103)] = 2441,
-  [SMALL_STATE(104)] = 2455,
-  [SMALL_STATE(105)] = 2469,
-  [SMALL_STATE(106)] = 2481,
-  [SMALL_STATE(107)] = 2491,
-  [SMALL_STATE(108)] = 2502,
-  [SMALL_STATE(109)] = 2515,
-  [SMALL_STATE(110)] = 2526,
-  [SMALL_STATE(111)] = 2539,
-  [SMALL_STATE(112)] = 2548,
-  [SMALL_STATE(113)] = 2561,
-  [SMALL_STATE(114)] = 2572,
-  [SMALL_STATE(115)] = 2585,
-  [SMALL_STATE(116)] = 2596,
-  [SMALL_STATE(117)] = 2609,
-  [SMALL_STATE(118)] = 2622,
-  [SMALL_STATE(119)] = 2635,
-  [SMALL_STATE(120)] = 2648,
-  [SMALL_STATE(121)] = 2661,
-  [SMALL_STATE(122)] = 2674,
-  [SMALL_STATE(123)] = 2687,
-  [SMALL_STATE(124)] = 2700,
-  [SMALL_STATE(125)] = 2713,
-  [SMALL_STATE(126)] = 2722,
-  [SMALL_STATE(127)] = 2735,
-  [SMALL_STATE(128)] = 2748,
+  [SMALL_STATE(81)] = 2144,
+  [SMALL_STATE(82)] = 2160,
+  [SMALL_STATE(83)] = 2177,
+  [SMALL_STATE(84)] = 2190,
+  [SMALL_STATE(85)] = 2203,
+  [SMALL_STATE(86)] = 2220,
+  [SMALL_STATE(87)] = 2233,
+  [SMALL_STATE(88)] = 2250,
+  [SMALL_STATE(89)] = 2263,
+  [SMALL_STATE(90)] = 2276,
+  [SMALL_STATE(91)] = 2289,
+  [SMALL_STATE(92)] = 2306,
+  [SMALL_STATE(93)] = 2319,
+  [SMALL_STATE(94)] = 2334,
+  [SMALL_STATE(95)] = 2347,
+  [SMALL_STATE(96)] = 2360,
+  [SMALL_STATE(97)] = 2373,
+  [SMALL_STATE(98)] = 2386,
+  [SMALL_STATE(99)] = 2399,
+  [SMALL_STATE(100)] = 2409,
+  [SMALL_STATE(101)] = 2423,
+  [SMALL_STATE(102)] = 2435,
+  [SMALL_STATE(103)] = 2449,
+  [SMALL_STATE(104)] = 2463,
+  [SMALL_STATE(105)] = 2475,
+  [SMALL_STATE(106)] = 2485,
+  [SMALL_STATE(107)] = 2495,
+  [SMALL_STATE(108)] = 2508,
+  [SMALL_STATE(109)] = 2519,
+  [SMALL_STATE(110)] = 2530,
+  [SMALL_STATE(111)] = 2543,
+  [SMALL_STATE(112)] = 2552,
+  [SMALL_STATE(113)] = 2565,
+  [SMALL_STATE(114)] = 2576,
+  [SMALL_STATE(115)] = 2589,
+  [SMALL_STATE(116)] = 2600,
+  [SMALL_STATE(117)] = 2613,
+  [SMALL_STATE(118)] = 2626,
+  [SMALL_STATE(119)] = 2639,
+  [SMALL_STATE(120)] = 2652,
+  [SMALL_STATE(121)] = 2665,
+  [SMALL_STATE(122)] = 2676,
+  [SMALL_STATE(123)] = 2689,
+  [SMALL_STATE(124)] = 2702,
+  [SMALL_STATE(125)] = 2715,
+  [SMALL_STATE(126)] = 2724,
+  [SMALL_STATE(127)] = 2737,
+  [SMALL_STATE(128)] = 2750,
   [SMALL_STATE(129)] = 2759,
-  [SMALL_STATE(130)] = 2768,
-  [SMALL_STATE(131)] = 2778,
-  [SMALL_STATE(132)] = 2788,
-  [SMALL_STATE(133)] = 2798,
-  [SMALL_STATE(134)] = 2808,
-  [SMALL_STATE(135)] = 2816,
-  [SMALL_STATE(136)] = 2826,
-  [SMALL_STATE(137)] = 2836,
-  [SMALL_STATE(138)] = 2844,
-  [SMALL_STATE(139)] = 2854,
-  [SMALL_STATE(140)] = 2864,
-  [SMALL_STATE(141)] = 2874,
-  [SMALL_STATE(142)] = 2882,
-  [SMALL_STATE(143)] = 2892,
-  [SMALL_STATE(144)] = 2902,
-  [SMALL_STATE(145)] = 2912,
-  [SMALL_STATE(146)] = 2922,
-  [SMALL_STATE(147)] = 2932,
-  [SMALL_STATE(148)] = 2942,
-  [SMALL_STATE(149)] = 2950,
-  [SMALL_STATE(150)] = 2960,
-  [SMALL_STATE(151)] = 2968,
-  [SMALL_STATE(152)] = 2978,
-  [SMALL_STATE(153)] = 2988,
-  [SMALL_STATE(154)] = 2995,
-  [SMALL_STATE(155)] = 3002,
-  [SMALL_STATE(156)] = 3009,
-  [SMALL_STATE(157)] = 3016,
-  [SMALL_STATE(158)] = 3023,
-  [SMALL_STATE(159)] = 3030,
-  [SMALL_STATE(160)] = 3037,
-  [SMALL_STATE(161)] = 3044,
-  [SMALL_STATE(162)] = 3051,
-  [SMALL_STATE(163)] = 3058,
-  [SMALL_STATE(164)] = 3065,
-  [SMALL_STATE(165)] = 3072,
-  [SMALL_STATE(166)] = 3079,
-  [SMALL_STATE(167)] = 3086,
-  [SMALL_STATE(168)] = 3093,
-  [SMALL_STATE(169)] = 3100,
-  [SMALL_STATE(170)] = 3107,
-  [SMALL_STATE(171)] = 3114,
-  [SMALL_STATE(172)] = 3121,
-  [SMALL_STATE(173)] = 3128,
-  [SMALL_STATE(174)] = 3135,
-  [SMALL_STATE(175)] = 3142,
-  [SMALL_STATE(176)] = 3149,
-  [SMALL_STATE(177)] = 3156,
-  [SMALL_STATE(178)] = 3163,
-  [SMALL_STATE(179)] = 3170,
-  [SMALL_STATE(180)] = 3177,
-  [SMALL_STATE(181)] = 3184,
-  [SMALL_STATE(182)] = 3191,
-  [SMALL_STATE(183)] = 3198,
-  [SMALL_STATE(184)] = 3205,
-  [SMALL_STATE(185)] = 3212,
-  [SMALL_STATE(186)] = 3219,
-  [SMALL_STATE(187)] = 3226,
-  [SMALL_STATE(188)] = 3233,
-  [SMALL_STATE(189)] = 3240,
-  [SMALL_STATE(190)] = 3247,
-  [SMALL_STATE(191)] = 3254,
-  [SMALL_STATE(192)] = 3261,
-  [SMALL_STATE(193)] = 3268,
-  [SMALL_STATE(194)] = 3275,
-  [SMALL_STATE(195)] = 3282,
+  [SMALL_STATE(130)] = 2772,
+  [SMALL_STATE(131)] = 2782,
+  [SMALL_STATE(132)] = 2792,
+  [SMALL_STATE(133)] = 2802,
+  [SMALL_STATE(134)] = 2812,
+  [SMALL_STATE(135)] = 2822,
+  [SMALL_STATE(136)] = 2830,
+  [SMALL_STATE(137)] = 2838,
+  [SMALL_STATE(138)] = 2848,
+  [SMALL_STATE(139)] = 2858,
+  [SMALL_STATE(140)] = 2868,
+  [SMALL_STATE(141)] = 2878,
+  [SMALL_STATE(142)] = 2888,
+  [SMALL_STATE(143)] = 2898,
+  [SMALL_STATE(144)] = 2906,
+  [SMALL_STATE(145)] = 2916,
+  [SMALL_STATE(146)] = 2926,
+  [SMALL_STATE(147)] = 2936,
+  [SMALL_STATE(148)] = 2944,
+  [SMALL_STATE(149)] = 2952,
+  [SMALL_STATE(150)] = 2962,
+  [SMALL_STATE(151)] = 2972,
+  [SMALL_STATE(152)] = 2982,
+  [SMALL_STATE(153)] = 2992,
+  [SMALL_STATE(154)] = 2999,
+  [SMALL_STATE(155)] = 3006,
+  [SMALL_STATE(156)] = 3013,
+  [SMALL_STATE(157)] = 3020,
+  [SMALL_STATE(158)] = 3027,
+  [SMALL_STATE(159)] = 3034,
+  [SMALL_STATE(160)] = 3041,
+  [SMALL_STATE(161)] = 3048,
+  [SMALL_STATE(162)] = 3055,
+  [SMALL_STATE(163)] = 3062,
+  [SMALL_STATE(164)] = 3069,
+  [SMALL_STATE(165)] = 3076,
+  [SMALL_STATE(166)] = 3083,
+  [SMALL_STATE(167)] = 3090,
+  [SMALL_STATE(168)] = 3097,
+  [SMALL_STATE(169)] = 3104,
+  [SMALL_STATE(170)] = 3111,
+  [SMALL_STATE(171)] = 3118,
+  [SMALL_STATE(172)] = 3125,
+  [SMALL_STATE(173)] = 3132,
+  [SMALL_STATE(174)] = 3139,
+  [SMALL_STATE(175)] = 3146,
+  [SMALL_STATE(176)] = 3153,
+  [SMALL_STATE(177)] = 3160,
+  [SMALL_STATE(178)] = 3167,
+  [SMALL_STATE(179)] = 3174,
+  [SMALL_STATE(180)] = 3181,
+  [SMALL_STATE(181)] = 3188,
+  [SMALL_STATE(182)] = 3195,
+  [SMALL_STATE(183)] = 3202,
+  [SMALL_STATE(184)] = 3209,
+  [SMALL_STATE(185)] = 3216,
+  [SMALL_STATE(186)] = 3223,
+  [SMALL_STATE(187)] = 3230,
+  [SMALL_STATE(188)] = 3237,
+  [SMALL_STATE(189)] = 3244,
+  [SMALL_STATE(190)] = 3251,
+  [SMALL_STATE(191)] = 3258,
+  [SMALL_STATE(192)] = 3265,
+  [SMALL_STATE(193)] = 3272,
+  [SMALL_STATE(194)] = 3279,
+  [SMALL_STATE(195)] = 3286,
+  [SMALL_STATE(196)] = 3293,
+  [SMALL_STATE(197)] = 3300,
+  [SMALL_STATE(198)] = 3307,
+  [SMALL_STATE(199)] = 3314,
+  [SMALL_STATE(200)] = 3321,
 };
 
 static const TSParseActionEntry ts_parse_actions[] = {
@@ -5088,104 +5257,104 @@ static const TSParseActionEntry ts_parse_actions[] = {
   [1] = {.entry = {.count = 1, .reusable = false}}, RECOVER(),
   [3] = {.entry = {.count = 1, .reusable = true}}, SHIFT_EXTRA(),
   [5] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_source_file, 0, 0, 0),
-  [7] = {.entry = {.count = 1, .reusable = false}}, SHIFT(149),
-  [9] = {.entry = {.count = 1, .reusable = true}}, SHIFT(48),
-  [11] = {.entry = {.count = 1, .reusable = true}}, SHIFT(99),
-  [13] = {.entry = {.count = 1, .reusable = false}}, SHIFT(154),
+  [7] = {.entry = {.count = 1, .reusable = false}}, SHIFT(150),
+  [9] = {.entry = {.count = 1, .reusable = true}}, SHIFT(46),
+  [11] = {.entry = {.count = 1, .reusable = true}}, SHIFT(102),
+  [13] = {.entry = {.count = 1, .reusable = false}}, SHIFT(188),
   [15] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_period, 2, 0, 13),
   [17] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_period, 2, 0, 13),
   [19] = {.entry = {.count = 1, .reusable = false}}, SHIFT(43),
-  [21] = {.entry = {.count = 1, .reusable = true}}, SHIFT(8),
-  [23] = {.entry = {.count = 1, .reusable = true}}, SHIFT(25),
+  [21] = {.entry = {.count = 1, .reusable = true}}, SHIFT(7),
+  [23] = {.entry = {.count = 1, .reusable = true}}, SHIFT(23),
   [25] = {.entry = {.count = 1, .reusable = true}}, SHIFT(112),
-  [27] = {.entry = {.count = 1, .reusable = false}}, SHIFT(24),
-  [29] = {.entry = {.count = 1, .reusable = true}}, SHIFT(24),
+  [27] = {.entry = {.count = 1, .reusable = false}}, SHIFT(28),
+  [29] = {.entry = {.count = 1, .reusable = true}}, SHIFT(28),
   [31] = {.entry = {.count = 1, .reusable = false}}, SHIFT(52),
-  [33] = {.entry = {.count = 1, .reusable = true}}, SHIFT(47),
+  [33] = {.entry = {.count = 1, .reusable = true}}, SHIFT(48),
   [35] = {.entry = {.count = 1, .reusable = true}}, SHIFT(50),
-  [37] = {.entry = {.count = 1, .reusable = true}}, SHIFT(81),
-  [39] = {.entry = {.count = 1, .reusable = true}}, SHIFT(134),
+  [37] = {.entry = {.count = 1, .reusable = true}}, SHIFT(89),
+  [39] = {.entry = {.count = 1, .reusable = true}}, SHIFT(135),
   [41] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_block, 2, 0, 0),
   [43] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_block, 2, 0, 0),
   [45] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_block, 3, 0, 0),
   [47] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_block, 3, 0, 0),
-  [49] = {.entry = {.count = 1, .reusable = false}}, SHIFT(146),
-  [51] = {.entry = {.count = 1, .reusable = true}}, SHIFT(14),
-  [53] = {.entry = {.count = 1, .reusable = true}}, SHIFT(12),
-  [55] = {.entry = {.count = 1, .reusable = false}}, SHIFT(178),
-  [57] = {.entry = {.count = 1, .reusable = false}}, SHIFT(179),
-  [59] = {.entry = {.count = 1, .reusable = false}}, SHIFT(166),
-  [61] = {.entry = {.count = 1, .reusable = false}}, SHIFT(175),
-  [63] = {.entry = {.count = 1, .reusable = true}}, SHIFT(97),
-  [65] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(146),
-  [68] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(14),
-  [71] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0),
-  [73] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(178),
-  [76] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(179),
-  [79] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(166),
-  [82] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(175),
-  [85] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(97),
-  [88] = {.entry = {.count = 1, .reusable = true}}, SHIFT(13),
-  [90] = {.entry = {.count = 1, .reusable = true}}, SHIFT(11),
-  [92] = {.entry = {.count = 1, .reusable = true}}, SHIFT(15),
-  [94] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_communication, 6, 0, 23),
-  [96] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_communication, 6, 0, 23),
-  [98] = {.entry = {.count = 1, .reusable = true}}, SHIFT(142),
-  [100] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_arguments, 2, 0, 0),
-  [102] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_arguments, 2, 0, 0),
-  [104] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_arguments, 3, 0, 0),
-  [106] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_arguments, 3, 0, 0),
-  [108] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_arguments, 4, 0, 0),
-  [110] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_arguments, 4, 0, 0),
-  [112] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_call, 2, 0, 7),
-  [114] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_call, 2, 0, 7),
-  [116] = {.entry = {.count = 1, .reusable = true}}, SHIFT(133),
-  [118] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_throw_statement, 2, 0, 6),
-  [120] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_throw_statement, 2, 0, 6),
-  [122] = {.entry = {.count = 1, .reusable = false}}, SHIFT(37),
-  [124] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_communication, 7, 0, 23),
-  [126] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_communication, 7, 0, 23),
-  [128] = {.entry = {.count = 1, .reusable = true}}, SHIFT(147),
-  [130] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_timeout, 3, 0, 26),
-  [132] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_timeout, 3, 0, 26),
-  [134] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_group_statement, 4, 0, 0),
-  [136] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_group_statement, 4, 0, 0),
-  [138] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_call, 4, 0, 7),
-  [140] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_call, 4, 0, 7),
-  [142] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_if_statement, 5, 0, 18),
-  [144] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_if_statement, 5, 0, 18),
-  [146] = {.entry = {.count = 1, .reusable = false}}, SHIFT(22),
-  [148] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_loop_statement, 5, 0, 20),
-  [150] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_loop_statement, 5, 0, 20),
-  [152] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_throw_statement, 3, 0, 10),
-  [154] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_throw_statement, 3, 0, 10),
-  [156] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_group_statement, 3, 0, 0),
-  [158] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_group_statement, 3, 0, 0),
-  [160] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_if_statement, 7, 0, 28),
-  [162] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_if_statement, 7, 0, 28),
-  [164] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_communication, 9, 0, 23),
-  [166] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_communication, 9, 0, 23),
+  [49] = {.entry = {.count = 1, .reusable = false}}, SHIFT(149),
+  [51] = {.entry = {.count = 1, .reusable = true}}, SHIFT(18),
+  [53] = {.entry = {.count = 1, .reusable = true}}, SHIFT(11),
+  [55] = {.entry = {.count = 1, .reusable = false}}, SHIFT(186),
+  [57] = {.entry = {.count = 1, .reusable = false}}, SHIFT(191),
+  [59] = {.entry = {.count = 1, .reusable = false}}, SHIFT(162),
+  [61] = {.entry = {.count = 1, .reusable = false}}, SHIFT(167),
+  [63] = {.entry = {.count = 1, .reusable = true}}, SHIFT(93),
+  [65] = {.entry = {.count = 1, .reusable = true}}, SHIFT(13),
+  [67] = {.entry = {.count = 1, .reusable = true}}, SHIFT(20),
+  [69] = {.entry = {.count = 1, .reusable = true}}, SHIFT(12),
+  [71] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(149),
+  [74] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(20),
+  [77] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0),
+  [79] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(186),
+  [82] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(191),
+  [85] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(162),
+  [88] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(167),
+  [91] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_block_repeat1, 2, 0, 0), SHIFT_REPEAT(93),
+  [94] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_arguments, 2, 0, 0),
+  [96] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_arguments, 2, 0, 0),
+  [98] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_throw_statement, 2, 0, 6),
+  [100] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_throw_statement, 2, 0, 6),
+  [102] = {.entry = {.count = 1, .reusable = false}}, SHIFT(38),
+  [104] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_call, 2, 0, 7),
+  [106] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_call, 2, 0, 7),
+  [108] = {.entry = {.count = 1, .reusable = true}}, SHIFT(138),
+  [110] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_arguments, 3, 0, 0),
+  [112] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_arguments, 3, 0, 0),
+  [114] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_communication, 6, 0, 23),
+  [116] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_communication, 6, 0, 23),
+  [118] = {.entry = {.count = 1, .reusable = true}}, SHIFT(137),
+  [120] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_arguments, 4, 0, 0),
+  [122] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_arguments, 4, 0, 0),
+  [124] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_timeout, 3, 0, 26),
+  [126] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_timeout, 3, 0, 26),
+  [128] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_communication, 7, 0, 23),
+  [130] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_communication, 7, 0, 23),
+  [132] = {.entry = {.count = 1, .reusable = true}}, SHIFT(146),
+  [134] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_communication, 9, 0, 23),
+  [136] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_communication, 9, 0, 23),
+  [138] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_group_statement, 3, 0, 0),
+  [140] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_group_statement, 3, 0, 0),
+  [142] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_group_statement, 4, 0, 0),
+  [144] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_group_statement, 4, 0, 0),
+  [146] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_loop_statement, 5, 0, 20),
+  [148] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_loop_statement, 5, 0, 20),
+  [150] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_call, 4, 0, 7),
+  [152] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_call, 4, 0, 7),
+  [154] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_throw_statement, 3, 0, 10),
+  [156] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_throw_statement, 3, 0, 10),
+  [158] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_if_statement, 5, 0, 18),
+  [160] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_if_statement, 5, 0, 18),
+  [162] = {.entry = {.count = 1, .reusable = false}}, SHIFT(22),
+  [164] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_if_statement, 7, 0, 28),
+  [166] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_if_statement, 7, 0, 28),
   [168] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_communication, 8, 0, 23),
   [170] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_communication, 8, 0, 23),
   [172] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_attribute, 2, 0, 0),
-  [174] = {.entry = {.count = 1, .reusable = true}}, SHIFT(168),
+  [174] = {.entry = {.count = 1, .reusable = true}}, SHIFT(178),
   [176] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_attribute, 2, 0, 0),
   [178] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_attribute, 1, 0, 0),
   [180] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_attribute, 1, 0, 0),
   [182] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_attribute_repeat1, 2, 0, 0),
-  [184] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_attribute_repeat1, 2, 0, 0), SHIFT_REPEAT(168),
+  [184] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_attribute_repeat1, 2, 0, 0), SHIFT_REPEAT(178),
   [187] = {.entry = {.count = 1, .reusable = false}}, REDUCE(aux_sym_attribute_repeat1, 2, 0, 0),
-  [189] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_source_file_repeat1, 2, 0, 0),
-  [191] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_source_file_repeat1, 2, 0, 0), SHIFT_REPEAT(149),
-  [194] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_source_file_repeat1, 2, 0, 0), SHIFT_REPEAT(46),
-  [197] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_source_file_repeat1, 2, 0, 0), SHIFT_REPEAT(99),
-  [200] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_source_file_repeat1, 2, 0, 0), SHIFT_REPEAT(154),
-  [203] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym__primary, 1, 0, 0),
-  [205] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym__primary, 1, 0, 0),
-  [207] = {.entry = {.count = 1, .reusable = true}}, SHIFT(2),
-  [209] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_source_file, 1, 0, 0),
-  [211] = {.entry = {.count = 1, .reusable = true}}, SHIFT(46),
-  [213] = {.entry = {.count = 1, .reusable = true}}, SHIFT(9),
+  [189] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_source_file, 1, 0, 0),
+  [191] = {.entry = {.count = 1, .reusable = true}}, SHIFT(47),
+  [193] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_source_file_repeat1, 2, 0, 0),
+  [195] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_source_file_repeat1, 2, 0, 0), SHIFT_REPEAT(150),
+  [198] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_source_file_repeat1, 2, 0, 0), SHIFT_REPEAT(47),
+  [201] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_source_file_repeat1, 2, 0, 0), SHIFT_REPEAT(102),
+  [204] = {.entry = {.count = 2, .reusable = false}}, REDUCE(aux_sym_source_file_repeat1, 2, 0, 0), SHIFT_REPEAT(188),
+  [207] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym__primary, 1, 0, 0),
+  [209] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym__primary, 1, 0, 0),
+  [211] = {.entry = {.count = 1, .reusable = true}}, SHIFT(2),
+  [213] = {.entry = {.count = 1, .reusable = true}}, SHIFT(8),
   [215] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym__period_and_condition, 1, 0, 9),
   [217] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym__comparison_level, 1, 0, 0),
   [219] = {.entry = {.count = 1, .reusable = true}}, SHIFT(53),
@@ -5194,196 +5363,202 @@ static const TSParseActionEntry ts_parse_actions[] = {
   [225] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_parenthesized_expression, 3, 0, 0),
   [227] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_boolean, 1, 0, 0),
   [229] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_boolean, 1, 0, 0),
-  [231] = {.entry = {.count = 1, .reusable = true}}, SHIFT(72),
+  [231] = {.entry = {.count = 1, .reusable = true}}, SHIFT(73),
   [233] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym__group_condition, 3, 0, 22),
   [235] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym__group_condition, 3, 0, 22),
-  [237] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_team_declaration, 3, 0, 2),
-  [239] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_team_declaration, 3, 0, 2),
+  [237] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_team_declaration, 4, 0, 2),
+  [239] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_team_declaration, 4, 0, 2),
   [241] = {.entry = {.count = 1, .reusable = true}}, SHIFT(65),
-  [243] = {.entry = {.count = 1, .reusable = true}}, SHIFT(131),
-  [245] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_team_declaration, 4, 0, 2),
-  [247] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_team_declaration, 4, 0, 2),
-  [249] = {.entry = {.count = 1, .reusable = true}}, SHIFT(66),
-  [251] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_robot_declaration, 2, 0, 3),
-  [253] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_robot_declaration, 2, 0, 3),
-  [255] = {.entry = {.count = 1, .reusable = true}}, SHIFT(184),
-  [257] = {.entry = {.count = 1, .reusable = true}}, SHIFT(38),
-  [259] = {.entry = {.count = 1, .reusable = true}}, SHIFT(152),
-  [261] = {.entry = {.count = 1, .reusable = true}}, SHIFT(135),
-  [263] = {.entry = {.count = 1, .reusable = true}}, SHIFT(20),
-  [265] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_team_declaration_repeat1, 2, 0, 0),
-  [267] = {.entry = {.count = 1, .reusable = false}}, REDUCE(aux_sym_team_declaration_repeat1, 2, 0, 0),
-  [269] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_team_declaration_repeat1, 2, 0, 0), SHIFT_REPEAT(131),
-  [272] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_robot_declaration, 5, 0, 16),
-  [274] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_robot_declaration, 5, 0, 16),
-  [276] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_team_declaration_repeat2, 2, 0, 0),
-  [278] = {.entry = {.count = 1, .reusable = false}}, REDUCE(aux_sym_team_declaration_repeat2, 2, 0, 0),
-  [280] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_team_declaration_repeat2, 2, 0, 0), SHIFT_REPEAT(61),
-  [283] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_service_definition, 6, 0, 11),
-  [285] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_service_definition, 6, 0, 11),
-  [287] = {.entry = {.count = 1, .reusable = false}}, SHIFT(174),
-  [289] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_group_statement_repeat1, 2, 0, 0),
-  [291] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_group_statement_repeat1, 2, 0, 0), SHIFT_REPEAT(152),
-  [294] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_group_statement_repeat1, 2, 0, 0), SHIFT_REPEAT(135),
-  [297] = {.entry = {.count = 1, .reusable = true}}, SHIFT(61),
-  [299] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_team_declaration, 5, 0, 2),
-  [301] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_team_declaration, 5, 0, 2),
-  [303] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_team_declaration_repeat2, 2, 0, 0), SHIFT_REPEAT(67),
-  [306] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym__expression, 1, 0, 0),
-  [308] = {.entry = {.count = 1, .reusable = true}}, SHIFT(30),
-  [310] = {.entry = {.count = 1, .reusable = true}}, SHIFT(89),
-  [312] = {.entry = {.count = 1, .reusable = true}}, SHIFT(192),
-  [314] = {.entry = {.count = 1, .reusable = true}}, SHIFT(157),
-  [316] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_or_expression, 3, 0, 19),
-  [318] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_and_expression, 3, 0, 19),
-  [320] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_comparison, 3, 0, 19),
-  [322] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_case_clause, 5, 0, 27),
-  [324] = {.entry = {.count = 1, .reusable = true}}, SHIFT(195),
-  [326] = {.entry = {.count = 1, .reusable = true}}, SHIFT(78),
-  [328] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_mode_assignment, 3, 0, 27),
-  [330] = {.entry = {.count = 1, .reusable = true}}, SHIFT(95),
-  [332] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_main_body_repeat1, 2, 0, 0),
-  [334] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_main_body_repeat1, 2, 0, 0), SHIFT_REPEAT(192),
-  [337] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_main_body_repeat1, 2, 0, 0), SHIFT_REPEAT(157),
-  [340] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_case_clause, 6, 0, 27),
-  [342] = {.entry = {.count = 1, .reusable = true}}, SHIFT(67),
-  [344] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_mode_assignment, 4, 0, 27),
-  [346] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_not_expression, 2, 0, 12),
-  [348] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_case_clause_repeat1, 2, 0, 0),
-  [350] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_case_clause_repeat1, 2, 0, 0), SHIFT_REPEAT(195),
-  [353] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_repeat_clause, 3, 0, 0),
-  [355] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_repeat_clause, 3, 0, 0),
-  [357] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_mode_body, 2, 0, 0),
-  [359] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_mode_body, 2, 0, 0),
-  [361] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_formation, 3, 0, 0),
-  [363] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_formation, 3, 0, 0),
-  [365] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_function_definition, 3, 0, 1),
-  [367] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_function_definition, 3, 0, 1),
-  [369] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_formation, 2, 0, 0),
-  [371] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_formation, 2, 0, 0),
-  [373] = {.entry = {.count = 1, .reusable = true}}, SHIFT(94),
-  [375] = {.entry = {.count = 1, .reusable = true}}, SHIFT(91),
-  [377] = {.entry = {.count = 1, .reusable = true}}, SHIFT(161),
-  [379] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_main_definition, 4, 0, 4),
-  [381] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_main_definition, 4, 0, 4),
-  [383] = {.entry = {.count = 1, .reusable = true}}, SHIFT(6),
-  [385] = {.entry = {.count = 1, .reusable = true}}, SHIFT(26),
-  [387] = {.entry = {.count = 1, .reusable = true}}, SHIFT(21),
-  [389] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_main_body, 3, 0, 0),
-  [391] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_main_body, 3, 0, 0),
-  [393] = {.entry = {.count = 1, .reusable = true}}, SHIFT(86),
-  [395] = {.entry = {.count = 1, .reusable = true}}, SHIFT(82),
-  [397] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_mode_body, 3, 0, 0),
-  [399] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_mode_body, 3, 0, 0),
-  [401] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_service_definition, 7, 0, 17),
-  [403] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_service_definition, 7, 0, 17),
-  [405] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_mode_definition, 4, 0, 5),
-  [407] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_mode_definition, 4, 0, 5),
-  [409] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_mode_body_repeat1, 2, 0, 0), SHIFT_REPEAT(94),
-  [412] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_mode_body_repeat1, 2, 0, 0),
-  [414] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_mode_body_repeat1, 2, 0, 0), SHIFT_REPEAT(161),
-  [417] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_main_body, 2, 0, 0),
-  [419] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_main_body, 2, 0, 0),
-  [421] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_repeat_clause, 4, 0, 33),
-  [423] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_repeat_clause, 4, 0, 33),
-  [425] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_arguments_repeat1, 2, 0, 0),
-  [427] = {.entry = {.count = 1, .reusable = true}}, SHIFT(188),
-  [429] = {.entry = {.count = 1, .reusable = true}}, SHIFT(85),
-  [431] = {.entry = {.count = 1, .reusable = true}}, SHIFT(158),
-  [433] = {.entry = {.count = 1, .reusable = true}}, SHIFT(169),
-  [435] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_group_arm, 3, 0, 14),
-  [437] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_leader_arm, 3, 0, 14),
-  [439] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_formation_repeat1, 2, 0, 0), SHIFT_REPEAT(188),
-  [442] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_formation_repeat1, 2, 0, 0),
-  [444] = {.entry = {.count = 1, .reusable = true}}, SHIFT(83),
+  [243] = {.entry = {.count = 1, .reusable = true}}, SHIFT(152),
+  [245] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_team_declaration, 3, 0, 2),
+  [247] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_team_declaration, 3, 0, 2),
+  [249] = {.entry = {.count = 1, .reusable = true}}, SHIFT(60),
+  [251] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_team_declaration_repeat1, 2, 0, 0),
+  [253] = {.entry = {.count = 1, .reusable = false}}, REDUCE(aux_sym_team_declaration_repeat1, 2, 0, 0),
+  [255] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_team_declaration_repeat1, 2, 0, 0), SHIFT_REPEAT(152),
+  [258] = {.entry = {.count = 1, .reusable = true}}, SHIFT(34),
+  [260] = {.entry = {.count = 1, .reusable = true}}, SHIFT(130),
+  [262] = {.entry = {.count = 1, .reusable = true}}, SHIFT(139),
+  [264] = {.entry = {.count = 1, .reusable = true}}, SHIFT(17),
+  [266] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_robot_declaration, 2, 0, 3),
+  [268] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_robot_declaration, 2, 0, 3),
+  [270] = {.entry = {.count = 1, .reusable = true}}, SHIFT(154),
+  [272] = {.entry = {.count = 1, .reusable = true}}, SHIFT(64),
+  [274] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_robot_declaration, 5, 0, 16),
+  [276] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_robot_declaration, 5, 0, 16),
+  [278] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_group_statement_repeat1, 2, 0, 0),
+  [280] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_group_statement_repeat1, 2, 0, 0), SHIFT_REPEAT(130),
+  [283] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_group_statement_repeat1, 2, 0, 0), SHIFT_REPEAT(139),
+  [286] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_team_declaration_repeat2, 2, 0, 0),
+  [288] = {.entry = {.count = 1, .reusable = false}}, REDUCE(aux_sym_team_declaration_repeat2, 2, 0, 0),
+  [290] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_team_declaration_repeat2, 2, 0, 0), SHIFT_REPEAT(64),
+  [293] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_team_declaration, 5, 0, 2),
+  [295] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_team_declaration, 5, 0, 2),
+  [297] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_service_definition, 6, 0, 11),
+  [299] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_service_definition, 6, 0, 11),
+  [301] = {.entry = {.count = 1, .reusable = false}}, SHIFT(184),
+  [303] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_not_expression, 2, 0, 12),
+  [305] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_team_declaration_repeat2, 2, 0, 0), SHIFT_REPEAT(68),
+  [308] = {.entry = {.count = 1, .reusable = true}}, SHIFT(88),
+  [310] = {.entry = {.count = 1, .reusable = true}}, SHIFT(155),
+  [312] = {.entry = {.count = 1, .reusable = true}}, SHIFT(161),
+  [314] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_main_body_repeat1, 2, 0, 0),
+  [316] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_main_body_repeat1, 2, 0, 0), SHIFT_REPEAT(155),
+  [319] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_main_body_repeat1, 2, 0, 0), SHIFT_REPEAT(161),
+  [322] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_or_expression, 3, 0, 19),
+  [324] = {.entry = {.count = 1, .reusable = true}}, SHIFT(24),
+  [326] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_and_expression, 3, 0, 19),
+  [328] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_comparison, 3, 0, 19),
+  [330] = {.entry = {.count = 1, .reusable = true}}, SHIFT(94),
+  [332] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym__expression, 1, 0, 0),
+  [334] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_case_clause, 5, 0, 27),
+  [336] = {.entry = {.count = 1, .reusable = true}}, SHIFT(177),
+  [338] = {.entry = {.count = 1, .reusable = true}}, SHIFT(79),
+  [340] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_mode_assignment, 3, 0, 27),
+  [342] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_case_clause, 6, 0, 27),
+  [344] = {.entry = {.count = 1, .reusable = true}}, SHIFT(68),
+  [346] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_mode_assignment, 4, 0, 27),
+  [348] = {.entry = {.count = 1, .reusable = false}}, SHIFT(198),
+  [350] = {.entry = {.count = 1, .reusable = false}}, SHIFT(158),
+  [352] = {.entry = {.count = 1, .reusable = false}}, SHIFT(173),
+  [354] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_case_clause_repeat1, 2, 0, 0),
+  [356] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_case_clause_repeat1, 2, 0, 0), SHIFT_REPEAT(177),
+  [359] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_mode_body_repeat1, 2, 0, 0), SHIFT_REPEAT(82),
+  [362] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_mode_body_repeat1, 2, 0, 0),
+  [364] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_mode_body_repeat1, 2, 0, 0), SHIFT_REPEAT(169),
+  [367] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_function_definition, 3, 0, 1),
+  [369] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_function_definition, 3, 0, 1),
+  [371] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_service_definition, 7, 0, 17),
+  [373] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_service_definition, 7, 0, 17),
+  [375] = {.entry = {.count = 1, .reusable = true}}, SHIFT(82),
+  [377] = {.entry = {.count = 1, .reusable = true}}, SHIFT(98),
+  [379] = {.entry = {.count = 1, .reusable = true}}, SHIFT(169),
+  [381] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_formation, 2, 0, 0),
+  [383] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_formation, 2, 0, 0),
+  [385] = {.entry = {.count = 1, .reusable = true}}, SHIFT(5),
+  [387] = {.entry = {.count = 1, .reusable = true}}, SHIFT(27),
+  [389] = {.entry = {.count = 1, .reusable = true}}, SHIFT(16),
+  [391] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_main_body, 3, 0, 0),
+  [393] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_main_body, 3, 0, 0),
+  [395] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_repeat_clause, 3, 0, 0),
+  [397] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_repeat_clause, 3, 0, 0),
+  [399] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_main_definition, 4, 0, 4),
+  [401] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_main_definition, 4, 0, 4),
+  [403] = {.entry = {.count = 1, .reusable = true}}, SHIFT(85),
+  [405] = {.entry = {.count = 1, .reusable = true}}, SHIFT(96),
+  [407] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_repeat_clause, 4, 0, 33),
+  [409] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_repeat_clause, 4, 0, 33),
+  [411] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_main_body, 2, 0, 0),
+  [413] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_main_body, 2, 0, 0),
+  [415] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_mode_definition, 4, 0, 5),
+  [417] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_mode_definition, 4, 0, 5),
+  [419] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_mode_body, 2, 0, 0),
+  [421] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_mode_body, 2, 0, 0),
+  [423] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_formation, 3, 0, 0),
+  [425] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_formation, 3, 0, 0),
+  [427] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_mode_body, 3, 0, 0),
+  [429] = {.entry = {.count = 1, .reusable = false}}, REDUCE(sym_mode_body, 3, 0, 0),
+  [431] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_leader_arm, 3, 0, 14),
+  [433] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_formation_repeat1, 2, 0, 0), SHIFT_REPEAT(156),
+  [436] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_formation_repeat1, 2, 0, 0),
+  [438] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_arguments_repeat1, 2, 0, 0),
+  [440] = {.entry = {.count = 1, .reusable = true}}, SHIFT(156),
+  [442] = {.entry = {.count = 1, .reusable = true}}, SHIFT(86),
+  [444] = {.entry = {.count = 1, .reusable = true}}, SHIFT(97),
   [446] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_message, 3, 0, 29),
-  [448] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_catch_clause, 6, 0, 38),
-  [450] = {.entry = {.count = 1, .reusable = true}}, SHIFT(51),
-  [452] = {.entry = {.count = 1, .reusable = true}}, SHIFT(43),
-  [454] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym__period_and_condition, 1, 0, 8),
-  [456] = {.entry = {.count = 1, .reusable = true}}, SHIFT(27),
-  [458] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_default_clause, 3, 0, 0),
-  [460] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym__period_and_condition, 3, 0, 21),
-  [462] = {.entry = {.count = 1, .reusable = true}}, SHIFT(117),
-  [464] = {.entry = {.count = 1, .reusable = true}}, SHIFT(23),
-  [466] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_message, 1, 0, 2),
-  [468] = {.entry = {.count = 1, .reusable = true}}, SHIFT(10),
-  [470] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_arguments_repeat1, 2, 0, 0), SHIFT_REPEAT(6),
-  [473] = {.entry = {.count = 1, .reusable = true}}, SHIFT(31),
-  [475] = {.entry = {.count = 1, .reusable = true}}, SHIFT(153),
-  [477] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_instance_of, 3, 0, 24),
-  [479] = {.entry = {.count = 1, .reusable = true}}, SHIFT(171),
-  [481] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_capable_of, 3, 0, 25),
-  [483] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_communication_repeat1, 2, 0, 0), SHIFT_REPEAT(117),
-  [486] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_communication_repeat1, 2, 0, 0),
-  [488] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_instance_of, 4, 0, 30),
-  [490] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_capable_of, 4, 0, 31),
-  [492] = {.entry = {.count = 1, .reusable = true}}, SHIFT(90),
-  [494] = {.entry = {.count = 1, .reusable = true}}, SHIFT(163),
-  [496] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_set_statement, 6, 0, 32),
-  [498] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_instance_of_repeat1, 2, 0, 35), SHIFT_REPEAT(153),
-  [501] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_instance_of_repeat1, 2, 0, 35),
-  [503] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_capable_of_repeat1, 2, 0, 37), SHIFT_REPEAT(171),
-  [506] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_capable_of_repeat1, 2, 0, 37),
-  [508] = {.entry = {.count = 1, .reusable = true}}, SHIFT(18),
-  [510] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_set_statement, 8, 0, 32),
-  [512] = {.entry = {.count = 1, .reusable = true}}, SHIFT(182),
-  [514] = {.entry = {.count = 1, .reusable = true}}, SHIFT(183),
-  [516] = {.entry = {.count = 1, .reusable = true}}, SHIFT(100),
-  [518] = {.entry = {.count = 1, .reusable = true}}, SHIFT(156),
-  [520] = {.entry = {.count = 1, .reusable = false}}, SHIFT(140),
-  [522] = {.entry = {.count = 1, .reusable = true}}, SHIFT(167),
-  [524] = {.entry = {.count = 1, .reusable = true}}, SHIFT(75),
-  [526] = {.entry = {.count = 1, .reusable = true}}, SHIFT(145),
-  [528] = {.entry = {.count = 1, .reusable = true}}, SHIFT(125),
-  [530] = {.entry = {.count = 1, .reusable = false}}, SHIFT(124),
-  [532] = {.entry = {.count = 1, .reusable = false}}, SHIFT(139),
-  [534] = {.entry = {.count = 1, .reusable = true}}, SHIFT(3),
+  [448] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_group_arm, 3, 0, 14),
+  [450] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_catch_clause, 6, 0, 39),
+  [452] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_instance_of_repeat1, 2, 0, 35), SHIFT_REPEAT(172),
+  [455] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_instance_of_repeat1, 2, 0, 35),
+  [457] = {.entry = {.count = 1, .reusable = true}}, SHIFT(21),
+  [459] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym__period_and_condition, 1, 0, 8),
+  [461] = {.entry = {.count = 1, .reusable = true}}, SHIFT(30),
+  [463] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_default_clause, 3, 0, 0),
+  [465] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym__period_and_condition, 3, 0, 21),
+  [467] = {.entry = {.count = 1, .reusable = true}}, SHIFT(129),
+  [469] = {.entry = {.count = 1, .reusable = true}}, SHIFT(29),
+  [471] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_message, 1, 0, 2),
+  [473] = {.entry = {.count = 1, .reusable = true}}, SHIFT(10),
+  [475] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_arguments_repeat1, 2, 0, 0), SHIFT_REPEAT(5),
+  [478] = {.entry = {.count = 1, .reusable = true}}, SHIFT(43),
+  [480] = {.entry = {.count = 1, .reusable = true}}, SHIFT(32),
+  [482] = {.entry = {.count = 1, .reusable = true}}, SHIFT(172),
+  [484] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_instance_of, 3, 0, 24),
+  [486] = {.entry = {.count = 1, .reusable = true}}, SHIFT(174),
+  [488] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_capable_of, 3, 0, 25),
+  [490] = {.entry = {.count = 1, .reusable = true}}, SHIFT(51),
+  [492] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_communication_repeat1, 2, 0, 0), SHIFT_REPEAT(129),
+  [495] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_communication_repeat1, 2, 0, 0),
+  [497] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_instance_of, 4, 0, 30),
+  [499] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_capable_of, 4, 0, 31),
+  [501] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_set_statement, 6, 0, 32),
+  [503] = {.entry = {.count = 1, .reusable = true}}, SHIFT(91),
+  [505] = {.entry = {.count = 1, .reusable = true}}, SHIFT(171),
+  [507] = {.entry = {.count = 2, .reusable = true}}, REDUCE(aux_sym_capable_of_repeat1, 2, 0, 37), SHIFT_REPEAT(174),
+  [510] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_capable_of_repeat1, 2, 0, 37),
+  [512] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_set_statement, 8, 0, 32),
+  [514] = {.entry = {.count = 1, .reusable = true}}, SHIFT(80),
+  [516] = {.entry = {.count = 1, .reusable = true}}, SHIFT(199),
+  [518] = {.entry = {.count = 1, .reusable = true}}, SHIFT(142),
+  [520] = {.entry = {.count = 1, .reusable = true}}, SHIFT(125),
+  [522] = {.entry = {.count = 1, .reusable = true}}, SHIFT(74),
+  [524] = {.entry = {.count = 1, .reusable = true}}, SHIFT(166),
+  [526] = {.entry = {.count = 1, .reusable = true}}, SHIFT(159),
+  [528] = {.entry = {.count = 1, .reusable = false}}, SHIFT(133),
+  [530] = {.entry = {.count = 1, .reusable = true}}, SHIFT(180),
+  [532] = {.entry = {.count = 1, .reusable = false}}, SHIFT(126),
+  [534] = {.entry = {.count = 1, .reusable = false}}, SHIFT(134),
   [536] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_instance_of_repeat1, 2, 0, 34),
-  [538] = {.entry = {.count = 1, .reusable = true}}, SHIFT(130),
-  [540] = {.entry = {.count = 1, .reusable = true}}, SHIFT(144),
-  [542] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_capable_of_repeat1, 2, 0, 36),
-  [544] = {.entry = {.count = 1, .reusable = true}}, SHIFT(148),
-  [546] = {.entry = {.count = 1, .reusable = true}}, SHIFT(132),
-  [548] = {.entry = {.count = 1, .reusable = true}}, SHIFT(176),
-  [550] = {.entry = {.count = 1, .reusable = true}}, SHIFT(138),
-  [552] = {.entry = {.count = 1, .reusable = true}}, SHIFT(180),
-  [554] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_others_arm, 2, 0, 15),
-  [556] = {.entry = {.count = 1, .reusable = true}}, SHIFT(54),
-  [558] = {.entry = {.count = 1, .reusable = true}}, SHIFT(194),
-  [560] = {.entry = {.count = 1, .reusable = true}}, SHIFT(96),
-  [562] = {.entry = {.count = 1, .reusable = true}}, SHIFT(143),
-  [564] = {.entry = {.count = 1, .reusable = true}}, SHIFT(60),
-  [566] = {.entry = {.count = 1, .reusable = true}}, SHIFT(155),
-  [568] = {.entry = {.count = 1, .reusable = true}}, SHIFT(29),
-  [570] = {.entry = {.count = 1, .reusable = true}}, SHIFT(177),
-  [572] = {.entry = {.count = 1, .reusable = true}}, SHIFT(45),
-  [574] = {.entry = {.count = 1, .reusable = true}}, SHIFT(181),
-  [576] = {.entry = {.count = 1, .reusable = true}}, SHIFT(19),
-  [578] = {.entry = {.count = 1, .reusable = true}}, SHIFT(150),
-  [580] = {.entry = {.count = 1, .reusable = true}}, SHIFT(137),
-  [582] = {.entry = {.count = 1, .reusable = true}},  ACCEPT_INPUT(),
-  [584] = {.entry = {.count = 1, .reusable = true}}, SHIFT(4),
-  [586] = {.entry = {.count = 1, .reusable = true}}, SHIFT(186),
-  [588] = {.entry = {.count = 1, .reusable = true}}, SHIFT(73),
-  [590] = {.entry = {.count = 1, .reusable = true}}, SHIFT(74),
-  [592] = {.entry = {.count = 1, .reusable = true}}, SHIFT(7),
-  [594] = {.entry = {.count = 1, .reusable = true}}, SHIFT(5),
-  [596] = {.entry = {.count = 1, .reusable = true}}, SHIFT(119),
-  [598] = {.entry = {.count = 1, .reusable = true}}, SHIFT(120),
-  [600] = {.entry = {.count = 1, .reusable = true}}, SHIFT(57),
-  [602] = {.entry = {.count = 1, .reusable = true}}, SHIFT(136),
-  [604] = {.entry = {.count = 1, .reusable = true}}, SHIFT(164),
-  [606] = {.entry = {.count = 1, .reusable = true}}, SHIFT(189),
-  [608] = {.entry = {.count = 1, .reusable = true}}, SHIFT(193),
-  [610] = {.entry = {.count = 1, .reusable = true}}, SHIFT(129),
-  [612] = {.entry = {.count = 1, .reusable = true}}, SHIFT(191),
-  [614] = {.entry = {.count = 1, .reusable = true}}, SHIFT(33),
-  [616] = {.entry = {.count = 1, .reusable = true}}, SHIFT(151),
-  [618] = {.entry = {.count = 1, .reusable = true}}, SHIFT(165),
-  [620] = {.entry = {.count = 1, .reusable = true}}, SHIFT(108),
-  [622] = {.entry = {.count = 1, .reusable = true}}, SHIFT(172),
-  [624] = {.entry = {.count = 1, .reusable = true}}, SHIFT(185),
+  [538] = {.entry = {.count = 1, .reusable = true}}, REDUCE(aux_sym_capable_of_repeat1, 2, 0, 36),
+  [540] = {.entry = {.count = 1, .reusable = true}}, SHIFT(3),
+  [542] = {.entry = {.count = 1, .reusable = true}}, SHIFT(132),
+  [544] = {.entry = {.count = 1, .reusable = true}}, SHIFT(145),
+  [546] = {.entry = {.count = 1, .reusable = true}}, SHIFT(176),
+  [548] = {.entry = {.count = 1, .reusable = true}}, SHIFT(182),
+  [550] = {.entry = {.count = 1, .reusable = true}}, SHIFT(195),
+  [552] = {.entry = {.count = 1, .reusable = true}}, SHIFT(35),
+  [554] = {.entry = {.count = 1, .reusable = true}}, SHIFT(170),
+  [556] = {.entry = {.count = 1, .reusable = true}}, SHIFT(183),
+  [558] = {.entry = {.count = 1, .reusable = true}}, SHIFT(144),
+  [560] = {.entry = {.count = 1, .reusable = true}}, SHIFT(25),
+  [562] = {.entry = {.count = 1, .reusable = true}},  ACCEPT_INPUT(),
+  [564] = {.entry = {.count = 1, .reusable = true}}, SHIFT(54),
+  [566] = {.entry = {.count = 1, .reusable = true}}, SHIFT(92),
+  [568] = {.entry = {.count = 1, .reusable = true}}, SHIFT(140),
+  [570] = {.entry = {.count = 1, .reusable = true}}, SHIFT(193),
+  [572] = {.entry = {.count = 1, .reusable = true}}, SHIFT(117),
+  [574] = {.entry = {.count = 1, .reusable = true}}, SHIFT(160),
+  [576] = {.entry = {.count = 1, .reusable = true}}, SHIFT(119),
+  [578] = {.entry = {.count = 1, .reusable = true}}, SHIFT(141),
+  [580] = {.entry = {.count = 1, .reusable = true}}, SHIFT(147),
+  [582] = {.entry = {.count = 1, .reusable = true}}, SHIFT(200),
+  [584] = {.entry = {.count = 1, .reusable = true}}, SHIFT(148),
+  [586] = {.entry = {.count = 1, .reusable = true}}, SHIFT(153),
+  [588] = {.entry = {.count = 1, .reusable = true}}, SHIFT(189),
+  [590] = {.entry = {.count = 1, .reusable = true}}, SHIFT(190),
+  [592] = {.entry = {.count = 1, .reusable = true}}, SHIFT(45),
+  [594] = {.entry = {.count = 1, .reusable = true}}, SHIFT(185),
+  [596] = {.entry = {.count = 1, .reusable = true}}, SHIFT(187),
+  [598] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_others_arm, 2, 0, 15),
+  [600] = {.entry = {.count = 1, .reusable = true}}, SHIFT(61),
+  [602] = {.entry = {.count = 1, .reusable = true}}, SHIFT(143),
+  [604] = {.entry = {.count = 1, .reusable = true}}, SHIFT(4),
+  [606] = {.entry = {.count = 1, .reusable = true}}, SHIFT(76),
+  [608] = {.entry = {.count = 1, .reusable = true}}, SHIFT(9),
+  [610] = {.entry = {.count = 1, .reusable = true}}, SHIFT(77),
+  [612] = {.entry = {.count = 1, .reusable = true}}, SHIFT(131),
+  [614] = {.entry = {.count = 1, .reusable = true}}, REDUCE(sym_counted_group, 5, 0, 38),
+  [616] = {.entry = {.count = 1, .reusable = true}}, SHIFT(194),
+  [618] = {.entry = {.count = 1, .reusable = true}}, SHIFT(6),
+  [620] = {.entry = {.count = 1, .reusable = true}}, SHIFT(128),
+  [622] = {.entry = {.count = 1, .reusable = true}}, SHIFT(168),
+  [624] = {.entry = {.count = 1, .reusable = true}}, SHIFT(196),
+  [626] = {.entry = {.count = 1, .reusable = true}}, SHIFT(179),
+  [628] = {.entry = {.count = 1, .reusable = true}}, SHIFT(151),
+  [630] = {.entry = {.count = 1, .reusable = true}}, SHIFT(19),
+  [632] = {.entry = {.count = 1, .reusable = true}}, SHIFT(175),
+  [634] = {.entry = {.count = 1, .reusable = true}}, SHIFT(59),
+  [636] = {.entry = {.count = 1, .reusable = true}}, SHIFT(120),
 };
 
 #ifdef __cplusplus

@@ -60,6 +60,17 @@ pub fn hover(
         }
         Symbol::RobotType(name) => docs::robot_type(catalog.robot(name)?),
         Symbol::Capability(name) => capability(analysis, catalog, name, offset),
+        Symbol::CountedGroup {
+            team,
+            name,
+            min,
+            robots,
+        } => format!(
+            "**group** `{name}`: a counted group of at least {min} robot{}, chosen at run time among the {robots} robot{} of team `{}` that run this statement. Each robot, at each pass, gives the live robots in formation order to the groups up to their minimums in declaration order; a spare runs `others`, else joins the groups round-robin; with too few alive, the later groups are short.",
+            if *min == 1 { "" } else { "s" },
+            if *robots == 1 { "" } else { "s" },
+            mission.team(*team).name
+        ),
         Symbol::Plan { team, plan } => docs::plan(text, mission.team(*team), *plan),
         Symbol::Service { team, service } => {
             docs::composite_service(analysis, text, *team, *service)

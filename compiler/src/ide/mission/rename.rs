@@ -121,7 +121,8 @@ fn renamable(symbol: &Symbol) -> Result<(), RenameError> {
         | Symbol::Mode { .. }
         | Symbol::Event { .. }
         | Symbol::Function(_)
-        | Symbol::TeamVariable { .. } => Ok(()),
+        | Symbol::TeamVariable { .. }
+        | Symbol::CountedGroup { .. } => Ok(()),
         Symbol::User => {
             refuse("`USER` is the operator's console, a built-in name; it cannot be renamed")
         }
@@ -159,6 +160,9 @@ fn clash(
     let mission = &analysis.mission;
     let team_of = |id: crate::sema::TeamId| mission.teams.get(id.0 as usize);
     match symbol {
+        // Named once, in its statement; a name another group of the
+        // statement has is E038, which the check after the rename reports.
+        Symbol::CountedGroup { .. } => None,
         Symbol::Team(id) => {
             if crate::sema::is_user(new) {
                 return Some(format!(

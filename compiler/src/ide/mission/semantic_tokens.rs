@@ -23,10 +23,11 @@ pub enum TokenKind {
     Variable,
     Value,
     Constant,
+    Group,
 }
 
 impl TokenKind {
-    pub const ALL: [TokenKind; 12] = [
+    pub const ALL: [TokenKind; 13] = [
         TokenKind::Team,
         TokenKind::Robot,
         TokenKind::RobotType,
@@ -39,6 +40,7 @@ impl TokenKind {
         TokenKind::Variable,
         TokenKind::Value,
         TokenKind::Constant,
+        TokenKind::Group,
     ];
 
     pub fn name(self) -> &'static str {
@@ -55,6 +57,7 @@ impl TokenKind {
             TokenKind::Variable => "variable",
             TokenKind::Value => "value",
             TokenKind::Constant => "constant",
+            TokenKind::Group => "group",
         }
     }
 
@@ -134,6 +137,7 @@ fn classify(symbol: &Symbol) -> (TokenKind, u32) {
         Symbol::TeamVariable { .. } => (TokenKind::Variable, 0),
         Symbol::Value { .. } => (TokenKind::Value, DEFAULT_LIBRARY),
         Symbol::Constant(_) => (TokenKind::Constant, 0),
+        Symbol::CountedGroup { .. } => (TokenKind::Group, 0),
     }
 }
 

@@ -570,3 +570,27 @@ fn hover_on_a_robot_type_says_the_platform_semo_build_builds_it_for() {
         hover.markdown
     );
 }
+
+#[test]
+fn a_counted_group_name_is_highlighted_and_its_hover_says_its_minimum_and_its_robots() {
+    let f = crate::ide::mission::testing::Fixture::new(
+        "{ C: Turtlebot3_Burger tb[5] }\nC.A.Go{ [[ group(Room1, min = 2) { scatter() }\n  group(Room2, min = 1) { standby() } ]] } repeat(1 SEC)\nC.M{ set(A, Go) }\nC.main{ default: mode = M }\n",
+    );
+    let at = f.text.find("Room2").unwrap();
+    let hover = hover(&f.analysis, &f.catalog, &f.text, at + 1).unwrap();
+    assert_eq!(&f.text[hover.range.range()], "Room2");
+    assert!(
+        hover.markdown.starts_with(
+            "**group** `Room2`: a counted group of at least 1 robot, chosen at run time among the 5 robots of team `C`"
+        ),
+        "{}",
+        hover.markdown
+    );
+    let tokens = crate::ide::mission::semantic_tokens::semantic_tokens(&f.analysis, None);
+    let groups: Vec<(&str, &str)> = tokens
+        .iter()
+        .filter(|t| t.kind.name() == "group")
+        .map(|t| (&f.text[t.span.range()], t.kind.name()))
+        .collect();
+    assert_eq!(groups, [("Room1", "group"), ("Room2", "group")]);
+}

@@ -489,12 +489,15 @@ impl Fingerprint {
                 self.int(*v);
             }
         }
-        let mut leaders: Vec<_> = robot.leaders.iter().collect();
-        leaders.sort_unstable();
-        for ((a, b), v) in leaders {
-            self.int(*a as i64);
-            self.int(*b as i64);
-            self.int(*v as i64);
+        for map in [&robot.leaders, &robot.allocated] {
+            let mut entries: Vec<_> = map.iter().collect();
+            entries.sort_unstable();
+            self.int(entries.len() as i64);
+            for ((a, b), v) in entries {
+                self.int(*a as i64);
+                self.int(*b as i64);
+                self.int(*v as i64);
+            }
         }
         match robot.group {
             None => self.int(-1),
