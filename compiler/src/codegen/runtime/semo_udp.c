@@ -1,5 +1,6 @@
-/* semo_udp.c: the loopback transport. Robot i of the mission's peer table
- * owns UDP port `port_base + i` on 127.0.0.1; a message to a robot is one
+/* semo_udp.c: the loopback transport. The robot at place i of the mission
+ * (`semo_peer::index`) owns UDP port `port_base + i` on 127.0.0.1; a message
+ * to a robot is one
  * datagram to its port. Only local processes can reach a loopback port, and
  * without a run key every one of them is trusted. With one ($SEMO_UDP_KEY,
  * the same for every robot of a run) each datagram carries its HMAC-SHA256
@@ -28,6 +29,8 @@ static int g_fd = -1;
  * recv can wait on the socket without a timeout. */
 static int g_wake[2] = {-1, -1};
 static int g_port_base;
+/* The program's peers, whose places give their ports. */
+static const semo_peer *g_peers;
 static size_t g_peer_count;
 /* The run key (none: g_key_len 0). */
 static unsigned char g_key[SEMO_UDP_KEY_MAX];
@@ -179,14 +182,14 @@ static int udp_open(const semo_program_desc *program, const semo_transport_confi
 {
     long port_base = config->port_base;
     if (g_fd >= 0 || program->self >= program->peer_count || port_base < 1 ||
-        (long)port_base + (long)program->peer_count > 65536)
+        (long)port_base + (long)program->robot_count > 65536)
         return -1;
     int fd = socket(AF_INET, SOCK_DGRAM, 0);
     if (fd < 0)
         return -1;
     /* Child processes (a task running a helper) must not inherit the port. */
     fcntl(fd, F_SETFD, FD_CLOEXEC);
-    struct sockaddr_in self = loopback((int)port_base + (int)program->self);
+    struct sockaddr_in self = loopback((int)port_base + (int)program->peers[program->self].index);
     if (bind(fd, (const struct sockaddr *)&self, sizeof self) != 0 || pipe(g_wake) != 0) {
         close(fd);
         return -1;
@@ -197,6 +200,7 @@ static int udp_open(const semo_program_desc *program, const semo_transport_confi
     }
     g_fd = fd;
     g_port_base = (int)port_base;
+    g_peers = program->peers;
     g_peer_count = program->peer_count;
     g_key_len = config->udp_key_len <= sizeof g_key ? config->udp_key_len : 0;
     if (g_key_len > 0)
@@ -217,7 +221,7 @@ static int udp_send(size_t peer, const void *data, size_t len)
         data = signed_data;
         len += UDP_TAG;
     }
-    struct sockaddr_in to = loopback(g_port_base + (int)peer);
+    struct sockaddr_in to = loopback(g_port_base + (int)g_peers[peer].index);
     ssize_t n;
     do
         n = sendto(g_fd, data, len, 0, (const struct sockaddr *)&to, sizeof to);
@@ -270,6 +274,7 @@ static void udp_close(void)
         g_wake[i] = -1;
     }
     g_fd = -1;
+    g_peers = NULL;
     g_peer_count = 0;
 }
 
