@@ -916,3 +916,60 @@ fn the_runtime_is_written_once_and_compiled_once_per_compiler_and_flags() {
     );
     assert!(copy.join("irobot").is_file());
 }
+
+#[path = "../compiler/benches/common/mission.rs"]
+mod benchmark_mission;
+
+/// Bytes of every file under `dir`, and the largest number of robots a
+/// robot's `main.c` there names (the rows of its `peers[]` table).
+fn bytes_and_widest_peer_table(dir: &Path) -> (u64, usize) {
+    let (mut bytes, mut widest) = (0, 0);
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+                continue;
+            }
+            bytes += std::fs::metadata(&path).unwrap().len();
+            if path.file_name().is_some_and(|n| n == "main.c") {
+                let text = std::fs::read_to_string(&path).unwrap();
+                let table = text
+                    .split("static const semo_peer peers[] = {\n")
+                    .nth(1)
+                    .and_then(|rest| rest.split("};").next())
+                    .expect("main.c has a peer table");
+                widest = widest.max(table.lines().count());
+            }
+        }
+    }
+    (bytes, widest)
+}
+
+/// A build's output is linear in the robots: twice the teams of the
+/// generated benchmark mission (each of six robots, talking to the next
+/// team) write at most twice the bytes, because a robot's program names only
+/// its peers (its team and the team it sends to: 12 robots), never the whole
+/// fleet, and the runtime is written once. Before, every `main.c` listed
+/// every robot of the mission: 1,002 robots wrote some 227 MB.
+#[test]
+fn twice_the_robots_write_at_most_twice_the_bytes() {
+    let measure = |teams: usize| {
+        let dir = scratch(&format!("fleet-{teams}"));
+        let mission = dir.join("fleet.mission");
+        std::fs::write(&mission, benchmark_mission::generate(teams)).unwrap();
+        let out = dir.join("out");
+        let built = build(&mission, "linux-sim", &out);
+        assert_eq!(built.code, 0, "{}", built.stderr);
+        bytes_and_widest_peer_table(&out)
+    };
+    let (small, small_widest) = measure(20);
+    let (large, large_widest) = measure(40);
+    assert_eq!((small_widest, large_widest), (12, 12));
+    assert!(
+        large <= 2 * small,
+        "120 robots wrote {small} bytes, 240 robots {large} (x{:.2})",
+        large as f64 / small as f64
+    );
+}

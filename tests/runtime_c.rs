@@ -464,16 +464,24 @@ fn a_task_waiting_for_events_does_not_poll() {
     }
 }
 
-/// A base port with base and base+1 free on 127.0.0.1 right now.
+/// A port base with the three ports of the test mission's places free: the
+/// two robots listen on base and base + 2 (their places 0 and 2; place 1 is
+/// a robot of the mission neither knows).
 fn free_port_pair() -> u16 {
     for _ in 0..100 {
         let a = UdpSocket::bind("127.0.0.1:0").expect("bind a UDP port");
         let base = a.local_addr().unwrap().port();
-        if base < 65535 && UdpSocket::bind(("127.0.0.1", base + 1)).is_ok() {
+        let free = |port: u16| UdpSocket::bind(("127.0.0.1", port)).is_ok();
+        if base < 65534 && free(base + 1) && free(base + 2) {
             return base;
         }
     }
-    panic!("no two adjacent free UDP ports");
+    panic!("no three adjacent free UDP ports");
+}
+
+/// The port of robot `b` (place 2 of the test mission) over `base`.
+fn port_of_b(base: &str) -> u16 {
+    base.parse::<u16>().unwrap() + 2
 }
 
 fn wait_for_start(trace: &Path, child: &mut Child) {
@@ -539,7 +547,7 @@ fn two_robots_exchange_messages_over_udp_and_reject_malformed_datagrams() {
         let (mut b, b_started) =
             p.spawn(&b_args.iter().map(String::as_str).collect::<Vec<_>>(), &[]);
         wait_for_start(&trace_b, &mut b);
-        send_datagrams_to(base.parse::<u16>().unwrap() + 1);
+        send_datagrams_to(port_of_b(&base));
         let a_args = args("udp-a", &trace_a);
         let a = p.run(&a_args.iter().map(String::as_str).collect::<Vec<_>>(), &[]);
         let b = finish(b, b_started, "udp-b");
@@ -621,7 +629,7 @@ fn with_a_run_key_a_datagram_without_its_signature_is_refused() {
             p.spawn(&b_args.iter().map(String::as_str).collect::<Vec<_>>(), &env);
         wait_for_start(&trace_b, &mut b);
         let socket = UdpSocket::bind("127.0.0.1:0").unwrap();
-        let port = base.parse::<u16>().unwrap() + 1;
+        let port = port_of_b(&base);
         use semo::deploy::datagram::{OUTSIDER, counter_now, sign};
         let at = counter_now();
         let mut altered = sign(&key, OUTSIDER, at, &note("Alpha.NOTE", "forged"));
@@ -1023,10 +1031,6 @@ fn bad_scenarios_are_refused_with_line_and_column() {
             "1:13: a fault is exactly one of \"kill\", \"restart\", \"drop\", \"delay\", \"partition\"",
         ),
         (
-            "{\"faults\": [{\"at\": 1, \"kill\": \"nobody\"}]}",
-            "1:31: robot \"nobody\" is not in the mission",
-        ),
-        (
             "{\"faults\": [{\"from\": 5, \"until\": 5, \"drop\": [\"solo\", \"solo\"]}]}",
             "1:34: \"until\" must be after \"from\"",
         ),
@@ -1067,5 +1071,25 @@ fn bad_scenarios_are_refused_with_line_and_column() {
         let missing = p.run(&["minimal", "--scenario", "/nonexistent.json"], &[]);
         assert_eq!(missing.code, 2);
         assert!(missing.stderr.contains("cannot read"), "{}", missing.stderr);
+    }
+}
+
+/// A robot knows only its peers (the robots it sends to or hears from), so
+/// faults naming a robot it does not know are for others: it reads them and
+/// runs (whether the name is in the mission is `semo simulate`'s check, with
+/// the whole fleet: `tests/simulate.rs`).
+#[test]
+fn faults_naming_a_robot_the_program_does_not_know_are_for_others() {
+    let text = "{\"duration\": 50, \"faults\": [{\"at\": 1, \"kill\": \"stranger\"}, {\"from\": 1, \"until\": 5, \"drop\": [\"solo\", \"stranger\"]}, {\"from\": 1, \"until\": 5, \"partition\": [[\"stranger\"], [\"solo\"]]}]}";
+    for flavor in flavors().into_iter().filter(|f| f.sim()) {
+        let p = program(flavor);
+        let path = work_dir().join(format!(
+            "strangers-{}-{}.json",
+            flavor.name(),
+            std::process::id()
+        ));
+        std::fs::write(&path, text).unwrap();
+        p.run_ok(&["minimal", "--scenario", path.to_str().unwrap()]);
+        let _ = std::fs::remove_file(&path);
     }
 }

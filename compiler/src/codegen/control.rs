@@ -7,6 +7,7 @@
 //! this firing), `STEP_WAIT` (try again next firing) or `STEP_DONE`.
 
 use super::c;
+use super::peers::Peers;
 use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::{
@@ -93,14 +94,13 @@ const ELECTION_C: &str = "/* Leader elections: each `leader(...)` arm's candidat
 /// alive when it is this robot or was heard from within three heartbeats
 /// (counted from when this robot joined: until then it had no chance to
 /// hear, so a robot starting or restarting counts every member alive).
-fn group_update(m: &ControlMachine) -> String {
+fn group_update(m: &ControlMachine, peers: &Peers) -> String {
     if m.group.is_empty() {
         return String::new();
     }
-    let list: Vec<String> = m.group.iter().map(|i| i.to_string()).collect();
     format!(
         "        static const size_t members[] = {{{list}}};\n        const semo_program_desc *p = semo_program();\n        int rank = 0, size = 0;\n        for (size_t k = 0; k < {count}; k++) {{\n            comm_heartbeat h = comm_heard(members[k]);\n            int64_t seen = h.seen > semo_joined_ms() ? h.seen : semo_joined_ms();\n            if (members[k] != p->self && last_heartbeat - seen > 3 * {hb})\n                continue; /* failed: silent for three heartbeats */\n            if (members[k] == p->self)\n                rank = size;\n            size++;\n        }}\n        semo_group_set(rank, size);\n",
-        list = list.join(", "),
+        list = peers.locals(&m.group),
         count = m.group.len(),
         hb = m.heartbeat_ms,
     )
@@ -115,7 +115,7 @@ const GROUP_OF_C: &str = "/* Counted groups: this robot's group among `groups` (
 /// simulation), else unknown (-1).
 const OWN_BATTERY_C: &str = "/* Whether the last election this robot decided named it (its heartbeats say so). */\nstatic bool leading;\n/* Terms (docs/groups.md): the highest this robot knows (heard, or its own),\n * and the one it leads under while `leading`. */\nstatic int64_t term_known, term_led;\n\n/* The highest term known now: its own, or one a heartbeat said. */\nstatic int64_t known_term(void)\n{\n    int64_t heard = comm_highest_term();\n    if (heard > term_known)\n        term_known = heard;\n    return term_known;\n}\n\n/* A term (at most 10^15) as decimal digits: not every target's printf\n * has %lld. */\nstatic void term_text(int64_t t, char out[24])\n{\n    char digits[24];\n    int n = 0;\n    do {\n        digits[n++] = (char)('0' + t % 10);\n        t /= 10;\n    } while (t > 0 && n < 23);\n    for (int i = 0; i < n; i++)\n        out[i] = digits[n - 1 - i];\n    out[n] = '\\0';\n}\n\n/* This robot's battery level for its heartbeats: the scenario's in\n * simulation, else unknown (-1). */\nstatic long own_battery(void)\n{\n#ifdef SEMO_SIM\n    long long level;\n    if (semo_sim_battery(&level))\n        return (long)level;\n#endif\n    return -1;\n}\n\n";
 
-pub fn control_task(program: &RobotProgram, words: &Words, header: &str) -> String {
+pub fn control_task(program: &RobotProgram, words: &Words, peers: &Peers, header: &str) -> String {
     let m = &program.control;
     let mut out = String::new();
     out.push_str(header);
@@ -210,14 +210,14 @@ pub fn control_task(program: &RobotProgram, words: &Words, header: &str) -> Stri
             service.line
         );
         for (pc, state) in service.states.iter().enumerate() {
-            emit_state(&mut body, program, words, pc, state);
+            emit_state(&mut body, program, words, peers, pc, state);
         }
         body.push_str("    default:\n        return STEP_DONE;\n    }\n}\n\n");
     }
     body.push_str(&super::battery::resource_manager(program, words));
     emit_dispatch(&mut body, program);
     emit_modes(&mut body, program);
-    emit_task(&mut body, program);
+    emit_task(&mut body, program, peers);
     let mut helpers = String::new();
     emit_helpers(&mut helpers, program, &body);
     let tables = [
@@ -470,7 +470,14 @@ fn emit_drop_unled(out: &mut String, program: &RobotProgram, receives: &[usize])
     out.push_str("        }\n");
 }
 
-fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize, state: &State) {
+fn emit_state(
+    out: &mut String,
+    program: &RobotProgram,
+    words: &Words,
+    peers: &Peers,
+    pc: usize,
+    state: &State,
+) {
     let m = &program.control;
     let _ = writeln!(
         out,
@@ -657,7 +664,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize
             others_at,
             receives,
         } => {
-            let list: Vec<String> = candidates.iter().map(|c| c.to_string()).collect();
+            let list = peers.locals(candidates);
             let algorithm = match algorithm {
                 LeaderAlgorithm::LowestId => "ELECT_LOWEST_ID",
                 LeaderAlgorithm::HighestBattery => "ELECT_HIGHEST_BATTERY",
@@ -666,7 +673,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize
             let _ = writeln!(
                 out,
                 "    {{\n        static const size_t candidates[] = {{{}}};\n        static long leader = -1; /* the last leader seen (control thread only) */{led}\n        int chosen = elected(candidates, {}, {algorithm}, &leader);\n        if (chosen < 0)\n            return STEP_WAIT; /* still listening */",
-                list.join(", "),
+                list,
                 candidates.len(),
                 // The leader before this election, for `emit_drop_unled`.
                 led = if receives.is_empty() {
@@ -687,7 +694,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize
             others_at,
         } => {
             let join = |items: Vec<String>| items.join(", ");
-            let members_list = join(members.iter().map(|c| c.to_string()).collect());
+            let members_list = peers.locals(members);
             let mins = join(groups.iter().map(|g| g.min.to_string()).collect());
             let names = join(groups.iter().map(|g| c::string(&g.name)).collect());
             let at = join(groups.iter().map(|g| g.at.index().to_string()).collect());
@@ -706,8 +713,7 @@ fn emit_state(out: &mut String, program: &RobotProgram, words: &Words, pc: usize
             timeout_ms,
             mark,
         } => {
-            let list: Vec<String> = members.iter().map(|c| c.to_string()).collect();
-            let list = list.join(", ");
+            let list = peers.locals(members);
             let hb = m.heartbeat_ms;
             let _ = writeln!(
                 out,
@@ -924,7 +930,7 @@ fn emit_modes(out: &mut String, program: &RobotProgram) {
     out.push_str("}\n\n");
 }
 
-fn emit_task(out: &mut String, program: &RobotProgram) {
+fn emit_task(out: &mut String, program: &RobotProgram, peers: &Peers) {
     let m = &program.control;
     let name = c::ident(CONTROL_TASK);
     let _ = writeln!(out, "void task_{name}_init(void)\n{{");
@@ -985,7 +991,7 @@ fn emit_task(out: &mut String, program: &RobotProgram) {
             hb = m.heartbeat_ms,
             team = c::string(&program.team),
             key = c::string(&super::files::alive_key(program)),
-            group = group_update(m),
+            group = group_update(m, peers),
         );
     }
     match default {

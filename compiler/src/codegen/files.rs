@@ -2,6 +2,7 @@
 //! `comm_task.c`, `lib_<name>.c`, `tasks/<task>.c` and the `Makefile`.
 
 use super::c;
+use super::peers::Peers;
 use super::values::Words;
 use super::{CompiledScenario, Layer, Target};
 use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK};
@@ -132,7 +133,13 @@ pub fn channels_c(program: &RobotProgram, target: Target, header: &str) -> Strin
     out
 }
 
-pub fn main_c(program: &RobotProgram, words: &Words, target: Target, header: &str) -> String {
+pub fn main_c(
+    program: &RobotProgram,
+    words: &Words,
+    peers: &Peers,
+    target: Target,
+    header: &str,
+) -> String {
     let mut out = String::from(header);
     out.push_str(match target.layer() {
         Layer::Threads => "#include \"program.h\"\n\n/* Tasks: one thread each. */\nstatic const semo_task_desc tasks[] = {\n",
@@ -185,9 +192,15 @@ pub fn main_c(program: &RobotProgram, words: &Words, target: Target, header: &st
         }
         out.push_str("};\n\n");
     }
-    out.push_str("/* Every robot of the mission: robot i listens on UDP port base + i. */\nstatic const semo_peer peers[] = {\n");
-    for (team, robot) in program.peers.iter() {
-        let _ = writeln!(out, "    {{{}, {}}},", c::string(team), c::string(robot));
+    out.push_str("/* The robots this one sends to or hears from (its team and those its\n * messages go to), each with its place among the mission's robots: over\n * UDP it listens on port base + place. */\nstatic const semo_peer peers[] = {\n");
+    for &i in peers.list() {
+        let (team, robot) = &program.peers[i];
+        let _ = writeln!(
+            out,
+            "    {{{}, {}, {i}}},",
+            c::string(team),
+            c::string(robot)
+        );
     }
     out.push_str("};\n\n");
     let threads = target.layer() == Layer::Threads;
@@ -196,14 +209,15 @@ pub fn main_c(program: &RobotProgram, words: &Words, target: Target, header: &st
     }
     let _ = writeln!(
         out,
-        "static const semo_program_desc program = {{\n    .mission = {},\n    .team = {},\n    .robot = {},\n    .robot_type = {},\n    .tasks = tasks,\n    .task_count = sizeof tasks / sizeof tasks[0],\n    .channels = semo_program_channels,\n    .channel_count = SEMO_CHANNEL_COUNT,\n    .groups = {},\n    .group_count = {},\n    .peers = peers,\n    .peer_count = sizeof peers / sizeof peers[0],\n    .self = {},\n{}{}{}}};\n\nint main(int argc, char **argv)\n{{\n    return semo_main(argc, argv, &program);\n}}",
+        "static const semo_program_desc program = {{\n    .mission = {},\n    .team = {},\n    .robot = {},\n    .robot_type = {},\n    .tasks = tasks,\n    .task_count = sizeof tasks / sizeof tasks[0],\n    .channels = semo_program_channels,\n    .channel_count = SEMO_CHANNEL_COUNT,\n    .groups = {},\n    .group_count = {},\n    .peers = peers,\n    .peer_count = sizeof peers / sizeof peers[0],\n    .self = {},\n    .robot_count = {},\n{}{}{}}};\n\nint main(int argc, char **argv)\n{{\n    return semo_main(argc, argv, &program);\n}}",
         c::string(&program.mission),
         c::string(&program.team),
         c::string(&program.robot),
         c::string(&program.robot_type),
         if groups.is_empty() { "NULL" } else { "groups" },
         groups.len(),
-        program.self_peer,
+        peers.own(),
+        program.peers.len(),
         if static_schedule {
             "    .schedule = schedule,\n    .schedule_count = sizeof schedule / sizeof schedule[0],\n"
         } else {
@@ -248,7 +262,13 @@ pub(super) fn lock(target: Target, name: &str) -> (&'static str, String, String,
     }
 }
 
-pub fn comm_task_c(program: &RobotProgram, words: &Words, target: Target, header: &str) -> String {
+pub fn comm_task_c(
+    program: &RobotProgram,
+    words: &Words,
+    peers: &Peers,
+    target: Target,
+    header: &str,
+) -> String {
     let m = &program.control;
     let mut out = String::from(header);
     let (include, declare, lock_seen, unlock_seen) = lock(target, "seen_lock");
@@ -290,7 +310,7 @@ pub fn comm_task_c(program: &RobotProgram, words: &Words, target: Target, header
         let _ = writeln!(
             out,
             "/* Heartbeats of the team's robots, for leader elections: when each robot\n * was last heard from, and what it said (`leader 87 3`: it claims\n * leadership under term 3, battery 87; `member - 2`: it does not, battery\n * unknown, the highest term it knows is 2). Every robot counts as alive at\n * start. */\n{declare}static comm_heartbeat heard[{peers}];\nstatic int64_t highest_term;\n\ncomm_heartbeat comm_heard(size_t peer)\n{{\n    comm_heartbeat h = {{0, false, -1, 0}};\n    {lock_seen}\n    if (peer < {peers})\n        h = heard[peer];\n    {unlock_seen}\n    return h;\n}}\n\nint64_t comm_highest_term(void)\n{{\n    {lock_seen}\n    int64_t t = highest_term;\n    {unlock_seen}\n    return t;\n}}\n\n/* A term's leading digits, at most {term_max} (a larger one says this). */\nstatic int64_t parse_term(const char *s)\n{{\n    int64_t t = 0;\n    for (; *s >= '0' && *s <= '9'; s++) {{\n        t = t * 10 + (*s - '0');\n        if (t > {term_max}LL)\n            t = {term_max}LL;\n    }}\n    return t;\n}}\n\nstatic bool heard_alive(const semo_message *m)\n{{\n    if (m->kind != SEMO_MSG_PUBLISH || strcmp(m->key, {key}) != 0)\n        return false;\n    /* The value is text; of another type it says only that the robot lives. */\n    const char *said = m->value.type == SEMO_TEXT ? m->value.text : \"\";\n    const char *battery = strchr(said, ' ');\n    const char *term = battery ? strchr(battery + 1, ' ') : NULL;\n    comm_heartbeat h = {{semo_now_ms(), strncmp(said, \"leader \", 7) == 0, -1, 0}};\n    if (battery && battery[1] >= '0' && battery[1] <= '9')\n        h.battery = strtol(battery + 1, NULL, 10);\n    if (term)\n        h.term = parse_term(term + 1);\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        if (strcmp(p->peers[i].robot, m->from_robot) == 0) {{\n            {lock_seen}\n            heard[i] = h;\n            if (h.term > highest_term)\n                highest_term = h.term;\n            {unlock_seen}\n        }}\n    return true;\n}}\n",
-            peers = program.peers.len().max(1),
+            peers = peers.len(),
             key = c::string(&alive_key(program)),
             term_max = super::control::TERM_MAX,
         );
@@ -302,7 +322,7 @@ pub fn comm_task_c(program: &RobotProgram, words: &Words, target: Target, header
             "/* GroupSync: for each robot and sync point (the group statement's offset\n * in the mission), the last pass it announced (`Team.__sync` = \"<point>\n * <pass>\"). A new one wakes the control task, which may be waiting. */\nstatic const long sync_point[] = {{{list}}};\nstatic long arrived[{peers}][{n}];\n\nlong comm_sync_arrived(size_t peer, size_t point)\n{{\n    long pass = 0;\n    {lock_seen}\n    if (peer < {peers} && point < {n})\n        pass = arrived[peer][point];\n    {unlock_seen}\n    return pass;\n}}\n\nstatic bool heard_sync(const semo_message *m)\n{{\n    if (strcmp(m->key, {key}) != 0)\n        return false;\n    /* The value is text; of another type it says nothing. */\n    const char *said = m->value.type == SEMO_TEXT ? m->value.text : \"\";\n    char *end;\n    long point = strtol(said, &end, 10), pass = strtol(end, NULL, 10);\n    const semo_program_desc *p = semo_program();\n    for (size_t i = 0; i < p->peer_count && i < {peers}; i++)\n        for (size_t k = 0; k < {n}; k++)\n            if (strcmp(p->peers[i].robot, m->from_robot) == 0 && sync_point[k] == point) {{\n                {lock_seen}\n                if (pass > arrived[i][k])\n                    arrived[i][k] = pass;\n                {unlock_seen}\n            }}\n    semo_wake({control});\n    return true;\n}}\n",
             list = points.join(", "),
             n = m.sync_points.len(),
-            peers = program.peers.len().max(1),
+            peers = peers.len(),
             key = c::string(&sync_key(program)),
             control = c::string(CONTROL_TASK),
         );
@@ -358,7 +378,7 @@ pub fn comm_task_c(program: &RobotProgram, words: &Words, target: Target, header
             let _ = writeln!(
                 out,
                 "    for (size_t i = 0; i < {}; i++)\n        heard[i].battery = -1;",
-                program.peers.len().max(1)
+                peers.len()
             );
         }
         if n > 0 {

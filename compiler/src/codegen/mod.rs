@@ -32,6 +32,7 @@ pub(crate) mod files;
 mod loops;
 pub use loops::GRAPH_TEXT_MAX;
 pub mod output;
+mod peers;
 mod schedule;
 mod shared;
 mod target;
@@ -210,19 +211,23 @@ pub enum Emit {
 
 /// The files of one robot's folder. `sources` names the input files for the
 /// header of every generated file; `scenario` is the world compiled into a
-/// target that [`Target::needs_scenario`] (ignored by the others). With them,
-/// the words its code asked the word table for and it lacked (each refuses
-/// the build: `missing_word_errors`).
-pub fn generate(
+/// target that [`Target::needs_scenario`] (ignored by the others); `fleet`
+/// the fleet's table the program's peers are found in. With them, what its
+/// code asked the word and peer tables for and they lacked (each refuses
+/// the build: `lacking_errors`).
+fn generate(
     program: &RobotProgram,
+    fleet: &peers::Fleet<'_>,
     target: Target,
     emit: Emit,
     sources: &[String],
     scenario: Option<&CompiledScenario>,
-) -> (RobotOutput, Vec<String>) {
+) -> (RobotOutput, Lacking) {
     let header = file_header(program, target, sources, Owner::Generated);
-    // One word table for every file: the words it lacked refuse the build.
+    // One word table and one peer table for every file: what they lacked
+    // refuses the build.
     let words = values::Words::of(program);
+    let peers = peers::Peers::of(program, fleet);
     let mut files = Vec::new();
     let mut push = |path: &str, text: String, owner: Owner| {
         files.push(GeneratedFile {
@@ -250,7 +255,7 @@ pub fn generate(
             target,
             files,
         };
-        return (output, Vec::new());
+        return (output, Lacking::default());
     }
     let mut sources_c = vec![
         "main.c".to_string(),
@@ -264,7 +269,7 @@ pub fn generate(
     );
     push(
         "main.c",
-        files::main_c(program, &words, target, &header),
+        files::main_c(program, &words, &peers, target, &header),
         Owner::Generated,
     );
     push(
@@ -274,7 +279,7 @@ pub fn generate(
     );
     push(
         "control_task.c",
-        control::control_task(program, &words, &header),
+        control::control_task(program, &words, &peers, &header),
         Owner::Generated,
     );
     let comm = program
@@ -284,12 +289,12 @@ pub fn generate(
     if comm {
         push(
             "comm_task.c",
-            files::comm_task_c(program, &words, target, &header),
+            files::comm_task_c(program, &words, &peers, target, &header),
             Owner::Generated,
         );
         sources_c.push("comm_task.c".into());
     }
-    if let Some((name, text)) = shared::library_c(program, target, &header) {
+    if let Some((name, text)) = shared::library_c(program, &peers, target, &header) {
         push(&name, text, Owner::Generated);
         sources_c.push(name);
     }
@@ -349,7 +354,21 @@ pub fn generate(
         target,
         files,
     };
-    (output, words.missing())
+    let lacking = Lacking {
+        words: words.missing(),
+        peers: peers.missing(),
+    };
+    (output, lacking)
+}
+
+/// What the code generated for a robot asked its tables for and they
+/// lacked: generator bugs, each refusing the build (E102).
+#[derive(Default)]
+struct Lacking {
+    /// Words its word table lacks.
+    words: Vec<String>,
+    /// Robots (fleet indices) its peer table lacks.
+    peers: Vec<usize>,
 }
 
 /// Bytes of the longest value the program holds that is known at build
@@ -632,9 +651,25 @@ pub fn build_refined_each(
         return BuildResult::refused_with(diagnostics);
     }
     let mut robots: Vec<RobotOutput> = Vec::new();
+    // Refinement gives every program one fleet table: indexed once.
+    let fleet = peers::Fleet::of(&programs[0].peers);
     for (i, (program, chosen)) in programs.iter().zip(&chosen).enumerate() {
-        let (robot, missing) = generate(program, chosen.target, emit, &sources, scenarios.get(i));
-        diagnostics.extend(missing_word_errors(build, program, &missing));
+        let other;
+        let fleet = if fleet.holds(program) {
+            &fleet
+        } else {
+            other = peers::Fleet::of(&program.peers);
+            &other
+        };
+        let (robot, lacking) = generate(
+            program,
+            fleet,
+            chosen.target,
+            emit,
+            &sources,
+            scenarios.get(i),
+        );
+        diagnostics.extend(lacking_errors(build, program, &lacking));
         robots.push(robot);
     }
     diagnostics.extend(
@@ -657,29 +692,28 @@ pub fn build_refined_each(
     }
 }
 
-/// The words generation asked the program's word table for and it lacked
-/// (`values::Words::index`): each an internal error (E102), never written
-/// as another word.
-fn missing_word_errors(
+/// The words and robots generation asked the program's word and peer
+/// tables for and they lacked (`values::Words::index`,
+/// `peers::Peers::local`): each an internal error (E102), never written as
+/// another word or robot.
+fn lacking_errors(
     build: &BuildInput<'_>,
     program: &crate::refine::RobotProgram,
-    missing: &[String],
+    lacking: &Lacking,
 ) -> Vec<crate::diag::Diagnostic> {
     use crate::diag::{Code, Diagnostic};
     let span = robot_span(build, &program.robot);
-    missing
-        .iter()
-        .map(|word| {
-            Diagnostic::new(
-                Code::CodegenInternal,
-                build.mission,
-                span,
-                format!(
-                    "the code generated for robot `{}` uses the word `{word}`, which its word table lacks",
-                    program.robot
-                ),
-            )
-        })
+    let robot = &program.robot;
+    let words = lacking.words.iter().map(|word| {
+        format!("the code generated for robot `{robot}` uses the word `{word}`, which its word table lacks")
+    });
+    let peers = lacking.peers.iter().map(|&i| {
+        let named = program.peers.get(i).map_or("?", |(_, r)| r.as_str());
+        format!("the code generated for robot `{robot}` names robot `{named}`, which its peer table lacks")
+    });
+    words
+        .chain(peers)
+        .map(|message| Diagnostic::new(Code::CodegenInternal, build.mission, span, message))
         .collect()
 }
 

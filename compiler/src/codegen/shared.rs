@@ -9,6 +9,7 @@
 
 use super::c;
 use super::files::lock;
+use super::peers::Peers;
 use super::values::Words;
 use super::{Layer, Target};
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
@@ -59,7 +60,12 @@ pub fn comm_dispatch(program: &RobotProgram) -> Option<String> {
 }
 
 /// `lib_<name>.c`.
-pub fn library_c(program: &RobotProgram, target: Target, header: &str) -> Option<(String, String)> {
+pub fn library_c(
+    program: &RobotProgram,
+    peers: &Peers,
+    target: Target,
+    header: &str,
+) -> Option<(String, String)> {
     let lib = program.library.as_ref()?;
     let prefix = prefix(lib);
     let mut out = String::from(header);
@@ -80,7 +86,7 @@ pub fn library_c(program: &RobotProgram, target: Target, header: &str) -> Option
             .and_then(|o| o.global.iter().position(|g| g.at == i))
     };
     if let Some(ownership) = &lib.ownership {
-        owner_protocol(&mut out, program, lib, ownership, &lock, &unlock);
+        owner_protocol(&mut out, program, peers, lib, ownership, &lock, &unlock);
     }
     for (i, key) in lib.attributes.iter().enumerate() {
         let _ = writeln!(out, "/* {} */", c::comment(key));
@@ -120,6 +126,7 @@ pub fn library_c(program: &RobotProgram, target: Target, header: &str) -> Option
 fn owner_protocol(
     out: &mut String,
     program: &RobotProgram,
+    peers: &Peers,
     lib: &SharedLibrary,
     ownership: &Ownership,
     lock: &str,
@@ -171,8 +178,8 @@ fn owner_protocol(
     let _ = writeln!(
         out,
         "/* The robots that own the values in turn (peer indices) and the owner now. */\nstatic const size_t owners[] = {{{}}};\nstatic size_t owner = {};\n",
-        list(&mut ownership.owners.iter().map(|o| o.to_string())),
-        ownership.owners[0]
+        peers.locals(&ownership.owners),
+        peers.local(ownership.owners[0])
     );
     let hb = program.control.heartbeat_ms;
     let _ = writeln!(

@@ -73,8 +73,9 @@ pub fn encode(d: &Datagram) -> Vec<u8> {
 /// The bytes of a SHA-256 digest: the tag a signed datagram ends with.
 pub const TAG_LEN: usize = 32;
 
-/// The bytes between a signed datagram and its tag: the sender's peer index
-/// (u32) and its counter (u64), little-endian, signed with it.
+/// The bytes between a signed datagram and its tag: the sender's place in
+/// the mission (u32: its `semo_peer.index`, [`OUTSIDER`] for a sender outside
+/// it) and its counter (u64), little-endian, signed with it.
 pub const STAMP_LEN: usize = 12;
 
 /// The sender index of a signer outside the mission's peer table (the

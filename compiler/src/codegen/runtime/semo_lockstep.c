@@ -23,8 +23,9 @@
  * them in a fixed order before it grants any later time.
  *
  * Frames, both ways: one kind byte, a 32-bit little-endian payload length,
- * the payload. Robot to coordinator: `H` (u32 peer index: who it is), `I`
- * (i64: the next wake-up, -1 none), `M` (u32 peer, then the datagram).
+ * the payload. Robot to coordinator: `H` (u32: who it is, its place among
+ * the mission's robots, `semo_peer::index`), `I` (i64: the next wake-up, -1
+ * none), `M` (u32: the place of the robot it is for, then the datagram).
  * Coordinator to robot: `G` (i64: mission time now), `D` (a datagram).
  */
 #define _POSIX_C_SOURCE 200809L
@@ -534,8 +535,12 @@ static int ls_open(const semo_program_desc *program, const semo_transport_config
 
 static int ls_send(size_t peer, const void *data, size_t len)
 {
+    /* The coordinator knows robots by their place in the mission. */
+    const semo_program_desc *p = semo_program();
+    if (peer >= p->peer_count)
+        return -1;
     unsigned char to[4];
-    put_le(to, (uint32_t)peer, 4);
+    put_le(to, (uint32_t)p->peers[peer].index, 4);
     return write_frame('M', to, sizeof to, data, len);
 }
 

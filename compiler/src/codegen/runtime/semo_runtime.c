@@ -1244,8 +1244,8 @@ static bool parse_udp_key(const char *hex, options *o)
 static int parse_options(int argc, char **argv, options *o)
 {
     const char *prog = argc > 0 && argv[0] ? argv[0] : "robot";
-    size_t peers = g_prog->peer_count ? g_prog->peer_count : 1;
-    long max_base = 65536 - (long)peers;
+    size_t robots = g_prog->robot_count ? g_prog->robot_count : 1;
+    long max_base = 65536 - (long)robots;
     const char *env = getenv("SEMO_PORT_BASE");
     o->port_base = DEFAULT_PORT_BASE;
     if (env && !parse_long(env, 1, max_base, &o->port_base)) {
@@ -1376,6 +1376,8 @@ static bool program_is_valid(const semo_program_desc *p)
         problem = "a table has entries but no array";
     else if (p->peer_count && p->self >= p->peer_count)
         problem = "`self` is not an index of `peers`";
+    else if (p->robot_count < p->peer_count || p->robot_count > 65535)
+        problem = "the mission has fewer robots than `peers` or more than ports";
     for (size_t i = 0; !problem && i < p->task_count; i++)
         if (!p->tasks[i].name || (p->tasks[i].trigger == SEMO_TRIGGER_TIME && p->tasks[i].period_ms <= 0))
             problem = "every task needs a name, and time-driven tasks a positive period";
@@ -1392,6 +1394,8 @@ static bool program_is_valid(const semo_program_desc *p)
     for (size_t i = 0; !problem && i < p->peer_count; i++)
         if (!p->peers[i].team || !p->peers[i].robot)
             problem = "a peer lacks a team or robot name";
+        else if (p->peers[i].index >= p->robot_count || (i > 0 && p->peers[i].index <= p->peers[i - 1].index))
+            problem = "the peers' places must rise and be places of the mission's robots";
     if (problem)
         fprintf(stderr, "semo runtime: invalid program tables: %s\n", problem);
     return !problem;
@@ -1593,16 +1597,16 @@ static int run(const options *o)
 #ifdef SEMO_SIM
     /* Lock-step: the coordinator is the clock and the network. */
     if (o->lockstep) {
-        if (semo__ls_connect(o->lockstep, p->self) != 0) {
+        if (semo__ls_connect(o->lockstep, p->peer_count ? p->peers[p->self].index : 0) != 0) {
             status = 1;
             goto stop;
         }
-        if (p->peer_count > 1)
+        if (p->robot_count > 1)
             g_transport = &semo_lockstep_transport;
     }
 #endif
     /* A robot alone in its mission has no one to hear from: no port, no receiver. */
-    if (p->peer_count > 1 && !g_transport) {
+    if (p->robot_count > 1 && !g_transport) {
         semo_transport_config net = o->identity;
         net.port_base = o->port_base;
         net.broker_host = o->broker_host;
@@ -1613,7 +1617,7 @@ static int run(const options *o)
         net.udp_key_len = o->udp_key_len;
         if (o->transport->open(p, &net) != 0) {
             if (o->transport == &semo_udp_transport)
-                fprintf(stderr, "semo runtime: cannot open the udp transport on port %ld\n", o->port_base + (long)p->self);
+                fprintf(stderr, "semo runtime: cannot open the udp transport on port %ld\n", o->port_base + (long)p->peers[p->self].index);
             else
                 fprintf(stderr, "semo runtime: cannot open the %s transport\n", o->transport->name);
             status = 1;

@@ -148,11 +148,15 @@ typedef struct {
     size_t sample_size;
 } semo_multicast_desc;
 
-/* Every robot of the mission (for the transport): its team, name and index.
- * Over UDP robot i listens on port `port_base + i` of 127.0.0.1. */
+/* A robot this one sends to or hears from (its team's robots and those its
+ * messages go to, not the whole mission): its team, name and place among the
+ * mission's robots, `index` (formation order, below `robot_count`). Over UDP
+ * the robot at place i listens on port `port_base + i` of 127.0.0.1; in
+ * lock-step the place is its id. */
 typedef struct {
     const char *team;
     const char *robot;
+    size_t index;
 } semo_peer;
 
 /* A threads robot's connection defaults, baked in by `semo build --deploy`
@@ -184,6 +188,7 @@ typedef struct {
     const semo_peer *peers;
     size_t peer_count;
     size_t self; /* index of this robot in `peers` */
+    size_t robot_count; /* robots of the mission (its peers are some of them) */
     /* Static schedule only: one iteration of the single-appearance schedule. */
     const semo_firing *schedule;
     size_t schedule_count;

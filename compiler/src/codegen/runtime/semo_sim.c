@@ -650,18 +650,24 @@ static bool read_command(reader *r, const json *v, const semo_program_desc *prog
     return true;
 }
 
-/* The peer index of robot `v` (a name of the mission), or an error at it. */
+/* A robot a fault names that is not among this robot's peers. */
+#define NOT_A_PEER SIZE_MAX
+
+/* The peer index of robot `v`, or NOT_A_PEER: the program knows only its
+ * peers (the robots it sends to or hears from), so a robot it does not know
+ * is one whose messages it never takes part in; as with the "robots" of
+ * others, whether the name is in the mission is `semo simulate`'s check
+ * (scenario.rs), which reads the scenario with the whole fleet. */
 static bool want_robot(reader *r, const json *v, const char *key, const semo_program_desc *program, size_t *out)
 {
     char name[64];
     if (!want_name(r, v, key, NAME_MAX_BYTES, name))
         return false;
+    *out = NOT_A_PEER;
     for (size_t i = 0; i < program->peer_count; i++)
-        if (strcmp(program->peers[i].robot, name) == 0) {
+        if (strcmp(program->peers[i].robot, name) == 0)
             *out = i;
-            return true;
-        }
-    return fail_at(r, v->line, v->col, "robot \"%s\" is not in the mission", name);
+    return true;
 }
 
 static bool want_interval(reader *r, const json *v, int64_t *from, int64_t *until)
@@ -722,8 +728,9 @@ static bool read_fault(reader *r, const json *v, const semo_program_desc *progra
             free(f.peers);
             return false;
         }
-        if (a == program->self || b == program->self) {
-            f.peers[a == program->self ? b : a] = true;
+        size_t other = a == program->self ? b : a;
+        if ((a == program->self || b == program->self) && other != NOT_A_PEER) {
+            f.peers[other] = true;
             touches = true;
         }
     } else { /* partition: robots of different groups (no group is one more) cannot talk */
@@ -738,7 +745,7 @@ static bool read_fault(reader *r, const json *v, const semo_program_desc *progra
             for (size_t m = 0; ok && m < members->count; m++) {
                 size_t peer;
                 ok = want_robot(r, &members->items[m], "partition", program, &peer);
-                if (ok && group[peer] < 0)
+                if (ok && peer != NOT_A_PEER && group[peer] < 0)
                     group[peer] = (long)g;
             }
         }

@@ -1,13 +1,14 @@
-/* semo_udp.c: the loopback transport. Robot i of the mission's peer table
- * owns UDP port `port_base + i` on 127.0.0.1; a message to a robot is one
+/* semo_udp.c: the loopback transport. The robot at place i of the mission
+ * (`semo_peer::index`) owns UDP port `port_base + i` on 127.0.0.1; a message
+ * to a robot is one
  * datagram to its port. Only local processes can reach a loopback port, and
  * without a run key every one of them is trusted. With one ($SEMO_UDP_KEY,
  * the same for every robot of a run) each datagram carries its HMAC-SHA256
  * under that key (RFC 2104, its 32 bytes after the runtime's datagram), and
  * recv refuses one whose tag is not right (SEMO_RECV_REFUSED): a process
  * that does not know the key can neither forge nor alter a message. Nor
- * replay one: between the datagram and its tag the sender writes its peer
- * index and a counter (both under the tag), the machine's monotonic clock
+ * replay one: between the datagram and its tag the sender writes its place
+ * in the mission and a counter (both under the tag), the machine's monotonic clock
  * in ns when it sent, raised past the last it sent, and recv refuses
  * (SEMO_RECV_REPLAYED) a counter no later than the last taken from that
  * sender, or older than UDP_FRESH_NS (a capture replayed to a robot
@@ -40,6 +41,8 @@ static int g_fd = -1;
  * recv can wait on the socket without a timeout. */
 static int g_wake[2] = {-1, -1};
 static int g_port_base;
+/* The program's peers, whose places give their ports. */
+static const semo_peer *g_peers;
 static size_t g_peer_count;
 static size_t g_self;
 /* The run key (none: g_key_len 0). */
@@ -230,7 +233,15 @@ static uint64_t get_le(const unsigned char *at, int bytes)
 static bool udp_stamp_fresh(const unsigned char *stamp)
 {
     uint64_t sender = get_le(stamp, 4), counter = get_le(stamp + 4, 8);
-    size_t slot = sender < g_peer_count ? (size_t)sender : g_peer_count;
+    /* The sender names its place in the mission (`semo_peer.index`): each
+     * robot's table lists only its peers, so positions differ between
+     * robots; a place not in the table is an outsider's. */
+    size_t slot = g_peer_count;
+    for (size_t i = 0; i < g_peer_count; i++)
+        if (g_peers[i].index == sender) {
+            slot = i;
+            break;
+        }
     uint64_t now = udp_clock_ns();
     if (counter <= g_last[slot] || counter + UDP_FRESH_NS < now)
         return false;
@@ -252,14 +263,14 @@ static int udp_open(const semo_program_desc *program, const semo_transport_confi
 {
     long port_base = config->port_base;
     if (g_fd >= 0 || program->self >= program->peer_count || port_base < 1 ||
-        (long)port_base + (long)program->peer_count > 65536)
+        (long)port_base + (long)program->robot_count > 65536)
         return -1;
     int fd = socket(AF_INET, SOCK_DGRAM, 0);
     if (fd < 0)
         return -1;
     /* Child processes (a task running a helper) must not inherit the port. */
     fcntl(fd, F_SETFD, FD_CLOEXEC);
-    struct sockaddr_in self = loopback((int)port_base + (int)program->self);
+    struct sockaddr_in self = loopback((int)port_base + (int)program->peers[program->self].index);
     if (bind(fd, (const struct sockaddr *)&self, sizeof self) != 0 || pipe(g_wake) != 0) {
         close(fd);
         return -1;
@@ -270,6 +281,7 @@ static int udp_open(const semo_program_desc *program, const semo_transport_confi
     }
     g_fd = fd;
     g_port_base = (int)port_base;
+    g_peers = program->peers;
     g_peer_count = program->peer_count;
     g_self = program->self;
     g_key_len = config->udp_key_len <= sizeof g_key ? config->udp_key_len : 0;
@@ -293,14 +305,14 @@ static int udp_send(size_t peer, const void *data, size_t len)
         if (len > SEMO__DATAGRAM_MAX)
             return -1;
         memcpy(signed_data, data, len);
-        put_le(signed_data + len, g_self, 4);
+        put_le(signed_data + len, g_peers[g_self].index, 4);
         put_le(signed_data + len + 4, udp_next_counter(), 8);
         len += UDP_STAMP;
         udp_tag(signed_data, len, signed_data + len);
         data = signed_data;
         len += UDP_TAG;
     }
-    struct sockaddr_in to = loopback(g_port_base + (int)peer);
+    struct sockaddr_in to = loopback(g_port_base + (int)g_peers[peer].index);
     ssize_t n;
     do
         n = sendto(g_fd, data, len, 0, (const struct sockaddr *)&to, sizeof to);
@@ -355,6 +367,7 @@ static void udp_close(void)
         g_wake[i] = -1;
     }
     g_fd = -1;
+    g_peers = NULL;
     g_peer_count = 0;
     free(g_last);
     g_last = NULL;

@@ -412,7 +412,7 @@ static int run_tasks(int argc, char **argv)
 /* The smallest program: one idle task. For option handling and memory use. */
 static void nothing(void) {}
 static const semo_task_desc minimal_tasks[] = {{"Idle", SEMO_TRIGGER_CONTROL, 0, NULL, nothing, NULL}};
-static const semo_peer minimal_peers[] = {{"SoloTeam", "solo"}};
+static const semo_peer minimal_peers[] = {{"SoloTeam", "solo", 0}};
 
 static int run_minimal(int argc, char **argv)
 {
@@ -425,6 +425,7 @@ static int run_minimal(int argc, char **argv)
         .task_count = 1,
         .peers = minimal_peers,
         .peer_count = 1,
+        .robot_count = 1,
     };
     return semo_main(argc, argv, &program);
 }
@@ -482,6 +483,7 @@ static int run_wake(int argc, char **argv)
         .channel_count = 1,
         .peers = minimal_peers,
         .peer_count = 1,
+        .robot_count = 1,
     };
     int status = semo_main(argc, argv, &program);
     CHECK(atomic_load(&sleeper_samples) == 1);
@@ -492,7 +494,10 @@ static int run_wake(int argc, char **argv)
 
 /* ------------------------------------------------------------------- udp */
 
-static const semo_peer udp_peers[] = {{"Alpha", "a"}, {"Beta", "b"}};
+/* Their mission has three robots; the one between them (place 1, port base
+ * + 1) is not a peer of either: each robot's table lists only its own, with
+ * their places. */
+static const semo_peer udp_peers[] = {{"Alpha", "a", 0}, {"Beta", "b", 2}};
 
 static void pinger_go(void)
 {
@@ -550,6 +555,7 @@ static int run_udp(int argc, char **argv, bool alpha)
         .peers = udp_peers,
         .peer_count = 2,
         .self = alpha ? 0 : 1,
+        .robot_count = 3,
     };
     int status = semo_main(argc, argv, &program);
     if (!alpha)
