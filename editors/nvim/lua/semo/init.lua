@@ -138,6 +138,7 @@ M.token_links = {
   robotType = '@lsp.type.type',
   capability = '@lsp.type.interface',
   plan = '@lsp.type.property',
+  group = '@lsp.type.namespace',
   service = '@lsp.type.function',
   mode = '@lsp.type.enumMember',
   value = '@lsp.type.enumMember',
