@@ -235,13 +235,20 @@ static bool udp_stamp_fresh(const unsigned char *stamp)
     uint64_t sender = get_le(stamp, 4), counter = get_le(stamp + 4, 8);
     /* The sender names its place in the mission (`semo_peer.index`): each
      * robot's table lists only its peers, so positions differ between
-     * robots; a place not in the table is an outsider's. */
-    size_t slot = g_peer_count;
-    for (size_t i = 0; i < g_peer_count; i++)
-        if (g_peers[i].index == sender) {
-            slot = i;
-            break;
+     * robots; a place not in the table is an outsider's. The table is in
+     * ascending places (`program_is_valid`): a binary search, so a robot of
+     * a large team pays log n per datagram, not n. */
+    size_t slot = g_peer_count, low = 0, high = g_peer_count;
+    while (low < high) {
+        size_t middle = low + (high - low) / 2;
+        if (g_peers[middle].index < sender) {
+            low = middle + 1;
+        } else {
+            if (g_peers[middle].index == sender)
+                slot = middle;
+            high = middle;
         }
+    }
     uint64_t now = udp_clock_ns();
     if (counter <= g_last[slot] || counter + UDP_FRESH_NS < now)
         return false;
