@@ -180,6 +180,22 @@ fn behaviour(events: &[Event], until: i64) -> Vec<String> {
     out
 }
 
+/// `robot`'s events in `semo simulate`'s trace of `mission` on `scenario`:
+/// the reference the board's run is compared with.
+fn simulated_events(mission: &Path, scenario: &Path, robot: &str) -> Vec<Event> {
+    let simulated = support::simulate_trace(mission, scenario, "sim");
+    assert_eq!(
+        simulated.code, 0,
+        "{}{}",
+        simulated.stdout, simulated.stderr
+    );
+    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
+    events(&lines)
+        .into_iter()
+        .filter(|e| field(e, "robot") == robot)
+        .collect()
+}
+
 /// The robot's behaviour on cortex-m-sim in QEMU and on linux-sim is the same:
 /// each run's behaviour up to `margin` ms before the end begins the other's
 /// (the linux-sim process starts its clock a little before its first firing,
@@ -232,17 +248,7 @@ fn compare_with_linux_sim(name: &str, mission: &Path, scenario: &Path, robot: &s
     same_behaviour(robot, &qemu, &linux, duration, 500);
 
     // And the simulator's (`semo simulate`), the reference of linux-sim.
-    let simulated = support::simulate_trace(mission, scenario, "sim");
-    assert_eq!(
-        simulated.code, 0,
-        "{}{}",
-        simulated.stdout, simulated.stderr
-    );
-    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
-    let simulated: Vec<Event> = events(&lines)
-        .into_iter()
-        .filter(|e| field(e, "robot") == robot)
-        .collect();
+    let simulated = simulated_events(mission, scenario, robot);
     same_behaviour(robot, &qemu, &simulated, duration, 500);
     qemu
 }
@@ -481,16 +487,6 @@ fn a_mixed_fleet_builds_each_robot_for_its_own_platform_and_both_make() {
     let qemu = events(&lines);
     assert_eq!(field(qemu.last().unwrap(), "event"), "stop", "{lines:?}");
     assert_eq!(modes(&qemu), ["SEARCH", "FOUND"]);
-    let simulated = support::simulate_trace(&mission, &scenario, "sim");
-    assert_eq!(
-        simulated.code, 0,
-        "{}{}",
-        simulated.stdout, simulated.stderr
-    );
-    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
-    let simulated: Vec<Event> = events(&lines)
-        .into_iter()
-        .filter(|e| field(e, "robot") == "ev")
-        .collect();
+    let simulated = simulated_events(&mission, &scenario, "ev");
     same_behaviour("ev", &qemu, &simulated, 2000, 500);
 }
