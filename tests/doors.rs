@@ -450,12 +450,7 @@ fn generate_in_editor(root: &Path, mission: &str) -> Value {
         let mut client = TestClient::start();
         let workspace = format!("file://{}", root.display());
         client.initialize(&["utf-16"], Some(&workspace)).await;
-        let mission = root.join(mission);
-        let uri = format!("file://{}", mission.display());
-        client
-            .open(&uri, &std::fs::read_to_string(&mission).unwrap())
-            .await;
-        client.diagnostics(&uri, Some(1)).await;
+        let uri = client.open_file(&root.join(mission)).await;
         let answer = client
             .request(
                 "workspace/executeCommand",

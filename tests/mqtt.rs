@@ -1668,12 +1668,7 @@ async fn start_monitor(
     client
         .initialize_with(serde_json::json!({}), Some(&root))
         .await;
-    let mission = workspace.join(mission);
-    let uri = format!("file://{}", mission.display());
-    client
-        .open(&uri, &std::fs::read_to_string(&mission).unwrap())
-        .await;
-    client.diagnostics(&uri, Some(1)).await;
+    let uri = client.open_file(&workspace.join(mission)).await;
     let answer = client
         .request("semo/monitor/start", serde_json::json!({ "uri": uri }))
         .await
@@ -1917,12 +1912,7 @@ fn a_broker_the_operator_cannot_trust_or_that_refuses_it_is_said_at_once() {
                 Some(&format!("file://{}", workspace.display())),
             )
             .await;
-        let mission = workspace.join("scouting.mission");
-        let uri = format!("file://{}", mission.display());
-        client
-            .open(&uri, &std::fs::read_to_string(&mission).unwrap())
-            .await;
-        client.diagnostics(&uri, Some(1)).await;
+        let uri = client.open_file(&workspace.join("scouting.mission")).await;
         let refused = client
             .request("semo/monitor/start", serde_json::json!({ "uri": uri }))
             .await

@@ -164,6 +164,18 @@ impl TestClient {
         .await;
     }
 
+    /// Opens the file at `path` as the editor does when a user opens it (its
+    /// text from disk, version 1) and waits for its first diagnostics: its
+    /// `file://` URI.
+    pub async fn open_file(&mut self, path: &std::path::Path) -> String {
+        let uri = format!("file://{}", path.display());
+        let text =
+            std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        self.open(&uri, &text).await;
+        self.diagnostics(&uri, Some(1)).await;
+        uri
+    }
+
     /// Waits for the diagnostics of `uri` published for `version` (any
     /// version when `None`), skipping older publications.
     pub async fn diagnostics(&mut self, uri: &str, version: Option<i64>) -> Vec<Value> {
