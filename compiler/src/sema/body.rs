@@ -8,6 +8,7 @@ use super::values::{Literal, VariableTest, VariableWrite};
 use super::{Checker, is_user, suggestion};
 use crate::catalog::{RobotTypeId, ServiceDef, ValueType};
 use crate::diag::Code;
+use crate::fasthash::FastMap;
 use crate::span::Span;
 use crate::syntax::ast::{self, Arg, ArmKind, CondKind, Expr, ExprKind, Name, StmtKind};
 use std::rc::Rc;
@@ -1364,7 +1365,8 @@ impl<'a> Checker<'a> {
     /// are positive whole numbers whose sum the robots can meet.
     fn counted_group(&mut self, g: &'a ast::GroupStmt, scope: &Scope) {
         let checkable = scope.team.is_some() && !scope.robots.is_empty();
-        let mut first_named: Vec<(&str, Span)> = Vec::new();
+        // By name: a statement of thousands of arms stays linear.
+        let mut first_named: FastMap<&str, Span> = FastMap::default();
         let mut sum: u64 = 0;
         let mut all_valid = true;
         let mut over_at = None;
@@ -1372,8 +1374,8 @@ impl<'a> Checker<'a> {
         for arm in &g.arms {
             let cond = &arm.condition;
             if let Some(name) = cond.counted_name() {
-                match first_named.iter().find(|(n, _)| *n == name.as_str()) {
-                    Some(&(_, first)) => {
+                match first_named.get(name.as_str()) {
+                    Some(&first) => {
                         self.diagnostics
                             .report(
                                 Code::DuplicateCountedGroup,
@@ -1382,7 +1384,9 @@ impl<'a> Checker<'a> {
                             )
                             .relate(first, "first named here");
                     }
-                    None => first_named.push((name.as_str(), name.span)),
+                    None => {
+                        first_named.insert(name.as_str(), name.span);
+                    }
                 }
             }
             if let (Some(team), Some(name), Some(min)) =
