@@ -222,6 +222,26 @@ fn a_killed_leader_is_replaced_the_same_way_in_c_and_in_the_simulator() {
     );
 }
 
+/// A robot killed at the instant it starts, and restarted: it writes its
+/// `start` and nothing more, as the simulator's robot, whose first instant
+/// comes after the faults of that instant.
+#[test]
+fn a_robot_killed_as_it_starts_is_killed_the_same_way_in_c_and_in_the_simulator() {
+    let (c, _) = compare(
+        "patrol_groups_kill_at_0",
+        &examples().join("swarm/patrol_groups.mission"),
+        r#"{"time_scale": 1, "duration": 2500,
+            "faults": [{"at": 0, "kill": "tb_1"}, {"at": 1000, "restart": "tb_1"},
+                       {"at": 1000, "kill": "tb_2"}]}"#,
+    );
+    let first: Vec<&str> = c["tb_1"]
+        .iter()
+        .take(3)
+        .map(|e| field(e, "event"))
+        .collect();
+    assert_eq!(first, ["start", "fault", "fault"], "{:?}", c["tb_1"]);
+}
+
 /// The leader killed and restarted: the new process starts from the default
 /// mode, on the mission's clock, listens, follows tb_1 until it gives way
 /// and takes the lead back (docs/groups.md): tb_1 and tb_2 follow tb_0 again

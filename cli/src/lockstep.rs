@@ -10,14 +10,19 @@
 //! their senders' peer indices, each sender's in the order it sent them. A
 //! run is then a function of the programs and the scenario: no clock is read
 //! and the machine's load changes nothing but how long it takes.
+//!
+//! A robot pauses after its `start` line (it reports itself idle at that
+//! instant), so a fault at the instant it starts (a kill at 0 ms, a kill
+//! right after a restart) comes before anything else it does, as in the
+//! simulator.
 
 use std::collections::BTreeMap;
 use std::io::{self, Read, Write};
 use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
-use std::sync::mpsc;
 
+use rustix::event::{PollFd, PollFlags, poll};
 use semo::sim::loss::LossDraws;
 
 /// A built robot program of the run.
@@ -92,10 +97,26 @@ enum Frame {
     End,
 }
 
+impl Frame {
+    /// The next frame of a robot's stream (it waits for a whole frame).
+    fn read(stream: &mut UnixStream) -> Frame {
+        match read_frame(stream) {
+            Ok((b'I', payload)) if payload.len() == 8 => {
+                let at = i64::from_le_bytes(payload[..8].try_into().expect("eight bytes"));
+                Frame::Idle((at >= 0).then_some(at))
+            }
+            Ok((b'M', payload)) if payload.len() >= 4 => Frame::Message {
+                to: u32::from_le_bytes(payload[..4].try_into().expect("four bytes")) as usize,
+                datagram: payload[4..].to_vec(),
+            },
+            Ok(_) | Err(_) => Frame::End,
+        }
+    }
+}
+
 struct Live {
     child: Child,
     stream: UnixStream,
-    incarnation: u32,
     idle: bool,
     wakes_at: Option<i64>,
 }
@@ -105,8 +126,6 @@ struct Coordinator<'r, 'a> {
     listener: UnixListener,
     live: Vec<Option<Live>>,
     incarnations: Vec<u32>,
-    frames: mpsc::Receiver<(usize, u32, Frame)>,
-    frames_to: mpsc::Sender<(usize, u32, Frame)>,
     now: i64,
     /// (arrival, sender, sequence) → (receiver, datagram): the delivery order.
     in_flight: BTreeMap<(i64, usize, u64), (usize, Vec<u8>)>,
@@ -120,14 +139,11 @@ struct Coordinator<'r, 'a> {
 
 impl<'r, 'a> Coordinator<'r, 'a> {
     fn new(run: &'r Run<'a>, listener: UnixListener) -> Self {
-        let (frames_to, frames) = mpsc::channel();
         Coordinator {
             run,
             listener,
             live: run.robots.iter().map(|_| None).collect(),
             incarnations: vec![0; run.robots.len()],
-            frames,
-            frames_to,
             now: 0,
             in_flight: BTreeMap::new(),
             sent: 0,
@@ -176,6 +192,9 @@ impl<'r, 'a> Coordinator<'r, 'a> {
                     ProcessFault::Restart if !running => {
                         self.trace_fault(peer, "restart");
                         self.start(peer)?;
+                        // Its `start` is written before a later fault of
+                        // this instant (it pauses after it).
+                        self.wait_until_all_idle()?;
                     }
                     ProcessFault::Kill | ProcessFault::Restart => {}
                 }
@@ -231,15 +250,9 @@ impl<'r, 'a> Coordinator<'r, 'a> {
                 robot.name
             ));
         }
-        let reader = stream
-            .try_clone()
-            .map_err(|e| format!("robot {}: {e}", robot.name))?;
-        let frames = self.frames_to.clone();
-        std::thread::spawn(move || read_frames(reader, peer, incarnation, frames));
         let mut live = Live {
             child,
             stream,
-            incarnation,
             idle: false,
             wakes_at: None,
         };
@@ -301,44 +314,78 @@ impl<'r, 'a> Coordinator<'r, 'a> {
         }
     }
 
-    /// Reads the robots' frames until every live robot is idle.
+    /// Reads the robots' frames until every live robot is idle. The
+    /// coordinator reads them itself, waiting on all the running robots'
+    /// streams at once: a reader thread per robot would cost a thread switch
+    /// per frame, and a run is mostly switches.
     fn wait_until_all_idle(&mut self) -> Result<(), String> {
-        while self.live.iter().flatten().any(|l| !l.idle) {
-            let (peer, incarnation, frame) = self
-                .frames
-                .recv()
-                .map_err(|_| "internal error: the robots' frames stopped".to_string())?;
-            let Some(live) = self.live[peer]
-                .as_mut()
-                .filter(|l| l.incarnation == incarnation)
-            else {
-                continue; // from a process killed since
-            };
-            match frame {
-                Frame::Idle(wakes_at) => {
-                    live.idle = true;
-                    live.wakes_at = wakes_at;
+        loop {
+            let running: Vec<usize> = (0..self.live.len())
+                .filter(|&p| self.live[p].as_ref().is_some_and(|l| !l.idle))
+                .collect();
+            if running.is_empty() {
+                return Ok(());
+            }
+            for peer in self.readable(&running)? {
+                self.take_frame(peer)?;
+            }
+        }
+    }
+
+    /// Those of `peers` whose streams have something to read (or ended).
+    fn readable(&self, peers: &[usize]) -> Result<Vec<usize>, String> {
+        let streams: Vec<&UnixStream> = peers
+            .iter()
+            .filter_map(|&p| self.live[p].as_ref().map(|l| &l.stream))
+            .collect();
+        let mut fds: Vec<PollFd<'_>> = streams
+            .iter()
+            .map(|s| PollFd::new(*s, PollFlags::IN))
+            .collect();
+        loop {
+            match poll(&mut fds, None) {
+                Ok(_) => break,
+                Err(rustix::io::Errno::INTR) => continue,
+                Err(e) => return Err(format!("internal error: waiting for the robots: {e}")),
+            }
+        }
+        Ok(peers
+            .iter()
+            .zip(&fds)
+            .filter(|(_, fd)| !fd.revents().is_empty())
+            .map(|(&p, _)| p)
+            .collect())
+    }
+
+    /// Reads and acts on one frame of the robot `peer`.
+    fn take_frame(&mut self, peer: usize) -> Result<(), String> {
+        let Some(live) = self.live[peer].as_mut() else {
+            return Ok(());
+        };
+        match Frame::read(&mut live.stream) {
+            Frame::Idle(wakes_at) => {
+                live.idle = true;
+                live.wakes_at = wakes_at;
+            }
+            Frame::Message { to, datagram } => {
+                if to >= self.live.len() {
+                    return Err(format!(
+                        "robot {} sent a message to peer {to}, which does not exist",
+                        self.run.robots[peer].name
+                    ));
                 }
-                Frame::Message { to, datagram } => {
-                    if to >= self.live.len() {
-                        return Err(format!(
-                            "robot {} sent a message to peer {to}, which does not exist",
-                            self.run.robots[peer].name
-                        ));
-                    }
-                    let (latency, loss) = (self.run.link)(peer, to);
-                    if loss > 0.0 && self.lost(peer, to, &datagram, loss)? {
-                        continue;
-                    }
-                    let arrival = self.now + latency;
-                    self.in_flight
-                        .insert((arrival, peer, self.sent), (to, datagram));
-                    self.sent += 1;
+                let (latency, loss) = (self.run.link)(peer, to);
+                if loss > 0.0 && self.lost(peer, to, &datagram, loss)? {
+                    return Ok(());
                 }
-                Frame::End => {
-                    if let Some(mut live) = self.live[peer].take() {
-                        let _ = live.child.wait();
-                    }
+                let arrival = self.now + latency;
+                self.in_flight
+                    .insert((arrival, peer, self.sent), (to, datagram));
+                self.sent += 1;
+            }
+            Frame::End => {
+                if let Some(mut live) = self.live[peer].take() {
+                    let _ = live.child.wait();
                 }
             }
         }
@@ -409,32 +456,6 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             let _ = stream.shutdown(std::net::Shutdown::Both);
             drop(stream);
             let _ = child.wait();
-        }
-    }
-}
-
-/// The frames of one robot's stream, to the coordinator, until it ends.
-fn read_frames(
-    mut stream: UnixStream,
-    peer: usize,
-    incarnation: u32,
-    to: mpsc::Sender<(usize, u32, Frame)>,
-) {
-    loop {
-        let frame = match read_frame(&mut stream) {
-            Ok((b'I', payload)) if payload.len() == 8 => {
-                let at = i64::from_le_bytes(payload[..8].try_into().expect("eight bytes"));
-                Frame::Idle((at >= 0).then_some(at))
-            }
-            Ok((b'M', payload)) if payload.len() >= 4 => Frame::Message {
-                to: u32::from_le_bytes(payload[..4].try_into().expect("four bytes")) as usize,
-                datagram: payload[4..].to_vec(),
-            },
-            Ok(_) | Err(_) => Frame::End,
-        };
-        let ended = matches!(frame, Frame::End);
-        if to.send((peer, incarnation, frame)).is_err() || ended {
-            return;
         }
     }
 }

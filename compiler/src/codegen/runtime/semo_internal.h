@@ -160,6 +160,10 @@ int semo__ls_connect(const char *path, size_t self);
 /* Called with `lock` held, returns with it held. */
 void semo__ls_wait(const void *key, pthread_mutex_t *lock, int64_t deadline_ms);
 void semo__ls_wake(const void *key, bool all);
+/* Reports the robot idle at this very instant and waits for the
+ * coordinator to grant it again: what the coordinator does at this instant
+ * (a fault) comes before whatever the robot does next. */
+void semo__ls_pause(void);
 /* pthread_create for a thread that takes turns (numbered now). */
 int semo__ls_create(pthread_t *thread, const pthread_attr_t *attr, void *(*body)(void *), void *arg);
 /* The calling thread takes no more turns (it ends, or only joins others). */

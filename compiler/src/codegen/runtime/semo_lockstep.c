@@ -200,6 +200,26 @@ void semo__ls_wake(const void *key, bool all)
     pthread_mutex_unlock(&g_ls.lock);
 }
 
+/* The key a paused thread waits on: nothing wakes it but a grant. */
+static const char g_paused;
+
+void semo__ls_pause(void)
+{
+    ls_thread *me = g_self;
+    pthread_mutex_lock(&g_ls.lock);
+    if (me && !g_ls.lost) {
+        /* Blocked until now, unlike semo__ls_wait's "time already
+         * reached", so the robot reports itself idle with this instant as
+         * its next wake-up. */
+        me->key = &g_paused;
+        me->deadline = semo__ls_now();
+        me->state = LS_BLOCKED;
+        hand_on_locked();
+        await_turn_locked(me);
+    }
+    pthread_mutex_unlock(&g_ls.lock);
+}
+
 typedef struct {
     ls_thread *me;
     void *(*body)(void *);

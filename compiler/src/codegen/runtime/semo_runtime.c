@@ -1639,6 +1639,12 @@ static int run(const options *o)
         goto stop;
     g_joined_at = semo_now_ms();
     trace_start(p, o);
+#ifdef SEMO_SIM
+    /* A fault at the instant the robot starts (a kill at 0 ms) comes after
+     * its `start` and before anything else it does, as in the simulator. */
+    if (o->lockstep)
+        semo__ls_pause();
+#endif
     for (; initialized < p->task_count; initialized++)
         if (p->tasks[initialized].init)
             p->tasks[initialized].init();
