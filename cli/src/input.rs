@@ -272,6 +272,13 @@ mod tests {
             ("[[ group(instance of X) { stop() } ]]\n", Content::Mission),
             ("[T]\nT.main { default: mode = M }\n", Content::Mission),
             ("# only a comment\n", Content::Mission),
+            ("\"quoted key\" = 1\n", Content::Project),
+            ("  \r\n# c\n  'literal' = 2\n", Content::Project),
+            // Known at its first expression: not parsed as TOML to its end.
+            (
+                "# a mission\n{ T: x a }\nT.main { default: mode = M }\n",
+                Content::Mission,
+            ),
         ];
         for (text, want) in cases {
             assert_eq!(Content::of(text), want, "{text}");

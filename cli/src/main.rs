@@ -724,7 +724,7 @@ fn run() -> i32 {
                     code
                 })
             } else {
-                check::run(paths, options, &mut out)
+                check::run_once(paths, options, &mut out)
             }
         }
         Command::Fmt {

@@ -310,7 +310,17 @@ fn normalize(path: &Path) -> PathBuf {
 /// project file, and never a mission (whose text opens with `{`, which TOML
 /// does not allow there), whatever its first line looks like.
 pub fn is_toml(text: &str) -> bool {
-    toml_edit::Document::parse(text).is_ok_and(|document| !document.as_table().is_empty())
+    // TOML's first expression is a key (bare or quoted) or a table header:
+    // a text opening otherwise (a mission's `{`) is not TOML, known without
+    // parsing it whole (the parser reads to the end, a mission's size).
+    let first = text
+        .lines()
+        .map(str::trim_start)
+        .find(|line| !line.is_empty() && !line.starts_with('#'))
+        .and_then(|line| line.chars().next());
+    let can_open = |c: char| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '"' | '\'' | '[');
+    first.is_some_and(can_open)
+        && toml_edit::Document::parse(text).is_ok_and(|document| !document.as_table().is_empty())
 }
 
 /// Reads the project file `text` of the project at `root` (the folder
