@@ -40,9 +40,9 @@ const EXAMPLES: &[(&str, &str, Option<&str>)] = &[
 
 /// Test fixtures (under the repository's `tests/fixtures/`) for what the
 /// examples do not generate: graph services with loops, counted groups,
-/// group synchronisation, globally shared values with battery policies,
-/// broadcast events, a relay receiving from another team, a team on the
-/// static schedule. As [`EXAMPLES`].
+/// group synchronisation, group services, globally shared values with
+/// battery policies, broadcast events, a relay receiving from another team,
+/// a team on the static schedule. As [`EXAMPLES`].
 const FIXTURES: &[(&str, &str, Option<&str>)] = &[
     (
         "fixture-loops",
@@ -55,6 +55,7 @@ const FIXTURES: &[(&str, &str, Option<&str>)] = &[
         Some("counted_groups/rooms.scenario.json"),
     ),
     ("fixture-group_sync", "group_sync/sync.mission", None),
+    ("fixture-group_service", "group_service/sweep.mission", None),
     (
         "fixture-shared_battery",
         "shared_battery/shared.mission",
@@ -77,6 +78,20 @@ const FIXTURES: &[(&str, &str, Option<&str>)] = &[
     ),
 ];
 
+/// This test's own missions (`compiler/tests/fixtures/golden/`), for what no
+/// other mission generates: timeouts on receives, calls and a strategy's
+/// actions, a leader's block that receives, a plain throw beside a
+/// broadcast one. (snapshot name, mission, `--strategy` folder under the
+/// repository, if any).
+const OWN: &[(&str, &str, Option<&str>)] = &[
+    ("golden-constructs", "constructs.mission", None),
+    (
+        "golden-strategy_timeout",
+        "strategy_timeout.mission",
+        Some("examples/scouting"),
+    ),
+];
+
 /// The scenario of an example the repository has none for.
 const QUIET_SCENARIO: &str = r#"{"duration": 2000}"#;
 
@@ -84,9 +99,15 @@ fn repository() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// What `semo build MISSION --target TARGET [--scenario FILE]` generates.
-fn build(mission: &Path, target: Target, scenario: Option<&str>) -> codegen::BuildResult {
-    let (run, id) = load_build(mission, &[]).expect("the example loads");
+/// What `semo build MISSION [--strategy PATH] --target TARGET [--scenario
+/// FILE]` generates.
+fn build(
+    mission: &Path,
+    strategy: &[PathBuf],
+    target: Target,
+    scenario: Option<&str>,
+) -> codegen::BuildResult {
+    let (run, id) = load_build(mission, strategy).expect("the mission loads");
     let analysis = run.analysis();
     let build = analysis.build_input(id).expect("the mission is checked");
     let input = build.input();
@@ -153,7 +174,7 @@ fn snapshot_every_target(folder: &str, missions: &[(&str, &str, Option<&str>)]) 
     for (name, mission, scenario) in missions {
         let mission = repository().join(folder).join(mission);
         for target in Target::ALL {
-            let result = build(&mission, target, *scenario);
+            let result = build(&mission, &[], target, *scenario);
             insta::assert_snapshot!(format!("{name}@{}", target.name()), written(&result));
         }
     }
@@ -167,4 +188,14 @@ fn the_files_of_every_example_for_every_target() {
 #[test]
 fn the_files_of_the_fixtures_the_examples_miss_for_every_target() {
     snapshot_every_target("tests/fixtures", FIXTURES);
+}
+
+#[test]
+fn the_files_of_the_constructs_only_this_test_writes_for_linux() {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/golden");
+    for (name, mission, strategy) in OWN {
+        let strategy: Vec<PathBuf> = strategy.iter().map(|s| repository().join(s)).collect();
+        let result = build(&folder.join(mission), &strategy, Target::Linux, None);
+        insta::assert_snapshot!(format!("{name}@linux"), written(&result));
+    }
 }
