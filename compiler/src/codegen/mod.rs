@@ -25,6 +25,7 @@
 mod battery;
 mod c;
 mod control;
+mod template;
 pub use control::{
     TERM_MAX, UNLED_REASON, fenced_heard, lease_ms, listen_ms, next_term, parse_term,
 };
