@@ -39,15 +39,20 @@ const EXAMPLES: &[(&str, &str, Option<&str>)] = &[
 ];
 
 /// Test fixtures (under the repository's `tests/fixtures/`) for what the
-/// examples do not generate: graph services with loops, counted groups,
-/// group synchronisation, group services, globally shared values with
-/// battery policies, broadcast events, a relay receiving from another team,
-/// a team on the static schedule. As [`EXAMPLES`].
+/// examples do not generate: graph services with loops and sub-graphs,
+/// counted groups, group synchronisation, group services, globally shared
+/// values with battery policies, broadcast events, a relay receiving from
+/// another team, a team on the static schedule. As [`EXAMPLES`].
 const FIXTURES: &[(&str, &str, Option<&str>)] = &[
     (
         "fixture-loops",
         "loops/loops.mission",
         Some("loops/loops.scenario.json"),
+    ),
+    (
+        "fixture-loops-tracking",
+        "loops/tracking.mission",
+        Some("loops/tracking.scenario.json"),
     ),
     (
         "fixture-counted_groups",
