@@ -117,9 +117,13 @@ pub fn fill(template: &Template, values: &[(&str, &dyn Display)]) -> String {
 /// Every template, for the tests that check them.
 #[cfg(test)]
 fn all() -> impl Iterator<Item = &'static Template> {
-    [super::control::TEMPLATES, super::files::TEMPLATES]
-        .into_iter()
-        .flatten()
+    [
+        super::control::TEMPLATES,
+        super::files::TEMPLATES,
+        super::loops::TEMPLATES,
+    ]
+    .into_iter()
+    .flatten()
 }
 
 #[cfg(test)]
