@@ -121,6 +121,7 @@ fn all() -> impl Iterator<Item = &'static Template> {
         super::control::TEMPLATES,
         super::files::TEMPLATES,
         super::loops::TEMPLATES,
+        super::shared::TEMPLATES,
     ]
     .into_iter()
     .flatten()
