@@ -122,6 +122,7 @@ fn all() -> impl Iterator<Item = &'static Template> {
         super::files::TEMPLATES,
         super::loops::TEMPLATES,
         super::shared::TEMPLATES,
+        super::battery::TEMPLATES,
     ]
     .into_iter()
     .flatten()
