@@ -16,7 +16,8 @@ use std::fmt::{Display, Write};
 /// A file of `codegen/templates/` and the slots it holds.
 #[derive(Clone, Copy, Debug)]
 pub struct Template {
-    /// Its path under `codegen/templates/`.
+    /// Its path under `codegen/` (`templates/...`; a board's link script is
+    /// the runtime's, `runtime/...`).
     pub path: &'static str,
     pub text: &'static str,
     /// Its slots' names, each once, in any order.
@@ -27,7 +28,7 @@ pub struct Template {
 macro_rules! template {
     ($path:literal, [$($slot:literal),* $(,)?]) => {
         $crate::codegen::template::Template {
-            path: $path,
+            path: concat!("templates/", $path),
             text: include_str!(concat!("templates/", $path)),
             slots: &[$($slot),*],
         }
@@ -123,6 +124,7 @@ fn all() -> impl Iterator<Item = &'static Template> {
         super::loops::TEMPLATES,
         super::shared::TEMPLATES,
         super::battery::TEMPLATES,
+        &[super::LINK_SCRIPT],
     ]
     .into_iter()
     .flatten()
@@ -194,7 +196,10 @@ mod tests {
             }
         }
         files.sort();
-        let mut listed: Vec<String> = all().map(|t| t.path.to_string()).collect();
+        let mut listed: Vec<String> = all()
+            .filter_map(|t| t.path.strip_prefix("templates/"))
+            .map(str::to_string)
+            .collect();
         listed.sort();
         assert_eq!(
             files, listed,
