@@ -41,14 +41,26 @@ pub fn declarations(program: &RobotProgram) -> String {
         );
     }
     if lib.ownership.is_some() {
-        let _ = writeln!(
-            out,
-            "/* A message of the owner protocol (comm_task.c hands each message over):\n * true when it was one, taken. */\nbool {prefix}_heard(const semo_message *m);\n/* When this robot would find its owner lost (mission ms; INT64_MAX while it\n * owns the values): the control task fires then. */\nint64_t {prefix}_owner_lost_at(void);"
-        );
+        out.push_str(&fill(&OWNER_DECLARATIONS, &[("prefix", &prefix)]));
     }
     out
 }
 
+/// `program.h`'s declarations of the owner protocol's functions.
+const OWNER_DECLARATIONS: Template = template!("shared/owner_declarations.h.in", ["prefix"]);
+/// `lib_<Team>Shared.c`'s values, and a value's getter and setter: of this
+/// robot's alone, or globally shared (through the owner).
+const LIBRARY_HEAD: Template = template!("shared/library_head.c.in", ["name", "declare", "count"]);
+const LOCAL_VALUE: Template = template!(
+    "shared/local_value.c.in",
+    ["prefix", "getter", "setter", "i", "lock", "unlock"]
+);
+const GLOBAL_VALUE: Template = template!(
+    "shared/global_value.c.in",
+    [
+        "prefix", "getter", "setter", "key", "i", "k", "lock", "unlock"
+    ]
+);
 /// The owner protocol's tables of globally shared values.
 const GLOBALS: Template = template!(
     "shared/globals.c.in",
@@ -68,8 +80,18 @@ const HEARD: Template = template!("shared/heard.c.in", ["prefix", "lock", "unloc
 
 /// Every template of the library task's owner protocol.
 #[cfg(test)]
-pub(super) const TEMPLATES: &[Template] =
-    &[GLOBALS, OWNERS, TELL, FOLLOW_FIRST, FOLLOW_BATTERY, HEARD];
+pub(super) const TEMPLATES: &[Template] = &[
+    OWNER_DECLARATIONS,
+    LIBRARY_HEAD,
+    LOCAL_VALUE,
+    GLOBAL_VALUE,
+    GLOBALS,
+    OWNERS,
+    TELL,
+    FOLLOW_FIRST,
+    FOLLOW_BATTERY,
+    HEARD,
+];
 
 /// The line of `comm_task.c`'s receive body that hands the owner protocol's
 /// messages to the library.
@@ -97,12 +119,14 @@ pub fn library_c(
     if lib.ownership.is_some() {
         out.push_str("#include <string.h>\n");
     }
-    let _ = writeln!(
-        out,
-        "\n/* Library task {}: the team's shared information, one value per attribute,\n * read and written by its getters and setters under one lock. */\n{declare}static semo_value value[{}];\n",
-        c::comment(&lib.name),
-        lib.attributes.len()
-    );
+    out.push_str(&fill(
+        &LIBRARY_HEAD,
+        &[
+            ("name", &c::comment(&lib.name)),
+            ("declare", &declare),
+            ("count", &lib.attributes.len()),
+        ],
+    ));
     let global = |i: usize| {
         lib.ownership
             .as_ref()
@@ -115,21 +139,32 @@ pub fn library_c(
         let _ = writeln!(out, "/* {} */", c::comment(key));
         match global(i) {
             None => {
-                let _ = writeln!(
-                    out,
-                    "LIBFUNC(semo_value, {prefix}_{}, (void))\n{{\n    {lock}\n    semo_value v = value[{i}];\n    {unlock}\n    return v;\n}}\n\nLIBFUNC(void, {prefix}_{}, (const semo_value *v))\n{{\n    {lock}\n    value[{i}] = *v;\n    {unlock}\n}}\n",
-                    getter(key),
-                    setter(key)
-                );
+                out.push_str(&fill(
+                    &LOCAL_VALUE,
+                    &[
+                        ("prefix", &prefix),
+                        ("getter", &getter(key)),
+                        ("setter", &setter(key)),
+                        ("i", &i),
+                        ("lock", &lock),
+                        ("unlock", &unlock),
+                    ],
+                ));
             }
             Some(k) => {
-                let _ = writeln!(
-                    out,
-                    "LIBFUNC(semo_value, {prefix}_{}, (void))\n{{\n    current_owner();\n    {lock}\n    semo_value v = value[{i}];\n    {unlock}\n    return v;\n}}\n\nLIBFUNC(void, {prefix}_{}, (const semo_value *v))\n{{\n    size_t to = current_owner();\n    {lock}\n    value[{i}] = *v;\n    {unlock}\n    semo_trace_value(\"shared_set\", \"value\", v, \"key\", {key_c}, \"owner\", semo_program()->peers[to].robot, NULL);\n    tell({k}, to, v);\n}}\n",
-                    getter(key),
-                    setter(key),
-                    key_c = c::string(key),
-                );
+                out.push_str(&fill(
+                    &GLOBAL_VALUE,
+                    &[
+                        ("prefix", &prefix),
+                        ("getter", &getter(key)),
+                        ("setter", &setter(key)),
+                        ("key", &c::string(key)),
+                        ("i", &i),
+                        ("k", &k),
+                        ("lock", &lock),
+                        ("unlock", &unlock),
+                    ],
+                ));
             }
         }
     }
