@@ -48,6 +48,8 @@ const PROGRAM_H_HEAD: Template = template!("files/program_h_head.h.in", []);
 const HEARD_ALIVE: Template = template!("files/heard_alive.h.in", []);
 const HEARD_SYNC: Template = template!("files/heard_sync.h.in", []);
 const HEARD_EVENT: Template = template!("files/heard_event.h.in", []);
+/// `program.h`'s declaration of the channels.
+const CHANNELS_DECLARATION: Template = template!("files/channels_declaration.h.in", ["count"]);
 /// `main.c` down to its task table, per layer.
 const MAIN_THREADS_HEAD: Template = template!("files/main_threads_head.c.in", []);
 const MAIN_STATIC_HEAD: Template = template!("files/main_static_head.c.in", []);
@@ -124,6 +126,9 @@ const TASK_SERVICE: Template = template!("files/task_service.c.in", ["task", "ro
 const TASK_SERVICE_SIM_START: Template = template!("files/task_service_sim_start.c.in", []);
 const TASK_SERVICE_SIM_WAIT: Template = template!("files/task_service_sim_wait.c.in", []);
 const TASK_SERVICE_TODO: Template = template!("files/task_service_todo.c.in", []);
+/// A sensor task's TODO for the user, per value it samples.
+const SENSOR_TODO: Template =
+    template!("files/sensor_todo.c.in", ["value", "kind", "example", "id"]);
 /// The Makefile's parts: the runtime's folder, what every Makefile has,
 /// the rules, each layer's head, a board's `size` and `run`.
 const RUNTIME_MK: Template = template!("files/runtime.mk.in", ["folder", "sources"]);
@@ -191,6 +196,7 @@ pub(super) const TEMPLATES: &[Template] = &[
     HEARD_ALIVE,
     HEARD_SYNC,
     HEARD_EVENT,
+    CHANNELS_DECLARATION,
     MAIN_THREADS_HEAD,
     MAIN_STATIC_HEAD,
     PROGRAM_DESC,
@@ -209,6 +215,7 @@ pub(super) const TEMPLATES: &[Template] = &[
     TASK_SERVICE_SIM_START,
     TASK_SERVICE_SIM_WAIT,
     TASK_SERVICE_TODO,
+    SENSOR_TODO,
     RUNTIME_MK,
     COMMON_MK,
     RULES_MK,
@@ -237,11 +244,10 @@ pub fn program_h(program: &RobotProgram, header: &str) -> String {
         out.push_str(HEARD_EVENT.text);
     }
     out.push_str(&super::shared::declarations(program));
-    let _ = writeln!(
-        out,
-        "\n/* The task graph's channels (channels.c). */\n#define SEMO_CHANNEL_COUNT {}\nextern const semo_channel_desc semo_program_channels[];",
-        program.graph.channels.len()
-    );
+    out.push_str(&fill(
+        &CHANNELS_DECLARATION,
+        &[("count", &program.graph.channels.len())],
+    ));
     out.push_str("\n#endif\n");
     out
 }
@@ -698,14 +704,15 @@ pub fn task_c(
                         );
                     }
                     false => {
-                        let _ = writeln!(
-                            out,
-                            "    /* TODO: read {v} ({ty}) from the sensor, e.g. {example},\n     * then write it: UFPort_WriteToQueue(port_{id}, &value, sizeof value). */\n    (void)value;\n    (void)port_{id};",
-                            v = c::comment(v),
-                            ty = c::comment(&kind.describe()),
-                            example = setter_example(kind),
-                            id = c::ident(v)
-                        );
+                        out.push_str(&fill(
+                            &SENSOR_TODO,
+                            &[
+                                ("value", &c::comment(v)),
+                                ("kind", &c::comment(&kind.describe())),
+                                ("example", &setter_example(kind)),
+                                ("id", &c::ident(v)),
+                            ],
+                        ));
                     }
                 }
             }
