@@ -130,6 +130,19 @@ const GRAPH_MOVE: Template = template!("loops/graph_move.c.in", []);
 const GRAPH_TEXT: Template = template!("loops/graph_text.c.in", ["max"]);
 const GRAPH_KEEP: Template = template!("loops/graph_keep.c.in", []);
 const LOOP_ENDED: Template = template!("loops/loop_ended.c.in", ["graph"]);
+/// The head of an inner task's work function.
+const WORK_HEAD: Template = template!(
+    "loops/work_head.c.in",
+    [
+        "path",
+        "reads",
+        "writes",
+        "exit",
+        "returns",
+        "name",
+        "signature"
+    ]
+);
 /// A time-triggered inner task's release.
 const RELEASE: Template = template!("loops/release.c.in", ["path", "period", "name"]);
 
@@ -143,6 +156,7 @@ pub(super) const TEMPLATES: &[Template] = &[
     GRAPH_KEEP,
     LOOP_ENDED,
     RELEASE,
+    WORK_HEAD,
 ];
 
 /// The channel rings and the helpers that move tokens (each written only
@@ -279,26 +293,39 @@ fn inner_task(
             .collect::<Vec<_>>()
             .join(", ")
     };
-    let _ = writeln!(
-        out,
-        "/* The work of inner task `{}`: reads {}; writes {} (each output the\n * integer 0 until set).{} */\nstatic {returns} work_{name}({signature})\n{{",
-        c::comment(&task.path),
-        if task.inputs.is_empty() {
-            "nothing".into()
-        } else {
-            rates(&task.inputs)
-        },
-        if task.outputs.is_empty() {
-            "nothing".into()
-        } else {
-            rates(&task.outputs)
-        },
-        if exit_of.is_some() {
-            " The exit task of its convergent loop: true to set the exit flag."
-        } else {
-            ""
-        }
-    );
+    out.push_str(&fill(
+        &WORK_HEAD,
+        &[
+            ("path", &c::comment(&task.path)),
+            (
+                "reads",
+                &if task.inputs.is_empty() {
+                    "nothing".into()
+                } else {
+                    rates(&task.inputs)
+                },
+            ),
+            (
+                "writes",
+                &if task.outputs.is_empty() {
+                    "nothing".into()
+                } else {
+                    rates(&task.outputs)
+                },
+            ),
+            (
+                "exit",
+                &if exit_of.is_some() {
+                    " The exit task of its convergent loop: true to set the exit flag."
+                } else {
+                    ""
+                },
+            ),
+            ("returns", &returns),
+            ("name", &name),
+            ("signature", &signature),
+        ],
+    ));
     for (p, input) in &ports {
         let _ = writeln!(out, "    (void){};", param(p, *input));
     }
