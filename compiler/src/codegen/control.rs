@@ -12,8 +12,8 @@ use super::template::{Template, fill, template};
 use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::{
-    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, SlotSource, State,
-    StateKind,
+    ActionMachine, ControlMachine, CountedGroup, Expr, LeaderAlgorithm, Operand, RobotProgram,
+    SendItem, SlotId, SlotSource, State, StateId, StateKind,
 };
 use crate::sema::Compared;
 use crate::syntax::ast::CmpOp;
@@ -591,6 +591,20 @@ fn emit_drop_unled(out: &mut String, program: &RobotProgram, receives: &[usize])
     out.push_str("        }\n");
 }
 
+/// What the C of every state reads: the program, its words and peers, the
+/// state's line in the mission and the state after it.
+#[derive(Clone, Copy)]
+struct StateCx<'a> {
+    program: &'a RobotProgram,
+    words: &'a Words,
+    peers: &'a Peers,
+    next: usize,
+    line: u32,
+}
+
+/// One state of a region's service: a `case` of its `switch`, written by
+/// the function of its kind (one per `StateKind`, in the order of the
+/// simulator's step).
 fn emit_state(
     out: &mut String,
     program: &RobotProgram,
@@ -599,364 +613,519 @@ fn emit_state(
     pc: usize,
     state: &State,
 ) {
-    let m = &program.control;
     let _ = writeln!(
         out,
         "    case {pc}: /* line {}: {} */",
         state.line,
         c::comment(&state.text)
     );
-    let next = pc + 1;
+    let cx = StateCx {
+        program,
+        words,
+        peers,
+        next: pc + 1,
+        line: state.line,
+    };
     match &state.kind {
         StateKind::Receive {
             messages,
             timeout_ms,
             mark,
-        } => {
-            let ready: Vec<String> = messages
-                .iter()
-                .map(|i| format!("UFPort_GetNumOfAvailableData(in_port[{i}]) > 0"))
-                .collect();
-            let ready = ready.join(" && ");
-            match timeout_ms {
-                // `receive(...), timeout = P`: go on without the values after P.
-                Some(t) => {
-                    out.push_str(&fill(
-                        &RECEIVE_TIMEOUT,
-                        &[
-                            ("mark", &mark),
-                            ("ready", &ready),
-                            ("t", &t),
-                            ("next", &next),
-                        ],
-                    ));
-                }
-                None => {
-                    let _ = writeln!(
-                        out,
-                        "        if (!({ready}))\n            return STEP_WAIT;"
-                    );
-                }
-            }
-            for &i in messages {
-                let s = m.incoming[i].slot;
-                let _ = writeln!(
-                    out,
-                    "        {{\n            semo_value v;\n            if (UFPort_ReadFromQueue(in_port[{i}], &v, sizeof v) > 0)\n                store({s}, &v);\n        }}"
-                );
-            }
-            let _ = writeln!(out, "        r->pc = {next};\n        return STEP_NEXT;");
-        }
-        StateKind::Send { items } => {
-            for item in items {
-                let value = operand(&item.value, words);
-                if let Some(s) = item.store {
-                    let _ = writeln!(out, "        store({s}, {value});");
-                }
-                let sent = match item.store {
-                    Some(s) => format!("&slot[{s}]"),
-                    None => value,
-                };
-                let _ = writeln!(
-                    out,
-                    "        semo_port_send(out_port[{}], {sent}, sizeof(semo_value)); /* {} */",
-                    item.message,
-                    c::comment(&m.outgoing[item.message].key)
-                );
-                if let Some(group) = item.own_group {
-                    // Its own publication is the latest its subscription sees.
-                    let _ = writeln!(
-                        out,
-                        "        UFMulticast_Write({}, {sent}, sizeof(semo_value));",
-                        c::string(&m.subscribed[group])
-                    );
-                }
-            }
-            let _ = writeln!(out, "        r->pc = {next};\n        return STEP_NEXT;");
-        }
-        StateKind::Subscribe { group, slot } => {
-            let _ = writeln!(
-                out,
-                "        {{\n            semo_value v;\n            if (UFMulticast_Read({}, &v, sizeof v) > 0)\n                store({slot}, &v);\n        }}\n        r->pc = {next};\n        return STEP_NEXT;",
-                c::string(&m.subscribed[*group])
-            );
-        }
+        } => emit_receive(out, &cx, messages, timeout_ms, mark),
+        StateKind::Send { items } => emit_send(out, &cx, items),
+        StateKind::Subscribe { group, slot } => emit_subscribe(out, &cx, group, slot),
         StateKind::Throw {
             event,
             broadcast: None,
-        } => {
-            let _ = writeln!(
-                out,
-                "        throw_event({});\n        r->pc = {next};\n        return STEP_NEXT;",
-                c::string(event)
-            );
-        }
+        } => emit_throw(out, &cx, event),
         StateKind::Throw {
             event,
             broadcast: Some(messages),
-        } => {
-            // The others of the group are told before the event acts here
-            // (a caught event ends the firing's steps).
-            for &message in messages {
-                let _ = writeln!(
-                    out,
-                    "        {{\n            semo_value told;\n            semo_value_set(&told, {});\n            semo_port_send(out_port[{message}], &told, sizeof told); /* {} to {} */\n        }}",
-                    c::string(event),
-                    c::comment(&m.outgoing[message].key),
-                    c::comment(&m.outgoing[message].to_team)
-                );
-            }
-            let _ = writeln!(
-                out,
-                "        throw_broadcast({});\n        r->pc = {next};\n        return STEP_NEXT;",
-                c::string(event)
-            );
-        }
+        } => emit_throw_broadcast(out, &cx, event, messages),
         StateKind::Call {
             service,
             task,
             args,
             timeout_ms,
             mark,
-        } => {
-            let port = request_index(program, task);
-            // The called task going idle wakes the control task; a timeout
-            // is a deadline of its own.
-            let wake = timeout_ms.map_or(String::new(), |t| {
-                format!("\n            wake_at(r->mark[{mark}] + {t} + 1);")
-            });
-            out.push_str(&fill(
-                &CALL_REQUEST,
-                &[
-                    ("port", &port),
-                    ("task", &c::string(task)),
-                    ("service", &c::string(service)),
-                    ("argc", &args.len()),
-                    ("args", &args_array(args, words)),
-                    ("mark", &mark),
-                    ("wake", &wake),
-                ],
-            ));
-            if let Some(t) = timeout_ms {
-                out.push_str(&fill(
-                    &CALL_TIMEOUT,
-                    &[
-                        ("mark", &mark),
-                        ("t", &t),
-                        ("task", &c::string(task)),
-                        ("service", &c::string(service)),
-                    ],
-                ));
-            }
-            out.push_str(&fill(
-                &CALL_WAIT,
-                &[("task", &c::string(task)), ("next", &next)],
-            ));
-        }
+        } => emit_call(out, &cx, service, task, args, timeout_ms, mark),
         StateKind::RunActions {
             service,
             machine,
             args,
             timeout_ms,
             mark,
-        } => {
-            let am = &m.actions[*machine];
-            let _ = writeln!(out, "        if (r->phase == 0) {{");
-            for (i, slot) in am.arguments.iter().enumerate() {
-                if let Some(arg) = args.get(i) {
-                    let _ = writeln!(out, "            store({slot}, {});", operand(arg, words));
-                }
-            }
-            out.push_str(&fill(
-                &ACTIONS_ENTER,
-                &[
-                    ("initial", &am.initial),
-                    ("mark", &mark),
-                    ("service", &c::string(service)),
-                ],
-            ));
-            if let Some(t) = timeout_ms {
-                out.push_str(&fill(
-                    &ACTIONS_TIMEOUT,
-                    &[
-                        ("mark", &mark),
-                        ("t", &t),
-                        ("service", &c::string(service)),
-                        ("next", &next),
-                    ],
-                ));
-            }
-            // An action taken (STEP_NEXT) enters the next action at the next
-            // firing, as in the simulator, where a firing that progressed is
-            // followed by the next: named here, since nothing else may wake
-            // the machine (an action whose commands' task just went idle).
-            out.push_str(&fill(
-                &ACTIONS_RUN,
-                &[
-                    ("machine", &machine),
-                    ("service", &c::string(service)),
-                    ("next", &next),
-                ],
-            ));
-        }
+        } => emit_run_actions(out, &cx, service, machine, args, timeout_ms, mark),
         StateKind::LeaderBranch {
             candidates,
             algorithm,
             others_at,
             receives,
-        } => {
-            let list = peers.locals(candidates);
-            let algorithm = match algorithm {
-                LeaderAlgorithm::LowestId => "ELECT_LOWEST_ID",
-                LeaderAlgorithm::HighestBattery => "ELECT_HIGHEST_BATTERY",
-                LeaderAlgorithm::Bully => "ELECT_BULLY",
-            };
-            out.push_str(&fill(
-                &LEADER_BRANCH,
-                &[
-                    ("list", &list),
-                    ("count", &candidates.len()),
-                    ("algorithm", &algorithm),
-                    // The leader before this election, for `emit_drop_unled`.
-                    (
-                        "led",
-                        &if receives.is_empty() {
-                            ""
-                        } else {
-                            "\n        long led = leader;"
-                        },
-                    ),
-                ],
-            ));
-            emit_drop_unled(out, program, receives);
-            let _ = writeln!(
-                out,
-                "        r->pc = chosen ? {next} : {others_at};\n        return STEP_NEXT;\n    }}"
-            );
-        }
+        } => emit_leader_branch(out, &cx, candidates, algorithm, others_at, receives),
         StateKind::GroupAllocate {
             members,
             groups,
             others_at,
-        } => {
-            let join = |items: Vec<String>| items.join(", ");
-            let members_list = peers.locals(members);
-            let mins = join(groups.iter().map(|g| g.min.to_string()).collect());
-            let names = join(groups.iter().map(|g| c::string(&g.name)).collect());
-            let at = join(groups.iter().map(|g| g.at.index().to_string()).collect());
-            let others = others_at.map_or(next, |o| o.index());
-            out.push_str(&fill(
-                &GROUP_ALLOCATE,
-                &[
-                    ("members_list", &members_list),
-                    ("mins", &mins),
-                    ("names", &names),
-                    ("at", &at),
-                    ("count", &members.len()),
-                    ("groups", &groups.len()),
-                    ("has_others", &others_at.is_some()),
-                    ("others", &others),
-                ],
-            ));
-        }
+        } => emit_group_allocate(out, &cx, members, groups, others_at),
         StateKind::GroupSync {
             members,
             point,
             timeout_ms,
             mark,
-        } => {
-            let list = peers.locals(members);
-            let hb = m.heartbeat_ms;
-            out.push_str(&fill(
-                &GROUP_SYNC,
-                &[
-                    ("list", &list),
-                    ("mark", &mark),
-                    ("count", &members.len()),
-                    ("offset", &m.sync_points[*point]),
-                    ("team", &c::string(&program.team)),
-                    ("key", &c::string(&super::files::sync_key(program))),
-                    ("point", &point),
-                    ("hb", &hb),
-                    ("timeout_ms", &timeout_ms),
-                    ("line", &state.line),
-                    ("next", &next),
-                ],
-            ));
-        }
-        StateKind::Branch { condition, else_to } => {
-            let _ = writeln!(
-                out,
-                "        r->pc = {} ? {next} : {else_to};\n        return STEP_NEXT;",
-                expr(condition, words)
-            );
-        }
-        StateKind::Jump { to } => {
-            let _ = writeln!(out, "        r->pc = {to};\n        return STEP_NEXT;");
-        }
+        } => emit_group_sync(out, &cx, members, point, timeout_ms, mark),
+        StateKind::Branch { condition, else_to } => emit_branch(out, &cx, condition, else_to),
+        StateKind::Jump { to } => emit_jump(out, &cx, to),
         StateKind::LoopHead {
             condition,
             exit_to,
             mark,
-        } => {
-            if let Some(cond) = condition {
-                let _ = writeln!(
-                    out,
-                    "        if (!{}) {{\n            r->pc = {exit_to};\n            return STEP_NEXT;\n        }}",
-                    expr(cond, words)
-                );
-            }
-            let _ = writeln!(
-                out,
-                "        r->mark[{mark}] = semo_now_ms();\n        r->pc = {next};\n        return STEP_NEXT;"
-            );
-        }
+        } => emit_loop_head(out, &cx, condition, exit_to, mark),
         StateKind::LoopTail {
             period_ms,
             mark,
             to,
-        } => {
-            match period_ms {
-                Some(p) => {
-                    let _ = writeln!(
-                        out,
-                        "        if (semo_now_ms() - r->mark[{mark}] < {p}) {{\n            wake_at(r->mark[{mark}] + {p});\n            return STEP_WAIT;\n        }}"
-                    );
-                    let _ = writeln!(out, "        r->pc = {to};\n        return STEP_NEXT;");
-                }
-                // Without a period, one iteration per firing.
-                None => {
-                    let _ = writeln!(
-                        out,
-                        "        r->pc = {to};\n        wake_at(semo_now_ms());\n        return STEP_WAIT;"
-                    );
-                }
-            }
-        }
+        } => emit_loop_tail(out, &cx, period_ms, mark, to),
         StateKind::Repeat {
             period_ms,
             condition,
             forever,
-        } => {
-            if let Some(cond) = condition {
-                let _ = writeln!(
-                    out,
-                    "        if (!{})\n            return STEP_DONE;",
-                    expr(cond, words)
-                );
-            }
-            if let Some(p) = period_ms {
-                let _ = writeln!(
-                    out,
-                    "        if (semo_now_ms() - r->pass_start < {p}) {{\n            wake_at(r->pass_start + {p});\n            return STEP_WAIT;\n        }}\n        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        return STEP_NEXT;"
-                );
-            } else if *forever || condition.is_some() {
-                // The next pass starts at the next firing.
-                out.push_str("        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        wake_at(semo_now_ms());\n        return STEP_WAIT;\n");
-            } else {
-                out.push_str("        return STEP_DONE;\n");
-            }
+        } => emit_repeat(out, &cx, period_ms, condition, forever),
+    }
+}
+
+/// `receive(...)`: waits until every message has come (or its timeout), then stores them.
+fn emit_receive(
+    out: &mut String,
+    cx: &StateCx,
+    messages: &[usize],
+    timeout_ms: &Option<i64>,
+    mark: &usize,
+) {
+    let StateCx { program, next, .. } = *cx;
+    let m = &program.control;
+    let ready: Vec<String> = messages
+        .iter()
+        .map(|i| format!("UFPort_GetNumOfAvailableData(in_port[{i}]) > 0"))
+        .collect();
+    let ready = ready.join(" && ");
+    match timeout_ms {
+        // `receive(...), timeout = P`: go on without the values after P.
+        Some(t) => {
+            out.push_str(&fill(
+                &RECEIVE_TIMEOUT,
+                &[
+                    ("mark", &mark),
+                    ("ready", &ready),
+                    ("t", &t),
+                    ("next", &next),
+                ],
+            ));
         }
+        None => {
+            let _ = writeln!(
+                out,
+                "        if (!({ready}))\n            return STEP_WAIT;"
+            );
+        }
+    }
+    for &i in messages {
+        let s = m.incoming[i].slot;
+        let _ = writeln!(
+            out,
+            "        {{\n            semo_value v;\n            if (UFPort_ReadFromQueue(in_port[{i}], &v, sizeof v) > 0)\n                store({s}, &v);\n        }}"
+        );
+    }
+    let _ = writeln!(out, "        r->pc = {next};\n        return STEP_NEXT;");
+}
+
+/// `send`/`publish`: each value to its message's port (and its own group).
+fn emit_send(out: &mut String, cx: &StateCx, items: &[SendItem]) {
+    let StateCx {
+        program,
+        words,
+        next,
+        ..
+    } = *cx;
+    let m = &program.control;
+    for item in items {
+        let value = operand(&item.value, words);
+        if let Some(s) = item.store {
+            let _ = writeln!(out, "        store({s}, {value});");
+        }
+        let sent = match item.store {
+            Some(s) => format!("&slot[{s}]"),
+            None => value,
+        };
+        let _ = writeln!(
+            out,
+            "        semo_port_send(out_port[{}], {sent}, sizeof(semo_value)); /* {} */",
+            item.message,
+            c::comment(&m.outgoing[item.message].key)
+        );
+        if let Some(group) = item.own_group {
+            // Its own publication is the latest its subscription sees.
+            let _ = writeln!(
+                out,
+                "        UFMulticast_Write({}, {sent}, sizeof(semo_value));",
+                c::string(&m.subscribed[group])
+            );
+        }
+    }
+    let _ = writeln!(out, "        r->pc = {next};\n        return STEP_NEXT;");
+}
+
+/// `subscribe`: the group's latest value, if any.
+fn emit_subscribe(out: &mut String, cx: &StateCx, group: &usize, slot: &SlotId) {
+    let StateCx { program, next, .. } = *cx;
+    let m = &program.control;
+    let _ = writeln!(
+        out,
+        "        {{\n            semo_value v;\n            if (UFMulticast_Read({}, &v, sizeof v) > 0)\n                store({slot}, &v);\n        }}\n        r->pc = {next};\n        return STEP_NEXT;",
+        c::string(&m.subscribed[*group])
+    );
+}
+
+/// `throw E`.
+fn emit_throw(out: &mut String, cx: &StateCx, event: &str) {
+    let StateCx { next, .. } = *cx;
+    let _ = writeln!(
+        out,
+        "        throw_event({});\n        r->pc = {next};\n        return STEP_NEXT;",
+        c::string(event)
+    );
+}
+
+/// `throw E broadcast`: the others of the group told first.
+fn emit_throw_broadcast(out: &mut String, cx: &StateCx, event: &str, messages: &[usize]) {
+    let StateCx { program, next, .. } = *cx;
+    let m = &program.control;
+    // The others of the group are told before the event acts here
+    // (a caught event ends the firing's steps).
+    for &message in messages {
+        let _ = writeln!(
+            out,
+            "        {{\n            semo_value told;\n            semo_value_set(&told, {});\n            semo_port_send(out_port[{message}], &told, sizeof told); /* {} to {} */\n        }}",
+            c::string(event),
+            c::comment(&m.outgoing[message].key),
+            c::comment(&m.outgoing[message].to_team)
+        );
+    }
+    let _ = writeln!(
+        out,
+        "        throw_broadcast({});\n        r->pc = {next};\n        return STEP_NEXT;",
+        c::string(event)
+    );
+}
+
+/// A service call: a request to its task, then waiting for the task to go idle (or the timeout).
+fn emit_call(
+    out: &mut String,
+    cx: &StateCx,
+    service: &str,
+    task: &str,
+    args: &[Operand],
+    timeout_ms: &Option<i64>,
+    mark: &usize,
+) {
+    let StateCx {
+        program,
+        words,
+        next,
+        ..
+    } = *cx;
+    let port = request_index(program, task);
+    // The called task going idle wakes the control task; a timeout
+    // is a deadline of its own.
+    let wake = timeout_ms.map_or(String::new(), |t| {
+        format!("\n            wake_at(r->mark[{mark}] + {t} + 1);")
+    });
+    out.push_str(&fill(
+        &CALL_REQUEST,
+        &[
+            ("port", &port),
+            ("task", &c::string(task)),
+            ("service", &c::string(service)),
+            ("argc", &args.len()),
+            ("args", &args_array(args, words)),
+            ("mark", &mark),
+            ("wake", &wake),
+        ],
+    ));
+    if let Some(t) = timeout_ms {
+        out.push_str(&fill(
+            &CALL_TIMEOUT,
+            &[
+                ("mark", &mark),
+                ("t", &t),
+                ("task", &c::string(task)),
+                ("service", &c::string(service)),
+            ],
+        ));
+    }
+    out.push_str(&fill(
+        &CALL_WAIT,
+        &[("task", &c::string(task)), ("next", &next)],
+    ));
+}
+
+/// A strategy's service: its action machine run until it is done (or the timeout).
+fn emit_run_actions(
+    out: &mut String,
+    cx: &StateCx,
+    service: &str,
+    machine: &usize,
+    args: &[Operand],
+    timeout_ms: &Option<i64>,
+    mark: &usize,
+) {
+    let StateCx {
+        program,
+        words,
+        next,
+        ..
+    } = *cx;
+    let m = &program.control;
+    let am = &m.actions[*machine];
+    let _ = writeln!(out, "        if (r->phase == 0) {{");
+    for (i, slot) in am.arguments.iter().enumerate() {
+        if let Some(arg) = args.get(i) {
+            let _ = writeln!(out, "            store({slot}, {});", operand(arg, words));
+        }
+    }
+    out.push_str(&fill(
+        &ACTIONS_ENTER,
+        &[
+            ("initial", &am.initial),
+            ("mark", &mark),
+            ("service", &c::string(service)),
+        ],
+    ));
+    if let Some(t) = timeout_ms {
+        out.push_str(&fill(
+            &ACTIONS_TIMEOUT,
+            &[
+                ("mark", &mark),
+                ("t", &t),
+                ("service", &c::string(service)),
+                ("next", &next),
+            ],
+        ));
+    }
+    // An action taken (STEP_NEXT) enters the next action at the next
+    // firing, as in the simulator, where a firing that progressed is
+    // followed by the next: named here, since nothing else may wake
+    // the machine (an action whose commands' task just went idle).
+    out.push_str(&fill(
+        &ACTIONS_RUN,
+        &[
+            ("machine", &machine),
+            ("service", &c::string(service)),
+            ("next", &next),
+        ],
+    ));
+}
+
+/// `leader(...)`: the election, then the leader's block or the others'.
+fn emit_leader_branch(
+    out: &mut String,
+    cx: &StateCx,
+    candidates: &[usize],
+    algorithm: &LeaderAlgorithm,
+    others_at: &StateId,
+    receives: &[usize],
+) {
+    let StateCx {
+        program,
+        peers,
+        next,
+        ..
+    } = *cx;
+    let list = peers.locals(candidates);
+    let algorithm = match algorithm {
+        LeaderAlgorithm::LowestId => "ELECT_LOWEST_ID",
+        LeaderAlgorithm::HighestBattery => "ELECT_HIGHEST_BATTERY",
+        LeaderAlgorithm::Bully => "ELECT_BULLY",
+    };
+    out.push_str(&fill(
+        &LEADER_BRANCH,
+        &[
+            ("list", &list),
+            ("count", &candidates.len()),
+            ("algorithm", &algorithm),
+            // The leader before this election, for `emit_drop_unled`.
+            (
+                "led",
+                &if receives.is_empty() {
+                    ""
+                } else {
+                    "\n        long led = leader;"
+                },
+            ),
+        ],
+    ));
+    emit_drop_unled(out, program, receives);
+    let _ = writeln!(
+        out,
+        "        r->pc = chosen ? {next} : {others_at};\n        return STEP_NEXT;\n    }}"
+    );
+}
+
+/// Counted groups: this robot's group among the live members.
+fn emit_group_allocate(
+    out: &mut String,
+    cx: &StateCx,
+    members: &[usize],
+    groups: &[CountedGroup],
+    others_at: &Option<StateId>,
+) {
+    let StateCx { peers, next, .. } = *cx;
+    let join = |items: Vec<String>| items.join(", ");
+    let members_list = peers.locals(members);
+    let mins = join(groups.iter().map(|g| g.min.to_string()).collect());
+    let names = join(groups.iter().map(|g| c::string(&g.name)).collect());
+    let at = join(groups.iter().map(|g| g.at.index().to_string()).collect());
+    let others = others_at.map_or(next, |o| o.index());
+    out.push_str(&fill(
+        &GROUP_ALLOCATE,
+        &[
+            ("members_list", &members_list),
+            ("mins", &mins),
+            ("names", &names),
+            ("at", &at),
+            ("count", &members.len()),
+            ("groups", &groups.len()),
+            ("has_others", &others_at.is_some()),
+            ("others", &others),
+        ],
+    ));
+}
+
+/// `GroupSync`: waits for the group's live members to arrive (or the timeout).
+fn emit_group_sync(
+    out: &mut String,
+    cx: &StateCx,
+    members: &[usize],
+    point: &usize,
+    timeout_ms: &i64,
+    mark: &usize,
+) {
+    let StateCx {
+        program,
+        peers,
+        next,
+        line,
+        ..
+    } = *cx;
+    let m = &program.control;
+    let list = peers.locals(members);
+    let hb = m.heartbeat_ms;
+    out.push_str(&fill(
+        &GROUP_SYNC,
+        &[
+            ("list", &list),
+            ("mark", &mark),
+            ("count", &members.len()),
+            ("offset", &m.sync_points[*point]),
+            ("team", &c::string(&program.team)),
+            ("key", &c::string(&super::files::sync_key(program))),
+            ("point", &point),
+            ("hb", &hb),
+            ("timeout_ms", &timeout_ms),
+            ("line", &line),
+            ("next", &next),
+        ],
+    ));
+}
+
+/// `if`.
+fn emit_branch(out: &mut String, cx: &StateCx, condition: &Expr, else_to: &StateId) {
+    let StateCx { words, next, .. } = *cx;
+    let _ = writeln!(
+        out,
+        "        r->pc = {} ? {next} : {else_to};\n        return STEP_NEXT;",
+        expr(condition, words)
+    );
+}
+
+/// A jump (the end of a branch).
+fn emit_jump(out: &mut String, _cx: &StateCx, to: &StateId) {
+    let _ = writeln!(out, "        r->pc = {to};\n        return STEP_NEXT;");
+}
+
+/// A loop's head: its condition, and the pass's start for its period.
+fn emit_loop_head(
+    out: &mut String,
+    cx: &StateCx,
+    condition: &Option<Expr>,
+    exit_to: &StateId,
+    mark: &usize,
+) {
+    let StateCx { words, next, .. } = *cx;
+    if let Some(cond) = condition {
+        let _ = writeln!(
+            out,
+            "        if (!{}) {{\n            r->pc = {exit_to};\n            return STEP_NEXT;\n        }}",
+            expr(cond, words)
+        );
+    }
+    let _ = writeln!(
+        out,
+        "        r->mark[{mark}] = semo_now_ms();\n        r->pc = {next};\n        return STEP_NEXT;"
+    );
+}
+
+/// A loop's tail: back to its head once its period is over.
+fn emit_loop_tail(
+    out: &mut String,
+    _cx: &StateCx,
+    period_ms: &Option<i64>,
+    mark: &usize,
+    to: &StateId,
+) {
+    match period_ms {
+        Some(p) => {
+            let _ = writeln!(
+                out,
+                "        if (semo_now_ms() - r->mark[{mark}] < {p}) {{\n            wake_at(r->mark[{mark}] + {p});\n            return STEP_WAIT;\n        }}"
+            );
+            let _ = writeln!(out, "        r->pc = {to};\n        return STEP_NEXT;");
+        }
+        // Without a period, one iteration per firing.
+        None => {
+            let _ = writeln!(
+                out,
+                "        r->pc = {to};\n        wake_at(semo_now_ms());\n        return STEP_WAIT;"
+            );
+        }
+    }
+}
+
+/// The end of a service's pass: `repeat(...)` or done.
+fn emit_repeat(
+    out: &mut String,
+    cx: &StateCx,
+    period_ms: &Option<i64>,
+    condition: &Option<Expr>,
+    forever: &bool,
+) {
+    let StateCx { words, .. } = *cx;
+    if let Some(cond) = condition {
+        let _ = writeln!(
+            out,
+            "        if (!{})\n            return STEP_DONE;",
+            expr(cond, words)
+        );
+    }
+    if let Some(p) = period_ms {
+        let _ = writeln!(
+            out,
+            "        if (semo_now_ms() - r->pass_start < {p}) {{\n            wake_at(r->pass_start + {p});\n            return STEP_WAIT;\n        }}\n        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        return STEP_NEXT;"
+        );
+    } else if *forever || condition.is_some() {
+        // The next pass starts at the next firing.
+        out.push_str("        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        wake_at(semo_now_ms());\n        return STEP_WAIT;\n");
+    } else {
+        out.push_str("        return STEP_DONE;\n");
     }
 }
 

@@ -13,7 +13,8 @@
 
 use std::fmt::{Display, Write};
 
-/// A file of `codegen/templates/` and the slots it holds.
+/// A template file (under `codegen/templates/`, or the runtime's link
+/// script) and the slots it holds.
 #[derive(Clone, Copy, Debug)]
 pub struct Template {
     /// Its path under `codegen/` (`templates/...`; a board's link script is
