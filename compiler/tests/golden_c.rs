@@ -11,6 +11,11 @@
 //! run the test with `INSTA_UPDATE=always` (or `cargo insta review`) and
 //! read the diff of the snapshots before committing it.
 //!
+//! Every fixed piece of every template of the generator
+//! (`src/codegen/templates/`) is in some snapshot
+//! (`every_template_s_text_is_in_some_snapshot`): moving text between the
+//! Rust and the templates, or changing a template, shows here.
+//!
 //! `cortex-m-sim` compiles a scenario into each robot: the example's own
 //! scenario where the repository has one (`tests/fixtures/`), else a run of
 //! two seconds with nothing happening.
@@ -203,4 +208,68 @@ fn the_files_of_the_constructs_only_this_test_writes_for_linux() {
         let result = build(&folder.join(mission), &strategy, Target::Linux, None);
         insta::assert_snapshot!(format!("{name}@linux"), written(&result));
     }
+}
+
+/// Every fixed piece of every template (`src/codegen/templates/`, the text
+/// between its slots) is in some snapshot, so that a change to any of them
+/// shows here: a template no mission above fills would change unseen.
+#[test]
+fn every_template_s_text_is_in_some_snapshot() {
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut snapshots = String::new();
+    for entry in std::fs::read_dir(manifest.join("tests/snapshots")).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        if name.starts_with("golden_c__") && name.ends_with(".snap") {
+            snapshots.push_str(&std::fs::read_to_string(&path).unwrap());
+        }
+    }
+    let mut folders = vec![manifest.join("src/codegen/templates")];
+    let mut unseen = Vec::new();
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                folders.push(path);
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            for piece in fixed_pieces(&text) {
+                if !snapshots.contains(piece) {
+                    unseen.push(format!("{}: {piece:?}", path.display()));
+                }
+            }
+        }
+    }
+    assert!(unseen.is_empty(), "in no snapshot:\n{}", unseen.join("\n"));
+}
+
+/// The text between a template's `{{slot}}`s (those of more than a few
+/// characters: a short piece proves nothing). A slot is `{{name}}`, `name`
+/// a lower-case identifier, as `codegen::template` reads it; any other `{{`
+/// is text.
+fn fixed_pieces(text: &str) -> Vec<&str> {
+    let mut pieces = Vec::new();
+    let (mut piece_start, mut at) = (0, 0);
+    while let Some(found) = text[at..].find("{{") {
+        let start = at + found;
+        let name = &text[start + 2..];
+        let len = name
+            .bytes()
+            .enumerate()
+            .take_while(|&(i, b)| {
+                b.is_ascii_lowercase() || b == b'_' || (i > 0 && b.is_ascii_digit())
+            })
+            .count();
+        if len > 0 && name[len..].starts_with("}}") {
+            pieces.push(&text[piece_start..start]);
+            piece_start = start + 2 + len + 2;
+            at = piece_start;
+        } else {
+            at = start + 1;
+        }
+    }
+    pieces.push(&text[piece_start..]);
+    pieces.retain(|p| p.trim().len() > 3);
+    pieces
 }
