@@ -14,8 +14,30 @@
 
 use super::c;
 use super::control::expr;
+use super::template::{Template, fill, template};
 use crate::refine::{BatteryPolicy, RobotProgram, RoleKind};
 use std::fmt::Write;
+
+/// The resource manager's tables, its head and one policy's check.
+const POLICIES: Template = template!("battery/policies.c.in", ["policies", "tasks", "levels"]);
+const MANAGE_RESOURCES_HEAD: Template = template!("battery/manage_resources_head.c.in", []);
+const POLICY: Template = template!(
+    "battery/policy.c.in",
+    ["text", "source", "condition", "i", "text_string"]
+);
+/// A levelled sensor task's next firing; a levelled actuator's `speed_scale`.
+const SENSOR_LEVEL: Template = template!("battery/sensor_level.c.in", ["param", "period_ms"]);
+const SPEED_SCALE: Template = template!("battery/speed_scale.c.in", ["param"]);
+
+/// Every template of the resource manager.
+#[cfg(test)]
+pub(super) const TEMPLATES: &[Template] = &[
+    POLICIES,
+    MANAGE_RESOURCES_HEAD,
+    POLICY,
+    SENSOR_LEVEL,
+    SPEED_SCALE,
+];
 
 /// The task parameter holding a sensor task's period level.
 pub const PERIOD_LEVEL_PARAM: &str = "semo_period_level";
@@ -41,23 +63,26 @@ pub(super) fn resource_manager(program: &RobotProgram, words: &super::values::Wo
     }
     let tasks = m.battery_tasks();
     let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "/* Adaptive resource management: the battery policies of the team's strategy. */\nstatic bool policy_holds[{}];\nstatic long long task_level[{}] = {{{}}};\n",
-        m.battery.len(),
-        tasks.len().max(1),
-        vec!["1"; tasks.len().max(1)].join(", ")
-    );
-    out.push_str("/* Checks every policy on the battery value just read; applies and traces\n * what changed. */\nstatic void manage_resources(void)\n{\n    bool holds;\n    long long level;\n    const char *level_text;\n");
+    out.push_str(&fill(
+        &POLICIES,
+        &[
+            ("policies", &m.battery.len()),
+            ("tasks", &tasks.len().max(1)),
+            ("levels", &vec!["1"; tasks.len().max(1)].join(", ")),
+        ],
+    ));
+    out.push_str(MANAGE_RESOURCES_HEAD.text);
     for (i, policy) in m.battery.iter().enumerate() {
-        let _ = writeln!(
-            out,
-            "    /* {} ({}) */\n    holds = {};\n    if (holds != policy_holds[{i}]) {{\n        policy_holds[{i}] = holds;\n        semo_trace(\"battery_policy\", \"condition\", {}, \"holds\", holds ? \"true\" : \"false\", NULL);\n    }}",
-            c::comment(&policy.text),
-            c::comment(&policy.source),
-            expr(&policy.condition, words),
-            c::string(&policy.text),
-        );
+        out.push_str(&fill(
+            &POLICY,
+            &[
+                ("text", &c::comment(&policy.text)),
+                ("source", &c::comment(&policy.source)),
+                ("condition", &expr(&policy.condition, words)),
+                ("i", &i),
+                ("text_string", &c::string(&policy.text)),
+            ],
+        ));
     }
     for (k, (task, sensor)) in tasks.iter().enumerate() {
         let levels = levels_of(&m.battery, task, *sensor);
@@ -134,9 +159,12 @@ pub(super) fn sensor_level_hint(
 ) -> Option<String> {
     let levelled = program.control.battery_tasks().contains(&(task, true));
     levelled.then(|| {
-        format!(
-            "    /* Adaptive resource management: the control task sets the period level. */\n    long long level = UFTask_GetIntegerParameter(TASK_NAME, {});\n    if (level > 1)\n        semo_next_firing(fired + level * {period_ms});\n",
-            c::string(PERIOD_LEVEL_PARAM)
+        fill(
+            &SENSOR_LEVEL,
+            &[
+                ("param", &c::string(PERIOD_LEVEL_PARAM)),
+                ("period_ms", &period_ms),
+            ],
         )
     })
 }
@@ -146,10 +174,5 @@ pub(super) fn sensor_level_hint(
 /// least 1), read when a call starts.
 pub(super) fn actuator_speed_scale(program: &RobotProgram, task: &str) -> Option<String> {
     let levelled = program.control.battery_tasks().contains(&(task, false));
-    levelled.then(|| {
-        format!(
-            "/* Adaptive resource management: at speed level L a call takes L times as long. */\nstatic int64_t speed_scale(void)\n{{\n    long long level = UFTask_GetIntegerParameter(TASK_NAME, {});\n    return level > 1 ? (int64_t)level : 1;\n}}\n\n",
-            c::string(SPEED_LEVEL_PARAM)
-        )
-    })
+    levelled.then(|| fill(&SPEED_SCALE, &[("param", &c::string(SPEED_LEVEL_PARAM))]))
 }

@@ -8,15 +8,132 @@
 
 use super::c;
 use super::peers::Peers;
+use super::template::{Template, fill, template};
 use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::{
-    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, SlotSource, State,
-    StateKind,
+    ActionMachine, ControlMachine, CountedGroup, Expr, LeaderAlgorithm, Operand, RobotProgram,
+    SendItem, SlotId, SlotSource, State, StateId, StateKind,
 };
 use crate::sema::Compared;
 use crate::syntax::ast::CmpOp;
 use std::fmt::Write;
+
+/// The region record, the mode variables and `wake_at`, before the machine.
+const REGION: Template = template!("control/region.c.in", []);
+/// `catch_event`'s head, before the `switch` of its catches.
+const CATCH_EVENT_HEAD: Template = template!("control/catch_event_head.c.in", []);
+/// `throw_event` beside `catch_event`.
+const THROW_EVENT: Template = template!("control/throw_event.c.in", []);
+/// `throw_event`'s head, before its own `switch` of catches (a program that
+/// neither broadcasts nor hears events).
+const THROW_EVENT_HEAD: Template = template!("control/throw_event_head.c.in", []);
+const THROW_BROADCAST: Template = template!("control/throw_broadcast.c.in", []);
+const TAKE_EVENTS: Template = template!("control/take_events.c.in", []);
+/// `request`: a service request written to its task's queue.
+const REQUEST: Template = template!("control/request.c.in", []);
+/// The states, one template per kind (or per part of one).
+const RECEIVE_TIMEOUT: Template = template!(
+    "control/receive_timeout.c.in",
+    ["mark", "ready", "t", "next"]
+);
+const CALL_REQUEST: Template = template!(
+    "control/call_request.c.in",
+    ["port", "task", "service", "argc", "args", "mark", "wake"]
+);
+const CALL_TIMEOUT: Template = template!(
+    "control/call_timeout.c.in",
+    ["mark", "t", "task", "service"]
+);
+const CALL_WAIT: Template = template!("control/call_wait.c.in", ["task", "next"]);
+const ACTIONS_ENTER: Template =
+    template!("control/actions_enter.c.in", ["initial", "mark", "service"]);
+const ACTIONS_TIMEOUT: Template = template!(
+    "control/actions_timeout.c.in",
+    ["mark", "t", "service", "next"]
+);
+const ACTIONS_RUN: Template = template!("control/actions_run.c.in", ["machine", "service", "next"]);
+const LEADER_BRANCH: Template = template!(
+    "control/leader_branch.c.in",
+    ["list", "count", "algorithm", "led"]
+);
+const GROUP_ALLOCATE: Template = template!(
+    "control/group_allocate.c.in",
+    [
+        "members_list",
+        "mins",
+        "names",
+        "at",
+        "count",
+        "groups",
+        "has_others",
+        "others"
+    ]
+);
+const GROUP_SYNC: Template = template!(
+    "control/group_sync.c.in",
+    [
+        "list",
+        "mark",
+        "count",
+        "offset",
+        "team",
+        "key",
+        "point",
+        "hb",
+        "timeout_ms",
+        "line",
+        "next"
+    ]
+);
+/// A strategy's action machine's head, before its actions.
+const ACTIONS_HEAD: Template =
+    template!("control/actions_head.c.in", ["service", "source", "index"]);
+const ENTER_MODE_HEAD: Template = template!("control/enter_mode_head.c.in", []);
+const ENTER_MODE_TAIL: Template = template!("control/enter_mode_tail.c.in", []);
+const LEAVE_MODE_HEAD: Template = template!("control/leave_mode_head.c.in", []);
+/// The control task's firing: its head, the heartbeat, its tail.
+const GO_HEAD: Template = template!("control/go_head.c.in", ["name"]);
+const HEARTBEAT: Template = template!("control/heartbeat.c.in", ["hb", "team", "key", "group"]);
+const GO_TAIL: Template = template!(
+    "control/go_tail.c.in",
+    ["steps_per_firing", "flush", "name"]
+);
+const GROUP_UPDATE: Template = template!("control/group_update.c.in", ["list", "count", "hb"]);
+
+/// Every template of `control_task.c`.
+#[cfg(test)]
+pub(super) const TEMPLATES: &[Template] = &[
+    DROP_UNLED,
+    ELECTED,
+    GROUP_OF,
+    LEADING,
+    REGION,
+    CATCH_EVENT_HEAD,
+    THROW_EVENT,
+    THROW_EVENT_HEAD,
+    THROW_BROADCAST,
+    TAKE_EVENTS,
+    REQUEST,
+    RECEIVE_TIMEOUT,
+    CALL_REQUEST,
+    CALL_TIMEOUT,
+    CALL_WAIT,
+    ACTIONS_ENTER,
+    ACTIONS_TIMEOUT,
+    ACTIONS_RUN,
+    LEADER_BRANCH,
+    GROUP_ALLOCATE,
+    GROUP_SYNC,
+    ACTIONS_HEAD,
+    ENTER_MODE_HEAD,
+    ENTER_MODE_TAIL,
+    LEAVE_MODE_HEAD,
+    GO_HEAD,
+    HEARTBEAT,
+    GO_TAIL,
+    GROUP_UPDATE,
+];
 
 /// State transitions a region may take in one firing: a service whose
 /// states never wait (only sends and branches) still yields to the others.
@@ -76,9 +193,10 @@ pub const UNLED_REASON: &str = "arrived before it led";
 /// has just become the leader drops the messages waiting for its leader's
 /// block (`StateKind::LeaderBranch`). Only the count seen first: a message
 /// the receive task writes meanwhile arrived after.
-const DROP_UNLED_C: &str = "/* Drops the messages a channel holds now (they arrived before this robot\n * led), oldest first, each traced; one the receive task writes meanwhile stays. */\nstatic void drop_unled(int port, const char *from, const char *key)\n{\n    semo_value stale;\n    for (int n = UFPort_GetNumOfAvailableData(port); n > 0; n--)\n        if (UFPort_ReadFromQueue(port, &stale, sizeof stale) > 0)\n            semo_trace(\"drop\", \"from\", from, \"key\", key, \"reason\", @REASON@, NULL);\n}\n\n";
+const DROP_UNLED: Template = template!("control/drop_unled.c.in", ["reason"]);
 
-/// Leader elections (`@HB@`: the heartbeat period, `@LISTEN@`: [`listen_ms`]).
+/// Leader elections (`hb`: the heartbeat period, `listen`: [`listen_ms`],
+/// `lease`: [`lease_ms`], `term_max`: [`TERM_MAX`]).
 /// `leading` is what this robot's heartbeats say: whether the last election
 /// it decided named it. A robot that joined a mission under way (restarted:
 /// its mission time was past one heartbeat period when it started, or the
@@ -86,7 +204,10 @@ const DROP_UNLED_C: &str = "/* Drops the messages a channel holds now (they arri
 /// live robot claims leadership it follows that robot instead of claiming:
 /// the claimant gives way at its own next election, so that two robots never
 /// both lead after a restart.
-const ELECTION_C: &str = "/* Leader elections: each `leader(...)` arm's candidates (peer indices, in\n * formation order) and algorithm. A candidate is alive when it is this\n * robot or was heard from within three heartbeats. lowest_id: the first\n * alive; bully: the last alive (the highest id); highest_battery: the\n * highest battery level its heartbeat said (unknown counts lowest; ties: the\n * first), after every robot has listened at start. A robot that joined the\n * mission under way (restarted) listens too, and while another live robot\n * claims leadership it follows that one instead of claiming. A change of\n * leader is traced. Fencing: a robot the election would choose leads only\n * while its lease holds, a strict majority of the candidates (itself\n * included) heard from within the lease; without one it is fenced (traced\n * once), waits, and with a majority again listens as a restarted robot does\n * before it claims, following a live claimant. Returns 1 (this\n * robot leads), 0, or -1 while listening or fenced. */\nenum { ELECT_LOWEST_ID, ELECT_HIGHEST_BATTERY, ELECT_BULLY };\n/* `*last` of an arm whose robot is fenced (no robot has index -2). */\n#define ELECT_FENCED (-2L)\nstatic int elected(const size_t *candidates, size_t n, int algorithm, long *last)\n{\n    static int rejoining = -1;\n    static bool fenced;      /* fenced since it last led or followed */\n    static int64_t regained = -1; /* when it heard a majority again */\n    const semo_program_desc *p = semo_program();\n    int64_t now = semo_now_ms();\n    if (rejoining < 0)\n        rejoining = semo_joined_ms() > @HB@ || semo_session_resumed();\n    if ((rejoining || algorithm == ELECT_HIGHEST_BATTERY) && now - semo_joined_ms() < @LISTEN@) {\n        wake_at(semo_joined_ms() + @LISTEN@);\n        return -1;\n    }\n    size_t leader = p->self;\n    bool found = false;\n    long best = -1;\n    for (size_t k = 0; k < n; k++) {\n        size_t c = candidates[algorithm == ELECT_BULLY ? n - 1 - k : k];\n        comm_heartbeat h = comm_heard(c);\n        if (c != p->self && now - h.seen > 3 * @HB@)\n            continue;\n        long level = c == p->self ? own_battery() : h.battery;\n        if (!found || (algorithm == ELECT_HIGHEST_BATTERY && level > best)) {\n            leader = c;\n            best = level;\n            found = true;\n        }\n        if (algorithm != ELECT_HIGHEST_BATTERY)\n            break;\n    }\n    /* Terms: a leader that has heard a higher term than its own since it\n     * began is deposed, and like a rejoining robot it follows a live\n     * claimant; a claim counts only under the highest term known. */\n    bool was_leading = leading;\n    int64_t highest = known_term();\n    bool deposed = was_leading && highest > term_led;\n    if ((rejoining || deposed) && leader == p->self) {\n        for (size_t i = 0; i < p->peer_count; i++) {\n            comm_heartbeat h = comm_heard(i);\n            if (i != p->self && h.leads && h.term >= highest && now - h.seen <= 3 * @HB@) {\n                leader = i;\n                break;\n            }\n        }\n    }\n    if (leader == p->self) {\n        size_t heard = 0;\n        for (size_t k = 0; k < n; k++)\n            if (candidates[k] == p->self || now - comm_heard(candidates[k]).seen <= @LEASE@)\n                heard++;\n        if (2 * heard <= n) {\n            leading = false;\n            rejoining = 1;\n            fenced = true;\n            regained = -1;\n            if (*last != ELECT_FENCED) {\n                char counted[48];\n                snprintf(counted, sizeof counted, \"%lu of %lu\", (unsigned long)heard, (unsigned long)n);\n                *last = ELECT_FENCED;\n                semo_trace(\"fenced\", \"heard\", counted, NULL);\n            }\n            /* Heartbeats heard wake nothing: ask again at the next firing\n             * of the period, as the simulator does at a waiting election. */\n            wake_at(now + 1);\n            return -1;\n        }\n        if (fenced) {\n            /* A majority again: listen before claiming, so that the\n             * heartbeat of a robot leading meanwhile has come. */\n            if (regained < 0)\n                regained = now;\n            if (now - regained < @LISTEN@) {\n                wake_at(now + 1);\n                return -1;\n            }\n            fenced = false;\n        }\n        rejoining = 0;\n    } else {\n        fenced = false; /* it follows a live robot: it has heard the team again */\n        regained = -1;\n    }\n    if (leader == p->self && (!was_leading || deposed)) {\n        /* It begins to lead (again, when deposed): under a new term. */\n        term_known = term_known < @TERM_MAX@LL ? term_known + 1 : term_known;\n        term_led = term_known;\n    }\n    leading = leader == p->self;\n    if ((long)leader != *last) {\n        *last = (long)leader;\n        semo_trace(\"leader\", \"leader\", p->peers[leader].robot, NULL);\n    }\n    return leading;\n}\n";
+const ELECTED: Template = template!(
+    "control/elected.c.in",
+    ["hb", "listen", "lease", "term_max"]
+);
 
 /// At each heartbeat of a member of its team's group (group services,
 /// `docs/groups.md`): its rank among the live members (formation order) and
@@ -98,22 +219,25 @@ fn group_update(m: &ControlMachine, peers: &Peers) -> String {
     if m.group.is_empty() {
         return String::new();
     }
-    format!(
-        "        static const size_t members[] = {{{list}}};\n        const semo_program_desc *p = semo_program();\n        int rank = 0, size = 0;\n        for (size_t k = 0; k < {count}; k++) {{\n            comm_heartbeat h = comm_heard(members[k]);\n            int64_t seen = h.seen > semo_joined_ms() ? h.seen : semo_joined_ms();\n            if (members[k] != p->self && last_heartbeat - seen > 3 * {hb})\n                continue; /* failed: silent for three heartbeats */\n            if (members[k] == p->self)\n                rank = size;\n            size++;\n        }}\n        semo_group_set(rank, size);\n",
-        list = peers.locals(&m.group),
-        count = m.group.len(),
-        hb = m.heartbeat_ms,
+    fill(
+        &GROUP_UPDATE,
+        &[
+            ("list", &peers.locals(&m.group)),
+            ("count", &m.group.len()),
+            ("hb", &m.heartbeat_ms),
+        ],
     )
 }
 
 /// Counted groups (`StateKind::GroupAllocate`): the rule of
 /// `refine::counted_allocation` over the live members, as the simulator's
 /// `GroupAllocate` applies it.
-const GROUP_OF_C: &str = "/* Counted groups: this robot's group among `groups` (declaration order) from\n * the live `members` (peer indices, formation order; a member is alive when it\n * is this robot or was heard from within three heartbeats since this robot\n * joined). The live members in formation order fill the minimums in\n * declaration order; a spare goes to `others` (-1) when the statement has one,\n * else to the groups round-robin. `*alive`: how many were counted. */\nstatic long group_of(const size_t *members, size_t n, const size_t *mins, size_t groups, bool has_others, size_t *alive)\n{\n    const semo_program_desc *p = semo_program();\n    int64_t now = semo_now_ms();\n    size_t position = 0, live = 0;\n    for (size_t k = 0; k < n; k++) {\n        comm_heartbeat h = comm_heard(members[k]);\n        int64_t seen = h.seen > semo_joined_ms() ? h.seen : semo_joined_ms();\n        if (members[k] != p->self && now - seen > 3 * @HB@)\n            continue; /* lost: silent for three heartbeats */\n        if (members[k] == p->self)\n            position = live;\n        live++;\n    }\n    *alive = live;\n    size_t filled = 0;\n    for (size_t g = 0; g < groups; g++) {\n        filled += mins[g];\n        if (position < filled)\n            return (long)g;\n    }\n    if (has_others || groups == 0)\n        return -1;\n    return (long)((position - filled) % groups);\n}\n\n";
+const GROUP_OF: Template = template!("control/group_of.c.in", ["hb"]);
 
-/// This robot's battery level for its heartbeats: the scenario's (in
+/// `leading` and the terms a robot's heartbeats say, and `own_battery`:
+/// this robot's battery level for its heartbeats, the scenario's (in
 /// simulation), else unknown (-1).
-const OWN_BATTERY_C: &str = "/* Whether the last election this robot decided named it (its heartbeats say so). */\nstatic bool leading;\n/* Terms (docs/groups.md): the highest this robot knows (heard, or its own),\n * and the one it leads under while `leading`. */\nstatic int64_t term_known, term_led;\n\n/* The highest term known now: its own, or one a heartbeat said. */\nstatic int64_t known_term(void)\n{\n    int64_t heard = comm_highest_term();\n    if (heard > term_known)\n        term_known = heard;\n    return term_known;\n}\n\n/* A term (at most 10^15) as decimal digits: not every target's printf\n * has %lld. */\nstatic void term_text(int64_t t, char out[24])\n{\n    char digits[24];\n    int n = 0;\n    do {\n        digits[n++] = (char)('0' + t % 10);\n        t /= 10;\n    } while (t > 0 && n < 23);\n    for (int i = 0; i < n; i++)\n        out[i] = digits[n - 1 - i];\n    out[n] = '\\0';\n}\n\n/* This robot's battery level for its heartbeats: the scenario's in\n * simulation, else unknown (-1). */\nstatic long own_battery(void)\n{\n#ifdef SEMO_SIM\n    long long level;\n    if (semo_sim_battery(&level))\n        return (long)level;\n#endif\n    return -1;\n}\n\n";
+const LEADING: Template = template!("control/leading.c.in", []);
 
 pub fn control_task(program: &RobotProgram, words: &Words, peers: &Peers, header: &str) -> String {
     let m = &program.control;
@@ -187,11 +311,7 @@ pub fn control_task(program: &RobotProgram, words: &Words, peers: &Peers, header
         out,
         "#define REGION_COUNT {regions}\n#define MARK_COUNT {marks}"
     );
-    out.push_str(
-        "typedef struct {\n    int service;        /* running service machine, -1 when none */\n    int pc;             /* its current state */\n    int phase;          /* progress inside a state that takes several firings */\n    int action;         /* current strategy action */\n    bool done;\n    int64_t started;    /* when the service started (mode timeouts) */\n    int64_t pass_start; /* when the current pass started (repeat periods) */\n    int64_t timeout_ms; /* from `set(..., timeout = P)`, 0 for none */\n    int64_t mark[MARK_COUNT];\n    const char *plan;\n} region;\n\n",
-    );
-    out.push_str("static region regions[REGION_COUNT];\nstatic int current_mode = -1;\nstatic int pending_mode = -1;\n\n");
-    out.push_str("/* When the machine next needs a firing without an event (data on its\n * channels, a task's state changed): the earliest deadline a waiting state\n * named in this firing. Waits on events name none: the task sleeps until one\n * comes (semo_next_firing). */\nstatic int64_t next_wake;\n\nstatic void wake_at(int64_t at)\n{\n    if (at < next_wake)\n        next_wake = at;\n}\n\n");
+    out.push_str(REGION.text);
 
     // The machine first, so that only the helpers and port tables it uses
     // are written (unused static functions and arrays fail -Werror).
@@ -288,7 +408,7 @@ pub(super) fn expr(e: &Expr, words: &Words) -> String {
 /// keeps `throw_event` as it always was.
 fn emit_catch_event(out: &mut String, program: &RobotProgram, throws: bool, broadcasts: bool) {
     let m = &program.control;
-    out.push_str("/* The current mode's `catch` of `event` asks for its mode change, unless one\n * is asked for already: whether it did. `from`: the robot that broadcast the\n * event, or NULL for this robot's own throw. */\nstatic bool catch_event(const char *event, const char *from)\n{\n");
+    out.push_str(CATCH_EVENT_HEAD.text);
     emit_catches(
         out,
         program,
@@ -296,13 +416,13 @@ fn emit_catch_event(out: &mut String, program: &RobotProgram, throws: bool, broa
     );
     out.push_str("    return false;\n}\n\n");
     if throws {
-        out.push_str("/* `throw`: asks for the mode change that the current mode's `catch` names. */\nstatic void throw_event(const char *event)\n{\n    semo_trace(\"throw\", \"name\", event, NULL);\n    catch_event(event, NULL);\n}\n\n");
+        out.push_str(THROW_EVENT.text);
     }
     if broadcasts {
-        out.push_str("/* `throw E broadcast`, once the others of the group are told: acts here as\n * `throw E` does. */\nstatic void throw_broadcast(const char *event)\n{\n    semo_trace(\"throw\", \"name\", event, \"broadcast\", \"true\", NULL);\n    catch_event(event, NULL);\n}\n\n");
+        out.push_str(THROW_BROADCAST.text);
     }
     if !m.events_heard.is_empty() {
-        out.push_str("/* At the start of a firing, in its mode: each broadcast event received since\n * the last one, in order, handled as this robot's own throw would be; one\n * the mode does not catch (or after a caught one) is dropped. */\nstatic void take_events(void)\n{\n    size_t from;\n    const char *event;\n    while (comm_event_take(&from, &event)) {\n        const char *robot = semo_program()->peers[from].robot;\n        if (!catch_event(event, robot))\n            semo_trace(\"drop\", \"from\", robot, \"name\", event, \"reason\", \"not caught\", NULL);\n    }\n}\n\n");
+        out.push_str(TAKE_EVENTS.text);
     }
 }
 
@@ -398,7 +518,7 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
     if broadcasts {
         emit_catch_event(out, program, uses("throw_event"), uses("throw_broadcast"));
     } else if uses("throw_event") {
-        out.push_str("/* `throw`: asks for the mode change that the current mode's `catch` names. */\nstatic void throw_event(const char *event)\n{\n    semo_trace(\"throw\", \"name\", event, NULL);\n");
+        out.push_str(THROW_EVENT_HEAD.text);
         emit_catches(
             out,
             program,
@@ -408,29 +528,30 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
     }
 
     if m.heartbeat {
-        out.push_str(OWN_BATTERY_C);
+        out.push_str(LEADING.text);
     }
     if uses("elected") {
-        out.push_str(
-            &ELECTION_C
-                .replace("@HB@", &m.heartbeat_ms.to_string())
-                .replace("@LISTEN@", &listen_ms(m.heartbeat_ms).to_string())
-                .replace("@LEASE@", &lease_ms(m.heartbeat_ms).to_string())
-                .replace("@TERM_MAX@", &TERM_MAX.to_string()),
-        );
-        out.push('\n');
+        out.push_str(&fill(
+            &ELECTED,
+            &[
+                ("hb", &m.heartbeat_ms),
+                ("listen", &listen_ms(m.heartbeat_ms)),
+                ("lease", &lease_ms(m.heartbeat_ms)),
+                ("term_max", &TERM_MAX),
+            ],
+        ));
     }
 
     if uses("group_of") {
-        out.push_str(&GROUP_OF_C.replace("@HB@", &m.heartbeat_ms.to_string()));
+        out.push_str(&fill(&GROUP_OF, &[("hb", &m.heartbeat_ms)]));
     }
 
     if uses("drop_unled") {
-        out.push_str(&DROP_UNLED_C.replace("@REASON@", &c::string(UNLED_REASON)));
+        out.push_str(&fill(&DROP_UNLED, &[("reason", &c::string(UNLED_REASON))]));
     }
 
     if uses("request") {
-        out.push_str("/* Writes a service request to the task's queue and starts one firing of it. */\nstatic bool request(int port, const char *task, const char *service, int argc, const semo_value *const *args)\n{\n    semo_request req;\n    memset(&req, 0, sizeof req);\n    strncpy(req.service, service, sizeof req.service - 1);\n    for (int i = 0; i < argc && i < SEMO_MAX_ARGS; i++)\n        req.args[i] = *args[i];\n    req.argc = argc < SEMO_MAX_ARGS ? argc : SEMO_MAX_ARGS;\n    if (UFControl_GetTaskState(task) != SEMO_TASK_IDLE)\n        return false;\n    /* The task is idle: a request still queued was stopped before its task\n     * fired (a mode change, a timeout) and must not run now. */\n    semo_request stale;\n    while (UFPort_GetNumOfAvailableData(port) > 0)\n        UFPort_ReadFromQueue(port, &stale, sizeof stale);\n    if (UFPort_WriteToQueue(port, &req, sizeof req) == 0)\n        return false;\n    UFControl_CallTask(task);\n    return true;\n}\n\n");
+        out.push_str(REQUEST.text);
     }
 }
 
@@ -470,6 +591,20 @@ fn emit_drop_unled(out: &mut String, program: &RobotProgram, receives: &[usize])
     out.push_str("        }\n");
 }
 
+/// What the C of every state reads: the program, its words and peers, the
+/// state's line in the mission and the state after it.
+#[derive(Clone, Copy)]
+struct StateCx<'a> {
+    program: &'a RobotProgram,
+    words: &'a Words,
+    peers: &'a Peers,
+    next: usize,
+    line: u32,
+}
+
+/// One state of a region's service: a `case` of its `switch`, written by
+/// the function of its kind (one per `StateKind`, in the order of the
+/// simulator's step).
 fn emit_state(
     out: &mut String,
     program: &RobotProgram,
@@ -478,326 +613,519 @@ fn emit_state(
     pc: usize,
     state: &State,
 ) {
-    let m = &program.control;
     let _ = writeln!(
         out,
         "    case {pc}: /* line {}: {} */",
         state.line,
         c::comment(&state.text)
     );
-    let next = pc + 1;
+    let cx = StateCx {
+        program,
+        words,
+        peers,
+        next: pc + 1,
+        line: state.line,
+    };
     match &state.kind {
         StateKind::Receive {
             messages,
             timeout_ms,
             mark,
-        } => {
-            let ready: Vec<String> = messages
-                .iter()
-                .map(|i| format!("UFPort_GetNumOfAvailableData(in_port[{i}]) > 0"))
-                .collect();
-            let ready = ready.join(" && ");
-            match timeout_ms {
-                // `receive(...), timeout = P`: go on without the values after P.
-                Some(t) => {
-                    let _ = writeln!(
-                        out,
-                        "        if (r->phase == 0) {{\n            r->mark[{mark}] = semo_now_ms();\n            r->phase = 1;\n        }}\n        if (!({ready})) {{\n            if (semo_now_ms() - r->mark[{mark}] <= {t}) {{\n                wake_at(r->mark[{mark}] + {t} + 1);\n                return STEP_WAIT;\n            }}\n            semo_trace(\"timeout\", \"statement\", \"receive\", NULL);\n            r->phase = 0;\n            r->pc = {next};\n            return STEP_NEXT;\n        }}\n        r->phase = 0;"
-                    );
-                }
-                None => {
-                    let _ = writeln!(
-                        out,
-                        "        if (!({ready}))\n            return STEP_WAIT;"
-                    );
-                }
-            }
-            for &i in messages {
-                let s = m.incoming[i].slot;
-                let _ = writeln!(
-                    out,
-                    "        {{\n            semo_value v;\n            if (UFPort_ReadFromQueue(in_port[{i}], &v, sizeof v) > 0)\n                store({s}, &v);\n        }}"
-                );
-            }
-            let _ = writeln!(out, "        r->pc = {next};\n        return STEP_NEXT;");
-        }
-        StateKind::Send { items } => {
-            for item in items {
-                let value = operand(&item.value, words);
-                if let Some(s) = item.store {
-                    let _ = writeln!(out, "        store({s}, {value});");
-                }
-                let sent = match item.store {
-                    Some(s) => format!("&slot[{s}]"),
-                    None => value,
-                };
-                let _ = writeln!(
-                    out,
-                    "        semo_port_send(out_port[{}], {sent}, sizeof(semo_value)); /* {} */",
-                    item.message,
-                    c::comment(&m.outgoing[item.message].key)
-                );
-                if let Some(group) = item.own_group {
-                    // Its own publication is the latest its subscription sees.
-                    let _ = writeln!(
-                        out,
-                        "        UFMulticast_Write({}, {sent}, sizeof(semo_value));",
-                        c::string(&m.subscribed[group])
-                    );
-                }
-            }
-            let _ = writeln!(out, "        r->pc = {next};\n        return STEP_NEXT;");
-        }
-        StateKind::Subscribe { group, slot } => {
-            let _ = writeln!(
-                out,
-                "        {{\n            semo_value v;\n            if (UFMulticast_Read({}, &v, sizeof v) > 0)\n                store({slot}, &v);\n        }}\n        r->pc = {next};\n        return STEP_NEXT;",
-                c::string(&m.subscribed[*group])
-            );
-        }
+        } => emit_receive(out, &cx, messages, timeout_ms, mark),
+        StateKind::Send { items } => emit_send(out, &cx, items),
+        StateKind::Subscribe { group, slot } => emit_subscribe(out, &cx, group, slot),
         StateKind::Throw {
             event,
             broadcast: None,
-        } => {
-            let _ = writeln!(
-                out,
-                "        throw_event({});\n        r->pc = {next};\n        return STEP_NEXT;",
-                c::string(event)
-            );
-        }
+        } => emit_throw(out, &cx, event),
         StateKind::Throw {
             event,
             broadcast: Some(messages),
-        } => {
-            // The others of the group are told before the event acts here
-            // (a caught event ends the firing's steps).
-            for &message in messages {
-                let _ = writeln!(
-                    out,
-                    "        {{\n            semo_value told;\n            semo_value_set(&told, {});\n            semo_port_send(out_port[{message}], &told, sizeof told); /* {} to {} */\n        }}",
-                    c::string(event),
-                    c::comment(&m.outgoing[message].key),
-                    c::comment(&m.outgoing[message].to_team)
-                );
-            }
-            let _ = writeln!(
-                out,
-                "        throw_broadcast({});\n        r->pc = {next};\n        return STEP_NEXT;",
-                c::string(event)
-            );
-        }
+        } => emit_throw_broadcast(out, &cx, event, messages),
         StateKind::Call {
             service,
             task,
             args,
             timeout_ms,
             mark,
-        } => {
-            let port = request_index(program, task);
-            // The called task going idle wakes the control task; a timeout
-            // is a deadline of its own.
-            let wake = timeout_ms.map_or(String::new(), |t| {
-                format!("\n            wake_at(r->mark[{mark}] + {t} + 1);")
-            });
-            let _ = writeln!(
-                out,
-                "        if (r->phase == 0) {{\n            if (!request(request_port[{port}], {task}, {service}, {argc}, {args}))\n                return STEP_WAIT;\n            r->mark[{mark}] = semo_now_ms();\n            r->phase = 1;{wake}\n            return STEP_WAIT;\n        }}",
-                task = c::string(task),
-                service = c::string(service),
-                argc = args.len(),
-                args = args_array(args, words),
-            );
-            if let Some(t) = timeout_ms {
-                let _ = writeln!(
-                    out,
-                    "        wake_at(r->mark[{mark}] + {t} + 1);\n        if (semo_now_ms() - r->mark[{mark}] > {t}) {{\n            UFControl_StopTask({});\n            semo_trace(\"timeout\", \"service\", {}, NULL);\n        }} else",
-                    c::string(task),
-                    c::string(service)
-                );
-            }
-            let _ = writeln!(
-                out,
-                "        if (UFControl_GetTaskState({}) != SEMO_TASK_IDLE)\n            return STEP_WAIT;\n        r->phase = 0;\n        r->pc = {next};\n        return STEP_NEXT;",
-                c::string(task)
-            );
-        }
+        } => emit_call(out, &cx, service, task, args, timeout_ms, mark),
         StateKind::RunActions {
             service,
             machine,
             args,
             timeout_ms,
             mark,
-        } => {
-            let am = &m.actions[*machine];
-            let _ = writeln!(out, "        if (r->phase == 0) {{");
-            for (i, slot) in am.arguments.iter().enumerate() {
-                if let Some(arg) = args.get(i) {
-                    let _ = writeln!(out, "            store({slot}, {});", operand(arg, words));
-                }
-            }
-            let _ = writeln!(
-                out,
-                "            r->action = {};\n            r->phase = 1;\n            r->mark[{mark}] = semo_now_ms();\n            semo_trace(\"actions_start\", \"service\", {}, NULL);\n        }}",
-                am.initial,
-                c::string(service)
-            );
-            if let Some(t) = timeout_ms {
-                let _ = writeln!(
-                    out,
-                    "        wake_at(r->mark[{mark}] + {t} + 1);\n        if (semo_now_ms() - r->mark[{mark}] > {t}) {{\n            semo_trace(\"timeout\", \"service\", {}, NULL);\n            r->phase = 0;\n            r->pc = {next};\n            return STEP_NEXT;\n        }}",
-                    c::string(service)
-                );
-            }
-            // An action taken (STEP_NEXT) enters the next action at the next
-            // firing, as in the simulator, where a firing that progressed is
-            // followed by the next: named here, since nothing else may wake
-            // the machine (an action whose commands' task just went idle).
-            let _ = writeln!(
-                out,
-                "        {{\n            int acted = actions_{machine}(r);\n            if (acted == STEP_NEXT)\n                wake_at(semo_now_ms());\n            if (acted != STEP_DONE)\n                return STEP_WAIT;\n        }}\n        semo_trace(\"actions_end\", \"service\", {}, NULL);\n        r->phase = 0;\n        r->pc = {next};\n        return STEP_NEXT;",
-                c::string(service)
-            );
-        }
+        } => emit_run_actions(out, &cx, service, machine, args, timeout_ms, mark),
         StateKind::LeaderBranch {
             candidates,
             algorithm,
             others_at,
             receives,
-        } => {
-            let list = peers.locals(candidates);
-            let algorithm = match algorithm {
-                LeaderAlgorithm::LowestId => "ELECT_LOWEST_ID",
-                LeaderAlgorithm::HighestBattery => "ELECT_HIGHEST_BATTERY",
-                LeaderAlgorithm::Bully => "ELECT_BULLY",
-            };
-            let _ = writeln!(
-                out,
-                "    {{\n        static const size_t candidates[] = {{{}}};\n        static long leader = -1; /* the last leader seen (control thread only) */{led}\n        int chosen = elected(candidates, {}, {algorithm}, &leader);\n        if (chosen < 0)\n            return STEP_WAIT; /* still listening */",
-                list,
-                candidates.len(),
-                // The leader before this election, for `emit_drop_unled`.
-                led = if receives.is_empty() {
-                    ""
-                } else {
-                    "\n        long led = leader;"
-                },
-            );
-            emit_drop_unled(out, program, receives);
-            let _ = writeln!(
-                out,
-                "        r->pc = chosen ? {next} : {others_at};\n        return STEP_NEXT;\n    }}"
-            );
-        }
+        } => emit_leader_branch(out, &cx, candidates, algorithm, others_at, receives),
         StateKind::GroupAllocate {
             members,
             groups,
             others_at,
-        } => {
-            let join = |items: Vec<String>| items.join(", ");
-            let members_list = peers.locals(members);
-            let mins = join(groups.iter().map(|g| g.min.to_string()).collect());
-            let names = join(groups.iter().map(|g| c::string(&g.name)).collect());
-            let at = join(groups.iter().map(|g| g.at.index().to_string()).collect());
-            let others = others_at.map_or(next, |o| o.index());
-            let _ = writeln!(
-                out,
-                "    {{\n        static const size_t members[] = {{{members_list}}};\n        static const size_t mins[] = {{{mins}}};\n        static const char *const names[] = {{{names}}};\n        static const int at[] = {{{at}}};\n        static long last = -2; /* the group last given, -1 others (control thread only) */\n        size_t alive;\n        long group = group_of(members, {}, mins, {}, {}, &alive);\n        if (group != last) {{\n            char counted[24];\n            snprintf(counted, sizeof counted, \"%lu\", (unsigned long)alive);\n            last = group;\n            semo_trace(\"allocated\", \"name\", group < 0 ? \"others\" : names[group], \"alive\", counted, NULL);\n        }}\n        r->pc = group < 0 ? {others} : at[group];\n        return STEP_NEXT;\n    }}",
-                members.len(),
-                groups.len(),
-                others_at.is_some(),
-            );
-        }
+        } => emit_group_allocate(out, &cx, members, groups, others_at),
         StateKind::GroupSync {
             members,
             point,
             timeout_ms,
             mark,
-        } => {
-            let list = peers.locals(members);
-            let hb = m.heartbeat_ms;
-            let _ = writeln!(
-                out,
-                "    {{\n        static const size_t members[] = {{{list}}};\n        static long pass; /* how often this robot reached the statement (control thread only) */\n        const semo_program_desc *p = semo_program();\n        int64_t now = semo_now_ms();\n        if (r->phase == 0) {{\n            semo_value arrived;\n            char text[48];\n            pass++;\n            r->mark[{mark}] = now;\n            r->phase = 1;\n            snprintf(text, sizeof text, \"{offset} %ld\", pass);\n            semo_value_set(&arrived, text);\n            semo_comm_send({team}, SEMO_MSG_SEND, {key}, &arrived);\n        }}\n        int waiting = 0;\n        for (size_t k = 0; k < {count}; k++) {{\n            size_t peer = members[k];\n            comm_heartbeat h = comm_heard(peer);\n            if (peer == p->self || comm_sync_arrived(peer, {point}) >= pass || now - h.seen > 3 * {hb})\n                continue; /* here, arrived, or known dead */\n            waiting++;\n            wake_at(h.seen + 3 * {hb} + 1);\n        }}\n        if (waiting > 0 && now - r->mark[{mark}] <= {timeout_ms}) {{\n            wake_at(r->mark[{mark}] + {timeout_ms} + 1);\n            return STEP_WAIT;\n        }}\n        if (waiting > 0)\n            semo_trace(\"timeout\", \"statement\", \"GroupSync\", NULL);\n        else\n            semo_trace(\"group_sync\", \"line\", \"{line}\", NULL);\n        r->phase = 0;\n        r->pc = {next};\n        return STEP_NEXT;\n    }}",
-                count = members.len(),
-                offset = m.sync_points[*point],
-                team = c::string(&program.team),
-                key = c::string(&super::files::sync_key(program)),
-                line = state.line,
-            );
-        }
-        StateKind::Branch { condition, else_to } => {
-            let _ = writeln!(
-                out,
-                "        r->pc = {} ? {next} : {else_to};\n        return STEP_NEXT;",
-                expr(condition, words)
-            );
-        }
-        StateKind::Jump { to } => {
-            let _ = writeln!(out, "        r->pc = {to};\n        return STEP_NEXT;");
-        }
+        } => emit_group_sync(out, &cx, members, point, timeout_ms, mark),
+        StateKind::Branch { condition, else_to } => emit_branch(out, &cx, condition, else_to),
+        StateKind::Jump { to } => emit_jump(out, &cx, to),
         StateKind::LoopHead {
             condition,
             exit_to,
             mark,
-        } => {
-            if let Some(cond) = condition {
-                let _ = writeln!(
-                    out,
-                    "        if (!{}) {{\n            r->pc = {exit_to};\n            return STEP_NEXT;\n        }}",
-                    expr(cond, words)
-                );
-            }
-            let _ = writeln!(
-                out,
-                "        r->mark[{mark}] = semo_now_ms();\n        r->pc = {next};\n        return STEP_NEXT;"
-            );
-        }
+        } => emit_loop_head(out, &cx, condition, exit_to, mark),
         StateKind::LoopTail {
             period_ms,
             mark,
             to,
-        } => {
-            match period_ms {
-                Some(p) => {
-                    let _ = writeln!(
-                        out,
-                        "        if (semo_now_ms() - r->mark[{mark}] < {p}) {{\n            wake_at(r->mark[{mark}] + {p});\n            return STEP_WAIT;\n        }}"
-                    );
-                    let _ = writeln!(out, "        r->pc = {to};\n        return STEP_NEXT;");
-                }
-                // Without a period, one iteration per firing.
-                None => {
-                    let _ = writeln!(
-                        out,
-                        "        r->pc = {to};\n        wake_at(semo_now_ms());\n        return STEP_WAIT;"
-                    );
-                }
-            }
-        }
+        } => emit_loop_tail(out, &cx, period_ms, mark, to),
         StateKind::Repeat {
             period_ms,
             condition,
             forever,
-        } => {
-            if let Some(cond) = condition {
-                let _ = writeln!(
-                    out,
-                    "        if (!{})\n            return STEP_DONE;",
-                    expr(cond, words)
-                );
-            }
-            if let Some(p) = period_ms {
-                let _ = writeln!(
-                    out,
-                    "        if (semo_now_ms() - r->pass_start < {p}) {{\n            wake_at(r->pass_start + {p});\n            return STEP_WAIT;\n        }}\n        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        return STEP_NEXT;"
-                );
-            } else if *forever || condition.is_some() {
-                // The next pass starts at the next firing.
-                out.push_str("        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        wake_at(semo_now_ms());\n        return STEP_WAIT;\n");
-            } else {
-                out.push_str("        return STEP_DONE;\n");
-            }
+        } => emit_repeat(out, &cx, period_ms, condition, forever),
+    }
+}
+
+/// `receive(...)`: waits until every message has come (or its timeout), then stores them.
+fn emit_receive(
+    out: &mut String,
+    cx: &StateCx,
+    messages: &[usize],
+    timeout_ms: &Option<i64>,
+    mark: &usize,
+) {
+    let StateCx { program, next, .. } = *cx;
+    let m = &program.control;
+    let ready: Vec<String> = messages
+        .iter()
+        .map(|i| format!("UFPort_GetNumOfAvailableData(in_port[{i}]) > 0"))
+        .collect();
+    let ready = ready.join(" && ");
+    match timeout_ms {
+        // `receive(...), timeout = P`: go on without the values after P.
+        Some(t) => {
+            out.push_str(&fill(
+                &RECEIVE_TIMEOUT,
+                &[
+                    ("mark", &mark),
+                    ("ready", &ready),
+                    ("t", &t),
+                    ("next", &next),
+                ],
+            ));
         }
+        None => {
+            let _ = writeln!(
+                out,
+                "        if (!({ready}))\n            return STEP_WAIT;"
+            );
+        }
+    }
+    for &i in messages {
+        let s = m.incoming[i].slot;
+        let _ = writeln!(
+            out,
+            "        {{\n            semo_value v;\n            if (UFPort_ReadFromQueue(in_port[{i}], &v, sizeof v) > 0)\n                store({s}, &v);\n        }}"
+        );
+    }
+    let _ = writeln!(out, "        r->pc = {next};\n        return STEP_NEXT;");
+}
+
+/// `send`/`publish`: each value to its message's port (and its own group).
+fn emit_send(out: &mut String, cx: &StateCx, items: &[SendItem]) {
+    let StateCx {
+        program,
+        words,
+        next,
+        ..
+    } = *cx;
+    let m = &program.control;
+    for item in items {
+        let value = operand(&item.value, words);
+        if let Some(s) = item.store {
+            let _ = writeln!(out, "        store({s}, {value});");
+        }
+        let sent = match item.store {
+            Some(s) => format!("&slot[{s}]"),
+            None => value,
+        };
+        let _ = writeln!(
+            out,
+            "        semo_port_send(out_port[{}], {sent}, sizeof(semo_value)); /* {} */",
+            item.message,
+            c::comment(&m.outgoing[item.message].key)
+        );
+        if let Some(group) = item.own_group {
+            // Its own publication is the latest its subscription sees.
+            let _ = writeln!(
+                out,
+                "        UFMulticast_Write({}, {sent}, sizeof(semo_value));",
+                c::string(&m.subscribed[group])
+            );
+        }
+    }
+    let _ = writeln!(out, "        r->pc = {next};\n        return STEP_NEXT;");
+}
+
+/// `subscribe`: the group's latest value, if any.
+fn emit_subscribe(out: &mut String, cx: &StateCx, group: &usize, slot: &SlotId) {
+    let StateCx { program, next, .. } = *cx;
+    let m = &program.control;
+    let _ = writeln!(
+        out,
+        "        {{\n            semo_value v;\n            if (UFMulticast_Read({}, &v, sizeof v) > 0)\n                store({slot}, &v);\n        }}\n        r->pc = {next};\n        return STEP_NEXT;",
+        c::string(&m.subscribed[*group])
+    );
+}
+
+/// `throw E`.
+fn emit_throw(out: &mut String, cx: &StateCx, event: &str) {
+    let StateCx { next, .. } = *cx;
+    let _ = writeln!(
+        out,
+        "        throw_event({});\n        r->pc = {next};\n        return STEP_NEXT;",
+        c::string(event)
+    );
+}
+
+/// `throw E broadcast`: the others of the group told first.
+fn emit_throw_broadcast(out: &mut String, cx: &StateCx, event: &str, messages: &[usize]) {
+    let StateCx { program, next, .. } = *cx;
+    let m = &program.control;
+    // The others of the group are told before the event acts here
+    // (a caught event ends the firing's steps).
+    for &message in messages {
+        let _ = writeln!(
+            out,
+            "        {{\n            semo_value told;\n            semo_value_set(&told, {});\n            semo_port_send(out_port[{message}], &told, sizeof told); /* {} to {} */\n        }}",
+            c::string(event),
+            c::comment(&m.outgoing[message].key),
+            c::comment(&m.outgoing[message].to_team)
+        );
+    }
+    let _ = writeln!(
+        out,
+        "        throw_broadcast({});\n        r->pc = {next};\n        return STEP_NEXT;",
+        c::string(event)
+    );
+}
+
+/// A service call: a request to its task, then waiting for the task to go idle (or the timeout).
+fn emit_call(
+    out: &mut String,
+    cx: &StateCx,
+    service: &str,
+    task: &str,
+    args: &[Operand],
+    timeout_ms: &Option<i64>,
+    mark: &usize,
+) {
+    let StateCx {
+        program,
+        words,
+        next,
+        ..
+    } = *cx;
+    let port = request_index(program, task);
+    // The called task going idle wakes the control task; a timeout
+    // is a deadline of its own.
+    let wake = timeout_ms.map_or(String::new(), |t| {
+        format!("\n            wake_at(r->mark[{mark}] + {t} + 1);")
+    });
+    out.push_str(&fill(
+        &CALL_REQUEST,
+        &[
+            ("port", &port),
+            ("task", &c::string(task)),
+            ("service", &c::string(service)),
+            ("argc", &args.len()),
+            ("args", &args_array(args, words)),
+            ("mark", &mark),
+            ("wake", &wake),
+        ],
+    ));
+    if let Some(t) = timeout_ms {
+        out.push_str(&fill(
+            &CALL_TIMEOUT,
+            &[
+                ("mark", &mark),
+                ("t", &t),
+                ("task", &c::string(task)),
+                ("service", &c::string(service)),
+            ],
+        ));
+    }
+    out.push_str(&fill(
+        &CALL_WAIT,
+        &[("task", &c::string(task)), ("next", &next)],
+    ));
+}
+
+/// A strategy's service: its action machine run until it is done (or the timeout).
+fn emit_run_actions(
+    out: &mut String,
+    cx: &StateCx,
+    service: &str,
+    machine: &usize,
+    args: &[Operand],
+    timeout_ms: &Option<i64>,
+    mark: &usize,
+) {
+    let StateCx {
+        program,
+        words,
+        next,
+        ..
+    } = *cx;
+    let m = &program.control;
+    let am = &m.actions[*machine];
+    let _ = writeln!(out, "        if (r->phase == 0) {{");
+    for (i, slot) in am.arguments.iter().enumerate() {
+        if let Some(arg) = args.get(i) {
+            let _ = writeln!(out, "            store({slot}, {});", operand(arg, words));
+        }
+    }
+    out.push_str(&fill(
+        &ACTIONS_ENTER,
+        &[
+            ("initial", &am.initial),
+            ("mark", &mark),
+            ("service", &c::string(service)),
+        ],
+    ));
+    if let Some(t) = timeout_ms {
+        out.push_str(&fill(
+            &ACTIONS_TIMEOUT,
+            &[
+                ("mark", &mark),
+                ("t", &t),
+                ("service", &c::string(service)),
+                ("next", &next),
+            ],
+        ));
+    }
+    // An action taken (STEP_NEXT) enters the next action at the next
+    // firing, as in the simulator, where a firing that progressed is
+    // followed by the next: named here, since nothing else may wake
+    // the machine (an action whose commands' task just went idle).
+    out.push_str(&fill(
+        &ACTIONS_RUN,
+        &[
+            ("machine", &machine),
+            ("service", &c::string(service)),
+            ("next", &next),
+        ],
+    ));
+}
+
+/// `leader(...)`: the election, then the leader's block or the others'.
+fn emit_leader_branch(
+    out: &mut String,
+    cx: &StateCx,
+    candidates: &[usize],
+    algorithm: &LeaderAlgorithm,
+    others_at: &StateId,
+    receives: &[usize],
+) {
+    let StateCx {
+        program,
+        peers,
+        next,
+        ..
+    } = *cx;
+    let list = peers.locals(candidates);
+    let algorithm = match algorithm {
+        LeaderAlgorithm::LowestId => "ELECT_LOWEST_ID",
+        LeaderAlgorithm::HighestBattery => "ELECT_HIGHEST_BATTERY",
+        LeaderAlgorithm::Bully => "ELECT_BULLY",
+    };
+    out.push_str(&fill(
+        &LEADER_BRANCH,
+        &[
+            ("list", &list),
+            ("count", &candidates.len()),
+            ("algorithm", &algorithm),
+            // The leader before this election, for `emit_drop_unled`.
+            (
+                "led",
+                &if receives.is_empty() {
+                    ""
+                } else {
+                    "\n        long led = leader;"
+                },
+            ),
+        ],
+    ));
+    emit_drop_unled(out, program, receives);
+    let _ = writeln!(
+        out,
+        "        r->pc = chosen ? {next} : {others_at};\n        return STEP_NEXT;\n    }}"
+    );
+}
+
+/// Counted groups: this robot's group among the live members.
+fn emit_group_allocate(
+    out: &mut String,
+    cx: &StateCx,
+    members: &[usize],
+    groups: &[CountedGroup],
+    others_at: &Option<StateId>,
+) {
+    let StateCx { peers, next, .. } = *cx;
+    let join = |items: Vec<String>| items.join(", ");
+    let members_list = peers.locals(members);
+    let mins = join(groups.iter().map(|g| g.min.to_string()).collect());
+    let names = join(groups.iter().map(|g| c::string(&g.name)).collect());
+    let at = join(groups.iter().map(|g| g.at.index().to_string()).collect());
+    let others = others_at.map_or(next, |o| o.index());
+    out.push_str(&fill(
+        &GROUP_ALLOCATE,
+        &[
+            ("members_list", &members_list),
+            ("mins", &mins),
+            ("names", &names),
+            ("at", &at),
+            ("count", &members.len()),
+            ("groups", &groups.len()),
+            ("has_others", &others_at.is_some()),
+            ("others", &others),
+        ],
+    ));
+}
+
+/// `GroupSync`: waits for the group's live members to arrive (or the timeout).
+fn emit_group_sync(
+    out: &mut String,
+    cx: &StateCx,
+    members: &[usize],
+    point: &usize,
+    timeout_ms: &i64,
+    mark: &usize,
+) {
+    let StateCx {
+        program,
+        peers,
+        next,
+        line,
+        ..
+    } = *cx;
+    let m = &program.control;
+    let list = peers.locals(members);
+    let hb = m.heartbeat_ms;
+    out.push_str(&fill(
+        &GROUP_SYNC,
+        &[
+            ("list", &list),
+            ("mark", &mark),
+            ("count", &members.len()),
+            ("offset", &m.sync_points[*point]),
+            ("team", &c::string(&program.team)),
+            ("key", &c::string(&super::files::sync_key(program))),
+            ("point", &point),
+            ("hb", &hb),
+            ("timeout_ms", &timeout_ms),
+            ("line", &line),
+            ("next", &next),
+        ],
+    ));
+}
+
+/// `if`.
+fn emit_branch(out: &mut String, cx: &StateCx, condition: &Expr, else_to: &StateId) {
+    let StateCx { words, next, .. } = *cx;
+    let _ = writeln!(
+        out,
+        "        r->pc = {} ? {next} : {else_to};\n        return STEP_NEXT;",
+        expr(condition, words)
+    );
+}
+
+/// A jump (the end of a branch).
+fn emit_jump(out: &mut String, _cx: &StateCx, to: &StateId) {
+    let _ = writeln!(out, "        r->pc = {to};\n        return STEP_NEXT;");
+}
+
+/// A loop's head: its condition, and the pass's start for its period.
+fn emit_loop_head(
+    out: &mut String,
+    cx: &StateCx,
+    condition: &Option<Expr>,
+    exit_to: &StateId,
+    mark: &usize,
+) {
+    let StateCx { words, next, .. } = *cx;
+    if let Some(cond) = condition {
+        let _ = writeln!(
+            out,
+            "        if (!{}) {{\n            r->pc = {exit_to};\n            return STEP_NEXT;\n        }}",
+            expr(cond, words)
+        );
+    }
+    let _ = writeln!(
+        out,
+        "        r->mark[{mark}] = semo_now_ms();\n        r->pc = {next};\n        return STEP_NEXT;"
+    );
+}
+
+/// A loop's tail: back to its head once its period is over.
+fn emit_loop_tail(
+    out: &mut String,
+    _cx: &StateCx,
+    period_ms: &Option<i64>,
+    mark: &usize,
+    to: &StateId,
+) {
+    match period_ms {
+        Some(p) => {
+            let _ = writeln!(
+                out,
+                "        if (semo_now_ms() - r->mark[{mark}] < {p}) {{\n            wake_at(r->mark[{mark}] + {p});\n            return STEP_WAIT;\n        }}"
+            );
+            let _ = writeln!(out, "        r->pc = {to};\n        return STEP_NEXT;");
+        }
+        // Without a period, one iteration per firing.
+        None => {
+            let _ = writeln!(
+                out,
+                "        r->pc = {to};\n        wake_at(semo_now_ms());\n        return STEP_WAIT;"
+            );
+        }
+    }
+}
+
+/// The end of a service's pass: `repeat(...)` or done.
+fn emit_repeat(
+    out: &mut String,
+    cx: &StateCx,
+    period_ms: &Option<i64>,
+    condition: &Option<Expr>,
+    forever: &bool,
+) {
+    let StateCx { words, .. } = *cx;
+    if let Some(cond) = condition {
+        let _ = writeln!(
+            out,
+            "        if (!{})\n            return STEP_DONE;",
+            expr(cond, words)
+        );
+    }
+    if let Some(p) = period_ms {
+        let _ = writeln!(
+            out,
+            "        if (semo_now_ms() - r->pass_start < {p}) {{\n            wake_at(r->pass_start + {p});\n            return STEP_WAIT;\n        }}\n        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        return STEP_NEXT;"
+        );
+    } else if *forever || condition.is_some() {
+        // The next pass starts at the next firing.
+        out.push_str("        r->pass_start = semo_now_ms();\n        r->pc = 0;\n        wake_at(semo_now_ms());\n        return STEP_WAIT;\n");
+    } else {
+        out.push_str("        return STEP_DONE;\n");
     }
 }
 
@@ -808,12 +1136,14 @@ fn emit_action_machine(
     index: usize,
     am: &ActionMachine,
 ) {
-    let _ = writeln!(
-        out,
-        "/* Strategy actions of `{}` ({}): phase 1 enters r->action (issues its\n * commands), phase 2 waits for them and takes the first transition that holds. */\nstatic int actions_{index}(region *r)\n{{\n    switch (r->action) {{",
-        c::comment(&am.service),
-        c::comment(&am.source)
-    );
+    out.push_str(&fill(
+        &ACTIONS_HEAD,
+        &[
+            ("service", &c::comment(&am.service)),
+            ("source", &c::comment(&am.source)),
+            ("index", &index),
+        ],
+    ));
     for (i, action) in am.actions.iter().enumerate() {
         let _ = writeln!(
             out,
@@ -898,7 +1228,7 @@ fn emit_dispatch(out: &mut String, program: &RobotProgram) {
 
 fn emit_modes(out: &mut String, program: &RobotProgram) {
     let m = &program.control;
-    out.push_str("/* Enters a mode: every plan the mode sets starts its service. */\nstatic void enter_mode(int mode)\n{\n    for (int i = 0; i < REGION_COUNT; i++) {\n        regions[i].service = -1;\n        regions[i].done = true;\n    }\n    current_mode = mode;\n    semo_trace(\"mode\", \"mode\", mode_name[mode], NULL);\n    switch (mode) {\n");
+    out.push_str(ENTER_MODE_HEAD.text);
     for mode in &m.modes {
         let _ = writeln!(
             out,
@@ -918,8 +1248,8 @@ fn emit_modes(out: &mut String, program: &RobotProgram) {
         }
         out.push_str("        break;\n");
     }
-    out.push_str("    default:\n        break;\n    }\n    for (int i = 0; i < REGION_COUNT; i++) {\n        region *r = &regions[i];\n        if (r->service < 0)\n            continue;\n        r->pc = 0;\n        r->phase = 0;\n        r->done = false;\n        r->started = r->pass_start = semo_now_ms();\n        semo_trace(\"service_start\", \"plan\", r->plan, \"service\", service_name[r->service], NULL);\n    }\n}\n\n");
-    out.push_str("/* Leaves the current mode: tasks its services called are stopped. */\nstatic void leave_mode(void)\n{\n    for (int i = 0; i < REGION_COUNT; i++) {\n        region *r = &regions[i];\n        if (r->service >= 0 && !r->done)\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], \"why\", \"mode change\", NULL);\n    }\n");
+    out.push_str(ENTER_MODE_TAIL.text);
+    out.push_str(LEAVE_MODE_HEAD.text);
     for task in &m.request_tasks {
         let _ = writeln!(
             out,
@@ -976,23 +1306,21 @@ fn emit_task(out: &mut String, program: &RobotProgram, peers: &Peers) {
     let default = m
         .default_mode
         .map(|d| format!("MODE_{}", c::ident(&m.modes[d].name)));
-    let _ = writeln!(
-        out,
-        "/* One firing: read inputs, advance every region, then change mode if an\n * event asked for it; the robot is finished when no region runs any more. */\nvoid task_{name}_go(void)\n{{\n    next_wake = INT64_MAX;\n    read_inputs();"
-    );
+    out.push_str(&fill(&GO_HEAD, &[("name", &name)]));
     if !m.battery.is_empty() {
         out.push_str("    manage_resources();\n");
     }
     if m.heartbeat {
         // Tell the team this robot is alive, for leader elections.
-        let _ = writeln!(
-            out,
-            "    static int64_t last_heartbeat = -{hb};\n    if (semo_now_ms() - last_heartbeat >= {hb}) {{\n        semo_value alive;\n        char text[64];\n        long battery = own_battery();\n        char said[24];\n        term_text(leading ? term_led : known_term(), said);\n        last_heartbeat = semo_now_ms();\n        if (battery < 0)\n            snprintf(text, sizeof text, \"%s - %s\", leading ? \"leader\" : \"member\", said);\n        else\n            snprintf(text, sizeof text, \"%s %ld %s\", leading ? \"leader\" : \"member\", battery, said);\n        semo_value_set(&alive, text);\n        semo_comm_send({team}, SEMO_MSG_PUBLISH, {key}, &alive);\n{group}    }}\n    wake_at(last_heartbeat + {hb});",
-            hb = m.heartbeat_ms,
-            team = c::string(&program.team),
-            key = c::string(&super::files::alive_key(program)),
-            group = group_update(m, peers),
-        );
+        out.push_str(&fill(
+            &HEARTBEAT,
+            &[
+                ("hb", &m.heartbeat_ms),
+                ("team", &c::string(&program.team)),
+                ("key", &c::string(&super::files::alive_key(program))),
+                ("group", &group_update(m, peers)),
+            ],
+        ));
     }
     match default {
         Some(d) => {
@@ -1013,8 +1341,12 @@ fn emit_task(out: &mut String, program: &RobotProgram, peers: &Peers) {
             c::ident(crate::refine::graph::COMM_SEND)
         )
     };
-    let _ = writeln!(
-        out,
-        "    bool running = false;\n    for (int i = 0; i < REGION_COUNT && pending_mode < 0; i++) {{\n        region *r = &regions[i];\n        if (r->service < 0 || r->done)\n            continue;\n        if (r->timeout_ms > 0 && semo_now_ms() - r->started > r->timeout_ms) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], \"why\", \"timeout\", NULL);\n            continue;\n        }}\n        if (r->timeout_ms > 0)\n            wake_at(r->started + r->timeout_ms + 1);\n        int result = STEP_NEXT;\n        for (int n = 0; n < {STEPS_PER_FIRING} && result == STEP_NEXT && pending_mode < 0; n++)\n            result = step(r);\n        if (result == STEP_NEXT)\n            wake_at(semo_now_ms()); /* more to do than one firing takes */\n        if (result == STEP_DONE) {{\n            r->done = true;\n            semo_trace(\"service_end\", \"plan\", r->plan, \"service\", service_name[r->service], NULL);\n        }} else {{\n            running = true;\n        }}\n    }}\n    if (pending_mode >= 0) {{\n        int next = pending_mode;\n        leave_mode();\n        pending_mode = -1;\n        enter_mode(next);\n        return;\n    }}\n    if (!running) {{\n        semo_trace(\"finish\", \"mode\", mode_name[current_mode], NULL);\n{flush}        semo_stop_program();\n        return;\n    }}\n    semo_next_firing(next_wake);\n}}\n\nvoid task_{name}_wrapup(void)\n{{\n}}"
-    );
+    out.push_str(&fill(
+        &GO_TAIL,
+        &[
+            ("steps_per_firing", &STEPS_PER_FIRING),
+            ("flush", &flush),
+            ("name", &name),
+        ],
+    ));
 }

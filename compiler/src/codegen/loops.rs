@@ -49,6 +49,7 @@
 //! (`semo_sim_loop_exit`).
 
 use super::c;
+use super::template::{Template, fill, template};
 use crate::refine::{GraphService, GraphStep, InnerTask, LoopPort, PortUse, SubgraphPort};
 use std::fmt::Write;
 
@@ -110,11 +111,7 @@ pub(super) fn graph_runner(service: &GraphService, simulated: bool) -> String {
         inner_task(&mut out, service, index, task, exit_of, simulated, &graph);
     }
     if has_loops {
-        out.push_str("/* Traces the end of an SDF/L loop with the iterations it ran. */\nstatic void loop_ended(const char *loop, unsigned long iterations)\n{\n    char text[24];\n    snprintf(text, sizeof text, \"%lu\", iterations);\n");
-        let _ = writeln!(
-            out,
-            "    semo_trace(\"graph_loop\", \"graph\", {graph}, \"loop\", loop, \"iterations\", text, NULL);\n}}\n"
-        );
+        out.push_str(&fill(&LOOP_ENDED, &[("graph", &graph)]));
     }
     out.push_str(
         "/* One iteration of the graph's looped schedule. */\nstatic void run_graph(void)\n{\n",
@@ -124,6 +121,43 @@ pub(super) fn graph_runner(service: &GraphService, simulated: bool) -> String {
     out.push_str("}\n\n");
     out
 }
+
+/// The ring of tokens of a channel between inner tasks.
+const GRAPH_CHANNEL: Template = template!("loops/graph_channel.c.in", []);
+/// `graph_broken`, `graph_take` and `graph_put` (every graph with channels).
+const GRAPH_TAKE_PUT: Template = template!("loops/graph_take_put.c.in", ["graph"]);
+const GRAPH_MOVE: Template = template!("loops/graph_move.c.in", []);
+const GRAPH_TEXT: Template = template!("loops/graph_text.c.in", ["max"]);
+const GRAPH_KEEP: Template = template!("loops/graph_keep.c.in", []);
+const LOOP_ENDED: Template = template!("loops/loop_ended.c.in", ["graph"]);
+/// The head of an inner task's work function.
+const WORK_HEAD: Template = template!(
+    "loops/work_head.c.in",
+    [
+        "path",
+        "reads",
+        "writes",
+        "exit",
+        "returns",
+        "name",
+        "signature"
+    ]
+);
+/// A time-triggered inner task's release.
+const RELEASE: Template = template!("loops/release.c.in", ["path", "period", "name"]);
+
+/// Every template of a graph service's runner.
+#[cfg(test)]
+pub(super) const TEMPLATES: &[Template] = &[
+    GRAPH_CHANNEL,
+    GRAPH_TAKE_PUT,
+    GRAPH_MOVE,
+    GRAPH_TEXT,
+    GRAPH_KEEP,
+    LOOP_ENDED,
+    RELEASE,
+    WORK_HEAD,
+];
 
 /// The channel rings and the helpers that move tokens (each written only
 /// when used: an unused static function fails -Werror).
@@ -138,7 +172,7 @@ fn channels(
     if service.channels.is_empty() {
         return;
     }
-    out.push_str("/* A channel between inner tasks: a ring of tokens, `count` from `head`. */\ntypedef struct {\n    semo_value *token;\n    unsigned long capacity, head, count;\n    const char *label;\n} graph_channel;\n\n");
+    out.push_str(GRAPH_CHANNEL.text);
     for (i, ch) in service.channels.iter().enumerate() {
         let initial = if ch.initial_tokens > 0 {
             let zeros = vec!["{.type = SEMO_INT}"; ch.initial_tokens.min(ch.capacity) as usize];
@@ -168,24 +202,15 @@ fn channels(
         );
     }
     out.push_str("};\n\n");
-    let _ = writeln!(
-        out,
-        "/* A channel short of tokens or over its bound: the schedule and the\n * analysis's bounds exclude both, so this is a generator bug. */\nstatic void graph_broken(const graph_channel *c, const char *what)\n{{\n    semo_trace(\"graph_error\", \"graph\", {graph}, \"channel\", c->label, \"error\", what, NULL);\n    fprintf(stderr, \"semo: internal error: task graph %s: channel %s %s\\n\", {graph}, c->label, what);\n    abort();\n}}\n"
-    );
-    out.push_str("static void graph_take(graph_channel *c, semo_value *out, unsigned long n)\n{\n    for (unsigned long k = 0; k < n; k++) {\n        if (c->count == 0)\n            graph_broken(c, \"is empty\");\n        out[k] = c->token[c->head];\n        c->head = (c->head + 1) % c->capacity;\n        c->count--;\n    }\n}\n\n");
-    out.push_str("static void graph_put(graph_channel *c, const semo_value *in, unsigned long n)\n{\n    for (unsigned long k = 0; k < n; k++) {\n        if (c->count == c->capacity)\n            graph_broken(c, \"is full\");\n        c->token[(c->head + c->count) % c->capacity] = in[k];\n        c->count++;\n    }\n}\n\n");
+    out.push_str(&fill(&GRAPH_TAKE_PUT, &[("graph", &graph)]));
     if moves {
-        out.push_str("/* Moves `n` tokens between a sub-graph task's channel and its sub-graph's. */\nstatic void graph_move(graph_channel *from, graph_channel *to, unsigned long n)\n{\n    for (unsigned long k = 0; k < n; k++) {\n        semo_value v;\n        graph_take(from, &v, 1);\n        graph_put(to, &v, 1);\n    }\n}\n\n");
+        out.push_str(GRAPH_MOVE.text);
     }
     if any_port {
-        let _ = writeln!(
-            out,
-            "/* Appends tokens to a trace field: their JSON, comma separated, cut at\n * {} characters. */\nstatic void graph_text(char *text, size_t cap, const semo_value *v, unsigned long n)\n{{\n    size_t len = strlen(text);\n    for (unsigned long k = 0; k < n && len + 1 < cap; k++) {{\n        if (len > 0) {{\n            text[len++] = ',';\n            text[len] = '\\0';\n        }}\n        len += semo_value_json(&v[k], text + len, cap - len);\n    }}\n}}\n",
-            GRAPH_TEXT_MAX - 1
-        );
+        out.push_str(&fill(&GRAPH_TEXT, &[("max", &(GRAPH_TEXT_MAX - 1))]));
     }
     if keeps {
-        out.push_str("/* Takes `n` tokens a loop iteration gave into the last `keep` taken. */\nstatic void graph_keep(graph_channel *c, semo_value *kept, unsigned long keep, unsigned long *held, unsigned long n)\n{\n    for (unsigned long k = 0; k < n; k++) {\n        semo_value v;\n        graph_take(c, &v, 1);\n        if (*held == keep) {\n            memmove(kept, kept + 1, (keep - 1) * sizeof *kept);\n            (*held)--;\n        }\n        kept[(*held)++] = v;\n    }\n}\n\n");
+        out.push_str(GRAPH_KEEP.text);
     }
 }
 
@@ -215,11 +240,14 @@ fn text_size(ports: &[PortUse]) -> u64 {
 /// does, and the iteration is abandoned (false).
 fn release(out: &mut String, service: &GraphService, index: usize, task: &InnerTask, period: u64) {
     let name = task_name(service, index);
-    let _ = writeln!(
-        out,
-        "/* Inner task `{}` is time-triggered: it fires at most once every {period} ms. */\nstatic int64_t start_{name}; /* its last firing's start, mission ms */\n\nstatic bool release_{name}(void)\n{{\n    static bool fired;\n    if (fired && !semo_sleep_until(start_{name} + {period}))\n        return false;\n    start_{name} = semo_now_ms();\n    fired = true;\n    return true;\n}}\n",
-        c::comment(&task.path)
-    );
+    out.push_str(&fill(
+        &RELEASE,
+        &[
+            ("path", &c::comment(&task.path)),
+            ("period", &period),
+            ("name", &name),
+        ],
+    ));
 }
 
 /// The work function of inner task `task` and its firing, `inner_<n>`.
@@ -265,26 +293,39 @@ fn inner_task(
             .collect::<Vec<_>>()
             .join(", ")
     };
-    let _ = writeln!(
-        out,
-        "/* The work of inner task `{}`: reads {}; writes {} (each output the\n * integer 0 until set).{} */\nstatic {returns} work_{name}({signature})\n{{",
-        c::comment(&task.path),
-        if task.inputs.is_empty() {
-            "nothing".into()
-        } else {
-            rates(&task.inputs)
-        },
-        if task.outputs.is_empty() {
-            "nothing".into()
-        } else {
-            rates(&task.outputs)
-        },
-        if exit_of.is_some() {
-            " The exit task of its convergent loop: true to set the exit flag."
-        } else {
-            ""
-        }
-    );
+    out.push_str(&fill(
+        &WORK_HEAD,
+        &[
+            ("path", &c::comment(&task.path)),
+            (
+                "reads",
+                &if task.inputs.is_empty() {
+                    "nothing".into()
+                } else {
+                    rates(&task.inputs)
+                },
+            ),
+            (
+                "writes",
+                &if task.outputs.is_empty() {
+                    "nothing".into()
+                } else {
+                    rates(&task.outputs)
+                },
+            ),
+            (
+                "exit",
+                &if exit_of.is_some() {
+                    " The exit task of its convergent loop: true to set the exit flag."
+                } else {
+                    ""
+                },
+            ),
+            ("returns", &returns),
+            ("name", &name),
+            ("signature", &signature),
+        ],
+    ));
     for (p, input) in &ports {
         let _ = writeln!(out, "    (void){};", param(p, *input));
     }

@@ -25,6 +25,7 @@
 mod battery;
 mod c;
 mod control;
+mod template;
 pub use control::{
     TERM_MAX, UNLED_REASON, fenced_heard, lease_ms, listen_ms, next_term, parse_term,
 };
@@ -65,7 +66,21 @@ const POSIX_SIM: (&str, &str) = ("semo_sim.c", include_str!("runtime/semo_sim.c"
 const LOCKSTEP: (&str, &str) = ("semo_lockstep.c", include_str!("runtime/semo_lockstep.c"));
 const STATIC: (&str, &str) = ("semo_static.c", include_str!("runtime/semo_static.c"));
 const LM3S6965: (&str, &str) = ("semo_lm3s6965.c", include_str!("runtime/semo_lm3s6965.c"));
-const LM3S6965_LD: (&str, &str) = ("lm3s6965.ld", include_str!("runtime/lm3s6965.ld.in"));
+const LM3S6965_LD: (&str, &str) = ("lm3s6965.ld", LINK_SCRIPT.text);
+/// A board's link script, its memory map filled in from the platform
+/// table's row ([`board_file`]).
+const LINK_SCRIPT: template::Template = template::Template {
+    path: "runtime/lm3s6965.ld.in",
+    text: include_str!("runtime/lm3s6965.ld.in"),
+    slots: &[
+        "board",
+        "machine",
+        "flash_origin",
+        "flash_kib",
+        "ram_origin",
+        "ram_kib",
+    ],
+};
 /// The make rules every robot's Makefile includes to compile the runtime.
 const MAKE_RULES: (&str, &str) = ("semo_runtime.mk", include_str!("runtime/semo_runtime.mk"));
 
@@ -115,21 +130,33 @@ pub fn runtime_files(targets: &[Target]) -> Vec<GeneratedFile> {
 }
 
 /// `text`, the runtime file `path`, with the facts of the board whose link
-/// script it is filled in (`@FLASH_ORIGIN@`, ...); other files as they are.
-fn board_file(targets: &[Target], path: &str, text: &str) -> String {
+/// script it is filled in (the slots of [`LINK_SCRIPT`]); other files as
+/// they are.
+fn board_file(targets: &[Target], path: &'static str, text: &'static str) -> String {
     let board = targets
         .iter()
         .filter_map(|t| t.platform().board.as_ref())
         .find(|b| b.link_script == path);
     match board {
         None => text.to_string(),
-        Some(board) => text
-            .replace("@BOARD@", board.name)
-            .replace("@MACHINE@", board.machine)
-            .replace("@FLASH_ORIGIN@", &format!("0x{:08X}", board.flash.origin))
-            .replace("@FLASH_KIB@", &board.flash.kib.to_string())
-            .replace("@RAM_ORIGIN@", &format!("0x{:08X}", board.ram.origin))
-            .replace("@RAM_KIB@", &board.ram.kib.to_string()),
+        Some(board) => template::fill(
+            &template::Template {
+                path,
+                text,
+                ..LINK_SCRIPT
+            },
+            &[
+                ("board", &board.name),
+                ("machine", &board.machine),
+                (
+                    "flash_origin",
+                    &format_args!("0x{:08X}", board.flash.origin),
+                ),
+                ("flash_kib", &board.flash.kib),
+                ("ram_origin", &format_args!("0x{:08X}", board.ram.origin)),
+                ("ram_kib", &board.ram.kib),
+            ],
+        ),
     }
 }
 

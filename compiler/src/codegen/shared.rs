@@ -10,6 +10,7 @@
 use super::c;
 use super::files::lock;
 use super::peers::Peers;
+use super::template::{Template, fill, template};
 use super::values::Words;
 use super::{Layer, Target};
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
@@ -40,13 +41,57 @@ pub fn declarations(program: &RobotProgram) -> String {
         );
     }
     if lib.ownership.is_some() {
-        let _ = writeln!(
-            out,
-            "/* A message of the owner protocol (comm_task.c hands each message over):\n * true when it was one, taken. */\nbool {prefix}_heard(const semo_message *m);\n/* When this robot would find its owner lost (mission ms; INT64_MAX while it\n * owns the values): the control task fires then. */\nint64_t {prefix}_owner_lost_at(void);"
-        );
+        out.push_str(&fill(&OWNER_DECLARATIONS, &[("prefix", &prefix)]));
     }
     out
 }
+
+/// `program.h`'s declarations of the owner protocol's functions.
+const OWNER_DECLARATIONS: Template = template!("shared/owner_declarations.h.in", ["prefix"]);
+/// `lib_<Team>Shared.c`'s values, and a value's getter and setter: of this
+/// robot's alone, or globally shared (through the owner).
+const LIBRARY_HEAD: Template = template!("shared/library_head.c.in", ["name", "declare", "count"]);
+const LOCAL_VALUE: Template = template!(
+    "shared/local_value.c.in",
+    ["prefix", "getter", "setter", "i", "lock", "unlock"]
+);
+const GLOBAL_VALUE: Template = template!(
+    "shared/global_value.c.in",
+    [
+        "prefix", "getter", "setter", "key", "i", "k", "lock", "unlock"
+    ]
+);
+/// The owner protocol's tables of globally shared values.
+const GLOBALS: Template = template!(
+    "shared/globals.c.in",
+    ["at", "names", "set_keys", "value_keys", "types"]
+);
+const OWNERS: Template = template!("shared/owners.c.in", ["owners", "first"]);
+/// `tell`, `current_owner` and `<prefix>_owner_lost_at`.
+const TELL: Template = template!(
+    "shared/tell.c.in",
+    ["name", "follow", "prefix", "lock", "unlock", "hb"]
+);
+/// `current_owner`'s choice of who follows a lost owner, per rule.
+const FOLLOW_FIRST: Template = template!("shared/follow_first.c.in", ["hb"]);
+const FOLLOW_BATTERY: Template = template!("shared/follow_battery.c.in", ["hb"]);
+/// `<prefix>_heard`.
+const HEARD: Template = template!("shared/heard.c.in", ["prefix", "lock", "unlock", "wake"]);
+
+/// Every template of the library task's owner protocol.
+#[cfg(test)]
+pub(super) const TEMPLATES: &[Template] = &[
+    OWNER_DECLARATIONS,
+    LIBRARY_HEAD,
+    LOCAL_VALUE,
+    GLOBAL_VALUE,
+    GLOBALS,
+    OWNERS,
+    TELL,
+    FOLLOW_FIRST,
+    FOLLOW_BATTERY,
+    HEARD,
+];
 
 /// The line of `comm_task.c`'s receive body that hands the owner protocol's
 /// messages to the library.
@@ -74,12 +119,14 @@ pub fn library_c(
     if lib.ownership.is_some() {
         out.push_str("#include <string.h>\n");
     }
-    let _ = writeln!(
-        out,
-        "\n/* Library task {}: the team's shared information, one value per attribute,\n * read and written by its getters and setters under one lock. */\n{declare}static semo_value value[{}];\n",
-        c::comment(&lib.name),
-        lib.attributes.len()
-    );
+    out.push_str(&fill(
+        &LIBRARY_HEAD,
+        &[
+            ("name", &c::comment(&lib.name)),
+            ("declare", &declare),
+            ("count", &lib.attributes.len()),
+        ],
+    ));
     let global = |i: usize| {
         lib.ownership
             .as_ref()
@@ -92,21 +139,32 @@ pub fn library_c(
         let _ = writeln!(out, "/* {} */", c::comment(key));
         match global(i) {
             None => {
-                let _ = writeln!(
-                    out,
-                    "LIBFUNC(semo_value, {prefix}_{}, (void))\n{{\n    {lock}\n    semo_value v = value[{i}];\n    {unlock}\n    return v;\n}}\n\nLIBFUNC(void, {prefix}_{}, (const semo_value *v))\n{{\n    {lock}\n    value[{i}] = *v;\n    {unlock}\n}}\n",
-                    getter(key),
-                    setter(key)
-                );
+                out.push_str(&fill(
+                    &LOCAL_VALUE,
+                    &[
+                        ("prefix", &prefix),
+                        ("getter", &getter(key)),
+                        ("setter", &setter(key)),
+                        ("i", &i),
+                        ("lock", &lock),
+                        ("unlock", &unlock),
+                    ],
+                ));
             }
             Some(k) => {
-                let _ = writeln!(
-                    out,
-                    "LIBFUNC(semo_value, {prefix}_{}, (void))\n{{\n    current_owner();\n    {lock}\n    semo_value v = value[{i}];\n    {unlock}\n    return v;\n}}\n\nLIBFUNC(void, {prefix}_{}, (const semo_value *v))\n{{\n    size_t to = current_owner();\n    {lock}\n    value[{i}] = *v;\n    {unlock}\n    semo_trace_value(\"shared_set\", \"value\", v, \"key\", {key_c}, \"owner\", semo_program()->peers[to].robot, NULL);\n    tell({k}, to, v);\n}}\n",
-                    getter(key),
-                    setter(key),
-                    key_c = c::string(key),
-                );
+                out.push_str(&fill(
+                    &GLOBAL_VALUE,
+                    &[
+                        ("prefix", &prefix),
+                        ("getter", &getter(key)),
+                        ("setter", &setter(key)),
+                        ("key", &c::string(key)),
+                        ("i", &i),
+                        ("k", &k),
+                        ("lock", &lock),
+                        ("unlock", &unlock),
+                    ],
+                ));
             }
         }
     }
@@ -135,15 +193,28 @@ fn owner_protocol(
     let words = Words::of(program);
     let list = |items: &mut dyn Iterator<Item = String>| items.collect::<Vec<_>>().join(", ");
     let global = &ownership.global;
-    let _ = writeln!(
-        out,
-        "/* Globally shared values (docs/shared-information.md): the owner holds\n * them; a write elsewhere is sent to it (`set`), and it tells the team each\n * value it takes (`told`). Per global value: its place in `value`, the keys,\n * its type and an enumeration's words (a value of another type is refused). */\nstatic const size_t global_at[] = {{{}}};\nstatic const char *const global_key[] = {{{}}};\nstatic const char *const set_key[] = {{{}}};\nstatic const char *const told_key[] = {{{}}};\nstatic const semo_type global_type[] = {{{}}};",
-        list(&mut global.iter().map(|g| g.at.to_string())),
-        list(&mut global.iter().map(|g| c::string(&lib.attributes[g.at]))),
-        list(&mut global.iter().map(|g| c::string(&g.set_key))),
-        list(&mut global.iter().map(|g| c::string(&g.value_key))),
-        list(&mut global.iter().map(|g| g.kind.c_tag().to_string())),
-    );
+    out.push_str(&fill(
+        &GLOBALS,
+        &[
+            ("at", &list(&mut global.iter().map(|g| g.at.to_string()))),
+            (
+                "names",
+                &list(&mut global.iter().map(|g| c::string(&lib.attributes[g.at]))),
+            ),
+            (
+                "set_keys",
+                &list(&mut global.iter().map(|g| c::string(&g.set_key))),
+            ),
+            (
+                "value_keys",
+                &list(&mut global.iter().map(|g| c::string(&g.value_key))),
+            ),
+            (
+                "types",
+                &list(&mut global.iter().map(|g| g.kind.c_tag().to_string())),
+            ),
+        ],
+    ));
     out.push_str("static const unsigned short *const global_domain[] = {");
     let mut lengths = Vec::new();
     for (n, g) in global.iter().enumerate() {
@@ -175,20 +246,25 @@ fn owner_protocol(
         "}};\nstatic const unsigned short global_domain_len[] = {{{}}};\n",
         lengths.join(", ")
     );
-    let _ = writeln!(
-        out,
-        "/* The robots that own the values in turn (peer indices) and the owner now. */\nstatic const size_t owners[] = {{{}}};\nstatic size_t owner = {};\n",
-        peers.locals(&ownership.owners),
-        peers.local(ownership.owners[0])
-    );
+    out.push_str(&fill(
+        &OWNERS,
+        &[
+            ("owners", &peers.locals(&ownership.owners)),
+            ("first", &peers.local(ownership.owners[0])),
+        ],
+    ));
     let hb = program.control.heartbeat_ms;
-    let _ = writeln!(
-        out,
-        "/* Tells the owner `to` of a write of global value `k`, or the team when\n * this robot owns it. */\nstatic void tell(size_t k, size_t to, const semo_value *v)\n{{\n    const semo_program_desc *p = semo_program();\n    if (to == p->self)\n        semo_comm_send(p->team, SEMO_MSG_SEND, told_key[k], v);\n    else\n        semo_comm_send(p->peers[to].robot, SEMO_MSG_SEND, set_key[k], v);\n}}\n\n/* The owner now: the owner stays while it lives (this robot, or heard from\n * within three heartbeats); a lost one is followed by the first live robot\n * of `owners`. A change is traced; a robot that becomes the owner tells the\n * team the values it last saw. */\nstatic size_t current_owner(void)\n{{\n    const semo_program_desc *p = semo_program();\n    int64_t now = semo_now_ms();\n    {lock}\n    size_t was = owner;\n    if (was != p->self && now - comm_heard(was).seen > 3 * {hb}) {{\n{follow}    }}\n    size_t now_owner = owner;\n    {unlock}\n    if (now_owner == was)\n        return was;\n    semo_trace(\"shared_owner\", \"library\", {name}, \"owner\", p->peers[now_owner].robot, \"lost\", p->peers[was].robot, NULL);\n    if (now_owner == p->self)\n        for (size_t k = 0; k < sizeof global_at / sizeof global_at[0]; k++) {{\n            {lock}\n            semo_value v = value[global_at[k]];\n            {unlock}\n            if (v.type != SEMO_NONE)\n                tell(k, now_owner, &v);\n        }}\n    return now_owner;\n}}\n\n/* Three heartbeats after the owner was last heard from, and one ms more:\n * the control task's read_inputs asks then (current_owner), as the\n * simulator's firing does. */\nint64_t {prefix}_owner_lost_at(void)\n{{\n    const semo_program_desc *p = semo_program();\n    {lock}\n    size_t now_owner = owner;\n    {unlock}\n    return now_owner == p->self ? INT64_MAX : comm_heard(now_owner).seen + 3 * {hb} + 1;\n}}\n",
-        name = c::string(&lib.name),
-        follow = follower(ownership.rule, hb),
-        prefix = prefix(lib),
-    );
+    out.push_str(&fill(
+        &TELL,
+        &[
+            ("name", &c::string(&lib.name)),
+            ("follow", &follower(ownership.rule, hb)),
+            ("prefix", &prefix(lib)),
+            ("lock", &lock),
+            ("unlock", &unlock),
+            ("hb", &hb),
+        ],
+    ));
 }
 
 /// The loop of `current_owner` choosing who follows a lost owner among the
@@ -197,22 +273,25 @@ fn owner_protocol(
 /// selection the one whose heartbeat said the highest level (the first of
 /// equals; unknown counts lowest; this robot's own level in simulation).
 fn follower(rule: OwnerRule, hb: i64) -> String {
-    if !rule.by_battery() {
-        return format!(
-            "        for (size_t k = 0; k < sizeof owners / sizeof owners[0]; k++) {{\n            size_t c = owners[k];\n            if (c == p->self || now - comm_heard(c).seen <= 3 * {hb}) {{\n                owner = c;\n                break;\n            }}\n        }}\n"
-        );
-    }
-    format!(
-        "        bool found = false;\n        long best = -1;\n        for (size_t k = 0; k < sizeof owners / sizeof owners[0]; k++) {{\n            size_t c = owners[k];\n            comm_heartbeat h = comm_heard(c);\n            if (c != p->self && now - h.seen > 3 * {hb})\n                continue;\n            long level = h.battery;\n            if (c == p->self) {{\n                level = -1;\n#ifdef SEMO_SIM\n                long long own;\n                if (semo_sim_battery(&own))\n                    level = (long)own;\n#endif\n            }}\n            if (!found || level > best) {{\n                owner = c;\n                best = level;\n                found = true;\n            }}\n        }}\n"
-    )
+    let follow = if rule.by_battery() {
+        &FOLLOW_BATTERY
+    } else {
+        &FOLLOW_FIRST
+    };
+    fill(follow, &[("hb", &hb)])
 }
 
 /// `<prefix>_heard`: a write sent to this robot (taken when it owns the
 /// value, else refused: the writer's owner is lost or not yet known here)
 /// and the owner's values.
 fn heard(out: &mut String, prefix: &str, lock: &str, unlock: &str, wake: &str) {
-    let _ = writeln!(
-        out,
-        "bool {prefix}_heard(const semo_message *m)\n{{\n    for (size_t k = 0; k < sizeof global_at / sizeof global_at[0]; k++) {{\n        bool set = strcmp(m->key, set_key[k]) == 0;\n        if (!set && strcmp(m->key, told_key[k]) != 0)\n            continue;\n        semo_value v = m->value;\n        if (!semo_value_coerce(&v, global_type[k]) || !semo_value_in(&v, global_domain[k], global_domain_len[k])) {{\n            semo_trace(\"reject\", \"key\", m->key, \"reason\", \"not a value of its type\", NULL);\n            return true;\n        }}\n        const semo_program_desc *p = semo_program();\n        if (set) {{\n            size_t to = current_owner();\n            if (to != p->self) {{\n                semo_trace(\"reject\", \"key\", m->key, \"reason\", \"not the owner\", NULL);\n                return true;\n            }}\n            {lock}\n            value[global_at[k]] = v;\n            {unlock}\n            semo_trace_value(\"shared_set\", \"value\", &v, \"key\", global_key[k], \"owner\", p->robot, \"from\", m->from_robot, NULL);\n            tell(k, to, &v);\n        }} else {{\n            {lock}\n            value[global_at[k]] = v;\n            {unlock}\n            semo_trace_value(\"shared_value\", \"value\", &v, \"key\", global_key[k], \"from\", m->from_robot, NULL);\n        }}{wake}\n        return true;\n    }}\n    return false;\n}}"
-    );
+    out.push_str(&fill(
+        &HEARD,
+        &[
+            ("prefix", &prefix),
+            ("lock", &lock),
+            ("unlock", &unlock),
+            ("wake", &wake),
+        ],
+    ));
 }
