@@ -258,6 +258,8 @@ fn the_repaired_missions_and_the_small_examples_have_no_finding() {
         ("examples/swarm/march.mission", true),
         ("examples/scouting/scouting.mission", false),
         ("examples/swarm/patrol_groups.mission", false),
+        // The benchmark's five robots in three teams (compiler/benches/verify.rs).
+        ("tests/fixtures/verify/three_teams/main.mission", false),
     ] {
         let (code, findings, data) = verify(mission, &["--max-states", "3000"]);
         assert_eq!((code, &findings), (0, &Vec::new()), "{mission}");
@@ -942,6 +944,42 @@ fn properties_on_random_missions_replay_broken_and_hold_in_random_behaviours() {
     );
     assert!(broken >= 5, "only {broken} broken properties");
     assert!(held >= 3, "only {held} `always` held");
+}
+
+/// `--no-reduction` is the search without merging states across instants,
+/// as the user reaches it: the document says which reductions ran, the
+/// same race is found with and without, and merging never needs more
+/// states than the unreduced search on the same horizon.
+#[test]
+fn no_reduction_runs_the_unreduced_search_and_finds_the_same_race() {
+    let mission = "tests/fixtures/verify/plans_race/main.mission";
+    let horizon = ["--horizon", "6s"];
+    let (code, reduced, merged) = verify(mission, &horizon);
+    let (full_code, unreduced, full) =
+        verify(mission, &[&horizon[..], &["--no-reduction"]].concat());
+    assert_eq!((code, full_code), (1, 1));
+    assert_eq!(
+        merged["reductions"],
+        serde_json::json!(["merge_in_time"]),
+        "{merged}"
+    );
+    assert_eq!(full["reductions"], serde_json::json!([]), "{full}");
+    let races = |found: &[(String, u64, String)]| -> Vec<(String, u64)> {
+        found
+            .iter()
+            .filter(|(code, _, _)| code == "V005")
+            .map(|(code, line, _)| (code.clone(), *line))
+            .collect()
+    };
+    assert_eq!(races(&reduced), [("V005".to_string(), 17)], "{reduced:?}");
+    assert_eq!(races(&unreduced), races(&reduced), "{unreduced:?}");
+    let states = |data: &serde_json::Value| data["states"].as_u64().unwrap();
+    assert!(
+        states(&merged) < states(&full),
+        "merging saved nothing: {} and {} states",
+        states(&merged),
+        states(&full)
+    );
 }
 
 /// The reduction is sound: over random missions, merging a state with one

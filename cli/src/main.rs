@@ -384,6 +384,12 @@ enum Command {
         /// during one step.
         #[arg(long, default_value_t = 0)]
         network: u32,
+        /// Merge only states of one instant: the search without its
+        /// reduction (states met at different instants that would go on
+        /// alike merged), to compare the two; it finds the same, with more
+        /// states.
+        #[arg(long)]
+        no_reduction: bool,
         /// Write each finding's counterexample into DIR as a scenario file.
         #[arg(long, value_name = "DIR")]
         counterexamples: Option<PathBuf>,
@@ -906,6 +912,7 @@ fn run() -> i32 {
             changes,
             faults,
             network,
+            no_reduction,
             counterexamples,
             expect,
             color,
@@ -922,7 +929,7 @@ fn run() -> i32 {
                     changes,
                     faults,
                     network,
-                    merge_in_time: true,
+                    merge_in_time: !no_reduction,
                     observe: false,
                     cancel: None,
                 },

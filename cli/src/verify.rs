@@ -96,6 +96,11 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         "states": report.states,
         "transitions": report.transitions,
         "explored_ms": report.reached_ms,
+        "reductions": if options.search.merge_in_time {
+            vec!["merge_in_time"]
+        } else {
+            Vec::new()
+        },
         "counterexamples": written_files
             .iter()
             .map(|f| f.as_ref().map(|p: &PathBuf| p.display().to_string()))

@@ -103,7 +103,8 @@ pub fn explore(
     // (team, thrower's statement, lost statement) → the race.
     let mut races: HashMap<(&str, u32, u32), (Race, Counterexample)> = HashMap::new();
     let mut nodes: Vec<Node> = Vec::new();
-    let mut seen: HashMap<u128, u32> = HashMap::new();
+    // Keyed by fingerprints, themselves hashes: the fast hasher suffices.
+    let mut seen: crate::fasthash::FastMap<u128, u32> = Default::default();
     let mut edges: Vec<(u32, u32)> = Vec::new();
     let mut leaders = Leaders::new(programs);
     // Each state with what the world has set and has left to do.
@@ -145,13 +146,22 @@ pub fn explore(
             if (0..node.finished.len()).all(|r| node.finished[r] || node.down[r]) {
                 continue;
             }
-            for choice in choices(inputs, &world) {
+            let all = choices(inputs, &world);
+            let last = all.len() - 1;
+            // The last choice takes the state itself: a clone (and a drop)
+            // fewer per state.
+            let mut state = Some((sim, world));
+            for (c, choice) in all.into_iter().enumerate() {
                 if nodes.len() >= options.max_states || cancelled(options) {
                     over_budget = true;
                     break;
                 }
-                let mut child = sim.clone();
-                let mut child_world = world.clone();
+                let (mut child, mut child_world) = if c == last {
+                    state.take().expect("only the last choice takes the state")
+                } else {
+                    let (sim, world) = state.as_ref().expect("kept until the last choice");
+                    (sim.clone(), world.clone())
+                };
                 apply(&mut child, &mut child_world, inputs, &choice);
                 child.run_to(next_t);
                 explored.transitions += 1;
@@ -337,7 +347,7 @@ impl Leaders {
 #[allow(clippy::too_many_arguments)]
 fn admit(
     nodes: &mut Vec<Node>,
-    seen: &mut HashMap<u128, u32>,
+    seen: &mut crate::fasthash::FastMap<u128, u32>,
     fingerprint: u128,
     sim: &Sim,
     world: &World,

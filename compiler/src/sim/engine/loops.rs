@@ -44,6 +44,11 @@ pub(super) struct GraphState {
 }
 
 impl GraphState {
+    /// No graph has run (`explore.rs` then hashes no text).
+    pub(super) fn is_empty(&self) -> bool {
+        self.channels.is_empty() && self.starts.is_empty() && self.due.is_empty()
+    }
+
     /// The state as text, its times relative to `now` (`explore.rs`).
     pub(super) fn relative(&self, now: i64) -> String {
         let mut channels: Vec<_> = self.channels.iter().collect();
