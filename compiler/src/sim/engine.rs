@@ -83,6 +83,11 @@ pub struct Run {
     pub end_ms: i64,
     /// Events the engine processed (for the cost per event).
     pub events: u64,
+    /// Entries the engine's event queue took (a message's deliveries at
+    /// one instant are one entry): with `events`, the run's work, which
+    /// follows the robots (`compiler/tests/sim_scaling.rs`). 0 for a
+    /// recorded run read back.
+    pub queued: u64,
 }
 
 impl Run {
@@ -93,6 +98,7 @@ impl Run {
             trace,
             end_ms,
             events,
+            queued: 0,
         }
     }
 
@@ -474,6 +480,8 @@ pub struct Sim<'p> {
     scenario: &'p Scenario,
     robots: Vec<Robot<'p>>,
     queue: BinaryHeap<Queued>,
+    /// Entries put in `queue` so far ([`Run::queued`]).
+    queued: u64,
     seq: u64,
     now: i64,
     losses: LossDraws,
@@ -684,6 +692,7 @@ impl<'p> Sim<'p> {
                 .map(|p| Robot::new(p, scenario, 0, 0))
                 .collect(),
             queue: BinaryHeap::new(),
+            queued: 0,
             seq: 0,
             now: 0,
             losses: LossDraws::new(options.seed),
@@ -693,7 +702,10 @@ impl<'p> Sim<'p> {
             recipients: Rc::new(recipients(programs)),
             names: {
                 let mut intern = Interner::default();
-                programs.iter().map(|p| Names::new(p, &mut intern)).collect()
+                programs
+                    .iter()
+                    .map(|p| Names::new(p, &mut intern))
+                    .collect()
             },
             inputs: Rc::from([]),
             last_fire: (-1, 0),
@@ -732,6 +744,7 @@ impl<'p> Sim<'p> {
             _ => self.seq,
         };
         self.queue.push(Queued::new(at, event, tie));
+        self.queued += 1;
     }
 
     /// Puts robot `r`'s next control firing at `at` (a time of its grid).
@@ -808,7 +821,10 @@ impl<'p> Sim<'p> {
             }
         }
         self.trace.drain(..).for_each(&mut *sink);
-        Run::of(self.programs, Vec::new(), self.now, events)
+        Run {
+            queued: self.queued,
+            ..Run::of(self.programs, Vec::new(), self.now, events)
+        }
     }
 
     /// Handles the events of the instants before `until`, or until every
@@ -1077,15 +1093,16 @@ impl<'p> Sim<'p> {
         robot.resources.advance(now);
         let inputs = &self.inputs[r];
         for &i in inputs.sensors.iter() {
-            let s = &program.control.slots[i];
-            let (SlotSource::Sensor { port, task }, Some(series)) =
-                (&s.source, &robot.sensor_series[i])
-            else {
+            let Some(series) = &robot.sensor_series[i] else {
                 continue;
             };
             if series.is_empty() && robot.battery.is_empty() {
-                continue; // nothing to read, as long as the run lasts
+                continue; // nothing to read (the slot's program not looked at)
             }
+            let s = &program.control.slots[i];
+            let SlotSource::Sensor { port, task } = &s.source else {
+                continue;
+            };
             let sampled = robot.sampled_at(task, now);
             let n = series.partition_point(|(at, _)| *at <= sampled);
             let read = if n > 0 {
@@ -1169,6 +1186,7 @@ impl<'p> Sim<'p> {
             let message = message.clone();
             self.queue
                 .push(Queued::new(at, Event::Deliver { to, message }, tie));
+            self.queued += 1;
         }
     }
 
@@ -1373,7 +1391,8 @@ impl<'p> Sim<'p> {
         // (`semo_value_coerce`); text is read as the type.
         let mut pending = VecDeque::new();
         let mut rejected = false;
-        for (i, (incoming, (from_team, key))) in m.incoming.iter().zip(&names.incoming).enumerate() {
+        for (i, (incoming, (from_team, key))) in m.incoming.iter().zip(&names.incoming).enumerate()
+        {
             if *from_team == message.from_team && *key == message.key {
                 let kind = &m.slots[incoming.slot.index()].kind;
                 let Some(value) = (match &message.value {
