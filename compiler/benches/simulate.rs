@@ -10,8 +10,9 @@
 //! idle firings replaces. Run with `cargo bench --bench simulate`.
 //!
 //! Measured (release, 10 minutes of mission time, a shared two-core
-//! machine): 102 robots 4,156,664 events in about 1.2 s of CPU, 42 MB;
-//! 1,002 robots 40,723,064 events in 27 to 36 s, 331 MB. Per event the
+//! machine): 102 robots 4,156,664 events in about 0.9 s of CPU (1.0 s
+//! before), 42 MB; 1,002 robots 40,723,064 events in 27.6 s (27.9 s
+//! before), 331 MB. Per event the
 //! instructions are the same for both (about 2,200, `valgrind --tool=
 //! cachegrind`: 2,180 and 2,260 before a message's deliveries at one
 //! instant shared a queue entry and firings read only their input slots,
