@@ -8,6 +8,17 @@
 //! tens of seconds). Scouting and the 102 robots are measured also with
 //! every control firing simulated (`Options::every_firing`), which skipping
 //! idle firings replaces. Run with `cargo bench --bench simulate`.
+//!
+//! Measured (release, 10 minutes of mission time, a shared two-core
+//! machine): 102 robots 4,156,664 events in about 0.9 s of CPU (1.0 s
+//! before), 42 MB; 1,002 robots 40,723,064 events in 27.6 s (27.9 s
+//! before), 331 MB. Per event the
+//! instructions are the same for both (about 2,200, `valgrind --tool=
+//! cachegrind`: 2,180 and 2,260 before a message's deliveries at one
+//! instant shared a queue entry and firings read only their input slots,
+//! 2,130 and 2,170 after); the misses of a 1 MB cache are not (1.4 against
+//! 28.0 before, 23.4 after): the large swarm's robots and programs outgrow
+//! the caches, which is the rest of its cost per event.
 
 mod common;
 use common::fastest;

@@ -3,9 +3,9 @@
 //! streamed, `sim::simulate_into`, into the summary's digest and the trace
 //! file's lines), a swarm of the generated benchmark mission (teams of six,
 //! each talking to its neighbours) with twice the teams takes at most about
-//! twice the events, allocations and peak of live bytes, and four times the
-//! mission time of a mission takes about the same memory. One test, so that
-//! nothing else allocates while it counts.
+//! twice the events, entries of the event queue, allocations and peak of
+//! live bytes, and four times the mission time of a mission takes about the
+//! same memory. One test, so that nothing else allocates while it counts.
 //!
 //! Measured with a counting allocator and the engine's event count, not a
 //! clock, so the figures are the same on an idle and on a loaded machine.
@@ -39,16 +39,17 @@ fn programs(name: &str, text: String) -> Vec<RobotProgram> {
     refined.programs
 }
 
-/// What simulating `programs` for `until_ms` costs: (events, peak of live
-/// bytes, allocations). Each trace event goes to the summary's digest and
-/// is written as its line, as `semo simulate --trace FILE` does.
-fn cost(programs: &[RobotProgram], until_ms: i64) -> (u64, usize, usize) {
+/// What simulating `programs` for `until_ms` costs: (events, entries of
+/// the event queue, peak of live bytes, allocations). Each trace event goes
+/// to the summary's digest and is written as its line, as `semo simulate
+/// --trace FILE` does.
+fn cost(programs: &[RobotProgram], until_ms: i64) -> (u64, u64, usize, usize) {
     let scenario = scenario::parse("{}", programs).expect("an empty scenario reads");
     let options = sim::Options {
         until_ms: Some(until_ms),
         ..sim::Options::default()
     };
-    let (events, peak, allocations) = counting::measure(|| {
+    let ((events, queued), peak, allocations) = counting::measure(|| {
         let robots = sim::Run::robots_of(programs);
         let mut digest = sim::Digest::new(&robots, &scenario.expect);
         let mut bytes = 0;
@@ -58,9 +59,9 @@ fn cost(programs: &[RobotProgram], until_ms: i64) -> (u64, usize, usize) {
         });
         assert!(bytes > 0 && run.trace.is_empty());
         assert!(!sim::summary_of(&run, &digest, &[]).contains("no mode"));
-        run.events
+        (run.events, run.queued)
     });
-    (events, peak, allocations)
+    (events, queued, peak, allocations)
 }
 
 /// `large` over `small`, said and checked against `at_most`.
@@ -83,9 +84,21 @@ fn the_simulators_work_follows_the_robots_and_its_memory_not_the_runs_length() {
     cost(&swarm(1), 100);
     let (small, large) = (swarm(8), swarm(16));
     assert_eq!((small.len(), large.len()), (48, 96));
-    let (events_small, peak_small, work_small) = cost(&small, 5000);
-    let (events_large, peak_large, work_large) = cost(&large, 5000);
+    let (events_small, queued_small, peak_small, work_small) = cost(&small, 5000);
+    let (events_large, queued_large, peak_large, work_large) = cost(&large, 5000);
     ratio("events", events_small as usize, events_large as usize, 2.1);
+    ratio(
+        "queue entries",
+        queued_small as usize,
+        queued_large as usize,
+        2.1,
+    );
+    // A message to a team is one entry for the robots it reaches at one
+    // instant, not one per robot: the queue took an entry per event.
+    assert!(
+        queued_large * 4 < events_large * 3,
+        "{queued_large} queue entries for {events_large} events"
+    );
     ratio("allocations", work_small, work_large, 2.2);
     ratio("peak bytes", peak_small, peak_large, 2.2);
 
@@ -95,8 +108,8 @@ fn the_simulators_work_follows_the_robots_and_its_memory_not_the_runs_length() {
     let patrol = std::fs::read_to_string(root.join("examples/swarm/patrol_groups.mission"))
         .expect("the example");
     let patrol = programs("patrol_groups.mission", patrol);
-    let (events_short, peak_short, _) = cost(&patrol, 20_000);
-    let (events_long, peak_long, _) = cost(&patrol, 80_000);
+    let (events_short, _, peak_short, _) = cost(&patrol, 20_000);
+    let (events_long, _, peak_long, _) = cost(&patrol, 80_000);
     ratio("events", events_short as usize, events_long as usize, 4.2);
     // A kept trace took four times the memory.
     ratio("peak bytes", peak_short, peak_long, 1.3);

@@ -83,6 +83,11 @@ pub struct Run {
     pub end_ms: i64,
     /// Events the engine processed (for the cost per event).
     pub events: u64,
+    /// Entries the engine's event queue took (a message's deliveries at
+    /// one instant are one entry): with `events`, the run's work, which
+    /// follows the robots (`compiler/tests/sim_scaling.rs`). 0 for a
+    /// recorded run read back.
+    pub queued: u64,
 }
 
 impl Run {
@@ -93,6 +98,7 @@ impl Run {
             trace,
             end_ms,
             events,
+            queued: 0,
         }
     }
 
@@ -120,9 +126,14 @@ enum Step {
 /// by its time).
 #[derive(Clone, Debug)]
 enum Event {
+    /// One message reaching, at one instant, the robots it goes to there
+    /// (`to`: each with the epoch it had when the message was sent), in
+    /// the order it was sent to them: handled as one delivery event each,
+    /// one after the other. One entry of the queue rather than one per
+    /// robot: a swarm's messages go to whole teams, and the queue's work
+    /// and size grew with every recipient (see [`Sim::comm_send`]).
     Deliver {
-        to: usize,
-        epoch: u32,
+        to: Rc<[(usize, u32)]>,
         /// Shared by every robot the message goes to.
         message: Rc<Message>,
     },
@@ -235,7 +246,10 @@ struct Message {
 }
 
 /// A robot's names as its messages and trace carry them, shared rather
-/// than copied (most of a large run's trace is messages).
+/// than copied (most of a large run's trace is messages), and each text
+/// once for the whole run ([`Interner`]): a message's key is then the same
+/// `Rc` as the key a robot listens for, which compares equal without
+/// reading either text (a swarm's receptions compared them byte by byte).
 struct Names {
     team: Rc<str>,
     /// Its name (messages carry it; its heartbeat's value is its name as text).
@@ -246,21 +260,71 @@ struct Names {
     event_key: Rc<str>,
     /// Per outgoing message: (to, key).
     outgoing: Vec<(Rc<str>, Rc<str>)>,
+    /// Per incoming message: (from team, key).
+    incoming: Vec<(Rc<str>, Rc<str>)>,
+    /// Per subscribed group: its key.
+    subscribed: Vec<Rc<str>>,
 }
 
 impl Names {
-    fn new(program: &RobotProgram) -> Names {
+    fn new(program: &RobotProgram, intern: &mut Interner) -> Names {
+        let m = &program.control;
         Names {
-            team: program.team.as_str().into(),
-            heartbeat: program.robot.as_str().into(),
-            alive_key: crate::codegen::files::alive_key(program).into(),
-            sync_key: crate::codegen::files::sync_key(program).into(),
-            event_key: crate::refine::event_key(&program.team).into(),
-            outgoing: program
-                .control
+            team: intern.text(&program.team),
+            heartbeat: intern.text(&program.robot),
+            alive_key: intern.text(&crate::codegen::files::alive_key(program)),
+            sync_key: intern.text(&crate::codegen::files::sync_key(program)),
+            event_key: intern.text(&crate::refine::event_key(&program.team)),
+            outgoing: m
                 .outgoing
                 .iter()
-                .map(|o| (o.to_team.as_str().into(), o.key.as_str().into()))
+                .map(|o| (intern.text(&o.to_team), intern.text(&o.key)))
+                .collect(),
+            incoming: m
+                .incoming
+                .iter()
+                .map(|i| (intern.text(&i.from_team), intern.text(&i.key)))
+                .collect(),
+            subscribed: m.subscribed.iter().map(|g| intern.text(g)).collect(),
+        }
+    }
+}
+
+/// One `Rc` per distinct text of the programs' names and keys.
+#[derive(Default)]
+struct Interner(HashMap<String, Rc<str>>);
+
+impl Interner {
+    fn text(&mut self, text: &str) -> Rc<str> {
+        if let Some(shared) = self.0.get(text) {
+            return shared.clone();
+        }
+        let shared: Rc<str> = text.into();
+        self.0.insert(text.to_string(), shared.clone());
+        shared
+    }
+}
+
+/// The slots a robot's control task reads its inputs into at each firing
+/// (`read_inputs`), found once: a firing reads these, not every slot of
+/// its program (a swarm's run spent a fifth of its memory traffic there).
+struct Inputs {
+    /// The slots fed by a sensor.
+    sensors: Vec<usize>,
+    /// The shared slots, each with its value's place in the library.
+    shared: Vec<(usize, usize)>,
+}
+
+impl Inputs {
+    fn of(robot: &Robot<'_>) -> Inputs {
+        let slots = &robot.program.control.slots;
+        Inputs {
+            sensors: (0..slots.len())
+                .filter(|&i| matches!(slots[i].source, SlotSource::Sensor { .. }))
+                .collect(),
+            shared: (0..slots.len())
+                .filter(|&i| slots[i].source == SlotSource::Shared)
+                .filter_map(|i| Some((i, robot.library_index[i]?)))
                 .collect(),
         }
     }
@@ -310,6 +374,10 @@ struct Robot<'p> {
     library: Vec<Held>,
     /// Per slot: its value's place in `library` (shared slots only).
     library_index: Vec<Option<usize>>,
+    /// A library value was written since the control task last read the
+    /// library into its slots (otherwise every shared slot holds its value
+    /// already, and reading them again, comparing text, is skipped).
+    library_written: bool,
     /// The owner of the library's globally shared values now (a peer index;
     /// `shared.rs`).
     owner: usize,
@@ -412,6 +480,8 @@ pub struct Sim<'p> {
     scenario: &'p Scenario,
     robots: Vec<Robot<'p>>,
     queue: BinaryHeap<Queued>,
+    /// Entries put in `queue` so far ([`Run::queued`]).
+    queued: u64,
     seq: u64,
     now: i64,
     losses: LossDraws,
@@ -427,6 +497,8 @@ pub struct Sim<'p> {
     recipients: Rc<HashMap<String, Rc<[usize]>>>,
     /// Per robot (program).
     names: Rc<[Names]>,
+    /// Per robot (program): the slots a firing reads its inputs into.
+    inputs: Rc<[Inputs]>,
     /// The last control firing handled: (time, chain).
     last_fire: (i64, u64),
     every_firing: bool,
@@ -521,6 +593,7 @@ impl<'p> Robot<'p> {
                         .flatten()
                 })
                 .collect(),
+            library_written: false,
             owner: program
                 .library
                 .as_ref()
@@ -619,6 +692,7 @@ impl<'p> Sim<'p> {
                 .map(|p| Robot::new(p, scenario, 0, 0))
                 .collect(),
             queue: BinaryHeap::new(),
+            queued: 0,
             seq: 0,
             now: 0,
             losses: LossDraws::new(options.seed),
@@ -626,7 +700,14 @@ impl<'p> Sim<'p> {
             operator_next: scenario.operator.iter().map(|c| c.first).collect(),
             commands: Vec::new(),
             recipients: Rc::new(recipients(programs)),
-            names: programs.iter().map(Names::new).collect(),
+            names: {
+                let mut intern = Interner::default();
+                programs
+                    .iter()
+                    .map(|p| Names::new(p, &mut intern))
+                    .collect()
+            },
+            inputs: Rc::from([]),
             last_fire: (-1, 0),
             every_firing: options.every_firing,
             isolated: None,
@@ -636,6 +717,7 @@ impl<'p> Sim<'p> {
             channel_full: "channel full".into(),
             races: None,
         };
+        sim.inputs = sim.robots.iter().map(Inputs::of).collect();
         for r in 0..programs.len() {
             sim.start(r);
         }
@@ -662,6 +744,7 @@ impl<'p> Sim<'p> {
             _ => self.seq,
         };
         self.queue.push(Queued::new(at, event, tie));
+        self.queued += 1;
     }
 
     /// Puts robot `r`'s next control firing at `at` (a time of its grid).
@@ -738,7 +821,10 @@ impl<'p> Sim<'p> {
             }
         }
         self.trace.drain(..).for_each(&mut *sink);
-        Run::of(self.programs, Vec::new(), self.now, events)
+        Run {
+            queued: self.queued,
+            ..Run::of(self.programs, Vec::new(), self.now, events)
+        }
     }
 
     /// Handles the events of the instants before `until`, or until every
@@ -754,7 +840,11 @@ impl<'p> Sim<'p> {
                 break;
             };
             self.now = t;
-            events += 1;
+            // A message's deliveries at one instant count one event each.
+            events += match &event {
+                Event::Deliver { to, .. } => to.len() as u64,
+                _ => 1,
+            };
             self.handle(event);
             if let Some(sink) = sink.as_mut() {
                 self.trace.drain(..).for_each(&mut **sink);
@@ -814,9 +904,15 @@ impl<'p> Sim<'p> {
                     self.wake(robot);
                 }
             }
-            Event::Deliver { to, epoch, message } => {
-                if self.robots[to].alive && self.robots[to].epoch == epoch {
-                    self.deliver(to, &message);
+            // Each recipient in turn, as if each had its own place in the
+            // queue: they were scheduled one after the other, so nothing
+            // else comes between them. (A delivery stops no robot: the run
+            // cannot end among them.)
+            Event::Deliver { to, message } => {
+                for &(r, epoch) in to.iter() {
+                    if self.robots[r].alive && self.robots[r].epoch == epoch {
+                        self.deliver(r, &message);
+                    }
                 }
             }
             Event::Operator(i) => self.operator(i),
@@ -977,6 +1073,7 @@ impl<'p> Sim<'p> {
         let library = robot.library_index[slot.index()];
         if let Some(k) = library {
             robot.library[k].clone_from(&value);
+            robot.library_written = true;
         }
         robot.slots[slot.index()].clone_from(&value);
         if let Some(k) = library {
@@ -994,39 +1091,44 @@ impl<'p> Sim<'p> {
         let robot = &mut self.robots[r];
         let program = robot.program;
         robot.resources.advance(now);
-        for (i, s) in program.control.slots.iter().enumerate() {
-            match &s.source {
-                SlotSource::Sensor { port, task } => {
-                    let sampled = robot.sampled_at(task, now);
-                    let Some(series) = &robot.sensor_series[i] else {
-                        continue;
-                    };
-                    let n = series.partition_point(|(at, _)| *at <= sampled);
-                    let read = if n > 0 {
-                        series[n - 1].1.clone()
-                    } else if port == "BATTERY"
-                        && let Some(level) = battery_level(&robot.battery, sampled)
-                    {
-                        s.kind.parse(&format!("{}", level.round()))
-                    } else {
-                        None
-                    };
-                    if let Some(v) = read
-                        && robot.slots[i].as_ref() != Some(&v)
-                    {
-                        robot.slots[i] = Some(v);
-                        robot.progressed = true;
-                    }
+        let inputs = &self.inputs[r];
+        for &i in inputs.sensors.iter() {
+            let Some(series) = &robot.sensor_series[i] else {
+                continue;
+            };
+            if series.is_empty() && robot.battery.is_empty() {
+                continue; // nothing to read (the slot's program not looked at)
+            }
+            let s = &program.control.slots[i];
+            let SlotSource::Sensor { port, task } = &s.source else {
+                continue;
+            };
+            let sampled = robot.sampled_at(task, now);
+            let n = series.partition_point(|(at, _)| *at <= sampled);
+            let read = if n > 0 {
+                series[n - 1].1.clone()
+            } else if port == "BATTERY"
+                && let Some(level) = battery_level(&robot.battery, sampled)
+            {
+                s.kind.parse(&format!("{}", level.round()))
+            } else {
+                None
+            };
+            if let Some(v) = read
+                && robot.slots[i].as_ref() != Some(&v)
+            {
+                robot.slots[i] = Some(v);
+                robot.progressed = true;
+            }
+        }
+        // Unless the library was written since, every shared slot holds
+        // its value already.
+        if std::mem::take(&mut robot.library_written) {
+            for &(i, k) in inputs.shared.iter() {
+                if robot.slots[i] != robot.library[k] {
+                    robot.slots[i].clone_from(&robot.library[k]);
+                    robot.progressed = true;
                 }
-                SlotSource::Shared => {
-                    if let Some(k) = robot.library_index[i]
-                        && robot.slots[i] != robot.library[k]
-                    {
-                        robot.slots[i].clone_from(&robot.library[k]);
-                        robot.progressed = true;
-                    }
-                }
-                SlotSource::Local => {}
             }
         }
     }
@@ -1060,6 +1162,10 @@ impl<'p> Sim<'p> {
             value,
             sent_at: self.now,
         });
+        // Each recipient in turn takes the next number of the queue's
+        // order; those reached at the same instant share one entry, under
+        // the first one's number (nothing else is numbered between them).
+        let mut arrivals: Vec<(i64, u64, usize, u32)> = Vec::new();
         for &dst in targets.iter() {
             if dst == r {
                 continue;
@@ -1067,15 +1173,20 @@ impl<'p> Sim<'p> {
             let Some(latency) = self.link(r, dst, &message.key) else {
                 continue;
             };
-            let epoch = self.robots[dst].epoch;
-            self.schedule(
-                self.now + latency,
-                Event::Deliver {
-                    to: dst,
-                    epoch,
-                    message: message.clone(),
-                },
-            );
+            self.seq += 1;
+            arrivals.push((self.now + latency, self.seq, dst, self.robots[dst].epoch));
+        }
+        while let Some(&(at, tie, _, _)) = arrivals.first() {
+            let to: Rc<[(usize, u32)]> = arrivals
+                .iter()
+                .filter(|a| a.0 == at)
+                .map(|&(_, _, dst, epoch)| (dst, epoch))
+                .collect();
+            arrivals.retain(|a| a.0 != at);
+            let message = message.clone();
+            self.queue
+                .push(Queued::new(at, Event::Deliver { to, message }, tie));
+            self.queued += 1;
         }
     }
 
@@ -1225,7 +1336,9 @@ impl<'p> Sim<'p> {
         }
         let robot = &mut self.robots[r];
         let m = &robot.program.control;
-        if m.heartbeat && message.publish && message.key == self.names[r].alive_key {
+        // Keys and names compare as their interned `Rc`s (`Names`).
+        let names = &self.names[r];
+        if m.heartbeat && message.publish && message.key == names.alive_key {
             // A heartbeat's value is text ("leader 80 2"); anything else says nothing.
             let text = match &message.value {
                 Some(Value::Text(t)) => t.as_str(),
@@ -1239,7 +1352,7 @@ impl<'p> Sim<'p> {
             return;
         }
         // `heard_sync`: an arrival at a group statement; wakes the control task.
-        if !m.sync_points.is_empty() && message.key == self.names[r].sync_key {
+        if !m.sync_points.is_empty() && message.key == names.sync_key {
             // Its value is text ("<point> <pass>"); anything else says nothing.
             let text = match &message.value {
                 Some(Value::Text(t)) => t.as_str(),
@@ -1260,15 +1373,15 @@ impl<'p> Sim<'p> {
         // `heard_event`: a broadcast event of its team.
         if !m.events_heard.is_empty()
             && !message.publish
-            && *message.key == *self.names[r].event_key
-            && *message.from_team == *self.names[r].team
+            && message.key == names.event_key
+            && message.from_team == names.team
         {
             self.hear_event(r, message);
             return;
         }
         if !m.subscribed.is_empty() && message.publish {
-            for (i, g) in m.subscribed.iter().enumerate() {
-                if **g == *message.key {
+            for (i, g) in names.subscribed.iter().enumerate() {
+                if *g == message.key {
                     robot.groups[i] = Some(message.value.clone());
                 }
             }
@@ -1278,8 +1391,9 @@ impl<'p> Sim<'p> {
         // (`semo_value_coerce`); text is read as the type.
         let mut pending = VecDeque::new();
         let mut rejected = false;
-        for (i, incoming) in m.incoming.iter().enumerate() {
-            if *incoming.from_team == *message.from_team && *incoming.key == *message.key {
+        for (i, (incoming, (from_team, key))) in m.incoming.iter().zip(&names.incoming).enumerate()
+        {
+            if *from_team == message.from_team && *key == message.key {
                 let kind = &m.slots[incoming.slot.index()].kind;
                 let Some(value) = (match &message.value {
                     Some(v) => kind.coerce(v).map(Some),

@@ -181,17 +181,37 @@ impl<'p> Sim<'p> {
         queue.sort_unstable_by_key(|q| q.key);
         for queued in queue {
             let (t, order, event) = (queued.time(), queued.order(), &queued.event);
-            let live = match event {
+            let alive = |r: usize, epoch: u32| {
+                let robot = &self.robots[r];
+                robot.alive && robot.epoch == epoch
+            };
+            // Each event to come as its time, its kind and what it does.
+            let comes = |fp: &mut Fingerprint, what: &[i64]| {
+                fp.time(t);
+                fp.int(order as i64);
+                what.iter().for_each(|&v| fp.int(v));
+            };
+            match event {
                 Event::Fire {
                     robot,
                     epoch,
                     token,
                 } => {
-                    let r = &self.robots[*robot];
-                    r.alive && r.epoch == *epoch && r.fire_token == *token
+                    if alive(*robot, *epoch) && self.robots[*robot].fire_token == *token {
+                        comes(&mut fp, &[*robot as i64]);
+                    }
                 }
-                Event::Deliver { to: r, epoch, .. } | Event::GraphTrace { robot: r, epoch } => {
-                    self.robots[*r].alive && self.robots[*r].epoch == *epoch
+                Event::GraphTrace { robot, epoch } => {
+                    if alive(*robot, *epoch) {
+                        comes(&mut fp, &[*robot as i64]);
+                    }
+                }
+                // A message's deliveries at one instant: each its own event.
+                Event::Deliver { to, message } => {
+                    for &(r, _) in to.iter().filter(|&&(r, epoch)| alive(r, epoch)) {
+                        comes(&mut fp, &[r as i64]);
+                        fp.message(message);
+                    }
                 }
                 Event::ServiceDone {
                     robot,
@@ -199,29 +219,13 @@ impl<'p> Sim<'p> {
                     generation,
                 } => {
                     let state = &self.robots[*robot].tasks[*task].1;
-                    self.robots[*robot].alive && state.busy && state.generation == *generation
+                    if self.robots[*robot].alive && state.busy && state.generation == *generation {
+                        comes(&mut fp, &[*robot as i64, *task as i64]);
+                    }
                 }
-                Event::Fault(_) | Event::Operator(_) => true,
-            };
-            if !live {
-                continue;
-            }
-            fp.time(t);
-            fp.int(order as i64);
-            match event {
-                Event::Fire { robot, .. } | Event::GraphTrace { robot, .. } => {
-                    fp.int(*robot as i64)
-                }
-                Event::Deliver { to, message, .. } => {
-                    fp.int(*to as i64);
-                    fp.message(message);
-                }
-                Event::ServiceDone { robot, task, .. } => {
-                    fp.int(*robot as i64);
-                    fp.int(*task as i64);
-                }
-                Event::Fault(i) => fp.int(*i as i64),
+                Event::Fault(i) => comes(&mut fp, &[*i as i64]),
                 Event::Operator(i) => {
+                    comes(&mut fp, &[]);
                     let c = self.command(*i);
                     fp.text(&c.to);
                     fp.text(&c.key);

@@ -188,6 +188,7 @@ impl Sim<'_> {
                 return true;
             }
             self.robots[r].library[g.at].clone_from(&value);
+            self.robots[r].library_written = true;
             self.trace.push(super::TraceEvent {
                 t: self.now,
                 robot: r,
@@ -203,6 +204,7 @@ impl Sim<'_> {
             self.tell(r, k, to, value);
         } else {
             self.robots[r].library[g.at].clone_from(&value);
+            self.robots[r].library_written = true;
             self.trace.push(super::TraceEvent {
                 t: self.now,
                 robot: r,
