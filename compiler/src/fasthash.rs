@@ -28,22 +28,33 @@ impl FastHasher {
     }
 }
 
+/// `bytes` as little-endian 64-bit words, the last one padded with zeros:
+/// `each` gets a word and how many of its bytes are the text's (8 but for
+/// a short last one), so that a hasher can tell "a" from "a\0".
+#[inline]
+pub(crate) fn le_words(bytes: &[u8], mut each: impl FnMut(u64, usize)) {
+    let mut chunks = bytes.chunks_exact(8);
+    for chunk in &mut chunks {
+        let mut word = [0; 8];
+        word.copy_from_slice(chunk);
+        each(u64::from_le_bytes(word), 8);
+    }
+    let rest = chunks.remainder();
+    if !rest.is_empty() {
+        let mut word = [0; 8];
+        word[..rest.len()].copy_from_slice(rest);
+        each(u64::from_le_bytes(word), rest.len());
+    }
+}
+
 impl Hasher for FastHasher {
     #[inline]
     fn write(&mut self, bytes: &[u8]) {
-        let mut chunks = bytes.chunks_exact(8);
-        for chunk in &mut chunks {
-            let mut word = [0; 8];
-            word.copy_from_slice(chunk);
-            self.add(u64::from_le_bytes(word));
-        }
-        let rest = chunks.remainder();
-        if !rest.is_empty() {
-            let mut word = [0; 8];
-            word[..rest.len()].copy_from_slice(rest);
+        le_words(bytes, |word, len| match len {
+            8 => self.add(word),
             // The length keeps "a" and "a\0" apart.
-            self.add(u64::from_le_bytes(word) ^ ((rest.len() as u64) << 56));
-        }
+            _ => self.add(word ^ ((len as u64) << 56)),
+        });
     }
 
     #[inline]

@@ -378,20 +378,9 @@ impl Fingerprint {
     }
 
     fn text(&mut self, s: &str) {
+        // The length, hashed first, tells "a" from "a\0".
         self.int(s.len() as i64);
-        let mut chunks = s.as_bytes().chunks_exact(8);
-        for chunk in &mut chunks {
-            let mut word = [0; 8];
-            word.copy_from_slice(chunk);
-            self.word(u64::from_le_bytes(word));
-        }
-        let rest = chunks.remainder();
-        if !rest.is_empty() {
-            // The length, hashed first, tells "a" from "a\0".
-            let mut word = [0; 8];
-            word[..rest.len()].copy_from_slice(rest);
-            self.word(u64::from_le_bytes(word));
-        }
+        crate::fasthash::le_words(s.as_bytes(), |word, _| self.word(word));
     }
 
     /// A value by its kind and content (no text made: this runs for every
