@@ -86,6 +86,56 @@ fn trace_path(work: &Path, robot: &Robot, incarnation: u32) -> PathBuf {
     work.join(format!("{}.{incarnation}.jsonl", robot.name))
 }
 
+/// The run's one processor: the coordinator's thread and every robot's
+/// threads run on it (the processor the coordinator was on, when it may
+/// stay there). In lock-step they take turns, one at a time; a turn handed
+/// to a thread on another processor waits for that processor to wake (on a
+/// virtual machine tens of microseconds, a dozen times per robot instant),
+/// which is most of a run's time on an idle machine. Where the affinity
+/// cannot be set the run goes on anywhere, only slower; the outcome is the
+/// same (lock-step fixes the order of everything).
+struct OneCpu {
+    one: rustix::thread::CpuSet,
+    /// The coordinator thread's affinity before, given back at the end.
+    before: Option<rustix::thread::CpuSet>,
+}
+
+impl OneCpu {
+    fn take() -> Self {
+        use rustix::thread::{CpuSet, sched_getaffinity, sched_getcpu, sched_setaffinity};
+        let before = sched_getaffinity(None).ok();
+        let mut one = CpuSet::new();
+        let here = sched_getcpu();
+        match &before {
+            Some(allowed) if here < CpuSet::MAX_CPU && allowed.is_set(here) => one.set(here),
+            Some(allowed) => match (0..CpuSet::MAX_CPU).find(|&c| allowed.is_set(c)) {
+                Some(c) => one.set(c),
+                None => return OneCpu { one, before: None },
+            },
+            None => return OneCpu { one, before: None },
+        }
+        let _ = sched_setaffinity(None, &one);
+        OneCpu { one, before }
+    }
+
+    /// Set before the robot connects, so that every thread it starts
+    /// inherits it.
+    fn keep(&self, child: &Child) {
+        if self.before.is_some() {
+            let pid = rustix::process::Pid::from_child(child);
+            let _ = rustix::thread::sched_setaffinity(Some(pid), &self.one);
+        }
+    }
+}
+
+impl Drop for OneCpu {
+    fn drop(&mut self) {
+        if let Some(before) = &self.before {
+            let _ = rustix::thread::sched_setaffinity(None, before);
+        }
+    }
+}
+
 /// What a robot's stream brought.
 enum Frame {
     /// Idle until the given time (`None`: until a message or for ever).
@@ -135,6 +185,8 @@ struct Coordinator<'r, 'a> {
     /// after that incarnation's own lines (a killed process writes nothing
     /// more; the simulator traces the same `fault` events).
     faults_after: Vec<BTreeMap<u32, String>>,
+    /// The processor of the run (given back when the coordinator goes).
+    cpu: OneCpu,
 }
 
 impl<'r, 'a> Coordinator<'r, 'a> {
@@ -149,6 +201,7 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             sent: 0,
             losses: LossDraws::new(run.seed),
             faults_after: vec![BTreeMap::new(); run.robots.len()],
+            cpu: OneCpu::take(),
         }
     }
 
@@ -234,6 +287,7 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             .stderr(errors)
             .spawn()
             .map_err(|e| format!("cannot start {}: {e}", robot.exe.display()))?;
+        self.cpu.keep(&child);
         let (stream, who) = match self.accept(&mut child) {
             Ok(accepted) => accepted,
             Err(e) => {
