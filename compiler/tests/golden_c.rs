@@ -224,20 +224,17 @@ fn every_template_s_text_is_in_some_snapshot() {
             snapshots.push_str(&std::fs::read_to_string(&path).unwrap());
         }
     }
-    let mut folders = vec![manifest.join("src/codegen/templates")];
     let mut unseen = Vec::new();
-    while let Some(folder) = folders.pop() {
-        for entry in std::fs::read_dir(&folder).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                folders.push(path);
-                continue;
-            }
-            let text = std::fs::read_to_string(&path).unwrap();
-            for piece in fixed_pieces(&text) {
-                if !snapshots.contains(piece) {
-                    unseen.push(format!("{}: {piece:?}", path.display()));
-                }
+    for entry in walkdir::WalkDir::new(manifest.join("src/codegen/templates")) {
+        let entry = entry.unwrap();
+        if !entry.file_type().is_file() {
+            continue;
+        }
+        let path = entry.path();
+        let text = std::fs::read_to_string(path).unwrap();
+        for piece in fixed_pieces(&text) {
+            if !snapshots.contains(piece) {
+                unseen.push(format!("{}: {piece:?}", path.display()));
             }
         }
     }
