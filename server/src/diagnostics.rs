@@ -57,6 +57,7 @@ pub const DATAFLOW_DEBOUNCE: std::time::Duration = std::time::Duration::from_mil
 
 /// Runs for the life of the server.
 pub async fn publish_loop(state: Arc<State>, client: Client) {
+    state.indexed.wait().await;
     loop {
         state.queue.wake.notified().await;
         while let Some(uri) = state.queue.pop() {

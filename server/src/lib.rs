@@ -36,6 +36,33 @@ pub struct State {
     pub queue: diagnostics::Queue,
     /// `semo verify`'s findings of saved missions (`verify.rs`).
     pub verified: verify::Verified,
+    /// Whether the workspace folders were read at start.
+    pub indexed: Indexed,
+}
+
+/// Opens once the workspace folders were read (after `initialized`).
+/// Requests and the diagnostics task wait for it, so that the first answer
+/// after start sees the project file and the catalogs as later ones do: a
+/// request sent at once after `initialized` would otherwise race the read
+/// (a live monitor started at once used the default broker, not the one
+/// of the project's deployment file).
+pub struct Indexed(tokio::sync::watch::Sender<bool>);
+
+impl Default for Indexed {
+    fn default() -> Indexed {
+        Indexed(tokio::sync::watch::channel(false).0)
+    }
+}
+
+impl Indexed {
+    pub fn open(&self) {
+        self.0.send_replace(true);
+    }
+
+    pub async fn wait(&self) {
+        // The sender lives as long as `self`: the wait ends only by opening.
+        let _ = self.0.subscribe().wait_for(|open| *open).await;
+    }
 }
 
 impl State {

@@ -54,11 +54,17 @@ impl Backend {
         }
     }
 
+    /// The world for a request: once the workspace folders were read.
+    async fn world(&self) -> std::sync::MutexGuard<'_, world::World> {
+        self.state.indexed.wait().await;
+        self.state.world()
+    }
+
     /// The current snapshot of a document, or an error for files never opened
     /// nor found in the workspace.
-    fn snapshot(&self, uri: &Uri) -> Result<Arc<Snapshot>> {
-        self.state
-            .world()
+    async fn snapshot(&self, uri: &Uri) -> Result<Arc<Snapshot>> {
+        self.world()
+            .await
             .snapshot(uri)
             .ok_or_else(|| unknown_document(uri))
     }
@@ -74,7 +80,7 @@ impl Backend {
         f: impl FnOnce(&Snapshot, &host::Analysis) -> T + Send + 'static,
     ) -> Result<T> {
         let (snapshot, workspace) = {
-            let world = self.state.world();
+            let world = self.world().await;
             (world.snapshot(uri), world.analysis())
         };
         let snapshot = snapshot.ok_or_else(|| unknown_document(uri))?;
@@ -94,7 +100,7 @@ impl Backend {
         uri: &Uri,
         f: impl FnOnce(&Snapshot) -> T + Send + 'static,
     ) -> Result<T> {
-        let snapshot = self.snapshot(uri)?;
+        let snapshot = self.snapshot(uri).await?;
         tokio::task::spawn_blocking(move || f(&snapshot))
             .await
             .map_err(|e| Error {
@@ -109,13 +115,12 @@ impl Backend {
         &self,
         params: handlers::catalog::CatalogParams,
     ) -> Result<serde_json::Value> {
-        let catalog = match params
-            .uri
-            .as_ref()
-            .and_then(|u| self.state.world().snapshot(u))
-        {
-            Some(snapshot) => snapshot.catalog.clone(),
-            None => self.state.world().catalog(),
+        let catalog = {
+            let world = self.world().await;
+            match params.uri.as_ref().and_then(|u| world.snapshot(u)) {
+                Some(snapshot) => snapshot.catalog.clone(),
+                None => world.catalog(),
+            }
         };
         tokio::task::spawn_blocking(move || handlers::catalog::catalog(catalog.catalog()))
             .await
@@ -140,7 +145,7 @@ impl Backend {
         params: handlers::monitor::StartParams,
     ) -> Result<serde_json::Value> {
         use handlers::monitor;
-        let job = monitor::job(&self.state.world(), params).map_err(handlers::request_failed)?;
+        let job = monitor::job(&*self.world().await, params).map_err(handlers::request_failed)?;
         let plan = tokio::task::spawn_blocking(move || monitor::plan(&job))
             .await
             .map_err(|_| Error::internal_error())?
@@ -173,7 +178,7 @@ impl Backend {
     /// `semo/viewFileText`: the server's text of a document, to debug
     /// synchronisation (as rust-analyzer's `viewFileText`).
     pub async fn view_file_text(&self, params: TextDocumentIdentifier) -> Result<String> {
-        Ok(self.snapshot(&params.uri)?.text.to_string())
+        Ok(self.snapshot(&params.uri).await?.text.to_string())
     }
 
     /// `semo.simulate`: the mission's robots run on a scenario; the summary,
@@ -183,7 +188,7 @@ impl Backend {
         use handlers::simulate;
         let params = simulate::params(arguments).map_err(Error::invalid_params)?;
         let job = {
-            let world = self.state.world();
+            let world = self.world().await;
             simulate::job(&world, params).map_err(handlers::request_failed)?
         };
         let outcome = tokio::task::spawn_blocking(move || simulate::simulate(&job))
@@ -204,7 +209,7 @@ impl Backend {
         let params = verify_mission::params(arguments).map_err(Error::invalid_params)?;
         let cancel = CancelOnDrop::default();
         let job = {
-            let world = self.state.world();
+            let world = self.world().await;
             verify_mission::job(&world, params, cancel.0.clone())
                 .map_err(handlers::request_failed)?
         };
@@ -226,7 +231,7 @@ impl Backend {
         use handlers::generate_code as generate;
         let params = generate::params(arguments).map_err(Error::invalid_params)?;
         let (job, encoding) = {
-            let world = self.state.world();
+            let world = self.world().await;
             let job = generate::job(&world, params).map_err(handlers::request_failed)?;
             (job, world.encoding)
         };
@@ -444,11 +449,11 @@ impl Backend {
 
     async fn index_workspace(&self) {
         let roots = self.state.world().roots().to_vec();
-        let Ok(found) = tokio::task::spawn_blocking(move || world::read_roots(&roots)).await else {
-            return;
-        };
-        let changed = self.state.world().index(found);
-        self.state.queue.push(changed.files);
+        if let Ok(found) = tokio::task::spawn_blocking(move || world::read_roots(&roots)).await {
+            let changed = self.state.world().index(found);
+            self.state.queue.push(changed.files);
+        }
+        self.state.indexed.open();
     }
 }
 
@@ -587,7 +592,7 @@ impl LanguageServer for Backend {
             snippets: self.snippets.load(Ordering::Relaxed),
         };
         let uri = &p.text_document_position.text_document.uri;
-        let scenario = handlers::scenario::job(&self.state.world(), uri);
+        let scenario = handlers::scenario::job(&*self.world().await, uri);
         if let Some(job) = scenario {
             return tokio::task::spawn_blocking(move || {
                 Some(handlers::scenario::completion(&job, position))
@@ -746,7 +751,7 @@ impl LanguageServer for Backend {
 
     async fn symbol(&self, p: WorkspaceSymbolParams) -> Result<Option<WorkspaceSymbolResponse>> {
         let (workspace, encoding, uris) = {
-            let world = self.state.world();
+            let world = self.world().await;
             (world.analysis(), world.encoding, world.file_uris())
         };
         let found = tokio::task::spawn_blocking(move || {

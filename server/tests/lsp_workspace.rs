@@ -123,6 +123,45 @@ async fn workspace_files_are_indexed_and_catalog_changes_recheck_missions() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A request sent at once after `initialized` sees the workspace as a later
+/// one does: it waits for the folders to be read. (Many files make the read
+/// long enough that a request which did not wait would answer before it.)
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_request_sent_at_once_after_start_sees_the_workspace() {
+    let dir = temp_workspace("at-once");
+    std::fs::write(dir.join("rover.robot.xml"), CATALOG).unwrap();
+    let filler = dir.join("filler");
+    std::fs::create_dir(&filler).unwrap();
+    for i in 0..600 {
+        std::fs::write(filler.join(format!("m{i}.mission")), "{\n  T: Rover r\n}\n").unwrap();
+    }
+    let mission = dir.join("dig.mission");
+    let text = "{\n  T: Rover r\n}\nT.P.S{\n  dig()\n} repeat()\nT.M{ set(P, S) }\nT.main{ default: mode = M }\n";
+    std::fs::write(&mission, text).unwrap();
+
+    let mut client = TestClient::start();
+    client.initialize(&["utf-16"], Some(&uri(&dir))).await;
+    let catalog = client
+        .request("semo/catalog", json!({ "uri": uri(&mission) }))
+        .await
+        .unwrap();
+    let types: Vec<&str> = catalog["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|r| r["name"].as_str())
+        .collect();
+    assert!(types.contains(&"Rover"), "{types:?}");
+    // The first diagnostics of the mission come with the catalog read too.
+    client.open(&uri(&mission), text).await;
+    assert_eq!(
+        client.diagnostics(&uri(&mission), Some(1)).await,
+        Vec::<Value>::new()
+    );
+    client.shutdown().await;
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_catalog_request_lists_builtin_and_workspace_robot_types_and_follows_changes() {
     let mut client = TestClient::start();
