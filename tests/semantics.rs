@@ -371,6 +371,6 @@ fn a_new_leader_does_not_act_on_commands_sent_before_it_led() {
         .filter(|e| field(e, "event") == "drop")
         .map(|e| (field(e, "key"), field(e, "reason")))
         .collect();
-    let before = ("USER.RC_CMD", semo::codegen::UNLED_REASON);
+    let before = ("USER.RC_CMD", semo::refine::protocol::UNLED_REASON);
     assert_eq!(dropped, [before, before]);
 }

@@ -310,7 +310,7 @@ pub fn analyze_graph_as(
     });
     let (hierarchy, report) = match &graph {
         Some(g) if loaded_cleanly => {
-            let hierarchy = subgraph::resolve(g, location, resolver);
+            let hierarchy = crate::taskgraph::resolve(g, location, resolver);
             let report = crate::taskgraph::analysis::analyze_as(g, &hierarchy, concurrency);
             (hierarchy, report)
         }

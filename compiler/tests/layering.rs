@@ -374,3 +374,190 @@ fn the_table_reader_reads_rows_and_rejects_nothing_silently() {
         ["b", "c"]
     );
 }
+
+/// Every path a file names from `crate::` or `super::`, as the segments of
+/// the module it reaches (`file_module`: the file's own module path, e.g.
+/// `["codegen", "output", "write"]` for `codegen/output/write.rs`), each
+/// group (`{a, b::c}`) expanded.
+fn module_paths(code: &str, file_module: &[String]) -> Vec<Vec<String>> {
+    fn ident(s: &str) -> &str {
+        let end = s
+            .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+            .unwrap_or(s.len());
+        &s[..end]
+    }
+    /// The paths under `rest` (after a `::`), each prefixed with `base`.
+    fn expand(rest: &str, base: Vec<String>, out: &mut Vec<Vec<String>>) {
+        let rest = rest.trim_start();
+        if let Some(group) = rest.strip_prefix('{') {
+            let mut depth = 0;
+            let mut start = 0;
+            for (i, c) in group.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => {
+                        expand(&group[start..i], base.clone(), out);
+                        return;
+                    }
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => {
+                        expand(&group[start..i], base.clone(), out);
+                        start = i + 1;
+                    }
+                    _ => {}
+                }
+            }
+            return;
+        }
+        let name = ident(rest);
+        let mut path = base;
+        if name.is_empty() || name == "self" {
+            out.push(path);
+            return;
+        }
+        path.push(name.to_string());
+        match rest[name.len()..].trim_start().strip_prefix("::") {
+            Some(more) => expand(more, path, out),
+            None => out.push(path),
+        }
+    }
+    let mut out = Vec::new();
+    for prefix in ["crate::", "super::"] {
+        for (at, _) in code.match_indices(prefix) {
+            let preceded = code[..at]
+                .chars()
+                .next_back()
+                .is_some_and(|c| c.is_alphanumeric() || c == '_' || c == '$' || c == ':');
+            if preceded {
+                continue; // `$crate::`, `super::super::` (taken at its first), a longer name
+            }
+            let mut rest = &code[at + prefix.len()..];
+            let base = if prefix == "crate::" {
+                Vec::new()
+            } else {
+                let mut base = file_module[..file_module.len().saturating_sub(1)].to_vec();
+                while let Some(more) = rest.trim_start().strip_prefix("super::") {
+                    base.pop();
+                    rest = more;
+                }
+                base
+            };
+            expand(rest, base, &mut out);
+        }
+    }
+    out
+}
+
+/// The parts of a folder module (`src/M/`): its files and folders but
+/// `mod.rs` and its own tests and their helpers (`tests`, `testing`), each
+/// with its files.
+fn parts(folder: &Path) -> BTreeMap<String, Vec<PathBuf>> {
+    let mut parts: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
+    for entry in std::fs::read_dir(folder).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        if name == "mod" || name == "tests" || name == "testing" {
+            continue;
+        }
+        let mut files = Vec::new();
+        if path.is_dir() {
+            rust_files(&path, &mut files);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            files.push(path);
+        }
+        if !files.is_empty() {
+            parts.entry(name).or_default().extend(files);
+        }
+    }
+    parts
+}
+
+/// A file's module path below `src`: `a/b.rs` → `[a, b]`, `a/b/mod.rs` → `[a, b]`.
+fn file_module(src: &Path, file: &Path) -> Vec<String> {
+    let relative = file.strip_prefix(src).unwrap().with_extension("");
+    let mut path: Vec<String> = relative
+        .iter()
+        .map(|s| s.to_string_lossy().into_owned())
+        .collect();
+    if path.last().is_some_and(|l| l == "mod") {
+        path.pop();
+    }
+    path
+}
+
+/// Inside each module folder, at every depth, the parts are layered too:
+/// no part reads a part that reads it back, directly or through others (the
+/// folder's own `mod.rs`, which wires them, and its tests stand above them
+/// all).
+#[test]
+fn the_parts_of_each_module_folder_form_no_cycle() {
+    let src = root().join("src");
+    let mut folders = Vec::new();
+    let mut stack = vec![src.clone()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                folders.push(path.clone());
+                stack.push(path);
+            }
+        }
+    }
+    let mut problems = Vec::new();
+    let mut checked = 0;
+    for folder in folders {
+        let module = file_module(&src, &folder.join("mod.rs"));
+        let parts = parts(&folder);
+        let mut reads: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+        for (part, files) in &parts {
+            let edges = reads.entry(part.clone()).or_default();
+            for file in files {
+                let code = code_only(&std::fs::read_to_string(file).unwrap());
+                for path in module_paths(&code, &file_module(&src, file)) {
+                    if path.len() > module.len()
+                        && path[..module.len()] == module[..]
+                        && path[module.len()] != *part
+                        && parts.contains_key(&path[module.len()])
+                    {
+                        edges.insert(path[module.len()].clone());
+                    }
+                }
+            }
+        }
+        checked += 1;
+        if let Some(cycle) = find_cycle(&reads) {
+            problems.push(format!("{}/: {}", module.join("/"), cycle.join(" → ")));
+        }
+    }
+    assert!(checked > 10, "only {checked} folders found under src/");
+    assert!(
+        problems.is_empty(),
+        "parts of a module folder read each other in a cycle:\n  {}",
+        problems.join("\n  ")
+    );
+}
+
+#[test]
+fn the_module_path_reader_resolves_crate_and_super_paths() {
+    let at = |p: &[&str]| p.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let code = code_only(
+        "use super::{model::Task, xml::{self, read}};\n\
+         use super::super::diag::Code;\n\
+         use crate::taskgraph::analysis::analyze;\n\
+         let x = crate::{span::Span, text};\n",
+    );
+    let found = module_paths(&code, &at(&["taskgraph", "subgraph"]));
+    let found: Vec<String> = found.iter().map(|p| p.join("::")).collect();
+    assert_eq!(
+        found,
+        [
+            "taskgraph::analysis::analyze",
+            "span::Span",
+            "text",
+            "taskgraph::model::Task",
+            "taskgraph::xml",
+            "taskgraph::xml::read",
+            "diag::Code",
+        ]
+    );
+}

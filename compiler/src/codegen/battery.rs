@@ -13,7 +13,6 @@
 //! does the same (`sim/engine/battery.rs`).
 
 use super::c;
-use super::control::expr;
 use super::template::{Template, fill, template};
 use crate::refine::{BatteryPolicy, RobotProgram, RoleKind};
 use std::fmt::Write;
@@ -78,7 +77,7 @@ pub(super) fn resource_manager(program: &RobotProgram, words: &super::values::Wo
             &[
                 ("text", &c::comment(&policy.text)),
                 ("source", &c::comment(&policy.source)),
-                ("condition", &expr(&policy.condition, words)),
+                ("condition", &words.condition(&policy.condition)),
                 ("i", &i),
                 ("text_string", &c::string(&policy.text)),
             ],

@@ -1,4 +1,7 @@
-//! C spelling: string literals, comments and identifiers from mission names.
+//! C spelling: string literals, comments and identifiers from mission names,
+//! and each layer's lock of state shared between tasks.
+
+use super::{Layer, Target};
 
 /// A C string literal for `text`: quotes, backslashes, control characters,
 /// non-ASCII bytes (as octal) and `?` (no trigraphs) escaped.
@@ -52,6 +55,26 @@ pub fn is_safe_name(name: &str) -> bool {
         .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
         && name.len() <= 64
+}
+
+/// The lock of state shared between tasks: a mutex on threads, nothing on
+/// the static schedule (one task runs at a time). `(include, declare, lock,
+/// unlock)` for a lock named `name`.
+pub fn lock(target: Target, name: &str) -> (&'static str, String, String, String) {
+    match target.layer() {
+        Layer::Threads => (
+            "#include <pthread.h>\n",
+            format!("static pthread_mutex_t {name} = PTHREAD_MUTEX_INITIALIZER;\n"),
+            format!("pthread_mutex_lock(&{name});"),
+            format!("pthread_mutex_unlock(&{name});"),
+        ),
+        Layer::Static => (
+            "",
+            String::new(),
+            "/* no lock: one task runs at a time */".into(),
+            "/* end of the access */".into(),
+        ),
+    }
 }
 
 #[cfg(test)]

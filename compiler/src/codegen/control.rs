@@ -11,12 +11,11 @@ use super::peers::Peers;
 use super::template::{Template, fill, template};
 use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
+use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms};
 use crate::refine::{
     ActionMachine, ControlMachine, CountedGroup, Expr, LeaderAlgorithm, Operand, RobotProgram,
     SendItem, SlotId, SlotSource, State, StateId, StateKind,
 };
-use crate::sema::Compared;
-use crate::syntax::ast::CmpOp;
 use std::fmt::Write;
 
 /// The region record, the mode variables and `wake_at`, before the machine.
@@ -138,56 +137,6 @@ pub(super) const TEMPLATES: &[Template] = &[
 /// State transitions a region may take in one firing: a service whose
 /// states never wait (only sends and branches) still yields to the others.
 const STEPS_PER_FIRING: usize = 64;
-
-/// How long a robot that must first hear its team (a restarted robot, or
-/// every robot of a `highest_battery` election at start) listens before an
-/// election: one heartbeat period and half of one more, so that the
-/// heartbeat each robot sends once per period has arrived even when its
-/// sender's firing was a little late. The simulator uses the same.
-pub fn listen_ms(heartbeat_ms: i64) -> i64 {
-    heartbeat_ms + heartbeat_ms / 2
-}
-
-/// A leader's lease (`docs/groups.md`, "Fencing"): a robot the election
-/// would choose leads only while it has heard a strict majority of the
-/// candidates, itself included, within the last two heartbeat periods. Two
-/// is less than the three silent periods after which the others count it
-/// lost, so a leader cut off from the majority steps down at its first
-/// election after its lease lapsed, before they elect another (at their
-/// first election after three). The simulator uses the same.
-pub fn lease_ms(heartbeat_ms: i64) -> i64 {
-    2 * heartbeat_ms
-}
-
-/// The largest term (`docs/groups.md`, "Terms"): a heartbeat saying more
-/// says this, and a robot that knows it begins to lead under it again, so
-/// that a rogue heartbeat cannot overflow the count (`int64_t` in the C,
-/// on every target).
-pub const TERM_MAX: i64 = 1_000_000_000_000_000;
-
-/// The term a robot begins to lead under: one past the highest it knows.
-pub fn next_term(highest: i64) -> i64 {
-    (highest + 1).min(TERM_MAX)
-}
-
-/// The term a heartbeat says (`heard_alive` in the C): its leading digits,
-/// at most [`TERM_MAX`]; none is 0.
-pub fn parse_term(word: &str) -> i64 {
-    let digits = word.bytes().take_while(u8::is_ascii_digit);
-    digits.fold(0i64, |term, d| {
-        (term * 10 + i64::from(d - b'0')).min(TERM_MAX)
-    })
-}
-
-/// The `heard` field of the `fenced` event: "2 of 5".
-pub fn fenced_heard(heard: usize, candidates: usize) -> String {
-    format!("{heard} of {candidates}")
-}
-
-/// The `reason` of the `drop` event of a message dropped because it arrived
-/// before its robot became the leader of the `leader(...)` arm whose block
-/// receives it (`drop_unled`). The simulator uses the same.
-pub const UNLED_REASON: &str = "arrived before it led";
 
 /// Drops what a channel holds now, oldest first, each traced: a robot that
 /// has just become the leader drops the messages waiting for its leader's
@@ -363,44 +312,6 @@ pub fn control_task(program: &RobotProgram, words: &Words, peers: &Peers, header
     out
 }
 
-fn operand(op: &Operand, words: &Words) -> String {
-    match op {
-        Operand::Slot(s) => format!("&slot[{s}]"),
-        Operand::Literal(value) => words.literal(value),
-    }
-}
-
-pub(super) fn expr(e: &Expr, words: &Words) -> String {
-    match e {
-        Expr::Or(a, b) => format!("({} || {})", expr(a, words), expr(b, words)),
-        Expr::And(a, b) => format!("({} && {})", expr(a, words), expr(b, words)),
-        Expr::Not(a) => format!("!{}", expr(a, words)),
-        Expr::Bool(b) => b.to_string(),
-        Expr::Truthy(o) => format!("semo_value_truthy({})", operand(o, words)),
-        // As the checker typed the comparison: the runtime never guesses
-        // from the values whether they are numbers.
-        Expr::Compare(a, op, b, compared) => {
-            let function = match compared {
-                Compared::Numbers => "semo_value_numbers",
-                Compared::Words => "semo_value_words",
-            };
-            let op = match op {
-                CmpOp::Eq => "SEMO_EQ",
-                CmpOp::Ne => "SEMO_NE",
-                CmpOp::Lt => "SEMO_LT",
-                CmpOp::Le => "SEMO_LE",
-                CmpOp::Gt => "SEMO_GT",
-                CmpOp::Ge => "SEMO_GE",
-            };
-            format!(
-                "{function}({}, {op}, {})",
-                operand(a, words),
-                operand(b, words)
-            )
-        }
-    }
-}
-
 /// A program that broadcasts or hears events: `catch_event` (the current
 /// mode's catch, with the thrower of a broadcast one), the throws `body`
 /// uses, and `take_events` (the broadcast events received since the last
@@ -568,7 +479,7 @@ fn args_array(args: &[Operand], words: &Words) -> String {
     if args.is_empty() {
         return "NULL".into();
     }
-    let items: Vec<String> = args.iter().map(|a| operand(a, words)).collect();
+    let items: Vec<String> = args.iter().map(|a| words.operand(a)).collect();
     format!("(const semo_value *const[]){{{}}}", items.join(", "))
 }
 
@@ -748,7 +659,7 @@ fn emit_send(out: &mut String, cx: &StateCx, items: &[SendItem]) {
     } = *cx;
     let m = &program.control;
     for item in items {
-        let value = operand(&item.value, words);
+        let value = words.operand(&item.value);
         if let Some(s) = item.store {
             let _ = writeln!(out, "        store({s}, {value});");
         }
@@ -889,7 +800,7 @@ fn emit_run_actions(
     let _ = writeln!(out, "        if (r->phase == 0) {{");
     for (i, slot) in am.arguments.iter().enumerate() {
         if let Some(arg) = args.get(i) {
-            let _ = writeln!(out, "            store({slot}, {});", operand(arg, words));
+            let _ = writeln!(out, "            store({slot}, {});", words.operand(arg));
         }
     }
     out.push_str(&fill(
@@ -1027,7 +938,7 @@ fn emit_group_sync(
             ("count", &members.len()),
             ("offset", &m.sync_points[*point]),
             ("team", &c::string(&program.team)),
-            ("key", &c::string(&super::files::sync_key(program))),
+            ("key", &c::string(&protocol::sync_key(program))),
             ("point", &point),
             ("hb", &hb),
             ("timeout_ms", &timeout_ms),
@@ -1043,7 +954,7 @@ fn emit_branch(out: &mut String, cx: &StateCx, condition: &Expr, else_to: &State
     let _ = writeln!(
         out,
         "        r->pc = {} ? {next} : {else_to};\n        return STEP_NEXT;",
-        expr(condition, words)
+        words.condition(condition)
     );
 }
 
@@ -1065,7 +976,7 @@ fn emit_loop_head(
         let _ = writeln!(
             out,
             "        if (!{}) {{\n            r->pc = {exit_to};\n            return STEP_NEXT;\n        }}",
-            expr(cond, words)
+            words.condition(cond)
         );
     }
     let _ = writeln!(
@@ -1113,7 +1024,7 @@ fn emit_repeat(
         let _ = writeln!(
             out,
             "        if (!{})\n            return STEP_DONE;",
-            expr(cond, words)
+            words.condition(cond)
         );
     }
     if let Some(p) = period_ms {
@@ -1180,7 +1091,7 @@ fn emit_action_machine(
         for (condition, to) in &action.transitions {
             let test = condition
                 .as_ref()
-                .map_or_else(|| "true".to_string(), |c| expr(c, words));
+                .map_or_else(|| "true".to_string(), |c| words.condition(c));
             let _ = writeln!(
                 out,
                 "        if ({test}) {{\n            r->action = {to};\n            r->phase = 1;\n            return STEP_NEXT;\n        }}"
@@ -1317,7 +1228,7 @@ fn emit_task(out: &mut String, program: &RobotProgram, peers: &Peers) {
             &[
                 ("hb", &m.heartbeat_ms),
                 ("team", &c::string(&program.team)),
-                ("key", &c::string(&super::files::alive_key(program))),
+                ("key", &c::string(&protocol::alive_key(program))),
                 ("group", &group_update(m, peers)),
             ],
         ));

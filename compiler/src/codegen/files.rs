@@ -7,20 +7,10 @@ use super::template::{Template, fill, template};
 use super::values::Words;
 use super::{CompiledScenario, Layer, Target};
 use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK};
+use crate::refine::protocol::{TERM_MAX, alive_key, sync_key};
 use crate::refine::{RobotProgram, RoleKind, ValueKind};
 use crate::taskgraph::Trigger;
 use std::fmt::Write;
-
-/// The key of the heartbeats a team's robots publish for leader elections.
-pub fn alive_key(program: &RobotProgram) -> String {
-    format!("{}.__alive", program.team)
-}
-
-/// The key of the announcements a team's robots send when they reach a
-/// group statement they synchronize at (`GroupSync`).
-pub fn sync_key(program: &RobotProgram) -> String {
-    format!("{}.__sync", program.team)
-}
 
 /// Samples of a request channel: a service name and its arguments.
 fn is_request_channel(src_task: &str, src_port: &str) -> bool {
@@ -430,26 +420,6 @@ pub fn main_c(
 /// include one robot's header).
 const DEPLOY_DEFAULTS: Template = template!("files/deploy_defaults.c.in", []);
 
-/// The lock of state shared between tasks: a mutex on threads, nothing on
-/// the static schedule (one task runs at a time). `(include, declare, lock,
-/// unlock)` for a lock named `name`.
-pub(super) fn lock(target: Target, name: &str) -> (&'static str, String, String, String) {
-    match target.layer() {
-        Layer::Threads => (
-            "#include <pthread.h>\n",
-            format!("static pthread_mutex_t {name} = PTHREAD_MUTEX_INITIALIZER;\n"),
-            format!("pthread_mutex_lock(&{name});"),
-            format!("pthread_mutex_unlock(&{name});"),
-        ),
-        Layer::Static => (
-            "",
-            String::new(),
-            "/* no lock: one task runs at a time */".into(),
-            "/* end of the access */".into(),
-        ),
-    }
-}
-
 pub fn comm_task_c(
     program: &RobotProgram,
     words: &Words,
@@ -459,7 +429,7 @@ pub fn comm_task_c(
 ) -> String {
     let m = &program.control;
     let mut out = String::from(header);
-    let (include, declare, lock_seen, unlock_seen) = lock(target, "seen_lock");
+    let (include, declare, lock_seen, unlock_seen) = c::lock(target, "seen_lock");
     let _ = write!(
         out,
         "#include \"program.h\"\n{}{}#include <string.h>\n\n",
@@ -503,7 +473,7 @@ pub fn comm_task_c(
                 ("declare", &declare),
                 ("peers", &peers.len()),
                 ("key", &c::string(&alive_key(program))),
-                ("term_max", &super::control::TERM_MAX),
+                ("term_max", &TERM_MAX),
                 ("lock_seen", &lock_seen),
                 ("unlock_seen", &unlock_seen),
             ],
@@ -622,7 +592,7 @@ pub fn comm_task_c(
 /// task (`comm_event_take`), as the simulator's `hear_event` does.
 fn comm_events(out: &mut String, program: &RobotProgram, target: Target) {
     let m = &program.control;
-    let (include, declare, lock, unlock) = lock(target, "event_lock");
+    let (include, declare, lock, unlock) = c::lock(target, "event_lock");
     let names: Vec<String> = m.events_heard.iter().map(|e| c::string(e)).collect();
     out.push_str(&fill(
         &COMM_EVENTS,

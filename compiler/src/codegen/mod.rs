@@ -25,12 +25,9 @@
 mod battery;
 mod c;
 mod control;
-mod template;
-pub use control::{
-    TERM_MAX, UNLED_REASON, fenced_heard, lease_ms, listen_ms, next_term, parse_term,
-};
 pub(crate) mod files;
 mod loops;
+mod template;
 pub use loops::GRAPH_TEXT_MAX;
 pub mod output;
 mod peers;
@@ -877,4 +874,19 @@ pub fn refine_checked_robots(build: &BuildInput<'_>, robots: crate::refine::Robo
         diagnostics,
         sources,
     }
+}
+
+/// Every template, for the tests that check them (`template`'s).
+#[cfg(test)]
+fn all_templates() -> impl Iterator<Item = &'static template::Template> {
+    [
+        control::TEMPLATES,
+        files::TEMPLATES,
+        loops::TEMPLATES,
+        shared::TEMPLATES,
+        battery::TEMPLATES,
+        &[LINK_SCRIPT],
+    ]
+    .into_iter()
+    .flatten()
 }

@@ -8,7 +8,6 @@
 //! The simulator does the same (`sim/engine/shared.rs`).
 
 use super::c;
-use super::files::lock;
 use super::peers::Peers;
 use super::template::{Template, fill, template};
 use super::values::Words;
@@ -114,7 +113,7 @@ pub fn library_c(
     let lib = program.library.as_ref()?;
     let prefix = prefix(lib);
     let mut out = String::from(header);
-    let (include, declare, lock, unlock) = lock(target, "lock");
+    let (include, declare, lock, unlock) = c::lock(target, "lock");
     let _ = write!(out, "#include \"program.h\"\n{include}");
     if lib.ownership.is_some() {
         out.push_str("#include <string.h>\n");

@@ -116,21 +116,6 @@ pub fn fill(template: &Template, values: &[(&str, &dyn Display)]) -> String {
     out
 }
 
-/// Every template, for the tests that check them.
-#[cfg(test)]
-fn all() -> impl Iterator<Item = &'static Template> {
-    [
-        super::control::TEMPLATES,
-        super::files::TEMPLATES,
-        super::loops::TEMPLATES,
-        super::shared::TEMPLATES,
-        super::battery::TEMPLATES,
-        &[super::LINK_SCRIPT],
-    ]
-    .into_iter()
-    .flatten()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -170,7 +155,7 @@ mod tests {
 
     #[test]
     fn every_template_declares_exactly_the_slots_it_holds() {
-        for template in all() {
+        for template in crate::codegen::all_templates() {
             let mut held = slots_in(template.text);
             held.sort_unstable();
             held.dedup();
@@ -197,14 +182,14 @@ mod tests {
             }
         }
         files.sort();
-        let mut listed: Vec<String> = all()
+        let mut listed: Vec<String> = crate::codegen::all_templates()
             .filter_map(|t| t.path.strip_prefix("templates/"))
             .map(str::to_string)
             .collect();
         listed.sort();
         assert_eq!(
             files, listed,
-            "files under codegen/templates/ and template::all()"
+            "files under codegen/templates/ and template::crate::codegen::all_templates()"
         );
     }
 }

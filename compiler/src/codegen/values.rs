@@ -5,6 +5,8 @@
 
 use super::c;
 use crate::refine::{Expr, Operand, RobotProgram, StateKind, Value, ValueKind};
+use crate::sema::Compared;
+use crate::syntax::ast::CmpOp;
 use std::cell::RefCell;
 use std::collections::BTreeSet;
 
@@ -18,6 +20,43 @@ pub struct Words {
 }
 
 impl Words {
+    /// A condition's operand in C: a pointer to its slot or a literal.
+    pub fn operand(&self, op: &Operand) -> String {
+        match op {
+            Operand::Slot(s) => format!("&slot[{s}]"),
+            Operand::Literal(value) => self.literal(value),
+        }
+    }
+
+    /// A refined condition in C (the control task's branches and loops,
+    /// the battery policies').
+    pub fn condition(&self, e: &Expr) -> String {
+        match e {
+            Expr::Or(a, b) => format!("({} || {})", self.condition(a), self.condition(b)),
+            Expr::And(a, b) => format!("({} && {})", self.condition(a), self.condition(b)),
+            Expr::Not(a) => format!("!{}", self.condition(a)),
+            Expr::Bool(b) => b.to_string(),
+            Expr::Truthy(o) => format!("semo_value_truthy({})", self.operand(o)),
+            // As the checker typed the comparison: the runtime never guesses
+            // from the values whether they are numbers.
+            Expr::Compare(a, op, b, compared) => {
+                let function = match compared {
+                    Compared::Numbers => "semo_value_numbers",
+                    Compared::Words => "semo_value_words",
+                };
+                let op = match op {
+                    CmpOp::Eq => "SEMO_EQ",
+                    CmpOp::Ne => "SEMO_NE",
+                    CmpOp::Lt => "SEMO_LT",
+                    CmpOp::Le => "SEMO_LE",
+                    CmpOp::Gt => "SEMO_GT",
+                    CmpOp::Ge => "SEMO_GE",
+                };
+                format!("{function}({}, {op}, {})", self.operand(a), self.operand(b))
+            }
+        }
+    }
+
     pub fn of(program: &RobotProgram) -> Words {
         let mut words = BTreeSet::new();
         for slot in &program.control.slots {

@@ -150,7 +150,7 @@ fn rights(
             }
         }
         if !program.control.sync_points.is_empty() {
-            let key = crate::codegen::files::sync_key(program);
+            let key = crate::refine::protocol::sync_key(program);
             rights
                 .write
                 .insert(topics::to_team(scope, &program.team, &key, me));

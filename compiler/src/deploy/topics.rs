@@ -215,7 +215,7 @@ pub fn statuses(scope: &Scope) -> String {
 /// The key of the heartbeats of the robot of `program` for leader
 /// elections (when `program.control.heartbeat`): `<team>.__alive`.
 pub fn heartbeat_key(program: &crate::refine::RobotProgram) -> String {
-    crate::codegen::files::alive_key(program)
+    crate::refine::protocol::alive_key(program)
 }
 
 /// Where the robot of `program` publishes its heartbeats: its team's topic

@@ -15,6 +15,7 @@
 
 pub mod graph;
 pub mod program;
+pub mod protocol;
 mod robot;
 pub mod value;
 

@@ -536,7 +536,7 @@ fn slots_and_literals_are_typed_as_the_catalog_declares() {
 fn a_sub_graph_reference_opens_into_a_step_running_its_schedule_once() {
     use crate::refine::GraphStep::{Fire, Subgraph};
     use crate::refine::SubgraphPort;
-    use crate::taskgraph::subgraph::{SubgraphSource, resolve};
+    use crate::taskgraph::{resolve, subgraph::SubgraphSource};
     use std::path::Path;
     let fixture = |name: &str| {
         let path = Path::new(env!("CARGO_MANIFEST_DIR"))

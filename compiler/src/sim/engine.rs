@@ -272,8 +272,8 @@ impl Names {
         Names {
             team: intern.text(&program.team),
             heartbeat: intern.text(&program.robot),
-            alive_key: intern.text(&crate::codegen::files::alive_key(program)),
-            sync_key: intern.text(&crate::codegen::files::sync_key(program)),
+            alive_key: intern.text(&crate::refine::protocol::alive_key(program)),
+            sync_key: intern.text(&crate::refine::protocol::sync_key(program)),
             event_key: intern.text(&crate::refine::event_key(&program.team)),
             outgoing: m
                 .outgoing
@@ -2308,7 +2308,7 @@ impl<'p> Sim<'p> {
                 let fields = vec![
                     ("from", from.clone()),
                     ("key", key.clone()),
-                    ("reason", crate::codegen::UNLED_REASON.into()),
+                    ("reason", crate::refine::protocol::UNLED_REASON.into()),
                 ];
                 self.emit(r, "drop", fields);
             }
@@ -2324,7 +2324,7 @@ impl<'p> Sim<'p> {
     /// `highest_battery` election) answers `None` until it has; a rejoining
     /// robot follows a live claimant instead of claiming. Fenced: a robot
     /// the election would choose that has not heard a majority of the
-    /// candidates within its lease ([`crate::codegen::lease_ms`]) answers
+    /// candidates within its lease ([`crate::refine::protocol::lease_ms`]) answers
     /// `None`, traced once, and rejoins after. A change of leader is traced.
     fn elected(
         &mut self,
@@ -2337,7 +2337,7 @@ impl<'p> Sim<'p> {
         let robot = &self.robots[r];
         let hb = robot.program.control.heartbeat_ms;
         let listens = robot.rejoining || algorithm == LeaderAlgorithm::HighestBattery;
-        if listens && now - robot.started_at < crate::codegen::listen_ms(hb) {
+        if listens && now - robot.started_at < crate::refine::protocol::listen_ms(hb) {
             return None;
         }
         let me = robot.program.self_peer;
@@ -2383,7 +2383,7 @@ impl<'p> Sim<'p> {
         if leader == me {
             // Fencing: without a majority heard within its lease this robot
             // may be the one cut off; it waits, and rejoins after.
-            let lease = crate::codegen::lease_ms(hb);
+            let lease = crate::refine::protocol::lease_ms(hb);
             let heard = candidates
                 .iter()
                 .filter(|&&c| c == me || now - robot.heard.get(c).seen <= lease)
@@ -2394,7 +2394,7 @@ impl<'p> Sim<'p> {
                 robot.rejoining = true;
                 robot.fenced = Some(None);
                 if robot.leaders.insert(state, FENCED) != Some(FENCED) {
-                    let counted = crate::codegen::fenced_heard(heard, candidates.len());
+                    let counted = crate::refine::protocol::fenced_heard(heard, candidates.len());
                     self.emit(r, "fenced", vec![("heard", counted.into())]);
                 }
                 return None;
@@ -2403,7 +2403,7 @@ impl<'p> Sim<'p> {
                 // A majority again: listen before claiming, so that the
                 // heartbeat of a robot leading meanwhile has come.
                 let regained = regained.unwrap_or(now);
-                if now - regained < crate::codegen::listen_ms(hb) {
+                if now - regained < crate::refine::protocol::listen_ms(hb) {
                     robot.fenced = Some(Some(regained));
                     return None;
                 }
@@ -2417,7 +2417,7 @@ impl<'p> Sim<'p> {
             robot.fenced = None;
         } else if !was_leading || deposed {
             // It begins to lead (again, when deposed): under a new term.
-            robot.term = crate::codegen::next_term(robot.term);
+            robot.term = crate::refine::protocol::next_term(robot.term);
             robot.term_led = robot.term;
         }
         robot.leading = leader == me;
@@ -2529,7 +2529,7 @@ impl Heard {
     };
 
     /// `heard_alive`: `leader 87 3` or `member - 2` (a missing or
-    /// malformed term is 0, a larger one [`crate::codegen::TERM_MAX`]).
+    /// malformed term is 0, a larger one [`crate::refine::protocol::TERM_MAX`]).
     fn parse(now: i64, value: &str) -> Heard {
         let mut words = value.split(' ').skip(1);
         let battery = words
@@ -2543,7 +2543,7 @@ impl Heard {
             seen: now,
             leads: value.starts_with("leader "),
             battery,
-            term: crate::codegen::parse_term(words.next().unwrap_or("")),
+            term: crate::refine::protocol::parse_term(words.next().unwrap_or("")),
         }
     }
 }

@@ -188,7 +188,7 @@ fn a_killed_leader_is_replaced_and_a_restarted_one_leads_again() {
         .find(|e| e.robot == tb_0 && e.t >= 3000 && e.field("leader") == Some("tb_0"))
         .unwrap()
         .t;
-    let listen = crate::codegen::listen_ms(crate::refine::HEARTBEAT_MS);
+    let listen = crate::refine::protocol::listen_ms(crate::refine::HEARTBEAT_MS);
     assert!(claimed >= 3000 + listen, "claimed at {claimed}");
 }
 
@@ -218,7 +218,7 @@ fn a_leader_cut_off_from_the_majority_steps_down_before_the_others_elect() {
     // tb_0's lease lapses two heartbeats after the last it heard; the
     // others count it lost after three.
     assert!(
-        fenced > 1200 + crate::codegen::lease_ms(hb) - hb,
+        fenced > 1200 + crate::refine::protocol::lease_ms(hb) - hb,
         "fenced at {fenced}"
     );
     assert!(

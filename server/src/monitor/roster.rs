@@ -21,7 +21,7 @@ pub struct Member {
     pub robot: String,
     pub team: String,
     /// Whether it publishes heartbeats (its team elects a leader), with
-    /// this key (`codegen::files::alive_key`) on its own topic
+    /// this key (`semo::refine::protocol::alive_key`) on its own topic
     /// (`topics::heartbeat`).
     pub heartbeat_key: Option<String>,
     /// Where its modes and services are written in the mission, so that an

@@ -125,7 +125,7 @@ pub fn analyze_with(graph: &TaskGraph, hierarchy: &Hierarchy) -> GraphReport {
 }
 
 /// Runs the analyses on every level of `graph` and of the sub-graphs its
-/// tasks reference (`hierarchy`, from [`crate::taskgraph::subgraph::resolve`]),
+/// tasks reference (`hierarchy`, from [`crate::taskgraph::resolve`]),
 /// each at `<level>/<task>` after the graph's own levels.
 ///
 /// A task standing for a sub-graph fires once per iteration of it: its ports
