@@ -19,9 +19,32 @@ fn root() -> PathBuf {
 /// The rows of the table under [`HEADING`]: module → the modules it may use.
 /// A row is `| `module` | `a`, `b` | why |`; `—` for none.
 fn allowed(architecture: &str) -> BTreeMap<String, BTreeSet<String>> {
+    table(architecture, HEADING)
+        .into_iter()
+        .map(|(module, cells)| {
+            (
+                module,
+                cells.first().map_or_else(BTreeSet::new, |c| names(c)),
+            )
+        })
+        .collect()
+}
+
+/// The names in backquotes in a cell.
+fn names(cell: &str) -> BTreeSet<String> {
+    cell.split('`')
+        .skip(1)
+        .step_by(2)
+        .map(str::to_string)
+        .collect()
+}
+
+/// The rows of the first table under `heading`: the module its first cell
+/// names → its other cells.
+fn table(architecture: &str, heading: &str) -> BTreeMap<String, Vec<String>> {
     let start = architecture
-        .find(HEADING)
-        .unwrap_or_else(|| panic!("ARCHITECTURE.md has no `{HEADING}` section"));
+        .find(heading)
+        .unwrap_or_else(|| panic!("ARCHITECTURE.md has no `{heading}` section"));
     let mut rows = BTreeMap::new();
     let mut in_table = false;
     for line in architecture[start..].lines().skip(1) {
@@ -34,22 +57,15 @@ fn allowed(architecture: &str) -> BTreeMap<String, BTreeSet<String>> {
         }
         in_table = true;
         let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
-        let names = |cell: &str| -> Vec<String> {
-            cell.split('`')
-                .skip(1)
-                .step_by(2)
-                .map(str::to_string)
-                .collect()
-        };
-        let module = names(cells[0]);
+        let module: Vec<String> = names(cells[0]).into_iter().collect();
         let [module] = module.as_slice() else {
             continue; // the header and the separator
         };
-        let uses = cells.get(1).map_or_else(Vec::new, |c| names(c));
-        let previous = rows.insert(module.clone(), uses.into_iter().collect());
-        assert!(previous.is_none(), "`{module}` has two rows in {HEADING}");
+        let rest: Vec<String> = cells[1..].iter().map(|c| c.to_string()).collect();
+        let previous = rows.insert(module.clone(), rest);
+        assert!(previous.is_none(), "`{module}` has two rows in {heading}");
     }
-    assert!(!rows.is_empty(), "the {HEADING} table is empty");
+    assert!(!rows.is_empty(), "the {heading} table is empty");
     rows
 }
 
@@ -258,49 +274,76 @@ fn find_cycle(rows: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> 
 #[test]
 fn modules_use_only_what_the_architecture_table_allows() {
     let architecture = std::fs::read_to_string(root().join("../ARCHITECTURE.md")).unwrap();
-    let rows = allowed(&architecture);
     let src = root().join("src");
-    let modules = modules(&src);
     let reexports = root_reexports(&std::fs::read_to_string(src.join("lib.rs")).unwrap());
-    let mut problems = Vec::new();
+    // The library's root only re-exports: any other root name is a mistake.
+    let problems = check_layers(&src, &allowed(&architecture), HEADING, |first| {
+        Some(
+            reexports
+                .get(first)
+                .cloned()
+                .unwrap_or_else(|| first.to_string()),
+        )
+    });
+    assert!(
+        problems.is_empty(),
+        "ARCHITECTURE.md's layering and the code disagree:\n  {}",
+        problems.join("\n  ")
+    );
+}
 
+/// The problems of the modules of `src` against `rows` (the table under
+/// `heading`); `root_item` names the module a `crate::NAME` that is no
+/// module comes from (a re-export at the root), or `None` for an item of
+/// the root itself, which is outside the table.
+fn check_layers(
+    src: &Path,
+    rows: &BTreeMap<String, BTreeSet<String>>,
+    heading: &str,
+    root_item: impl Fn(&str) -> Option<String>,
+) -> Vec<String> {
+    let modules = modules(src);
+    let mut problems = Vec::new();
     for name in modules.keys().filter(|m| !rows.contains_key(*m)) {
-        problems.push(format!("`{name}` (compiler/src) has no row in {HEADING}"));
+        problems.push(format!(
+            "`{name}` ({}) has no row in {heading}",
+            src.display()
+        ));
     }
-    for (name, uses) in &rows {
+    for (name, uses) in rows {
         if !modules.contains_key(name) {
             problems.push(format!(
-                "{HEADING} has a row for `{name}`, which is no module"
+                "{heading} has a row for `{name}`, which is no module"
             ));
         }
         for used in uses.iter().filter(|u| !rows.contains_key(*u)) {
             problems.push(format!("`{name}`'s row allows `{used}`, which has no row"));
         }
     }
-    if let Some(cycle) = find_cycle(&rows) {
-        problems.push(format!("{HEADING} has a cycle: {}", cycle.join(" → ")));
+    if let Some(cycle) = find_cycle(rows) {
+        problems.push(format!("{heading} has a cycle: {}", cycle.join(" → ")));
     }
-
     if !problems.is_empty() {
-        panic!(
-            "ARCHITECTURE.md's {HEADING} table is broken:\n  {}",
-            problems.join("\n  ")
-        );
+        return problems;
     }
     for (name, files) in &modules {
         let named = &rows[name];
-        let may_use = below(name, &rows);
+        let may_use = below(name, rows);
         let mut used = BTreeSet::new();
         for file in files {
             let code = code_only(&std::fs::read_to_string(file).unwrap());
             for first in crate_paths(&code) {
-                let module = match reexports.get(&first) {
-                    Some(module) => module.clone(),
-                    None => first,
+                let module = if modules.contains_key(&first) {
+                    first
+                } else {
+                    match root_item(&first) {
+                        Some(module) => module,
+                        None => continue,
+                    }
                 };
                 if !modules.contains_key(&module) {
                     problems.push(format!(
-                        "{}: `crate::{module}` is no module of the library",
+                        "{}: `crate::{module}` is no module",
                         file.display()
                     ));
                     continue;
@@ -310,8 +353,8 @@ fn modules_use_only_what_the_architecture_table_allows() {
                 }
                 if !may_use.contains(&module) {
                     problems.push(format!(
-                        "{}: `{name}` uses `{module}`, which its row in {HEADING} does not allow",
-                        file.strip_prefix(&src).unwrap_or(file).display()
+                        "{}: `{name}` uses `{module}`, which its row in {heading} does not allow",
+                        file.strip_prefix(src).unwrap_or(file).display()
                     ));
                 }
                 used.insert(module);
@@ -319,15 +362,11 @@ fn modules_use_only_what_the_architecture_table_allows() {
         }
         for unused in named.difference(&used) {
             problems.push(format!(
-                "`{name}`'s row in {HEADING} names `{unused}`, which it does not read: remove it"
+                "`{name}`'s row in {heading} names `{unused}`, which it does not read: remove it"
             ));
         }
     }
-    assert!(
-        problems.is_empty(),
-        "ARCHITECTURE.md's layering and the code disagree:\n  {}",
-        problems.join("\n  ")
-    );
+    problems
 }
 
 #[test]
@@ -558,6 +597,156 @@ fn the_module_path_reader_resolves_crate_and_super_paths() {
             "taskgraph::xml",
             "taskgraph::xml::read",
             "diag::Code",
+        ]
+    );
+}
+
+const SERVER_HEADING: &str = "## Server layers";
+
+/// The protocol's names a file uses: every name under `tower_lsp_server::`
+/// (a `use` tree expanded), `*` for a glob, and the names used through an
+/// alias of a protocol module (`use tower_lsp_server::ls_types::{self as lsp}`
+/// then `lsp::Diagnostic`).
+fn protocol_names(code: &str) -> BTreeSet<String> {
+    const MODULES: &[&str] = &[
+        "ls_types",
+        "jsonrpc",
+        "notification",
+        "request",
+        "self",
+        "as",
+    ];
+    let mut found = BTreeSet::new();
+    let mut aliases = Vec::new();
+    for (at, _) in code.match_indices("tower_lsp_server::") {
+        let rest = &code[at + "tower_lsp_server::".len()..];
+        // A path ends at the first character that cannot continue it, unless
+        // that is a group's `{`: then at the group's `}`.
+        let path_end = rest
+            .find(|c: char| !(c.is_alphanumeric() || c == '_' || c == ':' || c == '*'))
+            .unwrap_or(rest.len());
+        let mut end = path_end;
+        if rest[path_end..].starts_with('{') {
+            let mut depth = 0;
+            for (i, c) in rest[path_end..].char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' => {
+                        depth -= 1;
+                        if depth == 0 {
+                            end = path_end + i + 1;
+                            break;
+                        }
+                    }
+                    _ => {}
+                }
+            }
+        }
+        let tree = &rest[..end];
+        let words: Vec<&str> = tree
+            .split(|c: char| !(c.is_alphanumeric() || c == '_' || c == '*'))
+            .filter(|w| !w.is_empty())
+            .collect();
+        for (i, word) in words.iter().enumerate() {
+            if i > 0 && words[i - 1] == "as" {
+                aliases.push(word.to_string());
+            } else if !MODULES.contains(word) {
+                found.insert(word.to_string());
+            }
+        }
+    }
+    for alias in aliases {
+        for (at, _) in code.match_indices(&format!("{alias}::")) {
+            let preceded = code[..at]
+                .chars()
+                .next_back()
+                .is_some_and(|c| c.is_alphanumeric() || c == '_' || c == ':');
+            if preceded {
+                continue;
+            }
+            let name: String = code[at + alias.len() + 2..]
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            found.insert(name);
+        }
+    }
+    found
+}
+
+/// The language server's modules read down their table, and speak the
+/// protocol only as far as their row's third cell says: `all`, the names it
+/// may use, or `—` (the live view and the monitor, which `semo operator`
+/// shares, speak none). So the conversion of the library's answers into
+/// protocol types stays in `to_proto`, the handlers and the server's door.
+#[test]
+fn the_server_reads_down_its_table_and_speaks_the_protocol_where_it_says() {
+    let architecture = std::fs::read_to_string(root().join("../ARCHITECTURE.md")).unwrap();
+    let src = root().join("../server/src");
+    let rows = table(&architecture, SERVER_HEADING);
+    let reads: BTreeMap<String, BTreeSet<String>> = rows
+        .iter()
+        .map(|(m, cells)| {
+            (
+                m.clone(),
+                cells.first().map_or_else(BTreeSet::new, |c| names(c)),
+            )
+        })
+        .collect();
+    // `crate::State` and the other items of lib.rs: the state every task
+    // shares, above the table.
+    let mut problems = check_layers(&src, &reads, SERVER_HEADING, |_| None);
+    for (module, files) in modules(&src) {
+        let Some(cells) = rows.get(&module) else {
+            continue; // reported above
+        };
+        let cell = cells.get(1).map_or("", |c| c.trim());
+        let allowed = names(cell);
+        let mut used = BTreeSet::new();
+        for file in &files {
+            let code = code_only(&std::fs::read_to_string(file).unwrap());
+            for name in protocol_names(&code) {
+                if cell != "all" && !allowed.contains(&name) {
+                    problems.push(format!(
+                        "{}: `{module}` uses the protocol's `{name}`, which its row in {SERVER_HEADING} does not allow",
+                        file.strip_prefix(&src).unwrap_or(file).display()
+                    ));
+                }
+                used.insert(name);
+            }
+        }
+        for unused in allowed.difference(&used) {
+            problems.push(format!(
+                "`{module}`'s row in {SERVER_HEADING} names the protocol's `{unused}`, which it does not use: remove it"
+            ));
+        }
+    }
+    assert!(
+        problems.is_empty(),
+        "ARCHITECTURE.md's server layers and the code disagree:\n  {}",
+        problems.join("\n  ")
+    );
+}
+
+#[test]
+fn the_protocol_reader_finds_use_trees_globs_and_aliases() {
+    let code = code_only(
+        "use tower_lsp_server::ls_types::{self as lsp, Uri};\n\
+         use tower_lsp_server::{Client, jsonrpc::Result};\n\
+         use tower_lsp_server::ls_types::*;\n\
+         fn f() -> lsp::Diagnostic { tower_lsp_server::jsonrpc::ErrorCode::InternalError }\n",
+    );
+    let found: Vec<String> = protocol_names(&code).into_iter().collect();
+    assert_eq!(
+        found,
+        [
+            "*",
+            "Client",
+            "Diagnostic",
+            "ErrorCode",
+            "InternalError",
+            "Result",
+            "Uri"
         ]
     );
 }

@@ -13,19 +13,16 @@
 //! its search has ended, for that text only.
 
 use crate::State;
-use crate::encoding::LineMap;
+use crate::to_proto;
 use crate::world::{FileAnalysis, Snapshot, retire};
 use semo::catalog::BUILTIN_FILE;
-use semo::diag::{Code, FileId, Severity};
-use semo::text::LineIndex;
+use semo::diag::FileId;
 use semo::workspace::FileKind;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, Weak};
 use tokio::sync::Notify;
 use tower_lsp_server::Client;
-use tower_lsp_server::ls_types::{
-    self as lsp, DiagnosticRelatedInformation, DiagnosticTag, Location, NumberOrString, Uri,
-};
+use tower_lsp_server::ls_types::{self as lsp, Uri};
 
 #[derive(Default)]
 pub struct Queue {
@@ -90,10 +87,13 @@ async fn publish(state: &Arc<State>, client: &Client, uri: Uri) {
     let extra = dataflow.as_ref().map_or(&[][..], |d| &d.diagnostics[..]);
     // The file's own diagnostics are capped by the library (`diag::MAX_PER_FILE`);
     // the dataflow warnings are at most a few per service call.
-    let mut diagnostics = to_lsp(&snapshot, &analysis, &others);
+    let mut diagnostics =
+        to_proto::diagnostics(&snapshot, &analysis, analysis.diagnostics(), &others);
     diagnostics.extend(dataflow_to_lsp(state, &snapshot, &analysis, extra));
     let verified = state.verified.findings(&snapshot);
-    diagnostics.extend(convert_all(&snapshot, &analysis, &verified, &others));
+    diagnostics.extend(to_proto::diagnostics(
+        &snapshot, &analysis, &verified, &others,
+    ));
     let version = snapshot.version;
     drop(analysis);
     if later {
@@ -139,10 +139,13 @@ async fn publish_dataflow(state: Arc<State>, client: Client, snapshot: Weak<Snap
         drop(analysis);
         return retire(snapshot);
     }
-    let mut diagnostics = to_lsp(&snapshot, &analysis, &others);
+    let mut diagnostics =
+        to_proto::diagnostics(&snapshot, &analysis, analysis.diagnostics(), &others);
     diagnostics.extend(dataflow_to_lsp(&state, &snapshot, &analysis, extra));
     let verified = state.verified.findings(&snapshot);
-    diagnostics.extend(convert_all(&snapshot, &analysis, &verified, &others));
+    diagnostics.extend(to_proto::diagnostics(
+        &snapshot, &analysis, &verified, &others,
+    ));
     let (uri, version) = (snapshot.uri.clone(), snapshot.version);
     drop(analysis);
     retire(snapshot);
@@ -163,7 +166,7 @@ fn dataflow_to_lsp(
         let world = state.world();
         related_files(found, |id| world.uri_of(id).cloned())
     };
-    convert_all(snapshot, analysis, found, &others)
+    to_proto::diagnostics(snapshot, analysis, found, &others)
 }
 
 /// [`related_files`] of `diagnostics`, while `snapshot` is still the current
@@ -195,94 +198,4 @@ fn related_files(
         }
     }
     out
-}
-
-/// The library's diagnostics of a snapshot, as the protocol has them.
-pub fn to_lsp(
-    snapshot: &Snapshot,
-    analysis: &FileAnalysis,
-    others: &HashMap<FileId, Uri>,
-) -> Vec<lsp::Diagnostic> {
-    convert_all(snapshot, analysis, analysis.diagnostics(), others)
-}
-
-/// `found` (diagnostics in the snapshot's file) as the protocol has them.
-fn convert_all(
-    snapshot: &Snapshot,
-    analysis: &FileAnalysis,
-    found: &[semo::diag::Diagnostic],
-    others: &HashMap<FileId, Uri>,
-) -> Vec<lsp::Diagnostic> {
-    let here = snapshot.line_map(analysis);
-    // Line indexes of other (catalog) files, built once each.
-    let mut other_lines: HashMap<FileId, LineIndex> = HashMap::new();
-    found
-        .iter()
-        .map(|d| {
-            let related = d
-                .related
-                .iter()
-                .filter_map(|r| {
-                    let (uri, range) = if r.file == snapshot.id {
-                        (snapshot.uri.clone(), here.range(r.span))
-                    } else {
-                        let uri = others.get(&r.file)?;
-                        let text = snapshot.text_of(r.file)?;
-                        let index = other_lines
-                            .entry(r.file)
-                            .or_insert_with(|| LineIndex::new(text));
-                        let map = LineMap {
-                            text,
-                            index,
-                            encoding: snapshot.encoding,
-                        };
-                        (uri.clone(), map.range(r.span))
-                    };
-                    Some(DiagnosticRelatedInformation {
-                        location: Location::new(uri, range),
-                        message: r.message.clone(),
-                    })
-                })
-                .collect::<Vec<_>>();
-            lsp::Diagnostic {
-                related_information: (!related.is_empty()).then_some(related),
-                ..convert(d, here.range(d.span))
-            }
-        })
-        .collect()
-}
-
-/// One diagnostic at `range`, without related information.
-pub fn convert(d: &semo::diag::Diagnostic, range: lsp::Range) -> lsp::Diagnostic {
-    lsp::Diagnostic {
-        range,
-        severity: Some(severity(d.severity)),
-        code: Some(NumberOrString::String(d.code.as_str().to_string())),
-        source: Some("semo".to_string()),
-        message: d.message.clone(),
-        related_information: None,
-        tags: is_unnecessary(d.code).then(|| vec![DiagnosticTag::UNNECESSARY]),
-        // The did-you-mean travels with the diagnostic, for quick fixes.
-        data: d
-            .suggestion
-            .as_ref()
-            .map(|s| serde_json::json!({ "suggestion": s })),
-        code_description: None,
-    }
-}
-
-fn severity(s: Severity) -> lsp::DiagnosticSeverity {
-    match s {
-        Severity::Error => lsp::DiagnosticSeverity::ERROR,
-        Severity::Warning => lsp::DiagnosticSeverity::WARNING,
-        Severity::Hint => lsp::DiagnosticSeverity::HINT,
-    }
-}
-
-/// Code that is never used: editors grey it out.
-fn is_unnecessary(code: Code) -> bool {
-    matches!(
-        code,
-        Code::ServiceNeverSet | Code::FunctionNeverCalled | Code::UnreachableMode
-    )
 }

@@ -662,7 +662,12 @@ impl LanguageServer for Backend {
             .snapshot(&uri)
             .filter(|_| quick_fixes && creates_files)
         {
-            response.extend(self.state.verified.scenario_actions(&snapshot, &asked));
+            let found = self.state.verified.counterexamples(&snapshot);
+            if !found.is_empty() {
+                let analysis = snapshot.analysis();
+                let lines = snapshot.line_map(&analysis);
+                response.extend(crate::to_proto::scenario_actions(found, &lines, &asked));
+            }
         }
         Ok(Some(response))
     }

@@ -4,7 +4,7 @@
 
 use crate::encoding::{Encoding, LineMap};
 use crate::world::Snapshot;
-use semo::diag::FileId;
+use semo::diag::{Code, FileId, Severity};
 use semo::host::Analysis;
 use semo::ide::{
     self, Access, CompletionKind, Fold, FoldKind, HighlightToken, HoverResult, InlayKind,
@@ -390,4 +390,141 @@ fn encode_tokens(
         (prev_line, prev_col) = (line, col);
     }
     data
+}
+
+/// `found` (diagnostics in the snapshot's file) as the protocol has them;
+/// `others`: the URIs of the other files their related information points
+/// into.
+pub fn diagnostics(
+    snapshot: &Snapshot,
+    analysis: &crate::world::FileAnalysis,
+    found: &[semo::diag::Diagnostic],
+    others: &HashMap<FileId, Uri>,
+) -> Vec<Diagnostic> {
+    let here = snapshot.line_map(analysis);
+    // Line indexes of other (catalog) files, built once each.
+    let mut other_lines: HashMap<FileId, LineIndex> = HashMap::new();
+    found
+        .iter()
+        .map(|d| {
+            let related = d
+                .related
+                .iter()
+                .filter_map(|r| {
+                    let (uri, range) = if r.file == snapshot.id {
+                        (snapshot.uri.clone(), here.range(r.span))
+                    } else {
+                        let uri = others.get(&r.file)?;
+                        let text = snapshot.text_of(r.file)?;
+                        let index = other_lines
+                            .entry(r.file)
+                            .or_insert_with(|| LineIndex::new(text));
+                        let map = LineMap {
+                            text,
+                            index,
+                            encoding: snapshot.encoding,
+                        };
+                        (uri.clone(), map.range(r.span))
+                    };
+                    Some(DiagnosticRelatedInformation {
+                        location: Location::new(uri, range),
+                        message: r.message.clone(),
+                    })
+                })
+                .collect::<Vec<_>>();
+            Diagnostic {
+                related_information: (!related.is_empty()).then_some(related),
+                ..self::diagnostic(d, here.range(d.span))
+            }
+        })
+        .collect()
+}
+
+/// One diagnostic at `range`, without related information.
+pub fn diagnostic(d: &semo::diag::Diagnostic, range: Range) -> Diagnostic {
+    Diagnostic {
+        range,
+        severity: Some(severity(d.severity)),
+        code: Some(NumberOrString::String(d.code.as_str().to_string())),
+        source: Some("semo".to_string()),
+        message: d.message.clone(),
+        related_information: None,
+        tags: is_unnecessary(d.code).then(|| vec![DiagnosticTag::UNNECESSARY]),
+        // The did-you-mean travels with the diagnostic, for quick fixes.
+        data: d
+            .suggestion
+            .as_ref()
+            .map(|s| serde_json::json!({ "suggestion": s })),
+        code_description: None,
+    }
+}
+
+fn severity(s: Severity) -> DiagnosticSeverity {
+    match s {
+        Severity::Error => DiagnosticSeverity::ERROR,
+        Severity::Warning => DiagnosticSeverity::WARNING,
+        Severity::Hint => DiagnosticSeverity::HINT,
+    }
+}
+
+/// Code that is never used: editors grey it out.
+fn is_unnecessary(code: Code) -> bool {
+    matches!(
+        code,
+        Code::ServiceNeverSet | Code::FunctionNeverCalled | Code::UnreachableMode
+    )
+}
+
+/// `textDocument/codeAction` on `semo verify`'s findings: for each
+/// counterexample whose diagnostic is among those `asked` about, an action
+/// that writes its scenario beside the mission. The file is created, never
+/// overwritten (a file of that name stays as it is: the editor refuses the
+/// edit).
+pub fn scenario_actions(
+    found: Vec<crate::verify::Counterexample>,
+    lines: &LineMap<'_>,
+    asked: &[Diagnostic],
+) -> Vec<CodeActionOrCommand> {
+    let mut actions = Vec::new();
+    for example in found {
+        let d = &example.diagnostic;
+        let range = lines.range(d.span);
+        let Some(diagnostic) = asked.iter().find(|a| {
+            a.range == range && a.code == Some(NumberOrString::String(d.code.as_str().into()))
+        }) else {
+            continue;
+        };
+        let create = DocumentChangeOperation::Op(ResourceOp::Create(CreateFile {
+            uri: example.uri.clone(),
+            options: Some(CreateFileOptions {
+                overwrite: Some(false),
+                ignore_if_exists: Some(false),
+            }),
+            annotation_id: None,
+        }));
+        let write = DocumentChangeOperation::Edit(TextDocumentEdit {
+            text_document: OptionalVersionedTextDocumentIdentifier {
+                uri: example.uri,
+                version: None,
+            },
+            edits: vec![OneOf::Left(TextEdit {
+                range: Range::default(),
+                new_text: example.scenario,
+            })],
+        });
+        actions.push(CodeActionOrCommand::CodeAction(CodeAction {
+            title: format!(
+                "Write the scenario that shows this ({}.scenario.json; semo simulate replays it)",
+                example.name
+            ),
+            kind: Some(CodeActionKind::QUICKFIX),
+            diagnostics: Some(vec![diagnostic.clone()]),
+            edit: Some(WorkspaceEdit {
+                document_changes: Some(DocumentChanges::Operations(vec![create, write])),
+                ..WorkspaceEdit::default()
+            }),
+            ..CodeAction::default()
+        }));
+    }
+    actions
 }

@@ -12,7 +12,7 @@ use semo::workspace::FileKind;
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
-use tower_lsp_server::ls_types::{self as lsp, Uri};
+use tower_lsp_server::ls_types::Uri;
 
 /// The editor's search: a minute of mission time, twenty thousand states.
 fn options(cancel: Arc<AtomicBool>) -> semo::verify::Options {
@@ -74,77 +74,45 @@ impl Verified {
             .unwrap_or_default()
     }
 
-    /// `textDocument/codeAction` on findings of `snapshot` (those of
-    /// `asked` the search made): per finding with a counterexample, an
-    /// action that writes its scenario beside the mission, as `semo verify
-    /// --counterexamples` names it. The file is created, never overwritten
-    /// (a file of that name stays as it is: the editor refuses the edit).
-    pub fn scenario_actions(
-        &self,
-        snapshot: &Arc<Snapshot>,
-        asked: &[lsp::Diagnostic],
-    ) -> Vec<lsp::CodeActionOrCommand> {
+    /// The findings of `snapshot` that have a counterexample: each with the
+    /// file its scenario is written to beside the mission, as `semo verify
+    /// --counterexamples` names it (the quick fix of `to_proto::scenario_action`).
+    pub fn counterexamples(&self, snapshot: &Arc<Snapshot>) -> Vec<Counterexample> {
         let found = self.found(snapshot);
-        if found.is_empty() {
-            return Vec::new();
-        }
         let Some(path) = snapshot.uri.to_file_path() else {
             return Vec::new();
         };
         let stem = path
             .file_stem()
             .map_or("mission".into(), |s| s.to_string_lossy().into_owned());
-        let analysis = snapshot.analysis();
-        let lines = snapshot.line_map(&analysis);
-        let mut actions = Vec::new();
-        for (n, finding) in found.iter().enumerate() {
-            let d = &finding.diagnostic;
-            let range = lines.range(d.span);
-            let Some(diagnostic) = asked.iter().find(|a| {
-                a.range == range
-                    && a.code == Some(lsp::NumberOrString::String(d.code.as_str().into()))
-            }) else {
+        let mut out = Vec::new();
+        for (n, finding) in found.into_iter().enumerate() {
+            let Some(scenario) = finding.scenario else {
                 continue;
             };
-            let Some(scenario) = &finding.scenario else {
-                continue;
-            };
-            let name = semo::verify::counterexample_name(&stem, d.code, n + 1);
+            let name = semo::verify::counterexample_name(&stem, finding.diagnostic.code, n + 1);
             let file = path.with_file_name(format!("{name}.scenario.json"));
             let Some(uri) = Uri::from_file_path(&file) else {
                 continue;
             };
-            let create =
-                lsp::DocumentChangeOperation::Op(lsp::ResourceOp::Create(lsp::CreateFile {
-                    uri: uri.clone(),
-                    options: Some(lsp::CreateFileOptions {
-                        overwrite: Some(false),
-                        ignore_if_exists: Some(false),
-                    }),
-                    annotation_id: None,
-                }));
-            let write = lsp::DocumentChangeOperation::Edit(lsp::TextDocumentEdit {
-                text_document: lsp::OptionalVersionedTextDocumentIdentifier { uri, version: None },
-                edits: vec![lsp::OneOf::Left(lsp::TextEdit {
-                    range: lsp::Range::default(),
-                    new_text: scenario.clone(),
-                })],
+            out.push(Counterexample {
+                diagnostic: finding.diagnostic,
+                name,
+                uri,
+                scenario,
             });
-            actions.push(lsp::CodeActionOrCommand::CodeAction(lsp::CodeAction {
-                title: format!(
-                    "Write the scenario that shows this ({name}.scenario.json; semo simulate replays it)"
-                ),
-                kind: Some(lsp::CodeActionKind::QUICKFIX),
-                diagnostics: Some(vec![diagnostic.clone()]),
-                edit: Some(lsp::WorkspaceEdit {
-                    document_changes: Some(lsp::DocumentChanges::Operations(vec![create, write])),
-                    ..lsp::WorkspaceEdit::default()
-                }),
-                ..lsp::CodeAction::default()
-            }));
         }
-        actions
+        out
     }
+}
+
+/// A finding with its counterexample's scenario and where it is written.
+pub struct Counterexample {
+    pub diagnostic: semo::diag::Diagnostic,
+    /// The file's name without `.scenario.json`.
+    pub name: String,
+    pub uri: Uri,
+    pub scenario: String,
 }
 
 /// After a save: search the mission's current text in the background; when

@@ -4,7 +4,6 @@
 //! mission, creating the strategy entry of the built-in call at the cursor).
 //! The caller names the files of the assists' edits.
 
-use crate::diagnostics;
 use crate::to_proto::{self, FileEdits};
 use crate::world::Snapshot;
 use semo::diag::FileId;
@@ -49,7 +48,8 @@ pub fn code_actions(snapshot: &Snapshot, workspace: &Analysis, params: &CodeActi
     if wanted(&CodeActionKind::QUICKFIX) {
         let actions = workspace.code_actions(snapshot.id, lines.span(params.range));
         if !actions.is_empty() {
-            let published = diagnostics::to_lsp(snapshot, &analysis, &HashMap::new());
+            let published =
+                to_proto::diagnostics(snapshot, &analysis, analysis.diagnostics(), &HashMap::new());
             found.fixes = to_proto::quick_fixes(
                 &snapshot.uri,
                 &lines,

@@ -205,7 +205,7 @@ pub fn mission_diagnostics(
         .filter(|d| d.file == job.mission)
         .map(|d| tower_lsp_server::ls_types::Diagnostic {
             source: Some("semo build".into()),
-            ..crate::diagnostics::convert(d, map.range(d.span))
+            ..crate::to_proto::diagnostic(d, map.range(d.span))
         })
         .collect()
 }
