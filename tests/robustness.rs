@@ -61,7 +61,7 @@ fn check_never_panics(text: &str) {
 
 /// The editor features on the analysis, at a spread of offsets (past the end
 /// too): no panic, and their ranges lie inside the text, sorted or nested.
-fn ide_never_panics(text: &str, analysis: &semo::Analysis) {
+fn ide_never_panics(text: &str, analysis: &semo::CheckedMission) {
     use semo::ide::mission::*;
     let inside = |s: semo::span::Span| s.start <= s.end && s.end <= text.len();
     let tokens = semantic_tokens::semantic_tokens(analysis, None);
@@ -302,8 +302,8 @@ fn strategy_examples() -> &'static Vec<String> {
 
 /// The missions the strategies are cross-checked against (their teams are
 /// MasterTeam and Scouts).
-fn strategy_missions() -> &'static Vec<(String, semo::Analysis)> {
-    static MISSIONS: OnceLock<Vec<(String, semo::Analysis)>> = OnceLock::new();
+fn strategy_missions() -> &'static Vec<(String, semo::CheckedMission)> {
+    static MISSIONS: OnceLock<Vec<(String, semo::CheckedMission)>> = OnceLock::new();
     MISSIONS.get_or_init(|| {
         let fixtures = support::repo_root().join("tests/fixtures/diagnostics");
         [
@@ -468,7 +468,7 @@ fn the_strategy_examples_load_cleanly() {
 
 /// A mission checked and refined as `semo build` and `semo simulate` do it.
 struct Refined {
-    analysis: std::sync::Arc<semo::Analysis>,
+    analysis: std::sync::Arc<semo::CheckedMission>,
     programs: Vec<semo::refine::RobotProgram>,
 }
 

@@ -19,7 +19,7 @@ mod support;
 
 use semo::catalog::builtin_catalog;
 use semo::diag::{Code, FileId};
-use semo::sema::{Analysis, Peer, Symbol};
+use semo::sema::{CheckedMission, Peer, Symbol};
 use semo::syntax::ast::CommKind;
 use support::missiongen;
 use support::robots::{events, field, scratch};
@@ -37,7 +37,7 @@ struct Claim {
 }
 
 /// The claims of the W022 and W024 findings of a mission.
-fn claims(analysis: &Analysis) -> Vec<Claim> {
+fn claims(analysis: &CheckedMission) -> Vec<Claim> {
     let mission = &analysis.mission;
     let mut claims = Vec::new();
     for d in &analysis.diagnostics {
@@ -122,7 +122,7 @@ fn claims(analysis: &Analysis) -> Vec<Claim> {
 }
 
 /// The scenarios a mission's claims are held to.
-fn scenarios(analysis: &Analysis) -> [String; 2] {
+fn scenarios(analysis: &CheckedMission) -> [String; 2] {
     let commands: Vec<String> = analysis
         .mission
         .teams
@@ -144,7 +144,12 @@ fn scenarios(analysis: &Analysis) -> [String; 2] {
 }
 
 /// Runs the mission on each scenario and says which claims a trace breaks.
-fn broken_claims(name: &str, text: &str, analysis: &Analysis, claims: &[Claim]) -> Vec<String> {
+fn broken_claims(
+    name: &str,
+    text: &str,
+    analysis: &CheckedMission,
+    claims: &[Claim],
+) -> Vec<String> {
     let dir = scratch(&format!("value-flow-{name}"));
     let mission = dir.join(format!("{name}.mission"));
     std::fs::write(&mission, text).unwrap();

@@ -356,7 +356,7 @@ pub struct LoadedStrategy {
 #[derive(Debug)]
 pub struct Unit {
     pub catalog: Arc<CatalogResult>,
-    pub missions: Vec<(FileId, Arc<sema::Analysis>)>,
+    pub missions: Vec<(FileId, Arc<sema::CheckedMission>)>,
     pub strategies: Vec<(FileId, Arc<LoadedStrategy>)>,
     /// The missions' built-in calls linked to the entries refining them.
     pub links: StrategyLinks,
@@ -375,7 +375,7 @@ struct Memo {
     /// By folder (`None`: documents that are not files).
     catalogs: Memoised<Option<PathBuf>, Key, CatalogResult>,
     /// By file: (its revision, its catalog's key).
-    missions: Memoised<FileId, (u64, Key), sema::Analysis>,
+    missions: Memoised<FileId, (u64, Key), sema::CheckedMission>,
     strategies: Memoised<FileId, u64, LoadedStrategy>,
     units: Memoised<Option<PathBuf>, Key, Unit>,
     /// By file: (its revision, the task graphs' revision).
@@ -562,7 +562,7 @@ impl Analysis {
     }
 
     /// A mission checked against its catalog; `None` for other files.
-    pub fn mission(&self, id: FileId) -> Option<Arc<sema::Analysis>> {
+    pub fn mission(&self, id: FileId) -> Option<Arc<sema::CheckedMission>> {
         let file = self
             .files
             .get(&id)
@@ -633,7 +633,7 @@ impl Analysis {
             return found;
         }
         let catalog = self.catalog_from(folder);
-        let missions: Vec<(FileId, Arc<sema::Analysis>)> = missions
+        let missions: Vec<(FileId, Arc<sema::CheckedMission>)> = missions
             .iter()
             .filter_map(|m| Some((m.id, self.mission(m.id)?)))
             .collect();
@@ -646,7 +646,7 @@ impl Analysis {
             .iter()
             .filter_map(|(_, s)| s.strategy.as_ref())
             .collect();
-        let analyses: Vec<&sema::Analysis> = missions.iter().map(|(_, a)| &**a).collect();
+        let analyses: Vec<&sema::CheckedMission> = missions.iter().map(|(_, a)| &**a).collect();
         let (links, cross) = cross_check(&models, &analyses, &catalog.catalog);
         let unit = Arc::new(Unit {
             catalog,
@@ -968,7 +968,7 @@ impl Analysis {
 /// it to `codegen::build`.
 pub struct BuildFiles {
     pub file: Arc<SourceText>,
-    pub analysis: Arc<sema::Analysis>,
+    pub analysis: Arc<sema::CheckedMission>,
     pub unit: Arc<Unit>,
     pub strategies: Vec<Strategy>,
     pub mission_name: String,

@@ -51,4 +51,4 @@ mod xmlpos;
 /// The positioned XML element tree read by the task-graph and strategy loaders.
 mod xmltree;
 
-pub use sema::{Analysis, check_source};
+pub use sema::{CheckedMission, check_source};

@@ -14,7 +14,7 @@ use semo::catalog::Catalog;
 use semo::diag::{Diagnostic, FileId};
 use semo::host::{self, AnalysisHost, CatalogResult, Dropper, Roots};
 use semo::ide::FilePosition;
-use semo::sema::Analysis;
+use semo::sema::CheckedMission;
 use semo::text::LineIndex;
 use semo::workspace::{FileKind, GraphRun};
 use std::collections::HashMap;
@@ -67,7 +67,7 @@ pub struct Snapshot {
 pub struct FileAnalysis {
     pub lines: LineIndex,
     diagnostics: Vec<Diagnostic>,
-    pub mission: Option<Arc<Analysis>>,
+    pub mission: Option<Arc<CheckedMission>>,
     pub graph: Option<Arc<GraphRun>>,
 }
 

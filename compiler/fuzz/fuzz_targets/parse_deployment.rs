@@ -14,7 +14,7 @@ use std::sync::{Arc, OnceLock};
 const FILE: FileId = FileId(0);
 
 struct Mission {
-    analysis: Arc<semo::Analysis>,
+    analysis: Arc<semo::CheckedMission>,
     programs: Vec<semo::refine::RobotProgram>,
 }
 

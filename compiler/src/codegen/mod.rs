@@ -589,7 +589,7 @@ pub struct BuildInput<'a> {
     /// The mission's file name, written into generated headers.
     pub mission_name: String,
     pub text: &'a str,
-    pub analysis: &'a crate::sema::Analysis,
+    pub analysis: &'a crate::sema::CheckedMission,
     pub catalog: &'a crate::catalog::Catalog,
     pub strategies: &'a [crate::strategy::Strategy],
     /// Each strategy file's name, for generated headers.

@@ -268,7 +268,10 @@ impl Analysis {
     }
 
     /// A mission file's checked mission and text; `None` for other files.
-    pub(super) fn mission_of_kind(&self, file: FileId) -> Option<(Arc<sema::Analysis>, &str)> {
+    pub(super) fn mission_of_kind(
+        &self,
+        file: FileId,
+    ) -> Option<(Arc<sema::CheckedMission>, &str)> {
         let source = self.file(file).filter(|f| f.kind == FileKind::Mission)?;
         Some((self.mission(file)?, &source.text))
     }
@@ -280,12 +283,12 @@ impl Analysis {
             return T::default();
         };
         let loaded = self.strategy(file);
-        let checked: Vec<Arc<sema::Analysis>> = self
+        let checked: Vec<Arc<sema::CheckedMission>> = self
             .missions_seeing(file)
             .into_iter()
             .filter_map(|m| self.mission(m))
             .collect();
-        let missions: Vec<&sema::Analysis> = checked.iter().map(|m| &**m).collect();
+        let missions: Vec<&sema::CheckedMission> = checked.iter().map(|m| &**m).collect();
         let catalog = self.catalog(file);
         f(&StrategyFile {
             text: &source.text,

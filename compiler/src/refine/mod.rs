@@ -23,7 +23,7 @@ pub use program::*;
 pub use robot::SENSOR_PERIOD_MS;
 pub use value::{Value, ValueKind};
 
-use crate::Analysis;
+use crate::CheckedMission;
 use crate::catalog::Catalog;
 use crate::diag::{self, Diagnostic, FileId};
 use crate::strategy::{Strategy, StrategyLinks};
@@ -35,7 +35,7 @@ pub struct RefineInput<'a> {
     pub mission_name: &'a str,
     pub file: FileId,
     pub text: &'a str,
-    pub analysis: &'a Analysis,
+    pub analysis: &'a CheckedMission,
     pub catalog: &'a Catalog,
     pub strategies: &'a [Strategy],
     /// Strategy file names, by `Strategy::file`, for comments.

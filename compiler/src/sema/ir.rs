@@ -125,7 +125,7 @@ pub struct Service {
     pub plan: PlanId,
     pub span: Span,
     /// Index of the service's item in the file's syntax tree: its body and
-    /// `repeat` are read from there ([`crate::Analysis::service_syntax`]).
+    /// `repeat` are read from there ([`crate::CheckedMission::service_syntax`]).
     pub item: usize,
     /// Events this service can throw, directly or through functions it calls.
     pub throws: Vec<Name>,

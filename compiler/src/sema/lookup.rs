@@ -5,7 +5,7 @@
 //! either share their span (one name meaning several symbols: the robots of
 //! `tb[3]`, or a function body inlined for several teams) or do not overlap.
 
-use super::Analysis;
+use super::CheckedMission;
 use super::{Mission, Occurrence, Symbol, TeamId};
 use crate::span::Span;
 use crate::syntax::ast::{Item, SourceFile};
@@ -65,7 +65,7 @@ pub(crate) fn item_at(file: &SourceFile, offset: usize) -> Option<(usize, &Item)
 }
 
 /// The team whose service, mode or main block holds `offset`.
-pub(crate) fn enclosing_team(analysis: &Analysis, offset: usize) -> Option<TeamId> {
+pub(crate) fn enclosing_team(analysis: &CheckedMission, offset: usize) -> Option<TeamId> {
     let team = match item_at(&analysis.syntax, offset)?.1 {
         Item::Service(s) => &s.team,
         Item::Mode(m) => &m.team,

@@ -47,14 +47,14 @@ pub const MAX_ROBOTS_PER_MISSION: usize = 4096;
 
 /// Everything known about one mission file after checking.
 #[derive(Clone, Debug)]
-pub struct Analysis {
+pub struct CheckedMission {
     pub syntax: ast::SourceFile,
     pub mission: Mission,
     /// Syntax and semantic diagnostics, sorted by position.
     pub diagnostics: Vec<Diagnostic>,
 }
 
-impl Analysis {
+impl CheckedMission {
     pub fn has_errors(&self) -> bool {
         self.diagnostics.iter().any(Diagnostic::is_error)
     }
@@ -77,17 +77,17 @@ impl Analysis {
 }
 
 /// Parses and checks one mission script.
-pub fn check_source(file: FileId, text: &str, catalog: &Catalog) -> Analysis {
+pub fn check_source(file: FileId, text: &str, catalog: &Catalog) -> CheckedMission {
     check_parsed(file, syntax::parse(file, text), catalog)
 }
 
 /// Checks a mission script already parsed (by [`syntax::parse`] or
 /// [`syntax::parse_incremental`]): the same analysis as [`check_source`].
-pub fn check_parsed(file: FileId, parse: syntax::Parse, catalog: &Catalog) -> Analysis {
+pub fn check_parsed(file: FileId, parse: syntax::Parse, catalog: &Catalog) -> CheckedMission {
     let (mission, mut diagnostics) = check(file, &parse, catalog);
     diagnostics.extend(parse.diagnostics);
     diag::sort_and_dedup(&mut diagnostics);
-    Analysis {
+    CheckedMission {
         syntax: parse.file,
         mission,
         diagnostics,

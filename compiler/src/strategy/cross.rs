@@ -31,7 +31,7 @@
 use super::model::*;
 use crate::catalog::{Catalog, Implementation, RobotType, RobotTypeId};
 use crate::diag::{self, Code, Diagnostic, FileId, Related};
-use crate::sema::{Analysis, FunctionId, Mission, PlanId, ServiceId, Symbol, Team, TeamId};
+use crate::sema::{CheckedMission, FunctionId, Mission, PlanId, ServiceId, Symbol, Team, TeamId};
 use crate::span::Span;
 use crate::suggest::did_you_mean;
 use crate::syntax::ast::{self, ArmKind, StmtKind};
@@ -117,7 +117,7 @@ impl StrategyLinks {
 /// strategy files (with related positions in the missions).
 pub fn cross_check(
     strategies: &[&Strategy],
-    missions: &[&Analysis],
+    missions: &[&CheckedMission],
     catalog: &Catalog,
 ) -> (StrategyLinks, Vec<Diagnostic>) {
     let mut cx = Cross {
@@ -210,7 +210,7 @@ pub struct BuiltinCall {
 /// The built-in calls that `team`'s composite services run, service by
 /// service (a call inside a function once per service running it): what a
 /// strategy of the team may refine.
-pub fn team_calls(analysis: &Analysis, team: TeamId) -> Vec<BuiltinCall> {
+pub fn team_calls(analysis: &CheckedMission, team: TeamId) -> Vec<BuiltinCall> {
     let Some(team) = analysis.mission.teams.get(team.0 as usize) else {
         return Vec::new();
     };
@@ -229,7 +229,7 @@ pub fn team_calls(analysis: &Analysis, team: TeamId) -> Vec<BuiltinCall> {
 
 /// What the cross checks need of one mission, computed once.
 struct MissionSummary<'a> {
-    analysis: &'a Analysis,
+    analysis: &'a CheckedMission,
     /// Per team: the built-in calls its composite services run.
     calls: Vec<Vec<BuiltinCall>>,
     /// Per team: its composite services that elect a leader.
@@ -237,7 +237,7 @@ struct MissionSummary<'a> {
 }
 
 impl<'a> MissionSummary<'a> {
-    fn new(analysis: &'a Analysis) -> Self {
+    fn new(analysis: &'a CheckedMission) -> Self {
         let mission = &analysis.mission;
         let mut calls = Vec::new();
         let mut electing = Vec::new();
@@ -284,7 +284,7 @@ struct Walked {
 /// The built-in calls and leader elections of a composite service, through
 /// the functions it calls (each function walked once; a worklist, not
 /// recursion, so that long call chains cannot overflow the stack).
-fn walk_service(analysis: &Analysis, service: &crate::sema::Service) -> Walked {
+fn walk_service(analysis: &CheckedMission, service: &crate::sema::Service) -> Walked {
     let mission = &analysis.mission;
     let mut out = Walked::default();
     let Some(syntax) = analysis.service_syntax(service) else {

@@ -1,6 +1,6 @@
 use super::*;
 use crate::catalog::{Catalog, CatalogSource, builtin_catalog, load_catalog};
-use crate::sema::Analysis;
+use crate::sema::CheckedMission;
 use crate::span::Span;
 use crate::syntax::ast::{CmpOp, ExprKind};
 
@@ -191,7 +191,7 @@ fn no_strategy_element_gives_no_strategy() {
 
 // --- against the catalog and the missions ------------------------------------
 
-fn mission(file: FileId, text: &str, catalog: &Catalog) -> Analysis {
+fn mission(file: FileId, text: &str, catalog: &Catalog) -> CheckedMission {
     let analysis = crate::check_source(file, text, catalog);
     let errors: Vec<_> = analysis
         .diagnostics
@@ -202,7 +202,10 @@ fn mission(file: FileId, text: &str, catalog: &Catalog) -> Analysis {
     analysis
 }
 
-fn cross(strategies: &[&Strategy], missions: &[&Analysis]) -> (StrategyLinks, Vec<Diagnostic>) {
+fn cross(
+    strategies: &[&Strategy],
+    missions: &[&CheckedMission],
+) -> (StrategyLinks, Vec<Diagnostic>) {
     cross_check(strategies, missions, &builtin_catalog())
 }
 

@@ -27,7 +27,7 @@ pub mod workspace_symbol;
 
 use crate::encoding::{Encoding, LineMap};
 use crate::world::Snapshot;
-use semo::Analysis;
+use semo::CheckedMission;
 use tower_lsp_server::jsonrpc;
 use tower_lsp_server::ls_types::*;
 
@@ -106,7 +106,7 @@ pub fn capabilities(encoding: Encoding) -> ServerCapabilities {
 /// not missions (catalogs, task graphs).
 pub fn with_mission<T>(
     snapshot: &Snapshot,
-    f: impl FnOnce(&Analysis, LineMap<'_>) -> T,
+    f: impl FnOnce(&CheckedMission, LineMap<'_>) -> T,
 ) -> Option<T> {
     let analysis = snapshot.analysis();
     let mission = analysis.mission.as_ref()?;

@@ -18,13 +18,13 @@
 use crate::catalog::Catalog;
 use crate::diag::{Code, Diagnostic};
 pub use crate::edit::{CodeAction, TextEdit};
-use crate::sema::{Analysis, ModeId, PlanId, Symbol, Team, TeamId};
+use crate::sema::{CheckedMission, ModeId, PlanId, Symbol, Team, TeamId};
 use crate::span::Span;
 use crate::syntax::ast::{self, Item, SetTarget};
 
 /// The quick fixes for the diagnostics that touch `range`.
 pub fn code_actions(
-    analysis: &Analysis,
+    analysis: &CheckedMission,
     _catalog: &Catalog,
     text: &str,
     range: Span,
@@ -49,7 +49,7 @@ pub fn code_actions(
 }
 
 struct Fixes<'a> {
-    analysis: &'a Analysis,
+    analysis: &'a CheckedMission,
     text: &'a str,
     diagnostic: &'a Diagnostic,
     index: usize,

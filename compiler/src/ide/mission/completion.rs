@@ -16,7 +16,7 @@ use super::values;
 use crate::catalog::{Catalog, RobotTypeId, ValueDef, ValueType};
 use crate::ide::{CompletionConfig, CompletionItem, CompletionKind};
 use crate::sema::{
-    Analysis, Mission, ModeId, PlanId, ScopeKind, ServiceId, Symbol, Team, TeamId, is_user,
+    CheckedMission, Mission, ModeId, PlanId, ScopeKind, ServiceId, Symbol, Team, TeamId, is_user,
 };
 use crate::span::Span;
 use crate::syntax::ast::{self, Name};
@@ -24,7 +24,7 @@ use crate::syntax::token::Token;
 
 /// The completions at `offset` in `text`, most specific first.
 pub fn completions(
-    analysis: &Analysis,
+    analysis: &CheckedMission,
     catalog: &Catalog,
     text: &str,
     offset: usize,
@@ -61,7 +61,7 @@ pub fn completions(
 }
 
 struct Completions<'a> {
-    analysis: &'a Analysis,
+    analysis: &'a CheckedMission,
     mission: &'a Mission,
     catalog: &'a Catalog,
     text: &'a str,

@@ -9,7 +9,7 @@
 //! innermost level then say what may come next. This costs one item's worth of
 //! lexing, whatever the size of the file.
 
-use crate::sema::Analysis;
+use crate::sema::CheckedMission;
 use crate::span::Span;
 use crate::syntax::ast::{self, ArmKind, CommKind, Name};
 use crate::syntax::token::{self, Kw, Token};
@@ -160,7 +160,7 @@ pub(crate) struct Scan<'s> {
 /// around it, or of the last item before it. Inside a braced formation (which
 /// may declare hundreds of teams), the start of the team declaration there,
 /// with the formation's brace already open.
-fn window_start(analysis: &Analysis, offset: usize) -> (usize, Option<Span>) {
+fn window_start(analysis: &CheckedMission, offset: usize) -> (usize, Option<Span>) {
     let items = &analysis.syntax.items;
     let after = items.partition_point(|item| item.span().start <= offset);
     let Some(i) = after.checked_sub(1) else {
@@ -257,7 +257,7 @@ fn closer_of(open: Token<'_>) -> Option<Token<'static>> {
 }
 
 /// Scans `text[..end]` from the start of the item around `end`.
-pub(crate) fn scan<'s>(analysis: &Analysis, text: &'s str, end: usize) -> Scan<'s> {
+pub(crate) fn scan<'s>(analysis: &CheckedMission, text: &'s str, end: usize) -> Scan<'s> {
     let end = floor_char_boundary(text, end.min(text.len()));
     let (start, formation) = window_start(analysis, end);
     let start = floor_char_boundary(text, start.min(end));

@@ -1,7 +1,7 @@
 //! Markdown descriptions of what names mean, shared by hover and completion.
 
 use crate::catalog::{Catalog, RobotType, RobotTypeId, ServiceDef, ValueDef};
-use crate::sema::{Analysis, Mission, ModeId, ModeSet, PlanId, ServiceId, Team, TeamId};
+use crate::sema::{CheckedMission, Mission, ModeId, ModeSet, PlanId, ServiceId, Team, TeamId};
 use crate::syntax::ast;
 use std::fmt::Write;
 
@@ -231,7 +231,7 @@ pub(crate) fn schedule(text: &str, syntax: Option<&ast::CompositeService>) -> St
 
 /// A composite service of a team: path, schedule, events, modes that run it.
 pub(crate) fn composite_service(
-    analysis: &Analysis,
+    analysis: &CheckedMission,
     text: &str,
     team: TeamId,
     service: ServiceId,

@@ -8,7 +8,7 @@
 //! before), so that `} repeat(1 SEC)` stays visible, as indentation folding
 //! would have it.
 
-use crate::Analysis;
+use crate::CheckedMission;
 use crate::span::Span;
 use crate::syntax::ast::{Block, Else, Item, Stmt, StmtKind};
 
@@ -25,7 +25,7 @@ pub struct Fold {
 }
 
 /// The folds of the file, sorted by start (outer before inner).
-pub fn folding_ranges(analysis: &Analysis, text: &str) -> Vec<Fold> {
+pub fn folding_ranges(analysis: &CheckedMission, text: &str) -> Vec<Fold> {
     let mut folds = Folds {
         text,
         folds: Vec::new(),

@@ -11,12 +11,12 @@ use super::keywords;
 use super::robots::{self, RobotsHere};
 use crate::catalog::{Catalog, RobotTypeId};
 use crate::ide::HoverResult;
-use crate::sema::{Analysis, Mission, Symbol, TeamId};
+use crate::sema::{CheckedMission, Mission, Symbol, TeamId};
 use std::fmt::Write;
 
 /// The hover at `offset`, if a known name is there.
 pub fn hover(
-    analysis: &Analysis,
+    analysis: &CheckedMission,
     catalog: &Catalog,
     text: &str,
     offset: usize,
@@ -139,7 +139,7 @@ pub fn hover(
 /// A built-in service where it is called: which types of the robots running
 /// the statement provide it, and which other catalog types do.
 fn builtin_service(
-    analysis: &Analysis,
+    analysis: &CheckedMission,
     catalog: &Catalog,
     name: &str,
     offset: usize,
@@ -182,7 +182,7 @@ fn builtin_service(
 
 /// A robot value: its definition, and which types of the team have it.
 fn value(
-    analysis: &Analysis,
+    analysis: &CheckedMission,
     catalog: &Catalog,
     owner: Option<TeamId>,
     name: &str,
@@ -238,7 +238,7 @@ fn value(
 
 /// A capability in a group condition: which robot types have it, and which
 /// robots of the team.
-fn capability(analysis: &Analysis, catalog: &Catalog, name: &str, offset: usize) -> String {
+fn capability(analysis: &CheckedMission, catalog: &Catalog, name: &str, offset: usize) -> String {
     let mission = &analysis.mission;
     let mut out = format!("**capability** `{name}`");
     let types: Vec<String> = catalog

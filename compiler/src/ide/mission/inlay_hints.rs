@@ -5,13 +5,13 @@
 use super::docs;
 use crate::catalog::Catalog;
 pub use crate::ide::{InlayHint, InlayKind};
-use crate::sema::{Analysis, Runners, ScopeKind};
+use crate::sema::{CheckedMission, Runners, ScopeKind};
 use crate::span::Span;
 use crate::syntax::ast::{self, ArmKind, SetTarget};
 
 /// The hints whose position lies in `range`.
 pub fn inlay_hints(
-    analysis: &Analysis,
+    analysis: &CheckedMission,
     _catalog: &Catalog,
     text: &str,
     range: Span,
@@ -23,7 +23,7 @@ pub fn inlay_hints(
     hints
 }
 
-fn group_hints(analysis: &Analysis, text: &str, range: Span, hints: &mut Vec<InlayHint>) {
+fn group_hints(analysis: &CheckedMission, text: &str, range: Span, hints: &mut Vec<InlayHint>) {
     let mission = &analysis.mission;
     // A hint sits just before its scope's body, so only scopes that start
     // (at most a line or so) after the range's start can have one inside it.
@@ -66,7 +66,7 @@ fn group_hints(analysis: &Analysis, text: &str, range: Span, hints: &mut Vec<Inl
 
 /// The robots of runners: `a, b`, or `A: a, b; B: c` when several teams run
 /// them (a function); empty when there are none.
-fn robot_names(analysis: &Analysis, runs: &[Runners]) -> String {
+fn robot_names(analysis: &CheckedMission, runs: &[Runners]) -> String {
     let mission = &analysis.mission;
     let teams: Vec<_> = runs.iter().filter(|r| r.team.is_some()).collect();
     let mut parts: Vec<String> = Vec::new();
@@ -101,7 +101,7 @@ fn after_paren(text: &str, end: usize) -> usize {
     }
 }
 
-fn set_hints(analysis: &Analysis, text: &str, range: Span, hints: &mut Vec<InlayHint>) {
+fn set_hints(analysis: &CheckedMission, text: &str, range: Span, hints: &mut Vec<InlayHint>) {
     let mission = &analysis.mission;
     let items = &analysis.syntax.items;
     let first = items.partition_point(|i| i.span().end < range.start);

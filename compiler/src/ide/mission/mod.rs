@@ -1,6 +1,6 @@
 //! Editor features over one analysed mission, as plain data: what the
 //! language server answers, without any protocol type (as rust-analyzer's
-//! `ide` crate). Every function takes the [`Analysis`](crate::Analysis) of a
+//! `ide` crate). Every function takes the [`CheckedMission`](crate::CheckedMission) of a
 //! text (with the [`Catalog`](crate::catalog::Catalog) it was checked against
 //! and the text itself where needed) and byte offsets or
 //! [`Span`](crate::span::Span)s, and returns byte spans and plain data. None

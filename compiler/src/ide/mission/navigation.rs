@@ -18,7 +18,7 @@
 //! robots of `tb[3]`; a function called by several teams, whose `throw e`
 //! raises an event of each), the results of all of them are given.
 
-use crate::Analysis;
+use crate::CheckedMission;
 use crate::catalog::{BUILTIN_FILE, Catalog, Origin, RobotTypeId};
 use crate::ide::NavigationTarget;
 use crate::sema::lookup;
@@ -50,7 +50,7 @@ pub struct Reference {
 }
 
 /// The name at `offset` (containing it or ending there) and what it means.
-pub fn name_at(analysis: &Analysis, offset: usize) -> Option<NameAt> {
+pub fn name_at(analysis: &CheckedMission, offset: usize) -> Option<NameAt> {
     let occurrences = lookup::at(&analysis.mission, offset);
     let first = occurrences.first()?;
     Some(NameAt {
@@ -61,7 +61,11 @@ pub fn name_at(analysis: &Analysis, offset: usize) -> Option<NameAt> {
 
 /// The definitions of the name at `offset`, sorted; empty when there is no
 /// name there or its definition has no place (see the module docs).
-pub fn definition(analysis: &Analysis, catalog: &Catalog, offset: usize) -> Vec<NavigationTarget> {
+pub fn definition(
+    analysis: &CheckedMission,
+    catalog: &Catalog,
+    offset: usize,
+) -> Vec<NavigationTarget> {
     let Some(name) = name_at(analysis, offset) else {
         return Vec::new();
     };
@@ -92,7 +96,7 @@ pub fn definition(analysis: &Analysis, catalog: &Catalog, offset: usize) -> Vec<
 }
 
 /// Every name of the mission meaning what the name at `offset` means, sorted.
-pub fn references(analysis: &Analysis, offset: usize) -> Vec<Reference> {
+pub fn references(analysis: &CheckedMission, offset: usize) -> Vec<Reference> {
     let Some(name) = name_at(analysis, offset) else {
         return Vec::new();
     };
@@ -120,7 +124,7 @@ pub fn references(analysis: &Analysis, offset: usize) -> Vec<Reference> {
 }
 
 /// The definitions of `symbol` in the mission (see the module docs), sorted.
-pub(crate) fn definition_spans(analysis: &Analysis, symbol: &Symbol) -> Vec<Span> {
+pub(crate) fn definition_spans(analysis: &CheckedMission, symbol: &Symbol) -> Vec<Span> {
     let mission = &analysis.mission;
     let mut spans: Vec<Span> = match symbol {
         Symbol::Event { team, name } => mission
@@ -150,7 +154,7 @@ pub(crate) fn definition_spans(analysis: &Analysis, symbol: &Symbol) -> Vec<Span
 
 /// The spans where `symbol` is given a value, sorted: its definitions, and
 /// for a team variable also where it is received.
-fn write_spans(analysis: &Analysis, symbol: &Symbol, definitions: &[Span]) -> Vec<Span> {
+fn write_spans(analysis: &CheckedMission, symbol: &Symbol, definitions: &[Span]) -> Vec<Span> {
     let mut writes = definitions.to_vec();
     if matches!(symbol, Symbol::TeamVariable { .. }) {
         let incoming = incoming_spans(analysis);
@@ -167,7 +171,7 @@ fn write_spans(analysis: &Analysis, symbol: &Symbol, definitions: &[Span]) -> Ve
 }
 
 /// The last name of every attribute of a `receive` or `subscribe`, sorted.
-fn incoming_spans(analysis: &Analysis) -> Vec<Span> {
+fn incoming_spans(analysis: &CheckedMission) -> Vec<Span> {
     let mut spans = Vec::new();
     for item in &analysis.syntax.items {
         let body = match item {
@@ -189,7 +193,7 @@ fn incoming_spans(analysis: &Analysis) -> Vec<Span> {
 
 /// Where a catalog symbol is defined; `None` for symbols of the mission.
 fn catalog_origins(
-    analysis: &Analysis,
+    analysis: &CheckedMission,
     catalog: &Catalog,
     symbol: &Symbol,
     offset: usize,
@@ -230,7 +234,7 @@ fn catalog_origins(
 }
 
 /// The robot types of a team's robots (of every team when `None`), each once.
-fn running_types(analysis: &Analysis, team: Option<TeamId>) -> Vec<RobotTypeId> {
+fn running_types(analysis: &CheckedMission, team: Option<TeamId>) -> Vec<RobotTypeId> {
     let teams = &analysis.mission.teams;
     let teams = match team {
         Some(t) => teams.get(t.0 as usize..t.0 as usize + 1).unwrap_or(&[]),

@@ -19,7 +19,7 @@
 //! its calls).
 
 use super::navigation;
-use crate::Analysis;
+use crate::CheckedMission;
 use crate::catalog::Catalog;
 use crate::sema::Symbol;
 use crate::sema::lookup;
@@ -44,7 +44,11 @@ fn refuse<T>(message: impl Into<String>) -> Result<T, RenameError> {
 }
 
 /// The range of the name at `offset` if it can be renamed, else why not.
-pub fn prepare_rename(analysis: &Analysis, text: &str, offset: usize) -> Result<Span, RenameError> {
+pub fn prepare_rename(
+    analysis: &CheckedMission,
+    text: &str,
+    offset: usize,
+) -> Result<Span, RenameError> {
     let Some(name) = navigation::name_at(analysis, offset) else {
         return match word_at(text, offset) {
             Some(word) if Kw::from_word(word).is_some() => refuse(format!(
@@ -62,7 +66,7 @@ pub fn prepare_rename(analysis: &Analysis, text: &str, offset: usize) -> Result<
 /// The ranges to replace with `new_name` to rename the name at `offset`,
 /// sorted, or why the rename is refused.
 pub fn rename(
-    analysis: &Analysis,
+    analysis: &CheckedMission,
     catalog: &Catalog,
     text: &str,
     offset: usize,
@@ -151,7 +155,7 @@ fn check_name(name: &str) -> Result<(), RenameError> {
 
 /// What `symbol`, renamed to `new`, would clash with.
 fn clash(
-    analysis: &Analysis,
+    analysis: &CheckedMission,
     catalog: &Catalog,
     text: &str,
     symbol: &Symbol,
@@ -352,7 +356,7 @@ Guards.main { case (GO): catch (alarm): mode = GO catch (home): mode = GO defaul
     /// Renaming gives a mission that checks exactly like the original.
     fn assert_same_meaning(f: &Fixture, renamed: &str) {
         let after = crate::check_source(Fixture::FILE, renamed, &f.catalog);
-        let codes = |a: &Analysis| a.diagnostics.iter().map(|d| d.code).collect::<Vec<_>>();
+        let codes = |a: &CheckedMission| a.diagnostics.iter().map(|d| d.code).collect::<Vec<_>>();
         assert_eq!(codes(&after), codes(&f.analysis), "{renamed}");
         assert_eq!(
             after.mission.occurrences.len(),

@@ -2,7 +2,7 @@
 //! share: the services and values that are valid there.
 
 use crate::catalog::{Catalog, RobotTypeId, ServiceDef, ValueDef};
-use crate::sema::{Analysis, Mission, Occurrence, RobotId, ScopeKind, TeamId};
+use crate::sema::{CheckedMission, Mission, Occurrence, RobotId, ScopeKind, TeamId};
 use std::sync::Arc;
 
 /// The robots that run the statements at a place, by team.
@@ -17,7 +17,7 @@ impl RobotsHere {
     /// The robots running `offset`: from the innermost scope the checker
     /// recorded there; else (text too broken to be a scope yet) every robot of
     /// `fallback_team`; else unknown (no runs).
-    pub fn at(analysis: &Analysis, offset: usize, fallback_team: Option<&str>) -> RobotsHere {
+    pub fn at(analysis: &CheckedMission, offset: usize, fallback_team: Option<&str>) -> RobotsHere {
         let mission = &analysis.mission;
         if let Some(scope) = mission.scope_at(offset) {
             let runs = scope
@@ -42,7 +42,7 @@ impl RobotsHere {
 
     /// The robots around the innermost scope at `offset` (outside the
     /// `group` arm the offset is in), if it has a parent scope.
-    pub fn around(analysis: &Analysis, offset: usize) -> Option<RobotsHere> {
+    pub fn around(analysis: &CheckedMission, offset: usize) -> Option<RobotsHere> {
         let mission = &analysis.mission;
         let parent = mission.scope_at(offset)?.parent?;
         let scope = mission.scopes.get(parent as usize)?;

@@ -2,7 +2,7 @@
 //! through the nodes of the tree that hold it: name → attribute → expression
 //! → statement → block → item → file.
 
-use crate::Analysis;
+use crate::CheckedMission;
 use crate::span::Span;
 use crate::syntax::ast::{
     Arg, Attr, Block, Case, Catch, CommItem, Else, Expr, ExprKind, GroupArm, GroupCond, Ident,
@@ -11,7 +11,7 @@ use crate::syntax::ast::{
 
 /// The ranges holding `offset`, innermost first, each strictly inside the
 /// next; the last is the whole file.
-pub fn selection_ranges(analysis: &Analysis, text: &str, offset: usize) -> Vec<Span> {
+pub fn selection_ranges(analysis: &CheckedMission, text: &str, offset: usize) -> Vec<Span> {
     let file = Span::new(0, text.len());
     let offset = offset.min(text.len());
     let mut outward = vec![file];

@@ -2,7 +2,7 @@
 //! with what it is. Keywords, strings, numbers and comments are left to the
 //! editor's grammar.
 
-use crate::Analysis;
+use crate::CheckedMission;
 use crate::sema::Symbol;
 use crate::sema::lookup;
 use crate::span::Span;
@@ -82,7 +82,7 @@ pub struct HighlightToken {
 
 /// The highlighted names, sorted and not overlapping, of the whole file or
 /// of those overlapping `range`. Each is one identifier, so on one line.
-pub fn semantic_tokens(analysis: &Analysis, range: Option<Span>) -> Vec<HighlightToken> {
+pub fn semantic_tokens(analysis: &CheckedMission, range: Option<Span>) -> Vec<HighlightToken> {
     let mission = &analysis.mission;
     let occurrences = match range {
         Some(range) => lookup::in_range(mission, range),

@@ -6,7 +6,7 @@
 use super::context::{self, Lt, Paren, Trivia};
 use super::robots::{self, RobotsHere};
 use crate::catalog::Catalog;
-use crate::sema::Analysis;
+use crate::sema::CheckedMission;
 use crate::syntax::ast::CommKind;
 use crate::syntax::token::Token;
 use std::ops::Range;
@@ -25,7 +25,7 @@ pub struct SignatureHelp {
 
 /// The signature of the call whose parentheses hold `offset`.
 pub fn signature_help(
-    analysis: &Analysis,
+    analysis: &CheckedMission,
     catalog: &Catalog,
     text: &str,
     offset: usize,

@@ -6,13 +6,13 @@
 //! the top level. Items of undeclared teams and duplicate definitions (both
 //! reported by the checker) are not in it.
 
-use crate::Analysis;
+use crate::CheckedMission;
 use crate::ide::{NavigationTarget, StructureNode, SymbolKind, WorkspaceSymbol};
 use crate::sema::Team;
 use crate::syntax::ast::{self, Item};
 
 /// The outline of the mission, in file order.
-pub fn document_symbols(analysis: &Analysis, text: &str) -> Vec<StructureNode> {
+pub fn document_symbols(analysis: &CheckedMission, text: &str) -> Vec<StructureNode> {
     let mission = &analysis.mission;
     let decls: Vec<&ast::TeamDecl> = analysis
         .syntax
@@ -168,7 +168,7 @@ fn team_symbol(
 
 /// The teams, composite services, modes and functions of the mission whose
 /// name matches `query`, best first.
-pub fn workspace_symbols(analysis: &Analysis, query: &str) -> Vec<WorkspaceSymbol> {
+pub fn workspace_symbols(analysis: &CheckedMission, query: &str) -> Vec<WorkspaceSymbol> {
     let mission = &analysis.mission;
     let mut found = Vec::new();
     let mut add = |name: &str, kind, container: Option<String>, name_span| {

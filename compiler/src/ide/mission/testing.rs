@@ -1,7 +1,7 @@
 //! Helpers for the unit tests of the IDE features: a mission analysed against
 //! the built-in catalog (and optionally one catalog file), and readable spans.
 
-use crate::Analysis;
+use crate::CheckedMission;
 use crate::catalog::{Catalog, CatalogSource, load_catalog};
 use crate::diag::FileId;
 use crate::span::Span;
@@ -9,7 +9,7 @@ use crate::text::{ColumnUnit, LineIndex};
 
 pub(crate) struct Fixture {
     pub text: String,
-    pub analysis: Analysis,
+    pub analysis: CheckedMission,
     pub catalog: Catalog,
 }
 

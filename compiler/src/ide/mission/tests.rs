@@ -12,7 +12,7 @@ use super::signature_help::signature_help;
 use crate::catalog::{Catalog, CatalogSource, builtin_catalog, load_catalog};
 use crate::diag::FileId;
 use crate::ide::{CompletionConfig, CompletionItem, CompletionKind};
-use crate::sema::{Analysis, ScopeKind};
+use crate::sema::{CheckedMission, ScopeKind};
 use crate::span::Span;
 use crate::syntax::ast::ArmKind;
 use proptest::prelude::*;
@@ -23,7 +23,7 @@ fn builtin() -> &'static Catalog {
     CATALOG.get_or_init(builtin_catalog)
 }
 
-fn analyse(text: &str) -> Analysis {
+fn analyse(text: &str) -> CheckedMission {
     crate::check_source(FileId(0), text, builtin())
 }
 
@@ -392,7 +392,7 @@ fn a_word_that_is_also_a_value_is_fixed_either_way() {
 
 /// Every `ide` function at `offset` of `text`: nothing panics, and every
 /// range returned lies in the text, on character boundaries.
-fn every_feature_at(text: &str, analysis: &Analysis, offset: usize) {
+fn every_feature_at(text: &str, analysis: &CheckedMission, offset: usize) {
     let catalog = builtin();
     let valid = |span: Span| {
         assert!(span.start <= span.end && span.end <= text.len(), "{span:?}");

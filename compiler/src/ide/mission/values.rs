@@ -6,7 +6,7 @@
 //! service of `SlaveTeam` are the same value. Completion offers these after
 //! `==` and `!=`.
 
-use crate::sema::{Analysis, Symbol, lookup};
+use crate::sema::{CheckedMission, Symbol, lookup};
 use crate::syntax::ast::{self, CmpOp, Expr, ExprKind, Item, StmtKind};
 
 /// A literal written with a value in the mission.
@@ -20,7 +20,7 @@ pub(crate) struct Constant {
 
 /// The literals written with `value` in the mission, each once (by its
 /// text), in the order they first appear.
-pub(crate) fn constants_of(analysis: &Analysis, text: &str, value: &Symbol) -> Vec<Constant> {
+pub(crate) fn constants_of(analysis: &CheckedMission, text: &str, value: &Symbol) -> Vec<Constant> {
     let mut found = Finder {
         analysis,
         text,
@@ -44,7 +44,7 @@ pub(crate) fn constants_of(analysis: &Analysis, text: &str, value: &Symbol) -> V
 }
 
 struct Finder<'a> {
-    analysis: &'a Analysis,
+    analysis: &'a CheckedMission,
     text: &'a str,
     value: &'a Symbol,
     out: Vec<Constant>,

@@ -14,7 +14,7 @@ use crate::catalog::Catalog;
 use crate::diag::{Code, Diagnostic};
 pub use crate::edit::CodeAction;
 use crate::edit::TextEdit;
-use crate::sema::Analysis;
+use crate::sema::CheckedMission;
 use crate::span::Span;
 use crate::strategy::model::Strategy;
 use crate::strategy::{StrategyLinks, team_calls};
@@ -155,7 +155,7 @@ pub struct EntryEdit {
 /// robot types that provide the service. A single action, initial and final,
 /// so that the new entry checks as it is.
 pub fn create_entry(
-    mission: &Analysis,
+    mission: &CheckedMission,
     catalog: &Catalog,
     offset: usize,
     strategy: &Strategy,

@@ -20,7 +20,7 @@ pub mod raw;
 pub mod symbols;
 
 use crate::catalog::{Catalog, RobotType, RobotTypeId};
-use crate::sema::{Analysis, Team, TeamId};
+use crate::sema::{CheckedMission, Team, TeamId};
 use crate::strategy::model::{ServiceEntry, Strategy, TargetRobot, ValueEntry};
 
 /// What the editor features of one strategy file read: its text, its model
@@ -30,7 +30,7 @@ use crate::strategy::model::{ServiceEntry, Strategy, TargetRobot, ValueEntry};
 pub struct StrategyFile<'a> {
     pub text: &'a str,
     pub strategy: Option<&'a Strategy>,
-    pub missions: &'a [&'a Analysis],
+    pub missions: &'a [&'a CheckedMission],
     pub catalog: &'a Catalog,
 }
 
@@ -46,7 +46,7 @@ impl<'a> StrategyFile<'a> {
     }
 
     /// The strategy's team in each mission that declares it.
-    pub fn teams(&self) -> Vec<(&'a Analysis, TeamId, &'a Team)> {
+    pub fn teams(&self) -> Vec<(&'a CheckedMission, TeamId, &'a Team)> {
         let Some(name) = self.team_name() else {
             return Vec::new();
         };

@@ -21,7 +21,7 @@ const STRATEGY: &str = include_str!(concat!(
 ));
 
 struct Loaded {
-    mission: Analysis,
+    mission: CheckedMission,
     strategy: Option<Strategy>,
     links: StrategyLinks,
     diagnostics: Vec<crate::diag::Diagnostic>,
@@ -48,7 +48,7 @@ fn load(text: &str) -> Loaded {
 }
 
 impl Loaded {
-    fn file<'a>(&'a self, text: &'a str, missions: &'a [&'a Analysis]) -> StrategyFile<'a> {
+    fn file<'a>(&'a self, text: &'a str, missions: &'a [&'a CheckedMission]) -> StrategyFile<'a> {
         StrategyFile {
             text,
             strategy: self.strategy.as_ref(),
