@@ -353,7 +353,7 @@ impl World {
     /// first, then every file gets its snapshot once (rather than the files
     /// added early being renewed for each file added after them).
     pub fn index(&mut self, found: Vec<(Uri, Option<String>)>) -> Changed {
-        let mut ids = Vec::new();
+        let mut read = Vec::new();
         for (uri, text) in found {
             if self.is_open(&uri) {
                 continue;
@@ -367,6 +367,13 @@ impl World {
             let text: Arc<str> = text.into();
             self.host
                 .set_file(id, Some(path.clone()), kind, text.clone());
+            read.push((uri, id, kind, path, text));
+        }
+        // The snapshots once every file is in: a snapshot holds the host's
+        // table of files, and setting a file while one is held copies the
+        // whole table (a workspace of N files cost N copies of N entries).
+        let mut ids = Vec::new();
+        for (uri, id, kind, path, text) in read {
             let snapshot = Arc::new(self.new_snapshot(&uri, id, kind, None, text));
             let entry = FileEntry {
                 kind,
