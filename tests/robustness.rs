@@ -476,7 +476,7 @@ fn refined(path: &str) -> Refined {
     let (run, id) =
         semo::host::load_build(&support::repo_root().join(path), &[]).expect("the mission loads");
     let build = run.analysis().build_input(id).expect("the mission checks");
-    let refined = semo::codegen::refine_checked(&build.input());
+    let refined = semo::refine::refine_checked(&build.input());
     assert!(
         !refined.programs.is_empty(),
         "{path}: {:#?}",

@@ -513,7 +513,7 @@ fn refined(text: &str) -> Vec<semo::refine::RobotProgram> {
         .analysis()
         .build_input(id)
         .expect("a generated mission checks");
-    semo::codegen::refine_checked(&build.input()).programs
+    semo::refine::refine_checked(&build.input()).programs
 }
 
 /// A scenario exercising everything a control firing waits for: sensor

@@ -455,7 +455,7 @@ fn random_missions(
         std::fs::write(&path, &text).unwrap();
         let (run, id) = semo::host::load_build(&path, &[]).ok()?;
         let build = run.analysis().build_input(id)?;
-        let refined = semo::codegen::refine_checked(&build.input());
+        let refined = semo::refine::refine_checked(&build.input());
         (!refined.diagnostics.iter().any(|d| d.is_error())).then_some((
             seed,
             text,

@@ -357,13 +357,13 @@ fn report_scenario(record: &Record, format: Format, out: &mut impl Write) {
 /// world; only those targets compile it). A scenario's mistake is given
 /// positioned.
 fn build_with_scenario(
-    input: &codegen::BuildInput<'_>,
+    input: &semo::refine::BuildInput<'_>,
     path: &Path,
     text: &str,
     targets: &codegen::Targets,
     options: &Options,
 ) -> Result<codegen::BuildResult, Box<Record>> {
-    let refined = codegen::refine_checked(input);
+    let refined = semo::refine::refine_checked(input);
     if refined.programs.is_empty() {
         // Refused: the mission's own errors come first.
         return Ok(codegen::build_refined_each(

@@ -3,7 +3,6 @@
 
 use super::output::{self, Format};
 use super::render;
-use semo::codegen;
 use semo::deploy::{self, Deployment, broker};
 use semo::diag::Diagnostic;
 use semo::host::{self, CheckRun};
@@ -95,7 +94,7 @@ pub fn broker_config(
         Err(code) => return code,
     };
     let input = input.input();
-    let refined = codegen::refine_checked(&input);
+    let refined = semo::refine::refine_checked(&input);
     if refined.programs.is_empty() {
         run.diagnostics = refined.diagnostics;
         let _ = render::human(&run, Format::Human, color, &mut std::io::stderr());

@@ -544,8 +544,8 @@ fn write_frame(stream: &mut UnixStream, kind: u8, payload: &[u8]) -> io::Result<
 /// them, and runs them on the scenario until `until_ms`: each robot's name
 /// and trace, in peer order.
 pub fn simulate(
-    input: &semo::codegen::BuildInput<'_>,
-    refined: semo::codegen::Refined,
+    input: &semo::refine::BuildInput<'_>,
+    refined: semo::refine::Refined,
     scenario: &semo::sim::scenario::Scenario,
     scenario_text: &str,
     until_ms: i64,

@@ -990,9 +990,9 @@ fn refine_or_report(
     color: bool,
     command: &str,
     out: &mut impl Write,
-) -> Result<(semo::host::BuildFiles, semo::codegen::Refined), i32> {
+) -> Result<(semo::host::BuildFiles, semo::refine::Refined), i32> {
     let build = build_files(&check.analysis(), mission)?;
-    let refined = semo::codegen::refine_checked(&build.input());
+    let refined = semo::refine::refine_checked(&build.input());
     if refined.diagnostics.iter().any(|d| d.is_error()) {
         check.diagnostics = refined.diagnostics;
         let reported = match format {

@@ -17,7 +17,6 @@
 //! one typed while the broker cannot be reached is not sent, and said so
 //! (exit status 1), never queued to go out later.
 
-use semo::codegen;
 use semo::deploy::topics::{self, RunId, Scope};
 use semo::host;
 use semo_server::live::{
@@ -80,7 +79,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         Err(code) => return code,
     };
     let input = input.input();
-    let refined = codegen::refine_checked(&input);
+    let refined = semo::refine::refine_checked(&input);
     let Some(first) = refined.programs.first() else {
         run.diagnostics = refined.diagnostics;
         let _ = super::render::human(

@@ -360,8 +360,8 @@ pub fn json_summary(
 /// trace is theirs, merged in time order (robots in peer order at one instant).
 fn run_generated(
     options: &Options,
-    input: &semo::codegen::BuildInput<'_>,
-    refined: semo::codegen::Refined,
+    input: &semo::refine::BuildInput<'_>,
+    refined: semo::refine::Refined,
     scenario: &scenario::Scenario,
     scenario_text: &str,
     out: &mut impl Write,

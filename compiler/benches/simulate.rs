@@ -37,7 +37,7 @@ fn programs(files: semo::workspace::Files, id: semo::diag::FileId) -> Vec<RobotP
         .analysis()
         .build_input(id)
         .expect("the mission was checked");
-    let refined = semo::codegen::refine_checked(&build.input());
+    let refined = semo::refine::refine_checked(&build.input());
     assert!(!refined.programs.is_empty(), "{:#?}", refined.diagnostics);
     refined.programs
 }

@@ -19,7 +19,7 @@ fn programs(mission: &Path) -> (Vec<RobotProgram>, semo::diag::FileId, String) {
         .analysis()
         .build_input(id)
         .expect("the mission was checked");
-    let refined = semo::codegen::refine_checked(&build.input());
+    let refined = semo::refine::refine_checked(&build.input());
     assert!(!refined.programs.is_empty(), "{:#?}", refined.diagnostics);
     (refined.programs, id, text)
 }

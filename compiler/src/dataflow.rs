@@ -81,7 +81,7 @@ pub struct DataflowInput<'a> {
     pub mission: &'a Mission,
     pub catalog: &'a Catalog,
     /// What refinement gave for the mission: a program for at least one
-    /// robot of each declaration (`codegen::refine_checked_robots` with
+    /// robot of each declaration (`refine::refine_checked_robots` with
     /// `Robots::OnePerDeclaration`). The robots of a declaration are refined
     /// alike, so one program stands for all of them.
     pub programs: &'a [RobotProgram],

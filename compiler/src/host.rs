@@ -47,9 +47,9 @@
 //! from its previous version's [`ParseCache`]) and what reads it.
 
 use crate::catalog::{Catalog, CatalogSource, load_catalog};
-use crate::codegen::BuildInput;
 use crate::diag::{self, Diagnostic, FileId};
 use crate::project::{self, Project};
+use crate::refine::BuildInput;
 use crate::sema::{self, check_parsed};
 use crate::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
 use crate::syntax::{ParseCache, parse_incremental};

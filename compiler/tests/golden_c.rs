@@ -124,7 +124,7 @@ fn build(
     if !target.needs_scenario() {
         return codegen::build(&input, target, Emit::All);
     }
-    let refined = codegen::refine_checked(&input);
+    let refined = semo::refine::refine_checked(&input);
     assert!(
         !refined.programs.is_empty(),
         "{}: {:#?}",

@@ -34,7 +34,7 @@ fn programs(name: &str, text: String) -> Vec<RobotProgram> {
         .analysis()
         .build_input(id)
         .expect("the mission was checked");
-    let refined = semo::codegen::refine_checked(&build.input());
+    let refined = semo::refine::refine_checked(&build.input());
     assert!(!refined.programs.is_empty(), "{:#?}", refined.diagnostics);
     refined.programs
 }

@@ -182,7 +182,7 @@ pub fn explore(
         .host()
         .build_input(snapshot.id)
         .ok_or(NoReport::Errors)?;
-    let refined = semo::codegen::refine_checked(&build.input());
+    let refined = semo::refine::refine_checked(&build.input());
     if refined.diagnostics.iter().any(|d| d.is_error()) {
         return Err(NoReport::Errors);
     }

@@ -208,7 +208,7 @@ fn generated_taskgraph(mission: &str, robot: &str) -> String {
     let path = Some(std::path::PathBuf::from("/m/march.mission"));
     host.set_file(id, path, semo::workspace::FileKind::Mission, mission.into());
     let build = host.analysis().build_input(id).expect("a mission");
-    let refined = semo::codegen::refine_checked(&build.input());
+    let refined = semo::refine::refine_checked(&build.input());
     let program = refined
         .programs
         .iter()

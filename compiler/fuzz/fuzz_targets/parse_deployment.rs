@@ -26,7 +26,7 @@ fn mission() -> &'static Mission {
             .join("../../tests/fixtures/build/E121_deploy_unknown_robot/pair.mission");
         let (run, id) = semo::host::load_build(&path, &[]).expect("the mission loads");
         let build = run.analysis().build_input(id).expect("the mission checks");
-        let programs = semo::codegen::refine_checked(&build.input()).programs;
+        let programs = semo::refine::refine_checked(&build.input()).programs;
         assert!(!programs.is_empty());
         Mission {
             analysis: build.analysis.clone(),

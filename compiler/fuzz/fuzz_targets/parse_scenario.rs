@@ -19,7 +19,7 @@ fn programs() -> &'static [RobotProgram] {
             Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scouting/scouting.mission");
         let (run, id) = semo::host::load_build(&path, &[]).expect("the mission loads");
         let build = run.analysis().build_input(id).expect("the mission checks");
-        let programs = semo::codegen::refine_checked(&build.input()).programs;
+        let programs = semo::refine::refine_checked(&build.input()).programs;
         assert!(!programs.is_empty());
         programs
     })

@@ -8,9 +8,10 @@
 //! stay: the trace is the operator console's record, and in simulation the
 //! operator's commands are compiled in.
 
-use super::{BuildInput, Chosen, Emit, Layer};
+use super::{Chosen, Emit, Layer};
 use crate::diag::{Code, Diagnostic};
 use crate::refine::RobotProgram;
+use crate::refine::{BuildInput, robot_span};
 use crate::sema::Peer;
 
 /// The operator console's team name in messages.
@@ -161,19 +162,6 @@ fn relate_choice(diagnostic: &mut Diagnostic, chosen: &Chosen) {
             message: format!("{} is chosen here", chosen.target.name()),
         });
     }
-}
-
-/// Where the robot is declared (diagnostics about one robot point there).
-pub(super) fn robot_span(build: &BuildInput<'_>, robot: &str) -> crate::span::Span {
-    build
-        .analysis
-        .mission
-        .teams
-        .iter()
-        .flat_map(|t| &t.robots)
-        .find(|r| r.name == robot)
-        .map(|r| r.name_span)
-        .unwrap_or_default()
 }
 
 /// The first statement of `team` that messages another team (the checker's

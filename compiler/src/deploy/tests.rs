@@ -314,7 +314,7 @@ fn programs(file_name: &str) -> Vec<crate::refine::RobotProgram> {
     let catalog = crate::catalog::builtin_catalog();
     let analysis = crate::sema::check_source(FileId(0), text, &catalog);
     let links = crate::strategy::StrategyLinks::default();
-    let input = crate::codegen::BuildInput {
+    let input = crate::refine::BuildInput {
         mission: FileId(0),
         mission_name: file_name.to_string(),
         text,
@@ -326,7 +326,7 @@ fn programs(file_name: &str) -> Vec<crate::refine::RobotProgram> {
         diagnostics: &analysis.diagnostics,
         service_graphs: &[],
     };
-    let refined = crate::codegen::refine_checked(&input);
+    let refined = crate::refine::refine_checked(&input);
     assert_eq!(refined.programs.len(), 2, "{:?}", refined.diagnostics);
     refined.programs
 }

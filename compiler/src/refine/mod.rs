@@ -13,12 +13,16 @@
 //!
 //! Refinement reads only checked input: the caller refuses missions with errors.
 
+mod build;
 pub mod graph;
 pub mod program;
 pub mod protocol;
 mod robot;
 pub mod value;
 
+pub use build::{
+    BuildInput, Refined, is_plain_name, refine_checked, refine_checked_robots, robot_span,
+};
 pub use program::*;
 pub use robot::SENSOR_PERIOD_MS;
 pub use value::{Value, ValueKind};

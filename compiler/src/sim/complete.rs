@@ -70,7 +70,7 @@ pub fn editor_completions(
 ) -> Vec<crate::ide::CompletionItem> {
     let programs = mission
         .and_then(|id| analysis.build_input(id))
-        .map(|build| crate::codegen::refine_checked(&build.input()))
+        .map(|build| crate::refine::refine_checked(&build.input()))
         .filter(|refined| !refined.diagnostics.iter().any(|d| d.is_error()))
         .map(|refined| refined.programs)
         .unwrap_or_default();

@@ -16,7 +16,7 @@ pub(super) fn programs(mission: &str) -> Vec<RobotProgram> {
         .analysis()
         .build_input(id)
         .expect("the mission was checked");
-    let refined = crate::codegen::refine_checked(&build.input());
+    let refined = crate::refine::refine_checked(&build.input());
     assert!(!refined.programs.is_empty(), "{:#?}", refined.diagnostics);
     refined.programs
 }

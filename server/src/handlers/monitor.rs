@@ -4,7 +4,7 @@
 //! `semo/monitor` notifications.
 //!
 //! The robots are the refined programs of the mission as the workspace
-//! analysis checked it (`codegen::refine_checked` on the host's build
+//! analysis checked it (`semo::refine::refine_checked` on the host's build
 //! input, as `semo operator` and `semo.simulate` read it): a mission with
 //! errors is refused. The broker: the request's `broker` (the editor's
 //! setting), else the deployment file of the mission's project (`semo.toml`
@@ -89,7 +89,7 @@ pub fn plan(job: &Job) -> Result<Plan, String> {
         .analysis
         .build_input(job.mission)
         .ok_or("internal error: the mission is not in the workspace analysis")?;
-    let refined = semo::codegen::refine_checked(&build.input());
+    let refined = semo::refine::refine_checked(&build.input());
     let errors = refined.diagnostics.iter().filter(|d| d.is_error()).count();
     if errors > 0 || refined.programs.is_empty() {
         return Err(format!(

@@ -167,7 +167,7 @@ fn run(job: &Job, text: &str) -> Result<Ran, Refusal> {
     let build = job.analysis.build_input(job.mission).ok_or_else(|| {
         Refusal::Mission("internal error: the mission is not in the workspace analysis".into())
     })?;
-    let refined = semo::codegen::refine_checked(&build.input());
+    let refined = semo::refine::refine_checked(&build.input());
     let errors = refined.diagnostics.iter().filter(|d| d.is_error()).count();
     if errors > 0 {
         return Err(Refusal::Mission(format!(

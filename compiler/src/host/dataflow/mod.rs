@@ -1,6 +1,6 @@
 //! The dataflow warnings of a mission ([`crate::dataflow`]) over the
 //! workspace: refined by refinement's public entry point
-//! (`codegen::refine_checked_robots`, from [`Analysis::build_input`]), one
+//! (`refine::refine_checked_robots`, from [`Analysis::build_input`]), one
 //! robot of each declaration (`name[N]` is one: its robots are refined
 //! alike, so the cost is per declaration, not per robot), with the service
 //! graphs the workspace holds, analysed as [`Analysis::graph`] analyses
@@ -34,7 +34,7 @@ impl Analysis {
         let input = build.input();
         // One robot per declaration: the warnings and each robot's period
         // are its declaration's (`dataflow::analyze`).
-        let refined = crate::codegen::refine_checked_robots(&input, Robots::OnePerDeclaration);
+        let refined = crate::refine::refine_checked_robots(&input, Robots::OnePerDeclaration);
         let found = if refined.diagnostics.iter().any(|d| d.is_error()) {
             MissionDataflow::default()
         } else {

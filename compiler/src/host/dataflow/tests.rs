@@ -324,7 +324,7 @@ fn a_declaration_of_many_robots_is_analysed_once_with_the_same_answer_as_each_ro
     );
     // Exactly what analysing every robot's own program gives.
     let build = analysis.build_input(MISSION_ID).unwrap();
-    let every_robot = crate::codegen::refine_checked(&build.input());
+    let every_robot = crate::refine::refine_checked(&build.input());
     assert_eq!(every_robot.programs.len(), 6);
     let service_graph = |catalog: FileId, path: &str| analysis.service_graph(catalog, path);
     let from_every_robot = crate::dataflow::analyze(&crate::dataflow::DataflowInput {
@@ -337,7 +337,7 @@ fn a_declaration_of_many_robots_is_analysed_once_with_the_same_answer_as_each_ro
     assert_eq!(from_every_robot.diagnostics, dataflow.diagnostics);
     assert_eq!(from_every_robot.robots, dataflow.robots);
     assert_eq!(from_every_robot.graphs, dataflow.graphs);
-    let refined = crate::codegen::refine_checked_robots(&build.input(), Robots::OnePerDeclaration);
+    let refined = crate::refine::refine_checked_robots(&build.input(), Robots::OnePerDeclaration);
     let names: Vec<&str> = refined.programs.iter().map(|p| p.robot.as_str()).collect();
     assert_eq!(names, ["r_2", "s", "t_1"]);
 }
@@ -353,7 +353,7 @@ fn a_declaration_refused_for_its_last_robots_name_gives_no_dataflow() {
     let analysis = w.host.analysis();
     assert!(analysis.dataflow(MISSION_ID).unwrap().robots.is_empty());
     let build = analysis.build_input(MISSION_ID).unwrap();
-    let refused = crate::codegen::refine_checked(&build.input());
+    let refused = crate::refine::refine_checked(&build.input());
     assert!(refused.programs.is_empty());
     assert!(
         refused

@@ -169,7 +169,7 @@ impl Analysis {
         let build = self
             .build_input(mission)
             .ok_or_else(|| PictureError("only a mission has robots to draw".to_string()))?;
-        let refined = crate::codegen::refine_checked(&build.input());
+        let refined = crate::refine::refine_checked(&build.input());
         if refined.programs.is_empty() {
             let errors = refined.diagnostics.iter().filter(|d| d.is_error()).count();
             return Err(PictureError(format!(
