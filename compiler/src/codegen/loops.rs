@@ -50,12 +50,10 @@
 
 use super::c;
 use super::template::{Template, fill, template};
+use crate::refine::protocol::GRAPH_TEXT_MAX;
 use crate::refine::{GraphService, GraphStep, InnerTask, LoopPort, PortUse, SubgraphPort};
 use std::fmt::Write;
 
-/// Characters of a `graph_fire` trace's `read` or `wrote` field, at most
-/// (tokens beyond are cut, as `sim/engine/loops.rs` cuts them).
-pub const GRAPH_TEXT_MAX: u64 = 4096;
 
 /// Characters a token takes in a trace field, at most, for sizing: an
 /// integer and its comma.

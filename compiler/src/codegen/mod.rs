@@ -28,7 +28,6 @@ mod control;
 pub(crate) mod files;
 mod loops;
 mod template;
-pub use loops::GRAPH_TEXT_MAX;
 pub mod output;
 mod peers;
 mod schedule;

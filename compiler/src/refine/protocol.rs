@@ -65,3 +65,7 @@ pub fn fenced_heard(heard: usize, candidates: usize) -> String {
 /// before its robot became the leader of the `leader(...)` arm whose block
 /// receives it (`drop_unled`). The simulator uses the same.
 pub const UNLED_REASON: &str = "arrived before it led";
+
+/// Characters of a `graph_fire` trace's `read` or `wrote` field, at most:
+/// tokens beyond are cut, by the C and the simulator alike.
+pub const GRAPH_TEXT_MAX: u64 = 4096;

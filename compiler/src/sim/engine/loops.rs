@@ -27,7 +27,7 @@
 //! iteration's end; a stop ends the call then (`Sim::stop_task`).
 
 use super::{Event, Sim};
-use crate::codegen::GRAPH_TEXT_MAX;
+use crate::refine::protocol::GRAPH_TEXT_MAX;
 use crate::refine::{GraphService, GraphStep, LoopPort};
 use crate::sim::trace::TraceEvent;
 use std::collections::{HashMap, VecDeque};
