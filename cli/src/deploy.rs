@@ -89,14 +89,18 @@ pub fn broker_config(
         Ok(deployment) => deployment,
         Err(code) => return code,
     };
-    let input = match super::build_files(&run.analysis(), mission) {
+    let analysis = run.analysis();
+    let input = match super::build_files(&analysis, mission) {
         Ok(files) => files,
         Err(code) => return code,
     };
     let input = input.input();
-    let refined = semo::refine::refine_checked(&input);
+    let Some(refined) = analysis.refined(mission) else {
+        eprintln!("error: internal error: the mission is not in the workspace analysis");
+        return 2;
+    };
     if refined.programs.is_empty() {
-        run.diagnostics = refined.diagnostics;
+        run.diagnostics = refined.diagnostics.clone();
         let _ = render::human(&run, Format::Human, color, &mut std::io::stderr());
         eprintln!("error: refused: fix the errors above first");
         return 1;

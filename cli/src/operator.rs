@@ -74,14 +74,17 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             }
         }
     };
-    let input = match super::build_files(&run.analysis(), mission) {
-        Ok(files) => files,
-        Err(code) => return code,
+    let analysis = run.analysis();
+    // The check's errors, reported as every door reports them.
+    if let Err(code) = super::build_files(&analysis, mission) {
+        return code;
+    }
+    let Some(refined) = analysis.refined(mission) else {
+        eprintln!("error: internal error: the mission is not in the workspace analysis");
+        return 2;
     };
-    let input = input.input();
-    let refined = semo::refine::refine_checked(&input);
     let Some(first) = refined.programs.first() else {
-        run.diagnostics = refined.diagnostics;
+        run.diagnostics = refined.diagnostics.clone();
         let _ = super::render::human(
             &run,
             super::output::Format::Human,

@@ -382,6 +382,8 @@ struct Memo {
     graphs: Memoised<FileId, (u64, u64), GraphRun>,
     /// By mission: the revisions of what it reads and of the task graphs.
     dataflow: Memoised<FileId, Key, crate::dataflow::MissionDataflow>,
+    /// By mission, with the same key as `dataflow`.
+    refined: Memoised<FileId, Key, crate::refine::Refined>,
 }
 
 /// Results by slot, each with the key it was computed from.
@@ -398,6 +400,7 @@ impl Memo {
         drop_later(lock(&self.strategies).remove(&id));
         drop_later(lock(&self.graphs).remove(&id));
         drop_later(lock(&self.dataflow).remove(&id));
+        drop_later(lock(&self.refined).remove(&id));
     }
 }
 
@@ -999,6 +1002,7 @@ mod disk;
 mod dropper;
 mod ide;
 mod plan;
+mod refined;
 #[cfg(test)]
 mod tests;
 mod view;

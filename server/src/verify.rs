@@ -177,12 +177,11 @@ pub fn explore(
     properties: impl FnOnce(
         &[semo::refine::RobotProgram],
     ) -> Result<Vec<semo::verify::Property>, String>,
-) -> Result<(semo::verify::Report, Vec<semo::refine::RobotProgram>), NoReport> {
-    let build = snapshot
+) -> Result<(semo::verify::Report, Arc<semo::refine::Refined>), NoReport> {
+    let refined = snapshot
         .host()
-        .build_input(snapshot.id)
+        .refined(snapshot.id)
         .ok_or(NoReport::Errors)?;
-    let refined = semo::refine::refine_checked(&build.input());
     if refined.diagnostics.iter().any(|d| d.is_error()) {
         return Err(NoReport::Errors);
     }
@@ -201,13 +200,13 @@ pub fn explore(
     if let Some(project) = snapshot.host().project(snapshot.id) {
         report.apply_lints(&project.project);
     }
-    Ok((report, refined.programs))
+    Ok((report, refined))
 }
 
 /// The findings of a search of the snapshot's mission; `None` when it has
 /// errors (nothing to run) or the search was cancelled.
 fn search(snapshot: &Snapshot, cancel: Arc<AtomicBool>) -> Option<Vec<Finding>> {
-    let (report, programs) = match explore(snapshot, &options(cancel), |_| Ok(Vec::new())) {
+    let (report, refined) = match explore(snapshot, &options(cancel), |_| Ok(Vec::new())) {
         Ok(found) => found,
         Err(NoReport::Refused(problem)) => {
             // The editor's options are fixed: refusing them is a bug.
@@ -218,7 +217,7 @@ fn search(snapshot: &Snapshot, cancel: Arc<AtomicBool>) -> Option<Vec<Finding>> 
     };
     let scenarios = report.counterexamples.iter().map(|way| {
         way.as_ref()
-            .map(|w| w.scenario_json(&report.inputs, &programs))
+            .map(|w| w.scenario_json(&report.inputs, &refined.programs))
     });
     Some(
         report

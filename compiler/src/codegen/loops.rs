@@ -54,7 +54,6 @@ use crate::refine::protocol::GRAPH_TEXT_MAX;
 use crate::refine::{GraphService, GraphStep, InnerTask, LoopPort, PortUse, SubgraphPort};
 use std::fmt::Write;
 
-
 /// Characters a token takes in a trace field, at most, for sizing: an
 /// integer and its comma.
 const TOKEN_TEXT: u64 = 24;

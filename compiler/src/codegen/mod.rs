@@ -27,12 +27,12 @@ mod c;
 mod control;
 pub(crate) mod files;
 mod loops;
-mod template;
 pub mod output;
 mod peers;
 mod schedule;
 mod shared;
 mod target;
+mod template;
 mod values;
 
 use crate::refine::{BuildInput, Refined, refine_checked, robot_span};

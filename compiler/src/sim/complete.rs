@@ -69,12 +69,10 @@ pub fn editor_completions(
     offset: usize,
 ) -> Vec<crate::ide::CompletionItem> {
     let programs = mission
-        .and_then(|id| analysis.build_input(id))
-        .map(|build| crate::refine::refine_checked(&build.input()))
-        .filter(|refined| !refined.diagnostics.iter().any(|d| d.is_error()))
-        .map(|refined| refined.programs)
-        .unwrap_or_default();
-    completions(text, offset, &programs)
+        .and_then(|id| analysis.refined(id))
+        .filter(|refined| !refined.diagnostics.iter().any(|d| d.is_error()));
+    let programs = programs.as_ref().map_or(&[][..], |r| &r.programs[..]);
+    completions(text, offset, programs)
         .into_iter()
         .map(ScenarioCompletion::into_item)
         .collect()

@@ -85,11 +85,10 @@ pub fn job(world: &World, params: StartParams) -> Result<Job, String> {
 /// The session's plan: the robots, the broker, the credentials (reads the
 /// deployment file and the operator's password file: off the async threads).
 pub fn plan(job: &Job) -> Result<Plan, String> {
-    let build = job
+    let refined = job
         .analysis
-        .build_input(job.mission)
+        .refined(job.mission)
         .ok_or("internal error: the mission is not in the workspace analysis")?;
-    let refined = semo::refine::refine_checked(&build.input());
     let errors = refined.diagnostics.iter().filter(|d| d.is_error()).count();
     if errors > 0 || refined.programs.is_empty() {
         return Err(format!(

@@ -164,20 +164,19 @@ struct Ran {
 }
 
 fn run(job: &Job, text: &str) -> Result<Ran, Refusal> {
-    let build = job.analysis.build_input(job.mission).ok_or_else(|| {
+    let refined = job.analysis.refined(job.mission).ok_or_else(|| {
         Refusal::Mission("internal error: the mission is not in the workspace analysis".into())
     })?;
-    let refined = semo::refine::refine_checked(&build.input());
     let errors = refined.diagnostics.iter().filter(|d| d.is_error()).count();
     if errors > 0 {
         return Err(Refusal::Mission(format!(
             "cannot simulate: {errors} error(s) in the mission, its catalog or strategies"
         )));
     }
-    let programs = refined.programs;
-    let scenario = sim::scenario::parse(text, &programs).map_err(Refusal::Scenario)?;
+    let programs = &refined.programs;
+    let scenario = sim::scenario::parse(text, programs).map_err(Refusal::Scenario)?;
     let result = sim::simulate(
-        &programs,
+        programs,
         &scenario,
         &sim::Options {
             until_ms: job.until_ms,
@@ -205,7 +204,7 @@ fn run(job: &Job, text: &str) -> Result<Ran, Refusal> {
     let answer = json!({
         "ok": verdicts.iter().all(|v| v.met),
         "summary": sim::summary(&result, &verdicts),
-        "svg": sim::svg::to_svg(&result, &programs, &scenario),
+        "svg": sim::svg::to_svg(&result, programs, &scenario),
         "expectations": expectations,
     });
     Ok(Ran {

@@ -98,7 +98,7 @@ pub fn verify(job: &Job) -> Result<Value, String> {
             semo::verify::properties_of(&scenario.expect).map_err(positioned)
         }
     };
-    let (report, programs) =
+    let (report, refined) =
         crate::verify::explore(snapshot, &job.options, expectations).map_err(|why| match why {
             crate::verify::NoReport::Errors => {
                 "the mission has errors: fix them to verify it".to_string()
@@ -108,7 +108,7 @@ pub fn verify(job: &Job) -> Result<Value, String> {
         })?;
     let analysis = snapshot.analysis();
     let lines = snapshot.line_map(&analysis);
-    let programs = &programs;
+    let programs = &refined.programs;
     let scenario_of = |way: Option<&semo::verify::Counterexample>,
                        expect: Option<&semo::sim::scenario::ExpectKind>| {
         way.map(|w| w.scenario_json_expecting(&report.inputs, programs, expect))

@@ -26,7 +26,7 @@ impl Analysis {
     /// files. A service graph the workspace does not hold is not analysed.
     pub fn dataflow(&self, mission: FileId) -> Option<Arc<MissionDataflow>> {
         let file = self.file(mission).filter(|f| f.kind == FileKind::Mission)?;
-        let key = self.dataflow_key(mission);
+        let key = self.reads_key(mission);
         if let Some(found) = fresh(lock(&self.memo.dataflow).get(&mission), &key) {
             return Some(found);
         }
@@ -67,14 +67,15 @@ impl Analysis {
     /// Whether [`Analysis::dataflow`] of `mission` is known without
     /// computing: then it is given.
     pub fn dataflow_if_known(&self, mission: FileId) -> Option<Arc<MissionDataflow>> {
-        let key = self.dataflow_key(mission);
+        let key = self.reads_key(mission);
         fresh(lock(&self.memo.dataflow).get(&mission), &key)
     }
 
-    /// What a mission's dataflow is computed from: the mission, the files it
-    /// sees, its project file (the levels of its warnings), and every task
-    /// graph (`FileId(u32::MAX)` carries their revision).
-    fn dataflow_key(&self, mission: FileId) -> Key {
+    /// What a mission's refined programs and dataflow are computed from:
+    /// the mission, the files it sees, its project file (the levels of its
+    /// warnings), and every task graph (`FileId(u32::MAX)` carries their
+    /// revision).
+    pub(super) fn reads_key(&self, mission: FileId) -> Key {
         let project = self.project(mission).map(|p| p.file);
         let mut key: Key = self
             .reads(mission)

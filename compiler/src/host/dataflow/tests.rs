@@ -252,6 +252,30 @@ fn editing_the_graph_gives_a_new_answer_and_an_unchanged_workspace_the_same_one(
     assert_eq!(w.warnings(), Vec::new());
 }
 
+/// The refined mission is one memoised query: a second request on the same
+/// files refines nothing (the same answer), an edit of what it reads gives
+/// a new one, and a file that is no mission has none.
+#[test]
+fn the_refined_mission_is_computed_once_per_version_of_what_it_reads() {
+    let text = mission("T.P.S { scan() } repeat(40 MSEC)");
+    let mut w = Workspace::new("refined", &text, TIMED);
+    let first = w.host.analysis().refined(MISSION_ID).unwrap();
+    assert!(!first.programs.is_empty(), "{:#?}", first.diagnostics);
+    let again = w.host.analysis().refined(MISSION_ID).unwrap();
+    assert!(Arc::ptr_eq(&first, &again));
+    assert!(w.host.analysis().refined(FileId(1)).is_none());
+    let renamed = text.replace("T.P.S", "T.P.S ");
+    w.host.set_file(
+        MISSION_ID,
+        Some(w.dir.join("m.mission")),
+        FileKind::Mission,
+        Arc::from(renamed.as_str()),
+    );
+    let edited = w.host.analysis().refined(MISSION_ID).unwrap();
+    assert!(!Arc::ptr_eq(&first, &edited));
+    assert_eq!(edited.programs.len(), first.programs.len());
+}
+
 #[test]
 fn a_team_hover_lists_its_robots_periods() {
     let text = mission("T.P.S { scan() } repeat(60 MSEC)");

@@ -166,10 +166,9 @@ impl Analysis {
         mission: FileId,
         robot: Option<&str>,
     ) -> Result<RobotPicture, PictureError> {
-        let build = self
-            .build_input(mission)
+        let refined = self
+            .refined(mission)
             .ok_or_else(|| PictureError("only a mission has robots to draw".to_string()))?;
-        let refined = crate::refine::refine_checked(&build.input());
         if refined.programs.is_empty() {
             let errors = refined.diagnostics.iter().filter(|d| d.is_error()).count();
             return Err(PictureError(format!(
