@@ -284,3 +284,66 @@ fn taskgraph_page_examples_load_and_analyse_cleanly() {
     });
     assert!(loaded >= 2, "{loaded} whole task-graph files");
 }
+
+/// The files of the repository: git's list, else every file under the root
+/// but build output, dependencies and `.git`.
+fn repository_files() -> Vec<PathBuf> {
+    let root = repo_root();
+    let listed = std::process::Command::new("git")
+        .args(["ls-files", "-z"])
+        .current_dir(&root)
+        .output()
+        .ok()
+        .filter(|out| out.status.success() && !out.stdout.is_empty());
+    if let Some(out) = listed {
+        return String::from_utf8_lossy(&out.stdout)
+            .split('\0')
+            .filter(|p| !p.is_empty())
+            .map(|p| root.join(p))
+            .collect();
+    }
+    let mut files = Vec::new();
+    let mut folders = vec![root];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).into_iter().flatten().flatten() {
+            let path = entry.path();
+            let name = entry.file_name();
+            if path.is_dir() {
+                if !matches!(name.to_str(), Some("target" | "node_modules" | ".git")) {
+                    folders.push(path);
+                }
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    files
+}
+
+#[test]
+fn no_file_refers_to_the_specification_folder_outside_the_repository() {
+    // Spelled in pieces so that this file does not name them itself.
+    let outside: Vec<String> = ["spec", "examples"]
+        .iter()
+        .map(|folder| format!("shared/{folder}"))
+        .collect();
+    let mut found = Vec::new();
+    let files = repository_files();
+    assert!(files.len() > 100, "{} files", files.len());
+    for path in files {
+        // Binary files and files removed from the work tree are skipped.
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            continue;
+        };
+        for (number, line) in text.lines().enumerate() {
+            if outside.iter().any(|o| line.contains(o.as_str())) {
+                found.push(format!("{}:{}: {line}", path.display(), number + 1));
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "these point at files a clone of the repository does not have (the formats are in docs/):\n{}",
+        found.join("\n")
+    );
+}
