@@ -285,6 +285,50 @@ fn taskgraph_page_examples_load_and_analyse_cleanly() {
     assert!(loaded >= 2, "{loaded} whole task-graph files");
 }
 
+/// Every relative link of the three pages leads to a file, and to a heading
+/// of it when it names one (as `tests/language_reference.rs` checks the
+/// language pages).
+#[test]
+fn every_link_of_the_pages_leads_somewhere() {
+    use semo::ide::mission::keywords::heading_anchor;
+    let anchors = |text: &str| -> Vec<String> {
+        text.lines()
+            .filter(|l| l.starts_with('#'))
+            .map(|l| heading_anchor(l.trim_start_matches('#')))
+            .collect()
+    };
+    let docs = repo_root().join("docs");
+    let mut broken = Vec::new();
+    for name in ["catalog.md", "strategy.md", "taskgraph.md"] {
+        let text = page(name);
+        let mut rest = text.as_str();
+        while let Some(at) = rest.find("](") {
+            rest = &rest[at + 2..];
+            let Some(end) = rest.find(')') else { break };
+            let target = &rest[..end];
+            if target.contains("://") {
+                continue;
+            }
+            let (file, anchor) = target.split_once('#').unwrap_or((target, ""));
+            let linked = if file.is_empty() {
+                Some(text.clone())
+            } else {
+                std::fs::read_to_string(docs.join(file)).ok()
+            };
+            match linked {
+                None => broken.push(format!("docs/{name}: {target}: no such file")),
+                Some(linked)
+                    if !anchor.is_empty() && !anchors(&linked).iter().any(|a| a == anchor) =>
+                {
+                    broken.push(format!("docs/{name}: {target}: no such heading"))
+                }
+                Some(_) => {}
+            }
+        }
+    }
+    assert!(broken.is_empty(), "{}", broken.join("\n"));
+}
+
 /// The files of the repository: git's list, else every file under the root
 /// but build output, dependencies and `.git`.
 fn repository_files() -> Vec<PathBuf> {
