@@ -1,10 +1,10 @@
 //! The robot catalog: what each robot type is (platform, capabilities), knows
 //! (values) and can do (built-in services). Built from the embedded built-in
 //! catalog plus `*.robot.xml` files, which add types or override built-in ones by
-//! type name. See `shared/spec/catalog.md`.
+//! type name. The format's reference is `docs/catalog.md`.
 
 mod builtin;
-mod schema;
+pub mod schema;
 mod xml;
 
 pub use builtin::{BUILTIN_FILE, BUILTIN_NAME, BUILTIN_SOURCE, builtin_catalog};

@@ -1,10 +1,12 @@
-//! The catalog format's vocabulary, written once (from `shared/spec/catalog.md`):
-//! each element with its attributes, the elements it may hold and where it
-//! belongs (for "not allowed here"), and the value types. The reader
-//! ([`super::xml`]) checks the element tree against it.
+//! The catalog format's vocabulary, written once: each element with its
+//! attributes, the elements it may hold and where it belongs (for "not
+//! allowed here"), and the value types. The reader ([`super::xml`]) checks
+//! the element tree against it; `docs/catalog.md` is the format's reference
+//! for users, and `compiler/tests/format_docs.rs` checks that it names every
+//! element, attribute and type of these tables.
 
 /// One element of the format.
-pub(crate) struct ElementInfo {
+pub struct ElementInfo {
     pub name: &'static str,
     pub attributes: &'static [&'static str],
     /// The elements allowed directly inside this one.
@@ -17,7 +19,7 @@ const ROBOT_ATTRS: &[&str] = &["type", "aliases"];
 const ROBOT_CHILDREN: &[&str] = &["Doc", "Platform", "Capability", "Value", "Service"];
 const IN_ROBOT: &str = "inside `<Robot>`";
 
-pub(crate) const ELEMENTS: &[ElementInfo] = &[
+pub const ELEMENTS: &[ElementInfo] = &[
     ElementInfo {
         name: "Catalog",
         attributes: &[],
@@ -96,7 +98,7 @@ pub(crate) fn element(name: &str) -> Option<&'static ElementInfo> {
 }
 
 /// The value types, for messages and did-you-mean.
-pub(crate) const TYPE_NAMES: &[&str] = &[
+pub const TYPE_NAMES: &[&str] = &[
     "int", "float", "bool", "string", "location", "image", "enum",
 ];
 

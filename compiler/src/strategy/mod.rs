@@ -1,5 +1,5 @@
 //! Strategy files (`*.strategy.xml`): how a team's robots perform the services
-//! of a mission (see `shared/spec/strategy.md`).
+//! of a mission (the format's reference: `docs/strategy.md`).
 //!
 //! - [`model`]: the typed model, every entry with its byte ranges.
 //! - `xml`: the quick-xml loader (well-formedness, elements, attributes, value

@@ -1,5 +1,5 @@
-//! The strategy model: how one team performs the services of a mission (see
-//! `shared/spec/strategy.md`). Every entry keeps the byte ranges it was read
+//! The strategy model: how one team performs the services of a mission (the
+//! format: `docs/strategy.md`). Every entry keeps the byte ranges it was read
 //! from, so that checks (and the language server) can point into the file.
 //!
 //! Entries are kept even when an attribute is missing or malformed (that is

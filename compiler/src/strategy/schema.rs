@@ -1,6 +1,8 @@
 //! The strategy format's vocabulary, written once: which attributes each
 //! element has (read by the loader) and which children it may hold, with the
-//! short descriptions the editor shows (from `shared/spec/strategy.md`).
+//! short descriptions the editor shows. `docs/strategy.md` is the format's
+//! reference for users (`compiler/tests/format_docs.rs` checks that it names
+//! every element and attribute here); the descriptions say the same in brief.
 
 pub(crate) const STRATEGY_ATTRS: &[&str] = &["name"];
 pub(crate) const VALUE_ATTRS: &[&str] = &["name"];

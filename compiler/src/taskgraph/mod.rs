@@ -13,7 +13,10 @@ pub mod write;
 
 pub use model::*;
 pub use svg::{to_svg, to_svg_analyzed};
-pub use xml::{ExecutionTimes, GraphFormat, detect_format, load_task_graph, load_task_graph_as};
+pub use xml::{
+    ExecutionTimes, GraphFormat, SDF3_VOCABULARY, SEMO_VOCABULARY, detect_format, load_task_graph,
+    load_task_graph_as,
+};
 
 /// Follows the references of `graph` (read from `location`) to its
 /// sub-graphs, each usable only when its own analysis finds no error.

@@ -1,5 +1,5 @@
 //! The task-graph model (extended SDF: control, library and loop tasks,
-//! multicast ports). See `shared/spec/taskgraph.md`. Every element keeps the
+//! multicast ports). The file formats: `docs/taskgraph.md`. Every element keeps the
 //! byte range it was read from, so analyses can point at the channel or task
 //! concerned. Rates and counts are exact integers.
 

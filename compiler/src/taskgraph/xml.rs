@@ -1,6 +1,6 @@
 //! Reading task-graph files: our `*.taskgraph.xml` format (`<TaskGraph>`) and
 //! SDF3 graphs (`<sdf3 type="sdf">`), with positioned diagnostics (E060–E066,
-//! W060). See `shared/spec/taskgraph.md` for both formats.
+//! W060). `docs/taskgraph.md` is the reference of both formats for users.
 //!
 //! Our format is read in two steps: the XML is read into a small positioned
 //! element tree ([`crate::xmltree`]: every element, attribute and attribute
@@ -264,6 +264,52 @@ const FUNCTION_ATTRS: &[&str] = &["name", "returns"];
 const PARAM_ATTRS: &[&str] = &["name", "type"];
 const LOOP_ATTRS: &[&str] = &["name", "type", "loopCount", "exitTask"];
 const CHANNEL_ATTRS: &[&str] = &["src", "dst", "initialTokens", "capacity"];
+
+/// Every element of our format with the attributes the reader accepts on it,
+/// the very lists it checks with (a loop node's `<Port>` has its own), for
+/// those who list the format: `docs/taskgraph.md` names each of them
+/// (`compiler/tests/format_docs.rs`).
+pub const SEMO_VOCABULARY: &[(&str, &[&str])] = &[
+    ("TaskGraph", GRAPH_ATTRS),
+    ("Task", TASK_ATTRS),
+    ("Port", PORT_ATTRS),
+    ("Port", LOOP_PORT_ATTRS),
+    ("LibraryMasterPort", MASTER_ATTRS),
+    ("LibrarySlavePort", SLAVE_ATTRS),
+    ("Call", CALL_ATTRS),
+    ("MulticastPort", MULTICAST_ATTRS),
+    ("Library", LIBRARY_ATTRS),
+    ("Function", FUNCTION_ATTRS),
+    ("Param", PARAM_ATTRS),
+    ("Loop", LOOP_ATTRS),
+    ("Channel", CHANNEL_ATTRS),
+];
+
+/// The elements and attributes of an SDF3 file that the SDF3 readers read
+/// (everything else is ignored silently), as [`sdf3::Role`] and the readers
+/// take them: the root, the first `<applicationGraph>`, its first `<sdf>`
+/// and first `<sdfProperties>`.
+pub const SDF3_VOCABULARY: &[(&str, &[&str])] = &[
+    ("sdf3", &["type"]),
+    ("applicationGraph", &["name"]),
+    ("sdf", &["name"]),
+    ("actor", &["name"]),
+    ("port", &["name", "type", "rate"]),
+    (
+        "channel",
+        &[
+            "srcActor",
+            "srcPort",
+            "dstActor",
+            "dstPort",
+            "initialTokens",
+        ],
+    ),
+    ("sdfProperties", &[]),
+    ("actorProperties", &["actor"]),
+    ("processor", &["type", "default"]),
+    ("executionTime", &["time"]),
+];
 
 /// Whether a whole number must be at least one.
 #[derive(Clone, Copy, PartialEq, Eq)]

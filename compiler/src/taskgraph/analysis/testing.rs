@@ -83,7 +83,8 @@ pub(crate) fn graph(name: &str, tasks: Vec<Task>, channels: Vec<Channel>) -> Tas
     }
 }
 
-/// `shared/examples/taskgraphs/data_loop`: A 10→ L (D-loop × 10 over B, C) 10→ D.
+/// The graph of `examples/taskgraphs/data_loop.taskgraph.xml`, built in code:
+/// A 10→ L (D-loop × 10 over B, C) 10→ D.
 pub(crate) fn data_loop() -> TaskGraph {
     let mut l = task("L", &["in<10", "out>10"]);
     l.kind = TaskKind::Loop;

@@ -1323,3 +1323,43 @@ fn diagnostic_fixtures_produce_only_their_code() {
     }
     assert_eq!(seen, 8);
 }
+
+/// The vocabulary tables list exactly the elements the readers read: every
+/// element of our format (each once, a `<Port>` twice: a task's and a loop
+/// node's), and for SDF3 every element with a role under some parent.
+#[test]
+fn vocabularies_are_the_readers_elements() {
+    let mut listed: Vec<&str> = SEMO_VOCABULARY.iter().map(|(e, _)| *e).collect();
+    listed.dedup();
+    let mut known: Vec<&str> = SEMO_ELEMENTS.iter().map(|(e, _)| *e).collect();
+    listed.sort_unstable();
+    known.sort_unstable();
+    assert_eq!(listed, known);
+    use sdf3::Role;
+    let parents = [
+        Role::Root,
+        Role::ApplicationGraph,
+        Role::Sdf,
+        Role::Actor,
+        Role::Properties,
+        Role::ActorProperties,
+        Role::Processor,
+    ];
+    let (root, inner) = SDF3_VOCABULARY.split_first().unwrap();
+    assert_eq!(root.0, "sdf3");
+    for (element, _) in inner {
+        assert!(
+            parents
+                .iter()
+                .any(|p| p.child(element.as_bytes(), |_| true) != Role::Ignored),
+            "{element} is read by no role"
+        );
+    }
+    // The roles below the root: the parents but the root, then the leaves
+    // `port`, `channel` and `executionTime`.
+    assert_eq!(
+        inner.len(),
+        parents.len() - 1 + 3,
+        "a role without an entry"
+    );
+}
