@@ -11,7 +11,7 @@ use super::peers::Peers;
 use super::template::{Template, fill, template};
 use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
-use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms};
+use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms, lost_after_ms};
 use crate::refine::{
     ActionMachine, ControlMachine, CountedGroup, Expr, LeaderAlgorithm, Operand, RobotProgram,
     SendItem, SlotId, SlotSource, State, StateId, StateKind,
@@ -79,7 +79,7 @@ const GROUP_SYNC: Template = template!(
         "team",
         "key",
         "point",
-        "hb",
+        "lost",
         "timeout_ms",
         "line",
         "next"
@@ -98,7 +98,7 @@ const GO_TAIL: Template = template!(
     "control/go_tail.c.in",
     ["steps_per_firing", "flush", "name"]
 );
-const GROUP_UPDATE: Template = template!("control/group_update.c.in", ["list", "count", "hb"]);
+const GROUP_UPDATE: Template = template!("control/group_update.c.in", ["list", "count", "lost"]);
 
 /// Every template of `control_task.c`.
 #[cfg(test)]
@@ -155,7 +155,7 @@ const DROP_UNLED: Template = template!("control/drop_unled.c.in", ["reason"]);
 /// both lead after a restart.
 const ELECTED: Template = template!(
     "control/elected.c.in",
-    ["hb", "listen", "lease", "term_max"]
+    ["hb", "lost", "listen", "lease", "term_max"]
 );
 
 /// At each heartbeat of a member of its team's group (group services,
@@ -173,7 +173,7 @@ fn group_update(m: &ControlMachine, peers: &Peers) -> String {
         &[
             ("list", &peers.locals(&m.group)),
             ("count", &m.group.len()),
-            ("hb", &m.heartbeat_ms),
+            ("lost", &lost_after_ms(m.heartbeat_ms)),
         ],
     )
 }
@@ -181,7 +181,7 @@ fn group_update(m: &ControlMachine, peers: &Peers) -> String {
 /// Counted groups (`StateKind::GroupAllocate`): the rule of
 /// `refine::counted_allocation` over the live members, as the simulator's
 /// `GroupAllocate` applies it.
-const GROUP_OF: Template = template!("control/group_of.c.in", ["hb"]);
+const GROUP_OF: Template = template!("control/group_of.c.in", ["lost"]);
 
 /// `leading` and the terms a robot's heartbeats say, and `own_battery`:
 /// this robot's battery level for its heartbeats, the scenario's (in
@@ -446,6 +446,7 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
             &ELECTED,
             &[
                 ("hb", &m.heartbeat_ms),
+                ("lost", &lost_after_ms(m.heartbeat_ms)),
                 ("listen", &listen_ms(m.heartbeat_ms)),
                 ("lease", &lease_ms(m.heartbeat_ms)),
                 ("term_max", &TERM_MAX),
@@ -454,7 +455,10 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
     }
 
     if uses("group_of") {
-        out.push_str(&fill(&GROUP_OF, &[("hb", &m.heartbeat_ms)]));
+        out.push_str(&fill(
+            &GROUP_OF,
+            &[("lost", &lost_after_ms(m.heartbeat_ms))],
+        ));
     }
 
     if uses("drop_unled") {
@@ -929,7 +933,7 @@ fn emit_group_sync(
     } = *cx;
     let m = &program.control;
     let list = peers.locals(members);
-    let hb = m.heartbeat_ms;
+    let lost = lost_after_ms(m.heartbeat_ms);
     out.push_str(&fill(
         &GROUP_SYNC,
         &[
@@ -940,7 +944,7 @@ fn emit_group_sync(
             ("team", &c::string(&program.team)),
             ("key", &c::string(&protocol::sync_key(program))),
             ("point", &point),
-            ("hb", &hb),
+            ("lost", &lost),
             ("timeout_ms", &timeout_ms),
             ("line", &line),
             ("next", &next),

@@ -25,6 +25,15 @@ pub fn listen_ms(heartbeat_ms: i64) -> i64 {
     heartbeat_ms + heartbeat_ms / 2
 }
 
+/// When a peer is lost (`docs/groups.md`, "Liveness"): a robot counts a
+/// peer alive while it has heard the peer's heartbeat within this long, and
+/// lost once it has been silent for longer, for every rule that asks
+/// (elections, groups, group syncs, the owner of shared values, the live
+/// monitor). Three heartbeat periods. The simulator uses the same.
+pub fn lost_after_ms(heartbeat_ms: i64) -> i64 {
+    3 * heartbeat_ms
+}
+
 /// A leader's lease (`docs/groups.md`, "Fencing"): a robot the election
 /// would choose leads only while it has heard a strict majority of the
 /// candidates, itself included, within the last two heartbeat periods. Two

@@ -2101,9 +2101,9 @@ impl<'p> Sim<'p> {
                 // robot, or heard within three heartbeats since it joined).
                 let robot = &self.robots[r];
                 let me = program.self_peer;
-                let hb = m.heartbeat_ms;
+                let lost = crate::refine::protocol::lost_after_ms(m.heartbeat_ms);
                 let alive = |peer: usize| {
-                    peer == me || now - robot.heard.get(peer).seen.max(robot.started_at) <= 3 * hb
+                    peer == me || now - robot.heard.get(peer).seen.max(robot.started_at) <= lost
                 };
                 let live: Vec<usize> = members.iter().copied().filter(|&p| alive(p)).collect();
                 let position = live.iter().position(|&p| p == me).unwrap_or(0);
@@ -2145,7 +2145,7 @@ impl<'p> Sim<'p> {
                 }
                 let robot = &self.robots[r];
                 let pass = robot.sync_pass[&(service, pc)];
-                let hb = m.heartbeat_ms;
+                let lost = crate::refine::protocol::lost_after_ms(m.heartbeat_ms);
                 let me = program.self_peer;
                 let waiting = members.iter().any(|&peer| {
                     peer != me
@@ -2155,7 +2155,7 @@ impl<'p> Sim<'p> {
                             .copied()
                             .unwrap_or(0)
                             < pass
-                        && now - robot.heard.get(peer).seen <= 3 * hb
+                        && now - robot.heard.get(peer).seen <= lost
                 });
                 let started = robot.regions[i].marks[*mark];
                 if waiting && now - started <= *timeout_ms {
@@ -2341,7 +2341,8 @@ impl<'p> Sim<'p> {
             return None;
         }
         let me = robot.program.self_peer;
-        let alive = |c: usize| c == me || now - robot.heard.get(c).seen <= 3 * hb;
+        let lost = crate::refine::protocol::lost_after_ms(hb);
+        let alive = |c: usize| c == me || now - robot.heard.get(c).seen <= lost;
         let level = |c: usize| {
             if c == me {
                 own_battery(robot, now)
@@ -2372,9 +2373,7 @@ impl<'p> Sim<'p> {
             let claimant = robot
                 .heard
                 .iter()
-                .find(|&(i, h)| {
-                    i != me && h.leads && h.term >= robot.term && now - h.seen <= 3 * hb
-                })
+                .find(|&(i, h)| i != me && h.leads && h.term >= robot.term && now - h.seen <= lost)
                 .map(|(i, _)| i);
             if let Some(c) = claimant {
                 leader = c;
@@ -2574,7 +2573,8 @@ impl Sim<'_> {
         let now = self.now;
         let alive = |peer: usize| {
             peer == me
-                || now - robot.heard.get(peer).seen.max(robot.started_at) <= 3 * m.heartbeat_ms
+                || now - robot.heard.get(peer).seen.max(robot.started_at)
+                    <= crate::refine::protocol::lost_after_ms(m.heartbeat_ms)
         };
         let live: Vec<usize> = m.group.iter().copied().filter(|&p| alive(p)).collect();
         let rank = live.iter().position(|&p| p == me).unwrap_or(0);

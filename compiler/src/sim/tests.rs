@@ -225,7 +225,8 @@ fn a_leader_cut_off_from_the_majority_steps_down_before_the_others_elect() {
         fenced <= took_over,
         "fenced at {fenced}, tb_1 led at {took_over}"
     );
-    assert!(took_over > 1200 + 3 * hb - hb, "took over at {took_over}");
+    let lost = crate::refine::protocol::lost_after_ms(hb);
+    assert!(took_over > 1200 + lost - hb, "took over at {took_over}");
     let tb_0 = index_of(&run_, "tb_0");
     let heard = run_
         .trace

@@ -36,7 +36,7 @@ impl Sim<'_> {
         let Some(ownership) = program.library.as_ref().and_then(|l| l.ownership.as_ref()) else {
             return program.self_peer;
         };
-        let lost_after = 3 * program.control.heartbeat_ms;
+        let lost_after = crate::refine::protocol::lost_after_ms(program.control.heartbeat_ms);
         let lives = |peer: usize| {
             peer == program.self_peer || self.now - robot.heard.get(peer).seen <= lost_after
         };
@@ -93,8 +93,11 @@ impl Sim<'_> {
         let robot = &self.robots[r];
         let program = robot.program;
         program.library.as_ref()?.ownership.as_ref()?;
-        (robot.owner != program.self_peer)
-            .then(|| robot.heard.get(robot.owner).seen + 3 * program.control.heartbeat_ms + 1)
+        (robot.owner != program.self_peer).then(|| {
+            robot.heard.get(robot.owner).seen
+                + crate::refine::protocol::lost_after_ms(program.control.heartbeat_ms)
+                + 1
+        })
     }
 
     /// `tell`: a write of global value `k` to the owner `to`, or to the team
