@@ -4,7 +4,7 @@
 //! team owns them; a write elsewhere goes to the owner (`Team.__set.X`), the
 //! owner tells the team every value it takes (`Team.__value.X`), and the
 //! first live robot of the owner order takes over from a lost owner (no
-//! heartbeat for three periods), telling the team the values it last saw.
+//! heartbeat for `lost_after_ms`), telling the team the values it last saw.
 //! The simulator does the same (`sim/engine/shared.rs`).
 
 use super::c;
@@ -267,8 +267,8 @@ fn owner_protocol(
 }
 
 /// The loop of `current_owner` choosing who follows a lost owner among the
-/// live robots of `owners` (this robot, or heard from within three
-/// heartbeats): the first, or by the team's `highest_battery` leader
+/// live robots of `owners` (this robot, or heard from within
+/// `lost_after_ms`): the first, or by the team's `highest_battery` leader
 /// selection the one whose heartbeat said the highest level (the first of
 /// equals; unknown counts lowest; this robot's own level in simulation).
 fn follower(rule: OwnerRule, lost: i64) -> String {

@@ -2,7 +2,7 @@
 //! generates them (`docs/shared-information.md`): one robot of the team owns
 //! them; a write elsewhere is sent to the owner (`Team.__set.X`), the owner
 //! tells the team each value it takes (`Team.__value.X`), and a lost owner
-//! (no heartbeat for three periods) is followed by the first live robot of
+//! (no heartbeat for `protocol::lost_after_ms`) is followed by the first live robot of
 //! the owner order, which tells the team the values it last saw.
 
 use super::{Held, Message, Sim};
@@ -27,7 +27,7 @@ impl Sim<'_> {
     }
 
     /// `current_owner`: the owner stays while it lives (this robot, or heard
-    /// from within three heartbeats); a lost one is followed by the first
+    /// from within `lost_after_ms`); a lost one is followed by the first
     /// live robot of the owner order. A change is traced; a robot that
     /// becomes the owner tells the team the values it last saw.
     pub(super) fn current_owner(&mut self, r: usize) -> usize {
@@ -88,7 +88,7 @@ impl Sim<'_> {
     }
 
     /// When the robot would notice that its owner is lost: the firing after
-    /// three heartbeat periods without one (for [`Sim::wake_up`]).
+    /// `lost_after_ms` without one (for [`Sim::wake_up`]).
     pub(super) fn owner_lost_at(&self, r: usize) -> Option<i64> {
         let robot = &self.robots[r];
         let program = robot.program;
