@@ -2285,9 +2285,10 @@ fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
         assert_eq!(m.last().map(String::as_str), Some("PATROL"), "{robot}");
     }
 
-    // tb_1 takes over: tb_0 is dead three heartbeats after the last one it
-    // sent, and the leader's statement decides once a pass (every second);
-    // 300 ms for a late firing and delivery on a loaded machine.
+    // tb_1 takes over within three heartbeats of the last one tb_0 sent
+    // (docs/groups.md, "Takeover": lost after two silent periods, decided
+    // at tb_1's next heartbeat, whatever its phase); 300 ms for a late
+    // firing and delivery on a loaded machine.
     let last_heartbeat = traces[first_tb_0]
         .1
         .iter()
@@ -2301,7 +2302,7 @@ fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
         .map(|e| e["t"].as_i64().unwrap())
         .expect("tb_1 takes over");
     assert!(
-        took_over > killed_at - 50 && took_over <= last_heartbeat + 3 * 200 + 1000 + 300,
+        took_over > killed_at - 50 && took_over <= last_heartbeat + 3 * 200 + 300,
         "tb_1 took over at {took_over}, tb_0's last heartbeat at {last_heartbeat}"
     );
     // After the restart tb_0 leads again, and the others follow it.
@@ -2348,10 +2349,12 @@ fn two_leaders_for(lives: &[(String, Vec<Event>)]) -> i64 {
 /// patrol_groups over a private broker, the leader tb_0's connection to it
 /// cut by a TCP proxy from 1.2 s to 3.5 s (docs/groups.md, "Fencing"): tb_0
 /// hears no majority and steps down (`fenced`, "1 of 3"), tb_1 takes over,
-/// and healed, tb_0 follows tb_1 until it gives way, then leads again. Two
-/// leaders at once for at most the documented bound: one pass of the
-/// statement (1 s) minus one heartbeat period (200 ms); without fencing tb_0
-/// led through the whole cut while tb_1 led from about 2 s.
+/// and healed, tb_0 leads again once tb_1 has given way. Two
+/// leaders at once for less than the documented bound for processes whose
+/// heartbeats are out of phase: one and a half heartbeat periods (300 ms;
+/// every robot decides its elections at each heartbeat, and the lease is
+/// shorter than the loss rule); without fencing tb_0 led through the whole
+/// cut while tb_1 led from about 2 s.
 #[test]
 fn a_leader_cut_off_from_the_broker_steps_down_before_another_is_elected() {
     let Some(mut fleet) = Fleet::start("mqtt-fencing") else {
@@ -2402,10 +2405,18 @@ fn a_leader_cut_off_from_the_broker_steps_down_before_another_is_elected() {
     );
     assert_eq!(leaders_of(of("tb_1")), ["tb_0", "tb_1", "tb_0"]);
     assert_eq!(leaders_of(of("tb_2")), ["tb_0", "tb_1", "tb_0"]);
-    assert_eq!(leaders_of(of("tb_0")), ["tb_0", "tb_1", "tb_0"]);
-    let overlap = two_leaders_for(&traces);
+    // Healed, tb_0 follows tb_1 if tb_1's claim reaches it before tb_1,
+    // at its next heartbeat, has seen tb_0 alive and given way: a race of
+    // the two processes' heartbeats.
+    let tb_0 = leaders_of(of("tb_0"));
     assert!(
-        overlap <= 1000 - 200,
+        tb_0 == ["tb_0", "tb_1", "tb_0"] || tb_0 == ["tb_0", "tb_0"],
+        "{tb_0:?}"
+    );
+    let overlap = two_leaders_for(&traces);
+    let heartbeat_ms = 200;
+    assert!(
+        overlap < 3 * heartbeat_ms / 2,
         "two leaders for {overlap} ms: {:?} / {:?}",
         leaders_of(of("tb_0")),
         fenced

@@ -268,32 +268,47 @@ fn the_repaired_missions_and_the_small_examples_have_no_finding() {
     }
 }
 
-/// With faults (`--faults 1`): a leader whose block never ends never
-/// reaches its election again, so cut off it is not fenced and keeps
-/// leading while the others elect another (V004, on the statement); the
-/// counterexample's partition replayed by `semo simulate` ends with both
-/// leading. Without faults the same mission has no finding.
+/// With faults (`--faults 1`): a leader whose block never ends still
+/// decides its election at each heartbeat, so cut off it is fenced before
+/// the others count it lost: no finding, exhaustively (docs/groups.md,
+/// "Fencing"). With a lost link too (`--network 1`): the messages between
+/// tb_0 and tb_1 lost while each still hears tb_2, a majority with itself,
+/// tb_1 leads while tb_0 keeps leading (V004, on the statement); the
+/// counterexample's drop replayed by `semo simulate` ends with both leading.
 #[test]
-fn a_leader_that_never_decides_again_leads_beside_another_once_cut_off() {
+fn a_leader_cut_off_is_fenced_but_a_lost_link_leaves_two_leaders() {
     let dir = support::robots::scratch("verify-two-leaders");
     let dir_text = dir.to_string_lossy().to_string();
     let mission = "tests/fixtures/verify/two_leaders/main.mission";
     let (code, findings, _) = verify(mission, &[]);
     assert_eq!((code, findings.len()), (0, 0), "{findings:?}");
-    let (code, findings, data) =
-        verify(mission, &["--faults", "1", "--counterexamples", &dir_text]);
+    let (code, findings, data) = verify(mission, &["--faults", "1"]);
+    assert_eq!((code, findings.len()), (0, 0), "{findings:?}");
+    assert_eq!(data["exhaustive"], true, "{data}");
+    let (code, findings, data) = verify(
+        mission,
+        &[
+            "--faults",
+            "1",
+            "--network",
+            "1",
+            "--counterexamples",
+            &dir_text,
+        ],
+    );
     assert_eq!(code, 1);
     assert_eq!(data["exhaustive"], true, "{data}");
     let found: Vec<(&str, u64)> = findings.iter().map(|(c, l, _)| (c.as_str(), *l)).collect();
     assert_eq!(found, [("V004", 6)], "{findings:?}");
     let message = &findings[0].2;
     assert!(
-        message.contains("tb_0 and tb_1") && message.contains("tb_0 cut off at"),
+        message.contains("tb_0 and tb_1")
+            && message.contains("messages between tb_0 and tb_1 lost"),
         "{message}"
     );
     let scenario = data["counterexamples"][0].as_str().unwrap().to_string();
     let text = std::fs::read_to_string(&scenario).unwrap();
-    assert!(text.contains("\"partition\": [[\"tb_0\"]]"), "{text}");
+    assert!(text.contains("\"drop\": [\"tb_0\", \"tb_1\"]"), "{text}");
     let out = semo(&["simulate", mission, "--scenario", &scenario, "--trace", "-"]);
     assert_eq!(out.code, 0, "{}", out.stderr);
     // Each robot's last leader: tb_0 still itself, tb_1 itself.

@@ -234,7 +234,7 @@ codes! {
     ModeNeverEntered = "V001", Warning, "`semo verify`: a mode no robot of its team enters in any behaviour";
     NeverFinishes = "V002", Warning, "`semo verify`: a robot that finishes in some behaviours can reach a state from which it never finishes";
     WaitsForEver = "V003", Warning, "`semo verify`: a robot can reach a `receive` where it waits for ever, whatever the world does";
-    TwoLeaders = "V004", Warning, "`semo verify`: two robots can lead one `leader(...)` statement at once (with faults: a robot killed, restarted or cut off)";
+    TwoLeaders = "V004", Warning, "`semo verify`: two robots can lead one `leader(...)` statement at once (with faults: a robot killed, restarted or cut off, messages lost)";
     PlansRace = "V005", Warning, "`semo verify`: a plan's `throw` ends its mode in the instant another plan of the mode would send or throw: which one happens depends only on the plans' order";
 }
 

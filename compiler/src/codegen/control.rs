@@ -11,7 +11,7 @@ use super::peers::Peers;
 use super::template::{Template, fill, template};
 use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
-use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms};
+use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms, lost_after_ms};
 use crate::refine::{
     ActionMachine, ControlMachine, CountedGroup, Expr, LeaderAlgorithm, Operand, RobotProgram,
     SendItem, SlotId, SlotSource, State, StateId, StateKind,
@@ -52,9 +52,20 @@ const ACTIONS_TIMEOUT: Template = template!(
     ["mark", "t", "service", "next"]
 );
 const ACTIONS_RUN: Template = template!("control/actions_run.c.in", ["machine", "service", "next"]);
-const LEADER_BRANCH: Template = template!(
-    "control/leader_branch.c.in",
-    ["list", "count", "algorithm", "led"]
+const LEADER_BRANCH: Template = template!("control/leader_branch.c.in", ["election"]);
+/// `election_K`: the election of a `leader(...)` statement, called at its
+/// state and at each heartbeat ([`ControlMachine::elections`]).
+const ELECTION: Template = template!(
+    "control/election.c.in",
+    [
+        "election",
+        "line",
+        "list",
+        "count",
+        "algorithm",
+        "led",
+        "drop"
+    ]
 );
 const GROUP_ALLOCATE: Template = template!(
     "control/group_allocate.c.in",
@@ -79,7 +90,7 @@ const GROUP_SYNC: Template = template!(
         "team",
         "key",
         "point",
-        "hb",
+        "lost",
         "timeout_ms",
         "line",
         "next"
@@ -93,12 +104,15 @@ const ENTER_MODE_TAIL: Template = template!("control/enter_mode_tail.c.in", []);
 const LEAVE_MODE_HEAD: Template = template!("control/leave_mode_head.c.in", []);
 /// The control task's firing: its head, the heartbeat, its tail.
 const GO_HEAD: Template = template!("control/go_head.c.in", ["name"]);
-const HEARTBEAT: Template = template!("control/heartbeat.c.in", ["hb", "team", "key", "group"]);
+const HEARTBEAT: Template = template!(
+    "control/heartbeat.c.in",
+    ["hb", "elect", "team", "key", "group"]
+);
 const GO_TAIL: Template = template!(
     "control/go_tail.c.in",
     ["steps_per_firing", "flush", "name"]
 );
-const GROUP_UPDATE: Template = template!("control/group_update.c.in", ["list", "count", "hb"]);
+const GROUP_UPDATE: Template = template!("control/group_update.c.in", ["list", "count", "lost"]);
 
 /// Every template of `control_task.c`.
 #[cfg(test)]
@@ -122,6 +136,7 @@ pub(super) const TEMPLATES: &[Template] = &[
     ACTIONS_TIMEOUT,
     ACTIONS_RUN,
     LEADER_BRANCH,
+    ELECTION,
     GROUP_ALLOCATE,
     GROUP_SYNC,
     ACTIONS_HEAD,
@@ -155,13 +170,13 @@ const DROP_UNLED: Template = template!("control/drop_unled.c.in", ["reason"]);
 /// both lead after a restart.
 const ELECTED: Template = template!(
     "control/elected.c.in",
-    ["hb", "listen", "lease", "term_max"]
+    ["hb", "lost", "listen", "lease", "term_max"]
 );
 
 /// At each heartbeat of a member of its team's group (group services,
 /// `docs/groups.md`): its rank among the live members (formation order) and
 /// their number, for `semo_group_rank()`/`semo_group_size()`. A member is
-/// alive when it is this robot or was heard from within three heartbeats
+/// alive when it is this robot or was heard from within [`lost_after_ms`]
 /// (counted from when this robot joined: until then it had no chance to
 /// hear, so a robot starting or restarting counts every member alive).
 fn group_update(m: &ControlMachine, peers: &Peers) -> String {
@@ -173,7 +188,7 @@ fn group_update(m: &ControlMachine, peers: &Peers) -> String {
         &[
             ("list", &peers.locals(&m.group)),
             ("count", &m.group.len()),
-            ("hb", &m.heartbeat_ms),
+            ("lost", &lost_after_ms(m.heartbeat_ms)),
         ],
     )
 }
@@ -181,7 +196,7 @@ fn group_update(m: &ControlMachine, peers: &Peers) -> String {
 /// Counted groups (`StateKind::GroupAllocate`): the rule of
 /// `refine::counted_allocation` over the live members, as the simulator's
 /// `GroupAllocate` applies it.
-const GROUP_OF: Template = template!("control/group_of.c.in", ["hb"]);
+const GROUP_OF: Template = template!("control/group_of.c.in", ["lost"]);
 
 /// `leading` and the terms a robot's heartbeats say, and `own_battery`:
 /// this robot's battery level for its heartbeats, the scenario's (in
@@ -268,6 +283,12 @@ pub fn control_task(program: &RobotProgram, words: &Words, peers: &Peers, header
     for (i, machine) in m.actions.iter().enumerate() {
         emit_action_machine(&mut body, program, words, i, machine);
     }
+    for (k, election) in m.elections().enumerate() {
+        emit_election(&mut body, program, peers, k, &election);
+    }
+    // `election_K` of each `LeaderBranch` state, counted in the order of
+    // `ControlMachine::elections`.
+    let mut election = 0;
     for (i, service) in m.services.iter().enumerate() {
         let _ = writeln!(
             body,
@@ -279,7 +300,10 @@ pub fn control_task(program: &RobotProgram, words: &Words, peers: &Peers, header
             service.line
         );
         for (pc, state) in service.states.iter().enumerate() {
-            emit_state(&mut body, program, words, peers, pc, state);
+            emit_state(&mut body, program, words, peers, (pc, election), state);
+            if matches!(state.kind, StateKind::LeaderBranch { .. }) {
+                election += 1;
+            }
         }
         body.push_str("    default:\n        return STEP_DONE;\n    }\n}\n\n");
     }
@@ -446,6 +470,7 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
             &ELECTED,
             &[
                 ("hb", &m.heartbeat_ms),
+                ("lost", &lost_after_ms(m.heartbeat_ms)),
                 ("listen", &listen_ms(m.heartbeat_ms)),
                 ("lease", &lease_ms(m.heartbeat_ms)),
                 ("term_max", &TERM_MAX),
@@ -454,7 +479,10 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
     }
 
     if uses("group_of") {
-        out.push_str(&fill(&GROUP_OF, &[("hb", &m.heartbeat_ms)]));
+        out.push_str(&fill(
+            &GROUP_OF,
+            &[("lost", &lost_after_ms(m.heartbeat_ms))],
+        ));
     }
 
     if uses("drop_unled") {
@@ -483,23 +511,27 @@ fn args_array(args: &[Operand], words: &Words) -> String {
     format!("(const semo_value *const[]){{{}}}", items.join(", "))
 }
 
-/// A robot that has just become the leader here (`led`: the leader before)
-/// drops what waits for the receives of the leader's block (`receives`).
-fn emit_drop_unled(out: &mut String, program: &RobotProgram, receives: &[usize]) {
+/// A robot that has just become the leader here (`led`: the leader before,
+/// `leader`: the variable of the leader now) drops what waits for the
+/// receives of the leader's block (`receives`).
+fn emit_drop_unled(out: &mut String, program: &RobotProgram, receives: &[usize], leader: &str) {
     if receives.is_empty() {
         return;
     }
-    out.push_str("        if (chosen && led != leader) { /* it leads from now on */\n");
+    let _ = writeln!(
+        out,
+        "    if (chosen > 0 && led != {leader}) {{ /* it leads from now on */"
+    );
     for &k in receives {
         let incoming = &program.control.incoming[k];
         let _ = writeln!(
             out,
-            "            drop_unled(in_port[{k}], {}, {});",
+            "        drop_unled(in_port[{k}], {}, {});",
             c::string(&incoming.from_team),
             c::string(&incoming.key)
         );
     }
-    out.push_str("        }\n");
+    out.push_str("    }\n");
 }
 
 /// What the C of every state reads: the program, its words and peers, the
@@ -509,6 +541,9 @@ struct StateCx<'a> {
     program: &'a RobotProgram,
     words: &'a Words,
     peers: &'a Peers,
+    /// The index of the state's election among
+    /// [`ControlMachine::elections`] (for a `LeaderBranch` state).
+    election: usize,
     next: usize,
     line: u32,
 }
@@ -521,7 +556,7 @@ fn emit_state(
     program: &RobotProgram,
     words: &Words,
     peers: &Peers,
-    pc: usize,
+    (pc, election): (usize, usize),
     state: &State,
 ) {
     let _ = writeln!(
@@ -534,6 +569,7 @@ fn emit_state(
         program,
         words,
         peers,
+        election,
         next: pc + 1,
         line: state.line,
     };
@@ -567,12 +603,7 @@ fn emit_state(
             timeout_ms,
             mark,
         } => emit_run_actions(out, &cx, service, machine, args, timeout_ms, mark),
-        StateKind::LeaderBranch {
-            candidates,
-            algorithm,
-            others_at,
-            receives,
-        } => emit_leader_branch(out, &cx, candidates, algorithm, others_at, receives),
+        StateKind::LeaderBranch { others_at, .. } => emit_leader_branch(out, &cx, others_at),
         StateKind::GroupAllocate {
             members,
             groups,
@@ -836,45 +867,64 @@ fn emit_run_actions(
     ));
 }
 
-/// `leader(...)`: the election, then the leader's block or the others'.
-fn emit_leader_branch(
+/// `election_K`: a `leader(...)` statement's election, and the drop of
+/// what waits for its leader's block when this robot has just become the
+/// leader.
+fn emit_election(
     out: &mut String,
-    cx: &StateCx,
-    candidates: &[usize],
-    algorithm: &LeaderAlgorithm,
-    others_at: &StateId,
-    receives: &[usize],
+    program: &RobotProgram,
+    peers: &Peers,
+    k: usize,
+    e: &crate::refine::Election,
 ) {
-    let StateCx {
-        program,
-        peers,
-        next,
-        ..
-    } = *cx;
-    let list = peers.locals(candidates);
-    let algorithm = match algorithm {
+    let algorithm = match e.algorithm {
         LeaderAlgorithm::LowestId => "ELECT_LOWEST_ID",
         LeaderAlgorithm::HighestBattery => "ELECT_HIGHEST_BATTERY",
         LeaderAlgorithm::Bully => "ELECT_BULLY",
     };
+    let leader = format!("election_{k}_leader");
+    let mut drop = String::new();
+    emit_drop_unled(&mut drop, program, e.receives, &leader);
     out.push_str(&fill(
-        &LEADER_BRANCH,
+        &ELECTION,
         &[
-            ("list", &list),
-            ("count", &candidates.len()),
+            ("election", &k),
+            ("line", &e.line),
+            ("list", &peers.locals(e.candidates)),
+            ("count", &e.candidates.len()),
             ("algorithm", &algorithm),
-            // The leader before this election, for `emit_drop_unled`.
+            // The leader before this election, for the drop.
             (
                 "led",
-                &if receives.is_empty() {
-                    ""
+                &if e.receives.is_empty() {
+                    String::new()
                 } else {
-                    "\n        long led = leader;"
+                    format!("\n    long led = {leader};")
                 },
             ),
+            ("drop", &drop),
         ],
     ));
-    emit_drop_unled(out, program, receives);
+}
+
+/// The heartbeat's elections: each `election_K` this robot has decided at
+/// least once at its statement (its last leader is no longer -1).
+fn elect_at_heartbeat(m: &ControlMachine) -> String {
+    let mut out = String::new();
+    for k in 0..m.elections().count() {
+        let _ = writeln!(
+            out,
+            "        if (election_{k}_leader != -1)\n            election_{k}();"
+        );
+    }
+    out
+}
+
+/// `leader(...)`: the election (`election_K`), then the leader's block or
+/// the others'.
+fn emit_leader_branch(out: &mut String, cx: &StateCx, others_at: &StateId) {
+    let StateCx { election, next, .. } = *cx;
+    out.push_str(&fill(&LEADER_BRANCH, &[("election", &election)]));
     let _ = writeln!(
         out,
         "        r->pc = chosen ? {next} : {others_at};\n        return STEP_NEXT;\n    }}"
@@ -929,7 +979,7 @@ fn emit_group_sync(
     } = *cx;
     let m = &program.control;
     let list = peers.locals(members);
-    let hb = m.heartbeat_ms;
+    let lost = lost_after_ms(m.heartbeat_ms);
     out.push_str(&fill(
         &GROUP_SYNC,
         &[
@@ -940,7 +990,7 @@ fn emit_group_sync(
             ("team", &c::string(&program.team)),
             ("key", &c::string(&protocol::sync_key(program))),
             ("point", &point),
-            ("hb", &hb),
+            ("lost", &lost),
             ("timeout_ms", &timeout_ms),
             ("line", &line),
             ("next", &next),
@@ -1227,6 +1277,7 @@ fn emit_task(out: &mut String, program: &RobotProgram, peers: &Peers) {
             &HEARTBEAT,
             &[
                 ("hb", &m.heartbeat_ms),
+                ("elect", &elect_at_heartbeat(m)),
                 ("team", &c::string(&program.team)),
                 ("key", &c::string(&protocol::alive_key(program))),
                 ("group", &group_update(m, peers)),

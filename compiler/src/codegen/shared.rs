@@ -4,7 +4,7 @@
 //! team owns them; a write elsewhere goes to the owner (`Team.__set.X`), the
 //! owner tells the team every value it takes (`Team.__value.X`), and the
 //! first live robot of the owner order takes over from a lost owner (no
-//! heartbeat for three periods), telling the team the values it last saw.
+//! heartbeat for `lost_after_ms`), telling the team the values it last saw.
 //! The simulator does the same (`sim/engine/shared.rs`).
 
 use super::c;
@@ -69,11 +69,11 @@ const OWNERS: Template = template!("shared/owners.c.in", ["owners", "first"]);
 /// `tell`, `current_owner` and `<prefix>_owner_lost_at`.
 const TELL: Template = template!(
     "shared/tell.c.in",
-    ["name", "follow", "prefix", "lock", "unlock", "hb"]
+    ["name", "follow", "prefix", "lock", "unlock", "lost"]
 );
 /// `current_owner`'s choice of who follows a lost owner, per rule.
-const FOLLOW_FIRST: Template = template!("shared/follow_first.c.in", ["hb"]);
-const FOLLOW_BATTERY: Template = template!("shared/follow_battery.c.in", ["hb"]);
+const FOLLOW_FIRST: Template = template!("shared/follow_first.c.in", ["lost"]);
+const FOLLOW_BATTERY: Template = template!("shared/follow_battery.c.in", ["lost"]);
 /// `<prefix>_heard`.
 const HEARD: Template = template!("shared/heard.c.in", ["prefix", "lock", "unlock", "wake"]);
 
@@ -252,32 +252,32 @@ fn owner_protocol(
             ("first", &peers.local(ownership.owners[0])),
         ],
     ));
-    let hb = program.control.heartbeat_ms;
+    let lost = crate::refine::protocol::lost_after_ms(program.control.heartbeat_ms);
     out.push_str(&fill(
         &TELL,
         &[
             ("name", &c::string(&lib.name)),
-            ("follow", &follower(ownership.rule, hb)),
+            ("follow", &follower(ownership.rule, lost)),
             ("prefix", &prefix(lib)),
             ("lock", &lock),
             ("unlock", &unlock),
-            ("hb", &hb),
+            ("lost", &lost),
         ],
     ));
 }
 
 /// The loop of `current_owner` choosing who follows a lost owner among the
-/// live robots of `owners` (this robot, or heard from within three
-/// heartbeats): the first, or by the team's `highest_battery` leader
+/// live robots of `owners` (this robot, or heard from within
+/// `lost_after_ms`): the first, or by the team's `highest_battery` leader
 /// selection the one whose heartbeat said the highest level (the first of
 /// equals; unknown counts lowest; this robot's own level in simulation).
-fn follower(rule: OwnerRule, hb: i64) -> String {
+fn follower(rule: OwnerRule, lost: i64) -> String {
     let follow = if rule.by_battery() {
         &FOLLOW_BATTERY
     } else {
         &FOLLOW_FIRST
     };
-    fill(follow, &[("hb", &hb)])
+    fill(follow, &[("lost", &lost)])
 }
 
 /// `<prefix>_heard`: a write sent to this robot (taken when it owns the

@@ -227,7 +227,7 @@ pub struct ControlMachine {
     /// The team's group (peer indices, in formation order): the robots whose
     /// programs call any of the team's group services; empty when this robot
     /// is not one of them. Each member's rank is its place among the live
-    /// members (this robot, or heard from within three heartbeats).
+    /// members (this robot, or heard from within `protocol::lost_after_ms`).
     pub group: Vec<usize>,
     /// Adaptive resource management: the team strategy's battery policies,
     /// checked at every firing against the robot's `BATTERY` value.
@@ -287,6 +287,48 @@ impl ControlMachine {
             .unwrap_or(0)
             .max(1)
     }
+
+    /// The elections of the `leader(...)` statements: the `LeaderBranch`
+    /// states in service and state order. `election_K` in the C is the
+    /// K-th; both the C and the simulator decide each at its state and,
+    /// once decided there, again at each heartbeat, in this order
+    /// (`docs/groups.md`, "Takeover").
+    pub fn elections(&self) -> impl Iterator<Item = Election<'_>> {
+        let states = self.services.iter().enumerate().flat_map(|(service, s)| {
+            s.states
+                .iter()
+                .enumerate()
+                .map(move |(pc, state)| ((service, pc), state))
+        });
+        states.filter_map(|(at, state)| match &state.kind {
+            StateKind::LeaderBranch {
+                candidates,
+                algorithm,
+                receives,
+                ..
+            } => Some(Election {
+                at,
+                line: state.line,
+                candidates,
+                algorithm: *algorithm,
+                receives,
+            }),
+            _ => None,
+        })
+    }
+}
+
+/// A `leader(...)` statement's election ([`ControlMachine::elections`]): its
+/// `LeaderBranch` state's place and fields.
+#[derive(Clone, Copy, Debug)]
+pub struct Election<'a> {
+    /// (service, pc) of the state.
+    pub at: (usize, usize),
+    pub line: u32,
+    pub candidates: &'a [usize],
+    pub algorithm: LeaderAlgorithm,
+    /// The incoming messages the leader's block receives.
+    pub receives: &'a [usize],
 }
 
 impl ControlMachine {
@@ -343,7 +385,7 @@ pub struct BatteryPolicy {
 
 /// How often a robot that can be elected leader tells its team it is alive
 /// (mission ms) when its strategy names no `heartbeatPeriod`; a robot not
-/// heard from for three periods counts as failed.
+/// heard from for two periods (`protocol::lost_after_ms`) counts as failed.
 pub const HEARTBEAT_MS: i64 = 200;
 
 /// How a leader is chosen among the live candidates of a `leader(...)` arm:
@@ -465,7 +507,7 @@ pub enum StateKind {
     /// `[[ group(Name, min = N) ... ]]` (counted groups): give this robot a
     /// group from the `members` (peer indices, formation order: the robots
     /// that run the statement, as the checker decided) it knows alive (itself,
-    /// and those heard from within three heartbeats since it joined). The
+    /// and those heard from within `protocol::lost_after_ms` since it joined). The
     /// live members in formation order fill the groups up to their
     /// minimums in declaration order; a live member beyond the sum of the
     /// minimums (a spare) goes to `others_at` when the statement has

@@ -25,15 +25,29 @@ pub fn listen_ms(heartbeat_ms: i64) -> i64 {
     heartbeat_ms + heartbeat_ms / 2
 }
 
+/// When a peer is lost (`docs/groups.md`, "Takeover"): a robot counts a
+/// peer alive while it has heard the peer's heartbeat within this long, and
+/// lost once it has been silent for longer, for every rule that asks
+/// (elections, groups, group syncs, the owner of shared values, the live
+/// monitor). Two heartbeat periods: one lost heartbeat is tolerated, and
+/// as elections are also decided at each heartbeat, a dead leader is
+/// replaced at the latest at the third heartbeat after its last one. The
+/// simulator uses the same.
+pub fn lost_after_ms(heartbeat_ms: i64) -> i64 {
+    2 * heartbeat_ms
+}
+
 /// A leader's lease (`docs/groups.md`, "Fencing"): a robot the election
 /// would choose leads only while it has heard a strict majority of the
-/// candidates, itself included, within the last two heartbeat periods. Two
-/// is less than the three silent periods after which the others count it
-/// lost, so a leader cut off from the majority steps down at its first
-/// election after its lease lapsed, before they elect another (at their
-/// first election after three). The simulator uses the same.
+/// candidates, itself included, within the last one and a half heartbeat
+/// periods. Strictly less than [`lost_after_ms`], by half a period: with
+/// elections decided at each heartbeat, a leader cut off from the majority
+/// steps down at its heartbeat after its lease lapsed, no later than the
+/// others count it lost, when their heartbeats are in phase (robots started
+/// together) and messages take less than half a period. The simulator uses
+/// the same.
 pub fn lease_ms(heartbeat_ms: i64) -> i64 {
-    2 * heartbeat_ms
+    lost_after_ms(heartbeat_ms) - heartbeat_ms / 2
 }
 
 /// The largest term (`docs/groups.md`, "Terms"): a heartbeat saying more

@@ -1709,6 +1709,7 @@ impl<'p> Sim<'p> {
         self.manage_resources(r);
         if m.heartbeat && self.now - self.robots[r].last_heartbeat >= m.heartbeat_ms {
             self.robots[r].last_heartbeat = self.now;
+            self.elect_at_heartbeat(r);
             let robot = &self.robots[r];
             let term = if robot.leading {
                 robot.term_led
@@ -2080,13 +2081,9 @@ impl<'p> Sim<'p> {
                 others_at,
                 receives,
             } => {
-                let led = self.robots[r].leaders.get(&(service, pc)) == Some(&program.self_peer);
-                match self.elected(r, (service, pc), candidates, *algorithm) {
+                match self.election(r, (service, pc), candidates, *algorithm, receives) {
                     None => Step::Wait, // still listening
                     Some(elected) => {
-                        if elected && !led {
-                            self.drop_unled(r, receives);
-                        }
                         self.region(r, i).pc = if elected { next } else { others_at.index() };
                         Step::Next
                     }
@@ -2098,12 +2095,12 @@ impl<'p> Sim<'p> {
                 others_at,
             } => {
                 // `group_of` in the generated C: the live members (this
-                // robot, or heard within three heartbeats since it joined).
+                // robot, or heard within `lost_after_ms` since it joined).
                 let robot = &self.robots[r];
                 let me = program.self_peer;
-                let hb = m.heartbeat_ms;
+                let lost = crate::refine::protocol::lost_after_ms(m.heartbeat_ms);
                 let alive = |peer: usize| {
-                    peer == me || now - robot.heard.get(peer).seen.max(robot.started_at) <= 3 * hb
+                    peer == me || now - robot.heard.get(peer).seen.max(robot.started_at) <= lost
                 };
                 let live: Vec<usize> = members.iter().copied().filter(|&p| alive(p)).collect();
                 let position = live.iter().position(|&p| p == me).unwrap_or(0);
@@ -2145,7 +2142,7 @@ impl<'p> Sim<'p> {
                 }
                 let robot = &self.robots[r];
                 let pass = robot.sync_pass[&(service, pc)];
-                let hb = m.heartbeat_ms;
+                let lost = crate::refine::protocol::lost_after_ms(m.heartbeat_ms);
                 let me = program.self_peer;
                 let waiting = members.iter().any(|&peer| {
                     peer != me
@@ -2155,7 +2152,7 @@ impl<'p> Sim<'p> {
                             .copied()
                             .unwrap_or(0)
                             < pass
-                        && now - robot.heard.get(peer).seen <= 3 * hb
+                        && now - robot.heard.get(peer).seen <= lost
                 });
                 let started = robot.regions[i].marks[*mark];
                 if waiting && now - started <= *timeout_ms {
@@ -2318,8 +2315,44 @@ impl<'p> Sim<'p> {
         }
     }
 
-    /// `elected` (`codegen/control.rs`'s `ELECTION_C`): among the live
-    /// candidates (this robot, or heard from within three heartbeats) the
+    /// `election_K` in the C: the election of the `LeaderBranch` state
+    /// `state` ([`Sim::elected`]); a robot that has just become the leader
+    /// drops what waits for its leader's block (`receives`).
+    fn election(
+        &mut self,
+        r: usize,
+        state: (usize, usize),
+        candidates: &[usize],
+        algorithm: LeaderAlgorithm,
+        receives: &[usize],
+    ) -> Option<bool> {
+        let me = self.robots[r].program.self_peer;
+        let led = self.robots[r].leaders.get(&state) == Some(&me);
+        let elected = self.elected(r, state, candidates, algorithm);
+        if elected == Some(true) && !led {
+            self.drop_unled(r, receives);
+        }
+        elected
+    }
+
+    /// At each heartbeat, before it is sent: every election this robot has
+    /// decided at least once (at its statement) is decided again, in
+    /// service and state order, so that a lost leader is replaced, and a
+    /// leader whose lease lapsed steps down, within a heartbeat period of
+    /// the instant the rule says so, whether or not the statement is
+    /// reached then (`docs/groups.md`, "Takeover"); the heartbeat says the
+    /// outcome.
+    fn elect_at_heartbeat(&mut self, r: usize) {
+        let program = self.robots[r].program;
+        for e in program.control.elections() {
+            if self.robots[r].leaders.contains_key(&e.at) {
+                self.election(r, e.at, e.candidates, e.algorithm, e.receives);
+            }
+        }
+    }
+
+    /// `elected` (`codegen/control.rs`'s `ELECTED`): among the live
+    /// candidates (this robot, or heard from within `lost_after_ms`) the
     /// algorithm's choice; a robot that must listen first (restarted, or a
     /// `highest_battery` election) answers `None` until it has; a rejoining
     /// robot follows a live claimant instead of claiming. Fenced: a robot
@@ -2341,7 +2374,8 @@ impl<'p> Sim<'p> {
             return None;
         }
         let me = robot.program.self_peer;
-        let alive = |c: usize| c == me || now - robot.heard.get(c).seen <= 3 * hb;
+        let lost = crate::refine::protocol::lost_after_ms(hb);
+        let alive = |c: usize| c == me || now - robot.heard.get(c).seen <= lost;
         let level = |c: usize| {
             if c == me {
                 own_battery(robot, now)
@@ -2372,9 +2406,7 @@ impl<'p> Sim<'p> {
             let claimant = robot
                 .heard
                 .iter()
-                .find(|&(i, h)| {
-                    i != me && h.leads && h.term >= robot.term && now - h.seen <= 3 * hb
-                })
+                .find(|&(i, h)| i != me && h.leads && h.term >= robot.term && now - h.seen <= lost)
                 .map(|(i, _)| i);
             if let Some(c) = claimant {
                 leader = c;
@@ -2562,7 +2594,7 @@ impl Sim<'_> {
     /// At a heartbeat of a member of its team's group (`group_update` in
     /// `codegen/control.rs`): its rank among the live members (formation
     /// order) and their number, traced when they change. A member is alive
-    /// when it is this robot or was heard from within three heartbeats,
+    /// when it is this robot or was heard from within `lost_after_ms`,
     /// counted from when this robot joined.
     fn group_update(&mut self, r: usize) {
         let robot = &self.robots[r];
@@ -2574,7 +2606,8 @@ impl Sim<'_> {
         let now = self.now;
         let alive = |peer: usize| {
             peer == me
-                || now - robot.heard.get(peer).seen.max(robot.started_at) <= 3 * m.heartbeat_ms
+                || now - robot.heard.get(peer).seen.max(robot.started_at)
+                    <= crate::refine::protocol::lost_after_ms(m.heartbeat_ms)
         };
         let live: Vec<usize> = m.group.iter().copied().filter(|&p| alive(p)).collect();
         let rank = live.iter().position(|&p| p == me).unwrap_or(0);

@@ -10,11 +10,6 @@ use crate::live::{RunChoice, Status};
 use semo::deploy::topics::{self, Scope};
 use serde_json::{Value, json};
 
-/// A robot is lost when a robot that heart-beats has not been heard from
-/// for this many heartbeat periods: the generated leader election's own
-/// rule (`codegen/control.rs`, `elected`: heard within three heartbeats).
-pub const SILENT_PERIODS: i64 = 3;
-
 /// A robot of the mission, as refinement made it.
 #[derive(Clone, Debug)]
 pub struct Member {
@@ -74,7 +69,9 @@ impl Roster {
             mission: mission.to_string(),
             run,
             robots: members.into_iter().map(Robot::waiting).collect(),
-            silent_after_ms: SILENT_PERIODS * heartbeat_ms,
+            // A robot that heart-beats is lost by the robots' own rule
+            // (elections, groups, owners): silent for longer than this.
+            silent_after_ms: semo::refine::protocol::lost_after_ms(heartbeat_ms),
         }
     }
 
@@ -353,17 +350,18 @@ mod tests {
     }
 
     #[test]
-    fn a_running_robot_silent_for_three_heartbeats_is_lost_until_heard_again() {
+    fn a_running_robot_silent_past_the_loss_rule_is_lost_until_heard_again() {
         let mut r = roster();
+        let lost = semo::refine::protocol::lost_after_ms(200);
         r.message("semo/m/r1/status/a", RUNNING_A, 0);
         // Without any heartbeat heard its silence means nothing (a broker
         // whose ACL hides the heartbeats from the monitor).
         r.tick(10_000);
         assert_eq!(states(&r)[0], "a=running");
         r.message(&alive("a"), &heartbeat("a"), 10_000);
-        r.tick(10_600);
+        r.tick(10_000 + lost);
         assert_eq!(states(&r)[0], "a=running");
-        r.tick(10_601);
+        r.tick(10_000 + lost + 1);
         assert_eq!(states(&r)[0], "a=lost");
         assert_eq!(r.view()[0]["lostBecause"], "silent");
         r.message(&alive("a"), &heartbeat("a"), 10_700);

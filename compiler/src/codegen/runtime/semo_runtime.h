@@ -439,7 +439,7 @@ extern const semo_transport semo_mqtt_transport;
  * ascending robot id, formation order) and the number of live members. A
  * robot in no group (its strategy declares no group service it calls) has
  * rank -1 and size 0. Both change when a member fails (no heartbeat for
- * three periods) or returns; read them each time work is divided. */
+ * two periods) or returns; read them each time work is divided. */
 int semo_group_rank(void);
 int semo_group_size(void);
 /* For the generated control task: the rank and size it computed at a

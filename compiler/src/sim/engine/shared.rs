@@ -2,7 +2,7 @@
 //! generates them (`docs/shared-information.md`): one robot of the team owns
 //! them; a write elsewhere is sent to the owner (`Team.__set.X`), the owner
 //! tells the team each value it takes (`Team.__value.X`), and a lost owner
-//! (no heartbeat for three periods) is followed by the first live robot of
+//! (no heartbeat for `protocol::lost_after_ms`) is followed by the first live robot of
 //! the owner order, which tells the team the values it last saw.
 
 use super::{Held, Message, Sim};
@@ -27,7 +27,7 @@ impl Sim<'_> {
     }
 
     /// `current_owner`: the owner stays while it lives (this robot, or heard
-    /// from within three heartbeats); a lost one is followed by the first
+    /// from within `lost_after_ms`); a lost one is followed by the first
     /// live robot of the owner order. A change is traced; a robot that
     /// becomes the owner tells the team the values it last saw.
     pub(super) fn current_owner(&mut self, r: usize) -> usize {
@@ -36,7 +36,7 @@ impl Sim<'_> {
         let Some(ownership) = program.library.as_ref().and_then(|l| l.ownership.as_ref()) else {
             return program.self_peer;
         };
-        let lost_after = 3 * program.control.heartbeat_ms;
+        let lost_after = crate::refine::protocol::lost_after_ms(program.control.heartbeat_ms);
         let lives = |peer: usize| {
             peer == program.self_peer || self.now - robot.heard.get(peer).seen <= lost_after
         };
@@ -88,13 +88,16 @@ impl Sim<'_> {
     }
 
     /// When the robot would notice that its owner is lost: the firing after
-    /// three heartbeat periods without one (for [`Sim::wake_up`]).
+    /// `lost_after_ms` without one (for [`Sim::wake_up`]).
     pub(super) fn owner_lost_at(&self, r: usize) -> Option<i64> {
         let robot = &self.robots[r];
         let program = robot.program;
         program.library.as_ref()?.ownership.as_ref()?;
-        (robot.owner != program.self_peer)
-            .then(|| robot.heard.get(robot.owner).seen + 3 * program.control.heartbeat_ms + 1)
+        (robot.owner != program.self_peer).then(|| {
+            robot.heard.get(robot.owner).seen
+                + crate::refine::protocol::lost_after_ms(program.control.heartbeat_ms)
+                + 1
+        })
     }
 
     /// `tell`: a write of global value `k` to the owner `to`, or to the team
