@@ -17,9 +17,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use support::mosquitto::free_port;
 use support::mqtt::{Fleet, Processes, Started, folder_of, read_trace, robot_name};
-use support::robots::{
-    Event, PEDANTIC, build, field, modes, robot_command, robot_folders, scratch,
-};
+use support::robots::{Event, PEDANTIC, build_sim, field, modes, robot_folders, scratch};
 use support::{examples, repo_root};
 
 /// `semo build` of the scouting mission for linux-sim, each robot made with
@@ -52,7 +50,7 @@ fn run_together(
     for folder in folders {
         let robot = robot_name(folder);
         let trace = out.join(format!("{robot}.{tag}.jsonl"));
-        let child = robot_command(folder, &scenario(), &trace, port_base)
+        let child = support::mqtt::robot_on(folder, &scenario(), &trace, port_base)
             .args(transport_args)
             .stderr(Stdio::piped())
             .spawn()
@@ -313,9 +311,10 @@ fn transport_options_are_checked_and_an_unreachable_broker_is_reported() {
     assert_eq!(code, Some(2), "{stderr}");
     // Built with the default of linux-sim (udp only), mqtt is not there.
     let udp_only = scratch("mqtt-options-udp");
-    let built = build(
+    let built = build_sim(
         &examples().join("scouting/scouting.mission"),
         "linux-sim",
+        &scenario(),
         &udp_only,
     );
     assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
@@ -1448,7 +1447,7 @@ fn operator_console_drives_scouting_to_finish(name: &str, tls: bool) {
     for folder in &folders {
         let robot = robot_name(folder);
         let trace = out.join(format!("{robot}.operated.jsonl"));
-        let child = robot_command(folder, &alone, &trace, 1)
+        let child = support::mqtt::robot_on(folder, &alone, &trace, 1)
             .args(["--transport", "mqtt"])
             .stderr(Stdio::piped())
             .spawn()
@@ -1732,7 +1731,7 @@ fn editor_monitor_shows_the_running_robots_and_a_killed_one_lost(name: &str, tls
         for folder in &folders {
             let robot = robot_name(folder);
             let trace = out.join(format!("{robot}.monitored.jsonl"));
-            let child = robot_command(folder, &alone, &trace, 1)
+            let child = support::mqtt::robot_on(folder, &alone, &trace, 1)
                 .args(["--transport", "mqtt", "--duration", "1000000"])
                 .stderr(Stdio::piped())
                 .spawn()
@@ -1998,7 +1997,7 @@ fn the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor() {
         for folder in &folders {
             let robot = robot_name(folder);
             let trace = out.join(format!("{robot}.jsonl"));
-            let child = robot_command(folder, &world, &trace, 1)
+            let child = support::mqtt::robot_on(folder, &world, &trace, 1)
                 .args(["--transport", "mqtt"])
                 .stderr(Stdio::piped())
                 .spawn()

@@ -129,7 +129,7 @@ fn the_shared_library_compiles_with_gcc_and_clang() {
             .join("shared.mission");
         for cc in support::robots::compilers() {
             let out = support::robots::scratch(&format!("{fixture}-compile-{target}-{cc}"));
-            let built = support::robots::build(&mission, target, &out);
+            let built = support::robots::build_for(&mission, target, &out);
             assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
             for folder in robot_folders(&out) {
                 let library = folder.join("lib_ScoutsShared.c");

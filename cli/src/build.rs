@@ -88,13 +88,22 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             "error: {}",
             if compiled_in.is_empty() {
                 format!(
-                    "--scenario is compiled in only for target cortex-m-sim, and no robot of this build is built for it (target {} reads a scenario at run time, if at all)",
+                    "--scenario is compiled into simulations only (targets linux-sim, cortex-m-sim, or --sim), and no robot of this build is built for one (target {})",
                     names(&targets)
                 )
             } else {
                 let robots: Vec<&str> = compiled_in.iter().map(|r| r.robot.as_str()).collect();
+                let mut sims: Vec<&str> =
+                    compiled_in.iter().map(|r| r.chosen.target.name()).collect();
+                sims.sort_unstable();
+                sims.dedup();
+                let (targets, compile) = match sims.len() {
+                    1 => ("target", "compiles"),
+                    _ => ("targets", "compile"),
+                };
                 format!(
-                    "target cortex-m-sim compiles a scenario into each robot ({}): give --scenario FILE",
+                    "{targets} {} {compile} a scenario into each robot ({}): give --scenario FILE",
+                    sims.join(", "),
                     robots.join(", ")
                 )
             }

@@ -1030,7 +1030,6 @@ typedef struct {
     long port_base;
     int64_t duration_ms;
     bool duration_given;
-    const char *scenario;
     double time_scale;
     bool time_scale_given;
     long start_at_ms; /* --start-at: Unix ms of mission time 0; 0: when the program starts */
@@ -1063,7 +1062,7 @@ static void usage(FILE *f, const char *prog)
             "usage: %s [--trace FILE] [--transport udp|mqtt] [--port-base N] [--broker URL] [--run ID]"
             " [--duration MS] [--start-at UNIX_MS]"
 #ifdef SEMO_SIM
-            " [--scenario FILE] [--time-scale X] [--lockstep PATH]"
+            " [--time-scale X] [--lockstep PATH]"
 #endif
             "\n"
             "  --trace FILE      write a JSON-lines trace to FILE (\"-\": standard output)\n"
@@ -1082,8 +1081,8 @@ static void usage(FILE *f, const char *prog)
             "  --start-at T      mission time 0 is the wall-clock instant T (ms since 1970, or $SEMO_START_AT):\n"
             "                    robots given the same T start together; a T passed continues its mission time\n"
 #ifdef SEMO_SIM
-            "  --scenario FILE   the simulation scenario (JSON)\n"
-            "  --time-scale X    wall ms per mission ms (0.1: ten times faster; default 1)\n"
+            "  --time-scale X    wall ms per mission ms (0.1: ten times faster; default: the scenario's\n"
+            "                    time_scale, else 1); the scenario is compiled in (semo build --scenario FILE)\n"
             "  --lockstep PATH   virtual time: mission time and messages come from the coordinator on\n"
             "                    the Unix socket PATH (`semo simulate --engine c`); --start-at, --time-scale,\n"
             "                    --transport and --port-base do not apply\n"
@@ -1289,8 +1288,15 @@ static int parse_options(int argc, char **argv, options *o)
                 value = arg[len] == '=' ? arg + len + 1 : (i + 1 < argc ? argv[++i] : NULL);
             }
         }
+        if (which == 3) { /* the scenario is the build's: no program reads one */
+            fprintf(stderr,
+                    "%s: --scenario is not read at run time: a simulation's scenario is compiled into the program;"
+                    " build it with `semo build --sim --scenario FILE`\n",
+                    prog);
+            return 2;
+        }
 #ifndef SEMO_SIM
-        if ((which >= 3 && which < 5) || which == 8) {
+        if (which == 4 || which == 8) {
             fprintf(stderr, "%s: %s needs a simulation build (-DSEMO_SIM)\n", prog, names[which]);
             return 2;
         }
@@ -1325,9 +1331,6 @@ static int parse_options(int argc, char **argv, options *o)
             }
             o->duration_ms = n;
             o->duration_given = true;
-            break;
-        case 3:
-            o->scenario = value;
             break;
         case 4:
             o->time_scale = strtod(value, &end);
@@ -1718,12 +1721,11 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
         return 0;
     }
 #ifdef SEMO_SIM
-    if (status == 0 && o.scenario && semo__sim_load(o.scenario, program) != 0)
-        status = 2;
-    if (status == 0 && !o.time_scale_given && !semo__sim_time_scale(&o.time_scale))
-        o.time_scale = 1.0;
-    if (status == 0 && !o.duration_given && !semo__sim_duration(&o.duration_ms))
-        o.duration_ms = 0;
+    /* The scenario's settings, compiled in; the command line's win. */
+    if (!o.time_scale_given)
+        o.time_scale = semo__scenario.time_scale > 0 ? semo__scenario.time_scale : 1.0;
+    if (!o.duration_given)
+        o.duration_ms = semo__scenario.duration_ms;
 #endif
     if (status == 0) {
         g_scale = o.time_scale > 0 ? o.time_scale : 1.0;
@@ -1742,9 +1744,6 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
         pthread_cond_destroy(&g_run_cond);
         pthread_cond_destroy(&g_inbox_cond);
     }
-#ifdef SEMO_SIM
-    semo__sim_free();
-#endif
     g_prog = NULL;
     return status;
 }

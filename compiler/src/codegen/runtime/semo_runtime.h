@@ -201,8 +201,8 @@ typedef struct {
 
 /* Runs the program: parses the command line (`--trace FILE`,
  * `--transport udp|mqtt`, `--port-base N`, `--broker URL`, `--duration MS`;
- * simulation also `--scenario FILE` and
- * `--time-scale X`), allocates channels, opens the transport, calls every
+ * simulation also `--time-scale X`, its scenario being compiled in),
+ * allocates channels, opens the transport, calls every
  * task's init, starts one thread per task (time-driven tasks fire every
  * period, data-driven tasks fire again as soon as a firing returns,
  * control-driven tasks wait for UFControl_*), and waits until
