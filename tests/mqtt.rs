@@ -1164,6 +1164,7 @@ fn robots_reconnect_after_a_broker_restart_and_no_send_is_lost() {
     // The talker sends for 3 s; the listener listens 10 s, time for both to
     // reconnect (libmosquitto waits 1 s first) and take the backlog.
     let (folders, scenario) = burst_over_mqtt(&fleet, 3000, 10000);
+    support::mqtt::compile_in(&folders, &scenario);
     let (_, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let started: Vec<Started> = folders
@@ -1342,6 +1343,7 @@ fn a_second_run_on_the_same_broker_hears_nothing_of_the_first() {
         let scenario = two_runs_scenario(&fleet, n);
         // Started together, the worker's subscription stands before the
         // boss's first publication.
+        support::mqtt::compile_in(&folders, &scenario);
         let (_, start_at) = support::robots::start_barrier(folders.len());
         let start_at = start_at.to_string();
         let mut args = vec!["--start-at", start_at.as_str()];
@@ -2140,6 +2142,7 @@ fn kill_and_restart(
     (kill_at, restart_at): (i64, i64),
     what: &str,
 ) -> KillRestart {
+    support::mqtt::compile_in(folders, scenario);
     let (t0, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let barrier = ["--start-at", start_at.as_str()];
@@ -2367,6 +2370,7 @@ fn a_leader_cut_off_from_the_broker_steps_down_before_another_is_elected() {
     let through_proxy = format!("mqtt://127.0.0.1:{}", proxy.port);
     const CUT_AT: i64 = 1200;
     const HEAL_AT: i64 = 3500;
+    support::mqtt::compile_in(&folders, &scenario);
     let (t0, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let lives: Vec<Started> = folders
@@ -2433,6 +2437,7 @@ fn highest_battery_over_mqtt_elects_the_fullest_robot() {
                        "tb_2": {"battery": [{"at": 0, "level": 60}]}}}"#,
     )
     .unwrap();
+    support::mqtt::compile_in(&folders, &scenario);
     let (_, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let traces = fleet.run_all(&folders, &scenario, "battery", &["--start-at", &start_at]);
@@ -2577,6 +2582,7 @@ fn group_sync_over_mqtt_waits_for_the_live_members() {
                        "tb_2": {"services": {"move": 1200}}}}"#,
     )
     .unwrap();
+    support::mqtt::compile_in(&folders, &scenario);
     let (t0, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let started: Vec<Started> = folders

@@ -24,6 +24,7 @@ fn run_killing(fleet: &mut Fleet, folder: &str, victim: &str) -> Vec<(String, Ve
     let dir = repo_root().join("tests/fixtures").join(folder);
     let folders = support::mqtt::build(&dir.join("shared.mission"), &fleet.out, &[]);
     let scenario = dir.join("shared.scenario.json");
+    support::mqtt::compile_in(&folders, &scenario);
     let (t0, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let started: Vec<_> = ["a", "b", "c"]

@@ -217,10 +217,13 @@ fn compile(out: &Path, built: &Built) -> Vec<PathBuf> {
     folders
 }
 
-/// The program of a robot folder [`build_with`] wrote, with `scenario`
-/// compiled in (its folder built and made again when another one is in
-/// it), set to write its trace to `trace` on the ports from `port_base`.
-pub fn robot_on(folder: &Path, scenario: &Path, trace: &Path, port_base: u32) -> Command {
+/// Compiles `scenario` into the robots of `folders` (one output folder
+/// [`build_with`] wrote): built and made again unless it is the one in them
+/// already. Before a start barrier, so that the robots start on time.
+pub fn compile_in(folders: &[PathBuf], scenario: &Path) {
+    let Some(folder) = folders.first() else {
+        return;
+    };
     let out = folder
         .parent()
         .and_then(Path::parent)
@@ -236,6 +239,13 @@ pub fn robot_on(folder: &Path, scenario: &Path, trace: &Path, port_base: u32) ->
         built.scenario = text;
         compile(out, built);
     }
+}
+
+/// The program of a robot folder [`build_with`] wrote, with `scenario`
+/// compiled in ([`compile_in`]), set to write its trace to `trace` on the
+/// ports from `port_base`.
+pub fn robot_on(folder: &Path, scenario: &Path, trace: &Path, port_base: u32) -> Command {
+    compile_in(std::slice::from_ref(&folder.to_path_buf()), scenario);
     robot_command(folder, trace, port_base)
 }
 
