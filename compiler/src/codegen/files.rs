@@ -67,7 +67,8 @@ const PROGRAM_DESC: Template = template!(
         "robot_count",
         "schedule",
         "words",
-        "deploy"
+        "deploy",
+        "sim"
     ]
 );
 /// `comm_task.c`'s parts: sending, heartbeats, sync points, events, receiving.
@@ -421,6 +422,14 @@ pub fn main_c(
             (
                 "deploy",
                 &if threads { "    .deploy = &deploy,\n" } else { "" },
+            ),
+            (
+                "sim",
+                &if threads && target.simulated() {
+                    "    .sim = &semo_sim_platform,\n"
+                } else {
+                    ""
+                },
             ),
         ],
     ));

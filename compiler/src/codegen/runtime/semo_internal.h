@@ -8,6 +8,8 @@
  * semo__scenario below): semo_sim.c reads it for the threads platform
  * (sensors, battery, services, link faults, and a thread that feeds the
  * operator's commands into the queue), semo_static.c for the static one.
+ * The threads platform reaches semo_sim.c only through the hooks the
+ * program gives it (semo_program_desc::sim, semo_sim_hooks below).
  */
 #ifndef SEMO_INTERNAL_H
 #define SEMO_INTERNAL_H
@@ -176,18 +178,29 @@ void semo__ls_stopping(void);
 /* Ends the link (the program is over). */
 void semo__ls_close(void);
 extern const semo_transport semo_lockstep_transport;
-/* The scenario's link faults on a message from this robot to `peer` sent
- * now: false when it is lost, else the extra delay (ms, 0: none). */
-bool semo__sim_link(size_t peer, int64_t *delay_ms);
-/* Sends `data` to `peer` through `transport` `delay_ms` from now. */
-void semo__sim_send_later(const semo_transport *transport, size_t peer, const void *data, size_t len,
-                          int64_t delay_ms);
-/* Whether the scenario has link faults touching this robot (they need a
- * transport that sends to each robot). */
-bool semo__sim_has_link_faults(void);
-/* Starts and stops the thread that injects the operator's commands. */
-int semo__sim_start(void);
-void semo__sim_stop(void);
+#endif
+
+#ifdef SEMO_SIM
+struct semo__sim_tables_s;
+/* What a simulated world adds to the threads platform, given to it by the
+ * program (semo_program_desc::sim: semo_sim_platform, semo_sim.c): the
+ * platform calls the simulation through this table, never by name. */
+typedef struct semo_sim_hooks {
+    /* The world compiled in (time scale, duration, ...). */
+    const struct semo__sim_tables_s *world;
+    /* The link faults on a message from this robot to `peer` sent now:
+     * false when it is lost, else the extra delay (ms, 0: none). */
+    bool (*link)(size_t peer, int64_t *delay_ms);
+    /* Sends `data` to `peer` through `transport` `delay_ms` from now. */
+    void (*send_later)(const semo_transport *transport, size_t peer, const void *data, size_t len,
+                       int64_t delay_ms);
+    /* The battery level now, rounded; false when the world gives none. */
+    bool (*battery)(long long *level);
+    /* Starts and stops the threads that inject the operator's commands and
+     * send delayed datagrams. */
+    int (*start)(void);
+    void (*stop)(void);
+} semo_sim_hooks;
 #endif
 
 #ifdef SEMO_SIM
@@ -228,7 +241,7 @@ typedef struct {
     const size_t *peers;
     size_t peer_count;
 } semo__sim_link_entry;
-typedef struct {
+typedef struct semo__sim_tables_s {
     int64_t duration_ms; /* 0: until the program stops itself */
     const semo__sim_sensor_entry *sensors;
     size_t sensor_count;

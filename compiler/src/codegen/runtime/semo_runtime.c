@@ -781,11 +781,11 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
         if (g_transport->send_to)
             continue; /* one message for all of them, below */
 #ifdef SEMO_SIM
-        int64_t delay_ms;
-        if (!semo__sim_link(i, &delay_ms))
+        int64_t delay_ms = 0;
+        if (g_prog->sim && !g_prog->sim->link(i, &delay_ms))
             continue; /* a link fault of the scenario loses it */
         if (delay_ms > 0) {
-            semo__sim_send_later(g_transport, i, datagram, len, delay_ms);
+            g_prog->sim->send_later(g_transport, i, datagram, len, delay_ms);
             continue;
         }
 #endif
@@ -917,8 +917,8 @@ static void observe_status(const char *event, va_list args)
     long long level = 0;
     bool known = semo__battery(&level);
 #ifdef SEMO_SIM
-    if (!known)
-        known = semo_sim_battery(&level);
+    if (!known && g_prog->sim)
+        known = g_prog->sim->battery(&level);
 #endif
     if (known != g_status.battery_known || (known && level != g_status.battery)) {
         g_status.battery_known = known;
@@ -1628,7 +1628,7 @@ static int run(const options *o)
         }
         g_transport = o->transport;
 #ifdef SEMO_SIM
-        if (o->transport->send_to && semo__sim_has_link_faults()) {
+        if (o->transport->send_to && p->sim && p->sim->world->link_count > 0) {
             fprintf(stderr, "semo runtime: the scenario's link faults need a transport that sends to each robot (udp)\n");
             status = 1;
             goto stop;
@@ -1654,7 +1654,7 @@ static int run(const options *o)
     if (g_transport)
         receiver_started = start_thread(&receiver, receiver_thread, NULL, true);
 #ifdef SEMO_SIM
-    sim_started = semo__sim_start() == 0;
+    sim_started = !p->sim || p->sim->start() == 0;
     if (!sim_started)
         status = 1;
 #endif
@@ -1682,8 +1682,8 @@ stop:
     if (receiver_started)
         pthread_join(receiver, NULL);
 #ifdef SEMO_SIM
-    if (sim_started)
-        semo__sim_stop();
+    if (sim_started && p->sim)
+        p->sim->stop();
 #endif
     if (signals_started) {
         atomic_store(&g_signal_thread_done, true);
@@ -1721,11 +1721,12 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
         return 0;
     }
 #ifdef SEMO_SIM
-    /* The scenario's settings, compiled in; the command line's win. */
+    /* The world's settings, compiled in; the command line's win. */
+    const semo__sim_tables *world = program->sim ? program->sim->world : NULL;
     if (!o.time_scale_given)
-        o.time_scale = semo__scenario.time_scale > 0 ? semo__scenario.time_scale : 1.0;
+        o.time_scale = world && world->time_scale > 0 ? world->time_scale : 1.0;
     if (!o.duration_given)
-        o.duration_ms = semo__scenario.duration_ms;
+        o.duration_ms = world ? world->duration_ms : 0;
 #endif
     if (status == 0) {
         g_scale = o.time_scale > 0 ? o.time_scale : 1.0;

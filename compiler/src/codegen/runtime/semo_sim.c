@@ -11,6 +11,9 @@
  * delayed datagram is sent by a second thread at its time. Kill and restart
  * faults happen to the process from outside (a crash is not something a
  * program does to itself): they are not in the tables.
+ *
+ * The platform (semo_runtime.c) calls none of this by name: the program
+ * gives it semo_sim_platform, the table of hooks at the end of this file.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -24,11 +27,6 @@
 #include <string.h>
 
 #define DEFAULT_SERVICE_MS 100
-
-bool semo__sim_has_link_faults(void)
-{
-    return semo__scenario.link_count > 0;
-}
 
 /* ------------------------------------------------- the running scenario */
 
@@ -58,7 +56,7 @@ static void *operator_thread(void *arg)
     }
 }
 
-bool semo__sim_link(size_t peer, int64_t *delay_ms)
+static bool sim_link(size_t peer, int64_t *delay_ms)
 {
     int64_t now = semo_now_ms();
     *delay_ms = 0;
@@ -103,8 +101,8 @@ static bool has_delays(void)
     return false;
 }
 
-void semo__sim_send_later(const semo_transport *transport, size_t peer, const void *data, size_t len,
-                          int64_t delay_ms)
+static void sim_send_later(const semo_transport *transport, size_t peer, const void *data, size_t len,
+                           int64_t delay_ms)
 {
     late_datagram *d = malloc(sizeof *d + len);
     if (!d) {
@@ -160,7 +158,7 @@ static void *late_thread(void *arg)
     return NULL;
 }
 
-int semo__sim_start(void)
+static int sim_start(void)
 {
     if (has_delays()) {
         semo__cond_init(&g_late.changed);
@@ -187,7 +185,7 @@ int semo__sim_start(void)
     return 0;
 }
 
-void semo__sim_stop(void)
+static void sim_stop(void)
 {
     if (g_operator_started)
         pthread_join(g_operator, NULL);
@@ -281,6 +279,15 @@ int64_t semo_sim_loop_exit(const char *loop)
             return semo__scenario.loops[i].iteration;
     return 0;
 }
+
+const semo_sim_hooks semo_sim_platform = {
+    .world = &semo__scenario,
+    .link = sim_link,
+    .send_later = sim_send_later,
+    .battery = semo_sim_battery,
+    .start = sim_start,
+    .stop = sim_stop,
+};
 
 #else
 /* ISO C wants at least one declaration in a translation unit. */
