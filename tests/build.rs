@@ -32,6 +32,16 @@ fn build(mission: &Path, target: &str, out: &Path) -> support::Output {
     )
 }
 
+/// `semo build MISSION --target TARGET --scenario SCENARIO -o OUT`.
+fn build_sim(mission: &Path, target: &str, scenario: &Path, out: &Path) -> support::Output {
+    support::robots::build_sim(mission, target, scenario, out)
+}
+
+/// [`support::robots::build_for`].
+fn build_for(mission: &Path, target: &str, out: &Path) -> support::Output {
+    support::robots::build_for(mission, target, out)
+}
+
 fn example(path: &str) -> PathBuf {
     examples().join(path)
 }
@@ -75,7 +85,7 @@ fn every_example_and_fixture_that_builds_compiles_pedantically_with_gcc_and_clan
             .to_string();
         for target in ["linux", "linux-sim"] {
             let out = scratch(&format!("compile-{}-{target}", name.replace('/', "-")));
-            let built = build(mission, target, &out);
+            let built = build_for(mission, target, &out);
             if built.code != 0 {
                 assert!(
                     !must_build,
@@ -107,9 +117,14 @@ fn run_scouting(
     env: &[(&str, &str)],
 ) -> BTreeMap<String, (Vec<Event>, String)> {
     let out = scratch(name);
-    let built = build(&example("scouting/scouting.mission"), "linux-sim", &out);
-    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
     let scenario = repo_root().join("tests/fixtures/build/scouting.scenario.json");
+    let built = build_sim(
+        &example("scouting/scouting.mission"),
+        "linux-sim",
+        &scenario,
+        &out,
+    );
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
     // Each run gets its own ports, so runs in parallel do not hear each other.
     // Below the ephemeral range (32768 and up), where other sockets come and go.
     let port_base = 20000 + (std::process::id() % 250) * 40 + port_offset;
@@ -123,7 +138,6 @@ fn run_scouting(
         let robot = folder.file_name().unwrap().to_string_lossy().into_owned();
         let trace = out.join(format!("{robot}.jsonl"));
         let child = Command::new(folder.join(&robot))
-            .args(["--scenario", &scenario.display().to_string()])
             .args(["--trace", &trace.display().to_string()])
             .args(["--port-base", &port_base.to_string()])
             .envs(env.iter().copied())
@@ -254,20 +268,25 @@ fn scouting_runs_clean_under_thread_sanitizer() {
 fn a_failed_leader_is_replaced_by_the_next_robot() {
     // patrol_groups: `leader(instance of Turtlebot3_Burger)` among tb_0..tb_2.
     let out = scratch("leader");
-    let built = build(&example("swarm/patrol_groups.mission"), "linux-sim", &out);
+    let scenario = out.join("scenario.json");
+    std::fs::write(&scenario, r#"{"time_scale": 1, "duration": 3500}"#).unwrap();
+    let built = build_sim(
+        &example("swarm/patrol_groups.mission"),
+        "linux-sim",
+        &scenario,
+        &out.join("out"),
+    );
     assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
-    let folders = robot_folders(&out);
+    let folders = robot_folders(&out.join("out"));
     for folder in &folders {
         make(folder, "gcc", STRICT).unwrap_or_else(|e| panic!("{e}"));
     }
-    let scenario = out.join("scenario.json");
-    std::fs::write(&scenario, r#"{"time_scale": 1, "duration": 3500}"#).unwrap();
     let port_base = 20000 + (std::process::id() % 250) * 40 + 30;
     let mut children = BTreeMap::new();
     for folder in &folders {
         let robot = folder.file_name().unwrap().to_string_lossy().into_owned();
         let trace = out.join(format!("{robot}.jsonl"));
-        let child = robot_command(folder, &scenario, &trace, port_base)
+        let child = robot_command(folder, &trace, port_base)
             .spawn()
             .expect("the robot program starts");
         children.insert(robot, child);
@@ -344,11 +363,11 @@ fn output_is_byte_identical_for_identical_inputs() {
     let b = scratch("same-b");
     for target in ["linux", "linux-sim"] {
         assert_eq!(
-            build(&example("scouting/scouting.mission"), target, &a).code,
+            build_for(&example("scouting/scouting.mission"), target, &a).code,
             0
         );
         assert_eq!(
-            build(&example("scouting/scouting.mission"), target, &b).code,
+            build_for(&example("scouting/scouting.mission"), target, &b).code,
             0
         );
         let (left, right) = (contents(&a), contents(&b));
@@ -408,7 +427,7 @@ fn each_file_header_says_what_the_next_build_does_to_it() {
     let mission = example("follow/follow.mission");
     for target in ["linux", "linux-sim"] {
         let out = scratch(&format!("headers-{target}"));
-        let built = build(&mission, target, &out);
+        let built = build_for(&mission, target, &out);
         assert_eq!(built.code, 0, "{}", built.stderr);
         let promises = header_promises(&out.join("Team1/create1"));
         assert!(promises.contains_key("tasks/follow.c"), "{promises:?}");
@@ -605,15 +624,6 @@ fn unknown_targets_are_a_usage_error() {
 fn a_received_word_of_another_enumeration_is_refused() {
     let out = scratch("enum-receive");
     let fixture = repo_root().join("tests/fixtures/receive");
-    let built = build(&fixture.join("relay.mission"), "linux-sim", &out);
-    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
-    let placer = robot_folders(&out)
-        .into_iter()
-        .find(|f| f.ends_with("q"))
-        .expect("the placer is built");
-    make(&placer, "cc", STRICT).unwrap_or_else(|e| panic!("{e}"));
-    let port_base = 21000 + (std::process::id() % 250) * 40;
-    let trace = out.join("q.jsonl");
     let mut scenario: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(fixture.join("relay.scenario.json")).unwrap(),
     )
@@ -623,7 +633,21 @@ fn a_received_word_of_another_enumeration_is_refused() {
     scenario["duration"] = 4000.into();
     let scenario_path = out.join("relay.scenario.json");
     std::fs::write(&scenario_path, scenario.to_string()).unwrap();
-    let mut child = robot_command(&placer, &scenario_path, &trace, port_base as u32)
+    let built = build_sim(
+        &fixture.join("relay.mission"),
+        "linux-sim",
+        &scenario_path,
+        &out.join("out"),
+    );
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    let placer = robot_folders(&out.join("out"))
+        .into_iter()
+        .find(|f| f.ends_with("q"))
+        .expect("the placer is built");
+    make(&placer, "cc", STRICT).unwrap_or_else(|e| panic!("{e}"));
+    let port_base = 21000 + (std::process::id() % 250) * 40;
+    let trace = out.join("q.jsonl");
+    let mut child = robot_command(&placer, &trace, port_base as u32)
         .stderr(std::process::Stdio::piped())
         .spawn()
         .expect("the placer starts");
@@ -847,7 +871,7 @@ fn runtime_objects(out: &Path) -> BTreeMap<String, BTreeMap<String, std::time::S
 #[test]
 fn the_runtime_is_written_once_and_compiled_once_per_compiler_and_flags() {
     let out = scratch("shared-runtime");
-    let built = build(&example("scouting/scouting.mission"), "linux-sim", &out);
+    let built = build_for(&example("scouting/scouting.mission"), "linux-sim", &out);
     assert_eq!(built.code, 0, "{}", built.stderr);
     assert!(built.stdout.contains("semo-runtime"), "{}", built.stdout);
     let runtime = out.join("semo-runtime");
@@ -960,7 +984,7 @@ fn twice_the_robots_write_at_most_twice_the_bytes() {
         let mission = dir.join("fleet.mission");
         std::fs::write(&mission, benchmark_mission::generate(teams)).unwrap();
         let out = dir.join("out");
-        let built = build(&mission, "linux-sim", &out);
+        let built = build_for(&mission, "linux-sim", &out);
         assert_eq!(built.code, 0, "{}", built.stderr);
         bytes_and_widest_peer_table(&out)
     };

@@ -463,7 +463,7 @@ fn a_mixed_fleet_builds_each_robot_for_its_own_platform_and_both_make() {
     // A Linux robot's folder is what a build of every robot for linux-sim
     // writes (the board robot alone could not be: its team's fellows talk).
     let hosted = out.join("linux-sim");
-    build_for(&mission, "linux-sim", None, &hosted);
+    build_for(&mission, "linux-sim", Some(&scenario), &hosted);
     let (mixed_a, alone_a) = (sources(&a), sources(&hosted.join("Base/a")));
     assert!(mixed_a.contains_key("main.c") && mixed_a.contains_key("Makefile"));
     assert_eq!(mixed_a, alone_a, "a");

@@ -66,8 +66,8 @@ fn resources(events: &[&Event]) -> Vec<(i64, (String, String, String))> {
         .collect()
 }
 
-/// The robots of `mission`, in peer order (`semo build --target linux-sim`,
-/// without compiling them).
+/// The robots of `mission`, in peer order (`semo build --target linux`,
+/// without compiling them: the robots of a simulation are the same).
 fn robots_of(name: &str, mission: &Path) -> Vec<String> {
     let out = scratch(name);
     let built = semo_in(
@@ -76,7 +76,7 @@ fn robots_of(name: &str, mission: &Path) -> Vec<String> {
             "build",
             &mission.display().to_string(),
             "--target",
-            "linux-sim",
+            "linux",
             "-o",
             &out.display().to_string(),
         ],

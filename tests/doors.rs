@@ -441,6 +441,14 @@ fn tree(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
 /// the workspace `root`, as a user runs it once the mission is open: the
 /// server's answer.
 fn generate_in_editor(root: &Path, mission: &str) -> Value {
+    generate_in_editor_with(root, serde_json::json!({ "mission": mission }))
+}
+
+/// [`generate_in_editor`] with more of the command's arguments than the
+/// mission (`arguments["mission"]`, a path under `root`, becomes its URI).
+fn generate_in_editor_with(root: &Path, mut arguments: Value) -> Value {
+    let mission = arguments["mission"].as_str().unwrap().to_string();
+    arguments.as_object_mut().unwrap().remove("mission");
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
@@ -451,10 +459,11 @@ fn generate_in_editor(root: &Path, mission: &str) -> Value {
         let workspace = format!("file://{}", root.display());
         client.initialize(&["utf-16"], Some(&workspace)).await;
         let uri = client.open_file(&root.join(mission)).await;
+        arguments["uri"] = uri.as_str().into();
         let answer = client
             .request(
                 "workspace/executeCommand",
-                serde_json::json!({ "command": "semo.generateCode", "arguments": [{ "uri": uri }] }),
+                serde_json::json!({ "command": "semo.generateCode", "arguments": [arguments] }),
             )
             .await
             .expect("generated");
@@ -491,6 +500,8 @@ fn planned_project(dir: &Path) {
         dir.join("follow.mission"),
     )
     .unwrap();
+    // The simulation's scenario (compiled in: both doors are given it).
+    std::fs::write(dir.join("follow.scenario.json"), r#"{"duration": 2000}"#).unwrap();
 }
 
 /// `semo build` and the editor's Generate Code (no folder or target asked)
@@ -502,10 +513,13 @@ fn the_cli_and_the_editor_build_the_project_files_plan() {
     let (cli, editor) = (tmp.path().join("cli"), tmp.path().join("editor"));
     planned_project(&cli);
     planned_project(&editor);
-    let built = semo_in(&cli, &["build"]);
+    let built = semo_in(&cli, &["build", "--scenario", "follow.scenario.json"]);
     assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
 
-    let answer = generate_in_editor(&editor, "follow.mission");
+    let answer = generate_in_editor_with(
+        &editor,
+        serde_json::json!({ "mission": "follow.mission", "scenario": "follow.scenario.json" }),
+    );
     assert_eq!(answer["target"], "linux-sim", "{answer}");
     assert_eq!(
         answer["outputFolder"],

@@ -125,9 +125,11 @@ fn odd_missions_build(name: &str, seeds: std::ops::Range<u64>) {
             continue;
         }
         accepted += 1;
+        // A simulation has a scenario compiled in: one with nothing in it.
+        std::fs::write(dir.join("quiet.scenario.json"), r#"{"duration": 2000}"#).unwrap();
         for target in ["linux", "linux-sim", "cortex-m"] {
             let out = dir.join(target).display().to_string();
-            let args = [
+            let mut args = vec![
                 "build",
                 "odd.mission",
                 "--target",
@@ -137,6 +139,9 @@ fn odd_missions_build(name: &str, seeds: std::ops::Range<u64>) {
                 "--format",
                 "json",
             ];
+            if target.ends_with("-sim") {
+                args.extend(["--scenario", "quiet.scenario.json"]);
+            }
             let built = semo_in(&dir, &args);
             let diags = support::parse_json_report(&built.stdout);
             let errors: Vec<_> = diags.iter().filter(|d| d.severity == "error").collect();
@@ -178,17 +183,7 @@ fn pipeline_holds(name: &str, seeds: std::ops::Range<u64>) {
         );
         for target in TARGETS {
             let out = dir.join(target);
-            let built = semo_in(
-                &dir,
-                &[
-                    "build",
-                    "generated.mission",
-                    "--target",
-                    target,
-                    "-o",
-                    &out.display().to_string(),
-                ],
-            );
+            let built = support::robots::build_for(&mission, target, &out);
             assert_eq!(
                 built.code, 0,
                 "seed {seed}: `semo check` accepts it but `semo build --target {target}` refuses:\n{text}\n{}{}",

@@ -30,6 +30,10 @@ fn copy_example(example: &str, mission: &str, dir: &Path) -> PathBuf {
     dir.join(mission)
 }
 
+/// The follow example's scenario (a path from the repository's root, where
+/// [`build`] runs): what a simulation of it is built with.
+const FOLLOW_SCENARIO: &str = "tests/fixtures/cortex_m/follow.scenario.json";
+
 fn build(mission: &Path, out: &Path, extra: &[&str]) -> support::Output {
     let (mission, out) = (mission.display().to_string(), out.display().to_string());
     let mut args = vec!["build", &mission, "-o", &out];
@@ -355,7 +359,11 @@ fn switching_target_keeps_edited_task_files() {
     std::fs::write(&task, MY_TASK).unwrap();
     let before = contents(&out);
     // Refused, naming the file and the flag; nothing written.
-    let refused = build(&mission, &out, &["--target", "linux-sim"]);
+    let refused = build(
+        &mission,
+        &out,
+        &["--target", "linux-sim", "--scenario", FOLLOW_SCENARIO],
+    );
     assert_eq!(refused.code, 1, "{}", refused.stdout);
     assert!(
         refused.stderr.contains("tasks/follow.c"),
@@ -370,7 +378,17 @@ fn switching_target_keeps_edited_task_files() {
     assert!(refused.stderr.contains("--force"), "{}", refused.stderr);
     assert_eq!(contents(&out), before);
     // Forced: the edit is saved first, under a dated backup folder.
-    let forced = build(&mission, &out, &["--target", "linux-sim", "--force"]);
+    let forced = build(
+        &mission,
+        &out,
+        &[
+            "--target",
+            "linux-sim",
+            "--scenario",
+            FOLLOW_SCENARIO,
+            "--force",
+        ],
+    );
     assert_eq!(forced.code, 0, "{}", forced.stderr);
     let saved: Vec<_> = contents(&out.join(".semo-backup"))
         .into_iter()
@@ -430,7 +448,15 @@ fn runtime_copies_an_earlier_version_left_in_a_robot_folder_go() {
     let dir = scratch("retired");
     let mission = copy_example("follow", "follow.mission", &dir);
     let out = dir.join("out");
-    assert_eq!(build(&mission, &out, &["--target", "linux-sim"]).code, 0);
+    assert_eq!(
+        build(
+            &mission,
+            &out,
+            &["--target", "linux-sim", "--scenario", FOLLOW_SCENARIO]
+        )
+        .code,
+        0
+    );
     let folder = out.join("Team1/create1");
     // What an earlier version left: the runtime's files in the robot
     // folder, recorded as generated.
@@ -444,7 +470,11 @@ fn runtime_copies_an_earlier_version_left_in_a_robot_folder_go() {
     let edited = folder.join("semo_udp.c");
     std::fs::write(&edited, "/* my fix */\n").unwrap();
     let before = contents(&out);
-    let refused = build(&mission, &out, &["--target", "linux-sim"]);
+    let refused = build(
+        &mission,
+        &out,
+        &["--target", "linux-sim", "--scenario", FOLLOW_SCENARIO],
+    );
     assert_eq!(refused.code, 1, "{}", refused.stdout);
     assert!(
         refused.stderr.contains(
@@ -459,7 +489,17 @@ fn runtime_copies_an_earlier_version_left_in_a_robot_folder_go() {
         refused.stderr
     );
     assert_eq!(contents(&out), before);
-    let forced = build(&mission, &out, &["--target", "linux-sim", "--force"]);
+    let forced = build(
+        &mission,
+        &out,
+        &[
+            "--target",
+            "linux-sim",
+            "--scenario",
+            FOLLOW_SCENARIO,
+            "--force",
+        ],
+    );
     assert_eq!(forced.code, 0, "{}", forced.stderr);
     for name in ["semo_runtime.h", "semo_core.c", "semo_udp.c"] {
         assert!(!folder.join(name).exists(), "{name}");
@@ -721,7 +761,35 @@ fn a_nonsense_time_scale_is_refused_and_the_bounds_run_clean_under_ubsan() {
     let dir = scratch("time-scale");
     let mission = copy_example("follow", "follow.mission", &dir);
     let out = dir.join("out");
-    assert_eq!(build(&mission, &out, &["--target", "linux-sim"]).code, 0);
+    let scenario = dir.join("s.json");
+    let build_on = |text: &str| {
+        std::fs::write(&scenario, text).unwrap();
+        let scenario = scenario.display().to_string();
+        build(
+            &mission,
+            &out,
+            &["--target", "linux-sim", "--scenario", &scenario],
+        )
+    };
+    // A scenario's time scale out of the runtime's range is refused by the
+    // build that would compile it in.
+    for scale in ["1e-18", "0", "-1", "1e300", "nan"] {
+        let built = build_on(&format!("{{\"time_scale\": {scale}}}"));
+        assert_eq!(built.code, 2, "{scale}: {}", built.stderr);
+        if scale != "nan" {
+            // `nan` is not JSON: refused by the reader before the range.
+            assert!(
+                built
+                    .stderr
+                    .contains("\"time_scale\" must be a positive number from"),
+                "{scale}: {}",
+                built.stderr
+            );
+        }
+    }
+    // The fastest scale allowed runs a second of mission time and stops.
+    let built = build_on("{\"time_scale\": 0.000001, \"duration\": 1000}");
+    assert_eq!(built.code, 0, "{}", built.stderr);
     let folder = out.join("Team1/create1");
     let ubsan = "-std=c11 -O1 -g -fsanitize=undefined -fno-sanitize-recover=all";
     let made = Command::new("make")
@@ -749,16 +817,6 @@ fn a_nonsense_time_scale_is_refused_and_the_bounds_run_clean_under_ubsan() {
         (done.status.code(), stderr)
     };
     for scale in ["1e-18", "0", "-1", "1e300", "nan"] {
-        std::fs::write(dir.join("s.json"), format!("{{\"time_scale\": {scale}}}")).unwrap();
-        let (code, stderr) = run(&["--scenario", "s.json", "--duration", "10"]);
-        if scale != "nan" {
-            // `nan` is not JSON: refused by the reader before the range.
-            assert!(
-                stderr.contains("\"time_scale\" must be a positive number from"),
-                "{scale}: {stderr}"
-            );
-        }
-        assert_ne!(code, Some(0), "{scale}");
         let (code, stderr) = run(&["--time-scale", scale, "--duration", "10"]);
         assert_eq!(code, Some(2), "{scale}: {stderr}");
         assert!(
@@ -766,13 +824,7 @@ fn a_nonsense_time_scale_is_refused_and_the_bounds_run_clean_under_ubsan() {
             "{scale}: {stderr}"
         );
     }
-    // The fastest scale allowed runs a second of mission time and stops.
-    std::fs::write(
-        dir.join("s.json"),
-        "{\"time_scale\": 0.000001, \"duration\": 1000}",
-    )
-    .unwrap();
-    let (code, stderr) = run(&["--scenario", "s.json", "--trace", "trace.jsonl"]);
+    let (code, stderr) = run(&["--trace", "trace.jsonl"]);
     assert_eq!(code, Some(0), "{stderr}");
 }
 

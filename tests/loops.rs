@@ -371,7 +371,7 @@ fn graph_services_compile_pedantically_with_gcc_and_clang() {
         for cc in compilers() {
             for mission in ["loops.mission", "tracking.mission", "periodic.mission"] {
                 let out = scratch(&format!("loops/compile-{target}-{cc}-{mission}"));
-                let built = build(&fixture(mission), target, &out);
+                let built = support::robots::build_for(&fixture(mission), target, &out);
                 assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
                 for folder in robot_folders(&out) {
                     make(&folder, cc, PEDANTIC)
@@ -443,6 +443,8 @@ fn a_service_graph_whose_sub_graph_cannot_be_used_is_refused_on_the_call() {
                 "tracking.mission",
                 "--target",
                 "linux-sim",
+                "--scenario",
+                &fixture("tracking.scenario.json").display().to_string(),
                 "-o",
                 &out.display().to_string(),
                 "--format",

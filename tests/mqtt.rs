@@ -17,9 +17,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use support::mosquitto::free_port;
 use support::mqtt::{Fleet, Processes, Started, folder_of, read_trace, robot_name};
-use support::robots::{
-    Event, PEDANTIC, build, field, modes, robot_command, robot_folders, scratch,
-};
+use support::robots::{Event, PEDANTIC, build_sim, field, modes, robot_folders, scratch};
 use support::{examples, repo_root};
 
 /// `semo build` of the scouting mission for linux-sim, each robot made with
@@ -52,7 +50,7 @@ fn run_together(
     for folder in folders {
         let robot = robot_name(folder);
         let trace = out.join(format!("{robot}.{tag}.jsonl"));
-        let child = robot_command(folder, &scenario(), &trace, port_base)
+        let child = support::mqtt::robot_on(folder, &scenario(), &trace, port_base)
             .args(transport_args)
             .stderr(Stdio::piped())
             .spawn()
@@ -313,9 +311,10 @@ fn transport_options_are_checked_and_an_unreachable_broker_is_reported() {
     assert_eq!(code, Some(2), "{stderr}");
     // Built with the default of linux-sim (udp only), mqtt is not there.
     let udp_only = scratch("mqtt-options-udp");
-    let built = build(
+    let built = build_sim(
         &examples().join("scouting/scouting.mission"),
         "linux-sim",
+        &scenario(),
         &udp_only,
     );
     assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
@@ -1165,6 +1164,7 @@ fn robots_reconnect_after_a_broker_restart_and_no_send_is_lost() {
     // The talker sends for 3 s; the listener listens 10 s, time for both to
     // reconnect (libmosquitto waits 1 s first) and take the backlog.
     let (folders, scenario) = burst_over_mqtt(&fleet, 3000, 10000);
+    support::mqtt::compile_in(&folders, &scenario);
     let (_, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let started: Vec<Started> = folders
@@ -1343,6 +1343,7 @@ fn a_second_run_on_the_same_broker_hears_nothing_of_the_first() {
         let scenario = two_runs_scenario(&fleet, n);
         // Started together, the worker's subscription stands before the
         // boss's first publication.
+        support::mqtt::compile_in(&folders, &scenario);
         let (_, start_at) = support::robots::start_barrier(folders.len());
         let start_at = start_at.to_string();
         let mut args = vec!["--start-at", start_at.as_str()];
@@ -1448,7 +1449,7 @@ fn operator_console_drives_scouting_to_finish(name: &str, tls: bool) {
     for folder in &folders {
         let robot = robot_name(folder);
         let trace = out.join(format!("{robot}.operated.jsonl"));
-        let child = robot_command(folder, &alone, &trace, 1)
+        let child = support::mqtt::robot_on(folder, &alone, &trace, 1)
             .args(["--transport", "mqtt"])
             .stderr(Stdio::piped())
             .spawn()
@@ -1732,7 +1733,7 @@ fn editor_monitor_shows_the_running_robots_and_a_killed_one_lost(name: &str, tls
         for folder in &folders {
             let robot = robot_name(folder);
             let trace = out.join(format!("{robot}.monitored.jsonl"));
-            let child = robot_command(folder, &alone, &trace, 1)
+            let child = support::mqtt::robot_on(folder, &alone, &trace, 1)
                 .args(["--transport", "mqtt", "--duration", "1000000"])
                 .stderr(Stdio::piped())
                 .spawn()
@@ -1998,7 +1999,7 @@ fn the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor() {
         for folder in &folders {
             let robot = robot_name(folder);
             let trace = out.join(format!("{robot}.jsonl"));
-            let child = robot_command(folder, &world, &trace, 1)
+            let child = support::mqtt::robot_on(folder, &world, &trace, 1)
                 .args(["--transport", "mqtt"])
                 .stderr(Stdio::piped())
                 .spawn()
@@ -2141,6 +2142,7 @@ fn kill_and_restart(
     (kill_at, restart_at): (i64, i64),
     what: &str,
 ) -> KillRestart {
+    support::mqtt::compile_in(folders, scenario);
     let (t0, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let barrier = ["--start-at", start_at.as_str()];
@@ -2371,6 +2373,7 @@ fn a_leader_cut_off_from_the_broker_steps_down_before_another_is_elected() {
     let through_proxy = format!("mqtt://127.0.0.1:{}", proxy.port);
     const CUT_AT: i64 = 1200;
     const HEAL_AT: i64 = 3500;
+    support::mqtt::compile_in(&folders, &scenario);
     let (t0, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let lives: Vec<Started> = folders
@@ -2445,6 +2448,7 @@ fn highest_battery_over_mqtt_elects_the_fullest_robot() {
                        "tb_2": {"battery": [{"at": 0, "level": 60}]}}}"#,
     )
     .unwrap();
+    support::mqtt::compile_in(&folders, &scenario);
     let (_, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let traces = fleet.run_all(&folders, &scenario, "battery", &["--start-at", &start_at]);
@@ -2589,6 +2593,7 @@ fn group_sync_over_mqtt_waits_for_the_live_members() {
                        "tb_2": {"services": {"move": 1200}}}}"#,
     )
     .unwrap();
+    support::mqtt::compile_in(&folders, &scenario);
     let (t0, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let started: Vec<Started> = folders

@@ -329,6 +329,19 @@ fn build_takes_target_and_output_from_the_project_unless_given() {
     );
     write(&root.join("robots/rover.robot.xml"), ROVER);
     write(&root.join("m.mission"), ROVER_MISSION);
+    // A simulation compiles its scenario in: the command line's, else the
+    // mission's own beside it (as `semo simulate` chooses); without either
+    // the build says where it looked.
+    let build = semo_in(root, &["build", "m.mission"]);
+    assert_eq!(build.code, 2, "{}{}", build.stdout, build.stderr);
+    assert!(
+        build.stderr.contains(
+            "target linux-sim compiles a scenario into each robot (r): no scenario for m.mission: looked for m.scenario.json (name one with --scenario FILE)"
+        ),
+        "{}",
+        build.stderr
+    );
+    write(&root.join("m.scenario.json"), r#"{"duration": 2000}"#);
     let build = semo_in(root, &["build", "m.mission"]);
     assert_eq!(build.code, 0, "{}{}", build.stdout, build.stderr);
     assert!(
@@ -531,17 +544,9 @@ fn one_build_gives_each_robot_the_platform_its_type_names() {
         document["targets"],
         serde_json::json!(["linux", "cortex-m"])
     );
-    // `--sim`: each platform's simulation (cortex-m-sim compiles the
-    // scenario in, so it needs one).
-    let sim = semo_in(root, &["build", "--sim", "--format", "json"]);
-    assert_eq!(sim.code, 2, "{}{}", sim.stdout, sim.stderr);
-    assert!(
-        sim.stderr.contains(
-            "target cortex-m-sim compiles a scenario into each robot (ev): give --scenario FILE"
-        ),
-        "{}",
-        sim.stderr
-    );
+    // `--sim`: each platform's simulation (which compiles the scenario in,
+    // so it needs one: the fixture has one beside the mission, `fleet.scenario.json`,
+    // but it is named here as a user would).
     let sim = semo_in(
         root,
         &[
@@ -563,6 +568,7 @@ fn one_build_gives_each_robot_the_platform_its_type_names() {
         ]
     );
     assert!(out.join("Scouts/ev/scenario.c").is_file());
+    assert!(out.join("Base/a/scenario.c").is_file());
     assert!(runtime.join("semo_sim.c").is_file());
     // `--target` is every robot's, whatever the catalog says.
     let linux = semo_in(root, &["build", "--target", "linux", "--format", "json"]);
@@ -592,7 +598,11 @@ fn the_project_file_gives_a_team_or_a_robot_its_own_target() {
             "{project}\n[build]\ntarget = \"linux-sim\"\n\n[build.targets]\nScouts = \"linux\"\nev = \"cortex-m\"\na = \"linux\"\nScuots = \"linux\"\n"
         ),
     );
-    let built = semo_in(root, &["build", "--format", "json"]);
+    let scenario = ["--scenario", "fleet.scenario.json"];
+    let built = semo_in(
+        root,
+        &[&["build", "--format", "json"][..], &scenario].concat(),
+    );
     assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
     assert_eq!(
         planned(&built.stdout),
@@ -624,7 +634,7 @@ fn the_project_file_gives_a_team_or_a_robot_its_own_target() {
         "`[build.targets]` names `Scuots`, which is no team or robot of fleet.mission: its target is not used (did you mean `Scouts`?)"
     );
     // For people: on standard error, positioned in semo.toml.
-    let human = semo_in(root, &["build"]);
+    let human = semo_in(root, &[&["build"][..], &scenario].concat());
     assert_eq!(human.code, 0, "{}", human.stderr);
     assert!(
         human
@@ -651,7 +661,7 @@ fn the_project_file_gives_a_team_or_a_robot_its_own_target() {
         &format!("{written}\n[lints]\nW110 = \"deny\"\n"),
     );
     std::fs::remove_dir_all(root.join("out")).unwrap();
-    let denied = semo_in(root, &["build"]);
+    let denied = semo_in(root, &[&["build"][..], &scenario].concat());
     assert_eq!(denied.code, 1, "{}{}", denied.stdout, denied.stderr);
     assert!(
         denied

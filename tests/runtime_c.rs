@@ -130,22 +130,38 @@ struct Program {
     no_aslr: bool,
 }
 
-/// Builds once per flavor for the whole test process.
+/// Builds once per flavor for the whole test process, with a simulated
+/// world that has nothing in it (`tests/runtime_test_world.c`).
 fn program(flavor: Flavor) -> Program {
-    static BUILT: Mutex<Option<HashMap<String, Program>>> = Mutex::new(None);
+    built(flavor, false)
+}
+
+/// As [`program`], with robot irobot's world compiled in (what `semo build
+/// --scenario` writes: `tests/runtime_test_world.c` with
+/// `-DRUNTIME_TEST_WORLD`), for mode `sim`.
+fn program_with_world(flavor: Flavor) -> Program {
+    built(flavor, true)
+}
+
+fn built(flavor: Flavor, world: bool) -> Program {
+    static BUILT: Mutex<Option<HashMap<(String, bool), Program>>> = Mutex::new(None);
     let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
     let built = built.get_or_insert_with(HashMap::new);
-    if let Some(p) = built.get(&flavor.name()) {
+    if let Some(p) = built.get(&(flavor.name(), world)) {
         return p.clone();
     }
-    let p = compile(flavor);
-    built.insert(flavor.name(), p.clone());
+    let p = compile(flavor, world);
+    built.insert((flavor.name(), world), p.clone());
     p
 }
 
-fn compile(flavor: Flavor) -> Program {
+fn compile(flavor: Flavor, world: bool) -> Program {
     let dir = runtime_dir();
-    let exe = work_dir().join(format!("runtime_test-{}", flavor.name()));
+    let exe = work_dir().join(format!(
+        "runtime_test-{}{}",
+        flavor.name(),
+        if world { "-world" } else { "" }
+    ));
     // Built beside and renamed, so that a concurrent test run never sees half a file.
     let partial = exe.with_extension(format!("partial-{}", std::process::id()));
     let cc = match flavor {
@@ -154,8 +170,10 @@ fn compile(flavor: Flavor) -> Program {
     };
     let out = Command::new(cc)
         .args(flavor.flags())
+        .args(world.then_some("-DRUNTIME_TEST_WORLD"))
         .args([
             "tests/runtime_test.c",
+            "tests/runtime_test_world.c",
             "semo_core.c",
             "semo_runtime.c",
             "semo_udp.c",
@@ -328,10 +346,6 @@ fn read_trace(path: &Path, robot: &str) -> Vec<Value> {
 
 fn events<'a>(trace: &'a [Value], event: &str) -> Vec<&'a Value> {
     trace.iter().filter(|e| e["event"] == event).collect()
-}
-
-fn fixture(name: &str) -> String {
-    runtime_dir().join("tests").join(name).display().to_string()
 }
 
 // ------------------------------------------------------------------ tests
@@ -696,15 +710,9 @@ fn with_a_run_key_a_datagram_without_its_signature_is_refused() {
 #[test]
 fn simulation_feeds_scenario_sensors_and_operator_commands() {
     for flavor in flavors().into_iter().filter(|f| f.sim()) {
-        let p = program(flavor);
+        let p = program_with_world(flavor);
         let trace = trace_path("sim", flavor);
-        p.run_ok(&[
-            "sim",
-            "--trace",
-            trace.to_str().unwrap(),
-            "--scenario",
-            &fixture("scenario.json"),
-        ]);
+        p.run_ok(&["sim", "--trace", trace.to_str().unwrap()]);
         let trace = read_trace(&trace, "irobot");
         // The scenario's speed is the one the robot ran at.
         assert_eq!(trace[0]["time_scale"], "0.05", "{}", trace[0]);
@@ -823,41 +831,39 @@ fn duration_is_in_mission_time_and_the_command_line_beats_the_scenario() {
         let trace = read_trace(&trace, "solo");
         assert!(trace.last().unwrap()["t"].as_u64().unwrap() >= 100);
         if flavor.sim() {
-            // A scenario's speed and duration, then the command line's speed
-            // over them: the trace says which speed the robot ran at and how
-            // far its mission clock went (no wall clock is read here).
-            let ran = |name: &str, scenario: &str, extra: &[&str]| {
-                let file = work_dir().join(format!(
-                    "{name}-{}-{}.json",
-                    flavor.name(),
-                    std::process::id()
-                ));
-                std::fs::write(&file, scenario).unwrap();
+            // The compiled-in scenario's speed and duration (0.05, 20000 ms),
+            // each beaten by the command line's: the trace says which speed
+            // the robot ran at and how far its mission clock went (no wall
+            // clock is read here).
+            let p = program_with_world(flavor);
+            let ran = |name: &str, extra: &[&str]| {
                 let trace = trace_path(name, flavor);
                 let mut args = vec![
                     "minimal",
                     "--port-base",
                     &base,
-                    "--scenario",
-                    file.to_str().unwrap(),
                     "--trace",
                     trace.to_str().unwrap(),
                 ];
                 args.extend_from_slice(extra);
                 p.run_ok(&args);
-                let _ = std::fs::remove_file(&file);
                 read_trace(&trace, "solo")
             };
-            let fast = ran("fast", r#"{"time_scale": 0.01, "duration": 5000}"#, &[]);
-            assert_eq!(fast[0]["time_scale"], "0.01", "{}", fast[0]);
-            assert!(fast.last().unwrap()["t"].as_u64().unwrap() >= 5000);
-            let slow = ran(
-                "slow",
-                r#"{"time_scale": 1, "duration": 5000}"#,
-                &["--time-scale", "0.01"],
+            let scenario_s_speed = ran("scenario-speed", &["--duration", "5000"]);
+            assert_eq!(
+                scenario_s_speed[0]["time_scale"], "0.05",
+                "{}",
+                scenario_s_speed[0]
             );
-            assert_eq!(slow[0]["time_scale"], "0.01", "{}", slow[0]);
-            assert!(slow.last().unwrap()["t"].as_u64().unwrap() >= 5000);
+            let stop = |trace: &[Value]| trace.last().unwrap()["t"].as_u64().unwrap();
+            assert!((5000..20000).contains(&stop(&scenario_s_speed)));
+            let scenario_s_duration = ran("scenario-duration", &["--time-scale", "0.005"]);
+            assert_eq!(
+                scenario_s_duration[0]["time_scale"], "0.005",
+                "{}",
+                scenario_s_duration[0]
+            );
+            assert!(stop(&scenario_s_duration) >= 20000);
         }
     }
 }
@@ -938,7 +944,7 @@ fn bad_command_lines_are_refused_with_usage() {
     refused(
         &["minimal", "--scenario", "s.json"],
         &[],
-        "needs a simulation build",
+        "build it with `semo build --sim --scenario FILE`",
     );
     let help = p.run(&["minimal", "--help"], &[]);
     assert_eq!(help.code, 0);
@@ -965,131 +971,24 @@ fn bad_command_lines_are_refused_with_usage() {
     );
 }
 
+/// No program reads a scenario file: the scenario is compiled in (`semo
+/// build --scenario FILE`, whose reader's mistakes are the simulator's:
+/// `compiler/src/sim/tests.rs`), and a simulated program given one says
+/// how to build it instead.
 #[test]
-fn bad_scenarios_are_refused_with_line_and_column() {
-    let cases: &[(&str, &str)] = &[
-        (
-            "{\n  \"robots\": {\n    \"irobot\": [1,]\n  }\n}",
-            "3:18: unexpected character (expected a value)",
-        ),
-        ("{\"robots\": {}", "1:14: expected ',' or '}'"),
-        (
-            "{\"robots\": {}} x",
-            "1:16: unexpected text after the scenario object",
-        ),
-        (
-            "{\"time_scale\": 0}",
-            "1:16: \"time_scale\" must be a positive number",
-        ),
-        (
-            "{\"duration\": 1.5}",
-            "1:14: \"duration\" must be a whole number of milliseconds",
-        ),
-        (
-            "{\"robot\": {}}",
-            "1:11: unknown key \"robot\" in the scenario",
-        ),
-        (
-            "{\"robots\": {\"a\": 1, \"a\": 2}}",
-            "1:21: duplicate key \"a\"",
-        ),
-        (
-            "{\"robots\": {\"someone\": {\"sensors\": [{\"at\": 0, \"value\": \"X\"}]}}}",
-            "1:37: missing \"is\"",
-        ),
-        (
-            "{\"operator\": [{\"at\": 1, \"every\": 2, \"to\": \"a\", \"value\": \"V\", \"is\": \"x\"}]}",
-            "1:15: an operator command needs either \"at\" or \"every\"",
-        ),
-        (
-            "{\"operator\": [{\"every\": 0, \"to\": \"a\", \"value\": \"V\", \"is\": \"x\"}]}",
-            "1:25: \"every\" must be a whole number of milliseconds above 0",
-        ),
-        ("{\"a\": \"\\ud800\"}", "unpaired surrogate"),
-        ("{\"a\": \"tab\there\"}", "control character in a string"),
-        (
-            "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]",
-            "nesting deeper than 32",
-        ),
-        ("", "1:1: unexpected end of file"),
-        ("{\"n\": 01}", "1:8: expected ',' or '}'"),
-        // Battery levels and faults, read by linux-sim as by the simulator.
-        (
-            "{\"robots\": {\"x\": {\"battery\": [{\"at\": 5, \"level\": 1}, {\"at\": 5, \"level\": 2}]}}}",
-            "1:61: battery levels must be in time order",
-        ),
-        (
-            "{\"robots\": {\"x\": {\"battery\": [{\"at\": 0, \"level\": \"full\"}]}}}",
-            "1:50: \"level\" must be a number",
-        ),
-        (
-            "{\"robots\": {\"x\": {\"battery\": [{\"at\": 0, \"level\": 1e300}]}}}",
-            "1:50: \"level\" must be between -1e15 and 1e15",
-        ),
-        (
-            "{\"faults\": [{\"at\": 1}]}",
-            "1:13: a fault is exactly one of \"kill\", \"restart\", \"drop\", \"delay\", \"partition\"",
-        ),
-        (
-            "{\"faults\": [{\"from\": 5, \"until\": 5, \"drop\": [\"solo\", \"solo\"]}]}",
-            "1:34: \"until\" must be after \"from\"",
-        ),
-        (
-            "{\"faults\": [{\"from\": 1, \"until\": 5, \"delay\": [\"solo\"], \"by\": 3}]}",
-            "1:46: \"delay\" must name two robots",
-        ),
-        (
-            "{\"faults\": [{\"from\": 1, \"until\": 5, \"partition\": [[\"solo\", 7]]}]}",
-            "1:60: \"partition\" must be a non-empty string",
-        ),
-    ];
+fn a_simulated_program_given_a_scenario_says_to_compile_it_in() {
     for flavor in flavors().into_iter().filter(|f| f.sim()) {
         let p = program(flavor);
-        for (i, (text, says)) in cases.iter().enumerate() {
-            let path = work_dir().join(format!(
-                "bad-{i}-{}-{}.json",
-                flavor.name(),
-                std::process::id()
-            ));
-            std::fs::write(&path, text).unwrap();
-            let run = p.run(&["minimal", "--scenario", path.to_str().unwrap()], &[]);
-            let _ = std::fs::remove_file(&path);
-            assert_eq!(run.code, 2, "{text}: {}", run.stderr);
-            let expected = format!("scenario {}:", path.display());
-            assert!(
-                run.stderr.starts_with(&expected) && run.stderr.contains(says),
-                "{text}\nexpected {says:?} in:\n{}",
-                run.stderr
-            );
+        for args in [
+            &["minimal", "--scenario", "s.json"][..],
+            &["minimal", "--scenario=s.json"],
+        ] {
+            let run = p.run(args, &[]);
+            assert_eq!(run.code, 2, "{args:?}: {}", run.stderr);
             assert_eq!(
-                run.stderr.lines().count(),
-                1,
-                "one clear line: {}",
-                run.stderr
+                run.stderr.trim(),
+                "minimal: --scenario is not read at run time: a simulation's scenario is compiled into the program; build it with `semo build --sim --scenario FILE`",
             );
         }
-        let missing = p.run(&["minimal", "--scenario", "/nonexistent.json"], &[]);
-        assert_eq!(missing.code, 2);
-        assert!(missing.stderr.contains("cannot read"), "{}", missing.stderr);
-    }
-}
-
-/// A robot knows only its peers (the robots it sends to or hears from), so
-/// faults naming a robot it does not know are for others: it reads them and
-/// runs (whether the name is in the mission is `semo simulate`'s check, with
-/// the whole fleet: `tests/simulate.rs`).
-#[test]
-fn faults_naming_a_robot_the_program_does_not_know_are_for_others() {
-    let text = "{\"duration\": 50, \"faults\": [{\"at\": 1, \"kill\": \"stranger\"}, {\"from\": 1, \"until\": 5, \"drop\": [\"solo\", \"stranger\"]}, {\"from\": 1, \"until\": 5, \"partition\": [[\"stranger\"], [\"solo\"]]}]}";
-    for flavor in flavors().into_iter().filter(|f| f.sim()) {
-        let p = program(flavor);
-        let path = work_dir().join(format!(
-            "strangers-{}-{}.json",
-            flavor.name(),
-            std::process::id()
-        ));
-        std::fs::write(&path, text).unwrap();
-        p.run_ok(&["minimal", "--scenario", path.to_str().unwrap()]);
-        let _ = std::fs::remove_file(&path);
     }
 }

@@ -170,7 +170,8 @@ fn trace_lines_name_each_key_once() {
 fn robots_without_values_and_shared_getters_compile_pedantically() {
     for target in ["linux", "linux-sim"] {
         let out = scratch(&format!("semantics/pedantic-{target}"));
-        let built = build(&fixture("no_values_shared_getter.mission"), target, &out);
+        let built =
+            support::robots::build_for(&fixture("no_values_shared_getter.mission"), target, &out);
         assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
         let control = std::fs::read_to_string(out.join("Counter/nxt/control_task.c")).unwrap();
         assert!(control.contains("LIBCALL(shared, CounterShared_get_Counter_TICKS, )"));

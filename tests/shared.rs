@@ -24,6 +24,7 @@ fn run_killing(fleet: &mut Fleet, folder: &str, victim: &str) -> Vec<(String, Ve
     let dir = repo_root().join("tests/fixtures").join(folder);
     let folders = support::mqtt::build(&dir.join("shared.mission"), &fleet.out, &[]);
     let scenario = dir.join("shared.scenario.json");
+    support::mqtt::compile_in(&folders, &scenario);
     let (t0, start_at) = support::robots::start_barrier(folders.len());
     let start_at = start_at.to_string();
     let started: Vec<_> = ["a", "b", "c"]
@@ -129,7 +130,7 @@ fn the_shared_library_compiles_with_gcc_and_clang() {
             .join("shared.mission");
         for cc in support::robots::compilers() {
             let out = support::robots::scratch(&format!("{fixture}-compile-{target}-{cc}"));
-            let built = support::robots::build(&mission, target, &out);
+            let built = support::robots::build_for(&mission, target, &out);
             assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
             for folder in robot_folders(&out) {
                 let library = folder.join("lib_ScoutsShared.c");

@@ -46,17 +46,6 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         Ok(found) => found,
         Err(code) => return code,
     };
-    // Read before anything else, so that a wrong file stops the build
-    // before the output folder is touched (`-`: standard input).
-    let scenario = match &options.scenario {
-        None => None,
-        Some(path) => match input::read(path) {
-            Some((name, text)) if input::is_kind(&name, &text, Content::Scenario, BUILD) => {
-                Some((name, text))
-            }
-            _ => return 2,
-        },
-    };
     let (mut run, mission) = match super::defaults::load(&mission_file, &options.strategy) {
         Ok(loaded) => loaded,
         Err(code) => return code,
@@ -83,24 +72,51 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         .iter()
         .filter(|r| r.chosen.target.needs_scenario())
         .collect();
-    if options.scenario.is_some() == compiled_in.is_empty() {
+    if options.scenario.is_some() && compiled_in.is_empty() {
         eprintln!(
-            "error: {}",
-            if compiled_in.is_empty() {
-                format!(
-                    "--scenario is compiled in only for target cortex-m-sim, and no robot of this build is built for it (target {} reads a scenario at run time, if at all)",
-                    names(&targets)
-                )
-            } else {
-                let robots: Vec<&str> = compiled_in.iter().map(|r| r.robot.as_str()).collect();
-                format!(
-                    "target cortex-m-sim compiles a scenario into each robot ({}): give --scenario FILE",
-                    robots.join(", ")
-                )
-            }
+            "error: --scenario is compiled into simulations only (targets linux-sim, cortex-m-sim, or --sim), and no robot of this build is built for one (target {})",
+            names(&targets)
         );
         return 2;
     }
+    // A simulation's scenario: the command line's, else the mission's own
+    // (`<mission>.scenario.json`, as `semo simulate` and the editor choose).
+    let scenario_path = match (&options.scenario, compiled_in.is_empty()) {
+        (_, true) => None,
+        (Some(path), false) => Some(path.clone()),
+        (None, false) => match super::defaults::scenario(&mission_file) {
+            Ok(path) => Some(path),
+            Err(no) => {
+                let robots: Vec<&str> = compiled_in.iter().map(|r| r.robot.as_str()).collect();
+                let mut sims: Vec<&str> =
+                    compiled_in.iter().map(|r| r.chosen.target.name()).collect();
+                sims.sort_unstable();
+                sims.dedup();
+                let (targets, compile) = match sims.len() {
+                    1 => ("target", "compiles"),
+                    _ => ("targets", "compile"),
+                };
+                eprintln!(
+                    "error: {targets} {} {compile} a scenario into each robot ({}): {}",
+                    sims.join(", "),
+                    robots.join(", "),
+                    no.message
+                );
+                return 2;
+            }
+        },
+    };
+    // Read before anything is written, so that a wrong file stops the
+    // build before the output folder is touched (`-`: standard input).
+    let scenario = match &scenario_path {
+        None => None,
+        Some(path) => match input::read(path) {
+            Some((name, text)) if input::is_kind(&name, &text, Content::Scenario, BUILD) => {
+                Some((name, text))
+            }
+            _ => return 2,
+        },
+    };
     // The deployment file: the command line's, else the project file's.
     let deploy_path = plan.deployment.clone();
     let deployment = match &deploy_path {

@@ -129,9 +129,6 @@ pub fn scenario(mission: &Path) -> Result<PathBuf, NoChoice> {
         .unwrap_or_default();
     let stem = name.strip_suffix(".mission").unwrap_or(name);
     let own = mission.with_file_name(format!("{stem}.scenario.json"));
-    if own.is_file() {
-        return Ok(own);
-    }
     let folder = mission
         .parent()
         .filter(|f| !f.as_os_str().is_empty())
@@ -140,16 +137,8 @@ pub fn scenario(mission: &Path) -> Result<PathBuf, NoChoice> {
         folder: folder.to_path_buf(),
         message,
     };
-    let entries =
-        std::fs::read_dir(folder).map_err(|e| no_choice(format!("{}: {e}", folder.display())))?;
-    let mut named: Vec<PathBuf> = entries
-        .filter_map(|entry| Some(mission.with_file_name(entry.ok()?.file_name())))
-        .filter(|path| {
-            semo::sim::complete::is_scenario(path)
-                && semo::sim::complete::mission_for(path).as_deref() == Some(mission)
-        })
-        .collect();
-    named.sort();
+    let named = semo::sim::complete::scenarios_of(mission)
+        .map_err(|e| no_choice(format!("{}: {e}", folder.display())))?;
     match named.as_slice() {
         [one] => Ok(one.clone()),
         [] => Err(no_choice(format!(

@@ -43,7 +43,6 @@ pub enum ProcessFault {
 pub struct Run<'a> {
     /// In peer order (the programs' peer tables).
     pub robots: &'a [Robot],
-    pub scenario: &'a Path,
     /// (at, peer, fault), in time order.
     pub faults: Vec<(i64, usize, ProcessFault)>,
     /// The link from one peer to another: its latency (mission ms) and
@@ -276,8 +275,6 @@ impl<'r, 'a> Coordinator<'r, 'a> {
         )
         .map_err(|e| format!("{}: {e}", self.run.work.display()))?;
         let mut child = Command::new(&robot.exe)
-            .arg("--scenario")
-            .arg(self.run.scenario)
             .arg("--trace")
             .arg(trace_path(self.run.work, robot, incarnation))
             .arg("--lockstep")
@@ -547,7 +544,6 @@ pub fn simulate(
     input: &semo::refine::BuildInput<'_>,
     refined: semo::refine::Refined,
     scenario: &semo::sim::scenario::Scenario,
-    scenario_text: &str,
     until_ms: i64,
     seed: u64,
 ) -> Result<Vec<(String, String)>, String> {
@@ -558,12 +554,19 @@ pub fn simulate(
         .iter()
         .map(|p| (p.robot.clone(), p.self_peer))
         .collect();
+    // Each program gets its robot's world compiled in: the scenario is
+    // read once, here, by the simulator's reader.
+    let worlds: Vec<_> = refined
+        .programs
+        .iter()
+        .map(|p| scenario.compiled_for(p))
+        .collect();
     let built = semo::codegen::build_refined(
         input,
         refined,
         semo::codegen::Target::LinuxSim,
         semo::codegen::Emit::All,
-        &[],
+        &worlds,
     );
     if built.refused() {
         let why: Vec<String> = built
@@ -581,9 +584,6 @@ pub fn simulate(
         .prefix("semo-lockstep-")
         .tempdir()
         .map_err(|e| format!("cannot make a work folder: {e}"))?;
-    let scenario_path = work.path().join("scenario.json");
-    std::fs::write(&scenario_path, scenario_text)
-        .map_err(|e| format!("{}: {e}", scenario_path.display()))?;
     let runtime = work.path().join(semo::codegen::RUNTIME_FOLDER);
     write_files(&runtime, &built.runtime)?;
     let mut robots: Vec<Option<Robot>> = peers.iter().map(|_| None).collect();
@@ -634,7 +634,6 @@ pub fn simulate(
     };
     let traces = run(&Run {
         robots: &robots,
-        scenario: &scenario_path,
         faults,
         link: &link,
         seed,

@@ -155,7 +155,7 @@ enum Command {
         out: Option<PathBuf>,
         /// Every robot's target: `linux` (POSIX threads; you fill the task
         /// files), `linux-sim` (sensors, actuators and the operator
-        /// simulated from a scenario file given at run time), `cortex-m`
+        /// simulated from the --scenario compiled in), `cortex-m`
         /// (bare-metal TI Stellaris LM3S6965, a static schedule; you fill
         /// the task files) or `cortex-m-sim` (the same with --scenario
         /// compiled in, for QEMU). Default: each robot's own, from the
@@ -170,9 +170,9 @@ enum Command {
         #[arg(long)]
         sim: bool,
         /// The scenario (`*.scenario.json`; `-`: standard input) compiled
-        /// into each robot built for `cortex-m-sim` (`--target
-        /// cortex-m-sim`, or `--sim` with a cortex-m robot): needed by, and
-        /// only by, such a build.
+        /// into each robot built for a simulation (`--target linux-sim`,
+        /// `--target cortex-m-sim`, or `--sim`): needed by, and only by,
+        /// such a build; the programs read no scenario file.
         #[arg(long)]
         scenario: Option<PathBuf>,
         /// `all` (C code, Makefile and task graph) or `taskgraph` (only the

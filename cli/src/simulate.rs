@@ -115,14 +115,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         return 2;
     };
     if options.engine == Engine::C {
-        return run_generated(
-            &options,
-            &build.input(),
-            refined,
-            &scenario,
-            &scenario_text,
-            out,
-        );
+        return run_generated(&options, &build.input(), refined, &scenario, out);
     }
     let programs = refined.programs;
     let robots = sim::Run::robots_of(&programs);
@@ -363,7 +356,6 @@ fn run_generated(
     input: &semo::refine::BuildInput<'_>,
     refined: semo::refine::Refined,
     scenario: &scenario::Scenario,
-    scenario_text: &str,
     out: &mut impl Write,
 ) -> i32 {
     if options.json || options.svg.is_some() || options.mcap.is_some() {
@@ -379,14 +371,7 @@ fn run_generated(
         .until_ms
         .or(scenario.duration_ms)
         .unwrap_or(sim::DEFAULT_UNTIL_MS);
-    let robots = match super::lockstep::simulate(
-        input,
-        refined,
-        scenario,
-        scenario_text,
-        until_ms,
-        options.seed,
-    ) {
+    let robots = match super::lockstep::simulate(input, refined, scenario, until_ms, options.seed) {
         Ok(robots) => robots,
         Err(e) => {
             eprintln!("error: {e}");

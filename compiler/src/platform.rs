@@ -10,8 +10,9 @@
 //!
 //! A [`Target`] is a platform or its simulation: `linux` and `linux-sim`,
 //! `cortex-m` and `cortex-m-sim`. The simulation is the same program with
-//! sensors, services and the operator taken from a scenario and a trace
-//! written (`semo build --sim` picks it for every robot's platform).
+//! sensors, services and the operator taken from a scenario compiled in
+//! (`semo build --scenario FILE`) and a trace written (`semo build --sim`
+//! picks it for every robot's platform).
 
 /// How a platform runs a robot's tasks: the runtime's platform layer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -297,9 +298,11 @@ impl Target {
             .chain(board.map(|b| b.link_script))
     }
 
-    /// The scenario is compiled into the program (`semo build --scenario`).
+    /// The scenario is compiled into the program (`semo build --scenario`):
+    /// every simulation, on either runtime (no program reads a scenario
+    /// file).
     pub fn needs_scenario(self) -> bool {
-        self.simulated() && self.layer() == Layer::Static
+        self.simulated()
     }
 }
 

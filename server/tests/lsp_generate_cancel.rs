@@ -79,6 +79,8 @@ async fn a_cancelled_generation_leaves_the_output_folder_as_it_was() {
     for file in ["scouting.mission", "MasterTeam.strategy.xml"] {
         std::fs::copy(example(&format!("scouting/{file}")), ws.join(file)).unwrap();
     }
+    // What a simulation compiles in (`linux-sim` needs a scenario).
+    std::fs::write(ws.join("quiet.scenario.json"), r#"{"duration": 2000}"#).unwrap();
     let socket = dir.join("pause");
     // Every generation pauses after its first file operation (the first
     // file staged for its first robot).
@@ -100,7 +102,11 @@ async fn a_cancelled_generation_leaves_the_output_folder_as_it_was() {
     let generate = |target: &str| {
         json!({
             "command": "semo.generateCode",
-            "arguments": [{ "uri": mission_uri, "target": target }],
+            "arguments": [if target.ends_with("-sim") {
+                json!({ "uri": mission_uri, "target": target, "scenario": "quiet.scenario.json" })
+            } else {
+                json!({ "uri": mission_uri, "target": target })
+            }],
         })
     };
     // A first generation, let through.

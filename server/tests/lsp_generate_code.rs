@@ -93,17 +93,68 @@ async fn generate_code_writes_every_robot_with_progress() {
     let dir = scouting_workspace("generate");
     let capabilities = json!({ "window": { "workDoneProgress": true } });
     let (mut client, mission_uri, _) = started(&dir, capabilities).await;
+    // A simulation compiles its scenario in: the request's, else the
+    // mission's own beside it (as `semo build`); without either the request
+    // fails saying where to put one; a scenario's mistake is the request's
+    // error, positioned.
+    let generate = |scenario: Option<&str>| {
+        let mut arguments =
+            json!({ "uri": mission_uri, "outputFolder": "gen", "target": "linux-sim" });
+        if let Some(scenario) = scenario {
+            arguments["scenario"] = scenario.into();
+        }
+        json!({ "command": "semo.generateCode", "arguments": [arguments] })
+    };
+    let refused = client
+        .request("workspace/executeCommand", generate(None))
+        .await
+        .unwrap_err();
+    assert!(
+        refused["message"]
+            .as_str()
+            .unwrap()
+            .contains("scouting.scenario.json beside the mission"),
+        "{refused}"
+    );
+    assert!(!dir.join("gen").exists());
+    std::fs::write(
+        dir.join("bad.scenario.json"),
+        "{\n  \"robots\": {\"robot9\": {}}\n}",
+    )
+    .unwrap();
+    let bad = client
+        .request(
+            "workspace/executeCommand",
+            generate(Some("bad.scenario.json")),
+        )
+        .await
+        .unwrap_err();
+    assert!(
+        bad["message"]
+            .as_str()
+            .unwrap()
+            .ends_with("bad.scenario.json:2:24: robot \"robot9\" is not in the mission (robots: irobot, ti, nxt) (did you mean \"irobot\"?)"),
+        "{bad}"
+    );
+    std::fs::write(dir.join("s.scenario.json"), r#"{"duration": 2000}"#).unwrap();
     let result = client
         .request(
             "workspace/executeCommand",
-            json!({
-                "command": "semo.generateCode",
-                "arguments": [{ "uri": mission_uri, "outputFolder": "gen", "target": "linux-sim" }],
-            }),
+            generate(Some("s.scenario.json")),
         )
         .await
         .unwrap();
     assert_eq!(result["refused"], false, "{result}");
+    assert!(dir.join("gen/MasterTeam/irobot/scenario.c").is_file());
+    // The mission's own scenario, when the request names none.
+    std::fs::write(dir.join("scouting.scenario.json"), r#"{"duration": 3000}"#).unwrap();
+    let own = client
+        .request("workspace/executeCommand", generate(None))
+        .await
+        .unwrap();
+    assert_eq!(own["refused"], false, "{own}");
+    let compiled = std::fs::read_to_string(dir.join("gen/MasterTeam/irobot/scenario.c")).unwrap();
+    assert!(compiled.contains("3000"), "{compiled}");
     let robots: Vec<String> = result["robots"]
         .as_array()
         .unwrap()

@@ -142,7 +142,9 @@ async fn a_target_switch_over_an_edited_task_file_is_refused_unless_forced() {
     client.request(method, params).await.unwrap();
     let task = ws.join("out/Team1/create1/tasks/follow.c");
     std::fs::write(&task, "/* mine */\n").unwrap();
-    let sim = json!({ "uri": mission_uri, "target": "linux-sim" });
+    std::fs::write(ws.join("quiet.scenario.json"), r#"{"duration": 2000}"#).unwrap();
+    let sim =
+        json!({ "uri": mission_uri, "target": "linux-sim", "scenario": "quiet.scenario.json" });
     let (method, params) = generate(sim.clone());
     let refused = client.request(method, params).await.unwrap_err();
     let text = message(&refused);

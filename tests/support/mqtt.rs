@@ -1,7 +1,9 @@
 //! The MQTT tests' set-up, once: a private `mosquitto` broker on a free
 //! loopback port (its configuration, persistence and log in a temp folder),
 //! robots built for `linux-sim` with the MQTT transport compiled in, and
-//! their processes (killed when the test ends, whatever happens).
+//! their processes (killed when the test ends, whatever happens). A robot
+//! run on a scenario has it compiled in first, as a user does (`semo build
+//! --scenario FILE`, then `make`): [`robot_on`].
 //!
 //! Needs `mosquitto` and `libmosquitto-dev` (Debian). [`Fleet::start`] and
 //! [`broker_or_skip`] skip a test with a message when the broker is missing,
@@ -9,8 +11,28 @@
 
 use super::robots::{Event, PEDANTIC, events, robot_command, robot_folders, scratch};
 use super::{repo_root, semo_in};
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
+use std::sync::Mutex;
+
+/// How an output folder's robots were built ([`build_with`]) and the
+/// scenario compiled into them, so that [`robot_on`] builds them again with
+/// another one.
+struct Built {
+    mission: PathBuf,
+    extra: Vec<String>,
+    cc: String,
+    cflags: String,
+    /// The text of the scenario compiled in.
+    scenario: String,
+}
+
+static BUILT: Mutex<Option<HashMap<PathBuf, Built>>> = Mutex::new(None);
+
+/// The scenario a fleet is first built with: nothing happens for two
+/// seconds (any mission runs on it).
+const QUIET_SCENARIO: &str = r#"{"duration": 2000}"#;
 
 /// The `mosquitto` binary (Debian puts it in /usr/sbin, often not on PATH).
 pub fn mosquitto() -> Option<PathBuf> {
@@ -118,9 +140,11 @@ pub fn start_broker_with(
     index
 }
 
-/// `semo build MISSION --target linux-sim -o OUT EXTRA...`, each robot made
-/// with the MQTT transport built in (`make TRANSPORT=mqtt`) with `cc` and
-/// `cflags` (warnings are errors: any warning fails). The robot folders.
+/// `semo build MISSION --target linux-sim --scenario S -o OUT EXTRA...`,
+/// each robot made with the MQTT transport built in (`make TRANSPORT=mqtt`)
+/// with `cc` and `cflags` (warnings are errors: any warning fails); `S` is
+/// a scenario in which nothing happens for two seconds, until a robot is
+/// run on another ([`robot_on`]). The robot folders.
 pub fn build_with(
     mission: &Path,
     out: &Path,
@@ -128,26 +152,54 @@ pub fn build_with(
     cc: &str,
     cflags: &str,
 ) -> Vec<PathBuf> {
-    let (mission, out_arg) = (mission.display().to_string(), out.display().to_string());
+    let built = Built {
+        mission: mission.to_path_buf(),
+        extra: extra.iter().map(|s| s.to_string()).collect(),
+        cc: cc.to_string(),
+        cflags: cflags.to_string(),
+        scenario: QUIET_SCENARIO.to_string(),
+    };
+    let folders = compile(out, &built);
+    BUILT
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .get_or_insert_with(HashMap::new)
+        .insert(out.to_path_buf(), built);
+    folders
+}
+
+/// Builds and makes `out` as `built` says (its scenario written beside
+/// `out`); the robot folders.
+fn compile(out: &Path, built: &Built) -> Vec<PathBuf> {
+    std::fs::create_dir_all(out).unwrap();
+    let scenario = out.with_extension("compiled.scenario.json");
+    std::fs::write(&scenario, &built.scenario).unwrap();
+    let (mission, out_arg) = (
+        built.mission.display().to_string(),
+        out.display().to_string(),
+    );
+    let scenario_arg = scenario.display().to_string();
     let mut args = vec![
         "build",
         mission.as_str(),
         "--target",
         "linux-sim",
+        "--scenario",
+        scenario_arg.as_str(),
         "-o",
         out_arg.as_str(),
     ];
-    args.extend_from_slice(extra);
-    let built = semo_in(&repo_root(), &args);
-    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    args.extend(built.extra.iter().map(String::as_str));
+    let result = semo_in(&repo_root(), &args);
+    assert_eq!(result.code, 0, "{}{}", result.stdout, result.stderr);
     let folders = robot_folders(out);
     for folder in &folders {
         let made = Command::new("make")
             .args([
                 "-s",
                 "-j2",
-                &format!("CC={cc}"),
-                &format!("CFLAGS={cflags}"),
+                &format!("CC={}", built.cc),
+                &format!("CFLAGS={}", built.cflags),
                 "TRANSPORT=mqtt",
             ])
             .current_dir(folder)
@@ -156,11 +208,45 @@ pub fn build_with(
         let stderr = String::from_utf8_lossy(&made.stderr);
         assert!(
             made.status.success() && !stderr.contains("warning"),
-            "{} ({cc} {cflags}): {stderr}",
-            folder.display()
+            "{} ({} {}): {stderr}",
+            folder.display(),
+            built.cc,
+            built.cflags
         );
     }
     folders
+}
+
+/// Compiles `scenario` into the robots of `folders` (one output folder
+/// [`build_with`] wrote): built and made again unless it is the one in them
+/// already. Before a start barrier, so that the robots start on time.
+pub fn compile_in(folders: &[PathBuf], scenario: &Path) {
+    let Some(folder) = folders.first() else {
+        return;
+    };
+    let out = folder
+        .parent()
+        .and_then(Path::parent)
+        .expect("a robot folder is <out>/<team>/<robot>");
+    let text =
+        std::fs::read_to_string(scenario).unwrap_or_else(|e| panic!("{}: {e}", scenario.display()));
+    let mut all = BUILT.lock().unwrap_or_else(|e| e.into_inner());
+    let built = all
+        .get_or_insert_with(HashMap::new)
+        .get_mut(out)
+        .unwrap_or_else(|| panic!("{} was not built by build_with", out.display()));
+    if built.scenario != text {
+        built.scenario = text;
+        compile(out, built);
+    }
+}
+
+/// The program of a robot folder [`build_with`] wrote, with `scenario`
+/// compiled in ([`compile_in`]), set to write its trace to `trace` on the
+/// ports from `port_base`.
+pub fn robot_on(folder: &Path, scenario: &Path, trace: &Path, port_base: u32) -> Command {
+    compile_in(std::slice::from_ref(&folder.to_path_buf()), scenario);
+    robot_command(folder, trace, port_base)
 }
 
 /// [`build_with`] gcc at `-Wpedantic -Werror`.
@@ -292,7 +378,7 @@ impl Fleet {
     ) -> Started {
         let robot = robot_name(folder);
         let trace = self.out.join(format!("{robot}.{tag}.jsonl"));
-        let child = robot_command(folder, scenario, &trace, 1)
+        let child = robot_on(folder, scenario, &trace, 1)
             .args(self.transport_args())
             .args(extra)
             .envs(env.iter().copied())

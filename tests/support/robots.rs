@@ -21,13 +21,36 @@ pub fn scratch(name: &str) -> PathBuf {
     dir
 }
 
-/// `semo build MISSION --target TARGET -o OUT`, run from the repository root.
+/// `semo build MISSION --target TARGET -o OUT`, run from the repository
+/// root; a simulation target (`linux-sim`, `cortex-m-sim`) needs
+/// [`build_sim`].
 pub fn build(mission: &Path, target: &str, out: &Path) -> Output {
     let out_arg = out.display().to_string();
     let mission_arg = mission.display().to_string();
     semo_in(
         &repo_root(),
         &["build", &mission_arg, "--target", target, "-o", &out_arg],
+    )
+}
+
+/// `semo build MISSION --target TARGET --scenario SCENARIO -o OUT`: a
+/// simulation with the scenario compiled in.
+pub fn build_sim(mission: &Path, target: &str, scenario: &Path, out: &Path) -> Output {
+    let out_arg = out.display().to_string();
+    let mission_arg = mission.display().to_string();
+    let scenario_arg = scenario.display().to_string();
+    semo_in(
+        &repo_root(),
+        &[
+            "build",
+            &mission_arg,
+            "--target",
+            target,
+            "--scenario",
+            &scenario_arg,
+            "-o",
+            &out_arg,
+        ],
     )
 }
 
@@ -80,13 +103,24 @@ pub fn make(folder: &Path, cc: &str, cflags: &str) -> Result<(), String> {
     }
 }
 
-/// The `linux-sim` program of a robot folder, set to run `scenario` and write
-/// its trace to `trace`, on the ports from `port_base`.
-pub fn robot_command(folder: &Path, scenario: &Path, trace: &Path, port_base: u32) -> Command {
+/// A build for `target`; a simulation with a scenario in which nothing
+/// happens for two seconds (any mission runs on it), written beside `out`.
+pub fn build_for(mission: &Path, target: &str, out: &Path) -> Output {
+    if !target.ends_with("-sim") {
+        return build(mission, target, out);
+    }
+    std::fs::create_dir_all(out).unwrap();
+    let scenario = out.with_extension("quiet.scenario.json");
+    std::fs::write(&scenario, r#"{"duration": 2000}"#).unwrap();
+    build_sim(mission, target, &scenario, out)
+}
+
+/// The `linux-sim` program of a robot folder (its scenario compiled in),
+/// set to write its trace to `trace`, on the ports from `port_base`.
+pub fn robot_command(folder: &Path, trace: &Path, port_base: u32) -> Command {
     let robot = folder.file_name().expect("a robot folder").to_owned();
     let mut command = Command::new(folder.join(robot));
     command
-        .args(["--scenario", &scenario.display().to_string()])
         .args(["--trace", &trace.display().to_string()])
         .args(["--port-base", &port_base.to_string()]);
     command
@@ -131,13 +165,14 @@ pub fn run_in_simulation(
     out: &Path,
     scenario: &str,
 ) -> BTreeMap<String, Vec<String>> {
-    let built = build(mission, "linux-sim", out);
+    std::fs::create_dir_all(out).unwrap();
+    let scenario_path = out.join("scenario.json");
+    std::fs::write(&scenario_path, scenario).unwrap();
+    let built = build_sim(mission, "linux-sim", &scenario_path, out);
     assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
     for folder in &robot_folders(out) {
         make(folder, "gcc", PEDANTIC).unwrap_or_else(|e| panic!("{e}"));
     }
-    let scenario_path = out.join("scenario.json");
-    std::fs::write(&scenario_path, scenario).unwrap();
     let run = super::simulate_trace_with(mission, &scenario_path, "c", PEDANTIC);
     assert!(run.code <= 1, "{}{}", run.stdout, run.stderr);
     let mut traces: BTreeMap<String, Vec<String>> = robot_folders(out)

@@ -21,6 +21,21 @@ pub fn string(text: &str) -> String {
     out
 }
 
+/// A C `double` literal that reads back as `x` exactly (Rust's shortest
+/// round-trip spelling: `0.01`, `1e-6`, `100.0`, all C). The scenario's
+/// numbers are finite (its reader refuses others); a non-finite one is
+/// written as `<math.h>`'s name, which the file does not include, so that
+/// it fails to compile rather than reading as another number.
+pub fn real(x: f64) -> String {
+    if x.is_nan() {
+        "NAN".into()
+    } else if x.is_infinite() {
+        if x > 0.0 { "INFINITY" } else { "-INFINITY" }.into()
+    } else {
+        format!("{x:?}")
+    }
+}
+
 /// Text safe inside a `/* */` comment on one line: no line breaks or other
 /// control characters, no backslash (a line splice before the comment's end),
 /// and no `*/`, `/*` or `??` however the pieces meet (one pass, so no
@@ -70,6 +85,19 @@ pub fn lock(target: Target, name: &str) -> (&'static str, String, String, String
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn reals_are_c_literals_that_read_back_exactly() {
+        for x in [0.01, 1e-6, 100.0, -5.5, 1e15, 1e16, 0.1 + 0.2, 1e6] {
+            let written = real(x);
+            assert!(
+                written.contains('.') || written.contains('e'),
+                "{written}: a double, not an int"
+            );
+            assert_eq!(written.parse::<f64>(), Ok(x));
+        }
+        assert_eq!(real(f64::NAN), "NAN");
+    }
 
     #[test]
     fn strings_are_escaped() {

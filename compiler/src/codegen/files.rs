@@ -57,7 +57,8 @@ const PROGRAM_DESC: Template = template!(
         "robot_count",
         "schedule",
         "words",
-        "deploy"
+        "deploy",
+        "sim"
     ]
 );
 /// `comm_task.c`'s parts: sending, heartbeats, sync points, events, receiving.
@@ -175,7 +176,9 @@ const SCENARIO_TABLES: Template = template!(
         "duration_ms",
         "sensor_count",
         "service_count",
-        "operator_count"
+        "operator_count",
+        "more_tables",
+        "more_fields"
     ]
 );
 
@@ -409,6 +412,14 @@ pub fn main_c(
             (
                 "deploy",
                 &if threads { "    .deploy = &deploy,\n" } else { "" },
+            ),
+            (
+                "sim",
+                &if threads && target.simulated() {
+                    "    .sim = &semo_sim_platform,\n"
+                } else {
+                    ""
+                },
             ),
         ],
     ));
@@ -942,9 +953,18 @@ fn static_makefile(
     ));
 }
 
-/// `scenario.c` of a static-schedule simulation: the robot's world from the
-/// scenario as constant tables (`semo__sim_tables`, `semo_internal.h`).
-pub fn scenario_c(world: &CompiledScenario, header: &str) -> String {
+/// `scenario.c` of a simulated program (either runtime): the robot's world
+/// from the scenario as constant tables (`semo__sim_tables`,
+/// `semo_internal.h`). A table the world leaves empty (battery, loop exits,
+/// link faults, a time scale) is not written: its fields stay zero. A link
+/// fault's robots are written as the program's peer indices (`peers`);
+/// a robot not among them is one the program never sends to.
+pub fn scenario_c(
+    world: &CompiledScenario,
+    header: &str,
+    program: &crate::refine::RobotProgram,
+    peers: &super::peers::Peers,
+) -> String {
     let mut out = String::from(header);
     out.push_str("#include \"semo_internal.h\"\n\n/* This robot's world from the scenario, compiled in. */\n");
     let _ = writeln!(out, "static const semo__sim_sensor_entry sensors[] = {{");
@@ -981,6 +1001,7 @@ pub fn scenario_c(world: &CompiledScenario, header: &str) -> String {
     if world.operator.is_empty() {
         out.push_str("    {0, 0, -1, \"\", \"\"}, /* none */\n");
     }
+    let (tables, fields) = scenario_extra_tables(world, program, peers);
     out.push_str(&fill(
         &SCENARIO_TABLES,
         &[
@@ -989,9 +1010,91 @@ pub fn scenario_c(world: &CompiledScenario, header: &str) -> String {
             ("sensor_count", &world.sensors.len()),
             ("service_count", &world.services.len()),
             ("operator_count", &world.operator.len()),
+            ("more_tables", &tables),
+            ("more_fields", &fields),
         ],
     ));
     out
+}
+
+/// The tables of `scenario.c` written only when the world has them, and
+/// their fields of `semo__scenario`.
+fn scenario_extra_tables(
+    world: &CompiledScenario,
+    program: &crate::refine::RobotProgram,
+    peers: &super::peers::Peers,
+) -> (String, String) {
+    let (mut tables, mut fields) = (String::new(), String::new());
+    if let Some(scale) = world.time_scale {
+        let _ = writeln!(fields, "    .time_scale = {},", c::real(scale));
+    }
+    if !world.battery.is_empty() {
+        tables.push_str("static const semo__sim_battery_entry battery[] = {\n");
+        for (at, level) in &world.battery {
+            let _ = writeln!(tables, "    {{{at}, {}}},", c::real(*level));
+        }
+        tables.push_str("};\n");
+        let _ = writeln!(
+            fields,
+            "    .battery = battery,\n    .battery_count = {},",
+            world.battery.len()
+        );
+    }
+    if !world.loops.is_empty() {
+        tables.push_str("static const semo__sim_loop_entry loops[] = {\n");
+        for (path, iteration) in &world.loops {
+            let _ = writeln!(tables, "    {{{}, {iteration}}},", c::string(path));
+        }
+        tables.push_str("};\n");
+        let _ = writeln!(
+            fields,
+            "    .loops = loops,\n    .loop_count = {},",
+            world.loops.len()
+        );
+    }
+    // Each fault's peers (local indices), then the faults naming them.
+    let mut links = Vec::new();
+    for link in &world.links {
+        let mut locals: Vec<usize> = link
+            .robots
+            .iter()
+            .filter_map(|robot| program.peers.iter().position(|(_, r)| r == robot))
+            .filter_map(|fleet| peers.list().binary_search(&fleet).ok())
+            .collect();
+        locals.sort_unstable();
+        locals.dedup();
+        if locals.is_empty() {
+            continue;
+        }
+        let i = links.len();
+        let list: Vec<String> = locals.iter().map(usize::to_string).collect();
+        let _ = writeln!(
+            tables,
+            "static const size_t link_{i}_peers[] = {{{}}};",
+            list.join(", ")
+        );
+        let (lost, by) = match link.effect {
+            super::LinkEffect::Lost => ("true", 0),
+            super::LinkEffect::Delayed(by) => ("false", by),
+        };
+        links.push(format!(
+            "    {{{}, {}, {by}, {lost}, link_{i}_peers, {}}},\n",
+            link.from,
+            link.until,
+            locals.len()
+        ));
+    }
+    if !links.is_empty() {
+        tables.push_str("static const semo__sim_link_entry links[] = {\n");
+        tables.extend(links.iter().map(String::as_str));
+        tables.push_str("};\n");
+        let _ = writeln!(
+            fields,
+            "    .links = links,\n    .link_count = {},",
+            links.len()
+        );
+    }
+    (tables, fields)
 }
 
 /// How a sensor task a user writes sets a value of this kind.

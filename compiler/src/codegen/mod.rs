@@ -156,19 +156,48 @@ fn board_file(targets: &[Target], path: &'static str, text: &'static str) -> Str
     }
 }
 
-/// The world of one robot from a scenario, compiled into a static-schedule
-/// simulation (`scenario.c`). The simulator's scenario reader (`sim`) makes
-/// it from a scenario file.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+/// The world of one robot from a scenario, compiled into its simulated
+/// program (`scenario.c`, read by both simulation runtimes: no program
+/// reads a scenario file). The simulator's scenario reader (`sim`) makes
+/// it from a scenario file: `sim::scenario::Scenario::compiled_for`.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct CompiledScenario {
     /// Mission ms the run lasts; `None`: until the robot stops itself.
     pub duration_ms: Option<i64>,
+    /// Wall ms per mission ms on the wall clock; `None`: 1 (the program's
+    /// `--time-scale` overrides it).
+    pub time_scale: Option<f64>,
     /// (at, value name, value), in file order.
     pub sensors: Vec<(i64, String, String)>,
     /// (service, ms).
     pub services: Vec<(String, i64)>,
+    /// (at, level), in time order: the `BATTERY` value, linear between.
+    pub battery: Vec<(i64, f64)>,
+    /// (SDF/L loop path, the iteration whose exit task sets the exit flag).
+    pub loops: Vec<(String, u64)>,
     /// The operator's commands to this robot or its team.
     pub operator: Vec<OperatorCommand>,
+    /// The link faults on this robot's messages, in file order.
+    pub links: Vec<CompiledLink>,
+}
+
+/// A link fault on the messages this robot sends to `robots` during
+/// [`from`, `until`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CompiledLink {
+    pub effect: LinkEffect,
+    pub from: i64,
+    pub until: i64,
+    /// By name; those the program never sends to are not written.
+    pub robots: Vec<String>,
+}
+
+/// What a link fault does to a message.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LinkEffect {
+    Lost,
+    /// Arrives this many ms late.
+    Delayed(i64),
 }
 
 /// `key` (`USER.<value>`) = `value`, first at `first`, then every `every`
@@ -338,7 +367,7 @@ fn generate(
     if let (true, Some(world)) = (target.needs_scenario(), scenario) {
         push(
             "scenario.c",
-            files::scenario_c(world, &header),
+            files::scenario_c(world, &header, program, &peers),
             Owner::Generated,
         );
         sources_c.push("scenario.c".into());

@@ -31,6 +31,33 @@ pub fn is_scenario(path: &Path) -> bool {
         .is_some_and(|n| n.ends_with(".scenario.json"))
 }
 
+/// The scenarios a mission runs on when none is named (`semo simulate`,
+/// `semo build` of a simulation, the editor's Generate Code and Simulate):
+/// `<mission>.scenario.json` beside it when it exists, else every scenario
+/// beside it that belongs to it ([`mission_for`]), sorted. One is the
+/// choice; none or several, the door asks the user to name one.
+pub fn scenarios_of(mission: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let name = mission
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or_default();
+    let stem = name.strip_suffix(".mission").unwrap_or(name);
+    let own = mission.with_file_name(format!("{stem}.scenario.json"));
+    if own.is_file() {
+        return Ok(vec![own]);
+    }
+    let folder = mission
+        .parent()
+        .filter(|f| !f.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let mut named: Vec<PathBuf> = std::fs::read_dir(folder)?
+        .filter_map(|entry| Some(mission.with_file_name(entry.ok()?.file_name())))
+        .filter(|path| is_scenario(path) && mission_for(path).as_deref() == Some(mission))
+        .collect();
+    named.sort();
+    Ok(named)
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ScenarioCompletionKind {
     Robot,

@@ -1,9 +1,11 @@
 //! The scenario file (`*.scenario.json`, schema version 1, documented in
 //! `docs/scenario-and-trace.md`): what the world does around the robots
 //! (timed sensor values, service durations, operator commands, the network,
-//! faults) and what the run is expected to show. `linux-sim` programs read
-//! the same file (`semo_sim.c`); the keys it does not act on (`network`,
-//! `faults`, `expect`, `battery`) it accepts and ignores.
+//! faults) and what the run is expected to show. This is the one reader of
+//! the format: a simulated robot program (`linux-sim`, `cortex-m-sim`) gets
+//! its robot's part of the world compiled in by `semo build --scenario FILE`
+//! ([`Scenario::compiled_for`], written as C tables by `codegen`), and reads
+//! no file at run time.
 //!
 //! Every mistake is reported at the value that holds it (a byte offset,
 //! turned into line and column by [`ScenarioError::line_col`]), including
@@ -21,11 +23,67 @@ const MAX_MS: f64 = 1e15;
 /// Largest battery level in size (the runtime's `MAX_LEVEL`): it and its
 /// rounding fit an integer exactly.
 const MAX_LEVEL: f64 = 1e15;
+/// The time scales a program runs at (the runtime's `SEMO_TIME_SCALE_MIN`
+/// and `SEMO_TIME_SCALE_MAX`, which bound its `--time-scale` too).
+pub const TIME_SCALE: std::ops::RangeInclusive<f64> = 1e-6..=1e6;
+
+/// The keys each kind of object of the format takes: the reader's one list
+/// of each, which the editor's JSON Schema
+/// (`vscode-extension/schemas/scenario.schema.json`: validation, completion
+/// and hover of scenario files) must name exactly, no more and no fewer
+/// (`the_schema_names_exactly_the_keys_the_reader_takes`, `sim/tests.rs`).
+pub mod keys {
+    pub const SCENARIO: &[&str] = &[
+        "version",
+        "time_scale",
+        "duration",
+        "robots",
+        "operator",
+        "network",
+        "faults",
+        "expect",
+    ];
+    pub const ROBOT: &[&str] = &["sensors", "services", "battery", "loops"];
+    pub const SENSOR: &[&str] = &["at", "value", "is"];
+    pub const BATTERY: &[&str] = &["at", "level"];
+    pub const COMMAND: &[&str] = &["at", "every", "from", "until", "to", "value", "is"];
+    pub const NETWORK: &[&str] = &["latency", "loss", "links"];
+    pub const LINK: &[&str] = &["between", "latency", "loss"];
+    pub const FAULT: &[&str] = &[
+        "at",
+        "kill",
+        "restart",
+        "drop",
+        "delay",
+        "by",
+        "partition",
+        "from",
+        "until",
+    ];
+    /// An `expect` entry that is a property of the run's instants.
+    pub const PROPERTY: &[&str] = &["always", "eventually", "leads_to"];
+    /// Any other `expect` entry.
+    pub const EXPECTATION: &[&str] = &[
+        "robot",
+        "enters",
+        "never_enters",
+        "receives",
+        "from",
+        "before",
+        "all_end_in",
+    ];
+    pub const CONDITION: &[&str] = &[
+        "robot", "in", "enters", "receives", "from", "not", "all", "any",
+    ];
+}
 
 #[derive(Clone, Debug, Default)]
 pub struct Scenario {
     /// Mission ms the run lasts (`duration`; `None`: until every robot finished).
     pub duration_ms: Option<i64>,
+    /// Wall ms per mission ms of a program run on the wall clock
+    /// (`time_scale`; the simulator's time is virtual and ignores it).
+    pub time_scale: Option<f64>,
     /// Per robot of the mission, by name.
     pub robots: Vec<RobotWorld>,
     pub operator: Vec<Command>,
@@ -397,20 +455,79 @@ fn suggesting(v: &Value, message: String, name: &str, known: &[&str]) -> Scenari
 }
 
 impl Scenario {
-    /// The world of `program`'s robot, to compile into a static-schedule
-    /// simulation (`semo build --target cortex-m-sim --scenario FILE`): its
-    /// sensors and services, and the operator's commands to it or its team.
+    /// The world of `program`'s robot, to compile into a simulated program
+    /// (`semo build --target linux-sim|cortex-m-sim --scenario FILE`):
+    /// everything the program itself reads or does from the scenario. Its
+    /// sensors, battery, services and loop exits; the operator's commands
+    /// to it or its team; the link faults on its messages (what
+    /// [`super::engine`]'s `link` applies to a message this robot sends);
+    /// the run's duration and time scale. Process faults (kill, restart)
+    /// and the network's latency and loss are not in it: the lock-step
+    /// coordinator applies those from outside (`semo simulate --engine c`).
     pub fn compiled_for(&self, program: &RobotProgram) -> crate::codegen::CompiledScenario {
+        use crate::codegen::{CompiledLink, LinkEffect, OperatorCommand};
         let world = self.robots.iter().find(|w| w.robot == program.robot);
+        let me = program.robot.as_str();
+        let mission_robots = || program.peers.iter().map(|(_, robot)| robot.as_str());
+        let links = self
+            .faults
+            .iter()
+            .filter_map(|fault| {
+                let (effect, from, until, robots) = match &fault.kind {
+                    FaultKind::Kill { .. } | FaultKind::Restart { .. } => return None,
+                    FaultKind::Drop {
+                        between,
+                        from,
+                        until,
+                    } => (LinkEffect::Lost, *from, *until, other_end(between, me)?),
+                    FaultKind::Delay {
+                        between,
+                        by,
+                        from,
+                        until,
+                    } => (
+                        LinkEffect::Delayed(*by),
+                        *from,
+                        *until,
+                        other_end(between, me)?,
+                    ),
+                    FaultKind::Partition {
+                        groups,
+                        from,
+                        until,
+                    } => {
+                        // Robots of different groups (no group is one more)
+                        // cannot talk: the engine's `link`.
+                        let group_of =
+                            |robot: &str| groups.iter().position(|g| g.iter().any(|m| m == robot));
+                        let mine = group_of(me);
+                        let cut: Vec<String> = mission_robots()
+                            .filter(|&robot| robot != me && group_of(robot) != mine)
+                            .map(str::to_string)
+                            .collect();
+                        (LinkEffect::Lost, *from, *until, cut)
+                    }
+                };
+                (!robots.is_empty()).then_some(CompiledLink {
+                    effect,
+                    from,
+                    until,
+                    robots,
+                })
+            })
+            .collect();
         crate::codegen::CompiledScenario {
             duration_ms: self.duration_ms,
+            time_scale: self.time_scale,
             sensors: world.map(|w| w.sensors.clone()).unwrap_or_default(),
             services: world.map(|w| w.services.clone()).unwrap_or_default(),
+            battery: world.map(|w| w.battery.clone()).unwrap_or_default(),
+            loops: world.map(|w| w.loops.clone()).unwrap_or_default(),
             operator: self
                 .operator
                 .iter()
                 .filter(|c| c.to == program.robot || c.to == program.team)
-                .map(|c| crate::codegen::OperatorCommand {
+                .map(|c| OperatorCommand {
                     key: c.key.clone(),
                     value: c.value.clone(),
                     first: c.first,
@@ -418,7 +535,20 @@ impl Scenario {
                     until: c.until,
                 })
                 .collect(),
+            links,
         }
+    }
+}
+
+/// The robot at the other end of a link fault `between` two robots, as
+/// the robots whose messages from `me` it touches: none when `me` is at
+/// neither end.
+fn other_end(between: &(String, String), me: &str) -> Option<Vec<String>> {
+    let (a, b) = between;
+    match (a == me, b == me) {
+        (true, _) => Some(vec![b.clone()]),
+        (false, true) => Some(vec![a.clone()]),
+        (false, false) => None,
     }
 }
 
@@ -621,16 +751,7 @@ impl Reader<'_> {
         object(
             root,
             "a scenario object {\"robots\": ..., \"operator\": ...}",
-            &[
-                "version",
-                "time_scale",
-                "duration",
-                "robots",
-                "operator",
-                "network",
-                "faults",
-                "expect",
-            ],
+            keys::SCENARIO,
         )?;
         let mut scenario = Scenario::default();
         if let Some(v) = root.member("version") {
@@ -641,8 +762,13 @@ impl Reader<'_> {
         }
         if let Some(v) = root.member("time_scale") {
             match &v.kind {
-                Kind::Number(n, _) if *n > 0.0 => {}
-                _ => return fail(v, "\"time_scale\" must be a positive number"),
+                Kind::Number(n, _) if TIME_SCALE.contains(n) => scenario.time_scale = Some(*n),
+                _ => {
+                    return fail(
+                        v,
+                        "\"time_scale\" must be a positive number from 0.000001 (a million times faster) to 1000000",
+                    );
+                }
             }
         }
         scenario.duration_ms = opt_ms(root, "duration", 0)?;
@@ -686,7 +812,7 @@ impl Reader<'_> {
         object(
             v,
             "a robot {\"sensors\": [...], \"services\": {...}, \"battery\": [...], \"loops\": {...}}",
-            &["sensors", "services", "battery", "loops"],
+            keys::ROBOT,
         )?;
         let mut world = RobotWorld {
             robot: robot.to_string(),
@@ -697,7 +823,7 @@ impl Reader<'_> {
                 object(
                     entry,
                     "a sensor entry {\"at\", \"value\", \"is\"}",
-                    &["at", "value", "is"],
+                    keys::SENSOR,
                 )?;
                 let at = ms(require(entry, "at")?, "at", 0)?;
                 let value_at = require(entry, "value")?;
@@ -763,11 +889,7 @@ impl Reader<'_> {
         if let Some(battery) = v.member("battery") {
             let mut last = -1;
             for entry in array(battery, "an array of battery levels {\"at\", \"level\"}")? {
-                object(
-                    entry,
-                    "a battery level {\"at\", \"level\"}",
-                    &["at", "level"],
-                )?;
+                object(entry, "a battery level {\"at\", \"level\"}", keys::BATTERY)?;
                 let at_value = require(entry, "at")?;
                 let at = ms(at_value, "at", 0)?;
                 if at <= last {
@@ -793,7 +915,7 @@ impl Reader<'_> {
         object(
             v,
             "an operator command {\"at\"|\"every\", \"to\", \"value\", \"is\"}",
-            &["at", "every", "from", "until", "to", "value", "is"],
+            keys::COMMAND,
         )?;
         let to = self.robot_or_team(require(v, "to")?, "to")?;
         let key = format!("USER.{}", name(require(v, "value")?, "value")?);
@@ -832,7 +954,7 @@ impl Reader<'_> {
         object(
             v,
             "a network {\"latency\", \"loss\", \"links\"}",
-            &["latency", "loss", "links"],
+            keys::NETWORK,
         )?;
         let mut network = Network {
             latency_ms: opt_ms(v, "latency", 0)?.unwrap_or(DEFAULT_LATENCY_MS),
@@ -848,7 +970,7 @@ impl Reader<'_> {
                 object(
                     link,
                     "a link {\"between\", \"latency\", \"loss\"}",
-                    &["between", "latency", "loss"],
+                    keys::LINK,
                 )?;
                 network.links.push(Link {
                     between: self.pair(require(link, "between")?, "between")?,
@@ -877,17 +999,7 @@ impl Reader<'_> {
         object(
             v,
             "a fault {\"kill\"|\"restart\"|\"drop\"|\"delay\"|\"partition\", ...}",
-            &[
-                "at",
-                "kill",
-                "restart",
-                "drop",
-                "delay",
-                "by",
-                "partition",
-                "from",
-                "until",
-            ],
+            keys::FAULT,
         )?;
         let given = one_of(
             v,
@@ -948,14 +1060,13 @@ impl Reader<'_> {
     }
 
     fn expectation(&self, v: &Value) -> Result<Expectation> {
-        const TEMPORAL: [&str; 3] = ["always", "eventually", "leads_to"];
-        if TEMPORAL.iter().any(|k| v.member(k).is_some()) {
+        if keys::PROPERTY.iter().any(|k| v.member(k).is_some()) {
             object(
                 v,
                 "a property {\"always\"|\"eventually\": CONDITION} or {\"leads_to\": [CONDITION, CONDITION]}",
-                &TEMPORAL,
+                keys::PROPERTY,
             )?;
-            let given = one_of(v, "a property", &TEMPORAL)?;
+            let given = one_of(v, "a property", keys::PROPERTY)?;
             let value = require(v, given)?;
             let kind = match given {
                 "always" => ExpectKind::Always(self.condition(value)?),
@@ -978,15 +1089,7 @@ impl Reader<'_> {
         object(
             v,
             "an expectation {\"robot\", \"enters\"|\"never_enters\"|\"receives\", ...} or {\"all_end_in\"}",
-            &[
-                "robot",
-                "enters",
-                "never_enters",
-                "receives",
-                "from",
-                "before",
-                "all_end_in",
-            ],
+            keys::EXPECTATION,
         )?;
         let given = one_of(
             v,
@@ -1054,9 +1157,7 @@ impl Reader<'_> {
         object(
             v,
             "a condition {\"robot\", \"in\"|\"enters\"|\"receives\", \"from\"?} or {\"not\"|\"all\"|\"any\"}",
-            &[
-                "robot", "in", "enters", "receives", "from", "not", "all", "any",
-            ],
+            keys::CONDITION,
         )?;
         let given = one_of(v, "a condition", &KINDS)?;
         let about_robot = matches!(given, "in" | "enters" | "receives");

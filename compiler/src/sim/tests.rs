@@ -1481,3 +1481,269 @@ fn a_leader_cut_off_steps_down_before_another_leads_at_every_partition_instant()
         assert!(cut >= 150, "{mission}: tb_0 led at {cut} partitions");
     }
 }
+
+/// The schema's property names at `path` (object keys to follow; `*`: each
+/// item of a `oneOf` there, their names together).
+fn schema_keys(schema: &json::Value, path: &[&str]) -> Vec<String> {
+    let mut at = vec![schema];
+    for step in path {
+        at = at
+            .into_iter()
+            .flat_map(|v| match (*step, &v.kind) {
+                ("*", json::Kind::Array(items)) => items.iter().collect::<Vec<_>>(),
+                (key, _) => v.member(key).into_iter().collect(),
+            })
+            .collect();
+    }
+    let mut keys: Vec<String> = at
+        .iter()
+        .filter_map(|v| v.member("properties"))
+        .flat_map(|p| match &p.kind {
+            json::Kind::Object(members) => members.iter().map(|(k, _)| k.clone()).collect(),
+            _ => Vec::new(),
+        })
+        .collect();
+    keys.sort();
+    keys.dedup();
+    keys
+}
+
+/// Every object of the schema that names properties, by its path.
+fn schema_objects(v: &json::Value, path: &mut Vec<String>, found: &mut Vec<String>) {
+    match &v.kind {
+        json::Kind::Object(members) => {
+            if v.member("properties").is_some() {
+                found.push(path.join("/"));
+            }
+            for (key, member) in members {
+                path.push(key.clone());
+                schema_objects(member, path, found);
+                path.pop();
+            }
+        }
+        json::Kind::Array(items) => {
+            for item in items {
+                path.push("*".into());
+                schema_objects(item, path, found);
+                path.pop();
+            }
+        }
+        _ => {}
+    }
+}
+
+/// One description of the format's keys: the editor's JSON Schema (its
+/// validation, completion and hover of scenario files) names exactly the
+/// keys the reader takes, object by object, and no object the reader does
+/// not read.
+#[test]
+fn the_schema_names_exactly_the_keys_the_reader_takes() {
+    use scenario::keys;
+    let text = std::fs::read_to_string(repo("vscode-extension/schemas/scenario.schema.json"))
+        .expect("the schema is in the repository");
+    let schema = json::parse(&text).expect("the schema is JSON");
+    let expect: Vec<&str> = keys::PROPERTY
+        .iter()
+        .chain(keys::EXPECTATION)
+        .copied()
+        .collect();
+    let places: [(&[&str], &[&str]); 10] = [
+        (&[], keys::SCENARIO),
+        (
+            &["properties", "robots", "additionalProperties"],
+            keys::ROBOT,
+        ),
+        (
+            &[
+                "properties",
+                "robots",
+                "additionalProperties",
+                "properties",
+                "sensors",
+                "items",
+            ],
+            keys::SENSOR,
+        ),
+        (
+            &[
+                "properties",
+                "robots",
+                "additionalProperties",
+                "properties",
+                "battery",
+                "items",
+            ],
+            keys::BATTERY,
+        ),
+        (&["properties", "operator", "items"], keys::COMMAND),
+        (&["properties", "network"], keys::NETWORK),
+        (
+            &["properties", "network", "properties", "links", "items"],
+            keys::LINK,
+        ),
+        (
+            &["properties", "faults", "items", "oneOf", "*"],
+            keys::FAULT,
+        ),
+        (&["properties", "expect", "items", "oneOf", "*"], &expect),
+        (&["definitions", "condition", "oneOf", "*"], keys::CONDITION),
+    ];
+    for (path, reader) in &places {
+        let mut reader: Vec<String> = reader.iter().map(|k| k.to_string()).collect();
+        reader.sort();
+        assert_eq!(schema_keys(&schema, path), reader, "at {}", path.join("/"));
+    }
+    let mut found = Vec::new();
+    schema_objects(&schema, &mut Vec::new(), &mut found);
+    let checked: Vec<String> = places.iter().map(|(path, _)| path.join("/")).collect();
+    let unchecked: Vec<&String> = found.iter().filter(|f| !checked.contains(f)).collect();
+    assert!(
+        unchecked.is_empty(),
+        "objects the reader does not read: {unchecked:?}"
+    );
+}
+
+/// The mistakes the runtime's own JSON reader refused when programs read
+/// the scenario at run time (its tests moved here with it gone) are
+/// refused by the one reader, at the value, before anything is built
+/// (`semo build --scenario`, `semo simulate`).
+#[test]
+fn the_mistakes_the_runtime_refused_are_refused_at_the_value() {
+    let programs = programs("examples/scouting/scouting.mission");
+    let nested = format!("{}{}", "[".repeat(40), "]".repeat(40));
+    let cases: [(&str, (u32, u32), &str); 18] = [
+        (
+            "{\n  \"robots\": {\n    \"irobot\": [1,]\n  }\n}",
+            (3, 18),
+            "expected a JSON value",
+        ),
+        (
+            "{\"robots\": {}} x",
+            (1, 16),
+            "unexpected text after the scenario object",
+        ),
+        (
+            "{\"time_scale\": 0}",
+            (1, 16),
+            "\"time_scale\" must be a positive number from 0.000001 (a million times faster) to 1000000",
+        ),
+        (
+            "{\"time_scale\": 1e7}",
+            (1, 16),
+            "\"time_scale\" must be a positive number from 0.000001 (a million times faster) to 1000000",
+        ),
+        (
+            "{\"duration\": 1.5}",
+            (1, 14),
+            "\"duration\" must be a whole number of milliseconds",
+        ),
+        (
+            "{\"robots\": {\"ti\": 1, \"ti\": 2}}",
+            (1, 22),
+            "duplicate key \"ti\"",
+        ),
+        (
+            "{\"operator\": [{\"at\": 1, \"every\": 2, \"to\": \"ti\", \"value\": \"V\", \"is\": \"x\"}]}",
+            (1, 15),
+            "an operator command needs either \"at\" or \"every\"",
+        ),
+        (
+            "{\"operator\": [{\"every\": 0, \"to\": \"ti\", \"value\": \"V\", \"is\": \"x\"}]}",
+            (1, 25),
+            "\"every\" must be a whole number of milliseconds above 0",
+        ),
+        (
+            "{\"a\": \"\\ud800\"}",
+            (1, 14),
+            "unpaired surrogate in \\u escape",
+        ),
+        (
+            "{\"a\": \"tab\there\"}",
+            (1, 11),
+            "control character in string",
+        ),
+        (&nested, (1, 34), "nesting deeper than 32 levels"),
+        ("", (1, 1), "unexpected end of the file"),
+        ("{\"n\": 01}", (1, 7), "malformed number"),
+        (
+            "{\"robots\": {\"ti\": {\"battery\": [{\"at\": 5, \"level\": 1}, {\"at\": 5, \"level\": 2}]}}}",
+            (1, 62),
+            "battery levels must be in time order",
+        ),
+        (
+            "{\"robots\": {\"ti\": {\"battery\": [{\"at\": 0, \"level\": \"full\"}]}}}",
+            (1, 51),
+            "\"level\" must be a number",
+        ),
+        (
+            "{\"faults\": [{\"from\": 5, \"until\": 5, \"drop\": [\"ti\", \"nxt\"]}]}",
+            (1, 34),
+            "\"until\" must be after \"from\"",
+        ),
+        (
+            "{\"faults\": [{\"from\": 1, \"until\": 5, \"delay\": [\"ti\"], \"by\": 3}]}",
+            (1, 46),
+            "\"delay\" must name two robots",
+        ),
+        (
+            "{\"faults\": [{\"from\": 1, \"until\": 5, \"partition\": [[\"ti\", 7]]}]}",
+            (1, 58),
+            "\"partition\" must be a non-empty string shorter than 48 bytes",
+        ),
+    ];
+    for (text, line_col, message) in cases {
+        let e = scenario::parse(text, &programs).unwrap_err();
+        assert_eq!(
+            (e.line_col(text), e.message.as_str()),
+            (line_col, message),
+            "{text}"
+        );
+    }
+}
+
+/// A robot's compiled world ([`scenario::Scenario::compiled_for`]) holds
+/// what its program applies itself: its sensors, battery and loop exits,
+/// the run's time scale, and the link faults on its own messages (to the
+/// other robot of a drop or delay it is at an end of; to every robot
+/// outside its group of a partition); never a process fault, which the
+/// coordinator applies from outside, nor another robot's link fault.
+#[test]
+fn a_robot_s_compiled_world_holds_what_its_program_applies() {
+    use crate::codegen::{CompiledLink, LinkEffect};
+    let programs = programs("examples/scouting/scouting.mission");
+    let text = r#"{"time_scale": 0.5, "duration": 900,
+        "robots": {"irobot": {"battery": [{"at": 0, "level": 90}, {"at": 100, "level": 80.5}]}},
+        "faults": [{"at": 5, "kill": "irobot"},
+                   {"from": 1, "until": 5, "drop": ["ti", "irobot"]},
+                   {"from": 2, "until": 6, "delay": ["ti", "nxt"], "by": 7},
+                   {"from": 3, "until": 9, "partition": [["irobot"], ["ti"]]}]}"#;
+    let scenario = scenario::parse(text, &programs).unwrap();
+    let irobot = programs.iter().find(|p| p.robot == "irobot").unwrap();
+    let world = scenario.compiled_for(irobot);
+    assert_eq!(
+        (world.time_scale, world.duration_ms, &world.battery[..]),
+        (Some(0.5), Some(900), &[(0, 90.0), (100, 80.5)][..])
+    );
+    let link = |effect, from, until, robots: &[&str]| CompiledLink {
+        effect,
+        from,
+        until,
+        robots: robots.iter().map(|r| r.to_string()).collect(),
+    };
+    assert_eq!(
+        world.links,
+        [
+            link(LinkEffect::Lost, 1, 5, &["ti"]),
+            link(LinkEffect::Lost, 3, 9, &["ti", "nxt"]),
+        ]
+    );
+    let nxt = programs.iter().find(|p| p.robot == "nxt").unwrap();
+    assert_eq!(
+        scenario.compiled_for(nxt).links,
+        [
+            link(LinkEffect::Delayed(7), 2, 6, &["ti"]),
+            // No group is one more: nxt is cut from both.
+            link(LinkEffect::Lost, 3, 9, &["irobot", "ti"]),
+        ]
+    );
+}

@@ -8,9 +8,11 @@
 //! Arguments: one object `{ "uri": mission, "outputFolder"?: path (relative
 //! to the mission's folder), "target"?: every robot's target ("linux",
 //! "linux-sim", "cortex-m", "cortex-m-sim"), "sim"?: each robot's platform
-//! simulated (`semo build --sim`), "team"?: only this team's robots,
-//! "force"?: replace files in the way, saved first (as `semo build
-//! --force`) }`, or just the URI. What the arguments do not say the
+//! simulated (`semo build --sim`), "scenario"?: the scenario file compiled
+//! into a simulation (relative to the mission's folder; needed by, and only
+//! by, a simulation target, as `semo build --scenario`), "team"?: only this
+//! team's robots, "force"?: replace files in the way, saved first (as `semo
+//! build --force`) }`, or just the URI. What the arguments do not say the
 //! mission's project file and catalog do, as for `semo build`: both ask the
 //! host's one [`semo::host::Analysis::build_plan`] (each robot's target,
 //! the output folder, and the deployment whose broker and credentials are
@@ -51,6 +53,7 @@ pub struct GenerateParams {
     pub target: Option<String>,
     #[serde(default)]
     pub sim: bool,
+    pub scenario: Option<String>,
     pub team: Option<String>,
     #[serde(default)]
     pub force: bool,
@@ -67,6 +70,7 @@ pub fn params(arguments: &[Value]) -> Result<GenerateParams, String> {
             output_folder: None,
             target: None,
             sim: false,
+            scenario: None,
             team: None,
             force: false,
         },
@@ -88,6 +92,8 @@ pub struct Job {
     pub plan: BuildPlan,
     /// The deployment file to bake into the robots (`semo build --deploy`'s).
     pub deployment: Option<PathBuf>,
+    /// The scenario compiled into a simulation (`semo build --scenario`'s).
+    pub scenario: Option<PathBuf>,
     pub team: Option<String>,
     pub force: bool,
 }
@@ -128,6 +134,10 @@ pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
         world.roots()
     };
     let out = output::confine(&requested, allowed)?;
+    let scenario = match params.scenario {
+        Some(named) => Some(folder.join(named)),
+        None => default_scenario(&plan, &mission_path)?,
+    };
     Ok(Job {
         mission_uri: params.uri,
         mission_path,
@@ -135,10 +145,36 @@ pub fn job(world: &World, params: GenerateParams) -> Result<Job, String> {
         mission: mission.id,
         out,
         deployment: plan.deployment.clone(),
+        scenario,
         plan,
         team: params.team,
         force: params.force,
     })
+}
+
+/// A simulation's scenario when the request names none: the mission's
+/// own beside it, as `semo build` and `semo simulate` choose
+/// (`sim::complete::scenarios_of`); none needed when no robot is simulated.
+fn default_scenario(
+    plan: &semo::host::BuildPlan,
+    mission: &std::path::Path,
+) -> Result<Option<PathBuf>, String> {
+    if !plan.robots.iter().any(|r| r.chosen.target.needs_scenario()) {
+        return Ok(None);
+    }
+    let found = semo::sim::complete::scenarios_of(mission)
+        .map_err(|e| format!("cannot look for the mission's scenario: {e}"))?;
+    match found.as_slice() {
+        [one] => Ok(Some(one.clone())),
+        [] => Err(format!(
+            "a simulation compiles a scenario into each robot: add {} beside the mission, or name one",
+            mission.with_extension("scenario.json").display()
+        )),
+        many => Err(format!(
+            "a simulation compiles a scenario into each robot: {} scenarios beside the mission, name one",
+            many.len()
+        )),
+    }
 }
 
 fn path_of(snapshot: &Snapshot) -> Option<PathBuf> {
@@ -153,7 +189,11 @@ pub fn generate(job: &Job) -> Result<(BuildResult, String), String> {
         .build_input(job.mission)
         .ok_or("internal error: the mission is not in the workspace analysis")?;
     let text = build.file.text.to_string();
-    let mut result = codegen::build_each(&build.input(), &job.plan.targets(), Emit::All);
+    let input = build.input();
+    let mut result = match &job.scenario {
+        None => codegen::build_each(&input, &job.plan.targets(), Emit::All),
+        Some(path) => build_with_scenario(&input, path, &job.plan.targets())?,
+    };
     // The plan's findings in the project file, with generation's.
     result
         .diagnostics
@@ -185,6 +225,46 @@ pub fn generate(job: &Job) -> Result<(BuildResult, String), String> {
         }
     }
     Ok((result, text))
+}
+
+/// A build with the scenario at `path` compiled into each simulated robot
+/// (`semo build --scenario`): the mission refined first, since the
+/// scenario's names are checked against its programs. A scenario that
+/// cannot be read, or has a mistake, is the request's error, positioned.
+fn build_with_scenario(
+    input: &semo::refine::BuildInput<'_>,
+    path: &Path,
+    targets: &codegen::Targets,
+) -> Result<BuildResult, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("scenario {}: cannot read: {e}", path.display()))?;
+    let refined = semo::refine::refine_checked(input);
+    if refined.programs.is_empty() {
+        // Refused: the mission's own errors come first.
+        return Ok(codegen::build_refined_each(
+            input,
+            refined,
+            targets,
+            Emit::All,
+            &[],
+        ));
+    }
+    let scenario = semo::sim::scenario::parse(&text, &refined.programs).map_err(|e| {
+        let (line, col) = e.line_col(&text);
+        format!("scenario {}:{line}:{col}: {}", path.display(), e.message)
+    })?;
+    let worlds: Vec<_> = refined
+        .programs
+        .iter()
+        .map(|p| scenario.compiled_for(p))
+        .collect();
+    Ok(codegen::build_refined_each(
+        input,
+        refined,
+        targets,
+        Emit::All,
+        &worlds,
+    ))
 }
 
 /// The refusal's diagnostics in the mission, for publishing.

@@ -3,9 +3,13 @@
  * semo_core.c is the portable core (values, trace lines, numbers); a
  * platform layer owns the clock, the run state, channels, tasks and the
  * message queue: semo_runtime.c (POSIX threads) or semo_static.c (one loop,
- * with a board file such as semo_lm3s6965.c). semo_sim.c (POSIX, built with
- * -DSEMO_SIM) reads the scenario and feeds operator commands into the queue;
- * on the static schedule the scenario is compiled in (scenario.c).
+ * with a board file such as semo_lm3s6965.c). In simulation (-DSEMO_SIM) the
+ * robot's world from the scenario is compiled in (the generated scenario.c,
+ * semo__scenario below): semo_sim.c reads it for the threads platform
+ * (sensors, battery, services, link faults, and a thread that feeds the
+ * operator's commands into the queue), semo_static.c for the static one.
+ * The threads platform reaches semo_sim.c only through the hooks the
+ * program gives it (semo_program_desc::sim, semo_sim_hooks below).
  */
 #ifndef SEMO_INTERNAL_H
 #define SEMO_INTERNAL_H
@@ -174,29 +178,35 @@ void semo__ls_stopping(void);
 /* Ends the link (the program is over). */
 void semo__ls_close(void);
 extern const semo_transport semo_lockstep_transport;
-/* The scenario's link faults on a message from this robot to `peer` sent
- * now: false when it is lost, else the extra delay (ms, 0: none). */
-bool semo__sim_link(size_t peer, int64_t *delay_ms);
-/* Sends `data` to `peer` through `transport` `delay_ms` from now. */
-void semo__sim_send_later(const semo_transport *transport, size_t peer, const void *data, size_t len,
-                          int64_t delay_ms);
-/* Whether the scenario has link faults touching this robot (they need a
- * transport that sends to each robot). */
-bool semo__sim_has_link_faults(void);
-/* Reads the scenario for `program->robot`; on error prints
- * "scenario FILE:LINE:COL: message" and returns -1. */
-int semo__sim_load(const char *path, const semo_program_desc *program);
-/* The scenario's settings; false when it gives none. */
-bool semo__sim_time_scale(double *out);
-bool semo__sim_duration(int64_t *out);
-/* Starts and stops the thread that injects the operator's commands. */
-int semo__sim_start(void);
-void semo__sim_stop(void);
-void semo__sim_free(void);
 #endif
 
-#if defined(SEMO_SIM) && defined(SEMO_STATIC)
-/* The scenario compiled in as tables (the generated scenario.c). */
+#ifdef SEMO_SIM
+struct semo__sim_tables_s;
+/* What a simulated world adds to the threads platform, given to it by the
+ * program (semo_program_desc::sim: semo_sim_platform, semo_sim.c): the
+ * platform calls the simulation through this table, never by name. */
+typedef struct semo_sim_hooks {
+    /* The world compiled in (time scale, duration, ...). */
+    const struct semo__sim_tables_s *world;
+    /* The link faults on a message from this robot to `peer` sent now:
+     * false when it is lost, else the extra delay (ms, 0: none). */
+    bool (*link)(size_t peer, int64_t *delay_ms);
+    /* Sends `data` to `peer` through `transport` `delay_ms` from now. */
+    void (*send_later)(const semo_transport *transport, size_t peer, const void *data, size_t len,
+                       int64_t delay_ms);
+    /* The battery level now, rounded; false when the world gives none. */
+    bool (*battery)(long long *level);
+    /* Starts and stops the threads that inject the operator's commands and
+     * send delayed datagrams. */
+    int (*start)(void);
+    void (*stop)(void);
+} semo_sim_hooks;
+#endif
+
+#ifdef SEMO_SIM
+/* The robot's world from the scenario, compiled in as tables by `semo build
+ * --scenario FILE` (the generated scenario.c): both simulation runtimes read
+ * these, and no program reads a scenario file. */
 typedef struct {
     int64_t at;
     const char *value;
@@ -213,7 +223,25 @@ typedef struct {
     const char *key; /* "USER.<value>" */
     const char *is;
 } semo__sim_command_entry;
+/* The BATTERY value: linear between the points, in time order. */
 typedef struct {
+    int64_t at;
+    double level;
+} semo__sim_battery_entry;
+/* An SDF/L loop's path and the iteration whose exit task sets the exit flag. */
+typedef struct {
+    const char *path;
+    int64_t iteration;
+} semo__sim_loop_entry;
+/* A link fault on this robot's messages to `peers` (local indices) sent in
+ * [from, until): lost, or `by` ms late. */
+typedef struct {
+    int64_t from, until, by;
+    bool lost;
+    const size_t *peers;
+    size_t peer_count;
+} semo__sim_link_entry;
+typedef struct semo__sim_tables_s {
     int64_t duration_ms; /* 0: until the program stops itself */
     const semo__sim_sensor_entry *sensors;
     size_t sensor_count;
@@ -222,6 +250,13 @@ typedef struct {
     const semo__sim_command_entry *operator_commands;
     int64_t *operator_next; /* per command: when it is due next, -1 when done */
     size_t operator_count;
+    double time_scale; /* wall ms per mission ms; 0: none given (1) */
+    const semo__sim_battery_entry *battery;
+    size_t battery_count;
+    const semo__sim_loop_entry *loops;
+    size_t loop_count;
+    const semo__sim_link_entry *links;
+    size_t link_count;
 } semo__sim_tables;
 extern const semo__sim_tables semo__scenario;
 #endif

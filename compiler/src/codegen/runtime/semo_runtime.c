@@ -781,11 +781,11 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
         if (g_transport->send_to)
             continue; /* one message for all of them, below */
 #ifdef SEMO_SIM
-        int64_t delay_ms;
-        if (!semo__sim_link(i, &delay_ms))
+        int64_t delay_ms = 0;
+        if (g_prog->sim && !g_prog->sim->link(i, &delay_ms))
             continue; /* a link fault of the scenario loses it */
         if (delay_ms > 0) {
-            semo__sim_send_later(g_transport, i, datagram, len, delay_ms);
+            g_prog->sim->send_later(g_transport, i, datagram, len, delay_ms);
             continue;
         }
 #endif
@@ -917,8 +917,8 @@ static void observe_status(const char *event, va_list args)
     long long level = 0;
     bool known = semo__battery(&level);
 #ifdef SEMO_SIM
-    if (!known)
-        known = semo_sim_battery(&level);
+    if (!known && g_prog->sim)
+        known = g_prog->sim->battery(&level);
 #endif
     if (known != g_status.battery_known || (known && level != g_status.battery)) {
         g_status.battery_known = known;
@@ -1030,7 +1030,6 @@ typedef struct {
     long port_base;
     int64_t duration_ms;
     bool duration_given;
-    const char *scenario;
     double time_scale;
     bool time_scale_given;
     long start_at_ms; /* --start-at: Unix ms of mission time 0; 0: when the program starts */
@@ -1063,7 +1062,7 @@ static void usage(FILE *f, const char *prog)
             "usage: %s [--trace FILE] [--transport udp|mqtt] [--port-base N] [--broker URL] [--run ID]"
             " [--duration MS] [--start-at UNIX_MS]"
 #ifdef SEMO_SIM
-            " [--scenario FILE] [--time-scale X] [--lockstep PATH]"
+            " [--time-scale X] [--lockstep PATH]"
 #endif
             "\n"
             "  --trace FILE      write a JSON-lines trace to FILE (\"-\": standard output)\n"
@@ -1082,8 +1081,8 @@ static void usage(FILE *f, const char *prog)
             "  --start-at T      mission time 0 is the wall-clock instant T (ms since 1970, or $SEMO_START_AT):\n"
             "                    robots given the same T start together; a T passed continues its mission time\n"
 #ifdef SEMO_SIM
-            "  --scenario FILE   the simulation scenario (JSON)\n"
-            "  --time-scale X    wall ms per mission ms (0.1: ten times faster; default 1)\n"
+            "  --time-scale X    wall ms per mission ms (0.1: ten times faster; default: the scenario's\n"
+            "                    time_scale, else 1); the scenario is compiled in (semo build --scenario FILE)\n"
             "  --lockstep PATH   virtual time: mission time and messages come from the coordinator on\n"
             "                    the Unix socket PATH (`semo simulate --engine c`); --start-at, --time-scale,\n"
             "                    --transport and --port-base do not apply\n"
@@ -1289,8 +1288,15 @@ static int parse_options(int argc, char **argv, options *o)
                 value = arg[len] == '=' ? arg + len + 1 : (i + 1 < argc ? argv[++i] : NULL);
             }
         }
+        if (which == 3) { /* the scenario is the build's: no program reads one */
+            fprintf(stderr,
+                    "%s: --scenario is not read at run time: a simulation's scenario is compiled into the program;"
+                    " build it with `semo build --sim --scenario FILE`\n",
+                    prog);
+            return 2;
+        }
 #ifndef SEMO_SIM
-        if ((which >= 3 && which < 5) || which == 8) {
+        if (which == 4 || which == 8) {
             fprintf(stderr, "%s: %s needs a simulation build (-DSEMO_SIM)\n", prog, names[which]);
             return 2;
         }
@@ -1325,9 +1331,6 @@ static int parse_options(int argc, char **argv, options *o)
             }
             o->duration_ms = n;
             o->duration_given = true;
-            break;
-        case 3:
-            o->scenario = value;
             break;
         case 4:
             o->time_scale = strtod(value, &end);
@@ -1625,7 +1628,7 @@ static int run(const options *o)
         }
         g_transport = o->transport;
 #ifdef SEMO_SIM
-        if (o->transport->send_to && semo__sim_has_link_faults()) {
+        if (o->transport->send_to && p->sim && p->sim->world->link_count > 0) {
             fprintf(stderr, "semo runtime: the scenario's link faults need a transport that sends to each robot (udp)\n");
             status = 1;
             goto stop;
@@ -1651,7 +1654,7 @@ static int run(const options *o)
     if (g_transport)
         receiver_started = start_thread(&receiver, receiver_thread, NULL, true);
 #ifdef SEMO_SIM
-    sim_started = semo__sim_start() == 0;
+    sim_started = !p->sim || p->sim->start() == 0;
     if (!sim_started)
         status = 1;
 #endif
@@ -1679,8 +1682,8 @@ stop:
     if (receiver_started)
         pthread_join(receiver, NULL);
 #ifdef SEMO_SIM
-    if (sim_started)
-        semo__sim_stop();
+    if (sim_started && p->sim)
+        p->sim->stop();
 #endif
     if (signals_started) {
         atomic_store(&g_signal_thread_done, true);
@@ -1718,12 +1721,12 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
         return 0;
     }
 #ifdef SEMO_SIM
-    if (status == 0 && o.scenario && semo__sim_load(o.scenario, program) != 0)
-        status = 2;
-    if (status == 0 && !o.time_scale_given && !semo__sim_time_scale(&o.time_scale))
-        o.time_scale = 1.0;
-    if (status == 0 && !o.duration_given && !semo__sim_duration(&o.duration_ms))
-        o.duration_ms = 0;
+    /* The world's settings, compiled in; the command line's win. */
+    const semo__sim_tables *world = program->sim ? program->sim->world : NULL;
+    if (!o.time_scale_given)
+        o.time_scale = world && world->time_scale > 0 ? world->time_scale : 1.0;
+    if (!o.duration_given)
+        o.duration_ms = world ? world->duration_ms : 0;
 #endif
     if (status == 0) {
         g_scale = o.time_scale > 0 ? o.time_scale : 1.0;
@@ -1742,9 +1745,6 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
         pthread_cond_destroy(&g_run_cond);
         pthread_cond_destroy(&g_inbox_cond);
     }
-#ifdef SEMO_SIM
-    semo__sim_free();
-#endif
     g_prog = NULL;
     return status;
 }

@@ -197,12 +197,22 @@ typedef struct {
     size_t word_count;
     /* Threads targets: the connection defaults (NULL: none). */
     const semo_deploy_defaults *deploy;
+    /* Threads simulation: the simulated world's hooks the platform calls
+     * (&semo_sim_platform; NULL: none, the program runs without a world). */
+    const struct semo_sim_hooks *sim;
 } semo_program_desc;
+
+#ifdef SEMO_SIM
+/* The threads platform's simulated world (semo_sim.c), over the scenario
+ * compiled into the program (scenario.c): what a linux-sim program gives
+ * the platform in semo_program_desc::sim. */
+extern const struct semo_sim_hooks semo_sim_platform;
+#endif
 
 /* Runs the program: parses the command line (`--trace FILE`,
  * `--transport udp|mqtt`, `--port-base N`, `--broker URL`, `--duration MS`;
- * simulation also `--scenario FILE` and
- * `--time-scale X`), allocates channels, opens the transport, calls every
+ * simulation also `--time-scale X`, its scenario being compiled in),
+ * allocates channels, opens the transport, calls every
  * task's init, starts one thread per task (time-driven tasks fire every
  * period, data-driven tasks fire again as soon as a firing returns,
  * control-driven tasks wait for UFControl_*), and waits until

@@ -17,6 +17,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* A simulation build's programs give the platform the simulated world
+ * (runtime_test_world.c), as a generated linux-sim main.c does. */
+#ifdef SEMO_SIM
+#define SIM_WORLD .sim = &semo_sim_platform,
+#else
+#define SIM_WORLD
+#endif
+
 static atomic_int failures;
 
 #define CHECK(cond)                                                                                                    \
@@ -381,6 +389,7 @@ static const char *const task_words[] = {"LEFT", "RIGHT"};
 static int run_tasks(int argc, char **argv)
 {
     const semo_program_desc program = {
+        SIM_WORLD
         .words = task_words,
         .word_count = 2,
         .mission = "test.mission",
@@ -417,6 +426,7 @@ static const semo_peer minimal_peers[] = {{"SoloTeam", "solo", 0}};
 static int run_minimal(int argc, char **argv)
 {
     const semo_program_desc program = {
+        SIM_WORLD
         .mission = "minimal.mission",
         .team = "SoloTeam",
         .robot = "solo",
@@ -473,6 +483,7 @@ static const semo_channel_desc wake_channels[] = {{"Poker", "OUT", "Sleeper", "I
 static int run_wake(int argc, char **argv)
 {
     const semo_program_desc program = {
+        SIM_WORLD
         .mission = "wake.mission",
         .team = "SoloTeam",
         .robot = "solo",
@@ -546,6 +557,7 @@ static const semo_task_desc ponger_tasks[] = {{"Ponger", SEMO_TRIGGER_DATA, 0, N
 static int run_udp(int argc, char **argv, bool alpha)
 {
     const semo_program_desc program = {
+        SIM_WORLD
         .mission = "udp.mission",
         .team = alpha ? "Alpha" : "Beta",
         .robot = alpha ? "a" : "b",
@@ -626,6 +638,7 @@ static const semo_channel_desc sim_channels[] = {
 static int run_sim(int argc, char **argv)
 {
     const semo_program_desc program = {
+        SIM_WORLD
         .mission = "remote.mission",
         .team = "RemoteTeam",
         .robot = "irobot",
