@@ -398,11 +398,7 @@ fn build_with_scenario(
         let record = Record::scenario(path, text, warning.clone(), semo::diag::Severity::Warning);
         eprintln!("{}", record.scenario_line());
     }
-    let worlds: Vec<_> = refined
-        .programs
-        .iter()
-        .map(|p| scenario.compiled_for(p))
-        .collect();
+    let worlds = scenario.compiled_for_each(&refined.programs);
     Ok(codegen::build_refined_each(
         input,
         refined,

@@ -123,12 +123,7 @@ pub fn mission(usage: &str) -> Result<PathBuf, NoChoice> {
 /// one the editors offer first), else the only scenario beside it named
 /// after the mission (`<mission>.<anything>.scenario.json`).
 pub fn scenario(mission: &Path) -> Result<PathBuf, NoChoice> {
-    let name = mission
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or_default();
-    let stem = name.strip_suffix(".mission").unwrap_or(name);
-    let own = mission.with_file_name(format!("{stem}.scenario.json"));
+    let own = semo::sim::complete::own_scenario(mission);
     let folder = mission
         .parent()
         .filter(|f| !f.as_os_str().is_empty())

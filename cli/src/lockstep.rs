@@ -556,11 +556,7 @@ pub fn simulate(
         .collect();
     // Each program gets its robot's world compiled in: the scenario is
     // read once, here, by the simulator's reader.
-    let worlds: Vec<_> = refined
-        .programs
-        .iter()
-        .map(|p| scenario.compiled_for(p))
-        .collect();
+    let worlds = scenario.compiled_for_each(&refined.programs);
     let built = semo::codegen::build_refined(
         input,
         refined,

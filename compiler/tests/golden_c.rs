@@ -137,11 +137,7 @@ fn build(
         None => QUIET_SCENARIO.to_string(),
     };
     let scenario = semo::sim::scenario::parse(&text, &refined.programs).expect("the scenario");
-    let worlds: Vec<_> = refined
-        .programs
-        .iter()
-        .map(|p| scenario.compiled_for(p))
-        .collect();
+    let worlds = scenario.compiled_for_each(&refined.programs);
     codegen::build_refined(&input, refined, target, Emit::All, &worlds)
 }
 

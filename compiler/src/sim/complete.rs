@@ -31,18 +31,24 @@ pub fn is_scenario(path: &Path) -> bool {
         .is_some_and(|n| n.ends_with(".scenario.json"))
 }
 
+/// The mission's own scenario, `<mission>.scenario.json` beside it (the
+/// first the doors look for, and the editors offer).
+pub fn own_scenario(mission: &Path) -> PathBuf {
+    let name = mission
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or_default();
+    let stem = name.strip_suffix(".mission").unwrap_or(name);
+    mission.with_file_name(format!("{stem}.scenario.json"))
+}
+
 /// The scenarios a mission runs on when none is named (`semo simulate`,
 /// `semo build` of a simulation, the editor's Generate Code and Simulate):
 /// `<mission>.scenario.json` beside it when it exists, else every scenario
 /// beside it that belongs to it ([`mission_for`]), sorted. One is the
 /// choice; none or several, the door asks the user to name one.
 pub fn scenarios_of(mission: &Path) -> std::io::Result<Vec<PathBuf>> {
-    let name = mission
-        .file_name()
-        .and_then(|n| n.to_str())
-        .unwrap_or_default();
-    let stem = name.strip_suffix(".mission").unwrap_or(name);
-    let own = mission.with_file_name(format!("{stem}.scenario.json"));
+    let own = own_scenario(mission);
     if own.is_file() {
         return Ok(vec![own]);
     }

@@ -455,6 +455,15 @@ fn suggesting(v: &Value, message: String, name: &str, known: &[&str]) -> Scenari
 }
 
 impl Scenario {
+    /// [`Scenario::compiled_for`] each program, in order: the worlds a
+    /// simulated build compiles in (`codegen::build_refined_each`).
+    pub fn compiled_for_each(
+        &self,
+        programs: &[RobotProgram],
+    ) -> Vec<crate::codegen::CompiledScenario> {
+        programs.iter().map(|p| self.compiled_for(p)).collect()
+    }
+
     /// The world of `program`'s robot, to compile into a simulated program
     /// (`semo build --target linux-sim|cortex-m-sim --scenario FILE`):
     /// everything the program itself reads or does from the scenario. Its

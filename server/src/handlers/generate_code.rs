@@ -168,7 +168,7 @@ fn default_scenario(
         [one] => Ok(Some(one.clone())),
         [] => Err(format!(
             "a simulation compiles a scenario into each robot: add {} beside the mission, or name one",
-            mission.with_extension("scenario.json").display()
+            semo::sim::complete::own_scenario(mission).display()
         )),
         many => Err(format!(
             "a simulation compiles a scenario into each robot: {} scenarios beside the mission, name one",
@@ -253,11 +253,7 @@ fn build_with_scenario(
         let (line, col) = e.line_col(&text);
         format!("scenario {}:{line}:{col}: {}", path.display(), e.message)
     })?;
-    let worlds: Vec<_> = refined
-        .programs
-        .iter()
-        .map(|p| scenario.compiled_for(p))
-        .collect();
+    let worlds = scenario.compiled_for_each(&refined.programs);
     Ok(codegen::build_refined_each(
         input,
         refined,
