@@ -171,8 +171,9 @@ enum Command {
         sim: bool,
         /// The scenario (`*.scenario.json`; `-`: standard input) compiled
         /// into each robot built for a simulation (`--target linux-sim`,
-        /// `--target cortex-m-sim`, or `--sim`): needed by, and only by,
-        /// such a build; the programs read no scenario file.
+        /// `--target cortex-m-sim`, or `--sim`), and only for such a build;
+        /// default: the mission's own, as for `simulate`. The programs read
+        /// no scenario file.
         #[arg(long)]
         scenario: Option<PathBuf>,
         /// `all` (C code, Makefile and task graph) or `taskgraph` (only the
