@@ -236,7 +236,8 @@ fn build_with_scenario(
     path: &Path,
     targets: &codegen::Targets,
 ) -> Result<BuildResult, String> {
-    let text = std::fs::read_to_string(path)
+    // The library's bounded reader, as every other file the doors read.
+    let text = semo::fsread::read_text(path)
         .map_err(|e| format!("scenario {}: cannot read: {e}", path.display()))?;
     let refined = semo::refine::refine_checked(input);
     if refined.programs.is_empty() {
