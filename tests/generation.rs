@@ -1181,3 +1181,7 @@ fn a_build_syncs_twice_whatever_the_number_of_robots() {
     }
     assert_eq!(syncs, [2, 2]);
 }
+
+/// The stress runs of issue 33 (counts of what was lost or written outside).
+#[path = "generation/stress.rs"]
+mod stress;
