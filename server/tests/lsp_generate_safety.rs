@@ -188,3 +188,8 @@ async fn unknown_dollar_requests_are_answered_method_not_found() {
     // The server goes on answering.
     assert!(client.request("shutdown", Value::Null).await.is_ok());
 }
+
+/// The stress runs of issue 33 (counts of what was written outside or left
+/// partial).
+#[path = "lsp_generate_safety/stress.rs"]
+mod stress;
