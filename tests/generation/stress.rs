@@ -13,7 +13,7 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::thread::JoinHandle;
 
 /// Scouting copied into `dir` twice under two names (every generated file
@@ -337,7 +337,7 @@ fn swapper(real: PathBuf, target: PathBuf, stop: Arc<AtomicBool>) -> JoinHandle<
                 std::thread::yield_now();
                 let _ = std::fs::remove_file(&real);
             }
-            restore(&real, &moved, swaps);
+            restore(&real, &moved);
             std::thread::yield_now();
         }
         swaps
@@ -346,16 +346,29 @@ fn swapper(real: PathBuf, target: PathBuf, stop: Arc<AtomicBool>) -> JoinHandle<
 
 /// `moved` back at `real` (anything the build made there meanwhile is set
 /// aside beside it).
-fn restore(real: &Path, moved: &Path, n: usize) {
-    if let Ok(meta) = std::fs::symlink_metadata(real) {
-        if meta.is_symlink() {
-            std::fs::remove_file(real).unwrap();
-        } else {
-            let aside = real.with_extension(format!("made-{n}"));
-            std::fs::rename(real, aside).unwrap();
+fn restore(real: &Path, moved: &Path) {
+    // The build may make the folder again between any two of these steps
+    // (it found none): whatever is at `real` is set aside until the
+    // rename back wins.
+    static ASIDE: AtomicUsize = AtomicUsize::new(0);
+    for _ in 0..10_000 {
+        if let Ok(meta) = std::fs::symlink_metadata(real) {
+            if meta.is_symlink() {
+                let _ = std::fs::remove_file(real);
+            } else {
+                let n = ASIDE.fetch_add(1, Ordering::SeqCst);
+                let _ = std::fs::rename(real, real.with_extension(format!("made-{n}")));
+            }
+        }
+        if std::fs::rename(moved, real).is_ok() {
+            return;
         }
     }
-    std::fs::rename(moved, real).unwrap();
+    panic!(
+        "{} could not be put back at {}",
+        moved.display(),
+        real.display()
+    );
 }
 
 /// What the link-swap runs counted.

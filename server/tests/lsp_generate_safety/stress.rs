@@ -15,7 +15,7 @@ use serde_json::{Value, json};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -244,14 +244,7 @@ fn swapper(real: PathBuf, target: PathBuf, stop: Arc<AtomicBool>) -> JoinHandle<
                 std::thread::yield_now();
                 let _ = std::fs::remove_file(&real);
             }
-            if let Ok(meta) = std::fs::symlink_metadata(&real) {
-                if meta.is_symlink() {
-                    std::fs::remove_file(&real).unwrap();
-                } else {
-                    std::fs::rename(&real, real.with_extension(format!("made-{swaps}"))).unwrap();
-                }
-            }
-            std::fs::rename(&moved, &real).unwrap();
+            restore(&real, &moved);
             std::thread::yield_now();
         }
         swaps
@@ -272,6 +265,32 @@ fn first_robot_folder(out: &Path) -> PathBuf {
         .collect();
     folders.sort();
     folders.into_iter().next().expect("a robot folder")
+}
+
+/// `moved` back at `real`.
+fn restore(real: &Path, moved: &Path) {
+    // The build may make the folder again between any two of these steps
+    // (it found none): whatever is at `real` is set aside until the
+    // rename back wins.
+    static ASIDE: AtomicUsize = AtomicUsize::new(0);
+    for _ in 0..10_000 {
+        if let Ok(meta) = std::fs::symlink_metadata(real) {
+            if meta.is_symlink() {
+                let _ = std::fs::remove_file(real);
+            } else {
+                let n = ASIDE.fetch_add(1, Ordering::SeqCst);
+                let _ = std::fs::rename(real, real.with_extension(format!("made-{n}")));
+            }
+        }
+        if std::fs::rename(moved, real).is_ok() {
+            return;
+        }
+    }
+    panic!(
+        "{} could not be put back at {}",
+        moved.display(),
+        real.display()
+    );
 }
 
 /// What the link-swap runs counted.
