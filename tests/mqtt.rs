@@ -466,9 +466,20 @@ fn forge(
     datagram: Vec<u8>,
     stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
 ) -> std::thread::JoinHandle<usize> {
+    let mut options = rumqttc::MqttOptions::new(format!("forger-{user}"), "127.0.0.1", port);
+    options.set_credentials(user, password);
+    forge_with(options, topics, datagram, stop)
+}
+
+/// [`forge`] as the client `options` describe (TLS with a client
+/// certificate).
+fn forge_with(
+    options: rumqttc::MqttOptions,
+    topics: Vec<String>,
+    datagram: Vec<u8>,
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+) -> std::thread::JoinHandle<usize> {
     std::thread::spawn(move || {
-        let mut options = rumqttc::MqttOptions::new(format!("forger-{user}"), "127.0.0.1", port);
-        options.set_credentials(user, password);
         let (client, mut connection) = rumqttc::Client::new(options, 256);
         let network = std::thread::spawn(move || {
             for event in connection.iter() {

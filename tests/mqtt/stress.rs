@@ -113,6 +113,78 @@ fn stress_forged_operator_commands_are_never_taken() {
     assert_eq!((commands_taken, heartbeats_taken), (0, 0));
 }
 
+/// The slaves' stolen TLS identity (their user, password, client
+/// certificate and key, in `dir` as `tls_files` made them) as a client of
+/// the broker at `port`: the options of an attacker's client.
+fn slaves_over_tls(dir: &Path, port: u16) -> rumqttc::MqttOptions {
+    let file = dir.join("stolen.deploy.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "broker = \"mqtts://127.0.0.1:{port}\"\nca = \"ca.crt\"\n\n[operator]\nuser = \"slaves\"\npassword_file = \"slaves.pw\"\ncert = \"slaves.crt\"\nkey = \"slaves.key\"\n"
+        ),
+    )
+    .unwrap();
+    let stolen = semo::deploy::load(&file, semo::diag::FileId(0)).unwrap();
+    let url = format!("mqtts://127.0.0.1:{port}");
+    semo_server::live::BrokerAccess::new(&url, Some(&stolen))
+        .unwrap()
+        .options("forger-slaves-tls".into())
+}
+
+#[test]
+#[ignore = "stress run (minutes, real time): cargo test --test mqtt -- --ignored stress_"]
+fn stress_forged_operator_commands_over_tls_are_never_taken() {
+    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-stress-forged-tls", true) else {
+        return;
+    };
+    let (out, port) = (fleet.out.clone(), fleet.port);
+    let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
+    let folders = super::build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
+    let operator_topic = topics::to_team(
+        &scouting_run(FORGED_RUN),
+        "MasterTeam",
+        "USER.RC_CMD",
+        topics::OPERATOR,
+    );
+    let mut slave_topics = writable(&acl, "slaves", FORGED_RUN);
+    slave_topics.push(operator_topic);
+    let runs = sized("SEMO_STRESS_RUNS", 5);
+    let (mut commands, mut taken, mut refused_total) = (0, 0, 0);
+    for run in 0..runs {
+        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let forger = super::forge_with(
+            slaves_over_tls(&out, port),
+            slave_topics.clone(),
+            semo_server::live::operator_datagram("USER.RC_CMD", "RC_MODE"),
+            stop.clone(),
+        );
+        let forged = super::run_together(
+            &folders,
+            &out,
+            &format!("forged-tls-{run}"),
+            &[
+                "--transport".into(),
+                "mqtt".into(),
+                "--run".into(),
+                FORGED_RUN.into(),
+            ],
+            &mut fleet.processes,
+        );
+        stop.store(true, std::sync::atomic::Ordering::SeqCst);
+        commands += forger.join().unwrap();
+        let rc_mode = usize::from(modes(&forged["irobot"]).iter().any(|m| m == "RC_MODE"));
+        taken += received_from(&forged["irobot"], "operator", "USER.RC_CMD").len() + rc_mode;
+        refused_total += refused(&forged["irobot"]);
+    }
+    eprintln!(
+        "stress: {runs} scouting runs over mosquitto with TLS and client certificates: {commands} forged operator commands \
+         (the slaves' password, certificate and key), {taken} taken, {refused_total} delivered and refused by irobot"
+    );
+    assert!(commands > 0 && refused_total > 0);
+    assert_eq!(taken, 0);
+}
+
 /// patrol_groups built with its deployment over a broker running the
 /// generated ACL, and a scenario of `duration` ms in real time.
 fn patrol_fleet(name: &str, duration: i64) -> Option<(Fleet, Vec<PathBuf>, PathBuf, String)> {
@@ -169,6 +241,8 @@ struct Takeover {
     took_over: Option<i64>,
     /// Forged messages the Guards refused (`reject`, sender not its topic).
     forged_refused: usize,
+    /// Forged heartbeats ([`FORGED_HEARTBEAT`]) a robot took as tb_0's.
+    forged_taken: usize,
 }
 
 /// Runs the Guards (and the rest of patrol_groups) in run [`FORGED_RUN`]
@@ -242,7 +316,17 @@ fn kill_the_leader(
         .iter()
         .map(|robot| refused(&traces[*robot]))
         .sum();
+    let forged_taken = traces
+        .values()
+        .map(|events| {
+            received_from(events, "tb_0", "Guards.__alive")
+                .iter()
+                .filter(|v| *v == FORGED_HEARTBEAT)
+                .count()
+        })
+        .sum();
     Takeover {
+        forged_taken,
         killed_at,
         last_heartbeat,
         took_over,
@@ -302,7 +386,7 @@ fn stress_forged_heartbeats_keep_no_killed_leader_alive() {
     };
     let own_topic = format!("semo/patrol_groups/{FORGED_RUN}/Guards/Guards.__alive/Guards/tb_0");
     let kills = sized("SEMO_STRESS_RUNS", 10);
-    let (mut kept_alive, mut refused_total, mut no_leader) = (0, 0, Vec::new());
+    let (mut kept_alive, mut refused_total, mut taken, mut no_leader) = (0, 0, 0, Vec::new());
     for k in 0..kills {
         // tb_1's credentials (a robot of tb_0's team with a user of its
         // own) and the base's, in turn: tb_0's heartbeat ("leader", a term
@@ -334,6 +418,7 @@ fn stress_forged_heartbeats_keep_no_killed_leader_alive() {
             Some(forger),
         );
         refused_total += t.forged_refused;
+        taken += t.forged_taken;
         match t.took_over {
             Some(at) => no_leader.push(at - t.killed_at),
             None => kept_alive += 1,
@@ -345,11 +430,11 @@ fn stress_forged_heartbeats_keep_no_killed_leader_alive() {
         spread(&mut no_leader)
     };
     eprintln!(
-        "stress: {kills} kills of the leader tb_0 while tb_1's credentials (odd runs: the base's) forged its heartbeats: {kept_alive} kept it alive \
-         (no takeover), {refused_total} forged messages delivered and refused; no leader for {min} / {median} / {max} ms \
+        "stress: {kills} kills of the leader tb_0 while tb_1's credentials (odd runs: the base's) forged its heartbeats: {taken} taken, {kept_alive} runs \
+         in which it was kept alive (no takeover), {refused_total} forged messages delivered and refused; no leader for {min} / {median} / {max} ms \
          after the kill (min / median / max)"
     );
-    assert_eq!(kept_alive, 0);
+    assert_eq!((taken, kept_alive), (0, 0));
 }
 
 /// One partition of tb_0 (the leader) from the broker: two leaders' time
