@@ -201,11 +201,15 @@ fn user_during_builds(name: &str, builds: usize, in_place: bool) -> UserCounts {
         }
         let code = child.wait().unwrap().code();
         let report = stderr.join().unwrap();
-        last_actions = action;
         counts.builds += 1;
         match code {
-            Some(0) => {}
-            Some(1) if report.contains("while semo was") => counts.builds_kept_changes += 1,
+            // The length of a build that generated (a refused one stops
+            // early) is where the next one's edits are spread.
+            Some(0) => last_actions = action,
+            Some(1) if report.contains("while semo was") => {
+                counts.builds_kept_changes += 1;
+                last_actions = action;
+            }
             // An edit made before the build looked: a conflict, nothing written.
             Some(1) if report.contains("nothing was written") => counts.builds_refused += 1,
             other => panic!("build {round}: {other:?}: {report}"),
