@@ -40,7 +40,8 @@ pub struct State {
     pub indexed: Indexed,
 }
 
-/// Opens once the workspace folders were read (after `initialized`).
+/// Opens once the workspace folders were read (after `initialized`), or at
+/// `initialize` when there are none.
 /// Requests and the diagnostics task wait for it, so that the first answer
 /// after start sees the project file and the catalogs as later ones do: a
 /// request sent at once after `initialized` would otherwise race the read

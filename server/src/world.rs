@@ -372,7 +372,7 @@ impl World {
         // The snapshots once every file is in: a snapshot holds the host's
         // table of files, and setting a file while one is held copies the
         // whole table (a workspace of N files cost N copies of N entries).
-        let mut ids = Vec::new();
+        let mut fresh = Vec::new();
         for (uri, id, kind, path, text) in read {
             let snapshot = Arc::new(self.new_snapshot(&uri, id, kind, None, text));
             let entry = FileEntry {
@@ -381,16 +381,22 @@ impl World {
                 path: Some(path),
                 snapshot,
             };
+            fresh.push(uri.clone());
             if let Some(old) = self.files.insert(uri, entry) {
                 retire_to(&self.dropper, old.snapshot);
             }
-            ids.push(id);
         }
-        // What the open documents see may have changed too.
-        ids.extend(self.files.values().map(|f| f.snapshot.id));
-        ids.sort();
-        ids.dedup();
-        self.renew(&ids)
+        // What the files known before (open documents among them) see may
+        // have changed too; the files just read already see it all.
+        let just_read: std::collections::HashSet<&Uri> = fresh.iter().collect();
+        let known: Vec<FileId> = (self.files.iter())
+            .filter(|(uri, _)| !just_read.contains(uri))
+            .map(|(_, f)| f.snapshot.id)
+            .collect();
+        let mut changed = self.renew(&known);
+        changed.files.extend(fresh);
+        self.in_check_order(&mut changed.files);
+        changed
     }
 
     /// A file was deleted on disk. An open document stays as the client has it.
@@ -502,6 +508,16 @@ impl World {
             .collect()
     }
 
+    /// Missions first, then catalogs, task graphs and project files, then
+    /// strategies: the order their diagnostics are published in.
+    fn in_check_order(&self, uris: &mut [Uri]) {
+        uris.sort_by_key(|u| match self.files[u].kind {
+            FileKind::Mission => 0,
+            FileKind::Catalog | FileKind::TaskGraph | FileKind::Project => 1,
+            FileKind::Strategy => 2,
+        });
+    }
+
     /// New snapshots (same text, the current workspace) for the files `ids`;
     /// the old ones are retired; listed in a fixed order by kind, missions
     /// first.
@@ -511,11 +527,7 @@ impl World {
             .filter_map(|&id| self.uri_of(id).cloned())
             .filter(|u| self.files.contains_key(u))
             .collect();
-        uris.sort_by_key(|u| match self.files[u].kind {
-            FileKind::Mission => 0,
-            FileKind::Catalog | FileKind::TaskGraph | FileKind::Project => 1,
-            FileKind::Strategy => 2,
-        });
+        self.in_check_order(&mut uris);
         for uri in &uris {
             let old = self.files[uri].snapshot.clone();
             let fresh =

@@ -162,6 +162,30 @@ async fn a_request_sent_at_once_after_start_sees_the_workspace() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A client with no workspace folder that never sends `initialized` (out of
+/// protocol, but some do) still gets answers: with nothing to read, the
+/// server does not wait for the read.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn without_folders_requests_are_answered_before_initialized() {
+    let mut client = TestClient::start();
+    client
+        .request(
+            "initialize",
+            json!({ "processId": null, "rootUri": null, "capabilities": {} }),
+        )
+        .await
+        .unwrap();
+    let catalog = client
+        .request(
+            "semo/catalog",
+            json!({ "uri": "file:///nowhere/a.mission" }),
+        )
+        .await
+        .unwrap();
+    assert!(catalog["robots"].as_array().is_some_and(|r| !r.is_empty()));
+    client.shutdown().await;
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_catalog_request_lists_builtin_and_workspace_robot_types_and_follows_changes() {
     let mut client = TestClient::start();
