@@ -121,7 +121,7 @@ pub const ELEMENTS: &[ElementInfo] = &[
     element(
         "Parameter",
         PARAMETER_ATTRS,
-        &["name"],
+        &["name", "type", "dataCharacteristic"],
         "Data of an action: from or to a task (`channel`, `sysRequest`) or local to the control task (`variable`). Conditions read parameters by name.",
     ),
     element(

@@ -162,6 +162,12 @@ impl Reader<'_> {
 
     /// A required attribute: E083 when missing, E084 when blank.
     fn required<'e>(&mut self, e: &'e Elem, key: &str) -> Option<&'e Attr> {
+        // The schema's list is what completion inserts and the docs show.
+        debug_assert!(
+            element_info(&e.local).is_some_and(|info| info.required.contains(&key)),
+            "strategy::schema does not list `{key}` as required on `<{}>`",
+            e.local
+        );
         match get(&e.attrs, key) {
             None => {
                 let message = format!("`<{}>` needs a `{key}` attribute", e.local);
