@@ -16,6 +16,7 @@ mod support;
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
+use support::markdown::{blocks, broken_links, links};
 use support::{parse_json_report, repo_root, semo_in};
 
 /// A page of the reference: its file name and text.
@@ -39,34 +40,6 @@ fn pages() -> Vec<Page> {
     pages.sort_by(|a, b| a.name.cmp(&b.name));
     assert!(pages.len() > 1, "no pages in {}", dir.display());
     pages
-}
-
-/// A fenced block: its info string, its text, and the line of its opening fence.
-struct Block {
-    info: String,
-    body: String,
-    line: usize,
-}
-
-fn blocks(text: &str) -> Vec<Block> {
-    let mut blocks = Vec::new();
-    let mut lines = text.lines().enumerate();
-    while let Some((number, line)) = lines.next() {
-        let Some(info) = line.strip_prefix("```") else {
-            continue;
-        };
-        let body: Vec<&str> = lines
-            .by_ref()
-            .map(|(_, l)| l)
-            .take_while(|l| *l != "```")
-            .collect();
-        blocks.push(Block {
-            info: info.trim().to_string(),
-            body: body.join("\n") + "\n",
-            line: number + 1,
-        });
-    }
-    blocks
 }
 
 /// What a block's tag asks for.
@@ -224,36 +197,6 @@ fn every_example_of_the_reference_checks_and_runs_as_it_says() {
     assert!(missions >= 20, "only {missions} examples");
 }
 
-/// The relative links of a page: (target file, anchor), without web links.
-fn links(text: &str) -> Vec<(String, Option<String>)> {
-    let mut out = Vec::new();
-    let mut rest = text;
-    while let Some(at) = rest.find("](") {
-        rest = &rest[at + 2..];
-        let Some(end) = rest.find(')') else { break };
-        let target = &rest[..end];
-        if target.contains("://") || target.starts_with("mailto:") {
-            continue;
-        }
-        let (file, anchor) = match target.split_once('#') {
-            Some((file, anchor)) => (file.to_string(), Some(anchor.to_string())),
-            None => (target.to_string(), None),
-        };
-        out.push((file, anchor));
-    }
-    out
-}
-
-/// A heading's anchor as GitHub makes it.
-use semo::ide::mission::keywords::heading_anchor as slug;
-
-fn anchors(text: &str) -> BTreeSet<String> {
-    text.lines()
-        .filter(|l| l.starts_with('#'))
-        .map(|l| slug(l.trim_start_matches('#')))
-        .collect()
-}
-
 #[test]
 fn every_page_is_listed_in_the_index() {
     let pages = pages();
@@ -276,22 +219,8 @@ fn every_page_is_listed_in_the_index() {
 #[test]
 fn every_link_of_the_reference_leads_somewhere() {
     let dir = repo_root().join("docs/language");
-    let mut broken = Vec::new();
-    for page in pages() {
-        for (file, anchor) in links(&page.text) {
-            let target = if file.is_empty() {
-                dir.join(&page.name)
-            } else {
-                dir.join(&file)
-            };
-            let Ok(text) = std::fs::read_to_string(&target) else {
-                broken.push(format!("{}: {file} does not exist", page.name));
-                continue;
-            };
-            if let Some(anchor) = anchor.filter(|a| !anchors(&text).contains(a)) {
-                broken.push(format!("{}: {file} has no heading #{anchor}", page.name));
-            }
-        }
-    }
+    let broken: Vec<String> = (pages().iter())
+        .flat_map(|page| broken_links(&dir, &page.name, &page.text))
+        .collect();
     assert!(broken.is_empty(), "{}", broken.join("\n"));
 }

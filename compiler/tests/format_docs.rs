@@ -25,6 +25,9 @@ use semo::strategy::{self, DataCharacteristic, LeaderAlgorithm};
 use semo::taskgraph::{self, analysis};
 use std::path::{Path, PathBuf};
 
+#[path = "../../tests/support/markdown.rs"]
+mod markdown;
+
 fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
@@ -172,34 +175,6 @@ fn taskgraph_page_names_every_element_and_attribute_of_both_formats() {
     assert_complete("taskgraph.md", missing);
 }
 
-/// A fenced block: its info string, its text and the line of its fence.
-struct Block {
-    info: String,
-    body: String,
-    line: usize,
-}
-
-fn blocks(text: &str) -> Vec<Block> {
-    let mut blocks = Vec::new();
-    let mut lines = text.lines().enumerate();
-    while let Some((number, line)) = lines.next() {
-        let Some(info) = line.strip_prefix("```") else {
-            continue;
-        };
-        let body: Vec<&str> = lines
-            .by_ref()
-            .map(|(_, l)| l)
-            .take_while(|l| *l != "```")
-            .collect();
-        blocks.push(Block {
-            info: info.trim().to_string(),
-            body: body.join("\n") + "\n",
-            line: number + 1,
-        });
-    }
-    blocks
-}
-
 fn listing(diagnostics: &[Diagnostic]) -> String {
     diagnostics
         .iter()
@@ -214,7 +189,7 @@ fn load_blocks(name: &str, load: impl Fn(&str) -> Result<(), String>) -> usize {
     let text = page(name);
     let mut failures = Vec::new();
     let mut loaded = 0;
-    for block in blocks(&text) {
+    for block in markdown::blocks(&text) {
         let place = format!("docs/{name}:{}", block.line);
         match block.info.as_str() {
             "xml" => match load(&block.body) {
@@ -290,42 +265,11 @@ fn taskgraph_page_examples_load_and_analyse_cleanly() {
 /// language pages).
 #[test]
 fn every_link_of_the_pages_leads_somewhere() {
-    use semo::ide::mission::keywords::heading_anchor;
-    let anchors = |text: &str| -> Vec<String> {
-        text.lines()
-            .filter(|l| l.starts_with('#'))
-            .map(|l| heading_anchor(l.trim_start_matches('#')))
-            .collect()
-    };
     let docs = repo_root().join("docs");
-    let mut broken = Vec::new();
-    for name in ["catalog.md", "strategy.md", "taskgraph.md"] {
-        let text = page(name);
-        let mut rest = text.as_str();
-        while let Some(at) = rest.find("](") {
-            rest = &rest[at + 2..];
-            let Some(end) = rest.find(')') else { break };
-            let target = &rest[..end];
-            if target.contains("://") {
-                continue;
-            }
-            let (file, anchor) = target.split_once('#').unwrap_or((target, ""));
-            let linked = if file.is_empty() {
-                Some(text.clone())
-            } else {
-                std::fs::read_to_string(docs.join(file)).ok()
-            };
-            match linked {
-                None => broken.push(format!("docs/{name}: {target}: no such file")),
-                Some(linked)
-                    if !anchor.is_empty() && !anchors(&linked).iter().any(|a| a == anchor) =>
-                {
-                    broken.push(format!("docs/{name}: {target}: no such heading"))
-                }
-                Some(_) => {}
-            }
-        }
-    }
+    let broken: Vec<String> = ["catalog.md", "strategy.md", "taskgraph.md"]
+        .into_iter()
+        .flat_map(|name| markdown::broken_links(&docs, &format!("docs/{name}"), &page(name)))
+        .collect();
     assert!(broken.is_empty(), "{}", broken.join("\n"));
 }
 
