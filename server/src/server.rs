@@ -338,9 +338,34 @@ impl Backend {
                 Err(e) => return Err(self.generation_failed(progress, e).await),
             }
         }
-        let kept = match tokio::task::spawn_blocking(move || transaction.commit())
-            .await
-            .map_err(|_| Error::internal_error())?
+        // A cancel that comes once files are being replaced is too late: the
+        // generation finishes, and the user is told so (the client got
+        // `Canceled` and shows no outcome).
+        let late = Arc::new(LateCancel {
+            cancelled: cancelled.0.clone(),
+            committed: AtomicBool::new(false),
+            answered: AtomicBool::new(false),
+            told: AtomicBool::new(false),
+            client: self.client.clone(),
+            runtime: tokio::runtime::Handle::current(),
+            message: format!(
+                "SeMo: Generate Code was cancelled too late: the code of {} robot(s) was written to {}",
+                all.len(),
+                job.out.path().display()
+            ),
+        });
+        let _told_when_dropped = LateCancelGuard(late.clone());
+        let committing = late.clone();
+        let kept = match tokio::task::spawn_blocking(move || {
+            let kept = transaction.commit();
+            if kept.is_ok() {
+                committing.committed.store(true, Ordering::SeqCst);
+                committing.tell_if_late();
+            }
+            kept
+        })
+        .await
+        .map_err(|_| Error::internal_error())?
         {
             Ok(kept) => kept,
             Err(e) => return Err(self.generation_failed(progress, e).await),
@@ -373,6 +398,7 @@ impl Backend {
             job.out.path().display()
         );
         self.tell_generation(MessageType::INFO, &message).await;
+        late.answered.store(true, Ordering::SeqCst);
         Ok(serde_json::json!({
             "refused": false,
             "outputFolder": job.out.path().display().to_string(),
@@ -508,6 +534,12 @@ impl LanguageServer for Backend {
             let mut world = self.state.world();
             world.encoding = encoding;
             world.set_roots(roots(&params));
+            // With no folder to read there is nothing to wait for: opened
+            // here, a client that never sends `initialized` (the protocol
+            // asks it to) still gets answers.
+            if world.roots().is_empty() {
+                self.state.indexed.open();
+            }
         }
         Ok(InitializeResult {
             server_info: Some(ServerInfo {
@@ -834,6 +866,47 @@ fn unknown_document(uri: &Uri) -> Error {
         code: tower_lsp_server::jsonrpc::ErrorCode::InvalidParams,
         message: format!("unknown document {}", uri.as_str()).into(),
         data: None,
+    }
+}
+
+/// A Generate Code request whose files are being replaced: a cancel then
+/// no longer stops it. Whichever sees both the cancel and the end of the
+/// replacing second (the blocking work, or the dropped request) tells the
+/// user, once.
+struct LateCancel {
+    cancelled: Arc<AtomicBool>,
+    committed: AtomicBool,
+    /// The request answered with its result: no cancel came in time to drop it.
+    answered: AtomicBool,
+    told: AtomicBool,
+    client: Client,
+    runtime: tokio::runtime::Handle,
+    message: String,
+}
+
+impl LateCancel {
+    fn tell_if_late(&self) {
+        let late = self.cancelled.load(Ordering::SeqCst)
+            && self.committed.load(Ordering::SeqCst)
+            && !self.answered.load(Ordering::SeqCst);
+        if late && !self.told.swap(true, Ordering::SeqCst) {
+            let (client, message) = (self.client.clone(), self.message.clone());
+            self.runtime.spawn(async move {
+                client.show_message(MessageType::WARNING, message).await;
+            });
+        }
+    }
+}
+
+/// Held by the request's future: dropped (the request cancelled, or
+/// answered), it marks the cancel and tells the user if the files were
+/// already replaced.
+struct LateCancelGuard(Arc<LateCancel>);
+
+impl Drop for LateCancelGuard {
+    fn drop(&mut self) {
+        self.0.cancelled.store(true, Ordering::SeqCst);
+        self.0.tell_if_late();
     }
 }
 

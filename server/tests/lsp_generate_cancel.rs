@@ -1,5 +1,6 @@
-//! Cancelling `semo.generateCode` (issue 33): the generation stops before
-//! its next robot and leaves the output folder as it was. A test binary of
+//! Cancelling `semo.generateCode`: the generation stops before its next
+//! robot and leaves the output folder as it was; a cancel that comes once
+//! files are being replaced is too late, and the user is told. A test binary of
 //! its own: it pauses the server's generations through the hidden
 //! `SEMO_PAUSE_AFTER_FS_OPS` / `SEMO_PAUSE_SOCKET`, which hold for the whole
 //! process.
@@ -41,9 +42,18 @@ fn walk(root: &Path, dir: &Path) -> BTreeMap<PathBuf, Option<Vec<u8>>> {
     found
 }
 
-/// Answers the generations' pauses: each paused step's line goes to the
-/// test, which lets it go on by sending `()`.
-fn pause_answerer(socket: PathBuf) -> (mpsc::Receiver<String>, mpsc::Sender<()>) {
+/// Where the test holds a generation: given each paused step's line
+/// (`paused N KIND`), whether to hand it to the test.
+type HoldAt = std::sync::Arc<std::sync::Mutex<Box<dyn FnMut(&str) -> bool + Send>>>;
+
+fn hold_at(when: impl FnMut(&str) -> bool + Send + 'static) -> Box<dyn FnMut(&str) -> bool + Send> {
+    Box::new(when)
+}
+
+/// Answers the generations' pauses (one after every step): a step that
+/// `hold` picks goes to the test, which lets it go on by sending `()`; the
+/// others go on at once.
+fn pause_answerer(socket: PathBuf, hold: HoldAt) -> (mpsc::Receiver<String>, mpsc::Sender<()>) {
     let (paused_tx, paused_rx) = mpsc::channel();
     let (go_tx, go_rx) = mpsc::channel::<()>();
     let listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
@@ -55,9 +65,11 @@ fn pause_answerer(socket: PathBuf) -> (mpsc::Receiver<String>, mpsc::Sender<()>)
             if std::io::BufReader::new(&paused)
                 .read_line(&mut line)
                 .is_err()
-                || paused_tx.send(line).is_err()
-                || go_rx.recv().is_err()
             {
+                return;
+            }
+            let held = (hold.lock().unwrap())(&line);
+            if held && (paused_tx.send(line).is_err() || go_rx.recv().is_err()) {
                 return;
             }
         }
@@ -65,7 +77,7 @@ fn pause_answerer(socket: PathBuf) -> (mpsc::Receiver<String>, mpsc::Sender<()>)
     (paused_rx, go_tx)
 }
 
-/// The line of the next paused generation.
+/// The line of the next held pause.
 fn next_pause(paused: &mpsc::Receiver<String>) -> String {
     tokio::task::block_in_place(|| paused.recv().unwrap())
 }
@@ -86,11 +98,14 @@ async fn a_cancelled_generation_leaves_the_output_folder_as_it_was() {
     // file staged for its first robot).
     // SAFETY: set before the server starts; no other thread reads the
     // environment yet.
+    let every_step: Vec<String> = (1..=5000).map(|n| n.to_string()).collect();
     unsafe {
-        std::env::set_var("SEMO_PAUSE_AFTER_FS_OPS", "1");
+        std::env::set_var("SEMO_PAUSE_AFTER_FS_OPS", every_step.join(","));
         std::env::set_var("SEMO_PAUSE_SOCKET", &socket);
     }
-    let (paused, go) = pause_answerer(socket);
+    let first_step = || hold_at(|line| line.starts_with("paused 1 "));
+    let hold: HoldAt = std::sync::Arc::new(std::sync::Mutex::new(first_step()));
+    let (paused, go) = pause_answerer(socket, hold.clone());
     let mut client = semo_server::harness::TestClient::start();
     client.initialize_with(json!({}), Some(&uri(&ws))).await;
     let mission = ws.join("scouting.mission");
@@ -157,5 +172,44 @@ async fn a_cancelled_generation_leaves_the_output_folder_as_it_was() {
     let done: Value = client.response(id).await.unwrap();
     assert_eq!(done["target"], "linux-sim", "{done}");
     assert!(contents(&out) != before);
+
+    // A cancel that comes once the files are replaced (after the
+    // generation's second sync, which makes the replacement durable) is too
+    // late: the generation finishes, and the user is told so, since the
+    // client got `Canceled` and shows no outcome.
+    let before = contents(&out);
+    let mut syncs = 0;
+    *hold.lock().unwrap() = hold_at(move |line| {
+        syncs += usize::from(line.trim_end().ends_with(" sync"));
+        syncs == 2 && line.trim_end().ends_with(" sync")
+    });
+    let id = client
+        .send_request("workspace/executeCommand", generate("linux"))
+        .await;
+    let line = next_pause(&paused);
+    assert!(line.trim_end().ends_with(" sync"), "{line}");
+    client.notify("$/cancelRequest", json!({ "id": id })).await;
+    let cancelled = client.response(id).await.unwrap_err();
+    assert_eq!(cancelled["code"], -32800, "{cancelled}");
+    go.send(()).unwrap();
+    let told = client
+        .notification("window/showMessage", |m| {
+            m["message"]
+                .as_str()
+                .is_some_and(|t| t.contains("cancelled too late"))
+        })
+        .await;
+    assert_eq!(told["type"], 2, "a warning: {told}");
+    assert!(
+        told["message"].as_str().unwrap().contains("3 robot(s)"),
+        "{told}"
+    );
+    let after = contents(&out);
+    assert!(after != before, "the generation finished");
+    assert!(
+        after.keys().all(|p| !p.starts_with(".semo-work")),
+        "no work left: {:?}",
+        after.keys().collect::<Vec<_>>()
+    );
     client.shutdown().await;
 }

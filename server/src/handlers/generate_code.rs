@@ -28,7 +28,8 @@
 //!
 //! Cancelling the request (`$/cancelRequest`) stops the generation before
 //! its next robot, or before it replaces the first file: the folder stays
-//! as it was. Files changed while it ran are kept and listed in the
+//! as it was. A cancel that comes later is too late: the generation
+//! finishes, and a warning (`window/showMessage`) says the code was written. Files changed while it ran are kept and listed in the
 //! result's `kept` (`[{ "path", "why" }]`).
 
 use crate::encoding::LineMap;

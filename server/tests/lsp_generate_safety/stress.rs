@@ -120,6 +120,8 @@ struct CancelCounts {
     /// Answered `Canceled` once the generation had begun replacing files
     /// (its last step, which is not stopped half-way): the new folder whole.
     cancelled_too_late: usize,
+    /// Of those, told by a warning that the code was written.
+    told_too_late: usize,
     /// Done before the cancellation came: the new folder whole.
     completed: usize,
     /// Neither the old folder nor the new one whole.
@@ -183,6 +185,15 @@ async fn cancellations(name: &str, requests: usize) -> CancelCounts {
                     counts.as_it_was += 1;
                 } else if new_whole {
                     counts.cancelled_too_late += 1;
+                    // The client got `Canceled`: the server says the code
+                    // was written all the same.
+                    client
+                        .notification("window/showMessage", |m| {
+                            (m["message"].as_str())
+                                .is_some_and(|t| t.contains("cancelled too late"))
+                        })
+                        .await;
+                    counts.told_too_late += 1;
                 } else {
                     let changed: Vec<_> = after
                         .iter()
@@ -205,9 +216,15 @@ async fn cancellations(name: &str, requests: usize) -> CancelCounts {
 fn print_cancellations(c: &CancelCounts) {
     eprintln!(
         "stress: {} Generate Code requests cancelled at varied moments: {} answered Canceled ({} left the folder as it was, \
-         {} came once the files were being replaced and the new folder is whole), {} completed first; \
+         {} came once the files were being replaced and the new folder is whole, {} of them told so), {} completed first; \
          {} left the folder partial",
-        c.requests, c.cancelled, c.as_it_was, c.cancelled_too_late, c.completed, c.partial
+        c.requests,
+        c.cancelled,
+        c.as_it_was,
+        c.cancelled_too_late,
+        c.told_too_late,
+        c.completed,
+        c.partial
     );
 }
 
