@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use support::mosquitto::free_port;
 use support::mqtt::{Fleet, Processes, Started, folder_of, read_trace, robot_name};
-use support::robots::{Event, PEDANTIC, build_sim, field, modes, robot_folders, scratch};
+use support::robots::{Event, PEDANTIC, build_sim, events, field, modes, robot_folders, scratch};
 use support::{examples, repo_root};
 
 /// `semo build` of the scouting mission for linux-sim, each robot made with
@@ -1229,19 +1229,77 @@ fn robots_reconnect_after_a_broker_restart_and_no_send_is_lost() {
     );
 }
 
+/// The slaves' sends to the master so far, counted in a live trace file
+/// (the robot flushes each line; a line still being written is not counted).
+fn sends_to_master_so_far(trace: &Path) -> usize {
+    let text = std::fs::read_to_string(trace).unwrap_or_default();
+    let whole = &text[..text.rfind('\n').map_or(0, |end| end + 1)];
+    events(&whole.lines().map(str::to_string).collect::<Vec<_>>())
+        .iter()
+        .filter(|e| field(e, "event") == "send" && field(e, "to") == "MasterTeam")
+        .count()
+}
+
+/// Waits until `trace`'s robot has sent the master more than `than`
+/// messages; fails if the robot ends first.
+fn wait_for_sends(
+    fleet: &mut Fleet,
+    index: usize,
+    robot: &str,
+    trace: &Path,
+    than: usize,
+) -> usize {
+    loop {
+        let sent = sends_to_master_so_far(trace);
+        if sent > than {
+            return sent;
+        }
+        assert!(
+            fleet.processes.is_running(index),
+            "{robot} ended having sent the master {sent} message(s), waiting for more than {than}"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+}
+
+/// The master is killed while the slaves send it their colors, and restarted
+/// after each slave has sent it something more: what they sent meanwhile
+/// reaches its second life (its persistent session kept it). "Meanwhile" is
+/// read from the order of each slave's own trace (the sends after the ones
+/// counted at the kill, up to the ones counted at the restart), not from
+/// clocks, so a loaded machine cannot move a send out of the window.
 #[test]
 fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
     let Some(mut fleet) = Fleet::start("mqtt-robot-restart") else {
         return;
     };
     let folders = build_scouting(&fleet.out);
+    // The fixture's scenario with the slaves searching longer (their last
+    // color at 5.5 s instead of 3.5 s), so that they are still sending when
+    // the master comes back; the master's own mission is unchanged.
+    let mut world: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scenario()).unwrap()).unwrap();
+    for (slave, rgb) in [("ti", 5500), ("nxt", 5700)] {
+        for sensor in world["robots"][slave]["sensors"].as_array_mut().unwrap() {
+            let at = sensor["at"].as_i64().unwrap();
+            match (
+                sensor["value"].as_str().unwrap(),
+                sensor["is"].as_str().unwrap(),
+            ) {
+                ("COLOR", "RGB") => sensor["at"] = serde_json::json!(rgb),
+                ("LOCATION", "0,0") if at > 0 => sensor["at"] = serde_json::json!(rgb + 1000),
+                _ => {}
+            }
+        }
+    }
+    let world_file = fleet.out.join("longer-search.scenario.json");
+    std::fs::write(&world_file, world.to_string()).unwrap();
     const SCALE: f64 = 0.4; // wall ms per mission ms
     let scale = SCALE.to_string();
     let spawn = |fleet: &mut Fleet, folder: &Path, tag: &str| {
-        let run = fleet.spawn(folder, &scenario(), tag, &["--time-scale", &scale]);
+        let run = fleet.spawn(folder, &world_file, tag, &["--time-scale", &scale]);
         (run.trace, run.index)
     };
-    let started = std::time::Instant::now();
     let mut slaves = Vec::new();
     let mut master = None;
     for folder in &folders {
@@ -1253,17 +1311,28 @@ fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
         }
     }
     let (irobot, first) = master.unwrap();
-    // Killed while the slaves send their colors; back a moment later.
-    std::thread::sleep(std::time::Duration::from_millis(600));
+    // Killed once every slave is sending; back once every slave has sent
+    // it something more.
+    for (robot, trace, index) in &slaves {
+        wait_for_sends(&mut fleet, *index, robot, trace, 0);
+    }
     fleet.processes.kill(first);
-    let killed = started.elapsed().as_secs_f64() * 1000.0;
-    std::thread::sleep(std::time::Duration::from_millis(300));
-    let back_at = started.elapsed().as_secs_f64() * 1000.0;
+    let at_kill: Vec<usize> = (slaves.iter())
+        .map(|(_, trace, _)| sends_to_master_so_far(trace))
+        .collect();
+    for ((robot, trace, index), &before) in slaves.iter().zip(&at_kill) {
+        wait_for_sends(&mut fleet, *index, robot, trace, before);
+    }
+    let at_restart: Vec<usize> = (slaves.iter())
+        .map(|(_, trace, _)| sends_to_master_so_far(trace))
+        .collect();
     let (second_trace, second) = spawn(&mut fleet, &irobot, "second-life");
     let mut slave_traces = BTreeMap::new();
-    for (robot, trace, index) in slaves {
+    for ((robot, trace, index), window) in
+        slaves.into_iter().zip(at_kill.into_iter().zip(at_restart))
+    {
         fleet.processes.wait_success(index, &robot);
-        slave_traces.insert(robot, read_trace(&trace));
+        slave_traces.insert(robot, (read_trace(&trace), window));
     }
     fleet.processes.wait_success(second, "irobot (second life)");
     let second_life = read_trace(&second_trace);
@@ -1273,17 +1342,14 @@ fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
         "the restarted master runs its mission: {:?}",
         modes(&second_life)
     );
-    // What each slave sent while the master was dead (its mission clock
-    // started with ours; 50 ms of margin at each end) reaches the master's
+    // What each slave sent while the master was dead reaches the master's
     // second life: its persistent session kept it.
-    let (from, to) = ((killed + 50.0) / SCALE, (back_at - 50.0) / SCALE);
-    for (slave, events) in &slave_traces {
+    for (slave, (events, (at_kill, at_restart))) in &slave_traces {
         let meanwhile: Vec<(String, String)> = events
             .iter()
-            .filter(|e| {
-                let t = e["t"].as_f64().unwrap_or(0.0);
-                field(e, "event") == "send" && field(e, "to") == "MasterTeam" && t > from && t < to
-            })
+            .filter(|e| field(e, "event") == "send" && field(e, "to") == "MasterTeam")
+            .skip(*at_kill)
+            .take(at_restart - at_kill)
             .map(|e| (field(e, "key").to_string(), field(e, "value").to_string()))
             .collect();
         assert!(
@@ -1300,9 +1366,7 @@ fn a_killed_robot_restarts_and_gets_what_was_sent_while_it_was_dead() {
             received.remove(at.unwrap());
         }
         assert!(
-            !slave_traces[slave]
-                .iter()
-                .any(|e| field(e, "event") == "comm_error"),
+            !events.iter().any(|e| field(e, "event") == "comm_error"),
             "{slave} never fails to send"
         );
     }

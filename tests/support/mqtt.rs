@@ -77,6 +77,11 @@ impl Processes {
         child.wait().expect("wait for the terminated process");
     }
 
+    /// Whether the process is still running (not yet ended by itself).
+    pub fn is_running(&mut self, index: usize) -> bool {
+        matches!(self.0[index].try_wait(), Ok(None))
+    }
+
     /// SIGKILL and wait: a robot that vanishes without a word.
     pub fn kill(&mut self, index: usize) {
         let child = &mut self.0[index];
