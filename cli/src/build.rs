@@ -4,8 +4,9 @@
 use super::input::{self, Content};
 use super::output::{self, Format, Record};
 use semo::codegen::output::{OutputError, Transaction};
-use semo::codegen::{self, Chosen, Emit, Reason, Target};
+use semo::codegen::{self, Emit, Target};
 use semo::host;
+use semo::targets::{Chosen, Reason};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -376,7 +377,7 @@ fn build_with_scenario(
     input: &semo::refine::BuildInput<'_>,
     path: &Path,
     text: &str,
-    targets: &codegen::Targets,
+    targets: &semo::targets::Targets,
     options: &Options,
 ) -> Result<codegen::BuildResult, Box<Record>> {
     let refined = semo::refine::refine_checked(input);
@@ -481,7 +482,7 @@ fn target_line(chosen: &Chosen) -> String {
 
 /// `target linux-sim`, or `targets cortex-m (1), linux-sim (2)`.
 fn count_by_target(robots: &[semo::codegen::RobotOutput]) -> String {
-    let targets = codegen::distinct(robots.iter().map(|r| r.target));
+    let targets = semo::targets::distinct(robots.iter().map(|r| r.target));
     match targets.as_slice() {
         [one] => format!("target {one}"),
         _ => {

@@ -42,6 +42,7 @@ pub mod span;
 pub mod strategy;
 pub mod suggest;
 pub mod syntax;
+pub mod targets;
 pub mod taskgraph;
 pub mod text;
 pub mod verify;

@@ -35,8 +35,9 @@ mod target;
 mod template;
 mod values;
 
-use crate::refine::{BuildInput, Refined, refine_checked, robot_span};
+use crate::refine::{BuildInput, CompiledScenario, Refined, refine_checked, robot_span};
 use crate::refine::{RobotProgram, RoleKind};
+use crate::targets::{Targets, distinct};
 use crate::taskgraph::write::to_xml;
 
 /// The header a threads target's runtime reads its connection defaults from
@@ -154,61 +155,6 @@ fn board_file(targets: &[Target], path: &'static str, text: &'static str) -> Str
             ],
         ),
     }
-}
-
-/// The world of one robot from a scenario, compiled into its simulated
-/// program (`scenario.c`, read by both simulation runtimes: no program
-/// reads a scenario file). The simulator's scenario reader (`sim`) makes
-/// it from a scenario file: `sim::scenario::Scenario::compiled_for`.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct CompiledScenario {
-    /// Mission ms the run lasts; `None`: until the robot stops itself.
-    pub duration_ms: Option<i64>,
-    /// Wall ms per mission ms on the wall clock; `None`: 1 (the program's
-    /// `--time-scale` overrides it).
-    pub time_scale: Option<f64>,
-    /// (at, value name, value), in file order.
-    pub sensors: Vec<(i64, String, String)>,
-    /// (service, ms).
-    pub services: Vec<(String, i64)>,
-    /// (at, level), in time order: the `BATTERY` value, linear between.
-    pub battery: Vec<(i64, f64)>,
-    /// (SDF/L loop path, the iteration whose exit task sets the exit flag).
-    pub loops: Vec<(String, u64)>,
-    /// The operator's commands to this robot or its team.
-    pub operator: Vec<OperatorCommand>,
-    /// The link faults on this robot's messages, in file order.
-    pub links: Vec<CompiledLink>,
-}
-
-/// A link fault on the messages this robot sends to `robots` during
-/// [`from`, `until`).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct CompiledLink {
-    pub effect: LinkEffect,
-    pub from: i64,
-    pub until: i64,
-    /// By name; those the program never sends to are not written.
-    pub robots: Vec<String>,
-}
-
-/// What a link fault does to a message.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LinkEffect {
-    Lost,
-    /// Arrives this many ms late.
-    Delayed(i64),
-}
-
-/// `key` (`USER.<value>`) = `value`, first at `first`, then every `every`
-/// ms while at most `until`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct OperatorCommand {
-    pub key: String,
-    pub value: String,
-    pub first: i64,
-    pub every: Option<i64>,
-    pub until: i64,
 }
 
 /// Who owns a generated file.
@@ -496,116 +442,6 @@ impl BuildResult {
     /// [`Target::ALL`]'s order.
     pub fn targets(&self) -> Vec<Target> {
         distinct(self.robots.iter().map(|r| r.target))
-    }
-}
-
-/// `targets` each once, in [`Target::ALL`]'s order.
-pub fn distinct(targets: impl IntoIterator<Item = Target>) -> Vec<Target> {
-    let used: Vec<Target> = targets.into_iter().collect();
-    Target::ALL
-        .into_iter()
-        .filter(|t| used.contains(t))
-        .collect()
-}
-
-/// Why a robot is generated for its target: the messages of what the
-/// target refuses say it, and point at where it was said.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Reason {
-    /// The door's user asked it for every robot (`semo build --target`,
-    /// the editor's `target`).
-    Asked,
-    /// The project file says it (`[build] target` for every robot, or
-    /// `[build.targets]` for the robot or its team): the key as written,
-    /// and where its value is.
-    Project {
-        key: String,
-        at: crate::diag::FileId,
-        span: crate::span::Span,
-    },
-    /// The robot's type names its platform in the catalog (`<Platform
-    /// target="...">`), there.
-    Catalog {
-        robot_type: String,
-        at: crate::diag::FileId,
-        span: crate::span::Span,
-    },
-    /// Nobody said: the default platform, `linux`.
-    Default,
-}
-
-/// A robot's target and why; `simulated`: `--sim` turned the chosen
-/// platform into its simulation.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Chosen {
-    pub target: Target,
-    pub reason: Reason,
-    pub simulated: bool,
-}
-
-impl Chosen {
-    /// How the target came to be, for messages: `cortex-m, as its type
-    /// `Evalbot` says in the catalog`.
-    pub fn describe(&self) -> String {
-        let why = match &self.reason {
-            Reason::Asked => "as the build asked for every robot".to_string(),
-            Reason::Project { key, .. } => format!("as the project file's `{key}` says"),
-            Reason::Catalog { robot_type, .. } => {
-                format!("the platform its type `{robot_type}` names in the catalog")
-            }
-            Reason::Default => "the default platform".to_string(),
-        };
-        let sim = if self.simulated {
-            " (simulated: --sim)"
-        } else {
-            ""
-        };
-        format!("{}{sim}, {why}", self.target.name())
-    }
-
-    /// Where the target was written, if in a file.
-    pub fn written_at(&self) -> Option<(crate::diag::FileId, crate::span::Span)> {
-        match &self.reason {
-            Reason::Project { at, span, .. } | Reason::Catalog { at, span, .. } => {
-                Some((*at, *span))
-            }
-            Reason::Asked | Reason::Default => None,
-        }
-    }
-}
-
-/// The target of each robot of a build, by robot name (what the build plan
-/// decided, `host::Analysis::build_plan`); or one target for every robot.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Targets {
-    every: Option<Chosen>,
-    robots: std::collections::BTreeMap<String, Chosen>,
-}
-
-impl Targets {
-    /// `target` for every robot, as asked.
-    pub fn all(target: Target) -> Targets {
-        Targets {
-            every: Some(Chosen {
-                target,
-                reason: Reason::Asked,
-                simulated: false,
-            }),
-            robots: Default::default(),
-        }
-    }
-
-    /// Each robot's own (a robot not named has none: an internal error).
-    pub fn each(robots: impl IntoIterator<Item = (String, Chosen)>) -> Targets {
-        Targets {
-            every: None,
-            robots: robots.into_iter().collect(),
-        }
-    }
-
-    /// The target of robot `robot`.
-    pub fn of(&self, robot: &str) -> Option<&Chosen> {
-        self.robots.get(robot).or(self.every.as_ref())
     }
 }
 

@@ -234,7 +234,7 @@ pub fn generate(job: &Job) -> Result<(BuildResult, String), String> {
 fn build_with_scenario(
     input: &semo::refine::BuildInput<'_>,
     path: &Path,
-    targets: &codegen::Targets,
+    targets: &semo::targets::Targets,
 ) -> Result<BuildResult, String> {
     // The library's bounded reader, as every other file the doors read.
     let text = semo::fsread::read_text(path)
