@@ -559,7 +559,7 @@ pub fn simulate(
     let worlds = scenario.compiled_for_each(&refined.programs);
     let built = semo::codegen::build_refined(
         input,
-        refined,
+        &refined,
         semo::codegen::Target::LinuxSim,
         semo::codegen::Emit::All,
         &worlds,

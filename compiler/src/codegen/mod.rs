@@ -454,7 +454,7 @@ pub fn build(build: &BuildInput<'_>, target: Target, emit: Emit) -> BuildResult 
 
 /// [`build`] with each robot generated for its own target.
 pub fn build_each(build: &BuildInput<'_>, targets: &Targets, emit: Emit) -> BuildResult {
-    build_refined_each(build, refine_checked(build), targets, emit, &[])
+    build_refined_each(build, &refine_checked(build), targets, emit, &[])
 }
 
 /// Generates the code of refined programs (from [`refine_checked`]) for
@@ -463,7 +463,7 @@ pub fn build_each(build: &BuildInput<'_>, targets: &Targets, emit: Emit) -> Buil
 /// that [`Target::needs_scenario`].
 pub fn build_refined(
     build: &BuildInput<'_>,
-    refined: Refined,
+    refined: &Refined,
     target: Target,
     emit: Emit,
     scenarios: &[CompiledScenario],
@@ -475,21 +475,24 @@ pub fn build_refined(
 /// build, the runtime folder holding what each target used needs.
 pub fn build_refined_each(
     build: &BuildInput<'_>,
-    refined: Refined,
+    refined: &Refined,
     targets: &Targets,
     emit: Emit,
     scenarios: &[CompiledScenario],
 ) -> BuildResult {
+    // The refined mission is the host's memoised query, shared by every
+    // door: read, never taken.
     let Refined {
         programs,
-        mut diagnostics,
+        diagnostics,
         sources,
     } = refined;
+    let mut diagnostics = diagnostics.clone();
     if programs.is_empty() {
         return BuildResult::refused_with(diagnostics);
     }
     let mut chosen = Vec::new();
-    for program in &programs {
+    for program in programs {
         match targets.of(&program.robot) {
             Some(target) => chosen.push(target.clone()),
             // The plan names every robot of the mission: never a default.
@@ -509,7 +512,7 @@ pub fn build_refined_each(
     }
     diagnostics.extend(target::check(
         build,
-        &programs,
+        programs,
         &chosen,
         emit,
         scenarios.len() == programs.len(),
@@ -534,7 +537,7 @@ pub fn build_refined_each(
             fleet,
             chosen.target,
             emit,
-            &sources,
+            sources,
             scenarios.get(i),
         );
         diagnostics.extend(lacking_errors(build, program, &lacking));
