@@ -4,10 +4,11 @@
 use super::input::{self, Content};
 use super::output::{self, Format, Record};
 use semo::codegen::output::{OutputError, Transaction};
-use semo::codegen::{self, Chosen, Emit, Reason, Target};
+use semo::codegen::{Emit, Target};
 use semo::host;
+use semo::targets::{Chosen, Reason};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 pub struct Options {
     /// Else the project's one mission (`defaults::mission`).
@@ -140,16 +141,45 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return super::deploy::refuse(&mut run, found, options.format, options.color, out);
         }
     }
-    let chosen = plan.targets();
-    let mut result = match &scenario {
-        None => codegen::build_each(&input, &chosen, options.emit),
-        Some((name, text)) => match build_with_scenario(&input, name, text, &chosen, &options) {
-            Ok(result) => result,
-            Err(record) => {
-                report_scenario(&record, options.format, out);
-                return 2;
+    // The one build every door asks: the host's refined mission, the
+    // scenario compiled into each simulated robot.
+    let scenario_text = scenario.as_ref().map(|(_, text)| text.as_str());
+    let built = semo::build::generate(
+        &run.analysis(),
+        mission,
+        &plan.targets(),
+        options.emit,
+        scenario_text,
+    );
+    let mut result = match (built, &scenario) {
+        (Ok(built), _) => {
+            if let Some((name, text)) = &scenario {
+                // For people, whatever the format: the build's document
+                // has no place for a scenario's warnings.
+                for warning in built.scenario_warnings {
+                    let record =
+                        Record::scenario(name, text, warning, semo::diag::Severity::Warning);
+                    eprintln!("{}", record.scenario_line());
+                }
             }
-        },
+            built.result
+        }
+        (Err(semo::build::NotBuilt::Scenario(e)), Some((name, text))) => {
+            let record = Record::scenario(name, text, e, semo::diag::Severity::Error);
+            report_scenario(&record, options.format, out);
+            return 2;
+        }
+        (Err(semo::build::NotBuilt::NoMission), _) => {
+            eprintln!("internal error: the mission was loaded but not checked");
+            return 2;
+        }
+        (Err(semo::build::NotBuilt::Scenario(e)), None) => {
+            eprintln!(
+                "internal error: a scenario's mistake in a build without one: {}",
+                e.message
+            );
+            return 2;
+        }
     };
     // A plan finding the project denies (`[lints] W110 = "deny"`) refuses
     // the build as generation's errors do.
@@ -367,47 +397,6 @@ fn report_scenario(record: &Record, format: Format, out: &mut impl Write) {
     let _ = output::written(written);
 }
 
-/// Builds robots of which some are for a target that compiles the scenario
-/// (`text`, read from `path`) in: the mission is refined first, since the
-/// scenario's names are checked against its programs (each robot gets its
-/// world; only those targets compile it). A scenario's mistake is given
-/// positioned.
-fn build_with_scenario(
-    input: &semo::refine::BuildInput<'_>,
-    path: &Path,
-    text: &str,
-    targets: &codegen::Targets,
-    options: &Options,
-) -> Result<codegen::BuildResult, Box<Record>> {
-    let refined = semo::refine::refine_checked(input);
-    if refined.programs.is_empty() {
-        // Refused: the mission's own errors come first.
-        return Ok(codegen::build_refined_each(
-            input,
-            refined,
-            targets,
-            options.emit,
-            &[],
-        ));
-    }
-    let scenario = semo::sim::scenario::parse(text, &refined.programs)
-        .map_err(|e| Box::new(Record::scenario(path, text, e, semo::diag::Severity::Error)))?;
-    // For people, whatever the format: the build's document has no place
-    // for a scenario's warnings.
-    for warning in &scenario.warnings {
-        let record = Record::scenario(path, text, warning.clone(), semo::diag::Severity::Warning);
-        eprintln!("{}", record.scenario_line());
-    }
-    let worlds = scenario.compiled_for_each(&refined.programs);
-    Ok(codegen::build_refined_each(
-        input,
-        refined,
-        targets,
-        options.emit,
-        &worlds,
-    ))
-}
-
 /// A folder that could not be staged: files in the way are listed with those
 /// of the folders not yet staged (`rest`), all at once; nothing is written
 /// (the transaction drops what it staged). The exit status.
@@ -481,7 +470,7 @@ fn target_line(chosen: &Chosen) -> String {
 
 /// `target linux-sim`, or `targets cortex-m (1), linux-sim (2)`.
 fn count_by_target(robots: &[semo::codegen::RobotOutput]) -> String {
-    let targets = codegen::distinct(robots.iter().map(|r| r.target));
+    let targets = semo::targets::distinct(robots.iter().map(|r| r.target));
     match targets.as_slice() {
         [one] => format!("target {one}"),
         _ => {

@@ -542,7 +542,7 @@ fn write_frame(stream: &mut UnixStream, kind: u8, payload: &[u8]) -> io::Result<
 /// and trace, in peer order.
 pub fn simulate(
     input: &semo::refine::BuildInput<'_>,
-    refined: semo::refine::Refined,
+    refined: &semo::refine::Refined,
     scenario: &semo::sim::scenario::Scenario,
     until_ms: i64,
     seed: u64,

@@ -27,6 +27,7 @@ use clap::{CommandFactory, Parser, Subcommand, ValueEnum};
 use output::Format;
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
+use std::sync::Arc;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -982,8 +983,9 @@ fn build_files(
 }
 
 /// The refined programs of a loaded mission, for the commands that run
-/// them (`simulate`, `verify`); on errors, they are reported in `format`
-/// and the exit status (2) is returned.
+/// them (`simulate`, `verify`, `replay`): the workspace analysis's memoised
+/// query (`Analysis::refined`), the one every door asks. On errors, they
+/// are reported in `format` and the exit status (2) is returned.
 fn refine_or_report(
     check: &mut semo::host::CheckRun,
     mission: semo::diag::FileId,
@@ -991,11 +993,15 @@ fn refine_or_report(
     color: bool,
     command: &str,
     out: &mut impl Write,
-) -> Result<(semo::host::BuildFiles, semo::refine::Refined), i32> {
-    let build = build_files(&check.analysis(), mission)?;
-    let refined = semo::refine::refine_checked(&build.input());
+) -> Result<(semo::host::BuildFiles, Arc<semo::refine::Refined>), i32> {
+    let analysis = check.analysis();
+    let build = build_files(&analysis, mission)?;
+    let Some(refined) = analysis.refined(mission) else {
+        eprintln!("internal error: the mission was loaded but not checked");
+        return Err(2);
+    };
     if refined.diagnostics.iter().any(|d| d.is_error()) {
-        check.diagnostics = refined.diagnostics;
+        check.diagnostics = refined.diagnostics.clone();
         let reported = match format {
             Format::Human | Format::Concise => {
                 render::human(check, format, color, &mut std::io::stderr().lock())

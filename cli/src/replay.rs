@@ -59,7 +59,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             Ok(refined) => refined,
             Err(code) => return code,
         };
-    let programs = refined.programs;
+    let programs = &refined.programs;
     // The scenario: named, else the mission's own; without one there is
     // nothing to expect, and the run is still shown.
     let scenario_file = match options.scenario.clone() {
@@ -82,14 +82,14 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             if !input::is_kind(&name, &text, Content::Scenario, REPLAY) {
                 return 2;
             }
-            match simulate::read_scenario(&name, &text, &programs, format, "replay", out) {
+            match simulate::read_scenario(&name, &text, programs, format, "replay", out) {
                 Some(read) => read,
                 None => return 2,
             }
         }
         None => (Scenario::default(), Vec::new()),
     };
-    let mut replay = Replay::new(&programs);
+    let mut replay = Replay::new(programs);
     for path in &options.traces {
         if let Err(record) = read_trace(&mut replay, path) {
             if format == Format::Human {
@@ -112,13 +112,13 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let digest = sim::Digest::of(&run, &scenario.expect);
     let verdicts = digest.verdicts();
     if let Some(path) = &options.svg {
-        let picture = sim::svg::to_svg(&run, &programs, &scenario);
+        let picture = sim::svg::to_svg(&run, programs, &scenario);
         if simulate::write_to(path, &picture, out) != 0 {
             return 2;
         }
     }
     if let Some(path) = &options.mcap
-        && super::mcap::write(path, &run, &programs, out) != 0
+        && super::mcap::write(path, &run, programs, out) != 0
     {
         return 2;
     }

@@ -115,10 +115,10 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         return 2;
     };
     if options.engine == Engine::C {
-        return run_generated(&options, &build.input(), refined, &scenario, out);
+        return run_generated(&options, &build.input(), &refined, &scenario, out);
     }
-    let programs = refined.programs;
-    let robots = sim::Run::robots_of(&programs);
+    let programs = &refined.programs;
+    let robots = sim::Run::robots_of(programs);
     let mut digest = sim::Digest::new(&robots, &scenario.expect);
     let mut trace = match TraceOut::open(options.trace.as_deref()) {
         Ok(trace) => trace,
@@ -129,7 +129,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let keep = options.svg.is_some() || options.mcap.is_some();
     let mut kept = Vec::new();
     let mut run = sim::simulate_into(
-        &programs,
+        programs,
         &scenario,
         &sim::Options {
             until_ms: options.until_ms,
@@ -150,13 +150,13 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     }
     let verdicts = digest.verdicts();
     if let Some(path) = &options.svg {
-        let picture = sim::svg::to_svg(&run, &programs, &scenario);
+        let picture = sim::svg::to_svg(&run, programs, &scenario);
         if write_to(path, &picture, out) != 0 {
             return 2;
         }
     }
     if let Some(path) = &options.mcap
-        && super::mcap::write(path, &run, &programs, out) != 0
+        && super::mcap::write(path, &run, programs, out) != 0
     {
         return 2;
     }
@@ -354,7 +354,7 @@ pub fn json_summary(
 fn run_generated(
     options: &Options,
     input: &semo::refine::BuildInput<'_>,
-    refined: semo::refine::Refined,
+    refined: &semo::refine::Refined,
     scenario: &scenario::Scenario,
     out: &mut impl Write,
 ) -> i32 {

@@ -3,18 +3,21 @@
 //! The modules are layered: each reads only the modules below it in the
 //! `## Layers` table of ARCHITECTURE.md, which `tests/layering.rs` checks
 //! against every `crate::` path. From the bottom: positions and diagnostics
-//! ([`span`], [`text`], [`diag`], [`edit`]) and the platforms programs are
-//! built for ([`platform`], a data table); the languages ([`syntax`],
-//! [`format`], [`catalog`], [`sema`], [`taskgraph`], [`strategy`]); what is
-//! made of them ([`modemachine`], [`ide`], [`refine`], [`codegen`]);
-//! [`sim`], the simulator running the refined programs of a mission on a
-//! scenario; [`workspace`], which reads files from disk; and on top
-//! [`host`], the one workspace analysis the command line and the language
-//! server both ask.
+//! ([`span`], [`text`], [`diag`], [`edit`]), the platforms programs are
+//! built for ([`platform`], a data table) and which each robot of a build is
+//! for ([`targets`]); the languages ([`syntax`], [`format`], [`catalog`],
+//! [`sema`], [`taskgraph`], [`strategy`]); what is made of them
+//! ([`modemachine`], [`ide`], [`refine`]); [`workspace`], which reads files
+//! from disk; [`host`], the one workspace analysis the command line and the
+//! language server both ask; the two back ends over the refined programs,
+//! [`codegen`] (C) and [`sim`] (the simulator running them on a scenario),
+//! neither reading the other; and on top [`build`], one build of a mission
+//! (a scenario compiled in) for every door.
 //!
 //! The `semo` command (rendering with ariadne or JSON) is the `semo-cli` crate
 //! (`cli/`), above this library and the language server.
 
+pub mod build;
 pub mod catalog;
 pub mod codegen;
 pub mod dataflow;
@@ -42,6 +45,7 @@ pub mod span;
 pub mod strategy;
 pub mod suggest;
 pub mod syntax;
+pub mod targets;
 pub mod taskgraph;
 pub mod text;
 pub mod verify;

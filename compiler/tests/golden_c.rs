@@ -138,7 +138,7 @@ fn build(
     };
     let scenario = semo::sim::scenario::parse(&text, &refined.programs).expect("the scenario");
     let worlds = scenario.compiled_for_each(&refined.programs);
-    codegen::build_refined(&input, refined, target, Emit::All, &worlds)
+    codegen::build_refined(&input, &refined, target, Emit::All, &worlds)
 }
 
 /// One build as text: its diagnostics, each robot's files, the runtime's.

@@ -292,6 +292,28 @@ fn modules_use_only_what_the_architecture_table_allows() {
     );
 }
 
+/// The two back ends over `refine`, the C generator and the simulator, are
+/// siblings: neither may read the other, directly or through a module it
+/// reads (the host's build plan, say). So the simulator's meaning of a
+/// mission cannot come from the generator's code, nor the C from the
+/// simulator's, and whatever both need lives below both (`refine`).
+#[test]
+fn codegen_and_sim_are_sibling_back_ends() {
+    let architecture = std::fs::read_to_string(root().join("../ARCHITECTURE.md")).unwrap();
+    let rows = allowed(&architecture);
+    for (back_end, other) in [("sim", "codegen"), ("codegen", "sim")] {
+        let reaches = below(back_end, &rows);
+        assert!(
+            reaches.contains("refine"),
+            "`{back_end}` should read the refined programs"
+        );
+        assert!(
+            !reaches.contains(other),
+            "`{back_end}` reaches `{other}` in ARCHITECTURE.md's layers: the back ends are siblings over `refine`"
+        );
+    }
+}
+
 /// The problems of the modules of `src` against `rows` (the table under
 /// `heading`); `root_item` names the module a `crate::NAME` that is no
 /// module comes from (a re-export at the root), or `None` for an item of

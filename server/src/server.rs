@@ -390,7 +390,7 @@ impl Backend {
             let message = format!("SeMo: {}: {warning}", semo::project::FILE_NAME);
             self.tell_generation(MessageType::WARNING, &message).await;
         }
-        let targets = semo::codegen::distinct(all.iter().map(|r| r.target));
+        let targets = semo::targets::distinct(all.iter().map(|r| r.target));
         let message = format!(
             "SeMo: generated code for {} robot(s) ({}) in {}",
             robots.len(),

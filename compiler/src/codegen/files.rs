@@ -5,9 +5,10 @@ use super::c;
 use super::peers::Peers;
 use super::template::{Template, fill, template};
 use super::values::Words;
-use super::{CompiledScenario, Layer, Target};
+use super::{Layer, Target};
 use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK};
 use crate::refine::protocol::{TERM_MAX, alive_key, sync_key};
+use crate::refine::{CompiledScenario, LinkEffect};
 use crate::refine::{RobotProgram, RoleKind, ValueKind};
 use crate::taskgraph::Trigger;
 use std::fmt::Write;
@@ -1074,8 +1075,8 @@ fn scenario_extra_tables(
             list.join(", ")
         );
         let (lost, by) = match link.effect {
-            super::LinkEffect::Lost => ("true", 0),
-            super::LinkEffect::Delayed(by) => ("false", by),
+            LinkEffect::Lost => ("true", 0),
+            LinkEffect::Delayed(by) => ("false", by),
         };
         links.push(format!(
             "    {{{}, {}, {by}, {lost}, link_{i}_peers, {}}},\n",

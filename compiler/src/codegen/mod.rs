@@ -35,8 +35,9 @@ mod target;
 mod template;
 mod values;
 
-use crate::refine::{BuildInput, Refined, refine_checked, robot_span};
+use crate::refine::{BuildInput, CompiledScenario, Refined, refine_checked, robot_span};
 use crate::refine::{RobotProgram, RoleKind};
+use crate::targets::{Targets, distinct};
 use crate::taskgraph::write::to_xml;
 
 /// The header a threads target's runtime reads its connection defaults from
@@ -154,61 +155,6 @@ fn board_file(targets: &[Target], path: &'static str, text: &'static str) -> Str
             ],
         ),
     }
-}
-
-/// The world of one robot from a scenario, compiled into its simulated
-/// program (`scenario.c`, read by both simulation runtimes: no program
-/// reads a scenario file). The simulator's scenario reader (`sim`) makes
-/// it from a scenario file: `sim::scenario::Scenario::compiled_for`.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct CompiledScenario {
-    /// Mission ms the run lasts; `None`: until the robot stops itself.
-    pub duration_ms: Option<i64>,
-    /// Wall ms per mission ms on the wall clock; `None`: 1 (the program's
-    /// `--time-scale` overrides it).
-    pub time_scale: Option<f64>,
-    /// (at, value name, value), in file order.
-    pub sensors: Vec<(i64, String, String)>,
-    /// (service, ms).
-    pub services: Vec<(String, i64)>,
-    /// (at, level), in time order: the `BATTERY` value, linear between.
-    pub battery: Vec<(i64, f64)>,
-    /// (SDF/L loop path, the iteration whose exit task sets the exit flag).
-    pub loops: Vec<(String, u64)>,
-    /// The operator's commands to this robot or its team.
-    pub operator: Vec<OperatorCommand>,
-    /// The link faults on this robot's messages, in file order.
-    pub links: Vec<CompiledLink>,
-}
-
-/// A link fault on the messages this robot sends to `robots` during
-/// [`from`, `until`).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct CompiledLink {
-    pub effect: LinkEffect,
-    pub from: i64,
-    pub until: i64,
-    /// By name; those the program never sends to are not written.
-    pub robots: Vec<String>,
-}
-
-/// What a link fault does to a message.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LinkEffect {
-    Lost,
-    /// Arrives this many ms late.
-    Delayed(i64),
-}
-
-/// `key` (`USER.<value>`) = `value`, first at `first`, then every `every`
-/// ms while at most `until`.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct OperatorCommand {
-    pub key: String,
-    pub value: String,
-    pub first: i64,
-    pub every: Option<i64>,
-    pub until: i64,
 }
 
 /// Who owns a generated file.
@@ -499,116 +445,6 @@ impl BuildResult {
     }
 }
 
-/// `targets` each once, in [`Target::ALL`]'s order.
-pub fn distinct(targets: impl IntoIterator<Item = Target>) -> Vec<Target> {
-    let used: Vec<Target> = targets.into_iter().collect();
-    Target::ALL
-        .into_iter()
-        .filter(|t| used.contains(t))
-        .collect()
-}
-
-/// Why a robot is generated for its target: the messages of what the
-/// target refuses say it, and point at where it was said.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Reason {
-    /// The door's user asked it for every robot (`semo build --target`,
-    /// the editor's `target`).
-    Asked,
-    /// The project file says it (`[build] target` for every robot, or
-    /// `[build.targets]` for the robot or its team): the key as written,
-    /// and where its value is.
-    Project {
-        key: String,
-        at: crate::diag::FileId,
-        span: crate::span::Span,
-    },
-    /// The robot's type names its platform in the catalog (`<Platform
-    /// target="...">`), there.
-    Catalog {
-        robot_type: String,
-        at: crate::diag::FileId,
-        span: crate::span::Span,
-    },
-    /// Nobody said: the default platform, `linux`.
-    Default,
-}
-
-/// A robot's target and why; `simulated`: `--sim` turned the chosen
-/// platform into its simulation.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Chosen {
-    pub target: Target,
-    pub reason: Reason,
-    pub simulated: bool,
-}
-
-impl Chosen {
-    /// How the target came to be, for messages: `cortex-m, as its type
-    /// `Evalbot` says in the catalog`.
-    pub fn describe(&self) -> String {
-        let why = match &self.reason {
-            Reason::Asked => "as the build asked for every robot".to_string(),
-            Reason::Project { key, .. } => format!("as the project file's `{key}` says"),
-            Reason::Catalog { robot_type, .. } => {
-                format!("the platform its type `{robot_type}` names in the catalog")
-            }
-            Reason::Default => "the default platform".to_string(),
-        };
-        let sim = if self.simulated {
-            " (simulated: --sim)"
-        } else {
-            ""
-        };
-        format!("{}{sim}, {why}", self.target.name())
-    }
-
-    /// Where the target was written, if in a file.
-    pub fn written_at(&self) -> Option<(crate::diag::FileId, crate::span::Span)> {
-        match &self.reason {
-            Reason::Project { at, span, .. } | Reason::Catalog { at, span, .. } => {
-                Some((*at, *span))
-            }
-            Reason::Asked | Reason::Default => None,
-        }
-    }
-}
-
-/// The target of each robot of a build, by robot name (what the build plan
-/// decided, `host::Analysis::build_plan`); or one target for every robot.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Targets {
-    every: Option<Chosen>,
-    robots: std::collections::BTreeMap<String, Chosen>,
-}
-
-impl Targets {
-    /// `target` for every robot, as asked.
-    pub fn all(target: Target) -> Targets {
-        Targets {
-            every: Some(Chosen {
-                target,
-                reason: Reason::Asked,
-                simulated: false,
-            }),
-            robots: Default::default(),
-        }
-    }
-
-    /// Each robot's own (a robot not named has none: an internal error).
-    pub fn each(robots: impl IntoIterator<Item = (String, Chosen)>) -> Targets {
-        Targets {
-            every: None,
-            robots: robots.into_iter().collect(),
-        }
-    }
-
-    /// The target of robot `robot`.
-    pub fn of(&self, robot: &str) -> Option<&Chosen> {
-        self.robots.get(robot).or(self.every.as_ref())
-    }
-}
-
 /// Generates the code of a mission for `target`: every error of the check
 /// (in the mission, the catalog or the strategies) refuses generation, as do
 /// problems found while refining.
@@ -618,7 +454,7 @@ pub fn build(build: &BuildInput<'_>, target: Target, emit: Emit) -> BuildResult 
 
 /// [`build`] with each robot generated for its own target.
 pub fn build_each(build: &BuildInput<'_>, targets: &Targets, emit: Emit) -> BuildResult {
-    build_refined_each(build, refine_checked(build), targets, emit, &[])
+    build_refined_each(build, &refine_checked(build), targets, emit, &[])
 }
 
 /// Generates the code of refined programs (from [`refine_checked`]) for
@@ -627,7 +463,7 @@ pub fn build_each(build: &BuildInput<'_>, targets: &Targets, emit: Emit) -> Buil
 /// that [`Target::needs_scenario`].
 pub fn build_refined(
     build: &BuildInput<'_>,
-    refined: Refined,
+    refined: &Refined,
     target: Target,
     emit: Emit,
     scenarios: &[CompiledScenario],
@@ -639,21 +475,24 @@ pub fn build_refined(
 /// build, the runtime folder holding what each target used needs.
 pub fn build_refined_each(
     build: &BuildInput<'_>,
-    refined: Refined,
+    refined: &Refined,
     targets: &Targets,
     emit: Emit,
     scenarios: &[CompiledScenario],
 ) -> BuildResult {
+    // The refined mission is the host's memoised query, shared by every
+    // door: read, never taken.
     let Refined {
         programs,
-        mut diagnostics,
+        diagnostics,
         sources,
     } = refined;
+    let mut diagnostics = diagnostics.clone();
     if programs.is_empty() {
         return BuildResult::refused_with(diagnostics);
     }
     let mut chosen = Vec::new();
-    for program in &programs {
+    for program in programs {
         match targets.of(&program.robot) {
             Some(target) => chosen.push(target.clone()),
             // The plan names every robot of the mission: never a default.
@@ -673,7 +512,7 @@ pub fn build_refined_each(
     }
     diagnostics.extend(target::check(
         build,
-        &programs,
+        programs,
         &chosen,
         emit,
         scenarios.len() == programs.len(),
@@ -698,7 +537,7 @@ pub fn build_refined_each(
             fleet,
             chosen.target,
             emit,
-            &sources,
+            sources,
             scenarios.get(i),
         );
         diagnostics.extend(lacking_errors(build, program, &lacking));

@@ -8,11 +8,12 @@
 //! stay: the trace is the operator console's record, and in simulation the
 //! operator's commands are compiled in.
 
-use super::{Chosen, Emit, Layer};
+use super::{Emit, Layer};
 use crate::diag::{Code, Diagnostic};
 use crate::refine::RobotProgram;
 use crate::refine::{BuildInput, robot_span};
 use crate::sema::Peer;
+use crate::targets::Chosen;
 
 /// The operator console's team name in messages.
 const USER: &str = "USER";

@@ -12,10 +12,11 @@
 //! The output folder and the deployment are the door's, else the project
 //! file's `[build]`, else `out` beside the mission and none.
 
-use crate::codegen::{Chosen, Reason, Target, Targets};
 use crate::diag::{Diagnostic, FileId};
 use crate::host::Analysis;
+use crate::platform::Target;
 use crate::project::{NamedTarget, ProjectTarget};
+use crate::targets::{Chosen, Reason, Targets};
 use std::path::{Path, PathBuf};
 
 /// What a door's user said (each `None`, or `false`: not said).
@@ -64,7 +65,7 @@ impl BuildPlan {
 
     /// The targets of its robots, each once, in [`Target::ALL`]'s order.
     pub fn distinct_targets(&self) -> Vec<Target> {
-        crate::codegen::distinct(self.robots.iter().map(|r| r.chosen.target))
+        crate::targets::distinct(self.robots.iter().map(|r| r.chosen.target))
     }
 
     /// The target of robot `robot`.

@@ -1,8 +1,10 @@
 //! A mission's refined programs as one memoised query of the workspace
-//! analysis: the doors (simulate, verify, the monitor, the operator console,
-//! deployment, scenario completion, the task-graph picture) ask for it
-//! instead of refining the mission each on its own, and a second request on
-//! the same files refines nothing.
+//! analysis: every door asks for it instead of refining the mission on its
+//! own (`semo build` and the editor's Generate Code through `build::generate`;
+//! `semo simulate`, `verify` and `replay`; the monitor, the operator console,
+//! deployment, the server's simulate and verify, scenario completion, the
+//! task-graph picture), and a second request on the same files refines
+//! nothing.
 
 use super::{Analysis, drop_later, fresh, lock};
 use crate::diag::FileId;

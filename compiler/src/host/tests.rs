@@ -291,8 +291,9 @@ fn the_view_agrees_with_the_rule_and_lives_as_long_as_the_layout() {
 /// lacks is W110 on the project file.
 #[test]
 fn the_build_plan_gives_each_robot_its_target_and_says_why() {
-    use crate::codegen::{Reason, Target};
     use crate::host::PlanRequest;
+    use crate::platform::Target;
+    use crate::targets::Reason;
     let mut host = AnalysisHost::new(roots(&["/w"]));
     let catalog = "<Catalog xmlns=\"urn:semo:catalog:1\">\n  <Robot type=\"Board\">\n    <Platform os=\"none\" target=\"cortex-m\"/>\n    <Service name=\"beep\" task=\"buzzer\"/>\n  </Robot>\n  <Robot type=\"Pc\">\n    <Service name=\"beep\" task=\"buzzer\"/>\n  </Robot>\n</Catalog>\n";
     let mission = "{\n  A: Board a, Pc p, Board many[2]\n  B: Board b\n}\nA.P.S{ beep() } repeat(1 SEC)\nA.M{ set(P, S) }\nA.main{ default: mode = M }\nB.P.S{ beep() } repeat(1 SEC)\nB.M{ set(P, S) }\nB.main{ default: mode = M }\n";

@@ -10,6 +10,8 @@
 //!   simulator both perform on them.
 //! - `graph.rs`: the robot's task graph from what the machine uses, checked
 //!   with the SDF/L analyses.
+//! - `world.rs`: a robot's world compiled from a scenario
+//!   ([`CompiledScenario`]), which both back ends read.
 //!
 //! Refinement reads only checked input: the caller refuses missions with errors.
 
@@ -19,6 +21,7 @@ pub mod program;
 pub mod protocol;
 mod robot;
 pub mod value;
+mod world;
 
 pub use build::{
     BuildInput, Refined, is_plain_name, refine_checked, refine_checked_robots, robot_span,
@@ -26,6 +29,7 @@ pub use build::{
 pub use program::*;
 pub use robot::SENSOR_PERIOD_MS;
 pub use value::{Value, ValueKind};
+pub use world::{CompiledLink, CompiledScenario, LinkEffect, OperatorCommand};
 
 use crate::CheckedMission;
 use crate::catalog::Catalog;

@@ -460,7 +460,7 @@ impl Scenario {
     pub fn compiled_for_each(
         &self,
         programs: &[RobotProgram],
-    ) -> Vec<crate::codegen::CompiledScenario> {
+    ) -> Vec<crate::refine::CompiledScenario> {
         programs.iter().map(|p| self.compiled_for(p)).collect()
     }
 
@@ -473,8 +473,8 @@ impl Scenario {
     /// the run's duration and time scale. Process faults (kill, restart)
     /// and the network's latency and loss are not in it: the lock-step
     /// coordinator applies those from outside (`semo simulate --engine c`).
-    pub fn compiled_for(&self, program: &RobotProgram) -> crate::codegen::CompiledScenario {
-        use crate::codegen::{CompiledLink, LinkEffect, OperatorCommand};
+    pub fn compiled_for(&self, program: &RobotProgram) -> crate::refine::CompiledScenario {
+        use crate::refine::{CompiledLink, LinkEffect, OperatorCommand};
         let world = self.robots.iter().find(|w| w.robot == program.robot);
         let me = program.robot.as_str();
         let mission_robots = || program.peers.iter().map(|(_, robot)| robot.as_str());
@@ -525,7 +525,7 @@ impl Scenario {
                 })
             })
             .collect();
-        crate::codegen::CompiledScenario {
+        crate::refine::CompiledScenario {
             duration_ms: self.duration_ms,
             time_scale: self.time_scale,
             sensors: world.map(|w| w.sensors.clone()).unwrap_or_default(),

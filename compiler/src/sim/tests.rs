@@ -1709,7 +1709,7 @@ fn the_mistakes_the_runtime_refused_are_refused_at_the_value() {
 /// coordinator applies from outside, nor another robot's link fault.
 #[test]
 fn a_robot_s_compiled_world_holds_what_its_program_applies() {
-    use crate::codegen::{CompiledLink, LinkEffect};
+    use crate::refine::{CompiledLink, LinkEffect};
     let programs = programs("examples/scouting/scouting.mission");
     let text = r#"{"time_scale": 0.5, "duration": 900,
         "robots": {"irobot": {"battery": [{"at": 0, "level": 90}, {"at": 100, "level": 80.5}]}},

@@ -34,6 +34,7 @@
 
 use crate::encoding::LineMap;
 use crate::world::{Snapshot, World};
+use semo::build::NotBuilt;
 use semo::codegen::{self, BuildResult, Emit, Target, output};
 use semo::diag::{Diagnostic, FileId};
 use semo::host::BuildPlan;
@@ -185,15 +186,49 @@ fn path_of(snapshot: &Snapshot) -> Option<PathBuf> {
 /// Checks, refines and generates (no writing yet); the mission's text too,
 /// for positions.
 pub fn generate(job: &Job) -> Result<(BuildResult, String), String> {
-    let build = job
+    const NO_MISSION: &str = "internal error: the mission is not in the workspace analysis";
+    let text = job
         .analysis
-        .build_input(job.mission)
-        .ok_or("internal error: the mission is not in the workspace analysis")?;
-    let text = build.file.text.to_string();
-    let input = build.input();
-    let mut result = match &job.scenario {
-        None => codegen::build_each(&input, &job.plan.targets(), Emit::All),
-        Some(path) => build_with_scenario(&input, path, &job.plan.targets())?,
+        .file(job.mission)
+        .ok_or(NO_MISSION)?
+        .text
+        .to_string();
+    // The scenario compiled into each simulated robot (`semo build
+    // --scenario`), read with the library's bounded reader, as every other
+    // file the doors read.
+    let scenario = match &job.scenario {
+        None => None,
+        Some(path) => Some(
+            semo::fsread::read_text(path)
+                .map_err(|e| format!("scenario {}: cannot read: {e}", path.display()))?,
+        ),
+    };
+    // The one build every door asks (`semo build` too): a scenario's
+    // mistake is the request's error, positioned.
+    let built = semo::build::generate(
+        &job.analysis,
+        job.mission,
+        &job.plan.targets(),
+        Emit::All,
+        scenario.as_deref(),
+    );
+    let mut result = match (built, &job.scenario, &scenario) {
+        (Ok(built), ..) => built.result,
+        (Err(NotBuilt::Scenario(e)), Some(path), Some(text)) => {
+            let (line, col) = e.line_col(text);
+            return Err(format!(
+                "scenario {}:{line}:{col}: {}",
+                path.display(),
+                e.message
+            ));
+        }
+        (Err(NotBuilt::Scenario(e)), ..) => {
+            return Err(format!(
+                "internal error: a scenario's mistake in a build without one: {}",
+                e.message
+            ));
+        }
+        (Err(NotBuilt::NoMission), ..) => return Err(NO_MISSION.into()),
     };
     // The plan's findings in the project file, with generation's.
     result
@@ -226,43 +261,6 @@ pub fn generate(job: &Job) -> Result<(BuildResult, String), String> {
         }
     }
     Ok((result, text))
-}
-
-/// A build with the scenario at `path` compiled into each simulated robot
-/// (`semo build --scenario`): the mission refined first, since the
-/// scenario's names are checked against its programs. A scenario that
-/// cannot be read, or has a mistake, is the request's error, positioned.
-fn build_with_scenario(
-    input: &semo::refine::BuildInput<'_>,
-    path: &Path,
-    targets: &codegen::Targets,
-) -> Result<BuildResult, String> {
-    // The library's bounded reader, as every other file the doors read.
-    let text = semo::fsread::read_text(path)
-        .map_err(|e| format!("scenario {}: cannot read: {e}", path.display()))?;
-    let refined = semo::refine::refine_checked(input);
-    if refined.programs.is_empty() {
-        // Refused: the mission's own errors come first.
-        return Ok(codegen::build_refined_each(
-            input,
-            refined,
-            targets,
-            Emit::All,
-            &[],
-        ));
-    }
-    let scenario = semo::sim::scenario::parse(&text, &refined.programs).map_err(|e| {
-        let (line, col) = e.line_col(&text);
-        format!("scenario {}:{line}:{col}: {}", path.display(), e.message)
-    })?;
-    let worlds = scenario.compiled_for_each(&refined.programs);
-    Ok(codegen::build_refined_each(
-        input,
-        refined,
-        targets,
-        Emit::All,
-        &worlds,
-    ))
 }
 
 /// The refusal's diagnostics in the mission, for publishing.
