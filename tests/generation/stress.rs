@@ -8,12 +8,13 @@
 
 use super::{Content, contents, copy_example, generated_folders, hash, leftovers, rename_save};
 use super::{Pauses, build, build_paused, scratch};
+use crate::support::swap::swapper;
 use std::collections::BTreeMap;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::JoinHandle;
 
 /// Scouting copied into `dir` twice under two names (every generated file
@@ -324,58 +325,6 @@ enum Swapped {
     Robot,
     /// `.semo-backup`, during builds forced over an edited file.
     Backup,
-}
-
-/// Swaps `real` for a link to `target` and back, in a loop as tight as the
-/// scheduler allows, until `stop`; returns how many times it put the link.
-/// Whatever the build made meanwhile where the folder was is put aside
-/// (under `<real>.made-<n>`): inside the output folder, not counted.
-fn swapper(real: PathBuf, target: PathBuf, stop: Arc<AtomicBool>) -> JoinHandle<usize> {
-    std::thread::spawn(move || {
-        let moved = real.with_extension("swapped-away");
-        let mut swaps = 0;
-        while !stop.load(Ordering::SeqCst) {
-            if std::fs::rename(&real, &moved).is_err() {
-                std::thread::yield_now();
-                continue;
-            }
-            if std::os::unix::fs::symlink(&target, &real).is_ok() {
-                swaps += 1;
-                std::thread::yield_now();
-                let _ = std::fs::remove_file(&real);
-            }
-            restore(&real, &moved);
-            std::thread::yield_now();
-        }
-        swaps
-    })
-}
-
-/// `moved` back at `real` (anything the build made there meanwhile is set
-/// aside beside it).
-fn restore(real: &Path, moved: &Path) {
-    // The build may make the folder again between any two of these steps
-    // (it found none): whatever is at `real` is set aside until the
-    // rename back wins.
-    static ASIDE: AtomicUsize = AtomicUsize::new(0);
-    for _ in 0..10_000 {
-        if let Ok(meta) = std::fs::symlink_metadata(real) {
-            if meta.is_symlink() {
-                let _ = std::fs::remove_file(real);
-            } else {
-                let n = ASIDE.fetch_add(1, Ordering::SeqCst);
-                let _ = std::fs::rename(real, real.with_extension(format!("made-{n}")));
-            }
-        }
-        if std::fs::rename(moved, real).is_ok() {
-            return;
-        }
-    }
-    panic!(
-        "{} could not be put back at {}",
-        moved.display(),
-        real.display()
-    );
 }
 
 /// What the link-swap runs counted.

@@ -9,6 +9,7 @@ pub mod mqtt;
 pub mod proxy;
 pub mod python;
 pub mod robots;
+pub mod swap;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -11,13 +11,16 @@
 //! read once per process), and these must run free.
 
 use super::{generate, uri};
+
+#[path = "../../../tests/support/swap.rs"]
+mod swap;
 use serde_json::{Value, json};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::thread::JoinHandle;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
+use swap::swapper;
 
 /// A stress run's size: `var` if set, else `default`.
 fn sized(var: &str, default: usize) -> usize {
@@ -243,31 +246,6 @@ async fn stress_generate_code_cancelled_at_varied_moments() {
     assert_eq!(counts.partial, 0, "{counts:?}");
 }
 
-/// Swaps `real` for a link to `target` and back, in a loop as tight as the
-/// scheduler allows, until `stop`; returns how many times it put the link.
-/// What the generation made meanwhile where the folder was (it was missing
-/// for an instant) is set aside beside it, under `<name>.made-<n>`.
-fn swapper(real: PathBuf, target: PathBuf, stop: Arc<AtomicBool>) -> JoinHandle<usize> {
-    std::thread::spawn(move || {
-        let moved = real.with_extension("swapped-away");
-        let mut swaps = 0;
-        while !stop.load(Ordering::SeqCst) {
-            if std::fs::rename(&real, &moved).is_err() {
-                std::thread::yield_now();
-                continue;
-            }
-            if std::os::unix::fs::symlink(&target, &real).is_ok() {
-                swaps += 1;
-                std::thread::yield_now();
-                let _ = std::fs::remove_file(&real);
-            }
-            restore(&real, &moved);
-            std::thread::yield_now();
-        }
-        swaps
-    })
-}
-
 /// The first robot folder (`<team>/<robot>`) generation wrote in `out`.
 fn first_robot_folder(out: &Path) -> PathBuf {
     let mut folders: Vec<PathBuf> = std::fs::read_dir(out)
@@ -282,32 +260,6 @@ fn first_robot_folder(out: &Path) -> PathBuf {
         .collect();
     folders.sort();
     folders.into_iter().next().expect("a robot folder")
-}
-
-/// `moved` back at `real`.
-fn restore(real: &Path, moved: &Path) {
-    // The build may make the folder again between any two of these steps
-    // (it found none): whatever is at `real` is set aside until the
-    // rename back wins.
-    static ASIDE: AtomicUsize = AtomicUsize::new(0);
-    for _ in 0..10_000 {
-        if let Ok(meta) = std::fs::symlink_metadata(real) {
-            if meta.is_symlink() {
-                let _ = std::fs::remove_file(real);
-            } else {
-                let n = ASIDE.fetch_add(1, Ordering::SeqCst);
-                let _ = std::fs::rename(real, real.with_extension(format!("made-{n}")));
-            }
-        }
-        if std::fs::rename(moved, real).is_ok() {
-            return;
-        }
-    }
-    panic!(
-        "{} could not be put back at {}",
-        moved.display(),
-        real.display()
-    );
 }
 
 /// What the link-swap runs counted.
