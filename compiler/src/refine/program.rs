@@ -24,6 +24,17 @@ newtype_index! {
     pub struct SlotId;
 }
 
+newtype_index! {
+    /// A channel of a service graph: an index into [`GraphService::channels`]
+    /// (the generated C's `ch<N>`).
+    pub struct GraphChannelId;
+}
+
+newtype_index! {
+    /// An inner task of a service graph: an index into [`GraphService::tasks`].
+    pub struct InnerTaskId;
+}
+
 /// The robot's battery level, a catalog value: what a strategy's battery
 /// condition reads (`Battery`), and what the robot's status reports.
 pub const BATTERY_VALUE: &str = "BATTERY";
@@ -124,7 +135,7 @@ pub struct InnerTask {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PortUse {
     pub port: String,
-    pub channel: usize,
+    pub channel: GraphChannelId,
     pub rate: u64,
 }
 
@@ -141,8 +152,8 @@ pub struct LoopPort {
     pub distributing: bool,
     pub outer_rate: u64,
     pub inner_rate: u64,
-    pub outer: usize,
-    pub inner: usize,
+    pub outer: GraphChannelId,
+    pub inner: GraphChannelId,
 }
 
 /// A term of a service graph's looped schedule, loop nodes opened.
@@ -150,7 +161,7 @@ pub struct LoopPort {
 pub enum GraphStep {
     /// `count` firings of inner task `task`, an index in
     /// [`GraphService::tasks`].
-    Fire { task: usize, count: u64 },
+    Fire { task: InnerTaskId, count: u64 },
     /// A loop of the schedule: `body` `count` times.
     Repeat { count: u64, body: Vec<GraphStep> },
     /// An SDF/L loop node (`path` as for tasks): its body's schedule,
@@ -161,7 +172,7 @@ pub enum GraphStep {
         path: String,
         convergent: bool,
         loop_count: u64,
-        exit_task: Option<usize>,
+        exit_task: Option<InnerTaskId>,
         /// Its data ports, in declaration order.
         ports: Vec<LoopPort>,
         body: Vec<GraphStep>,
@@ -186,8 +197,8 @@ pub struct SubgraphPort {
     pub port: String,
     pub input: bool,
     pub rate: u64,
-    pub outer: usize,
-    pub inner: usize,
+    pub outer: GraphChannelId,
+    pub inner: GraphChannelId,
 }
 
 /// The control task's machine.
