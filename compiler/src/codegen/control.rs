@@ -13,8 +13,8 @@ use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms, lost_after_ms};
 use crate::refine::{
-    ActionMachine, ControlMachine, CountedGroup, Expr, LeaderAlgorithm, Operand, RobotProgram,
-    SendItem, SlotId, SlotSource, State, StateId, StateKind,
+    ActionMachine, ControlMachine, CountedGroup, Expr, LeaderAlgorithm, ModeId, Operand,
+    RobotProgram, SendItem, SlotId, SlotSource, State, StateId, StateKind,
 };
 use std::fmt::Write;
 
@@ -367,7 +367,7 @@ fn emit_catch_event(out: &mut String, program: &RobotProgram, throws: bool, broa
 fn emit_catches(out: &mut String, program: &RobotProgram, caught: &str) {
     let m = &program.control;
     out.push_str("    switch (current_mode) {\n");
-    for (from, mode) in m.modes.iter().enumerate() {
+    for (from, mode) in ModeId::all(m.modes.len()).zip(&m.modes) {
         let catches: Vec<_> = m.transitions.iter().filter(|t| t.from == from).collect();
         if catches.is_empty() {
             continue;
@@ -380,7 +380,7 @@ fn emit_catches(out: &mut String, program: &RobotProgram, caught: &str) {
                 c::string(&t.event),
                 c::comment(&program.mission),
                 t.line,
-                c::ident(&m.modes[t.to].name)
+                c::ident(&m.mode(t.to).name)
             );
         }
         out.push_str("        break;\n");
@@ -1266,7 +1266,7 @@ fn emit_task(out: &mut String, program: &RobotProgram, peers: &Peers) {
     );
     let default = m
         .default_mode
-        .map(|d| format!("MODE_{}", c::ident(&m.modes[d].name)));
+        .map(|d| format!("MODE_{}", c::ident(&m.mode(d).name)));
     out.push_str(&fill(&GO_HEAD, &[("name", &name)]));
     if !m.battery.is_empty() {
         out.push_str("    manage_resources();\n");

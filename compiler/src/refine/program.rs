@@ -25,6 +25,13 @@ newtype_index! {
 }
 
 newtype_index! {
+    /// A mode of the control machine: an index into [`ControlMachine::modes`]
+    /// (the generated C's `MODE_<name>` enumerator has its value), at the
+    /// position of the team's mode (`sema::ModeId`) it refines.
+    pub struct ModeId;
+}
+
+newtype_index! {
     /// A channel of a service graph: an index into [`GraphService::channels`]
     /// (the generated C's `ch<N>`).
     pub struct GraphChannelId;
@@ -205,8 +212,7 @@ pub struct SubgraphPort {
 #[derive(Clone, Debug, Default)]
 pub struct ControlMachine {
     pub modes: Vec<ModeState>,
-    /// Index into `modes`.
-    pub default_mode: Option<usize>,
+    pub default_mode: Option<ModeId>,
     /// `case (from): catch (event): mode = to`, with the line of the catch.
     pub transitions: Vec<ModeTransition>,
     pub services: Vec<ServiceMachine>,
@@ -269,6 +275,11 @@ pub const MAX_EVENT_NAME_BYTES: usize = 63;
 pub const EVENT_QUEUE: usize = 16;
 
 impl ControlMachine {
+    /// Mode `id` of [`ControlMachine::modes`].
+    pub fn mode(&self, id: ModeId) -> &ModeState {
+        &self.modes[id.index()]
+    }
+
     /// The most plans any mode runs at once (at least 1): the size of the
     /// machine's per-plan state, in C and in the simulator alike.
     pub fn region_count(&self) -> usize {
@@ -422,9 +433,9 @@ pub struct Region {
 
 #[derive(Clone, Debug)]
 pub struct ModeTransition {
-    pub from: usize,
+    pub from: ModeId,
     pub event: String,
-    pub to: usize,
+    pub to: ModeId,
     pub line: u32,
 }
 

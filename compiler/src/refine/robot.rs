@@ -252,13 +252,15 @@ impl Builder<'_, '_> {
             });
         }
         if let Some(main) = &team.main {
-            self.machine.default_mode = main.default.map(|d| d.index());
+            // One mode state per team mode, in order (`build_modes`): the
+            // team's mode position is the machine's.
+            self.machine.default_mode = main.default.map(|d| ModeId::new(d.index()));
             for t in &main.transitions {
                 let line = self.line(t.span);
                 self.machine.transitions.push(ModeTransition {
-                    from: t.from.index(),
+                    from: ModeId::new(t.from.index()),
                     event: t.event.to_string(),
-                    to: t.to.index(),
+                    to: ModeId::new(t.to.index()),
                     line,
                 });
             }

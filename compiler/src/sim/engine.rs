@@ -35,8 +35,8 @@ use crate::refine::SENSOR_PERIOD_MS;
 use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
 use crate::refine::{
-    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, RoleKind, SlotId,
-    SlotSource, StateKind, counted_allocation,
+    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, ModeId, Operand, RobotProgram, RoleKind,
+    SlotId, SlotSource, StateKind, counted_allocation,
 };
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
@@ -399,8 +399,8 @@ struct Robot<'p> {
     /// Per subscribed group: the latest value.
     groups: Vec<Option<Held>>,
     regions: Vec<Region>,
-    current_mode: Option<usize>,
-    pending_mode: Option<usize>,
+    current_mode: Option<ModeId>,
+    pending_mode: Option<ModeId>,
     /// Broadcast events received and not yet looked at by the control task:
     /// (the thrower's peer index, the event's index in `events_heard`), in
     /// arrival order, at most `EVENT_QUEUE` (`comm_event_take`).
@@ -1582,7 +1582,7 @@ impl<'p> Sim<'p> {
             return false;
         };
         self.robots[r].pending_mode = Some(t.to);
-        let mode = m.modes[t.to].name.clone();
+        let mode = m.mode(t.to).name.clone();
         let mut fields = vec![("name", event.into()), ("mode", mode.into())];
         if let Some(from) = from {
             fields.push(("from", from));
@@ -1644,19 +1644,15 @@ impl<'p> Sim<'p> {
         }
     }
 
-    fn enter_mode(&mut self, r: usize, mode: usize) {
+    fn enter_mode(&mut self, r: usize, mode: ModeId) {
         let m: &ControlMachine = &self.robots[r].program.control;
         for region in &mut self.robots[r].regions {
             region.service = None;
             region.done = true;
         }
         self.robots[r].current_mode = Some(mode);
-        self.emit(
-            r,
-            "mode",
-            vec![("mode", m.modes[mode].name.as_str().into())],
-        );
-        for (i, region) in m.modes[mode].regions.iter().enumerate() {
+        self.emit(r, "mode", vec![("mode", m.mode(mode).name.as_str().into())]);
+        for (i, region) in m.mode(mode).regions.iter().enumerate() {
             let slot = &mut self.robots[r].regions[i];
             slot.service = Some(region.service);
             slot.plan = region.plan.clone();
@@ -1797,7 +1793,7 @@ impl<'p> Sim<'p> {
         if !running {
             let mode = self.robots[r]
                 .current_mode
-                .map(|c| m.modes[c].name.clone())
+                .map(|c| m.mode(c).name.clone())
                 .unwrap_or_default();
             self.emit(r, "finish", vec![("mode", mode.into())]);
             self.stop(r);

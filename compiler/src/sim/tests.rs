@@ -1217,7 +1217,7 @@ fn a_throw_that_ends_the_mode_before_a_later_plan_sends_is_noted_as_a_race() {
                     "{} at {} in {}: {} before {}",
                     programs[race.robot].robot,
                     race.at,
-                    m.modes[race.mode].name,
+                    m.mode(race.mode).name,
                     state(race.thrower),
                     state(race.lost)
                 )

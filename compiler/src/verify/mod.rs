@@ -414,7 +414,7 @@ pub fn verify_expecting(
         let program = &programs[race.robot];
         let m = &program.control;
         let plan = |service: usize| {
-            m.modes[race.mode]
+            m.mode(race.mode)
                 .regions
                 .iter()
                 .find(|region| region.service == service)
@@ -431,7 +431,7 @@ pub fn verify_expecting(
                 race.at,
                 program.robot,
                 plan(race.thrower.0),
-                m.modes[race.mode].name,
+                m.mode(race.mode).name,
                 plan(race.lost.0),
                 lost.text.trim(),
                 lost.line,

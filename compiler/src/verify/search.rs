@@ -363,7 +363,7 @@ fn admit(
         .map(|r| !sim.is_running(r) && !world.down[r])
         .collect();
     let modes = robots
-        .map(|r| sim.mode_of(r).and_then(|m| u16::try_from(m).ok()))
+        .map(|r| sim.mode_of(r).and_then(|m| u16::try_from(m.index()).ok()))
         .collect();
     let waiting = (0..sim.robot_count())
         .flat_map(|r| {

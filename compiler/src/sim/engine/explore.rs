@@ -16,7 +16,7 @@
 
 use super::{Event, Held, Message, Queued, Robot, SENSOR_PERIOD_MS, Sim};
 use crate::refine::value::Value;
-use crate::refine::{RobotProgram, ServiceMachine, SlotSource, StateKind};
+use crate::refine::{ModeId, RobotProgram, ServiceMachine, SlotSource, StateKind};
 use crate::sim::scenario::Command;
 use crate::sim::trace::TraceEvent;
 
@@ -151,7 +151,7 @@ impl<'p> Sim<'p> {
     }
 
     /// The mode robot `r` is in: an index into its program's modes.
-    pub fn mode_of(&self, r: usize) -> Option<usize> {
+    pub fn mode_of(&self, r: usize) -> Option<ModeId> {
         self.robots[r].current_mode
     }
 
@@ -489,8 +489,8 @@ impl Fingerprint {
             }
             self.text(&region.plan);
         }
-        self.int(robot.current_mode.map_or(-1, |m| m as i64));
-        self.int(robot.pending_mode.map_or(-1, |m| m as i64));
+        self.int(robot.current_mode.map_or(-1, |m| m.index() as i64));
+        self.int(robot.pending_mode.map_or(-1, |m| m.index() as i64));
         self.int(robot.events.len() as i64);
         for &(peer, event) in &robot.events {
             self.int(peer as i64);

@@ -15,7 +15,7 @@
 //! on the way is the race. The run itself is not changed.
 
 use super::{STEPS_PER_FIRING, Sim, Step};
-use crate::refine::StateKind;
+use crate::refine::{ModeId, StateKind};
 
 /// A plan's caught `throw` ended the mode in an instant in which a later
 /// plan of the mode would have sent a message or thrown a caught event.
@@ -25,8 +25,8 @@ pub struct Race {
     pub robot: usize,
     /// Mission ms of the instant.
     pub at: i64,
-    /// The mode that ended (an index into the robot's modes).
-    pub mode: usize,
+    /// The mode that ended.
+    pub mode: ModeId,
     /// (service, state) of the throw that ended it.
     pub thrower: (usize, usize),
     /// (service, state) of the send or throw that did not happen.
