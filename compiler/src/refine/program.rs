@@ -32,6 +32,14 @@ newtype_index! {
 }
 
 newtype_index! {
+    /// A service machine of the control machine: an index into
+    /// [`ControlMachine::services`] (the generated C's `regions[].service`).
+    /// Not the team's `sema::ServiceId`: a machine is made for each service
+    /// a mode sets, in the order the modes first set them.
+    pub struct ServiceMachineId;
+}
+
+newtype_index! {
     /// A channel of a service graph: an index into [`GraphService::channels`]
     /// (the generated C's `ch<N>`).
     pub struct GraphChannelId;
@@ -280,6 +288,11 @@ impl ControlMachine {
         &self.modes[id.index()]
     }
 
+    /// Service machine `id` of [`ControlMachine::services`].
+    pub fn service(&self, id: ServiceMachineId) -> &ServiceMachine {
+        &self.services[id.index()]
+    }
+
     /// The most plans any mode runs at once (at least 1): the size of the
     /// machine's per-plan state, in C and in the simulator alike.
     pub fn region_count(&self) -> usize {
@@ -316,10 +329,10 @@ impl ControlMachine {
     /// once decided there, again at each heartbeat, in this order
     /// (`docs/groups.md`, "Takeover").
     pub fn elections(&self) -> impl Iterator<Item = Election<'_>> {
-        let states = self.services.iter().enumerate().flat_map(|(service, s)| {
-            s.states
-                .iter()
-                .enumerate()
+        let services = ServiceMachineId::all(self.services.len()).zip(&self.services);
+        let states = services.flat_map(|(service, s)| {
+            StateId::all(s.states.len())
+                .zip(&s.states)
                 .map(move |(pc, state)| ((service, pc), state))
         });
         states.filter_map(|(at, state)| match &state.kind {
@@ -345,7 +358,7 @@ impl ControlMachine {
 #[derive(Clone, Copy, Debug)]
 pub struct Election<'a> {
     /// (service, pc) of the state.
-    pub at: (usize, usize),
+    pub at: (ServiceMachineId, StateId),
     pub line: u32,
     pub candidates: &'a [usize],
     pub algorithm: LeaderAlgorithm,
@@ -426,8 +439,7 @@ pub struct ModeState {
 #[derive(Clone, Debug)]
 pub struct Region {
     pub plan: String,
-    /// Index into [`ControlMachine::services`].
-    pub service: usize,
+    pub service: ServiceMachineId,
     pub timeout_ms: Option<i64>,
 }
 

@@ -147,7 +147,7 @@ struct Builder<'a, 'i> {
     /// Service task → the services or actuator commands it runs.
     services: BTreeMap<String, BTreeSet<String>>,
     /// Team service → machine index.
-    service_machines: HashMap<ServiceId, usize>,
+    service_machines: HashMap<ServiceId, ServiceMachineId>,
     /// (strategy file, entry index) → action machine index.
     action_machines: HashMap<(u32, usize), usize>,
     /// The team service whose machine is being built (for the strategy's
@@ -267,12 +267,12 @@ impl Builder<'_, '_> {
         }
     }
 
-    fn service_machine(&mut self, service: ServiceId) -> usize {
+    fn service_machine(&mut self, service: ServiceId) -> ServiceMachineId {
         if let Some(&m) = self.service_machines.get(&service) {
             return m;
         }
         let info = &self.team.services[service.index()];
-        let index = self.machine.services.len();
+        let index = ServiceMachineId::new(self.machine.services.len());
         self.service_machines.insert(service, index);
         self.machine.services.push(ServiceMachine {
             plan: self.team.plans[info.plan.index()].name.to_string(),
@@ -314,7 +314,7 @@ impl Builder<'_, '_> {
             });
         }
         self.current_service = outer;
-        let m = &mut self.machine.services[index];
+        let m = &mut self.machine.services[index.index()];
         m.states = states;
         m.marks = marks;
         index

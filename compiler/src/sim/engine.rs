@@ -36,7 +36,7 @@ use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
 use crate::refine::{
     ActionMachine, ControlMachine, Expr, LeaderAlgorithm, ModeId, Operand, RobotProgram, RoleKind,
-    SlotId, SlotSource, StateKind, counted_allocation,
+    ServiceMachineId, SlotId, SlotSource, StateId, StateKind, counted_allocation,
 };
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
@@ -332,7 +332,7 @@ impl Inputs {
 
 #[derive(Clone, Debug, Default)]
 struct Region {
-    service: Option<usize>,
+    service: Option<ServiceMachineId>,
     pc: usize,
     phase: u8,
     action: usize,
@@ -425,14 +425,14 @@ struct Robot<'p> {
     /// listening time before it claims).
     fenced: Option<Option<i64>>,
     /// How often this robot reached each `GroupSync` state, by (service, pc).
-    sync_pass: HashMap<(usize, usize), i64>,
+    sync_pass: HashMap<(ServiceMachineId, StateId), i64>,
     /// The last pass each (peer, sync point) announced (`comm_sync_arrived`).
     sync_arrived: HashMap<(usize, usize), i64>,
     /// The last leader each `LeaderBranch` state saw, by (service, pc).
-    leaders: HashMap<(usize, usize), usize>,
+    leaders: HashMap<(ServiceMachineId, StateId), usize>,
     /// The group each `GroupAllocate` state last gave this robot, by
     /// (service, pc): its index, or [`OTHERS`].
-    allocated: HashMap<(usize, usize), usize>,
+    allocated: HashMap<(ServiceMachineId, StateId), usize>,
     /// The last (rank, size) in the team's group this robot traced
     /// (`semo_group_set`); `None` before its first heartbeat.
     group: Option<(usize, usize)>,
@@ -1671,7 +1671,7 @@ impl<'p> Sim<'p> {
             region.pass_start = now;
             let fields = vec![
                 ("plan", region.plan.as_str().into()),
-                ("service", m.services[service].name.as_str().into()),
+                ("service", m.service(service).name.as_str().into()),
             ];
             self.emit(r, "service_start", fields);
         }
@@ -1686,7 +1686,7 @@ impl<'p> Sim<'p> {
             {
                 let fields = vec![
                     ("plan", region.plan.as_str().into()),
-                    ("service", m.services[service].name.as_str().into()),
+                    ("service", m.service(service).name.as_str().into()),
                     ("why", "mode change".into()),
                 ];
                 self.emit(r, "service_end", fields);
@@ -1750,7 +1750,7 @@ impl<'p> Sim<'p> {
                 self.robots[r].regions[i].done = true;
                 let fields = vec![
                     ("plan", plan),
-                    ("service", m.services[service].name.as_str().into()),
+                    ("service", m.service(service).name.as_str().into()),
                     ("why", "timeout".into()),
                 ];
                 self.emit(r, "service_end", fields);
@@ -1777,7 +1777,7 @@ impl<'p> Sim<'p> {
                 region.done = true;
                 let fields = vec![
                     ("plan", region.plan.as_str().into()),
-                    ("service", m.services[service].name.as_str().into()),
+                    ("service", m.service(service).name.as_str().into()),
                 ];
                 self.emit(r, "service_end", fields);
             } else {
@@ -1852,7 +1852,7 @@ impl<'p> Sim<'p> {
             if region.timeout_ms > 0 {
                 at_least(region.started + region.timeout_ms + 1);
             }
-            let Some(state) = m.services[service].states.get(region.pc) else {
+            let Some(state) = m.service(service).states.get(region.pc) else {
                 continue;
             };
             match &state.kind {
@@ -1912,11 +1912,11 @@ impl<'p> Sim<'p> {
     }
 
     /// One state of region `i`'s service (`service_<n>` of the C).
-    fn step(&mut self, r: usize, i: usize, service: usize) -> Step {
+    fn step(&mut self, r: usize, i: usize, service: ServiceMachineId) -> Step {
         let program: &'p RobotProgram = self.robots[r].program;
         let m = &program.control;
         let pc = self.robots[r].regions[i].pc;
-        let Some(state) = m.services[service].states.get(pc) else {
+        let Some(state) = m.service(service).states.get(pc) else {
             return Step::Done;
         };
         let next = pc + 1;
@@ -2077,7 +2077,13 @@ impl<'p> Sim<'p> {
                 others_at,
                 receives,
             } => {
-                match self.election(r, (service, pc), candidates, *algorithm, receives) {
+                match self.election(
+                    r,
+                    (service, StateId::new(pc)),
+                    candidates,
+                    *algorithm,
+                    receives,
+                ) {
                     None => Step::Wait, // still listening
                     Some(elected) => {
                         self.region(r, i).pc = if elected { next } else { others_at.index() };
@@ -2108,7 +2114,7 @@ impl<'p> Sim<'p> {
                     (None, None) => (OTHERS, "others", next),
                 };
                 let robot = &mut self.robots[r];
-                if robot.allocated.insert((service, pc), key) != Some(key) {
+                if robot.allocated.insert((service, StateId::new(pc)), key) != Some(key) {
                     let fields = vec![
                         ("name", name.into()),
                         ("alive", live.len().to_string().into()),
@@ -2126,7 +2132,10 @@ impl<'p> Sim<'p> {
             } => {
                 if self.robots[r].regions[i].phase == 0 {
                     let robot = &mut self.robots[r];
-                    let pass = robot.sync_pass.entry((service, pc)).or_insert(0);
+                    let pass = robot
+                        .sync_pass
+                        .entry((service, StateId::new(pc)))
+                        .or_insert(0);
                     *pass += 1;
                     let value = format!("{} {}", m.sync_points[*point], *pass);
                     let region = self.region(r, i);
@@ -2137,7 +2146,7 @@ impl<'p> Sim<'p> {
                     self.comm_send(r, team, false, key, Some(Value::text(&value)));
                 }
                 let robot = &self.robots[r];
-                let pass = robot.sync_pass[&(service, pc)];
+                let pass = robot.sync_pass[&(service, StateId::new(pc))];
                 let lost = crate::refine::protocol::lost_after_ms(m.heartbeat_ms);
                 let me = program.self_peer;
                 let waiting = members.iter().any(|&peer| {
@@ -2317,7 +2326,7 @@ impl<'p> Sim<'p> {
     fn election(
         &mut self,
         r: usize,
-        state: (usize, usize),
+        state: (ServiceMachineId, StateId),
         candidates: &[usize],
         algorithm: LeaderAlgorithm,
         receives: &[usize],
@@ -2358,7 +2367,7 @@ impl<'p> Sim<'p> {
     fn elected(
         &mut self,
         r: usize,
-        state: (usize, usize),
+        state: (ServiceMachineId, StateId),
         candidates: &[usize],
         algorithm: LeaderAlgorithm,
     ) -> Option<bool> {

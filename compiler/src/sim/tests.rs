@@ -2,7 +2,7 @@
 //! the generated C programs, faults, determinism, and scenario mistakes.
 
 use super::*;
-use crate::refine::RobotProgram;
+use crate::refine::{RobotProgram, ServiceMachineId, StateId};
 use std::path::Path;
 
 fn repo(path: &str) -> std::path::PathBuf {
@@ -1212,7 +1212,9 @@ fn a_throw_that_ends_the_mode_before_a_later_plan_sends_is_noted_as_a_race() {
             .iter()
             .map(|race| {
                 let m = &programs[race.robot].control;
-                let state = |(s, pc): (usize, usize)| m.services[s].states[pc].text.clone();
+                let state = |(s, pc): (ServiceMachineId, StateId)| {
+                    m.service(s).states[pc.index()].text.clone()
+                };
                 format!(
                     "{} at {} in {}: {} before {}",
                     programs[race.robot].robot,

@@ -16,7 +16,9 @@
 
 use super::{Event, Held, Message, Queued, Robot, SENSOR_PERIOD_MS, Sim};
 use crate::refine::value::Value;
-use crate::refine::{ModeId, RobotProgram, ServiceMachine, SlotSource, StateKind};
+use crate::refine::{
+    ModeId, RobotProgram, ServiceMachine, ServiceMachineId, SlotSource, StateId, StateKind,
+};
 use crate::sim::scenario::Command;
 use crate::sim::trace::TraceEvent;
 
@@ -97,20 +99,21 @@ impl<'p> Sim<'p> {
 
     /// The `receive` states robot `r` waits in: (service, state) of each
     /// region of its mode that is at one and has not taken its messages.
-    pub fn waiting_receives(&self, r: usize) -> Vec<(usize, usize)> {
+    pub fn waiting_receives(&self, r: usize) -> Vec<(ServiceMachineId, StateId)> {
         let robot = &self.robots[r];
         if !robot.alive {
             return Vec::new();
         }
-        let services = &robot.program.control.services;
+        let m = &robot.program.control;
         robot
             .regions
             .iter()
             .filter(|region| !region.done)
             .filter_map(|region| {
                 let s = region.service?;
-                let state = services[s].states.get(region.pc)?;
-                matches!(state.kind, StateKind::Receive { .. }).then_some((s, region.pc))
+                let state = m.service(s).states.get(region.pc)?;
+                matches!(state.kind, StateKind::Receive { .. })
+                    .then_some((s, StateId::new(region.pc)))
             })
             .collect()
     }
@@ -134,13 +137,13 @@ impl<'p> Sim<'p> {
 
     /// The `leader(...)` statements robot `r` leads now, as (service,
     /// state) of its program: it runs and its last election there chose it.
-    pub fn leads(&self, r: usize) -> Vec<(usize, usize)> {
+    pub fn leads(&self, r: usize) -> Vec<(ServiceMachineId, StateId)> {
         let robot = &self.robots[r];
         if !robot.alive {
             return Vec::new();
         }
         let me = robot.program.self_peer;
-        let mut led: Vec<(usize, usize)> = robot
+        let mut led: Vec<(ServiceMachineId, StateId)> = robot
             .leaders
             .iter()
             .filter(|(_, leader)| **leader == me)
@@ -466,7 +469,7 @@ impl Fingerprint {
             }
         }
         for region in &robot.regions {
-            self.int(region.service.map_or(-1, |s| s as i64));
+            self.int(region.service.map_or(-1, |s| s.index() as i64));
             self.int(region.pc as i64);
             self.int(region.phase as i64);
             self.int(region.action as i64);
@@ -477,7 +480,7 @@ impl Fingerprint {
             if region.timeout_ms > 0 {
                 self.time(region.started);
             }
-            let timed = region.service.map(|s| timed[s]).unwrap_or_default();
+            let timed = region.service.map(|s| timed[s.index()]).unwrap_or_default();
             if timed.pass {
                 self.time(region.pass_start);
             }
@@ -513,13 +516,16 @@ impl Fingerprint {
             Some(None) => self.int(-2),
             Some(Some(t)) => self.time(t),
         }
-        for map in [&robot.sync_pass, &robot.sync_arrived] {
-            let mut entries: Vec<_> = map.iter().collect();
+        // A sync state by its positions, as a (peer, point) is.
+        let passes = robot.sync_pass.iter();
+        let passes = passes.map(|(&(s, pc), &v)| ((s.index(), pc.index()), v));
+        let arrived = robot.sync_arrived.iter().map(|(&at, &v)| (at, v));
+        for mut entries in [passes.collect::<Vec<_>>(), arrived.collect()] {
             entries.sort_unstable();
             for ((a, b), v) in entries {
-                self.int(*a as i64);
-                self.int(*b as i64);
-                self.int(*v);
+                self.int(a as i64);
+                self.int(b as i64);
+                self.int(v);
             }
         }
         for map in [&robot.leaders, &robot.allocated] {
@@ -527,8 +533,8 @@ impl Fingerprint {
             entries.sort_unstable();
             self.int(entries.len() as i64);
             for ((a, b), v) in entries {
-                self.int(*a as i64);
-                self.int(*b as i64);
+                self.int(a.index() as i64);
+                self.int(b.index() as i64);
                 self.int(*v as i64);
             }
         }
