@@ -13,8 +13,9 @@ use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms, lost_after_ms};
 use crate::refine::{
-    ActionMachine, ControlMachine, CountedGroup, Expr, LeaderAlgorithm, ModeId, Operand,
-    RobotProgram, SendItem, SlotId, SlotSource, State, StateId, StateKind,
+    ActionMachine, ControlMachine, CountedGroup, Expr, IncomingId, LeaderAlgorithm, ModeId,
+    Operand, OutgoingId, RobotProgram, SendItem, SlotId, SlotSource, State, StateId, StateKind,
+    SubscriptionId,
 };
 use std::fmt::Write;
 
@@ -514,7 +515,12 @@ fn args_array(args: &[Operand], words: &Words) -> String {
 /// A robot that has just become the leader here (`led`: the leader before,
 /// `leader`: the variable of the leader now) drops what waits for the
 /// receives of the leader's block (`receives`).
-fn emit_drop_unled(out: &mut String, program: &RobotProgram, receives: &[usize], leader: &str) {
+fn emit_drop_unled(
+    out: &mut String,
+    program: &RobotProgram,
+    receives: &[IncomingId],
+    leader: &str,
+) {
     if receives.is_empty() {
         return;
     }
@@ -523,7 +529,7 @@ fn emit_drop_unled(out: &mut String, program: &RobotProgram, receives: &[usize],
         "    if (chosen > 0 && led != {leader}) {{ /* it leads from now on */"
     );
     for &k in receives {
-        let incoming = &program.control.incoming[k];
+        let incoming = program.control.incoming_message(k);
         let _ = writeln!(
             out,
             "        drop_unled(in_port[{k}], {}, {});",
@@ -639,7 +645,7 @@ fn emit_state(
 fn emit_receive(
     out: &mut String,
     cx: &StateCx,
-    messages: &[usize],
+    messages: &[IncomingId],
     timeout_ms: &Option<i64>,
     mark: &usize,
 ) {
@@ -671,7 +677,7 @@ fn emit_receive(
         }
     }
     for &i in messages {
-        let s = m.incoming[i].slot;
+        let s = m.incoming_message(i).slot;
         let _ = writeln!(
             out,
             "        {{\n            semo_value v;\n            if (UFPort_ReadFromQueue(in_port[{i}], &v, sizeof v) > 0)\n                store({s}, &v);\n        }}"
@@ -702,14 +708,14 @@ fn emit_send(out: &mut String, cx: &StateCx, items: &[SendItem]) {
             out,
             "        semo_port_send(out_port[{}], {sent}, sizeof(semo_value)); /* {} */",
             item.message,
-            c::comment(&m.outgoing[item.message].key)
+            c::comment(&m.outgoing_message(item.message).key)
         );
         if let Some(group) = item.own_group {
             // Its own publication is the latest its subscription sees.
             let _ = writeln!(
                 out,
                 "        UFMulticast_Write({}, {sent}, sizeof(semo_value));",
-                c::string(&m.subscribed[group])
+                c::string(m.subscription(group))
             );
         }
     }
@@ -717,13 +723,13 @@ fn emit_send(out: &mut String, cx: &StateCx, items: &[SendItem]) {
 }
 
 /// `subscribe`: the group's latest value, if any.
-fn emit_subscribe(out: &mut String, cx: &StateCx, group: &usize, slot: &SlotId) {
+fn emit_subscribe(out: &mut String, cx: &StateCx, group: &SubscriptionId, slot: &SlotId) {
     let StateCx { program, next, .. } = *cx;
     let m = &program.control;
     let _ = writeln!(
         out,
         "        {{\n            semo_value v;\n            if (UFMulticast_Read({}, &v, sizeof v) > 0)\n                store({slot}, &v);\n        }}\n        r->pc = {next};\n        return STEP_NEXT;",
-        c::string(&m.subscribed[*group])
+        c::string(m.subscription(*group))
     );
 }
 
@@ -738,7 +744,7 @@ fn emit_throw(out: &mut String, cx: &StateCx, event: &str) {
 }
 
 /// `throw E broadcast`: the others of the group told first.
-fn emit_throw_broadcast(out: &mut String, cx: &StateCx, event: &str, messages: &[usize]) {
+fn emit_throw_broadcast(out: &mut String, cx: &StateCx, event: &str, messages: &[OutgoingId]) {
     let StateCx { program, next, .. } = *cx;
     let m = &program.control;
     // The others of the group are told before the event acts here
@@ -748,8 +754,8 @@ fn emit_throw_broadcast(out: &mut String, cx: &StateCx, event: &str, messages: &
             out,
             "        {{\n            semo_value told;\n            semo_value_set(&told, {});\n            semo_port_send(out_port[{message}], &told, sizeof told); /* {} to {} */\n        }}",
             c::string(event),
-            c::comment(&m.outgoing[message].key),
-            c::comment(&m.outgoing[message].to_team)
+            c::comment(&m.outgoing_message(message).key),
+            c::comment(&m.outgoing_message(message).to_team)
         );
     }
     let _ = writeln!(

@@ -40,6 +40,24 @@ newtype_index! {
 }
 
 newtype_index! {
+    /// A message the control task receives: an index into
+    /// [`ControlMachine::incoming`] (the generated C's `in_port[]`).
+    pub struct IncomingId;
+}
+
+newtype_index! {
+    /// A message the control task sends: an index into
+    /// [`ControlMachine::outgoing`] (the generated C's `out_port[]`).
+    pub struct OutgoingId;
+}
+
+newtype_index! {
+    /// A latest-value group the control task reads: an index into
+    /// [`ControlMachine::subscribed`] (the generated C's `subscribed[]`).
+    pub struct SubscriptionId;
+}
+
+newtype_index! {
     /// A channel of a service graph: an index into [`GraphService::channels`]
     /// (the generated C's `ch<N>`).
     pub struct GraphChannelId;
@@ -288,6 +306,21 @@ impl ControlMachine {
         &self.modes[id.index()]
     }
 
+    /// Incoming message `id` of [`ControlMachine::incoming`].
+    pub fn incoming_message(&self, id: IncomingId) -> &IncomingMessage {
+        &self.incoming[id.index()]
+    }
+
+    /// Outgoing message `id` of [`ControlMachine::outgoing`].
+    pub fn outgoing_message(&self, id: OutgoingId) -> &OutgoingMessage {
+        &self.outgoing[id.index()]
+    }
+
+    /// The key of subscribed group `id` of [`ControlMachine::subscribed`].
+    pub fn subscription(&self, id: SubscriptionId) -> &str {
+        &self.subscribed[id.index()]
+    }
+
     /// Service machine `id` of [`ControlMachine::services`].
     pub fn service(&self, id: ServiceMachineId) -> &ServiceMachine {
         &self.services[id.index()]
@@ -363,7 +396,7 @@ pub struct Election<'a> {
     pub candidates: &'a [usize],
     pub algorithm: LeaderAlgorithm,
     /// The incoming messages the leader's block receives.
-    pub receives: &'a [usize],
+    pub receives: &'a [IncomingId],
 }
 
 impl ControlMachine {
@@ -478,10 +511,10 @@ pub struct State {
 
 #[derive(Clone, Debug)]
 pub enum StateKind {
-    /// Wait for one sample of each incoming message (indices into
-    /// [`ControlMachine::incoming`]), storing each in its slot.
+    /// Wait for one sample of each incoming message, storing each in its
+    /// slot.
     Receive {
-        messages: Vec<usize>,
+        messages: Vec<IncomingId>,
         /// `receive(...), timeout = P`: give up after P (mark holds the start).
         timeout_ms: Option<i64>,
         mark: usize,
@@ -492,18 +525,17 @@ pub enum StateKind {
     },
     /// Read the latest published value of a group into its slot.
     Subscribe {
-        group: usize,
+        group: SubscriptionId,
         slot: SlotId,
     },
     /// `throw E`: the current mode's catch of E asks for a mode change.
-    /// With `broadcast` (`throw E broadcast`), the messages (indices into
-    /// [`ControlMachine::outgoing`], key [`event_key`], the event's name as
-    /// text) that tell the others of the thrower's group first: one to the
+    /// With `broadcast` (`throw E broadcast`), the messages (key
+    /// [`event_key`], the event's name as text) that tell the others of the thrower's group first: one to the
     /// team when the group is the whole team, else one to each other robot
     /// of it; empty when the thrower is the group's only robot.
     Throw {
         event: String,
-        broadcast: Option<Vec<usize>>,
+        broadcast: Option<Vec<OutgoingId>>,
     },
     /// Call the task implementing a built-in service and wait until it is idle.
     Call {
@@ -536,7 +568,7 @@ pub enum StateKind {
         candidates: Vec<usize>,
         algorithm: LeaderAlgorithm,
         others_at: StateId,
-        receives: Vec<usize>,
+        receives: Vec<IncomingId>,
     },
     /// `[[ group(Name, min = N) ... ]]` (counted groups): give this robot a
     /// group from the `members` (peer indices, formation order: the robots
@@ -630,15 +662,14 @@ pub fn counted_allocation(mins: &[usize], has_others: bool, position: usize) -> 
 /// One value of a `send`/`publish`.
 #[derive(Clone, Debug)]
 pub struct SendItem {
-    /// Index into [`ControlMachine::outgoing`].
-    pub message: usize,
+    pub message: OutgoingId,
     pub value: Operand,
     /// `send(T, T.X = v)`: the shared slot `v` is stored in first.
     pub store: Option<SlotId>,
-    /// A publication of a value this robot also subscribes to: the index into
-    /// [`ControlMachine::subscribed`] of the group it is written to at once,
-    /// since the latest value team T published includes the robot's own.
-    pub own_group: Option<usize>,
+    /// A publication of a value this robot also subscribes to: the group it
+    /// is written to at once, since the latest value team T published
+    /// includes the robot's own.
+    pub own_group: Option<SubscriptionId>,
 }
 
 /// A strategy entry's actions: the bottom level of the machine.

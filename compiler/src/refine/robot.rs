@@ -790,10 +790,10 @@ impl Builder<'_, '_> {
                     let key = self.attr_key(&item.attr);
                     let slot = self.shared_slot(&item.attr);
                     let group = match self.machine.subscribed.iter().position(|g| *g == key) {
-                        Some(g) => g,
+                        Some(g) => SubscriptionId::new(g),
                         None => {
                             self.machine.subscribed.push(key.clone());
-                            self.machine.subscribed.len() - 1
+                            SubscriptionId::new(self.machine.subscribed.len() - 1)
                         }
                     };
                     self.push(states, StateKind::Subscribe { group, slot }, span);
@@ -1443,14 +1443,14 @@ impl Builder<'_, '_> {
         }
     }
 
-    fn outgoing(&mut self, to_team: &str, publish: bool, key: &str) -> usize {
+    fn outgoing(&mut self, to_team: &str, publish: bool, key: &str) -> OutgoingId {
         if let Some(i) = self
             .machine
             .outgoing
             .iter()
             .position(|m| m.to_team == to_team && m.publish == publish && m.key == key)
         {
-            return i;
+            return OutgoingId::new(i);
         }
         let port = format!(
             "{}_{}_{}",
@@ -1464,14 +1464,14 @@ impl Builder<'_, '_> {
             key: key.to_string(),
             port,
         });
-        self.machine.outgoing.len() - 1
+        OutgoingId::new(self.machine.outgoing.len() - 1)
     }
 
     /// The messages that tell the others of the thrower's group of a
     /// `throw E broadcast` (the group the checker recorded): one to the team
     /// when it is the whole team, else one to each other robot of it.
     /// `None` when the checker recorded no broadcast there.
-    fn broadcast_messages(&mut self, event: &ast::Ident) -> Option<Vec<usize>> {
+    fn broadcast_messages(&mut self, event: &ast::Ident) -> Option<Vec<OutgoingId>> {
         let team = self.team;
         let receivers = team.broadcast_at(event.span)?.receivers.clone();
         if event.name.len() > MAX_EVENT_NAME_BYTES {
@@ -1511,7 +1511,7 @@ impl Builder<'_, '_> {
         events
     }
 
-    fn incoming(&mut self, from_team: &str, attr: &ast::Attr) -> usize {
+    fn incoming(&mut self, from_team: &str, attr: &ast::Attr) -> IncomingId {
         let key = self.attr_key(attr);
         if let Some(i) = self
             .machine
@@ -1519,7 +1519,7 @@ impl Builder<'_, '_> {
             .iter()
             .position(|m| m.from_team == from_team && *m.key == key)
         {
-            return i;
+            return IncomingId::new(i);
         }
         let slot = self.shared_slot(attr);
         let port = format!("from_{}_{}", from_team, key.replace('.', "_"));
@@ -1529,7 +1529,7 @@ impl Builder<'_, '_> {
             slot,
             port,
         });
-        self.machine.incoming.len() - 1
+        IncomingId::new(self.machine.incoming.len() - 1)
     }
 }
 
@@ -1545,9 +1545,10 @@ fn link_own_publications(machine: &mut ControlMachine) {
     for state in services.iter_mut().flat_map(|s| s.states.iter_mut()) {
         if let StateKind::Send { items } = &mut state.kind {
             for item in items {
-                let message = &outgoing[item.message];
+                let message = &outgoing[item.message.index()];
                 if message.publish {
-                    item.own_group = subscribed.iter().position(|g| *g == message.key);
+                    let group = subscribed.iter().position(|g| *g == message.key);
+                    item.own_group = group.map(SubscriptionId::new);
                 }
             }
         }
@@ -1631,8 +1632,8 @@ struct Forward(StateId);
 
 /// The incoming messages the `Receive` states of `states` take, each once,
 /// in index order (a leader's block: [`StateKind::LeaderBranch`]).
-fn received_in(states: &[State]) -> Vec<usize> {
-    let mut messages: Vec<usize> = states
+fn received_in(states: &[State]) -> Vec<IncomingId> {
+    let mut messages: Vec<IncomingId> = states
         .iter()
         .filter_map(|s| match &s.kind {
             StateKind::Receive { messages, .. } => Some(messages.iter().copied()),

@@ -699,7 +699,7 @@ fn a_broadcast_goes_to_the_throwers_group_as_the_checker_recorded_it() {
                 } => Some(
                     std::iter::once(event.clone())
                         .chain(messages.iter().map(|&m| {
-                            let o = &p.control.outgoing[m];
+                            let o = p.control.outgoing_message(m);
                             assert_eq!((o.key.as_str(), o.publish), ("T.__event", false));
                             o.to_team.clone()
                         }))

@@ -35,8 +35,9 @@ use crate::refine::SENSOR_PERIOD_MS;
 use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
 use crate::refine::{
-    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, ModeId, Operand, RobotProgram, RoleKind,
-    ServiceMachineId, SlotId, SlotSource, StateId, StateKind, counted_allocation,
+    ActionMachine, ControlMachine, Expr, IncomingId, LeaderAlgorithm, ModeId, Operand, OutgoingId,
+    RobotProgram, RoleKind, ServiceMachineId, SlotId, SlotSource, StateId, StateKind,
+    counted_allocation,
 };
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
@@ -1547,11 +1548,11 @@ impl<'p> Sim<'p> {
     /// `throw E broadcast` (`throw_broadcast`): traced once, the others of
     /// the thrower's group told (the event's name as text, key
     /// `Team.__event`), then caught here as `throw E` is.
-    fn throw_broadcast(&mut self, r: usize, event: &str, messages: &[usize]) {
+    fn throw_broadcast(&mut self, r: usize, event: &str, messages: &[OutgoingId]) {
         let fields = vec![("name", event.into()), ("broadcast", "true".into())];
         self.emit(r, "throw", fields);
         for &message in messages {
-            let (to, key) = self.names[r].outgoing[message].clone();
+            let (to, key) = self.names[r].outgoing[message.index()].clone();
             self.comm_send(r, to, false, key, Some(Value::text(event)));
         }
         self.catch_event(r, event);
@@ -1934,7 +1935,7 @@ impl<'p> Sim<'p> {
                 }
                 let ready = messages
                     .iter()
-                    .all(|&k| !self.robots[r].inbox[k].0.is_empty());
+                    .all(|&k| !self.robots[r].inbox[k.index()].0.is_empty());
                 if !ready {
                     let Some(t) = timeout_ms else {
                         return Step::Wait;
@@ -1952,9 +1953,9 @@ impl<'p> Sim<'p> {
                     self.region(r, i).phase = 0;
                 }
                 for &k in messages {
-                    if let Some(v) = self.robots[r].inbox[k].0.pop_front() {
-                        self.robots[r].stalled[k] = false;
-                        self.store(r, m.incoming[k].slot, v);
+                    if let Some(v) = self.robots[r].inbox[k.index()].0.pop_front() {
+                        self.robots[r].stalled[k.index()] = false;
+                        self.store(r, m.incoming_message(k).slot, v);
                     }
                 }
                 // Room for a message the receive task holds up.
@@ -1974,17 +1975,17 @@ impl<'p> Sim<'p> {
                     };
                     if let Some(group) = item.own_group {
                         // Its own publication is the latest its subscription sees.
-                        self.robots[r].groups[group] = Some(sent.clone());
+                        self.robots[r].groups[group.index()] = Some(sent.clone());
                     }
-                    let publish = m.outgoing[item.message].publish;
-                    let (to, key) = self.names[r].outgoing[item.message].clone();
+                    let publish = m.outgoing_message(item.message).publish;
+                    let (to, key) = self.names[r].outgoing[item.message.index()].clone();
                     self.comm_send(r, to, publish, key, sent);
                 }
                 self.region(r, i).pc = next;
                 Step::Next
             }
             StateKind::Subscribe { group, slot } => {
-                if let Some(v) = self.robots[r].groups[*group].clone() {
+                if let Some(v) = self.robots[r].groups[group.index()].clone() {
                     self.store(r, *slot, v);
                 }
                 self.region(r, i).pc = next;
@@ -2290,18 +2291,18 @@ impl<'p> Sim<'p> {
     /// the channels now, oldest first, as the C's `drop_unled` takes them;
     /// a message the receive task holds up then finds room, as after a
     /// `receive`.
-    fn drop_unled(&mut self, r: usize, messages: &[usize]) {
+    fn drop_unled(&mut self, r: usize, messages: &[IncomingId]) {
         let mut took = false;
         for &k in messages {
             let robot = &mut self.robots[r];
-            let waiting = robot.inbox[k].0.len();
+            let waiting = robot.inbox[k.index()].0.len();
             if waiting == 0 {
                 continue;
             }
-            robot.inbox[k].0.clear();
-            robot.stalled[k] = false;
+            robot.inbox[k.index()].0.clear();
+            robot.stalled[k.index()] = false;
             took = true;
-            let incoming = &robot.program.control.incoming[k];
+            let incoming = robot.program.control.incoming_message(k);
             let (from, key): (Rc<str>, Rc<str>) = (
                 incoming.from_team.as_str().into(),
                 incoming.key.as_str().into(),
@@ -2329,7 +2330,7 @@ impl<'p> Sim<'p> {
         state: (ServiceMachineId, StateId),
         candidates: &[usize],
         algorithm: LeaderAlgorithm,
-        receives: &[usize],
+        receives: &[IncomingId],
     ) -> Option<bool> {
         let me = self.robots[r].program.self_peer;
         let led = self.robots[r].leaders.get(&state) == Some(&me);

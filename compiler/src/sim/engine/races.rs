@@ -68,7 +68,7 @@ impl Sim<'_> {
         // which the team does not act on. Or a throw the mode catches.
         let acts = |state: &crate::refine::State| match &state.kind {
             StateKind::Send { items } => items.iter().any(|item| {
-                let message = &m.outgoing[item.message];
+                let message = m.outgoing_message(item.message);
                 !message.publish && message.to_team != "USER"
             }),
             StateKind::Throw { event, .. } => caught(event),
