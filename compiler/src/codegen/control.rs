@@ -13,7 +13,7 @@ use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms, lost_after_ms};
 use crate::refine::{
-    ActionMachine, ControlMachine, CountedGroup, Expr, IncomingId, LeaderAlgorithm, ModeId,
+    ActionMachine, ControlMachine, CountedGroup, Expr, IncomingId, LeaderAlgorithm, MarkId, ModeId,
     Operand, OutgoingId, RobotProgram, SendItem, SlotId, SlotSource, State, StateId, StateKind,
     SubscriptionId,
 };
@@ -647,7 +647,7 @@ fn emit_receive(
     cx: &StateCx,
     messages: &[IncomingId],
     timeout_ms: &Option<i64>,
-    mark: &usize,
+    mark: &MarkId,
 ) {
     let StateCx { program, next, .. } = *cx;
     let m = &program.control;
@@ -773,7 +773,7 @@ fn emit_call(
     task: &str,
     args: &[Operand],
     timeout_ms: &Option<i64>,
-    mark: &usize,
+    mark: &MarkId,
 ) {
     let StateCx {
         program,
@@ -824,7 +824,7 @@ fn emit_run_actions(
     machine: &usize,
     args: &[Operand],
     timeout_ms: &Option<i64>,
-    mark: &usize,
+    mark: &MarkId,
 ) {
     let StateCx {
         program,
@@ -974,7 +974,7 @@ fn emit_group_sync(
     members: &[usize],
     point: &usize,
     timeout_ms: &i64,
-    mark: &usize,
+    mark: &MarkId,
 ) {
     let StateCx {
         program,
@@ -1025,7 +1025,7 @@ fn emit_loop_head(
     cx: &StateCx,
     condition: &Option<Expr>,
     exit_to: &StateId,
-    mark: &usize,
+    mark: &MarkId,
 ) {
     let StateCx { words, next, .. } = *cx;
     if let Some(cond) = condition {
@@ -1046,7 +1046,7 @@ fn emit_loop_tail(
     out: &mut String,
     _cx: &StateCx,
     period_ms: &Option<i64>,
-    mark: &usize,
+    mark: &MarkId,
     to: &StateId,
 ) {
     match period_ms {

@@ -58,6 +58,13 @@ newtype_index! {
 }
 
 newtype_index! {
+    /// A mark (a timer: when a loop pass, a call or a wait started) of its
+    /// service machine: below [`ServiceMachine::marks`] (the generated C's
+    /// `r->mark[]`).
+    pub struct MarkId;
+}
+
+newtype_index! {
     /// A channel of a service graph: an index into [`GraphService::channels`]
     /// (the generated C's `ch<N>`).
     pub struct GraphChannelId;
@@ -492,7 +499,8 @@ pub struct ServiceMachine {
     pub name: String,
     pub line: u32,
     pub states: Vec<State>,
-    /// Timers and marks the states use (loop starts, call starts).
+    /// How many timers and marks the states use (loop starts, call
+    /// starts): each [`MarkId`] of its states is below it.
     pub marks: usize,
 }
 
@@ -517,7 +525,7 @@ pub enum StateKind {
         messages: Vec<IncomingId>,
         /// `receive(...), timeout = P`: give up after P (mark holds the start).
         timeout_ms: Option<i64>,
-        mark: usize,
+        mark: MarkId,
     },
     /// Send each item (storing assigned values in their shared slot first).
     Send {
@@ -543,7 +551,7 @@ pub enum StateKind {
         task: String,
         args: Vec<Operand>,
         timeout_ms: Option<i64>,
-        mark: usize,
+        mark: MarkId,
     },
     /// Run a strategy action machine to its final action.
     RunActions {
@@ -551,7 +559,7 @@ pub enum StateKind {
         machine: usize,
         args: Vec<Operand>,
         timeout_ms: Option<i64>,
-        mark: usize,
+        mark: MarkId,
     },
     /// `leader(cond)` for a robot that meets `cond`: continue (run the
     /// leader's block) if `algorithm` chooses this robot among the live
@@ -598,7 +606,7 @@ pub enum StateKind {
         /// Index into [`ControlMachine::sync_points`].
         point: usize,
         timeout_ms: i64,
-        mark: usize,
+        mark: MarkId,
     },
     /// Continue at `else_to` unless the condition holds.
     Branch {
@@ -613,12 +621,12 @@ pub enum StateKind {
     LoopHead {
         condition: Option<Expr>,
         exit_to: StateId,
-        mark: usize,
+        mark: MarkId,
     },
     /// End of a loop body: wait for the period (from the mark), then `to`.
     LoopTail {
         period_ms: Option<i64>,
-        mark: usize,
+        mark: MarkId,
         to: StateId,
     },
     /// After the body: `repeat(period?, condition?)`; `forever` for `repeat()`;

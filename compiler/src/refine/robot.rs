@@ -1620,9 +1620,10 @@ enum ArmChoice<'s> {
     },
 }
 
-fn next_mark(marks: &mut usize) -> usize {
+/// A new mark of the service machine whose `marks` (a count) it raises.
+fn next_mark(marks: &mut usize) -> MarkId {
     *marks += 1;
-    *marks - 1
+    MarkId::new(*marks - 1)
 }
 
 /// A state pushed by [`Builder::push_forward`] whose target is the state

@@ -1869,14 +1869,14 @@ impl<'p> Sim<'p> {
                     if let Some(t) = timeout_ms
                         && region.phase > 0
                     {
-                        at_least(region.marks[*mark] + t + 1);
+                        at_least(region.marks[mark.index()] + t + 1);
                     }
                 }
                 StateKind::LoopTail {
                     period_ms: Some(p),
                     mark,
                     ..
-                } => at_least(region.marks[*mark] + p),
+                } => at_least(region.marks[mark.index()] + p),
                 StateKind::Repeat {
                     period_ms: Some(p), ..
                 } => at_least(region.pass_start + p),
@@ -1930,7 +1930,7 @@ impl<'p> Sim<'p> {
             } => {
                 if timeout_ms.is_some() && self.robots[r].regions[i].phase == 0 {
                     let region = self.region(r, i);
-                    region.marks[*mark] = now;
+                    region.marks[mark.index()] = now;
                     region.phase = 1;
                 }
                 let ready = messages
@@ -1940,7 +1940,7 @@ impl<'p> Sim<'p> {
                     let Some(t) = timeout_ms else {
                         return Step::Wait;
                     };
-                    if now - self.robots[r].regions[i].marks[*mark] <= *t {
+                    if now - self.robots[r].regions[i].marks[mark.index()] <= *t {
                         return Step::Wait;
                     }
                     self.emit(r, "timeout", vec![("statement", "receive".into())]);
@@ -2012,12 +2012,12 @@ impl<'p> Sim<'p> {
                         return Step::Wait;
                     }
                     let region = self.region(r, i);
-                    region.marks[*mark] = now;
+                    region.marks[mark.index()] = now;
                     region.phase = 1;
                     return Step::Wait;
                 }
-                let timed_out =
-                    timeout_ms.is_some_and(|t| now - self.robots[r].regions[i].marks[*mark] > t);
+                let timed_out = timeout_ms
+                    .is_some_and(|t| now - self.robots[r].regions[i].marks[mark.index()] > t);
                 if timed_out {
                     self.stop_task(r, task);
                     self.emit(r, "timeout", vec![("service", service.as_str().into())]);
@@ -2047,7 +2047,7 @@ impl<'p> Sim<'p> {
                     let region = self.region(r, i);
                     region.action = am.initial;
                     region.phase = 1;
-                    region.marks[*mark] = now;
+                    region.marks[mark.index()] = now;
                     self.emit(
                         r,
                         "actions_start",
@@ -2055,7 +2055,7 @@ impl<'p> Sim<'p> {
                     );
                 }
                 if let Some(t) = timeout_ms
-                    && now - self.robots[r].regions[i].marks[*mark] > *t
+                    && now - self.robots[r].regions[i].marks[mark.index()] > *t
                 {
                     self.emit(r, "timeout", vec![("service", service.as_str().into())]);
                     let region = self.region(r, i);
@@ -2140,7 +2140,7 @@ impl<'p> Sim<'p> {
                     *pass += 1;
                     let value = format!("{} {}", m.sync_points[*point], *pass);
                     let region = self.region(r, i);
-                    region.marks[*mark] = now;
+                    region.marks[mark.index()] = now;
                     region.phase = 1;
                     let names = &self.names[r];
                     let (team, key) = (names.team.clone(), names.sync_key.clone());
@@ -2160,7 +2160,7 @@ impl<'p> Sim<'p> {
                             < pass
                         && now - robot.heard.get(peer).seen <= lost
                 });
-                let started = robot.regions[i].marks[*mark];
+                let started = robot.regions[i].marks[mark.index()];
                 if waiting && now - started <= *timeout_ms {
                     return Step::Wait;
                 }
@@ -2196,7 +2196,7 @@ impl<'p> Sim<'p> {
                     return Step::Next;
                 }
                 let region = self.region(r, i);
-                region.marks[*mark] = now;
+                region.marks[mark.index()] = now;
                 region.pc = next;
                 Step::Next
             }
@@ -2206,7 +2206,7 @@ impl<'p> Sim<'p> {
                 to,
             } => match period_ms {
                 Some(p) => {
-                    if now - self.robots[r].regions[i].marks[*mark] < *p {
+                    if now - self.robots[r].regions[i].marks[mark.index()] < *p {
                         return Step::Wait;
                     }
                     self.region(r, i).pc = to.index();
