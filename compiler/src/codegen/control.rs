@@ -13,9 +13,9 @@ use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms, lost_after_ms};
 use crate::refine::{
-    ActionMachine, ControlMachine, CountedGroup, Expr, IncomingId, LeaderAlgorithm, MarkId, ModeId,
-    Operand, OutgoingId, RobotProgram, SendItem, SlotId, SlotSource, State, StateId, StateKind,
-    SubscriptionId,
+    ActionMachine, ActionMachineId, ControlMachine, CountedGroup, Expr, IncomingId,
+    LeaderAlgorithm, MarkId, ModeId, Operand, OutgoingId, RobotProgram, SendItem, SlotId,
+    SlotSource, State, StateId, StateKind, SubscriptionId,
 };
 use std::fmt::Write;
 
@@ -821,7 +821,7 @@ fn emit_run_actions(
     out: &mut String,
     cx: &StateCx,
     service: &str,
-    machine: &usize,
+    machine: &ActionMachineId,
     args: &[Operand],
     timeout_ms: &Option<i64>,
     mark: &MarkId,
@@ -833,7 +833,7 @@ fn emit_run_actions(
         ..
     } = *cx;
     let m = &program.control;
-    let am = &m.actions[*machine];
+    let am = m.action_machine(*machine);
     let _ = writeln!(out, "        if (r->phase == 0) {{");
     for (i, slot) in am.arguments.iter().enumerate() {
         if let Some(arg) = args.get(i) {

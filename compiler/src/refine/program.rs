@@ -65,6 +65,18 @@ newtype_index! {
 }
 
 newtype_index! {
+    /// A strategy entry's action machine: an index into
+    /// [`ControlMachine::actions`] (the generated C's `actions_<n>`).
+    pub struct ActionMachineId;
+}
+
+newtype_index! {
+    /// An action of its action machine: an index into
+    /// [`ActionMachine::actions`].
+    pub struct ActionId;
+}
+
+newtype_index! {
     /// A channel of a service graph: an index into [`GraphService::channels`]
     /// (the generated C's `ch<N>`).
     pub struct GraphChannelId;
@@ -328,6 +340,11 @@ impl ControlMachine {
         &self.subscribed[id.index()]
     }
 
+    /// Action machine `id` of [`ControlMachine::actions`].
+    pub fn action_machine(&self, id: ActionMachineId) -> &ActionMachine {
+        &self.actions[id.index()]
+    }
+
     /// Service machine `id` of [`ControlMachine::services`].
     pub fn service(&self, id: ServiceMachineId) -> &ServiceMachine {
         &self.services[id.index()]
@@ -556,7 +573,7 @@ pub enum StateKind {
     /// Run a strategy action machine to its final action.
     RunActions {
         service: String,
-        machine: usize,
+        machine: ActionMachineId,
         args: Vec<Operand>,
         timeout_ms: Option<i64>,
         mark: MarkId,
@@ -687,7 +704,7 @@ pub struct ActionMachine {
     /// `Strategy file` line of the `<Service>` element.
     pub source: String,
     pub actions: Vec<ActionState>,
-    pub initial: usize,
+    pub initial: ActionId,
     /// Slots of the `variable` parameters set from the call's arguments, in order.
     pub arguments: Vec<SlotId>,
 }
@@ -701,7 +718,7 @@ pub struct ActionState {
     /// given: a value as written, a sensor reading, the call's argument).
     pub commands: Vec<(String, Operand)>,
     /// Checked in order; the first that holds is taken. `None` = always.
-    pub transitions: Vec<(Option<Expr>, usize)>,
+    pub transitions: Vec<(Option<Expr>, ActionId)>,
 }
 
 /// A value of the machine and where it comes from.

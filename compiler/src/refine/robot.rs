@@ -149,7 +149,7 @@ struct Builder<'a, 'i> {
     /// Team service → machine index.
     service_machines: HashMap<ServiceId, ServiceMachineId>,
     /// (strategy file, entry index) → action machine index.
-    action_machines: HashMap<(u32, usize), usize>,
+    action_machines: HashMap<(u32, usize), ActionMachineId>,
     /// The team service whose machine is being built (for the strategy's
     /// leader selection scoped to a composite service).
     current_service: Option<ServiceId>,
@@ -929,7 +929,7 @@ impl Builder<'_, '_> {
     }
 
     /// The strategy entry refining the call at `span` for this robot's type.
-    fn strategy_machine(&mut self, span: Span, service: &str) -> Option<usize> {
+    fn strategy_machine(&mut self, span: Span, service: &str) -> Option<ActionMachineId> {
         let link = self
             .input
             .links
@@ -958,7 +958,7 @@ impl Builder<'_, '_> {
         let source = self.strategy_name(strategy);
         let machine = self.action_machine(entry, service, source, strategy, span);
         self.machine.actions.push(machine);
-        let index = self.machine.actions.len() - 1;
+        let index = ActionMachineId::new(self.machine.actions.len() - 1);
         self.action_machines.insert(key, index);
         Some(index)
     }
@@ -1013,10 +1013,9 @@ impl Builder<'_, '_> {
                 }
             }
         }
-        let index_of: HashMap<u64, usize> = entry
-            .actions
-            .iter()
-            .enumerate()
+        // One action state per action of the entry, in order (below).
+        let index_of: HashMap<u64, ActionId> = ActionId::all(entry.actions.len())
+            .zip(&entry.actions)
             .filter_map(|(i, a)| a.id.as_ref().map(|id| (id.value, i)))
             .collect();
         let mut actions = Vec::new();
@@ -1082,11 +1081,11 @@ impl Builder<'_, '_> {
             });
         }
         let initial = match entry.actions.iter().position(|a| a.initial.is_yes()) {
-            Some(i) => i,
+            Some(i) => ActionId::new(i),
             None => {
                 let what = format!("the strategy of `{service}` has no initial action");
                 self.internal_error(call, &what);
-                0
+                ActionId::new(0)
             }
         };
         ActionMachine {

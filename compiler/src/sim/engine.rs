@@ -35,8 +35,8 @@ use crate::refine::SENSOR_PERIOD_MS;
 use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
 use crate::refine::{
-    ActionMachine, ControlMachine, Expr, IncomingId, LeaderAlgorithm, ModeId, Operand, OutgoingId,
-    RobotProgram, RoleKind, ServiceMachineId, SlotId, SlotSource, StateId, StateKind,
+    ActionId, ActionMachine, ControlMachine, Expr, IncomingId, LeaderAlgorithm, ModeId, Operand,
+    OutgoingId, RobotProgram, RoleKind, ServiceMachineId, SlotId, SlotSource, StateId, StateKind,
     counted_allocation,
 };
 use std::collections::{BinaryHeap, HashMap, VecDeque};
@@ -331,12 +331,14 @@ impl Inputs {
     }
 }
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 struct Region {
     service: Option<ServiceMachineId>,
     pc: usize,
     phase: u8,
-    action: usize,
+    /// The current action of the action machine a `RunActions` state runs
+    /// (set to its initial action when the state starts).
+    action: ActionId,
     done: bool,
     started: i64,
     pass_start: i64,
@@ -609,9 +611,18 @@ impl<'p> Robot<'p> {
             groups: vec![None; m.subscribed.len()],
             regions: vec![
                 Region {
-                    marks: vec![0; marks],
+                    service: None,
+                    pc: 0,
+                    phase: 0,
+                    // As the C's zeroed region; no action runs before a
+                    // `RunActions` state sets its machine's initial one.
+                    action: ActionId::new(0),
                     done: true,
-                    ..Region::default()
+                    started: 0,
+                    pass_start: 0,
+                    timeout_ms: 0,
+                    marks: vec![0; marks],
+                    plan: String::new(),
                 };
                 regions
             ],
@@ -2036,7 +2047,7 @@ impl<'p> Sim<'p> {
                 timeout_ms,
                 mark,
             } => {
-                let am = &m.actions[*machine];
+                let am = m.action_machine(*machine);
                 if self.robots[r].regions[i].phase == 0 {
                     for (k, slot) in am.arguments.iter().enumerate() {
                         if let Some(arg) = args.get(k) {
@@ -2250,7 +2261,7 @@ impl<'p> Sim<'p> {
     /// `actions_<n>`: phase 1 enters the current action (issues its
     /// commands), phase 2 waits for them and takes the first transition that holds.
     fn actions(&mut self, r: usize, i: usize, am: &'p ActionMachine) -> Step {
-        let Some(action) = am.actions.get(self.robots[r].regions[i].action) else {
+        let Some(action) = am.actions.get(self.robots[r].regions[i].action.index()) else {
             return Step::Done;
         };
         if action.is_final {

@@ -472,7 +472,7 @@ impl Fingerprint {
             self.int(region.service.map_or(-1, |s| s.index() as i64));
             self.int(region.pc as i64);
             self.int(region.phase as i64);
-            self.int(region.action as i64);
+            self.int(region.action.index() as i64);
             self.int(region.done as i64);
             // A time only a period or a timeout reads: otherwise when a
             // pass started changes nothing, and hashing it would tell apart
