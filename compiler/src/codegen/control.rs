@@ -15,7 +15,7 @@ use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms,
 use crate::refine::{
     ActionMachine, ActionMachineId, ControlMachine, CountedGroup, Expr, IncomingId,
     LeaderAlgorithm, MarkId, ModeId, Operand, OutgoingId, RobotProgram, SendItem, SlotId,
-    SlotSource, State, StateId, StateKind, SubscriptionId,
+    SlotSource, State, StateId, StateKind, SubscriptionId, SyncPointId,
 };
 use std::fmt::Write;
 
@@ -972,7 +972,7 @@ fn emit_group_sync(
     out: &mut String,
     cx: &StateCx,
     members: &[usize],
-    point: &usize,
+    point: &SyncPointId,
     timeout_ms: &i64,
     mark: &MarkId,
 ) {
@@ -992,7 +992,7 @@ fn emit_group_sync(
             ("list", &list),
             ("mark", &mark),
             ("count", &members.len()),
-            ("offset", &m.sync_points[*point]),
+            ("offset", &m.sync_point(*point)),
             ("team", &c::string(&program.team)),
             ("key", &c::string(&protocol::sync_key(program))),
             ("point", &point),

@@ -77,6 +77,12 @@ newtype_index! {
 }
 
 newtype_index! {
+    /// A group statement this robot synchronizes at: an index into
+    /// [`ControlMachine::sync_points`].
+    pub struct SyncPointId;
+}
+
+newtype_index! {
     /// A channel of a service graph: an index into [`GraphService::channels`]
     /// (the generated C's `ch<N>`).
     pub struct GraphChannelId;
@@ -343,6 +349,11 @@ impl ControlMachine {
     /// Action machine `id` of [`ControlMachine::actions`].
     pub fn action_machine(&self, id: ActionMachineId) -> &ActionMachine {
         &self.actions[id.index()]
+    }
+
+    /// The mission offset sync point `id` names ([`ControlMachine::sync_points`]).
+    pub fn sync_point(&self, id: SyncPointId) -> usize {
+        self.sync_points[id.index()]
     }
 
     /// Service machine `id` of [`ControlMachine::services`].
@@ -620,8 +631,7 @@ pub enum StateKind {
     /// periods), or `timeout_ms` has passed.
     GroupSync {
         members: Vec<usize>,
-        /// Index into [`ControlMachine::sync_points`].
-        point: usize,
+        point: SyncPointId,
         timeout_ms: i64,
         mark: MarkId,
     },

@@ -366,10 +366,10 @@ impl Builder<'_, '_> {
             .iter()
             .position(|&p| p == span.start)
         {
-            Some(i) => i,
+            Some(i) => SyncPointId::new(i),
             None => {
                 self.machine.sync_points.push(span.start);
-                self.machine.sync_points.len() - 1
+                SyncPointId::new(self.machine.sync_points.len() - 1)
             }
         };
         let (_, heartbeat_ms) = self.leader_selection();

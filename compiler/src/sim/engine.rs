@@ -37,7 +37,7 @@ use crate::refine::value::{self, Value};
 use crate::refine::{
     ActionId, ActionMachine, ControlMachine, Expr, IncomingId, LeaderAlgorithm, ModeId, Operand,
     OutgoingId, RobotProgram, RoleKind, ServiceMachineId, SlotId, SlotSource, StateId, StateKind,
-    counted_allocation,
+    SyncPointId, counted_allocation,
 };
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
@@ -430,7 +430,7 @@ struct Robot<'p> {
     /// How often this robot reached each `GroupSync` state, by (service, pc).
     sync_pass: HashMap<(ServiceMachineId, StateId), i64>,
     /// The last pass each (peer, sync point) announced (`comm_sync_arrived`).
-    sync_arrived: HashMap<(usize, usize), i64>,
+    sync_arrived: HashMap<(usize, SyncPointId), i64>,
     /// The last leader each `LeaderBranch` state saw, by (service, pc).
     leaders: HashMap<(ServiceMachineId, StateId), usize>,
     /// The group each `GroupAllocate` state last gave this robot, by
@@ -1375,6 +1375,7 @@ impl<'p> Sim<'p> {
             let (offset, pass) = (number(words.next()), number(words.next()));
             let peer = sender_peer(robot.program, message);
             let point = m.sync_points.iter().position(|&p| p as i64 == offset);
+            let point = point.map(SyncPointId::new);
             if let (Some(peer), Some(point)) = (peer, point) {
                 let last = robot.sync_arrived.entry((peer, point)).or_insert(0);
                 *last = (*last).max(pass);
@@ -2149,7 +2150,7 @@ impl<'p> Sim<'p> {
                         .entry((service, StateId::new(pc)))
                         .or_insert(0);
                     *pass += 1;
-                    let value = format!("{} {}", m.sync_points[*point], *pass);
+                    let value = format!("{} {}", m.sync_point(*point), *pass);
                     let region = self.region(r, i);
                     region.marks[mark.index()] = now;
                     region.phase = 1;

@@ -519,7 +519,8 @@ impl Fingerprint {
         // A sync state by its positions, as a (peer, point) is.
         let passes = robot.sync_pass.iter();
         let passes = passes.map(|(&(s, pc), &v)| ((s.index(), pc.index()), v));
-        let arrived = robot.sync_arrived.iter().map(|(&at, &v)| (at, v));
+        let arrived = robot.sync_arrived.iter();
+        let arrived = arrived.map(|(&(peer, point), &v)| ((peer, point.index()), v));
         for mut entries in [passes.collect::<Vec<_>>(), arrived.collect()] {
             entries.sort_unstable();
             for ((a, b), v) in entries {
