@@ -83,6 +83,12 @@ newtype_index! {
 }
 
 newtype_index! {
+    /// A value of the team's library: an index into
+    /// [`SharedLibrary::attributes`] (the generated library's `values[]`).
+    pub struct AttributeId;
+}
+
+newtype_index! {
     /// A channel of a service graph: an index into [`GraphService::channels`]
     /// (the generated C's `ch<N>`).
     pub struct GraphChannelId;
@@ -782,6 +788,13 @@ pub struct SharedLibrary {
     pub ownership: Option<Ownership>,
 }
 
+impl SharedLibrary {
+    /// The key of attribute `id` of [`SharedLibrary::attributes`].
+    pub fn attribute(&self, id: AttributeId) -> &str {
+        &self.attributes[id.index()]
+    }
+}
+
 /// The globally shared attributes of a team's library and the robots that
 /// own them in turn: one robot of `owners` holds them, the others set them
 /// through messages to it and read what it last told them.
@@ -826,8 +839,8 @@ impl OwnerRule {
 /// One globally shared attribute of a library.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct GlobalValue {
-    /// Its index in [`SharedLibrary::attributes`].
-    pub at: usize,
+    /// Its place in [`SharedLibrary::attributes`].
+    pub at: AttributeId,
     /// The type of its values (its shared slot's): a value of another type
     /// received is refused.
     pub kind: ValueKind,

@@ -35,9 +35,9 @@ use crate::refine::SENSOR_PERIOD_MS;
 use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
 use crate::refine::{
-    ActionId, ActionMachine, ControlMachine, Expr, IncomingId, LeaderAlgorithm, ModeId, Operand,
-    OutgoingId, RobotProgram, RoleKind, ServiceMachineId, SlotId, SlotSource, StateId, StateKind,
-    SyncPointId, counted_allocation,
+    ActionId, ActionMachine, AttributeId, ControlMachine, Expr, IncomingId, LeaderAlgorithm,
+    ModeId, Operand, OutgoingId, RobotProgram, RoleKind, ServiceMachineId, SlotId, SlotSource,
+    StateId, StateKind, SyncPointId, counted_allocation,
 };
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
@@ -313,7 +313,7 @@ struct Inputs {
     /// The slots fed by a sensor.
     sensors: Vec<usize>,
     /// The shared slots, each with its value's place in the library.
-    shared: Vec<(usize, usize)>,
+    shared: Vec<(usize, AttributeId)>,
 }
 
 impl Inputs {
@@ -376,7 +376,7 @@ struct Robot<'p> {
     /// The library task's values, one per shared key (`lib_<name>.c`).
     library: Vec<Held>,
     /// Per slot: its value's place in `library` (shared slots only).
-    library_index: Vec<Option<usize>>,
+    library_index: Vec<Option<AttributeId>>,
     /// A library value was written since the control task last read the
     /// library into its slots (otherwise every shared slot holds its value
     /// already, and reading them again, comparing text, is skipped).
@@ -587,13 +587,17 @@ impl<'p> Robot<'p> {
             started_at: at,
             slots: vec![None; m.slots.len()],
             library: vec![None; library_keys.len()],
+            // Read from the program's library (whose attributes are
+            // `library_keys`, made by the same rule).
             library_index: m
                 .slots
                 .iter()
                 .map(|s| {
-                    (s.source == SlotSource::Shared && program.library.is_some())
-                        .then(|| library_keys.iter().position(|k| *k == s.key))
+                    let lib = program.library.as_ref()?;
+                    (s.source == SlotSource::Shared)
+                        .then(|| lib.attributes.iter().position(|k| *k == s.key))
                         .flatten()
+                        .map(AttributeId::new)
                 })
                 .collect(),
             library_written: false,
@@ -1084,7 +1088,7 @@ impl<'p> Sim<'p> {
         robot.progressed = true;
         let library = robot.library_index[slot.index()];
         if let Some(k) = library {
-            robot.library[k].clone_from(&value);
+            robot.library[k.index()].clone_from(&value);
             robot.library_written = true;
         }
         robot.slots[slot.index()].clone_from(&value);
@@ -1137,8 +1141,8 @@ impl<'p> Sim<'p> {
         // its value already.
         if std::mem::take(&mut robot.library_written) {
             for &(i, k) in inputs.shared.iter() {
-                if robot.slots[i] != robot.library[k] {
-                    robot.slots[i].clone_from(&robot.library[k]);
+                if robot.slots[i] != robot.library[k.index()] {
+                    robot.slots[i].clone_from(&robot.library[k.index()]);
                     robot.progressed = true;
                 }
             }

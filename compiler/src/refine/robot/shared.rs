@@ -11,8 +11,8 @@
 //! receives them.
 
 use super::super::program::{
-    ControlMachine, GlobalValue, HEARTBEAT_MS, OwnerRule, Ownership, RobotProgram, SharedLibrary,
-    SlotSource,
+    AttributeId, ControlMachine, GlobalValue, HEARTBEAT_MS, OwnerRule, Ownership, RobotProgram,
+    SharedLibrary, SlotSource,
 };
 use super::super::value::ValueKind;
 use crate::diag::{Code, Diagnostic};
@@ -43,13 +43,12 @@ pub(super) fn library(
         return None;
     }
     let own = format!("{}.", team.name);
-    let global: Vec<GlobalValue> = attributes
-        .iter()
-        .enumerate()
+    let global: Vec<GlobalValue> = AttributeId::all(attributes.len())
+        .zip(&attributes)
         .filter(|(_, key)| key.starts_with(&own) && !machine.subscribed.contains(key))
         .map(|(at, key)| GlobalValue {
             at,
-            kind: kinds[at].clone(),
+            kind: kinds[at.index()].clone(),
             set_key: set_key(&team.name, key),
             value_key: value_key(&team.name, key),
         })

@@ -6,13 +6,13 @@
 //! the owner order, which tells the team the values it last saw.
 
 use super::{Held, Message, Sim};
-use crate::refine::GlobalValue;
+use crate::refine::{AttributeId, GlobalValue};
 use std::rc::Rc;
 
 impl Sim<'_> {
     /// The global value of library place `at`, if it is one: (its index in
     /// the ownership, the value).
-    fn global_at(&self, r: usize, at: usize) -> Option<(usize, &GlobalValue)> {
+    fn global_at(&self, r: usize, at: AttributeId) -> Option<(usize, &GlobalValue)> {
         let ownership = self.robots[r]
             .program
             .library
@@ -78,7 +78,7 @@ impl Sim<'_> {
         self.emit(r, "shared_owner", fields);
         if next == program.self_peer {
             for (k, g) in ownership.global.iter().enumerate() {
-                let value = self.robots[r].library[g.at].clone();
+                let value = self.robots[r].library[g.at.index()].clone();
                 if value.is_some() {
                     self.tell(r, k, next, value);
                 }
@@ -123,7 +123,7 @@ impl Sim<'_> {
 
     /// The setter of library place `at` after the value is stored: a global
     /// value's write is traced and told to its owner (or the team).
-    pub(super) fn shared_set(&mut self, r: usize, at: usize, value: &Held) {
+    pub(super) fn shared_set(&mut self, r: usize, at: AttributeId, value: &Held) {
         let Some((k, g)) = self.global_at(r, at) else {
             return;
         };
@@ -131,7 +131,7 @@ impl Sim<'_> {
             .program
             .library
             .as_ref()
-            .map_or("", |l| &l.attributes[g.at])
+            .map_or("", |l| l.attribute(g.at))
             .into();
         let to = self.current_owner(r);
         let program = self.robots[r].program;
@@ -179,7 +179,7 @@ impl Sim<'_> {
             self.emit(r, "reject", fields);
             return true;
         };
-        let key: Rc<str> = lib.attributes[g.at].as_str().into();
+        let key: Rc<str> = lib.attribute(g.at).into();
         if set {
             let to = self.current_owner(r);
             if to != program.self_peer {
@@ -190,7 +190,7 @@ impl Sim<'_> {
                 self.emit(r, "reject", fields);
                 return true;
             }
-            self.robots[r].library[g.at].clone_from(&value);
+            self.robots[r].library[g.at.index()].clone_from(&value);
             self.robots[r].library_written = true;
             self.trace.push(super::TraceEvent {
                 t: self.now,
@@ -206,7 +206,7 @@ impl Sim<'_> {
             });
             self.tell(r, k, to, value);
         } else {
-            self.robots[r].library[g.at].clone_from(&value);
+            self.robots[r].library[g.at.index()].clone_from(&value);
             self.robots[r].library_written = true;
             self.trace.push(super::TraceEvent {
                 t: self.now,
