@@ -14,7 +14,7 @@ use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms, lost_after_ms};
 use crate::refine::{
     ActionMachine, ActionMachineId, ControlMachine, CountedGroup, Expr, IncomingId,
-    LeaderAlgorithm, MarkId, ModeId, Operand, OutgoingId, RobotProgram, SendItem, SlotId,
+    LeaderAlgorithm, MarkId, ModeId, Operand, OutgoingId, PeerId, RobotProgram, SendItem, SlotId,
     SlotSource, State, StateId, StateKind, SubscriptionId, SyncPointId,
 };
 use std::fmt::Write;
@@ -941,7 +941,7 @@ fn emit_leader_branch(out: &mut String, cx: &StateCx, others_at: &StateId) {
 fn emit_group_allocate(
     out: &mut String,
     cx: &StateCx,
-    members: &[usize],
+    members: &[PeerId],
     groups: &[CountedGroup],
     others_at: &Option<StateId>,
 ) {
@@ -971,7 +971,7 @@ fn emit_group_allocate(
 fn emit_group_sync(
     out: &mut String,
     cx: &StateCx,
-    members: &[usize],
+    members: &[PeerId],
     point: &SyncPointId,
     timeout_ms: &i64,
     mark: &MarkId,

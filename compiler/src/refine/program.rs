@@ -89,6 +89,12 @@ newtype_index! {
 }
 
 newtype_index! {
+    /// A robot of the mission: an index into [`RobotProgram::peers`]
+    /// (formation order, across teams).
+    pub struct PeerId;
+}
+
+newtype_index! {
     /// A channel of a service graph: an index into [`GraphService::channels`]
     /// (the generated C's `ch<N>`).
     pub struct GraphChannelId;
@@ -122,11 +128,18 @@ pub struct RobotProgram {
     /// cost memory linear in its robots, not quadratic.
     pub peers: Arc<[(String, String)]>,
     /// This robot's index in `peers`.
-    pub self_peer: usize,
+    pub self_peer: PeerId,
     /// The team's shared information, held by the library task.
     pub library: Option<SharedLibrary>,
     /// The service tasks that run a task graph (`graph=` in the catalog).
     pub graph_services: Vec<GraphService>,
+}
+
+impl RobotProgram {
+    /// Robot `id` of [`RobotProgram::peers`]: (team, robot).
+    pub fn peer(&self, id: PeerId) -> &(String, String) {
+        &self.peers[id.index()]
+    }
 }
 
 /// A service the robot's type implements by a task graph: each call runs
@@ -302,7 +315,7 @@ pub struct ControlMachine {
     /// programs call any of the team's group services; empty when this robot
     /// is not one of them. Each member's rank is its place among the live
     /// members (this robot, or heard from within `protocol::lost_after_ms`).
-    pub group: Vec<usize>,
+    pub group: Vec<PeerId>,
     /// Adaptive resource management: the team strategy's battery policies,
     /// checked at every firing against the robot's `BATTERY` value.
     pub battery: Vec<BatteryPolicy>,
@@ -434,7 +447,7 @@ pub struct Election<'a> {
     /// (service, pc) of the state.
     pub at: (ServiceMachineId, StateId),
     pub line: u32,
-    pub candidates: &'a [usize],
+    pub candidates: &'a [PeerId],
     pub algorithm: LeaderAlgorithm,
     /// The incoming messages the leader's block receives.
     pub receives: &'a [IncomingId],
@@ -607,7 +620,7 @@ pub enum StateKind {
     /// `receive` takes only what arrived while this robot leads
     /// (`docs/groups.md`).
     LeaderBranch {
-        candidates: Vec<usize>,
+        candidates: Vec<PeerId>,
         algorithm: LeaderAlgorithm,
         others_at: StateId,
         receives: Vec<IncomingId>,
@@ -624,7 +637,7 @@ pub enum StateKind {
     /// ([`counted_allocation`]). The robot continues at its group's `at`;
     /// a change of its group is traced (`allocated`).
     GroupAllocate {
-        members: Vec<usize>,
+        members: Vec<PeerId>,
         groups: Vec<CountedGroup>,
         others_at: Option<StateId>,
     },
@@ -636,7 +649,7 @@ pub enum StateKind {
     /// arrived at that pass or is known dead (no heartbeat for three
     /// periods), or `timeout_ms` has passed.
     GroupSync {
-        members: Vec<usize>,
+        members: Vec<PeerId>,
         point: SyncPointId,
         timeout_ms: i64,
         mark: MarkId,
@@ -808,7 +821,7 @@ pub struct Ownership {
     /// then the others in formation order, else the team's leader order
     /// (`lowest_id`, `highest_battery`: formation order; `bully`: the
     /// reverse).
-    pub owners: Vec<usize>,
+    pub owners: Vec<PeerId>,
     /// Who follows a lost owner.
     pub rule: OwnerRule,
 }

@@ -60,7 +60,8 @@ pub(super) fn refine_robot(
     builder.machine.battery = builder.battery_policies();
     builder.machine.events_heard = builder.events_heard();
     let graph_services = builder.graph_services();
-    let self_peer = builder.first_peer() + robot_index;
+    let first_peer = builder.first_peer();
+    let self_peer = PeerId::new(first_peer + robot_index);
     let team_leader = builder.team_leader_algorithm();
     let Builder {
         mut machine,
@@ -71,7 +72,7 @@ pub(super) fn refine_robot(
     } = builder;
     separate_sensor_tasks(&mut machine, &mut sensors, &services);
     link_own_publications(&mut machine);
-    let library = shared::library(team, self_peer - robot_index, team_leader, &mut machine);
+    let library = shared::library(team, first_peer, team_leader, &mut machine);
     let mut tasks: Vec<TaskRole> = sensors
         .into_iter()
         .map(|(task, values)| TaskRole {
@@ -378,7 +379,10 @@ impl Builder<'_, '_> {
         let state = self.push(
             states,
             StateKind::GroupSync {
-                members: members.into_iter().map(|i| first_peer + i).collect(),
+                members: members
+                    .into_iter()
+                    .map(|i| PeerId::new(first_peer + i))
+                    .collect(),
                 point,
                 timeout_ms: (timeout.millis.round() as i64).max(0),
                 mark,
@@ -531,7 +535,10 @@ impl Builder<'_, '_> {
                         // Peer indices of the candidates, in formation order:
                         // the first one alive leads.
                         let first_peer = self.first_peer();
-                        let candidates = candidates.iter().map(|i| first_peer + i).collect();
+                        let candidates = candidates
+                            .iter()
+                            .map(|i| PeerId::new(first_peer + i))
+                            .collect();
                         let (algorithm, heartbeat_ms) = self.leader_selection();
                         self.need_heartbeat(heartbeat_ms.unwrap_or(HEARTBEAT_MS));
                         let branch = self.push_forward(states, stmt.span, |others_at| {
@@ -612,7 +619,10 @@ impl Builder<'_, '_> {
             return;
         }
         let first_peer = self.first_peer();
-        let members: Vec<usize> = runners.iter().map(|i| first_peer + i).collect();
+        let members: Vec<PeerId> = runners
+            .iter()
+            .map(|i| PeerId::new(first_peer + i))
+            .collect();
         let (_, heartbeat_ms) = self.leader_selection();
         self.need_heartbeat(heartbeat_ms.unwrap_or(HEARTBEAT_MS));
         let allocate = self.push(

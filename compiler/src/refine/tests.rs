@@ -207,7 +207,7 @@ fn every_robot_gets_a_program_with_its_peers() {
             ("SlaveTeam", "nxt")
         ]
     );
-    assert_eq!(programs[2].self_peer, 2);
+    assert_eq!(programs[2].self_peer, PeerId::new(2));
     assert_eq!(programs[0].peers.len(), 3);
 }
 
@@ -341,7 +341,9 @@ fn group_arms_a_robot_can_never_join_are_dropped() {
             .iter()
             .flat_map(|s| &s.states)
             .filter_map(|s| match &s.kind {
-                StateKind::LeaderBranch { candidates, .. } => Some(candidates.clone()),
+                StateKind::LeaderBranch { candidates, .. } => {
+                    Some(candidates.iter().map(|p| p.index()).collect())
+                }
                 _ => None,
             })
             .collect()
@@ -774,7 +776,7 @@ fn counted_groups_put_every_arm_in_every_program_behind_one_allocation() {
                     groups,
                     others_at,
                 } => Some((
-                    members.clone(),
+                    members.iter().map(|p| p.index()).collect(),
                     groups.iter().map(|g| (g.name.clone(), g.min)).collect(),
                     others_at.is_some(),
                 )),

@@ -36,8 +36,8 @@ use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
 use crate::refine::{
     ActionId, ActionMachine, AttributeId, ControlMachine, Expr, IncomingId, LeaderAlgorithm,
-    ModeId, Operand, OutgoingId, RobotProgram, RoleKind, ServiceMachineId, SlotId, SlotSource,
-    StateId, StateKind, SyncPointId, counted_allocation,
+    ModeId, Operand, OutgoingId, PeerId, RobotProgram, RoleKind, ServiceMachineId, SlotId,
+    SlotSource, StateId, StateKind, SyncPointId, counted_allocation,
 };
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
@@ -239,8 +239,8 @@ struct Message {
     publish: bool,
     from_team: Rc<str>,
     from_robot: Rc<str>,
-    /// Index of the sender in the peers (operator: `None`).
-    from_peer: Option<usize>,
+    /// The sender among the peers (operator: `None`).
+    from_peer: Option<PeerId>,
     key: Rc<str>,
     value: Held,
     sent_at: i64,
@@ -381,9 +381,8 @@ struct Robot<'p> {
     /// library into its slots (otherwise every shared slot holds its value
     /// already, and reading them again, comparing text, is skipped).
     library_written: bool,
-    /// The owner of the library's globally shared values now (a peer index;
-    /// `shared.rs`).
-    owner: usize,
+    /// The owner of the library's globally shared values now (`shared.rs`).
+    owner: PeerId,
     /// Per incoming message: the channel to the control task (capacity).
     inbox: Vec<(VecDeque<Held>, usize)>,
     /// The receive task held up by a full channel ([`Holding`]), and the
@@ -405,9 +404,9 @@ struct Robot<'p> {
     current_mode: Option<ModeId>,
     pending_mode: Option<ModeId>,
     /// Broadcast events received and not yet looked at by the control task:
-    /// (the thrower's peer index, the event's index in `events_heard`), in
-    /// arrival order, at most `EVENT_QUEUE` (`comm_event_take`).
-    events: VecDeque<(usize, usize)>,
+    /// (the thrower, the event's index in `events_heard`), in arrival
+    /// order, at most `EVENT_QUEUE` (`comm_event_take`).
+    events: VecDeque<(PeerId, usize)>,
     last_heartbeat: i64,
     /// Per peer: what its last heartbeat said (`comm_heard`).
     heard: Hearing,
@@ -430,9 +429,9 @@ struct Robot<'p> {
     /// How often this robot reached each `GroupSync` state, by (service, pc).
     sync_pass: HashMap<(ServiceMachineId, StateId), i64>,
     /// The last pass each (peer, sync point) announced (`comm_sync_arrived`).
-    sync_arrived: HashMap<(usize, SyncPointId), i64>,
+    sync_arrived: HashMap<(PeerId, SyncPointId), i64>,
     /// The last leader each `LeaderBranch` state saw, by (service, pc).
-    leaders: HashMap<(ServiceMachineId, StateId), usize>,
+    leaders: HashMap<(ServiceMachineId, StateId), Leader>,
     /// The group each `GroupAllocate` state last gave this robot, by
     /// (service, pc): its index, or [`OTHERS`].
     allocated: HashMap<(ServiceMachineId, StateId), usize>,
@@ -671,11 +670,11 @@ impl<'p> Robot<'p> {
 /// in a mission): the sender's own index when the peers are the same
 /// mission's, found without reading every robot's name (a heartbeat is
 /// heard by the whole team, so a scan made a swarm's run quadratic).
-fn sender_peer(program: &RobotProgram, message: &Message) -> Option<usize> {
-    let named = |p: usize| *program.peers[p].1 == *message.from_robot;
+fn sender_peer(program: &RobotProgram, message: &Message) -> Option<PeerId> {
+    let named = |p: PeerId| *program.peer(p).1 == *message.from_robot;
     match message.from_peer {
-        Some(p) if p < program.peers.len() && named(p) => Some(p),
-        _ => (0..program.peers.len()).find(|&p| named(p)),
+        Some(p) if p.index() < program.peers.len() && named(p) => Some(p),
+        _ => PeerId::all(program.peers.len()).find(|&p| named(p)),
     }
 }
 
@@ -1649,7 +1648,7 @@ impl<'p> Sim<'p> {
         while let Some((peer, event)) = self.robots[r].events.pop_front() {
             let program = self.robots[r].program;
             let name = program.control.events_heard[event].as_str();
-            let from: Rc<str> = program.peers[peer].1.as_str().into();
+            let from: Rc<str> = program.peer(peer).1.as_str().into();
             if !self.catch_event_from(r, name, Some(from.clone())) {
                 let fields = vec![
                     ("from", from),
@@ -2118,10 +2117,10 @@ impl<'p> Sim<'p> {
                 let robot = &self.robots[r];
                 let me = program.self_peer;
                 let lost = crate::refine::protocol::lost_after_ms(m.heartbeat_ms);
-                let alive = |peer: usize| {
+                let alive = |peer: PeerId| {
                     peer == me || now - robot.heard.get(peer).seen.max(robot.started_at) <= lost
                 };
-                let live: Vec<usize> = members.iter().copied().filter(|&p| alive(p)).collect();
+                let live: Vec<PeerId> = members.iter().copied().filter(|&p| alive(p)).collect();
                 let position = live.iter().position(|&p| p == me).unwrap_or(0);
                 let mins: Vec<usize> = groups.iter().map(|g| g.min).collect();
                 let chosen = counted_allocation(&mins, others_at.is_some(), position);
@@ -2344,12 +2343,12 @@ impl<'p> Sim<'p> {
         &mut self,
         r: usize,
         state: (ServiceMachineId, StateId),
-        candidates: &[usize],
+        candidates: &[PeerId],
         algorithm: LeaderAlgorithm,
         receives: &[IncomingId],
     ) -> Option<bool> {
         let me = self.robots[r].program.self_peer;
-        let led = self.robots[r].leaders.get(&state) == Some(&me);
+        let led = self.robots[r].leaders.get(&state) == Some(&Leader::Robot(me));
         let elected = self.elected(r, state, candidates, algorithm);
         if elected == Some(true) && !led {
             self.drop_unled(r, receives);
@@ -2385,7 +2384,7 @@ impl<'p> Sim<'p> {
         &mut self,
         r: usize,
         state: (ServiceMachineId, StateId),
-        candidates: &[usize],
+        candidates: &[PeerId],
         algorithm: LeaderAlgorithm,
     ) -> Option<bool> {
         let now = self.now;
@@ -2397,8 +2396,8 @@ impl<'p> Sim<'p> {
         }
         let me = robot.program.self_peer;
         let lost = crate::refine::protocol::lost_after_ms(hb);
-        let alive = |c: usize| c == me || now - robot.heard.get(c).seen <= lost;
-        let level = |c: usize| {
+        let alive = |c: PeerId| c == me || now - robot.heard.get(c).seen <= lost;
+        let level = |c: PeerId| {
             if c == me {
                 own_battery(robot, now)
             } else {
@@ -2411,7 +2410,7 @@ impl<'p> Sim<'p> {
             LeaderAlgorithm::Bully => live.next_back(),
             // The highest level, the first of equals; unknown is lowest.
             LeaderAlgorithm::HighestBattery => {
-                live.fold(None, |best: Option<usize>, c| match best {
+                live.fold(None, |best: Option<PeerId>, c| match best {
                     Some(b) if level(c).unwrap_or(-1) <= level(b).unwrap_or(-1) => Some(b),
                     _ => Some(c),
                 })
@@ -2447,7 +2446,7 @@ impl<'p> Sim<'p> {
             if 2 * heard <= candidates.len() {
                 robot.rejoining = true;
                 robot.fenced = Some(None);
-                if robot.leaders.insert(state, FENCED) != Some(FENCED) {
+                if robot.leaders.insert(state, Leader::Fenced) != Some(Leader::Fenced) {
                     let counted = crate::refine::protocol::fenced_heard(heard, candidates.len());
                     self.emit(r, "fenced", vec![("heard", counted.into())]);
                 }
@@ -2475,9 +2474,9 @@ impl<'p> Sim<'p> {
             robot.term_led = robot.term;
         }
         robot.leading = leader == me;
-        if robot.leaders.get(&state) != Some(&leader) {
-            robot.leaders.insert(state, leader);
-            let name = robot.program.peers[leader].1.clone();
+        if robot.leaders.get(&state) != Some(&Leader::Robot(leader)) {
+            robot.leaders.insert(state, Leader::Robot(leader));
+            let name = robot.program.peer(leader).1.clone();
             self.emit(r, "leader", vec![("leader", name.into())]);
         }
         Some(leader == me)
@@ -2488,9 +2487,24 @@ impl<'p> Sim<'p> {
 /// has this index).
 const OTHERS: usize = usize::MAX;
 
-/// The last leader of an arm whose robot is fenced (`ELECT_FENCED` in the C):
-/// no peer has this index.
-const FENCED: usize = usize::MAX;
+/// The last leader a `LeaderBranch` state saw.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(super) enum Leader {
+    Robot(PeerId),
+    /// None: this robot is fenced (`ELECT_FENCED` in the C).
+    Fenced,
+}
+
+impl Leader {
+    /// As the exploration fingerprint hashes it: the peer's position, -1
+    /// when fenced (what the `usize::MAX` that stood for it came to).
+    pub(super) fn code(self) -> i64 {
+        match self {
+            Leader::Robot(peer) => peer.index() as i64,
+            Leader::Fenced => -1,
+        }
+    }
+}
 
 /// What each peer's last heartbeat said, kept for the peers of the robot's
 /// team, the only robots whose heartbeats reach it (published to the team
@@ -2500,11 +2514,11 @@ const FENCED: usize = usize::MAX;
 /// time 0, claiming nothing, battery unknown.
 #[derive(Clone, Debug)]
 struct Hearing {
-    /// The peer index of `team[0]`.
+    /// The peer of `team[0]`.
     first: usize,
     team: Vec<Heard>,
-    /// Other peers heard, by peer index.
-    others: Vec<(usize, Heard)>,
+    /// Other peers heard, in peer order.
+    others: Vec<(PeerId, Heard)>,
 }
 
 impl Hearing {
@@ -2516,8 +2530,8 @@ impl Hearing {
         }
     }
 
-    fn get(&self, peer: usize) -> Heard {
-        match self.team.get(peer.wrapping_sub(self.first)) {
+    fn get(&self, peer: PeerId) -> Heard {
+        match self.team.get(peer.index().wrapping_sub(self.first)) {
             Some(heard) => *heard,
             None => self
                 .others
@@ -2526,8 +2540,8 @@ impl Hearing {
         }
     }
 
-    fn set(&mut self, peer: usize, heard: Heard) {
-        if let Some(h) = self.team.get_mut(peer.wrapping_sub(self.first)) {
+    fn set(&mut self, peer: PeerId, heard: Heard) {
+        if let Some(h) = self.team.get_mut(peer.index().wrapping_sub(self.first)) {
             *h = heard;
             return;
         }
@@ -2538,21 +2552,19 @@ impl Hearing {
     }
 
     /// Every peer kept, in peer order (a peer not kept was never heard).
-    fn iter(&self) -> impl Iterator<Item = (usize, Heard)> + '_ {
+    fn iter(&self) -> impl Iterator<Item = (PeerId, Heard)> + '_ {
         let (first, end) = (self.first, self.first + self.team.len());
-        let before = self.others.iter().filter(move |(p, _)| *p < first);
-        let after = self.others.iter().filter(move |(p, _)| *p >= end);
-        before
-            .copied()
-            .chain((first..).zip(self.team.iter().copied()))
-            .chain(after.copied())
+        let before = self.others.iter().filter(move |(p, _)| p.index() < first);
+        let after = self.others.iter().filter(move |(p, _)| p.index() >= end);
+        let team = (first..).map(PeerId::new).zip(self.team.iter().copied());
+        before.copied().chain(team).chain(after.copied())
     }
 }
 
 /// The peers of `program`'s team: its run of peers (teams are in
 /// formation order), found from its own place.
 fn team_peers(program: &RobotProgram) -> std::ops::Range<usize> {
-    let (peers, me) = (&program.peers, program.self_peer);
+    let (peers, me) = (&program.peers, program.self_peer.index());
     let same = |p: &usize| peers[*p].0 == program.team;
     let start = (0..me).rev().take_while(same).last().unwrap_or(me);
     let end = (me..peers.len())
@@ -2626,12 +2638,12 @@ impl Sim<'_> {
         }
         let me = robot.program.self_peer;
         let now = self.now;
-        let alive = |peer: usize| {
+        let alive = |peer: PeerId| {
             peer == me
                 || now - robot.heard.get(peer).seen.max(robot.started_at)
                     <= crate::refine::protocol::lost_after_ms(m.heartbeat_ms)
         };
-        let live: Vec<usize> = m.group.iter().copied().filter(|&p| alive(p)).collect();
+        let live: Vec<PeerId> = m.group.iter().copied().filter(|&p| alive(p)).collect();
         let rank = live.iter().position(|&p| p == me).unwrap_or(0);
         let now_group = (rank, live.len());
         if self.robots[r].group == Some(now_group) {

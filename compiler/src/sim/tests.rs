@@ -736,7 +736,12 @@ fn pairs(list: &[(&str, &str)]) -> Vec<(String, String)> {
 #[test]
 fn group_service_members_learn_rank_and_size() {
     let programs = programs("tests/fixtures/group_service/sweep.mission");
-    assert!(programs.iter().all(|p| p.control.group == [0, 1, 2]));
+    let peers = crate::refine::PeerId::all(3);
+    assert!(
+        programs
+            .iter()
+            .all(|p| p.control.group.iter().copied().eq(peers.clone()))
+    );
     let (run_, _) = run(&programs, r#"{"duration": 1000}"#, 0);
     for (i, robot) in ["tb_0", "tb_1", "tb_2"].into_iter().enumerate() {
         let rank = i.to_string();

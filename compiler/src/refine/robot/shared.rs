@@ -11,8 +11,8 @@
 //! receives them.
 
 use super::super::program::{
-    AttributeId, ControlMachine, GlobalValue, HEARTBEAT_MS, OwnerRule, Ownership, RobotProgram,
-    SharedLibrary, SlotSource,
+    AttributeId, ControlMachine, GlobalValue, HEARTBEAT_MS, OwnerRule, Ownership, PeerId,
+    RobotProgram, SharedLibrary, SlotSource,
 };
 use super::super::value::ValueKind;
 use crate::diag::{Code, Diagnostic};
@@ -55,7 +55,9 @@ pub(super) fn library(
         .collect();
     let ownership = (team.robots.len() > 1 && !global.is_empty()).then(|| Ownership {
         global,
-        owners: (first_peer..first_peer + team.robots.len()).collect(),
+        owners: (first_peer..first_peer + team.robots.len())
+            .map(PeerId::new)
+            .collect(),
         rule: OwnerRule::Leader(leader),
     });
     if ownership.is_some() && !machine.heartbeat {
@@ -83,7 +85,7 @@ pub(in crate::refine) fn owners_of_team(
     strategies: &[Strategy],
 ) -> Vec<Diagnostic> {
     let team_programs = || programs.iter().filter(|p| p.team == team);
-    let sharing: Vec<usize> = team_programs()
+    let sharing: Vec<PeerId> = team_programs()
         .filter(|p| p.library.as_ref().is_some_and(|l| l.ownership.is_some()))
         .map(|p| p.self_peer)
         .collect();

@@ -146,7 +146,7 @@ impl<'p> Sim<'p> {
         let mut led: Vec<(ServiceMachineId, StateId)> = robot
             .leaders
             .iter()
-            .filter(|(_, leader)| **leader == me)
+            .filter(|(_, leader)| **leader == super::Leader::Robot(me))
             .map(|(state, _)| *state)
             .collect();
         led.sort_unstable();
@@ -418,7 +418,7 @@ impl Fingerprint {
         self.int(m.publish as i64);
         self.text(&m.from_team);
         self.text(&m.from_robot);
-        self.int(m.from_peer.map_or(-1, |p| p as i64));
+        self.int(m.from_peer.map_or(-1, |p| p.index() as i64));
         self.text(&m.key);
         self.held(&m.value);
         self.time(m.sent_at);
@@ -437,7 +437,7 @@ impl Fingerprint {
         for v in robot.slots.iter().chain(&robot.library) {
             self.held(v);
         }
-        self.int(robot.owner as i64);
+        self.int(robot.owner.index() as i64);
         for (queue, _) in &robot.inbox {
             self.int(queue.len() as i64);
             for v in queue {
@@ -496,12 +496,12 @@ impl Fingerprint {
         self.int(robot.pending_mode.map_or(-1, |m| m.index() as i64));
         self.int(robot.events.len() as i64);
         for &(peer, event) in &robot.events {
-            self.int(peer as i64);
+            self.int(peer.index() as i64);
             self.int(event as i64);
         }
         self.time(robot.last_heartbeat);
         for (peer, h) in robot.heard.iter() {
-            self.int(peer as i64);
+            self.int(peer.index() as i64);
             self.time(h.seen);
             self.int(h.leads as i64);
             self.int(h.battery.unwrap_or(i64::MIN));
@@ -520,7 +520,7 @@ impl Fingerprint {
         let passes = robot.sync_pass.iter();
         let passes = passes.map(|(&(s, pc), &v)| ((s.index(), pc.index()), v));
         let arrived = robot.sync_arrived.iter();
-        let arrived = arrived.map(|(&(peer, point), &v)| ((peer, point.index()), v));
+        let arrived = arrived.map(|(&(peer, point), &v)| ((peer.index(), point.index()), v));
         for mut entries in [passes.collect::<Vec<_>>(), arrived.collect()] {
             entries.sort_unstable();
             for ((a, b), v) in entries {
@@ -529,14 +529,16 @@ impl Fingerprint {
                 self.int(v);
             }
         }
-        for map in [&robot.leaders, &robot.allocated] {
-            let mut entries: Vec<_> = map.iter().collect();
+        // A leader as its code: a peer's position, or -1 when fenced.
+        let leaders = robot.leaders.iter().map(|(&at, &v)| (at, v.code()));
+        let allocated = robot.allocated.iter().map(|(&at, &v)| (at, v as i64));
+        for mut entries in [leaders.collect::<Vec<_>>(), allocated.collect()] {
             entries.sort_unstable();
             self.int(entries.len() as i64);
             for ((a, b), v) in entries {
                 self.int(a.index() as i64);
                 self.int(b.index() as i64);
-                self.int(*v as i64);
+                self.int(v);
             }
         }
         match robot.group {
