@@ -490,7 +490,7 @@ struct Behaviour {
     /// after the prefix.
     acted: Vec<bool>,
     /// Per robot: the `receive` states it waits in at the end.
-    waiting: Vec<Vec<(usize, usize)>>,
+    waiting: Vec<Vec<(semo::refine::ServiceMachineId, semo::refine::StateId)>>,
 }
 
 /// One random behaviour of the world `semo verify` explores: the choices
@@ -664,9 +664,9 @@ fn random_findings_hold(
                     semo::sim::Sim::new(&programs, &scenario, &semo::sim::Options::default());
                 sim.run_to(way.end_ms);
                 for r in [*a, *b] {
-                    let states = &programs[r].control.services;
+                    let m = &programs[r].control;
                     let led: Vec<u32> = (sim.leads(r).into_iter())
-                        .map(|(service, state)| states[service].states[state].line)
+                        .map(|(service, state)| m.service(service).states[state.index()].line)
                         .collect();
                     assert!(
                         led.contains(line),

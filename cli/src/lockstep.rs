@@ -549,7 +549,7 @@ pub fn simulate(
 ) -> Result<Vec<(String, String)>, String> {
     use semo::sim::scenario::FaultKind;
     let network = &scenario.network;
-    let peers: Vec<(String, usize)> = refined
+    let peers: Vec<(String, semo::refine::PeerId)> = refined
         .programs
         .iter()
         .map(|p| (p.robot.clone(), p.self_peer))
@@ -593,7 +593,9 @@ pub fn simulate(
                 output.robot
             ));
         };
-        robots[peer] = Some(Robot {
+        // One program per robot of the mission (`refine_checked`), so a
+        // peer's position is a place in `robots`.
+        robots[peer.index()] = Some(Robot {
             name: output.robot.clone(),
             exe: folder.join(&output.robot),
         });

@@ -13,8 +13,9 @@ use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms, lost_after_ms};
 use crate::refine::{
-    ActionMachine, ControlMachine, CountedGroup, Expr, LeaderAlgorithm, Operand, RobotProgram,
-    SendItem, SlotId, SlotSource, State, StateId, StateKind,
+    ActionMachine, ActionMachineId, ControlMachine, CountedGroup, Expr, IncomingId,
+    LeaderAlgorithm, MarkId, ModeId, Operand, OutgoingId, PeerId, RobotProgram, SendItem, SlotId,
+    SlotSource, State, StateId, StateKind, SubscriptionId, SyncPointId,
 };
 use std::fmt::Write;
 
@@ -367,7 +368,7 @@ fn emit_catch_event(out: &mut String, program: &RobotProgram, throws: bool, broa
 fn emit_catches(out: &mut String, program: &RobotProgram, caught: &str) {
     let m = &program.control;
     out.push_str("    switch (current_mode) {\n");
-    for (from, mode) in m.modes.iter().enumerate() {
+    for (from, mode) in ModeId::all(m.modes.len()).zip(&m.modes) {
         let catches: Vec<_> = m.transitions.iter().filter(|t| t.from == from).collect();
         if catches.is_empty() {
             continue;
@@ -380,7 +381,7 @@ fn emit_catches(out: &mut String, program: &RobotProgram, caught: &str) {
                 c::string(&t.event),
                 c::comment(&program.mission),
                 t.line,
-                c::ident(&m.modes[t.to].name)
+                c::ident(&m.mode(t.to).name)
             );
         }
         out.push_str("        break;\n");
@@ -514,7 +515,12 @@ fn args_array(args: &[Operand], words: &Words) -> String {
 /// A robot that has just become the leader here (`led`: the leader before,
 /// `leader`: the variable of the leader now) drops what waits for the
 /// receives of the leader's block (`receives`).
-fn emit_drop_unled(out: &mut String, program: &RobotProgram, receives: &[usize], leader: &str) {
+fn emit_drop_unled(
+    out: &mut String,
+    program: &RobotProgram,
+    receives: &[IncomingId],
+    leader: &str,
+) {
     if receives.is_empty() {
         return;
     }
@@ -523,7 +529,7 @@ fn emit_drop_unled(out: &mut String, program: &RobotProgram, receives: &[usize],
         "    if (chosen > 0 && led != {leader}) {{ /* it leads from now on */"
     );
     for &k in receives {
-        let incoming = &program.control.incoming[k];
+        let incoming = program.control.incoming_message(k);
         let _ = writeln!(
             out,
             "        drop_unled(in_port[{k}], {}, {});",
@@ -639,9 +645,9 @@ fn emit_state(
 fn emit_receive(
     out: &mut String,
     cx: &StateCx,
-    messages: &[usize],
+    messages: &[IncomingId],
     timeout_ms: &Option<i64>,
-    mark: &usize,
+    mark: &MarkId,
 ) {
     let StateCx { program, next, .. } = *cx;
     let m = &program.control;
@@ -671,7 +677,7 @@ fn emit_receive(
         }
     }
     for &i in messages {
-        let s = m.incoming[i].slot;
+        let s = m.incoming_message(i).slot;
         let _ = writeln!(
             out,
             "        {{\n            semo_value v;\n            if (UFPort_ReadFromQueue(in_port[{i}], &v, sizeof v) > 0)\n                store({s}, &v);\n        }}"
@@ -702,14 +708,14 @@ fn emit_send(out: &mut String, cx: &StateCx, items: &[SendItem]) {
             out,
             "        semo_port_send(out_port[{}], {sent}, sizeof(semo_value)); /* {} */",
             item.message,
-            c::comment(&m.outgoing[item.message].key)
+            c::comment(&m.outgoing_message(item.message).key)
         );
         if let Some(group) = item.own_group {
             // Its own publication is the latest its subscription sees.
             let _ = writeln!(
                 out,
                 "        UFMulticast_Write({}, {sent}, sizeof(semo_value));",
-                c::string(&m.subscribed[group])
+                c::string(m.subscription(group))
             );
         }
     }
@@ -717,13 +723,13 @@ fn emit_send(out: &mut String, cx: &StateCx, items: &[SendItem]) {
 }
 
 /// `subscribe`: the group's latest value, if any.
-fn emit_subscribe(out: &mut String, cx: &StateCx, group: &usize, slot: &SlotId) {
+fn emit_subscribe(out: &mut String, cx: &StateCx, group: &SubscriptionId, slot: &SlotId) {
     let StateCx { program, next, .. } = *cx;
     let m = &program.control;
     let _ = writeln!(
         out,
         "        {{\n            semo_value v;\n            if (UFMulticast_Read({}, &v, sizeof v) > 0)\n                store({slot}, &v);\n        }}\n        r->pc = {next};\n        return STEP_NEXT;",
-        c::string(&m.subscribed[*group])
+        c::string(m.subscription(*group))
     );
 }
 
@@ -738,7 +744,7 @@ fn emit_throw(out: &mut String, cx: &StateCx, event: &str) {
 }
 
 /// `throw E broadcast`: the others of the group told first.
-fn emit_throw_broadcast(out: &mut String, cx: &StateCx, event: &str, messages: &[usize]) {
+fn emit_throw_broadcast(out: &mut String, cx: &StateCx, event: &str, messages: &[OutgoingId]) {
     let StateCx { program, next, .. } = *cx;
     let m = &program.control;
     // The others of the group are told before the event acts here
@@ -748,8 +754,8 @@ fn emit_throw_broadcast(out: &mut String, cx: &StateCx, event: &str, messages: &
             out,
             "        {{\n            semo_value told;\n            semo_value_set(&told, {});\n            semo_port_send(out_port[{message}], &told, sizeof told); /* {} to {} */\n        }}",
             c::string(event),
-            c::comment(&m.outgoing[message].key),
-            c::comment(&m.outgoing[message].to_team)
+            c::comment(&m.outgoing_message(message).key),
+            c::comment(&m.outgoing_message(message).to_team)
         );
     }
     let _ = writeln!(
@@ -767,7 +773,7 @@ fn emit_call(
     task: &str,
     args: &[Operand],
     timeout_ms: &Option<i64>,
-    mark: &usize,
+    mark: &MarkId,
 ) {
     let StateCx {
         program,
@@ -815,10 +821,10 @@ fn emit_run_actions(
     out: &mut String,
     cx: &StateCx,
     service: &str,
-    machine: &usize,
+    machine: &ActionMachineId,
     args: &[Operand],
     timeout_ms: &Option<i64>,
-    mark: &usize,
+    mark: &MarkId,
 ) {
     let StateCx {
         program,
@@ -827,7 +833,7 @@ fn emit_run_actions(
         ..
     } = *cx;
     let m = &program.control;
-    let am = &m.actions[*machine];
+    let am = m.action_machine(*machine);
     let _ = writeln!(out, "        if (r->phase == 0) {{");
     for (i, slot) in am.arguments.iter().enumerate() {
         if let Some(arg) = args.get(i) {
@@ -935,7 +941,7 @@ fn emit_leader_branch(out: &mut String, cx: &StateCx, others_at: &StateId) {
 fn emit_group_allocate(
     out: &mut String,
     cx: &StateCx,
-    members: &[usize],
+    members: &[PeerId],
     groups: &[CountedGroup],
     others_at: &Option<StateId>,
 ) {
@@ -965,10 +971,10 @@ fn emit_group_allocate(
 fn emit_group_sync(
     out: &mut String,
     cx: &StateCx,
-    members: &[usize],
-    point: &usize,
+    members: &[PeerId],
+    point: &SyncPointId,
     timeout_ms: &i64,
-    mark: &usize,
+    mark: &MarkId,
 ) {
     let StateCx {
         program,
@@ -986,7 +992,7 @@ fn emit_group_sync(
             ("list", &list),
             ("mark", &mark),
             ("count", &members.len()),
-            ("offset", &m.sync_points[*point]),
+            ("offset", &m.sync_point(*point)),
             ("team", &c::string(&program.team)),
             ("key", &c::string(&protocol::sync_key(program))),
             ("point", &point),
@@ -1019,7 +1025,7 @@ fn emit_loop_head(
     cx: &StateCx,
     condition: &Option<Expr>,
     exit_to: &StateId,
-    mark: &usize,
+    mark: &MarkId,
 ) {
     let StateCx { words, next, .. } = *cx;
     if let Some(cond) = condition {
@@ -1040,7 +1046,7 @@ fn emit_loop_tail(
     out: &mut String,
     _cx: &StateCx,
     period_ms: &Option<i64>,
-    mark: &usize,
+    mark: &MarkId,
     to: &StateId,
 ) {
     match period_ms {
@@ -1266,7 +1272,7 @@ fn emit_task(out: &mut String, program: &RobotProgram, peers: &Peers) {
     );
     let default = m
         .default_mode
-        .map(|d| format!("MODE_{}", c::ident(&m.modes[d].name)));
+        .map(|d| format!("MODE_{}", c::ident(&m.mode(d).name)));
     out.push_str(&fill(&GO_HEAD, &[("name", &name)]));
     if !m.battery.is_empty() {
         out.push_str("    manage_resources();\n");

@@ -9,7 +9,7 @@ use super::{Layer, Target};
 use crate::refine::graph::{COMM_RECEIVE, COMM_SEND, CONTROL_TASK};
 use crate::refine::protocol::{TERM_MAX, alive_key, sync_key};
 use crate::refine::{CompiledScenario, LinkEffect};
-use crate::refine::{RobotProgram, RoleKind, ValueKind};
+use crate::refine::{PeerId, RobotProgram, RoleKind, ValueKind};
 use crate::taskgraph::Trigger;
 use std::fmt::Write;
 
@@ -367,7 +367,7 @@ pub fn main_c(
     }
     out.push_str("/* The robots this one sends to or hears from (its team and those its\n * messages go to), each with its place among the mission's robots: over\n * UDP it listens on port base + place. */\nstatic const semo_peer peers[] = {\n");
     for &i in peers.list() {
-        let (team, robot) = &program.peers[i];
+        let (team, robot) = program.peer(i);
         let _ = writeln!(
             out,
             "    {{{}, {}, {i}}},",
@@ -1060,7 +1060,7 @@ fn scenario_extra_tables(
             .robots
             .iter()
             .filter_map(|robot| program.peers.iter().position(|(_, r)| r == robot))
-            .filter_map(|fleet| peers.list().binary_search(&fleet).ok())
+            .filter_map(|fleet| peers.list().binary_search(&PeerId::new(fleet)).ok())
             .collect();
         locals.sort_unstable();
         locals.dedup();

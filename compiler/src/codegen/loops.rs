@@ -51,7 +51,10 @@
 use super::c;
 use super::template::{Template, fill, template};
 use crate::refine::protocol::GRAPH_TEXT_MAX;
-use crate::refine::{GraphService, GraphStep, InnerTask, LoopPort, PortUse, SubgraphPort};
+use crate::refine::{
+    GraphChannelId, GraphService, GraphStep, InnerTask, InnerTaskId, LoopPort, PortUse,
+    SubgraphPort,
+};
 use std::fmt::Write;
 
 /// Characters a token takes in a trace field, at most, for sizing: an
@@ -67,7 +70,7 @@ pub(super) fn graph_runner(service: &GraphService, simulated: bool) -> String {
     let Ok(steps_of) = &service.steps else {
         return out;
     };
-    let mut exits: Vec<(usize, &str)> = Vec::new();
+    let mut exits: Vec<(InnerTaskId, &str)> = Vec::new();
     collect_exits(steps_of, &mut exits);
     let graph = c::string(&service.graph);
     let has_loops = has_loop_nodes(steps_of);
@@ -100,7 +103,7 @@ pub(super) fn graph_runner(service: &GraphService, simulated: bool) -> String {
         keeps,
         has_subgraphs(steps_of),
     );
-    for (index, task) in service.tasks.iter().enumerate() {
+    for (index, task) in InnerTaskId::all(service.tasks.len()).zip(&service.tasks) {
         let exit_of = exits.iter().find(|(t, _)| *t == index).map(|(_, l)| *l);
         if let Some(period) = task.period_ms {
             release(&mut out, service, index, task, period);
@@ -235,7 +238,13 @@ fn text_size(ports: &[PortUse]) -> u64 {
 /// request does not cut the wait (an iteration is never left half run: its
 /// channels would not hold the next call's tokens); the program stopping
 /// does, and the iteration is abandoned (false).
-fn release(out: &mut String, service: &GraphService, index: usize, task: &InnerTask, period: u64) {
+fn release(
+    out: &mut String,
+    service: &GraphService,
+    index: InnerTaskId,
+    task: &InnerTask,
+    period: u64,
+) {
     let name = task_name(service, index);
     out.push_str(&fill(
         &RELEASE,
@@ -251,7 +260,7 @@ fn release(out: &mut String, service: &GraphService, index: usize, task: &InnerT
 fn inner_task(
     out: &mut String,
     service: &GraphService,
-    index: usize,
+    index: InnerTaskId,
     task: &InnerTask,
     exit_of: Option<&str>,
     simulated: bool,
@@ -468,7 +477,8 @@ pub(super) fn check(service: &GraphService) -> Result<(), String> {
     let Ok(steps_of) = &service.steps else {
         return Ok(());
     };
-    let capacity = |channel: usize| service.channels.get(channel).map(|c| c.capacity);
+    let capacity =
+        |channel: GraphChannelId| service.channels.get(channel.index()).map(|c| c.capacity);
     for task in &service.tasks {
         for p in task.inputs.iter().chain(&task.outputs) {
             if capacity(p.channel).is_none_or(|c| p.rate > c) {
@@ -482,11 +492,11 @@ pub(super) fn check(service: &GraphService) -> Result<(), String> {
     fn walk(
         steps: &[GraphStep],
         tasks: usize,
-        capacity: &dyn Fn(usize) -> Option<u64>,
+        capacity: &dyn Fn(GraphChannelId) -> Option<u64>,
     ) -> Result<(), String> {
         for step in steps {
             match step {
-                GraphStep::Fire { task, .. } if *task >= tasks => {
+                GraphStep::Fire { task, .. } if task.index() >= tasks => {
                     return Err(format!("a firing names task {task} of {tasks}"));
                 }
                 GraphStep::Fire { .. } => {}
@@ -498,7 +508,7 @@ pub(super) fn check(service: &GraphService) -> Result<(), String> {
                     body,
                     ..
                 } => {
-                    if exit_task.is_some_and(|e| e >= tasks) {
+                    if exit_task.is_some_and(|e| e.index() >= tasks) {
                         return Err(format!("loop `{path}` names exit task out of {tasks}"));
                     }
                     for p in ports {
@@ -561,7 +571,7 @@ fn has_loop_outputs(steps: &[GraphStep]) -> bool {
 }
 
 /// The exit tasks of convergent loops (their index), with their loop's path.
-fn collect_exits<'s>(steps: &'s [GraphStep], exits: &mut Vec<(usize, &'s str)>) {
+fn collect_exits<'s>(steps: &'s [GraphStep], exits: &mut Vec<(InnerTaskId, &'s str)>) {
     for step in steps {
         match step {
             GraphStep::Fire { .. } => {}
@@ -587,14 +597,17 @@ fn collect_exits<'s>(steps: &'s [GraphStep], exits: &mut Vec<(usize, &'s str)>) 
 /// The C name of inner task `index`'s firing function (refinement lists
 /// every task it fires: `target::check` refuses a graph that names another
 /// as an internal error before generation).
-fn firing(service: &GraphService, index: usize) -> String {
+fn firing(service: &GraphService, index: InnerTaskId) -> String {
     format!("inner_{}", task_name(service, index))
 }
 
 /// The name inner task `index` goes by in C (`<n>_<path>`): its firing is
 /// `inner_<name>`, a time-triggered one's release `release_<name>`.
-fn task_name(service: &GraphService, index: usize) -> String {
-    let path = service.tasks.get(index).map_or("", |t| t.path.as_str());
+fn task_name(service: &GraphService, index: InnerTaskId) -> String {
+    let path = service
+        .tasks
+        .get(index.index())
+        .map_or("", |t| t.path.as_str());
     format!("{index}_{}", c::ident(path))
 }
 
@@ -606,7 +619,7 @@ fn steps(
     steps_of: &[GraphStep],
     indent: usize,
     depth: &mut usize,
-    exit: Option<(usize, usize)>,
+    exit: Option<(InnerTaskId, usize)>,
 ) {
     let pad = "    ".repeat(indent);
     for step in steps_of {
@@ -623,7 +636,7 @@ fn steps(
                 // stopping abandons the iteration.
                 let periodic = service
                     .tasks
-                    .get(*task)
+                    .get(task.index())
                     .is_some_and(|t| t.period_ms.is_some());
                 if periodic {
                     call = format!(

@@ -366,7 +366,7 @@ struct Lacking {
     /// Words its word table lacks.
     words: Vec<String>,
     /// Robots (fleet indices) its peer table lacks.
-    peers: Vec<usize>,
+    peers: Vec<crate::refine::PeerId>,
 }
 
 /// Bytes of the longest value the program holds that is known at build
@@ -579,7 +579,7 @@ fn lacking_errors(
         format!("the code generated for robot `{robot}` uses the word `{word}`, which its word table lacks")
     });
     let peers = lacking.peers.iter().map(|&i| {
-        let named = program.peers.get(i).map_or("?", |(_, r)| r.as_str());
+        let named = program.peers.get(i.index()).map_or("?", |(_, r)| r.as_str());
         format!("the code generated for robot `{robot}` names robot `{named}`, which its peer table lacks")
     });
     words

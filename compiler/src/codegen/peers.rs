@@ -17,7 +17,7 @@
 //! table lacks is recorded (`missing`) and refuses the build (E102), never
 //! written as another robot's index.
 
-use crate::refine::RobotProgram;
+use crate::refine::{PeerId, RobotProgram};
 use std::cell::RefCell;
 use std::collections::{BTreeSet, HashMap};
 
@@ -26,15 +26,15 @@ use std::collections::{BTreeSet, HashMap};
 /// in its own peers.
 pub struct Fleet<'a> {
     table: &'a [(String, String)],
-    teams: HashMap<&'a str, Vec<usize>>,
-    robots: HashMap<&'a str, usize>,
+    teams: HashMap<&'a str, Vec<PeerId>>,
+    robots: HashMap<&'a str, PeerId>,
 }
 
 impl<'a> Fleet<'a> {
     pub fn of(table: &'a [(String, String)]) -> Fleet<'a> {
-        let mut teams: HashMap<&str, Vec<usize>> = HashMap::new();
+        let mut teams: HashMap<&str, Vec<PeerId>> = HashMap::new();
         let mut robots = HashMap::new();
-        for (i, (team, robot)) in table.iter().enumerate() {
+        for (i, (team, robot)) in PeerId::all(table.len()).zip(table) {
             teams.entry(team.as_str()).or_default().push(i);
             robots.insert(robot.as_str(), i);
         }
@@ -51,7 +51,7 @@ impl<'a> Fleet<'a> {
     }
 
     /// The robots a message addressed to `to` (a team or a robot) reaches.
-    fn addressed(&self, to: &str) -> &[usize] {
+    fn addressed(&self, to: &str) -> &[PeerId] {
         match self.teams.get(to) {
             Some(team) => team,
             None => self.robots.get(to).map_or(&[], std::slice::from_ref),
@@ -62,10 +62,10 @@ impl<'a> Fleet<'a> {
 /// One program's peer table: fleet indices, ascending (formation order, so
 /// a message to a team reaches its robots in the order it always did).
 pub struct Peers {
-    list: Vec<usize>,
+    list: Vec<PeerId>,
     /// The robot itself, as a local index.
     own: usize,
-    missing: RefCell<BTreeSet<usize>>,
+    missing: RefCell<BTreeSet<PeerId>>,
 }
 
 impl Peers {
@@ -75,7 +75,7 @@ impl Peers {
         for message in &program.control.outgoing {
             robots.extend(fleet.addressed(&message.to_team));
         }
-        let list: Vec<usize> = robots.into_iter().collect();
+        let list: Vec<PeerId> = robots.into_iter().collect();
         let own = list.binary_search(&program.self_peer).unwrap_or(0);
         Peers {
             list,
@@ -85,7 +85,7 @@ impl Peers {
     }
 
     /// The fleet indices of the peers, in table order.
-    pub fn list(&self) -> &[usize] {
+    pub fn list(&self) -> &[PeerId] {
         &self.list
     }
 
@@ -104,7 +104,7 @@ impl Peers {
     /// and the robots it sends to), so a miss is a generator bug: it is
     /// recorded for [`Peers::missing`] and the index returned is past the
     /// table's end (the program is refused, never written with it).
-    pub fn local(&self, fleet: usize) -> usize {
+    pub fn local(&self, fleet: PeerId) -> usize {
         self.list.binary_search(&fleet).unwrap_or_else(|_| {
             self.missing.borrow_mut().insert(fleet);
             self.list.len()
@@ -112,13 +112,13 @@ impl Peers {
     }
 
     /// `fleet` indices as a C initializer list of local indices.
-    pub fn locals(&self, fleet: &[usize]) -> String {
+    pub fn locals(&self, fleet: &[PeerId]) -> String {
         let list: Vec<String> = fleet.iter().map(|&i| self.local(i).to_string()).collect();
         list.join(", ")
     }
 
     /// The fleet indices asked for that the table lacks, ascending.
-    pub fn missing(&self) -> Vec<usize> {
+    pub fn missing(&self) -> Vec<PeerId> {
         self.missing.borrow().iter().copied().collect()
     }
 }
@@ -137,8 +137,8 @@ mod tests {
     fn a_message_to_a_team_reaches_its_robots_and_to_a_robot_that_robot() {
         let rows = table(&[("A", "a1"), ("B", "b1"), ("A", "a2"), ("B", "b2")]);
         let fleet = Fleet::of(&rows);
-        assert_eq!(fleet.addressed("A"), &[0, 2]);
-        assert_eq!(fleet.addressed("b2"), &[3]);
+        assert_eq!(fleet.addressed("A"), &[PeerId::new(0), PeerId::new(2)]);
+        assert_eq!(fleet.addressed("b2"), &[PeerId::new(3)]);
         assert!(fleet.addressed("USER").is_empty());
     }
 }

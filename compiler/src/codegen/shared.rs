@@ -13,7 +13,7 @@ use super::template::{Template, fill, template};
 use super::values::Words;
 use super::{Layer, Target};
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
-use crate::refine::{OwnerRule, Ownership, RobotProgram, SharedLibrary, ValueKind};
+use crate::refine::{AttributeId, OwnerRule, Ownership, RobotProgram, SharedLibrary, ValueKind};
 use std::fmt::Write;
 
 /// The C prefix of the library's functions.
@@ -127,9 +127,10 @@ pub fn library_c(
         ],
     ));
     let global = |i: usize| {
+        let at = AttributeId::new(i);
         lib.ownership
             .as_ref()
-            .and_then(|o| o.global.iter().position(|g| g.at == i))
+            .and_then(|o| o.global.iter().position(|g| g.at == at))
     };
     if let Some(ownership) = &lib.ownership {
         owner_protocol(&mut out, program, peers, lib, ownership, &lock, &unlock);
@@ -198,7 +199,7 @@ fn owner_protocol(
             ("at", &list(&mut global.iter().map(|g| g.at.to_string()))),
             (
                 "names",
-                &list(&mut global.iter().map(|g| c::string(&lib.attributes[g.at]))),
+                &list(&mut global.iter().map(|g| c::string(lib.attribute(g.at)))),
             ),
             (
                 "set_keys",

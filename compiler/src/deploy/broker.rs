@@ -141,7 +141,7 @@ fn rights(
                 .write
                 .insert(topics::to_team(scope, &program.team, &global.value_key, me));
             for &owner in ownership.map_or(&[][..], |o| &o.owners) {
-                let (team, robot) = &program.peers[owner];
+                let (team, robot) = program.peer(owner);
                 if *robot != program.robot {
                     rights
                         .write

@@ -7,7 +7,7 @@
 //! control task does not wait for its own sends, and SDF would report such a
 //! cycle as a deadlock.
 
-use super::program::{RobotProgram, RoleKind, StateKind};
+use super::program::{RobotProgram, RoleKind, StateKind, SubscriptionId};
 use crate::diag::{Code, Diagnostic, FileId, Severity};
 use crate::span::Span;
 use crate::taskgraph::{
@@ -224,7 +224,7 @@ pub fn build(program: &RobotProgram) -> TaskGraph {
         });
     }
     // The control task writes its own publications to the groups it reads.
-    let own_groups: std::collections::BTreeSet<usize> = machine
+    let own_groups: std::collections::BTreeSet<SubscriptionId> = machine
         .services
         .iter()
         .flat_map(|s| &s.states)
@@ -240,7 +240,7 @@ pub fn build(program: &RobotProgram) -> TaskGraph {
             name: named(&format!("own_{g}")),
             span: Span::default(),
             dir: Direction::Out,
-            group: named(&machine.subscribed[g]),
+            group: named(&machine.subscribed[g.index()]),
         });
     }
     // The control task comes after every task that feeds it and before

@@ -162,7 +162,7 @@ pub fn refine_robots(
 /// Each team's group (`<GroupService>`): the robots whose refined programs
 /// call one of the team's group services, given to each of them.
 fn assign_groups(programs: &mut [RobotProgram]) {
-    let mut groups: std::collections::BTreeMap<String, Vec<usize>> = Default::default();
+    let mut groups: std::collections::BTreeMap<String, Vec<PeerId>> = Default::default();
     for p in programs.iter() {
         if !p.control.group_services.is_empty() {
             groups.entry(p.team.clone()).or_default().push(p.self_peer);

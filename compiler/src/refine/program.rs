@@ -24,6 +24,87 @@ newtype_index! {
     pub struct SlotId;
 }
 
+newtype_index! {
+    /// A mode of the control machine: an index into [`ControlMachine::modes`]
+    /// (the generated C's `MODE_<name>` enumerator has its value), at the
+    /// position of the team's mode (`sema::ModeId`) it refines.
+    pub struct ModeId;
+}
+
+newtype_index! {
+    /// A service machine of the control machine: an index into
+    /// [`ControlMachine::services`] (the generated C's `regions[].service`).
+    /// Not the team's `sema::ServiceId`: a machine is made for each service
+    /// a mode sets, in the order the modes first set them.
+    pub struct ServiceMachineId;
+}
+
+newtype_index! {
+    /// A message the control task receives: an index into
+    /// [`ControlMachine::incoming`] (the generated C's `in_port[]`).
+    pub struct IncomingId;
+}
+
+newtype_index! {
+    /// A message the control task sends: an index into
+    /// [`ControlMachine::outgoing`] (the generated C's `out_port[]`).
+    pub struct OutgoingId;
+}
+
+newtype_index! {
+    /// A latest-value group the control task reads: an index into
+    /// [`ControlMachine::subscribed`] (the generated C's `subscribed[]`).
+    pub struct SubscriptionId;
+}
+
+newtype_index! {
+    /// A mark (a timer: when a loop pass, a call or a wait started) of its
+    /// service machine: below [`ServiceMachine::marks`] (the generated C's
+    /// `r->mark[]`).
+    pub struct MarkId;
+}
+
+newtype_index! {
+    /// A strategy entry's action machine: an index into
+    /// [`ControlMachine::actions`] (the generated C's `actions_<n>`).
+    pub struct ActionMachineId;
+}
+
+newtype_index! {
+    /// An action of its action machine: an index into
+    /// [`ActionMachine::actions`].
+    pub struct ActionId;
+}
+
+newtype_index! {
+    /// A group statement this robot synchronizes at: an index into
+    /// [`ControlMachine::sync_points`].
+    pub struct SyncPointId;
+}
+
+newtype_index! {
+    /// A value of the team's library: an index into
+    /// [`SharedLibrary::attributes`] (the generated library's `values[]`).
+    pub struct AttributeId;
+}
+
+newtype_index! {
+    /// A robot of the mission: an index into [`RobotProgram::peers`]
+    /// (formation order, across teams).
+    pub struct PeerId;
+}
+
+newtype_index! {
+    /// A channel of a service graph: an index into [`GraphService::channels`]
+    /// (the generated C's `ch<N>`).
+    pub struct GraphChannelId;
+}
+
+newtype_index! {
+    /// An inner task of a service graph: an index into [`GraphService::tasks`].
+    pub struct InnerTaskId;
+}
+
 /// The robot's battery level, a catalog value: what a strategy's battery
 /// condition reads (`Battery`), and what the robot's status reports.
 pub const BATTERY_VALUE: &str = "BATTERY";
@@ -47,11 +128,18 @@ pub struct RobotProgram {
     /// cost memory linear in its robots, not quadratic.
     pub peers: Arc<[(String, String)]>,
     /// This robot's index in `peers`.
-    pub self_peer: usize,
+    pub self_peer: PeerId,
     /// The team's shared information, held by the library task.
     pub library: Option<SharedLibrary>,
     /// The service tasks that run a task graph (`graph=` in the catalog).
     pub graph_services: Vec<GraphService>,
+}
+
+impl RobotProgram {
+    /// Robot `id` of [`RobotProgram::peers`]: (team, robot).
+    pub fn peer(&self, id: PeerId) -> &(String, String) {
+        &self.peers[id.index()]
+    }
 }
 
 /// A service the robot's type implements by a task graph: each call runs
@@ -124,7 +212,7 @@ pub struct InnerTask {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct PortUse {
     pub port: String,
-    pub channel: usize,
+    pub channel: GraphChannelId,
     pub rate: u64,
 }
 
@@ -141,8 +229,8 @@ pub struct LoopPort {
     pub distributing: bool,
     pub outer_rate: u64,
     pub inner_rate: u64,
-    pub outer: usize,
-    pub inner: usize,
+    pub outer: GraphChannelId,
+    pub inner: GraphChannelId,
 }
 
 /// A term of a service graph's looped schedule, loop nodes opened.
@@ -150,7 +238,7 @@ pub struct LoopPort {
 pub enum GraphStep {
     /// `count` firings of inner task `task`, an index in
     /// [`GraphService::tasks`].
-    Fire { task: usize, count: u64 },
+    Fire { task: InnerTaskId, count: u64 },
     /// A loop of the schedule: `body` `count` times.
     Repeat { count: u64, body: Vec<GraphStep> },
     /// An SDF/L loop node (`path` as for tasks): its body's schedule,
@@ -161,7 +249,7 @@ pub enum GraphStep {
         path: String,
         convergent: bool,
         loop_count: u64,
-        exit_task: Option<usize>,
+        exit_task: Option<InnerTaskId>,
         /// Its data ports, in declaration order.
         ports: Vec<LoopPort>,
         body: Vec<GraphStep>,
@@ -186,16 +274,15 @@ pub struct SubgraphPort {
     pub port: String,
     pub input: bool,
     pub rate: u64,
-    pub outer: usize,
-    pub inner: usize,
+    pub outer: GraphChannelId,
+    pub inner: GraphChannelId,
 }
 
 /// The control task's machine.
 #[derive(Clone, Debug, Default)]
 pub struct ControlMachine {
     pub modes: Vec<ModeState>,
-    /// Index into `modes`.
-    pub default_mode: Option<usize>,
+    pub default_mode: Option<ModeId>,
     /// `case (from): catch (event): mode = to`, with the line of the catch.
     pub transitions: Vec<ModeTransition>,
     pub services: Vec<ServiceMachine>,
@@ -228,7 +315,7 @@ pub struct ControlMachine {
     /// programs call any of the team's group services; empty when this robot
     /// is not one of them. Each member's rank is its place among the live
     /// members (this robot, or heard from within `protocol::lost_after_ms`).
-    pub group: Vec<usize>,
+    pub group: Vec<PeerId>,
     /// Adaptive resource management: the team strategy's battery policies,
     /// checked at every firing against the robot's `BATTERY` value.
     pub battery: Vec<BatteryPolicy>,
@@ -258,6 +345,41 @@ pub const MAX_EVENT_NAME_BYTES: usize = 63;
 pub const EVENT_QUEUE: usize = 16;
 
 impl ControlMachine {
+    /// Mode `id` of [`ControlMachine::modes`].
+    pub fn mode(&self, id: ModeId) -> &ModeState {
+        &self.modes[id.index()]
+    }
+
+    /// Incoming message `id` of [`ControlMachine::incoming`].
+    pub fn incoming_message(&self, id: IncomingId) -> &IncomingMessage {
+        &self.incoming[id.index()]
+    }
+
+    /// Outgoing message `id` of [`ControlMachine::outgoing`].
+    pub fn outgoing_message(&self, id: OutgoingId) -> &OutgoingMessage {
+        &self.outgoing[id.index()]
+    }
+
+    /// The key of subscribed group `id` of [`ControlMachine::subscribed`].
+    pub fn subscription(&self, id: SubscriptionId) -> &str {
+        &self.subscribed[id.index()]
+    }
+
+    /// Action machine `id` of [`ControlMachine::actions`].
+    pub fn action_machine(&self, id: ActionMachineId) -> &ActionMachine {
+        &self.actions[id.index()]
+    }
+
+    /// The mission offset sync point `id` names ([`ControlMachine::sync_points`]).
+    pub fn sync_point(&self, id: SyncPointId) -> usize {
+        self.sync_points[id.index()]
+    }
+
+    /// Service machine `id` of [`ControlMachine::services`].
+    pub fn service(&self, id: ServiceMachineId) -> &ServiceMachine {
+        &self.services[id.index()]
+    }
+
     /// The most plans any mode runs at once (at least 1): the size of the
     /// machine's per-plan state, in C and in the simulator alike.
     pub fn region_count(&self) -> usize {
@@ -294,10 +416,10 @@ impl ControlMachine {
     /// once decided there, again at each heartbeat, in this order
     /// (`docs/groups.md`, "Takeover").
     pub fn elections(&self) -> impl Iterator<Item = Election<'_>> {
-        let states = self.services.iter().enumerate().flat_map(|(service, s)| {
-            s.states
-                .iter()
-                .enumerate()
+        let services = ServiceMachineId::all(self.services.len()).zip(&self.services);
+        let states = services.flat_map(|(service, s)| {
+            StateId::all(s.states.len())
+                .zip(&s.states)
                 .map(move |(pc, state)| ((service, pc), state))
         });
         states.filter_map(|(at, state)| match &state.kind {
@@ -323,12 +445,12 @@ impl ControlMachine {
 #[derive(Clone, Copy, Debug)]
 pub struct Election<'a> {
     /// (service, pc) of the state.
-    pub at: (usize, usize),
+    pub at: (ServiceMachineId, StateId),
     pub line: u32,
-    pub candidates: &'a [usize],
+    pub candidates: &'a [PeerId],
     pub algorithm: LeaderAlgorithm,
     /// The incoming messages the leader's block receives.
-    pub receives: &'a [usize],
+    pub receives: &'a [IncomingId],
 }
 
 impl ControlMachine {
@@ -404,16 +526,15 @@ pub struct ModeState {
 #[derive(Clone, Debug)]
 pub struct Region {
     pub plan: String,
-    /// Index into [`ControlMachine::services`].
-    pub service: usize,
+    pub service: ServiceMachineId,
     pub timeout_ms: Option<i64>,
 }
 
 #[derive(Clone, Debug)]
 pub struct ModeTransition {
-    pub from: usize,
+    pub from: ModeId,
     pub event: String,
-    pub to: usize,
+    pub to: ModeId,
     pub line: u32,
 }
 
@@ -425,7 +546,8 @@ pub struct ServiceMachine {
     pub name: String,
     pub line: u32,
     pub states: Vec<State>,
-    /// Timers and marks the states use (loop starts, call starts).
+    /// How many timers and marks the states use (loop starts, call
+    /// starts): each [`MarkId`] of its states is below it.
     pub marks: usize,
 }
 
@@ -444,13 +566,13 @@ pub struct State {
 
 #[derive(Clone, Debug)]
 pub enum StateKind {
-    /// Wait for one sample of each incoming message (indices into
-    /// [`ControlMachine::incoming`]), storing each in its slot.
+    /// Wait for one sample of each incoming message, storing each in its
+    /// slot.
     Receive {
-        messages: Vec<usize>,
+        messages: Vec<IncomingId>,
         /// `receive(...), timeout = P`: give up after P (mark holds the start).
         timeout_ms: Option<i64>,
-        mark: usize,
+        mark: MarkId,
     },
     /// Send each item (storing assigned values in their shared slot first).
     Send {
@@ -458,18 +580,17 @@ pub enum StateKind {
     },
     /// Read the latest published value of a group into its slot.
     Subscribe {
-        group: usize,
+        group: SubscriptionId,
         slot: SlotId,
     },
     /// `throw E`: the current mode's catch of E asks for a mode change.
-    /// With `broadcast` (`throw E broadcast`), the messages (indices into
-    /// [`ControlMachine::outgoing`], key [`event_key`], the event's name as
-    /// text) that tell the others of the thrower's group first: one to the
+    /// With `broadcast` (`throw E broadcast`), the messages (key
+    /// [`event_key`], the event's name as text) that tell the others of the thrower's group first: one to the
     /// team when the group is the whole team, else one to each other robot
     /// of it; empty when the thrower is the group's only robot.
     Throw {
         event: String,
-        broadcast: Option<Vec<usize>>,
+        broadcast: Option<Vec<OutgoingId>>,
     },
     /// Call the task implementing a built-in service and wait until it is idle.
     Call {
@@ -477,15 +598,15 @@ pub enum StateKind {
         task: String,
         args: Vec<Operand>,
         timeout_ms: Option<i64>,
-        mark: usize,
+        mark: MarkId,
     },
     /// Run a strategy action machine to its final action.
     RunActions {
         service: String,
-        machine: usize,
+        machine: ActionMachineId,
         args: Vec<Operand>,
         timeout_ms: Option<i64>,
-        mark: usize,
+        mark: MarkId,
     },
     /// `leader(cond)` for a robot that meets `cond`: continue (run the
     /// leader's block) if `algorithm` chooses this robot among the live
@@ -499,10 +620,10 @@ pub enum StateKind {
     /// `receive` takes only what arrived while this robot leads
     /// (`docs/groups.md`).
     LeaderBranch {
-        candidates: Vec<usize>,
+        candidates: Vec<PeerId>,
         algorithm: LeaderAlgorithm,
         others_at: StateId,
-        receives: Vec<usize>,
+        receives: Vec<IncomingId>,
     },
     /// `[[ group(Name, min = N) ... ]]` (counted groups): give this robot a
     /// group from the `members` (peer indices, formation order: the robots
@@ -516,7 +637,7 @@ pub enum StateKind {
     /// ([`counted_allocation`]). The robot continues at its group's `at`;
     /// a change of its group is traced (`allocated`).
     GroupAllocate {
-        members: Vec<usize>,
+        members: Vec<PeerId>,
         groups: Vec<CountedGroup>,
         others_at: Option<StateId>,
     },
@@ -528,11 +649,10 @@ pub enum StateKind {
     /// arrived at that pass or is known dead (no heartbeat for three
     /// periods), or `timeout_ms` has passed.
     GroupSync {
-        members: Vec<usize>,
-        /// Index into [`ControlMachine::sync_points`].
-        point: usize,
+        members: Vec<PeerId>,
+        point: SyncPointId,
         timeout_ms: i64,
-        mark: usize,
+        mark: MarkId,
     },
     /// Continue at `else_to` unless the condition holds.
     Branch {
@@ -547,12 +667,12 @@ pub enum StateKind {
     LoopHead {
         condition: Option<Expr>,
         exit_to: StateId,
-        mark: usize,
+        mark: MarkId,
     },
     /// End of a loop body: wait for the period (from the mark), then `to`.
     LoopTail {
         period_ms: Option<i64>,
-        mark: usize,
+        mark: MarkId,
         to: StateId,
     },
     /// After the body: `repeat(period?, condition?)`; `forever` for `repeat()`;
@@ -596,15 +716,14 @@ pub fn counted_allocation(mins: &[usize], has_others: bool, position: usize) -> 
 /// One value of a `send`/`publish`.
 #[derive(Clone, Debug)]
 pub struct SendItem {
-    /// Index into [`ControlMachine::outgoing`].
-    pub message: usize,
+    pub message: OutgoingId,
     pub value: Operand,
     /// `send(T, T.X = v)`: the shared slot `v` is stored in first.
     pub store: Option<SlotId>,
-    /// A publication of a value this robot also subscribes to: the index into
-    /// [`ControlMachine::subscribed`] of the group it is written to at once,
-    /// since the latest value team T published includes the robot's own.
-    pub own_group: Option<usize>,
+    /// A publication of a value this robot also subscribes to: the group it
+    /// is written to at once, since the latest value team T published
+    /// includes the robot's own.
+    pub own_group: Option<SubscriptionId>,
 }
 
 /// A strategy entry's actions: the bottom level of the machine.
@@ -614,7 +733,7 @@ pub struct ActionMachine {
     /// `Strategy file` line of the `<Service>` element.
     pub source: String,
     pub actions: Vec<ActionState>,
-    pub initial: usize,
+    pub initial: ActionId,
     /// Slots of the `variable` parameters set from the call's arguments, in order.
     pub arguments: Vec<SlotId>,
 }
@@ -628,7 +747,7 @@ pub struct ActionState {
     /// given: a value as written, a sensor reading, the call's argument).
     pub commands: Vec<(String, Operand)>,
     /// Checked in order; the first that holds is taken. `None` = always.
-    pub transitions: Vec<(Option<Expr>, usize)>,
+    pub transitions: Vec<(Option<Expr>, ActionId)>,
 }
 
 /// A value of the machine and where it comes from.
@@ -682,6 +801,13 @@ pub struct SharedLibrary {
     pub ownership: Option<Ownership>,
 }
 
+impl SharedLibrary {
+    /// The key of attribute `id` of [`SharedLibrary::attributes`].
+    pub fn attribute(&self, id: AttributeId) -> &str {
+        &self.attributes[id.index()]
+    }
+}
+
 /// The globally shared attributes of a team's library and the robots that
 /// own them in turn: one robot of `owners` holds them, the others set them
 /// through messages to it and read what it last told them.
@@ -695,7 +821,7 @@ pub struct Ownership {
     /// then the others in formation order, else the team's leader order
     /// (`lowest_id`, `highest_battery`: formation order; `bully`: the
     /// reverse).
-    pub owners: Vec<usize>,
+    pub owners: Vec<PeerId>,
     /// Who follows a lost owner.
     pub rule: OwnerRule,
 }
@@ -726,8 +852,8 @@ impl OwnerRule {
 /// One globally shared attribute of a library.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct GlobalValue {
-    /// Its index in [`SharedLibrary::attributes`].
-    pub at: usize,
+    /// Its place in [`SharedLibrary::attributes`].
+    pub at: AttributeId,
     /// The type of its values (its shared slot's): a value of another type
     /// received is refused.
     pub kind: ValueKind,

@@ -60,7 +60,8 @@ pub(super) fn refine_robot(
     builder.machine.battery = builder.battery_policies();
     builder.machine.events_heard = builder.events_heard();
     let graph_services = builder.graph_services();
-    let self_peer = builder.first_peer() + robot_index;
+    let first_peer = builder.first_peer();
+    let self_peer = PeerId::new(first_peer + robot_index);
     let team_leader = builder.team_leader_algorithm();
     let Builder {
         mut machine,
@@ -71,7 +72,7 @@ pub(super) fn refine_robot(
     } = builder;
     separate_sensor_tasks(&mut machine, &mut sensors, &services);
     link_own_publications(&mut machine);
-    let library = shared::library(team, self_peer - robot_index, team_leader, &mut machine);
+    let library = shared::library(team, first_peer, team_leader, &mut machine);
     let mut tasks: Vec<TaskRole> = sensors
         .into_iter()
         .map(|(task, values)| TaskRole {
@@ -147,9 +148,9 @@ struct Builder<'a, 'i> {
     /// Service task → the services or actuator commands it runs.
     services: BTreeMap<String, BTreeSet<String>>,
     /// Team service → machine index.
-    service_machines: HashMap<ServiceId, usize>,
+    service_machines: HashMap<ServiceId, ServiceMachineId>,
     /// (strategy file, entry index) → action machine index.
-    action_machines: HashMap<(u32, usize), usize>,
+    action_machines: HashMap<(u32, usize), ActionMachineId>,
     /// The team service whose machine is being built (for the strategy's
     /// leader selection scoped to a composite service).
     current_service: Option<ServiceId>,
@@ -252,25 +253,27 @@ impl Builder<'_, '_> {
             });
         }
         if let Some(main) = &team.main {
-            self.machine.default_mode = main.default.map(|d| d.index());
+            // One mode state per team mode, in order (`build_modes`): the
+            // team's mode position is the machine's.
+            self.machine.default_mode = main.default.map(|d| ModeId::new(d.index()));
             for t in &main.transitions {
                 let line = self.line(t.span);
                 self.machine.transitions.push(ModeTransition {
-                    from: t.from.index(),
+                    from: ModeId::new(t.from.index()),
                     event: t.event.to_string(),
-                    to: t.to.index(),
+                    to: ModeId::new(t.to.index()),
                     line,
                 });
             }
         }
     }
 
-    fn service_machine(&mut self, service: ServiceId) -> usize {
+    fn service_machine(&mut self, service: ServiceId) -> ServiceMachineId {
         if let Some(&m) = self.service_machines.get(&service) {
             return m;
         }
         let info = &self.team.services[service.index()];
-        let index = self.machine.services.len();
+        let index = ServiceMachineId::new(self.machine.services.len());
         self.service_machines.insert(service, index);
         self.machine.services.push(ServiceMachine {
             plan: self.team.plans[info.plan.index()].name.to_string(),
@@ -312,7 +315,7 @@ impl Builder<'_, '_> {
             });
         }
         self.current_service = outer;
-        let m = &mut self.machine.services[index];
+        let m = &mut self.machine.services[index.index()];
         m.states = states;
         m.marks = marks;
         index
@@ -364,10 +367,10 @@ impl Builder<'_, '_> {
             .iter()
             .position(|&p| p == span.start)
         {
-            Some(i) => i,
+            Some(i) => SyncPointId::new(i),
             None => {
                 self.machine.sync_points.push(span.start);
-                self.machine.sync_points.len() - 1
+                SyncPointId::new(self.machine.sync_points.len() - 1)
             }
         };
         let (_, heartbeat_ms) = self.leader_selection();
@@ -376,7 +379,10 @@ impl Builder<'_, '_> {
         let state = self.push(
             states,
             StateKind::GroupSync {
-                members: members.into_iter().map(|i| first_peer + i).collect(),
+                members: members
+                    .into_iter()
+                    .map(|i| PeerId::new(first_peer + i))
+                    .collect(),
                 point,
                 timeout_ms: (timeout.millis.round() as i64).max(0),
                 mark,
@@ -529,7 +535,10 @@ impl Builder<'_, '_> {
                         // Peer indices of the candidates, in formation order:
                         // the first one alive leads.
                         let first_peer = self.first_peer();
-                        let candidates = candidates.iter().map(|i| first_peer + i).collect();
+                        let candidates = candidates
+                            .iter()
+                            .map(|i| PeerId::new(first_peer + i))
+                            .collect();
                         let (algorithm, heartbeat_ms) = self.leader_selection();
                         self.need_heartbeat(heartbeat_ms.unwrap_or(HEARTBEAT_MS));
                         let branch = self.push_forward(states, stmt.span, |others_at| {
@@ -610,7 +619,10 @@ impl Builder<'_, '_> {
             return;
         }
         let first_peer = self.first_peer();
-        let members: Vec<usize> = runners.iter().map(|i| first_peer + i).collect();
+        let members: Vec<PeerId> = runners
+            .iter()
+            .map(|i| PeerId::new(first_peer + i))
+            .collect();
         let (_, heartbeat_ms) = self.leader_selection();
         self.need_heartbeat(heartbeat_ms.unwrap_or(HEARTBEAT_MS));
         let allocate = self.push(
@@ -788,10 +800,10 @@ impl Builder<'_, '_> {
                     let key = self.attr_key(&item.attr);
                     let slot = self.shared_slot(&item.attr);
                     let group = match self.machine.subscribed.iter().position(|g| *g == key) {
-                        Some(g) => g,
+                        Some(g) => SubscriptionId::new(g),
                         None => {
                             self.machine.subscribed.push(key.clone());
-                            self.machine.subscribed.len() - 1
+                            SubscriptionId::new(self.machine.subscribed.len() - 1)
                         }
                     };
                     self.push(states, StateKind::Subscribe { group, slot }, span);
@@ -927,7 +939,7 @@ impl Builder<'_, '_> {
     }
 
     /// The strategy entry refining the call at `span` for this robot's type.
-    fn strategy_machine(&mut self, span: Span, service: &str) -> Option<usize> {
+    fn strategy_machine(&mut self, span: Span, service: &str) -> Option<ActionMachineId> {
         let link = self
             .input
             .links
@@ -956,7 +968,7 @@ impl Builder<'_, '_> {
         let source = self.strategy_name(strategy);
         let machine = self.action_machine(entry, service, source, strategy, span);
         self.machine.actions.push(machine);
-        let index = self.machine.actions.len() - 1;
+        let index = ActionMachineId::new(self.machine.actions.len() - 1);
         self.action_machines.insert(key, index);
         Some(index)
     }
@@ -1011,10 +1023,9 @@ impl Builder<'_, '_> {
                 }
             }
         }
-        let index_of: HashMap<u64, usize> = entry
-            .actions
-            .iter()
-            .enumerate()
+        // One action state per action of the entry, in order (below).
+        let index_of: HashMap<u64, ActionId> = ActionId::all(entry.actions.len())
+            .zip(&entry.actions)
             .filter_map(|(i, a)| a.id.as_ref().map(|id| (id.value, i)))
             .collect();
         let mut actions = Vec::new();
@@ -1080,11 +1091,11 @@ impl Builder<'_, '_> {
             });
         }
         let initial = match entry.actions.iter().position(|a| a.initial.is_yes()) {
-            Some(i) => i,
+            Some(i) => ActionId::new(i),
             None => {
                 let what = format!("the strategy of `{service}` has no initial action");
                 self.internal_error(call, &what);
-                0
+                ActionId::new(0)
             }
         };
         ActionMachine {
@@ -1441,14 +1452,14 @@ impl Builder<'_, '_> {
         }
     }
 
-    fn outgoing(&mut self, to_team: &str, publish: bool, key: &str) -> usize {
+    fn outgoing(&mut self, to_team: &str, publish: bool, key: &str) -> OutgoingId {
         if let Some(i) = self
             .machine
             .outgoing
             .iter()
             .position(|m| m.to_team == to_team && m.publish == publish && m.key == key)
         {
-            return i;
+            return OutgoingId::new(i);
         }
         let port = format!(
             "{}_{}_{}",
@@ -1462,14 +1473,14 @@ impl Builder<'_, '_> {
             key: key.to_string(),
             port,
         });
-        self.machine.outgoing.len() - 1
+        OutgoingId::new(self.machine.outgoing.len() - 1)
     }
 
     /// The messages that tell the others of the thrower's group of a
     /// `throw E broadcast` (the group the checker recorded): one to the team
     /// when it is the whole team, else one to each other robot of it.
     /// `None` when the checker recorded no broadcast there.
-    fn broadcast_messages(&mut self, event: &ast::Ident) -> Option<Vec<usize>> {
+    fn broadcast_messages(&mut self, event: &ast::Ident) -> Option<Vec<OutgoingId>> {
         let team = self.team;
         let receivers = team.broadcast_at(event.span)?.receivers.clone();
         if event.name.len() > MAX_EVENT_NAME_BYTES {
@@ -1509,7 +1520,7 @@ impl Builder<'_, '_> {
         events
     }
 
-    fn incoming(&mut self, from_team: &str, attr: &ast::Attr) -> usize {
+    fn incoming(&mut self, from_team: &str, attr: &ast::Attr) -> IncomingId {
         let key = self.attr_key(attr);
         if let Some(i) = self
             .machine
@@ -1517,7 +1528,7 @@ impl Builder<'_, '_> {
             .iter()
             .position(|m| m.from_team == from_team && *m.key == key)
         {
-            return i;
+            return IncomingId::new(i);
         }
         let slot = self.shared_slot(attr);
         let port = format!("from_{}_{}", from_team, key.replace('.', "_"));
@@ -1527,7 +1538,7 @@ impl Builder<'_, '_> {
             slot,
             port,
         });
-        self.machine.incoming.len() - 1
+        IncomingId::new(self.machine.incoming.len() - 1)
     }
 }
 
@@ -1543,9 +1554,10 @@ fn link_own_publications(machine: &mut ControlMachine) {
     for state in services.iter_mut().flat_map(|s| s.states.iter_mut()) {
         if let StateKind::Send { items } = &mut state.kind {
             for item in items {
-                let message = &outgoing[item.message];
+                let message = &outgoing[item.message.index()];
                 if message.publish {
-                    item.own_group = subscribed.iter().position(|g| *g == message.key);
+                    let group = subscribed.iter().position(|g| *g == message.key);
+                    item.own_group = group.map(SubscriptionId::new);
                 }
             }
         }
@@ -1617,9 +1629,10 @@ enum ArmChoice<'s> {
     },
 }
 
-fn next_mark(marks: &mut usize) -> usize {
+/// A new mark of the service machine whose `marks` (a count) it raises.
+fn next_mark(marks: &mut usize) -> MarkId {
     *marks += 1;
-    *marks - 1
+    MarkId::new(*marks - 1)
 }
 
 /// A state pushed by [`Builder::push_forward`] whose target is the state
@@ -1629,8 +1642,8 @@ struct Forward(StateId);
 
 /// The incoming messages the `Receive` states of `states` take, each once,
 /// in index order (a leader's block: [`StateKind::LeaderBranch`]).
-fn received_in(states: &[State]) -> Vec<usize> {
-    let mut messages: Vec<usize> = states
+fn received_in(states: &[State]) -> Vec<IncomingId> {
+    let mut messages: Vec<IncomingId> = states
         .iter()
         .filter_map(|s| match &s.kind {
             StateKind::Receive { messages, .. } => Some(messages.iter().copied()),

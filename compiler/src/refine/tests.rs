@@ -207,7 +207,7 @@ fn every_robot_gets_a_program_with_its_peers() {
             ("SlaveTeam", "nxt")
         ]
     );
-    assert_eq!(programs[2].self_peer, 2);
+    assert_eq!(programs[2].self_peer, PeerId::new(2));
     assert_eq!(programs[0].peers.len(), 3);
 }
 
@@ -341,7 +341,9 @@ fn group_arms_a_robot_can_never_join_are_dropped() {
             .iter()
             .flat_map(|s| &s.states)
             .filter_map(|s| match &s.kind {
-                StateKind::LeaderBranch { candidates, .. } => Some(candidates.clone()),
+                StateKind::LeaderBranch { candidates, .. } => {
+                    Some(candidates.iter().map(|p| p.index()).collect())
+                }
                 _ => None,
             })
             .collect()
@@ -424,7 +426,10 @@ fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
     use crate::refine::GraphStep::{Fire, Loop};
     use crate::refine::LoopPort;
     use crate::taskgraph::subgraph::Hierarchy;
-    let fire = |task: usize| Fire { task, count: 1 };
+    let fire = |task: usize| Fire {
+        task: InnerTaskId::new(task),
+        count: 1,
+    };
     let load = |name: &str| {
         let text = shared(&format!("taskgraphs/{name}.taskgraph.xml"));
         crate::taskgraph::load_task_graph(FileId(9), &text)
@@ -441,8 +446,8 @@ fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
         distributing,
         outer_rate: 10,
         inner_rate: 1,
-        outer,
-        inner,
+        outer: GraphChannelId::new(outer),
+        inner: GraphChannelId::new(inner),
     };
     assert_eq!(
         data_loop.steps,
@@ -487,7 +492,12 @@ fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
             &b.outputs[0].port,
             b.outputs[0].channel
         ),
-        (&"i".to_string(), 2, &"o".to_string(), 3)
+        (
+            &"i".to_string(),
+            GraphChannelId::new(2),
+            &"o".to_string(),
+            GraphChannelId::new(3)
+        )
     );
     // k-means: a C-type loop (exit task ReplaceCenter) around a D-type one.
     let kmeans = robot::steps_of(&load("kmeans"), &none).unwrap();
@@ -503,7 +513,7 @@ fn a_service_graph_becomes_its_looped_schedule_with_loop_nodes_opened() {
     else {
         panic!("{kmeans:?}");
     };
-    assert_eq!(paths[*exit], "Converge/ReplaceCenter");
+    assert_eq!(paths[exit.index()], "Converge/ReplaceCenter");
     assert!(
         matches!(&body[1], Loop { path, loop_count: 16, convergent: false, .. } if path == "Converge/Assign")
     );
@@ -578,19 +588,23 @@ fn a_sub_graph_reference_opens_into_a_step_running_its_schedule_once() {
         port: port.into(),
         input,
         rate,
-        outer,
-        inner,
+        outer: GraphChannelId::new(outer),
+        inner: GraphChannelId::new(inner),
+    };
+    let fire = |task, count| Fire {
+        task: InnerTaskId::new(task),
+        count,
     };
     assert_eq!(
         opened.steps,
         [
-            Fire { task: 0, count: 1 },
+            fire(0, 1),
             Subgraph {
                 path: "Filter".into(),
                 ports: vec![port("in", true, 2, 0, 3), port("out", false, 1, 1, 4)],
-                body: vec![Fire { task: 1, count: 2 }, Fire { task: 2, count: 1 }],
+                body: vec![fire(1, 2), fire(2, 1)],
             },
-            Fire { task: 3, count: 1 },
+            fire(3, 1),
         ]
     );
     let bounded: Vec<(&str, u64)> = opened
@@ -609,8 +623,8 @@ fn a_sub_graph_reference_opens_into_a_step_running_its_schedule_once() {
         ]
     );
     // Predict reads the boundary channel of `in`, Update writes that of `out`.
-    assert_eq!(opened.tasks[1].inputs[0].channel, 3);
-    assert_eq!(opened.tasks[2].outputs[0].channel, 4);
+    assert_eq!(opened.tasks[1].inputs[0].channel, GraphChannelId::new(3));
+    assert_eq!(opened.tasks[2].outputs[0].channel, GraphChannelId::new(4));
 }
 
 /// A time-triggered inner task carries its period, from the checked model,
@@ -687,7 +701,7 @@ fn a_broadcast_goes_to_the_throwers_group_as_the_checker_recorded_it() {
                 } => Some(
                     std::iter::once(event.clone())
                         .chain(messages.iter().map(|&m| {
-                            let o = &p.control.outgoing[m];
+                            let o = p.control.outgoing_message(m);
                             assert_eq!((o.key.as_str(), o.publish), ("T.__event", false));
                             o.to_team.clone()
                         }))
@@ -762,7 +776,7 @@ fn counted_groups_put_every_arm_in_every_program_behind_one_allocation() {
                     groups,
                     others_at,
                 } => Some((
-                    members.clone(),
+                    members.iter().map(|p| p.index()).collect(),
                     groups.iter().map(|g| (g.name.clone(), g.min)).collect(),
                     others_at.is_some(),
                 )),

@@ -35,8 +35,9 @@ use crate::refine::SENSOR_PERIOD_MS;
 use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
 use crate::refine::{
-    ActionMachine, ControlMachine, Expr, LeaderAlgorithm, Operand, RobotProgram, RoleKind, SlotId,
-    SlotSource, StateKind, counted_allocation,
+    ActionId, ActionMachine, AttributeId, ControlMachine, Expr, IncomingId, LeaderAlgorithm,
+    ModeId, Operand, OutgoingId, PeerId, RobotProgram, RoleKind, ServiceMachineId, SlotId,
+    SlotSource, StateId, StateKind, SyncPointId, counted_allocation,
 };
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
@@ -238,8 +239,8 @@ struct Message {
     publish: bool,
     from_team: Rc<str>,
     from_robot: Rc<str>,
-    /// Index of the sender in the peers (operator: `None`).
-    from_peer: Option<usize>,
+    /// The sender among the peers (operator: `None`).
+    from_peer: Option<PeerId>,
     key: Rc<str>,
     value: Held,
     sent_at: i64,
@@ -312,7 +313,7 @@ struct Inputs {
     /// The slots fed by a sensor.
     sensors: Vec<usize>,
     /// The shared slots, each with its value's place in the library.
-    shared: Vec<(usize, usize)>,
+    shared: Vec<(usize, AttributeId)>,
 }
 
 impl Inputs {
@@ -330,12 +331,14 @@ impl Inputs {
     }
 }
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 struct Region {
-    service: Option<usize>,
+    service: Option<ServiceMachineId>,
     pc: usize,
     phase: u8,
-    action: usize,
+    /// The current action of the action machine a `RunActions` state runs
+    /// (set to its initial action when the state starts).
+    action: ActionId,
     done: bool,
     started: i64,
     pass_start: i64,
@@ -373,14 +376,13 @@ struct Robot<'p> {
     /// The library task's values, one per shared key (`lib_<name>.c`).
     library: Vec<Held>,
     /// Per slot: its value's place in `library` (shared slots only).
-    library_index: Vec<Option<usize>>,
+    library_index: Vec<Option<AttributeId>>,
     /// A library value was written since the control task last read the
     /// library into its slots (otherwise every shared slot holds its value
     /// already, and reading them again, comparing text, is skipped).
     library_written: bool,
-    /// The owner of the library's globally shared values now (a peer index;
-    /// `shared.rs`).
-    owner: usize,
+    /// The owner of the library's globally shared values now (`shared.rs`).
+    owner: PeerId,
     /// Per incoming message: the channel to the control task (capacity).
     inbox: Vec<(VecDeque<Held>, usize)>,
     /// The receive task held up by a full channel ([`Holding`]), and the
@@ -399,12 +401,12 @@ struct Robot<'p> {
     /// Per subscribed group: the latest value.
     groups: Vec<Option<Held>>,
     regions: Vec<Region>,
-    current_mode: Option<usize>,
-    pending_mode: Option<usize>,
+    current_mode: Option<ModeId>,
+    pending_mode: Option<ModeId>,
     /// Broadcast events received and not yet looked at by the control task:
-    /// (the thrower's peer index, the event's index in `events_heard`), in
-    /// arrival order, at most `EVENT_QUEUE` (`comm_event_take`).
-    events: VecDeque<(usize, usize)>,
+    /// (the thrower, the event's index in `events_heard`), in arrival
+    /// order, at most `EVENT_QUEUE` (`comm_event_take`).
+    events: VecDeque<(PeerId, usize)>,
     last_heartbeat: i64,
     /// Per peer: what its last heartbeat said (`comm_heard`).
     heard: Hearing,
@@ -425,14 +427,14 @@ struct Robot<'p> {
     /// listening time before it claims).
     fenced: Option<Option<i64>>,
     /// How often this robot reached each `GroupSync` state, by (service, pc).
-    sync_pass: HashMap<(usize, usize), i64>,
+    sync_pass: HashMap<(ServiceMachineId, StateId), i64>,
     /// The last pass each (peer, sync point) announced (`comm_sync_arrived`).
-    sync_arrived: HashMap<(usize, usize), i64>,
+    sync_arrived: HashMap<(PeerId, SyncPointId), i64>,
     /// The last leader each `LeaderBranch` state saw, by (service, pc).
-    leaders: HashMap<(usize, usize), usize>,
+    leaders: HashMap<(ServiceMachineId, StateId), Leader>,
     /// The group each `GroupAllocate` state last gave this robot, by
     /// (service, pc): its index, or [`OTHERS`].
-    allocated: HashMap<(usize, usize), usize>,
+    allocated: HashMap<(ServiceMachineId, StateId), usize>,
     /// The last (rank, size) in the team's group this robot traced
     /// (`semo_group_set`); `None` before its first heartbeat.
     group: Option<(usize, usize)>,
@@ -584,13 +586,17 @@ impl<'p> Robot<'p> {
             started_at: at,
             slots: vec![None; m.slots.len()],
             library: vec![None; library_keys.len()],
+            // Read from the program's library (whose attributes are
+            // `library_keys`, made by the same rule).
             library_index: m
                 .slots
                 .iter()
                 .map(|s| {
-                    (s.source == SlotSource::Shared && program.library.is_some())
-                        .then(|| library_keys.iter().position(|k| *k == s.key))
+                    let lib = program.library.as_ref()?;
+                    (s.source == SlotSource::Shared)
+                        .then(|| lib.attributes.iter().position(|k| *k == s.key))
                         .flatten()
+                        .map(AttributeId::new)
                 })
                 .collect(),
             library_written: false,
@@ -608,9 +614,18 @@ impl<'p> Robot<'p> {
             groups: vec![None; m.subscribed.len()],
             regions: vec![
                 Region {
-                    marks: vec![0; marks],
+                    service: None,
+                    pc: 0,
+                    phase: 0,
+                    // As the C's zeroed region; no action runs before a
+                    // `RunActions` state sets its machine's initial one.
+                    action: ActionId::new(0),
                     done: true,
-                    ..Region::default()
+                    started: 0,
+                    pass_start: 0,
+                    timeout_ms: 0,
+                    marks: vec![0; marks],
+                    plan: String::new(),
                 };
                 regions
             ],
@@ -655,11 +670,11 @@ impl<'p> Robot<'p> {
 /// in a mission): the sender's own index when the peers are the same
 /// mission's, found without reading every robot's name (a heartbeat is
 /// heard by the whole team, so a scan made a swarm's run quadratic).
-fn sender_peer(program: &RobotProgram, message: &Message) -> Option<usize> {
-    let named = |p: usize| *program.peers[p].1 == *message.from_robot;
+fn sender_peer(program: &RobotProgram, message: &Message) -> Option<PeerId> {
+    let named = |p: PeerId| *program.peer(p).1 == *message.from_robot;
     match message.from_peer {
-        Some(p) if p < program.peers.len() && named(p) => Some(p),
-        _ => (0..program.peers.len()).find(|&p| named(p)),
+        Some(p) if p.index() < program.peers.len() && named(p) => Some(p),
+        _ => PeerId::all(program.peers.len()).find(|&p| named(p)),
     }
 }
 
@@ -1072,7 +1087,7 @@ impl<'p> Sim<'p> {
         robot.progressed = true;
         let library = robot.library_index[slot.index()];
         if let Some(k) = library {
-            robot.library[k].clone_from(&value);
+            robot.library[k.index()].clone_from(&value);
             robot.library_written = true;
         }
         robot.slots[slot.index()].clone_from(&value);
@@ -1125,8 +1140,8 @@ impl<'p> Sim<'p> {
         // its value already.
         if std::mem::take(&mut robot.library_written) {
             for &(i, k) in inputs.shared.iter() {
-                if robot.slots[i] != robot.library[k] {
-                    robot.slots[i].clone_from(&robot.library[k]);
+                if robot.slots[i] != robot.library[k.index()] {
+                    robot.slots[i].clone_from(&robot.library[k.index()]);
                     robot.progressed = true;
                 }
             }
@@ -1363,6 +1378,7 @@ impl<'p> Sim<'p> {
             let (offset, pass) = (number(words.next()), number(words.next()));
             let peer = sender_peer(robot.program, message);
             let point = m.sync_points.iter().position(|&p| p as i64 == offset);
+            let point = point.map(SyncPointId::new);
             if let (Some(peer), Some(point)) = (peer, point) {
                 let last = robot.sync_arrived.entry((peer, point)).or_insert(0);
                 *last = (*last).max(pass);
@@ -1547,11 +1563,11 @@ impl<'p> Sim<'p> {
     /// `throw E broadcast` (`throw_broadcast`): traced once, the others of
     /// the thrower's group told (the event's name as text, key
     /// `Team.__event`), then caught here as `throw E` is.
-    fn throw_broadcast(&mut self, r: usize, event: &str, messages: &[usize]) {
+    fn throw_broadcast(&mut self, r: usize, event: &str, messages: &[OutgoingId]) {
         let fields = vec![("name", event.into()), ("broadcast", "true".into())];
         self.emit(r, "throw", fields);
         for &message in messages {
-            let (to, key) = self.names[r].outgoing[message].clone();
+            let (to, key) = self.names[r].outgoing[message.index()].clone();
             self.comm_send(r, to, false, key, Some(Value::text(event)));
         }
         self.catch_event(r, event);
@@ -1582,7 +1598,7 @@ impl<'p> Sim<'p> {
             return false;
         };
         self.robots[r].pending_mode = Some(t.to);
-        let mode = m.modes[t.to].name.clone();
+        let mode = m.mode(t.to).name.clone();
         let mut fields = vec![("name", event.into()), ("mode", mode.into())];
         if let Some(from) = from {
             fields.push(("from", from));
@@ -1632,7 +1648,7 @@ impl<'p> Sim<'p> {
         while let Some((peer, event)) = self.robots[r].events.pop_front() {
             let program = self.robots[r].program;
             let name = program.control.events_heard[event].as_str();
-            let from: Rc<str> = program.peers[peer].1.as_str().into();
+            let from: Rc<str> = program.peer(peer).1.as_str().into();
             if !self.catch_event_from(r, name, Some(from.clone())) {
                 let fields = vec![
                     ("from", from),
@@ -1644,19 +1660,15 @@ impl<'p> Sim<'p> {
         }
     }
 
-    fn enter_mode(&mut self, r: usize, mode: usize) {
+    fn enter_mode(&mut self, r: usize, mode: ModeId) {
         let m: &ControlMachine = &self.robots[r].program.control;
         for region in &mut self.robots[r].regions {
             region.service = None;
             region.done = true;
         }
         self.robots[r].current_mode = Some(mode);
-        self.emit(
-            r,
-            "mode",
-            vec![("mode", m.modes[mode].name.as_str().into())],
-        );
-        for (i, region) in m.modes[mode].regions.iter().enumerate() {
+        self.emit(r, "mode", vec![("mode", m.mode(mode).name.as_str().into())]);
+        for (i, region) in m.mode(mode).regions.iter().enumerate() {
             let slot = &mut self.robots[r].regions[i];
             slot.service = Some(region.service);
             slot.plan = region.plan.clone();
@@ -1675,7 +1687,7 @@ impl<'p> Sim<'p> {
             region.pass_start = now;
             let fields = vec![
                 ("plan", region.plan.as_str().into()),
-                ("service", m.services[service].name.as_str().into()),
+                ("service", m.service(service).name.as_str().into()),
             ];
             self.emit(r, "service_start", fields);
         }
@@ -1690,7 +1702,7 @@ impl<'p> Sim<'p> {
             {
                 let fields = vec![
                     ("plan", region.plan.as_str().into()),
-                    ("service", m.services[service].name.as_str().into()),
+                    ("service", m.service(service).name.as_str().into()),
                     ("why", "mode change".into()),
                 ];
                 self.emit(r, "service_end", fields);
@@ -1754,7 +1766,7 @@ impl<'p> Sim<'p> {
                 self.robots[r].regions[i].done = true;
                 let fields = vec![
                     ("plan", plan),
-                    ("service", m.services[service].name.as_str().into()),
+                    ("service", m.service(service).name.as_str().into()),
                     ("why", "timeout".into()),
                 ];
                 self.emit(r, "service_end", fields);
@@ -1781,7 +1793,7 @@ impl<'p> Sim<'p> {
                 region.done = true;
                 let fields = vec![
                     ("plan", region.plan.as_str().into()),
-                    ("service", m.services[service].name.as_str().into()),
+                    ("service", m.service(service).name.as_str().into()),
                 ];
                 self.emit(r, "service_end", fields);
             } else {
@@ -1797,7 +1809,7 @@ impl<'p> Sim<'p> {
         if !running {
             let mode = self.robots[r]
                 .current_mode
-                .map(|c| m.modes[c].name.clone())
+                .map(|c| m.mode(c).name.clone())
                 .unwrap_or_default();
             self.emit(r, "finish", vec![("mode", mode.into())]);
             self.stop(r);
@@ -1856,7 +1868,7 @@ impl<'p> Sim<'p> {
             if region.timeout_ms > 0 {
                 at_least(region.started + region.timeout_ms + 1);
             }
-            let Some(state) = m.services[service].states.get(region.pc) else {
+            let Some(state) = m.service(service).states.get(region.pc) else {
                 continue;
             };
             match &state.kind {
@@ -1872,14 +1884,14 @@ impl<'p> Sim<'p> {
                     if let Some(t) = timeout_ms
                         && region.phase > 0
                     {
-                        at_least(region.marks[*mark] + t + 1);
+                        at_least(region.marks[mark.index()] + t + 1);
                     }
                 }
                 StateKind::LoopTail {
                     period_ms: Some(p),
                     mark,
                     ..
-                } => at_least(region.marks[*mark] + p),
+                } => at_least(region.marks[mark.index()] + p),
                 StateKind::Repeat {
                     period_ms: Some(p), ..
                 } => at_least(region.pass_start + p),
@@ -1916,11 +1928,11 @@ impl<'p> Sim<'p> {
     }
 
     /// One state of region `i`'s service (`service_<n>` of the C).
-    fn step(&mut self, r: usize, i: usize, service: usize) -> Step {
+    fn step(&mut self, r: usize, i: usize, service: ServiceMachineId) -> Step {
         let program: &'p RobotProgram = self.robots[r].program;
         let m = &program.control;
         let pc = self.robots[r].regions[i].pc;
-        let Some(state) = m.services[service].states.get(pc) else {
+        let Some(state) = m.service(service).states.get(pc) else {
             return Step::Done;
         };
         let next = pc + 1;
@@ -1933,17 +1945,17 @@ impl<'p> Sim<'p> {
             } => {
                 if timeout_ms.is_some() && self.robots[r].regions[i].phase == 0 {
                     let region = self.region(r, i);
-                    region.marks[*mark] = now;
+                    region.marks[mark.index()] = now;
                     region.phase = 1;
                 }
                 let ready = messages
                     .iter()
-                    .all(|&k| !self.robots[r].inbox[k].0.is_empty());
+                    .all(|&k| !self.robots[r].inbox[k.index()].0.is_empty());
                 if !ready {
                     let Some(t) = timeout_ms else {
                         return Step::Wait;
                     };
-                    if now - self.robots[r].regions[i].marks[*mark] <= *t {
+                    if now - self.robots[r].regions[i].marks[mark.index()] <= *t {
                         return Step::Wait;
                     }
                     self.emit(r, "timeout", vec![("statement", "receive".into())]);
@@ -1956,9 +1968,9 @@ impl<'p> Sim<'p> {
                     self.region(r, i).phase = 0;
                 }
                 for &k in messages {
-                    if let Some(v) = self.robots[r].inbox[k].0.pop_front() {
-                        self.robots[r].stalled[k] = false;
-                        self.store(r, m.incoming[k].slot, v);
+                    if let Some(v) = self.robots[r].inbox[k.index()].0.pop_front() {
+                        self.robots[r].stalled[k.index()] = false;
+                        self.store(r, m.incoming_message(k).slot, v);
                     }
                 }
                 // Room for a message the receive task holds up.
@@ -1978,17 +1990,17 @@ impl<'p> Sim<'p> {
                     };
                     if let Some(group) = item.own_group {
                         // Its own publication is the latest its subscription sees.
-                        self.robots[r].groups[group] = Some(sent.clone());
+                        self.robots[r].groups[group.index()] = Some(sent.clone());
                     }
-                    let publish = m.outgoing[item.message].publish;
-                    let (to, key) = self.names[r].outgoing[item.message].clone();
+                    let publish = m.outgoing_message(item.message).publish;
+                    let (to, key) = self.names[r].outgoing[item.message.index()].clone();
                     self.comm_send(r, to, publish, key, sent);
                 }
                 self.region(r, i).pc = next;
                 Step::Next
             }
             StateKind::Subscribe { group, slot } => {
-                if let Some(v) = self.robots[r].groups[*group].clone() {
+                if let Some(v) = self.robots[r].groups[group.index()].clone() {
                     self.store(r, *slot, v);
                 }
                 self.region(r, i).pc = next;
@@ -2015,12 +2027,12 @@ impl<'p> Sim<'p> {
                         return Step::Wait;
                     }
                     let region = self.region(r, i);
-                    region.marks[*mark] = now;
+                    region.marks[mark.index()] = now;
                     region.phase = 1;
                     return Step::Wait;
                 }
-                let timed_out =
-                    timeout_ms.is_some_and(|t| now - self.robots[r].regions[i].marks[*mark] > t);
+                let timed_out = timeout_ms
+                    .is_some_and(|t| now - self.robots[r].regions[i].marks[mark.index()] > t);
                 if timed_out {
                     self.stop_task(r, task);
                     self.emit(r, "timeout", vec![("service", service.as_str().into())]);
@@ -2039,7 +2051,7 @@ impl<'p> Sim<'p> {
                 timeout_ms,
                 mark,
             } => {
-                let am = &m.actions[*machine];
+                let am = m.action_machine(*machine);
                 if self.robots[r].regions[i].phase == 0 {
                     for (k, slot) in am.arguments.iter().enumerate() {
                         if let Some(arg) = args.get(k) {
@@ -2050,7 +2062,7 @@ impl<'p> Sim<'p> {
                     let region = self.region(r, i);
                     region.action = am.initial;
                     region.phase = 1;
-                    region.marks[*mark] = now;
+                    region.marks[mark.index()] = now;
                     self.emit(
                         r,
                         "actions_start",
@@ -2058,7 +2070,7 @@ impl<'p> Sim<'p> {
                     );
                 }
                 if let Some(t) = timeout_ms
-                    && now - self.robots[r].regions[i].marks[*mark] > *t
+                    && now - self.robots[r].regions[i].marks[mark.index()] > *t
                 {
                     self.emit(r, "timeout", vec![("service", service.as_str().into())]);
                     let region = self.region(r, i);
@@ -2081,7 +2093,13 @@ impl<'p> Sim<'p> {
                 others_at,
                 receives,
             } => {
-                match self.election(r, (service, pc), candidates, *algorithm, receives) {
+                match self.election(
+                    r,
+                    (service, StateId::new(pc)),
+                    candidates,
+                    *algorithm,
+                    receives,
+                ) {
                     None => Step::Wait, // still listening
                     Some(elected) => {
                         self.region(r, i).pc = if elected { next } else { others_at.index() };
@@ -2099,10 +2117,10 @@ impl<'p> Sim<'p> {
                 let robot = &self.robots[r];
                 let me = program.self_peer;
                 let lost = crate::refine::protocol::lost_after_ms(m.heartbeat_ms);
-                let alive = |peer: usize| {
+                let alive = |peer: PeerId| {
                     peer == me || now - robot.heard.get(peer).seen.max(robot.started_at) <= lost
                 };
-                let live: Vec<usize> = members.iter().copied().filter(|&p| alive(p)).collect();
+                let live: Vec<PeerId> = members.iter().copied().filter(|&p| alive(p)).collect();
                 let position = live.iter().position(|&p| p == me).unwrap_or(0);
                 let mins: Vec<usize> = groups.iter().map(|g| g.min).collect();
                 let chosen = counted_allocation(&mins, others_at.is_some(), position);
@@ -2112,7 +2130,7 @@ impl<'p> Sim<'p> {
                     (None, None) => (OTHERS, "others", next),
                 };
                 let robot = &mut self.robots[r];
-                if robot.allocated.insert((service, pc), key) != Some(key) {
+                if robot.allocated.insert((service, StateId::new(pc)), key) != Some(key) {
                     let fields = vec![
                         ("name", name.into()),
                         ("alive", live.len().to_string().into()),
@@ -2130,18 +2148,21 @@ impl<'p> Sim<'p> {
             } => {
                 if self.robots[r].regions[i].phase == 0 {
                     let robot = &mut self.robots[r];
-                    let pass = robot.sync_pass.entry((service, pc)).or_insert(0);
+                    let pass = robot
+                        .sync_pass
+                        .entry((service, StateId::new(pc)))
+                        .or_insert(0);
                     *pass += 1;
-                    let value = format!("{} {}", m.sync_points[*point], *pass);
+                    let value = format!("{} {}", m.sync_point(*point), *pass);
                     let region = self.region(r, i);
-                    region.marks[*mark] = now;
+                    region.marks[mark.index()] = now;
                     region.phase = 1;
                     let names = &self.names[r];
                     let (team, key) = (names.team.clone(), names.sync_key.clone());
                     self.comm_send(r, team, false, key, Some(Value::text(&value)));
                 }
                 let robot = &self.robots[r];
-                let pass = robot.sync_pass[&(service, pc)];
+                let pass = robot.sync_pass[&(service, StateId::new(pc))];
                 let lost = crate::refine::protocol::lost_after_ms(m.heartbeat_ms);
                 let me = program.self_peer;
                 let waiting = members.iter().any(|&peer| {
@@ -2154,7 +2175,7 @@ impl<'p> Sim<'p> {
                             < pass
                         && now - robot.heard.get(peer).seen <= lost
                 });
-                let started = robot.regions[i].marks[*mark];
+                let started = robot.regions[i].marks[mark.index()];
                 if waiting && now - started <= *timeout_ms {
                     return Step::Wait;
                 }
@@ -2190,7 +2211,7 @@ impl<'p> Sim<'p> {
                     return Step::Next;
                 }
                 let region = self.region(r, i);
-                region.marks[*mark] = now;
+                region.marks[mark.index()] = now;
                 region.pc = next;
                 Step::Next
             }
@@ -2200,7 +2221,7 @@ impl<'p> Sim<'p> {
                 to,
             } => match period_ms {
                 Some(p) => {
-                    if now - self.robots[r].regions[i].marks[*mark] < *p {
+                    if now - self.robots[r].regions[i].marks[mark.index()] < *p {
                         return Step::Wait;
                     }
                     self.region(r, i).pc = to.index();
@@ -2244,7 +2265,7 @@ impl<'p> Sim<'p> {
     /// `actions_<n>`: phase 1 enters the current action (issues its
     /// commands), phase 2 waits for them and takes the first transition that holds.
     fn actions(&mut self, r: usize, i: usize, am: &'p ActionMachine) -> Step {
-        let Some(action) = am.actions.get(self.robots[r].regions[i].action) else {
+        let Some(action) = am.actions.get(self.robots[r].regions[i].action.index()) else {
             return Step::Done;
         };
         if action.is_final {
@@ -2285,18 +2306,18 @@ impl<'p> Sim<'p> {
     /// the channels now, oldest first, as the C's `drop_unled` takes them;
     /// a message the receive task holds up then finds room, as after a
     /// `receive`.
-    fn drop_unled(&mut self, r: usize, messages: &[usize]) {
+    fn drop_unled(&mut self, r: usize, messages: &[IncomingId]) {
         let mut took = false;
         for &k in messages {
             let robot = &mut self.robots[r];
-            let waiting = robot.inbox[k].0.len();
+            let waiting = robot.inbox[k.index()].0.len();
             if waiting == 0 {
                 continue;
             }
-            robot.inbox[k].0.clear();
-            robot.stalled[k] = false;
+            robot.inbox[k.index()].0.clear();
+            robot.stalled[k.index()] = false;
             took = true;
-            let incoming = &robot.program.control.incoming[k];
+            let incoming = robot.program.control.incoming_message(k);
             let (from, key): (Rc<str>, Rc<str>) = (
                 incoming.from_team.as_str().into(),
                 incoming.key.as_str().into(),
@@ -2321,13 +2342,13 @@ impl<'p> Sim<'p> {
     fn election(
         &mut self,
         r: usize,
-        state: (usize, usize),
-        candidates: &[usize],
+        state: (ServiceMachineId, StateId),
+        candidates: &[PeerId],
         algorithm: LeaderAlgorithm,
-        receives: &[usize],
+        receives: &[IncomingId],
     ) -> Option<bool> {
         let me = self.robots[r].program.self_peer;
-        let led = self.robots[r].leaders.get(&state) == Some(&me);
+        let led = self.robots[r].leaders.get(&state) == Some(&Leader::Robot(me));
         let elected = self.elected(r, state, candidates, algorithm);
         if elected == Some(true) && !led {
             self.drop_unled(r, receives);
@@ -2362,8 +2383,8 @@ impl<'p> Sim<'p> {
     fn elected(
         &mut self,
         r: usize,
-        state: (usize, usize),
-        candidates: &[usize],
+        state: (ServiceMachineId, StateId),
+        candidates: &[PeerId],
         algorithm: LeaderAlgorithm,
     ) -> Option<bool> {
         let now = self.now;
@@ -2375,8 +2396,8 @@ impl<'p> Sim<'p> {
         }
         let me = robot.program.self_peer;
         let lost = crate::refine::protocol::lost_after_ms(hb);
-        let alive = |c: usize| c == me || now - robot.heard.get(c).seen <= lost;
-        let level = |c: usize| {
+        let alive = |c: PeerId| c == me || now - robot.heard.get(c).seen <= lost;
+        let level = |c: PeerId| {
             if c == me {
                 own_battery(robot, now)
             } else {
@@ -2389,7 +2410,7 @@ impl<'p> Sim<'p> {
             LeaderAlgorithm::Bully => live.next_back(),
             // The highest level, the first of equals; unknown is lowest.
             LeaderAlgorithm::HighestBattery => {
-                live.fold(None, |best: Option<usize>, c| match best {
+                live.fold(None, |best: Option<PeerId>, c| match best {
                     Some(b) if level(c).unwrap_or(-1) <= level(b).unwrap_or(-1) => Some(b),
                     _ => Some(c),
                 })
@@ -2425,7 +2446,7 @@ impl<'p> Sim<'p> {
             if 2 * heard <= candidates.len() {
                 robot.rejoining = true;
                 robot.fenced = Some(None);
-                if robot.leaders.insert(state, FENCED) != Some(FENCED) {
+                if robot.leaders.insert(state, Leader::Fenced) != Some(Leader::Fenced) {
                     let counted = crate::refine::protocol::fenced_heard(heard, candidates.len());
                     self.emit(r, "fenced", vec![("heard", counted.into())]);
                 }
@@ -2453,9 +2474,9 @@ impl<'p> Sim<'p> {
             robot.term_led = robot.term;
         }
         robot.leading = leader == me;
-        if robot.leaders.get(&state) != Some(&leader) {
-            robot.leaders.insert(state, leader);
-            let name = robot.program.peers[leader].1.clone();
+        if robot.leaders.get(&state) != Some(&Leader::Robot(leader)) {
+            robot.leaders.insert(state, Leader::Robot(leader));
+            let name = robot.program.peer(leader).1.clone();
             self.emit(r, "leader", vec![("leader", name.into())]);
         }
         Some(leader == me)
@@ -2466,9 +2487,24 @@ impl<'p> Sim<'p> {
 /// has this index).
 const OTHERS: usize = usize::MAX;
 
-/// The last leader of an arm whose robot is fenced (`ELECT_FENCED` in the C):
-/// no peer has this index.
-const FENCED: usize = usize::MAX;
+/// The last leader a `LeaderBranch` state saw.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub(super) enum Leader {
+    Robot(PeerId),
+    /// None: this robot is fenced (`ELECT_FENCED` in the C).
+    Fenced,
+}
+
+impl Leader {
+    /// As the exploration fingerprint hashes it: the peer's position, -1
+    /// when fenced (what the `usize::MAX` that stood for it came to).
+    pub(super) fn code(self) -> i64 {
+        match self {
+            Leader::Robot(peer) => peer.index() as i64,
+            Leader::Fenced => -1,
+        }
+    }
+}
 
 /// What each peer's last heartbeat said, kept for the peers of the robot's
 /// team, the only robots whose heartbeats reach it (published to the team
@@ -2478,11 +2514,11 @@ const FENCED: usize = usize::MAX;
 /// time 0, claiming nothing, battery unknown.
 #[derive(Clone, Debug)]
 struct Hearing {
-    /// The peer index of `team[0]`.
+    /// The peer of `team[0]`.
     first: usize,
     team: Vec<Heard>,
-    /// Other peers heard, by peer index.
-    others: Vec<(usize, Heard)>,
+    /// Other peers heard, in peer order.
+    others: Vec<(PeerId, Heard)>,
 }
 
 impl Hearing {
@@ -2494,8 +2530,8 @@ impl Hearing {
         }
     }
 
-    fn get(&self, peer: usize) -> Heard {
-        match self.team.get(peer.wrapping_sub(self.first)) {
+    fn get(&self, peer: PeerId) -> Heard {
+        match self.team.get(peer.index().wrapping_sub(self.first)) {
             Some(heard) => *heard,
             None => self
                 .others
@@ -2504,8 +2540,8 @@ impl Hearing {
         }
     }
 
-    fn set(&mut self, peer: usize, heard: Heard) {
-        if let Some(h) = self.team.get_mut(peer.wrapping_sub(self.first)) {
+    fn set(&mut self, peer: PeerId, heard: Heard) {
+        if let Some(h) = self.team.get_mut(peer.index().wrapping_sub(self.first)) {
             *h = heard;
             return;
         }
@@ -2516,21 +2552,19 @@ impl Hearing {
     }
 
     /// Every peer kept, in peer order (a peer not kept was never heard).
-    fn iter(&self) -> impl Iterator<Item = (usize, Heard)> + '_ {
+    fn iter(&self) -> impl Iterator<Item = (PeerId, Heard)> + '_ {
         let (first, end) = (self.first, self.first + self.team.len());
-        let before = self.others.iter().filter(move |(p, _)| *p < first);
-        let after = self.others.iter().filter(move |(p, _)| *p >= end);
-        before
-            .copied()
-            .chain((first..).zip(self.team.iter().copied()))
-            .chain(after.copied())
+        let before = self.others.iter().filter(move |(p, _)| p.index() < first);
+        let after = self.others.iter().filter(move |(p, _)| p.index() >= end);
+        let team = (first..).map(PeerId::new).zip(self.team.iter().copied());
+        before.copied().chain(team).chain(after.copied())
     }
 }
 
 /// The peers of `program`'s team: its run of peers (teams are in
 /// formation order), found from its own place.
 fn team_peers(program: &RobotProgram) -> std::ops::Range<usize> {
-    let (peers, me) = (&program.peers, program.self_peer);
+    let (peers, me) = (&program.peers, program.self_peer.index());
     let same = |p: &usize| peers[*p].0 == program.team;
     let start = (0..me).rev().take_while(same).last().unwrap_or(me);
     let end = (me..peers.len())
@@ -2604,12 +2638,12 @@ impl Sim<'_> {
         }
         let me = robot.program.self_peer;
         let now = self.now;
-        let alive = |peer: usize| {
+        let alive = |peer: PeerId| {
             peer == me
                 || now - robot.heard.get(peer).seen.max(robot.started_at)
                     <= crate::refine::protocol::lost_after_ms(m.heartbeat_ms)
         };
-        let live: Vec<usize> = m.group.iter().copied().filter(|&p| alive(p)).collect();
+        let live: Vec<PeerId> = m.group.iter().copied().filter(|&p| alive(p)).collect();
         let rank = live.iter().position(|&p| p == me).unwrap_or(0);
         let now_group = (rank, live.len());
         if self.robots[r].group == Some(now_group) {

@@ -2,7 +2,7 @@
 //! the generated C programs, faults, determinism, and scenario mistakes.
 
 use super::*;
-use crate::refine::RobotProgram;
+use crate::refine::{RobotProgram, ServiceMachineId, StateId};
 use std::path::Path;
 
 fn repo(path: &str) -> std::path::PathBuf {
@@ -736,7 +736,12 @@ fn pairs(list: &[(&str, &str)]) -> Vec<(String, String)> {
 #[test]
 fn group_service_members_learn_rank_and_size() {
     let programs = programs("tests/fixtures/group_service/sweep.mission");
-    assert!(programs.iter().all(|p| p.control.group == [0, 1, 2]));
+    let peers = crate::refine::PeerId::all(3);
+    assert!(
+        programs
+            .iter()
+            .all(|p| p.control.group.iter().copied().eq(peers.clone()))
+    );
     let (run_, _) = run(&programs, r#"{"duration": 1000}"#, 0);
     for (i, robot) in ["tb_0", "tb_1", "tb_2"].into_iter().enumerate() {
         let rank = i.to_string();
@@ -1212,12 +1217,14 @@ fn a_throw_that_ends_the_mode_before_a_later_plan_sends_is_noted_as_a_race() {
             .iter()
             .map(|race| {
                 let m = &programs[race.robot].control;
-                let state = |(s, pc): (usize, usize)| m.services[s].states[pc].text.clone();
+                let state = |(s, pc): (ServiceMachineId, StateId)| {
+                    m.service(s).states[pc.index()].text.clone()
+                };
                 format!(
                     "{} at {} in {}: {} before {}",
                     programs[race.robot].robot,
                     race.at,
-                    m.modes[race.mode].name,
+                    m.mode(race.mode).name,
                     state(race.thrower),
                     state(race.lost)
                 )

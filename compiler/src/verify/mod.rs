@@ -30,7 +30,7 @@ pub use properties::{MAX_PROPERTIES, Outcome, Property, properties_of};
 pub use search::{apply, choices};
 
 use crate::diag::{Code, Diagnostic, FileId};
-use crate::refine::{RobotProgram, SENSOR_PERIOD_MS};
+use crate::refine::{RobotProgram, SENSOR_PERIOD_MS, ServiceMachineId, StateId};
 use crate::span::Span;
 use crate::text::LineIndex;
 use std::collections::HashSet;
@@ -196,8 +196,8 @@ pub enum Claim {
     /// state `state` of service `service`.
     WaitsForEver {
         robot: usize,
-        service: usize,
-        state: usize,
+        service: ServiceMachineId,
+        state: StateId,
     },
     /// At the counterexample's end, robots `robots` (indices into the
     /// programs) of `team` both lead the `leader(...)` statement at `line`.
@@ -211,8 +211,8 @@ pub enum Claim {
     /// throw at `lost` would have run.
     Race {
         robot: usize,
-        thrower: (usize, usize),
-        lost: (usize, usize),
+        thrower: (ServiceMachineId, StateId),
+        lost: (ServiceMachineId, StateId),
     },
 }
 
@@ -369,7 +369,7 @@ pub fn verify_expecting(
     }
     for ((r, service, state), way) in &explored.waits_for_ever {
         let program = &programs[*r];
-        let statement = &program.control.services[*service].states[*state];
+        let statement = &program.control.service(*service).states[state.index()];
         findings.push(Diagnostic::new(
             Code::WaitsForEver,
             file,
@@ -413,15 +413,15 @@ pub fn verify_expecting(
     for (race, way) in &explored.races {
         let program = &programs[race.robot];
         let m = &program.control;
-        let plan = |service: usize| {
-            m.modes[race.mode]
+        let plan = |service: ServiceMachineId| {
+            m.mode(race.mode)
                 .regions
                 .iter()
                 .find(|region| region.service == service)
-                .map_or_else(|| m.services[service].name.clone(), |r| r.plan.clone())
+                .map_or_else(|| m.service(service).name.clone(), |r| r.plan.clone())
         };
-        let thrower = &m.services[race.thrower.0].states[race.thrower.1];
-        let lost = &m.services[race.lost.0].states[race.lost.1];
+        let thrower = &m.service(race.thrower.0).states[race.thrower.1.index()];
+        let lost = &m.service(race.lost.0).states[race.lost.1.index()];
         let mut finding = Diagnostic::new(
             Code::PlansRace,
             file,
@@ -431,7 +431,7 @@ pub fn verify_expecting(
                 race.at,
                 program.robot,
                 plan(race.thrower.0),
-                m.modes[race.mode].name,
+                m.mode(race.mode).name,
                 plan(race.lost.0),
                 lost.text.trim(),
                 lost.line,

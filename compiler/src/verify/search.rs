@@ -9,7 +9,7 @@
 use super::inputs::Inputs;
 use super::properties::{self, Label, Outcome, Property};
 use super::{Choice, Counterexample, Options, World};
-use crate::refine::RobotProgram;
+use crate::refine::{RobotProgram, ServiceMachineId, StateId};
 use crate::sim::{self, Memory, Race, Scenario, Sim};
 use std::collections::{HashMap, HashSet};
 
@@ -36,7 +36,7 @@ pub struct Explored {
     /// Per `receive` (robot, service, state) that a robot can reach and
     /// then wait in for ever, whatever the world does (only when
     /// exhaustive): the shortest way there.
-    pub waits_for_ever: Vec<((usize, usize, usize), Counterexample)>,
+    pub waits_for_ever: Vec<((usize, ServiceMachineId, StateId), Counterexample)>,
     /// Per `leader(...)` statement (team, mission line) that two robots
     /// lead at once in some state: the two, and the shortest way there.
     /// A state seen is a witness: judged bounded or not.
@@ -54,7 +54,7 @@ pub struct Explored {
 pub type TwoLeaders = ((String, u32), (usize, usize), Counterexample);
 
 /// A (service, state) of a robot's program.
-type StateAt = (usize, usize);
+type StateAt = (ServiceMachineId, StateId);
 
 struct Node {
     parent: Option<u32>,
@@ -168,8 +168,8 @@ pub fn explore(
                 let trace = child.take_trace();
                 let label = judge.label(&nodes[id as usize], &trace);
                 for race in child.take_races() {
-                    let statement = |(service, state): (usize, usize)| {
-                        programs[race.robot].control.services[service].states[state]
+                    let statement = |(service, state): StateAt| {
+                        programs[race.robot].control.service(service).states[state.index()]
                             .span
                             .start as u32
                     };
@@ -293,16 +293,12 @@ impl Leaders {
         let statements = programs
             .iter()
             .map(|p| {
-                let lines = p
-                    .control
-                    .services
-                    .iter()
-                    .enumerate()
+                let services = &p.control.services;
+                let lines = ServiceMachineId::all(services.len())
+                    .zip(services)
                     .flat_map(|(s, service)| {
-                        service
-                            .states
-                            .iter()
-                            .enumerate()
+                        StateId::all(service.states.len())
+                            .zip(&service.states)
                             .filter_map(move |(pc, state)| {
                                 matches!(state.kind, crate::refine::StateKind::LeaderBranch { .. })
                                     .then_some(((s, pc), state.line))
@@ -363,13 +359,15 @@ fn admit(
         .map(|r| !sim.is_running(r) && !world.down[r])
         .collect();
     let modes = robots
-        .map(|r| sim.mode_of(r).and_then(|m| u16::try_from(m).ok()))
+        .map(|r| sim.mode_of(r).and_then(|m| u16::try_from(m.index()).ok()))
         .collect();
     let waiting = (0..sim.robot_count())
         .flat_map(|r| {
             sim.waiting_receives(r)
                 .into_iter()
-                .map(move |(service, state)| (r as u32, service as u32, state as u32))
+                .map(move |(service, state)| {
+                    (r as u32, service.index() as u32, state.index() as u32)
+                })
         })
         .collect();
     nodes.push(Node {
@@ -630,7 +628,7 @@ impl Graph<'_> {
 
     /// Per `receive` a robot waits in in some state: the first state (the
     /// shallowest) from which it waits there for ever, if any.
-    fn waits_for_ever(&self) -> Vec<((usize, usize, usize), Counterexample)> {
+    fn waits_for_ever(&self) -> Vec<((usize, ServiceMachineId, StateId), Counterexample)> {
         let mut receives: Vec<(u32, u32, u32)> = self
             .nodes
             .iter()
@@ -645,7 +643,10 @@ impl Graph<'_> {
             // `receive` and back between two looks).
             let leaves = self.can_reach(|n| !n.waiting.contains(&w) || n.moved.contains(&w.0));
             if let Some(n) = leaves.iter().position(|l| !l) {
-                found.push(((w.0 as usize, w.1 as usize, w.2 as usize), self.way_to(n)));
+                // Packed from `Sim::waiting_receives` in `admit`.
+                let (service, state) = (w.1 as usize, w.2 as usize);
+                let at = (ServiceMachineId::new(service), StateId::new(state));
+                found.push(((w.0 as usize, at.0, at.1), self.way_to(n)));
             }
         }
         found

@@ -24,8 +24,8 @@ use super::{Builder, implementing_task};
 use crate::catalog::Implementation;
 use crate::diag::{Code, Related};
 use crate::refine::program::{
-    GraphChannel, GraphRefused, GraphService, GraphStep, InnerTask, LoopPort, PortUse, StateKind,
-    SubgraphPort,
+    GraphChannel, GraphChannelId, GraphRefused, GraphService, GraphStep, InnerTask, InnerTaskId,
+    LoopPort, PortUse, StateKind, SubgraphPort,
 };
 use crate::span::Span;
 use crate::taskgraph::TaskGraph;
@@ -250,7 +250,7 @@ struct Opener<'l, 'g> {
     stands_for: Vec<Option<(&'g Task, &'g [PortLink])>>,
     channels: Vec<GraphChannel>,
     /// (task path below the graph, port, side) → the channels joining it.
-    ends: HashMap<(String, String, Side), Vec<usize>>,
+    ends: HashMap<(String, String, Side), Vec<GraphChannelId>>,
     tasks: Vec<InnerTask>,
 }
 
@@ -317,7 +317,7 @@ impl Opener<'_, '_> {
                     false => (inner, outer),
                 }
             };
-            let channel = self.channels.len();
+            let channel = GraphChannelId::new(self.channels.len());
             self.channels.push(GraphChannel {
                 label: if at.is_empty() {
                     edge.label.clone()
@@ -349,7 +349,7 @@ impl Opener<'_, '_> {
     }
 
     /// The one channel joining `path`'s `port` on `side`, if any.
-    fn end(&self, path: &str, port: &str, side: Side) -> Result<Option<usize>, String> {
+    fn end(&self, path: &str, port: &str, side: Side) -> Result<Option<GraphChannelId>, String> {
         match self
             .ends
             .get(&(path.to_string(), port.to_string(), side))
@@ -365,9 +365,9 @@ impl Opener<'_, '_> {
 
     /// The index of inner task `path` in [`Opened::tasks`], listed at its
     /// first firing.
-    fn inner_task(&mut self, path: &str, task: &Task) -> Result<usize, String> {
+    fn inner_task(&mut self, path: &str, task: &Task) -> Result<InnerTaskId, String> {
         if let Some(index) = self.tasks.iter().position(|t| t.path == path) {
-            return Ok(index);
+            return Ok(InnerTaskId::new(index));
         }
         let mut inputs = Vec::new();
         let mut outputs = Vec::new();
@@ -403,7 +403,7 @@ impl Opener<'_, '_> {
             outputs,
             period_ms,
         });
-        Ok(self.tasks.len() - 1)
+        Ok(InnerTaskId::new(self.tasks.len() - 1))
     }
 
     /// The ports of task `path` standing for a sub-graph that a channel
@@ -556,7 +556,7 @@ impl Opener<'_, '_> {
                                                 "has exit task `{exit}` that its loop never fires"
                                             )
                                         })?;
-                                    Some(index)
+                                    Some(InnerTaskId::new(index))
                                 }
                             };
                             let looped = GraphStep::Loop {

@@ -11,8 +11,8 @@
 //! receives them.
 
 use super::super::program::{
-    ControlMachine, GlobalValue, HEARTBEAT_MS, OwnerRule, Ownership, RobotProgram, SharedLibrary,
-    SlotSource,
+    AttributeId, ControlMachine, GlobalValue, HEARTBEAT_MS, OwnerRule, Ownership, PeerId,
+    RobotProgram, SharedLibrary, SlotSource,
 };
 use super::super::value::ValueKind;
 use crate::diag::{Code, Diagnostic};
@@ -43,20 +43,21 @@ pub(super) fn library(
         return None;
     }
     let own = format!("{}.", team.name);
-    let global: Vec<GlobalValue> = attributes
-        .iter()
-        .enumerate()
+    let global: Vec<GlobalValue> = AttributeId::all(attributes.len())
+        .zip(&attributes)
         .filter(|(_, key)| key.starts_with(&own) && !machine.subscribed.contains(key))
         .map(|(at, key)| GlobalValue {
             at,
-            kind: kinds[at].clone(),
+            kind: kinds[at.index()].clone(),
             set_key: set_key(&team.name, key),
             value_key: value_key(&team.name, key),
         })
         .collect();
     let ownership = (team.robots.len() > 1 && !global.is_empty()).then(|| Ownership {
         global,
-        owners: (first_peer..first_peer + team.robots.len()).collect(),
+        owners: (first_peer..first_peer + team.robots.len())
+            .map(PeerId::new)
+            .collect(),
         rule: OwnerRule::Leader(leader),
     });
     if ownership.is_some() && !machine.heartbeat {
@@ -84,7 +85,7 @@ pub(in crate::refine) fn owners_of_team(
     strategies: &[Strategy],
 ) -> Vec<Diagnostic> {
     let team_programs = || programs.iter().filter(|p| p.team == team);
-    let sharing: Vec<usize> = team_programs()
+    let sharing: Vec<PeerId> = team_programs()
         .filter(|p| p.library.as_ref().is_some_and(|l| l.ownership.is_some()))
         .map(|p| p.self_peer)
         .collect();

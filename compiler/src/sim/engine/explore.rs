@@ -16,7 +16,9 @@
 
 use super::{Event, Held, Message, Queued, Robot, SENSOR_PERIOD_MS, Sim};
 use crate::refine::value::Value;
-use crate::refine::{RobotProgram, ServiceMachine, SlotSource, StateKind};
+use crate::refine::{
+    ModeId, RobotProgram, ServiceMachine, ServiceMachineId, SlotSource, StateId, StateKind,
+};
 use crate::sim::scenario::Command;
 use crate::sim::trace::TraceEvent;
 
@@ -97,20 +99,21 @@ impl<'p> Sim<'p> {
 
     /// The `receive` states robot `r` waits in: (service, state) of each
     /// region of its mode that is at one and has not taken its messages.
-    pub fn waiting_receives(&self, r: usize) -> Vec<(usize, usize)> {
+    pub fn waiting_receives(&self, r: usize) -> Vec<(ServiceMachineId, StateId)> {
         let robot = &self.robots[r];
         if !robot.alive {
             return Vec::new();
         }
-        let services = &robot.program.control.services;
+        let m = &robot.program.control;
         robot
             .regions
             .iter()
             .filter(|region| !region.done)
             .filter_map(|region| {
                 let s = region.service?;
-                let state = services[s].states.get(region.pc)?;
-                matches!(state.kind, StateKind::Receive { .. }).then_some((s, region.pc))
+                let state = m.service(s).states.get(region.pc)?;
+                matches!(state.kind, StateKind::Receive { .. })
+                    .then_some((s, StateId::new(region.pc)))
             })
             .collect()
     }
@@ -134,16 +137,16 @@ impl<'p> Sim<'p> {
 
     /// The `leader(...)` statements robot `r` leads now, as (service,
     /// state) of its program: it runs and its last election there chose it.
-    pub fn leads(&self, r: usize) -> Vec<(usize, usize)> {
+    pub fn leads(&self, r: usize) -> Vec<(ServiceMachineId, StateId)> {
         let robot = &self.robots[r];
         if !robot.alive {
             return Vec::new();
         }
         let me = robot.program.self_peer;
-        let mut led: Vec<(usize, usize)> = robot
+        let mut led: Vec<(ServiceMachineId, StateId)> = robot
             .leaders
             .iter()
-            .filter(|(_, leader)| **leader == me)
+            .filter(|(_, leader)| **leader == super::Leader::Robot(me))
             .map(|(state, _)| *state)
             .collect();
         led.sort_unstable();
@@ -151,7 +154,7 @@ impl<'p> Sim<'p> {
     }
 
     /// The mode robot `r` is in: an index into its program's modes.
-    pub fn mode_of(&self, r: usize) -> Option<usize> {
+    pub fn mode_of(&self, r: usize) -> Option<ModeId> {
         self.robots[r].current_mode
     }
 
@@ -415,7 +418,7 @@ impl Fingerprint {
         self.int(m.publish as i64);
         self.text(&m.from_team);
         self.text(&m.from_robot);
-        self.int(m.from_peer.map_or(-1, |p| p as i64));
+        self.int(m.from_peer.map_or(-1, |p| p.index() as i64));
         self.text(&m.key);
         self.held(&m.value);
         self.time(m.sent_at);
@@ -434,7 +437,7 @@ impl Fingerprint {
         for v in robot.slots.iter().chain(&robot.library) {
             self.held(v);
         }
-        self.int(robot.owner as i64);
+        self.int(robot.owner.index() as i64);
         for (queue, _) in &robot.inbox {
             self.int(queue.len() as i64);
             for v in queue {
@@ -466,10 +469,10 @@ impl Fingerprint {
             }
         }
         for region in &robot.regions {
-            self.int(region.service.map_or(-1, |s| s as i64));
+            self.int(region.service.map_or(-1, |s| s.index() as i64));
             self.int(region.pc as i64);
             self.int(region.phase as i64);
-            self.int(region.action as i64);
+            self.int(region.action.index() as i64);
             self.int(region.done as i64);
             // A time only a period or a timeout reads: otherwise when a
             // pass started changes nothing, and hashing it would tell apart
@@ -477,7 +480,7 @@ impl Fingerprint {
             if region.timeout_ms > 0 {
                 self.time(region.started);
             }
-            let timed = region.service.map(|s| timed[s]).unwrap_or_default();
+            let timed = region.service.map(|s| timed[s.index()]).unwrap_or_default();
             if timed.pass {
                 self.time(region.pass_start);
             }
@@ -489,16 +492,16 @@ impl Fingerprint {
             }
             self.text(&region.plan);
         }
-        self.int(robot.current_mode.map_or(-1, |m| m as i64));
-        self.int(robot.pending_mode.map_or(-1, |m| m as i64));
+        self.int(robot.current_mode.map_or(-1, |m| m.index() as i64));
+        self.int(robot.pending_mode.map_or(-1, |m| m.index() as i64));
         self.int(robot.events.len() as i64);
         for &(peer, event) in &robot.events {
-            self.int(peer as i64);
+            self.int(peer.index() as i64);
             self.int(event as i64);
         }
         self.time(robot.last_heartbeat);
         for (peer, h) in robot.heard.iter() {
-            self.int(peer as i64);
+            self.int(peer.index() as i64);
             self.time(h.seen);
             self.int(h.leads as i64);
             self.int(h.battery.unwrap_or(i64::MIN));
@@ -513,23 +516,29 @@ impl Fingerprint {
             Some(None) => self.int(-2),
             Some(Some(t)) => self.time(t),
         }
-        for map in [&robot.sync_pass, &robot.sync_arrived] {
-            let mut entries: Vec<_> = map.iter().collect();
+        // A sync state by its positions, as a (peer, point) is.
+        let passes = robot.sync_pass.iter();
+        let passes = passes.map(|(&(s, pc), &v)| ((s.index(), pc.index()), v));
+        let arrived = robot.sync_arrived.iter();
+        let arrived = arrived.map(|(&(peer, point), &v)| ((peer.index(), point.index()), v));
+        for mut entries in [passes.collect::<Vec<_>>(), arrived.collect()] {
             entries.sort_unstable();
             for ((a, b), v) in entries {
-                self.int(*a as i64);
-                self.int(*b as i64);
-                self.int(*v);
+                self.int(a as i64);
+                self.int(b as i64);
+                self.int(v);
             }
         }
-        for map in [&robot.leaders, &robot.allocated] {
-            let mut entries: Vec<_> = map.iter().collect();
+        // A leader as its code: a peer's position, or -1 when fenced.
+        let leaders = robot.leaders.iter().map(|(&at, &v)| (at, v.code()));
+        let allocated = robot.allocated.iter().map(|(&at, &v)| (at, v as i64));
+        for mut entries in [leaders.collect::<Vec<_>>(), allocated.collect()] {
             entries.sort_unstable();
             self.int(entries.len() as i64);
             for ((a, b), v) in entries {
-                self.int(*a as i64);
-                self.int(*b as i64);
-                self.int(*v as i64);
+                self.int(a.index() as i64);
+                self.int(b.index() as i64);
+                self.int(v);
             }
         }
         match robot.group {

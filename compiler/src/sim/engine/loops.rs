@@ -28,7 +28,7 @@
 
 use super::{Event, Sim};
 use crate::refine::protocol::GRAPH_TEXT_MAX;
-use crate::refine::{GraphService, GraphStep, LoopPort};
+use crate::refine::{GraphChannelId, GraphService, GraphStep, InnerTaskId, LoopPort};
 use crate::sim::trace::TraceEvent;
 use std::collections::{HashMap, VecDeque};
 use std::rc::Rc;
@@ -39,7 +39,7 @@ use std::rc::Rc;
 #[derive(Clone, Debug, Default)]
 pub(super) struct GraphState {
     channels: HashMap<String, Vec<VecDeque<i64>>>,
-    starts: HashMap<(String, usize), i64>,
+    starts: HashMap<(String, InnerTaskId), i64>,
     due: VecDeque<TraceEvent>,
 }
 
@@ -56,7 +56,8 @@ impl GraphState {
         let mut starts: Vec<_> = self
             .starts
             .iter()
-            .map(|(k, t)| (k.clone(), t - now))
+            // By position, as before the index was typed: the same text.
+            .map(|((task, inner), t)| ((task.clone(), inner.index()), t - now))
             .collect();
         starts.sort_unstable();
         let due: Vec<_> = self
@@ -156,8 +157,7 @@ struct GraphRun<'s, 'p> {
 
 /// The innermost convergent loop: its exit task, iteration and flag.
 struct Exit {
-    /// An index in the service's tasks.
-    task: usize,
+    task: InnerTaskId,
     iteration: u64,
     at: u64,
     flag: bool,
@@ -208,8 +208,8 @@ impl GraphRun<'_, '_> {
         }
     }
 
-    fn broken(&mut self, channel: usize, what: &str) -> Broken {
-        let label = self.service.channels[channel].label.as_str();
+    fn broken(&mut self, channel: GraphChannelId, what: &str) -> Broken {
+        let label = self.service.channels[channel.index()].label.as_str();
         let fields = vec![
             ("graph", self.graph.clone()),
             ("channel", Rc::from(label)),
@@ -219,9 +219,9 @@ impl GraphRun<'_, '_> {
         Broken
     }
 
-    fn take(&mut self, channel: usize, n: u64, into: &mut Vec<i64>) -> Result<(), Broken> {
+    fn take(&mut self, channel: GraphChannelId, n: u64, into: &mut Vec<i64>) -> Result<(), Broken> {
         for _ in 0..n {
-            match self.channels[channel].pop_front() {
+            match self.channels[channel.index()].pop_front() {
                 Some(token) => into.push(token),
                 None => return Err(self.broken(channel, "is empty")),
             }
@@ -229,22 +229,22 @@ impl GraphRun<'_, '_> {
         Ok(())
     }
 
-    fn put(&mut self, channel: usize, tokens: &[i64]) -> Result<(), Broken> {
-        let capacity = self.service.channels[channel].capacity as usize;
+    fn put(&mut self, channel: GraphChannelId, tokens: &[i64]) -> Result<(), Broken> {
+        let capacity = self.service.channels[channel.index()].capacity as usize;
         for &token in tokens {
-            if self.channels[channel].len() >= capacity {
+            if self.channels[channel.index()].len() >= capacity {
                 return Err(self.broken(channel, "is full"));
             }
-            self.channels[channel].push_back(token);
+            self.channels[channel.index()].push_back(token);
         }
         Ok(())
     }
 
-    fn fire(&mut self, index: usize) -> Result<(), Broken> {
+    fn fire(&mut self, index: InnerTaskId) -> Result<(), Broken> {
         let service = self.service;
         // Refinement lists every task it fires (code generation checks it,
         // `codegen::loops::check`).
-        let Some(task) = service.tasks.get(index) else {
+        let Some(task) = service.tasks.get(index.index()) else {
             return Ok(());
         };
         let path = task.path.as_str();
@@ -398,7 +398,12 @@ impl GraphRun<'_, '_> {
 
     /// `n` tokens from channel `from` to `to`, one at a time as the
     /// generated `graph_move` moves them.
-    fn move_tokens(&mut self, from: usize, to: usize, n: u64) -> Result<(), Broken> {
+    fn move_tokens(
+        &mut self,
+        from: GraphChannelId,
+        to: GraphChannelId,
+        n: u64,
+    ) -> Result<(), Broken> {
         for _ in 0..n {
             let mut token = Vec::with_capacity(1);
             self.take(from, 1, &mut token)?;

@@ -15,7 +15,7 @@
 //! on the way is the race. The run itself is not changed.
 
 use super::{STEPS_PER_FIRING, Sim, Step};
-use crate::refine::StateKind;
+use crate::refine::{ModeId, ServiceMachineId, StateId, StateKind};
 
 /// A plan's caught `throw` ended the mode in an instant in which a later
 /// plan of the mode would have sent a message or thrown a caught event.
@@ -25,12 +25,12 @@ pub struct Race {
     pub robot: usize,
     /// Mission ms of the instant.
     pub at: i64,
-    /// The mode that ended (an index into the robot's modes).
-    pub mode: usize,
+    /// The mode that ended.
+    pub mode: ModeId,
     /// (service, state) of the throw that ended it.
-    pub thrower: (usize, usize),
+    pub thrower: (ServiceMachineId, StateId),
     /// (service, state) of the send or throw that did not happen.
-    pub lost: (usize, usize),
+    pub lost: (ServiceMachineId, StateId),
 }
 
 impl Sim<'_> {
@@ -68,7 +68,7 @@ impl Sim<'_> {
         // which the team does not act on. Or a throw the mode catches.
         let acts = |state: &crate::refine::State| match &state.kind {
             StateKind::Send { items } => items.iter().any(|item| {
-                let message = &m.outgoing[item.message];
+                let message = m.outgoing_message(item.message);
                 !message.publish && message.to_team != "USER"
             }),
             StateKind::Throw { event, .. } => caught(event),
@@ -83,7 +83,7 @@ impl Sim<'_> {
             let timed_out = region.timeout_ms > 0 && self.now - region.started > region.timeout_ms;
             // Copying the fleet's state costs in proportion to the fleet:
             // only for a plan whose service can act at all.
-            if region.done || timed_out || !m.services[service].states.iter().any(acts) {
+            if region.done || timed_out || !m.service(service).states.iter().any(acts) {
                 continue;
             }
             // The plan's turn as it would have come without the throw.
@@ -92,7 +92,7 @@ impl Sim<'_> {
             alone.robots[r].pending_mode = None;
             for _ in 0..STEPS_PER_FIRING {
                 let pc = alone.robots[r].regions[j].pc;
-                let Some(state) = m.services[service].states.get(pc) else {
+                let Some(state) = m.service(service).states.get(pc) else {
                     break;
                 };
                 let acting = acts(state);
@@ -104,8 +104,8 @@ impl Sim<'_> {
                         robot: r,
                         at: self.now,
                         mode,
-                        thrower: (thrower_service, thrower_state),
-                        lost: (service, pc),
+                        thrower: (thrower_service, StateId::new(thrower_state)),
+                        lost: (service, StateId::new(pc)),
                     });
                     break;
                 }

@@ -6,13 +6,13 @@
 //! the owner order, which tells the team the values it last saw.
 
 use super::{Held, Message, Sim};
-use crate::refine::GlobalValue;
+use crate::refine::{AttributeId, GlobalValue, PeerId};
 use std::rc::Rc;
 
 impl Sim<'_> {
     /// The global value of library place `at`, if it is one: (its index in
     /// the ownership, the value).
-    fn global_at(&self, r: usize, at: usize) -> Option<(usize, &GlobalValue)> {
+    fn global_at(&self, r: usize, at: AttributeId) -> Option<(usize, &GlobalValue)> {
         let ownership = self.robots[r]
             .program
             .library
@@ -30,14 +30,14 @@ impl Sim<'_> {
     /// from within `lost_after_ms`); a lost one is followed by the first
     /// live robot of the owner order. A change is traced; a robot that
     /// becomes the owner tells the team the values it last saw.
-    pub(super) fn current_owner(&mut self, r: usize) -> usize {
+    pub(super) fn current_owner(&mut self, r: usize) -> PeerId {
         let robot = &self.robots[r];
         let program = robot.program;
         let Some(ownership) = program.library.as_ref().and_then(|l| l.ownership.as_ref()) else {
             return program.self_peer;
         };
         let lost_after = crate::refine::protocol::lost_after_ms(program.control.heartbeat_ms);
-        let lives = |peer: usize| {
+        let lives = |peer: PeerId| {
             peer == program.self_peer || self.now - robot.heard.get(peer).seen <= lost_after
         };
         let was = robot.owner;
@@ -47,7 +47,7 @@ impl Sim<'_> {
         // The first live robot of the order, or by `highest_battery` the
         // live one with the highest level its heartbeat said (the first of
         // equals; unknown counts lowest; its own level for itself).
-        let level = |peer: usize| {
+        let level = |peer: PeerId| {
             if peer == program.self_peer {
                 super::own_battery(robot, self.now)
             } else {
@@ -57,7 +57,7 @@ impl Sim<'_> {
         };
         let mut live = ownership.owners.iter().copied().filter(|&c| lives(c));
         let chosen = if ownership.rule.by_battery() {
-            live.fold(None, |best: Option<usize>, c| match best {
+            live.fold(None, |best: Option<PeerId>, c| match best {
                 Some(b) if level(c) <= level(b) => Some(b),
                 _ => Some(c),
             })
@@ -72,13 +72,13 @@ impl Sim<'_> {
         let library: Rc<str> = program.library.as_ref().map_or("", |l| &l.name).into();
         let fields = vec![
             ("library", library),
-            ("owner", program.peers[next].1.as_str().into()),
-            ("lost", program.peers[was].1.as_str().into()),
+            ("owner", program.peer(next).1.as_str().into()),
+            ("lost", program.peer(was).1.as_str().into()),
         ];
         self.emit(r, "shared_owner", fields);
         if next == program.self_peer {
             for (k, g) in ownership.global.iter().enumerate() {
-                let value = self.robots[r].library[g.at].clone();
+                let value = self.robots[r].library[g.at.index()].clone();
                 if value.is_some() {
                     self.tell(r, k, next, value);
                 }
@@ -102,7 +102,7 @@ impl Sim<'_> {
 
     /// `tell`: a write of global value `k` to the owner `to`, or to the team
     /// when this robot owns it.
-    fn tell(&mut self, r: usize, k: usize, to: usize, value: Held) {
+    fn tell(&mut self, r: usize, k: usize, to: PeerId, value: Held) {
         let program = self.robots[r].program;
         let Some(g) = program
             .library
@@ -116,14 +116,14 @@ impl Sim<'_> {
             let team = self.names[r].team.clone();
             self.comm_send(r, team, false, g.value_key.as_str().into(), value);
         } else {
-            let owner: Rc<str> = program.peers[to].1.as_str().into();
+            let owner: Rc<str> = program.peer(to).1.as_str().into();
             self.comm_send(r, owner, false, g.set_key.as_str().into(), value);
         }
     }
 
     /// The setter of library place `at` after the value is stored: a global
     /// value's write is traced and told to its owner (or the team).
-    pub(super) fn shared_set(&mut self, r: usize, at: usize, value: &Held) {
+    pub(super) fn shared_set(&mut self, r: usize, at: AttributeId, value: &Held) {
         let Some((k, g)) = self.global_at(r, at) else {
             return;
         };
@@ -131,7 +131,7 @@ impl Sim<'_> {
             .program
             .library
             .as_ref()
-            .map_or("", |l| &l.attributes[g.at])
+            .map_or("", |l| l.attribute(g.at))
             .into();
         let to = self.current_owner(r);
         let program = self.robots[r].program;
@@ -139,7 +139,7 @@ impl Sim<'_> {
             t: self.now,
             robot: r,
             event: "shared_set",
-            fields: vec![("key", key), ("owner", program.peers[to].1.as_str().into())],
+            fields: vec![("key", key), ("owner", program.peer(to).1.as_str().into())],
             value: Some(("value", value.clone())),
             sent_at: None,
         });
@@ -179,7 +179,7 @@ impl Sim<'_> {
             self.emit(r, "reject", fields);
             return true;
         };
-        let key: Rc<str> = lib.attributes[g.at].as_str().into();
+        let key: Rc<str> = lib.attribute(g.at).into();
         if set {
             let to = self.current_owner(r);
             if to != program.self_peer {
@@ -190,7 +190,7 @@ impl Sim<'_> {
                 self.emit(r, "reject", fields);
                 return true;
             }
-            self.robots[r].library[g.at].clone_from(&value);
+            self.robots[r].library[g.at.index()].clone_from(&value);
             self.robots[r].library_written = true;
             self.trace.push(super::TraceEvent {
                 t: self.now,
@@ -206,7 +206,7 @@ impl Sim<'_> {
             });
             self.tell(r, k, to, value);
         } else {
-            self.robots[r].library[g.at].clone_from(&value);
+            self.robots[r].library[g.at.index()].clone_from(&value);
             self.robots[r].library_written = true;
             self.trace.push(super::TraceEvent {
                 t: self.now,
