@@ -8,7 +8,7 @@
 
 use super::{Content, contents, copy_example, generated_folders, hash, leftovers, rename_save};
 use super::{Pauses, build, build_paused, scratch};
-use crate::support::swap::swapper;
+use crate::support::swap::{clear_set_aside, swapper};
 use std::collections::BTreeMap;
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -398,15 +398,7 @@ fn links_swapped_during_builds(name: &str, what: Swapped, builds: usize) -> Swap
         counts.outside += written.len();
         // Back to a clean output folder for the next build: what the build
         // made where a folder was for a moment, and any edit, go.
-        for entry in std::fs::read_dir(real.parent().unwrap()).unwrap() {
-            let path = entry.unwrap().path();
-            if path
-                .extension()
-                .is_some_and(|e| e.to_string_lossy().starts_with("made-"))
-            {
-                std::fs::remove_dir_all(&path).unwrap();
-            }
-        }
+        clear_set_aside(&real);
         let _ = std::fs::remove_file(robot.join("main.c"));
         let _ = std::fs::remove_dir_all(out.join(".semo-backup"));
     }

@@ -44,23 +44,50 @@ fn spread(values: &mut [i64]) -> (i64, i64, i64) {
     (values[0], median, values[n - 1])
 }
 
-#[test]
-#[ignore = "stress run (minutes, real time): cargo test --test mqtt -- --ignored stress_"]
-fn stress_forged_operator_commands_are_never_taken() {
-    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-stress-forged", false) else {
-        return;
-    };
-    let (out, port) = (fleet.out.clone(), fleet.port);
-    let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
-    let folders = super::build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
-    let operator_topic = topics::to_team(
+/// The scouting fleet deployed over a broker with the generated ACL (and
+/// TLS if `tls`), built, with the topics a forger holding the slaves'
+/// credentials may write and the operator's command topic: what both
+/// forged-command runs share.
+struct ForgedFleet {
+    fleet: Fleet,
+    acl: String,
+    folders: Vec<PathBuf>,
+    slave_topics: Vec<String>,
+}
+
+fn forged_fleet(name: &str, tls: bool) -> Option<ForgedFleet> {
+    let (fleet, deploy) = deployed_fleet(name, tls)?;
+    let acl = std::fs::read_to_string(fleet.out.join("broker/semo.acl")).unwrap();
+    let folders =
+        super::build_scouting_with(&fleet.out, &["--deploy", &deploy.display().to_string()]);
+    let mut slave_topics = writable(&acl, "slaves", FORGED_RUN);
+    slave_topics.push(topics::to_team(
         &scouting_run(FORGED_RUN),
         "MasterTeam",
         "USER.RC_CMD",
         topics::OPERATOR,
-    );
-    let mut slave_topics = writable(&acl, "slaves", FORGED_RUN);
-    slave_topics.push(operator_topic);
+    ));
+    Some(ForgedFleet {
+        fleet,
+        acl,
+        folders,
+        slave_topics,
+    })
+}
+
+#[test]
+#[ignore = "stress run (minutes, real time): cargo test --test mqtt -- --ignored stress_"]
+fn stress_forged_operator_commands_are_never_taken() {
+    let Some(ForgedFleet {
+        mut fleet,
+        acl,
+        folders,
+        slave_topics,
+    }) = forged_fleet("mqtt-stress-forged", false)
+    else {
+        return;
+    };
+    let (out, port) = (fleet.out.clone(), fleet.port);
     let runs = sized("SEMO_STRESS_RUNS", 5);
     let (mut commands, mut commands_taken, mut commands_refused) = (0, 0, 0);
     let (mut heartbeats, mut heartbeats_taken, mut heartbeats_refused) = (0, 0, 0);
@@ -135,20 +162,16 @@ fn slaves_over_tls(dir: &Path, port: u16) -> rumqttc::MqttOptions {
 #[test]
 #[ignore = "stress run (minutes, real time): cargo test --test mqtt -- --ignored stress_"]
 fn stress_forged_operator_commands_over_tls_are_never_taken() {
-    let Some((mut fleet, deploy)) = deployed_fleet("mqtt-stress-forged-tls", true) else {
+    let Some(ForgedFleet {
+        mut fleet,
+        folders,
+        slave_topics,
+        ..
+    }) = forged_fleet("mqtt-stress-forged-tls", true)
+    else {
         return;
     };
     let (out, port) = (fleet.out.clone(), fleet.port);
-    let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
-    let folders = super::build_scouting_with(&out, &["--deploy", &deploy.display().to_string()]);
-    let operator_topic = topics::to_team(
-        &scouting_run(FORGED_RUN),
-        "MasterTeam",
-        "USER.RC_CMD",
-        topics::OPERATOR,
-    );
-    let mut slave_topics = writable(&acl, "slaves", FORGED_RUN);
-    slave_topics.push(operator_topic);
     let runs = sized("SEMO_STRESS_RUNS", 5);
     let (mut commands, mut taken, mut refused_total) = (0, 0, 0);
     for run in 0..runs {

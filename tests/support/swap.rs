@@ -33,6 +33,21 @@ pub fn swapper(real: PathBuf, target: PathBuf, stop: Arc<AtomicBool>) -> JoinHan
     })
 }
 
+/// Removes what the swapper set aside beside `real` (the `<real>.made-<n>`
+/// folders), so that the next run starts from a clean output folder.
+pub fn clear_set_aside(real: &Path) {
+    let folder = real.parent().expect("a swapped folder has a parent");
+    for entry in std::fs::read_dir(folder).unwrap() {
+        let path = entry.unwrap().path();
+        if path
+            .extension()
+            .is_some_and(|e| e.to_string_lossy().starts_with("made-"))
+        {
+            std::fs::remove_dir_all(&path).unwrap();
+        }
+    }
+}
+
 /// `moved` back at `real` (anything the build made there meanwhile is set
 /// aside beside it).
 fn restore(real: &Path, moved: &Path) {

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
-use swap::swapper;
+use swap::{clear_set_aside, swapper};
 
 /// A stress run's size: `var` if set, else `default`.
 fn sized(var: &str, default: usize) -> usize {
@@ -309,15 +309,7 @@ async fn links_swapped(name: &str, robot: bool, generations: usize) -> SwapCount
             eprintln!("generation {i}: written outside: {:?}", written.keys());
         }
         counts.outside += written.len();
-        for entry in std::fs::read_dir(real.parent().unwrap()).unwrap() {
-            let path = entry.unwrap().path();
-            if path
-                .extension()
-                .is_some_and(|e| e.to_string_lossy().starts_with("made-"))
-            {
-                std::fs::remove_dir_all(&path).unwrap();
-            }
-        }
+        clear_set_aside(&real);
     }
     client.shutdown().await;
     counts
