@@ -129,15 +129,16 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             }
         }
     };
-    let input = match super::build_files(&run.analysis(), mission) {
-        Ok(files) => files,
-        Err(code) => return code,
-    };
-    let input = input.input();
     if let Some(deployment) = &deployment {
-        let found = semo::deploy::check(deployment, &input.analysis.mission);
+        // The checked mission the deployment is checked against (the
+        // build below asks the host for its own input).
+        let files = match super::build_files(&run.analysis(), mission) {
+            Ok(files) => files,
+            Err(code) => return code,
+        };
+        let found = semo::deploy::check(deployment, &files.input().analysis.mission);
         if found.iter().any(|d| d.is_error()) {
-            drop(input);
+            drop(files);
             return super::deploy::refuse(&mut run, found, options.format, options.color, out);
         }
     }
