@@ -75,7 +75,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         .collect();
     if options.scenario.is_some() && compiled_in.is_empty() {
         eprintln!(
-            "error: --scenario is compiled into simulations only (targets linux-sim, cortex-m-sim, or --sim), and no robot of this build is built for one (target {})",
+            "error: --scenario is compiled into simulations only (targets linux-sim, cortex-m-sim, stm32f4-sim, or --sim), and no robot of this build is built for one (target {})",
             names(&targets)
         );
         return 2;

@@ -158,8 +158,9 @@ enum Command {
         /// files), `linux-sim` (sensors, actuators and the operator
         /// simulated from the --scenario compiled in), `cortex-m`
         /// (bare-metal TI Stellaris LM3S6965, a static schedule; you fill
-        /// the task files) or `cortex-m-sim` (the same with --scenario
-        /// compiled in, for QEMU). Default: each robot's own, from the
+        /// the task files), `stm32f4` (the same on an ST STM32F405) or
+        /// `cortex-m-sim`, `stm32f4-sim` (the same with --scenario compiled
+        /// in, for QEMU). Default: each robot's own, from the
         /// project file (`[build.targets]` for its team or itself, `[build]
         /// target` for all), else the platform its robot type names in the
         /// catalog (`<Platform target="...">`), else `linux`.

@@ -124,6 +124,11 @@ pub struct Memory {
 /// files share and the portable core.
 const CORE: [&str; 3] = ["semo_runtime.h", "semo_internal.h", "semo_core.c"];
 
+/// The runtime files of a Cortex-M board's static schedule: the core, the
+/// loop and the core's SysTick clock (its start-up file and link script
+/// come from its [`Board`]).
+const CORTEX_M: [&str; 5] = [CORE[0], CORE[1], CORE[2], "semo_static.c", "semo_systick.c"];
+
 /// Every platform, in the order targets are listed.
 pub const PLATFORMS: &[Platform] = &[
     Platform {
@@ -162,11 +167,11 @@ pub const PLATFORMS: &[Platform] = &[
         layer: Layer::Static,
         real: Variant {
             transport: None,
-            runtime: &[CORE[0], CORE[1], CORE[2], "semo_static.c"],
+            runtime: &CORTEX_M,
         },
         sim: Variant {
             transport: None,
-            runtime: &[CORE[0], CORE[1], CORE[2], "semo_static.c"],
+            runtime: &CORTEX_M,
         },
         board: Some(Board {
             name: "TI Stellaris LM3S6965",
@@ -196,6 +201,49 @@ pub const PLATFORMS: &[Platform] = &[
             machine: "lm3s6965evb",
         }),
     },
+    Platform {
+        name: "stm32f4",
+        doc: "bare metal on a Cortex-M4 (ST STM32F405, the OpenCR's family): a static schedule, no threads, no heap",
+        layer: Layer::Static,
+        real: Variant {
+            transport: None,
+            runtime: &CORTEX_M,
+        },
+        sim: Variant {
+            transport: None,
+            runtime: &CORTEX_M,
+        },
+        board: Some(Board {
+            name: "ST STM32F405",
+            cpu: "Cortex-M4",
+            // Soft-float, as on the Cortex-M3: the FPU stays off.
+            arch: "-mcpu=cortex-m4 -mthumb",
+            toolchain: Toolchain {
+                cc: "arm-none-eabi-gcc",
+                size: "arm-none-eabi-size",
+                libc: "newlib-nano",
+                specs: "nano.specs",
+            },
+            flash: Memory {
+                origin: 0x0800_0000,
+                kib: 1024,
+            },
+            // SRAM1 and SRAM2, one after the other (the 64 KiB of
+            // core-coupled memory at 0x10000000 are left out).
+            ram: Memory {
+                origin: 0x2000_0000,
+                kib: 128,
+            },
+            startup: "semo_stm32f405.c",
+            link_script: "stm32f405.ld",
+            stack_bytes: 2048,
+            clock_hz: 168_000_000,
+            timer: "SysTick",
+            serial: "USART1",
+            emulator: "qemu-system-arm",
+            machine: "netduinoplus2",
+        }),
+    },
 ];
 
 /// A code-generation target: a platform, or its simulation.
@@ -213,15 +261,21 @@ pub enum Target {
     /// --scenario FILE`), tracing on the serial port and exiting through
     /// semihosting, so that a run in the emulator is a test.
     CortexMSim,
+    /// Bare metal on a Cortex-M4 (ST STM32F405): as [`Target::CortexM`].
+    Stm32F4,
+    /// Its simulation, as [`Target::CortexMSim`].
+    Stm32F4Sim,
 }
 
 impl Target {
     /// Every target, as listed to users.
-    pub const ALL: [Target; 4] = [
+    pub const ALL: [Target; 6] = [
         Target::Linux,
         Target::LinuxSim,
         Target::CortexM,
         Target::CortexMSim,
+        Target::Stm32F4,
+        Target::Stm32F4Sim,
     ];
 
     /// Its name: the platform's, `-sim` after it for the simulation.
@@ -231,6 +285,8 @@ impl Target {
             Target::LinuxSim => "linux-sim",
             Target::CortexM => "cortex-m",
             Target::CortexMSim => "cortex-m-sim",
+            Target::Stm32F4 => "stm32f4",
+            Target::Stm32F4Sim => "stm32f4-sim",
         }
     }
 
@@ -248,6 +304,7 @@ impl Target {
         let name = match self {
             Target::Linux | Target::LinuxSim => "linux",
             Target::CortexM | Target::CortexMSim => "cortex-m",
+            Target::Stm32F4 | Target::Stm32F4Sim => "stm32f4",
         };
         PLATFORMS
             .iter()
@@ -258,7 +315,10 @@ impl Target {
     /// Sensors, services and the operator come from a scenario: at run time
     /// (`--scenario FILE`, POSIX) or compiled in (static, `scenario.c`).
     pub fn simulated(self) -> bool {
-        matches!(self, Target::LinuxSim | Target::CortexMSim)
+        matches!(
+            self,
+            Target::LinuxSim | Target::CortexMSim | Target::Stm32F4Sim
+        )
     }
 
     /// The simulation of this target's platform (`semo build --sim`).
@@ -266,6 +326,7 @@ impl Target {
         match self {
             Target::Linux | Target::LinuxSim => Target::LinuxSim,
             Target::CortexM | Target::CortexMSim => Target::CortexMSim,
+            Target::Stm32F4 | Target::Stm32F4Sim => Target::Stm32F4Sim,
         }
     }
 

@@ -1,6 +1,7 @@
 //! The files code generation writes, as golden output (insta snapshots under
 //! `tests/snapshots/`): every example mission (`examples/`) for every target
-//! (`Target::ALL`), one snapshot per pair holding every robot's files, each
+//! (`Target::ALL`, a second board's targets on the follow robot only), one
+//! snapshot per pair holding every robot's files, each
 //! under a header naming it, then the runtime folder's files (a file written
 //! as it is in `src/codegen/runtime/` is only named; one filled in for a
 //! board is written out). A target that refuses a mission's robots (a
@@ -175,11 +176,22 @@ fn written(result: &codegen::BuildResult) -> String {
     out
 }
 
+/// The targets every mission is snapshotted for: every target but those of
+/// a second board of a layer, whose files differ from the first board's
+/// only in the board's facts (its Makefile's head, its start-up file and
+/// link script): those are snapshotted on one mission
+/// (`the_files_of_a_second_board_for_the_follow_robot`).
+fn targets_for_every_mission() -> impl Iterator<Item = Target> {
+    Target::ALL
+        .into_iter()
+        .filter(|t| !matches!(t, Target::Stm32F4 | Target::Stm32F4Sim))
+}
+
 /// Every target's files of each mission of `missions`, under `folder`.
 fn snapshot_every_target(folder: &str, missions: &[(&str, &str, Option<&str>)]) {
     for (name, mission, scenario) in missions {
         let mission = repository().join(folder).join(mission);
-        for target in Target::ALL {
+        for target in targets_for_every_mission() {
             let result = build(&mission, &[], target, *scenario);
             insta::assert_snapshot!(format!("{name}@{}", target.name()), written(&result));
         }
@@ -194,6 +206,22 @@ fn the_files_of_every_example_for_every_target() {
 #[test]
 fn the_files_of_the_fixtures_the_examples_miss_for_every_target() {
     snapshot_every_target("tests/fixtures", FIXTURES);
+}
+
+#[test]
+fn the_files_of_a_second_board_for_the_follow_robot() {
+    let (_, mission, scenario) = EXAMPLES
+        .iter()
+        .find(|(name, ..)| *name == "follow")
+        .expect("the follow example");
+    let mission = repository().join("examples").join(mission);
+    for target in Target::ALL
+        .into_iter()
+        .filter(|t| targets_for_every_mission().all(|every| every != *t))
+    {
+        let result = build(&mission, &[], target, *scenario);
+        insta::assert_snapshot!(format!("follow@{}", target.name()), written(&result));
+    }
 }
 
 #[test]

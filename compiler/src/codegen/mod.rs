@@ -62,20 +62,25 @@ const MQTT: (&str, &str) = ("semo_mqtt.c", include_str!("runtime/semo_mqtt.c"));
 const POSIX_SIM: (&str, &str) = ("semo_sim.c", include_str!("runtime/semo_sim.c"));
 const LOCKSTEP: (&str, &str) = ("semo_lockstep.c", include_str!("runtime/semo_lockstep.c"));
 const STATIC: (&str, &str) = ("semo_static.c", include_str!("runtime/semo_static.c"));
+const SYSTICK: (&str, &str) = ("semo_systick.c", include_str!("runtime/semo_systick.c"));
 const LM3S6965: (&str, &str) = ("semo_lm3s6965.c", include_str!("runtime/semo_lm3s6965.c"));
 const LM3S6965_LD: (&str, &str) = ("lm3s6965.ld", LINK_SCRIPT.text);
+const STM32F405: (&str, &str) = ("semo_stm32f405.c", include_str!("runtime/semo_stm32f405.c"));
+const STM32F405_LD: (&str, &str) = ("stm32f405.ld", LINK_SCRIPT.text);
 /// A board's link script, its memory map filled in from the platform
-/// table's row ([`board_file`]).
+/// table's row ([`board_file`]): one template for every board.
 const LINK_SCRIPT: template::Template = template::Template {
-    path: "runtime/lm3s6965.ld.in",
-    text: include_str!("runtime/lm3s6965.ld.in"),
+    path: "runtime/board.ld.in",
+    text: include_str!("runtime/board.ld.in"),
     slots: &[
+        "ld",
         "board",
         "machine",
         "flash_origin",
         "flash_kib",
         "ram_origin",
         "ram_kib",
+        "startup",
     ],
 };
 /// The make rules every robot's Makefile includes to compile the runtime.
@@ -92,8 +97,11 @@ const RUNTIME_FILES: &[(&str, &str)] = &[
     POSIX_SIM,
     LOCKSTEP,
     STATIC,
+    SYSTICK,
     LM3S6965,
     LM3S6965_LD,
+    STM32F405,
+    STM32F405_LD,
     MAKE_RULES,
 ];
 
@@ -143,6 +151,7 @@ fn board_file(targets: &[Target], path: &'static str, text: &'static str) -> Str
                 ..LINK_SCRIPT
             },
             &[
+                ("ld", &board.link_script),
                 ("board", &board.name),
                 ("machine", &board.machine),
                 (
@@ -152,6 +161,7 @@ fn board_file(targets: &[Target], path: &'static str, text: &'static str) -> Str
                 ("flash_kib", &board.flash.kib),
                 ("ram_origin", &format_args!("0x{:08X}", board.ram.origin)),
                 ("ram_kib", &board.ram.kib),
+                ("startup", &board.startup),
             ],
         ),
     }

@@ -103,7 +103,7 @@ w001 = "allow"
     E111 '"robots"' `catalogs` must be a list of folders, such as ["robots"]
     W110 'catalog' unknown key of [project] `catalog` (known: version, name, catalogs, strategies, task-graphs) (did you mean `catalogs`?)
     W110 'biuld' unknown table `biuld` (known: project, build, lints) (did you mean `build`?)
-    E111 '"linux-simm"' unknown target `linux-simm` (targets: linux, linux-sim, cortex-m, cortex-m-sim) (did you mean `linux-sim`?)
+    E111 '"linux-simm"' unknown target `linux-simm` (targets: linux, linux-sim, cortex-m, cortex-m-sim, stm32f4, stm32f4-sim) (did you mean `linux-sim`?)
     E111 '3' `output` must be a string
     E111 '"quiet"' the level of W007 must be "allow", "warn" or "deny"
     E112 '"allow"' E019 is an error: it cannot be allowed or made a warning (only "deny")
@@ -252,7 +252,9 @@ fn completion_offers_tables_keys_codes_and_values() {
             "linux→\"linux\"",
             "linux-sim→\"linux-sim\"",
             "cortex-m→\"cortex-m\"",
-            "cortex-m-sim→\"cortex-m-sim\""
+            "cortex-m-sim→\"cortex-m-sim\"",
+            "stm32f4→\"stm32f4\"",
+            "stm32f4-sim→\"stm32f4-sim\""
         ]
     );
     let codes = offered("[project]\nversion = 1\n[lints]\nW0$0");
@@ -345,7 +347,7 @@ ti = 3
 "#;
     let (project, diagnostics) = read(text);
     insta::assert_snapshot!(listing(text, &diagnostics).join("\n"), @r#"
-    E111 '"cortx-m"' unknown target `cortx-m` (targets: linux, linux-sim, cortex-m, cortex-m-sim) (did you mean `cortex-m`?)
+    E111 '"cortx-m"' unknown target `cortx-m` (targets: linux, linux-sim, cortex-m, cortex-m-sim, stm32f4, stm32f4-sim) (did you mean `cortex-m`?)
     E111 '3' the target of `ti` must be a string, such as "linux"
     "#);
     assert!(project.targets.is_empty());
@@ -380,7 +382,9 @@ fn completion_in_build_targets_offers_the_missions_names_and_the_targets() {
             "linux→\"linux\"",
             "linux-sim→\"linux-sim\"",
             "cortex-m→\"cortex-m\"",
-            "cortex-m-sim→\"cortex-m-sim\""
+            "cortex-m-sim→\"cortex-m-sim\"",
+            "stm32f4→\"stm32f4\"",
+            "stm32f4-sim→\"stm32f4-sim\""
         ]
     );
 }

@@ -7,7 +7,7 @@
 //!
 //! Arguments: one object `{ "uri": mission, "outputFolder"?: path (relative
 //! to the mission's folder), "target"?: every robot's target ("linux",
-//! "linux-sim", "cortex-m", "cortex-m-sim"), "sim"?: each robot's platform
+//! "linux-sim", "cortex-m", "cortex-m-sim", "stm32f4", "stm32f4-sim"), "sim"?: each robot's platform
 //! simulated (`semo build --sim`), "scenario"?: the scenario file compiled
 //! into a simulation (relative to the mission's folder; needed by, and only
 //! by, a simulation target, as `semo build --scenario`), "team"?: only this

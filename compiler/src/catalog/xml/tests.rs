@@ -541,7 +541,7 @@ fn a_platform_target_that_is_no_platform_is_positioned_with_a_did_you_mean() {
     assert_eq!((d.code, at), (Code::CatalogBadAttribute, "cortx-m"));
     assert_eq!(
         d.message,
-        "unknown platform `cortx-m` (platforms: linux, cortex-m) (did you mean `cortex-m`?)"
+        "unknown platform `cortx-m` (platforms: linux, cortex-m, stm32f4) (did you mean `cortex-m`?)"
     );
     assert_eq!(d.suggestion.as_deref(), Some("cortex-m"));
     // A simulation is the build's choice, not the robot's.

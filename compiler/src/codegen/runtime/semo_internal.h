@@ -261,16 +261,21 @@ typedef struct semo__sim_tables_s {
 extern const semo__sim_tables semo__scenario;
 #endif
 
-/* Platform hooks of the static schedule, given by the board file
- * (semo_lm3s6965.c): a millisecond clock, the trace's output, sleeping
- * until a deadline of that clock (or an interrupt: the caller looks at the
- * time again; INT64_MAX: no deadline) and ending the program. */
+/* Platform hooks of the static schedule: the board file (semo_lm3s6965.c,
+ * semo_stm32f405.c) starts the board and writes the trace's output; the
+ * core's timer (semo_systick.c, every Cortex-M) gives a millisecond clock,
+ * sleeping until a deadline of that clock (or an interrupt: the caller
+ * looks at the time again; INT64_MAX: no deadline) and ending the program. */
 #ifdef SEMO_STATIC
 void semo__board_init(void);
 int64_t semo__board_now_ms(void);
 void semo__board_put(void *ctx, const char *bytes, size_t n);
 void semo__board_sleep_until(int64_t deadline_ms);
 void semo__board_exit(int status);
+/* semo_systick.c's: started by the board's init, its handler in the board's
+ * vector table. */
+void semo__systick_start(void);
+void semo__systick(void);
 #endif
 
 #ifdef SEMO_MQTT

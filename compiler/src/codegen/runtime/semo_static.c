@@ -8,8 +8,9 @@
  * no clock tick, so an idle robot wakes only for its deadlines. No call
  * blocks, nothing is allocated: channels live in the buffers the generated
  * channels.c gives them, everything else in the fixed tables below (sizes
- * overridable with -D). The board file (semo_lm3s6965.c) gives the clock,
- * the trace's output and the exit.
+ * overridable with -D). The board file (semo_lm3s6965.c, semo_stm32f405.c)
+ * gives the trace's output, the core's SysTick (semo_systick.c) the clock
+ * and the exit.
  */
 #include "semo_internal.h"
 
