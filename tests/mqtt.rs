@@ -2186,6 +2186,17 @@ fn leaders_of(events: &[Event]) -> Vec<String> {
         .collect()
 }
 
+/// The leaders a robot followed in turn: [`leaders_of`] with the same
+/// leader twice in a row taken once. On a loaded machine a robot may hear no
+/// majority for a moment (its process or the broker starved for more than
+/// the lease: it traces `fenced`), drop its leader and elect the same one
+/// again; that is one leadership, not a change of leader.
+fn leaders_in_turn(events: &[Event]) -> Vec<String> {
+    let mut leaders = leaders_of(events);
+    leaders.dedup();
+    leaders
+}
+
 /// Mission ms since the start barrier's instant `t0` (time scale 1;
 /// negative before it).
 fn mission_ms(t0: std::time::Instant) -> i64 {
@@ -2383,9 +2394,9 @@ fn patrol_groups_over_mqtt_keeps_one_leader_across_a_restart() {
         "tb_1 took over at {took_over}, tb_0's last heartbeat at {last_heartbeat}"
     );
     // After the restart tb_0 leads again, and the others follow it.
-    assert_eq!(leaders_of(of("tb_1")), ["tb_0", "tb_1", "tb_0"]);
-    assert_eq!(leaders_of(of("tb_2")), ["tb_0", "tb_1", "tb_0"]);
-    let second = leaders_of(of("tb_0"));
+    assert_eq!(leaders_in_turn(of("tb_1")), ["tb_0", "tb_1", "tb_0"]);
+    assert_eq!(leaders_in_turn(of("tb_2")), ["tb_0", "tb_1", "tb_0"]);
+    let second = leaders_in_turn(of("tb_0"));
     assert_eq!(
         second.last().map(String::as_str),
         Some("tb_0"),
@@ -2479,18 +2490,24 @@ fn a_leader_cut_off_from_the_broker_steps_down_before_another_is_elected() {
         .filter(|e| field(e, "event") == "fenced")
         .map(|e| (e["t"].as_i64().unwrap(), field(e, "heard")))
         .collect();
+    // Once during the cut; a loaded machine may starve a process or the
+    // broker past the lease at other times too, which fences as well.
+    let during_cut: Vec<&(i64, &str)> = fenced
+        .iter()
+        .filter(|(t, _)| (CUT_AT..HEAL_AT).contains(t))
+        .collect();
     assert!(
-        matches!(fenced.as_slice(), [(t, "1 of 3")] if (CUT_AT..HEAL_AT).contains(t)),
+        matches!(during_cut.as_slice(), [(_, "1 of 3")]),
         "tb_0 fenced: {fenced:?}"
     );
-    assert_eq!(leaders_of(of("tb_1")), ["tb_0", "tb_1", "tb_0"]);
-    assert_eq!(leaders_of(of("tb_2")), ["tb_0", "tb_1", "tb_0"]);
+    assert_eq!(leaders_in_turn(of("tb_1")), ["tb_0", "tb_1", "tb_0"]);
+    assert_eq!(leaders_in_turn(of("tb_2")), ["tb_0", "tb_1", "tb_0"]);
     // Healed, tb_0 follows tb_1 if tb_1's claim reaches it before tb_1,
     // at its next heartbeat, has seen tb_0 alive and given way: a race of
     // the two processes' heartbeats.
-    let tb_0 = leaders_of(of("tb_0"));
+    let tb_0 = leaders_in_turn(of("tb_0"));
     assert!(
-        tb_0 == ["tb_0", "tb_1", "tb_0"] || tb_0 == ["tb_0", "tb_0"],
+        tb_0 == ["tb_0", "tb_1", "tb_0"] || tb_0 == ["tb_0"],
         "{tb_0:?}"
     );
     // The time with two leaders is a race of real processes (their
@@ -2535,7 +2552,7 @@ fn highest_battery_over_mqtt_elects_the_fullest_robot() {
     let traces = fleet.run_all(&folders, &scenario, "battery", &["--start-at", &start_at]);
     let lives: Vec<(String, Vec<Event>)> = traces.clone().into_iter().collect();
     for (robot, events) in &traces {
-        assert_eq!(leaders_of(events), ["tb_1"], "{robot}");
+        assert_eq!(leaders_in_turn(events), ["tb_1"], "{robot}");
         // Everyone listened one and a half heartbeats (100 ms) first.
         let first = events
             .iter()
