@@ -272,7 +272,7 @@ fn dataflow_warnings_are_the_same_at_every_door() {
         .map(|e| e.unwrap().path())
         .filter_map(|p| {
             let name = p.file_name()?.to_string_lossy().into_owned();
-            let code = ["W070", "W071", "W072", "W073"]
+            let code = ["W070", "W071", "W072", "W073", "W074", "W075"]
                 .into_iter()
                 .find(|c| name.starts_with(c))?;
             Some((code.to_string(), p))
@@ -282,7 +282,7 @@ fn dataflow_warnings_are_the_same_at_every_door() {
     let codes: BTreeSet<&str> = dirs.iter().map(|(c, _)| c.as_str()).collect();
     assert_eq!(
         codes.len(),
-        4,
+        6,
         "a fixture for each dataflow warning: {dirs:?}"
     );
     for (code, dir) in &dirs {

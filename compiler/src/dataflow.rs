@@ -16,7 +16,11 @@
 //! - W073: the graph's iteration period (its throughput, exact, one firing
 //!   of a task at a time as generated) is longer than the period the mission
 //!   asks for around the call (`repeat(P)` of its service, or the innermost
-//!   `loop(P)` holding it): the robot cannot keep up.
+//!   `loop(P)` holding it): the robot cannot keep up;
+//! - W074: the graph's latency from one of its tasks to another (a sensor's
+//!   sample to the actuator's command it causes) is over the bound the
+//!   catalog states on the service (`<Latency>`); W075: such a bound cannot
+//!   be checked, and why ([`latency`]).
 //!
 //! Execution times (`wcet`) of the service graphs count milliseconds of
 //! mission time, the unit a mission's periods are compared in. A
@@ -35,6 +39,9 @@
 //! be read, or has format errors, is reported in its own file (and E055 in
 //! the catalog) and gives no warning here.
 
+mod latency;
+
+use crate::catalog::latency::LatencyBound;
 use crate::catalog::{Catalog, Implementation, RobotType};
 use crate::diag::{self, Code, Diagnostic, FileId, Related};
 use crate::refine::{RobotProgram, State, StateKind};
@@ -54,6 +61,9 @@ pub struct MissionDataflow {
     pub diagnostics: Vec<Diagnostic>,
     /// The service graph files analysed (a change to one changes this).
     pub graphs: Vec<FileId>,
+    /// How many latency analyses ran for the catalog's bounds: one per
+    /// distinct (graph, source, sink), however many robots and calls.
+    pub latency_analyses: usize,
 }
 
 /// One robot's dataflow.
@@ -93,6 +103,7 @@ pub struct DataflowInput<'a> {
 /// calls, once, and gives its result to each of the declaration's robots.
 pub fn analyze(input: &DataflowInput<'_>) -> MissionDataflow {
     let mut out = MissionDataflow::default();
+    let mut latencies = latency::Latencies::default();
     let programs: HashMap<(&str, &str), &RobotProgram> = input
         .programs
         .iter()
@@ -114,6 +125,7 @@ pub fn analyze(input: &DataflowInput<'_>) -> MissionDataflow {
                 robot_type,
                 &mut out.diagnostics,
                 &mut out.graphs,
+                &mut latencies,
             );
             out.robots.extend(robots.map(|r| RobotDataflow {
                 robot: r.name.to_string(),
@@ -121,6 +133,7 @@ pub fn analyze(input: &DataflowInput<'_>) -> MissionDataflow {
             }));
         }
     }
+    out.latency_analyses = latencies.analyses;
     diag::sort_and_dedup(&mut out.diagnostics);
     out.graphs.sort();
     out.graphs.dedup();
@@ -176,6 +189,9 @@ struct GraphCall<'p> {
     state: &'p State,
     /// The period asked for around the call, and where.
     asked: Option<(i64, Span)>,
+    /// The latency bounds the catalog states on the service, and its file.
+    bounds: &'p [LatencyBound],
+    catalog: FileId,
 }
 
 fn robot(
@@ -184,6 +200,7 @@ fn robot(
     robot_type: Option<&RobotType>,
     diagnostics: &mut Vec<Diagnostic>,
     graphs: &mut Vec<FileId>,
+    latencies: &mut latency::Latencies,
 ) -> RobotDataflow {
     let mut found = RobotDataflow {
         team: program.team.clone(),
@@ -194,6 +211,15 @@ fn robot(
     for call in graph_calls(input, program, robot_type) {
         graphs.extend(call.run.graph.as_ref().map(|g| g.file));
         diagnostics.extend(graph_problems(input.file, &call));
+        let bounded = latency::BoundedCall {
+            file: input.file,
+            span: call.state.span,
+            service: call.service,
+            path: call.path,
+            catalog: call.catalog,
+            run: &call.run,
+        };
+        diagnostics.extend(latencies.check(&bounded, call.bounds));
         let throughput = iteration_period(&call.run);
         // The time-triggered tasks bound it when the throughput does not
         // say more.
@@ -292,6 +318,8 @@ fn graph_calls<'p>(
                 run,
                 state,
                 asked: asked_period(&machine.states, index),
+                bounds: &def.latency,
+                catalog: def.origin.file,
             });
         }
     }

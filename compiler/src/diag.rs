@@ -156,6 +156,8 @@ codes! {
     DataflowDeadlock = "W071", Warning, "a mission line calling a service whose task graph deadlocks";
     DataflowBufferTooSmall = "W072", Warning, "a mission line calling a service whose task graph has a channel smaller than its schedule needs";
     DataflowTooSlow = "W073", Warning, "a `repeat(P)` or `loop(P)` period shorter than the iteration period of a service graph called inside: the robot cannot keep up";
+    DataflowLatencyExceeded = "W074", Warning, "a call of a service whose task graph takes longer from a task to another than the latency bound its catalog states (`<Latency>`)";
+    DataflowLatencyUnchecked = "W075", Warning, "a latency bound (`<Latency>`) of a service's task graph that cannot be checked: an unknown task, no execution times, no path, or no latency (the reason is given)";
     // Strategy files (*.strategy.xml).
     StrategyXml = "E080", Error, "a strategy file that is not well-formed XML";
     StrategyRawLt = "E081", Error, "a plain `<` inside an attribute value, where XML needs `&lt;`";

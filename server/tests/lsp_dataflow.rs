@@ -34,7 +34,11 @@ fn codes(diagnostics: &Value) -> Vec<String> {
 /// A client on the fixture folder with its mission open (version 1).
 async fn open_fixture(name: &str) -> (TestClient, String, String) {
     let dir = fixture(name);
-    let mission = dir.join("scan.mission");
+    let mission = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "mission"))
+        .unwrap();
     let text = std::fs::read_to_string(&mission).unwrap();
     let mut client = TestClient::start();
     client.initialize(&["utf-16"], Some(&uri(&dir))).await;
@@ -99,6 +103,66 @@ async fn a_period_the_graph_cannot_keep_up_with_is_warned_about_on_the_period() 
     let (covered, message) = case("W073_dataflow_too_slow", "W073").await;
     assert_eq!(covered, "20 MSEC");
     assert!(message.contains("50 ms"), "{message}");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_latency_over_the_catalogs_bound_is_warned_about_on_the_call() {
+    // Hand-computed in the fixture's mission: 30 + 20 + 15 ms from `camera`
+    // to `wheels`, against 50 MSEC (`track`'s 0.065 SEC holds).
+    let (mut client, mission, text) = open_fixture("W074_dataflow_latency_exceeded").await;
+    let diagnostics = published_with(&mut client, &mission, 1, "W074").await;
+    let found: Vec<&Value> = diagnostics
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|d| d["code"] == "W074")
+        .collect();
+    assert_eq!(found.len(), 1, "{diagnostics:#}");
+    assert_eq!(found[0]["severity"], 2, "a warning");
+    assert_eq!(text_at(&text, &found[0]["range"]), "follow()");
+    assert_eq!(
+        found[0]["message"],
+        "`follow` runs the task graph `graphs/follow.taskgraph.xml`, whose latency from `camera` to `wheels` is over the 50 MSEC (50 ms) its catalog allows: minimal latency 65 ms, self-timed latency 65 ms"
+    );
+    // The bound's declaration, in the catalog, is the related information.
+    let related = &found[0]["relatedInformation"][0];
+    assert!(
+        related["location"]["uri"]
+            .as_str()
+            .unwrap()
+            .ends_with("rover.robot.xml"),
+        "{related:#}"
+    );
+    assert_eq!(
+        related["message"],
+        "the bound, 50 MSEC (50 ms), is stated here"
+    );
+    client.shutdown().await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_latency_bound_that_cannot_be_checked_is_warned_about_with_why() {
+    let (mut client, mission, _) = open_fixture("W075_dataflow_latency_unchecked").await;
+    let diagnostics = published_with(&mut client, &mission, 1, "W075").await;
+    let mut found: Vec<&str> = diagnostics
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|d| d["code"] == "W075")
+        .map(|d| d["message"].as_str().unwrap())
+        .collect();
+    found.sort_unstable();
+    assert_eq!(found.len(), 3, "{diagnostics:#}");
+    // In the order of their messages: `steer`'s (to `wheels`), `whels`,
+    // then from `wheels`.
+    for (message, why) in found.iter().zip([
+        "states no execution times",
+        "no task `whels` (did you mean `wheels`?)",
+        "no path of channels leads from the source to the sink",
+    ]) {
+        assert!(message.contains(why), "{message}");
+    }
+    client.shutdown().await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

@@ -4,6 +4,7 @@
 //! type name. The format's reference is `docs/catalog.md`.
 
 mod builtin;
+pub mod latency;
 pub mod schema;
 mod xml;
 
@@ -195,6 +196,9 @@ pub struct ServiceDef {
     pub params: Vec<ParamDef>,
     pub doc: String,
     pub implementation: Implementation,
+    /// The latency bounds stated on its task graph (`<Latency>`; only a
+    /// `graph=` service has them).
+    pub latency: Vec<latency::LatencyBound>,
     pub origin: Origin,
 }
 
@@ -433,6 +437,6 @@ mod tests {
                 seen += 1;
             }
         }
-        assert_eq!(seen, 8);
+        assert_eq!(seen, 9);
     }
 }

@@ -69,8 +69,14 @@ pub const ELEMENTS: &[ElementInfo] = &[
     ElementInfo {
         name: "Service",
         attributes: &["name", "task", "graph", "doc", "aliases"],
-        children: &["Doc", "Param"],
+        children: &["Doc", "Param", "Latency"],
         belongs: IN_ROBOT,
+    },
+    ElementInfo {
+        name: "Latency",
+        attributes: &["from", "to", "max"],
+        children: &[],
+        belongs: "inside a `<Service>` implemented by a task graph (`graph=`)",
     },
     ElementInfo {
         name: "Param",

@@ -9,6 +9,7 @@
 //! robot type) is left out of the result. Diagnostics come in document order,
 //! the malformed XML (where reading stopped) last.
 
+use super::latency::{self, LatencyBound};
 use super::schema::{self, TYPE_NAMES};
 use super::{
     Implementation, Origin, ParamDef, Platform, RobotType, ServiceDef, ValueDef, ValueType,
@@ -527,12 +528,14 @@ impl Reader<'_, '_> {
                     params: Vec::new(),
                     doc,
                     implementation,
+                    latency: Vec::new(),
                     origin: self.origin(e),
                 })
         });
         let mut item = ItemBuild::new(def, doc_at);
         self.content(e, |r, c| match c.local.as_str() {
             "Param" => r.param(c, &mut item),
+            "Latency" => r.latency(c, &mut item),
             _ => r.item_doc(c, "Service", &mut item),
         });
         if let Some(def) = item.def {
@@ -545,6 +548,43 @@ impl Reader<'_, '_> {
         let mut left_out = String::new();
         let doc = item.def.as_mut().map_or(&mut left_out, T::doc_mut);
         self.doc(e, target, &mut item.doc_at, doc);
+    }
+
+    /// A `<Latency>` bound of a service: its tasks are names of the
+    /// service's graph (checked against the graph where it is analysed,
+    /// `crate::dataflow`); its time is read here.
+    fn latency(&mut self, e: &Elem, service: &mut ItemBuild<ServiceDef>) {
+        self.check_attributes(e);
+        let from = self.required(e, "from");
+        let to = self.required(e, "to");
+        let max = self.required(e, "max").and_then(|a| {
+            latency::parse_time(a.trimmed())
+                .map_err(|why| self.sink.report(Code::CatalogBadAttribute, a.span, why))
+                .ok()
+        });
+        self.leaf(e);
+        let Some(def) = service.def.as_mut() else {
+            return;
+        };
+        if !matches!(def.implementation, Implementation::Graph(_)) {
+            self.sink.report(
+                Code::CatalogBadAttribute,
+                e.tag,
+                format!(
+                    "a latency bound is stated on a task graph: `{}` is not implemented by one (give it `graph=\"…\"`)",
+                    def.name
+                ),
+            );
+            return;
+        }
+        if let (Some(from), Some(to), Some(max)) = (from, to, max) {
+            def.latency.push(LatencyBound {
+                from: (from.trimmed().to_string(), from.trimmed_span()),
+                to: (to.trimmed().to_string(), to.trimmed_span()),
+                max,
+                span: e.tag,
+            });
+        }
     }
 
     fn param(&mut self, e: &Elem, service: &mut ItemBuild<ServiceDef>) {

@@ -386,6 +386,17 @@ impl TimeUnit {
         }
     }
 
+    /// [`TimeUnit::millis`] as a whole number (every unit is a whole
+    /// number of milliseconds), for exact arithmetic.
+    pub fn whole_millis(self) -> u64 {
+        match self {
+            TimeUnit::Msec => 1,
+            TimeUnit::Sec => 1_000,
+            TimeUnit::Min => 60_000,
+            TimeUnit::Hour => 3_600_000,
+        }
+    }
+
     pub fn as_str(self) -> &'static str {
         match self {
             TimeUnit::Msec => "MSEC",

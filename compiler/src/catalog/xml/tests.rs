@@ -554,3 +554,99 @@ fn a_platform_target_that_is_no_platform_is_positioned_with_a_did_you_mean() {
         d.message
     );
 }
+
+#[test]
+fn latency_bounds_are_read_on_graph_services() {
+    let text = wrap(
+        "<Service name=\"follow\" graph=\"g.taskgraph.xml\">\n  <Latency from=\" camera \" to=\"wheels\" max=\"0.5 SEC\"/>\n</Service>",
+    );
+    let parsed = parse(&text);
+    assert!(parsed.diagnostics.is_empty(), "{:#?}", parsed.diagnostics);
+    let bounds = &parsed.robots[0].robot.services[0].latency;
+    assert_eq!(bounds.len(), 1);
+    let bound = &bounds[0];
+    assert_eq!(bound.from.0, "camera");
+    assert_eq!(&text[bound.from.1.range()], "camera");
+    assert_eq!(&text[bound.to.1.range()], "wheels");
+    assert_eq!((bound.max.num, bound.max.den), (500, 1));
+    assert_eq!(bound.max.written, "0.5 SEC");
+    assert!(text[bound.span.range()].starts_with("<Latency"));
+}
+
+#[test]
+fn bad_latency_bounds_are_positioned() {
+    let graph = |latency: &str| {
+        wrap(&format!(
+            "<Service name=\"follow\" graph=\"g.taskgraph.xml\">{latency}</Service>"
+        ))
+    };
+    for (latency, code, at, says) in [
+        (
+            "<Latency from=\"a\" to=\"b\" max=\"-5 MSEC\"/>",
+            Code::CatalogBadAttribute,
+            "-5 MSEC",
+            "a positive number (like 50 or 0.5), not `-5`",
+        ),
+        (
+            "<Latency from=\"a\" to=\"b\" max=\"50ms\"/>",
+            Code::CatalogBadAttribute,
+            "50ms",
+            "a positive number and a unit",
+        ),
+        (
+            "<Latency from=\"a\" to=\"b\" max=\"5 DAYS\"/>",
+            Code::CatalogBadAttribute,
+            "5 DAYS",
+            "`DAYS` is not a unit of time",
+        ),
+        (
+            "<Latency from=\"a\" to=\"b\" max=\"0 SEC\"/>",
+            Code::CatalogBadAttribute,
+            "0 SEC",
+            "more than 0",
+        ),
+        (
+            "<Latency from=\"a\" max=\"5 MSEC\"/>",
+            Code::CatalogMissingAttribute,
+            "<Latency from=\"a\" max=\"5 MSEC\"/>",
+            "needs a `to` attribute",
+        ),
+        (
+            "<Latency from=\"\" to=\"b\" max=\"5 MSEC\"/>",
+            Code::CatalogBadAttribute,
+            "",
+            "`from` is empty",
+        ),
+    ] {
+        let text = graph(latency);
+        let parsed = parse(&text);
+        assert_eq!(
+            parsed.diagnostics.len(),
+            1,
+            "{latency}: {:#?}",
+            parsed.diagnostics
+        );
+        let d = &parsed.diagnostics[0];
+        assert_eq!(d.code, code, "{latency}");
+        if !at.is_empty() {
+            assert_eq!(&text[d.span.range()], at, "{latency}");
+        }
+        assert!(d.message.contains(says), "{latency}: {}", d.message);
+        // A bound with a bad value is left out.
+        assert!(parsed.robots[0].robot.services[0].latency.is_empty());
+    }
+    // On a service that is no graph, and outside a service.
+    let text = wrap(
+        "<Service name=\"beep\" task=\"buzzer\"><Latency from=\"a\" to=\"b\" max=\"5 MSEC\"/></Service>",
+    );
+    let (d, at) = only(&text);
+    assert_eq!(d.code, Code::CatalogBadAttribute);
+    assert!(at.starts_with("<Latency"));
+    assert!(
+        d.message.contains("`beep` is not implemented by one"),
+        "{}",
+        d.message
+    );
+    let text = wrap("<Latency from=\"a\" to=\"b\" max=\"5 MSEC\"/>");
+    assert_eq!(codes(&text), ["E051"]);
+}

@@ -67,12 +67,16 @@ const GRAPH_ID: FileId = FileId(2);
 
 impl Workspace {
     fn new(name: &str, mission: &str, graph: &str) -> Workspace {
+        Workspace::with_catalog(name, mission, CATALOG, graph)
+    }
+
+    fn with_catalog(name: &str, mission: &str, catalog: &str, graph: &str) -> Workspace {
         let dir = std::env::temp_dir().join(format!("semo-dataflow-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(dir.join("graphs")).unwrap();
         let files = [
             (MISSION_ID, "m.mission", FileKind::Mission, mission),
-            (FileId(1), "rover.robot.xml", FileKind::Catalog, CATALOG),
+            (FileId(1), "rover.robot.xml", FileKind::Catalog, catalog),
             (
                 GRAPH_ID,
                 "graphs/scan.taskgraph.xml",
@@ -466,4 +470,180 @@ fn a_time_triggered_task_in_a_loop_counts_every_iteration() {
             .is_some_and(|p| p.contains("`r_0`: 120 ms (`scan`")),
         "{periods:?}"
     );
+}
+
+/// `scan`'s graph with a latency bound of `max` from `A` to `B`.
+fn bounded_catalog(max: &str) -> String {
+    CATALOG.replace(
+        r#"doc="Scan the ground."/>"#,
+        &format!(r#"doc="Scan the ground."><Latency from="A" to="B" max="{max}"/></Service>"#),
+    )
+}
+
+/// `A` (30 ms) sets the pace, `B` (20 ms) follows: by hand, the minimal
+/// latency from `A` to `B` is 30 + 20 = 50 ms, and the self-timed one too
+/// (iteration k: `A` runs 30k..30k+30, `B` 30k+30..30k+50).
+const PACED: &str = r#"<TaskGraph name="scan" xmlns="urn:semo:taskgraph:1">
+  <Task name="A" wcet="30"><Port name="o" dir="out"/></Task>
+  <Task name="B" wcet="20"><Port name="i" dir="in"/></Task>
+  <Channel src="A.o" dst="B.i"/>
+</TaskGraph>
+"#;
+
+#[test]
+fn a_latency_over_the_catalogs_bound_is_reported_on_the_call_with_its_numbers() {
+    let text = mission("T.P.S { scan() } repeat(100 MSEC)");
+    let w = Workspace::with_catalog("latency-over", &text, &bounded_catalog("49 MSEC"), PACED);
+    let found = w.warnings();
+    assert_eq!(codes(&found), [Code::DataflowLatencyExceeded], "{found:#?}");
+    assert_eq!(w.text_at(&text, &found[0]), "scan()");
+    assert_eq!(
+        found[0].message,
+        "`scan` runs the task graph `graphs/scan.taskgraph.xml`, whose latency from `A` to `B` is over the 49 MSEC (49 ms) its catalog allows: minimal latency 50 ms, self-timed latency 50 ms"
+    );
+    let related: Vec<(FileId, &str)> = found[0]
+        .related
+        .iter()
+        .map(|r| (r.file, r.message.as_str()))
+        .collect();
+    assert_eq!(
+        related,
+        [
+            (FileId(1), "the bound, 49 MSEC (49 ms), is stated here"),
+            (GRAPH_ID, "`A`, the path's source"),
+            (GRAPH_ID, "`B`, the path's sink"),
+        ]
+    );
+}
+
+#[test]
+fn a_latency_exactly_at_the_bound_holds_in_any_unit() {
+    for max in ["50 MSEC", "0.05 SEC", "1 MIN"] {
+        let text = mission("T.P.S { scan() } repeat(100 MSEC)");
+        let w = Workspace::with_catalog("latency-holds", &text, &bounded_catalog(max), PACED);
+        assert_eq!(w.warnings(), [], "{max}");
+    }
+    // A thousandth of a millisecond less is over it: the comparison is exact.
+    let text = mission("T.P.S { scan() } repeat(100 MSEC)");
+    let w = Workspace::with_catalog(
+        "latency-exact",
+        &text,
+        &bounded_catalog("0.049999 SEC"),
+        PACED,
+    );
+    let found = w.warnings();
+    assert_eq!(codes(&found), [Code::DataflowLatencyExceeded], "{found:#?}");
+    assert!(
+        found[0].message.contains("0.049999 SEC (49999/1000 ms)"),
+        "{}",
+        found[0].message
+    );
+}
+
+#[test]
+fn a_self_timed_latency_growing_without_bound_is_over_any_bound() {
+    // `A` (30 ms) starts an iteration every 30 ms, `B` (50 ms) ends one
+    // every 50: the minimal latency, 80 ms, is within 100 ms, but the
+    // self-timed one grows every iteration.
+    let text = mission("T.P.S { scan() } repeat(100 MSEC)");
+    let w = Workspace::with_catalog(
+        "latency-unbounded",
+        &text,
+        &bounded_catalog("100 MSEC"),
+        TIMED,
+    );
+    let found = w.warnings();
+    assert_eq!(codes(&found), [Code::DataflowLatencyExceeded], "{found:#?}");
+    assert!(
+        found[0]
+            .message
+            .contains("minimal latency 80 ms, self-timed latency unbounded (`B` takes 50"),
+        "{}",
+        found[0].message
+    );
+}
+
+#[test]
+fn a_bound_that_cannot_be_checked_says_why() {
+    let text = mission("T.P.S { scan() } repeat(100 MSEC)");
+    let untimed = PACED
+        .replace(r#" wcet="30""#, "")
+        .replace(r#" wcet="20""#, "");
+    for (catalog, graph, why) in [
+        (
+            bounded_catalog("50 MSEC").replace(r#"to="B""#, r#"to="b""#),
+            PACED.to_string(),
+            "the graph's top level has no task `b` (did you mean `B`?)",
+        ),
+        (
+            bounded_catalog("50 MSEC").replace(r#"from="A" to="B""#, r#"from="B" to="A""#),
+            PACED.to_string(),
+            "no latency: no path of channels leads from the source to the sink",
+        ),
+        (
+            bounded_catalog("50 MSEC"),
+            untimed,
+            "the task graph states no execution times (`wcet`)",
+        ),
+        (
+            bounded_catalog("50 MSEC"),
+            DEADLOCK.replace('X', "A").replace('Y', "B"),
+            "an iteration deadlocks",
+        ),
+    ] {
+        let w = Workspace::with_catalog("latency-unchecked", &text, &catalog, &graph);
+        let found: Vec<Diagnostic> = w
+            .warnings()
+            .into_iter()
+            .filter(|d| d.code == Code::DataflowLatencyUnchecked)
+            .collect();
+        assert_eq!(found.len(), 1, "{why}: {found:#?}");
+        assert!(found[0].message.contains(why), "{}", found[0].message);
+        assert_eq!(w.text_at(&text, &found[0]), "scan()");
+        assert_eq!(found[0].related[0].file, FileId(1));
+    }
+    // An unknown task is pointed at where the catalog names it.
+    let catalog = bounded_catalog("50 MSEC").replace(r#"to="B""#, r#"to="b""#);
+    let w = Workspace::with_catalog("latency-unknown", &text, &catalog, PACED);
+    let found = w.warnings();
+    assert_eq!(
+        codes(&found),
+        [Code::DataflowLatencyUnchecked],
+        "{found:#?}"
+    );
+    let at = &found[0].related[1];
+    assert_eq!((at.file, &catalog[at.span.range()]), (FileId(1), "b"));
+    assert_eq!(at.message, "`b`: no such task in the graph's top level");
+}
+
+#[test]
+fn each_latency_is_analysed_once_however_many_robots_and_calls() {
+    // Separate declarations are refined apart, and one robot calls `scan`
+    // twice: the latency of the one graph is analysed once all the same,
+    // and twice the robots make no more analyses.
+    let analyses = |robots: usize| {
+        let declarations: Vec<String> = (0..robots).map(|i| format!("Rover r{i}")).collect();
+        let text = format!(
+            "{{ T: {} }}\nT.P.S {{ scan() scan() }} repeat(100 MSEC)\nT.M {{ set(P, S) }}\nT.main {{ default: mode = M }}\n",
+            declarations.join(", ")
+        );
+        let w = Workspace::with_catalog(
+            &format!("latency-once-{robots}"),
+            &text,
+            &bounded_catalog("49 MSEC"),
+            PACED,
+        );
+        let found = w.warnings();
+        assert_eq!(
+            codes(&found),
+            [Code::DataflowLatencyExceeded; 2],
+            "{found:#?}"
+        );
+        let analysis = w.host.analysis();
+        let dataflow = analysis.dataflow(MISSION_ID).unwrap();
+        assert_eq!(dataflow.robots.len(), robots);
+        dataflow.latency_analyses
+    };
+    assert_eq!(analyses(2), 1);
+    assert_eq!(analyses(4), 1);
 }
