@@ -125,9 +125,24 @@ pub struct Memory {
 const CORE: [&str; 3] = ["semo_runtime.h", "semo_internal.h", "semo_core.c"];
 
 /// The runtime files of a Cortex-M board's static schedule: the core, the
-/// loop and the core's SysTick clock (its start-up file and link script
+/// loop and what every Cortex-M shares (reset, SysTick clock, sleep, exit) (its start-up file and link script
 /// come from its [`Board`]).
-const CORTEX_M: [&str; 5] = [CORE[0], CORE[1], CORE[2], "semo_static.c", "semo_systick.c"];
+const CORTEX_M: [&str; 5] = [
+    CORE[0],
+    CORE[1],
+    CORE[2],
+    "semo_static.c",
+    "semo_cortex_m.c",
+];
+
+/// The cross toolchain of the Cortex-M boards (Debian's
+/// `gcc-arm-none-eabi` and `libnewlib-arm-none-eabi`).
+const ARM_NONE_EABI: Toolchain = Toolchain {
+    cc: "arm-none-eabi-gcc",
+    size: "arm-none-eabi-size",
+    libc: "newlib-nano",
+    specs: "nano.specs",
+};
 
 /// Every platform, in the order targets are listed.
 pub const PLATFORMS: &[Platform] = &[
@@ -177,12 +192,7 @@ pub const PLATFORMS: &[Platform] = &[
             name: "TI Stellaris LM3S6965",
             cpu: "Cortex-M3",
             arch: "-mcpu=cortex-m3 -mthumb",
-            toolchain: Toolchain {
-                cc: "arm-none-eabi-gcc",
-                size: "arm-none-eabi-size",
-                libc: "newlib-nano",
-                specs: "nano.specs",
-            },
+            toolchain: ARM_NONE_EABI,
             flash: Memory {
                 origin: 0x0000_0000,
                 kib: 256,
@@ -218,12 +228,7 @@ pub const PLATFORMS: &[Platform] = &[
             cpu: "Cortex-M4",
             // Soft-float, as on the Cortex-M3: the FPU stays off.
             arch: "-mcpu=cortex-m4 -mthumb",
-            toolchain: Toolchain {
-                cc: "arm-none-eabi-gcc",
-                size: "arm-none-eabi-size",
-                libc: "newlib-nano",
-                specs: "nano.specs",
-            },
+            toolchain: ARM_NONE_EABI,
             flash: Memory {
                 origin: 0x0800_0000,
                 kib: 1024,

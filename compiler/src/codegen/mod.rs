@@ -62,7 +62,7 @@ const MQTT: (&str, &str) = ("semo_mqtt.c", include_str!("runtime/semo_mqtt.c"));
 const POSIX_SIM: (&str, &str) = ("semo_sim.c", include_str!("runtime/semo_sim.c"));
 const LOCKSTEP: (&str, &str) = ("semo_lockstep.c", include_str!("runtime/semo_lockstep.c"));
 const STATIC: (&str, &str) = ("semo_static.c", include_str!("runtime/semo_static.c"));
-const SYSTICK: (&str, &str) = ("semo_systick.c", include_str!("runtime/semo_systick.c"));
+const CORTEX_M: (&str, &str) = ("semo_cortex_m.c", include_str!("runtime/semo_cortex_m.c"));
 const LM3S6965: (&str, &str) = ("semo_lm3s6965.c", include_str!("runtime/semo_lm3s6965.c"));
 const LM3S6965_LD: (&str, &str) = ("lm3s6965.ld", LINK_SCRIPT.text);
 const STM32F405: (&str, &str) = ("semo_stm32f405.c", include_str!("runtime/semo_stm32f405.c"));
@@ -97,7 +97,7 @@ const RUNTIME_FILES: &[(&str, &str)] = &[
     POSIX_SIM,
     LOCKSTEP,
     STATIC,
-    SYSTICK,
+    CORTEX_M,
     LM3S6965,
     LM3S6965_LD,
     STM32F405,

@@ -263,7 +263,7 @@ extern const semo__sim_tables semo__scenario;
 
 /* Platform hooks of the static schedule: the board file (semo_lm3s6965.c,
  * semo_stm32f405.c) starts the board and writes the trace's output; the
- * core's timer (semo_systick.c, every Cortex-M) gives a millisecond clock,
+ * core (semo_cortex_m.c, every Cortex-M) gives a millisecond clock,
  * sleeping until a deadline of that clock (or an interrupt: the caller
  * looks at the time again; INT64_MAX: no deadline) and ending the program. */
 #ifdef SEMO_STATIC
@@ -272,10 +272,12 @@ int64_t semo__board_now_ms(void);
 void semo__board_put(void *ctx, const char *bytes, size_t n);
 void semo__board_sleep_until(int64_t deadline_ms);
 void semo__board_exit(int status);
-/* semo_systick.c's: started by the board's init, its handler in the board's
- * vector table. */
+/* semo_cortex_m.c's: the clock started by the board's init; the reset,
+ * SysTick and fault handlers in the board's vector table. */
 void semo__systick_start(void);
+void semo__reset(void);
 void semo__systick(void);
+void semo__fault(void);
 #endif
 
 #ifdef SEMO_MQTT

@@ -1,13 +1,11 @@
 /* semo_lm3s6965.c: the board file of the `cortex-m` targets for the TI
  * Stellaris LM3S6965 (QEMU's `lm3s6965evb`, the Evalbot's family): the
- * vector table and reset code, and UART0 as the trace's output and a
- * wake-up source (a received byte ends a sleep). The clock, the sleep and
- * the exit are the core's (semo_systick.c). Linked with lm3s6965.ld; no C
- * library start-up files (-nostartfiles).
+ * stack, the vector table, and UART0 as the trace's output and a wake-up
+ * source (a received byte ends a sleep). The reset code, the clock, the
+ * sleep, the exit and the fault handler are the core's (semo_cortex_m.c).
+ * Linked with lm3s6965.ld.
  */
 #include "semo_internal.h"
-
-#include <string.h>
 
 /* The main stack, counted in the RAM that arm-none-eabi-size reports (as bss). */
 #ifndef SEMO_STACK_BYTES
@@ -49,20 +47,6 @@ void semo__board_put(void *ctx, const char *bytes, size_t n)
     }
 }
 
-/* ------------------------------------------------------------- start-up */
-
-int main(int argc, char **argv);
-
-extern uint32_t _sidata[], _sdata[], _edata[], _sbss[], _ebss[];
-
-void semo__reset(void);
-void semo__reset(void)
-{
-    memcpy(_sdata, _sidata, (size_t)((char *)_edata - (char *)_sdata));
-    memset(_sbss, 0, (size_t)((char *)_ebss - (char *)_sbss));
-    semo__board_exit(main(0, NULL));
-}
-
 /* A received byte only wakes the loop (nothing reads the UART yet). */
 static void uart0(void)
 {
@@ -73,14 +57,6 @@ static void uart0(void)
     UART0_ICR = UART_IM_RX | UART_IM_RT;
 }
 
-/* A fault or an unexpected interrupt: the program cannot go on. */
-static void fault(void)
-{
-    static const char message[] = "semo runtime: fault\n";
-    semo__board_put(NULL, message, sizeof message - 1);
-    semo__board_exit(1);
-}
-
 typedef union {
     uint32_t *stack_top;
     void (*handler)(void);
@@ -89,25 +65,25 @@ typedef union {
 __attribute__((section(".isr_vector"), used)) static const vector g_vectors[16 + UART0_IRQ + 1] = {
     {.stack_top = &g_stack[SEMO_STACK_BYTES / 4]},
     {.handler = semo__reset},
-    {.handler = fault}, /* NMI */
-    {.handler = fault}, /* HardFault */
-    {.handler = fault}, /* MemManage */
-    {.handler = fault}, /* BusFault */
-    {.handler = fault}, /* UsageFault */
+    {.handler = semo__fault}, /* NMI */
+    {.handler = semo__fault}, /* HardFault */
+    {.handler = semo__fault}, /* MemManage */
+    {.handler = semo__fault}, /* BusFault */
+    {.handler = semo__fault}, /* UsageFault */
     {0},
     {0},
     {0},
     {0},
-    {.handler = fault}, /* SVCall */
-    {.handler = fault}, /* DebugMonitor */
+    {.handler = semo__fault}, /* SVCall */
+    {.handler = semo__fault}, /* DebugMonitor */
     {0},
-    {.handler = fault}, /* PendSV */
+    {.handler = semo__fault}, /* PendSV */
     {.handler = semo__systick},
     /* External interrupts 0..4 (GPIO ports A to E) stay disabled. */
-    {.handler = fault},
-    {.handler = fault},
-    {.handler = fault},
-    {.handler = fault},
-    {.handler = fault},
+    {.handler = semo__fault},
+    {.handler = semo__fault},
+    {.handler = semo__fault},
+    {.handler = semo__fault},
+    {.handler = semo__fault},
     {.handler = uart0},
 };

@@ -9,8 +9,8 @@
  * blocks, nothing is allocated: channels live in the buffers the generated
  * channels.c gives them, everything else in the fixed tables below (sizes
  * overridable with -D). The board file (semo_lm3s6965.c, semo_stm32f405.c)
- * gives the trace's output, the core's SysTick (semo_systick.c) the clock
- * and the exit.
+ * gives the trace's output, the core (semo_cortex_m.c) the clock and the
+ * exit.
  */
 #include "semo_internal.h"
 

@@ -1,16 +1,14 @@
 /* semo_stm32f405.c: the board file of the `stm32f4` targets for the ST
  * STM32F405 (a Cortex-M4; QEMU's `netduinoplus2`, the family of the
- * OpenCR's STM32F7): the vector table and reset code, and USART1 as the
+ * OpenCR's STM32F7): the stack, the vector table, and USART1 as the
  * trace's output and a wake-up source (a received byte ends a sleep). The
- * clock, the sleep and the exit are the core's (semo_systick.c). Linked
- * with stm32f405.ld (flash at 0x08000000, which the chip also shows at 0,
- * where the core reads its vector table at reset); no C library start-up
- * files (-nostartfiles). The floating-point unit stays off: the Makefile
- * compiles for the soft-float ABI, as on the Cortex-M3.
+ * reset code, the clock, the sleep, the exit and the fault handler are the
+ * core's (semo_cortex_m.c). Linked with stm32f405.ld (flash at 0x08000000,
+ * which the chip also shows at 0, where the core reads its vector table at
+ * reset). The floating-point unit stays off: the Makefile compiles for the
+ * soft-float ABI, as on the Cortex-M3.
  */
 #include "semo_internal.h"
-
-#include <string.h>
 
 /* The main stack, counted in the RAM that arm-none-eabi-size reports (as bss). */
 #ifndef SEMO_STACK_BYTES
@@ -59,20 +57,6 @@ void semo__board_put(void *ctx, const char *bytes, size_t n)
     }
 }
 
-/* ------------------------------------------------------------- start-up */
-
-int main(int argc, char **argv);
-
-extern uint32_t _sidata[], _sdata[], _edata[], _sbss[], _ebss[];
-
-void semo__reset(void);
-void semo__reset(void)
-{
-    memcpy(_sdata, _sidata, (size_t)((char *)_edata - (char *)_sdata));
-    memset(_sbss, 0, (size_t)((char *)_ebss - (char *)_sbss));
-    semo__board_exit(main(0, NULL));
-}
-
 /* A received byte only wakes the loop (nothing reads the port yet):
  * reading the data register clears the interrupt. */
 static void usart1(void)
@@ -83,14 +67,6 @@ static void usart1(void)
     }
 }
 
-/* A fault or an unexpected interrupt: the program cannot go on. */
-static void fault(void)
-{
-    static const char message[] = "semo runtime: fault\n";
-    semo__board_put(NULL, message, sizeof message - 1);
-    semo__board_exit(1);
-}
-
 typedef union {
     uint32_t *stack_top;
     void (*handler)(void);
@@ -98,7 +74,7 @@ typedef union {
 
 /* The core's 16 vectors, then the chip's interrupts up to USART1's (37):
  * the others stay disabled, and one taken anyway is a fault. */
-#define FAULT {.handler = fault}
+#define FAULT {.handler = semo__fault}
 #define FAULT4 FAULT, FAULT, FAULT, FAULT
 __attribute__((section(".isr_vector"), used)) static const vector g_vectors[16 + USART1_IRQ + 1] = {
     {.stack_top = &g_stack[SEMO_STACK_BYTES / 4]},

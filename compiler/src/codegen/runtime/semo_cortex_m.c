@@ -1,14 +1,20 @@
-/* semo_systick.c: the mission clock and the sleep of the `cortex-m` boards,
- * on the core's own timer, so the same on every Cortex-M board: SysTick as a
- * tickless clock (it interrupts only when the loop's next deadline comes, or
- * after its longest period: 2^24 cycles), and the exit (through
- * semihosting when built with -DSEMO_SEMIHOSTING, so that a QEMU run ends;
- * on a board the robot halts). The board file (its start-up file, named by
- * the platform table) starts it with semo__systick_start and puts
- * semo__systick in its vector table; SEMO_CPU_HZ, the core clock SysTick
- * counts, comes from the table through the Makefile.
+/* semo_cortex_m.c: what every `cortex-m` board shares, being the core's:
+ * the reset code (.data copied, .bss zeroed, then main), the mission clock
+ * and the sleep on SysTick as a tickless clock (it interrupts only when the
+ * loop's next deadline comes, or after its longest period: 2^24 cycles),
+ * the exit (through semihosting when built with -DSEMO_SEMIHOSTING, so that
+ * a QEMU run ends; on a board the robot halts) and the fault handler. The
+ * board file (its start-up file, named by the platform table) has the stack,
+ * the serial port and the vector table, which names semo__reset,
+ * semo__systick and semo__fault, and starts the clock with
+ * semo__systick_start; SEMO_CPU_HZ, the core clock SysTick counts, comes
+ * from the table through the Makefile. Linked with the board's script
+ * (board.ld.in), which gives the symbols of .data and .bss; no C library
+ * start-up files (-nostartfiles).
  */
 #include "semo_internal.h"
+
+#include <string.h>
 
 #ifndef SEMO_CPU_HZ
 #error "SEMO_CPU_HZ: the core clock, from the board's Makefile"
@@ -129,4 +135,25 @@ void semo__systick(void)
      * the clock is never early). */
     if (g_period != SYSTICK_MAX_CYCLES)
         start_period(SYSTICK_MAX_CYCLES);
+}
+
+/* ------------------------------------------------------------- start-up */
+
+int main(int argc, char **argv);
+
+extern uint32_t _sidata[], _sdata[], _edata[], _sbss[], _ebss[];
+
+void semo__reset(void)
+{
+    memcpy(_sdata, _sidata, (size_t)((char *)_edata - (char *)_sdata));
+    memset(_sbss, 0, (size_t)((char *)_ebss - (char *)_sbss));
+    semo__board_exit(main(0, NULL));
+}
+
+/* A fault or an unexpected interrupt: the program cannot go on. */
+void semo__fault(void)
+{
+    static const char message[] = "semo runtime: fault\n";
+    semo__board_put(NULL, message, sizeof message - 1);
+    semo__board_exit(1);
 }
