@@ -155,6 +155,7 @@ pub fn refine_robots(
         }
     }
     assign_groups(&mut programs);
+    share_control_machines(&mut programs);
     diag::sort_and_dedup(&mut diagnostics);
     (programs, diagnostics)
 }
@@ -172,7 +173,28 @@ fn assign_groups(programs: &mut [RobotProgram]) {
         if !p.control.group_services.is_empty() {
             let mut members = groups[&p.team].clone();
             members.sort_unstable();
-            p.control.group = members;
+            // Each program's machine is still its own (shared only below).
+            std::sync::Arc::make_mut(&mut p.control).group = members;
+        }
+    }
+}
+
+/// Robots whose control machines are equal share one: each program's
+/// machine is compared with the one before it in formation order, where the
+/// robots of a declaration (`name[N]`, refined alike but for their names
+/// and places, which the machine does not hold) sit side by side. One
+/// comparison per robot keeps refinement linear in robots, and a swarm of
+/// one kind of robot holds one machine (the simulator and code generation
+/// read the same machine for each of them).
+fn share_control_machines(programs: &mut [RobotProgram]) {
+    for i in 1..programs.len() {
+        let (before, rest) = programs.split_at_mut(i);
+        let (previous, program) = (&before[i - 1], &mut rest[0]);
+        if previous.team == program.team
+            && !std::sync::Arc::ptr_eq(&previous.control, &program.control)
+            && previous.control == program.control
+        {
+            program.control = std::sync::Arc::clone(&previous.control);
         }
     }
 }

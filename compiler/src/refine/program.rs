@@ -120,7 +120,12 @@ pub struct RobotProgram {
     /// Per channel of `graph`: the samples its buffer holds (the buffer
     /// analysis's bound, at least the capacity refinement declared).
     pub capacities: Vec<u64>,
-    pub control: ControlMachine,
+    /// The control task's machine: one per distinct machine, shared by
+    /// the robots whose machines are equal (the robots of one declaration,
+    /// `name[N]`, are refined alike), so a swarm's programs hold one copy
+    /// per kind of robot, not one per robot, and what reads them (the
+    /// simulator, code generation) reads the same data for each.
+    pub control: Arc<ControlMachine>,
     /// The non-control tasks of `graph` and what each one does.
     pub tasks: Vec<TaskRole>,
     /// Every robot of the mission, in formation order: (team, robot). One
@@ -279,7 +284,7 @@ pub struct SubgraphPort {
 }
 
 /// The control task's machine.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, PartialEq, Default)]
 pub struct ControlMachine {
     pub modes: Vec<ModeState>,
     pub default_mode: Option<ModeId>,
@@ -491,7 +496,7 @@ impl ControlMachine {
 /// `period × level` and each listed actuator task runs at `1 / level` of its
 /// speed (a call takes `level` times as long); when it stops holding, they
 /// return to level 1.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct BatteryPolicy {
     /// The condition as written (`Battery<30`): the trace names the policy by it.
     pub text: String,
@@ -515,7 +520,7 @@ pub const HEARTBEAT_MS: i64 = 200;
 /// [`LeaderAlgorithm::LowestId`] (the first in formation order).
 pub use crate::strategy::LeaderAlgorithm;
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ModeState {
     pub name: String,
     pub line: u32,
@@ -523,14 +528,14 @@ pub struct ModeState {
     pub regions: Vec<Region>,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Region {
     pub plan: String,
     pub service: ServiceMachineId,
     pub timeout_ms: Option<i64>,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ModeTransition {
     pub from: ModeId,
     pub event: String,
@@ -540,7 +545,7 @@ pub struct ModeTransition {
 
 /// A composite service as a sequence of states; execution moves to the next
 /// state unless a state says otherwise.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ServiceMachine {
     pub plan: String,
     pub name: String,
@@ -551,7 +556,7 @@ pub struct ServiceMachine {
     pub marks: usize,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct State {
     pub kind: StateKind,
     /// The mission line the state comes from (1-based).
@@ -564,7 +569,7 @@ pub struct State {
     pub text: String,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum StateKind {
     /// Wait for one sample of each incoming message, storing each in its
     /// slot.
@@ -685,7 +690,7 @@ pub enum StateKind {
 }
 
 /// One arm of a statement of counted groups ([`StateKind::GroupAllocate`]).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct CountedGroup {
     pub name: String,
     pub min: usize,
@@ -714,7 +719,7 @@ pub fn counted_allocation(mins: &[usize], has_others: bool, position: usize) -> 
 }
 
 /// One value of a `send`/`publish`.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SendItem {
     pub message: OutgoingId,
     pub value: Operand,
@@ -727,7 +732,7 @@ pub struct SendItem {
 }
 
 /// A strategy entry's actions: the bottom level of the machine.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ActionMachine {
     pub service: String,
     /// `Strategy file` line of the `<Service>` element.
@@ -738,7 +743,7 @@ pub struct ActionMachine {
     pub arguments: Vec<SlotId>,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct ActionState {
     pub name: String,
     pub id: u64,
@@ -751,7 +756,7 @@ pub struct ActionState {
 }
 
 /// A value of the machine and where it comes from.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Slot {
     /// `MasterTeam.LOCATION`, `USER.RC_CMD`, or `move.goalLocation`.
     pub key: String,
@@ -772,7 +777,7 @@ pub enum SlotSource {
     Local,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct OutgoingMessage {
     pub to_team: String,
     pub publish: bool,
@@ -781,7 +786,7 @@ pub struct OutgoingMessage {
     pub port: String,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct IncomingMessage {
     pub from_team: String,
     pub key: String,

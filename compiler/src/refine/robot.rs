@@ -115,7 +115,7 @@ pub(super) fn refine_robot(
             channels: Vec::new(),
             libraries: Vec::new(),
         },
-        control: machine,
+        control: std::sync::Arc::new(machine),
         tasks,
         peers: std::sync::Arc::clone(peers),
         self_peer,

@@ -323,6 +323,25 @@ fn the_task_graph_has_sensor_service_and_communication_tasks() {
 }
 
 #[test]
+fn robots_of_one_declaration_share_one_control_machine() {
+    let programs = programs(&shared("swarm/patrol_groups.mission"), &[]);
+    let machine = |robot: &str| &program(&programs, robot).control;
+    // `tb[3]`: one machine for the three turtlebots, the same in memory
+    // (not a copy), and another for the Ev3 robots, whose group arm
+    // differs.
+    assert!(std::sync::Arc::ptr_eq(machine("tb_0"), machine("tb_1")));
+    assert!(std::sync::Arc::ptr_eq(machine("tb_0"), machine("tb_2")));
+    assert!(std::sync::Arc::ptr_eq(machine("ev_0"), machine("ev_1")));
+    assert!(!std::sync::Arc::ptr_eq(machine("tb_0"), machine("ev_0")));
+    assert_ne!(**machine("tb_0"), **machine("ev_0"));
+    // What differs between them lies outside the machine.
+    assert_ne!(
+        program(&programs, "tb_0").self_peer,
+        program(&programs, "tb_1").self_peer
+    );
+}
+
+#[test]
 fn group_arms_a_robot_can_never_join_are_dropped() {
     let programs = programs(&shared("swarm/patrol_groups.mission"), &[]);
     // Turtlebots watch the light (group arm); Ev3 robots patrol (others).
