@@ -135,6 +135,13 @@ const CORTEX_M: [&str; 5] = [
     "semo_cortex_m.c",
 ];
 
+/// A Cortex-M board's program and its simulation alike: the static
+/// schedule, no transport to other robots yet (E103).
+const BOARD_PROGRAM: Variant = Variant {
+    transport: None,
+    runtime: &CORTEX_M,
+};
+
 /// The cross toolchain of the Cortex-M boards (Debian's
 /// `gcc-arm-none-eabi` and `libnewlib-arm-none-eabi`).
 const ARM_NONE_EABI: Toolchain = Toolchain {
@@ -180,14 +187,8 @@ pub const PLATFORMS: &[Platform] = &[
         name: "cortex-m",
         doc: "bare metal on a Cortex-M3 (TI Stellaris LM3S6965): a static schedule, no threads, no heap",
         layer: Layer::Static,
-        real: Variant {
-            transport: None,
-            runtime: &CORTEX_M,
-        },
-        sim: Variant {
-            transport: None,
-            runtime: &CORTEX_M,
-        },
+        real: BOARD_PROGRAM,
+        sim: BOARD_PROGRAM,
         board: Some(Board {
             name: "TI Stellaris LM3S6965",
             cpu: "Cortex-M3",
@@ -215,14 +216,8 @@ pub const PLATFORMS: &[Platform] = &[
         name: "stm32f4",
         doc: "bare metal on a Cortex-M4 (ST STM32F405, the OpenCR's family): a static schedule, no threads, no heap",
         layer: Layer::Static,
-        real: Variant {
-            transport: None,
-            runtime: &CORTEX_M,
-        },
-        sim: Variant {
-            transport: None,
-            runtime: &CORTEX_M,
-        },
+        real: BOARD_PROGRAM,
+        sim: BOARD_PROGRAM,
         board: Some(Board {
             name: "ST STM32F405",
             cpu: "Cortex-M4",
