@@ -7,6 +7,12 @@
  * which the chip also shows at 0, where the core reads its vector table at
  * reset). The floating-point unit stays off: the Makefile compiles for the
  * soft-float ABI, as on the Cortex-M3.
+ *
+ * The clock tree is left as it is: SEMO_CPU_HZ (168 MHz) is the core clock
+ * QEMU's netduinoplus2 runs, whatever RCC says. A real STM32F405 starts on
+ * its 16 MHz internal oscillator: there, build with `make
+ * SEMO_CPU_HZ=16000000`, or set the PLL to 168 MHz before
+ * semo__systick_start.
  */
 #include "semo_internal.h"
 
