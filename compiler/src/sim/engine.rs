@@ -433,8 +433,8 @@ struct Robot<'p> {
     /// The last leader each `LeaderBranch` state saw, by (service, pc).
     leaders: HashMap<(ServiceMachineId, StateId), Leader>,
     /// The group each `GroupAllocate` state last gave this robot, by
-    /// (service, pc): its index, or [`OTHERS`].
-    allocated: HashMap<(ServiceMachineId, StateId), usize>,
+    /// (service, pc): its index, or `None` for the others.
+    allocated: HashMap<(ServiceMachineId, StateId), Option<usize>>,
     /// The last (rank, size) in the team's group this robot traced
     /// (`semo_group_set`); `None` before its first heartbeat.
     group: Option<(usize, usize)>,
@@ -2124,13 +2124,13 @@ impl<'p> Sim<'p> {
                 let position = live.iter().position(|&p| p == me).unwrap_or(0);
                 let mins: Vec<usize> = groups.iter().map(|g| g.min).collect();
                 let chosen = counted_allocation(&mins, others_at.is_some(), position);
-                let (key, name, at) = match (chosen, others_at) {
-                    (Some(k), _) => (k, groups[k].name.as_str(), groups[k].at.index()),
-                    (None, Some(at)) => (OTHERS, "others", at.index()),
-                    (None, None) => (OTHERS, "others", next),
+                let (name, at) = match (chosen, others_at) {
+                    (Some(k), _) => (groups[k].name.as_str(), groups[k].at.index()),
+                    (None, Some(at)) => ("others", at.index()),
+                    (None, None) => ("others", next),
                 };
                 let robot = &mut self.robots[r];
-                if robot.allocated.insert((service, StateId::new(pc)), key) != Some(key) {
+                if robot.allocated.insert((service, StateId::new(pc)), chosen) != Some(chosen) {
                     let fields = vec![
                         ("name", name.into()),
                         ("alive", live.len().to_string().into()),
@@ -2482,10 +2482,6 @@ impl<'p> Sim<'p> {
         Some(leader == me)
     }
 }
-
-/// What a `GroupAllocate` state last gave a robot sent to `others` (no group
-/// has this index).
-const OTHERS: usize = usize::MAX;
 
 /// The last leader a `LeaderBranch` state saw.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]

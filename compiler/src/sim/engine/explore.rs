@@ -531,7 +531,11 @@ impl Fingerprint {
         }
         // A leader as its code: a peer's position, or -1 when fenced.
         let leaders = robot.leaders.iter().map(|(&at, &v)| (at, v.code()));
-        let allocated = robot.allocated.iter().map(|(&at, &v)| (at, v as i64));
+        // The others as -1: the bytes hashed before `None` stood for them.
+        let allocated = robot
+            .allocated
+            .iter()
+            .map(|(&at, &v)| (at, v.map_or(-1, |k| k as i64)));
         for mut entries in [leaders.collect::<Vec<_>>(), allocated.collect()] {
             entries.sort_unstable();
             self.int(entries.len() as i64);
