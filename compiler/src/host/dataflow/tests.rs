@@ -616,6 +616,71 @@ fn a_bound_that_cannot_be_checked_says_why() {
     assert_eq!(at.message, "`b`: no such task in the graph's top level");
 }
 
+/// `Z` (10 ms) beside the source `A` (30 ms) both feed `B` (10 ms): `Z`'s
+/// samples pile up on its channel, so the self-timed execution never
+/// repeats and its latency is not known; the minimal one is, by hand
+/// 30 + 10 = 40 ms (`Z`'s sample is there when `A`'s comes).
+const RUNS_AHEAD: &str = r#"<TaskGraph name="scan" xmlns="urn:semo:taskgraph:1">
+  <Task name="Z" wcet="10"><Port name="o" dir="out"/></Task>
+  <Task name="A" wcet="30"><Port name="o" dir="out"/></Task>
+  <Task name="B" wcet="10"><Port name="z" dir="in"/><Port name="a" dir="in"/></Task>
+  <Channel src="Z.o" dst="B.z"/>
+  <Channel src="A.o" dst="B.a"/>
+</TaskGraph>
+"#;
+
+#[test]
+fn a_bound_the_minimal_latency_meets_while_the_self_timed_one_is_unknown_is_checked_in_part() {
+    let text = mission("T.P.S { scan() } repeat(100 MSEC)");
+    let w = Workspace::with_catalog(
+        "latency-in-part",
+        &text,
+        &bounded_catalog("50 MSEC"),
+        RUNS_AHEAD,
+    );
+    let found: Vec<Diagnostic> = w
+        .warnings()
+        .into_iter()
+        .filter(|d| {
+            matches!(
+                d.code,
+                Code::DataflowLatencyUnchecked | Code::DataflowLatencyExceeded
+            )
+        })
+        .collect();
+    assert_eq!(
+        codes(&found),
+        [Code::DataflowLatencyUnchecked],
+        "{found:#?}"
+    );
+    let message = &found[0].message;
+    assert!(
+        message.contains(
+            "is checked only in part: the minimal latency, 40 ms, is within 50 MSEC (50 ms), but the self-timed latency is not known (samples pile up on channel"
+        ),
+        "{message}"
+    );
+    // Over the minimal latency, the bound is broken whatever the other.
+    let w = Workspace::with_catalog(
+        "latency-in-part-over",
+        &text,
+        &bounded_catalog("39 MSEC"),
+        RUNS_AHEAD,
+    );
+    let over: Vec<Code> = w
+        .warnings()
+        .into_iter()
+        .map(|d| d.code)
+        .filter(|c| {
+            matches!(
+                c,
+                Code::DataflowLatencyUnchecked | Code::DataflowLatencyExceeded
+            )
+        })
+        .collect();
+    assert_eq!(over, [Code::DataflowLatencyExceeded]);
+}
+
 #[test]
 fn each_latency_is_analysed_once_however_many_robots_and_calls() {
     // Separate declarations are refined apart, and one robot calls `scan`
