@@ -182,9 +182,14 @@ fn written(result: &codegen::BuildResult) -> String {
 /// link script): those are snapshotted on one mission
 /// (`the_files_of_a_second_board_for_the_follow_robot`).
 fn targets_for_every_mission() -> impl Iterator<Item = Target> {
-    Target::ALL
-        .into_iter()
-        .filter(|t| !matches!(t, Target::Stm32F4 | Target::Stm32F4Sim))
+    // The first platform of each layer, as the table lists them.
+    let first_of_layer = |t: Target| {
+        semo::platform::PLATFORMS
+            .iter()
+            .find(|p| p.layer == t.layer())
+            .is_some_and(|p| p == t.platform())
+    };
+    Target::ALL.into_iter().filter(move |&t| first_of_layer(t))
 }
 
 /// Every target's files of each mission of `missions`, under `folder`.

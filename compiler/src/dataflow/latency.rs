@@ -17,6 +17,7 @@
 use crate::catalog::latency::LatencyBound;
 use crate::diag::{Code, Diagnostic, FileId, Related};
 use crate::span::Span;
+use crate::taskgraph::TaskGraph;
 use crate::taskgraph::analysis::hierarchy_levels;
 use crate::taskgraph::analysis::latency::{self, NoSelfTimed};
 use crate::workspace::GraphRun;
@@ -90,18 +91,16 @@ impl Latencies {
             .entry(key)
             .or_insert_with(|| {
                 *analyses += 1;
-                measure(run, &bound.from.0, &bound.to.0)
+                measure(run, graph, &bound.from.0, &bound.to.0)
             })
             .clone()
     }
 }
 
-/// The latency from task `from` to task `to` of the graph's top level.
-fn measure(run: &GraphRun, from: &str, to: &str) -> Measured {
+/// The latency from task `from` to task `to` of the top level of `graph`,
+/// the graph `run` read.
+fn measure(run: &GraphRun, graph: &TaskGraph, from: &str, to: &str) -> Measured {
     let none = |why: &str| Measured::None(why.to_string());
-    let Some(graph) = run.graph.as_ref() else {
-        return none("the task graph could not be read");
-    };
     // The analyses' own errors first (W070 and W071 on the call say them
     // too), then any other (a format error: the graph is not analysed).
     let top = run.report.levels.first();

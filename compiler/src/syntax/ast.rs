@@ -377,17 +377,13 @@ impl TimeUnit {
         })
     }
 
+    /// [`TimeUnit::whole_millis`] for arithmetic on reals.
     pub fn millis(self) -> f64 {
-        match self {
-            TimeUnit::Msec => 1.0,
-            TimeUnit::Sec => 1_000.0,
-            TimeUnit::Min => 60_000.0,
-            TimeUnit::Hour => 3_600_000.0,
-        }
+        self.whole_millis() as f64
     }
 
-    /// [`TimeUnit::millis`] as a whole number (every unit is a whole
-    /// number of milliseconds), for exact arithmetic.
+    /// The milliseconds of one unit: every unit is a whole number of them,
+    /// for exact arithmetic.
     pub fn whole_millis(self) -> u64 {
         match self {
             TimeUnit::Msec => 1,
