@@ -28,6 +28,13 @@
 //! time: 311.7 MB -> 304.7 MB of peak memory (`/usr/bin/time`), the same
 //! 40,723,064 events and summary; 102 robots x 10 minutes: 39 MB either way,
 //! 997.2M -> 995.1M instructions for 1 minute (callgrind).
+//!
+//! Words and text shared (`Arc<str>`), trace fields inline, a send's
+//! arrivals in a kept list, the scenario's read-only tables shared by
+//! clones: allocations per event 5.42 -> 3.16 (`sim_scaling`); 102 robots x
+//! 1 minute of `semo simulate` 1,106.1M -> 964.1M instructions, 1,002
+//! robots x 10 s 2,426.1M -> 2,180.8M (callgrind, whole command, the same
+//! output).
 
 mod common;
 use common::fastest;

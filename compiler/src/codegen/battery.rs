@@ -60,7 +60,7 @@ pub(super) fn resource_manager(program: &RobotProgram, words: &super::values::Wo
     if m.battery.is_empty() {
         return String::new();
     }
-    let tasks = m.battery_tasks();
+    let tasks: Vec<(&str, bool)> = m.battery_tasks().collect();
     let mut out = String::new();
     out.push_str(&fill(
         &POLICIES,
@@ -156,7 +156,7 @@ pub(super) fn sensor_level_hint(
     task: &str,
     period_ms: i64,
 ) -> Option<String> {
-    let levelled = program.control.battery_tasks().contains(&(task, true));
+    let levelled = program.control.battery_tasks().any(|t| t == (task, true));
     levelled.then(|| {
         fill(
             &SENSOR_LEVEL,
@@ -172,6 +172,6 @@ pub(super) fn sensor_level_hint(
 /// the factor its calls' duration is multiplied by (its speed level, at
 /// least 1), read when a call starts.
 pub(super) fn actuator_speed_scale(program: &RobotProgram, task: &str) -> Option<String> {
-    let levelled = program.control.battery_tasks().contains(&(task, false));
+    let levelled = program.control.battery_tasks().any(|t| t == (task, false));
     levelled.then(|| fill(&SPEED_SCALE, &[("param", &c::string(SPEED_LEVEL_PARAM))]))
 }

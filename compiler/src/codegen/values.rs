@@ -66,7 +66,7 @@ impl Words {
         }
         each_literal(program, &mut |v| {
             if let Value::Word(w) = v {
-                words.insert(w.clone());
+                words.insert(w.to_string());
             }
         });
         Words {

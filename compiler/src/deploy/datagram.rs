@@ -167,8 +167,8 @@ pub fn decode(data: &[u8]) -> Option<Datagram> {
                 _ => return None,
             }))
         }
-        WORD => Some(Value::Word(field(&mut rest)?)),
-        TEXT => Some(Value::Text(field(&mut rest)?)),
+        WORD => Some(Value::Word(field(&mut rest)?.into())),
+        TEXT => Some(Value::Text(field(&mut rest)?.into())),
         _ => return None,
     };
     rest.is_empty().then_some(Datagram {

@@ -475,19 +475,21 @@ impl ControlMachine {
     }
 
     /// The tasks some policy gives a level, in first-mention order: sensors
-    /// (`true`) then actuators (`false`).
-    pub fn battery_tasks(&self) -> Vec<(&str, bool)> {
-        let mut tasks: Vec<(&str, bool)> = Vec::new();
-        for sensor in [true, false] {
-            for p in &self.battery {
-                for (t, _) in if sensor { &p.sensors } else { &p.actuators } {
-                    if !tasks.contains(&(t.as_str(), sensor)) {
-                        tasks.push((t, sensor));
-                    }
-                }
-            }
-        }
-        tasks
+    /// (`true`) then actuators (`false`). Made as they are read, nothing
+    /// allocated: the simulator asks for a call's speed level at every call.
+    pub fn battery_tasks(&self) -> impl Iterator<Item = (&str, bool)> + Clone {
+        [true, false].into_iter().flat_map(move |sensor| {
+            let mentions = self.battery.iter().flat_map(move |p| {
+                let listed = if sensor { &p.sensors } else { &p.actuators };
+                listed.iter().map(|(task, _)| task.as_str())
+            });
+            // A task's first mention only (a handful of tasks per robot).
+            let earlier = mentions.clone();
+            mentions
+                .enumerate()
+                .filter(move |&(k, task)| !earlier.clone().take(k).any(|t| t == task))
+                .map(move |(_, task)| (task, sensor))
+        })
     }
 }
 

@@ -1171,7 +1171,7 @@ impl Builder<'_, '_> {
             names
                 .get(attr.last().as_str())
                 .cloned()
-                .unwrap_or_else(|| Operand::Literal(Value::Word(attr.dotted())))
+                .unwrap_or_else(|| Operand::Literal(Value::Word(attr.dotted().into())))
         };
         // The strategy checker reads a guard as a variable against numbers
         // (strategy::guards): a comparison with a number compares numbers.
@@ -1202,7 +1202,7 @@ impl Builder<'_, '_> {
                 resolved
                     .get(&attr.span)
                     .cloned()
-                    .unwrap_or_else(|| Operand::Literal(Value::Word(attr.dotted())))
+                    .unwrap_or_else(|| Operand::Literal(Value::Word(attr.dotted().into())))
             },
             &mut |e| {
                 mission.compared_at(e.span).unwrap_or_else(|| {
@@ -1254,7 +1254,7 @@ impl Builder<'_, '_> {
             Some(Symbol::Value { .. }) | Some(Symbol::TeamVariable { .. }) => {
                 Operand::Slot(self.shared_slot(attr))
             }
-            Some(Symbol::Constant(name)) => Operand::Literal(Value::Word(name.to_string())),
+            Some(Symbol::Constant(name)) => Operand::Literal(Value::Word(name.into())),
             other => {
                 let what = format!(
                     "`{}` is read as a value, but the checker resolved it to {other:?}",
@@ -1697,7 +1697,7 @@ fn literal_value(kind: &ExprKind) -> Value {
             Some(ms) => Value::Real(ms),
             None => Value::text(""),
         },
-        ExprKind::Attr(a) => Value::Word(a.dotted()),
+        ExprKind::Attr(a) => Value::Word(a.dotted().into()),
         _ => Value::text(""),
     }
 }

@@ -13,6 +13,7 @@
 
 use crate::catalog::ValueType;
 use std::fmt::Write;
+use std::sync::Arc;
 
 /// The bytes a text value holds in the simulator and in a POSIX build
 /// (`SEMO_TEXT_MAX`, `semo_runtime.h`): 63 bytes and the terminating NUL.
@@ -86,9 +87,9 @@ impl ValueKind {
                 if !domain.iter().any(|d| d == text) {
                     return None;
                 }
-                Value::Word(text.to_string())
+                Value::Word(text.into())
             }
-            ValueKind::Text | ValueKind::Variable => Value::Text(cut_text(text)),
+            ValueKind::Text | ValueKind::Variable => Value::Text(cut_text(text).into()),
         })
     }
 
@@ -104,9 +105,9 @@ impl ValueKind {
             | (ValueKind::Text, Value::Text(_)) => Some(value.clone()),
             (ValueKind::Real, Value::Int(i)) => Some(Value::Real(*i as f64)),
             (ValueKind::Word(domain), Value::Word(w)) => {
-                domain.iter().any(|d| d == w).then(|| value.clone())
+                domain.iter().any(|d| **d == **w).then(|| value.clone())
             }
-            (ValueKind::Text, Value::Word(w)) => Some(Value::Text(cut_text(w))),
+            (ValueKind::Text, Value::Word(w)) => Some(Value::Text(cut_text(w).into())),
             (kind, Value::Text(t)) => kind.parse(t),
             _ => None,
         }
@@ -114,13 +115,17 @@ impl ValueKind {
 }
 
 /// A value: a literal of the program, or what a slot holds at run time.
+///
+/// Words and text are shared (`Arc<str>`): the simulator copies a value into
+/// every slot, channel and message that carries it, and `semo verify` clones
+/// whole fleets of them per state, so a copy is a count, not an allocation.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Value {
     Int(i64),
     Real(f64),
     Bool(bool),
-    Word(String),
-    Text(String),
+    Word(Arc<str>),
+    Text(Arc<str>),
 }
 
 impl Value {
@@ -131,13 +136,13 @@ impl Value {
             Some(i) => Value::Int(i),
             None => match parse_real(text) {
                 Some(r) => Value::Real(r),
-                None => Value::Text(cut_text(text)),
+                None => Value::Text(cut_text(text).into()),
             },
         }
     }
 
     pub fn text(text: &str) -> Value {
-        Value::Text(cut_text(text))
+        Value::Text(cut_text(text).into())
     }
 
     /// A value written in a strategy file (a parameter's or an actuator
@@ -147,7 +152,7 @@ impl Value {
             "true" => Value::Bool(true),
             "false" => Value::Bool(false),
             _ if parse_real(text).is_some() => Value::number(text),
-            _ => Value::Word(text.to_string()),
+            _ => Value::Word(text.into()),
         }
     }
 
@@ -157,7 +162,7 @@ impl Value {
             Value::Int(i) => i.to_string(),
             Value::Real(r) => format_real(*r),
             Value::Bool(b) => b.to_string(),
-            Value::Word(w) | Value::Text(w) => w.clone(),
+            Value::Word(w) | Value::Text(w) => w.to_string(),
         }
     }
 

@@ -30,7 +30,7 @@
 
 use super::loss::LossDraws;
 use super::scenario::{Command, DEFAULT_SERVICE_MS, FaultKind, Scenario};
-use super::trace::TraceEvent;
+use super::trace::{Fields, TraceEvent};
 use crate::refine::SENSOR_PERIOD_MS;
 use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
@@ -39,6 +39,7 @@ use crate::refine::{
     ModeId, Operand, OutgoingId, PeerId, RobotProgram, RoleKind, ServiceMachineId, SlotId,
     SlotSource, StateId, StateKind, SyncPointId, counted_allocation,
 };
+use smallvec::smallvec;
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
 
@@ -376,7 +377,7 @@ struct Robot<'p> {
     /// The library task's values, one per shared key (`lib_<name>.c`).
     library: Vec<Held>,
     /// Per slot: its value's place in `library` (shared slots only).
-    library_index: Vec<Option<AttributeId>>,
+    library_index: Rc<[Option<AttributeId>]>,
     /// A library value was written since the control task last read the
     /// library into its slots (otherwise every shared slot holds its value
     /// already, and reading them again, comparing text, is skipped).
@@ -445,9 +446,11 @@ struct Robot<'p> {
     /// sensor's type; `None` when the text is not one, which the sensor
     /// task skips: `semo_sim_sensor` is false), by time.
     sensor_series: Vec<Option<SensorSeries>>,
-    battery: Vec<(i64, f64)>,
+    /// The scenario's battery levels (read only, as `service_ms` and
+    /// `library_index`: shared by the clones `semo verify` makes).
+    battery: Rc<[(i64, f64)]>,
     /// The scenario's time of each service (the last entry of a name counts).
-    service_ms: Vec<(String, i64)>,
+    service_ms: Rc<[(String, i64)]>,
     /// Orders the control firings of robots at the same time: robots that
     /// started earlier fire first, as each firing schedules the next.
     chain: u64,
@@ -521,6 +524,9 @@ pub struct Sim<'p> {
     channel_full: Rc<str>,
     /// `semo verify`'s races, when it watches for them ([`Sim::watch_races`]).
     races: Option<Vec<Race>>,
+    /// A send's arrivals (instant, order, robot, its epoch), kept between
+    /// sends for its room: a send allocates no list of its own.
+    arrivals: Vec<(i64, u64, usize, u32)>,
 }
 
 impl<'p> Robot<'p> {
@@ -647,8 +653,8 @@ impl<'p> Robot<'p> {
             tasks,
             has_receiver: m.has_receiver(),
             sensor_series,
-            battery: world.map(|w| w.battery.clone()).unwrap_or_default(),
-            service_ms: world.map(|w| w.services.clone()).unwrap_or_default(),
+            battery: world.map_or_else(|| Rc::from([]), |w| Rc::from(w.battery.as_slice())),
+            service_ms: world.map_or_else(|| Rc::from([]), |w| Rc::from(w.services.as_slice())),
             chain: 0,
             next_fire: None,
             fire_token: 0,
@@ -731,6 +737,7 @@ impl<'p> Sim<'p> {
             restarts_due: 0,
             channel_full: "channel full".into(),
             races: None,
+            arrivals: Vec::new(),
         };
         sim.inputs = sim.robots.iter().map(Inputs::of).collect();
         for r in 0..programs.len() {
@@ -778,7 +785,7 @@ impl<'p> Sim<'p> {
         );
     }
 
-    fn emit(&mut self, robot: usize, event: &'static str, fields: Vec<(&'static str, Rc<str>)>) {
+    fn emit(&mut self, robot: usize, event: &'static str, fields: Fields) {
         self.trace.push(TraceEvent {
             t: self.now,
             robot,
@@ -794,7 +801,7 @@ impl<'p> Sim<'p> {
         self.emit(
             r,
             "start",
-            vec![
+            smallvec![
                 ("team", p.team.as_str().into()),
                 ("type", p.robot_type.as_str().into()),
                 ("mission", p.mission.as_str().into()),
@@ -992,7 +999,7 @@ impl<'p> Sim<'p> {
         if self.robots[r].alive {
             self.robots[r].alive = false;
             self.running -= 1;
-            self.emit(r, "fault", vec![("fault", "kill".into())]);
+            self.emit(r, "fault", smallvec![("fault", "kill".into())]);
         }
     }
 
@@ -1003,7 +1010,7 @@ impl<'p> Sim<'p> {
             let epoch = self.robots[r].epoch + 1;
             self.robots[r] = Robot::new(self.robots[r].program, self.scenario, self.now, epoch);
             self.running += 1;
-            self.emit(r, "fault", vec![("fault", "restart".into())]);
+            self.emit(r, "fault", smallvec![("fault", "restart".into())]);
             self.start(r);
         }
     }
@@ -1026,7 +1033,7 @@ impl<'p> Sim<'p> {
         self.robots[r].alive = false;
         self.running -= 1;
         self.trace_dropped(r);
-        self.emit(r, "stop", Vec::new());
+        self.emit(r, "stop", Fields::new());
     }
 
     /// The runtime's summary at stop (`semo__trace_dropped_samples`): per
@@ -1046,7 +1053,7 @@ impl<'p> Sim<'p> {
                 "{}.{}->{}.{}",
                 c.src.task, c.src.port, c.dst.task, c.dst.port
             );
-            let fields = vec![
+            let fields = smallvec![
                 ("channel", channel.into()),
                 ("count", count.to_string().into()),
             ];
@@ -1157,7 +1164,7 @@ impl<'p> Sim<'p> {
             t: self.now,
             robot: r,
             event: "send",
-            fields: vec![("to", to.clone()), ("key", key.clone())],
+            fields: smallvec![("to", to.clone()), ("key", key.clone())],
             value: Some(("value", value.clone())),
             sent_at: None,
         });
@@ -1180,7 +1187,7 @@ impl<'p> Sim<'p> {
         // Each recipient in turn takes the next number of the queue's
         // order; those reached at the same instant share one entry, under
         // the first one's number (nothing else is numbered between them).
-        let mut arrivals: Vec<(i64, u64, usize, u32)> = Vec::new();
+        let mut arrivals = std::mem::take(&mut self.arrivals);
         for &dst in targets.iter() {
             if dst == r {
                 continue;
@@ -1203,6 +1210,7 @@ impl<'p> Sim<'p> {
                 .push(Queued::new(at, Event::Deliver { to, message }, tie));
             self.queued += 1;
         }
+        self.arrivals = arrivals;
     }
 
     /// The latency of a message from `a` to `b` now, or `None` when it is lost.
@@ -1306,7 +1314,7 @@ impl<'p> Sim<'p> {
             let (from, key) = (holding.from.clone(), holding.key.clone());
             let waits = !holding.pending.is_empty();
             if dropped {
-                let fields = vec![
+                let fields = smallvec![
                     ("from", from),
                     ("key", key),
                     ("reason", self.channel_full.clone()),
@@ -1338,7 +1346,7 @@ impl<'p> Sim<'p> {
             t: self.now,
             robot: r,
             event: "receive",
-            fields: vec![
+            fields: smallvec![
                 ("from", message.from_team.clone()),
                 ("from_robot", message.from_robot.clone()),
                 ("key", message.key.clone()),
@@ -1356,7 +1364,7 @@ impl<'p> Sim<'p> {
         if m.heartbeat && message.publish && message.key == names.alive_key {
             // A heartbeat's value is text ("leader 80 2"); anything else says nothing.
             let text = match &message.value {
-                Some(Value::Text(t)) => t.as_str(),
+                Some(Value::Text(t)) => t,
                 _ => "",
             };
             let heard = Heard::parse(self.now, text);
@@ -1370,7 +1378,7 @@ impl<'p> Sim<'p> {
         if !m.sync_points.is_empty() && message.key == names.sync_key {
             // Its value is text ("<point> <pass>"); anything else says nothing.
             let text = match &message.value {
-                Some(Value::Text(t)) => t.as_str(),
+                Some(Value::Text(t)) => t,
                 _ => "",
             };
             let mut words = text.split(' ');
@@ -1430,7 +1438,7 @@ impl<'p> Sim<'p> {
             });
         }
         if rejected {
-            let fields = vec![
+            let fields = smallvec![
                 ("key", message.key.clone()),
                 ("reason", "not a value of its type".into()),
             ];
@@ -1486,7 +1494,7 @@ impl<'p> Sim<'p> {
             t: self.now,
             robot: r,
             event: "call_start",
-            fields: vec![("task", task.clone()), ("service", service)],
+            fields: smallvec![("task", task.clone()), ("service", service)],
             value: Some(("arg", arg.clone())),
             sent_at: None,
         });
@@ -1495,7 +1503,7 @@ impl<'p> Sim<'p> {
                 t: self.now,
                 robot: r,
                 event: "actuate",
-                fields: vec![("task", task.clone())],
+                fields: smallvec![("task", task.clone())],
                 value: Some(("value", arg)),
                 sent_at: None,
             });
@@ -1516,7 +1524,7 @@ impl<'p> Sim<'p> {
     fn end_call(&mut self, r: usize, t: usize) {
         let (task, state) = &mut self.robots[r].tasks[t];
         state.busy = false;
-        let fields = vec![("task", task.clone()), ("service", state.service.clone())];
+        let fields = smallvec![("task", task.clone()), ("service", state.service.clone())];
         self.emit(r, "call_end", fields);
     }
 
@@ -1556,7 +1564,7 @@ impl<'p> Sim<'p> {
     // -------------------------------------------------------- the machine
 
     fn throw_event(&mut self, r: usize, event: &str) {
-        self.emit(r, "throw", vec![("name", event.into())]);
+        self.emit(r, "throw", smallvec![("name", event.into())]);
         self.catch_event(r, event);
     }
 
@@ -1564,7 +1572,7 @@ impl<'p> Sim<'p> {
     /// the thrower's group told (the event's name as text, key
     /// `Team.__event`), then caught here as `throw E` is.
     fn throw_broadcast(&mut self, r: usize, event: &str, messages: &[OutgoingId]) {
-        let fields = vec![("name", event.into()), ("broadcast", "true".into())];
+        let fields = smallvec![("name", event.into()), ("broadcast", "true".into())];
         self.emit(r, "throw", fields);
         for &message in messages {
             let (to, key) = self.names[r].outgoing[message.index()].clone();
@@ -1599,7 +1607,7 @@ impl<'p> Sim<'p> {
         };
         self.robots[r].pending_mode = Some(t.to);
         let mode = m.mode(t.to).name.clone();
-        let mut fields = vec![("name", event.into()), ("mode", mode.into())];
+        let mut fields = smallvec![("name", event.into()), ("mode", mode.into())];
         if let Some(from) = from {
             fields.push(("from", from));
         }
@@ -1615,11 +1623,11 @@ impl<'p> Sim<'p> {
         let robot = &self.robots[r];
         let heard = &robot.program.control.events_heard;
         let event = match &message.value {
-            Some(Value::Text(t)) => heard.binary_search_by(|e| e.as_str().cmp(t.as_str())).ok(),
+            Some(Value::Text(t)) => heard.binary_search_by(|e| e.as_str().cmp(t)).ok(),
             _ => None,
         };
         let (Some(event), Some(peer)) = (event, sender_peer(robot.program, message)) else {
-            let fields = vec![
+            let fields = smallvec![
                 ("key", message.key.clone()),
                 ("reason", "not an event it hears".into()),
             ];
@@ -1627,7 +1635,7 @@ impl<'p> Sim<'p> {
             return;
         };
         if robot.events.len() >= crate::refine::EVENT_QUEUE {
-            let fields = vec![
+            let fields = smallvec![
                 ("from", message.from_robot.clone()),
                 ("name", heard[event].as_str().into()),
                 ("reason", "too many events".into()),
@@ -1650,7 +1658,7 @@ impl<'p> Sim<'p> {
             let name = program.control.events_heard[event].as_str();
             let from: Rc<str> = program.peer(peer).1.as_str().into();
             if !self.catch_event_from(r, name, Some(from.clone())) {
-                let fields = vec![
+                let fields = smallvec![
                     ("from", from),
                     ("name", name.into()),
                     ("reason", "not caught".into()),
@@ -1667,7 +1675,11 @@ impl<'p> Sim<'p> {
             region.done = true;
         }
         self.robots[r].current_mode = Some(mode);
-        self.emit(r, "mode", vec![("mode", m.mode(mode).name.as_str().into())]);
+        self.emit(
+            r,
+            "mode",
+            smallvec![("mode", m.mode(mode).name.as_str().into())],
+        );
         for (i, region) in m.mode(mode).regions.iter().enumerate() {
             let slot = &mut self.robots[r].regions[i];
             slot.service = Some(region.service);
@@ -1685,7 +1697,7 @@ impl<'p> Sim<'p> {
             region.done = false;
             region.started = now;
             region.pass_start = now;
-            let fields = vec![
+            let fields = smallvec![
                 ("plan", region.plan.as_str().into()),
                 ("service", m.service(service).name.as_str().into()),
             ];
@@ -1700,7 +1712,7 @@ impl<'p> Sim<'p> {
             if let Some(service) = region.service
                 && !region.done
             {
-                let fields = vec![
+                let fields = smallvec![
                     ("plan", region.plan.as_str().into()),
                     ("service", m.service(service).name.as_str().into()),
                     ("why", "mode change".into()),
@@ -1742,7 +1754,7 @@ impl<'p> Sim<'p> {
             match m.default_mode {
                 Some(d) => self.enter_mode(r, d),
                 None => {
-                    self.emit(r, "finish", vec![("why", "no default mode".into())]);
+                    self.emit(r, "finish", smallvec![("why", "no default mode".into())]);
                     self.stop(r);
                     return;
                 }
@@ -1764,7 +1776,7 @@ impl<'p> Sim<'p> {
             if region.timeout_ms > 0 && self.now - region.started > region.timeout_ms {
                 let plan: Rc<str> = region.plan.as_str().into();
                 self.robots[r].regions[i].done = true;
-                let fields = vec![
+                let fields = smallvec![
                     ("plan", plan),
                     ("service", m.service(service).name.as_str().into()),
                     ("why", "timeout".into()),
@@ -1791,7 +1803,7 @@ impl<'p> Sim<'p> {
             if result == Step::Done {
                 let region = &mut self.robots[r].regions[i];
                 region.done = true;
-                let fields = vec![
+                let fields = smallvec![
                     ("plan", region.plan.as_str().into()),
                     ("service", m.service(service).name.as_str().into()),
                 ];
@@ -1811,7 +1823,7 @@ impl<'p> Sim<'p> {
                 .current_mode
                 .map(|c| m.mode(c).name.clone())
                 .unwrap_or_default();
-            self.emit(r, "finish", vec![("mode", mode.into())]);
+            self.emit(r, "finish", smallvec![("mode", mode.into())]);
             self.stop(r);
         }
     }
@@ -1958,7 +1970,7 @@ impl<'p> Sim<'p> {
                     if now - self.robots[r].regions[i].marks[mark.index()] <= *t {
                         return Step::Wait;
                     }
-                    self.emit(r, "timeout", vec![("statement", "receive".into())]);
+                    self.emit(r, "timeout", smallvec![("statement", "receive".into())]);
                     let region = self.region(r, i);
                     region.phase = 0;
                     region.pc = next;
@@ -2035,7 +2047,11 @@ impl<'p> Sim<'p> {
                     .is_some_and(|t| now - self.robots[r].regions[i].marks[mark.index()] > t);
                 if timed_out {
                     self.stop_task(r, task);
-                    self.emit(r, "timeout", vec![("service", service.as_str().into())]);
+                    self.emit(
+                        r,
+                        "timeout",
+                        smallvec![("service", service.as_str().into())],
+                    );
                 } else if self.busy(r, task) {
                     return Step::Wait;
                 }
@@ -2066,13 +2082,17 @@ impl<'p> Sim<'p> {
                     self.emit(
                         r,
                         "actions_start",
-                        vec![("service", service.as_str().into())],
+                        smallvec![("service", service.as_str().into())],
                     );
                 }
                 if let Some(t) = timeout_ms
                     && now - self.robots[r].regions[i].marks[mark.index()] > *t
                 {
-                    self.emit(r, "timeout", vec![("service", service.as_str().into())]);
+                    self.emit(
+                        r,
+                        "timeout",
+                        smallvec![("service", service.as_str().into())],
+                    );
                     let region = self.region(r, i);
                     region.phase = 0;
                     region.pc = next;
@@ -2081,7 +2101,11 @@ impl<'p> Sim<'p> {
                 if self.actions(r, i, am) != Step::Done {
                     return Step::Wait;
                 }
-                self.emit(r, "actions_end", vec![("service", service.as_str().into())]);
+                self.emit(
+                    r,
+                    "actions_end",
+                    smallvec![("service", service.as_str().into())],
+                );
                 let region = self.region(r, i);
                 region.phase = 0;
                 region.pc = next;
@@ -2131,7 +2155,7 @@ impl<'p> Sim<'p> {
                 };
                 let robot = &mut self.robots[r];
                 if robot.allocated.insert((service, StateId::new(pc)), chosen) != Some(chosen) {
-                    let fields = vec![
+                    let fields = smallvec![
                         ("name", name.into()),
                         ("alive", live.len().to_string().into()),
                     ];
@@ -2180,10 +2204,10 @@ impl<'p> Sim<'p> {
                     return Step::Wait;
                 }
                 if waiting {
-                    self.emit(r, "timeout", vec![("statement", "GroupSync".into())]);
+                    self.emit(r, "timeout", smallvec![("statement", "GroupSync".into())]);
                 } else {
                     let line = state.line.to_string();
-                    self.emit(r, "group_sync", vec![("line", line.into())]);
+                    self.emit(r, "group_sync", smallvec![("line", line.into())]);
                 }
                 let region = self.region(r, i);
                 region.phase = 0;
@@ -2323,7 +2347,7 @@ impl<'p> Sim<'p> {
                 incoming.key.as_str().into(),
             );
             for _ in 0..waiting {
-                let fields = vec![
+                let fields = smallvec![
                     ("from", from.clone()),
                     ("key", key.clone()),
                     ("reason", crate::refine::protocol::UNLED_REASON.into()),
@@ -2448,7 +2472,7 @@ impl<'p> Sim<'p> {
                 robot.fenced = Some(None);
                 if robot.leaders.insert(state, Leader::Fenced) != Some(Leader::Fenced) {
                     let counted = crate::refine::protocol::fenced_heard(heard, candidates.len());
-                    self.emit(r, "fenced", vec![("heard", counted.into())]);
+                    self.emit(r, "fenced", smallvec![("heard", counted.into())]);
                 }
                 return None;
             }
@@ -2477,7 +2501,7 @@ impl<'p> Sim<'p> {
         if robot.leaders.get(&state) != Some(&Leader::Robot(leader)) {
             robot.leaders.insert(state, Leader::Robot(leader));
             let name = robot.program.peer(leader).1.clone();
-            self.emit(r, "leader", vec![("leader", name.into())]);
+            self.emit(r, "leader", smallvec![("leader", name.into())]);
         }
         Some(leader == me)
     }
@@ -2649,7 +2673,7 @@ impl Sim<'_> {
         self.emit(
             r,
             "group",
-            vec![
+            smallvec![
                 ("rank", rank.to_string().into()),
                 ("size", live.len().to_string().into()),
             ],

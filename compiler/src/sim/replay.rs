@@ -19,7 +19,6 @@ use super::trace::TraceEvent;
 use crate::fasthash::{FastMap, FastSet};
 use crate::refine::RobotProgram;
 use crate::refine::value::Value;
-use std::rc::Rc;
 
 /// The longest trace line read, in bytes (a `graph_fire` line, the longest
 /// the runtime writes, is under 9 KiB); longer is an error at the line.
@@ -264,7 +263,7 @@ impl<'p> Replay<'p> {
                 EVENTS.iter().copied(),
             ));
         };
-        let mut fields: Vec<(&'static str, Rc<str>)> = Vec::new();
+        let mut fields = super::trace::Fields::new();
         let mut typed = None;
         for (key, v) in members {
             if matches!(key.as_str(), "t" | "robot" | "event") {

@@ -8,6 +8,10 @@ use crate::refine::value::{self, Value};
 use std::fmt::Write;
 use std::rc::Rc;
 
+/// A trace event's string fields: inline up to three (most events), so
+/// that making an event allocates no list.
+pub type Fields = smallvec::SmallVec<[(&'static str, Rc<str>); 3]>;
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct TraceEvent {
     /// Mission ms.
@@ -16,7 +20,7 @@ pub struct TraceEvent {
     pub robot: usize,
     pub event: &'static str,
     /// String fields in the order the runtime writes them.
-    pub fields: Vec<(&'static str, Rc<str>)>,
+    pub fields: Fields,
     /// The typed value written after them (`semo_trace_value`): its key and
     /// the value (`None`: no value, `null`).
     pub value: Option<(&'static str, Option<Value>)>,
@@ -111,7 +115,7 @@ mod tests {
             t: 40,
             robot: 0,
             event: "send",
-            fields: vec![("to", "USER".into())],
+            fields: smallvec::smallvec![("to", "USER".into())],
             value: Some(("value", Some(Value::text("a\"b\n")))),
             sent_at: None,
         };

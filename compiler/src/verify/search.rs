@@ -135,6 +135,7 @@ pub fn explore(
         }
     }
     let mut t = 0;
+    let mut trace_hint = 0;
     while !frontier.is_empty() && !over_budget {
         if t >= options.horizon_ms {
             break;
@@ -163,9 +164,12 @@ pub fn explore(
                     (sim.clone(), world.clone())
                 };
                 apply(&mut child, &mut child_world, inputs, &choice);
+                // About as many events as the step before.
+                child.reserve_trace(trace_hint);
                 child.run_to(next_t);
                 explored.transitions += 1;
                 let trace = child.take_trace();
+                trace_hint = trace.len();
                 let label = judge.label(&nodes[id as usize], &trace);
                 for race in child.take_races() {
                     let statement = |(service, state): StateAt| {

@@ -54,7 +54,7 @@ impl Builder<'_, '_> {
                     if attr.last().as_str().eq_ignore_ascii_case("battery") {
                         Operand::Slot(battery)
                     } else {
-                        Operand::Literal(crate::refine::Value::Word(attr.dotted()))
+                        Operand::Literal(crate::refine::Value::Word(attr.dotted().into()))
                     }
                 };
                 let mut compare_as = |e: &crate::syntax::ast::Expr| match &e.kind {

@@ -9,6 +9,7 @@
 //! call (the level when the call starts).
 
 use super::{Robot, SENSOR_PERIOD_MS, Sim};
+use smallvec::smallvec;
 use std::rc::Rc;
 
 /// When a sensor task a policy names samples: the last sample, the next
@@ -35,12 +36,11 @@ pub(super) struct Resources {
 impl Resources {
     pub(super) fn new(program: &crate::refine::RobotProgram, started_at: i64) -> Resources {
         let m = &program.control;
-        let tasks = m.battery_tasks();
         Resources {
             holds: vec![false; m.battery.len()],
-            levels: vec![1; tasks.len()],
-            sampling: tasks
-                .iter()
+            levels: vec![1; m.battery_tasks().count()],
+            sampling: m
+                .battery_tasks()
                 .filter(|(_, sensor)| *sensor)
                 .map(|(task, _)| Sampling {
                     task: task.to_string(),
@@ -108,8 +108,7 @@ impl Robot<'_> {
     pub(super) fn speed_scale(&self, task: &str) -> i64 {
         let m = &self.program.control;
         m.battery_tasks()
-            .iter()
-            .position(|t| *t == (task, false))
+            .position(|t| t == (task, false))
             .map_or(1, |k| self.resources.levels[k] as i64)
     }
 }
@@ -127,21 +126,21 @@ impl Sim<'_> {
             if holds != self.robots[r].resources.holds[i] {
                 self.robots[r].resources.holds[i] = holds;
                 self.robots[r].progressed = true;
-                let fields = vec![
+                let fields = smallvec![
                     ("condition", Rc::from(policy.text.as_str())),
                     ("holds", Rc::from(if holds { "true" } else { "false" })),
                 ];
                 self.emit(r, "battery_policy", fields);
             }
         }
-        for (k, (task, sensor)) in m.battery_tasks().into_iter().enumerate() {
+        for (k, (task, sensor)) in m.battery_tasks().enumerate() {
             let level = m.battery_level(task, sensor, &self.robots[r].resources.holds);
             if level == self.robots[r].resources.levels[k] {
                 continue;
             }
             let resources = &mut self.robots[r].resources;
             resources.levels[k] = level;
-            let mut fields = vec![
+            let mut fields = smallvec![
                 ("task", Rc::from(task)),
                 ("level", Rc::from(level.to_string().as_str())),
             ];

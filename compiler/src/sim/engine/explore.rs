@@ -87,6 +87,12 @@ impl<'p> Sim<'p> {
         std::mem::take(&mut self.trace)
     }
 
+    /// Makes room for `events` more trace events at once (a step's trace
+    /// grown one event at a time is copied at every doubling).
+    pub fn reserve_trace(&mut self, events: usize) {
+        self.trace.reserve(events);
+    }
+
     /// How many robots the mission has.
     pub fn robot_count(&self) -> usize {
         self.robots.len()

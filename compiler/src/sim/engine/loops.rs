@@ -26,10 +26,11 @@
 //! `release` is the start), and the call's service time counts from the
 //! iteration's end; a stop ends the call then (`Sim::stop_task`).
 
-use super::{Event, Sim};
+use super::{Event, Fields, Sim};
 use crate::refine::protocol::GRAPH_TEXT_MAX;
 use crate::refine::{GraphChannelId, GraphService, GraphStep, InnerTaskId, LoopPort};
 use crate::sim::trace::TraceEvent;
+use smallvec::smallvec;
 use std::collections::{HashMap, VecDeque};
 use std::rc::Rc;
 
@@ -177,7 +178,7 @@ fn text(tokens: &[i64]) -> Rc<str> {
 
 impl GraphRun<'_, '_> {
     /// A trace line at the iteration's time: now, or when it is due.
-    fn emit(&mut self, event: &'static str, fields: Vec<(&'static str, Rc<str>)>) {
+    fn emit(&mut self, event: &'static str, fields: Fields) {
         let line = TraceEvent {
             t: self.clock,
             robot: self.robot,
@@ -210,7 +211,7 @@ impl GraphRun<'_, '_> {
 
     fn broken(&mut self, channel: GraphChannelId, what: &str) -> Broken {
         let label = self.service.channels[channel.index()].label.as_str();
-        let fields = vec![
+        let fields = smallvec![
             ("graph", self.graph.clone()),
             ("channel", Rc::from(label)),
             ("error", Rc::from(what)),
@@ -279,7 +280,7 @@ impl GraphRun<'_, '_> {
             })
             .collect();
         let wrote: Vec<i64> = written.iter().flatten().copied().collect();
-        let mut fields = vec![
+        let mut fields = smallvec![
             ("graph", self.graph.clone()),
             ("task", Rc::from(path)),
             ("read", text(&read)),
@@ -370,7 +371,7 @@ impl GraphRun<'_, '_> {
                             }
                         }
                     }
-                    let fields = vec![
+                    let fields = smallvec![
                         ("graph", self.graph.clone()),
                         ("loop", Rc::from(path.as_str())),
                         ("iterations", Rc::from(n.to_string().as_str())),

@@ -7,6 +7,7 @@
 
 use super::{Held, Message, Sim};
 use crate::refine::{AttributeId, GlobalValue, PeerId};
+use smallvec::smallvec;
 use std::rc::Rc;
 
 impl Sim<'_> {
@@ -70,7 +71,7 @@ impl Sim<'_> {
         self.robots[r].owner = next;
         self.robots[r].progressed = true;
         let library: Rc<str> = program.library.as_ref().map_or("", |l| &l.name).into();
-        let fields = vec![
+        let fields = smallvec![
             ("library", library),
             ("owner", program.peer(next).1.as_str().into()),
             ("lost", program.peer(was).1.as_str().into()),
@@ -139,7 +140,7 @@ impl Sim<'_> {
             t: self.now,
             robot: r,
             event: "shared_set",
-            fields: vec![("key", key), ("owner", program.peer(to).1.as_str().into())],
+            fields: smallvec![("key", key), ("owner", program.peer(to).1.as_str().into())],
             value: Some(("value", value.clone())),
             sent_at: None,
         });
@@ -172,7 +173,7 @@ impl Sim<'_> {
             Some(v) => g.kind.coerce(v).map(Some),
             None => Some(None),
         }) else {
-            let fields = vec![
+            let fields = smallvec![
                 ("key", message.key.clone()),
                 ("reason", "not a value of its type".into()),
             ];
@@ -183,7 +184,7 @@ impl Sim<'_> {
         if set {
             let to = self.current_owner(r);
             if to != program.self_peer {
-                let fields = vec![
+                let fields = smallvec![
                     ("key", message.key.clone()),
                     ("reason", "not the owner".into()),
                 ];
@@ -196,7 +197,7 @@ impl Sim<'_> {
                 t: self.now,
                 robot: r,
                 event: "shared_set",
-                fields: vec![
+                fields: smallvec![
                     ("key", key),
                     ("owner", program.robot.as_str().into()),
                     ("from", message.from_robot.clone()),
@@ -212,7 +213,7 @@ impl Sim<'_> {
                 t: self.now,
                 robot: r,
                 event: "shared_value",
-                fields: vec![("key", key), ("from", message.from_robot.clone())],
+                fields: smallvec![("key", key), ("from", message.from_robot.clone())],
                 value: Some(("value", value)),
                 sent_at: None,
             });
