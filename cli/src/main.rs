@@ -338,7 +338,7 @@ enum Command {
         in each class its comparisons tell apart; each operator command a robot reads), one \
         choice per step of the world's clock. States met before are not explored again, so \
         a mission that repeats itself is explored completely (a proof for those choices), \
-        else up to --horizon or --max-states (bounded; the report says which). Reports a \
+        else up to --horizon, --max-states or --max-memory (bounded; the report says which). Reports a \
         mode no robot of its team ever enters (V001), a robot that can reach a state \
         from which it never finishes though it finishes in other behaviours (V002), and a \
         robot that can reach a `receive` where it waits for ever (V003). With --faults N the \
@@ -373,6 +373,11 @@ enum Command {
         /// States beyond which the search stops.
         #[arg(long, default_value_t = 50_000)]
         max_states: usize,
+        /// Memory beyond which the search stops: about what the states it
+        /// keeps to explore and its graph of states met hold (`512MB`,
+        /// `2GB`; a state of a 20-robot mission is about 70 KB).
+        #[arg(long, value_parser = verify::parse_bytes, default_value = "1GiB")]
+        max_memory: usize,
         /// How many times after the start the world may choose along one
         /// behaviour (a sensor value into another class, an operator command).
         #[arg(long, default_value_t = 2)]
@@ -912,6 +917,7 @@ fn run() -> i32 {
             step,
             horizon,
             max_states,
+            max_memory,
             changes,
             faults,
             network,
@@ -929,6 +935,7 @@ fn run() -> i32 {
                     step_ms: step,
                     horizon_ms: horizon,
                     max_states,
+                    max_memory,
                     changes,
                     faults,
                     network,

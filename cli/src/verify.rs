@@ -21,6 +21,31 @@ pub struct Options {
     pub expect: Option<PathBuf>,
 }
 
+/// A memory size: a whole number of bytes, or with a unit (`kB`, `MB`, `GB`
+/// in powers of 1000; `KiB`, `MiB`, `GiB` in powers of 1024).
+pub fn parse_bytes(text: &str) -> Result<usize, String> {
+    let split = text
+        .find(|c: char| !c.is_ascii_digit())
+        .unwrap_or(text.len());
+    let (number, unit) = text.split_at(split);
+    let scale: usize = match unit.to_ascii_lowercase().as_str() {
+        "" | "b" => 1,
+        "kb" => 1000,
+        "mb" => 1000 * 1000,
+        "gb" => 1000 * 1000 * 1000,
+        "kib" => 1 << 10,
+        "mib" => 1 << 20,
+        "gib" => 1 << 30,
+        _ => return Err(format!("unknown unit `{unit}` (kB, MB, GB, KiB, MiB, GiB)")),
+    };
+    number
+        .parse::<usize>()
+        .ok()
+        .and_then(|n| n.checked_mul(scale))
+        .filter(|n| *n > 0)
+        .ok_or_else(|| format!("`{text}` is not a positive size such as 512MB or 2GiB"))
+}
+
 pub fn run(options: Options, out: &mut impl Write) -> i32 {
     let format = options.format;
     if let Some(problem) = options.search.problem() {
@@ -96,6 +121,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         "states": report.states,
         "transitions": report.transitions,
         "explored_ms": report.reached_ms,
+        "bounded_by": report.bound.map(|b| b.name()),
         "reductions": if options.search.merge_in_time {
             vec!["merge_in_time"]
         } else {
@@ -338,4 +364,25 @@ fn write_counterexamples(
         written.push(Some(write_replay(dir, &name, &text, programs)?));
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_bytes;
+
+    #[test]
+    fn sizes_read_in_bytes_with_decimal_and_binary_units() {
+        assert_eq!(parse_bytes("4096"), Ok(4096));
+        assert_eq!(parse_bytes("512MB"), Ok(512_000_000));
+        assert_eq!(parse_bytes("2GiB"), Ok(2 << 30));
+        assert_eq!(parse_bytes("64kb"), Ok(64_000));
+        assert!(parse_bytes("0MB").is_err());
+        assert!(
+            parse_bytes("1TB")
+                .unwrap_err()
+                .contains("unknown unit `TB`")
+        );
+        assert!(parse_bytes("MB").is_err());
+        assert!(parse_bytes("99999999999999999999GB").is_err());
+    }
 }

@@ -14,11 +14,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use tower_lsp_server::ls_types::Uri;
 
-/// The editor's search: a minute of mission time, twenty thousand states.
+/// The editor's search: a minute of mission time, twenty thousand states,
+/// 256 MiB (beside the editor's own memory: a swarm's states are large).
 fn options(cancel: Arc<AtomicBool>) -> semo::verify::Options {
     semo::verify::Options {
         horizon_ms: 60_000,
         max_states: 20_000,
+        max_memory: 256 << 20,
         cancel: Some(cancel),
         ..semo::verify::Options::default()
     }

@@ -2542,6 +2542,12 @@ struct Hearing {
 }
 
 impl Hearing {
+    /// About the bytes it holds (`Sim::approx_bytes`).
+    fn approx_bytes(&self) -> usize {
+        self.team.len() * std::mem::size_of::<Heard>()
+            + self.others.len() * std::mem::size_of::<(PeerId, Heard)>()
+    }
+
     fn new(team: std::ops::Range<usize>) -> Hearing {
         Hearing {
             first: team.start,

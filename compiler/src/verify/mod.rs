@@ -45,6 +45,10 @@ pub struct Options {
     pub horizon_ms: i64,
     /// States beyond which the search stops (bounded).
     pub max_states: usize,
+    /// Bytes beyond which the search stops (bounded): about what the
+    /// states it keeps to explore and its graph of states met hold
+    /// (`Sim::approx_bytes`; a state of 20 robots is about 70 KB).
+    pub max_memory: usize,
     /// How many times after the start the world may choose (a sensor
     /// value into another class, an operator command) along one behaviour.
     pub changes: u32,
@@ -68,12 +72,50 @@ pub struct Options {
     pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
+/// [`Options::max_memory`] by default: 1 GiB.
+pub const DEFAULT_MAX_MEMORY: usize = 1 << 30;
+
+/// What stopped a search before it explored every behaviour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Bound {
+    /// Every state up to the horizon was explored, and some go on.
+    Horizon,
+    /// `Options::max_states`.
+    States,
+    /// `Options::max_memory`.
+    Memory,
+    /// `Options::cancel`.
+    Cancelled,
+}
+
+impl Bound {
+    /// As the JSON document and the headline name it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Bound::Horizon => "horizon",
+            Bound::States => "states",
+            Bound::Memory => "memory",
+            Bound::Cancelled => "cancelled",
+        }
+    }
+
+    fn said(self) -> &'static str {
+        match self {
+            Bound::Horizon => "the horizon",
+            Bound::States => "the state budget",
+            Bound::Memory => "the memory budget",
+            Bound::Cancelled => "cancelled",
+        }
+    }
+}
+
 impl Default for Options {
     fn default() -> Self {
         Options {
             step_ms: 500,
             horizon_ms: 120_000,
             max_states: 50_000,
+            max_memory: DEFAULT_MAX_MEMORY,
             changes: 2,
             faults: 0,
             network: 0,
@@ -226,9 +268,8 @@ pub struct Report {
     pub states: usize,
     pub transitions: u64,
     pub exhaustive: bool,
-    /// The state budget stopped the search (else every state up to the
-    /// horizon was explored), or it was cancelled.
-    pub over_budget: bool,
+    /// What stopped the search, when it is not exhaustive.
+    pub bound: Option<Bound>,
     pub cancelled: bool,
     pub reached_ms: i64,
     pub inputs: Inputs,
@@ -244,7 +285,8 @@ pub struct Report {
 impl Report {
     /// How far the search looked, in one line: `explored every behaviour: N
     /// state(s), M transition(s): a proof for the choices explored`, or
-    /// `explored (bounded): ...: the first T ms`.
+    /// `explored (bounded): ...: the first T ms` (and what stopped it, when
+    /// not the horizon).
     pub fn headline(&self) -> String {
         format!(
             "{} {} state(s), {} transition(s): {}",
@@ -255,10 +297,17 @@ impl Report {
             },
             self.states,
             self.transitions,
-            if self.exhaustive {
-                "a proof for the choices explored".to_string()
-            } else {
-                format!("the first {} ms", self.reached_ms)
+            match self.bound {
+                _ if self.exhaustive => "a proof for the choices explored".to_string(),
+                Some(bound @ (Bound::States | Bound::Memory)) => format!(
+                    "the first {} ms (stopped by {})",
+                    self.reached_ms,
+                    bound.said()
+                ),
+                Some(Bound::Cancelled) => {
+                    format!("the first {} ms (cancelled)", self.reached_ms)
+                }
+                _ => format!("the first {} ms", self.reached_ms),
             }
         )
     }
@@ -457,7 +506,7 @@ pub fn verify_expecting(
         states: explored.states,
         transitions: explored.transitions,
         exhaustive: explored.exhaustive,
-        over_budget: explored.over_budget,
+        bound: explored.bound,
         cancelled: explored.cancelled,
         reached_ms: explored.reached_ms,
         inputs,

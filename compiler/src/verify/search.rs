@@ -8,7 +8,7 @@
 
 use super::inputs::Inputs;
 use super::properties::{self, Label, Outcome, Property};
-use super::{Choice, Counterexample, Options, World};
+use super::{Bound, Choice, Counterexample, Options, World};
 use crate::refine::{RobotProgram, ServiceMachineId, StateId};
 use crate::sim::{self, Memory, Race, Scenario, Sim};
 use std::collections::{HashMap, HashSet};
@@ -23,8 +23,8 @@ pub struct Explored {
     pub reached_ms: i64,
     /// (team, mode) entered in some behaviour.
     pub entered: HashSet<(String, String)>,
-    /// The state budget stopped the search, or it was cancelled.
-    pub over_budget: bool,
+    /// What stopped the search before it explored every behaviour.
+    pub bound: Option<Bound>,
     pub cancelled: bool,
     /// With `Options::observe`: every trace event of every behaviour
     /// explored, without its times.
@@ -90,7 +90,7 @@ pub fn explore(
         exhaustive: false,
         reached_ms: 0,
         entered: HashSet::new(),
-        over_budget: false,
+        bound: None,
         cancelled: false,
         observed: HashSet::new(),
         stuck: Vec::new(),
@@ -107,12 +107,26 @@ pub fn explore(
     let mut seen: crate::fasthash::FastMap<u128, u32> = Default::default();
     let mut edges: Vec<(u32, u32)> = Vec::new();
     let mut leaders = Leaders::new(programs);
-    // Each state with what the world has set and has left to do.
-    let mut frontier: Vec<(u32, Sim, World)> = Vec::new();
-    let mut over_budget = false;
+    // Each state with what the world has set and has left to do, and the
+    // bytes it holds.
+    let mut frontier: Vec<(u32, Sim, World, usize)> = Vec::new();
+    // The bytes of the states kept to explore (`frontier` and `next`).
+    let mut kept_bytes = 0;
+    let mut bound = None;
+    let over = |nodes: &Vec<Node>, edges: &Vec<(u32, u32)>, kept: usize| {
+        if cancelled(options) {
+            Some(Bound::Cancelled)
+        } else if nodes.len() >= options.max_states {
+            Some(Bound::States)
+        } else if kept + graph_bytes(nodes, edges, programs.len()) > options.max_memory {
+            Some(Bound::Memory)
+        } else {
+            None
+        }
+    };
     for start in start_classes(inputs) {
-        if nodes.len() >= options.max_states {
-            over_budget = true;
+        bound = over(&nodes, &edges, kept_bytes);
+        if bound.is_some() {
             break;
         }
         let mut sim = root.clone();
@@ -131,18 +145,20 @@ pub fn explore(
                 0,
             );
             leaders.look(&sim, id);
-            frontier.push((id, sim, world));
+            let bytes = sim.approx_bytes();
+            kept_bytes += bytes;
+            frontier.push((id, sim, world, bytes));
         }
     }
     let mut t = 0;
     let mut trace_hint = 0;
-    while !frontier.is_empty() && !over_budget {
+    while !frontier.is_empty() && bound.is_none() {
         if t >= options.horizon_ms {
             break;
         }
         let next_t = t + options.step_ms;
         let mut next = Vec::new();
-        for (id, sim, world) in std::mem::take(&mut frontier) {
+        for (id, sim, world, bytes) in std::mem::take(&mut frontier) {
             let node = &nodes[id as usize];
             if (0..node.finished.len()).all(|r| node.finished[r] || node.down[r]) {
                 continue;
@@ -153,8 +169,8 @@ pub fn explore(
             // fewer per state.
             let mut state = Some((sim, world));
             for (c, choice) in all.into_iter().enumerate() {
-                if nodes.len() >= options.max_states || cancelled(options) {
-                    over_budget = true;
+                bound = over(&nodes, &edges, kept_bytes);
+                if bound.is_some() {
                     break;
                 }
                 let (mut child, mut child_world) = if c == last {
@@ -242,11 +258,15 @@ pub fn explore(
                     }
                 };
                 if let Some(child_id) = child_id {
-                    next.push((child_id, child, child_world));
+                    let bytes = child.approx_bytes();
+                    kept_bytes += bytes;
+                    next.push((child_id, child, child_world, bytes));
                     explored.reached_ms = next_t;
                 }
             }
-            if over_budget {
+            // Its successors made, the state itself is gone.
+            kept_bytes -= bytes;
+            if bound.is_some() {
                 break;
             }
         }
@@ -254,8 +274,10 @@ pub fn explore(
         t = next_t;
     }
     explored.states = nodes.len();
-    explored.exhaustive = frontier.is_empty() && !over_budget;
-    explored.over_budget = over_budget;
+    explored.exhaustive = frontier.is_empty() && bound.is_none();
+    if !explored.exhaustive {
+        explored.bound = Some(bound.unwrap_or(Bound::Horizon));
+    }
     explored.cancelled = cancelled(options);
     explored.two_leaders = leaders
         .found
@@ -406,6 +428,14 @@ fn start_classes(inputs: &Inputs) -> impl Iterator<Item = Vec<usize>> + '_ {
         }
         Some(current)
     })
+}
+
+/// About the bytes of the graph of states met: per state its node (with
+/// its per-robot lists), its place in the seen set; per transition its edge.
+fn graph_bytes(nodes: &[Node], edges: &[(u32, u32)], robots: usize) -> usize {
+    let per_node =
+        std::mem::size_of::<Node>() + robots * 6 + 2 * std::mem::size_of::<(u128, u32)>();
+    nodes.len() * per_node + std::mem::size_of_val(edges)
 }
 
 fn cancelled(options: &Options) -> bool {

@@ -62,6 +62,17 @@ impl Resources {
         out
     }
 
+    /// About the bytes it holds (`Sim::approx_bytes`).
+    pub(super) fn approx_bytes(&self) -> usize {
+        self.holds.len()
+            + self.levels.len() * 8
+            + self
+                .sampling
+                .iter()
+                .map(|s| std::mem::size_of::<Sampling>() + s.task.len())
+                .sum::<usize>()
+    }
+
     /// The sensor task's sampling, when a policy names it.
     fn sampling(&self, task: &str) -> Option<&Sampling> {
         self.sampling.iter().find(|s| s.task == task)

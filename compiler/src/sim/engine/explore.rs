@@ -164,6 +164,21 @@ impl<'p> Sim<'p> {
         self.robots[r].current_mode
     }
 
+    /// About how many bytes this state holds of its own: its robots, event
+    /// queue and trace, by their lengths and the sizes of their elements
+    /// (words and text values are shared between clones and not counted,
+    /// nor the allocator's own overhead). What `semo verify`'s memory
+    /// budget counts per state it keeps.
+    pub fn approx_bytes(&self) -> usize {
+        use std::mem::size_of;
+        size_of::<Sim>()
+            + self.queue.len() * size_of::<Queued>()
+            + self.trace.capacity() * size_of::<TraceEvent>()
+            + self.commands.len() * size_of::<Command>()
+            + self.disturbed.len() * size_of::<super::Disturbance>()
+            + self.robots.iter().map(Robot::approx_bytes).sum::<usize>()
+    }
+
     /// The state, as a 128-bit hash of what decides the rest of the run
     /// (see the module's comment): equal states give equal fingerprints.
     pub fn fingerprint(&self, memory: &Memory) -> u128 {
@@ -245,6 +260,56 @@ impl<'p> Sim<'p> {
             }
         }
         fp.finish()
+    }
+}
+
+impl Robot<'_> {
+    /// [`Sim::approx_bytes`] of one robot.
+    fn approx_bytes(&self) -> usize {
+        use std::mem::size_of;
+        let held = size_of::<Held>();
+        // A hash map's entries, with its control bytes.
+        let map = |len: usize, entry: usize| len * (entry + 1);
+        size_of::<Robot>()
+            + (self.slots.len() + self.library.len()) * held
+            + self
+                .inbox
+                .iter()
+                .map(|(queue, _)| {
+                    size_of::<(std::collections::VecDeque<Held>, usize)>() + queue.len() * held
+                })
+                .sum::<usize>()
+            + self.behind.len() * (size_of::<Message>() + 16)
+            + self.stalled.len()
+            + self.dropped.len() * 8
+            + self.groups.len() * size_of::<Option<Held>>()
+            + self
+                .regions
+                .iter()
+                .map(|r| size_of::<super::Region>() + r.marks.len() * 8 + r.plan.len())
+                .sum::<usize>()
+            + self.events.len() * 16
+            + self.heard.approx_bytes()
+            + map(self.sync_pass.len(), 24)
+            + map(self.sync_arrived.len(), 24)
+            + map(self.leaders.len(), 24)
+            + map(self.allocated.len(), 32)
+            + self
+                .tasks
+                .iter()
+                .map(|(_, t)| {
+                    size_of::<(std::rc::Rc<str>, super::TaskState)>()
+                        + t.untaken.as_ref().map_or(0, |a| a.len() * held)
+                })
+                .sum::<usize>()
+            + self
+                .sensor_series
+                .iter()
+                .flatten()
+                .map(|series| series.len() * size_of::<(i64, Option<Value>)>())
+                .sum::<usize>()
+            + self.resources.approx_bytes()
+            + self.graphs.approx_bytes()
     }
 }
 

@@ -50,6 +50,24 @@ impl GraphState {
         self.channels.is_empty() && self.starts.is_empty() && self.due.is_empty()
     }
 
+    /// About the bytes it holds (`Sim::approx_bytes`).
+    pub(super) fn approx_bytes(&self) -> usize {
+        let channels: usize = self
+            .channels
+            .iter()
+            .map(|(name, queues)| {
+                64 + name.len() + queues.iter().map(|q| 32 + q.len() * 8).sum::<usize>()
+            })
+            .sum();
+        channels
+            + self
+                .starts
+                .iter()
+                .map(|((task, _), _)| 48 + task.len())
+                .sum::<usize>()
+            + self.due.len() * std::mem::size_of::<TraceEvent>()
+    }
+
     /// The state as text, its times relative to `now` (`explore.rs`).
     pub(super) fn relative(&self, now: i64) -> String {
         let mut channels: Vec<_> = self.channels.iter().collect();
