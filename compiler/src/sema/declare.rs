@@ -32,6 +32,7 @@ impl<'a> Checker<'a> {
             }
         }
         self.collect_variables();
+        self.check_parameter_names();
     }
 
     fn declare_team(&mut self, decl: &ast::TeamDecl, robot_names: &mut FastMap<Name, Span>) {
@@ -225,11 +226,13 @@ impl<'a> Checker<'a> {
         self.functions_by_name.insert(f.name.name.clone(), id);
         self.function_syntax.push(f);
         self.occurrence(f.name.span, Symbol::Function(id), true);
+        let params = self.declare_params(id, f);
         self.mission.functions.push(FunctionInfo {
             name: f.name.name.clone(),
             name_span: f.name.span,
             item,
             called: false,
+            params,
         });
     }
 

@@ -109,10 +109,15 @@ pub struct Repeat {
     pub span: Span,
 }
 
-/// `def name { ... }`
+/// `def name { ... }` or `def name(PARAM, ...) { ... }`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Function {
     pub name: Ident,
+    /// The parameters, in order: each a name that stands for its argument
+    /// in the body (`docs/language/services.md`).
+    pub params: Vec<Ident>,
+    /// The range of `( ... )` after the name; `None` for `def name { ... }`.
+    pub params_span: Option<Span>,
     pub body: Block,
     pub span: Span,
 }

@@ -1,8 +1,8 @@
 //! Cutting the token stream into independent top-level chunks, so that a syntax
 //! error in one item (even an unbalanced brace) cannot swallow the items after it.
 //!
-//! A chunk starts at every item header. `T.P.S {`, `T.M {`, `T.main {` and
-//! `def f {` can never occur inside a statement, so they start a chunk wherever
+//! A chunk starts at every item header. `T.P.S {`, `T.M {`, `T.main {`,
+//! `def f {` and `def f(A, B) {` can never occur inside a statement, so they start a chunk wherever
 //! they appear; `{` and `T:` start one only at brace depth zero (they also occur
 //! inside a braced team formation). A `}` with no matching `{` is a chunk of its own.
 
@@ -18,6 +18,23 @@ fn header_brace(tokens: &[Tok<'_>], i: usize) -> Option<usize> {
     let ident = |k: usize| matches!(at(k), Some(Token::Ident(_)));
     let brace = |k: usize| (at(k) == Some(Token::LBrace)).then_some(i + k);
     match at(0)? {
+        Token::Kw(Kw::Def) if ident(1) && at(2) == Some(Token::LParen) => {
+            // `def f(A, B) {`: the list ends at the first bracket or `def`
+            // (so that each token is looked at by one header at most: the
+            // cut stays linear), and the header is an item only if that is
+            // `)` then `{` (a list that does not parse is still a header).
+            let close = (3..).find(|&k| {
+                !matches!(
+                    at(k),
+                    Some(t) if !matches!(
+                        t,
+                        Token::LParen | Token::RParen | Token::LBrace | Token::RBrace | Token::Kw(Kw::Def)
+                    )
+                )
+            })?;
+            (at(close) == Some(Token::RParen)).then_some(())?;
+            brace(close + 1)
+        }
         Token::Kw(Kw::Def) if ident(1) => brace(2),
         Token::Ident(_) if at(1) == Some(Token::Dot) => match at(2)? {
             Token::Kw(Kw::Main) => brace(3),
@@ -141,9 +158,24 @@ mod tests {
     }
 
     #[test]
+    fn a_function_with_parameters_is_a_header_even_when_its_list_is_wrong() {
+        let text = "def f(A, B) { move(A) \ndef g(5 SEC) { x }\ndef h( { y } A.M { }";
+        assert_eq!(
+            chunk_texts(text),
+            // `def h(` without `)` is no header: its `{` at the top starts one.
+            vec![
+                "def f(A, B) { move(A)",
+                "def g(5 SEC) { x }\ndef h(",
+                "{ y }",
+                "A.M { }"
+            ]
+        );
+    }
+
+    #[test]
     fn resuming_at_any_chunk_start_cuts_the_same_chunks() {
         let text = "{ A: x a\n B: y b }\n} } A.P.S { { move() } A.M { set(P, S) }\n\
-                    T: a b { def f { x } T.main { } ) } A.P.S { B.C.D {";
+                    T: a b { def f { x } T.main { } ) } A.P.S { B.C.D { def g(X) { y } def h( {";
         let tokens = lex(text);
         let all = split(&tokens);
         assert!(all.len() > 8, "{all:?}");

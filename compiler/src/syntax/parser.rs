@@ -588,12 +588,33 @@ where
             })
         });
 
+    // `(A, B)`: a list that does not parse is reported where it goes wrong
+    // and the body is still parsed, as a function without parameters.
+    let params = name()
+        .labelled("a parameter name")
+        .separated_by(tok(Token::Comma))
+        .collect::<Vec<_>>()
+        .delimited_by(tok(Token::LParen), tok(Token::RParen))
+        .map_with(|params, e| (params, sp(e.span())))
+        .recover_with(via_parser(nested_delimiters(
+            Token::LParen,
+            Token::RParen,
+            [(Token::LBrace, Token::RBrace)],
+            |span| (Vec::new(), sp(span)),
+        )));
     let function = kw(Kw::Def)
         .ignore_then(name().labelled("a function name"))
+        .then(params.or_not())
         .then(braced_block())
-        .map_with(|(name, body), e| {
+        .map_with(|((name, params), body), e| {
+            let (params, params_span) = match params {
+                Some((params, span)) => (params, Some(span)),
+                None => (Vec::new(), None),
+            };
             Item::Function(Function {
                 name,
+                params,
+                params_span,
                 body,
                 span: sp(e.span()),
             })

@@ -166,8 +166,18 @@ impl Shift for Repeat {
 
 impl Shift for Function {
     fn shift(&mut self, delta: isize) {
-        let Function { name, body, span } = self;
+        let Function {
+            name,
+            params,
+            params_span,
+            body,
+            span,
+        } = self;
         name.shift(delta);
+        for param in params {
+            param.shift(delta);
+        }
+        params_span.shift(delta);
         body.shift(delta);
         span.shift(delta);
     }

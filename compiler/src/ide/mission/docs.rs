@@ -431,3 +431,13 @@ pub(crate) fn event(t: &Team, name: &str) -> String {
     }
     out
 }
+
+/// What one use of a parameter asks of its argument, in words.
+pub(super) fn param_need(need: &crate::sema::ParamNeed) -> String {
+    match &need.kind {
+        crate::sema::NeedKind::Argument { service, param, ty } => {
+            format!("passed to `{service}` as `{param}` ({ty})")
+        }
+        crate::sema::NeedKind::Number => "compared as a number".to_string(),
+    }
+}
