@@ -78,8 +78,12 @@ module.exports = grammar({
     function_definition: $ => seq(
       'def',
       field('name', $.identifier),
+      optional(field('parameters', $.parameter_list)),
       field('body', $.block),
     ),
+
+    // `(PLACE, WAIT)`: names that stand for the call's arguments in the body.
+    parameter_list: $ => seq('(', commaSep(field('parameter', $.identifier)), ')'),
 
     mode_definition: $ => seq(
       field('team', $.identifier),
