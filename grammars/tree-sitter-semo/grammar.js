@@ -64,7 +64,8 @@ module.exports = grammar({
     // ----- items -----
 
     service_definition: $ => seq(
-      field('team', $.identifier),
+      // `A, B.Plan.S`: a service each of these teams runs.
+      commaSep1(field('team', $.identifier)),
       '.',
       field('plan', $.identifier),
       '.',

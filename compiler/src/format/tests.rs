@@ -247,3 +247,11 @@ fn a_function_keeps_its_parameter_list_on_its_header() {
         "def go_to(PLACE, WAIT) {\n  move(PLACE)\n}\n\ndef home() {\n  stop()\n}\n"
     );
 }
+
+#[test]
+fn a_service_shared_by_teams_lists_its_teams_on_its_header() {
+    assert_eq!(
+        fmt("A ,B  ,C.P.S{x()}repeat()"),
+        "A, B, C.P.S {\n  x()\n} repeat()\n"
+    );
+}

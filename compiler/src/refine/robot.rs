@@ -1243,13 +1243,25 @@ impl Builder<'_, '_> {
         }
     }
 
+    /// What the checker resolved the attribute to for this robot's team. A
+    /// body that several teams run (a service shared by teams, a function
+    /// their services call) has one symbol per team at a bare name: this
+    /// team's own value or variable is the one its robots read.
+    fn symbol_of(&self, attr: &ast::Attr) -> Option<Symbol> {
+        let symbols =
+            crate::sema::lookup::with_span(&self.input.analysis.mission, attr.last().span);
+        let own = symbols.iter().find(|o| match &o.symbol {
+            Symbol::Value { owner, .. } => *owner == Some(self.team_id),
+            Symbol::TeamVariable { team, .. } => *team == Some(self.team_id),
+            _ => false,
+        });
+        own.or(symbols.first()).map(|o| o.symbol.clone())
+    }
+
     /// What an attribute in an expression reads: a sensor, a shared value or
     /// a constant.
     fn attr_operand(&mut self, attr: &ast::Attr) -> Operand {
-        let symbols =
-            crate::sema::lookup::with_span(&self.input.analysis.mission, attr.last().span);
-        let symbol = symbols.first().map(|o| o.symbol.clone());
-        match symbol {
+        match self.symbol_of(attr) {
             // The robot's own value: its sensor when its type has one, else
             // the value its team receives (spec §3: no sensor needed).
             Some(Symbol::Value {
@@ -1377,11 +1389,15 @@ impl Builder<'_, '_> {
     /// from the catalog's operator), or a team variable. Anything else is an
     /// internal error: the build is refused, never typed by guess.
     fn attr_kind(&mut self, attr: &ast::Attr) -> ValueKind {
+        // This team's symbol first, then any value or variable recorded there.
         let symbols =
             crate::sema::lookup::with_span(&self.input.analysis.mission, attr.last().span);
+        let candidates: Vec<Symbol> = (self.symbol_of(attr).into_iter())
+            .chain(symbols.iter().map(|o| o.symbol.clone()))
+            .collect();
         let catalog = self.input.catalog;
         let mission = &self.input.analysis.mission;
-        let declared = symbols.iter().find_map(|o| match &o.symbol {
+        let declared = candidates.iter().find_map(|symbol| match symbol {
             Symbol::TeamVariable { .. } => Some(Some(ValueKind::Variable)),
             Symbol::Value { owner, name } => {
                 let of_team = owner.and_then(|team| {

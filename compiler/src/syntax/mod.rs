@@ -586,6 +586,22 @@ mod tests {
     }
 
     #[test]
+    fn a_service_shared_by_teams_keeps_each_team_positioned() {
+        let text = "A, B , C.Act.S { x() } repeat()\nsend(T, T.X)\nD.M { }";
+        let p = parse(FileId(0), text);
+        // The stray `send` between items is one error; the items around it parse.
+        assert_eq!(p.diagnostics.len(), 1, "{:?}", p.diagnostics);
+        let ast::Item::Service(s) = &p.file.items[0] else {
+            panic!("{:?}", p.file.items)
+        };
+        assert_eq!((s.team.as_str(), s.team.span), ("A", Span::new(0, 1)));
+        let more: Vec<(&str, Span)> = s.more_teams.iter().map(|t| (t.as_str(), t.span)).collect();
+        assert_eq!(more, [("B", Span::new(3, 4)), ("C", Span::new(7, 8))]);
+        assert_eq!((s.plan.as_str(), s.name.as_str()), ("Act", "S"));
+        assert!(matches!(p.file.items.last(), Some(ast::Item::Mode(_))));
+    }
+
+    #[test]
     fn a_standalone_expression_is_positioned_from_its_base() {
         let p = parse_expr(FileId(2), "distance > 20 and not stop", 100);
         assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);

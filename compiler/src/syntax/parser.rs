@@ -570,16 +570,24 @@ where
                 span: sp(e.span()),
             }
         });
-    let service = name()
+    // `A, B.Plan.S`: the teams that share the service, each running it.
+    let teams = name().then(
+        tok(Token::Comma)
+            .ignore_then(name().labelled("a team name"))
+            .repeated()
+            .collect::<Vec<_>>(),
+    );
+    let service = teams
         .then_ignore(tok(Token::Dot))
         .then(name())
         .then_ignore(tok(Token::Dot))
         .then(name())
         .then(braced_block())
         .then(repeat.or_not())
-        .map_with(|((((team, plan), name), body), repeat), e| {
+        .map_with(|(((((team, more_teams), plan), name), body), repeat), e| {
             Item::Service(CompositeService {
                 team,
+                more_teams,
                 plan,
                 name,
                 body,
