@@ -263,6 +263,18 @@ pub(crate) fn composite_service(
         },
     };
     write!(out, "\n\n{how}").ok();
+    if let Some(shared) = syntax.filter(|x| !x.more_teams.is_empty()) {
+        let teams: Vec<String> = std::iter::once(&shared.team)
+            .chain(&shared.more_teams)
+            .map(|team| format!("`{}`", team.name))
+            .collect();
+        write!(
+            out,
+            "\n\nShared by teams {}: each runs its own copy, checked with its own robots.",
+            list(&teams)
+        )
+        .ok();
+    }
     if !s.throws.is_empty() {
         write!(out, "\n\nThrows {}.", list(&ticked(&s.throws))).ok();
     }
