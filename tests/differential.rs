@@ -752,3 +752,21 @@ fn counted_groups_with_a_spare_are_allocated_the_same_way_in_c_and_in_the_simula
     assert_eq!(names(4000), ["Room1", "Room1", "Room2"], "tb_0 lost at 4 s");
     assert_eq!(groups_at(&sim, 2000)["tb_3"], "others");
 }
+
+/// Functions with parameters (`tests/fixtures/parameters/patrol.mission`):
+/// the generated C runs the inlined calls, each argument in its parameter's
+/// place, as the simulator does, event for event (`tests/simulate.rs`
+/// shows both equal to the mission written out by hand).
+#[test]
+fn functions_with_parameters_run_the_same_in_c_and_in_the_simulator() {
+    let fixtures = repo_root().join("tests/fixtures/parameters");
+    let scenario = std::fs::read_to_string(fixtures.join("patrol.scenario.json")).unwrap();
+    let (_, sim) = compare("parameters", &fixtures.join("patrol.mission"), &scenario);
+    let moves: Vec<&str> = events_of(&sim, "ti", "call_start")
+        .into_iter()
+        .filter(|e| field(e, "service") == "move")
+        .map(|e| field(e, "arg"))
+        .take(3)
+        .collect();
+    assert_eq!(moves, ["kitchen", "hall door", "1,1"]);
+}

@@ -331,6 +331,34 @@ fn many_services_in_one_plan_cost_in_proportion() {
     );
 }
 
+/// Functions with parameters: each call's arguments are recorded once per
+/// walk and checked after every body is walked against the needs of the
+/// parameter they reach, passed on from function to function: no body is
+/// walked more often than without parameters, and the needs passed on are
+/// gathered once per parameter.
+#[test]
+fn many_functions_with_parameters_cost_in_proportion() {
+    scales_linearly(
+        "functions with parameters",
+        200,
+        &["check", "--format", "json", "m.mission"],
+        |dir, n| {
+            let mut text = String::from(
+                "{ T: TIEvalbot a }\ndef go(PLACE, WAIT) {\n  move(PLACE)\n  if (WAIT > 1) standby()\n}\n",
+            );
+            for i in 0..n {
+                text.push_str(&format!("def f{i}(P, W) {{ go(P, W) }}\n"));
+            }
+            text.push_str("T.P.S {\n");
+            for i in 0..n {
+                text.push_str(&format!("  f{i}(room{i}, {i})\n"));
+            }
+            text.push_str("} repeat()\nT.M { set(P, S) }\nT.main { default: mode = M }\n");
+            std::fs::write(dir.join("m.mission"), text).unwrap();
+        },
+    );
+}
+
 #[test]
 fn many_modes_cases_and_catches_cost_in_proportion() {
     scales_linearly(

@@ -628,3 +628,143 @@ fn skipping_idle_firings_changes_no_trace() {
     // The skipping is exercised, not only harmless.
     assert!(firings_saved > 0);
 }
+
+/// The files of a built folder, by path, each as a program reads it: the
+/// mission's file name `rename.0` written as `rename.1`, C comments (`/* */`),
+/// XML comments and Makefile comment lines left out (they cite the source
+/// lines, which differ between a function and its hand-written copy), and
+/// without the manifest of the files' hashes.
+fn built_files(out: &Path, rename: (&str, &str)) -> std::collections::BTreeMap<String, String> {
+    fn strip(text: &str, open: &str, close: &str) -> String {
+        let mut kept = String::new();
+        let mut rest = text;
+        while let Some(start) = rest.find(open) {
+            kept.push_str(&rest[..start]);
+            let after = &rest[start + open.len()..];
+            rest = after
+                .find(close)
+                .map_or("", |end| &after[end + close.len()..]);
+        }
+        kept + rest
+    }
+    let mut files = std::collections::BTreeMap::new();
+    let mut folders = vec![out.to_path_buf()];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                folders.push(path);
+                continue;
+            }
+            let name = path.strip_prefix(out).unwrap().display().to_string();
+            if name.ends_with(".semo-manifest") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path)
+                .unwrap()
+                .replace(rename.0, rename.1);
+            let text = strip(&strip(&text, "/*", "*/"), "<!--", "-->");
+            let text: Vec<&str> = text
+                .lines()
+                .filter(|l| !(name.ends_with("Makefile") && l.starts_with('#')))
+                .collect();
+            files.insert(name, text.join("\n"));
+        }
+    }
+    files
+}
+
+/// Functions with parameters (issue 36) are inlined with each argument in
+/// its parameter's place: `tests/fixtures/parameters/patrol.mission` (a word,
+/// bare words, a number, a robot value, passed on from one function to
+/// another, compared, sent) simulates to the same trace as the same mission
+/// with every call written out by hand, and builds to the same programs
+/// (but for the comments that cite the mission's lines).
+#[test]
+fn a_function_with_parameters_runs_and_builds_as_its_hand_written_copy() {
+    let fixtures = repo_root().join("tests/fixtures/parameters");
+    let scenario = fixtures.join("patrol.scenario.json");
+    let dir = scratch("parameters");
+    let mut traces = Vec::new();
+    let mut builds = Vec::new();
+    for name in ["patrol", "patrol_by_hand"] {
+        let mission = fixtures.join(format!("{name}.mission"));
+        let out = support::simulate_trace(&mission, &scenario, "sim");
+        assert_eq!(out.code, 0, "{name}: {}{}", out.stdout, out.stderr);
+        traces.push(
+            out.stdout
+                .replace("patrol_by_hand.mission", "patrol.mission"),
+        );
+        let folder = dir.join(name);
+        let mission = mission.display().to_string();
+        let built = semo(&["build", &mission, "-o", &folder.display().to_string()]);
+        assert_eq!(built.code, 0, "{name}: {}{}", built.stdout, built.stderr);
+        builds.push(built_files(
+            &folder,
+            ("patrol_by_hand.mission", "patrol.mission"),
+        ));
+    }
+    assert!(
+        traces[0].contains(r#""service":"move","arg":"hall door""#)
+            && traces[0].contains(r#""key":"Scouts.Seen","value":"2,3""#)
+            && traces[0].contains(r#""mode":"HOME""#),
+        "the run does not reach what it should show:\n{}",
+        traces[0]
+    );
+    assert_eq!(traces[0], traces[1]);
+    assert_eq!(
+        builds[0].keys().collect::<Vec<_>>(),
+        builds[1].keys().collect::<Vec<_>>()
+    );
+    for (file, text) in &builds[0] {
+        assert_eq!(text, &builds[1][file], "{file}");
+    }
+}
+
+/// A service shared by teams (`tests/fixtures/shared_services/rescue.mission`,
+/// `Scouts, Rovers.Action.Search`) is each team's own: it simulates to the
+/// same trace as the mission with one copy per team, and builds to the same
+/// programs but for the comments that cite the mission's lines.
+#[test]
+fn a_service_shared_by_teams_runs_and_builds_as_one_copy_per_team() {
+    let fixtures = repo_root().join("tests/fixtures/shared_services");
+    let scenario = fixtures.join("rescue.scenario.json");
+    let dir = scratch("shared_services");
+    let mut traces = Vec::new();
+    let mut builds = Vec::new();
+    for name in ["rescue", "rescue_copies"] {
+        let mission = fixtures.join(format!("{name}.mission"));
+        let out = support::simulate_trace(&mission, &scenario, "sim");
+        assert_eq!(out.code, 0, "{name}: {}{}", out.stdout, out.stderr);
+        traces.push(
+            out.stdout
+                .replace("rescue_copies.mission", "rescue.mission"),
+        );
+        let folder = dir.join(name);
+        let mission = mission.display().to_string();
+        let built = semo(&["build", &mission, "-o", &folder.display().to_string()]);
+        assert_eq!(built.code, 0, "{name}: {}{}", built.stdout, built.stderr);
+        builds.push(built_files(
+            &folder,
+            ("rescue_copies.mission", "rescue.mission"),
+        ));
+    }
+    for robot in ["ti", "ir", "tb"] {
+        let started = format!(
+            r#""robot":"{robot}","event":"service_start","plan":"Action","service":"Search""#
+        );
+        assert!(
+            traces[0].contains(&started),
+            "{robot} runs Search:\n{}",
+            traces[0]
+        );
+    }
+    assert_eq!(traces[0], traces[1]);
+    assert_eq!(
+        builds[0].keys().collect::<Vec<_>>(),
+        builds[1].keys().collect::<Vec<_>>()
+    );
+    for (file, text) in &builds[0] {
+        assert_eq!(text, &builds[1][file], "{file}");
+    }
+}

@@ -64,7 +64,8 @@ module.exports = grammar({
     // ----- items -----
 
     service_definition: $ => seq(
-      field('team', $.identifier),
+      // `A, B.Plan.S`: a service each of these teams runs.
+      commaSep1(field('team', $.identifier)),
       '.',
       field('plan', $.identifier),
       '.',
@@ -78,8 +79,12 @@ module.exports = grammar({
     function_definition: $ => seq(
       'def',
       field('name', $.identifier),
+      optional(field('parameters', $.parameter_list)),
       field('body', $.block),
     ),
+
+    // `(PLACE, WAIT)`: names that stand for the call's arguments in the body.
+    parameter_list: $ => seq('(', commaSep(field('parameter', $.identifier)), ')'),
 
     mode_definition: $ => seq(
       field('team', $.identifier),

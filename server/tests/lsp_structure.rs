@@ -468,7 +468,8 @@ async fn capabilities_are_announced() {
             "variable",
             "value",
             "constant",
-            "group"
+            "group",
+            "parameter"
         ])
     );
     assert_eq!(

@@ -239,3 +239,19 @@ fn a_counted_group_is_written_name_comma_min_equals() {
         "{\n  T: iRobotCreate a[3]\n}\n\nT.A.S {\n  [[\n    group(R1, min = 2) {\n      x()\n    }\n    group(R2, min = 1) {\n      y()\n    }\n  ]]\n} repeat()\n"
     );
 }
+
+#[test]
+fn a_function_keeps_its_parameter_list_on_its_header() {
+    assert_eq!(
+        fmt("def go_to (  PLACE ,WAIT ){move(PLACE)} def home(){stop()}"),
+        "def go_to(PLACE, WAIT) {\n  move(PLACE)\n}\n\ndef home() {\n  stop()\n}\n"
+    );
+}
+
+#[test]
+fn a_service_shared_by_teams_lists_its_teams_on_its_header() {
+    assert_eq!(
+        fmt("A ,B  ,C.P.S{x()}repeat()"),
+        "A, B, C.P.S {\n  x()\n} repeat()\n"
+    );
+}

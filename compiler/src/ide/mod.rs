@@ -86,6 +86,8 @@ pub enum CompletionKind {
     Event,
     /// A symbolic constant (`DARK`, a value of an enumeration, `OFF`).
     Constant,
+    /// A parameter of the function whose body the cursor is in.
+    Parameter,
     /// A time unit (`SEC`).
     Unit,
     Keyword,

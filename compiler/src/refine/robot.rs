@@ -54,6 +54,7 @@ pub(super) fn refine_robot(
         service_machines: HashMap::new(),
         action_machines: HashMap::new(),
         current_service: None,
+        arguments: Vec::new(),
         diagnostics: Vec::new(),
     };
     builder.build_modes();
@@ -154,6 +155,11 @@ struct Builder<'a, 'i> {
     /// The team service whose machine is being built (for the strategy's
     /// leader selection scoped to a composite service).
     current_service: Option<ServiceId>,
+    /// The arguments of the function calls being inlined, innermost last:
+    /// in a function's body its parameter `i` is its call's argument `i`,
+    /// refined where the parameter is used, in the caller's frame, as a
+    /// hand-written copy would be (the same slots, made in the same order).
+    arguments: Vec<Vec<ast::Arg>>,
     diagnostics: Vec<Diagnostic>,
 }
 
@@ -822,7 +828,6 @@ impl Builder<'_, '_> {
     ) {
         let symbols = crate::sema::lookup::with_span(&self.input.analysis.mission, call.name.span);
         let timeout_ms = call.timeout.as_ref().and_then(period_ms);
-        let args: Vec<Operand> = call.args.iter().map(|a| self.arg(a)).collect();
         if let Some(function) = symbols.iter().find_map(|o| match o.symbol {
             Symbol::Function(f) => Some(f),
             _ => None,
@@ -833,7 +838,19 @@ impl Builder<'_, '_> {
             }
             let info = &self.input.analysis.mission.functions[function.0 as usize];
             if let Some(ast::Item::Function(f)) = self.input.analysis.syntax.items.get(info.item) {
+                if call.args.len() != f.params.len() {
+                    let what = format!(
+                        "`{}` takes {} arguments, yet the checker let a call give {}",
+                        f.name.name,
+                        f.params.len(),
+                        call.args.len()
+                    );
+                    self.internal_error(call.args_span, &what);
+                    return;
+                }
+                self.arguments.push(call.args.clone());
                 self.block(&f.body, states, marks, depth + 1);
+                self.arguments.pop();
             }
             return;
         }
@@ -858,6 +875,7 @@ impl Builder<'_, '_> {
             return;
         };
         let service = def.name.clone();
+        let args: Vec<Operand> = call.args.iter().map(|a| self.arg(a)).collect();
         self.note_group_service(&service);
         let mark = next_mark(marks);
         if let Some(machine) = self.strategy_machine(call.name.span, &service) {
@@ -1225,13 +1243,25 @@ impl Builder<'_, '_> {
         }
     }
 
+    /// What the checker resolved the attribute to for this robot's team. A
+    /// body that several teams run (a service shared by teams, a function
+    /// their services call) has one symbol per team at a bare name: this
+    /// team's own value or variable is the one its robots read.
+    fn symbol_of(&self, attr: &ast::Attr) -> Option<Symbol> {
+        let symbols =
+            crate::sema::lookup::with_span(&self.input.analysis.mission, attr.last().span);
+        let own = symbols.iter().find(|o| match &o.symbol {
+            Symbol::Value { owner, .. } => *owner == Some(self.team_id),
+            Symbol::TeamVariable { team, .. } => *team == Some(self.team_id),
+            _ => false,
+        });
+        own.or(symbols.first()).map(|o| o.symbol.clone())
+    }
+
     /// What an attribute in an expression reads: a sensor, a shared value or
     /// a constant.
     fn attr_operand(&mut self, attr: &ast::Attr) -> Operand {
-        let symbols =
-            crate::sema::lookup::with_span(&self.input.analysis.mission, attr.last().span);
-        let symbol = symbols.first().map(|o| o.symbol.clone());
-        match symbol {
+        match self.symbol_of(attr) {
             // The robot's own value: its sensor when its type has one, else
             // the value its team receives (spec §3: no sensor needed).
             Some(Symbol::Value {
@@ -1255,6 +1285,8 @@ impl Builder<'_, '_> {
                 Operand::Slot(self.shared_slot(attr))
             }
             Some(Symbol::Constant(name)) => Operand::Literal(Value::Word(name.into())),
+            // The argument of the call being inlined, as its caller gave it.
+            Some(Symbol::Parameter { index, .. }) => self.parameter_operand(index, attr),
             other => {
                 let what = format!(
                     "`{}` is read as a value, but the checker resolved it to {other:?}",
@@ -1264,6 +1296,30 @@ impl Builder<'_, '_> {
                 Operand::Literal(Value::text(""))
             }
         }
+    }
+
+    /// The `index`th argument of the call being inlined, refined in its
+    /// caller's frame (an argument that is itself a parameter is the
+    /// caller's caller's argument, and so on).
+    fn parameter_operand(&mut self, index: u32, attr: &ast::Attr) -> Operand {
+        let Some(frame) = self.arguments.pop() else {
+            let what = format!(
+                "the parameter `{}` is read outside a call of its function",
+                attr.dotted()
+            );
+            self.internal_error(attr.span, &what);
+            return Operand::Literal(Value::text(""));
+        };
+        let operand = match frame.get(index as usize) {
+            Some(arg) => self.arg(arg),
+            None => {
+                let what = format!("the parameter `{}` has no argument", attr.dotted());
+                self.internal_error(attr.span, &what);
+                Operand::Literal(Value::text(""))
+            }
+        };
+        self.arguments.push(frame);
+        operand
     }
 
     /// Whether the robot's team receives or subscribes to its own value `name`
@@ -1333,11 +1389,15 @@ impl Builder<'_, '_> {
     /// from the catalog's operator), or a team variable. Anything else is an
     /// internal error: the build is refused, never typed by guess.
     fn attr_kind(&mut self, attr: &ast::Attr) -> ValueKind {
+        // This team's symbol first, then any value or variable recorded there.
         let symbols =
             crate::sema::lookup::with_span(&self.input.analysis.mission, attr.last().span);
+        let candidates: Vec<Symbol> = (self.symbol_of(attr).into_iter())
+            .chain(symbols.iter().map(|o| o.symbol.clone()))
+            .collect();
         let catalog = self.input.catalog;
         let mission = &self.input.analysis.mission;
-        let declared = symbols.iter().find_map(|o| match &o.symbol {
+        let declared = candidates.iter().find_map(|symbol| match symbol {
             Symbol::TeamVariable { .. } => Some(Some(ValueKind::Variable)),
             Symbol::Value { owner, name } => {
                 let of_team = owner.and_then(|team| {

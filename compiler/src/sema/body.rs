@@ -117,9 +117,17 @@ enum Resolution {
     Bare {
         name: Name,
         known: Candidates,
+        /// The function whose body is walked: its parameters are candidates too.
+        function: Option<FunctionId>,
     },
     /// Nothing can be said (no robot runs the statement).
     Unchecked,
+    /// A parameter of the function whose body is being walked.
+    Parameter {
+        function: FunctionId,
+        index: u32,
+        name: Name,
+    },
 }
 
 /// A value read or sent by robots of which some lack it: E033 unless their
@@ -143,7 +151,7 @@ enum Candidates {
 
 /// The type of an expression, as far as the checker can tell.
 #[derive(Clone, Debug, PartialEq)]
-enum Type {
+pub(super) enum Type {
     Text,
     Int,
     Float,
@@ -152,11 +160,23 @@ enum Type {
     Value(ValueType),
     Constant(Name),
     Unknown,
+    /// A parameter of the function being walked: whatever each call gives
+    /// (checked against the body's uses once every body is walked,
+    /// `params.rs`). Compared as a team variable is.
+    Param {
+        function: FunctionId,
+        index: u32,
+        name: Name,
+    },
+}
+
+/// Whether `t` is surely a number (not what the checker cannot type).
+fn known_number(t: &Type) -> bool {
+    t.is_numeric() && !matches!(t, Type::Unknown | Type::Param { .. })
 }
 
 /// How a comparison of these two sides compares (see [`Compared`]).
 fn compared(lt: &Type, rt: &Type, ordering: bool) -> Compared {
-    let known_number = |t: &Type| t.is_numeric() && *t != Type::Unknown;
     let numbers =
         lt.is_numeric() && rt.is_numeric() && (known_number(lt) || known_number(rt) || ordering);
     if numbers {
@@ -167,7 +187,7 @@ fn compared(lt: &Type, rt: &Type, ordering: bool) -> Compared {
 }
 
 impl Type {
-    fn describe(&self) -> String {
+    pub(super) fn describe(&self) -> String {
         match self {
             Type::Text => "a string".into(),
             Type::Int => "a whole number".into(),
@@ -177,28 +197,31 @@ impl Type {
             Type::Value(t) => format!("a value of type {t}"),
             Type::Constant(c) => format!("the constant `{c}`"),
             Type::Unknown => "a value".into(),
+            Type::Param { name, .. } => format!("the parameter `{name}`"),
         }
     }
 
     /// Whether `<`, `<=`, `>`, `>=` may order it: a number, a numeric value,
     /// a period, or what the checker cannot type (a team variable, or a name
     /// already reported).
-    fn is_numeric(&self) -> bool {
+    pub(super) fn is_numeric(&self) -> bool {
         matches!(
             self,
             Type::Int
                 | Type::Float
                 | Type::Period
                 | Type::Unknown
+                | Type::Param { .. }
                 | Type::Value(ValueType::Int | ValueType::Float)
         )
     }
 
     /// Whether an argument of this type fits a parameter of type `param`.
-    fn fits(&self, param: &ValueType) -> bool {
+    pub(super) fn fits(&self, param: &ValueType) -> bool {
         use ValueType as V;
         match (self, param) {
-            (Type::Unknown, _) => true,
+            // A parameter's argument is checked at each call (`params.rs`).
+            (Type::Unknown | Type::Param { .. }, _) => true,
             (Type::Value(v), p) => match (v, p) {
                 (a, b) if a.name() == b.name() => true,
                 (V::Int, V::Float) => true,
@@ -442,13 +465,7 @@ impl<'a> Checker<'a> {
         }
         if let Some(&function) = self.functions_by_name.get(&call.name.name) {
             self.occurrence(call.name.span, Symbol::Function(function), false);
-            if !call.args.is_empty() {
-                self.diagnostics.report(
-                    Code::WrongArgumentCount,
-                    call.args_span,
-                    format!("the function `{}` takes no arguments", call.name.name),
-                );
-            }
+            self.function_arguments(function, call, scope);
             if scope.inlining.contains(&function) {
                 self.diagnostics.report(
                     Code::RecursiveFunction,
@@ -485,6 +502,41 @@ impl<'a> Checker<'a> {
             return;
         }
         self.builtin_call(call, scope);
+    }
+
+    /// The arguments of a call of `function`, typed in the caller's scope
+    /// and recorded for the check against the body's uses (`params.rs`);
+    /// E022 when there are more or fewer than its parameters.
+    fn function_arguments(&mut self, function: FunctionId, call: &ast::Call, scope: &Scope) {
+        let params = &self.mission.functions[function.0 as usize].params;
+        let (given, takes) = (call.args.len(), params.len());
+        if given != takes {
+            let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
+            let expected = match takes {
+                0 => "no arguments".to_string(),
+                1 => format!("1 argument ({})", names.join(", ")),
+                n => format!("{n} arguments ({})", names.join(", ")),
+            };
+            self.diagnostics.report(
+                Code::WrongArgumentCount,
+                call.args_span,
+                format!(
+                    "the function `{}` takes {expected}, but {given} {} given",
+                    call.name.name,
+                    if given == 1 { "is" } else { "are" },
+                ),
+            );
+        }
+        for (index, arg) in call.args.iter().enumerate() {
+            let ty = match arg {
+                Arg::Words { .. } => Type::Text,
+                Arg::Expr(e) => self.expr(e, scope, true),
+            };
+            if index < takes {
+                self.param_uses
+                    .argument((function, index as u32), ty, arg.span());
+            }
+        }
     }
 
     /// The same scope, run by fewer robots (inside a group).
@@ -655,6 +707,21 @@ impl<'a> Checker<'a> {
                 Arg::Words { .. } => Type::Text,
                 Arg::Expr(e) => self.expr(e, scope, true),
             };
+            if let Type::Param {
+                function, index, ..
+            } = &ty
+            {
+                let kind = NeedKind::Argument {
+                    service: Name::new(&def.name),
+                    param: Name::new(&param.name),
+                    ty: param.ty.clone(),
+                };
+                let need = ParamNeed {
+                    kind,
+                    span: arg.span(),
+                };
+                self.param_uses.need((*function, *index), need);
+            }
             if !ty.fits(&param.ty) {
                 self.diagnostics.report(
                     Code::WrongArgumentType,
@@ -767,6 +834,23 @@ impl<'a> Checker<'a> {
         );
         let how = compared(&lt, &rt, ordering);
         self.comparison(span, how);
+        // A parameter compared with a number, or ordered, compares as a
+        // number: each call's argument must be one, so that the comparison
+        // means what it would with the argument written in its place.
+        for (side, other, side_span) in [(&lt, &rt, lhs.span), (&rt, &lt, rhs.span)] {
+            if let Type::Param {
+                function, index, ..
+            } = side
+            {
+                if ordering || known_number(other) {
+                    let need = ParamNeed {
+                        kind: NeedKind::Number,
+                        span: side_span,
+                    };
+                    self.param_uses.need((*function, *index), need);
+                }
+            }
+        }
         if matches!(op, ast::CmpOp::Eq | ast::CmpOp::Ne) {
             let sides = [(lhs, (rhs, &rt)), (rhs, (lhs, &lt))];
             for (variable, (other, other_type)) in sides {
@@ -865,6 +949,16 @@ impl<'a> Checker<'a> {
     }
 
     fn resolve_attr(&self, attr: &ast::Attr, scope: &Scope) -> Resolution {
+        if let ([name], Some(&function)) = (attr.segments.as_slice(), scope.inlining.last()) {
+            let params = &self.mission.functions[function.0 as usize].params;
+            if let Some(index) = params.iter().position(|p| p.name == name.name) {
+                return Resolution::Parameter {
+                    function,
+                    index: index as u32,
+                    name: name.name.clone(),
+                };
+            }
+        }
         match attr.segments.as_slice() {
             [name] => match scope.team {
                 Some(team) => self.resolve_in_team(team, &name.name, scope, true),
@@ -880,6 +974,7 @@ impl<'a> Checker<'a> {
                         Resolution::Bare {
                             name: name.name.clone(),
                             known: Candidates::Everywhere,
+                            function: scope.inlining.last().copied(),
                         }
                     }
                 }
@@ -975,6 +1070,7 @@ impl<'a> Checker<'a> {
             return Resolution::Bare {
                 name: Name::new(name),
                 known: Candidates::Team(team, types),
+                function: scope.inlining.last().copied(),
             };
         }
         Resolution::NotInTeam {
@@ -1139,8 +1235,16 @@ impl<'a> Checker<'a> {
                 self.occurrence(last, Symbol::Constant(name.clone()), false);
                 Type::Constant(name)
             }
-            Resolution::Bare { name, known } => {
-                let known = self.candidate_names(&known);
+            Resolution::Bare {
+                name,
+                known,
+                function,
+            } => {
+                let mut known = self.candidate_names(&known);
+                if let Some(f) = function {
+                    let params = &self.mission.functions[f.0 as usize].params;
+                    known.extend(params.iter().map(|p| p.name.to_string()));
+                }
                 let guess = suggestion(&name, known.iter().map(String::as_str));
                 self.diagnostics.report(
                     Code::UnknownAttribute,
@@ -1155,6 +1259,19 @@ impl<'a> Checker<'a> {
                 Type::Unknown
             }
             Resolution::Unchecked => Type::Unknown,
+            Resolution::Parameter {
+                function,
+                index,
+                name,
+            } => {
+                self.param_uses.used((function, index));
+                self.occurrence(last, Symbol::Parameter { function, index }, false);
+                Type::Param {
+                    function,
+                    index,
+                    name,
+                }
+            }
         }
     }
 
@@ -1649,7 +1766,7 @@ impl<'a> Checker<'a> {
     }
 }
 
-fn describe_param(ty: &ValueType) -> String {
+pub(super) fn describe_param(ty: &ValueType) -> String {
     match ty {
         ValueType::Enum(domain) => format!("one of {}", domain.join(", ")),
         ValueType::Location => "a location such as \"5,5\"".into(),

@@ -32,6 +32,7 @@ impl<'a> Checker<'a> {
             }
         }
         self.collect_variables();
+        self.check_parameter_names();
     }
 
     fn declare_team(&mut self, decl: &ast::TeamDecl, robot_names: &mut FastMap<Name, Span>) {
@@ -225,18 +226,57 @@ impl<'a> Checker<'a> {
         self.functions_by_name.insert(f.name.name.clone(), id);
         self.function_syntax.push(f);
         self.occurrence(f.name.span, Symbol::Function(id), true);
+        let params = self.declare_params(id, f);
         self.mission.functions.push(FunctionInfo {
             name: f.name.name.clone(),
             name_span: f.name.span,
             item,
             called: false,
+            params,
         });
     }
 
+    /// A composite service, in each team its header names: a service shared
+    /// by teams (`A, B.Plan.S`) is each team's own, its body walked with
+    /// each team's robots (and so checked against every robot of every
+    /// team), refined into each team's programs from the one syntax item.
     fn declare_service(&mut self, s: &'a ast::CompositeService, item: usize) {
-        let Some(team) = self.header_team(&s.team, "a composite service") else {
-            self.rejected_bodies.push((None, &s.body));
-            return;
+        let mut seen: Vec<&Name> = Vec::new();
+        // A body no team takes is still checked, as a rejected definition.
+        let (mut declared, mut rejected) = (false, None);
+        for team in std::iter::once(&s.team).chain(&s.more_teams) {
+            if seen.contains(&&team.name) {
+                self.diagnostics.report(
+                    Code::DuplicateService,
+                    team.span,
+                    format!(
+                        "the team `{}` is named twice in the header of `{}.{}`",
+                        team.name, s.plan.name, s.name.name
+                    ),
+                );
+                continue;
+            }
+            seen.push(&team.name);
+            match self.declare_service_of(team, s, item) {
+                Ok(()) => declared = true,
+                Err(team) => rejected = rejected.or(Some(team)),
+            }
+        }
+        if let (false, Some(team)) = (declared, rejected) {
+            self.rejected_bodies.push((team, &s.body));
+        }
+    }
+
+    /// The service in one team of its header; else the team whose robots
+    /// check its body as a rejected definition (`None`: an unknown team).
+    fn declare_service_of(
+        &mut self,
+        team: &ast::Ident,
+        s: &'a ast::CompositeService,
+        item: usize,
+    ) -> Result<(), Option<TeamId>> {
+        let Some(team) = self.header_team(team, "a composite service") else {
+            return Err(None);
         };
         let plan = match self.team(team).plan_by_name(&s.plan.name) {
             Some(plan) => {
@@ -260,12 +300,13 @@ impl<'a> Checker<'a> {
                     s.name.span,
                     format!(
                         "`{}.{}.{}` is already defined",
-                        s.team.name, s.plan.name, s.name.name
+                        self.team(team).name,
+                        s.plan.name,
+                        s.name.name
                     ),
                 )
                 .relate(first, "first defined here");
-            self.rejected_bodies.push((Some(team), &s.body));
-            return;
+            return Err(Some(team));
         }
         self.service_syntax[team.0 as usize].push(s);
         let service = self.team_mut(team).add_service(Service {
@@ -277,6 +318,7 @@ impl<'a> Checker<'a> {
             throws: Vec::new(),
         });
         self.occurrence(s.name.span, Symbol::Service { team, service }, true);
+        Ok(())
     }
 
     fn declare_mode(&mut self, m: &ast::ModeDef) {

@@ -204,6 +204,40 @@ pub struct FunctionInfo {
     /// Index of the function's item in the file's syntax tree.
     pub item: usize,
     pub called: bool,
+    /// The parameters, in order (`def name(PLACE, ...)`).
+    pub params: Vec<ParamInfo>,
+}
+
+/// A parameter of a function: a name that stands, in the body, for the
+/// argument of the call being run (`docs/language/services.md`).
+#[derive(Clone, Debug)]
+pub struct ParamInfo {
+    pub name: Name,
+    pub span: Span,
+    /// What the body asks of it, its own uses and those of the functions it
+    /// is passed on to: every call's argument is checked against each (E023).
+    pub needs: Vec<ParamNeed>,
+}
+
+/// One use that asks something of a parameter's argument.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamNeed {
+    pub kind: NeedKind,
+    /// Where the parameter is used so (in this function or one it calls).
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum NeedKind {
+    /// Passed to a built-in service's parameter of this type.
+    Argument {
+        service: Name,
+        param: Name,
+        ty: crate::catalog::ValueType,
+    },
+    /// Compared with a number, or ordered (`<`, `<=`, `>`, `>=`): compared
+    /// as numbers, so the argument must be one.
+    Number,
 }
 
 /// Who is at the other end of a communication statement.
@@ -280,6 +314,12 @@ pub enum Symbol {
     },
     /// A symbolic constant such as `colored_paper`.
     Constant(Name),
+    /// The `index`th parameter of a function, where it is declared and
+    /// where its body uses it.
+    Parameter {
+        function: FunctionId,
+        index: u32,
+    },
     /// The name of a counted group, `group(Name, min = N)`, where it is
     /// written (its only occurrence: a group is named in its statement
     /// alone): `min` its minimum, `robots` how many robots run the

@@ -24,6 +24,7 @@ mod comm;
 mod declare;
 pub mod ir;
 pub(crate) mod lookup;
+mod params;
 mod values;
 
 pub use ir::*;
@@ -105,6 +106,7 @@ pub fn check<'a>(
     let mut checker = Checker::new(file, catalog);
     checker.declare(source);
     checker.check_bodies();
+    checker.check_parameters();
     checker.check_behaviour(source);
     checker.check_communication();
     // Sorted now: the value flow looks names up.
@@ -177,6 +179,10 @@ pub(crate) struct Checker<'a> {
     /// range of its event name: a function's statement walked for several
     /// callers is one entry with the robots of all.
     broadcast_index: FastMap<(TeamId, Span), usize>,
+    /// What each function's body asks of its parameters, and the argument
+    /// of every call walked, checked against each other once every body is
+    /// walked (`params.rs`).
+    param_uses: params::ParamUses,
     /// The mission went past [`MAX_ROBOTS_PER_MISSION`] (reported once):
     /// no further robot is declared.
     robots_full: bool,
@@ -212,6 +218,7 @@ impl<'a> Checker<'a> {
             robot_sets: FastSet::default(),
             thrown: FastSet::default(),
             broadcast_index: FastMap::default(),
+            param_uses: params::ParamUses::default(),
             robots_full: false,
         }
     }

@@ -90,10 +90,15 @@ pub struct Count {
     pub span: Span,
 }
 
-/// `Team.Plan.Service { ... } repeat(...)`
+/// `Team.Plan.Service { ... } repeat(...)`, or `A, B.Plan.Service { ... }`:
+/// one service that the robots of each team named run, each team its own
+/// copy (`docs/language/services.md`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CompositeService {
+    /// The first team of the header.
     pub team: Ident,
+    /// The teams after the first (`A, B.Plan.S`: `B`); empty for one team.
+    pub more_teams: Vec<Ident>,
     pub plan: Ident,
     pub name: Ident,
     pub body: Block,
@@ -109,10 +114,15 @@ pub struct Repeat {
     pub span: Span,
 }
 
-/// `def name { ... }`
+/// `def name { ... }` or `def name(PARAM, ...) { ... }`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Function {
     pub name: Ident,
+    /// The parameters, in order: each a name that stands for its argument
+    /// in the body (`docs/language/services.md`).
+    pub params: Vec<Ident>,
+    /// The range of `( ... )` after the name; `None` for `def name { ... }`.
+    pub params_span: Option<Span>,
     pub body: Block,
     pub span: Span,
 }

@@ -1,8 +1,8 @@
 //! Cutting the token stream into independent top-level chunks, so that a syntax
 //! error in one item (even an unbalanced brace) cannot swallow the items after it.
 //!
-//! A chunk starts at every item header. `T.P.S {`, `T.M {`, `T.main {` and
-//! `def f {` can never occur inside a statement, so they start a chunk wherever
+//! A chunk starts at every item header. `T.P.S {`, `A, B.P.S {`, `T.M {`,
+//! `T.main {`, `def f {` and `def f(A, B) {` can never occur inside a statement, so they start a chunk wherever
 //! they appear; `{` and `T:` start one only at brace depth zero (they also occur
 //! inside a braced team formation). A `}` with no matching `{` is a chunk of its own.
 
@@ -18,7 +18,42 @@ fn header_brace(tokens: &[Tok<'_>], i: usize) -> Option<usize> {
     let ident = |k: usize| matches!(at(k), Some(Token::Ident(_)));
     let brace = |k: usize| (at(k) == Some(Token::LBrace)).then_some(i + k);
     match at(0)? {
+        Token::Kw(Kw::Def) if ident(1) && at(2) == Some(Token::LParen) => {
+            // `def f(A, B) {`: the list ends at the first bracket or `def`
+            // (so that each token is looked at by one header at most: the
+            // cut stays linear), and the header is an item only if that is
+            // `)` then `{` (a list that does not parse is still a header).
+            let close = (3..).find(|&k| {
+                !matches!(
+                    at(k),
+                    Some(t) if !matches!(
+                        t,
+                        Token::LParen | Token::RParen | Token::LBrace | Token::RBrace | Token::Kw(Kw::Def)
+                    )
+                )
+            })?;
+            (at(close) == Some(Token::RParen)).then_some(())?;
+            brace(close + 1)
+        }
         Token::Kw(Kw::Def) if ident(1) => brace(2),
+        // `A, B.P.S {`: a service shared by teams. The list is scanned
+        // from its first name only (a name after a comma is inside the
+        // list), so each token is looked at by one header at most.
+        Token::Ident(_)
+            if at(1) == Some(Token::Comma)
+                && i.checked_sub(1).is_none_or(|p| tokens[p].0 != Token::Comma) =>
+        {
+            let mut k = 1;
+            while at(k) == Some(Token::Comma) && ident(k + 1) {
+                k += 2;
+            }
+            let service = at(k) == Some(Token::Dot)
+                && ident(k + 1)
+                && at(k + 2) == Some(Token::Dot)
+                && ident(k + 3);
+            service.then_some(())?;
+            brace(k + 4)
+        }
         Token::Ident(_) if at(1) == Some(Token::Dot) => match at(2)? {
             Token::Kw(Kw::Main) => brace(3),
             Token::Ident(_) if at(3) == Some(Token::Dot) && ident(4) => brace(5),
@@ -141,9 +176,37 @@ mod tests {
     }
 
     #[test]
+    fn a_function_with_parameters_is_a_header_even_when_its_list_is_wrong() {
+        let text = "def f(A, B) { move(A) \ndef g(5 SEC) { x }\ndef h( { y } A.M { }";
+        assert_eq!(
+            chunk_texts(text),
+            // `def h(` without `)` is no header: its `{` at the top starts one.
+            vec![
+                "def f(A, B) { move(A)",
+                "def g(5 SEC) { x }\ndef h(",
+                "{ y }",
+                "A.M { }"
+            ]
+        );
+    }
+
+    #[test]
+    fn a_service_shared_by_teams_is_one_header() {
+        let text = "A, B.P.S { send(T, T.X) move() \nA, B, C.Q.R { x }\nf(a, b) A.M { }";
+        assert_eq!(
+            chunk_texts(text),
+            vec![
+                "A, B.P.S { send(T, T.X) move()",
+                "A, B, C.Q.R { x }\nf(a, b)",
+                "A.M { }"
+            ]
+        );
+    }
+
+    #[test]
     fn resuming_at_any_chunk_start_cuts_the_same_chunks() {
         let text = "{ A: x a\n B: y b }\n} } A.P.S { { move() } A.M { set(P, S) }\n\
-                    T: a b { def f { x } T.main { } ) } A.P.S { B.C.D {";
+                    T: a b { def f { x } T.main { } ) } A.P.S { B.C.D { def g(X) { y } def h( { A, B.C.D { x, y";
         let tokens = lex(text);
         let all = split(&tokens);
         assert!(all.len() > 8, "{all:?}");

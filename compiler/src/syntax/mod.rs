@@ -551,6 +551,57 @@ mod tests {
     }
 
     #[test]
+    fn a_function_keeps_its_parameters_positioned() {
+        let text = "def go_to(PLACE, WAIT) { move(PLACE) }\ndef home { stop() }";
+        let p = parse(FileId(0), text);
+        assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);
+        let ast::Item::Function(f) = &p.file.items[0] else {
+            panic!("{:?}", p.file.items)
+        };
+        let params: Vec<(&str, Span)> = f.params.iter().map(|p| (p.as_str(), p.span)).collect();
+        assert_eq!(
+            params,
+            [("PLACE", Span::new(10, 15)), ("WAIT", Span::new(17, 21))]
+        );
+        assert_eq!(f.params_span, Some(Span::new(9, 22)));
+        let ast::Item::Function(home) = &p.file.items[1] else {
+            panic!("{:?}", p.file.items)
+        };
+        assert!(home.params.is_empty() && home.params_span.is_none());
+    }
+
+    #[test]
+    fn a_parameter_list_that_does_not_parse_is_positioned_and_the_body_parses() {
+        let text = "def go_to(5 SEC) { move(x) }\ndef home(A) { stop() }";
+        let p = parse(FileId(0), text);
+        assert_eq!(p.diagnostics.len(), 1, "{:?}", p.diagnostics);
+        assert_eq!(p.diagnostics[0].code, Code::SyntaxError);
+        assert_eq!(p.diagnostics[0].span, Span::new(10, 11));
+        let ast::Item::Function(f) = &p.file.items[0] else {
+            panic!("{:?}", p.file.items)
+        };
+        assert!(f.params.is_empty());
+        assert_eq!(f.body.stmts.len(), 1);
+        assert!(matches!(&p.file.items[1], ast::Item::Function(h) if h.params.len() == 1));
+    }
+
+    #[test]
+    fn a_service_shared_by_teams_keeps_each_team_positioned() {
+        let text = "A, B , C.Act.S { x() } repeat()\nsend(T, T.X)\nD.M { }";
+        let p = parse(FileId(0), text);
+        // The stray `send` between items is one error; the items around it parse.
+        assert_eq!(p.diagnostics.len(), 1, "{:?}", p.diagnostics);
+        let ast::Item::Service(s) = &p.file.items[0] else {
+            panic!("{:?}", p.file.items)
+        };
+        assert_eq!((s.team.as_str(), s.team.span), ("A", Span::new(0, 1)));
+        let more: Vec<(&str, Span)> = s.more_teams.iter().map(|t| (t.as_str(), t.span)).collect();
+        assert_eq!(more, [("B", Span::new(3, 4)), ("C", Span::new(7, 8))]);
+        assert_eq!((s.plan.as_str(), s.name.as_str()), ("Act", "S"));
+        assert!(matches!(p.file.items.last(), Some(ast::Item::Mode(_))));
+    }
+
+    #[test]
     fn a_standalone_expression_is_positioned_from_its_base() {
         let p = parse_expr(FileId(2), "distance > 20 and not stop", 100);
         assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);

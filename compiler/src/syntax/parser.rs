@@ -570,16 +570,24 @@ where
                 span: sp(e.span()),
             }
         });
-    let service = name()
+    // `A, B.Plan.S`: the teams that share the service, each running it.
+    let teams = name().then(
+        tok(Token::Comma)
+            .ignore_then(name().labelled("a team name"))
+            .repeated()
+            .collect::<Vec<_>>(),
+    );
+    let service = teams
         .then_ignore(tok(Token::Dot))
         .then(name())
         .then_ignore(tok(Token::Dot))
         .then(name())
         .then(braced_block())
         .then(repeat.or_not())
-        .map_with(|((((team, plan), name), body), repeat), e| {
+        .map_with(|(((((team, more_teams), plan), name), body), repeat), e| {
             Item::Service(CompositeService {
                 team,
+                more_teams,
                 plan,
                 name,
                 body,
@@ -588,12 +596,33 @@ where
             })
         });
 
+    // `(A, B)`: a list that does not parse is reported where it goes wrong
+    // and the body is still parsed, as a function without parameters.
+    let params = name()
+        .labelled("a parameter name")
+        .separated_by(tok(Token::Comma))
+        .collect::<Vec<_>>()
+        .delimited_by(tok(Token::LParen), tok(Token::RParen))
+        .map_with(|params, e| (params, sp(e.span())))
+        .recover_with(via_parser(nested_delimiters(
+            Token::LParen,
+            Token::RParen,
+            [(Token::LBrace, Token::RBrace)],
+            |span| (Vec::new(), sp(span)),
+        )));
     let function = kw(Kw::Def)
         .ignore_then(name().labelled("a function name"))
+        .then(params.or_not())
         .then(braced_block())
-        .map_with(|(name, body), e| {
+        .map_with(|((name, params), body), e| {
+            let (params, params_span) = match params {
+                Some((params, span)) => (params, Some(span)),
+                None => (Vec::new(), None),
+            };
             Item::Function(Function {
                 name,
+                params,
+                params_span,
                 body,
                 span: sp(e.span()),
             })

@@ -136,6 +136,7 @@ impl Shift for CompositeService {
     fn shift(&mut self, delta: isize) {
         let CompositeService {
             team,
+            more_teams,
             plan,
             name,
             body,
@@ -143,6 +144,9 @@ impl Shift for CompositeService {
             span,
         } = self;
         team.shift(delta);
+        for more in more_teams {
+            more.shift(delta);
+        }
         plan.shift(delta);
         name.shift(delta);
         body.shift(delta);
@@ -166,8 +170,18 @@ impl Shift for Repeat {
 
 impl Shift for Function {
     fn shift(&mut self, delta: isize) {
-        let Function { name, body, span } = self;
+        let Function {
+            name,
+            params,
+            params_span,
+            body,
+            span,
+        } = self;
         name.shift(delta);
+        for param in params {
+            param.shift(delta);
+        }
+        params_span.shift(delta);
         body.shift(delta);
         span.shift(delta);
     }

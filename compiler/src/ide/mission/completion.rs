@@ -554,12 +554,19 @@ impl<'a> Completions<'a> {
             if current.is_some_and(|c| c.0 as usize == i) {
                 continue;
             }
+            // `go_to(${1:PLACE})`: a stop at each parameter, named.
+            let params: Vec<String> = f
+                .params
+                .iter()
+                .enumerate()
+                .map(|(i, p)| format!("${{{}:{}}}", i + 1, snippets::escape(&p.name)))
+                .collect();
             self.add_snippet(
                 LIKELY,
                 CompletionKind::Function,
                 f.name.as_str(),
-                &format!("{}()", snippets::escape(&f.name)),
-                Some(format!("def {}", f.name)),
+                &format!("{}({})", snippets::escape(&f.name), params.join(", ")),
+                Some(super::hover::function_signature(f)),
                 Some("A function: its statements run here, by these robots.".to_string()),
             );
         }
@@ -760,6 +767,26 @@ impl<'a> Completions<'a> {
         }
         let here = self.robots_here();
         let types = here.types(self.mission);
+        // In a function's body, its parameters first: what a call gives.
+        let analysis = self.analysis;
+        let function = self.mission.functions.iter().find(|f| {
+            analysis
+                .function_syntax(f)
+                .is_some_and(|syntax| syntax.body.span.contains(self.offset))
+        });
+        if let Some(f) = function {
+            let signature = super::hover::function_signature(f);
+            for p in &f.params {
+                let detail = format!("parameter of {signature}");
+                self.add(
+                    LIKELY,
+                    CompletionKind::Parameter,
+                    p.name.as_str(),
+                    Some(detail),
+                    None,
+                );
+            }
+        }
         for v in robots::shared_values(self.catalog, &types) {
             self.add_value(LIKELY, v, None);
         }

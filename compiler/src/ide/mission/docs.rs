@@ -263,6 +263,18 @@ pub(crate) fn composite_service(
         },
     };
     write!(out, "\n\n{how}").ok();
+    if let Some(shared) = syntax.filter(|x| !x.more_teams.is_empty()) {
+        let teams: Vec<String> = std::iter::once(&shared.team)
+            .chain(&shared.more_teams)
+            .map(|team| format!("`{}`", team.name))
+            .collect();
+        write!(
+            out,
+            "\n\nShared by teams {}: each runs its own copy, checked with its own robots.",
+            list(&teams)
+        )
+        .ok();
+    }
     if !s.throws.is_empty() {
         write!(out, "\n\nThrows {}.", list(&ticked(&s.throws))).ok();
     }
@@ -430,4 +442,14 @@ pub(crate) fn event(t: &Team, name: &str) -> String {
         write!(out, "\n\nCaught in {}.", catches.join(", ")).ok();
     }
     out
+}
+
+/// What one use of a parameter asks of its argument, in words.
+pub(super) fn param_need(need: &crate::sema::ParamNeed) -> String {
+    match &need.kind {
+        crate::sema::NeedKind::Argument { service, param, ty } => {
+            format!("passed to `{service}` as `{param}` ({ty})")
+        }
+        crate::sema::NeedKind::Number => "compared as a number".to_string(),
+    }
 }

@@ -79,8 +79,13 @@ pub fn hover(
         Symbol::Event { team, name } => docs::event(mission.team(*team), name),
         Symbol::Function(f) => {
             let info = mission.functions.get(f.0 as usize)?;
-            let mut out = docs::code(&format!("def {}", info.name));
-            out.push_str("\n\nA function: its statements are copied where it is called.");
+            let mut out = docs::code(&function_signature(info));
+            out.push_str("\n\nA function: its statements are copied where it is called");
+            out.push_str(if info.params.is_empty() {
+                "."
+            } else {
+                ", each parameter standing for the call's argument."
+            });
             let teams: Vec<String> = mission
                 .scopes
                 .iter()
@@ -132,8 +137,43 @@ pub fn hover(
             "{}\n\nA symbolic constant: a word passed or compared as it is written.",
             docs::code(name)
         ),
+        Symbol::Parameter { function, index } => {
+            let info = mission.functions.get(function.0 as usize)?;
+            parameter(info, *index as usize)?
+        }
     };
     Some(HoverResult { range, markdown })
+}
+
+/// `def name(A, B)`, or `def name` without parameters.
+pub(super) fn function_signature(info: &crate::sema::FunctionInfo) -> String {
+    if info.params.is_empty() {
+        return format!("def {}", info.name);
+    }
+    let names: Vec<&str> = info.params.iter().map(|p| p.name.as_str()).collect();
+    format!("def {}({})", info.name, names.join(", "))
+}
+
+/// A parameter: whose it is, what it means, and what its uses ask of each
+/// call's argument (the checker's needs, its own and those of the
+/// functions it is passed on to).
+fn parameter(info: &crate::sema::FunctionInfo, index: usize) -> Option<String> {
+    let param = info.params.get(index)?;
+    let mut out = docs::code(&param.name);
+    write!(
+        out,
+        "\n\nParameter {} of `{}`: in its body it stands for the argument of the call being run, read where it is used.",
+        index + 1,
+        function_signature(info)
+    )
+    .ok();
+    let asks: Vec<String> = param.needs.iter().map(docs::param_need).collect();
+    if asks.is_empty() {
+        out.push_str("\n\nAny argument fits.");
+    } else {
+        write!(out, "\n\nIts argument is {}.", list(&asks)).ok();
+    }
+    Some(out)
 }
 
 /// A built-in service where it is called: which types of the robots running

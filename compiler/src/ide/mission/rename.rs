@@ -126,6 +126,7 @@ fn renamable(symbol: &Symbol) -> Result<(), RenameError> {
         | Symbol::Event { .. }
         | Symbol::Function(_)
         | Symbol::TeamVariable { .. }
+        | Symbol::Parameter { .. }
         | Symbol::CountedGroup { .. } => Ok(()),
         Symbol::User => {
             refuse("`USER` is the operator's console, a built-in name; it cannot be renamed")
@@ -284,6 +285,9 @@ fn clash(
             }
             None
         }
+        Symbol::Parameter { function, .. } => {
+            parameter_clash(analysis, catalog, text, symbol, *function, new)
+        }
         Symbol::User
         | Symbol::RobotType(_)
         | Symbol::Capability(_)
@@ -291,6 +295,51 @@ fn clash(
         | Symbol::Value { .. }
         | Symbol::Constant(_) => None,
     }
+}
+
+/// What a parameter of `function`, renamed to `new`, would clash with:
+/// another parameter of the function, a value robots read or a team
+/// variable (E045), or a name its body already writes with another meaning
+/// (which would then mean the parameter).
+fn parameter_clash(
+    analysis: &CheckedMission,
+    catalog: &Catalog,
+    text: &str,
+    symbol: &Symbol,
+    function: crate::sema::FunctionId,
+    new: &str,
+) -> Option<String> {
+    let mission = &analysis.mission;
+    let info = mission.functions.get(function.0 as usize)?;
+    if let Some(other) = info.params.iter().find(|p| p.name == new) {
+        return Some(format!(
+            "`{}` already has a parameter `{}`",
+            info.name, other.name
+        ));
+    }
+    if let Some((_, r)) = catalog.types().find(|(_, r)| r.value(new).is_some()) {
+        return Some(format!(
+            "`{new}` is a value of robot type {}: the parameter would hide it",
+            r.name
+        ));
+    }
+    if mission
+        .teams
+        .iter()
+        .any(|t| t.variables.iter().any(|v| v == new))
+    {
+        return Some(format!(
+            "`{new}` is a team variable: the parameter would hide it"
+        ));
+    }
+    let body = analysis.function_syntax(info)?.span;
+    mission.occurrences.iter().find(|o| {
+        body.contains(o.span.start) && o.symbol != *symbol && text.get(o.span.range()) == Some(new)
+    })?;
+    Some(format!(
+        "`{new}` already means something else in the body of `{}`: it would mean the parameter",
+        info.name
+    ))
 }
 
 /// The identifier-like word around `offset`, if any.

@@ -24,10 +24,11 @@ pub enum TokenKind {
     Value,
     Constant,
     Group,
+    Parameter,
 }
 
 impl TokenKind {
-    pub const ALL: [TokenKind; 13] = [
+    pub const ALL: [TokenKind; 14] = [
         TokenKind::Team,
         TokenKind::Robot,
         TokenKind::RobotType,
@@ -41,6 +42,7 @@ impl TokenKind {
         TokenKind::Value,
         TokenKind::Constant,
         TokenKind::Group,
+        TokenKind::Parameter,
     ];
 
     pub fn name(self) -> &'static str {
@@ -58,6 +60,7 @@ impl TokenKind {
             TokenKind::Value => "value",
             TokenKind::Constant => "constant",
             TokenKind::Group => "group",
+            TokenKind::Parameter => "parameter",
         }
     }
 
@@ -138,6 +141,7 @@ fn classify(symbol: &Symbol) -> (TokenKind, u32) {
         Symbol::Value { .. } => (TokenKind::Value, DEFAULT_LIBRARY),
         Symbol::Constant(_) => (TokenKind::Constant, 0),
         Symbol::CountedGroup { .. } => (TokenKind::Group, 0),
+        Symbol::Parameter { .. } => (TokenKind::Parameter, 0),
     }
 }
 

@@ -4,6 +4,7 @@
 //! own forms `set`, `send`/`receive`/`publish`/`subscribe`, `loop` and `repeat`.
 
 use super::context::{self, Lt, Paren, Trivia};
+use super::docs;
 use super::robots::{self, RobotsHere};
 use crate::catalog::Catalog;
 use crate::sema::CheckedMission;
@@ -48,8 +49,23 @@ pub fn signature_help(
     let help = match frame.paren.as_ref()? {
         Paren::Call { name, .. } => {
             if let Some(f) = analysis.mission.functions.iter().find(|f| f.name == *name) {
-                let doc = "A function: it takes no arguments; its statements run here.";
-                return Some(build(&f.name, Vec::new(), Some(doc.to_string()), index));
+                let doc = match f.params.is_empty() {
+                    true => "A function: it takes no arguments; its statements run here.",
+                    false => {
+                        "A function: its statements run here, each parameter standing for its argument."
+                    }
+                };
+                // Each parameter with what its uses ask of the argument.
+                let params = f
+                    .params
+                    .iter()
+                    .map(|p| {
+                        let asks: Vec<String> = p.needs.iter().map(docs::param_need).collect();
+                        let doc = (!asks.is_empty()).then(|| asks.join("; "));
+                        (p.name.to_string(), doc)
+                    })
+                    .collect();
+                return Some(build(&f.name, params, Some(doc.to_string()), index));
             }
             let here = RobotsHere::at(analysis, offset, scan.head.team().map(|t| t.as_str()));
             let types = here.types(&analysis.mission);

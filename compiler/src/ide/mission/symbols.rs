@@ -42,9 +42,11 @@ pub fn document_symbols(analysis: &CheckedMission, text: &str) -> Vec<StructureN
         })
         .collect();
     symbols.extend(mission.functions.iter().map(|f| {
+        // `(PLACE, WAIT)`: a function's parameters, as its header lists them.
+        let names: Vec<&str> = f.params.iter().map(|p| p.name.as_str()).collect();
         StructureNode {
             name: f.name.to_string(),
-            detail: None,
+            detail: (!names.is_empty()).then(|| format!("({})", names.join(", "))),
             kind: SymbolKind::Function,
             span: analysis
                 .function_syntax(f)
@@ -316,6 +318,17 @@ Team Guards [Guards] lines 4-21 (4 robots)
   Main main [main] lines 21-21 (default: GO)
 Function warn [warn] lines 6-6
 "
+        );
+    }
+
+    #[test]
+    fn a_function_with_parameters_lists_them_as_its_detail() {
+        let f = Fixture::new("def go_to(PLACE, WAIT) { move(PLACE) }\ndef home { stop() }\n");
+        let mut out = String::new();
+        outline(&f, &document_symbols(&f.analysis, &f.text), 0, &mut out);
+        assert_eq!(
+            out,
+            "Function go_to [go_to] lines 1-1 ((PLACE, WAIT))\nFunction home [home] lines 2-2\n"
         );
     }
 

@@ -390,6 +390,110 @@ fn a_word_that_is_also_a_value_is_fixed_either_way() {
     }
 }
 
+/// A function with parameters, in the editor: completion offers the
+/// parameters in its body (and a snippet with a stop per parameter at a
+/// call), hover says what a parameter's uses ask, go to definition and
+/// rename reach the parameter list and every use (nothing outside the
+/// body), semantic tokens mark them as parameters, and signature help
+/// names them.
+#[test]
+fn parameters_in_the_editor() {
+    let catalog = builtin();
+    let text = "{ R: TIEvalbot ti }\ndef go_to(PLACE, WAIT) {\n  move(PLACE)\n  if (WAIT > 2) standby()\n}\nR.Action.Go {\n  go_to(kitchen, 3)\n} repeat(1 SEC)\nR.GO { set(Action, Go) }\nR.main { default: mode = GO }\n";
+    let analysis = crate::check_source(FileId(0), text, catalog);
+    assert!(
+        analysis.diagnostics.is_empty(),
+        "{:#?}",
+        analysis.diagnostics
+    );
+
+    // Completion in the body, not outside it.
+    let body = text.find("if (WAIT").unwrap() + 4;
+    let items = completions(
+        &analysis,
+        catalog,
+        text,
+        body,
+        CompletionConfig { snippets: true },
+    );
+    assert_eq!(
+        labels_of(&items, CompletionKind::Parameter),
+        ["PLACE", "WAIT"]
+    );
+    let outside = text.find("go_to(kitchen").unwrap();
+    let items = completions(
+        &analysis,
+        catalog,
+        text,
+        outside,
+        CompletionConfig { snippets: true },
+    );
+    assert!(labels_of(&items, CompletionKind::Parameter).is_empty());
+    let call = items
+        .iter()
+        .find(|i| i.label == "go_to")
+        .expect("the function");
+    assert_eq!(call.insert, "go_to(${1:PLACE}, ${2:WAIT})");
+
+    // Hover on a use: its function and what its argument must be.
+    let use_at = text.find("move(PLACE)").unwrap() + 6;
+    let h = hover(&analysis, catalog, text, use_at).expect("a hover");
+    assert!(
+        h.markdown
+            .contains("Parameter 1 of `def go_to(PLACE, WAIT)`"),
+        "{}",
+        h.markdown
+    );
+    assert!(
+        h.markdown.contains("passed to `move` as `goal` (location)"),
+        "{}",
+        h.markdown
+    );
+    let wait = text.find("WAIT >").unwrap();
+    let h = hover(&analysis, catalog, text, wait).expect("a hover");
+    assert!(
+        h.markdown.contains("compared as a number"),
+        "{}",
+        h.markdown
+    );
+
+    // Definition and rename.
+    let declared = text.find("PLACE,").unwrap();
+    let targets = super::navigation::definition(&analysis, catalog, use_at);
+    let spans: Vec<Span> = targets.iter().map(|t| t.span).collect();
+    assert_eq!(spans, [Span::new(declared, declared + 5)]);
+    let edits = super::rename::rename(&analysis, catalog, text, use_at, "GOAL").unwrap();
+    assert_eq!(
+        edits,
+        [
+            Span::new(declared, declared + 5),
+            Span::new(use_at - 1, use_at + 4)
+        ]
+    );
+    let clash = super::rename::rename(&analysis, catalog, text, use_at, "WAIT").unwrap_err();
+    assert!(
+        clash.to_string().contains("already has a parameter `WAIT`"),
+        "{clash}"
+    );
+    let clash = super::rename::rename(&analysis, catalog, text, use_at, "LOCATION").unwrap_err();
+    assert!(clash.to_string().contains("value of robot type"), "{clash}");
+
+    // Semantic tokens: the declarations and the uses.
+    let tokens = super::semantic_tokens::semantic_tokens(&analysis, None);
+    let params: Vec<&str> = tokens
+        .iter()
+        .filter(|t| t.kind == super::semantic_tokens::TokenKind::Parameter)
+        .map(|t| &text[t.span.range()])
+        .collect();
+    assert_eq!(params, ["PLACE", "WAIT", "PLACE", "WAIT"]);
+
+    // Signature help at the call's second argument.
+    let second = text.find(", 3)").unwrap() + 2;
+    let help = signature_help(&analysis, catalog, text, second).expect("signature help");
+    assert_eq!(help.label, "go_to(PLACE, WAIT)");
+    assert_eq!(help.active_parameter, Some(1));
+}
+
 /// Every `ide` function at `offset` of `text`: nothing panics, and every
 /// range returned lies in the text, on character boundaries.
 fn every_feature_at(text: &str, analysis: &CheckedMission, offset: usize) {

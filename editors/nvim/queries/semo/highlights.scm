@@ -120,6 +120,9 @@
 (function_definition
   name: (identifier) @function)
 
+(parameter_list
+  parameter: (identifier) @variable.parameter)
+
 (call
   function: (identifier) @function.call)
 
