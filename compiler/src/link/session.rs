@@ -117,14 +117,13 @@ impl Outgoing {
     /// makes the frame in flight go again at once.
     pub fn heard(&mut self, frame: &Frame) {
         match frame.kind {
-            Kind::Ack => {
+            Kind::Ack
                 if self
                     .in_flight
                     .as_ref()
-                    .is_some_and(|(f, _)| f.seq == frame.seq)
-                {
-                    self.in_flight = None;
-                }
+                    .is_some_and(|(f, _)| f.seq == frame.seq) =>
+            {
+                self.in_flight = None;
             }
             Kind::Welcome => self.welcomed = true,
             Kind::Hello => {
