@@ -310,3 +310,91 @@ fn bad_arguments_are_refused_with_exit_status_2() {
     assert_eq!(help.code, 0);
     assert!(help.stdout.contains("--link"));
 }
+
+/// The scouting mission with `ti` on the link: its `linux-sim` program with
+/// `--transport link` through `semo gateway`, `irobot` and `nxt` over MQTT,
+/// one private broker. Every robot enters the modes `semo simulate` gives
+/// it on the same scenario, in the same order, to FINISH; the master hears
+/// ti's colors (they went up the link and through the broker), and the
+/// broker's messages reached ti (its own modes depend on the master's
+/// forwarded commands).
+#[test]
+fn a_linux_robot_over_the_link_behaves_as_in_the_simulator() {
+    use support::robots::{events, field, modes};
+    let Some(mut fleet) = Fleet::start("gateway-scouting") else {
+        return;
+    };
+    let scenario = support::repo_root().join("tests/fixtures/build/scouting.scenario.json");
+    let folders = support::mqtt::build(&scouting(), &fleet.out, &[]);
+    // Built with the scenario before anything starts (compiling takes time).
+    support::mqtt::compile_in(&folders, &scenario);
+    let link_port = support::mosquitto::free_port();
+    let gw = fleet.processes.push(
+        Command::new(env!("CARGO_BIN_EXE_semo"))
+            .arg("gateway")
+            .arg(scouting())
+            .args(["--link", &format!("ti=listen:127.0.0.1:{link_port}")])
+            .args(["--broker", &fleet.url()])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("semo gateway starts"),
+    );
+    let link = format!("tcp:127.0.0.1:{link_port}");
+    // Every robot starts at one instant, ti's link open by then.
+    let (_, start_at) = support::robots::start_barrier(3);
+    let start_at = start_at.to_string();
+    let mut started = Vec::new();
+    for folder in &folders {
+        let robot = support::mqtt::robot_name(folder);
+        let (args, env): (Vec<String>, Vec<(&str, &str)>) = if robot == "ti" {
+            (
+                vec!["--transport".into(), "link".into()],
+                vec![("SEMO_LINK", link.as_str())],
+            )
+        } else {
+            (fleet.transport_args(), vec![])
+        };
+        let mut args: Vec<&str> = args.iter().map(String::as_str).collect();
+        args.extend(["--start-at", start_at.as_str()]);
+        started.push(fleet.spawn_with(folder, &scenario, "link", &args, &env));
+    }
+    let traces: std::collections::BTreeMap<String, Vec<support::robots::Event>> = started
+        .iter()
+        .map(|s| (s.robot.clone(), fleet.finish(s, "link")))
+        .collect();
+    let simulated = support::simulate_trace(&scouting(), &scenario, "sim");
+    assert_eq!(simulated.code, 0, "{}", simulated.stderr);
+    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
+    let simulated = events(&lines);
+    assert_eq!(traces.len(), 3);
+    for (robot, trace) in &traces {
+        let reference: Vec<_> = simulated
+            .iter()
+            .filter(|e| field(e, "robot") == robot)
+            .cloned()
+            .collect();
+        assert_eq!(
+            modes(trace),
+            modes(&reference),
+            "{robot}'s modes with ti on the link and in `semo simulate`"
+        );
+        assert_eq!(modes(trace).last().map(String::as_str), Some("FINISH"));
+    }
+    let heard_ti = traces["irobot"].iter().any(|e| {
+        field(e, "event") == "receive"
+            && field(e, "from_robot") == "ti"
+            && field(e, "key") == "SlaveTeam.COLOR"
+    });
+    assert!(heard_ti, "the master hears ti's colors through the gateway");
+    let ti_heard = traces["ti"]
+        .iter()
+        .filter(|e| field(e, "event") == "receive")
+        .count();
+    assert!(ti_heard > 0, "ti hears the fleet through the gateway");
+    assert!(
+        !traces["ti"].iter().any(|e| field(e, "event") == "reject"),
+        "nothing refused"
+    );
+    fleet.processes.kill(gw);
+}
