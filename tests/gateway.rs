@@ -166,6 +166,16 @@ fn a_link_robot_is_a_member_of_the_fleet_on_its_own_topics_only() {
     };
     robot.until("the session", |_, e| e.outgoing.welcomed());
 
+    // Noise on the line (a frame with a flipped bit, a flood without a
+    // zero) is dropped and said; the link goes on.
+    let mut noise = Frame::addressed(Kind::Publish, 0, "MasterTeam", b"SEMO")
+        .unwrap()
+        .encode()
+        .unwrap();
+    noise[8] ^= 0x40; // a letter of "MasterTeam"
+    noise.extend(vec![0x5A; 3 * semo::link::WIRE_MAX]);
+    noise.push(0);
+    robot.stream.write_all(&noise).unwrap();
     // A send claiming another robot is refused; the good one after it is
     // the first thing published.
     robot.send(
@@ -262,6 +272,11 @@ fn a_link_robot_is_a_member_of_the_fleet_on_its_own_topics_only() {
         "{said}"
     );
     assert!(said.contains("ti: link closed"), "{said}");
+    assert!(
+        said.contains("ti: a bad frame (CRC mismatch), dropped"),
+        "{said}"
+    );
+    assert!(said.contains("ti: a bad frame (longer than"), "{said}");
 }
 
 #[test]

@@ -299,6 +299,33 @@ struct LinkGateway {
 struct Counts {
     refused_frames: u64,
     refused_messages: u64,
+    /// Frames the broker connection could not take (its queue full).
+    lost: u64,
+}
+
+/// Hands a message to the robot's MQTT connection without waiting: the
+/// connection's thread may itself wait for room on the link (a robot slow
+/// to acknowledge), and a link thread waiting for it would wait forever.
+/// A message its full queue cannot take is lost, counted and said.
+fn hand_to_broker(
+    client: &rumqttc::Client,
+    name: &str,
+    counts: &mut Counts,
+    topic: String,
+    qos: rumqttc::QoS,
+    retain: bool,
+    payload: Vec<u8>,
+) {
+    if client
+        .try_publish(topic.clone(), qos, retain, payload)
+        .is_err()
+    {
+        counts.lost += 1;
+        eprintln!(
+            "gateway: {name}: lost a message to {topic}: the broker connection's queue is full ({} lost)",
+            counts.lost
+        );
+    }
 }
 
 impl LinkGateway {
@@ -315,7 +342,7 @@ impl LinkGateway {
         let mut mqtt = access.options(client_id);
         mqtt.set_keep_alive(Duration::from_secs(10));
         mqtt.set_clean_session(false);
-        let (client, connection) = rumqttc::Client::new(mqtt, 64);
+        let (client, connection) = rumqttc::Client::new(mqtt, 256);
         let subscriptions = [
             topics::team_inbox(&self.scope, &self.robot.team),
             topics::robot_inbox(&self.scope, &self.robot.team, &self.robot.robot),
@@ -490,7 +517,10 @@ impl LinkGateway {
         match frame.kind {
             Kind::Status => {
                 let text = String::from_utf8_lossy(&frame.payload).into_owned();
-                let _ = client.publish(
+                hand_to_broker(
+                    client,
+                    self.name(),
+                    counts,
                     topics::status(&self.scope, &self.robot.robot),
                     rumqttc::QoS::AtLeastOnce,
                     true,
@@ -520,7 +550,15 @@ impl LinkGateway {
                             } else {
                                 rumqttc::QoS::AtLeastOnce
                             };
-                            let _ = client.publish(topic, qos, false, data.to_vec());
+                            hand_to_broker(
+                                client,
+                                self.name(),
+                                counts,
+                                topic,
+                                qos,
+                                false,
+                                data.to_vec(),
+                            );
                             None
                         }
                         None => Some(format!("`{to}` is no team, robot or USER of the mission")),
@@ -611,7 +649,7 @@ impl LinkGateway {
             "state": "lost",
             "started": started,
         });
-        let _ = client.publish(
+        let _ = client.try_publish(
             topics::status(&self.scope, &self.robot.robot),
             rumqttc::QoS::AtLeastOnce,
             true,
