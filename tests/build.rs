@@ -880,7 +880,9 @@ fn the_runtime_is_written_once_and_compiled_once_per_compiler_and_flags() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .filter(|name| name.ends_with(".c"))
         .collect();
-    assert_eq!(sources.len(), 6, "{sources:?}");
+    // The core, the threads platform, UDP, MQTT, the serial link and its
+    // transport, the simulation and lock-step.
+    assert_eq!(sources.len(), 8, "{sources:?}");
     let folders = robot_folders(&out);
     assert_eq!(folders.len(), 3, "{folders:?}");
     for folder in &folders {

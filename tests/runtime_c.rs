@@ -177,6 +177,8 @@ fn compile(flavor: Flavor, world: bool) -> Program {
             "semo_core.c",
             "semo_runtime.c",
             "semo_udp.c",
+            "semo_link.c",
+            "semo_link_transport.c",
             "semo_sim.c",
             "semo_lockstep.c",
             "-o",

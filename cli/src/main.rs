@@ -9,6 +9,7 @@ mod defaults;
 mod deploy;
 mod fix;
 mod fmt;
+mod gateway;
 mod graph;
 mod init;
 mod input;
@@ -219,6 +220,47 @@ enum Command {
         deploy: Option<PathBuf>,
         /// The run to show and command (the robots' `--run`); default: the
         /// newest, followed as newer runs start.
+        #[arg(long, value_name = "ID")]
+        run: Option<String>,
+        /// More strategy (and catalog) files or folders to read.
+        #[arg(long)]
+        strategy: Vec<PathBuf>,
+        #[arg(long, value_enum, default_value_t = ColorChoice::Auto)]
+        color: ColorChoice,
+    },
+    /// Bridge robots on serial links to the MQTT broker: each link is one
+    /// robot of the mission, which the gateway speaks for with that robot's
+    /// client id, credentials and topics (docs/link.md, docs/gateway.md).
+    #[command(
+        long_about = "Bridge robots on serial links (docs/link.md) to the MQTT broker. Each \
+        --link ROBOT=LINK is one robot of the mission: the gateway is its MQTT client, with its \
+        client id and credentials from the deployment file (so the broker's ACL applies to it \
+        as to a Linux robot), publishes its sends, publishes and status on its own topics, and \
+        passes down the link what the broker delivers to it. A frame never says who sent it: a \
+        datagram naming another sender than the link's robot is refused.\n\n\
+        LINK is tcp:HOST:PORT (the gateway connects, again when the connection is lost; QEMU's \
+        -serial tcp:HOST:PORT,server), listen:HOST:PORT (the gateway listens), or the path of a \
+        serial device (set up beforehand: stty -F DEVICE 115200 raw).\n\n\
+        Runs until stopped. Exit status: 2 for bad arguments (an unknown robot, a link given \
+        twice, a bad LINK or run id, mission errors), 1 when the broker refuses the connection \
+        for good (a TLS certificate not trusted)."
+    )]
+    Gateway {
+        /// The mission script.
+        mission: PathBuf,
+        /// A robot and its link: ROBOT=tcp:HOST:PORT, ROBOT=listen:HOST:PORT
+        /// or ROBOT=DEVICE (repeatable).
+        #[arg(long = "link", value_name = "ROBOT=LINK")]
+        links: Vec<String>,
+        /// The broker, mqtt://HOST[:PORT] or mqtts://HOST[:PORT] (default: the
+        /// deployment's, else mqtt://127.0.0.1:1883).
+        #[arg(long, value_name = "URL")]
+        broker: Option<String>,
+        /// A deployment file: each robot's client id and credentials (and the broker).
+        #[arg(long, value_name = "FILE")]
+        deploy: Option<PathBuf>,
+        /// The run the robots take part in (their topics' scope; default
+        /// $SEMO_RUN, else `default`).
         #[arg(long, value_name = "ID")]
         run: Option<String>,
         /// More strategy (and catalog) files or folders to read.
@@ -839,6 +881,26 @@ fn run() -> i32 {
             operator::Options {
                 mission,
                 strategy,
+                broker,
+                deploy,
+                run,
+                color: use_color(color),
+            },
+            &mut out,
+        ),
+        Command::Gateway {
+            mission,
+            links,
+            broker,
+            deploy,
+            run,
+            strategy,
+            color,
+        } => gateway::run(
+            gateway::Options {
+                mission,
+                strategy,
+                links,
                 broker,
                 deploy,
                 run,

@@ -35,6 +35,7 @@ pub mod ide;
 mod index;
 /// Graph drawing shared by the task-graph and mode-machine pictures.
 mod layout;
+pub mod link;
 pub mod modemachine;
 pub mod platform;
 pub mod project;

@@ -59,6 +59,12 @@ const CORE: (&str, &str) = ("semo_core.c", include_str!("runtime/semo_core.c"));
 const POSIX: (&str, &str) = ("semo_runtime.c", include_str!("runtime/semo_runtime.c"));
 const UDP: (&str, &str) = ("semo_udp.c", include_str!("runtime/semo_udp.c"));
 const MQTT: (&str, &str) = ("semo_mqtt.c", include_str!("runtime/semo_mqtt.c"));
+const LINK_H: (&str, &str) = ("semo_link.h", include_str!("runtime/semo_link.h"));
+const LINK: (&str, &str) = ("semo_link.c", include_str!("runtime/semo_link.c"));
+const LINK_TRANSPORT: (&str, &str) = (
+    "semo_link_transport.c",
+    include_str!("runtime/semo_link_transport.c"),
+);
 const POSIX_SIM: (&str, &str) = ("semo_sim.c", include_str!("runtime/semo_sim.c"));
 const LOCKSTEP: (&str, &str) = ("semo_lockstep.c", include_str!("runtime/semo_lockstep.c"));
 const STATIC: (&str, &str) = ("semo_static.c", include_str!("runtime/semo_static.c"));
@@ -94,6 +100,9 @@ const RUNTIME_FILES: &[(&str, &str)] = &[
     POSIX,
     UDP,
     MQTT,
+    LINK_H,
+    LINK,
+    LINK_TRANSPORT,
     POSIX_SIM,
     LOCKSTEP,
     STATIC,

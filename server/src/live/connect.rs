@@ -57,10 +57,41 @@ impl BrokerAccess {
     /// password file gone meanwhile, a certificate rustls cannot use) is
     /// said with the file's path.
     pub fn new(url: &str, deployment: Option<&Deployment>) -> Result<BrokerAccess, String> {
-        let address = semo::deploy::broker_address(url)?;
         let operator = deployment
             .map(Deployment::operator_credentials)
             .unwrap_or_default();
+        BrokerAccess::as_client(url, &operator, "the operator", deployment.is_some())
+    }
+
+    /// The access to `url` as robot `robot` of team `team` with its
+    /// credentials from the deployment (`semo gateway` speaks for it): its
+    /// entry's over its team's over the file's, as `semo build --deploy`
+    /// bakes them into a Linux robot.
+    pub fn robot(
+        url: &str,
+        deployment: Option<&Deployment>,
+        team: &str,
+        robot: &str,
+    ) -> Result<BrokerAccess, String> {
+        let credentials = deployment
+            .map(|d| d.robot(team, robot).credentials)
+            .unwrap_or_default();
+        BrokerAccess::as_client(
+            url,
+            &credentials,
+            &format!("robot `{robot}`"),
+            deployment.is_some(),
+        )
+    }
+
+    /// The access to `url` as the client `who` with `operator`'s credentials.
+    fn as_client(
+        url: &str,
+        operator: &semo::deploy::Credentials,
+        who: &str,
+        deployed: bool,
+    ) -> Result<BrokerAccess, String> {
+        let address = semo::deploy::broker_address(url)?;
         let credentials = match &operator.user {
             None => None,
             Some(user) => {
@@ -68,10 +99,7 @@ impl BrokerAccess {
                     None => String::new(),
                     Some(path) => semo::workspace::read_text(path)
                         .map_err(|e| {
-                            format!(
-                                "cannot read the operator's password file {}: {e}",
-                                path.display()
-                            )
+                            format!("cannot read {who}'s password file {}: {e}", path.display())
                         })?
                         .lines()
                         .next()
@@ -84,8 +112,8 @@ impl BrokerAccess {
         let (ca, tls) = if address.tls {
             let Some(ca) = operator.ca.clone() else {
                 return Err(format!(
-                    "{url} is a TLS broker: its certificate is checked with the CA of the deployment file (`ca` at its top or in [operator]), {}",
-                    if deployment.is_some() {
+                    "{url} is a TLS broker: its certificate is checked with the CA of the deployment file (`ca` at its top, or {who}'s own), {}",
+                    if deployed {
                         "which names none"
                     } else {
                         "and none is given (--deploy FILE, or the project's `[build] deployment`)"

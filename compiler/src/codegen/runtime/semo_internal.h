@@ -286,5 +286,8 @@ void semo__fault(void);
  * its run (the default client id names the run). */
 bool semo__mqtt_session_present(void);
 #endif
+/* Whether the gateway's Welcome said the broker kept the robot's session
+ * (semo_link_transport.c, POSIX). */
+bool semo__link_session_present(void);
 
 #endif /* SEMO_INTERNAL_H */

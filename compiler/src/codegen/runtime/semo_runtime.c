@@ -35,6 +35,8 @@
  * only where it is the default, as only then is libmosquitto linked. */
 #ifdef SEMO_MQTT
 #define DEFAULT_TRANSPORT "mqtt"
+#elif defined(SEMO_LINK_DEFAULT)
+#define DEFAULT_TRANSPORT "link"
 #else
 #define DEFAULT_TRANSPORT "udp"
 #endif
@@ -743,6 +745,8 @@ int64_t semo_joined_ms(void)
 
 bool semo_session_resumed(void)
 {
+    if (g_transport == &semo_link_transport)
+        return semo__link_session_present();
 #ifdef SEMO_MQTT
     if (g_transport == &semo_mqtt_transport)
         return semo__mqtt_session_present();
@@ -1059,14 +1063,15 @@ static const char *default_broker(void)
 static void usage(FILE *f, const char *prog)
 {
     fprintf(f,
-            "usage: %s [--trace FILE] [--transport udp|mqtt] [--port-base N] [--broker URL] [--run ID]"
+            "usage: %s [--trace FILE] [--transport udp|mqtt|link] [--port-base N] [--broker URL] [--run ID]"
             " [--duration MS] [--start-at UNIX_MS]"
 #ifdef SEMO_SIM
             " [--time-scale X] [--lockstep PATH]"
 #endif
             "\n"
             "  --trace FILE      write a JSON-lines trace to FILE (\"-\": standard output)\n"
-            "  --transport T     udp (loopback) or mqtt (default %s, or $SEMO_TRANSPORT)\n"
+            "  --transport T     udp (loopback), mqtt, or link: the serial link to `semo gateway`\n"
+            "                    at $SEMO_LINK=tcp:HOST:PORT (default %s, or $SEMO_TRANSPORT)\n"
             "  --port-base N     udp: robot i uses UDP port N+i on 127.0.0.1 (default %d, or $SEMO_PORT_BASE);\n"
             "                    $SEMO_UDP_KEY (hex, 16 to 64 bytes, the same for every robot of the run):\n"
             "                    datagrams are signed with it, and one not signed with it is refused\n"
@@ -1109,6 +1114,10 @@ static bool parse_transport(const char *prog, const char *name, const semo_trans
         *out = &semo_udp_transport;
         return true;
     }
+    if (strcmp(name, "link") == 0) {
+        *out = &semo_link_transport;
+        return true;
+    }
 #ifdef SEMO_MQTT
     if (strcmp(name, "mqtt") == 0) {
         *out = &semo_mqtt_transport;
@@ -1121,7 +1130,7 @@ static bool parse_transport(const char *prog, const char *name, const semo_trans
         return false;
     }
 #endif
-    fprintf(stderr, "%s: the transport must be udp or mqtt, not \"%s\"\n", prog, name);
+    fprintf(stderr, "%s: the transport must be udp or mqtt or link, not \"%s\"\n", prog, name);
     return false;
 }
 
@@ -1208,7 +1217,7 @@ static bool mqtt_identity(const char *prog, options *o)
         problem = "an mqtts:// broker needs the CA that signed its certificate ($SEMO_MQTT_CA)";
     else if (!net->broker_tls && net->cert)
         problem = "a client certificate needs an mqtts:// broker";
-    if (o->transport == &semo_udp_transport)
+    if (o->transport == &semo_udp_transport || o->transport == &semo_link_transport)
         return true;
     if (problem)
         fprintf(stderr, "%s: %s\n", prog, problem);
@@ -1618,6 +1627,7 @@ static int run(const options *o)
         net.started_unix_ms = g_started_unix_ms;
         net.udp_key = o->udp_key;
         net.udp_key_len = o->udp_key_len;
+        net.link = getenv("SEMO_LINK");
         if (o->transport->open(p, &net) != 0) {
             if (o->transport == &semo_udp_transport)
                 fprintf(stderr, "semo runtime: cannot open the udp transport on port %ld\n", o->port_base + (long)p->peers[p->self].index);

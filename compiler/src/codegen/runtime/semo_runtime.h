@@ -376,6 +376,7 @@ typedef struct {
     bool broker_tls;         /* mqtts:// */
     const char *run;         /* mqtt: the run's id (`--run`), a checked topic level */
     long long started_unix_ms; /* mqtt: mission time 0 on the wall clock, for the last will */
+    const char *link;        /* link: tcp:HOST:PORT of the gateway ($SEMO_LINK) */
     const char *client_id;   /* default semo-<mission>-<run>-<robot> */
     const char *user;
     const char *password_file; /* its first line is the password */
@@ -438,6 +439,8 @@ typedef struct {
     void (*close)(void);
 } semo_transport;
 extern const semo_transport semo_udp_transport;
+/* The serial link to `semo gateway` over TCP ($SEMO_LINK, semo_link_transport.c). */
+extern const semo_transport semo_link_transport;
 #ifdef SEMO_MQTT
 extern const semo_transport semo_mqtt_transport;
 #endif

@@ -12,7 +12,7 @@
 RUNTIME_KEY := $(shell printf '%s' '$(subst ','\'',$(CC) $(CFLAGS) $(SEMO_CFLAGS))' | cksum | cut -d ' ' -f 1)
 RUNTIME_OBJ := $(RUNTIME)/obj/$(RUNTIME_KEY)
 RUNTIME_OBJECTS := $(addprefix $(RUNTIME_OBJ)/,$(RUNTIME_SOURCES:.c=.o))
-RUNTIME_HEADERS := $(RUNTIME)/semo_runtime.h $(RUNTIME)/semo_internal.h
+RUNTIME_HEADERS := $(RUNTIME)/semo_runtime.h $(RUNTIME)/semo_internal.h $(wildcard $(RUNTIME)/semo_link.h)
 
 $(RUNTIME_OBJ)/%.o: $(RUNTIME)/%.c $(RUNTIME_HEADERS)
 	@mkdir -p $(RUNTIME_OBJ)

@@ -1,0 +1,775 @@
+//! `semo gateway MISSION --link ROBOT=LINK…`: a robot on a serial link
+//! (`docs/link.md`) becomes a member of the fleet on the MQTT broker. For
+//! each link the gateway is that robot's MQTT client, with its client id and
+//! credentials from the deployment file (so the broker's ACL applies to it
+//! as to a Linux robot), subscribed to its topics; it publishes the robot's
+//! `send`s (QoS 1), `publish`es (QoS 0) and status (retained), and passes
+//! down the link what the broker delivers to it.
+//!
+//! Trust comes from the link, never from a frame: a frame's datagram must
+//! name the link's robot as its sender (else it is refused and counted),
+//! the topic's sender levels are the link's robot, and a message from the
+//! broker whose datagram names another sender or key than its topic goes
+//! down as `R` (the robot traces a `reject`), as `semo_mqtt.c` refuses it.
+//! The topics are `semo::deploy::topics`, the runtime's.
+//!
+//! A link is `tcp:HOST:PORT` (the gateway connects, and again when the
+//! connection is lost: QEMU's `-serial tcp:HOST:PORT,server`), `listen:HOST:PORT`
+//! (the gateway listens, one robot at a time), or the path of a serial
+//! device (set up beforehand, e.g. `stty -F /dev/ttyUSB0 115200 raw`).
+
+use semo::deploy::datagram;
+use semo::deploy::topics::{self, RunId, Scope, Sender};
+use semo::host;
+use semo::link::{Endpoint, Frame, Kind};
+use semo_server::live::{BrokerAccess, DEFAULT_BROKER};
+use std::collections::{BTreeSet, VecDeque};
+use std::io::{Read, Write};
+use std::net::{TcpListener, TcpStream};
+use std::path::PathBuf;
+use std::sync::mpsc::{SyncSender, sync_channel};
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::{Duration, Instant};
+
+pub struct Options {
+    pub mission: PathBuf,
+    pub strategy: Vec<PathBuf>,
+    pub links: Vec<String>,
+    pub broker: Option<String>,
+    pub deploy: Option<PathBuf>,
+    pub run: Option<String>,
+    pub color: bool,
+}
+
+/// Where a link's bytes come from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Place {
+    Connect(String),
+    Listen(String),
+    Device(PathBuf),
+}
+
+/// `ROBOT=LINK` as given.
+pub fn parse_link(text: &str) -> Result<(String, Place), String> {
+    let Some((robot, link)) = text.split_once('=') else {
+        return Err(format!(
+            "`{text}` is not ROBOT=LINK (e.g. ti=tcp:127.0.0.1:5000, ti=listen:127.0.0.1:5000, ti=/dev/ttyUSB0)"
+        ));
+    };
+    let address = |rest: &str, what: &str| -> Result<String, String> {
+        match rest.rsplit_once(':') {
+            Some((host, port)) if !host.is_empty() && port.parse::<u16>().is_ok() => {
+                Ok(rest.to_string())
+            }
+            _ => Err(format!(
+                "`{what}{rest}` needs HOST:PORT (e.g. 127.0.0.1:5000)"
+            )),
+        }
+    };
+    let place = if let Some(rest) = link.strip_prefix("tcp:") {
+        Place::Connect(address(rest, "tcp:")?)
+    } else if let Some(rest) = link.strip_prefix("listen:") {
+        Place::Listen(address(rest, "listen:")?)
+    } else if link.is_empty() {
+        return Err(format!("`{text}` names no link"));
+    } else {
+        Place::Device(PathBuf::from(link))
+    };
+    if robot.is_empty() {
+        return Err(format!("`{text}` names no robot"));
+    }
+    Ok((robot.to_string(), place))
+}
+
+/// What the link thread hears.
+enum Event {
+    /// Bytes from the line.
+    Bytes(Vec<u8>),
+    /// The line closed (it is opened again).
+    Closed(String),
+    /// The broker accepted the connection and the subscriptions:
+    /// whether it kept the robot's session.
+    Ready(bool),
+    /// A message the broker delivered on one of the robot's topics.
+    Message { topic: String, payload: Vec<u8> },
+}
+
+/// A robot of the mission, as the gateway speaks for it.
+#[derive(Clone)]
+struct Robot {
+    team: String,
+    robot: String,
+}
+
+/// What one link's robot may name as a destination: the mission's teams,
+/// its robots (with their teams) and the operator.
+#[derive(Clone)]
+struct Roster {
+    teams: BTreeSet<String>,
+    robots: Vec<Robot>,
+}
+
+pub fn run(options: Options, out: &mut impl Write) -> i32 {
+    let run_id = match options
+        .run
+        .clone()
+        .or_else(|| std::env::var("SEMO_RUN").ok().filter(|r| !r.is_empty()))
+        .map(|r| RunId::parse(&r))
+        .transpose()
+    {
+        Ok(run) => run.unwrap_or_else(|| RunId::parse("default").expect("a valid run id")),
+        Err(why) => {
+            eprintln!("error: --run: {why}");
+            return 2;
+        }
+    };
+    if options.links.is_empty() {
+        eprintln!("error: no link: give at least one --link ROBOT=LINK");
+        return 2;
+    }
+    let mut links = Vec::new();
+    for text in &options.links {
+        match parse_link(text) {
+            Ok(link) => links.push(link),
+            Err(why) => {
+                eprintln!("error: --link: {why}");
+                return 2;
+            }
+        }
+    }
+    let (mut run, mission) = match host::load_build(&options.mission, &options.strategy) {
+        Ok(loaded) => loaded,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return 2;
+        }
+    };
+    let deployment = match &options.deploy {
+        None => None,
+        Some(path) => {
+            match super::deploy::load(
+                &mut run,
+                path,
+                super::output::Format::Human,
+                options.color,
+                out,
+            ) {
+                Ok(deployment) => Some(deployment),
+                Err(code) => return code,
+            }
+        }
+    };
+    let analysis = run.analysis();
+    if let Err(code) = super::build_files(&analysis, mission) {
+        return code;
+    }
+    let Some(refined) = analysis.refined(mission) else {
+        eprintln!("error: internal error: the mission is not in the workspace analysis");
+        return 2;
+    };
+    let Some(first) = refined.programs.first() else {
+        eprintln!("error: refused: fix the mission's errors first (`semo check`)");
+        return 2;
+    };
+    let roster = Roster {
+        teams: refined.programs.iter().map(|p| p.team.clone()).collect(),
+        robots: refined
+            .programs
+            .iter()
+            .map(|p| Robot {
+                team: p.team.clone(),
+                robot: p.robot.clone(),
+            })
+            .collect(),
+    };
+    let mission_topic = topics::mission(&first.mission);
+    let scope = Scope::run(&mission_topic, &run_id);
+    let url = match (&options.broker, &deployment) {
+        (Some(url), _) => url.clone(),
+        (None, Some(d)) => d.broker.url.clone(),
+        (None, None) => DEFAULT_BROKER.to_string(),
+    };
+    let mut seen = BTreeSet::new();
+    let mut plans = Vec::new();
+    for (name, place) in links {
+        let Some(robot) = roster.robots.iter().find(|r| r.robot == name).cloned() else {
+            let names: Vec<&str> = roster.robots.iter().map(|r| r.robot.as_str()).collect();
+            eprintln!(
+                "error: --link: the mission has no robot `{name}` (its robots: {})",
+                names.join(", ")
+            );
+            return 2;
+        };
+        if !seen.insert(name.clone()) {
+            eprintln!("error: --link: robot `{name}` is given two links");
+            return 2;
+        }
+        let access = match BrokerAccess::robot(&url, deployment.as_ref(), &robot.team, &robot.robot)
+        {
+            Ok(access) => access,
+            Err(why) => {
+                eprintln!("error: {why}");
+                return 2;
+            }
+        };
+        let client_id = deployment
+            .as_ref()
+            .and_then(|d| d.robot(&robot.team, &robot.robot).client_id)
+            .unwrap_or_else(|| format!("semo-{mission_topic}-{run_id}-{}", robot.robot));
+        plans.push((robot, place, access, client_id));
+    }
+    let _ = writeln!(
+        out,
+        "gateway on {url}, mission {mission_topic}, run {run_id}: {}",
+        plans
+            .iter()
+            .map(|(r, place, _, _)| format!("{} on {}", r.robot, describe(place)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let _ = out.flush();
+    let threads: Vec<_> = plans
+        .into_iter()
+        .map(|(robot, place, access, client_id)| {
+            let gateway = LinkGateway {
+                robot,
+                place,
+                scope: scope.clone(),
+                roster: roster.clone(),
+            };
+            std::thread::spawn(move || gateway.serve(access, client_id))
+        })
+        .collect();
+    for thread in threads {
+        let _ = thread.join();
+    }
+    1
+}
+
+fn describe(place: &Place) -> String {
+    match place {
+        Place::Connect(address) => format!("tcp:{address}"),
+        Place::Listen(address) => format!("listen:{address}"),
+        Place::Device(path) => path.display().to_string(),
+    }
+}
+
+/// Messages from the broker the link thread holds at most (queued behind
+/// the one in flight and waiting); beyond, the broker holds them (the
+/// connection's thread waits for room, as a Linux robot's full inbox holds
+/// back its transport).
+const ROOM: usize = 64;
+/// Reliable frames behind the one in flight, per link.
+const LINK_QUEUE: usize = 16;
+
+/// Room for messages from the broker: the MQTT thread takes a place before
+/// it hands a message over, the link thread gives it back when the robot
+/// has acknowledged it.
+struct Room {
+    free: Mutex<usize>,
+    freed: Condvar,
+}
+
+impl Room {
+    fn take(&self) {
+        let mut free = self.free.lock().unwrap_or_else(|e| e.into_inner());
+        while *free == 0 {
+            free = self.freed.wait(free).unwrap_or_else(|e| e.into_inner());
+        }
+        *free -= 1;
+    }
+
+    fn give(&self, n: usize) {
+        if n > 0 {
+            *self.free.lock().unwrap_or_else(|e| e.into_inner()) += n;
+            self.freed.notify_all();
+        }
+    }
+}
+
+struct LinkGateway {
+    robot: Robot,
+    place: Place,
+    scope: Scope,
+    roster: Roster,
+}
+
+/// The counts a link keeps, said on standard error as they change.
+#[derive(Default)]
+struct Counts {
+    refused_frames: u64,
+    refused_messages: u64,
+    /// Frames the broker connection could not take (its queue full).
+    lost: u64,
+}
+
+/// Hands a message to the robot's MQTT connection without waiting: the
+/// connection's thread may itself wait for room on the link (a robot slow
+/// to acknowledge), and a link thread waiting for it would wait forever.
+/// A message its full queue cannot take is lost, counted and said.
+fn hand_to_broker(
+    client: &rumqttc::Client,
+    name: &str,
+    counts: &mut Counts,
+    topic: String,
+    qos: rumqttc::QoS,
+    retain: bool,
+    payload: Vec<u8>,
+) {
+    if client
+        .try_publish(topic.clone(), qos, retain, payload)
+        .is_err()
+    {
+        counts.lost += 1;
+        eprintln!(
+            "gateway: {name}: lost a message to {topic}: the broker connection's queue is full ({} lost)",
+            counts.lost
+        );
+    }
+}
+
+impl LinkGateway {
+    fn name(&self) -> &str {
+        &self.robot.robot
+    }
+
+    fn serve(self, access: BrokerAccess, client_id: String) {
+        let (events, heard) = sync_channel::<Event>(256);
+        let room = Arc::new(Room {
+            free: Mutex::new(ROOM),
+            freed: Condvar::new(),
+        });
+        let mut mqtt = access.options(client_id);
+        mqtt.set_keep_alive(Duration::from_secs(10));
+        mqtt.set_clean_session(false);
+        let (client, connection) = rumqttc::Client::new(mqtt, 256);
+        let subscriptions = [
+            topics::team_inbox(&self.scope, &self.robot.team),
+            topics::robot_inbox(&self.scope, &self.robot.team, &self.robot.robot),
+        ];
+        {
+            let events = events.clone();
+            let room = room.clone();
+            let client = client.clone();
+            let name = self.name().to_string();
+            std::thread::spawn(move || {
+                broker_thread(
+                    connection,
+                    client,
+                    subscriptions,
+                    access,
+                    events,
+                    room,
+                    name,
+                )
+            });
+        }
+        // The link opens once the broker is ready: a robot's Hello is
+        // answered with what the broker says of its session.
+        let session_present = loop {
+            match heard.recv() {
+                Ok(Event::Ready(present)) => break present,
+                Ok(Event::Message { .. }) => room.give(1), // before Ready: none
+                Ok(_) => {}
+                Err(_) => return,
+            }
+        };
+        let mut held: VecDeque<(String, Vec<u8>)> = VecDeque::new();
+        let mut counts = Counts::default();
+        let mut endpoint = Endpoint::new(LINK_QUEUE);
+        endpoint.welcome_flags = u8::from(session_present);
+        let started = Instant::now();
+        let mut last_status: Option<String> = None;
+        loop {
+            let Some(writer) = self.open(events.clone()) else {
+                std::thread::sleep(Duration::from_millis(500));
+                continue;
+            };
+            let mut writer = writer;
+            eprintln!("gateway: {}: link open", self.name());
+            endpoint.outgoing.restart();
+            let mut wire = Vec::new();
+            let now = || started.elapsed().as_millis() as u64;
+            endpoint.tick(now(), &mut wire);
+            let closed = loop {
+                if !wire.is_empty() {
+                    if let Err(e) = writer.write_all(&wire) {
+                        break format!("write: {e}");
+                    }
+                    wire.clear();
+                }
+                let wait = endpoint
+                    .outgoing
+                    .deadline()
+                    .map(|d| Duration::from_millis(d.saturating_sub(now())));
+                let event = match wait {
+                    Some(wait) => match heard.recv_timeout(wait) {
+                        Ok(event) => Some(event),
+                        Err(std::sync::mpsc::RecvTimeoutError::Timeout) => None,
+                        Err(_) => return,
+                    },
+                    None => match heard.recv() {
+                        Ok(event) => Some(event),
+                        Err(_) => return,
+                    },
+                };
+                let pending_before = endpoint.outgoing.pending();
+                match event {
+                    None => {}
+                    Some(Event::Bytes(bytes)) => {
+                        for frame in endpoint.feed(&bytes, now(), &mut wire) {
+                            self.publish_for_robot(&frame, &client, &mut counts, &mut last_status);
+                        }
+                        for bad in endpoint.bad_frames.drain(..) {
+                            eprintln!("gateway: {}: a bad frame ({bad}), dropped", self.name());
+                        }
+                    }
+                    Some(Event::Closed(why)) => break why,
+                    Some(Event::Ready(_)) => {}
+                    Some(Event::Message { topic, payload }) => held.push_back((topic, payload)),
+                }
+                // Messages from the broker go down as the link has room.
+                while let Some((topic, payload)) = held.front() {
+                    let frame = self.down_the_link(topic, payload, &mut counts);
+                    match frame {
+                        None => {
+                            held.pop_front();
+                            room.give(1);
+                        }
+                        Some((kind, bytes)) => {
+                            if endpoint.queue(kind, bytes).is_err() {
+                                break;
+                            }
+                            held.pop_front();
+                        }
+                    }
+                }
+                // Room comes back as the robot acknowledges.
+                let pending_after = endpoint.outgoing.pending();
+                room.give(pending_before.saturating_sub(pending_after));
+                endpoint.tick(now(), &mut wire);
+            };
+            eprintln!("gateway: {}: link closed ({closed})", self.name());
+            self.lost(&client, last_status.as_deref());
+        }
+    }
+
+    /// Opens the link and starts its reader; the writing half, or `None`
+    /// (said on standard error) when it cannot be opened now.
+    fn open(&self, events: SyncSender<Event>) -> Option<Box<dyn Write + Send>> {
+        let (reader, writer): (Box<dyn Read + Send>, Box<dyn Write + Send>) = match &self.place {
+            Place::Connect(address) => match TcpStream::connect(address) {
+                Ok(stream) => {
+                    let _ = stream.set_nodelay(true);
+                    (Box::new(stream.try_clone().ok()?), Box::new(stream))
+                }
+                Err(e) => {
+                    eprintln!("gateway: {}: tcp:{address}: {e} (retrying)", self.name());
+                    return None;
+                }
+            },
+            Place::Listen(address) => {
+                let listener = match TcpListener::bind(address) {
+                    Ok(listener) => listener,
+                    Err(e) => {
+                        eprintln!("gateway: {}: listen:{address}: {e} (retrying)", self.name());
+                        return None;
+                    }
+                };
+                let (stream, _) = listener.accept().ok()?;
+                let _ = stream.set_nodelay(true);
+                (Box::new(stream.try_clone().ok()?), Box::new(stream))
+            }
+            Place::Device(path) => {
+                match std::fs::OpenOptions::new()
+                    .read(true)
+                    .write(true)
+                    .open(path)
+                {
+                    Ok(file) => (Box::new(file.try_clone().ok()?), Box::new(file)),
+                    Err(e) => {
+                        eprintln!(
+                            "gateway: {}: {}: {e} (retrying)",
+                            self.name(),
+                            path.display()
+                        );
+                        return None;
+                    }
+                }
+            }
+        };
+        std::thread::spawn(move || read_link(reader, events));
+        Some(writer)
+    }
+
+    /// A frame the robot sent: published for it, or refused.
+    fn publish_for_robot(
+        &self,
+        frame: &Frame,
+        client: &rumqttc::Client,
+        counts: &mut Counts,
+        last_status: &mut Option<String>,
+    ) {
+        let me = Sender {
+            team: &self.robot.team,
+            robot: &self.robot.robot,
+        };
+        match frame.kind {
+            Kind::Status => {
+                let text = String::from_utf8_lossy(&frame.payload).into_owned();
+                hand_to_broker(
+                    client,
+                    self.name(),
+                    counts,
+                    topics::status(&self.scope, &self.robot.robot),
+                    rumqttc::QoS::AtLeastOnce,
+                    true,
+                    frame.payload.clone(),
+                );
+                *last_status = Some(text);
+            }
+            Kind::Send | Kind::Publish => {
+                let Some((to, data)) = frame.destination() else {
+                    return;
+                };
+                let to = String::from_utf8_lossy(to).into_owned();
+                let publish = frame.kind == Kind::Publish;
+                let refusal = match datagram::decode(data) {
+                    None => Some("not a runtime datagram".to_string()),
+                    Some(d) if d.team != me.team || d.robot != me.robot => Some(format!(
+                        "its datagram names {}/{} as the sender, not this link's robot",
+                        d.team, d.robot
+                    )),
+                    Some(d) if d.publish != publish => {
+                        Some("its datagram's kind is not its frame's".to_string())
+                    }
+                    Some(d) => match self.topic_to(&to, &d.key, me) {
+                        Some(topic) => {
+                            let qos = if publish {
+                                rumqttc::QoS::AtMostOnce
+                            } else {
+                                rumqttc::QoS::AtLeastOnce
+                            };
+                            hand_to_broker(
+                                client,
+                                self.name(),
+                                counts,
+                                topic,
+                                qos,
+                                false,
+                                data.to_vec(),
+                            );
+                            None
+                        }
+                        None => Some(format!("`{to}` is no team, robot or USER of the mission")),
+                    },
+                };
+                if let Some(why) = refusal {
+                    counts.refused_frames += 1;
+                    eprintln!(
+                        "gateway: {}: refused a {} to {to}: {why} ({} refused)",
+                        self.name(),
+                        if publish { "publish" } else { "send" },
+                        counts.refused_frames
+                    );
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// The topic of a message from `me` to `to` (a team, `USER`, or one
+    /// robot), as `semo_mqtt.c` names it: a team wins over a robot of the
+    /// same name.
+    fn topic_to(&self, to: &str, key: &str, me: Sender) -> Option<String> {
+        if self.roster.teams.contains(to) || to == "USER" {
+            return Some(topics::to_team(&self.scope, to, key, me));
+        }
+        let robot = self.roster.robots.iter().find(|r| r.robot == to)?;
+        Some(topics::to_robot(
+            &self.scope,
+            &robot.team,
+            &robot.robot,
+            key,
+            me,
+        ))
+    }
+
+    /// What a message from the broker becomes on the link: `M` with its
+    /// datagram, `R` when its datagram names another sender or key than
+    /// its topic, nothing for the robot's own message to its team.
+    fn down_the_link(
+        &self,
+        topic: &str,
+        payload: &[u8],
+        counts: &mut Counts,
+    ) -> Option<(Kind, Vec<u8>)> {
+        let Some(d) = datagram::decode(payload) else {
+            // The runtime rejects it as malformed, as over MQTT.
+            return Some((Kind::Message, payload.to_vec()));
+        };
+        let sender = Sender::claimed_by(&d);
+        let own_team = topics::to_team(&self.scope, &self.robot.team, &d.key, sender);
+        let own_robot = topics::to_robot(
+            &self.scope,
+            &self.robot.team,
+            &self.robot.robot,
+            &d.key,
+            sender,
+        );
+        let on_its_topic = topic == own_team || topic == own_robot;
+        if on_its_topic && d.team == self.robot.team && d.robot == self.robot.robot {
+            return None; // our own message to our team
+        }
+        if !on_its_topic {
+            counts.refused_messages += 1;
+            eprintln!(
+                "gateway: {}: a message on {topic} names another sender or key ({} refused)",
+                self.name(),
+                counts.refused_messages
+            );
+            return Some((Kind::Refused, Vec::new()));
+        }
+        if payload.len() > semo::link::PAYLOAD_MAX {
+            return None;
+        }
+        Some((Kind::Message, payload.to_vec()))
+    }
+
+    /// The link closed: the robot's status says it is lost (retained, as a
+    /// Linux robot's last will says), with the `started` of its last status.
+    fn lost(&self, client: &rumqttc::Client, last_status: Option<&str>) {
+        let started = last_status
+            .and_then(|s| serde_json::from_str::<serde_json::Value>(s).ok())
+            .and_then(|v| v.get("started").cloned())
+            .unwrap_or(serde_json::Value::String("0".to_string()));
+        let status = serde_json::json!({
+            "robot": self.robot.robot,
+            "event": "status",
+            "state": "lost",
+            "started": started,
+        });
+        let _ = client.try_publish(
+            topics::status(&self.scope, &self.robot.robot),
+            rumqttc::QoS::AtLeastOnce,
+            true,
+            status.to_string().into_bytes(),
+        );
+    }
+}
+
+/// The link's bytes, as they come, until it closes.
+fn read_link(mut reader: Box<dyn Read + Send>, events: SyncSender<Event>) {
+    let mut buf = [0u8; 4096];
+    loop {
+        match reader.read(&mut buf) {
+            Ok(0) => {
+                let _ = events.send(Event::Closed("end of stream".to_string()));
+                return;
+            }
+            Ok(n) => {
+                if events.send(Event::Bytes(buf[..n].to_vec())).is_err() {
+                    return;
+                }
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => {
+                let _ = events.send(Event::Closed(e.to_string()));
+                return;
+            }
+        }
+    }
+}
+
+/// The robot's MQTT connection: subscribes on every connection, says when
+/// the subscriptions stand, hands over what the broker delivers (waiting
+/// for room, so the broker holds a burst).
+fn broker_thread(
+    mut connection: rumqttc::Connection,
+    client: rumqttc::Client,
+    subscriptions: [String; 2],
+    access: BrokerAccess,
+    events: SyncSender<Event>,
+    room: Arc<Room>,
+    name: String,
+) {
+    let mut session_present = false;
+    let mut ready = false;
+    for event in connection.iter() {
+        match event {
+            Ok(rumqttc::Event::Incoming(rumqttc::Packet::ConnAck(ack))) => {
+                session_present = ack.session_present;
+                for topic in &subscriptions {
+                    let _ = client.try_subscribe(topic.clone(), rumqttc::QoS::AtLeastOnce);
+                }
+            }
+            Ok(rumqttc::Event::Incoming(rumqttc::Packet::SubAck(_))) => {
+                if !ready {
+                    ready = true;
+                    if events.send(Event::Ready(session_present)).is_err() {
+                        return;
+                    }
+                }
+            }
+            Ok(rumqttc::Event::Incoming(rumqttc::Packet::Publish(p))) => {
+                room.take();
+                if events
+                    .send(Event::Message {
+                        topic: p.topic,
+                        payload: p.payload.to_vec(),
+                    })
+                    .is_err()
+                {
+                    return;
+                }
+            }
+            Ok(_) => {}
+            Err(e) => {
+                let failure = access.failure(&e);
+                eprintln!(
+                    "gateway: {name}: broker: {}{}",
+                    failure.message,
+                    if failure.permanent { "" } else { " (retrying)" }
+                );
+                if failure.permanent {
+                    std::process::exit(1);
+                }
+                std::thread::sleep(Duration::from_secs(1));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn links_are_robot_equals_a_place() {
+        assert_eq!(
+            parse_link("ti=tcp:127.0.0.1:5000"),
+            Ok((
+                "ti".to_string(),
+                Place::Connect("127.0.0.1:5000".to_string())
+            ))
+        );
+        assert_eq!(
+            parse_link("ti=listen:localhost:7"),
+            Ok(("ti".to_string(), Place::Listen("localhost:7".to_string())))
+        );
+        assert_eq!(
+            parse_link("ti=/dev/ttyUSB0"),
+            Ok(("ti".to_string(), Place::Device("/dev/ttyUSB0".into())))
+        );
+        for bad in [
+            "ti",
+            "=tcp:a:1",
+            "ti=",
+            "ti=tcp:host",
+            "ti=tcp::1",
+            "ti=listen:h:99999",
+        ] {
+            assert!(parse_link(bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -1,0 +1,266 @@
+/* semo_link.c: the serial link's frames and sessions (semo_link.h,
+ * docs/link.md). No heap, no stdio: every buffer is the link's. */
+#include "semo_link.h"
+
+#include <string.h>
+
+uint16_t semo_link_crc16(const unsigned char *bytes, size_t n)
+{
+    uint16_t crc = 0xFFFF;
+    for (size_t i = 0; i < n; i++) {
+        crc ^= (uint16_t)(bytes[i] << 8);
+        for (int b = 0; b < 8; b++)
+            crc = (crc & 0x8000) ? (uint16_t)((crc << 1) ^ 0x1021) : (uint16_t)(crc << 1);
+    }
+    return crc;
+}
+
+void semo_link_init(semo_link *link, semo_link_write write, void *ctx)
+{
+    memset(link, 0, sizeof *link);
+    link->write = write;
+    link->ctx = ctx;
+}
+
+/* Stuffs the body (kind, seq, payload a then b, CRC) into link->wire and
+ * writes it with its closing zero. */
+static void write_frame(semo_link *link, unsigned char kind, uint16_t seq, const unsigned char *a, size_t alen,
+                        const unsigned char *b, size_t blen)
+{
+    unsigned char head[3] = {kind, (unsigned char)(seq >> 8), (unsigned char)seq};
+    uint16_t crc = 0xFFFF;
+    /* The CRC over the pieces, as semo_link_crc16 over their concatenation. */
+    const unsigned char *pieces[3] = {head, a, b};
+    size_t lens[3] = {3, alen, blen};
+    for (int p = 0; p < 3; p++)
+        for (size_t i = 0; i < lens[p]; i++) {
+            crc ^= (uint16_t)(pieces[p][i] << 8);
+            for (int k = 0; k < 8; k++)
+                crc = (crc & 0x8000) ? (uint16_t)((crc << 1) ^ 0x1021) : (uint16_t)(crc << 1);
+        }
+    unsigned char tail[2] = {(unsigned char)(crc >> 8), (unsigned char)crc};
+    const unsigned char *all[4] = {head, a, b, tail};
+    size_t all_lens[4] = {3, alen, blen, 2};
+    size_t out = 0, code_at = out++;
+    unsigned char code = 1;
+    for (int p = 0; p < 4; p++)
+        for (size_t i = 0; i < all_lens[p]; i++) {
+            unsigned char byte = all[p][i];
+            if (byte == 0) {
+                link->wire[code_at] = code;
+                code_at = out++;
+                code = 1;
+            } else {
+                link->wire[out++] = byte;
+                if (++code == 0xFF) {
+                    link->wire[code_at] = code;
+                    code_at = out++;
+                    code = 1;
+                }
+            }
+        }
+    link->wire[code_at] = code;
+    link->wire[out++] = 0;
+    link->write(link->ctx, link->wire, out);
+}
+
+int semo_link_queue(semo_link *link, unsigned char kind, const void *a, size_t alen, const void *b, size_t blen)
+{
+    if (alen + blen > SEMO_LINK_PAYLOAD_MAX || link->tx_count >= SEMO_LINK_QUEUE + 1)
+        return -1;
+    size_t slot = (link->tx_head + link->tx_count) % (SEMO_LINK_QUEUE + 1);
+    link->queue[slot].kind = kind;
+    link->queue[slot].len = alen + blen;
+    if (alen)
+        memcpy(link->queue[slot].payload, a, alen);
+    if (blen)
+        memcpy(link->queue[slot].payload + alen, b, blen);
+    link->tx_count++;
+    return 0;
+}
+
+int semo_link_emit(semo_link *link, unsigned char kind, const void *a, size_t alen, const void *b, size_t blen)
+{
+    if (alen + blen > SEMO_LINK_PAYLOAD_MAX)
+        return -1;
+    write_frame(link, kind, 0, a, alen, b, blen);
+    return 0;
+}
+
+static void send_in_flight(semo_link *link, int64_t now)
+{
+    link->tx_sent_at = now;
+    write_frame(link, link->queue[link->tx_head].kind, link->tx_seq, link->queue[link->tx_head].payload,
+                link->queue[link->tx_head].len, NULL, 0);
+}
+
+void semo_link_tick(semo_link *link, int64_t now)
+{
+    if (!link->welcomed) {
+        if (!link->hello_sent || now >= link->hello_at + SEMO_LINK_HELLO_RETRY_MS) {
+            link->hello_sent = true;
+            link->hello_at = now;
+            write_frame(link, SEMO_LINK_HELLO, 0, NULL, 0, NULL, 0);
+        }
+        return;
+    }
+    if (link->tx_in_flight) {
+        if (now >= link->tx_sent_at + SEMO_LINK_RETRY_MS) {
+            link->retransmissions++;
+            send_in_flight(link, now);
+        }
+        return;
+    }
+    if (link->tx_count > 0) {
+        link->tx_in_flight = true;
+        send_in_flight(link, now);
+    }
+}
+
+int64_t semo_link_deadline(const semo_link *link)
+{
+    if (!link->welcomed)
+        return link->hello_sent ? link->hello_at + SEMO_LINK_HELLO_RETRY_MS : 0;
+    if (link->tx_in_flight)
+        return link->tx_sent_at + SEMO_LINK_RETRY_MS;
+    return link->tx_count > 0 ? 0 : INT64_MAX;
+}
+
+void semo_link_restart(semo_link *link)
+{
+    link->welcomed = false;
+    link->hello_sent = false;
+    link->tx_sent_at = INT64_MIN / 2; /* due at once once welcomed */
+    link->rx_len = 0;
+    link->rx_overflow = false;
+}
+
+size_t semo_link_pending(const semo_link *link)
+{
+    return link->tx_count;
+}
+
+static bool reliable(unsigned char kind)
+{
+    return kind == SEMO_LINK_SEND || kind == SEMO_LINK_STATUS || kind == SEMO_LINK_MESSAGE ||
+           kind == SEMO_LINK_REFUSED;
+}
+
+/* Whether the payload has its kind's shape (semo::link's `fits`). */
+static bool fits(unsigned char kind, const unsigned char *p, size_t len)
+{
+    switch (kind) {
+    case SEMO_LINK_HELLO:
+    case SEMO_LINK_REFUSED:
+    case SEMO_LINK_ACK:
+        return len == 0;
+    case SEMO_LINK_WELCOME:
+        return len == 1;
+    case SEMO_LINK_SEND:
+    case SEMO_LINK_PUBLISH:
+        return len >= 1 && p[0] >= 1 && (size_t)p[0] <= len - 1;
+    case SEMO_LINK_STATUS:
+    case SEMO_LINK_MESSAGE:
+        return len >= 1;
+    default:
+        return false;
+    }
+}
+
+/* Unstuffs link->rx in place; the body's length, or 0 when it is no
+ * stuffing. */
+static size_t unstuff(semo_link *link)
+{
+    size_t in = 0, out = 0, n = link->rx_len;
+    unsigned char *b = link->rx;
+    while (in < n) {
+        size_t code = b[in];
+        if (code == 0 || in + code > n)
+            return 0;
+        for (size_t i = 1; i < code; i++)
+            b[out++] = b[in + i];
+        in += code;
+        if (code < 0xFF && in < n)
+            b[out++] = 0;
+    }
+    return out;
+}
+
+bool semo_link_feed(semo_link *link, unsigned char byte, int64_t now, semo_link_frame *out)
+{
+    if (byte != 0) {
+        if (link->rx_len + 1 < SEMO_LINK_WIRE_MAX)
+            link->rx[link->rx_len++] = byte;
+        else
+            link->rx_overflow = true;
+        return false;
+    }
+    bool overflow = link->rx_overflow;
+    size_t stuffed = link->rx_len;
+    link->rx_len = 0;
+    link->rx_overflow = false;
+    if (overflow) {
+        link->bad_frames++;
+        return false;
+    }
+    if (stuffed == 0)
+        return false;
+    link->rx_len = stuffed;
+    size_t n = unstuff(link);
+    link->rx_len = 0;
+    if (n < 5 || semo_link_crc16(link->rx, n - 2) != (uint16_t)((link->rx[n - 2] << 8) | link->rx[n - 1])) {
+        link->bad_frames++;
+        return false;
+    }
+    unsigned char kind = link->rx[0];
+    uint16_t seq = (uint16_t)((link->rx[1] << 8) | link->rx[2]);
+    const unsigned char *payload = link->rx + 3;
+    size_t len = n - 5;
+    if (!fits(kind, payload, len)) {
+        link->bad_frames++;
+        return false;
+    }
+    switch (kind) {
+    case SEMO_LINK_ACK:
+        if (link->tx_in_flight && seq == link->tx_seq) {
+            link->tx_in_flight = false;
+            link->tx_head = (link->tx_head + 1) % (SEMO_LINK_QUEUE + 1);
+            link->tx_count--;
+            link->tx_seq++;
+            semo_link_tick(link, now);
+        }
+        return false;
+    case SEMO_LINK_HELLO:
+        /* The other side (re)started: its numbers start again, and what we
+         * have in flight goes again at once. */
+        link->rx_seen = false;
+        write_frame(link, SEMO_LINK_WELCOME, seq, &link->welcome_flags, 1, NULL, 0);
+        if (link->tx_in_flight)
+            link->tx_sent_at = INT64_MIN / 2;
+        semo_link_tick(link, now);
+        return false;
+    case SEMO_LINK_WELCOME:
+        if (!link->welcomed) {
+            link->welcomed = true;
+            link->peer_flags = payload[0];
+            semo_link_tick(link, now);
+        }
+        return false;
+    default:
+        break;
+    }
+    if (reliable(kind)) {
+        write_frame(link, SEMO_LINK_ACK, seq, NULL, 0, NULL, 0);
+        if (link->rx_seen && link->rx_last == seq) {
+            link->duplicates++;
+            return false;
+        }
+        link->rx_seen = true;
+        link->rx_last = seq;
+    }
+    out->kind = kind;
+    out->seq = seq;
+    out->payload = payload;
+    out->len = len;
+    return true;
+}

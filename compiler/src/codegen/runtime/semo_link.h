@@ -1,0 +1,112 @@
+/* semo_link.h: the serial link between a small robot and `semo gateway`
+ * (docs/link.md), the same definition as `semo::link` on the Rust side
+ * (`tests/link.rs` holds them to each other).
+ *
+ * A frame: kind (1 byte), seq (2, big-endian), payload, CRC-16/CCITT-FALSE
+ * of those (2, big-endian); COBS-stuffed and closed by a zero byte.
+ * The reliable kinds (S, T, M, R) go one at a time, each with the next
+ * sequence number, again every SEMO_LINK_RETRY_MS until their `A` comes;
+ * the receiver acknowledges every copy and takes a frame only when its
+ * number is not the last one it took. A session starts with `H`, answered
+ * by `W`: no reliable frame goes before.
+ *
+ * No heap, no stdio: a `semo_link` holds every buffer, sized here
+ * (SEMO_LINK_PAYLOAD_MAX and SEMO_LINK_QUEUE may be set smaller for a
+ * board: a longer frame is refused by both sides). Not thread-safe: the
+ * caller holds its lock around every call. Time is the caller's (ms). */
+#ifndef SEMO_LINK_H
+#define SEMO_LINK_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifndef SEMO_LINK_PAYLOAD_MAX
+#define SEMO_LINK_PAYLOAD_MAX 1536
+#endif
+/* Reliable frames waiting behind the one in flight. */
+#ifndef SEMO_LINK_QUEUE
+#define SEMO_LINK_QUEUE 4
+#endif
+#define SEMO_LINK_BODY_MAX (3 + SEMO_LINK_PAYLOAD_MAX + 2)
+#define SEMO_LINK_WIRE_MAX (SEMO_LINK_BODY_MAX + SEMO_LINK_BODY_MAX / 254 + 1 + 1)
+#define SEMO_LINK_RETRY_MS 200
+#define SEMO_LINK_HELLO_RETRY_MS 500
+
+enum {
+    SEMO_LINK_HELLO = 'H',
+    SEMO_LINK_WELCOME = 'W',
+    SEMO_LINK_SEND = 'S',
+    SEMO_LINK_PUBLISH = 'P',
+    SEMO_LINK_STATUS = 'T',
+    SEMO_LINK_MESSAGE = 'M',
+    SEMO_LINK_REFUSED = 'R',
+    SEMO_LINK_ACK = 'A',
+};
+
+/* Writes bytes to the line (all of them). */
+typedef void (*semo_link_write)(void *ctx, const unsigned char *bytes, size_t n);
+
+/* A frame handed to the caller: its payload lives in the link until the
+ * next call. */
+typedef struct {
+    unsigned char kind;
+    uint16_t seq;
+    const unsigned char *payload;
+    size_t len;
+} semo_link_frame;
+
+typedef struct {
+    semo_link_write write;
+    void *ctx;
+    /* Receiving: the bytes since the last zero, decoded in place. */
+    unsigned char rx[SEMO_LINK_WIRE_MAX];
+    size_t rx_len;
+    bool rx_overflow;
+    bool rx_seen; /* a reliable frame was taken in this session: rx_last */
+    uint16_t rx_last;
+    /* Sending. */
+    struct {
+        unsigned char kind;
+        size_t len;
+        unsigned char payload[SEMO_LINK_PAYLOAD_MAX];
+    } queue[SEMO_LINK_QUEUE + 1]; /* [tx_head] is in flight when tx_in_flight */
+    size_t tx_head, tx_count;
+    uint16_t tx_seq;
+    bool tx_in_flight;
+    int64_t tx_sent_at;
+    bool welcomed;
+    bool hello_sent;
+    int64_t hello_at;
+    unsigned char welcome_flags; /* what our Welcome says; what theirs said */
+    unsigned char peer_flags;
+    unsigned char wire[SEMO_LINK_WIRE_MAX];
+    /* Counted for the trace: frames that were no frame (CRC, stuffing,
+     * length, kind), copies not taken, frames sent again. */
+    unsigned long bad_frames, duplicates, retransmissions;
+} semo_link;
+
+void semo_link_init(semo_link *link, semo_link_write write, void *ctx);
+/* Queues a reliable frame whose payload is `a` then `b` (either may be
+ * empty); -1 when it is too long or the queue is full. */
+int semo_link_queue(semo_link *link, unsigned char kind, const void *a, size_t alen, const void *b, size_t blen);
+/* Writes an unreliable frame (P) now; -1 when it is too long. */
+int semo_link_emit(semo_link *link, unsigned char kind, const void *a, size_t alen, const void *b, size_t blen);
+/* One byte from the line at time `now`: acknowledgements, hellos and
+ * welcomes are handled here; returns true when `*out` holds a frame for the
+ * caller (a new reliable frame, already acknowledged, or a P). */
+bool semo_link_feed(semo_link *link, unsigned char byte, int64_t now, semo_link_frame *out);
+/* Writes what is due at `now` (a hello, the next reliable frame, one sent
+ * again). */
+void semo_link_tick(semo_link *link, int64_t now);
+/* When semo_link_tick next has something to do (INT64_MAX: only after a
+ * frame is queued or heard). */
+int64_t semo_link_deadline(const semo_link *link);
+/* The line went away (and may come back): a new session starts with a
+ * hello; what was not acknowledged goes again. */
+void semo_link_restart(semo_link *link);
+/* Reliable frames not yet acknowledged. */
+size_t semo_link_pending(const semo_link *link);
+uint16_t semo_link_crc16(const unsigned char *bytes, size_t n);
+
+#endif

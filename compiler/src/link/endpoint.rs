@@ -1,0 +1,101 @@
+//! One side of a link, whole: bytes in, the frames for the caller out, and
+//! the bytes to write (acknowledgements, welcomes, the reliable frames and
+//! their copies), as `semo_link_feed` and `semo_link_tick` do in C.
+
+use super::frame::{Frame, FrameError, Kind};
+use super::reader::Reader;
+use super::session::{Incoming, Outgoing, QueueFull};
+
+#[derive(Debug)]
+pub struct Endpoint {
+    pub outgoing: Outgoing,
+    pub incoming: Incoming,
+    reader: Reader,
+    /// What this side's `Welcome` says (bit 0: the robot's broker session
+    /// was kept).
+    pub welcome_flags: u8,
+    /// Bytes between zeros that were no frame, by why.
+    pub bad_frames: Vec<FrameError>,
+}
+
+impl Endpoint {
+    /// `capacity`: reliable frames waiting behind the one in flight.
+    pub fn new(capacity: usize) -> Endpoint {
+        Endpoint {
+            outgoing: Outgoing::new(capacity),
+            incoming: Incoming::new(),
+            reader: Reader::new(),
+            welcome_flags: 0,
+            bad_frames: Vec::new(),
+        }
+    }
+
+    /// Queues a reliable frame.
+    pub fn queue(&mut self, kind: Kind, payload: Vec<u8>) -> Result<(), QueueFull> {
+        self.outgoing.push(kind, payload)
+    }
+
+    /// Bytes from the line at `now`: the new frames for the caller (a new
+    /// reliable frame, acknowledged, or an unreliable one); what to write
+    /// goes to `write`.
+    pub fn feed(&mut self, bytes: &[u8], now: u64, write: &mut Vec<u8>) -> Vec<Frame> {
+        let mut taken = Vec::new();
+        for &byte in bytes {
+            let Some(result) = self.reader.push(byte) else {
+                continue;
+            };
+            let frame = match result {
+                Ok(frame) => frame,
+                Err(e) => {
+                    // Bounded: the caller counts and clears them.
+                    if self.bad_frames.len() < 1024 {
+                        self.bad_frames.push(e);
+                    }
+                    continue;
+                }
+            };
+            match frame.kind {
+                Kind::Ack | Kind::Welcome => self.outgoing.heard(&frame),
+                Kind::Hello => {
+                    self.incoming.restart();
+                    put(
+                        write,
+                        &Frame::new(Kind::Welcome, frame.seq, vec![self.welcome_flags]),
+                    );
+                    self.outgoing.heard(&frame);
+                }
+                kind if kind.reliable() => {
+                    put(write, &Frame::new(Kind::Ack, frame.seq, Vec::new()));
+                    if self.incoming.accept(frame.seq) {
+                        taken.push(frame);
+                    }
+                }
+                _ => taken.push(frame),
+            }
+            self.tick(now, write);
+        }
+        taken
+    }
+
+    /// Writes what is due at `now`.
+    pub fn tick(&mut self, now: u64, write: &mut Vec<u8>) {
+        while let Some(frame) = self.outgoing.poll(now) {
+            put(write, &frame);
+            if frame.kind == Kind::Hello || self.outgoing.deadline().is_some_and(|d| d > now) {
+                break;
+            }
+        }
+    }
+
+    /// An unreliable frame, written now.
+    pub fn emit(&self, frame: &Frame, write: &mut Vec<u8>) {
+        put(write, frame);
+    }
+}
+
+fn put(write: &mut Vec<u8>, frame: &Frame) {
+    // Every frame made here fits: payloads are checked when queued.
+    if let Some(wire) = frame.encode() {
+        write.extend(wire);
+    }
+}

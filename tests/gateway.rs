@@ -1,0 +1,415 @@
+//! `semo gateway` end to end: a private mosquitto, the gateway, a robot on a
+//! link (the test, speaking the link with `semo::link`, as `semo_link.c`
+//! does: `tests/link.rs` holds the two to each other) and an MQTT client
+//! watching the run's topics. What the link robot sends is published on its
+//! own topics with its datagram unchanged; a frame claiming another sender
+//! is refused, never published; what the broker delivers to the robot comes
+//! down the link, and a message whose datagram names another sender than
+//! its topic comes down as `R`; its status is retained, and `lost` when the
+//! link closes. Waits are bounded by events (a message heard), never by
+//! time: the deadlines only end a test that would otherwise hang.
+
+mod support;
+
+use semo::deploy::datagram::{self, Datagram};
+use semo::link::{Endpoint, Frame, Kind};
+use semo::refine::Value;
+use std::io::{Read, Write};
+use std::net::{TcpListener, TcpStream};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+use support::mqtt::Fleet;
+
+const LIMIT: Duration = Duration::from_secs(20);
+
+fn scouting() -> std::path::PathBuf {
+    support::examples().join("scouting/scouting.mission")
+}
+
+fn gram(publish: bool, team: &str, robot: &str, key: &str, value: i64) -> Vec<u8> {
+    datagram::encode(&Datagram {
+        publish,
+        team: team.into(),
+        robot: robot.into(),
+        key: key.into(),
+        value: Some(Value::Int(value)),
+    })
+}
+
+/// The robot's end of the link: the test's side of a TCP connection the
+/// gateway made, with the link's session over it.
+struct LinkRobot {
+    stream: TcpStream,
+    endpoint: Endpoint,
+    started: Instant,
+    taken: Vec<Frame>,
+}
+
+impl LinkRobot {
+    fn now(&self) -> u64 {
+        self.started.elapsed().as_millis() as u64
+    }
+
+    /// Reads and answers until `done` holds of what was taken.
+    fn until(&mut self, what: &str, done: impl Fn(&[Frame], &Endpoint) -> bool) {
+        let end = Instant::now() + LIMIT;
+        let mut buf = [0u8; 4096];
+        loop {
+            let mut wire = Vec::new();
+            let now = self.now();
+            self.endpoint.tick(now, &mut wire);
+            self.stream.write_all(&wire).unwrap();
+            if done(&self.taken, &self.endpoint) {
+                return;
+            }
+            assert!(Instant::now() < end, "the link robot waited for {what}");
+            match self.stream.read(&mut buf) {
+                Ok(0) => panic!("the gateway closed the link while waiting for {what}"),
+                Ok(n) => {
+                    let mut wire = Vec::new();
+                    let now = self.now();
+                    let frames = self.endpoint.feed(&buf[..n], now, &mut wire);
+                    self.taken.extend(frames);
+                    self.stream.write_all(&wire).unwrap();
+                }
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                    ) => {}
+                Err(e) => panic!("link: {e}"),
+            }
+        }
+    }
+
+    fn send(&mut self, kind: Kind, to: &str, datagram: &[u8]) {
+        let frame = Frame::addressed(kind, 0, to, datagram).unwrap();
+        if kind.reliable() {
+            self.endpoint.queue(kind, frame.payload).unwrap();
+            self.until("the gateway's ack", |_, e| e.outgoing.pending() == 0);
+        } else {
+            let mut wire = Vec::new();
+            self.endpoint.emit(&frame, &mut wire);
+            self.stream.write_all(&wire).unwrap();
+        }
+    }
+}
+
+/// An MQTT client on the run's topics: what it hears comes through `rx`.
+fn watcher(url_port: u16, run: &str) -> (rumqttc::Client, mpsc::Receiver<(String, Vec<u8>, bool)>) {
+    let mut options = rumqttc::MqttOptions::new("watcher", "127.0.0.1", url_port);
+    options.set_keep_alive(Duration::from_secs(10));
+    let (client, mut connection) = rumqttc::Client::new(options, 64);
+    client
+        .subscribe(format!("semo/scouting/{run}/#"), rumqttc::QoS::AtLeastOnce)
+        .unwrap();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for event in connection.iter() {
+            match event {
+                Ok(rumqttc::Event::Incoming(rumqttc::Packet::SubAck(_))) => {
+                    let _ = tx.send((String::new(), Vec::new(), false));
+                }
+                Ok(rumqttc::Event::Incoming(rumqttc::Packet::Publish(p))) => {
+                    if tx.send((p.topic, p.payload.to_vec(), p.retain)).is_err() {
+                        return;
+                    }
+                }
+                Ok(_) => {}
+                Err(_) => std::thread::sleep(Duration::from_millis(100)),
+            }
+        }
+    });
+    // Subscribed before anything is sent.
+    let (topic, _, _) = rx.recv_timeout(LIMIT).expect("the watcher's SUBACK");
+    assert!(topic.is_empty());
+    (client, rx)
+}
+
+fn heard(rx: &mpsc::Receiver<(String, Vec<u8>, bool)>, what: &str) -> (String, Vec<u8>, bool) {
+    rx.recv_timeout(LIMIT)
+        .unwrap_or_else(|_| panic!("the watcher waited for {what}"))
+}
+
+fn gateway(fleet: &Fleet, link_port: u16, run: &str) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_semo"))
+        .arg("gateway")
+        .arg(scouting())
+        .args(["--link", &format!("ti=tcp:127.0.0.1:{link_port}")])
+        .args(["--broker", &fleet.url(), "--run", run])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("semo gateway starts")
+}
+
+#[test]
+fn a_link_robot_is_a_member_of_the_fleet_on_its_own_topics_only() {
+    let Some(mut fleet) = Fleet::start("gateway-bridge") else {
+        return;
+    };
+    let run = "g1";
+    let (client, rx) = watcher(fleet.port, run);
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let link_port = listener.local_addr().unwrap().port();
+    let gw = fleet.processes.push(gateway(&fleet, link_port, run));
+    let (stream, _) = listener.accept().expect("the gateway connects to the link");
+    stream
+        .set_read_timeout(Some(Duration::from_millis(50)))
+        .unwrap();
+    let mut robot = LinkRobot {
+        stream,
+        endpoint: Endpoint::new(8),
+        started: Instant::now(),
+        taken: Vec::new(),
+    };
+    robot.until("the session", |_, e| e.outgoing.welcomed());
+
+    // Noise on the line (a frame with a flipped bit, a flood without a
+    // zero) is dropped and said; the link goes on.
+    let mut noise = Frame::addressed(Kind::Publish, 0, "MasterTeam", b"SEMO")
+        .unwrap()
+        .encode()
+        .unwrap();
+    noise[8] ^= 0x40; // a letter of "MasterTeam"
+    noise.extend(vec![0x5A; 3 * semo::link::WIRE_MAX]);
+    noise.push(0);
+    robot.stream.write_all(&noise).unwrap();
+    // A send claiming another robot is refused; the good one after it is
+    // the first thing published.
+    robot.send(
+        Kind::Send,
+        "MasterTeam",
+        &gram(false, "MasterTeam", "irobot", "SlaveTeam.COLOR", 1),
+    );
+    let good = gram(false, "SlaveTeam", "ti", "SlaveTeam.COLOR", 7);
+    robot.send(Kind::Send, "MasterTeam", &good);
+    let (topic, payload, retained) = heard(&rx, "ti's send");
+    assert_eq!(
+        topic,
+        format!("semo/scouting/{run}/MasterTeam/SlaveTeam.COLOR/SlaveTeam/ti")
+    );
+    assert_eq!(payload, good, "the datagram unchanged");
+    assert!(!retained);
+    // A publish to one robot goes on that robot's topic.
+    let heartbeat = gram(true, "SlaveTeam", "ti", "SlaveTeam.LOCATION", 3);
+    robot.send(Kind::Publish, "irobot", &heartbeat);
+    let (topic, payload, _) = heard(&rx, "ti's publish");
+    assert_eq!(
+        topic,
+        format!("semo/scouting/{run}/MasterTeam/irobot/SlaveTeam.LOCATION/SlaveTeam/ti")
+    );
+    assert_eq!(payload, heartbeat);
+
+    // From the broker: a message to SlaveTeam on its sender's topic comes
+    // down as M; one whose datagram names another sender than its topic as R.
+    let forward = gram(false, "MasterTeam", "irobot", "USER.RC_CMD", 2);
+    client
+        .publish(
+            format!("semo/scouting/{run}/SlaveTeam/USER.RC_CMD/MasterTeam/irobot"),
+            rumqttc::QoS::AtLeastOnce,
+            false,
+            forward.clone(),
+        )
+        .unwrap();
+    client
+        .publish(
+            format!("semo/scouting/{run}/SlaveTeam/USER.RC_CMD/MasterTeam/irobot"),
+            rumqttc::QoS::AtLeastOnce,
+            false,
+            gram(false, "SlaveTeam", "nxt", "USER.RC_CMD", 9),
+        )
+        .unwrap();
+    robot.until("two frames from the gateway", |taken, _| taken.len() >= 2);
+    assert_eq!(robot.taken[0].kind, Kind::Message);
+    assert_eq!(robot.taken[0].payload, forward);
+    assert_eq!(robot.taken[1].kind, Kind::Refused);
+    // The watcher hears those two as well (they are on the run's topics).
+    heard(&rx, "the forward");
+    heard(&rx, "the forged one");
+
+    // The status is published on the robot's status topic; when the link
+    // closes the gateway says the robot is lost (retained), with the
+    // `started` of its last status, as a Linux robot's last will does.
+    let status = br#"{"t":5,"robot":"ti","event":"status","state":"running","started":"1234","mode":"Move"}"#;
+    robot.endpoint.queue(Kind::Status, status.to_vec()).unwrap();
+    robot.until("the status's ack", |_, e| e.outgoing.pending() == 0);
+    let (topic, payload, _) = heard(&rx, "ti's status");
+    assert_eq!(topic, format!("semo/scouting/{run}/status/ti"));
+    assert_eq!(payload, status);
+    drop(robot);
+    let (topic, payload, _) = heard(&rx, "ti lost");
+    assert_eq!(topic, format!("semo/scouting/{run}/status/ti"));
+    let lost: serde_json::Value = serde_json::from_slice(&payload).unwrap();
+    assert_eq!(
+        lost,
+        serde_json::json!({"robot": "ti", "event": "status", "state": "lost", "started": "1234"})
+    );
+    // A console that comes later reads it retained.
+    let (_late, late_rx) = watcher(fleet.port, run);
+    let (topic, _, retained) = heard(&late_rx, "the retained status");
+    assert_eq!(topic, format!("semo/scouting/{run}/status/ti"));
+    assert!(retained);
+    // The gateway is still running: it waits for the link to come back.
+    assert!(fleet.processes.is_running(gw));
+    let (_again, _) = listener.accept().expect("the gateway connects again");
+    // Every refusal was counted and said.
+    fleet.processes.kill(gw);
+    let mut said = String::new();
+    fleet.processes.0[gw]
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut said)
+        .unwrap();
+    assert!(
+        said.contains("ti: refused a send to MasterTeam: its datagram names MasterTeam/irobot as the sender, not this link's robot (1 refused)"),
+        "{said}"
+    );
+    assert!(
+        said.contains("names another sender or key (1 refused)"),
+        "{said}"
+    );
+    assert!(said.contains("ti: link closed"), "{said}");
+    assert!(
+        said.contains("ti: a bad frame (CRC mismatch), dropped"),
+        "{said}"
+    );
+    assert!(said.contains("ti: a bad frame (longer than"), "{said}");
+}
+
+#[test]
+fn bad_arguments_are_refused_with_exit_status_2() {
+    let mission = scouting();
+    let mission = mission.to_str().unwrap();
+    for (args, says) in [
+        (vec!["gateway", mission], "no link"),
+        (vec!["gateway", mission, "--link", "ti"], "ROBOT=LINK"),
+        (
+            vec!["gateway", mission, "--link", "ti=tcp:nowhere"],
+            "HOST:PORT",
+        ),
+        (
+            vec!["gateway", mission, "--link", "tee=tcp:127.0.0.1:1"],
+            "no robot `tee`",
+        ),
+        (
+            vec![
+                "gateway",
+                mission,
+                "--link",
+                "ti=tcp:127.0.0.1:1",
+                "--link",
+                "ti=tcp:127.0.0.1:2",
+            ],
+            "two links",
+        ),
+        (
+            vec![
+                "gateway",
+                mission,
+                "--link",
+                "ti=tcp:127.0.0.1:1",
+                "--run",
+                "a/b",
+            ],
+            "--run",
+        ),
+    ] {
+        let out = support::semo(&args);
+        assert_eq!(out.code, 2, "{args:?}: {}", out.stderr);
+        assert!(out.stderr.contains(says), "{args:?}: {}", out.stderr);
+    }
+    let help = support::semo(&["gateway", "--help"]);
+    assert_eq!(help.code, 0);
+    assert!(help.stdout.contains("--link"));
+}
+
+/// The scouting mission with `ti` on the link: its `linux-sim` program with
+/// `--transport link` through `semo gateway`, `irobot` and `nxt` over MQTT,
+/// one private broker. Every robot enters the modes `semo simulate` gives
+/// it on the same scenario, in the same order, to FINISH; the master hears
+/// ti's colors (they went up the link and through the broker), and the
+/// broker's messages reached ti (its own modes depend on the master's
+/// forwarded commands).
+#[test]
+fn a_linux_robot_over_the_link_behaves_as_in_the_simulator() {
+    use support::robots::{events, field, modes};
+    let Some(mut fleet) = Fleet::start("gateway-scouting") else {
+        return;
+    };
+    let scenario = support::repo_root().join("tests/fixtures/build/scouting.scenario.json");
+    let folders = support::mqtt::build(&scouting(), &fleet.out, &[]);
+    // Built with the scenario before anything starts (compiling takes time).
+    support::mqtt::compile_in(&folders, &scenario);
+    let link_port = support::mosquitto::free_port();
+    let gw = fleet.processes.push(
+        Command::new(env!("CARGO_BIN_EXE_semo"))
+            .arg("gateway")
+            .arg(scouting())
+            .args(["--link", &format!("ti=listen:127.0.0.1:{link_port}")])
+            .args(["--broker", &fleet.url()])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("semo gateway starts"),
+    );
+    let link = format!("tcp:127.0.0.1:{link_port}");
+    // Every robot starts at one instant, ti's link open by then.
+    let (_, start_at) = support::robots::start_barrier(3);
+    let start_at = start_at.to_string();
+    let mut started = Vec::new();
+    for folder in &folders {
+        let robot = support::mqtt::robot_name(folder);
+        let (args, env): (Vec<String>, Vec<(&str, &str)>) = if robot == "ti" {
+            (
+                vec!["--transport".into(), "link".into()],
+                vec![("SEMO_LINK", link.as_str())],
+            )
+        } else {
+            (fleet.transport_args(), vec![])
+        };
+        let mut args: Vec<&str> = args.iter().map(String::as_str).collect();
+        args.extend(["--start-at", start_at.as_str()]);
+        started.push(fleet.spawn_with(folder, &scenario, "link", &args, &env));
+    }
+    let traces: std::collections::BTreeMap<String, Vec<support::robots::Event>> = started
+        .iter()
+        .map(|s| (s.robot.clone(), fleet.finish(s, "link")))
+        .collect();
+    let simulated = support::simulate_trace(&scouting(), &scenario, "sim");
+    assert_eq!(simulated.code, 0, "{}", simulated.stderr);
+    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
+    let simulated = events(&lines);
+    assert_eq!(traces.len(), 3);
+    for (robot, trace) in &traces {
+        let reference: Vec<_> = simulated
+            .iter()
+            .filter(|e| field(e, "robot") == robot)
+            .cloned()
+            .collect();
+        assert_eq!(
+            modes(trace),
+            modes(&reference),
+            "{robot}'s modes with ti on the link and in `semo simulate`"
+        );
+        assert_eq!(modes(trace).last().map(String::as_str), Some("FINISH"));
+    }
+    let heard_ti = traces["irobot"].iter().any(|e| {
+        field(e, "event") == "receive"
+            && field(e, "from_robot") == "ti"
+            && field(e, "key") == "SlaveTeam.COLOR"
+    });
+    assert!(heard_ti, "the master hears ti's colors through the gateway");
+    let ti_heard = traces["ti"]
+        .iter()
+        .filter(|e| field(e, "event") == "receive")
+        .count();
+    assert!(ti_heard > 0, "ti hears the fleet through the gateway");
+    assert!(
+        !traces["ti"].iter().any(|e| field(e, "event") == "reject"),
+        "nothing refused"
+    );
+    fleet.processes.kill(gw);
+}

@@ -1,0 +1,350 @@
+//! The serial link's two definitions held to each other: `semo_link.c`
+//! (driven line by line through `runtime/tests/link_test.c`, built with
+//! AddressSanitizer and UBSan) against `semo::link` in Rust. Frames made on
+//! one side are read on the other, byte for byte the same; bad bytes (a
+//! flipped bit, a frame cut short, a flood without a zero, a kind nobody
+//! sends) are counted and never taken; a lost `Ack` brings the frame again,
+//! and the copy is acknowledged but not taken twice. Time is stepped by the
+//! test (`t MS`), never read from a clock.
+
+mod support;
+
+use semo::link::{Endpoint, Frame, Kind, PAYLOAD_MAX, RETRY_MS, Reader};
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
+use std::sync::OnceLock;
+
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+fn unhex(text: &str) -> Vec<u8> {
+    (0..text.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(&text[i..i + 2], 16).unwrap())
+        .collect()
+}
+
+/// `link_test.c` with `semo_link.c`, built once per test process.
+fn driver() -> &'static Path {
+    static BUILT: OnceLock<PathBuf> = OnceLock::new();
+    BUILT.get_or_init(|| {
+        let runtime = support::repo_root().join("compiler/src/codegen/runtime");
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("link");
+        std::fs::create_dir_all(&dir).unwrap();
+        let exe = dir.join(format!("link_test-{}", std::process::id()));
+        let out = Command::new("gcc")
+            .current_dir(&runtime)
+            .args([
+                "-std=c11",
+                "-Wall",
+                "-Wextra",
+                "-Werror",
+                "-g",
+                "-fsanitize=address,undefined",
+                "-fno-sanitize-recover=all",
+                "tests/link_test.c",
+                "semo_link.c",
+                "-o",
+            ])
+            .arg(&exe)
+            .output()
+            .expect("gcc runs");
+        assert!(
+            out.status.success(),
+            "link_test.c does not build:\n{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        exe
+    })
+}
+
+/// The C side, one command at a time.
+struct CSide {
+    child: Child,
+    input: ChildStdin,
+    output: BufReader<ChildStdout>,
+}
+
+/// What one command made the C side do.
+#[derive(Debug, Default)]
+struct Said {
+    wire: Vec<u8>,
+    taken: Vec<Frame>,
+    lines: Vec<String>,
+}
+
+impl CSide {
+    fn start() -> CSide {
+        let mut child = Command::new(driver())
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .expect("the driver starts");
+        let input = child.stdin.take().unwrap();
+        let output = BufReader::new(child.stdout.take().unwrap());
+        let mut c = CSide {
+            child,
+            input,
+            output,
+        };
+        let hello = c.read_until_dot();
+        assert_eq!(
+            hello.lines,
+            vec![format!("payload_max {PAYLOAD_MAX}")],
+            "both sides agree on the longest payload"
+        );
+        c
+    }
+
+    fn read_until_dot(&mut self) -> Said {
+        let mut said = Said::default();
+        loop {
+            let mut line = String::new();
+            assert!(
+                self.output.read_line(&mut line).unwrap() > 0,
+                "the C side ended"
+            );
+            let line = line.trim_end();
+            if line == "." {
+                return said;
+            }
+            if let Some(w) = line.strip_prefix("wire ") {
+                said.wire.extend(unhex(w));
+            } else if let Some(t) = line.strip_prefix("take ") {
+                let mut parts = t.splitn(3, ' ');
+                let kind = Kind::from_byte(parts.next().unwrap().as_bytes()[0]).unwrap();
+                let seq = parts.next().unwrap().parse().unwrap();
+                said.taken
+                    .push(Frame::new(kind, seq, unhex(parts.next().unwrap_or(""))));
+            } else {
+                said.lines.push(line.to_string());
+            }
+        }
+    }
+
+    fn command(&mut self, line: &str) -> Said {
+        writeln!(self.input, "{line}").unwrap();
+        self.input.flush().unwrap();
+        self.read_until_dot()
+    }
+
+    fn time(&mut self, ms: u64) -> Said {
+        self.command(&format!("t {ms}"))
+    }
+
+    fn bytes(&mut self, bytes: &[u8]) -> Said {
+        self.command(&format!("b {}", hex(bytes)))
+    }
+
+    fn queue(&mut self, kind: Kind, payload: &[u8]) -> Said {
+        self.command(&format!("q {} {}", kind.byte() as char, hex(payload)))
+    }
+
+    fn stats(&mut self) -> String {
+        self.command("s").lines.join("\n")
+    }
+}
+
+impl Drop for CSide {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn frames(wire: &[u8]) -> Vec<Frame> {
+    Reader::new()
+        .push_all(wire)
+        .into_iter()
+        .map(|r| r.expect("the C side writes only frames"))
+        .collect()
+}
+
+/// The C side (as the robot) and a Rust endpoint (as the gateway), their
+/// session started: the C side's Hello answered.
+fn connected() -> (CSide, Endpoint) {
+    let mut c = CSide::start();
+    let mut rust = Endpoint::new(8);
+    let hello = c.time(0);
+    assert_eq!(
+        frames(&hello.wire),
+        vec![Frame::new(Kind::Hello, 0, vec![])]
+    );
+    let mut answer = Vec::new();
+    assert!(rust.feed(&hello.wire, 0, &mut answer).is_empty());
+    // Welcome, then the Rust side's own Hello.
+    let answered = c.bytes(&answer);
+    let mut back = Vec::new();
+    rust.feed(&answered.wire, 0, &mut back);
+    assert!(rust.outgoing.welcomed());
+    assert!(c.stats().contains("welcomed=1"));
+    (c, rust)
+}
+
+#[test]
+fn frames_made_in_c_read_in_rust_and_back_byte_for_byte() {
+    let mut c = CSide::start();
+    // An unreliable frame C writes is the frame Rust writes, byte for byte.
+    let datagram = b"SEMO\x02p\x09SlaveTeam\x02ti\x03POS\x05\x033,4".to_vec();
+    let made = Frame::addressed(Kind::Publish, 0, "MasterTeam", &datagram).unwrap();
+    let said = c.command(&format!("e P {}", hex(&made.payload)));
+    assert_eq!(said.wire, made.encode().unwrap());
+    // Payloads with zeros and 0xFF runs, up to the longest.
+    for payload in [
+        vec![0u8; 3],
+        (0..=255u8).collect::<Vec<_>>(),
+        vec![0xFF; PAYLOAD_MAX],
+    ] {
+        let frame = Frame::new(Kind::Status, 0, payload.clone());
+        let said = c.command(&format!("e T {}", hex(&payload)));
+        assert_eq!(
+            said.wire,
+            frame.encode().unwrap(),
+            "{} bytes",
+            payload.len()
+        );
+    }
+    // One byte too long: refused by C as by Rust.
+    let said = c.command(&format!("e T {}", hex(&vec![1u8; PAYLOAD_MAX + 1])));
+    assert_eq!(said.lines, vec!["refused"]);
+    assert!(
+        Frame::new(Kind::Status, 0, vec![1; PAYLOAD_MAX + 1])
+            .encode()
+            .is_none()
+    );
+
+    // Rust's frames taken by C with the same payloads.
+    let (mut c, mut rust) = connected();
+    let mut wire = Vec::new();
+    for n in 0..3u8 {
+        rust.queue(Kind::Message, vec![n, 0, n]).unwrap();
+    }
+    rust.tick(10, &mut wire);
+    let mut taken = Vec::new();
+    for _ in 0..3 {
+        let said = c.bytes(&std::mem::take(&mut wire));
+        taken.extend(said.taken);
+        // The Ack lets the next one go.
+        let answers = rust.feed(&said.wire, 10, &mut wire);
+        assert!(answers.is_empty());
+    }
+    assert_eq!(
+        taken,
+        (0..3u8)
+            .map(|n| Frame::new(Kind::Message, n as u16, vec![n, 0, n]))
+            .collect::<Vec<_>>()
+    );
+    assert_eq!(rust.outgoing.pending(), 0);
+}
+
+#[test]
+fn corrupted_truncated_and_flooding_bytes_are_counted_never_taken() {
+    let (mut c, _rust) = connected();
+    let good = Frame::new(Kind::Message, 0, b"datagram".to_vec())
+        .encode()
+        .unwrap();
+    let mut flipped = good.clone();
+    flipped[4] ^= 0x01;
+    let truncated: Vec<u8> = good[..good.len() - 4].iter().copied().chain([0]).collect();
+    let mut stream = Vec::new();
+    stream.extend(&flipped);
+    stream.extend(&truncated);
+    stream.extend(vec![0xA5; 5000]); // a flood without a zero
+    stream.push(0);
+    stream.extend(
+        Frame::new(Kind::Ack, 0, b"x".to_vec()).encode().unwrap(), // a payload its kind has not
+    );
+    let said = c.bytes(&stream);
+    assert!(said.taken.is_empty(), "{:?}", said.taken);
+    assert!(
+        said.wire.is_empty(),
+        "nothing acknowledged: {:?}",
+        said.wire
+    );
+    assert!(c.stats().contains("bad=4"), "{}", c.stats());
+    // And the next good frame is read.
+    let said = c.bytes(&good);
+    assert_eq!(
+        said.taken,
+        vec![Frame::new(Kind::Message, 0, b"datagram".to_vec())]
+    );
+    // Random bytes: the sanitizers would stop the driver on any fault.
+    let mut x = 0x2545F491u32;
+    let noise: Vec<u8> = (0..20000)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            (x >> 24) as u8
+        })
+        .collect();
+    c.bytes(&noise);
+    assert!(c.stats().starts_with("stats"));
+}
+
+#[test]
+fn a_lost_ack_brings_the_frame_again_and_the_copy_is_not_taken() {
+    // Rust to C: the C side's Ack is lost.
+    let (mut c, mut rust) = connected();
+    let mut wire = Vec::new();
+    rust.queue(Kind::Message, b"once".to_vec()).unwrap();
+    rust.tick(1000, &mut wire);
+    let said = c.bytes(&std::mem::take(&mut wire));
+    assert_eq!(said.taken.len(), 1);
+    // ... its Ack never reaches Rust: after RETRY_MS the frame goes again.
+    rust.tick(1000 + RETRY_MS - 1, &mut wire);
+    assert!(wire.is_empty(), "not before its time");
+    rust.tick(1000 + RETRY_MS, &mut wire);
+    assert_eq!(frames(&wire)[0].payload, b"once");
+    assert_eq!(rust.outgoing.retransmissions, 1);
+    let said = c.bytes(&std::mem::take(&mut wire));
+    assert!(said.taken.is_empty(), "the copy is not taken");
+    assert_eq!(frames(&said.wire), vec![Frame::new(Kind::Ack, 0, vec![])]);
+    assert!(c.stats().contains("dup=1"));
+    rust.feed(&said.wire, 1300, &mut wire);
+    assert_eq!(rust.outgoing.pending(), 0);
+
+    // C to Rust: Rust's Ack is lost.
+    c.time(2000);
+    let said = c.queue(Kind::Send, b"\x04Teamdatagram");
+    let taken = rust.feed(&said.wire, 2000, &mut wire);
+    assert_eq!(taken.len(), 1);
+    assert_eq!(
+        taken[0].destination(),
+        Some((&b"Team"[..], &b"datagram"[..]))
+    );
+    wire.clear(); // the Ack is lost
+    assert!(c.time(2000 + RETRY_MS - 1).wire.is_empty());
+    let again = c.time(2000 + RETRY_MS);
+    assert!(c.stats().contains("retx=1"));
+    assert!(rust.feed(&again.wire, 2200, &mut wire).is_empty());
+    assert_eq!(rust.incoming.duplicates, 1);
+    c.bytes(&wire);
+    assert!(c.stats().contains("pending=0"));
+}
+
+#[test]
+fn a_restarted_robot_is_heard_from_sequence_zero_again() {
+    let (mut c, mut rust) = connected();
+    let mut wire = Vec::new();
+    let said = c.queue(Kind::Send, b"\x01Tfirst");
+    assert_eq!(rust.feed(&said.wire, 0, &mut wire).len(), 1);
+    c.bytes(&std::mem::take(&mut wire));
+    drop(c);
+    // A new robot (numbering from 0 again) starts with Hello.
+    let mut c = CSide::start();
+    let hello = c.time(5000);
+    rust.feed(&hello.wire, 5000, &mut wire);
+    let said = c.bytes(&std::mem::take(&mut wire));
+    let said = c
+        .queue(Kind::Send, b"\x01Tsecond")
+        .wire
+        .into_iter()
+        .chain(said.wire)
+        .collect::<Vec<_>>();
+    let taken = rust.feed(&said, 5000, &mut wire);
+    assert_eq!(taken.len(), 1, "sequence 0 of the new session is new");
+    assert_eq!(taken[0].destination().unwrap().1, b"second");
+}
