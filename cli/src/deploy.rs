@@ -10,6 +10,27 @@ use semo::workspace::FileKind;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// The mission's build and, with `--deploy FILE`, its deployment: what the
+/// doors that join a running fleet (the operator console, the gateway)
+/// start from. `Err`: the exit status, the reason said.
+pub fn load_fleet(
+    mission: &Path,
+    strategy: &[PathBuf],
+    deploy: Option<&Path>,
+    color: bool,
+    out: &mut impl Write,
+) -> Result<(CheckRun, semo::diag::FileId, Option<Deployment>), i32> {
+    let (mut run, id) = host::load_build(mission, strategy).map_err(|e| {
+        eprintln!("error: {e}");
+        2
+    })?;
+    let deployment = match deploy {
+        None => None,
+        Some(path) => Some(load(&mut run, path, Format::Human, color, out)?),
+    };
+    Ok((run, id, deployment))
+}
+
 /// Reads and parses a deployment file into `run.files` (so that its
 /// diagnostics render and report like the check's; it is not one of
 /// `run.checked`, and `Files` has no kind for it, so it is labelled a

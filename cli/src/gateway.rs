@@ -20,7 +20,7 @@
 
 use semo::deploy::datagram;
 use semo::deploy::topics::{self, RunId, Scope, Sender};
-use semo::host;
+
 use semo::link::{Endpoint, Frame, Kind};
 use semo_server::live::{BrokerAccess, DEFAULT_BROKER};
 use std::collections::{BTreeSet, VecDeque};
@@ -137,27 +137,15 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             }
         }
     }
-    let (mut run, mission) = match host::load_build(&options.mission, &options.strategy) {
+    let (run, mission, deployment) = match super::deploy::load_fleet(
+        &options.mission,
+        &options.strategy,
+        options.deploy.as_deref(),
+        options.color,
+        out,
+    ) {
         Ok(loaded) => loaded,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
-    };
-    let deployment = match &options.deploy {
-        None => None,
-        Some(path) => {
-            match super::deploy::load(
-                &mut run,
-                path,
-                super::output::Format::Human,
-                options.color,
-                out,
-            ) {
-                Ok(deployment) => Some(deployment),
-                Err(code) => return code,
-            }
-        }
+        Err(code) => return code,
     };
     let analysis = run.analysis();
     if let Err(code) = super::build_files(&analysis, mission) {
@@ -538,7 +526,8 @@ impl LinkGateway {
                     None => Some("not a runtime datagram".to_string()),
                     Some(d) if d.team != me.team || d.robot != me.robot => Some(format!(
                         "its datagram names {}/{} as the sender, not this link's robot",
-                        d.team, d.robot
+                        d.team.escape_debug(),
+                        d.robot.escape_debug()
                     )),
                     Some(d) if d.publish != publish => {
                         Some("its datagram's kind is not its frame's".to_string())
@@ -561,15 +550,20 @@ impl LinkGateway {
                             );
                             None
                         }
-                        None => Some(format!("`{to}` is no team, robot or USER of the mission")),
+                        None => Some(format!(
+                            "`{}` is no team, robot or USER of the mission",
+                            to.escape_debug()
+                        )),
                     },
                 };
                 if let Some(why) = refusal {
                     counts.refused_frames += 1;
                     eprintln!(
-                        "gateway: {}: refused a {} to {to}: {why} ({} refused)",
+                        // What the frame says, escaped: it may hold any bytes.
+                        "gateway: {}: refused a {} to {}: {why} ({} refused)",
                         self.name(),
                         if publish { "publish" } else { "send" },
+                        to.escape_debug(),
                         counts.refused_frames
                     );
                 }

@@ -18,7 +18,7 @@
 //! (exit status 1), never queued to go out later.
 
 use semo::deploy::topics::{self, RunId, Scope};
-use semo::host;
+
 use semo_server::live::{
     BrokerAccess, DEFAULT_BROKER, RunChoice, Status, datagram_fields, operator_datagram,
     status_topic,
@@ -51,28 +51,15 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             return 2;
         }
     };
-    let (run, mission) = match host::load_build(&options.mission, &options.strategy) {
+    let (mut run, mission, deployment) = match super::deploy::load_fleet(
+        &options.mission,
+        &options.strategy,
+        options.deploy.as_deref(),
+        options.color,
+        out,
+    ) {
         Ok(loaded) => loaded,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return 2;
-        }
-    };
-    let mut run = run;
-    let deployment = match &options.deploy {
-        None => None,
-        Some(path) => {
-            match super::deploy::load(
-                &mut run,
-                path,
-                super::output::Format::Human,
-                options.color,
-                out,
-            ) {
-                Ok(deployment) => Some(deployment),
-                Err(code) => return code,
-            }
-        }
+        Err(code) => return code,
     };
     let analysis = run.analysis();
     // The check's errors, reported as every door reports them.
