@@ -124,7 +124,8 @@ static void taken(const semo_link_frame *f)
         if (!g_interrupted)
             g_refused++;
     } else if (f->kind == SEMO_LINK_MESSAGE && !g_interrupted) {
-        /* The link's queue is the gateway's: it holds what does not fit here. */
+        /* Room was made before the frame was taken (io_thread); none only
+         * once the program stops, when nothing more is delivered. */
         if (g_count < LINK_INBOX) {
             link_datagram *slot = &g_inbox[(g_head + g_count) % LINK_INBOX];
             slot->len = f->len < sizeof slot->data ? f->len : sizeof slot->data;
@@ -178,6 +179,13 @@ static void *io_thread(void *arg)
             continue;
         }
         for (ssize_t i = 0; i < n; i++) {
+            /* A frame's last byte may bring a message, which the link
+             * acknowledges as it takes it: with the inbox full, wait for
+             * room (link_recv makes it) rather than acknowledge a message
+             * and lose it. The gateway keeps the rest meanwhile, as the
+             * broker does for a full MQTT robot. */
+            while (buf[i] == 0 && g_count == LINK_INBOX && !g_interrupted && !g_stopping)
+                pthread_cond_wait(&g_changed, &g_lock);
             semo_link_frame f;
             if (semo_link_feed(&g_link, buf[i], now_ms(), &f))
                 taken(&f);
@@ -307,6 +315,7 @@ static int link_recv(void *data, size_t cap, int timeout_ms)
         memcpy(data, slot->data, (size_t)n);
         g_head = (g_head + 1) % LINK_INBOX;
         g_count--;
+        pthread_cond_broadcast(&g_changed); /* room for the link's next message */
     }
     pthread_mutex_unlock(&g_lock);
     return n;
