@@ -682,35 +682,37 @@ fn built_files(out: &Path, rename: (&str, &str)) -> std::collections::BTreeMap<S
 /// (but for the comments that cite the mission's lines).
 #[test]
 fn a_function_with_parameters_runs_and_builds_as_its_hand_written_copy() {
-    let fixtures = repo_root().join("tests/fixtures/parameters");
-    let scenario = fixtures.join("patrol.scenario.json");
-    let dir = scratch("parameters");
+    let trace = runs_and_builds_alike("parameters", "patrol", "patrol_by_hand");
+    assert!(
+        trace.contains(r#""service":"move","arg":"hall door""#)
+            && trace.contains(r#""key":"Scouts.Seen","value":"2,3""#)
+            && trace.contains(r#""mode":"HOME""#),
+        "the run does not reach what it should show:\n{trace}"
+    );
+}
+
+/// Simulates (on `<a>.scenario.json`) and builds the missions `a` and `b` of
+/// the fixture folder `tests/fixtures/<folder>`, which must agree: the same
+/// trace, and the same generated files but for the comments that cite the
+/// mission's lines (`b`'s file name read as `a`'s). `a`'s trace.
+fn runs_and_builds_alike(folder: &str, a: &str, b: &str) -> String {
+    let fixtures = repo_root().join("tests/fixtures").join(folder);
+    let scenario = fixtures.join(format!("{a}.scenario.json"));
+    let dir = scratch(folder);
+    let rename = (format!("{b}.mission"), format!("{a}.mission"));
     let mut traces = Vec::new();
     let mut builds = Vec::new();
-    for name in ["patrol", "patrol_by_hand"] {
+    for name in [a, b] {
         let mission = fixtures.join(format!("{name}.mission"));
         let out = support::simulate_trace(&mission, &scenario, "sim");
         assert_eq!(out.code, 0, "{name}: {}{}", out.stdout, out.stderr);
-        traces.push(
-            out.stdout
-                .replace("patrol_by_hand.mission", "patrol.mission"),
-        );
+        traces.push(out.stdout.replace(&rename.0, &rename.1));
         let folder = dir.join(name);
         let mission = mission.display().to_string();
         let built = semo(&["build", &mission, "-o", &folder.display().to_string()]);
         assert_eq!(built.code, 0, "{name}: {}{}", built.stdout, built.stderr);
-        builds.push(built_files(
-            &folder,
-            ("patrol_by_hand.mission", "patrol.mission"),
-        ));
+        builds.push(built_files(&folder, (&rename.0, &rename.1)));
     }
-    assert!(
-        traces[0].contains(r#""service":"move","arg":"hall door""#)
-            && traces[0].contains(r#""key":"Scouts.Seen","value":"2,3""#)
-            && traces[0].contains(r#""mode":"HOME""#),
-        "the run does not reach what it should show:\n{}",
-        traces[0]
-    );
     assert_eq!(traces[0], traces[1]);
     assert_eq!(
         builds[0].keys().collect::<Vec<_>>(),
@@ -719,6 +721,7 @@ fn a_function_with_parameters_runs_and_builds_as_its_hand_written_copy() {
     for (file, text) in &builds[0] {
         assert_eq!(text, &builds[1][file], "{file}");
     }
+    traces.swap_remove(0)
 }
 
 /// A service shared by teams (`tests/fixtures/shared_services/rescue.mission`,
@@ -727,44 +730,11 @@ fn a_function_with_parameters_runs_and_builds_as_its_hand_written_copy() {
 /// programs but for the comments that cite the mission's lines.
 #[test]
 fn a_service_shared_by_teams_runs_and_builds_as_one_copy_per_team() {
-    let fixtures = repo_root().join("tests/fixtures/shared_services");
-    let scenario = fixtures.join("rescue.scenario.json");
-    let dir = scratch("shared_services");
-    let mut traces = Vec::new();
-    let mut builds = Vec::new();
-    for name in ["rescue", "rescue_copies"] {
-        let mission = fixtures.join(format!("{name}.mission"));
-        let out = support::simulate_trace(&mission, &scenario, "sim");
-        assert_eq!(out.code, 0, "{name}: {}{}", out.stdout, out.stderr);
-        traces.push(
-            out.stdout
-                .replace("rescue_copies.mission", "rescue.mission"),
-        );
-        let folder = dir.join(name);
-        let mission = mission.display().to_string();
-        let built = semo(&["build", &mission, "-o", &folder.display().to_string()]);
-        assert_eq!(built.code, 0, "{name}: {}{}", built.stdout, built.stderr);
-        builds.push(built_files(
-            &folder,
-            ("rescue_copies.mission", "rescue.mission"),
-        ));
-    }
+    let trace = runs_and_builds_alike("shared_services", "rescue", "rescue_copies");
     for robot in ["ti", "ir", "tb"] {
         let started = format!(
             r#""robot":"{robot}","event":"service_start","plan":"Action","service":"Search""#
         );
-        assert!(
-            traces[0].contains(&started),
-            "{robot} runs Search:\n{}",
-            traces[0]
-        );
-    }
-    assert_eq!(traces[0], traces[1]);
-    assert_eq!(
-        builds[0].keys().collect::<Vec<_>>(),
-        builds[1].keys().collect::<Vec<_>>()
-    );
-    for (file, text) in &builds[0] {
-        assert_eq!(text, &builds[1][file], "{file}");
+        assert!(trace.contains(&started), "{robot} runs Search:\n{trace}");
     }
 }

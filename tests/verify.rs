@@ -421,21 +421,28 @@ fn the_human_report_names_the_choices_and_how_to_replay() {
 fn a_swarm_with_more_start_combinations_than_the_budget_stops_at_the_budget() {
     let dir = support::robots::scratch("verify-swarm");
     for robots in [20, 40] {
-        let mission = dir.join(format!("swarm{robots}.mission"));
-        std::fs::write(
-            &mission,
-            format!(
-                "{{\n  Scouts: TIEvalbot s[{robots}]\n}}\n\nScouts.Action.Go {{\n  if (LOCATION == \"5,5\")\n    throw ARRIVED\n}} repeat(1 SEC)\n\nScouts.GO {{ set(Action, Go) }}\nScouts.DONE {{ set(Action, OFF) }}\n\nScouts.main {{\n  case (GO):\n    catch (ARRIVED): mode = DONE\n  default: mode = GO\n}}\n"
-            ),
-        )
-        .unwrap();
-        let path = mission.to_string_lossy().to_string();
+        let path = scouts_swarm(&dir, robots);
         let (code, findings, data) = verify(&path, &["--max-states", "300"]);
         assert_eq!((code, &findings), (0, &Vec::new()), "{robots}");
         assert_eq!(data["exhaustive"], false, "{robots}: {data}");
         assert_eq!(data["states"], 300, "{robots}: {data}");
         assert_eq!(data["bounded_by"], "states", "{robots}: {data}");
     }
+}
+
+/// A mission of `robots` TIEvalbots in one team, each comparing its
+/// location (so every robot's sensor has two classes: 2^robots start
+/// combinations), written into `dir`; its path.
+fn scouts_swarm(dir: &std::path::Path, robots: usize) -> String {
+    let mission = dir.join(format!("swarm{robots}.mission"));
+    std::fs::write(
+        &mission,
+        format!(
+            "{{\n  Scouts: TIEvalbot s[{robots}]\n}}\n\nScouts.Action.Go {{\n  if (LOCATION == \"5,5\")\n    throw ARRIVED\n}} repeat(1 SEC)\n\nScouts.GO {{ set(Action, Go) }}\nScouts.DONE {{ set(Action, OFF) }}\n\nScouts.main {{\n  case (GO):\n    catch (ARRIVED): mode = DONE\n  default: mode = GO\n}}\n"
+        ),
+    )
+    .unwrap();
+    mission.to_string_lossy().to_string()
 }
 
 /// The memory budget bounds a swarm's search by what its states hold: a
@@ -448,15 +455,7 @@ fn a_swarm_search_stops_at_the_memory_budget_with_states_in_inverse_proportion_t
     let dir = support::robots::scratch("verify-swarm-memory");
     let mut states = Vec::new();
     for robots in [20, 40] {
-        let mission = dir.join(format!("swarm{robots}.mission"));
-        std::fs::write(
-            &mission,
-            format!(
-                "{{\n  Scouts: TIEvalbot s[{robots}]\n}}\n\nScouts.Action.Go {{\n  if (LOCATION == \"5,5\")\n    throw ARRIVED\n}} repeat(1 SEC)\n\nScouts.GO {{ set(Action, Go) }}\nScouts.DONE {{ set(Action, OFF) }}\n\nScouts.main {{\n  case (GO):\n    catch (ARRIVED): mode = DONE\n  default: mode = GO\n}}\n"
-            ),
-        )
-        .unwrap();
-        let path = mission.to_string_lossy().to_string();
+        let path = scouts_swarm(&dir, robots);
         let (code, findings, data) = verify(&path, &["--max-memory", "16MiB"]);
         assert_eq!((code, &findings), (0, &Vec::new()), "{robots}");
         assert_eq!(data["exhaustive"], false, "{robots}: {data}");
