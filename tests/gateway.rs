@@ -132,12 +132,12 @@ fn heard(rx: &mpsc::Receiver<(String, Vec<u8>, bool)>, what: &str) -> (String, V
         .unwrap_or_else(|_| panic!("the watcher waited for {what}"))
 }
 
-fn gateway(fleet: &Fleet, link_port: u16, run: &str) -> Child {
+fn gateway(broker: &str, link_port: u16, run: &str) -> Child {
     Command::new(env!("CARGO_BIN_EXE_semo"))
         .arg("gateway")
         .arg(scouting())
         .args(["--link", &format!("ti=tcp:127.0.0.1:{link_port}")])
-        .args(["--broker", &fleet.url(), "--run", run])
+        .args(["--broker", broker, "--run", run])
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
@@ -153,7 +153,7 @@ fn a_link_robot_is_a_member_of_the_fleet_on_its_own_topics_only() {
     let (client, rx) = watcher(fleet.port, run);
     let listener = TcpListener::bind("127.0.0.1:0").unwrap();
     let link_port = listener.local_addr().unwrap().port();
-    let gw = fleet.processes.push(gateway(&fleet, link_port, run));
+    let gw = fleet.processes.push(gateway(&fleet.url(), link_port, run));
     let (stream, _) = listener.accept().expect("the gateway connects to the link");
     stream
         .set_read_timeout(Some(Duration::from_millis(50)))
@@ -277,6 +277,75 @@ fn a_link_robot_is_a_member_of_the_fleet_on_its_own_topics_only() {
         "{said}"
     );
     assert!(said.contains("ti: a bad frame (longer than"), "{said}");
+}
+
+/// A send is acknowledged to the robot only once the broker has it: with
+/// the gateway cut off from the broker (a TCP proxy the test holds, which
+/// drops what it reads), the send the gateway handed on is not acknowledged,
+/// so a gateway that stopped then would lose nothing (the robot keeps it and
+/// sends it again); healed, the gateway's connection publishes it again and
+/// the robot hears its `Ack`. (The gateway acknowledged a send as it took
+/// it, before the broker had it.)
+#[test]
+fn a_send_is_acknowledged_to_the_robot_only_once_the_broker_has_it() {
+    let Some(mut fleet) = Fleet::start("gateway-puback") else {
+        return;
+    };
+    let run = "g3";
+    let (_client, rx) = watcher(fleet.port, run);
+    let proxy = support::proxy::Proxy::start(fleet.port);
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let link_port = listener.local_addr().unwrap().port();
+    let through_proxy = format!("mqtt://127.0.0.1:{}", proxy.port);
+    fleet
+        .processes
+        .push(gateway(&through_proxy, link_port, run));
+    let (stream, _) = listener.accept().expect("the gateway connects to the link");
+    stream
+        .set_read_timeout(Some(Duration::from_millis(50)))
+        .unwrap();
+    let mut robot = LinkRobot {
+        stream,
+        endpoint: Endpoint::new(8),
+        started: Instant::now(),
+        taken: Vec::new(),
+    };
+    robot.until("the session", |_, e| e.outgoing.welcomed());
+
+    proxy.cut();
+    let good = gram(false, "SlaveTeam", "ti", "SlaveTeam.COLOR", 7);
+    let frame = Frame::addressed(Kind::Send, 0, "MasterTeam", &good).unwrap();
+    robot.endpoint.queue(Kind::Send, frame.payload).unwrap();
+    // The gateway handed the publish on: the proxy dropped its bytes. An
+    // `Ack` written before that would be on the link by now.
+    robot.until("the publish to reach the cut proxy", |_, _| {
+        proxy.dropped() > 0
+    });
+    robot.until("what the link holds", |_, _| true);
+    let mut buf = [0u8; 4096];
+    for _ in 0..4 {
+        if let Ok(n) = robot.stream.read(&mut buf) {
+            let mut wire = Vec::new();
+            let now = robot.now();
+            robot.endpoint.feed(&buf[..n], now, &mut wire);
+        }
+    }
+    assert_eq!(
+        robot.endpoint.outgoing.pending(),
+        1,
+        "the send was acknowledged before the broker had it"
+    );
+
+    proxy.heal();
+    robot.until("the ack once the broker has the send", |_, e| {
+        e.outgoing.pending() == 0
+    });
+    let (topic, payload, _) = heard(&rx, "ti's send, published again after the heal");
+    assert_eq!(
+        topic,
+        format!("semo/scouting/{run}/MasterTeam/SlaveTeam.COLOR/SlaveTeam/ti")
+    );
+    assert_eq!(payload, good);
 }
 
 #[test]

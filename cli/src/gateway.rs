@@ -23,7 +23,7 @@ use semo::deploy::topics::{self, RunId, Scope, Sender};
 
 use semo::link::{Endpoint, Frame, Kind};
 use semo_server::live::{BrokerAccess, DEFAULT_BROKER};
-use std::collections::{BTreeSet, VecDeque};
+use std::collections::{BTreeSet, HashMap, VecDeque};
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream};
 use std::path::PathBuf;
@@ -92,7 +92,30 @@ enum Event {
     Ready(bool),
     /// A message the broker delivered on one of the robot's topics.
     Message { topic: String, payload: Vec<u8> },
+    /// The broker acknowledged the publish of the robot's reliable frame
+    /// with this sequence number: the robot may now hear its `Ack`.
+    Acked(u16),
 }
+
+/// What became of a frame the robot sent.
+enum Handed {
+    /// A reliable one, handed to the broker connection: acknowledged to
+    /// the robot when the broker acknowledges it ([`Event::Acked`]).
+    Awaiting,
+    /// Unreliable, handed or not: nothing to acknowledge.
+    Unreliable,
+    /// Refused: acknowledged at once (it will never be published).
+    Refused,
+    /// Reliable, but the broker connection's queue was full: not
+    /// acknowledged, so the robot sends it again and it is taken again.
+    NotTaken,
+}
+
+/// The sequence number of the robot's reliable frame just handed to the
+/// broker connection, for its thread to tie to the publish's packet id.
+/// One at a time: the robot sends its next reliable frame only after this
+/// one's `Ack`.
+type Handing = Arc<Mutex<Option<u16>>>;
 
 /// A robot of the mission, as the gateway speaks for it.
 #[derive(Clone)]
@@ -295,24 +318,48 @@ struct Counts {
 /// connection's thread may itself wait for room on the link (a robot slow
 /// to acknowledge), and a link thread waiting for it would wait forever.
 /// A message its full queue cannot take is lost, counted and said.
+#[allow(clippy::too_many_arguments)]
 fn hand_to_broker(
     client: &rumqttc::Client,
+    handing: &Handing,
+    reliable: Option<u16>,
     name: &str,
     counts: &mut Counts,
     topic: String,
     qos: rumqttc::QoS,
     retain: bool,
     payload: Vec<u8>,
-) {
+) -> Handed {
+    // Said before the request, which the connection's thread may take at
+    // once (a QoS 0 publish leaves it: it has no packet id to tie).
+    let mut handed = handing.lock().unwrap_or_else(|e| e.into_inner());
+    if reliable.is_some() {
+        *handed = reliable;
+    }
     if client
         .try_publish(topic.clone(), qos, retain, payload)
         .is_err()
     {
+        if reliable.is_some() {
+            *handed = None;
+        }
+        if reliable.is_some() {
+            eprintln!(
+                "gateway: {name}: the broker connection's queue is full: the send to {topic} waits for the robot's next copy"
+            );
+            return Handed::NotTaken;
+        }
         counts.lost += 1;
         eprintln!(
-            "gateway: {name}: lost a message to {topic}: the broker connection's queue is full ({} lost)",
+            "gateway: {name}: lost a publish to {topic}: the broker connection's queue is full ({} lost)",
             counts.lost
         );
+        return Handed::Unreliable;
+    }
+    if reliable.is_some() {
+        Handed::Awaiting
+    } else {
+        Handed::Unreliable
     }
 }
 
@@ -331,6 +378,7 @@ impl LinkGateway {
         mqtt.set_keep_alive(Duration::from_secs(10));
         mqtt.set_clean_session(false);
         let (client, connection) = rumqttc::Client::new(mqtt, 256);
+        let handing: Handing = Arc::new(Mutex::new(None));
         let subscriptions = [
             topics::team_inbox(&self.scope, &self.robot.team),
             topics::robot_inbox(&self.scope, &self.robot.team, &self.robot.robot),
@@ -339,11 +387,13 @@ impl LinkGateway {
             let events = events.clone();
             let room = room.clone();
             let client = client.clone();
+            let handing = handing.clone();
             let name = self.name().to_string();
             std::thread::spawn(move || {
                 broker_thread(
                     connection,
                     client,
+                    handing,
                     subscriptions,
                     access,
                     events,
@@ -366,6 +416,9 @@ impl LinkGateway {
         let mut counts = Counts::default();
         let mut endpoint = Endpoint::new(LINK_QUEUE);
         endpoint.welcome_flags = u8::from(session_present);
+        // A send is acknowledged to the robot once the broker has it, so a
+        // gateway that stops in between loses none: the robot sends it again.
+        endpoint.defer_acks = true;
         let started = Instant::now();
         let mut last_status: Option<String> = None;
         loop {
@@ -406,7 +459,18 @@ impl LinkGateway {
                     None => {}
                     Some(Event::Bytes(bytes)) => {
                         for frame in endpoint.feed(&bytes, now(), &mut wire) {
-                            self.publish_for_robot(&frame, &client, &mut counts, &mut last_status);
+                            let handed = self.publish_for_robot(
+                                &frame,
+                                &client,
+                                &handing,
+                                &mut counts,
+                                &mut last_status,
+                            );
+                            match handed {
+                                Handed::Awaiting | Handed::Unreliable => {}
+                                Handed::Refused => endpoint.acknowledge(frame.seq, &mut wire),
+                                Handed::NotTaken => endpoint.incoming.forget(frame.seq),
+                            }
                         }
                         for bad in endpoint.bad_frames.drain(..) {
                             eprintln!("gateway: {}: a bad frame ({bad}), dropped", self.name());
@@ -414,6 +478,7 @@ impl LinkGateway {
                     }
                     Some(Event::Closed(why)) => break why,
                     Some(Event::Ready(_)) => {}
+                    Some(Event::Acked(seq)) => endpoint.acknowledge(seq, &mut wire),
                     Some(Event::Message { topic, payload }) => held.push_back((topic, payload)),
                 }
                 // Messages from the broker go down as the link has room.
@@ -495,9 +560,10 @@ impl LinkGateway {
         &self,
         frame: &Frame,
         client: &rumqttc::Client,
+        handing: &Handing,
         counts: &mut Counts,
         last_status: &mut Option<String>,
-    ) {
+    ) -> Handed {
         let me = Sender {
             team: &self.robot.team,
             robot: &self.robot.robot,
@@ -505,8 +571,10 @@ impl LinkGateway {
         match frame.kind {
             Kind::Status => {
                 let text = String::from_utf8_lossy(&frame.payload).into_owned();
-                hand_to_broker(
+                let handed = hand_to_broker(
                     client,
+                    handing,
+                    Some(frame.seq),
                     self.name(),
                     counts,
                     topics::status(&self.scope, &self.robot.robot),
@@ -515,13 +583,16 @@ impl LinkGateway {
                     frame.payload.clone(),
                 );
                 *last_status = Some(text);
+                handed
             }
             Kind::Send | Kind::Publish => {
                 let Some((to, data)) = frame.destination() else {
-                    return;
+                    // Its shape was checked as it was read.
+                    return Handed::Refused;
                 };
                 let to = String::from_utf8_lossy(to).into_owned();
                 let publish = frame.kind == Kind::Publish;
+                let mut handed = Handed::Refused;
                 let refusal = match datagram::decode(data) {
                     None => Some("not a runtime datagram".to_string()),
                     Some(d) if d.team != me.team || d.robot != me.robot => Some(format!(
@@ -539,8 +610,10 @@ impl LinkGateway {
                             } else {
                                 rumqttc::QoS::AtLeastOnce
                             };
-                            hand_to_broker(
+                            handed = hand_to_broker(
                                 client,
+                                handing,
+                                (!publish).then_some(frame.seq),
                                 self.name(),
                                 counts,
                                 topic,
@@ -567,8 +640,9 @@ impl LinkGateway {
                         counts.refused_frames
                     );
                 }
+                handed
             }
-            _ => {}
+            _ => Handed::Unreliable,
         }
     }
 
@@ -678,9 +752,11 @@ fn read_link(mut reader: Box<dyn Read + Send>, events: SyncSender<Event>) {
 /// The robot's MQTT connection: subscribes on every connection, says when
 /// the subscriptions stand, hands over what the broker delivers (waiting
 /// for room, so the broker holds a burst).
+#[allow(clippy::too_many_arguments)]
 fn broker_thread(
     mut connection: rumqttc::Connection,
     client: rumqttc::Client,
+    handing: Handing,
     subscriptions: [String; 2],
     access: BrokerAccess,
     events: SyncSender<Event>,
@@ -689,8 +765,27 @@ fn broker_thread(
 ) {
     let mut session_present = false;
     let mut ready = false;
+    // Packet id → the robot's frame it publishes (QoS 1, until its PubAck).
+    let mut awaiting: HashMap<u16, u16> = HashMap::new();
     for event in connection.iter() {
         match event {
+            // A new QoS 1 publish (a packet id not seen: not one sent again
+            // after a reconnection): the robot's frame just handed, if any.
+            Ok(rumqttc::Event::Outgoing(rumqttc::Outgoing::Publish(pkid)))
+                if pkid != 0 && !awaiting.contains_key(&pkid) =>
+            {
+                let handed = handing.lock().unwrap_or_else(|e| e.into_inner()).take();
+                if let Some(seq) = handed {
+                    awaiting.insert(pkid, seq);
+                }
+            }
+            Ok(rumqttc::Event::Incoming(rumqttc::Packet::PubAck(ack))) => {
+                if let Some(seq) = awaiting.remove(&ack.pkid)
+                    && events.send(Event::Acked(seq)).is_err()
+                {
+                    return;
+                }
+            }
             Ok(rumqttc::Event::Incoming(rumqttc::Packet::ConnAck(ack))) => {
                 session_present = ack.session_present;
                 for topic in &subscriptions {

@@ -16,6 +16,12 @@ pub struct Endpoint {
     pub welcome_flags: u8,
     /// Bytes between zeros that were no frame, by why.
     pub bad_frames: Vec<FrameError>,
+    /// A new reliable frame is taken without its `Ack`, which the caller
+    /// gives with [`Endpoint::acknowledge`] once the frame is passed on
+    /// (the gateway: when the broker has it); its copies meanwhile get
+    /// none either. Otherwise every reliable frame is acknowledged as it
+    /// comes.
+    pub defer_acks: bool,
 }
 
 impl Endpoint {
@@ -27,6 +33,7 @@ impl Endpoint {
             reader: Reader::new(),
             welcome_flags: 0,
             bad_frames: Vec::new(),
+            defer_acks: false,
         }
     }
 
@@ -65,8 +72,12 @@ impl Endpoint {
                     self.outgoing.heard(&frame);
                 }
                 kind if kind.reliable() => {
-                    put(write, &Frame::new(Kind::Ack, frame.seq, Vec::new()));
-                    if self.incoming.accept(frame.seq) {
+                    let new = self.incoming.accept(frame.seq);
+                    if !self.defer_acks || (!new && self.incoming.acked) {
+                        self.incoming.acked = true;
+                        put(write, &Frame::new(Kind::Ack, frame.seq, Vec::new()));
+                    }
+                    if new {
                         taken.push(frame);
                     }
                 }
@@ -75,6 +86,15 @@ impl Endpoint {
             self.tick(now, write);
         }
         taken
+    }
+
+    /// Acknowledges reliable frame `seq`, taken with `defer_acks` (nothing
+    /// when it is not the last one taken: the session restarted since).
+    pub fn acknowledge(&mut self, seq: u16, write: &mut Vec<u8>) {
+        if self.incoming.unacked() == Some(seq) {
+            self.incoming.acked = true;
+            put(write, &Frame::new(Kind::Ack, seq, Vec::new()));
+        }
     }
 
     /// Writes what is due at `now`.

@@ -150,6 +150,9 @@ impl Outgoing {
 #[derive(Debug, Default)]
 pub struct Incoming {
     last: Option<u16>,
+    /// The last frame taken was acknowledged (its copies are then
+    /// acknowledged again; before, they wait with it: `Endpoint::defer_acks`).
+    pub acked: bool,
     /// Copies of a frame already taken (their `Ack` was lost).
     pub duplicates: u64,
 }
@@ -167,7 +170,21 @@ impl Incoming {
             return false;
         }
         self.last = Some(seq);
+        self.acked = false;
         true
+    }
+
+    /// The last frame taken, if it is `seq` and not yet acknowledged.
+    pub fn unacked(&self) -> Option<u16> {
+        self.last.filter(|_| !self.acked)
+    }
+
+    /// Forgets that `seq` was taken (not acknowledged, it could not be
+    /// passed on): its next copy is taken again.
+    pub fn forget(&mut self, seq: u16) {
+        if self.unacked() == Some(seq) {
+            self.last = None;
+        }
     }
 
     /// The other side said `Hello`: its numbers start again.

@@ -194,3 +194,42 @@ fn the_queue_is_bounded() {
     out.push(Kind::Message, vec![2]).unwrap();
     assert_eq!(out.push(Kind::Message, vec![3]), Err(QueueFull));
 }
+
+/// With `defer_acks` (the gateway's), a reliable frame is taken without its
+/// `Ack`, and so are its copies, until the caller acknowledges it; one the
+/// caller could not pass on is forgotten, so its next copy is taken again.
+#[test]
+fn deferred_acks_wait_for_the_caller_and_forgotten_frames_are_taken_again() {
+    // Whether `out` holds the Ack of `seq` (beside the Hellos the gateway's
+    // own side sends until welcomed).
+    let acked = |out: &[u8], seq: u16| {
+        let ack = wire(Kind::Ack, seq, b"");
+        out.windows(ack.len()).any(|w| w == ack.as_slice())
+    };
+    let mut gateway = Endpoint::new(4);
+    gateway.defer_acks = true;
+    let send = wire(Kind::Send, 3, b"\x01Tx");
+    let mut out = Vec::new();
+    assert_eq!(gateway.feed(&send, 0, &mut out).len(), 1);
+    assert!(!acked(&out, 3), "taken, not acknowledged");
+    assert!(
+        gateway.feed(&send, 200, &mut out).is_empty(),
+        "a copy is not taken"
+    );
+    assert!(!acked(&out, 3), "nor acknowledged before the frame");
+    gateway.acknowledge(3, &mut out);
+    assert!(acked(&out, 3));
+    out.clear();
+    gateway.feed(&send, 400, &mut out);
+    assert!(acked(&out, 3), "a later copy: its Ack was lost");
+    // Not passed on (the broker connection full): forgotten, taken again.
+    let next = wire(Kind::Send, 4, b"\x01Ty");
+    out.clear();
+    assert_eq!(gateway.feed(&next, 600, &mut out).len(), 1);
+    gateway.incoming.forget(4);
+    assert_eq!(gateway.feed(&next, 800, &mut out).len(), 1, "taken again");
+    assert!(!acked(&out, 4));
+    // An acknowledgement of another number writes no Ack.
+    gateway.acknowledge(9, &mut out);
+    assert!(!acked(&out, 9));
+}
