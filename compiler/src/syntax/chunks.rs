@@ -11,6 +11,16 @@ use chumsky::span::SimpleSpan;
 
 type Tok<'s> = (Token<'s>, SimpleSpan);
 
+/// The most tokens a header's list (a function's parameters, the teams of a
+/// shared service) may hold: a header is then at most [`MAX_HEADER_TOKENS`]
+/// long, which incremental parsing relies on (it cuts again from a chunk
+/// start at least that far before an edit, so that no header it keeps
+/// reaches into the edit). 64 tokens: 32 names.
+pub const MAX_LIST_TOKENS: usize = 64;
+
+/// The longest header: `def f(` or `A.P.S {` around the longest list.
+pub const MAX_HEADER_TOKENS: usize = MAX_LIST_TOKENS + 6;
+
 /// If an item header starts at token `i`, the index of its opening brace.
 #[inline(always)]
 fn header_brace(tokens: &[Tok<'_>], i: usize) -> Option<usize> {
@@ -23,7 +33,7 @@ fn header_brace(tokens: &[Tok<'_>], i: usize) -> Option<usize> {
             // (so that each token is looked at by one header at most: the
             // cut stays linear), and the header is an item only if that is
             // `)` then `{` (a list that does not parse is still a header).
-            let close = (3..).find(|&k| {
+            let close = (3..=3 + MAX_LIST_TOKENS).find(|&k| {
                 !matches!(
                     at(k),
                     Some(t) if !matches!(
@@ -44,7 +54,7 @@ fn header_brace(tokens: &[Tok<'_>], i: usize) -> Option<usize> {
                 && i.checked_sub(1).is_none_or(|p| tokens[p].0 != Token::Comma) =>
         {
             let mut k = 1;
-            while at(k) == Some(Token::Comma) && ident(k + 1) {
+            while at(k) == Some(Token::Comma) && ident(k + 1) && k < MAX_LIST_TOKENS {
                 k += 2;
             }
             let service = at(k) == Some(Token::Dot)

@@ -139,7 +139,7 @@ pub fn parse_incremental(
     // Cut chunks again from a chunk start far enough before the edit...
     let resume = old
         .chunks
-        .partition_point(|c| c.tokens.start + 6 <= lexed.kept_before)
+        .partition_point(|c| c.tokens.start + chunks::MAX_HEADER_TOKENS <= lexed.kept_before)
         .saturating_sub(1);
     let from = old.chunks.get(resume).map_or(0, |c| c.tokens.start);
     // ...until a chunk starts after the new tokens where an old one did.
