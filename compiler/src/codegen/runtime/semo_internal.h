@@ -96,6 +96,92 @@ void semo__queue_taken(int port);
  * byte (bool), or a length byte and the text (word, text). Nothing after. */
 #define SEMO__DATAGRAM_MAGIC "SEMO\x02"
 #define SEMO__DATAGRAM_MAX (6 + 3 * 256 + 1 + 256)
+
+#ifndef SEMO_STATIC
+#include <pthread.h>
+#include <string.h>
+#include <time.h>
+
+/* What a network transport's thread received and its `recv` has not taken
+ * yet (semo_mqtt.c, semo_link_transport.c): the datagrams in order, and the
+ * refused messages still to report (SEMO_RECV_REFUSED), under the
+ * transport's own lock. One code for both: header-only, so that a program
+ * built with one transport alone (the MQTT benchmarks) needs nothing else. */
+#define SEMO__RECEIVED_MAX 64
+typedef struct {
+    struct {
+        size_t len;
+        unsigned char data[SEMO__DATAGRAM_MAX + 1];
+    } slots[SEMO__RECEIVED_MAX];
+    size_t head, count;
+    unsigned long refused;
+} semo__received;
+
+/* `ms` wall milliseconds from now on CLOCK_MONOTONIC (the clock the
+ * transports' conditions wait on). */
+static inline struct timespec semo__deadline_after(int ms)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    t.tv_sec += ms / 1000;
+    t.tv_nsec += (long)(ms % 1000) * 1000000L;
+    if (t.tv_nsec >= 1000000000L) {
+        t.tv_sec++;
+        t.tv_nsec -= 1000000000L;
+    }
+    return t;
+}
+
+static inline bool semo__received_full(const semo__received *r)
+{
+    return r->count == SEMO__RECEIVED_MAX;
+}
+
+/* Under the lock, with room made first (the network thread waits while
+ * full rather than lose a message): keeps `len` bytes of `data` (at most a
+ * slot's). */
+static inline void semo__received_put(semo__received *r, const void *data, size_t len)
+{
+    if (semo__received_full(r))
+        return;
+    size_t at = (r->head + r->count) % SEMO__RECEIVED_MAX;
+    r->slots[at].len = len < sizeof r->slots[at].data ? len : sizeof r->slots[at].data;
+    memcpy(r->slots[at].data, data, r->slots[at].len);
+    r->count++;
+}
+
+/* A transport's `recv`: waits on `changed` under `lock` until a datagram or
+ * a refusal is there, `*interrupted`, or `timeout_ms` (< 0: no limit); then
+ * copies the next datagram into `data` (at most `cap` bytes) and returns
+ * its length, or SEMO_RECV_REFUSED, or 0. A take is broadcast: the network
+ * thread may wait for room. */
+static inline int semo__received_take(semo__received *r, pthread_mutex_t *lock, pthread_cond_t *changed,
+                                      const bool *interrupted, void *data, size_t cap, int timeout_ms)
+{
+    struct timespec deadline = semo__deadline_after(timeout_ms < 0 ? 0 : timeout_ms);
+    pthread_mutex_lock(lock);
+    int waited = 0;
+    while (r->count == 0 && r->refused == 0 && !*interrupted && waited == 0) {
+        if (timeout_ms < 0)
+            pthread_cond_wait(changed, lock);
+        else
+            waited = pthread_cond_timedwait(changed, lock, &deadline);
+    }
+    int n = 0;
+    if (r->refused > 0 && !*interrupted) {
+        r->refused--;
+        n = SEMO_RECV_REFUSED;
+    } else if (r->count > 0 && !*interrupted) {
+        n = (int)(r->slots[r->head].len < cap ? r->slots[r->head].len : cap);
+        memcpy(data, r->slots[r->head].data, (size_t)n);
+        r->head = (r->head + 1) % SEMO__RECEIVED_MAX;
+        r->count--;
+        pthread_cond_broadcast(changed);
+    }
+    pthread_mutex_unlock(lock);
+    return n;
+}
+#endif
 size_t semo__encode_message(const semo_message *m, unsigned char *out);
 /* False for anything else (the message is then unspecified). */
 bool semo__decode_message(const unsigned char *in, size_t len, semo_message *m);

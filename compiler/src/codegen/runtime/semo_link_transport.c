@@ -29,15 +29,9 @@
 #include <time.h>
 #include <unistd.h>
 
-#define LINK_INBOX 64
 #define LINK_OPEN_WAIT_MS 5000
 #define LINK_CLOSE_WAIT_MS 2000
 #define LINK_RECONNECT_MS 100
-
-typedef struct {
-    size_t len;
-    unsigned char data[SEMO__DATAGRAM_MAX + 1];
-} link_datagram;
 
 static semo_link g_link;
 static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
@@ -48,9 +42,7 @@ static int g_fd = -1;
 static int g_wake[2] = {-1, -1};
 static char g_host[256], g_port[16];
 static bool g_stopping, g_interrupted;
-static link_datagram g_inbox[LINK_INBOX];
-static size_t g_head, g_count;
-static unsigned long g_refused;
+static semo__received g_received; /* what recv has still to take */
 
 static int64_t now_ms(void)
 {
@@ -59,18 +51,6 @@ static int64_t now_ms(void)
     return (int64_t)t.tv_sec * 1000 + t.tv_nsec / 1000000;
 }
 
-static struct timespec deadline_after(int ms)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    t.tv_sec += ms / 1000;
-    t.tv_nsec += (long)(ms % 1000) * 1000000L;
-    if (t.tv_nsec >= 1000000000L) {
-        t.tv_sec++;
-        t.tv_nsec -= 1000000000L;
-    }
-    return t;
-}
 
 /* The link's writes, under g_lock: the whole frame or, the line gone,
  * nothing (the reliable ones go again on the next connection). */
@@ -122,16 +102,11 @@ static void taken(const semo_link_frame *f)
 {
     if (f->kind == SEMO_LINK_REFUSED) {
         if (!g_interrupted)
-            g_refused++;
+            g_received.refused++;
     } else if (f->kind == SEMO_LINK_MESSAGE && !g_interrupted) {
         /* Room was made before the frame was taken (io_thread); none only
          * once the program stops, when nothing more is delivered. */
-        if (g_count < LINK_INBOX) {
-            link_datagram *slot = &g_inbox[(g_head + g_count) % LINK_INBOX];
-            slot->len = f->len < sizeof slot->data ? f->len : sizeof slot->data;
-            memcpy(slot->data, f->payload, slot->len);
-            g_count++;
-        }
+        semo__received_put(&g_received, f->payload, f->len);
     }
     pthread_cond_broadcast(&g_changed);
 }
@@ -147,7 +122,7 @@ static void *io_thread(void *arg)
             int fd = connect_gateway();
             pthread_mutex_lock(&g_lock);
             if (fd < 0) {
-                struct timespec until = deadline_after(LINK_RECONNECT_MS);
+                struct timespec until = semo__deadline_after(LINK_RECONNECT_MS);
                 while (!g_stopping && pthread_cond_timedwait(&g_changed, &g_lock, &until) == 0) {
                 }
                 continue;
@@ -184,7 +159,7 @@ static void *io_thread(void *arg)
              * room (link_recv makes it) rather than acknowledge a message
              * and lose it. The gateway keeps the rest meanwhile, as the
              * broker does for a full MQTT robot. */
-            while (buf[i] == 0 && g_count == LINK_INBOX && !g_interrupted && !g_stopping)
+            while (buf[i] == 0 && semo__received_full(&g_received) && !g_interrupted && !g_stopping)
                 pthread_cond_wait(&g_changed, &g_lock);
             semo_link_frame f;
             if (semo_link_feed(&g_link, buf[i], now_ms(), &f))
@@ -238,14 +213,14 @@ static int link_open(const semo_program_desc *program, const semo_transport_conf
         return -1;
     semo_link_init(&g_link, write_all, NULL);
     g_stopping = g_interrupted = false;
-    g_head = g_count = 0;
-    g_refused = 0;
+    g_received.head = g_received.count = 0;
+    g_received.refused = 0;
     if (pthread_create(&g_thread, NULL, io_thread, NULL) != 0)
         return -1;
     g_thread_started = true;
     /* Nothing is sent before the gateway has answered: it holds the robot's
      * subscriptions by then. */
-    struct timespec deadline = deadline_after(LINK_OPEN_WAIT_MS);
+    struct timespec deadline = semo__deadline_after(LINK_OPEN_WAIT_MS);
     pthread_mutex_lock(&g_lock);
     int waited = 0;
     while (!g_link.welcomed && waited == 0)
@@ -296,29 +271,7 @@ static int link_status(const char *json, size_t len)
 
 static int link_recv(void *data, size_t cap, int timeout_ms)
 {
-    struct timespec deadline = deadline_after(timeout_ms < 0 ? 0 : timeout_ms);
-    pthread_mutex_lock(&g_lock);
-    int waited = 0;
-    while (g_count == 0 && g_refused == 0 && !g_interrupted && waited == 0) {
-        if (timeout_ms < 0)
-            pthread_cond_wait(&g_changed, &g_lock);
-        else
-            waited = pthread_cond_timedwait(&g_changed, &g_lock, &deadline);
-    }
-    int n = 0;
-    if (g_refused > 0 && !g_interrupted) {
-        g_refused--;
-        n = SEMO_RECV_REFUSED;
-    } else if (g_count > 0 && !g_interrupted) {
-        link_datagram *slot = &g_inbox[g_head];
-        n = (int)(slot->len < cap ? slot->len : cap);
-        memcpy(data, slot->data, (size_t)n);
-        g_head = (g_head + 1) % LINK_INBOX;
-        g_count--;
-        pthread_cond_broadcast(&g_changed); /* room for the link's next message */
-    }
-    pthread_mutex_unlock(&g_lock);
-    return n;
+    return semo__received_take(&g_received, &g_lock, &g_changed, &g_interrupted, data, cap, timeout_ms);
 }
 
 static void link_interrupt(void)
@@ -335,7 +288,7 @@ static void link_close(void)
     if (!g_thread_started)
         return;
     /* What was sent reliably reaches the gateway before we go. */
-    struct timespec deadline = deadline_after(LINK_CLOSE_WAIT_MS);
+    struct timespec deadline = semo__deadline_after(LINK_CLOSE_WAIT_MS);
     pthread_mutex_lock(&g_lock);
     int waited = 0;
     while (semo_link_pending(&g_link) > 0 && g_fd >= 0 && waited == 0)

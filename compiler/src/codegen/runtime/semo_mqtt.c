@@ -43,7 +43,6 @@
 #include <string.h>
 #include <time.h>
 
-#define MQTT_QUEUE 64
 /* The runtime's largest datagram (SEMO__DATAGRAM_MAX: 3 fields and a value) and a
  * spare byte: a longer payload arrives truncated and is rejected as
  * malformed by the runtime. */
@@ -58,11 +57,6 @@
 #define MQTT_OPEN_WAIT_MS 5000
 #define MQTT_CLOSE_WAIT_MS 2000
 
-typedef struct {
-    size_t len;
-    unsigned char data[MQTT_PAYLOAD_MAX];
-} mqtt_payload;
-
 static struct mosquitto *g_mosq;
 static const semo_program_desc *g_program;
 static char g_mission[64];
@@ -71,10 +65,8 @@ static char g_run[SEMO_RUN_MAX];
 static char g_run_prefix[MQTT_TOPIC_MAX];
 static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t g_changed; /* monotonic clock; every state change below */
-static mqtt_payload g_queue[MQTT_QUEUE];
-static size_t g_head, g_count;
+static semo__received g_received; /* what recv has still to take */
 static bool g_interrupted;
-static unsigned long g_refused; /* messages refused and not yet told to recv */
 static bool g_subscribed;
 static int g_connect_refused; /* the broker's CONNACK code when it refused */
 static bool g_connected_once, g_session_present; /* the first CONNACK's session-present flag */
@@ -178,18 +170,6 @@ static bool datagram_field(const unsigned char *data, size_t len, int index, cha
     return false;
 }
 
-static struct timespec deadline_after(int ms)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    t.tv_sec += ms / 1000;
-    t.tv_nsec += (long)(ms % 1000) * 1000000L;
-    if (t.tv_nsec >= 1000000000L) {
-        t.tv_sec++;
-        t.tv_nsec -= 1000000000L;
-    }
-    return t;
-}
 
 static void outbox_flush(void);
 
@@ -296,20 +276,17 @@ static void on_message(struct mosquitto *mosq, void *obj, const struct mosquitto
     if (refused) {
         /* Told to recv, which the runtime traces; never delivered. */
         if (!g_interrupted)
-            g_refused++;
+            g_received.refused++;
         pthread_cond_broadcast(&g_changed);
         pthread_mutex_unlock(&g_lock);
         return;
     }
     /* A full queue holds back the network thread (and so the broker's
      * acknowledgement) rather than losing a message. */
-    while (g_count == MQTT_QUEUE && !g_interrupted)
+    while (semo__received_full(&g_received) && !g_interrupted)
         pthread_cond_wait(&g_changed, &g_lock);
     if (!g_interrupted) {
-        mqtt_payload *slot = &g_queue[(g_head + g_count) % MQTT_QUEUE];
-        slot->len = len < sizeof slot->data ? len : sizeof slot->data;
-        memcpy(slot->data, data, slot->len);
-        g_count++;
+        semo__received_put(&g_received, data, len);
         pthread_cond_broadcast(&g_changed);
     }
     pthread_mutex_unlock(&g_lock);
@@ -372,9 +349,9 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     snprintf(g_run, sizeof g_run, "%s", config->run && *config->run ? config->run : SEMO_RUN_DEFAULT);
     scope_of(g_run_prefix, sizeof g_run_prefix);
     snprintf(g_run_prefix + strlen(g_run_prefix), sizeof g_run_prefix - strlen(g_run_prefix), "/");
-    g_head = g_count = 0;
+    g_received.head = g_received.count = 0;
     g_interrupted = g_subscribed = false;
-    g_refused = 0;
+    g_received.refused = 0;
     g_connect_refused = 0;
     g_subscribe_mid = -1;
     g_unacked = 0;
@@ -426,7 +403,7 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
         return -1;
     }
     /* Sending before our subscriptions stand would lose the answers. */
-    struct timespec deadline = deadline_after(MQTT_OPEN_WAIT_MS);
+    struct timespec deadline = semo__deadline_after(MQTT_OPEN_WAIT_MS);
     pthread_mutex_lock(&g_lock);
     int waited = 0;
     while (!g_subscribed && !g_connect_refused && waited == 0)
@@ -551,29 +528,7 @@ static int mqtt_send_to(const char *to, const void *data, size_t len)
 
 static int mqtt_recv(void *data, size_t cap, int timeout_ms)
 {
-    struct timespec deadline = deadline_after(timeout_ms < 0 ? 0 : timeout_ms);
-    pthread_mutex_lock(&g_lock);
-    int waited = 0;
-    while (g_count == 0 && g_refused == 0 && !g_interrupted && waited == 0) {
-        if (timeout_ms < 0)
-            pthread_cond_wait(&g_changed, &g_lock);
-        else
-            waited = pthread_cond_timedwait(&g_changed, &g_lock, &deadline);
-    }
-    int n = 0;
-    if (g_refused > 0 && !g_interrupted) {
-        g_refused--;
-        n = SEMO_RECV_REFUSED;
-    } else if (g_count > 0 && !g_interrupted) {
-        mqtt_payload *slot = &g_queue[g_head];
-        n = (int)(slot->len < cap ? slot->len : cap);
-        memcpy(data, slot->data, (size_t)n);
-        g_head = (g_head + 1) % MQTT_QUEUE;
-        g_count--;
-        pthread_cond_broadcast(&g_changed);
-    }
-    pthread_mutex_unlock(&g_lock);
-    return n;
+    return semo__received_take(&g_received, &g_lock, &g_changed, &g_interrupted, data, cap, timeout_ms);
 }
 
 /* <scope>/status/<robot>. */
@@ -610,7 +565,7 @@ static void mqtt_close(void)
         return;
     /* What we sent at QoS 1 must reach the broker before we go: after a
      * disconnection libmosquitto forgets its queue. */
-    struct timespec deadline = deadline_after(MQTT_CLOSE_WAIT_MS);
+    struct timespec deadline = semo__deadline_after(MQTT_CLOSE_WAIT_MS);
     pthread_mutex_lock(&g_lock);
     int waited = 0;
     while (g_unacked > 0 && waited == 0)
