@@ -160,7 +160,7 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             }
         }
     }
-    let (run, mission, deployment) = match super::deploy::load_fleet(
+    let (mut run, mission, deployment) = match super::deploy::load_fleet(
         &options.mission,
         &options.strategy,
         options.deploy.as_deref(),
@@ -170,16 +170,21 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         Ok(loaded) => loaded,
         Err(code) => return code,
     };
-    let analysis = run.analysis();
-    if let Err(code) = super::build_files(&analysis, mission) {
-        return code;
-    }
-    let Some(refined) = analysis.refined(mission) else {
-        eprintln!("error: internal error: the mission is not in the workspace analysis");
-        return 2;
+    // The refined robots, or the mission's errors reported as `semo build` reports them.
+    let human = super::output::Format::Human;
+    let refined = match super::refine_or_report(
+        &mut run,
+        mission,
+        human,
+        options.color,
+        "bridge its robots",
+        out,
+    ) {
+        Ok((_, refined)) => refined,
+        Err(code) => return code,
     };
     let Some(first) = refined.programs.first() else {
-        eprintln!("error: refused: fix the mission's errors first (`semo check`)");
+        eprintln!("error: the mission has no robot to bridge");
         return 2;
     };
     let roster = Roster {
@@ -314,52 +319,77 @@ struct Counts {
     lost: u64,
 }
 
-/// Hands a message to the robot's MQTT connection without waiting: the
-/// connection's thread may itself wait for room on the link (a robot slow
-/// to acknowledge), and a link thread waiting for it would wait forever.
-/// A message its full queue cannot take is lost, counted and said.
-#[allow(clippy::too_many_arguments)]
-fn hand_to_broker(
-    client: &rumqttc::Client,
-    handing: &Handing,
-    reliable: Option<u16>,
-    name: &str,
-    counts: &mut Counts,
+/// The robot's MQTT connection as the link thread uses it: the client, and
+/// the sequence number of the reliable frame just handed to it, for the
+/// connection's thread to tie to the publish's packet id.
+#[derive(Clone)]
+struct Broker {
+    client: rumqttc::Client,
+    handing: Handing,
+}
+
+/// A publish the gateway makes for the robot.
+struct Outbound {
     topic: String,
     qos: rumqttc::QoS,
     retain: bool,
     payload: Vec<u8>,
-) -> Handed {
-    // Said before the request, which the connection's thread may take at
-    // once (a QoS 0 publish leaves it: it has no packet id to tie).
-    let mut handed = handing.lock().unwrap_or_else(|e| e.into_inner());
-    if reliable.is_some() {
-        *handed = reliable;
-    }
-    if client
-        .try_publish(topic.clone(), qos, retain, payload)
-        .is_err()
-    {
+}
+
+impl Broker {
+    /// Hands `message` to the connection without waiting: the connection's
+    /// thread may itself wait for room on the link (a robot slow to
+    /// acknowledge), and a link thread waiting for it would wait forever.
+    /// `reliable`: the sequence number of the robot's frame it publishes,
+    /// acknowledged at the broker's PUBACK. A reliable one the full queue
+    /// cannot take is not taken (the robot sends it again); an unreliable
+    /// one is lost, counted and said.
+    fn hand(
+        &self,
+        name: &str,
+        counts: &mut Counts,
+        message: Outbound,
+        reliable: Option<u16>,
+    ) -> Handed {
+        // Said before the request, which the connection's thread may take at
+        // once (a QoS 0 publish leaves it: it has no packet id to tie).
+        let mut handed = self.handing.lock().unwrap_or_else(|e| e.into_inner());
         if reliable.is_some() {
-            *handed = None;
+            *handed = reliable;
         }
-        if reliable.is_some() {
-            eprintln!(
-                "gateway: {name}: the broker connection's queue is full: the send to {topic} waits for the robot's next copy"
-            );
-            return Handed::NotTaken;
+        let Outbound {
+            topic,
+            qos,
+            retain,
+            payload,
+        } = message;
+        if self
+            .client
+            .try_publish(topic.clone(), qos, retain, payload)
+            .is_ok()
+        {
+            return match reliable {
+                Some(_) => Handed::Awaiting,
+                None => Handed::Unreliable,
+            };
         }
-        counts.lost += 1;
-        eprintln!(
-            "gateway: {name}: lost a publish to {topic}: the broker connection's queue is full ({} lost)",
-            counts.lost
-        );
-        return Handed::Unreliable;
-    }
-    if reliable.is_some() {
-        Handed::Awaiting
-    } else {
-        Handed::Unreliable
+        match reliable {
+            Some(_) => {
+                *handed = None;
+                eprintln!(
+                    "gateway: {name}: the broker connection's queue is full: the send to {topic} waits for the robot's next copy"
+                );
+                Handed::NotTaken
+            }
+            None => {
+                counts.lost += 1;
+                eprintln!(
+                    "gateway: {name}: lost a publish to {topic}: the broker connection's queue is full ({} lost)",
+                    counts.lost
+                );
+                Handed::Unreliable
+            }
+        }
     }
 }
 
@@ -378,7 +408,10 @@ impl LinkGateway {
         mqtt.set_keep_alive(Duration::from_secs(10));
         mqtt.set_clean_session(false);
         let (client, connection) = rumqttc::Client::new(mqtt, 256);
-        let handing: Handing = Arc::new(Mutex::new(None));
+        let broker = Broker {
+            client,
+            handing: Arc::new(Mutex::new(None)),
+        };
         let subscriptions = [
             topics::team_inbox(&self.scope, &self.robot.team),
             topics::robot_inbox(&self.scope, &self.robot.team, &self.robot.robot),
@@ -386,14 +419,12 @@ impl LinkGateway {
         {
             let events = events.clone();
             let room = room.clone();
-            let client = client.clone();
-            let handing = handing.clone();
+            let broker = broker.clone();
             let name = self.name().to_string();
             std::thread::spawn(move || {
                 broker_thread(
                     connection,
-                    client,
-                    handing,
+                    broker,
                     subscriptions,
                     access,
                     events,
@@ -461,8 +492,7 @@ impl LinkGateway {
                         for frame in endpoint.feed(&bytes, now(), &mut wire) {
                             let handed = self.publish_for_robot(
                                 &frame,
-                                &client,
-                                &handing,
+                                &broker,
                                 &mut counts,
                                 &mut last_status,
                             );
@@ -503,7 +533,7 @@ impl LinkGateway {
                 endpoint.tick(now(), &mut wire);
             };
             eprintln!("gateway: {}: link closed ({closed})", self.name());
-            self.lost(&client, last_status.as_deref());
+            self.lost(&broker.client, last_status.as_deref());
         }
     }
 
@@ -559,8 +589,7 @@ impl LinkGateway {
     fn publish_for_robot(
         &self,
         frame: &Frame,
-        client: &rumqttc::Client,
-        handing: &Handing,
+        broker: &Broker,
         counts: &mut Counts,
         last_status: &mut Option<String>,
     ) -> Handed {
@@ -571,17 +600,13 @@ impl LinkGateway {
         match frame.kind {
             Kind::Status => {
                 let text = String::from_utf8_lossy(&frame.payload).into_owned();
-                let handed = hand_to_broker(
-                    client,
-                    handing,
-                    Some(frame.seq),
-                    self.name(),
-                    counts,
-                    topics::status(&self.scope, &self.robot.robot),
-                    rumqttc::QoS::AtLeastOnce,
-                    true,
-                    frame.payload.clone(),
-                );
+                let status = Outbound {
+                    topic: topics::status(&self.scope, &self.robot.robot),
+                    qos: rumqttc::QoS::AtLeastOnce,
+                    retain: true,
+                    payload: frame.payload.clone(),
+                };
+                let handed = broker.hand(self.name(), counts, status, Some(frame.seq));
                 *last_status = Some(text);
                 handed
             }
@@ -610,17 +635,14 @@ impl LinkGateway {
                             } else {
                                 rumqttc::QoS::AtLeastOnce
                             };
-                            handed = hand_to_broker(
-                                client,
-                                handing,
-                                (!publish).then_some(frame.seq),
-                                self.name(),
-                                counts,
+                            let message = Outbound {
                                 topic,
                                 qos,
-                                false,
-                                data.to_vec(),
-                            );
+                                retain: false,
+                                payload: data.to_vec(),
+                            };
+                            let reliable = (!publish).then_some(frame.seq);
+                            handed = broker.hand(self.name(), counts, message, reliable);
                             None
                         }
                         None => Some(format!(
@@ -752,11 +774,9 @@ fn read_link(mut reader: Box<dyn Read + Send>, events: SyncSender<Event>) {
 /// The robot's MQTT connection: subscribes on every connection, says when
 /// the subscriptions stand, hands over what the broker delivers (waiting
 /// for room, so the broker holds a burst).
-#[allow(clippy::too_many_arguments)]
 fn broker_thread(
     mut connection: rumqttc::Connection,
-    client: rumqttc::Client,
-    handing: Handing,
+    broker: Broker,
     subscriptions: [String; 2],
     access: BrokerAccess,
     events: SyncSender<Event>,
@@ -774,7 +794,11 @@ fn broker_thread(
             Ok(rumqttc::Event::Outgoing(rumqttc::Outgoing::Publish(pkid)))
                 if pkid != 0 && !awaiting.contains_key(&pkid) =>
             {
-                let handed = handing.lock().unwrap_or_else(|e| e.into_inner()).take();
+                let handed = broker
+                    .handing
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .take();
                 if let Some(seq) = handed {
                     awaiting.insert(pkid, seq);
                 }
@@ -789,7 +813,9 @@ fn broker_thread(
             Ok(rumqttc::Event::Incoming(rumqttc::Packet::ConnAck(ack))) => {
                 session_present = ack.session_present;
                 for topic in &subscriptions {
-                    let _ = client.try_subscribe(topic.clone(), rumqttc::QoS::AtLeastOnce);
+                    let _ = broker
+                        .client
+                        .try_subscribe(topic.clone(), rumqttc::QoS::AtLeastOnce);
                 }
             }
             Ok(rumqttc::Event::Incoming(rumqttc::Packet::SubAck(_))) => {
