@@ -99,12 +99,14 @@ impl Bound {
         }
     }
 
+    /// What the headline adds after how far the search got (nothing for
+    /// the horizon: "the first T ms" says it).
     fn said(self) -> &'static str {
         match self {
-            Bound::Horizon => "the horizon",
-            Bound::States => "the state budget",
-            Bound::Memory => "the memory budget",
-            Bound::Cancelled => "cancelled",
+            Bound::Horizon => "",
+            Bound::States => " (stopped by the state budget)",
+            Bound::Memory => " (stopped by the memory budget)",
+            Bound::Cancelled => " (cancelled)",
         }
     }
 }
@@ -298,16 +300,10 @@ impl Report {
             self.states,
             self.transitions,
             match self.bound {
-                _ if self.exhaustive => "a proof for the choices explored".to_string(),
-                Some(bound @ (Bound::States | Bound::Memory)) => format!(
-                    "the first {} ms (stopped by {})",
-                    self.reached_ms,
-                    bound.said()
-                ),
-                Some(Bound::Cancelled) => {
-                    format!("the first {} ms (cancelled)", self.reached_ms)
+                Some(bound) if !self.exhaustive => {
+                    format!("the first {} ms{}", self.reached_ms, bound.said())
                 }
-                _ => format!("the first {} ms", self.reached_ms),
+                _ => "a proof for the choices explored".to_string(),
             }
         )
     }
