@@ -52,7 +52,7 @@ use crate::project::{self, Project};
 use crate::refine::BuildInput;
 use crate::sema::{self, check_parsed};
 use crate::strategy::{Strategy, StrategyLinks, cross_check, load_strategy};
-use crate::syntax::{ParseCache, parse_incremental};
+use crate::syntax::{self, ParseCache, parse_incremental};
 use crate::taskgraph::subgraph::{self, SubgraphSource};
 use crate::workspace::{FileKind, FileResolver, GraphRun, analyze_graph_at};
 use std::borrow::Cow;
@@ -175,6 +175,9 @@ pub struct AnalysisHost {
     /// What sees what: kept while the layout stays (see [`view`]).
     view: Arc<View>,
     memo: Arc<Memo>,
+    /// Whether a mission's parse leaves a cache for the file's next version
+    /// (see [`AnalysisHost::without_parse_caches`]).
+    parse_caches: bool,
 }
 
 /// A project file read: the project (rooted at the file's folder; a
@@ -208,7 +211,18 @@ impl AnalysisHost {
             projects: Projects::default(),
             view: Arc::default(),
             memo: Arc::default(),
+            parse_caches: true,
         }
+    }
+
+    /// A host whose missions are parsed from scratch, without leaving a parse
+    /// cache: for a door that analyses each text once (the command line).
+    /// The parse is the same; the cache (the tokens, and each chunk's tree
+    /// beside the file's) would be a third of a large mission's peak memory,
+    /// kept for an edit that never comes.
+    pub fn without_parse_caches(mut self) -> AnalysisHost {
+        self.parse_caches = false;
+        self
     }
 
     pub fn set_roots(&mut self, roots: Roots) {
@@ -329,6 +343,7 @@ impl AnalysisHost {
             projects: self.projects.clone(),
             view: self.view.clone(),
             memo: self.memo.clone(),
+            parse_caches: self.parse_caches,
         }
     }
 }
@@ -414,6 +429,7 @@ pub struct Analysis {
     projects: Projects,
     view: Arc<View>,
     memo: Arc<Memo>,
+    parse_caches: bool,
 }
 
 impl Analysis {
@@ -580,10 +596,15 @@ impl Analysis {
         if let Some(found) = fresh(lock(&self.memo.missions).get(&id), &memo_key) {
             return Some(found);
         }
-        let previous = file.parses.get();
-        let (parse, cache) = parse_incremental(id, &file.text, previous.as_deref());
-        drop(previous);
-        file.parses.put(cache);
+        let parse = if self.parse_caches {
+            let previous = file.parses.get();
+            let (parse, cache) = parse_incremental(id, &file.text, previous.as_deref());
+            drop(previous);
+            file.parses.put(cache);
+            parse
+        } else {
+            syntax::parse(id, &file.text)
+        };
         let analysis = Arc::new(check_parsed(id, parse, &catalog.catalog));
         let old = lock(&self.memo.missions).insert(id, (memo_key, analysis.clone()));
         drop_later(old);

@@ -55,7 +55,6 @@ fn folder_of(path: &Path) -> PathBuf {
 /// when no project file says where to look.
 pub const MAX_ENTRIES: usize = 20_000;
 
-#[derive(Default)]
 struct Loader {
     files: Files,
     host: AnalysisHost,
@@ -65,6 +64,20 @@ struct Loader {
     projects: Vec<PathBuf>,
     /// Found while loading (W112), reported with the rest.
     notes: Vec<Diagnostic>,
+}
+
+impl Default for Loader {
+    fn default() -> Self {
+        Loader {
+            files: Files::default(),
+            // Each text is analysed once.
+            host: AnalysisHost::default().without_parse_caches(),
+            by_path: HashMap::new(),
+            checked: Vec::new(),
+            projects: Vec::new(),
+            notes: Vec::new(),
+        }
+    }
 }
 
 impl Loader {

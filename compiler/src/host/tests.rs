@@ -141,6 +141,27 @@ fn an_edit_recomputes_only_what_reads_the_edited_file() {
 }
 
 #[test]
+fn a_host_without_parse_caches_checks_alike_and_keeps_no_cache() {
+    let files = [
+        (0, "/w/a/one.mission", FileKind::Mission, MISSION),
+        (1, "/w/a/rover.robot.xml", FileKind::Catalog, CATALOG),
+    ];
+    let cached = host_with(&files).analysis();
+    let mut host = AnalysisHost::new(roots(&["/w"])).without_parse_caches();
+    for &(id, path, kind, text) in &files {
+        host.set_file(FileId(id), Some(PathBuf::from(path)), kind, text.into());
+    }
+    let once = host.analysis();
+    assert_eq!(
+        once.mission(FileId(0)).unwrap().syntax,
+        cached.mission(FileId(0)).unwrap().syntax
+    );
+    assert_eq!(once.diagnostics(FileId(0)), cached.diagnostics(FileId(0)));
+    assert!(cached.parse_cache(FileId(0)).is_some());
+    assert!(once.parse_cache(FileId(0)).is_none());
+}
+
+#[test]
 fn the_build_input_carries_the_diagnostics_of_every_file_the_mission_reads() {
     let broken = CATALOG.replace("</Catalog>", "");
     let host = host_with(&[
