@@ -359,6 +359,39 @@ fn many_functions_with_parameters_cost_in_proportion() {
     );
 }
 
+/// Teams that all declare a variable of one name (`T.Status`) and read it:
+/// whether a team has the variable is one lookup, not a walk along the list
+/// of every team that declares the name (x13.7 for ten times the teams).
+#[test]
+fn many_teams_with_a_variable_of_one_name_cost_in_proportion() {
+    scales_linearly(
+        "teams sharing a variable name",
+        200,
+        &["check", "--format", "json", "m.mission"],
+        |dir, n| {
+            let n = n.max(1);
+            let mut text = String::from("{\n");
+            for i in 0..n {
+                text.push_str(&format!("  T{i}: iRobotCreate a{i}\n"));
+            }
+            text.push_str("}\n");
+            for i in 0..n {
+                text.push_str(&format!(
+                    "T{i}.P.S {{\n  send(T{}, T{i}.Status = \"x\")\n",
+                    (i + 1) % n
+                ));
+                for k in 0..10 {
+                    text.push_str(&format!("  if (Status == \"x\") throw e{k}\n"));
+                }
+                text.push_str(&format!(
+                    "}} repeat()\nT{i}.M {{ set(P, S) }}\nT{i}.main {{ default: mode = M }}\n"
+                ));
+            }
+            std::fs::write(dir.join("m.mission"), text).unwrap();
+        },
+    );
+}
+
 #[test]
 fn many_modes_cases_and_catches_cost_in_proportion() {
     scales_linearly(

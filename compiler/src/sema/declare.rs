@@ -5,7 +5,7 @@
 use super::ir::*;
 use super::{Checker, MAX_ROBOTS_PER_DECLARATION, MAX_ROBOTS_PER_MISSION, is_user, suggestion};
 use crate::diag::Code;
-use crate::fasthash::{FastMap, FastSet};
+use crate::fasthash::FastMap;
 use crate::span::Span;
 use crate::syntax::ast::{self, Item, Name};
 
@@ -384,9 +384,8 @@ impl<'a> Checker<'a> {
         }
         // Each (team, name) once, in the order found, without scanning the
         // lists (a mission may name thousands of variables).
-        let mut seen = FastSet::default();
         for (team, name) in found {
-            if !seen.insert((team, name.clone())) {
+            if !self.team_variables.insert((team, name.clone())) {
                 continue;
             }
             if let Some(t) = team {

@@ -136,6 +136,9 @@ pub(crate) struct Checker<'a> {
     /// Team variables declared anywhere by `T.X = ...` or received, by name:
     /// the teams declaring them (`None` when written bare inside a function).
     variables: FastMap<Name, Vec<Option<TeamId>>>,
+    /// The same, by (team, name): whether a team has a variable is one lookup,
+    /// where a name that thousands of teams declare has a list as long.
+    team_variables: FastSet<(Option<TeamId>, Name)>,
     /// Services named by the `set`s of a mode defined twice (already reported):
     /// they are not "never set".
     set_by_duplicate_modes: FastSet<(TeamId, ServiceId)>,
@@ -202,6 +205,7 @@ impl<'a> Checker<'a> {
             teams_by_name: FastMap::default(),
             functions_by_name: FastMap::default(),
             variables: FastMap::default(),
+            team_variables: FastSet::default(),
             set_by_duplicate_modes: FastSet::default(),
             mains_with_unknown_modes: FastSet::default(),
             comms_with_unknown_team: Vec::new(),
@@ -268,9 +272,9 @@ impl<'a> Checker<'a> {
 
     /// Whether `name` is a team variable of `team` (or written bare in a function).
     fn is_variable(&self, team: TeamId, name: &str) -> bool {
-        self.variables
-            .get(name)
-            .is_some_and(|teams| teams.iter().any(|t| t.is_none_or(|t| t == team)))
+        let name = Name::new(name);
+        self.team_variables.contains(&(Some(team), name.clone()))
+            || self.team_variables.contains(&(None, name))
     }
 
     fn team_names(&self) -> Vec<String> {
