@@ -1,4 +1,4 @@
-//! Tokens and the chumsky lexer. Comments and whitespace are dropped; characters
+//! Tokens and the lexer (a hand-written scanner, see [`lex`]). Comments and whitespace are dropped; characters
 //! the language does not use become [`Token::Error`] so the parser can go on.
 
 use crate::span::Span;
@@ -222,98 +222,138 @@ impl fmt::Display for Token<'_> {
 
 pub type Spanned<'src> = (Token<'src>, SimpleSpan);
 
-fn lexer<'src>() -> impl Parser<'src, &'src str, Vec<Spanned<'src>>, extra::Default> {
-    let word = text::ascii::ident().map(|word: &str| match Kw::from_word(word) {
-        Some(kw) => Token::Kw(kw),
-        None => Token::Ident(word),
-    });
-
-    let number = just('-')
-        .or_not()
-        .then(text::digits(10))
-        .then(just('.').then(text::digits(10)).or_not())
-        .to_slice()
-        .map(Token::Number);
-
-    let escape = just('\\').then(none_of('\n'));
-    let string = just('"')
-        .ignore_then(escape.ignored().or(none_of("\"\\\n").ignored()).repeated())
-        .ignore_then(just('"').or_not())
-        .map_with(|close, e| {
-            let raw: &str = e.slice();
-            match close {
-                Some(_) => Token::Str(raw),
-                None => Token::Unterminated(raw),
-            }
-        });
-
-    let two_chars = choice((
-        just("[[").to(Token::GroupOpen),
-        just("]]").to(Token::GroupClose),
-        just("==").to(Token::EqEq),
-        just("!=").to(Token::NotEq),
-        just("<=").to(Token::Le),
-        just(">=").to(Token::Ge),
-        just("&&").to(Token::AndAnd),
-        just("||").to(Token::OrOr),
-    ));
-    // Punctuation that never starts a two-character operator, matched first.
-    let single = select! {
-        '{' => Token::LBrace,
-        '}' => Token::RBrace,
-        '(' => Token::LParen,
-        ')' => Token::RParen,
-        ':' => Token::Colon,
-        ';' => Token::Semi,
-        ',' => Token::Comma,
-        '.' => Token::Dot,
-    };
-    let prefix_of_two = select! {
-        '[' => Token::LBracket,
-        ']' => Token::RBracket,
-        '=' => Token::Assign,
-        '<' => Token::Lt,
-        '>' => Token::Gt,
-        '!' => Token::Bang,
-    };
-
-    let token = choice((
-        word,
-        single,
-        string,
-        number,
-        two_chars,
-        prefix_of_two,
-        // An unknown character, with the ones right after it that cannot
-        // start a token either: junk is one token per run, not per byte.
-        any().map(Token::Error).then_ignore(unknown_run_rest()),
-    ));
-
-    // Whitespace and `#` comments, skipped in one tight loop: trivia is most of
-    // the characters of a script, and combinators per character cost far more.
-    let trivia = custom::<_, &'src str, (), extra::Default>(|inp| {
-        while let Some(c) = inp.peek() {
-            if c == '#' {
-                while inp.peek().is_some_and(|c| c != '\n') {
-                    inp.skip();
-                }
-            } else if c.is_whitespace() {
-                inp.skip();
-            } else {
-                break;
-            }
+/// The tokens of `text` in one pass over its bytes; whitespace and `#`
+/// comments are skipped. Written out rather than combined from parsers: the
+/// lexer reads every character of every file, and a combinator per
+/// character cost it about seventy instructions a byte.
+///
+/// - A word is `[A-Za-z_][A-Za-z0-9_]*`; a reserved one is a [`Kw`].
+/// - A number is `-?[0-9]+(\.[0-9]+)?` (a `.` not followed by a digit is a
+///   [`Token::Dot`] after the number).
+/// - A string runs from `"` to the next unescaped `"`; a `\` escapes any
+///   character but a newline. Without its closing quote on the line it is a
+///   [`Token::Unterminated`] that ends before the newline (or the `\` that
+///   precedes it).
+/// - Two-character operators are taken before their one-character prefixes.
+/// - Any other character is a [`Token::Error`], with the characters right
+///   after it that cannot start a token either: one token per run of junk.
+fn scan(text: &str) -> Vec<Spanned<'_>> {
+    let bytes = text.as_bytes();
+    let at = |i: usize| bytes.get(i).copied();
+    let mut out = Vec::with_capacity(text.len() / 4);
+    let mut i = 0;
+    while let Some(b) = at(i) {
+        if b == b'#' {
+            i += bytes[i..]
+                .iter()
+                .position(|&c| c == b'\n')
+                .unwrap_or(bytes.len() - i);
+            continue;
         }
-        Ok(())
-    });
-
-    trivia
-        .ignore_then(token.map_with(|tok, e| (tok, e.span())))
-        .repeated()
-        .collect()
-        .then_ignore(trivia)
+        if b.is_ascii_whitespace() || b == 0x0B {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        let token = match b {
+            b'a'..=b'z' | b'A'..=b'Z' | b'_' => {
+                i += 1;
+                while at(i).is_some_and(|c| c.is_ascii_alphanumeric() || c == b'_') {
+                    i += 1;
+                }
+                let word = &text[start..i];
+                Kw::from_word(word).map_or(Token::Ident(word), Token::Kw)
+            }
+            b'{' | b'}' | b'(' | b')' | b':' | b';' | b',' | b'.' => {
+                i += 1;
+                match b {
+                    b'{' => Token::LBrace,
+                    b'}' => Token::RBrace,
+                    b'(' => Token::LParen,
+                    b')' => Token::RParen,
+                    b':' => Token::Colon,
+                    b';' => Token::Semi,
+                    b',' => Token::Comma,
+                    _ => Token::Dot,
+                }
+            }
+            b'"' => {
+                i += 1;
+                loop {
+                    match at(i) {
+                        Some(b'"') => {
+                            i += 1;
+                            break Token::Str(&text[start..i]);
+                        }
+                        Some(b'\\') if at(i + 1).is_some_and(|c| c != b'\n') => i += 2,
+                        Some(b'\\' | b'\n') | None => break Token::Unterminated(&text[start..i]),
+                        // A byte of a longer character is never one of the above.
+                        Some(_) => i += 1,
+                    }
+                }
+            }
+            b'0'..=b'9' | b'-' if b != b'-' || at(i + 1).is_some_and(|c| c.is_ascii_digit()) => {
+                let digits = |mut i: usize| {
+                    while at(i).is_some_and(|c| c.is_ascii_digit()) {
+                        i += 1;
+                    }
+                    i
+                };
+                i = digits(if b == b'-' { i + 1 } else { i });
+                if at(i) == Some(b'.') && at(i + 1).is_some_and(|c| c.is_ascii_digit()) {
+                    i = digits(i + 1);
+                }
+                Token::Number(&text[start..i])
+            }
+            _ => {
+                let pair = match (b, at(i + 1)) {
+                    (b'[', Some(b'[')) => Some(Token::GroupOpen),
+                    (b']', Some(b']')) => Some(Token::GroupClose),
+                    (b'=', Some(b'=')) => Some(Token::EqEq),
+                    (b'!', Some(b'=')) => Some(Token::NotEq),
+                    (b'<', Some(b'=')) => Some(Token::Le),
+                    (b'>', Some(b'=')) => Some(Token::Ge),
+                    (b'&', Some(b'&')) => Some(Token::AndAnd),
+                    (b'|', Some(b'|')) => Some(Token::OrOr),
+                    _ => None,
+                };
+                let single = match b {
+                    b'[' => Some(Token::LBracket),
+                    b']' => Some(Token::RBracket),
+                    b'=' => Some(Token::Assign),
+                    b'<' => Some(Token::Lt),
+                    b'>' => Some(Token::Gt),
+                    b'!' => Some(Token::Bang),
+                    _ => None,
+                };
+                if let Some(token) = pair {
+                    i += 2;
+                    token
+                } else if let Some(token) = single {
+                    i += 1;
+                    token
+                } else {
+                    let c = text[i..].chars().next().expect("a character starts here");
+                    i += c.len_utf8();
+                    if c.is_whitespace() {
+                        continue;
+                    }
+                    for rest in text[i..].chars() {
+                        if !never_starts_token(rest) {
+                            break;
+                        }
+                        i += rest.len_utf8();
+                    }
+                    Token::Error(c)
+                }
+            }
+        };
+        out.push((token, SimpleSpan::from(start..i)));
+    }
+    out
 }
 
-/// Whether `c` can never start a token or trivia (see the lexer above): such
+/// Whether `c` can never start a token or trivia (see [`scan`]): such
 /// characters after an unknown one join its run.
 fn never_starts_token(c: char) -> bool {
     !(c.is_ascii_alphanumeric()
@@ -322,20 +362,16 @@ fn never_starts_token(c: char) -> bool {
         || "-\"{}():;,.[]=<>!&|#".contains(c))
 }
 
-/// The rest of a run of unknown characters, skipped in one tight loop.
-fn unknown_run_rest<'src>() -> impl Parser<'src, &'src str, (), extra::Default> + Clone {
-    custom::<_, &'src str, (), extra::Default>(|inp| {
-        while inp.peek().is_some_and(never_starts_token) {
-            inp.skip();
-        }
-        Ok(())
-    })
-}
-
 /// Splits `text` into tokens. Never fails: unknown characters and unterminated
 /// strings become tokens that the parser reports.
 pub fn lex(text: &str) -> Vec<Spanned<'_>> {
-    let tokens = lexer().parse(text).into_output().unwrap_or_default();
+    let tokens = scan(text);
+    if !tokens
+        .iter()
+        .any(|(t, _)| matches!(t, Token::Unterminated(_)))
+    {
+        return tokens;
+    }
     let mut out = Vec::with_capacity(tokens.len());
     for (tok, span) in tokens {
         match tok {
@@ -346,9 +382,8 @@ pub fn lex(text: &str) -> Vec<Spanned<'_>> {
                         Token::Unterminated(&raw[..cut]),
                         SimpleSpan::from(span.start..end),
                     ));
-                    let rest = lexer().parse(&text[end..span.end]).into_output();
                     out.extend(
-                        rest.unwrap_or_default()
+                        scan(&text[end..span.end])
                             .into_iter()
                             .map(|(t, s)| (t, SimpleSpan::from(s.start + end..s.end + end))),
                     );
@@ -470,6 +505,95 @@ mod tests {
             assert_eq!(Kw::from_word(kw.as_str()), Some(kw));
         }
         assert_eq!(Kw::from_word("If"), None);
+    }
+
+    #[test]
+    fn numbers_minus_signs_and_dots_lex_as_the_grammar_says() {
+        assert_eq!(
+            kinds("-4 - x 1.5 2. 3.y 7ab"),
+            vec![
+                Token::Number("-4"),
+                Token::Error('-'),
+                Token::Ident("x"),
+                Token::Number("1.5"),
+                Token::Number("2"),
+                Token::Dot,
+                Token::Number("3"),
+                Token::Dot,
+                Token::Ident("y"),
+                Token::Number("7"),
+                Token::Ident("ab"),
+            ]
+        );
+    }
+
+    #[test]
+    fn a_string_ends_at_its_quote_or_before_the_end_of_its_line() {
+        assert_eq!(
+            kinds("\"a\\\"\" \"b\\\nc \"d\u{a0}\nx"),
+            vec![
+                Token::Str("\"a\\\"\""),
+                Token::Unterminated("\"b"),
+                Token::Error('\\'),
+                Token::Ident("c"),
+                Token::Unterminated("\"d\u{a0}"),
+                Token::Ident("x"),
+            ]
+        );
+    }
+
+    #[test]
+    fn operators_take_two_characters_before_one_and_junk_runs_are_one_token() {
+        assert_eq!(
+            kinds("[[[ ]]] <= < == = != ! && & || | @~é x\u{2028}#c\ny"),
+            vec![
+                Token::GroupOpen,
+                Token::LBracket,
+                Token::GroupClose,
+                Token::RBracket,
+                Token::Le,
+                Token::Lt,
+                Token::EqEq,
+                Token::Assign,
+                Token::NotEq,
+                Token::Bang,
+                Token::AndAnd,
+                Token::Error('&'),
+                Token::OrOr,
+                Token::Error('|'),
+                Token::Error('@'),
+                Token::Ident("x"),
+                Token::Ident("y"),
+            ]
+        );
+    }
+
+    proptest::proptest! {
+        /// Whatever the text, the tokens follow each other on character
+        /// boundaries, each non-empty, with only whitespace and comments
+        /// between them.
+        #[test]
+        fn tokens_tile_the_text_but_for_whitespace_and_comments(
+            pieces in proptest::collection::vec(proptest::sample::select(vec![
+                "a", "Z", "_", "if", "x1", "0", "9", "-", ".", "\"", "\\", "\n", " ", "\t",
+                "\u{b}", "\r", "#", "{", "}", "(", ")", ":", ";", ",", "[", "]", "=", "<", ">",
+                "!", "&", "|", "@", "é", "😀", "\u{a0}", "\u{2028}", "$",
+            ]), 0..40)
+        ) {
+            let text: String = pieces.concat();
+            let mut end = 0;
+            for (token, span) in lex(&text) {
+                proptest::prop_assert!(span.start < span.end, "{:?} empty in {:?}", token, text);
+                proptest::prop_assert!(text.is_char_boundary(span.start) && text.is_char_boundary(span.end));
+                let gap = &text[end..span.start];
+                let trivia = gap.split('\n').all(|line| {
+                    let code = line.split_once('#').map_or(line, |(code, _)| code);
+                    code.chars().all(char::is_whitespace)
+                });
+                proptest::prop_assert!(trivia, "{:?} between tokens in {:?}", gap, text);
+                end = span.end;
+            }
+        }
     }
 
     #[test]
