@@ -83,6 +83,7 @@ static bool g_subscribed;
 static int g_connect_refused; /* the broker's CONNACK code when it refused */
 static bool g_connected_once, g_session_present; /* the first CONNACK's session-present flag */
 static int g_subscribe_mid = -1;
+static unsigned long g_opened; /* opens so far: a topic named under an earlier open is not reused */
 static long g_unacked; /* messages handed to libmosquitto whose on_publish has not come */
 /* Acknowledgements (on_publish) and disconnections wake, on g_acked, only
  * those who wait for them: close (g_closing) and sends finding
@@ -390,6 +391,7 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     g_connect_refused = 0;
     g_subscribe_mid = -1;
     g_unacked = 0;
+    g_opened++;
     g_closing = g_connected = false;
     g_ack_waiters = 0;
     g_out_head = g_out_count = 0;
@@ -519,18 +521,13 @@ static void outbox_flush(void)
     pthread_mutex_unlock(&g_send_lock);
 }
 
-/* `to` is a team (every robot of it hears) or one robot's name. */
-static int mqtt_send_to(const char *to, const void *data, size_t len)
+/* The topic of a message to `to` (a team or a robot of the mission, or
+ * USER) with `key` from us; false when there is none or it does not fit. */
+static bool topic_to(const char *to, const char *key, char *topic, size_t cap)
 {
-    if (!g_mosq || len < 6 || len > MQTT_PAYLOAD_MAX)
-        return -1;
-    char key[256];
-    if (!datagram_field(data, len, 2, key, sizeof key))
-        return -1;
     /* The sender levels are ours, whatever the datagram says: the broker
      * lets our user write only those. */
     const semo_peer *self = &g_program->peers[g_program->self];
-    char topic[MQTT_TOPIC_MAX];
     bool team = false;
     const semo_peer *robot = NULL;
     for (size_t i = 0; i < g_program->peer_count; i++) {
@@ -539,15 +536,38 @@ static int mqtt_send_to(const char *to, const void *data, size_t len)
         else if (strcmp(g_program->peers[i].robot, to) == 0)
             robot = &g_program->peers[i];
     }
-    bool fits;
     if (team || strcmp(to, "USER") == 0) /* USER: every operator console */
-        fits = topic_of(topic, sizeof topic, to, NULL, key, self->team, self->robot);
-    else if (robot)
-        fits = topic_of(topic, sizeof topic, robot->team, robot->robot, key, self->team, self->robot);
-    else
+        return topic_of(topic, cap, to, NULL, key, self->team, self->robot);
+    if (robot)
+        return topic_of(topic, cap, robot->team, robot->robot, key, self->team, self->robot);
+    return false;
+}
+
+/* `to` is a team (every robot of it hears) or one robot's name. */
+static int mqtt_send_to(const char *to, const void *data, size_t len)
+{
+    if (!g_mosq || len < 6 || len > MQTT_PAYLOAD_MAX)
         return -1;
-    if (!fits)
+    char key[256];
+    if (!datagram_field(data, len, 2, key, sizeof key))
         return -1;
+    /* The topic this thread named last, when it is the same (a robot sends
+     * the same key to the same team many times in a row): built only
+     * once, not at every message. */
+    static _Thread_local struct {
+        unsigned long opened; /* g_opened when it was built: another open, another scope */
+        char to[256], key[256], topic[MQTT_TOPIC_MAX];
+    } last;
+    if (last.opened != g_opened || strcmp(last.to, to) != 0 || strcmp(last.key, key) != 0) {
+        if (strlen(to) >= sizeof last.to || !topic_to(to, key, last.topic, sizeof last.topic)) {
+            last.opened = 0;
+            return -1;
+        }
+        memcpy(last.to, to, strlen(to) + 1);
+        memcpy(last.key, key, strlen(key) + 1);
+        last.opened = g_opened;
+    }
+    const char *topic = last.topic;
     bool is_send = ((const unsigned char *)data)[5] == SEMO_MSG_SEND;
     if (!is_send) {
         /* A publish while disconnected is lost, as on UDP: the next one
@@ -562,10 +582,11 @@ static int mqtt_send_to(const char *to, const void *data, size_t len)
      * on_connect (the network thread, the one that reads the
      * acknowledgements) takes to flush the outbox. */
     pthread_mutex_lock(&g_lock);
-    g_ack_waiters++;
-    while (g_unacked >= MQTT_UNACKED_MAX && g_connected && !g_interrupted)
+    while (g_unacked >= MQTT_UNACKED_MAX && g_connected && !g_interrupted) {
+        g_ack_waiters++;
         pthread_cond_wait(&g_acked, &g_lock);
-    g_ack_waiters--;
+        g_ack_waiters--;
+    }
     pthread_mutex_unlock(&g_lock);
     /* A send is never lost: while the broker is away (libmosquitto refuses
      * to publish then) it waits in the outbox, in order, until on_connect. */

@@ -188,9 +188,28 @@ static FILE *g_trace;
 static bool g_trace_owned; /* false for "-" (stdout) */
 static pthread_mutex_t g_trace_lock = PTHREAD_MUTEX_INITIALIZER;
 
-static void put_file(void *file, const char *bytes, size_t n)
+/* A trace line is written in many small pieces (each field, each escaped
+ * run of a string): they are gathered here and given to stdio at once, not
+ * one locked fwrite a piece (a sixth of a sending robot's instructions). */
+typedef struct {
+    FILE *file;
+    size_t len;
+    char bytes[1024];
+} line_buffer;
+
+static void put_line(void *ctx, const char *bytes, size_t n)
 {
-    fwrite(bytes, 1, n, (FILE *)file);
+    line_buffer *line = ctx;
+    if (line->len + n > sizeof line->bytes) {
+        fwrite(line->bytes, 1, line->len, line->file);
+        line->len = 0;
+        if (n > sizeof line->bytes) {
+            fwrite(bytes, 1, n, line->file);
+            return;
+        }
+    }
+    memcpy(line->bytes + line->len, bytes, n);
+    line->len += n;
 }
 
 static void observe_status(const char *event, va_list args);
@@ -204,8 +223,12 @@ void semo__trace_emit(const char *event, const char *value_key, const semo_value
     pthread_mutex_lock(&g_trace_lock);
     if (g_trace) {
         /* The time is read under the lock so that lines are in time order. */
-        semo__sink sink = {put_file, g_trace};
+        line_buffer line;
+        line.file = g_trace;
+        line.len = 0;
+        semo__sink sink = {put_line, &line};
         semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args, value_key, value);
+        fwrite(line.bytes, 1, line.len, g_trace);
         fflush(g_trace);
     }
     pthread_mutex_unlock(&g_trace_lock);
