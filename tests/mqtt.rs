@@ -2836,3 +2836,8 @@ fn group_service_over_mqtt_redivides_when_a_member_fails_and_returns() {
 /// takeovers), all `#[ignore]`d.
 #[path = "mqtt/stress.rs"]
 mod stress;
+
+/// One robot's send path at QoS 1: every message once and in order, and
+/// (ignored) its rate next to `mosquitto_pub`'s and its memory.
+#[path = "mqtt/send_rate.rs"]
+mod send_rate;

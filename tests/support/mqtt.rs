@@ -358,6 +358,11 @@ impl Fleet {
         self.broker = Some(index);
     }
 
+    /// The broker's process, while it runs.
+    pub fn broker_process(&self) -> Option<&Child> {
+        self.broker.map(|index| &self.processes.0[index])
+    }
+
     /// Stops the broker as a service stop does (it saves its state).
     pub fn stop_broker(&mut self) {
         if let Some(index) = self.broker.take() {

@@ -915,6 +915,25 @@ int semo_port_offer(int port, const void *buf, size_t size)
     return write_waiting(port, buf, size, false);
 }
 
+/* Taken and sent under the channel's lock: two threads forwarding from
+ * one channel (CommSend, and the control task running CommSend's body when
+ * it finishes) send in the order they took, never the other way round. */
+bool semo_port_forward(int port, const char *to_team, semo_msg_kind kind, const char *key)
+{
+    semo__ring r;
+    if (!semo__channel_ring(port, &r) || r.sample_size != sizeof(semo_value))
+        return false;
+    semo_value v;
+    semo__queue_lock(port);
+    bool taken = ring_take(&r, &v);
+    if (taken)
+        semo_comm_send(to_team, kind, key, &v);
+    semo__queue_unlock(port);
+    if (taken)
+        semo__queue_taken(port);
+    return taken;
+}
+
 int UFPort_GetNumOfAvailableData(int port)
 {
     semo__ring r;

@@ -56,6 +56,18 @@
  * the acknowledgements of QoS 1 messages still in flight (wall ms). */
 #define MQTT_OPEN_WAIT_MS 5000
 #define MQTT_CLOSE_WAIT_MS 2000
+/* QoS 1 messages sent and not yet acknowledged, at most (libmosquitto's
+ * MOSQ_OPT_SEND_MAXIMUM; more wait, in order, in its queue): the broker's
+ * rate times a loaded machine's scheduling delay of a few ms (20k/s × 3 ms),
+ * where libmosquitto's default of 20 made the sender wait on loopback. */
+#define MQTT_SEND_WINDOW 64
+/* Messages handed to libmosquitto and not yet acknowledged, at most, while
+ * connected: beyond the window libmosquitto queues each one it is given
+ * (allocated), so a robot sending faster than the broker acknowledges
+ * would grow without bound; a send waits for acknowledgements instead
+ * (back-pressure, as the message channels give). Not while disconnected:
+ * a send then waits in the outbox (MQTT_OUTBOX). */
+#define MQTT_UNACKED_MAX (4 * MQTT_SEND_WINDOW)
 
 static struct mosquitto *g_mosq;
 static const semo_program_desc *g_program;
@@ -71,7 +83,16 @@ static bool g_subscribed;
 static int g_connect_refused; /* the broker's CONNACK code when it refused */
 static bool g_connected_once, g_session_present; /* the first CONNACK's session-present flag */
 static int g_subscribe_mid = -1;
+static unsigned long g_opened; /* opens so far: a topic named under an earlier open is not reused */
 static long g_unacked; /* messages handed to libmosquitto whose on_publish has not come */
+/* Acknowledgements (on_publish) and disconnections wake, on g_acked, only
+ * those who wait for them: close (g_closing) and sends finding
+ * MQTT_UNACKED_MAX unacknowledged (g_ack_waiters). Waking the receiver
+ * (which waits on g_changed) at every one cost a thread switch a message. */
+static pthread_cond_t g_acked; /* monotonic clock */
+static bool g_closing;
+static int g_ack_waiters;
+static bool g_connected; /* between a CONNACK that accepted and a disconnection */
 
 /* Sends made while the broker was unreachable, oldest first; g_send_lock
  * also keeps sends in order against the flush (never held by a callback
@@ -191,6 +212,7 @@ static void on_connect(struct mosquitto *mosq, void *obj, int rc, int flags)
         if (!g_connected_once)
             g_session_present = (flags & 1) != 0;
         g_connected_once = true;
+        g_connected = true;
         pthread_mutex_unlock(&g_lock);
     }
     if (rc != 0) {
@@ -212,6 +234,19 @@ static void on_connect(struct mosquitto *mosq, void *obj, int rc, int flags)
         pthread_mutex_unlock(&g_lock);
     }
     outbox_flush();
+}
+
+/* A send waiting for acknowledgements gives up waiting: until the next
+ * connection, sends go to the outbox. */
+static void on_disconnect(struct mosquitto *mosq, void *obj, int rc)
+{
+    (void)mosq;
+    (void)obj;
+    (void)rc;
+    pthread_mutex_lock(&g_lock);
+    g_connected = false;
+    pthread_cond_broadcast(&g_acked);
+    pthread_mutex_unlock(&g_lock);
 }
 
 static void on_subscribe(struct mosquitto *mosq, void *obj, int mid, int count, const int *granted)
@@ -236,7 +271,8 @@ static void on_publish(struct mosquitto *mosq, void *obj, int mid)
     pthread_mutex_lock(&g_lock);
     if (g_unacked > 0)
         g_unacked--;
-    pthread_cond_broadcast(&g_changed);
+    if (g_closing || g_ack_waiters > 0)
+        pthread_cond_broadcast(&g_acked);
     pthread_mutex_unlock(&g_lock);
 }
 
@@ -355,11 +391,15 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     g_connect_refused = 0;
     g_subscribe_mid = -1;
     g_unacked = 0;
+    g_opened++;
+    g_closing = g_connected = false;
+    g_ack_waiters = 0;
     g_out_head = g_out_count = 0;
     pthread_condattr_t attr;
     pthread_condattr_init(&attr);
     pthread_condattr_setclock(&attr, CLOCK_MONOTONIC);
     pthread_cond_init(&g_changed, &attr);
+    pthread_cond_init(&g_acked, &attr);
     pthread_condattr_destroy(&attr);
 
     mosquitto_lib_init();
@@ -380,6 +420,7 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
         return -1;
     }
     mosquitto_int_option(g_mosq, MOSQ_OPT_TCP_NODELAY, 1);
+    mosquitto_int_option(g_mosq, MOSQ_OPT_SEND_MAXIMUM, MQTT_SEND_WINDOW);
     /* If we vanish without disconnecting, the broker says so on our status. */
     char will_topic[MQTT_TOPIC_MAX], will[MQTT_TOPIC_MAX];
     status_topic(will_topic, sizeof will_topic);
@@ -389,6 +430,7 @@ static int mqtt_open(const semo_program_desc *program, const semo_transport_conf
     mosquitto_will_set(g_mosq, will_topic, will_len, will, 1, true);
     mosquitto_connect_with_flags_callback_set(g_mosq, on_connect);
     mosquitto_subscribe_callback_set(g_mosq, on_subscribe);
+    mosquitto_disconnect_callback_set(g_mosq, on_disconnect);
     mosquitto_publish_callback_set(g_mosq, on_publish);
     mosquitto_message_callback_set(g_mosq, on_message);
     /* After a lost connection the network thread reconnects by itself. */
@@ -479,18 +521,13 @@ static void outbox_flush(void)
     pthread_mutex_unlock(&g_send_lock);
 }
 
-/* `to` is a team (every robot of it hears) or one robot's name. */
-static int mqtt_send_to(const char *to, const void *data, size_t len)
+/* The topic of a message to `to` (a team or a robot of the mission, or
+ * USER) with `key` from us; false when there is none or it does not fit. */
+static bool topic_to(const char *to, const char *key, char *topic, size_t cap)
 {
-    if (!g_mosq || len < 6 || len > MQTT_PAYLOAD_MAX)
-        return -1;
-    char key[256];
-    if (!datagram_field(data, len, 2, key, sizeof key))
-        return -1;
     /* The sender levels are ours, whatever the datagram says: the broker
      * lets our user write only those. */
     const semo_peer *self = &g_program->peers[g_program->self];
-    char topic[MQTT_TOPIC_MAX];
     bool team = false;
     const semo_peer *robot = NULL;
     for (size_t i = 0; i < g_program->peer_count; i++) {
@@ -499,15 +536,38 @@ static int mqtt_send_to(const char *to, const void *data, size_t len)
         else if (strcmp(g_program->peers[i].robot, to) == 0)
             robot = &g_program->peers[i];
     }
-    bool fits;
     if (team || strcmp(to, "USER") == 0) /* USER: every operator console */
-        fits = topic_of(topic, sizeof topic, to, NULL, key, self->team, self->robot);
-    else if (robot)
-        fits = topic_of(topic, sizeof topic, robot->team, robot->robot, key, self->team, self->robot);
-    else
+        return topic_of(topic, cap, to, NULL, key, self->team, self->robot);
+    if (robot)
+        return topic_of(topic, cap, robot->team, robot->robot, key, self->team, self->robot);
+    return false;
+}
+
+/* `to` is a team (every robot of it hears) or one robot's name. */
+static int mqtt_send_to(const char *to, const void *data, size_t len)
+{
+    if (!g_mosq || len < 6 || len > MQTT_PAYLOAD_MAX)
         return -1;
-    if (!fits)
+    char key[256];
+    if (!datagram_field(data, len, 2, key, sizeof key))
         return -1;
+    /* The topic this thread named last, when it is the same (a robot sends
+     * the same key to the same team many times in a row): built only
+     * once, not at every message. */
+    static _Thread_local struct {
+        unsigned long opened; /* g_opened when it was built: another open, another scope */
+        char to[256], key[256], topic[MQTT_TOPIC_MAX];
+    } last;
+    if (last.opened != g_opened || strcmp(last.to, to) != 0 || strcmp(last.key, key) != 0) {
+        if (strlen(to) >= sizeof last.to || !topic_to(to, key, last.topic, sizeof last.topic)) {
+            last.opened = 0;
+            return -1;
+        }
+        memcpy(last.to, to, strlen(to) + 1);
+        memcpy(last.key, key, strlen(key) + 1);
+        last.opened = g_opened;
+    }
+    const char *topic = last.topic;
     bool is_send = ((const unsigned char *)data)[5] == SEMO_MSG_SEND;
     if (!is_send) {
         /* A publish while disconnected is lost, as on UDP: the next one
@@ -517,6 +577,17 @@ static int mqtt_send_to(const char *to, const void *data, size_t len)
         int rc = publish(topic, data, len, 0, false);
         return rc == MOSQ_ERR_SUCCESS || rc == MOSQ_ERR_NO_CONN ? 0 : -1;
     }
+    /* Back-pressure: never more than MQTT_UNACKED_MAX in libmosquitto's
+     * hands while connected. Waited for outside g_send_lock, which
+     * on_connect (the network thread, the one that reads the
+     * acknowledgements) takes to flush the outbox. */
+    pthread_mutex_lock(&g_lock);
+    while (g_unacked >= MQTT_UNACKED_MAX && g_connected && !g_interrupted) {
+        g_ack_waiters++;
+        pthread_cond_wait(&g_acked, &g_lock);
+        g_ack_waiters--;
+    }
+    pthread_mutex_unlock(&g_lock);
     /* A send is never lost: while the broker is away (libmosquitto refuses
      * to publish then) it waits in the outbox, in order, until on_connect. */
     pthread_mutex_lock(&g_send_lock);
@@ -556,6 +627,7 @@ static void mqtt_interrupt(void)
     pthread_mutex_lock(&g_lock);
     g_interrupted = true;
     pthread_cond_broadcast(&g_changed);
+    pthread_cond_broadcast(&g_acked);
     pthread_mutex_unlock(&g_lock);
 }
 
@@ -567,9 +639,10 @@ static void mqtt_close(void)
      * disconnection libmosquitto forgets its queue. */
     struct timespec deadline = semo__deadline_after(MQTT_CLOSE_WAIT_MS);
     pthread_mutex_lock(&g_lock);
+    g_closing = true;
     int waited = 0;
     while (g_unacked > 0 && waited == 0)
-        waited = pthread_cond_timedwait(&g_changed, &g_lock, &deadline);
+        waited = pthread_cond_timedwait(&g_acked, &g_lock, &deadline);
     pthread_mutex_unlock(&g_lock);
     mosquitto_disconnect(g_mosq);
     mosquitto_loop_stop(g_mosq, false);
@@ -577,6 +650,7 @@ static void mqtt_close(void)
     g_mosq = NULL;
     mosquitto_lib_cleanup();
     pthread_cond_destroy(&g_changed);
+    pthread_cond_destroy(&g_acked);
     /* Sends the broker never came back for are lost with the program. */
     for (; g_out_count > 0; g_out_count--) {
         free(g_outbox[g_out_head]);

@@ -188,9 +188,28 @@ static FILE *g_trace;
 static bool g_trace_owned; /* false for "-" (stdout) */
 static pthread_mutex_t g_trace_lock = PTHREAD_MUTEX_INITIALIZER;
 
-static void put_file(void *file, const char *bytes, size_t n)
+/* A trace line is written in many small pieces (each field, each escaped
+ * run of a string): they are gathered here and given to stdio at once, not
+ * one locked fwrite a piece (a sixth of a sending robot's instructions). */
+typedef struct {
+    FILE *file;
+    size_t len;
+    char bytes[1024];
+} line_buffer;
+
+static void put_line(void *ctx, const char *bytes, size_t n)
 {
-    fwrite(bytes, 1, n, (FILE *)file);
+    line_buffer *line = ctx;
+    if (line->len + n > sizeof line->bytes) {
+        fwrite(line->bytes, 1, line->len, line->file);
+        line->len = 0;
+        if (n > sizeof line->bytes) {
+            fwrite(bytes, 1, n, line->file);
+            return;
+        }
+    }
+    memcpy(line->bytes + line->len, bytes, n);
+    line->len += n;
 }
 
 static void observe_status(const char *event, va_list args);
@@ -204,8 +223,12 @@ void semo__trace_emit(const char *event, const char *value_key, const semo_value
     pthread_mutex_lock(&g_trace_lock);
     if (g_trace) {
         /* The time is read under the lock so that lines are in time order. */
-        semo__sink sink = {put_file, g_trace};
+        line_buffer line;
+        line.file = g_trace;
+        line.len = 0;
+        semo__sink sink = {put_line, &line};
         semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args, value_key, value);
+        fwrite(line.bytes, 1, line.len, g_trace);
         fflush(g_trace);
     }
     pthread_mutex_unlock(&g_trace_lock);
@@ -221,6 +244,7 @@ typedef struct {
     pthread_mutex_t lock;
     pthread_cond_t readable; /* a write for the reader; a take or a reader's firing for a writer */
     struct task_s *reader; /* the task reading it, woken by a write */
+    struct task_s *writer; /* the task writing it (semo_port_await_sends) */
     atomic_int room_waiters; /* writers waiting for room (semo__queue_wait_room) */
 } channel;
 
@@ -268,6 +292,24 @@ bool semo__queue_wait(int queue, int64_t deadline_ms)
     return true;
 }
 
+/* semo_port_await_sends: a send task waiting for the rest of its writer's
+ * firing. One condition for all its channels (it waits on several), told
+ * only while someone waits (`g_send_waiters`, counted under `g_sends_lock`
+ * before the channels are looked at: a write or a firing's end after that
+ * look finds the count and takes the lock to broadcast). */
+static pthread_mutex_t g_sends_lock = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t g_sends_cond;
+static atomic_int g_send_waiters;
+
+static void tell_send_waiters(void)
+{
+    if (atomic_load(&g_send_waiters) == 0)
+        return;
+    pthread_mutex_lock(&g_sends_lock);
+    cond_broadcast(&g_sends_cond);
+    pthread_mutex_unlock(&g_sends_lock);
+}
+
 /* A waiter looks at the count under the lock before it waits, so a signal
  * after the lock is released is never missed. */
 void semo__queue_written(int queue)
@@ -278,6 +320,7 @@ void semo__queue_written(int queue)
     } else {
         cond_signal(&g_channels[queue].readable);
         wake_task(g_channels[queue].reader);
+        tell_send_waiters();
     }
 }
 
@@ -432,10 +475,12 @@ bool semo__queue_wait_room(int queue, semo__room_wait *room)
     return wait;
 }
 
-/* After a firing of `t`: writers waiting for room in its channels look again. */
+/* After a firing of `t`: writers waiting for room in its channels look
+ * again, and so does a send task waiting for the rest of the firing. */
 static void firing_ended(task *t)
 {
     atomic_fetch_add(&t->firings_ended, 1);
+    tell_send_waiters();
     for (size_t i = 0; g_prog && i < g_prog->channel_count; i++) {
         channel *c = &g_channels[i];
         if (c->reader == t && atomic_load(&c->room_waiters) > 0) {
@@ -444,6 +489,39 @@ static void firing_ended(task *t)
             pthread_mutex_unlock(&c->lock);
         }
     }
+}
+
+/* Whether a channel holds a sample, or its writer (another thread's task)
+ * is in a firing that may still write to it. */
+static void look_at_channel(int port, bool *holds, bool *writing)
+{
+    channel *c = channel_at(port);
+    if (!c)
+        return;
+    pthread_mutex_lock(&c->lock);
+    *holds = *holds || c->state.count > 0;
+    pthread_mutex_unlock(&c->lock);
+    task *w = c->writer;
+    if (w && w != g_current && atomic_load(&w->firings_begun) > atomic_load(&w->firings_ended))
+        *writing = true;
+}
+
+bool semo_port_await_sends(const int *ports, size_t count)
+{
+    pthread_mutex_lock(&g_sends_lock);
+    atomic_fetch_add(&g_send_waiters, 1);
+    bool holds = false;
+    for (;;) {
+        bool writing = false;
+        for (size_t i = 0; i < count; i++)
+            look_at_channel(ports[i], &holds, &writing);
+        if (holds || !writing || !semo_running())
+            break;
+        wait_until(&g_sends_cond, &g_sends_lock, -1);
+    }
+    atomic_fetch_sub(&g_send_waiters, 1);
+    pthread_mutex_unlock(&g_sends_lock);
+    return holds;
 }
 
 void semo_next_firing(int64_t at_ms)
@@ -993,6 +1071,9 @@ void semo_stop_program(void)
         cond_broadcast(&g_channels[i].readable);
         pthread_mutex_unlock(&g_channels[i].lock);
     }
+    pthread_mutex_lock(&g_sends_lock);
+    cond_broadcast(&g_sends_cond);
+    pthread_mutex_unlock(&g_sends_lock);
     for (size_t i = 0; g_tasks && i < g_prog->task_count; i++) {
         pthread_mutex_lock(&g_tasks[i].lock);
         cond_broadcast(&g_tasks[i].changed);
@@ -1476,9 +1557,12 @@ static bool allocate_program_state(const semo_program_desc *p)
         pthread_mutex_init(&g_groups[i].lock, NULL);
     }
     for (size_t i = 0; i < p->channel_count; i++)
-        for (size_t k = 0; k < p->task_count; k++)
+        for (size_t k = 0; k < p->task_count; k++) {
             if (strcmp(p->channels[i].dst_task, p->tasks[k].name) == 0)
                 g_channels[i].reader = &g_tasks[k];
+            if (strcmp(p->channels[i].src_task, p->tasks[k].name) == 0)
+                g_channels[i].writer = &g_tasks[k];
+        }
     for (size_t i = 0; i < p->task_count; i++) {
         task *t = &g_tasks[i];
         t->desc = &p->tasks[i];
@@ -1742,6 +1826,7 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
         g_scale = o.time_scale > 0 ? o.time_scale : 1.0;
         init_cond(&g_run_cond);
         init_cond(&g_inbox_cond);
+        init_cond(&g_sends_cond);
         if (open_trace(o.trace) != 0) {
             status = 1;
         } else if (!allocate_program_state(program)) {

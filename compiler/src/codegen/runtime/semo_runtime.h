@@ -275,6 +275,15 @@ int semo_port_send(int port, const void *buf, size_t size);
  * next takes from the channel, a message that finds it full is dropped at
  * once (the channel is stalled). The simulator does the same. */
 int semo_port_offer(int port, const void *buf, size_t size);
+/* The send task's wait for the rest of a firing (CommSend, after taking
+ * what its channels `ports` held): true when one of them holds a message
+ * again; false once they are empty and their writer (the control task) is
+ * not in a firing, or the program is stopping. While that firing goes on
+ * it waits for its next send: the messages one control firing sends all
+ * leave in it, whatever the channel's room (16), instead of 16 or so a
+ * period. Never waits on the caller's own firing (the control task runs
+ * CommSend's body itself when it finishes), nor on the static schedule. */
+bool semo_port_await_sends(const int *ports, size_t count);
 
 /* ------------------------------------------------------------- multicast */
 
@@ -360,6 +369,11 @@ typedef struct {
  * "USER": the operator console, which only traces it and counts as one).
  * Returns the number of robots it was sent to, -1 on error. */
 int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value);
+/* The send task's step (CommSend): takes the oldest message of channel
+ * `port` and sends it (semo_comm_send) to `to_team` as `key`, both under
+ * the channel's lock, so that whoever takes first sends first; false when
+ * the channel is empty. Never blocks on an empty channel. */
+bool semo_port_forward(int port, const char *to_team, semo_msg_kind kind, const char *key);
 /* The next message received (operator commands of the simulation arrive
  * here too, from team "USER"); waits at most `timeout_ms` mission ms
  * (< 0: until a message arrives or the program stops).
