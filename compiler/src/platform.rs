@@ -97,10 +97,33 @@ pub struct Board {
     pub timer: &'static str,
     /// The serial port the trace goes to.
     pub serial: &'static str,
+    /// The serial link to `semo gateway` for a robot that messages other
+    /// robots; `None`: the board has none yet, and such a robot is refused
+    /// (E103).
+    pub link: Option<SerialLink>,
     /// The emulator `make run` starts, and its machine.
     pub emulator: &'static str,
     pub machine: &'static str,
 }
+
+/// A board's serial link to `semo gateway` (`docs/link.md`): what a robot
+/// that messages other robots adds to the board's program.
+#[derive(Debug, PartialEq, Eq)]
+pub struct SerialLink {
+    /// The serial port (`UART1`).
+    pub port: &'static str,
+    /// Its pins, for wiring a real board.
+    pub pins: &'static str,
+    /// Its default rate (`make SEMO_LINK_BAUD=...`).
+    pub baud: u32,
+    /// The runtime files the link adds (compiled only into the robots that
+    /// message other robots).
+    pub runtime: &'static [&'static str],
+}
+
+/// The runtime files of the serial link on a board: the frames and
+/// sessions, and the static schedule's transport over them.
+pub const LINK_RUNTIME: [&str; 3] = ["semo_link.h", "semo_link.c", "semo_static_link.c"];
 
 /// The cross toolchain of a board.
 #[derive(Debug, PartialEq, Eq)]
@@ -214,6 +237,12 @@ pub const PLATFORMS: &[Platform] = &[
             clock_hz: 12_000_000,
             timer: "SysTick",
             serial: "UART0",
+            link: Some(SerialLink {
+                port: "UART1",
+                pins: "U1Rx on PD2, U1Tx on PD3",
+                baud: 115_200,
+                runtime: &LINK_RUNTIME,
+            }),
             emulator: "qemu-system-arm",
             machine: "lm3s6965evb",
         }),
@@ -246,6 +275,7 @@ pub const PLATFORMS: &[Platform] = &[
             clock_hz: 168_000_000,
             timer: "SysTick",
             serial: "USART1",
+            link: None,
             emulator: "qemu-system-arm",
             machine: "netduinoplus2",
         }),
@@ -361,6 +391,12 @@ impl Target {
             .runtime
             .iter()
             .copied()
+            .chain(
+                board
+                    .and_then(|b| b.link.as_ref())
+                    .into_iter()
+                    .flat_map(|l| l.runtime.iter().copied()),
+            )
             .chain(board.map(|b| b.startup))
             .chain(board.map(|b| b.link_script))
     }
