@@ -328,3 +328,53 @@ fn the_messaging_evalbot_fits_the_flash_and_ram_budget() {
     assert!(flash <= 32 * 1024, "flash {flash} B > 32 KB");
     assert!(ram <= 8 * 1024, "RAM {ram} B > 8 KB");
 }
+
+/// Every example mission whose robots message each other (scouting, patrol,
+/// the swarms) builds for `cortex-m` with the link, and every robot
+/// compiles and links with arm-none-eabi-gcc at `-Wpedantic -Werror`
+/// (until the link they were refused, E103).
+#[test]
+fn every_example_builds_for_cortex_m_with_the_link_and_compiles() {
+    let test = "every_example_builds_for_cortex_m_with_the_link_and_compiles";
+    if !board_tools_present(test) {
+        return;
+    }
+    let out = robots::scratch("board-link-examples");
+    let mut linked = 0;
+    for mission in [
+        "scouting/scouting.mission",
+        "patrol/patrol.mission",
+        "swarm/march.mission",
+        "swarm/patrol_groups.mission",
+    ] {
+        let path = support::examples().join(mission);
+        let name = Path::new(mission).file_stem().unwrap().to_string_lossy();
+        let dir = out.join(name.as_ref());
+        let (path_arg, dir_arg) = (path.display().to_string(), dir.display().to_string());
+        let built = support::semo_in(
+            &support::repo_root(),
+            &["build", &path_arg, "--target", "cortex-m", "-o", &dir_arg],
+        );
+        assert_eq!(built.code, 0, "{mission}: {}{}", built.stdout, built.stderr);
+        for folder in robots::robot_folders(&dir) {
+            let makefile = std::fs::read_to_string(folder.join("Makefile")).unwrap();
+            linked += usize::from(makefile.contains(" -DSEMO_LINK "));
+            let made = Command::new("make")
+                .args([
+                    "-s",
+                    "-j2",
+                    "CFLAGS=-std=c11 -Wall -Wextra -Wpedantic -Werror -Os",
+                ])
+                .current_dir(&folder)
+                .output()
+                .expect("make runs");
+            let stderr = String::from_utf8_lossy(&made.stderr);
+            assert!(
+                made.status.success() && !stderr.contains("warning"),
+                "{}: {stderr}",
+                folder.display()
+            );
+        }
+    }
+    assert!(linked >= 10, "robots built with the link: {linked}");
+}
