@@ -1,8 +1,8 @@
 //! The platforms robot programs are built for, as data: [`PLATFORMS`], one
 //! row per platform with every fact generation needs about it (the runtime
 //! layer, the default transport, the runtime files, and for a board its CPU,
-//! toolchain, memory, link script, start-up file, clock, timer and serial
-//! port). Code generation reads it for each robot's Makefile, the link
+//! toolchain, memory, link script, start-up file, clock, timer, serial
+//! port and serial link to `semo gateway`). Code generation reads it for each robot's Makefile, the link
 //! script and the shared runtime folder; the catalog for a robot type's
 //! `<Platform target="...">`; the project file for `[build] target` and
 //! `[build.targets]`. A new board is a new row (and its board file in the
@@ -63,8 +63,10 @@ pub struct Platform {
 /// What differs between a platform's program and its simulation.
 #[derive(Debug, PartialEq, Eq)]
 pub struct Variant {
-    /// The default transport its Makefile builds in; `None`: the program
-    /// talks only to the operator (no link to other robots yet, E103).
+    /// The default network transport its Makefile builds in; `None`: no
+    /// network (a board: the operator through its trace, other robots
+    /// through its [`SerialLink`] to `semo gateway`, if it has one, E103
+    /// otherwise).
     pub transport: Option<Transport>,
     /// The runtime files it compiles, in the runtime folder (for a board,
     /// its start-up file and link script come after these).
@@ -159,7 +161,8 @@ const CORTEX_M: [&str; 5] = [
 ];
 
 /// A Cortex-M board's program and its simulation alike: the static
-/// schedule, no transport to other robots yet (E103).
+/// schedule, no network (other robots only through the board's
+/// [`SerialLink`], if it has one; E103 otherwise).
 const BOARD_PROGRAM: Variant = Variant {
     transport: None,
     runtime: &CORTEX_M,
