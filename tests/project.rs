@@ -689,12 +689,15 @@ fn the_project_file_gives_a_team_or_a_robot_its_own_target() {
     assert_eq!(e111.suggestion.as_deref(), Some("cortex-m"));
 }
 
-/// A robot whose type's platform cannot run it (a cortex-m robot that
-/// talks to another robot) is refused, naming the robot, the platform and
-/// why, pointing at the catalog's `target=`: never built for linux behind
-/// the user's back. The project file can then build it for linux.
+/// A robot whose type's platform cannot run it (an stm32f4 robot, a board
+/// without a serial link, that talks to another robot) is refused, naming
+/// the robot, the platform, why and the boards that have a link, pointing
+/// at the catalog's `target=`: never built for linux behind the user's
+/// back. On cortex-m, which has the link, the same robot is built with it;
+/// the project file can build it for linux instead.
 #[test]
-fn a_talking_robot_on_a_board_is_refused_naming_its_platform_and_where_it_is_chosen() {
+fn a_talking_robot_on_a_board_without_a_link_is_refused_naming_its_platform_and_where_it_is_chosen()
+{
     let dir = mixed_fleet();
     let root = dir.path();
     let mission = read(&root.join("fleet.mission")).replace(
@@ -702,6 +705,17 @@ fn a_talking_robot_on_a_board_is_refused_naming_its_platform_and_where_it_is_cho
         "  send(USER, Scouts.DISTANCE)\n  send(Base, Scouts.DISTANCE)\n",
     );
     write(&root.join("fleet.mission"), &mission);
+    // On cortex-m (the catalog's platform) it is built, with the link.
+    let built = semo_in(root, &["build", "--format", "json"]);
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    let makefile = read(&root.join("out/Scouts/ev/Makefile"));
+    assert!(makefile.contains(" -DSEMO_LINK "), "{makefile}");
+    std::fs::remove_dir_all(root.join("out")).unwrap();
+    let catalog = read(&root.join("robots/fleet.robot.xml"));
+    write(
+        &root.join("robots/fleet.robot.xml"),
+        &catalog.replace("target=\"cortex-m\"", "target=\"stm32f4\""),
+    );
     let built = semo_in(root, &["build", "--format", "json"]);
     assert_eq!(built.code, 1, "{}{}", built.stdout, built.stderr);
     let document: serde_json::Value = serde_json::from_str(&built.stdout).unwrap();
@@ -715,7 +729,7 @@ fn a_talking_robot_on_a_board_is_refused_naming_its_platform_and_where_it_is_cho
     let d = e103[0];
     assert_eq!(
         d["message"],
-        "robot `ev` (team `Scouts`) is built for cortex-m, the platform its type `Evalbot` names in the catalog: send `Scouts.DISTANCE` to team `Base`, but cortex-m has no transport to other robots yet: build it for linux, or message only USER"
+        "robot `ev` (team `Scouts`) is built for stm32f4, the platform its type `Evalbot` names in the catalog: send `Scouts.DISTANCE` to team `Base`, but stm32f4 has no serial link to other robots yet (cortex-m has one, on UART1 to `semo gateway`): build it for cortex-m or linux, or message only USER"
     );
     assert!(
         d["file"].as_str().unwrap().ends_with("fleet.mission"),
@@ -729,11 +743,11 @@ fn a_talking_robot_on_a_board_is_refused_naming_its_platform_and_where_it_is_cho
             .ends_with("robots/fleet.robot.xml"),
         "{d}"
     );
-    assert_eq!(related["message"], "cortex-m is chosen here");
+    assert_eq!(related["message"], "stm32f4 is chosen here");
     let catalog = read(&root.join("robots/fleet.robot.xml"));
     let at = catalog
         .lines()
-        .position(|l| l.contains("target=\"cortex-m\""))
+        .position(|l| l.contains("target=\"stm32f4\""))
         .unwrap() as u64
         + 1;
     assert_eq!(related["line"], at, "{d}");

@@ -1,8 +1,8 @@
 //! The platforms robot programs are built for, as data: [`PLATFORMS`], one
 //! row per platform with every fact generation needs about it (the runtime
 //! layer, the default transport, the runtime files, and for a board its CPU,
-//! toolchain, memory, link script, start-up file, clock, timer and serial
-//! port). Code generation reads it for each robot's Makefile, the link
+//! toolchain, memory, link script, start-up file, clock, timer, serial
+//! port and serial link to `semo gateway`). Code generation reads it for each robot's Makefile, the link
 //! script and the shared runtime folder; the catalog for a robot type's
 //! `<Platform target="...">`; the project file for `[build] target` and
 //! `[build.targets]`. A new board is a new row (and its board file in the
@@ -63,8 +63,10 @@ pub struct Platform {
 /// What differs between a platform's program and its simulation.
 #[derive(Debug, PartialEq, Eq)]
 pub struct Variant {
-    /// The default transport its Makefile builds in; `None`: the program
-    /// talks only to the operator (no link to other robots yet, E103).
+    /// The default network transport its Makefile builds in; `None`: no
+    /// network (a board: the operator through its trace, other robots
+    /// through its [`SerialLink`] to `semo gateway`, if it has one, E103
+    /// otherwise).
     pub transport: Option<Transport>,
     /// The runtime files it compiles, in the runtime folder (for a board,
     /// its start-up file and link script come after these).
@@ -97,10 +99,33 @@ pub struct Board {
     pub timer: &'static str,
     /// The serial port the trace goes to.
     pub serial: &'static str,
+    /// The serial link to `semo gateway` for a robot that messages other
+    /// robots; `None`: the board has none yet, and such a robot is refused
+    /// (E103).
+    pub link: Option<SerialLink>,
     /// The emulator `make run` starts, and its machine.
     pub emulator: &'static str,
     pub machine: &'static str,
 }
+
+/// A board's serial link to `semo gateway` (`docs/link.md`): what a robot
+/// that messages other robots adds to the board's program.
+#[derive(Debug, PartialEq, Eq)]
+pub struct SerialLink {
+    /// The serial port (`UART1`).
+    pub port: &'static str,
+    /// Its pins, for wiring a real board.
+    pub pins: &'static str,
+    /// Its default rate (`make SEMO_LINK_BAUD=...`).
+    pub baud: u32,
+    /// The runtime files the link adds (compiled only into the robots that
+    /// message other robots).
+    pub runtime: &'static [&'static str],
+}
+
+/// The runtime files of the serial link on a board: the frames and
+/// sessions, and the static schedule's transport over them.
+pub const LINK_RUNTIME: [&str; 3] = ["semo_link.h", "semo_link.c", "semo_static_link.c"];
 
 /// The cross toolchain of a board.
 #[derive(Debug, PartialEq, Eq)]
@@ -136,7 +161,8 @@ const CORTEX_M: [&str; 5] = [
 ];
 
 /// A Cortex-M board's program and its simulation alike: the static
-/// schedule, no transport to other robots yet (E103).
+/// schedule, no network (other robots only through the board's
+/// [`SerialLink`], if it has one; E103 otherwise).
 const BOARD_PROGRAM: Variant = Variant {
     transport: None,
     runtime: &CORTEX_M,
@@ -214,6 +240,12 @@ pub const PLATFORMS: &[Platform] = &[
             clock_hz: 12_000_000,
             timer: "SysTick",
             serial: "UART0",
+            link: Some(SerialLink {
+                port: "UART1",
+                pins: "U1Rx on PD2, U1Tx on PD3",
+                baud: 115_200,
+                runtime: &LINK_RUNTIME,
+            }),
             emulator: "qemu-system-arm",
             machine: "lm3s6965evb",
         }),
@@ -246,6 +278,7 @@ pub const PLATFORMS: &[Platform] = &[
             clock_hz: 168_000_000,
             timer: "SysTick",
             serial: "USART1",
+            link: None,
             emulator: "qemu-system-arm",
             machine: "netduinoplus2",
         }),
@@ -361,6 +394,12 @@ impl Target {
             .runtime
             .iter()
             .copied()
+            .chain(
+                board
+                    .and_then(|b| b.link.as_ref())
+                    .into_iter()
+                    .flat_map(|l| l.runtime.iter().copied()),
+            )
             .chain(board.map(|b| b.startup))
             .chain(board.map(|b| b.link_script))
     }

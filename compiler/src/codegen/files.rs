@@ -161,6 +161,8 @@ const MAKEFILE_STATIC: Template = template!(
         "task_count",
         "groups",
         "inbox",
+        "link_sizes",
+        "link_flags",
         "no_reals",
         "exit",
         "sim",
@@ -168,7 +170,7 @@ const MAKEFILE_STATIC: Template = template!(
         "common"
     ]
 );
-const BOARD_RUN_MK: Template = template!("files/board_run.mk.in", ["machine"]);
+const BOARD_RUN_MK: Template = template!("files/board_run.mk.in", ["machine", "link_serial"]);
 /// `scenario.c`'s tables.
 const SCENARIO_TABLES: Template = template!(
     "files/scenario_tables.c.in",
@@ -797,16 +799,41 @@ pub struct StaticSizes {
     pub inbox: usize,
     /// Whether the program holds reals (else `-DSEMO_NO_REALS`).
     pub reals: bool,
+    /// The serial link, for a robot that messages other robots.
+    pub link: Option<LinkSizes>,
+}
+
+/// A board robot's serial link (`-DSEMO_LINK`): its port and buffers.
+pub struct LinkSizes {
+    pub port: &'static str,
+    pub pins: &'static str,
+    pub baud: u32,
+    /// The largest frame payload (`SEMO_LINK_PAYLOAD_MAX`,
+    /// `board_link::payload_max`).
+    pub payload: usize,
+    pub queue: usize,
 }
 
 impl StaticSizes {
-    pub fn of(program: &RobotProgram, longest_value: usize) -> StaticSizes {
+    pub fn of(
+        program: &RobotProgram,
+        longest_value: usize,
+        link: Option<&crate::platform::SerialLink>,
+    ) -> StaticSizes {
         let receives = program
             .tasks
             .iter()
             .any(|t| t.kind == RoleKind::CommReceive);
+        let value_bytes = (longest_value + 1).max(16).next_multiple_of(4);
         StaticSizes {
-            value_bytes: (longest_value + 1).max(16).next_multiple_of(4),
+            link: link.map(|l| LinkSizes {
+                port: l.port,
+                pins: l.pins,
+                baud: l.baud,
+                payload: super::board_link::payload_max(program, value_bytes),
+                queue: super::board_link::QUEUE,
+            }),
+            value_bytes,
             tasks: program.graph.tasks.len().max(1),
             groups: program.control.subscribed.len().max(1),
             inbox: if receives { 4 } else { 1 },
@@ -868,7 +895,17 @@ pub fn makefile(
     if let Some(board) = &target.platform().board {
         static_makefile(&mut out, program, target, board, &runtime, &common, sizes);
         out.push_str(rules);
-        out.push_str(&fill(&BOARD_RUN_MK, &[("machine", &board.machine)]));
+        let link_serial = match &sizes.link {
+            Some(l) => format!(
+                " -serial mon:stdio -serial $(SEMO_LINK_SERIAL)\n\n# {} in QEMU: `semo gateway MISSION --link {}=tcp:127.0.0.1:4560` connects to it.\nSEMO_LINK_SERIAL ?= tcp:127.0.0.1:4560,server,nowait",
+                l.port, program.robot
+            ),
+            None => String::new(),
+        };
+        out.push_str(&fill(
+            &BOARD_RUN_MK,
+            &[("machine", &board.machine), ("link_serial", &link_serial)],
+        ));
         return out;
     }
     out.push_str(&fill(
@@ -928,6 +965,23 @@ fn static_makefile(
             ("task_count", &sizes.tasks),
             ("groups", &sizes.groups),
             ("inbox", &sizes.inbox),
+            (
+                "link_sizes",
+                &sizes.link.as_ref().map_or(String::new(), |l| {
+                    format!(
+                        "# The serial link to `semo gateway` on {} ({}, {} baud; docs/link.md):\n# its largest frame payload, from the mission's names, and the frames queued.\nSEMO_LINK_BAUD ?= {}\nSEMO_LINK_PAYLOAD_MAX ?= {}\nSEMO_LINK_QUEUE ?= {}\n",
+                        l.port, l.pins, l.baud, l.baud, l.payload, l.queue
+                    )
+                }),
+            ),
+            (
+                "link_flags",
+                &if sizes.link.is_some() {
+                    " -DSEMO_LINK -DSEMO_LINK_BAUD=$(SEMO_LINK_BAUD)u -DSEMO_LINK_PAYLOAD_MAX=$(SEMO_LINK_PAYLOAD_MAX) -DSEMO_LINK_QUEUE=$(SEMO_LINK_QUEUE)"
+                } else {
+                    ""
+                },
+            ),
             (
                 "no_reals",
                 &if sizes.reals { "" } else { " -DSEMO_NO_REALS" },

@@ -23,6 +23,7 @@
 //! runtime folder holds what every target used needs.
 
 mod battery;
+mod board_link;
 mod c;
 mod control;
 pub(crate) mod files;
@@ -68,6 +69,10 @@ const LINK_TRANSPORT: (&str, &str) = (
 const POSIX_SIM: (&str, &str) = ("semo_sim.c", include_str!("runtime/semo_sim.c"));
 const LOCKSTEP: (&str, &str) = ("semo_lockstep.c", include_str!("runtime/semo_lockstep.c"));
 const STATIC: (&str, &str) = ("semo_static.c", include_str!("runtime/semo_static.c"));
+const STATIC_LINK: (&str, &str) = (
+    "semo_static_link.c",
+    include_str!("runtime/semo_static_link.c"),
+);
 const CORTEX_M: (&str, &str) = ("semo_cortex_m.c", include_str!("runtime/semo_cortex_m.c"));
 const LM3S6965: (&str, &str) = ("semo_lm3s6965.c", include_str!("runtime/semo_lm3s6965.c"));
 const LM3S6965_LD: (&str, &str) = ("lm3s6965.ld", LINK_SCRIPT.text);
@@ -106,6 +111,7 @@ const RUNTIME_FILES: &[(&str, &str)] = &[
     POSIX_SIM,
     LOCKSTEP,
     STATIC,
+    STATIC_LINK,
     CORTEX_M,
     LM3S6965,
     LM3S6965_LD,
@@ -344,11 +350,28 @@ fn generate(
             Owner::Generated,
         );
     }
+    // A board robot that messages no other robot leaves its board's link
+    // out (target::check refused the ones a board without a link cannot run).
+    let link = target
+        .platform()
+        .board
+        .as_ref()
+        .and_then(|b| b.link.as_ref())
+        .filter(|_| target::peer_messages(program).is_some());
+    let link_only = |name: &str| {
+        link.is_none()
+            && target
+                .platform()
+                .board
+                .as_ref()
+                .and_then(|b| b.link.as_ref())
+                .is_some_and(|l| l.runtime.contains(&name))
+    };
     let runtime_c: Vec<&str> = target
         .runtime()
-        .filter(|name| name.ends_with(".c"))
+        .filter(|name| name.ends_with(".c") && !link_only(name))
         .collect();
-    let sizes = files::StaticSizes::of(program, longest_value(&files, scenario));
+    let sizes = files::StaticSizes::of(program, longest_value(&files, scenario), link);
     let makefile = files::makefile(
         program,
         target,

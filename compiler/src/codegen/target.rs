@@ -1,12 +1,14 @@
 //! What a target refuses to generate, robot by robot (each on the target
 //! the build's plan chose for it, named with why in the message and
-//! pointed at where it was written): a static-schedule target has no
-//! transport to other robots yet (a serial link to a gateway is a later
-//! step), so a robot that sends to, receives from, publishes to or
-//! subscribes to other robots is refused there (E103), never built with its
-//! messages silently dropped. Messages to and from the operator (`USER`)
-//! stay: the trace is the operator console's record, and in simulation the
-//! operator's commands are compiled in.
+//! pointed at where it was written). A board reaches other robots only
+//! through its serial link to `semo gateway` (`platform::SerialLink`,
+//! `semo_static_link.c`): a robot that sends to, receives from, publishes
+//! to or subscribes to other robots is built with the link on a board that
+//! has one (`cortex-m`'s UART1) and refused on a board that has none yet
+//! (`stm32f4`, E103), never built with its messages silently dropped.
+//! Messages to and from the operator (`USER`) need no link: the trace is
+//! the operator console's record, and in simulation the operator's
+//! commands are compiled in.
 
 use super::{Emit, Layer};
 use crate::diag::{Code, Diagnostic};
@@ -108,7 +110,15 @@ pub fn check(
     }
     // One diagnostic per team and target: its robots share the statements.
     let mut teams: Vec<(&str, &Chosen, Vec<&str>, String, crate::span::Span)> = Vec::new();
-    for (program, chosen) in on_static() {
+    let without_link = on_static().filter(|(_, chosen)| {
+        chosen
+            .target
+            .platform()
+            .board
+            .as_ref()
+            .is_none_or(|b| b.link.is_none())
+    });
+    for (program, chosen) in without_link {
         let Some(why) = peer_messages(program) else {
             continue;
         };
@@ -124,6 +134,11 @@ pub fn check(
             }
         }
     }
+    // The boards that have a link, named in the message (the platform table's).
+    let linked: Vec<(&str, &str)> = crate::platform::PLATFORMS
+        .iter()
+        .filter_map(|p| Some((p.name, p.board.as_ref()?.link.as_ref()?.port)))
+        .collect();
     for (team, chosen, robots, why, span) in teams {
         let who = if robots.len() == 1 {
             format!("robot `{}` (team `{team}`)", robots[0])
@@ -135,11 +150,21 @@ pub fn check(
             build.mission,
             span,
             format!(
-                "{who} {} {}: {why}, but {} has no transport to other robots yet: build {} for linux, or message only USER",
+                "{who} {} {}: {why}, but {} has no serial link to other robots yet ({}): build {} for {} or linux, or message only USER",
                 if robots.len() == 1 { "is" } else { "are" },
                 built_for(chosen),
                 chosen.target.name(),
+                linked
+                    .iter()
+                    .map(|(name, port)| format!("{name} has one, on {port} to `semo gateway`"))
+                    .collect::<Vec<_>>()
+                    .join("; "),
                 if robots.len() == 1 { "it" } else { "them" },
+                linked
+                    .iter()
+                    .map(|(name, _)| *name)
+                    .collect::<Vec<_>>()
+                    .join(" or "),
             ),
         );
         relate_choice(&mut d, chosen);
@@ -179,7 +204,7 @@ fn message_span(build: &BuildInput<'_>, team: &str) -> Option<crate::span::Span>
 }
 
 /// How the robot talks to other robots, if it does.
-fn peer_messages(program: &RobotProgram) -> Option<String> {
+pub(super) fn peer_messages(program: &RobotProgram) -> Option<String> {
     let m = &program.control;
     if let Some(o) = m.outgoing.iter().find(|o| o.to_team != USER) {
         let verb = if o.publish { "publish" } else { "send" };

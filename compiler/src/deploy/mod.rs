@@ -252,7 +252,9 @@ pub fn check(deployment: &Deployment, mission: &Mission) -> Vec<Diagnostic> {
 /// has a network transport: its `semo_deploy.h` names the broker, client
 /// id, user and the paths of the password file and TLS files (the runtime
 /// reads the password at start). A robot on a platform without one (a
-/// board: it talks to nobody, E103) has nothing to bake. Returns false when
+/// board: it reaches the fleet through its serial link and `semo gateway`,
+/// which reads its credentials from the deployment file itself, or talks
+/// to nobody) has nothing to bake. Returns false when
 /// no robot of the build has a network transport.
 pub fn bake(deployment: &Deployment, result: &mut BuildResult) -> bool {
     let mut baked = false;

@@ -992,6 +992,14 @@ bool semo__inbox_waiting(void)
     return waiting;
 }
 
+bool semo__inbox_holds_back(void)
+{
+    semo__queue_lock(SEMO__INBOX);
+    bool full = g_inbox_polled && g_inbox_state.count == g_inbox_ring.capacity;
+    semo__queue_unlock(SEMO__INBOX);
+    return full;
+}
+
 /* How long a message waits for room in a full inbox that no task has polled
  * yet (mission ms): a robot that receives nothing must not hold back its
  * transport for ever. */
@@ -1117,6 +1125,27 @@ static size_t put_field(unsigned char *out, const char *text)
     return n + 1;
 }
 
+static size_t field_size(const char *text)
+{
+    size_t n = strlen(text);
+    return 1 + (n > 255 ? 255 : n);
+}
+
+size_t semo__encoded_size(const semo_message *m)
+{
+    size_t n = 6 + field_size(m->from_team) + field_size(m->from_robot) + field_size(m->key) + 1;
+    const semo_value *v = &m->value;
+    if (v->type == SEMO_INT || v->type == SEMO_REAL) {
+        n += 8;
+    } else if (v->type == SEMO_BOOL) {
+        n += 1;
+    } else if (v->type == SEMO_WORD || v->type == SEMO_TEXT) {
+        const char *text = semo_value_word_text(v);
+        n += field_size(text ? text : "");
+    }
+    return n;
+}
+
 size_t semo__encode_message(const semo_message *m, unsigned char *out)
 {
     size_t n = 5;
@@ -1228,3 +1257,52 @@ bool semo__decode_message(const unsigned char *in, size_t len, semo_message *m)
            take_field(in, len, &at, m->from_robot, sizeof m->from_robot) &&
            take_field(in, len, &at, m->key, sizeof m->key) && take_value(in, len, &at, &m->value) && at == len;
 }
+
+#ifdef SEMO_SIM
+/* ------------------------------------------------------------ simulation */
+
+/* The battery level at `t`: linear between the scenario's points, the first
+ * before them and the last after them (the simulator's battery_level, the
+ * same operations in the same order). */
+static double battery_level(int64_t t)
+{
+    const semo__sim_battery_entry *b = semo__scenario.battery;
+    size_t count = semo__scenario.battery_count;
+    if (t <= b[0].at)
+        return b[0].level;
+    for (size_t i = 1; i < count; i++)
+        if (t <= b[i].at)
+            return b[i - 1].level + (b[i].level - b[i - 1].level) * (double)(t - b[i - 1].at) / (double)(b[i].at - b[i - 1].at);
+    return b[count - 1].level;
+}
+
+/* Rust's f64::round (halves away from zero) without libm: doubles of 2^52
+ * and more are whole already. */
+static double round_half_away(double x)
+{
+    if (!(x > -4503599627370496.0 && x < 4503599627370496.0))
+        return x;
+    double whole = (double)(long long)x; /* toward zero; the fraction is exact */
+    if (x - whole >= 0.5)
+        return whole + 1;
+    if (whole - x >= 0.5)
+        return whole - 1;
+    return whole;
+}
+
+double semo__sim_battery_at(int64_t t)
+{
+    return round_half_away(battery_level(t));
+}
+
+/* Both simulation platforms' (semo_sim.c, semo_static.c): the scenario's
+ * battery level now, rounded. */
+bool semo_sim_battery(long long *level)
+{
+    if (semo__scenario.battery_count == 0)
+        return false;
+    if (level)
+        *level = (long long)semo__sim_battery_at(semo_now_ms());
+    return true;
+}
+#endif

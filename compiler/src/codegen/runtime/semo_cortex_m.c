@@ -14,6 +14,7 @@
  */
 #include "semo_internal.h"
 
+#include <stddef.h>
 #include <string.h>
 
 #ifndef SEMO_CPU_HZ
@@ -36,6 +37,10 @@
  * SysTick counted down in the current period of `g_period` cycles. */
 static volatile uint64_t g_period_start;
 static volatile uint32_t g_period;
+
+#ifdef SEMO_LINK
+volatile bool semo__board_woken;
+#endif
 
 /* A new period of `cycles` from now (at most SYSTICK_MAX_CYCLES). */
 static void start_period(uint32_t cycles)
@@ -91,6 +96,14 @@ void semo__board_sleep_until(int64_t deadline_ms)
     /* Masked from here to wfi: an interrupt that comes meanwhile stays
      * pending and ends the wfi at once instead of being slept through. */
     __asm__ volatile("cpsid i" ::: "memory");
+#ifdef SEMO_LINK
+    /* A byte came on the link since the last sleep: the loop reads it first. */
+    if (semo__board_woken) {
+        semo__board_woken = false;
+        __asm__ volatile("cpsie i" ::: "memory");
+        return;
+    }
+#endif
     uint32_t period = g_period;
     uint32_t counted = cycles_in_period();
     uint64_t now = g_period_start + counted;
@@ -149,6 +162,19 @@ void semo__reset(void)
     memset(_sbss, 0, (size_t)((char *)_ebss - (char *)_sbss));
     semo__board_exit(main(0, NULL));
 }
+
+#ifdef SEMO_LINK
+/* No heap: newlib-nano's printf family (a heartbeat's text, formatted with
+ * snprintf by the generated control task) links malloc for its own
+ * buffers, which a string's formatting never asks for. Every request for
+ * heap memory fails here, so none is ever taken from the stack's RAM. */
+void *_sbrk(ptrdiff_t increment);
+void *_sbrk(ptrdiff_t increment)
+{
+    (void)increment;
+    return (void *)-1;
+}
+#endif
 
 /* A fault or an unexpected interrupt: the program cannot go on. */
 void semo__fault(void)

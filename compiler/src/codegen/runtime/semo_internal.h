@@ -183,6 +183,8 @@ static inline int semo__received_take(semo__received *r, pthread_mutex_t *lock, 
 }
 #endif
 size_t semo__encode_message(const semo_message *m, unsigned char *out);
+/* How many bytes semo__encode_message writes for `m`. */
+size_t semo__encoded_size(const semo_message *m);
 /* False for anything else (the message is then unspecified). */
 bool semo__decode_message(const unsigned char *in, size_t len, semo_message *m);
 
@@ -209,6 +211,10 @@ void semo__deliver(const semo_message *msg);
 void semo__inbox_reset(void);
 /* Whether a message waits for a task that polls the inbox. */
 bool semo__inbox_waiting(void);
+/* Whether the inbox is full while a task reads it: a transport that can
+ * keep a message where it is (on the line, at the gateway) holds it back
+ * rather than have semo__deliver drop it on the static schedule. */
+bool semo__inbox_holds_back(void);
 /* What every send does before the transport: checks the arguments and
  * traces the send; -1 on bad arguments, 1 when it went to the operator
  * console ("USER", whose record is the trace), 0 when the transport must
@@ -345,6 +351,9 @@ typedef struct semo__sim_tables_s {
     size_t link_count;
 } semo__sim_tables;
 extern const semo__sim_tables semo__scenario;
+/* The scenario's battery level at mission time `t` (linear between its
+ * points), rounded half away from zero; its table must not be empty. */
+double semo__sim_battery_at(int64_t t);
 #endif
 
 /* Platform hooks of the static schedule: the board file (semo_lm3s6965.c,
@@ -364,6 +373,30 @@ void semo__systick_start(void);
 void semo__reset(void);
 void semo__systick(void);
 void semo__fault(void);
+#ifdef SEMO_LINK
+/* The link to `semo gateway` on the board's second serial port (-DSEMO_LINK:
+ * a robot that messages other robots; docs/link.md). The board file starts
+ * it in semo__board_init and gives: writing bytes (all of them, waiting for
+ * room), the next byte received without taking it (false: none yet), taking
+ * it, and the bytes lost to a full receive buffer. A received byte ends a
+ * sleep: the interrupt sets semo__board_woken, which semo__board_sleep_until
+ * reads with interrupts masked, so a byte that came just before the sleep
+ * is not slept through. */
+void semo__board_link_put(const unsigned char *bytes, size_t n);
+bool semo__board_link_peek(unsigned char *byte);
+void semo__board_link_take(void);
+unsigned long semo__board_link_overruns(void);
+extern volatile bool semo__board_woken;
+/* semo_static_link.c's, for the loop (semo_static.c): waits for the
+ * gateway's welcome (mission time starts after it); feeds what the line
+ * brought and writes what is due; when that is next needed (board ms,
+ * INT64_MAX: only when a byte comes); waits (at most 2 s) for what was sent
+ * to be acknowledged, and traces what the link lost. */
+void semo__link_open(void);
+void semo__link_pump(void);
+int64_t semo__link_deadline(void);
+void semo__link_close(void);
+#endif
 #endif
 
 #ifdef SEMO_MQTT

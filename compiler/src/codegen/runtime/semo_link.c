@@ -22,30 +22,31 @@ void semo_link_init(semo_link *link, semo_link_write write, void *ctx)
     link->ctx = ctx;
 }
 
-/* Stuffs the body (kind, seq, payload a then b, CRC) into link->wire and
- * writes it with its closing zero. */
-static void write_frame(semo_link *link, unsigned char kind, uint16_t seq, const unsigned char *a, size_t alen,
-                        const unsigned char *b, size_t blen)
+/* Stuffs the body (kind, seq, the payload's `count` pieces in order, CRC)
+ * into link->wire and writes it with its closing zero. */
+static void write_pieces(semo_link *link, unsigned char kind, uint16_t seq, const unsigned char *const *pieces,
+                         const size_t *lens, int count)
 {
     unsigned char head[3] = {kind, (unsigned char)(seq >> 8), (unsigned char)seq};
     uint16_t crc = 0xFFFF;
     /* The CRC over the pieces, as semo_link_crc16 over their concatenation. */
-    const unsigned char *pieces[3] = {head, a, b};
-    size_t lens[3] = {3, alen, blen};
-    for (int p = 0; p < 3; p++)
-        for (size_t i = 0; i < lens[p]; i++) {
-            crc ^= (uint16_t)(pieces[p][i] << 8);
+    for (int p = -1; p < count; p++) {
+        const unsigned char *bytes = p < 0 ? head : pieces[p];
+        size_t n = p < 0 ? 3 : lens[p];
+        for (size_t i = 0; i < n; i++) {
+            crc ^= (uint16_t)(bytes[i] << 8);
             for (int k = 0; k < 8; k++)
                 crc = (crc & 0x8000) ? (uint16_t)((crc << 1) ^ 0x1021) : (uint16_t)(crc << 1);
         }
+    }
     unsigned char tail[2] = {(unsigned char)(crc >> 8), (unsigned char)crc};
-    const unsigned char *all[4] = {head, a, b, tail};
-    size_t all_lens[4] = {3, alen, blen, 2};
     size_t out = 0, code_at = out++;
     unsigned char code = 1;
-    for (int p = 0; p < 4; p++)
-        for (size_t i = 0; i < all_lens[p]; i++) {
-            unsigned char byte = all[p][i];
+    for (int p = -1; p <= count; p++) {
+        const unsigned char *bytes = p < 0 ? head : p == count ? tail : pieces[p];
+        size_t n = p < 0 ? 3 : p == count ? 2 : lens[p];
+        for (size_t i = 0; i < n; i++) {
+            unsigned char byte = bytes[i];
             if (byte == 0) {
                 link->wire[code_at] = code;
                 code_at = out++;
@@ -59,9 +60,18 @@ static void write_frame(semo_link *link, unsigned char kind, uint16_t seq, const
                 }
             }
         }
+    }
     link->wire[code_at] = code;
     link->wire[out++] = 0;
     link->write(link->ctx, link->wire, out);
+}
+
+static void write_frame(semo_link *link, unsigned char kind, uint16_t seq, const unsigned char *a, size_t alen,
+                        const unsigned char *b, size_t blen)
+{
+    const unsigned char *pieces[2] = {a, b};
+    size_t lens[2] = {alen, blen};
+    write_pieces(link, kind, seq, pieces, lens, 2);
 }
 
 int semo_link_queue(semo_link *link, unsigned char kind, const void *a, size_t alen, const void *b, size_t blen)
@@ -84,6 +94,34 @@ int semo_link_emit(semo_link *link, unsigned char kind, const void *a, size_t al
     if (alen + blen > SEMO_LINK_PAYLOAD_MAX)
         return -1;
     write_frame(link, kind, 0, a, alen, b, blen);
+    return 0;
+}
+
+int semo_link_send_datagram(semo_link *link, const char *to, const void *datagram, size_t len)
+{
+    size_t to_len = strlen(to);
+    /* The kind is the datagram's sixth byte ("SEMO" 0x02 <kind>). */
+    if (len < 6 || to_len == 0 || to_len > 255 || 1 + to_len + len > SEMO_LINK_PAYLOAD_MAX)
+        return -1;
+    unsigned char head[1] = {(unsigned char)to_len};
+    if (((const unsigned char *)datagram)[5] != SEMO_LINK_DATAGRAM_SEND) {
+        if (!link->welcomed)
+            return 0;
+        const unsigned char *pieces[3] = {head, (const unsigned char *)to, (const unsigned char *)datagram};
+        size_t lens[3] = {1, to_len, len};
+        write_pieces(link, SEMO_LINK_PUBLISH, 0, pieces, lens, 3);
+        return 0;
+    }
+    size_t slot = (link->tx_head + link->tx_count) % (SEMO_LINK_QUEUE + 1);
+    if (link->tx_count >= SEMO_LINK_QUEUE + 1)
+        return -2;
+    /* Straight into the queue's slot: no second copy of the payload. */
+    link->queue[slot].kind = SEMO_LINK_SEND;
+    link->queue[slot].len = 1 + to_len + len;
+    link->queue[slot].payload[0] = head[0];
+    memcpy(link->queue[slot].payload + 1, to, to_len);
+    memcpy(link->queue[slot].payload + 1 + to_len, datagram, len);
+    link->tx_count++;
     return 0;
 }
 

@@ -32,6 +32,8 @@
 #define SEMO_LINK_WIRE_MAX (SEMO_LINK_BODY_MAX + SEMO_LINK_BODY_MAX / 254 + 1 + 1)
 #define SEMO_LINK_RETRY_MS 200
 #define SEMO_LINK_HELLO_RETRY_MS 500
+/* A datagram's kind byte (its sixth) for a send (semo_runtime.h's SEMO_MSG_SEND). */
+#define SEMO_LINK_DATAGRAM_SEND 's'
 
 enum {
     SEMO_LINK_HELLO = 'H',
@@ -105,6 +107,14 @@ int64_t semo_link_deadline(const semo_link *link);
 /* The line went away (and may come back): a new session starts with a
  * hello; what was not acknowledged goes again. */
 void semo_link_restart(semo_link *link);
+/* A datagram for `to` (a team, a robot or "USER"; a length byte then the
+ * name lead the payload): reliably (S) when the datagram is a send, at once
+ * (P) when it is a publish, which before the session stands is lost as at
+ * QoS 0. What every transport over the link sends (semo_link_transport.c on
+ * POSIX, semo_static_link.c on a board). 0 when queued or written, -1 when
+ * it can never go (no name, too long), -2 while the queue is full: the
+ * caller makes room (waits, or feeds the line) and asks again. */
+int semo_link_send_datagram(semo_link *link, const char *to, const void *datagram, size_t len);
 /* Reliable frames not yet acknowledged. */
 size_t semo_link_pending(const semo_link *link);
 uint16_t semo_link_crc16(const unsigned char *bytes, size_t n);

@@ -248,20 +248,17 @@ static int queue_reliable(unsigned char kind, const void *a, size_t alen, const 
     return rc;
 }
 
+/* The link's frame for the datagram (semo_link_send_datagram, as a board
+ * sends it); a send waits for room in the link's queue. */
 static int link_send_to(const char *to, const void *data, size_t len)
 {
-    size_t to_len = strlen(to);
-    if (len < 6 || to_len == 0 || to_len > 255)
-        return -1;
-    unsigned char head[256];
-    head[0] = (unsigned char)to_len;
-    memcpy(head + 1, to, to_len);
-    if (((const unsigned char *)data)[5] == SEMO_MSG_SEND)
-        return queue_reliable(SEMO_LINK_SEND, head, 1 + to_len, data, len);
     pthread_mutex_lock(&g_lock);
-    int rc = g_fd >= 0 && g_link.welcomed ? semo_link_emit(&g_link, SEMO_LINK_PUBLISH, head, 1 + to_len, data, len) : 0;
+    int rc;
+    while ((rc = semo_link_send_datagram(&g_link, to, data, len)) == -2 && !g_interrupted)
+        pthread_cond_wait(&g_changed, &g_lock);
     pthread_mutex_unlock(&g_lock);
-    return rc;
+    wake_thread();
+    return rc == 0 ? 0 : -1;
 }
 
 static int link_status(const char *json, size_t len)

@@ -1,9 +1,12 @@
 /* semo_lm3s6965.c: the board file of the `cortex-m` targets for the TI
  * Stellaris LM3S6965 (QEMU's `lm3s6965evb`, the Evalbot's family): the
  * stack, the vector table, and UART0 as the trace's output and a wake-up
- * source (a received byte ends a sleep). The reset code, the clock, the
- * sleep, the exit and the fault handler are the core's (semo_cortex_m.c).
- * Linked with lm3s6965.ld.
+ * source (a received byte ends a sleep). With -DSEMO_LINK (a robot that
+ * messages other robots) UART1 (U1Rx on PD2, U1Tx on PD3; QEMU's second
+ * `-serial`) is the link to `semo gateway` (semo_static_link.c): written
+ * polled, read by its interrupt into a ring of twice the longest frame.
+ * The reset code, the clock, the sleep, the exit and the fault handler are
+ * the core's (semo_cortex_m.c). Linked with lm3s6965.ld.
  */
 #include "semo_internal.h"
 
@@ -23,6 +26,32 @@
 #define UART_IM_RT (1u << 6)
 #define NVIC_ISER0 REG(0xE000E100u)
 #define UART0_IRQ 5u
+#ifdef SEMO_LINK
+#include "semo_link.h"
+#define UART1_DR REG(0x4000D000u)
+#define UART1_FR REG(0x4000D018u)
+#define UART1_IBRD REG(0x4000D024u)
+#define UART1_FBRD REG(0x4000D028u)
+#define UART1_LCRH REG(0x4000D02Cu)
+#define UART1_CTL REG(0x4000D030u)
+#define UART1_IM REG(0x4000D038u)
+#define UART1_ICR REG(0x4000D044u)
+#define UART_LCRH_8N1_FIFO 0x70u /* 8 data bits, no parity, 1 stop bit, FIFOs on */
+#define UART_CTL_ON 0x301u       /* UARTEN, TXE, RXE */
+#define UART1_IRQ 6u
+#define SYSCTL_RCGC1 REG(0x400FE104u) /* bit 1: UART1 */
+#define SYSCTL_RCGC2 REG(0x400FE108u) /* bit 3: GPIO port D */
+#define GPIOD_AFSEL REG(0x40007420u)
+#define GPIOD_DEN REG(0x4000751Cu)
+#define PD2_PD3 0x0Cu
+/* The link's rate: 115200 baud unless the Makefile says otherwise. */
+#ifndef SEMO_LINK_BAUD
+#define SEMO_LINK_BAUD 115200u
+#endif
+#define LAST_IRQ UART1_IRQ
+#else
+#define LAST_IRQ UART0_IRQ
+#endif
 
 /* Its own section (lm3s6965.ld): zeroing .bss must not wipe the stack it runs on. */
 __attribute__((section(".stack"))) static uint32_t g_stack[SEMO_STACK_BYTES / 4];
@@ -30,11 +59,87 @@ static volatile uint32_t g_uart_input; /* bytes received (and discarded) */
 
 /* ---------------------------------------------------------------- board */
 
+#ifdef SEMO_LINK
+/* Received on the link, from the interrupt (which alone moves `head`) to
+ * the loop (which alone moves `tail`). */
+#define RX_RING (2u * SEMO_LINK_WIRE_MAX)
+static volatile unsigned char g_rx[RX_RING];
+static volatile uint32_t g_rx_head, g_rx_tail;
+static volatile unsigned long g_rx_overruns;
+
+static void link_init(void)
+{
+    SYSCTL_RCGC1 |= 1u << 1;
+    SYSCTL_RCGC2 |= 1u << 3;
+    GPIOD_AFSEL |= PD2_PD3;
+    GPIOD_DEN |= PD2_PD3;
+    UART1_CTL = 0;
+    /* The divisor in 64ths: SEMO_CPU_HZ / (16 * baud), rounded. */
+    uint32_t divisor = (SEMO_CPU_HZ * 4u + SEMO_LINK_BAUD / 2u) / SEMO_LINK_BAUD;
+    UART1_IBRD = divisor >> 6;
+    UART1_FBRD = divisor & 63u;
+    UART1_LCRH = UART_LCRH_8N1_FIFO;
+    UART1_IM = UART_IM_RX | UART_IM_RT;
+    UART1_CTL = UART_CTL_ON;
+}
+
+void semo__board_link_put(const unsigned char *bytes, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        while (UART1_FR & UART_FR_TXFF)
+            ;
+        UART1_DR = bytes[i];
+    }
+}
+
+bool semo__board_link_peek(unsigned char *byte)
+{
+    if (g_rx_tail == g_rx_head)
+        return false;
+    *byte = g_rx[g_rx_tail];
+    return true;
+}
+
+void semo__board_link_take(void)
+{
+    if (g_rx_tail != g_rx_head)
+        g_rx_tail = (g_rx_tail + 1u) % RX_RING;
+}
+
+unsigned long semo__board_link_overruns(void)
+{
+    return g_rx_overruns;
+}
+
+/* A full ring loses the byte (counted): the frame it was in fails its CRC,
+ * goes unacknowledged and comes again. */
+static void uart1(void)
+{
+    while (!(UART1_FR & UART_FR_RXFE)) {
+        unsigned char byte = (unsigned char)UART1_DR;
+        uint32_t next = (g_rx_head + 1u) % RX_RING;
+        if (next == g_rx_tail) {
+            g_rx_overruns++;
+        } else {
+            g_rx[g_rx_head] = byte;
+            g_rx_head = next;
+        }
+    }
+    UART1_ICR = UART_IM_RX | UART_IM_RT;
+    semo__board_woken = true;
+}
+#endif
+
 void semo__board_init(void)
 {
     semo__systick_start();
     UART0_IM = UART_IM_RX | UART_IM_RT;
+#ifdef SEMO_LINK
+    link_init();
+    NVIC_ISER0 = 1u << UART0_IRQ | 1u << UART1_IRQ;
+#else
     NVIC_ISER0 = 1u << UART0_IRQ;
+#endif
 }
 
 void semo__board_put(void *ctx, const char *bytes, size_t n)
@@ -62,7 +167,7 @@ typedef union {
     void (*handler)(void);
 } vector;
 
-__attribute__((section(".isr_vector"), used)) static const vector g_vectors[16 + UART0_IRQ + 1] = {
+__attribute__((section(".isr_vector"), used)) static const vector g_vectors[16 + LAST_IRQ + 1] = {
     {.stack_top = &g_stack[SEMO_STACK_BYTES / 4]},
     {.handler = semo__reset},
     {.handler = semo__fault}, /* NMI */
@@ -86,4 +191,7 @@ __attribute__((section(".isr_vector"), used)) static const vector g_vectors[16 +
     {.handler = semo__fault},
     {.handler = semo__fault},
     {.handler = uart0},
+#ifdef SEMO_LINK
+    {.handler = uart1},
+#endif
 };

@@ -201,35 +201,6 @@ static void sim_stop(void)
     g_late.started = false;
 }
 
-/* The battery level at `t`: linear between the scenario's points, the first
- * before them and the last after them (the simulator's battery_level, the
- * same operations in the same order). */
-static double battery_level(int64_t t)
-{
-    const semo__sim_battery_entry *b = semo__scenario.battery;
-    size_t count = semo__scenario.battery_count;
-    if (t <= b[0].at)
-        return b[0].level;
-    for (size_t i = 1; i < count; i++)
-        if (t <= b[i].at)
-            return b[i - 1].level + (b[i].level - b[i - 1].level) * (double)(t - b[i - 1].at) / (double)(b[i].at - b[i - 1].at);
-    return b[count - 1].level;
-}
-
-/* Rust's f64::round (halves away from zero) without libm: doubles of 2^52
- * and more are whole already. */
-static double round_half_away(double x)
-{
-    if (!(x > -4503599627370496.0 && x < 4503599627370496.0))
-        return x;
-    double whole = (double)(long long)x; /* toward zero; the fraction is exact */
-    if (x - whole >= 0.5)
-        return whole + 1;
-    if (whole - x >= 0.5)
-        return whole - 1;
-    return whole;
-}
-
 bool semo_sim_sensor(const char *value, semo_type type, semo_value *out)
 {
     const semo__sim_sensor_entry *latest = NULL;
@@ -244,19 +215,10 @@ bool semo_sim_sensor(const char *value, semo_type type, semo_value *out)
         return semo_value_parse(out ? out : &read, type, latest->is);
     if (value && strcmp(value, "BATTERY") == 0 && semo__scenario.battery_count > 0) {
         char text[400]; /* "%.0f" of any double fits */
-        snprintf(text, sizeof text, "%.0f", round_half_away(battery_level(now)));
+        snprintf(text, sizeof text, "%.0f", semo__sim_battery_at(now));
         return semo_value_parse(out ? out : &read, type, text);
     }
     return false;
-}
-
-bool semo_sim_battery(long long *level)
-{
-    if (semo__scenario.battery_count == 0)
-        return false;
-    if (level)
-        *level = (long long)round_half_away(battery_level(semo_now_ms()));
-    return true;
 }
 
 void semo_sim_actuate(const char *task, const semo_value *command)

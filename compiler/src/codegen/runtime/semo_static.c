@@ -416,10 +416,12 @@ void UFTimer_Cancel(int id)
 
 /* --------------------------------------------------------------- messages */
 
-/* Only the operator console ("USER", whose record is the trace) is reachable
- * here: the generator refuses missions that message other robots on a
- * static-schedule target (E103), so anything else is an error. The inbox
+/* Without the link (-DSEMO_LINK, semo_static_link.c) only the operator
+ * console ("USER", whose record is the trace) is reachable: the generator
+ * builds a robot that messages other robots with the link, or refuses it
+ * on a board that has none (E103), so anything else is an error. The inbox
  * (semo_comm_poll, semo__deliver) is the core's. */
+#ifndef SEMO_LINK
 int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value)
 {
     int local = semo__comm_send_local(to_team, kind, key, value);
@@ -428,6 +430,7 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
     semo_trace("comm_error", "to", to_team, "key", key, NULL);
     return -1;
 }
+#endif
 
 /* ------------------------------------------------------------- simulation */
 
@@ -600,6 +603,10 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
                                                          ? SEMO_TASK_IDLE
                                                          : SEMO_TASK_RUNNING,
                                         .repeat = true}};
+#ifdef SEMO_LINK
+    /* Mission time starts once the robot has joined the fleet. */
+    semo__link_open();
+#endif
     semo__inbox_reset();
     g_start_ms = semo__board_now_ms();
     g_running = true;
@@ -614,6 +621,9 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
         if (program->tasks[i].init)
             program->tasks[i].init();
     while (g_running) {
+#ifdef SEMO_LINK
+        semo__link_pump();
+#endif
         Core_1_go();
         g_passes++;
         int64_t now = semo_now_ms();
@@ -627,6 +637,11 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
 #endif
         if (duration > 0 && duration < wake)
             wake = duration;
+#ifdef SEMO_LINK
+        int64_t link = semo__link_deadline();
+        if (link != INT64_MAX && link - g_start_ms < wake)
+            wake = link - g_start_ms;
+#endif
         if (wake > now)
             semo__board_sleep_until(wake == INT64_MAX ? INT64_MAX : g_start_ms + wake);
     }
@@ -635,6 +650,9 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
         if (program->tasks[i].wrapup)
             program->tasks[i].wrapup();
     semo__trace_dropped_samples();
+#ifdef SEMO_LINK
+    semo__link_close();
+#endif
     semo_trace("stop", NULL);
 #ifdef SEMO_COUNT_PASSES
     /* For measuring (not a trace line: built only with -DSEMO_COUNT_PASSES). */

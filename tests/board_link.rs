@@ -1,0 +1,380 @@
+//! A board robot on the serial link, end to end (issue 35, item 2): the
+//! scouting mission's Evalbot `ti` built for `cortex-m-sim` runs in QEMU
+//! (`lm3s6965evb`: UART0, the first `-serial`, is its trace on standard
+//! output; UART1, the second, is its link, served on a TCP port), `semo
+//! gateway --link ti=tcp:127.0.0.1:PORT` connects to that port and speaks
+//! MQTT for it, and `irobot` and `nxt` run as `linux-sim` programs on the
+//! same private mosquitto. Every robot enters the modes `semo simulate`
+//! gives it on the same scenario, in the same order, to FINISH; the master
+//! hears ti's colors and ti its team mate's heartbeats, through the board's UART,
+//! the gateway and the broker.
+//!
+//! Time: QEMU runs in real time here (no `-icount`: the link's repeats and
+//! the Linux robots' clocks are wall clocks), and the Linux robots run the
+//! scenario at its real pace (`--time-scale 1`, which wins over the
+//! scenario's) with their mission time 0 at the instant the board's trace
+//! says it started (`--start-at`, an instant already past). What is compared
+//! is the order of modes, not times; the deadlines only end a test that
+//! would otherwise hang.
+//!
+//! Skipped with a message without arm-none-eabi-gcc, qemu-system-arm or
+//! mosquitto, unless `SEMO_CORTEX_M_TESTS=require` / `SEMO_MQTT_TESTS=require`
+//! (CI), where a missing tool fails.
+
+mod support;
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+use support::mqtt::Fleet;
+use support::robots::{self, Event, events, field, modes};
+
+/// A hang guard, not a timing tolerance.
+const LIMIT: Duration = Duration::from_secs(120);
+
+fn scouting() -> PathBuf {
+    support::examples().join("scouting/scouting.mission")
+}
+
+fn scenario() -> PathBuf {
+    support::repo_root().join("tests/fixtures/build/scouting.scenario.json")
+}
+
+/// Whether the board's tools are here; without them the test is skipped
+/// (with a message) unless `SEMO_CORTEX_M_TESTS=require`.
+fn board_tools_present(test: &str) -> bool {
+    let missing: Vec<&str> = ["arm-none-eabi-gcc", "qemu-system-arm"]
+        .into_iter()
+        .filter(|tool| !robots::has(tool))
+        .collect();
+    if missing.is_empty() {
+        return true;
+    }
+    let required = std::env::var("SEMO_CORTEX_M_TESTS").is_ok_and(|v| v == "require");
+    assert!(
+        !required,
+        "{test}: SEMO_CORTEX_M_TESTS=require but {} missing",
+        missing.join(", ")
+    );
+    eprintln!(
+        "skipped {test}: {} not installed (CI installs them and sets SEMO_CORTEX_M_TESTS=require)",
+        missing.join(", ")
+    );
+    false
+}
+
+/// `semo build` of the scouting mission for `cortex-m-sim` with the
+/// scenario; `make` of ti's folder at `-Wpedantic -Werror`; its ELF file.
+fn board_ti(out: &Path) -> PathBuf {
+    let (mission, scenario, out_arg) = (
+        scouting().display().to_string(),
+        scenario().display().to_string(),
+        out.display().to_string(),
+    );
+    let built = support::semo_in(
+        &support::repo_root(),
+        &[
+            "build",
+            &mission,
+            "--target",
+            "cortex-m-sim",
+            "--scenario",
+            &scenario,
+            "-o",
+            &out_arg,
+        ],
+    );
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    let folder = out.join("SlaveTeam/ti");
+    let makefile = std::fs::read_to_string(folder.join("Makefile")).unwrap();
+    assert!(
+        makefile.contains("-DSEMO_LINK ") && makefile.contains("SEMO_LINK_PAYLOAD_MAX ?="),
+        "ti messages other robots: built with the link\n{makefile}"
+    );
+    let made = Command::new("make")
+        .args([
+            "-s",
+            "-j2",
+            "CFLAGS=-std=c11 -Wall -Wextra -Wpedantic -Werror -Os",
+        ])
+        .current_dir(&folder)
+        .output()
+        .expect("make runs");
+    let stderr = String::from_utf8_lossy(&made.stderr);
+    assert!(
+        made.status.success() && !stderr.contains("warning"),
+        "{stderr}"
+    );
+    folder.join("ti.elf")
+}
+
+/// QEMU running `elf` on the LM3S6965 with UART1 served on `link_port`;
+/// its trace lines come through the receiver as they are written.
+fn qemu(elf: &Path, link_port: u16) -> (Child, mpsc::Receiver<String>) {
+    let mut child = Command::new("qemu-system-arm")
+        .args(["-M", "lm3s6965evb", "-display", "none", "-monitor", "none"])
+        .args(["-semihosting", "-serial", "stdio", "-serial"])
+        .arg(format!("tcp:127.0.0.1:{link_port},server,nowait"))
+        .arg("-kernel")
+        .arg(elf)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("qemu-system-arm starts");
+    let stdout = child.stdout.take().unwrap();
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines() {
+            let Ok(line) = line else { return };
+            if tx.send(line).is_err() {
+                return;
+            }
+        }
+    });
+    (child, rx)
+}
+
+fn unix_ms() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .expect("the clock is after 1970")
+        .as_millis() as u64
+}
+
+/// The board's trace lines until its `stop` (or its end), the first one
+/// handed to `started` as it comes.
+fn board_trace(rx: &mpsc::Receiver<String>, mut started: impl FnMut(&Event)) -> Vec<String> {
+    let end = Instant::now() + LIMIT;
+    let mut lines = Vec::new();
+    loop {
+        let left = end.saturating_duration_since(Instant::now());
+        let Ok(line) = rx.recv_timeout(left) else {
+            assert!(
+                Instant::now() < end,
+                "the board's trace waited past {LIMIT:?}: {lines:#?}"
+            );
+            return lines;
+        };
+        let event = events(std::slice::from_ref(&line));
+        if let Some(e) = event.first() {
+            if lines.is_empty() {
+                started(e);
+            }
+            let stop = field(e, "event") == "stop";
+            lines.push(line);
+            if stop {
+                return lines;
+            }
+        } else {
+            lines.push(line);
+        }
+    }
+}
+
+#[test]
+fn the_evalbot_in_qemu_on_the_serial_link_behaves_as_in_the_simulator() {
+    let test = "the_evalbot_in_qemu_on_the_serial_link_behaves_as_in_the_simulator";
+    if !board_tools_present(test) {
+        return;
+    }
+    let Some(mut fleet) = Fleet::start("board-link-scouting") else {
+        return;
+    };
+    let scenario = scenario();
+    // Everything is compiled before anything starts.
+    let elf = board_ti(&fleet.out.join("board"));
+    let folders = support::mqtt::build(&scouting(), &fleet.out.join("linux"), &[]);
+    support::mqtt::compile_in(&folders, &scenario);
+
+    let link_port = support::mosquitto::free_port();
+    let (board, board_rx) = qemu(&elf, link_port);
+    let board = fleet.processes.push(board);
+    let gateway = fleet.processes.push(
+        Command::new(env!("CARGO_BIN_EXE_semo"))
+            .arg("gateway")
+            .arg(scouting())
+            .args(["--link", &format!("ti=tcp:127.0.0.1:{link_port}")])
+            .args(["--broker", &fleet.url()])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("semo gateway starts"),
+    );
+    // The board's mission time starts when the gateway welcomes it: the
+    // Linux robots count theirs from that instant.
+    let mut linux = Vec::new();
+    let lines = board_trace(&board_rx, |first| {
+        assert_eq!(field(first, "event"), "start", "{first:?}");
+        let t = first["t"].as_u64().unwrap();
+        let start_at = (unix_ms() - t).to_string();
+        for folder in folders.iter().filter(|f| !f.ends_with("ti")) {
+            let args = ["--time-scale", "1", "--start-at", start_at.as_str()];
+            linux.push(fleet.spawn(folder, &scenario, "board", &args));
+        }
+    });
+    let mut traces: std::collections::BTreeMap<String, Vec<Event>> = linux
+        .iter()
+        .map(|s| (s.robot.clone(), fleet.finish(s, "board")))
+        .collect();
+    std::fs::write(fleet.out.join("ti.board.jsonl"), lines.join("\n")).unwrap();
+    let ti = events(&lines);
+    assert_eq!(
+        field(ti.last().unwrap(), "event"),
+        "stop",
+        "the board's trace ends: {lines:#?}"
+    );
+    traces.insert("ti".into(), ti);
+    fleet.processes.wait_success(board, "QEMU (ti)");
+    fleet.processes.kill(gateway);
+
+    let simulated = support::simulate_trace(&scouting(), &scenario, "sim");
+    assert_eq!(simulated.code, 0, "{}", simulated.stderr);
+    let simulated = events(
+        &simulated
+            .stdout
+            .lines()
+            .map(str::to_string)
+            .collect::<Vec<_>>(),
+    );
+    assert_eq!(traces.len(), 3);
+    for (robot, trace) in &traces {
+        let reference: Vec<Event> = simulated
+            .iter()
+            .filter(|e| field(e, "robot") == robot)
+            .cloned()
+            .collect();
+        assert_eq!(
+            modes(trace),
+            modes(&reference),
+            "{robot}'s modes with ti on a board in QEMU and in `semo simulate`"
+        );
+        assert_eq!(modes(trace).last().map(String::as_str), Some("FINISH"));
+    }
+    let heard = |robot: &str, from: &str, key: &str| {
+        traces[robot].iter().any(|e| {
+            field(e, "event") == "receive"
+                && field(e, "from_robot") == from
+                && field(e, "key") == key
+        })
+    };
+    assert!(
+        heard("irobot", "ti", "SlaveTeam.COLOR"),
+        "the master hears ti's colors: up the UART, through the gateway and the broker"
+    );
+    assert!(
+        heard("ti", "nxt", "SlaveTeam.__alive"),
+        "ti hears nxt's heartbeats: from the broker, through the gateway, down the UART"
+    );
+    // Nothing refused or failed on the way (the master drops some of ti's
+    // reports for a full channel, as in the simulator: ti repeats them
+    // faster than the master's plan takes them).
+    for (robot, trace) in &traces {
+        let refused: Vec<&Event> = trace
+            .iter()
+            .filter(|e| matches!(field(e, "event"), "reject" | "comm_error"))
+            .collect();
+        assert!(refused.is_empty(), "{robot}: {refused:?}");
+    }
+}
+
+/// Issue 35's budget: the scouting `ti`, which messages its fleet, built for
+/// `cortex-m` (the build a user makes) with its link fits 32 KB of flash
+/// and 8 KB of RAM (`arm-none-eabi-size`: text + data, data + bss with the
+/// stack). Measured (gcc-arm-none-eabi 12.2, newlib-nano): 22512 B of flash,
+/// 8092 B of RAM (the link's record with three frames of 164 bytes, its
+/// receive ring of two frames, and newlib's snprintf for the heartbeat).
+#[test]
+fn the_messaging_evalbot_fits_the_flash_and_ram_budget() {
+    let test = "the_messaging_evalbot_fits_the_flash_and_ram_budget";
+    if !board_tools_present(test) || !robots::has("arm-none-eabi-size") {
+        return;
+    }
+    let out = robots::scratch("board-link-budget");
+    let (mission, out_arg) = (scouting().display().to_string(), out.display().to_string());
+    let built = support::semo_in(
+        &support::repo_root(),
+        &["build", &mission, "--target", "cortex-m", "-o", &out_arg],
+    );
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    let folder = out.join("SlaveTeam/ti");
+    let made = Command::new("make")
+        .args(["-s", "-j2"])
+        .current_dir(&folder)
+        .output()
+        .expect("make runs");
+    assert!(
+        made.status.success(),
+        "{}",
+        String::from_utf8_lossy(&made.stderr)
+    );
+    let sizes = Command::new("arm-none-eabi-size")
+        .arg(folder.join("ti.elf"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&sizes.stdout);
+    let numbers: Vec<u64> = text
+        .lines()
+        .nth(1)
+        .expect("a line of sizes")
+        .split_whitespace()
+        .take(3)
+        .map(|n| n.parse().unwrap())
+        .collect();
+    let (flash, ram) = (numbers[0] + numbers[1], numbers[1] + numbers[2]);
+    eprintln!("scouting ti on cortex-m with the link: flash {flash} B, RAM {ram} B");
+    assert!(flash <= 32 * 1024, "flash {flash} B > 32 KB");
+    assert!(ram <= 8 * 1024, "RAM {ram} B > 8 KB");
+}
+
+/// Every example mission whose robots message each other (scouting, patrol,
+/// the swarms) builds for `cortex-m` with the link, and every robot
+/// compiles and links with arm-none-eabi-gcc at `-Wpedantic -Werror`
+/// (until the link they were refused, E103).
+#[test]
+fn every_example_builds_for_cortex_m_with_the_link_and_compiles() {
+    let test = "every_example_builds_for_cortex_m_with_the_link_and_compiles";
+    if !board_tools_present(test) {
+        return;
+    }
+    let out = robots::scratch("board-link-examples");
+    let mut linked = 0;
+    for mission in [
+        "scouting/scouting.mission",
+        "patrol/patrol.mission",
+        "swarm/march.mission",
+        "swarm/patrol_groups.mission",
+    ] {
+        let path = support::examples().join(mission);
+        let name = Path::new(mission).file_stem().unwrap().to_string_lossy();
+        let dir = out.join(name.as_ref());
+        let (path_arg, dir_arg) = (path.display().to_string(), dir.display().to_string());
+        let built = support::semo_in(
+            &support::repo_root(),
+            &["build", &path_arg, "--target", "cortex-m", "-o", &dir_arg],
+        );
+        assert_eq!(built.code, 0, "{mission}: {}{}", built.stdout, built.stderr);
+        for folder in robots::robot_folders(&dir) {
+            let makefile = std::fs::read_to_string(folder.join("Makefile")).unwrap();
+            linked += usize::from(makefile.contains(" -DSEMO_LINK "));
+            let made = Command::new("make")
+                .args([
+                    "-s",
+                    "-j2",
+                    "CFLAGS=-std=c11 -Wall -Wextra -Wpedantic -Werror -Os",
+                ])
+                .current_dir(&folder)
+                .output()
+                .expect("make runs");
+            let stderr = String::from_utf8_lossy(&made.stderr);
+            assert!(
+                made.status.success() && !stderr.contains("warning"),
+                "{}: {stderr}",
+                folder.display()
+            );
+        }
+    }
+    assert!(linked >= 10, "robots built with the link: {linked}");
+}
