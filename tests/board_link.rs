@@ -42,29 +42,6 @@ fn scenario() -> PathBuf {
     support::repo_root().join("tests/fixtures/build/scouting.scenario.json")
 }
 
-/// Whether the board's tools are here; without them the test is skipped
-/// (with a message) unless `SEMO_CORTEX_M_TESTS=require`.
-fn board_tools_present(test: &str) -> bool {
-    let missing: Vec<&str> = ["arm-none-eabi-gcc", "qemu-system-arm"]
-        .into_iter()
-        .filter(|tool| !robots::has(tool))
-        .collect();
-    if missing.is_empty() {
-        return true;
-    }
-    let required = std::env::var("SEMO_CORTEX_M_TESTS").is_ok_and(|v| v == "require");
-    assert!(
-        !required,
-        "{test}: SEMO_CORTEX_M_TESTS=require but {} missing",
-        missing.join(", ")
-    );
-    eprintln!(
-        "skipped {test}: {} not installed (CI installs them and sets SEMO_CORTEX_M_TESTS=require)",
-        missing.join(", ")
-    );
-    false
-}
-
 /// `semo build` of the scouting mission for `cortex-m-sim` with the
 /// scenario; `make` of ti's folder at `-Wpedantic -Werror`; its ELF file.
 fn board_ti(out: &Path) -> PathBuf {
@@ -93,20 +70,7 @@ fn board_ti(out: &Path) -> PathBuf {
         makefile.contains("-DSEMO_LINK ") && makefile.contains("SEMO_LINK_PAYLOAD_MAX ?="),
         "ti messages other robots: built with the link\n{makefile}"
     );
-    let made = Command::new("make")
-        .args([
-            "-s",
-            "-j2",
-            "CFLAGS=-std=c11 -Wall -Wextra -Wpedantic -Werror -Os",
-        ])
-        .current_dir(&folder)
-        .output()
-        .expect("make runs");
-    let stderr = String::from_utf8_lossy(&made.stderr);
-    assert!(
-        made.status.success() && !stderr.contains("warning"),
-        "{stderr}"
-    );
+    robots::make_board(&folder);
     folder.join("ti.elf")
 }
 
@@ -177,7 +141,7 @@ fn board_trace(rx: &mpsc::Receiver<String>, mut started: impl FnMut(&Event)) -> 
 #[test]
 fn the_evalbot_in_qemu_on_the_serial_link_behaves_as_in_the_simulator() {
     let test = "the_evalbot_in_qemu_on_the_serial_link_behaves_as_in_the_simulator";
-    if !board_tools_present(test) {
+    if !robots::board_tools_present(test) {
         return;
     }
     let Some(mut fleet) = Fleet::start("board-link-scouting") else {
@@ -289,7 +253,7 @@ fn the_evalbot_in_qemu_on_the_serial_link_behaves_as_in_the_simulator() {
 #[test]
 fn the_messaging_evalbot_fits_the_flash_and_ram_budget() {
     let test = "the_messaging_evalbot_fits_the_flash_and_ram_budget";
-    if !board_tools_present(test) || !robots::has("arm-none-eabi-size") {
+    if !robots::board_tools_present(test) {
         return;
     }
     let out = robots::scratch("board-link-budget");
@@ -336,7 +300,7 @@ fn the_messaging_evalbot_fits_the_flash_and_ram_budget() {
 #[test]
 fn every_example_builds_for_cortex_m_with_the_link_and_compiles() {
     let test = "every_example_builds_for_cortex_m_with_the_link_and_compiles";
-    if !board_tools_present(test) {
+    if !robots::board_tools_present(test) {
         return;
     }
     let out = robots::scratch("board-link-examples");
@@ -359,21 +323,7 @@ fn every_example_builds_for_cortex_m_with_the_link_and_compiles() {
         for folder in robots::robot_folders(&dir) {
             let makefile = std::fs::read_to_string(folder.join("Makefile")).unwrap();
             linked += usize::from(makefile.contains(" -DSEMO_LINK "));
-            let made = Command::new("make")
-                .args([
-                    "-s",
-                    "-j2",
-                    "CFLAGS=-std=c11 -Wall -Wextra -Wpedantic -Werror -Os",
-                ])
-                .current_dir(&folder)
-                .output()
-                .expect("make runs");
-            let stderr = String::from_utf8_lossy(&made.stderr);
-            assert!(
-                made.status.success() && !stderr.contains("warning"),
-                "{}: {stderr}",
-                folder.display()
-            );
+            robots::make_board(&folder);
         }
     }
     assert!(linked >= 10, "robots built with the link: {linked}");

@@ -29,29 +29,6 @@ const QEMU_LIMIT: Duration = Duration::from_secs(120);
 /// The warnings the generated C must compile without, as on linux.
 const CFLAGS: &str = "-std=c11 -Wall -Wextra -Wpedantic -Werror -Os";
 
-/// Whether the tools are here; without them the test is skipped (with a
-/// message) unless `SEMO_CORTEX_M_TESTS=require`.
-fn tools_present(test: &str) -> bool {
-    let missing: Vec<&str> = ["arm-none-eabi-gcc", "arm-none-eabi-size", "qemu-system-arm"]
-        .into_iter()
-        .filter(|tool| !robots::has(tool))
-        .collect();
-    if missing.is_empty() {
-        return true;
-    }
-    let required = std::env::var("SEMO_CORTEX_M_TESTS").is_ok_and(|v| v == "require");
-    assert!(
-        !required,
-        "{test}: SEMO_CORTEX_M_TESTS=require but {} missing (apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm)",
-        missing.join(", ")
-    );
-    eprintln!(
-        "skipped {test}: {} not installed (CI installs them and sets SEMO_CORTEX_M_TESTS=require)",
-        missing.join(", ")
-    );
-    false
-}
-
 fn fixture(name: &str) -> PathBuf {
     support::repo_root()
         .join("tests/fixtures/cortex_m")
@@ -263,7 +240,7 @@ fn compare_with_linux_sim(
 
 #[test]
 fn the_follow_robot_runs_in_qemu_as_on_linux_sim() {
-    if !tools_present("the_follow_robot_runs_in_qemu_as_on_linux_sim") {
+    if !robots::board_tools_present("the_follow_robot_runs_in_qemu_as_on_linux_sim") {
         return;
     }
     let lines = compare_with_linux_sim(
@@ -300,7 +277,7 @@ fn the_follow_robot_runs_in_qemu_as_on_linux_sim() {
 
 #[test]
 fn a_swarm_robot_runs_in_qemu_as_on_linux_sim() {
-    if !tools_present("a_swarm_robot_runs_in_qemu_as_on_linux_sim") {
+    if !robots::board_tools_present("a_swarm_robot_runs_in_qemu_as_on_linux_sim") {
         return;
     }
     let qemu = events(&compare_with_linux_sim(
@@ -321,7 +298,7 @@ fn a_swarm_robot_runs_in_qemu_as_on_linux_sim() {
 /// time, whatever the board.
 #[test]
 fn the_follow_robot_runs_on_an_stm32f4_as_on_the_lm3s6965() {
-    if !tools_present("the_follow_robot_runs_on_an_stm32f4_as_on_the_lm3s6965") {
+    if !robots::board_tools_present("the_follow_robot_runs_on_an_stm32f4_as_on_the_lm3s6965") {
         return;
     }
     let (mission, scenario) = (
@@ -344,7 +321,7 @@ fn the_follow_robot_runs_on_an_stm32f4_as_on_the_lm3s6965() {
 /// passes per simulated second.
 #[test]
 fn the_static_loop_wakes_only_when_a_task_is_due() {
-    if !tools_present("the_static_loop_wakes_only_when_a_task_is_due") {
+    if !robots::board_tools_present("the_static_loop_wakes_only_when_a_task_is_due") {
         return;
     }
     let out = scratch("cortex-m-passes");
@@ -382,7 +359,7 @@ fn the_static_loop_wakes_only_when_a_task_is_due() {
 /// a user makes: the board's target, the task files as generated).
 #[test]
 fn robots_fit_the_flash_and_ram_budgets() {
-    if !tools_present("robots_fit_the_flash_and_ram_budgets") {
+    if !robots::board_tools_present("robots_fit_the_flash_and_ram_budgets") {
         return;
     }
     // What the runtime takes today per board, with room for a compiler's
@@ -469,7 +446,9 @@ fn sources(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
 /// build of every robot for linux-sim writes.
 #[test]
 fn a_mixed_fleet_builds_each_robot_for_its_own_platform_and_both_make() {
-    if !tools_present("a_mixed_fleet_builds_each_robot_for_its_own_platform_and_both_make") {
+    if !robots::board_tools_present(
+        "a_mixed_fleet_builds_each_robot_for_its_own_platform_and_both_make",
+    ) {
         return;
     }
     let project = support::repo_root().join("tests/fixtures/mixed_fleet");

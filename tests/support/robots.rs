@@ -145,6 +145,50 @@ pub fn has(program: &str) -> bool {
     Command::new(program).arg("--version").output().is_ok()
 }
 
+/// Whether the board tools are here (the ARM compiler, its `size`, QEMU);
+/// without them a board test is skipped (with a message) unless
+/// `SEMO_CORTEX_M_TESTS=require` (CI), where a missing tool fails it.
+pub fn board_tools_present(test: &str) -> bool {
+    let missing: Vec<&str> = ["arm-none-eabi-gcc", "arm-none-eabi-size", "qemu-system-arm"]
+        .into_iter()
+        .filter(|tool| !has(tool))
+        .collect();
+    if missing.is_empty() {
+        return true;
+    }
+    let required = std::env::var("SEMO_CORTEX_M_TESTS").is_ok_and(|v| v == "require");
+    assert!(
+        !required,
+        "{test}: SEMO_CORTEX_M_TESTS=require but {} missing (apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm)",
+        missing.join(", ")
+    );
+    eprintln!(
+        "skipped {test}: {} not installed (CI installs them and sets SEMO_CORTEX_M_TESTS=require)",
+        missing.join(", ")
+    );
+    false
+}
+
+/// `make` in a board robot's folder with warnings as errors (`-Wpedantic
+/// -Werror -Os`); fails the test on an error or a warning.
+pub fn make_board(folder: &Path) {
+    let made = Command::new("make")
+        .args([
+            "-s",
+            "-j2",
+            "CFLAGS=-std=c11 -Wall -Wextra -Wpedantic -Werror -Os",
+        ])
+        .current_dir(folder)
+        .output()
+        .expect("make runs");
+    let stderr = String::from_utf8_lossy(&made.stderr);
+    assert!(
+        made.status.success() && !stderr.contains("warning"),
+        "{}: {stderr}",
+        folder.display()
+    );
+}
+
 /// gcc, and clang where it is installed (CI installs it).
 pub fn compilers() -> Vec<&'static str> {
     let found: Vec<&str> = ["gcc", "clang"].into_iter().filter(|c| has(c)).collect();
