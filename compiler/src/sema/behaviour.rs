@@ -2,9 +2,8 @@
 //! `case`/`catch`/`mode =` must name modes; every mode should be reachable from
 //! the default, every thrown event caught, every service set somewhere.
 
-use super::body::Type;
+use super::body::{ParamRef, Type};
 use super::ir::*;
-use super::params::ParamRef;
 use super::{Checker, suggestion};
 use crate::diag::{Code, Severity};
 use crate::fasthash::{FastMap, FastSet};
@@ -352,7 +351,7 @@ impl<'a> Checker<'a> {
             _ => "an expression is worked out at run time".to_string(),
         };
         let message = format!(
-            "{not_fixed}, but the arguments of a mode or a service in `set` must be fixed when the mission is written (a word, a string, a number)"
+            "{not_fixed}, but the arguments of a mode or a service in `set` must be known when the mission is written (a word, a string, a number)"
         );
         self.diagnostics
             .report(Code::ArgumentNotFixed, arg.span(), message);

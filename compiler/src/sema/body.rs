@@ -4,7 +4,6 @@
 //! their body is checked at every call, with the caller's robots.
 
 use super::ir::*;
-use super::params::ParamRef;
 use super::values::{Literal, VariableTest, VariableWrite};
 use super::{Checker, is_user, suggestion};
 use crate::catalog::{RobotTypeId, ServiceDef, ValueType};
@@ -92,6 +91,9 @@ impl Scope {
         }
     }
 }
+
+/// A parameter: whose, and its place in the list.
+pub(super) type ParamRef = (ParamOwner, u32);
 
 /// What an attribute (`X`, `T.X`, `USER.X`) refers to, before reporting.
 #[derive(Clone, Debug)]

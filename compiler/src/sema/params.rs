@@ -23,15 +23,12 @@
 //! parameter's needs are at most one per type a service takes, plus one.
 
 use super::Checker;
-use super::body::Type;
+use super::body::{ParamRef, Type};
 use super::ir::*;
 use crate::diag::Code;
 use crate::fasthash::{FastMap, FastSet};
 use crate::span::Span;
 use crate::syntax::ast::{self, Name};
-
-/// A parameter: whose, and its place in the list.
-pub(super) type ParamRef = (ParamOwner, u32);
 
 /// What the walk of the bodies found about parameters.
 #[derive(Default)]
