@@ -273,6 +273,15 @@ pub fn match_score(query: &str, name: &str) -> Option<u32> {
     }
 }
 
+/// `(A, B)`, or nothing without parameters.
+fn param_list(params: &[crate::sema::ParamInfo]) -> String {
+    if params.is_empty() {
+        return String::new();
+    }
+    let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
+    format!("({})", names.join(", "))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -392,13 +401,4 @@ Function warn [warn] lines 6-6
         assert_eq!(match_score("go", "GO"), Some(1));
         assert_eq!(match_score("xyz", "GO"), None);
     }
-}
-
-/// `(A, B)`, or nothing without parameters.
-fn param_list(params: &[crate::sema::ParamInfo]) -> String {
-    if params.is_empty() {
-        return String::new();
-    }
-    let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
-    format!("({})", names.join(", "))
 }
