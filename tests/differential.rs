@@ -770,3 +770,26 @@ fn functions_with_parameters_run_the_same_in_c_and_in_the_simulator() {
         .collect();
     assert_eq!(moves, ["kitchen", "hall door", "1,1"]);
 }
+
+/// Modes with parameters (`tests/fixtures/mode_params/rounds.mission`): the
+/// generated C enters each mode a mode with parameters is entered as, and
+/// runs each service with its mode's arguments in place of the parameters,
+/// as the simulator does, event for event (`tests/simulate.rs` shows both
+/// equal to the mission written out by hand).
+#[test]
+fn modes_with_parameters_run_the_same_in_c_and_in_the_simulator() {
+    let fixtures = repo_root().join("tests/fixtures/mode_params");
+    let scenario = std::fs::read_to_string(fixtures.join("rounds.scenario.json")).unwrap();
+    let (_, sim) = compare("mode_params", &fixtures.join("rounds.mission"), &scenario);
+    let modes: Vec<&str> = events_of(&sim, "ti", "mode")
+        .into_iter()
+        .map(|e| field(e, "mode"))
+        .collect();
+    assert_eq!(modes, ["MOVE(kitchen, 2)", "SEARCH(hall door)", "HOME"]);
+    let started: Vec<&str> = events_of(&sim, "ti", "service_start")
+        .into_iter()
+        .map(|e| field(e, "service"))
+        .take(3)
+        .collect();
+    assert_eq!(started, ["Go(kitchen, 2)", "Beat", "Look(hall door)"]);
+}

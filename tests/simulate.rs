@@ -634,7 +634,7 @@ fn skipping_idle_firings_changes_no_trace() {
 /// XML comments and Makefile comment lines left out (they cite the source
 /// lines, which differ between a function and its hand-written copy), and
 /// without the manifest of the files' hashes.
-fn built_files(out: &Path, rename: (&str, &str)) -> std::collections::BTreeMap<String, String> {
+fn built_files(out: &Path, renames: &[(&str, &str)]) -> std::collections::BTreeMap<String, String> {
     fn strip(text: &str, open: &str, close: &str) -> String {
         let mut kept = String::new();
         let mut rest = text;
@@ -660,9 +660,10 @@ fn built_files(out: &Path, rename: (&str, &str)) -> std::collections::BTreeMap<S
             if name.ends_with(".semo-manifest") {
                 continue;
             }
-            let text = std::fs::read_to_string(&path)
-                .unwrap()
-                .replace(rename.0, rename.1);
+            let text = renames.iter().fold(
+                std::fs::read_to_string(&path).unwrap(),
+                |text, (from, to)| text.replace(from, to),
+            );
             let text = strip(&strip(&text, "/*", "*/"), "<!--", "-->");
             let text: Vec<&str> = text
                 .lines()
@@ -696,22 +697,35 @@ fn a_function_with_parameters_runs_and_builds_as_its_hand_written_copy() {
 /// trace, and the same generated files but for the comments that cite the
 /// mission's lines (`b`'s file name read as `a`'s). `a`'s trace.
 fn runs_and_builds_alike(folder: &str, a: &str, b: &str) -> String {
+    runs_and_builds_alike_renamed(folder, a, b, &[])
+}
+
+/// [`runs_and_builds_alike`], `a`'s trace and files read with each of
+/// `names` (`a`'s name of a mode or service, `b`'s) replaced by `b`'s.
+fn runs_and_builds_alike_renamed(folder: &str, a: &str, b: &str, names: &[(&str, &str)]) -> String {
     let fixtures = repo_root().join("tests/fixtures").join(folder);
     let scenario = fixtures.join(format!("{a}.scenario.json"));
     let dir = scratch(folder);
-    let rename = (format!("{b}.mission"), format!("{a}.mission"));
+    let file = (format!("{b}.mission"), format!("{a}.mission"));
     let mut traces = Vec::new();
     let mut builds = Vec::new();
     for name in [a, b] {
+        let renames: Vec<(&str, &str)> = match name == a {
+            true => names.to_vec(),
+            false => vec![(file.0.as_str(), file.1.as_str())],
+        };
         let mission = fixtures.join(format!("{name}.mission"));
         let out = support::simulate_trace(&mission, &scenario, "sim");
         assert_eq!(out.code, 0, "{name}: {}{}", out.stdout, out.stderr);
-        traces.push(out.stdout.replace(&rename.0, &rename.1));
+        let trace = renames
+            .iter()
+            .fold(out.stdout, |text, (from, to)| text.replace(from, to));
+        traces.push(trace);
         let folder = dir.join(name);
         let mission = mission.display().to_string();
         let built = semo(&["build", &mission, "-o", &folder.display().to_string()]);
         assert_eq!(built.code, 0, "{name}: {}{}", built.stdout, built.stderr);
-        builds.push(built_files(&folder, (&rename.0, &rename.1)));
+        builds.push(built_files(&folder, &renames));
     }
     assert_eq!(traces[0], traces[1]);
     assert_eq!(
@@ -722,6 +736,33 @@ fn runs_and_builds_alike(folder: &str, a: &str, b: &str) -> String {
         assert_eq!(text, &builds[1][file], "{file}");
     }
     traces.swap_remove(0)
+}
+
+/// Modes with parameters (issue 36) are one mode of the machine per list
+/// of arguments they are entered with, each running its services with the
+/// mode's arguments in place of the parameters:
+/// `tests/fixtures/mode_params/rounds.mission` (two modes with parameters,
+/// a `case` for each holding in every mode it is entered as, a service set
+/// with a word, bare words and a number, compared, sent, inside a group)
+/// simulates to the same trace as the same mission with those modes and
+/// services written out by hand, and builds to the same programs (but for
+/// the comments that cite the mission's lines and the names' texts).
+#[test]
+fn a_mode_with_parameters_runs_and_builds_as_its_hand_written_copy() {
+    let names = [
+        ("MOVE(kitchen, 2)", "MOVE_kitchen__2_"),
+        ("SEARCH(hall door)", "SEARCH_hall_door_"),
+        ("Go(kitchen, 2)", "Go_kitchen__2_"),
+        ("Look(hall door)", "Look_hall_door_"),
+    ];
+    let trace = runs_and_builds_alike_renamed("mode_params", "rounds", "rounds_by_hand", &names);
+    assert!(
+        trace.contains(r#""service":"move","arg":"kitchen""#)
+            && trace.contains(r#""key":"Scouts.Area","value":"hall door""#)
+            && trace.contains(r#""catch","name":"arrived","mode":"SEARCH_hall_door_""#)
+            && trace.contains(r#""mode":"HOME""#),
+        "the run does not reach what it should show:\n{trace}"
+    );
 }
 
 /// A service shared by teams (`tests/fixtures/shared_services/rescue.mission`,

@@ -115,8 +115,10 @@ codes! {
     DuplicateCountedGroup = "E038", Error, "two counted groups of one statement with the same name";
     CountedGroupsTooLarge = "E039", Error, "counted groups whose minimums add up to more robots than run the statement: they can never all be met";
     CountedGroupMixed = "E043", Error, "a counted group (`group(Name, min = N)`) beside an `instance of`/`capable of` group or a `leader` arm in one statement, or a `leader` arm with a count";
-    DuplicateParameter = "E044", Error, "a function with two parameters of the same name";
-    ParameterHidesName = "E045", Error, "a function parameter named like a value robots read or a team variable: in the body the name would mean the parameter, hiding the other";
+    DuplicateParameter = "E044", Error, "a function, composite service or mode with two parameters of the same name";
+    ParameterHidesName = "E045", Error, "a parameter (of a function, composite service or mode) named like a value robots read or a team variable: where used the name would mean the parameter, hiding the other";
+    ModeArgumentCount = "E046", Error, "a mode entered (`mode = MOVE(kitchen)`) or a composite service set (`set(Action, Go(kitchen))`) with more or fewer arguments than its parameters, or with arguments it does not take";
+    ArgumentNotFixed = "E047", Error, "an argument of a mode entered or of a service set that is not known when the mission is written (a value robots read, a team variable, an expression): each list of arguments is a mode of its own";
     TooManyRobots = "E036", Error, "`name[N]` with N above 4096, or a mission with more than 4096 robots in all";
     // Catalog files (*.robot.xml).
     CatalogXml = "E050", Error, "a catalog file that is not well-formed XML";
@@ -229,7 +231,7 @@ codes! {
     TeamWithoutMain = "W011", Warning, "a team without a main block: its robots do nothing";
     EmptyOthers = "W012", Warning, "an `others` block that no robot is left to run";
     CountedGroupsNoSpare = "W014", Hint, "counted groups whose minimums take every robot that runs the statement: a robot lost leaves a group short";
-    ParameterNeverUsed = "W015", Warning, "a function parameter that its body never uses: its argument is read for nothing";
+    ParameterNeverUsed = "W015", Warning, "a parameter that is never used (a function's or a composite service's in its body, a mode's in its `set`s): its argument is given for nothing";
     BroadcastToNoOne = "W013", Hint, "a `throw E broadcast` that only one robot runs: its group (or team) has no one else to tell";
     ComparisonNeverHolds = "W020", Warning, "a comparison of a team variable with a value it is never set to: it never holds";
     ComparisonAlwaysHolds = "W021", Warning, "`!=` between a team variable and a value it is never set to: it holds whenever the variable has a value";

@@ -70,6 +70,7 @@ module.exports = grammar({
       field('plan', $.identifier),
       '.',
       field('name', $.identifier),
+      optional(field('parameters', $.parameter_list)),
       field('body', $.block),
       optional(field('repeat', $.repeat_clause)),
     ),
@@ -83,13 +84,16 @@ module.exports = grammar({
       field('body', $.block),
     ),
 
-    // `(PLACE, WAIT)`: names that stand for the call's arguments in the body.
+    // `(PLACE, WAIT)`: names that stand for the call's arguments in the body
+    // (a function's), for the arguments a mode's `set` gives (a service's),
+    // or for those the mode is entered with (a mode's).
     parameter_list: $ => seq('(', commaSep(field('parameter', $.identifier)), ')'),
 
     mode_definition: $ => seq(
       field('team', $.identifier),
       '.',
       field('name', $.identifier),
+      optional(field('parameters', $.parameter_list)),
       field('body', $.mode_body),
     ),
 
@@ -101,6 +105,7 @@ module.exports = grammar({
       field('plan', $.identifier),
       ',',
       field('service', choice($.identifier, $.off)),
+      optional(field('arguments', $.arguments)),
       optional(seq(',', $.timeout)),
       ')',
     ),
@@ -136,7 +141,13 @@ module.exports = grammar({
 
     default_clause: $ => seq('default', ':', $.mode_assignment),
 
-    mode_assignment: $ => seq('mode', '=', field('mode', $.identifier), repeat(';')),
+    mode_assignment: $ => seq(
+      'mode',
+      '=',
+      field('mode', $.identifier),
+      optional(field('arguments', $.arguments)),
+      repeat(';'),
+    ),
 
     // ----- statements -----
 

@@ -245,13 +245,9 @@ pub fn control_task(program: &RobotProgram, words: &Words, peers: &Peers, header
     // Ports.
     // Modes.
     out.push_str("/* Modes (top level). */\nenum {");
-    for (i, mode) in m.modes.iter().enumerate() {
-        let _ = write!(
-            out,
-            "{}MODE_{}",
-            if i == 0 { " " } else { ", " },
-            c::ident(&mode.name)
-        );
+    let idents = mode_idents(m);
+    for (i, ident) in idents.iter().enumerate() {
+        let _ = write!(out, "{}MODE_{ident}", if i == 0 { " " } else { ", " });
     }
     if m.modes.is_empty() {
         out.push_str(" MODE_NONE_");
@@ -368,12 +364,13 @@ fn emit_catch_event(out: &mut String, program: &RobotProgram, throws: bool, broa
 fn emit_catches(out: &mut String, program: &RobotProgram, caught: &str) {
     let m = &program.control;
     out.push_str("    switch (current_mode) {\n");
-    for (from, mode) in ModeId::all(m.modes.len()).zip(&m.modes) {
+    let idents = mode_idents(m);
+    for (from, ident) in ModeId::all(m.modes.len()).zip(&idents) {
         let catches: Vec<_> = m.transitions.iter().filter(|t| t.from == from).collect();
         if catches.is_empty() {
             continue;
         }
-        let _ = writeln!(out, "    case MODE_{}:", c::ident(&mode.name));
+        let _ = writeln!(out, "    case MODE_{ident}:");
         for t in catches {
             let _ = writeln!(
                 out,
@@ -381,7 +378,7 @@ fn emit_catches(out: &mut String, program: &RobotProgram, caught: &str) {
                 c::string(&t.event),
                 c::comment(&program.mission),
                 t.line,
-                c::ident(&m.mode(t.to).name)
+                idents[t.to.index()]
             );
         }
         out.push_str("        break;\n");
@@ -1193,14 +1190,32 @@ fn emit_dispatch(out: &mut String, program: &RobotProgram) {
     out.push_str(" };\n\n");
 }
 
+/// Each mode's C identifier (after `MODE_`): its name's, unless a mode
+/// before it has that one (`MOVE(a b)` and `MOVE(a_b)` would both be
+/// `MOVE_a_b_`), then with its index added until it is unique. Plain names
+/// of one machine are distinct, so they keep their own.
+fn mode_idents(m: &crate::refine::ControlMachine) -> Vec<String> {
+    let mut taken = std::collections::HashSet::new();
+    let mut idents = Vec::with_capacity(m.modes.len());
+    for (i, mode) in m.modes.iter().enumerate() {
+        let mut ident = c::ident(&mode.name);
+        while !taken.insert(ident.clone()) {
+            ident = format!("{ident}_{i}");
+        }
+        idents.push(ident);
+    }
+    idents
+}
+
 fn emit_modes(out: &mut String, program: &RobotProgram) {
     let m = &program.control;
     out.push_str(ENTER_MODE_HEAD.text);
-    for mode in &m.modes {
+    let idents = mode_idents(m);
+    for (i, mode) in m.modes.iter().enumerate() {
         let _ = writeln!(
             out,
             "    case MODE_{}: /* {}:{} */",
-            c::ident(&mode.name),
+            idents[i],
             c::comment(&program.mission),
             mode.line
         );
@@ -1272,7 +1287,7 @@ fn emit_task(out: &mut String, program: &RobotProgram, peers: &Peers) {
     );
     let default = m
         .default_mode
-        .map(|d| format!("MODE_{}", c::ident(&m.mode(d).name)));
+        .map(|d| format!("MODE_{}", mode_idents(m)[d.index()]));
     out.push_str(&fill(&GO_HEAD, &[("name", &name)]));
     if !m.battery.is_empty() {
         out.push_str("    manage_resources();\n");

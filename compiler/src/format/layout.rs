@@ -159,7 +159,7 @@ fn team(e: &mut Emitter<'_, '_>, t: &ast::TeamDecl) {
 }
 
 fn mode(e: &mut Emitter<'_, '_>, m: &ast::ModeDef) -> Result {
-    e.plain(m.name.span.end);
+    e.plain(m.params_span.map_or(m.name.span.end, |list| list.end));
     braced(e, m.sets.is_empty(), |e| {
         for (j, set) in m.sets.iter().enumerate() {
             e.boundary(separator(j == 0), false);

@@ -255,3 +255,13 @@ fn a_service_shared_by_teams_lists_its_teams_on_its_header() {
         "A, B, C.P.S {\n  x()\n} repeat()\n"
     );
 }
+
+#[test]
+fn modes_and_services_keep_their_parameters_and_arguments_on_one_line() {
+    assert_eq!(
+        fmt(
+            "R.Action.Go( PLACE,WAIT ){move(PLACE)} repeat()\nR.MOVE( TARGET ){ set(Action,Go( TARGET ,2)) }\nR.main{ case(MOVE): catch(x): mode=MOVE( hall door )\n default: mode = MOVE( kitchen ) }"
+        ),
+        "R.Action.Go(PLACE, WAIT) {\n  move(PLACE)\n} repeat()\n\nR.MOVE(TARGET) {\n  set(Action, Go(TARGET, 2))\n}\n\nR.main {\n  case (MOVE):\n    catch (x): mode = MOVE(hall door)\n  default: mode = MOVE(kitchen)\n}\n"
+    );
+}

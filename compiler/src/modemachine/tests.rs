@@ -239,3 +239,27 @@ T.main{
     assert!(svg.contains("<g class=\"change\" data-from=\"BUSY\" data-to=\"IDLE\">"));
     assert_eq!(svg.matches("stroke-dasharray").count(), 2);
 }
+
+/// A mode with parameters is drawn once per list of arguments it is
+/// entered with, each named as entered (`MOVE(kitchen)`); a `case` for it
+/// holds in each; a string argument's quotes are escaped in the picture.
+#[test]
+fn a_mode_with_parameters_is_one_box_per_list_of_arguments() {
+    let text = "{ R: iRobotCreate r }\n\
+                R.Action.Go(PLACE) { move(PLACE) throw arrived }\n\
+                R.MOVE(TARGET) { set(Action, Go(TARGET)) }\n\
+                R.main {\n  case (MOVE):\n    catch (arrived): mode = MOVE(\"a<b\")\n  default: mode = MOVE(kitchen)\n}\n";
+    let found = machines_of(text);
+    let m = &found[0];
+    assert_eq!(m.modes, ["MOVE(kitchen)", "MOVE(\"a<b\")"]);
+    assert_eq!(m.default, Some(0));
+    let changes: Vec<(usize, usize)> = m.changes.iter().map(|c| (c.from, c.to)).collect();
+    assert_eq!(changes, [(0, 1), (1, 1)]);
+    let svg = to_svg(&found);
+    assert!(svg.contains(">MOVE(kitchen)</text>"), "{svg}");
+    assert!(
+        svg.contains(">MOVE(&quot;a&lt;b&quot;)</text>")
+            || svg.contains(">MOVE(\"a&lt;b\")</text>"),
+        "{svg}"
+    );
+}

@@ -149,7 +149,10 @@ struct Builder<'a, 'i> {
     /// Service task → the services or actuator commands it runs.
     services: BTreeMap<String, BTreeSet<String>>,
     /// Team service → machine index.
-    service_machines: HashMap<ServiceId, ServiceMachineId>,
+    /// Team service and its arguments as written (none for a service
+    /// without parameters) → machine index: a service with parameters is
+    /// one machine per distinct list of arguments, as written by hand.
+    service_machines: HashMap<(ServiceId, Vec<String>), ServiceMachineId>,
     /// (strategy file, entry index) → action machine index.
     action_machines: HashMap<(u32, usize), ActionMachineId>,
     /// The team service whose machine is being built (for the strategy's
@@ -244,7 +247,7 @@ impl Builder<'_, '_> {
                 let (Some(plan), Some(service)) = (set.plan, set.service) else {
                     continue; // OFF
                 };
-                let machine = self.service_machine(service);
+                let machine = self.service_machine(service, &set.args);
                 regions.push(Region {
                     plan: team.plans[plan.index()].name.to_string(),
                     service: machine,
@@ -274,16 +277,34 @@ impl Builder<'_, '_> {
         }
     }
 
-    fn service_machine(&mut self, service: ServiceId) -> ServiceMachineId {
-        if let Some(&m) = self.service_machines.get(&service) {
+    /// The machine of `service` run with `args` (the mode's `set` gives
+    /// them, fixed): in its body each parameter is its argument, as in a
+    /// copy of the body with the arguments written in place.
+    fn service_machine(&mut self, service: ServiceId, args: &[ast::Arg]) -> ServiceMachineId {
+        let written: Vec<String> = args.iter().map(ast::Arg::written).collect();
+        let key = (service, written);
+        if let Some(&m) = self.service_machines.get(&key) {
             return m;
         }
         let info = &self.team.services[service.index()];
+        if info.params.len() != args.len() {
+            let what = format!(
+                "`{}` takes {} arguments, yet the checker let a mode set it with {}",
+                info.name,
+                info.params.len(),
+                args.len()
+            );
+            self.internal_error(info.name_span, &what);
+        }
+        let name = match key.1.is_empty() {
+            true => info.name.to_string(),
+            false => format!("{}({})", info.name, key.1.join(", ")),
+        };
         let index = ServiceMachineId::new(self.machine.services.len());
-        self.service_machines.insert(service, index);
+        self.service_machines.insert(key, index);
         self.machine.services.push(ServiceMachine {
             plan: self.team.plans[info.plan.index()].name.to_string(),
-            name: info.name.to_string(),
+            name,
             line: self.line(info.name_span),
             states: Vec::new(),
             marks: 0,
@@ -291,6 +312,9 @@ impl Builder<'_, '_> {
         let mut states = Vec::new();
         let mut marks = 0;
         let outer = self.current_service.replace(service);
+        // The service's parameters are its arguments: the frame under any
+        // function call its body inlines.
+        self.arguments.push(args.to_vec());
         if let Some(syntax) = self.input.analysis.service_syntax(info) {
             self.block(&syntax.body, &mut states, &mut marks, 0);
             let (period_ms, condition, forever, span, period_span) = match &syntax.repeat {
@@ -320,6 +344,7 @@ impl Builder<'_, '_> {
                 text,
             });
         }
+        self.arguments.pop();
         self.current_service = outer;
         let m = &mut self.machine.services[index.index()];
         m.states = states;

@@ -2,6 +2,7 @@
 //! `case`/`catch`/`mode =` must name modes; every mode should be reachable from
 //! the default, every thrown event caught, every service set somewhere.
 
+use super::body::{ParamRef, Type};
 use super::ir::*;
 use super::{Checker, suggestion};
 use crate::diag::{Code, Severity};
@@ -19,6 +20,9 @@ impl<'a> Checker<'a> {
                 Item::Main(m) => self.main(m),
                 _ => {}
             }
+        }
+        for t in 0..self.mission.teams.len() {
+            self.instantiate(TeamId(t as u32));
         }
         for t in 0..self.mission.teams.len() {
             let team = TeamId(t as u32);
@@ -47,6 +51,12 @@ impl<'a> Checker<'a> {
         (self.team(team).modes[mode.index()].span == m.span).then_some((team, mode))
     }
 
+    /// The template of a mode with parameters, unless it was rejected.
+    fn declared_template(&self, team: TeamId, m: &ast::ModeDef) -> Option<TemplateId> {
+        let template = self.team(team).template_by_name(&m.name.name)?;
+        (self.team(team).template(template).span == m.span).then_some(template)
+    }
+
     fn mode_sets(&mut self, m: &ast::ModeDef) {
         let Some(team) = self.team_id(&m.team.name) else {
             return;
@@ -54,6 +64,10 @@ impl<'a> Checker<'a> {
         // `None` for a second definition of the mode (already reported): its sets
         // are still checked.
         let mode = self.declared_mode(m).map(|(_, mode)| mode);
+        let template = match m.params_span {
+            Some(_) => self.declared_template(team, m),
+            None => None,
+        };
         let mut sets: Vec<ModeSet> = Vec::new();
         // Where each plan is first set, without scanning `sets`.
         let mut first_sets: FastMap<PlanId, Span> = FastMap::default();
@@ -104,16 +118,25 @@ impl<'a> Checker<'a> {
                 (SetTarget::Service(name), Some(plan)) => self.set_target(team, plan, name),
                 (SetTarget::Service(_), None) => None,
             };
+            if let Some(service) = service {
+                self.service_arguments(team, service, set, template);
+            }
             sets.push(ModeSet {
                 plan,
                 service,
+                args: set
+                    .args
+                    .as_ref()
+                    .map(|a| a.args.clone())
+                    .unwrap_or_default(),
                 timeout_ms: set.timeout.as_ref().and_then(|p| p.millis()),
                 span: set.span,
             });
         }
-        match mode {
-            Some(mode) => self.team_mut(team).modes[mode.index()].sets = sets,
-            None => self
+        match (mode, template) {
+            (Some(mode), _) => self.team_mut(team).modes[mode.index()].sets = sets,
+            (None, Some(template)) => self.team_mut(team).templates[template.index()].sets = sets,
+            (None, None) => self
                 .set_by_duplicate_modes
                 .extend(sets.iter().filter_map(|s| s.service).map(|s| (team, s))),
         }
@@ -154,13 +177,300 @@ impl<'a> Checker<'a> {
         None
     }
 
-    /// Resolves a mode name in a main block, reporting it if undefined.
-    fn mode_ref(&mut self, team: TeamId, name: &ast::Ident) -> Option<ModeId> {
-        let mode = self.lookup_mode_ref(team, name);
+    /// Resolves a mode entered in a main block (`mode = M`, `mode =
+    /// MOVE(kitchen)`, the default), reporting it if undefined: a mode with
+    /// parameters entered with arguments is the mode of the machine for
+    /// those arguments, made the first time they are given.
+    fn mode_ref(
+        &mut self,
+        team: TeamId,
+        name: &ast::Ident,
+        args: Option<&ast::ArgList>,
+    ) -> Option<ModeId> {
+        let mode = match self.team(team).template_by_name(&name.name) {
+            Some(template) => {
+                let symbol = Symbol::ModeTemplate { team, template };
+                self.occurrence(name.span, symbol, false);
+                self.entered_template(team, template, name, args)
+            }
+            None => {
+                let mode = self.lookup_mode_ref(team, name);
+                if let (Some(_), Some(args)) = (mode, args) {
+                    let message = format!(
+                        "the mode `{}` takes no arguments (it has no parameters)",
+                        name.name
+                    );
+                    self.diagnostics
+                        .report(Code::ModeArgumentCount, args.span, message);
+                }
+                mode
+            }
+        };
         if mode.is_none() {
             self.mains_with_unknown_modes.insert(team);
         }
         mode
+    }
+
+    /// A mode named in `case (M):`: a mode of the machine, or a mode with
+    /// parameters, whose catches then hold in each mode it is entered as.
+    fn case_ref(&mut self, team: TeamId, name: &ast::Ident) -> Option<CaseFrom> {
+        if let Some(template) = self.team(team).template_by_name(&name.name) {
+            let symbol = Symbol::ModeTemplate { team, template };
+            self.occurrence(name.span, symbol, false);
+            return Some(CaseFrom::Template(template));
+        }
+        let mode = self.lookup_mode_ref(team, name).map(CaseFrom::Mode);
+        if mode.is_none() {
+            self.mains_with_unknown_modes.insert(team);
+        }
+        mode
+    }
+
+    /// `MOVE(kitchen)`: its arguments checked (E046 the count, E047 one
+    /// not fixed, each recorded for its parameter's needs), then the mode
+    /// of the machine for them.
+    fn entered_template(
+        &mut self,
+        team: TeamId,
+        template: TemplateId,
+        name: &ast::Ident,
+        args: Option<&ast::ArgList>,
+    ) -> Option<ModeId> {
+        let owner = ParamOwner::Mode(team, template);
+        let given = args.map_or(&[][..], |a| a.args.as_slice());
+        if !self.argument_count(owner, given.len(), args.map_or(name.span, |a| a.span)) {
+            return None;
+        }
+        let mut fixed = true;
+        for (index, arg) in given.iter().enumerate() {
+            match self.fixed_argument(team, arg) {
+                Some(ty) => self
+                    .param_uses
+                    .argument((owner, index as u32), ty, arg.span()),
+                None => fixed = false,
+            }
+        }
+        if !fixed {
+            return None;
+        }
+        let t = self.team(team);
+        let written: Vec<String> = given.iter().map(ast::Arg::written).collect();
+        let instance_name = Name::new(format!("{}({})", name.name, written.join(", ")));
+        if let Some(mode) = t.mode_by_name(&instance_name) {
+            return Some(mode);
+        }
+        let declared = t.template(template);
+        let mode = Mode {
+            name: instance_name,
+            name_span: declared.name_span,
+            span: declared.span,
+            // Filled once every mode's `set`s are checked (`instantiate`).
+            sets: Vec::new(),
+            instance: Some(ModeInstance {
+                template,
+                args: given.to_vec(),
+            }),
+        };
+        let mode = self.team_mut(team).add_mode(mode);
+        self.team_mut(team).templates[template.index()]
+            .instances
+            .push(mode);
+        Some(mode)
+    }
+
+    /// Whether `given` arguments (written at `span`) are as many as
+    /// `owner`'s parameters; E046 when not.
+    fn argument_count(&mut self, owner: ParamOwner, given: usize, span: Span) -> bool {
+        let params = self.mission.params(owner);
+        let takes = params.len();
+        if given == takes {
+            return true;
+        }
+        let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
+        let expected = match takes {
+            0 => "no arguments".to_string(),
+            1 => format!("1 argument ({})", names.join(", ")),
+            n => format!("{n} arguments ({})", names.join(", ")),
+        };
+        let what = match owner {
+            ParamOwner::Mode(..) => "mode",
+            _ => "service",
+        };
+        let message = format!(
+            "the {what} `{}` takes {expected}, but {given} {} given",
+            self.mission.owner_name(owner),
+            if given == 1 { "is" } else { "are" },
+        );
+        self.diagnostics
+            .report(Code::ModeArgumentCount, span, message);
+        false
+    }
+
+    /// The type of an argument fixed when the mission is written (a word,
+    /// a string, a number, a period, `true`/`false`); E047 otherwise. A
+    /// bare word is a word unless the team's robots read a value or the
+    /// team has a variable of that name.
+    fn fixed_argument(&mut self, team: TeamId, arg: &ast::Arg) -> Option<Type> {
+        let expr = match arg {
+            ast::Arg::Words { .. } => return Some(Type::Text),
+            ast::Arg::Expr(e) => e,
+        };
+        let not_fixed = match &expr.kind {
+            ast::ExprKind::Str(_) => return Some(Type::Text),
+            ast::ExprKind::Number(n) if n.contains('.') => return Some(Type::Float),
+            ast::ExprKind::Number(_) => return Some(Type::Int),
+            ast::ExprKind::Period(p) => {
+                self.period(p);
+                return Some(Type::Period);
+            }
+            ast::ExprKind::Bool(_) => return Some(Type::Bool),
+            ast::ExprKind::Error => return None,
+            ast::ExprKind::Attr(attr) => match attr.segments.as_slice() {
+                [name] => {
+                    let catalog = self.catalog;
+                    let read = self.team_types[team.0 as usize]
+                        .iter()
+                        .any(|(ty, _)| catalog.get(*ty).value(&name.name).is_some());
+                    let variable = self.is_variable(team, &name.name);
+                    if !read && !variable {
+                        let word = Symbol::Constant(name.name.clone());
+                        self.occurrence(name.span, word, false);
+                        return Some(Type::Constant(name.name.clone()));
+                    }
+                    let what = if read { "a value" } else { "a team variable" };
+                    format!(
+                        "`{}` is {what} of team {}, read at run time (write `\"{}\"` for the word)",
+                        name.name,
+                        self.team(team).name,
+                        name.name
+                    )
+                }
+                _ => format!("`{}` is a value read at run time", attr.dotted()),
+            },
+            _ => "an expression is worked out at run time".to_string(),
+        };
+        let message = format!(
+            "{not_fixed}, but the arguments of a mode or a service in `set` must be known when the mission is written (a word, a string, a number)"
+        );
+        self.diagnostics
+            .report(Code::ArgumentNotFixed, arg.span(), message);
+        None
+    }
+
+    /// The arguments of `set(Plan, S(...))`: as many as `service`'s
+    /// parameters (E046), each fixed (E047) or, in a mode with parameters,
+    /// one of them (passed on to the service's parameter).
+    fn service_arguments(
+        &mut self,
+        team: TeamId,
+        service: ServiceId,
+        set: &ast::SetStmt,
+        template: Option<TemplateId>,
+    ) {
+        let owner = ParamOwner::Service(team, service);
+        let given = set.args.as_ref().map_or(&[][..], |a| a.args.as_slice());
+        let span = set.args.as_ref().map_or(set.span, |a| a.span);
+        if !self.argument_count(owner, given.len(), span) {
+            return;
+        }
+        for (index, arg) in given.iter().enumerate() {
+            let callee = (owner, index as u32);
+            if let Some((param, name)) = template.and_then(|t| self.mode_parameter(team, t, arg)) {
+                self.param_uses.used(param);
+                let (owner, index) = param;
+                self.occurrence(arg.span(), Symbol::Parameter { owner, index }, false);
+                self.param_uses
+                    .argument(callee, Type::Param { param, name }, arg.span());
+            } else if let Some(ty) = self.fixed_argument(team, arg) {
+                if let (Some(t), Type::Constant(word)) = (template, &ty) {
+                    self.misspelt_mode_parameter(team, t, word, arg.span());
+                }
+                self.param_uses.argument(callee, ty, arg.span());
+            }
+        }
+    }
+
+    /// W007 for a word given in a mode's `set` that looks like one of the
+    /// mode's parameters misspelt: it would be passed as the word.
+    fn misspelt_mode_parameter(
+        &mut self,
+        team: TeamId,
+        template: TemplateId,
+        word: &Name,
+        span: Span,
+    ) {
+        let params = &self.team(team).template(template).params;
+        let Some(guess) = suggestion(word, params.iter().map(|p| p.name.as_str())) else {
+            return;
+        };
+        let message = format!(
+            "`{word}` is no parameter of the mode `{}`: it is given as the word `{word}`",
+            self.team(team).template(template).name
+        );
+        self.diagnostics
+            .report(Code::UnknownAttribute, span, message)
+            .suggest(Some(guess));
+    }
+
+    /// The parameter of mode `template` that `arg` names, if it is one.
+    fn mode_parameter(
+        &self,
+        team: TeamId,
+        template: TemplateId,
+        arg: &ast::Arg,
+    ) -> Option<(ParamRef, Name)> {
+        let ast::Arg::Expr(ast::Expr {
+            kind: ast::ExprKind::Attr(attr),
+            ..
+        }) = arg
+        else {
+            return None;
+        };
+        let [name] = attr.segments.as_slice() else {
+            return None;
+        };
+        let params = &self.team(team).template(template).params;
+        let index = params.iter().position(|p| p.name == name.name)?;
+        Some((
+            (ParamOwner::Mode(team, template), index as u32),
+            name.name.clone(),
+        ))
+    }
+
+    /// Each mode entered with arguments gets its template's `set`s, each
+    /// argument that is a parameter of the mode replaced by the argument
+    /// the mode is entered with: the mode the hand-written copy is.
+    fn instantiate(&mut self, team: TeamId) {
+        let t = self.team(team);
+        let mut filled = Vec::new();
+        for mode in t.mode_ids() {
+            let Some(instance) = &t.mode(mode).instance else {
+                continue;
+            };
+            let template = t.template(instance.template);
+            let sets: Vec<ModeSet> = template
+                .sets
+                .iter()
+                .map(|set| ModeSet {
+                    args: set
+                        .args
+                        .iter()
+                        .map(
+                            |arg| match self.mode_parameter(team, instance.template, arg) {
+                                Some(((_, index), _)) => instance.args[index as usize].clone(),
+                                None => arg.clone(),
+                            },
+                        )
+                        .collect(),
+                    ..set.clone()
+                })
+                .collect();
+            filled.push((mode, sets));
+        }
+        for (mode, sets) in filled {
+            self.team_mut(team).modes[mode.index()].sets = sets;
+        }
     }
 
     fn lookup_mode_ref(&mut self, team: TeamId, name: &ast::Ident) -> Option<ModeId> {
@@ -171,7 +481,13 @@ impl<'a> Checker<'a> {
             }
             None => {
                 let t = self.team(team);
-                let guess = suggestion(&name.name, t.modes.iter().map(|m| m.name.as_str()));
+                let names = t
+                    .modes
+                    .iter()
+                    .filter(|m| m.instance.is_none())
+                    .map(|m| &m.name);
+                let templates = t.templates.iter().map(|m| &m.name);
+                let guess = suggestion(&name.name, names.chain(templates).map(Name::as_str));
                 let message = format!("team {} has no mode `{}`", t.name, name.name);
                 self.diagnostics
                     .report(Code::UnknownMode, name.span, message)
@@ -197,7 +513,7 @@ impl<'a> Checker<'a> {
             return;
         }
         let default = match &m.default {
-            Some(name) => self.mode_ref(team, name),
+            Some(name) => self.mode_ref(team, name, m.default_args.as_ref()),
             None => {
                 self.diagnostics.report(
                     Code::MissingDefault,
@@ -213,9 +529,12 @@ impl<'a> Checker<'a> {
         let mut transitions = Vec::new();
         // The first case of each mode, and below the first catch of each
         // event, by hash: a main may have thousands.
-        let mut cased: FastMap<ModeId, Span> = FastMap::default();
+        let mut cased: FastMap<CaseFrom, Span> = FastMap::default();
+        // The catches of a case for a mode with parameters, added for each
+        // mode it is entered as once the whole main is read.
+        let mut template_catches: Vec<(TemplateId, Transition)> = Vec::new();
         for case in &m.cases {
-            let from = self.mode_ref(team, &case.mode);
+            let from = self.case_ref(team, &case.mode);
             if let Some(from) = from {
                 if let Some(&first) = cased.get(&from) {
                     self.diagnostics
@@ -243,17 +562,31 @@ impl<'a> Checker<'a> {
                 } else {
                     caught.insert(&catch.event.name, catch.event.span);
                 }
-                let to = self.mode_ref(team, &catch.target);
+                let to = self.mode_ref(team, &catch.target, catch.target_args.as_ref());
                 if let (Some(from), Some(to)) = (from, to) {
-                    transitions.push(Transition {
+                    let transition = |from| Transition {
                         from,
                         event: catch.event.name.clone(),
                         event_span: catch.event.span,
                         to,
                         span: catch.span,
                         never_thrown: false,
-                    });
+                    };
+                    match from {
+                        CaseFrom::Mode(from) => transitions.push(transition(from)),
+                        CaseFrom::Template(template) => {
+                            template_catches.push((template, transition(ModeId::new(0))))
+                        }
+                    }
                 }
+            }
+        }
+        for (template, transition) in template_catches {
+            for &from in &self.team(team).template(template).instances {
+                transitions.push(Transition {
+                    from,
+                    ..transition.clone()
+                });
             }
         }
         self.team_mut(team).main = Some(Main {
@@ -384,6 +717,13 @@ impl<'a> Checker<'a> {
             }
         }
         let default_name = t.modes[start.index()].name.clone();
+        // A mode with parameters that no catch nor the default enters.
+        let never_entered: Vec<(Span, Name)> = t
+            .templates
+            .iter()
+            .filter(|m| m.instances.is_empty())
+            .map(|m| (m.name_span, m.name.clone()))
+            .collect();
         let unreachable: Vec<ModeId> = t.mode_ids().filter(|i| !reached.contains(i)).collect();
         let findings: Vec<(crate::span::Span, Name)> = unreachable
             .iter()
@@ -404,14 +744,28 @@ impl<'a> Checker<'a> {
                 format!("the mode `{name}` can never be entered: no catch leads to it from the default mode {default_name}"),
             );
         }
+        for (span, name) in never_entered {
+            self.diagnostics.report(
+                Code::UnreachableMode,
+                span,
+                format!("the mode `{name}` is never entered: no catch nor the default names it with arguments"),
+            );
+        }
     }
 
     fn services_never_set(&mut self, team: TeamId) {
         let t = self.team(team);
+        // A service set only by a mode with parameters never entered is
+        // reported there (W002), not here.
         let set: FastSet<ServiceId> = t
             .modes
             .iter()
             .flat_map(|m| m.sets.iter().filter_map(|s| s.service))
+            .chain(
+                t.templates
+                    .iter()
+                    .flat_map(|m| m.sets.iter().filter_map(|s| s.service)),
+            )
             .collect();
         let unused: Vec<(crate::span::Span, String)> = t
             .service_ids()
@@ -426,4 +780,12 @@ impl<'a> Checker<'a> {
             );
         }
     }
+}
+
+/// What a `case` names: a mode of the machine, or a mode with parameters
+/// (its catches hold in each mode it is entered as).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum CaseFrom {
+    Mode(ModeId),
+    Template(TemplateId),
 }

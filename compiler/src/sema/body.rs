@@ -80,6 +80,21 @@ pub(super) struct Scope {
     inlining: Vec<FunctionId>,
 }
 
+impl Scope {
+    /// Whose parameters a bare name in the statement may be: the innermost
+    /// function's being inlined, else the service's.
+    fn param_owner(&self) -> Option<ParamOwner> {
+        match (self.inlining.last(), self.team, self.service) {
+            (Some(&function), ..) => Some(ParamOwner::Function(function)),
+            (None, Some(team), Some(service)) => Some(ParamOwner::Service(team, service)),
+            _ => None,
+        }
+    }
+}
+
+/// A parameter: whose, and its place in the list.
+pub(super) type ParamRef = (ParamOwner, u32);
+
 /// What an attribute (`X`, `T.X`, `USER.X`) refers to, before reporting.
 #[derive(Clone, Debug)]
 enum Resolution {
@@ -117,15 +132,16 @@ enum Resolution {
     Bare {
         name: Name,
         known: Candidates,
-        /// The function whose body is walked: its parameters are candidates too.
-        function: Option<FunctionId>,
+        /// The function or service whose body is walked: its parameters are
+        /// candidates too.
+        function: Option<ParamOwner>,
     },
     /// Nothing can be said (no robot runs the statement).
     Unchecked,
-    /// A parameter of the function whose body is being walked.
+    /// A parameter of the function (else the service) whose body is being
+    /// walked.
     Parameter {
-        function: FunctionId,
-        index: u32,
+        param: ParamRef,
         name: Name,
     },
 }
@@ -160,12 +176,11 @@ pub(super) enum Type {
     Value(ValueType),
     Constant(Name),
     Unknown,
-    /// A parameter of the function being walked: whatever each call gives
-    /// (checked against the body's uses once every body is walked,
-    /// `params.rs`). Compared as a team variable is.
+    /// A parameter of the function (or service) being walked: whatever
+    /// each call (`set`) gives (checked against the body's uses once every
+    /// body is walked, `params.rs`). Compared as a team variable is.
     Param {
-        function: FunctionId,
-        index: u32,
+        param: ParamRef,
         name: Name,
     },
 }
@@ -533,8 +548,8 @@ impl<'a> Checker<'a> {
                 Arg::Expr(e) => self.expr(e, scope, true),
             };
             if index < takes {
-                self.param_uses
-                    .argument((function, index as u32), ty, arg.span());
+                let callee = (ParamOwner::Function(function), index as u32);
+                self.param_uses.argument(callee, ty, arg.span());
             }
         }
     }
@@ -707,10 +722,7 @@ impl<'a> Checker<'a> {
                 Arg::Words { .. } => Type::Text,
                 Arg::Expr(e) => self.expr(e, scope, true),
             };
-            if let Type::Param {
-                function, index, ..
-            } = &ty
-            {
+            if let Type::Param { param: used, .. } = &ty {
                 let kind = NeedKind::Argument {
                     service: Name::new(&def.name),
                     param: Name::new(&param.name),
@@ -720,7 +732,7 @@ impl<'a> Checker<'a> {
                     kind,
                     span: arg.span(),
                 };
-                self.param_uses.need((*function, *index), need);
+                self.param_uses.need(*used, need);
             }
             if !ty.fits(&param.ty) {
                 self.diagnostics.report(
@@ -838,16 +850,13 @@ impl<'a> Checker<'a> {
         // number: each call's argument must be one, so that the comparison
         // means what it would with the argument written in its place.
         for (side, other, side_span) in [(&lt, &rt, lhs.span), (&rt, &lt, rhs.span)] {
-            if let Type::Param {
-                function, index, ..
-            } = side
-            {
+            if let Type::Param { param, .. } = side {
                 if ordering || known_number(other) {
                     let need = ParamNeed {
                         kind: NeedKind::Number,
                         span: side_span,
                     };
-                    self.param_uses.need((*function, *index), need);
+                    self.param_uses.need(*param, need);
                 }
             }
         }
@@ -949,12 +958,11 @@ impl<'a> Checker<'a> {
     }
 
     fn resolve_attr(&self, attr: &ast::Attr, scope: &Scope) -> Resolution {
-        if let ([name], Some(&function)) = (attr.segments.as_slice(), scope.inlining.last()) {
-            let params = &self.mission.functions[function.0 as usize].params;
+        if let ([name], Some(owner)) = (attr.segments.as_slice(), scope.param_owner()) {
+            let params = self.mission.params(owner);
             if let Some(index) = params.iter().position(|p| p.name == name.name) {
                 return Resolution::Parameter {
-                    function,
-                    index: index as u32,
+                    param: (owner, index as u32),
                     name: name.name.clone(),
                 };
             }
@@ -974,7 +982,7 @@ impl<'a> Checker<'a> {
                         Resolution::Bare {
                             name: name.name.clone(),
                             known: Candidates::Everywhere,
-                            function: scope.inlining.last().copied(),
+                            function: scope.param_owner(),
                         }
                     }
                 }
@@ -1070,7 +1078,7 @@ impl<'a> Checker<'a> {
             return Resolution::Bare {
                 name: Name::new(name),
                 known: Candidates::Team(team, types),
-                function: scope.inlining.last().copied(),
+                function: scope.param_owner(),
             };
         }
         Resolution::NotInTeam {
@@ -1241,8 +1249,8 @@ impl<'a> Checker<'a> {
                 function,
             } => {
                 let mut known = self.candidate_names(&known);
-                if let Some(f) = function {
-                    let params = &self.mission.functions[f.0 as usize].params;
+                if let Some(owner) = function {
+                    let params = self.mission.params(owner);
                     known.extend(params.iter().map(|p| p.name.to_string()));
                 }
                 let guess = suggestion(&name, known.iter().map(String::as_str));
@@ -1259,18 +1267,11 @@ impl<'a> Checker<'a> {
                 Type::Unknown
             }
             Resolution::Unchecked => Type::Unknown,
-            Resolution::Parameter {
-                function,
-                index,
-                name,
-            } => {
-                self.param_uses.used((function, index));
-                self.occurrence(last, Symbol::Parameter { function, index }, false);
-                Type::Param {
-                    function,
-                    index,
-                    name,
-                }
+            Resolution::Parameter { param, name } => {
+                self.param_uses.used(param);
+                let (owner, index) = param;
+                self.occurrence(last, Symbol::Parameter { owner, index }, false);
+                Type::Param { param, name }
             }
         }
     }

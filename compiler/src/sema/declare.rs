@@ -226,7 +226,7 @@ impl<'a> Checker<'a> {
         self.functions_by_name.insert(f.name.name.clone(), id);
         self.function_syntax.push(f);
         self.occurrence(f.name.span, Symbol::Function(id), true);
-        let params = self.declare_params(id, f);
+        let params = self.declare_params(ParamOwner::Function(id), &f.name.name, &f.params);
         self.mission.functions.push(FunctionInfo {
             name: f.name.name.clone(),
             name_span: f.name.span,
@@ -316,8 +316,13 @@ impl<'a> Checker<'a> {
             span: s.span,
             item,
             throws: Vec::new(),
+            params: Vec::new(),
         });
         self.occurrence(s.name.span, Symbol::Service { team, service }, true);
+        let owner = ParamOwner::Service(team, service);
+        let what = self.team(team).service_path(service);
+        let params = self.declare_params(owner, &what, &s.params);
+        self.team_mut(team).services[service.index()].params = params;
         Ok(())
     }
 
@@ -325,8 +330,14 @@ impl<'a> Checker<'a> {
         let Some(team) = self.header_team(&m.team, "a mode") else {
             return;
         };
-        if let Some(existing) = self.team(team).mode_by_name(&m.name.name) {
-            let first = self.team(team).modes[existing.index()].name_span;
+        let t = self.team(team);
+        let existing = match t.mode_by_name(&m.name.name) {
+            Some(mode) => Some(t.mode(mode).name_span),
+            None => t
+                .template_by_name(&m.name.name)
+                .map(|template| t.template(template).name_span),
+        };
+        if let Some(first) = existing {
             self.diagnostics
                 .report(
                     Code::DuplicateMode,
@@ -339,11 +350,31 @@ impl<'a> Checker<'a> {
                 .relate(first, "first defined here");
             return;
         }
+        if m.params_span.is_some() {
+            // A mode with parameters: a mode of the machine only as entered
+            // with arguments (`behaviour.rs` makes one per list of them).
+            let template = self.team_mut(team).add_template(ModeTemplate {
+                name: m.name.name.clone(),
+                name_span: m.name.span,
+                span: m.span,
+                params: Vec::new(),
+                sets: Vec::new(),
+                instances: Vec::new(),
+            });
+            let symbol = Symbol::ModeTemplate { team, template };
+            self.occurrence(m.name.span, symbol, true);
+            let owner = ParamOwner::Mode(team, template);
+            let what = format!("{}.{}", m.team.name, m.name.name);
+            let params = self.declare_params(owner, &what, &m.params);
+            self.team_mut(team).templates[template.index()].params = params;
+            return;
+        }
         let mode = self.team_mut(team).add_mode(Mode {
             name: m.name.name.clone(),
             name_span: m.name.span,
             span: m.span,
             sets: Vec::new(),
+            instance: None,
         });
         self.occurrence(m.name.span, Symbol::Mode { team, mode }, true);
     }

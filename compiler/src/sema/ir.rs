@@ -32,6 +32,20 @@ newtype_index! {
 }
 
 newtype_index! {
+    /// A mode with parameters of its team: an index into [`Team::templates`].
+    pub struct TemplateId;
+}
+
+/// Whose parameter a name is: a function's (`def f(P)`), a composite
+/// service's (`T.Plan.S(P)`) or a mode's (`T.M(P)`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ParamOwner {
+    Function(FunctionId),
+    Service(TeamId, ServiceId),
+    Mode(TeamId, TemplateId),
+}
+
+newtype_index! {
     /// A robot of its team: an index into [`Team::robots`] (`name[N]`
     /// declares N of them). Not the robot's number in the generated
     /// programs, which counts across teams.
@@ -77,7 +91,13 @@ pub struct Team {
     pub robots: Vec<Robot>,
     pub plans: Vec<Plan>,
     pub services: Vec<Service>,
+    /// The modes of its mode machine: each mode without parameters, and
+    /// each mode with parameters once per distinct list of arguments it is
+    /// entered with (`MOVE(kitchen)`, `MOVE(hall)`: [`Mode::instance`]).
     pub modes: Vec<Mode>,
+    /// Its modes with parameters, as declared: each is a mode of the
+    /// machine only through the arguments it is entered with.
+    pub templates: Vec<ModeTemplate>,
     pub main: Option<Main>,
     /// Events its services throw or its main catches.
     pub events: Vec<Event>,
@@ -97,6 +117,7 @@ struct Names {
     plans: FastMap<Name, PlanId>,
     services: FastMap<(PlanId, Name), ServiceId>,
     modes: FastMap<Name, ModeId>,
+    templates: FastMap<Name, TemplateId>,
     events: FastMap<Name, usize>,
 }
 
@@ -129,14 +150,47 @@ pub struct Service {
     pub item: usize,
     /// Events this service can throw, directly or through functions it calls.
     pub throws: Vec<Name>,
+    /// The parameters, in order (`T.Plan.S(PLACE)`): each stands in the
+    /// body for the argument of the mode's `set` that runs it.
+    pub params: Vec<ParamInfo>,
 }
 
 #[derive(Clone, Debug)]
 pub struct Mode {
+    /// As written, or for a mode with parameters entered with arguments,
+    /// the mode's name and the arguments as written: `MOVE(kitchen)`.
     pub name: Name,
     pub name_span: Span,
     pub span: Span,
     pub sets: Vec<ModeSet>,
+    /// For a mode with parameters: which, and the arguments it is entered
+    /// with here.
+    pub instance: Option<ModeInstance>,
+}
+
+/// A mode with parameters entered with one list of arguments: the mode
+/// its `set`s are with each parameter standing for its argument.
+#[derive(Clone, Debug)]
+pub struct ModeInstance {
+    pub template: TemplateId,
+    /// As first written where the mode is entered (`mode = MOVE(kitchen)`):
+    /// words, strings or numbers, fixed when the mission is written.
+    pub args: Vec<ast::Arg>,
+}
+
+/// A mode with parameters (`T.MOVE(TARGET) { set(Action, Go(TARGET)) }`).
+#[derive(Clone, Debug)]
+pub struct ModeTemplate {
+    pub name: Name,
+    pub name_span: Span,
+    pub span: Span,
+    pub params: Vec<ParamInfo>,
+    /// Its `set`s, each argument as written (a parameter of the mode or a
+    /// fixed word, string or number).
+    pub sets: Vec<ModeSet>,
+    /// The modes of the machine it is entered as, one per distinct list
+    /// of arguments, in the order first entered.
+    pub instances: Vec<ModeId>,
 }
 
 #[derive(Clone, Debug)]
@@ -144,6 +198,11 @@ pub struct ModeSet {
     pub plan: Option<PlanId>,
     /// `None` for `OFF` (or a service that does not exist, already reported).
     pub service: Option<ServiceId>,
+    /// The arguments of a service with parameters, fixed: the service runs
+    /// with each parameter standing for its argument
+    /// (`set(Action, Go(kitchen))`, or in an instance of a mode with
+    /// parameters the mode's argument). In a [`ModeTemplate`], as written.
+    pub args: Vec<ast::Arg>,
     pub timeout_ms: Option<f64>,
     pub span: Span,
 }
@@ -314,11 +373,17 @@ pub enum Symbol {
     },
     /// A symbolic constant such as `colored_paper`.
     Constant(Name),
-    /// The `index`th parameter of a function, where it is declared and
-    /// where its body uses it.
+    /// The `index`th parameter of a function, a service or a mode, where
+    /// it is declared and where its body (a mode's `set`s) uses it.
     Parameter {
-        function: FunctionId,
+        owner: ParamOwner,
         index: u32,
+    },
+    /// A mode with parameters, where declared and where named (in `case`,
+    /// and entered with arguments).
+    ModeTemplate {
+        team: TeamId,
+        template: TemplateId,
     },
     /// The name of a counted group, `group(Name, min = N)`, where it is
     /// written (its only occurrence: a group is named in its statement
@@ -397,6 +462,39 @@ impl Mission {
             .map(|i| TeamId(i as u32))
     }
 
+    /// The parameters of a function, a service or a mode with parameters.
+    pub fn params(&self, owner: ParamOwner) -> &[ParamInfo] {
+        match owner {
+            ParamOwner::Function(f) => &self.functions[f.0 as usize].params,
+            ParamOwner::Service(team, service) => &self.team(team).service(service).params,
+            ParamOwner::Mode(team, template) => &self.team(team).template(template).params,
+        }
+    }
+
+    pub(super) fn params_mut(&mut self, owner: ParamOwner) -> &mut Vec<ParamInfo> {
+        match owner {
+            ParamOwner::Function(f) => &mut self.functions[f.0 as usize].params,
+            ParamOwner::Service(team, service) => {
+                &mut self.teams[team.0 as usize].services[service.index()].params
+            }
+            ParamOwner::Mode(team, template) => {
+                &mut self.teams[team.0 as usize].templates[template.index()].params
+            }
+        }
+    }
+
+    /// `def f`, `T.Plan.S` or `T.M`: what a parameter belongs to, for messages.
+    pub fn owner_name(&self, owner: ParamOwner) -> String {
+        match owner {
+            ParamOwner::Function(f) => self.functions[f.0 as usize].name.to_string(),
+            ParamOwner::Service(team, service) => self.team(team).service_path(service),
+            ParamOwner::Mode(team, template) => {
+                let t = self.team(team);
+                format!("{}.{}", t.name, t.template(template).name)
+            }
+        }
+    }
+
     /// The innermost occurrence at a byte offset (for hover, go-to-definition).
     pub fn occurrence_at(&self, offset: usize) -> Option<&Occurrence> {
         self.occurrences
@@ -447,6 +545,7 @@ impl Team {
             plans: Vec::new(),
             services: Vec::new(),
             modes: Vec::new(),
+            templates: Vec::new(),
             main: None,
             events: Vec::new(),
             broadcasts: Vec::new(),
@@ -478,6 +577,22 @@ impl Team {
         self.names.modes.insert(mode.name.clone(), id);
         self.modes.push(mode);
         id
+    }
+
+    /// Adds `template` (whose name the team has for no mode yet).
+    pub fn add_template(&mut self, template: ModeTemplate) -> TemplateId {
+        let id = TemplateId::new(self.templates.len());
+        self.names.templates.insert(template.name.clone(), id);
+        self.templates.push(template);
+        id
+    }
+
+    pub fn template_by_name(&self, name: &str) -> Option<TemplateId> {
+        self.names.templates.get(name).copied()
+    }
+
+    pub fn template(&self, template: TemplateId) -> &ModeTemplate {
+        &self.templates[template.index()]
     }
 
     /// The broadcast whose event is named at `span` (the event's range in

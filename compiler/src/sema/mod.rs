@@ -106,8 +106,9 @@ pub fn check<'a>(
     let mut checker = Checker::new(file, catalog);
     checker.declare(source);
     checker.check_bodies();
-    checker.check_parameters();
     checker.check_behaviour(source);
+    // After the modes: a `set` and a mode entered give arguments too.
+    checker.check_parameters();
     checker.check_communication();
     // Sorted now: the value flow looks names up.
     checker.sort_occurrences();

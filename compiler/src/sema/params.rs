@@ -1,8 +1,14 @@
-//! Function parameters (`def go_to(PLACE) { move(PLACE) }`): their names
-//! (E044 twice in one function, E045 a name that would hide a value or a
-//! team variable), what each body asks of them, and every call's arguments
-//! checked against that once every body is walked (E023), W015 for one the
-//! body never uses.
+//! Parameters of functions (`def go_to(PLACE) { move(PLACE) }`), of
+//! composite services (`T.Action.Go(PLACE) { move(PLACE) }`) and of modes
+//! (`T.MOVE(TARGET) { set(Action, Go(TARGET)) }`): their names (E044 twice
+//! in one list, E045 a name that would hide a value or a team variable),
+//! what each body asks of them, and every argument (of a call, of a `set`,
+//! of a mode entered) checked against that once every body is walked
+//! (E023), W015 for one that is never used.
+//!
+//! A service's parameter is a function's for its body; a mode's parameter
+//! has no body: used as the argument of a service in the mode's `set`s, it
+//! is passed on to that service's parameter and asks what that one asks.
 //!
 //! A parameter stands in its body for the argument of the call being run, so
 //! a function is the program its calls would be with the argument written in
@@ -17,15 +23,12 @@
 //! parameter's needs are at most one per type a service takes, plus one.
 
 use super::Checker;
-use super::body::Type;
+use super::body::{ParamRef, Type};
 use super::ir::*;
 use crate::diag::Code;
 use crate::fasthash::{FastMap, FastSet};
 use crate::span::Span;
 use crate::syntax::ast::{self, Name};
-
-/// A parameter: its function and its place in the list.
-pub(super) type ParamRef = (FunctionId, u32);
 
 /// What the walk of the bodies found about parameters.
 #[derive(Default)]
@@ -41,7 +44,8 @@ pub(super) struct ParamUses {
     used: FastSet<ParamRef>,
 }
 
-/// An argument of a function call, as the caller's scope typed it.
+/// An argument of a function call, a `set` or a mode entered, as the
+/// caller's scope typed it.
 pub(super) struct CallArgument {
     pub callee: ParamRef,
     pub ty: Type,
@@ -64,10 +68,8 @@ impl ParamUses {
     /// Records the argument `ty` at `span` of the call of `callee`'s function.
     pub(super) fn argument(&mut self, callee: ParamRef, ty: Type, span: Span) {
         match ty {
-            Type::Param {
-                function, index, ..
-            } => {
-                self.passed_on.push(((function, index), callee));
+            Type::Param { param, .. } => {
+                self.passed_on.push((param, callee));
             }
             ty => self.arguments.push(CallArgument { callee, ty, span }),
         }
@@ -75,29 +77,31 @@ impl ParamUses {
 }
 
 impl<'a> Checker<'a> {
-    /// The parameters of `f` (its id `id`), each name recorded where it is
-    /// written; a name written twice is E044 (the first one is the one the
-    /// body's uses mean).
-    pub(super) fn declare_params(&mut self, id: FunctionId, f: &ast::Function) -> Vec<ParamInfo> {
+    /// The parameters `list` of `owner` (named `what` in messages), each
+    /// name recorded where it is written; a name written twice is E044 (the
+    /// first one is the one the body's uses mean).
+    pub(super) fn declare_params(
+        &mut self,
+        owner: ParamOwner,
+        what: &str,
+        list: &[ast::Ident],
+    ) -> Vec<ParamInfo> {
         let mut seen: FastMap<&Name, Span> = FastMap::default();
-        let mut params = Vec::with_capacity(f.params.len());
-        for (index, param) in f.params.iter().enumerate() {
+        let mut params = Vec::with_capacity(list.len());
+        for (index, param) in list.iter().enumerate() {
             if let Some(&first) = seen.get(&param.name) {
                 self.diagnostics
                     .report(
                         Code::DuplicateParameter,
                         param.span,
-                        format!(
-                            "`{}` is already a parameter of `{}`",
-                            param.name, f.name.name
-                        ),
+                        format!("`{}` is already a parameter of `{what}`", param.name),
                     )
                     .relate(first, "first written here");
             } else {
                 seen.insert(&param.name, param.span);
             }
             let symbol = Symbol::Parameter {
-                function: id,
+                owner,
                 index: index as u32,
             };
             self.occurrence(param.span, symbol, true);
@@ -110,6 +114,23 @@ impl<'a> Checker<'a> {
         params
     }
 
+    /// Every owner of parameters, in the order declared per kind.
+    fn param_owners(&self) -> Vec<ParamOwner> {
+        let mut owners: Vec<ParamOwner> = (0..self.mission.functions.len())
+            .map(|f| ParamOwner::Function(FunctionId(f as u32)))
+            .collect();
+        for (t, team) in self.mission.teams.iter().enumerate() {
+            let id = TeamId(t as u32);
+            owners.extend(
+                team.service_ids()
+                    .filter(|s| !team.service(*s).params.is_empty())
+                    .map(|s| ParamOwner::Service(id, s)),
+            );
+            owners.extend(TemplateId::all(team.templates.len()).map(|m| ParamOwner::Mode(id, m)));
+        }
+        owners
+    }
+
     /// E045: a parameter named like a value some robot type of the catalog
     /// reads, or a team variable of the mission. In the body the bare name
     /// would mean the parameter, so the value could not be read there by
@@ -117,8 +138,8 @@ impl<'a> Checker<'a> {
     /// per name.
     pub(super) fn check_parameter_names(&mut self) {
         let mut found = Vec::new();
-        for (f, function) in self.mission.functions.iter().enumerate() {
-            for param in &function.params {
+        for owner in self.param_owners() {
+            for param in self.mission.params(owner) {
                 let name = &param.name;
                 let value_of = self
                     .catalog
@@ -132,11 +153,11 @@ impl<'a> Checker<'a> {
                     }
                     None => continue,
                 };
-                found.push((f, param.span, name.clone(), hidden));
+                found.push((owner, param.span, name.clone(), hidden));
             }
         }
-        for (f, span, name, hidden) in found {
-            let function = &self.mission.functions[f].name;
+        for (owner, span, name, hidden) in found {
+            let function = self.mission.owner_name(owner);
             let message = format!(
                 "the parameter `{name}` of `{function}` would hide {hidden} in its body: name the parameter otherwise"
             );
@@ -153,19 +174,16 @@ impl<'a> Checker<'a> {
     pub(super) fn check_parameters(&mut self) {
         let uses = std::mem::take(&mut self.param_uses);
         let needs = closed_needs(&uses);
-        for (f, function) in self.mission.functions.iter_mut().enumerate() {
-            for (i, param) in function.params.iter_mut().enumerate() {
-                param.needs = needs
-                    .get(&(FunctionId(f as u32), i as u32))
-                    .cloned()
-                    .unwrap_or_default();
+        let owners = self.param_owners();
+        for &owner in &owners {
+            for (i, param) in self.mission.params_mut(owner).iter_mut().enumerate() {
+                param.needs = needs.get(&(owner, i as u32)).cloned().unwrap_or_default();
             }
         }
         let mut reported: FastSet<(Span, Span)> = FastSet::default();
         for argument in &uses.arguments {
-            let (function, index) = argument.callee;
-            let info = &self.mission.functions[function.0 as usize];
-            let Some(param) = info.params.get(index as usize) else {
+            let (owner, index) = argument.callee;
+            let Some(param) = self.mission.params(owner).get(index as usize) else {
                 continue;
             };
             for need in &param.needs {
@@ -188,7 +206,7 @@ impl<'a> Checker<'a> {
                 let message = format!(
                     "the parameter `{}` of `{}` {asks}, but this is {}",
                     param.name,
-                    info.name,
+                    self.mission.owner_name(owner),
                     argument.ty.describe()
                 );
                 self.diagnostics
@@ -197,20 +215,29 @@ impl<'a> Checker<'a> {
             }
         }
         let mut unused = Vec::new();
-        for (f, function) in self.mission.functions.iter().enumerate() {
-            for (i, param) in function.params.iter().enumerate() {
+        for &owner in &owners {
+            let params = self.mission.params(owner);
+            for (i, param) in params.iter().enumerate() {
                 // A name written twice is E044 already; its uses mean the first.
-                let again = function.params[..i].iter().any(|p| p.name == param.name);
-                if !again && !uses.used.contains(&(FunctionId(f as u32), i as u32)) {
-                    unused.push((param.span, param.name.clone(), function.name.clone()));
+                let again = params[..i].iter().any(|p| p.name == param.name);
+                if !again && !uses.used.contains(&(owner, i as u32)) {
+                    unused.push((param.span, param.name.clone(), owner));
                 }
             }
         }
-        for (span, name, function) in unused {
+        for (span, name, owner) in unused {
+            let (whose, body) = match owner {
+                ParamOwner::Mode(..) => ("mode", "its `set`s"),
+                _ => ("", "its body"),
+            };
+            let owner = self.mission.owner_name(owner);
             self.diagnostics.report(
                 Code::ParameterNeverUsed,
                 span,
-                format!("the parameter `{name}` of `{function}` is never used in its body"),
+                format!(
+                    "the parameter `{name}` of {whose}{}`{owner}` is never used in {body}",
+                    if whose.is_empty() { "" } else { " " }
+                ),
             );
         }
     }

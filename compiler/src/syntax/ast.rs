@@ -101,6 +101,12 @@ pub struct CompositeService {
     pub more_teams: Vec<Ident>,
     pub plan: Ident,
     pub name: Ident,
+    /// The parameters, in order (`T.P.S(PLACE) { ... }`): each a name that
+    /// stands in the body for the argument a mode's `set` gives
+    /// (`docs/language/modes.md`).
+    pub params: Vec<Ident>,
+    /// The range of `( ... )` after the name; `None` without a list.
+    pub params_span: Option<Span>,
     pub body: Block,
     pub repeat: Option<Repeat>,
     pub span: Span,
@@ -127,12 +133,27 @@ pub struct Function {
     pub span: Span,
 }
 
-/// `Team.MODE { set(...) ... }`
+/// `Team.MODE { set(...) ... }` or `Team.MODE(TARGET) { ... }`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ModeDef {
     pub team: Ident,
     pub name: Ident,
+    /// The parameters, in order: each a name that stands in the mode's
+    /// `set`s for the argument the mode is entered with
+    /// (`mode = MOVE(kitchen)`, `docs/language/modes.md`).
+    pub params: Vec<Ident>,
+    /// The range of `( ... )` after the name; `None` without a list.
+    pub params_span: Option<Span>,
     pub sets: Vec<SetStmt>,
+    pub span: Span,
+}
+
+/// `( a, b )` after a mode or service name: the arguments it is entered or
+/// set with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ArgList {
+    pub args: Vec<Arg>,
+    /// The range of `( ... )`.
     pub span: Span,
 }
 
@@ -140,6 +161,8 @@ pub struct ModeDef {
 pub struct SetStmt {
     pub plan: Ident,
     pub service: SetTarget,
+    /// `set(Plan, S(a, b))`: the arguments of a service with parameters.
+    pub args: Option<ArgList>,
     pub timeout: Option<Period>,
     pub span: Span,
 }
@@ -159,6 +182,8 @@ pub struct MainDef {
     pub main_span: Span,
     pub cases: Vec<Case>,
     pub default: Option<Ident>,
+    /// `default: mode = MOVE(kitchen)`: the default mode's arguments.
+    pub default_args: Option<ArgList>,
     pub span: Span,
 }
 
@@ -173,6 +198,8 @@ pub struct Case {
 pub struct Catch {
     pub event: Ident,
     pub target: Ident,
+    /// `mode = MOVE(kitchen)`: the arguments the mode is entered with.
+    pub target_args: Option<ArgList>,
     pub span: Span,
 }
 
@@ -256,6 +283,23 @@ impl Arg {
         match self {
             Arg::Expr(e) => e.span,
             Arg::Words { span, .. } => *span,
+        }
+    }
+
+    /// A fixed argument as written, for the name of the mode or service it
+    /// is given to (`MOVE(kitchen)`, `MOVE("hall door")`): distinct
+    /// arguments have distinct texts (a string keeps its quotes, escaped).
+    pub fn written(&self) -> String {
+        match self {
+            Arg::Words { text, .. } => text.clone(),
+            Arg::Expr(e) => match &e.kind {
+                ExprKind::Str(s) => format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\"")),
+                ExprKind::Number(n) => n.clone(),
+                ExprKind::Period(p) => format!("{} {}", p.amount, p.unit.as_str()),
+                ExprKind::Bool(b) => b.to_string(),
+                ExprKind::Attr(a) => a.dotted(),
+                _ => "?".to_string(),
+            },
         }
     }
 }

@@ -2,7 +2,9 @@
 //! error in one item (even an unbalanced brace) cannot swallow the items after it.
 //!
 //! A chunk starts at every item header. `T.P.S {`, `A, B.P.S {`, `T.M {`,
-//! `T.main {`, `def f {` and `def f(A, B) {` can never occur inside a statement, so they start a chunk wherever
+//! `T.main {`, `def f {`, and with a parameter list `def f(A, B) {`,
+//! `T.P.S(A) {`, `A, B.P.S(A) {` and `T.M(A) {` can never occur inside a
+//! statement, so they start a chunk wherever
 //! they appear; `{` and `T:` start one only at brace depth zero (they also occur
 //! inside a braced team formation). A `}` with no matching `{` is a chunk of its own.
 
@@ -11,15 +13,17 @@ use chumsky::span::SimpleSpan;
 
 type Tok<'s> = (Token<'s>, SimpleSpan);
 
-/// The most tokens a header's list (a function's parameters, the teams of a
-/// shared service) may hold: a header is then at most [`MAX_HEADER_TOKENS`]
+/// The most tokens a header's list (the parameters of a function, a service
+/// or a mode, the teams of a shared service) may hold: a header is then at
+/// most [`MAX_HEADER_TOKENS`]
 /// long, which incremental parsing relies on (it cuts again from a chunk
 /// start at least that far before an edit, so that no header it keeps
 /// reaches into the edit). 64 tokens: 32 names.
 pub const MAX_LIST_TOKENS: usize = 64;
 
-/// The longest header: `def f(` or `A.P.S {` around the longest list.
-pub const MAX_HEADER_TOKENS: usize = MAX_LIST_TOKENS + 6;
+/// The longest header: `A, B.P.S(A) {`, a list of teams and a list of
+/// parameters, each at most the longest list.
+pub const MAX_HEADER_TOKENS: usize = 2 * MAX_LIST_TOKENS + 8;
 
 /// If an item header starts at token `i`, the index of its opening brace.
 #[inline(always)]
@@ -27,24 +31,25 @@ fn header_brace(tokens: &[Tok<'_>], i: usize) -> Option<usize> {
     let at = |k: usize| tokens.get(i + k).map(|t| t.0);
     let ident = |k: usize| matches!(at(k), Some(Token::Ident(_)));
     let brace = |k: usize| (at(k) == Some(Token::LBrace)).then_some(i + k);
-    match at(0)? {
-        Token::Kw(Kw::Def) if ident(1) && at(2) == Some(Token::LParen) => {
-            // `def f(A, B) {`: the list ends at the first bracket or `def`
-            // (so that each token is looked at by one header at most: the
-            // cut stays linear), and the header is an item only if that is
-            // `)` then `{` (a list that does not parse is still a header).
-            let close = (3..=3 + MAX_LIST_TOKENS).find(|&k| {
-                !matches!(
-                    at(k),
-                    Some(t) if !matches!(
-                        t,
-                        Token::LParen | Token::RParen | Token::LBrace | Token::RBrace | Token::Kw(Kw::Def)
-                    )
+    // `(A, B) {` from `from`, the token after `(`: the list ends at the
+    // first bracket or `def` (so that each token is looked at by one header
+    // at most: the cut stays linear), and the header is an item only if
+    // that is `)` then `{` (a list that does not parse is still a header).
+    let params = |from: usize| {
+        let close = (from..=from + MAX_LIST_TOKENS).find(|&k| {
+            !matches!(
+                at(k),
+                Some(t) if !matches!(
+                    t,
+                    Token::LParen | Token::RParen | Token::LBrace | Token::RBrace | Token::Kw(Kw::Def)
                 )
-            })?;
-            (at(close) == Some(Token::RParen)).then_some(())?;
-            brace(close + 1)
-        }
+            )
+        })?;
+        (at(close) == Some(Token::RParen)).then_some(())?;
+        brace(close + 1)
+    };
+    match at(0)? {
+        Token::Kw(Kw::Def) if ident(1) && at(2) == Some(Token::LParen) => params(3),
         Token::Kw(Kw::Def) if ident(1) => brace(2),
         // `A, B.P.S {`: a service shared by teams. The list is scanned
         // from its first name only (a name after a comma is inside the
@@ -62,11 +67,18 @@ fn header_brace(tokens: &[Tok<'_>], i: usize) -> Option<usize> {
                 && at(k + 2) == Some(Token::Dot)
                 && ident(k + 3);
             service.then_some(())?;
-            brace(k + 4)
+            match at(k + 4) {
+                Some(Token::LParen) => params(k + 5),
+                _ => brace(k + 4),
+            }
         }
         Token::Ident(_) if at(1) == Some(Token::Dot) => match at(2)? {
             Token::Kw(Kw::Main) => brace(3),
-            Token::Ident(_) if at(3) == Some(Token::Dot) && ident(4) => brace(5),
+            Token::Ident(_) if at(3) == Some(Token::Dot) && ident(4) => match at(5) {
+                Some(Token::LParen) => params(6),
+                _ => brace(5),
+            },
+            Token::Ident(_) if at(3) == Some(Token::LParen) => params(4),
             Token::Ident(_) => brace(3),
             _ => None,
         },
@@ -196,6 +208,21 @@ mod tests {
                 "def g(5 SEC) { x }\ndef h(",
                 "{ y }",
                 "A.M { }"
+            ]
+        );
+    }
+
+    #[test]
+    fn services_and_modes_with_parameters_are_headers() {
+        let text = "A.P.S(X) { move(X) \nA, B.P.T(X, Y) { x }\nA.M(X) { set(P, S(X)) }\nA.N( { y }";
+        assert_eq!(
+            chunk_texts(text),
+            // `A.N(` without `)` is no header: its `{` at the top starts one.
+            vec![
+                "A.P.S(X) { move(X)",
+                "A, B.P.T(X, Y) { x }",
+                "A.M(X) { set(P, S(X)) }\nA.N(",
+                "{ y }"
             ]
         );
     }

@@ -586,6 +586,37 @@ mod tests {
     }
 
     #[test]
+    fn modes_and_services_keep_their_parameters_and_arguments_positioned() {
+        let text = "R.A.Go(PLACE) { move(PLACE) }\nR.MOVE(T) { set(A, Go(T)) }\n\
+                    R.main { case (MOVE): catch (e): mode = MOVE(hall door) default: mode = MOVE(5) }";
+        let p = parse(FileId(0), text);
+        assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);
+        let [
+            ast::Item::Service(go),
+            ast::Item::Mode(mode),
+            ast::Item::Main(main),
+        ] = p.file.items.as_slice()
+        else {
+            panic!("{:?}", p.file.items)
+        };
+        assert_eq!(go.params[0].span, Span::new(7, 12));
+        assert_eq!(go.params_span, Some(Span::new(6, 13)));
+        assert_eq!(
+            (mode.params[0].as_str(), mode.params_span),
+            ("T", Some(Span::new(36, 39)))
+        );
+        let args = mode.sets[0].args.as_ref().unwrap();
+        assert_eq!((args.args.len(), args.span), (1, Span::new(51, 54)));
+        let catch = &main.cases[0].catches[0];
+        let target_args = catch.target_args.as_ref().unwrap();
+        assert!(
+            matches!(&target_args.args[0], ast::Arg::Words { text, .. } if text == "hall door")
+        );
+        let default = main.default_args.as_ref().unwrap();
+        assert_eq!(default.args[0].written(), "5");
+    }
+
+    #[test]
     fn a_service_shared_by_teams_keeps_each_team_positioned() {
         let text = "A, B , C.Act.S { x() } repeat()\nsend(T, T.X)\nD.M { }";
         let p = parse(FileId(0), text);

@@ -339,20 +339,7 @@ where
                 })
             });
 
-        let word = select! {
-            Token::Ident(w) => w,
-            Token::Kw(k) => k.as_str(),
-        };
-        let words = word
-            .repeated()
-            .at_least(2)
-            .collect::<Vec<_>>()
-            .map_with(|ws, e| Arg::Words {
-                text: ws.join(" "),
-                span: sp(e.span()),
-            })
-            .then_ignore(one_of([Token::Comma, Token::RParen]).rewind());
-        let arg = words.or(expr().map(Arg::Expr));
+        let arg = arg();
         let call = name()
             .then(
                 arg.separated_by(tok(Token::Comma))
@@ -458,6 +445,44 @@ where
     })
 }
 
+/// An argument: an expression, or several bare words taken as one string.
+fn arg<'t, 's: 't, I, E>() -> impl Parser<'t, I, Arg, extra::Err<E>> + Clone
+where
+    I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
+{
+    let word = select! {
+        Token::Ident(w) => w,
+        Token::Kw(k) => k.as_str(),
+    };
+    let words = word
+        .repeated()
+        .at_least(2)
+        .collect::<Vec<_>>()
+        .map_with(|ws, e| Arg::Words {
+            text: ws.join(" "),
+            span: sp(e.span()),
+        })
+        .then_ignore(one_of([Token::Comma, Token::RParen]).rewind());
+    words.or(expr().map(Arg::Expr))
+}
+
+/// `(a, b)` after a mode or service name.
+fn arg_list<'t, 's: 't, I, E>() -> impl Parser<'t, I, ArgList, extra::Err<E>> + Clone
+where
+    I: ValueInput<'t, Token = Token<'s>, Span = SimpleSpan>,
+    E: ParseErr<'t, I> + 't,
+{
+    arg()
+        .separated_by(tok(Token::Comma))
+        .collect::<Vec<_>>()
+        .delimited_by(tok(Token::LParen), tok(Token::RParen))
+        .map_with(|args, e| ArgList {
+            args,
+            span: sp(e.span()),
+        })
+}
+
 /// `else if (...)` is an unbraced block holding one `if`: keep it as an else-if.
 fn else_of(block: Block) -> Else {
     match block.stmts.as_slice() {
@@ -498,6 +523,14 @@ fn count_value(written: &str) -> Option<u32> {
         Ok(n) => Some(n),
         Err(_) if written.bytes().all(|b| b.is_ascii_digit()) => Some(u32::MAX),
         Err(_) => None,
+    }
+}
+
+/// A parameter list as written, or none.
+fn split_params(list: Option<(Vec<Ident>, Span)>) -> (Vec<Ident>, Option<Span>) {
+    match list {
+        Some((params, span)) => (params, Some(span)),
+        None => (Vec::new(), None),
     }
 }
 
@@ -570,34 +603,8 @@ where
                 span: sp(e.span()),
             }
         });
-    // `A, B.Plan.S`: the teams that share the service, each running it.
-    let teams = name().then(
-        tok(Token::Comma)
-            .ignore_then(name().labelled("a team name"))
-            .repeated()
-            .collect::<Vec<_>>(),
-    );
-    let service = teams
-        .then_ignore(tok(Token::Dot))
-        .then(name())
-        .then_ignore(tok(Token::Dot))
-        .then(name())
-        .then(braced_block())
-        .then(repeat.or_not())
-        .map_with(|(((((team, more_teams), plan), name), body), repeat), e| {
-            Item::Service(CompositeService {
-                team,
-                more_teams,
-                plan,
-                name,
-                body,
-                repeat,
-                span: sp(e.span()),
-            })
-        });
-
     // `(A, B)`: a list that does not parse is reported where it goes wrong
-    // and the body is still parsed, as a function without parameters.
+    // and the body is still parsed, as one without parameters.
     let params = name()
         .labelled("a parameter name")
         .separated_by(tok(Token::Comma))
@@ -610,15 +617,44 @@ where
             [(Token::LBrace, Token::RBrace)],
             |span| (Vec::new(), sp(span)),
         )));
+    // `A, B.Plan.S`: the teams that share the service, each running it.
+    let teams = name().then(
+        tok(Token::Comma)
+            .ignore_then(name().labelled("a team name"))
+            .repeated()
+            .collect::<Vec<_>>(),
+    );
+    let service = teams
+        .then_ignore(tok(Token::Dot))
+        .then(name())
+        .then_ignore(tok(Token::Dot))
+        .then(name())
+        .then(params.clone().or_not())
+        .then(braced_block())
+        .then(repeat.or_not())
+        .map_with(
+            |((((((team, more_teams), plan), name), params), body), repeat), e| {
+                let (params, params_span) = split_params(params);
+                Item::Service(CompositeService {
+                    team,
+                    more_teams,
+                    plan,
+                    name,
+                    params,
+                    params_span,
+                    body,
+                    repeat,
+                    span: sp(e.span()),
+                })
+            },
+        );
+
     let function = kw(Kw::Def)
         .ignore_then(name().labelled("a function name"))
-        .then(params.or_not())
+        .then(params.clone().or_not())
         .then(braced_block())
         .map_with(|((name, params), body), e| {
-            let (params, params_span) = match params {
-                Some((params, span)) => (params, Some(span)),
-                None => (Vec::new(), None),
-            };
+            let (params, params_span) = split_params(params);
             Item::Function(Function {
                 name,
                 params,
@@ -637,12 +673,14 @@ where
                 .labelled("a plan name")
                 .then_ignore(tok(Token::Comma))
                 .then(set_target)
+                .then(arg_list().or_not())
                 .then(tok(Token::Comma).ignore_then(timeout()).or_not())
                 .delimited_by(tok(Token::LParen), tok(Token::RParen)),
         )
-        .map_with(|((plan, service), timeout), e| SetStmt {
+        .map_with(|(((plan, service), args), timeout), e| SetStmt {
             plan,
             service,
+            args,
             timeout,
             span: sp(e.span()),
         })
@@ -650,16 +688,20 @@ where
     let mode = name()
         .then_ignore(tok(Token::Dot))
         .then(name())
+        .then(params.or_not())
         .then(
             recovering(set_stmt.map(Some), |_| None)
                 .repeated()
                 .collect::<Vec<_>>()
                 .delimited_by(tok(Token::LBrace), tok(Token::RBrace)),
         )
-        .map_with(|((team, name), sets), e| {
+        .map_with(|(((team, name), params), sets), e| {
+            let (params, params_span) = split_params(params);
             Item::Mode(ModeDef {
                 team,
                 name,
+                params,
+                params_span,
                 sets: sets.into_iter().flatten().collect(),
                 span: sp(e.span()),
             })
@@ -668,6 +710,7 @@ where
     let mode_assign = kw(Kw::Mode)
         .ignore_then(tok(Token::Assign))
         .ignore_then(name().labelled("a mode name"))
+        .then(arg_list().or_not())
         .then_ignore(semis.clone());
     let catch = kw(Kw::Catch)
         .ignore_then(
@@ -677,9 +720,10 @@ where
         )
         .then_ignore(tok(Token::Colon))
         .then(mode_assign.clone())
-        .map_with(|(event, target), e| Catch {
+        .map_with(|(event, (target, target_args)), e| Catch {
             event,
             target,
+            target_args,
             span: sp(e.span()),
         });
     let case = kw(Kw::Case)
@@ -720,11 +764,16 @@ where
                     MainArm::Bad => {}
                 }
             }
+            let (default, default_args) = match default {
+                Some((name, args)) => (Some(name), args),
+                None => (None, None),
+            };
             Item::Main(MainDef {
                 team,
                 main_span: sp(main_span),
                 cases,
                 default,
+                default_args,
                 span: sp(e.span()),
             })
         });
@@ -756,7 +805,7 @@ where
 #[derive(Clone)]
 enum MainArm {
     Case(Case),
-    Default(Ident),
+    Default((Ident, Option<ArgList>)),
     /// A line that did not parse (already reported).
     Bad,
 }

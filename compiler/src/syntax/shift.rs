@@ -139,6 +139,8 @@ impl Shift for CompositeService {
             more_teams,
             plan,
             name,
+            params,
+            params_span,
             body,
             repeat,
             span,
@@ -149,6 +151,8 @@ impl Shift for CompositeService {
         }
         plan.shift(delta);
         name.shift(delta);
+        params.shift(delta);
+        params_span.shift(delta);
         body.shift(delta);
         repeat.shift(delta);
         span.shift(delta);
@@ -192,11 +196,15 @@ impl Shift for ModeDef {
         let ModeDef {
             team,
             name,
+            params,
+            params_span,
             sets,
             span,
         } = self;
         team.shift(delta);
         name.shift(delta);
+        params.shift(delta);
+        params_span.shift(delta);
         sets.shift(delta);
         span.shift(delta);
     }
@@ -207,12 +215,22 @@ impl Shift for SetStmt {
         let SetStmt {
             plan,
             service,
+            args,
             timeout,
             span,
         } = self;
         plan.shift(delta);
         service.shift(delta);
+        args.shift(delta);
         timeout.shift(delta);
+        span.shift(delta);
+    }
+}
+
+impl Shift for ArgList {
+    fn shift(&mut self, delta: isize) {
+        let ArgList { args, span } = self;
+        args.shift(delta);
         span.shift(delta);
     }
 }
@@ -233,12 +251,14 @@ impl Shift for MainDef {
             main_span,
             cases,
             default,
+            default_args,
             span,
         } = self;
         team.shift(delta);
         main_span.shift(delta);
         cases.shift(delta);
         default.shift(delta);
+        default_args.shift(delta);
         span.shift(delta);
     }
 }
@@ -261,10 +281,12 @@ impl Shift for Catch {
         let Catch {
             event,
             target,
+            target_args,
             span,
         } = self;
         event.shift(delta);
         target.shift(delta);
+        target_args.shift(delta);
         span.shift(delta);
     }
 }

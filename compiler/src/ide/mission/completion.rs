@@ -786,6 +786,34 @@ impl<'a> Completions<'a> {
                     None,
                 );
             }
+        } else {
+            // In a service's body with parameters, its parameters first.
+            let service = self.mission.teams.iter().enumerate().find_map(|(t, team)| {
+                team.service_ids().find_map(|s| {
+                    let info = team.service(s);
+                    let inside = !info.params.is_empty()
+                        && analysis
+                            .service_syntax(info)
+                            .is_some_and(|syntax| syntax.body.span.contains(self.offset));
+                    inside.then_some(crate::sema::ParamOwner::Service(
+                        crate::sema::TeamId(t as u32),
+                        s,
+                    ))
+                })
+            });
+            if let Some(owner) = service {
+                let whose = self.mission.owner_name(owner);
+                for p in self.mission.params(owner) {
+                    let detail = format!("parameter of {whose}");
+                    self.add(
+                        LIKELY,
+                        CompletionKind::Parameter,
+                        p.name.as_str(),
+                        Some(detail),
+                        None,
+                    );
+                }
+            }
         }
         for v in robots::shared_values(self.catalog, &types) {
             self.add_value(LIKELY, v, None);
@@ -1019,22 +1047,44 @@ impl<'a> Completions<'a> {
                 continue;
             }
             let syntax = self.analysis.service_syntax(s);
-            self.add(
-                EXACT,
-                CompletionKind::Service,
-                s.name.as_str(),
-                Some(format!(
-                    "{} {}",
-                    t.service_path(ServiceId::new(i)),
-                    docs::schedule(self.text, syntax)
-                )),
-                Some(docs::composite_service(
-                    self.analysis,
-                    self.text,
-                    team,
-                    ServiceId::new(i),
-                )),
-            );
+            // `Go(${1:PLACE})` for a service with parameters.
+            let params: Vec<String> = s
+                .params
+                .iter()
+                .enumerate()
+                .map(|(i, p)| format!("${{{}:{}}}", i + 1, snippets::escape(&p.name)))
+                .collect();
+            let detail = Some(format!(
+                "{} {}",
+                t.service_path(ServiceId::new(i)),
+                docs::schedule(self.text, syntax)
+            ));
+            let documentation = Some(docs::composite_service(
+                self.analysis,
+                self.text,
+                team,
+                ServiceId::new(i),
+            ));
+            if params.is_empty() {
+                self.add(
+                    EXACT,
+                    CompletionKind::Service,
+                    s.name.as_str(),
+                    detail,
+                    documentation,
+                );
+            } else {
+                let body = format!("{}({})", snippets::escape(&s.name), params.join(", "));
+                let name = s.name.as_str();
+                self.add_snippet(
+                    EXACT,
+                    CompletionKind::Service,
+                    name,
+                    &body,
+                    detail,
+                    documentation,
+                );
+            }
         }
         self.add(
             LIKELY,
@@ -1050,7 +1100,25 @@ impl<'a> Completions<'a> {
             return;
         };
         let cased = self.closed_names(&Paren::Case);
+        // A mode with parameters is named without arguments in `case`.
+        for (i, m) in t.templates.iter().enumerate() {
+            let rank = if cased.contains(&m.name) {
+                OTHER
+            } else {
+                EXACT
+            };
+            self.add(
+                rank,
+                CompletionKind::Mode,
+                m.name.as_str(),
+                Some(format!("mode with parameters of {}", t.name)),
+                Some(docs::mode_template(t, crate::sema::TemplateId::new(i))),
+            );
+        }
         for (i, m) in t.modes.iter().enumerate() {
+            if m.instance.is_some() {
+                continue;
+            }
             let rank = if cased.contains(&m.name) {
                 OTHER
             } else {
@@ -1071,12 +1139,32 @@ impl<'a> Completions<'a> {
             return;
         };
         for (i, m) in t.modes.iter().enumerate() {
+            if m.instance.is_some() {
+                continue;
+            }
             self.add(
                 EXACT,
                 CompletionKind::Mode,
                 m.name.as_str(),
                 Some(format!("mode of {}", t.name)),
                 Some(docs::mode(self.text, t, ModeId::new(i))),
+            );
+        }
+        // `MOVE(${1:TARGET})`: a stop at each parameter, named.
+        for (i, m) in t.templates.iter().enumerate() {
+            let params: Vec<String> = m
+                .params
+                .iter()
+                .enumerate()
+                .map(|(i, p)| format!("${{{}:{}}}", i + 1, snippets::escape(&p.name)))
+                .collect();
+            self.add_snippet(
+                EXACT,
+                CompletionKind::Mode,
+                m.name.as_str(),
+                &format!("{}({})", snippets::escape(&m.name), params.join(", ")),
+                Some(format!("mode with parameters of {}", t.name)),
+                Some(docs::mode_template(t, crate::sema::TemplateId::new(i))),
             );
         }
     }

@@ -180,9 +180,17 @@ fn window_start(analysis: &CheckedMission, offset: usize) -> (usize, Option<Span
     (items[i].span().start.min(offset), None)
 }
 
-/// If the tokens end with an item header (`T.P.S`, `T.main`, `T.M`, `def f`),
-/// the item it starts.
+/// If the tokens end with an item header (`T.P.S`, `T.main`, `T.M`, `def f`,
+/// each with a parameter list or not), the item it starts.
 fn header(level: &[Lt<'_>]) -> Option<Head> {
+    // `T.M(A)`, `T.P.S(A)`, `def f(A)`: the parameter list is part of it.
+    let level = match level.last() {
+        Some(Lt::Closed {
+            opener: Token::LParen,
+            ..
+        }) => &level[..level.len() - 1],
+        _ => level,
+    };
     let n = level.len();
     let tok = |back: usize| -> Option<Token<'_>> {
         n.checked_sub(back)

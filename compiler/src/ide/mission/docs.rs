@@ -338,6 +338,56 @@ pub(crate) fn plan(text: &str, t: &Team, plan: PlanId) -> String {
 }
 
 /// A mode: what each plan runs, and where its events lead.
+/// A mode with parameters: its signature, what each `set` runs, and the
+/// modes of the machine it is entered as.
+pub(crate) fn mode_template(t: &Team, template: crate::sema::TemplateId) -> String {
+    let Some(m) = t.templates.get(template.index()) else {
+        return String::new();
+    };
+    let params: Vec<&str> = m.params.iter().map(|p| p.name.as_str()).collect();
+    let mut out = format!(
+        "**mode** `{}({})` of team `{}`\n\nA mode with parameters: each list of arguments it is entered with is a mode of its own, with each parameter standing in its `set`s for its argument.",
+        m.name,
+        params.join(", "),
+        t.name
+    );
+    let mut lines = Vec::new();
+    for s in &m.sets {
+        let (Some(plan), Some(svc)) = (s.plan, s.service) else {
+            continue;
+        };
+        let args: Vec<String> = s
+            .args
+            .iter()
+            .map(crate::syntax::ast::Arg::written)
+            .collect();
+        let mut line = format!(
+            "- `{}` runs `{}",
+            t.plans[plan.index()].name,
+            t.services[svc.index()].name
+        );
+        if !args.is_empty() {
+            write!(line, "({})", args.join(", ")).ok();
+        }
+        line.push('`');
+        lines.push(line);
+    }
+    if !lines.is_empty() {
+        write!(out, "\n\n{}", lines.join("\n")).ok();
+    }
+    let entered: Vec<String> = m
+        .instances
+        .iter()
+        .map(|i| format!("`{}`", t.modes[i.index()].name))
+        .collect();
+    if entered.is_empty() {
+        out.push_str("\n\nNever entered.");
+    } else {
+        write!(out, "\n\nEntered as {}.", entered.join(", ")).ok();
+    }
+    out
+}
+
 pub(crate) fn mode(text: &str, t: &Team, mode: ModeId) -> String {
     let Some(m) = t.modes.get(mode.index()) else {
         return String::new();
@@ -349,7 +399,16 @@ pub(crate) fn mode(text: &str, t: &Team, mode: ModeId) -> String {
         let line = match set {
             Some(s) => match s.service {
                 Some(svc) => {
-                    let mut l = format!("- `{}` runs `{}`", p.name, t.services[svc.index()].name);
+                    let args: Vec<String> = s
+                        .args
+                        .iter()
+                        .map(crate::syntax::ast::Arg::written)
+                        .collect();
+                    let service = match args.is_empty() {
+                        true => t.services[svc.index()].name.to_string(),
+                        false => format!("{}({})", t.services[svc.index()].name, args.join(", ")),
+                    };
+                    let mut l = format!("- `{}` runs `{service}`", p.name);
                     if let Some(ms) = s.timeout_ms {
                         write!(l, " (at most {})", millis_text(ms)).ok();
                     }

@@ -137,9 +137,9 @@ pub fn hover(
             "{}\n\nA symbolic constant: a word passed or compared as it is written.",
             docs::code(name)
         ),
-        Symbol::Parameter { function, index } => {
-            let info = mission.functions.get(function.0 as usize)?;
-            parameter(info, *index as usize)?
+        Symbol::Parameter { owner, index } => parameter(mission, *owner, *index as usize)?,
+        Symbol::ModeTemplate { team, template } => {
+            docs::mode_template(mission.team(*team), *template)
         }
     };
     Some(HoverResult { range, markdown })
@@ -157,14 +157,34 @@ pub(super) fn function_signature(info: &crate::sema::FunctionInfo) -> String {
 /// A parameter: whose it is, what it means, and what its uses ask of each
 /// call's argument (the checker's needs, its own and those of the
 /// functions it is passed on to).
-fn parameter(info: &crate::sema::FunctionInfo, index: usize) -> Option<String> {
-    let param = info.params.get(index)?;
+fn parameter(
+    mission: &crate::sema::Mission,
+    owner: crate::sema::ParamOwner,
+    index: usize,
+) -> Option<String> {
+    use crate::sema::ParamOwner;
+    let params = mission.params(owner);
+    let param = params.get(index)?;
+    let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
+    let (signature, meaning) = match owner {
+        ParamOwner::Function(f) => (
+            function_signature(mission.functions.get(f.0 as usize)?),
+            "in its body it stands for the argument of the call being run, read where it is used",
+        ),
+        ParamOwner::Service(..) => (
+            format!("{}({})", mission.owner_name(owner), names.join(", ")),
+            "in its body it stands for the argument the mode's `set` gives, fixed when the mission is written",
+        ),
+        ParamOwner::Mode(..) => (
+            format!("{}({})", mission.owner_name(owner), names.join(", ")),
+            "in the mode's `set`s it stands for the argument the mode is entered with (`mode = M(...)`): each list of arguments is a mode of its own",
+        ),
+    };
     let mut out = docs::code(&param.name);
     write!(
         out,
-        "\n\nParameter {} of `{}`: in its body it stands for the argument of the call being run, read where it is used.",
+        "\n\nParameter {} of `{signature}`: {meaning}.",
         index + 1,
-        function_signature(info)
     )
     .ok();
     let asks: Vec<String> = param.needs.iter().map(docs::param_need).collect();

@@ -123,6 +123,7 @@ fn renamable(symbol: &Symbol) -> Result<(), RenameError> {
         | Symbol::Plan { .. }
         | Symbol::Service { .. }
         | Symbol::Mode { .. }
+        | Symbol::ModeTemplate { .. }
         | Symbol::Event { .. }
         | Symbol::Function(_)
         | Symbol::TeamVariable { .. }
@@ -223,12 +224,21 @@ fn clash(
         }
         Symbol::Mode { team, mode } => {
             let t = team_of(*team)?;
+            if t.template_by_name(new).is_some() {
+                return Some(format!("team {} already has a mode `{new}`", t.name));
+            }
             let other = t.mode_by_name(new).filter(|m| m != mode)?;
             Some(format!(
                 "team {} already has a mode `{}`",
                 t.name,
                 t.modes[other.index()].name
             ))
+        }
+        Symbol::ModeTemplate { team, template } => {
+            let t = team_of(*team)?;
+            let other = t.template_by_name(new).filter(|m| m != template);
+            (other.is_some() || t.mode_by_name(new).is_some())
+                .then(|| format!("team {} already has a mode `{new}`", t.name))
         }
         Symbol::Event { team, name } => {
             let t = team_of(*team)?;
@@ -285,8 +295,8 @@ fn clash(
             }
             None
         }
-        Symbol::Parameter { function, .. } => {
-            parameter_clash(analysis, catalog, text, symbol, *function, new)
+        Symbol::Parameter { owner, .. } => {
+            parameter_clash(analysis, catalog, text, symbol, *owner, new)
         }
         Symbol::User
         | Symbol::RobotType(_)
@@ -297,24 +307,26 @@ fn clash(
     }
 }
 
-/// What a parameter of `function`, renamed to `new`, would clash with:
-/// another parameter of the function, a value robots read or a team
-/// variable (E045), or a name its body already writes with another meaning
-/// (which would then mean the parameter).
+/// What a parameter of `owner` (a function, a service, a mode), renamed
+/// to `new`, would clash with: another parameter of its list, a value
+/// robots read or a team variable (E045), or a name its body (a mode's
+/// `set`s) already writes with another meaning (which would then mean the
+/// parameter).
 fn parameter_clash(
     analysis: &CheckedMission,
     catalog: &Catalog,
     text: &str,
     symbol: &Symbol,
-    function: crate::sema::FunctionId,
+    owner: crate::sema::ParamOwner,
     new: &str,
 ) -> Option<String> {
+    use crate::sema::ParamOwner;
     let mission = &analysis.mission;
-    let info = mission.functions.get(function.0 as usize)?;
-    if let Some(other) = info.params.iter().find(|p| p.name == new) {
+    let whose = mission.owner_name(owner);
+    if let Some(other) = mission.params(owner).iter().find(|p| p.name == new) {
         return Some(format!(
-            "`{}` already has a parameter `{}`",
-            info.name, other.name
+            "`{whose}` already has a parameter `{}`",
+            other.name
         ));
     }
     if let Some((_, r)) = catalog.types().find(|(_, r)| r.value(new).is_some()) {
@@ -332,13 +344,20 @@ fn parameter_clash(
             "`{new}` is a team variable: the parameter would hide it"
         ));
     }
-    let body = analysis.function_syntax(info)?.span;
+    let body = match owner {
+        ParamOwner::Function(f) => {
+            analysis
+                .function_syntax(mission.functions.get(f.0 as usize)?)?
+                .span
+        }
+        ParamOwner::Service(team, service) => mission.team(team).service(service).span,
+        ParamOwner::Mode(team, template) => mission.team(team).template(template).span,
+    };
     mission.occurrences.iter().find(|o| {
         body.contains(o.span.start) && o.symbol != *symbol && text.get(o.span.range()) == Some(new)
     })?;
     Some(format!(
-        "`{new}` already means something else in the body of `{}`: it would mean the parameter",
-        info.name
+        "`{new}` already means something else in the body of `{whose}`: it would mean the parameter"
     ))
 }
 

@@ -134,7 +134,7 @@ fn classify(symbol: &Symbol) -> (TokenKind, u32) {
         Symbol::Plan { .. } => (TokenKind::Plan, 0),
         Symbol::Service { .. } => (TokenKind::Service, 0),
         Symbol::BuiltinService(_) => (TokenKind::Service, DEFAULT_LIBRARY),
-        Symbol::Mode { .. } => (TokenKind::Mode, 0),
+        Symbol::Mode { .. } | Symbol::ModeTemplate { .. } => (TokenKind::Mode, 0),
         Symbol::Event { .. } => (TokenKind::Event, 0),
         Symbol::Function(_) => (TokenKind::Function, 0),
         Symbol::TeamVariable { .. } => (TokenKind::Variable, 0),

@@ -67,6 +67,9 @@ pub fn signature_help(
                     .collect();
                 return Some(build(&f.name, params, Some(doc.to_string()), index));
             }
+            if let Some(help) = parameterised(analysis, scan.head.team(), name, index) {
+                return Some(help);
+            }
             let here = RobotsHere::at(analysis, offset, scan.head.team().map(|t| t.as_str()));
             let types = here.types(&analysis.mission);
             let def = types
@@ -158,6 +161,48 @@ pub fn signature_help(
 }
 
 /// `name(p1, p2)` with each parameter's range in the label.
+/// `MOVE(TARGET)` after `mode =`, `Go(PLACE)` in `set`: a mode or a
+/// composite service with parameters of the item's team, each parameter
+/// with what its uses ask of the argument.
+fn parameterised(
+    analysis: &CheckedMission,
+    team: Option<&crate::syntax::ast::Name>,
+    name: &str,
+    index: usize,
+) -> Option<SignatureHelp> {
+    use crate::sema::ParamOwner;
+    let mission = &analysis.mission;
+    let id = mission.team_by_name(team?)?;
+    let t = mission.team(id);
+    let (owner, doc) = match t.template_by_name(name) {
+        Some(template) => (
+            ParamOwner::Mode(id, template),
+            "A mode with parameters: each list of fixed arguments is a mode of its own.",
+        ),
+        None => {
+            let service = t
+                .service_ids()
+                .find(|s| t.service(*s).name == name && !t.service(*s).params.is_empty())?;
+            (
+                ParamOwner::Service(id, service),
+                "A composite service with parameters: it runs with each parameter standing for its fixed argument.",
+            )
+        }
+    };
+    let params = mission
+        .params(owner)
+        .iter()
+        .map(|p| {
+            let asks: Vec<String> = p.needs.iter().map(docs::param_need).collect();
+            (
+                p.name.to_string(),
+                (!asks.is_empty()).then(|| asks.join("; ")),
+            )
+        })
+        .collect();
+    Some(build(name, params, Some(doc.to_string()), index))
+}
+
 fn build(
     name: &str,
     params: Vec<(String, Option<String>)>,

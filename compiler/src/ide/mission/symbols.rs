@@ -94,7 +94,13 @@ fn team_symbol(
             .filter(|s| s.plan.index() == p)
             .map(|s| StructureNode {
                 name: s.name.to_string(),
-                detail: Some(format!("{}.{}.{}", team.name, plan.name, s.name)),
+                detail: Some(format!(
+                    "{}.{}.{}{}",
+                    team.name,
+                    plan.name,
+                    s.name,
+                    param_list(&s.params)
+                )),
                 kind: SymbolKind::Service,
                 span: s.span,
                 name_span: s.name_span,
@@ -113,19 +119,28 @@ fn team_symbol(
             children: services,
         });
     }
-    for mode in &team.modes {
-        let sets: Vec<String> = mode
-            .sets
-            .iter()
+    let set_list = |sets: &[crate::sema::ModeSet]| -> Vec<String> {
+        sets.iter()
             .filter_map(|set| {
                 let plan = &team.plans.get(set.plan?.index())?.name;
                 let service = match set.service {
-                    Some(s) => team.services.get(s.index())?.name.as_str(),
-                    None => "OFF",
+                    Some(s) => team.services.get(s.index())?.name.to_string(),
+                    None => "OFF".to_string(),
                 };
-                Some(format!("{plan}: {service}"))
+                let args: Vec<String> = set.args.iter().map(ast::Arg::written).collect();
+                Some(match args.is_empty() {
+                    true => format!("{plan}: {service}"),
+                    false => format!("{plan}: {service}({})", args.join(", ")),
+                })
             })
-            .collect();
+            .collect()
+    };
+    // The modes as declared, in the file's order: a mode with parameters
+    // once (with its parameters), not once per list of arguments it is
+    // entered with.
+    let modes_from = children.len();
+    for mode in team.modes.iter().filter(|m| m.instance.is_none()) {
+        let sets = set_list(&mode.sets);
         children.push(StructureNode {
             name: mode.name.to_string(),
             detail: (!sets.is_empty()).then(|| sets.join(", ")),
@@ -135,6 +150,22 @@ fn team_symbol(
             children: Vec::new(),
         });
     }
+    for template in &team.templates {
+        let sets = set_list(&template.sets);
+        let params = param_list(&template.params);
+        children.push(StructureNode {
+            name: template.name.to_string(),
+            detail: Some(match sets.is_empty() {
+                true => params,
+                false => format!("{params} {}", sets.join(", ")),
+            }),
+            kind: SymbolKind::Mode,
+            span: template.span,
+            name_span: template.name_span,
+            children: Vec::new(),
+        });
+    }
+    children[modes_from..].sort_by_key(|node| node.span.start);
     if let Some(main) = &team.main
         && let Some(syntax) = mains.iter().find(|m| m.span == main.span)
     {
@@ -197,12 +228,16 @@ pub fn workspace_symbols(analysis: &CheckedMission, query: &str) -> Vec<Workspac
             let container = Some(format!("{}.{plan}", team.name));
             add(&s.name, SymbolKind::Service, container, s.name_span);
         }
-        for m in &team.modes {
+        // Modes as declared: a mode with parameters once.
+        let declared = team.modes.iter().filter(|m| m.instance.is_none());
+        let declared = declared.map(|m| (&m.name, m.name_span));
+        let templates = team.templates.iter().map(|m| (&m.name, m.name_span));
+        for (name, name_span) in declared.chain(templates) {
             add(
-                &m.name,
+                name,
                 SymbolKind::Mode,
                 Some(team.name.to_string()),
-                m.name_span,
+                name_span,
             );
         }
     }
@@ -236,6 +271,15 @@ pub fn match_score(query: &str, name: &str) -> Option<u32> {
             .all(|c| chars.by_ref().any(|d| d == c))
             .then_some(4)
     }
+}
+
+/// `(A, B)`, or nothing without parameters.
+fn param_list(params: &[crate::sema::ParamInfo]) -> String {
+    if params.is_empty() {
+        return String::new();
+    }
+    let names: Vec<&str> = params.iter().map(|p| p.name.as_str()).collect();
+    format!("({})", names.join(", "))
 }
 
 #[cfg(test)]

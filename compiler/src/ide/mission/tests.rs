@@ -494,6 +494,136 @@ fn parameters_in_the_editor() {
     assert_eq!(help.active_parameter, Some(1));
 }
 
+/// Modes and services with parameters, in the editor: completion offers a
+/// service's parameters in its body and snippets for the mode after
+/// `mode =` and the service in `set`; hover on the mode names the modes it
+/// is entered as, on a parameter what it stands for; definition and rename
+/// reach the mode's declaration and every place it is named, and a
+/// parameter's list and uses; semantic tokens; signature help at the
+/// arguments; the outline lists the mode once with its parameters.
+#[test]
+fn modes_with_parameters_in_the_editor() {
+    let catalog = builtin();
+    let text = "{ R: TIEvalbot ti }\nR.Action.Go(PLACE) {\n  move(PLACE)\n  throw arrived\n}\nR.Action.Wait { standby() } repeat()\nR.MOVE(TARGET) { set(Action, Go(TARGET)) }\nR.WAIT { set(Action, Wait) }\nR.main {\n  case (MOVE):\n    catch (arrived): mode = WAIT\n  case (WAIT):\n    catch (go): mode = MOVE(hall)\n  default: mode = MOVE(kitchen)\n}\n";
+    let analysis = crate::check_source(FileId(0), text, catalog);
+    let errors: Vec<_> = analysis
+        .diagnostics
+        .iter()
+        .filter(|d| d.is_error())
+        .collect();
+    assert!(errors.is_empty(), "{errors:#?}");
+
+    // Completion: the service's parameter in its body; the mode's snippet.
+    let body = text.find("move(PLACE)").unwrap() + 5;
+    let items = completions(
+        &analysis,
+        catalog,
+        text,
+        body,
+        CompletionConfig { snippets: true },
+    );
+    assert_eq!(labels_of(&items, CompletionKind::Parameter), ["PLACE"]);
+    let entered = text.find("MOVE(hall)").unwrap();
+    let items = completions(
+        &analysis,
+        catalog,
+        text,
+        entered,
+        CompletionConfig { snippets: true },
+    );
+    let mode = items.iter().find(|i| i.label == "MOVE").expect("the mode");
+    assert_eq!(mode.insert, "MOVE(${1:TARGET})");
+    assert!(
+        !items.iter().any(|i| i.label.contains('(')),
+        "a mode entered with arguments is offered by its name alone"
+    );
+
+    // Hover on the mode where it is entered, and on its parameter.
+    let h = hover(&analysis, catalog, text, entered + 1).expect("a hover");
+    assert!(h.markdown.contains("`MOVE(TARGET)`"), "{}", h.markdown);
+    assert!(
+        h.markdown
+            .contains("Entered as `MOVE(kitchen)`, `MOVE(hall)`."),
+        "{}",
+        h.markdown
+    );
+    let target = text.find("Go(TARGET)").unwrap() + 3;
+    let h = hover(&analysis, catalog, text, target).expect("a hover");
+    assert!(
+        h.markdown.contains("Parameter 1 of `R.MOVE(TARGET)`"),
+        "{}",
+        h.markdown
+    );
+    assert!(h.markdown.contains("passed to `move`"), "{}", h.markdown);
+
+    // Definition of the mode and rename everywhere it is named.
+    let declared = text.find("MOVE(TARGET)").unwrap();
+    let targets = super::navigation::definition(&analysis, catalog, entered + 1);
+    let spans: Vec<Span> = targets.iter().map(|t| t.span).collect();
+    assert_eq!(spans, [Span::new(declared, declared + 4)]);
+    let edits = super::rename::rename(&analysis, catalog, text, entered + 1, "GO_TO").unwrap();
+    let renamed: Vec<usize> = edits.iter().map(|s| s.start).collect();
+    let named: Vec<usize> = text.match_indices("MOVE").map(|(i, _)| i).collect();
+    assert_eq!(renamed, named);
+    let clash = super::rename::rename(&analysis, catalog, text, entered + 1, "WAIT").unwrap_err();
+    assert!(
+        clash.to_string().contains("already has a mode `WAIT`"),
+        "{clash}"
+    );
+    // A mode's parameter: its list and its use in the `set`s.
+    let edits = super::rename::rename(&analysis, catalog, text, target, "GOAL").unwrap();
+    let param = text.find("TARGET").unwrap();
+    assert_eq!(
+        edits,
+        [Span::new(param, param + 6), Span::new(target, target + 6)]
+    );
+
+    // Semantic tokens: the parameters, and the mode as a mode everywhere.
+    let tokens = super::semantic_tokens::semantic_tokens(&analysis, None);
+    let of = |kind| -> Vec<&str> {
+        tokens
+            .iter()
+            .filter(|t| t.kind == kind)
+            .map(|t| &text[t.span.range()])
+            .collect()
+    };
+    use super::semantic_tokens::TokenKind;
+    assert_eq!(
+        of(TokenKind::Parameter),
+        ["PLACE", "PLACE", "TARGET", "TARGET"]
+    );
+    assert_eq!(
+        of(TokenKind::Mode).iter().filter(|m| **m == "MOVE").count(),
+        4
+    );
+
+    // Signature help at the mode's argument and the service's.
+    let help = signature_help(&analysis, catalog, text, entered + 5).expect("signature help");
+    assert_eq!(
+        (help.label.as_str(), help.active_parameter),
+        ("MOVE(TARGET)", Some(0))
+    );
+    let help = signature_help(&analysis, catalog, text, target).expect("signature help");
+    assert_eq!(help.label, "Go(PLACE)");
+
+    // The outline: the mode once, with its parameters.
+    let outline = super::symbols::document_symbols(&analysis, text);
+    let team = &outline[0];
+    let modes: Vec<(&str, Option<&str>)> = team
+        .children
+        .iter()
+        .filter(|c| c.kind == crate::ide::SymbolKind::Mode)
+        .map(|c| (c.name.as_str(), c.detail.as_deref()))
+        .collect();
+    assert_eq!(
+        modes,
+        [
+            ("MOVE", Some("(TARGET) Action: Go(TARGET)")),
+            ("WAIT", Some("Action: Wait"))
+        ]
+    );
+}
+
 /// Every `ide` function at `offset` of `text`: nothing panics, and every
 /// range returned lies in the text, on character boundaries.
 fn every_feature_at(text: &str, analysis: &CheckedMission, offset: usize) {
