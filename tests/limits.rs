@@ -194,6 +194,32 @@ fn a_mission_past_the_robot_limit_is_an_error_on_the_declaration_that_crosses_it
     assert!(e036[0].message.contains("4096"), "{:?}", e036[0]);
 }
 
+/// A mode with parameters entered with a thousand rooms from a thousand
+/// catches of its `case`, with sixty-four `set`s: its copies would hold about
+/// a million `set`s and catches (gigabytes). Past 65,536 the checker says
+/// E048, where the copies cross it, at once and in bounded memory; below it,
+/// the same mission with fewer rooms checks cleanly.
+#[test]
+fn modes_entered_with_too_many_lists_of_arguments_are_e048_in_bounded_memory() {
+    use support::missiongen::mode_entered_with_many_rooms;
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(
+        dir.join("m.mission"),
+        mode_entered_with_many_rooms(64, 1000),
+    )
+    .unwrap();
+    let (code, diags) = check_bounded(dir, &["m.mission"]);
+    assert_eq!(code, 1);
+    let codes: Vec<&str> = diags.iter().map(|d| d.code.as_str()).collect();
+    assert_eq!(codes, ["E048", "E048"], "{}", support::listing(&diags));
+    assert!(diags.iter().all(|d| d.message.contains("65536")));
+    // 64 sets and 1 + 99 catches, for each of 100 rooms: 16,500.
+    std::fs::write(dir.join("m.mission"), mode_entered_with_many_rooms(64, 100)).unwrap();
+    let (code, diags) = check_bounded(dir, &["m.mission"]);
+    assert_eq!(code, 0, "{}", support::listing(&diags));
+}
+
 #[test]
 fn a_swarm_of_a_thousand_robots_and_one_at_the_limit_check_cleanly() {
     let tmp = tempfile::tempdir().unwrap();

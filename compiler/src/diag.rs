@@ -118,6 +118,7 @@ codes! {
     DuplicateParameter = "E044", Error, "a function, composite service or mode with two parameters of the same name";
     ParameterHidesName = "E045", Error, "a parameter (of a function, composite service or mode) named like a value robots read or a team variable: where used the name would mean the parameter, hiding the other";
     ModeArgumentCount = "E046", Error, "a mode entered (`mode = MOVE(kitchen)`) or a composite service set (`set(Action, Go(kitchen))`) with more or fewer arguments than its parameters, or with arguments it does not take";
+    ModeCopiesPastLimit = "E048", Error, "modes entered with so many distinct lists of arguments that their copies would hold more than 65,536 `set`s and catches in all";
     ArgumentNotFixed = "E047", Error, "an argument of a mode entered or of a service set that is not known when the mission is written (a value robots read, a team variable, an expression): each list of arguments is a mode of its own";
     TooManyRobots = "E036", Error, "`name[N]` with N above 4096, or a mission with more than 4096 robots in all";
     // Catalog files (*.robot.xml).

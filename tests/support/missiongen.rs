@@ -809,3 +809,29 @@ pub fn scenario(seed: u64, robots: &[String], duration: i64, time_scale: f64) ->
         faults.join(",\n  ")
     )
 }
+
+/// A mission whose mode `MOVE(TARGET)` sets `sets` plans and one that
+/// throws every event, and is entered with `entries` different rooms, each
+/// from a catch of `case (MOVE)`: its copies hold about `(sets + entries) *
+/// entries` `set`s and catches (E048 past 65,536).
+pub fn mode_entered_with_many_rooms(sets: usize, entries: usize) -> String {
+    let mut text = String::from("{ R: iRobotCreate scout }\n");
+    for p in 0..sets {
+        text.push_str(&format!("R.P{p}.Go(PLACE) {{ move(PLACE) }} repeat()\n"));
+    }
+    // One service throws every event the main catches.
+    text.push_str("R.Watch.Look {\n");
+    for room in 1..entries.max(1) {
+        text.push_str(&format!("  if (DISTANCE < {room}) throw e{room}\n"));
+    }
+    text.push_str("} repeat()\nR.MOVE(TARGET) {\n  set(Watch, Look)\n");
+    for p in 0..sets {
+        text.push_str(&format!("  set(P{p}, Go(TARGET))\n"));
+    }
+    text.push_str("}\nR.main {\n  default: mode = MOVE(room0)\n  case (MOVE):\n");
+    for room in 1..entries.max(1) {
+        text.push_str(&format!("    catch (e{room}): mode = MOVE(room{room})\n"));
+    }
+    text.push_str("}\n");
+    text
+}

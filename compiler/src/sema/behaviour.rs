@@ -4,7 +4,7 @@
 
 use super::body::{ParamRef, Type};
 use super::ir::*;
-use super::{Checker, suggestion};
+use super::{Checker, MAX_MODE_COPIES, suggestion};
 use crate::diag::{Code, Severity};
 use crate::fasthash::{FastMap, FastSet};
 use crate::span::Span;
@@ -441,14 +441,27 @@ impl<'a> Checker<'a> {
     /// Each mode entered with arguments gets its template's `set`s, each
     /// argument that is a parameter of the mode replaced by the argument
     /// the mode is entered with: the mode the hand-written copy is.
+    ///
+    /// Past [`MAX_MODE_COPIES`] in all, the first list of arguments that goes
+    /// past it is E048 and its mode gets no `set`s (an error: nothing is
+    /// built from the mission).
     fn instantiate(&mut self, team: TeamId) {
         let t = self.team(team);
         let mut filled = Vec::new();
+        let mut past_limit = Vec::new();
+        let mut copied = self.mode_copies;
         for mode in t.mode_ids() {
             let Some(instance) = &t.mode(mode).instance else {
                 continue;
             };
             let template = t.template(instance.template);
+            if copied + template.sets.len() > MAX_MODE_COPIES {
+                let spans = instance.args.iter().map(ast::Arg::span);
+                let span = spans.reduce(Span::cover).unwrap_or(template.name_span);
+                past_limit.push((span, t.mode(mode).name.clone()));
+                continue;
+            }
+            copied += template.sets.len();
             let sets: Vec<ModeSet> = template
                 .sets
                 .iter()
@@ -468,8 +481,18 @@ impl<'a> Checker<'a> {
                 .collect();
             filled.push((mode, sets));
         }
+        self.mode_copies = copied;
         for (mode, sets) in filled {
             self.team_mut(team).modes[mode.index()].sets = sets;
+        }
+        // The first list past the bound (the others would say the same).
+        if let Some((span, name)) = past_limit.first() {
+            self.past_mode_copies.insert(team);
+            let message = format!(
+                "entering `{name}` would make the copies of the modes entered with arguments hold more than {MAX_MODE_COPIES} `set`s and catches in all: enter fewer distinct lists of arguments, or give the mode fewer `set`s"
+            );
+            self.diagnostics
+                .report(Code::ModeCopiesPastLimit, *span, message);
         }
     }
 
@@ -581,13 +604,30 @@ impl<'a> Checker<'a> {
                 }
             }
         }
+        let mut past_limit = None;
         for (template, transition) in template_catches {
+            let count = self.team(team).template(template).instances.len();
+            if self.mode_copies + count > MAX_MODE_COPIES {
+                past_limit.get_or_insert((transition.span, count));
+                continue;
+            }
+            self.mode_copies += count;
             for &from in &self.team(team).template(template).instances {
                 transitions.push(Transition {
                     from,
                     ..transition.clone()
                 });
             }
+        }
+        if let Some((span, modes)) = past_limit {
+            // Which modes the machine reaches is unknown without them.
+            self.mains_with_unknown_modes.insert(team);
+            self.past_mode_copies.insert(team);
+            let message = format!(
+                "this catch holds in each of the {modes} modes its mode is entered as: the copies of the modes entered with arguments would hold more than {MAX_MODE_COPIES} `set`s and catches in all; enter fewer distinct lists of arguments"
+            );
+            self.diagnostics
+                .report(Code::ModeCopiesPastLimit, span, message);
         }
         self.team_mut(team).main = Some(Main {
             span: m.span,
@@ -649,6 +689,11 @@ impl<'a> Checker<'a> {
         let Some(main) = &self.team(team).main else {
             return;
         };
+        // Modes past E048 lack their `set`s or catches: they would all seem
+        // to throw nothing.
+        if self.past_mode_copies.contains(&team) {
+            return;
+        }
         let t = self.team(team);
         let mut findings = Vec::new();
         let mut never_thrown = Vec::new();

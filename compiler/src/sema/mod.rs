@@ -46,6 +46,13 @@ pub const MAX_ROBOTS_PER_DECLARATION: u32 = 4096;
 /// declaration that goes past it).
 pub const MAX_ROBOTS_PER_MISSION: usize = 4096;
 
+/// The most `set`s and catches the copies of modes entered with arguments
+/// may hold in all (E048, where they go past it): each distinct list of
+/// arguments copies its mode's `set`s and the catches of `case` for the
+/// mode, so many lists of a mode with many of them would otherwise cost
+/// their product.
+pub const MAX_MODE_COPIES: usize = 65_536;
+
 /// Everything known about one mission file after checking.
 #[derive(Clone, Debug)]
 pub struct CheckedMission {
@@ -146,6 +153,12 @@ pub(crate) struct Checker<'a> {
     /// Teams whose main block names an undefined mode (already reported): which
     /// modes it can reach is unknown.
     mains_with_unknown_modes: FastSet<TeamId>,
+    /// The `set`s and catches the copies of modes entered with arguments
+    /// hold so far, all teams (at most [`MAX_MODE_COPIES`]).
+    mode_copies: usize,
+    /// Teams with modes left without copies past [`MAX_MODE_COPIES`]
+    /// (E048, already reported).
+    past_mode_copies: FastSet<TeamId>,
     /// Communication statements naming an unknown team (already reported), as
     /// (kind, running team, value): they may be the counterpart of another.
     comms_with_unknown_team: Vec<(ast::CommKind, TeamId, AttrKey)>,
@@ -209,6 +222,8 @@ impl<'a> Checker<'a> {
             team_variables: FastSet::default(),
             set_by_duplicate_modes: FastSet::default(),
             mains_with_unknown_modes: FastSet::default(),
+            mode_copies: 0,
+            past_mode_copies: FastSet::default(),
             comms_with_unknown_team: Vec::new(),
             received_values: Default::default(),
             lacking_values: Vec::new(),
