@@ -695,7 +695,7 @@ impl<'a> Checker<'a> {
             return;
         }
         let t = self.team(team);
-        let mut findings = Vec::new();
+        let mut findings: Vec<(Span, &Name, &Name, Vec<&Name>)> = Vec::new();
         let mut never_thrown = Vec::new();
         // The events each mode's services throw, gathered once per mode: a
         // mode may have many catches.
@@ -712,15 +712,35 @@ impl<'a> Checker<'a> {
             });
             if !thrown.contains(&tr.event) && !told.contains(&tr.event) {
                 never_thrown.push(i);
-                findings.push((
-                    tr.event_span,
-                    format!(
-                        "no service that mode {} runs throws `{}`, so this catch never fires there",
-                        mode.name, tr.event
-                    ),
-                ));
+                // A catch of `case (MOVE)` is one transition per mode MOVE is
+                // entered as, side by side: said once, naming the modes.
+                match findings.last_mut() {
+                    Some((span, _, _, more)) if *span == tr.event_span => more.push(&mode.name),
+                    _ => findings.push((tr.event_span, &tr.event, &mode.name, Vec::new())),
+                }
             }
         }
+        let findings: Vec<(Span, String)> = findings
+            .into_iter()
+            .map(|(span, event, first, more)| {
+                let message = match more.as_slice() {
+                    [] => format!(
+                        "no service that mode {first} runs throws `{event}`, so this catch never fires there"
+                    ),
+                    [second] => format!(
+                        "no service that modes {first} and {second} run throws `{event}`, so this catch never fires there"
+                    ),
+                    [second, third] => format!(
+                        "no service that modes {first}, {second} and {third} run throws `{event}`, so this catch never fires there"
+                    ),
+                    [second, rest @ ..] => format!(
+                        "no service that modes {first}, {second} and {} more run throws `{event}`, so this catch never fires there",
+                        rest.len()
+                    ),
+                };
+                (span, message)
+            })
+            .collect();
         if let Some(main) = &mut self.team_mut(team).main {
             for i in never_thrown {
                 main.transitions[i].never_thrown = true;
