@@ -110,7 +110,14 @@ fn unix_ms() -> u64 {
 
 /// The board's trace lines until its `stop` (or its end), the first one
 /// handed to `started` as it comes.
-fn board_trace(rx: &mpsc::Receiver<String>, mut started: impl FnMut(&Event)) -> Vec<String> {
+/// `gateway_log` is the gateway's standard error, said when the board's
+/// trace waits too long (it tells whether the link or the broker was the
+/// one waited for).
+fn board_trace(
+    rx: &mpsc::Receiver<String>,
+    gateway_log: &Path,
+    mut started: impl FnMut(&Event),
+) -> Vec<String> {
     let end = Instant::now() + LIMIT;
     let mut lines = Vec::new();
     loop {
@@ -118,7 +125,8 @@ fn board_trace(rx: &mpsc::Receiver<String>, mut started: impl FnMut(&Event)) -> 
         let Ok(line) = rx.recv_timeout(left) else {
             assert!(
                 Instant::now() < end,
-                "the board's trace waited past {LIMIT:?}: {lines:#?}"
+                "the board's trace waited past {LIMIT:?}: {lines:#?}\nthe gateway said:\n{}",
+                std::fs::read_to_string(gateway_log).unwrap_or_default()
             );
             return lines;
         };
@@ -153,6 +161,7 @@ fn the_evalbot_in_qemu_on_the_serial_link_behaves_as_in_the_simulator() {
     let folders = support::mqtt::build(&scouting(), &fleet.out.join("linux"), &[]);
     support::mqtt::compile_in(&folders, &scenario);
 
+    let gateway_log = fleet.out.join("gateway.stderr");
     let link_port = support::mosquitto::free_port();
     let (board, board_rx) = qemu(&elf, link_port);
     let board = fleet.processes.push(board);
@@ -163,14 +172,14 @@ fn the_evalbot_in_qemu_on_the_serial_link_behaves_as_in_the_simulator() {
             .args(["--link", &format!("ti=tcp:127.0.0.1:{link_port}")])
             .args(["--broker", &fleet.url()])
             .stdout(Stdio::null())
-            .stderr(Stdio::null())
+            .stderr(std::fs::File::create(&gateway_log).expect("a log file"))
             .spawn()
             .expect("semo gateway starts"),
     );
     // The board's mission time starts when the gateway welcomes it: the
     // Linux robots count theirs from that instant.
     let mut linux = Vec::new();
-    let lines = board_trace(&board_rx, |first| {
+    let lines = board_trace(&board_rx, &gateway_log, |first| {
         assert_eq!(field(first, "event"), "start", "{first:?}");
         let t = first["t"].as_u64().unwrap();
         let start_at = (unix_ms() - t).to_string();
