@@ -555,17 +555,12 @@ impl<'a> Completions<'a> {
                 continue;
             }
             // `go_to(${1:PLACE})`: a stop at each parameter, named.
-            let params: Vec<String> = f
-                .params
-                .iter()
-                .enumerate()
-                .map(|(i, p)| format!("${{{}:{}}}", i + 1, snippets::escape(&p.name)))
-                .collect();
+            let call = snippets::call(&f.name, f.params.iter().map(|p| p.name.as_str()));
             self.add_snippet(
                 LIKELY,
                 CompletionKind::Function,
                 f.name.as_str(),
-                &format!("{}({})", snippets::escape(&f.name), params.join(", ")),
+                &call,
                 Some(super::hover::function_signature(f)),
                 Some("A function: its statements run here, by these robots.".to_string()),
             );
@@ -1047,13 +1042,6 @@ impl<'a> Completions<'a> {
                 continue;
             }
             let syntax = self.analysis.service_syntax(s);
-            // `Go(${1:PLACE})` for a service with parameters.
-            let params: Vec<String> = s
-                .params
-                .iter()
-                .enumerate()
-                .map(|(i, p)| format!("${{{}:{}}}", i + 1, snippets::escape(&p.name)))
-                .collect();
             let detail = Some(format!(
                 "{} {}",
                 t.service_path(ServiceId::new(i)),
@@ -1065,7 +1053,7 @@ impl<'a> Completions<'a> {
                 team,
                 ServiceId::new(i),
             ));
-            if params.is_empty() {
+            if s.params.is_empty() {
                 self.add(
                     EXACT,
                     CompletionKind::Service,
@@ -1074,7 +1062,8 @@ impl<'a> Completions<'a> {
                     documentation,
                 );
             } else {
-                let body = format!("{}({})", snippets::escape(&s.name), params.join(", "));
+                // `Go(${1:PLACE})` for a service with parameters.
+                let body = snippets::call(&s.name, s.params.iter().map(|p| p.name.as_str()));
                 let name = s.name.as_str();
                 self.add_snippet(
                     EXACT,
@@ -1152,17 +1141,12 @@ impl<'a> Completions<'a> {
         }
         // `MOVE(${1:TARGET})`: a stop at each parameter, named.
         for (i, m) in t.templates.iter().enumerate() {
-            let params: Vec<String> = m
-                .params
-                .iter()
-                .enumerate()
-                .map(|(i, p)| format!("${{{}:{}}}", i + 1, snippets::escape(&p.name)))
-                .collect();
+            let call = snippets::call(&m.name, m.params.iter().map(|p| p.name.as_str()));
             self.add_snippet(
                 EXACT,
                 CompletionKind::Mode,
                 m.name.as_str(),
-                &format!("{}({})", snippets::escape(&m.name), params.join(", ")),
+                &call,
                 Some(format!("mode with parameters of {}", t.name)),
                 Some(docs::mode_template(t, crate::sema::TemplateId::new(i))),
             );

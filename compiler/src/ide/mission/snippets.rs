@@ -25,6 +25,17 @@ pub const MISSION_TEMPLATE: &str = "\
 # Part 3. Mode changes:        TeamName.main { case (Mode): catch (event): mode = Other  default: mode = Mode }
 ";
 
+/// `name(${1:A}, ${2:B})`: a call with a stop at each parameter, named
+/// (functions, composite services and modes with parameters).
+pub fn call<'p>(name: &str, params: impl IntoIterator<Item = &'p str>) -> String {
+    let stops: Vec<String> = params
+        .into_iter()
+        .enumerate()
+        .map(|(i, p)| format!("${{{}:{}}}", i + 1, escape(p)))
+        .collect();
+    format!("{}({})", escape(name), stops.join(", "))
+}
+
 /// Escapes text for use inside a snippet.
 pub fn escape(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
