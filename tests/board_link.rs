@@ -283,20 +283,7 @@ fn the_messaging_evalbot_fits_the_flash_and_ram_budget() {
         "{}",
         String::from_utf8_lossy(&made.stderr)
     );
-    let sizes = Command::new("arm-none-eabi-size")
-        .arg(folder.join("ti.elf"))
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&sizes.stdout);
-    let numbers: Vec<u64> = text
-        .lines()
-        .nth(1)
-        .expect("a line of sizes")
-        .split_whitespace()
-        .take(3)
-        .map(|n| n.parse().unwrap())
-        .collect();
-    let (flash, ram) = (numbers[0] + numbers[1], numbers[1] + numbers[2]);
+    let (flash, ram) = robots::board_size(&folder.join("ti.elf"));
     eprintln!("scouting ti on cortex-m with the link: flash {flash} B, RAM {ram} B");
     assert!(flash <= 32 * 1024, "flash {flash} B > 32 KB");
     assert!(ram <= 8 * 1024, "RAM {ram} B > 8 KB");

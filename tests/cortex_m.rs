@@ -70,25 +70,6 @@ fn make_with(folder: &Path, extra: &str) -> PathBuf {
     folder.join(format!("{robot}.elf"))
 }
 
-/// Flash (text + data) and RAM (data + bss, the stack included) of an ELF file.
-fn size(elf: &Path) -> (u64, u64) {
-    let out = Command::new("arm-none-eabi-size")
-        .arg(elf)
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    let numbers: Vec<u64> = text
-        .lines()
-        .nth(1)
-        .expect("a line of sizes")
-        .split_whitespace()
-        .take(3)
-        .map(|n| n.parse().unwrap())
-        .collect();
-    let (text, data, bss) = (numbers[0], numbers[1], numbers[2]);
-    (text + data, data + bss)
-}
-
 /// Runs the program built for `target` in QEMU (the machine its row of the
 /// platform table names) until it exits through semihosting; its serial
 /// output (the trace). Killed and failed after [`QEMU_LIMIT`].
@@ -384,7 +365,7 @@ fn robots_fit_the_flash_and_ram_budgets() {
             None,
             &out.join("follow"),
         );
-        let (flash, ram) = size(&make(&follow[0]));
+        let (flash, ram) = robots::board_size(&make(&follow[0]));
         eprintln!("follow robot on {target}: flash {flash} B, RAM {ram} B");
         assert!(
             flash <= 32 * 1024,
@@ -396,7 +377,7 @@ fn robots_fit_the_flash_and_ram_budgets() {
             "{target}: follow robot {flash} B / {ram} B grew past {follow_guard:?}"
         );
         for folder in build_for(&fixture("swarm.mission"), target, None, &out.join("swarm")) {
-            let (flash, ram) = size(&make(&folder));
+            let (flash, ram) = robots::board_size(&make(&folder));
             eprintln!(
                 "{target}: {}: flash {flash} B, RAM {ram} B",
                 folder.display()

@@ -189,6 +189,25 @@ pub fn make_board(folder: &Path) {
     );
 }
 
+/// Flash (text + data) and RAM (data + bss, the stack included) of an ELF file.
+pub fn board_size(elf: &Path) -> (u64, u64) {
+    let out = Command::new("arm-none-eabi-size")
+        .arg(elf)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    let numbers: Vec<u64> = text
+        .lines()
+        .nth(1)
+        .expect("a line of sizes")
+        .split_whitespace()
+        .take(3)
+        .map(|n| n.parse().unwrap())
+        .collect();
+    let (text, data, bss) = (numbers[0], numbers[1], numbers[2]);
+    (text + data, data + bss)
+}
+
 /// gcc, and clang where it is installed (CI installs it).
 pub fn compilers() -> Vec<&'static str> {
     let found: Vec<&str> = ["gcc", "clang"].into_iter().filter(|c| has(c)).collect();
