@@ -398,17 +398,26 @@ fn a_robot_whose_broker_stops_acknowledging_holds_a_bounded_number_of_sends_then
         &[],
     );
     let log = fleet.broker_dir().join("mosquitto.log");
+    // Until the broker has taken its subscription (its log's `CLIENT QOS
+    // TOPIC` line), which the talker waits to be acknowledged before it
+    // sends anything: stopped before, the broker would fail its start.
+    let subscribed = "semo-send_rate-default-talker 1 ";
     while !std::fs::read_to_string(&log)
         .unwrap_or_default()
-        .contains("as semo-send_rate-default-talker")
+        .lines()
+        .any(|line| {
+            line.split_once(": ")
+                .is_some_and(|(_, rest)| rest.starts_with(subscribed))
+        })
     {
         assert!(
             fleet.processes.is_running(started.index),
-            "the talker ended before it connected"
+            "the talker ended before it subscribed"
         );
         std::thread::sleep(Duration::from_millis(20));
     }
-    // Time for its subscriptions' acknowledgement, which it waits for.
+    // Room for the acknowledgement to leave, which mosquitto writes after
+    // it logs the subscription.
     std::thread::sleep(Duration::from_millis(1000));
     super::signal(fleet.broker_process().unwrap(), "STOP");
     // Sends traced before the broker stopped may have been acknowledged.

@@ -71,8 +71,10 @@ pub fn write_config(dir: &Path, port: u16, keeps: Keeps) -> PathBuf {
         ));
     }
     if keeps.log {
+        // The default kinds, and each subscription (`CLIENT QOS TOPIC`):
+        // a test can see that a client's subscriptions were taken.
         text.push_str(&format!(
-            "log_dest file {}\n",
+            "log_dest file {}\nlog_type error\nlog_type warning\nlog_type notice\nlog_type information\nlog_type subscribe\n",
             dir.join("mosquitto.log").display()
         ));
     }
