@@ -50,13 +50,19 @@ impl LinkRobot {
     /// The robot at the end of the link the gateway connects to on
     /// `listener`, once its session stands.
     fn connected(listener: &TcpListener) -> LinkRobot {
+        LinkRobot::taking(listener, semo::link::PAYLOAD_MAX as u16)
+    }
+
+    /// As [`LinkRobot::connected`], a robot that takes payloads of at most
+    /// `payload_max` bytes (a board's `SEMO_LINK_PAYLOAD_MAX`).
+    fn taking(listener: &TcpListener, payload_max: u16) -> LinkRobot {
         let (stream, _) = listener.accept().expect("the gateway connects to the link");
         stream
             .set_read_timeout(Some(Duration::from_millis(50)))
             .unwrap();
         let mut robot = LinkRobot {
             stream,
-            endpoint: Endpoint::new(8),
+            endpoint: Endpoint::taking(8, payload_max),
             started: Instant::now(),
             taken: Vec::new(),
         };
@@ -342,6 +348,67 @@ fn a_send_is_acknowledged_to_the_robot_only_once_the_broker_has_it() {
         format!("semo/scouting/{run}/MasterTeam/SlaveTeam.COLOR/SlaveTeam/ti")
     );
     assert_eq!(payload, good);
+}
+
+/// A board takes shorter payloads than the gateway (the scouting `ti`: 164
+/// bytes); its session says how long. A message from the broker longer than
+/// that comes down as `R` (`L`: too long), counted and said, and the next
+/// message comes down after it. (The gateway sent it as `M`: a bad frame on
+/// the board, never acknowledged, sent again for ever ahead of every later
+/// message.)
+#[test]
+fn a_message_longer_than_the_board_takes_is_refused_and_the_next_one_arrives() {
+    let Some(mut fleet) = Fleet::start("gateway-bound") else {
+        return;
+    };
+    let run = "g4";
+    let (client, rx) = watcher(fleet.port, run);
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let link_port = listener.local_addr().unwrap().port();
+    let gw = fleet.processes.push(gateway(&fleet.url(), link_port, run));
+    let mut robot = LinkRobot::taking(&listener, 64);
+
+    let topic = format!("semo/scouting/{run}/SlaveTeam/USER.RC_CMD/MasterTeam/irobot");
+    let long = datagram::encode(&Datagram {
+        publish: false,
+        team: "MasterTeam".into(),
+        robot: "irobot".into(),
+        key: "USER.RC_CMD".into(),
+        value: Some(Value::Text("x".repeat(60).into())),
+    });
+    assert!(long.len() > 64);
+    let short = gram(false, "MasterTeam", "irobot", "USER.RC_CMD", 2);
+    for payload in [&long, &short] {
+        client
+            .publish(&topic, rumqttc::QoS::AtLeastOnce, false, payload.clone())
+            .unwrap();
+    }
+    robot.until("two frames from the gateway", |taken, _| taken.len() >= 2);
+    assert_eq!(
+        robot.taken[0],
+        Frame::new(Kind::Refused, robot.taken[0].seq, b"L".to_vec())
+    );
+    assert_eq!(robot.taken[1].kind, Kind::Message);
+    assert_eq!(robot.taken[1].payload, short);
+    assert!(robot.endpoint.bad_frames.is_empty(), "nothing too long came");
+    heard(&rx, "the long message");
+    heard(&rx, "the short one");
+
+    fleet.processes.kill(gw);
+    let mut said = String::new();
+    fleet.processes.0[gw]
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut said)
+        .unwrap();
+    assert!(
+        said.contains(&format!(
+            "ti: a message of {} bytes on {topic} is longer than the robot takes (64 bytes) (1 refused)",
+            long.len()
+        )),
+        "{said}"
+    );
 }
 
 #[test]

@@ -26,16 +26,35 @@ fn unhex(text: &str) -> Vec<u8> {
         .collect()
 }
 
+/// The payload bound of the board the second driver stands for (the
+/// scouting `ti`'s).
+const BOARD_PAYLOAD_MAX: usize = 164;
+
 /// `link_test.c` with `semo_link.c`, built once per test process.
 fn driver() -> &'static Path {
     static BUILT: OnceLock<PathBuf> = OnceLock::new();
-    BUILT.get_or_init(|| {
+    BUILT.get_or_init(|| build_driver(None))
+}
+
+/// The same, built with a board's smaller `SEMO_LINK_PAYLOAD_MAX`.
+fn board_driver() -> &'static Path {
+    static BUILT: OnceLock<PathBuf> = OnceLock::new();
+    BUILT.get_or_init(|| build_driver(Some(BOARD_PAYLOAD_MAX)))
+}
+
+fn build_driver(payload_max: Option<usize>) -> PathBuf {
+    {
         let runtime = support::repo_root().join("compiler/src/codegen/runtime");
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("link");
         std::fs::create_dir_all(&dir).unwrap();
-        let exe = dir.join(format!("link_test-{}", std::process::id()));
+        let exe = dir.join(format!(
+            "link_test-{}-{}",
+            std::process::id(),
+            payload_max.unwrap_or(PAYLOAD_MAX)
+        ));
         let out = Command::new("gcc")
             .current_dir(&runtime)
+            .args(payload_max.map(|n| format!("-DSEMO_LINK_PAYLOAD_MAX={n}")))
             .args([
                 "-std=c11",
                 "-Wall",
@@ -57,7 +76,7 @@ fn driver() -> &'static Path {
             String::from_utf8_lossy(&out.stderr)
         );
         exe
-    })
+    }
 }
 
 /// The C side, one command at a time.
@@ -77,7 +96,12 @@ struct Said {
 
 impl CSide {
     fn start() -> CSide {
-        let mut child = Command::new(driver())
+        CSide::start_taking(driver(), PAYLOAD_MAX)
+    }
+
+    /// The C side built with `payload_max` (the driver built so).
+    fn start_taking(driver: &Path, payload_max: usize) -> CSide {
+        let mut child = Command::new(driver)
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .spawn()
@@ -92,7 +116,7 @@ impl CSide {
         let hello = c.read_until_dot();
         assert_eq!(
             hello.lines,
-            vec![format!("payload_max {PAYLOAD_MAX}")],
+            vec![format!("payload_max {payload_max}")],
             "both sides agree on the longest payload"
         );
         c
@@ -170,7 +194,11 @@ fn connected() -> (CSide, Endpoint) {
     let hello = c.time(0);
     assert_eq!(
         frames(&hello.wire),
-        vec![Frame::new(Kind::Hello, 0, vec![])]
+        vec![Frame::new(
+            Kind::Hello,
+            0,
+            (PAYLOAD_MAX as u16).to_be_bytes().to_vec()
+        )]
     );
     let mut answer = Vec::new();
     assert!(rust.feed(&hello.wire, 0, &mut answer).is_empty());
@@ -347,4 +375,41 @@ fn a_restarted_robot_is_heard_from_sequence_zero_again() {
     let taken = rust.feed(&said, 5000, &mut wire);
     assert_eq!(taken.len(), 1, "sequence 0 of the new session is new");
     assert_eq!(taken[0].destination().unwrap().1, b"second");
+}
+
+/// A board built with a smaller `SEMO_LINK_PAYLOAD_MAX` says it in its
+/// Hello and in its Welcome, so the gateway's side learns it however the
+/// session starts; a frame longer than that is a bad frame on the board,
+/// counted, never taken nor acknowledged; a refusal's reason byte is read.
+#[test]
+fn a_board_says_its_payload_bound_and_longer_frames_are_bad_there() {
+    let mut c = CSide::start_taking(board_driver(), BOARD_PAYLOAD_MAX);
+    let mut gateway = Endpoint::new(8);
+    let hello = c.time(0);
+    assert_eq!(
+        frames(&hello.wire),
+        vec![Frame::new(Kind::Hello, 0, vec![0, BOARD_PAYLOAD_MAX as u8])]
+    );
+    let mut answer = Vec::new();
+    gateway.feed(&hello.wire, 0, &mut answer);
+    assert_eq!(gateway.peer_payload_max, BOARD_PAYLOAD_MAX);
+    // The board's Welcome (to the gateway's Hello) says it too.
+    let answered = c.bytes(&answer);
+    let welcome = frames(&answered.wire);
+    assert_eq!(welcome[0].kind, Kind::Welcome);
+    assert_eq!(welcome[0].payload_max(), Some(BOARD_PAYLOAD_MAX));
+    let mut reconnected = Endpoint::new(8);
+    reconnected.feed(&answered.wire, 0, &mut Vec::new());
+    assert!(reconnected.outgoing.welcomed());
+    assert_eq!(reconnected.peer_payload_max, BOARD_PAYLOAD_MAX);
+    assert!(c.stats().contains(&format!("peer_payload_max={PAYLOAD_MAX}")));
+
+    let too_long = Frame::new(Kind::Message, 0, vec![7; BOARD_PAYLOAD_MAX + 1]);
+    let said = c.bytes(&too_long.encode().unwrap());
+    assert!(said.taken.is_empty() && said.wire.is_empty(), "{said:?}");
+    assert!(c.stats().contains("bad=1"), "{}", c.stats());
+    let fits = Frame::new(Kind::Message, 1, vec![7; BOARD_PAYLOAD_MAX]);
+    assert_eq!(c.bytes(&fits.encode().unwrap()).taken, vec![fits]);
+    let refused = Frame::new(Kind::Refused, 2, b"L".to_vec());
+    assert_eq!(c.bytes(&refused.encode().unwrap()).taken, vec![refused]);
 }

@@ -21,7 +21,7 @@
 use semo::deploy::datagram;
 use semo::deploy::topics::{self, RunId, Scope, Sender};
 
-use semo::link::{Endpoint, Frame, Kind};
+use semo::link::{Endpoint, Frame, Kind, Refusal};
 use semo_server::live::{BrokerAccess, DEFAULT_BROKER};
 use std::collections::{BTreeSet, HashMap, VecDeque};
 use std::io::{Read, Write};
@@ -511,9 +511,15 @@ impl LinkGateway {
                     Some(Event::Acked(seq)) => endpoint.acknowledge(seq, &mut wire),
                     Some(Event::Message { topic, payload }) => held.push_back((topic, payload)),
                 }
-                // Messages from the broker go down as the link has room.
-                while let Some((topic, payload)) = held.front() {
-                    let frame = self.down_the_link(topic, payload, &mut counts);
+                // Messages from the broker go down as the link has room,
+                // once the session stands: its Welcome (or the robot's
+                // Hello) said how long a payload the robot takes.
+                while let Some((topic, payload)) = held
+                    .front()
+                    .filter(|_| endpoint.outgoing.welcomed())
+                {
+                    let frame =
+                        self.down_the_link(topic, payload, endpoint.peer_payload_max, &mut counts);
                     match frame {
                         None => {
                             held.pop_front();
@@ -687,16 +693,20 @@ impl LinkGateway {
 
     /// What a message from the broker becomes on the link: `M` with its
     /// datagram, `R` when its datagram names another sender or key than
-    /// its topic, nothing for the robot's own message to its team.
+    /// its topic or is longer than the robot takes (`payload_max`), nothing
+    /// for the robot's own message to its team. (An `M` longer than the
+    /// robot takes would be a bad frame there, never acknowledged, and sent
+    /// again for ever ahead of every later message.)
     fn down_the_link(
         &self,
         topic: &str,
         payload: &[u8],
+        payload_max: usize,
         counts: &mut Counts,
     ) -> Option<(Kind, Vec<u8>)> {
         let Some(d) = datagram::decode(payload) else {
             // The runtime rejects it as malformed, as over MQTT.
-            return Some((Kind::Message, payload.to_vec()));
+            return Some(self.message_down(topic, payload, payload_max, counts));
         };
         let sender = Sender::claimed_by(&d);
         let own_team = topics::to_team(&self.scope, &self.robot.team, &d.key, sender);
@@ -714,16 +724,36 @@ impl LinkGateway {
         if !on_its_topic {
             counts.refused_messages += 1;
             eprintln!(
-                "gateway: {}: a message on {topic} names another sender or key ({} refused)",
+                "gateway: {}: a message on {} names another sender or key ({} refused)",
                 self.name(),
+                topic.escape_debug(),
                 counts.refused_messages
             );
-            return Some((Kind::Refused, Vec::new()));
+            return Some((Kind::Refused, vec![Refusal::Topic.byte()]));
         }
-        if payload.len() > semo::link::PAYLOAD_MAX {
-            return None;
+        Some(self.message_down(topic, payload, payload_max, counts))
+    }
+
+    /// `M` with the message, or `R` when it is longer than the robot takes.
+    fn message_down(
+        &self,
+        topic: &str,
+        payload: &[u8],
+        payload_max: usize,
+        counts: &mut Counts,
+    ) -> (Kind, Vec<u8>) {
+        if payload.len() <= payload_max {
+            return (Kind::Message, payload.to_vec());
         }
-        Some((Kind::Message, payload.to_vec()))
+        counts.refused_messages += 1;
+        eprintln!(
+            "gateway: {}: a message of {} bytes on {} is longer than the robot takes ({payload_max} bytes) ({} refused)",
+            self.name(),
+            payload.len(),
+            topic.escape_debug(),
+            counts.refused_messages
+        );
+        (Kind::Refused, vec![Refusal::Length.byte()])
     }
 
     /// The link closed: the robot's status says it is lost (retained, as a

@@ -2,7 +2,7 @@
 //! the bytes to write (acknowledgements, welcomes, the reliable frames and
 //! their copies), as `semo_link_feed` and `semo_link_tick` do in C.
 
-use super::frame::{Frame, FrameError, Kind};
+use super::frame::{Frame, FrameError, Kind, PAYLOAD_MAX};
 use super::reader::Reader;
 use super::session::{Incoming, Outgoing, QueueFull};
 
@@ -14,6 +14,13 @@ pub struct Endpoint {
     /// What this side's `Welcome` says (bit 0: the robot's broker session
     /// was kept).
     pub welcome_flags: u8,
+    /// The longest payload this side takes (said in its `Hello` and
+    /// `Welcome`); a longer frame is a bad frame.
+    payload_max: usize,
+    /// The longest payload the other side takes, as its last `Hello` or
+    /// `Welcome` said ([`PAYLOAD_MAX`] until then): a frame for it must not
+    /// be longer (the gateway refuses such a message with `R`).
+    pub peer_payload_max: usize,
     /// Bytes between zeros that were no frame, by why.
     pub bad_frames: Vec<FrameError>,
     /// A new reliable frame is taken without its `Ack`, which the caller
@@ -27,11 +34,21 @@ pub struct Endpoint {
 impl Endpoint {
     /// `capacity`: reliable frames waiting behind the one in flight.
     pub fn new(capacity: usize) -> Endpoint {
+        Endpoint::taking(capacity, PAYLOAD_MAX as u16)
+    }
+
+    /// An endpoint that takes payloads of at most `payload_max` bytes (as a
+    /// board built with a smaller `SEMO_LINK_PAYLOAD_MAX`), at most
+    /// [`PAYLOAD_MAX`].
+    pub fn taking(capacity: usize, payload_max: u16) -> Endpoint {
+        let payload_max = payload_max.min(PAYLOAD_MAX as u16);
         Endpoint {
-            outgoing: Outgoing::new(capacity),
+            outgoing: Outgoing::new(capacity, payload_max),
             incoming: Incoming::new(),
             reader: Reader::new(),
             welcome_flags: 0,
+            payload_max: payload_max as usize,
+            peer_payload_max: PAYLOAD_MAX,
             bad_frames: Vec::new(),
             defer_acks: false,
         }
@@ -52,6 +69,12 @@ impl Endpoint {
                 continue;
             };
             let frame = match result {
+                Ok(frame) if frame.payload.len() > self.payload_max => {
+                    if self.bad_frames.len() < 1024 {
+                        self.bad_frames.push(FrameError::Payload(frame.kind));
+                    }
+                    continue;
+                }
                 Ok(frame) => frame,
                 Err(e) => {
                     // Bounded: the caller counts and clears them.
@@ -61,14 +84,16 @@ impl Endpoint {
                     continue;
                 }
             };
+            if let Some(max) = frame.payload_max() {
+                self.peer_payload_max = max.min(PAYLOAD_MAX);
+            }
             match frame.kind {
                 Kind::Ack | Kind::Welcome => self.outgoing.heard(&frame),
                 Kind::Hello => {
                     self.incoming.restart();
-                    put(
-                        write,
-                        &Frame::new(Kind::Welcome, frame.seq, vec![self.welcome_flags]),
-                    );
+                    let [high, low] = (self.payload_max as u16).to_be_bytes();
+                    let welcome = vec![self.welcome_flags, high, low];
+                    put(write, &Frame::new(Kind::Welcome, frame.seq, welcome));
                     self.outgoing.heard(&frame);
                 }
                 kind if kind.reliable() => {

@@ -18,10 +18,13 @@ pub const WIRE_MAX: usize = BODY_MAX + BODY_MAX / 254 + 1 + 1;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Kind {
     /// `H`: a side (re)starts a session: the other forgets the sequence
-    /// numbers it saw and answers `Welcome`. Empty.
+    /// numbers it saw and answers `Welcome`. Two bytes (big-endian): the
+    /// longest payload the sender takes (a board's may be smaller than
+    /// [`PAYLOAD_MAX`]).
     Hello,
     /// `W`: the answer to `Hello` (its `seq`); one byte of flags, bit 0: the
-    /// broker kept the robot's session (`semo_session_resumed`).
+    /// broker kept the robot's session (`semo_session_resumed`), then the
+    /// sender's longest payload, as in `Hello`.
     Welcome,
     /// `S` (robot to gateway, reliable): a `send`: the destination (a team,
     /// a robot or `USER`) as a length byte and its bytes, then the datagram.
@@ -33,8 +36,8 @@ pub enum Kind {
     /// `M` (gateway to robot, reliable): a datagram the broker delivered on
     /// one of the robot's topics.
     Message,
-    /// `R` (gateway to robot, reliable): a message the gateway refused (its
-    /// datagram names another sender or key than its topic). Empty.
+    /// `R` (gateway to robot, reliable): a message the gateway refused; one
+    /// byte says why ([`Refusal`]).
     Refused,
     /// `A`: the reliable frame `seq` arrived. Empty.
     Ack,
@@ -75,6 +78,25 @@ impl Kind {
             self,
             Kind::Send | Kind::Status | Kind::Message | Kind::Refused
         )
+    }
+}
+
+/// Why the gateway refused a message from the broker (an `R`'s byte).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Refusal {
+    /// `T`: its datagram names another sender or key than its topic.
+    Topic,
+    /// `L`: it is longer than the robot takes (the bound its `Hello` or
+    /// `Welcome` said).
+    Length,
+}
+
+impl Refusal {
+    pub fn byte(self) -> u8 {
+        match self {
+            Refusal::Topic => b'T',
+            Refusal::Length => b'L',
+        }
     }
 }
 
@@ -180,6 +202,16 @@ impl Frame {
         Some(wire)
     }
 
+    /// The payload bound a `Hello` or `Welcome` says.
+    pub fn payload_max(&self) -> Option<usize> {
+        let bytes = match self.kind {
+            Kind::Hello => &self.payload[..],
+            Kind::Welcome => self.payload.get(1..)?,
+            _ => return None,
+        };
+        Some(u16::from_be_bytes(bytes.try_into().ok()?) as usize)
+    }
+
     /// The frame of the bytes between two zeros (without them).
     pub fn decode(stuffed: &[u8]) -> Result<Frame, FrameError> {
         if stuffed.len() + 1 > WIRE_MAX {
@@ -208,8 +240,10 @@ impl Frame {
     /// Whether the payload has its kind's shape.
     fn fits(&self) -> bool {
         match self.kind {
-            Kind::Hello | Kind::Refused | Kind::Ack => self.payload.is_empty(),
-            Kind::Welcome => self.payload.len() == 1,
+            Kind::Ack => self.payload.is_empty(),
+            Kind::Refused => self.payload.len() == 1,
+            Kind::Hello => self.payload.len() == 2,
+            Kind::Welcome => self.payload.len() == 3,
             Kind::Send | Kind::Publish => self.destination().is_some(),
             Kind::Status | Kind::Message => !self.payload.is_empty(),
         }

@@ -21,7 +21,7 @@ mod reader;
 mod session;
 
 pub use endpoint::Endpoint;
-pub use frame::{BODY_MAX, Frame, FrameError, Kind, PAYLOAD_MAX, WIRE_MAX, crc16};
+pub use frame::{BODY_MAX, Frame, FrameError, Kind, PAYLOAD_MAX, Refusal, WIRE_MAX, crc16};
 pub use reader::Reader;
 pub use session::{HELLO_RETRY_MS, Incoming, Outgoing, QueueFull, RETRY_MS};
 

@@ -28,6 +28,8 @@ pub struct QueueFull;
 #[derive(Debug)]
 pub struct Outgoing {
     capacity: usize,
+    /// The longest payload this side takes, said in its `Hello`.
+    payload_max: u16,
     queue: VecDeque<(Kind, Vec<u8>)>,
     next_seq: u16,
     /// The frame waiting for its `Ack`, and when it goes again.
@@ -40,10 +42,12 @@ pub struct Outgoing {
 
 impl Outgoing {
     /// A sending half holding at most `capacity` reliable frames besides
-    /// the one in flight; it starts its session with `Hello`.
-    pub fn new(capacity: usize) -> Outgoing {
+    /// the one in flight; it starts its session with `Hello`, saying
+    /// `payload_max`.
+    pub fn new(capacity: usize, payload_max: u16) -> Outgoing {
         Outgoing {
             capacity,
+            payload_max,
             queue: VecDeque::new(),
             next_seq: 0,
             in_flight: None,
@@ -82,7 +86,11 @@ impl Outgoing {
                 return None;
             }
             self.hello_at = Some(now);
-            return Some(Frame::new(Kind::Hello, 0, Vec::new()));
+            return Some(Frame::new(
+                Kind::Hello,
+                0,
+                self.payload_max.to_be_bytes().to_vec(),
+            ));
         }
         if let Some((frame, due)) = &mut self.in_flight {
             if now < *due {

@@ -36,13 +36,13 @@ fn cobs_round_trips_zeros_and_long_runs() {
 #[test]
 fn every_kind_round_trips_through_the_reader() {
     let frames = vec![
-        Frame::new(Kind::Hello, 0, vec![]),
-        Frame::new(Kind::Welcome, 0, vec![1]),
+        Frame::new(Kind::Hello, 0, vec![6, 0]),
+        Frame::new(Kind::Welcome, 0, vec![1, 0, 164]),
         Frame::addressed(Kind::Send, 7, "SlaveTeam", b"SEMO\x02s\x00\x00\x00\x00").unwrap(),
         Frame::addressed(Kind::Publish, 0, "USER", &[0; 40]).unwrap(),
         Frame::new(Kind::Status, 65535, br#"{"state":"running"}"#.to_vec()),
         Frame::new(Kind::Message, 3, vec![0, 1, 2, 0]),
-        Frame::new(Kind::Refused, 4, vec![]),
+        Frame::new(Kind::Refused, 4, vec![Refusal::Length.byte()]),
         Frame::new(Kind::Ack, 9, vec![]),
         Frame::new(Kind::Message, 1, vec![0; PAYLOAD_MAX]),
     ];
@@ -147,7 +147,7 @@ fn a_send_names_a_destination_of_one_to_255_bytes() {
 /// Two sessions over a lossy wire, stepped by hand.
 #[test]
 fn a_lost_ack_brings_a_retransmission_whose_copy_is_not_taken_twice() {
-    let mut robot = Outgoing::new(4);
+    let mut robot = Outgoing::new(4, PAYLOAD_MAX as u16);
     let mut gateway_in = Incoming::new();
     // The session starts: Hello, then nothing reliable before Welcome.
     robot.push(Kind::Send, b"\x01Tx".to_vec()).unwrap();
@@ -155,7 +155,7 @@ fn a_lost_ack_brings_a_retransmission_whose_copy_is_not_taken_twice() {
     assert_eq!(robot.poll(10), None, "Hello waits for its Welcome");
     assert_eq!(robot.poll(HELLO_RETRY_MS).unwrap().kind, Kind::Hello);
     gateway_in.restart();
-    robot.heard(&Frame::new(Kind::Welcome, 0, vec![0]));
+    robot.heard(&Frame::new(Kind::Welcome, 0, vec![0, 6, 0]));
     let first = robot.poll(600).unwrap();
     assert_eq!((first.kind, first.seq), (Kind::Send, 0));
     assert!(gateway_in.accept(first.seq));
@@ -189,7 +189,7 @@ fn a_restarted_side_is_heard_from_zero_again() {
 
 #[test]
 fn the_queue_is_bounded() {
-    let mut out = Outgoing::new(2);
+    let mut out = Outgoing::new(2, PAYLOAD_MAX as u16);
     out.push(Kind::Message, vec![1]).unwrap();
     out.push(Kind::Message, vec![2]).unwrap();
     assert_eq!(out.push(Kind::Message, vec![3]), Err(QueueFull));
@@ -232,4 +232,52 @@ fn deferred_acks_wait_for_the_caller_and_forgotten_frames_are_taken_again() {
     // An acknowledgement of another number writes no Ack.
     gateway.acknowledge(9, &mut out);
     assert!(!acked(&out, 9));
+}
+
+/// Each side says the longest payload it takes in its `Hello` and its
+/// `Welcome`, so the gateway knows a board's smaller bound however the
+/// session started (the board's reset, or the gateway's reconnection, which
+/// the board answers with `Welcome` without saying `Hello` again); a longer
+/// frame is a bad frame on the side that cannot take it, never taken.
+#[test]
+fn each_side_says_its_payload_bound_and_refuses_longer_frames() {
+    let mut board = Endpoint::taking(2, 164);
+    let mut gateway = Endpoint::new(4);
+    assert_eq!(gateway.peer_payload_max, PAYLOAD_MAX, "until told");
+    // The board's reset: its Hello says 164.
+    let mut hello = Vec::new();
+    board.tick(0, &mut hello);
+    assert_eq!(frames(&hello), vec![Frame::new(Kind::Hello, 0, vec![0, 164])]);
+    let mut welcome = Vec::new();
+    gateway.feed(&hello, 0, &mut welcome);
+    assert_eq!(gateway.peer_payload_max, 164);
+    // The gateway's Welcome says its own bound, the most either takes.
+    let answer = frames(&welcome);
+    assert_eq!(answer[0].kind, Kind::Welcome);
+    assert_eq!(answer[0].payload_max(), Some(PAYLOAD_MAX));
+    board.feed(&welcome, 0, &mut Vec::new());
+    assert_eq!(board.peer_payload_max, PAYLOAD_MAX);
+    // A gateway that reconnects says Hello; the board's Welcome tells it.
+    let mut again = Endpoint::new(4);
+    let mut hello = Vec::new();
+    again.tick(0, &mut hello);
+    let mut welcome = Vec::new();
+    board.feed(&hello, 0, &mut welcome);
+    again.feed(&welcome, 0, &mut Vec::new());
+    assert!(again.outgoing.welcomed());
+    assert_eq!(again.peer_payload_max, 164);
+    // A frame longer than the board takes is bad there, never taken.
+    let long = wire(Kind::Message, 0, &[7; 165]);
+    assert!(board.feed(&long, 0, &mut Vec::new()).is_empty());
+    assert_eq!(board.bad_frames, vec![FrameError::Payload(Kind::Message)]);
+    let fits = wire(Kind::Message, 1, &[7; 164]);
+    assert_eq!(board.feed(&fits, 0, &mut Vec::new()).len(), 1);
+}
+
+fn frames(wire: &[u8]) -> Vec<Frame> {
+    Reader::new()
+        .push_all(wire)
+        .into_iter()
+        .map(Result::unwrap)
+        .collect()
 }

@@ -115,6 +115,7 @@ typedef struct {
     } slots[SEMO__RECEIVED_MAX];
     size_t head, count;
     unsigned long refused;
+    unsigned long too_long; /* SEMO_RECV_TOO_LONG: the link's gateway refused them */
 } semo__received;
 
 /* `ms` wall milliseconds from now on CLOCK_MONOTONIC (the clock the
@@ -153,7 +154,7 @@ static inline void semo__received_put(semo__received *r, const void *data, size_
 /* A transport's `recv`: waits on `changed` under `lock` until a datagram or
  * a refusal is there, `*interrupted`, or `timeout_ms` (< 0: no limit); then
  * copies the next datagram into `data` (at most `cap` bytes) and returns
- * its length, or SEMO_RECV_REFUSED, or 0. A take is broadcast: the network
+ * its length, or SEMO_RECV_REFUSED or SEMO_RECV_TOO_LONG, or 0. A take is broadcast: the network
  * thread may wait for room. */
 static inline int semo__received_take(semo__received *r, pthread_mutex_t *lock, pthread_cond_t *changed,
                                       const bool *interrupted, void *data, size_t cap, int timeout_ms)
@@ -161,7 +162,7 @@ static inline int semo__received_take(semo__received *r, pthread_mutex_t *lock, 
     struct timespec deadline = semo__deadline_after(timeout_ms < 0 ? 0 : timeout_ms);
     pthread_mutex_lock(lock);
     int waited = 0;
-    while (r->count == 0 && r->refused == 0 && !*interrupted && waited == 0) {
+    while (r->count == 0 && r->refused == 0 && r->too_long == 0 && !*interrupted && waited == 0) {
         if (timeout_ms < 0)
             pthread_cond_wait(changed, lock);
         else
@@ -171,6 +172,9 @@ static inline int semo__received_take(semo__received *r, pthread_mutex_t *lock, 
     if (r->refused > 0 && !*interrupted) {
         r->refused--;
         n = SEMO_RECV_REFUSED;
+    } else if (r->too_long > 0 && !*interrupted) {
+        r->too_long--;
+        n = SEMO_RECV_TOO_LONG;
     } else if (r->count > 0 && !*interrupted) {
         n = (int)(r->slots[r->head].len < cap ? r->slots[r->head].len : cap);
         memcpy(data, r->slots[r->head].data, (size_t)n);

@@ -20,7 +20,12 @@ void semo_link_init(semo_link *link, semo_link_write write, void *ctx)
     memset(link, 0, sizeof *link);
     link->write = write;
     link->ctx = ctx;
+    link->peer_payload_max = SEMO_LINK_PAYLOAD_MAX;
 }
+
+/* The payload bound our H and W say, big-endian. */
+static const unsigned char g_payload_max[2] = {(unsigned char)(SEMO_LINK_PAYLOAD_MAX >> 8),
+                                               (unsigned char)SEMO_LINK_PAYLOAD_MAX};
 
 /* Stuffs the body (kind, seq, the payload's `count` pieces in order, CRC)
  * into link->wire and writes it with its closing zero. */
@@ -138,7 +143,7 @@ void semo_link_tick(semo_link *link, int64_t now)
         if (!link->hello_sent || now >= link->hello_at + SEMO_LINK_HELLO_RETRY_MS) {
             link->hello_sent = true;
             link->hello_at = now;
-            write_frame(link, SEMO_LINK_HELLO, 0, NULL, 0, NULL, 0);
+            write_frame(link, SEMO_LINK_HELLO, 0, g_payload_max, 2, NULL, 0);
         }
         return;
     }
@@ -188,12 +193,14 @@ static bool reliable(unsigned char kind)
 static bool fits(unsigned char kind, const unsigned char *p, size_t len)
 {
     switch (kind) {
-    case SEMO_LINK_HELLO:
-    case SEMO_LINK_REFUSED:
     case SEMO_LINK_ACK:
         return len == 0;
-    case SEMO_LINK_WELCOME:
+    case SEMO_LINK_REFUSED:
         return len == 1;
+    case SEMO_LINK_HELLO:
+        return len == 2;
+    case SEMO_LINK_WELCOME:
+        return len == 3;
     case SEMO_LINK_SEND:
     case SEMO_LINK_PUBLISH:
         return len >= 1 && p[0] >= 1 && (size_t)p[0] <= len - 1;
@@ -272,7 +279,8 @@ bool semo_link_feed(semo_link *link, unsigned char byte, int64_t now, semo_link_
         /* The other side (re)started: its numbers start again, and what we
          * have in flight goes again at once. */
         link->rx_seen = false;
-        write_frame(link, SEMO_LINK_WELCOME, seq, &link->welcome_flags, 1, NULL, 0);
+        link->peer_payload_max = (size_t)((payload[0] << 8) | payload[1]);
+        write_frame(link, SEMO_LINK_WELCOME, seq, &link->welcome_flags, 1, g_payload_max, 2);
         if (link->tx_in_flight)
             link->tx_sent_at = INT64_MIN / 2;
         semo_link_tick(link, now);
@@ -281,6 +289,7 @@ bool semo_link_feed(semo_link *link, unsigned char byte, int64_t now, semo_link_
         if (!link->welcomed) {
             link->welcomed = true;
             link->peer_flags = payload[0];
+            link->peer_payload_max = (size_t)((payload[1] << 8) | payload[2]);
             semo_link_tick(link, now);
         }
         return false;

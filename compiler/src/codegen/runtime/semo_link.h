@@ -28,12 +28,20 @@
 #ifndef SEMO_LINK_QUEUE
 #define SEMO_LINK_QUEUE 4
 #endif
+/* H and W say it in two bytes. */
+_Static_assert(SEMO_LINK_PAYLOAD_MAX >= 64 && SEMO_LINK_PAYLOAD_MAX <= 0xFFFF,
+               "SEMO_LINK_PAYLOAD_MAX must be 64 to 65535");
 #define SEMO_LINK_BODY_MAX (3 + SEMO_LINK_PAYLOAD_MAX + 2)
 #define SEMO_LINK_WIRE_MAX (SEMO_LINK_BODY_MAX + SEMO_LINK_BODY_MAX / 254 + 1 + 1)
 #define SEMO_LINK_RETRY_MS 200
 #define SEMO_LINK_HELLO_RETRY_MS 500
 /* A datagram's kind byte (its sixth) for a send (semo_runtime.h's SEMO_MSG_SEND). */
 #define SEMO_LINK_DATAGRAM_SEND 's'
+/* What an R says (its one byte): the message's datagram names another
+ * sender or key than its topic; the message is longer than this side takes
+ * (the payload bound its H or W said). */
+#define SEMO_LINK_REFUSED_TOPIC 'T'
+#define SEMO_LINK_REFUSED_LENGTH 'L'
 
 enum {
     SEMO_LINK_HELLO = 'H',
@@ -82,6 +90,10 @@ typedef struct {
     int64_t hello_at;
     unsigned char welcome_flags; /* what our Welcome says; what theirs said */
     unsigned char peer_flags;
+    /* The longest payload the other side takes, as its H or W said
+     * (SEMO_LINK_PAYLOAD_MAX until it has). Ours, SEMO_LINK_PAYLOAD_MAX, is
+     * in each of our H and W: a board's may be smaller than the gateway's. */
+    size_t peer_payload_max;
     unsigned char wire[SEMO_LINK_WIRE_MAX];
     /* Counted for the trace: frames that were no frame (CRC, stuffing,
      * length, kind), copies not taken, frames sent again. */

@@ -101,7 +101,9 @@ static int connect_gateway(void)
 static void taken(const semo_link_frame *f)
 {
     if (f->kind == SEMO_LINK_REFUSED) {
-        if (!g_interrupted)
+        if (!g_interrupted && f->payload[0] == SEMO_LINK_REFUSED_LENGTH)
+            g_received.too_long++;
+        else if (!g_interrupted)
             g_received.refused++;
     } else if (f->kind == SEMO_LINK_MESSAGE && !g_interrupted) {
         /* Room was made before the frame was taken (io_thread); none only
@@ -215,6 +217,7 @@ static int link_open(const semo_program_desc *program, const semo_transport_conf
     g_stopping = g_interrupted = false;
     g_received.head = g_received.count = 0;
     g_received.refused = 0;
+    g_received.too_long = 0;
     if (pthread_create(&g_thread, NULL, io_thread, NULL) != 0)
         return -1;
     g_thread_started = true;

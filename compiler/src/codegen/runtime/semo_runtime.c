@@ -1040,6 +1040,8 @@ static void *receiver_thread(void *arg)
             semo_trace("reject", "reason", g_transport->refusal, NULL);
         } else if (n == SEMO_RECV_REPLAYED) {
             semo_trace("reject", "reason", SEMO_REPLAYED_REASON, NULL);
+        } else if (n == SEMO_RECV_TOO_LONG) {
+            semo_trace("reject", "reason", SEMO_TOO_LONG_REASON, NULL);
         } else if (n < 0) {
             semo_trace("comm_error", "reason", "receive failed", NULL);
             semo_sleep_ms(RECV_ERROR_PAUSE_MS); /* a failing socket must not spin */

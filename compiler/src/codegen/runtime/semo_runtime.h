@@ -423,6 +423,11 @@ typedef struct {
  * SEMO_REPLAYED_REASON), never delivered. */
 #define SEMO_RECV_REPLAYED (-3)
 #define SEMO_REPLAYED_REASON "replayed: not newer than the last from its sender"
+/* What recv returns for a message the serial link's gateway did not pass
+ * on because it is longer than the robot's link takes (docs/link.md):
+ * traced (`reject`, reason SEMO_TOO_LONG_REASON). */
+#define SEMO_RECV_TOO_LONG (-4)
+#define SEMO_TOO_LONG_REASON "longer than the link takes"
 
 /* The transport interface: loopback UDP (`semo_udp.c`) and MQTT
  * (`semo_mqtt.c`, with -DSEMO_MQTT). */

@@ -43,7 +43,9 @@ static void line_write(void *ctx, const unsigned char *bytes, size_t n)
 static void taken(const semo_link_frame *f)
 {
     if (f->kind == SEMO_LINK_REFUSED) {
-        semo_trace("reject", "reason", "sender not its topic", NULL);
+        semo_trace("reject", "reason",
+                   f->payload[0] == SEMO_LINK_REFUSED_LENGTH ? SEMO_TOO_LONG_REASON : "sender not its topic",
+                   NULL);
     } else if (f->kind == SEMO_LINK_MESSAGE) {
         if (semo__decode_message(f->payload, f->len, &g_message))
             semo__deliver(&g_message);

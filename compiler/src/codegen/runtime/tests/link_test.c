@@ -77,9 +77,9 @@ int main(void)
         } else if (line[0] == 'f') {
             g_link.welcome_flags = (unsigned char)atoi(line + 2);
         } else if (line[0] == 's') {
-            printf("stats bad=%lu dup=%lu retx=%lu pending=%zu welcomed=%d peer_flags=%u\n", g_link.bad_frames,
-                   g_link.duplicates, g_link.retransmissions, semo_link_pending(&g_link), g_link.welcomed,
-                   g_link.peer_flags);
+            printf("stats bad=%lu dup=%lu retx=%lu pending=%zu welcomed=%d peer_flags=%u peer_payload_max=%zu\n",
+                   g_link.bad_frames, g_link.duplicates, g_link.retransmissions, semo_link_pending(&g_link),
+                   g_link.welcomed, g_link.peer_flags, g_link.peer_payload_max);
         }
         printf(".\n");
         fflush(stdout);
