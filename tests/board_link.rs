@@ -1,7 +1,9 @@
 //! A board robot on the serial link, end to end (issue 35, item 2): the
 //! scouting mission's Evalbot `ti` built for `cortex-m-sim` runs in QEMU
 //! (`lm3s6965evb`: UART0, the first `-serial`, is its trace on standard
-//! output; UART1, the second, is its link, served on a TCP port), `semo
+//! output; UART1, the second, is its link, served on a TCP port), and so
+//! does the same robot built for `stm32f4-sim` (`netduinoplus2`: USART1
+//! and USART2), `semo
 //! gateway --link ti=tcp:127.0.0.1:PORT` connects to that port and speaks
 //! MQTT for it, and `irobot` and `nxt` run as `linux-sim` programs on the
 //! same private mosquitto. Every robot enters the modes `semo simulate`
@@ -42,9 +44,27 @@ fn scenario() -> PathBuf {
     support::repo_root().join("tests/fixtures/build/scouting.scenario.json")
 }
 
-/// `semo build` of the scouting mission for `cortex-m-sim` with the
-/// scenario; `make` of ti's folder at `-Wpedantic -Werror`; its ELF file.
-fn board_ti(out: &Path) -> PathBuf {
+/// A board the scouting `ti` is tested on: its simulation target and
+/// QEMU's machine.
+#[derive(Clone, Copy)]
+struct Board {
+    target: &'static str,
+    machine: &'static str,
+}
+
+const LM3S6965: Board = Board {
+    target: "cortex-m-sim",
+    machine: "lm3s6965evb",
+};
+
+const STM32F405: Board = Board {
+    target: "stm32f4-sim",
+    machine: "netduinoplus2",
+};
+
+/// `semo build` of the scouting mission for `board` with the scenario;
+/// `make` of ti's folder at `-Wpedantic -Werror`; its ELF file.
+fn board_ti(out: &Path, board: Board) -> PathBuf {
     let (mission, scenario, out_arg) = (
         scouting().display().to_string(),
         scenario().display().to_string(),
@@ -56,7 +76,7 @@ fn board_ti(out: &Path) -> PathBuf {
             "build",
             &mission,
             "--target",
-            "cortex-m-sim",
+            board.target,
             "--scenario",
             &scenario,
             "-o",
@@ -74,11 +94,12 @@ fn board_ti(out: &Path) -> PathBuf {
     folder.join("ti.elf")
 }
 
-/// QEMU running `elf` on the LM3S6965 with UART1 served on `link_port`;
-/// its trace lines come through the receiver as they are written.
-fn qemu(elf: &Path, link_port: u16) -> (Child, mpsc::Receiver<String>) {
+/// QEMU running `elf` on `board` with its link port (the second serial)
+/// served on `link_port`; its trace lines come through the receiver as
+/// they are written.
+fn qemu(elf: &Path, board: Board, link_port: u16) -> (Child, mpsc::Receiver<String>) {
     let mut child = Command::new("qemu-system-arm")
-        .args(["-M", "lm3s6965evb", "-display", "none", "-monitor", "none"])
+        .args(["-M", board.machine, "-display", "none", "-monitor", "none"])
         .args(["-semihosting", "-serial", "stdio", "-serial"])
         .arg(format!("tcp:127.0.0.1:{link_port},server,nowait"))
         .arg("-kernel")
@@ -148,22 +169,37 @@ fn board_trace(
 
 #[test]
 fn the_evalbot_in_qemu_on_the_serial_link_behaves_as_in_the_simulator() {
-    let test = "the_evalbot_in_qemu_on_the_serial_link_behaves_as_in_the_simulator";
+    behaves_as_in_the_simulator(
+        "the_evalbot_in_qemu_on_the_serial_link_behaves_as_in_the_simulator",
+        LM3S6965,
+    );
+}
+
+/// The same robot on the second board family: its link on USART2.
+#[test]
+fn the_scout_on_an_stm32_in_qemu_on_the_serial_link_behaves_as_in_the_simulator() {
+    behaves_as_in_the_simulator(
+        "the_scout_on_an_stm32_in_qemu_on_the_serial_link_behaves_as_in_the_simulator",
+        STM32F405,
+    );
+}
+
+fn behaves_as_in_the_simulator(test: &str, on: Board) {
     if !robots::board_tools_present(test) {
         return;
     }
-    let Some(mut fleet) = Fleet::start("board-link-scouting") else {
+    let Some(mut fleet) = Fleet::start(&format!("board-link-{}", on.machine)) else {
         return;
     };
     let scenario = scenario();
     // Everything is compiled before anything starts.
-    let elf = board_ti(&fleet.out.join("board"));
+    let elf = board_ti(&fleet.out.join("board"), on);
     let folders = support::mqtt::build(&scouting(), &fleet.out.join("linux"), &[]);
     support::mqtt::compile_in(&folders, &scenario);
 
     let gateway_log = fleet.out.join("gateway.stderr");
     let link_port = support::mosquitto::free_port();
-    let (board, board_rx) = qemu(&elf, link_port);
+    let (board, board_rx) = qemu(&elf, on, link_port);
     let board = fleet.processes.push(board);
     let gateway = fleet.processes.push(
         Command::new(env!("CARGO_BIN_EXE_semo"))
@@ -253,74 +289,94 @@ fn the_evalbot_in_qemu_on_the_serial_link_behaves_as_in_the_simulator() {
     }
 }
 
-/// Issue 35's budget: the scouting `ti`, which messages its fleet, built for
-/// `cortex-m` (the build a user makes) with its link fits 32 KB of flash
-/// and 8 KB of RAM (`arm-none-eabi-size`: text + data, data + bss with the
-/// stack). Measured (gcc-arm-none-eabi 12.2, newlib-nano): 22512 B of flash,
-/// 8092 B of RAM (the link's record with three frames of 164 bytes, its
-/// receive ring of two frames, and newlib's snprintf for the heartbeat).
+/// Issue 35's budget: the scouting `ti`, which messages its fleet, built
+/// for each board (the build a user makes) with its link fits the board's
+/// budget (`arm-none-eabi-size`: text + data, data + bss with the stack):
+/// 32 KB of flash and 8 KB of RAM on `cortex-m`, 64 KB and 16 KB on
+/// `stm32f4` (`tests/cortex_m.rs`'s budgets). Measured (gcc-arm-none-eabi
+/// 12.2, newlib-nano): `cortex-m` 22660 B of flash and 8084 B of RAM,
+/// `stm32f4` 23308 B and 8084 B (the link's record with three frames of 164
+/// bytes, its receive ring of two frames, and newlib's snprintf for the
+/// heartbeat).
 #[test]
-fn the_messaging_evalbot_fits_the_flash_and_ram_budget() {
-    let test = "the_messaging_evalbot_fits_the_flash_and_ram_budget";
+fn the_messaging_scout_fits_each_board_budget() {
+    let test = "the_messaging_scout_fits_each_board_budget";
     if !robots::board_tools_present(test) {
         return;
     }
-    let out = robots::scratch("board-link-budget");
-    let (mission, out_arg) = (scouting().display().to_string(), out.display().to_string());
-    let built = support::semo_in(
-        &support::repo_root(),
-        &["build", &mission, "--target", "cortex-m", "-o", &out_arg],
-    );
-    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
-    let folder = out.join("SlaveTeam/ti");
-    let made = Command::new("make")
-        .args(["-s", "-j2"])
-        .current_dir(&folder)
-        .output()
-        .expect("make runs");
-    assert!(
-        made.status.success(),
-        "{}",
-        String::from_utf8_lossy(&made.stderr)
-    );
-    let (flash, ram) = robots::board_size(&folder.join("ti.elf"));
-    eprintln!("scouting ti on cortex-m with the link: flash {flash} B, RAM {ram} B");
-    assert!(flash <= 32 * 1024, "flash {flash} B > 32 KB");
-    assert!(ram <= 8 * 1024, "RAM {ram} B > 8 KB");
+    for (target, flash_max, ram_max) in [("cortex-m", 32, 8), ("stm32f4", 64, 16)] {
+        let out = robots::scratch(&format!("board-link-budget-{target}"));
+        let (mission, out_arg) = (scouting().display().to_string(), out.display().to_string());
+        let built = support::semo_in(
+            &support::repo_root(),
+            &["build", &mission, "--target", target, "-o", &out_arg],
+        );
+        assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+        let folder = out.join("SlaveTeam/ti");
+        let made = Command::new("make")
+            .args(["-s", "-j2"])
+            .current_dir(&folder)
+            .output()
+            .expect("make runs");
+        assert!(
+            made.status.success(),
+            "{}",
+            String::from_utf8_lossy(&made.stderr)
+        );
+        let (flash, ram) = robots::board_size(&folder.join("ti.elf"));
+        eprintln!("scouting ti on {target} with the link: flash {flash} B, RAM {ram} B");
+        assert!(
+            flash <= flash_max * 1024,
+            "{target}: flash {flash} B > {flash_max} KB"
+        );
+        assert!(
+            ram <= ram_max * 1024,
+            "{target}: RAM {ram} B > {ram_max} KB"
+        );
+    }
 }
 
 /// Every example mission whose robots message each other (scouting, patrol,
-/// the swarms) builds for `cortex-m` with the link, and every robot
+/// the swarms) builds for each board with the link, and every robot
 /// compiles and links with arm-none-eabi-gcc at `-Wpedantic -Werror`
 /// (until the link they were refused, E103).
 #[test]
-fn every_example_builds_for_cortex_m_with_the_link_and_compiles() {
-    let test = "every_example_builds_for_cortex_m_with_the_link_and_compiles";
+fn every_example_builds_for_each_board_with_the_link_and_compiles() {
+    let test = "every_example_builds_for_each_board_with_the_link_and_compiles";
     if !robots::board_tools_present(test) {
         return;
     }
-    let out = robots::scratch("board-link-examples");
-    let mut linked = 0;
-    for mission in [
-        "scouting/scouting.mission",
-        "patrol/patrol.mission",
-        "swarm/march.mission",
-        "swarm/patrol_groups.mission",
-    ] {
-        let path = support::examples().join(mission);
-        let name = Path::new(mission).file_stem().unwrap().to_string_lossy();
-        let dir = out.join(name.as_ref());
-        let (path_arg, dir_arg) = (path.display().to_string(), dir.display().to_string());
-        let built = support::semo_in(
-            &support::repo_root(),
-            &["build", &path_arg, "--target", "cortex-m", "-o", &dir_arg],
-        );
-        assert_eq!(built.code, 0, "{mission}: {}{}", built.stdout, built.stderr);
-        for folder in robots::robot_folders(&dir) {
-            let makefile = std::fs::read_to_string(folder.join("Makefile")).unwrap();
-            linked += usize::from(makefile.contains(" -DSEMO_LINK "));
-            robots::make_board(&folder);
+    for target in ["cortex-m", "stm32f4"] {
+        let out = robots::scratch(&format!("board-link-examples-{target}"));
+        let mut linked = 0;
+        for mission in [
+            "scouting/scouting.mission",
+            "patrol/patrol.mission",
+            "swarm/march.mission",
+            "swarm/patrol_groups.mission",
+        ] {
+            let path = support::examples().join(mission);
+            let name = Path::new(mission).file_stem().unwrap().to_string_lossy();
+            let dir = out.join(name.as_ref());
+            let (path_arg, dir_arg) = (path.display().to_string(), dir.display().to_string());
+            let built = support::semo_in(
+                &support::repo_root(),
+                &["build", &path_arg, "--target", target, "-o", &dir_arg],
+            );
+            assert_eq!(
+                built.code, 0,
+                "{mission} {target}: {}{}",
+                built.stdout, built.stderr
+            );
+            for folder in robots::robot_folders(&dir) {
+                let makefile = std::fs::read_to_string(folder.join("Makefile")).unwrap();
+                linked += usize::from(makefile.contains(" -DSEMO_LINK "));
+                robots::make_board(&folder);
+            }
         }
+        assert!(
+            linked >= 10,
+            "{target}: robots built with the link: {linked}"
+        );
     }
-    assert!(linked >= 10, "robots built with the link: {linked}");
 }

@@ -390,7 +390,10 @@ fn a_message_longer_than_the_board_takes_is_refused_and_the_next_one_arrives() {
     );
     assert_eq!(robot.taken[1].kind, Kind::Message);
     assert_eq!(robot.taken[1].payload, short);
-    assert!(robot.endpoint.bad_frames.is_empty(), "nothing too long came");
+    assert!(
+        robot.endpoint.bad_frames.is_empty(),
+        "nothing too long came"
+    );
     heard(&rx, "the long message");
     heard(&rx, "the short one");
 

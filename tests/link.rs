@@ -402,7 +402,10 @@ fn a_board_says_its_payload_bound_and_longer_frames_are_bad_there() {
     reconnected.feed(&answered.wire, 0, &mut Vec::new());
     assert!(reconnected.outgoing.welcomed());
     assert_eq!(reconnected.peer_payload_max, BOARD_PAYLOAD_MAX);
-    assert!(c.stats().contains(&format!("peer_payload_max={PAYLOAD_MAX}")));
+    assert!(
+        c.stats()
+            .contains(&format!("peer_payload_max={PAYLOAD_MAX}"))
+    );
 
     let too_long = Frame::new(Kind::Message, 0, vec![7; BOARD_PAYLOAD_MAX + 1]);
     let said = c.bytes(&too_long.encode().unwrap());

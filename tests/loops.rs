@@ -396,6 +396,48 @@ fn a_graph_service_on_cortex_m_is_refused() {
     );
 }
 
+/// The same refusal for a board the project file chose: the message names
+/// the robot and how its target was chosen, and its related information
+/// points at the project file's line that chose it.
+#[test]
+fn a_graph_service_on_a_board_the_project_file_chose_is_refused_pointing_at_the_choice() {
+    let dir = scratch("loops/project-choice");
+    std::fs::create_dir_all(dir.join("graphs")).unwrap();
+    for file in ["loops.mission", "clusterer.robot.xml"] {
+        std::fs::copy(fixture(file), dir.join(file)).unwrap();
+    }
+    for graph in std::fs::read_dir(fixture("graphs")).unwrap() {
+        let graph = graph.unwrap().path();
+        std::fs::copy(&graph, dir.join("graphs").join(graph.file_name().unwrap())).unwrap();
+    }
+    let project = "[project]\nversion = 1\nname = \"loops\"\ncatalogs = [\".\"]\n\n[build.targets]\nc = \"cortex-m\"\n";
+    std::fs::write(dir.join("semo.toml"), project).unwrap();
+    let built = semo_in(&dir, &["build", "--format", "json"]);
+    assert_eq!(built.code, 1, "{}{}", built.stdout, built.stderr);
+    let document: serde_json::Value = serde_json::from_str(&built.stdout).unwrap();
+    let e103: Vec<&serde_json::Value> = document["diagnostics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|d| d["code"] == "E103")
+        .collect();
+    assert_eq!(e103.len(), 1, "{document}");
+    let message = e103[0]["message"].as_str().unwrap();
+    assert!(
+        message.starts_with("robot `c` is built for cortex-m, ")
+            && message.contains("runs task graph"),
+        "{message}"
+    );
+    let related = &e103[0]["related"][0];
+    assert_eq!(related["message"], "cortex-m is chosen here", "{document}");
+    assert!(
+        related["file"].as_str().unwrap().ends_with("semo.toml"),
+        "{document}"
+    );
+    assert_eq!(related["line"], 7, "{document}");
+    assert!(!dir.join("out").exists(), "nothing is written");
+}
+
 /// A sub-graph reference the workspace cannot follow refuses the build on
 /// the service's call (E135), pointing at the graph file's own diagnostic:
 /// a missing file (E067), a file leading back to the graph (E069) or one

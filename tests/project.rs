@@ -689,15 +689,12 @@ fn the_project_file_gives_a_team_or_a_robot_its_own_target() {
     assert_eq!(e111.suggestion.as_deref(), Some("cortex-m"));
 }
 
-/// A robot whose type's platform cannot run it (an stm32f4 robot, a board
-/// without a serial link, that talks to another robot) is refused, naming
-/// the robot, the platform, why and the boards that have a link, pointing
-/// at the catalog's `target=`: never built for linux behind the user's
-/// back. On cortex-m, which has the link, the same robot is built with it;
-/// the project file can build it for linux instead.
+/// A robot that talks to another robot is built, on either board, with its
+/// board's serial link to `semo gateway`: on cortex-m (the catalog's
+/// platform) on UART1, on stm32f4 on USART2; the project file can build it
+/// for linux instead.
 #[test]
-fn a_talking_robot_on_a_board_without_a_link_is_refused_naming_its_platform_and_where_it_is_chosen()
-{
+fn a_talking_robot_on_either_board_is_built_with_its_link_and_the_project_file_can_choose_linux() {
     let dir = mixed_fleet();
     let root = dir.path();
     let mission = read(&root.join("fleet.mission")).replace(
@@ -705,53 +702,23 @@ fn a_talking_robot_on_a_board_without_a_link_is_refused_naming_its_platform_and_
         "  send(USER, Scouts.DISTANCE)\n  send(Base, Scouts.DISTANCE)\n",
     );
     write(&root.join("fleet.mission"), &mission);
-    // On cortex-m (the catalog's platform) it is built, with the link.
-    let built = semo_in(root, &["build", "--format", "json"]);
-    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
-    let makefile = read(&root.join("out/Scouts/ev/Makefile"));
-    assert!(makefile.contains(" -DSEMO_LINK "), "{makefile}");
-    std::fs::remove_dir_all(root.join("out")).unwrap();
-    let catalog = read(&root.join("robots/fleet.robot.xml"));
-    write(
-        &root.join("robots/fleet.robot.xml"),
-        &catalog.replace("target=\"cortex-m\"", "target=\"stm32f4\""),
-    );
-    let built = semo_in(root, &["build", "--format", "json"]);
-    assert_eq!(built.code, 1, "{}{}", built.stdout, built.stderr);
-    let document: serde_json::Value = serde_json::from_str(&built.stdout).unwrap();
-    let e103: Vec<&serde_json::Value> = document["diagnostics"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter(|d| d["code"] == "E103")
-        .collect();
-    assert_eq!(e103.len(), 1, "{document}");
-    let d = e103[0];
-    assert_eq!(
-        d["message"],
-        "robot `ev` (team `Scouts`) is built for stm32f4, the platform its type `Evalbot` names in the catalog: send `Scouts.DISTANCE` to team `Base`, but stm32f4 has no serial link to other robots yet (cortex-m has one, on UART1 to `semo gateway`): build it for cortex-m or linux, or message only USER"
-    );
-    assert!(
-        d["file"].as_str().unwrap().ends_with("fleet.mission"),
-        "{d}"
-    );
-    let related = &d["related"][0];
-    assert!(
-        related["file"]
-            .as_str()
-            .unwrap()
-            .ends_with("robots/fleet.robot.xml"),
-        "{d}"
-    );
-    assert_eq!(related["message"], "stm32f4 is chosen here");
-    let catalog = read(&root.join("robots/fleet.robot.xml"));
-    let at = catalog
-        .lines()
-        .position(|l| l.contains("target=\"stm32f4\""))
-        .unwrap() as u64
-        + 1;
-    assert_eq!(related["line"], at, "{d}");
-    assert!(!root.join("out").exists(), "nothing is written");
+    for (target, port) in [("cortex-m", "UART1"), ("stm32f4", "USART2")] {
+        let catalog = read(&root.join("robots/fleet.robot.xml"));
+        let catalog = catalog
+            .replace("target=\"cortex-m\"", &format!("target=\"{target}\""))
+            .replace("target=\"stm32f4\"", &format!("target=\"{target}\""));
+        write(&root.join("robots/fleet.robot.xml"), &catalog);
+        let built = semo_in(root, &["build", "--format", "json"]);
+        assert_eq!(built.code, 0, "{target}: {}{}", built.stdout, built.stderr);
+        assert_eq!(planned(&built.stdout)[0], format!("ev {target} (catalog)"));
+        let makefile = read(&root.join("out/Scouts/ev/Makefile"));
+        assert!(makefile.contains(" -DSEMO_LINK "), "{makefile}");
+        assert!(
+            makefile.contains(&format!("# The serial link to `semo gateway` on {port} ")),
+            "{makefile}"
+        );
+        std::fs::remove_dir_all(root.join("out")).unwrap();
+    }
     // The project file builds it for linux instead.
     let project = read(&root.join("semo.toml"));
     write(

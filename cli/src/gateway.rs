@@ -514,9 +514,8 @@ impl LinkGateway {
                 // Messages from the broker go down as the link has room,
                 // once the session stands: its Welcome (or the robot's
                 // Hello) said how long a payload the robot takes.
-                while let Some((topic, payload)) = held
-                    .front()
-                    .filter(|_| endpoint.outgoing.welcomed())
+                while let Some((topic, payload)) =
+                    held.front().filter(|_| endpoint.outgoing.welcomed())
                 {
                     let frame =
                         self.down_the_link(topic, payload, endpoint.peer_payload_max, &mut counts);

@@ -65,8 +65,7 @@ pub struct Platform {
 pub struct Variant {
     /// The default network transport its Makefile builds in; `None`: no
     /// network (a board: the operator through its trace, other robots
-    /// through its [`SerialLink`] to `semo gateway`, if it has one, E103
-    /// otherwise).
+    /// through its [`SerialLink`] to `semo gateway`).
     pub transport: Option<Transport>,
     /// The runtime files it compiles, in the runtime folder (for a board,
     /// its start-up file and link script come after these).
@@ -100,9 +99,9 @@ pub struct Board {
     /// The serial port the trace goes to.
     pub serial: &'static str,
     /// The serial link to `semo gateway` for a robot that messages other
-    /// robots; `None`: the board has none yet, and such a robot is refused
-    /// (E103).
-    pub link: Option<SerialLink>,
+    /// robots: every board has one, so no robot is refused for its
+    /// messages.
+    pub link: SerialLink,
     /// The emulator `make run` starts, and its machine.
     pub emulator: &'static str,
     pub machine: &'static str,
@@ -162,7 +161,7 @@ const CORTEX_M: [&str; 5] = [
 
 /// A Cortex-M board's program and its simulation alike: the static
 /// schedule, no network (other robots only through the board's
-/// [`SerialLink`], if it has one; E103 otherwise).
+/// [`SerialLink`]).
 const BOARD_PROGRAM: Variant = Variant {
     transport: None,
     runtime: &CORTEX_M,
@@ -240,12 +239,12 @@ pub const PLATFORMS: &[Platform] = &[
             clock_hz: 12_000_000,
             timer: "SysTick",
             serial: "UART0",
-            link: Some(SerialLink {
+            link: SerialLink {
                 port: "UART1",
                 pins: "U1Rx on PD2, U1Tx on PD3",
                 baud: 115_200,
                 runtime: &LINK_RUNTIME,
-            }),
+            },
             emulator: "qemu-system-arm",
             machine: "lm3s6965evb",
         }),
@@ -278,7 +277,12 @@ pub const PLATFORMS: &[Platform] = &[
             clock_hz: 168_000_000,
             timer: "SysTick",
             serial: "USART1",
-            link: None,
+            link: SerialLink {
+                port: "USART2",
+                pins: "TX on PA2, RX on PA3 (alternate function 7)",
+                baud: 115_200,
+                runtime: &LINK_RUNTIME,
+            },
             emulator: "qemu-system-arm",
             machine: "netduinoplus2",
         }),
@@ -396,9 +400,8 @@ impl Target {
             .copied()
             .chain(
                 board
-                    .and_then(|b| b.link.as_ref())
                     .into_iter()
-                    .flat_map(|l| l.runtime.iter().copied()),
+                    .flat_map(|b| b.link.runtime.iter().copied()),
             )
             .chain(board.map(|b| b.startup))
             .chain(board.map(|b| b.link_script))

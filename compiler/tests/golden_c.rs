@@ -4,8 +4,8 @@
 //! snapshot per pair holding every robot's files, each
 //! under a header naming it, then the runtime folder's files (a file written
 //! as it is in `src/codegen/runtime/` is only named; one filled in for a
-//! board is written out). A target that refuses a mission's robots (a
-//! board without a serial link to other robots, E103) is snapshotted with
+//! board is written out). A target that refuses a mission's robots (E103)
+//! is snapshotted with
 //! its diagnostics, so that a change of what is refused shows too. A change
 //! to the emitted C, Makefile or task graph shows in review as a change to
 //! a snapshot, and a change nobody meant fails here. A deliberate change:

@@ -351,12 +351,12 @@ fn generate(
         );
     }
     // A board robot that messages no other robot leaves its board's link
-    // out (target::check refused the ones a board without a link cannot run).
+    // out.
     let link = target
         .platform()
         .board
         .as_ref()
-        .and_then(|b| b.link.as_ref())
+        .map(|b| &b.link)
         .filter(|_| target::peer_messages(program).is_some());
     let link_only = |name: &str| {
         link.is_none()
@@ -364,8 +364,7 @@ fn generate(
                 .platform()
                 .board
                 .as_ref()
-                .and_then(|b| b.link.as_ref())
-                .is_some_and(|l| l.runtime.contains(&name))
+                .is_some_and(|b| b.link.runtime.contains(&name))
     };
     let runtime_c: Vec<&str> = target
         .runtime()

@@ -3,18 +3,16 @@
 //! pointed at where it was written). A board reaches other robots only
 //! through its serial link to `semo gateway` (`platform::SerialLink`,
 //! `semo_static_link.c`): a robot that sends to, receives from, publishes
-//! to or subscribes to other robots is built with the link on a board that
-//! has one (`cortex-m`'s UART1) and refused on a board that has none yet
-//! (`stm32f4`, E103), never built with its messages silently dropped.
-//! Messages to and from the operator (`USER`) need no link: the trace is
-//! the operator console's record, and in simulation the operator's
-//! commands are compiled in.
+//! to or subscribes to other robots is built with the link
+//! ([`peer_messages`]; every board has one), never with its messages
+//! silently dropped. Messages to and from the operator (`USER`) need no
+//! link: the trace is the operator console's record, and in simulation the
+//! operator's commands are compiled in.
 
 use super::{Emit, Layer};
 use crate::diag::{Code, Diagnostic};
 use crate::refine::RobotProgram;
 use crate::refine::{BuildInput, robot_span};
-use crate::sema::Peer;
 use crate::targets::Chosen;
 
 /// The operator console's team name in messages.
@@ -108,74 +106,7 @@ pub fn check(
             found.push(d);
         }
     }
-    // One diagnostic per team and target: its robots share the statements.
-    let mut teams: Vec<(&str, &Chosen, Vec<&str>, String, crate::span::Span)> = Vec::new();
-    let without_link = on_static().filter(|(_, chosen)| {
-        chosen
-            .target
-            .platform()
-            .board
-            .as_ref()
-            .is_none_or(|b| b.link.is_none())
-    });
-    for (program, chosen) in without_link {
-        let Some(why) = peer_messages(program) else {
-            continue;
-        };
-        let same = |(team, c, ..): &&mut (&str, &Chosen, Vec<&str>, String, _)| {
-            *team == program.team && *c == chosen
-        };
-        match teams.iter_mut().find(same) {
-            Some((_, _, robots, ..)) => robots.push(&program.robot),
-            None => {
-                let span = message_span(build, &program.team)
-                    .unwrap_or_else(|| robot_span(build, &program.robot));
-                teams.push((&program.team, chosen, vec![&program.robot], why, span));
-            }
-        }
-    }
-    // The boards that have a link, named in the message (the platform table's).
-    let linked: Vec<(&str, &str)> = crate::platform::PLATFORMS
-        .iter()
-        .filter_map(|p| Some((p.name, p.board.as_ref()?.link.as_ref()?.port)))
-        .collect();
-    for (team, chosen, robots, why, span) in teams {
-        let who = if robots.len() == 1 {
-            format!("robot `{}` (team `{team}`)", robots[0])
-        } else {
-            format!("the robots of team `{team}` ({})", robots.join(", "))
-        };
-        let mut d = Diagnostic::new(
-            Code::TargetUnsupported,
-            build.mission,
-            span,
-            format!(
-                "{who} {} {}: {why}, but {} has no serial link to other robots yet ({}): build {} for {} or linux, or message only USER",
-                if robots.len() == 1 { "is" } else { "are" },
-                built_for(chosen),
-                chosen.target.name(),
-                linked
-                    .iter()
-                    .map(|(name, port)| format!("{name} has one, on {port} to `semo gateway`"))
-                    .collect::<Vec<_>>()
-                    .join("; "),
-                if robots.len() == 1 { "it" } else { "them" },
-                linked
-                    .iter()
-                    .map(|(name, _)| *name)
-                    .collect::<Vec<_>>()
-                    .join(" or "),
-            ),
-        );
-        relate_choice(&mut d, chosen);
-        found.push(d);
-    }
     found
-}
-
-/// `built for cortex-m, the platform its type ... names`.
-fn built_for(chosen: &Chosen) -> String {
-    format!("built for {}", chosen.describe())
 }
 
 /// Points at where the target was chosen (the catalog's `target=`, the
@@ -190,20 +121,8 @@ fn relate_choice(diagnostic: &mut Diagnostic, chosen: &Chosen) {
     }
 }
 
-/// The first statement of `team` that messages another team (the checker's
-/// `messages`); `None` for a robot that only exchanges heartbeats.
-fn message_span(build: &BuildInput<'_>, team: &str) -> Option<crate::span::Span> {
-    let mission = &build.analysis.mission;
-    let id = mission.teams.iter().position(|t| t.name == team)?;
-    mission
-        .messages
-        .iter()
-        .filter(|m| m.team.0 as usize == id && m.peer != Peer::User)
-        .map(|m| m.span)
-        .min_by_key(|s| s.start)
-}
-
-/// How the robot talks to other robots, if it does.
+/// How the robot talks to other robots, if it does (then a board builds it
+/// with its link).
 pub(super) fn peer_messages(program: &RobotProgram) -> Option<String> {
     let m = &program.control;
     if let Some(o) = m.outgoing.iter().find(|o| o.to_team != USER) {

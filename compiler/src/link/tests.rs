@@ -247,7 +247,10 @@ fn each_side_says_its_payload_bound_and_refuses_longer_frames() {
     // The board's reset: its Hello says 164.
     let mut hello = Vec::new();
     board.tick(0, &mut hello);
-    assert_eq!(frames(&hello), vec![Frame::new(Kind::Hello, 0, vec![0, 164])]);
+    assert_eq!(
+        frames(&hello),
+        vec![Frame::new(Kind::Hello, 0, vec![0, 164])]
+    );
     let mut welcome = Vec::new();
     gateway.feed(&hello, 0, &mut welcome);
     assert_eq!(gateway.peer_payload_max, 164);

@@ -13,6 +13,9 @@
  * start-up files (-nostartfiles).
  */
 #include "semo_internal.h"
+#ifdef SEMO_LINK
+#include "semo_link.h"
+#endif
 
 #include <stddef.h>
 #include <string.h>
@@ -40,6 +43,46 @@ static volatile uint32_t g_period;
 
 #ifdef SEMO_LINK
 volatile bool semo__board_woken;
+
+/* Received on the link, from the board's interrupt (which alone moves
+ * `head`) to the loop (which alone moves `tail`): twice the longest frame. */
+#define RX_RING (2u * SEMO_LINK_WIRE_MAX)
+static volatile unsigned char g_rx[RX_RING];
+static volatile uint32_t g_rx_head, g_rx_tail;
+static volatile unsigned long g_rx_overruns;
+
+/* A full ring loses the byte (counted): the frame it was in fails its CRC,
+ * goes unacknowledged and comes again. */
+void semo__board_link_received(unsigned char byte)
+{
+    uint32_t next = (g_rx_head + 1u) % RX_RING;
+    if (next == g_rx_tail) {
+        g_rx_overruns++;
+    } else {
+        g_rx[g_rx_head] = byte;
+        g_rx_head = next;
+    }
+    semo__board_woken = true;
+}
+
+bool semo__board_link_peek(unsigned char *byte)
+{
+    if (g_rx_tail == g_rx_head)
+        return false;
+    *byte = g_rx[g_rx_tail];
+    return true;
+}
+
+void semo__board_link_take(void)
+{
+    if (g_rx_tail != g_rx_head)
+        g_rx_tail = (g_rx_tail + 1u) % RX_RING;
+}
+
+unsigned long semo__board_link_overruns(void)
+{
+    return g_rx_overruns;
+}
 #endif
 
 /* A new period of `cycles` from now (at most SYSTICK_MAX_CYCLES). */

@@ -380,13 +380,15 @@ void semo__fault(void);
 #ifdef SEMO_LINK
 /* The link to `semo gateway` on the board's second serial port (-DSEMO_LINK:
  * a robot that messages other robots; docs/link.md). The board file starts
- * it in semo__board_init and gives: writing bytes (all of them, waiting for
- * room), the next byte received without taking it (false: none yet), taking
- * it, and the bytes lost to a full receive buffer. A received byte ends a
- * sleep: the interrupt sets semo__board_woken, which semo__board_sleep_until
- * reads with interrupts masked, so a byte that came just before the sleep
- * is not slept through. */
+ * it in semo__board_init, writes bytes (all of them, waiting for room), and
+ * hands each byte its interrupt receives to the core's receive ring
+ * (semo_cortex_m.c), which gives the next byte received without taking it
+ * (false: none yet), takes it, and counts the bytes lost to a full ring. A
+ * received byte ends a sleep: it sets semo__board_woken, which
+ * semo__board_sleep_until reads with interrupts masked, so a byte that came
+ * just before the sleep is not slept through. */
 void semo__board_link_put(const unsigned char *bytes, size_t n);
+void semo__board_link_received(unsigned char byte);
 bool semo__board_link_peek(unsigned char *byte);
 void semo__board_link_take(void);
 unsigned long semo__board_link_overruns(void);

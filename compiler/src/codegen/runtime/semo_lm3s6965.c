@@ -4,7 +4,7 @@
  * source (a received byte ends a sleep). With -DSEMO_LINK (a robot that
  * messages other robots) UART1 (U1Rx on PD2, U1Tx on PD3; QEMU's second
  * `-serial`) is the link to `semo gateway` (semo_static_link.c): written
- * polled, read by its interrupt into a ring of twice the longest frame.
+ * polled, read by its interrupt into the core's receive ring.
  * The reset code, the clock, the sleep, the exit and the fault handler are
  * the core's (semo_cortex_m.c). Linked with lm3s6965.ld.
  */
@@ -60,13 +60,6 @@ static volatile uint32_t g_uart_input; /* bytes received (and discarded) */
 /* ---------------------------------------------------------------- board */
 
 #ifdef SEMO_LINK
-/* Received on the link, from the interrupt (which alone moves `head`) to
- * the loop (which alone moves `tail`). */
-#define RX_RING (2u * SEMO_LINK_WIRE_MAX)
-static volatile unsigned char g_rx[RX_RING];
-static volatile uint32_t g_rx_head, g_rx_tail;
-static volatile unsigned long g_rx_overruns;
-
 static void link_init(void)
 {
     SYSCTL_RCGC1 |= 1u << 1;
@@ -92,41 +85,12 @@ void semo__board_link_put(const unsigned char *bytes, size_t n)
     }
 }
 
-bool semo__board_link_peek(unsigned char *byte)
-{
-    if (g_rx_tail == g_rx_head)
-        return false;
-    *byte = g_rx[g_rx_tail];
-    return true;
-}
-
-void semo__board_link_take(void)
-{
-    if (g_rx_tail != g_rx_head)
-        g_rx_tail = (g_rx_tail + 1u) % RX_RING;
-}
-
-unsigned long semo__board_link_overruns(void)
-{
-    return g_rx_overruns;
-}
-
-/* A full ring loses the byte (counted): the frame it was in fails its CRC,
- * goes unacknowledged and comes again. */
+/* Every byte the FIFO holds goes to the core's receive ring. */
 static void uart1(void)
 {
-    while (!(UART1_FR & UART_FR_RXFE)) {
-        unsigned char byte = (unsigned char)UART1_DR;
-        uint32_t next = (g_rx_head + 1u) % RX_RING;
-        if (next == g_rx_tail) {
-            g_rx_overruns++;
-        } else {
-            g_rx[g_rx_head] = byte;
-            g_rx_head = next;
-        }
-    }
+    while (!(UART1_FR & UART_FR_RXFE))
+        semo__board_link_received((unsigned char)UART1_DR);
     UART1_ICR = UART_IM_RX | UART_IM_RT;
-    semo__board_woken = true;
 }
 #endif
 

@@ -418,8 +418,8 @@ void UFTimer_Cancel(int id)
 
 /* Without the link (-DSEMO_LINK, semo_static_link.c) only the operator
  * console ("USER", whose record is the trace) is reachable: the generator
- * builds a robot that messages other robots with the link, or refuses it
- * on a board that has none (E103), so anything else is an error. The inbox
+ * builds every robot that messages other robots with the link, so anything
+ * else is an error. The inbox
  * (semo_comm_poll, semo__deliver) is the core's. */
 #ifndef SEMO_LINK
 int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, const semo_value *value)
