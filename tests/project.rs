@@ -736,3 +736,35 @@ fn a_talking_robot_on_either_board_is_built_with_its_link_and_the_project_file_c
         ]
     );
 }
+
+/// The built-in catalog's TIEvalbot is a Stellaris LM3S robot: the scouting
+/// example built with no target has `ti` on cortex-m, with its serial link
+/// (it talks to the other robots), and `irobot` and `nxt` on linux.
+#[test]
+fn the_scouting_example_builds_ti_for_its_board_and_the_others_for_linux() {
+    let dir = workspace();
+    let out = dir.path().join("out");
+    let mission = support::examples().join("scouting/scouting.mission");
+    let built = semo_in(
+        &support::repo_root(),
+        &[
+            "build",
+            mission.to_str().unwrap(),
+            "--format",
+            "json",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+    assert_eq!(
+        planned(&built.stdout),
+        [
+            "irobot linux (default)",
+            "ti cortex-m (catalog)",
+            "nxt linux (default)"
+        ]
+    );
+    let makefile = read(&out.join("SlaveTeam/ti/Makefile"));
+    assert!(makefile.contains(" -DSEMO_LINK "), "{makefile}");
+}
