@@ -380,3 +380,61 @@ fn every_example_builds_for_each_board_with_the_link_and_compiles() {
         );
     }
 }
+
+/// A scenario's link faults on a board robot's messages cannot happen on
+/// its serial link (the gateway has no way to lose or delay a message on
+/// the scenario's say): `semo build` refuses them (E103, naming the robot
+/// and its target) instead of a board that stops at its start.
+#[test]
+fn link_faults_on_a_board_robots_messages_are_refused_at_build_time() {
+    let out = robots::scratch("board-link-faults");
+    let mut scenario: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scenario()).unwrap()).unwrap();
+    scenario["faults"] = serde_json::json!([
+        {"from": 1000, "until": 2000, "drop": ["irobot", "ti"]}
+    ]);
+    let faulty = out.join("faults.scenario.json");
+    std::fs::write(&faulty, scenario.to_string()).unwrap();
+    let (mission, scenario_arg, out_arg) = (
+        scouting().display().to_string(),
+        faulty.display().to_string(),
+        out.join("robots").display().to_string(),
+    );
+    let built = support::semo_in(
+        &support::repo_root(),
+        &[
+            "build",
+            &mission,
+            "--sim",
+            "--scenario",
+            &scenario_arg,
+            "-o",
+            &out_arg,
+        ],
+    );
+    assert_eq!(built.code, 1, "{}{}", built.stdout, built.stderr);
+    assert!(
+        built.stderr.contains("[E103]")
+            && built.stderr.contains(
+                "robot `ti` is built for cortex-m-sim (simulated: --sim), the platform its type `TIEvalbot` names in the catalog: the scenario's link faults on its messages"
+            ),
+        "{}",
+        built.stderr
+    );
+    assert!(!out.join("robots").exists(), "nothing is written");
+    // On linux-sim the same scenario builds: its udp transport applies them.
+    let built = support::semo_in(
+        &support::repo_root(),
+        &[
+            "build",
+            &mission,
+            "--target",
+            "linux-sim",
+            "--scenario",
+            &scenario_arg,
+            "-o",
+            &out_arg,
+        ],
+    );
+    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
+}

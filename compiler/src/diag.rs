@@ -193,7 +193,7 @@ codes! {
     CodegenUnsupported = "E100", Error, "a construct that code generation does not support yet";
     OutputNameEscapes = "E101", Error, "a name that cannot become a file or C identifier of the generated code (it could write outside the output folder, or clashes with a generated task)";
     CodegenInternal = "E102", Error, "an internal error of refinement or code generation: something the checker should have excluded (please report it)";
-    TargetUnsupported = "E103", Error, "a robot its target cannot run as written (the target `--target`, the project file or its robot type's platform in the catalog chose): on a board a robot whose service runs a task graph, or a board's simulation without `--scenario`";
+    TargetUnsupported = "E103", Error, "a robot its target cannot run as written (the target `--target`, the project file or its robot type's platform in the catalog chose): on a board a robot whose service runs a task graph, a board's simulation without `--scenario`, or one whose scenario has link faults on the messages of a robot on its serial link";
     ServiceSubgraphUnusable = "E135", Error, "a service implemented by a task graph whose sub-graph references cannot be used (a file that cannot be read, has errors, leads back to itself or whose open ports do not match the task's): the service cannot run";
     // The project file (`semo.toml`).
     ProjectSyntax = "E110", Error, "a project file (`semo.toml`) that is not valid TOML";

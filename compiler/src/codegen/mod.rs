@@ -551,13 +551,7 @@ pub fn build_refined_each(
             }
         }
     }
-    diagnostics.extend(target::check(
-        build,
-        programs,
-        &chosen,
-        emit,
-        scenarios.len() == programs.len(),
-    ));
+    diagnostics.extend(target::check(build, programs, &chosen, emit, scenarios));
     crate::diag::sort_and_dedup(&mut diagnostics);
     if diagnostics.iter().any(crate::diag::Diagnostic::is_error) {
         return BuildResult::refused_with(diagnostics);

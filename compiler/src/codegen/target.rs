@@ -12,22 +12,23 @@
 use super::{Emit, Layer};
 use crate::diag::{Code, Diagnostic};
 use crate::refine::RobotProgram;
-use crate::refine::{BuildInput, robot_span};
+use crate::refine::{BuildInput, CompiledScenario, robot_span};
 use crate::targets::Chosen;
 
 /// The operator console's team name in messages.
 const USER: &str = "USER";
 
 /// The diagnostics that refuse `programs`, each on its own target
-/// (`targets`, in the same order). `has_scenarios`: a compiled world was
-/// given for every program.
+/// (`targets`, in the same order). `scenarios`: the compiled world of each
+/// program, in the same order, when the build was given a scenario.
 pub fn check(
     build: &BuildInput<'_>,
     programs: &[RobotProgram],
     targets: &[Chosen],
     emit: Emit,
-    has_scenarios: bool,
+    scenarios: &[CompiledScenario],
 ) -> Vec<Diagnostic> {
+    let has_scenarios = scenarios.len() == programs.len();
     let mut found = Vec::new();
     if emit == Emit::TaskGraph {
         return found;
@@ -100,6 +101,32 @@ pub fn check(
                     graph.task,
                     graph.graph,
                     chosen.target.name()
+                ),
+            );
+            relate_choice(&mut d, chosen);
+            found.push(d);
+        }
+    }
+    // A board's messages to other robots go through its serial link and
+    // `semo gateway`, which cannot lose or delay one on the scenario's
+    // say: link faults need linux-sim's udp transport. Said here rather
+    // than when the board starts.
+    if has_scenarios {
+        for ((program, chosen), world) in programs.iter().zip(targets).zip(scenarios) {
+            if chosen.target.layer() != Layer::Static
+                || world.links.is_empty()
+                || peer_messages(program).is_none()
+            {
+                continue;
+            }
+            let mut d = Diagnostic::new(
+                Code::TargetUnsupported,
+                build.mission,
+                robot_span(build, &program.robot),
+                format!(
+                    "robot `{}` is built for {}: the scenario's link faults on its messages (`drop`, `delay`, `partition`) need the udp transport of linux-sim, which a board on its serial link to `semo gateway` has not: build it for linux-sim, or leave it out of the scenario's link faults",
+                    program.robot,
+                    chosen.describe(),
                 ),
             );
             relate_choice(&mut d, chosen);
