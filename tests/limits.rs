@@ -418,6 +418,45 @@ fn many_teams_with_a_variable_of_one_name_cost_in_proportion() {
     );
 }
 
+/// `semo check FILE` checks that file, not its folder: beside a sibling
+/// mission of 3,000 teams (and no strategy file, which would be
+/// cross-checked against every mission of the folder), a small mission's
+/// check costs about what it costs alone (it checked the sibling too: 0.28 s
+/// of CPU instead of 0.006 s, debug build).
+#[test]
+fn checking_one_mission_does_not_check_a_big_sibling_without_strategy_files() {
+    let small = "{ T: iRobotCreate r }\nT.P.S{ stop() } repeat(1 SEC)\nT.M{ set(P, S) }\nT.main{ default: mode = M }\n";
+    let mut big = String::from("{\n");
+    for i in 0..3000 {
+        big.push_str(&format!("  T{i}: iRobotCreate r{i}\n"));
+    }
+    big.push_str("}\n");
+    for i in 0..3000 {
+        big.push_str(&format!(
+            "T{i}.P.S{{ stop() }} repeat(1 SEC)\nT{i}.M{{ set(P, S) }}\nT{i}.main{{ default: mode = M }}\n"
+        ));
+    }
+    let mut counts = Vec::new();
+    for with_sibling in [false, true] {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("a.mission"), small).unwrap();
+        if with_sibling {
+            std::fs::write(dir.path().join("big.mission"), &big).unwrap();
+        }
+        let Some(count) = instructions(dir.path(), &["check", "a.mission"]) else {
+            return;
+        };
+        counts.push(count);
+    }
+    eprintln!("alone {}, beside the big sibling {}", counts[0], counts[1]);
+    assert!(
+        counts[1] < counts[0] * 2,
+        "alone {} instructions, beside a big sibling {}",
+        counts[0],
+        counts[1]
+    );
+}
+
 #[test]
 fn many_modes_cases_and_catches_cost_in_proportion() {
     scales_linearly(

@@ -32,6 +32,8 @@
 //! unit's catalog files (sorted by path) make its catalog; its missions are
 //! checked against it; its strategy files are cross-checked together against
 //! its catalog and missions (so an entry refined in two files is found). A
+//! unit without strategy files needs its missions for nothing: each is
+//! checked when it is asked for, so `semo check FILE` checks no sibling. A
 //! file's diagnostics are its own plus those found in it by every unit that
 //! sees it; a catalog or strategy file no unit sees is checked with the
 //! files its own folder sees. Task graphs are analysed on their own,
@@ -371,6 +373,8 @@ pub struct LoadedStrategy {
 #[derive(Debug)]
 pub struct Unit {
     pub catalog: Arc<CatalogResult>,
+    /// The missions, checked, that its strategy files were cross-checked
+    /// against: none when it sees no strategy file.
     pub missions: Vec<(FileId, Arc<sema::CheckedMission>)>,
     pub strategies: Vec<(FileId, Arc<LoadedStrategy>)>,
     /// The missions' built-in calls linked to the entries refining them.
@@ -657,15 +661,22 @@ impl Analysis {
             return found;
         }
         let catalog = self.catalog_from(folder);
-        let missions: Vec<(FileId, Arc<sema::CheckedMission>)> = missions
-            .iter()
-            .filter_map(|m| Some((m.id, self.mission(m.id)?)))
-            .collect();
         let strategies: Vec<(FileId, Arc<LoadedStrategy>)> = seen
             .iter()
             .filter(|f| f.kind == FileKind::Strategy)
             .filter_map(|f| Some((f.id, self.strategy(f.id)?)))
             .collect();
+        // The missions matter to the unit only against its strategy files:
+        // without one, a check of one mission (`semo check FILE`, an
+        // edit) does not check its siblings.
+        let missions: Vec<(FileId, Arc<sema::CheckedMission>)> = if strategies.is_empty() {
+            Vec::new()
+        } else {
+            missions
+                .iter()
+                .filter_map(|m| Some((m.id, self.mission(m.id)?)))
+                .collect()
+        };
         let models: Vec<&Strategy> = strategies
             .iter()
             .filter_map(|(_, s)| s.strategy.as_ref())
@@ -842,11 +853,7 @@ impl Analysis {
     /// refuses the build). `None` for other files.
     pub fn build_input(&self, mission: FileId) -> Option<BuildFiles> {
         let unit = self.unit(mission)?;
-        let analysis = unit
-            .missions
-            .iter()
-            .find(|(id, _)| *id == mission)
-            .map(|(_, a)| a.clone())?;
+        let analysis = self.mission(mission)?;
         let file = self.files.get(&mission)?.clone();
         let name_of = |id: FileId| -> String {
             match self.file(id).and_then(|f| f.path.as_deref()) {
