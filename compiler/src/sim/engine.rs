@@ -536,6 +536,10 @@ pub struct Sim<'p> {
     /// A send's arrivals (instant, order, robot, its epoch), kept between
     /// sends for its room: a send allocates no list of its own.
     arrivals: Vec<(i64, u64, usize, u32)>,
+    /// The robots of one of its instants, gathered here and copied into
+    /// their entry's list at once (collected straight, the list was made
+    /// twice: grown as a `Vec`, then copied into the `Rc`).
+    reached: Vec<(usize, u32)>,
 }
 
 impl<'p> Robot<'p> {
@@ -748,6 +752,7 @@ impl<'p> Sim<'p> {
             channel_full: "channel full".into(),
             races: None,
             arrivals: Vec::new(),
+            reached: Vec::new(),
         };
         sim.inputs = sim.robots.iter().map(Inputs::of).collect();
         for r in 0..programs.len() {
@@ -1200,6 +1205,7 @@ impl<'p> Sim<'p> {
         // order; those reached at the same instant share one entry, under
         // the first one's number (nothing else is numbered between them).
         let mut arrivals = std::mem::take(&mut self.arrivals);
+        let mut reached = std::mem::take(&mut self.reached);
         for &dst in targets.iter() {
             if dst == r {
                 continue;
@@ -1211,11 +1217,14 @@ impl<'p> Sim<'p> {
             arrivals.push((self.now + latency, self.seq, dst, self.robots[dst].epoch));
         }
         while let Some(&(at, tie, _, _)) = arrivals.first() {
-            let to: Rc<[(usize, u32)]> = arrivals
-                .iter()
-                .filter(|a| a.0 == at)
-                .map(|&(_, _, dst, epoch)| (dst, epoch))
-                .collect();
+            reached.clear();
+            reached.extend(
+                arrivals
+                    .iter()
+                    .filter(|a| a.0 == at)
+                    .map(|&(_, _, dst, epoch)| (dst, epoch)),
+            );
+            let to: Rc<[(usize, u32)]> = Rc::from(reached.as_slice());
             arrivals.retain(|a| a.0 != at);
             let message = message.clone();
             self.queue
@@ -1223,6 +1232,7 @@ impl<'p> Sim<'p> {
             self.queued += 1;
         }
         self.arrivals = arrivals;
+        self.reached = reached;
     }
 
     /// The latency of a message from `a` to `b` now, or `None` when it is lost.
@@ -1932,8 +1942,10 @@ impl<'p> Sim<'p> {
                 _ => at_least(self.now + CONTROL_PERIOD_MS),
             }
         }
-        // The next sensor sample that brings a new value.
-        for (i, s) in m.slots.iter().enumerate() {
+        // The next sensor sample that brings a new value (the slots a
+        // sensor feeds, listed once: not every slot of the program).
+        for &i in self.inputs[r].sensors.iter() {
+            let s = &m.slots[i];
             let (SlotSource::Sensor { port, task }, Some(series)) =
                 (&s.source, &robot.sensor_series[i])
             else {
