@@ -422,7 +422,7 @@ struct Robot<'p> {
     /// Its last heartbeat's words (leading, battery, term) and text: sent
     /// again as they are while they hold (most heartbeats say what the
     /// last one said; formatting each one was a tenth of a swarm's run).
-    said: Option<((bool, Option<i64>, i64), Value)>,
+    said: Option<(HeartbeatWords, Value)>,
     /// The highest term (leadership epoch, `docs/groups.md`, "Terms") this
     /// robot knows: heard in a heartbeat, or its own.
     term: i64,
@@ -475,6 +475,9 @@ struct Robot<'p> {
     /// the service graphs run so far (`loops.rs`).
     graphs: loops::GraphState,
 }
+
+/// What a heartbeat says: whether its robot leads, its battery, its term.
+type HeartbeatWords = (bool, Option<i64>, i64);
 
 /// A link `semo verify` disturbs ([`Sim::disturb`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
