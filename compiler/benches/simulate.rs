@@ -35,6 +35,15 @@
 //! 1 minute of `semo simulate` 1,106.1M -> 964.1M instructions, 1,002
 //! robots x 10 s 2,426.1M -> 2,180.8M (callgrind, whole command, the same
 //! output).
+//!
+//! A heartbeat's text made only when its words change and read once per
+//! message, the recipients of an instant listed once, `wake_up` over the
+//! sensor slots only: whole `semo simulate`, 10 minutes of mission time
+//! (perf stat, instructions; the same trace and summaries), 102 robots
+//! 7,722M -> 6,461M (about 1.2 s of CPU at 2 instructions per cycle and
+//! 3 GHz), 1,002 robots 77,769M -> 65,412M (about 21-22 s of CPU either
+//! way: at one instruction per cycle the large swarm waits on memory);
+//! peak RSS 37 -> 40 MB and 290 -> 312 MB.
 
 mod common;
 use common::fastest;

@@ -31,6 +31,7 @@
 use super::loss::LossDraws;
 use super::scenario::{Command, DEFAULT_SERVICE_MS, FaultKind, Scenario};
 use super::trace::{Fields, TraceEvent};
+use crate::fasthash::FastMap;
 use crate::refine::SENSOR_PERIOD_MS;
 use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
@@ -40,6 +41,7 @@ use crate::refine::{
     SlotSource, StateId, StateKind, SyncPointId, counted_allocation,
 };
 use smallvec::smallvec;
+use std::cell::OnceCell;
 use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
 
@@ -245,6 +247,9 @@ struct Message {
     key: Rc<str>,
     value: Held,
     sent_at: i64,
+    /// What a heartbeat's text says, read once for all the robots it
+    /// reaches (`Heard::parse` of the same text gives the same words).
+    said: OnceCell<Heard>,
 }
 
 /// A robot's names as its messages and trace carry them, shared rather
@@ -414,6 +419,10 @@ struct Robot<'p> {
     /// Whether the last election this robot decided named it (what its
     /// heartbeats say).
     leading: bool,
+    /// Its last heartbeat's words (leading, battery, term) and text: sent
+    /// again as they are while they hold (most heartbeats say what the
+    /// last one said; formatting each one was a tenth of a swarm's run).
+    said: Option<(HeartbeatWords, Value)>,
     /// The highest term (leadership epoch, `docs/groups.md`, "Terms") this
     /// robot knows: heard in a heartbeat, or its own.
     term: i64,
@@ -428,14 +437,14 @@ struct Robot<'p> {
     /// listening time before it claims).
     fenced: Option<Option<i64>>,
     /// How often this robot reached each `GroupSync` state, by (service, pc).
-    sync_pass: HashMap<(ServiceMachineId, StateId), i64>,
+    sync_pass: FastMap<(ServiceMachineId, StateId), i64>,
     /// The last pass each (peer, sync point) announced (`comm_sync_arrived`).
-    sync_arrived: HashMap<(PeerId, SyncPointId), i64>,
+    sync_arrived: FastMap<(PeerId, SyncPointId), i64>,
     /// The last leader each `LeaderBranch` state saw, by (service, pc).
-    leaders: HashMap<(ServiceMachineId, StateId), Leader>,
+    leaders: FastMap<(ServiceMachineId, StateId), Leader>,
     /// The group each `GroupAllocate` state last gave this robot, by
     /// (service, pc): its index, or `None` for the others.
-    allocated: HashMap<(ServiceMachineId, StateId), Option<usize>>,
+    allocated: FastMap<(ServiceMachineId, StateId), Option<usize>>,
     /// The last (rank, size) in the team's group this robot traced
     /// (`semo_group_set`); `None` before its first heartbeat.
     group: Option<(usize, usize)>,
@@ -466,6 +475,9 @@ struct Robot<'p> {
     /// the service graphs run so far (`loops.rs`).
     graphs: loops::GraphState,
 }
+
+/// What a heartbeat says: whether its robot leads, its battery, its term.
+type HeartbeatWords = (bool, Option<i64>, i64);
 
 /// A link `semo verify` disturbs ([`Sim::disturb`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -499,7 +511,7 @@ pub struct Sim<'p> {
     commands: Vec<Command>,
     /// The robots a message to a team or robot name goes to (`semo_comm_send`'s
     /// peer loop, computed once).
-    recipients: Rc<HashMap<String, Rc<[usize]>>>,
+    recipients: Rc<FastMap<String, Rc<[usize]>>>,
     /// Per robot (program).
     names: Rc<[Names]>,
     /// Per robot (program): the slots a firing reads its inputs into.
@@ -527,6 +539,10 @@ pub struct Sim<'p> {
     /// A send's arrivals (instant, order, robot, its epoch), kept between
     /// sends for its room: a send allocates no list of its own.
     arrivals: Vec<(i64, u64, usize, u32)>,
+    /// The robots of one of its instants, gathered here and copied into
+    /// their entry's list at once (collected straight, the list was made
+    /// twice: grown as a `Vec`, then copied into the `Rc`).
+    reached: Vec<(usize, u32)>,
 }
 
 impl<'p> Robot<'p> {
@@ -641,14 +657,15 @@ impl<'p> Robot<'p> {
             last_heartbeat: at - m.heartbeat_ms,
             heard: Hearing::new(team_peers(program)),
             leading: false,
+            said: None,
             term: 0,
             term_led: 0,
             rejoining: m.heartbeat && at > m.heartbeat_ms,
             fenced: None,
-            sync_pass: HashMap::new(),
-            sync_arrived: HashMap::new(),
-            leaders: HashMap::new(),
-            allocated: HashMap::new(),
+            sync_pass: FastMap::default(),
+            sync_arrived: FastMap::default(),
+            leaders: FastMap::default(),
+            allocated: FastMap::default(),
             group: None,
             tasks,
             has_receiver: m.has_receiver(),
@@ -738,6 +755,7 @@ impl<'p> Sim<'p> {
             channel_full: "channel full".into(),
             races: None,
             arrivals: Vec::new(),
+            reached: Vec::new(),
         };
         sim.inputs = sim.robots.iter().map(Inputs::of).collect();
         for r in 0..programs.len() {
@@ -961,6 +979,7 @@ impl<'p> Sim<'p> {
             key: command.key.as_str().into(),
             value: Some(Value::text(&command.value)),
             sent_at: self.now,
+            said: OnceCell::new(),
         });
         for r in 0..self.robots.len() {
             let p = self.robots[r].program;
@@ -1183,11 +1202,13 @@ impl<'p> Sim<'p> {
             key,
             value,
             sent_at: self.now,
+            said: OnceCell::new(),
         });
         // Each recipient in turn takes the next number of the queue's
         // order; those reached at the same instant share one entry, under
         // the first one's number (nothing else is numbered between them).
         let mut arrivals = std::mem::take(&mut self.arrivals);
+        let mut reached = std::mem::take(&mut self.reached);
         for &dst in targets.iter() {
             if dst == r {
                 continue;
@@ -1199,11 +1220,14 @@ impl<'p> Sim<'p> {
             arrivals.push((self.now + latency, self.seq, dst, self.robots[dst].epoch));
         }
         while let Some(&(at, tie, _, _)) = arrivals.first() {
-            let to: Rc<[(usize, u32)]> = arrivals
-                .iter()
-                .filter(|a| a.0 == at)
-                .map(|&(_, _, dst, epoch)| (dst, epoch))
-                .collect();
+            reached.clear();
+            reached.extend(
+                arrivals
+                    .iter()
+                    .filter(|a| a.0 == at)
+                    .map(|&(_, _, dst, epoch)| (dst, epoch)),
+            );
+            let to: Rc<[(usize, u32)]> = Rc::from(reached.as_slice());
             arrivals.retain(|a| a.0 != at);
             let message = message.clone();
             self.queue
@@ -1211,6 +1235,7 @@ impl<'p> Sim<'p> {
             self.queued += 1;
         }
         self.arrivals = arrivals;
+        self.reached = reached;
     }
 
     /// The latency of a message from `a` to `b` now, or `None` when it is lost.
@@ -1367,7 +1392,11 @@ impl<'p> Sim<'p> {
                 Some(Value::Text(t)) => t,
                 _ => "",
             };
-            let heard = Heard::parse(self.now, text);
+            let said = *message.said.get_or_init(|| Heard::parse(0, text));
+            let heard = Heard {
+                seen: self.now,
+                ..said
+            };
             if let Some(peer) = sender_peer(robot.program, message) {
                 robot.heard.set(peer, heard);
                 robot.term = robot.term.max(heard.term);
@@ -1740,14 +1769,19 @@ impl<'p> Sim<'p> {
             } else {
                 robot.term
             };
-            let value = heartbeat_value(robot.leading, own_battery(robot, self.now), term);
+            let words = (robot.leading, own_battery(robot, self.now), term);
+            let value = match &robot.said {
+                Some((said, value)) if *said == words => value.clone(),
+                _ => {
+                    let (leading, battery, term) = words;
+                    let value = Value::text(&heartbeat_value(leading, battery, term));
+                    self.robots[r].said = Some((words, value.clone()));
+                    value
+                }
+            };
             let names = &self.names[r];
-            let (team, key, value) = (
-                names.team.clone(),
-                names.alive_key.clone(),
-                Some(Value::text(&value)),
-            );
-            self.comm_send(r, team, true, key, value);
+            let (team, key) = (names.team.clone(), names.alive_key.clone());
+            self.comm_send(r, team, true, key, Some(value));
             self.group_update(r);
         }
         if self.robots[r].current_mode.is_none() {
@@ -1911,8 +1945,10 @@ impl<'p> Sim<'p> {
                 _ => at_least(self.now + CONTROL_PERIOD_MS),
             }
         }
-        // The next sensor sample that brings a new value.
-        for (i, s) in m.slots.iter().enumerate() {
+        // The next sensor sample that brings a new value (the slots a
+        // sensor feeds, listed once: not every slot of the program).
+        for &i in self.inputs[r].sensors.iter() {
+            let s = &m.slots[i];
             let (SlotSource::Sensor { port, task }, Some(series)) =
                 (&s.source, &robot.sensor_series[i])
             else {
@@ -2669,9 +2705,17 @@ impl Sim<'_> {
                 || now - robot.heard.get(peer).seen.max(robot.started_at)
                     <= crate::refine::protocol::lost_after_ms(m.heartbeat_ms)
         };
-        let live: Vec<PeerId> = m.group.iter().copied().filter(|&p| alive(p)).collect();
-        let rank = live.iter().position(|&p| p == me).unwrap_or(0);
-        let now_group = (rank, live.len());
+        // Its place among the live members (0 when it is none of them),
+        // and their number, counted without listing them.
+        let (mut rank, mut live) = (None, 0);
+        for &peer in m.group.iter().filter(|&&p| alive(p)) {
+            if peer == me && rank.is_none() {
+                rank = Some(live);
+            }
+            live += 1;
+        }
+        let rank = rank.unwrap_or(0);
+        let now_group = (rank, live);
         if self.robots[r].group == Some(now_group) {
             return;
         }
@@ -2681,7 +2725,7 @@ impl Sim<'_> {
             "group",
             smallvec![
                 ("rank", rank.to_string().into()),
-                ("size", live.len().to_string().into()),
+                ("size", live.to_string().into()),
             ],
         );
     }
@@ -2695,8 +2739,8 @@ fn own_battery(robot: &Robot<'_>, now: i64) -> Option<i64> {
 
 /// For every team and robot name, the robots (program indices) a message
 /// to that name goes to: the robots of the team, or the robot itself.
-fn recipients(programs: &[RobotProgram]) -> HashMap<String, Rc<[usize]>> {
-    let mut map: HashMap<String, Vec<usize>> = HashMap::new();
+fn recipients(programs: &[RobotProgram]) -> FastMap<String, Rc<[usize]>> {
+    let mut map: FastMap<String, Vec<usize>> = FastMap::default();
     for (i, p) in programs.iter().enumerate() {
         map.entry(p.team.clone()).or_default().push(i);
         if p.robot != p.team {

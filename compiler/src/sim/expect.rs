@@ -117,16 +117,20 @@ impl<'a> Digest<'a> {
         }
         self.last_line[r] = Some(e.t);
         self.timeline.see(e);
-        match (e.event, e.field("fault")) {
-            ("mode", _) => {
+        // By the event's name first: most events are none of these, and
+        // looking for a `fault` field in each cost a search of its fields.
+        match e.event {
+            "mode" => {
                 if let Some((_, mode)) = e.fields.iter().find(|(k, _)| *k == "mode") {
                     self.modes[r].push((e.t, mode.clone()));
                 }
             }
-            ("receive", _) => self.receive(e),
-            ("finish", _) => self.words[r] = Some(Word::Finished(e.t)),
-            ("fault", Some("kill")) => self.words[r] = Some(Word::Killed(e.t)),
-            ("start", _) => self.words[r] = Some(Word::Running),
+            "receive" => self.receive(e),
+            "finish" => self.words[r] = Some(Word::Finished(e.t)),
+            "fault" if e.field("fault") == Some("kill") => {
+                self.words[r] = Some(Word::Killed(e.t));
+            }
+            "start" => self.words[r] = Some(Word::Running),
             _ => {}
         }
     }
