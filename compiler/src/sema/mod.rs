@@ -25,6 +25,7 @@ mod declare;
 pub mod ir;
 pub(crate) mod lookup;
 mod params;
+mod results;
 mod values;
 
 pub use ir::*;
