@@ -232,6 +232,7 @@ pub fn control_task(program: &RobotProgram, words: &Words, peers: &Peers, header
             SlotSource::Sensor { task, .. } => format!("sensor task {task}"),
             SlotSource::Shared => "shared information (library)".into(),
             SlotSource::Local => "strategy variable".into(),
+            SlotSource::Result => "action result".into(),
         };
         let _ = writeln!(
             out,
@@ -433,7 +434,7 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
                     );
                 }
             }
-            SlotSource::Local => {}
+            SlotSource::Local | SlotSource::Result => {}
         }
     }
     if let Some(lib) = program.library.as_ref().filter(|l| l.ownership.is_some()) {
@@ -598,6 +599,7 @@ fn emit_state(
             args,
             timeout_ms,
             mark,
+            results: _,
         } => emit_call(out, &cx, service, task, args, timeout_ms, mark),
         StateKind::RunActions {
             service,

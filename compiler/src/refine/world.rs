@@ -23,6 +23,11 @@ pub struct CompiledScenario {
     pub sensors: Vec<(i64, String, String)>,
     /// (service, ms).
     pub services: Vec<(String, i64)>,
+    /// (service, what each of its calls gives back, in call order): the
+    /// `n`th call's values in the order of the service's results (`None`,
+    /// none); calls past the list give the last entry again, and a service
+    /// without one gives none.
+    pub results: Vec<(String, Vec<Vec<Option<String>>>)>,
     /// (at, level), in time order: the `BATTERY` value, linear between.
     pub battery: Vec<(i64, f64)>,
     /// (SDF/L loop path, the iteration whose exit task sets the exit flag).
