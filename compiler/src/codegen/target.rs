@@ -12,7 +12,7 @@
 
 use super::{Emit, Layer};
 use crate::diag::{Code, Diagnostic};
-use crate::refine::{RobotProgram, StateKind};
+use crate::refine::RobotProgram;
 use crate::refine::{BuildInput, robot_span};
 use crate::sema::Peer;
 use crate::targets::Chosen;
@@ -68,27 +68,6 @@ pub fn check(
                 d.related.extend(refused.related.iter().cloned());
                 found.push(d);
             }
-        }
-    }
-    // Action results are not carried by the generated programs yet: the
-    // simulator runs them (`semo simulate`), a build refuses them rather
-    // than leave the names none.
-    let mut refused_at = Vec::new();
-    for program in programs {
-        let binding = program.control.services.iter().flat_map(|s| &s.states).filter(
-            |state| matches!(&state.kind, StateKind::Call { results, .. } if !results.is_empty()),
-        );
-        for state in binding {
-            if refused_at.contains(&state.span) {
-                continue;
-            }
-            refused_at.push(state.span);
-            found.push(Diagnostic::new(
-                Code::CodegenUnsupported,
-                build.mission,
-                state.span,
-                "code generation does not support action results (`FOUND, WHERE = search(...)`) yet: `semo simulate` runs them",
-            ));
         }
     }
     let on_static = || {
