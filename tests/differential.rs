@@ -804,7 +804,11 @@ fn modes_with_parameters_run_the_same_in_c_and_in_the_simulator() {
 fn action_results_are_the_same_in_c_and_in_the_simulator() {
     let fixtures = repo_root().join("tests/fixtures/action_results");
     let scenario = std::fs::read_to_string(fixtures.join("survey.scenario.json")).unwrap();
-    let (_, sim) = compare("action_results", &fixtures.join("survey.mission"), &scenario);
+    let (_, sim) = compare(
+        "action_results",
+        &fixtures.join("survey.mission"),
+        &scenario,
+    );
     let wheres: Vec<&str> = events_of(&sim, "ti", "result")
         .into_iter()
         .filter(|e| field(e, "name") == "WHERE")

@@ -800,8 +800,15 @@ fn action_results_take_the_scenario_s_values_call_by_call() {
     let lines: Vec<String> = out
         .stdout
         .lines()
-        .filter(|l| ["result", "send", "timeout", "call_start"].iter().any(|e| l.contains(&format!("\"event\":\"{e}\""))))
-        .map(|l| l.replace("{\"t\":", "").replace(",\"robot\":\"ti\",\"event\":", " "))
+        .filter(|l| {
+            ["result", "send", "timeout", "call_start"]
+                .iter()
+                .any(|e| l.contains(&format!("\"event\":\"{e}\"")))
+        })
+        .map(|l| {
+            l.replace("{\"t\":", "")
+                .replace(",\"robot\":\"ti\",\"event\":", " ")
+        })
         .collect();
     let expected = [
         r#"0 "call_start","task":"search","service":"search","arg":"red paper"}"#,

@@ -218,10 +218,12 @@ fn text(listed: &[Listed<'_>], files: &Files) -> String {
         if !robot.doc.is_empty() {
             text.push_str(&format!("  {}\n", robot.doc));
         }
-        let services = robot
-            .services
-            .iter()
-            .map(|s| (format!("{}{}{}", s.signature(), gives(s), also(&s.aliases)), &s.doc));
+        let services = robot.services.iter().map(|s| {
+            (
+                format!("{}{}{}", s.signature(), gives(s), also(&s.aliases)),
+                &s.doc,
+            )
+        });
         section(&mut text, "services:", services.collect());
         let values = robot.values.iter().map(|v| {
             let unit = v.unit.as_ref().map_or(String::new(), |u| format!(" ({u})"));

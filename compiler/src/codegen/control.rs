@@ -39,7 +39,9 @@ const RECEIVE_TIMEOUT: Template = template!(
 );
 const CALL_REQUEST: Template = template!(
     "control/call_request.c.in",
-    ["port", "task", "service", "argc", "args", "mark", "wake", "started"]
+    [
+        "port", "task", "service", "argc", "args", "mark", "wake", "started"
+    ]
 );
 const CALL_TIMEOUT: Template = template!(
     "control/call_timeout.c.in",

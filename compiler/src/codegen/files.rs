@@ -1157,7 +1157,11 @@ fn scenario_extra_tables(
                     .iter()
                     .map(|v| v.as_deref().map_or("NULL".to_string(), c::string))
                     .collect();
-                let texts = if texts.is_empty() { vec!["NULL".to_string()] } else { texts };
+                let texts = if texts.is_empty() {
+                    vec!["NULL".to_string()]
+                } else {
+                    texts
+                };
                 let _ = writeln!(
                     tables,
                     "static const char *const results_{i}_{k}[] = {{{}}};",
@@ -1184,7 +1188,11 @@ fn scenario_extra_tables(
         }
         tables.push_str("static const semo__sim_results_entry results[] = {\n");
         tables.extend(entries.iter().map(String::as_str));
-        let _ = writeln!(tables, "}};\nstatic size_t results_done[{}];", entries.len());
+        let _ = writeln!(
+            tables,
+            "}};\nstatic size_t results_done[{}];",
+            entries.len()
+        );
         let _ = writeln!(
             fields,
             "    .results = results,\n    .results_done = results_done,\n    .results_count = {},",

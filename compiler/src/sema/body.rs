@@ -145,7 +145,10 @@ enum Resolution {
         name: Name,
     },
     /// A result name the function's (else the service's) body binds.
-    Result { owner: ParamOwner, index: u32 },
+    Result {
+        owner: ParamOwner,
+        index: u32,
+    },
 }
 
 /// A value read or sent by robots of which some lack it: E033 unless their

@@ -460,7 +460,7 @@ struct Robot<'p> {
     /// The scenario's time of each service (the last entry of a name counts).
     service_ms: Rc<[(String, i64)]>,
     /// The scenario's results of each service's calls, in call order.
-    service_results: Rc<[(String, Vec<Vec<Option<String>>>)]>,
+    service_results: Rc<[(String, crate::refine::CallResults)]>,
     /// How many calls of each service (with results in the scenario) were
     /// done, to pick the next one's results.
     calls_done: Vec<u64>,
@@ -668,8 +668,7 @@ impl<'p> Robot<'p> {
             sensor_series,
             battery: world.map_or_else(|| Rc::from([]), |w| Rc::from(w.battery.as_slice())),
             service_ms: world.map_or_else(|| Rc::from([]), |w| Rc::from(w.services.as_slice())),
-            service_results: world
-                .map_or_else(|| Rc::from([]), |w| Rc::from(w.results.as_slice())),
+            service_results: world.map_or_else(|| Rc::from([]), |w| Rc::from(w.results.as_slice())),
             calls_done: vec![0; world.map_or(0, |w| w.results.len())],
             chain: 0,
             next_fire: None,
@@ -1611,7 +1610,9 @@ impl<'p> Sim<'p> {
         let t = self.robots[r].task_index(task);
         let reply = self.robots[r].tasks[t].1.reply.clone();
         for (k, slot) in results.iter().enumerate() {
-            let text = reply.as_ref().and_then(|values| values.get(k).cloned().flatten());
+            let text = reply
+                .as_ref()
+                .and_then(|values| values.get(k).cloned().flatten());
             let decl = &m.slots[slot.index()];
             let value = text.and_then(|text| decl.kind.parse(&text));
             self.store(r, *slot, value.clone());
@@ -1619,7 +1620,10 @@ impl<'p> Sim<'p> {
                 t: self.now,
                 robot: r,
                 event: "result",
-                fields: smallvec![("service", service.into()), ("name", result_name(&decl.key))],
+                fields: smallvec![
+                    ("service", service.into()),
+                    ("name", result_name(&decl.key))
+                ],
                 value: Some(("value", value)),
                 sent_at: None,
             });

@@ -105,7 +105,7 @@ pub struct RobotWorld {
     pub services: Vec<(String, i64)>,
     /// (service, what each call gives back, in call order): see
     /// [`crate::refine::CompiledScenario::results`].
-    pub results: Vec<(String, Vec<Vec<Option<String>>>)>,
+    pub results: Vec<(String, crate::refine::CallResults)>,
     /// (at, level): the `BATTERY` sensor value, linear between points.
     pub battery: Vec<(i64, f64)>,
     /// (SDF/L loop path, iteration): when a convergent loop's exit task
@@ -629,7 +629,7 @@ fn ms(v: &Value, key: &str, min: i64) -> Result<i64> {
 /// A service's `results`: per call, in call order, an array of what it
 /// gives back in the order of the service's results (`true`, `"3,4"`, `2`;
 /// `null` for none).
-fn call_results(v: &Value) -> Result<Vec<Vec<Option<String>>>> {
+fn call_results(v: &Value) -> Result<crate::refine::CallResults> {
     const WHAT: &str = "an array of each call's results, [[true, \"3,4\"], [false]]";
     let mut calls = Vec::new();
     for call in array(v, WHAT)? {
@@ -914,7 +914,9 @@ impl Reader<'_> {
                         world.services.push((service.clone(), t));
                     }
                     if let Some(results) = d.member("results") {
-                        world.results.push((service.clone(), call_results(results)?));
+                        world
+                            .results
+                            .push((service.clone(), call_results(results)?));
                     }
                     continue;
                 }

@@ -584,7 +584,8 @@ mod tests {
         let ast::StmtKind::Call(call) = &first.kind else {
             panic!("{first:?}")
         };
-        let results: Vec<(&str, Span)> = call.results.iter().map(|r| (r.as_str(), r.span)).collect();
+        let results: Vec<(&str, Span)> =
+            call.results.iter().map(|r| (r.as_str(), r.span)).collect();
         assert_eq!(results, [("F", Span::new(8, 9)), ("W", Span::new(11, 12))]);
         assert_eq!(call.name.as_str(), "search");
         assert!(call.timeout.is_some());

@@ -684,9 +684,18 @@ fn a_service_lists_its_results_in_order_each_checked_as_a_value() {
     let service = |results: &str| wrap(&format!("<Service name=\"s\">{results}</Service>"));
     let twice = service("<Result name=\"F\" type=\"bool\"/><Result name=\"F\" type=\"int\"/>");
     assert_eq!(codes(&twice), ["E053"]);
-    assert_eq!(codes(&service("<Result name=\"a b\" type=\"bool\"/>")), ["E056"]);
-    assert_eq!(codes(&service("<Result name=\"F\" type=\"boolean\"/>")), ["E054"]);
+    assert_eq!(
+        codes(&service("<Result name=\"a b\" type=\"bool\"/>")),
+        ["E056"]
+    );
+    assert_eq!(
+        codes(&service("<Result name=\"F\" type=\"boolean\"/>")),
+        ["E054"]
+    );
     assert_eq!(codes(&service("<Result name=\"F\"/>")), ["E052"]);
-    assert_eq!(codes(&service("<Result name=\"F\" type=\"enum\"/>")), ["E056"]);
+    assert_eq!(
+        codes(&service("<Result name=\"F\" type=\"enum\"/>")),
+        ["E056"]
+    );
     assert_eq!(codes(&wrap("<Result name=\"F\" type=\"bool\"/>")), ["E051"]);
 }

@@ -332,8 +332,14 @@ fn result_clash(
             r.name
         ));
     }
-    if mission.teams.iter().any(|t| t.variables.iter().any(|v| v == new)) {
-        return Some(format!("`{new}` is a team variable: the result would hide it"));
+    if mission
+        .teams
+        .iter()
+        .any(|t| t.variables.iter().any(|v| v == new))
+    {
+        return Some(format!(
+            "`{new}` is a team variable: the result would hide it"
+        ));
     }
     None
 }

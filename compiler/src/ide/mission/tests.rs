@@ -846,7 +846,10 @@ fn action_results_in_the_editor() {
     let config = CompletionConfig { snippets: true };
     let after = text.find("if (FOUND").unwrap() + 4;
     let items = completions(&analysis, catalog, text, after, config);
-    assert_eq!(labels_of(&items, CompletionKind::Result), ["FOUND", "WHERE"]);
+    assert_eq!(
+        labels_of(&items, CompletionKind::Result),
+        ["FOUND", "WHERE"]
+    );
     assert_eq!(labels_of(&items, CompletionKind::Parameter), ["TARGET"]);
     let before = text.find("FOUND, WHERE").unwrap();
     let items = completions(&analysis, catalog, text, before, config);
@@ -854,11 +857,20 @@ fn action_results_in_the_editor() {
 
     let read = text.find("move(WHERE)").unwrap() + 6;
     let clash = super::rename::rename(&analysis, catalog, text, read, "FOUND").unwrap_err();
-    assert!(clash.to_string().contains("already binds a result `FOUND`"), "{clash}");
+    assert!(
+        clash.to_string().contains("already binds a result `FOUND`"),
+        "{clash}"
+    );
     let clash = super::rename::rename(&analysis, catalog, text, read, "TARGET").unwrap_err();
-    assert!(clash.to_string().contains("already has a parameter"), "{clash}");
+    assert!(
+        clash.to_string().contains("already has a parameter"),
+        "{clash}"
+    );
     let clash = super::rename::rename(&analysis, catalog, text, read, "LOCATION").unwrap_err();
-    assert!(clash.to_string().contains("has a value `LOCATION`"), "{clash}");
+    assert!(
+        clash.to_string().contains("has a value `LOCATION`"),
+        "{clash}"
+    );
 
     let tokens = super::semantic_tokens::semantic_tokens(&analysis, None);
     let variables: Vec<&str> = tokens
