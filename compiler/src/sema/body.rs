@@ -982,12 +982,8 @@ impl<'a> Checker<'a> {
                     name: name.name.clone(),
                 };
             }
-            let results = self.mission.results(owner);
-            if let Some(index) = results.iter().position(|r| r.name == name.name) {
-                return Resolution::Result {
-                    owner,
-                    index: index as u32,
-                };
+            if let Some(index) = self.result_of(owner, &name.name) {
+                return Resolution::Result { owner, index };
             }
         }
         match attr.segments.as_slice() {

@@ -29,15 +29,15 @@ impl<'a> Checker<'a> {
         body: &ast::Block,
     ) -> Vec<ResultInfo> {
         let mut results: Vec<ResultInfo> = Vec::new();
-        let mut index: FastMap<Name, usize> = FastMap::default();
         let mut calls = Vec::new();
         bindings(body, &mut calls);
         for call in calls {
             for name in &call.results {
-                if index.contains_key(&name.name) {
+                let key = (owner, name.name.clone());
+                if self.result_index.contains_key(&key) {
                     continue;
                 }
-                index.insert(name.name.clone(), results.len());
+                self.result_index.insert(key, results.len() as u32);
                 let symbol = Symbol::Result {
                     owner,
                     index: results.len() as u32,
@@ -96,6 +96,11 @@ impl<'a> Checker<'a> {
             self.diagnostics
                 .report(Code::ParameterHidesName, span, message);
         }
+    }
+
+    /// The index of `name` among the results `owner`'s body binds.
+    pub(super) fn result_of(&self, owner: ParamOwner, name: &Name) -> Option<u32> {
+        self.result_index.get(&(owner, name.clone())).copied()
     }
 
     /// A function's call that binds names: E049 (functions give nothing back).
@@ -194,14 +199,10 @@ impl<'a> Checker<'a> {
         service: &Name,
         result: &ResultDef,
     ) {
-        let Some(index) = self
-            .mission
-            .results(owner)
-            .iter()
-            .position(|r| r.name == name.name)
-        else {
+        let Some(&index) = self.result_index.get(&(owner, name.name.clone())) else {
             return;
         };
+        let index = index as usize;
         let symbol = Symbol::Result {
             owner,
             index: index as u32,
