@@ -793,3 +793,26 @@ fn modes_with_parameters_run_the_same_in_c_and_in_the_simulator() {
         .collect();
     assert_eq!(started, ["Go(kitchen, 2)", "Beat", "Look(hall door)"]);
 }
+
+/// Action results (`tests/fixtures/action_results/survey.mission`): the
+/// generated C's service task gives back the scenario's results call by
+/// call (`semo_sim_results`, `semo_reply`), and its control task stores and
+/// traces them as the simulator does, event for event: the entries past
+/// the list, a function's call, a call stopped by its timeout whose result
+/// stays none.
+#[test]
+fn action_results_are_the_same_in_c_and_in_the_simulator() {
+    let fixtures = repo_root().join("tests/fixtures/action_results");
+    let scenario = std::fs::read_to_string(fixtures.join("survey.scenario.json")).unwrap();
+    let (_, sim) = compare(
+        "action_results",
+        &fixtures.join("survey.mission"),
+        &scenario,
+    );
+    let wheres: Vec<&str> = events_of(&sim, "ti", "result")
+        .into_iter()
+        .filter(|e| field(e, "name") == "WHERE")
+        .map(|e| e.get("value").and_then(|v| v.as_str()).unwrap_or("none"))
+        .collect();
+    assert_eq!(wheres, ["3,4", "none", "7", "7"]);
+}

@@ -779,3 +779,80 @@ fn a_service_shared_by_teams_runs_and_builds_as_one_copy_per_team() {
         assert!(trace.contains(&started), "{robot} runs Search:\n{trace}");
     }
 }
+
+/// Action results (`FOUND, WHERE = search(...)`): each call done takes the
+/// scenario's next entry for its service (a function's call too), the last
+/// one again past the list; a call stopped by its timeout gives nothing back
+/// and takes no entry, so its result stays none; what a result took is
+/// traced (`result`) and decides what the robot does next.
+#[test]
+fn action_results_take_the_scenario_s_values_call_by_call() {
+    let fixtures = repo_root().join("tests/fixtures/action_results");
+    let out = semo(&[
+        "simulate",
+        &fixtures.join("survey.mission").display().to_string(),
+        "--scenario",
+        &fixtures.join("survey.scenario.json").display().to_string(),
+        "--trace",
+        "-",
+    ]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let lines: Vec<String> = out
+        .stdout
+        .lines()
+        .filter(|l| {
+            ["result", "send", "timeout", "call_start"]
+                .iter()
+                .any(|e| l.contains(&format!("\"event\":\"{e}\"")))
+        })
+        .map(|l| {
+            l.replace("{\"t\":", "")
+                .replace(",\"robot\":\"ti\",\"event\":", " ")
+        })
+        .collect();
+    let expected = [
+        r#"0 "call_start","task":"search","service":"search","arg":"red paper"}"#,
+        r#"200 "result","service":"search","name":"FOUND","value":true}"#,
+        r#"200 "result","service":"search","name":"WHERE","value":"3,4"}"#,
+        r#"200 "call_start","task":"wheel","service":"move","arg":"3,4"}"#,
+        r#"300 "send","to":"USER","key":"R.Spot","value":"3,4"}"#,
+        r#"1000 "call_start","task":"search","service":"search","arg":"red paper"}"#,
+        r#"1200 "result","service":"search","name":"FOUND","value":false}"#,
+        r#"1200 "result","service":"search","name":"WHERE","value":null}"#,
+        r#"1200 "call_start","task":"search","service":"search","arg":"blue"}"#,
+        r#"1310 "timeout","service":"search"}"#,
+        r#"1310 "send","to":"USER","key":"R.Spot","value":null}"#,
+        r#"2000 "call_start","task":"search","service":"search","arg":"red paper"}"#,
+        r#"2200 "result","service":"search","name":"FOUND","value":true}"#,
+        r#"2200 "result","service":"search","name":"WHERE","value":"7"}"#,
+        r#"2200 "call_start","task":"wheel","service":"move","arg":"7"}"#,
+        r#"2300 "send","to":"USER","key":"R.Spot","value":"7"}"#,
+        r#"3000 "call_start","task":"search","service":"search","arg":"red paper"}"#,
+        r#"3200 "result","service":"search","name":"FOUND","value":true}"#,
+        r#"3200 "result","service":"search","name":"WHERE","value":"7"}"#,
+        r#"3200 "call_start","task":"wheel","service":"move","arg":"7"}"#,
+        r#"3300 "send","to":"USER","key":"R.Spot","value":"7"}"#,
+    ];
+    assert_eq!(lines, expected, "{}", out.stdout);
+
+    // A result that is not an array of values is refused with its position.
+    let dir = scratch("results");
+    let scenario = write(
+        &dir,
+        "bad.scenario.json",
+        r#"{"robots": {"ti": {"services": {"search": {"ms": 10, "results": [[{"x": 1}]]}}}}}"#,
+    );
+    let bad = semo(&[
+        "simulate",
+        &fixtures.join("survey.mission").display().to_string(),
+        "--scenario",
+        &scenario,
+    ]);
+    assert_eq!(bad.code, 2, "{}", bad.stderr);
+    assert!(
+        bad.stderr
+            .contains(":1:67: a result is true, false, a number, a string or null"),
+        "{}",
+        bad.stderr
+    );
+}

@@ -218,10 +218,12 @@ fn text(listed: &[Listed<'_>], files: &Files) -> String {
         if !robot.doc.is_empty() {
             text.push_str(&format!("  {}\n", robot.doc));
         }
-        let services = robot
-            .services
-            .iter()
-            .map(|s| (format!("{}{}", s.signature(), also(&s.aliases)), &s.doc));
+        let services = robot.services.iter().map(|s| {
+            (
+                format!("{}{}{}", s.signature(), gives(s), also(&s.aliases)),
+                &s.doc,
+            )
+        });
         section(&mut text, "services:", services.collect());
         let values = robot.values.iter().map(|v| {
             let unit = v.unit.as_ref().map_or(String::new(), |u| format!(" ({u})"));
@@ -275,4 +277,12 @@ fn document_fields(listed: &[Listed<'_>], files: &Files) -> serde_json::Value {
         Listed::Robot(_) => None,
     });
     serde_json::json!({ "robots": robots, "operator": operator })
+}
+
+/// ` -> FOUND: bool, WHERE: location` after a service that gives results back.
+fn gives(s: &semo::catalog::ServiceDef) -> String {
+    match s.results.is_empty() {
+        true => String::new(),
+        false => format!(" -> {}", s.results_signature()),
+    }
 }

@@ -116,8 +116,9 @@ codes! {
     CountedGroupsTooLarge = "E039", Error, "counted groups whose minimums add up to more robots than run the statement: they can never all be met";
     CountedGroupMixed = "E043", Error, "a counted group (`group(Name, min = N)`) beside an `instance of`/`capable of` group or a `leader` arm in one statement, or a `leader` arm with a count";
     DuplicateParameter = "E044", Error, "a function, composite service or mode with two parameters of the same name";
-    ParameterHidesName = "E045", Error, "a parameter (of a function, composite service or mode) named like a value robots read or a team variable: where used the name would mean the parameter, hiding the other";
+    ParameterHidesName = "E045", Error, "a parameter (of a function, composite service or mode) or an action result named like a value robots read or a team variable (a result also like a parameter): where used the name would mean the parameter or the result, hiding the other";
     ModeArgumentCount = "E046", Error, "a mode entered (`mode = MOVE(kitchen)`) or a composite service set (`set(Action, Go(kitchen))`) with more or fewer arguments than its parameters, or with arguments it does not take";
+    ResultsNotGiven = "E049", Error, "a call that binds names its service does not give back: more names than the service's results, a function's call (functions give nothing back), a result named twice in one list, robots running the call whose types give different results, or one name bound to results of different types";
     ModeCopiesPastLimit = "E048", Error, "modes entered with so many distinct lists of arguments that their copies would hold more than 65,536 `set`s and catches in all";
     ArgumentNotFixed = "E047", Error, "an argument of a mode entered or of a service set that is not known when the mission is written (a value robots read, a team variable, an expression): each list of arguments is a mode of its own";
     TooManyRobots = "E036", Error, "`name[N]` with N above 4096, or a mission with more than 4096 robots in all";
@@ -233,6 +234,7 @@ codes! {
     EmptyOthers = "W012", Warning, "an `others` block that no robot is left to run";
     CountedGroupsNoSpare = "W014", Hint, "counted groups whose minimums take every robot that runs the statement: a robot lost leaves a group short";
     ParameterNeverUsed = "W015", Warning, "a parameter that is never used (a function's or a composite service's in its body, a mode's in its `set`s): its argument is given for nothing";
+    ResultReadBeforeBound = "W016", Warning, "an action result read where no call written before it binds the name: until a call binding it is done, it is none";
     BroadcastToNoOne = "W013", Hint, "a `throw E broadcast` that only one robot runs: its group (or team) has no one else to tell";
     ComparisonNeverHolds = "W020", Warning, "a comparison of a team variable with a value it is never set to: it never holds";
     ComparisonAlwaysHolds = "W021", Warning, "`!=` between a team variable and a value it is never set to: it holds whenever the variable has a value";

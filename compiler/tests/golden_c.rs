@@ -48,7 +48,8 @@ const EXAMPLES: &[(&str, &str, Option<&str>)] = &[
 /// examples do not generate: graph services with loops and sub-graphs,
 /// counted groups, group synchronisation, group services, globally shared
 /// values with battery policies, broadcast events, a relay receiving from
-/// another team, a team on the static schedule. As [`EXAMPLES`].
+/// another team, a team on the static schedule, action results. As
+/// [`EXAMPLES`].
 const FIXTURES: &[(&str, &str, Option<&str>)] = &[
     (
         "fixture-loops",
@@ -86,6 +87,11 @@ const FIXTURES: &[(&str, &str, Option<&str>)] = &[
         "fixture-cortex_m-swarm",
         "cortex_m/swarm.mission",
         Some("cortex_m/swarm.scenario.json"),
+    ),
+    (
+        "fixture-action_results",
+        "action_results/survey.mission",
+        Some("action_results/survey.scenario.json"),
     ),
 ];
 

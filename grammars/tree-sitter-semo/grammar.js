@@ -198,10 +198,14 @@ module.exports = grammar({
     ),
 
     call: $ => seq(
+      optional(field('results', $.results)),
       field('function', $.identifier),
       field('arguments', $.arguments),
       optional(seq(',', $.timeout)),
     ),
+
+    /** `FOUND, WHERE =` before a call: the names bound to its service's results. */
+    results: $ => seq(commaSep1(field('name', $.identifier)), '='),
 
     arguments: $ => seq('(', commaSep(choice($._expression, $.words)), ')'),
 

@@ -71,7 +71,7 @@ pub fn completion_kind(kind: CompletionKind) -> CompletionItemKind {
     match kind {
         K::BuiltinService | K::Function => CompletionItemKind::FUNCTION,
         K::Value | K::Port => CompletionItemKind::FIELD,
-        K::TeamVariable | K::Robot | K::Parameter => CompletionItemKind::VARIABLE,
+        K::TeamVariable | K::Robot | K::Parameter | K::Result => CompletionItemKind::VARIABLE,
         K::Team | K::User | K::Task => CompletionItemKind::MODULE,
         K::RobotType | K::Element => CompletionItemKind::CLASS,
         K::Capability | K::Attribute => CompletionItemKind::PROPERTY,

@@ -188,12 +188,24 @@ pub struct ParamDef {
     pub optional: bool,
 }
 
+/// One result of a `<Service>`: a value the service's task gives back when
+/// a call is done, which a mission binds to a name
+/// (`FOUND, WHERE = search(red)`, `docs/language/services.md`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ResultDef {
+    pub name: String,
+    pub ty: ValueType,
+    pub doc: String,
+}
+
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ServiceDef {
     pub name: String,
     /// Other accepted spellings (`stand_by` for `standby`).
     pub aliases: Vec<String>,
     pub params: Vec<ParamDef>,
+    /// What a call gives back when it is done, in order (`<Result>`).
+    pub results: Vec<ResultDef>,
     pub doc: String,
     pub implementation: Implementation,
     /// The latency bounds stated on its task graph (`<Latency>`; only a
@@ -215,6 +227,17 @@ impl ServiceDef {
             .map(|p| format!("{}{}: {}", p.name, if p.optional { "?" } else { "" }, p.ty))
             .collect();
         format!("{}({})", self.name, params.join(", "))
+    }
+
+    /// `FOUND: bool, WHERE: location`, for hovers and messages; empty
+    /// when the service gives nothing back.
+    pub fn results_signature(&self) -> String {
+        let results: Vec<String> = self
+            .results
+            .iter()
+            .map(|r| format!("{}: {}", r.name, r.ty))
+            .collect();
+        results.join(", ")
     }
 }
 

@@ -69,7 +69,7 @@ pub const ELEMENTS: &[ElementInfo] = &[
     ElementInfo {
         name: "Service",
         attributes: &["name", "task", "graph", "doc", "aliases"],
-        children: &["Doc", "Param", "Latency"],
+        children: &["Doc", "Param", "Result", "Latency"],
         belongs: IN_ROBOT,
     },
     ElementInfo {
@@ -77,6 +77,12 @@ pub const ELEMENTS: &[ElementInfo] = &[
         attributes: &["from", "to", "max"],
         children: &[],
         belongs: "inside a `<Service>` implemented by a task graph (`graph=`)",
+    },
+    ElementInfo {
+        name: "Result",
+        attributes: &["name", "type", "domain", "doc"],
+        children: &[],
+        belongs: "inside `<Service>`",
     },
     ElementInfo {
         name: "Param",

@@ -12,7 +12,8 @@
 use super::latency::{self, LatencyBound};
 use super::schema::{self, TYPE_NAMES};
 use super::{
-    Implementation, Origin, ParamDef, Platform, RobotType, ServiceDef, ValueDef, ValueType,
+    Implementation, Origin, ParamDef, Platform, ResultDef, RobotType, ServiceDef, ValueDef,
+    ValueType,
 };
 use crate::diag::{Code, Diagnostic, FileId, Sink};
 use crate::span::Span;
@@ -151,6 +152,8 @@ struct ItemBuild<T> {
     /// Where the item was documented (`doc=` or an earlier `<Doc>`).
     doc_at: Option<Span>,
     param_names: HashMap<String, Span>,
+    /// A service's results by name, to where each is first written.
+    result_names: HashMap<String, Span>,
     /// The first optional parameter seen, for "required after optional".
     optional_seen: bool,
 }
@@ -161,6 +164,7 @@ impl<T> ItemBuild<T> {
             def,
             doc_at,
             param_names: HashMap::new(),
+            result_names: HashMap::new(),
             optional_seen: false,
         }
     }
@@ -526,6 +530,7 @@ impl Reader<'_, '_> {
                     name: name.0,
                     aliases,
                     params: Vec::new(),
+                    results: Vec::new(),
                     doc,
                     implementation,
                     latency: Vec::new(),
@@ -535,6 +540,7 @@ impl Reader<'_, '_> {
         let mut item = ItemBuild::new(def, doc_at);
         self.content(e, |r, c| match c.local.as_str() {
             "Param" => r.param(c, &mut item),
+            "Result" => r.result(c, &mut item),
             "Latency" => r.latency(c, &mut item),
             _ => r.item_doc(c, "Service", &mut item),
         });
@@ -610,6 +616,33 @@ impl Reader<'_, '_> {
             self.add_param(service, name, span, ty, optional);
         }
         self.leaf(e);
+    }
+
+    /// A `<Result>` of a service: a name missions bind (an identifier, E056
+    /// otherwise; twice in one service E053) and a value type, read as a
+    /// `<Value>`'s.
+    fn result(&mut self, e: &Elem, service: &mut ItemBuild<ServiceDef>) {
+        self.check_attributes(e);
+        let name = self.name_attr(e, "name");
+        let ty = self.required(e, "type").map(|t| self.value_type(t, e));
+        let (doc, _) = doc_attr(e);
+        self.leaf(e);
+        let (Some((name, span)), Some(ty)) = (name, ty) else {
+            return;
+        };
+        if let Some(&first) = service.result_names.get(&name) {
+            duplicate(
+                &mut self.sink,
+                span,
+                first,
+                format!("this service already has a result `{name}`"),
+            );
+            return;
+        }
+        service.result_names.insert(name.clone(), span);
+        if let Some(def) = service.def.as_mut() {
+            def.results.push(ResultDef { name, ty, doc });
+        }
     }
 
     fn add_param(

@@ -15,7 +15,7 @@ use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms,
 use crate::refine::{
     ActionMachine, ActionMachineId, ControlMachine, CountedGroup, Expr, IncomingId,
     LeaderAlgorithm, MarkId, ModeId, Operand, OutgoingId, PeerId, RobotProgram, SendItem, SlotId,
-    SlotSource, State, StateId, StateKind, SubscriptionId, SyncPointId,
+    SlotSource, State, StateId, StateKind, SubscriptionId, SyncPointId, ValueKind,
 };
 use std::fmt::Write;
 
@@ -39,13 +39,16 @@ const RECEIVE_TIMEOUT: Template = template!(
 );
 const CALL_REQUEST: Template = template!(
     "control/call_request.c.in",
-    ["port", "task", "service", "argc", "args", "mark", "wake"]
+    [
+        "port", "task", "service", "argc", "args", "mark", "wake", "started"
+    ]
 );
 const CALL_TIMEOUT: Template = template!(
     "control/call_timeout.c.in",
     ["mark", "t", "task", "service"]
 );
-const CALL_WAIT: Template = template!("control/call_wait.c.in", ["task", "next"]);
+const CALL_WAIT: Template = template!("control/call_wait.c.in", ["task", "next", "taken"]);
+const REPLIES: Template = template!("control/replies.c.in", ["tasks", "most", "names"]);
 const ACTIONS_ENTER: Template =
     template!("control/actions_enter.c.in", ["initial", "mark", "service"]);
 const ACTIONS_TIMEOUT: Template = template!(
@@ -133,6 +136,7 @@ pub(super) const TEMPLATES: &[Template] = &[
     CALL_REQUEST,
     CALL_TIMEOUT,
     CALL_WAIT,
+    REPLIES,
     ACTIONS_ENTER,
     ACTIONS_TIMEOUT,
     ACTIONS_RUN,
@@ -232,6 +236,7 @@ pub fn control_task(program: &RobotProgram, words: &Words, peers: &Peers, header
             SlotSource::Sensor { task, .. } => format!("sensor task {task}"),
             SlotSource::Shared => "shared information (library)".into(),
             SlotSource::Local => "strategy variable".into(),
+            SlotSource::Result => "action result".into(),
         };
         let _ = writeln!(
             out,
@@ -433,7 +438,7 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
                     );
                 }
             }
-            SlotSource::Local => {}
+            SlotSource::Local | SlotSource::Result => {}
         }
     }
     if let Some(lib) = program.library.as_ref().filter(|l| l.ownership.is_some()) {
@@ -489,6 +494,28 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
 
     if uses("request") {
         out.push_str(REQUEST.text);
+    }
+
+    if uses("take_result") {
+        let most = m
+            .services
+            .iter()
+            .flat_map(|s| &s.states)
+            .filter_map(|state| match &state.kind {
+                StateKind::Call { results, .. } => Some(results.len()),
+                _ => None,
+            })
+            .max()
+            .unwrap_or(0);
+        let names: Vec<String> = m.request_tasks.iter().map(|t| c::string(t)).collect();
+        out.push_str(&fill(
+            &REPLIES,
+            &[
+                ("tasks", &m.request_tasks.len()),
+                ("most", &most),
+                ("names", &names.join(", ")),
+            ],
+        ));
     }
 }
 
@@ -598,7 +625,8 @@ fn emit_state(
             args,
             timeout_ms,
             mark,
-        } => emit_call(out, &cx, service, task, args, timeout_ms, mark),
+            results,
+        } => emit_call(out, &cx, service, task, args, (timeout_ms, mark), results),
         StateKind::RunActions {
             service,
             machine,
@@ -769,8 +797,8 @@ fn emit_call(
     service: &str,
     task: &str,
     args: &[Operand],
-    timeout_ms: &Option<i64>,
-    mark: &MarkId,
+    (timeout_ms, mark): (&Option<i64>, &MarkId),
+    results: &[SlotId],
 ) {
     let StateCx {
         program,
@@ -794,6 +822,7 @@ fn emit_call(
             ("args", &args_array(args, words)),
             ("mark", &mark),
             ("wake", &wake),
+            ("started", &results_none(port, results)),
         ],
     ));
     if let Some(t) = timeout_ms {
@@ -807,10 +836,67 @@ fn emit_call(
             ],
         ));
     }
+    let taken = results_taken(cx, service, port, results);
+    let taken = match (timeout_ms, taken.is_empty()) {
+        (Some(t), false) => format!(
+            "\n        if (semo_now_ms() - r->mark[{mark}] <= {t}) {{{}\n        }}",
+            taken.replace("\n        ", "\n            ")
+        ),
+        _ => taken,
+    };
     out.push_str(&fill(
         &CALL_WAIT,
-        &[("task", &c::string(task)), ("next", &next)],
+        &[
+            ("task", &c::string(task)),
+            ("next", &next),
+            ("taken", &taken),
+        ],
     ));
+}
+
+/// A call binding results starts: they are none, and so is what its task
+/// last gave back, until the call is done.
+fn results_none(port: usize, results: &[SlotId]) -> String {
+    if results.is_empty() {
+        return String::new();
+    }
+    let mut out = format!("\n            reply_count[{port}] = 0;");
+    for slot in results {
+        let _ = write!(out, "\n            slot[{slot}].type = SEMO_NONE;");
+    }
+    out
+}
+
+/// A call binding results is done: each slot takes what the task gave
+/// back, read as the slot's type (`take_result`), and is traced as the
+/// simulator traces it (`result`).
+fn results_taken(cx: &StateCx, service: &str, port: usize, results: &[SlotId]) -> String {
+    let mut out = String::new();
+    for (k, slot) in results.iter().enumerate() {
+        let declared = &cx.program.control.slots[slot.index()];
+        let domain = match &declared.kind {
+            ValueKind::Word(domain) if domain.is_empty() => "(const unsigned short[]){0}, 0".into(),
+            ValueKind::Word(domain) => format!(
+                "(const unsigned short[]){{{}}}, {}",
+                domain
+                    .iter()
+                    .map(|w| cx.words.index(w).to_string())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                domain.len()
+            ),
+            _ => "NULL, 0".into(),
+        };
+        let name = declared.key.rsplit('.').next().unwrap_or(&declared.key);
+        let _ = write!(
+            out,
+            "\n        take_result({port}, {k}, {}, {domain}, {slot});\n        semo_trace_value(\"result\", \"value\", &slot[{slot}], \"service\", {}, \"name\", {}, NULL);",
+            declared.kind.c_tag(),
+            c::string(service),
+            c::string(name)
+        );
+    }
+    out
 }
 
 /// A strategy's service: its action machine run until it is done (or the timeout).

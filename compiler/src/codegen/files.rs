@@ -112,7 +112,7 @@ const COMM_INCOMING: Template = template!("files/comm_incoming.c.in", ["n"]);
 /// head, the threads simulation's call, the user's TODO.
 const TASK_SERVICE_STATIC_SIM: Template = template!(
     "files/task_service_static_sim.c.in",
-    ["task", "robot", "services", "scale"]
+    ["task", "robot", "services", "scale", "reply"]
 );
 const TASK_SERVICE: Template = template!("files/task_service.c.in", ["task", "robot", "services"]);
 const TASK_SERVICE_SIM_START: Template = template!("files/task_service_sim_start.c.in", []);
@@ -724,6 +724,15 @@ pub fn task_c(
                             ""
                         },
                     ),
+                    (
+                        "reply",
+                        &gives_results(program, &role.task).map_or(String::new(), |most| {
+                            format!(
+                                "\n    bool stopped = !semo_running() || UFControl_StopRequested(TASK_NAME);\n{}",
+                                sim_reply(most).trim_end()
+                            )
+                        }),
+                    ),
                 ],
             ));
         }
@@ -761,15 +770,30 @@ pub fn task_c(
                     };
                     out.push_str(TASK_SERVICE_SIM_START.text);
                     out.push_str(run_graph);
-                    out.push_str(TASK_SERVICE_SIM_WAIT.text);
+                    let replies = gives_results(program, &role.task);
+                    let wait = TASK_SERVICE_SIM_WAIT.text;
+                    match replies {
+                        Some(_) => out.push_str(&wait.replace(
+                            "    UFControl_WaitStop(",
+                            "    bool stopped = UFControl_WaitStop(",
+                        )),
+                        None => out.push_str(wait),
+                    }
                     out.push_str(scale);
-                    out.push_str(");\n    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n");
+                    out.push_str(");\n");
+                    if let Some(most) = replies {
+                        out.push_str(&sim_reply(most));
+                    }
+                    out.push_str("    semo_trace(\"call_end\", \"task\", TASK_NAME, \"service\", req.service, NULL);\n");
                 }
                 // The static simulation's body is the arm above.
                 (true, Layer::Static) => {}
                 (false, _) => {
                     out.push_str(run_graph);
                     out.push_str(TASK_SERVICE_TODO.text);
+                    if gives_results(program, &role.task).is_some() {
+                        out.push_str("    /* A call binding results: give them back before returning,\n     * semo_reply(TASK_NAME, n, values), in the order of the service's results. */\n");
+                    }
                     for s in services {
                         let _ = writeln!(
                             out,
@@ -785,6 +809,33 @@ pub fn task_c(
         (RoleKind::CommSend | RoleKind::CommReceive, _) => return None,
     }
     Some(out)
+}
+
+/// A simulated service task whose call was done (not stopped) gives back
+/// the scenario's results for it (`semo_sim_results`), as the simulator's
+/// task does.
+fn sim_reply(most: usize) -> String {
+    format!(
+        "    if (!stopped) {{\n        semo_value results[{most}];\n        int n = semo_sim_results(req.service, results, {most});\n        semo_reply(TASK_NAME, n, results);\n    }}\n"
+    )
+}
+
+/// The most results a call of the program that `task` performs binds
+/// (`None`: none binds any): then the task gives back what its calls
+/// found (`semo_reply`, defined by the control task only then).
+fn gives_results(program: &crate::refine::RobotProgram, task: &str) -> Option<usize> {
+    program
+        .control
+        .services
+        .iter()
+        .flat_map(|s| &s.states)
+        .filter_map(|state| match &state.kind {
+            crate::refine::StateKind::Call {
+                task: t, results, ..
+            } if t == task && !results.is_empty() => Some(results.len()),
+            _ => None,
+        })
+        .max()
 }
 
 /// The runtime's table sizes on the static schedule, from the program; the
@@ -1093,6 +1144,59 @@ fn scenario_extra_tables(
             fields,
             "    .battery = battery,\n    .battery_count = {},",
             world.battery.len()
+        );
+    }
+    if !world.results.is_empty() {
+        // Per service, per call done, its values' texts (NULL: none).
+        let mut entries = Vec::new();
+        for (i, (service, calls)) in world.results.iter().enumerate() {
+            let mut names = Vec::new();
+            let mut counts = Vec::new();
+            for (k, values) in calls.iter().enumerate() {
+                let texts: Vec<String> = values
+                    .iter()
+                    .map(|v| v.as_deref().map_or("NULL".to_string(), c::string))
+                    .collect();
+                let texts = if texts.is_empty() {
+                    vec!["NULL".to_string()]
+                } else {
+                    texts
+                };
+                let _ = writeln!(
+                    tables,
+                    "static const char *const results_{i}_{k}[] = {{{}}};",
+                    texts.join(", ")
+                );
+                names.push(format!("results_{i}_{k}"));
+                counts.push(values.len().to_string());
+            }
+            if calls.is_empty() {
+                names.push("NULL".to_string());
+                counts.push("0".to_string());
+            }
+            let _ = writeln!(
+                tables,
+                "static const char *const *const results_{i}[] = {{{}}};\nstatic const size_t results_{i}_counts[] = {{{}}};",
+                names.join(", "),
+                counts.join(", ")
+            );
+            entries.push(format!(
+                "    {{{}, results_{i}, results_{i}_counts, {}}},\n",
+                c::string(service),
+                calls.len()
+            ));
+        }
+        tables.push_str("static const semo__sim_results_entry results[] = {\n");
+        tables.extend(entries.iter().map(String::as_str));
+        let _ = writeln!(
+            tables,
+            "}};\nstatic size_t results_done[{}];",
+            entries.len()
+        );
+        let _ = writeln!(
+            fields,
+            "    .results = results,\n    .results_done = results_done,\n    .results_count = {},",
+            entries.len()
         );
     }
     if !world.loops.is_empty() {

@@ -265,3 +265,11 @@ fn modes_and_services_keep_their_parameters_and_arguments_on_one_line() {
         "R.Action.Go(PLACE, WAIT) {\n  move(PLACE)\n} repeat()\n\nR.MOVE(TARGET) {\n  set(Action, Go(TARGET, 2))\n}\n\nR.main {\n  case (MOVE):\n    catch (x): mode = MOVE(hall door)\n  default: mode = MOVE(kitchen)\n}\n"
     );
 }
+
+#[test]
+fn a_call_keeps_the_names_bound_to_its_results_on_its_line() {
+    assert_eq!(
+        fmt("T.P.S{FOUND ,WHERE=search( red paper ),timeout=2 SEC\nA=search()}"),
+        "T.P.S {\n  FOUND, WHERE = search(red paper), timeout = 2 SEC\n  A = search()\n}\n"
+    );
+}

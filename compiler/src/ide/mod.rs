@@ -88,6 +88,9 @@ pub enum CompletionKind {
     Constant,
     /// A parameter of the function whose body the cursor is in.
     Parameter,
+    /// An action result bound before the cursor in its body
+    /// (`FOUND` of `FOUND, WHERE = search(red)`).
+    Result,
     /// A time unit (`SEC`).
     Unit,
     Keyword,

@@ -29,7 +29,7 @@ pub use build::{
 pub use program::*;
 pub use robot::SENSOR_PERIOD_MS;
 pub use value::{Value, ValueKind};
-pub use world::{CompiledLink, CompiledScenario, LinkEffect, OperatorCommand};
+pub use world::{CallResults, CompiledLink, CompiledScenario, LinkEffect, OperatorCommand};
 
 use crate::CheckedMission;
 use crate::catalog::Catalog;

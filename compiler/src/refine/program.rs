@@ -599,13 +599,18 @@ pub enum StateKind {
         event: String,
         broadcast: Option<Vec<OutgoingId>>,
     },
-    /// Call the task implementing a built-in service and wait until it is idle.
+    /// Call the task implementing a built-in service and wait until it is
+    /// idle. `results`: the slots of the names the call binds
+    /// (`FOUND, WHERE = search(red)`), in the order of the service's
+    /// results: none from the call's start, then what the task gave back
+    /// when it is done (they stay none after a timeout).
     Call {
         service: String,
         task: String,
         args: Vec<Operand>,
         timeout_ms: Option<i64>,
         mark: MarkId,
+        results: Vec<SlotId>,
     },
     /// Run a strategy action machine to its final action.
     RunActions {
@@ -777,6 +782,9 @@ pub enum SlotSource {
     Shared,
     /// A strategy variable parameter (set from a call's argument).
     Local,
+    /// An action result (`FOUND` of `FOUND, WHERE = search(red)`): set by
+    /// the control task when a call binding it starts (none) and ends.
+    Result,
 }
 
 #[derive(Clone, Debug, PartialEq)]

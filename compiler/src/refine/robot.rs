@@ -902,8 +902,15 @@ impl Builder<'_, '_> {
         let service = def.name.clone();
         let args: Vec<Operand> = call.args.iter().map(|a| self.arg(a)).collect();
         self.note_group_service(&service);
+        let results = self.result_slots(call);
         let mark = next_mark(marks);
         if let Some(machine) = self.strategy_machine(call.name.span, &service) {
+            if !call.results.is_empty() {
+                self.unsupported(
+                    call.name.span,
+                    "action results of a service a strategy refines into actions",
+                );
+            }
             self.push(
                 states,
                 StateKind::RunActions {
@@ -931,9 +938,53 @@ impl Builder<'_, '_> {
                 args,
                 timeout_ms,
                 mark,
+                results,
             },
             span,
         );
+    }
+
+    /// The slots of the names `call` binds to its service's results, as
+    /// the checker resolved them (one slot per result name of its body).
+    fn result_slots(&mut self, call: &ast::Call) -> Vec<SlotId> {
+        let mut slots = Vec::with_capacity(call.results.len());
+        for name in &call.results {
+            let symbols = crate::sema::lookup::with_span(&self.input.analysis.mission, name.span);
+            let Some(slot) = symbols.iter().find_map(|o| match o.symbol {
+                Symbol::Result { owner, index } if self.owns_body(owner) => Some((owner, index)),
+                _ => None,
+            }) else {
+                let what = format!("the checker resolved the result `{}` to nothing", name.name);
+                self.internal_error(name.span, &what);
+                continue;
+            };
+            slots.push(self.result_slot(slot.0, slot.1, name.span));
+        }
+        slots
+    }
+
+    /// Whether the body of `owner` is one this robot's team runs: a
+    /// function's, or a service of its team (a shared service's body has a
+    /// copy per team).
+    fn owns_body(&self, owner: crate::sema::ParamOwner) -> bool {
+        match owner {
+            crate::sema::ParamOwner::Service(team, _) => team == self.team_id,
+            _ => true,
+        }
+    }
+
+    /// The slot of result `index` of `owner`'s body, typed as the checker
+    /// typed it.
+    fn result_slot(&mut self, owner: crate::sema::ParamOwner, index: u32, span: Span) -> SlotId {
+        let mission = &self.input.analysis.mission;
+        let result = &mission.results(owner)[index as usize];
+        let key = format!("{}.{}", mission.owner_name(owner), result.name);
+        let Some(ty) = result.ty.clone() else {
+            let what = format!("the checker gave the result `{}` no type", result.name);
+            self.internal_error(span, &what);
+            return self.slot(&key, SlotSource::Result, ValueKind::Variable);
+        };
+        self.slot(&key, SlotSource::Result, ValueKind::declared(&ty))
     }
 
     /// A call of a service the team's strategy declares a group service
@@ -1278,6 +1329,8 @@ impl Builder<'_, '_> {
         let own = symbols.iter().find(|o| match &o.symbol {
             Symbol::Value { owner, .. } => *owner == Some(self.team_id),
             Symbol::TeamVariable { team, .. } => *team == Some(self.team_id),
+            // A shared service's result: this team's copy of the body.
+            Symbol::Result { owner, .. } => self.owns_body(*owner),
             _ => false,
         });
         own.or(symbols.first()).map(|o| o.symbol.clone())
@@ -1312,6 +1365,9 @@ impl Builder<'_, '_> {
             Some(Symbol::Constant(name)) => Operand::Literal(Value::Word(name.into())),
             // The argument of the call being inlined, as its caller gave it.
             Some(Symbol::Parameter { index, .. }) => self.parameter_operand(index, attr),
+            Some(Symbol::Result { owner, index }) => {
+                Operand::Slot(self.result_slot(owner, index, attr.span))
+            }
             other => {
                 let what = format!(
                     "`{}` is read as a value, but the checker resolved it to {other:?}",

@@ -23,6 +23,11 @@ pub struct CompiledScenario {
     pub sensors: Vec<(i64, String, String)>,
     /// (service, ms).
     pub services: Vec<(String, i64)>,
+    /// (service, what each of its calls gives back, in call order): the
+    /// `n`th call's values in the order of the service's results (`None`,
+    /// none); calls past the list give the last entry again, and a service
+    /// without one gives none.
+    pub results: Vec<(String, CallResults)>,
     /// (at, level), in time order: the `BATTERY` value, linear between.
     pub battery: Vec<(i64, f64)>,
     /// (SDF/L loop path, the iteration whose exit task sets the exit flag).
@@ -32,6 +37,10 @@ pub struct CompiledScenario {
     /// The link faults on this robot's messages, in file order.
     pub links: Vec<CompiledLink>,
 }
+
+/// What a service's calls give back, per call done in order: each call's
+/// values in the order of the service's results (`None`: none).
+pub type CallResults = Vec<Vec<Option<String>>>;
 
 /// A link fault on the messages this robot sends to `robots` during
 /// [`from`, `until`).

@@ -144,6 +144,11 @@ enum Resolution {
         param: ParamRef,
         name: Name,
     },
+    /// A result name the function's (else the service's) body binds.
+    Result {
+        owner: ParamOwner,
+        index: u32,
+    },
 }
 
 /// A value read or sent by robots of which some lack it: E033 unless their
@@ -480,6 +485,7 @@ impl<'a> Checker<'a> {
         }
         if let Some(&function) = self.functions_by_name.get(&call.name.name) {
             self.occurrence(call.name.span, Symbol::Function(function), false);
+            self.function_results(call);
             self.function_arguments(function, call, scope);
             if scope.inlining.contains(&function) {
                 self.diagnostics.report(
@@ -694,6 +700,16 @@ impl<'a> Checker<'a> {
                 .report(Code::ServiceNotProvided, call.name.span, message);
         }
         self.arguments(call, def, scope);
+        let providers: Vec<(Name, &ServiceDef)> = types
+            .iter()
+            .filter_map(|(ty, _)| {
+                let robot_type = catalog.get(*ty);
+                robot_type
+                    .service(name)
+                    .map(|d| (Name::new(&robot_type.name), d))
+            })
+            .collect();
+        self.service_results(call, def, &providers, scope.param_owner());
     }
 
     fn arguments(&mut self, call: &ast::Call, def: &ServiceDef, scope: &Scope) {
@@ -965,6 +981,9 @@ impl<'a> Checker<'a> {
                     param: (owner, index as u32),
                     name: name.name.clone(),
                 };
+            }
+            if let Some(index) = self.result_of(owner, &name.name) {
+                return Resolution::Result { owner, index };
             }
         }
         match attr.segments.as_slice() {
@@ -1252,6 +1271,8 @@ impl<'a> Checker<'a> {
                 if let Some(owner) = function {
                     let params = self.mission.params(owner);
                     known.extend(params.iter().map(|p| p.name.to_string()));
+                    let results = self.mission.results(owner);
+                    known.extend(results.iter().map(|r| r.name.to_string()));
                 }
                 let guess = suggestion(&name, known.iter().map(String::as_str));
                 self.diagnostics.report(
@@ -1267,6 +1288,24 @@ impl<'a> Checker<'a> {
                 Type::Unknown
             }
             Resolution::Unchecked => Type::Unknown,
+            Resolution::Result { owner, index } => {
+                let result = &self.mission.results(owner)[index as usize];
+                let (bound, ty) = (result.span, result.ty.clone());
+                if attr.span.start < bound.start {
+                    self.diagnostics
+                        .report(
+                            Code::ResultReadBeforeBound,
+                            attr.span,
+                            format!(
+                                "`{}` is read before any call binds it: it is none until the call below is done",
+                                result.name
+                            ),
+                        )
+                        .relate(bound, "bound here");
+                }
+                self.occurrence(last, Symbol::Result { owner, index }, false);
+                ty.map_or(Type::Unknown, Type::Value)
+            }
             Resolution::Parameter { param, name } => {
                 self.param_uses.used(param);
                 let (owner, index) = param;

@@ -33,6 +33,7 @@ impl<'a> Checker<'a> {
         }
         self.collect_variables();
         self.check_parameter_names();
+        self.check_result_names();
     }
 
     fn declare_team(&mut self, decl: &ast::TeamDecl, robot_names: &mut FastMap<Name, Span>) {
@@ -233,7 +234,10 @@ impl<'a> Checker<'a> {
             item,
             called: false,
             params,
+            results: Vec::new(),
         });
+        let results = self.declare_results(ParamOwner::Function(id), &f.body);
+        self.mission.functions[id.0 as usize].results = results;
     }
 
     /// A composite service, in each team its header names: a service shared
@@ -317,12 +321,15 @@ impl<'a> Checker<'a> {
             item,
             throws: Vec::new(),
             params: Vec::new(),
+            results: Vec::new(),
         });
         self.occurrence(s.name.span, Symbol::Service { team, service }, true);
         let owner = ParamOwner::Service(team, service);
         let what = self.team(team).service_path(service);
         let params = self.declare_params(owner, &what, &s.params);
         self.team_mut(team).services[service.index()].params = params;
+        let results = self.declare_results(owner, &s.body);
+        self.team_mut(team).services[service.index()].results = results;
         Ok(())
     }
 

@@ -153,6 +153,9 @@ pub struct Service {
     /// The parameters, in order (`T.Plan.S(PLACE)`): each stands in the
     /// body for the argument of the mode's `set` that runs it.
     pub params: Vec<ParamInfo>,
+    /// The names its body binds to action results (`F, W = search(red)`),
+    /// in the order first bound.
+    pub results: Vec<ResultInfo>,
 }
 
 #[derive(Clone, Debug)]
@@ -265,6 +268,26 @@ pub struct FunctionInfo {
     pub called: bool,
     /// The parameters, in order (`def name(PLACE, ...)`).
     pub params: Vec<ParamInfo>,
+    /// The names its body binds to action results, in the order first bound.
+    pub results: Vec<ResultInfo>,
+}
+
+/// A name a body binds to a result of a built-in service
+/// (`FOUND, WHERE = search(red)`): a value of the robot running the body,
+/// none until a call binding it is done, readable by name after it
+/// (`docs/language/services.md`).
+#[derive(Clone, Debug)]
+pub struct ResultInfo {
+    pub name: Name,
+    /// Where it is first bound (its definition).
+    pub span: Span,
+    /// The service whose call first binds it, and that result's name in the
+    /// catalog (`search`, `FOUND`).
+    pub service: Name,
+    pub catalog_name: Option<Name>,
+    /// Its type, the catalog's for that result; `None` until a call binding
+    /// it is walked with robots that have the service.
+    pub ty: Option<crate::catalog::ValueType>,
 }
 
 /// A parameter of a function: a name that stands, in the body, for the
@@ -379,6 +402,12 @@ pub enum Symbol {
         owner: ParamOwner,
         index: u32,
     },
+    /// The `index`th result name of a function's or a service's body
+    /// (`FOUND` of `FOUND, WHERE = search(red)`), where bound and where read.
+    Result {
+        owner: ParamOwner,
+        index: u32,
+    },
     /// A mode with parameters, where declared and where named (in `case`,
     /// and entered with arguments).
     ModeTemplate {
@@ -468,6 +497,26 @@ impl Mission {
             ParamOwner::Function(f) => &self.functions[f.0 as usize].params,
             ParamOwner::Service(team, service) => &self.team(team).service(service).params,
             ParamOwner::Mode(team, template) => &self.team(team).template(template).params,
+        }
+    }
+
+    /// The result names a function's or a service's body binds (a mode
+    /// binds none).
+    pub fn results(&self, owner: ParamOwner) -> &[ResultInfo] {
+        match owner {
+            ParamOwner::Function(f) => &self.functions[f.0 as usize].results,
+            ParamOwner::Service(team, service) => &self.team(team).service(service).results,
+            ParamOwner::Mode(..) => &[],
+        }
+    }
+
+    pub(super) fn results_mut(&mut self, owner: ParamOwner) -> Option<&mut Vec<ResultInfo>> {
+        match owner {
+            ParamOwner::Function(f) => Some(&mut self.functions[f.0 as usize].results),
+            ParamOwner::Service(team, service) => {
+                Some(&mut self.teams[team.0 as usize].services[service.index()].results)
+            }
+            ParamOwner::Mode(..) => None,
         }
     }
 

@@ -25,6 +25,7 @@ mod declare;
 pub mod ir;
 pub(crate) mod lookup;
 mod params;
+mod results;
 mod values;
 
 pub use ir::*;
@@ -200,6 +201,10 @@ pub(crate) struct Checker<'a> {
     /// of every call walked, checked against each other once every body is
     /// walked (`params.rs`).
     param_uses: params::ParamUses,
+    /// Each body's result names to their index in its `results`: a read
+    /// or a binding finds its result in constant time, however many a
+    /// body binds.
+    result_index: FastMap<(ParamOwner, Name), u32>,
     /// The mission went past [`MAX_ROBOTS_PER_MISSION`] (reported once):
     /// no further robot is declared.
     robots_full: bool,
@@ -239,6 +244,7 @@ impl<'a> Checker<'a> {
             thrown: FastSet::default(),
             broadcast_index: FastMap::default(),
             param_uses: params::ParamUses::default(),
+            result_index: FastMap::default(),
             robots_full: false,
         }
     }

@@ -368,6 +368,14 @@ struct TaskState {
     /// time-triggered tasks wait for their periods): a stop ends the call
     /// then, not before.
     graph_until: i64,
+    /// What the last call gave back when it was done, as the scenario
+    /// wrote it (`None`: it was stopped, has not ended yet, or the scenario
+    /// gives its service no results): the control task reads it into the
+    /// call's result slots.
+    reply: Option<Rc<[Option<String>]>>,
+    /// The call under way was stopped (it ends when its graph's iteration
+    /// does, giving nothing back).
+    stopped: bool,
 }
 
 /// One robot's running program (one process of `linux-sim`).
@@ -460,6 +468,11 @@ struct Robot<'p> {
     battery: Rc<[(i64, f64)]>,
     /// The scenario's time of each service (the last entry of a name counts).
     service_ms: Rc<[(String, i64)]>,
+    /// The scenario's results of each service's calls, in call order.
+    service_results: Rc<[(String, crate::refine::CallResults)]>,
+    /// How many calls of each service (with results in the scenario) were
+    /// done, to pick the next one's results.
+    calls_done: Vec<u64>,
     /// Orders the control firings of robots at the same time: robots that
     /// started earlier fire first, as each firing schedules the next.
     chain: u64,
@@ -672,6 +685,8 @@ impl<'p> Robot<'p> {
             sensor_series,
             battery: world.map_or_else(|| Rc::from([]), |w| Rc::from(w.battery.as_slice())),
             service_ms: world.map_or_else(|| Rc::from([]), |w| Rc::from(w.services.as_slice())),
+            service_results: world.map_or_else(|| Rc::from([]), |w| Rc::from(w.results.as_slice())),
+            calls_done: vec![0; world.map_or(0, |w| w.results.len())],
             chain: 0,
             next_fire: None,
             fire_token: 0,
@@ -940,7 +955,8 @@ impl<'p> Sim<'p> {
             } => {
                 let state = &self.robots[robot].tasks[task].1;
                 if self.robots[robot].alive && state.busy && state.generation == generation {
-                    self.end_call(robot, task);
+                    let done = !state.stopped;
+                    self.end_call(robot, task, done);
                     self.wake(robot);
                 }
             }
@@ -1046,7 +1062,7 @@ impl<'p> Sim<'p> {
             if state.untaken.take().is_some() {
                 state.busy = false;
             } else if state.busy {
-                self.end_call(r, t);
+                self.end_call(r, t, false);
             }
         }
         self.robots[r].alive = false;
@@ -1485,6 +1501,7 @@ impl<'p> Sim<'p> {
         }
         let state = &mut self.robots[r].tasks[t].1;
         state.busy = true;
+        state.reply = None;
         state.untaken = Some(args);
         if *state.service != *service {
             state.service = service.into();
@@ -1550,9 +1567,31 @@ impl<'p> Sim<'p> {
         );
     }
 
-    fn end_call(&mut self, r: usize, t: usize) {
-        let (task, state) = &mut self.robots[r].tasks[t];
+    /// The call under way ends; `done`: it was not stopped, so it gives
+    /// back the scenario's results for it (the `n`th done call of its
+    /// service the `n`th entry, the last one past the list).
+    fn end_call(&mut self, r: usize, t: usize, done: bool) {
+        let robot = &mut self.robots[r];
+        let service = robot.tasks[t].1.service.clone();
+        let reply = match robot
+            .service_results
+            .iter()
+            .rposition(|(s, _)| **s == *service)
+        {
+            Some(k) if done => {
+                let calls = &robot.service_results[k].1;
+                let n = robot.calls_done[k] as usize;
+                robot.calls_done[k] += 1;
+                let values = calls.get(n).or(calls.last()).map_or(&[][..], Vec::as_slice);
+                Some(Rc::from(values))
+            }
+            // Nothing in the scenario: every result none.
+            _ => None,
+        };
+        let (task, state) = &mut robot.tasks[t];
         state.busy = false;
+        state.stopped = false;
+        state.reply = reply;
         let fields = smallvec![("task", task.clone()), ("service", state.service.clone())];
         self.emit(r, "call_end", fields);
     }
@@ -1570,6 +1609,7 @@ impl<'p> Sim<'p> {
             return;
         }
         if state.graph_until > self.now {
+            state.stopped = true;
             state.generation += 1;
             let (at, generation) = (state.graph_until, state.generation);
             self.schedule(
@@ -1581,7 +1621,41 @@ impl<'p> Sim<'p> {
                 },
             );
         } else {
-            self.end_call(r, t);
+            self.end_call(r, t, false);
+        }
+    }
+
+    /// A call binding results is done: each slot takes what the task gave
+    /// back, read as the slot's type (a text not of it, or a result the
+    /// scenario does not give, is none), and is traced (`result`).
+    fn take_results(
+        &mut self,
+        r: usize,
+        m: &ControlMachine,
+        task: &str,
+        service: &str,
+        results: &[SlotId],
+    ) {
+        let t = self.robots[r].task_index(task);
+        let reply = self.robots[r].tasks[t].1.reply.clone();
+        for (k, slot) in results.iter().enumerate() {
+            let text = reply
+                .as_ref()
+                .and_then(|values| values.get(k).cloned().flatten());
+            let decl = &m.slots[slot.index()];
+            let value = text.and_then(|text| decl.kind.parse(&text));
+            self.store(r, *slot, value.clone());
+            self.trace.push(TraceEvent {
+                t: self.now,
+                robot: r,
+                event: "result",
+                fields: smallvec![
+                    ("service", service.into()),
+                    ("name", result_name(&decl.key))
+                ],
+                value: Some(("value", value)),
+                sent_at: None,
+            });
         }
     }
 
@@ -2068,11 +2142,16 @@ impl<'p> Sim<'p> {
                 args,
                 timeout_ms,
                 mark,
+                results,
             } => {
                 if self.robots[r].regions[i].phase == 0 {
                     let values = args.iter().map(|a| self.value(r, a)).collect();
                     if !self.request(r, task, service, values) {
                         return Step::Wait;
+                    }
+                    // Its results are none until it is done.
+                    for slot in results {
+                        self.store(r, *slot, None);
                     }
                     let region = self.region(r, i);
                     region.marks[mark.index()] = now;
@@ -2090,6 +2169,8 @@ impl<'p> Sim<'p> {
                     );
                 } else if self.busy(r, task) {
                     return Step::Wait;
+                } else if !results.is_empty() {
+                    self.take_results(r, m, task, service, results);
                 }
                 let region = self.region(r, i);
                 region.phase = 0;
@@ -2777,4 +2858,10 @@ fn battery_level(points: &[(i64, f64)], t: i64) -> Option<f64> {
         }
     }
     points.last().map(|p| p.1)
+}
+
+/// The name a mission binds a result to, from its slot's key
+/// (`R.Action.Look.FOUND`, `go_home.FOUND`): after the last dot.
+fn result_name(key: &str) -> Rc<str> {
+    key.rsplit('.').next().unwrap_or(key).into()
 }

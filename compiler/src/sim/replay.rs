@@ -37,6 +37,7 @@ pub const EVENTS: &[&str] = &[
     "call_start",
     "actuate",
     "call_end",
+    "result",
     "actions_start",
     "actions_end",
     "timeout",

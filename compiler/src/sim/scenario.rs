@@ -44,6 +44,8 @@ pub mod keys {
         "expect",
     ];
     pub const ROBOT: &[&str] = &["sensors", "services", "battery", "loops"];
+    /// A service's entry when it gives results: `{"ms": 300, "results": [...]}`.
+    pub const SERVICE: &[&str] = &["ms", "results"];
     pub const SENSOR: &[&str] = &["at", "value", "is"];
     pub const BATTERY: &[&str] = &["at", "level"];
     pub const COMMAND: &[&str] = &["at", "every", "from", "until", "to", "value", "is"];
@@ -101,6 +103,9 @@ pub struct RobotWorld {
     /// (at, value name, value), in file order.
     pub sensors: Vec<(i64, String, String)>,
     pub services: Vec<(String, i64)>,
+    /// (service, what each call gives back, in call order): see
+    /// [`crate::refine::CompiledScenario::results`].
+    pub results: Vec<(String, crate::refine::CallResults)>,
     /// (at, level): the `BATTERY` sensor value, linear between points.
     pub battery: Vec<(i64, f64)>,
     /// (SDF/L loop path, iteration): when a convergent loop's exit task
@@ -530,6 +535,7 @@ impl Scenario {
             time_scale: self.time_scale,
             sensors: world.map(|w| w.sensors.clone()).unwrap_or_default(),
             services: world.map(|w| w.services.clone()).unwrap_or_default(),
+            results: world.map(|w| w.results.clone()).unwrap_or_default(),
             battery: world.map(|w| w.battery.clone()).unwrap_or_default(),
             loops: world.map(|w| w.loops.clone()).unwrap_or_default(),
             operator: self
@@ -618,6 +624,28 @@ fn ms(v: &Value, key: &str, min: i64) -> Result<i64> {
             ),
         ),
     }
+}
+
+/// A service's `results`: per call, in call order, an array of what it
+/// gives back in the order of the service's results (`true`, `"3,4"`, `2`;
+/// `null` for none).
+fn call_results(v: &Value) -> Result<crate::refine::CallResults> {
+    const WHAT: &str = "an array of each call's results, [[true, \"3,4\"], [false]]";
+    let mut calls = Vec::new();
+    for call in array(v, WHAT)? {
+        let mut values = Vec::new();
+        for value in array(call, WHAT)? {
+            values.push(match &value.kind {
+                Kind::Null => None,
+                Kind::Bool(b) => Some(b.to_string()),
+                Kind::Number(_, text) => Some(text.clone()),
+                Kind::String(text) => Some(text.clone()),
+                _ => return fail(value, "a result is true, false, a number, a string or null"),
+            });
+        }
+        calls.push(values);
+    }
+    Ok(calls)
 }
 
 fn opt_ms(object: &Value, key: &str, min: i64) -> Result<Option<i64>> {
@@ -875,6 +903,23 @@ impl Reader<'_> {
                 );
             };
             for (service, d) in members {
+                if let Kind::Object(_) = d.kind {
+                    // `{"ms": 300, "results": [[true, "3,4"], [false]]}`.
+                    object(
+                        d,
+                        "a service {\"ms\": 300, \"results\": [[...], ...]}",
+                        keys::SERVICE,
+                    )?;
+                    if let Some(t) = opt_ms(d, "ms", 0)? {
+                        world.services.push((service.clone(), t));
+                    }
+                    if let Some(results) = d.member("results") {
+                        world
+                            .results
+                            .push((service.clone(), call_results(results)?));
+                    }
+                    continue;
+                }
                 world.services.push((service.clone(), ms(d, service, 0)?));
             }
         }

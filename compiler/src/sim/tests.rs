@@ -1554,7 +1554,7 @@ fn the_schema_names_exactly_the_keys_the_reader_takes() {
         .chain(keys::EXPECTATION)
         .copied()
         .collect();
-    let places: [(&[&str], &[&str]); 10] = [
+    let places: [(&[&str], &[&str]); 11] = [
         (&[], keys::SCENARIO),
         (
             &["properties", "robots", "additionalProperties"],
@@ -1581,6 +1581,19 @@ fn the_schema_names_exactly_the_keys_the_reader_takes() {
                 "items",
             ],
             keys::BATTERY,
+        ),
+        (
+            &[
+                "properties",
+                "robots",
+                "additionalProperties",
+                "properties",
+                "services",
+                "additionalProperties",
+                "anyOf",
+                "*",
+            ],
+            keys::SERVICE,
         ),
         (&["properties", "operator", "items"], keys::COMMAND),
         (&["properties", "network"], keys::NETWORK),

@@ -258,9 +258,13 @@ pub struct Loop {
     pub body: Block,
 }
 
-/// A built-in service or function call: `move("5,5"), timeout = 10 SEC`.
+/// A built-in service or function call: `move("5,5"), timeout = 10 SEC`,
+/// or with its results bound: `FOUND, WHERE = search(red)`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Call {
+    /// The names bound to the service's results, in order (`FOUND, WHERE =`);
+    /// empty when none are (`docs/language/services.md`).
+    pub results: Vec<Ident>,
     pub name: Ident,
     pub args: Vec<Arg>,
     pub timeout: Option<Period>,

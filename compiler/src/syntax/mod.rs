@@ -571,6 +571,46 @@ mod tests {
     }
 
     #[test]
+    fn a_call_keeps_the_names_bound_to_its_results_positioned() {
+        let text = "R.A.S { F, W = search(red), timeout = 2 SEC\n move(W) }";
+        let p = parse(FileId(0), text);
+        assert!(p.diagnostics.is_empty(), "{:?}", p.diagnostics);
+        let ast::Item::Service(s) = &p.file.items[0] else {
+            panic!("{:?}", p.file.items)
+        };
+        let [first, second] = s.body.stmts.as_slice() else {
+            panic!("{:?}", s.body.stmts)
+        };
+        let ast::StmtKind::Call(call) = &first.kind else {
+            panic!("{first:?}")
+        };
+        let results: Vec<(&str, Span)> =
+            call.results.iter().map(|r| (r.as_str(), r.span)).collect();
+        assert_eq!(results, [("F", Span::new(8, 9)), ("W", Span::new(11, 12))]);
+        assert_eq!(call.name.as_str(), "search");
+        assert!(call.timeout.is_some());
+        assert_eq!(first.span, Span::new(8, 43));
+        assert!(matches!(&second.kind, ast::StmtKind::Call(c) if c.results.is_empty()));
+    }
+
+    #[test]
+    fn names_bound_without_a_call_are_a_positioned_syntax_error_and_the_next_line_parses() {
+        let text = "R.A.S {\n F, = search(red)\n X Y = search(red)\n stop()\n}";
+        let p = parse(FileId(0), text);
+        let spans: Vec<Span> = p.diagnostics.iter().map(|d| d.span).collect();
+        assert!(p.diagnostics.iter().all(|d| d.code == Code::SyntaxError));
+        assert_eq!(spans, [Span::new(12, 13), Span::new(29, 30)]);
+        let ast::Item::Service(s) = &p.file.items[0] else {
+            panic!("{:?}", p.file.items)
+        };
+        assert!(
+            matches!(&s.body.stmts.last().map(|s| &s.kind), Some(ast::StmtKind::Call(c)) if c.name.as_str() == "stop"),
+            "{:?}",
+            s.body.stmts
+        );
+    }
+
+    #[test]
     fn a_parameter_list_that_does_not_parse_is_positioned_and_the_body_parses() {
         let text = "def go_to(5 SEC) { move(x) }\ndef home(A) { stop() }";
         let p = parse(FileId(0), text);

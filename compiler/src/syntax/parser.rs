@@ -340,7 +340,18 @@ where
             });
 
         let arg = arg();
-        let call = name()
+        // `FOUND, WHERE = search(red)`: the names bound to the results. A
+        // statement starting with a name is a call, so trying the list
+        // first costs at most the names before a `(`.
+        let results = name()
+            .separated_by(tok(Token::Comma))
+            .at_least(1)
+            .collect::<Vec<_>>()
+            .then_ignore(tok(Token::Assign))
+            .or_not()
+            .map(Option::unwrap_or_default);
+        let call = results
+            .then(name())
             .then(
                 arg.separated_by(tok(Token::Comma))
                     .collect::<Vec<_>>()
@@ -348,8 +359,9 @@ where
                     .map_with(|args, e| (args, sp(e.span()))),
             )
             .then(tok(Token::Comma).ignore_then(timeout()).or_not())
-            .map(|((name, (args, args_span)), timeout)| {
+            .map(|(((results, name), (args, args_span)), timeout)| {
                 StmtKind::Call(Call {
+                    results,
                     name,
                     args,
                     timeout,

@@ -364,11 +364,13 @@ impl Shift for Loop {
 impl Shift for Call {
     fn shift(&mut self, delta: isize) {
         let Call {
+            results,
             name,
             args,
             timeout,
             args_span,
         } = self;
+        results.shift(delta);
         name.shift(delta);
         args.shift(delta);
         timeout.shift(delta);

@@ -126,6 +126,9 @@
 (call
   function: (identifier) @function.call)
 
+(results
+  name: (identifier) @variable)
+
 (mode_definition
   team: (identifier) @module
   name: (identifier) @constant)

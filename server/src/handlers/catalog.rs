@@ -37,6 +37,11 @@ pub fn robot(r: &RobotType) -> Value {
                 "type": p.ty.to_string(),
                 "optional": p.optional,
             })).collect::<Vec<_>>(),
+            "results": s.results.iter().map(|r| json!({
+                "name": r.name,
+                "type": r.ty.to_string(),
+                "doc": r.doc,
+            })).collect::<Vec<_>>(),
             "doc": s.doc,
         })).collect::<Vec<_>>(),
         "values": r.values.iter().map(|v| json!({

@@ -650,3 +650,52 @@ fn bad_latency_bounds_are_positioned() {
     let text = wrap("<Latency from=\"a\" to=\"b\" max=\"5 MSEC\"/>");
     assert_eq!(codes(&text), ["E051"]);
 }
+
+#[test]
+fn a_service_lists_its_results_in_order_each_checked_as_a_value() {
+    let text = wrap(
+        "<Service name=\"survey\" task=\"drill\">\
+           <Param name=\"where\" type=\"location\"/>\
+           <Result name=\"FOUND\" type=\"bool\" doc=\"Whether it is there.\"/>\
+           <Result name=\"GRADE\" type=\"enum\" domain=\"LOW HIGH\"/>\
+         </Service>",
+    );
+    let parsed = parse(&text);
+    assert!(parsed.diagnostics.is_empty(), "{:#?}", parsed.diagnostics);
+    let survey = &parsed.robots[0].robot.services[0];
+    let results: Vec<(&str, &ValueType, &str)> = survey
+        .results
+        .iter()
+        .map(|r| (r.name.as_str(), &r.ty, r.doc.as_str()))
+        .collect();
+    let grade = ValueType::Enum(vec!["LOW".into(), "HIGH".into()]);
+    assert_eq!(
+        results,
+        [
+            ("FOUND", &ValueType::Bool, "Whether it is there."),
+            ("GRADE", &grade, "")
+        ]
+    );
+    assert_eq!(
+        survey.results_signature(),
+        "FOUND: bool, GRADE: enum {LOW, HIGH}"
+    );
+
+    let service = |results: &str| wrap(&format!("<Service name=\"s\">{results}</Service>"));
+    let twice = service("<Result name=\"F\" type=\"bool\"/><Result name=\"F\" type=\"int\"/>");
+    assert_eq!(codes(&twice), ["E053"]);
+    assert_eq!(
+        codes(&service("<Result name=\"a b\" type=\"bool\"/>")),
+        ["E056"]
+    );
+    assert_eq!(
+        codes(&service("<Result name=\"F\" type=\"boolean\"/>")),
+        ["E054"]
+    );
+    assert_eq!(codes(&service("<Result name=\"F\"/>")), ["E052"]);
+    assert_eq!(
+        codes(&service("<Result name=\"F\" type=\"enum\"/>")),
+        ["E056"]
+    );
+    assert_eq!(codes(&wrap("<Result name=\"F\" type=\"bool\"/>")), ["E051"]);
+}

@@ -337,6 +337,14 @@ typedef struct {
     const size_t *peers;
     size_t peer_count;
 } semo__sim_link_entry;
+/* What a service's calls give back (action results), per call done in
+ * order: its values' texts (NULL: none) and their count. */
+typedef struct {
+    const char *service;
+    const char *const *const *calls;
+    const size_t *counts;
+    size_t call_count;
+} semo__sim_results_entry;
 typedef struct semo__sim_tables_s {
     int64_t duration_ms; /* 0: until the program stops itself */
     const semo__sim_sensor_entry *sensors;
@@ -353,11 +361,38 @@ typedef struct semo__sim_tables_s {
     size_t loop_count;
     const semo__sim_link_entry *links;
     size_t link_count;
+    const semo__sim_results_entry *results;
+    size_t *results_done; /* per entry: the calls done so far */
+    size_t results_count;
 } semo__sim_tables;
 extern const semo__sim_tables semo__scenario;
 /* The scenario's battery level at mission time `t` (linear between its
  * points), rounded half away from zero; its table must not be empty. */
 double semo__sim_battery_at(int64_t t);
+
+#include <string.h>
+/* semo_sim_results on the tables, for both simulation runtimes. */
+static inline int semo__sim_results(const char *service, semo_value *values, int max)
+{
+    const semo__sim_tables *w = &semo__scenario;
+    for (size_t i = 0; service && i < w->results_count; i++) {
+        const semo__sim_results_entry *e = &w->results[i];
+        if (strcmp(e->service, service) != 0 || e->call_count == 0)
+            continue;
+        size_t call = w->results_done[i] < e->call_count ? w->results_done[i] : e->call_count - 1;
+        w->results_done[i]++;
+        int n = 0;
+        for (size_t k = 0; k < e->counts[call] && n < max; k++, n++) {
+            const char *text = e->calls[call][k];
+            if (text)
+                semo_value_set(&values[n], text);
+            else
+                values[n] = (semo_value){.type = SEMO_NONE};
+        }
+        return n;
+    }
+    return 0;
+}
 #endif
 
 /* Platform hooks of the static schedule: the board file (semo_lm3s6965.c,

@@ -497,6 +497,17 @@ void semo_trace(const char *event, ...);
  * (semo_value_json: the JSON type follows the value's type). */
 void semo_trace_value(const char *event, const char *value_key, const semo_value *value, ...);
 
+/* --------------------------------------------------------- action results */
+
+/* A service task gives back what its call found, before the firing that
+ * ends the call: `count` values in the order of the service's results (its
+ * catalog entry's <Result>s, docs/catalog.md), each of its result's type
+ * (text is read as the type). The control task reads them into the names
+ * the mission binds (`FOUND, WHERE = search(red)`) when the call is done;
+ * a call stopped gives nothing back. The generated control task defines it
+ * when its mission binds results. */
+void semo_reply(const char *task, int count, const semo_value *values);
+
 /* ------------------------------------------------------------- simulation */
 
 #ifdef SEMO_SIM
@@ -508,6 +519,11 @@ bool semo_sim_sensor(const char *value, semo_type type, semo_value *out);
 void semo_sim_actuate(const char *task, const semo_value *command);
 /* How long (mission ms) a built-in service takes in the scenario (default 100). */
 int64_t semo_sim_service_ms(const char *service);
+/* What the scenario says the next done call of `service` gives back, as
+ * text values (none for its null): at most `max` into `values`; their
+ * count, 0 when the scenario gives the service none. Each call takes the
+ * next entry, the last one again past the list. */
+int semo_sim_results(const char *service, semo_value *values, int max);
 /* The scenario's battery level now, rounded (its "battery" points); false
  * when the scenario gives none. Heartbeats carry it (highest_battery). */
 bool semo_sim_battery(long long *level);

@@ -234,6 +234,11 @@ int64_t semo_sim_service_ms(const char *service)
     return DEFAULT_SERVICE_MS;
 }
 
+int semo_sim_results(const char *service, semo_value *values, int max)
+{
+    return semo__sim_results(service, values, max);
+}
+
 int64_t semo_sim_loop_exit(const char *loop)
 {
     for (size_t i = 0; loop && i < semo__scenario.loop_count; i++)

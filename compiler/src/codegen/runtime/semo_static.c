@@ -463,6 +463,11 @@ int64_t semo_sim_service_ms(const char *service)
     return DEFAULT_SERVICE_MS;
 }
 
+int semo_sim_results(const char *service, semo_value *values, int max)
+{
+    return semo__sim_results(service, values, max);
+}
+
 /* Delivers the operator's commands that are due, in time order. */
 static void deliver_operator_commands(void)
 {

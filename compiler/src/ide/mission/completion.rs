@@ -769,7 +769,7 @@ impl<'a> Completions<'a> {
                 .function_syntax(f)
                 .is_some_and(|syntax| syntax.body.span.contains(self.offset))
         });
-        if let Some(f) = function {
+        let body_owner = if let Some(f) = function {
             let signature = super::hover::function_signature(f);
             for p in &f.params {
                 let detail = format!("parameter of {signature}");
@@ -781,12 +781,18 @@ impl<'a> Completions<'a> {
                     None,
                 );
             }
+            self.mission
+                .functions
+                .iter()
+                .position(|g| std::ptr::eq(g, f))
+                .map(|i| crate::sema::ParamOwner::Function(crate::sema::FunctionId(i as u32)))
         } else {
-            // In a service's body with parameters, its parameters first.
+            // In a service's body with parameters or results, its
+            // parameters first.
             let service = self.mission.teams.iter().enumerate().find_map(|(t, team)| {
                 team.service_ids().find_map(|s| {
                     let info = team.service(s);
-                    let inside = !info.params.is_empty()
+                    let inside = !(info.params.is_empty() && info.results.is_empty())
                         && analysis
                             .service_syntax(info)
                             .is_some_and(|syntax| syntax.body.span.contains(self.offset));
@@ -808,6 +814,24 @@ impl<'a> Completions<'a> {
                         None,
                     );
                 }
+            }
+            service
+        };
+        // The results bound before the cursor: what the calls gave back.
+        if let Some(owner) = body_owner {
+            for r in self.mission.results(owner) {
+                if r.span.end > self.offset {
+                    continue;
+                }
+                let ty = r.ty.as_ref().map_or(String::new(), |ty| format!(", {ty}"));
+                let detail = format!("result of {}{ty}", r.service);
+                self.add(
+                    LIKELY,
+                    CompletionKind::Result,
+                    r.name.as_str(),
+                    Some(detail),
+                    None,
+                );
             }
         }
         for v in robots::shared_values(self.catalog, &types) {

@@ -55,6 +55,25 @@ pub(crate) fn service(def: &ServiceDef) -> String {
     if !def.doc.is_empty() {
         write!(out, "\n\n{}", def.doc).ok();
     }
+    if !def.results.is_empty() {
+        let results: Vec<String> = def
+            .results
+            .iter()
+            .map(|r| match r.doc.is_empty() {
+                true => format!("`{}: {}`", r.name, r.ty),
+                false => format!("`{}: {}` ({})", r.name, r.ty, r.doc.trim_end_matches('.')),
+            })
+            .collect();
+        let names: Vec<&str> = def.results.iter().map(|r| r.name.as_str()).collect();
+        write!(
+            out,
+            "\n\nGives back {} when done: `{} = {}(...)`.",
+            list(&results),
+            names.join(", "),
+            def.name
+        )
+        .ok();
+    }
     if !def.aliases.is_empty() {
         write!(out, "\n\nAlso written {}.", list(&ticked(&def.aliases))).ok();
     }

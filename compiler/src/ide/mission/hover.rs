@@ -138,6 +138,7 @@ pub fn hover(
             docs::code(name)
         ),
         Symbol::Parameter { owner, index } => parameter(mission, *owner, *index as usize)?,
+        Symbol::Result { owner, index } => result(mission, *owner, *index as usize)?,
         Symbol::ModeTemplate { team, template } => {
             docs::mode_template(mission.team(*team), *template)
         }
@@ -152,6 +153,31 @@ pub(super) fn function_signature(info: &crate::sema::FunctionInfo) -> String {
     }
     let names: Vec<&str> = info.params.iter().map(|p| p.name.as_str()).collect();
     format!("def {}({})", info.name, names.join(", "))
+}
+
+/// An action result: the service whose call binds it, its type, and what
+/// it holds when.
+fn result(
+    mission: &crate::sema::Mission,
+    owner: crate::sema::ParamOwner,
+    index: usize,
+) -> Option<String> {
+    let result = mission.results(owner).get(index)?;
+    let mut out = docs::code(&match &result.ty {
+        Some(ty) => format!("{}: {ty}", result.name),
+        None => result.name.to_string(),
+    });
+    let which = match &result.catalog_name {
+        Some(name) => format!("the result `{name}` of `{}`", result.service),
+        None => format!("a result of `{}`", result.service),
+    };
+    write!(
+        out,
+        "\n\nAction result, {which}, bound in `{}`: what the call gave back when it was done (the robot's own). None until then, and after a call stopped by its timeout.",
+        mission.owner_name(owner)
+    )
+    .ok();
+    Some(out)
 }
 
 /// A parameter: whose it is, what it means, and what its uses ask of each

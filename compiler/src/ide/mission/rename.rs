@@ -128,6 +128,7 @@ fn renamable(symbol: &Symbol) -> Result<(), RenameError> {
         | Symbol::Function(_)
         | Symbol::TeamVariable { .. }
         | Symbol::Parameter { .. }
+        | Symbol::Result { .. }
         | Symbol::CountedGroup { .. } => Ok(()),
         Symbol::User => {
             refuse("`USER` is the operator's console, a built-in name; it cannot be renamed")
@@ -298,6 +299,7 @@ fn clash(
         Symbol::Parameter { owner, .. } => {
             parameter_clash(analysis, catalog, text, symbol, *owner, new)
         }
+        Symbol::Result { owner, .. } => result_clash(analysis, catalog, *owner, new),
         Symbol::User
         | Symbol::RobotType(_)
         | Symbol::Capability(_)
@@ -305,6 +307,41 @@ fn clash(
         | Symbol::Value { .. }
         | Symbol::Constant(_) => None,
     }
+}
+
+/// What a result name of `owner`'s body, renamed to `new`, would clash
+/// with: another result or a parameter of the body, a value robots read or
+/// a team variable (E045).
+fn result_clash(
+    analysis: &CheckedMission,
+    catalog: &Catalog,
+    owner: crate::sema::ParamOwner,
+    new: &str,
+) -> Option<String> {
+    let mission = &analysis.mission;
+    let whose = mission.owner_name(owner);
+    if mission.results(owner).iter().any(|r| r.name == new) {
+        return Some(format!("`{whose}` already binds a result `{new}`"));
+    }
+    if mission.params(owner).iter().any(|p| p.name == new) {
+        return Some(format!("`{whose}` already has a parameter `{new}`"));
+    }
+    if let Some((_, r)) = catalog.types().find(|(_, r)| r.value(new).is_some()) {
+        return Some(format!(
+            "robot type {} has a value `{new}`: the result would hide it",
+            r.name
+        ));
+    }
+    if mission
+        .teams
+        .iter()
+        .any(|t| t.variables.iter().any(|v| v == new))
+    {
+        return Some(format!(
+            "`{new}` is a team variable: the result would hide it"
+        ));
+    }
+    None
 }
 
 /// What a parameter of `owner` (a function, a service, a mode), renamed

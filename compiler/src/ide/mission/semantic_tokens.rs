@@ -142,6 +142,9 @@ fn classify(symbol: &Symbol) -> (TokenKind, u32) {
         Symbol::Constant(_) => (TokenKind::Constant, 0),
         Symbol::CountedGroup { .. } => (TokenKind::Group, 0),
         Symbol::Parameter { .. } => (TokenKind::Parameter, 0),
+        // A result is a variable of the robot running the body: the
+        // standard type, which themes colour.
+        Symbol::Result { .. } => (TokenKind::Variable, 0),
     }
 }
 

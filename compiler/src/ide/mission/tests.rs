@@ -828,3 +828,59 @@ fn a_counted_group_name_is_highlighted_and_its_hover_says_its_minimum_and_its_ro
         .collect();
     assert_eq!(groups, [("Room1", "group"), ("Room2", "group")]);
 }
+
+/// Action results in the editor, in a function's body: completion offers
+/// those bound before the cursor, rename refuses a name the body already
+/// has or a robot value, semantic tokens mark them as variables, and the
+/// service's hover lists what it gives back.
+#[test]
+fn action_results_in_the_editor() {
+    let catalog = builtin();
+    let text = "{ R: TIEvalbot ti }\ndef look(TARGET) {\n  FOUND, WHERE = search(TARGET)\n  if (FOUND) move(WHERE)\n}\nR.Action.Go {\n  look(red)\n} repeat(1 SEC)\nR.GO { set(Action, Go) }\nR.main { default: mode = GO }\n";
+    let analysis = crate::check_source(FileId(0), text, catalog);
+    assert!(
+        analysis.diagnostics.is_empty(),
+        "{:#?}",
+        analysis.diagnostics
+    );
+    let config = CompletionConfig { snippets: true };
+    let after = text.find("if (FOUND").unwrap() + 4;
+    let items = completions(&analysis, catalog, text, after, config);
+    assert_eq!(
+        labels_of(&items, CompletionKind::Result),
+        ["FOUND", "WHERE"]
+    );
+    assert_eq!(labels_of(&items, CompletionKind::Parameter), ["TARGET"]);
+    let before = text.find("FOUND, WHERE").unwrap();
+    let items = completions(&analysis, catalog, text, before, config);
+    assert!(labels_of(&items, CompletionKind::Result).is_empty());
+
+    let read = text.find("move(WHERE)").unwrap() + 6;
+    let clash = super::rename::rename(&analysis, catalog, text, read, "FOUND").unwrap_err();
+    assert!(
+        clash.to_string().contains("already binds a result `FOUND`"),
+        "{clash}"
+    );
+    let clash = super::rename::rename(&analysis, catalog, text, read, "TARGET").unwrap_err();
+    assert!(
+        clash.to_string().contains("already has a parameter"),
+        "{clash}"
+    );
+    let clash = super::rename::rename(&analysis, catalog, text, read, "LOCATION").unwrap_err();
+    assert!(
+        clash.to_string().contains("has a value `LOCATION`"),
+        "{clash}"
+    );
+
+    let tokens = super::semantic_tokens::semantic_tokens(&analysis, None);
+    let variables: Vec<&str> = tokens
+        .iter()
+        .filter(|t| t.kind == super::semantic_tokens::TokenKind::Variable)
+        .map(|t| &text[t.span.range()])
+        .collect();
+    assert_eq!(variables, ["FOUND", "WHERE", "FOUND", "WHERE"]);
+
+    let h = hover(&analysis, catalog, text, read).expect("a hover");
+    assert!(h.markdown.contains("WHERE: location"), "{}", h.markdown);
+    assert!(h.markdown.contains("bound in `look`"), "{}", h.markdown);
+}

@@ -637,6 +637,27 @@ impl Fingerprint {
             self.text(&task.service);
             // Read only while the graph's iteration is under way.
             self.int((task.graph_until - self.now).max(0));
+            // What a call gives back, read only when the scenario gives
+            // results (a state without them fingerprints as before).
+            if robot.service_results.is_empty() {
+                continue;
+            }
+            self.int(task.stopped as i64);
+            match &task.reply {
+                None => self.int(-1),
+                Some(values) => {
+                    self.int(values.len() as i64);
+                    for v in values.iter() {
+                        match v {
+                            None => self.int(-1),
+                            Some(text) => self.text(text),
+                        }
+                    }
+                }
+            }
+        }
+        for &n in &robot.calls_done {
+            self.int(n as i64);
         }
         // The sensor values: the latest entry and when it came (a sample
         // may not have read it yet).
