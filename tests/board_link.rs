@@ -184,10 +184,18 @@ fn the_scout_on_an_stm32_in_qemu_on_the_serial_link_behaves_as_in_the_simulator(
     );
 }
 
+/// The boards' runs take turns: each is a real-time run of QEMU, a gateway
+/// and two Linux robots, and two at once would only load the machine they
+/// keep pace with.
+static ONE_BOARD_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 fn behaves_as_in_the_simulator(test: &str, on: Board) {
     if !robots::board_tools_present(test) {
         return;
     }
+    let _turn = ONE_BOARD_AT_A_TIME
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
     let Some(mut fleet) = Fleet::start(&format!("board-link-{}", on.machine)) else {
         return;
     };
