@@ -131,6 +131,24 @@ impl<'a> Checker<'a> {
         owners
     }
 
+    /// What a name declared in a body (a parameter, a result) would hide
+    /// there: a value some robot type of the catalog reads, or a team
+    /// variable of the mission (E045: one meaning per name).
+    pub(super) fn hidden_by(&self, name: &str) -> Option<String> {
+        let value_of = self
+            .catalog
+            .types()
+            .find(|(_, r)| r.value(name).is_some())
+            .map(|(_, r)| r.name.clone());
+        match value_of {
+            Some(ty) => Some(format!("the value `{name}` of robot type {ty}")),
+            None if self.variables.contains_key(name) => {
+                Some(format!("the team variable `{name}`"))
+            }
+            None => None,
+        }
+    }
+
     /// E045: a parameter named like a value some robot type of the catalog
     /// reads, or a team variable of the mission. In the body the bare name
     /// would mean the parameter, so the value could not be read there by
@@ -140,20 +158,9 @@ impl<'a> Checker<'a> {
         let mut found = Vec::new();
         for owner in self.param_owners() {
             for param in self.mission.params(owner) {
-                let name = &param.name;
-                let value_of = self
-                    .catalog
-                    .types()
-                    .find(|(_, r)| r.value(name).is_some())
-                    .map(|(_, r)| r.name.clone());
-                let hidden = match value_of {
-                    Some(ty) => format!("the value `{name}` of robot type {ty}"),
-                    None if self.variables.contains_key(name) => {
-                        format!("the team variable `{name}`")
-                    }
-                    None => continue,
-                };
-                found.push((owner, param.span, name.clone(), hidden));
+                if let Some(hidden) = self.hidden_by(&param.name) {
+                    found.push((owner, param.span, param.name.clone(), hidden));
+                }
             }
         }
         for (owner, span, name, hidden) in found {

@@ -70,22 +70,13 @@ impl<'a> Checker<'a> {
         for owner in owners {
             for result in self.mission.results(owner) {
                 let name = &result.name;
-                let value_of = self
-                    .catalog
-                    .types()
-                    .find(|(_, r)| r.value(name).is_some())
-                    .map(|(_, r)| r.name.clone());
-                let hidden = match value_of {
-                    Some(ty) => format!("the value `{name}` of robot type {ty}"),
-                    None if self.variables.contains_key(name) => {
-                        format!("the team variable `{name}`")
-                    }
-                    None if self.mission.params(owner).iter().any(|p| &p.name == name) => {
-                        format!("the parameter `{name}`")
-                    }
-                    None => continue,
-                };
-                found.push((owner, result.span, name.clone(), hidden));
+                let hidden = self.hidden_by(name).or_else(|| {
+                    let param = self.mission.params(owner).iter().any(|p| &p.name == name);
+                    param.then(|| format!("the parameter `{name}`"))
+                });
+                if let Some(hidden) = hidden {
+                    found.push((owner, result.span, name.clone(), hidden));
+                }
             }
         }
         for (owner, span, name, hidden) in found {
