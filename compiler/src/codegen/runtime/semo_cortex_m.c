@@ -31,6 +31,9 @@
 #define ICSR REG(0xE000ED04u)
 #define ICSR_PENDSTCLR (1u << 25)
 #define ICSR_PENDSTSET (1u << 26)
+/* The shortest sleep: SysTick's reload value is the period less one, and
+ * a reload value of 0 disables it. */
+#define MIN_SLEEP_CYCLES 2u
 /* SysTick counts down 24 bits: its longest period. */
 #define SYSTICK_MAX_CYCLES (1u << 24)
 #define CYCLES_PER_MS (SEMO_CPU_HZ / 1000u)
@@ -152,7 +155,11 @@ void semo__board_sleep_until(int64_t deadline_ms)
     uint64_t now = g_period_start + counted;
     /* INT64_MAX: no deadline (only an interrupt ends the sleep). */
     uint64_t deadline = deadline_ms >= INT64_MAX / CYCLES_PER_MS ? UINT64_MAX : (uint64_t)deadline_ms * CYCLES_PER_MS;
-    if (!period_ended() && deadline > now) {
+    /* A period of one cycle would be a reload value of 0, which stops
+     * SysTick for good (the clock would stand still and the sleep never
+     * end): a deadline closer than MIN_SLEEP_CYCLES is waited for awake,
+     * the caller looking at the time again. */
+    if (!period_ended() && deadline > now && deadline - now >= MIN_SLEEP_CYCLES) {
         uint64_t wait = deadline - now;
         g_period_start = now;
         start_period(wait < SYSTICK_MAX_CYCLES ? (uint32_t)wait : SYSTICK_MAX_CYCLES);
