@@ -30,7 +30,13 @@ impl<'a> Checker<'a> {
     ) -> Vec<ResultInfo> {
         let mut results: Vec<ResultInfo> = Vec::new();
         let mut calls = Vec::new();
-        bindings(body, &mut calls);
+        body.walk(&mut |stmt| {
+            if let StmtKind::Call(call) = &stmt.kind
+                && !call.results.is_empty()
+            {
+                calls.push(call);
+            }
+        });
         for call in calls {
             for name in &call.results {
                 let key = (owner, name.name.clone());
@@ -230,36 +236,6 @@ impl<'a> Checker<'a> {
 }
 
 /// Every call that binds results in `block`, in the order written.
-fn bindings<'b>(block: &'b ast::Block, out: &mut Vec<&'b ast::Call>) {
-    for stmt in &block.stmts {
-        binding_stmt(stmt, out);
-    }
-}
-
-fn binding_stmt<'b>(stmt: &'b ast::Stmt, out: &mut Vec<&'b ast::Call>) {
-    match &stmt.kind {
-        StmtKind::Call(c) if !c.results.is_empty() => out.push(c),
-        StmtKind::If(i) => {
-            bindings(&i.then_block, out);
-            match i.else_branch.as_deref() {
-                Some(ast::Else::If(s)) => binding_stmt(s, out),
-                Some(ast::Else::Block(b)) => bindings(b, out),
-                None => {}
-            }
-        }
-        StmtKind::Loop(l) => bindings(&l.body, out),
-        StmtKind::Group(g) => {
-            for arm in &g.arms {
-                bindings(&arm.body, out);
-            }
-            if let Some(others) = &g.others {
-                bindings(&others.body, out);
-            }
-        }
-        _ => {}
-    }
-}
-
 /// Whether two robot types' service gives back the same results (names and
 /// types, in order).
 fn same_results(a: &[ResultDef], b: &[ResultDef]) -> bool {

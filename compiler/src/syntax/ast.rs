@@ -549,8 +549,9 @@ impl Attr {
 }
 
 impl Block {
-    /// Calls `f` on every statement of the block, nested ones included, in order.
-    pub fn walk(&self, f: &mut impl FnMut(&Stmt)) {
+    /// Calls `f` on every statement of the block, nested ones included, in
+    /// order (with the block's lifetime: `f` may keep what it is given).
+    pub fn walk<'s>(&'s self, f: &mut impl FnMut(&'s Stmt)) {
         for stmt in &self.stmts {
             stmt.walk(f);
         }
@@ -559,7 +560,7 @@ impl Block {
 
 impl Stmt {
     /// Calls `f` on this statement and every statement nested in it.
-    pub fn walk(&self, f: &mut impl FnMut(&Stmt)) {
+    pub fn walk<'s>(&'s self, f: &mut impl FnMut(&'s Stmt)) {
         f(self);
         match &self.kind {
             StmtKind::If(i) => {
