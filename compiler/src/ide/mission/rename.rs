@@ -326,22 +326,27 @@ fn result_clash(
     if mission.params(owner).iter().any(|p| p.name == new) {
         return Some(format!("`{whose}` already has a parameter `{new}`"));
     }
+    Some(match hidden_by(analysis, catalog, new)? {
+        Hidden::Value(ty) => {
+            format!("robot type {ty} has a value `{new}`: the result would hide it")
+        }
+        Hidden::Variable => format!("`{new}` is a team variable: the result would hide it"),
+    })
+}
+
+/// What a parameter or result renamed to `new` would hide (E045): a value
+/// some robot type reads (that type), or a team variable.
+enum Hidden<'c> {
+    Value(&'c str),
+    Variable,
+}
+
+fn hidden_by<'c>(analysis: &CheckedMission, catalog: &'c Catalog, new: &str) -> Option<Hidden<'c>> {
     if let Some((_, r)) = catalog.types().find(|(_, r)| r.value(new).is_some()) {
-        return Some(format!(
-            "robot type {} has a value `{new}`: the result would hide it",
-            r.name
-        ));
+        return Some(Hidden::Value(&r.name));
     }
-    if mission
-        .teams
-        .iter()
-        .any(|t| t.variables.iter().any(|v| v == new))
-    {
-        return Some(format!(
-            "`{new}` is a team variable: the result would hide it"
-        ));
-    }
-    None
+    let variable = (analysis.mission.teams.iter()).any(|t| t.variables.iter().any(|v| v == new));
+    variable.then_some(Hidden::Variable)
 }
 
 /// What a parameter of `owner` (a function, a service, a mode), renamed
@@ -366,20 +371,18 @@ fn parameter_clash(
             other.name
         ));
     }
-    if let Some((_, r)) = catalog.types().find(|(_, r)| r.value(new).is_some()) {
-        return Some(format!(
-            "`{new}` is a value of robot type {}: the parameter would hide it",
-            r.name
-        ));
-    }
-    if mission
-        .teams
-        .iter()
-        .any(|t| t.variables.iter().any(|v| v == new))
-    {
-        return Some(format!(
-            "`{new}` is a team variable: the parameter would hide it"
-        ));
+    match hidden_by(analysis, catalog, new) {
+        Some(Hidden::Value(ty)) => {
+            return Some(format!(
+                "`{new}` is a value of robot type {ty}: the parameter would hide it"
+            ));
+        }
+        Some(Hidden::Variable) => {
+            return Some(format!(
+                "`{new}` is a team variable: the parameter would hide it"
+            ));
+        }
+        None => {}
     }
     let body = match owner {
         ParamOwner::Function(f) => {
