@@ -167,6 +167,19 @@ fn gateway(broker: &str, link_port: u16, run: &str) -> Child {
         .expect("semo gateway starts")
 }
 
+/// Stops the gateway `gw` of `fleet`; what it said on standard error.
+fn stopped_saying(fleet: &mut Fleet, gw: usize) -> String {
+    fleet.processes.kill(gw);
+    let mut said = String::new();
+    fleet.processes.0[gw]
+        .stderr
+        .take()
+        .expect("the gateway's standard error is piped")
+        .read_to_string(&mut said)
+        .unwrap();
+    said
+}
+
 #[test]
 fn a_link_robot_is_a_member_of_the_fleet_on_its_own_topics_only() {
     let Some(mut fleet) = Fleet::start("gateway-bridge") else {
@@ -268,14 +281,7 @@ fn a_link_robot_is_a_member_of_the_fleet_on_its_own_topics_only() {
     assert!(fleet.processes.is_running(gw));
     let (_again, _) = listener.accept().expect("the gateway connects again");
     // Every refusal was counted and said.
-    fleet.processes.kill(gw);
-    let mut said = String::new();
-    fleet.processes.0[gw]
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut said)
-        .unwrap();
+    let said = stopped_saying(&mut fleet, gw);
     assert!(
         said.contains("ti: refused a send to MasterTeam: its datagram names MasterTeam/irobot as the sender, not this link's robot (1 refused)"),
         "{said}"
@@ -397,14 +403,7 @@ fn a_message_longer_than_the_board_takes_is_refused_and_the_next_one_arrives() {
     heard(&rx, "the long message");
     heard(&rx, "the short one");
 
-    fleet.processes.kill(gw);
-    let mut said = String::new();
-    fleet.processes.0[gw]
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut said)
-        .unwrap();
+    let said = stopped_saying(&mut fleet, gw);
     assert!(
         said.contains(&format!(
             "ti: a message of {} bytes on {topic} is longer than the robot takes (64 bytes) (1 refused)",
