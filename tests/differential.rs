@@ -753,6 +753,96 @@ fn counted_groups_with_a_spare_are_allocated_the_same_way_in_c_and_in_the_simula
     assert_eq!(groups_at(&sim, 2000)["tb_3"], "others");
 }
 
+/// Nested counted groups (`tests/fixtures/counted_groups/nested.mission`:
+/// two rooms of at least two, and in each room one sweeper): tb_0 (Room1's
+/// sweeper) killed at 1 s, tb_3 at 2.6 s, tb_0 restarted at 4 s. Both
+/// engines agree event for event; once the losses are known, each room has
+/// its minimum and exactly one sweeper among its own live robots: the inner
+/// statement splits the room's robots, not the team's.
+#[test]
+fn nested_counted_groups_split_each_room_the_same_way_in_c_and_in_the_simulator() {
+    let fixtures = repo_root().join("tests/fixtures/counted_groups");
+    let scenario = std::fs::read_to_string(fixtures.join("nested.scenario.json")).unwrap();
+    let (_, sim) = compare(
+        "counted_nested",
+        &fixtures.join("nested.mission"),
+        &scenario,
+    );
+    // Each live robot's room and role at `t`: its latest `allocated` of
+    // each statement (the rooms are named Room*, the roles not).
+    let rooms_at = |t: i64| -> BTreeMap<String, Vec<String>> {
+        let mut room: BTreeMap<String, (String, String)> = BTreeMap::new();
+        for e in sim.iter().filter(|e| e["t"].as_i64().unwrap() <= t) {
+            let robot = field(e, "robot").to_string();
+            match field(e, "event") {
+                "allocated" => {
+                    let entry = room.entry(robot).or_default();
+                    let name = field(e, "name").to_string();
+                    if name.starts_with("Room") {
+                        entry.0 = name;
+                    } else {
+                        entry.1 = name;
+                    }
+                }
+                "fault" if field(e, "fault") == "kill" => {
+                    room.remove(&robot);
+                }
+                _ => {}
+            }
+        }
+        let mut rooms: BTreeMap<String, Vec<String>> = BTreeMap::new();
+        for (robot, (name, role)) in room {
+            rooms
+                .entry(name)
+                .or_default()
+                .push(format!("{robot} {role}"));
+        }
+        rooms
+    };
+    let expected = |rooms: &[(&str, &[&str])]| -> BTreeMap<String, Vec<String>> {
+        rooms
+            .iter()
+            .map(|(name, robots)| {
+                (
+                    name.to_string(),
+                    robots.iter().map(|r| r.to_string()).collect(),
+                )
+            })
+            .collect()
+    };
+    assert_eq!(
+        rooms_at(500),
+        expected(&[
+            ("Room1", &["tb_0 Sweeper", "tb_1 others", "tb_4 others"]),
+            ("Room2", &["tb_2 Sweeper", "tb_3 others", "tb_5 others"]),
+        ])
+    );
+    assert_eq!(
+        rooms_at(2000),
+        expected(&[
+            ("Room1", &["tb_1 Sweeper", "tb_2 others", "tb_5 others"]),
+            ("Room2", &["tb_3 Sweeper", "tb_4 others"]),
+        ]),
+        "tb_0 lost: tb_1 sweeps Room1"
+    );
+    assert_eq!(
+        rooms_at(3500),
+        expected(&[
+            ("Room1", &["tb_1 Sweeper", "tb_2 others"]),
+            ("Room2", &["tb_4 Sweeper", "tb_5 others"]),
+        ]),
+        "tb_3 lost too"
+    );
+    assert_eq!(
+        rooms_at(6000),
+        expected(&[
+            ("Room1", &["tb_0 Sweeper", "tb_1 others", "tb_5 others"]),
+            ("Room2", &["tb_2 Sweeper", "tb_4 others"]),
+        ]),
+        "tb_0 back"
+    );
+}
+
 /// Functions with parameters (`tests/fixtures/parameters/patrol.mission`):
 /// the generated C runs the inlined calls, each argument in its parameter's
 /// place, as the simulator does, event for event (`tests/simulate.rs`

@@ -13,7 +13,7 @@ use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms, lost_after_ms};
 use crate::refine::{
-    ActionMachine, ActionMachineId, ControlMachine, CountedGroup, Expr, IncomingId,
+    ActionMachine, ActionMachineId, ControlMachine, CountedGroup, EnclosingArm, Expr, IncomingId,
     LeaderAlgorithm, MarkId, ModeId, Operand, OutgoingId, PeerId, RobotProgram, SendItem, SlotId,
     SlotSource, State, StateId, StateKind, SubscriptionId, SyncPointId, ValueKind,
 };
@@ -78,10 +78,13 @@ const GROUP_ALLOCATE: Template = template!(
         "mins",
         "names",
         "at",
-        "count",
         "groups",
         "has_others",
-        "others"
+        "others",
+        "narrow",
+        "sharing",
+        "last",
+        "forget"
     ]
 );
 const GROUP_SYNC: Template = template!(
@@ -124,6 +127,7 @@ pub(super) const TEMPLATES: &[Template] = &[
     DROP_UNLED,
     ELECTED,
     GROUP_OF,
+    NARROW_TO_ARM,
     LEADING,
     REGION,
     CATCH_EVENT_HEAD,
@@ -202,6 +206,10 @@ fn group_update(m: &ControlMachine, peers: &Peers) -> String {
 /// `refine::counted_allocation` over the live members, as the simulator's
 /// `GroupAllocate` applies it.
 const GROUP_OF: Template = template!("control/group_of.c.in", ["lost"]);
+
+/// Nested counted groups: the members a robot splits with, by the rule of
+/// `refine::members_sharing_arms`.
+const NARROW_TO_ARM: Template = template!("control/narrow_to_arm.c.in", []);
 
 /// `leading` and the terms a robot's heartbeats say, and `own_battery`:
 /// this robot's battery level for its heartbeats, the scenario's (in
@@ -292,6 +300,14 @@ pub fn control_task(program: &RobotProgram, words: &Words, peers: &Peers, header
     // `ControlMachine::elections`.
     let mut election = 0;
     for (i, service) in m.services.iter().enumerate() {
+        // The group each statement of counted groups last gave this robot
+        // (-1 others, -2 none yet): at file scope, so that a statement can
+        // make the ones nested in its arms forget theirs.
+        for (pc, state) in service.states.iter().enumerate() {
+            if matches!(state.kind, StateKind::GroupAllocate { .. }) {
+                let _ = writeln!(body, "static long allocated_{i}_{pc} = -2;");
+            }
+        }
         let _ = writeln!(
             body,
             "/* {}.{}.{} ({}:{}) */\nstatic int service_{i}(region *r)\n{{\n    switch (r->pc) {{",
@@ -302,7 +318,7 @@ pub fn control_task(program: &RobotProgram, words: &Words, peers: &Peers, header
             service.line
         );
         for (pc, state) in service.states.iter().enumerate() {
-            emit_state(&mut body, program, words, peers, (pc, election), state);
+            emit_state(&mut body, program, words, peers, (i, pc, election), state);
             if matches!(state.kind, StateKind::LeaderBranch { .. }) {
                 election += 1;
             }
@@ -488,6 +504,10 @@ fn emit_helpers(out: &mut String, program: &RobotProgram, body: &str) {
         ));
     }
 
+    if uses("narrow_to_arm") {
+        out.push_str(NARROW_TO_ARM.text);
+    }
+
     if uses("drop_unled") {
         out.push_str(&fill(&DROP_UNLED, &[("reason", &c::string(UNLED_REASON))]));
     }
@@ -574,6 +594,9 @@ struct StateCx<'a> {
     /// The index of the state's election among
     /// [`ControlMachine::elections`] (for a `LeaderBranch` state).
     election: usize,
+    /// The state's service (`service_K`) and its own number.
+    service: usize,
+    pc: usize,
     next: usize,
     line: u32,
 }
@@ -586,7 +609,7 @@ fn emit_state(
     program: &RobotProgram,
     words: &Words,
     peers: &Peers,
-    (pc, election): (usize, usize),
+    (service, pc, election): (usize, usize, usize),
     state: &State,
 ) {
     let _ = writeln!(
@@ -600,6 +623,8 @@ fn emit_state(
         words,
         peers,
         election,
+        service,
+        pc,
         next: pc + 1,
         line: state.line,
     };
@@ -639,7 +664,9 @@ fn emit_state(
             members,
             groups,
             others_at,
-        } => emit_group_allocate(out, &cx, members, groups, others_at),
+            within,
+            nested,
+        } => emit_group_allocate(out, &cx, members, groups, others_at, (within, nested)),
         StateKind::GroupSync {
             members,
             point,
@@ -1027,14 +1054,56 @@ fn emit_group_allocate(
     members: &[PeerId],
     groups: &[CountedGroup],
     others_at: &Option<StateId>,
+    (within, nested): (&[EnclosingArm], &[StateId]),
 ) {
-    let StateCx { peers, next, .. } = *cx;
+    let StateCx {
+        peers,
+        next,
+        service,
+        pc,
+        ..
+    } = *cx;
     let join = |items: Vec<String>| items.join(", ");
     let members_list = peers.locals(members);
-    let mins = join(groups.iter().map(|g| g.min.to_string()).collect());
+    let mins_of = |mins: &[usize]| join(mins.iter().map(|m| m.to_string()).collect());
+    let mins = mins_of(&groups.iter().map(|g| g.min).collect::<Vec<_>>());
     let names = join(groups.iter().map(|g| c::string(&g.name)).collect());
     let at = join(groups.iter().map(|g| g.at.index().to_string()).collect());
     let others = others_at.map_or(next, |o| o.index());
+    // Nested: narrow the members level by level to the arms this robot runs.
+    let mut narrow = String::new();
+    let mut from = ("NULL".to_string(), "0".to_string());
+    for (level, arm) in within.iter().enumerate() {
+        let _ = write!(
+            narrow,
+            "\n        static const size_t within{level}_members[] = {{{}}};\n        static const size_t within{level}_mins[] = {{{}}};\n        size_t kept{level}[{n}];\n        size_t n_kept{level} = narrow_to_arm(kept{level}, {}, {}, within{level}_members, {n}, within{level}_mins, {}, {}, {});",
+            peers.locals(&arm.members),
+            mins_of(&arm.mins),
+            from.0,
+            from.1,
+            arm.mins.len(),
+            arm.has_others,
+            arm.arm.map_or(-1, |k| k as i64),
+            n = arm.members.len(),
+        );
+        from = (format!("kept{level}"), format!("n_kept{level}"));
+    }
+    let forget: String = nested
+        .iter()
+        .map(|inner| format!("\n            allocated_{service}_{} = -2;", inner.index()))
+        .collect();
+    let sharing = if within.is_empty() {
+        format!("members, {}", members.len())
+    } else {
+        let _ = write!(
+            narrow,
+            "\n        size_t sharing[{n}];\n        size_t n_sharing = sharing_arms(sharing, members, {n}, {}, {});",
+            from.0,
+            from.1,
+            n = members.len(),
+        );
+        "sharing, n_sharing".to_string()
+    };
     out.push_str(&fill(
         &GROUP_ALLOCATE,
         &[
@@ -1042,10 +1111,13 @@ fn emit_group_allocate(
             ("mins", &mins),
             ("names", &names),
             ("at", &at),
-            ("count", &members.len()),
             ("groups", &groups.len()),
             ("has_others", &others_at.is_some()),
             ("others", &others),
+            ("narrow", &narrow),
+            ("sharing", &sharing),
+            ("last", &format!("allocated_{service}_{pc}")),
+            ("forget", &forget),
         ],
     ));
 }

@@ -648,10 +648,20 @@ pub enum StateKind {
     /// fewer live members than the sum, the later groups are short
     /// ([`counted_allocation`]). The robot continues at its group's `at`;
     /// a change of its group is traced (`allocated`).
+    ///
+    /// Nested in arms of other counted groups (`within`, outermost first),
+    /// the members are only those the enclosing statements put, by the same
+    /// rule from the same view, in the arms this robot runs
+    /// ([`members_sharing_arms`]): a room's robots split among themselves.
+    /// `nested`: the statements of counted groups written in its arms (of
+    /// this service): when this robot's group here changes, they forget the
+    /// group they last gave it, so its group there is traced again.
     GroupAllocate {
         members: Vec<PeerId>,
         groups: Vec<CountedGroup>,
         others_at: Option<StateId>,
+        within: Vec<EnclosingArm>,
+        nested: Vec<StateId>,
     },
     /// The start of a group statement when the team's strategy has
     /// `<GroupSync timeout>`: tell the team this robot has arrived (its
@@ -703,6 +713,81 @@ pub struct CountedGroup {
     pub min: usize,
     /// The first state of the arm's block.
     pub at: StateId,
+}
+
+/// An arm of counted groups that a nested statement of counted groups is
+/// written in ([`StateKind::GroupAllocate`]'s `within`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnclosingArm {
+    /// The enclosing statement's members (formation order).
+    pub members: Vec<PeerId>,
+    /// Its groups' minimums (declaration order).
+    pub mins: Vec<usize>,
+    pub has_others: bool,
+    /// The arm: `Some(k)`, the `k`-th group; `None`, `others`.
+    pub arm: Option<usize>,
+}
+
+/// The members of a nested statement of counted groups that this robot
+/// (`me`) splits with: those of `members` that are alive and that every
+/// enclosing statement (`within`, outermost first) puts in the arm the
+/// statement is written in, each level's rule ([`counted_allocation`])
+/// applied to the live robots the levels above kept, in formation order;
+/// and `me` itself, which runs the statement whatever its view says. With
+/// no enclosing arm, the live members. One rule for the simulator and the
+/// generated C (`narrow_to_arm` in `codegen/control.rs`). Every list is
+/// ascending, so each level is one merge: linear in the members.
+pub fn members_sharing_arms(
+    within: &[EnclosingArm],
+    members: &[PeerId],
+    me: PeerId,
+    alive: impl Fn(PeerId) -> bool,
+) -> Vec<PeerId> {
+    let mut kept: Option<Vec<PeerId>> = None;
+    for level in within {
+        let mut next = Vec::new();
+        let mut position = 0;
+        let mut cursor = Ascending::new(kept.as_deref());
+        for &peer in &level.members {
+            if !cursor.holds(peer) || !alive(peer) {
+                continue;
+            }
+            if counted_allocation(&level.mins, level.has_others, position) == level.arm {
+                next.push(peer);
+            }
+            position += 1;
+        }
+        kept = Some(next);
+    }
+    let mut cursor = Ascending::new(kept.as_deref());
+    members
+        .iter()
+        .copied()
+        .filter(|&peer| (cursor.holds(peer) && alive(peer)) || peer == me)
+        .collect()
+}
+
+/// Membership in an ascending list, asked in ascending order: one merge.
+/// `None` holds every peer.
+struct Ascending<'a> {
+    list: Option<&'a [PeerId]>,
+    at: usize,
+}
+
+impl<'a> Ascending<'a> {
+    fn new(list: Option<&'a [PeerId]>) -> Self {
+        Ascending { list, at: 0 }
+    }
+
+    fn holds(&mut self, peer: PeerId) -> bool {
+        let Some(list) = self.list else {
+            return true;
+        };
+        while self.at < list.len() && list[self.at] < peer {
+            self.at += 1;
+        }
+        self.at < list.len() && list[self.at] == peer
+    }
 }
 
 /// Where a statement of counted groups puts the live member at `position`

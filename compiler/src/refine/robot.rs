@@ -55,6 +55,7 @@ pub(super) fn refine_robot(
         action_machines: HashMap::new(),
         current_service: None,
         arguments: Vec::new(),
+        counted_within: Vec::new(),
         diagnostics: Vec::new(),
     };
     builder.build_modes();
@@ -163,6 +164,9 @@ struct Builder<'a, 'i> {
     /// refined where the parameter is used, in the caller's frame, as a
     /// hand-written copy would be (the same slots, made in the same order).
     arguments: Vec<Vec<ast::Arg>>,
+    /// The arms of counted groups the statement being refined is written
+    /// in, outermost first (a nested statement splits only its arm's robots).
+    counted_within: Vec<EnclosingArm>,
     diagnostics: Vec<Diagnostic>,
 }
 
@@ -656,18 +660,7 @@ impl Builder<'_, '_> {
             .collect();
         let (_, heartbeat_ms) = self.leader_selection();
         self.need_heartbeat(heartbeat_ms.unwrap_or(HEARTBEAT_MS));
-        let allocate = self.push(
-            states,
-            StateKind::GroupAllocate {
-                members,
-                groups: Vec::new(),
-                others_at: None,
-            },
-            span,
-        );
-        states[allocate.index()].text = "counted groups: this robot's group".into();
-        let mut groups = Vec::new();
-        let mut ends = Vec::new();
+        let mut named = Vec::new();
         for arm in &g.arms {
             let (Some(name), Some(min)) = (arm.condition.counted_name(), &arm.condition.min) else {
                 self.internal_error(
@@ -680,29 +673,59 @@ impl Builder<'_, '_> {
                 self.internal_error(min.count.span, "a counted group's min the checker refused");
                 return;
             };
-            groups.push(CountedGroup {
-                name: name.name.to_string(),
-                min: min as usize,
-                at: StateId::new(states.len()),
-            });
+            named.push((name.name.to_string(), min as usize));
+        }
+        let allocate = self.push(
+            states,
+            StateKind::GroupAllocate {
+                members: members.clone(),
+                groups: Vec::new(),
+                others_at: None,
+                within: self.counted_within.clone(),
+                nested: Vec::new(),
+            },
+            span,
+        );
+        states[allocate.index()].text = "counted groups: this robot's group".into();
+        let enclosing = |arm| EnclosingArm {
+            members: members.clone(),
+            mins: named.iter().map(|(_, min)| *min).collect(),
+            has_others: g.others.is_some(),
+            arm,
+        };
+        let mut groups = Vec::new();
+        let mut ends = Vec::new();
+        for (k, (arm, (name, min))) in g.arms.iter().zip(named.iter().cloned()).enumerate() {
+            let at = StateId::new(states.len());
+            self.counted_within.push(enclosing(Some(k)));
             self.block(&arm.body, states, marks, depth);
+            self.counted_within.pop();
             let jump = self.push_forward(states, span, |to| StateKind::Jump { to });
-            states[jump.0.index()].text = format!("end of group {}", name.name);
+            states[jump.0.index()].text = format!("end of group {name}");
             ends.push(jump);
+            groups.push(CountedGroup { name, min, at });
         }
         let others_at = g.others.as_ref().map(|others| {
             let at = StateId::new(states.len());
+            self.counted_within.push(enclosing(None));
             self.block(&others.body, states, marks, depth);
+            self.counted_within.pop();
             at
         });
+        let inner: Vec<StateId> = (allocate.index() + 1..states.len())
+            .filter(|&i| matches!(states[i].kind, StateKind::GroupAllocate { .. }))
+            .map(StateId::new)
+            .collect();
         if let StateKind::GroupAllocate {
             groups: g,
             others_at: o,
+            nested,
             ..
         } = &mut states[allocate.index()].kind
         {
             *g = groups;
             *o = others_at;
+            *nested = inner;
         }
         for jump in ends {
             land(states, jump);

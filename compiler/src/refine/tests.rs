@@ -794,6 +794,7 @@ fn counted_groups_put_every_arm_in_every_program_behind_one_allocation() {
                     members,
                     groups,
                     others_at,
+                    ..
                 } => Some((
                     members.iter().map(|p| p.index()).collect(),
                     groups.iter().map(|g| (g.name.clone(), g.min)).collect(),

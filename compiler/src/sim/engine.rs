@@ -38,7 +38,7 @@ use crate::refine::value::{self, Value};
 use crate::refine::{
     ActionId, ActionMachine, AttributeId, ControlMachine, Expr, IncomingId, LeaderAlgorithm,
     ModeId, Operand, OutgoingId, PeerId, RobotProgram, RoleKind, ServiceMachineId, SlotId,
-    SlotSource, StateId, StateKind, SyncPointId, counted_allocation,
+    SlotSource, StateId, StateKind, SyncPointId, counted_allocation, members_sharing_arms,
 };
 use smallvec::smallvec;
 use std::cell::OnceCell;
@@ -2252,6 +2252,8 @@ impl<'p> Sim<'p> {
                 members,
                 groups,
                 others_at,
+                within,
+                nested,
             } => {
                 // `group_of` in the generated C: the live members (this
                 // robot, or heard within `lost_after_ms` since it joined).
@@ -2261,7 +2263,7 @@ impl<'p> Sim<'p> {
                 let alive = |peer: PeerId| {
                     peer == me || now - robot.heard.get(peer).seen.max(robot.started_at) <= lost
                 };
-                let live: Vec<PeerId> = members.iter().copied().filter(|&p| alive(p)).collect();
+                let live = members_sharing_arms(within, members, me, alive);
                 let position = live.iter().position(|&p| p == me).unwrap_or(0);
                 let mins: Vec<usize> = groups.iter().map(|g| g.min).collect();
                 let chosen = counted_allocation(&mins, others_at.is_some(), position);
@@ -2272,6 +2274,9 @@ impl<'p> Sim<'p> {
                 };
                 let robot = &mut self.robots[r];
                 if robot.allocated.insert((service, StateId::new(pc)), chosen) != Some(chosen) {
+                    for &inner in nested {
+                        robot.allocated.remove(&(service, inner));
+                    }
                     let fields = smallvec![
                         ("name", name.into()),
                         ("alive", live.len().to_string().into()),
