@@ -385,6 +385,35 @@ fn many_functions_with_parameters_cost_in_proportion() {
     );
 }
 
+/// Parameters compared with a literal no argument gives (W020): each
+/// parameter's values are resolved once, from those passed on to it, and
+/// hold a bounded number of values and places to point at, so a parameter
+/// passed on from many functions (`g`'s, from every `f`) costs in
+/// proportion to them.
+#[test]
+fn many_parameters_compared_with_what_no_argument_gives_cost_in_proportion() {
+    scales_linearly(
+        "parameters compared with literals",
+        200,
+        &["check", "--format", "json", "m.mission"],
+        |dir, n| {
+            let mut text =
+                String::from("{ T: TIEvalbot a }\ndef g(P) {\n  if (P == nowhere) standby()\n}\n");
+            for i in 0..n {
+                text.push_str(&format!(
+                    "def f{i}(P) {{\n  g(P)\n  if (P != nowhere) standby()\n}}\n"
+                ));
+            }
+            text.push_str("T.P.S {\n");
+            for i in 0..n {
+                text.push_str(&format!("  f{i}(room{})\n", i % 50));
+            }
+            text.push_str("} repeat()\nT.M { set(P, S) }\nT.main { default: mode = M }\n");
+            std::fs::write(dir.join("m.mission"), text).unwrap();
+        },
+    );
+}
+
 /// Teams that all declare a variable of one name (`T.Status`) and read it:
 /// whether a team has the variable is one lookup, not a walk along the list
 /// of every team that declares the name (x13.7 for ten times the teams).

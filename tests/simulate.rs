@@ -855,4 +855,26 @@ fn action_results_take_the_scenario_s_values_call_by_call() {
         "{}",
         bad.stderr
     );
+
+    // A value the result's type does not read is refused where it is
+    // written, not taken as none (FOUND is a bool in the catalog).
+    let scenario = write(
+        &dir,
+        "wrong.scenario.json",
+        r#"{"robots": {"ti": {"services": {"search": {"ms": 10, "results": [["yes", "3,4"]]}}}}}"#,
+    );
+    let wrong = semo(&[
+        "simulate",
+        &fixtures.join("survey.mission").display().to_string(),
+        "--scenario",
+        &scenario,
+    ]);
+    assert_eq!(wrong.code, 2, "{}", wrong.stderr);
+    assert!(
+        wrong.stderr.contains(
+            ":1:67: result FOUND of search must be a value of its type (bool), not \"yes\""
+        ),
+        "{}",
+        wrong.stderr
+    );
 }

@@ -236,8 +236,8 @@ codes! {
     ParameterNeverUsed = "W015", Warning, "a parameter that is never used (a function's or a composite service's in its body, a mode's in its `set`s): its argument is given for nothing";
     ResultReadBeforeBound = "W016", Warning, "an action result read where no call written before it binds the name: until a call binding it is done, it is none";
     BroadcastToNoOne = "W013", Hint, "a `throw E broadcast` that only one robot runs: its group (or team) has no one else to tell";
-    ComparisonNeverHolds = "W020", Warning, "a comparison of a team variable with a value it is never set to: it never holds";
-    ComparisonAlwaysHolds = "W021", Warning, "`!=` between a team variable and a value it is never set to: it holds whenever the variable has a value";
+    ComparisonNeverHolds = "W020", Warning, "a comparison of a team variable or a parameter with a value it is never given: it never holds";
+    ComparisonAlwaysHolds = "W021", Warning, "`!=` between a team variable or a parameter and a value it is never given: it always holds (a variable, once it has a value)";
     ReadBeforeSent = "W022", Warning, "a value read once, when the mission starts, before any robot can have sent it: it reads none, and nothing sent later is read there";
     ForwardedOnce = "W023", Warning, "a received value sent on once each time its mode starts while another plan of the mode keeps receiving it: what comes later is never sent on";
     ReceiveNeverFed = "W024", Warning, "a receive or subscribe that no robot can ever feed: its sends or publishes never run, or run only on the receiving robot itself";

@@ -224,6 +224,7 @@ pub fn symbol_kind(kind: ide::SymbolKind) -> SymbolKind {
         K::Service | K::Function => SymbolKind::FUNCTION,
         K::Mode | K::Action => SymbolKind::ENUM_MEMBER,
         K::Main => SymbolKind::EVENT,
+        K::Result => SymbolKind::VARIABLE,
     }
 }
 

@@ -24,6 +24,7 @@ fn symbol_kind(kind: &Value) -> &'static str {
         Some(5) => "class",
         Some(8) => "field",
         Some(12) => "function",
+        Some(13) => "variable",
         Some(22) => "enum-member",
         Some(24) => "event",
         other => panic!("unexpected symbol kind {other:?}"),

@@ -201,6 +201,9 @@ pub enum SymbolKind {
     Value,
     /// An action of a strategy service.
     Action,
+    /// A name a mission's function or composite service binds to what a
+    /// service call gives back (`FOUND, WHERE = search(red)`).
+    Result,
 }
 
 /// One entry of a file's outline (document symbols), with the entries inside it.

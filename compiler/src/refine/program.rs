@@ -330,6 +330,21 @@ pub struct ControlMachine {
     /// them into the event queue its control task reads at the start of
     /// each firing; empty when no one can tell it anything.
     pub events_heard: Vec<String>,
+    /// Each built-in service the control task calls (`StateKind::Call`),
+    /// once, in the order first called, with what the robot type's catalog
+    /// entry says it gives back: the scenario's reader checks a service's
+    /// `results` against it (`sim::scenario`), so a value the call's slots
+    /// would read as none is refused where it is written.
+    pub gives_back: Vec<ServiceResults>,
+}
+
+/// A built-in service and its results (`<Result>`), in order: each one's
+/// name and the kind of value it is ([`ValueKind::declared`]); empty when
+/// the service gives nothing back.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ServiceResults {
+    pub service: String,
+    pub results: Vec<(String, ValueKind)>,
 }
 
 /// The key of the messages that carry a team's broadcast events

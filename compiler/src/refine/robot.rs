@@ -948,6 +948,7 @@ impl Builder<'_, '_> {
             return;
         }
         let task = implementing_task(&def.implementation, &service);
+        note_gives_back(&mut self.machine.gives_back, def);
         self.services
             .entry(task.clone())
             .or_default()
@@ -1704,6 +1705,22 @@ impl Builder<'_, '_> {
         });
         IncomingId::new(self.machine.incoming.len() - 1)
     }
+}
+
+/// Records what `def`, a service the control task calls, gives back
+/// ([`ControlMachine::gives_back`]), once per service.
+fn note_gives_back(gives_back: &mut Vec<ServiceResults>, def: &crate::catalog::ServiceDef) {
+    if gives_back.iter().any(|g| g.service == def.name) {
+        return;
+    }
+    gives_back.push(ServiceResults {
+        service: def.name.clone(),
+        results: def
+            .results
+            .iter()
+            .map(|r| (r.name.clone(), ValueKind::declared(&r.ty)))
+            .collect(),
+    });
 }
 
 /// Each publication of a value the robot subscribes to also goes to its own

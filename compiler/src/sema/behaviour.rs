@@ -2,7 +2,7 @@
 //! `case`/`catch`/`mode =` must name modes; every mode should be reachable from
 //! the default, every thrown event caught, every service set somewhere.
 
-use super::body::{ParamRef, Type};
+use super::body::{ParamRef, Type, argument_literal};
 use super::ir::*;
 use super::{Checker, MAX_MODE_COPIES, suggestion};
 use crate::diag::{Code, Severity};
@@ -244,11 +244,16 @@ impl<'a> Checker<'a> {
         }
         let mut fixed = true;
         for (index, arg) in given.iter().enumerate() {
+            let callee = (owner, index as u32);
             match self.fixed_argument(team, arg) {
-                Some(ty) => self
-                    .param_uses
-                    .argument((owner, index as u32), ty, arg.span()),
-                None => fixed = false,
+                Some(ty) => {
+                    let literal = argument_literal(arg, &ty);
+                    self.param_uses.argument(callee, ty, arg.span(), literal);
+                }
+                None => {
+                    self.param_uses.unfixed(callee, arg.span());
+                    fixed = false;
+                }
             }
         }
         if !fixed {
@@ -293,6 +298,10 @@ impl<'a> Checker<'a> {
             1 => format!("1 argument ({})", names.join(", ")),
             n => format!("{n} arguments ({})", names.join(", ")),
         };
+        // What this entry or `set` gives them is not known (value flow).
+        for index in 0..takes {
+            self.param_uses.unfixed((owner, index as u32), span);
+        }
         let what = match owner {
             ParamOwner::Mode(..) => "mode",
             _ => "service",
@@ -381,12 +390,15 @@ impl<'a> Checker<'a> {
                 let (owner, index) = param;
                 self.occurrence(arg.span(), Symbol::Parameter { owner, index }, false);
                 self.param_uses
-                    .argument(callee, Type::Param { param, name }, arg.span());
+                    .argument(callee, Type::Param { param, name }, arg.span(), None);
             } else if let Some(ty) = self.fixed_argument(team, arg) {
                 if let (Some(t), Type::Constant(word)) = (template, &ty) {
                     self.misspelt_mode_parameter(team, t, word, arg.span());
                 }
-                self.param_uses.argument(callee, ty, arg.span());
+                let literal = argument_literal(arg, &ty);
+                self.param_uses.argument(callee, ty, arg.span(), literal);
+            } else {
+                self.param_uses.unfixed(callee, arg.span());
             }
         }
     }

@@ -4,7 +4,7 @@
 //! their body is checked at every call, with the caller's robots.
 
 use super::ir::*;
-use super::values::{Literal, VariableTest, VariableWrite};
+use super::values::{Literal, ParameterTest, VariableTest, VariableWrite};
 use super::{Checker, is_user, suggestion};
 use crate::catalog::{RobotTypeId, ServiceDef, ValueType};
 use crate::diag::Code;
@@ -547,6 +547,11 @@ impl<'a> Checker<'a> {
                     if given == 1 { "is" } else { "are" },
                 ),
             );
+            // What this call gives them is not known (value flow).
+            for index in 0..takes {
+                let param = (ParamOwner::Function(function), index as u32);
+                self.param_uses.unfixed(param, call.args_span);
+            }
         }
         for (index, arg) in call.args.iter().enumerate() {
             let ty = match arg {
@@ -555,7 +560,8 @@ impl<'a> Checker<'a> {
             };
             if index < takes {
                 let callee = (ParamOwner::Function(function), index as u32);
-                self.param_uses.argument(callee, ty, arg.span());
+                let literal = argument_literal(arg, &ty);
+                self.param_uses.argument(callee, ty, arg.span(), literal);
             }
         }
     }
@@ -881,6 +887,21 @@ impl<'a> Checker<'a> {
             for (variable, (other, other_type)) in sides {
                 let constant = literal(other, other_type).map(|c| (c, other.span));
                 self.record_variable_test(variable, constant, op, how, scope);
+            }
+            // `PARAM == C`: what its arguments give decides it (`values`).
+            for (side, other, other_type) in [(&lt, rhs, &rt), (&rt, lhs, &lt)] {
+                if let Type::Param { param, name } = side
+                    && let Some(constant) = literal(other, other_type)
+                {
+                    self.parameter_tests.push(ParameterTest {
+                        param: *param,
+                        name: name.clone(),
+                        equal: op == ast::CmpOp::Eq,
+                        constant,
+                        compared: how,
+                        span: other.span,
+                    });
+                }
             }
         }
         if ordering {
@@ -1811,6 +1832,16 @@ pub(super) fn describe_param(ty: &ValueType) -> String {
         ValueType::Enum(domain) => format!("one of {}", domain.join(", ")),
         ValueType::Location => "a location such as \"5,5\"".into(),
         other => format!("a {}", other.name()),
+    }
+}
+
+/// The literal an argument is, as a comparison with the parameter it is
+/// given reads it (`ty`: its checked type): several bare words are a
+/// string.
+pub(super) fn argument_literal(arg: &ast::Arg, ty: &Type) -> Option<Literal> {
+    match arg {
+        ast::Arg::Words { text, .. } => Some(Literal::Word(text.clone())),
+        ast::Arg::Expr(e) => literal(e, ty),
     }
 }
 

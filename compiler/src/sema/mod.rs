@@ -186,6 +186,11 @@ pub(crate) struct Checker<'a> {
     /// literal, for the value flow (`values.rs`).
     variable_writes: Vec<values::VariableWrite>,
     variable_tests: Vec<values::VariableTest>,
+    /// Every comparison of a parameter with a literal, and what each
+    /// parameter is given (once every body is walked, `params.rs`), for the
+    /// value flow.
+    parameter_tests: Vec<values::ParameterTest>,
+    given: Option<values::Given>,
     /// The robots that run each of `mission.messages`, in the same order.
     message_robots: Vec<std::sync::Arc<[RobotId]>>,
     /// Every set of robots running a scope, once ([`Checker::shared_robots`]).
@@ -239,6 +244,8 @@ impl<'a> Checker<'a> {
             comparison_index: FastMap::default(),
             variable_writes: Vec::new(),
             variable_tests: Vec::new(),
+            parameter_tests: Vec::new(),
+            given: None,
             message_robots: Vec::new(),
             robot_sets: FastSet::default(),
             thrown: FastSet::default(),

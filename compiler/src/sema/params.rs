@@ -4,7 +4,10 @@
 //! in one list, E045 a name that would hide a value or a team variable),
 //! what each body asks of them, and every argument (of a call, of a `set`,
 //! of a mode entered) checked against that once every body is walked
-//! (E023), W015 for one that is never used.
+//! (E023), W015 for one that is never used. The literals the arguments
+//! are, and the parameters passed on, go to the value flow
+//! (`values::Given`: W020, W021 for a parameter compared with what no
+//! argument gives).
 //!
 //! A service's parameter is a function's for its body; a mode's parameter
 //! has no body: used as the argument of a service in the mode's `set`s, it
@@ -25,6 +28,7 @@
 use super::Checker;
 use super::body::{ParamRef, Type};
 use super::ir::*;
+use super::values::{Arguments, Given, Literal};
 use crate::diag::Code;
 use crate::fasthash::{FastMap, FastSet};
 use crate::span::Span;
@@ -40,6 +44,9 @@ pub(super) struct ParamUses {
     passed_on: Vec<(ParamRef, ParamRef)>,
     /// The argument of every call walked that is not itself a parameter.
     arguments: Vec<CallArgument>,
+    /// The arguments not known when the mission is written that are not
+    /// in `arguments` (E047): (the parameter, where).
+    unfixed: Vec<(ParamRef, Span)>,
     /// The parameters some body uses.
     used: FastSet<ParamRef>,
 }
@@ -50,6 +57,9 @@ pub(super) struct CallArgument {
     pub callee: ParamRef,
     pub ty: Type,
     pub span: Span,
+    /// The literal it is, as a comparison reads it (`None`: not one), for
+    /// the value flow.
+    pub literal: Option<Literal>,
 }
 
 impl ParamUses {
@@ -65,14 +75,32 @@ impl ParamUses {
         self.used.insert(param);
     }
 
-    /// Records the argument `ty` at `span` of the call of `callee`'s function.
-    pub(super) fn argument(&mut self, callee: ParamRef, ty: Type, span: Span) {
+    /// Records the argument `ty` at `span` of the call of `callee`'s
+    /// function (`literal`: the literal it is, if one).
+    pub(super) fn argument(
+        &mut self,
+        callee: ParamRef,
+        ty: Type,
+        span: Span,
+        literal: Option<Literal>,
+    ) {
         match ty {
             Type::Param { param, .. } => {
                 self.passed_on.push((param, callee));
             }
-            ty => self.arguments.push(CallArgument { callee, ty, span }),
+            ty => self.arguments.push(CallArgument {
+                callee,
+                ty,
+                span,
+                literal,
+            }),
         }
+    }
+
+    /// Records an argument of `callee` not known when the mission is
+    /// written (reported E047): nothing is known of what it gives.
+    pub(super) fn unfixed(&mut self, callee: ParamRef, span: Span) {
+        self.unfixed.push((callee, span));
     }
 }
 
@@ -232,6 +260,15 @@ impl<'a> Checker<'a> {
                 }
             }
         }
+        self.given = Some(Given::new(Arguments {
+            literals: uses
+                .arguments
+                .into_iter()
+                .map(|a| (a.callee, a.literal, a.span))
+                .chain(uses.unfixed.into_iter().map(|(p, span)| (p, None, span)))
+                .collect(),
+            passed_on: uses.passed_on,
+        }));
         for (span, name, owner) in unused {
             let (whose, body) = match owner {
                 ParamOwner::Mode(..) => ("mode", "its `set`s"),

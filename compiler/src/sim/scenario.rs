@@ -628,20 +628,67 @@ fn ms(v: &Value, key: &str, min: i64) -> Result<i64> {
 
 /// A service's `results`: per call, in call order, an array of what it
 /// gives back in the order of the service's results (`true`, `"3,4"`, `2`;
-/// `null` for none).
-fn call_results(v: &Value) -> Result<crate::refine::CallResults> {
+/// `null` for none), checked against `gives` (what the service gives back,
+/// as the robot's refined program has it from the catalog; `None` when the
+/// robot never calls the service, so nothing reads the entry): a service
+/// that gives nothing back, more values than it gives, or a value its
+/// result's type does not read (which the call would take as none) is
+/// refused at the value that holds it.
+fn call_results(
+    v: &Value,
+    service: &str,
+    gives: Option<&crate::refine::ServiceResults>,
+) -> Result<crate::refine::CallResults> {
     const WHAT: &str = "an array of each call's results, [[true, \"3,4\"], [false]]";
+    if let Some(gives) = gives
+        && gives.results.is_empty()
+    {
+        return fail(
+            v,
+            format!(
+                "service {service} gives nothing back: \"results\" are for a service with results"
+            ),
+        );
+    }
     let mut calls = Vec::new();
     for call in array(v, WHAT)? {
         let mut values = Vec::new();
-        for value in array(call, WHAT)? {
-            values.push(match &value.kind {
+        for (k, value) in array(call, WHAT)?.iter().enumerate() {
+            let text = match &value.kind {
                 Kind::Null => None,
                 Kind::Bool(b) => Some(b.to_string()),
                 Kind::Number(_, text) => Some(text.clone()),
                 Kind::String(text) => Some(text.clone()),
                 _ => return fail(value, "a result is true, false, a number, a string or null"),
-            });
+            };
+            if let Some(gives) = gives {
+                let Some((name, kind)) = gives.results.get(k) else {
+                    let names: Vec<&str> = gives.results.iter().map(|(n, _)| n.as_str()).collect();
+                    return fail(
+                        value,
+                        format!(
+                            "service {service} gives back {} ({}): this call has more values",
+                            match names.len() {
+                                1 => "1 result".to_string(),
+                                n => format!("{n} results"),
+                            },
+                            names.join(", ")
+                        ),
+                    );
+                };
+                if let Some(text) = &text
+                    && kind.parse(text).is_none()
+                {
+                    return fail(
+                        value,
+                        format!(
+                            "result {name} of {service} must be a value of its type ({}), not {text:?}",
+                            kind.describe()
+                        ),
+                    );
+                }
+            }
+            values.push(text);
         }
         calls.push(values);
     }
@@ -742,6 +789,17 @@ impl Reader<'_> {
             "robot {robot} samples no sensor value \"{value}\": nothing reads this entry (it samples: {listed})"
         );
         Some(suggesting(v, message, value, &sampled))
+    }
+
+    /// What `service` gives back as `robot`'s program calls it (its
+    /// catalog's results, `ControlMachine::gives_back`); `None` when the
+    /// robot never calls it.
+    fn gives_back(&self, robot: &str, service: &str) -> Option<&crate::refine::ServiceResults> {
+        self.programs
+            .iter()
+            .filter(|p| p.robot == robot)
+            .flat_map(|p| &p.control.gives_back)
+            .find(|g| g.service == service)
     }
 
     /// A mode of `robot`'s team (or of any team when `robot` is `None`).
@@ -914,9 +972,10 @@ impl Reader<'_> {
                         world.services.push((service.clone(), t));
                     }
                     if let Some(results) = d.member("results") {
+                        let gives = self.gives_back(robot, service);
                         world
                             .results
-                            .push((service.clone(), call_results(results)?));
+                            .push((service.clone(), call_results(results, service, gives)?));
                     }
                     continue;
                 }

@@ -546,6 +546,56 @@ fn a_sensor_value_no_task_samples_is_a_positioned_warning_with_a_did_you_mean() 
     );
 }
 
+/// A service's `results` are checked against what the service gives back
+/// as the robot's type's catalog says (`search`: FOUND, a bool, and WHERE,
+/// a location): a value of another type, more values than it gives, and
+/// results for a service that gives none are refused where they are
+/// written, not taken as none at run time.
+#[test]
+fn scenario_results_are_checked_against_the_catalog() {
+    let programs = programs("tests/fixtures/action_results/survey.mission");
+    let with =
+        |services: &str| format!("{{\"robots\": {{\"ti\": {{\"services\": {{{services}}}}}}}}}");
+    for (services, line_col, message) in [
+        (
+            r#""search": {"results": [[true, "3,4"], ["yes", "3,4"]]}"#,
+            (1, 72),
+            "result FOUND of search must be a value of its type (bool), not \"yes\"",
+        ),
+        (
+            r#""search": {"results": [[1, null]]}"#,
+            (1, 57),
+            "result FOUND of search must be a value of its type (bool), not \"1\"",
+        ),
+        (
+            r#""search": {"results": [[false, null, 3]]}"#,
+            (1, 70),
+            "service search gives back 2 results (FOUND, WHERE): this call has more values",
+        ),
+        (
+            r#""move": {"ms": 10, "results": [["3,4"]]}"#,
+            (1, 63),
+            "service move gives nothing back: \"results\" are for a service with results",
+        ),
+    ] {
+        let text = with(services);
+        let e = scenario::parse(&text, &programs).unwrap_err();
+        assert_eq!(
+            (e.line_col(&text), e.message.as_str()),
+            (line_col, message),
+            "{text}"
+        );
+    }
+    // What the service gives back, fewer values (the rest none) and
+    // nulls are read; a service the robot never calls is not checked:
+    // nothing reads its entry.
+    let good = with(
+        r#""search": {"results": [[true, 7], [false], ["true", null]]}, "scatter": {"results": [[1]]}"#,
+    );
+    let read = scenario::parse(&good, &programs).unwrap_or_else(|e| panic!("{e:?}"));
+    assert_eq!(read.robots[0].results.len(), 2);
+}
+
 #[test]
 fn scenario_mistakes_point_at_the_value() {
     let programs = programs("examples/scouting/scouting.mission");

@@ -3,8 +3,10 @@
 //!
 //! The outline has one entry per team, holding its robots, its plans with
 //! their composite services, its modes and its main block; functions are at
-//! the top level. Items of undeclared teams and duplicate definitions (both
-//! reported by the checker) are not in it.
+//! the top level. A function or service holds the names its body binds to
+//! action results (`FOUND, WHERE = search(red)`), each at its first binding.
+//! Items of undeclared teams and duplicate definitions (both reported by the
+//! checker) are not in it.
 
 use crate::CheckedMission;
 use crate::ide::{NavigationTarget, StructureNode, SymbolKind, WorkspaceSymbol};
@@ -52,7 +54,7 @@ pub fn document_symbols(analysis: &CheckedMission, text: &str) -> Vec<StructureN
                 .function_syntax(f)
                 .map_or(f.name_span, |syntax| syntax.span),
             name_span: f.name_span,
-            children: Vec::new(),
+            children: result_symbols(&f.results),
         }
     }));
     symbols.sort_by_key(|s| s.span.start);
@@ -104,7 +106,7 @@ fn team_symbol(
                 kind: SymbolKind::Service,
                 span: s.span,
                 name_span: s.name_span,
-                children: Vec::new(),
+                children: result_symbols(&s.results),
             })
             .collect();
         let span = services
@@ -273,6 +275,26 @@ pub fn match_score(query: &str, name: &str) -> Option<u32> {
     }
 }
 
+/// The names a body binds to action results, at their first binding, in
+/// the order bound: `FOUND` with the detail `FOUND: bool of search` (the
+/// catalog's result and type, once a call binding it was checked).
+fn result_symbols(results: &[crate::sema::ResultInfo]) -> Vec<StructureNode> {
+    results
+        .iter()
+        .map(|r| StructureNode {
+            name: r.name.to_string(),
+            detail: Some(match (&r.catalog_name, &r.ty) {
+                (Some(result), Some(ty)) => format!("{result}: {ty} of {}", r.service),
+                _ => format!("of {}", r.service),
+            }),
+            kind: SymbolKind::Result,
+            span: r.span,
+            name_span: r.span,
+            children: Vec::new(),
+        })
+        .collect()
+}
+
 /// `(A, B)`, or nothing without parameters.
 fn param_list(params: &[crate::sema::ParamInfo]) -> String {
     if params.is_empty() {
@@ -373,6 +395,33 @@ Function warn [warn] lines 6-6
         assert_eq!(
             out,
             "Function go_to [go_to] lines 1-1 ((PLACE, WAIT))\nFunction home [home] lines 2-2\n"
+        );
+    }
+
+    #[test]
+    fn results_a_body_binds_are_under_its_function_or_service() {
+        let f = Fixture::new(
+            "{ R: TIEvalbot ti }\n\
+             def check {\n  SEEN = search(blue)\n}\n\
+             R.Action.Survey {\n  FOUND, WHERE = search(red)\n  check()\n  FOUND, WHERE = search(red)\n} repeat(1 SEC)\n\
+             R.SURVEY { set(Action, Survey) }\nR.main { default: mode = SURVEY }\n",
+        );
+        let mut out = String::new();
+        outline(&f, &document_symbols(&f.analysis, &f.text), 0, &mut out);
+        assert_eq!(
+            out,
+            "\
+Team R [R] lines 1-11 (1 robot)
+  Robot ti [ti] lines 1-1 (TIEvalbot)
+  Plan Action [Action] lines 5-9
+    Service Survey [Survey] lines 5-9 (R.Action.Survey)
+      Result FOUND [FOUND] lines 6-6 (FOUND: bool of search)
+      Result WHERE [WHERE] lines 6-6 (WHERE: location of search)
+  Mode SURVEY [SURVEY] lines 10-10 (Action: Survey)
+  Main main [main] lines 11-11 (default: SURVEY)
+Function check [check] lines 2-4
+  Result SEEN [SEEN] lines 3-3 (FOUND: bool of search)
+"
         );
     }
 

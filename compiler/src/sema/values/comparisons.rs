@@ -9,39 +9,26 @@
 //! A variable with any writer whose value is not a literal (a sensor
 //! reading, another variable), or that the operator may send, has unknown
 //! values and is never reported.
+//!
+//! A parameter of a function, a composite service or a mode stands for
+//! its argument, which the mission writes: when every argument reaching it
+//! is a literal ([`super::arguments`], following a mode's or a function's
+//! parameter passed on), `PARAM == C` with a constant none of them gives
+//! never holds (W020) and `PARAM != C` always holds (W021: a parameter
+//! always has its argument). Both name the arguments as related
+//! information. A parameter any argument of which is read at run time, or
+//! that nothing gives an argument, is never reported.
 
+use super::arguments::Values;
+use super::literal::Literal;
 use super::{RELATED, VariableWrite, list};
 use crate::diag::Code;
-use crate::fasthash::FastMap;
+use crate::fasthash::{FastMap, FastSet};
 use crate::sema::Checker;
-use crate::sema::ir::{AttrKey, Compared};
+use crate::sema::ir::{AttrKey, Compared, ParamOwner};
 use crate::sema::suggestion;
 use crate::span::Span;
-
-/// A literal as a comparison reads it: words and strings by their text,
-/// numbers by their value.
-#[derive(Clone, Debug, PartialEq)]
-pub(in crate::sema) enum Literal {
-    Word(String),
-    Number(f64),
-}
-
-impl Literal {
-    /// What the comparison compares, if this literal is of its kind.
-    fn compared_as(&self, compared: Compared) -> bool {
-        matches!(
-            (self, compared),
-            (Literal::Word(_), Compared::Words) | (Literal::Number(_), Compared::Numbers)
-        )
-    }
-
-    fn text(&self) -> String {
-        match self {
-            Literal::Word(w) => w.clone(),
-            Literal::Number(n) => n.to_string(),
-        }
-    }
-}
+use crate::syntax::ast::Name;
 
 /// A comparison of a team variable with a literal: `T.X == C` (`equal`) or
 /// `T.X != C`.
@@ -55,8 +42,84 @@ pub(in crate::sema) struct VariableTest {
     pub span: Span,
 }
 
+/// A comparison of a parameter with a literal: `PARAM == C` (`equal`) or
+/// `PARAM != C`.
+#[derive(Clone, Debug)]
+pub(in crate::sema) struct ParameterTest {
+    pub param: (ParamOwner, u32),
+    pub name: Name,
+    pub equal: bool,
+    pub constant: Literal,
+    pub compared: Compared,
+    /// The constant's range (a did-you-mean replaces it).
+    pub span: Span,
+}
+
 impl Checker<'_> {
     pub(super) fn check_comparisons(&mut self) {
+        self.check_variable_comparisons();
+        self.check_parameter_comparisons();
+    }
+
+    /// W020, W021 for parameters: see the module's documentation.
+    fn check_parameter_comparisons(&mut self) {
+        let Some(mut given) = self.given.take() else {
+            return;
+        };
+        let tests = std::mem::take(&mut self.parameter_tests);
+        // A body walked for several sets of robots records its tests once
+        // per walk.
+        let mut seen: FastSet<(Span, bool)> = FastSet::default();
+        for test in &tests {
+            if !seen.insert((test.span, test.equal)) {
+                continue;
+            }
+            let Values::Known {
+                values,
+                given: arguments,
+            } = given.values(test.param)
+            else {
+                continue; // some argument is not known when the mission is written
+            };
+            if values.is_empty()
+                || !values.iter().all(|v| v.compared_as(test.compared))
+                || values.contains(&test.constant)
+            {
+                continue;
+            }
+            let mut possible: Vec<String> = values.iter().map(Literal::text).collect();
+            possible.sort();
+            possible.dedup();
+            let constant = test.constant.text();
+            let name = &test.name;
+            let (code, op, verdict) = if test.equal {
+                (Code::ComparisonNeverHolds, "==", "never holds")
+            } else {
+                (Code::ComparisonAlwaysHolds, "!=", "always holds")
+            };
+            let owner = self.mission.owner_name(test.param.0);
+            let guess = suggestion(&constant, possible.iter().map(String::as_str));
+            let diagnostic = self
+                .diagnostics
+                .report(
+                    code,
+                    test.span,
+                    format!(
+                        "`{name} {op} {constant}` {verdict}: the parameter `{name}` of `{owner}` is only ever given {}, never `{constant}`",
+                        list(&possible)
+                    ),
+                )
+                .suggest(guess);
+            for (span, literal) in arguments {
+                diagnostic.relate(
+                    *span,
+                    format!("`{name}` is given `{}` here", literal.text()),
+                );
+            }
+        }
+    }
+
+    fn check_variable_comparisons(&mut self) {
         let mut writes: FastMap<&AttrKey, Vec<&VariableWrite>> = FastMap::default();
         for write in &self.variable_writes {
             writes.entry(&write.key).or_default().push(write);
@@ -178,6 +241,115 @@ mod tests {
             findings(sends, "S.V == 6"),
             [(Code::ComparisonNeverHolds, "6".to_string())]
         );
+    }
+
+    /// The W020/W021 findings of a mission where the mode `MOVE(TARGET)`
+    /// sets `Go(TARGET)`, `Go(PLACE)` tests `test` and passes `PLACE` to
+    /// `def look(AREA)`; `entries` enters the modes: (code, the constant,
+    /// the related places' texts). Errors are allowed.
+    fn parameter_findings(test: &str, entries: &str) -> Vec<(Code, String, Vec<String>)> {
+        let text = format!(
+            "{{ R: TIEvalbot ti }}\n\
+             def look(AREA) {{\n  if (AREA != attic) standby()\n}}\n\
+             R.Action.Go(PLACE) {{\n  move(PLACE)\n  look(PLACE)\n  if ({test}) throw arrived\n}} repeat(1 SEC)\n\
+             R.MOVE(TARGET) {{ set(Action, Go(TARGET)) }}\n\
+             R.DOOR {{ set(Action, Go(door)) }}\n\
+             R.main {{\n  case (MOVE):\n    catch (arrived): mode = DOOR\n{entries}\n}}\n"
+        );
+        let analysis = crate::check_source(
+            crate::diag::FileId(0),
+            &text,
+            &crate::catalog::builtin_catalog(),
+        );
+        let at = |span: crate::span::Span| text[span.start..span.end].to_string();
+        analysis
+            .diagnostics
+            .iter()
+            .filter(|d| [Code::ComparisonNeverHolds, Code::ComparisonAlwaysHolds].contains(&d.code))
+            .map(|d| {
+                (
+                    d.code,
+                    at(d.span),
+                    d.related.iter().map(|r| at(r.span)).collect(),
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_parameter_compared_with_a_constant_no_argument_gives() {
+        // PLACE is given kitchen (through MOVE's TARGET) and door; AREA
+        // what PLACE is given.
+        let found = parameter_findings("PLACE == hall", "  default: mode = MOVE(kitchen)");
+        assert_eq!(
+            found,
+            [
+                (
+                    Code::ComparisonAlwaysHolds,
+                    "attic".to_string(),
+                    vec!["door".to_string(), "kitchen".to_string()]
+                ),
+                (
+                    Code::ComparisonNeverHolds,
+                    "hall".to_string(),
+                    vec!["door".to_string(), "kitchen".to_string()]
+                ),
+            ]
+        );
+        let found = parameter_findings("\"hall\" != PLACE", "  default: mode = MOVE(kitchen)");
+        assert_eq!(found[1].0, Code::ComparisonAlwaysHolds);
+        assert_eq!(found[1].1, "\"hall\"");
+    }
+
+    #[test]
+    fn a_parameter_some_argument_gives_the_constant_is_not_reported() {
+        // A word and a string with the same text are equal as words.
+        let found = parameter_findings("PLACE == \"door\"", "  default: mode = MOVE(kitchen)");
+        assert_eq!(found.len(), 1, "{found:?}"); // AREA != attic only
+        let found = parameter_findings("PLACE == hall", "  default: mode = MOVE(hall)");
+        assert_eq!(found.len(), 1, "{found:?}");
+    }
+
+    #[test]
+    fn a_parameter_given_anything_read_at_run_time_is_not_reported() {
+        // MOVE is entered with a word elsewhere, but look is also given the
+        // robot's location.
+        let text = "{ R: TIEvalbot ti }\n\
+             def look(AREA) {\n  if (AREA == attic) standby()\n}\n\
+             R.Action.Look {\n  look(cellar)\n  look(R.LOCATION)\n} repeat(1 SEC)\n\
+             R.LOOK { set(Action, Look) }\nR.main { default: mode = LOOK }\n";
+        let codes = [Code::ComparisonNeverHolds, Code::ComparisonAlwaysHolds];
+        assert!(super::super::tests::diagnostics_with(text, &codes).is_empty());
+        let without = text.replace("  look(R.LOCATION)\n", "");
+        assert_eq!(
+            super::super::tests::diagnostics_with(&without, &codes).len(),
+            1
+        );
+    }
+
+    #[test]
+    fn a_mode_entered_with_the_wrong_count_makes_its_parameters_unknown() {
+        // MOVE(hall, 2) is E046: what it would give TARGET is not known.
+        let found = parameter_findings(
+            "PLACE == hall",
+            "  case (DOOR):\n    catch (arrived): mode = MOVE(hall, 2)\n  default: mode = MOVE(kitchen)",
+        );
+        assert!(found.is_empty(), "{found:?}");
+    }
+
+    #[test]
+    fn a_parameter_compared_as_a_number_compares_its_arguments_by_value() {
+        let text = "{ R: TIEvalbot ti }\n\
+             def wait(N) {\n  if (N == 2) standby()\n  if (N == 3) standby()\n}\n\
+             R.Action.Wait {\n  wait(2.0)\n} repeat(1 SEC)\n\
+             R.WAIT { set(Action, Wait) }\nR.main { default: mode = WAIT }\n";
+        let codes = [Code::ComparisonNeverHolds, Code::ComparisonAlwaysHolds];
+        let found = super::super::tests::diagnostics_with(text, &codes);
+        let spans: Vec<&str> = found
+            .iter()
+            .map(|d| &text[d.span.start..d.span.end])
+            .collect();
+        assert_eq!(spans, ["3"]);
     }
 
     #[test]

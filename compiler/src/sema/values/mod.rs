@@ -2,7 +2,9 @@
 //! hold, and when it can have been sent, from the mission alone:
 //!
 //! - [`comparisons`]: a comparison of a team variable with a constant none
-//!   of its writers sets decides the same way at every run (W020, W021);
+//!   of its writers sets, or of a parameter with a constant none of its
+//!   arguments gives ([`arguments`]), decides the same way at every run
+//!   (W020, W021);
 //! - [`early_reads`]: a value read once, when the mission starts, before
 //!   any robot can have sent it (W022);
 //! - [`forwarded_once`]: a received value sent on once when its mode starts,
@@ -16,13 +18,17 @@
 //! services can run ([`timeline`]), so they are left out when the mission
 //! has an error: a broken line may be a missing send or catch.
 
+mod arguments;
 mod comparisons;
 mod early_reads;
 mod forwarded_once;
+mod literal;
 mod timeline;
 mod unfed;
 
-pub(super) use comparisons::{Literal, VariableTest};
+pub(super) use arguments::{Arguments, Given};
+pub(super) use comparisons::{ParameterTest, VariableTest};
+pub(super) use literal::Literal;
 
 use super::Checker;
 use super::ir::{AttrKey, TeamId};
