@@ -6,8 +6,10 @@
 //! is refused, never published; what the broker delivers to the robot comes
 //! down the link, and a message whose datagram names another sender than
 //! its topic comes down as `R`; its status is retained, and `lost` when the
-//! link closes. Waits are bounded by events (a message heard), never by
-//! time: the deadlines only end a test that would otherwise hang.
+//! link closes; a gateway killed and started again loses no message either
+//! way and passes none twice. Waits are bounded by events (a message
+//! heard), never by time: the deadlines only end a test that would
+//! otherwise hang.
 
 mod support;
 
@@ -103,6 +105,27 @@ impl LinkRobot {
                     ) => {}
                 Err(e) => panic!("link: {e}"),
             }
+        }
+    }
+
+    /// A new gateway connects to the link (the last one stopped): the
+    /// robot goes on with its session state as a board does, which does not
+    /// see the gateway go; the new gateway's `Hello` starts the session.
+    fn reconnected(&mut self, listener: &TcpListener) {
+        let (stream, _) = listener.accept().expect("the new gateway connects");
+        stream
+            .set_read_timeout(Some(Duration::from_millis(50)))
+            .unwrap();
+        self.stream = stream;
+    }
+
+    /// Waits until the gateway has written bytes down the link, without
+    /// reading them (the robot takes nothing, so acknowledges nothing).
+    fn until_written_to(&self, what: &str) {
+        let end = Instant::now() + LIMIT;
+        let mut buf = [0u8; 64];
+        while !matches!(self.stream.peek(&mut buf), Ok(n) if n > 0) {
+            assert!(Instant::now() < end, "the link robot waited for {what}");
         }
     }
 
@@ -413,6 +436,126 @@ fn a_message_longer_than_the_board_takes_is_refused_and_the_next_one_arrives() {
     );
 }
 
+/// What the watcher hears, kept in order: `until` reads until `done`
+/// holds of everything heard so far.
+struct Heard {
+    rx: mpsc::Receiver<(String, Vec<u8>, bool)>,
+    all: Vec<(String, Vec<u8>)>,
+}
+
+impl Heard {
+    fn until(&mut self, what: &str, done: impl Fn(&[(String, Vec<u8>)]) -> bool) {
+        while !done(&self.all) {
+            let (topic, payload, _) = heard(&self.rx, what);
+            self.all.push((topic, payload));
+        }
+    }
+
+    /// The payloads heard on `topic`, in order.
+    fn on(&self, topic: &str) -> Vec<Vec<u8>> {
+        self.all
+            .iter()
+            .filter(|(t, _)| t == topic)
+            .map(|(_, p)| p.clone())
+            .collect()
+    }
+}
+
+/// A gateway killed (SIGKILL) in the middle of a run and a new one started
+/// on the same link: no message is lost and none passes twice. Up the link,
+/// a send the robot made while no gateway was there goes once the new
+/// gateway's session stands, and what the first gateway published is not
+/// published again. Down the link, the messages the first gateway held (the
+/// robot had not acknowledged them) and the one published while no gateway
+/// ran come down from the new gateway, each once and in order: a message is
+/// acknowledged to the broker only once the robot has it, so the broker
+/// delivers it again to the next gateway (the gateway acknowledged each as
+/// it arrived, so those it held died with it, uncounted; and the messages a
+/// kept session brings before the subscriptions' SUBACK were dropped).
+#[test]
+fn a_gateway_restarted_in_the_middle_loses_no_message_and_passes_none_twice() {
+    let Some(mut fleet) = Fleet::start("gateway-restart") else {
+        return;
+    };
+    let run = "g5";
+    let (client, rx) = watcher(fleet.port, run);
+    let mut heard = Heard {
+        rx,
+        all: Vec::new(),
+    };
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let link_port = listener.local_addr().unwrap().port();
+    let first = fleet.processes.push(gateway(&fleet.url(), link_port, run));
+    let mut robot = LinkRobot::connected(&listener);
+
+    let up = format!("semo/scouting/{run}/MasterTeam/SlaveTeam.COLOR/SlaveTeam/ti");
+    let send = |v| gram(false, "SlaveTeam", "ti", "SlaveTeam.COLOR", v);
+    let down = format!("semo/scouting/{run}/SlaveTeam/USER.RC_CMD/MasterTeam/irobot");
+    let message = |v| gram(false, "MasterTeam", "irobot", "USER.RC_CMD", v);
+    let publish = |v| {
+        client
+            .publish(&down, rumqttc::QoS::AtLeastOnce, false, message(v))
+            .unwrap()
+    };
+
+    // Up: a send, acknowledged (the broker has it).
+    robot.send(Kind::Send, "MasterTeam", &send(1));
+    // Down: three messages; the first gateway passes the first down the
+    // link, and the robot takes none of them.
+    for v in 1..=3 {
+        publish(v);
+    }
+    heard.until("the three messages", |all| {
+        all.iter().filter(|(t, _)| *t == down).count() == 3
+    });
+    robot.until_written_to("the first message down the link");
+    let said = stopped_saying(&mut fleet, first);
+    assert!(said.contains("ti: link open"), "{said}");
+
+    // No gateway: a message for the robot waits at the broker, and the
+    // robot's next send waits with the robot.
+    publish(4);
+    heard.until("the message sent while no gateway ran", |all| {
+        all.iter().filter(|(t, _)| *t == down).count() == 4
+    });
+    let frame = Frame::addressed(Kind::Send, 0, "MasterTeam", &send(2)).unwrap();
+    robot.endpoint.queue(Kind::Send, frame.payload).unwrap();
+
+    let second = fleet.processes.push(gateway(&fleet.url(), link_port, run));
+    robot.reconnected(&listener);
+    robot.until("the send made while no gateway ran", |_, e| {
+        e.outgoing.pending() == 0
+    });
+    // One more each way, after everything before: a copy of anything
+    // earlier would come before it (one topic, one sender: in order).
+    robot.send(Kind::Send, "MasterTeam", &send(3));
+    publish(5);
+    robot.until("the five messages", |taken, _| {
+        taken.iter().any(|f| f.payload == message(5))
+    });
+    let taken: Vec<(Kind, Vec<u8>)> = robot
+        .taken
+        .iter()
+        .map(|f| (f.kind, f.payload.clone()))
+        .collect();
+    let expected: Vec<(Kind, Vec<u8>)> = (1..=5).map(|v| (Kind::Message, message(v))).collect();
+    assert_eq!(
+        taken, expected,
+        "every message down the link once, in order, across the restart"
+    );
+    heard.until("the send after the restart", |all| {
+        all.iter().any(|(t, p)| *t == up && *p == send(3))
+    });
+    assert_eq!(
+        heard.on(&up),
+        vec![send(1), send(2), send(3)],
+        "every send published once, in order, across the restart"
+    );
+    let said = stopped_saying(&mut fleet, second);
+    assert!(said.contains("ti: link open"), "{said}");
+    assert!(!said.contains("bad frame"), "{said}");
+}
+
 #[test]
 fn bad_arguments_are_refused_with_exit_status_2() {
     let mission = scouting();
@@ -564,3 +707,4 @@ fn a_linux_robot_over_the_link_behaves_as_in_the_simulator() {
     );
     fleet.processes.kill(gw);
 }
+
