@@ -9,7 +9,9 @@
 //! same private mosquitto. Every robot enters the modes `semo simulate`
 //! gives it on the same scenario, in the same order, to FINISH; the master
 //! hears ti's colors and ti its team mate's heartbeats, through the board's UART,
-//! the gateway and the broker.
+//! the gateway and the broker. The same with ti's QEMU killed in the middle
+//! and started again on the same link (the simulator given the matching
+//! kill and restart of ti).
 //!
 //! Time: QEMU runs in real time here (no `-icount`: the link's repeats and
 //! the Linux robots' clocks are wall clocks), and the Linux robots run the
@@ -288,6 +290,194 @@ fn behaves_as_in_the_simulator(test: &str, on: Board) {
     // Nothing refused or failed on the way (the master drops some of ti's
     // reports for a full channel, as in the simulator: ti repeats them
     // faster than the master's plan takes them).
+    for (robot, trace) in &traces {
+        let refused: Vec<&Event> = trace
+            .iter()
+            .filter(|e| matches!(field(e, "event"), "reject" | "comm_error"))
+            .collect();
+        assert!(refused.is_empty(), "{robot}: {refused:?}");
+    }
+}
+
+/// The Evalbot killed and started again in the middle (issue 35): QEMU
+/// killed once ti's trace shows its first mode change, and a new QEMU
+/// started on the same link port, which the gateway connects to again. The
+/// simulator runs the same scenario with ti killed and restarted in the
+/// middle of its search (`{"kill": "ti"}`, `{"restart": "ti"}`). What must
+/// hold is compared: irobot's and nxt's modes, ti's modes up to its kill,
+/// and the restarted ti's from its first mode on, as in the simulator.
+///
+/// The restarted board counts its mission time from 0 again (from the
+/// gateway's welcome: a board has no clock of the fleet's), so its
+/// scenario's sensors replay from their start, where the simulator's
+/// restarted ti reads them at the mission time of its restart; with the
+/// kill in its search both see the same modes: the search again, the
+/// return and the finish.
+#[test]
+fn the_evalbot_in_qemu_killed_and_restarted_behaves_as_in_the_simulator() {
+    let test = "the_evalbot_in_qemu_killed_and_restarted_behaves_as_in_the_simulator";
+    if !robots::board_tools_present(test) {
+        return;
+    }
+    let _turn = ONE_BOARD_AT_A_TIME
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    let on = LM3S6965;
+    let Some(mut fleet) = Fleet::start("board-link-restart") else {
+        return;
+    };
+    let scenario = scenario();
+    let elf = board_ti(&fleet.out.join("board"), on);
+    let folders = support::mqtt::build(&scouting(), &fleet.out.join("linux"), &[]);
+    support::mqtt::compile_in(&folders, &scenario);
+
+    let gateway_log = fleet.out.join("gateway.stderr");
+    let link_port = support::mosquitto::free_port();
+    let (board, board_rx) = qemu(&elf, on, link_port);
+    let board = fleet.processes.push(board);
+    let gateway = fleet.processes.push(
+        Command::new(env!("CARGO_BIN_EXE_semo"))
+            .arg("gateway")
+            .arg(scouting())
+            .args(["--link", &format!("ti=tcp:127.0.0.1:{link_port}")])
+            .args(["--broker", &fleet.url()])
+            .stdout(Stdio::null())
+            .stderr(std::fs::File::create(&gateway_log).expect("a log file"))
+            .spawn()
+            .expect("semo gateway starts"),
+    );
+
+    // ti's first life, until its first mode change; the Linux robots count
+    // their mission time from its start.
+    let mut linux = Vec::new();
+    let mut first_life = Vec::new();
+    let end = Instant::now() + LIMIT;
+    while modes(&events(&first_life)).len() < 2 {
+        let left = end.saturating_duration_since(Instant::now());
+        let line = board_rx.recv_timeout(left).unwrap_or_else(|_| {
+            panic!(
+                "the board's first mode change: {first_life:#?}\nthe gateway said:\n{}",
+                std::fs::read_to_string(&gateway_log).unwrap_or_default()
+            )
+        });
+        if first_life.is_empty() {
+            let start = events(std::slice::from_ref(&line));
+            let start = start.first().expect("the board's first line is an event");
+            assert_eq!(field(start, "event"), "start", "{start:?}");
+            let start_at = (unix_ms() - start["t"].as_u64().unwrap()).to_string();
+            for folder in folders.iter().filter(|f| !f.ends_with("ti")) {
+                let args = ["--time-scale", "1", "--start-at", start_at.as_str()];
+                linux.push(fleet.spawn(folder, &scenario, "board", &args));
+            }
+        }
+        first_life.push(line);
+    }
+    fleet.processes.kill(board);
+    // What it wrote before it died; the last line may be cut short by the
+    // kill, and is left out then.
+    first_life.extend(board_rx.iter());
+    if first_life
+        .last()
+        .is_some_and(|l| serde_json::from_str::<serde_json::Value>(l).is_err())
+    {
+        first_life.pop();
+    }
+
+    // Its second life on the same link, to its end.
+    let (again, again_rx) = qemu(&elf, on, link_port);
+    let again = fleet.processes.push(again);
+    let second_life = board_trace(&again_rx, &gateway_log, |first| {
+        assert_eq!(field(first, "event"), "start", "{first:?}");
+    });
+    let mut traces: std::collections::BTreeMap<String, Vec<Event>> = linux
+        .iter()
+        .map(|s| (s.robot.clone(), fleet.finish(s, "board")))
+        .collect();
+    fleet.processes.wait_success(again, "QEMU (ti, restarted)");
+    fleet.processes.kill(gateway);
+    std::fs::write(fleet.out.join("ti.first.jsonl"), first_life.join("\n")).unwrap();
+    std::fs::write(fleet.out.join("ti.second.jsonl"), second_life.join("\n")).unwrap();
+    let (first_life, second_life) = (events(&first_life), events(&second_life));
+    assert_eq!(field(second_life.last().unwrap(), "event"), "stop");
+    let gateway_said = std::fs::read_to_string(&gateway_log).unwrap();
+    // (At least twice: the new QEMU may reset a connection the gateway
+    // made while it started, which the gateway then makes again.)
+    assert!(
+        gateway_said.matches("ti: link open").count() >= 2
+            && gateway_said.contains("ti: link closed"),
+        "the gateway meets ti again on its link: {gateway_said}"
+    );
+
+    // The simulator on the same scenario, ti killed in its search and
+    // restarted.
+    let mut faulted: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&scenario).unwrap()).unwrap();
+    faulted["faults"] = serde_json::json!([
+        {"at": 1200, "kill": "ti"},
+        {"at": 1600, "restart": "ti"}
+    ]);
+    let faulted_path = fleet.out.join("restart.scenario.json");
+    std::fs::write(&faulted_path, faulted.to_string()).unwrap();
+    let simulated = support::simulate_trace(&scouting(), &faulted_path, "sim");
+    assert_eq!(simulated.code, 0, "{}", simulated.stderr);
+    let simulated = events(
+        &simulated
+            .stdout
+            .lines()
+            .map(str::to_string)
+            .collect::<Vec<_>>(),
+    );
+    let of = |robot: &str| -> Vec<Event> {
+        simulated
+            .iter()
+            .filter(|e| field(e, "robot") == robot)
+            .cloned()
+            .collect()
+    };
+    for (robot, trace) in &traces {
+        assert_eq!(
+            modes(trace),
+            modes(&of(robot)),
+            "{robot}'s modes with ti killed and restarted in QEMU and in `semo simulate`"
+        );
+    }
+    let simulated_ti = of("ti");
+    let restart = simulated_ti
+        .iter()
+        .position(|e| field(e, "event") == "fault" && field(e, "fault") == "restart")
+        .expect("the simulator restarts ti");
+    let (before, after) = simulated_ti.split_at(restart);
+    assert_eq!(
+        modes(&first_life),
+        modes(before),
+        "ti's modes up to its kill, in QEMU and in `semo simulate`"
+    );
+    assert_eq!(
+        modes(&second_life),
+        modes(after),
+        "the restarted ti's modes, from its first, in QEMU and in `semo simulate`"
+    );
+    assert_eq!(modes(after).first(), modes(before).first());
+    assert_eq!(modes(after).last().map(String::as_str), Some("FINISH"));
+
+    // The restarted ti is a member of the fleet again: the master hears its
+    // colors, and it hears its team mate.
+    traces.insert("ti".into(), second_life);
+    assert!(
+        traces["irobot"]
+            .iter()
+            .any(|e| field(e, "event") == "receive"
+                && field(e, "from_robot") == "ti"
+                && field(e, "key") == "SlaveTeam.COLOR"
+                && field(e, "value") == "RGB"),
+        "the master hears the restarted ti's last color"
+    );
+    assert!(
+        traces["ti"]
+            .iter()
+            .any(|e| field(e, "event") == "receive" && field(e, "from_robot") == "nxt"),
+        "the restarted ti hears nxt"
+    );
     for (robot, trace) in &traces {
         let refused: Vec<&Event> = trace
             .iter()
