@@ -556,6 +556,32 @@ fn a_gateway_restarted_in_the_middle_loses_no_message_and_passes_none_twice() {
     assert!(!said.contains("bad frame"), "{said}");
 }
 
+/// A robot that comes back on its link (a board reset, its QEMU started
+/// again) is welcomed as a robot restarted in its run: its broker session,
+/// the gateway's, was kept, and the `Welcome` says so (its
+/// `semo_session_resumed`, as a restarted Linux robot's CONNACK says), so
+/// that its elections listen before they claim; the first session of a
+/// run says not. (Every `Welcome` said what the broker said when the
+/// gateway started: a board restarted in a swarm claimed leadership at
+/// once.)
+#[test]
+fn a_robot_back_on_its_link_is_told_its_session_was_kept() {
+    let Some(mut fleet) = Fleet::start("gateway-welcome-again") else {
+        return;
+    };
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let link_port = listener.local_addr().unwrap().port();
+    let gw = fleet.processes.push(gateway(&fleet.url(), link_port, "g7"));
+    let robot = LinkRobot::connected(&listener);
+    assert_eq!(robot.endpoint.peer_flags, 0, "a new run: no session kept");
+    drop(robot);
+    let robot = LinkRobot::connected(&listener);
+    assert_eq!(robot.endpoint.peer_flags, 1, "back on its link");
+    drop(robot);
+    let said = stopped_saying(&mut fleet, gw);
+    assert!(said.matches("ti: link open").count() >= 2, "{said}");
+}
+
 #[test]
 fn bad_arguments_are_refused_with_exit_status_2() {
     let mission = scouting();

@@ -584,6 +584,13 @@ impl LinkGateway {
                 endpoint.tick(now(), &mut wire);
             };
             eprintln!("gateway: {}: link closed ({closed})", self.name());
+            // A robot that comes back on its link (reset, its QEMU started
+            // again) finds its broker session kept, the gateway's: its
+            // Welcome says so, as a restarted Linux robot's CONNACK does,
+            // so that its elections listen before they claim.
+            if endpoint.outgoing.welcomed() {
+                endpoint.welcome_flags = 1;
+            }
             self.lost(&broker.client, last_status.as_deref());
         }
     }
