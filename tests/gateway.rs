@@ -6,8 +6,10 @@
 //! is refused, never published; what the broker delivers to the robot comes
 //! down the link, and a message whose datagram names another sender than
 //! its topic comes down as `R`; its status is retained, and `lost` when the
-//! link closes. Waits are bounded by events (a message heard), never by
-//! time: the deadlines only end a test that would otherwise hang.
+//! link closes; a gateway killed and started again loses no message either
+//! way and passes none twice. Waits are bounded by events (a message
+//! heard), never by time: the deadlines only end a test that would
+//! otherwise hang.
 
 mod support;
 
@@ -103,6 +105,27 @@ impl LinkRobot {
                     ) => {}
                 Err(e) => panic!("link: {e}"),
             }
+        }
+    }
+
+    /// A new gateway connects to the link (the last one stopped): the
+    /// robot goes on with its session state as a board does, which does not
+    /// see the gateway go; the new gateway's `Hello` starts the session.
+    fn reconnected(&mut self, listener: &TcpListener) {
+        let (stream, _) = listener.accept().expect("the new gateway connects");
+        stream
+            .set_read_timeout(Some(Duration::from_millis(50)))
+            .unwrap();
+        self.stream = stream;
+    }
+
+    /// Waits until the gateway has written bytes down the link, without
+    /// reading them (the robot takes nothing, so acknowledges nothing).
+    fn until_written_to(&self, what: &str) {
+        let end = Instant::now() + LIMIT;
+        let mut buf = [0u8; 64];
+        while !matches!(self.stream.peek(&mut buf), Ok(n) if n > 0) {
+            assert!(Instant::now() < end, "the link robot waited for {what}");
         }
     }
 
@@ -413,6 +436,152 @@ fn a_message_longer_than_the_board_takes_is_refused_and_the_next_one_arrives() {
     );
 }
 
+/// What the watcher hears, kept in order: `until` reads until `done`
+/// holds of everything heard so far.
+struct Heard {
+    rx: mpsc::Receiver<(String, Vec<u8>, bool)>,
+    all: Vec<(String, Vec<u8>)>,
+}
+
+impl Heard {
+    fn until(&mut self, what: &str, done: impl Fn(&[(String, Vec<u8>)]) -> bool) {
+        while !done(&self.all) {
+            let (topic, payload, _) = heard(&self.rx, what);
+            self.all.push((topic, payload));
+        }
+    }
+
+    /// The payloads heard on `topic`, in order.
+    fn on(&self, topic: &str) -> Vec<Vec<u8>> {
+        self.all
+            .iter()
+            .filter(|(t, _)| t == topic)
+            .map(|(_, p)| p.clone())
+            .collect()
+    }
+}
+
+/// A gateway killed (SIGKILL) in the middle of a run and a new one started
+/// on the same link: no message is lost and none passes twice. Up the link,
+/// a send the robot made while no gateway was there goes once the new
+/// gateway's session stands, and what the first gateway published is not
+/// published again. Down the link, the messages the first gateway held (the
+/// robot had not acknowledged them) and the one published while no gateway
+/// ran come down from the new gateway, each once and in order: a message is
+/// acknowledged to the broker only once the robot has it, so the broker
+/// delivers it again to the next gateway (the gateway acknowledged each as
+/// it arrived, so those it held died with it, uncounted; and the messages a
+/// kept session brings before the subscriptions' SUBACK were dropped).
+#[test]
+fn a_gateway_restarted_in_the_middle_loses_no_message_and_passes_none_twice() {
+    let Some(mut fleet) = Fleet::start("gateway-restart") else {
+        return;
+    };
+    let run = "g5";
+    let (client, rx) = watcher(fleet.port, run);
+    let mut heard = Heard {
+        rx,
+        all: Vec::new(),
+    };
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let link_port = listener.local_addr().unwrap().port();
+    let first = fleet.processes.push(gateway(&fleet.url(), link_port, run));
+    let mut robot = LinkRobot::connected(&listener);
+
+    let up = format!("semo/scouting/{run}/MasterTeam/SlaveTeam.COLOR/SlaveTeam/ti");
+    let send = |v| gram(false, "SlaveTeam", "ti", "SlaveTeam.COLOR", v);
+    let down = format!("semo/scouting/{run}/SlaveTeam/USER.RC_CMD/MasterTeam/irobot");
+    let message = |v| gram(false, "MasterTeam", "irobot", "USER.RC_CMD", v);
+    let publish = |v| {
+        client
+            .publish(&down, rumqttc::QoS::AtLeastOnce, false, message(v))
+            .unwrap()
+    };
+
+    // Up: a send, acknowledged (the broker has it).
+    robot.send(Kind::Send, "MasterTeam", &send(1));
+    // Down: three messages; the first gateway passes the first down the
+    // link, and the robot takes none of them.
+    for v in 1..=3 {
+        publish(v);
+    }
+    heard.until("the three messages", |all| {
+        all.iter().filter(|(t, _)| *t == down).count() == 3
+    });
+    robot.until_written_to("the first message down the link");
+    let said = stopped_saying(&mut fleet, first);
+    assert!(said.contains("ti: link open"), "{said}");
+
+    // No gateway: a message for the robot waits at the broker, and the
+    // robot's next send waits with the robot.
+    publish(4);
+    heard.until("the message sent while no gateway ran", |all| {
+        all.iter().filter(|(t, _)| *t == down).count() == 4
+    });
+    let frame = Frame::addressed(Kind::Send, 0, "MasterTeam", &send(2)).unwrap();
+    robot.endpoint.queue(Kind::Send, frame.payload).unwrap();
+
+    let second = fleet.processes.push(gateway(&fleet.url(), link_port, run));
+    robot.reconnected(&listener);
+    robot.until("the send made while no gateway ran", |_, e| {
+        e.outgoing.pending() == 0
+    });
+    // One more each way, after everything before: a copy of anything
+    // earlier would come before it (one topic, one sender: in order).
+    robot.send(Kind::Send, "MasterTeam", &send(3));
+    publish(5);
+    robot.until("the five messages", |taken, _| {
+        taken.iter().any(|f| f.payload == message(5))
+    });
+    let taken: Vec<(Kind, Vec<u8>)> = robot
+        .taken
+        .iter()
+        .map(|f| (f.kind, f.payload.clone()))
+        .collect();
+    let expected: Vec<(Kind, Vec<u8>)> = (1..=5).map(|v| (Kind::Message, message(v))).collect();
+    assert_eq!(
+        taken, expected,
+        "every message down the link once, in order, across the restart"
+    );
+    heard.until("the send after the restart", |all| {
+        all.iter().any(|(t, p)| *t == up && *p == send(3))
+    });
+    assert_eq!(
+        heard.on(&up),
+        vec![send(1), send(2), send(3)],
+        "every send published once, in order, across the restart"
+    );
+    let said = stopped_saying(&mut fleet, second);
+    assert!(said.contains("ti: link open"), "{said}");
+    assert!(!said.contains("bad frame"), "{said}");
+}
+
+/// A robot that comes back on its link (a board reset, its QEMU started
+/// again) is welcomed as a robot restarted in its run: its broker session,
+/// the gateway's, was kept, and the `Welcome` says so (its
+/// `semo_session_resumed`, as a restarted Linux robot's CONNACK says), so
+/// that its elections listen before they claim; the first session of a
+/// run says not. (Every `Welcome` said what the broker said when the
+/// gateway started: a board restarted in a swarm claimed leadership at
+/// once.)
+#[test]
+fn a_robot_back_on_its_link_is_told_its_session_was_kept() {
+    let Some(mut fleet) = Fleet::start("gateway-welcome-again") else {
+        return;
+    };
+    let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+    let link_port = listener.local_addr().unwrap().port();
+    let gw = fleet.processes.push(gateway(&fleet.url(), link_port, "g7"));
+    let robot = LinkRobot::connected(&listener);
+    assert_eq!(robot.endpoint.peer_flags, 0, "a new run: no session kept");
+    drop(robot);
+    let robot = LinkRobot::connected(&listener);
+    assert_eq!(robot.endpoint.peer_flags, 1, "back on its link");
+    drop(robot);
+    let said = stopped_saying(&mut fleet, gw);
+    assert!(said.matches("ti: link open").count() >= 2, "{said}");
+}
+
 #[test]
 fn bad_arguments_are_refused_with_exit_status_2() {
     let mission = scouting();
@@ -563,4 +732,177 @@ fn a_linux_robot_over_the_link_behaves_as_in_the_simulator() {
         "nothing refused"
     );
     fleet.processes.kill(gw);
+}
+
+/// The scouting mission as in the test above, at its real pace (so that a
+/// gateway restart is a moment of it), with the gateway killed (SIGKILL)
+/// once ti has heard its fleet and sent to it, and a new one started on the
+/// same link. ti does not crash: it connects again (its trace's `link`
+/// event counts one reconnection, and the publishes lost while no session
+/// stood), hears its fleet after the restart, and ends as every robot
+/// does, in the modes `semo simulate` gives. Every send ti traced is
+/// published, in order, and none twice but the one in flight when the
+/// gateway was killed: the broker may have had it (its PUBACK read) while
+/// its `Ack` had not reached ti, which then sends it again to the new
+/// gateway, as an MQTT robot sends a QoS 1 message again around a
+/// reconnection. (A gateway knows nothing of what the last one published.)
+#[test]
+fn a_linux_robot_on_the_link_survives_a_gateway_restart_in_the_middle() {
+    use support::robots::{events, field, modes};
+    let Some(mut fleet) = Fleet::start("gateway-restart-scouting") else {
+        return;
+    };
+    let run = "g6";
+    let scenario = support::repo_root().join("tests/fixtures/build/scouting.scenario.json");
+    let folders = support::mqtt::build(&scouting(), &fleet.out, &[]);
+    support::mqtt::compile_in(&folders, &scenario);
+    let (_client, rx) = watcher(fleet.port, run);
+    let mut heard = Heard {
+        rx,
+        all: Vec::new(),
+    };
+    let link_port = support::mosquitto::free_port();
+    let listening = |fleet: &Fleet| {
+        Command::new(env!("CARGO_BIN_EXE_semo"))
+            .arg("gateway")
+            .arg(scouting())
+            .args(["--link", &format!("ti=listen:127.0.0.1:{link_port}")])
+            .args(["--broker", &fleet.url(), "--run", run])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("semo gateway starts")
+    };
+    let first = fleet.processes.push(listening(&fleet));
+    let link = format!("tcp:127.0.0.1:{link_port}");
+    let (_, start_at) = support::robots::start_barrier(3);
+    let start_at = start_at.to_string();
+    let mut started = Vec::new();
+    for folder in &folders {
+        let robot = support::mqtt::robot_name(folder);
+        let (args, env): (Vec<String>, Vec<(&str, &str)>) = if robot == "ti" {
+            (
+                vec!["--transport".into(), "link".into()],
+                vec![("SEMO_LINK", link.as_str())],
+            )
+        } else {
+            (fleet.transport_args(), vec![])
+        };
+        let mut args: Vec<&str> = args.iter().map(String::as_str).collect();
+        args.extend(["--start-at", start_at.as_str(), "--time-scale", "1"]);
+        args.extend(["--run", run]);
+        started.push(fleet.spawn_with(folder, &scenario, "restart", &args, &env));
+    }
+    let ti = started.iter().find(|s| s.robot == "ti").unwrap();
+
+    // Messages flow both ways (ti reports its colors to the master as fast
+    // as the link takes them, and hears nxt's heartbeats): the gateway is
+    // killed then.
+    let end = Instant::now() + LIMIT;
+    let before = loop {
+        let trace = support::mqtt::read_trace(&ti.trace);
+        let heard = trace.iter().any(|e| field(e, "event") == "receive");
+        let reported = trace
+            .iter()
+            .any(|e| field(e, "event") == "send" && field(e, "to") == "MasterTeam");
+        if heard && reported {
+            break trace.len();
+        }
+        assert!(Instant::now() < end, "ti neither heard nor sent: {trace:?}");
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    let said = stopped_saying(&mut fleet, first);
+    assert!(said.contains("ti: link open"), "{said}");
+    let second = fleet.processes.push(listening(&fleet));
+
+    let traces: std::collections::BTreeMap<String, Vec<support::robots::Event>> = started
+        .iter()
+        .map(|s| (s.robot.clone(), fleet.finish(s, "restart")))
+        .collect();
+    let said = stopped_saying(&mut fleet, second);
+    assert!(said.contains("ti: link open"), "the new gateway: {said}");
+
+    // ti connected again and heard its fleet after the restart.
+    let ti_trace = &traces["ti"];
+    assert_eq!(field(ti_trace.last().unwrap(), "event"), "stop");
+    let links: Vec<_> = ti_trace
+        .iter()
+        .filter(|e| field(e, "event") == "link")
+        .collect();
+    assert_eq!(links.len(), 1, "{links:?}");
+    assert_eq!(field(links[0], "reconnections"), "1", "{links:?}");
+    assert!(links[0].get("lost").is_some(), "{links:?}");
+    assert!(
+        ti_trace[before..]
+            .iter()
+            .any(|e| field(e, "event") == "receive"),
+        "ti hears its fleet after the restart"
+    );
+
+    // The same modes as in the simulator, for every robot.
+    let simulated = support::simulate_trace(&scouting(), &scenario, "sim");
+    assert_eq!(simulated.code, 0, "{}", simulated.stderr);
+    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
+    let simulated = events(&lines);
+    for (robot, trace) in &traces {
+        let reference: Vec<_> = simulated
+            .iter()
+            .filter(|e| field(e, "robot") == robot)
+            .cloned()
+            .collect();
+        assert_eq!(
+            modes(trace),
+            modes(&reference),
+            "{robot}'s modes with a gateway restart and in `semo simulate`"
+        );
+    }
+
+    // Every send ti traced was published, in order; at most the one in
+    // flight at the kill twice, right after its first copy.
+    let sent: Vec<(String, String)> = ti_trace
+        .iter()
+        .filter(|e| field(e, "event") == "send" && field(e, "to") == "MasterTeam")
+        .map(|e| (field(e, "key").to_string(), e["value"].to_string()))
+        .collect();
+    assert!(!sent.is_empty());
+    let last = sent.last().cloned().unwrap();
+    let prefix = format!("semo/scouting/{run}/MasterTeam/");
+    let from_ti = |all: &[(String, Vec<u8>)]| -> Vec<(String, String)> {
+        all.iter()
+            .filter(|(t, _)| t.starts_with(&prefix) && t.ends_with("/SlaveTeam/ti"))
+            .filter_map(|(_, p)| datagram::decode(p))
+            .filter(|d| !d.publish)
+            .map(|d| {
+                let value = match d.value {
+                    Some(Value::Text(t) | Value::Word(t)) => {
+                        serde_json::Value::String(t.to_string())
+                    }
+                    other => panic!("ti sends texts: {other:?}"),
+                };
+                (d.key.to_string(), value.to_string())
+            })
+            .collect()
+    };
+    heard.until("ti's last send", |all| {
+        from_ti(all).iter().filter(|s| **s == last).count()
+            >= sent.iter().filter(|s| **s == last).count()
+    });
+    let published = from_ti(&heard.all);
+    let mut once = published.clone();
+    if published.len() == sent.len() + 1 {
+        // The first copy that is not the next send traced.
+        let i = (0..sent.len())
+            .find(|&i| published[i] != sent[i])
+            .unwrap_or(sent.len());
+        assert!(
+            i > 0 && published[i] == published[i - 1],
+            "only the send in flight at the kill is published again, at once: {i}"
+        );
+        once.remove(i);
+        eprintln!("published again after the restart: {:?}", published[i]);
+    }
+    assert_eq!(
+        once, sent,
+        "every send ti traced published in order, none lost, none twice but the one in flight"
+    );
 }

@@ -377,6 +377,53 @@ fn a_restarted_robot_is_heard_from_sequence_zero_again() {
     assert_eq!(taken[0].destination().unwrap().1, b"second");
 }
 
+/// A publish (`P`, as at QoS 0) made while no session stands (before the
+/// gateway's `Welcome`, or once the line went away: a gateway restarting)
+/// is lost: counted (`lost`, which the robot's trace says at its end),
+/// never written; one made in a session goes at once. A send waits for the
+/// next session instead.
+#[test]
+fn a_publish_without_a_session_is_counted_lost_and_a_send_waits() {
+    let publish = |value: i64| {
+        semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+            publish: true,
+            team: "SlaveTeam".into(),
+            robot: "ti".into(),
+            key: "SlaveTeam.LOCATION".into(),
+            value: Some(semo::refine::Value::Int(value)),
+        })
+    };
+    let mut c = CSide::start();
+    let before = c.command(&format!("d SlaveTeam {}", hex(&publish(1))));
+    assert!(
+        before.wire.is_empty() && before.lines.is_empty(),
+        "{before:?}"
+    );
+    assert!(c.stats().contains("lost=1"), "{}", c.stats());
+    drop(c);
+
+    let (mut c, mut rust) = connected();
+    let said = c.command(&format!("d SlaveTeam {}", hex(&publish(2))));
+    let mut wire = Vec::new();
+    let taken = rust.feed(&said.wire, 0, &mut wire);
+    assert_eq!(taken.len(), 1);
+    assert_eq!(taken[0].kind, Kind::Publish);
+    assert_eq!(taken[0].destination().unwrap().1, publish(2));
+    assert!(c.stats().contains("lost=0"), "{}", c.stats());
+
+    c.command("r");
+    let gone = c.command(&format!("d SlaveTeam {}", hex(&publish(3))));
+    assert!(gone.wire.is_empty(), "nothing written without a session");
+    assert!(c.stats().contains("lost=1"), "{}", c.stats());
+    let send = c.queue(Kind::Send, b"\x01Tlater");
+    assert!(
+        frames(&send.wire).iter().all(|f| f.kind == Kind::Hello),
+        "a send waits for the next session: {:?}",
+        frames(&send.wire)
+    );
+    assert!(c.stats().contains("pending=1"), "{}", c.stats());
+}
+
 /// A board built with a smaller `SEMO_LINK_PAYLOAD_MAX` says it in its
 /// Hello and in its Welcome, so the gateway's side learns it however the
 /// session starts; a frame longer than that is a bad frame on the board,

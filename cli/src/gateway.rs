@@ -90,8 +90,11 @@ enum Event {
     /// The broker accepted the connection and the subscriptions:
     /// whether it kept the robot's session.
     Ready(bool),
-    /// A message the broker delivered on one of the robot's topics.
-    Message { topic: String, payload: Vec<u8> },
+    /// A message the broker delivered on one of the robot's topics, not
+    /// yet acknowledged to the broker: that waits until the robot has it
+    /// (its `Ack` on the link), so a gateway that stops in between loses
+    /// none: the broker delivers it again to the next gateway.
+    Message(rumqttc::Publish),
     /// The broker acknowledged the publish of the robot's reliable frame
     /// with this sequence number: the robot may now hear its `Ack`.
     Acked(u16),
@@ -277,6 +280,9 @@ fn describe(place: &Place) -> String {
 const ROOM: usize = 64;
 /// Reliable frames behind the one in flight, per link.
 const LINK_QUEUE: usize = 16;
+/// How soon an acknowledgement to the broker that found the connection's
+/// queue full is tried again.
+const ACK_RETRY: Duration = Duration::from_millis(20);
 
 /// Room for messages from the broker: the MQTT thread takes a place before
 /// it hands a message over, the link thread gives it back when the robot
@@ -407,6 +413,9 @@ impl LinkGateway {
         let mut mqtt = access.options(client_id);
         mqtt.set_keep_alive(Duration::from_secs(10));
         mqtt.set_clean_session(false);
+        // A message is acknowledged to the broker once the robot has it
+        // (`settling` in the link's loop), not as it arrives.
+        mqtt.set_manual_acks(true);
         let (client, connection) = rumqttc::Client::new(mqtt, 256);
         let broker = Broker {
             client,
@@ -435,15 +444,24 @@ impl LinkGateway {
         }
         // The link opens once the broker is ready: a robot's Hello is
         // answered with what the broker says of its session.
+        let mut early = VecDeque::new();
         let session_present = loop {
             match heard.recv() {
                 Ok(Event::Ready(present)) => break present,
-                Ok(Event::Message { .. }) => room.give(1), // before Ready: none
+                // A kept session's messages come right after the broker's
+                // CONNACK, before the SUBACK: they wait with the rest.
+                Ok(Event::Message(publish)) => early.push_back(publish),
                 Ok(_) => {}
                 Err(_) => return,
             }
         };
-        let mut held: VecDeque<(String, Vec<u8>)> = VecDeque::new();
+        let mut held: VecDeque<rumqttc::Publish> = early;
+        // The messages taken from `held`, in order, until the broker hears
+        // they were passed on: each is done when the robot has acknowledged
+        // its frame (or at once when no frame goes down).
+        let mut settling: VecDeque<(rumqttc::Publish, bool)> = VecDeque::new();
+        // Acknowledgements the broker connection's queue could not take yet.
+        let mut acks: VecDeque<rumqttc::Publish> = VecDeque::new();
         let mut counts = Counts::default();
         let mut endpoint = Endpoint::new(LINK_QUEUE);
         endpoint.welcome_flags = u8::from(session_present);
@@ -474,6 +492,13 @@ impl LinkGateway {
                     .outgoing
                     .deadline()
                     .map(|d| Duration::from_millis(d.saturating_sub(now())));
+                // Acknowledgements waiting for room in the connection's queue
+                // are tried again soon, whatever else comes.
+                let wait = match wait {
+                    _ if acks.is_empty() => wait,
+                    Some(wait) => Some(wait.min(ACK_RETRY)),
+                    None => Some(ACK_RETRY),
+                };
                 let event = match wait {
                     Some(wait) => match heard.recv_timeout(wait) {
                         Ok(event) => Some(event),
@@ -509,35 +534,63 @@ impl LinkGateway {
                     Some(Event::Closed(why)) => break why,
                     Some(Event::Ready(_)) => {}
                     Some(Event::Acked(seq)) => endpoint.acknowledge(seq, &mut wire),
-                    Some(Event::Message { topic, payload }) => held.push_back((topic, payload)),
+                    Some(Event::Message(publish)) => held.push_back(publish),
                 }
                 // Messages from the broker go down as the link has room,
                 // once the session stands: its Welcome (or the robot's
                 // Hello) said how long a payload the robot takes.
-                while let Some((topic, payload)) =
-                    held.front().filter(|_| endpoint.outgoing.welcomed())
-                {
-                    let frame =
-                        self.down_the_link(topic, payload, endpoint.peer_payload_max, &mut counts);
-                    match frame {
+                while let Some(publish) = held.front().filter(|_| endpoint.outgoing.welcomed()) {
+                    let frame = self.down_the_link(
+                        &publish.topic,
+                        &publish.payload,
+                        endpoint.peer_payload_max,
+                        &mut counts,
+                    );
+                    let on_link = match frame {
                         None => {
-                            held.pop_front();
                             room.give(1);
+                            false
                         }
                         Some((kind, bytes)) => {
                             if endpoint.queue(kind, bytes).is_err() {
                                 break;
                             }
-                            held.pop_front();
+                            true
                         }
-                    }
+                    };
+                    let publish = held.pop_front().expect("the front was there");
+                    settling.push_back((publish, !on_link));
                 }
-                // Room comes back as the robot acknowledges.
+                // Room comes back as the robot acknowledges, and the broker
+                // hears of each message the robot has, in order.
                 let pending_after = endpoint.outgoing.pending();
-                room.give(pending_before.saturating_sub(pending_after));
+                let acked = pending_before.saturating_sub(pending_after);
+                room.give(acked);
+                settling
+                    .iter_mut()
+                    .filter(|(_, done)| !done)
+                    .take(acked)
+                    .for_each(|(_, done)| *done = true);
+                while settling.front().is_some_and(|(_, done)| *done) {
+                    let (publish, _) = settling.pop_front().expect("the front was there");
+                    acks.push_back(publish);
+                }
+                while let Some(publish) = acks.front() {
+                    if broker.client.try_ack(publish).is_err() {
+                        break;
+                    }
+                    acks.pop_front();
+                }
                 endpoint.tick(now(), &mut wire);
             };
             eprintln!("gateway: {}: link closed ({closed})", self.name());
+            // A robot that comes back on its link (reset, its QEMU started
+            // again) finds its broker session kept, the gateway's: its
+            // Welcome says so, as a restarted Linux robot's CONNACK does,
+            // so that its elections listen before they claim.
+            if endpoint.outgoing.welcomed() {
+                endpoint.welcome_flags = 1;
+            }
             self.lost(&broker.client, last_status.as_deref());
         }
     }
@@ -857,13 +910,7 @@ fn broker_thread(
             }
             Ok(rumqttc::Event::Incoming(rumqttc::Packet::Publish(p))) => {
                 room.take();
-                if events
-                    .send(Event::Message {
-                        topic: p.topic,
-                        payload: p.payload.to_vec(),
-                    })
-                    .is_err()
-                {
+                if events.send(Event::Message(p)).is_err() {
                     return;
                 }
             }

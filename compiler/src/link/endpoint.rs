@@ -14,6 +14,10 @@ pub struct Endpoint {
     /// What this side's `Welcome` says (bit 0: the robot's broker session
     /// was kept).
     pub welcome_flags: u8,
+    /// What the other side's `Welcome` said when it started this side's
+    /// session (`semo_link`'s `peer_flags`: on the robot,
+    /// `semo_session_resumed`).
+    pub peer_flags: u8,
     /// The longest payload this side takes (said in its `Hello` and
     /// `Welcome`); a longer frame is a bad frame.
     payload_max: usize,
@@ -47,6 +51,7 @@ impl Endpoint {
             incoming: Incoming::new(),
             reader: Reader::new(),
             welcome_flags: 0,
+            peer_flags: 0,
             payload_max: payload_max as usize,
             peer_payload_max: PAYLOAD_MAX,
             bad_frames: Vec::new(),
@@ -88,6 +93,10 @@ impl Endpoint {
                 self.peer_payload_max = max.min(PAYLOAD_MAX);
             }
             match frame.kind {
+                Kind::Welcome if !self.outgoing.welcomed() => {
+                    self.peer_flags = frame.payload[0];
+                    self.outgoing.heard(&frame);
+                }
                 Kind::Ack | Kind::Welcome => self.outgoing.heard(&frame),
                 Kind::Hello => {
                     self.incoming.restart();

@@ -449,5 +449,9 @@ bool semo__mqtt_session_present(void);
 /* Whether the gateway's Welcome said the broker kept the robot's session
  * (semo_link_transport.c, POSIX). */
 bool semo__link_session_present(void);
+/* Before the program's `stop`: waits (at most 2 s) for what was sent
+ * reliably to be acknowledged, then traces a `link` event with what the
+ * link lost or did again, when anything (semo_link_transport.c). */
+void semo__link_report(void);
 
 #endif /* SEMO_INTERNAL_H */

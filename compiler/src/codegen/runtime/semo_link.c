@@ -110,8 +110,10 @@ int semo_link_send_datagram(semo_link *link, const char *to, const void *datagra
         return -1;
     unsigned char head[1] = {(unsigned char)to_len};
     if (((const unsigned char *)datagram)[5] != SEMO_LINK_DATAGRAM_SEND) {
-        if (!link->welcomed)
+        if (!link->welcomed) {
+            link->lost++;
             return 0;
+        }
         const unsigned char *pieces[3] = {head, (const unsigned char *)to, (const unsigned char *)datagram};
         size_t lens[3] = {1, to_len, len};
         write_pieces(link, SEMO_LINK_PUBLISH, 0, pieces, lens, 3);

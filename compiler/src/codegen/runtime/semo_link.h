@@ -96,8 +96,9 @@ typedef struct {
     size_t peer_payload_max;
     unsigned char wire[SEMO_LINK_WIRE_MAX];
     /* Counted for the trace: frames that were no frame (CRC, stuffing,
-     * length, kind), copies not taken, frames sent again. */
-    unsigned long bad_frames, duplicates, retransmissions;
+     * length, kind), copies not taken, frames sent again, publishes lost
+     * because no session stood (the line away, the gateway restarting). */
+    unsigned long bad_frames, duplicates, retransmissions, lost;
 } semo_link;
 
 void semo_link_init(semo_link *link, semo_link_write write, void *ctx);
@@ -122,7 +123,7 @@ void semo_link_restart(semo_link *link);
 /* A datagram for `to` (a team, a robot or "USER"; a length byte then the
  * name lead the payload): reliably (S) when the datagram is a send, at once
  * (P) when it is a publish, which before the session stands is lost as at
- * QoS 0. What every transport over the link sends (semo_link_transport.c on
+ * QoS 0 (and counted, `lost`). What every transport over the link sends (semo_link_transport.c on
  * POSIX, semo_static_link.c on a board). 0 when queued or written, -1 when
  * it can never go (no name, too long), -2 while the queue is full: the
  * caller makes room (waits, or feeds the line) and asks again. */

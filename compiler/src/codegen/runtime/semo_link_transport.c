@@ -9,9 +9,12 @@
  * due (hellos, the reliable frames and their copies), and reconnects when
  * the connection is lost (a gateway restarted). `send` waits for room in the
  * link's queue (never lost); `publish` goes at once (lost with the line, as
- * at QoS 0); the status goes reliably. `open` waits (at most 5 s) for the
- * gateway's Welcome, whose flag says whether the broker kept the robot's
- * session (semo_session_resumed). */
+ * at QoS 0, and counted); the status goes reliably. `open` waits (at most
+ * 5 s) for the gateway's Welcome, whose flag says whether the broker kept
+ * the robot's session (semo_session_resumed). At the end the trace's `link`
+ * event says what the link lost or did again: bad frames, duplicates,
+ * repeats, publishes lost without a session, reconnections (a gateway
+ * restarted), frames never acknowledged. */
 #define _POSIX_C_SOURCE 200809L
 
 #include "semo_internal.h"
@@ -42,6 +45,7 @@ static int g_fd = -1;
 static int g_wake[2] = {-1, -1};
 static char g_host[256], g_port[16];
 static bool g_stopping, g_interrupted;
+static unsigned long g_connections; /* to the gateway, the first included */
 static semo__received g_received; /* what recv has still to take */
 
 static int64_t now_ms(void)
@@ -130,6 +134,7 @@ static void *io_thread(void *arg)
                 continue;
             }
             g_fd = fd;
+            g_connections++;
             semo_link_restart(&g_link);
         }
         semo_link_tick(&g_link, now_ms());
@@ -152,6 +157,9 @@ static void *io_thread(void *arg)
             !(n < 0 && errno == EINTR)) {
             close(g_fd); /* the gateway went away: connect again */
             g_fd = -1;
+            /* No session until the next Welcome: a publish meanwhile is
+             * lost and counted, not written to a closed line. */
+            semo_link_restart(&g_link);
             pthread_cond_broadcast(&g_changed);
             continue;
         }
@@ -218,6 +226,7 @@ static int link_open(const semo_program_desc *program, const semo_transport_conf
     g_received.head = g_received.count = 0;
     g_received.refused = 0;
     g_received.too_long = 0;
+    g_connections = 0;
     if (pthread_create(&g_thread, NULL, io_thread, NULL) != 0)
         return -1;
     g_thread_started = true;
@@ -281,6 +290,35 @@ static void link_interrupt(void)
     pthread_cond_broadcast(&g_changed);
     pthread_mutex_unlock(&g_lock);
     wake_thread();
+}
+
+static void format_count(char *out, unsigned long n)
+{
+    snprintf(out, 21, "%lu", n);
+}
+
+void semo__link_report(void)
+{
+    if (!g_thread_started)
+        return;
+    struct timespec deadline = semo__deadline_after(LINK_CLOSE_WAIT_MS);
+    pthread_mutex_lock(&g_lock);
+    int waited = 0;
+    while (semo_link_pending(&g_link) > 0 && g_fd >= 0 && waited == 0)
+        waited = pthread_cond_timedwait(&g_changed, &g_lock, &deadline);
+    unsigned long counts[6] = {g_link.bad_frames, g_link.duplicates, g_link.retransmissions, g_link.lost,
+                               g_connections > 1 ? g_connections - 1 : 0, semo_link_pending(&g_link)};
+    pthread_mutex_unlock(&g_lock);
+    bool any = false;
+    for (int i = 0; i < 6; i++)
+        any = any || counts[i] > 0;
+    if (!any)
+        return;
+    char text[6][21];
+    for (int i = 0; i < 6; i++)
+        format_count(text[i], counts[i]);
+    semo_trace("link", "bad_frames", text[0], "duplicates", text[1], "retransmissions", text[2], "lost", text[3],
+               "reconnections", text[4], "unacknowledged", text[5], NULL);
 }
 
 static void link_close(void)

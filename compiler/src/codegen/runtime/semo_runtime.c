@@ -1790,6 +1790,8 @@ stop:
         if (p->tasks[i].wrapup)
             p->tasks[i].wrapup();
     semo__trace_dropped_samples();
+    if (g_transport == &semo_link_transport)
+        semo__link_report();
     semo_trace("stop", NULL);
     if (g_transport)
         g_transport->close();

@@ -4,6 +4,8 @@
  *   b HEX         bytes from the line
  *   q KIND HEX    queue a reliable frame;   e KIND HEX   write an unreliable one
  *   f FLAGS       what our Welcome says
+ *   d TO HEX      semo_link_send_datagram of the datagram HEX to TO
+ *   r             the line went away (semo_link_restart)
  *   s             print the counters
  * Every byte written to the line is printed `wire HEX`, every frame taken
  * `take KIND SEQ HEX`; each command ends with a line `.`. */
@@ -74,12 +76,23 @@ int main(void)
                 printf("refused\n");
             if (line[0] == 'q')
                 semo_link_tick(&g_link, now);
+        } else if (line[0] == 'd') {
+            char to[256];
+            int used = 0;
+            if (sscanf(line + 2, "%255s %n", to, &used) == 1 && used > 0) {
+                size_t n = hex_in(line + 2 + used, g_buf, sizeof g_buf);
+                if (semo_link_send_datagram(&g_link, to, g_buf, n) != 0)
+                    printf("refused\n");
+            }
+        } else if (line[0] == 'r') {
+            semo_link_restart(&g_link);
         } else if (line[0] == 'f') {
             g_link.welcome_flags = (unsigned char)atoi(line + 2);
         } else if (line[0] == 's') {
-            printf("stats bad=%lu dup=%lu retx=%lu pending=%zu welcomed=%d peer_flags=%u peer_payload_max=%zu\n",
+            printf("stats bad=%lu dup=%lu retx=%lu pending=%zu welcomed=%d peer_flags=%u peer_payload_max=%zu "
+                   "lost=%lu\n",
                    g_link.bad_frames, g_link.duplicates, g_link.retransmissions, semo_link_pending(&g_link),
-                   g_link.welcomed, g_link.peer_flags, g_link.peer_payload_max);
+                   g_link.welcomed, g_link.peer_flags, g_link.peer_payload_max, g_link.lost);
         }
         printf(".\n");
         fflush(stdout);
