@@ -22,7 +22,7 @@
 use super::arguments::Values;
 use super::literal::Literal;
 use super::{RELATED, VariableWrite, list};
-use crate::diag::Code;
+use crate::diag::{Code, Sink};
 use crate::fasthash::{FastMap, FastSet};
 use crate::sema::Checker;
 use crate::sema::ir::{AttrKey, Compared, ParamOwner};
@@ -87,35 +87,34 @@ impl Checker<'_> {
             {
                 continue;
             }
-            let mut possible: Vec<String> = values.iter().map(Literal::text).collect();
-            possible.sort();
-            possible.dedup();
-            let constant = test.constant.text();
             let name = &test.name;
-            let (code, op, verdict) = if test.equal {
-                (Code::ComparisonNeverHolds, "==", "never holds")
-            } else {
-                (Code::ComparisonAlwaysHolds, "!=", "always holds")
-            };
             let owner = self.mission.owner_name(test.param.0);
-            let guess = suggestion(&constant, possible.iter().map(String::as_str));
-            let diagnostic = self
-                .diagnostics
-                .report(
-                    code,
-                    test.span,
+            let related = arguments
+                .iter()
+                .map(|(span, literal)| {
+                    (
+                        *span,
+                        format!("`{name}` is given `{}` here", literal.text()),
+                    )
+                })
+                .collect();
+            report_undecided(
+                &mut self.diagnostics,
+                Undecided {
+                    span: test.span,
+                    equal: test.equal,
+                    subject: name.to_string(),
+                    constant: &test.constant,
+                    always: "always holds",
+                },
+                values.iter(),
+                |possible, constant| {
                     format!(
-                        "`{name} {op} {constant}` {verdict}: the parameter `{name}` of `{owner}` is only ever given {}, never `{constant}`",
-                        list(&possible)
-                    ),
-                )
-                .suggest(guess);
-            for (span, literal) in arguments {
-                diagnostic.relate(
-                    *span,
-                    format!("`{name}` is given `{}` here", literal.text()),
-                );
-            }
+                        "the parameter `{name}` of `{owner}` is only ever given {possible}, never `{constant}`"
+                    )
+                },
+                related,
+            );
         }
     }
 
@@ -145,44 +144,79 @@ impl Checker<'_> {
             findings.push((test, writers.clone(), values));
         }
         for (test, writers, values) in findings {
-            let mut possible: Vec<String> = values.iter().map(|v| v.text()).collect();
-            possible.sort();
-            possible.dedup();
-            let constant = test.constant.text();
             let key = &test.key;
-            let (code, op, verdict) = if test.equal {
-                (Code::ComparisonNeverHolds, "==", "never holds")
-            } else {
-                (
-                    Code::ComparisonAlwaysHolds,
-                    "!=",
-                    "holds whenever it has a value",
-                )
-            };
-            let guess = suggestion(&constant, possible.iter().map(String::as_str));
-            let diagnostic = self
-                .diagnostics
-                .report(
-                    code,
-                    test.span,
-                    format!(
-                        "`{key} {op} {constant}` {verdict}: `{key}` is only ever set to {}, never to `{constant}`",
-                        list(&possible)
-                    ),
-                )
-                .suggest(guess);
-            let mut related: Vec<(Span, String)> = writers
+            let related = writers
                 .iter()
                 .zip(&values)
                 .map(|(w, v)| (w.span, format!("`{key}` is set to `{}` here", v.text())))
                 .collect();
-            related.sort_by_key(|(span, _)| span.start);
-            related.dedup_by_key(|(span, _)| *span);
-            for (span, message) in related.into_iter().take(RELATED) {
-                diagnostic.relate(span, message);
-            }
+            report_undecided(
+                &mut self.diagnostics,
+                Undecided {
+                    span: test.span,
+                    equal: test.equal,
+                    subject: key.to_string(),
+                    constant: &test.constant,
+                    always: "holds whenever it has a value",
+                },
+                values.iter().copied(),
+                |possible, constant| {
+                    format!("`{key}` is only ever set to {possible}, never to `{constant}`")
+                },
+                related,
+            );
         }
     }
+}
+
+/// W020 (`==`) or W021 (`!=`) on a comparison of `subject` with a
+/// constant none of `values` equals: the message says what it is
+/// compared with (`why`: the values listed, the constant), suggests the
+/// closest value, and points at where the values come from (`related`,
+/// in the file's order, the first [`RELATED`]).
+fn report_undecided<'v>(
+    diagnostics: &mut Sink,
+    test: Undecided<'_>,
+    values: impl Iterator<Item = &'v Literal>,
+    why: impl FnOnce(&str, &str) -> String,
+    mut related: Vec<(Span, String)>,
+) {
+    let mut possible: Vec<String> = values.map(Literal::text).collect();
+    possible.sort();
+    possible.dedup();
+    let constant = test.constant.text();
+    let subject = &test.subject;
+    let (code, op, verdict) = if test.equal {
+        (Code::ComparisonNeverHolds, "==", "never holds")
+    } else {
+        (Code::ComparisonAlwaysHolds, "!=", test.always)
+    };
+    let guess = suggestion(&constant, possible.iter().map(String::as_str));
+    let why = why(&list(&possible), &constant);
+    let diagnostic = diagnostics
+        .report(
+            code,
+            test.span,
+            format!("`{subject} {op} {constant}` {verdict}: {why}"),
+        )
+        .suggest(guess);
+    related.sort_by_key(|(span, _)| span.start);
+    related.dedup_by_key(|(span, _)| *span);
+    for (span, message) in related.into_iter().take(RELATED) {
+        diagnostic.relate(span, message);
+    }
+}
+
+/// A comparison W020/W021 reports ([`report_undecided`]).
+struct Undecided<'a> {
+    span: Span,
+    equal: bool,
+    /// The variable or parameter compared, as written in the message.
+    subject: String,
+    constant: &'a Literal,
+    /// W021's verdict: a parameter always has its argument, a variable
+    /// only once it is set.
+    always: &'a str,
 }
 
 #[cfg(test)]
