@@ -196,6 +196,65 @@ fn the_scout_on_an_stm32_in_qemu_on_the_serial_link_behaves_as_in_the_simulator(
 /// keep pace with.
 static ONE_BOARD_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
+/// `semo gateway` for the scouting `ti` on the link at `link_port` (QEMU's
+/// serial port, or a relay to it), its standard error kept in `log`.
+fn gateway(fleet: &Fleet, link_port: u16, extra: &[&str], log: &Path) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_semo"))
+        .arg("gateway")
+        .arg(scouting())
+        .args(["--link", &format!("ti=tcp:127.0.0.1:{link_port}")])
+        .args(["--broker", &fleet.url()])
+        .args(extra)
+        .stdout(Stdio::null())
+        .stderr(std::fs::File::create(log).expect("a log file"))
+        .spawn()
+        .expect("semo gateway starts")
+}
+
+/// What a QEMU run of the scouting mission starts with: everything
+/// compiled before anything starts (the Linux robots with the scenario,
+/// `ti` for its board), then `ti`'s QEMU on a free port and a gateway to it.
+struct BoardRun {
+    fleet: Fleet,
+    scenario: PathBuf,
+    folders: Vec<PathBuf>,
+    elf: PathBuf,
+    link_port: u16,
+    gateway_log: PathBuf,
+    /// QEMU's and the gateway's places in the fleet's processes.
+    board: usize,
+    board_rx: mpsc::Receiver<String>,
+    gateway: usize,
+}
+
+impl BoardRun {
+    fn start(name: &str, on: Board) -> Option<BoardRun> {
+        let mut fleet = Fleet::start(name)?;
+        let scenario = scenario();
+        let elf = board_ti(&fleet.out.join("board"), on);
+        let folders = support::mqtt::build(&scouting(), &fleet.out.join("linux"), &[]);
+        support::mqtt::compile_in(&folders, &scenario);
+        let gateway_log = fleet.out.join("gateway.stderr");
+        let link_port = support::mosquitto::free_port();
+        let (board, board_rx) = qemu(&elf, on, link_port);
+        let board = fleet.processes.push(board);
+        let gateway = fleet
+            .processes
+            .push(gateway(&fleet, link_port, &[], &gateway_log));
+        Some(BoardRun {
+            fleet,
+            scenario,
+            folders,
+            elf,
+            link_port,
+            gateway_log,
+            board,
+            board_rx,
+            gateway,
+        })
+    }
+}
+
 fn behaves_as_in_the_simulator(test: &str, on: Board) {
     if !robots::board_tools_present(test) {
         return;
@@ -203,30 +262,19 @@ fn behaves_as_in_the_simulator(test: &str, on: Board) {
     let _turn = ONE_BOARD_AT_A_TIME
         .lock()
         .unwrap_or_else(|e| e.into_inner());
-    let Some(mut fleet) = Fleet::start(&format!("board-link-{}", on.machine)) else {
+    let Some(BoardRun {
+        mut fleet,
+        scenario,
+        folders,
+        gateway_log,
+        board,
+        board_rx,
+        gateway,
+        ..
+    }) = BoardRun::start(&format!("board-link-{}", on.machine), on)
+    else {
         return;
     };
-    let scenario = scenario();
-    // Everything is compiled before anything starts.
-    let elf = board_ti(&fleet.out.join("board"), on);
-    let folders = support::mqtt::build(&scouting(), &fleet.out.join("linux"), &[]);
-    support::mqtt::compile_in(&folders, &scenario);
-
-    let gateway_log = fleet.out.join("gateway.stderr");
-    let link_port = support::mosquitto::free_port();
-    let (board, board_rx) = qemu(&elf, on, link_port);
-    let board = fleet.processes.push(board);
-    let gateway = fleet.processes.push(
-        Command::new(env!("CARGO_BIN_EXE_semo"))
-            .arg("gateway")
-            .arg(scouting())
-            .args(["--link", &format!("ti=tcp:127.0.0.1:{link_port}")])
-            .args(["--broker", &fleet.url()])
-            .stdout(Stdio::null())
-            .stderr(std::fs::File::create(&gateway_log).expect("a log file"))
-            .spawn()
-            .expect("semo gateway starts"),
-    );
     // The board's mission time starts when the gateway welcomes it: the
     // Linux robots count theirs from that instant.
     let mut linux = Vec::new();
@@ -254,25 +302,12 @@ fn behaves_as_in_the_simulator(test: &str, on: Board) {
     fleet.processes.wait_success(board, "QEMU (ti)");
     fleet.processes.kill(gateway);
 
-    let simulated = support::simulate_trace(&scouting(), &scenario, "sim");
-    assert_eq!(simulated.code, 0, "{}", simulated.stderr);
-    let simulated = events(
-        &simulated
-            .stdout
-            .lines()
-            .map(str::to_string)
-            .collect::<Vec<_>>(),
-    );
+    let simulated = support::robots::simulated_modes(&scouting(), &scenario);
     assert_eq!(traces.len(), 3);
     for (robot, trace) in &traces {
-        let reference: Vec<Event> = simulated
-            .iter()
-            .filter(|e| field(e, "robot") == robot)
-            .cloned()
-            .collect();
         assert_eq!(
             modes(trace),
-            modes(&reference),
+            simulated[robot],
             "{robot}'s modes with ti on a board in QEMU and in `semo simulate`"
         );
         assert_eq!(modes(trace).last().map(String::as_str), Some("FINISH"));
@@ -328,29 +363,20 @@ fn the_evalbot_in_qemu_killed_and_restarted_behaves_as_in_the_simulator() {
         .lock()
         .unwrap_or_else(|e| e.into_inner());
     let on = LM3S6965;
-    let Some(mut fleet) = Fleet::start("board-link-restart") else {
+    let Some(BoardRun {
+        mut fleet,
+        scenario,
+        folders,
+        elf,
+        link_port,
+        gateway_log,
+        board,
+        board_rx,
+        gateway,
+    }) = BoardRun::start("board-link-restart", on)
+    else {
         return;
     };
-    let scenario = scenario();
-    let elf = board_ti(&fleet.out.join("board"), on);
-    let folders = support::mqtt::build(&scouting(), &fleet.out.join("linux"), &[]);
-    support::mqtt::compile_in(&folders, &scenario);
-
-    let gateway_log = fleet.out.join("gateway.stderr");
-    let link_port = support::mosquitto::free_port();
-    let (board, board_rx) = qemu(&elf, on, link_port);
-    let board = fleet.processes.push(board);
-    let gateway = fleet.processes.push(
-        Command::new(env!("CARGO_BIN_EXE_semo"))
-            .arg("gateway")
-            .arg(scouting())
-            .args(["--link", &format!("ti=tcp:127.0.0.1:{link_port}")])
-            .args(["--broker", &fleet.url()])
-            .stdout(Stdio::null())
-            .stderr(std::fs::File::create(&gateway_log).expect("a log file"))
-            .spawn()
-            .expect("semo gateway starts"),
-    );
 
     // ti's first life, until its first mode change; the Linux robots count
     // their mission time from its start.
@@ -763,17 +789,9 @@ fn send_latency_from_the_board_through_the_gateway_and_the_broker() {
         }
     });
     let gateway_log = fleet.out.join("gateway.stderr");
-    let gateway = fleet.processes.push(
-        Command::new(env!("CARGO_BIN_EXE_semo"))
-            .arg("gateway")
-            .arg(scouting())
-            .args(["--link", &format!("ti=tcp:127.0.0.1:{relay_port}")])
-            .args(["--broker", &fleet.url(), "--run", run])
-            .stdout(Stdio::null())
-            .stderr(std::fs::File::create(&gateway_log).expect("a log file"))
-            .spawn()
-            .expect("semo gateway starts"),
-    );
+    let gateway = fleet
+        .processes
+        .push(gateway(&fleet, relay_port, &["--run", run], &gateway_log));
     let lines = board_trace(&board_rx, &gateway_log, |_| {});
     fleet.processes.wait_success(board, "QEMU (ti)");
     fleet.processes.kill(gateway);

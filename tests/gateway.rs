@@ -646,6 +646,39 @@ fn bad_arguments_are_refused_with_exit_status_2() {
     assert!(help.stdout.contains("--link"));
 }
 
+/// Starts the scouting robots built in `folders` at one instant (ti's link
+/// open by then): `ti` with `--transport link` to the gateway listening on
+/// `link_port`, the others over MQTT; `extra`: more arguments for each.
+fn start_with_ti_on_link(
+    fleet: &mut Fleet,
+    folders: &[std::path::PathBuf],
+    scenario: &std::path::Path,
+    link_port: u16,
+    extra: &[&str],
+    tag: &str,
+) -> Vec<support::mqtt::Started> {
+    let link = format!("tcp:127.0.0.1:{link_port}");
+    let (_, start_at) = support::robots::start_barrier(folders.len());
+    let start_at = start_at.to_string();
+    let mut started = Vec::new();
+    for folder in folders {
+        let robot = support::mqtt::robot_name(folder);
+        let (args, env): (Vec<String>, Vec<(&str, &str)>) = if robot == "ti" {
+            (
+                vec!["--transport".into(), "link".into()],
+                vec![("SEMO_LINK", link.as_str())],
+            )
+        } else {
+            (fleet.transport_args(), vec![])
+        };
+        let mut args: Vec<&str> = args.iter().map(String::as_str).collect();
+        args.extend(["--start-at", start_at.as_str()]);
+        args.extend(extra);
+        started.push(fleet.spawn_with(folder, scenario, tag, &args, &env));
+    }
+    started
+}
+
 /// The scouting mission with `ti` on the link: its `linux-sim` program with
 /// `--transport link` through `semo gateway`, `irobot` and `nxt` over MQTT,
 /// one private broker. Every robot enters the modes `semo simulate` gives
@@ -655,7 +688,7 @@ fn bad_arguments_are_refused_with_exit_status_2() {
 /// forwarded commands).
 #[test]
 fn a_linux_robot_over_the_link_behaves_as_in_the_simulator() {
-    use support::robots::{events, field, modes};
+    use support::robots::{field, modes};
     let Some(mut fleet) = Fleet::start("gateway-scouting") else {
         return;
     };
@@ -675,43 +708,17 @@ fn a_linux_robot_over_the_link_behaves_as_in_the_simulator() {
             .spawn()
             .expect("semo gateway starts"),
     );
-    let link = format!("tcp:127.0.0.1:{link_port}");
-    // Every robot starts at one instant, ti's link open by then.
-    let (_, start_at) = support::robots::start_barrier(3);
-    let start_at = start_at.to_string();
-    let mut started = Vec::new();
-    for folder in &folders {
-        let robot = support::mqtt::robot_name(folder);
-        let (args, env): (Vec<String>, Vec<(&str, &str)>) = if robot == "ti" {
-            (
-                vec!["--transport".into(), "link".into()],
-                vec![("SEMO_LINK", link.as_str())],
-            )
-        } else {
-            (fleet.transport_args(), vec![])
-        };
-        let mut args: Vec<&str> = args.iter().map(String::as_str).collect();
-        args.extend(["--start-at", start_at.as_str()]);
-        started.push(fleet.spawn_with(folder, &scenario, "link", &args, &env));
-    }
+    let started = start_with_ti_on_link(&mut fleet, &folders, &scenario, link_port, &[], "link");
     let traces: std::collections::BTreeMap<String, Vec<support::robots::Event>> = started
         .iter()
         .map(|s| (s.robot.clone(), fleet.finish(s, "link")))
         .collect();
-    let simulated = support::simulate_trace(&scouting(), &scenario, "sim");
-    assert_eq!(simulated.code, 0, "{}", simulated.stderr);
-    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
-    let simulated = events(&lines);
+    let simulated = support::robots::simulated_modes(&scouting(), &scenario);
     assert_eq!(traces.len(), 3);
     for (robot, trace) in &traces {
-        let reference: Vec<_> = simulated
-            .iter()
-            .filter(|e| field(e, "robot") == robot)
-            .cloned()
-            .collect();
         assert_eq!(
             modes(trace),
-            modes(&reference),
+            simulated[robot],
             "{robot}'s modes with ti on the link and in `semo simulate`"
         );
         assert_eq!(modes(trace).last().map(String::as_str), Some("FINISH"));
@@ -748,7 +755,7 @@ fn a_linux_robot_over_the_link_behaves_as_in_the_simulator() {
 /// reconnection. (A gateway knows nothing of what the last one published.)
 #[test]
 fn a_linux_robot_on_the_link_survives_a_gateway_restart_in_the_middle() {
-    use support::robots::{events, field, modes};
+    use support::robots::{field, modes};
     let Some(mut fleet) = Fleet::start("gateway-restart-scouting") else {
         return;
     };
@@ -774,25 +781,14 @@ fn a_linux_robot_on_the_link_survives_a_gateway_restart_in_the_middle() {
             .expect("semo gateway starts")
     };
     let first = fleet.processes.push(listening(&fleet));
-    let link = format!("tcp:127.0.0.1:{link_port}");
-    let (_, start_at) = support::robots::start_barrier(3);
-    let start_at = start_at.to_string();
-    let mut started = Vec::new();
-    for folder in &folders {
-        let robot = support::mqtt::robot_name(folder);
-        let (args, env): (Vec<String>, Vec<(&str, &str)>) = if robot == "ti" {
-            (
-                vec!["--transport".into(), "link".into()],
-                vec![("SEMO_LINK", link.as_str())],
-            )
-        } else {
-            (fleet.transport_args(), vec![])
-        };
-        let mut args: Vec<&str> = args.iter().map(String::as_str).collect();
-        args.extend(["--start-at", start_at.as_str(), "--time-scale", "1"]);
-        args.extend(["--run", run]);
-        started.push(fleet.spawn_with(folder, &scenario, "restart", &args, &env));
-    }
+    let started = start_with_ti_on_link(
+        &mut fleet,
+        &folders,
+        &scenario,
+        link_port,
+        &["--time-scale", "1", "--run", run],
+        "restart",
+    );
     let ti = started.iter().find(|s| s.robot == "ti").unwrap();
 
     // Messages flow both ways (ti reports its colors to the master as fast
@@ -840,19 +836,11 @@ fn a_linux_robot_on_the_link_survives_a_gateway_restart_in_the_middle() {
     );
 
     // The same modes as in the simulator, for every robot.
-    let simulated = support::simulate_trace(&scouting(), &scenario, "sim");
-    assert_eq!(simulated.code, 0, "{}", simulated.stderr);
-    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
-    let simulated = events(&lines);
+    let simulated = support::robots::simulated_modes(&scouting(), &scenario);
     for (robot, trace) in &traces {
-        let reference: Vec<_> = simulated
-            .iter()
-            .filter(|e| field(e, "robot") == robot)
-            .cloned()
-            .collect();
         assert_eq!(
             modes(trace),
-            modes(&reference),
+            simulated[robot],
             "{robot}'s modes with a gateway restart and in `semo simulate`"
         );
     }

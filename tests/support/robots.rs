@@ -276,6 +276,27 @@ pub fn modes(events: &[Event]) -> Vec<String> {
         .collect()
 }
 
+/// Each robot's modes in `semo simulate` of `mission` on `scenario` (the
+/// reference a run of real processes is compared with), by robot.
+pub fn simulated_modes(
+    mission: &std::path::Path,
+    scenario: &std::path::Path,
+) -> std::collections::BTreeMap<String, Vec<String>> {
+    let simulated = super::simulate_trace(mission, scenario, "sim");
+    assert_eq!(simulated.code, 0, "{}", simulated.stderr);
+    let lines: Vec<String> = simulated.stdout.lines().map(str::to_string).collect();
+    let mut by_robot: std::collections::BTreeMap<String, Vec<String>> = Default::default();
+    for e in events(&lines) {
+        if field(&e, "event") == "mode" {
+            by_robot
+                .entry(field(&e, "robot").to_string())
+                .or_default()
+                .push(field(&e, "mode").to_string());
+        }
+    }
+    by_robot
+}
+
 /// The services a robot's tasks started, in order.
 pub fn calls(events: &[Event]) -> Vec<String> {
     events
