@@ -292,6 +292,16 @@ static void link_interrupt(void)
     wake_thread();
 }
 
+/* With g_lock held: waits (up to LINK_CLOSE_WAIT_MS) until what was sent
+ * reliably is acknowledged, or the link is gone. */
+static void wait_for_acknowledgements(void)
+{
+    struct timespec deadline = semo__deadline_after(LINK_CLOSE_WAIT_MS);
+    int waited = 0;
+    while (semo_link_pending(&g_link) > 0 && g_fd >= 0 && waited == 0)
+        waited = pthread_cond_timedwait(&g_changed, &g_lock, &deadline);
+}
+
 static void format_count(char *out, unsigned long n)
 {
     snprintf(out, 21, "%lu", n);
@@ -301,11 +311,8 @@ void semo__link_report(void)
 {
     if (!g_thread_started)
         return;
-    struct timespec deadline = semo__deadline_after(LINK_CLOSE_WAIT_MS);
     pthread_mutex_lock(&g_lock);
-    int waited = 0;
-    while (semo_link_pending(&g_link) > 0 && g_fd >= 0 && waited == 0)
-        waited = pthread_cond_timedwait(&g_changed, &g_lock, &deadline);
+    wait_for_acknowledgements();
     unsigned long counts[6] = {g_link.bad_frames, g_link.duplicates, g_link.retransmissions, g_link.lost,
                                g_connections > 1 ? g_connections - 1 : 0, semo_link_pending(&g_link)};
     pthread_mutex_unlock(&g_lock);
@@ -326,11 +333,8 @@ static void link_close(void)
     if (!g_thread_started)
         return;
     /* What was sent reliably reaches the gateway before we go. */
-    struct timespec deadline = semo__deadline_after(LINK_CLOSE_WAIT_MS);
     pthread_mutex_lock(&g_lock);
-    int waited = 0;
-    while (semo_link_pending(&g_link) > 0 && g_fd >= 0 && waited == 0)
-        waited = pthread_cond_timedwait(&g_changed, &g_lock, &deadline);
+    wait_for_acknowledgements();
     g_stopping = true;
     pthread_cond_broadcast(&g_changed);
     pthread_mutex_unlock(&g_lock);
