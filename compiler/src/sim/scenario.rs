@@ -12,6 +12,7 @@
 //! names the mission does not have.
 
 use super::json::{self, Kind, Value};
+use crate::fasthash::{FastMap, FastSet};
 use crate::refine::RobotProgram;
 
 /// The schema version this reader understands.
@@ -574,11 +575,23 @@ pub fn parse(text: &str, programs: &[RobotProgram]) -> Result<Scenario> {
         message: e.message,
         suggestion: None,
     })?;
-    Reader { programs }.scenario(&root)
+    let by_robot = programs.iter().map(|p| (p.robot.as_str(), p)).collect();
+    let teams = programs.iter().map(|p| p.team.as_str()).collect();
+    Reader {
+        programs,
+        by_robot,
+        teams,
+    }
+    .scenario(&root)
 }
 
 struct Reader<'a> {
     programs: &'a [RobotProgram],
+    /// Each robot's program: a scenario names robots one entry at a time,
+    /// and a lookup per entry must not walk the fleet (a swarm's scenario
+    /// would cost the square of its robots).
+    by_robot: FastMap<&'a str, &'a RobotProgram>,
+    teams: FastSet<&'a str>,
 }
 
 fn object<'v>(v: &'v Value, what: &str, keys: &[&str]) -> Result<&'v [(String, Value)]> {
@@ -733,7 +746,7 @@ impl Reader<'_> {
 
     /// Fails at `v` unless `robot` is a robot of the mission.
     fn known_robot(&self, v: &Value, robot: &str) -> Result<()> {
-        if self.programs.iter().any(|p| p.robot == robot) {
+        if self.by_robot.contains_key(robot) {
             return Ok(());
         }
         let known: Vec<&str> = self.programs.iter().map(|p| p.robot.as_str()).collect();
@@ -746,7 +759,7 @@ impl Reader<'_> {
 
     fn robot_or_team(&self, v: &Value, key: &str) -> Result<String> {
         let to = name(v, key)?;
-        if self.programs.iter().any(|p| p.robot == to || p.team == to) {
+        if self.by_robot.contains_key(to) || self.teams.contains(to) {
             return Ok(to.to_string());
         }
         let known: Vec<&str> = self
@@ -795,21 +808,21 @@ impl Reader<'_> {
     /// catalog's results, `ControlMachine::gives_back`); `None` when the
     /// robot never calls it.
     fn gives_back(&self, robot: &str, service: &str) -> Option<&crate::refine::ServiceResults> {
-        self.programs
+        self.by_robot
+            .get(robot)?
+            .control
+            .gives_back
             .iter()
-            .filter(|p| p.robot == robot)
-            .flat_map(|p| &p.control.gives_back)
             .find(|g| g.service == service)
     }
 
     /// A mode of `robot`'s team (or of any team when `robot` is `None`).
     fn mode(&self, v: &Value, key: &str, robot: Option<&str>) -> Result<String> {
         let mode = name(v, key)?;
-        let programs: Vec<&RobotProgram> = self
-            .programs
-            .iter()
-            .filter(|p| robot.is_none_or(|r| p.robot == r))
-            .collect();
+        let programs: Vec<&RobotProgram> = match robot {
+            Some(robot) => self.by_robot.get(robot).copied().into_iter().collect(),
+            None => self.programs.iter().collect(),
+        };
         if programs
             .iter()
             .any(|p| p.control.modes.iter().any(|m| m.name == mode))
