@@ -529,6 +529,31 @@ fn a_broadcast_event_to_a_group_acts_the_same_in_c_and_in_the_simulator() {
     assert_eq!(modes, ["GO", "HOLD", "GO"], "tb_0 is told `ping` by tb_1");
 }
 
+/// `throw E broadcast` in an arm of counted groups
+/// (`tests/fixtures/counted_groups/alarm.mission`: Room1 and Room2, at least
+/// two each, five robots): tb_1 killed at 0.1 s; at 4 s, with the loss known,
+/// the rooms are tb_0 and tb_2, and tb_3 and tb_4. tb_3, told "fire", tells
+/// its room: tb_4 alone catches it, from tb_3, in both engines; tb_0 and
+/// tb_2, which may run Room2's arm but do not now, are told nothing.
+#[test]
+fn a_broadcast_in_a_counted_arm_goes_to_the_throwers_room_in_c_and_in_the_simulator() {
+    let fixtures = repo_root().join("tests/fixtures/counted_groups");
+    let scenario = std::fs::read_to_string(fixtures.join("alarm.scenario.json")).unwrap();
+    let (_, sim) = compare("counted_alarm", &fixtures.join("alarm.mission"), &scenario);
+    let throws = events_of(&sim, "tb_3", "throw");
+    assert_eq!(throws.len(), 1, "{throws:?}");
+    assert_eq!(field(throws[0], "broadcast"), "true");
+    let caught = events_of(&sim, "tb_4", "catch");
+    assert_eq!(caught.len(), 1, "{caught:?}");
+    assert_eq!(field(caught[0], "from"), "tb_3");
+    for robot in ["tb_0", "tb_2"] {
+        assert!(
+            events_of(&sim, robot, "catch").is_empty() && events_of(&sim, robot, "drop").is_empty(),
+            "{robot} is in Room1 now: told nothing"
+        );
+    }
+}
+
 /// Adaptive resource management (the strategy's `BatteryRequirement`:
 /// below 30 % the camera and ultrasonic sample every 200 ms and the wheels
 /// run at half speed): irobot's battery drains from 100 % to 20 % by 3 s

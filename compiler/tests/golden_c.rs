@@ -46,7 +46,7 @@ const EXAMPLES: &[(&str, &str, Option<&str>)] = &[
 
 /// Test fixtures (under the repository's `tests/fixtures/`) for what the
 /// examples do not generate: graph services with loops and sub-graphs,
-/// counted groups (nested), group synchronisation, group services, globally shared
+/// counted groups (nested, and a broadcast in a counted arm), group synchronisation, group services, globally shared
 /// values with battery policies, broadcast events, a relay receiving from
 /// another team, a team on the static schedule, action results. As
 /// [`EXAMPLES`].
@@ -65,6 +65,11 @@ const FIXTURES: &[(&str, &str, Option<&str>)] = &[
         "fixture-counted_groups",
         "counted_groups/nested.mission",
         Some("counted_groups/nested.scenario.json"),
+    ),
+    (
+        "fixture-counted_alarm",
+        "counted_groups/alarm.mission",
+        Some("counted_groups/alarm.scenario.json"),
     ),
     ("fixture-group_sync", "group_sync/sync.mission", None),
     ("fixture-group_service", "group_service/sweep.mission", None),

@@ -13,9 +13,10 @@ use super::values::Words;
 use crate::refine::graph::{CONTROL_TASK, getter, setter};
 use crate::refine::protocol::{self, TERM_MAX, UNLED_REASON, lease_ms, listen_ms, lost_after_ms};
 use crate::refine::{
-    ActionMachine, ActionMachineId, ControlMachine, CountedGroup, EnclosingArm, Expr, IncomingId,
-    LeaderAlgorithm, MarkId, ModeId, Operand, OutgoingId, PeerId, RobotProgram, SendItem, SlotId,
-    SlotSource, State, StateId, StateKind, SubscriptionId, SyncPointId, ValueKind,
+    ActionMachine, ActionMachineId, Broadcast, ControlMachine, CountedGroup, EnclosingArm, Expr,
+    IncomingId, LeaderAlgorithm, MarkId, ModeId, Operand, OutgoingId, PeerId, RobotProgram,
+    SendItem, SlotId, SlotSource, State, StateId, StateKind, SubscriptionId, SyncPointId,
+    ValueKind, event_key,
 };
 use std::fmt::Write;
 
@@ -128,6 +129,7 @@ pub(super) const TEMPLATES: &[Template] = &[
     ELECTED,
     GROUP_OF,
     NARROW_TO_ARM,
+    THROW_BROADCAST_WITHIN,
     LEADING,
     REGION,
     CATCH_EVENT_HEAD,
@@ -210,6 +212,15 @@ const GROUP_OF: Template = template!("control/group_of.c.in", ["lost"]);
 /// Nested counted groups: the members a robot splits with, by the rule of
 /// `refine::members_sharing_arms`.
 const NARROW_TO_ARM: Template = template!("control/narrow_to_arm.c.in", []);
+/// `throw E broadcast` in arms of counted groups: told to those of the other
+/// robots that may run the arm (`to`, their ports `ports`) that share this
+/// robot's arms now (`Broadcast` in `refine`).
+const THROW_BROADCAST_WITHIN: Template = template!(
+    "control/throw_broadcast_within.c.in",
+    [
+        "narrow", "to", "ports", "n", "kept", "n_kept", "event", "key"
+    ]
+);
 
 /// `leading` and the terms a robot's heartbeats say, and `own_battery`:
 /// this robot's battery level for its heartbeats, the scenario's (in
@@ -642,8 +653,8 @@ fn emit_state(
         } => emit_throw(out, &cx, event),
         StateKind::Throw {
             event,
-            broadcast: Some(messages),
-        } => emit_throw_broadcast(out, &cx, event, messages),
+            broadcast: Some(broadcast),
+        } => emit_throw_broadcast(out, &cx, event, broadcast),
         StateKind::Call {
             service,
             task,
@@ -796,11 +807,41 @@ fn emit_throw(out: &mut String, cx: &StateCx, event: &str) {
 }
 
 /// `throw E broadcast`: the others of the group told first.
-fn emit_throw_broadcast(out: &mut String, cx: &StateCx, event: &str, messages: &[OutgoingId]) {
-    let StateCx { program, next, .. } = *cx;
+fn emit_throw_broadcast(out: &mut String, cx: &StateCx, event: &str, broadcast: &Broadcast) {
+    let StateCx {
+        program,
+        peers,
+        next,
+        ..
+    } = *cx;
     let m = &program.control;
     // The others of the group are told before the event acts here
     // (a caught event ends the firing's steps).
+    if !broadcast.within.is_empty() {
+        // Only those that share this robot's arms now.
+        let (narrow, (kept, n_kept)) = narrow_to_arms(peers, &broadcast.within);
+        let ports: Vec<String> = (broadcast.messages.iter())
+            .map(|m| m.index().to_string())
+            .collect();
+        out.push_str(&fill(
+            &THROW_BROADCAST_WITHIN,
+            &[
+                ("narrow", &narrow),
+                ("to", &peers.locals(&broadcast.to)),
+                ("ports", &ports.join(", ")),
+                ("n", &broadcast.to.len()),
+                ("kept", &kept),
+                ("n_kept", &n_kept),
+                ("event", &c::string(event)),
+                ("key", &c::comment(&event_key(&program.team))),
+            ],
+        ));
+    }
+    let messages: &[OutgoingId] = if broadcast.within.is_empty() {
+        &broadcast.messages
+    } else {
+        &[]
+    };
     for &message in messages {
         let _ = writeln!(
             out,
@@ -1070,24 +1111,7 @@ fn emit_group_allocate(
     let names = join(groups.iter().map(|g| c::string(&g.name)).collect());
     let at = join(groups.iter().map(|g| g.at.index().to_string()).collect());
     let others = others_at.map_or(next, |o| o.index());
-    // Nested: narrow the members level by level to the arms this robot runs.
-    let mut narrow = String::new();
-    let mut from = ("NULL".to_string(), "0".to_string());
-    for (level, arm) in within.iter().enumerate() {
-        let _ = write!(
-            narrow,
-            "\n        static const size_t within{level}_members[] = {{{}}};\n        static const size_t within{level}_mins[] = {{{}}};\n        size_t kept{level}[{n}];\n        size_t n_kept{level} = narrow_to_arm(kept{level}, {}, {}, within{level}_members, {n}, within{level}_mins, {}, {}, {});",
-            peers.locals(&arm.members),
-            mins_of(&arm.mins),
-            from.0,
-            from.1,
-            arm.mins.len(),
-            arm.has_others,
-            arm.arm.map_or(-1, |k| k as i64),
-            n = arm.members.len(),
-        );
-        from = (format!("kept{level}"), format!("n_kept{level}"));
-    }
+    let (mut narrow, from) = narrow_to_arms(peers, within);
     let forget: String = nested
         .iter()
         .map(|inner| format!("\n            allocated_{service}_{} = -2;", inner.index()))
@@ -1120,6 +1144,34 @@ fn emit_group_allocate(
             ("forget", &forget),
         ],
     ));
+}
+
+/// Nested in arms of counted groups (`within`): C statements that narrow the
+/// members level by level to the arms this robot runs, and the array and
+/// count of the last level (`NULL`, `0` with no level).
+fn narrow_to_arms(peers: &Peers, within: &[EnclosingArm]) -> (String, (String, String)) {
+    let mins_of = |mins: &[usize]| {
+        let mins: Vec<String> = mins.iter().map(|m| m.to_string()).collect();
+        mins.join(", ")
+    };
+    let mut narrow = String::new();
+    let mut from = ("NULL".to_string(), "0".to_string());
+    for (level, arm) in within.iter().enumerate() {
+        let _ = write!(
+            narrow,
+            "\n        static const size_t within{level}_members[] = {{{}}};\n        static const size_t within{level}_mins[] = {{{}}};\n        size_t kept{level}[{n}];\n        size_t n_kept{level} = narrow_to_arm(kept{level}, {}, {}, within{level}_members, {n}, within{level}_mins, {}, {}, {});",
+            peers.locals(&arm.members),
+            mins_of(&arm.mins),
+            from.0,
+            from.1,
+            arm.mins.len(),
+            arm.has_others,
+            arm.arm.map_or(-1, |k| k as i64),
+            n = arm.members.len(),
+        );
+        from = (format!("kept{level}"), format!("n_kept{level}"));
+    }
+    (narrow, from)
 }
 
 /// `GroupSync`: waits for the group's live members to arrive (or the timeout).

@@ -606,13 +606,11 @@ pub enum StateKind {
         slot: SlotId,
     },
     /// `throw E`: the current mode's catch of E asks for a mode change.
-    /// With `broadcast` (`throw E broadcast`), the messages (key
-    /// [`event_key`], the event's name as text) that tell the others of the thrower's group first: one to the
-    /// team when the group is the whole team, else one to each other robot
-    /// of it; empty when the thrower is the group's only robot.
+    /// With `broadcast` (`throw E broadcast`), the others of the thrower's
+    /// group are told first ([`Broadcast`]).
     Throw {
         event: String,
-        broadcast: Option<Vec<OutgoingId>>,
+        broadcast: Option<Broadcast>,
     },
     /// Call the task implementing a built-in service and wait until it is
     /// idle. `results`: the slots of the names the call binds
@@ -719,6 +717,25 @@ pub enum StateKind {
         condition: Option<Expr>,
         forever: bool,
     },
+}
+
+/// Who a `throw E broadcast` tells ([`StateKind::Throw`]): the messages
+/// (key [`event_key`], the event's name as text) to the others of the
+/// thrower's group, one to the team when the group is the whole team, else
+/// one to each other robot of it; none when the thrower is the group's only
+/// robot.
+///
+/// Written in arms of counted groups (`within`, outermost first), the group
+/// is the one this robot runs at run time: there is one message to each
+/// other robot that may run the arm (`to`, the peer of each message, in
+/// formation order), and only those [`members_sharing_arms`] keeps, by the
+/// rule and the view of who is alive that allocated this robot, are told.
+/// Outside counted groups `within` and `to` are empty.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Broadcast {
+    pub messages: Vec<OutgoingId>,
+    pub to: Vec<PeerId>,
+    pub within: Vec<EnclosingArm>,
 }
 
 /// One arm of a statement of counted groups ([`StateKind::GroupAllocate`]).

@@ -1641,11 +1641,11 @@ impl Builder<'_, '_> {
         OutgoingId::new(self.machine.outgoing.len() - 1)
     }
 
-    /// The messages that tell the others of the thrower's group of a
-    /// `throw E broadcast` (the group the checker recorded): one to the team
-    /// when it is the whole team, else one to each other robot of it.
-    /// `None` when the checker recorded no broadcast there.
-    fn broadcast_messages(&mut self, event: &ast::Ident) -> Option<Vec<OutgoingId>> {
+    /// Who a `throw E broadcast` tells ([`Broadcast`]), of the group the
+    /// checker recorded; in arms of counted groups, each other robot that
+    /// may share this one's arm. `None` when the checker recorded no
+    /// broadcast there.
+    fn broadcast_messages(&mut self, event: &ast::Ident) -> Option<Broadcast> {
         let team = self.team;
         let receivers = team.broadcast_at(event.span)?.receivers.clone();
         if event.name.len() > MAX_EVENT_NAME_BYTES {
@@ -1657,19 +1657,31 @@ impl Builder<'_, '_> {
             );
         }
         let key = event_key(&team.name);
-        if receivers.len() == team.robots.len() && receivers.len() > 1 {
-            return Some(vec![self.outgoing(&team.name, false, &key)]);
+        let within = self.counted_within.clone();
+        if within.is_empty() && receivers.len() == team.robots.len() && receivers.len() > 1 {
+            let messages = vec![self.outgoing(&team.name, false, &key)];
+            return Some(Broadcast {
+                messages,
+                to: Vec::new(),
+                within,
+            });
         }
         let others = receivers.iter().filter(|r| r.index() != self.robot_index);
-        let names: Vec<String> = others
-            .map(|r| team.robots[r.index()].name.to_string())
+        let (names, to): (Vec<String>, Vec<PeerId>) = others
+            .map(|r| {
+                let name = team.robots[r.index()].name.to_string();
+                (name, PeerId::new(self.first_peer() + r.index()))
+            })
+            .unzip();
+        let messages = (names.iter())
+            .map(|name| self.outgoing(name, false, &key))
             .collect();
-        Some(
-            names
-                .iter()
-                .map(|name| self.outgoing(name, false, &key))
-                .collect(),
-        )
+        let to = if within.is_empty() { Vec::new() } else { to };
+        Some(Broadcast {
+            messages,
+            to,
+            within,
+        })
     }
 
     /// The events another robot may tell this one (`events_heard`).

@@ -716,10 +716,10 @@ fn a_broadcast_goes_to_the_throwers_group_as_the_checker_recorded_it() {
             .filter_map(|s| match &s.kind {
                 StateKind::Throw {
                     event,
-                    broadcast: Some(messages),
+                    broadcast: Some(broadcast),
                 } => Some(
                     std::iter::once(event.clone())
-                        .chain(messages.iter().map(|&m| {
+                        .chain(broadcast.messages.iter().map(|&m| {
                             let o = p.control.outgoing_message(m);
                             assert_eq!((o.key.as_str(), o.publish), ("T.__event", false));
                             o.to_team.clone()
@@ -745,6 +745,38 @@ fn a_broadcast_goes_to_the_throwers_group_as_the_checker_recorded_it() {
     assert_eq!(by_robot[0].1.control.events_heard, ["all", "near"]);
     assert_eq!(by_robot[3].1.control.events_heard, ["all"]);
     assert!(by_robot[3].1.control.has_receiver());
+}
+
+/// In an arm of counted groups, the group is chosen at run time: the
+/// thrower has one message to each other robot that may run the arm, with
+/// the peer it goes to and the arms it is written in, never the team
+/// message, even when every robot of the team may run the arm.
+#[test]
+fn a_broadcast_in_a_counted_arm_names_each_robot_and_the_arms_it_is_in() {
+    let text = "{ T: Turtlebot3_Burger tb[3] }\nT.A.S{ [[ group(Room1, min = 1) { scatter() throw near broadcast }\n  group(Room2, min = 1) { standby() } ]] } repeat(1 SEC)\nT.M{ set(A, S) }\nT.N{ set(A, OFF) }\nT.main{ case (M): catch (near): mode = N\n default: mode = M }\n";
+    let programs = programs(text, &[]);
+    let p = program(&programs, "tb_1");
+    let broadcasts: Vec<&Broadcast> = (p.control.services[0].states.iter())
+        .filter_map(|s| match &s.kind {
+            StateKind::Throw {
+                broadcast: Some(b), ..
+            } => Some(b),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(broadcasts.len(), 1);
+    let b = broadcasts[0];
+    let to: Vec<usize> = b.to.iter().map(|p| p.index()).collect();
+    assert_eq!(to, [0, 2], "the others, in formation order");
+    let sent_to: Vec<&str> = (b.messages.iter())
+        .map(|&m| p.control.outgoing_message(m).to_team.as_str())
+        .collect();
+    assert_eq!(sent_to, ["tb_0", "tb_2"], "one message to each, not to T");
+    assert_eq!(b.within.len(), 1);
+    assert_eq!(b.within[0].arm, Some(0));
+    assert_eq!(b.within[0].mins, [1, 1]);
+    let members: Vec<usize> = b.within[0].members.iter().map(|p| p.index()).collect();
+    assert_eq!(members, [0, 1, 2]);
 }
 
 #[test]

@@ -36,9 +36,10 @@ use crate::refine::SENSOR_PERIOD_MS;
 use crate::refine::graph::CONTROL_PERIOD_MS;
 use crate::refine::value::{self, Value};
 use crate::refine::{
-    ActionId, ActionMachine, AttributeId, ControlMachine, Expr, IncomingId, LeaderAlgorithm,
-    ModeId, Operand, OutgoingId, PeerId, RobotProgram, RoleKind, ServiceMachineId, SlotId,
-    SlotSource, StateId, StateKind, SyncPointId, counted_allocation, members_sharing_arms,
+    ActionId, ActionMachine, AttributeId, Broadcast, ControlMachine, EnclosingArm, Expr,
+    IncomingId, LeaderAlgorithm, ModeId, Operand, OutgoingId, PeerId, RobotProgram, RoleKind,
+    ServiceMachineId, SlotId, SlotSource, StateId, StateKind, SyncPointId, counted_allocation,
+    members_sharing_arms,
 };
 use smallvec::smallvec;
 use std::cell::OnceCell;
@@ -1674,14 +1675,44 @@ impl<'p> Sim<'p> {
     /// `throw E broadcast` (`throw_broadcast`): traced once, the others of
     /// the thrower's group told (the event's name as text, key
     /// `Team.__event`), then caught here as `throw E` is.
-    fn throw_broadcast(&mut self, r: usize, event: &str, messages: &[OutgoingId]) {
+    /// In arms of counted groups, only the robots that share this one's
+    /// arms are told (`throw_broadcast_within` in the C).
+    fn throw_broadcast(&mut self, r: usize, event: &str, broadcast: &Broadcast) {
         let fields = smallvec![("name", event.into()), ("broadcast", "true".into())];
         self.emit(r, "throw", fields);
-        for &message in messages {
+        let told: Vec<OutgoingId> = if broadcast.within.is_empty() {
+            broadcast.messages.clone()
+        } else {
+            let sharing = self.sharing_arms(r, &broadcast.within, &broadcast.to);
+            let mut sharing = sharing.iter().peekable();
+            (broadcast.to.iter().zip(&broadcast.messages))
+                .filter(|&(&peer, _)| {
+                    while sharing.next_if(|&&p| p < peer).is_some() {}
+                    sharing.peek() == Some(&&peer)
+                })
+                .map(|(_, &message)| message)
+                .collect()
+        };
+        for message in told {
             let (to, key) = self.names[r].outgoing[message.index()].clone();
             self.comm_send(r, to, false, key, Some(Value::text(event)));
         }
         self.catch_event(r, event);
+    }
+
+    /// Of `members`, robot `r` and the live robots that every enclosing
+    /// counted group (`within`) puts in the arms `r` runs
+    /// ([`members_sharing_arms`]); alive as `group_of` in the generated C
+    /// says: heard within `lost_after_ms` since `r` joined.
+    fn sharing_arms(&self, r: usize, within: &[EnclosingArm], members: &[PeerId]) -> Vec<PeerId> {
+        let robot = &self.robots[r];
+        let me = robot.program.self_peer;
+        let lost = crate::refine::protocol::lost_after_ms(robot.program.control.heartbeat_ms);
+        let now = self.now;
+        let alive = |peer: PeerId| {
+            peer == me || now - robot.heard.get(peer).seen.max(robot.started_at) <= lost
+        };
+        members_sharing_arms(within, members, me, alive)
     }
 
     /// The current mode's catch of `event`, unless a mode change is asked
@@ -2131,7 +2162,7 @@ impl<'p> Sim<'p> {
             StateKind::Throw { event, broadcast } => {
                 match broadcast {
                     None => self.throw_event(r, event),
-                    Some(messages) => self.throw_broadcast(r, event, messages),
+                    Some(broadcast) => self.throw_broadcast(r, event, broadcast),
                 }
                 self.region(r, i).pc = next;
                 Step::Next
@@ -2255,15 +2286,8 @@ impl<'p> Sim<'p> {
                 within,
                 nested,
             } => {
-                // `group_of` in the generated C: the live members (this
-                // robot, or heard within `lost_after_ms` since it joined).
-                let robot = &self.robots[r];
                 let me = program.self_peer;
-                let lost = crate::refine::protocol::lost_after_ms(m.heartbeat_ms);
-                let alive = |peer: PeerId| {
-                    peer == me || now - robot.heard.get(peer).seen.max(robot.started_at) <= lost
-                };
-                let live = members_sharing_arms(within, members, me, alive);
+                let live = self.sharing_arms(r, within, members);
                 let position = live.iter().position(|&p| p == me).unwrap_or(0);
                 let mins: Vec<usize> = groups.iter().map(|g| g.min).collect();
                 let chosen = counted_allocation(&mins, others_at.is_some(), position);
