@@ -467,7 +467,11 @@ impl Scenario {
         &self,
         programs: &[RobotProgram],
     ) -> Vec<crate::refine::CompiledScenario> {
-        programs.iter().map(|p| self.compiled_for(p)).collect()
+        let lookup = Lookup::of(self);
+        programs
+            .iter()
+            .map(|p| self.compiled_with(p, &lookup))
+            .collect()
     }
 
     /// The world of `program`'s robot, to compile into a simulated program
@@ -480,14 +484,23 @@ impl Scenario {
     /// and the network's latency and loss are not in it: the lock-step
     /// coordinator applies those from outside (`semo simulate --engine c`).
     pub fn compiled_for(&self, program: &RobotProgram) -> crate::refine::CompiledScenario {
+        self.compiled_with(program, &Lookup::of(self))
+    }
+
+    /// [`Scenario::compiled_for`] with the scenario's entries found through
+    /// `lookup`, built once for a whole fleet: each robot's part is then
+    /// found without walking every robot's (a swarm's build was quadratic).
+    fn compiled_with(
+        &self,
+        program: &RobotProgram,
+        lookup: &Lookup<'_>,
+    ) -> crate::refine::CompiledScenario {
         use crate::refine::{CompiledLink, LinkEffect, OperatorCommand};
-        let world = self.robots.iter().find(|w| w.robot == program.robot);
+        let world = lookup.worlds.get(program.robot.as_str()).copied();
         let me = program.robot.as_str();
         let mission_robots = || program.peers.iter().map(|(_, robot)| robot.as_str());
-        let links = self
-            .faults
-            .iter()
-            .filter_map(|fault| {
+        let links = (self.faults.iter().zip(&lookup.partitions))
+            .filter_map(|(fault, group_of)| {
                 let (effect, from, until, robots) = match &fault.kind {
                     FaultKind::Kill { .. } | FaultKind::Restart { .. } => return None,
                     FaultKind::Drop {
@@ -506,15 +519,10 @@ impl Scenario {
                         *until,
                         other_end(between, me)?,
                     ),
-                    FaultKind::Partition {
-                        groups,
-                        from,
-                        until,
-                    } => {
+                    FaultKind::Partition { from, until, .. } => {
                         // Robots of different groups (no group is one more)
                         // cannot talk: the engine's `link`.
-                        let group_of =
-                            |robot: &str| groups.iter().position(|g| g.iter().any(|m| m == robot));
+                        let group_of = |robot: &str| group_of.get(robot).copied();
                         let mine = group_of(me);
                         let cut: Vec<String> = mission_robots()
                             .filter(|&robot| robot != me && group_of(robot) != mine)
@@ -539,10 +547,8 @@ impl Scenario {
             results: world.map(|w| w.results.clone()).unwrap_or_default(),
             battery: world.map(|w| w.battery.clone()).unwrap_or_default(),
             loops: world.map(|w| w.loops.clone()).unwrap_or_default(),
-            operator: self
-                .operator
-                .iter()
-                .filter(|c| c.to == program.robot || c.to == program.team)
+            operator: lookup
+                .operator_to(&program.robot, &program.team)
                 .map(|c| OperatorCommand {
                     key: c.key.clone(),
                     value: c.value.clone(),
@@ -553,6 +559,57 @@ impl Scenario {
                 .collect(),
             links,
         }
+    }
+}
+
+/// The scenario's entries by the robot they concern, for
+/// [`Scenario::compiled_with`].
+struct Lookup<'s> {
+    worlds: FastMap<&'s str, &'s RobotWorld>,
+    /// The operator's commands by their `to` (a robot or a team), each list
+    /// in file order, with its index in the file to merge a robot's and its
+    /// team's back into file order.
+    operator: FastMap<&'s str, Vec<(usize, &'s Command)>>,
+    /// Per fault, in order: for a partition, each robot's group (a robot
+    /// in none is absent); empty for the other faults.
+    partitions: Vec<FastMap<&'s str, usize>>,
+}
+
+impl<'s> Lookup<'s> {
+    fn of(scenario: &'s Scenario) -> Self {
+        let worlds = (scenario.robots.iter())
+            .map(|w| (w.robot.as_str(), w))
+            .collect();
+        let mut operator: FastMap<&str, Vec<(usize, &Command)>> = FastMap::default();
+        for (i, c) in scenario.operator.iter().enumerate() {
+            operator.entry(c.to.as_str()).or_default().push((i, c));
+        }
+        let partitions = (scenario.faults.iter())
+            .map(|fault| match &fault.kind {
+                FaultKind::Partition { groups, .. } => (groups.iter().enumerate())
+                    .flat_map(|(g, members)| members.iter().map(move |m| (m.as_str(), g)))
+                    // The first group naming a robot is its group.
+                    .rev()
+                    .collect(),
+                _ => FastMap::default(),
+            })
+            .collect();
+        Lookup {
+            worlds,
+            operator,
+            partitions,
+        }
+    }
+
+    /// The commands to `robot` or to its `team`, in file order.
+    fn operator_to(&self, robot: &str, team: &str) -> impl Iterator<Item = &'s Command> {
+        let of = |to: &str| self.operator.get(to).into_iter().flatten().copied();
+        let mut both: Vec<(usize, &Command)> = of(robot).collect();
+        if team != robot {
+            both.extend(of(team));
+            both.sort_by_key(|(i, _)| *i);
+        }
+        both.into_iter().map(|(_, c)| c)
     }
 }
 

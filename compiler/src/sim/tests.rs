@@ -1817,3 +1817,30 @@ fn a_robot_s_compiled_world_holds_what_its_program_applies() {
         ]
     );
 }
+
+/// A robot's compiled commands are those to it and to its team, in the
+/// file's order, and every robot's world is the same built for the fleet
+/// at once (`compiled_for_each`, one lookup) as for it alone.
+#[test]
+fn a_robot_s_compiled_commands_keep_the_file_s_order_across_robot_and_team() {
+    let programs = programs("examples/scouting/scouting.mission");
+    let text = r#"{"operator": [
+        {"at": 3, "to": "irobot", "value": "RC_CMD", "is": "A"},
+        {"at": 1, "to": "MasterTeam", "value": "RC_CMD", "is": "B"},
+        {"at": 2, "to": "ti", "value": "RC_CMD", "is": "C"},
+        {"at": 0, "to": "irobot", "value": "RC_CMD", "is": "D"}],
+        "faults": [{"from": 3, "until": 9, "partition": [["irobot", "ti"], ["ti"]]}]}"#;
+    let scenario = scenario::parse(text, &programs).unwrap();
+    let irobot = programs.iter().find(|p| p.robot == "irobot").unwrap();
+    let values: Vec<String> = (scenario.compiled_for(irobot).operator.iter())
+        .map(|c| c.value.clone())
+        .collect();
+    assert_eq!(values, ["A", "B", "D"]);
+    let each = scenario.compiled_for_each(&programs);
+    for (p, world) in programs.iter().zip(&each) {
+        assert_eq!(world, &scenario.compiled_for(p), "{}", p.robot);
+    }
+    // A robot named in two groups is in the first: ti is with irobot.
+    let ti = programs.iter().position(|p| p.robot == "ti").unwrap();
+    assert_eq!(each[ti].links[0].robots, ["nxt"]);
+}
