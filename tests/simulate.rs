@@ -878,3 +878,43 @@ fn action_results_take_the_scenario_s_values_call_by_call() {
         wrong.stderr
     );
 }
+
+/// The fire example (issue 36: counted groups, action results and a
+/// broadcast in a counted arm together): the searcher that finds the fire
+/// tells its own room only, whose two robots fight it; the other rooms go
+/// on searching, the leader reports to the base, and robot `fb_0`, lost and
+/// restarted, moves the others between the rooms without a fight. The
+/// scenario's own expectations say which robots fight; the trace says the
+/// base heard of it.
+#[test]
+fn in_the_fire_example_only_the_room_that_found_the_fire_fights_it() {
+    let fire = examples().join("fire");
+    let out = semo(&[
+        "simulate",
+        &fire.join("fire.mission").display().to_string(),
+        "--scenario",
+        &fire.join("fire.scenario.json").display().to_string(),
+        "--trace",
+        "-",
+    ]);
+    assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
+    let events: Vec<serde_json::Value> = out
+        .stdout
+        .lines()
+        .filter(|l| l.starts_with('{'))
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let fighters: std::collections::BTreeSet<&str> = events
+        .iter()
+        .filter(|e| e["event"] == "mode" && e["mode"] == "FIGHT")
+        .map(|e| e["robot"].as_str().unwrap())
+        .collect();
+    assert_eq!(fighters.into_iter().collect::<Vec<_>>(), ["fb_3", "fb_4"]);
+    assert!(
+        events.iter().any(|e| e["robot"] == "base"
+            && e["event"] == "send"
+            && e["to"] == "USER"
+            && e["value"] == "6,2"),
+        "the base never warned the operator"
+    );
+}
