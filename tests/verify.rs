@@ -576,15 +576,13 @@ fn random_behaviour_seen(
     };
     let mut t = 0;
     if prefix.is_empty() {
-        let start = (inputs.sensors.iter())
-            .map(|s| rng.below(s.values.len()))
-            .collect();
-        semo::verify::apply(&mut sim, &mut world, inputs, &Choice::Start(start));
+        let start = random_start(inputs, rng);
+        semo::verify::apply(&mut sim, &mut world, inputs, &mut Choice::Start(start));
     }
     for (at, choice) in prefix {
         sim.run_to(*at);
         note(&mut sim, &mut seen, false);
-        semo::verify::apply(&mut sim, &mut world, inputs, choice);
+        semo::verify::apply(&mut sim, &mut world, inputs, &mut choice.clone());
         t = *at;
     }
     if !prefix.is_empty() {
@@ -595,12 +593,12 @@ fn random_behaviour_seen(
     while t < options.horizon_ms {
         let all = semo::verify::choices(inputs, &world);
         // Mostly still, as most steps of a run are.
-        let choice = if rng.chance(80) {
+        let mut choice = if rng.chance(80) {
             Choice::Nothing
         } else {
             all[rng.below(all.len())].clone()
         };
-        semo::verify::apply(&mut sim, &mut world, inputs, &choice);
+        semo::verify::apply(&mut sim, &mut world, inputs, &mut choice);
         t += options.step_ms;
         sim.run_to(t);
         note(&mut sim, &mut seen, true);
@@ -613,6 +611,14 @@ fn random_behaviour_seen(
         .map(|r| sim.waiting_receives(r))
         .collect();
     seen
+}
+
+/// A random class for each sensor input, then each result input.
+fn random_start(inputs: &semo::verify::Inputs, rng: &mut support::missiongen::Rng) -> Vec<usize> {
+    (inputs.sensors.iter().map(|s| s.values.len()))
+        .chain(inputs.results.iter().map(|r| r.values.len()))
+        .map(|n| rng.below(n))
+        .collect()
 }
 
 /// Soundness of the search and its merged states, over random missions: a
@@ -828,52 +834,117 @@ fn a_counterexample_scenario_replays_the_run_its_choices_made() {
     let mut rng = support::missiongen::Rng::new(5);
     let (mut compared, mut network) = (0, 0);
     for (seed, text, programs, _) in random_missions("verify-replay-choices", 300..316) {
-        let inputs = semo::verify::Inputs::derive(&programs);
-        let empty = semo::sim::Scenario::default();
-        let mut live = semo::sim::Sim::new(&programs, &empty, &semo::sim::Options::default());
-        let mut world = semo::verify::World::new(&inputs, &options, programs.len());
-        let start = (inputs.sensors.iter())
-            .map(|s| rng.below(s.values.len()))
-            .collect();
-        let mut made = vec![(0, Choice::Start(start))];
-        semo::verify::apply(&mut live, &mut world, &inputs, &made[0].1);
-        let mut trace = Vec::new();
-        let mut t = 0;
-        while t < 8_000 {
-            let all = semo::verify::choices(&inputs, &world);
-            let choice = all[rng.below(all.len())].clone();
-            network += usize::from(matches!(choice, Choice::Lose { .. } | Choice::Delay { .. }));
-            semo::verify::apply(&mut live, &mut world, &inputs, &choice);
-            made.push((t, choice));
-            t += options.step_ms;
-            live.run_to(t);
-            trace.extend(live.take_trace().iter().map(|e| format!("{e:?}")));
-        }
-        let way = Counterexample {
-            choices: made,
-            end_ms: t,
-            step_ms: options.step_ms,
-        };
-        let scenario = way.scenario_json(&inputs, &programs);
-        let parsed = semo::sim::scenario::parse(&scenario, &programs)
-            .unwrap_or_else(|e| panic!("seed {seed}: {e:?}\n{scenario}"));
-        let mut replay = semo::sim::Sim::new(&programs, &parsed, &semo::sim::Options::default());
-        replay.run_to(t);
-        let replayed: Vec<String> = replay
-            .take_trace()
-            .iter()
-            .map(|e| format!("{e:?}"))
-            .collect();
-        assert!(
-            replayed == trace,
-            "seed {seed}: the replay differs\n{scenario}\n{text}"
-        );
+        let made = replay_a_random_behaviour(&programs, &options, &mut rng, 8_000)
+            .unwrap_or_else(|(scenario, why)| panic!("seed {seed}: {why}\n{scenario}\n{text}"));
+        network += (made.iter())
+            .filter(|c| matches!(c, Choice::Lose { .. } | Choice::Delay { .. }))
+            .count();
         compared += 1;
     }
     eprintln!("{compared} random behaviours replayed, {network} network choices among them");
     assert!(
         compared >= 8 && network >= 10,
         "{compared} compared, {network} network choices"
+    );
+}
+
+/// One random behaviour of `programs` up to `end_ms`, every choice a
+/// random one of those the search could make, against the replay of its
+/// counterexample scenario by the simulator: the choices made, or the
+/// scenario and why the replay differs.
+fn replay_a_random_behaviour(
+    programs: &[semo::refine::RobotProgram],
+    options: &semo::verify::Options,
+    rng: &mut support::missiongen::Rng,
+    end_ms: i64,
+) -> Result<Vec<semo::verify::Choice>, (String, String)> {
+    use semo::verify::{Choice, Counterexample};
+    let inputs = semo::verify::Inputs::derive(programs);
+    let empty = semo::sim::Scenario::default();
+    let mut live = semo::sim::Sim::new(programs, &empty, &semo::sim::Options::default());
+    let mut world = semo::verify::World::new(&inputs, options, programs.len());
+    let mut start = Choice::Start(random_start(&inputs, rng));
+    semo::verify::apply(&mut live, &mut world, &inputs, &mut start);
+    let mut made = vec![(0, start)];
+    let mut trace = Vec::new();
+    let mut t = 0;
+    while t < end_ms {
+        let all = semo::verify::choices(&inputs, &world);
+        let mut choice = all[rng.below(all.len())].clone();
+        semo::verify::apply(&mut live, &mut world, &inputs, &mut choice);
+        made.push((t, choice));
+        t += options.step_ms;
+        live.run_to(t);
+        trace.extend(live.take_trace().iter().map(|e| format!("{e:?}")));
+    }
+    let way = Counterexample {
+        choices: made,
+        end_ms: t,
+        step_ms: options.step_ms,
+    };
+    let scenario = way.scenario_json(&inputs, programs);
+    let parsed = semo::sim::scenario::parse(&scenario, programs)
+        .map_err(|e| (scenario.clone(), format!("{e:?}")))?;
+    let mut replay = semo::sim::Sim::new(programs, &parsed, &semo::sim::Options::default());
+    replay.run_to(t);
+    let replayed: Vec<String> = (replay.take_trace().iter())
+        .map(|e| format!("{e:?}"))
+        .collect();
+    if replayed != trace {
+        let at = (replayed.iter().zip(&trace))
+            .position(|(a, b)| a != b)
+            .unwrap_or(replayed.len().min(trace.len()));
+        let why = format!(
+            "the replay differs at event {at}: {:?} against {:?}",
+            replayed.get(at),
+            trace.get(at)
+        );
+        return Err((scenario, why));
+    }
+    Ok(way.choices.into_iter().map(|(_, c)| c).collect())
+}
+
+/// What a robot's calls give back is the world's to choose: `semo verify`
+/// finds the mode only a search that found something leads to, and
+/// random behaviours that change what the calls give back, with robots
+/// killed and restarted between (a restarted robot's calls are given
+/// back, in order, what its first process's were), replay exactly from
+/// their scenarios.
+#[test]
+fn action_results_are_explored_and_their_choices_replay() {
+    let mission = "tests/fixtures/verify/results/main.mission";
+    let (code, findings, data) = verify(mission, &[]);
+    assert_eq!((code, &findings), (0, &vec![]), "{data}");
+    let (run, id) = semo::host::load_build(&support::repo_root().join(mission), &[]).unwrap();
+    let build = run.analysis().build_input(id).unwrap();
+    let programs = semo::refine::refine_checked(&build.input()).programs;
+    let inputs = semo::verify::Inputs::derive(&programs);
+    let services: Vec<(&str, &str, usize)> = (inputs.results.iter())
+        .map(|r| (r.robot_name.as_str(), r.service.as_str(), r.values.len()))
+        .collect();
+    assert_eq!(services, [("ti", "search", 2)]);
+    let options = semo::verify::Options {
+        changes: 6,
+        faults: 4,
+        ..semo::verify::Options::default()
+    };
+    let mut rng = support::missiongen::Rng::new(11);
+    let (mut changed, mut restarted) = (0, 0);
+    for _ in 0..24 {
+        let made = replay_a_random_behaviour(&programs, &options, &mut rng, 6_000)
+            .unwrap_or_else(|(scenario, why)| panic!("{why}\n{scenario}"));
+        changed += made
+            .iter()
+            .filter(|c| matches!(c, semo::verify::Choice::Results { .. }))
+            .count();
+        restarted += made
+            .iter()
+            .filter(|c| matches!(c, semo::verify::Choice::Restart { .. }))
+            .count();
+    }
+    assert!(
+        changed >= 10 && restarted >= 5,
+        "{changed} result changes, {restarted} restarts"
     );
 }
 

@@ -2,9 +2,11 @@
 //! programs alone: for each sensor value a robot compares, one value of
 //! each class its comparisons tell apart (below, at and above each number;
 //! each word and one that is none of them); for each operator command a
-//! robot reads, each value it is compared with and one that is none.
+//! robot reads, each value it is compared with and one that is none; for
+//! each service whose results a robot binds, what its calls give back, by
+//! the same classes (a bool: true or false).
 
-use crate::refine::value::{self, Value};
+use crate::refine::value::{self, Value, ValueKind};
 use crate::refine::{ControlMachine, Expr, Operand, RobotProgram, SlotId, SlotSource, StateKind};
 use crate::sema::Compared;
 use crate::syntax::ast::CmpOp;
@@ -21,6 +23,26 @@ pub struct SensorInput {
     pub values: Vec<String>,
 }
 
+/// What one robot's calls of one service give back (`FOUND, WHERE =
+/// search(red)`), which the world chooses as it chooses a sensor's class.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ResultInput {
+    /// Index of the robot's program.
+    pub robot: usize,
+    pub robot_name: String,
+    pub service: String,
+    /// One tuple per class, each value in the order of the service's
+    /// results as scenario text (`None`: none): a bool result is `true` or
+    /// `false`, a result the mission compares takes one value per class of
+    /// its comparisons, one it only passes on is none. At most
+    /// [`MAX_RESULT_CLASSES`] tuples.
+    pub values: Vec<Vec<Option<String>>>,
+}
+
+/// The most classes of a service's results explored: beyond, the later
+/// combinations are left out (several compared results multiply).
+pub const MAX_RESULT_CLASSES: usize = 16;
+
 /// An operator command the robots of a team read.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CommandInput {
@@ -33,6 +55,7 @@ pub struct CommandInput {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Inputs {
     pub sensors: Vec<SensorInput>,
+    pub results: Vec<ResultInput>,
     pub commands: Vec<CommandInput>,
     /// The pairs of robots (indices, the lower first) that may exchange a
     /// message: one sends or publishes to the other's team or name, or
@@ -81,6 +104,7 @@ pub fn derive(programs: &[RobotProgram]) -> Inputs {
                 values,
             });
         }
+        inputs.results.extend(results_of(r, program, &tests));
         for incoming in m.incoming.iter().filter(|i| i.from_team == "USER") {
             let Some(name) = incoming.key.strip_prefix("USER.") else {
                 continue;
@@ -108,6 +132,87 @@ pub fn derive(programs: &[RobotProgram]) -> Inputs {
     }
     inputs.links = links(programs);
     inputs
+}
+
+/// The results robot `r`'s calls bind, per service it calls so, in the
+/// order first called: the classes of each result over every call that
+/// binds it, combined.
+fn results_of(r: usize, program: &RobotProgram, tests: &[Vec<Test>]) -> Vec<ResultInput> {
+    let m = &program.control;
+    // Per service: per result position, its classes.
+    let mut by_service: Vec<(String, Vec<Vec<Option<String>>>)> = Vec::new();
+    for state in m.services.iter().flat_map(|s| &s.states) {
+        let StateKind::Call {
+            service, results, ..
+        } = &state.kind
+        else {
+            continue;
+        };
+        if results.is_empty() {
+            continue;
+        }
+        let entry = match by_service.iter().position(|(s, _)| s == service) {
+            Some(i) => &mut by_service[i].1,
+            None => {
+                by_service.push((service.clone(), Vec::new()));
+                &mut by_service.last_mut().expect("just pushed").1
+            }
+        };
+        for (k, slot) in results.iter().enumerate() {
+            let kind = &m.slots[slot.index()].kind;
+            let mut values: Vec<Option<String>> = if *kind == ValueKind::Bool {
+                vec![Some("true".into()), Some("false".into())]
+            } else if tests[slot.index()].is_empty() {
+                vec![None]
+            } else {
+                classes(&tests[slot.index()], |t| kind.parse(t))
+                    .into_iter()
+                    .map(Some)
+                    .collect()
+            };
+            if values.is_empty() {
+                values.push(None);
+            }
+            if entry.len() <= k {
+                entry.resize(k + 1, Vec::new());
+            }
+            for v in values {
+                if !entry[k].contains(&v) {
+                    entry[k].push(v);
+                }
+            }
+        }
+    }
+    by_service
+        .into_iter()
+        .map(|(service, positions)| {
+            // Every combination, the first position turning slowest.
+            let mut tuples: Vec<Vec<Option<String>>> = vec![Vec::new()];
+            for choices in &positions {
+                let choices = if choices.is_empty() {
+                    &vec![None]
+                } else {
+                    choices
+                };
+                tuples = (tuples.iter())
+                    .flat_map(|t| {
+                        choices.iter().map(move |c| {
+                            let mut t = t.clone();
+                            t.push(c.clone());
+                            t
+                        })
+                    })
+                    .take(MAX_RESULT_CLASSES)
+                    .collect();
+            }
+            ResultInput {
+                robot: r,
+                robot_name: program.robot.clone(),
+                service,
+                values: tuples,
+            }
+        })
+        .collect()
 }
 
 /// [`Inputs::links`].

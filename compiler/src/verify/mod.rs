@@ -25,7 +25,7 @@ mod inputs;
 mod properties;
 mod search;
 
-pub use inputs::{CommandInput, Inputs, SensorInput};
+pub use inputs::{CommandInput, Inputs, ResultInput, SensorInput};
 pub use properties::{MAX_PROPERTIES, Outcome, Property, properties_of};
 pub use search::{apply, choices};
 
@@ -143,9 +143,19 @@ impl Options {
 /// One choice of the world.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Choice {
-    /// At the start: the class of each sensor input.
+    /// At the start: the class of each sensor input, then of each result
+    /// input ([`Inputs::results`]).
     Start(Vec<usize>),
     Nothing,
+    /// What a robot's calls of a service give back becomes class `value`
+    /// of result input `input`, from its `at_call`th call on (counting the
+    /// calls of every process of the robot: a call done is never given
+    /// back something else; set when the choice is made).
+    Results {
+        input: usize,
+        value: usize,
+        at_call: usize,
+    },
     Sensor {
         input: usize,
         value: usize,
@@ -187,6 +197,10 @@ pub enum Choice {
 pub struct World {
     /// Per sensor input: its class now.
     pub classes: Vec<usize>,
+    /// Per result input: its class now, what its calls give back per call
+    /// (as a scenario's `"results"`), and how many calls an earlier
+    /// process of its robot did (those entries stay as they were given).
+    pub results: Vec<ResultsNow>,
     /// Sensor changes and operator commands left.
     pub changes: u32,
     /// Faults left.
@@ -207,6 +221,7 @@ impl World {
     pub fn new(inputs: &Inputs, options: &Options, robots: usize) -> World {
         World {
             classes: vec![0; inputs.sensors.len()],
+            results: vec![ResultsNow::default(); inputs.results.len()],
             changes: options.changes,
             faults: options.faults,
             network: options.network,
@@ -214,6 +229,26 @@ impl World {
             down: vec![false; robots],
             isolated: None,
         }
+    }
+}
+
+/// What the world gives back for one result input ([`World::results`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ResultsNow {
+    pub class: usize,
+    pub calls: crate::refine::CallResults,
+    pub used: usize,
+}
+
+impl ResultsNow {
+    /// From call `at` on, the calls give back `values`: the entries before
+    /// are kept (filled with the last one up to `at`), the later dropped.
+    pub fn give_from(&mut self, at: usize, values: Vec<Option<String>>) {
+        self.calls.truncate(at);
+        if let Some(last) = self.calls.last().cloned() {
+            self.calls.resize(at, last);
+        }
+        self.calls.push(values);
     }
 }
 
@@ -589,6 +624,8 @@ impl Counterexample {
         // The sensor entries per robot, and the operator's commands, in
         // the order the choices were made.
         let mut sensors: Vec<Vec<(i64, &SensorInput, usize)>> = vec![Vec::new(); robots.len()];
+        // What each result input gives back, rebuilt choice by choice.
+        let mut results = vec![ResultsNow::default(); inputs.results.len()];
         let mut commands = Vec::new();
         // Each fault as a scenario entry; a cut runs to its heal, else to
         // the end.
@@ -607,11 +644,22 @@ impl Counterexample {
             };
             match choice {
                 Choice::Start(classes) => {
-                    for (s, &v) in classes.iter().enumerate() {
+                    let (of_sensors, of_results) =
+                        classes.split_at(inputs.sensors.len().min(classes.len()));
+                    for (s, &v) in of_sensors.iter().enumerate() {
                         sensor(s, v);
+                    }
+                    for (i, &v) in of_results.iter().enumerate() {
+                        results[i].give_from(0, inputs.results[i].values[v].clone());
                     }
                 }
                 Choice::Sensor { input, value } => sensor(*input, *value),
+                Choice::Results {
+                    input,
+                    value,
+                    at_call,
+                } => results[*input]
+                    .give_from(*at_call, inputs.results[*input].values[*value].clone()),
                 Choice::Command { input, value } => {
                     commands.push((*at, &inputs.commands[*input], *value))
                 }
@@ -662,27 +710,63 @@ impl Counterexample {
             self.end_ms
         );
         let mut first_robot = true;
-        for (program, entries) in robots.iter().zip(&sensors) {
-            if entries.is_empty() {
+        for (r, (program, entries)) in robots.iter().zip(&sensors).enumerate() {
+            let given: Vec<(&str, &ResultsNow)> = (inputs.results.iter().zip(&results))
+                .filter(|(input, now)| input.robot == r && !now.calls.is_empty())
+                .map(|(input, now)| (input.service.as_str(), now))
+                .collect();
+            if entries.is_empty() && given.is_empty() {
                 continue;
             }
             let _ = write!(
                 out,
-                "{}\n    {}: {{\"sensors\": [",
+                "{}\n    {}: {{",
                 if first_robot { "" } else { "," },
                 json_string(&program.robot)
             );
             first_robot = false;
-            for (i, (at, input, v)) in entries.iter().enumerate() {
-                let _ = write!(
-                    out,
-                    "{}\n      {{\"at\": {at}, \"value\": {}, \"is\": {}}}",
-                    if i == 0 { "" } else { "," },
-                    json_string(&input.port),
-                    json_string(&input.values[*v])
-                );
+            if !entries.is_empty() {
+                out.push_str("\"sensors\": [");
+                for (i, (at, input, v)) in entries.iter().enumerate() {
+                    let _ = write!(
+                        out,
+                        "{}\n      {{\"at\": {at}, \"value\": {}, \"is\": {}}}",
+                        if i == 0 { "" } else { "," },
+                        json_string(&input.port),
+                        json_string(&input.values[*v])
+                    );
+                }
+                out.push_str("\n    ]");
             }
-            out.push_str("\n    ]}");
+            if !given.is_empty() {
+                if !entries.is_empty() {
+                    out.push_str(", ");
+                }
+                out.push_str("\"services\": {");
+                for (i, (service, now)) in given.iter().enumerate() {
+                    let calls: Vec<String> = (now.calls.iter())
+                        .map(|values| {
+                            let values: Vec<String> = (values.iter())
+                                .map(|v| match v.as_deref() {
+                                    None => "null".to_string(),
+                                    Some(b @ ("true" | "false")) => b.to_string(),
+                                    Some(text) => json_string(text),
+                                })
+                                .collect();
+                            format!("[{}]", values.join(", "))
+                        })
+                        .collect();
+                    let _ = write!(
+                        out,
+                        "{}\n      {}: {{\"results\": [{}]}}",
+                        if i == 0 { "" } else { "," },
+                        json_string(service),
+                        calls.join(", ")
+                    );
+                }
+                out.push_str("\n    }");
+            }
+            out.push('}');
         }
         out.push_str(if first_robot { "},\n" } else { "\n  },\n" });
         out.push_str("  \"operator\": [");

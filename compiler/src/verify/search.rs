@@ -131,7 +131,12 @@ pub fn explore(
         }
         let mut sim = root.clone();
         let mut world = World::new(inputs, options, programs.len());
-        apply(&mut sim, &mut world, inputs, &Choice::Start(start.clone()));
+        apply(
+            &mut sim,
+            &mut world,
+            inputs,
+            &mut Choice::Start(start.clone()),
+        );
         let fp = key(sim.fingerprint(&memory), &world, 0, options);
         if !seen.contains_key(&fp) {
             let id = admit(
@@ -168,7 +173,7 @@ pub fn explore(
             // The last choice takes the state itself: a clone (and a drop)
             // fewer per state.
             let mut state = Some((sim, world));
-            for (c, choice) in all.into_iter().enumerate() {
+            for (c, mut choice) in all.into_iter().enumerate() {
                 bound = over(&nodes, &edges, kept_bytes);
                 if bound.is_some() {
                     break;
@@ -179,7 +184,7 @@ pub fn explore(
                     let (sim, world) = state.as_ref().expect("kept until the last choice");
                     (sim.clone(), world.clone())
                 };
-                apply(&mut child, &mut child_world, inputs, &choice);
+                apply(&mut child, &mut child_world, inputs, &mut choice);
                 // About as many events as the step before.
                 child.reserve_trace(trace_hint);
                 child.run_to(next_t);
@@ -409,18 +414,21 @@ fn admit(
     id
 }
 
-/// Every combination of the sensor inputs' classes, the first classes
-/// first, made one at a time (there are exponentially many: the search
-/// takes what its budget allows).
+/// Every combination of the sensor inputs' classes and then the result
+/// inputs', the first classes first, made one at a time (there are
+/// exponentially many: the search takes what its budget allows).
 fn start_classes(inputs: &Inputs) -> impl Iterator<Item = Vec<usize>> + '_ {
-    let mut next = Some(vec![0; inputs.sensors.len()]);
+    let sizes: Vec<usize> = (inputs.sensors.iter().map(|s| s.values.len()))
+        .chain(inputs.results.iter().map(|r| r.values.len()))
+        .collect();
+    let mut next = Some(vec![0; sizes.len()]);
     std::iter::from_fn(move || {
         let current = next.take()?;
         // An odometer whose last input turns fastest.
         let mut following = current.clone();
         for s in (0..following.len()).rev() {
             following[s] += 1;
-            if following[s] < inputs.sensors[s].values.len() {
+            if following[s] < sizes[s] {
                 next = Some(following);
                 break;
             }
@@ -487,6 +495,18 @@ pub fn choices(inputs: &Inputs, world: &World) -> Vec<Choice> {
                 all.push(Choice::Command { input: c, value: v });
             }
         }
+        for (i, input) in inputs.results.iter().enumerate() {
+            for v in 0..input.values.len() {
+                if v != world.results[i].class {
+                    // Where it takes effect is known when it is made.
+                    all.push(Choice::Results {
+                        input: i,
+                        value: v,
+                        at_call: 0,
+                    });
+                }
+            }
+        }
     }
     if world.network > 0 {
         // Each pair of robots that may exchange a message, both alive now.
@@ -514,11 +534,14 @@ pub fn choices(inputs: &Inputs, world: &World) -> Vec<Choice> {
 }
 
 /// Makes `choice` in `sim` now, keeping `world` (what is set, what is
-/// left) up to date.
-pub fn apply(sim: &mut Sim, world: &mut World, inputs: &Inputs, choice: &Choice) {
+/// left) up to date; a [`Choice::Results`] learns the call it takes effect
+/// from.
+pub fn apply(sim: &mut Sim, world: &mut World, inputs: &Inputs, choice: &mut Choice) {
     match *choice {
         Choice::Nothing | Choice::Start(_) => {}
-        Choice::Sensor { .. } | Choice::Command { .. } => world.changes -= 1,
+        Choice::Sensor { .. } | Choice::Command { .. } | Choice::Results { .. } => {
+            world.changes -= 1
+        }
         Choice::Lose { .. } | Choice::Delay { .. } => world.network -= 1,
         Choice::Kill { .. } | Choice::Restart { .. } | Choice::Isolate { .. } | Choice::Heal => {
             world.faults -= 1
@@ -527,11 +550,34 @@ pub fn apply(sim: &mut Sim, world: &mut World, inputs: &Inputs, choice: &Choice)
     match *choice {
         Choice::Nothing => {}
         Choice::Start(ref start) => {
-            for (s, &v) in start.iter().enumerate() {
+            let (of_sensors, of_results) = start.split_at(inputs.sensors.len().min(start.len()));
+            for (s, &v) in of_sensors.iter().enumerate() {
                 let input = &inputs.sensors[s];
                 sim.set_sensor(input.robot, &input.port, &input.values[v]);
                 world.classes[s] = v;
             }
+            for (i, &v) in of_results.iter().enumerate() {
+                let input = &inputs.results[i];
+                let now = &mut world.results[i];
+                now.class = v;
+                now.give_from(0, input.values[v].clone());
+                sim.set_call_results(input.robot, &input.service, now.calls.clone());
+            }
+        }
+        Choice::Results {
+            input,
+            value,
+            ref mut at_call,
+        } => {
+            let results = &inputs.results[input];
+            let now = &mut world.results[input];
+            // The calls done (by this process or an earlier one) keep
+            // what they were given.
+            let done = sim.calls_done(results.robot, &results.service);
+            *at_call = now.used.max(done);
+            now.class = value;
+            now.give_from(*at_call, results.values[value].clone());
+            sim.set_call_results(results.robot, &results.service, now.calls.clone());
         }
         Choice::Sensor { input, value } => {
             let s = &inputs.sensors[input];
@@ -543,6 +589,11 @@ pub fn apply(sim: &mut Sim, world: &mut World, inputs: &Inputs, choice: &Choice)
             sim.give_command(&c.to, &format!("USER.{}", c.value), &c.values[value]);
         }
         Choice::Kill { robot } => {
+            for (input, now) in inputs.results.iter().zip(&mut world.results) {
+                if input.robot == robot {
+                    now.used = now.used.max(sim.calls_done(robot, &input.service));
+                }
+            }
             sim.kill(robot);
             world.down[robot] = true;
         }
@@ -554,6 +605,12 @@ pub fn apply(sim: &mut Sim, world: &mut World, inputs: &Inputs, choice: &Choice)
             for (s, input) in inputs.sensors.iter().enumerate() {
                 if input.robot == robot {
                     sim.set_sensor(robot, &input.port, &input.values[world.classes[s]]);
+                }
+            }
+            // Its calls count from the first again, as a replay's would.
+            for (input, now) in inputs.results.iter().zip(&world.results) {
+                if input.robot == robot {
+                    sim.set_call_results(robot, &input.service, now.calls.clone());
                 }
             }
         }

@@ -17,7 +17,8 @@
 use super::{Event, Held, Message, Queued, Robot, SENSOR_PERIOD_MS, Sim};
 use crate::refine::value::Value;
 use crate::refine::{
-    ModeId, RobotProgram, ServiceMachine, ServiceMachineId, SlotSource, StateId, StateKind,
+    CallResults, ModeId, RobotProgram, ServiceMachine, ServiceMachineId, SlotSource, StateId,
+    StateKind,
 };
 use crate::sim::scenario::Command;
 use crate::sim::trace::TraceEvent;
@@ -65,6 +66,31 @@ impl<'p> Sim<'p> {
                 self.schedule_fire(r, at);
             }
         }
+    }
+
+    /// How many calls of `service` robot `r`'s process has done that gave
+    /// back results of a scenario's (or [`Sim::set_call_results`]') list.
+    pub fn calls_done(&self, r: usize, service: &str) -> usize {
+        let robot = &self.robots[r];
+        (robot.service_results.iter())
+            .rposition(|(s, _)| s == service)
+            .map_or(0, |k| robot.calls_done[k] as usize)
+    }
+
+    /// What robot `r`'s calls of `service` give back becomes `calls`, per
+    /// call of its process in order (the last one again past the list): as
+    /// the scenario's `"results"` for the service would make it.
+    pub fn set_call_results(&mut self, r: usize, service: &str, calls: CallResults) {
+        let robot = &mut self.robots[r];
+        let mut all = robot.service_results.to_vec();
+        match all.iter().rposition(|(s, _)| s == service) {
+            Some(k) => all[k].1 = calls,
+            None => {
+                all.push((service.to_string(), calls));
+                robot.calls_done.push(0);
+            }
+        }
+        robot.service_results = all.into();
     }
 
     /// The operator sends `key` = `value` to `to` (a robot or a team) now:
@@ -656,8 +682,20 @@ impl Fingerprint {
                 }
             }
         }
-        for &n in &robot.calls_done {
-            self.int(n as i64);
+        // What the later calls give back: the rest of each list from the
+        // next call (its last entry once past it), not how many were done.
+        for ((_, calls), &n) in robot.service_results.iter().zip(&robot.calls_done) {
+            let rest = &calls[(n as usize).min(calls.len().saturating_sub(1))..];
+            self.int(rest.len() as i64);
+            for values in rest {
+                self.int(values.len() as i64);
+                for v in values {
+                    match v {
+                        None => self.int(-1),
+                        Some(text) => self.text(text),
+                    }
+                }
+            }
         }
         // The sensor values: the latest entry and when it came (a sample
         // may not have read it yet).
