@@ -889,6 +889,7 @@ fn action_results_take_the_scenario_s_values_call_by_call() {
 #[test]
 fn in_the_fire_example_only_the_room_that_found_the_fire_fights_it() {
     let fire = examples().join("fire");
+    let svg = scratch("fire").join("fire.svg");
     let out = semo(&[
         "simulate",
         &fire.join("fire.mission").display().to_string(),
@@ -896,6 +897,8 @@ fn in_the_fire_example_only_the_room_that_found_the_fire_fights_it() {
         &fire.join("fire.scenario.json").display().to_string(),
         "--trace",
         "-",
+        "--svg",
+        &svg.display().to_string(),
     ]);
     assert_eq!(out.code, 0, "{}{}", out.stdout, out.stderr);
     let events: Vec<serde_json::Value> = out
@@ -917,4 +920,22 @@ fn in_the_fire_example_only_the_room_that_found_the_fire_fights_it() {
             && e["value"] == "6,2"),
         "the base never warned the operator"
     );
+    // The timeline marks each robot's group where it changes, as traced.
+    let traced: Vec<(String, String)> = (events.iter())
+        .filter(|e| e["event"] == "allocated")
+        .map(|e| (e["t"].to_string(), e["name"].as_str().unwrap().to_string()))
+        .collect();
+    let elements = svg_elements(&std::fs::read_to_string(&svg).unwrap());
+    let mut drawn: Vec<(String, String)> = (elements.iter())
+        .filter(|(_, a)| attr(a, "class") == Some("allocated"))
+        .map(|(_, a)| {
+            let at = attr(a, "data-t").unwrap().to_string();
+            (at, attr(a, "data-group").unwrap().to_string())
+        })
+        .collect();
+    let mut sorted = traced.clone();
+    sorted.sort();
+    drawn.sort();
+    assert!(traced.iter().any(|(_, group)| group == "Hall"));
+    assert_eq!(drawn, sorted);
 }

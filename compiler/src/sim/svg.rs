@@ -1,8 +1,9 @@
 //! The timeline of a run as SVG: one swim lane per robot with its modes as
 //! coloured bands, one row of bars per plan (a colour per plan) for the
 //! services that ran, named where they are wide enough, messages as arrows
-//! between lanes coloured by their key, throws and catches as markers, how
-//! each robot's run ended (finished, stopped, killed), faults marked, and a
+//! between lanes coloured by their key, throws and catches as markers, each
+//! robot's group in counted groups where it changes, how each robot's run
+//! ended (finished, stopped, killed), faults marked, and a
 //! legend of the plans, keys and markers. Every band and bar carries the
 //! mission line that caused it (`data-line`), so that an editor can jump
 //! there. Labels are drawn last, on a white halo, so that no arrow hides
@@ -311,6 +312,42 @@ pub fn to_svg(run: &Run, programs: &[RobotProgram], scenario: &Scenario) -> Stri
                 e.t
             );
         }
+        // Its group in statements of counted groups, at each change: a
+        // triangle on the lane's top edge, named above the lane where the
+        // name fits before the robot's next change.
+        let allocations: Vec<&&TraceEvent> =
+            events.iter().filter(|e| e.event == "allocated").collect();
+        for (k, e) in allocations.iter().enumerate() {
+            let group = e.field("name").unwrap_or_default();
+            let alive = e.field("alive").unwrap_or_default();
+            let _ = writeln!(
+                body,
+                "<g class=\"allocated\" data-group=\"{}\" data-alive=\"{}\" data-t=\"{}\"><path transform=\"translate({:.1},{:.1})\" d=\"M0,0 L3,5 L-3,5 z\" fill=\"#1f3b73\"/><title>{} in {} at {} ms ({} alive)</title></g>",
+                escape(group),
+                escape(alive),
+                e.t,
+                x(e.t),
+                lane.top,
+                escape(&program.robot),
+                escape(group),
+                e.t,
+                escape(alive)
+            );
+            let room = allocations
+                .get(k + 1)
+                .map_or(LABEL_WIDTH + PLOT_WIDTH, |next| x(next.t))
+                - x(e.t);
+            if room > text_width(group, 7.0) + 4.0 {
+                label(
+                    &mut labels,
+                    "allocated-label",
+                    x(e.t) + 2.0,
+                    lane.top - 1.0,
+                    7.0,
+                    group,
+                );
+            }
+        }
         // How the robot's run ended: its latest finish or kill (a restart
         // after a kill runs it again), else a stop before the run's end; a
         // robot still running when the run ends is not marked.
@@ -568,7 +605,7 @@ fn legend(top: f64, plans: &Legend, keys: &Legend) -> (String, f64) {
     }
     let _ = writeln!(
         out,
-        "<text x=\"6\" y=\"{0:.1}\" fill=\"#555\">markers</text><g class=\"legend-entry\" data-kind=\"markers\" transform=\"translate({LABEL_WIDTH},{1:.1})\"><path d=\"M3,4 L6,0 L9,4 L6,8 z\" fill=\"#d62728\"/><text x=\"14\" y=\"7\">throw</text><path d=\"M55,1 L61,7 M55,7 L61,1\" stroke=\"#d62728\"/><text x=\"66\" y=\"7\">catch</text><rect x=\"110\" y=\"0\" width=\"3\" height=\"8\" fill=\"#333\"/><text x=\"117\" y=\"7\">end of a robot's run</text><line x1=\"240\" y1=\"0\" x2=\"240\" y2=\"8\" stroke=\"#000\" stroke-width=\"2\"/><text x=\"245\" y=\"7\">kill / restart</text><rect x=\"325\" y=\"0\" width=\"14\" height=\"8\" fill=\"none\" stroke=\"#000\" stroke-dasharray=\"3,2\"/><text x=\"344\" y=\"7\">link dropped / delayed</text><rect x=\"470\" y=\"0\" width=\"14\" height=\"8\" fill=\"#000\" opacity=\"0.1\"/><text x=\"489\" y=\"7\">partition</text></g>",
+        "<text x=\"6\" y=\"{0:.1}\" fill=\"#555\">markers</text><g class=\"legend-entry\" data-kind=\"markers\" transform=\"translate({LABEL_WIDTH},{1:.1})\"><path d=\"M3,4 L6,0 L9,4 L6,8 z\" fill=\"#d62728\"/><text x=\"14\" y=\"7\">throw</text><path d=\"M55,1 L61,7 M55,7 L61,1\" stroke=\"#d62728\"/><text x=\"66\" y=\"7\">catch</text><rect x=\"110\" y=\"0\" width=\"3\" height=\"8\" fill=\"#333\"/><text x=\"117\" y=\"7\">end of a robot's run</text><line x1=\"240\" y1=\"0\" x2=\"240\" y2=\"8\" stroke=\"#000\" stroke-width=\"2\"/><text x=\"245\" y=\"7\">kill / restart</text><rect x=\"325\" y=\"0\" width=\"14\" height=\"8\" fill=\"none\" stroke=\"#000\" stroke-dasharray=\"3,2\"/><text x=\"344\" y=\"7\">link dropped / delayed</text><rect x=\"470\" y=\"0\" width=\"14\" height=\"8\" fill=\"#000\" opacity=\"0.1\"/><text x=\"489\" y=\"7\">partition</text><path transform=\"translate(560,1)\" d=\"M0,0 L3,5 L-3,5 z\" fill=\"#1f3b73\"/><text x=\"567\" y=\"7\">group allocation</text></g>",
         y + 10.0,
         y + 3.0
     );
