@@ -824,7 +824,7 @@ fn a_message_the_network_loses_leaves_its_receiver_waiting_for_ever() {
 /// from `Counterexample::scenario_json`, give the same trace.
 #[test]
 fn a_counterexample_scenario_replays_the_run_its_choices_made() {
-    use semo::verify::{Choice, Counterexample};
+    use semo::verify::Choice;
     let options = semo::verify::Options {
         changes: 2,
         faults: 2,
