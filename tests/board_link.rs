@@ -11,7 +11,11 @@
 //! hears ti's colors and ti its team mate's heartbeats, through the board's UART,
 //! the gateway and the broker. The same with ti's QEMU killed in the middle
 //! and started again on the same link (the simulator given the matching
-//! kill and restart of ti).
+//! kill and restart of ti). The operator console and the live monitor see
+//! the board robot as they see a Linux robot: its status, published by the
+//! gateway from the board's `T` frames and read as they read it
+//! (`semo_server::live`), is running in the modes the simulator gives, in
+//! order, and ends stopped in FINISH; killed, it is lost, then running again.
 //!
 //! Time: QEMU runs in real time here (no `-icount`: the link's repeats and
 //! the Linux robots' clocks are wall clocks), and the Linux robots run the
@@ -27,6 +31,7 @@
 
 mod support;
 
+use semo_server::live::{self, Status};
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -211,6 +216,116 @@ fn gateway(fleet: &Fleet, link_port: u16, extra: &[&str], log: &Path) -> Child {
         .expect("semo gateway starts")
 }
 
+/// The robots' statuses as the operator console and the live monitor read
+/// them (`semo_server::live`: the status topics of every run of the
+/// mission, each payload decoded by `Status::decode`), from before anything
+/// starts: each status with its JSON object, in the order the broker
+/// delivers them.
+struct Statuses {
+    _client: rumqttc::Client,
+    rx: mpsc::Receiver<(Status, serde_json::Value)>,
+    heard: Vec<(Status, serde_json::Value)>,
+}
+
+impl Statuses {
+    fn watch(port: u16) -> Statuses {
+        let mut options = rumqttc::MqttOptions::new("status-watcher", "127.0.0.1", port);
+        options.set_keep_alive(Duration::from_secs(10));
+        let (client, mut connection) = rumqttc::Client::new(options, 64);
+        let every_run = semo::deploy::topics::Scope::every_run("scouting");
+        client
+            .subscribe(
+                semo::deploy::topics::statuses(&every_run),
+                rumqttc::QoS::AtLeastOnce,
+            )
+            .unwrap();
+        let (tx, rx) = mpsc::channel();
+        let (subscribed_tx, subscribed) = mpsc::channel();
+        std::thread::spawn(move || {
+            for event in connection.iter() {
+                match event {
+                    Ok(rumqttc::Event::Incoming(rumqttc::Packet::SubAck(_))) => {
+                        let _ = subscribed_tx.send(());
+                    }
+                    Ok(rumqttc::Event::Incoming(rumqttc::Packet::Publish(p))) => {
+                        let Some((_, robot)) = live::status_topic("scouting", &p.topic) else {
+                            continue;
+                        };
+                        let status = Status::decode(&robot, &p.payload)
+                            .unwrap_or_else(|| panic!("{robot}'s status reads: {:?}", p.payload));
+                        let json = serde_json::from_slice(&p.payload).unwrap();
+                        if tx.send((status, json)).is_err() {
+                            return;
+                        }
+                    }
+                    Ok(_) => {}
+                    Err(_) => std::thread::sleep(Duration::from_millis(100)),
+                }
+            }
+        });
+        subscribed
+            .recv_timeout(LIMIT)
+            .expect("the status watcher's SUBACK");
+        Statuses {
+            _client: client,
+            rx,
+            heard: Vec::new(),
+        }
+    }
+
+    /// Every status heard until `robot`'s `count`-th saying `state`.
+    fn until(&mut self, robot: &str, state: &str, count: usize) -> &[(Status, serde_json::Value)] {
+        let end = Instant::now() + LIMIT;
+        let seen = |heard: &[(Status, serde_json::Value)]| {
+            heard
+                .iter()
+                .filter(|(s, _)| s.robot == robot && s.state == state)
+                .count()
+        };
+        while seen(&self.heard) < count {
+            let left = end.saturating_duration_since(Instant::now());
+            let status = self.rx.recv_timeout(left).unwrap_or_else(|_| {
+                panic!("{robot}'s status `{state}` ({count}): {:#?}", self.heard)
+            });
+            self.heard.push(status);
+        }
+        &self.heard
+    }
+}
+
+/// The statuses heard, one JSON object a line, beside the traces.
+fn save_statuses(path: &Path, heard: &[(Status, serde_json::Value)]) {
+    let lines: Vec<String> = heard.iter().map(|(_, json)| json.to_string()).collect();
+    std::fs::write(path, lines.join("\n")).unwrap();
+}
+
+/// `robot`'s statuses among `heard`.
+fn statuses_of<'a>(heard: &'a [(Status, serde_json::Value)], robot: &str) -> Vec<&'a Status> {
+    heard
+        .iter()
+        .filter(|(s, _)| s.robot == robot)
+        .map(|(s, _)| s)
+        .collect()
+}
+
+/// The modes `statuses` say, each once in a row (a status says its mode
+/// again with each change of its services).
+fn status_modes(statuses: &[&Status]) -> Vec<String> {
+    let mut modes: Vec<String> = statuses
+        .iter()
+        .filter(|s| !s.mode.is_empty())
+        .map(|s| s.mode.clone())
+        .collect();
+    modes.dedup();
+    modes
+}
+
+/// The same, of a trace's `mode` events.
+fn distinct_in_a_row(mut modes: Vec<String>) -> Vec<String> {
+    modes.dedup();
+    modes
+}
+
 /// What a QEMU run of the scouting mission starts with: everything
 /// compiled before anything starts (the Linux robots with the scenario,
 /// `ti` for its board), then `ti`'s QEMU on a free port and a gateway to it.
@@ -225,6 +340,7 @@ struct BoardRun {
     board: usize,
     board_rx: mpsc::Receiver<String>,
     gateway: usize,
+    statuses: Statuses,
 }
 
 impl BoardRun {
@@ -235,6 +351,7 @@ impl BoardRun {
         let folders = support::mqtt::build(&scouting(), &fleet.out.join("linux"), &[]);
         support::mqtt::compile_in(&folders, &scenario);
         let gateway_log = fleet.out.join("gateway.stderr");
+        let statuses = Statuses::watch(fleet.port);
         let link_port = support::mosquitto::free_port();
         let (board, board_rx) = qemu(&elf, on, link_port);
         let board = fleet.processes.push(board);
@@ -251,6 +368,7 @@ impl BoardRun {
             board,
             board_rx,
             gateway,
+            statuses,
         })
     }
 }
@@ -270,6 +388,7 @@ fn behaves_as_in_the_simulator(test: &str, on: Board) {
         board,
         board_rx,
         gateway,
+        mut statuses,
         ..
     }) = BoardRun::start(&format!("board-link-{}", on.machine), on)
     else {
@@ -300,9 +419,14 @@ fn behaves_as_in_the_simulator(test: &str, on: Board) {
     );
     traces.insert("ti".into(), ti);
     fleet.processes.wait_success(board, "QEMU (ti)");
+    // The board waited for its last status to be acknowledged, which the
+    // gateway does once the broker has it.
+    let heard = statuses.until("ti", "stopped", 1).to_vec();
     fleet.processes.kill(gateway);
+    save_statuses(&fleet.out.join("statuses.jsonl"), &heard);
 
     let simulated = support::robots::simulated_modes(&scouting(), &scenario);
+    ti_s_status_is_a_linux_robot_s(&heard, &simulated["ti"]);
     assert_eq!(traces.len(), 3);
     for (robot, trace) in &traces {
         assert_eq!(
@@ -339,6 +463,48 @@ fn behaves_as_in_the_simulator(test: &str, on: Board) {
     }
 }
 
+/// What the operator console and the live monitor read of the board robot
+/// `ti` (`heard`: every status, in order): running, in the modes `modes`
+/// (the simulator's) in order, then finished and stopped in the last mode,
+/// its plans idle; `started` 0 (its mission time 0 is the gateway's
+/// welcome: a board has no wall clock); a status with the fields of its
+/// team mate's, a Linux robot's, at times that never go back.
+fn ti_s_status_is_a_linux_robot_s(heard: &[(Status, serde_json::Value)], modes: &[String]) {
+    let ti = statuses_of(heard, "ti");
+    assert_eq!(
+        status_modes(&ti),
+        distinct_in_a_row(modes.to_vec()),
+        "the modes ti's status says, in order, and the simulator's: {ti:#?}"
+    );
+    let mut states: Vec<&str> = ti.iter().map(|s| s.state.as_str()).collect();
+    states.dedup();
+    assert_eq!(states, ["running", "finished", "stopped"], "{ti:#?}");
+    assert!(ti.iter().all(|s| s.started == Some(0)), "{ti:#?}");
+    let times: Vec<i64> = ti.iter().map(|s| s.t.expect("a status's time")).collect();
+    assert!(times.is_sorted(), "{times:?}");
+    assert!(
+        ti.iter()
+            .any(|s| s.state == "running" && !s.services.is_empty()),
+        "a running ti's status names the service each plan runs: {ti:#?}"
+    );
+    let last = ti.last().unwrap();
+    assert_eq!(
+        (last.state.as_str(), last.mode.as_str()),
+        ("stopped", modes.last().unwrap().as_str())
+    );
+    assert!(last.services.is_empty(), "{last:?}");
+    // The same JSON as a Linux robot's status (nxt, ti's team mate on MQTT).
+    let fields = |robot: &str| -> Vec<String> {
+        let (_, json) = heard
+            .iter()
+            .rev()
+            .find(|(s, _)| s.robot == robot)
+            .unwrap_or_else(|| panic!("{robot}'s status"));
+        json.as_object().unwrap().keys().cloned().collect()
+    };
+    assert_eq!(fields("ti"), fields("nxt"));
+}
+
 /// The Evalbot killed and started again in the middle (issue 35): QEMU
 /// killed once ti's trace shows its first mode change, and a new QEMU
 /// started on the same link port, which the gateway connects to again. The
@@ -373,6 +539,7 @@ fn the_evalbot_in_qemu_killed_and_restarted_behaves_as_in_the_simulator() {
         board,
         board_rx,
         gateway,
+        mut statuses,
     }) = BoardRun::start("board-link-restart", on)
     else {
         return;
@@ -425,7 +592,9 @@ fn the_evalbot_in_qemu_killed_and_restarted_behaves_as_in_the_simulator() {
         .map(|s| (s.robot.clone(), fleet.finish(s, "board")))
         .collect();
     fleet.processes.wait_success(again, "QEMU (ti, restarted)");
+    let heard = statuses.until("ti", "stopped", 1).to_vec();
     fleet.processes.kill(gateway);
+    save_statuses(&fleet.out.join("statuses.jsonl"), &heard);
     std::fs::write(fleet.out.join("ti.first.jsonl"), first_life.join("\n")).unwrap();
     std::fs::write(fleet.out.join("ti.second.jsonl"), second_life.join("\n")).unwrap();
     let (first_life, second_life) = (events(&first_life), events(&second_life));
@@ -491,6 +660,33 @@ fn the_evalbot_in_qemu_killed_and_restarted_behaves_as_in_the_simulator() {
     assert_eq!(modes(after).first(), modes(before).first());
     assert_eq!(modes(after).last().map(String::as_str), Some("FINISH"));
 
+    // The console and the monitor see it running, lost when its QEMU is
+    // killed (the gateway says so when its link closes), then running again
+    // in its second life's modes, to its stop. Its first life's last status
+    // may not have left the board before the kill: what was published of
+    // it is a beginning of its modes.
+    let ti = statuses_of(&heard, "ti");
+    let mut states: Vec<&str> = ti.iter().map(|s| s.state.as_str()).collect();
+    states.dedup();
+    assert_eq!(
+        states,
+        ["running", "lost", "running", "finished", "stopped"],
+        "{ti:#?}"
+    );
+    let lost = ti.iter().position(|s| s.state == "lost").unwrap();
+    let restarted = lost + ti[lost..].iter().position(|s| s.state != "lost").unwrap();
+    let first_modes = status_modes(&ti[..lost]);
+    assert!(
+        !first_modes.is_empty() && distinct_in_a_row(modes(&first_life)).starts_with(&first_modes),
+        "ti's first life in its status {first_modes:?} and its trace {:?}",
+        modes(&first_life)
+    );
+    assert_eq!(
+        status_modes(&ti[restarted..]),
+        distinct_in_a_row(modes(&second_life)),
+        "the restarted ti's modes in its status and its trace"
+    );
+
     // The restarted ti is a member of the fleet again: the master hears its
     // colors, and it hears its team mate.
     traces.insert("ti".into(), second_life);
@@ -523,10 +719,12 @@ fn the_evalbot_in_qemu_killed_and_restarted_behaves_as_in_the_simulator() {
 /// budget (`arm-none-eabi-size`: text + data, data + bss with the stack):
 /// 32 KB of flash and 8 KB of RAM on `cortex-m`, 64 KB and 16 KB on
 /// `stm32f4` (`tests/cortex_m.rs`'s budgets). Measured (gcc-arm-none-eabi
-/// 12.2, newlib-nano): `cortex-m` 22660 B of flash and 8084 B of RAM,
-/// `stm32f4` 23308 B and 8084 B (the link's record with three frames of 164
-/// bytes, its receive ring of two frames, and newlib's snprintf for the
-/// heartbeat).
+/// 12.2, newlib-nano): `cortex-m` 24280 B of flash and 8140 B of RAM,
+/// `stm32f4` 24944 B and 8140 B (the link's record with three frames of
+/// 200 bytes, its longest status, in which sends, publishes and statuses
+/// are made; its receive ring of two frames of 164; newlib's snprintf for
+/// the heartbeat). Its status added 1604 B of flash and 48 B of RAM (22676
+/// B and 8092 B before).
 #[test]
 fn the_messaging_scout_fits_each_board_budget() {
     let test = "the_messaging_scout_fits_each_board_budget";

@@ -29,6 +29,8 @@ fn unhex(text: &str) -> Vec<u8> {
 /// The payload bound of the board the second driver stands for (the
 /// scouting `ti`'s).
 const BOARD_PAYLOAD_MAX: usize = 164;
+/// ... and the longest it sends, its status (the scouting `ti`'s).
+const BOARD_SEND_MAX: usize = 200;
 
 /// `link_test.c` with `semo_link.c`, built once per test process.
 fn driver() -> &'static Path {
@@ -36,13 +38,15 @@ fn driver() -> &'static Path {
     BUILT.get_or_init(|| build_driver(None))
 }
 
-/// The same, built with a board's smaller `SEMO_LINK_PAYLOAD_MAX`.
+/// The same, built with a board's smaller `SEMO_LINK_PAYLOAD_MAX` and
+/// `SEMO_LINK_SEND_MAX`.
 fn board_driver() -> &'static Path {
     static BUILT: OnceLock<PathBuf> = OnceLock::new();
-    BUILT.get_or_init(|| build_driver(Some(BOARD_PAYLOAD_MAX)))
+    BUILT.get_or_init(|| build_driver(Some((BOARD_PAYLOAD_MAX, BOARD_SEND_MAX))))
 }
 
-fn build_driver(payload_max: Option<usize>) -> PathBuf {
+/// `payload_max`: a board's bounds, what it takes and what it sends.
+fn build_driver(payload_max: Option<(usize, usize)>) -> PathBuf {
     {
         let runtime = support::repo_root().join("compiler/src/codegen/runtime");
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("link");
@@ -50,11 +54,16 @@ fn build_driver(payload_max: Option<usize>) -> PathBuf {
         let exe = dir.join(format!(
             "link_test-{}-{}",
             std::process::id(),
-            payload_max.unwrap_or(PAYLOAD_MAX)
+            payload_max.map_or(PAYLOAD_MAX, |(n, _)| n)
         ));
         let out = Command::new("gcc")
             .current_dir(&runtime)
-            .args(payload_max.map(|n| format!("-DSEMO_LINK_PAYLOAD_MAX={n}")))
+            .args(payload_max.into_iter().flat_map(|(takes, sends)| {
+                [
+                    format!("-DSEMO_LINK_PAYLOAD_MAX={takes}"),
+                    format!("-DSEMO_LINK_SEND_MAX={sends}"),
+                ]
+            }))
             .args([
                 "-std=c11",
                 "-Wall",
@@ -422,6 +431,59 @@ fn a_publish_without_a_session_is_counted_lost_and_a_send_waits() {
         frames(&send.wire)
     );
     assert!(c.stats().contains("pending=1"), "{}", c.stats());
+}
+
+/// A board sends frames up to its `SEMO_LINK_SEND_MAX` (its status), longer
+/// than the ones it takes: the gateway's side reads them; one byte more is
+/// refused on the board.
+#[test]
+fn a_board_sends_frames_longer_than_it_takes() {
+    let mut c = CSide::start_taking(board_driver(), BOARD_PAYLOAD_MAX);
+    let mut gateway = Endpoint::new(8);
+    let mut answer = Vec::new();
+    gateway.feed(&c.time(0).wire, 0, &mut answer);
+    let mut back = Vec::new();
+    gateway.feed(&c.bytes(&answer).wire, 0, &mut back);
+    let status = vec![b's'; BOARD_SEND_MAX];
+    let said = c.queue(Kind::Status, &status);
+    assert!(said.lines.is_empty(), "{said:?}");
+    let taken = gateway.feed(&said.wire, 0, &mut back);
+    assert_eq!(taken, vec![Frame::new(Kind::Status, 0, status)]);
+    let said = c.queue(Kind::Status, &vec![b's'; BOARD_SEND_MAX + 1]);
+    assert_eq!(said.lines, vec!["refused"]);
+}
+
+/// A frame queued and not yet on the line may be written again in place (a
+/// newer status takes the place of one that has not left): what goes is
+/// the new payload, under its number; the frame on the line, or a last
+/// frame of another kind, is never rewritten.
+#[test]
+fn a_waiting_frame_is_written_again_in_place_until_it_leaves() {
+    let (mut c, mut rust) = connected();
+    // The first goes on the line at once: it cannot be rewritten.
+    let said = c.queue(Kind::Status, b"first");
+    assert_eq!(frames(&said.wire)[0].payload, b"first");
+    assert_eq!(c.command("w T 00").lines, vec!["none"]);
+    // The second waits behind it: rewritten, shorter and longer.
+    assert!(c.queue(Kind::Status, b"second").wire.is_empty());
+    assert_eq!(c.command("w S 00").lines, vec!["none"], "another kind");
+    assert!(c.command(&format!("w T {}", hex(b"2nd"))).lines.is_empty());
+    assert!(
+        c.command(&format!("w T {}", hex(b"the second, newer")))
+            .lines
+            .is_empty()
+    );
+    // The first's Ack lets it go, as last written.
+    let mut wire = Vec::new();
+    let taken = rust.feed(&said.wire, 0, &mut wire);
+    assert_eq!(taken, vec![Frame::new(Kind::Status, 0, b"first".to_vec())]);
+    let said = c.bytes(&wire);
+    let taken = rust.feed(&said.wire, 0, &mut Vec::new());
+    assert_eq!(
+        taken,
+        vec![Frame::new(Kind::Status, 1, b"the second, newer".to_vec())]
+    );
+    assert_eq!(c.command("w T 00").lines, vec!["none"], "on the line now");
 }
 
 /// A board built with a smaller `SEMO_LINK_PAYLOAD_MAX` says it in its

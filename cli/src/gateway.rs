@@ -591,7 +591,12 @@ impl LinkGateway {
             if endpoint.outgoing.welcomed() {
                 endpoint.welcome_flags = 1;
             }
-            self.lost(&broker.client, last_status.as_deref());
+            // A robot whose last status says it stopped ended as a Linux
+            // robot that disconnects: no last will (a board's QEMU exits
+            // after its `stop`, and its status stays `stopped`).
+            if state_of(last_status.as_deref()).as_deref() != Some("stopped") {
+                self.lost(&broker.client, last_status.as_deref());
+            }
         }
     }
 
@@ -828,6 +833,12 @@ impl LinkGateway {
             status.to_string().into_bytes(),
         );
     }
+}
+
+/// The `state` a status says, if it is a JSON object with one.
+fn state_of(status: Option<&str>) -> Option<String> {
+    let value: serde_json::Value = serde_json::from_str(status?).ok()?;
+    Some(value.get("state")?.as_str()?.to_string())
 }
 
 /// The link's bytes, as they come, until it closes.

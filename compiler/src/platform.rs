@@ -123,8 +123,14 @@ pub struct SerialLink {
 }
 
 /// The runtime files of the serial link on a board: the frames and
-/// sessions, and the static schedule's transport over them.
-pub const LINK_RUNTIME: [&str; 3] = ["semo_link.h", "semo_link.c", "semo_static_link.c"];
+/// sessions, the static schedule's transport over them, and the robot's
+/// status sent on it.
+pub const LINK_RUNTIME: [&str; 4] = [
+    "semo_link.h",
+    "semo_link.c",
+    "semo_static_link.c",
+    "semo_static_status.c",
+];
 
 /// The cross toolchain of a board.
 #[derive(Debug, PartialEq, Eq)]

@@ -859,17 +859,25 @@ pub struct LinkSizes {
     pub port: &'static str,
     pub pins: &'static str,
     pub baud: u32,
-    /// The largest frame payload (`SEMO_LINK_PAYLOAD_MAX`,
+    /// The largest frame payload it takes (`SEMO_LINK_PAYLOAD_MAX`,
     /// `board_link::payload_max`).
     pub payload: usize,
+    /// The largest it sends, its status included (`SEMO_LINK_SEND_MAX`,
+    /// `board_link::send_max`).
+    pub send: usize,
     pub queue: usize,
+    /// The plans its status follows (`SEMO_STATUS_PLANS`).
+    pub plans: usize,
 }
 
 impl StaticSizes {
+    /// `simulated_battery`: the robot's scenario gives it a battery level
+    /// (its status may then say one without a `BATTERY` value).
     pub fn of(
         program: &RobotProgram,
         longest_value: usize,
         link: Option<&crate::platform::SerialLink>,
+        simulated_battery: bool,
     ) -> StaticSizes {
         let receives = program
             .tasks
@@ -882,7 +890,13 @@ impl StaticSizes {
                 pins: l.pins,
                 baud: l.baud,
                 payload: super::board_link::payload_max(program, value_bytes),
+                send: super::board_link::send_max(
+                    program,
+                    value_bytes,
+                    super::board_link::knows_battery(program, simulated_battery),
+                ),
                 queue: super::board_link::QUEUE,
+                plans: super::board_link::status_plans(program),
             }),
             value_bytes,
             tasks: program.graph.tasks.len().max(1),
@@ -1020,15 +1034,15 @@ fn static_makefile(
                 "link_sizes",
                 &sizes.link.as_ref().map_or(String::new(), |l| {
                     format!(
-                        "# The serial link to `semo gateway` on {} ({}, {} baud; docs/link.md):\n# its largest frame payload, from the mission's names, and the frames queued.\nSEMO_LINK_BAUD ?= {}\nSEMO_LINK_PAYLOAD_MAX ?= {}\nSEMO_LINK_QUEUE ?= {}\n",
-                        l.port, l.pins, l.baud, l.baud, l.payload, l.queue
+                        "# The serial link to `semo gateway` on {} ({}, {} baud; docs/link.md):\n# the largest frame payload it takes and sends (its status), from the mission's\n# names, the frames queued, and the plans its status follows.\nSEMO_LINK_BAUD ?= {}\nSEMO_LINK_PAYLOAD_MAX ?= {}\nSEMO_LINK_SEND_MAX ?= {}\nSEMO_LINK_QUEUE ?= {}\nSEMO_STATUS_PLANS ?= {}\n",
+                        l.port, l.pins, l.baud, l.baud, l.payload, l.send, l.queue, l.plans
                     )
                 }),
             ),
             (
                 "link_flags",
                 &if sizes.link.is_some() {
-                    " -DSEMO_LINK -DSEMO_LINK_BAUD=$(SEMO_LINK_BAUD)u -DSEMO_LINK_PAYLOAD_MAX=$(SEMO_LINK_PAYLOAD_MAX) -DSEMO_LINK_QUEUE=$(SEMO_LINK_QUEUE)"
+                    " -DSEMO_LINK -DSEMO_LINK_BAUD=$(SEMO_LINK_BAUD)u -DSEMO_LINK_PAYLOAD_MAX=$(SEMO_LINK_PAYLOAD_MAX) -DSEMO_LINK_SEND_MAX=$(SEMO_LINK_SEND_MAX) -DSEMO_LINK_QUEUE=$(SEMO_LINK_QUEUE) -DSEMO_STATUS_PLANS=$(SEMO_STATUS_PLANS)"
                 } else {
                     ""
                 },

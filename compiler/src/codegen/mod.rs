@@ -73,6 +73,10 @@ const STATIC_LINK: (&str, &str) = (
     "semo_static_link.c",
     include_str!("runtime/semo_static_link.c"),
 );
+const STATIC_STATUS: (&str, &str) = (
+    "semo_static_status.c",
+    include_str!("runtime/semo_static_status.c"),
+);
 const CORTEX_M: (&str, &str) = ("semo_cortex_m.c", include_str!("runtime/semo_cortex_m.c"));
 const LM3S6965: (&str, &str) = ("semo_lm3s6965.c", include_str!("runtime/semo_lm3s6965.c"));
 const LM3S6965_LD: (&str, &str) = ("lm3s6965.ld", LINK_SCRIPT.text);
@@ -112,6 +116,7 @@ const RUNTIME_FILES: &[(&str, &str)] = &[
     LOCKSTEP,
     STATIC,
     STATIC_LINK,
+    STATIC_STATUS,
     CORTEX_M,
     LM3S6965,
     LM3S6965_LD,
@@ -370,7 +375,14 @@ fn generate(
         .runtime()
         .filter(|name| name.ends_with(".c") && !link_only(name))
         .collect();
-    let sizes = files::StaticSizes::of(program, longest_value(&files, scenario), link);
+    let simulated_battery =
+        target.needs_scenario() && scenario.is_some_and(|w| !w.battery.is_empty());
+    let sizes = files::StaticSizes::of(
+        program,
+        longest_value(&files, scenario),
+        link,
+        simulated_battery,
+    );
     let makefile = files::makefile(
         program,
         target,

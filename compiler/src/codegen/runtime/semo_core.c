@@ -585,13 +585,12 @@ static void put_text(const semo__sink *sink, const char *text)
     sink->put(sink->ctx, text, strlen(text));
 }
 
-/* A JSON string: control characters escaped, invalid UTF-8 as U+FFFD so
- * that every line parses. */
-static void put_json_string(const semo__sink *sink, const char *text)
+/* A JSON string's characters, without its quotes: control characters
+ * escaped, invalid UTF-8 as U+FFFD so that every line parses. */
+void semo__json_chars(const semo__sink *sink, const char *text)
 {
     static const char hex[] = "0123456789abcdef";
     const unsigned char *s = (const unsigned char *)(text ? text : "");
-    put_text(sink, "\"");
     while (*s) {
         /* A run of characters that need no escape goes out at once. */
         size_t plain = 0;
@@ -630,6 +629,12 @@ static void put_json_string(const semo__sink *sink, const char *text)
             }
         }
     }
+}
+
+static void put_json_string(const semo__sink *sink, const char *text)
+{
+    put_text(sink, "\"");
+    semo__json_chars(sink, text);
     put_text(sink, "\"");
 }
 
@@ -724,6 +729,22 @@ void semo__trace_line(const semo__sink *sink, int64_t t, const char *robot, cons
         put_json_value(sink, value);
     }
     put_text(sink, "}\n");
+}
+
+const char *semo__trace_pair(va_list args, const char *key)
+{
+    va_list scan;
+    va_copy(scan, args);
+    const char *found = NULL;
+    for (const char *k = va_arg(scan, const char *); k && !found; k = va_arg(scan, const char *)) {
+        const char *v = va_arg(scan, const char *);
+        if (!v)
+            break;
+        if (strcmp(k, key) == 0)
+            found = v;
+    }
+    va_end(scan);
+    return found;
 }
 
 void semo_trace(const char *event, ...)

@@ -28,6 +28,10 @@ typedef struct {
  * none) names a typed value written last (semo_trace_value). */
 void semo__trace_line(const semo__sink *sink, int64_t t, const char *robot, const char *event, va_list args,
                       const char *value_key, const semo_value *value);
+/* A JSON string's characters, escaped as a trace line's, without quotes. */
+void semo__json_chars(const semo__sink *sink, const char *text);
+/* The value of `key` among a trace call's pairs (semo_trace's), or NULL. */
+const char *semo__trace_pair(va_list args, const char *key);
 /* Platform: writes one trace line where the platform's trace goes
  * (semo_trace and semo_trace_value are the core's). */
 void semo__trace_emit(const char *event, const char *value_key, const semo_value *value, va_list args);
@@ -431,12 +435,28 @@ extern volatile bool semo__board_woken;
 /* semo_static_link.c's, for the loop (semo_static.c): waits for the
  * gateway's welcome (mission time starts after it); feeds what the line
  * brought and writes what is due; when that is next needed (board ms,
- * INT64_MAX: only when a byte comes); waits (at most 2 s) for what was sent
- * to be acknowledged, and traces what the link lost. */
+ * INT64_MAX: only when a byte comes); before the program's `stop`, waits
+ * (at most 2 s) for what was sent to be acknowledged and traces what the
+ * link lost (semo__link_report, below); after it, waits (at most 2 s) for
+ * its last status. */
 void semo__link_open(void);
 void semo__link_pump(void);
 int64_t semo__link_deadline(void);
 void semo__link_close(void);
+/* The payload of the link queue's next frame, to be written in place
+ * (SEMO_LINK_SEND_MAX bytes) and queued by semo__link_commit. While the
+ * queue is full it pumps the line until a slot frees, however long when
+ * `patient` (a send), else only while the program runs; never from within
+ * the line's own feeding (a trace made as a frame is taken): NULL then. */
+unsigned char *semo__link_slot(bool patient);
+void semo__link_commit(unsigned char kind, size_t len);
+/* The last frame queued, if of kind `kind` and not on the line yet, to be
+ * written again in place (semo_link_waiting); its new length. */
+unsigned char *semo__link_waiting(unsigned char kind);
+void semo__link_rewrite(size_t len);
+/* semo_static_status.c's: the robot's status, kept from each trace event
+ * (semo__trace_emit's) and sent on the link when it changes. */
+void semo__status_observe(const char *event, va_list args);
 #endif
 #endif
 
@@ -451,7 +471,8 @@ bool semo__mqtt_session_present(void);
 bool semo__link_session_present(void);
 /* Before the program's `stop`: waits (at most 2 s) for what was sent
  * reliably to be acknowledged, then traces a `link` event with what the
- * link lost or did again, when anything (semo_link_transport.c). */
+ * link lost or did again, when anything (semo_link_transport.c on POSIX,
+ * semo_static_link.c on a board). */
 void semo__link_report(void);
 
 #endif /* SEMO_INTERNAL_H */

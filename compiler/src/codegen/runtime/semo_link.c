@@ -79,24 +79,62 @@ static void write_frame(semo_link *link, unsigned char kind, uint16_t seq, const
     write_pieces(link, kind, seq, pieces, lens, 2);
 }
 
-int semo_link_queue(semo_link *link, unsigned char kind, const void *a, size_t alen, const void *b, size_t blen)
+unsigned char *semo_link_slot(semo_link *link)
 {
-    if (alen + blen > SEMO_LINK_PAYLOAD_MAX || link->tx_count >= SEMO_LINK_QUEUE + 1)
+    if (link->tx_count >= SEMO_LINK_QUEUE + 1)
+        return NULL;
+    return link->queue[(link->tx_head + link->tx_count) % (SEMO_LINK_QUEUE + 1)].payload;
+}
+
+int semo_link_commit(semo_link *link, unsigned char kind, size_t len)
+{
+    if (len > SEMO_LINK_SEND_MAX || link->tx_count >= SEMO_LINK_QUEUE + 1)
         return -1;
     size_t slot = (link->tx_head + link->tx_count) % (SEMO_LINK_QUEUE + 1);
     link->queue[slot].kind = kind;
-    link->queue[slot].len = alen + blen;
-    if (alen)
-        memcpy(link->queue[slot].payload, a, alen);
-    if (blen)
-        memcpy(link->queue[slot].payload + alen, b, blen);
+    link->queue[slot].len = len;
     link->tx_count++;
     return 0;
 }
 
+/* The last frame queued, if it is not on the line yet: -1 when none. */
+static int last_waiting(const semo_link *link)
+{
+    if (link->tx_count == 0 || (link->tx_count == 1 && link->tx_in_flight))
+        return -1;
+    return (int)((link->tx_head + link->tx_count - 1) % (SEMO_LINK_QUEUE + 1));
+}
+
+unsigned char *semo_link_waiting(semo_link *link, unsigned char kind)
+{
+    int last = last_waiting(link);
+    return last >= 0 && link->queue[last].kind == kind ? link->queue[last].payload : NULL;
+}
+
+int semo_link_rewrite(semo_link *link, size_t len)
+{
+    int last = last_waiting(link);
+    if (last < 0 || len > SEMO_LINK_SEND_MAX)
+        return -1;
+    link->queue[last].len = len;
+    return 0;
+}
+
+int semo_link_queue(semo_link *link, unsigned char kind, const void *a, size_t alen, const void *b, size_t blen)
+{
+    unsigned char *slot = semo_link_slot(link);
+    if (alen + blen > SEMO_LINK_SEND_MAX || !slot)
+        return -1;
+    if (alen)
+        memcpy(slot, a, alen);
+    if (blen)
+        memcpy(slot + alen, b, blen);
+    return semo_link_commit(link, kind, alen + blen);
+}
+
 int semo_link_emit(semo_link *link, unsigned char kind, const void *a, size_t alen, const void *b, size_t blen)
 {
-    if (alen + blen > SEMO_LINK_PAYLOAD_MAX)
+    if (alen + blen > SEMO_LINK_SEND_MAX)
         return -1;
     write_frame(link, kind, 0, a, alen, b, blen);
     return 0;
@@ -106,7 +144,7 @@ int semo_link_send_datagram(semo_link *link, const char *to, const void *datagra
 {
     size_t to_len = strlen(to);
     /* The kind is the datagram's sixth byte ("SEMO" 0x02 <kind>). */
-    if (len < 6 || to_len == 0 || to_len > 255 || 1 + to_len + len > SEMO_LINK_PAYLOAD_MAX)
+    if (len < 6 || to_len == 0 || to_len > 255 || 1 + to_len + len > SEMO_LINK_SEND_MAX)
         return -1;
     unsigned char head[1] = {(unsigned char)to_len};
     if (((const unsigned char *)datagram)[5] != SEMO_LINK_DATAGRAM_SEND) {
@@ -119,17 +157,15 @@ int semo_link_send_datagram(semo_link *link, const char *to, const void *datagra
         write_pieces(link, SEMO_LINK_PUBLISH, 0, pieces, lens, 3);
         return 0;
     }
-    size_t slot = (link->tx_head + link->tx_count) % (SEMO_LINK_QUEUE + 1);
-    if (link->tx_count >= SEMO_LINK_QUEUE + 1)
+    unsigned char *slot = semo_link_slot(link);
+    if (!slot)
         return -2;
-    /* Straight into the queue's slot: no second copy of the payload. */
-    link->queue[slot].kind = SEMO_LINK_SEND;
-    link->queue[slot].len = 1 + to_len + len;
-    link->queue[slot].payload[0] = head[0];
-    memcpy(link->queue[slot].payload + 1, to, to_len);
-    memcpy(link->queue[slot].payload + 1 + to_len, datagram, len);
-    link->tx_count++;
-    return 0;
+    /* Straight into the queue's slot: no second copy of the payload. The
+     * datagram may be there already (semo_link_slot): memmove. */
+    memmove(slot + 1 + to_len, datagram, len);
+    slot[0] = head[0];
+    memcpy(slot + 1, to, to_len);
+    return semo_link_commit(link, SEMO_LINK_SEND, 1 + to_len + len);
 }
 
 static void send_in_flight(semo_link *link, int64_t now)

@@ -11,9 +11,10 @@
  * by `W`: no reliable frame goes before.
  *
  * No heap, no stdio: a `semo_link` holds every buffer, sized here
- * (SEMO_LINK_PAYLOAD_MAX and SEMO_LINK_QUEUE may be set smaller for a
- * board: a longer frame is refused by both sides). Not thread-safe: the
- * caller holds its lock around every call. Time is the caller's (ms). */
+ * (SEMO_LINK_PAYLOAD_MAX, SEMO_LINK_SEND_MAX and SEMO_LINK_QUEUE may be set
+ * smaller for a board: a longer frame is refused by both sides). Not
+ * thread-safe: the caller holds its lock around every call. Time is the
+ * caller's (ms). */
 #ifndef SEMO_LINK_H
 #define SEMO_LINK_H
 
@@ -21,8 +22,15 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* The longest payload this side takes (said in its H and W). */
 #ifndef SEMO_LINK_PAYLOAD_MAX
 #define SEMO_LINK_PAYLOAD_MAX 1536
+#endif
+/* The longest payload this side sends: a board's status may be longer than
+ * anything it is sent, and the gateway takes up to 1536 bytes; only the
+ * frames sent (the queue, link->wire) are sized by it. */
+#ifndef SEMO_LINK_SEND_MAX
+#define SEMO_LINK_SEND_MAX SEMO_LINK_PAYLOAD_MAX
 #endif
 /* Reliable frames waiting behind the one in flight. */
 #ifndef SEMO_LINK_QUEUE
@@ -31,8 +39,15 @@
 /* H and W say it in two bytes. */
 _Static_assert(SEMO_LINK_PAYLOAD_MAX >= 64 && SEMO_LINK_PAYLOAD_MAX <= 0xFFFF,
                "SEMO_LINK_PAYLOAD_MAX must be 64 to 65535");
-#define SEMO_LINK_BODY_MAX (3 + SEMO_LINK_PAYLOAD_MAX + 2)
-#define SEMO_LINK_WIRE_MAX (SEMO_LINK_BODY_MAX + SEMO_LINK_BODY_MAX / 254 + 1 + 1)
+/* A robot sends what it may be sent (its sends, the gateway's are alike)
+ * and the gateway takes no longer. */
+_Static_assert(SEMO_LINK_SEND_MAX >= SEMO_LINK_PAYLOAD_MAX && SEMO_LINK_SEND_MAX <= 1536,
+               "SEMO_LINK_SEND_MAX must be SEMO_LINK_PAYLOAD_MAX to 1536");
+/* A frame's bytes on the line, stuffed and closed, for a payload of `n`. */
+#define SEMO_LINK_WIRE_FOR(n) ((3 + (n) + 2) + (3 + (n) + 2) / 254 + 1 + 1)
+/* The longest frame received on the line, and sent. */
+#define SEMO_LINK_WIRE_MAX SEMO_LINK_WIRE_FOR(SEMO_LINK_PAYLOAD_MAX)
+#define SEMO_LINK_SEND_WIRE_MAX SEMO_LINK_WIRE_FOR(SEMO_LINK_SEND_MAX)
 #define SEMO_LINK_RETRY_MS 200
 #define SEMO_LINK_HELLO_RETRY_MS 500
 /* A datagram's kind byte (its sixth) for a send (semo_runtime.h's SEMO_MSG_SEND). */
@@ -79,7 +94,7 @@ typedef struct {
     struct {
         unsigned char kind;
         size_t len;
-        unsigned char payload[SEMO_LINK_PAYLOAD_MAX];
+        unsigned char payload[SEMO_LINK_SEND_MAX];
     } queue[SEMO_LINK_QUEUE + 1]; /* [tx_head] is in flight when tx_in_flight */
     size_t tx_head, tx_count;
     uint16_t tx_seq;
@@ -94,7 +109,7 @@ typedef struct {
      * (SEMO_LINK_PAYLOAD_MAX until it has). Ours, SEMO_LINK_PAYLOAD_MAX, is
      * in each of our H and W: a board's may be smaller than the gateway's. */
     size_t peer_payload_max;
-    unsigned char wire[SEMO_LINK_WIRE_MAX];
+    unsigned char wire[SEMO_LINK_SEND_WIRE_MAX];
     /* Counted for the trace: frames that were no frame (CRC, stuffing,
      * length, kind), copies not taken, frames sent again, publishes lost
      * because no session stood (the line away, the gateway restarting). */
@@ -105,6 +120,23 @@ void semo_link_init(semo_link *link, semo_link_write write, void *ctx);
 /* Queues a reliable frame whose payload is `a` then `b` (either may be
  * empty); -1 when it is too long or the queue is full. */
 int semo_link_queue(semo_link *link, unsigned char kind, const void *a, size_t alen, const void *b, size_t blen);
+/* The payload of the next reliable frame, to be written in place (at most
+ * SEMO_LINK_SEND_MAX bytes: no second buffer for it) and queued by
+ * semo_link_commit; NULL while the queue is full. A datagram written at
+ * its place in the slot (after the length byte and the destination) may be
+ * handed to semo_link_send_datagram from there. */
+unsigned char *semo_link_slot(semo_link *link);
+/* Queues the frame of kind `kind` whose `len` bytes were written in
+ * semo_link_slot's slot; -1 when it is too long or the queue is full. */
+int semo_link_commit(semo_link *link, unsigned char kind, size_t len);
+/* The payload of the last frame queued, when it is of kind `kind` and
+ * still waits (not on the line yet), to be written again in place and its
+ * new length set by semo_link_rewrite; NULL otherwise. A newer status
+ * takes the place of one that has not left. */
+unsigned char *semo_link_waiting(semo_link *link, unsigned char kind);
+/* The last frame queued (semo_link_waiting's) is now `len` bytes; -1 when
+ * it is too long or none waits. */
+int semo_link_rewrite(semo_link *link, size_t len);
 /* Writes an unreliable frame (P) now; -1 when it is too long. */
 int semo_link_emit(semo_link *link, unsigned char kind, const void *a, size_t alen, const void *b, size_t blen);
 /* One byte from the line at time `now`: acknowledgements, hellos and

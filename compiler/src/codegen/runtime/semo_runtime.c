@@ -937,23 +937,6 @@ static void status_line(status_buffer *b, const char *event, ...)
     va_end(args);
 }
 
-/* The value of `key` among a trace call's pairs, or NULL. */
-static const char *pair_value(va_list args, const char *key)
-{
-    va_list scan;
-    va_copy(scan, args);
-    const char *found = NULL;
-    for (const char *k = va_arg(scan, const char *); k && !found; k = va_arg(scan, const char *)) {
-        const char *v = va_arg(scan, const char *);
-        if (!v)
-            break;
-        if (strcmp(k, key) == 0)
-            found = v;
-    }
-    va_end(scan);
-    return found;
-}
-
 static void copy_name(char *out, const char *name)
 {
     snprintf(out, STATUS_NAME, "%s", name ? name : "");
@@ -973,13 +956,13 @@ static void observe_status(const char *event, va_list args)
     } else if (strcmp(event, "stop") == 0) {
         snprintf(g_status.state, sizeof g_status.state, "stopped");
     } else if (strcmp(event, "mode") == 0) {
-        copy_name(g_status.mode, pair_value(args, "mode"));
+        copy_name(g_status.mode, semo__trace_pair(args, "mode"));
     } else if (strcmp(event, "leader") == 0) {
-        copy_name(g_status.leader, pair_value(args, "leader"));
+        copy_name(g_status.leader, semo__trace_pair(args, "leader"));
     } else if (strcmp(event, "fenced") == 0) {
         g_status.leader[0] = '\0'; /* it knows no leader until it hears a majority */
     } else if (strcmp(event, "service_start") == 0 || strcmp(event, "service_end") == 0) {
-        const char *plan = pair_value(args, "plan");
+        const char *plan = semo__trace_pair(args, "plan");
         size_t i = 0;
         while (i < g_status.running_count && strcmp(g_status.running[i].plan, plan ? plan : "") != 0)
             i++;
@@ -989,7 +972,7 @@ static void observe_status(const char *event, va_list args)
             copy_name(g_status.running[i].plan, plan);
         }
         if (i < g_status.running_count)
-            copy_name(g_status.running[i].service, starts ? pair_value(args, "service") : "");
+            copy_name(g_status.running[i].service, starts ? semo__trace_pair(args, "service") : "");
     } else {
         changed = false;
     }

@@ -70,6 +70,13 @@ void semo_sleep_ms(int64_t ms)
 
 void semo__trace_emit(const char *event, const char *value_key, const semo_value *value, va_list args)
 {
+#ifdef SEMO_LINK
+    /* The status follows the trace (before its line, as on POSIX). */
+    va_list seen;
+    va_copy(seen, args);
+    semo__status_observe(event, seen);
+    va_end(seen);
+#endif
     semo__sink sink = {semo__board_put, NULL};
     semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args, value_key, value);
 }
@@ -656,9 +663,13 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
             program->tasks[i].wrapup();
     semo__trace_dropped_samples();
 #ifdef SEMO_LINK
-    semo__link_close();
+    semo__link_report();
 #endif
     semo_trace("stop", NULL);
+#ifdef SEMO_LINK
+    /* The status `stop` queued goes before the board exits. */
+    semo__link_close();
+#endif
 #ifdef SEMO_COUNT_PASSES
     /* For measuring (not a trace line: built only with -DSEMO_COUNT_PASSES). */
     char passes[21], ms[21];

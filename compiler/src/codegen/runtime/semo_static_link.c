@@ -10,15 +10,19 @@
  * bytes received fed to the link, what is due written) and sleeps until the
  * link's next deadline (a hello or a frame to repeat, on the board's clock)
  * or a received byte. A `send` goes reliably (repeated until acknowledged);
- * while the link's queue is full it pumps the line in place until there is
- * room (never lost). A `publish` goes at once (lost with the line, as at
- * QoS 0). A message (M) goes to the inbox, and while the inbox is full and a
- * task reads it, the rest stays on the line (the gateway and the broker keep
- * what follows, as for a full Linux robot); a refusal (R) is traced. At
- * start the robot says hello until the gateway welcomes it, without a time
- * limit (a robot that messages others has nothing to do without them):
- * mission time 0 is when it joined. At the end it waits at most 2 s for
- * what it sent to be acknowledged, and traces what the link lost.
+ * a `publish` goes at once (lost with the line, as at QoS 0). Both are made
+ * in the next free slot of the link's queue, where a send's frame is
+ * queued (no buffer of their own): while the queue is full the line is
+ * pumped in place until a slot frees (never lost). The robot's status (T,
+ * semo_static_status.c) is queued the same way. A message (M) goes to the
+ * inbox, and while the inbox is full and a task reads it, the rest stays on
+ * the line (the gateway and the broker keep what follows, as for a full
+ * Linux robot); a refusal (R) is traced. At start the robot says hello
+ * until the gateway welcomes it, without a time limit (a robot that
+ * messages others has nothing to do without them): mission time 0 is when
+ * it joined. At the end it waits at most 2 s for what it sent to be
+ * acknowledged and traces what the link lost, then, after its `stop`, at
+ * most 2 s more for its last status.
  */
 #ifdef SEMO_LINK
 #include "semo_internal.h"
@@ -32,6 +36,10 @@ static semo_link g_link;
 /* One message at a time (nothing else runs): the one being sent, until it
  * is encoded, then the one being received. Static, off the stack. */
 static semo_message g_message;
+/* The line is being fed: a frame taken may be traced with arguments in
+ * g_message or in the link, so nothing pumps the line again until it is
+ * done (semo__link_slot). */
+static bool g_feeding;
 
 static void line_write(void *ctx, const unsigned char *bytes, size_t n)
 {
@@ -61,16 +69,18 @@ static void taken(const semo_link_frame *f)
 static void feed(bool hold, bool until_welcomed)
 {
     unsigned char byte;
+    g_feeding = true;
     while (semo__board_link_peek(&byte)) {
         if (byte == 0 && hold && semo__inbox_holds_back())
-            return;
+            break;
         semo__board_link_take();
         semo_link_frame f;
         if (semo_link_feed(&g_link, byte, semo__board_now_ms(), &f))
             taken(&f);
         if (until_welcomed && g_link.welcomed)
-            return;
+            break;
     }
+    g_feeding = false;
 }
 
 /* Sleeps until the link's next deadline, `limit` (board ms) or a byte. */
@@ -113,7 +123,8 @@ int64_t semo__link_deadline(void)
     return semo_link_deadline(&g_link);
 }
 
-void semo__link_close(void)
+/* Waits (at most LINK_CLOSE_WAIT_MS) for what was sent to be acknowledged. */
+static void wait_for_acknowledgements(void)
 {
     int64_t until = semo__board_now_ms() + LINK_CLOSE_WAIT_MS;
     while (semo_link_pending(&g_link) > 0 && semo__board_now_ms() < until) {
@@ -121,6 +132,11 @@ void semo__link_close(void)
         semo_link_tick(&g_link, semo__board_now_ms());
         wait_on_line(until);
     }
+}
+
+void semo__link_report(void)
+{
+    wait_for_acknowledgements();
     unsigned long overruns = semo__board_link_overruns();
     if (g_link.bad_frames || g_link.duplicates || g_link.retransmissions || overruns ||
         semo_link_pending(&g_link)) {
@@ -133,6 +149,42 @@ void semo__link_close(void)
         semo_trace("link", "bad_frames", counts[0], "duplicates", counts[1], "retransmissions", counts[2],
                    "overruns", counts[3], "unacknowledged", counts[4], NULL);
     }
+}
+
+void semo__link_close(void)
+{
+    wait_for_acknowledgements();
+}
+
+unsigned char *semo__link_slot(bool patient)
+{
+    unsigned char *slot;
+    while ((slot = semo_link_slot(&g_link)) == NULL && !g_feeding && (patient || semo_running())) {
+        /* Room comes with the gateway's acknowledgement: read the line for
+         * it here (a message behind it goes to the inbox, or is dropped and
+         * traced when the inbox is full: nothing else can take it now). */
+        feed(false, false);
+        semo_link_tick(&g_link, semo__board_now_ms());
+        if ((slot = semo_link_slot(&g_link)) == NULL)
+            wait_on_line(INT64_MAX);
+    }
+    return slot;
+}
+
+void semo__link_commit(unsigned char kind, size_t len)
+{
+    semo_link_commit(&g_link, kind, len);
+    semo_link_tick(&g_link, semo__board_now_ms());
+}
+
+unsigned char *semo__link_waiting(unsigned char kind)
+{
+    return semo_link_waiting(&g_link, kind);
+}
+
+void semo__link_rewrite(size_t len)
+{
+    semo_link_rewrite(&g_link, len);
 }
 
 int64_t semo_joined_ms(void)
@@ -174,9 +226,9 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
     int sent = local == 1 ? 1 : addressed(to_team);
     if (sent == 0)
         return 0;
-    /* No datagram longer than a frame's payload can go: the buffer is no
-     * longer either. */
-    static unsigned char datagram[SEMO_LINK_PAYLOAD_MAX];
+    /* The slot first: the line is read while waiting for one, and a
+     * message read goes through g_message. */
+    unsigned char *slot = semo__link_slot(true);
     const semo_program_desc *p = semo_program();
     semo_message *m = &g_message;
     memset(m, 0, sizeof *m);
@@ -185,19 +237,13 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
     copy_name(m->from_robot, sizeof m->from_robot, p->robot);
     copy_name(m->key, sizeof m->key, key);
     m->value = *value;
-    if (semo__encoded_size(m) > sizeof datagram) {
-        semo_trace("comm_error", "to", to_team, "key", key, NULL);
-        return -1;
-    }
-    size_t len = semo__encode_message(m, datagram);
-    int rc;
-    while ((rc = semo_link_send_datagram(&g_link, to_team, datagram, len)) == -2) {
-        /* Room comes with the gateway's acknowledgement: read the line for
-         * it here (a message behind it goes to the inbox, or is dropped and
-         * traced when the inbox is full: nothing else can take it now). */
-        feed(false, false);
-        semo_link_tick(&g_link, semo__board_now_ms());
-        wait_on_line(INT64_MAX);
+    /* The datagram goes where semo_link_send_datagram puts it, after the
+     * length byte and the destination: no frame longer than a slot can go. */
+    size_t to_len = strlen(to_team);
+    int rc = -1;
+    if (slot && to_len > 0 && to_len <= 255 && 1 + to_len + semo__encoded_size(m) <= SEMO_LINK_SEND_MAX) {
+        unsigned char *datagram = slot + 1 + to_len;
+        rc = semo_link_send_datagram(&g_link, to_team, datagram, semo__encode_message(m, datagram));
     }
     if (rc != 0) {
         semo_trace("comm_error", "to", to_team, "key", key, NULL);

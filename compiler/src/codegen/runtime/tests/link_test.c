@@ -3,6 +3,8 @@
  *   t MS          the time is now MS: write what is due
  *   b HEX         bytes from the line
  *   q KIND HEX    queue a reliable frame;   e KIND HEX   write an unreliable one
+ *   w KIND HEX    write the last queued frame again in place, if of KIND and
+ *                 not on the line yet (`none` otherwise)
  *   f FLAGS       what our Welcome says
  *   d TO HEX      semo_link_send_datagram of the datagram HEX to TO
  *   r             the line went away (semo_link_restart)
@@ -76,6 +78,17 @@ int main(void)
                 printf("refused\n");
             if (line[0] == 'q')
                 semo_link_tick(&g_link, now);
+        } else if (line[0] == 'w' && sscanf(line + 2, "%c", &kind) == 1) {
+            size_t n = hex_in(line + 4, g_buf, sizeof g_buf);
+            unsigned char *waiting = semo_link_waiting(&g_link, (unsigned char)kind);
+            if (!waiting)
+                printf("none\n");
+            else if (n > SEMO_LINK_SEND_MAX)
+                printf("refused\n");
+            else {
+                memcpy(waiting, g_buf, n);
+                semo_link_rewrite(&g_link, n);
+            }
         } else if (line[0] == 'd') {
             char to[256];
             int used = 0;
