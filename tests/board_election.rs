@@ -266,13 +266,29 @@ fn one_robot_per_board_kind_elects_one_leader_and_fails_over_when_its_qemu_is_ki
         if killed_at.is_none() && linux.is_some() {
             let lx_trace =
                 std::fs::read_to_string(&linux.as_ref().unwrap().trace).unwrap_or_default();
+            // Every robot counts its peers alive at its start, so following
+            // lm at first says nothing of the link: each follows lm and has
+            // heard its claim (a heartbeat saying `leader`) through the
+            // gateway and the broker, and lm has heard both.
+            let heard = |trace: &[Event], from: &str, leads: bool| {
+                trace.iter().any(|e| {
+                    field(e, "event") == "receive"
+                        && field(e, "from_robot") == from
+                        && field(e, "key") == "Crew.__alive"
+                        && (!leads || field(e, "value").starts_with("leader "))
+                })
+            };
+            let board = |robot: &str| {
+                whole_events(lines.get(robot).into_iter().flatten().map(String::as_str))
+            };
+            let (lm, st, lx) = (board("lm"), board("st"), whole_events(lx_trace.lines()));
             let follows_lm =
                 |trace: &[Event]| leaders(trace).last().map(String::as_str) == Some("lm");
-            let all_follow = ["lm", "st"].iter().all(|robot| {
-                follows_lm(&whole_events(
-                    lines.get(*robot).into_iter().flatten().map(String::as_str),
-                ))
-            }) && follows_lm(&whole_events(lx_trace.lines()));
+            let all_follow = [&lm, &st, &lx].into_iter().all(|t| follows_lm(t))
+                && heard(&st, "lm", true)
+                && heard(&lx, "lm", true)
+                && heard(&lm, "st", false)
+                && heard(&lm, "lx", false);
             if all_follow {
                 fleet.processes.kill(qemus["lm"]);
                 killed_at = Some(qemu::unix_ms());
