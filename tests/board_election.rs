@@ -6,7 +6,8 @@
 //! `linux-sim` process on the same broker. One `semo build --sim` builds
 //! each robot for the platform the project file names. The election is
 //! `lowest_id`: lm, the first in formation order, leads; its QEMU is killed
-//! once all three follow it, and st, the next, takes over.
+//! once all three follow it and st and lx have heard its claim, and st, the
+//! next, takes over (under a higher term).
 //!
 //! What must hold, from the robots' traces: every robot's leaders in order
 //! (its `leader` events) are the ones `semo simulate` gives it on the same
@@ -16,7 +17,8 @@
 //! Instants are the traces' mission times, each robot's put on one clock
 //! by its mission time 0: a board's is the gateway's welcome (the instant
 //! its `start` line was read, at or after it was written), the Linux
-//! robot's its `--start-at`. What is compared is orders, never durations:
+//! robot's its `--start-at`; lm leads until the instant its kill returned
+//! (after it died). What is compared is orders, never durations:
 //! the deadline only ends a test that would otherwise hang.
 //!
 //! Skipped with a message without arm-none-eabi-gcc, qemu-system-arm or
