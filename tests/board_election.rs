@@ -265,9 +265,10 @@ fn one_robot_per_board_kind_elects_one_leader_and_fails_over_when_its_qemu_is_ki
             "the boards' traces waited past {LIMIT:?}: {lines:#?}\nthe gateway said:\n{}",
             std::fs::read_to_string(&gateway_log).unwrap_or_default()
         );
-        if killed_at.is_none() && linux.is_some() {
-            let lx_trace =
-                std::fs::read_to_string(&linux.as_ref().unwrap().trace).unwrap_or_default();
+        if killed_at.is_none()
+            && let Some(started) = &linux
+        {
+            let lx_trace = std::fs::read_to_string(&started.trace).unwrap_or_default();
             // Every robot counts its peers alive at its start, so following
             // lm at first says nothing of the link: each follows lm and has
             // heard its claim (a heartbeat saying `leader`) through the
