@@ -8,6 +8,7 @@ pub mod mosquitto;
 pub mod mqtt;
 pub mod proxy;
 pub mod python;
+pub mod qemu;
 pub mod robots;
 pub mod swap;
 
