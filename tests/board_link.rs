@@ -32,12 +32,12 @@
 mod support;
 
 use semo_server::live::{self, Status};
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 use support::mqtt::Fleet;
+use support::qemu::{self, Board, LM3S6965, STM32F405, unix_ms};
 use support::robots::{self, Event, events, field, modes};
 
 /// A hang guard, not a timing tolerance.
@@ -50,24 +50,6 @@ fn scouting() -> PathBuf {
 fn scenario() -> PathBuf {
     support::repo_root().join("tests/fixtures/build/scouting.scenario.json")
 }
-
-/// A board the scouting `ti` is tested on: its simulation target and
-/// QEMU's machine.
-#[derive(Clone, Copy)]
-struct Board {
-    target: &'static str,
-    machine: &'static str,
-}
-
-const LM3S6965: Board = Board {
-    target: "cortex-m-sim",
-    machine: "lm3s6965evb",
-};
-
-const STM32F405: Board = Board {
-    target: "stm32f4-sim",
-    machine: "netduinoplus2",
-};
 
 /// `semo build` of the scouting mission for `board` with the scenario;
 /// `make` of ti's folder at `-Wpedantic -Werror`; its ELF file.
@@ -110,35 +92,9 @@ fn board_ti_on(out: &Path, board: Board, scenario: &Path) -> PathBuf {
 /// served on `link_port`; its trace lines come through the receiver as
 /// they are written.
 fn qemu(elf: &Path, board: Board, link_port: u16) -> (Child, mpsc::Receiver<String>) {
-    let mut child = Command::new("qemu-system-arm")
-        .args(["-M", board.machine, "-display", "none", "-monitor", "none"])
-        .args(["-semihosting", "-serial", "stdio", "-serial"])
-        .arg(format!("tcp:127.0.0.1:{link_port},server,nowait"))
-        .arg("-kernel")
-        .arg(elf)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("qemu-system-arm starts");
-    let stdout = child.stdout.take().unwrap();
     let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stdout).lines() {
-            let Ok(line) = line else { return };
-            if tx.send(line).is_err() {
-                return;
-            }
-        }
-    });
+    let child = qemu::spawn_with(elf, board, link_port, move |line| tx.send(line).is_ok());
     (child, rx)
-}
-
-fn unix_ms() -> u64 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .expect("the clock is after 1970")
-        .as_millis() as u64
 }
 
 /// The board's trace lines until its `stop` (or its end), the first one

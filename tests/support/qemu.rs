@@ -57,6 +57,25 @@ pub fn spawn(
     robot: &str,
     lines: mpsc::Sender<Line>,
 ) -> Child {
+    let robot = robot.to_string();
+    spawn_with(elf, board, link_port, move |text| {
+        let line = Line {
+            robot: robot.clone(),
+            read_at_unix_ms: unix_ms(),
+            text,
+        };
+        lines.send(line).is_ok()
+    })
+}
+
+/// QEMU as [`spawn`] starts it, each trace line handed to `line` as it is
+/// read, until QEMU ends or `line` says no more.
+pub fn spawn_with(
+    elf: &Path,
+    board: Board,
+    link_port: u16,
+    mut line: impl FnMut(String) -> bool + Send + 'static,
+) -> Child {
     let mut child = Command::new("qemu-system-arm")
         .args(["-M", board.machine, "-display", "none", "-monitor", "none"])
         .args(["-semihosting", "-serial", "stdio", "-serial"])
@@ -69,16 +88,10 @@ pub fn spawn(
         .spawn()
         .expect("qemu-system-arm starts");
     let stdout = child.stdout.take().expect("stdout is piped");
-    let robot = robot.to_string();
     std::thread::spawn(move || {
         for text in BufReader::new(stdout).lines() {
             let Ok(text) = text else { return };
-            let line = Line {
-                robot: robot.clone(),
-                read_at_unix_ms: unix_ms(),
-                text,
-            };
-            if lines.send(line).is_err() {
+            if !line(text) {
                 return;
             }
         }
