@@ -77,7 +77,10 @@ pub fn refine_checked_robots(build: &BuildInput<'_>, robots: super::Robots) -> R
     diagnostics.extend(found);
     // Names become folders, files and C identifiers: only plain identifiers.
     for program in &programs {
-        let span = robot_span(build, &program.robot);
+        // Looked up only for a diagnostic: finding each robot's declaration
+        // walks the teams' robots, and doing it for every robot cost the
+        // square of a swarm's robots.
+        let span = || robot_span(build, &program.robot);
         let names = [&program.team, &program.robot]
             .into_iter()
             .chain(program.tasks.iter().map(|t| &t.task))
@@ -94,7 +97,7 @@ pub fn refine_checked_robots(build: &BuildInput<'_>, robots: super::Robots) -> R
                 diagnostics.push(Diagnostic::new(
                     Code::OutputNameEscapes,
                     mission,
-                    span,
+                    span(),
                     format!(
                         "task `{}` (of robot `{}`) has the name of a task the generator adds: rename it in the catalog or strategy",
                         role.task, program.robot
@@ -107,7 +110,7 @@ pub fn refine_checked_robots(build: &BuildInput<'_>, robots: super::Robots) -> R
                 diagnostics.push(Diagnostic::new(
                     Code::OutputNameEscapes,
                     mission,
-                    span,
+                    span(),
                     format!(
                         "`{name}` (of robot `{}`) cannot name a file or C identifier: use letters, digits and `_` only",
                         program.robot

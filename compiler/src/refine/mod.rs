@@ -120,6 +120,7 @@ pub fn refine_robots(
         // W130 for a team: what every one of its robots gives.
         let mut names_no_task: Vec<Vec<Diagnostic>> = Vec::new();
         let mut team_programs = Vec::new();
+        let mut runners = robot::TeamRunners::default();
         for robot in selected {
             let (program, found) = robot::refine_robot(
                 input,
@@ -128,6 +129,7 @@ pub fn refine_robots(
                 crate::sema::TeamId(team_index as u32),
                 first_peer,
                 robot.index(),
+                &mut runners,
             );
             let (warned, found): (Vec<Diagnostic>, Vec<Diagnostic>) = found
                 .into_iter()

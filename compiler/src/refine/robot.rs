@@ -32,6 +32,7 @@ pub(super) fn refine_robot(
     team_id: TeamId,
     first_peer: usize,
     robot_index: usize,
+    runners: &mut TeamRunners,
 ) -> (Option<RobotProgram>, Vec<Diagnostic>) {
     let mission = &input.analysis.mission;
     let team = mission.team(team_id);
@@ -56,6 +57,7 @@ pub(super) fn refine_robot(
         current_service: None,
         arguments: Vec::new(),
         counted_within: Vec::new(),
+        runners,
         diagnostics: Vec::new(),
     };
     builder.build_modes();
@@ -167,8 +169,17 @@ struct Builder<'a, 'i> {
     /// The arms of counted groups the statement being refined is written
     /// in, outermost first (a nested statement splits only its arm's robots).
     counted_within: Vec<EnclosingArm>,
+    /// The team's robots that run each scope, shared by its robots.
+    runners: &'a mut TeamRunners,
     diagnostics: Vec<Diagnostic>,
 }
+
+/// The robots of one team that run each scope (by its span), found once for
+/// the team: every robot of the team asks for the same scopes, and a set
+/// made per robot (the `others` of a swarm's group statements hold every
+/// robot) cost the square of the team's robots.
+#[derive(Default)]
+pub(super) struct TeamRunners(HashMap<Span, Option<std::rc::Rc<BTreeSet<usize>>>>);
 
 impl<'i> Builder<'_, 'i> {
     /// The strategy files written for this robot's team, in file order.
@@ -388,9 +399,9 @@ impl Builder<'_, '_> {
             .iter()
             .map(|a| a.body.span)
             .chain(group.others.as_ref().map(|o| o.body.span));
-        let mut members = BTreeSet::new();
+        let mut members: BTreeSet<usize> = BTreeSet::new();
         for body in bodies.collect::<Vec<_>>() {
-            members.extend(self.runners_of(body).unwrap_or_default());
+            members.extend(self.runners_of(body).iter().flat_map(|r| r.iter()));
         }
         if !members.contains(&self.robot_index) || members.len() < 2 {
             return;
@@ -759,7 +770,7 @@ impl Builder<'_, '_> {
                 return ArmChoice::Leader {
                     body: &arm.body,
                     others,
-                    candidates: runners.into_iter().collect(),
+                    candidates: runners.iter().copied().collect(),
                 };
             }
             return ArmChoice::Static(Some(&arm.body));
@@ -778,27 +789,26 @@ impl Builder<'_, '_> {
     /// The robots of this robot's team that run the scope at `span`, as the
     /// checker recorded them (every context it was checked in). A body the
     /// checker did not record is an internal error.
-    fn runners_of(&mut self, span: Span) -> Option<BTreeSet<usize>> {
-        let mission = &self.input.analysis.mission;
-        let first = mission
-            .scopes
-            .partition_point(|s| s.span.start < span.start);
-        let scope = mission.scopes[first..]
-            .iter()
-            .take_while(|s| s.span.start == span.start)
-            .find(|s| s.span == span);
-        let Some(scope) = scope else {
-            self.internal_error(span, "the checker recorded no robots for this block");
-            return None;
-        };
-        Some(
-            scope
-                .runs
+    fn runners_of(&mut self, span: Span) -> Option<std::rc::Rc<BTreeSet<usize>>> {
+        let (mission, team) = (&self.input.analysis.mission, self.team_id);
+        let runners = self.runners.0.entry(span).or_insert_with(|| {
+            let first = mission
+                .scopes
+                .partition_point(|s| s.span.start < span.start);
+            let scope = mission.scopes[first..]
                 .iter()
-                .filter(|r| r.team == Some(self.team_id))
-                .flat_map(|r| r.robots.iter().map(|&i| i.index()))
-                .collect(),
-        )
+                .take_while(|s| s.span.start == span.start)
+                .find(|s| s.span == span)?;
+            let robots = (scope.runs.iter())
+                .filter(|r| r.team == Some(team))
+                .flat_map(|r| r.robots.iter().map(|&i| i.index()));
+            Some(std::rc::Rc::new(robots.collect()))
+        });
+        let runners = runners.clone();
+        if runners.is_none() {
+            self.internal_error(span, "the checker recorded no robots for this block");
+        }
+        runners
     }
 
     fn comm(&mut self, comm: &ast::Comm, span: Span, states: &mut Vec<State>, marks: &mut usize) {

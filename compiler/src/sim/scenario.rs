@@ -833,10 +833,7 @@ impl Reader<'_> {
     /// warning, not an error: one scenario may serve variants of a mission,
     /// not all of which read every value.
     fn unsampled(&self, v: &Value, robot: &str, value: &str) -> Option<ScenarioError> {
-        let mut sampled: Vec<&str> = self
-            .programs
-            .iter()
-            .filter(|p| p.robot == robot)
+        let mut sampled: Vec<&str> = (self.by_robot.get(robot).into_iter())
             .flat_map(|p| &p.tasks)
             .filter_map(|t| match &t.kind {
                 crate::refine::RoleKind::Sensor { values, .. } => Some(values),
@@ -998,10 +995,7 @@ impl Reader<'_> {
                 let is = value_text(is_value)?;
                 // Read as the catalog's type of the value, as the sensor task
                 // reads it (`semo_sim_sensor`): say so here, not by silence.
-                let kind = self
-                    .programs
-                    .iter()
-                    .filter(|p| p.robot == robot)
+                let kind = (self.by_robot.get(robot).into_iter())
                     .flat_map(|p| &p.control.slots)
                     .find_map(|s| match &s.source {
                         crate::refine::SlotSource::Sensor { port, .. } if *port == value => {
