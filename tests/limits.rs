@@ -10,7 +10,8 @@
 //! killed, and the test sees it. "In proportion" counts the instructions
 //! (valgrind's callgrind) that two sizes ten times apart add to the empty
 //! input's, against a bound of twelve: a quadratic path adds a hundred
-//! times more there, a linear one ten.
+//! times more there, a linear one ten. `semo simulate` is held the same
+//! way: what each doubling of a swarm's robots adds.
 
 mod support;
 
@@ -64,6 +65,11 @@ fn check_bounded(dir: &Path, paths: &[&str]) -> (i32, Vec<Diag>) {
 /// when valgrind is missing (skipped with a message unless
 /// `SEMO_VALGRIND_TESTS=require`, as CI sets).
 fn instructions(dir: &Path, args: &[&str]) -> Option<u64> {
+    instructions_and_output(dir, args).map(|(count, _)| count)
+}
+
+/// [`instructions`], with what `semo ARGS` printed and its exit status.
+fn instructions_and_output(dir: &Path, args: &[&str]) -> Option<(u64, Output)> {
     let out = std::process::Command::new("valgrind")
         .args(["--tool=callgrind", "--callgrind-out-file=/dev/null"])
         .arg(env!("CARGO_BIN_EXE_semo"))
@@ -86,7 +92,13 @@ fn instructions(dir: &Path, args: &[&str]) -> Option<u64> {
         .lines()
         .find_map(|line| line.split_once("Collected :"))
         .map(|(_, n)| n.trim().parse().expect("a count"));
-    Some(collected.unwrap_or_else(|| panic!("no count from callgrind: {stderr}")))
+    let count = collected.unwrap_or_else(|| panic!("no count from callgrind: {stderr}"));
+    let output = Output {
+        code: out.status.code().unwrap_or(-1),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: stderr.into_owned(),
+    };
+    Some((count, output))
 }
 
 /// Asserts that `semo ARGS` on the input `write(dir, n)` costs in
@@ -253,6 +265,82 @@ fn a_team_at_the_robot_limit_costs_little_per_statement() {
         e033.message.contains("ev_7 and 4087 more"),
         "{}",
         e033.message
+    );
+}
+
+// ---------------------------------------------------------------------------
+// Simulation.
+
+/// A scenario for [`swarm`] with `ev[count]`, naming every robot: each Ev3
+/// robot's services, the light the TurtleBots read (dark at once, bright at
+/// 600 ms: the team hides and comes back), an operator command to the team,
+/// a robot killed and restarted, and a partition between half the team and
+/// the rest. 1.2 s of mission time.
+fn swarm_scenario(count: usize) -> String {
+    let mut robots: Vec<String> = (0..count)
+        .map(|i| format!(r#""ev_{i}": {{"services": {{"move": 300, "scatter": 200}}}}"#))
+        .collect();
+    robots.extend((0..3).map(|i| {
+        format!(
+            r#""tb_{i}": {{"sensors": [{{"at": 0, "value": "LIGHTNESS", "is": "100"}}, {{"at": 600, "value": "LIGHTNESS", "is": "700"}}]}}"#
+        )
+    }));
+    let half: Vec<String> = (0..count / 2).map(|i| format!(r#""ev_{i}""#)).collect();
+    format!(
+        r#"{{"duration": 1200,
+ "robots": {{{}}},
+ "operator": [{{"at": 100, "to": "Guards", "value": "RC_CMD", "is": "x"}}],
+ "faults": [{{"at": 200, "kill": "ev_1"}}, {{"at": 500, "restart": "ev_1"}},
+            {{"partition": [["base", "tb_0", {}]], "from": 300, "until": 700}}]}}"#,
+        robots.join(",\n  "),
+        half.join(", ")
+    )
+}
+
+/// `semo simulate` as a user runs it (reading and refining the mission,
+/// reading the scenario, the run, the summary) costs in proportion to the
+/// robots: from 250 to 500 to 1,000 Ev3 robots, the second doubling adds at
+/// most 2.4 times what the first added (a linear cost adds twice as much,
+/// a quadratic one four times). Tables of the fleet built per robot or per
+/// message (a robot's scenario entry, its team's peers and heartbeat table,
+/// an operator command's robots, a partition's groups, the runners of each
+/// group statement, each robot's declaration) made it x3.39.
+#[test]
+fn simulating_twice_the_robots_costs_twice() {
+    let mut counts = Vec::new();
+    for count in [250, 500, 1000] {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        std::fs::write(dir.join("swarm.mission"), swarm(&count.to_string())).unwrap();
+        std::fs::write(dir.join("swarm.scenario.json"), swarm_scenario(count)).unwrap();
+        let Some((instructions, out)) =
+            instructions_and_output(dir, &["simulate", "swarm.mission"])
+        else {
+            return;
+        };
+        assert_eq!(out.code, 0, "{count}: {}{}", out.stdout, out.stderr);
+        // The example's other robots are four; the team hid and came back.
+        let head = format!("simulated {} robot(s) for 1200 ms", count + 4);
+        assert!(out.stdout.starts_with(&head), "{}", out.stdout);
+        assert!(
+            out.stdout
+                .contains("Guards/ev_0: PATROL@0 -> HIDE@500 -> PATROL@1000"),
+            "{}",
+            out.stdout
+        );
+        counts.push(instructions);
+    }
+    let [small, middle, large] = counts[..] else {
+        unreachable!()
+    };
+    let (first, second) = (middle.saturating_sub(small), large.saturating_sub(middle));
+    let ratio = second as f64 / first.max(1) as f64;
+    eprintln!(
+        "simulate: 250 robots {small}, 500 {middle}, 1000 {large} instructions; the doublings add {first} then {second} (x{ratio:.2})"
+    );
+    assert!(
+        ratio <= 2.4,
+        "the second doubling of the robots added x{ratio:.2} the first's instructions ({first} then {second})"
     );
 }
 

@@ -29,7 +29,7 @@
 //! the reference the skipping is tested against), so the trace is the same.
 
 use super::loss::LossDraws;
-use super::scenario::{Command, DEFAULT_SERVICE_MS, FaultKind, Scenario};
+use super::scenario::{Command, DEFAULT_SERVICE_MS, FaultKind, RobotWorld, Scenario};
 use super::trace::{Fields, TraceEvent};
 use crate::fasthash::FastMap;
 use crate::refine::SENSOR_PERIOD_MS;
@@ -41,6 +41,7 @@ use crate::refine::{
     ServiceMachineId, SlotId, SlotSource, StateId, StateKind, SyncPointId, counted_allocation,
     members_sharing_arms,
 };
+use fleet::Fleet;
 use smallvec::smallvec;
 use std::cell::OnceCell;
 use std::collections::{BinaryHeap, HashMap, VecDeque};
@@ -48,6 +49,7 @@ use std::rc::Rc;
 
 mod battery;
 mod explore;
+mod fleet;
 mod loops;
 mod races;
 mod shared;
@@ -251,66 +253,6 @@ struct Message {
     /// What a heartbeat's text says, read once for all the robots it
     /// reaches (`Heard::parse` of the same text gives the same words).
     said: OnceCell<Heard>,
-}
-
-/// A robot's names as its messages and trace carry them, shared rather
-/// than copied (most of a large run's trace is messages), and each text
-/// once for the whole run ([`Interner`]): a message's key is then the same
-/// `Rc` as the key a robot listens for, which compares equal without
-/// reading either text (a swarm's receptions compared them byte by byte).
-struct Names {
-    team: Rc<str>,
-    /// Its name (messages carry it; its heartbeat's value is its name as text).
-    heartbeat: Rc<str>,
-    alive_key: Rc<str>,
-    sync_key: Rc<str>,
-    /// The key of its team's broadcast events (`refine::event_key`).
-    event_key: Rc<str>,
-    /// Per outgoing message: (to, key).
-    outgoing: Vec<(Rc<str>, Rc<str>)>,
-    /// Per incoming message: (from team, key).
-    incoming: Vec<(Rc<str>, Rc<str>)>,
-    /// Per subscribed group: its key.
-    subscribed: Vec<Rc<str>>,
-}
-
-impl Names {
-    fn new(program: &RobotProgram, intern: &mut Interner) -> Names {
-        let m = &program.control;
-        Names {
-            team: intern.text(&program.team),
-            heartbeat: intern.text(&program.robot),
-            alive_key: intern.text(&crate::refine::protocol::alive_key(program)),
-            sync_key: intern.text(&crate::refine::protocol::sync_key(program)),
-            event_key: intern.text(&crate::refine::event_key(&program.team)),
-            outgoing: m
-                .outgoing
-                .iter()
-                .map(|o| (intern.text(&o.to_team), intern.text(&o.key)))
-                .collect(),
-            incoming: m
-                .incoming
-                .iter()
-                .map(|i| (intern.text(&i.from_team), intern.text(&i.key)))
-                .collect(),
-            subscribed: m.subscribed.iter().map(|g| intern.text(g)).collect(),
-        }
-    }
-}
-
-/// One `Rc` per distinct text of the programs' names and keys.
-#[derive(Default)]
-struct Interner(HashMap<String, Rc<str>>);
-
-impl Interner {
-    fn text(&mut self, text: &str) -> Rc<str> {
-        if let Some(shared) = self.0.get(text) {
-            return shared.clone();
-        }
-        let shared: Rc<str> = text.into();
-        self.0.insert(text.to_string(), shared.clone());
-        shared
-    }
 }
 
 /// The slots a robot's control task reads its inputs into at each firing
@@ -523,11 +465,9 @@ pub struct Sim<'p> {
     /// numbered after the scenario's: each one as a scenario command given
     /// once at that instant.
     commands: Vec<Command>,
-    /// The robots a message to a team or robot name goes to (`semo_comm_send`'s
-    /// peer loop, computed once).
-    recipients: Rc<FastMap<String, Rc<[usize]>>>,
-    /// Per robot (program).
-    names: Rc<[Names]>,
+    /// The fleet's tables (names, teams, recipients, worlds, network),
+    /// made once and shared by every robot and clone.
+    fleet: Rc<Fleet>,
     /// Per robot (program): the slots a firing reads its inputs into.
     inputs: Rc<[Inputs]>,
     /// The last control firing handled: (time, chain).
@@ -553,16 +493,19 @@ pub struct Sim<'p> {
     /// A send's arrivals (instant, order, robot, its epoch), kept between
     /// sends for its room: a send allocates no list of its own.
     arrivals: Vec<(i64, u64, usize, u32)>,
-    /// The robots of one of its instants, gathered here and copied into
-    /// their entry's list at once (collected straight, the list was made
-    /// twice: grown as a `Vec`, then copied into the `Rc`).
-    reached: Vec<(usize, u32)>,
 }
 
 impl<'p> Robot<'p> {
-    fn new(program: &'p RobotProgram, scenario: &Scenario, at: i64, epoch: u32) -> Robot<'p> {
+    /// Robot `program` started at `at`, in its `epoch`th process; `world`:
+    /// its entry of the scenario; `team`: the peers of its team.
+    fn new(
+        program: &'p RobotProgram,
+        world: Option<&RobotWorld>,
+        team: std::ops::Range<usize>,
+        at: i64,
+        epoch: u32,
+    ) -> Robot<'p> {
         let m = &program.control;
-        let world = scenario.robots.iter().find(|w| w.robot == program.robot);
         let sensor_series = m
             .slots
             .iter()
@@ -669,7 +612,7 @@ impl<'p> Robot<'p> {
             pending_mode: None,
             events: VecDeque::new(),
             last_heartbeat: at - m.heartbeat_ms,
-            heard: Hearing::new(team_peers(program)),
+            heard: Hearing::new(team),
             leading: false,
             said: None,
             term: 0,
@@ -738,12 +681,12 @@ fn inbox_channels(program: &RobotProgram) -> Vec<Option<usize>> {
 
 impl<'p> Sim<'p> {
     pub fn new(programs: &'p [RobotProgram], scenario: &'p Scenario, options: &Options) -> Sim<'p> {
+        let fleet = Fleet::new(programs, scenario);
         let mut sim = Sim {
             programs,
             scenario,
-            robots: programs
-                .iter()
-                .map(|p| Robot::new(p, scenario, 0, 0))
+            robots: (programs.iter().enumerate())
+                .map(|(r, p)| Robot::new(p, fleet.world(scenario, r), fleet.team(r), 0, 0))
                 .collect(),
             queue: BinaryHeap::new(),
             queued: 0,
@@ -753,14 +696,7 @@ impl<'p> Sim<'p> {
             trace: Vec::new(),
             operator_next: scenario.operator.iter().map(|c| c.first).collect(),
             commands: Vec::new(),
-            recipients: Rc::new(recipients(programs)),
-            names: {
-                let mut intern = Interner::default();
-                programs
-                    .iter()
-                    .map(|p| Names::new(p, &mut intern))
-                    .collect()
-            },
+            fleet: Rc::new(fleet),
             inputs: Rc::from([]),
             last_fire: (-1, 0),
             every_firing: options.every_firing,
@@ -771,7 +707,6 @@ impl<'p> Sim<'p> {
             channel_full: "channel full".into(),
             races: None,
             arrivals: Vec::new(),
-            reached: Vec::new(),
         };
         sim.inputs = sim.robots.iter().map(Inputs::of).collect();
         for r in 0..programs.len() {
@@ -998,9 +933,14 @@ impl<'p> Sim<'p> {
             sent_at: self.now,
             said: OnceCell::new(),
         });
-        for r in 0..self.robots.len() {
-            let p = self.robots[r].program;
-            if (p.robot == command.to || p.team == command.to) && self.robots[r].alive {
+        // The robots of the team or the robot named, in formation order.
+        let fleet = self.fleet.clone();
+        for &r in fleet
+            .recipients(&command.to)
+            .into_iter()
+            .flat_map(|to| to.iter())
+        {
+            if self.robots[r].alive {
                 self.deliver(r, &message);
             }
         }
@@ -1044,7 +984,9 @@ impl<'p> Sim<'p> {
     pub(crate) fn restart(&mut self, r: usize) {
         if !self.robots[r].alive {
             let epoch = self.robots[r].epoch + 1;
-            self.robots[r] = Robot::new(self.robots[r].program, self.scenario, self.now, epoch);
+            let (world, team) = (self.fleet.world(self.scenario, r), self.fleet.team(r));
+            let program = self.robots[r].program;
+            self.robots[r] = Robot::new(program, world, team, self.now, epoch);
             self.running += 1;
             self.emit(r, "fault", smallvec![("fault", "restart".into())]);
             self.start(r);
@@ -1052,7 +994,7 @@ impl<'p> Sim<'p> {
     }
 
     fn index_of(&self, robot: &str) -> Option<usize> {
-        self.programs.iter().position(|p| p.robot == robot)
+        self.fleet.index_of(robot)
     }
 
     /// The robot stops (its mission ended, or the run did): the calls under
@@ -1208,13 +1150,14 @@ impl<'p> Sim<'p> {
             return;
         }
         let program = self.robots[r].program;
-        let Some(targets) = self.recipients.get(&*to).cloned() else {
+        let fleet = self.fleet.clone();
+        let Some(targets) = fleet.recipients(&to) else {
             return;
         };
         let message = Rc::new(Message {
             publish,
-            from_team: self.names[r].team.clone(),
-            from_robot: self.names[r].heartbeat.clone(),
+            from_team: fleet.names[r].team.clone(),
+            from_robot: fleet.names[r].heartbeat.clone(),
             from_peer: Some(program.self_peer),
             key,
             value,
@@ -1225,7 +1168,6 @@ impl<'p> Sim<'p> {
         // order; those reached at the same instant share one entry, under
         // the first one's number (nothing else is numbered between them).
         let mut arrivals = std::mem::take(&mut self.arrivals);
-        let mut reached = std::mem::take(&mut self.reached);
         for &dst in targets.iter() {
             if dst == r {
                 continue;
@@ -1236,31 +1178,28 @@ impl<'p> Sim<'p> {
             self.seq += 1;
             arrivals.push((self.now + latency, self.seq, dst, self.robots[dst].epoch));
         }
-        while let Some(&(at, tie, _, _)) = arrivals.first() {
-            reached.clear();
-            reached.extend(
-                arrivals
-                    .iter()
-                    .filter(|a| a.0 == at)
-                    .map(|&(_, _, dst, epoch)| (dst, epoch)),
-            );
-            let to: Rc<[(usize, u32)]> = Rc::from(reached.as_slice());
-            arrivals.retain(|a| a.0 != at);
+        // By instant, each instant's robots in the order they were sent
+        // to (the numbers are distinct), then one entry per instant: one
+        // pass, not one over the arrivals per instant. Mostly sorted already
+        // (one latency), and sorted in place (a stable sort takes room).
+        arrivals.sort_unstable_by_key(|&(at, tie, _, _)| (at, tie));
+        for instant in arrivals.chunk_by(|a, b| a.0 == b.0) {
+            let (at, tie, _, _) = instant[0];
+            let to: Rc<[(usize, u32)]> = instant.iter().map(|&(_, _, dst, e)| (dst, e)).collect();
             let message = message.clone();
             self.queue
                 .push(Queued::new(at, Event::Deliver { to, message }, tie));
             self.queued += 1;
         }
+        arrivals.clear();
         self.arrivals = arrivals;
-        self.reached = reached;
     }
 
     /// The latency of a message from `a` to `b` now, or `None` when it is lost.
     fn link(&mut self, a: usize, b: usize, key: &str) -> Option<i64> {
         let (na, nb) = (&self.programs[a].robot, &self.programs[b].robot);
-        let pair = |(x, y): &(String, String)| (x == na && y == nb) || (x == nb && y == na);
         let network = &self.scenario.network;
-        let link = network.links.iter().find(|l| pair(&l.between));
+        let link = self.fleet.link(a, b).map(|l| &network.links[l]);
         let mut latency = link
             .and_then(|l| l.latency_ms)
             .unwrap_or(network.latency_ms);
@@ -1277,33 +1216,7 @@ impl<'p> Sim<'p> {
                 }
             }
         }
-        for fault in &self.scenario.faults {
-            match &fault.kind {
-                FaultKind::Drop {
-                    between,
-                    from,
-                    until,
-                } if pair(between) && (*from..*until).contains(&now) => return None,
-                FaultKind::Delay {
-                    between,
-                    by,
-                    from,
-                    until,
-                } if pair(between) && (*from..*until).contains(&now) => latency += by,
-                FaultKind::Partition {
-                    groups,
-                    from,
-                    until,
-                } if (*from..*until).contains(&now) => {
-                    let group_of =
-                        |n: &String| groups.iter().position(|g| g.iter().any(|m| m == n));
-                    if group_of(na) != group_of(nb) {
-                        return None;
-                    }
-                }
-                _ => {}
-            }
-        }
+        latency += self.fleet.faults(a, b, now)?;
         if self.losses.lost(na, nb, key, loss) {
             return None;
         }
@@ -1402,7 +1315,7 @@ impl<'p> Sim<'p> {
         let robot = &mut self.robots[r];
         let m = &robot.program.control;
         // Keys and names compare as their interned `Rc`s (`Names`).
-        let names = &self.names[r];
+        let names = &self.fleet.names[r];
         if m.heartbeat && message.publish && message.key == names.alive_key {
             // A heartbeat's value is text ("leader 80 2"); anything else says nothing.
             let text = match &message.value {
@@ -1694,7 +1607,7 @@ impl<'p> Sim<'p> {
                 .collect()
         };
         for message in told {
-            let (to, key) = self.names[r].outgoing[message.index()].clone();
+            let (to, key) = self.fleet.names[r].outgoing[message.index()].clone();
             self.comm_send(r, to, false, key, Some(Value::text(event)));
         }
         self.catch_event(r, event);
@@ -1884,7 +1797,7 @@ impl<'p> Sim<'p> {
                     value
                 }
             };
-            let names = &self.names[r];
+            let names = &self.fleet.names[r];
             let (team, key) = (names.team.clone(), names.alive_key.clone());
             self.comm_send(r, team, true, key, Some(value));
             self.group_update(r);
@@ -2146,7 +2059,7 @@ impl<'p> Sim<'p> {
                         self.robots[r].groups[group.index()] = Some(sent.clone());
                     }
                     let publish = m.outgoing_message(item.message).publish;
-                    let (to, key) = self.names[r].outgoing[item.message.index()].clone();
+                    let (to, key) = self.fleet.names[r].outgoing[item.message.index()].clone();
                     self.comm_send(r, to, publish, key, sent);
                 }
                 self.region(r, i).pc = next;
@@ -2327,7 +2240,7 @@ impl<'p> Sim<'p> {
                     let region = self.region(r, i);
                     region.marks[mark.index()] = now;
                     region.phase = 1;
-                    let names = &self.names[r];
+                    let names = &self.fleet.names[r];
                     let (team, key) = (names.team.clone(), names.sync_key.clone());
                     self.comm_send(r, team, false, key, Some(Value::text(&value)));
                 }
@@ -2676,13 +2589,17 @@ impl Leader {
 /// team, the only robots whose heartbeats reach it (published to the team
 /// under its alive key), so that each robot of a swarm does not hold a
 /// table of the whole swarm; a peer of another team heard is kept aside.
+/// The team's table is made at the first heartbeat heard: only robots that
+/// take heartbeats (`ControlMachine::heartbeat`) hear any, and a table per
+/// robot made when it starts was the square of a team's robots.
 /// A peer never heard reads as the C's static table: heard at mission
 /// time 0, claiming nothing, battery unknown.
 #[derive(Clone, Debug)]
 struct Hearing {
-    /// The peer of `team[0]`.
-    first: usize,
-    team: Vec<Heard>,
+    /// The peers of the team.
+    team: std::ops::Range<usize>,
+    /// Per peer of the team, in order; empty until one is heard.
+    heard: Vec<Heard>,
     /// Other peers heard, in peer order.
     others: Vec<(PeerId, Heard)>,
 }
@@ -2690,31 +2607,34 @@ struct Hearing {
 impl Hearing {
     /// About the bytes it holds (`Sim::approx_bytes`).
     fn approx_bytes(&self) -> usize {
-        self.team.len() * std::mem::size_of::<Heard>()
+        self.heard.len() * std::mem::size_of::<Heard>()
             + self.others.len() * std::mem::size_of::<(PeerId, Heard)>()
     }
 
     fn new(team: std::ops::Range<usize>) -> Hearing {
         Hearing {
-            first: team.start,
-            team: vec![Heard::NEVER; team.len()],
+            team,
+            heard: Vec::new(),
             others: Vec::new(),
         }
     }
 
     fn get(&self, peer: PeerId) -> Heard {
-        match self.team.get(peer.index().wrapping_sub(self.first)) {
-            Some(heard) => *heard,
-            None => self
-                .others
-                .binary_search_by_key(&peer, |(p, _)| *p)
-                .map_or(Heard::NEVER, |i| self.others[i].1),
+        if self.team.contains(&peer.index()) {
+            let heard = self.heard.get(peer.index() - self.team.start);
+            return heard.copied().unwrap_or(Heard::NEVER);
         }
+        self.others
+            .binary_search_by_key(&peer, |(p, _)| *p)
+            .map_or(Heard::NEVER, |i| self.others[i].1)
     }
 
     fn set(&mut self, peer: PeerId, heard: Heard) {
-        if let Some(h) = self.team.get_mut(peer.index().wrapping_sub(self.first)) {
-            *h = heard;
+        if self.team.contains(&peer.index()) {
+            if self.heard.is_empty() {
+                self.heard = vec![Heard::NEVER; self.team.len()];
+            }
+            self.heard[peer.index() - self.team.start] = heard;
             return;
         }
         match self.others.binary_search_by_key(&peer, |(p, _)| *p) {
@@ -2723,27 +2643,16 @@ impl Hearing {
         }
     }
 
-    /// Every peer kept, in peer order (a peer not kept was never heard).
+    /// Every peer of the team and every other peer kept, in peer order (a
+    /// peer not kept was never heard).
     fn iter(&self) -> impl Iterator<Item = (PeerId, Heard)> + '_ {
-        let (first, end) = (self.first, self.first + self.team.len());
+        let team = self.team.clone();
+        let (first, end) = (team.start, team.end);
         let before = self.others.iter().filter(move |(p, _)| p.index() < first);
         let after = self.others.iter().filter(move |(p, _)| p.index() >= end);
-        let team = (first..).map(PeerId::new).zip(self.team.iter().copied());
+        let team = team.map(move |p| (PeerId::new(p), self.get(PeerId::new(p))));
         before.copied().chain(team).chain(after.copied())
     }
-}
-
-/// The peers of `program`'s team: its run of peers (teams are in
-/// formation order), found from its own place.
-fn team_peers(program: &RobotProgram) -> std::ops::Range<usize> {
-    let (peers, me) = (&program.peers, program.self_peer.index());
-    let same = |p: &usize| peers[*p].0 == program.team;
-    let start = (0..me).rev().take_while(same).last().unwrap_or(me);
-    let end = (me..peers.len())
-        .take_while(same)
-        .last()
-        .map_or(me, |p| p + 1);
-    start..end
 }
 
 /// What a robot's last heartbeat said (`comm_heartbeat` in the C).
@@ -2845,19 +2754,6 @@ impl Sim<'_> {
 /// `semo_sim_battery`): the scenario's battery points at `now`, rounded.
 fn own_battery(robot: &Robot<'_>, now: i64) -> Option<i64> {
     battery_level(&robot.battery, now).map(|l| l.round() as i64)
-}
-
-/// For every team and robot name, the robots (program indices) a message
-/// to that name goes to: the robots of the team, or the robot itself.
-fn recipients(programs: &[RobotProgram]) -> FastMap<String, Rc<[usize]>> {
-    let mut map: FastMap<String, Vec<usize>> = FastMap::default();
-    for (i, p) in programs.iter().enumerate() {
-        map.entry(p.team.clone()).or_default().push(i);
-        if p.robot != p.team {
-            map.entry(p.robot.clone()).or_default().push(i);
-        }
-    }
-    map.into_iter().map(|(k, v)| (k, v.into())).collect()
 }
 
 /// The actuator command name a task runs (`control.rs`'s `actuator_name`).

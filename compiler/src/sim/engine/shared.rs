@@ -114,7 +114,7 @@ impl Sim<'_> {
             return;
         };
         if to == program.self_peer {
-            let team = self.names[r].team.clone();
+            let team = self.fleet.names[r].team.clone();
             self.comm_send(r, team, false, g.value_key.as_str().into(), value);
         } else {
             let owner: Rc<str> = program.peer(to).1.as_str().into();
