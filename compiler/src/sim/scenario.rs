@@ -638,6 +638,7 @@ pub fn parse(text: &str, programs: &[RobotProgram]) -> Result<Scenario> {
         programs,
         by_robot,
         teams,
+        every_mode: std::cell::OnceCell::new(),
     }
     .scenario(&root)
 }
@@ -649,6 +650,9 @@ struct Reader<'a> {
     /// would cost the square of its robots).
     by_robot: FastMap<&'a str, &'a RobotProgram>,
     teams: FastSet<&'a str>,
+    /// The modes of every team, made at the first expectation about every
+    /// robot (`all_end_in`): one walk of the fleet, not one per expectation.
+    every_mode: std::cell::OnceCell<FastSet<&'a str>>,
 }
 
 fn object<'v>(v: &'v Value, what: &str, keys: &[&str]) -> Result<&'v [(String, Value)]> {
@@ -873,20 +877,29 @@ impl Reader<'_> {
     /// A mode of `robot`'s team (or of any team when `robot` is `None`).
     fn mode(&self, v: &Value, key: &str, robot: Option<&str>) -> Result<String> {
         let mode = name(v, key)?;
-        let programs: Vec<&RobotProgram> = match robot {
-            Some(robot) => self.by_robot.get(robot).copied().into_iter().collect(),
-            None => self.programs.iter().collect(),
+        let mut known: Vec<&str> = match robot {
+            Some(robot) => {
+                let modes = self
+                    .by_robot
+                    .get(robot)
+                    .map_or(&[][..], |p| &p.control.modes[..]);
+                if modes.iter().any(|m| m.name == mode) {
+                    return Ok(mode.to_string());
+                }
+                modes.iter().map(|m| m.name.as_str()).collect()
+            }
+            None => {
+                let every_mode = self.every_mode.get_or_init(|| {
+                    (self.programs.iter())
+                        .flat_map(|p| p.control.modes.iter().map(|m| m.name.as_str()))
+                        .collect()
+                });
+                if every_mode.contains(mode) {
+                    return Ok(mode.to_string());
+                }
+                every_mode.iter().copied().collect()
+            }
         };
-        if programs
-            .iter()
-            .any(|p| p.control.modes.iter().any(|m| m.name == mode))
-        {
-            return Ok(mode.to_string());
-        }
-        let mut known: Vec<&str> = programs
-            .iter()
-            .flat_map(|p| p.control.modes.iter().map(|m| m.name.as_str()))
-            .collect();
         known.sort_unstable();
         known.dedup();
         // No did-you-mean: modes share their `_MODE` endings, so the
