@@ -1135,6 +1135,67 @@ fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
     assert_eq!(lost["started"], running["started"], "{lost}");
 }
 
+/// `tests/fixtures/counted_groups/alarm.mission` over MQTT: five robots in
+/// two rooms, until an operator's `fire` to tb_3 makes it throw `fire` to
+/// its room, which goes to FIGHT (no counted groups there). Each robot's
+/// last status says its groups as its trace's last `allocated` does while
+/// it searches, and none once in FIGHT: a new mode starts with none.
+#[test]
+fn a_robots_status_has_its_counted_group_until_its_mode_changes() {
+    let Some(mut fleet) = Fleet::start("mqtt-status-groups") else {
+        return;
+    };
+    let port = fleet.port;
+    let fixture = repo_root().join("tests/fixtures/counted_groups/alarm.mission");
+    let folders = support::mqtt::build(&fixture, &fleet.out, &[]);
+    let scenario = fleet.out.join("alarm.scenario.json");
+    std::fs::write(
+        &scenario,
+        r#"{"duration": 3000, "operator": [{"at": 1500, "to": "tb_3", "value": "RC_CMD", "is": "fire"}]}"#,
+    )
+    .unwrap();
+    let traces = fleet.run_all(&folders, &scenario, "alarm", &[]);
+    let mut fighting = 0;
+    for (robot, events) in &traces {
+        let out = Command::new("mosquitto_sub")
+            .args(["-h", "127.0.0.1", "-p", &port.to_string()])
+            .args(["-t", &format!("semo/alarm/default/status/{robot}")])
+            .args(["-C", "1", "-W", "3", "--retained-only"])
+            .output()
+            .expect("mosquitto_sub runs (Debian mosquitto-clients)");
+        let payload = String::from_utf8_lossy(&out.stdout);
+        let status = semo_server::live::Status::decode(robot, payload.trim().as_bytes())
+            .unwrap_or_else(|| panic!("{robot}: no status: {payload}"));
+        assert_eq!(status.state, "stopped", "{payload}");
+        let last = events
+            .iter()
+            .rfind(|e| field(e, "event") == "allocated")
+            .map(|e| {
+                (
+                    field(e, "name").to_string(),
+                    field(e, "alive").parse().unwrap(),
+                )
+            });
+        match modes(events).last().map(String::as_str) {
+            Some("FIGHT") => {
+                fighting += 1;
+                assert_eq!(status.groups, [], "{robot}: {payload}");
+                assert!(!payload.contains("\"groups\""), "{payload}");
+            }
+            Some("SEARCH") => {
+                let last = last.unwrap_or_else(|| panic!("{robot} was allocated"));
+                assert!(last.0.starts_with("Room"), "{robot}: {last:?}");
+                assert_eq!(status.groups, [last], "{robot}: {payload}");
+            }
+            other => panic!("{robot} ends in {other:?}"),
+        }
+    }
+    assert!(
+        (2..5).contains(&fighting),
+        "tb_3's room fights, the other room searches on: {fighting} fighting"
+    );
+}
+
 /// The burst mission (`tests/fixtures/messages`: twenty sends at once, pass
 /// after pass, a listener that takes every one) over MQTT, with the
 /// talker's sending made to last `sending_ms` and the listener to run
