@@ -1135,6 +1135,90 @@ fn each_robot_keeps_a_retained_status_and_a_killed_one_is_lost() {
     assert_eq!(lost["started"], running["started"], "{lost}");
 }
 
+/// `tests/fixtures/counted_groups/alarm.mission` over MQTT: five robots in
+/// two rooms, until an operator's `fire` to tb_3 makes it throw `fire` to
+/// its room, which goes to FIGHT (no counted groups there). Each robot's
+/// last status says its groups as its trace's last `allocated` does while
+/// it searches, and none once in FIGHT: a new mode starts with none. Built
+/// with the address and undefined-behaviour sanitizers: the status's list
+/// of groups is kept without a report.
+#[test]
+fn a_robots_status_has_its_counted_group_until_its_mode_changes() {
+    let Some(mut fleet) = Fleet::start("mqtt-status-groups") else {
+        return;
+    };
+    let port = fleet.port;
+    let fixture = repo_root().join("tests/fixtures/counted_groups/alarm.mission");
+    let folders = support::mqtt::build_with(
+        &fixture,
+        &fleet.out,
+        &[],
+        "gcc",
+        &format!("{SANITIZED} -fsanitize=address,undefined -fno-sanitize-recover=all"),
+    );
+    let scenario = fleet.out.join("alarm.scenario.json");
+    std::fs::write(
+        &scenario,
+        r#"{"duration": 3000, "operator": [{"at": 1500, "to": "tb_3", "value": "RC_CMD", "is": "fire"}]}"#,
+    )
+    .unwrap();
+    let env = [
+        ("ASAN_OPTIONS", "detect_leaks=1:abort_on_error=1"),
+        ("UBSAN_OPTIONS", "print_stacktrace=1:halt_on_error=1"),
+    ];
+    let started: Vec<Started> = folders
+        .iter()
+        .map(|folder| fleet.spawn_with(folder, &scenario, "alarm", &[], &env))
+        .collect();
+    let mut traces = BTreeMap::new();
+    for run in &started {
+        let stderr = fleet
+            .processes
+            .wait_success(run.index, &format!("{} (alarm)", run.robot));
+        assert!(stderr.trim().is_empty(), "{}: {stderr}", run.robot);
+        traces.insert(run.robot.clone(), read_trace(&run.trace));
+    }
+    let mut fighting = 0;
+    for (robot, events) in &traces {
+        let out = Command::new("mosquitto_sub")
+            .args(["-h", "127.0.0.1", "-p", &port.to_string()])
+            .args(["-t", &format!("semo/alarm/default/status/{robot}")])
+            .args(["-C", "1", "-W", "3", "--retained-only"])
+            .output()
+            .expect("mosquitto_sub runs (Debian mosquitto-clients)");
+        let payload = String::from_utf8_lossy(&out.stdout);
+        let status = semo_server::live::Status::decode(robot, payload.trim().as_bytes())
+            .unwrap_or_else(|| panic!("{robot}: no status: {payload}"));
+        assert_eq!(status.state, "stopped", "{payload}");
+        let last = events
+            .iter()
+            .rfind(|e| field(e, "event") == "allocated")
+            .map(|e| {
+                (
+                    field(e, "name").to_string(),
+                    field(e, "alive").parse().unwrap(),
+                )
+            });
+        match modes(events).last().map(String::as_str) {
+            Some("FIGHT") => {
+                fighting += 1;
+                assert_eq!(status.groups, [], "{robot}: {payload}");
+                assert!(!payload.contains("\"groups\""), "{payload}");
+            }
+            Some("SEARCH") => {
+                let last = last.unwrap_or_else(|| panic!("{robot} was allocated"));
+                assert!(last.0.starts_with("Room"), "{robot}: {last:?}");
+                assert_eq!(status.groups, [last], "{robot}: {payload}");
+            }
+            other => panic!("{robot} ends in {other:?}"),
+        }
+    }
+    assert!(
+        (2..5).contains(&fighting),
+        "tb_3's room fights, the other room searches on: {fighting} fighting"
+    );
+}
+
 /// The burst mission (`tests/fixtures/messages`: twenty sends at once, pass
 /// after pass, a listener that takes every one) over MQTT, with the
 /// talker's sending made to last `sending_ms` and the listener to run
@@ -2130,6 +2214,181 @@ fn the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor() {
         assert_eq!(stopped["stopped"], true);
         client.shutdown().await;
     });
+}
+
+/// The nested counted groups fixture's deployment: the crew's user and the
+/// operator, on a private broker at `port`.
+fn rooms_deployment(dir: &Path, port: u16) -> PathBuf {
+    let users = [("crew", "crew-secret"), ("operator", "operator-secret")];
+    password_files(dir, &users);
+    let file = dir.join("nested.deploy.toml");
+    std::fs::write(
+        &file,
+        format!(
+            "broker = \"mqtt://127.0.0.1:{port}\"\n\n[broker_config]\npassword_file = \"passwd\"\n\n[operator]\nuser = \"operator\"\npassword_file = \"operator.pw\"\n\n[teams.Crew]\nuser = \"crew\"\npassword_file = \"crew.pw\"\n"
+        ),
+    )
+    .unwrap();
+    file
+}
+
+/// The groups a monitor view shows of `robot`: `group=alive` each.
+fn groups_shown(view: &serde_json::Value, robot: &str) -> Vec<String> {
+    let groups = shown(view, robot)["groups"].as_array().cloned();
+    groups
+        .unwrap_or_default()
+        .iter()
+        .map(|g| format!("{}={}", g["group"].as_str().unwrap_or("?"), g["alive"]))
+        .collect()
+}
+
+/// `tests/fixtures/counted_groups/nested.mission` (six TurtleBots in two
+/// rooms of at least two, one sweeper in each room) built for MQTT and run
+/// as processes on a private broker, with the editor's monitor and the
+/// operator console watching: each shows every robot's counted groups from
+/// its status, and, once tb_0 (Room1's sweeper) is killed, the groups the
+/// others move to, as the robots' own `allocated` lines say.
+#[test]
+fn the_monitor_and_the_console_show_each_robots_counted_groups() {
+    let mission = repo_root().join("tests/fixtures/counted_groups/nested.mission");
+    let mut deploy = None;
+    let Some(mut fleet) = Fleet::start_configured("mqtt-monitor-groups", |broker_dir, port| {
+        let out = broker_dir
+            .parent()
+            .expect("the broker folder is in the test's");
+        let file = rooms_deployment(out, port);
+        let config = broker_config_for(out, &mission, &file);
+        deploy = Some(file);
+        config
+    }) else {
+        return;
+    };
+    let deploy = deploy.expect("configured");
+    let out = fleet.out.clone();
+    let folders =
+        support::mqtt::build(&mission, &out, &["--deploy", &deploy.display().to_string()]);
+    let processes = &mut fleet.processes;
+    let workspace = monitor_workspace(&out, &deploy, std::slice::from_ref(&mission));
+    let world = out.join("rooms.scenario.json");
+    std::fs::write(&world, r#"{"time_scale": 1, "duration": 1000000}"#).unwrap();
+
+    let mut console = Command::new(env!("CARGO_BIN_EXE_semo"))
+        .arg("operator")
+        .arg(&mission)
+        .arg("--deploy")
+        .arg(&deploy)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("semo operator starts");
+    let stdin = console.stdin.take().unwrap();
+    let stdout = console.stdout.take().unwrap();
+    let (lines_tx, lines) = std::sync::mpsc::channel::<String>();
+    std::thread::spawn(move || {
+        use std::io::BufRead;
+        for line in std::io::BufReader::new(stdout).lines() {
+            let Ok(line) = line else { break };
+            if lines_tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    processes.push(console);
+    lines
+        .recv_timeout(std::time::Duration::from_secs(30))
+        .expect("the console starts");
+
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap();
+    let mut robots = BTreeMap::new();
+    runtime.block_on(async {
+        let (mut client, uri, _) = start_monitor(&workspace, "nested.mission").await;
+        for folder in &folders {
+            let robot = robot_name(folder);
+            let trace = out.join(format!("{robot}.jsonl"));
+            let child = support::mqtt::robot_on(folder, &world, &trace, 1)
+                .args(["--transport", "mqtt"])
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("the robot program starts");
+            robots.insert(robot, (processes.push(child), trace));
+        }
+        // Every robot in a room and a role; each room has at least two
+        // robots and exactly one sweeper.
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|all| {
+                all.len() == 6
+                    && all.iter().all(|r| {
+                        r["state"] == "running"
+                            && r["groups"].as_array().is_some_and(|g| g.len() == 2)
+                    })
+            })
+        })
+        .await;
+        for room in ["Room1", "Room2"] {
+            let members: Vec<Vec<String>> = robots
+                .keys()
+                .map(|r| groups_shown(&view, r))
+                .filter(|g| g[0].starts_with(&format!("{room}=")))
+                .collect();
+            assert!(members.len() >= 2, "{room}: {view}");
+            let sweepers = members.iter().filter(|g| g[1].starts_with("Sweeper=")).count();
+            assert_eq!(sweepers, 1, "{room}: {view}");
+        }
+
+        // tb_0 killed: the five left fill the rooms again (tb_1, tb_2, tb_5
+        // in Room1; tb_3, tb_4 in Room2) and Room1's first, tb_1, sweeps.
+        let (tb_0, _) = &robots["tb_0"];
+        processes.0[*tb_0].kill().unwrap();
+        processes.0[*tb_0].wait().unwrap();
+        let view = monitor_view(&mut client, |p| {
+            p["robots"].as_array().is_some_and(|all| {
+                let groups = |robot: &str| {
+                    let r = all.iter().find(|r| r["robot"] == robot);
+                    r.map(|r| r["groups"].clone()).unwrap_or_default()
+                };
+                all.iter().any(|r| r["robot"] == "tb_0" && r["lost"] == true)
+                    && groups("tb_1")[1]["group"] == "Sweeper"
+                    && groups("tb_2")
+                        == serde_json::json!([{"group": "Room1", "alive": 5}, {"group": "others", "alive": 3}])
+            })
+        })
+        .await;
+        assert_eq!(groups_shown(&view, "tb_1")[0], "Room1=6", "{view}");
+        let stopped = client
+            .request("semo/monitor/stop", serde_json::json!({ "uri": uri }))
+            .await
+            .unwrap();
+        assert_eq!(stopped["stopped"], true);
+        client.shutdown().await;
+    });
+    // The console printed tb_2's move, as its status said it.
+    let moved = std::iter::from_fn(|| lines.recv_timeout(std::time::Duration::from_secs(10)).ok())
+        .find(|l| {
+            l.starts_with("status tb_2: running ROOMS")
+                && l.contains(" groups Room1 (5 alive), others (3 alive)")
+        });
+    assert!(moved.is_some(), "the console shows tb_2 in Room1");
+    drop(stdin);
+    // The status says what the robot's trace says: tb_2's last `allocated`
+    // lines name Room1 (5 alive) and others (3 alive). SIGTERM ends it
+    // cleanly, its trace closed.
+    let (tb_2, trace) = &robots["tb_2"];
+    signal(&fleet.processes.0[*tb_2], "TERM");
+    fleet.processes.0[*tb_2].wait().unwrap();
+    let allocated: Vec<String> = read_trace(trace)
+        .iter()
+        .filter(|e| field(e, "event") == "allocated")
+        .map(|e| format!("{}={}", field(e, "name"), field(e, "alive")))
+        .collect();
+    assert!(
+        allocated.ends_with(&["Room1=5".to_string(), "others=3".to_string()]),
+        "{allocated:?}"
+    );
 }
 
 /// When each life's leading changes, in time order (`lives`: every robot's

@@ -448,12 +448,18 @@ struct View {
     printed: BTreeMap<String, String>,
 }
 
-/// What makes a robot's status worth a new line: its state, mode and
-/// leader, which an operator acts on. Its services (which come and go
+/// What makes a robot's status worth a new line: its state, mode, leader
+/// and counted groups, which an operator acts on. Its services (which come and go
 /// every period) and battery level are shown on that line, but their
 /// changes alone print nothing: three robots printed 45 lines in 10 s.
 fn what_counts(status: &Status) -> String {
-    format!("{} {} {}", status.state, status.mode, status.leader)
+    format!(
+        "{} {} {} {}",
+        status.state,
+        status.mode,
+        status.leader,
+        status.groups_text()
+    )
 }
 
 impl View {
@@ -497,10 +503,10 @@ impl View {
     }
 }
 
-/// `status ROBOT: STATE MODE [SERVICES] leader L battery B`.
+/// `status ROBOT: STATE MODE [SERVICES] leader L groups G (N alive), ... battery B`.
 fn status_line(robot: &str, status: &Status) -> String {
     format!(
-        "status {robot}: {} {}{}{}{}",
+        "status {robot}: {} {}{}{}{}{}",
         status.state,
         status.mode,
         match status.services_text().as_str() {
@@ -510,6 +516,10 @@ fn status_line(robot: &str, status: &Status) -> String {
         match status.leader.as_str() {
             "" => String::new(),
             l => format!(" leader {l}"),
+        },
+        match status.groups_text().as_str() {
+            "" => String::new(),
+            g => format!(" groups {g}"),
         },
         match status.battery {
             Some(level) => format!(" battery {level}"),
@@ -595,6 +605,17 @@ mod tests {
         assert_eq!(
             heard(view, "semo/scouting/r1/status/irobot", moving),
             "status irobot: running AUTO_MODE [Action=Wander] battery 70"
+        );
+        // A robot's counted groups are what it does: a change is a new line.
+        let room = br#"{"robot":"irobot","state":"running","started":"1000","mode":"AUTO_MODE","services":"Action=Wander","groups":"Room1=4","battery":70}"#;
+        assert_eq!(
+            heard(view, "semo/scouting/r1/status/irobot", room),
+            "status irobot: running AUTO_MODE [Action=Wander] groups Room1 (4 alive) battery 70"
+        );
+        let moved = br#"{"robot":"irobot","state":"running","started":"1000","mode":"AUTO_MODE","services":"Action=Wander","groups":"Room2=3,Sweeper=1"}"#;
+        assert_eq!(
+            heard(view, "semo/scouting/r1/status/irobot", moved),
+            "status irobot: running AUTO_MODE [Action=Wander] groups Room2 (3 alive), Sweeper (1 alive)"
         );
         // Another robot's status on ti's topic is nobody's.
         assert_eq!(

@@ -26,6 +26,12 @@ pub struct Status {
     pub leader: String,
     /// The service each plan runs, in the robot's order: `(plan, service)`.
     pub services: Vec<(String, String)>,
+    /// The robot's group at each statement of counted groups
+    /// (`group(Name, min = N)`) it passed since its mode started, in the
+    /// statements' order: `(group, alive)`, the group (`others` for a
+    /// spare) and how many members it counted alive when it took it. Empty
+    /// for a board robot, which does not say its groups.
+    pub groups: Vec<(String, u32)>,
     /// The battery level, when the runtime reports one.
     pub battery: Option<f64>,
     /// The robot's mission time of the change (ms), when given.
@@ -58,6 +64,16 @@ impl Status {
                 Some((plan.to_string(), service.to_string()))
             })
             .collect();
+        // Entries that are not `group=count` are skipped: a status is
+        // shown as well as it can be read.
+        let groups = text("groups")
+            .split(',')
+            .filter_map(|pair| {
+                let (group, alive) = pair.split_once('=')?;
+                let alive = alive.parse().ok()?;
+                (!group.is_empty()).then(|| (group.to_string(), alive))
+            })
+            .collect();
         let named = text("robot");
         if !named.is_empty() && topics::level(&named) != robot {
             return None;
@@ -72,6 +88,7 @@ impl Status {
             mode: text("mode"),
             leader: text("leader"),
             services,
+            groups,
             // The runtime writes trace fields as text (`"battery":"87"`).
             battery: object.get("battery").and_then(|v| {
                 v.as_f64()
@@ -92,6 +109,16 @@ impl Status {
             .map(|(plan, service)| format!("{plan}={service}"))
             .collect::<Vec<_>>()
             .join(",")
+    }
+
+    /// `group (N alive), group (M alive)`, in the statements' order; empty without
+    /// counted groups.
+    pub fn groups_text(&self) -> String {
+        self.groups
+            .iter()
+            .map(|(group, alive)| format!("{group} ({alive} alive)"))
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 }
 
@@ -244,6 +271,39 @@ mod tests {
             None
         );
         assert_eq!(Status::decode("r", b"\xff"), None);
+    }
+
+    #[test]
+    fn a_status_says_the_robots_counted_groups() {
+        let payload = br#"{"t":2000,"robot":"tb_2","event":"status","state":"running","mode":"ROOMS","leader":"","services":"Work=Rooms","groups":"Room1=5,others=3"}"#;
+        let status = Status::decode("tb_2", payload).unwrap();
+        assert_eq!(
+            status.groups,
+            [("Room1".to_string(), 5), ("others".to_string(), 3)]
+        );
+        assert_eq!(status.groups_text(), "Room1 (5 alive), others (3 alive)");
+        // Without the field (no counted groups, a board, the last will): none.
+        let none = Status::decode("r", br#"{"state":"running","mode":"M"}"#).unwrap();
+        assert!(none.groups.is_empty() && none.groups_text().is_empty());
+        // What cannot be read is skipped, never a panic.
+        for (groups, read) in [
+            (r#""Room1""#, vec![]),
+            (r#""=3,Room2=x,Room3=-1,Room4=99999999999""#, vec![]),
+            (
+                r#""Room1=2,,junk,Room2=1=1,Room3=1""#,
+                vec![("Room1", 2), ("Room3", 1)],
+            ),
+            (r#""""#, vec![]),
+            ("7", vec![]),
+            ("null", vec![]),
+            (r#"["Room1=2"]"#, vec![]),
+            (r#""Räum=2""#, vec![("Räum", 2)]),
+        ] {
+            let payload = format!(r#"{{"state":"running","groups":{groups}}}"#);
+            let status = Status::decode("r", payload.as_bytes()).unwrap();
+            let read: Vec<(String, u32)> = read.iter().map(|(g, a)| (g.to_string(), *a)).collect();
+            assert_eq!(status.groups, read, "{groups}");
+        }
     }
 
     fn run(id: &str) -> RunId {

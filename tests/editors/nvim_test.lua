@@ -231,6 +231,20 @@ local function run()
   vim.notify = notify
   check(notified == 0, notified .. ' notification(s) from :SemoMonitor')
 
+  -- 7b'. A robot's counted groups end its line; a robot without any has none.
+  local grouped = semo.monitor_table({ mission = 'm', broker = 'b', connection = 'connected',
+    robots = { { robot = 'tb_2', team = 'Crew', state = 'running', lost = false, mode = 'ROOMS',
+      services = { { plan = 'Work', service = 'Rooms' } },
+      groups = { { group = 'Room1', alive = 5 }, { group = 'others', alive = 3 } } },
+      { robot = 'tb_3', team = 'Crew', state = 'running', lost = false, mode = 'ROOMS',
+        services = {}, groups = {} } } })
+  local grouped_lines = vim.split(grouped, '\n')
+  check(grouped_lines[2]:find('Work=Rooms%s+Room1%(5%),others%(3%)$') ~= nil,
+    'the groups are not at the end of the line: ' .. grouped_lines[2])
+  check(grouped_lines[3] == 'tb_3       Crew         running          ROOMS',
+    'a robot without groups: ' .. vim.inspect(grouped_lines[3]))
+  report('monitor groups: ' .. grouped_lines[2])
+
   -- 7c. The running robots on the mission text: a view as the server sends it (r in MOVING,
   -- running Drive) marks the mode's line and the service's; a lost robot marks nothing.
   local lines = vim.api.nvim_buf_get_lines(mission, 0, -1, false)

@@ -85,7 +85,8 @@ const GROUP_ALLOCATE: Template = template!(
         "narrow",
         "sharing",
         "last",
-        "forget"
+        "forget",
+        "statement"
     ]
 );
 const GROUP_SYNC: Template = template!(
@@ -1114,7 +1115,13 @@ fn emit_group_allocate(
     let (mut narrow, from) = narrow_to_arms(peers, within);
     let forget: String = nested
         .iter()
-        .map(|inner| format!("\n            allocated_{service}_{} = -2;", inner.index()))
+        .map(|inner| {
+            format!(
+                "\n            allocated_{service}_{} = -2;\n            semo_status_group({}, NULL, 0);",
+                inner.index(),
+                group_statement(cx.program, service, inner.index())
+            )
+        })
         .collect();
     let sharing = if within.is_empty() {
         format!("members, {}", members.len())
@@ -1142,8 +1149,25 @@ fn emit_group_allocate(
             ("sharing", &sharing),
             ("last", &format!("allocated_{service}_{pc}")),
             ("forget", &forget),
+            ("statement", &group_statement(cx.program, service, pc)),
         ],
     ));
+}
+
+/// The number of the statement of counted groups at state `pc` of service
+/// `service` among all of the machine's, in the machine's order: the key of
+/// the robot's group there in its status (`semo_status_group`).
+fn group_statement(program: &RobotProgram, service: usize, pc: usize) -> usize {
+    let is_allocate = |s: &State| matches!(s.kind, StateKind::GroupAllocate { .. });
+    let services = &program.control.services;
+    services[..service]
+        .iter()
+        .map(|s| s.states.iter().filter(|s| is_allocate(s)).count())
+        .sum::<usize>()
+        + services[service].states[..pc]
+            .iter()
+            .filter(|s| is_allocate(s))
+            .count()
 }
 
 /// Nested in arms of counted groups (`within`): C statements that narrow the

@@ -1,6 +1,6 @@
 //! The monitor's picture of a mission's robots in one run, from what the
 //! broker delivers: every robot of the checked mission, `waiting` until
-//! its first status, then its state, mode, services and leader, and `lost`
+//! its first status, then its state, mode, services, counted groups and leader, and `lost`
 //! when its last will arrives or when it stops heart-beating. The run is
 //! the one given, else the newest heard of (`live::RunChoice`): a newer
 //! run's status starts the picture over. Pure: the time is the monitor's
@@ -188,6 +188,7 @@ impl Robot {
                 "mode": null,
                 "modeLine": null,
                 "services": [],
+                "groups": [],
                 "leader": null,
                 "isLeader": false,
                 "battery": null,
@@ -210,6 +211,11 @@ impl Robot {
                 json!({ "plan": plan, "service": service, "line": line })
             })
             .collect();
+        let groups: Vec<Value> = status
+            .groups
+            .iter()
+            .map(|(group, alive)| json!({ "group": group, "alive": alive }))
+            .collect();
         let mut view = json!({
             "robot": self.member.robot,
             "team": self.member.team,
@@ -218,6 +224,7 @@ impl Robot {
             "mode": (!status.mode.is_empty()).then_some(&status.mode),
             "modeLine": lines.modes.get(&status.mode),
             "services": services,
+            "groups": groups,
             "leader": (!status.leader.is_empty()).then_some(&status.leader),
             "isLeader": status.leader == self.member.robot,
             "battery": status.battery,
@@ -331,6 +338,20 @@ mod tests {
         // The lines an editor marks: the mode's and each service's.
         assert_eq!(a["modeLine"], 7);
         assert_eq!(r.view()[1]["modeLine"], Value::Null);
+        // No counted groups: none, as for a robot still waiting.
+        assert_eq!(
+            (&a["groups"], &r.view()[1]["groups"]),
+            (&json!([]), &json!([]))
+        );
+        r.message(
+            "semo/m/r1/status/b",
+            br#"{"robot":"b","state":"running","mode":"M","leader":"a","services":"P=S","groups":"Room1=4,Sweeper=2"}"#,
+            1,
+        );
+        assert_eq!(
+            r.view()[1]["groups"],
+            json!([{ "group": "Room1", "alive": 4 }, { "group": "Sweeper", "alive": 2 }])
+        );
     }
 
     #[test]

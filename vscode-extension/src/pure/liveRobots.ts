@@ -1,7 +1,7 @@
 // The "Robots (live)" view's tree, from the server's `semo/monitor`
 // notifications (docs/live-monitor.md): one node per robot with its state
-// and mode, its services per plan below it, the leader marked, lost robots
-// marked. Pure: unit-tested without VS Code.
+// and mode, its counted groups, its services per plan below it, the leader
+// marked, lost robots marked. Pure: unit-tested without VS Code.
 
 /** A robot as `semo/monitor` sends it. */
 export interface LiveRobot {
@@ -14,6 +14,9 @@ export interface LiveRobot {
   /** The mission line (1-based) where its mode is written. */
   modeLine?: number | null;
   services: { plan: string; service: string; line?: number | null }[];
+  /** Its group at each statement of counted groups, in the mission's order
+   * (absent from a server that does not send them). */
+  groups?: { group: string; alive: number }[];
   leader: string | null;
   isLeader: boolean;
   battery: number | null;
@@ -62,6 +65,10 @@ function robotNode(view: MonitorView, robot: LiveRobot): LiveNode {
   if (robot.mode) {
     parts.push(robot.mode);
   }
+  const groups = robot.groups ?? [];
+  if (groups.length > 0) {
+    parts.push(groups.map((g) => g.group).join(', '));
+  }
   if (robot.isLeader) {
     parts.push('★ leader');
   }
@@ -74,6 +81,9 @@ function robotNode(view: MonitorView, robot: LiveRobot): LiveNode {
     robot.lost ? lostWhy(robot) : `state: ${robot.state}`,
     robot.mode ? `mode: ${robot.mode}` : 'mode: not reported yet',
     robot.leader ? `leader: ${robot.leader}${robot.isLeader ? ' (itself)' : ''}` : '',
+    groups.length > 0
+      ? `groups: ${groups.map((g) => `${g.group} (${g.alive} alive)`).join(', ')}`
+      : '',
   ]
     .filter((line, i) => i < 2 || line !== '')
     .join('\n\n');

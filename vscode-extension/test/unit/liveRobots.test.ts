@@ -84,6 +84,31 @@ test('one node per robot after the connection, services below each', () => {
   assert.notEqual(tree[1].id, buildLiveTree({ ...VIEW, robots: [{ ...VIEW.robots[0], services: [] }] })[1].id);
 });
 
+test("a robot's counted groups are in its description and tooltip", () => {
+  const rooms = buildLiveTree({
+    ...VIEW,
+    robots: [
+      {
+        ...VIEW.robots[0],
+        mode: 'ROOMS',
+        isLeader: false,
+        leader: null,
+        groups: [
+          { group: 'Room1', alive: 5 },
+          { group: 'others', alive: 3 },
+        ],
+      },
+      { ...VIEW.robots[0], robot: 'tb_9', groups: [] },
+    ],
+  });
+  assert.equal(rooms[1].description, 'running · ROOMS · Room1, others');
+  assert.match(rooms[1].tooltip, /groups: Room1 \(5 alive\), others \(3 alive\)/);
+  // None (or a server that sends none): nothing said.
+  assert.equal(rooms[2].description, 'running · PATROL · ★ leader');
+  assert.doesNotMatch(rooms[2].tooltip, /groups/);
+  assert.doesNotMatch(buildLiveTree(VIEW)[1].tooltip, /groups/);
+});
+
 test('the leader is marked, lost robots are marked with the reason, waiting ones too', () => {
   const [, leader, lost, waiting] = buildLiveTree(VIEW);
   assert.equal(leader.description, 'running · PATROL · ★ leader');

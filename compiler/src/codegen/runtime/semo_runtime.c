@@ -892,9 +892,14 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
  * on every change through the transport's `status` (MQTT: retained on
  * semo/<mission>/<run>/status/<robot>) as one JSON line of the trace's form:
  * {"t":..,"robot":..,"event":"status","state":..,"started":"<Unix ms>",
- * "mode":..,"leader":..,"services":"Plan=Service,...","battery":"87"}
- * (`battery` only when the robot knows its level). */
+ * "mode":..,"leader":..,"services":"Plan=Service,...","groups":"Room1=4,...",
+ * "battery":"87"}
+ * (`battery` only when the robot knows its level; `groups` only when it
+ * passed a statement of counted groups since its mode started: its group at
+ * each, in the statements' order, with the members it counted alive when it
+ * took it, told by the control task through semo_status_group). */
 #define STATUS_PLANS 16
+#define STATUS_GROUPS 16
 #define STATUS_NAME 64
 /* Mission time 0 on the wall clock (Unix ms): the robot's status says it,
  * so that a console can tell the newest run. */
@@ -909,12 +914,19 @@ static struct {
         char plan[STATUS_NAME], service[STATUS_NAME];
     } running[STATUS_PLANS];
     size_t running_count;
+    /* By statement number, in order. */
+    struct {
+        unsigned statement;
+        char group[STATUS_NAME];
+        size_t alive;
+    } groups[STATUS_GROUPS];
+    size_t group_count;
     bool battery_known;
     long long battery;
 } g_status = {.lock = PTHREAD_MUTEX_INITIALIZER};
 
 typedef struct {
-    char text[1024 + 4 * STATUS_PLANS * STATUS_NAME];
+    char text[1024 + 4 * STATUS_PLANS * STATUS_NAME + 2 * STATUS_GROUPS * (STATUS_NAME + 24)];
     size_t len;
 } status_buffer;
 
@@ -942,6 +954,69 @@ static void copy_name(char *out, const char *name)
     snprintf(out, STATUS_NAME, "%s", name ? name : "");
 }
 
+/* Publishes the status kept (g_status.lock held). */
+static void publish_status(const semo_transport *transport)
+{
+    char services[STATUS_PLANS * 2 * STATUS_NAME + STATUS_PLANS * 2] = "";
+    size_t at = 0;
+    for (size_t i = 0; i < g_status.running_count; i++)
+        if (g_status.running[i].service[0] && at < sizeof services)
+            at += (size_t)snprintf(services + at, sizeof services - at, "%s%s=%s", at ? "," : "",
+                                   g_status.running[i].plan, g_status.running[i].service);
+    char groups[STATUS_GROUPS * (STATUS_NAME + 24)] = "";
+    at = 0;
+    for (size_t i = 0; i < g_status.group_count && at < sizeof groups; i++)
+        at += (size_t)snprintf(groups + at, sizeof groups - at, "%s%s=%lu", at ? "," : "", g_status.groups[i].group,
+                               (unsigned long)g_status.groups[i].alive);
+    status_buffer line = {.len = 0};
+    char battery[24], started[24];
+    semo__format_i64(battery, g_status.battery);
+    semo__format_i64(started, g_started_unix_ms);
+    /* A field without a value is absent: the list ends before it, or
+     * `battery` takes the place of `groups`. */
+    bool with_groups = g_status.group_count > 0;
+    const char *after = g_status.battery_known ? "battery" : NULL;
+    status_line(&line, "status", "state", g_status.state, "started", started, "mode", g_status.mode, "leader",
+                g_status.leader, "services", services, with_groups ? "groups" : after, with_groups ? groups : battery,
+                with_groups ? after : NULL, battery, NULL);
+    if (line.len > 0 && line.text[line.len - 1] == '\n')
+        line.text[--line.len] = '\0'; /* one JSON object, not a line */
+    transport->status(line.text, line.len);
+}
+
+void semo_status_group(unsigned statement, const char *group, size_t alive)
+{
+    const semo_transport *transport = g_transport;
+    if (!transport || !transport->status)
+        return;
+    pthread_mutex_lock(&g_status.lock);
+    size_t i = 0;
+    while (i < g_status.group_count && g_status.groups[i].statement < statement)
+        i++;
+    bool found = i < g_status.group_count && g_status.groups[i].statement == statement;
+    bool changed = false;
+    if (!group && found) {
+        memmove(&g_status.groups[i], &g_status.groups[i + 1], (g_status.group_count - i - 1) * sizeof g_status.groups[0]);
+        g_status.group_count--;
+        changed = true;
+    } else if (group && found && strcmp(g_status.groups[i].group, group) != 0) {
+        copy_name(g_status.groups[i].group, group);
+        g_status.groups[i].alive = alive;
+        changed = true;
+    } else if (group && !found && g_status.group_count < STATUS_GROUPS) {
+        memmove(&g_status.groups[i + 1], &g_status.groups[i], (g_status.group_count - i) * sizeof g_status.groups[0]);
+        g_status.group_count++;
+        g_status.groups[i].statement = statement;
+        copy_name(g_status.groups[i].group, group);
+        g_status.groups[i].alive = alive;
+        changed = true;
+    }
+    /* Before the robot's `start` there is nothing to say yet. */
+    if (changed && g_status.state[0])
+        publish_status(transport);
+    pthread_mutex_unlock(&g_status.lock);
+}
+
 static void observe_status(const char *event, va_list args)
 {
     const semo_transport *transport = g_transport;
@@ -957,6 +1032,8 @@ static void observe_status(const char *event, va_list args)
         snprintf(g_status.state, sizeof g_status.state, "stopped");
     } else if (strcmp(event, "mode") == 0) {
         copy_name(g_status.mode, semo__trace_pair(args, "mode"));
+        /* The new mode's statements tell their groups as they are passed. */
+        g_status.group_count = 0;
     } else if (strcmp(event, "leader") == 0) {
         copy_name(g_status.leader, semo__trace_pair(args, "leader"));
     } else if (strcmp(event, "fenced") == 0) {
@@ -990,24 +1067,8 @@ static void observe_status(const char *event, va_list args)
         g_status.battery = level;
         changed = true;
     }
-    if (changed) {
-        char services[STATUS_PLANS * 2 * STATUS_NAME + STATUS_PLANS * 2] = "";
-        size_t at = 0;
-        for (size_t i = 0; i < g_status.running_count; i++)
-            if (g_status.running[i].service[0] && at < sizeof services)
-                at += (size_t)snprintf(services + at, sizeof services - at, "%s%s=%s", at ? "," : "",
-                                       g_status.running[i].plan, g_status.running[i].service);
-        status_buffer line = {.len = 0};
-        char battery[24], started[24];
-        semo__format_i64(battery, g_status.battery);
-        semo__format_i64(started, g_started_unix_ms);
-        /* Without a level the list ends before `battery`: the field is absent. */
-        status_line(&line, "status", "state", g_status.state, "started", started, "mode", g_status.mode, "leader",
-                    g_status.leader, "services", services, g_status.battery_known ? "battery" : NULL, battery, NULL);
-        if (line.len > 0 && line.text[line.len - 1] == '\n')
-            line.text[--line.len] = '\0'; /* one JSON object, not a line */
-        transport->status(line.text, line.len);
-    }
+    if (changed)
+        publish_status(transport);
     pthread_mutex_unlock(&g_status.lock);
 }
 

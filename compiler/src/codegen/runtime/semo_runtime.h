@@ -485,6 +485,17 @@ void semo_group_set(int rank, int size);
  * the latest one (`battery`, docs/deployment.md). */
 void semo_battery_report(const semo_value *level);
 
+/* ----------------------------------------------------------------- groups */
+
+/* For the generated control task, at each pass through statement number
+ * `statement` of counted groups (numbered in the machine's order from 0):
+ * the group it gave this robot (`others` for a spare) and how many members
+ * it counted alive; `group` NULL when the statement forgets it (its
+ * enclosing group changed). The robot's status carries the groups of the
+ * statements passed since its mode started (`groups`, docs/deployment.md);
+ * the trace's `allocated` says each change. A board keeps none. */
+void semo_status_group(unsigned statement, const char *group, size_t alive);
+
 /* ----------------------------------------------------------------- traces */
 
 /* Appends one JSON line `{"t":<mission ms>,"robot":"<robot>","event":"<event>",

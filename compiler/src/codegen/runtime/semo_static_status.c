@@ -10,6 +10,8 @@
  * read it as a Linux robot's:
  *   {"t":..,"robot":..,"event":"status","state":..,"started":"0","mode":..,
  *    "leader":..,"services":"Plan=Service,...","battery":".."}
+ * No `groups`: a board keeps no counted groups (semo_static.c's
+ * semo_status_group does nothing; the trace's `allocated` says them).
  * `started` is 0: a board has no wall clock, and its mission time 0 is the
  * gateway's welcome (semo_static_link.c). `battery` only when the robot
  * knows its level (its BATTERY value, in simulation the scenario's).

@@ -251,7 +251,7 @@ local function present(value)
 end
 
 --- A `semo/monitor` view (docs/live-monitor.md) as a table: a header, one line per robot
---- (`*` marks a leader; lost robots say why).
+--- (`*` marks a leader; lost robots say why; counted groups last, `Room1(5),others(3)`).
 function M.monitor_table(view)
   local error = present(view.error)
   local lines = {
@@ -264,13 +264,17 @@ function M.monitor_table(view)
     for _, s in ipairs(robot.services) do
       table.insert(services, s.plan .. '=' .. s.service)
     end
+    local groups = {}
+    for _, g in ipairs(robot.groups or {}) do
+      table.insert(groups, string.format('%s(%s)', g.group, tostring(g.alive)))
+    end
     local state = robot.state
     if robot.lost then
       state = 'LOST (' .. (present(robot.lostBecause) or '?') .. ')'
     end
-    table.insert(lines, vim.trim(string.format('%-10s %-12s %-16s %-14s %s',
+    table.insert(lines, vim.trim(string.format('%-10s %-12s %-16s %-14s %-20s %s',
       robot.robot .. (robot.isLeader and ' *' or ''), robot.team, state,
-      present(robot.mode) or '', table.concat(services, ','))))
+      present(robot.mode) or '', table.concat(services, ','), table.concat(groups, ','))))
   end
   return table.concat(lines, '\n')
 end
