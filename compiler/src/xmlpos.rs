@@ -444,11 +444,19 @@ pub(crate) fn read_attributes_keeping_lt_into(
 /// The index of the first of `items` whose key is that of an item before it,
 /// in linear time: a scan while there are few (most elements have a handful
 /// of attributes), a hash set past that.
+///
+/// The scan compares two keys' lengths and first bytes before their bytes,
+/// which tells apart the names an element carries (SDF3's `srcActor` and
+/// `dstActor`, `name` and `type`) without calling `memcmp`. Every element of
+/// a document is checked, so this is on the reader's hot path.
 pub(crate) fn first_repeated<T>(items: &[T], key: impl Fn(&T) -> &[u8]) -> Option<usize> {
     const SCAN: usize = 16;
     if items.len() <= SCAN {
-        return (1..items.len())
-            .find(|&i| items[..i].iter().any(|seen| key(seen) == key(&items[i])));
+        let same = |a: &[u8], b: &[u8]| a.len() == b.len() && a.first() == b.first() && a == b;
+        return (1..items.len()).find(|&i| {
+            let k = key(&items[i]);
+            items[..i].iter().any(|seen| same(key(seen), k))
+        });
     }
     let mut seen = FastSet::default();
     seen.reserve(items.len());
@@ -640,6 +648,23 @@ mod tests {
             keys.push(format!("a{}", n / 2));
             assert_eq!(first_repeated(&keys, |k| k.as_bytes()), Some(n));
         }
+    }
+
+    /// Keys alike in length and first byte are told apart in full, an
+    /// empty key is one like any other, and the first repeat is the one given.
+    #[test]
+    fn keys_with_the_same_digest_are_compared_in_full() {
+        let first = |keys: &[&str]| first_repeated(keys, |k| k.as_bytes());
+        assert_eq!(first(&["srcActor", "dstActor", "name", "type"]), None);
+        assert_eq!(first(&["abxd", "acxd", "abyd", "adxd"]), None);
+        assert_eq!(first(&["abxd", "acxd", "abyd", "acxd", "abxd"]), Some(3));
+        assert_eq!(first(&["", "a", ""]), Some(2));
+        assert_eq!(first(&["", "a"]), None);
+        assert_eq!(first(&[]), None);
+        let long = "x".repeat(70_000);
+        let other = format!("x{}x", "y".repeat(70_000 - 2));
+        assert_eq!(first(&[&long, &other, "x"]), None);
+        assert_eq!(first(&[&other, &long, &long]), Some(2));
     }
 
     #[test]
