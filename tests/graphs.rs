@@ -728,6 +728,67 @@ fn buffers_give_the_trade_off_and_a_chosen_point() {
     );
 }
 
+/// Every point of SDF3's storage/throughput front on its benchmark graphs
+/// is on `semo graph buffers --sdf3-compat`'s front: the same total size
+/// with the same throughput. The points are SDF3's own answers (its
+/// `sdf3analysis-sdf --algo buffersize`, throughputs to its six
+/// significant digits), kept as data in `tests/data/sdf3/buffersize.json`;
+/// the three benchmarks SDF3 does not finish within 120 s are not there.
+#[test]
+fn sdf3_buffer_fronts_are_on_semos_fronts() {
+    let data = std::fs::read_to_string(sdf3().join("buffersize.json")).unwrap();
+    let fronts: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&data).unwrap();
+    assert!(fronts.len() >= 8, "{}", fronts.len());
+    let period = |text: &str| -> f64 {
+        match text.split_once('/') {
+            Some((n, d)) => n.parse::<f64>().unwrap() / d.parse::<f64>().unwrap(),
+            None => text.parse().unwrap(),
+        }
+    };
+    for (graph, points) in &fronts {
+        let out = semo_in(
+            &sdf3(),
+            &[
+                "graph",
+                "buffers",
+                "--sdf3-compat",
+                "--format",
+                "json",
+                graph,
+            ],
+        );
+        assert_eq!(out.code, 0, "{graph}: {}{}", out.stdout, out.stderr);
+        let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+        let ours: Vec<(u64, f64)> = (v["points"].as_array().unwrap().iter())
+            .map(|p| {
+                (
+                    p["size"].as_u64().unwrap(),
+                    period(p["period"].as_str().unwrap()),
+                )
+            })
+            .collect();
+        for point in points.as_array().unwrap() {
+            let size = point[0].as_u64().unwrap();
+            let throughput: f64 = point[1].as_str().unwrap().parse().unwrap();
+            if throughput == 0.0 {
+                // SDF3 lists the distribution that deadlocks (size 0) as a
+                // point of throughput 0; semo's front starts at the
+                // smallest live distribution.
+                assert_eq!(size, 0, "{graph}");
+                continue;
+            }
+            let found = ours.iter().find(|(s, _)| *s == size);
+            let Some(&(_, p)) = found else {
+                panic!("{graph}: SDF3's point of size {size} is not on semo's front {ours:?}");
+            };
+            assert!(
+                ((1.0 / p) - throughput).abs() <= throughput * 1e-5,
+                "{graph}: size {size}: semo's period {p}, SDF3's throughput {throughput}"
+            );
+        }
+    }
+}
+
 /// A file starting with a byte-order mark (as some Windows editors save it)
 /// gets its diagnostics where they are: the mark is one column, and every
 /// range, to the end of the element, is one column on from the same file
