@@ -591,6 +591,27 @@ fn deployed_fleet(name: &str, tls: bool) -> Option<(Fleet, PathBuf)> {
     Some((fleet, deploy.expect("configured")))
 }
 
+/// A fleet whose broker runs the configuration `semo deploy broker-config`
+/// writes for `mission` under the deployment `deployment` makes (from the
+/// test's folder and the broker's port), and that deployment file.
+fn fleet_deployed_for(
+    name: &str,
+    mission: &Path,
+    deployment: fn(&Path, u16) -> PathBuf,
+) -> Option<(Fleet, PathBuf)> {
+    let mut deploy = None;
+    let fleet = Fleet::start_configured(name, |broker_dir, port| {
+        let out = broker_dir
+            .parent()
+            .expect("the broker folder is in the test's");
+        let file = deployment(out, port);
+        let config = broker_config_for(out, mission, &file);
+        deploy = Some(file);
+        config
+    })?;
+    Some((fleet, deploy.expect("configured")))
+}
+
 #[test]
 fn robots_take_messages_only_from_the_sender_their_topic_names_and_the_acl_lets() {
     let Some((mut fleet, deploy)) = deployed_fleet("mqtt-acl", false) else {
@@ -2120,19 +2141,11 @@ fn the_editor_monitor_marks_a_hung_leader_lost_and_shows_its_successor() {
     // Team Guards elects a leader among its Turtlebots tb_0..tb_2 with
     // heartbeats; the broker's ACL lets the operator (the monitor) read them.
     let mission = examples().join("swarm/patrol_groups.mission");
-    let mut deploy = None;
-    let Some(mut fleet) = Fleet::start_configured("mqtt-monitor-leader", |broker_dir, port| {
-        let out = broker_dir
-            .parent()
-            .expect("the broker folder is in the test's");
-        let file = patrol_deployment(out, port);
-        let config = broker_config_for(out, &mission, &file);
-        deploy = Some(file);
-        config
-    }) else {
+    let Some((mut fleet, deploy)) =
+        fleet_deployed_for("mqtt-monitor-leader", &mission, patrol_deployment)
+    else {
         return;
     };
-    let deploy = deploy.expect("configured");
     let out = fleet.out.clone();
     let acl = std::fs::read_to_string(out.join("broker/semo.acl")).unwrap();
     assert!(
@@ -2251,19 +2264,11 @@ fn groups_shown(view: &serde_json::Value, robot: &str) -> Vec<String> {
 #[test]
 fn the_monitor_and_the_console_show_each_robots_counted_groups() {
     let mission = repo_root().join("tests/fixtures/counted_groups/nested.mission");
-    let mut deploy = None;
-    let Some(mut fleet) = Fleet::start_configured("mqtt-monitor-groups", |broker_dir, port| {
-        let out = broker_dir
-            .parent()
-            .expect("the broker folder is in the test's");
-        let file = rooms_deployment(out, port);
-        let config = broker_config_for(out, &mission, &file);
-        deploy = Some(file);
-        config
-    }) else {
+    let Some((mut fleet, deploy)) =
+        fleet_deployed_for("mqtt-monitor-groups", &mission, rooms_deployment)
+    else {
         return;
     };
-    let deploy = deploy.expect("configured");
     let out = fleet.out.clone();
     let folders =
         support::mqtt::build(&mission, &out, &["--deploy", &deploy.display().to_string()]);
