@@ -177,6 +177,13 @@ fn watcher(url_port: u16, run: &str) -> (rumqttc::Client, mpsc::Receiver<(String
     (client, rx)
 }
 
+fn unix_ms() -> i64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_millis() as i64
+}
+
 fn heard(rx: &mpsc::Receiver<(String, Vec<u8>, bool)>, what: &str) -> (String, Vec<u8>, bool) {
     rx.recv_timeout(LIMIT)
         .unwrap_or_else(|_| panic!("the watcher waited for {what}"))
@@ -217,7 +224,9 @@ fn a_link_robot_is_a_member_of_the_fleet_on_its_own_topics_only() {
     let listener = TcpListener::bind("127.0.0.1:0").unwrap();
     let link_port = listener.local_addr().unwrap().port();
     let gw = fleet.processes.push(gateway(&fleet.url(), link_port, run));
+    let before_welcome = unix_ms();
     let mut robot = LinkRobot::connected(&listener);
+    let after_welcome = unix_ms();
 
     // Noise on the line (a frame with a flipped bit, a flood without a
     // zero) is dropped and said; the link goes on.
@@ -281,6 +290,21 @@ fn a_link_robot_is_a_member_of_the_fleet_on_its_own_topics_only() {
     // The watcher hears those two as well (they are on the run's topics).
     heard(&rx, "the forward");
     heard(&rx, "the forged one");
+
+    // A board has no clock: its status says `started` 0, and the gateway
+    // says the time it welcomed the board's session (its mission time 0).
+    let board =
+        br#"{"t":5,"robot":"ti","event":"status","state":"running","started":"0","mode":"Move"}"#;
+    robot.endpoint.queue(Kind::Status, board.to_vec()).unwrap();
+    robot.until("the board status's ack", |_, e| e.outgoing.pending() == 0);
+    let (_, payload, _) = heard(&rx, "ti's board status");
+    let said: serde_json::Value = serde_json::from_slice(&payload).unwrap();
+    let started: i64 = said["started"].as_str().unwrap().parse().unwrap();
+    assert!(
+        (before_welcome..=after_welcome).contains(&started),
+        "started {started} is the welcome, between {before_welcome} and {after_welcome}"
+    );
+    assert_eq!(said["mode"], "Move", "the rest as the board said it");
 
     // The status is published on the robot's status topic; when the link
     // closes the gateway says the robot is lost (retained), with the

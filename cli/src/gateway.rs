@@ -470,6 +470,10 @@ impl LinkGateway {
         endpoint.defer_acks = true;
         let started = Instant::now();
         let mut last_status: Option<String> = None;
+        // When the robot's session last started (its `Hello` welcomed), on
+        // the wall clock: its mission time 0, which its status cannot say
+        // (a board has no clock) and the gateway then says for it.
+        let mut welcomed_unix_ms: Option<i64> = None;
         loop {
             let Some(writer) = self.open(events.clone()) else {
                 std::thread::sleep(Duration::from_millis(500));
@@ -514,12 +518,18 @@ impl LinkGateway {
                 match event {
                     None => {}
                     Some(Event::Bytes(bytes)) => {
-                        for frame in endpoint.feed(&bytes, now(), &mut wire) {
+                        let hellos = endpoint.hellos;
+                        let frames = endpoint.feed(&bytes, now(), &mut wire);
+                        if endpoint.hellos != hellos {
+                            welcomed_unix_ms = Some(unix_ms());
+                        }
+                        for frame in frames {
                             let handed = self.publish_for_robot(
                                 &frame,
                                 &broker,
                                 &mut counts,
                                 &mut last_status,
+                                welcomed_unix_ms,
                             );
                             match handed {
                                 Handed::Awaiting | Handed::Unreliable => {}
@@ -607,7 +617,10 @@ impl LinkGateway {
             Place::Connect(address) => match TcpStream::connect(address) {
                 Ok(stream) => {
                     let _ = stream.set_nodelay(true);
-                    (Box::new(stream.try_clone().ok()?), Box::new(stream))
+                    (
+                        Box::new(QuickAck(stream.try_clone().ok()?)),
+                        Box::new(stream),
+                    )
                 }
                 Err(e) => {
                     eprintln!("gateway: {}: tcp:{address}: {e} (retrying)", self.name());
@@ -624,7 +637,10 @@ impl LinkGateway {
                 };
                 let (stream, _) = listener.accept().ok()?;
                 let _ = stream.set_nodelay(true);
-                (Box::new(stream.try_clone().ok()?), Box::new(stream))
+                (
+                    Box::new(QuickAck(stream.try_clone().ok()?)),
+                    Box::new(stream),
+                )
             }
             Place::Device(path) => {
                 match std::fs::OpenOptions::new()
@@ -655,6 +671,7 @@ impl LinkGateway {
         broker: &Broker,
         counts: &mut Counts,
         last_status: &mut Option<String>,
+        welcomed_unix_ms: Option<i64>,
     ) -> Handed {
         let me = Sender {
             team: &self.robot.team,
@@ -662,12 +679,13 @@ impl LinkGateway {
         };
         match frame.kind {
             Kind::Status => {
-                let text = String::from_utf8_lossy(&frame.payload).into_owned();
+                let payload = with_start(&frame.payload, welcomed_unix_ms);
+                let text = String::from_utf8_lossy(&payload).into_owned();
                 let status = Outbound {
                     topic: topics::status(&self.scope, &self.robot.robot),
                     qos: rumqttc::QoS::AtLeastOnce,
                     retain: true,
-                    payload: frame.payload.clone(),
+                    payload,
                 };
                 let handed = broker.hand(self.name(), counts, status, Some(frame.seq));
                 *last_status = Some(text);
@@ -841,6 +859,52 @@ fn state_of(status: Option<&str>) -> Option<String> {
     Some(value.get("state")?.as_str()?.to_string())
 }
 
+/// A board's status with `started` said: the wall-clock time of its
+/// session's welcome (its mission time 0, as a Linux robot's status says
+/// its own), when the gateway welcomed it and the board says `"0"` (it has
+/// no clock). Anything else goes on unchanged: the gateway never puts a
+/// time in a status that says one, nor in what is not a status object.
+fn with_start(payload: &[u8], welcomed_unix_ms: Option<i64>) -> Vec<u8> {
+    let Some(at) = welcomed_unix_ms else {
+        return payload.to_vec();
+    };
+    let Ok(serde_json::Value::Object(mut status)) = serde_json::from_slice(payload) else {
+        return payload.to_vec();
+    };
+    match status.get_mut("started") {
+        Some(started) if started.as_str() == Some("0") => {
+            *started = serde_json::Value::String(at.to_string());
+        }
+        _ => return payload.to_vec(),
+    }
+    serde_json::to_vec(&status).unwrap_or_else(|_| payload.to_vec())
+}
+
+/// Now on the wall clock, in Unix ms.
+fn unix_ms() -> i64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_millis() as i64)
+}
+
+/// A link's TCP connection read with every byte acknowledged at once.
+/// The robot's end writes a frame a few bytes at a time (a UART's bytes, as
+/// QEMU's serial socket passes them on); with Nagle's algorithm there (QEMU
+/// without `nodelay`) each write after the first waits for the last one's
+/// acknowledgement, which Linux delays up to 40 ms when the gateway has
+/// nothing to answer yet: a frame would take tens of ms to arrive.
+/// `TCP_QUICKACK` lasts only until the next delayed acknowledgement, so it
+/// is set again after each read.
+struct QuickAck(TcpStream);
+
+impl Read for QuickAck {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.0.read(buf)?;
+        let _ = rustix::net::sockopt::set_tcp_quickack(&self.0, true);
+        Ok(n)
+    }
+}
+
 /// The link's bytes, as they come, until it closes.
 fn read_link(mut reader: Box<dyn Read + Send>, events: SyncSender<Event>) {
     let mut buf = [0u8; 4096];
@@ -972,6 +1036,26 @@ mod tests {
             "ti=listen:h:99999",
         ] {
             assert!(parse_link(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn a_boards_status_gets_the_time_of_its_welcome() {
+        let board =
+            br#"{"t":0,"robot":"ti","event":"status","state":"running","started":"0","mode":"M"}"#;
+        assert_eq!(
+            String::from_utf8(with_start(board, Some(1_700_000_000_123))).unwrap(),
+            r#"{"t":0,"robot":"ti","event":"status","state":"running","started":"1700000000123","mode":"M"}"#,
+            "the fields in their order, only `started` said"
+        );
+        // Not welcomed by this gateway (it restarted under a running
+        // board): nothing to say.
+        assert_eq!(with_start(board, None), board.to_vec());
+        // A status that says a time, or what is no status object, unchanged.
+        let timed = br#"{"robot":"ti","started":"42"}"#;
+        assert_eq!(with_start(timed, Some(7)), timed.to_vec());
+        for odd in [&b"not json"[..], b"[1,2]", br#"{"started":0}"#] {
+            assert_eq!(with_start(odd, Some(7)), odd.to_vec());
         }
     }
 }

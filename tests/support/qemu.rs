@@ -79,7 +79,9 @@ pub fn spawn_with(
     let mut child = Command::new("qemu-system-arm")
         .args(["-M", board.machine, "-display", "none", "-monitor", "none"])
         .args(["-semihosting", "-serial", "stdio", "-serial"])
-        .arg(format!("tcp:127.0.0.1:{link_port},server,nowait"))
+        .arg(format!(
+            "tcp:127.0.0.1:{link_port},server=on,wait=off,nodelay=on"
+        ))
         .arg("-kernel")
         .arg(elf)
         .stdin(Stdio::null())

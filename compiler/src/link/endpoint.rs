@@ -33,6 +33,9 @@ pub struct Endpoint {
     /// none either. Otherwise every reliable frame is acknowledged as it
     /// comes.
     pub defer_acks: bool,
+    /// `Hello`s taken: the other side (re)started its session, each
+    /// answered with a `Welcome` (a board's mission time starts at it).
+    pub hellos: u64,
 }
 
 impl Endpoint {
@@ -56,6 +59,7 @@ impl Endpoint {
             peer_payload_max: PAYLOAD_MAX,
             bad_frames: Vec::new(),
             defer_acks: false,
+            hellos: 0,
         }
     }
 
@@ -99,6 +103,7 @@ impl Endpoint {
                 }
                 Kind::Ack | Kind::Welcome => self.outgoing.heard(&frame),
                 Kind::Hello => {
+                    self.hellos += 1;
                     self.incoming.restart();
                     let [high, low] = (self.payload_max as u16).to_be_bytes();
                     let welcome = vec![self.welcome_flags, high, low];
