@@ -18,7 +18,9 @@
 //! by its mission time 0: a board's is the gateway's welcome (the instant
 //! its `start` line was read, at or after it was written), the Linux
 //! robot's its `--start-at`; lm leads until the instant its kill returned
-//! (after it died). What is compared is orders, never durations:
+//! (after it died). st's last status, kept by the broker, says its counted
+//! group as its trace's last `allocated` does, and the gateway's welcome as
+//! its `started`. What is compared is orders, never durations:
 //! the deadline only ends a test that would otherwise hang.
 //!
 //! Skipped with a message without arm-none-eabi-gcc, qemu-system-arm or
@@ -226,6 +228,7 @@ fn one_robot_per_board_kind_elects_one_leader_and_fails_over_when_its_qemu_is_ki
     }
     drop(tx);
     let gateway_log = fleet.out.join("gateway.stderr");
+    let before_gateway = qemu::unix_ms();
     let gateway = fleet.processes.push(gateway(&fleet, &ports, &gateway_log));
 
     // The boards' lines as they come; lx started at the first board's
@@ -456,6 +459,48 @@ fn one_robot_per_board_kind_elects_one_leader_and_fails_over_when_its_qemu_is_ki
             .collect();
         assert!(refused.is_empty(), "{robot}: {refused:?}");
     }
+
+    // st's last status, retained at the broker, says its counted group as
+    // a Linux robot's does (the group of its last `allocated`, with the
+    // robots it counted alive then), and the wall-clock time the gateway
+    // welcomed it as its `started` (a board has no clock).
+    let status = retained_status(&fleet, "st");
+    let allocated = traces["st"]
+        .iter()
+        .rfind(|e| field(e, "event") == "allocated")
+        .expect("st takes a counted group");
+    assert_eq!(status["state"], "stopped", "{status}");
+    assert_eq!(
+        status["groups"],
+        format!("{}={}", field(allocated, "name"), field(allocated, "alive")),
+        "{status}"
+    );
+    let started: u64 = status["started"].as_str().unwrap().parse().unwrap();
+    assert!(
+        (before_gateway..=killed_at).contains(&started),
+        "st was welcomed after the gateway started and before lm's kill (which waited for st's heartbeats): {status}"
+    );
+}
+
+/// The status the broker keeps for `robot` (retained), as JSON.
+fn retained_status(fleet: &Fleet, robot: &str) -> serde_json::Value {
+    let mut options = rumqttc::MqttOptions::new("status-reader", "127.0.0.1", fleet.port);
+    options.set_keep_alive(Duration::from_secs(10));
+    let (client, mut connection) = rumqttc::Client::new(options, 16);
+    client
+        .subscribe(
+            format!("semo/+/+/status/{robot}"),
+            rumqttc::QoS::AtLeastOnce,
+        )
+        .unwrap();
+    let end = Instant::now() + LIMIT;
+    for event in connection.iter() {
+        assert!(Instant::now() < end, "no retained status of {robot}");
+        if let Ok(rumqttc::Event::Incoming(rumqttc::Packet::Publish(p))) = event {
+            return serde_json::from_slice(&p.payload).expect("a status is JSON");
+        }
+    }
+    panic!("the broker closed before {robot}'s status")
 }
 
 /// The Linux robot on the fleet's broker (`--transport mqtt`), its trace

@@ -422,8 +422,9 @@ fn behaves_as_in_the_simulator(test: &str, on: Board) {
 /// What the operator console and the live monitor read of the board robot
 /// `ti` (`heard`: every status, in order): running, in the modes `modes`
 /// (the simulator's) in order, then finished and stopped in the last mode,
-/// its plans idle; `started` 0 (its mission time 0 is the gateway's
-/// welcome: a board has no wall clock); a status with the fields of its
+/// its plans idle; `started` the one wall-clock time of the gateway's
+/// welcome (the board's mission time 0: a board has no wall clock, it says
+/// 0 and the gateway says when); a status with the fields of its
 /// team mate's, a Linux robot's, at times that never go back.
 fn ti_s_status_is_a_linux_robot_s(heard: &[(Status, serde_json::Value)], modes: &[String]) {
     let ti = statuses_of(heard, "ti");
@@ -435,7 +436,11 @@ fn ti_s_status_is_a_linux_robot_s(heard: &[(Status, serde_json::Value)], modes: 
     let mut states: Vec<&str> = ti.iter().map(|s| s.state.as_str()).collect();
     states.dedup();
     assert_eq!(states, ["running", "finished", "stopped"], "{ti:#?}");
-    assert!(ti.iter().all(|s| s.started == Some(0)), "{ti:#?}");
+    let welcome = ti[0].started.expect("ti's status says when it started");
+    assert!(
+        welcome > 0 && ti.iter().all(|s| s.started == Some(welcome)),
+        "one start, the gateway's welcome: {ti:#?}"
+    );
     let times: Vec<i64> = ti.iter().map(|s| s.t.expect("a status's time")).collect();
     assert!(times.is_sorted(), "{times:?}");
     assert!(

@@ -19,7 +19,7 @@
 //! frames it sends are sized for the longer of the two
 //! ([`send_max`]), the frames it takes only for what it may be sent.
 
-use crate::refine::{RobotProgram, SlotSource};
+use crate::refine::{RobotProgram, SlotSource, StateKind};
 
 /// The longest key a datagram carries (`semo_message::key` holds 64 bytes
 /// with its NUL).
@@ -86,10 +86,44 @@ pub fn status_plans(program: &RobotProgram) -> usize {
     plans(program).len().max(1)
 }
 
+/// The robot's statements of counted groups, each as the longest entry it
+/// may put in the status's `groups` (`Name=<alive>`, JSON-escaped: its
+/// longest group name or `others`, and at most as many live robots as
+/// the statement has members).
+fn counted_groups(program: &RobotProgram) -> Vec<usize> {
+    program
+        .control
+        .services
+        .iter()
+        .flat_map(|service| &service.states)
+        .filter_map(|state| match &state.kind {
+            StateKind::GroupAllocate {
+                members, groups, ..
+            } => {
+                let name = groups
+                    .iter()
+                    .map(|g| json_len(&g.name))
+                    .chain(["others".len()])
+                    .max()
+                    .unwrap_or(0);
+                Some(name + 1 + members.len().to_string().len())
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// How many statements of counted groups the status follows
+/// (`SEMO_STATUS_GROUPS`; 0: none, and no table on the board).
+pub fn status_groups(program: &RobotProgram) -> usize {
+    counted_groups(program).len()
+}
+
 /// The longest status JSON the robot writes (`semo_static_status.c`'s
 /// `write_status`): its mission time, its name, its longest state, `started`
 /// 0, its longest mode, the longest name of a robot it may follow when it
-/// elects a leader, every plan running its longest service, and a battery
+/// elects a leader, every plan running its longest service, its group at
+/// each statement of counted groups with the most it may count, a battery
 /// level when it may know one; each string as the runtime escapes it.
 fn status_max(program: &RobotProgram, battery: bool) -> usize {
     let quoted = |len: usize| 2 + len;
@@ -115,6 +149,8 @@ fn status_max(program: &RobotProgram, battery: bool) -> usize {
         .map(|(plan, service)| json_len(plan) + 1 + service)
         .sum::<usize>()
         + plans.len().saturating_sub(1);
+    let counted = counted_groups(program);
+    let groups = counted.iter().sum::<usize>() + counted.len().saturating_sub(1);
     let state = ["running", "finished", "stopped"].map(str::len);
     "{\"t\":".len()
         + I64_DIGITS
@@ -125,6 +161,11 @@ fn status_max(program: &RobotProgram, battery: bool) -> usize {
         + field("mode", quoted(mode.unwrap_or(0)))
         + field("leader", quoted(leader.unwrap_or(0)))
         + field("services", quoted(services))
+        + if counted.is_empty() {
+            0
+        } else {
+            field("groups", quoted(groups))
+        }
         + if battery {
             field("battery", quoted(I64_DIGITS))
         } else {
@@ -210,6 +251,24 @@ mod tests {
         assert_eq!(status_plans(tb), 2);
         let longest = r#"{"t":-9223372036854775808,"robot":"tb_0","event":"status","state":"finished","started":"0","mode":"RESTING","leader":"tb_0","services":"Action=Patrolling,Report=ToBase"}"#;
         assert_eq!(status_max(tb, false), longest.len());
+    }
+
+    /// Each statement of counted groups adds its longest entry (its
+    /// longest group name or `others`, `=`, the most it may count), the
+    /// entries separated by commas, after the services.
+    #[test]
+    fn the_status_bound_holds_a_group_at_each_statement_of_counted_groups() {
+        let text = "{ Crew: Turtlebot3_Burger tb[12] }\nCrew.Work.Search {\n  [[ group(Room1, min = 2) {\n       [[ group(Sweeper, min = 1) { move(\"1,4\") }\n          others { standby() } ]]\n     }\n     group(Hall, min = 1) { move(\"6,2\") }\n     others { standby() }\n  ]]\n} repeat(1 SEC)\nCrew.SEARCH { set(Work, Search) }\nCrew.main { default: mode = SEARCH }\n";
+        let programs = refined(text);
+        let tb = programs.iter().find(|p| p.robot == "tb_0").unwrap();
+        assert_eq!(status_groups(tb), 2);
+        let plain = r#"{"t":-9223372036854775808,"robot":"tb_0","event":"status","state":"finished","started":"0","mode":"SEARCH","leader":"tb_10","services":"Work=Search"}"#;
+        let groups = r#","groups":"others=12,Sweeper=12""#;
+        assert_eq!(status_max(tb, false), plain.len() + groups.len());
+        // Without counted groups: no table and nothing in the bound.
+        let programs = refined(SCOUTS);
+        let ti = programs.iter().find(|p| p.robot == "ti").unwrap();
+        assert_eq!(status_groups(ti), 0);
     }
 
     #[test]

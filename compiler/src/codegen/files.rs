@@ -868,6 +868,9 @@ pub struct LinkSizes {
     pub queue: usize,
     /// The plans its status follows (`SEMO_STATUS_PLANS`).
     pub plans: usize,
+    /// Its statements of counted groups, whose groups its status says
+    /// (`SEMO_STATUS_GROUPS`).
+    pub groups: usize,
 }
 
 impl StaticSizes {
@@ -897,6 +900,7 @@ impl StaticSizes {
                 ),
                 queue: super::board_link::QUEUE,
                 plans: super::board_link::status_plans(program),
+                groups: super::board_link::status_groups(program),
             }),
             value_bytes,
             tasks: program.graph.tasks.len().max(1),
@@ -962,7 +966,7 @@ pub fn makefile(
         out.push_str(rules);
         let link_serial = match &sizes.link {
             Some(l) => format!(
-                " -serial mon:stdio -serial $(SEMO_LINK_SERIAL)\n\n# {} in QEMU: `semo gateway MISSION --link {}=tcp:127.0.0.1:4560` connects to it.\nSEMO_LINK_SERIAL ?= tcp:127.0.0.1:4560,server,nowait",
+                " -serial mon:stdio -serial $(SEMO_LINK_SERIAL)\n\n# {} in QEMU: `semo gateway MISSION --link {}=tcp:127.0.0.1:4560` connects to it.\nSEMO_LINK_SERIAL ?= tcp:127.0.0.1:4560,server=on,wait=off,nodelay=on",
                 l.port, program.robot
             ),
             None => String::new(),
@@ -1034,17 +1038,25 @@ fn static_makefile(
                 "link_sizes",
                 &sizes.link.as_ref().map_or(String::new(), |l| {
                     format!(
-                        "# The serial link to `semo gateway` on {} ({}, {} baud; docs/link.md):\n# the largest frame payload it takes and sends (its status), from the mission's\n# names, the frames queued, and the plans its status follows.\nSEMO_LINK_BAUD ?= {}\nSEMO_LINK_PAYLOAD_MAX ?= {}\nSEMO_LINK_SEND_MAX ?= {}\nSEMO_LINK_QUEUE ?= {}\nSEMO_STATUS_PLANS ?= {}\n",
-                        l.port, l.pins, l.baud, l.baud, l.payload, l.send, l.queue, l.plans
+                        "# The serial link to `semo gateway` on {} ({}, {} baud; docs/link.md):\n# the largest frame payload it takes and sends (its status), from the mission's\n# names, the frames queued, and the plans its status follows.\nSEMO_LINK_BAUD ?= {}\nSEMO_LINK_PAYLOAD_MAX ?= {}\nSEMO_LINK_SEND_MAX ?= {}\nSEMO_LINK_QUEUE ?= {}\nSEMO_STATUS_PLANS ?= {}\n{}",
+                        l.port, l.pins, l.baud, l.baud, l.payload, l.send, l.queue, l.plans,
+                        // Only a robot with counted groups has the table.
+                        if l.groups > 0 {
+                            format!("# Its statements of counted groups, whose groups its status says.\nSEMO_STATUS_GROUPS ?= {}\n", l.groups)
+                        } else {
+                            String::new()
+                        }
                     )
                 }),
             ),
             (
                 "link_flags",
-                &if sizes.link.is_some() {
-                    " -DSEMO_LINK -DSEMO_LINK_BAUD=$(SEMO_LINK_BAUD)u -DSEMO_LINK_PAYLOAD_MAX=$(SEMO_LINK_PAYLOAD_MAX) -DSEMO_LINK_SEND_MAX=$(SEMO_LINK_SEND_MAX) -DSEMO_LINK_QUEUE=$(SEMO_LINK_QUEUE) -DSEMO_STATUS_PLANS=$(SEMO_STATUS_PLANS)"
-                } else {
-                    ""
+                &match &sizes.link {
+                    Some(l) => format!(
+                        " -DSEMO_LINK -DSEMO_LINK_BAUD=$(SEMO_LINK_BAUD)u -DSEMO_LINK_PAYLOAD_MAX=$(SEMO_LINK_PAYLOAD_MAX) -DSEMO_LINK_SEND_MAX=$(SEMO_LINK_SEND_MAX) -DSEMO_LINK_QUEUE=$(SEMO_LINK_QUEUE) -DSEMO_STATUS_PLANS=$(SEMO_STATUS_PLANS){}",
+                        if l.groups > 0 { " -DSEMO_STATUS_GROUPS=$(SEMO_STATUS_GROUPS)" } else { "" }
+                    ),
+                    None => String::new(),
                 },
             ),
             (

@@ -81,14 +81,16 @@ void semo__trace_emit(const char *event, const char *value_key, const semo_value
     semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args, value_key, value);
 }
 
-/* A board's status does not carry its groups (docs/deployment.md, "Status"):
- * the trace's `allocated` lines say them. */
+#ifndef SEMO_LINK
+/* A board robot alone has no status (a linked one's is in
+ * semo_static_status.c, its groups with it). */
 void semo_status_group(unsigned statement, const char *group, size_t alive)
 {
     (void)statement;
     (void)group;
     (void)alive;
 }
+#endif
 
 /* --------------------------------------------------------------- channels */
 

@@ -9,11 +9,16 @@
  * <scope>/status/<robot>, where the operator console and the live monitor
  * read it as a Linux robot's:
  *   {"t":..,"robot":..,"event":"status","state":..,"started":"0","mode":..,
- *    "leader":..,"services":"Plan=Service,...","battery":".."}
- * No `groups`: a board keeps no counted groups (semo_static.c's
- * semo_status_group does nothing; the trace's `allocated` says them).
+ *    "leader":..,"services":"Plan=Service,...","groups":"Room1=4,...",
+ *    "battery":".."}
+ * `groups` as a Linux robot's: only when it passed a statement of counted
+ * groups since its mode started, its group at each (by statement number,
+ * told by the control task through semo_status_group) with the members it
+ * counted alive when it took it; the Makefile's SEMO_STATUS_GROUPS is how
+ * many such statements the robot has (none: no table at all).
  * `started` is 0: a board has no wall clock, and its mission time 0 is the
- * gateway's welcome (semo_static_link.c). `battery` only when the robot
+ * gateway's welcome (semo_static_link.c), whose wall-clock time the gateway
+ * puts in its place. `battery` only when the robot
  * knows its level (its BATTERY value, in simulation the scenario's).
  *
  * No heap, no copies: the names come from the generated control task's
@@ -46,6 +51,11 @@
 #define SEMO_STATUS_PLANS 8
 #endif
 _Static_assert(SEMO_STATUS_PLANS >= 1 && SEMO_STATUS_PLANS <= 0xFFFF, "SEMO_STATUS_PLANS must be 1 to 65535");
+/* The statements of counted groups the robot has (the Makefile's). */
+#ifndef SEMO_STATUS_GROUPS
+#define SEMO_STATUS_GROUPS 0
+#endif
+_Static_assert(SEMO_STATUS_GROUPS >= 0 && SEMO_STATUS_GROUPS <= 0xFFFF, "SEMO_STATUS_GROUPS must be 0 to 65535");
 
 /* A name not known yet is NULL, written "" (semo__json_chars). */
 static struct {
@@ -55,6 +65,15 @@ static struct {
     struct {
         const char *plan, *service;
     } running[SEMO_STATUS_PLANS];
+#if SEMO_STATUS_GROUPS > 0
+    /* By statement number, in order; the group's name is the control
+     * task's constant (a group's name, or "others"). */
+    struct {
+        const char *group;
+        unsigned short statement, alive;
+    } groups[SEMO_STATUS_GROUPS];
+    unsigned short group_count;
+#endif
     /* The battery level the last status said. */
     long long battery;
     unsigned short running_count;
@@ -123,6 +142,19 @@ static void write_status(const semo__sink *sink, int64_t t)
         first = false;
     }
     put(sink, "\"");
+#if SEMO_STATUS_GROUPS > 0
+    if (g_status.group_count > 0) {
+        put(sink, ",\"groups\":\"");
+        for (size_t i = 0; i < g_status.group_count; i++) {
+            put(sink, i ? "," : "");
+            semo__json_chars(sink, g_status.groups[i].group);
+            put(sink, "=");
+            semo__format_i64(number, g_status.groups[i].alive);
+            put(sink, number);
+        }
+        put(sink, "\"");
+    }
+#endif
     if (g_status.battery_known) {
         semo__format_i64(number, g_status.battery);
         field(sink, "battery", number);
@@ -142,6 +174,8 @@ static void plan_runs(const char *plan, const char *service, bool starts)
         g_status.running[i].service = starts && service ? service : "";
 }
 
+static void queue_status(void);
+
 void semo__status_observe(const char *event, va_list args)
 {
     bool changed = true;
@@ -153,6 +187,10 @@ void semo__status_observe(const char *event, va_list args)
         g_status.state = "stopped";
     } else if (strcmp(event, "mode") == 0) {
         g_status.mode = semo__trace_pair(args, "mode");
+#if SEMO_STATUS_GROUPS > 0
+        /* The new mode's statements tell their groups as they are passed. */
+        g_status.group_count = 0;
+#endif
     } else if (strcmp(event, "leader") == 0) {
         g_status.leader = semo__trace_pair(args, "leader");
     } else if (strcmp(event, "fenced") == 0) {
@@ -165,6 +203,50 @@ void semo__status_observe(const char *event, va_list args)
         changed = false;
     }
     g_status.pending = g_status.pending || changed;
+    queue_status();
+}
+
+#if SEMO_STATUS_GROUPS > 0
+void semo_status_group(unsigned statement, const char *group, size_t alive)
+{
+    unsigned short n = g_status.group_count;
+    unsigned short i = 0;
+    while (i < n && g_status.groups[i].statement < statement)
+        i++;
+    bool found = i < n && g_status.groups[i].statement == statement;
+    unsigned short counted = alive > 0xFFFF ? 0xFFFF : (unsigned short)alive;
+    if (!group && found) {
+        memmove(&g_status.groups[i], &g_status.groups[i + 1], (size_t)(n - i - 1) * sizeof g_status.groups[0]);
+        g_status.group_count--;
+    } else if (group && found && strcmp(g_status.groups[i].group, group) != 0) {
+        g_status.groups[i].group = group;
+        g_status.groups[i].alive = counted;
+    } else if (group && !found && n < SEMO_STATUS_GROUPS) {
+        memmove(&g_status.groups[i + 1], &g_status.groups[i], (size_t)(n - i) * sizeof g_status.groups[0]);
+        g_status.group_count++;
+        g_status.groups[i].statement = (unsigned short)statement;
+        g_status.groups[i].group = group;
+        g_status.groups[i].alive = counted;
+    } else {
+        return;
+    }
+    g_status.pending = true;
+    queue_status();
+}
+#else
+/* No statement of counted groups: nothing to tell. */
+void semo_status_group(unsigned statement, const char *group, size_t alive)
+{
+    (void)statement;
+    (void)group;
+    (void)alive;
+}
+#endif
+
+/* Queues the status when it changed since the last one queued (or the
+ * battery level did). */
+static void queue_status(void)
+{
     /* The battery: what the control task last read of its BATTERY value; in
      * simulation without one, the scenario's level. */
     long long level = 0;
