@@ -79,19 +79,19 @@ pub(super) fn front(
         // before) whose cycle keeps its samples here gives its outcome:
         // the channel grown is not on it.
         let mut inherited = None;
-        for j in 0..caps.len() {
-            if caps[j] < minimal[j] + steps[j] {
+        for (j, (&cap, (&low, &step))) in caps.iter().zip(minimal.iter().zip(steps)).enumerate() {
+            if cap < low.saturating_add(step) {
                 continue;
             }
             search.work = search.work.saturating_add(1);
             let parent = hash
-                .wrapping_sub(part(j, caps[j]))
-                .wrapping_add(part(j, caps[j] - steps[j]));
+                .wrapping_sub(part(j, cap))
+                .wrapping_add(part(j, cap - step));
             let found = table.find(parent, |other| {
                 search.work = search.work.saturating_add(channels);
                 other.iter().zip(&caps).enumerate().all(|(i, (&o, &c))| {
                     if i == j {
-                        o.checked_add(steps[j]) == Some(c)
+                        o.checked_add(step) == Some(c)
                     } else {
                         o == c
                     }
