@@ -789,6 +789,60 @@ fn sdf3_buffer_fronts_are_on_semos_fronts() {
     }
 }
 
+/// The generated graphs with a self-loop on every actor or on about half of
+/// them where the exact exploration used to run out of its budget: every
+/// point of `semo graph buffers --sdf3-compat`'s front is proven (`exact`),
+/// the front ends at the maximal throughput and its minimum is exact, and
+/// any SDF3 point `buffersize.json` holds for them is on it.
+#[test]
+fn self_looped_generated_graphs_have_exact_buffer_fronts() {
+    let data = std::fs::read_to_string(sdf3().join("buffersize.json")).unwrap();
+    let fronts: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&data).unwrap();
+    for graph in [
+        "generated/r12_1_selfloops.xml",
+        "generated/r12_1_somelooped.xml",
+        "generated/r12_6_selfloops.xml",
+        "generated/r12_6_somelooped.xml",
+    ] {
+        let out = semo_in(
+            &sdf3(),
+            &[
+                "graph",
+                "buffers",
+                "--sdf3-compat",
+                "--format",
+                "json",
+                graph,
+            ],
+        );
+        assert_eq!(out.code, 0, "{graph}: {}{}", out.stdout, out.stderr);
+        let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+        assert_eq!(v["exact_front"], true, "{graph}: {v}");
+        let points = v["points"].as_array().unwrap();
+        assert!(!points.is_empty(), "{graph}");
+        for p in points {
+            assert_eq!(p["proof"], "exact", "{graph}: {p}");
+        }
+        assert_eq!(points.last().unwrap()["period"], v["max_period"], "{graph}");
+        let minimal = &v["minimal_size"];
+        assert_eq!(minimal["exact"], true, "{graph}: {minimal}");
+        assert_eq!(minimal["found"], points.last().unwrap()["size"], "{graph}");
+        let key = graph.trim_start_matches("generated/");
+        for point in fronts
+            .get(key)
+            .and_then(|f| f.as_array())
+            .into_iter()
+            .flatten()
+        {
+            let size = point[0].as_u64().unwrap();
+            assert!(
+                size == 0 || points.iter().any(|p| p["size"] == size),
+                "{graph}: SDF3's point of size {size} is not on semo's front"
+            );
+        }
+    }
+}
+
 /// A file starting with a byte-order mark (as some Windows editors save it)
 /// gets its diagnostics where they are: the mark is one column, and every
 /// range, to the end of the element, is one column on from the same file

@@ -74,6 +74,13 @@ pub struct Throughput {
     /// self-loop channel). Empty when no cycle bounds the period (period 0,
     /// only with [`Concurrency::Auto`]).
     pub critical_cycle: Vec<usize>,
+    /// The level nodes of the critical cycle's firings in flow order, as
+    /// the engine found it, before [`Throughput::critical_cycle`] merges
+    /// consecutive firings of one node and repeated rounds: each entry and
+    /// the next (the last and the first) are joined by a channel between
+    /// those nodes (a self-loop, or a node's chain of firings, when they are
+    /// the same node). Empty when `critical_cycle` is.
+    pub walk: Vec<usize>,
 }
 
 /// Most HSDF nodes plus edges built before giving up (about 150 MB).
@@ -227,10 +234,11 @@ fn period(
 ) -> Result<Throughput, NoPeriod> {
     let direct = counts.iter().all(|&c| c == 1) && sdf.edges.iter().all(|e| e.produce == e.consume);
     if !direct && symbolic_is_cheaper(sdf, counts, chained) {
-        if let Some((period, critical_cycle)) = symbolic::period(sdf, counts, wcet, chained) {
+        if let Some((period, walk)) = symbolic::period(sdf, counts, wcet, chained) {
             return Ok(Throughput {
                 period,
-                critical_cycle,
+                critical_cycle: level_cycle(walk.clone()),
+                walk,
             });
         }
     }
@@ -243,13 +251,15 @@ fn period(
         return Ok(Throughput {
             period: Ratio { num: 0, den: 1 },
             critical_cycle: Vec::new(),
+            walk: Vec::new(),
         });
     };
     let (period, cycle) = max_cycle_ratio(&hsdf).ok_or(NoPeriod::Overflow)?;
     let walk: Vec<usize> = cycle.iter().map(|&v| hsdf.actor(v)).collect();
     Ok(Throughput {
         period,
-        critical_cycle: level_cycle(walk),
+        critical_cycle: level_cycle(walk.clone()),
+        walk,
     })
 }
 
@@ -1220,11 +1230,8 @@ mod tests {
         // Two parts, each of one node firing once per iteration of its own:
         // no expansion, B's 10^9 firings back to back bound it.
         assert_eq!(
-            throughput(&level, &counts, Concurrency::Single),
-            Ok(Throughput {
-                period: ratio(1_000_000_000, 1),
-                critical_cycle: vec![1],
-            })
+            throughput(&level, &counts, Concurrency::Single).map(|t| (t.period, t.critical_cycle)),
+            Ok((ratio(1_000_000_000, 1), vec![1]))
         );
         // One part of 10^9 + 1 firings with 10^9 initial samples: too big
         // for both engines.

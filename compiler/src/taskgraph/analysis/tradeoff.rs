@@ -180,6 +180,12 @@ struct Search<'l, 'g> {
     cost: u64,
     /// Whether [`Search::within`] said no once.
     exhausted: bool,
+    /// Whether a critical cycle's space edges are those joining two
+    /// consecutive firings of the cycle (the exact exploration: the fewer,
+    /// the fewer distributions it grows), or those joining two consecutive
+    /// nodes of the level's cycle, a node's self-loop whenever the node is
+    /// on it (the greedy search, whose points depend on the ties it breaks).
+    precise: bool,
 }
 
 /// The work of one evaluation: the size of the HSDF with space edges (as
@@ -230,16 +236,21 @@ impl Search<'_, '_> {
         }
         let t = throughput(&with_space, &self.counts, self.concurrency).ok()?;
         // Space edges joining consecutive nodes of the critical cycle (a
-        // self-loop's when the cycle is one node).
+        // self-loop's when the cycle is one node), or, `precise`, of its
+        // firings (a self-loop's only between two firings of its node).
         // (As sets: on a large level the cycle can have thousands of nodes.)
-        let cycle = &t.critical_cycle;
+        let cycle = if self.precise {
+            &t.walk
+        } else {
+            &t.critical_cycle
+        };
         let nodes: FastSet<usize> = cycle.iter().copied().collect();
         let steps: FastSet<(usize, usize)> = (0..cycle.len())
             .map(|i| (cycle[i], cycle[(i + 1) % cycle.len()]))
             .collect();
         let mut on_cycle = Vec::new();
         for (k, e) in with_space.edges.iter().enumerate().skip(n) {
-            let joins = if e.src == e.dst {
+            let joins = if e.src == e.dst && !self.precise {
                 nodes.contains(&e.src)
             } else {
                 steps.contains(&(e.src, e.dst))
@@ -279,6 +290,7 @@ pub fn trade_off_towards(
         work: cost,
         cost,
         exhausted: false,
+        precise: false,
     };
     let minimal: Vec<u64> = level.edges.iter().map(minimal_capacity).collect();
     // Nothing found: SDF3's per-channel bounds hold for any positive
@@ -312,9 +324,10 @@ pub fn trade_off_towards(
     // Exact where the exploration fits its budget: every Pareto point.
     if target.num > 0 && search.cost.saturating_mul(MIN_EXACT_EVALUATIONS) <= EXACT_WORK {
         let before = search.work;
-        if let Some(points) =
-            exact::front(&mut search, &minimal, &steps, target, before + EXACT_WORK)
-        {
+        search.precise = true;
+        let front = exact::front(&mut search, &minimal, &steps, target, before + EXACT_WORK);
+        search.precise = false;
+        if let Some(points) = front {
             let lower_bound = match points.last() {
                 Some(last) if target == max_period => last.size,
                 _ => minimal.iter().sum(),

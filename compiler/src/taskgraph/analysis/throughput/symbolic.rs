@@ -23,7 +23,7 @@
 //! The critical cycle is traced back through the firings: each vector entry
 //! remembers which input gave its max.
 
-use super::{Hsdf, Rates, Sdf, level_cycle, max_cycle_ratio};
+use super::{Hsdf, Rates, Sdf, max_cycle_ratio};
 use crate::taskgraph::analysis::ratio::Ratio;
 use std::collections::VecDeque;
 
@@ -73,8 +73,8 @@ pub(super) fn cost(sdf: &Sdf, counts: &[u64], chained: &[bool]) -> Option<u64> {
 /// firing `o - D` of the iteration.
 type Origin = usize;
 
-/// The period and the level nodes around a critical cycle (in flow order,
-/// before [`level_cycle`]); `None` on overflow or when the iteration cannot
+/// The period and the level nodes of a critical cycle's firings (in flow
+/// order, before [`super::level_cycle`] merges them); `None` on overflow or when the iteration cannot
 /// complete (the caller then uses the HSDF).
 pub(super) fn period(
     sdf: &Sdf,
@@ -236,7 +236,7 @@ pub(super) fn period(
         path.reverse();
         walk.extend(path);
     }
-    Some((ratio, level_cycle(walk)))
+    Some((ratio, walk))
 }
 
 /// `start = max(start, the vector of origin)`, remembering where each

@@ -465,3 +465,31 @@ fn large_rates_stop_at_the_work_budget() {
         level.edges.iter().map(minimal_capacity).sum::<u64>()
     );
 }
+
+/// The generated graphs with self-loops where the exact exploration used to
+/// run out of its budget (its front was only bounded): exact now, within
+/// [`EXACT_WORK`], each point reaching its period in the simulation and the
+/// last the maximal throughput. (SDF3's own exploration stops before the
+/// maximal throughput on these; `tests/data/sdf3/README.md`.)
+#[test]
+fn self_looped_generated_graphs_have_exact_fronts() {
+    for name in [
+        "r12_1_selfloops",
+        "r12_1_somelooped",
+        "r12_6_selfloops",
+        "r12_6_somelooped",
+    ] {
+        let g = load(&format!("generated/{name}"));
+        let level = Level::build(&g, None, g.name.clone());
+        let found = trade_off(&level, Concurrency::Auto).unwrap();
+        assert!(found.exact_front && found.exact(), "{name}");
+        assert!(!found.budget_exhausted, "{name}");
+        assert!(found.work <= EXACT_WORK, "{name}: {}", found.work);
+        assert_eq!(
+            found.points.last().unwrap().period,
+            found.max_period,
+            "{name}"
+        );
+        check_points(&level, &found, Concurrency::Auto);
+    }
+}
