@@ -90,6 +90,7 @@ fn measure_once(
         until_ms,
         seed: 1,
         every_firing,
+        untraced_messages: scenario.expect.is_empty(),
     };
     let (run, lines) = streamed(programs, &scenario, &options);
     let best = fastest(Duration::from_secs(3), || {
@@ -117,13 +118,14 @@ fn streamed(
     (run, lines)
 }
 
-/// One streamed run of a long mission, timed once.
-fn measure_long(name: &str, programs: &[RobotProgram], until_ms: i64) {
-    let scenario = scenario::parse("{}", programs).expect("the scenario reads");
+/// One streamed run of a long mission on a scenario, timed once.
+fn measure_long(name: &str, programs: &[RobotProgram], scenario: &str, until_ms: i64) {
+    let scenario = scenario::parse(scenario, programs).expect("the scenario reads");
     let options = sim::Options {
         until_ms: Some(until_ms),
         seed: 1,
         every_firing: false,
+        untraced_messages: scenario.expect.is_empty(),
     };
     let start = Instant::now();
     let (run, lines) = streamed(programs, &scenario, &options);
@@ -165,5 +167,18 @@ fn main() {
 
     let ten_minutes = 10 * 60 * 1000;
     measure("swarm", &swarm(17), "{}", Some(ten_minutes));
-    measure_long("swarm of 1,002", &swarm(167), ten_minutes);
+    measure_long("swarm of 1,002", &swarm(167), "{}", ten_minutes);
+
+    // Issue 36's target: a team of 200 robots in nested counted groups.
+    let mut files = semo::workspace::Files::default();
+    let id = files.add(
+        "nested_groups.mission".into(),
+        semo::workspace::FileKind::Mission,
+        common::mission::nested_groups(200),
+    );
+    let nested = programs(files, id);
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("benches/fixtures");
+    let scenario = std::fs::read_to_string(fixtures.join("nested_groups.scenario.json"))
+        .expect("the benchmark scenario");
+    measure_long("nested groups of 200", &nested, &scenario, ten_minutes);
 }
