@@ -126,3 +126,65 @@ fn the_simulators_work_follows_the_robots_and_its_memory_not_the_runs_length() {
     // A kept trace took four times the memory.
     ratio("peak bytes", peak_short, peak_long, 1.3);
 }
+
+/// What simulating `programs` for `until_ms` as `semo simulate` runs a
+/// scenario without expectations and without `--trace` costs (no message
+/// traced, `Options::untraced_messages`): (events, entries of the event
+/// queue, allocations).
+fn untraced_cost(programs: &[RobotProgram], until_ms: i64) -> (u64, u64, usize) {
+    let scenario = scenario::parse("{}", programs).expect("an empty scenario reads");
+    let options = sim::Options {
+        until_ms: Some(until_ms),
+        untraced_messages: true,
+        ..sim::Options::default()
+    };
+    let ((events, queued), _, allocations) = counting::measure(|| {
+        let robots = sim::Run::robots_of(programs);
+        let mut digest = sim::Digest::new(&robots, &scenario.expect);
+        let run = sim::simulate_into(programs, &scenario, &options, &mut |e| digest.see(&e));
+        assert!(!sim::summary_of(&run, &digest, &[]).contains("no mode"));
+        (run.events, run.queued)
+    });
+    (events, queued, allocations)
+}
+
+#[test]
+fn a_heartbeat_heard_costs_no_allocation_and_a_heartbeat_sent_one_queue_entry() {
+    let _one = counting::MEASURING
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    // The benchmark's input is the generator's (`cargo bench --bench simulate`).
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let fixture = std::fs::read_to_string(root.join("benches/fixtures/nested_groups.mission"))
+        .expect("the benchmark mission");
+    assert_eq!(fixture, mission::nested_groups(200));
+
+    let team = |robots| programs("nested_groups.mission", mission::nested_groups(robots));
+    untraced_cost(&team(10), 100);
+    let (small, large) = (team(20), team(40));
+    let (events_small, queued_small, work_small) = untraced_cost(&small, 5000);
+    let (events_large, queued_large, work_large) = untraced_cost(&large, 5000);
+    // Every robot hears every other: twice the robots, four times the
+    // heartbeats heard; but a heartbeat sent is one entry of the queue
+    // for all its robots, and hearing one allocates nothing.
+    ratio("events", events_small as usize, events_large as usize, 4.3);
+    ratio(
+        "queue entries",
+        queued_small as usize,
+        queued_large as usize,
+        2.2,
+    );
+    ratio("allocations", work_small, work_large, 2.5);
+    // What twice the mission time adds (the robots' start and the summary
+    // left out): a heartbeat's message and list of robots for its 39
+    // hearers, and each pass through the counted groups' lists of live
+    // members (0.23 per event); an allocation per hearer took one per
+    // event more.
+    let (events_longer, _, work_longer) = untraced_cost(&large, 10_000);
+    let per_event = (work_longer - work_large) as f64 / (events_longer - events_large) as f64;
+    eprintln!("allocations per event, no message traced: {per_event:.3}");
+    assert!(
+        per_event <= 0.5,
+        "{per_event:.3} allocations per event ({work_large} for {events_large}, {work_longer} for {events_longer})"
+    );
+}

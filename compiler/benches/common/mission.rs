@@ -90,3 +90,59 @@ Team{t}.main{{
     }
     m
 }
+
+/// Issue 36's swarm mission: one team of `robots` TurtleBots split at run
+/// time into three rooms of counted groups (minimums of 30%, 30% and 20%
+/// of the team), each room split again into two searchers and the robots
+/// at its door, every second. Every robot sends a heartbeat to all the
+/// others every 200 ms, so almost every event of a run is a heartbeat
+/// heard. `benches/fixtures/nested_groups.mission` is this of 200 robots.
+#[allow(dead_code)] // the simulator's bench and scaling test only
+pub fn nested_groups(robots: usize) -> String {
+    let (room, small) = (robots * 3 / 10, robots / 5);
+    format!(
+        r#"# Benchmark input (issue 36's performance target, `cargo bench --bench
+# simulate`): one team of {robots} robots split at run time into three rooms of
+# counted groups, each room split again into searchers and robots at its door.
+# Every robot sends a heartbeat to the other {others} every 200 ms, so almost all of
+# a run's events are heartbeat receipts.
+{{
+  Crew: Turtlebot3_Burger tb[{robots}]
+}}
+
+def room(DOOR) {{
+  [[
+    group(Searcher, min = 2) {{
+      move(DOOR)
+    }}
+    others {{
+      standby()
+    }}
+  ]]
+}}
+
+Crew.Work.Rooms {{
+  [[
+    group(Room1, min = {room}) {{
+      room("1,1")
+    }}
+    group(Room2, min = {room}) {{
+      room("5,1")
+    }}
+    group(Room3, min = {small}) {{
+      room("9,1")
+    }}
+  ]]
+}} repeat(1 SEC)
+
+Crew.ROOMS {{
+  set(Work, Rooms)
+}}
+
+Crew.main {{
+  default: mode = ROOMS
+}}
+"#,
+        others = robots - 1
+    )
+}

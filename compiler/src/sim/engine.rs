@@ -75,8 +75,17 @@ pub struct Options {
     /// Seeds message loss; a run is a function of programs, scenario and seed.
     pub seed: u64,
     /// Simulates every control firing, idle ones too: the slow reference
-    /// against which skipping idle firings is tested (the trace is the same).
+    /// against which skipping idle firings is tested (the trace is the same),
+    /// and every message sent to each robot through `Sim::link`, which a
+    /// network without faults or links of its own skips.
     pub every_firing: bool,
+    /// Makes no `send` and `receive` trace events, for a caller whose sink
+    /// reads none (a summary without expectations reads only `start`,
+    /// `mode`, `finish` and `fault`): they are most of a swarm's trace (a
+    /// team of 200 robots hears 199 heartbeats every 200 ms each), and
+    /// making them was most of its run. What the robots do, the other
+    /// events, `events` and `end_ms` are the same.
+    pub untraced_messages: bool,
 }
 
 /// The outcome of a run.
@@ -493,6 +502,11 @@ pub struct Sim<'p> {
     /// A send's arrivals (instant, order, robot, its epoch), kept between
     /// sends for its room: a send allocates no list of its own.
     arrivals: Vec<(i64, u64, usize, u32)>,
+    /// Makes no `send` and `receive` trace events ([`Options::untraced_messages`]).
+    untraced_messages: bool,
+    /// Trace events not made ([`Sim::untraced_messages`]) so far: a firing
+    /// that would have traced one is no idle firing.
+    unmade: u64,
 }
 
 impl<'p> Robot<'p> {
@@ -707,6 +721,8 @@ impl<'p> Sim<'p> {
             channel_full: "channel full".into(),
             races: None,
             arrivals: Vec::new(),
+            untraced_messages: options.untraced_messages,
+            unmade: 0,
         };
         sim.inputs = sim.robots.iter().map(Inputs::of).collect();
         for r in 0..programs.len() {
@@ -859,13 +875,13 @@ impl<'p> Sim<'p> {
                     self.last_fire = (self.now, r.chain);
                     self.robots[robot].progressed = false;
                     self.robots[robot].firings += 1;
-                    let traced = self.trace.len();
+                    let traced = self.trace.len() as u64 + self.unmade;
                     self.fire(robot);
                     if self.robots[robot].alive {
                         self.take_requests(robot);
                         let idle = !self.every_firing
                             && !self.robots[robot].progressed
-                            && self.trace.len() == traced;
+                            && self.trace.len() as u64 + self.unmade == traced;
                         match if idle {
                             self.wake_up(robot)
                         } else {
@@ -900,13 +916,7 @@ impl<'p> Sim<'p> {
             // queue: they were scheduled one after the other, so nothing
             // else comes between them. (A delivery stops no robot: the run
             // cannot end among them.)
-            Event::Deliver { to, message } => {
-                for &(r, epoch) in to.iter() {
-                    if self.robots[r].alive && self.robots[r].epoch == epoch {
-                        self.deliver(r, &message);
-                    }
-                }
-            }
+            Event::Deliver { to, message } => self.deliver_all(&to, &message),
             Event::Operator(i) => self.operator(i),
             Event::Fault(i) => self.fault(i),
         }
@@ -1138,14 +1148,18 @@ impl<'p> Sim<'p> {
     /// `semo_comm_send`: traced, then to every other robot of `to` (team or
     /// robot name) through the network; `USER` only traces.
     fn comm_send(&mut self, r: usize, to: Rc<str>, publish: bool, key: Rc<str>, value: Held) {
-        self.trace.push(TraceEvent {
-            t: self.now,
-            robot: r,
-            event: "send",
-            fields: smallvec![("to", to.clone()), ("key", key.clone())],
-            value: Some(("value", value.clone())),
-            sent_at: None,
-        });
+        if self.untraced_messages {
+            self.unmade += 1;
+        } else {
+            self.trace.push(TraceEvent {
+                t: self.now,
+                robot: r,
+                event: "send",
+                fields: smallvec![("to", to.clone()), ("key", key.clone())],
+                value: Some(("value", value.clone())),
+                sent_at: None,
+            });
+        }
         if &*to == "USER" {
             return;
         }
@@ -1167,6 +1181,24 @@ impl<'p> Sim<'p> {
         // Each recipient in turn takes the next number of the queue's
         // order; those reached at the same instant share one entry, under
         // the first one's number (nothing else is numbered between them).
+        if self.plain_network() {
+            // Every link the network's: the message reaches every
+            // recipient at one instant, each as `link` would say.
+            let at = self.now + self.scenario.network.latency_ms;
+            let robots = &self.robots;
+            let to: Rc<[(usize, u32)]> = (targets.iter())
+                .filter(|&&dst| dst != r)
+                .map(|&dst| (dst, robots[dst].epoch))
+                .collect();
+            if !to.is_empty() {
+                let tie = self.seq + 1;
+                self.seq += to.len() as u64;
+                self.queue
+                    .push(Queued::new(at, Event::Deliver { to, message }, tie));
+                self.queued += 1;
+            }
+            return;
+        }
         let mut arrivals = std::mem::take(&mut self.arrivals);
         for &dst in targets.iter() {
             if dst == r {
@@ -1195,6 +1227,17 @@ impl<'p> Sim<'p> {
         self.arrivals = arrivals;
     }
 
+    /// Whether every message now takes the network's latency and none is
+    /// lost ([`Sim::link`] of every pair): no link of its own, no loss, no
+    /// fault of the network, none of `semo verify`'s disturbances.
+    fn plain_network(&self) -> bool {
+        !self.every_firing
+            && self.fleet.plain_network()
+            && self.scenario.network.loss <= 0.0
+            && self.isolated.is_none()
+            && self.disturbed.is_empty()
+    }
+
     /// The latency of a message from `a` to `b` now, or `None` when it is lost.
     fn link(&mut self, a: usize, b: usize, key: &str) -> Option<i64> {
         let (na, nb) = (&self.programs[a].robot, &self.programs[b].robot);
@@ -1221,6 +1264,34 @@ impl<'p> Sim<'p> {
             return None;
         }
         Some(latency)
+    }
+
+    /// A message reaches the robots `to` at one instant (each with the epoch
+    /// it had when the message was sent), each in turn. A heartbeat, most
+    /// of a swarm's messages, reaching a robot whose receive task takes it
+    /// at once is heard here without the receive task's general path
+    /// ([`Sim::take_in`]: the same trace event and the same [`Hearing`]).
+    fn deliver_all(&mut self, to: &[(usize, u32)], message: &Rc<Message>) {
+        let heartbeat = message.publish && matches!(message.value, Some(Value::Text(_)));
+        for &(r, epoch) in to {
+            let robot = &self.robots[r];
+            if !robot.alive || robot.epoch != epoch {
+                continue;
+            }
+            let program = robot.program;
+            let at_once = heartbeat
+                && robot.has_receiver
+                && robot.holding.is_none()
+                && program.control.heartbeat
+                && message.key == self.fleet.names[r].alive_key
+                && (program.library.as_ref()).is_none_or(|lib| lib.ownership.is_none());
+            if at_once {
+                self.trace_receive(r, message);
+                self.hear_heartbeat(r, message);
+            } else {
+                self.deliver(r, message);
+            }
+        }
     }
 
     /// A message reaches the robot: the receive task takes it, unless it is
@@ -1297,18 +1368,7 @@ impl<'p> Sim<'p> {
     /// group, or a message for the control task's channels (held up while
     /// one is full: [`Sim::release`]).
     fn take_in(&mut self, r: usize, message: &Message) {
-        self.trace.push(TraceEvent {
-            t: self.now,
-            robot: r,
-            event: "receive",
-            fields: smallvec![
-                ("from", message.from_team.clone()),
-                ("from_robot", message.from_robot.clone()),
-                ("key", message.key.clone()),
-            ],
-            value: Some(("value", message.value.clone())),
-            sent_at: Some(message.sent_at),
-        });
+        self.trace_receive(r, message);
         if self.shared_heard(r, message) {
             return;
         }
@@ -1317,20 +1377,7 @@ impl<'p> Sim<'p> {
         // Keys and names compare as their interned `Rc`s (`Names`).
         let names = &self.fleet.names[r];
         if m.heartbeat && message.publish && message.key == names.alive_key {
-            // A heartbeat's value is text ("leader 80 2"); anything else says nothing.
-            let text = match &message.value {
-                Some(Value::Text(t)) => t,
-                _ => "",
-            };
-            let said = *message.said.get_or_init(|| Heard::parse(0, text));
-            let heard = Heard {
-                seen: self.now,
-                ..said
-            };
-            if let Some(peer) = sender_peer(robot.program, message) {
-                robot.heard.set(peer, heard);
-                robot.term = robot.term.max(heard.term);
-            }
+            self.hear_heartbeat(r, message);
             return;
         }
         // `heard_sync`: an arrival at a group statement; wakes the control task.
@@ -1402,6 +1449,47 @@ impl<'p> Sim<'p> {
                 ("reason", "not a value of its type".into()),
             ];
             self.emit(r, "reject", fields);
+        }
+    }
+
+    /// The receive task's trace event of `message` (unless
+    /// [`Options::untraced_messages`]).
+    fn trace_receive(&mut self, r: usize, message: &Message) {
+        if self.untraced_messages {
+            self.unmade += 1;
+            return;
+        }
+        self.trace.push(TraceEvent {
+            t: self.now,
+            robot: r,
+            event: "receive",
+            fields: smallvec![
+                ("from", message.from_team.clone()),
+                ("from_robot", message.from_robot.clone()),
+                ("key", message.key.clone()),
+            ],
+            value: Some(("value", message.value.clone())),
+            sent_at: Some(message.sent_at),
+        });
+    }
+
+    /// A heartbeat taken by robot `r`'s receive task (`heard_alive`): what
+    /// its sender's says, as of now.
+    fn hear_heartbeat(&mut self, r: usize, message: &Message) {
+        // A heartbeat's value is text ("leader 80 2"); anything else says nothing.
+        let text = match &message.value {
+            Some(Value::Text(t)) => t,
+            _ => "",
+        };
+        let said = *message.said.get_or_init(|| Heard::parse(0, text));
+        let heard = Heard {
+            seen: self.now,
+            ..said
+        };
+        let robot = &mut self.robots[r];
+        if let Some(peer) = sender_peer(robot.program, message) {
+            robot.heard.set(peer, heard);
+            robot.term = robot.term.max(heard.term);
         }
     }
 

@@ -34,11 +34,32 @@ fn run(programs: &[RobotProgram], scenario: &str, seed: u64) -> (Run, Vec<Verdic
         &scenario,
         &Options {
             every_firing: true,
-            ..options
+            ..options.clone()
         },
     );
     assert_eq!(run.trace_lines(), every_firing.trace_lines());
     assert_eq!(run.end_ms, every_firing.end_ms);
+    // Without the messages' trace events, the robots do the same.
+    let untraced = simulate(
+        programs,
+        &scenario,
+        &Options {
+            untraced_messages: true,
+            ..options
+        },
+    );
+    let without_messages = |run: &Run| {
+        let lines = run.trace_lines();
+        let kept = lines.lines().filter(|l| {
+            !l.contains(r#","event":"send","#) && !l.contains(r#","event":"receive","#)
+        });
+        kept.map(str::to_string).collect::<Vec<_>>()
+    };
+    assert_eq!(
+        without_messages(&run),
+        untraced.trace_lines().lines().collect::<Vec<_>>()
+    );
+    assert_eq!((run.end_ms, run.events), (untraced.end_ms, untraced.events));
     let verdicts = expect::judge(&run, &scenario.expect);
     (run, verdicts)
 }
@@ -1162,6 +1183,7 @@ fn a_run_cut_by_until_is_the_start_of_the_whole_run_with_faults() {
         until_ms: Some(until_ms),
         seed: 3,
         every_firing,
+        ..Options::default()
     };
     let whole = simulate(&programs, &scenario, &options(6000, false));
     for until in [

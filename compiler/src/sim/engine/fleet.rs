@@ -151,6 +151,13 @@ impl Fleet {
         self.network.links.get(&pair(a, b)).copied()
     }
 
+    /// Whether the scenario names no link and no network fault (the
+    /// network's latency and loss are then every link's).
+    pub(super) fn plain_network(&self) -> bool {
+        let network = &self.network;
+        network.links.is_empty() && network.pairs.is_empty() && network.partitions.is_empty()
+    }
+
     /// What the scenario's faults do now to a message between robots `a`
     /// and `b`: `None` when one of them loses it (a `drop` of the pair, a
     /// partition between them), else the ms the `delay`s of the pair add.
