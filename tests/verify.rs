@@ -164,9 +164,10 @@ fn two_robots_whose_messages_reach_a_third_in_one_instant_race() {
             && message.contains("instead of mode"),
         "{message}"
     );
-    let related: Vec<u64> = (race["related"].as_array().unwrap().iter())
+    let mut related: Vec<u64> = (race["related"].as_array().unwrap().iter())
         .map(|r| r["line"].as_u64().unwrap())
         .collect();
+    related.sort();
     assert_eq!(related, [10, 12], "{race}");
     // The replay: both answers reach the base at the finding's instant.
     let at: String = message
@@ -820,8 +821,7 @@ fn random_findings_hold(
                 let pair = |a: usize, b: usize| (a.min(b), a.max(b));
                 assert!(
                     races.iter().any(|race| race.robot == *robot
-                        && pair(race.first.from, race.second.from)
-                            == pair(senders.0, senders.1)),
+                        && pair(race.first.from, race.second.from) == pair(senders.0, senders.1)),
                     "seed {seed}: the race at {} is not replayed by {races:?}\n{text}",
                     programs[*robot].robot
                 );
@@ -851,9 +851,7 @@ fn random_findings_hold(
                         "seed {seed}: {} left its receive\n{text}",
                         programs[*robot].robot
                     ),
-                    Claim::TwoLeaders { .. }
-                    | Claim::Race { .. }
-                    | Claim::MessageRace { .. } => {
+                    Claim::TwoLeaders { .. } | Claim::Race { .. } | Claim::MessageRace { .. } => {
                         unreachable!("replayed above")
                     }
                 }

@@ -1346,11 +1346,15 @@ fn two_robots_whose_messages_the_receiver_takes_in_either_order_race() {
     let race = "tests/fixtures/verify/robots_race/main.mission";
     assert_eq!(
         races_of(race, "5,5", "0,0"),
-        ["base at 1: Scouts.SEEN=YES from north then Scouts.SEEN=NO from south; else LOST not FOUND"]
+        [
+            "base at 1: Scouts.SEEN=YES from north then Scouts.SEEN=NO from south; else LOST not FOUND"
+        ]
     );
     assert_eq!(
         races_of(race, "0,0", "5,5"),
-        ["base at 1: Scouts.SEEN=NO from north then Scouts.SEEN=YES from south; else FOUND not LOST"]
+        [
+            "base at 1: Scouts.SEEN=NO from north then Scouts.SEEN=YES from south; else FOUND not LOST"
+        ]
     );
     assert_eq!(races_of(race, "0,0", "1,1"), Vec::<String>::new());
     let commute = "tests/fixtures/verify/robots_commute/main.mission";

@@ -552,7 +552,9 @@ pub fn verify_expecting(
             format!("{what} from {}", programs[a.from].robot)
         };
         let mode_name = |mode: Option<crate::refine::ModeId>| {
-            mode.map_or("no mode".to_string(), |id| format!("mode {}", m.mode(id).name))
+            mode.map_or("no mode".to_string(), |id| {
+                format!("mode {}", m.mode(id).name)
+            })
         };
         let differs = match race.differs {
             sim::Differs::Mode(ran, other) => format!(
@@ -598,7 +600,7 @@ pub fn verify_expecting(
                 finding.relate(
                     send.span,
                     format!(
-                        "{} sends this at the same time as the other ({} ms on its way)",
+                        "{} sends this; it arrives at {} ms, in the instant the other does",
                         programs[arrival.from].robot, race.at
                     ),
                 );
@@ -679,27 +681,44 @@ fn receive_of(
 }
 
 /// The statement of `program` that sends `arrival`: a `send` or `publish`
-/// of its key, or the `throw ... broadcast` of its event.
+/// of its key (one that writes its value as a literal first), or the
+/// `throw ... broadcast` of its event.
 fn send_of<'a>(
     program: &'a RobotProgram,
     arrival: &sim::Arrival,
 ) -> Option<&'a crate::refine::State> {
-    use crate::refine::StateKind;
+    use crate::refine::{Operand, StateKind};
     let m = &program.control;
     let event = arrival.value.as_ref().map(|v| v.as_text());
-    (m.services.iter().flat_map(|s| &s.states)).find(|state| match &state.kind {
+    // Per statement: whether it sends the key, and whether it writes the
+    // arrival's value as a literal.
+    let sends = |state: &crate::refine::State| match &state.kind {
         StateKind::Send { items } if arrival.taken != sim::Taken::Event => {
-            items.iter().any(|item| {
+            let mut sends = (false, false);
+            for item in items {
                 let message = m.outgoing_message(item.message);
-                message.key == arrival.key && message.publish == arrival.publish
-            })
+                if message.key == arrival.key && message.publish == arrival.publish {
+                    sends.0 = true;
+                    if let Operand::Literal(v) = &item.value {
+                        sends.1 |= Some(v.as_text()) == event;
+                    }
+                }
+            }
+            sends
         }
         StateKind::Throw {
             event: thrown,
             broadcast: Some(_),
-        } if arrival.taken == sim::Taken::Event => Some(thrown) == event.as_ref(),
-        _ => false,
-    })
+        } if arrival.taken == sim::Taken::Event => {
+            let same = Some(thrown) == event.as_ref();
+            (same, same)
+        }
+        _ => (false, false),
+    };
+    let states = || m.services.iter().flat_map(|s| &s.states);
+    states()
+        .find(|state| sends(state).1)
+        .or_else(|| states().find(|state| sends(state).0))
 }
 
 /// " (after help killed at 0 ms)" when the way has faults, else nothing.

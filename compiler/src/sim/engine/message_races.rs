@@ -174,7 +174,8 @@ impl<'p> Sim<'p> {
             return;
         }
         rest.sort_unstable_by_key(|q| q.key);
-        let mut batch: Vec<(Rc<[(usize, u32)]>, Rc<Message>)> = vec![(first.0.clone(), first.1.clone())];
+        let mut batch: Vec<(Rc<[(usize, u32)]>, Rc<Message>)> =
+            vec![(first.0.clone(), first.1.clone())];
         for q in rest {
             if let Event::Deliver { to, message } = &q.event {
                 batch.push((to.clone(), message.clone()));
@@ -188,7 +189,8 @@ impl<'p> Sim<'p> {
             }
             for &(r, epoch) in to.iter() {
                 let robot = &self.robots[r];
-                if robot.alive && robot.epoch == epoch
+                if robot.alive
+                    && robot.epoch == epoch
                     && let Some(taken) = self.taken(r, message)
                 {
                     by_robot[r].push((message.clone(), taken));
