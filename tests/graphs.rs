@@ -746,19 +746,7 @@ fn sdf3_buffer_fronts_are_on_semos_fronts() {
         }
     };
     for (graph, points) in &fronts {
-        let out = semo_in(
-            &sdf3(),
-            &[
-                "graph",
-                "buffers",
-                "--sdf3-compat",
-                "--format",
-                "json",
-                graph,
-            ],
-        );
-        assert_eq!(out.code, 0, "{graph}: {}{}", out.stdout, out.stderr);
-        let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+        let v = sdf3_buffers_json(graph);
         let ours: Vec<(u64, f64)> = (v["points"].as_array().unwrap().iter())
             .map(|p| {
                 (
@@ -789,6 +777,22 @@ fn sdf3_buffer_fronts_are_on_semos_fronts() {
     }
 }
 
+/// `semo graph buffers --sdf3-compat --format json` of an SDF3 graph (a path
+/// under `tests/data/sdf3`), which must succeed.
+fn sdf3_buffers_json(graph: &str) -> serde_json::Value {
+    let args = [
+        "graph",
+        "buffers",
+        "--sdf3-compat",
+        "--format",
+        "json",
+        graph,
+    ];
+    let out = semo_in(&sdf3(), &args);
+    assert_eq!(out.code, 0, "{graph}: {}{}", out.stdout, out.stderr);
+    serde_json::from_str(&out.stdout).unwrap()
+}
+
 /// The generated graphs with a self-loop on every actor or on about half of
 /// them where the exact exploration used to run out of its budget: every
 /// point of `semo graph buffers --sdf3-compat`'s front is proven (`exact`),
@@ -804,19 +808,7 @@ fn self_looped_generated_graphs_have_exact_buffer_fronts() {
         "generated/r12_6_selfloops.xml",
         "generated/r12_6_somelooped.xml",
     ] {
-        let out = semo_in(
-            &sdf3(),
-            &[
-                "graph",
-                "buffers",
-                "--sdf3-compat",
-                "--format",
-                "json",
-                graph,
-            ],
-        );
-        assert_eq!(out.code, 0, "{graph}: {}{}", out.stdout, out.stderr);
-        let v: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+        let v = sdf3_buffers_json(graph);
         assert_eq!(v["exact_front"], true, "{graph}: {v}");
         let points = v["points"].as_array().unwrap();
         assert!(!points.is_empty(), "{graph}");
