@@ -19,9 +19,12 @@
 //! upper bound on the smallest one that does). Lower bound on the smallest
 //! total reaching the maximal throughput: the sum, over channels, of the
 //! smallest capacity of that channel alone (all others unbounded) that keeps
-//! the maximal throughput, found by bisection when the level is small enough,
-//! else SDF3's per-channel lower bounds. When both bounds meet, the minimum is
-//! exact. Where growing from below does not reach the maximal throughput
+//! the maximal throughput, found by bisection on the channel's steps while
+//! the budget lasts, else SDF3's per-channel lower bounds. When both bounds
+//! meet, the minimum is exact; and where those per-channel minima together
+//! reach the maximal throughput (one more evaluation), they are the smallest
+//! distribution that does, whatever the search found (mp3playback: 2910,
+//! where growing and shrinking found 2916). Where growing from below does not reach the maximal throughput
 //! within the budget (large levels), the channels are doubled from above
 //! until it is reached, the last doubling is taken back along the way
 //! between the two distributions as far as one bisected fraction of every
@@ -140,6 +143,21 @@ pub fn minimal_capacity(e: &Edge) -> u64 {
     }
     let g = gcd(p, c).max(1);
     (p + c - g + d % g).max(d)
+}
+
+/// The step by which a channel's capacity grows: `gcd(p, c)`, since its
+/// samples are claimed and freed in multiples of it, so that a capacity
+/// between `d + k·gcd` and the next is no better than `d + k·gcd`. SDF3's
+/// lower bound is such a capacity on every channel of a consistent, live
+/// level (a self-loop there has `p = c ≤ d`); should it not be, the step is
+/// 1, which is always safe, only slower.
+fn step(e: &Edge, minimal: u64) -> u64 {
+    let g = gcd(e.produce, e.consume).max(1);
+    if (minimal - e.initial_tokens) % g == 0 {
+        g
+    } else {
+        1
+    }
 }
 
 /// The level with a space edge for each capacity: its edges, then per edge
@@ -319,7 +337,8 @@ pub fn trade_off_towards(
     let steps: Vec<u64> = level
         .edges
         .iter()
-        .map(|e| gcd(e.produce, e.consume).max(1))
+        .zip(&minimal)
+        .map(|(e, &m)| step(e, m))
         .collect();
     // Exact where the exploration fits its budget: every Pareto point.
     if target.num > 0 && search.cost.saturating_mul(MIN_EXACT_EVALUATIONS) <= EXACT_WORK {
@@ -456,7 +475,7 @@ pub fn trade_off_towards(
     };
     if let Some(reaching) = reaching {
         // Each channel alone brought down as far as the others allow.
-        let caps = shrink(&mut search, reaching, &minimal, target);
+        let caps = shrink(&mut search, reaching, &minimal, &steps, target);
         let size: u64 = caps.iter().sum();
         // The points grown from below that are no smaller are dominated.
         points.retain(|p| p.size < size && p.period > target);
@@ -481,7 +500,25 @@ pub fn trade_off_towards(
     // Towards a goal, SDF3's per-channel bounds (they hold for any
     // positive throughput): the search's bound is for the maximal one.
     let lower_bound = if target == max_period {
-        lower_bound(&mut search, max_period, reached.as_deref())
+        // One evaluation is kept for the minima together: where they reach
+        // the maximal throughput, no smaller distribution does.
+        let budget = MAX_WORK.saturating_sub(search.cost);
+        let minima = channel_minima(&mut search, max_period, reached.as_deref(), &steps, budget);
+        let bound: u64 = minima.iter().sum();
+        let above = reached.is_none_or(|caps| caps.iter().sum::<u64>() > bound);
+        if above
+            && search.within(MAX_WORK)
+            && search.period_of(&minima).is_some_and(|p| p <= max_period)
+        {
+            points.retain(|p| p.size < bound);
+            points.push(Point {
+                size: bound,
+                period: max_period,
+                capacities: minima,
+            });
+            complete = true;
+        }
+        bound
     } else {
         minimal.iter().sum()
     };
@@ -596,6 +633,36 @@ fn between(
     above
 }
 
+/// The capacity `from` brought down to the lattice of its channel's steps
+/// (`minimal + k·step`): a capacity between two lattice points is no better
+/// than the one below it (space is freed and claimed in multiples of the
+/// step), so it reaches exactly what that one reaches.
+fn on_lattice(from: u64, minimal: u64, step: u64) -> u64 {
+    minimal + from.saturating_sub(minimal) / step * step
+}
+
+/// Bisection on one channel's lattice between `low` (which does not reach,
+/// on the lattice) and `high` (which does, on the lattice) while one more
+/// evaluation fits `budget`: the pair narrowed, `high − low == step` when
+/// it finished.
+fn bisect(
+    search: &mut Search<'_, '_>,
+    (mut low, mut high): (u64, u64),
+    step: u64,
+    budget: u64,
+    mut reaches: impl FnMut(&mut Search<'_, '_>, u64) -> bool,
+) -> (u64, u64) {
+    while high - low > step && search.within(budget) {
+        let middle = low + (high - low) / step / 2 * step;
+        if reaches(search, middle) {
+            high = middle;
+        } else {
+            low = middle;
+        }
+    }
+    (low, high)
+}
+
 /// `caps` (reaching `max_period`) with each channel in turn bisected down
 /// to the smallest capacity (at least `minimal`) that keeps the period, the
 /// others fixed, while the work budget lasts.
@@ -603,13 +670,16 @@ fn shrink(
     search: &mut Search<'_, '_>,
     mut caps: Vec<u64>,
     minimal: &[u64],
+    steps: &[u64],
     max_period: Ratio,
 ) -> Vec<u64> {
+    let budget = MAX_WORK * 2 / 3;
     let all = |caps: &[u64]| caps.iter().map(|&c| Some(c)).collect::<Vec<_>>();
     let reaches = |search: &mut Search<'_, '_>, caps: &[u64]| matches!(search.evaluate(&all(caps)), Some(Outcome::Period(p, _)) if p <= max_period);
     for i in 0..caps.len() {
-        let (mut low, mut high) = (minimal[i], caps[i]);
-        if low >= high || !search.within(MAX_WORK * 2 / 3) {
+        caps[i] = on_lattice(caps[i], minimal[i], steps[i]);
+        let (low, high) = (minimal[i], caps[i]);
+        if low >= high || !search.within(budget) {
             continue;
         }
         let mut trial = caps.clone();
@@ -618,34 +688,39 @@ fn shrink(
             caps[i] = low;
             continue;
         }
-        // `low` fails, `high` reaches.
-        while high - low > 1 && search.within(MAX_WORK * 2 / 3) {
-            let middle = low + (high - low) / 2;
-            trial[i] = middle;
-            if reaches(search, &trial) {
-                high = middle;
-            } else {
-                low = middle;
-            }
-        }
+        let (_, high) = bisect(search, (low, high), steps[i], budget, |search, cap| {
+            trial[i] = cap;
+            reaches(search, &trial)
+        });
         caps[i] = high;
     }
     caps
 }
 
-/// Σ over channels of the smallest capacity of that channel alone (the
-/// others unbounded) keeping `max_period`, each at least SDF3's lower bound
-/// (`found`: the capacities of a distribution reaching it, if any). A channel
-/// at its SDF3 lower bound in `found` needs no search; the others are
-/// bisected while the work budget lasts, and keep SDF3's bound beyond it.
-fn lower_bound(search: &mut Search<'_, '_>, max_period: Ratio, found: Option<&[u64]>) -> u64 {
+/// Per channel, the smallest capacity of that channel alone (the others
+/// unbounded) keeping `max_period`, each at least SDF3's lower bound
+/// (`found`: the capacities of a distribution reaching it, if any): each a
+/// sure lower bound on that channel's capacity in any distribution reaching
+/// `max_period` (more room elsewhere never helps less than unbounded room),
+/// so their sum bounds the total. A channel at its SDF3 lower bound in
+/// `found` needs no search; the others are bisected on their lattice while
+/// `budget` lasts, and keep the largest capacity known to fall short plus
+/// one step (or SDF3's bound) beyond it.
+fn channel_minima(
+    search: &mut Search<'_, '_>,
+    max_period: Ratio,
+    found: Option<&[u64]>,
+    steps: &[u64],
+    budget: u64,
+) -> Vec<u64> {
     let level = search.level;
     let minimal: Vec<u64> = level.edges.iter().map(minimal_capacity).collect();
-    let mut total = 0u64;
+    let mut minima = Vec::with_capacity(minimal.len());
     for i in 0..level.edges.len() {
-        let ceiling = found.map(|caps| caps[i]);
-        if ceiling == Some(minimal[i]) || !search.within(MAX_WORK) {
-            total += minimal[i];
+        let step = steps[i];
+        let ceiling = found.map(|caps| on_lattice(caps[i], minimal[i], step));
+        if ceiling == Some(minimal[i]) || !search.within(budget) {
+            minima.push(minimal[i]);
             continue;
         }
         let reaches = |search: &mut Search<'_, '_>, cap: u64| {
@@ -655,7 +730,7 @@ fn lower_bound(search: &mut Search<'_, '_>, max_period: Ratio, found: Option<&[u
         };
         let mut low = minimal[i];
         if reaches(search, low) {
-            total += low;
+            minima.push(low);
             continue;
         }
         let high = match ceiling {
@@ -664,11 +739,11 @@ fn lower_bound(search: &mut Search<'_, '_>, max_period: Ratio, found: Option<&[u
                 // Double until the channel alone no longer holds the period back.
                 let mut high = low;
                 let mut reached = None;
-                while search.within(MAX_WORK) {
+                while search.within(budget) {
                     let Some(next) = high.checked_mul(2) else {
                         break;
                     };
-                    high = next;
+                    high = on_lattice(next, minimal[i], step);
                     if reaches(search, high) {
                         reached = Some(high);
                         break;
@@ -678,23 +753,16 @@ fn lower_bound(search: &mut Search<'_, '_>, max_period: Ratio, found: Option<&[u
                 reached
             }
         };
-        let Some(mut high) = high else {
-            total += low;
+        let Some(high) = high else {
+            minima.push(low + step);
             continue;
         };
-        // `low` fails, `high` reaches (capacity only ever helps).
-        while high - low > 1 && search.within(MAX_WORK) {
-            let middle = low + (high - low) / 2;
-            if reaches(search, middle) {
-                high = middle;
-            } else {
-                low = middle;
-            }
-        }
-        // Cut short: `low + 1` is still a sure bound.
-        total += if high - low > 1 { low + 1 } else { high };
+        // `low` fails, `high` reaches (capacity only ever helps); cut
+        // short, `low + step` is still a sure bound.
+        let (low, _) = bisect(search, (low, high), step, budget, reaches);
+        minima.push(low + step);
     }
-    total
+    minima
 }
 
 #[cfg(test)]
