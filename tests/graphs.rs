@@ -763,6 +763,15 @@ fn sdf3_buffer_fronts_are_on_semos_fronts() {
     };
     for (graph, points) in &fronts {
         let v = sdf3_buffers_json(graph);
+        // Where SDF3's exploration finishes, semo's does too: the whole
+        // front proven, within the budget the JSON states.
+        assert_eq!(v["exact_front"], true, "{graph}: {}", v["budget"]);
+        assert_eq!(v["minimal_size"]["exact"], true, "{graph}");
+        assert!(
+            v["budget"]["work"].as_u64() <= v["budget"]["limit"].as_u64(),
+            "{graph}: {}",
+            v["budget"]
+        );
         let ours: Vec<(u64, f64)> = (v["points"].as_array().unwrap().iter())
             .map(|p| {
                 (

@@ -552,15 +552,15 @@ const UNBOUNDED: &str = "the throughput is unbounded (no cycle bounds the period
 
 /// The sentence saying that the work budget stopped the search.
 fn budget_words(found: &semo::taskgraph::analysis::tradeoff::TradeOff) -> String {
-    use semo::taskgraph::analysis::tradeoff::MAX_WORK;
+    let limit = found.work_limit;
     if found.evaluations == 1 {
         return format!(
-            "no distribution evaluated: one evaluation takes {} work units (firings plus dependencies of one iteration), more than the search's budget of {MAX_WORK}",
+            "no distribution evaluated: one evaluation takes {} work units (firings plus dependencies of one iteration), more than the search's budget of {limit}",
             found.evaluation_cost
         );
     }
     format!(
-        "the search stopped at its work budget ({} work units of {MAX_WORK}, {} evaluations of {} each): the points are distributions found, the bounds hold",
+        "the search stopped at its work budget ({} work units of {limit}, {} evaluations of {} each): the points are distributions found, the bounds hold",
         found.work, found.evaluations, found.evaluation_cost
     )
 }
@@ -679,7 +679,7 @@ fn buffers_json(
         },
         "budget": {
             "work": found.work,
-            "limit": semo::taskgraph::analysis::tradeoff::MAX_WORK,
+            "limit": found.work_limit,
             "per_evaluation": found.evaluation_cost,
             "exhausted": found.budget_exhausted,
         },

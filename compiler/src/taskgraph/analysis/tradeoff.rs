@@ -65,6 +65,15 @@ pub const MAX_WORK: u64 = 6_000_000;
 /// The work the exact exploration may do before the greedy search takes
 /// over with its own [`MAX_WORK`].
 pub const EXACT_WORK: u64 = MAX_WORK;
+/// The exact exploration's budget on a level of at most
+/// [`FEW_CHANNELS`] channels whose evaluations are cheap enough that it
+/// holds [`MANY_EVALUATIONS`]: the distributions of each size are few there,
+/// so a longer exploration is likely to finish (SDF3's `h263decoder`: 1,478
+/// evaluations, 12.3M units), where on a level of thousands of channels, or
+/// of evaluations so large that few fit, no budget of a second would.
+pub const SMALL_EXACT_WORK: u64 = MAX_WORK * 5 / 2;
+const FEW_CHANNELS: usize = 16;
+const MANY_EVALUATIONS: u64 = 1_000;
 /// The exact exploration is not tried when its budget holds fewer
 /// evaluations than this: it could not finish.
 const MIN_EXACT_EVALUATIONS: u64 = 32;
@@ -94,8 +103,11 @@ pub struct TradeOff {
     /// Periods evaluated.
     pub evaluations: usize,
     /// Work units of the evaluations after the maximal throughput's own
-    /// (see [`MAX_WORK`]): with it, at most `MAX_WORK`.
+    /// (see [`MAX_WORK`]): with it, at most `work_limit`.
     pub work: u64,
+    /// The budget of the search that gave `points`: [`MAX_WORK`], or the
+    /// exact exploration's ([`EXACT_WORK`], [`SMALL_EXACT_WORK`]).
+    pub work_limit: u64,
     /// Work units of one evaluation of a distribution.
     pub evaluation_cost: u64,
     /// Whether the work budget stopped some part of the search.
@@ -320,6 +332,7 @@ pub fn trade_off_towards(
         complete: false,
         evaluations: search.evaluations,
         work: search.work - search.cost,
+        work_limit: MAX_WORK,
         evaluation_cost: search.cost,
         budget_exhausted: search.exhausted,
         exact_front: false,
@@ -341,10 +354,13 @@ pub fn trade_off_towards(
         .map(|(e, &m)| step(e, m))
         .collect();
     // Exact where the exploration fits its budget: every Pareto point.
-    if target.num > 0 && search.cost.saturating_mul(MIN_EXACT_EVALUATIONS) <= EXACT_WORK {
+    let small = level.edges.len() <= FEW_CHANNELS
+        && search.cost.saturating_mul(MANY_EVALUATIONS) <= SMALL_EXACT_WORK;
+    let exact_work = if small { SMALL_EXACT_WORK } else { EXACT_WORK };
+    if target.num > 0 && search.cost.saturating_mul(MIN_EXACT_EVALUATIONS) <= exact_work {
         let before = search.work;
         search.precise = true;
-        let front = exact::front(&mut search, &minimal, &steps, target, before + EXACT_WORK);
+        let front = exact::front(&mut search, &minimal, &steps, target, before + exact_work);
         search.precise = false;
         if let Some(points) = front {
             let lower_bound = match points.last() {
@@ -358,6 +374,7 @@ pub fn trade_off_towards(
                 complete: true,
                 evaluations: search.evaluations,
                 work: search.work - search.cost,
+                work_limit: exact_work,
                 evaluation_cost: search.cost,
                 budget_exhausted: false,
                 exact_front: true,
@@ -529,6 +546,7 @@ pub fn trade_off_towards(
         complete,
         evaluations: search.evaluations,
         work: search.work - search.cost,
+        work_limit: MAX_WORK,
         evaluation_cost: search.cost,
         budget_exhausted: search.exhausted,
         exact_front: false,

@@ -100,7 +100,8 @@ fn sdf3_buffer_fronts_are_found() {
 fn smallest_size_for_the_maximal_throughput() {
     // (graph, lower bound, size found, SDF3's minimum if it finished)
     let cases = [
-        ("h263decoder", 1220, 1230, Some(1230)),
+        // Exact since its exploration has the small levels' budget.
+        ("h263decoder", 1230, 1230, Some(1230)),
         ("h263encoder", 401, 401, Some(401)),
         ("modem", 72, 72, Some(72)),
         ("random_50", 242, 242, Some(242)),
