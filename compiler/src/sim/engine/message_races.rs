@@ -1,0 +1,318 @@
+//! Races between robots, for `semo verify` (V006). Messages that reach one
+//! robot in one instant are taken by its receive task one after the other:
+//! the simulator takes them in its event queue's order (the order they were
+//! sent in), the lock-step coordinator of `--engine c` in the senders' peer
+//! order, but over MQTT the two messages of two different senders may come
+//! in either order. When the order decides what the robot does next, what
+//! the team does depends on which of two things that happen at once comes
+//! first.
+//!
+//! What is compared: at the first delivery of an instant, for each robot
+//! that takes, in that instant, messages from two different senders that
+//! it acts on (a value for a `receive`, a published value it subscribes to,
+//! a broadcast event of its team, a shared value it keeps) and that are not
+//! the same message (same kind, team, key and value), the instant's
+//! deliveries run on two copies of the fleet: one in the run's order, one
+//! with the later sender's messages taken before the earlier one's (each
+//! sender's own messages keep their order, as MQTT keeps them). Both then
+//! run until the robot's control firing that reacts (the firing a message
+//! wakes, else the end of the instant), and the two are compared by the
+//! search's fingerprint: two states that differ there go on differently.
+//! The run itself is not changed. Publishes are compared too: a publish's
+//! next value replaces it, but two publishes of one key in one instant race
+//! on which value stays, and a `subscribe` reads that one until then.
+//! Heartbeats and arrivals at a group statement are left out: each peer's
+//! has its own place, so their order never matters.
+
+use super::{Event, Memory, Message, Sim};
+use crate::refine::ModeId;
+use crate::refine::value::Value;
+use std::rc::Rc;
+
+/// What a message is to the robot it reaches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Taken {
+    /// A value for a `receive` (the incoming message's index).
+    Received(usize),
+    /// A published value of a group it subscribes to (the group's index).
+    Subscribed(usize),
+    /// A broadcast event of its team.
+    Event,
+    /// A value of the team's shared information.
+    Shared,
+}
+
+/// One of the two messages of a race: who sent it and what it is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Arrival {
+    /// The sender (an index into the programs).
+    pub from: usize,
+    /// The sending team's name.
+    pub from_team: String,
+    pub key: String,
+    pub publish: bool,
+    pub value: Option<Value>,
+    pub taken: Taken,
+}
+
+/// What differs between the two orders at the robot's reaction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Differs {
+    /// The mode it is in or goes to: (in the run's order, in the other).
+    Mode(Option<ModeId>, Option<ModeId>),
+    /// A value it holds (received, subscribed, shared).
+    Values,
+    /// What it does next (what waits to be taken, what it sent).
+    Next,
+}
+
+/// Robot `robot` took, at `at`, `first` then `second` from two different
+/// senders; in the other order its reaction differs (`differs`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MessageRace {
+    /// The receiver (an index into the programs).
+    pub robot: usize,
+    /// Mission ms of the instant.
+    pub at: i64,
+    /// The receiver's mode then.
+    pub mode: Option<ModeId>,
+    pub first: Arrival,
+    pub second: Arrival,
+    pub differs: Differs,
+}
+
+/// What watching for races between robots keeps.
+#[derive(Clone)]
+pub(super) struct Watch {
+    found: Vec<MessageRace>,
+    /// The last instant whose deliveries were looked at.
+    checked: i64,
+    memory: Rc<Memory>,
+}
+
+impl<'p> Sim<'p> {
+    /// From now on, note every race between robots
+    /// ([`Sim::take_message_races`]).
+    pub fn watch_message_races(&mut self) {
+        if self.message_races.is_none() {
+            self.message_races = Some(Box::new(Watch {
+                found: Vec::new(),
+                checked: i64::MIN,
+                memory: Rc::new(Memory::of(self.programs)),
+            }));
+        }
+    }
+
+    /// The races between robots noted since the last call.
+    pub fn take_message_races(&mut self) -> Vec<MessageRace> {
+        self.message_races
+            .as_mut()
+            .map(|w| std::mem::take(&mut w.found))
+            .unwrap_or_default()
+    }
+
+    /// What `message` is to robot `r`, or `None` when its order among
+    /// others cannot matter (a heartbeat, an arrival at a group statement,
+    /// a message it does not take): as [`Sim::take_in`] routes it.
+    fn taken(&self, r: usize, message: &Message) -> Option<Taken> {
+        let robot = &self.robots[r];
+        if !robot.has_receiver {
+            return None;
+        }
+        let program = robot.program;
+        if let Some(ownership) = program.library.as_ref().and_then(|l| l.ownership.as_ref())
+            && ownership
+                .global
+                .iter()
+                .any(|g| *g.set_key == *message.key || *g.value_key == *message.key)
+        {
+            return Some(Taken::Shared);
+        }
+        let m = &program.control;
+        let names = &self.fleet.names[r];
+        if m.heartbeat && message.publish && message.key == names.alive_key {
+            return None;
+        }
+        if !m.sync_points.is_empty() && message.key == names.sync_key {
+            return None;
+        }
+        if !m.events_heard.is_empty()
+            && !message.publish
+            && message.key == names.event_key
+            && message.from_team == names.team
+        {
+            return Some(Taken::Event);
+        }
+        if !m.subscribed.is_empty() && message.publish {
+            return (names.subscribed.iter())
+                .position(|g| *g == message.key)
+                .map(Taken::Subscribed);
+        }
+        (names.incoming.iter())
+            .position(|(team, key)| *team == message.from_team && *key == message.key)
+            .map(Taken::Received)
+    }
+
+    /// The first delivery of this instant is about to be handled (`first`,
+    /// already out of the queue): for each robot that takes messages of two
+    /// senders in it, compares its reaction in the run's order and with
+    /// each two senders next to each other swapped.
+    pub(super) fn look_for_message_races(&mut self, first: (&Rc<[(usize, u32)]>, &Rc<Message>)) {
+        let Some(watch) = self.message_races.as_mut() else {
+            return;
+        };
+        if watch.checked == self.now {
+            return;
+        }
+        watch.checked = self.now;
+        let now = self.now;
+        // The instant's deliveries in the order they will be handled.
+        let mut rest: Vec<_> = (self.queue.iter())
+            .filter(|q| q.time() == now && matches!(q.event, Event::Deliver { .. }))
+            .collect();
+        if rest.is_empty() {
+            return;
+        }
+        rest.sort_unstable_by_key(|q| q.key);
+        let mut batch: Vec<(Rc<[(usize, u32)]>, Rc<Message>)> =
+            vec![(first.0.clone(), first.1.clone())];
+        for q in rest {
+            if let Event::Deliver { to, message } = &q.event {
+                batch.push((to.clone(), message.clone()));
+            }
+        }
+        // Per receiver: the messages it takes, in order, with their kind.
+        let mut by_robot: Vec<Vec<(Rc<Message>, Taken)>> = vec![Vec::new(); self.robots.len()];
+        for (to, message) in &batch {
+            if message.from.is_none() {
+                continue;
+            }
+            for &(r, epoch) in to.iter() {
+                let robot = &self.robots[r];
+                if robot.alive
+                    && robot.epoch == epoch
+                    && let Some(taken) = self.taken(r, message)
+                {
+                    by_robot[r].push((message.clone(), taken));
+                }
+            }
+        }
+        let mut found = Vec::new();
+        for (r, taken) in by_robot.iter().enumerate() {
+            // The senders in the order their first message comes.
+            let mut senders: Vec<usize> = Vec::new();
+            for (message, _) in taken {
+                let from = message.from.expect("robots' messages only");
+                if !senders.contains(&from) {
+                    senders.push(from);
+                }
+            }
+            if senders.len() < 2 {
+                continue;
+            }
+            for pair in senders.windows(2) {
+                let (a, b) = (pair[0], pair[1]);
+                let of = |s: usize| taken.iter().filter(move |(m, _)| m.from == Some(s));
+                // The same message from both commutes.
+                let same = of(a).chain(of(b)).all(|(m, t)| {
+                    let (m0, t0) = of(a).next().expect("a sends");
+                    *t == *t0
+                        && m.publish == m0.publish
+                        && m.from_team == m0.from_team
+                        && m.key == m0.key
+                        && m.value == m0.value
+                });
+                if same {
+                    continue;
+                }
+                // b's messages where a's and b's were, before a's.
+                let mut swapped: Vec<&Rc<Message>> = Vec::with_capacity(taken.len());
+                let mut moved = of(b).chain(of(a)).map(|(m, _)| m);
+                for (m, _) in taken {
+                    if m.from == Some(a) || m.from == Some(b) {
+                        swapped.push(moved.next().expect("as many"));
+                    } else {
+                        swapped.push(m);
+                    }
+                }
+                let plain: Vec<&Rc<Message>> = taken.iter().map(|(m, _)| m).collect();
+                let mut ordered = self.delivered(r, &batch, &plain);
+                let mut other = self.delivered(r, &batch, &swapped);
+                // The firing the messages woke (the later one, should the
+                // orders wake different ones), else the end of the instant.
+                let fires = |sim: &Sim| sim.robots[r].next_fire.unwrap_or(now).max(now);
+                let until = fires(&ordered).max(fires(&other)) + 1;
+                ordered.run_to(until);
+                other.run_to(until);
+                let memory = &self.message_races.as_ref().expect("watching").memory;
+                if ordered.fingerprint(memory) == other.fingerprint(memory) {
+                    continue;
+                }
+                let arrival = |s: usize| {
+                    let (m, t) = of(s).next().expect("sends");
+                    Arrival {
+                        from: s,
+                        from_team: m.from_team.to_string(),
+                        key: m.key.to_string(),
+                        publish: m.publish,
+                        value: m.value.clone(),
+                        taken: *t,
+                    }
+                };
+                let mode = |sim: &Sim| {
+                    let robot = &sim.robots[r];
+                    robot.pending_mode.or(robot.current_mode)
+                };
+                let differs = if mode(&ordered) != mode(&other) {
+                    Differs::Mode(mode(&ordered), mode(&other))
+                } else {
+                    let (x, y) = (&ordered.robots[r], &other.robots[r]);
+                    if x.slots != y.slots || x.groups != y.groups || x.library != y.library {
+                        Differs::Values
+                    } else {
+                        Differs::Next
+                    }
+                };
+                found.push(MessageRace {
+                    robot: r,
+                    at: now,
+                    mode: self.robots[r].current_mode,
+                    first: arrival(a),
+                    second: arrival(b),
+                    differs,
+                });
+            }
+        }
+        if let Some(watch) = self.message_races.as_mut() {
+            watch.found.extend(found);
+        }
+    }
+
+    /// A copy of the fleet with the instant's deliveries (`batch`) taken,
+    /// robot `r` taking its own in `order`; watching nothing.
+    fn delivered(
+        &self,
+        r: usize,
+        batch: &[(Rc<[(usize, u32)]>, Rc<Message>)],
+        order: &[&Rc<Message>],
+    ) -> Sim<'p> {
+        let now = self.now;
+        let mut copy = self.clone();
+        copy.races = None;
+        copy.message_races = None;
+        copy.queue
+            .retain(|q| !(q.time() == now && matches!(q.event, Event::Deliver { .. })));
+        for (to, message) in batch {
+            for &(dst, epoch) in to.iter() {
+                let robot = &copy.robots[dst];
+                if dst != r && robot.alive && robot.epoch == epoch {
+                    copy.deliver(dst, message);
+                }
+            }
+        }
+        for message in order {
+            copy.deliver(r, message);
+        }
+        copy
+    }
+}
