@@ -924,7 +924,7 @@ impl<'p> Sim<'p> {
             // queue: they were scheduled one after the other, so nothing
             // else comes between them. (A delivery stops no robot: the run
             // cannot end among them.)
-Event::Deliver { to, message } => {
+            Event::Deliver { to, message } => {
                 if self.message_races.is_some() {
                     self.look_for_message_races((&to, &message));
                 }

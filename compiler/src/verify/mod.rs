@@ -538,6 +538,9 @@ pub fn verify_expecting(
             lost: race.lost,
         });
     }
+    // One finding per (statement, robots, keys): the search keeps a race
+    // per mode and per kind of message, which may name the same ones.
+    let mut told: HashSet<(Span, usize, [(usize, &str); 2])> = HashSet::new();
     for (race, way) in &explored.message_races {
         let program = &programs[race.robot];
         let m = &program.control;
@@ -573,6 +576,11 @@ pub fn verify_expecting(
             .map(|(span, line)| span.unwrap_or_else(|| line_span(text, &lines, line)))
             .or_else(|| sends.iter().flatten().next().map(|s| s.span))
             .unwrap_or(Span { start: 0, end: 0 });
+        let mut pair = [&race.first, &race.second].map(|a| (a.from, a.key.as_str()));
+        pair.sort_unstable();
+        if !told.insert((span, race.robot, pair)) {
+            continue;
+        }
         let mut finding = Diagnostic::new(
             Code::RobotsRace,
             file,

@@ -15,19 +15,31 @@
 //! deliveries run on two copies of the fleet: one in the run's order, one
 //! with the later sender's messages taken before the earlier one's (each
 //! sender's own messages keep their order, as MQTT keeps them). Both then
-//! run until the robot's control firing that reacts (the firing a message
-//! wakes, else the end of the instant), and the two are compared by the
-//! search's fingerprint: two states that differ there go on differently.
+//! run to the robot's control firing that reacts (the firing a message
+//! wakes, else the end of the instant), and on, firing by firing, until
+//! both have taken all of the instant's messages (none held up by a full
+//! channel or behind one; at most [`TAKING_FIRINGS`] firings): compared
+//! while one still waits, two orders that end the same would differ only
+//! in which message waits. Then the two are compared by the search's
+//! fingerprint, leaving out what nothing the team does reads ([`Unread`]:
+//! a received value read only by `send(USER, ...)`, a report to the
+//! operator, or by nothing, in its slot, the library and the channel that
+//! feeds it): two states that differ in anything else go on differently.
 //! The run itself is not changed. Publishes are compared too: a publish's
 //! next value replaces it, but two publishes of one key in one instant race
 //! on which value stays, and a `subscribe` reads that one until then.
 //! Heartbeats and arrivals at a group statement are left out: each peer's
 //! has its own place, so their order never matters.
 
-use super::{Event, Memory, Message, Sim};
-use crate::refine::ModeId;
+use super::{Event, Memory, Message, Robot, Sim};
 use crate::refine::value::Value;
+use crate::refine::{AttributeId, Expr, ModeId, Operand, SlotSource, StateKind};
 use std::rc::Rc;
+
+/// How many of the robot's firings the two orders run, at most, for it to
+/// take the instant's messages (each firing takes one from a full channel,
+/// or the one after drops it).
+const TAKING_FIRINGS: usize = 8;
 
 /// What a message is to the robot it reaches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -88,6 +100,113 @@ pub(super) struct Watch {
     /// The last instant whose deliveries were looked at.
     checked: i64,
     memory: Rc<Memory>,
+    /// Per robot: what only reaches the operator ([`Unread`]).
+    unread: Rc<[Unread]>,
+}
+
+/// A robot's values that nothing it does reads: each read only by a
+/// `send(USER, ...)` (a report to the operator, which the team does not act
+/// on), or never. Two orders that differ only there differ in nothing the
+/// team does: [`Sim::forget_unread`] blanks them before the comparison.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(super) struct Unread {
+    /// Per slot.
+    slots: Vec<bool>,
+    /// Per place of the library (every slot it feeds unread).
+    library: Vec<bool>,
+}
+
+impl Unread {
+    /// Robot `robot`'s: a slot is unread when it holds a received value
+    /// (`SlotSource::Shared`) that is not one of the team's globally shared
+    /// values (a write of those is told to the team), and no statement
+    /// reads it but as the value of a `send(USER, ...)` that stores it
+    /// nowhere: no condition, no call's or action's argument, no send to a
+    /// robot, no action machine's command or transition, no battery
+    /// policy.
+    fn of(robot: &Robot) -> Unread {
+        let program = robot.program;
+        let m = &program.control;
+        let mut read = vec![false; m.slots.len()];
+        fn operand(read: &mut [bool], op: &Operand) {
+            if let Operand::Slot(s) = op {
+                read[s.index()] = true;
+            }
+        }
+        fn expr(read: &mut [bool], e: &Expr) {
+            match e {
+                Expr::Or(a, b) | Expr::And(a, b) => {
+                    expr(read, a);
+                    expr(read, b);
+                }
+                Expr::Not(a) => expr(read, a),
+                Expr::Compare(a, _, b, _) => {
+                    operand(read, a);
+                    operand(read, b);
+                }
+                Expr::Truthy(a) => operand(read, a),
+                Expr::Bool(_) => {}
+            }
+        }
+        for state in m.services.iter().flat_map(|s| &s.states) {
+            match &state.kind {
+                StateKind::Send { items } => {
+                    for item in items {
+                        let report = m.outgoing_message(item.message).to_team == "USER"
+                            && item.store.is_none()
+                            && item.own_group.is_none();
+                        if !report {
+                            operand(&mut read, &item.value);
+                        }
+                    }
+                }
+                StateKind::Call { args, .. } | StateKind::RunActions { args, .. } => {
+                    args.iter().for_each(|a| operand(&mut read, a));
+                }
+                StateKind::Branch { condition, .. } => expr(&mut read, condition),
+                StateKind::LoopHead { condition, .. } | StateKind::Repeat { condition, .. } => {
+                    condition.iter().for_each(|c| expr(&mut read, c));
+                }
+                StateKind::Receive { .. }
+                | StateKind::Subscribe { .. }
+                | StateKind::Throw { .. }
+                | StateKind::LeaderBranch { .. }
+                | StateKind::GroupAllocate { .. }
+                | StateKind::GroupSync { .. }
+                | StateKind::Jump { .. }
+                | StateKind::LoopTail { .. } => {}
+            }
+        }
+        for action in m.actions.iter().flat_map(|a| &a.actions) {
+            action
+                .commands
+                .iter()
+                .for_each(|(_, op)| operand(&mut read, op));
+            (action.transitions.iter())
+                .filter_map(|(e, _)| e.as_ref())
+                .for_each(|e| expr(&mut read, e));
+        }
+        m.battery.iter().for_each(|b| expr(&mut read, &b.condition));
+        let global: Vec<AttributeId> = (program.library.as_ref())
+            .and_then(|l| l.ownership.as_ref())
+            .map(|o| o.global.iter().map(|g| g.at).collect())
+            .unwrap_or_default();
+        let slots: Vec<bool> = (m.slots.iter().enumerate())
+            .map(|(i, slot)| {
+                slot.source == SlotSource::Shared
+                    && !read[i]
+                    && robot.library_index[i].is_none_or(|k| !global.contains(&k))
+            })
+            .collect();
+        let library = (0..robot.library.len())
+            .map(|k| {
+                (robot.library_index.iter().enumerate())
+                    .filter(|(_, at)| at.is_some_and(|at| at.index() == k))
+                    .all(|(i, _)| slots[i])
+            })
+            .collect();
+        Unread { slots, library }
+    }
 }
 
 impl<'p> Sim<'p> {
@@ -99,6 +218,7 @@ impl<'p> Sim<'p> {
                 found: Vec::new(),
                 checked: i64::MIN,
                 memory: Rc::new(Memory::of(self.programs)),
+                unread: self.robots.iter().map(Unread::of).collect(),
             }));
         }
     }
@@ -238,14 +358,28 @@ impl<'p> Sim<'p> {
                 let plain: Vec<&Rc<Message>> = taken.iter().map(|(m, _)| m).collect();
                 let mut ordered = self.delivered(r, &batch, &plain);
                 let mut other = self.delivered(r, &batch, &swapped);
-                // The firing the messages woke (the later one, should the
-                // orders wake different ones), else the end of the instant.
-                let fires = |sim: &Sim| sim.robots[r].next_fire.unwrap_or(now).max(now);
-                let until = fires(&ordered).max(fires(&other)) + 1;
-                ordered.run_to(until);
-                other.run_to(until);
-                let memory = &self.message_races.as_ref().expect("watching").memory;
-                if ordered.fingerprint(memory) == other.fingerprint(memory) {
+                // Both run to the firing the messages woke (the later one,
+                // should the orders wake different ones), else to the end
+                // of the instant; then on, firing by firing, while either
+                // has not taken all of them yet (one held up by a full
+                // channel, or behind it): a few firings take or drop them.
+                let fires = |sim: &Sim| sim.robots[r].next_fire.unwrap_or(sim.now).max(sim.now);
+                let waits = |sim: &Sim| {
+                    let robot = &sim.robots[r];
+                    robot.alive && (robot.holding.is_some() || !robot.behind.is_empty())
+                };
+                for _ in 0..TAKING_FIRINGS {
+                    let until = fires(&ordered).max(fires(&other)) + 1;
+                    ordered.run_to(until);
+                    other.run_to(until);
+                    if !waits(&ordered) && !waits(&other) {
+                        break;
+                    }
+                }
+                let watch = self.message_races.as_ref().expect("watching");
+                ordered.forget_unread(&watch.unread);
+                other.forget_unread(&watch.unread);
+                if ordered.fingerprint(&watch.memory) == other.fingerprint(&watch.memory) {
                     continue;
                 }
                 let arrival = |s: usize| {
@@ -285,6 +419,33 @@ impl<'p> Sim<'p> {
         }
         if let Some(watch) = self.message_races.as_mut() {
             watch.found.extend(found);
+        }
+    }
+
+    /// Blanks every robot's values that nothing it does reads
+    /// ([`Unread`]): in its slots and library, and waiting in the channels
+    /// that feed those slots (the messages waiting are still counted).
+    fn forget_unread(&mut self, unread: &[Unread]) {
+        for (robot, unread) in self.robots.iter_mut().zip(unread) {
+            let m = &robot.program.control;
+            let forget = |v: &mut Option<Value>| *v = None;
+            (robot.slots.iter_mut().zip(&unread.slots))
+                .filter(|(_, u)| **u)
+                .for_each(|(v, _)| forget(v));
+            (robot.library.iter_mut().zip(&unread.library))
+                .filter(|(_, u)| **u)
+                .for_each(|(v, _)| forget(v));
+            let channel = |c: usize| unread.slots[m.incoming[c].slot.index()];
+            for (c, (queue, _)) in robot.inbox.iter_mut().enumerate() {
+                if channel(c) {
+                    queue.iter_mut().for_each(forget);
+                }
+            }
+            if let Some(holding) = &mut robot.holding {
+                (holding.pending.iter_mut())
+                    .filter(|(c, _)| channel(*c))
+                    .for_each(|(_, v)| forget(v));
+            }
         }
     }
 
