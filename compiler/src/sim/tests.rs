@@ -1330,7 +1330,7 @@ fn two_robots_whose_messages_the_receiver_takes_in_either_order_race() {
         );
         let scenario = scenario::parse(&text, &programs).unwrap_or_else(|e| panic!("{e:?}"));
         let mut watched = Sim::new(&programs, &scenario, &Options::default());
-        watched.watch_message_races();
+        watched.watch_message_races(crate::verify::Options::default().step_ms);
         watched.run_to(2_000);
         let mut plain = Sim::new(&programs, &scenario, &Options::default());
         plain.run_to(2_000);

@@ -88,7 +88,7 @@ pub fn explore(
     let memory = Memory::of(programs);
     let mut root = Sim::new(programs, &scenario, &sim::Options::default());
     root.watch_races();
-    root.watch_message_races();
+    root.watch_message_races(options.step_ms);
     let mut explored = Explored {
         states: 0,
         transitions: 0,

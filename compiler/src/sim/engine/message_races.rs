@@ -24,7 +24,15 @@
 //! fingerprint, leaving out what nothing the team does reads ([`Unread`]:
 //! a received value read only by `send(USER, ...)`, a report to the
 //! operator, or by nothing, in its slot, the library and the channel that
-//! feeds it): two states that differ in anything else go on differently.
+//! feeds it). Should the robot go to another mode in one than in the
+//! other, that is a race: another thing the team does. Otherwise both run
+//! on, instant by instant, until the world's next choice (the search's
+//! step: nothing new comes in before it); if they come to one state on the
+//! way (a published value replaced before anything read it), the order
+//! changed nothing. Two states that still differ there go on differently.
+//! (When every message the robot takes from the two is a value for unread
+//! slots only, filling the same channels in either order, the two orders
+//! differ in those values alone: nothing is run.)
 //! The run itself is not changed. Publishes are compared too: a publish's
 //! next value replaces it, but two publishes of one key in one instant race
 //! on which value stays, and a `subscribe` reads that one until then.
@@ -102,6 +110,9 @@ pub(super) struct Watch {
     memory: Rc<Memory>,
     /// Per robot: what only reaches the operator ([`Unread`]).
     unread: Rc<[Unread]>,
+    /// The world's clock (`semo verify`'s step): it chooses nothing
+    /// between two of its ticks.
+    step_ms: i64,
 }
 
 /// A robot's values that nothing it does reads: each read only by a
@@ -211,14 +222,16 @@ impl Unread {
 
 impl<'p> Sim<'p> {
     /// From now on, note every race between robots
-    /// ([`Sim::take_message_races`]).
-    pub fn watch_message_races(&mut self) {
+    /// ([`Sim::take_message_races`]), the world choosing at most every
+    /// `step_ms` (a multiple of the sensor period: `semo verify`'s step).
+    pub fn watch_message_races(&mut self, step_ms: i64) {
         if self.message_races.is_none() {
             self.message_races = Some(Box::new(Watch {
                 found: Vec::new(),
                 checked: i64::MIN,
                 memory: Rc::new(Memory::of(self.programs)),
                 unread: self.robots.iter().map(Unread::of).collect(),
+                step_ms: step_ms.max(1),
             }));
         }
     }
@@ -356,6 +369,9 @@ impl<'p> Sim<'p> {
                     }
                 }
                 let plain: Vec<&Rc<Message>> = taken.iter().map(|(m, _)| m).collect();
+                if self.alike_but_unread(r, &plain, &swapped) {
+                    continue;
+                }
                 let mut ordered = self.delivered(r, &batch, &plain);
                 let mut other = self.delivered(r, &batch, &swapped);
                 // Both run to the firing the messages woke (the later one,
@@ -382,17 +398,7 @@ impl<'p> Sim<'p> {
                 if ordered.fingerprint(&watch.memory) == other.fingerprint(&watch.memory) {
                     continue;
                 }
-                let arrival = |s: usize| {
-                    let (m, t) = of(s).next().expect("sends");
-                    Arrival {
-                        from: s,
-                        from_team: m.from_team.to_string(),
-                        key: m.key.to_string(),
-                        publish: m.publish,
-                        value: m.value.clone(),
-                        taken: *t,
-                    }
-                };
+                // What differs once both took them, the robot's reaction.
                 let mode = |sim: &Sim| {
                     let robot = &sim.robots[r];
                     robot.pending_mode.or(robot.current_mode)
@@ -407,6 +413,28 @@ impl<'p> Sim<'p> {
                         Differs::Next
                     }
                 };
+                // Another mode is another thing the team does, whatever
+                // comes after. Otherwise, until the world's next choice
+                // nothing new comes in: a difference that is gone by then
+                // (a published value replaced before anything read it)
+                // changes nothing.
+                let horizon = (now.div_euclid(watch.step_ms) + 1) * watch.step_ms;
+                if !matches!(differs, Differs::Mode(..))
+                    && ordered.converge(&mut other, horizon, &watch.unread, &watch.memory)
+                {
+                    continue;
+                }
+                let arrival = |s: usize| {
+                    let (m, t) = of(s).next().expect("sends");
+                    Arrival {
+                        from: s,
+                        from_team: m.from_team.to_string(),
+                        key: m.key.to_string(),
+                        publish: m.publish,
+                        value: m.value.clone(),
+                        taken: *t,
+                    }
+                };
                 found.push(MessageRace {
                     robot: r,
                     at: now,
@@ -419,6 +447,79 @@ impl<'p> Sim<'p> {
         }
         if let Some(watch) = self.message_races.as_mut() {
             watch.found.extend(found);
+        }
+    }
+
+    /// Whether robot `r` takes the messages `plain` and `swapped` (the
+    /// same, in two orders) alike but for values nothing it does reads:
+    /// each is a value for `receive`s of unread slots only, of their type,
+    /// and the two orders fill the same channels one after the other. The
+    /// receive task then holds up, drops and wakes alike, and the two
+    /// fleets differ in [`Unread`] values alone: nothing to run.
+    fn alike_but_unread(&self, r: usize, plain: &[&Rc<Message>], swapped: &[&Rc<Message>]) -> bool {
+        let Some(watch) = self.message_races.as_ref() else {
+            return false;
+        };
+        let unread = &watch.unread[r];
+        let m = &self.robots[r].program.control;
+        let names = &self.fleet.names[r];
+        // The channels a message fills, when all of them feed unread slots
+        // and take its value.
+        let channels = |message: &Message| -> Option<Vec<usize>> {
+            if self
+                .taken(r, message)
+                .is_none_or(|t| !matches!(t, Taken::Received(_)))
+            {
+                return None;
+            }
+            let mut filled = Vec::new();
+            for (c, (team, key)) in names.incoming.iter().enumerate() {
+                if *team != message.from_team || *key != message.key {
+                    continue;
+                }
+                let slot = m.incoming[c].slot.index();
+                let fits = message
+                    .value
+                    .as_ref()
+                    .is_none_or(|v| m.slots[slot].kind.coerce(v).is_some());
+                if !unread.slots[slot] || !fits {
+                    return None;
+                }
+                filled.push(c);
+            }
+            Some(filled)
+        };
+        plain
+            .iter()
+            .zip(swapped)
+            .all(|(x, y)| match (channels(x), channels(y)) {
+                (Some(a), Some(b)) => a == b,
+                _ => false,
+            })
+    }
+
+    /// Runs `self` and `other` on, instant by instant, before `until`;
+    /// whether they come to the same state (unread values aside) on the way.
+    fn converge(
+        &mut self,
+        other: &mut Sim,
+        until: i64,
+        unread: &[Unread],
+        memory: &Memory,
+    ) -> bool {
+        loop {
+            let next = |sim: &Sim| sim.queue.peek().map_or(i64::MAX, |q| q.time());
+            let t = next(self).min(next(other));
+            if t >= until {
+                return false;
+            }
+            self.run_to(t + 1);
+            other.run_to(t + 1);
+            self.forget_unread(unread);
+            other.forget_unread(unread);
+            if self.fingerprint(memory) == other.fingerprint(memory) {
+                return true;
+            }
         }
     }
 
