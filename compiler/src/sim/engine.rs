@@ -926,7 +926,7 @@ impl<'p> Sim<'p> {
             // cannot end among them.)
             Event::Deliver { to, message } => {
                 if self.message_races.is_some() {
-                    self.look_for_message_races((&to, &message));
+                    self.look_for_message_races(&to, &message);
                 }
                 self.deliver_all(&to, &message)
             }

@@ -540,7 +540,8 @@ pub fn verify_expecting(
     }
     // One finding per (statement, robots, keys): the search keeps a race
     // per mode and per kind of message, which may name the same ones.
-    let mut told: HashSet<(Span, usize, [(usize, &str); 2])> = HashSet::new();
+    type Told<'a> = (Span, usize, [(usize, &'a str); 2]);
+    let mut told: HashSet<Told> = HashSet::new();
     for (race, way) in &explored.message_races {
         let program = &programs[race.robot];
         let m = &program.control;

@@ -44,6 +44,10 @@ use crate::refine::value::Value;
 use crate::refine::{AttributeId, Expr, ModeId, Operand, SlotSource, StateKind};
 use std::rc::Rc;
 
+/// One delivery of an instant: the robots it reaches (each with its epoch
+/// when it was sent) and the message.
+type Delivery = (Rc<[(usize, u32)]>, Rc<Message>);
+
 /// How many of the robot's firings the two orders run, at most, for it to
 /// take the instant's messages (each firing takes one from a full channel,
 /// or the one after drops it).
@@ -286,11 +290,15 @@ impl<'p> Sim<'p> {
             .map(Taken::Received)
     }
 
-    /// The first delivery of this instant is about to be handled (`first`,
-    /// already out of the queue): for each robot that takes messages of two
-    /// senders in it, compares its reaction in the run's order and with
-    /// each two senders next to each other swapped.
-    pub(super) fn look_for_message_races(&mut self, first: (&Rc<[(usize, u32)]>, &Rc<Message>)) {
+    /// The first delivery of this instant is about to be handled (`message`
+    /// to `to`, already out of the queue): for each robot that takes
+    /// messages of two senders in it, compares its reaction in the run's
+    /// order and with each two senders next to each other swapped.
+    pub(super) fn look_for_message_races(
+        &mut self,
+        to: &Rc<[(usize, u32)]>,
+        message: &Rc<Message>,
+    ) {
         let Some(watch) = self.message_races.as_mut() else {
             return;
         };
@@ -307,8 +315,7 @@ impl<'p> Sim<'p> {
             return;
         }
         rest.sort_unstable_by_key(|q| q.key);
-        let mut batch: Vec<(Rc<[(usize, u32)]>, Rc<Message>)> =
-            vec![(first.0.clone(), first.1.clone())];
+        let mut batch: Vec<Delivery> = vec![(to.clone(), message.clone())];
         for q in rest {
             if let Event::Deliver { to, message } = &q.event {
                 batch.push((to.clone(), message.clone()));
@@ -552,12 +559,7 @@ impl<'p> Sim<'p> {
 
     /// A copy of the fleet with the instant's deliveries (`batch`) taken,
     /// robot `r` taking its own in `order`; watching nothing.
-    fn delivered(
-        &self,
-        r: usize,
-        batch: &[(Rc<[(usize, u32)]>, Rc<Message>)],
-        order: &[&Rc<Message>],
-    ) -> Sim<'p> {
+    fn delivered(&self, r: usize, batch: &[Delivery], order: &[&Rc<Message>]) -> Sim<'p> {
         let now = self.now;
         let mut copy = self.clone();
         copy.races = None;
