@@ -139,6 +139,75 @@ fn a_throw_that_ends_the_mode_before_another_plan_sends_is_a_race() {
     assert_eq!((code, findings), (0, Vec::new()));
 }
 
+/// Two scouts answer the base in one instant and the base decides on the
+/// first answer it takes: the network may bring either first (V006, on the
+/// base's `receive`, the two sends as related information, and nothing
+/// else). The counterexample replayed: the base takes both at that instant,
+/// the first being the one the finding names. Answers under keys of their
+/// own that the base takes both of commute, and an answer only reported to
+/// the operator changes nothing the team does: nothing.
+#[test]
+fn two_robots_whose_messages_reach_a_third_in_one_instant_race() {
+    let dir = support::robots::scratch("verify-robots-race");
+    let dir_text = dir.to_string_lossy().to_string();
+    let mission = "tests/fixtures/verify/robots_race/main.mission";
+    let (code, findings, data) = verify(mission, &["--counterexamples", &dir_text]);
+    assert_eq!(code, 1);
+    assert_eq!(data["exhaustive"], true, "{data}");
+    let found: Vec<(&str, u64)> = findings.iter().map(|(c, l, _)| (c.as_str(), *l)).collect();
+    assert_eq!(found, [("V006", 18)], "{findings:?}");
+    let race = &data["diagnostics"][0];
+    let message = race["message"].as_str().unwrap();
+    assert!(
+        message.contains("base takes Scouts.SEEN")
+            && message.contains("from north")
+            && message.contains("from south")
+            && message.contains("instead of mode"),
+        "{message}"
+    );
+    let mut related: Vec<u64> = (race["related"].as_array().unwrap().iter())
+        .map(|r| r["line"].as_u64().unwrap())
+        .collect();
+    related.sort();
+    assert_eq!(related, [10, 12], "{race}");
+    // The replay: both answers reach the base at the finding's instant.
+    let at: String = message
+        .strip_prefix("at ")
+        .and_then(|m| m.split(' ').next())
+        .unwrap()
+        .to_string();
+    let scenario = data["counterexamples"][0].as_str().unwrap().to_string();
+    assert!(
+        scenario.ends_with("main.V006-1.scenario.json"),
+        "{scenario}"
+    );
+    let out = semo(&["simulate", mission, "--scenario", &scenario, "--trace", "-"]);
+    assert_eq!(out.code, 0, "{}", out.stderr);
+    let taken: Vec<&str> = (out.stdout.lines())
+        .filter(|l| {
+            l.contains("\"robot\":\"base\"")
+                && l.contains("\"event\":\"receive\"")
+                && l.contains(&format!("\"t\":{at},"))
+        })
+        .collect();
+    assert_eq!(taken.len(), 2, "{}", out.stdout);
+    assert!(
+        taken[0].contains("\"value\":\"YES\"") != taken[1].contains("\"value\":\"YES\""),
+        "{taken:?}"
+    );
+    // The cure of `semo explain V006`: keys of their own, both taken. And
+    // an answer the base only reports to the operator: the order changes
+    // the report alone.
+    for mission in [
+        "tests/fixtures/verify/robots_commute/main.mission",
+        "tests/fixtures/verify/robots_report/main.mission",
+    ] {
+        let (code, findings, data) = verify(mission, &[]);
+        assert_eq!((code, findings), (0, Vec::new()), "{mission}");
+        assert_eq!(data["exhaustive"], true, "{mission}: {data}");
+    }
+}
+
 /// The user's properties (a scenario's `expect`: `always`, `eventually`,
 /// `leads_to` and the one-run expectations without a deadline), judged
 /// over every behaviour: each broken one with a scenario whose replay by
@@ -250,6 +319,14 @@ fn the_users_properties_are_judged_over_every_behaviour_and_broken_ones_replay()
     );
 }
 
+/// The scouting example's master takes both slaves' colours in one instant
+/// but only reports them to the operator: no race (V006 leaves out what
+/// only `send(USER, ...)` reads). The patrol's guards, though, publish
+/// DARK and BRIGHT under one key, each as its own light says: when both
+/// come in one instant (one guard patrols while another hides), which one
+/// a guard's `subscribe` reads, and so whether it hides, is the network's
+/// choice. That is a race between robots, on the `subscribe`, and the
+/// only finding there.
 #[test]
 fn the_repaired_missions_and_the_small_examples_have_no_finding() {
     for (mission, exhaustive) in [
@@ -257,7 +334,6 @@ fn the_repaired_missions_and_the_small_examples_have_no_finding() {
         ("examples/follow/follow.mission", true),
         ("examples/swarm/march.mission", true),
         ("examples/scouting/scouting.mission", false),
-        ("examples/swarm/patrol_groups.mission", false),
         // The benchmark's five robots in three teams (compiler/benches/verify.rs).
         ("tests/fixtures/verify/three_teams/main.mission", false),
     ] {
@@ -266,6 +342,18 @@ fn the_repaired_missions_and_the_small_examples_have_no_finding() {
         assert_eq!(data["exhaustive"], exhaustive, "{mission}: {data}");
         assert!(data["states"].as_u64().unwrap() > 0, "{mission}");
     }
+    let mission = "examples/swarm/patrol_groups.mission";
+    let (code, findings, data) = verify(mission, &["--max-states", "3000"]);
+    assert_eq!(code, 1, "{findings:?}");
+    assert_eq!(data["exhaustive"], false, "{data}");
+    assert!(
+        !findings.is_empty()
+            && findings.iter().all(|(code, line, message)| code == "V006"
+                && *line == 65
+                && message.contains("Guards.Alarm = DARK (published)")
+                && message.contains("Guards.Alarm = BRIGHT (published)")),
+        "{findings:?}"
+    );
 }
 
 /// With faults (`--faults 1`): a leader whose block never ends still
@@ -748,6 +836,26 @@ fn random_findings_hold(
                 eprintln!("seed {seed}: V005 replayed");
                 continue;
             }
+            if let Claim::MessageRace { robot, senders } = claim {
+                let way = way.as_ref().expect("V006 has its way");
+                let scenario = way.scenario_json(&report.inputs, &programs);
+                let scenario = semo::sim::scenario::parse(&scenario, &programs).unwrap();
+                let mut sim =
+                    semo::sim::Sim::new(&programs, &scenario, &semo::sim::Options::default());
+                sim.watch_message_races(options.step_ms);
+                sim.run_to(way.end_ms);
+                let races = sim.take_message_races();
+                let pair = |a: usize, b: usize| (a.min(b), a.max(b));
+                assert!(
+                    races.iter().any(|race| race.robot == *robot
+                        && pair(race.first.from, race.second.from) == pair(senders.0, senders.1)),
+                    "seed {seed}: the race at {} is not replayed by {races:?}\n{text}",
+                    programs[*robot].robot
+                );
+                held += 1;
+                eprintln!("seed {seed}: V006 replayed");
+                continue;
+            }
             for _ in 0..4 {
                 let way = way.as_ref().map_or(&[][..], |w| &w.choices[..]);
                 let seen = random_behaviour(&programs, &report.inputs, options, way, &mut rng);
@@ -770,7 +878,7 @@ fn random_findings_hold(
                         "seed {seed}: {} left its receive\n{text}",
                         programs[*robot].robot
                     ),
-                    Claim::TwoLeaders { .. } | Claim::Race { .. } => {
+                    Claim::TwoLeaders { .. } | Claim::Race { .. } | Claim::MessageRace { .. } => {
                         unreachable!("replayed above")
                     }
                 }

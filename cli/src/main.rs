@@ -390,7 +390,9 @@ enum Command {
         to N times. --expect SCENARIO checks that scenario's `expect` list over every behaviour (`always`, \
         `eventually`, `leads_to`; a broken one exits 1 with a scenario that replays it). A \
         plan's `throw` that ends its mode in the instant another plan of the mode would \
-        send or throw is reported too (V005: the plans' order decides a race). \
+        send or throw is reported too (V005: the plans' order decides a race), and so is \
+        a robot that takes messages of two robots in one instant and would react otherwise \
+        had the network brought them the other way round (V006: a race between robots). \
         --counterexamples DIR writes, per finding, the \
         scenario `semo simulate` replays to it (see docs/verify.md).\n\n\
         Exit status: 0 nothing found, 1 a finding, 2 bad input (mission errors, options)."

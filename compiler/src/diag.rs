@@ -246,6 +246,7 @@ codes! {
     WaitsForEver = "V003", Warning, "`semo verify`: a robot can reach a `receive` where it waits for ever, whatever the world does";
     TwoLeaders = "V004", Warning, "`semo verify`: two robots can lead one `leader(...)` statement at once (with faults: a robot killed, restarted or cut off, messages lost)";
     PlansRace = "V005", Warning, "`semo verify`: a plan's `throw` ends its mode in the instant another plan of the mode would send or throw: which one happens depends only on the plans' order";
+    RobotsRace = "V006", Warning, "`semo verify`: a robot takes messages of two robots in one instant, and taken in the other order (which the network may give) it would react otherwise: which message comes first decides (a race between robots)";
 }
 
 impl fmt::Display for Code {

@@ -51,9 +51,11 @@ mod battery;
 mod explore;
 mod fleet;
 mod loops;
+mod message_races;
 mod races;
 mod shared;
 
+pub use message_races::{Arrival, Differs, MessageRace, Taken};
 pub use races::Race;
 
 pub use explore::Memory;
@@ -256,6 +258,8 @@ struct Message {
     from_robot: Rc<str>,
     /// The sender among the peers (operator: `None`).
     from_peer: Option<PeerId>,
+    /// The sender among the robots (operator: `None`).
+    from: Option<usize>,
     key: Rc<str>,
     value: Held,
     sent_at: i64,
@@ -499,6 +503,9 @@ pub struct Sim<'p> {
     channel_full: Rc<str>,
     /// `semo verify`'s races, when it watches for them ([`Sim::watch_races`]).
     races: Option<Vec<Race>>,
+    /// `semo verify`'s races between robots, when it watches for them
+    /// ([`Sim::watch_message_races`]).
+    message_races: Option<Box<message_races::Watch>>,
     /// A send's arrivals (instant, order, robot, its epoch), kept between
     /// sends for its room: a send allocates no list of its own.
     arrivals: Vec<(i64, u64, usize, u32)>,
@@ -720,6 +727,7 @@ impl<'p> Sim<'p> {
             restarts_due: 0,
             channel_full: "channel full".into(),
             races: None,
+            message_races: None,
             arrivals: Vec::new(),
             untraced_messages: options.untraced_messages,
             unmade: 0,
@@ -916,7 +924,12 @@ impl<'p> Sim<'p> {
             // queue: they were scheduled one after the other, so nothing
             // else comes between them. (A delivery stops no robot: the run
             // cannot end among them.)
-            Event::Deliver { to, message } => self.deliver_all(&to, &message),
+            Event::Deliver { to, message } => {
+                if self.message_races.is_some() {
+                    self.look_for_message_races(&to, &message);
+                }
+                self.deliver_all(&to, &message)
+            }
             Event::Operator(i) => self.operator(i),
             Event::Fault(i) => self.fault(i),
         }
@@ -938,6 +951,7 @@ impl<'p> Sim<'p> {
             from_team: "USER".into(),
             from_robot: "USER".into(),
             from_peer: None,
+            from: None,
             key: command.key.as_str().into(),
             value: Some(Value::text(&command.value)),
             sent_at: self.now,
@@ -1173,6 +1187,7 @@ impl<'p> Sim<'p> {
             from_team: fleet.names[r].team.clone(),
             from_robot: fleet.names[r].heartbeat.clone(),
             from_peer: Some(program.self_peer),
+            from: Some(r),
             key,
             value,
             sent_at: self.now,

@@ -33,7 +33,9 @@ pub mod svg;
 pub mod temporal;
 pub mod trace;
 
-pub use engine::{DEFAULT_UNTIL_MS, Memory, Options, Race, Run, Sim};
+pub use engine::{
+    Arrival, DEFAULT_UNTIL_MS, Differs, Memory, MessageRace, Options, Race, Run, Sim, Taken,
+};
 pub use expect::{Digest, Verdict};
 pub use scenario::{Scenario, ScenarioError};
 pub use trace::TraceEvent;

@@ -1314,6 +1314,80 @@ fn a_throw_that_ends_the_mode_before_a_later_plan_sends_is_noted_as_a_race() {
     );
 }
 
+/// Races between robots (`semo verify`'s V006): both scouts' answers reach
+/// the base at 1 ms, north's first; taken the other way round the base
+/// would go to LOST, not FOUND. Watching notes exactly that and changes
+/// nothing of the run. The same answer from both, answers under keys of
+/// their own that the base takes both of, or an answer the base only
+/// reports to the operator, are no race.
+#[test]
+fn two_robots_whose_messages_the_receiver_takes_in_either_order_race() {
+    let races_of = |mission: &str, north: &str, south: &str| {
+        let programs = programs(mission);
+        let text = format!(
+            r#"{{"robots": {{"north": {{"sensors": [{{"at": 0, "value": "LOCATION", "is": "{north}"}}]}},
+                "south": {{"sensors": [{{"at": 0, "value": "LOCATION", "is": "{south}"}}]}}}}}}"#
+        );
+        let scenario = scenario::parse(&text, &programs).unwrap_or_else(|e| panic!("{e:?}"));
+        let mut watched = Sim::new(&programs, &scenario, &Options::default());
+        watched.watch_message_races(crate::verify::Options::default().step_ms);
+        watched.run_to(2_000);
+        let mut plain = Sim::new(&programs, &scenario, &Options::default());
+        plain.run_to(2_000);
+        let lines = |sim: &mut Sim| -> Vec<String> {
+            sim.take_trace().iter().map(|e| format!("{e:?}")).collect()
+        };
+        assert_eq!(lines(&mut watched), lines(&mut plain), "{mission}");
+        let said: Vec<String> = watched
+            .take_message_races()
+            .iter()
+            .map(|race| {
+                let m = &programs[race.robot].control;
+                let arrival = |a: &Arrival| {
+                    let value = a.value.as_ref().map(|v| v.as_text()).unwrap_or_default();
+                    format!("{}={value} from {}", a.key, programs[a.from].robot)
+                };
+                let differs = match race.differs {
+                    Differs::Mode(ran, other) => format!(
+                        "{} not {}",
+                        other.map_or("-", |id| m.mode(id).name.as_str()),
+                        ran.map_or("-", |id| m.mode(id).name.as_str())
+                    ),
+                    other => format!("{other:?}"),
+                };
+                format!(
+                    "{} at {}: {} then {}; else {differs}",
+                    programs[race.robot].robot,
+                    race.at,
+                    arrival(&race.first),
+                    arrival(&race.second)
+                )
+            })
+            .collect();
+        said
+    };
+    let race = "tests/fixtures/verify/robots_race/main.mission";
+    assert_eq!(
+        races_of(race, "5,5", "0,0"),
+        [
+            "base at 1: Scouts.SEEN=YES from north then Scouts.SEEN=NO from south; else LOST not FOUND"
+        ]
+    );
+    assert_eq!(
+        races_of(race, "0,0", "5,5"),
+        [
+            "base at 1: Scouts.SEEN=NO from north then Scouts.SEEN=YES from south; else FOUND not LOST"
+        ]
+    );
+    assert_eq!(races_of(race, "0,0", "1,1"), Vec::<String>::new());
+    let commute = "tests/fixtures/verify/robots_commute/main.mission";
+    assert_eq!(races_of(commute, "5,5", "0,0"), Vec::<String>::new());
+    // The answer taken only reported to the operator: the orders differ in
+    // the report alone.
+    let report = "tests/fixtures/verify/robots_report/main.mission";
+    assert_eq!(races_of(report, "5,5", "0,0"), Vec::<String>::new());
+}
+
 /// `always`, `eventually` and `leads_to` on one run of scouting, judged
 /// instant by instant (beside the scenario's own expectations), each
 /// verdict with its instant; and each written back as JSON reads back the

@@ -31,6 +31,7 @@ pub use search::{apply, choices};
 
 use crate::diag::{Code, Diagnostic, FileId};
 use crate::refine::{RobotProgram, SENSOR_PERIOD_MS, ServiceMachineId, StateId};
+use crate::sim;
 use crate::span::Span;
 use crate::text::LineIndex;
 use std::collections::HashSet;
@@ -293,6 +294,13 @@ pub enum Claim {
         thrower: (ServiceMachineId, StateId),
         lost: (ServiceMachineId, StateId),
     },
+    /// At the counterexample's last instants, robot `robot` takes messages
+    /// of robots `senders` in one instant, and in the other order it
+    /// reacts otherwise.
+    MessageRace {
+        robot: usize,
+        senders: (usize, usize),
+    },
 }
 
 /// What a search found and how far it looked.
@@ -530,6 +538,90 @@ pub fn verify_expecting(
             lost: race.lost,
         });
     }
+    // One finding per (statement, robots, keys): the search keeps a race
+    // per mode and per kind of message, which may name the same ones.
+    type Told<'a> = (Span, usize, [(usize, &'a str); 2]);
+    let mut told: HashSet<Told> = HashSet::new();
+    for (race, way) in &explored.message_races {
+        let program = &programs[race.robot];
+        let m = &program.control;
+        let taken_at = |a: &sim::Arrival| receive_of(m, race.mode, a);
+        let said = |a: &sim::Arrival| {
+            let value = a.value.as_ref().map_or("none".to_string(), |v| v.as_text());
+            let what = match a.taken {
+                sim::Taken::Event => format!("event {value}"),
+                _ if a.publish => format!("{} = {value} (published)", a.key),
+                _ => format!("{} = {value}", a.key),
+            };
+            format!("{what} from {}", programs[a.from].robot)
+        };
+        let mode_name = |mode: Option<crate::refine::ModeId>| {
+            mode.map_or("no mode".to_string(), |id| {
+                format!("mode {}", m.mode(id).name)
+            })
+        };
+        let differs = match race.differs {
+            sim::Differs::Mode(ran, other) => format!(
+                "it would be in {} instead of {}",
+                mode_name(other),
+                mode_name(ran)
+            ),
+            sim::Differs::Values => "it would hold another value".to_string(),
+            sim::Differs::Next => "what it does next would differ".to_string(),
+        };
+        let first_at = taken_at(&race.first);
+        let second_at = taken_at(&race.second);
+        let sends = [&race.first, &race.second].map(|a| send_of(&programs[a.from], a));
+        let span = first_at
+            .or(second_at)
+            .map(|(span, line)| span.unwrap_or_else(|| line_span(text, &lines, line)))
+            .or_else(|| sends.iter().flatten().next().map(|s| s.span))
+            .unwrap_or(Span { start: 0, end: 0 });
+        let mut pair = [&race.first, &race.second].map(|a| (a.from, a.key.as_str()));
+        pair.sort_unstable();
+        if !told.insert((span, race.robot, pair)) {
+            continue;
+        }
+        let mut finding = Diagnostic::new(
+            Code::RobotsRace,
+            file,
+            span,
+            format!(
+                "at {} ms {} takes {} and {} in one instant, in that order; taken the other way round, as the network may deliver them, {differs}: which robot's message comes first decides it{}",
+                race.at,
+                program.robot,
+                said(&race.first),
+                said(&race.second),
+                faults_aside(way, programs)
+            ),
+        );
+        if let (Some(a), Some(b)) = (first_at, second_at)
+            && a != b
+        {
+            let (span, line) = b;
+            finding.relate(
+                span.unwrap_or_else(|| line_span(text, &lines, line)),
+                format!("{} is taken here", said(&race.second)),
+            );
+        }
+        for (arrival, send) in [&race.first, &race.second].into_iter().zip(&sends) {
+            if let Some(send) = send {
+                finding.relate(
+                    send.span,
+                    format!(
+                        "{} sends this; it arrives at {} ms, in the instant the other does",
+                        programs[arrival.from].robot, race.at
+                    ),
+                );
+            }
+        }
+        findings.push(finding);
+        counterexamples.push(Some(way.clone()));
+        claims.push(Claim::MessageRace {
+            robot: race.robot,
+            senders: (race.first.from, race.second.from),
+        });
+    }
     Ok(Report {
         findings,
         counterexamples,
@@ -553,6 +645,89 @@ pub fn verify_expecting(
         },
         properties: properties.into_iter().zip(outcomes).collect(),
     })
+}
+
+/// Where robot program `m` takes `arrival` in `mode`: the `receive` or
+/// `subscribe` statement (preferring one of the mode's plans) as its span,
+/// or a broadcast event's `catch` as its line.
+fn receive_of(
+    m: &crate::refine::ControlMachine,
+    mode: Option<crate::refine::ModeId>,
+    arrival: &sim::Arrival,
+) -> Option<(Option<Span>, u32)> {
+    use crate::refine::StateKind;
+    let takes = |state: &crate::refine::State| match (&state.kind, arrival.taken) {
+        (StateKind::Receive { messages, .. }, sim::Taken::Received(i)) => {
+            messages.iter().any(|k| k.index() == i)
+        }
+        (StateKind::Subscribe { group, .. }, sim::Taken::Subscribed(g)) => group.index() == g,
+        _ => false,
+    };
+    if arrival.taken == sim::Taken::Event {
+        let event = arrival.value.as_ref().map(|v| v.as_text())?;
+        return (m.transitions.iter())
+            .find(|t| Some(t.from) == mode && t.event == event)
+            .or_else(|| m.transitions.iter().find(|t| t.event == event))
+            .map(|t| (None, t.line));
+    }
+    let in_mode: Vec<ServiceMachineId> = mode
+        .map(|id| m.mode(id).regions.iter().map(|r| r.service).collect())
+        .unwrap_or_default();
+    let services = (m.services.iter().enumerate())
+        .map(|(i, s)| (ServiceMachineId::new(i), s))
+        .filter(|(id, _)| in_mode.contains(id))
+        .chain(
+            (m.services.iter().enumerate())
+                .map(|(i, s)| (ServiceMachineId::new(i), s))
+                .filter(|(id, _)| !in_mode.contains(id)),
+        );
+    for (_, service) in services {
+        if let Some(state) = service.states.iter().find(|s| takes(s)) {
+            return Some((Some(state.span), state.line));
+        }
+    }
+    None
+}
+
+/// The statement of `program` that sends `arrival`: a `send` or `publish`
+/// of its key (one that writes its value as a literal first), or the
+/// `throw ... broadcast` of its event.
+fn send_of<'a>(
+    program: &'a RobotProgram,
+    arrival: &sim::Arrival,
+) -> Option<&'a crate::refine::State> {
+    use crate::refine::{Operand, StateKind};
+    let m = &program.control;
+    let event = arrival.value.as_ref().map(|v| v.as_text());
+    // Per statement: whether it sends the key, and whether it writes the
+    // arrival's value as a literal.
+    let sends = |state: &crate::refine::State| match &state.kind {
+        StateKind::Send { items } if arrival.taken != sim::Taken::Event => {
+            let mut sends = (false, false);
+            for item in items {
+                let message = m.outgoing_message(item.message);
+                if message.key == arrival.key && message.publish == arrival.publish {
+                    sends.0 = true;
+                    if let Operand::Literal(v) = &item.value {
+                        sends.1 |= Some(v.as_text()) == event;
+                    }
+                }
+            }
+            sends
+        }
+        StateKind::Throw {
+            event: thrown,
+            broadcast: Some(_),
+        } if arrival.taken == sim::Taken::Event => {
+            let same = Some(thrown) == event.as_ref();
+            (same, same)
+        }
+        _ => (false, false),
+    };
+    let states = || m.services.iter().flat_map(|s| &s.states);
+    states()
+        .find(|state| sends(state).1)
+        .or_else(|| states().find(|state| sends(state).0))
 }
 
 /// " (after help killed at 0 ms)" when the way has faults, else nothing.

@@ -10,7 +10,7 @@ use super::inputs::Inputs;
 use super::properties::{self, Label, Outcome, Property};
 use super::{Bound, Choice, Counterexample, Options, World};
 use crate::refine::{RobotProgram, ServiceMachineId, StateId};
-use crate::sim::{self, Memory, Race, Scenario, Sim};
+use crate::sim::{self, Memory, MessageRace, Race, Scenario, Sim};
 use std::collections::{HashMap, HashSet};
 
 /// What the search saw, for the properties to judge.
@@ -45,6 +45,10 @@ pub struct Explored {
     /// statements): its first instant met and the shortest way there. A
     /// race seen is a witness: judged bounded or not.
     pub races: Vec<(Race, Counterexample)>,
+    /// Per race between robots (the receiver's team and mode, and the two
+    /// messages' teams, keys and kinds, in either order): its first
+    /// instant met and the shortest way there. A witness too.
+    pub message_races: Vec<(MessageRace, Counterexample)>,
     /// Per property of the user's (same order): what became of it.
     pub properties: Vec<Outcome>,
 }
@@ -84,6 +88,7 @@ pub fn explore(
     let memory = Memory::of(programs);
     let mut root = Sim::new(programs, &scenario, &sim::Options::default());
     root.watch_races();
+    root.watch_message_races(options.step_ms);
     let mut explored = Explored {
         states: 0,
         transitions: 0,
@@ -97,11 +102,16 @@ pub fn explore(
         waits_for_ever: Vec::new(),
         two_leaders: Vec::new(),
         races: Vec::new(),
+        message_races: Vec::new(),
         properties: Vec::new(),
     };
     let mut judge = Judge::new(programs, properties);
     // (team, thrower's statement, lost statement) → the race.
     let mut races: HashMap<(&str, u32, u32), (Race, Counterexample)> = HashMap::new();
+    // (receiver's team, its mode, the two messages as (team, key, kind),
+    // sorted) → the race.
+    type Crossing<'a> = (&'a str, Option<u32>, [(String, String, sim::Taken); 2]);
+    let mut message_races: HashMap<Crossing, (MessageRace, Counterexample)> = HashMap::new();
     let mut nodes: Vec<Node> = Vec::new();
     // Keyed by fingerprints, themselves hashes: the fast hasher suffices.
     let mut seen: crate::fasthash::FastMap<u128, u32> = Default::default();
@@ -211,6 +221,22 @@ pub fn explore(
                         )
                     });
                 }
+                for race in child.take_message_races() {
+                    let said = |a: &sim::Arrival| (a.from_team.clone(), a.key.clone(), a.taken);
+                    let mut pair = [said(&race.first), said(&race.second)];
+                    pair.sort_by(|x, y| (&x.0, &x.1).cmp(&(&y.0, &y.1)));
+                    let at = (
+                        programs[race.robot].team.as_str(),
+                        race.mode.map(|m| m.index() as u32),
+                        pair,
+                    );
+                    message_races.entry(at).or_insert_with(|| {
+                        (
+                            race,
+                            counterexample(&nodes, id, &choice, t, options.step_ms),
+                        )
+                    });
+                }
                 for e in trace {
                     // What a robot does (not what merely reaches it): it
                     // left any `receive` it waited in, or works beside it.
@@ -296,6 +322,10 @@ pub fn explore(
     explored
         .races
         .sort_by_key(|(race, _)| (race.robot, race.thrower, race.lost));
+    explored.message_races = message_races.into_values().collect();
+    explored
+        .message_races
+        .sort_by_key(|(race, _)| (race.robot, race.at, race.first.from, race.second.from));
     explored.properties = judge.outcomes(&nodes, explored.exhaustive, options.step_ms);
     if explored.exhaustive {
         let graph = Graph {
