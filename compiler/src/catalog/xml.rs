@@ -16,10 +16,10 @@ use super::{
     ValueType,
 };
 use crate::diag::{Code, Diagnostic, FileId, Sink};
+use crate::fasthash::FastMap;
 use crate::span::Span;
 use crate::xmlpos::{Attr, get, is_ident, suggest};
 use crate::xmltree::{Elem, TreeFormat, Vocabulary, read_tree};
-use std::collections::HashMap;
 use std::path::Path;
 
 /// Reads one catalog file: the robot types it defines and its diagnostics.
@@ -71,7 +71,7 @@ pub fn parse_catalog(file: FileId, text: &str, base_dir: Option<&Path>) -> Parse
         text,
         base_dir,
         sink: Sink::new(file),
-        robot_names: HashMap::new(),
+        robot_names: FastMap::default(),
         out: ParsedCatalog::default(),
     };
     if let Some(root) = &root {
@@ -106,7 +106,21 @@ fn suggest_type(name: &str) -> Option<String> {
 
 /// Collapses runs of whitespace (a `<Doc>` may span lines) into single spaces.
 fn one_line(s: &str) -> String {
-    s.split_whitespace().collect::<Vec<_>>().join(" ")
+    let mut line = String::with_capacity(s.len());
+    let mut push = |word: &str| {
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(word);
+    };
+    // The same words either way on ASCII text without a vertical tab (which
+    // only `split_whitespace` splits on); the ASCII split decodes nothing.
+    if s.is_ascii() && !s.as_bytes().contains(&0x0b) {
+        s.split_ascii_whitespace().for_each(&mut push);
+    } else {
+        s.split_whitespace().for_each(&mut push);
+    }
+    line
 }
 
 /// Whether the markup between two pieces of a `<Doc>`'s text separates words:
@@ -140,9 +154,9 @@ struct RobotBuild {
     names: Vec<(String, Span)>,
     doc_at: Option<Span>,
     platform_at: Option<Span>,
-    capabilities: HashMap<String, Span>,
-    value_names: HashMap<String, Span>,
-    service_names: HashMap<String, Span>,
+    capabilities: FastMap<String, Span>,
+    value_names: FastMap<String, Span>,
+    service_names: FastMap<String, Span>,
 }
 
 /// A value or service being read.
@@ -151,9 +165,9 @@ struct ItemBuild<T> {
     def: Option<T>,
     /// Where the item was documented (`doc=` or an earlier `<Doc>`).
     doc_at: Option<Span>,
-    param_names: HashMap<String, Span>,
+    param_names: FastMap<String, Span>,
     /// A service's results by name, to where each is first written.
-    result_names: HashMap<String, Span>,
+    result_names: FastMap<String, Span>,
     /// The first optional parameter seen, for "required after optional".
     optional_seen: bool,
 }
@@ -163,8 +177,8 @@ impl<T> ItemBuild<T> {
         ItemBuild {
             def,
             doc_at,
-            param_names: HashMap::new(),
-            result_names: HashMap::new(),
+            param_names: FastMap::default(),
+            result_names: FastMap::default(),
             optional_seen: false,
         }
     }
@@ -175,7 +189,7 @@ struct Reader<'t, 'p> {
     base_dir: Option<&'p Path>,
     sink: Sink,
     /// Robot type names and aliases of this file, to where they are first written.
-    robot_names: HashMap<String, Span>,
+    robot_names: FastMap<String, Span>,
     out: ParsedCatalog,
 }
 
@@ -276,9 +290,9 @@ impl Reader<'_, '_> {
             names: Vec::new(),
             doc_at: None,
             platform_at: None,
-            capabilities: HashMap::new(),
-            value_names: HashMap::new(),
-            service_names: HashMap::new(),
+            capabilities: FastMap::default(),
+            value_names: FastMap::default(),
+            service_names: FastMap::default(),
         };
         if let Some((name, span)) = self.name_attr(e, "type") {
             if operator && name != "USER" {
@@ -741,7 +755,7 @@ impl Reader<'_, '_> {
     /// Returns the aliases that are free.
     fn register_item(
         &mut self,
-        names: &mut HashMap<String, Span>,
+        names: &mut FastMap<String, Span>,
         what: &str,
         name: &(String, Span),
         aliases: Vec<(String, Span)>,
@@ -789,7 +803,7 @@ impl Reader<'_, '_> {
                 );
                 return ValueType::String;
             }
-            let mut seen: HashMap<&str, Span> = HashMap::new();
+            let mut seen: FastMap<&str, Span> = FastMap::default();
             let mut values = Vec::new();
             for (w, span) in &words {
                 if !self.check_name(w, *span) {

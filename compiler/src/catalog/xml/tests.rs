@@ -699,3 +699,14 @@ fn a_service_lists_its_results_in_order_each_checked_as_a_value() {
     );
     assert_eq!(codes(&wrap("<Result name=\"F\" type=\"bool\"/>")), ["E051"]);
 }
+
+proptest! {
+    /// A doc collapsed to one line has the words `split_whitespace` finds,
+    /// one space apart, whichever split reads it (vertical tabs and Unicode
+    /// spaces included).
+    #[test]
+    fn one_line_keeps_the_words_of_split_whitespace(s in "[a-c \t\n\r\u{b}\u{c}\u{a0}\u{2003}]{0,24}") {
+        let words: Vec<&str> = s.split_whitespace().collect();
+        prop_assert_eq!(one_line(&s), words.join(" "));
+    }
+}
