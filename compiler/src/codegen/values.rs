@@ -144,18 +144,18 @@ fn each_literal(program: &RobotProgram, f: &mut dyn FnMut(&Value)) {
             StateKind::Call { args, .. } | StateKind::RunActions { args, .. } => {
                 args.iter().for_each(&mut add)
             }
-            StateKind::Branch { condition, .. } => operands(condition, &mut add),
+            StateKind::Branch { condition, .. } => condition.for_each_operand(&mut add),
             StateKind::LoopHead {
                 condition: Some(c), ..
             }
             | StateKind::Repeat {
                 condition: Some(c), ..
-            } => operands(c, &mut add),
+            } => c.for_each_operand(&mut add),
             _ => {}
         }
     }
     for policy in &m.battery {
-        operands(&policy.condition, &mut add);
+        policy.condition.for_each_operand(&mut add);
     }
     for action in m.actions.iter().flat_map(|a| &a.actions) {
         for (_, command) in &action.commands {
@@ -163,26 +163,9 @@ fn each_literal(program: &RobotProgram, f: &mut dyn FnMut(&Value)) {
         }
         for (condition, _) in action.transitions.iter() {
             if let Some(c) = condition {
-                operands(c, &mut add);
+                c.for_each_operand(&mut add);
             }
         }
-    }
-}
-
-/// Every operand of an expression.
-fn operands(e: &Expr, f: &mut dyn FnMut(&Operand)) {
-    match e {
-        Expr::Or(a, b) | Expr::And(a, b) => {
-            operands(a, f);
-            operands(b, f);
-        }
-        Expr::Not(a) => operands(a, f),
-        Expr::Compare(a, _, b, _) => {
-            f(a);
-            f(b);
-        }
-        Expr::Truthy(o) => f(o),
-        Expr::Bool(_) => {}
     }
 }
 

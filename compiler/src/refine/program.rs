@@ -1036,6 +1036,25 @@ pub enum Expr {
     Bool(bool),
 }
 
+impl Expr {
+    /// Calls `f` on every operand of the expression, left to right.
+    pub fn for_each_operand(&self, f: &mut dyn FnMut(&Operand)) {
+        match self {
+            Expr::Or(a, b) | Expr::And(a, b) => {
+                a.for_each_operand(f);
+                b.for_each_operand(f);
+            }
+            Expr::Not(a) => a.for_each_operand(f),
+            Expr::Compare(a, _, b, _) => {
+                f(a);
+                f(b);
+            }
+            Expr::Truthy(o) => f(o),
+            Expr::Bool(_) => {}
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub enum Operand {
     Slot(SlotId),

@@ -1275,15 +1275,7 @@ fn a_throw_that_ends_the_mode_before_a_later_plan_sends_is_noted_as_a_race() {
     let races_of = |mission: &str| {
         let programs = programs(mission);
         let scenario = Scenario::default();
-        let mut watched = Sim::new(&programs, &scenario, &Options::default());
-        watched.watch_races();
-        watched.run_to(2_000);
-        let mut plain = Sim::new(&programs, &scenario, &Options::default());
-        plain.run_to(2_000);
-        let lines = |sim: &mut Sim| -> Vec<String> {
-            sim.take_trace().iter().map(|e| format!("{e:?}")).collect()
-        };
-        assert_eq!(lines(&mut watched), lines(&mut plain), "{mission}");
+        let mut watched = watched_alike(&programs, &scenario, mission, Sim::watch_races);
         let said: Vec<String> = watched
             .take_races()
             .iter()
@@ -1314,6 +1306,26 @@ fn a_throw_that_ends_the_mode_before_a_later_plan_sends_is_noted_as_a_race() {
     );
 }
 
+/// `mission` run to 2 s with `watch` set up, after checking that watching
+/// changes nothing of its trace (the same run without it).
+fn watched_alike<'p>(
+    programs: &'p [RobotProgram],
+    scenario: &'p Scenario,
+    mission: &str,
+    watch: impl FnOnce(&mut Sim<'p>),
+) -> Sim<'p> {
+    let mut watched = Sim::new(programs, scenario, &Options::default());
+    watch(&mut watched);
+    watched.run_to(2_000);
+    let mut plain = Sim::new(programs, scenario, &Options::default());
+    plain.run_to(2_000);
+    let lines = |sim: &mut Sim| -> Vec<String> {
+        sim.take_trace().iter().map(|e| format!("{e:?}")).collect()
+    };
+    assert_eq!(lines(&mut watched), lines(&mut plain), "{mission}");
+    watched
+}
+
 /// Races between robots (`semo verify`'s V006): both scouts' answers reach
 /// the base at 1 ms, north's first; taken the other way round the base
 /// would go to LOST, not FOUND. Watching notes exactly that and changes
@@ -1329,15 +1341,10 @@ fn two_robots_whose_messages_the_receiver_takes_in_either_order_race() {
                 "south": {{"sensors": [{{"at": 0, "value": "LOCATION", "is": "{south}"}}]}}}}}}"#
         );
         let scenario = scenario::parse(&text, &programs).unwrap_or_else(|e| panic!("{e:?}"));
-        let mut watched = Sim::new(&programs, &scenario, &Options::default());
-        watched.watch_message_races(crate::verify::Options::default().step_ms);
-        watched.run_to(2_000);
-        let mut plain = Sim::new(&programs, &scenario, &Options::default());
-        plain.run_to(2_000);
-        let lines = |sim: &mut Sim| -> Vec<String> {
-            sim.take_trace().iter().map(|e| format!("{e:?}")).collect()
-        };
-        assert_eq!(lines(&mut watched), lines(&mut plain), "{mission}");
+        let step_ms = crate::verify::Options::default().step_ms;
+        let mut watched = watched_alike(&programs, &scenario, mission, |sim| {
+            sim.watch_message_races(step_ms)
+        });
         let said: Vec<String> = watched
             .take_message_races()
             .iter()

@@ -149,19 +149,7 @@ impl Unread {
             }
         }
         fn expr(read: &mut [bool], e: &Expr) {
-            match e {
-                Expr::Or(a, b) | Expr::And(a, b) => {
-                    expr(read, a);
-                    expr(read, b);
-                }
-                Expr::Not(a) => expr(read, a),
-                Expr::Compare(a, _, b, _) => {
-                    operand(read, a);
-                    operand(read, b);
-                }
-                Expr::Truthy(a) => operand(read, a),
-                Expr::Bool(_) => {}
-            }
+            e.for_each_operand(&mut |op| operand(read, op));
         }
         for state in m.services.iter().flat_map(|s| &s.states) {
             match &state.kind {
@@ -213,13 +201,13 @@ impl Unread {
                     && robot.library_index[i].is_none_or(|k| !global.contains(&k))
             })
             .collect();
-        let library = (0..robot.library.len())
-            .map(|k| {
-                (robot.library_index.iter().enumerate())
-                    .filter(|(_, at)| at.is_some_and(|at| at.index() == k))
-                    .all(|(i, _)| slots[i])
-            })
-            .collect();
+        // A place is unread when every slot it feeds is (one pass over the slots).
+        let mut library = vec![true; robot.library.len()];
+        for (i, at) in robot.library_index.iter().enumerate() {
+            if let Some(at) = at {
+                library[at.index()] &= slots[i];
+            }
+        }
         Unread { slots, library }
     }
 }
@@ -347,114 +335,124 @@ impl<'p> Sim<'p> {
                     senders.push(from);
                 }
             }
-            if senders.len() < 2 {
-                continue;
-            }
             for pair in senders.windows(2) {
-                let (a, b) = (pair[0], pair[1]);
-                let of = |s: usize| taken.iter().filter(move |(m, _)| m.from == Some(s));
-                // The same message from both commutes.
-                let same = of(a).chain(of(b)).all(|(m, t)| {
-                    let (m0, t0) = of(a).next().expect("a sends");
-                    *t == *t0
-                        && m.publish == m0.publish
-                        && m.from_team == m0.from_team
-                        && m.key == m0.key
-                        && m.value == m0.value
-                });
-                if same {
-                    continue;
-                }
-                // b's messages where a's and b's were, before a's.
-                let mut swapped: Vec<&Rc<Message>> = Vec::with_capacity(taken.len());
-                let mut moved = of(b).chain(of(a)).map(|(m, _)| m);
-                for (m, _) in taken {
-                    if m.from == Some(a) || m.from == Some(b) {
-                        swapped.push(moved.next().expect("as many"));
-                    } else {
-                        swapped.push(m);
-                    }
-                }
-                let plain: Vec<&Rc<Message>> = taken.iter().map(|(m, _)| m).collect();
-                if self.alike_but_unread(r, &plain, &swapped) {
-                    continue;
-                }
-                let mut ordered = self.delivered(r, &batch, &plain);
-                let mut other = self.delivered(r, &batch, &swapped);
-                // Both run to the firing the messages woke (the later one,
-                // should the orders wake different ones), else to the end
-                // of the instant; then on, firing by firing, while either
-                // has not taken all of them yet (one held up by a full
-                // channel, or behind it): a few firings take or drop them.
-                let fires = |sim: &Sim| sim.robots[r].next_fire.unwrap_or(sim.now).max(sim.now);
-                let waits = |sim: &Sim| {
-                    let robot = &sim.robots[r];
-                    robot.alive && (robot.holding.is_some() || !robot.behind.is_empty())
-                };
-                for _ in 0..TAKING_FIRINGS {
-                    let until = fires(&ordered).max(fires(&other)) + 1;
-                    ordered.run_to(until);
-                    other.run_to(until);
-                    if !waits(&ordered) && !waits(&other) {
-                        break;
-                    }
-                }
-                let watch = self.message_races.as_ref().expect("watching");
-                ordered.forget_unread(&watch.unread);
-                other.forget_unread(&watch.unread);
-                if ordered.fingerprint(&watch.memory) == other.fingerprint(&watch.memory) {
-                    continue;
-                }
-                // What differs once both took them, the robot's reaction.
-                let mode = |sim: &Sim| {
-                    let robot = &sim.robots[r];
-                    robot.pending_mode.or(robot.current_mode)
-                };
-                let differs = if mode(&ordered) != mode(&other) {
-                    Differs::Mode(mode(&ordered), mode(&other))
-                } else {
-                    let (x, y) = (&ordered.robots[r], &other.robots[r]);
-                    if x.slots != y.slots || x.groups != y.groups || x.library != y.library {
-                        Differs::Values
-                    } else {
-                        Differs::Next
-                    }
-                };
-                // Another mode is another thing the team does, whatever
-                // comes after. Otherwise, until the world's next choice
-                // nothing new comes in: a difference that is gone by then
-                // (a published value replaced before anything read it)
-                // changes nothing.
-                let horizon = (now.div_euclid(watch.step_ms) + 1) * watch.step_ms;
-                if !matches!(differs, Differs::Mode(..))
-                    && ordered.converge(&mut other, horizon, &watch.unread, &watch.memory)
-                {
-                    continue;
-                }
-                let arrival = |s: usize| {
-                    let (m, t) = of(s).next().expect("sends");
-                    Arrival {
-                        from: s,
-                        from_team: m.from_team.to_string(),
-                        key: m.key.to_string(),
-                        publish: m.publish,
-                        value: m.value.clone(),
-                        taken: *t,
-                    }
-                };
-                found.push(MessageRace {
-                    robot: r,
-                    at: now,
-                    mode: self.robots[r].current_mode,
-                    first: arrival(a),
-                    second: arrival(b),
-                    differs,
-                });
+                found.extend(self.race_between(r, taken, (pair[0], pair[1]), &batch));
             }
         }
         if let Some(watch) = self.message_races.as_mut() {
             watch.found.extend(found);
         }
+    }
+
+    /// Whether robot `r`, taking `taken` in this instant, reacts otherwise
+    /// with sender `b`'s messages before sender `a`'s (`a`'s come first in
+    /// the run): the race, if so.
+    fn race_between(
+        &self,
+        r: usize,
+        taken: &[(Rc<Message>, Taken)],
+        (a, b): (usize, usize),
+        batch: &[Delivery],
+    ) -> Option<MessageRace> {
+        let now = self.now;
+        let of = |s: usize| taken.iter().filter(move |(m, _)| m.from == Some(s));
+        // The same message from both commutes.
+        let (m0, t0) = of(a).next().expect("a sends");
+        let same = of(a).chain(of(b)).all(|(m, t)| {
+            *t == *t0
+                && m.publish == m0.publish
+                && m.from_team == m0.from_team
+                && m.key == m0.key
+                && m.value == m0.value
+        });
+        if same {
+            return None;
+        }
+        // b's messages where a's and b's were, before a's.
+        let mut swapped: Vec<&Rc<Message>> = Vec::with_capacity(taken.len());
+        let mut moved = of(b).chain(of(a)).map(|(m, _)| m);
+        for (m, _) in taken {
+            if m.from == Some(a) || m.from == Some(b) {
+                swapped.push(moved.next().expect("as many"));
+            } else {
+                swapped.push(m);
+            }
+        }
+        let plain: Vec<&Rc<Message>> = taken.iter().map(|(m, _)| m).collect();
+        if self.alike_but_unread(r, &plain, &swapped) {
+            return None;
+        }
+        let mut ordered = self.delivered(r, batch, &plain);
+        let mut other = self.delivered(r, batch, &swapped);
+        // Both run to the firing the messages woke (the later one,
+        // should the orders wake different ones), else to the end
+        // of the instant; then on, firing by firing, while either
+        // has not taken all of them yet (one held up by a full
+        // channel, or behind it): a few firings take or drop them.
+        let fires = |sim: &Sim| sim.robots[r].next_fire.unwrap_or(sim.now).max(sim.now);
+        let waits = |sim: &Sim| {
+            let robot = &sim.robots[r];
+            robot.alive && (robot.holding.is_some() || !robot.behind.is_empty())
+        };
+        for _ in 0..TAKING_FIRINGS {
+            let until = fires(&ordered).max(fires(&other)) + 1;
+            ordered.run_to(until);
+            other.run_to(until);
+            if !waits(&ordered) && !waits(&other) {
+                break;
+            }
+        }
+        let watch = self.message_races.as_ref().expect("watching");
+        ordered.forget_unread(&watch.unread);
+        other.forget_unread(&watch.unread);
+        if ordered.fingerprint(&watch.memory) == other.fingerprint(&watch.memory) {
+            return None;
+        }
+        // What differs once both took them, the robot's reaction.
+        let mode = |sim: &Sim| {
+            let robot = &sim.robots[r];
+            robot.pending_mode.or(robot.current_mode)
+        };
+        let differs = if mode(&ordered) != mode(&other) {
+            Differs::Mode(mode(&ordered), mode(&other))
+        } else {
+            let (x, y) = (&ordered.robots[r], &other.robots[r]);
+            if x.slots != y.slots || x.groups != y.groups || x.library != y.library {
+                Differs::Values
+            } else {
+                Differs::Next
+            }
+        };
+        // Another mode is another thing the team does, whatever
+        // comes after. Otherwise, until the world's next choice
+        // nothing new comes in: a difference that is gone by then
+        // (a published value replaced before anything read it)
+        // changes nothing.
+        let horizon = (now.div_euclid(watch.step_ms) + 1) * watch.step_ms;
+        if !matches!(differs, Differs::Mode(..))
+            && ordered.converge(&mut other, horizon, &watch.unread, &watch.memory)
+        {
+            return None;
+        }
+        let arrival = |s: usize| {
+            let (m, t) = of(s).next().expect("sends");
+            Arrival {
+                from: s,
+                from_team: m.from_team.to_string(),
+                key: m.key.to_string(),
+                publish: m.publish,
+                value: m.value.clone(),
+                taken: *t,
+            }
+        };
+        Some(MessageRace {
+            robot: r,
+            at: now,
+            mode: self.robots[r].current_mode,
+            first: arrival(a),
+            second: arrival(b),
+            differs,
+        })
     }
 
     /// Whether robot `r` takes the messages `plain` and `swapped` (the

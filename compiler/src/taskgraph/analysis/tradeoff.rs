@@ -520,7 +520,14 @@ pub fn trade_off_towards(
         // One evaluation is kept for the minima together: where they reach
         // the maximal throughput, no smaller distribution does.
         let budget = MAX_WORK.saturating_sub(search.cost);
-        let minima = channel_minima(&mut search, max_period, reached.as_deref(), &steps, budget);
+        let minima = channel_minima(
+            &mut search,
+            max_period,
+            reached.as_deref(),
+            &minimal,
+            &steps,
+            budget,
+        );
         let bound: u64 = minima.iter().sum();
         let above = reached.is_none_or(|caps| caps.iter().sum::<u64>() > bound);
         if above
@@ -728,11 +735,11 @@ fn channel_minima(
     search: &mut Search<'_, '_>,
     max_period: Ratio,
     found: Option<&[u64]>,
+    minimal: &[u64],
     steps: &[u64],
     budget: u64,
 ) -> Vec<u64> {
     let level = search.level;
-    let minimal: Vec<u64> = level.edges.iter().map(minimal_capacity).collect();
     let mut minima = Vec::with_capacity(minimal.len());
     for i in 0..level.edges.len() {
         let step = steps[i];
