@@ -1341,7 +1341,9 @@ fn two_robots_whose_messages_the_receiver_takes_in_either_order_race() {
                 "south": {{"sensors": [{{"at": 0, "value": "LOCATION", "is": "{south}"}}]}}}}}}"#
         );
         let scenario = scenario::parse(&text, &programs).unwrap_or_else(|e| panic!("{e:?}"));
-        let step_ms = crate::verify::Options::default().step_ms;
+        // The world's step the race is looked for within (any step holding
+        // both arrivals' instant will do).
+        let step_ms = 500;
         let mut watched = watched_alike(&programs, &scenario, mission, |sim| {
             sim.watch_message_races(step_ms)
         });
