@@ -50,6 +50,7 @@ use std::rc::Rc;
 mod battery;
 mod explore;
 mod fleet;
+mod folded;
 mod loops;
 mod message_races;
 mod races;
@@ -155,6 +156,16 @@ enum Event {
         /// Shared by every robot the message goes to.
         message: Rc<Message>,
     },
+    /// A heartbeat reaching its sender's whole team at one instant, kept
+    /// once for the robots that take it at once (`engine/folded.rs`):
+    /// handled as one delivery event per robot it goes to (`recipients`),
+    /// as [`Event::Deliver`] would be.
+    Heartbeat {
+        message: Rc<Message>,
+        recipients: u32,
+        /// The queue number its send took.
+        sent: u64,
+    },
     /// The trace lines of a service graph's iteration under way that are
     /// due now (`loops.rs`: its time-triggered tasks wait for their periods).
     GraphTrace {
@@ -228,7 +239,7 @@ impl Event {
     fn order(&self) -> u8 {
         match self {
             Event::Fault(_) => 0,
-            Event::Deliver { .. } => 1,
+            Event::Deliver { .. } | Event::Heartbeat { .. } => 1,
             Event::GraphTrace { .. } => 2,
             Event::ServiceDone { .. } => 3,
             Event::Operator(_) => 4,
@@ -378,8 +389,15 @@ struct Robot<'p> {
     /// order, at most `EVENT_QUEUE` (`comm_event_take`).
     events: VecDeque<(PeerId, usize)>,
     last_heartbeat: i64,
-    /// Per peer: what its last heartbeat said (`comm_heard`).
+    /// Per peer: what its last heartbeat said (`comm_heard`), where it was
+    /// heard one by one ([`Sim::heard`] reads it with the folded ones).
     heard: Hearing,
+    /// In a run that folds heartbeats (`engine/folded.rs`): since which
+    /// folded delivery it takes its team's heartbeats folded, while it does.
+    folded_from: Option<u64>,
+    /// The queue's number when this process of the robot started: a
+    /// message sent before was for an earlier one.
+    epoch_seq: u64,
     /// Whether the last election this robot decided named it (what its
     /// heartbeats say).
     leading: bool,
@@ -514,6 +532,9 @@ pub struct Sim<'p> {
     /// Trace events not made ([`Sim::untraced_messages`]) so far: a firing
     /// that would have traced one is no idle firing.
     unmade: u64,
+    /// The heartbeats kept once for a team, when the run folds them
+    /// (`engine/folded.rs`): untraced messages on a plain network.
+    folded: Option<folded::Folded>,
 }
 
 impl<'p> Robot<'p> {
@@ -634,6 +655,8 @@ impl<'p> Robot<'p> {
             events: VecDeque::new(),
             last_heartbeat: at - m.heartbeat_ms,
             heard: Hearing::new(team),
+            folded_from: None,
+            epoch_seq: 0,
             leading: false,
             said: None,
             term: 0,
@@ -731,9 +754,14 @@ impl<'p> Sim<'p> {
             arrivals: Vec::new(),
             untraced_messages: options.untraced_messages,
             unmade: 0,
+            folded: None,
         };
+        if options.untraced_messages && sim.plain_network() {
+            sim.folded = Some(folded::Folded::new(programs.len()));
+        }
         sim.inputs = sim.robots.iter().map(Inputs::of).collect();
         for r in 0..programs.len() {
+            sim.start_folding(r);
             sim.start(r);
         }
         for (i, c) in scenario.operator.iter().enumerate() {
@@ -858,6 +886,7 @@ impl<'p> Sim<'p> {
             // A message's deliveries at one instant count one event each.
             events += match &event {
                 Event::Deliver { to, .. } => to.len() as u64,
+                Event::Heartbeat { recipients, .. } => u64::from(*recipients),
                 _ => 1,
             };
             self.handle(event);
@@ -930,6 +959,7 @@ impl<'p> Sim<'p> {
                 }
                 self.deliver_all(&to, &message)
             }
+            Event::Heartbeat { message, sent, .. } => self.deliver_folded(&message, sent),
             Event::Operator(i) => self.operator(i),
             Event::Fault(i) => self.fault(i),
         }
@@ -998,6 +1028,7 @@ impl<'p> Sim<'p> {
     pub(crate) fn kill(&mut self, r: usize) {
         if self.robots[r].alive {
             self.robots[r].alive = false;
+            self.stop_folding(r);
             self.running -= 1;
             self.emit(r, "fault", smallvec![("fault", "kill".into())]);
         }
@@ -1011,6 +1042,8 @@ impl<'p> Sim<'p> {
             let (world, team) = (self.fleet.world(self.scenario, r), self.fleet.team(r));
             let program = self.robots[r].program;
             self.robots[r] = Robot::new(program, world, team, self.now, epoch);
+            self.robots[r].epoch_seq = self.seq;
+            self.start_folding(r);
             self.running += 1;
             self.emit(r, "fault", smallvec![("fault", "restart".into())]);
             self.start(r);
@@ -1033,6 +1066,7 @@ impl<'p> Sim<'p> {
             }
         }
         self.robots[r].alive = false;
+        self.stop_folding(r);
         self.running -= 1;
         self.trace_dropped(r);
         self.emit(r, "stop", Fields::new());
@@ -1200,6 +1234,22 @@ impl<'p> Sim<'p> {
             // Every link the network's: the message reaches every
             // recipient at one instant, each as `link` would say.
             let at = self.now + self.scenario.network.latency_ms;
+            if self.folds(r, targets, &message) {
+                let recipients = targets.iter().filter(|&&dst| dst != r).count();
+                if recipients > 0 {
+                    let sent = self.seq + 1;
+                    self.seq += recipients as u64;
+                    let recipients = recipients as u32;
+                    let event = Event::Heartbeat {
+                        message,
+                        recipients,
+                        sent,
+                    };
+                    self.queue.push(Queued::new(at, event, sent));
+                    self.queued += 1;
+                }
+                return;
+            }
             let robots = &self.robots;
             let to: Rc<[(usize, u32)]> = (targets.iter())
                 .filter(|&&dst| dst != r)
@@ -1290,22 +1340,28 @@ impl<'p> Sim<'p> {
         let heartbeat = message.publish && matches!(message.value, Some(Value::Text(_)));
         for &(r, epoch) in to {
             let robot = &self.robots[r];
-            if !robot.alive || robot.epoch != epoch {
-                continue;
+            if robot.alive && robot.epoch == epoch {
+                self.deliver_one(r, message, heartbeat);
             }
-            let program = robot.program;
-            let at_once = heartbeat
-                && robot.has_receiver
-                && robot.holding.is_none()
-                && program.control.heartbeat
-                && message.key == self.fleet.names[r].alive_key
-                && (program.library.as_ref()).is_none_or(|lib| lib.ownership.is_none());
-            if at_once {
-                self.trace_receive(r, message);
-                self.hear_heartbeat(r, message);
-            } else {
-                self.deliver(r, message);
-            }
+        }
+    }
+
+    /// `message` reaches robot `r` (alive, the process it was sent to);
+    /// `heartbeat`: the message is one (a published text).
+    fn deliver_one(&mut self, r: usize, message: &Rc<Message>, heartbeat: bool) {
+        let robot = &self.robots[r];
+        let program = robot.program;
+        let at_once = heartbeat
+            && robot.has_receiver
+            && robot.holding.is_none()
+            && program.control.heartbeat
+            && message.key == self.fleet.names[r].alive_key
+            && (program.library.as_ref()).is_none_or(|lib| lib.ownership.is_none());
+        if at_once {
+            self.trace_receive(r, message);
+            self.hear_heartbeat(r, message);
+        } else {
+            self.deliver(r, message);
         }
     }
 
@@ -1330,6 +1386,19 @@ impl<'p> Sim<'p> {
     /// the messages behind, in order, until one is held up again. Waiting
     /// wakes the control task, as `semo_port_offer` does.
     fn release(&mut self, r: usize, firing_ended: bool) {
+        self.take_behind(r, firing_ended);
+        // Held up, it takes heartbeats one by one; free, folded again.
+        if self.folded.is_some() {
+            if self.robots[r].holding.is_some() {
+                self.stop_folding(r);
+            } else {
+                self.start_folding(r);
+            }
+        }
+    }
+
+    /// [`Sim::release`]'s work: the channels written, the messages behind taken.
+    fn take_behind(&mut self, r: usize, firing_ended: bool) {
         loop {
             let robot = &mut self.robots[r];
             let Some(holding) = &mut robot.holding else {
@@ -1722,12 +1791,12 @@ impl<'p> Sim<'p> {
     /// says: heard within `lost_after_ms` since `r` joined.
     fn sharing_arms(&self, r: usize, within: &[EnclosingArm], members: &[PeerId]) -> Vec<PeerId> {
         let robot = &self.robots[r];
+        let heard = self.heard(r);
         let me = robot.program.self_peer;
         let lost = crate::refine::protocol::lost_after_ms(robot.program.control.heartbeat_ms);
         let now = self.now;
-        let alive = |peer: PeerId| {
-            peer == me || now - robot.heard.get(peer).seen.max(robot.started_at) <= lost
-        };
+        let alive =
+            |peer: PeerId| peer == me || now - heard.get(peer).seen.max(robot.started_at) <= lost;
         members_sharing_arms(within, members, me, alive)
     }
 
@@ -1884,6 +1953,7 @@ impl<'p> Sim<'p> {
         if m.heartbeat && self.now - self.robots[r].last_heartbeat >= m.heartbeat_ms {
             self.robots[r].last_heartbeat = self.now;
             self.elect_at_heartbeat(r);
+            self.fold_term(r);
             let robot = &self.robots[r];
             let term = if robot.leading {
                 robot.term_led
@@ -2348,6 +2418,7 @@ impl<'p> Sim<'p> {
                     self.comm_send(r, team, false, key, Some(Value::text(&value)));
                 }
                 let robot = &self.robots[r];
+                let heard = self.heard(r);
                 let pass = robot.sync_pass[&(service, StateId::new(pc))];
                 let lost = crate::refine::protocol::lost_after_ms(m.heartbeat_ms);
                 let me = program.self_peer;
@@ -2359,7 +2430,7 @@ impl<'p> Sim<'p> {
                             .copied()
                             .unwrap_or(0)
                             < pass
-                        && now - robot.heard.get(peer).seen <= lost
+                        && now - heard.get(peer).seen <= lost
                 });
                 let started = robot.regions[i].marks[mark.index()];
                 if waiting && now - started <= *timeout_ms {
@@ -2573,8 +2644,10 @@ impl<'p> Sim<'p> {
         candidates: &[PeerId],
         algorithm: LeaderAlgorithm,
     ) -> Option<bool> {
+        self.fold_term(r);
         let now = self.now;
         let robot = &self.robots[r];
+        let heard = self.heard(r);
         let hb = robot.program.control.heartbeat_ms;
         let listens = robot.rejoining || algorithm == LeaderAlgorithm::HighestBattery;
         if listens && now - robot.started_at < crate::refine::protocol::listen_ms(hb) {
@@ -2582,12 +2655,12 @@ impl<'p> Sim<'p> {
         }
         let me = robot.program.self_peer;
         let lost = crate::refine::protocol::lost_after_ms(hb);
-        let alive = |c: PeerId| c == me || now - robot.heard.get(c).seen <= lost;
+        let alive = |c: PeerId| c == me || now - heard.get(c).seen <= lost;
         let level = |c: PeerId| {
             if c == me {
                 own_battery(robot, now)
             } else {
-                robot.heard.get(c).battery
+                heard.get(c).battery
             }
         };
         let mut live = candidates.iter().copied().filter(|&c| alive(c));
@@ -2610,8 +2683,7 @@ impl<'p> Sim<'p> {
         let was_leading = robot.leading;
         let deposed = was_leading && robot.term > robot.term_led;
         if (robot.rejoining || deposed) && leader == me {
-            let claimant = robot
-                .heard
+            let claimant = heard
                 .iter()
                 .find(|&(i, h)| i != me && h.leads && h.term >= robot.term && now - h.seen <= lost)
                 .map(|(i, _)| i);
@@ -2625,7 +2697,7 @@ impl<'p> Sim<'p> {
             let lease = crate::refine::protocol::lease_ms(hb);
             let heard = candidates
                 .iter()
-                .filter(|&&c| c == me || now - robot.heard.get(c).seen <= lease)
+                .filter(|&&c| c == me || now - heard.get(c).seen <= lease)
                 .count();
             let robot = &mut self.robots[r];
             robot.leading = false;
@@ -2822,9 +2894,10 @@ impl Sim<'_> {
         }
         let me = robot.program.self_peer;
         let now = self.now;
+        let heard = self.heard(r);
         let alive = |peer: PeerId| {
             peer == me
-                || now - robot.heard.get(peer).seen.max(robot.started_at)
+                || now - heard.get(peer).seen.max(robot.started_at)
                     <= crate::refine::protocol::lost_after_ms(m.heartbeat_ms)
         };
         // Its place among the live members (0 when it is none of them),

@@ -154,6 +154,8 @@ impl<'p> Sim<'p> {
     /// reaches it (`None`: every link as the scenario says), as a scenario
     /// partition `[[r]]` from now; messages already under way arrive.
     pub fn isolate(&mut self, r: Option<usize>) {
+        // A folding run's heartbeats reach whole teams at once.
+        debug_assert!(self.folded.is_none());
         self.isolated = r;
     }
 
@@ -161,6 +163,7 @@ impl<'p> Sim<'p> {
     /// lost (`delay` `None`) or take `delay` ms longer: the scenario's
     /// `drop` or `delay` fault `[now, until)` of that pair.
     pub fn disturb(&mut self, a: usize, b: usize, until: i64, delay: Option<i64>) {
+        debug_assert!(self.folded.is_none());
         let now = self.now;
         self.disturbed.retain(|d| d.until > now);
         self.disturbed
@@ -211,6 +214,9 @@ impl<'p> Sim<'p> {
         // The last firing handled (`last_fire`) is left out: it decides
         // only a firing at its own instant, which is past at a step.
         let mut fp = Fingerprint::new(self.now, memory.ms);
+        // `semo verify` traces messages, so its runs never fold heartbeats
+        // (`engine/folded.rs`): what a robot heard is its own table.
+        debug_assert!(self.folded.is_none());
         for (robot, timed) in self.robots.iter().zip(&memory.timed) {
             fp.robot(robot, timed);
         }
@@ -261,6 +267,18 @@ impl<'p> Sim<'p> {
                     for &(r, _) in to.iter().filter(|&&(r, epoch)| alive(r, epoch)) {
                         comes(&mut fp, &[r as i64]);
                         fp.message(message);
+                    }
+                }
+                // A folded heartbeat (`engine/folded.rs`): each robot of the
+                // sender's team alive and started before it was sent.
+                Event::Heartbeat { message, sent, .. } => {
+                    let from = message.from.expect("a heartbeat is a robot's");
+                    for r in self.fleet.team(from).filter(|&r| r != from) {
+                        let robot = &self.robots[r];
+                        if robot.alive && robot.epoch_seq < *sent {
+                            comes(&mut fp, &[r as i64]);
+                            fp.message(message);
+                        }
                     }
                 }
                 Event::ServiceDone {

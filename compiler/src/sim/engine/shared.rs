@@ -38,8 +38,9 @@ impl Sim<'_> {
             return program.self_peer;
         };
         let lost_after = crate::refine::protocol::lost_after_ms(program.control.heartbeat_ms);
+        let heard = self.heard(r);
         let lives = |peer: PeerId| {
-            peer == program.self_peer || self.now - robot.heard.get(peer).seen <= lost_after
+            peer == program.self_peer || self.now - heard.get(peer).seen <= lost_after
         };
         let was = robot.owner;
         if lives(was) {
@@ -52,7 +53,7 @@ impl Sim<'_> {
             if peer == program.self_peer {
                 super::own_battery(robot, self.now)
             } else {
-                robot.heard.get(peer).battery
+                heard.get(peer).battery
             }
             .unwrap_or(-1)
         };
@@ -95,7 +96,7 @@ impl Sim<'_> {
         let program = robot.program;
         program.library.as_ref()?.ownership.as_ref()?;
         (robot.owner != program.self_peer).then(|| {
-            robot.heard.get(robot.owner).seen
+            self.heard(r).get(robot.owner).seen
                 + crate::refine::protocol::lost_after_ms(program.control.heartbeat_ms)
                 + 1
         })
