@@ -398,6 +398,9 @@ struct Robot<'p> {
     /// The queue's number when this process of the robot started: a
     /// message sent before was for an earlier one.
     epoch_seq: u64,
+    /// Its receive task takes each heartbeat of its team at once when it
+    /// is free ([`Sim::hear_heartbeat`]): it can take them folded.
+    heartbeats_at_once: bool,
     /// Whether the last election this robot decided named it (what its
     /// heartbeats say).
     leading: bool,
@@ -657,6 +660,9 @@ impl<'p> Robot<'p> {
             heard: Hearing::new(team),
             folded_from: None,
             epoch_seq: 0,
+            // With shared values the receive task first looks for their
+            // keys (`Sim::shared_heard`), never the alive key.
+            heartbeats_at_once: m.has_receiver() && m.heartbeat,
             leading: false,
             said: None,
             term: 0,
@@ -756,7 +762,10 @@ impl<'p> Sim<'p> {
             unmade: 0,
             folded: None,
         };
-        if options.untraced_messages && sim.plain_network() {
+        // Peers are the mission's robots, in order, for every robot.
+        let peers_are_robots = (programs.iter().enumerate())
+            .all(|(r, p)| p.self_peer.index() == r && p.peers.len() == programs.len());
+        if options.untraced_messages && sim.plain_network() && peers_are_robots {
             sim.folded = Some(folded::Folded::new(programs.len()));
         }
         sim.inputs = sim.robots.iter().map(Inputs::of).collect();
@@ -1388,11 +1397,13 @@ impl<'p> Sim<'p> {
     fn release(&mut self, r: usize, firing_ended: bool) {
         self.take_behind(r, firing_ended);
         // Held up, it takes heartbeats one by one; free, folded again.
-        if self.folded.is_some() {
-            if self.robots[r].holding.is_some() {
-                self.stop_folding(r);
-            } else {
+        let robot = &self.robots[r];
+        let folds = robot.heartbeats_at_once && robot.holding.is_none();
+        if self.folded.is_some() && folds != robot.folded_from.is_some() {
+            if folds {
                 self.start_folding(r);
+            } else {
+                self.stop_folding(r);
             }
         }
     }

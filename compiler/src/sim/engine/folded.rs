@@ -125,24 +125,14 @@ impl<'p> Sim<'p> {
             && targets.last() == Some(&(team.end - 1))
     }
 
-    /// Whether robot `r`'s program takes every heartbeat of its team at once
-    /// when its receive task is free (as [`Sim::deliver_all`] asks).
-    fn takes_heartbeats_at_once(&self, r: usize) -> bool {
-        let robot = &self.robots[r];
-        let program = robot.program;
-        robot.has_receiver
-            && program.control.heartbeat
-            && program.self_peer.index() == r
-            && (program.library.as_ref()).is_none_or(|lib| lib.ownership.is_none())
-    }
-
     /// Robot `r` (started, restarted, or its receive task free again) takes
     /// its team's heartbeats folded from now on when it can, else one by one.
     pub(super) fn start_folding(&mut self, r: usize) {
         if self.folded.is_none() || !self.robots[r].alive || self.robots[r].folded_from.is_some() {
             return;
         }
-        let at_once = self.takes_heartbeats_at_once(r) && self.robots[r].holding.is_none();
+        let robot = &self.robots[r];
+        let at_once = robot.heartbeats_at_once && robot.holding.is_none();
         let team = self.fleet.team(r).start;
         let folded = self.folded.as_mut().expect("checked above");
         let listed = folded.one_by_one[team].binary_search(&r);
