@@ -1359,13 +1359,10 @@ impl<'p> Sim<'p> {
     /// `heartbeat`: the message is one (a published text).
     fn deliver_one(&mut self, r: usize, message: &Rc<Message>, heartbeat: bool) {
         let robot = &self.robots[r];
-        let program = robot.program;
         let at_once = heartbeat
-            && robot.has_receiver
+            && robot.heartbeats_at_once
             && robot.holding.is_none()
-            && program.control.heartbeat
-            && message.key == self.fleet.names[r].alive_key
-            && (program.library.as_ref()).is_none_or(|lib| lib.ownership.is_none());
+            && message.key == self.fleet.names[r].alive_key;
         if at_once {
             self.trace_receive(r, message);
             self.hear_heartbeat(r, message);
