@@ -51,7 +51,9 @@
 //! 10 minutes of mission time, 120,535,145 events, 99.9% of them heartbeats
 //! heard. The runs here make no message's trace event, as `semo simulate`
 //! without `--trace` on a scenario without expectations
-//! (`Options::untraced_messages`); the numbers are in
+//! (`Options::untraced_messages`), which on a plain network also folds
+//! heartbeats (`sim/engine/folded.rs`): 0.93 s here (8 ns per event), the
+//! 1,002 robots 29.4 s -> about 21 s; the numbers are in
 //! `docs/scenario-and-trace.md`, "How long a simulation takes".
 
 mod common;
