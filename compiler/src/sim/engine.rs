@@ -279,6 +279,25 @@ struct Message {
     said: OnceCell<Heard>,
 }
 
+impl Message {
+    /// Whether it is a heartbeat to a team whose alive key is `alive_key`:
+    /// published under that key, its value text.
+    fn is_heartbeat(&self, alive_key: &str) -> bool {
+        self.publish && matches!(self.value, Some(Value::Text(_))) && *self.key == *alive_key
+    }
+
+    /// What a heartbeat says, as of `now` (`heard_alive`; a value that is
+    /// not text says nothing).
+    fn heard_at(&self, now: i64) -> Heard {
+        let text = match &self.value {
+            Some(Value::Text(t)) => t,
+            _ => "",
+        };
+        let said = *self.said.get_or_init(|| Heard::parse(0, text));
+        Heard { seen: now, ..said }
+    }
+}
+
 /// The slots a robot's control task reads its inputs into at each firing
 /// (`read_inputs`), found once: a firing reads these, not every slot of
 /// its program (a swarm's run spent a fifth of its memory traffic there).
@@ -538,6 +557,9 @@ pub struct Sim<'p> {
     /// The heartbeats kept once for a team, when the run folds them
     /// (`engine/folded.rs`): untraced messages on a plain network.
     folded: Option<folded::Folded>,
+    /// The robots a folded heartbeat reaches one by one, kept between
+    /// heartbeats for its room (as `arrivals`).
+    one_by_one: Vec<usize>,
 }
 
 impl<'p> Robot<'p> {
@@ -761,6 +783,7 @@ impl<'p> Sim<'p> {
             untraced_messages: options.untraced_messages,
             unmade: 0,
             folded: None,
+            one_by_one: Vec::new(),
         };
         // Peers are the mission's robots, in order, for every robot.
         let peers_are_robots = (programs.iter().enumerate())
@@ -1346,23 +1369,20 @@ impl<'p> Sim<'p> {
     /// at once is heard here without the receive task's general path
     /// ([`Sim::take_in`]: the same trace event and the same [`Hearing`]).
     fn deliver_all(&mut self, to: &[(usize, u32)], message: &Rc<Message>) {
-        let heartbeat = message.publish && matches!(message.value, Some(Value::Text(_)));
         for &(r, epoch) in to {
             let robot = &self.robots[r];
             if robot.alive && robot.epoch == epoch {
-                self.deliver_one(r, message, heartbeat);
+                self.deliver_one(r, message);
             }
         }
     }
 
-    /// `message` reaches robot `r` (alive, the process it was sent to);
-    /// `heartbeat`: the message is one (a published text).
-    fn deliver_one(&mut self, r: usize, message: &Rc<Message>, heartbeat: bool) {
+    /// `message` reaches robot `r` (alive, the process it was sent to).
+    fn deliver_one(&mut self, r: usize, message: &Rc<Message>) {
         let robot = &self.robots[r];
-        let at_once = heartbeat
-            && robot.heartbeats_at_once
+        let at_once = robot.heartbeats_at_once
             && robot.holding.is_none()
-            && message.key == self.fleet.names[r].alive_key;
+            && message.is_heartbeat(&self.fleet.names[r].alive_key);
         if at_once {
             self.trace_receive(r, message);
             self.hear_heartbeat(r, message);
@@ -1568,16 +1588,7 @@ impl<'p> Sim<'p> {
     /// A heartbeat taken by robot `r`'s receive task (`heard_alive`): what
     /// its sender's says, as of now.
     fn hear_heartbeat(&mut self, r: usize, message: &Message) {
-        // A heartbeat's value is text ("leader 80 2"); anything else says nothing.
-        let text = match &message.value {
-            Some(Value::Text(t)) => t,
-            _ => "",
-        };
-        let said = *message.said.get_or_init(|| Heard::parse(0, text));
-        let heard = Heard {
-            seen: self.now,
-            ..said
-        };
+        let heard = message.heard_at(self.now);
         let robot = &mut self.robots[r];
         if let Some(peer) = sender_peer(robot.program, message) {
             robot.heard.set(peer, heard);

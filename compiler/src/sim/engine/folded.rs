@@ -78,23 +78,22 @@ pub(super) struct View<'a> {
 
 impl View<'_> {
     pub(super) fn get(&self, peer: PeerId) -> Heard {
-        if let Some((last, robot, from)) = self.folded
-            && self.hearing.team.contains(&peer.index())
-            && let Some(beat) = &last[peer.index()]
-            && heard_it(robot, from, beat)
-        {
-            return beat.heard;
-        }
-        self.hearing.get(peer)
+        self.folded_beat(peer)
+            .unwrap_or_else(|| self.hearing.get(peer))
     }
 
     /// Every peer of the team and every other peer kept, in peer order (as
     /// [`Hearing::iter`]).
     pub(super) fn iter(&self) -> impl Iterator<Item = (PeerId, Heard)> + '_ {
-        self.hearing.iter().map(|(peer, own)| match self.folded {
-            Some(_) if self.hearing.team.contains(&peer.index()) => (peer, self.get(peer)),
-            _ => (peer, own),
-        })
+        (self.hearing.iter()).map(|(peer, own)| (peer, self.folded_beat(peer).unwrap_or(own)))
+    }
+
+    /// The peer's last folded heartbeat, if the robot heard it.
+    fn folded_beat(&self, peer: PeerId) -> Option<Heard> {
+        let (last, robot, from) = self.folded?;
+        let beat = last.get(peer.index())?.as_ref()?;
+        (self.hearing.team.contains(&peer.index()) && heard_it(robot, from, beat))
+            .then_some(beat.heard)
     }
 }
 
@@ -117,9 +116,7 @@ impl<'p> Sim<'p> {
     pub(super) fn folds(&self, r: usize, targets: &[usize], message: &Message) -> bool {
         let team = self.fleet.team(r);
         self.folded.is_some()
-            && message.publish
-            && message.key == self.fleet.names[r].alive_key
-            && matches!(message.value, Some(crate::refine::value::Value::Text(_)))
+            && message.is_heartbeat(&self.fleet.names[r].alive_key)
             && targets.len() == team.len()
             && targets.first() == Some(&team.start)
             && targets.last() == Some(&(team.end - 1))
@@ -203,27 +200,20 @@ impl<'p> Sim<'p> {
     pub(super) fn deliver_folded(&mut self, message: &std::rc::Rc<Message>, sent: u64) {
         let s = message.from.expect("a heartbeat is a robot's");
         let team = self.fleet.team(s);
-        let text = match &message.value {
-            Some(crate::refine::value::Value::Text(t)) => t,
-            _ => "",
-        };
-        let said = *message.said.get_or_init(|| Heard::parse(0, text));
+        let heard = message.heard_at(self.now);
         let folded = self.folded.as_mut().expect("only a folding run folds");
         folded.delivered += 1;
         let beat = Beat {
-            heard: Heard {
-                seen: self.now,
-                ..said
-            },
+            heard,
             sent,
             delivery: folded.delivered,
         };
         let before = folded.last[s].replace(beat);
-        folded.max_term[team.start] = folded.max_term[team.start].max(said.term);
+        folded.max_term[team.start] = folded.max_term[team.start].max(heard.term);
         // A sender restarted says a lower term than before: the robots that
         // heard the higher one keep it.
         if let Some(before) = before
-            && before.heard.term > said.term
+            && before.heard.term > heard.term
         {
             for p in team.clone().filter(|&p| p != s) {
                 let robot = &mut self.robots[p];
@@ -234,16 +224,17 @@ impl<'p> Sim<'p> {
                 }
             }
         }
-        let one_by_one = &folded.one_by_one[team.start];
-        if one_by_one.is_empty() {
-            return;
-        }
-        for r in one_by_one.clone() {
+        // A copy: taking the heartbeat can free a robot, which leaves the list.
+        let mut one_by_one = std::mem::take(&mut self.one_by_one);
+        one_by_one.extend_from_slice(&folded.one_by_one[team.start]);
+        for &r in &one_by_one {
             // Alive (listed), and the process the heartbeat was sent to.
             if r != s && self.robots[r].epoch_seq < sent {
-                self.deliver_one(r, message, true);
+                self.deliver_one(r, message);
             }
         }
+        one_by_one.clear();
+        self.one_by_one = one_by_one;
     }
 }
 
@@ -271,8 +262,9 @@ mod tests {
             untraced_messages: true,
             ..Options::default()
         };
-        assert!(Sim::new(programs, &scenario, &traced).folded.is_none());
-        let one_by_one = Sim::new(programs, &scenario, &traced).run(&traced);
+        let tracing = Sim::new(programs, &scenario, &traced);
+        assert!(tracing.folded.is_none());
+        let one_by_one = tracing.run(&traced);
         let folding = Sim::new(programs, &scenario, &untraced);
         let mut counting = folding.clone();
         let folded = folding.run(&untraced);
