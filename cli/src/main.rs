@@ -743,6 +743,11 @@ enum ColorChoice {
     Never,
 }
 
+/// mimalloc rather than the C library's malloc: most of what `semo` does
+/// is small allocations (see the workspace's Cargo.toml for the figures).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn main() {
     std::process::exit(run());
 }

@@ -12,6 +12,9 @@ use semo::refine::RobotProgram;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+#[path = "common/allocator.rs"]
+mod allocator;
+
 fn programs(mission: &Path) -> (Vec<RobotProgram>, semo::diag::FileId, String) {
     let (run, id) = semo::host::load_build(mission, &[]).expect("the example loads");
     let text = run.files.get(id).text.clone();

@@ -7,6 +7,9 @@
 #[path = "../tests/support/broker.rs"]
 mod broker;
 
+#[path = "../../compiler/benches/common/allocator.rs"]
+mod allocator;
+
 use rumqttc::{AsyncClient, MqttOptions, QoS};
 use semo_server::harness::TestClient;
 use serde_json::json;

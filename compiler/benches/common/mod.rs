@@ -3,6 +3,8 @@
 #[allow(dead_code)] // not every bench generates a mission
 pub mod mission;
 
+mod allocator;
+
 use std::time::{Duration, Instant};
 
 /// Runs `f` at least three times and for about `budget`; gives the fastest run.
