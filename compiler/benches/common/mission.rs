@@ -4,7 +4,10 @@
 use std::fmt::Write;
 
 /// A realistic mission: mixed teams with groups, communication between
-/// neighbouring teams, modes with transitions, functions, comments.
+/// neighbouring teams, modes with transitions, functions, comments. It
+/// checks without a warning: a team going home tells the next one `done`
+/// (which the next one's `Hear` compares with), so the editor's benches
+/// measure an edit's check, not 154 W020 warnings sent with each one.
 pub fn generate(teams: usize) -> String {
     let mut m = String::from("# Generated benchmark mission\n{\n");
     for t in 0..teams {
@@ -70,6 +73,7 @@ Team{t}.Action.Hide{{
 
 Team{t}.Action.Return{{
   report_home()
+  send(Team{next}, Team{t}.Status = "done")
 }}
 
 Team{t}.PATROL{{ set(Listen, Hear); set(Report, Tell); set(Action, Patrol) }}
