@@ -14,9 +14,11 @@ mod mission;
 #[path = "support/counting.rs"]
 mod counting;
 
-/// The peak of live bytes above the start while `semo check FILE` checks a
-/// generated mission of `teams` teams (six robots each), which must be valid.
-fn peak_bytes_of_check(teams: usize) -> usize {
+/// `semo check FILE` of a generated mission of `teams` teams (six robots
+/// each), and the peak of live bytes above the start while it ran. Every
+/// test of this file checks through here, one at a time: the counters are
+/// the process's, and a check running beside a measurement would count in it.
+fn check_generated(teams: usize) -> (semo::host::CheckRun, usize) {
     let text = mission::generate(teams);
     let _one = counting::MEASURING
         .lock()
@@ -27,8 +29,14 @@ fn peak_bytes_of_check(teams: usize) -> usize {
         std::fs::write(&path, text).expect("write the mission");
         semo::host::load_check(std::slice::from_ref(&path)).expect("the mission loads")
     });
+    (run, peak)
+}
+
+/// The peak of live bytes while checking a generated mission of `teams`
+/// teams, which must be valid.
+fn peak_bytes_of_check(teams: usize) -> usize {
+    let (run, peak) = check_generated(teams);
     assert_eq!(run.error_count(), 0, "the generated mission is valid");
-    drop(run);
     peak
 }
 
@@ -37,10 +45,7 @@ fn peak_bytes_of_check(teams: usize) -> usize {
 /// on 10k lines once made an edit's diagnostics twice as slow to arrive).
 #[test]
 fn the_generated_benchmark_mission_checks_without_a_warning() {
-    let folder = tempfile::tempdir().expect("a temporary folder");
-    let path = folder.path().join("swarm.mission");
-    std::fs::write(&path, mission::generate(3)).expect("write the mission");
-    let run = semo::host::load_check(std::slice::from_ref(&path)).expect("the mission loads");
+    let (run, _) = check_generated(3);
     let said: Vec<String> = (run.diagnostics.iter())
         .filter(|d| d.severity <= semo::diag::Severity::Warning)
         .map(|d| format!("{:?} {}", d.code, d.message))

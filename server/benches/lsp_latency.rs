@@ -22,8 +22,9 @@
 //! going home tells the next one `done`), which measures the edit's check
 //! again: p50 11.2–12.7 ms and p99 19.4–24.9 ms here against `e73eac1`'s
 //! bench 10.6–12.0 ms and 24.0–24.6 ms in the same runs, peak RSS 96 MB
-//! against 99–100 MB. A mission with many warnings pays for them at each
-//! edit: the 154 cost about 5–8 ms of p50.
+//! against 99–100 MB (both above the first runs' 70 MB: why these runs
+//! peaked higher was not found). A mission with many warnings pays for
+//! them at each edit: the 154 cost about 5–8 ms of p50.
 
 #[path = "../../compiler/benches/common/mission.rs"]
 mod mission;
