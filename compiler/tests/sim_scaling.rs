@@ -130,22 +130,22 @@ fn the_simulators_work_follows_the_robots_and_its_memory_not_the_runs_length() {
 /// What simulating `programs` for `until_ms` as `semo simulate` runs a
 /// scenario without expectations and without `--trace` costs (no message
 /// traced, `Options::untraced_messages`): (events, entries of the event
-/// queue, allocations).
-fn untraced_cost(programs: &[RobotProgram], until_ms: i64) -> (u64, u64, usize) {
+/// queue, allocations, members of counted groups walked).
+fn untraced_cost(programs: &[RobotProgram], until_ms: i64) -> (u64, u64, usize, u64) {
     let scenario = scenario::parse("{}", programs).expect("an empty scenario reads");
     let options = sim::Options {
         until_ms: Some(until_ms),
         untraced_messages: true,
         ..sim::Options::default()
     };
-    let ((events, queued), _, allocations) = counting::measure(|| {
+    let ((events, queued, walked), _, allocations) = counting::measure(|| {
         let robots = sim::Run::robots_of(programs);
         let mut digest = sim::Digest::new(&robots, &scenario.expect);
         let run = sim::simulate_into(programs, &scenario, &options, &mut |e| digest.see(&e));
         assert!(!sim::summary_of(&run, &digest, &[]).contains("no mode"));
-        (run.events, run.queued)
+        (run.events, run.queued, run.members_walked)
     });
-    (events, queued, allocations)
+    (events, queued, allocations, walked)
 }
 
 #[test]
@@ -162,8 +162,8 @@ fn a_heartbeat_heard_costs_no_allocation_and_a_heartbeat_sent_one_queue_entry() 
     let team = |robots| programs("nested_groups.mission", mission::nested_groups(robots));
     untraced_cost(&team(10), 100);
     let (small, large) = (team(20), team(40));
-    let (events_small, queued_small, work_small) = untraced_cost(&small, 5000);
-    let (events_large, queued_large, work_large) = untraced_cost(&large, 5000);
+    let (events_small, queued_small, work_small, walked_small) = untraced_cost(&small, 5000);
+    let (events_large, queued_large, work_large, walked_large) = untraced_cost(&large, 5000);
     // Every robot hears every other: twice the robots, four times the
     // heartbeats heard; but a heartbeat sent is one entry of the queue
     // for all its robots, and hearing one allocates nothing.
@@ -175,12 +175,22 @@ fn a_heartbeat_heard_costs_no_allocation_and_a_heartbeat_sent_one_queue_entry() 
         2.2,
     );
     ratio("allocations", work_small, work_large, 2.5);
+    // Every robot passes through the rooms each second, but the robots
+    // that count alive the same ones share one walk over the members
+    // (`engine/counted.rs`): each robot walking its own took 3.4 times
+    // as many members here, and 400 robots 3.5 times as long as 200.
+    ratio(
+        "members walked",
+        walked_small as usize,
+        walked_large as usize,
+        2.1,
+    );
     // What twice the mission time adds (the robots' start and the summary
     // left out): a heartbeat's message and list of robots for its 39
     // hearers, and each pass through the counted groups' lists of live
     // members (0.23 per event); an allocation per hearer took one per
     // event more.
-    let (events_longer, _, work_longer) = untraced_cost(&large, 10_000);
+    let (events_longer, _, work_longer, _) = untraced_cost(&large, 10_000);
     let per_event = (work_longer - work_large) as f64 / (events_longer - events_large) as f64;
     eprintln!("allocations per event, no message traced: {per_event:.3}");
     assert!(

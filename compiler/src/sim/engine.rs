@@ -48,6 +48,7 @@ use std::collections::{BinaryHeap, HashMap, VecDeque};
 use std::rc::Rc;
 
 mod battery;
+mod counted;
 mod explore;
 mod fleet;
 mod folded;
@@ -107,6 +108,10 @@ pub struct Run {
     /// follows the robots (`compiler/tests/sim_scaling.rs`). 0 for a
     /// recorded run read back.
     pub queued: u64,
+    /// Members of counted groups looked at to find who shares a robot's
+    /// arms (`engine/counted.rs`): the groups' work, which follows the
+    /// robots too. 0 for a recorded run read back.
+    pub members_walked: u64,
 }
 
 impl Run {
@@ -118,6 +123,7 @@ impl Run {
             end_ms,
             events,
             queued: 0,
+            members_walked: 0,
         }
     }
 
@@ -557,6 +563,9 @@ pub struct Sim<'p> {
     /// The heartbeats kept once for a team, when the run folds them
     /// (`engine/folded.rs`): untraced messages on a plain network.
     folded: Option<folded::Folded>,
+    /// Counted groups' walks over their members, shared by the robots
+    /// that see their team alike at an instant (`engine/counted.rs`).
+    counted: counted::Counted,
     /// The robots a folded heartbeat reaches one by one, kept between
     /// heartbeats for its room (as `arrivals`).
     one_by_one: Vec<usize>,
@@ -783,6 +792,7 @@ impl<'p> Sim<'p> {
             untraced_messages: options.untraced_messages,
             unmade: 0,
             folded: None,
+            counted: counted::Counted::default(),
             one_by_one: Vec::new(),
         };
         // Peers are the mission's robots, in order, for every robot.
@@ -898,6 +908,7 @@ impl<'p> Sim<'p> {
         self.trace.drain(..).for_each(&mut *sink);
         Run {
             queued: self.queued,
+            members_walked: self.counted.walked,
             ..Run::of(self.programs, Vec::new(), self.now, events)
         }
     }
@@ -1267,7 +1278,11 @@ impl<'p> Sim<'p> {
             // recipient at one instant, each as `link` would say.
             let at = self.now + self.scenario.network.latency_ms;
             if self.folds(r, targets, &message) {
-                let recipients = targets.iter().filter(|&&dst| dst != r).count();
+                // `folds`: the targets are the sender's team, the sender
+                // among them (counting them was a walk over the team per
+                // heartbeat, a third of 800 robots' run).
+                let recipients = targets.len() - 1;
+                debug_assert_eq!(recipients, targets.iter().filter(|&&d| d != r).count());
                 if recipients > 0 {
                     let sent = self.seq + 1;
                     self.seq += recipients as u64;
@@ -1788,12 +1803,8 @@ impl<'p> Sim<'p> {
             broadcast.messages.clone()
         } else {
             let sharing = self.sharing_arms(r, &broadcast.within, &broadcast.to);
-            let mut sharing = sharing.iter().peekable();
             (broadcast.to.iter().zip(&broadcast.messages))
-                .filter(|&(&peer, _)| {
-                    while sharing.next_if(|&&p| p < peer).is_some() {}
-                    sharing.peek() == Some(&&peer)
-                })
+                .filter(|&(&peer, _)| sharing.contains(peer))
                 .map(|(_, &message)| message)
                 .collect()
         };
@@ -1802,21 +1813,6 @@ impl<'p> Sim<'p> {
             self.comm_send(r, to, false, key, Some(Value::text(event)));
         }
         self.catch_event(r, event);
-    }
-
-    /// Of `members`, robot `r` and the live robots that every enclosing
-    /// counted group (`within`) puts in the arms `r` runs
-    /// ([`members_sharing_arms`]); alive as `group_of` in the generated C
-    /// says: heard within `lost_after_ms` since `r` joined.
-    fn sharing_arms(&self, r: usize, within: &[EnclosingArm], members: &[PeerId]) -> Vec<PeerId> {
-        let robot = &self.robots[r];
-        let heard = self.heard(r);
-        let me = robot.program.self_peer;
-        let lost = crate::refine::protocol::lost_after_ms(robot.program.control.heartbeat_ms);
-        let now = self.now;
-        let alive =
-            |peer: PeerId| peer == me || now - heard.get(peer).seen.max(robot.started_at) <= lost;
-        members_sharing_arms(within, members, me, alive)
     }
 
     /// The current mode's catch of `event`, unless a mode change is asked
@@ -2393,7 +2389,7 @@ impl<'p> Sim<'p> {
             } => {
                 let me = program.self_peer;
                 let live = self.sharing_arms(r, within, members);
-                let position = live.iter().position(|&p| p == me).unwrap_or(0);
+                let position = live.position(me).unwrap_or(0);
                 let mins: Vec<usize> = groups.iter().map(|g| g.min).collect();
                 let chosen = counted_allocation(&mins, others_at.is_some(), position);
                 let (name, at) = match (chosen, others_at) {

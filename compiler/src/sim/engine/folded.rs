@@ -62,6 +62,82 @@ impl Folded {
     }
 }
 
+/// Who a team's robots that hear it alike count alive at one instant
+/// (`engine/counted.rs`): the team's robots whose last folded heartbeat
+/// came within `lost` ms, and what a robot must have heard folded for its
+/// own view to be this one ([`TeamView::seen_alike_by`]).
+#[derive(Clone, Debug)]
+pub(super) struct TeamView {
+    /// Per robot of the team, in order.
+    alive: Vec<bool>,
+    first: usize,
+    /// The oldest folded delivery and send among the team's last
+    /// heartbeats (`u64::MAX` when none has one).
+    oldest_delivery: u64,
+    oldest_send: u64,
+    /// Every robot of the team has a last folded heartbeat.
+    every_one_beat: bool,
+}
+
+impl TeamView {
+    pub(super) fn alive(&self, peer: PeerId) -> bool {
+        (peer.index().checked_sub(self.first)).is_some_and(|i| self.alive.get(i) == Some(&true))
+    }
+
+    /// Whether `robot` counts alive whom this view does, `lost` ms after
+    /// each one's last heartbeat, as `Sim::sharing_arms` asks its own view
+    /// now: it takes its team's heartbeats folded and heard each one's last
+    /// (so [`View::get`] gives that one), or heard none of a robot that sent
+    /// none folded and has no table of its own (so it reads as never heard);
+    /// and it joined more than `lost` ms ago (so its start counts no one
+    /// alive); and it counts itself alive in this view as in its own.
+    pub(super) fn seen_alike_by(&self, robot: &Robot, now: i64, lost: i64) -> bool {
+        let Some(from) = robot.folded_from else {
+            return false;
+        };
+        self.oldest_delivery > from
+            && self.oldest_send > robot.epoch_seq
+            && (self.every_one_beat || robot.heard.heard.is_empty())
+            && now - robot.started_at > lost
+            && self.alive(robot.program.self_peer)
+    }
+}
+
+impl Folded {
+    /// The view of `team` (robot indices, which are its peers' in a run
+    /// that folds) at `now`: alive when its last folded heartbeat came
+    /// within `lost` ms.
+    pub(super) fn team_view(&self, team: std::ops::Range<usize>, now: i64, lost: i64) -> TeamView {
+        let mut view = TeamView {
+            alive: Vec::with_capacity(team.len()),
+            first: team.start,
+            oldest_delivery: u64::MAX,
+            oldest_send: u64::MAX,
+            every_one_beat: true,
+        };
+        for beat in &self.last[team] {
+            match beat {
+                Some(beat) => {
+                    view.alive.push(now - beat.heard.seen <= lost);
+                    view.oldest_delivery = view.oldest_delivery.min(beat.delivery);
+                    view.oldest_send = view.oldest_send.min(beat.sent);
+                }
+                None => {
+                    view.alive.push(false);
+                    view.every_one_beat = false;
+                }
+            }
+        }
+        view
+    }
+
+    /// Folded deliveries so far: the view of a team changes only with them
+    /// and with time.
+    pub(super) fn delivered(&self) -> u64 {
+        self.delivered
+    }
+}
+
 /// Whether `robot` heard `beat` (taking heartbeats at once since `from`).
 fn heard_it(robot: &Robot, from: u64, beat: &Beat) -> bool {
     beat.delivery > from && beat.sent > robot.epoch_seq
