@@ -529,6 +529,10 @@ pub struct Sim<'p> {
     fleet: Rc<Fleet>,
     /// Per robot (program): the slots a firing reads its inputs into.
     inputs: Rc<[Inputs]>,
+    /// Per robot (program): its elections ([`ControlMachine::elections`]),
+    /// found once: each heartbeat decides them again, and looking for them
+    /// walked every state of the program (3% of a swarm's run).
+    elections: Rc<[Vec<crate::refine::Election<'p>>]>,
     /// The last control firing handled: (time, chain).
     last_fire: (i64, u64),
     every_firing: bool,
@@ -779,6 +783,7 @@ impl<'p> Sim<'p> {
             commands: Vec::new(),
             fleet: Rc::new(fleet),
             inputs: Rc::from([]),
+            elections: Rc::from([]),
             last_fire: (-1, 0),
             every_firing: options.every_firing,
             isolated: None,
@@ -802,6 +807,9 @@ impl<'p> Sim<'p> {
             sim.folded = Some(folded::Folded::new(programs.len()));
         }
         sim.inputs = sim.robots.iter().map(Inputs::of).collect();
+        sim.elections = (programs.iter())
+            .map(|p| p.control.elections().collect())
+            .collect();
         for r in 0..programs.len() {
             sim.start_folding(r);
             sim.start(r);
@@ -2636,8 +2644,8 @@ impl<'p> Sim<'p> {
     /// reached then (`docs/groups.md`, "Takeover"); the heartbeat says the
     /// outcome.
     fn elect_at_heartbeat(&mut self, r: usize) {
-        let program = self.robots[r].program;
-        for e in program.control.elections() {
+        let elections = self.elections.clone();
+        for e in &elections[r] {
             if self.robots[r].leaders.contains_key(&e.at) {
                 self.election(r, e.at, e.candidates, e.algorithm, e.receives);
             }
