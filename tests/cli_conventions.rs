@@ -1,8 +1,9 @@
 //! The command-line conventions users expect of a tool (issue 18, "CLI"),
 //! each through the `semo` binary: `-` for standard input, `--deny
 //! warnings`, colour by `--color` then `NO_COLOR`, `CLICOLOR_FORCE` and
-//! `TERM=dumb`, hints called hints, one `-o/--output` meaning, and `--help`
-//! saying what the tool does.
+//! `TERM=dumb`, hints called hints, one `-o/--output` meaning, `--help`
+//! saying what the tool does, and a mission's terminal controls shown in
+//! diagnostics, not obeyed.
 
 mod support;
 
@@ -69,6 +70,47 @@ fn hints_are_called_hints() {
     assert!(!out.stderr.contains("Advice"), "{}", out.stderr);
     // Without colour, not a single escape sequence, the hint's header too.
     assert!(!out.stderr.contains('\u{1b}'), "{:?}", out.stderr);
+}
+
+/// A mission's text quoted in a diagnostic is shown, never obeyed: the
+/// terminal controls in a line (an escape sequence setting the window's
+/// title, a carriage return hiding what came before it) come out as their
+/// control pictures, and a line too long to quote (a file of 400,000 NULs
+/// printed 2.8 MB for one error) gets the one-line form and a note.
+#[test]
+fn a_missions_terminal_controls_are_shown_and_its_long_lines_not_quoted() {
+    let root = repo_root();
+    let mission =
+        "{\n  R: iRobotCreate r\n}\nR.A.S { mvoe(\"1,1\") } # \u{1b}]0;PWNED\u{7} \rhidden\n";
+    for format in ["human", "concise"] {
+        let out = semo_with_stdin(&root, &["check", "--format", format, "-"], mission);
+        assert_eq!(out.code, 1, "{}", out.stderr);
+        assert!(out.stderr.contains("E024"), "{}", out.stderr);
+        assert!(
+            !out.stderr.contains(['\u{1b}', '\u{7}', '\r']),
+            "{format}: {:?}",
+            out.stderr
+        );
+    }
+    let out = semo_with_stdin(&root, &["check", "-"], mission);
+    assert!(
+        out.stderr.contains("# ␛]0;PWNED␇ ␍hidden"),
+        "{}",
+        out.stderr
+    );
+
+    let junk = "\0".repeat(400_000);
+    let out = semo_with_stdin(&root, &["check", "-"], &junk);
+    assert_eq!(out.code, 1, "{}", out.stderr);
+    assert!(
+        out.stderr.contains("E001")
+            && out
+                .stderr
+                .contains("(line 1 is 400000 bytes long: no snippet)"),
+        "{}",
+        out.stderr
+    );
+    assert!(out.stderr.len() < 2_000, "{} bytes", out.stderr.len());
 }
 
 /// `semo check` of a mission with an error, its output not a terminal, in

@@ -21,6 +21,7 @@ mod output;
 mod render;
 mod replay;
 mod simulate;
+mod terminal;
 mod verify;
 mod watch;
 

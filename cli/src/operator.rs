@@ -242,7 +242,8 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
                         }
                     }
                     Heard::Refused => eprintln!(
-                        "operator: refused a message on {topic}: not a runtime message from the sender its topic names"
+                        "operator: refused a message on {}: not a runtime message from the sender its topic names",
+                        crate::terminal::visible(&topic)
                     ),
                 }
                 Vec::new()
@@ -465,8 +466,22 @@ fn what_counts(status: &Status) -> String {
 impl View {
     /// The lines to print for a message: a robot's `send(USER, …)`, or its
     /// status when it changed, of the run shown; a newer run's status (when
-    /// no run is given) is said and followed.
+    /// no run is given) is said and followed. What robots say is theirs:
+    /// its control characters are shown, never obeyed by the terminal
+    /// (`terminal.rs`).
     fn message(&mut self, topic: &str, payload: &[u8]) -> Heard {
+        match self.lines(topic, payload) {
+            Heard::Lines(lines) => Heard::Lines(
+                (lines.iter())
+                    .map(|line| crate::terminal::visible(line).into_owned())
+                    .collect(),
+            ),
+            Heard::Refused => Heard::Refused,
+        }
+    }
+
+    /// [`View::message`]'s lines, as the robots said them.
+    fn lines(&mut self, topic: &str, payload: &[u8]) -> Heard {
         let Some((run, robot)) = status_topic(&self.mission, topic) else {
             return self.sent(topic, payload);
         };
@@ -621,6 +636,35 @@ mod tests {
         assert_eq!(
             heard(view, "semo/scouting/r1/status/ti", WAITING),
             "refused"
+        );
+    }
+
+    /// A robot's value or status that holds terminal controls (an escape
+    /// sequence clearing the screen, a carriage return hiding what came
+    /// before) is shown, not obeyed.
+    #[test]
+    fn control_characters_a_robot_sends_are_shown_not_obeyed() {
+        let irobot = topics::Sender {
+            team: "MasterTeam",
+            robot: "irobot",
+        };
+        let told = semo::deploy::datagram::encode(&semo::deploy::datagram::Datagram {
+            publish: false,
+            team: "MasterTeam".into(),
+            robot: "irobot".into(),
+            key: "MasterTeam.DISTANCE".into(),
+            value: Some(semo::refine::Value::text("\x1b[2J\rall clear")),
+        });
+        let own = topics::to_team(&scope("r1"), "USER", "MasterTeam.DISTANCE", irobot);
+        let view = &mut view(Some("r1"));
+        assert_eq!(
+            heard(view, &own, &told),
+            "irobot: send(USER, MasterTeam.DISTANCE) = ␛[2J␍all clear"
+        );
+        let status = br#"{"robot":"irobot","state":"running","started":"1000","mode":"WAIT\u001b]0;x\u0007"}"#;
+        assert_eq!(
+            heard(view, "semo/scouting/r1/status/irobot", status),
+            "status irobot: running WAIT␛]0;x␇"
         );
     }
 

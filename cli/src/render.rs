@@ -2,10 +2,13 @@
 //! summary line (machine shapes are in `output`).
 
 use crate::output::Format;
+use crate::terminal::{ShownSource, visible};
 use ariadne::{Color, Config, IndexType, Label, Report, ReportKind};
 use semo::diag::{Diagnostic, Severity};
 use semo::host::CheckRun;
+use semo::text::{ColumnUnit, LineIndex};
 use semo::workspace::Files;
+use std::collections::HashMap;
 use std::io::{self, Write};
 
 pub fn kind(severity: Severity) -> ReportKind<'static> {
@@ -25,10 +28,6 @@ pub fn color(severity: Severity) -> Color {
     }
 }
 
-fn path_of(files: &Files, d: &Diagnostic) -> String {
-    files.get(d.file).path.display().to_string()
-}
-
 /// Clamps a span to the text and to character boundaries, so that a bad span
 /// can never make the renderer fail.
 pub fn safe_range(text: &str, span: semo::span::Span) -> std::ops::Range<usize> {
@@ -43,7 +42,39 @@ pub fn safe_range(text: &str, span: semo::span::Span) -> std::ops::Range<usize> 
     start..end.max(start)
 }
 
-/// Source snippets for people: one ariadne report per diagnostic.
+/// The longest line a snippet shows, in bytes: a longer one (a file of
+/// one 400,000-byte line once printed 2.8 MB for one diagnostic, its line
+/// and its underline) gets the one-line form, and a note.
+const LONGEST_SHOWN_LINE: usize = 500;
+
+/// A file as the snippets show it: control characters shown, not obeyed
+/// (`terminal.rs`), and where its lines start.
+struct Shown {
+    path: String,
+    source: ShownSource,
+    lines: LineIndex,
+}
+
+impl Shown {
+    /// `span` of the original text, in the shown one.
+    fn range(&self, original: &str, span: semo::span::Span) -> std::ops::Range<usize> {
+        let range = safe_range(original, span);
+        self.source.offset(range.start)..self.source.offset(range.end)
+    }
+
+    /// The line (from 1) and length of the line `span` starts on, when it
+    /// is too long to show.
+    fn long_line(&self, original: &str, span: semo::span::Span) -> Option<(usize, usize)> {
+        let start = safe_range(original, span).start;
+        let line = self.lines.line_col(original, start, ColumnUnit::Utf8).line as usize;
+        let length = self.lines.line_start(line + 1) - self.lines.line_start(line);
+        (length > LONGEST_SHOWN_LINE).then_some((line + 1, length))
+    }
+}
+
+/// Source snippets for people: one ariadne report per diagnostic. Text of
+/// the files and of the messages is shown with its control characters made
+/// visible, so that a mission cannot drive the terminal.
 pub fn diagnostics(
     files: &Files,
     diagnostics: &[Diagnostic],
@@ -57,38 +88,56 @@ pub fn diagnostics(
     let config = Config::default()
         .with_color(colored)
         .with_index_type(IndexType::Byte);
-    let mut sources = Vec::new();
-    for f in files.iter() {
-        sources.push((f.path.display().to_string(), f.text.clone()));
-    }
     let builtin = files.get(semo::catalog::BUILTIN_FILE);
-    sources.push((builtin.path.display().to_string(), builtin.text.clone()));
-    let mut cache = ariadne::sources(sources);
+    let mut shown = HashMap::new();
+    for f in files.iter().chain([builtin]) {
+        shown.entry(f.id).or_insert_with(|| Shown {
+            path: f.path.display().to_string(),
+            source: ShownSource::new(&f.text),
+            lines: LineIndex::new(&f.text),
+        });
+    }
+    let mut cache = ariadne::sources(
+        shown
+            .values()
+            .map(|s| (s.path.clone(), s.source.text.clone())),
+    );
     for d in diagnostics {
-        let path = path_of(files, d);
-        let range = safe_range(&files.get(d.file).text, d.span);
-        let mut report = Report::build(kind(d.severity), (path.clone(), range.clone()))
+        let text = &files.get(d.file).text;
+        let file = &shown[&d.file];
+        let mut long = file.long_line(text, d.span);
+        for related in &d.related {
+            let related_text = &files.get(related.file).text;
+            long = long.or(shown[&related.file].long_line(related_text, related.span));
+        }
+        if let Some((line, length)) = long {
+            let mut one = Vec::new();
+            concise(files, std::slice::from_ref(d), &mut one)?;
+            out.write_all(&one)?;
+            writeln!(out, "  (line {line} is {length} bytes long: no snippet)")?;
+            continue;
+        }
+        let range = file.range(text, d.span);
+        let mut report = Report::build(kind(d.severity), (file.path.clone(), range.clone()))
             .with_config(config)
             .with_code(d.code.as_str())
-            .with_message(&d.message)
+            .with_message(visible(&d.message))
             .with_label(
-                Label::new((path, range))
+                Label::new((file.path.clone(), range))
                     .with_message(d.code.summary())
                     .with_color(color(d.severity)),
             );
         for related in &d.related {
-            let file = files.get(related.file);
+            let other = &shown[&related.file];
+            let range = other.range(&files.get(related.file).text, related.span);
             report = report.with_label(
-                Label::new((
-                    file.path.display().to_string(),
-                    safe_range(&file.text, related.span),
-                ))
-                .with_message(&related.message)
-                .with_color(Color::Blue),
+                Label::new((other.path.clone(), range))
+                    .with_message(visible(&related.message))
+                    .with_color(Color::Blue),
             );
         }
         if let Some(s) = &d.suggestion {
-            report = report.with_help(format!("did you mean `{s}`?"));
+            report = report.with_help(format!("did you mean `{}`?", visible(s)));
         }
         // Each report is rendered aside and written at once: ariadne writes
         // a snippet in small pieces, and standard error is unbuffered (a line
@@ -149,7 +198,11 @@ pub fn concise(files: &Files, found: &[Diagnostic], out: &mut impl Write) -> io:
         let code = record.code.map_or("", |c| c.as_str());
         text.push_str(&format!(
             "{}:{}:{}: {}[{code}]: {}",
-            record.file, record.start.line, record.start.column, record.severity, record.message
+            visible(&record.file),
+            record.start.line,
+            record.start.column,
+            record.severity,
+            visible(&record.message)
         ));
         // Most messages name their did-you-mean already.
         if let Some(s) = record
@@ -157,12 +210,15 @@ pub fn concise(files: &Files, found: &[Diagnostic], out: &mut impl Write) -> io:
             .as_ref()
             .filter(|s| !record.message.contains(*s))
         {
-            text.push_str(&format!(" (did you mean `{s}`?)"));
+            text.push_str(&format!(" (did you mean `{}`?)", visible(s)));
         }
         for related in &record.related {
             text.push_str(&format!(
                 " [{}:{}:{}: {}]",
-                related.file, related.line, related.column, related.message
+                visible(&related.file),
+                related.line,
+                related.column,
+                visible(&related.message)
             ));
         }
         text.push('\n');

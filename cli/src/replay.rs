@@ -127,7 +127,10 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         let report = if options.json {
             simulate::json_summary("replay", &run, &digest, &verdicts, &warnings)
         } else {
-            sim::replay_summary(&run, &verdicts, options.traces.len())
+            // The traces are the robots': what they name is shown, never
+            // obeyed by the terminal (`terminal.rs`).
+            let summary = sim::replay_summary(&run, &verdicts, options.traces.len());
+            crate::terminal::visible(&summary).into_owned()
         };
         let _ = out.write_all(report.as_bytes());
     }
