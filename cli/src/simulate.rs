@@ -174,7 +174,9 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         let report = if options.json {
             json_summary("simulate", &run, &digest, &verdicts, &warnings)
         } else {
-            sim::summary_of(&run, &digest, &verdicts)
+            // Values of the scenario's in it: shown, not obeyed (`terminal.rs`).
+            let summary = sim::summary_of(&run, &digest, &verdicts);
+            crate::terminal::visible(&summary).into_owned()
         };
         let _ = out.write_all(report.as_bytes());
     }
@@ -197,7 +199,7 @@ pub fn read_scenario(
         Err(e) => {
             let record = Record::scenario(name, text, e, Severity::Error);
             if format == Format::Human {
-                eprintln!("{}", record.scenario_line());
+                eprintln!("{}", crate::terminal::visible(&record.scenario_line()));
             } else {
                 let document = output::json_document(
                     command,
@@ -216,7 +218,7 @@ pub fn read_scenario(
         .collect();
     if format == Format::Human {
         for warning in &warnings {
-            eprintln!("{}", warning.scenario_line());
+            eprintln!("{}", crate::terminal::visible(&warning.scenario_line()));
         }
     }
     Some((scenario, warnings))

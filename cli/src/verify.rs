@@ -158,7 +158,8 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
             let commands = (report.inputs.commands.iter())
                 .map(|c| (format!("command {} USER.{}", c.to, c.value), &c.values));
             for (input, values) in sensors.chain(commands) {
-                let _ = writeln!(out, "  {input}: {}", values.join(" | "));
+                let line = format!("  {input}: {}", values.join(" | "));
+                let _ = writeln!(out, "{}", crate::terminal::visible(&line));
             }
             for ((property, outcome), file) in report.properties.iter().zip(&property_files) {
                 let _ = writeln!(
@@ -225,7 +226,7 @@ fn read_properties(
             let record =
                 output::Record::scenario(file, &text, mistake, semo::diag::Severity::Error);
             if format == Format::Human {
-                eprintln!("{}", record.scenario_line());
+                eprintln!("{}", crate::terminal::visible(&record.scenario_line()));
             } else {
                 let document = output::json_document(
                     "verify",
