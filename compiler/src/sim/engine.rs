@@ -2881,8 +2881,9 @@ impl Heard {
             .next()
             .filter(|b| b.starts_with(|c: char| c.is_ascii_digit()))
             .and_then(|b| {
-                let digits: String = b.chars().take_while(char::is_ascii_digit).collect();
-                digits.parse().ok()
+                // The leading digits, read in place (a copy per heartbeat).
+                let end = b.find(|c: char| !c.is_ascii_digit()).unwrap_or(b.len());
+                b[..end].parse().ok()
             });
         Heard {
             seen: now,
