@@ -907,7 +907,6 @@ fn a_linux_robot_on_the_link_survives_a_gateway_restart_in_the_middle() {
         .map(|e| (field(e, "key").to_string(), e["value"].to_string()))
         .collect();
     assert!(!sent.is_empty());
-    let last = sent.last().cloned().unwrap();
     let prefix = format!("semo/scouting/{run}/MasterTeam/");
     let from_ti = |all: &[(String, Vec<u8>)]| -> Vec<(String, String)> {
         all.iter()
