@@ -111,10 +111,11 @@ pub fn diagnostics(
             long = long.or(shown[&related.file].long_line(related_text, related.span));
         }
         if let Some((line, length)) = long {
+            // Written at once, as a report is (below).
             let mut one = Vec::new();
             concise(files, std::slice::from_ref(d), &mut one)?;
+            writeln!(one, "  (line {line} is {length} bytes long: no snippet)")?;
             out.write_all(&one)?;
-            writeln!(out, "  (line {line} is {length} bytes long: no snippet)")?;
             continue;
         }
         let range = file.range(text, d.span);
@@ -261,13 +262,15 @@ pub fn summary(run: &CheckRun, out: &mut impl Write) -> io::Result<()> {
     } else {
         String::new()
     };
-    writeln!(
-        out,
-        "checked {} and {}{graphs}{strategies}: {}, {}, {}",
+    // One write: standard error is unbuffered, and `writeln!` writes each
+    // piece of its format on its own.
+    let line = format!(
+        "checked {} and {}{graphs}{strategies}: {}, {}, {}\n",
         plural(of_kind(semo::workspace::FileKind::Mission), "mission"),
         plural(of_kind(semo::workspace::FileKind::Catalog), "catalog file"),
         plural(count(Severity::Error), "error"),
         plural(count(Severity::Warning), "warning"),
         plural(count(Severity::Hint), "hint"),
-    )
+    );
+    out.write_all(line.as_bytes())
 }
