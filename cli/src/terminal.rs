@@ -16,11 +16,7 @@ pub fn visible(text: &str) -> Cow<'_, str> {
     if !text.char_indices().any(|(i, c)| hidden(text, i, c)) {
         return Cow::Borrowed(text);
     }
-    let mut out = String::with_capacity(text.len() + 8);
-    for (i, c) in text.char_indices() {
-        out.push(if hidden(text, i, c) { shown(c) } else { c });
-    }
-    Cow::Owned(out)
+    Cow::Owned(ShownSource::new(text).text)
 }
 
 /// A source text with its control characters shown, and the way from its
