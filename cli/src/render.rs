@@ -88,13 +88,20 @@ pub fn diagnostics(
     let config = Config::default()
         .with_color(colored)
         .with_index_type(IndexType::Byte);
-    let builtin = files.get(semo::catalog::BUILTIN_FILE);
+    // Only the files the diagnostics point into are shown: a workspace of
+    // hundreds of files with one problem copies and indexes one.
     let mut shown = HashMap::new();
-    for f in files.iter().chain([builtin]) {
-        shown.entry(f.id).or_insert_with(|| Shown {
-            path: f.path.display().to_string(),
-            source: ShownSource::new(&f.text),
-            lines: LineIndex::new(&f.text),
+    let pointed = diagnostics
+        .iter()
+        .flat_map(|d| std::iter::once(d.file).chain(d.related.iter().map(|r| r.file)));
+    for id in pointed {
+        shown.entry(id).or_insert_with(|| {
+            let f = files.get(id);
+            Shown {
+                path: f.path.display().to_string(),
+                source: ShownSource::new(&f.text),
+                lines: LineIndex::new(&f.text),
+            }
         });
     }
     let mut cache = ariadne::sources(
