@@ -23,9 +23,9 @@ mod support;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use support::{examples, repo_root, semo_in};
+use support::{examples, repo_root};
 
-type Event = serde_json::Map<String, serde_json::Value>;
+use support::differential::{Event, by_robot, field, parse_trace, robots_of, run_differences};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
@@ -34,16 +34,6 @@ fn scratch(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
-}
-
-fn field<'e>(event: &'e Event, key: &str) -> &'e str {
-    event.get(key).and_then(|v| v.as_str()).unwrap_or("")
-}
-
-fn parse_trace(text: &str) -> Vec<Event> {
-    text.lines()
-        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("bad trace line {l}: {e}")))
-        .collect()
 }
 
 /// The resource manager's events: (time, (event, the policy's condition or
@@ -66,40 +56,11 @@ fn resources(events: &[&Event]) -> Vec<(i64, (String, String, String))> {
         .collect()
 }
 
-/// The robots of `mission`, in peer order (`semo build --target linux`,
-/// without compiling them: the robots of a simulation are the same).
-fn robots_of(name: &str, mission: &Path) -> Vec<String> {
-    let out = scratch(name);
-    let built = semo_in(
-        &repo_root(),
-        &[
-            "build",
-            &mission.display().to_string(),
-            "--target",
-            "linux",
-            "-o",
-            &out.display().to_string(),
-        ],
-    );
-    assert_eq!(built.code, 0, "{}{}", built.stdout, built.stderr);
-    support::robots::robot_folders(&out)
-        .into_iter()
-        .map(|folder| folder.file_name().unwrap().to_string_lossy().into_owned())
-        .collect()
-}
-
 /// Each robot's trace (its incarnations' in order) when the generated
 /// programs run `scenario` in lock-step (`semo simulate --engine c`: built,
 /// run as processes, killed and restarted at the scenario's faults).
 fn lock_step(mission: &Path, scenario: &Path) -> BTreeMap<String, Vec<Event>> {
-    let mut traces: BTreeMap<String, Vec<Event>> = BTreeMap::new();
-    for event in run_engine(mission, scenario, "c") {
-        traces
-            .entry(field(&event, "robot").to_string())
-            .or_default()
-            .push(event);
-    }
-    traces
+    by_robot(run_engine(mission, scenario, "c"))
 }
 
 fn simulate(mission: &Path, scenario: &Path) -> Vec<Event> {
@@ -111,71 +72,6 @@ fn run_engine(mission: &Path, scenario: &Path, engine: &str) -> Vec<Event> {
     let out = support::simulate_trace(mission, scenario, engine);
     assert!(out.code <= 1, "{engine}: {}{}", out.stdout, out.stderr);
     parse_trace(&out.stdout)
-}
-
-/// Each robot's events by mission instant, every event as canonical JSON
-/// (its fields in name order), the events of one instant sorted.
-fn by_instant<'e>(events: impl Iterator<Item = &'e Event>) -> BTreeMap<i64, Vec<String>> {
-    let mut instants: BTreeMap<i64, Vec<String>> = BTreeMap::new();
-    for e in events {
-        let canonical: BTreeMap<&String, &serde_json::Value> = e.iter().collect();
-        instants
-            .entry(e["t"].as_i64().expect("every trace line has its time"))
-            .or_default()
-            .push(serde_json::to_string(&canonical).unwrap());
-    }
-    for events in instants.values_mut() {
-        events.sort_unstable();
-    }
-    instants
-}
-
-/// The differences between `robot`'s events in C and in the simulator: the
-/// first few instants at which they differ, with the events of each side
-/// that the other lacks.
-fn differences(robot: &str, c: &[Event], sim: &[Event]) -> Vec<String> {
-    let (c, sim) = (
-        by_instant(c.iter()),
-        by_instant(sim.iter().filter(|e| field(e, "robot") == robot)),
-    );
-    let mut instants: Vec<i64> = c.keys().chain(sim.keys()).copied().collect();
-    instants.sort_unstable();
-    instants.dedup();
-    let none = Vec::new();
-    let mut out = Vec::new();
-    for t in instants {
-        let (in_c, in_sim) = (c.get(&t).unwrap_or(&none), sim.get(&t).unwrap_or(&none));
-        if in_c == in_sim {
-            continue;
-        }
-        let mut text = format!("{robot} at {t} ms:");
-        for (side, events, other) in [("C  ", in_c, in_sim), ("sim", in_sim, in_c)] {
-            for e in events.iter().filter(|e| !other.contains(e)) {
-                text.push_str(&format!("\n  only in {side}: {e}"));
-            }
-        }
-        out.push(text);
-        if out.len() == 5 {
-            out.push(format!("{robot}: more instants differ"));
-            break;
-        }
-    }
-    out
-}
-
-/// The differences of a whole run: per robot, as [`differences`]; a robot
-/// with events on one side only counts too.
-fn run_differences(c: &BTreeMap<String, Vec<Event>>, sim: &[Event]) -> Vec<String> {
-    let mut robots: Vec<&str> = c.keys().map(String::as_str).collect();
-    for e in sim {
-        if !robots.contains(&field(e, "robot")) {
-            robots.push(field(e, "robot"));
-        }
-    }
-    robots
-        .into_iter()
-        .flat_map(|robot| differences(robot, c.get(robot).map_or(&[][..], |v| v), sim))
-        .collect()
 }
 
 /// Runs `mission` on the scenario both ways, asserts the two traces are the
@@ -671,7 +567,7 @@ fn random_missions(seeds: std::ops::Range<u64>) {
         let dir = scratch(&format!("random-{seed}"));
         let mission = dir.join(format!("random{seed}.mission"));
         std::fs::write(&mission, support::missiongen::mission(seed, &catalog)).unwrap();
-        let robots = robots_of(&format!("random-{seed}-out"), &mission);
+        let robots = robots_of(&scratch(&format!("random-{seed}-out")), &mission);
         let scenario = support::missiongen::scenario(seed, &robots, duration, 0.2);
         let scenario_path = dir.join("scenario.json");
         std::fs::write(&scenario_path, &scenario).unwrap();

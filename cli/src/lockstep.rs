@@ -16,7 +16,7 @@
 //! right after a restart) comes before anything else it does, as in the
 //! simulator.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
 use std::io::{self, Read, Write};
 use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
@@ -29,8 +29,68 @@ use semo::sim::loss::LossDraws;
 pub struct Robot {
     /// Its name (its trace files are named after it).
     pub name: String,
-    /// The program (`<folder>/<robot>`).
-    pub exe: PathBuf,
+    pub launch: Launch,
+}
+
+/// How a robot of the run is started.
+pub enum Launch {
+    /// A `linux-sim` program (`<folder>/<robot>`), as a process with
+    /// `--trace FILE --lockstep SOCKET`.
+    Program(PathBuf),
+    /// A board's simulation firmware made with `make LOCKSTEP=1`
+    /// (`semo_static_lockstep.c`), in the board's emulator: its trace port
+    /// written to the trace file, its link port connected to the socket.
+    Board {
+        elf: PathBuf,
+        board: &'static semo::platform::Board,
+    },
+}
+
+impl Launch {
+    fn command(&self, trace: &Path, socket: &Path) -> Command {
+        match self {
+            Launch::Program(exe) => {
+                let mut command = Command::new(exe);
+                command
+                    .arg("--trace")
+                    .arg(trace)
+                    .arg("--lockstep")
+                    .arg(socket);
+                command
+            }
+            Launch::Board { elf, board } => {
+                let mut command = Command::new(board.emulator);
+                command
+                    .args(["-M", board.machine, "-display", "none", "-monitor", "none"])
+                    .args(["-semihosting", "-serial"])
+                    .arg(chardev("file", trace))
+                    .arg("-serial")
+                    .arg(chardev("unix", socket))
+                    .arg("-kernel")
+                    .arg(elf);
+                command
+            }
+        }
+    }
+
+    fn path(&self) -> &Path {
+        match self {
+            Launch::Program(exe) => exe,
+            Launch::Board { elf, .. } => elf,
+        }
+    }
+
+    /// A board's serial port cannot close: it is told the run ended.
+    fn is_board(&self) -> bool {
+        matches!(self, Launch::Board { .. })
+    }
+}
+
+/// A QEMU character device on `path` (`file:PATH`, `unix:PATH`).
+fn chardev(kind: &str, path: &Path) -> std::ffi::OsString {
+    let mut arg = std::ffi::OsString::from(format!("{kind}:"));
+    arg.push(path);
+    arg
 }
 
 /// What happens to a process from outside, at a mission time.
@@ -64,7 +124,7 @@ pub fn run(run: &Run<'_>) -> Result<Vec<String>, String> {
         .map_err(|e| format!("cannot listen on {}: {e}", socket.display()))?;
     let mut coordinator = Coordinator::new(run, listener);
     let result = coordinator.drive();
-    coordinator.stop_all();
+    coordinator.stop_all(result.is_ok());
     result?;
     let mut traces = Vec::new();
     for (peer, robot) in run.robots.iter().enumerate() {
@@ -135,14 +195,28 @@ impl Drop for OneCpu {
     }
 }
 
+/// What became of a message offered to a robot.
+enum Offered {
+    Taken,
+    /// Refused for now (given back).
+    Busy(Vec<u8>),
+    /// The robot is not running, or its stream ended.
+    Lost,
+}
+
 /// What a robot's stream brought.
 enum Frame {
     /// Idle until the given time (`None`: until a message or for ever).
     Idle(Option<i64>),
     /// A datagram for a peer.
     Message { to: usize, datagram: Vec<u8> },
-    /// The stream ended (the process ended or was killed), broke, or
-    /// brought a frame no robot sends.
+    /// A board took the message it was sent.
+    Taken,
+    /// A board cannot take the message it was sent yet.
+    Busy,
+    /// A frame no robot sends (its kind).
+    Unexpected(u8),
+    /// The stream ended (the process ended or was killed) or broke.
     End,
 }
 
@@ -158,7 +232,10 @@ impl Frame {
                 to: u32::from_le_bytes(payload[..4].try_into().expect("four bytes")) as usize,
                 datagram: payload[4..].to_vec(),
             },
-            Ok(_) | Err(_) => Frame::End,
+            Ok((b'A', payload)) if payload.is_empty() => Frame::Taken,
+            Ok((b'B', payload)) if payload.is_empty() => Frame::Busy,
+            Ok((kind, _)) => Frame::Unexpected(kind),
+            Err(_) => Frame::End,
         }
     }
 }
@@ -178,6 +255,11 @@ struct Coordinator<'r, 'a> {
     now: i64,
     /// (arrival, sender, sequence) → (receiver, datagram): the delivery order.
     in_flight: BTreeMap<(i64, usize, u64), (usize, Vec<u8>)>,
+    /// Per robot, the messages that arrived for it, in order, from the
+    /// first it refused (a board whose inbox is full and unpolled).
+    kept: Vec<VecDeque<Vec<u8>>>,
+    /// Per robot: it ran since it last refused a message.
+    may_offer: Vec<bool>,
     sent: u64,
     losses: LossDraws,
     /// Per peer, by incarnation: the trace lines of the faults done to it
@@ -197,6 +279,8 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             incarnations: vec![0; run.robots.len()],
             now: 0,
             in_flight: BTreeMap::new(),
+            kept: vec![VecDeque::new(); run.robots.len()],
+            may_offer: vec![false; run.robots.len()],
             sent: 0,
             losses: LossDraws::new(run.seed),
             faults_after: vec![BTreeMap::new(); run.robots.len()],
@@ -216,8 +300,10 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             }
             let next_wake = self.live.iter().flatten().filter_map(|l| l.wakes_at).min();
             let next_arrival = self.in_flight.keys().next().map(|k| k.0);
+            // Messages a board refused are offered again once it ran.
+            let next_offer = self.may_offer.iter().any(|&m| m).then_some(self.now);
             let next_fault = faults.peek().map(|f| f.0);
-            let Some(next) = [next_wake, next_arrival, next_fault]
+            let Some(next) = [next_wake, next_arrival, next_offer, next_fault]
                 .into_iter()
                 .flatten()
                 .min()
@@ -274,16 +360,17 @@ impl<'r, 'a> Coordinator<'r, 'a> {
                 .join(format!("{}.{incarnation}.stderr", robot.name)),
         )
         .map_err(|e| format!("{}: {e}", self.run.work.display()))?;
-        let mut child = Command::new(&robot.exe)
-            .arg("--trace")
-            .arg(trace_path(self.run.work, robot, incarnation))
-            .arg("--lockstep")
-            .arg(self.run.work.join("lockstep.sock"))
+        let mut child = robot
+            .launch
+            .command(
+                &trace_path(self.run.work, robot, incarnation),
+                &self.run.work.join("lockstep.sock"),
+            )
             .stdin(Stdio::null())
             .stdout(Stdio::null())
             .stderr(errors)
             .spawn()
-            .map_err(|e| format!("cannot start {}: {e}", robot.exe.display()))?;
+            .map_err(|e| format!("cannot start {}: {e}", robot.launch.path().display()))?;
         self.cpu.keep(&child);
         let (stream, who) = match self.accept(&mut child) {
             Ok(accepted) => accepted,
@@ -359,6 +446,9 @@ impl<'r, 'a> Coordinator<'r, 'a> {
     }
 
     fn kill(&mut self, peer: usize) {
+        // What it had not taken goes with it, as what arrives after.
+        self.kept[peer].clear();
+        self.may_offer[peer] = false;
         if let Some(mut live) = self.live[peer].take() {
             let _ = live.child.kill();
             let _ = live.child.wait();
@@ -418,29 +508,105 @@ impl<'r, 'a> Coordinator<'r, 'a> {
                 live.idle = true;
                 live.wakes_at = wakes_at;
             }
-            Frame::Message { to, datagram } => {
-                if to >= self.live.len() {
-                    return Err(format!(
-                        "robot {} sent a message to peer {to}, which does not exist",
-                        self.run.robots[peer].name
-                    ));
-                }
-                let (latency, loss) = (self.run.link)(peer, to);
-                if loss > 0.0 && self.lost(peer, to, &datagram, loss)? {
-                    return Ok(());
-                }
-                let arrival = self.now + latency;
-                self.in_flight
-                    .insert((arrival, peer, self.sent), (to, datagram));
-                self.sent += 1;
+            Frame::Message { to, datagram } => self.route(peer, to, datagram)?,
+            frame @ (Frame::Taken | Frame::Busy | Frame::Unexpected(_)) => {
+                return Err(self.unexpected(peer, &frame));
             }
             Frame::End => {
                 if let Some(mut live) = self.live[peer].take() {
-                    let _ = live.child.wait();
+                    // A robot ends by itself when its mission finished or
+                    // its scenario's time is up; anything else is a failure
+                    // the run must not hide.
+                    match live.child.wait() {
+                        Ok(status) if !status.success() => {
+                            let robot = &self.run.robots[peer];
+                            let incarnation = self.incarnations[peer] - 1;
+                            // The work folder goes with the run: what the
+                            // robot said goes into the error. A board says
+                            // it on its trace port, after its trace.
+                            let said = |path: PathBuf| {
+                                let text = std::fs::read_to_string(path).unwrap_or_default();
+                                text.lines()
+                                    .filter(|l| !l.starts_with('{'))
+                                    .map(|l| format!("\n  {l}"))
+                                    .collect::<String>()
+                            };
+                            return Err(format!(
+                                "robot {} failed ({status}){}{}",
+                                robot.name,
+                                said(trace_path(self.run.work, robot, incarnation)),
+                                said(
+                                    self.run
+                                        .work
+                                        .join(format!("{}.{incarnation}.stderr", robot.name))
+                                ),
+                            ));
+                        }
+                        _ => {}
+                    }
                 }
             }
         }
         Ok(())
+    }
+
+    /// A message `peer` sent to `to`, on its way (or lost, as the scenario
+    /// says).
+    fn route(&mut self, peer: usize, to: usize, datagram: Vec<u8>) -> Result<(), String> {
+        if to >= self.live.len() {
+            return Err(format!(
+                "robot {} sent a message to peer {to}, which does not exist",
+                self.run.robots[peer].name
+            ));
+        }
+        let (latency, loss) = (self.run.link)(peer, to);
+        if loss > 0.0 && self.lost(peer, to, &datagram, loss)? {
+            return Ok(());
+        }
+        let arrival = self.now + latency;
+        self.in_flight
+            .insert((arrival, peer, self.sent), (to, datagram));
+        self.sent += 1;
+        Ok(())
+    }
+
+    fn unexpected(&self, peer: usize, frame: &Frame) -> String {
+        let what = match frame {
+            Frame::Idle(_) => "an idle report".to_string(),
+            Frame::Taken | Frame::Busy => "an answer to a message".to_string(),
+            Frame::Unexpected(kind) => format!("a frame of kind {kind:#04x}"),
+            Frame::Message { .. } | Frame::End => "a frame".to_string(),
+        };
+        format!(
+            "internal error: robot {} sent {what} out of turn in lock-step",
+            self.run.robots[peer].name
+        )
+    }
+
+    /// Reads what a board sends until it answers the message it was sent:
+    /// whether it took it (else it will, later). Its messages meanwhile (a
+    /// full inbox runs the task that reads it, which may send) go on their
+    /// way.
+    fn until_taken(&mut self, peer: usize) -> Result<bool, String> {
+        loop {
+            let Some(live) = self.live[peer].as_mut() else {
+                return Ok(true);
+            };
+            match Frame::read(&mut live.stream) {
+                Frame::Taken => return Ok(true),
+                Frame::Busy => return Ok(false),
+                Frame::Message { to, datagram } => self.route(peer, to, datagram)?,
+                frame @ (Frame::Idle(_) | Frame::Unexpected(_)) => {
+                    return Err(self.unexpected(peer, &frame));
+                }
+                Frame::End => {
+                    return Err(format!(
+                        "robot {} ended while it took a message; its trace says why",
+                        self.run.robots[peer].name
+                    ));
+                }
+            }
+        }
     }
 
     /// Whether the scenario's random loss takes this message, drawn as the
@@ -457,30 +623,101 @@ impl<'r, 'a> Coordinator<'r, 'a> {
     }
 
     /// Delivers every message due by now; the robots that got one are
-    /// granted the time (they run what the messages wake).
+    /// granted the time (they run what the messages wake). The messages a
+    /// board refused go first once it has run since (they arrived before the
+    /// others), and stay in order before any that arrive after them.
     fn deliver_due(&mut self) -> Result<(), String> {
-        let mut woken = vec![false; self.live.len()];
+        let robots = self.live.len();
+        let (mut woken, mut told) = (vec![false; robots], vec![false; robots]);
+        for (to, woken) in woken.iter_mut().enumerate() {
+            if !self.may_offer[to] {
+                continue;
+            }
+            self.may_offer[to] = false;
+            while let Some(datagram) = self.kept[to].pop_front() {
+                match self.offer(to, datagram, &mut told)? {
+                    Offered::Taken => *woken = true,
+                    Offered::Busy(datagram) => {
+                        self.kept[to].push_front(datagram);
+                        break;
+                    }
+                    Offered::Lost => {}
+                }
+            }
+        }
         while let Some(entry) = self.in_flight.first_entry() {
             if entry.key().0 > self.now {
                 break;
             }
             let (to, datagram) = entry.remove();
-            // A message for a robot that is not running is lost.
-            if let Some(live) = self.live[to].as_mut()
-                && write_frame(&mut live.stream, b'D', &datagram).is_ok()
-            {
-                woken[to] = true;
+            if !self.kept[to].is_empty() {
+                self.kept[to].push_back(datagram);
+                continue;
+            }
+            match self.offer(to, datagram, &mut told)? {
+                Offered::Taken => woken[to] = true,
+                Offered::Busy(datagram) => self.kept[to].push_back(datagram),
+                Offered::Lost => {}
             }
         }
-        for (peer, woken) in woken.into_iter().enumerate() {
-            if woken {
+        for peer in 0..robots {
+            if woken[peer] {
                 self.grant(peer)?;
+            } else if told[peer] {
+                // It refused every message, and waits for the time: it runs
+                // only what was due anyway, which alone may make room.
+                let due = self.live[peer]
+                    .as_ref()
+                    .is_some_and(|l| l.wakes_at.is_some_and(|t| t <= self.now));
+                self.grant_as(peer, due)?;
             }
         }
         Ok(())
     }
 
+    /// Sends robot `to` one message: a board is told the instant first
+    /// (once per round, in `told`) and says whether it took it.
+    fn offer(
+        &mut self,
+        to: usize,
+        datagram: Vec<u8>,
+        told: &mut [bool],
+    ) -> Result<Offered, String> {
+        let board = self.run.robots[to].launch.is_board();
+        // A message for a robot that is not running is lost.
+        let Some(live) = self.live[to].as_mut() else {
+            return Ok(Offered::Lost);
+        };
+        // A board takes a message at once (it may run the task that reads
+        // its inbox): it is told the time first.
+        if board && !told[to] {
+            if write_frame(&mut live.stream, b'N', &self.now.to_le_bytes()).is_err() {
+                return Ok(Offered::Lost); // it ended: its reader reports the end
+            }
+            told[to] = true;
+        }
+        if write_frame(&mut live.stream, b'D', &datagram).is_err() {
+            return Ok(Offered::Lost);
+        }
+        // A serial port has no flow control: a board is sent the next
+        // message once it has answered this one.
+        if board && !self.until_taken(to)? {
+            return Ok(Offered::Busy(datagram));
+        }
+        Ok(Offered::Taken)
+    }
+
     fn grant(&mut self, peer: usize) -> Result<(), String> {
+        self.grant_as(peer, true)
+    }
+
+    /// Grants `peer` the time; `runs`: it will run something (what was due,
+    /// or a message), so the messages it refused may be offered again
+    /// after.
+    fn grant_as(&mut self, peer: usize, runs: bool) -> Result<(), String> {
+        if runs && !self.kept[peer].is_empty() {
+            self.may_offer[peer] = true;
+        }
         let now = self.now;
         let Some(live) = self.live[peer].as_mut() else {
             return Ok(());
@@ -499,11 +736,27 @@ impl<'r, 'a> Coordinator<'r, 'a> {
 
     /// Ends the run: a robot whose coordinator is gone stops (its wrap-ups
     /// run and its trace is closed).
-    fn stop_all(&mut self) {
-        for live in self.live.iter_mut().filter_map(Option::take) {
-            let Live {
-                mut child, stream, ..
-            } = live;
+    fn stop_all(&mut self, well: bool) {
+        for (peer, live) in self.live.iter_mut().enumerate() {
+            let Some(Live {
+                mut child,
+                mut stream,
+                ..
+            }) = live.take()
+            else {
+                continue;
+            };
+            // A board's serial port does not close: it is told. It stops
+            // as a program does when its socket closes (at the last time
+            // it was granted). After a failure, when it may be in the middle
+            // of anything, it is stopped.
+            if self.run.robots[peer].launch.is_board() {
+                if well {
+                    let _ = write_frame(&mut stream, b'E', &[]);
+                } else {
+                    let _ = child.kill();
+                }
+            }
             let _ = stream.shutdown(std::net::Shutdown::Both);
             drop(stream);
             let _ = child.wait();
@@ -537,16 +790,28 @@ fn write_frame(stream: &mut UnixStream, kind: u8, payload: &[u8]) -> io::Result<
     stream.write_all(&frame)
 }
 
-/// Builds the mission's `linux-sim` programs in a private folder, makes
-/// them, and runs them on the scenario until `until_ms`: each robot's name
-/// and trace, in peer order.
+/// A robot of a lock-step run.
+pub struct Ran {
+    pub name: String,
+    /// Its incarnations' trace lines, in order.
+    pub trace: String,
+    /// The board whose emulator ran it, if any (else a `linux-sim` process).
+    pub board: Option<&'static semo::platform::Board>,
+    pub target: semo::platform::Target,
+}
+
+/// Builds the mission's programs in a private folder, each robot for its
+/// simulation target in `targets` (`linux-sim`, or a board's `-sim` made
+/// with `LOCKSTEP=1` and run in its emulator), makes them, and runs them on
+/// the scenario until `until_ms`: each robot, in peer order.
 pub fn simulate(
     input: &semo::refine::BuildInput<'_>,
     refined: &semo::refine::Refined,
+    targets: &semo::targets::Targets,
     scenario: &semo::sim::scenario::Scenario,
     until_ms: i64,
     seed: u64,
-) -> Result<Vec<(String, String)>, String> {
+) -> Result<Vec<Ran>, String> {
     use semo::sim::scenario::FaultKind;
     let network = &scenario.network;
     let peers: Vec<(String, semo::refine::PeerId)> = refined
@@ -557,10 +822,10 @@ pub fn simulate(
     // Each program gets its robot's world compiled in: the scenario is
     // read once, here, by the simulator's reader.
     let worlds = scenario.compiled_for_each(&refined.programs);
-    let built = semo::codegen::build_refined(
+    let built = semo::codegen::build_refined_each(
         input,
         refined,
-        semo::codegen::Target::LinuxSim,
+        targets,
         semo::codegen::Emit::All,
         &worlds,
     );
@@ -572,7 +837,7 @@ pub fn simulate(
             .map(|d| format!("{}: {}", d.code.as_str(), d.message))
             .collect();
         return Err(format!(
-            "the mission cannot be built for linux-sim:\n  {}",
+            "the mission cannot be built for its simulations:\n  {}",
             why.join("\n  ")
         ));
     }
@@ -583,10 +848,18 @@ pub fn simulate(
     let runtime = work.path().join(semo::codegen::RUNTIME_FOLDER);
     write_files(&runtime, &built.runtime)?;
     let mut robots: Vec<Option<Robot>> = peers.iter().map(|_| None).collect();
+    let mut targets_of: Vec<Option<semo::platform::Target>> = peers.iter().map(|_| None).collect();
     for output in &built.robots {
         let folder = work.path().join(&output.team).join(&output.robot);
         write_files(&folder, &output.files)?;
-        make(&folder)?;
+        if !output.target.simulated() {
+            return Err(format!(
+                "internal error: robot {} was built for {}, which is no simulation",
+                output.robot, output.target
+            ));
+        }
+        let board = output.target.platform().board.as_ref();
+        make(&folder, board.is_some())?;
         let Some(&(_, peer)) = peers.iter().find(|(name, _)| *name == output.robot) else {
             return Err(format!(
                 "internal error: robot {} is not in the peer table",
@@ -595,9 +868,16 @@ pub fn simulate(
         };
         // One program per robot of the mission (`refine_checked`), so a
         // peer's position is a place in `robots`.
+        targets_of[peer.index()] = Some(output.target);
         robots[peer.index()] = Some(Robot {
             name: output.robot.clone(),
-            exe: folder.join(&output.robot),
+            launch: match board {
+                Some(board) => Launch::Board {
+                    elf: folder.join(format!("{}.elf", output.robot)),
+                    board,
+                },
+                None => Launch::Program(folder.join(&output.robot)),
+            },
         });
     }
     let robots: Vec<Robot> = robots
@@ -638,7 +918,20 @@ pub fn simulate(
         until_ms,
         work: work.path(),
     })?;
-    Ok(robots.iter().map(|r| r.name.clone()).zip(traces).collect())
+    Ok(robots
+        .into_iter()
+        .zip(targets_of)
+        .zip(traces)
+        .map(|((robot, target), trace)| Ran {
+            board: match robot.launch {
+                Launch::Board { board, .. } => Some(board),
+                Launch::Program(_) => None,
+            },
+            name: robot.name,
+            trace,
+            target: target.unwrap_or(semo::platform::Target::LinuxSim),
+        })
+        .collect())
 }
 
 /// `files` written into `folder` (a work folder of this run's own).
@@ -653,10 +946,12 @@ fn write_files(folder: &Path, files: &[semo::codegen::GeneratedFile]) -> Result<
     Ok(())
 }
 
-/// `make` in a robot's folder (quiet; its errors are shown).
-fn make(folder: &Path) -> Result<(), String> {
+/// `make` in a robot's folder (quiet; its errors are shown); a board's
+/// firmware with lock-step on its link's port.
+fn make(folder: &Path, board: bool) -> Result<(), String> {
     let made = Command::new("make")
         .arg("-s")
+        .args(board.then_some("LOCKSTEP=1"))
         .current_dir(folder)
         .output()
         .map_err(|e| format!("cannot run make (is it installed?): {e}"))?;
@@ -673,10 +968,10 @@ fn make(folder: &Path) -> Result<(), String> {
 
 /// The robots' traces as one, in time order; at one instant, robots in
 /// peer order, each robot's lines in its order.
-pub fn merged(robots: &[(String, String)]) -> String {
+pub fn merged(robots: &[Ran]) -> String {
     let mut lines: Vec<(i64, usize, usize, &str)> = Vec::new();
-    for (peer, (_, text)) in robots.iter().enumerate() {
-        for (i, line) in text.lines().enumerate() {
+    for (peer, robot) in robots.iter().enumerate() {
+        for (i, line) in robot.trace.lines().enumerate() {
             lines.push((time_of(line), peer, i, line));
         }
     }

@@ -325,6 +325,12 @@ enum Command {
         /// lock-step virtual time: the same trace format).
         #[arg(long, value_enum, default_value_t = simulate::Engine::Sim)]
         engine: simulate::Engine,
+        /// With `--engine c`: each robot on its own platform's simulation
+        /// (the build plan of `semo build --sim`): a board robot's firmware
+        /// in QEMU, in the same lock-step (needs arm-none-eabi-gcc and
+        /// qemu-system-arm).
+        #[arg(long)]
+        boards: bool,
     },
     /// Read back the traces of a run (each robot's `--trace` file, or one
     /// merged file), merged by time: the summary and timeline `semo
@@ -942,6 +948,7 @@ fn run() -> i32 {
             mcap,
             color,
             engine,
+            boards,
         } => simulate::run(
             simulate::Options {
                 mission,
@@ -955,6 +962,7 @@ fn run() -> i32 {
                 mcap,
                 color: use_color(color),
                 engine,
+                boards,
             },
             &mut out,
         ),

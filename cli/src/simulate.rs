@@ -24,6 +24,9 @@ pub struct Options {
     pub mcap: Option<PathBuf>,
     pub color: bool,
     pub engine: Engine,
+    /// With `--engine c`: each robot on its own platform's simulation, a
+    /// board robot's firmware in its emulator.
+    pub boards: bool,
 }
 
 /// What runs the robots.
@@ -65,6 +68,12 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
     } else {
         Format::Human
     };
+    if options.boards && options.engine != Engine::C {
+        eprintln!(
+            "error: --boards runs the generated programs, each on its platform's simulation: it needs --engine c"
+        );
+        return 2;
+    }
     let mission_file = match super::defaults::mission_file(
         options.mission.clone(),
         &options.strategy,
@@ -115,7 +124,24 @@ pub fn run(options: Options, out: &mut impl Write) -> i32 {
         return 2;
     };
     if options.engine == Engine::C {
-        return run_generated(&options, &build.input(), &refined, &scenario, out);
+        // Every robot on linux-sim, or with --boards each on its own
+        // platform's simulation (the build plan `semo build --sim` follows).
+        let targets = if options.boards {
+            check
+                .analysis()
+                .build_plan(
+                    mission,
+                    &mission_file,
+                    semo::host::PlanRequest {
+                        sim: true,
+                        ..Default::default()
+                    },
+                )
+                .targets()
+        } else {
+            semo::targets::Targets::all(semo::platform::Target::LinuxSim)
+        };
+        return run_generated(&options, &build.input(), &refined, &targets, &scenario, out);
     }
     let programs = &refined.programs;
     let robots = sim::Run::robots_of(programs);
@@ -363,6 +389,7 @@ fn run_generated(
     options: &Options,
     input: &semo::refine::BuildInput<'_>,
     refined: &semo::refine::Refined,
+    targets: &semo::targets::Targets,
     scenario: &scenario::Scenario,
     out: &mut impl Write,
 ) -> i32 {
@@ -379,10 +406,18 @@ fn run_generated(
         .until_ms
         .or(scenario.duration_ms)
         .unwrap_or(sim::DEFAULT_UNTIL_MS);
-    let robots = match super::lockstep::simulate(input, refined, scenario, until_ms, options.seed) {
+    let robots = match super::lockstep::simulate(
+        input,
+        refined,
+        targets,
+        scenario,
+        until_ms,
+        options.seed,
+    ) {
         Ok(robots) => robots,
         Err(e) => {
-            eprintln!("error: {e}");
+            // It may quote what a robot or a compiler wrote.
+            eprintln!("error: {}", super::terminal::visible(&e));
             return 2;
         }
     };
@@ -398,8 +433,19 @@ fn run_generated(
             "{} robots ran their generated programs in lock-step: {lines} trace events\n",
             robots.len()
         );
-        for (robot, text) in &robots {
-            summary.push_str(&format!("  {robot}: {} events\n", text.lines().count()));
+        for robot in &robots {
+            summary.push_str(&format!(
+                "  {}: {} events",
+                robot.name,
+                robot.trace.lines().count()
+            ));
+            if let Some(board) = robot.board {
+                summary.push_str(&format!(
+                    " ({}, {} in {} {})",
+                    robot.target, board.name, board.emulator, board.machine
+                ));
+            }
+            summary.push('\n');
         }
         let _ = out.write_all(summary.as_bytes());
     }

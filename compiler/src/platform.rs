@@ -165,12 +165,29 @@ const CORTEX_M: [&str; 5] = [
     "semo_cortex_m.c",
 ];
 
-/// A Cortex-M board's program and its simulation alike: the static
-/// schedule, no network (other robots only through the board's
-/// [`SerialLink`]).
+/// A Cortex-M board's program: the static schedule, no network (other
+/// robots only through the board's [`SerialLink`]).
 const BOARD_PROGRAM: Variant = Variant {
     transport: None,
     runtime: &CORTEX_M,
+};
+
+/// Its simulation's runtime: the program's, and lock-step on the link's
+/// serial port (`make LOCKSTEP=1`, `semo simulate --engine c --boards`),
+/// for every robot, messaging or not.
+const CORTEX_M_SIM: [&str; 6] = [
+    CORTEX_M[0],
+    CORTEX_M[1],
+    CORTEX_M[2],
+    CORTEX_M[3],
+    CORTEX_M[4],
+    "semo_static_lockstep.c",
+];
+
+/// A Cortex-M board's simulation: its program's variant, with lock-step.
+const BOARD_SIM: Variant = Variant {
+    transport: None,
+    runtime: &CORTEX_M_SIM,
 };
 
 /// The cross toolchain of the Cortex-M boards (Debian's
@@ -225,7 +242,7 @@ pub const PLATFORMS: &[Platform] = &[
         doc: "bare metal on a Cortex-M3 (TI Stellaris LM3S6965): a static schedule, no threads, no heap",
         layer: Layer::Static,
         real: BOARD_PROGRAM,
-        sim: BOARD_PROGRAM,
+        sim: BOARD_SIM,
         board: Some(Board {
             name: "TI Stellaris LM3S6965",
             cpu: "Cortex-M3",
@@ -260,7 +277,7 @@ pub const PLATFORMS: &[Platform] = &[
         doc: "bare metal on a Cortex-M4 (ST STM32F405, the OpenCR's family): a static schedule, no threads, no heap",
         layer: Layer::Static,
         real: BOARD_PROGRAM,
-        sim: BOARD_PROGRAM,
+        sim: BOARD_SIM,
         board: Some(Board {
             name: "ST STM32F405",
             cpu: "Cortex-M4",

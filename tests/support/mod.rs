@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod cc;
+pub mod differential;
 pub mod markdown;
 pub mod missiongen;
 pub mod mosquitto;

@@ -56,6 +56,7 @@ const PROGRAM_DESC: Template = template!(
         "group_count",
         "self",
         "robot_count",
+        "receives",
         "schedule",
         "words",
         "deploy",
@@ -396,6 +397,7 @@ pub fn main_c(
             ("group_count", &groups.len()),
             ("self", &peers.own()),
             ("robot_count", &program.peers.len()),
+            ("receives", &receives(program)),
             (
                 "schedule",
                 &if static_schedule {
@@ -873,6 +875,15 @@ pub struct LinkSizes {
     pub groups: usize,
 }
 
+/// Whether a task of the robot takes messages from its inbox (its
+/// communication task): without one, what arrives is ignored.
+fn receives(program: &RobotProgram) -> bool {
+    program
+        .tasks
+        .iter()
+        .any(|t| t.kind == RoleKind::CommReceive)
+}
+
 impl StaticSizes {
     /// `simulated_battery`: the robot's scenario gives it a battery level
     /// (its status may then say one without a `BATTERY` value).
@@ -882,10 +893,7 @@ impl StaticSizes {
         link: Option<&crate::platform::SerialLink>,
         simulated_battery: bool,
     ) -> StaticSizes {
-        let receives = program
-            .tasks
-            .iter()
-            .any(|t| t.kind == RoleKind::CommReceive);
+        let receives = receives(program);
         let value_bytes = (longest_value + 1).max(16).next_multiple_of(4);
         StaticSizes {
             link: link.map(|l| LinkSizes {
@@ -1073,10 +1081,14 @@ fn static_makefile(
             ),
             (
                 "sim",
-                &if target.simulated() {
-                    " -DSEMO_SIM -DSEMO_SEMIHOSTING"
-                } else {
+                &if !target.simulated() {
                     ""
+                } else if sizes.link.is_some() {
+                    " -DSEMO_SIM -DSEMO_SEMIHOSTING$(if $(LOCKSTEP), -DSEMO_LOCKSTEP)"
+                } else {
+                    // In lock-step a robot that messages no one speaks on
+                    // the link's port too (its sizes the runtime's defaults).
+                    " -DSEMO_SIM -DSEMO_SEMIHOSTING$(if $(LOCKSTEP), -DSEMO_LOCKSTEP -DSEMO_LINK)"
                 },
             ),
             ("runtime", &runtime),

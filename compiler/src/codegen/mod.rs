@@ -77,6 +77,10 @@ const STATIC_STATUS: (&str, &str) = (
     "semo_static_status.c",
     include_str!("runtime/semo_static_status.c"),
 );
+const STATIC_LOCKSTEP: (&str, &str) = (
+    "semo_static_lockstep.c",
+    include_str!("runtime/semo_static_lockstep.c"),
+);
 const CORTEX_M: (&str, &str) = ("semo_cortex_m.c", include_str!("runtime/semo_cortex_m.c"));
 const LM3S6965: (&str, &str) = ("semo_lm3s6965.c", include_str!("runtime/semo_lm3s6965.c"));
 const LM3S6965_LD: (&str, &str) = ("lm3s6965.ld", LINK_SCRIPT.text);
@@ -117,6 +121,7 @@ const RUNTIME_FILES: &[(&str, &str)] = &[
     STATIC,
     STATIC_LINK,
     STATIC_STATUS,
+    STATIC_LOCKSTEP,
     CORTEX_M,
     LM3S6965,
     LM3S6965_LD,

@@ -1013,6 +1013,14 @@ bool semo__inbox_waiting(void)
     return waiting;
 }
 
+bool semo__inbox_unpolled_full(void)
+{
+    semo__queue_lock(SEMO__INBOX);
+    bool full = !g_inbox_polled && g_inbox_state.count == g_inbox_ring.capacity;
+    semo__queue_unlock(SEMO__INBOX);
+    return full;
+}
+
 bool semo__inbox_holds_back(void)
 {
     semo__queue_lock(SEMO__INBOX);
@@ -1021,10 +1029,6 @@ bool semo__inbox_holds_back(void)
     return full;
 }
 
-/* How long a message waits for room in a full inbox that no task has polled
- * yet (mission ms): a robot that receives nothing must not hold back its
- * transport for ever. */
-#define INBOX_UNPOLLED_WAIT_MS 1000
 
 /* ---------------------------------------------------------- task control */
 
@@ -1082,14 +1086,15 @@ void semo__deliver(const semo_message *msg)
     /* A robot whose mission has finished (or that is stopping) takes no
      * more messages, as the simulator's stopped robot hears none: what
      * arrives after the control task's `finish` is not queued. */
-    if (!semo_running())
+    const semo_program_desc *program = semo_program();
+    if (!semo_running() || (program && !program->receives))
         return;
     semo__queue_lock(SEMO__INBOX);
     /* A full inbox holds back the deliverer, and through it the transport
      * (MQTT: the broker keeps the rest of a burst, such as what it queued
      * for a robot that reconnects), rather than losing a message; where the
      * platform cannot wait (the static schedule) the message is dropped. */
-    int64_t deadline = semo_now_ms() + INBOX_UNPOLLED_WAIT_MS;
+    int64_t deadline = semo_now_ms() + SEMO__INBOX_UNPOLLED_WAIT_MS;
     while (g_inbox_state.count == g_inbox_ring.capacity && semo_running() &&
            (g_inbox_polled || semo_now_ms() < deadline) &&
            semo__queue_wait(SEMO__INBOX, g_inbox_polled ? -1 : deadline))
@@ -1110,6 +1115,7 @@ int semo_comm_poll(semo_message *out, int64_t timeout_ms)
     int64_t deadline = timeout_ms < 0 ? -1 : semo_now_ms() + timeout_ms;
     semo__queue_lock(SEMO__INBOX);
     g_inbox_polled = true;
+    semo__inbox_polled();
     while (g_inbox_state.count == 0 && semo_running() && (deadline < 0 || semo_now_ms() < deadline) &&
            semo__queue_wait(SEMO__INBOX, deadline))
         ;
@@ -1326,4 +1332,37 @@ bool semo_sim_battery(long long *level)
         *level = (long long)semo__sim_battery_at(semo_now_ms());
     return true;
 }
+/* Both simulation platforms': the scenario's latest sample of `value` at
+ * this instant; BATTERY without one is the scenario's battery level (the
+ * simulator's rule). */
+bool semo_sim_sensor(const char *value, semo_type type, semo_value *out)
+{
+    const semo__sim_sensor_entry *latest = NULL;
+    int64_t now = semo_now_ms();
+    for (size_t i = 0; value && i < semo__scenario.sensor_count; i++) {
+        const semo__sim_sensor_entry *e = &semo__scenario.sensors[i];
+        if (e->at <= now && strcmp(e->value, value) == 0 && (!latest || e->at >= latest->at))
+            latest = e;
+    }
+    semo_value read;
+    if (latest)
+        return semo_value_parse(out ? out : &read, type, latest->is);
+    if (value && strcmp(value, "BATTERY") == 0 && semo__scenario.battery_count > 0) {
+        /* A whole number (semo__sim_battery_at rounds), of a scenario's level. */
+        char text[21];
+        semo__format_i64(text, (int64_t)semo__sim_battery_at(now));
+        return semo_value_parse(out ? out : &read, type, text);
+    }
+    return false;
+}
 #endif
+
+int64_t semo__on_grid(int64_t at, int64_t first, int64_t period_ms)
+{
+    if (at == INT64_MAX || first < 0 || at <= first || period_ms <= 0)
+        return at;
+    int64_t periods = (at - first) / period_ms + ((at - first) % period_ms != 0);
+    if (periods > (INT64_MAX - first) / period_ms)
+        return INT64_MAX;
+    return first + periods * period_ms;
+}

@@ -75,6 +75,9 @@ bool semo__queue_wait(int queue, int64_t deadline_ms);
 /* Platform, after the lock is released: something was added to the queue;
  * wakes its reader (and tasks sleeping on a semo_next_firing hint). */
 void semo__queue_written(int queue);
+/* Platform: the task running polls the inbox (semo_comm_poll): the static
+ * schedule in lock-step fires it when a delivery finds the inbox full. */
+void semo__inbox_polled(void);
 /* A writer waiting for room in a full message channel (semo_port_send:
  * `patient`; semo_port_offer: not). `marked`/`mark` are the platform's,
  * zero at the first call. */
@@ -213,6 +216,10 @@ semo__task_control *semo__control_begin(const char *name);
  * released. */
 void semo__control_end(semo__task_control *control);
 
+/* The first instant at or after `at` of the grid of `period_ms` that
+ * starts at `first` (INT64_MAX stays: no time; `first` < 0: no grid yet):
+ * the instants a time-driven task fires at, on either platform. */
+int64_t semo__on_grid(int64_t at, int64_t first, int64_t period_ms);
 /* Queues a message as if it had arrived over the transport. */
 void semo__deliver(const semo_message *msg);
 /* Empties the inbox (start-up, shut-down). */
@@ -223,6 +230,12 @@ bool semo__inbox_waiting(void);
  * keep a message where it is (on the line, at the gateway) holds it back
  * rather than have semo__deliver drop it on the static schedule. */
 bool semo__inbox_holds_back(void);
+/* Whether the inbox is full and no task has polled it yet: a delivery then
+ * waits at most SEMO__INBOX_UNPOLLED_WAIT_MS (mission ms) for room before
+ * the message is dropped (a robot that receives nothing must not hold back
+ * its transport for ever). */
+bool semo__inbox_unpolled_full(void);
+#define SEMO__INBOX_UNPOLLED_WAIT_MS 1000
 /* What every send does before the transport: checks the arguments and
  * traces the send; -1 on bad arguments, 1 when it went to the operator
  * console ("USER", whose record is the trace), 0 when the transport must
@@ -454,6 +467,14 @@ void semo__link_commit(unsigned char kind, size_t len);
  * written again in place (semo_link_waiting); its new length. */
 unsigned char *semo__link_waiting(unsigned char kind);
 void semo__link_rewrite(size_t len);
+#ifdef SEMO_LOCKSTEP
+/* semo_static_lockstep.c's: mission time as the coordinator granted it;
+ * reports the robot idle until `wake_ms` (INT64_MAX: until a message) and
+ * returns once the coordinator grants a time (after delivering what came)
+ * or ends the run (the program is then stopped). */
+int64_t semo__lockstep_now(void);
+void semo__lockstep_idle(int64_t wake_ms);
+#endif
 /* semo_static_status.c's: the robot's status, kept from each trace event
  * (semo__trace_emit's) and sent on the link when it changes. */
 void semo__status_observe(const char *event, va_list args);

@@ -324,6 +324,9 @@ void semo__queue_written(int queue)
     }
 }
 
+/* A receiver waits for room in the inbox instead (semo__queue_wait). */
+void semo__inbox_polled(void) {}
+
 /* Only a writer waits on a channel that has just been taken from. */
 void semo__queue_taken(int queue)
 {
@@ -550,18 +553,6 @@ void semo_wake(const char *task_name)
     wake_task(find_task(task_name));
 }
 
-/* The first instant at or after `at` of the grid of `period_ms` that
- * starts at `first` (INT64_MAX stays: no time). */
-static int64_t on_grid(int64_t at, int64_t first, int64_t period_ms)
-{
-    if (at == INT64_MAX || at <= first || period_ms <= 0)
-        return at;
-    int64_t periods = (at - first) / period_ms + ((at - first) % period_ms != 0);
-    if (periods > (INT64_MAX - first) / period_ms)
-        return INT64_MAX;
-    return first + periods * period_ms;
-}
-
 /* Time- and data-driven tasks start running; control-driven ones wait
  * for the control task. All of them obey UFControl_*. */
 static void *task_thread(void *arg)
@@ -601,10 +592,10 @@ static void *task_thread(void *arg)
              * the next (as the simulator's control task fires every period
              * from its start, and only then). The instant is kept once
              * chosen: on the wall clock a wait ends a little after it. */
-            due = on_grid(due, first_release, d->period_ms);
+            due = semo__on_grid(due, first_release, d->period_ms);
             if (t->woken && due < now) {
                 if (woken_release < 0)
-                    woken_release = on_grid(now, first_release, d->period_ms);
+                    woken_release = semo__on_grid(now, first_release, d->period_ms);
                 due = woken_release;
             }
             if (now < due) {
@@ -613,7 +604,7 @@ static void *task_thread(void *arg)
                 continue;
             }
             woken_release = -1;
-            next_release = on_grid(now + 1, first_release, d->period_ms);
+            next_release = semo__on_grid(now + 1, first_release, d->period_ms);
             t->hinted = t->woken = false;
         }
         pthread_mutex_unlock(&t->lock);

@@ -189,6 +189,10 @@ typedef struct {
     size_t peer_count;
     size_t self; /* index of this robot in `peers` */
     size_t robot_count; /* robots of the mission (its peers are some of them) */
+    /* A task takes messages from the inbox (the communication task): without
+     * one, a message that arrives is ignored, as the simulator's robot that
+     * takes no message hears none (it would fill the inbox for nothing). */
+    bool receives;
     /* Static schedule only: one iteration of the single-appearance schedule. */
     const semo_firing *schedule;
     size_t schedule_count;
@@ -229,7 +233,10 @@ int semo_main(int argc, char **argv, const semo_program_desc *program);
 void Core_1_go(void);
 /* For a task body on the static schedule that must wait (a service taking
  * time): the current firing is not over; the body returns and is called
- * again at the next pass, and the task stays busy (not idle) meanwhile. */
+ * again at the next pass, and the task stays busy (not idle) meanwhile.
+ * When the program stops, a firing under way is called once more, with
+ * semo_running() false, to end (a call under way ends with the program, as
+ * a POSIX task's wait does). */
 void semo_firing_continues(void);
 #endif
 
@@ -327,7 +334,7 @@ void semo_next_firing(int64_t at_ms);
 
 /* Something task `task` waits for changed that is none of the above (the
  * communication task recorded a robot's arrival at a group statement): if
- * it sleeps on its semo_next_firing hint, it fires now. POSIX only. */
+ * it sleeps on its semo_next_firing hint, it fires now. */
 void semo_wake(const char *task);
 
 /* Task parameters (per task, by name); unknown ones read as 0. */

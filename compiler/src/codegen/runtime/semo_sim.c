@@ -201,26 +201,6 @@ static void sim_stop(void)
     g_late.started = false;
 }
 
-bool semo_sim_sensor(const char *value, semo_type type, semo_value *out)
-{
-    const semo__sim_sensor_entry *latest = NULL;
-    int64_t now = semo_now_ms();
-    for (size_t i = 0; value && i < semo__scenario.sensor_count; i++) {
-        const semo__sim_sensor_entry *e = &semo__scenario.sensors[i];
-        if (e->at <= now && strcmp(e->value, value) == 0 && (!latest || e->at >= latest->at))
-            latest = e;
-    }
-    semo_value read;
-    if (latest)
-        return semo_value_parse(out ? out : &read, type, latest->is);
-    if (value && strcmp(value, "BATTERY") == 0 && semo__scenario.battery_count > 0) {
-        char text[400]; /* "%.0f" of any double fits */
-        snprintf(text, sizeof text, "%.0f", semo__sim_battery_at(now));
-        return semo_value_parse(out ? out : &read, type, text);
-    }
-    return false;
-}
-
 void semo_sim_actuate(const char *task, const semo_value *command)
 {
     semo_trace_value("actuate", "value", command ? command : SEMO_LIT(""), "task", task, NULL);

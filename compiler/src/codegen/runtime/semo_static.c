@@ -55,7 +55,11 @@ void semo_stop_program(void)
 
 int64_t semo_now_ms(void)
 {
+#ifdef SEMO_LOCKSTEP
+    return semo__lockstep_now();
+#else
     return semo__board_now_ms() - g_start_ms;
+#endif
 }
 
 /* Blocks the whole loop: only for start-up code, never in a task body. */
@@ -63,14 +67,18 @@ void semo_sleep_ms(int64_t ms)
 {
     int64_t end = semo_now_ms() + ms;
     while (g_running && semo_now_ms() < end)
+#ifdef SEMO_LOCKSTEP
+        semo__lockstep_idle(end);
+#else
         semo__board_sleep_until(g_start_ms + end);
+#endif
 }
 
 /* ----------------------------------------------------------------- traces */
 
 void semo__trace_emit(const char *event, const char *value_key, const semo_value *value, va_list args)
 {
-#ifdef SEMO_LINK
+#if defined(SEMO_LINK) && !defined(SEMO_LOCKSTEP)
     /* The status follows the trace (before its line, as on POSIX). */
     va_list seen;
     va_copy(seen, args);
@@ -81,9 +89,9 @@ void semo__trace_emit(const char *event, const char *value_key, const semo_value
     semo__trace_line(&sink, semo_now_ms(), g_prog ? g_prog->robot : "", event, args, value_key, value);
 }
 
-#ifndef SEMO_LINK
-/* A board robot alone has no status (a linked one's is in
- * semo_static_status.c, its groups with it). */
+#if !defined(SEMO_LINK) || defined(SEMO_LOCKSTEP)
+/* A board robot alone, or in lock-step, has no status (a linked one's is
+ * in semo_static_status.c, its groups with it). */
 void semo_status_group(unsigned statement, const char *group, size_t alive)
 {
     (void)statement;
@@ -121,11 +129,24 @@ void semo__queue_unlock(int queue)
     (void)queue;
 }
 
-/* Nothing would write while this waited: a read of an empty queue returns. */
+#ifdef SEMO_LOCKSTEP
+static bool drain_inbox(void);
+#endif
+
+/* Nothing would write while this waited: a read of an empty queue returns.
+ * In lock-step a delivery to a full inbox (messages come only between
+ * passes) fires the task that reads it first, as a POSIX robot's receiver
+ * waits for it; elsewhere the message is dropped (a link holds it back on
+ * the line instead: semo__inbox_holds_back). */
 bool semo__queue_wait(int queue, int64_t deadline_ms)
 {
-    (void)queue;
     (void)deadline_ms;
+#ifdef SEMO_LOCKSTEP
+    if (queue == SEMO__INBOX)
+        return drain_inbox();
+#else
+    (void)queue;
+#endif
     return false;
 }
 
@@ -198,6 +219,9 @@ struct task_s {
 };
 
 static task g_tasks[SEMO_MAX_TASKS];
+/* Mission time of the loop's first pass: the start of every time-driven
+ * task's period grid (-1: before it). */
+static int64_t g_first_pass_ms = -1;
 static bool g_continues; /* set by the body being fired */
 static task *g_current;  /* the task being fired */
 
@@ -211,11 +235,44 @@ static task *find_task(const char *name)
     return NULL;
 }
 
+#ifdef SEMO_LOCKSTEP
+/* The task that reads the inbox: the last one that polled it. */
+static task *g_inbox_reader;
+#endif
+
+void semo__inbox_polled(void)
+{
+#ifdef SEMO_LOCKSTEP
+    if (g_current)
+        g_inbox_reader = g_current;
+#endif
+}
+
+#ifdef SEMO_LOCKSTEP
+static void fire_if_due(size_t i);
+
+/* Outside any firing, the inbox full: fires its reader once; whether it
+ * made room. */
+static bool drain_inbox(void)
+{
+    if (!g_inbox_reader || g_current)
+        return false;
+    bool held = semo__inbox_holds_back();
+    fire_if_due((size_t)(g_inbox_reader - g_tasks));
+    return held && !semo__inbox_holds_back();
+}
+#endif
+
 /* Something task `t` may wait for happened: its hint is void. */
 static void wake_task(task *t)
 {
     if (t && t != g_current)
         t->woken = true;
+}
+
+void semo_wake(const char *task_name)
+{
+    wake_task(find_task(task_name));
 }
 
 static void wake_reader(int port)
@@ -279,6 +336,23 @@ void semo_firing_continues(void)
     g_continues = true;
 }
 
+/* When a running time-driven task that is not in a firing fires next: its
+ * period, or its hint unless it was woken, on the period's grid from its
+ * first firing, the loop's first pass, as every time-driven task runs from
+ * the start (a task woken between two grid points fires at the next,a task woken between two grid points fires at the next,
+ * as the simulator's control task fires every period from its start, and
+ * only then; as on POSIX). */
+static int64_t time_due(const task *t, int64_t period_ms, int64_t now)
+{
+    int64_t due = t->next_release;
+    if (t->hinted && !t->woken && t->hint_ms > due)
+        due = t->hint_ms;
+    due = semo__on_grid(due, g_first_pass_ms, period_ms);
+    if (t->woken && due < now)
+        due = semo__on_grid(now, g_first_pass_ms, period_ms);
+    return due;
+}
+
 /* Fires task `i` if it is due; the rules of the POSIX threads, one step at a time. */
 static void fire_if_due(size_t i)
 {
@@ -298,9 +372,9 @@ static void fire_if_due(size_t i)
     if (t->in_firing && hint_holds && now < t->hint_ms)
         return;
     if (d->trigger == SEMO_TRIGGER_TIME && !t->in_firing) {
-        if (now < t->next_release || (hint_holds && now < t->hint_ms))
+        if (now < time_due(t, d->period_ms, now))
             return;
-        t->next_release = now + d->period_ms;
+        t->next_release = semo__on_grid(now + 1, g_first_pass_ms, d->period_ms);
     }
     t->hinted = t->woken = false;
     g_continues = false;
@@ -455,19 +529,6 @@ int semo_comm_send(const char *to_team, semo_msg_kind kind, const char *key, con
 #ifdef SEMO_SIM
 #define DEFAULT_SERVICE_MS 100
 
-bool semo_sim_sensor(const char *value, semo_type type, semo_value *out)
-{
-    const semo__sim_sensor_entry *latest = NULL;
-    int64_t now = semo_now_ms();
-    for (size_t i = 0; value && i < semo__scenario.sensor_count; i++) {
-        const semo__sim_sensor_entry *e = &semo__scenario.sensors[i];
-        if (e->at <= now && strcmp(e->value, value) == 0 && (!latest || e->at >= latest->at))
-            latest = e;
-    }
-    semo_value read;
-    return latest && semo_value_parse(out ? out : &read, type, latest->is);
-}
-
 void semo_sim_actuate(const char *task, const semo_value *command)
 {
     semo_trace_value("actuate", "value", command ? command : SEMO_LIT(""), "task", task, NULL);
@@ -532,6 +593,16 @@ static void start_operator(void)
 
 void Core_1_go(void)
 {
+    /* At one instant the calls whose service time ends come before the
+     * control firing that sees them (docs/language/timing.md, "One instant,
+     * step by step"): a continuing firing whose time has come goes first,
+     * whatever its place in the schedule. */
+    int64_t now = semo_now_ms();
+    for (size_t s = 0; s < g_prog->schedule_count && g_running; s++) {
+        const task *t = &g_tasks[g_prog->schedule[s].task];
+        if (t->in_firing && t->hinted && !t->woken && t->hint_ms <= now)
+            fire_if_due(g_prog->schedule[s].task);
+    }
 #ifdef SEMO_SIM
     deliver_operator_commands();
 #endif
@@ -539,6 +610,24 @@ void Core_1_go(void)
         const semo_firing *f = &g_prog->schedule[s];
         for (unsigned n = 0; n < f->count && g_running; n++)
             fire_if_due(f->task);
+    }
+}
+
+/* The program stopped: each firing under way is called once more, in the
+ * schedule's order, to end (a call under way ends with the program:
+ * `call_end`, then `stop`, as on POSIX and in the simulator). */
+static void end_firings(void)
+{
+    for (size_t s = 0; s < g_prog->schedule_count; s++) {
+        task *t = &g_tasks[g_prog->schedule[s].task];
+        if (!t->in_firing)
+            continue;
+        g_continues = false;
+        g_current = t;
+        if (g_prog->tasks[g_prog->schedule[s].task].go)
+            g_prog->tasks[g_prog->schedule[s].task].go();
+        g_current = NULL;
+        t->in_firing = false;
     }
 }
 
@@ -571,9 +660,7 @@ static int64_t next_due(int64_t now)
         } else if (t->control.state != SEMO_TASK_RUNNING) {
             continue;
         } else if (g_prog->tasks[i].trigger == SEMO_TRIGGER_TIME) {
-            due = t->next_release;
-            if (hint_holds && t->hint_ms > due)
-                due = t->hint_ms;
+            due = time_due(t, g_prog->tasks[i].period_ms, now);
         } else if ((!t->control.repeat && t->control.calls > 0) || input_waiting(i) || semo__inbox_waiting()) {
             due = now;
         }
@@ -640,17 +727,29 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
 #endif
     semo_trace("start", "team", program->team, "type", program->robot_type ? program->robot_type : "", "mission",
                program->mission ? program->mission : "", NULL);
+#ifdef SEMO_LOCKSTEP
+    /* A fault at the instant the robot starts comes after its `start` and
+     * before anything else it does, as in the simulator. */
+    semo__lockstep_idle(semo_now_ms());
+#endif
     for (size_t i = 0; i < program->task_count; i++)
         if (program->tasks[i].init)
             program->tasks[i].init();
+    g_first_pass_ms = semo_now_ms();
     while (g_running) {
 #ifdef SEMO_LINK
         semo__link_pump();
 #endif
+        /* At the scenario's duration the robot stops first: nothing of
+         * that instant runs. */
+        if (duration > 0 && semo_now_ms() >= duration)
+            break;
         Core_1_go();
         g_passes++;
         int64_t now = semo_now_ms();
-        if (duration > 0 && now >= duration)
+        /* A program that stopped itself (its mission finished) stops at
+         * this instant, not at its next deadline. */
+        if (!g_running || (duration > 0 && now >= duration))
             break;
         int64_t wake = next_due(now);
 #ifdef SEMO_SIM
@@ -666,9 +765,14 @@ int semo_main(int argc, char **argv, const semo_program_desc *program)
             wake = link - g_start_ms;
 #endif
         if (wake > now)
+#ifdef SEMO_LOCKSTEP
+            semo__lockstep_idle(wake);
+#else
             semo__board_sleep_until(wake == INT64_MAX ? INT64_MAX : g_start_ms + wake);
+#endif
     }
     g_running = false;
+    end_firings();
     for (size_t i = 0; i < program->task_count; i++)
         if (program->tasks[i].wrapup)
             program->tasks[i].wrapup();

@@ -24,7 +24,8 @@
  * acknowledged and traces what the link lost, then, after its `stop`, at
  * most 2 s more for its last status.
  */
-#ifdef SEMO_LINK
+/* In lock-step the port speaks to the coordinator (semo_static_lockstep.c). */
+#if defined(SEMO_LINK) && !defined(SEMO_LOCKSTEP)
 #include "semo_internal.h"
 #include "semo_link.h"
 

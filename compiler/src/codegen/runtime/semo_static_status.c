@@ -40,7 +40,8 @@
  * gone), goes with the next event instead, if any. Nothing goes before the
  * robot's `start`.
  */
-#ifdef SEMO_LINK
+/* In lock-step (-DSEMO_LOCKSTEP) the robot has no operators. */
+#if defined(SEMO_LINK) && !defined(SEMO_LOCKSTEP)
 #include "semo_internal.h"
 #include "semo_link.h"
 

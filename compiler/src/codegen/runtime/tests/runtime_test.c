@@ -389,6 +389,7 @@ static const char *const task_words[] = {"LEFT", "RIGHT"};
 static int run_tasks(int argc, char **argv)
 {
     const semo_program_desc program = {
+        .receives = true, /* its tasks may take messages (semo_comm_poll) */
         SIM_WORLD
         .words = task_words,
         .word_count = 2,
@@ -426,6 +427,7 @@ static const semo_peer minimal_peers[] = {{"SoloTeam", "solo", 0}};
 static int run_minimal(int argc, char **argv)
 {
     const semo_program_desc program = {
+        .receives = true,
         SIM_WORLD
         .mission = "minimal.mission",
         .team = "SoloTeam",
@@ -483,6 +485,7 @@ static const semo_channel_desc wake_channels[] = {{"Poker", "OUT", "Sleeper", "I
 static int run_wake(int argc, char **argv)
 {
     const semo_program_desc program = {
+        .receives = true,
         SIM_WORLD
         .mission = "wake.mission",
         .team = "SoloTeam",
@@ -557,6 +560,7 @@ static const semo_task_desc ponger_tasks[] = {{"Ponger", SEMO_TRIGGER_DATA, 0, N
 static int run_udp(int argc, char **argv, bool alpha)
 {
     const semo_program_desc program = {
+        .receives = true,
         SIM_WORLD
         .mission = "udp.mission",
         .team = alpha ? "Alpha" : "Beta",
@@ -638,6 +642,7 @@ static const semo_channel_desc sim_channels[] = {
 static int run_sim(int argc, char **argv)
 {
     const semo_program_desc program = {
+        .receives = true,
         SIM_WORLD
         .mission = "remote.mission",
         .team = "RemoteTeam",
