@@ -118,10 +118,11 @@ fn run_in_qemu(elf: &Path, target: &str) -> Vec<String> {
 
 /// What must match between the two traces: modes, services started and
 /// ended per plan, events thrown, and the services called, in order. A
-/// service called again and again counts once per run of calls: how many
-/// calls fit in a time differs by a control period between the two
-/// schedules (threads racing at the end of a call, or a loop firing the
-/// control task first), as between linux-sim and the simulator.
+/// service called again and again counts once per run of calls: on the
+/// wall clock (QEMU's virtual one here, linux-sim's real one) how many
+/// calls fit in a time may differ by a control period. In lock-step both
+/// give the simulator's trace exactly (`tests/board_lockstep.rs`,
+/// `tests/differential.rs`).
 fn behaviour(events: &[Event], until: i64) -> Vec<String> {
     let mut out: Vec<String> = events
         .iter()

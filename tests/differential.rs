@@ -179,6 +179,26 @@ fn a_restarted_leader_comes_back_the_same_way_in_c_and_in_the_simulator() {
 /// send path in C): tb_0 is fenced while tb_1 and tb_2 elect tb_1, then
 /// healed it follows tb_1 until tb_1 gives way (docs/groups.md, "Fencing"),
 /// in both, at the same instants.
+/// tb_0 restarted at 2601 ms, the instant its teammates' heartbeats of
+/// 2600 ms arrive: sent while it was down, they do not reach its new
+/// process (a message reaches the process its receiver ran when it was
+/// sent), in both.
+#[test]
+fn messages_sent_while_a_robot_was_down_miss_it_restarted_the_same_way_in_c_and_in_the_simulator() {
+    let (processes, _) = compare(
+        "restart_at_arrival",
+        &examples().join("swarm/patrol_groups.mission"),
+        r#"{"duration": 4000, "faults": [{"at": 1200, "kill": "tb_0"}, {"at": 2601, "restart": "tb_0"}]}"#,
+    );
+    let heard_at_restart = processes["tb_0"]
+        .iter()
+        .any(|e| e["t"].as_i64() == Some(2601) && field(e, "event") == "receive");
+    assert!(
+        !heard_at_restart,
+        "tb_0 heard what was sent while it was down"
+    );
+}
+
 #[test]
 fn a_leader_cut_off_is_fenced_the_same_way_in_c_and_in_the_simulator() {
     let (processes, _) = compare(

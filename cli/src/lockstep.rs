@@ -195,6 +195,14 @@ impl Drop for OneCpu {
     }
 }
 
+/// A message on its way.
+struct InFlight {
+    to: usize,
+    /// The receiver's process when it was sent (its count of starts).
+    incarnation: u32,
+    datagram: Vec<u8>,
+}
+
 /// What became of a message offered to a robot.
 enum Offered {
     Taken,
@@ -253,8 +261,8 @@ struct Coordinator<'r, 'a> {
     live: Vec<Option<Live>>,
     incarnations: Vec<u32>,
     now: i64,
-    /// (arrival, sender, sequence) → (receiver, datagram): the delivery order.
-    in_flight: BTreeMap<(i64, usize, u64), (usize, Vec<u8>)>,
+    /// (arrival, sender, sequence) → the message: the delivery order.
+    in_flight: BTreeMap<(i64, usize, u64), InFlight>,
     /// Per robot, the messages that arrived for it, in order, from the
     /// first it refused (a board whose inbox is full and unpolled).
     kept: Vec<VecDeque<Vec<u8>>>,
@@ -564,8 +572,15 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             return Ok(());
         }
         let arrival = self.now + latency;
-        self.in_flight
-            .insert((arrival, peer, self.sent), (to, datagram));
+        // It reaches the process the receiver ran when it was sent, as in
+        // the simulator (a robot restarted meanwhile, or down then, does
+        // not hear it).
+        let message = InFlight {
+            to,
+            incarnation: self.incarnations[to],
+            datagram,
+        };
+        self.in_flight.insert((arrival, peer, self.sent), message);
         self.sent += 1;
         Ok(())
     }
@@ -649,7 +664,14 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             if entry.key().0 > self.now {
                 break;
             }
-            let (to, datagram) = entry.remove();
+            let InFlight {
+                to,
+                incarnation,
+                datagram,
+            } = entry.remove();
+            if incarnation != self.incarnations[to] {
+                continue;
+            }
             if !self.kept[to].is_empty() {
                 self.kept[to].push_back(datagram);
                 continue;
