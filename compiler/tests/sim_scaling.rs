@@ -101,21 +101,24 @@ fn the_simulators_work_follows_the_robots_and_its_memory_not_the_runs_length() {
         "{queued_large} queue entries for {events_large} events"
     );
     ratio("allocations", work_small, work_large, 2.2);
-    // Under three allocations per event, the trace line's text among them:
-    // each trace event's fields in a list of their own on the heap, and a
-    // text value copied into every slot and message that carries it, took
-    // 5.4 (5.42 on the 96 robots); each heartbeat's text made anew and each
-    // instant's recipients listed twice, 3.16 (2.68 since).
+    // Under two and a half allocations per event, the trace line's text
+    // among them: each trace event's fields in a list of their own on the
+    // heap, and a text value copied into every slot and message that
+    // carries it, took 5.4 (5.42 on the 96 robots); each heartbeat's text
+    // made anew and each instant's recipients listed twice, 3.16 (2.90
+    // since); a trace line's text grown from 64 bytes and a list of the
+    // channels each message taken writes, 3.00 (2.02 since).
     let per_event = work_large as f64 / events_large as f64;
     eprintln!("allocations per event: {per_event:.2}");
     assert!(
-        per_event <= 3.0,
+        per_event <= 2.5,
         "{per_event:.2} allocations per event ({work_large} for {events_large})"
     );
     ratio("peak bytes", peak_small, peak_large, 2.2);
 
-    // (The swarm's owners of shared values fall behind their messages: a
-    // backlog that grows with the run, as in the generated C.)
+    // (A receive task held up by a full channel takes every message behind
+    // it once free: no backlog grows with the run. It took one message at
+    // a time, and the 1,002-robot benchmark's grew to 290 of its 362 MB.)
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let patrol = std::fs::read_to_string(root.join("examples/swarm/patrol_groups.mission"))
         .expect("the example");
@@ -124,7 +127,7 @@ fn the_simulators_work_follows_the_robots_and_its_memory_not_the_runs_length() {
     let (events_long, _, peak_long, _) = cost(&patrol, 80_000);
     ratio("events", events_short as usize, events_long as usize, 4.2);
     // A kept trace took four times the memory.
-    ratio("peak bytes", peak_short, peak_long, 1.3);
+    ratio("peak bytes", peak_short, peak_long, 1.1);
 }
 
 /// What simulating `programs` for `until_ms` as `semo simulate` runs a

@@ -261,8 +261,10 @@ impl Event {
 /// making room; it is then dropped.
 #[derive(Clone)]
 struct Holding {
-    /// The channels still to write, with the value for each.
-    pending: VecDeque<(usize, Held)>,
+    /// The channels still to write, with the value for each, in order
+    /// (inline: a message feeds one channel or two, and the receive task
+    /// takes every message through here).
+    pending: smallvec::SmallVec<[(usize, Held); 2]>,
     mark: u64,
     from: Rc<str>,
     key: Rc<str>,
@@ -1438,6 +1440,10 @@ impl<'p> Sim<'p> {
         self.take_behind(r, firing_ended);
         // Held up, it takes heartbeats one by one; free, folded again.
         let robot = &self.robots[r];
+        debug_assert!(
+            robot.holding.is_some() || robot.behind.is_empty(),
+            "a free receive task takes every message behind"
+        );
         let folds = robot.heartbeats_at_once && robot.holding.is_none();
         if self.folded.is_some() && folds != robot.folded_from.is_some() {
             if folds {
@@ -1453,20 +1459,26 @@ impl<'p> Sim<'p> {
         loop {
             let robot = &mut self.robots[r];
             let Some(holding) = &mut robot.holding else {
-                return;
+                // Free: it takes the messages behind, in order, until one
+                // is held up again (CommReceive's loop).
+                let Some(next) = robot.behind.pop_front() else {
+                    return;
+                };
+                self.take_in(r, &next);
+                continue;
             };
             let give_up = firing_ended && robot.firings > holding.mark;
             let (mut queued, mut dropped) = (false, false);
-            while let Some((channel, _)) = holding.pending.front() {
+            while let Some((channel, _)) = holding.pending.first() {
                 let (queue, capacity) = &mut robot.inbox[*channel];
                 if queue.len() < *capacity {
-                    let (_, value) = holding.pending.pop_front().expect("a front");
+                    let (_, value) = holding.pending.remove(0);
                     queue.push_back(value);
                     queued = true;
                 } else if give_up || robot.stalled[*channel] {
                     robot.stalled[*channel] = true;
                     robot.dropped[*channel] += 1;
-                    holding.pending.pop_front();
+                    holding.pending.remove(0);
                     dropped = true;
                 } else {
                     break;
@@ -1490,12 +1502,7 @@ impl<'p> Sim<'p> {
             if waits {
                 return;
             }
-            let robot = &mut self.robots[r];
-            robot.holding = None;
-            let Some(next) = robot.behind.pop_front() else {
-                return;
-            };
-            self.take_in(r, &next);
+            self.robots[r].holding = None;
         }
     }
 
@@ -1554,7 +1561,7 @@ impl<'p> Sim<'p> {
         }
         // A value of another type than the key's is refused
         // (`semo_value_coerce`); text is read as the type.
-        let mut pending = VecDeque::new();
+        let mut pending = smallvec::SmallVec::new();
         let mut rejected = false;
         for (i, (incoming, (from_team, key))) in m.incoming.iter().zip(&names.incoming).enumerate()
         {
@@ -1567,7 +1574,7 @@ impl<'p> Sim<'p> {
                     rejected = true;
                     continue;
                 };
-                pending.push_back((i, value));
+                pending.push((i, value));
             }
         }
         if !pending.is_empty() {

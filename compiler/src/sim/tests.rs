@@ -540,6 +540,32 @@ fn link_faults_lose_and_delay_messages() {
     assert_eq!(late.t - late.sent_at.unwrap(), 251);
 }
 
+/// A receive task held up by a full channel takes, once free, every
+/// message that waited behind, in order, until one is held up again (as
+/// the generated CommReceive's loop does). It took one: the rest waited
+/// behind for ever, unheard (heartbeats among them), and a swarm's backlog
+/// grew with the run (290 of the 1,002-robot benchmark's 362 MB).
+#[test]
+fn messages_behind_a_held_receive_task_are_all_taken() {
+    let programs = programs("tests/fixtures/messages/behind.mission");
+    let (run, _) = run(&programs, r#"{"duration": 60000}"#, 0);
+    let count = |event: &str, key: &str| {
+        (run.trace.iter())
+            .filter(|e| e.event == event && e.field("key") == Some(key))
+            .count()
+    };
+    // The team's own messages: each reaches the five others.
+    for key in ["Team0.__alive", "Team0.Status"] {
+        let (sent, received) = (count("send", key), count("receive", key));
+        assert!(sent >= 300, "{key}: {sent} sent");
+        assert_eq!(
+            received,
+            5 * sent,
+            "{key}: each of the five others takes each one"
+        );
+    }
+}
+
 #[test]
 fn a_sensor_value_no_task_samples_is_a_positioned_warning_with_a_did_you_mean() {
     let programs = programs("examples/scouting/scouting.mission");

@@ -39,7 +39,9 @@ impl TraceEvent {
 
     /// The event as one JSON line (without the newline), as `semo_trace` writes it.
     pub fn to_json(&self, robot: &str) -> String {
-        let mut out = String::with_capacity(64);
+        // Room for most lines at once: a message's line (sender, key and
+        // value) is about 100 bytes, and from 64 each grew once more.
+        let mut out = String::with_capacity(128);
         let _ = write!(out, "{{\"t\":{},\"robot\":", self.t);
         json_string(&mut out, robot);
         out.push_str(",\"event\":");
