@@ -5,7 +5,7 @@
 //! each talking to its neighbours) with twice the teams takes at most about
 //! twice the events, entries of the event queue, allocations and peak of
 //! live bytes, and four times the mission time of a mission takes about the
-//! same memory, and an event costs about three allocations. One test, so
+//! same memory, and an event costs under two and a half allocations. One test, so
 //! that nothing else allocates while it counts.
 //!
 //! Measured with a counting allocator and the engine's event count, not a

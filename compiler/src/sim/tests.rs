@@ -5,6 +5,9 @@ use super::*;
 use crate::refine::{RobotProgram, ServiceMachineId, StateId};
 use std::path::Path;
 
+#[path = "../../benches/common/mission.rs"]
+mod mission;
+
 fn repo(path: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join(path)
 }
@@ -12,10 +15,20 @@ fn repo(path: &str) -> std::path::PathBuf {
 /// The refined programs of an example mission, as `semo simulate` gets them.
 pub(super) fn programs(mission: &str) -> Vec<RobotProgram> {
     let (run, id) = crate::host::load_build(&repo(mission), &[]).unwrap();
-    let build = run
-        .analysis()
-        .build_input(id)
-        .expect("the mission was checked");
+    refined(&run.analysis(), id)
+}
+
+/// The refined programs of a mission's text (the built-in catalog only).
+fn programs_of_text(name: &str, text: String) -> Vec<RobotProgram> {
+    let mut host = crate::host::AnalysisHost::default();
+    let id = crate::diag::FileId(0);
+    let kind = crate::workspace::FileKind::Mission;
+    host.set_file(id, Some(name.into()), kind, text.into());
+    refined(&host.analysis(), id)
+}
+
+fn refined(analysis: &crate::host::Analysis, id: crate::diag::FileId) -> Vec<RobotProgram> {
+    let build = analysis.build_input(id).expect("the mission was checked");
     let refined = crate::refine::refine_checked(&build.input());
     assert!(!refined.programs.is_empty(), "{:#?}", refined.diagnostics);
     refined.programs
@@ -547,7 +560,10 @@ fn link_faults_lose_and_delay_messages() {
 /// grew with the run (290 of the 1,002-robot benchmark's 362 MB).
 #[test]
 fn messages_behind_a_held_receive_task_are_all_taken() {
-    let programs = programs("tests/fixtures/messages/behind.mission");
+    // One team of the benchmark swarm: every robot tells the team its
+    // status each second while `Hear` reads one every half second, and the
+    // team's heartbeats (it has a leader and groups) come in between.
+    let programs = programs_of_text("swarm.mission", mission::generate(1));
     let (run, _) = run(&programs, r#"{"duration": 60000}"#, 0);
     let count = |event: &str, key: &str| {
         (run.trace.iter())
