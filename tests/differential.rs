@@ -175,10 +175,6 @@ fn a_restarted_leader_comes_back_the_same_way_in_c_and_in_the_simulator() {
     );
 }
 
-/// The leader cut off from the majority (a partition, applied on the UDP
-/// send path in C): tb_0 is fenced while tb_1 and tb_2 elect tb_1, then
-/// healed it follows tb_1 until tb_1 gives way (docs/groups.md, "Fencing"),
-/// in both, at the same instants.
 /// tb_0 restarted at 2601 ms, the instant its teammates' heartbeats of
 /// 2600 ms arrive: sent while it was down, they do not reach its new
 /// process (a message reaches the process its receiver ran when it was
@@ -199,6 +195,39 @@ fn messages_sent_while_a_robot_was_down_miss_it_restarted_the_same_way_in_c_and_
     );
 }
 
+/// A network of no latency: a message reaches its receivers at the instant
+/// it is sent, so the robots that run after its sender in that instant hear
+/// it first. tb_0 claims leadership (term 1) in its heartbeat of 200 ms, and
+/// tb_1 and tb_2, running after it, say term 1 in theirs of the same
+/// instant, in both; likewise after tb_1 is restarted at 2600 ms, a
+/// heartbeat instant (the coordinator used to run every robot of an instant
+/// before it delivered any of that instant's messages).
+#[test]
+fn messages_of_no_latency_reach_the_robots_running_after_their_sender_in_c_and_in_the_simulator() {
+    let (processes, _) = compare(
+        "no_latency",
+        &examples().join("swarm/patrol_groups.mission"),
+        r#"{"duration": 5000, "network": {"latency": 0},
+            "faults": [{"at": 1000, "kill": "tb_1"}, {"at": 2600, "restart": "tb_1"}]}"#,
+    );
+    let heartbeat_at_200 = |robot: &str| {
+        processes[robot]
+            .iter()
+            .find(|e| {
+                e["t"].as_i64() == Some(200)
+                    && field(e, "event") == "send"
+                    && field(e, "key") == "Guards.__alive"
+            })
+            .map(|e| field(e, "value").to_string())
+    };
+    assert_eq!(heartbeat_at_200("tb_0").as_deref(), Some("leader - 1"));
+    assert_eq!(heartbeat_at_200("tb_2").as_deref(), Some("member - 1"));
+}
+
+/// The leader cut off from the majority (a partition, applied on the UDP
+/// send path in C): tb_0 is fenced while tb_1 and tb_2 elect tb_1, then
+/// healed it follows tb_1 until tb_1 gives way (docs/groups.md, "Fencing"),
+/// in both, at the same instants.
 #[test]
 fn a_leader_cut_off_is_fenced_the_same_way_in_c_and_in_the_simulator() {
     let (processes, _) = compare(

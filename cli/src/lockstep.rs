@@ -7,9 +7,13 @@
 //! the earliest time it wants to wake at), to the earliest of those times,
 //! of the messages' arrivals and of the scenario's process faults. Messages
 //! arrive after the scenario's network latency, delivered in the order of
-//! their senders' peer indices, each sender's in the order it sent them. A
-//! run is then a function of the programs and the scenario: no clock is read
-//! and the machine's load changes nothing but how long it takes.
+//! their senders' peer indices, each sender's in the order it sent them. At
+//! one instant the robots run one at a time, in the order they started (as
+//! the simulator fires them), each after the messages that reached it by
+//! then: over a link of no latency a message reaches the robots that run
+//! after its sender at the instant it was sent. A run is then a function of
+//! the programs and the scenario: no clock is read and the machine's load
+//! changes nothing but how long it takes.
 //!
 //! A robot pauses after its `start` line (it reports itself idle at that
 //! instant), so a fault at the instant it starts (a kill at 0 ms, a kill
@@ -276,6 +280,10 @@ struct Coordinator<'r, 'a> {
     faults_after: Vec<BTreeMap<u32, String>>,
     /// The processor of the run (given back when the coordinator goes).
     cpu: OneCpu,
+    /// Per peer, the order of its last start among all starts: the order in
+    /// which the robots due at one instant run (the simulator's).
+    started: Vec<u64>,
+    starts: u64,
 }
 
 impl<'r, 'a> Coordinator<'r, 'a> {
@@ -293,6 +301,8 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             losses: LossDraws::new(run.seed),
             faults_after: vec![BTreeMap::new(); run.robots.len()],
             cpu: OneCpu::take(),
+            started: vec![0; run.robots.len()],
+            starts: 0,
         }
     }
 
@@ -345,15 +355,38 @@ impl<'r, 'a> Coordinator<'r, 'a> {
                     ProcessFault::Kill | ProcessFault::Restart => {}
                 }
             }
-            self.deliver_due()?;
-            for peer in 0..self.live.len() {
+            self.run_instant()?;
+        }
+    }
+
+    /// Runs the robots due now, or told of messages now, one at a time in
+    /// the order of their starts (as the simulator fires them), each after
+    /// the messages that reached it by then: a message sent at this instant
+    /// over a link of no latency reaches the robots that run after its
+    /// sender, as in the simulator.
+    fn run_instant(&mut self) -> Result<(), String> {
+        let mut asked: Vec<Option<bool>> = vec![None; self.live.len()];
+        loop {
+            for (peer, runs) in self.deliver_due()? {
+                asked[peer] = Some(asked[peer].unwrap_or(false) || runs);
+            }
+            for (peer, asked) in asked.iter_mut().enumerate() {
                 let due = self.live[peer]
                     .as_ref()
                     .is_some_and(|l| l.idle && l.wakes_at.is_some_and(|t| t <= self.now));
                 if due {
-                    self.grant(peer)?;
+                    *asked = Some(true);
                 }
             }
+            let Some(peer) = (0..asked.len())
+                .filter(|&p| asked[p].is_some())
+                .min_by_key(|&p| self.started[p])
+            else {
+                return Ok(());
+            };
+            let runs = asked[peer].take().unwrap_or(true);
+            self.grant_as(peer, runs)?;
+            self.wait_until_all_idle()?;
         }
     }
 
@@ -362,6 +395,8 @@ impl<'r, 'a> Coordinator<'r, 'a> {
         let robot = &self.run.robots[peer];
         let incarnation = self.incarnations[peer];
         self.incarnations[peer] += 1;
+        self.started[peer] = self.starts;
+        self.starts += 1;
         let errors = std::fs::File::create(
             self.run
                 .work
@@ -641,7 +676,7 @@ impl<'r, 'a> Coordinator<'r, 'a> {
     /// granted the time (they run what the messages wake). The messages a
     /// board refused go first once it has run since (they arrived before the
     /// others), and stay in order before any that arrive after them.
-    fn deliver_due(&mut self) -> Result<(), String> {
+    fn deliver_due(&mut self) -> Result<Vec<(usize, bool)>, String> {
         let robots = self.live.len();
         let (mut woken, mut told) = (vec![false; robots], vec![false; robots]);
         for (to, woken) in woken.iter_mut().enumerate() {
@@ -682,19 +717,20 @@ impl<'r, 'a> Coordinator<'r, 'a> {
                 Offered::Lost => {}
             }
         }
+        let mut grants = Vec::new();
         for peer in 0..robots {
             if woken[peer] {
-                self.grant(peer)?;
+                grants.push((peer, true));
             } else if told[peer] {
                 // It refused every message, and waits for the time: it runs
                 // only what was due anyway, which alone may make room.
                 let due = self.live[peer]
                     .as_ref()
                     .is_some_and(|l| l.wakes_at.is_some_and(|t| t <= self.now));
-                self.grant_as(peer, due)?;
+                grants.push((peer, due));
             }
         }
-        Ok(())
+        Ok(grants)
     }
 
     /// Sends robot `to` one message: a board is told the instant first
@@ -727,10 +763,6 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             return Ok(Offered::Busy(datagram));
         }
         Ok(Offered::Taken)
-    }
-
-    fn grant(&mut self, peer: usize) -> Result<(), String> {
-        self.grant_as(peer, true)
     }
 
     /// Grants `peer` the time; `runs`: it will run something (what was due,
