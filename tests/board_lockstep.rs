@@ -254,8 +254,8 @@ fn a_leader_on_a_board_fails_over_the_same_way_in_qemu_and_in_the_simulator() {
 /// Random valid missions (`support/missiongen.rs`) with every robot on a
 /// board (the project file's `[build] target`, the LM3S6965 and the
 /// STM32F405 in turn), on random scenarios without link faults (the
-/// linux-sim runtime applies those; a board refuses them): the same exact
-/// comparison.
+/// linux-sim runtime applies those; a board refuses them) and without a
+/// network of no latency: the same exact comparison.
 #[test]
 fn random_missions_on_boards_behave_as_in_the_simulator() {
     if !robots::board_tools_present("random_missions_on_boards_behave_as_in_the_simulator") {
@@ -278,6 +278,14 @@ fn random_missions_on_boards_behave_as_in_the_simulator() {
         let mut scenario: serde_json::Value = serde_json::from_str(&text).unwrap();
         if let Some(faults) = scenario["faults"].as_array_mut() {
             faults.retain(|f| f.get("from").is_none());
+        }
+        // Nor a network of no latency, which boards refuse in lock-step
+        // (`a_board_with_a_link_of_no_latency_is_refused`).
+        if let Some(network) = scenario.get_mut("network").and_then(|n| n.as_object_mut()) {
+            network.remove("latency");
+            if network.is_empty() {
+                scenario.as_object_mut().unwrap().remove("network");
+            }
         }
         let scenario = scenario_file(&dir, &scenario.to_string());
         let reference = simulate(&mission, &scenario, &[], &dir);
@@ -302,6 +310,54 @@ fn random_missions_on_boards_behave_as_in_the_simulator() {
 
 /// `--boards` is a way of running the generated programs: with the
 /// simulator it is refused, clearly.
+/// A board takes messages only between its steps, so a message of no
+/// latency that reaches it before its first step would be taken after it,
+/// where the simulator's robot (and a linux-sim one) takes it within the
+/// step: `--boards` refuses such a network before it builds anything, so
+/// the board tools are not needed to see it.
+#[test]
+fn a_board_with_a_link_of_no_latency_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("no_latency.json");
+    for (network, peer) in [
+        (r#"{"latency": 0}"#, "irobot"),
+        (
+            r#"{"latency": 0, "links": [{"between": ["ti", "irobot"], "latency": 5}]}"#,
+            "nxt",
+        ),
+        (
+            r#"{"links": [{"between": ["nxt", "ti"], "latency": 0}]}"#,
+            "nxt",
+        ),
+    ] {
+        std::fs::write(
+            &scenario,
+            format!(r#"{{"duration": 1000, "network": {network}}}"#),
+        )
+        .unwrap();
+        let out = support::semo_in(
+            &repo_root(),
+            &[
+                "simulate",
+                "examples/scouting/scouting.mission",
+                "--scenario",
+                scenario.to_str().unwrap(),
+                "--engine",
+                "c",
+                "--boards",
+            ],
+        );
+        assert_eq!(out.code, 2, "{network}: {}{}", out.stdout, out.stderr);
+        assert!(
+            out.stderr
+                .contains("robot ti runs on the TI Stellaris LM3S6965")
+                && out.stderr.contains(&format!("here to {peer}:")),
+            "{network}: {}",
+            out.stderr
+        );
+    }
+}
+
 #[test]
 fn boards_without_the_generated_programs_is_refused() {
     let out = support::semo_in(

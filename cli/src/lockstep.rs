@@ -873,6 +873,7 @@ pub fn simulate(
         .iter()
         .map(|p| (p.robot.clone(), p.self_peer))
         .collect();
+    no_latency_on_a_board(refined, targets, network)?;
     // Each program gets its robot's world compiled in: the scenario is
     // read once, here, by the simulator's reader.
     let worlds = scenario.compiled_for_each(&refined.programs);
@@ -986,6 +987,52 @@ pub fn simulate(
             target: target.unwrap_or(semo::platform::Target::LinuxSim),
         })
         .collect())
+}
+
+/// Refuses a board robot with a link of no latency. A message of no
+/// latency reaches the robots that run after its sender in the instant it
+/// was sent, and one that arrives before a robot's first step, into an
+/// inbox no task has read yet, must wait for the task that reads it within
+/// that step: a `linux-sim` robot's receiver waits so, but a board takes
+/// messages only between its steps, so it would act first and take them
+/// after (or never, if that step ends its mission).
+fn no_latency_on_a_board<'r>(
+    refined: &'r semo::refine::Refined,
+    targets: &semo::targets::Targets,
+    network: &semo::sim::scenario::Network,
+) -> Result<(), String> {
+    let on_board = |robot: &'r str| {
+        targets
+            .of(robot)
+            .and_then(|chosen| chosen.target.platform().board.as_ref())
+            .map(|board| (robot, board))
+    };
+    let latency = |a: &str, b: &str| {
+        network
+            .links
+            .iter()
+            .find(|l| {
+                (l.between.0 == a && l.between.1 == b) || (l.between.0 == b && l.between.1 == a)
+            })
+            .and_then(|l| l.latency_ms)
+            .unwrap_or(network.latency_ms)
+    };
+    for (robot, board) in refined.programs.iter().filter_map(|p| on_board(&p.robot)) {
+        let other = refined
+            .programs
+            .iter()
+            .find(|o| o.robot != robot && latency(robot, &o.robot) == 0);
+        if let Some(other) = other {
+            return Err(format!(
+                "robot {robot} runs on the {} board's emulator, which takes the messages of an \
+                 instant only between its steps: a link of no latency (here to {}: a message \
+                 arriving at the instant it is sent) is modelled for linux-sim robots only. Give \
+                 {robot}'s links a latency of 1 ms or more, or run without --boards",
+                board.name, other.robot
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `files` written into `folder` (a work folder of this run's own).

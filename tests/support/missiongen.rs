@@ -787,24 +787,34 @@ pub fn scenario(seed: u64, robots: &[String], duration: i64, time_scale: f64) ->
             ));
         }
     }
-    // Random loss, drawn last so that the faults above stay those of the
-    // seed: on the whole network, or on one link.
-    let mut loss = String::new();
+    // Random loss, drawn after the faults so that those stay the seed's: on
+    // the whole network, or on one link.
+    let mut network = Vec::new();
     if rng.chance(40) {
         let p = 5 + 5 * rng.below(6);
-        loss = if robots.len() >= 2 && rng.chance(50) {
+        network.push(if robots.len() >= 2 && rng.chance(50) {
             let a = rng.below(robots.len());
             let b = (a + 1 + rng.below(robots.len() - 1)) % robots.len();
             format!(
-                r#" "network": {{"links": [{{"between": ["{}", "{}"], "loss": 0.{p:02}}}]}},"#,
+                r#""links": [{{"between": ["{}", "{}"], "loss": 0.{p:02}}}]"#,
                 robots[a], robots[b]
             )
         } else {
-            format!(r#" "network": {{"loss": 0.{p:02}}},"#)
-        };
+            format!(r#""loss": 0.{p:02}"#)
+        });
     }
+    // A network of no latency, drawn last: a message then reaches the
+    // robots that run after its sender in the instant it was sent.
+    if rng.chance(30) {
+        network.push(r#""latency": 0"#.to_string());
+    }
+    let network = if network.is_empty() {
+        String::new()
+    } else {
+        format!(r#" "network": {{{}}},"#, network.join(", "))
+    };
     format!(
-        "{{\"time_scale\": {time_scale}, \"duration\": {duration},{loss}\n \"robots\": {{{}}},\n \"faults\": [{}]}}\n",
+        "{{\"time_scale\": {time_scale}, \"duration\": {duration},{network}\n \"robots\": {{{}}},\n \"faults\": [{}]}}\n",
         worlds.join(",\n  "),
         faults.join(",\n  ")
     )
