@@ -6,12 +6,12 @@
 //! Mission time moves only when every robot is idle (each has said so with
 //! the earliest time it wants to wake at), to the earliest of those times,
 //! of the messages' arrivals and of the scenario's process faults. Messages
-//! arrive after the scenario's network latency, delivered in the order of
-//! their senders' peer indices, each sender's in the order it sent them. At
-//! one instant the robots run one at a time, in the order they started (as
-//! the simulator fires them), each after the messages that reached it by
-//! then: over a link of no latency a message reaches the robots that run
-//! after its sender at the instant it was sent. A run is then a function of
+//! arrive after the scenario's network latency; those arriving at one
+//! instant are delivered in the order they were sent. At one instant the
+//! robots run one at a time, in the order they started (as the simulator
+//! fires them), each after the messages that reached it by then: over a
+//! link of no latency a message reaches the robots that run after its
+//! sender at the instant it was sent. A run is then a function of
 //! the programs and the scenario: no clock is read and the machine's load
 //! changes nothing but how long it takes.
 //!
@@ -220,8 +220,13 @@ enum Offered {
 enum Frame {
     /// Idle until the given time (`None`: until a message or for ever).
     Idle(Option<i64>),
-    /// A datagram for a peer.
-    Message { to: usize, datagram: Vec<u8> },
+    /// A datagram for a peer, to arrive `delay_ms` after the link's
+    /// latency.
+    Message {
+        to: usize,
+        delay_ms: i64,
+        datagram: Vec<u8>,
+    },
     /// A board took the message it was sent.
     Taken,
     /// A board cannot take the message it was sent yet.
@@ -242,7 +247,13 @@ impl Frame {
             }
             Ok((b'M', payload)) if payload.len() >= 4 => Frame::Message {
                 to: u32::from_le_bytes(payload[..4].try_into().expect("four bytes")) as usize,
+                delay_ms: 0,
                 datagram: payload[4..].to_vec(),
+            },
+            Ok((b'L', payload)) if payload.len() >= 12 => Frame::Message {
+                to: u32::from_le_bytes(payload[..4].try_into().expect("four bytes")) as usize,
+                delay_ms: i64::from_le_bytes(payload[4..12].try_into().expect("eight bytes")),
+                datagram: payload[12..].to_vec(),
             },
             Ok((b'A', payload)) if payload.is_empty() => Frame::Taken,
             Ok((b'B', payload)) if payload.is_empty() => Frame::Busy,
@@ -265,8 +276,11 @@ struct Coordinator<'r, 'a> {
     live: Vec<Option<Live>>,
     incarnations: Vec<u32>,
     now: i64,
-    /// (arrival, sender, sequence) → the message: the delivery order.
-    in_flight: BTreeMap<(i64, usize, u64), InFlight>,
+    /// (arrival, sequence) → the message: the delivery order, the order
+    /// the messages were sent in for those arriving at one instant (as the
+    /// simulator's queue numbers them; the robots run one at a time, so the
+    /// order the coordinator hears them in is the order they were sent in).
+    in_flight: BTreeMap<(i64, u64), InFlight>,
     /// Per robot, the messages that arrived for it, in order, from the
     /// first it refused (a board whose inbox is full and unpolled).
     kept: Vec<VecDeque<Vec<u8>>>,
@@ -551,7 +565,11 @@ impl<'r, 'a> Coordinator<'r, 'a> {
                 live.idle = true;
                 live.wakes_at = wakes_at;
             }
-            Frame::Message { to, datagram } => self.route(peer, to, datagram)?,
+            Frame::Message {
+                to,
+                delay_ms,
+                datagram,
+            } => self.route(peer, to, delay_ms, datagram)?,
             frame @ (Frame::Taken | Frame::Busy | Frame::Unexpected(_)) => {
                 return Err(self.unexpected(peer, &frame));
             }
@@ -593,9 +611,16 @@ impl<'r, 'a> Coordinator<'r, 'a> {
         Ok(())
     }
 
-    /// A message `peer` sent to `to`, on its way (or lost, as the scenario
-    /// says).
-    fn route(&mut self, peer: usize, to: usize, datagram: Vec<u8>) -> Result<(), String> {
+    /// A message `peer` sent to `to` now, on its way (or lost, as the
+    /// scenario says), `delay_ms` later than the link's latency (a delay
+    /// fault the sender's runtime applies).
+    fn route(
+        &mut self,
+        peer: usize,
+        to: usize,
+        delay_ms: i64,
+        datagram: Vec<u8>,
+    ) -> Result<(), String> {
         if to >= self.live.len() {
             return Err(format!(
                 "robot {} sent a message to peer {to}, which does not exist",
@@ -606,7 +631,15 @@ impl<'r, 'a> Coordinator<'r, 'a> {
         if loss > 0.0 && self.lost(peer, to, &datagram, loss)? {
             return Ok(());
         }
-        let arrival = self.now + latency;
+        // A scenario's times are at most 10^15 ms, so a sum of them cannot
+        // overflow; a robot saying otherwise is not of this build.
+        if !(0..=1_000_000_000_000_000).contains(&delay_ms) {
+            return Err(format!(
+                "internal error: robot {} delayed a message by {delay_ms} ms",
+                self.run.robots[peer].name
+            ));
+        }
+        let arrival = self.now + latency + delay_ms;
         // It reaches the process the receiver ran when it was sent, as in
         // the simulator (a robot restarted meanwhile, or down then, does
         // not hear it).
@@ -615,7 +648,7 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             incarnation: self.incarnations[to],
             datagram,
         };
-        self.in_flight.insert((arrival, peer, self.sent), message);
+        self.in_flight.insert((arrival, self.sent), message);
         self.sent += 1;
         Ok(())
     }
@@ -645,7 +678,11 @@ impl<'r, 'a> Coordinator<'r, 'a> {
             match Frame::read(&mut live.stream) {
                 Frame::Taken => return Ok(true),
                 Frame::Busy => return Ok(false),
-                Frame::Message { to, datagram } => self.route(peer, to, datagram)?,
+                Frame::Message {
+                    to,
+                    delay_ms,
+                    datagram,
+                } => self.route(peer, to, delay_ms, datagram)?,
                 frame @ (Frame::Idle(_) | Frame::Unexpected(_)) => {
                     return Err(self.unexpected(peer, &frame));
                 }

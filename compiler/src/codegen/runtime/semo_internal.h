@@ -290,6 +290,10 @@ void semo__ls_leave(void);
 void semo__ls_stopping(void);
 /* Ends the link (the program is over). */
 void semo__ls_close(void);
+/* Sends a datagram to `peer` through the coordinator, which holds it
+ * `delay_ms` longer than the network would (a delay fault): taken as sent
+ * now, as the simulator takes it. */
+int semo__ls_send_late(size_t peer, const void *data, size_t len, int64_t delay_ms);
 extern const semo_transport semo_lockstep_transport;
 #endif
 

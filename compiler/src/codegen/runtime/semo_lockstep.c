@@ -25,7 +25,10 @@
  * Frames, both ways: one kind byte, a 32-bit little-endian payload length,
  * the payload. Robot to coordinator: `H` (u32: who it is, its place among
  * the mission's robots, `semo_peer::index`), `I` (i64: the next wake-up, -1
- * none), `M` (u32: the place of the robot it is for, then the datagram).
+ * none), `M` (u32: the place of the robot it is for, then the datagram),
+ * `L` (the same after an i64: the extra delay of a scenario's delay fault,
+ * ms: the coordinator holds the message that much longer, and takes it, for
+ * its random loss and the receiver it reaches, as sent now).
  * Coordinator to robot: `G` (i64: mission time now), `D` (a datagram).
  */
 #define _POSIX_C_SOURCE 200809L
@@ -562,6 +565,17 @@ static int ls_send(size_t peer, const void *data, size_t len)
     unsigned char to[4];
     put_le(to, (uint32_t)p->peers[peer].index, 4);
     return write_frame('M', to, sizeof to, data, len);
+}
+
+int semo__ls_send_late(size_t peer, const void *data, size_t len, int64_t delay_ms)
+{
+    const semo_program_desc *p = semo_program();
+    if (peer >= p->peer_count)
+        return -1;
+    unsigned char head[12];
+    put_le(head, (uint32_t)p->peers[peer].index, 4);
+    put_le(head + 4, (uint64_t)delay_ms, 8);
+    return write_frame('L', head, sizeof head, data, len);
 }
 
 static int ls_recv(void *data, size_t cap, int timeout_ms)

@@ -8,7 +8,8 @@
  * operator commands are delivered into the message queue at their time by
  * one thread. Link faults (drop, delay, partition) act on the send path:
  * semo_comm_send asks semo__sim_link for each robot it sends to, and a
- * delayed datagram is sent by a second thread at its time. Kill and restart
+ * delayed datagram is sent by a second thread at its time (in lock-step it
+ * goes to the coordinator at once, with its delay). Kill and restart
  * faults happen to the process from outside (a crash is not something a
  * program does to itself): they are not in the tables.
  *
@@ -104,6 +105,16 @@ static bool has_delays(void)
 static void sim_send_later(const semo_transport *transport, size_t peer, const void *data, size_t len,
                            int64_t delay_ms)
 {
+    if (semo__ls_on()) {
+        /* In lock-step the coordinator is the network: it holds the message
+         * for the delay, taking it as sent now (its loss drawn in the order
+         * of the sends, its receiver the process running now), as the
+         * simulator does. Held here, it would reach the coordinator only
+         * when due, after later messages, and die with a killed sender. */
+        if (semo__ls_send_late(peer, data, len, delay_ms) != 0)
+            semo_trace("comm_error", "to", semo_program()->peers[peer].robot, NULL);
+        return;
+    }
     late_datagram *d = malloc(sizeof *d + len);
     if (!d) {
         semo_trace("comm_error", "reason", "out of memory for a delayed message", NULL);
