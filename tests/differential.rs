@@ -232,24 +232,41 @@ fn messages_of_no_latency_reach_the_robots_running_after_their_sender_in_c_and_i
 /// used to deliver them by the senders' peer indices, a0's first.)
 #[test]
 fn messages_arriving_together_are_taken_in_the_order_they_were_sent_in_c_and_in_the_simulator() {
-    let (_, reference) = compare(
+    let moves = arrival_order_moves(
         "arrival_order",
-        &repo_root().join("tests/fixtures/arrival_order/order.mission"),
-        r#"{"duration": 1000,
+        r#""duration": 1000,
             "network": {"links": [{"between": ["a0", "b"], "latency": 2}, {"between": ["a1", "b"], "latency": 7}]},
-            "faults": [{"at": 200, "kill": "a0"}, {"at": 305, "restart": "a0"}],
-            "robots": {"a0": {"sensors": [{"at": 0, "value": "LOCATION", "is": "0,0"}]},
-                       "a1": {"sensors": [{"at": 0, "value": "LOCATION", "is": "1,1"}]},
-                       "b": {"services": {"move": 1}}}}"#,
+            "faults": [{"at": 200, "kill": "a0"}, {"at": 305, "restart": "a0"}]"#,
     );
-    let moves: Vec<(i64, &str)> = reference
+    let between_300_and_400: Vec<&(i64, String)> = moves
         .iter()
-        .filter(|e| {
-            field(e, "event") == "call_start" && (300..400).contains(&e["t"].as_i64().unwrap())
-        })
-        .map(|e| (e["t"].as_i64().unwrap(), field(e, "arg")))
+        .filter(|(t, _)| (300..400).contains(t))
         .collect();
-    assert_eq!(moves, [(310, "1,1"), (330, "0,0")]);
+    assert_eq!(
+        between_300_and_400,
+        [&(310, "1,1".to_string()), &(330, "0,0".to_string())]
+    );
+}
+
+/// The arrival-order fixture (a0 at "0,0" and a1 at "1,1" send their
+/// locations to b, which moves to each in 1 ms) on a scenario with
+/// `duration_network_and_faults`, compared in both: b's moves (time, place).
+fn arrival_order_moves(name: &str, duration_network_and_faults: &str) -> Vec<(i64, String)> {
+    let (_, reference) = compare(
+        name,
+        &repo_root().join("tests/fixtures/arrival_order/order.mission"),
+        &format!(
+            r#"{{{duration_network_and_faults},
+                "robots": {{"a0": {{"sensors": [{{"at": 0, "value": "LOCATION", "is": "0,0"}}]}},
+                            "a1": {{"sensors": [{{"at": 0, "value": "LOCATION", "is": "1,1"}}]}},
+                            "b": {{"services": {{"move": 1}}}}}}}}"#
+        ),
+    );
+    reference
+        .iter()
+        .filter(|e| field(e, "event") == "call_start")
+        .map(|e| (e["t"].as_i64().unwrap(), field(e, "arg").to_string()))
+        .collect()
 }
 
 /// A message held by a delay fault is on its way from when it was sent: it
@@ -262,22 +279,17 @@ fn messages_arriving_together_are_taken_in_the_order_they_were_sent_in_c_and_in_
 /// seeds 191 and 299 of `many_random_missions_...`.)
 #[test]
 fn a_delayed_message_outlives_its_killed_sender_in_c_and_in_the_simulator() {
-    let (_, reference) = compare(
+    let moves = arrival_order_moves(
         "delayed_after_kill",
-        &repo_root().join("tests/fixtures/arrival_order/order.mission"),
-        r#"{"duration": 600,
-            "faults": [{"from": 0, "until": 150, "delay": ["a0", "b"], "by": 300}, {"at": 250, "kill": "a0"}],
-            "robots": {"a0": {"sensors": [{"at": 0, "value": "LOCATION", "is": "0,0"}]},
-                       "a1": {"sensors": [{"at": 0, "value": "LOCATION", "is": "1,1"}]},
-                       "b": {"services": {"move": 1}}}}"#,
+        r#""duration": 600,
+            "faults": [{"from": 0, "until": 150, "delay": ["a0", "b"], "by": 300}, {"at": 250, "kill": "a0"}]"#,
     );
-    let after_kill: Vec<i64> = reference
+    let to_a0_after_its_kill: Vec<i64> = moves
         .iter()
-        .filter(|e| field(e, "event") == "call_start" && field(e, "arg") == "0,0")
-        .map(|e| e["t"].as_i64().unwrap())
-        .filter(|&t| t > 250)
+        .filter(|(t, place)| *t > 250 && place == "0,0")
+        .map(|(t, _)| *t)
         .collect();
-    assert_eq!(after_kill, [310, 410]);
+    assert_eq!(to_a0_after_its_kill, [310, 410]);
 }
 
 /// The leader cut off from the majority (a partition, applied on the UDP
